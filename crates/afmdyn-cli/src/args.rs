@@ -1,0 +1,168 @@
+//! Flags shared by every subcommand: the model parameters (with the paper's α aliases), the
+//! TOML config file, the integrator.
+
+use crate::error::CliError;
+use afmdyn::integrate::{IntegratorKind, IntegratorOptions};
+use afmdyn::Params;
+use clap::Args;
+use serde::Deserialize;
+use std::path::PathBuf;
+
+/// Model flags; each overrides the config file, which overrides the defaults (paper Figs. 5–14).
+#[derive(Debug, Clone, Args, Default)]
+pub struct ModelArgs {
+    /// TOML file with model parameters (snake_case names of these flags, or alpha1..alpha6)
+    #[arg(long, value_name = "FILE.toml")]
+    pub config: Option<PathBuf>,
+    /// Number of Galerkin modes N (1..=20)
+    #[arg(long, value_name = "N")]
+    pub modes: Option<usize>,
+    /// Tip-mass ratio α1 = M/(mL)
+    #[arg(
+        long = "tip-mass-ratio",
+        alias = "alpha1",
+        value_name = "α1",
+        allow_negative_numbers = true
+    )]
+    pub alpha1: Option<f64>,
+    /// Base-drive amplitude α2 = f/g0
+    #[arg(
+        long = "drive-amplitude",
+        alias = "alpha2",
+        value_name = "α2",
+        allow_negative_numbers = true
+    )]
+    pub alpha2: Option<f64>,
+    /// Beam damping α3
+    #[arg(
+        long = "beam-damping",
+        alias = "alpha3",
+        value_name = "α3",
+        allow_negative_numbers = true
+    )]
+    pub alpha3: Option<f64>,
+    /// Contact stiffness α4 = K1 L³/(EI)
+    #[arg(
+        long = "contact-stiffness",
+        alias = "alpha4",
+        value_name = "α4",
+        allow_negative_numbers = true
+    )]
+    pub alpha4: Option<f64>,
+    /// Tip–sample gap α5 = g1/g0 (may be negative)
+    #[arg(
+        long = "gap",
+        alias = "alpha5",
+        value_name = "α5",
+        allow_negative_numbers = true
+    )]
+    pub alpha5: Option<f64>,
+    /// Contact damping α6
+    #[arg(
+        long = "contact-damping",
+        alias = "alpha6",
+        value_name = "α6",
+        allow_negative_numbers = true
+    )]
+    pub alpha6: Option<f64>,
+    /// Dimensionless drive frequency Ω
+    #[arg(long, value_name = "Ω", allow_negative_numbers = true)]
+    pub omega: Option<f64>,
+}
+
+/// The model section of a config file. Unknown keys are rejected.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModelFile {
+    /// N.
+    pub modes: Option<usize>,
+    /// α1.
+    #[serde(alias = "alpha1")]
+    pub tip_mass_ratio: Option<f64>,
+    /// α2.
+    #[serde(alias = "alpha2")]
+    pub drive_amplitude: Option<f64>,
+    /// α3.
+    #[serde(alias = "alpha3")]
+    pub beam_damping: Option<f64>,
+    /// α4.
+    #[serde(alias = "alpha4")]
+    pub contact_stiffness: Option<f64>,
+    /// α5.
+    #[serde(alias = "alpha5")]
+    pub gap: Option<f64>,
+    /// α6.
+    #[serde(alias = "alpha6")]
+    pub contact_damping: Option<f64>,
+    /// Ω.
+    pub omega: Option<f64>,
+}
+
+/// Read and parse a TOML config file.
+pub fn read_toml<T: for<'de> Deserialize<'de>>(path: &PathBuf) -> Result<T, CliError> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| CliError::Input(format!("config {}: {e}", path.display())))?;
+    toml::from_str(&text).map_err(|e| {
+        let msg = e.message().replace('\n', " ");
+        CliError::Input(format!("config {}: {msg}", path.display()))
+    })
+}
+
+impl ModelArgs {
+    /// Resolve defaults ← config ← flags and validate.
+    pub fn params(&self, defaults: Params) -> Result<Params, CliError> {
+        let file: ModelFile = match &self.config {
+            Some(p) => read_toml(p)?,
+            None => ModelFile::default(),
+        };
+        let pick = |flag: Option<f64>, file: Option<f64>, def: f64| flag.or(file).unwrap_or(def);
+        let p = Params {
+            modes: self.modes.or(file.modes).unwrap_or(defaults.modes),
+            alpha1: pick(self.alpha1, file.tip_mass_ratio, defaults.alpha1),
+            alpha2: pick(self.alpha2, file.drive_amplitude, defaults.alpha2),
+            alpha3: pick(self.alpha3, file.beam_damping, defaults.alpha3),
+            alpha4: pick(self.alpha4, file.contact_stiffness, defaults.alpha4),
+            alpha5: pick(self.alpha5, file.gap, defaults.alpha5),
+            alpha6: pick(self.alpha6, file.contact_damping, defaults.alpha6),
+            omega: pick(self.omega, file.omega, defaults.omega),
+        };
+        p.validate().map_err(|e| CliError::Input(e.to_string()))?;
+        Ok(p)
+    }
+}
+
+/// Integrator flags.
+#[derive(Debug, Clone, Args)]
+pub struct IntegratorArgs {
+    /// Time integrator: exact (piecewise-exact, default), rk4 (located switchings),
+    /// rk4-naive (region per stage, as in the paper) or adaptive (DOP853 oracle)
+    #[arg(long, default_value = "exact", value_parser = parse_integrator)]
+    pub integrator: IntegratorKind,
+    /// Fixed steps per drive period of rk4 / rk4-naive (default 2000)
+    #[arg(long, value_name = "M")]
+    pub steps_per_period: Option<usize>,
+    /// Relative/absolute tolerance of the adaptive integrator
+    #[arg(long, default_value_t = 1e-12)]
+    pub tolerance: f64,
+}
+
+fn parse_integrator(s: &str) -> Result<IntegratorKind, String> {
+    s.parse()
+}
+
+impl IntegratorArgs {
+    /// Options. `exact` chooses its own grid, refined from `samples_per_period` so that samples
+    /// land on grid points; `--steps-per-period` is the fixed step count of rk4 (default 2000).
+    pub fn options(&self, samples_per_period: usize) -> IntegratorOptions {
+        let steps = match self.integrator {
+            IntegratorKind::Exact => samples_per_period.max(1),
+            IntegratorKind::Rk4 | IntegratorKind::Rk4Naive => self.steps_per_period.unwrap_or(2000),
+            IntegratorKind::Adaptive => 1,
+        };
+        IntegratorOptions {
+            kind: self.integrator,
+            steps_per_period: steps,
+            tolerance: self.tolerance,
+        }
+    }
+}

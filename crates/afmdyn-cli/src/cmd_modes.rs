@@ -1,0 +1,277 @@
+//! `afmdyn modes` and `afmdyn units`.
+
+use crate::args::{read_toml, ModelArgs};
+use crate::error::CliError;
+use crate::output::{ensure_dir, f, write_csv};
+use crate::plot::{save, Figure, Series, Style};
+use afmdyn::eigen::{fig3_sweep, spectrum, RegionSpectrum};
+use afmdyn::units::{
+    beam_damping_from_q, contact_stiffness, material, Cantilever, ContactStiffness, Material,
+    PhysicalModel, SILICON_TIP,
+};
+use afmdyn::Params;
+use clap::Args;
+use serde::Deserialize;
+use serde_json::json;
+use std::path::PathBuf;
+
+/// `afmdyn modes` flags.
+#[derive(Debug, Args)]
+pub struct ModesArgs {
+    #[command(flatten)]
+    model: ModelArgs,
+    /// Print one JSON document instead of a table
+    #[arg(long)]
+    json: bool,
+    /// Run a sweep instead: `fig3` (ω₁/ω₀₁ and ω₂/ω₀₂ over α1 × α4, paper Fig. 3)
+    #[arg(long, value_parser = ["fig3"])]
+    sweep: Option<String>,
+    /// Output directory of the sweep
+    #[arg(long, default_value = "afmdyn-out/modes")]
+    out: PathBuf,
+}
+
+fn region_json(r: &RegionSpectrum) -> serde_json::Value {
+    json!({
+        "omega": r.omega,
+        "eigenvalues": r.eigenvalues.iter().map(|e| [e.re, e.im]).collect::<Vec<_>>(),
+    })
+}
+
+/// Run `afmdyn modes`.
+pub fn modes(a: &ModesArgs) -> Result<(), CliError> {
+    let p = a.model.params(Params::default())?;
+    if a.sweep.is_some() {
+        return fig3(a, &p);
+    }
+    let (free, contact) = spectrum(&p)?;
+    if a.json {
+        let doc =
+            json!({ "params": p, "free": region_json(&free), "contact": region_json(&contact) });
+        println!("{doc}");
+        return Ok(());
+    }
+    println!(
+        "N = {}, α1 = {}, α3 = {}, α4 = {}, α6 = {} (dimensionless, eq. 5 time scale)",
+        p.modes, p.alpha1, p.alpha3, p.alpha4, p.alpha6
+    );
+    for (name, r) in [
+        ("free (region I)", &free),
+        ("contact (region II)", &contact),
+    ] {
+        println!("\n{name}");
+        println!(
+            "{:>4} {:>14} {:>14} {:>14} {:>10}",
+            "i", "ω (undamped)", "Re λ", "Im λ", "ζ"
+        );
+        for (i, w) in r.omega.iter().enumerate() {
+            let e = r.eigenvalues.get(i);
+            println!(
+                "{:>4} {:>14.6} {:>14.6} {:>14.6} {:>10.5}",
+                i + 1,
+                w,
+                e.map_or(f64::NAN, |e| e.re),
+                e.map_or(f64::NAN, |e| e.im),
+                e.map_or(f64::NAN, |e| e.zeta)
+            );
+        }
+    }
+    Ok(())
+}
+
+fn fig3(a: &ModesArgs, p: &Params) -> Result<(), CliError> {
+    let alpha1: Vec<f64> = (0..=10).map(|i| 0.05 * i as f64).collect();
+    let alpha4: Vec<f64> = (0..=100).map(|i| 2.0 * i as f64).collect();
+    let pts = fig3_sweep(p.modes, &alpha1, &alpha4)?;
+    ensure_dir(&a.out)?;
+    write_csv(
+        &a.out.join("fig3.csv"),
+        &[
+            "alpha1",
+            "alpha4",
+            "omega1_over_omega01",
+            "omega2_over_omega02",
+        ],
+        pts.iter()
+            .map(|q| vec![f(q.alpha1), f(q.alpha4), f(q.ratio1), f(q.ratio2)]),
+    )?;
+    for (stem, which, title) in [
+        (
+            "fig3a",
+            1,
+            "Fig. 3a: first natural frequency in contact, ω₁/ω₀₁",
+        ),
+        (
+            "fig3b",
+            2,
+            "Fig. 3b: second natural frequency in contact, ω₂/ω₀₂",
+        ),
+    ] {
+        let series = alpha1
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| i % 2 == 0)
+            .map(|(k, &a1)| Series {
+                label: format!("α1 = {a1:.2}"),
+                points: pts
+                    .iter()
+                    .filter(|q| q.alpha1 == a1)
+                    .map(|q| (q.alpha4, if which == 1 { q.ratio1 } else { q.ratio2 }))
+                    .collect(),
+                style: Style::Line,
+                color: k / 2,
+            })
+            .collect();
+        let fig = Figure {
+            title: format!("{title} (N = {})", p.modes),
+            x_label: "contact stiffness α4".into(),
+            y_label: if which == 1 {
+                "ω₁/ω₀₁".into()
+            } else {
+                "ω₂/ω₀₂".into()
+            },
+            series,
+            shade: vec![],
+        };
+        save(&a.out, stem, &fig)?;
+    }
+    if a.json {
+        println!("{}", json!({ "params": p, "points": pts, "out": a.out }));
+    } else {
+        println!("wrote {} points to {}", pts.len(), a.out.display());
+    }
+    Ok(())
+}
+
+/// `afmdyn units` flags.
+#[derive(Debug, Args)]
+pub struct UnitsArgs {
+    /// Probe description (TOML, SI units); see examples/probe.toml
+    #[arg(long, value_name = "FILE.toml")]
+    config: PathBuf,
+    /// Print one JSON document
+    #[arg(long)]
+    json: bool,
+}
+
+/// A probe file: cantilever, tip, sample and drive, in SI units.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ProbeFile {
+    modes: Option<usize>,
+    length: f64,
+    width: f64,
+    thickness: f64,
+    youngs_modulus: f64,
+    density: f64,
+    tip_mass: f64,
+    beam_damping: Option<f64>,
+    quality_factor: Option<f64>,
+    contact_stiffness: Option<f64>,
+    hertz: Option<HertzFile>,
+    contact_damping: f64,
+    drive_amplitude: f64,
+    beam_gap: f64,
+    tip_gap: f64,
+    drive_frequency_hz: f64,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct HertzFile {
+    tip_radius: f64,
+    indentation: f64,
+    tip_youngs_modulus: Option<f64>,
+    tip_poisson_ratio: Option<f64>,
+    sample: Option<String>,
+    sample_youngs_modulus: Option<f64>,
+    sample_poisson_ratio: Option<f64>,
+}
+
+/// Run `afmdyn units`.
+pub fn units(a: &UnitsArgs) -> Result<(), CliError> {
+    let pf: ProbeFile = read_toml(&a.config)?;
+    let k1 = match (pf.contact_stiffness, &pf.hertz) {
+        (Some(k), None) => contact_stiffness(ContactStiffness::Direct(k))?,
+        (None, Some(h)) => {
+            let sample = match (&h.sample, h.sample_youngs_modulus, h.sample_poisson_ratio) {
+                (Some(name), None, None) => material(name)?,
+                (None, Some(e), Some(nu)) => Material { youngs_modulus: e, poisson_ratio: nu },
+                _ => {
+                    return Err(CliError::Input(
+                        "hertz: give either sample = \"name\" or both sample_youngs_modulus and sample_poisson_ratio".into(),
+                    ))
+                }
+            };
+            let tip = Material {
+                youngs_modulus: h.tip_youngs_modulus.unwrap_or(SILICON_TIP.youngs_modulus),
+                poisson_ratio: h.tip_poisson_ratio.unwrap_or(SILICON_TIP.poisson_ratio),
+            };
+            contact_stiffness(ContactStiffness::Hertz {
+                tip,
+                sample,
+                radius: h.tip_radius,
+                indentation: h.indentation,
+            })?
+        }
+        _ => {
+            return Err(CliError::Input(
+                "give exactly one of contact_stiffness or [hertz]".into(),
+            ))
+        }
+    };
+    let mut model = PhysicalModel {
+        cantilever: Cantilever {
+            length: pf.length,
+            width: pf.width,
+            thickness: pf.thickness,
+            youngs_modulus: pf.youngs_modulus,
+            density: pf.density,
+        },
+        modes: pf.modes.unwrap_or(3),
+        tip_mass: pf.tip_mass,
+        beam_damping: 0.0,
+        contact_stiffness: k1,
+        contact_damping: pf.contact_damping,
+        drive_amplitude: pf.drive_amplitude,
+        beam_gap: pf.beam_gap,
+        tip_gap: pf.tip_gap,
+        drive_frequency_hz: pf.drive_frequency_hz,
+    };
+    model.beam_damping = match (pf.beam_damping, pf.quality_factor) {
+        (Some(c), None) => c,
+        (None, Some(q)) => beam_damping_from_q(&model, q)?,
+        _ => {
+            return Err(CliError::Input(
+                "give exactly one of beam_damping or quality_factor".into(),
+            ))
+        }
+    };
+    let p = model.to_params()?;
+    let s = model.scales();
+    if a.json {
+        println!("{}", json!({ "params": p, "scales": s, "physical": model }));
+        return Ok(());
+    }
+    println!("dimensionless parameters (eq. 7):");
+    println!("  N  = {}", p.modes);
+    println!("  α1 = {:.6e}  tip-mass ratio M/(mL)", p.alpha1);
+    println!("  α2 = {:.6e}  drive amplitude f/g0", p.alpha2);
+    println!("  α3 = {:.6e}  beam damping", p.alpha3);
+    println!(
+        "  α4 = {:.6e}  contact stiffness K1 L³/(EI)  (K1 = {:.6e} N/m)",
+        p.alpha4, k1
+    );
+    println!("  α5 = {:.6e}  gap g1/g0", p.alpha5);
+    println!("  α6 = {:.6e}  contact damping", p.alpha6);
+    println!("  Ω  = {:.6e}  drive frequency", p.omega);
+    println!("scales (eq. 5):");
+    println!("  one unit of τ = {:.6e} s", s.time_s);
+    println!("  one unit of W = {:.6e} m", s.length_m);
+    println!("  spring constant 3EI/L³ = {:.6e} N/m", s.spring_constant);
+    println!(
+        "  first natural frequency f₁ = {:.6e} Hz",
+        s.first_frequency_hz
+    );
+    Ok(())
+}

@@ -1,0 +1,58 @@
+//! CLI errors: bad input (exit code 2) or failures while running (exit code 1).
+
+use thiserror::Error;
+
+/// What can go wrong in a command.
+#[derive(Debug, Error)]
+pub enum CliError {
+    /// Invalid flags, config or parameters: exit code 2.
+    #[error("{0}")]
+    Input(String),
+    /// A computation failed.
+    #[error("{0}")]
+    Sim(#[from] afmdyn::SimError),
+    /// Writing an output failed.
+    #[error("{0}")]
+    Io(String),
+}
+
+impl CliError {
+    /// Process exit code.
+    pub fn code(&self) -> i32 {
+        match self {
+            CliError::Input(_) => 2,
+            CliError::Sim(e) => match e {
+                afmdyn::SimError::Params(_)
+                | afmdyn::SimError::StateLength { .. }
+                | afmdyn::SimError::NotFinite { .. }
+                | afmdyn::SimError::OutOfRange { .. } => 2,
+                _ => 1,
+            },
+            CliError::Io(_) => 1,
+        }
+    }
+}
+
+impl From<std::io::Error> for CliError {
+    fn from(e: std::io::Error) -> Self {
+        CliError::Io(e.to_string())
+    }
+}
+
+impl From<csv::Error> for CliError {
+    fn from(e: csv::Error) -> Self {
+        CliError::Io(e.to_string())
+    }
+}
+
+impl From<afmdyn::ParamError> for CliError {
+    fn from(e: afmdyn::ParamError) -> Self {
+        CliError::Input(e.to_string())
+    }
+}
+
+impl From<afmdyn::UnitsError> for CliError {
+    fn from(e: afmdyn::UnitsError) -> Self {
+        CliError::Input(e.to_string())
+    }
+}

@@ -1,0 +1,82 @@
+//! `afmdyn` — command-line interface: parse flags, call the library, write outputs.
+
+mod args;
+mod cmd_analysis;
+mod cmd_modes;
+mod cmd_simulate;
+mod error;
+mod output;
+mod plot;
+
+use clap::{Parser, Subcommand};
+use error::CliError;
+
+/// Multi-modal tapping-mode AFM dynamics with intermittent contact.
+#[derive(Debug, Parser)]
+#[command(name = "afmdyn", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Natural frequencies and damped eigenvalues of the free and contact systems (eqs. 19–23)
+    Modes(cmd_modes::ModesArgs),
+    /// Convert a physical probe description (SI units) into the dimensionless α's and Ω
+    Units(cmd_modes::UnitsArgs),
+    /// Integrate one trajectory and write time series, switchings, Poincaré points and plots
+    Simulate(cmd_simulate::SimulateArgs),
+    /// Steady-state tip motion for N = 1..N_max modes (paper Fig. 4)
+    Converge(cmd_simulate::ConvergeArgs),
+    /// Bifurcation diagram over Ω or any α (paper Fig. 5); the main job
+    Bifurcation(cmd_analysis::BifurcationArgs),
+    /// Coexisting attractors and basin fractions at fixed parameters (paper Figs. 6–17)
+    Attractors(cmd_analysis::AttractorsArgs),
+}
+
+fn run(cli: Cli) -> Result<(), CliError> {
+    match cli.command {
+        Command::Modes(a) => cmd_modes::modes(&a),
+        Command::Units(a) => cmd_modes::units(&a),
+        Command::Simulate(a) => cmd_simulate::simulate(&a),
+        Command::Converge(a) => cmd_simulate::converge(&a),
+        Command::Bifurcation(a) => cmd_analysis::bifurcation(&a),
+        Command::Attractors(a) => cmd_analysis::attractors(&a),
+    }
+}
+
+fn main() {
+    let cli = match Cli::try_parse() {
+        Ok(c) => c,
+        Err(e) => {
+            use clap::error::ErrorKind;
+            if matches!(
+                e.kind(),
+                ErrorKind::DisplayHelp
+                    | ErrorKind::DisplayVersion
+                    | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand
+            ) {
+                let _ = e.print();
+                std::process::exit(
+                    if e.kind() == ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand {
+                        2
+                    } else {
+                        0
+                    },
+                );
+            }
+            let text = e.to_string();
+            let line = text
+                .lines()
+                .find(|l| !l.trim().is_empty())
+                .unwrap_or("invalid arguments");
+            eprintln!("afmdyn: {}", line.trim_start_matches("error: "));
+            std::process::exit(2);
+        }
+    };
+    if let Err(e) = run(cli) {
+        eprintln!("afmdyn: {}", e.to_string().replace('\n', " "));
+        std::process::exit(e.code());
+    }
+}

@@ -1,0 +1,125 @@
+//! Coexisting attractors at fixed parameters: sample initial states, classify each steady
+//! state, cluster the distinct attractors and estimate their basin fractions.
+
+use super::bifurcation::random_state;
+use super::period::close;
+use super::steady::{steady_state, SteadyOptions, SteadyState};
+use crate::error::SimError;
+use crate::integrate::{build, IntegratorOptions};
+use crate::model::CantileverModel;
+use crate::params::Params;
+use nalgebra::DVector;
+use rayon::prelude::*;
+
+/// An attractor search.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AttractorSpec {
+    /// Parameters.
+    pub params: Params,
+    /// Number of random initial states.
+    pub samples: usize,
+    /// Seed of the initial states.
+    pub seed: u64,
+    /// Relative tolerance for two section point sets to be the same attractor.
+    pub cluster_tol: f64,
+    /// Steady-state options.
+    pub steady: SteadyOptions,
+    /// Integrator.
+    pub integrator: IntegratorOptions,
+}
+
+/// One attractor with its basin estimate.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Attractor {
+    /// The steady state found from the first member start.
+    pub steady: SteadyState,
+    /// An initial state that reaches it.
+    pub initial: DVector<f64>,
+    /// Number of starts that reached it.
+    pub count: usize,
+    /// count / (number of successful starts).
+    pub basin_fraction: f64,
+}
+
+/// The result of an attractor search.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AttractorReport {
+    /// Attractors, most frequent first.
+    pub attractors: Vec<Attractor>,
+    /// Starts that failed (error messages).
+    pub failures: Vec<String>,
+}
+
+/// Same attractor: same period and every section point of `a` matches one of `b` (the cycle
+/// may be entered at a different phase). Nonperiodic motions are grouped when X_max and
+/// min V_T agree to 5 %.
+pub fn same_attractor(a: &SteadyState, b: &SteadyState, tol: f64) -> bool {
+    match (a.period(), b.period()) {
+        (Some(n), Some(m)) if n == m => a
+            .poincare
+            .iter()
+            .all(|p| b.poincare.iter().any(|q| close(&p.state, &q.state, tol))),
+        (None, None) => {
+            let rel = |x: f64, y: f64| (x - y).abs() <= 0.05 * x.abs().max(y.abs()).max(1e-3);
+            rel(a.stats.x_max, b.stats.x_max) && rel(a.stats.v_t_min, b.stats.v_t_min)
+        }
+        _ => false,
+    }
+}
+
+/// Run the search in parallel over samples.
+///
+/// # Errors
+/// [`SimError`] for invalid parameters or options (individual failing starts are reported in
+/// [`AttractorReport::failures`]).
+pub fn find_attractors(spec: &AttractorSpec) -> Result<AttractorReport, SimError> {
+    if spec.samples == 0 {
+        return Err(SimError::out_of_range("samples", 0, "must be >= 1"));
+    }
+    if !(spec.cluster_tol.is_finite() && spec.cluster_tol > 0.0) {
+        return Err(SimError::out_of_range(
+            "cluster tolerance",
+            spec.cluster_tol,
+            "must be finite and > 0",
+        ));
+    }
+    let model = CantileverModel::new(&spec.params)?;
+    let results: Vec<(DVector<f64>, Result<SteadyState, SimError>)> = (0..spec.samples)
+        .into_par_iter()
+        .with_max_len(1)
+        .map(|i| {
+            let z0 = random_state(&model, spec.seed, i as u64);
+            let r = build(&model, spec.integrator, 0.0, &z0)
+                .and_then(|mut it| steady_state(it.as_mut(), &spec.steady));
+            (z0, r)
+        })
+        .collect();
+    let mut attractors: Vec<Attractor> = Vec::new();
+    let mut failures = Vec::new();
+    for (z0, r) in results {
+        match r {
+            Err(e) => failures.push(e.to_string()),
+            Ok(s) => match attractors
+                .iter_mut()
+                .find(|a| same_attractor(&a.steady, &s, spec.cluster_tol))
+            {
+                Some(a) => a.count += 1,
+                None => attractors.push(Attractor {
+                    steady: s,
+                    initial: z0,
+                    count: 1,
+                    basin_fraction: 0.0,
+                }),
+            },
+        }
+    }
+    let ok: usize = attractors.iter().map(|a| a.count).sum();
+    for a in &mut attractors {
+        a.basin_fraction = a.count as f64 / ok.max(1) as f64;
+    }
+    attractors.sort_by_key(|a| std::cmp::Reverse(a.count));
+    Ok(AttractorReport {
+        attractors,
+        failures,
+    })
+}

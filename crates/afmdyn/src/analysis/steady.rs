@@ -1,0 +1,308 @@
+//! Steady state on the stroboscopic Poincaré map τ = 2πk/Ω (drive phase 0) and its statistics.
+
+use super::period::{detect_period, MAX_PERIOD};
+use crate::error::SimError;
+use crate::galerkin::Region;
+use crate::integrate::{advance_dyn, Integrator, Step};
+use nalgebra::DVector;
+use serde::Serialize;
+use std::collections::VecDeque;
+
+/// Options of the steady-state search.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SteadyOptions {
+    /// Relative tolerance for two returns to coincide.
+    pub tol: f64,
+    /// Cap on the transient, in drive periods.
+    pub max_periods: usize,
+    /// Largest period searched (≤ 64).
+    pub max_period: usize,
+    /// Periods recorded for a motion classified nonperiodic.
+    pub nonperiodic_record: usize,
+}
+
+impl Default for SteadyOptions {
+    fn default() -> Self {
+        SteadyOptions {
+            tol: 1e-8,
+            max_periods: 1500,
+            max_period: MAX_PERIOD,
+            nonperiodic_record: 64,
+        }
+    }
+}
+
+/// Classification of a steady state.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(rename_all = "lowercase", tag = "kind")]
+pub enum Motion {
+    /// Period-n orbit of the stroboscopic map.
+    Periodic {
+        /// n.
+        period: usize,
+    },
+    /// No return within tolerance before the cap.
+    Nonperiodic,
+}
+
+/// One point of the stroboscopic section.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PoincarePoint {
+    /// τ = 2πk/Ω.
+    pub tau: f64,
+    /// V_T at the section.
+    pub v_t: f64,
+    /// W(1,τ) at the section.
+    pub w_tip: f64,
+    /// State (a, ȧ), shape `[2N]`.
+    pub state: DVector<f64>,
+}
+
+/// Statistics of the recorded steady-state periods.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Default)]
+pub struct OrbitStats {
+    /// X_max: the largest tip displacement W(1,τ).
+    pub x_max: f64,
+    /// Smallest W(1,τ).
+    pub x_min: f64,
+    /// Smallest V_T (deepest indentation when negative).
+    pub v_t_min: f64,
+    /// Fraction of time in contact.
+    pub contact_fraction: f64,
+    /// Contacts (entries into region II) per drive period.
+    pub contacts_per_period: f64,
+}
+
+/// A steady state reached from one initial condition.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SteadyState {
+    /// Period-n or nonperiodic.
+    pub motion: Motion,
+    /// Periods of transient before recording.
+    pub transient_periods: usize,
+    /// Section points of the recorded cycle (n for period-n, `nonperiodic_record` otherwise).
+    pub poincare: Vec<PoincarePoint>,
+    /// Statistics over the recorded periods.
+    pub stats: OrbitStats,
+}
+
+impl SteadyState {
+    /// n for a period-n orbit.
+    pub fn period(&self) -> Option<usize> {
+        match self.motion {
+            Motion::Periodic { period } => Some(period),
+            Motion::Nonperiodic => None,
+        }
+    }
+    /// The state at the last section point (to continue from).
+    pub fn end_state(&self) -> &DVector<f64> {
+        &self.poincare.last().expect("at least one point").state
+    }
+}
+
+/// Accumulates [`OrbitStats`] step by step, locating interior extrema of W(1,τ) and V_T on the
+/// integrator's dense output.
+#[derive(Debug, Clone)]
+pub struct StatsObserver {
+    x_max: f64,
+    x_min: f64,
+    v_min: f64,
+    contact_time: f64,
+    contacts: usize,
+    time: f64,
+}
+
+impl Default for StatsObserver {
+    fn default() -> Self {
+        StatsObserver {
+            x_max: f64::NEG_INFINITY,
+            x_min: f64::INFINITY,
+            v_min: f64::INFINITY,
+            contact_time: 0.0,
+            contacts: 0,
+            time: 0.0,
+        }
+    }
+}
+
+/// Zero of the derivative f′ of a dense quantity on [a, b] by safeguarded Newton, given
+/// f′(a), f′(b) of opposite signs; `f(τ)` returns (f, f′, f″).
+fn extremum(mut a: f64, mut b: f64, fa_d: f64, f: &mut dyn FnMut(f64) -> [f64; 3]) -> f64 {
+    let rising = fa_d > 0.0;
+    let mut t = 0.5 * (a + b);
+    for _ in 0..60 {
+        let [_, d, dd] = f(t);
+        if (d > 0.0) == rising {
+            a = t;
+        } else {
+            b = t;
+        }
+        let mut next = if dd != 0.0 { t - d / dd } else { f64::NAN };
+        if !(next > a && next < b) {
+            next = 0.5 * (a + b);
+        }
+        if (next - t).abs() <= 4.0 * f64::EPSILON * (1.0 + t.abs())
+            || b - a <= 4.0 * f64::EPSILON * (1.0 + t.abs())
+        {
+            return next;
+        }
+        t = next;
+    }
+    t
+}
+
+impl StatsObserver {
+    /// Account for one step; `before` is the state at `step.tau0`.
+    pub fn observe(&mut self, integ: &mut dyn Integrator, step: &Step, before: &DVector<f64>) {
+        let len = step.tau1 - step.tau0;
+        if len <= 0.0 {
+            return;
+        }
+        let model = integ.model().clone();
+        let p = *model.params();
+        self.time += len;
+        if step.region == Region::Contact {
+            self.contact_time += len;
+        }
+        if matches!(&step.event, Some(e) if e.to == Region::Contact) {
+            self.contacts += 1;
+        }
+        let z1 = integ.state().clone();
+        let (w0, w1) = (model.w_tip(before), model.w_tip(&z1));
+        let (d0, d1) = (model.w_tip_dot(before), model.w_tip_dot(&z1));
+        self.x_max = self.x_max.max(w0).max(w1);
+        self.x_min = self.x_min.min(w0).min(w1);
+        if (d0 > 0.0) != (d1 > 0.0) {
+            let t = extremum(step.tau0, step.tau1, d0, &mut |t| integ.dense_tip(t));
+            let w = integ.dense_tip(t)[0];
+            self.x_max = self.x_max.max(w);
+            self.x_min = self.x_min.min(w);
+        }
+        let (v0, v1) = (model.v_t(step.tau0, before), model.v_t(step.tau1, &z1));
+        self.v_min = self.v_min.min(v0).min(v1);
+        let (vd0, vd1) = (
+            model.v_t_dot(step.tau0, before),
+            model.v_t_dot(step.tau1, &z1),
+        );
+        if vd0 < 0.0 && vd1 > 0.0 {
+            let mut vt = |t: f64| {
+                let w = integ.dense_tip(t);
+                let (s, c) = (p.omega * t).sin_cos();
+                [
+                    w[0] + p.alpha2 * s + p.alpha5,
+                    w[1] + p.alpha2 * p.omega * c,
+                    w[2] - p.alpha2 * p.omega * p.omega * s,
+                ]
+            };
+            let t = extremum(step.tau0, step.tau1, vd0, &mut vt);
+            self.v_min = self.v_min.min(vt(t)[0]);
+        }
+    }
+
+    /// The statistics, with `periods` the number of drive periods observed.
+    pub fn finish(&self, periods: usize) -> OrbitStats {
+        OrbitStats {
+            x_max: self.x_max,
+            x_min: self.x_min,
+            v_t_min: self.v_min,
+            contact_fraction: if self.time > 0.0 {
+                self.contact_time / self.time
+            } else {
+                0.0
+            },
+            contacts_per_period: self.contacts as f64 / periods.max(1) as f64,
+        }
+    }
+}
+
+/// Advance one drive period to the next section point τ = 2πk/Ω.
+fn next_section(
+    integ: &mut dyn Integrator,
+    stats: Option<&mut StatsObserver>,
+) -> Result<(), SimError> {
+    let period = integ.model().period();
+    let k = (integ.tau() / period + 1e-9).floor() + 1.0;
+    let target = k * period;
+    match stats {
+        None => advance_dyn(integ, target, &mut |_, _, _| Ok(())),
+        Some(obs) => advance_dyn(integ, target, &mut |it, st, before| {
+            obs.observe(it, st, before);
+            Ok(())
+        }),
+    }
+}
+
+fn point(integ: &dyn Integrator) -> PoincarePoint {
+    let m = integ.model();
+    let z = integ.state();
+    PoincarePoint {
+        tau: integ.tau(),
+        v_t: m.v_t(integ.tau(), z),
+        w_tip: m.w_tip(z),
+        state: z.clone(),
+    }
+}
+
+/// Iterate the stroboscopic map from the integrator's current state until the returns repeat
+/// with some period n ≤ `max_period` (then record one cycle) or the cap is reached (then record
+/// `nonperiodic_record` periods as a nonperiodic motion).
+///
+/// # Errors
+/// [`SimError`] from the integrator (divergence, chattering) or for invalid options.
+pub fn steady_state(
+    integ: &mut dyn Integrator,
+    opts: &SteadyOptions,
+) -> Result<SteadyState, SimError> {
+    if !(opts.tol.is_finite() && opts.tol > 0.0) {
+        return Err(SimError::out_of_range(
+            "tolerance",
+            opts.tol,
+            "must be finite and > 0",
+        ));
+    }
+    if opts.max_period == 0 || opts.max_period > MAX_PERIOD {
+        return Err(SimError::out_of_range(
+            "max period",
+            opts.max_period,
+            "must be in 1..=64",
+        ));
+    }
+    // align on the section
+    let period = integ.model().period();
+    let phase = integ.tau() / period;
+    if (phase - phase.round()).abs() > 1e-9 {
+        next_section(integ, None)?;
+    }
+    let mut history: VecDeque<DVector<f64>> = VecDeque::with_capacity(2 * opts.max_period + 2);
+    history.push_back(integ.state().clone());
+    let mut found = None;
+    let mut k = 0;
+    while k < opts.max_periods {
+        next_section(integ, None)?;
+        k += 1;
+        if history.len() == 2 * opts.max_period + 1 {
+            history.pop_front();
+        }
+        history.push_back(integ.state().clone());
+        if let Some(n) = detect_period(history.make_contiguous(), opts.tol, opts.max_period) {
+            found = Some(n);
+            break;
+        }
+    }
+    let record = found.unwrap_or(opts.nonperiodic_record.max(1));
+    let mut obs = StatsObserver::default();
+    let mut poincare = Vec::with_capacity(record);
+    for _ in 0..record {
+        next_section(integ, Some(&mut obs))?;
+        poincare.push(point(integ));
+    }
+    Ok(SteadyState {
+        motion: match found {
+            Some(period) => Motion::Periodic { period },
+            None => Motion::Nonperiodic,
+        },
+        transient_periods: k,
+        poincare,
+        stats: obs.finish(record),
+    })
+}

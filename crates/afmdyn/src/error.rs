@@ -1,0 +1,158 @@
+//! Typed errors of the library. Every message names the offending field and the allowed range.
+
+use thiserror::Error;
+
+/// A model parameter outside its allowed range (see [`crate::Params`]).
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum ParamError {
+    /// The number of Galerkin modes N is outside 1..=20.
+    #[error("modes = {0}: the number of Galerkin modes N must be an integer in 1..=20")]
+    Modes(usize),
+    /// A non-negative coefficient (α1, α2, α3, α4, α6) is negative or not finite.
+    #[error("{name} = {value}: must be finite and >= 0")]
+    NonNegative {
+        /// Field name with its paper symbol, e.g. `alpha4 (contact stiffness α4)`.
+        name: &'static str,
+        /// The rejected value.
+        value: f64,
+    },
+    /// The gap α5 is not finite.
+    #[error("alpha5 (gap α5) = {0}: must be a finite number")]
+    Gap(f64),
+    /// The drive frequency Ω is not finite or not positive.
+    #[error("omega (drive frequency Ω) = {0}: must be finite and > 0")]
+    Omega(f64),
+}
+
+/// A physical-unit input outside its allowed range (see [`crate::units`]).
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum UnitsError {
+    /// A quantity that must be finite and strictly positive is not.
+    #[error("{name} = {value}: must be finite and > 0 ({unit})")]
+    Positive {
+        /// Field name.
+        name: &'static str,
+        /// Rejected value.
+        value: f64,
+        /// SI unit of the field.
+        unit: &'static str,
+    },
+    /// A quantity that must be finite and non-negative is not.
+    #[error("{name} = {value}: must be finite and >= 0 ({unit})")]
+    NonNegative {
+        /// Field name.
+        name: &'static str,
+        /// Rejected value.
+        value: f64,
+        /// SI unit of the field.
+        unit: &'static str,
+    },
+    /// A Poisson ratio outside (-1, 0.5].
+    #[error("{name} = {value}: a Poisson ratio must lie in (-1, 0.5]")]
+    Poisson {
+        /// Field name.
+        name: &'static str,
+        /// Rejected value.
+        value: f64,
+    },
+    /// A quantity that must be finite is not.
+    #[error("{name} = {value}: must be a finite number ({unit})")]
+    Finite {
+        /// Field name.
+        name: &'static str,
+        /// Rejected value.
+        value: f64,
+        /// SI unit of the field.
+        unit: &'static str,
+    },
+    /// Two mutually exclusive inputs were both given, or neither.
+    #[error("{0}")]
+    Choice(String),
+    /// The derived dimensionless set is invalid.
+    #[error(transparent)]
+    Params(#[from] ParamError),
+}
+
+/// Failure of a trajectory computation.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum SimError {
+    /// Invalid model parameters.
+    #[error(transparent)]
+    Params(#[from] ParamError),
+    /// A state vector has the wrong length.
+    #[error("{name}: expected {expected} values, got {got}")]
+    StateLength {
+        /// Which input.
+        name: &'static str,
+        /// Expected length (N or 2N).
+        expected: usize,
+        /// Given length.
+        got: usize,
+    },
+    /// A state component or a time is NaN or infinite.
+    #[error("{name} = {value}: must be a finite number")]
+    NotFinite {
+        /// Which input.
+        name: &'static str,
+        /// Rejected value.
+        value: f64,
+    },
+    /// A run length, count or tolerance is out of range.
+    #[error("{name} = {value}: {allowed}")]
+    OutOfRange {
+        /// Which input.
+        name: &'static str,
+        /// Rejected value (as text, it may be an integer).
+        value: String,
+        /// The allowed range in words.
+        allowed: &'static str,
+    },
+    /// Repeated switchings with vanishing intervals (chattering / sliding).
+    #[error(
+        "chattering at tau = {tau}: {count} switchings within {window:e} of dimensionless time"
+    )]
+    Chattering {
+        /// Time at which the chattering was detected.
+        tau: f64,
+        /// Number of switchings in the window.
+        count: usize,
+        /// Width of the window.
+        window: f64,
+    },
+    /// The state grew beyond any physical bound (a diverging integration).
+    #[error("diverged at tau = {tau}: |z| = {norm:e}")]
+    Diverged {
+        /// Time of divergence.
+        tau: f64,
+        /// State norm.
+        norm: f64,
+    },
+    /// The adaptive oracle integrator reported a failure.
+    #[error("adaptive integrator failed at tau = {tau}: {message}")]
+    Adaptive {
+        /// Time of the failure.
+        tau: f64,
+        /// The crate's message.
+        message: String,
+    },
+}
+
+impl SimError {
+    /// Shorthand for [`SimError::OutOfRange`].
+    pub fn out_of_range(name: &'static str, value: impl ToString, allowed: &'static str) -> Self {
+        SimError::OutOfRange {
+            name,
+            value: value.to_string(),
+            allowed,
+        }
+    }
+}
+
+/// Check that `value` is finite, naming `name` in the error.
+pub(crate) fn finite(name: &'static str, value: f64) -> Result<f64, SimError> {
+    if value.is_finite() {
+        Ok(value)
+    } else {
+        Err(SimError::NotFinite { name, value })
+    }
+}

@@ -1,0 +1,198 @@
+//! Galerkin matrices and modal forcing of the free (I) and contact (II) regions,
+//! paper eqs. 10–18.
+//!
+//! With W(ξ,τ) = Σ a_j φ_j(ξ) (eq. 9) and X = (a_1 … a_N)ᵀ, each region obeys
+//! M Ẍ + C_s Ẋ + K_s X = F_s(τ) (eq. 10). All matrices are N×N, symmetric; M is positive
+//! definite, K_s positive definite, C_s positive semi-definite for α's ≥ 0.
+
+use crate::beam::ModeShapes;
+use crate::error::ParamError;
+use crate::params::Params;
+use nalgebra::{DMatrix, DVector};
+use serde::{Deserialize, Serialize};
+
+/// The two regions of the switched model (eq. 10).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+pub enum Region {
+    /// Region I: tip free, V_T > 0.
+    #[default]
+    Free,
+    /// Region II: tip in contact with the sample spring α4 and damper α6, V_T ≤ 0.
+    Contact,
+}
+
+impl Region {
+    /// Index 0 (free) or 1 (contact).
+    pub fn index(self) -> usize {
+        match self {
+            Region::Free => 0,
+            Region::Contact => 1,
+        }
+    }
+
+    /// The other region.
+    pub fn other(self) -> Region {
+        match self {
+            Region::Free => Region::Contact,
+            Region::Contact => Region::Free,
+        }
+    }
+
+    /// Region of a tip displacement V_T: contact when V_T ≤ 0 (eq. 10).
+    pub fn of_v_t(v_t: f64) -> Region {
+        if v_t <= 0.0 {
+            Region::Contact
+        } else {
+            Region::Free
+        }
+    }
+}
+
+/// Modal forcing F_s(τ) = `constant` + `sin` · sin Ωτ + `cos` · cos Ωτ, each of shape `[N]`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Forcing {
+    /// Constant part.
+    pub constant: DVector<f64>,
+    /// Coefficient of sin Ωτ.
+    pub sin: DVector<f64>,
+    /// Coefficient of cos Ωτ.
+    pub cos: DVector<f64>,
+}
+
+impl Forcing {
+    /// F(τ) for drive frequency `omega`, written into `out` (shape `[N]`).
+    pub fn eval_into(&self, omega: f64, tau: f64, out: &mut DVector<f64>) {
+        let (s, c) = (omega * tau).sin_cos();
+        out.copy_from(&self.constant);
+        out.axpy(s, &self.sin, 1.0);
+        out.axpy(c, &self.cos, 1.0);
+    }
+}
+
+/// Galerkin matrices of one region (eq. 10): mass, damping, stiffness (N×N) and forcing.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RegionMatrices {
+    /// Mass matrix M (eq. 11 / eq. 15).
+    pub mass: DMatrix<f64>,
+    /// Damping matrix C_s (eq. 12 or eq. 16).
+    pub damping: DMatrix<f64>,
+    /// Stiffness matrix K_s (eq. 13 or eq. 17).
+    pub stiffness: DMatrix<f64>,
+    /// Forcing F_s (eq. 14 or eq. 18).
+    pub forcing: Forcing,
+}
+
+/// The Galerkin discretisation of the paper's model for one parameter set.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Galerkin {
+    params: Params,
+    shapes: ModeShapes,
+    tip: DVector<f64>,
+    integrals: DVector<f64>,
+    free: RegionMatrices,
+    contact: RegionMatrices,
+}
+
+impl Galerkin {
+    /// Assemble both regions' matrices.
+    ///
+    /// # Errors
+    /// [`ParamError`] if `params` fails validation.
+    pub fn new(params: &Params) -> Result<Self, ParamError> {
+        params.validate()?;
+        let n = params.modes;
+        let shapes = ModeShapes::new(n);
+        let tip = DVector::from_vec(shapes.tip());
+        let integrals = DVector::from_vec(shapes.integrals());
+        let outer = &tip * tip.transpose();
+        let mass = mass_matrix(params, &outer);
+        let k_free = DMatrix::from_diagonal(&DVector::from_vec(shapes.beta4()));
+        let free = RegionMatrices {
+            mass: mass.clone(),
+            damping: damping_free(params, n),
+            stiffness: k_free.clone(),
+            forcing: forcing_free(params, &tip, &integrals),
+        };
+        let contact = RegionMatrices {
+            mass,
+            damping: damping_contact(params, n, &outer),
+            stiffness: stiffness_contact(params, &k_free, &outer),
+            forcing: forcing_contact(params, &tip, &free.forcing),
+        };
+        Ok(Galerkin {
+            params: *params,
+            shapes,
+            tip,
+            integrals,
+            free,
+            contact,
+        })
+    }
+
+    /// The parameters this discretisation was built for.
+    pub fn params(&self) -> &Params {
+        &self.params
+    }
+
+    /// The clamped–free mode shapes.
+    pub fn shapes(&self) -> &ModeShapes {
+        &self.shapes
+    }
+
+    /// Tip values φ_i(1), shape `[N]`.
+    pub fn tip(&self) -> &DVector<f64> {
+        &self.tip
+    }
+
+    /// ∫₀¹ φ_i dξ, shape `[N]`.
+    pub fn integrals(&self) -> &DVector<f64> {
+        &self.integrals
+    }
+
+    /// Matrices of one region.
+    pub fn region(&self, r: Region) -> &RegionMatrices {
+        match r {
+            Region::Free => &self.free,
+            Region::Contact => &self.contact,
+        }
+    }
+}
+
+/// Eq. 11 (and eq. 15, M^II = M^I): M_ij = α1 φ_i(1) φ_j(1) + δ_ij ∫φ_i φ_j dξ, with ∫φ_i² = 1.
+fn mass_matrix(p: &Params, outer: &DMatrix<f64>) -> DMatrix<f64> {
+    DMatrix::identity(p.modes, p.modes) + outer * p.alpha1
+}
+
+/// Eq. 12: C^I_ij = δ_ij α3 ∫φ_i φ_j dξ = α3 δ_ij.
+fn damping_free(p: &Params, n: usize) -> DMatrix<f64> {
+    DMatrix::identity(n, n) * p.alpha3
+}
+
+/// Eq. 16: C^II_ij = α3 δ_ij + α6 φ_i(1) φ_j(1).
+fn damping_contact(p: &Params, n: usize, outer: &DMatrix<f64>) -> DMatrix<f64> {
+    damping_free(p, n) + outer * p.alpha6
+}
+
+/// Eq. 17: K^II_ij = δ_ij β_i⁴ + α4 φ_i(1) φ_j(1); the diagonal β_i⁴ = ∫φ_i φ_i'''' dξ is eq. 13.
+fn stiffness_contact(p: &Params, k_free: &DMatrix<f64>, outer: &DMatrix<f64>) -> DMatrix<f64> {
+    k_free + outer * p.alpha4
+}
+
+/// Eq. 14: F^I_i = α2 Ω² [α1 φ_i(1) + ∫φ_i] sin Ωτ − α2 α3 ∫φ_i cos Ωτ.
+fn forcing_free(p: &Params, tip: &DVector<f64>, integrals: &DVector<f64>) -> Forcing {
+    let n = tip.len();
+    Forcing {
+        constant: DVector::zeros(n),
+        sin: (tip * p.alpha1 + integrals) * (p.alpha2 * p.omega * p.omega),
+        cos: integrals * (-p.alpha2 * p.alpha3),
+    }
+}
+
+/// Eq. 18: F^II_i = F^I_i − α2 α4 φ_i(1) sin Ωτ − α4 α5 φ_i(1) − α2 α6 Ω φ_i(1) cos Ωτ.
+fn forcing_contact(p: &Params, tip: &DVector<f64>, free: &Forcing) -> Forcing {
+    Forcing {
+        constant: tip * (-p.alpha4 * p.alpha5),
+        sin: &free.sin - tip * (p.alpha2 * p.alpha4),
+        cos: &free.cos - tip * (p.alpha2 * p.alpha6 * p.omega),
+    }
+}

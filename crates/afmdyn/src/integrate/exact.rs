@@ -1,0 +1,695 @@
+//! Exact propagation of the piecewise-linear model with located switchings.
+//!
+//! Between switchings each region is linear and time-invariant with constant plus harmonic
+//! forcing (eq. 10), so with δz = z − z_p(τ) (z_p the periodic particular solution)
+//!
+//! z(τ + t) = z_p(τ + t) + e^{A_s t} δz(τ).
+//!
+//! **Grid.** The drive period T is split into m sub-steps h = T/m with ‖Ã_s‖₂ h ≤ θ, where
+//! Ã_s = T_s A_s T_s⁻¹ is A_s in energy coordinates y = (L_Kᵀ a, L_Mᵀ ȧ) (K_s = L_K L_Kᵀ,
+//! M = L_M L_Mᵀ). Φ_s = e^{A_s h} and z_p at the grid points are precomputed, so a step costs one
+//! 2N×2N matrix–vector product. Partial steps (after a switching, to a requested time) use the
+//! Taylor series of e^{Ã t} y, which converges fast because ‖Ã t‖ ≤ θ.
+//!
+//! **Switching detection** on the gap g = ±V_T (eq. 8; + in region I, − in region II) is rigorous:
+//! in energy coordinates the homogeneous flow does not increase ‖y‖ (Ã + Ãᵀ ⪯ 0 since C ⪰ 0),
+//! so |g''| ≤ ‖Ãᵀ² c̃‖ ‖y(τ_entry)‖ + Ω²|V_p| bounds the curvature over the stint. A step is
+//! accepted without search when the two parabolas g(a) + g'(a)s − Bs²/2 and
+//! g(b) − g'(b)s − Bs²/2 prove g > 0 over it; otherwise the tip motion in the step is expanded as
+//! a power series (moments c̃ᵀÃⁿy), the bound is tightened, and a pruned bisection finds the
+//! *leftmost* zero — also a dip below V_T = 0 that returns between two grid points (grazing) —
+//! which a safeguarded Newton iteration polishes to round-off.
+//!
+//! **No re-trigger.** Right after a switching g = 0 and g' > 0 in the new region; the search
+//! starts where the lower parabola g'(0)s − Bs²/2 is largest, so the same event cannot fire twice.
+//! Many switchings in a vanishing time window are reported as [`SimError::Chattering`].
+
+use super::{Integrator, Step, SwitchEvent};
+use crate::error::{finite, SimError};
+use crate::galerkin::Region;
+use crate::model::CantileverModel;
+use nalgebra::{DMatrix, DVector};
+use std::collections::VecDeque;
+
+/// Bound on ‖Ã‖₂ h for the grid step (radians of the fastest mode per step).
+pub const THETA: f64 = 1.0;
+/// Number of Taylor terms kept in partial steps and tip polynomials (‖Ãt‖ ≤ θ: 1/31! ≈ 1e-34).
+const K: usize = 30;
+/// Switchings within [`CHATTER_WINDOW`] of τ that count as chattering.
+const CHATTER_COUNT: usize = 64;
+/// Time window of the chattering test.
+const CHATTER_WINDOW: f64 = 1e-9;
+
+/// Precomputed data of one region.
+#[derive(Debug, Clone)]
+struct RegionProp {
+    /// Energy transform T_s (2N×2N, block diagonal) and its inverse.
+    t: DMatrix<f64>,
+    tinv: DMatrix<f64>,
+    /// Ã_s = T A T⁻¹.
+    at: DMatrix<f64>,
+    /// Φ_s = e^{A_s h} in plain coordinates.
+    phi: DMatrix<f64>,
+    /// Particular solution z_p(τ) = p0 + ps sin Ωτ + pc cos Ωτ.
+    p0: DVector<f64>,
+    ps: DVector<f64>,
+    pc: DVector<f64>,
+    /// z_p at the m + 1 grid points of one period (columns).
+    zp_grid: DMatrix<f64>,
+    /// Tip part of z_p: W_p = w0 + ws sin + wc cos.
+    wp: [f64; 3],
+    /// Rows c̃ᵀ Ãⁿ, n = 0..=K+2, (K+3)×2N: tip-deflection moments of the homogeneous part.
+    rows: DMatrix<f64>,
+    /// ‖c̃ᵀÃ²‖₂.
+    kappa2: f64,
+    /// Ω² · amplitude of V_p (bound on |V_p''|).
+    vp_curv: f64,
+}
+
+/// The tip motion inside one step as a truncated power series plus the harmonic part.
+#[derive(Debug, Clone)]
+struct TipPoly {
+    tau0: f64,
+    /// mo[n] / n!, mo[n+1]/n!, mo[n+2]/n! for n = 0..=K.
+    c: [[f64; K + 1]; 3],
+    wp: [f64; 3],
+    omega: f64,
+    alpha2: f64,
+    alpha5: f64,
+    sigma: f64,
+    /// Bound on |g''| over the step.
+    curv: f64,
+}
+
+impl TipPoly {
+    fn horner(c: &[f64; K + 1], t: f64) -> f64 {
+        c.iter().rev().fold(0.0, |acc, &x| acc * t + x)
+    }
+    /// [W, W', W''] of the tip at local time t.
+    fn w(&self, t: f64) -> [f64; 3] {
+        let (s, c) = (self.omega * (self.tau0 + t)).sin_cos();
+        let (w0, ws, wc) = (self.wp[0], self.wp[1], self.wp[2]);
+        let om = self.omega;
+        [
+            Self::horner(&self.c[0], t) + w0 + ws * s + wc * c,
+            Self::horner(&self.c[1], t) + om * (ws * c - wc * s),
+            Self::horner(&self.c[2], t) - om * om * (ws * s + wc * c),
+        ]
+    }
+    /// Gap g = σ V_T and its derivative at local time t.
+    fn g(&self, t: f64) -> (f64, f64) {
+        let w = self.w(t);
+        let (s, c) = (self.omega * (self.tau0 + t)).sin_cos();
+        let v = w[0] + self.alpha2 * s + self.alpha5;
+        let dv = w[1] + self.alpha2 * self.omega * c;
+        (self.sigma * v, self.sigma * dv)
+    }
+}
+
+/// Positive root of g + d s − B s²/2 (∞ when it never vanishes, 0 when g ≤ 0 and d ≤ 0).
+fn parabola_root(g: f64, d: f64, b: f64) -> f64 {
+    if b <= 0.0 {
+        return if d >= 0.0 {
+            f64::INFINITY
+        } else {
+            (g / -d).max(0.0)
+        };
+    }
+    let disc = d * d + 2.0 * b * g;
+    if disc < 0.0 {
+        return 0.0;
+    }
+    ((d + disc.sqrt()) / b).max(0.0)
+}
+
+/// True when the curvature bound proves g > 0 on the open interval (0, len).
+fn certified_positive(ga: f64, da: f64, gb: f64, db: f64, b: f64, len: f64) -> bool {
+    gb > 0.0 && parabola_root(ga, da, b) + parabola_root(gb, -db, b) > len
+}
+
+struct Search<'a> {
+    poly: &'a TipPoly,
+}
+
+impl Search<'_> {
+    /// Leftmost t in (a, b] with g(t) ≤ 0, given g(a) > 0; None when g > 0 on (a, b].
+    fn first(&self, a: f64, ga: (f64, f64), b: f64, gb: (f64, f64), depth: u32) -> Option<f64> {
+        if gb.0 <= 0.0 {
+            return Some(self.leftmost(a, ga, b, gb, depth));
+        }
+        let width = b - a;
+        if certified_positive(ga.0, ga.1, gb.0, gb.1, self.poly.curv, width)
+            || depth > 64
+            || width <= 4.0 * f64::EPSILON * (1.0 + self.poly.tau0.abs())
+        {
+            return None;
+        }
+        let m = 0.5 * (a + b);
+        let gm = self.poly.g(m);
+        if gm.0 <= 0.0 {
+            return Some(self.leftmost(a, ga, m, gm, depth + 1));
+        }
+        self.first(a, ga, m, gm, depth + 1)
+            .or_else(|| self.first(m, gm, b, gb, depth + 1))
+    }
+
+    /// Leftmost zero in [a, b] with g(a) > 0 ≥ g(b).
+    fn leftmost(&self, a: f64, ga: (f64, f64), b: f64, gb: (f64, f64), depth: u32) -> f64 {
+        let width = b - a;
+        let monotone = ga.1 < 0.0 && gb.1 < 0.0 && -(ga.1 + gb.1) > self.poly.curv * width;
+        if monotone || depth > 64 || width <= 4.0 * f64::EPSILON * (1.0 + self.poly.tau0.abs()) {
+            return self.newton(a, ga.0, b, gb.0);
+        }
+        let m = 0.5 * (a + b);
+        let gm = self.poly.g(m);
+        if gm.0 <= 0.0 {
+            return self.leftmost(a, ga, m, gm, depth + 1);
+        }
+        if let Some(t) = self.first(a, ga, m, gm, depth + 1) {
+            return t;
+        }
+        self.leftmost(m, gm, b, gb, depth + 1)
+    }
+
+    /// Safeguarded Newton on a bracket with g(lo) > 0 ≥ g(hi).
+    fn newton(&self, mut lo: f64, glo: f64, mut hi: f64, ghi: f64) -> f64 {
+        let mut t = if glo - ghi > 0.0 {
+            lo + (hi - lo) * glo / (glo - ghi)
+        } else {
+            0.5 * (lo + hi)
+        };
+        for _ in 0..100 {
+            let (g, d) = self.poly.g(t);
+            if g > 0.0 {
+                lo = t;
+            } else {
+                hi = t;
+            }
+            let mut next = if d != 0.0 { t - g / d } else { f64::NAN };
+            if !(next > lo && next < hi) {
+                next = 0.5 * (lo + hi);
+            }
+            let done = (next - t).abs() <= 2.0 * f64::EPSILON * (1.0 + (self.poly.tau0 + t).abs())
+                || hi - lo <= 4.0 * f64::EPSILON * (1.0 + (self.poly.tau0 + t).abs());
+            t = next;
+            if done {
+                break;
+            }
+        }
+        t.clamp(lo, hi)
+    }
+}
+
+/// The last step, kept for dense output.
+#[derive(Debug, Clone)]
+struct LastStep {
+    tau0: f64,
+    region: Region,
+    /// Homogeneous part δz(τ0) in plain coordinates.
+    dz0: DVector<f64>,
+    poly: Option<TipPoly>,
+}
+
+/// Exact propagator (see the module docs).
+#[derive(Debug, Clone)]
+pub struct ExactPropagator {
+    model: CantileverModel,
+    regions: [RegionProp; 2],
+    m: usize,
+    h: f64,
+    period: f64,
+    tau: f64,
+    z: DVector<f64>,
+    region: Region,
+    on_grid: Option<i64>,
+    ybound: f64,
+    just_switched: bool,
+    recent: VecDeque<f64>,
+    last: LastStep,
+    zb: DVector<f64>,
+    buf: [DVector<f64>; 4],
+}
+
+fn energy_transform(model: &CantileverModel, r: Region) -> (DMatrix<f64>, DMatrix<f64>) {
+    let n = model.modes();
+    let g = model.galerkin().region(r);
+    let lk = g.stiffness.clone().cholesky().expect("K is SPD").l();
+    let lm = g.mass.clone().cholesky().expect("M is SPD").l();
+    let mut t = DMatrix::zeros(2 * n, 2 * n);
+    t.view_mut((0, 0), (n, n)).copy_from(&lk.transpose());
+    t.view_mut((n, n), (n, n)).copy_from(&lm.transpose());
+    let tinv = t.clone().try_inverse().expect("T is invertible");
+    (t, tinv)
+}
+
+/// Spectral norm (largest singular value).
+fn norm2(a: &DMatrix<f64>) -> f64 {
+    a.clone().svd(false, false).singular_values.max()
+}
+
+impl ExactPropagator {
+    /// Build the propagator; the grid has a multiple of `min_steps_per_period` sub-steps per
+    /// period, refined until ‖Ã_s‖₂ h ≤ θ in both regions.
+    ///
+    /// # Panics
+    /// When the forced response is singular: Ω exactly at an undamped natural frequency
+    /// (α3 = 0 and no contact damping), where no periodic particular solution exists.
+    pub fn new(model: &CantileverModel, min_steps_per_period: usize) -> Self {
+        Self::try_new(model, min_steps_per_period).expect("forced response exists")
+    }
+
+    /// As [`ExactPropagator::new`], with an error instead of a panic.
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] for Ω at an undamped resonance (see [`ExactPropagator::new`]).
+    pub fn try_new(model: &CantileverModel, min_steps_per_period: usize) -> Result<Self, SimError> {
+        let n = model.modes();
+        let dim = 2 * n;
+        let omega = model.omega();
+        let period = model.period();
+        let transforms = [
+            energy_transform(model, Region::Free),
+            energy_transform(model, Region::Contact),
+        ];
+        let ats: Vec<DMatrix<f64>> = [Region::Free, Region::Contact]
+            .iter()
+            .map(|&r| &transforms[r.index()].0 * &model.dynamics(r).a * &transforms[r.index()].1)
+            .collect();
+        let rho = ats.iter().map(norm2).fold(0.0, f64::max);
+        let need = ((period * rho / THETA).ceil() as usize).max(8);
+        let base = min_steps_per_period.max(1);
+        let m = base * need.div_ceil(base);
+        let h = period / m as f64;
+        let p = *model.params();
+        let mut regions = Vec::with_capacity(2);
+        for r in [Region::Free, Region::Contact] {
+            let (t, tinv) = transforms[r.index()].clone();
+            let at = ats[r.index()].clone();
+            let d = model.dynamics(r);
+            let phi = &tinv * (&at * h).exp() * &t;
+            // particular solution: A p0 = −b_const; [[A, ΩI], [−ΩI, A]] (ps, pc) = −(b_sin, b_cos)
+            let p0 = d.a.clone().lu().solve(&(-&d.b_const)).ok_or_else(|| {
+                SimError::out_of_range("state matrix", "singular", "K must be SPD")
+            })?;
+            let mut big = DMatrix::zeros(2 * dim, 2 * dim);
+            big.view_mut((0, 0), (dim, dim)).copy_from(&d.a);
+            big.view_mut((dim, dim), (dim, dim)).copy_from(&d.a);
+            for i in 0..dim {
+                big[(i, dim + i)] = omega;
+                big[(dim + i, i)] = -omega;
+            }
+            let mut rhs = DVector::zeros(2 * dim);
+            rhs.rows_mut(0, dim).copy_from(&(-&d.b_sin));
+            rhs.rows_mut(dim, dim).copy_from(&(-&d.b_cos));
+            let sol = big.lu().solve(&rhs).ok_or_else(|| {
+                SimError::out_of_range(
+                    "omega",
+                    omega,
+                    "is an undamped natural frequency: no periodic forced response (add damping)",
+                )
+            })?;
+            let ps = sol.rows(0, dim).into_owned();
+            let pc = sol.rows(dim, dim).into_owned();
+            let mut zp_grid = DMatrix::zeros(dim, m + 1);
+            for k in 0..=m {
+                let (s, c) = (omega * (k as f64 * h)).sin_cos();
+                let col = &p0 + &ps * s + &pc * c;
+                zp_grid.set_column(k, &col);
+            }
+            let tip = model.tip();
+            let wp = [
+                tip.dot(&p0.rows(0, n)),
+                tip.dot(&ps.rows(0, n)),
+                tip.dot(&pc.rows(0, n)),
+            ];
+            // c̃ = T⁻ᵀ c with c = (φ(1), 0); rows c̃ᵀ Ãⁿ
+            let mut c = DVector::zeros(dim);
+            c.rows_mut(0, n).copy_from(tip);
+            let mut row = tinv.transpose() * c;
+            let mut rows = DMatrix::zeros(K + 3, dim);
+            for k in 0..K + 3 {
+                rows.set_row(k, &row.transpose());
+                row = at.transpose() * row;
+            }
+            let kappa2 = rows.row(2).norm();
+            let vp_curv = omega * omega * (wp[1] + p.alpha2).hypot(wp[2]);
+            regions.push(RegionProp {
+                t,
+                tinv,
+                at,
+                phi,
+                p0,
+                ps,
+                pc,
+                zp_grid,
+                wp,
+                rows,
+                kappa2,
+                vp_curv,
+            });
+        }
+        let regions: [RegionProp; 2] = regions.try_into().expect("two regions");
+        let zero = DVector::zeros(dim);
+        Ok(ExactPropagator {
+            model: model.clone(),
+            regions,
+            m,
+            h,
+            period,
+            tau: 0.0,
+            z: zero.clone(),
+            region: Region::Free,
+            on_grid: Some(0),
+            ybound: 0.0,
+            just_switched: true,
+            recent: VecDeque::new(),
+            last: LastStep {
+                tau0: 0.0,
+                region: Region::Free,
+                dz0: zero.clone(),
+                poly: None,
+            },
+            zb: zero.clone(),
+            buf: [zero.clone(), zero.clone(), zero.clone(), zero],
+        })
+    }
+
+    /// Sub-steps per drive period m.
+    pub fn steps_per_period(&self) -> usize {
+        self.m
+    }
+
+    /// Grid time of global index j: (j div m) T + (j mod m) h.
+    fn grid_tau(&self, j: i64) -> f64 {
+        let m = self.m as i64;
+        j.div_euclid(m) as f64 * self.period + j.rem_euclid(m) as f64 * self.h
+    }
+
+    /// Index of the first grid point strictly after τ.
+    fn next_grid(&self, tau: f64) -> i64 {
+        let p = (tau / self.period).floor();
+        let rem = tau - p * self.period;
+        let mut j = p as i64 * self.m as i64 + (rem / self.h).floor() as i64 + 1;
+        while self.grid_tau(j - 1) > tau {
+            j -= 1;
+        }
+        while self.grid_tau(j) <= tau {
+            j += 1;
+        }
+        j
+    }
+
+    fn zp_into(rp: &RegionProp, omega: f64, tau: f64, out: &mut DVector<f64>) {
+        let (s, c) = (omega * tau).sin_cos();
+        out.copy_from(&rp.p0);
+        out.axpy(s, &rp.ps, 1.0);
+        out.axpy(c, &rp.pc, 1.0);
+    }
+
+    /// y(t) = Σ Ãⁿ y0 tⁿ/n! into `out`.
+    fn taylor(
+        at: &DMatrix<f64>,
+        y0: &DVector<f64>,
+        t: f64,
+        out: &mut DVector<f64>,
+        term: &mut DVector<f64>,
+        tmp: &mut DVector<f64>,
+    ) {
+        out.copy_from(y0);
+        term.copy_from(y0);
+        let floor = 1e-36 * y0.norm_squared();
+        for n in 1..=K {
+            tmp.gemv(t / n as f64, at, term, 0.0);
+            std::mem::swap(term, tmp);
+            *out += &*term;
+            if term.norm_squared() <= floor {
+                break;
+            }
+        }
+    }
+
+    /// Homogeneous state at local time t of the last step, in plain coordinates, added to z_p.
+    fn state_in_last(&mut self, t: f64, out: &mut DVector<f64>) {
+        let rp = &self.regions[self.last.region.index()];
+        let [y0, yt, term, tmp] = &mut self.buf;
+        y0.gemv(1.0, &rp.t, &self.last.dz0, 0.0);
+        Self::taylor(&rp.at, y0, t, yt, term, tmp);
+        Self::zp_into(rp, self.model.omega(), self.last.tau0 + t, out);
+        out.gemv(1.0, &rp.tinv, yt, 1.0);
+    }
+
+    fn build_poly(&self, region: Region, tau0: f64, dz0: &DVector<f64>, len: f64) -> TipPoly {
+        let rp = &self.regions[region.index()];
+        let y0 = &rp.t * dz0;
+        let mo = &rp.rows * y0;
+        let mut c = [[0.0; K + 1]; 3];
+        let mut fact = 1.0;
+        for n in 0..=K {
+            if n > 0 {
+                fact *= n as f64;
+            }
+            for (d, row) in c.iter_mut().enumerate() {
+                row[n] = mo[n + d] / fact;
+            }
+        }
+        let p = self.model.params();
+        let curv = c[2]
+            .iter()
+            .enumerate()
+            .map(|(n, x)| x.abs() * len.powi(n as i32))
+            .sum::<f64>()
+            + rp.vp_curv;
+        TipPoly {
+            tau0,
+            c,
+            wp: rp.wp,
+            omega: p.omega,
+            alpha2: p.alpha2,
+            alpha5: p.alpha5,
+            sigma: if region == Region::Free { 1.0 } else { -1.0 },
+            curv,
+        }
+    }
+
+    fn energy_bound(&self, region: Region, tau: f64, z: &DVector<f64>) -> f64 {
+        let rp = &self.regions[region.index()];
+        let mut zp = DVector::zeros(z.len());
+        Self::zp_into(rp, self.model.omega(), tau, &mut zp);
+        (&rp.t * (z - zp)).norm()
+    }
+
+    fn chatter_check(&mut self, tau: f64) -> Result<(), SimError> {
+        self.recent.push_back(tau);
+        while self.recent.len() > CHATTER_COUNT {
+            self.recent.pop_front();
+        }
+        if self.recent.len() == CHATTER_COUNT {
+            let window = tau - self.recent[0];
+            if window < CHATTER_WINDOW {
+                return Err(SimError::Chattering {
+                    tau,
+                    count: CHATTER_COUNT,
+                    window,
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+impl Integrator for ExactPropagator {
+    fn model(&self) -> &CantileverModel {
+        &self.model
+    }
+    fn tau(&self) -> f64 {
+        self.tau
+    }
+    fn state(&self) -> &DVector<f64> {
+        &self.z
+    }
+    fn region(&self) -> Region {
+        self.region
+    }
+    fn name(&self) -> &'static str {
+        "exact"
+    }
+
+    fn reset(&mut self, tau: f64, z: &DVector<f64>) -> Result<(), SimError> {
+        finite("initial time", tau)?;
+        self.model.check_state("initial state", z)?;
+        self.tau = tau;
+        self.z.copy_from(z);
+        self.region = entering_region(&self.model, tau, z);
+        let j = self.next_grid(tau) - 1;
+        self.on_grid = (self.grid_tau(j) == tau).then_some(j);
+        self.ybound = self.energy_bound(self.region, tau, z);
+        self.just_switched = true;
+        self.recent.clear();
+        self.last = LastStep {
+            tau0: tau,
+            region: self.region,
+            dz0: DVector::zeros(z.len()),
+            poly: None,
+        };
+        Ok(())
+    }
+
+    fn step(&mut self, tau_max: f64) -> Result<Step, SimError> {
+        let region = self.region;
+        let tau0 = self.tau;
+        let omega = self.model.omega();
+        let j_next = match self.on_grid {
+            Some(j) => j + 1,
+            None => self.next_grid(tau0),
+        };
+        let t_grid = self.grid_tau(j_next);
+        let tau_b = t_grid.min(tau_max);
+        let len = tau_b - tau0;
+        if len <= 0.0 {
+            return Ok(Step {
+                tau0,
+                tau1: tau0,
+                region,
+                event: None,
+            });
+        }
+        let full = self.on_grid.is_some() && tau_b == t_grid;
+        let ri = region.index();
+        // homogeneous part at the start, end state into buf[1]
+        let mut dz0 = std::mem::take(&mut self.last.dz0);
+        let mut z_b = std::mem::take(&mut self.zb);
+        if full {
+            let k = self.on_grid.expect("on grid").rem_euclid(self.m as i64) as usize;
+            let rp = &self.regions[ri];
+            dz0.copy_from(&self.z);
+            dz0 -= &rp.zp_grid.column(k);
+            z_b.copy_from(&rp.zp_grid.column(k + 1));
+            z_b.gemv(1.0, &rp.phi, &dz0, 1.0);
+        } else {
+            let rp = &self.regions[ri];
+            Self::zp_into(rp, omega, tau0, &mut dz0);
+            dz0.neg_mut();
+            dz0 += &self.z;
+        }
+        self.last = LastStep {
+            tau0,
+            region,
+            dz0,
+            poly: None,
+        };
+        if !full {
+            self.state_in_last(len, &mut z_b);
+        }
+        let sigma = if region == Region::Free { 1.0 } else { -1.0 };
+        let m = &self.model;
+        let mut ga = sigma * m.v_t(tau0, &self.z);
+        let da = sigma * m.v_t_dot(tau0, &self.z);
+        let gb = sigma * m.v_t(tau_b, &z_b);
+        let db = sigma * m.v_t_dot(tau_b, &z_b);
+        let switched = self.just_switched || ga <= 0.0;
+        if switched {
+            ga = ga.max(0.0);
+        }
+        let rp = &self.regions[ri];
+        let cheap = rp.kappa2 * self.ybound + rp.vp_curv;
+        let mut hit = None;
+        if !certified_positive(ga, da, gb, db, cheap, len) {
+            let poly = self.build_poly(region, tau0, &self.last.dz0, len);
+            let search = Search { poly: &poly };
+            // start of the search: after a switching, where the lower parabola peaks
+            let mut a = 0.0;
+            let mut g_a = (ga, da);
+            if switched {
+                a = if da > 0.0 && poly.curv > 0.0 {
+                    (da / poly.curv).min(0.5 * len)
+                } else {
+                    (4.0 * f64::EPSILON * (1.0 + tau0.abs())).min(0.5 * len)
+                };
+                g_a = poly.g(a);
+            }
+            if g_a.0 <= 0.0 {
+                hit = Some(a);
+            } else {
+                hit = search.first(a, g_a, len, (gb, db), 0);
+            }
+            self.last.poly = Some(poly);
+        }
+        self.just_switched = false;
+        match hit {
+            None => {
+                self.zb = z_b;
+                std::mem::swap(&mut self.z, &mut self.zb);
+                self.tau = tau_b;
+                self.on_grid = (tau_b == t_grid).then_some(j_next);
+                if let Some(j) = self.on_grid {
+                    if j.rem_euclid(self.m as i64) == 0 {
+                        let norm = self.z.norm();
+                        if norm.is_nan() || norm >= 1e12 {
+                            return Err(SimError::Diverged { tau: tau_b, norm });
+                        }
+                    }
+                }
+                Ok(Step {
+                    tau0,
+                    tau1: tau_b,
+                    region,
+                    event: None,
+                })
+            }
+            Some(t) => {
+                self.zb = z_b;
+                let mut zs = DVector::zeros(self.z.len());
+                self.state_in_last(t, &mut zs);
+                let tau_s = tau0 + t;
+                let to = region.other();
+                let v_t_dot = self.model.v_t_dot(tau_s, &zs);
+                self.z.copy_from(&zs);
+                self.tau = tau_s;
+                self.region = to;
+                self.on_grid = None;
+                self.just_switched = true;
+                self.ybound = self.energy_bound(to, tau_s, &zs);
+                self.chatter_check(tau_s)?;
+                Ok(Step {
+                    tau0,
+                    tau1: tau_s,
+                    region,
+                    event: Some(SwitchEvent {
+                        tau: tau_s,
+                        from: region,
+                        to,
+                        v_t_dot,
+                        state: zs,
+                    }),
+                })
+            }
+        }
+    }
+
+    fn dense_tip(&mut self, tau: f64) -> [f64; 3] {
+        let t = tau - self.last.tau0;
+        if self.last.poly.is_none() {
+            let len = (self.tau - self.last.tau0).max(t);
+            let dz0 = self.last.dz0.clone();
+            self.last.poly = Some(self.build_poly(self.last.region, self.last.tau0, &dz0, len));
+        }
+        self.last.poly.as_ref().expect("built").w(t)
+    }
+
+    fn dense_state(&mut self, tau: f64) -> DVector<f64> {
+        let mut out = DVector::zeros(self.z.len());
+        self.state_in_last(tau - self.last.tau0, &mut out);
+        out
+    }
+}
+
+/// Region of a state on entering the integration: contact when V_T < 0, or V_T = 0 moving
+/// inwards (dV_T/dτ ≤ 0); free otherwise.
+pub(crate) fn entering_region(model: &CantileverModel, tau: f64, z: &DVector<f64>) -> Region {
+    let v = model.v_t(tau, z);
+    if v < 0.0 || (v == 0.0 && model.v_t_dot(tau, z) <= 0.0) {
+        Region::Contact
+    } else {
+        Region::Free
+    }
+}

@@ -1,0 +1,299 @@
+//! Integrators of the switched model behind one interface.
+//!
+//! * [`exact::ExactPropagator`] — exact piecewise-linear propagation (matrix exponential on a
+//!   fixed grid aligned with the drive period) with rigorously located switchings. Default.
+//! * [`rk4::Rk4`] — the paper's fixed-step fourth-order Runge–Kutta, with located switchings
+//!   or, as in the paper, with the region chosen per stage from the sign of V_T.
+//! * [`adaptive::AdaptiveOracle`] — DOP853 from the `differential-equations` crate with terminal
+//!   events, an independent oracle.
+//!
+//! A driver calls [`Integrator::step`] until the target time; each step ends at a grid point,
+//! at `tau_max`, or at a switching, which it reports as a [`SwitchEvent`].
+
+pub mod adaptive;
+pub mod exact;
+pub mod rk4;
+
+use crate::error::SimError;
+use crate::galerkin::Region;
+use crate::model::CantileverModel;
+use nalgebra::DVector;
+use serde::{Deserialize, Serialize};
+use std::str::FromStr;
+
+/// A located switching between the free and contact regions.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SwitchEvent {
+    /// Time of the switching (dimensionless τ).
+    pub tau: f64,
+    /// Region before.
+    pub from: Region,
+    /// Region after.
+    pub to: Region,
+    /// dV_T/dτ at the switching (impact velocity when entering contact).
+    pub v_t_dot: f64,
+    /// State z = (a, ȧ) at the switching, shape `[2N]`.
+    pub state: DVector<f64>,
+}
+
+/// What one call of [`Integrator::step`] did.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Step {
+    /// Start time.
+    pub tau0: f64,
+    /// End time.
+    pub tau1: f64,
+    /// Region in force during the step.
+    pub region: Region,
+    /// The switching that ended the step, if any.
+    pub event: Option<SwitchEvent>,
+}
+
+/// Callback after every step: `(integrator, step, state before the step)`.
+pub type StepObserver<'a> =
+    dyn FnMut(&mut dyn Integrator, &Step, &DVector<f64>) -> Result<(), SimError> + 'a;
+
+/// A time integrator of [`CantileverModel`].
+pub trait Integrator: Send {
+    /// The model.
+    fn model(&self) -> &CantileverModel;
+    /// Current time τ.
+    fn tau(&self) -> f64;
+    /// Current state z = (a, ȧ), shape `[2N]`.
+    fn state(&self) -> &DVector<f64>;
+    /// Region in force at the current state.
+    fn region(&self) -> Region;
+    /// Restart from (τ, z); the region is taken from the sign of V_T (eq. 8).
+    ///
+    /// # Errors
+    /// [`SimError`] for a non-finite τ or a state of the wrong length or with non-finite entries.
+    fn reset(&mut self, tau: f64, z: &DVector<f64>) -> Result<(), SimError>;
+    /// Advance by one step, never past `tau_max`.
+    ///
+    /// # Errors
+    /// [`SimError::Chattering`], [`SimError::Diverged`] or an integrator failure.
+    fn step(&mut self, tau_max: f64) -> Result<Step, SimError>;
+    /// Tip deflection W(1,τ) and its first two τ-derivatives at `tau` inside the last step.
+    fn dense_tip(&mut self, tau: f64) -> [f64; 3];
+    /// Full state at `tau` inside the last step, shape `[2N]`.
+    fn dense_state(&mut self, tau: f64) -> DVector<f64>;
+    /// Integrator name.
+    fn name(&self) -> &'static str;
+
+    /// Advance to exactly `tau_end`, calling `on_step(self, step, z_before)` after every step.
+    ///
+    /// # Errors
+    /// As [`Integrator::step`], or what `on_step` returns.
+    fn advance_to(&mut self, tau_end: f64, on_step: &mut StepObserver<'_>) -> Result<(), SimError>
+    where
+        Self: Sized,
+    {
+        advance_dyn(self, tau_end, on_step)
+    }
+}
+
+/// [`Integrator::advance_to`] for trait objects.
+///
+/// # Errors
+/// As [`Integrator::step`], or what `on_step` returns.
+pub fn advance_dyn(
+    integ: &mut dyn Integrator,
+    tau_end: f64,
+    on_step: &mut StepObserver<'_>,
+) -> Result<(), SimError> {
+    crate::error::finite("tau_end", tau_end)?;
+    let mut before = integ.state().clone();
+    while integ.tau() < tau_end {
+        before.copy_from(integ.state());
+        let step = integ.step(tau_end)?;
+        on_step(integ, &step, &before)?;
+    }
+    Ok(())
+}
+
+/// Which integrator to use.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum IntegratorKind {
+    /// Exact piecewise-linear propagation (default).
+    #[default]
+    Exact,
+    /// Fixed-step RK4 with located switchings.
+    Rk4,
+    /// Fixed-step RK4 choosing the region per stage from sign(V_T), as in the paper.
+    Rk4Naive,
+    /// Adaptive DOP853 oracle with terminal events.
+    Adaptive,
+}
+
+impl FromStr for IntegratorKind {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "exact" => Ok(IntegratorKind::Exact),
+            "rk4" => Ok(IntegratorKind::Rk4),
+            "rk4-naive" | "rk4_naive" => Ok(IntegratorKind::Rk4Naive),
+            "adaptive" | "dop853" => Ok(IntegratorKind::Adaptive),
+            _ => Err(format!(
+                "integrator '{s}': expected exact, rk4, rk4-naive or adaptive"
+            )),
+        }
+    }
+}
+
+/// Options shared by the integrators.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct IntegratorOptions {
+    /// Which integrator.
+    pub kind: IntegratorKind,
+    /// Steps per drive period: a lower bound for `exact` (its grid is refined to resolve the
+    /// fastest mode, and made a multiple of this value), the fixed step for `rk4`.
+    pub steps_per_period: usize,
+    /// Relative and absolute tolerance of the adaptive oracle.
+    pub tolerance: f64,
+}
+
+impl Default for IntegratorOptions {
+    fn default() -> Self {
+        IntegratorOptions {
+            kind: IntegratorKind::Exact,
+            steps_per_period: 1,
+            tolerance: 1e-12,
+        }
+    }
+}
+
+/// Build an integrator of `model` starting at (τ, z).
+///
+/// # Errors
+/// [`SimError`] for invalid options or initial state.
+pub fn build(
+    model: &CantileverModel,
+    opts: IntegratorOptions,
+    tau: f64,
+    z: &DVector<f64>,
+) -> Result<Box<dyn Integrator>, SimError> {
+    if opts.steps_per_period == 0 || opts.steps_per_period > 10_000_000 {
+        return Err(SimError::out_of_range(
+            "steps per period",
+            opts.steps_per_period,
+            "must be in 1..=10000000",
+        ));
+    }
+    let mut integ: Box<dyn Integrator> = match opts.kind {
+        IntegratorKind::Exact => {
+            Box::new(exact::ExactPropagator::new(model, opts.steps_per_period))
+        }
+        IntegratorKind::Rk4 => Box::new(rk4::Rk4::new(model, opts.steps_per_period, true)),
+        IntegratorKind::Rk4Naive => Box::new(rk4::Rk4::new(model, opts.steps_per_period, false)),
+        IntegratorKind::Adaptive => {
+            if !(opts.tolerance.is_finite() && opts.tolerance > 0.0 && opts.tolerance < 1.0) {
+                return Err(SimError::out_of_range(
+                    "tolerance",
+                    opts.tolerance,
+                    "must be in (0, 1)",
+                ));
+            }
+            Box::new(adaptive::AdaptiveOracle::new(model, opts.tolerance))
+        }
+    };
+    integ.reset(tau, z)?;
+    Ok(integ)
+}
+
+/// End points of the last step of a Runge–Kutta integrator, for Hermite dense output:
+/// (τ0, z0, ż0) and (τ1, z1, ż1).
+#[derive(Debug, Clone)]
+pub(crate) struct HermiteStep {
+    t0: f64,
+    z0: DVector<f64>,
+    f0: DVector<f64>,
+    t1: f64,
+    z1: DVector<f64>,
+    f1: DVector<f64>,
+}
+
+impl HermiteStep {
+    pub(crate) fn new(dim: usize) -> Self {
+        let z = DVector::zeros(dim);
+        HermiteStep {
+            t0: 0.0,
+            z0: z.clone(),
+            f0: z.clone(),
+            t1: 0.0,
+            z1: z.clone(),
+            f1: z,
+        }
+    }
+
+    /// Record a step of `model` in region `r` from (t0, z0) to (t1, z1).
+    pub(crate) fn record(
+        &mut self,
+        model: &CantileverModel,
+        r: Region,
+        t0: f64,
+        z0: &DVector<f64>,
+        t1: f64,
+        z1: &DVector<f64>,
+    ) {
+        self.t0 = t0;
+        self.z0.copy_from(z0);
+        model.rhs(r, t0, z0, &mut self.f0);
+        self.t1 = t1;
+        self.z1.copy_from(z1);
+        model.rhs(r, t1, z1, &mut self.f1);
+    }
+
+    /// [W, W', W''] of the tip at τ.
+    pub(crate) fn tip(&self, model: &CantileverModel, tau: f64) -> [f64; 3] {
+        let n = model.modes();
+        let tip = model.tip();
+        let w0 = [tip.dot(&self.z0.rows(0, n)), tip.dot(&self.f0.rows(0, n))];
+        let w1 = [tip.dot(&self.z1.rows(0, n)), tip.dot(&self.f1.rows(0, n))];
+        hermite_tip(self.t0, w0, self.t1, w1, tau)
+    }
+
+    /// Full state at τ.
+    pub(crate) fn state(&self, tau: f64) -> DVector<f64> {
+        DVector::from_iterator(
+            self.z0.len(),
+            (0..self.z0.len()).map(|i| {
+                hermite_tip(
+                    self.t0,
+                    [self.z0[i], self.f0[i]],
+                    self.t1,
+                    [self.z1[i], self.f1[i]],
+                    tau,
+                )[0]
+            }),
+        )
+    }
+}
+
+/// Cubic Hermite interpolation of the tip deflection inside a step from its end values
+/// (W, W') — the dense output of the Runge–Kutta integrators. Returns [W, W', W''] at `tau`.
+pub(crate) fn hermite_tip(t0: f64, w0: [f64; 2], t1: f64, w1: [f64; 2], tau: f64) -> [f64; 3] {
+    let h = t1 - t0;
+    if h <= 0.0 {
+        return [w1[0], w1[1], 0.0];
+    }
+    let s = (tau - t0) / h;
+    let (p0, m0, p1, m1) = (w0[0], w0[1] * h, w1[0], w1[1] * h);
+    let h00 = 2.0 * s.powi(3) - 3.0 * s * s + 1.0;
+    let h10 = s.powi(3) - 2.0 * s * s + s;
+    let h01 = -2.0 * s.powi(3) + 3.0 * s * s;
+    let h11 = s.powi(3) - s * s;
+    let d00 = 6.0 * s * s - 6.0 * s;
+    let d10 = 3.0 * s * s - 4.0 * s + 1.0;
+    let d01 = -6.0 * s * s + 6.0 * s;
+    let d11 = 3.0 * s * s - 2.0 * s;
+    let e00 = 12.0 * s - 6.0;
+    let e10 = 6.0 * s - 4.0;
+    let e01 = -12.0 * s + 6.0;
+    let e11 = 6.0 * s - 2.0;
+    [
+        h00 * p0 + h10 * m0 + h01 * p1 + h11 * m1,
+        (d00 * p0 + d10 * m0 + d01 * p1 + d11 * m1) / h,
+        (e00 * p0 + e10 * m0 + e01 * p1 + e11 * m1) / (h * h),
+    ]
+}

@@ -1,0 +1,239 @@
+//! The dimensionless parameter set of the paper (eq. 7) with validation.
+
+use crate::error::ParamError;
+use serde::{Deserialize, Serialize};
+use std::fmt;
+use std::str::FromStr;
+
+/// Largest number of Galerkin modes supported (the mode shapes are accurate to ~1e-13 up to i = 20).
+pub const MAX_MODES: usize = 20;
+
+/// Dimensionless model parameters (paper eq. 7), all in the units of eq. 5.
+///
+/// | field | symbol | meaning | allowed |
+/// |---|---|---|---|
+/// | `modes` | N | number of Galerkin modes (eq. 9) | 1..=20 |
+/// | `alpha1` | α1 = M/(mL) | tip-mass ratio | finite, ≥ 0 |
+/// | `alpha2` | α2 = f/g0 | base-drive amplitude | finite, ≥ 0 |
+/// | `alpha3` | α3 | beam (viscous) damping | finite, ≥ 0 |
+/// | `alpha4` | α4 = K1 L³/(EI) | contact stiffness | finite, ≥ 0 |
+/// | `alpha5` | α5 = g1/g0 | tip–sample gap | finite |
+/// | `alpha6` | α6 | contact damping | finite, ≥ 0 |
+/// | `omega` | Ω | drive frequency (dimensionless) | finite, > 0 |
+///
+/// The fields are public for convenience; every constructor of a model calls [`Params::validate`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Params {
+    /// Number of Galerkin modes N.
+    pub modes: usize,
+    /// α1, tip-mass ratio M/(mL).
+    pub alpha1: f64,
+    /// α2, drive amplitude f/g0.
+    pub alpha2: f64,
+    /// α3, beam damping.
+    pub alpha3: f64,
+    /// α4, contact stiffness K1 L³/(EI).
+    pub alpha4: f64,
+    /// α5, gap g1/g0.
+    pub alpha5: f64,
+    /// α6, contact damping.
+    pub alpha6: f64,
+    /// Ω, dimensionless drive frequency.
+    pub omega: f64,
+}
+
+impl Default for Params {
+    /// The paper's set for Figs. 5–14 (eq. 26 with α1 = 0.1, N = 3) at Ω = 2.6.
+    fn default() -> Self {
+        Params {
+            modes: 3,
+            alpha1: 0.1,
+            alpha2: 0.1,
+            alpha3: 0.1,
+            alpha4: 20.0,
+            alpha5: 0.0,
+            alpha6: 0.2,
+            omega: 2.6,
+        }
+    }
+}
+
+impl Params {
+    /// Build and validate a parameter set.
+    ///
+    /// # Errors
+    /// [`ParamError`] naming the first field out of range.
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        modes: usize,
+        alpha1: f64,
+        alpha2: f64,
+        alpha3: f64,
+        alpha4: f64,
+        alpha5: f64,
+        alpha6: f64,
+        omega: f64,
+    ) -> Result<Self, ParamError> {
+        let p = Params {
+            modes,
+            alpha1,
+            alpha2,
+            alpha3,
+            alpha4,
+            alpha5,
+            alpha6,
+            omega,
+        };
+        p.validate()?;
+        Ok(p)
+    }
+
+    /// The paper's eq. 24 set (α1 = α2 = 0.1, α3 = α5 = α6 = 0, α4 = 20) at Ω = 4.1 (Fig. 4).
+    pub fn paper_eq24() -> Self {
+        Params {
+            alpha3: 0.0,
+            alpha6: 0.0,
+            omega: 4.1,
+            ..Params::default()
+        }
+    }
+
+    /// Check every field against its allowed range.
+    ///
+    /// # Errors
+    /// [`ParamError`] naming the first field out of range.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        if !(1..=MAX_MODES).contains(&self.modes) {
+            return Err(ParamError::Modes(self.modes));
+        }
+        for (name, value) in [
+            ("alpha1 (tip-mass ratio α1)", self.alpha1),
+            ("alpha2 (drive amplitude α2)", self.alpha2),
+            ("alpha3 (beam damping α3)", self.alpha3),
+            ("alpha4 (contact stiffness α4)", self.alpha4),
+            ("alpha6 (contact damping α6)", self.alpha6),
+        ] {
+            if !(value.is_finite() && value >= 0.0) {
+                return Err(ParamError::NonNegative { name, value });
+            }
+        }
+        if !self.alpha5.is_finite() {
+            return Err(ParamError::Gap(self.alpha5));
+        }
+        if !(self.omega.is_finite() && self.omega > 0.0) {
+            return Err(ParamError::Omega(self.omega));
+        }
+        Ok(())
+    }
+
+    /// The drive period T = 2π/Ω.
+    pub fn period(&self) -> f64 {
+        std::f64::consts::TAU / self.omega
+    }
+
+    /// Value of one sweepable parameter.
+    pub fn get(&self, p: SweepParam) -> f64 {
+        match p {
+            SweepParam::Omega => self.omega,
+            SweepParam::Alpha1 => self.alpha1,
+            SweepParam::Alpha2 => self.alpha2,
+            SweepParam::Alpha3 => self.alpha3,
+            SweepParam::Alpha4 => self.alpha4,
+            SweepParam::Alpha5 => self.alpha5,
+            SweepParam::Alpha6 => self.alpha6,
+        }
+    }
+
+    /// A copy with one sweepable parameter replaced (not validated: call [`Params::validate`]).
+    pub fn with(&self, p: SweepParam, value: f64) -> Params {
+        let mut q = *self;
+        match p {
+            SweepParam::Omega => q.omega = value,
+            SweepParam::Alpha1 => q.alpha1 = value,
+            SweepParam::Alpha2 => q.alpha2 = value,
+            SweepParam::Alpha3 => q.alpha3 = value,
+            SweepParam::Alpha4 => q.alpha4 = value,
+            SweepParam::Alpha5 => q.alpha5 = value,
+            SweepParam::Alpha6 => q.alpha6 = value,
+        }
+        q
+    }
+}
+
+/// A continuous parameter that sweeps and continuation can vary.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SweepParam {
+    /// Ω, drive frequency.
+    Omega,
+    /// α1, tip-mass ratio.
+    Alpha1,
+    /// α2, drive amplitude.
+    Alpha2,
+    /// α3, beam damping.
+    Alpha3,
+    /// α4, contact stiffness.
+    Alpha4,
+    /// α5, gap.
+    Alpha5,
+    /// α6, contact damping.
+    Alpha6,
+}
+
+impl SweepParam {
+    /// Canonical name (`omega`, `alpha1` … `alpha6`).
+    pub fn name(self) -> &'static str {
+        match self {
+            SweepParam::Omega => "omega",
+            SweepParam::Alpha1 => "alpha1",
+            SweepParam::Alpha2 => "alpha2",
+            SweepParam::Alpha3 => "alpha3",
+            SweepParam::Alpha4 => "alpha4",
+            SweepParam::Alpha5 => "alpha5",
+            SweepParam::Alpha6 => "alpha6",
+        }
+    }
+
+    /// Paper symbol (Ω, α1 … α6).
+    pub fn symbol(self) -> &'static str {
+        match self {
+            SweepParam::Omega => "Ω",
+            SweepParam::Alpha1 => "α1",
+            SweepParam::Alpha2 => "α2",
+            SweepParam::Alpha3 => "α3",
+            SweepParam::Alpha4 => "α4",
+            SweepParam::Alpha5 => "α5",
+            SweepParam::Alpha6 => "α6",
+        }
+    }
+}
+
+impl fmt::Display for SweepParam {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for SweepParam {
+    type Err = String;
+    /// Accepts `omega`, `alpha1`…`alpha6` and the descriptive names (`tip-mass-ratio`,
+    /// `drive-amplitude`, `beam-damping`, `contact-stiffness`, `gap`, `contact-damping`), with `-` or `_`.
+    fn from_str(s: &str) -> Result<Self, String> {
+        let k = s.trim().to_ascii_lowercase().replace('_', "-");
+        Ok(match k.as_str() {
+            "omega" | "Ω" => SweepParam::Omega,
+            "alpha1" | "tip-mass-ratio" => SweepParam::Alpha1,
+            "alpha2" | "drive-amplitude" => SweepParam::Alpha2,
+            "alpha3" | "beam-damping" => SweepParam::Alpha3,
+            "alpha4" | "contact-stiffness" => SweepParam::Alpha4,
+            "alpha5" | "gap" => SweepParam::Alpha5,
+            "alpha6" | "contact-damping" => SweepParam::Alpha6,
+            _ => {
+                return Err(format!(
+                    "unknown parameter '{s}': expected omega, alpha1..alpha6 or tip-mass-ratio, \
+                     drive-amplitude, beam-damping, contact-stiffness, gap, contact-damping"
+                ))
+            }
+        })
+    }
+}

@@ -1,0 +1,389 @@
+//! Physical units ↔ the dimensionless set (paper eqs. 5 and 7, Hertz contact of §4).
+//!
+//! Eq. 7 prints α3 = C √(L⁴/EI) and α6 = (C1/L) √(L⁴/EI); non-dimensionalising eq. 3 with the
+//! time scale of eq. 5 gives α3 = C L² / √(EI m) and α6 = C1 L / √(EI m). The two agree only when
+//! m = 1 in the chosen units, so the dimensionally consistent forms are implemented here.
+
+use crate::eigen::natural_modes;
+use crate::error::UnitsError;
+use crate::galerkin::{Galerkin, Region};
+use crate::params::Params;
+use serde::{Deserialize, Serialize};
+
+/// An isotropic elastic material: Young's modulus (Pa) and Poisson ratio.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Material {
+    /// Young's modulus E (Pa).
+    pub youngs_modulus: f64,
+    /// Poisson ratio ν.
+    pub poisson_ratio: f64,
+}
+
+/// The paper's silicon tip (§4, from its ref. [44]): E₁ = 130 GPa, ν₁ = 0.27.
+pub const SILICON_TIP: Material = Material {
+    youngs_modulus: 130e9,
+    poisson_ratio: 0.27,
+};
+
+/// Named sample materials: (name, material). Sources per entry.
+pub const SAMPLE_MATERIALS: &[(&str, Material)] = &[
+    // E: the paper §4 ("polystyrene (E2 = 4 GPa)", from its ref. [44]).
+    // ν: 0.34, J.E. Mark (ed.), Physical Properties of Polymers Handbook, 2nd ed., Springer 2007.
+    (
+        "polystyrene",
+        Material {
+            youngs_modulus: 4e9,
+            poisson_ratio: 0.34,
+        },
+    ),
+    // E: the paper §4 ("highly oriented pyrolytic graphite (E2 = 5 GPa)", from its ref. [44]).
+    // ν: 0.2, an assumed typical value for graphite (not given in the paper).
+    (
+        "hopg",
+        Material {
+            youngs_modulus: 5e9,
+            poisson_ratio: 0.2,
+        },
+    ),
+    // E: 1.32 MPa, Sylgard 184 cured at 25 °C, Johnston et al., J. Micromech. Microeng. 24
+    // (2014) 035017; ν: 0.49 (near-incompressible elastomer), same source.
+    (
+        "pdms",
+        Material {
+            youngs_modulus: 1.32e6,
+            poisson_ratio: 0.49,
+        },
+    ),
+    // Muscovite mica, in-plane: E ≈ 178 GPa, ν ≈ 0.25 from the elastic constants of
+    // McNeil & Grimsditch, J. Phys.: Condens. Matter 5 (1993) 1681.
+    (
+        "mica",
+        Material {
+            youngs_modulus: 178e9,
+            poisson_ratio: 0.25,
+        },
+    ),
+    // Silicon ⟨100⟩: E = 130 GPa, ν = 0.27 as the paper's tip (§4); Hopcroft, Nix & Kenny,
+    // J. Microelectromech. Syst. 19 (2010) 229 give E⟨100⟩ = 130 GPa.
+    ("silicon", SILICON_TIP),
+];
+
+/// Look up a sample material by name (case-insensitive).
+///
+/// # Errors
+/// [`UnitsError::Choice`] listing the known names.
+pub fn material(name: &str) -> Result<Material, UnitsError> {
+    let key = name.trim().to_ascii_lowercase();
+    SAMPLE_MATERIALS
+        .iter()
+        .find(|(n, _)| *n == key)
+        .map(|(_, m)| *m)
+        .ok_or_else(|| {
+            let names: Vec<&str> = SAMPLE_MATERIALS.iter().map(|(n, _)| *n).collect();
+            UnitsError::Choice(format!(
+                "sample = '{name}': unknown material, expected one of {}",
+                names.join(", ")
+            ))
+        })
+}
+
+/// Hertz contact stiffness K₁ = 2E*√(RΔ), 1/E* = (1 − ν₁²)/E₁ + (1 − ν₂²)/E₂ (paper §4). N/m.
+pub fn hertz_stiffness(tip: Material, sample: Material, radius: f64, indentation: f64) -> f64 {
+    let inv = (1.0 - tip.poisson_ratio.powi(2)) / tip.youngs_modulus
+        + (1.0 - sample.poisson_ratio.powi(2)) / sample.youngs_modulus;
+    2.0 / inv * (radius * indentation).sqrt()
+}
+
+/// A rectangular cantilever: geometry and material (SI).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Cantilever {
+    /// Length L (m).
+    pub length: f64,
+    /// Width b (m).
+    pub width: f64,
+    /// Thickness h (m).
+    pub thickness: f64,
+    /// Young's modulus E (Pa).
+    pub youngs_modulus: f64,
+    /// Density ρ (kg/m³).
+    pub density: f64,
+}
+
+impl Cantilever {
+    /// Check every field is finite and > 0.
+    ///
+    /// # Errors
+    /// [`UnitsError::Positive`] naming the field.
+    pub fn validate(&self) -> Result<(), UnitsError> {
+        for (name, value, unit) in [
+            ("length", self.length, "m"),
+            ("width", self.width, "m"),
+            ("thickness", self.thickness, "m"),
+            ("youngs_modulus", self.youngs_modulus, "Pa"),
+            ("density", self.density, "kg/m^3"),
+        ] {
+            positive(name, value, unit)?;
+        }
+        Ok(())
+    }
+    /// Second moment of area I = b h³ / 12 (m⁴).
+    pub fn inertia(&self) -> f64 {
+        self.width * self.thickness.powi(3) / 12.0
+    }
+    /// Bending stiffness EI (N m²).
+    pub fn bending_stiffness(&self) -> f64 {
+        self.youngs_modulus * self.inertia()
+    }
+    /// Mass per unit length m = ρ b h (kg/m).
+    pub fn mass_per_length(&self) -> f64 {
+        self.density * self.width * self.thickness
+    }
+    /// Static spring constant K_c = 3EI/L³ (N/m), paper §4.
+    pub fn spring_constant(&self) -> f64 {
+        3.0 * self.bending_stiffness() / self.length.powi(3)
+    }
+    /// Seconds per unit of dimensionless time: t = τ √(mL⁴/EI) (eq. 5).
+    pub fn time_scale(&self) -> f64 {
+        (self.mass_per_length() * self.length.powi(4) / self.bending_stiffness()).sqrt()
+    }
+    /// First natural frequency of the bare cantilever f₁ = β₁² √(EI/(mL⁴)) / 2π (Hz).
+    pub fn first_frequency_hz(&self) -> f64 {
+        crate::beam::beta_root(1).powi(2) / self.time_scale() / std::f64::consts::TAU
+    }
+}
+
+/// The resolved physical model in SI units (the dimensional counterpart of [`Params`]).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct PhysicalModel {
+    /// The cantilever.
+    pub cantilever: Cantilever,
+    /// Number of Galerkin modes N.
+    pub modes: usize,
+    /// Tip mass M (kg).
+    pub tip_mass: f64,
+    /// Beam viscous damping per unit length C (N s/m²).
+    pub beam_damping: f64,
+    /// Contact stiffness K₁ (N/m).
+    pub contact_stiffness: f64,
+    /// Contact damping C₁ (N s/m).
+    pub contact_damping: f64,
+    /// Base-drive amplitude f (m).
+    pub drive_amplitude: f64,
+    /// Beam–substrate gap g₀ (m), the length scale of W (eq. 5).
+    pub beam_gap: f64,
+    /// Tip–sample gap g₁ (m).
+    pub tip_gap: f64,
+    /// Drive frequency (Hz).
+    pub drive_frequency_hz: f64,
+}
+
+/// Scales that turn dimensionless results back into SI.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Scales {
+    /// Seconds per unit τ (eq. 5).
+    pub time_s: f64,
+    /// Metres per unit W (= g₀, eq. 5).
+    pub length_m: f64,
+    /// Static spring constant K_c = 3EI/L³ (N/m).
+    pub spring_constant: f64,
+    /// First natural frequency of the bare cantilever (Hz).
+    pub first_frequency_hz: f64,
+}
+
+impl PhysicalModel {
+    /// Validate every field.
+    ///
+    /// # Errors
+    /// [`UnitsError`] naming the field and its range.
+    pub fn validate(&self) -> Result<(), UnitsError> {
+        self.cantilever.validate()?;
+        for (name, value, unit) in [
+            ("tip_mass", self.tip_mass, "kg"),
+            ("beam_damping", self.beam_damping, "N s/m^2"),
+            ("contact_stiffness", self.contact_stiffness, "N/m"),
+            ("contact_damping", self.contact_damping, "N s/m"),
+            ("drive_amplitude", self.drive_amplitude, "m"),
+        ] {
+            non_negative(name, value, unit)?;
+        }
+        positive("beam_gap", self.beam_gap, "m")?;
+        positive("drive_frequency_hz", self.drive_frequency_hz, "Hz")?;
+        if !self.tip_gap.is_finite() {
+            return Err(UnitsError::Finite {
+                name: "tip_gap",
+                value: self.tip_gap,
+                unit: "m",
+            });
+        }
+        Ok(())
+    }
+
+    /// The dimensionless set (eq. 7; α3 and α6 in the consistent form of the module docs) and
+    /// Ω = ω √(mL⁴/EI) (eq. 5).
+    ///
+    /// # Errors
+    /// [`UnitsError`] for invalid physical input.
+    pub fn to_params(&self) -> Result<Params, UnitsError> {
+        self.validate()?;
+        let c = &self.cantilever;
+        let (l, m, ei) = (c.length, c.mass_per_length(), c.bending_stiffness());
+        let root = (ei * m).sqrt();
+        let p = Params {
+            modes: self.modes,
+            alpha1: self.tip_mass / (m * l),
+            alpha2: self.drive_amplitude / self.beam_gap,
+            alpha3: self.beam_damping * l * l / root,
+            alpha4: self.contact_stiffness * l.powi(3) / ei,
+            alpha5: self.tip_gap / self.beam_gap,
+            alpha6: self.contact_damping * l / root,
+            omega: std::f64::consts::TAU * self.drive_frequency_hz * c.time_scale(),
+        };
+        p.validate()?;
+        Ok(p)
+    }
+
+    /// The inverse map: physical values from a dimensionless set, a cantilever and g₀.
+    ///
+    /// # Errors
+    /// [`UnitsError`] for an invalid cantilever, g₀ or parameter set.
+    pub fn from_params(
+        cantilever: Cantilever,
+        p: &Params,
+        beam_gap: f64,
+    ) -> Result<Self, UnitsError> {
+        cantilever.validate()?;
+        positive("beam_gap", beam_gap, "m")?;
+        p.validate()?;
+        let (l, m, ei) = (
+            cantilever.length,
+            cantilever.mass_per_length(),
+            cantilever.bending_stiffness(),
+        );
+        let root = (ei * m).sqrt();
+        Ok(PhysicalModel {
+            cantilever,
+            modes: p.modes,
+            tip_mass: p.alpha1 * m * l,
+            beam_damping: p.alpha3 * root / (l * l),
+            contact_stiffness: p.alpha4 * ei / l.powi(3),
+            contact_damping: p.alpha6 * root / l,
+            drive_amplitude: p.alpha2 * beam_gap,
+            beam_gap,
+            tip_gap: p.alpha5 * beam_gap,
+            drive_frequency_hz: p.omega / cantilever.time_scale() / std::f64::consts::TAU,
+        })
+    }
+
+    /// Time and length scales.
+    pub fn scales(&self) -> Scales {
+        Scales {
+            time_s: self.cantilever.time_scale(),
+            length_m: self.beam_gap,
+            spring_constant: self.cantilever.spring_constant(),
+            first_frequency_hz: self.cantilever.first_frequency_hz(),
+        }
+    }
+}
+
+/// Beam damping given directly (C, N s/m²) or through the first-mode quality factor Q₁.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum BeamDamping {
+    /// C in N s/m².
+    Coefficient(f64),
+    /// Q₁ of the first free mode (with the tip mass).
+    QualityFactor(f64),
+}
+
+/// Contact stiffness given directly (N/m) or by the Hertz model.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ContactStiffness {
+    /// K₁ in N/m.
+    Direct(f64),
+    /// K₁ = 2E*√(RΔ).
+    Hertz {
+        /// Tip material.
+        tip: Material,
+        /// Sample material.
+        sample: Material,
+        /// Tip radius R (m).
+        radius: f64,
+        /// Indentation Δ (m).
+        indentation: f64,
+    },
+}
+
+/// Resolve a damping given as Q₁ into C: α3 = ω₁ / (Q₁ x₁ᵀx₁) for the first mass-normalised
+/// free mode x₁ (C^I = α3·I, eq. 12), then C = α3 √(EI m)/L².
+///
+/// # Errors
+/// [`UnitsError`] for Q₁ ≤ 0 or an invalid model.
+pub fn beam_damping_from_q(model: &PhysicalModel, q1: f64) -> Result<f64, UnitsError> {
+    positive("quality_factor", q1, "1")?;
+    let mut undamped = *model;
+    undamped.beam_damping = 0.0;
+    let p = undamped.to_params()?;
+    let g = Galerkin::new(&p)?;
+    let modes = natural_modes(g.region(Region::Free));
+    let x1 = modes.vectors.column(0);
+    let alpha3 = modes.omega[0] / (q1 * x1.dot(&x1));
+    let c = &model.cantilever;
+    Ok(alpha3 * (c.bending_stiffness() * c.mass_per_length()).sqrt() / c.length.powi(2))
+}
+
+/// Resolve a Hertz or direct contact stiffness into K₁ (N/m).
+///
+/// # Errors
+/// [`UnitsError`] for a non-positive radius/indentation/modulus or a Poisson ratio out of range.
+pub fn contact_stiffness(k: ContactStiffness) -> Result<f64, UnitsError> {
+    match k {
+        ContactStiffness::Direct(k1) => non_negative("contact_stiffness", k1, "N/m"),
+        ContactStiffness::Hertz {
+            tip,
+            sample,
+            radius,
+            indentation,
+        } => {
+            positive("tip_radius", radius, "m")?;
+            non_negative("indentation", indentation, "m")?;
+            for (name, m) in [("tip", tip), ("sample", sample)] {
+                positive(
+                    if name == "tip" {
+                        "tip_youngs_modulus"
+                    } else {
+                        "sample_youngs_modulus"
+                    },
+                    m.youngs_modulus,
+                    "Pa",
+                )?;
+                if !(m.poisson_ratio > -1.0 && m.poisson_ratio <= 0.5) {
+                    return Err(UnitsError::Poisson {
+                        name: if name == "tip" {
+                            "tip_poisson_ratio"
+                        } else {
+                            "sample_poisson_ratio"
+                        },
+                        value: m.poisson_ratio,
+                    });
+                }
+            }
+            Ok(hertz_stiffness(tip, sample, radius, indentation))
+        }
+    }
+}
+
+fn positive(name: &'static str, value: f64, unit: &'static str) -> Result<f64, UnitsError> {
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        Err(UnitsError::Positive { name, value, unit })
+    }
+}
+
+fn non_negative(name: &'static str, value: f64, unit: &'static str) -> Result<f64, UnitsError> {
+    if value.is_finite() && value >= 0.0 {
+        Ok(value)
+    } else {
+        Err(UnitsError::NonNegative { name, value, unit })
+    }
+}
