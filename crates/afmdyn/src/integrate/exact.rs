@@ -32,13 +32,33 @@ use nalgebra::{DMatrix, DVector};
 use std::collections::VecDeque;
 
 /// Bound on ‖Ã‖₂ h for the grid step (radians of the fastest mode per step).
-pub const THETA: f64 = 1.0;
-/// Number of Taylor terms kept in partial steps and tip polynomials (‖Ãt‖ ≤ θ: 1/31! ≈ 1e-34).
-const K: usize = 30;
+pub const THETA: f64 = 2.5;
+/// Number of Taylor terms kept in partial steps and tip polynomials (‖Ãt‖ ≤ θ = 2.5:
+/// θ^41/41! ≈ 3e-34).
+const K: usize = 40;
 /// Switchings within [`CHATTER_WINDOW`] of τ that count as chattering.
 const CHATTER_COUNT: usize = 64;
 /// Time window of the chattering test.
 const CHATTER_WINDOW: f64 = 1e-9;
+
+/// y ← α A x (+ y when `accumulate`), A column-major with `x.len()` columns. Hand-written:
+/// nalgebra's dynamic gemv has a per-call overhead comparable to the 36 multiply–adds of N = 3,
+/// and this is the inner loop of the propagator.
+#[inline]
+fn matvec(a: &DMatrix<f64>, x: &[f64], y: &mut [f64], alpha: f64, accumulate: bool) {
+    let rows = a.nrows();
+    debug_assert_eq!(rows, y.len());
+    debug_assert_eq!(a.ncols(), x.len());
+    if !accumulate {
+        y.fill(0.0);
+    }
+    for (col, &xj) in a.as_slice().chunks_exact(rows).zip(x) {
+        let s = alpha * xj;
+        for (yi, aij) in y.iter_mut().zip(col) {
+            *yi += aij * s;
+        }
+    }
+}
 
 /// Precomputed data of one region.
 #[derive(Debug, Clone)]
@@ -207,7 +227,6 @@ struct LastStep {
     region: Region,
     /// Homogeneous part δz(τ0) in plain coordinates.
     dz0: DVector<f64>,
-    poly: Option<TipPoly>,
 }
 
 /// Exact propagator (see the module docs).
@@ -226,6 +245,12 @@ pub struct ExactPropagator {
     just_switched: bool,
     recent: VecDeque<f64>,
     last: LastStep,
+    /// Tip polynomial of the last step, when built.
+    poly: Option<Box<TipPoly>>,
+    /// V_T and dV_T/dτ at the current state.
+    vt: (f64, f64),
+    /// sin Ωτ_k and cos Ωτ_k on the grid of one period (k = 0..=m).
+    trig: Vec<(f64, f64)>,
     zb: DVector<f64>,
     buf: [DVector<f64>; 4],
 }
@@ -367,8 +392,12 @@ impl ExactPropagator {
                 tau0: 0.0,
                 region: Region::Free,
                 dz0: zero.clone(),
-                poly: None,
             },
+            poly: None,
+            vt: (0.0, 0.0),
+            trig: (0..=m)
+                .map(|k| (omega * (k as f64 * h)).sin_cos())
+                .collect(),
             zb: zero.clone(),
             buf: [zero.clone(), zero.clone(), zero.clone(), zero],
         })
@@ -417,9 +446,9 @@ impl ExactPropagator {
     ) {
         out.copy_from(y0);
         term.copy_from(y0);
-        let floor = 1e-36 * y0.norm_squared();
+        let floor = 1e-34 * y0.norm_squared();
         for n in 1..=K {
-            tmp.gemv(t / n as f64, at, term, 0.0);
+            matvec(at, term.as_slice(), tmp.as_mut_slice(), t / n as f64, false);
             std::mem::swap(term, tmp);
             *out += &*term;
             if term.norm_squared() <= floor {
@@ -432,16 +461,25 @@ impl ExactPropagator {
     fn state_in_last(&mut self, t: f64, out: &mut DVector<f64>) {
         let rp = &self.regions[self.last.region.index()];
         let [y0, yt, term, tmp] = &mut self.buf;
-        y0.gemv(1.0, &rp.t, &self.last.dz0, 0.0);
+        matvec(
+            &rp.t,
+            self.last.dz0.as_slice(),
+            y0.as_mut_slice(),
+            1.0,
+            false,
+        );
         Self::taylor(&rp.at, y0, t, yt, term, tmp);
         Self::zp_into(rp, self.model.omega(), self.last.tau0 + t, out);
-        out.gemv(1.0, &rp.tinv, yt, 1.0);
+        matvec(&rp.tinv, yt.as_slice(), out.as_mut_slice(), 1.0, true);
     }
 
     fn build_poly(&self, region: Region, tau0: f64, dz0: &DVector<f64>, len: f64) -> TipPoly {
         let rp = &self.regions[region.index()];
-        let y0 = &rp.t * dz0;
-        let mo = &rp.rows * y0;
+        let mut y0 = [0.0; 2 * crate::params::MAX_MODES];
+        let y0 = &mut y0[..dz0.len()];
+        matvec(&rp.t, dz0.as_slice(), y0, 1.0, false);
+        let mut mo = [0.0; K + 3];
+        matvec(&rp.rows, y0, &mut mo, 1.0, false);
         let mut c = [[0.0; K + 1]; 3];
         let mut fact = 1.0;
         for n in 0..=K {
@@ -529,8 +567,9 @@ impl Integrator for ExactPropagator {
             tau0: tau,
             region: self.region,
             dz0: DVector::zeros(z.len()),
-            poly: None,
         };
+        self.poly = None;
+        self.vt = (self.model.v_t(tau, z), self.model.v_t_dot(tau, z));
         Ok(())
     }
 
@@ -561,31 +600,46 @@ impl Integrator for ExactPropagator {
         if full {
             let k = self.on_grid.expect("on grid").rem_euclid(self.m as i64) as usize;
             let rp = &self.regions[ri];
-            dz0.copy_from(&self.z);
-            dz0 -= &rp.zp_grid.column(k);
-            z_b.copy_from(&rp.zp_grid.column(k + 1));
-            z_b.gemv(1.0, &rp.phi, &dz0, 1.0);
+            let dim = dz0.len();
+            let zp = rp.zp_grid.as_slice();
+            let (zk, zk1) = (
+                &zp[k * dim..(k + 1) * dim],
+                &zp[(k + 1) * dim..(k + 2) * dim],
+            );
+            for ((d, z), p) in dz0.iter_mut().zip(self.z.iter()).zip(zk) {
+                *d = z - p;
+            }
+            z_b.as_mut_slice().copy_from_slice(zk1);
+            matvec(&rp.phi, dz0.as_slice(), z_b.as_mut_slice(), 1.0, true);
         } else {
             let rp = &self.regions[ri];
             Self::zp_into(rp, omega, tau0, &mut dz0);
             dz0.neg_mut();
             dz0 += &self.z;
         }
-        self.last = LastStep {
-            tau0,
-            region,
-            dz0,
-            poly: None,
-        };
-        if !full {
+        self.last.tau0 = tau0;
+        self.last.region = region;
+        self.last.dz0 = dz0;
+        self.poly = None;
+        let vt_b = if full {
+            let k = (self.on_grid.expect("on grid").rem_euclid(self.m as i64) + 1) as usize;
+            let (s, c) = self.trig[k];
+            let p = self.model.params();
+            let n = p.modes;
+            let tip = self.model.tip();
+            (
+                tip.dot(&z_b.rows(0, n)) + p.alpha2 * s + p.alpha5,
+                tip.dot(&z_b.rows(n, n)) + p.alpha2 * p.omega * c,
+            )
+        } else {
             self.state_in_last(len, &mut z_b);
-        }
+            (self.model.v_t(tau_b, &z_b), self.model.v_t_dot(tau_b, &z_b))
+        };
         let sigma = if region == Region::Free { 1.0 } else { -1.0 };
-        let m = &self.model;
-        let mut ga = sigma * m.v_t(tau0, &self.z);
-        let da = sigma * m.v_t_dot(tau0, &self.z);
-        let gb = sigma * m.v_t(tau_b, &z_b);
-        let db = sigma * m.v_t_dot(tau_b, &z_b);
+        let mut ga = sigma * self.vt.0;
+        let da = sigma * self.vt.1;
+        let gb = sigma * vt_b.0;
+        let db = sigma * vt_b.1;
         let switched = self.just_switched || ga <= 0.0;
         if switched {
             ga = ga.max(0.0);
@@ -612,7 +666,7 @@ impl Integrator for ExactPropagator {
             } else {
                 hit = search.first(a, g_a, len, (gb, db), 0);
             }
-            self.last.poly = Some(poly);
+            self.poly = Some(Box::new(poly));
         }
         self.just_switched = false;
         match hit {
@@ -620,6 +674,7 @@ impl Integrator for ExactPropagator {
                 self.zb = z_b;
                 std::mem::swap(&mut self.z, &mut self.zb);
                 self.tau = tau_b;
+                self.vt = vt_b;
                 self.on_grid = (tau_b == t_grid).then_some(j_next);
                 if let Some(j) = self.on_grid {
                     if j.rem_euclid(self.m as i64) == 0 {
@@ -645,6 +700,7 @@ impl Integrator for ExactPropagator {
                 let v_t_dot = self.model.v_t_dot(tau_s, &zs);
                 self.z.copy_from(&zs);
                 self.tau = tau_s;
+                self.vt = (self.model.v_t(tau_s, &zs), v_t_dot);
                 self.region = to;
                 self.on_grid = None;
                 self.just_switched = true;
@@ -668,12 +724,12 @@ impl Integrator for ExactPropagator {
 
     fn dense_tip(&mut self, tau: f64) -> [f64; 3] {
         let t = tau - self.last.tau0;
-        if self.last.poly.is_none() {
+        if self.poly.is_none() {
             let len = (self.tau - self.last.tau0).max(t);
-            let dz0 = self.last.dz0.clone();
-            self.last.poly = Some(self.build_poly(self.last.region, self.last.tau0, &dz0, len));
+            let poly = self.build_poly(self.last.region, self.last.tau0, &self.last.dz0, len);
+            self.poly = Some(Box::new(poly));
         }
-        self.last.poly.as_ref().expect("built").w(t)
+        self.poly.as_ref().expect("built").w(t)
     }
 
     fn dense_state(&mut self, tau: f64) -> DVector<f64> {
