@@ -1,0 +1,369 @@
+//! End-to-end tests of the `afmdyn` binary: the README's promises, the JSON contracts, bad input,
+//! atomic outputs, and resuming an interrupted sweep.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn afmdyn(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_afmdyn"))
+        .args(args)
+        .output()
+        .expect("run afmdyn")
+}
+
+fn json(out: &Output) -> serde_json::Value {
+    assert!(
+        out.status.success(),
+        "stderr: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("one JSON document")
+}
+
+fn bad_input(args: &[&str], needle: &str) {
+    let out = afmdyn(args);
+    assert_eq!(out.status.code(), Some(2), "{args:?}");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.trim_end().lines().count(), 1, "one line: {err}");
+    assert!(
+        err.contains(needle),
+        "{args:?}: '{err}' should mention '{needle}'"
+    );
+    assert!(out.stdout.is_empty(), "no output presented as a result");
+}
+
+#[test]
+fn modes_json_reproduces_eq25_with_five_modes() {
+    let doc = json(&afmdyn(&[
+        "modes", "--json", "--modes", "5", "--alpha3", "0", "--alpha6", "0",
+    ]));
+    let w: Vec<f64> = doc["contact"]["omega"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    for (got, printed) in w.iter().zip([7.79, 20.33, 55.81]) {
+        assert_eq!((got * 100.0).round() / 100.0, printed, "paper eq. 25");
+    }
+    // undamped: eigenvalues are ±iω, we list Im ≥ 0 sorted by Im, matching omega
+    let ev = doc["contact"]["eigenvalues"].as_array().unwrap();
+    assert_eq!(ev.len(), 5);
+    for (e, wi) in ev.iter().zip(&w) {
+        assert!((e[1].as_f64().unwrap() - wi).abs() < 1e-9 * wi);
+        assert!(e[0].as_f64().unwrap().abs() < 1e-9 * wi);
+    }
+    assert_eq!(doc["params"]["modes"], 5);
+    assert!(doc["free"]["omega"].as_array().unwrap().len() == 5);
+}
+
+#[test]
+fn config_file_and_flags() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = dir.path().join("m.toml");
+    std::fs::write(
+        &cfg,
+        "modes = 4\nalpha1 = 0.2\ncontact_stiffness = 30.0\nomega = 3.0\n",
+    )
+    .unwrap();
+    let doc = json(&afmdyn(&[
+        "modes",
+        "--json",
+        "--config",
+        cfg.to_str().unwrap(),
+        "--omega",
+        "3.5",
+    ]));
+    assert_eq!(doc["params"]["modes"], 4);
+    assert_eq!(doc["params"]["alpha1"], 0.2);
+    assert_eq!(doc["params"]["alpha4"], 30.0);
+    assert_eq!(doc["params"]["omega"], 3.5, "flags override the file");
+    std::fs::write(&cfg, "modes = 4\nstiffnes = 3.0\n").unwrap();
+    bad_input(
+        &["modes", "--config", cfg.to_str().unwrap()],
+        "unknown field",
+    );
+    std::fs::write(&cfg, "modes = \"three\"\n").unwrap();
+    bad_input(
+        &["modes", "--config", cfg.to_str().unwrap()],
+        "invalid type",
+    );
+    bad_input(&["modes", "--config", "/nonexistent/x.toml"], "x.toml");
+}
+
+#[test]
+fn bad_parameters_exit_2_with_one_line() {
+    bad_input(&["modes", "--modes", "0"], "1..=20");
+    bad_input(&["modes", "--modes", "21"], "1..=20");
+    bad_input(&["modes", "--alpha4", "-1"], "alpha4");
+    bad_input(&["modes", "--tip-mass-ratio", "-0.5"], "alpha1");
+    bad_input(&["modes", "--omega", "0"], "omega");
+    bad_input(&["modes", "--omega", "nan"], "omega");
+    bad_input(&["modes", "--gap", "inf"], "alpha5");
+    bad_input(&["modes", "--bogus"], "--bogus");
+    bad_input(&["simulate", "--periods", "-3"], "periods");
+    bad_input(&["simulate", "--periods", "nan"], "periods");
+    bad_input(
+        &["simulate", "--initial-modal", "0.1,0.2;0,0,0"],
+        "expected 3",
+    );
+    bad_input(&["simulate", "--initial-modal", "nan,0,0;0,0,0"], "finite");
+    bad_input(
+        &["simulate", "--initial-modal", "0.1,0,0"],
+        "--initial-modal",
+    );
+    bad_input(&["bifurcation", "--param", "beta"], "beta");
+    bad_input(
+        &[
+            "bifurcation",
+            "--param",
+            "alpha4",
+            "--from",
+            "-1",
+            "--to",
+            "5",
+        ],
+        "alpha4",
+    );
+    bad_input(&["simulate", "--integrator", "euler"], "euler");
+}
+
+#[test]
+fn simulate_writes_series_events_section_and_plots() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("sim");
+    let doc = json(&afmdyn(&[
+        "simulate",
+        "--periods",
+        "6",
+        "--transient",
+        "2",
+        "--samples-per-period",
+        "50",
+        "--json",
+        "--out",
+        out.to_str().unwrap(),
+    ]));
+    assert!(doc["switchings"].as_u64().unwrap() >= 6);
+    assert_eq!(doc["body_contact"], false);
+    assert_eq!(doc["final"]["a"].as_array().unwrap().len(), 3);
+    let t = doc["tau_end"].as_f64().unwrap();
+    assert!((t - 8.0 * std::f64::consts::TAU / 2.6).abs() < 1e-9);
+    // V_T = W + α2 sin Ωτ + α5 (eq. 8) in the summary
+    let (w, v) = (
+        doc["final"]["w_tip"].as_f64().unwrap(),
+        doc["final"]["v_t"].as_f64().unwrap(),
+    );
+    assert!((v - (w + 0.1 * (2.6 * t).sin())).abs() < 1e-12);
+    for f in [
+        "timeseries.csv",
+        "timeseries.npy",
+        "events.csv",
+        "poincare.csv",
+        "energy.csv",
+        "tip.png",
+        "tip.svg",
+        "phase.png",
+        "spectrum.svg",
+    ] {
+        assert!(out.join(f).exists(), "{f}");
+    }
+    let ts = std::fs::read_to_string(out.join("timeseries.csv")).unwrap();
+    let header = ts.lines().next().unwrap();
+    assert_eq!(
+        header,
+        "tau,v_t,w_tip,w_tip_dot,in_contact,contact_force,a_1,a_2,a_3,a_dot_1,a_dot_2,a_dot_3"
+    );
+    assert_eq!(ts.lines().count(), 1 + 6 * 50 + 1);
+    let poincare = std::fs::read_to_string(out.join("poincare.csv")).unwrap();
+    assert_eq!(
+        poincare.lines().count(),
+        1 + 7,
+        "sections at τ = 2πk/Ω, k = 2..=8"
+    );
+    // no temporary file is left behind
+    assert!(std::fs::read_dir(&out).unwrap().all(|e| !e
+        .unwrap()
+        .file_name()
+        .to_string_lossy()
+        .contains("partial")));
+    // the same run with the oracle integrator ends at the same state
+    let doc2 = json(&afmdyn(&[
+        "simulate",
+        "--periods",
+        "6",
+        "--transient",
+        "2",
+        "--samples-per-period",
+        "50",
+        "--json",
+        "--integrator",
+        "adaptive",
+        "--tolerance",
+        "1e-13",
+        "--out",
+        out.to_str().unwrap(),
+    ]));
+    assert!((doc2["final"]["w_tip"].as_f64().unwrap() - w).abs() < 1e-8);
+}
+
+#[test]
+fn units_example_probe() {
+    let probe = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/probe.toml");
+    let doc = json(&afmdyn(&[
+        "units",
+        "--json",
+        "--config",
+        probe.to_str().unwrap(),
+    ]));
+    let k = doc["scales"]["spring_constant"].as_f64().unwrap();
+    assert!((k - 43.83).abs() < 0.1, "3EI/L³ of the 125 µm probe: {k}");
+    assert!(doc["params"]["alpha4"].as_f64().unwrap() > 0.0);
+}
+
+fn rows(path: &Path) -> Vec<String> {
+    let mut r: Vec<String> = std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(String::from)
+        .collect();
+    r.sort();
+    r
+}
+
+#[test]
+fn bifurcation_resumes_after_a_kill_without_lost_or_duplicated_rows() {
+    let dir = tempfile::tempdir().unwrap();
+    let (full, cut) = (dir.path().join("full"), dir.path().join("cut"));
+    let args = |out: &Path| {
+        vec![
+            "bifurcation".to_string(),
+            "--from".into(),
+            "2.4".into(),
+            "--to".into(),
+            "2.9".into(),
+            "--steps".into(),
+            "12".into(),
+            "--starts".into(),
+            "1".into(),
+            "--max-periods".into(),
+            "300".into(),
+            "--out".into(),
+            out.to_str().unwrap().into(),
+        ]
+    };
+    let run = |extra: &[&str], out: &Path| {
+        let mut a: Vec<String> = args(out);
+        a.extend(extra.iter().map(|s| s.to_string()));
+        afmdyn(&a.iter().map(String::as_str).collect::<Vec<_>>())
+    };
+    assert!(run(&[], &full).status.success());
+    let reference = rows(&full.join("bifurcation.csv"));
+    assert!(!reference.is_empty());
+    // a killed run: the partial file holds a prefix of the rows, cut inside a line
+    std::fs::create_dir_all(&cut).unwrap();
+    let text = std::fs::read_to_string(full.join("bifurcation.csv")).unwrap();
+    let cut_at = text.len() * 3 / 5;
+    std::fs::write(cut.join(".bifurcation.partial.csv"), &text[..cut_at]).unwrap();
+    assert!(!cut.join("bifurcation.csv").exists());
+    let out = run(&["--resume"], &cut);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let resumed = rows(&cut.join("bifurcation.csv"));
+    assert_eq!(resumed.len(), reference.len(), "no lost or duplicated rows");
+    assert_eq!(
+        resumed, reference,
+        "the resumed sweep equals the uninterrupted one"
+    );
+    assert!(!cut.join(".bifurcation.partial.csv").exists());
+    assert!(cut.join("bifurcation.npy").exists() && cut.join("bifurcation.png").exists());
+}
+
+#[test]
+fn default_bifurcation_run_completes_and_writes_plot_and_data() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_afmdyn"))
+        .arg("bifurcation")
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let o = dir.path().join("afmdyn-out");
+    for f in [
+        "bifurcation.csv",
+        "bifurcation.npy",
+        "bifurcation.png",
+        "bifurcation.svg",
+        "bifurcation-xmax.png",
+        "bifurcation-branches.svg",
+    ] {
+        assert!(
+            o.join(f).metadata().map(|m| m.len() > 0).unwrap_or(false),
+            "{f}"
+        );
+    }
+    let text = std::fs::read_to_string(o.join("bifurcation.csv")).unwrap();
+    let mut keys: Vec<(String, String)> = text
+        .lines()
+        .skip(1)
+        .filter(|l| l.split(',').nth(6) == Some("0"))
+        .map(|l| {
+            let c: Vec<&str> = l.split(',').collect();
+            (c[2].to_string(), c[3].to_string())
+        })
+        .collect();
+    keys.sort();
+    keys.dedup();
+    assert_eq!(keys.len(), 800, "400 values × forward and backward");
+    // the paper's Fig. 5 set over Ω ∈ [1, 5]
+    let first = text.lines().nth(1).unwrap();
+    assert!(first.starts_with("omega,"));
+}
+
+#[test]
+fn attractors_json_contract() {
+    let dir = tempfile::tempdir().unwrap();
+    let doc = json(&afmdyn(&[
+        "attractors",
+        "--omega",
+        "3.2",
+        "--samples",
+        "6",
+        "--json",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]));
+    let atts = doc["attractors"].as_array().unwrap();
+    assert!(!atts.is_empty());
+    let total: f64 = atts
+        .iter()
+        .map(|a| a["basin_fraction"].as_f64().unwrap())
+        .sum();
+    assert!((total - 1.0).abs() < 1e-12);
+    for a in atts {
+        let n = a["period"].as_u64().unwrap_or(0) as usize;
+        if n > 0 {
+            assert_eq!(a["poincare"]["v_t"].as_array().unwrap().len(), n);
+            assert_eq!(a["poincare"]["w_tip"].as_array().unwrap().len(), n);
+        }
+        // at drive phase 0, V_T = W_tip + α5 (eq. 8 with sin 0 = 0)
+        for (v, w) in a["poincare"]["v_t"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .zip(a["poincare"]["w_tip"].as_array().unwrap())
+        {
+            assert!((v.as_f64().unwrap() - w.as_f64().unwrap()).abs() < 1e-12);
+        }
+        assert!(a["x_max"].as_f64().unwrap() >= a["poincare"]["w_tip"][0].as_f64().unwrap());
+    }
+    assert!(dir.path().join("attractor-1-phase.png").exists());
+}

@@ -1,0 +1,167 @@
+//! Steady states on the stroboscopic map: period detection, a period-2 orbit checked with the
+//! independent DOP853 oracle, attractor clustering, sweeps.
+
+use afmdyn::analysis::attractors::{find_attractors, same_attractor, AttractorSpec};
+use afmdyn::analysis::bifurcation::{run_sweep, Branch, Resume, SweepSpec};
+use afmdyn::analysis::period::detect_period;
+use afmdyn::analysis::steady::{steady_state, Motion, SteadyOptions};
+use afmdyn::integrate::{advance_dyn, build, IntegratorKind, IntegratorOptions};
+use afmdyn::{CantileverModel, Params, SweepParam};
+use nalgebra::DVector;
+use std::sync::Mutex;
+
+fn v(x: f64, y: f64) -> DVector<f64> {
+    DVector::from_vec(vec![x, y])
+}
+
+#[test]
+fn period_detection_on_constructed_sequences() {
+    let cycle = |n: usize, len: usize| -> Vec<DVector<f64>> {
+        (0..len)
+            .map(|k| v((k % n) as f64, ((k % n) * (k % n)) as f64))
+            .collect()
+    };
+    for n in [1, 2, 3, 11, 21, 28, 64] {
+        assert_eq!(
+            detect_period(&cycle(n, 2 * n + 3), 1e-10, 64),
+            Some(n),
+            "period {n}"
+        );
+    }
+    // a period-4 cycle is not reported as period 2 even though every other point matches half
+    let p4: Vec<_> = (0..12)
+        .map(|k| v([0.0, 1.0, 0.0, 2.0][k % 4], 0.0))
+        .collect();
+    assert_eq!(detect_period(&p4, 1e-10, 64), Some(4));
+    // not enough history for a period-5 decision
+    assert_eq!(detect_period(&cycle(5, 9), 1e-10, 64), None);
+    // a converging (not yet converged) sequence and an irrational rotation are not periodic
+    let conv: Vec<_> = (0..40).map(|k| v(0.5f64.powi(k), 1.0)).collect();
+    assert_eq!(detect_period(&conv[..10], 1e-10, 64), None);
+    assert_eq!(detect_period(&conv, 1e-10, 64), Some(1));
+    let rot: Vec<_> = (0..200)
+        .map(|k| v((k as f64 * 2f64.sqrt()).sin(), 0.0))
+        .collect();
+    assert_eq!(detect_period(&rot, 1e-8, 64), None);
+    // tolerance is relative to 1 + |P|
+    let big: Vec<_> = (0..6)
+        .map(|k| v(1e6 + 1e-4 * (k % 2) as f64, 0.0))
+        .collect();
+    assert_eq!(detect_period(&big, 1e-9, 64), Some(1));
+}
+
+#[test]
+fn period_two_orbit_at_omega_2_8_is_confirmed_by_the_oracle() {
+    let p = Params {
+        omega: 2.8,
+        ..Params::default()
+    };
+    let m = CantileverModel::new(&p).unwrap();
+    let mut it = build(&m, IntegratorOptions::default(), 0.0, &m.rest()).unwrap();
+    let s = steady_state(it.as_mut(), &SteadyOptions::default()).unwrap();
+    assert_eq!(s.motion, Motion::Periodic { period: 2 });
+    assert_eq!(s.poincare.len(), 2);
+    // independent check with DOP853: two periods return to the point, one does not
+    let z = s.poincare[0].state.clone();
+    let t0 = s.poincare[0].tau;
+    let oracle = IntegratorOptions {
+        kind: IntegratorKind::Adaptive,
+        steps_per_period: 1,
+        tolerance: 1e-13,
+    };
+    let mut ad = build(&m, oracle, t0, &z).unwrap();
+    advance_dyn(ad.as_mut(), t0 + p.period(), &mut |_, _, _| Ok(())).unwrap();
+    let one = ad.state().clone();
+    advance_dyn(ad.as_mut(), t0 + 2.0 * p.period(), &mut |_, _, _| Ok(())).unwrap();
+    assert!(
+        (ad.state() - &z).amax() < 1e-7,
+        "P² z = z: {}",
+        (ad.state() - &z).amax()
+    );
+    assert!((&one - &z).amax() > 1e-3, "P z ≠ z");
+    assert!((&one - &s.poincare[1].state).amax() < 1e-7);
+    assert!(s.stats.contacts_per_period > 0.0 && s.stats.contact_fraction > 0.0);
+    assert!(s.stats.x_max >= s.poincare.iter().map(|q| q.w_tip).fold(f64::MIN, f64::max));
+    assert!(s.stats.v_t_min < 0.0, "the tip indents the sample");
+}
+
+#[test]
+fn clustering_merges_one_attractor_and_separates_two() {
+    let spec = |omega: f64| AttractorSpec {
+        params: Params {
+            omega,
+            ..Params::default()
+        },
+        samples: 24,
+        seed: 7,
+        cluster_tol: 1e-5,
+        steady: SteadyOptions::default(),
+        integrator: IntegratorOptions::default(),
+    };
+    // Ω = 2.8: every start reaches the same period-2 orbit, entered at either phase
+    let r = find_attractors(&spec(2.8)).unwrap();
+    assert_eq!(
+        r.attractors.len(),
+        1,
+        "{:?}",
+        r.attractors
+            .iter()
+            .map(|a| a.steady.motion.clone())
+            .collect::<Vec<_>>()
+    );
+    assert_eq!(r.attractors[0].count, 24);
+    // Ω = 1.8: two coexisting period-2 orbits with different contact fractions
+    let r = find_attractors(&spec(1.8)).unwrap();
+    assert_eq!(r.attractors.len(), 2);
+    let (a, b) = (&r.attractors[0].steady, &r.attractors[1].steady);
+    assert!(!same_attractor(a, b, 1e-5) && !same_attractor(b, a, 1e-5));
+    assert!((a.stats.contact_fraction - b.stats.contact_fraction).abs() > 0.01);
+    assert!((r.attractors.iter().map(|x| x.basin_fraction).sum::<f64>() - 1.0).abs() < 1e-12);
+}
+
+#[test]
+fn sweep_streams_every_point_once_and_resume_skips_done_points() {
+    let spec = SweepSpec {
+        base: Params::default(),
+        param: SweepParam::Alpha2,
+        values: SweepSpec::linspace(0.05, 0.12, 5).unwrap(),
+        continuation: true,
+        starts: 1,
+        seed: 3,
+        steady: SteadyOptions {
+            max_periods: 400,
+            ..SteadyOptions::default()
+        },
+        integrator: IntegratorOptions::default(),
+    };
+    spec.validate().unwrap();
+    let seen = Mutex::new(Vec::new());
+    run_sweep(&spec, &Resume::default(), &|p| {
+        seen.lock()
+            .unwrap()
+            .push((p.index, p.branch, p.result.is_ok()))
+    });
+    let mut all = seen.into_inner().unwrap();
+    all.sort();
+    assert_eq!(all.len(), 15);
+    all.dedup();
+    assert_eq!(all.len(), 15, "each (value, branch) once");
+    assert!(all.iter().all(|x| x.2));
+    let mut resume = Resume::default();
+    for i in 0..3 {
+        resume.done.insert((i, Branch::Forward));
+    }
+    let again = Mutex::new(Vec::new());
+    run_sweep(&spec, &resume, &|p| {
+        again.lock().unwrap().push((p.index, p.branch))
+    });
+    let again = again.into_inner().unwrap();
+    assert_eq!(again.len(), 12);
+    assert!(!again.iter().any(|(i, b)| *b == Branch::Forward && *i < 3));
+    // an invalid swept value is caught before running
+    let bad = SweepSpec {
+        values: vec![0.1, -0.2],
+        ..spec
+    };
+    assert!(bad.validate().is_err());
+}
