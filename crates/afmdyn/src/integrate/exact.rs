@@ -28,7 +28,7 @@ use super::{Integrator, Step, SwitchEvent};
 use crate::error::{finite, SimError};
 use crate::galerkin::Region;
 use crate::model::CantileverModel;
-use nalgebra::{DMatrix, DVector};
+use nalgebra::{Complex, DMatrix, DVector};
 use std::collections::VecDeque;
 
 /// Bound on ‖Ã‖₂ h for the grid step (radians of the fastest mode per step).
@@ -60,6 +60,75 @@ fn matvec(a: &DMatrix<f64>, x: &[f64], y: &mut [f64], alpha: f64, accumulate: bo
     }
 }
 
+/// e^{Ã t} through the eigendecomposition Ã = V Λ V⁻¹ (complex), for partial steps of arbitrary
+/// length: one complex exponential per eigenvalue and two 2N×2N products, against ~30 Taylor
+/// terms. Eigenvalues from nalgebra's real Schur form, eigenvectors by inverse iteration. Only
+/// used when V is well conditioned (Ã is close to normal in energy coordinates).
+#[derive(Debug, Clone)]
+struct ModalExp {
+    /// |c̃ᵀ v_k| |λ_k|²: curvature of the tip deflection per unit modal amplitude.
+    tip_lam2: Vec<f64>,
+    lambda: Vec<Complex<f64>>,
+    v: DMatrix<Complex<f64>>,
+    vinv: DMatrix<Complex<f64>>,
+}
+
+impl ModalExp {
+    fn new(at: &DMatrix<f64>) -> Option<Self> {
+        let dim = at.nrows();
+        let lambda: Vec<Complex<f64>> = at.complex_eigenvalues().iter().copied().collect();
+        let a = at.map(|x| Complex::new(x, 0.0));
+        let scale = at.norm().max(1.0);
+        let mut v = DMatrix::<Complex<f64>>::zeros(dim, dim);
+        for (k, &l) in lambda.iter().enumerate() {
+            let shift = l + Complex::new(1e-10 * scale, 1e-10 * scale);
+            let lu = (&a - DMatrix::<Complex<f64>>::identity(dim, dim) * shift).lu();
+            let mut x = DVector::<Complex<f64>>::from_element(dim, Complex::new(1.0, 0.3));
+            for _ in 0..3 {
+                x = lu.solve(&x)?;
+                let norm = x.norm();
+                if !norm.is_finite() || norm == 0.0 {
+                    return None;
+                }
+                x /= Complex::new(norm, 0.0);
+            }
+            v.set_column(k, &x);
+        }
+        let vinv = v.clone().try_inverse()?;
+        // accept only an accurate, well-conditioned decomposition
+        let lam = DMatrix::from_diagonal(&DVector::from_vec(lambda.clone()));
+        let residual = (&a * &v - &v * lam).norm();
+        let cond = v.norm() * vinv.norm();
+        (residual <= 1e-12 * scale && cond <= 1e4).then_some(ModalExp {
+            tip_lam2: vec![0.0; dim],
+            lambda,
+            v,
+            vinv,
+        })
+    }
+
+    /// out = e^{Ã t} y0 (real).
+    fn apply(&self, y0: &[f64], t: f64, out: &mut [f64]) {
+        let dim = y0.len();
+        let mut c = [Complex::new(0.0, 0.0); 2 * crate::params::MAX_MODES];
+        let c = &mut c[..dim];
+        for (j, &yj) in y0.iter().enumerate() {
+            for (ci, vij) in c.iter_mut().zip(self.vinv.column(j).iter()) {
+                *ci += vij * yj;
+            }
+        }
+        for (ci, l) in c.iter_mut().zip(&self.lambda) {
+            *ci *= (l * t).exp();
+        }
+        out.fill(0.0);
+        for (j, cj) in c.iter().enumerate() {
+            for (o, vij) in out.iter_mut().zip(self.v.column(j).iter()) {
+                *o += vij.re * cj.re - vij.im * cj.im;
+            }
+        }
+    }
+}
+
 /// Precomputed data of one region.
 #[derive(Debug, Clone)]
 struct RegionProp {
@@ -68,6 +137,8 @@ struct RegionProp {
     tinv: DMatrix<f64>,
     /// Ã_s = T A T⁻¹.
     at: DMatrix<f64>,
+    /// e^{Ã t} by eigendecomposition, when well conditioned.
+    modal: Option<ModalExp>,
     /// Φ_s = e^{A_s h} in plain coordinates.
     phi: DMatrix<f64>,
     /// Particular solution z_p(τ) = p0 + ps sin Ωτ + pc cos Ωτ.
@@ -84,6 +155,8 @@ struct RegionProp {
     kappa2: f64,
     /// Ω² · amplitude of V_p (bound on |V_p''|).
     vp_curv: f64,
+    /// 1/n!, n = 0..=K.
+    inv_fact: [f64; K + 1],
 }
 
 /// The tip motion inside one step as a truncated power series plus the harmonic part.
@@ -92,6 +165,8 @@ struct TipPoly {
     tau0: f64,
     /// mo[n] / n!, mo[n+1]/n!, mo[n+2]/n! for n = 0..=K.
     c: [[f64; K + 1]; 3],
+    /// Terms kept: the tail beyond is below round-off over the step.
+    terms: usize,
     wp: [f64; 3],
     omega: f64,
     alpha2: f64,
@@ -102,7 +177,7 @@ struct TipPoly {
 }
 
 impl TipPoly {
-    fn horner(c: &[f64; K + 1], t: f64) -> f64 {
+    fn horner(c: &[f64], t: f64) -> f64 {
         c.iter().rev().fold(0.0, |acc, &x| acc * t + x)
     }
     /// [W, W', W''] of the tip at local time t.
@@ -111,17 +186,20 @@ impl TipPoly {
         let (w0, ws, wc) = (self.wp[0], self.wp[1], self.wp[2]);
         let om = self.omega;
         [
-            Self::horner(&self.c[0], t) + w0 + ws * s + wc * c,
-            Self::horner(&self.c[1], t) + om * (ws * c - wc * s),
-            Self::horner(&self.c[2], t) - om * om * (ws * s + wc * c),
+            Self::horner(&self.c[0][..self.terms], t) + w0 + ws * s + wc * c,
+            Self::horner(&self.c[1][..self.terms], t) + om * (ws * c - wc * s),
+            Self::horner(&self.c[2][..self.terms], t) - om * om * (ws * s + wc * c),
         ]
     }
     /// Gap g = σ V_T and its derivative at local time t.
     fn g(&self, t: f64) -> (f64, f64) {
-        let w = self.w(t);
         let (s, c) = (self.omega * (self.tau0 + t)).sin_cos();
-        let v = w[0] + self.alpha2 * s + self.alpha5;
-        let dv = w[1] + self.alpha2 * self.omega * c;
+        let (w0, ws, wc) = (self.wp[0], self.wp[1], self.wp[2]);
+        let om = self.omega;
+        let w = Self::horner(&self.c[0][..self.terms], t) + w0 + ws * s + wc * c;
+        let dw = Self::horner(&self.c[1][..self.terms], t) + om * (ws * c - wc * s);
+        let v = w + self.alpha2 * s + self.alpha5;
+        let dv = dw + self.alpha2 * om * c;
         (self.sigma * v, self.sigma * dv)
     }
 }
@@ -241,6 +319,7 @@ pub struct ExactPropagator {
     z: DVector<f64>,
     region: Region,
     on_grid: Option<i64>,
+    /// Bound on |W_hom''| over the current stint (see `curvature_bound`).
     ybound: f64,
     just_switched: bool,
     recent: VecDeque<f64>,
@@ -358,9 +437,17 @@ impl ExactPropagator {
             }
             let kappa2 = rows.row(2).norm();
             let vp_curv = omega * omega * (wp[1] + p.alpha2).hypot(wp[2]);
+            let mut modal = ModalExp::new(&at);
+            if let Some(me) = &mut modal {
+                let ct = rows.row(0).transpose().map(|x| Complex::new(x, 0.0));
+                for k in 0..dim {
+                    me.tip_lam2[k] = (ct.dot(&me.v.column(k))).norm() * me.lambda[k].norm_sqr();
+                }
+            }
             regions.push(RegionProp {
                 t,
                 tinv,
+                modal,
                 at,
                 phi,
                 p0,
@@ -371,6 +458,7 @@ impl ExactPropagator {
                 rows,
                 kappa2,
                 vp_curv,
+                inv_fact: std::array::from_fn(|n| 1.0 / (1..=n).map(|k| k as f64).product::<f64>()),
             });
         }
         let regions: [RegionProp; 2] = regions.try_into().expect("two regions");
@@ -468,7 +556,10 @@ impl ExactPropagator {
             1.0,
             false,
         );
-        Self::taylor(&rp.at, y0, t, yt, term, tmp);
+        match &rp.modal {
+            Some(me) => me.apply(y0.as_slice(), t, yt.as_mut_slice()),
+            None => Self::taylor(&rp.at, y0, t, yt, term, tmp),
+        }
         Self::zp_into(rp, self.model.omega(), self.last.tau0 + t, out);
         matvec(&rp.tinv, yt.as_slice(), out.as_mut_slice(), 1.0, true);
     }
@@ -481,25 +572,34 @@ impl ExactPropagator {
         let mut mo = [0.0; K + 3];
         matvec(&rp.rows, y0, &mut mo, 1.0, false);
         let mut c = [[0.0; K + 1]; 3];
-        let mut fact = 1.0;
-        for n in 0..=K {
-            if n > 0 {
-                fact *= n as f64;
-            }
-            for (d, row) in c.iter_mut().enumerate() {
-                row[n] = mo[n + d] / fact;
+        for (d, row) in c.iter_mut().enumerate() {
+            for ((x, m), f) in row.iter_mut().zip(&mo[d..]).zip(&rp.inv_fact) {
+                *x = m * f;
             }
         }
         let p = self.model.params();
-        let curv = c[2]
-            .iter()
-            .enumerate()
-            .map(|(n, x)| x.abs() * len.powi(n as i32))
-            .sum::<f64>()
-            + rp.vp_curv;
+        let mut lp = [1.0; K + 1];
+        for n in 1..=K {
+            lp[n] = lp[n - 1] * len;
+        }
+        let curv = c[2].iter().zip(&lp).map(|(x, l)| x.abs() * l).sum::<f64>() + rp.vp_curv;
+        // keep terms until the remaining tail of every series is below round-off over the step
+        let size = |n: usize| c.iter().map(|row| row[n].abs()).fold(0.0, f64::max) * lp[n];
+        let scale =
+            (0..=K).map(size).fold(0.0, f64::max) + rp.wp.iter().map(|x| x.abs()).sum::<f64>();
+        let mut terms = K + 1;
+        let mut tail = 0.0;
+        while terms > 1 {
+            tail += size(terms - 1);
+            if tail > 1e-18 * scale {
+                break;
+            }
+            terms -= 1;
+        }
         TipPoly {
             tau0,
             c,
+            terms,
             wp: rp.wp,
             omega: p.omega,
             alpha2: p.alpha2,
@@ -509,11 +609,27 @@ impl ExactPropagator {
         }
     }
 
-    fn energy_bound(&self, region: Region, tau: f64, z: &DVector<f64>) -> f64 {
+    /// Bound on |W_hom''| for the whole stint in `region` entered at (τ, z): the smaller of
+    /// the energy bound ‖c̃ᵀÃ²‖ ‖y‖ (‖e^{Ãt}‖₂ ≤ 1) and, with the eigendecomposition
+    /// y(t) = Σ v_k e^{λ_k t} q_k, the modal bound Σ |c̃ᵀv_k| |λ_k|² |q_k| (Re λ_k ≤ 0).
+    fn curvature_bound(&self, region: Region, tau: f64, z: &DVector<f64>) -> f64 {
         let rp = &self.regions[region.index()];
         let mut zp = DVector::zeros(z.len());
         Self::zp_into(rp, self.model.omega(), tau, &mut zp);
-        (&rp.t * (z - zp)).norm()
+        let y = &rp.t * (z - zp);
+        let energy = rp.kappa2 * y.norm();
+        match &rp.modal {
+            Some(me) => {
+                let q = &me.vinv * y.map(|x| Complex::new(x, 0.0));
+                let modal: f64 = q
+                    .iter()
+                    .zip(&me.tip_lam2)
+                    .map(|(qk, w)| qk.norm() * w)
+                    .sum();
+                energy.min(modal * (1.0 + 1e-12))
+            }
+            None => energy,
+        }
     }
 
     fn chatter_check(&mut self, tau: f64) -> Result<(), SimError> {
@@ -560,7 +676,7 @@ impl Integrator for ExactPropagator {
         self.region = entering_region(&self.model, tau, z);
         let j = self.next_grid(tau) - 1;
         self.on_grid = (self.grid_tau(j) == tau).then_some(j);
-        self.ybound = self.energy_bound(self.region, tau, z);
+        self.ybound = self.curvature_bound(self.region, tau, z);
         self.just_switched = true;
         self.recent.clear();
         self.last = LastStep {
@@ -606,7 +722,7 @@ impl Integrator for ExactPropagator {
                 &zp[k * dim..(k + 1) * dim],
                 &zp[(k + 1) * dim..(k + 2) * dim],
             );
-            for ((d, z), p) in dz0.iter_mut().zip(self.z.iter()).zip(zk) {
+            for ((d, z), p) in dz0.as_mut_slice().iter_mut().zip(self.z.as_slice()).zip(zk) {
                 *d = z - p;
             }
             z_b.as_mut_slice().copy_from_slice(zk1);
@@ -626,10 +742,12 @@ impl Integrator for ExactPropagator {
             let (s, c) = self.trig[k];
             let p = self.model.params();
             let n = p.modes;
-            let tip = self.model.tip();
+            let tip = self.model.tip().as_slice();
+            let zb = z_b.as_slice();
+            let dot = |x: &[f64]| tip.iter().zip(x).map(|(a, b)| a * b).sum::<f64>();
             (
-                tip.dot(&z_b.rows(0, n)) + p.alpha2 * s + p.alpha5,
-                tip.dot(&z_b.rows(n, n)) + p.alpha2 * p.omega * c,
+                dot(&zb[..n]) + p.alpha2 * s + p.alpha5,
+                dot(&zb[n..]) + p.alpha2 * p.omega * c,
             )
         } else {
             self.state_in_last(len, &mut z_b);
@@ -645,7 +763,7 @@ impl Integrator for ExactPropagator {
             ga = ga.max(0.0);
         }
         let rp = &self.regions[ri];
-        let cheap = rp.kappa2 * self.ybound + rp.vp_curv;
+        let cheap = self.ybound + rp.vp_curv;
         let mut hit = None;
         if !certified_positive(ga, da, gb, db, cheap, len) {
             let poly = self.build_poly(region, tau0, &self.last.dz0, len);
@@ -704,7 +822,7 @@ impl Integrator for ExactPropagator {
                 self.region = to;
                 self.on_grid = None;
                 self.just_switched = true;
-                self.ybound = self.energy_bound(to, tau_s, &zs);
+                self.ybound = self.curvature_bound(to, tau_s, &zs);
                 self.chatter_check(tau_s)?;
                 Ok(Step {
                     tau0,
