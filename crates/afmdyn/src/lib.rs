@@ -14,6 +14,21 @@
 //!
 //! Time is the dimensionless τ of eq. 5 and displacements are in units of the beam gap g₀.
 //! States are `z: [f64; 2N]` = (a, ȧ), modal coordinates and their τ-derivatives.
+//!
+//! ```
+//! use afmdyn::analysis::steady::{steady_state, Motion, SteadyOptions};
+//! use afmdyn::integrate::{build, IntegratorOptions};
+//! use afmdyn::{CantileverModel, Params};
+//!
+//! // the paper's Figs. 5–14 set at Ω = 2.8 (eq. 26, α1 = 0.1, N = 3)
+//! let params = Params { omega: 2.8, ..Params::default() };
+//! let model = CantileverModel::new(&params)?;
+//! let mut integ = build(&model, IntegratorOptions::default(), 0.0, &model.rest())?;
+//! let orbit = steady_state(integ.as_mut(), &SteadyOptions::default())?;
+//! assert_eq!(orbit.motion, Motion::Periodic { period: 2 });
+//! assert!(orbit.stats.contact_fraction > 0.0);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 #![warn(missing_docs)]
 
 pub mod analysis;
