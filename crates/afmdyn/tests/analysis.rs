@@ -3,7 +3,7 @@
 
 use afmdyn::analysis::attractors::{find_attractors, same_attractor, AttractorSpec};
 use afmdyn::analysis::bifurcation::{run_sweep, Branch, Resume, SweepSpec};
-use afmdyn::analysis::period::detect_period;
+use afmdyn::analysis::period::{detect_period, minimal_divisor, MERGE_FACTOR};
 use afmdyn::analysis::steady::{steady_state, Motion, SteadyOptions};
 use afmdyn::integrate::{advance_dyn, build, IntegratorKind, IntegratorOptions};
 use afmdyn::{CantileverModel, Params, SweepParam};
@@ -48,6 +48,31 @@ fn period_detection_on_constructed_sequences() {
         .map(|k| v(1e6 + 1e-4 * (k % 2) as f64, 0.0))
         .collect();
     assert_eq!(detect_period(&big, 1e-9, 64), Some(1));
+}
+
+#[test]
+fn a_slowly_rotating_focus_is_period_one_not_four() {
+    // returns spiral into a fixed point, turning by 90° per period: P_{k+4} ≈ P_k long before
+    // P_{k+1} ≈ P_k
+    let mu = 0.999f64;
+    let seq: Vec<DVector<f64>> = (0..400)
+        .map(|k| {
+            let r = 1e-6 * mu.powi(k);
+            let a = k as f64 * std::f64::consts::FRAC_PI_2;
+            v(1.0 + r * a.cos(), r * a.sin())
+        })
+        .collect();
+    let first = (8..seq.len())
+        .find_map(|k| detect_period(&seq[..k], 1e-8, 64).map(|n| (k, n)))
+        .unwrap();
+    assert_eq!(first.1, 4, "the naive test is fooled");
+    let (k, n) = first;
+    assert_eq!(minimal_divisor(&seq[..k + 8], n, 1e-8 * MERGE_FACTOR), 1);
+    // a genuine period-4 cycle is not merged
+    let p4: Vec<_> = (0..20)
+        .map(|k| v([0.0, 1.0, 0.0, 2.0][k % 4], 0.0))
+        .collect();
+    assert_eq!(minimal_divisor(&p4, 4, 1e-8 * MERGE_FACTOR), 4);
 }
 
 #[test]

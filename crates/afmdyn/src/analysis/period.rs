@@ -27,3 +27,18 @@ pub fn detect_period(history: &[DVector<f64>], tol: f64, max_period: usize) -> O
             && (1..n).all(|j| close(&history[last - j], &history[last - j - n], tol))
     })
 }
+
+/// Factor by which the tolerance is widened when a detected period n is reduced to a divisor.
+pub const MERGE_FACTOR: f64 = 1e3;
+
+/// The smallest divisor d of `n` such that the last `n` returns repeat with shift d within
+/// `tol`. A stable focus whose returns rotate by ≈ 2π/n per period matches its n-th iterate
+/// long before its consecutive iterates agree; reducing with a wider tolerance
+/// (`MERGE_FACTOR` × the detection tolerance) reports it as the fixed point it converges to.
+pub fn minimal_divisor(history: &[DVector<f64>], n: usize, tol: f64) -> usize {
+    let last = history.len() - 1;
+    (1..n)
+        .filter(|d| n % d == 0 && history.len() > n + d)
+        .find(|&d| (0..n).all(|j| close(&history[last - j], &history[last - j - d], tol)))
+        .unwrap_or(n)
+}

@@ -1,6 +1,6 @@
 //! Steady state on the stroboscopic Poincaré map τ = 2πk/Ω (drive phase 0) and its statistics.
 
-use super::period::{detect_period, MAX_PERIOD};
+use super::period::{detect_period, minimal_divisor, MAX_PERIOD, MERGE_FACTOR};
 use crate::error::SimError;
 use crate::galerkin::Region;
 use crate::integrate::{advance_dyn, Integrator, Step};
@@ -273,20 +273,29 @@ pub fn steady_state(
     if (phase - phase.round()).abs() > 1e-9 {
         next_section(integ, None)?;
     }
-    let mut history: VecDeque<DVector<f64>> = VecDeque::with_capacity(2 * opts.max_period + 2);
+    let mut history: VecDeque<DVector<f64>> = VecDeque::with_capacity(3 * opts.max_period + 2);
     history.push_back(integ.state().clone());
     let mut found = None;
+    let mut confirm: Vec<usize> = Vec::new();
     let mut k = 0;
     while k < opts.max_periods {
         next_section(integ, None)?;
         k += 1;
-        if history.len() == 2 * opts.max_period + 1 {
+        if history.len() == 3 * opts.max_period + 1 {
             history.pop_front();
         }
         history.push_back(integ.state().clone());
         if let Some(n) = detect_period(history.make_contiguous(), opts.tol, opts.max_period) {
-            found = Some(n);
-            break;
+            confirm.push(n);
+            // a candidate must hold for two more cycles, then be reduced to its smallest
+            // divisor within the merge tolerance (see `minimal_divisor`)
+            if confirm.len() > 2 * n {
+                let h = history.make_contiguous();
+                found = Some(minimal_divisor(h, n, opts.tol * MERGE_FACTOR));
+                break;
+            }
+        } else {
+            confirm.clear();
         }
     }
     let record = found.unwrap_or(opts.nonperiodic_record.max(1));
