@@ -38,7 +38,7 @@ pub const MERGE_FACTOR: f64 = 1e3;
 pub fn minimal_divisor(history: &[DVector<f64>], n: usize, tol: f64) -> usize {
     let last = history.len() - 1;
     (1..n)
-        .filter(|d| n % d == 0 && history.len() > n + d)
+        .filter(|&d| n.is_multiple_of(d) && history.len() > n + d)
         .find(|&d| (0..n).all(|j| close(&history[last - j], &history[last - j - d], tol)))
         .unwrap_or(n)
 }
