@@ -592,6 +592,7 @@ fn attractor_json(s: &SteadyState, basin: f64) -> serde_json::Value {
         "v_t_min": s.stats.v_t_min,
         "contact_fraction": s.stats.contact_fraction,
         "contacts_per_period": s.stats.contacts_per_period,
+        "body_contact": s.stats.body_contact,
         "basin_fraction": basin,
     })
 }
@@ -680,7 +681,7 @@ pub fn attractors(a: &AttractorsArgs) -> Result<(), CliError> {
                 .map(|q| (q.w_tip, model.w_tip_dot(&q.state)))
                 .collect(),
             style: Style::Points,
-            color: 1,
+            color: if k % 10 == 3 { 4 } else { 3 },
         });
         save(
             &a.out,
@@ -716,13 +717,14 @@ pub fn attractors(a: &AttractorsArgs) -> Result<(), CliError> {
         );
         for (k, x) in report.attractors.iter().enumerate() {
             println!(
-                "  {}: {:<12} basin {:>5.1} %  X_max = {:.4}  min V_T = {:.4}  contact fraction {:.3}",
+                "  {}: {:<12} basin {:>5.1} %  X_max = {:.4}  min V_T = {:.4}  contact fraction {:.3}{}",
                 k + 1,
                 x.steady.period().map_or("nonperiodic".into(), |n| format!("period-{n}")),
                 100.0 * x.basin_fraction,
                 x.steady.stats.x_max,
                 x.steady.stats.v_t_min,
-                x.steady.stats.contact_fraction
+                x.steady.stats.contact_fraction,
+                if x.steady.stats.body_contact { "  (beam body touches the substrate: Fig. 2f)" } else { "" }
             );
         }
         println!("outputs in {}", a.out.display());

@@ -137,7 +137,7 @@ where
                 .draw_series(LineSeries::new(s.points.iter().copied(), c.stroke_width(2)))
                 .map_err(|e| e.to_string())?,
             Style::Points => chart
-                .draw_series(s.points.iter().map(|&p| Circle::new(p, 2, c.filled())))
+                .draw_series(s.points.iter().map(|&p| Circle::new(p, 4, c.filled())))
                 .map_err(|e| e.to_string())?,
         };
         if !s.label.is_empty() {

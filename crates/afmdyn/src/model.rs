@@ -258,7 +258,7 @@ pub struct BodyContactCheck {
 }
 
 impl BodyContactCheck {
-    /// Sample the beam at `points` interior stations ξ_i = i/(points+1)·… up to ξ = 0.99.
+    /// Sample the beam at `points` interior stations ξ_i = 0.99 i / points, i = 1..=points.
     pub fn new(model: &CantileverModel, points: usize) -> Self {
         let n = model.modes();
         let shapes = model.galerkin().shapes();

@@ -4,6 +4,7 @@ use super::period::{detect_period, minimal_divisor, MAX_PERIOD, MERGE_FACTOR};
 use crate::error::SimError;
 use crate::galerkin::Region;
 use crate::integrate::{advance_dyn, Integrator, Step};
+use crate::model::BodyContactCheck;
 use nalgebra::DVector;
 use serde::Serialize;
 use std::collections::VecDeque;
@@ -71,6 +72,9 @@ pub struct OrbitStats {
     pub contact_fraction: f64,
     /// Contacts (entries into region II) per drive period.
     pub contacts_per_period: f64,
+    /// Whether a beam point other than the tip reached the substrate at a step end (the
+    /// paper's Fig. 2f assumption is violated).
+    pub body_contact: bool,
 }
 
 /// A steady state reached from one initial condition.
@@ -110,6 +114,8 @@ pub struct StatsObserver {
     contact_time: f64,
     contacts: usize,
     time: f64,
+    body: Option<BodyContactCheck>,
+    body_contact: bool,
 }
 
 impl Default for StatsObserver {
@@ -121,6 +127,8 @@ impl Default for StatsObserver {
             contact_time: 0.0,
             contacts: 0,
             time: 0.0,
+            body: None,
+            body_contact: false,
         }
     }
 }
@@ -168,6 +176,10 @@ impl StatsObserver {
             self.contacts += 1;
         }
         let z1 = integ.state().clone();
+        let body = self
+            .body
+            .get_or_insert_with(|| BodyContactCheck::new(&model, 32));
+        self.body_contact |= body.touches(&model, step.tau1, &z1);
         let (w0, w1) = (model.w_tip(before), model.w_tip(&z1));
         let (d0, d1) = (model.w_tip_dot(before), model.w_tip_dot(&z1));
         self.x_max = self.x_max.max(w0).max(w1);
@@ -211,6 +223,7 @@ impl StatsObserver {
                 0.0
             },
             contacts_per_period: self.contacts as f64 / periods.max(1) as f64,
+            body_contact: self.body_contact,
         }
     }
 }
