@@ -55,9 +55,12 @@ pub struct Figure {
     pub shade: Vec<(f64, f64)>,
 }
 
+/// Number of palette colours.
+const PALETTE: usize = 10;
+
 /// Palette colour `i`.
 pub fn color(i: usize) -> RGBColor {
-    const P: [RGBColor; 10] = [
+    const P: [RGBColor; PALETTE] = [
         RGBColor(31, 119, 180),
         RGBColor(214, 39, 40),
         RGBColor(44, 160, 44),
@@ -225,10 +228,30 @@ pub fn save_scatter_stream(
             .label_style(("sans-serif", 15))
             .draw()
             .map_err(|x| e(x.to_string()))?;
+        // one marker per (pixel, colour): memory and file size stay bounded by the canvas,
+        // not by the number of points (an SVG would otherwise grow with the sweep)
+        let (w, h) = root.dim_in_pixel();
+        let (w, h) = (w as usize + 1, h as usize + 1);
+        let mut seen = vec![0u64; (w * h * PALETTE).div_ceil(64)];
         feed(&mut |chunk| {
+            let fresh: Vec<(f64, f64, usize)> = chunk
+                .iter()
+                .copied()
+                .filter(|&(x, y, c)| {
+                    let (px, py) = chart.backend_coord(&(x, y));
+                    if px < 0 || py < 0 || px as usize >= w || py as usize >= h {
+                        return false;
+                    }
+                    let bit = (py as usize * w + px as usize) * PALETTE + c % PALETTE;
+                    let (word, mask) = (bit / 64, 1u64 << (bit % 64));
+                    let new = seen[word] & mask == 0;
+                    seen[word] |= mask;
+                    new
+                })
+                .collect();
             chart
                 .draw_series(
-                    chunk
+                    fresh
                         .iter()
                         .map(|&(x, y, c)| Circle::new((x, y), 1, color(c).filled())),
                 )
