@@ -34,7 +34,8 @@ pub struct SteadyArgs {
 }
 
 impl SteadyArgs {
-    fn options(&self) -> Result<SteadyOptions, CliError> {
+    /// Steady-state options, validated.
+    pub fn options(&self) -> Result<SteadyOptions, CliError> {
         if !(self.tol.is_finite() && self.tol > 0.0) {
             return Err(CliError::Input(format!(
                 "tol = {}: must be finite and > 0",

@@ -56,7 +56,7 @@ fn parse_list(s: &str, what: &'static str) -> Result<Vec<f64>, CliError> {
         .collect()
 }
 
-fn initial_state(
+pub(crate) fn initial_state(
     model: &CantileverModel,
     spec: &Option<String>,
 ) -> Result<nalgebra::DVector<f64>, CliError> {

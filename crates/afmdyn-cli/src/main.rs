@@ -3,6 +3,7 @@
 mod args;
 mod cmd_analysis;
 mod cmd_modes;
+mod cmd_orbits;
 mod cmd_simulate;
 mod error;
 mod output;
@@ -33,6 +34,12 @@ enum Command {
     Bifurcation(cmd_analysis::BifurcationArgs),
     /// Coexisting attractors and basin fractions at fixed parameters (paper Figs. 6–17)
     Attractors(cmd_analysis::AttractorsArgs),
+    /// Find a period-n orbit by Newton shooting; Floquet multipliers and stability
+    Orbit(cmd_orbits::OrbitArgs),
+    /// Pseudo-arclength continuation of a period-n branch; folds, period doublings, grazing
+    Continue(cmd_orbits::ContinueArgs),
+    /// Lyapunov spectrum (with saltation matrices) and the 0–1 test for chaos
+    Lyapunov(cmd_orbits::LyapunovArgs),
 }
 
 fn run(cli: Cli) -> Result<(), CliError> {
@@ -43,6 +50,9 @@ fn run(cli: Cli) -> Result<(), CliError> {
         Command::Converge(a) => cmd_simulate::converge(&a),
         Command::Bifurcation(a) => cmd_analysis::bifurcation(&a),
         Command::Attractors(a) => cmd_analysis::attractors(&a),
+        Command::Orbit(a) => cmd_orbits::orbit(&a),
+        Command::Continue(a) => cmd_orbits::continuation(&a),
+        Command::Lyapunov(a) => cmd_orbits::lyapunov(&a),
     }
 }
 

@@ -23,8 +23,12 @@ fn register_font() {
 pub enum Style {
     /// Solid line.
     Line,
-    /// Dots.
+    /// Large dots (markers).
     Points,
+    /// Small dots (a background cloud).
+    Dots,
+    /// Dashed line.
+    Dashed,
 }
 
 /// One plotted series.
@@ -141,6 +145,21 @@ where
                 .map_err(|e| e.to_string())?,
             Style::Points => chart
                 .draw_series(s.points.iter().map(|&p| Circle::new(p, 4, c.filled())))
+                .map_err(|e| e.to_string())?,
+            Style::Dots => chart
+                .draw_series(
+                    s.points
+                        .iter()
+                        .map(|&p| Circle::new(p, 1, c.mix(0.6).filled())),
+                )
+                .map_err(|e| e.to_string())?,
+            Style::Dashed => chart
+                .draw_series(DashedLineSeries::new(
+                    s.points.iter().copied(),
+                    6,
+                    4,
+                    c.stroke_width(2),
+                ))
                 .map_err(|e| e.to_string())?,
         };
         if !s.label.is_empty() {

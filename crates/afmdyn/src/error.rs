@@ -127,6 +127,16 @@ pub enum SimError {
         /// State norm.
         norm: f64,
     },
+    /// Newton's method (shooting or continuation) did not converge.
+    #[error("{what} did not converge: residual {residual:e} after {iterations} iterations")]
+    NoConvergence {
+        /// Which solver.
+        what: &'static str,
+        /// Iterations made.
+        iterations: usize,
+        /// Final residual.
+        residual: f64,
+    },
     /// The adaptive oracle integrator reported a failure.
     #[error("adaptive integrator failed at tau = {tau}: {message}")]
     Adaptive {

@@ -203,6 +203,36 @@ impl CantileverModel {
         }
     }
 
+    /// Saltation (jump) matrix of the flow's Jacobian at a switching from region `from` to `to`
+    /// at (τ, z) on V_T = 0 (eq. 8):
+    ///
+    /// S = I + (f⁺ − f⁻) ∇_zV_Tᵀ / (dV_T/dτ)⁻,  (dV_T/dτ)⁻ = ∇_zV_T · f⁻ + ∂V_T/∂τ,
+    ///
+    /// with ∇_zV_T = (φ(1), 0) and ∂V_T/∂τ = α2 Ω cos Ωτ (the sample moves with the base in these
+    /// coordinates). f⁺ − f⁻ = ∓(0, M⁻¹φ(1)(α4 V_T + α6 V̇_T)) is the contact force switched on or
+    /// off; on V_T = 0 only the damper term α6 V̇_T remains, so S ≠ I whenever α6 > 0.
+    /// Source: Leine & Nijmeijer, *Dynamics and Bifurcations of Non-Smooth Mechanical Systems*
+    /// (Springer 2004), ch. 7; Müller, *Lyapunov exponents of dynamical systems with jumps* (1995).
+    ///
+    /// Returns the 2N×2N identity when dV_T/dτ = 0 (grazing: the saltation is unbounded there).
+    pub fn saltation(&self, from: Region, to: Region, tau: f64, z: &DVector<f64>) -> DMatrix<f64> {
+        let dim = self.dim();
+        let n = self.modes();
+        let mut f_minus = DVector::zeros(dim);
+        let mut f_plus = DVector::zeros(dim);
+        self.rhs(from, tau, z, &mut f_minus);
+        self.rhs(to, tau, z, &mut f_plus);
+        let mut grad = DVector::zeros(dim);
+        grad.rows_mut(0, n).copy_from(self.tip());
+        let p = &self.params;
+        let rate = grad.dot(&f_minus) + p.alpha2 * p.omega * (p.omega * tau).cos();
+        let mut s = DMatrix::identity(dim, dim);
+        if rate != 0.0 {
+            s += (f_plus - f_minus) * grad.transpose() / rate;
+        }
+        s
+    }
+
     /// Check a state: length 2N and finite components.
     ///
     /// # Errors

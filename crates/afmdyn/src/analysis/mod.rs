@@ -1,8 +1,14 @@
 //! Analyses on the stroboscopic Poincaré map: steady states and their periods, parameter
-//! sweeps (bifurcation diagrams), coexisting attractors and basins, mode convergence (Fig. 4).
+//! sweeps (bifurcation diagrams), coexisting attractors and basins, mode convergence (Fig. 4);
+//! beyond the paper: monodromy matrices with saltation, Newton shooting, Floquet multipliers,
+//! pseudo-arclength continuation, Lyapunov exponents and the 0–1 test for chaos.
 
 pub mod attractors;
 pub mod bifurcation;
+pub mod continuation;
 pub mod converge;
+pub mod lyapunov;
+pub mod monodromy;
 pub mod period;
+pub mod shooting;
 pub mod steady;

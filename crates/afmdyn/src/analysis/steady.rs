@@ -135,7 +135,12 @@ impl Default for StatsObserver {
 
 /// Zero of the derivative f′ of a dense quantity on [a, b] by safeguarded Newton, given
 /// f′(a), f′(b) of opposite signs; `f(τ)` returns (f, f′, f″).
-fn extremum(mut a: f64, mut b: f64, fa_d: f64, f: &mut dyn FnMut(f64) -> [f64; 3]) -> f64 {
+pub(crate) fn extremum(
+    mut a: f64,
+    mut b: f64,
+    fa_d: f64,
+    f: &mut dyn FnMut(f64) -> [f64; 3],
+) -> f64 {
     let rising = fa_d > 0.0;
     let mut t = 0.5 * (a + b);
     for _ in 0..60 {

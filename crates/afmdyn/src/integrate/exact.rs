@@ -305,6 +305,8 @@ struct LastStep {
     region: Region,
     /// Homogeneous part δz(τ0) in plain coordinates.
     dz0: DVector<f64>,
+    /// Whether the step was a whole grid step (its transition matrix is Φ_s).
+    full: bool,
 }
 
 /// Exact propagator (see the module docs).
@@ -480,6 +482,7 @@ impl ExactPropagator {
                 tau0: 0.0,
                 region: Region::Free,
                 dz0: zero.clone(),
+                full: false,
             },
             poly: None,
             vt: (0.0, 0.0),
@@ -494,6 +497,43 @@ impl ExactPropagator {
     /// Sub-steps per drive period m.
     pub fn steps_per_period(&self) -> usize {
         self.m
+    }
+
+    /// Transition matrix e^{A_s t} of region `r` in plain coordinates (2N×2N), for
+    /// 0 ≤ t ≤ one grid step: the precomputed Φ_s when t is the grid step, else
+    /// T⁻¹ e^{Ã t} T column by column (eigendecomposition, or the Taylor series).
+    pub fn transition(&self, r: Region, t: f64) -> DMatrix<f64> {
+        let rp = &self.regions[r.index()];
+        if t == self.h {
+            return rp.phi.clone();
+        }
+        let dim = self.z.len();
+        let mut e = DMatrix::zeros(dim, dim);
+        let (mut yt, mut term, mut tmp) = (
+            DVector::zeros(dim),
+            DVector::zeros(dim),
+            DVector::zeros(dim),
+        );
+        for j in 0..dim {
+            let y0 = rp.t.column(j).into_owned();
+            match &rp.modal {
+                Some(me) => me.apply(y0.as_slice(), t, yt.as_mut_slice()),
+                None => Self::taylor(&rp.at, &y0, t, &mut yt, &mut term, &mut tmp),
+            }
+            e.set_column(j, &yt);
+        }
+        &rp.tinv * e
+    }
+
+    /// Jacobian ∂z(τ1)/∂z(τ0) of the flow over the last step [τ0, τ1] inside its region
+    /// (without the saltation at a switching that ends it), 2N×2N.
+    pub fn last_step_jacobian(&self) -> DMatrix<f64> {
+        let len = self.tau - self.last.tau0;
+        // a whole grid step that ended on the grid (a switching would have cut it short)
+        if self.last.full && self.on_grid.is_some() {
+            return self.regions[self.last.region.index()].phi.clone();
+        }
+        self.transition(self.last.region, len)
     }
 
     /// Grid time of global index j: (j div m) T + (j mod m) h.
@@ -683,6 +723,7 @@ impl Integrator for ExactPropagator {
             tau0: tau,
             region: self.region,
             dz0: DVector::zeros(z.len()),
+            full: false,
         };
         self.poly = None;
         self.vt = (self.model.v_t(tau, z), self.model.v_t_dot(tau, z));
@@ -736,6 +777,7 @@ impl Integrator for ExactPropagator {
         self.last.tau0 = tau0;
         self.last.region = region;
         self.last.dz0 = dz0;
+        self.last.full = full;
         self.poly = None;
         let vt_b = if full {
             let k = (self.on_grid.expect("on grid").rem_euclid(self.m as i64) + 1) as usize;

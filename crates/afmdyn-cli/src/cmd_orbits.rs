@@ -1,0 +1,401 @@
+//! `afmdyn orbit`, `afmdyn continue` and `afmdyn lyapunov`.
+
+use crate::args::ModelArgs;
+use crate::cmd_analysis::SteadyArgs;
+use crate::cmd_simulate::initial_state;
+use crate::error::CliError;
+use crate::output::{ensure_dir, f, write_csv};
+use crate::plot::{save, Figure, Series, Style};
+use afmdyn::analysis::continuation::{
+    continue_branch, switch_at_period_doubling, BranchPoint, ContinuationSpec,
+};
+use afmdyn::analysis::lyapunov::{lyapunov_spectrum, LyapunovOptions};
+use afmdyn::analysis::shooting::{shoot, PeriodicOrbit, ShootingOptions};
+use afmdyn::analysis::steady::steady_state;
+use afmdyn::integrate::{build, IntegratorOptions};
+use afmdyn::{CantileverModel, Params, SweepParam};
+use clap::Args;
+use nalgebra::DVector;
+use serde_json::json;
+use std::path::PathBuf;
+
+/// Initial-state flags of the orbit commands.
+#[derive(Debug, Clone, Args)]
+pub struct StartArgs {
+    /// Initial modal state "a1,..,aN;adot1,..,adotN" (default: the steady state reached from rest)
+    #[arg(long, allow_hyphen_values = true)]
+    initial_modal: Option<String>,
+    #[command(flatten)]
+    steady: SteadyArgs,
+}
+
+impl StartArgs {
+    /// The guess: the given state, or the end of the steady state reached from it (or from rest),
+    /// with its period when one was detected.
+    fn guess(&self, model: &CantileverModel) -> Result<(DVector<f64>, Option<usize>), CliError> {
+        let z0 = initial_state(model, &self.initial_modal)?;
+        if self.initial_modal.is_some() {
+            return Ok((z0, None));
+        }
+        let mut integ = build(model, IntegratorOptions::default(), 0.0, &z0)?;
+        let s = steady_state(integ.as_mut(), &self.steady.options()?)?;
+        Ok((s.end_state().clone(), s.period()))
+    }
+}
+
+/// `afmdyn orbit` flags.
+#[derive(Debug, Args)]
+pub struct OrbitArgs {
+    #[command(flatten)]
+    model: ModelArgs,
+    #[command(flatten)]
+    start: StartArgs,
+    /// Period n of the orbit (default: the period of the steady state reached, else 1)
+    #[arg(long)]
+    period: Option<usize>,
+    /// Print one JSON document
+    #[arg(long)]
+    json: bool,
+}
+
+fn orbit_json(model: &CantileverModel, o: &PeriodicOrbit) -> serde_json::Value {
+    json!({
+        "period": o.period,
+        "poincare": {
+            "v_t": o.section.iter().map(|z| model.v_t(0.0, z)).collect::<Vec<_>>(),
+            "w_tip": o.section.iter().map(|z| model.w_tip(z)).collect::<Vec<_>>(),
+        },
+        "multipliers": o.multipliers.iter().map(|m| [m.re, m.im]).collect::<Vec<_>>(),
+        "stable": o.stable,
+        "critical": o.critical,
+        "grazing_distance": o.grazing_distance,
+        "switchings": o.switchings,
+        "newton_residuals": o.residuals,
+        "state": o.state.iter().collect::<Vec<_>>(),
+    })
+}
+
+/// Run `afmdyn orbit`.
+pub fn orbit(a: &OrbitArgs) -> Result<(), CliError> {
+    let p = a.model.params(Params::default())?;
+    let model = CantileverModel::new(&p)?;
+    let (guess, found) = a.start.guess(&model)?;
+    let n = a.period.or(found).unwrap_or(1);
+    if !(1..=64).contains(&n) {
+        return Err(CliError::Input(format!("period = {n}: must be in 1..=64")));
+    }
+    let o = shoot(&model, &guess, n, &ShootingOptions::default())?;
+    if a.json {
+        let mut doc = orbit_json(&model, &o);
+        doc["params"] = json!(p);
+        println!("{doc}");
+        return Ok(());
+    }
+    println!(
+        "period-{} orbit at Ω = {} ({}), {} switchings per cycle",
+        n,
+        p.omega,
+        if o.stable { "stable" } else { "unstable" },
+        o.switchings
+    );
+    println!(
+        "Newton residuals: {}",
+        o.residuals
+            .iter()
+            .map(|r| format!("{r:.2e}"))
+            .collect::<Vec<_>>()
+            .join(" → ")
+    );
+    println!("Floquet multipliers (|μ|):");
+    for m in &o.multipliers {
+        println!("  {:+.8} {:+.8}i   {:.8}", m.re, m.im, m.norm());
+    }
+    println!(
+        "critical multiplier type: {:?}; distance to grazing {:.3e}",
+        o.critical, o.grazing_distance
+    );
+    for (k, z) in o.section.iter().enumerate() {
+        println!("  section {k}: W(1,τ) = {:.9}", model.w_tip(z));
+    }
+    Ok(())
+}
+
+/// `afmdyn continue` flags.
+#[derive(Debug, Args)]
+pub struct ContinueArgs {
+    #[command(flatten)]
+    model: ModelArgs,
+    #[command(flatten)]
+    start: StartArgs,
+    /// Continued parameter: omega or alpha1..alpha6
+    #[arg(long, default_value = "omega")]
+    param: SweepParam,
+    /// Start value
+    #[arg(long, default_value_t = 5.0, allow_negative_numbers = true)]
+    from: f64,
+    /// End of the range
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
+    to: f64,
+    /// Period n of the branch (default: the period of the steady state at --from)
+    #[arg(long)]
+    period: Option<usize>,
+    /// At each period doubling, switch to the period-2n branch and continue it too
+    #[arg(long)]
+    switch: bool,
+    /// Draw the branches over this bifurcation.csv (from `afmdyn bifurcation`)
+    #[arg(long, value_name = "CSV")]
+    overlay: Option<PathBuf>,
+    /// Output directory
+    #[arg(long, default_value = "afmdyn-out/continue")]
+    out: PathBuf,
+    /// Print one JSON summary
+    #[arg(long)]
+    json: bool,
+}
+
+fn branch_rows(model: &CantileverModel, id: usize, br: &[BranchPoint]) -> Vec<Vec<String>> {
+    br.iter()
+        .map(|b| {
+            vec![
+                id.to_string(),
+                b.period.to_string(),
+                f(b.s),
+                f(b.value),
+                b.stable.to_string(),
+                f(b.multipliers[0].norm()),
+                format!("{:?}", b.critical),
+                b.section
+                    .iter()
+                    .map(|z| format!("{}", model.w_tip(z)))
+                    .collect::<Vec<_>>()
+                    .join(" "),
+                b.switchings.to_string(),
+                f(b.grazing_distance),
+                b.event.map_or(String::new(), |e| format!("{e:?}")),
+            ]
+        })
+        .collect()
+}
+
+/// Run `afmdyn continue`.
+pub fn continuation(a: &ContinueArgs) -> Result<(), CliError> {
+    let base = a.model.params(Params::default())?;
+    let p0 = base.with(a.param, a.from);
+    p0.validate()?;
+    base.with(a.param, a.to).validate()?;
+    let model = CantileverModel::new(&p0)?;
+    let (guess, found) = a.start.guess(&model)?;
+    let n = a.period.or(found).unwrap_or(1);
+    let spec = ContinuationSpec::new(base, a.param, a.from, a.to, n);
+    let mut branches: Vec<Vec<BranchPoint>> = vec![continue_branch(&spec, &guess)?];
+    if a.switch {
+        let pds: Vec<BranchPoint> = branches[0]
+            .iter()
+            .filter(|b| {
+                b.event == Some(afmdyn::analysis::continuation::BranchEvent::PeriodDoubling)
+            })
+            .cloned()
+            .collect();
+        for pd in pds {
+            if let Some((value, z)) = switch_at_period_doubling(&spec, &pd) {
+                let sub = ContinuationSpec {
+                    from: value,
+                    period: 2 * n,
+                    ..spec.clone()
+                };
+                if let Ok(b) = continue_branch(&sub, &z) {
+                    branches.push(b);
+                }
+            }
+        }
+    }
+    ensure_dir(&a.out)?;
+    write_csv(
+        &a.out.join("continuation.csv"),
+        &[
+            "branch",
+            "period",
+            "s",
+            "value",
+            "stable",
+            "max_multiplier",
+            "critical",
+            "w_tip_section",
+            "switchings",
+            "grazing_distance",
+            "event",
+        ],
+        branches
+            .iter()
+            .enumerate()
+            .flat_map(|(i, b)| branch_rows(&model, i, b)),
+    )?;
+    // plot: section points of each branch, stable solid, unstable dashed (as dots)
+    let mut series = Vec::new();
+    for (i, b) in branches.iter().enumerate() {
+        let np = b.first().map_or(0, |x| x.section.len());
+        for k in 0..np {
+            let mut run: Vec<(f64, f64)> = Vec::new();
+            let mut stable = b.first().is_some_and(|x| x.stable);
+            for x in b {
+                let pt = (x.value, model.w_tip(&x.section[k.min(x.section.len() - 1)]));
+                if x.stable != stable && !run.is_empty() {
+                    run.push(pt);
+                    series.push(Series {
+                        label: String::new(),
+                        points: std::mem::take(&mut run),
+                        style: if stable { Style::Line } else { Style::Dashed },
+                        color: i,
+                    });
+                    stable = x.stable;
+                }
+                run.push(pt);
+            }
+            if !run.is_empty() {
+                series.push(Series {
+                    label: String::new(),
+                    points: run,
+                    style: if stable { Style::Line } else { Style::Dashed },
+                    color: i,
+                });
+            }
+        }
+    }
+    if let Some(first) = series.first_mut() {
+        first.label = format!("period-{n} branch (solid stable, dashed unstable)");
+    }
+    let events: Vec<(f64, f64)> = branches
+        .iter()
+        .flat_map(|b| {
+            b.iter()
+                .filter(|x| x.event.is_some())
+                .map(|x| (x.value, model.w_tip(&x.section[0])))
+        })
+        .collect();
+    series.push(Series {
+        label: "fold / period doubling / NS / grazing".into(),
+        points: events,
+        style: Style::Points,
+        color: 3,
+    });
+    let mut underlay = Vec::new();
+    if let Some(csv_path) = &a.overlay {
+        let mut rd = csv::Reader::from_path(csv_path)?;
+        for r in rd.records() {
+            let r = r?;
+            if let (Ok(v), Ok(w)) = (r[1].parse::<f64>(), r[10].parse::<f64>()) {
+                underlay.push((v, w));
+            }
+        }
+    }
+    if !underlay.is_empty() {
+        series.insert(
+            0,
+            Series {
+                label: "bifurcation sweep".into(),
+                points: underlay,
+                style: Style::Dots,
+                color: 7,
+            },
+        );
+    }
+    save(
+        &a.out,
+        "continuation",
+        &Figure {
+            title: format!("Continuation of period-{n} orbits in {}", a.param.symbol()),
+            x_label: format!("{} ({})", a.param.symbol(), a.param.name()),
+            y_label: "W(1,τ) at τ = 2πk/Ω".into(),
+            series,
+            shade: vec![],
+        },
+    )?;
+    let events: Vec<_> = branches
+        .iter()
+        .flatten()
+        .filter(|b| b.event.is_some())
+        .map(|b| json!({ "event": b.event, "value": b.value, "period": b.period, "stable": b.stable }))
+        .collect();
+    if a.json {
+        println!(
+            "{}",
+            json!({ "params": base, "param": a.param.name(), "branches": branches.len(), "points": branches.iter().map(Vec::len).sum::<usize>(), "events": events })
+        );
+    } else {
+        println!(
+            "{} branch(es), {} points; located:",
+            branches.len(),
+            branches.iter().map(Vec::len).sum::<usize>()
+        );
+        for b in branches.iter().flatten().filter(|b| b.event.is_some()) {
+            println!(
+                "  {:<16} at {} = {:.6} (period {})",
+                format!("{:?}", b.event.expect("event")),
+                a.param.name(),
+                b.value,
+                b.period
+            );
+        }
+        println!("outputs in {}", a.out.display());
+    }
+    Ok(())
+}
+
+/// `afmdyn lyapunov` flags.
+#[derive(Debug, Args)]
+pub struct LyapunovArgs {
+    #[command(flatten)]
+    model: ModelArgs,
+    /// Initial modal state "a1,..,aN;adot1,..,adotN" (default: rest)
+    #[arg(long, allow_hyphen_values = true)]
+    initial_modal: Option<String>,
+    /// Drive periods discarded first
+    #[arg(long, default_value_t = 500)]
+    transient: usize,
+    /// Drive periods averaged
+    #[arg(long, default_value_t = 4000)]
+    periods: usize,
+    /// Blocks for the uncertainty
+    #[arg(long, default_value_t = 10)]
+    blocks: usize,
+    /// Print one JSON document
+    #[arg(long)]
+    json: bool,
+}
+
+/// Run `afmdyn lyapunov`.
+pub fn lyapunov(a: &LyapunovArgs) -> Result<(), CliError> {
+    let p = a.model.params(Params::default())?;
+    let model = CantileverModel::new(&p)?;
+    let z0 = initial_state(&model, &a.initial_modal)?;
+    let l = lyapunov_spectrum(
+        &model,
+        &z0,
+        &LyapunovOptions {
+            transient_periods: a.transient,
+            periods: a.periods,
+            blocks: a.blocks,
+        },
+    )?;
+    if a.json {
+        println!(
+            "{}",
+            json!({ "params": p, "exponents": l.exponents, "uncertainty": l.uncertainty, "volume_rate": l.volume_rate, "zero_one": l.zero_one, "verdict": l.verdict, "periods": l.periods })
+        );
+        return Ok(());
+    }
+    println!(
+        "Lyapunov exponents (per unit τ) over {} periods at Ω = {}:",
+        l.periods, p.omega
+    );
+    for (e, u) in l.exponents.iter().zip(&l.uncertainty) {
+        println!("  {e:+.6} ± {u:.6}");
+    }
+    println!(
+        "sum {:+.6}; mean phase-volume contraction {:+.6}",
+        l.exponents.iter().sum::<f64>(),
+        l.volume_rate
+    );
+    println!("0–1 test K = {:.3}; verdict: {:?}", l.zero_one, l.verdict);
+    Ok(())
+}

@@ -1,0 +1,451 @@
+//! Pseudo-arclength continuation of period-n orbits of the stroboscopic map in Ω or any α, with
+//! detection and location of folds, period doublings, Neimark–Sacker and grazing points, and
+//! branch switching at a period doubling onto the period-2n branch.
+//!
+//! Unknowns y = (z, p) ∈ R^{2N+1}; F(z, p) = Pⁿ(z; p) − z = 0 augmented by the arclength
+//! condition tᵀ(y − y_pred) = 0 (Keller 1977; Seydel, *Practical Bifurcation and Stability
+//! Analysis*, 3rd ed., Springer 2010, ch. 4). ∂F/∂z = M − I with M the monodromy matrix;
+//! ∂F/∂p by central differences of the map. Test functions between accepted points: dp/ds
+//! (fold), det(M + I) (period doubling), the number of complex multipliers outside the unit
+//! circle (Neimark–Sacker) and the number of switchings per cycle (grazing); each sign change
+//! is located by bisection on the arclength step.
+
+use super::monodromy::{stroboscopic, FlowMap};
+use super::shooting::{
+    critical_multiplier, floquet_multipliers, shoot_with, Instability, ShootingOptions,
+};
+use crate::error::SimError;
+use crate::integrate::exact::ExactPropagator;
+use crate::model::CantileverModel;
+use crate::params::{Params, SweepParam};
+use nalgebra::{Complex, DMatrix, DVector};
+use serde::Serialize;
+
+/// A continuation run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ContinuationSpec {
+    /// Parameters (the continued one is overwritten).
+    pub base: Params,
+    /// Continued parameter.
+    pub param: SweepParam,
+    /// Start value.
+    pub from: f64,
+    /// The run stops when the parameter leaves [min(from, to), max(from, to)].
+    pub to: f64,
+    /// Period n of the orbit.
+    pub period: usize,
+    /// Initial arclength step.
+    pub ds: f64,
+    /// Smallest step before giving up.
+    pub ds_min: f64,
+    /// Largest step.
+    pub ds_max: f64,
+    /// Cap on the number of points.
+    pub max_points: usize,
+    /// Newton options (also for the corrector).
+    pub newton: ShootingOptions,
+}
+
+impl ContinuationSpec {
+    /// Defaults for a run from `from` to `to`.
+    pub fn new(base: Params, param: SweepParam, from: f64, to: f64, period: usize) -> Self {
+        let span = (to - from).abs().max(1e-6);
+        ContinuationSpec {
+            base,
+            param,
+            from,
+            to,
+            period,
+            ds: span / 200.0,
+            ds_min: span * 1e-9,
+            ds_max: span / 50.0,
+            max_points: 5000,
+            newton: ShootingOptions::default(),
+        }
+    }
+}
+
+/// A labelled point of a branch.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum BranchEvent {
+    /// Fold (limit point): dp/ds changes sign.
+    Fold,
+    /// Period doubling: a multiplier through −1.
+    PeriodDoubling,
+    /// Neimark–Sacker: a complex pair through the unit circle.
+    NeimarkSacker,
+    /// Grazing: the number of switchings per cycle changes.
+    Grazing,
+}
+
+/// One point of a branch.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BranchPoint {
+    /// Arclength.
+    pub s: f64,
+    /// Parameter value.
+    pub value: f64,
+    /// Period n.
+    pub period: usize,
+    /// States at the n section points (τ = kT).
+    pub section: Vec<DVector<f64>>,
+    /// Floquet multipliers, decreasing modulus.
+    pub multipliers: Vec<Complex<f64>>,
+    /// Stable.
+    pub stable: bool,
+    /// Type of the critical multiplier.
+    pub critical: Instability,
+    /// Switchings per cycle.
+    pub switchings: usize,
+    /// Distance to grazing.
+    pub grazing_distance: f64,
+    /// Label when this point locates a bifurcation.
+    pub event: Option<BranchEvent>,
+}
+
+struct Solver {
+    spec: ContinuationSpec,
+    /// Propagators of the last few parameter values (p and p ± δ for ∂F/∂p).
+    cache: Vec<(f64, ExactPropagator)>,
+}
+
+impl Solver {
+    fn new(spec: &ContinuationSpec) -> Result<Self, SimError> {
+        Ok(Solver {
+            spec: spec.clone(),
+            cache: Vec::new(),
+        })
+    }
+
+    fn at(&mut self, p: f64) -> Result<&mut ExactPropagator, SimError> {
+        let i = match self.cache.iter().position(|(v, _)| *v == p) {
+            Some(i) => i,
+            None => {
+                let model = CantileverModel::new(&self.spec.base.with(self.spec.param, p))?;
+                if self.cache.len() == 6 {
+                    self.cache.remove(0);
+                }
+                self.cache.push((p, ExactPropagator::try_new(&model, 1)?));
+                self.cache.len() - 1
+            }
+        };
+        Ok(&mut self.cache[i].1)
+    }
+
+    fn map(&mut self, z: &DVector<f64>, p: f64) -> Result<FlowMap, SimError> {
+        let n = self.spec.period;
+        stroboscopic(self.at(p)?, z, n)
+    }
+
+    /// ∂Pⁿ/∂p by central differences.
+    fn dp(&mut self, z: &DVector<f64>, p: f64) -> Result<DVector<f64>, SimError> {
+        let d = 1e-6 * p.abs().max(1.0);
+        let plus = self.map(z, p + d)?.state;
+        let minus = self.map(z, p - d)?.state;
+        Ok((plus - minus) / (2.0 * d))
+    }
+
+    /// Bordered Jacobian [[M − I, F_p], [tᵀ]].
+    fn bordered(m: &DMatrix<f64>, fp: &DVector<f64>, t: &DVector<f64>) -> DMatrix<f64> {
+        let dim = m.nrows();
+        let mut j = DMatrix::zeros(dim + 1, dim + 1);
+        j.view_mut((0, 0), (dim, dim))
+            .copy_from(&(m - DMatrix::identity(dim, dim)));
+        j.view_mut((0, dim), (dim, 1)).copy_from(fp);
+        j.view_mut((dim, 0), (1, dim + 1)).copy_from(&t.transpose());
+        j
+    }
+
+    /// Unit tangent of the branch from the bordered system with ∂F/∂p = `fp`, oriented along
+    /// `t_old`.
+    fn tangent(
+        m: &DMatrix<f64>,
+        fp: &DVector<f64>,
+        t_old: &DVector<f64>,
+    ) -> Result<DVector<f64>, SimError> {
+        let dim = m.nrows();
+        let mut rhs = DVector::zeros(dim + 1);
+        rhs[dim] = 1.0;
+        let t = Self::bordered(m, fp, t_old)
+            .lu()
+            .solve(&rhs)
+            .ok_or(SimError::NoConvergence {
+                what: "continuation tangent",
+                iterations: 0,
+                residual: f64::NAN,
+            })?;
+        Ok(t.normalize())
+    }
+
+    /// Newton corrector from the predictor; returns the converged y, its map, the iterations
+    /// and ∂F/∂p at the last iterate (reused for the next tangent).
+    #[allow(clippy::type_complexity)]
+    fn correct(
+        &mut self,
+        y_pred: &DVector<f64>,
+        t: &DVector<f64>,
+    ) -> Result<(DVector<f64>, FlowMap, usize, DVector<f64>), SimError> {
+        let dim = y_pred.len() - 1;
+        let mut y = y_pred.clone();
+        let mut fp = self.dp(&y.rows(0, dim).into_owned(), y[dim])?;
+        for it in 0..10 {
+            let (z, p) = (y.rows(0, dim).into_owned(), y[dim]);
+            let map = self.map(&z, p)?;
+            let f = &map.state - &z;
+            let arc = t.dot(&(&y - y_pred));
+            let res = f.norm();
+            if res <= self.spec.newton.tol * (1.0 + z.norm())
+                && arc.abs() <= 1e-12 * (1.0 + y.norm())
+            {
+                return Ok((y, map, it, fp));
+            }
+            if it > 0 {
+                fp = self.dp(&z, p)?;
+            }
+            let mut g = DVector::zeros(dim + 1);
+            g.rows_mut(0, dim).copy_from(&f);
+            g[dim] = arc;
+            let delta = Self::bordered(&map.jacobian, &fp, t)
+                .lu()
+                .solve(&(-g))
+                .ok_or(SimError::NoConvergence {
+                    what: "continuation corrector",
+                    iterations: it,
+                    residual: res,
+                })?;
+            y += delta;
+            if !y.iter().all(|v| v.is_finite()) {
+                break;
+            }
+        }
+        Err(SimError::NoConvergence {
+            what: "continuation corrector",
+            iterations: 10,
+            residual: f64::NAN,
+        })
+    }
+}
+
+/// Test functions of a point: (dp/ds, det(M + I), complex multipliers outside the circle, switchings).
+fn tests(
+    t: &DVector<f64>,
+    m: &DMatrix<f64>,
+    mu: &[Complex<f64>],
+    switchings: usize,
+) -> (f64, f64, usize, usize) {
+    let dim = m.nrows();
+    let pd = (m + DMatrix::identity(dim, dim)).determinant();
+    let ns = mu
+        .iter()
+        .filter(|c| c.im.abs() > 1e-9 && c.norm() > 1.0)
+        .count();
+    (t[dim], pd, ns, switchings)
+}
+
+fn changed(a: &(f64, f64, usize, usize), b: &(f64, f64, usize, usize)) -> Option<BranchEvent> {
+    if a.3 != b.3 {
+        Some(BranchEvent::Grazing)
+    } else if a.0.signum() != b.0.signum() {
+        Some(BranchEvent::Fold)
+    } else if a.1.signum() != b.1.signum() {
+        Some(BranchEvent::PeriodDoubling)
+    } else if a.2 != b.2 {
+        Some(BranchEvent::NeimarkSacker)
+    } else {
+        None
+    }
+}
+
+/// The test function of event `e` at `t`, signed so that it keeps the sign it has at the
+/// reference point `a` until the event (integer counts: +1 while equal to a's count, else −1).
+fn which(e: BranchEvent, t: &(f64, f64, usize, usize), a: &(f64, f64, usize, usize)) -> f64 {
+    let same = |x: usize, y: usize| if x == y { 1.0 } else { -1.0 };
+    match e {
+        BranchEvent::Fold => t.0 * a.0.signum(),
+        BranchEvent::PeriodDoubling => t.1 * a.1.signum(),
+        BranchEvent::NeimarkSacker => same(t.2, a.2),
+        BranchEvent::Grazing => same(t.3, a.3),
+    }
+}
+
+fn point(
+    solver: &mut Solver,
+    s: f64,
+    y: &DVector<f64>,
+    map: &FlowMap,
+) -> Result<BranchPoint, SimError> {
+    let dim = y.len() - 1;
+    let z = y.rows(0, dim).into_owned();
+    let p = y[dim];
+    let mut section = vec![z.clone()];
+    let mut w = z;
+    let n = solver.spec.period;
+    for _ in 1..n {
+        w = stroboscopic(solver.at(p)?, &w, 1)?.state;
+        section.push(w.clone());
+    }
+    let mu = floquet_multipliers(&map.jacobian);
+    let (crit, critical) = critical_multiplier(&mu);
+    Ok(BranchPoint {
+        s,
+        value: p,
+        period: n,
+        section,
+        stable: crit.norm() < 1.0,
+        critical,
+        multipliers: mu,
+        switchings: map.switchings,
+        grazing_distance: map.grazing_distance,
+        event: None,
+    })
+}
+
+/// Continue the period-n branch through the orbit found by shooting from `guess` at `from`.
+/// Points are returned in arclength order; located bifurcations carry their label.
+///
+/// # Errors
+/// [`SimError`] when the first orbit cannot be found or the parameters are invalid.
+pub fn continue_branch(
+    spec: &ContinuationSpec,
+    guess: &DVector<f64>,
+) -> Result<Vec<BranchPoint>, SimError> {
+    spec.base.with(spec.param, spec.from).validate()?;
+    spec.base.with(spec.param, spec.to).validate()?;
+    let mut solver = Solver::new(spec)?;
+    let orbit = shoot_with(solver.at(spec.from)?, guess, spec.period, &spec.newton)?;
+    let dim = orbit.state.len();
+    let mut y = DVector::zeros(dim + 1);
+    y.rows_mut(0, dim).copy_from(&orbit.state);
+    y[dim] = spec.from;
+    let dir = if spec.to >= spec.from { 1.0 } else { -1.0 };
+    let mut t0 = DVector::zeros(dim + 1);
+    t0[dim] = dir;
+    let map = solver.map(&orbit.state, spec.from)?;
+    let fp0 = solver.dp(&orbit.state, spec.from)?;
+    let mut t = Solver::tangent(&map.jacobian, &fp0, &t0)?;
+    if t[dim] * dir < 0.0 {
+        t = -t;
+    }
+    let (lo, hi) = (spec.from.min(spec.to), spec.from.max(spec.to));
+    let mut s = 0.0;
+    let mut ds = spec.ds;
+    let mut out = vec![point(&mut solver, s, &y, &map)?];
+    let mut tf = tests(&t, &map.jacobian, &out[0].multipliers, map.switchings);
+    while out.len() < spec.max_points {
+        let y_pred = &y + &t * ds;
+        let (y_new, map_new, iters, fp_new) = match solver.correct(&y_pred, &t) {
+            Ok(r) => r,
+            Err(_) => {
+                ds *= 0.5;
+                if ds < spec.ds_min {
+                    break;
+                }
+                continue;
+            }
+        };
+        let t_new = Solver::tangent(&map_new.jacobian, &fp_new, &t)?;
+        let mut pt = point(&mut solver, s + ds, &y_new, &map_new)?;
+        let tf_new = tests(
+            &t_new,
+            &map_new.jacobian,
+            &pt.multipliers,
+            map_new.switchings,
+        );
+        if let Some(ev) = changed(&tf, &tf_new) {
+            // locate by bisection on the step from the previous point
+            let f0 = which(ev, &tf, &tf);
+            let (mut a, mut b) = (0.0, ds);
+            let mut best: Option<BranchPoint> = None;
+            for _ in 0..30 {
+                let mid = 0.5 * (a + b);
+                let Ok((ym, mm, _, fpm)) = solver.correct(&(&y + &t * mid), &t) else {
+                    break;
+                };
+                let tm = Solver::tangent(&mm.jacobian, &fpm, &t)?;
+                let mut pm = point(&mut solver, s + mid, &ym, &mm)?;
+                let fm = which(
+                    ev,
+                    &tests(&tm, &mm.jacobian, &pm.multipliers, mm.switchings),
+                    &tf,
+                );
+                if fm.signum() == f0.signum() {
+                    a = mid;
+                } else {
+                    b = mid;
+                    pm.event = Some(ev);
+                    best = Some(pm);
+                }
+                if b - a <= 1e-7 * (1.0 + s.abs()) {
+                    break;
+                }
+            }
+            if let Some(bp) = best {
+                out.push(bp);
+            }
+        }
+        if !(lo..=hi).contains(&y_new[dim]) {
+            break;
+        }
+        s += ds;
+        pt.s = s;
+        out.push(pt);
+        y = y_new;
+        t = t_new;
+        tf = tf_new;
+        ds = if iters <= 2 {
+            (ds * 1.5).min(spec.ds_max)
+        } else if iters >= 5 {
+            ds * 0.5
+        } else {
+            ds
+        };
+    }
+    Ok(out)
+}
+
+/// Start of the period-2n branch at a located period-doubling point: shoot a period-2n orbit
+/// from the point displaced along the eigenvector of the multiplier nearest −1, at parameter
+/// values on either side. Returns (parameter, period-2n orbit state) when one is found that is
+/// not the period-n orbit itself.
+pub fn switch_at_period_doubling(
+    spec: &ContinuationSpec,
+    pd: &BranchPoint,
+) -> Option<(f64, DVector<f64>)> {
+    let z = pd.section[0].clone();
+    let model = CantileverModel::new(&spec.base.with(spec.param, pd.value)).ok()?;
+    let mut prop = ExactPropagator::try_new(&model, 1).ok()?;
+    let m = stroboscopic(&mut prop, &z, pd.period).ok()?.jacobian;
+    let dim = z.len();
+    // eigenvector of μ ≈ −1 by inverse iteration on M + (1 − 1e-8) I
+    let lu = (&m + DMatrix::identity(dim, dim) * (1.0 - 1e-8)).lu();
+    let mut v = DVector::from_element(dim, 1.0);
+    for _ in 0..4 {
+        v = lu.solve(&v)?.normalize();
+    }
+    // the period-2n orbit bifurcates like √|Δp|: try a few parameter offsets, each with a
+    // displacement of the matching size, on both sides and both signs of the eigenvector
+    for rel in [1e-3, 1e-2] {
+        let dp = rel * pd.value.abs().max(1.0);
+        let eps = 3.0 * rel.sqrt() * (1.0 + z.norm());
+        for sign_p in [1.0, -1.0] {
+            let p = pd.value + sign_p * dp;
+            let Ok(model) = CantileverModel::new(&spec.base.with(spec.param, p)) else {
+                continue;
+            };
+            let Ok(mut prop) = ExactPropagator::try_new(&model, 1) else {
+                continue;
+            };
+            for sign_v in [1.0, -1.0] {
+                let guess = &z + &v * (sign_v * eps);
+                if let Ok(o) = shoot_with(&mut prop, &guess, 2 * pd.period, &spec.newton) {
+                    let half = stroboscopic(&mut prop, &o.state, pd.period).ok()?.state;
+                    if (&half - &o.state).norm() > 1e-6 * (1.0 + o.state.norm()) {
+                        return Some((p, o.state));
+                    }
+                }
+            }
+        }
+    }
+    None
+}

@@ -1,0 +1,193 @@
+//! Periodic orbits of the stroboscopic map by Newton shooting, with Floquet multipliers.
+//!
+//! A period-n orbit is a zero of F(z) = Pⁿ(z) − z. Newton's step solves (M − I) δ = −F with M the
+//! monodromy matrix of Pⁿ ([`super::monodromy`]); it converges quadratically to stable and
+//! unstable orbits alike. The Floquet multipliers are the eigenvalues of M.
+
+use super::monodromy::{stroboscopic, FlowMap};
+use crate::error::SimError;
+use crate::integrate::exact::ExactPropagator;
+use crate::integrate::Integrator;
+use crate::model::CantileverModel;
+use nalgebra::{Complex, DMatrix, DVector};
+use serde::Serialize;
+
+/// Newton options.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShootingOptions {
+    /// Converged when ‖Pⁿ(z) − z‖ ≤ tol (1 + ‖z‖).
+    pub tol: f64,
+    /// Iteration cap.
+    pub max_iter: usize,
+}
+
+impl Default for ShootingOptions {
+    fn default() -> Self {
+        ShootingOptions {
+            tol: 1e-11,
+            max_iter: 40,
+        }
+    }
+}
+
+/// How an orbit is (or would become) unstable, from the multiplier of largest modulus.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Instability {
+    /// A real multiplier through +1 (fold / saddle-node).
+    Fold,
+    /// A real multiplier through −1 (period doubling / flip).
+    PeriodDoubling,
+    /// A complex pair through the unit circle (Neimark–Sacker).
+    NeimarkSacker,
+}
+
+/// The critical multiplier: the one of largest modulus, and its type.
+pub fn critical_multiplier(mu: &[Complex<f64>]) -> (Complex<f64>, Instability) {
+    let m = *mu
+        .iter()
+        .max_by(|a, b| a.norm().total_cmp(&b.norm()))
+        .expect("multipliers");
+    let kind = if m.im.abs() > 1e-9 * m.norm().max(1.0) {
+        Instability::NeimarkSacker
+    } else if m.re > 0.0 {
+        Instability::Fold
+    } else {
+        Instability::PeriodDoubling
+    };
+    (m, kind)
+}
+
+/// A period-n orbit of the stroboscopic map.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PeriodicOrbit {
+    /// n.
+    pub period: usize,
+    /// State at τ = 0 (drive phase 0), shape `[2N]`.
+    pub state: DVector<f64>,
+    /// States at the n section points τ = kT, k = 0..n.
+    pub section: Vec<DVector<f64>>,
+    /// Monodromy matrix of Pⁿ at the orbit.
+    pub monodromy: DMatrix<f64>,
+    /// Floquet multipliers, sorted by decreasing modulus.
+    pub multipliers: Vec<Complex<f64>>,
+    /// All multipliers inside the unit circle.
+    pub stable: bool,
+    /// Type of the critical multiplier.
+    pub critical: Instability,
+    /// Distance to grazing (see [`FlowMap::grazing_distance`]).
+    pub grazing_distance: f64,
+    /// Switchings per cycle.
+    pub switchings: usize,
+    /// ‖F‖ after each Newton iteration.
+    pub residuals: Vec<f64>,
+}
+
+/// Eigenvalues of a monodromy matrix, sorted by decreasing modulus.
+pub fn floquet_multipliers(m: &DMatrix<f64>) -> Vec<Complex<f64>> {
+    let mut mu: Vec<Complex<f64>> = m.complex_eigenvalues().iter().copied().collect();
+    mu.sort_by(|a, b| b.norm().total_cmp(&a.norm()));
+    mu
+}
+
+/// Newton iteration for F(z) = Pⁿ(z) − z from `guess`, reusing `prop`.
+///
+/// # Errors
+/// [`SimError::NoConvergence`] when Newton fails; [`SimError`] from the propagator.
+pub fn shoot_with(
+    prop: &mut ExactPropagator,
+    guess: &DVector<f64>,
+    n: usize,
+    opts: &ShootingOptions,
+) -> Result<PeriodicOrbit, SimError> {
+    if n == 0 {
+        return Err(SimError::out_of_range("period", n, "must be >= 1"));
+    }
+    prop.model().check_state("initial guess", guess)?;
+    let dim = guess.len();
+    let mut z = guess.clone();
+    let mut residuals = Vec::new();
+    let mut map = stroboscopic(prop, &z, n)?;
+    let mut res = (&map.state - &z).norm();
+    for _ in 0..opts.max_iter {
+        residuals.push(res);
+        if res <= opts.tol * (1.0 + z.norm()) {
+            return finish(prop, z, n, map, residuals);
+        }
+        let a = &map.jacobian - DMatrix::identity(dim, dim);
+        let delta = a
+            .lu()
+            .solve(&(&z - &map.state))
+            .ok_or(SimError::NoConvergence {
+                what: "shooting (singular M − I)",
+                iterations: residuals.len(),
+                residual: res,
+            })?;
+        // damped Newton: halve the step while the residual grows
+        let mut lambda = 1.0;
+        loop {
+            let trial = &z + &delta * lambda;
+            let tmap = stroboscopic(prop, &trial, n)?;
+            let tres = (&tmap.state - &trial).norm();
+            if tres < res || lambda < 1e-3 {
+                z = trial;
+                map = tmap;
+                res = tres;
+                break;
+            }
+            lambda *= 0.5;
+        }
+    }
+    residuals.push(res);
+    if res <= opts.tol * (1.0 + z.norm()) {
+        return finish(prop, z, n, map, residuals);
+    }
+    Err(SimError::NoConvergence {
+        what: "shooting",
+        iterations: opts.max_iter,
+        residual: res,
+    })
+}
+
+fn finish(
+    prop: &mut ExactPropagator,
+    z: DVector<f64>,
+    n: usize,
+    map: FlowMap,
+    residuals: Vec<f64>,
+) -> Result<PeriodicOrbit, SimError> {
+    let mut section = vec![z.clone()];
+    let mut w = z.clone();
+    for _ in 1..n {
+        w = stroboscopic(prop, &w, 1)?.state;
+        section.push(w.clone());
+    }
+    let multipliers = floquet_multipliers(&map.jacobian);
+    let (crit, critical) = critical_multiplier(&multipliers);
+    Ok(PeriodicOrbit {
+        period: n,
+        state: z,
+        section,
+        monodromy: map.jacobian,
+        stable: crit.norm() < 1.0,
+        critical,
+        multipliers,
+        grazing_distance: map.grazing_distance,
+        switchings: map.switchings,
+        residuals,
+    })
+}
+
+/// Find a period-n orbit of `model` near `guess`.
+///
+/// # Errors
+/// As [`shoot_with`].
+pub fn shoot(
+    model: &CantileverModel,
+    guess: &DVector<f64>,
+    n: usize,
+    opts: &ShootingOptions,
+) -> Result<PeriodicOrbit, SimError> {
+    let mut prop = ExactPropagator::try_new(model, 1)?;
+    shoot_with(&mut prop, guess, n, opts)
+}

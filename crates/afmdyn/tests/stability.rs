@@ -1,0 +1,355 @@
+//! Monodromy matrices with saltation, Newton shooting, Floquet multipliers, continuation,
+//! Lyapunov exponents and the 0–1 test, each against an independent reference.
+
+use afmdyn::analysis::continuation::{continue_branch, BranchEvent, ContinuationSpec};
+use afmdyn::analysis::lyapunov::{lyapunov_spectrum, zero_one_test, LyapunovOptions, Verdict};
+use afmdyn::analysis::monodromy::stroboscopic;
+use afmdyn::analysis::shooting::{shoot, Instability, ShootingOptions};
+use afmdyn::analysis::steady::{steady_state, SteadyOptions};
+use afmdyn::galerkin::Region;
+use afmdyn::integrate::exact::ExactPropagator;
+use afmdyn::integrate::{build, IntegratorOptions};
+use afmdyn::{CantileverModel, Params, SweepParam};
+use nalgebra::{Complex, DMatrix, DVector};
+use proptest::prelude::*;
+
+fn model(p: Params) -> CantileverModel {
+    CantileverModel::new(&p).unwrap()
+}
+
+fn attractor(m: &CantileverModel) -> (DVector<f64>, Option<usize>) {
+    let mut it = build(m, IntegratorOptions::default(), 0.0, &m.rest()).unwrap();
+    let s = steady_state(
+        it.as_mut(),
+        &SteadyOptions {
+            max_periods: 600,
+            ..SteadyOptions::default()
+        },
+    )
+    .unwrap();
+    (s.end_state().clone(), s.period())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 24, .. ProptestConfig::default() })]
+
+    /// The analytic monodromy (step propagators × saltation matrices) equals a central
+    /// finite-difference Jacobian of the one-period map.
+    #[test]
+    fn monodromy_matches_finite_differences(
+        omega in 1.5f64..5.0, alpha4 in 5.0f64..40.0, alpha6 in 0.0f64..0.6, alpha1 in 0.0f64..0.3,
+        a1 in -0.3f64..0.3, a2 in -0.02f64..0.02, v1 in -1.0f64..1.0, v2 in -1.0f64..1.0,
+    ) {
+        let m = model(Params { omega, alpha4, alpha6, alpha1, ..Params::default() });
+        let z0 = DVector::from_vec(vec![a1, a2, 0.0, v1, v2, 0.0]);
+        let mut prop = ExactPropagator::new(&m, 1);
+        let map = stroboscopic(&mut prop, &z0, 1).unwrap();
+        // near-grazing switchings make the map non-differentiable at finite size: skip them
+        prop_assume!(map.grazing_distance > 1e-3);
+        let h = 1e-6;
+        let mut fd = DMatrix::zeros(6, 6);
+        for j in 0..6 {
+            let mut zp = z0.clone();
+            let mut zm = z0.clone();
+            zp[j] += h;
+            zm[j] -= h;
+            let a = stroboscopic(&mut prop, &zp, 1).unwrap();
+            let b = stroboscopic(&mut prop, &zm, 1).unwrap();
+            prop_assume!(a.switchings == map.switchings && b.switchings == map.switchings);
+            fd.set_column(j, &((a.state - b.state) / (2.0 * h)));
+        }
+        let err = (&fd - &map.jacobian).amax() / (1.0 + map.jacobian.amax());
+        prop_assert!(err < 1e-5, "relative error {err}");
+    }
+}
+
+#[test]
+fn saltation_is_the_contact_damper_jump() {
+    // on V_T = 0 the jump of the vector field is −(0, M⁻¹φ α6 V̇_T), so
+    // S = [[I, 0], [−α6 M⁻¹φφᵀ, I]] entering contact (and + leaving), independent of V̇_T
+    let p = Params {
+        alpha6: 0.37,
+        ..Params::default()
+    };
+    let m = model(p);
+    let g = m.galerkin().region(Region::Free);
+    let phi = m.tip().clone();
+    let minv = g.mass.clone().try_inverse().unwrap();
+    let block = &minv * &phi * phi.transpose() * p.alpha6;
+    let mut z = DVector::from_vec(vec![0.1, 0.02, -0.003, 0.4, -0.2, 0.1]);
+    let tau = 0.7;
+    // put the state on V_T = 0
+    z[0] -= m.v_t(tau, &z) / phi[0];
+    assert!(m.v_t(tau, &z).abs() < 1e-15);
+    for (from, to, sign) in [
+        (Region::Free, Region::Contact, -1.0),
+        (Region::Contact, Region::Free, 1.0),
+    ] {
+        let s = m.saltation(from, to, tau, &z);
+        let mut want = DMatrix::identity(6, 6);
+        want.view_mut((3, 0), (3, 3)).copy_from(&(&block * sign));
+        assert!((&s - &want).amax() < 1e-12, "{from:?} → {to:?}");
+        assert!((s.determinant() - 1.0).abs() < 1e-12);
+    }
+}
+
+#[test]
+fn multipliers_of_a_never_touching_orbit_are_exp_lambda_t() {
+    let p = Params {
+        alpha5: 5.0,
+        ..Params::default()
+    };
+    let m = model(p);
+    let o = shoot(&m, &m.rest(), 1, &ShootingOptions::default()).unwrap();
+    assert_eq!(o.switchings, 0);
+    let eig = m.dynamics(Region::Free).a.complex_eigenvalues();
+    let mut want: Vec<Complex<f64>> = eig.iter().map(|l| (l * p.period()).exp()).collect();
+    want.sort_by(|a, b| b.norm().total_cmp(&a.norm()));
+    for w in &want {
+        let best = o
+            .multipliers
+            .iter()
+            .map(|m| (m - w).norm())
+            .fold(f64::INFINITY, f64::min);
+        assert!(best < 1e-10, "{w} not among {:?}", o.multipliers);
+    }
+    assert!(o.stable);
+}
+
+#[test]
+fn shooting_converges_quadratically_to_the_period_two_orbit() {
+    let m = model(Params {
+        omega: 2.8,
+        ..Params::default()
+    });
+    let (z, n) = attractor(&m);
+    assert_eq!(n, Some(2));
+    // start away from the orbit so several Newton steps are needed
+    let guess = &z + DVector::from_element(6, 2e-3);
+    let o = shoot(&m, &guess, 2, &ShootingOptions::default()).unwrap();
+    let r = &o.residuals;
+    assert!(r.len() >= 3, "{r:?}");
+    let last = r.last().unwrap();
+    assert!(*last < 1e-12, "{r:?}");
+    // quadratic: e_{k+1} ≲ C e_k² for the steps above round-off
+    for w in r.windows(2).filter(|w| w[1] > 1e-13 && w[0] < 1e-2) {
+        assert!(w[1] < 50.0 * w[0] * w[0], "not quadratic: {r:?}");
+    }
+    assert!(
+        (&o.section[0] - &z).amax() < 1e-6 || (&o.section[1] - &z).amax() < 1e-6,
+        "the attractor's orbit"
+    );
+    assert!(o.stable);
+}
+
+#[test]
+fn multipliers_predict_the_decay_of_a_perturbation() {
+    let m = model(Params {
+        omega: 3.5,
+        ..Params::default()
+    });
+    let (z, _) = attractor(&m);
+    let o = shoot(&m, &z, 1, &ShootingOptions::default()).unwrap();
+    let mu = o.multipliers[0].norm();
+    assert!(mu < 1.0);
+    // P^k(z* + δ) − z* decays like |μ_max|^k once the faster components have died out
+    let mut prop = ExactPropagator::new(&m, 1);
+    let mut w = &o.state + DVector::from_element(6, 1e-7);
+    let mut d = Vec::new();
+    for _ in 0..60 {
+        w = stroboscopic(&mut prop, &w, 1).unwrap().state;
+        d.push((&w - &o.state).norm());
+    }
+    let rate = (d[59] / d[39]).powf(1.0 / 20.0);
+    assert!(
+        (rate - mu).abs() < 0.02 * mu,
+        "observed {rate}, predicted {mu}"
+    );
+}
+
+#[test]
+fn lyapunov_spectrum_without_contact_is_the_real_parts_of_the_eigenvalues() {
+    let p = Params {
+        alpha5: 5.0,
+        ..Params::default()
+    };
+    let m = model(p);
+    // finite-time exponents of a non-normal linear flow converge like ln(cond V)/t
+    let l = lyapunov_spectrum(
+        &m,
+        &m.rest(),
+        &LyapunovOptions {
+            transient_periods: 10,
+            periods: 6000,
+            blocks: 4,
+        },
+    )
+    .unwrap();
+    let mut re: Vec<f64> = m
+        .dynamics(Region::Free)
+        .a
+        .complex_eigenvalues()
+        .iter()
+        .map(|c| c.re)
+        .collect();
+    re.sort_by(|a, b| b.total_cmp(a));
+    for (e, r) in l.exponents.iter().zip(&re) {
+        assert!((e - r).abs() < 8e-4, "{:?} vs {re:?}", l.exponents);
+    }
+    // each complex pair shares its real part; the finite-time split within a pair averages out
+    for k in 0..3 {
+        let mean = 0.5 * (l.exponents[2 * k] + l.exponents[2 * k + 1]);
+        assert!(
+            (mean - re[2 * k]).abs() < 2e-4,
+            "pair {k}: {mean} vs {}",
+            re[2 * k]
+        );
+    }
+    assert_eq!(l.verdict, Verdict::Periodic);
+}
+
+#[test]
+fn lyapunov_sum_is_the_mean_phase_volume_contraction() {
+    // Liouville: Σλ = (1 − f) tr A_I + f tr A_II (+ Σ log|det S| = 0, see above), with the
+    // contact fraction f measured independently by the steady-state statistics
+    let p = Params {
+        omega: 2.8,
+        ..Params::default()
+    };
+    let m = model(p);
+    let (z, _) = attractor(&m);
+    let mut it = build(&m, IntegratorOptions::default(), 0.0, &z).unwrap();
+    let s = steady_state(it.as_mut(), &SteadyOptions::default()).unwrap();
+    let f = s.stats.contact_fraction;
+    let tr = |r| m.dynamics(r).a.trace();
+    let want = (1.0 - f) * tr(Region::Free) + f * tr(Region::Contact);
+    let l = lyapunov_spectrum(
+        &m,
+        &z,
+        &LyapunovOptions {
+            transient_periods: 0,
+            periods: 200,
+            blocks: 4,
+        },
+    )
+    .unwrap();
+    let sum: f64 = l.exponents.iter().sum();
+    assert!(
+        (sum - l.volume_rate).abs() < 1e-10,
+        "{sum} vs {}",
+        l.volume_rate
+    );
+    assert!((sum - want).abs() < 1e-9, "{sum} vs {want}");
+}
+
+#[test]
+fn lyapunov_exponent_of_a_periodic_orbit_is_its_floquet_rate() {
+    // λ₁ = ln|μ_max| / (nT) for a stable period-n orbit (Floquet theory)
+    let p = Params {
+        omega: 2.8,
+        ..Params::default()
+    };
+    let m = model(p);
+    let (z, n) = attractor(&m);
+    let o = shoot(&m, &z, n.unwrap(), &ShootingOptions::default()).unwrap();
+    let want = o.multipliers[0].norm().ln() / (o.period as f64 * p.period());
+    let l = lyapunov_spectrum(
+        &m,
+        &o.state,
+        &LyapunovOptions {
+            transient_periods: 0,
+            periods: 1000,
+            blocks: 5,
+        },
+    )
+    .unwrap();
+    assert!(
+        (l.exponents[0] - want).abs() < 0.01 * want.abs() + 3.0 * l.uncertainty[0],
+        "{} vs {want}",
+        l.exponents[0]
+    );
+    assert_eq!(l.verdict, Verdict::Periodic);
+}
+
+#[test]
+fn the_motion_at_omega_2_6_is_chaotic() {
+    let m = model(Params::default());
+    let l = lyapunov_spectrum(
+        &m,
+        &m.rest(),
+        &LyapunovOptions {
+            transient_periods: 300,
+            periods: 2000,
+            blocks: 10,
+        },
+    )
+    .unwrap();
+    assert!(
+        l.exponents[0] > 10.0 * l.uncertainty[0] && l.exponents[0] > 0.05,
+        "{:?} ± {:?}",
+        l.exponents,
+        l.uncertainty
+    );
+    assert!(l.zero_one > 0.8, "K = {}", l.zero_one);
+    assert_eq!(l.verdict, Verdict::Chaotic);
+    // and its period-1 orbit exists but is unstable by period doubling
+    let o = shoot(&m, &attractor(&m).0, 1, &ShootingOptions::default()).unwrap();
+    assert!(!o.stable && o.critical == Instability::PeriodDoubling);
+}
+
+#[test]
+fn zero_one_test_on_known_sequences() {
+    // logistic map at r = 4 is chaotic; a period-3 sequence and a quasi-periodic one are not
+    let mut x = 0.3f64;
+    let logistic: Vec<f64> = (0..2000)
+        .map(|_| {
+            x = 4.0 * x * (1.0 - x);
+            x
+        })
+        .collect();
+    assert!(zero_one_test(&logistic, 1) > 0.9);
+    let p3: Vec<f64> = (0..2000).map(|k| [0.1, 0.7, 0.4][k % 3]).collect();
+    assert!(zero_one_test(&p3, 1).abs() < 0.2);
+    let qp: Vec<f64> = (0..2000).map(|k| (k as f64 * 2f64.sqrt()).sin()).collect();
+    assert!(zero_one_test(&qp, 1) < 0.3);
+}
+
+#[test]
+fn continuation_locates_the_period_doubling_near_omega_2_91() {
+    let base = Params::default();
+    let m = model(Params { omega: 3.2, ..base });
+    let (z, n) = attractor(&m);
+    assert_eq!(n, Some(1));
+    let spec = ContinuationSpec::new(base, SweepParam::Omega, 3.2, 2.7, 1);
+    let br = continue_branch(&spec, &z).unwrap();
+    let pd = br
+        .iter()
+        .find(|b| b.event == Some(BranchEvent::PeriodDoubling))
+        .expect("a period doubling");
+    // independent check by shooting on either side: stable above, μ < −1 below
+    let side = |omega: f64| {
+        shoot(
+            &model(Params { omega, ..base }),
+            &pd.section[0],
+            1,
+            &ShootingOptions::default(),
+        )
+        .unwrap()
+    };
+    let above = side(pd.value + 2e-3);
+    let below = side(pd.value - 2e-3);
+    assert!(above.stable, "stable above {}", pd.value);
+    assert!(
+        !below.stable && below.multipliers[0].re < -1.0,
+        "flip below {}",
+        pd.value
+    );
+    assert!(
+        (pd.multipliers
+            .iter()
+            .map(|m| (m + 1.0).norm())
+            .fold(f64::INFINITY, f64::min))
+            < 1e-3,
+        "μ = −1 at the located point"
+    );
+}
