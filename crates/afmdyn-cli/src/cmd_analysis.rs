@@ -582,6 +582,20 @@ pub struct AttractorsArgs {
     json: bool,
 }
 
+/// A section state as the `--initial-modal` string "a1,..,aN;adot1,..,adotN" (at drive phase 0),
+/// so that `afmdyn orbit --initial-modal` can start from an attractor.
+fn initial_modal(z: Option<&DVector<f64>>) -> String {
+    let Some(z) = z else { return String::new() };
+    let n = z.len() / 2;
+    let join = |v: &[f64]| {
+        v.iter()
+            .map(|x| format!("{x}"))
+            .collect::<Vec<_>>()
+            .join(",")
+    };
+    format!("{};{}", join(&z.as_slice()[..n]), join(&z.as_slice()[n..]))
+}
+
 fn attractor_json(s: &SteadyState, basin: f64) -> serde_json::Value {
     json!({
         "period": s.period(),
@@ -595,6 +609,7 @@ fn attractor_json(s: &SteadyState, basin: f64) -> serde_json::Value {
         "contacts_per_period": s.stats.contacts_per_period,
         "body_contact": s.stats.body_contact,
         "basin_fraction": basin,
+        "initial_modal": initial_modal(s.poincare.first().map(|q| &q.state)),
     })
 }
 

@@ -367,3 +367,110 @@ fn attractors_json_contract() {
     }
     assert!(dir.path().join("attractor-1-phase.png").exists());
 }
+
+#[test]
+fn orbit_json_contract_and_attractor_handoff() {
+    let dir = tempfile::tempdir().unwrap();
+    let att = json(&afmdyn(&[
+        "attractors",
+        "--omega",
+        "2.8",
+        "--samples",
+        "4",
+        "--json",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]));
+    let a = &att["attractors"][0];
+    assert_eq!(a["period"], 2);
+    let start = a["initial_modal"].as_str().unwrap().to_string();
+    let doc = json(&afmdyn(&[
+        "orbit",
+        "--omega",
+        "2.8",
+        "--period",
+        "2",
+        "--initial-modal",
+        &start,
+        "--json",
+    ]));
+    assert_eq!(doc["period"], 2);
+    assert_eq!(doc["stable"], true);
+    assert_eq!(doc["multipliers"].as_array().unwrap().len(), 6);
+    assert_eq!(doc["poincare"]["v_t"].as_array().unwrap().len(), 2);
+    // the orbit found by shooting is the attractor: same section points (in some order)
+    let w: Vec<f64> = doc["poincare"]["w_tip"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    let wa: Vec<f64> = a["poincare"]["w_tip"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    for x in &w {
+        assert!(wa.iter().any(|y| (x - y).abs() < 1e-6), "{w:?} vs {wa:?}");
+    }
+    for m in doc["multipliers"].as_array().unwrap() {
+        assert!(m[0].as_f64().unwrap().hypot(m[1].as_f64().unwrap()) < 1.0);
+    }
+    bad_input(&["orbit", "--period", "0"], "period");
+}
+
+#[test]
+fn lyapunov_json_contract() {
+    let doc = json(&afmdyn(&[
+        "lyapunov",
+        "--omega",
+        "3.5",
+        "--transient",
+        "100",
+        "--periods",
+        "300",
+        "--blocks",
+        "3",
+        "--json",
+    ]));
+    let e: Vec<f64> = doc["exponents"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    let u = doc["uncertainty"].as_array().unwrap();
+    assert_eq!(e.len(), 6);
+    assert_eq!(u.len(), 6);
+    assert!(e.windows(2).all(|w| w[0] >= w[1]), "sorted");
+    assert!(e[0] < 0.0, "a stable period-1 orbit at Ω = 3.5");
+    assert!((e.iter().sum::<f64>() - doc["volume_rate"].as_f64().unwrap()).abs() < 1e-9);
+    assert_eq!(doc["verdict"], "periodic");
+    bad_input(&["lyapunov", "--periods", "1", "--blocks", "10"], "periods");
+}
+
+#[test]
+fn continue_writes_branch_csv_and_overlay_plot() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("c");
+    let doc = json(&afmdyn(&[
+        "continue",
+        "--from",
+        "3.2",
+        "--to",
+        "2.8",
+        "--json",
+        "--out",
+        out.to_str().unwrap(),
+    ]));
+    let events = doc["events"].as_array().unwrap();
+    assert!(
+        events.iter().any(|e| e["event"] == "period-doubling"),
+        "{events:?}"
+    );
+    let csv = std::fs::read_to_string(out.join("continuation.csv")).unwrap();
+    assert!(csv.starts_with("branch,period,s,value,stable,max_multiplier,critical,w_tip_section,switchings,grazing_distance,event"));
+    assert!(csv.lines().count() > 10);
+    assert!(out.join("continuation.png").exists() && out.join("continuation.svg").exists());
+}

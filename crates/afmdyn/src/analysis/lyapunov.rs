@@ -135,6 +135,11 @@ pub fn lyapunov_spectrum(
         exponents[i] = mean;
         uncertainty[i] = (var / rates.len() as f64).sqrt();
     }
+    // QR orders the exponents only asymptotically: sort the finite-time estimates
+    let mut order: Vec<usize> = (0..dim).collect();
+    order.sort_by(|&a, &b| exponents[b].total_cmp(&exponents[a]));
+    let exponents: Vec<f64> = order.iter().map(|&i| exponents[i]).collect();
+    let uncertainty: Vec<f64> = order.iter().map(|&i| uncertainty[i]).collect();
     let zero_one = zero_one_test(&section, 0x5eed);
     let (l1, s1) = (exponents[0], uncertainty[0]);
     let tol = 3.0 * s1 + 1e-4;
@@ -160,7 +165,8 @@ pub fn lyapunov_spectrum(
 /// The 0–1 test for chaos (correlation method) on a scalar series φ_j: K = median over 100
 /// frequencies c ∈ (π/5, 4π/5) of corr(n, D_c(n)), n ≤ len/10, with
 /// D_c(n) = M_c(n) − ⟨φ⟩² (1 − cos nc)/(1 − cos c) and M_c the mean square displacement of
-/// p_c(n) = Σ φ_j cos jc, q_c(n) = Σ φ_j sin jc. Returns NaN for fewer than 100 points.
+/// p_c(n) = Σ φ_j cos jc, q_c(n) = Σ φ_j sin jc. Returns NaN for fewer than 100 points and 0
+/// for a series constant to 1e-9 (a period-1 orbit seen on its section).
 pub fn zero_one_test(phi: &[f64], seed: u64) -> f64 {
     let len = phi.len();
     if len < 100 {
@@ -168,6 +174,11 @@ pub fn zero_one_test(phi: &[f64], seed: u64) -> f64 {
     }
     let ncut = len / 10;
     let mean = phi.iter().sum::<f64>() / len as f64;
+    // a series that has settled on a fixed point of the section carries no information: regular
+    let spread = phi.iter().map(|v| (v - mean).abs()).fold(0.0, f64::max);
+    if spread <= 1e-9 * (1.0 + mean.abs()) {
+        return 0.0;
+    }
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut ks: Vec<f64> = (0..100)
         .map(|_| {
