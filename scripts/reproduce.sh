@@ -7,7 +7,7 @@ cd "$(dirname "$0")/.."
 cargo build --release -q
 A=target/release/afmdyn
 F=docs/figures
-mkdir -p "$F"/fig4 "$F"/fig5 "$F"/fig6-7 "$F"/fig8-14 "$F"/fig15-17 "$F"/fig15-17-text
+mkdir -p "$F"/continuation "$F"/lyapunov "$F"/fig4 "$F"/fig5 "$F"/fig6-7 "$F"/fig8-14 "$F"/fig15-17 "$F"/fig15-17-text
 S=${SAMPLES:-64}
 
 $A modes --config examples/eq25.toml --json > "$F/eq25.json"
@@ -25,6 +25,14 @@ for run in "fig8-14 8" "fig8-14 32" "fig8-14 100" "fig6-7 64" "fig6-7 128" "fig6
   $A attractors --config "examples/$1.toml" --samples "$S" --integrator rk4-naive --steps-per-period "$2" \
     --json --out "$out" > "$out.json"
   rm -rf "$out"
+done
+# beyond the paper: the period-1 branch by continuation over the Fig. 5 diagram, and the
+# Lyapunov classification of the paper's nonperiodic motions
+$A continue --config examples/fig5.toml --from 5 --to 1 --switch --overlay "$F/fig5/bifurcation.csv" \
+  --json --out "$F/continuation" > "$F/continuation/summary.json"
+for om in 2.0 2.05 2.1 2.15 2.6 20; do
+  $A lyapunov --config examples/fig5.toml --omega "$om" --json > "$F/lyapunov/omega-$om.json"
+  $A orbit --config examples/fig5.toml --omega "$om" --json > "$F/lyapunov/orbit-omega-$om.json"
 done
 # keep the pictures and summaries; drop the bulky vector and table copies
 find "$F" \( -name '*.svg' -o -name '*.npy' -o -name 'attractor-*.csv' \) -delete
