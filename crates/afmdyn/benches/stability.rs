@@ -17,16 +17,27 @@ use std::time::Duration;
 fn attractor(p: &Params) -> DVector<f64> {
     let m = CantileverModel::new(p).unwrap();
     let mut it = build(&m, IntegratorOptions::default(), 0.0, &m.rest()).unwrap();
-    steady_state(it.as_mut(), &SteadyOptions::default()).unwrap().end_state().clone()
+    steady_state(it.as_mut(), &SteadyOptions::default())
+        .unwrap()
+        .end_state()
+        .clone()
 }
 
 fn shooting(c: &mut Criterion) {
-    let p = Params { omega: 3.5, ..Params::default() };
+    let p = Params {
+        omega: 3.5,
+        ..Params::default()
+    };
     let m = CantileverModel::new(&p).unwrap();
     let guess = attractor(&p) + DVector::from_element(6, 1e-3);
-    let iters = shoot(&m, &guess, 1, &ShootingOptions::default()).unwrap().residuals.len();
+    let iters = shoot(&m, &guess, 1, &ShootingOptions::default())
+        .unwrap()
+        .residuals
+        .len();
     println!("shooting: {iters} residual evaluations (Newton iterations + 1)");
-    c.bench_function("shoot period-1, N = 3", |b| b.iter(|| black_box(shoot(&m, &guess, 1, &ShootingOptions::default()).unwrap())));
+    c.bench_function("shoot period-1, N = 3", |b| {
+        b.iter(|| black_box(shoot(&m, &guess, 1, &ShootingOptions::default()).unwrap()))
+    });
 }
 
 fn continuation(c: &mut Criterion) {
@@ -36,8 +47,12 @@ fn continuation(c: &mut Criterion) {
     let n = continue_branch(&spec, &guess).unwrap().len();
     println!("continuation Ω 5 → 1: {n} points");
     let mut g = c.benchmark_group("continuation");
-    g.sample_size(10).warm_up_time(Duration::from_millis(100)).measurement_time(Duration::from_secs(20));
-    g.bench_function("period-1 branch, Ω 5 → 1", |b| b.iter(|| black_box(continue_branch(&spec, &guess).unwrap().len())));
+    g.sample_size(10)
+        .warm_up_time(Duration::from_millis(100))
+        .measurement_time(Duration::from_secs(20));
+    g.bench_function("period-1 branch, Ω 5 → 1", |b| {
+        b.iter(|| black_box(continue_branch(&spec, &guess).unwrap().len()))
+    });
     g.finish();
 }
 

@@ -133,11 +133,22 @@ impl CantileverModel {
     }
     /// Switching function V_T = W(1,τ) + α2 sin Ωτ + α5 (eq. 8).
     pub fn v_t(&self, tau: f64, z: &DVector<f64>) -> f64 {
-        self.w_tip(z) + self.params.alpha2 * (self.params.omega * tau).sin() + self.params.alpha5
+        self.v_t_from_tip(tau, [self.w_tip(z), 0.0, 0.0])[0]
+    }
+    /// [V_T, dV_T/dτ, d²V_T/dτ²] at τ from the tip deflection and its derivatives
+    /// [W(1,τ), W', W''] (eq. 8 differentiated twice).
+    pub fn v_t_from_tip(&self, tau: f64, w: [f64; 3]) -> [f64; 3] {
+        let p = &self.params;
+        let (s, c) = (p.omega * tau).sin_cos();
+        [
+            w[0] + p.alpha2 * s + p.alpha5,
+            w[1] + p.alpha2 * p.omega * c,
+            w[2] - p.alpha2 * p.omega * p.omega * s,
+        ]
     }
     /// dV_T/dτ = ∂W(1,τ)/∂τ + α2 Ω cos Ωτ.
     pub fn v_t_dot(&self, tau: f64, z: &DVector<f64>) -> f64 {
-        self.w_tip_dot(z) + self.params.alpha2 * self.params.omega * (self.params.omega * tau).cos()
+        self.v_t_from_tip(tau, [0.0, self.w_tip_dot(z), 0.0])[1]
     }
     /// Region of a state: contact when V_T ≤ 0 (eq. 10).
     pub fn region_at(&self, tau: f64, z: &DVector<f64>) -> Region {

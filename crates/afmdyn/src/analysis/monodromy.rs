@@ -80,15 +80,7 @@ pub fn flow_with_jacobian(
             model.v_t_dot(step.tau1, &z1),
         );
         if len > 0.0 && (d0 > 0.0) != (d1 > 0.0) {
-            let mut vt = |t: f64| {
-                let w = prop.dense_tip(t);
-                let (s, c) = (p.omega * t).sin_cos();
-                [
-                    w[0] + p.alpha2 * s + p.alpha5,
-                    w[1] + p.alpha2 * p.omega * c,
-                    w[2] - p.alpha2 * p.omega * p.omega * s,
-                ]
-            };
+            let mut vt = |t: f64| prop.dense_v_t(t);
             let t = extremum(step.tau0, step.tau1, d0, &mut vt);
             out.grazing_distance = out.grazing_distance.min(vt(t)[0].abs());
         }

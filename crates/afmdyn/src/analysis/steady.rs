@@ -172,7 +172,6 @@ impl StatsObserver {
             return;
         }
         let model = integ.model().clone();
-        let p = *model.params();
         self.time += len;
         if step.region == Region::Contact {
             self.contact_time += len;
@@ -202,15 +201,7 @@ impl StatsObserver {
             model.v_t_dot(step.tau1, &z1),
         );
         if vd0 < 0.0 && vd1 > 0.0 {
-            let mut vt = |t: f64| {
-                let w = integ.dense_tip(t);
-                let (s, c) = (p.omega * t).sin_cos();
-                [
-                    w[0] + p.alpha2 * s + p.alpha5,
-                    w[1] + p.alpha2 * p.omega * c,
-                    w[2] - p.alpha2 * p.omega * p.omega * s,
-                ]
-            };
+            let mut vt = |t: f64| integ.dense_v_t(t);
             let t = extremum(step.tau0, step.tau1, vd0, &mut vt);
             self.v_min = self.v_min.min(vt(t)[0]);
         }

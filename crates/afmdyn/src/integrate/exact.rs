@@ -24,7 +24,7 @@
 //! starts where the lower parabola g'(0)s − Bs²/2 is largest, so the same event cannot fire twice.
 //! Many switchings in a vanishing time window are reported as [`SimError::Chattering`].
 
-use super::{Integrator, Step, SwitchEvent};
+use super::{Integrator, Step};
 use crate::error::{finite, SimError};
 use crate::galerkin::Region;
 use crate::model::CantileverModel;
@@ -709,11 +709,9 @@ impl Integrator for ExactPropagator {
     }
 
     fn reset(&mut self, tau: f64, z: &DVector<f64>) -> Result<(), SimError> {
-        finite("initial time", tau)?;
-        self.model.check_state("initial state", z)?;
+        self.region = checked_start(&self.model, tau, z)?;
         self.tau = tau;
         self.z.copy_from(z);
-        self.region = entering_region(&self.model, tau, z);
         let j = self.next_grid(tau) - 1;
         self.on_grid = (self.grid_tau(j) == tau).then_some(j);
         self.ybound = self.curvature_bound(self.region, tau, z);
@@ -866,18 +864,7 @@ impl Integrator for ExactPropagator {
                 self.just_switched = true;
                 self.ybound = self.curvature_bound(to, tau_s, &zs);
                 self.chatter_check(tau_s)?;
-                Ok(Step {
-                    tau0,
-                    tau1: tau_s,
-                    region,
-                    event: Some(SwitchEvent {
-                        tau: tau_s,
-                        from: region,
-                        to,
-                        v_t_dot,
-                        state: zs,
-                    }),
-                })
+                Ok(Step::switched(&self.model, tau0, region, tau_s, &zs))
             }
         }
     }
@@ -897,6 +884,17 @@ impl Integrator for ExactPropagator {
         self.state_in_last(tau - self.last.tau0, &mut out);
         out
     }
+}
+
+/// Validate a start (τ, z) and return its region (see [`entering_region`]).
+pub(crate) fn checked_start(
+    model: &CantileverModel,
+    tau: f64,
+    z: &DVector<f64>,
+) -> Result<Region, SimError> {
+    finite("initial time", tau)?;
+    model.check_state("initial state", z)?;
+    Ok(entering_region(model, tau, z))
 }
 
 /// Region of a state on entering the integration: contact when V_T < 0, or V_T = 0 moving

@@ -36,6 +36,30 @@ pub struct SwitchEvent {
     pub state: DVector<f64>,
 }
 
+impl Step {
+    /// A step of `model` in region `from` that ends at a switching at (τ_s, z_s).
+    pub fn switched(
+        model: &CantileverModel,
+        tau0: f64,
+        from: Region,
+        tau_s: f64,
+        z_s: &DVector<f64>,
+    ) -> Step {
+        Step {
+            tau0,
+            tau1: tau_s,
+            region: from,
+            event: Some(SwitchEvent {
+                tau: tau_s,
+                from,
+                to: from.other(),
+                v_t_dot: model.v_t_dot(tau_s, z_s),
+                state: z_s.clone(),
+            }),
+        }
+    }
+}
+
 /// What one call of [`Integrator::step`] did.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Step {
@@ -77,6 +101,11 @@ pub trait Integrator: Send {
     fn dense_tip(&mut self, tau: f64) -> [f64; 3];
     /// Full state at `tau` inside the last step, shape `[2N]`.
     fn dense_state(&mut self, tau: f64) -> DVector<f64>;
+    /// [V_T, dV_T/dτ, d²V_T/dτ²] at `tau` inside the last step (from [`Integrator::dense_tip`]).
+    fn dense_v_t(&mut self, tau: f64) -> [f64; 3] {
+        let w = self.dense_tip(tau);
+        self.model().v_t_from_tip(tau, w)
+    }
     /// Integrator name.
     fn name(&self) -> &'static str;
 

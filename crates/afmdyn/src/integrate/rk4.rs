@@ -9,9 +9,9 @@
 //!   overshoot the discontinuity; a switching is reported at the end of the step where the
 //!   region changed.
 
-use super::exact::entering_region;
-use super::{HermiteStep, Integrator, Step, SwitchEvent};
-use crate::error::{finite, SimError};
+use super::exact::checked_start;
+use super::{HermiteStep, Integrator, Step};
+use crate::error::SimError;
 use crate::galerkin::Region;
 use crate::model::CantileverModel;
 use nalgebra::DVector;
@@ -130,11 +130,9 @@ impl Integrator for Rk4 {
     }
 
     fn reset(&mut self, tau: f64, z: &DVector<f64>) -> Result<(), SimError> {
-        finite("initial time", tau)?;
-        self.model.check_state("initial state", z)?;
+        self.region = checked_start(&self.model, tau, z)?;
         self.tau = tau;
         self.z.copy_from(z);
-        self.region = entering_region(&self.model, tau, z);
         Ok(())
     }
 
@@ -171,19 +169,7 @@ impl Integrator for Rk4 {
             check_finite(tau_b, &self.z)?;
             if after != region {
                 self.region = after;
-                let v_t_dot = self.model.v_t_dot(tau_b, &self.z);
-                return Ok(Step {
-                    tau0,
-                    tau1: tau_b,
-                    region,
-                    event: Some(SwitchEvent {
-                        tau: tau_b,
-                        from: region,
-                        to: after,
-                        v_t_dot,
-                        state: self.z.clone(),
-                    }),
-                });
+                return Ok(Step::switched(&self.model, tau0, region, tau_b, &self.z));
             }
             return Ok(Step {
                 tau0,
@@ -248,21 +234,8 @@ impl Integrator for Rk4 {
         self.tau = tau_s;
         self.last
             .record(&self.model, region, tau0, &z0, self.tau, &self.z);
-        let to = region.other();
-        self.region = to;
-        let v_t_dot = self.model.v_t_dot(tau_s, &self.z);
-        Ok(Step {
-            tau0,
-            tau1: tau_s,
-            region,
-            event: Some(SwitchEvent {
-                tau: tau_s,
-                from: region,
-                to,
-                v_t_dot,
-                state: self.z.clone(),
-            }),
-        })
+        self.region = region.other();
+        Ok(Step::switched(&self.model, tau0, region, tau_s, &self.z))
     }
 
     fn dense_tip(&mut self, tau: f64) -> [f64; 3] {
