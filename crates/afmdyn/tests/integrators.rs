@@ -423,3 +423,25 @@ fn bad_run_lengths_are_rejected() {
         Err(SimError::OutOfRange { .. })
     ));
 }
+
+#[test]
+fn undamped_resonance_is_an_error_not_a_panic() {
+    // α3 = α6 = 0 and Ω exactly at the first free natural frequency: no periodic forced response
+    let p0 = Params {
+        alpha3: 0.0,
+        alpha6: 0.0,
+        ..Params::default()
+    };
+    let (free, _) = afmdyn::eigen::spectrum(&p0).unwrap();
+    let p = Params {
+        omega: free.omega[0],
+        ..p0
+    };
+    let m = CantileverModel::new(&p).unwrap();
+    let r = build(&m, options(IntegratorKind::Exact), 0.0, &m.rest());
+    assert!(
+        matches!(r, Err(SimError::OutOfRange { name: "omega", .. })),
+        "{:?}",
+        r.err()
+    );
+}

@@ -412,13 +412,19 @@ impl ExactPropagator {
             let mut rhs = DVector::zeros(2 * dim);
             rhs.rows_mut(0, dim).copy_from(&(-&d.b_sin));
             rhs.rows_mut(dim, dim).copy_from(&(-&d.b_cos));
-            let sol = big.lu().solve(&rhs).ok_or_else(|| {
+            let resonance = || {
                 SimError::out_of_range(
                     "omega",
                     omega,
                     "is an undamped natural frequency: no periodic forced response (add damping)",
                 )
-            })?;
+            };
+            let big_norm = big.norm();
+            let sol = big.lu().solve(&rhs).ok_or_else(resonance)?;
+            // numerically singular (Ω within round-off of an undamped resonance)
+            if !(sol.norm() * big_norm <= 1e13 * rhs.norm()) && rhs.norm() > 0.0 {
+                return Err(resonance());
+            }
             let ps = sol.rows(0, dim).into_owned();
             let pc = sol.rows(dim, dim).into_owned();
             let mut zp_grid = DMatrix::zeros(dim, m + 1);

@@ -210,9 +210,10 @@ pub fn build(
         ));
     }
     let mut integ: Box<dyn Integrator> = match opts.kind {
-        IntegratorKind::Exact => {
-            Box::new(exact::ExactPropagator::new(model, opts.steps_per_period))
-        }
+        IntegratorKind::Exact => Box::new(exact::ExactPropagator::try_new(
+            model,
+            opts.steps_per_period,
+        )?),
         IntegratorKind::Rk4 => Box::new(rk4::Rk4::new(model, opts.steps_per_period, true)),
         IntegratorKind::Rk4Naive => Box::new(rk4::Rk4::new(model, opts.steps_per_period, false)),
         IntegratorKind::Adaptive => {
