@@ -422,7 +422,8 @@ impl ExactPropagator {
             let big_norm = big.norm();
             let sol = big.lu().solve(&rhs).ok_or_else(resonance)?;
             // numerically singular (Ω within round-off of an undamped resonance)
-            if !(sol.norm() * big_norm <= 1e13 * rhs.norm()) && rhs.norm() > 0.0 {
+            let amplification = sol.norm() * big_norm;
+            if rhs.norm() > 0.0 && (amplification.is_nan() || amplification > 1e13 * rhs.norm()) {
                 return Err(resonance());
             }
             let ps = sol.rows(0, dim).into_owned();
