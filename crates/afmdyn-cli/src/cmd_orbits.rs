@@ -198,13 +198,39 @@ pub fn continuation(a: &ContinueArgs) -> Result<(), CliError> {
             .collect();
         for pd in pds {
             if let Some((value, z)) = switch_at_period_doubling(&spec, &pd) {
+                // the two period doublings that bound a window start the same period-2n branch
+                let known = branches[1..].iter().flatten().any(|b| {
+                    (b.value - value).abs() < 1e-2
+                        && b.section
+                            .iter()
+                            .any(|q| (q - &z).norm() < 1e-3 * (1.0 + z.norm()))
+                });
+                if known {
+                    continue;
+                }
                 let sub = ContinuationSpec {
                     from: value,
                     period: 2 * n,
                     ..spec.clone()
                 };
                 if let Ok(b) = continue_branch(&sub, &z) {
-                    branches.push(b);
+                    // the same branch reached from the other end of its window: same bifurcations
+                    let marks = |br: &[BranchPoint]| -> Vec<(String, f64)> {
+                        br.iter()
+                            .filter_map(|x| x.event.map(|e| (format!("{e:?}"), x.value)))
+                            .collect()
+                    };
+                    let new = marks(&b);
+                    let duplicate = branches[1..].iter().any(|old| {
+                        let old = marks(old);
+                        !new.is_empty()
+                            && new.iter().all(|(e, v)| {
+                                old.iter().any(|(oe, ov)| oe == e && (ov - v).abs() < 1e-6)
+                            })
+                    });
+                    if !duplicate {
+                        branches.push(b);
+                    }
                 }
             }
         }

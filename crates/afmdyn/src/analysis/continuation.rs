@@ -332,6 +332,7 @@ pub fn continue_branch(
     let mut ds = spec.ds;
     let mut out = vec![point(&mut solver, s, &y, &map)?];
     let mut tf = tests(&t, &map.jacobian, &out[0].multipliers, map.switchings);
+    let first = y.clone();
     while out.len() < spec.max_points {
         let y_pred = &y + &t * ds;
         let (y_new, map_new, iters, fp_new) = match solver.correct(&y_pred, &t) {
@@ -380,6 +381,16 @@ pub fn continue_branch(
                     break;
                 }
             }
+            // a genuine fold has a multiplier +1; a sign change of dp/ds without one is the
+            // tangent flipping across a non-smooth (grazing) point: retry with a smaller step
+            let spurious_fold = ev == BranchEvent::Fold
+                && best
+                    .as_ref()
+                    .is_none_or(|bp| bp.multipliers.iter().all(|m| (m - 1.0).norm() > 1e-2));
+            if spurious_fold && ds > 16.0 * spec.ds_min {
+                ds *= 0.25;
+                continue;
+            }
             if let Some(bp) = best {
                 out.push(bp);
             }
@@ -387,9 +398,20 @@ pub fn continue_branch(
         if !(lo..=hi).contains(&y_new[dim]) {
             break;
         }
+        // stop when the branch closes on itself (an isola back at its first point), or when a
+        // period-2n branch has merged into a period-n orbit (its half-cycle repeats): beyond that
+        // it would trace the period-n branch again
+        let closed = out.len() > 10 && (&y_new - &first).norm() < 0.5 * ds;
+        let half = spec.period / 2;
+        let merged = spec.period.is_multiple_of(2)
+            && out.len() > 3
+            && (&pt.section[half] - &pt.section[0]).norm() < 1e-6 * (1.0 + pt.section[0].norm());
         s += ds;
         pt.s = s;
         out.push(pt);
+        if closed || merged {
+            break;
+        }
         y = y_new;
         t = t_new;
         tf = tf_new;
