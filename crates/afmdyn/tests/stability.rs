@@ -352,4 +352,24 @@ fn continuation_locates_the_period_doubling_near_omega_2_91() {
             < 1e-3,
         "μ = −1 at the located point"
     );
+    // every located fold has a multiplier +1 and every period doubling one at −1
+    let nearest = |b: &afmdyn::analysis::continuation::BranchPoint, target: f64| {
+        b.multipliers
+            .iter()
+            .map(|m| (m - target).norm())
+            .fold(f64::INFINITY, f64::min)
+    };
+    for b in br.iter().filter(|b| b.event.is_some()) {
+        match b.event.unwrap() {
+            BranchEvent::Fold => {
+                assert!(nearest(b, 1.0) < 1e-2, "fold at {} without μ = +1", b.value)
+            }
+            BranchEvent::PeriodDoubling => assert!(
+                nearest(b, -1.0) < 1e-2,
+                "flip at {} without μ = −1",
+                b.value
+            ),
+            _ => {}
+        }
+    }
 }
