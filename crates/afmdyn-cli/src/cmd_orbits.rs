@@ -68,6 +68,7 @@ fn orbit_json(model: &CantileverModel, o: &PeriodicOrbit) -> serde_json::Value {
         "multipliers": o.multipliers.iter().map(|m| [m.re, m.im]).collect::<Vec<_>>(),
         "stable": o.stable,
         "critical": o.critical,
+        "grazing": o.grazing,
         "grazing_distance": o.grazing_distance,
         "switchings": o.switchings,
         "newton_residuals": o.residuals,
@@ -111,8 +112,10 @@ pub fn orbit(a: &OrbitArgs) -> Result<(), CliError> {
         println!("  {:+.8} {:+.8}i   {:.8}", m.re, m.im, m.norm());
     }
     println!(
-        "critical multiplier type: {:?}; distance to grazing {:.3e}",
-        o.critical, o.grazing_distance
+        "critical multiplier type: {:?}; distance to grazing {:.3e}{}",
+        o.critical,
+        o.grazing_distance,
+        if o.grazing { " (grazing)" } else { "" }
     );
     for (k, z) in o.section.iter().enumerate() {
         println!("  section {k}: W(1,τ) = {:.9}", model.w_tip(z));

@@ -396,6 +396,10 @@ fn orbit_json_contract_and_attractor_handoff() {
     ]));
     assert_eq!(doc["period"], 2);
     assert_eq!(doc["stable"], true);
+    assert_eq!(
+        doc["grazing"],
+        doc["grazing_distance"].as_f64().unwrap() < 1e-3
+    );
     assert_eq!(doc["multipliers"].as_array().unwrap().len(), 6);
     assert_eq!(doc["poincare"]["v_t"].as_array().unwrap().len(), 2);
     // the orbit found by shooting is the attractor: same section points (in some order)

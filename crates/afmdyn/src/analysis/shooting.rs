@@ -30,6 +30,10 @@ impl Default for ShootingOptions {
     }
 }
 
+/// Distance to grazing below which an orbit is flagged as grazing: a local extremum of V_T
+/// within 1e-3 gap units of the sample, or a switching with |dV_T/dτ|/Ω below 1e-3.
+pub const GRAZING_TOL: f64 = 1e-3;
+
 /// How an orbit is (or would become) unstable, from the multiplier of largest modulus.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
@@ -77,6 +81,8 @@ pub struct PeriodicOrbit {
     pub critical: Instability,
     /// Distance to grazing (see [`FlowMap::grazing_distance`]).
     pub grazing_distance: f64,
+    /// The orbit is (near) grazing: `grazing_distance` < [`GRAZING_TOL`].
+    pub grazing: bool,
     /// Switchings per cycle.
     pub switchings: usize,
     /// ‖F‖ after each Newton iteration.
@@ -172,6 +178,7 @@ fn finish(
         stable: crit.norm() < 1.0,
         critical,
         multipliers,
+        grazing: map.grazing_distance < GRAZING_TOL,
         grazing_distance: map.grazing_distance,
         switchings: map.switchings,
         residuals,
