@@ -12,7 +12,7 @@
 
 use super::monodromy::{stroboscopic, FlowMap};
 use super::shooting::{
-    critical_multiplier, floquet_multipliers, shoot_with, Instability, ShootingOptions,
+    floquet_stability, section_points, shoot_with, Instability, ShootingOptions,
 };
 use crate::error::SimError;
 use crate::integrate::exact::ExactPropagator;
@@ -278,23 +278,17 @@ fn point(
     let dim = y.len() - 1;
     let z = y.rows(0, dim).into_owned();
     let p = y[dim];
-    let mut section = vec![z.clone()];
-    let mut w = z;
     let n = solver.spec.period;
-    for _ in 1..n {
-        w = stroboscopic(solver.at(p)?, &w, 1)?.state;
-        section.push(w.clone());
-    }
-    let mu = floquet_multipliers(&map.jacobian);
-    let (crit, critical) = critical_multiplier(&mu);
+    let section = section_points(solver.at(p)?, &z, n)?;
+    let (multipliers, stable, critical) = floquet_stability(&map.jacobian);
     Ok(BranchPoint {
         s,
         value: p,
         period: n,
         section,
-        stable: crit.norm() < 1.0,
+        stable,
         critical,
-        multipliers: mu,
+        multipliers,
         switchings: map.switchings,
         grazing_distance: map.grazing_distance,
         event: None,

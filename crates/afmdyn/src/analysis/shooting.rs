@@ -155,6 +155,31 @@ pub fn shoot_with(
     })
 }
 
+/// The n section states z, P(z), …, Pⁿ⁻¹(z) of a period-n orbit.
+///
+/// # Errors
+/// [`SimError`] from the propagator.
+pub fn section_points(
+    prop: &mut ExactPropagator,
+    z: &DVector<f64>,
+    n: usize,
+) -> Result<Vec<DVector<f64>>, SimError> {
+    let mut section = vec![z.clone()];
+    for _ in 1..n {
+        let next = stroboscopic(prop, section.last().expect("non-empty"), 1)?.state;
+        section.push(next);
+    }
+    Ok(section)
+}
+
+/// Floquet multipliers of a monodromy matrix (decreasing modulus), whether all lie inside the
+/// unit circle, and the type of the critical one.
+pub fn floquet_stability(m: &DMatrix<f64>) -> (Vec<Complex<f64>>, bool, Instability) {
+    let multipliers = floquet_multipliers(m);
+    let (crit, critical) = critical_multiplier(&multipliers);
+    (multipliers, crit.norm() < 1.0, critical)
+}
+
 fn finish(
     prop: &mut ExactPropagator,
     z: DVector<f64>,
@@ -162,20 +187,14 @@ fn finish(
     map: FlowMap,
     residuals: Vec<f64>,
 ) -> Result<PeriodicOrbit, SimError> {
-    let mut section = vec![z.clone()];
-    let mut w = z.clone();
-    for _ in 1..n {
-        w = stroboscopic(prop, &w, 1)?.state;
-        section.push(w.clone());
-    }
-    let multipliers = floquet_multipliers(&map.jacobian);
-    let (crit, critical) = critical_multiplier(&multipliers);
+    let section = section_points(prop, &z, n)?;
+    let (multipliers, stable, critical) = floquet_stability(&map.jacobian);
     Ok(PeriodicOrbit {
         period: n,
         state: z,
         section,
         monodromy: map.jacobian,
-        stable: crit.norm() < 1.0,
+        stable,
         critical,
         multipliers,
         grazing: map.grazing_distance < GRAZING_TOL,
