@@ -445,3 +445,18 @@ fn undamped_resonance_is_an_error_not_a_panic() {
         r.err()
     );
 }
+
+#[test]
+fn a_tip_resting_on_the_sample_stays_without_chattering() {
+    // α2 = α5 = 0 from rest: V_T = dV_T/dτ = 0 and the contact force vanishes, so the exact
+    // solution is rest; the switching test must not flip between the regions forever
+    let m = CantileverModel::new(&Params {
+        alpha2: 0.0,
+        ..Params::default()
+    })
+    .unwrap();
+    let mut it = build(&m, options(IntegratorKind::Exact), 0.0, &m.rest()).unwrap();
+    let ev = events_until(it.as_mut(), 5.0 * m.period());
+    assert!(ev.is_empty(), "{} switchings", ev.len());
+    assert_eq!(it.state().amax(), 0.0);
+}

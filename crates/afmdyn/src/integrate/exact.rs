@@ -177,6 +177,8 @@ struct TipPoly {
     alpha2: f64,
     alpha5: f64,
     sigma: f64,
+    /// Dead band added to the gap (see [`ExactPropagator`]'s `dead`).
+    dead: f64,
     /// Bound on |g''| over the step.
     curv: f64,
 }
@@ -205,7 +207,7 @@ impl TipPoly {
         let dw = Self::horner(&self.c[1][..self.terms], t) + om * (ws * c - wc * s);
         let v = w + self.alpha2 * s + self.alpha5;
         let dv = dw + self.alpha2 * om * c;
-        (self.sigma * v, self.sigma * dv)
+        (self.sigma * v + self.dead, self.sigma * dv)
     }
 }
 
@@ -335,6 +337,11 @@ pub struct ExactPropagator {
     poly: Option<Box<TipPoly>>,
     /// V_T and dV_T/dτ at the current state.
     vt: (f64, f64),
+    /// Round-off dead band of the switching test: a region is left when V_T passes 0 by more
+    /// than this (1e-15 of the displacement scale). A tip resting on the sample with zero force
+    /// (V_T = V̇_T = 0, e.g. α2 = α5 = 0 from rest) then stays put instead of chattering; a real
+    /// switching is located within dead/|dV_T/dτ| ≈ 1e-14 of V_T = 0.
+    dead: f64,
     /// sin Ωτ_k and cos Ωτ_k on the grid of one period (k = 0..=m).
     trig: Vec<(f64, f64)>,
     zb: DVector<f64>,
@@ -476,6 +483,11 @@ impl ExactPropagator {
             });
         }
         let regions: [RegionProp; 2] = regions.try_into().expect("two regions");
+        let scale = regions
+            .iter()
+            .map(|r| r.wp[1].hypot(r.wp[2]) + r.wp[0].abs())
+            .fold(0.0, f64::max);
+        let dead = 1e-15 * (1.0 + p.alpha5.abs() + p.alpha2 + scale);
         let zero = DVector::zeros(dim);
         Ok(ExactPropagator {
             model: model.clone(),
@@ -498,6 +510,7 @@ impl ExactPropagator {
             },
             poly: None,
             vt: (0.0, 0.0),
+            dead,
             trig: (0..=m)
                 .map(|k| (omega * (k as f64 * h)).sin_cos())
                 .collect(),
@@ -657,6 +670,7 @@ impl ExactPropagator {
             alpha2: p.alpha2,
             alpha5: p.alpha5,
             sigma: if region == Region::Free { 1.0 } else { -1.0 },
+            dead: self.dead,
             curv,
         }
     }
@@ -806,9 +820,9 @@ impl Integrator for ExactPropagator {
             (self.model.v_t(tau_b, &z_b), self.model.v_t_dot(tau_b, &z_b))
         };
         let sigma = if region == Region::Free { 1.0 } else { -1.0 };
-        let mut ga = sigma * self.vt.0;
+        let mut ga = sigma * self.vt.0 + self.dead;
         let da = sigma * self.vt.1;
-        let gb = sigma * vt_b.0;
+        let gb = sigma * vt_b.0 + self.dead;
         let db = sigma * vt_b.1;
         let switched = self.just_switched || ga <= 0.0;
         if switched {
