@@ -171,7 +171,6 @@ impl StatsObserver {
         if len <= 0.0 {
             return;
         }
-        let model = integ.model().clone();
         self.time += len;
         if step.region == Region::Contact {
             self.contact_time += len;
@@ -179,13 +178,24 @@ impl StatsObserver {
         if matches!(&step.event, Some(e) if e.to == Region::Contact) {
             self.contacts += 1;
         }
-        let z1 = integ.state().clone();
-        let body = self
-            .body
-            .get_or_insert_with(|| BodyContactCheck::new(&model, 32));
-        self.body_contact |= body.touches(&model, step.tau1, &z1);
-        let (w0, w1) = (model.w_tip(before), model.w_tip(&z1));
-        let (d0, d1) = (model.w_tip_dot(before), model.w_tip_dot(&z1));
+        // end-point values first (borrowing the model), then the dense-output searches
+        let ((w0, w1), (d0, d1), (v0, v1), (vd0, vd1)) = {
+            let model = integ.model();
+            let z1 = integ.state();
+            let body = self
+                .body
+                .get_or_insert_with(|| BodyContactCheck::new(model, 32));
+            self.body_contact |= body.touches(model, step.tau1, z1);
+            (
+                (model.w_tip(before), model.w_tip(z1)),
+                (model.w_tip_dot(before), model.w_tip_dot(z1)),
+                (model.v_t(step.tau0, before), model.v_t(step.tau1, z1)),
+                (
+                    model.v_t_dot(step.tau0, before),
+                    model.v_t_dot(step.tau1, z1),
+                ),
+            )
+        };
         self.x_max = self.x_max.max(w0).max(w1);
         self.x_min = self.x_min.min(w0).min(w1);
         if (d0 > 0.0) != (d1 > 0.0) {
@@ -194,12 +204,7 @@ impl StatsObserver {
             self.x_max = self.x_max.max(w);
             self.x_min = self.x_min.min(w);
         }
-        let (v0, v1) = (model.v_t(step.tau0, before), model.v_t(step.tau1, &z1));
         self.v_min = self.v_min.min(v0).min(v1);
-        let (vd0, vd1) = (
-            model.v_t_dot(step.tau0, before),
-            model.v_t_dot(step.tau1, &z1),
-        );
         if vd0 < 0.0 && vd1 > 0.0 {
             let mut vt = |t: f64| integ.dense_v_t(t);
             let t = extremum(step.tau0, step.tau1, vd0, &mut vt);
