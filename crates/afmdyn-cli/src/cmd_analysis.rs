@@ -125,6 +125,18 @@ const HEADER: [&str; 18] = [
     "state",
 ];
 
+/// Column positions in [`HEADER`] (also read by `afmdyn continue --overlay`).
+pub(crate) const COL_VALUE: usize = 1;
+pub(crate) const COL_INDEX: usize = 2;
+pub(crate) const COL_BRANCH: usize = 3;
+pub(crate) const COL_STATUS: usize = 4;
+pub(crate) const COL_PERIOD: usize = 5;
+pub(crate) const COL_POINT: usize = 6;
+pub(crate) const COL_POINTS: usize = 7;
+pub(crate) const COL_W_TIP: usize = 10;
+pub(crate) const COL_X_MAX: usize = 11;
+pub(crate) const COL_STATE: usize = 17;
+
 fn branch_code(b: Branch) -> f64 {
     match b {
         Branch::Forward => 0.0,
@@ -212,19 +224,21 @@ fn scan_partial(path: &Path) -> Result<Resume, CliError> {
             }
             let cells: Vec<Vec<&str>> = group.iter().map(|l| l.split(',').collect()).collect();
             let complete = cells.iter().all(|c| c.len() == HEADER.len())
-                && cells[0][7].parse::<usize>().ok() == Some(cells.len())
+                && cells[0][COL_POINTS].parse::<usize>().ok() == Some(cells.len())
                 && cells
                     .iter()
                     .enumerate()
-                    .all(|(i, c)| c[6].parse::<usize>().ok() == Some(i));
+                    .all(|(i, c)| c[COL_POINT].parse::<usize>().ok() == Some(i));
             if complete {
-                let index: usize = cells[0][2]
+                let index: usize = cells[0][COL_INDEX]
                     .parse()
                     .map_err(|_| CliError::Io("resume: bad index".into()))?;
-                let branch: Branch = cells[0][3].parse().map_err(CliError::Io)?;
+                let branch: Branch = cells[0][COL_BRANCH].parse().map_err(CliError::Io)?;
                 resume.done.insert((index, branch));
-                if matches!(branch, Branch::Forward | Branch::Backward) && cells[0][4] != "error" {
-                    let state: Vec<f64> = cells.last().expect("rows")[17]
+                if matches!(branch, Branch::Forward | Branch::Backward)
+                    && cells[0][COL_STATUS] != "error"
+                {
+                    let state: Vec<f64> = cells.last().expect("rows")[COL_STATE]
                         .split(' ')
                         .filter_map(|v| v.parse().ok())
                         .collect();
@@ -399,11 +413,11 @@ pub fn bifurcation(a: &BifurcationArgs) -> Result<(), CliError> {
     let (mut periodic, mut nonperiodic, mut errors) = (0usize, 0usize, 0usize);
     read_rows(&final_csv, &mut |r| {
         rows += 1;
-        let v: f64 = r[1].parse().unwrap_or(f64::NAN);
-        let w: f64 = r[10].parse().unwrap_or(f64::NAN);
-        let x: f64 = r[11].parse().unwrap_or(f64::NAN);
-        if r[6] == *"0" {
-            match &r[4] {
+        let v: f64 = r[COL_VALUE].parse().unwrap_or(f64::NAN);
+        let w: f64 = r[COL_W_TIP].parse().unwrap_or(f64::NAN);
+        let x: f64 = r[COL_X_MAX].parse().unwrap_or(f64::NAN);
+        if r[COL_POINT] == *"0" {
+            match &r[COL_STATUS] {
                 "periodic" => periodic += 1,
                 "nonperiodic" => nonperiodic += 1,
                 _ => errors += 1,
@@ -472,19 +486,19 @@ pub fn bifurcation(a: &BifurcationArgs) -> Result<(), CliError> {
         let feed = |draw: &mut ChunkSink<'_>| -> Result<(), CliError> {
             let mut chunk = Vec::with_capacity(4096);
             read_rows(&final_csv, &mut |r| {
-                let v: f64 = r[1].parse().unwrap_or(f64::NAN);
+                let v: f64 = r[COL_VALUE].parse().unwrap_or(f64::NAN);
                 let y: f64 = r[col].parse().unwrap_or(f64::NAN);
                 if !y.is_finite() {
                     return Ok(());
                 }
                 let c = if by_branch {
-                    match &r[3] {
+                    match &r[COL_BRANCH] {
                         "forward" => 0,
                         "backward" => 1,
                         _ => 7,
                     }
                 } else {
-                    period_color(status_code(&r[4], &r[5]))
+                    period_color(status_code(&r[COL_STATUS], &r[COL_PERIOD]))
                 };
                 chunk.push((v, y, c));
                 if chunk.len() == chunk.capacity() {
@@ -537,12 +551,12 @@ fn write_bifurcation_npy(csv_path: &Path, npy: &Path, rows: usize) -> Result<(),
     let mut rd = csv::Reader::from_path(csv_path)?;
     let it = rd.records().filter_map(Result::ok).map(|r| {
         let num = |i: usize| r[i].parse::<f64>().unwrap_or(f64::NAN);
-        let branch: Branch = r[3].parse().unwrap_or(Branch::Start(u32::MAX));
+        let branch: Branch = r[COL_BRANCH].parse().unwrap_or(Branch::Start(u32::MAX));
         vec![
             num(1),
             num(2),
             branch_code(branch),
-            status_code(&r[4], &r[5]),
+            status_code(&r[COL_STATUS], &r[COL_PERIOD]),
             num(6),
             num(8),
             num(9),

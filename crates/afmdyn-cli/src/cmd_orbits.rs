@@ -1,7 +1,7 @@
 //! `afmdyn orbit`, `afmdyn continue` and `afmdyn lyapunov`.
 
 use crate::args::ModelArgs;
-use crate::cmd_analysis::SteadyArgs;
+use crate::cmd_analysis::{SteadyArgs, COL_VALUE, COL_W_TIP};
 use crate::cmd_simulate::initial_state;
 use crate::error::CliError;
 use crate::output::{ensure_dir, f, write_csv};
@@ -312,7 +312,7 @@ pub fn continuation(a: &ContinueArgs) -> Result<(), CliError> {
         let mut rd = csv::Reader::from_path(csv_path)?;
         for r in rd.records() {
             let r = r?;
-            if let (Ok(v), Ok(w)) = (r[1].parse::<f64>(), r[10].parse::<f64>()) {
+            if let (Ok(v), Ok(w)) = (r[COL_VALUE].parse::<f64>(), r[COL_W_TIP].parse::<f64>()) {
                 underlay.push((v, w));
             }
         }

@@ -10,8 +10,8 @@
 //! method) is computed on V_T at the stroboscopic section: K ≈ 0 for regular, ≈ 1 for chaotic
 //! motion. It uses no derivative information, so it checks the exponents independently.
 
+use super::monodromy::flow_with_jacobian;
 use crate::error::SimError;
-use crate::galerkin::Region;
 use crate::integrate::exact::ExactPropagator;
 use crate::integrate::{advance_dyn, Integrator};
 use crate::model::CantileverModel;
@@ -95,7 +95,7 @@ pub fn lyapunov_spectrum(
     prop.reset(0.0, z0)?;
     let t0 = opts.transient_periods as f64 * period;
     advance_dyn(&mut prop, t0, &mut |_, _, _| Ok(()))?;
-    let trace = [Region::Free, Region::Contact].map(|r| model.dynamics(r).a.trace());
+    let mut z = prop.state().clone();
     let mut q = DMatrix::<f64>::identity(dim, dim);
     let per_block = opts.periods / opts.blocks;
     let mut block_sums = vec![vec![0.0; dim]; opts.blocks];
@@ -103,27 +103,19 @@ pub fn lyapunov_spectrum(
     let mut section = Vec::with_capacity(opts.periods);
     let total_periods = per_block * opts.blocks;
     for k in 0..total_periods {
-        let target = t0 + (k + 1) as f64 * period;
-        while prop.tau() < target {
-            let step = prop.step(target)?;
-            let len = step.tau1 - step.tau0;
-            if len > 0.0 {
-                q = prop.last_step_jacobian() * q;
-                log_volume += trace[step.region.index()] * len;
-            }
-            if let Some(e) = &step.event {
-                let s = model.saltation(e.from, e.to, e.tau, &e.state);
-                log_volume += s.determinant().abs().ln();
-                q = s * q;
-            }
-        }
+        // one period of the flow with its Jacobian (step propagators × saltation matrices)
+        let (ta, tb) = (t0 + k as f64 * period, t0 + (k + 1) as f64 * period);
+        let map = flow_with_jacobian(&mut prop, ta, &z, tb)?;
+        log_volume += map.log_volume;
+        q = map.jacobian * q;
+        z = map.state;
         let qr = q.clone().qr();
         let r = qr.r();
         for (i, acc) in block_sums[k / per_block].iter_mut().enumerate() {
             *acc += r[(i, i)].abs().ln();
         }
         q = qr.q();
-        section.push(model.v_t(prop.tau(), prop.state()));
+        section.push(model.v_t(tb, &z));
     }
     let block_time = per_block as f64 * period;
     let mut exponents = vec![0.0; dim];

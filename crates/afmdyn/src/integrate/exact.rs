@@ -329,7 +329,7 @@ pub struct ExactPropagator {
     region: Region,
     on_grid: Option<i64>,
     /// Bound on |W_hom''| over the current stint (see `curvature_bound`).
-    ybound: f64,
+    stint_curvature: f64,
     just_switched: bool,
     recent: VecDeque<f64>,
     last: LastStep,
@@ -499,7 +499,7 @@ impl ExactPropagator {
             z: zero.clone(),
             region: Region::Free,
             on_grid: Some(0),
-            ybound: 0.0,
+            stint_curvature: 0.0,
             just_switched: true,
             recent: VecDeque::new(),
             last: LastStep {
@@ -740,7 +740,7 @@ impl Integrator for ExactPropagator {
         self.z.copy_from(z);
         let j = self.next_grid(tau) - 1;
         self.on_grid = (self.grid_tau(j) == tau).then_some(j);
-        self.ybound = self.curvature_bound(self.region, tau, z);
+        self.stint_curvature = self.curvature_bound(self.region, tau, z);
         self.just_switched = true;
         self.recent.clear();
         self.last = LastStep {
@@ -829,7 +829,7 @@ impl Integrator for ExactPropagator {
             ga = ga.max(0.0);
         }
         let rp = &self.regions[ri];
-        let cheap = self.ybound + rp.vp_curv;
+        let cheap = self.stint_curvature + rp.vp_curv;
         let mut hit = None;
         if !certified_positive(ga, da, gb, db, cheap, len) {
             let poly = self.build_poly(region, tau0, &self.last.dz0, len);
@@ -888,7 +888,7 @@ impl Integrator for ExactPropagator {
                 self.region = to;
                 self.on_grid = None;
                 self.just_switched = true;
-                self.ybound = self.curvature_bound(to, tau_s, &zs);
+                self.stint_curvature = self.curvature_bound(to, tau_s, &zs);
                 self.chatter_check(tau_s)?;
                 Ok(Step::switched(&self.model, tau0, region, tau_s, &zs))
             }

@@ -108,20 +108,10 @@ pub trait Integrator: Send {
     }
     /// Integrator name.
     fn name(&self) -> &'static str;
-
-    /// Advance to exactly `tau_end`, calling `on_step(self, step, z_before)` after every step.
-    ///
-    /// # Errors
-    /// As [`Integrator::step`], or what `on_step` returns.
-    fn advance_to(&mut self, tau_end: f64, on_step: &mut StepObserver<'_>) -> Result<(), SimError>
-    where
-        Self: Sized,
-    {
-        advance_dyn(self, tau_end, on_step)
-    }
 }
 
-/// [`Integrator::advance_to`] for trait objects.
+/// Advance `integ` to exactly `tau_end`, calling `on_step(integ, step, z_before)` after every
+/// step.
 ///
 /// # Errors
 /// As [`Integrator::step`], or what `on_step` returns.
