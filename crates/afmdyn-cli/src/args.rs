@@ -3,7 +3,7 @@
 
 use crate::error::CliError;
 use afmdyn::integrate::{IntegratorKind, IntegratorOptions};
-use afmdyn::Params;
+use afmdyn::{LawKind, Params};
 use clap::Args;
 use serde::Deserialize;
 use std::path::PathBuf;
@@ -68,6 +68,23 @@ pub struct ModelArgs {
     /// Dimensionless drive frequency Ω
     #[arg(long, value_name = "Ω", allow_negative_numbers = true)]
     pub omega: Option<f64>,
+    /// Tip–sample law: linear (the paper, α4 δ + α6 δ̇), hertz (α4 δ^1.5 + α6 δ̇), dmt (van der
+    /// Waals + adhesion + Hertz + α6 √δ δ̇) or impact (rigid sample, restitution r)
+    #[arg(long, value_name = "LAW", value_parser = parse_law)]
+    pub contact_law: Option<LawKind>,
+    /// Coefficient of restitution r of the impact law, 0..=1 (default 0.8)
+    #[arg(long, value_name = "r", allow_negative_numbers = true)]
+    pub restitution: Option<f64>,
+    /// DMT van der Waals group H̃ = H R L³/(6 EI g0³) ≥ 0 (default 0.05)
+    #[arg(long, value_name = "H̃", allow_negative_numbers = true)]
+    pub hamaker: Option<f64>,
+    /// DMT intermolecular distance ã0 = a0/g0 > 0, the contact threshold (default 0.01)
+    #[arg(long, value_name = "ã0", allow_negative_numbers = true)]
+    pub intermolecular_distance: Option<f64>,
+}
+
+fn parse_law(s: &str) -> Result<LawKind, String> {
+    s.parse()
 }
 
 /// The model section of a config file. Unknown keys are rejected.
@@ -96,6 +113,14 @@ pub struct ModelFile {
     pub contact_damping: Option<f64>,
     /// Ω.
     pub omega: Option<f64>,
+    /// linear | hertz | dmt | impact.
+    pub contact_law: Option<LawKind>,
+    /// Impact law: r.
+    pub restitution: Option<f64>,
+    /// DMT: H̃.
+    pub hamaker: Option<f64>,
+    /// DMT: ã0.
+    pub intermolecular_distance: Option<f64>,
 }
 
 /// Read and parse a TOML config file.
@@ -116,7 +141,40 @@ impl ModelArgs {
             None => ModelFile::default(),
         };
         let pick = |flag: Option<f64>, file: Option<f64>, def: f64| flag.or(file).unwrap_or(def);
+        let kind = self.contact_law.or(file.contact_law);
+        let restitution = self.restitution.or(file.restitution);
+        let hamaker = self.hamaker.or(file.hamaker);
+        let a0 = self
+            .intermolecular_distance
+            .or(file.intermolecular_distance);
+        let contact_law = match kind {
+            Some(k) => {
+                for (given, name, law) in [
+                    (restitution.is_some(), "restitution", LawKind::Impact),
+                    (hamaker.is_some(), "hamaker", LawKind::Dmt),
+                    (a0.is_some(), "intermolecular_distance", LawKind::Dmt),
+                ] {
+                    if given && k != law {
+                        return Err(CliError::Input(format!(
+                            "{name} is a group of the {law:?} law, not of contact_law = {k:?} \
+                             (set --contact-law {})",
+                            format!("{law:?}").to_lowercase()
+                        )));
+                    }
+                }
+                k.with_groups(hamaker, a0, restitution)
+            }
+            None if restitution.is_some() || hamaker.is_some() || a0.is_some() => {
+                return Err(CliError::Input(
+                    "restitution / hamaker / intermolecular_distance need --contact-law \
+                     impact or dmt"
+                        .into(),
+                ))
+            }
+            None => defaults.contact_law,
+        };
         let p = Params {
+            contact_law,
             modes: self.modes.or(file.modes).unwrap_or(defaults.modes),
             alpha1: pick(self.alpha1, file.tip_mass_ratio, defaults.alpha1),
             alpha2: pick(self.alpha2, file.drive_amplitude, defaults.alpha2),
@@ -134,9 +192,10 @@ impl ModelArgs {
 /// Integrator flags.
 #[derive(Debug, Clone, Args)]
 pub struct IntegratorArgs {
-    /// Time integrator: exact (piecewise-exact, default), rk4 (located switchings),
-    /// rk4-naive (region per stage, as in the paper) or adaptive (DOP853 oracle)
-    #[arg(long, default_value = "exact", value_parser = parse_integrator)]
+    /// Time integrator: auto (exact for the linear law, adaptive otherwise; default), exact
+    /// (piecewise-exact), rk4 (located switchings), rk4-naive (region per stage, as in the
+    /// paper) or adaptive (DOP853 with events and variational equations)
+    #[arg(long, default_value = "auto", value_parser = parse_integrator)]
     pub integrator: IntegratorKind,
     /// Fixed steps per drive period of rk4 / rk4-naive (default 2000)
     #[arg(long, value_name = "M")]
@@ -155,7 +214,7 @@ impl IntegratorArgs {
     /// land on grid points; `--steps-per-period` is the fixed step count of rk4 (default 2000).
     pub fn options(&self, samples_per_period: usize) -> IntegratorOptions {
         let steps = match self.integrator {
-            IntegratorKind::Exact => samples_per_period.max(1),
+            IntegratorKind::Auto | IntegratorKind::Exact => samples_per_period.max(1),
             IntegratorKind::Rk4 | IntegratorKind::Rk4Naive => self.steps_per_period.unwrap_or(2000),
             IntegratorKind::Adaptive => 1,
         };

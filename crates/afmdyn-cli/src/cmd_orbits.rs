@@ -404,6 +404,7 @@ pub fn lyapunov(a: &LyapunovArgs) -> Result<(), CliError> {
             transient_periods: a.transient,
             periods: a.periods,
             blocks: a.blocks,
+            ..Default::default()
         },
     )?;
     if a.json {

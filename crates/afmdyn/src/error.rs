@@ -22,6 +22,16 @@ pub enum ParamError {
     /// The drive frequency Ω is not finite or not positive.
     #[error("omega (drive frequency Ω) = {0}: must be finite and > 0")]
     Omega(f64),
+    /// A group of the tip–sample law (see [`crate::contact::ContactLaw`]) is out of range.
+    #[error("{name} = {value}: must satisfy {range}")]
+    Law {
+        /// The group's name with its symbol.
+        name: &'static str,
+        /// The rejected value.
+        value: f64,
+        /// The allowed range.
+        range: &'static str,
+    },
 }
 
 /// A physical-unit input outside its allowed range (see [`crate::units`]).
@@ -136,6 +146,16 @@ pub enum SimError {
         iterations: usize,
         /// Final residual.
         residual: f64,
+    },
+    /// The chosen integrator cannot integrate the chosen contact law.
+    #[error("integrator '{integrator}' cannot integrate the '{law}' contact law: {hint}")]
+    Unsupported {
+        /// The integrator's name.
+        integrator: &'static str,
+        /// The law's name.
+        law: &'static str,
+        /// What to use instead.
+        hint: &'static str,
     },
     /// The adaptive oracle integrator reported a failure.
     #[error("adaptive integrator failed at tau = {tau}: {message}")]

@@ -8,7 +8,8 @@
 //!
 //! The tree follows the paper:
 //! [`beam`] (mode shapes) → [`galerkin`] (eqs. 10–18) → [`eigen`] (eqs. 19–23) and [`units`]
-//! (eqs. 5, 7) → [`model`] (the switched system) → [`integrate`] (exact propagation, RK4, an
+//! (eqs. 5, 7) → [`contact`] (tip–sample laws) → [`system`] (the hybrid-system interface,
+//! saltation) → [`model`] (the cantilever–sample system) → [`integrate`] (exact propagation, RK4, an
 //! adaptive oracle) → [`trajectory`] (observables, stroboscopic Poincaré section) →
 //! [`analysis`] (steady states, periods, bifurcation sweeps, attractors, mode convergence).
 //!
@@ -33,17 +34,22 @@
 
 pub mod analysis;
 pub mod beam;
+pub mod contact;
 pub mod eigen;
 pub mod error;
 pub mod galerkin;
 pub mod integrate;
 pub mod model;
 pub mod params;
+pub mod roots;
+pub mod system;
 pub mod trajectory;
 pub mod units;
 
+pub use contact::{ContactLaw, LawKind};
 pub use error::{ParamError, SimError, UnitsError};
 pub use galerkin::Region;
 pub use integrate::{Integrator, IntegratorKind, IntegratorOptions};
 pub use model::CantileverModel;
 pub use params::{Params, SweepParam};
+pub use system::{EventKind, HybridSystem};

@@ -1,13 +1,35 @@
-//! The switched model (paper eqs. 8 and 10) in first-order form, with its observables.
+//! The cantilever–sample model (paper eqs. 8–18) in first-order form, for any tip–sample law.
 //!
-//! State `z: [f64; 2N]` = (a, ȧ): modal coordinates a_j and their τ-derivatives. In region s,
-//! ż = A_s z + b_s(τ) with A_s = [[0, I], [−M⁻¹K_s, −M⁻¹C_s]] and
-//! b_s(τ) = (0, M⁻¹F_s(τ)), F_s = constant + sin·sin Ωτ + cos·cos Ωτ.
+//! State `z: [f64; 2N]` = (a, ȧ): modal coordinates a_j and their τ-derivatives. In both regions
+//!
+//! M ä + C ȧ + K a = F^I(τ) + φ(1) F_c(δ, δ̇),  δ = −V_T (eq. 8),
+//!
+//! with M, C, K, F^I of eqs. 11–14 and the law F_c of [`crate::contact`] (repulsive positive).
+//! Region I (free) has F_c = 0 except for the DMT van der Waals attraction; region II is contact
+//! (V_T ≤ 0). For the linear law, region s is ż = A_s z + b_s(τ) with
+//! A_s = [[0, I], [−M⁻¹K_s, −M⁻¹C_s]] and b_s(τ) = (0, M⁻¹F_s(τ)) (eqs. 15–18): the affine form
+//! the exact propagator uses ([`CantileverModel::dynamics`]).
+//!
+//! **Impact law.** Region I is free flight; an impact at V_T = 0 applies Newton's law
+//! dV_T/dτ⁺ = −r dV_T/dτ⁻ through the tip: ȧ⁺ = ȧ⁻ − (1 + r) V̇_T⁻ M⁻¹φ / (φᵀM⁻¹φ), the impulse
+//! P φ at the tip that meets the law (Brogliato, *Nonsmooth Mechanics*, 3rd ed., Springer 2016,
+//! §4.2; m_eff = 1/(φᵀM⁻¹φ) is the modal mass at the tip). Region II is **sticking**: the tip
+//! moves with the sample (V_T ≡ 0) under the constraint force λ = −m_eff V̈_T^free, the force that
+//! cancels the free tip acceleration relative to the sample; the tip leaves when λ falls to 0.
+//! A chattering sequence (impact velocities decaying as rᵏ) ends in sticking once
+//! |V̇_T⁻| ≤ [`STICK_VELOCITY`] and λ > 0.
 
+use crate::contact::{ContactLaw, TipSample, TipSampleLaw};
 use crate::error::{ParamError, SimError};
 use crate::galerkin::{Galerkin, Region};
 use crate::params::Params;
+use crate::system::{EventKind, Guard, HybridSystem, Jump};
 use nalgebra::{DMatrix, DVector};
+
+/// Impact velocity below which a chattering sequence ends in sticking (units of g₀ per unit τ;
+/// the paper's drive velocity α2 Ω is ≈ 0.26). With r < 1 the impact velocities decay as rᵏ, so
+/// at most ln(1e-10/|V̇_T⁻(0)|)/ln r impacts precede the sticking.
+pub const STICK_VELOCITY: f64 = 1e-10;
 
 /// First-order dynamics of one region: ż = A z + b_const + b_sin sin Ωτ + b_cos cos Ωτ.
 #[derive(Debug, Clone, PartialEq)]
@@ -22,24 +44,35 @@ pub struct RegionDynamics {
     pub b_cos: DVector<f64>,
 }
 
-/// Rates of the energy balance dE/dτ = P_base − D_beam − D_contact (see [`CantileverModel::energy`]).
+/// Rates of the energy balance dE/dτ = P_base − D_beam − D_contact (see [`CantileverModel::power`]).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct PowerTerms {
-    /// Power of the base motion: ẊᵀF^I(τ) (inertial drive in the clamped frame, eq. 14) plus,
-    /// in contact, α2 Ω cos Ωτ · F_c (the sample moves with the base in these coordinates).
+    /// Power of the base motion: ȦᵀF^I(τ) (inertial drive in the clamped frame, eq. 14) minus
+    /// α2 Ω cos Ωτ · F_c (the sample is fixed while the clamped frame moves).
     pub base: f64,
-    /// Beam damping dissipation α3 ẊᵀẊ (eq. 12).
+    /// Beam damping dissipation α3 ȦᵀȦ (eq. 12).
     pub beam_dissipation: f64,
-    /// Contact damper dissipation α6 V̇_T² (in contact only).
+    /// Sample dissipation F_d δ̇ (α6 V̇_T² for the linear law in contact).
     pub contact_dissipation: f64,
 }
 
-/// The paper's cantilever–sample model for one parameter set.
+/// The cantilever–sample model for one parameter set and tip–sample law.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CantileverModel {
     params: Params,
     galerkin: Galerkin,
+    /// eq. 10 with the linear law (regions I and II); region I is also the free flight of
+    /// every law apart from its tip force.
     regions: [RegionDynamics; 2],
+    law: TipSample,
+    /// M⁻¹φ(1), shape `[N]`.
+    mphi: DVector<f64>,
+    /// m_eff = 1/(φᵀM⁻¹φ).
+    m_eff: f64,
+    /// φᵀ[−M⁻¹K, −M⁻¹C], shape `[2N]`: the free tip acceleration per unit z.
+    tip_acc: DVector<f64>,
+    /// φᵀM⁻¹F^I: constant, sin and cos coefficients of the free tip acceleration.
+    tip_acc_forcing: [f64; 3],
 }
 
 impl CantileverModel {
@@ -49,10 +82,19 @@ impl CantileverModel {
     /// [`ParamError`] if `params` is invalid.
     pub fn new(params: &Params) -> Result<Self, ParamError> {
         let galerkin = Galerkin::new(params)?;
+        let n = params.modes;
+        let minv = galerkin
+            .region(Region::Free)
+            .mass
+            .clone()
+            .cholesky()
+            .ok_or(ParamError::NonNegative {
+                name: "alpha1 (tip-mass ratio α1; mass matrix not positive definite)",
+                value: params.alpha1,
+            })?
+            .inverse();
         let build = |r: Region| {
             let m = galerkin.region(r);
-            let n = params.modes;
-            let minv = m.mass.clone().cholesky().expect("M is SPD").inverse();
             let mut a = DMatrix::zeros(2 * n, 2 * n);
             a.view_mut((0, n), (n, n)).fill_with_identity();
             a.view_mut((n, 0), (n, n))
@@ -71,16 +113,39 @@ impl CantileverModel {
             }
         };
         let regions = [build(Region::Free), build(Region::Contact)];
+        let tip = galerkin.tip().clone();
+        let mphi = &minv * &tip;
+        let m_eff = 1.0 / tip.dot(&mphi);
+        let free = &regions[0];
+        let tip_acc = free.a.rows(n, n).transpose() * &tip;
+        let tip_acc_forcing = [
+            tip.dot(&free.b_const.rows(n, n)),
+            tip.dot(&free.b_sin.rows(n, n)),
+            tip.dot(&free.b_cos.rows(n, n)),
+        ];
         Ok(CantileverModel {
             params: *params,
+            law: TipSample {
+                law: params.contact_law,
+                stiffness: params.alpha4,
+                damping: params.alpha6,
+            },
             galerkin,
             regions,
+            mphi,
+            m_eff,
+            tip_acc,
+            tip_acc_forcing,
         })
     }
 
     /// Parameters.
     pub fn params(&self) -> &Params {
         &self.params
+    }
+    /// The tip–sample law.
+    pub fn law(&self) -> &ContactLaw {
+        &self.params.contact_law
     }
     /// Number of modes N.
     pub fn modes(&self) -> usize {
@@ -106,30 +171,133 @@ impl CantileverModel {
     pub fn tip(&self) -> &DVector<f64> {
         self.galerkin.tip()
     }
-    /// First-order dynamics of a region.
+    /// M⁻¹φ(1), shape `[N]`: the modal acceleration per unit tip force.
+    pub fn tip_mobility(&self) -> &DVector<f64> {
+        &self.mphi
+    }
+    /// Modal mass at the tip m_eff = 1/(φᵀM⁻¹φ).
+    pub fn effective_mass(&self) -> f64 {
+        self.m_eff
+    }
+    /// First-order dynamics of a region for the **linear law** (eqs. 10, 15–18): the affine
+    /// form used by the exact propagator. Region I is also the free flight of the Hertz and
+    /// impact laws.
     pub fn dynamics(&self, r: Region) -> &RegionDynamics {
         &self.regions[r.index()]
     }
 
-    /// ż = A_s z + b_s(τ) written into `dz` (eq. 10 in first-order form). No allocation.
+    /// ż written into `dz` (eq. 10 in first-order form with the law's tip force). No allocation.
     pub fn rhs(&self, r: Region, tau: f64, z: &DVector<f64>, dz: &mut DVector<f64>) {
-        let d = &self.regions[r.index()];
-        let (s, c) = (self.params.omega * tau).sin_cos();
-        dz.copy_from(&d.b_const);
-        dz.axpy(s, &d.b_sin, 1.0);
-        dz.axpy(c, &d.b_cos, 1.0);
-        dz.gemv(1.0, &d.a, z, 1.0);
+        self.rhs_slice(r, tau, z.as_slice(), dz.as_mut_slice());
     }
 
+    /// As [`CantileverModel::rhs`] on slices of length 2N.
+    pub fn rhs_slice(&self, r: Region, tau: f64, z: &[f64], dz: &mut [f64]) {
+        let n = self.modes();
+        let (s, c) = (self.params.omega * tau).sin_cos();
+        let linear = self.law.law.is_affine();
+        let d = &self.regions[if linear { r.index() } else { 0 }];
+        for (i, o) in dz.iter_mut().enumerate() {
+            *o = d.b_const[i] + s * d.b_sin[i] + c * d.b_cos[i];
+        }
+        crate::integrate::matvec(&d.a, z, dz, 1.0, true);
+        if linear {
+            return;
+        }
+        let (head, acc) = dz.split_at_mut(n);
+        let _ = head;
+        let f = self.tip_force_with(r, (s, c), z, acc);
+        if f != 0.0 {
+            for (o, m) in acc.iter_mut().zip(self.mphi.iter()) {
+                *o += f * m;
+            }
+        }
+    }
+
+    /// Tip force F_c (repulsive positive) in region r at (τ, z): the law's force, or in the
+    /// sticking region of the impact law the constraint force λ.
+    pub fn contact_force(&self, r: Region, tau: f64, z: &DVector<f64>) -> f64 {
+        let n = self.modes();
+        let sc = (self.params.omega * tau).sin_cos();
+        let mut dz = vec![0.0; 2 * n];
+        if matches!(self.law.law, ContactLaw::Impact { .. }) && r == Region::Contact {
+            self.rhs_slice(Region::Free, tau, z.as_slice(), &mut dz);
+        }
+        self.tip_force_with(r, sc, z.as_slice(), &dz[n..])
+    }
+
+    /// F_c given sin/cos of Ωτ and, for sticking, the free modal acceleration `acc_free`.
+    fn tip_force_with(&self, r: Region, (s, c): (f64, f64), z: &[f64], acc_free: &[f64]) -> f64 {
+        let p = &self.params;
+        let n = p.modes;
+        let contact = r == Region::Contact;
+        match self.law.law {
+            ContactLaw::Impact { .. } => {
+                if contact {
+                    let tip_acc: f64 = self.tip().iter().zip(acc_free).map(|(a, b)| a * b).sum();
+                    self.m_eff * (p.alpha2 * p.omega * p.omega * s - tip_acc)
+                } else {
+                    0.0
+                }
+            }
+            _ if !contact && !self.law.acts_outside() => 0.0,
+            _ => {
+                let tip = self.tip().as_slice();
+                let w: f64 = tip.iter().zip(&z[..n]).map(|(a, b)| a * b).sum();
+                let wd: f64 = tip.iter().zip(&z[n..]).map(|(a, b)| a * b).sum();
+                let v = w + p.alpha2 * s + p.alpha5;
+                let vd = wd + p.alpha2 * p.omega * c;
+                self.law.force(contact, -v, -vd).force
+            }
+        }
+    }
+
+    /// ∂ż/∂z at (τ, z) in region r into `jac` (2N×2N): A_I plus the rank-one tip-force term
+    /// M⁻¹φ (∂F_c/∂z)ᵀ with ∂F_c/∂a = −(∂F_c/∂δ) φ, ∂F_c/∂ȧ = −(∂F_c/∂δ̇) φ; for sticking
+    /// ∂λ/∂z = −m_eff φᵀ[−M⁻¹K, −M⁻¹C]. The linear law gives A_s of eqs. 15–18.
+    pub fn jacobian_into(&self, r: Region, tau: f64, z: &[f64], jac: &mut DMatrix<f64>) {
+        let n = self.modes();
+        let linear = self.law.law.is_affine();
+        jac.copy_from(&self.regions[if linear { r.index() } else { 0 }].a);
+        if linear {
+            return;
+        }
+        let mut row = DVector::zeros(2 * n);
+        match self.law.law {
+            ContactLaw::Impact { .. } => {
+                if r == Region::Contact {
+                    row.copy_from(&(-self.m_eff * &self.tip_acc));
+                }
+            }
+            _ => {
+                if r == Region::Contact || self.law.acts_outside() {
+                    let [v, vd, _] = self
+                        .v_t_from_tip(tau, [self.w_tip_slice(z, 0), self.w_tip_slice(z, n), 0.0]);
+                    let f = self.law.force(r == Region::Contact, -v, -vd);
+                    row.rows_mut(0, n).copy_from(&(-f.d_delta * self.tip()));
+                    row.rows_mut(n, n).copy_from(&(-f.d_rate * self.tip()));
+                }
+            }
+        }
+        let mut lower = jac.rows_mut(n, n);
+        lower.ger(1.0, &self.mphi, &row, 1.0);
+    }
+
+    fn w_tip_slice(&self, z: &[f64], offset: usize) -> f64 {
+        let n = self.modes();
+        self.tip()
+            .iter()
+            .zip(&z[offset..offset + n])
+            .map(|(a, b)| a * b)
+            .sum()
+    }
     /// Tip deflection W(1,τ) = Σ a_j φ_j(1) (eq. 9 at ξ = 1).
     pub fn w_tip(&self, z: &DVector<f64>) -> f64 {
-        let n = self.modes();
-        self.tip().dot(&z.rows(0, n))
+        self.w_tip_slice(z.as_slice(), 0)
     }
     /// Tip velocity ∂W(1,τ)/∂τ.
     pub fn w_tip_dot(&self, z: &DVector<f64>) -> f64 {
-        let n = self.modes();
-        self.tip().dot(&z.rows(n, n))
+        self.w_tip_slice(z.as_slice(), self.modes())
     }
     /// Switching function V_T = W(1,τ) + α2 sin Ωτ + α5 (eq. 8).
     pub fn v_t(&self, tau: f64, z: &DVector<f64>) -> f64 {
@@ -150,19 +318,10 @@ impl CantileverModel {
     pub fn v_t_dot(&self, tau: f64, z: &DVector<f64>) -> f64 {
         self.v_t_from_tip(tau, [0.0, self.w_tip_dot(z), 0.0])[1]
     }
-    /// Region of a state: contact when V_T ≤ 0 (eq. 10).
+    /// Region by the sign of V_T: contact when V_T ≤ 0 (eq. 10). (For the impact law, sticking
+    /// is tracked by the integrators; see [`HybridSystem::mode_at`].)
     pub fn region_at(&self, tau: f64, z: &DVector<f64>) -> Region {
         Region::of_v_t(self.v_t(tau, z))
-    }
-    /// Contact force F_c = α4 V_T + α6 V̇_T in region II, 0 in region I. The beam feels
-    /// −F_c δ(ξ−1) (eq. 6), so F_c < 0 (tip pressed into the sample) pushes the tip away.
-    pub fn contact_force(&self, r: Region, tau: f64, z: &DVector<f64>) -> f64 {
-        match r {
-            Region::Free => 0.0,
-            Region::Contact => {
-                self.params.alpha4 * self.v_t(tau, z) + self.params.alpha6 * self.v_t_dot(tau, z)
-            }
-        }
     }
     /// Beam deflection W(ξ,τ) = Σ a_j φ_j(ξ) (eq. 9).
     pub fn deflection(&self, xi: f64, z: &DVector<f64>) -> f64 {
@@ -170,24 +329,22 @@ impl CantileverModel {
         phi.iter().zip(z.iter()).map(|(p, a)| p * a).sum()
     }
 
-    /// Stored energy E = ½ȦᵀMȦ + ½XᵀK^I X, plus ½α4 V_T² in contact (continuous across a
-    /// switching because V_T = 0 there).
+    /// Stored energy E = ½ȦᵀMȦ + ½XᵀK^I X + U(δ), U the potential of the law's conservative
+    /// part (½α4 V_T² for the linear law in contact; continuous across a switching).
     pub fn energy(&self, r: Region, tau: f64, z: &DVector<f64>) -> f64 {
         let n = self.modes();
         let g = self.galerkin.region(Region::Free);
         let x = z.rows(0, n);
         let v = z.rows(n, n);
-        let kinetic = 0.5 * (g.mass.clone() * v).dot(&v);
-        let bending = 0.5 * (g.stiffness.clone() * x).dot(&x);
-        let spring = match r {
-            Region::Free => 0.0,
-            Region::Contact => 0.5 * self.params.alpha4 * self.v_t(tau, z).powi(2),
-        };
-        kinetic + bending + spring
+        let kinetic = 0.5 * (&g.mass * v).dot(&v);
+        let bending = 0.5 * (&g.stiffness * x).dot(&x);
+        kinetic + bending + self.law.potential(r == Region::Contact, -self.v_t(tau, z))
     }
 
-    /// The rates of the energy balance at (τ, z) in region r. Multiplying eq. 10 by Ẋᵀ gives
-    /// dE/dτ = P_base − D_beam − D_contact exactly.
+    /// The rates of the energy balance at (τ, z) in region r. Multiplying the equation of
+    /// motion by Ȧᵀ gives dE/dτ = P_base − D_beam − D_contact exactly, with
+    /// P_base = ȦᵀF^I(τ) − α2 Ω cos Ωτ · F_c and D_contact = F_d δ̇ (F_d the dissipative part
+    /// of the law).
     pub fn power(&self, r: Region, tau: f64, z: &DVector<f64>) -> PowerTerms {
         let n = self.modes();
         let p = &self.params;
@@ -196,52 +353,50 @@ impl CantileverModel {
         let (s, c) = (p.omega * tau).sin_cos();
         let drive = g.forcing.sin.dot(&v) * s + g.forcing.cos.dot(&v) * c;
         let beam = p.alpha3 * v.dot(&v);
-        match r {
-            Region::Free => PowerTerms {
-                base: drive,
-                beam_dissipation: beam,
-                contact_dissipation: 0.0,
-            },
-            Region::Contact => {
-                let vd = self.v_t_dot(tau, z);
-                let fc = self.contact_force(r, tau, z);
-                PowerTerms {
-                    base: drive + p.alpha2 * p.omega * c * fc,
-                    beam_dissipation: beam,
-                    contact_dissipation: p.alpha6 * vd * vd,
-                }
-            }
+        let fc = self.contact_force(r, tau, z);
+        let rate = -self.v_t_dot(tau, z);
+        let delta = -self.v_t(tau, z);
+        PowerTerms {
+            base: drive - p.alpha2 * p.omega * c * fc,
+            beam_dissipation: beam,
+            contact_dissipation: self.law.dissipative(r == Region::Contact, delta, rate) * rate,
         }
     }
 
-    /// Saltation (jump) matrix of the flow's Jacobian at a switching from region `from` to `to`
-    /// at (τ, z) on V_T = 0 (eq. 8):
-    ///
-    /// S = I + (f⁺ − f⁻) ∇_zV_Tᵀ / (dV_T/dτ)⁻,  (dV_T/dτ)⁻ = ∇_zV_T · f⁻ + ∂V_T/∂τ,
-    ///
-    /// with ∇_zV_T = (φ(1), 0) and ∂V_T/∂τ = α2 Ω cos Ωτ (the sample moves with the base in these
-    /// coordinates). f⁺ − f⁻ = ∓(0, M⁻¹φ(1)(α4 V_T + α6 V̇_T)) is the contact force switched on or
-    /// off; on V_T = 0 only the damper term α6 V̇_T remains, so S ≠ I whenever α6 > 0.
-    /// Source: Leine & Nijmeijer, *Dynamics and Bifurcations of Non-Smooth Mechanical Systems*
-    /// (Springer 2004), ch. 7; Müller, *Lyapunov exponents of dynamical systems with jumps* (1995).
-    ///
-    /// Returns the 2N×2N identity when dV_T/dτ = 0 (grazing: the saltation is unbounded there).
-    pub fn saltation(&self, from: Region, to: Region, tau: f64, z: &DVector<f64>) -> DMatrix<f64> {
-        let dim = self.dim();
-        let n = self.modes();
-        let mut f_minus = DVector::zeros(dim);
-        let mut f_plus = DVector::zeros(dim);
-        self.rhs(from, tau, z, &mut f_minus);
-        self.rhs(to, tau, z, &mut f_plus);
-        let mut grad = DVector::zeros(dim);
-        grad.rows_mut(0, n).copy_from(self.tip());
+    /// Energy bookkeeping of an impact at τ with pre-impact rate V̇_T⁻ = `v_minus` and
+    /// restitution r: (loss in the sample, work of the impulse on the clamped frame). The
+    /// kinetic energy of the motion relative to the sample changes by −(1 − r²) ½ m_eff (V̇_T⁻)²;
+    /// the impulse P = −(1 + r) m_eff V̇_T⁻ at the tip also does the work −P α2 Ω cos Ωτ, so
+    /// ΔE = −loss + base (derivation in `docs/contact-laws.md`).
+    pub fn impact_energy(&self, tau: f64, v_minus: f64, restitution: f64) -> (f64, f64) {
         let p = &self.params;
-        let rate = grad.dot(&f_minus) + p.alpha2 * p.omega * (p.omega * tau).cos();
-        let mut s = DMatrix::identity(dim, dim);
-        if rate != 0.0 {
-            s += (f_plus - f_minus) * grad.transpose() / rate;
+        let base_velocity = p.alpha2 * p.omega * (p.omega * tau).cos();
+        let loss = 0.5 * (1.0 - restitution * restitution) * self.m_eff * v_minus * v_minus;
+        let base = (1.0 + restitution) * self.m_eff * v_minus * base_velocity;
+        (loss, base)
+    }
+
+    /// Saltation matrix (2N×2N) at an event of region `from` at (τ, z⁻): the generic
+    /// [`crate::system::saltation`] of this system. For the linear law on V_T = 0 only the
+    /// damper term α6 V̇_T jumps, so S ≠ I whenever α6 > 0.
+    pub fn saltation(&self, from: Region, tau: f64, z: &DVector<f64>) -> DMatrix<f64> {
+        crate::system::saltation(self, from, tau, z.as_slice()).0
+    }
+
+    /// Constraint force λ of sticking (impact law) at (τ, z), with its gradient and τ-rate:
+    /// λ = m_eff (α2 Ω² sin Ωτ − φᵀä_free).
+    fn sticking_force(&self, tau: f64, z: &[f64]) -> Guard {
+        let p = &self.params;
+        let om = p.omega;
+        let (s, c) = (om * tau).sin_cos();
+        let [f0, fs, fc] = self.tip_acc_forcing;
+        let acc =
+            self.tip_acc.iter().zip(z).map(|(a, b)| a * b).sum::<f64>() + f0 + fs * s + fc * c;
+        Guard {
+            value: self.m_eff * (p.alpha2 * om * om * s - acc),
+            grad: -self.m_eff * &self.tip_acc,
+            d_tau: self.m_eff * (p.alpha2 * om * om * om * c - om * (fs * c - fc * s)),
         }
-        s
     }
 
     /// Check a state: length 2N and finite components.
@@ -260,6 +415,28 @@ impl CantileverModel {
             return Err(SimError::NotFinite { name, value: *v });
         }
         Ok(())
+    }
+
+    /// Check a start (τ, z) and return its region: [`CantileverModel::check_state`], a finite
+    /// τ, and for the impact law no penetration of the rigid sample (V_T ≥ 0).
+    ///
+    /// # Errors
+    /// [`SimError::NotFinite`], [`SimError::StateLength`], or [`SimError::OutOfRange`] for a
+    /// start inside the rigid sample.
+    pub fn checked_start(&self, tau: f64, z: &DVector<f64>) -> Result<Region, SimError> {
+        crate::error::finite("initial time", tau)?;
+        self.check_state("initial state", z)?;
+        if matches!(self.law.law, ContactLaw::Impact { .. }) {
+            let v = self.v_t(tau, z);
+            if v < 0.0 {
+                return Err(SimError::out_of_range(
+                    "initial V_T",
+                    v,
+                    "must be >= 0 for the impact law (the sample is rigid)",
+                ));
+            }
+        }
+        Ok(self.mode_at(tau, z.as_slice()))
     }
 
     /// The state at rest (a = ȧ = 0).
@@ -288,6 +465,135 @@ impl CantileverModel {
         let z = DVector::from_iterator(2 * n, a.iter().chain(a_dot).copied());
         self.check_state("initial state", &z)?;
         Ok(z)
+    }
+
+    fn v_t_pair(&self, tau: f64, z: &[f64]) -> (f64, f64) {
+        let n = self.modes();
+        let [v, vd, _] =
+            self.v_t_from_tip(tau, [self.w_tip_slice(z, 0), self.w_tip_slice(z, n), 0.0]);
+        (v, vd)
+    }
+}
+
+impl HybridSystem for CantileverModel {
+    fn dim(&self) -> usize {
+        2 * self.params.modes
+    }
+    fn period(&self) -> f64 {
+        self.params.period()
+    }
+
+    /// Contact when V_T < 0, or V_T = 0 moving inwards (dV_T/dτ ≤ 0); free otherwise. For the
+    /// impact law: sticking when V_T = 0, dV_T/dτ = 0 and the constraint force λ > 0.
+    fn mode_at(&self, tau: f64, z: &[f64]) -> Region {
+        let (v, vd) = self.v_t_pair(tau, z);
+        if self.law.law.restitution().is_some() {
+            if v <= 0.0 && vd == 0.0 && self.sticking_force(tau, z).value > 0.0 {
+                Region::Contact
+            } else {
+                Region::Free
+            }
+        } else if v < 0.0 || (v == 0.0 && vd <= 0.0) {
+            Region::Contact
+        } else {
+            Region::Free
+        }
+    }
+
+    fn rhs(&self, mode: Region, tau: f64, z: &[f64], dz: &mut [f64]) {
+        self.rhs_slice(mode, tau, z, dz);
+    }
+
+    fn jacobian(&self, mode: Region, tau: f64, z: &[f64], jac: &mut DMatrix<f64>) {
+        self.jacobian_into(mode, tau, z, jac);
+    }
+
+    /// Free flight: g = V_T; contact: g = −V_T; sticking (impact law): g = λ.
+    fn guard(&self, mode: Region, tau: f64, z: &[f64]) -> Guard {
+        if mode == Region::Contact && self.law.law.restitution().is_some() {
+            return self.sticking_force(tau, z);
+        }
+        let n = self.modes();
+        let p = &self.params;
+        let sigma = if mode == Region::Free { 1.0 } else { -1.0 };
+        let mut grad = DVector::zeros(2 * n);
+        grad.rows_mut(0, n).copy_from(&(sigma * self.tip()));
+        Guard {
+            value: sigma * self.v_t_pair(tau, z).0,
+            grad,
+            d_tau: sigma * p.alpha2 * p.omega * (p.omega * tau).cos(),
+        }
+    }
+
+    fn guard_value(&self, mode: Region, tau: f64, z: &[f64]) -> f64 {
+        if mode == Region::Contact && self.law.law.restitution().is_some() {
+            return self.sticking_force(tau, z).value;
+        }
+        let v = self.v_t_pair(tau, z).0;
+        if mode == Region::Free {
+            v
+        } else {
+            -v
+        }
+    }
+
+    /// Switchings are the identity; the impact law's free-flight guard is an impact (module
+    /// docs), ending in sticking when |V̇_T⁻| ≤ [`STICK_VELOCITY`] and λ > 0 after a plastic
+    /// impact; sticking ends in a release (identity).
+    fn jump(&self, from: Region, tau: f64, z: &[f64]) -> Jump {
+        let Some(r) = self.law.law.restitution() else {
+            return Jump::switching(from.other(), z);
+        };
+        if from == Region::Contact {
+            let mut j = Jump::switching(Region::Free, z);
+            j.kind = EventKind::Release;
+            return j;
+        }
+        let n = self.modes();
+        let p = &self.params;
+        let (_, v_minus) = self.v_t_pair(tau, z);
+        // ȧ⁺ = ȧ⁻ − (1 + r) m_eff V̇_T⁻ M⁻¹φ; the plastic impact (r = 0) first when sticking
+        let apply = |r: f64| {
+            let mut state = DVector::from_column_slice(z);
+            let k = (1.0 + r) * self.m_eff * v_minus;
+            for (o, m) in state.rows_mut(n, n).iter_mut().zip(self.mphi.iter()) {
+                *o -= k * m;
+            }
+            state
+        };
+        let plastic = apply(0.0);
+        let sticks = v_minus.abs() <= STICK_VELOCITY
+            && self.sticking_force(tau, plastic.as_slice()).value > 0.0;
+        let r_eff = if sticks { 0.0 } else { r };
+        let state = if sticks { plastic } else { apply(r) };
+        // R = I − (1 + r) m_eff [0 0; M⁻¹φ φᵀ 0] on the velocity block (V̇_T⁻ = φᵀȧ + α2Ω cos Ωτ)
+        let mut jacobian = DMatrix::identity(2 * n, 2 * n);
+        let k = (1.0 + r_eff) * self.m_eff;
+        let mut block = jacobian.view_mut((n, n), (n, n));
+        block.ger(-k, &self.mphi, self.tip(), 1.0);
+        // ∂ȧ⁺/∂τ = −(1 + r) m_eff M⁻¹φ ∂V̇_T⁻/∂τ, ∂V̇_T⁻/∂τ = −α2 Ω² sin Ωτ
+        let mut d_tau = DVector::zeros(2 * n);
+        let dv = -p.alpha2 * p.omega * p.omega * (p.omega * tau).sin();
+        d_tau.rows_mut(n, n).copy_from(&(-k * dv * &self.mphi));
+        Jump {
+            to: if sticks {
+                Region::Contact
+            } else {
+                Region::Free
+            },
+            kind: if sticks {
+                EventKind::Stick
+            } else {
+                EventKind::Impact
+            },
+            state,
+            jacobian,
+            d_tau,
+        }
+    }
+
+    fn is_affine(&self) -> bool {
+        self.law.law.is_affine()
     }
 }
 

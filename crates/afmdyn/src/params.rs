@@ -1,5 +1,6 @@
 //! The dimensionless parameter set of the paper (eq. 7) with validation.
 
+use crate::contact::ContactLaw;
 use crate::error::ParamError;
 use serde::{Deserialize, Serialize};
 use std::fmt;
@@ -20,7 +21,10 @@ pub const MAX_MODES: usize = 20;
 /// | `alpha5` | α5 = g1/g0 | tip–sample gap | finite |
 /// | `alpha6` | α6 | contact damping | finite, ≥ 0 |
 /// | `omega` | Ω | drive frequency (dimensionless) | finite, > 0 |
+/// | `contact_law` | F_c(δ, δ̇) | tip–sample law and its groups ([`ContactLaw`]) | see the law |
 ///
+/// α4 and α6 are the stiffness and damping groups of whichever law is chosen (the Hertz group
+/// and the Kelvin–Voigt group for `hertz`/`dmt`, see [`crate::contact`]).
 /// The fields are public for convenience; every constructor of a model calls [`Params::validate`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Params {
@@ -40,6 +44,9 @@ pub struct Params {
     pub alpha6: f64,
     /// Ω, dimensionless drive frequency.
     pub omega: f64,
+    /// The tip–sample force law (default: the paper's linear spring–damper).
+    #[serde(default)]
+    pub contact_law: ContactLaw,
 }
 
 impl Default for Params {
@@ -54,6 +61,7 @@ impl Default for Params {
             alpha5: 0.0,
             alpha6: 0.2,
             omega: 2.6,
+            contact_law: ContactLaw::Linear,
         }
     }
 }
@@ -83,6 +91,7 @@ impl Params {
             alpha5,
             alpha6,
             omega,
+            contact_law: ContactLaw::Linear,
         };
         p.validate()?;
         Ok(p)
@@ -123,7 +132,7 @@ impl Params {
         if !(self.omega.is_finite() && self.omega > 0.0) {
             return Err(ParamError::Omega(self.omega));
         }
-        Ok(())
+        self.contact_law.validate()
     }
 
     /// The drive period T = 2π/Ω.

@@ -5,6 +5,7 @@ use crate::error::{finite, SimError};
 use crate::galerkin::Region;
 use crate::integrate::{advance_dyn, Integrator, SwitchEvent};
 use crate::model::{BodyContactCheck, CantileverModel};
+use crate::system::EventKind;
 use gauss_quad::legendre::GaussLegendre;
 use nalgebra::DVector;
 use std::num::NonZeroUsize;
@@ -22,7 +23,7 @@ pub struct Sample {
     pub w_tip_dot: f64,
     /// Region at the sample.
     pub region: Region,
-    /// Contact force α4 V_T + α6 V̇_T in contact, else 0.
+    /// Tip–sample force F_c (repulsive positive; α4 δ + α6 δ̇ for the linear law in contact).
     pub contact_force: f64,
     /// State (a, ȧ), shape `[2N]`.
     pub state: DVector<f64>,
@@ -196,6 +197,17 @@ pub fn record(integ: &mut dyn Integrator, spec: &RecordSpec) -> Result<Trajector
             out.body_contact |= b.touches(&model, tau, &z);
         }
         if let Some(e) = step.event {
+            // an impact's impulse: energy lost in the sample and work done on the clamped frame
+            let r = match e.kind {
+                EventKind::Impact => model.law().restitution(),
+                EventKind::Stick => Some(0.0),
+                _ => None,
+            };
+            if let (true, Some(r)) = (spec.energy, r) {
+                let (loss, base) = model.impact_energy(e.tau, e.v_t_dot, r);
+                acc.contact_dissipation += loss;
+                acc.base_work += base;
+            }
             out.events.push(e);
         }
         if spec.energy

@@ -230,6 +230,7 @@ impl PhysicalModel {
         let (l, m, ei) = (c.length, c.mass_per_length(), c.bending_stiffness());
         let root = (ei * m).sqrt();
         let p = Params {
+            contact_law: Default::default(),
             modes: self.modes,
             alpha1: self.tip_mass / (m * l),
             alpha2: self.drive_amplitude / self.beam_gap,

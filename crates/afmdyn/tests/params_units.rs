@@ -148,6 +148,7 @@ fn alphas_to_physical_and_back() {
         alpha5: -0.05,
         alpha6: 0.3,
         omega: 3.3,
+        ..Params::default()
     };
     let phys = PhysicalModel::from_params(probe(), &p, 20e-9).unwrap();
     let q = phys.to_params().unwrap();

@@ -85,7 +85,7 @@ fn saltation_is_the_contact_damper_jump() {
         (Region::Free, Region::Contact, -1.0),
         (Region::Contact, Region::Free, 1.0),
     ] {
-        let s = m.saltation(from, to, tau, &z);
+        let s = m.saltation(from, tau, &z);
         let mut want = DMatrix::identity(6, 6);
         want.view_mut((3, 0), (3, 3)).copy_from(&(&block * sign));
         assert!((&s - &want).amax() < 1e-12, "{from:?} → {to:?}");
@@ -182,6 +182,7 @@ fn lyapunov_spectrum_without_contact_is_the_real_parts_of_the_eigenvalues() {
             transient_periods: 10,
             periods: 6000,
             blocks: 4,
+            ..Default::default()
         },
     )
     .unwrap();
@@ -230,6 +231,7 @@ fn lyapunov_sum_is_the_mean_phase_volume_contraction() {
             transient_periods: 0,
             periods: 200,
             blocks: 4,
+            ..Default::default()
         },
     )
     .unwrap();
@@ -260,6 +262,7 @@ fn lyapunov_exponent_of_a_periodic_orbit_is_its_floquet_rate() {
             transient_periods: 0,
             periods: 1000,
             blocks: 5,
+            ..Default::default()
         },
     )
     .unwrap();
@@ -281,6 +284,7 @@ fn the_motion_at_omega_2_6_is_chaotic() {
             transient_periods: 300,
             periods: 2000,
             blocks: 10,
+            ..Default::default()
         },
     )
     .unwrap();

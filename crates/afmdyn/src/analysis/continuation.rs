@@ -15,7 +15,7 @@ use super::shooting::{
     floquet_stability, section_points, shoot_with, Instability, ShootingOptions,
 };
 use crate::error::SimError;
-use crate::integrate::exact::ExactPropagator;
+use crate::integrate::{build, Integrator, IntegratorOptions};
 use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
 use nalgebra::{Complex, DMatrix, DVector};
@@ -44,6 +44,8 @@ pub struct ContinuationSpec {
     pub max_points: usize,
     /// Newton options (also for the corrector).
     pub newton: ShootingOptions,
+    /// Integrator of the stroboscopic map (default: auto, exact for the linear law).
+    pub integrator: IntegratorOptions,
 }
 
 impl ContinuationSpec {
@@ -61,6 +63,7 @@ impl ContinuationSpec {
             ds_max: span / 50.0,
             max_points: 5000,
             newton: ShootingOptions::default(),
+            integrator: IntegratorOptions::default(),
         }
     }
 }
@@ -107,7 +110,7 @@ pub struct BranchPoint {
 struct Solver {
     spec: ContinuationSpec,
     /// Propagators of the last few parameter values (p and p ± δ for ∂F/∂p).
-    cache: Vec<(f64, ExactPropagator)>,
+    cache: Vec<(f64, Box<dyn Integrator>)>,
 }
 
 impl Solver {
@@ -118,7 +121,7 @@ impl Solver {
         })
     }
 
-    fn at(&mut self, p: f64) -> Result<&mut ExactPropagator, SimError> {
+    fn at(&mut self, p: f64) -> Result<&mut dyn Integrator, SimError> {
         let i = match self.cache.iter().position(|(v, _)| *v == p) {
             Some(i) => i,
             None => {
@@ -126,11 +129,12 @@ impl Solver {
                 if self.cache.len() == 6 {
                     self.cache.remove(0);
                 }
-                self.cache.push((p, ExactPropagator::try_new(&model, 1)?));
+                let integ = build(&model, self.spec.integrator, 0.0, &model.rest())?;
+                self.cache.push((p, integ));
                 self.cache.len() - 1
             }
         };
-        Ok(&mut self.cache[i].1)
+        Ok(self.cache[i].1.as_mut())
     }
 
     fn map(&mut self, z: &DVector<f64>, p: f64) -> Result<FlowMap, SimError> {
@@ -430,8 +434,8 @@ pub fn switch_at_period_doubling(
 ) -> Option<(f64, DVector<f64>)> {
     let z = pd.section[0].clone();
     let model = CantileverModel::new(&spec.base.with(spec.param, pd.value)).ok()?;
-    let mut prop = ExactPropagator::try_new(&model, 1).ok()?;
-    let m = stroboscopic(&mut prop, &z, pd.period).ok()?.jacobian;
+    let mut integ = build(&model, spec.integrator, 0.0, &model.rest()).ok()?;
+    let m = stroboscopic(integ.as_mut(), &z, pd.period).ok()?.jacobian;
     let dim = z.len();
     // eigenvector of μ ≈ −1 by inverse iteration on M + (1 − 1e-8) I
     let lu = (&m + DMatrix::identity(dim, dim) * (1.0 - 1e-8)).lu();
@@ -449,13 +453,15 @@ pub fn switch_at_period_doubling(
             let Ok(model) = CantileverModel::new(&spec.base.with(spec.param, p)) else {
                 continue;
             };
-            let Ok(mut prop) = ExactPropagator::try_new(&model, 1) else {
+            let Ok(mut integ) = build(&model, spec.integrator, 0.0, &model.rest()) else {
                 continue;
             };
             for sign_v in [1.0, -1.0] {
                 let guess = &z + &v * (sign_v * eps);
-                if let Ok(o) = shoot_with(&mut prop, &guess, 2 * pd.period, &spec.newton) {
-                    let half = stroboscopic(&mut prop, &o.state, pd.period).ok()?.state;
+                if let Ok(o) = shoot_with(integ.as_mut(), &guess, 2 * pd.period, &spec.newton) {
+                    let half = stroboscopic(integ.as_mut(), &o.state, pd.period)
+                        .ok()?
+                        .state;
                     if (&half - &o.state).norm() > 1e-6 * (1.0 + o.state.norm()) {
                         return Some((p, o.state));
                     }

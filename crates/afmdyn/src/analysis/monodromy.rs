@@ -1,13 +1,13 @@
 //! The stroboscopic map P(z) = z(τ0 + nT) and its Jacobian (the monodromy matrix of the
-//! period-n map): the product of the exact segment propagators e^{A_s t} and the saltation
-//! matrices at every switching ([`CantileverModel::saltation`]).
+//! period-n map): the product of the step Jacobians of any integrator that provides them (the
+//! exact transition matrices e^{A_s t}, or the adaptive integrator's variational equations) and
+//! the saltation matrix of every event ([`crate::system::saltation`]).
 
-use super::steady::extremum;
 use crate::error::SimError;
 use crate::galerkin::Region;
-use crate::integrate::exact::ExactPropagator;
 use crate::integrate::Integrator;
-use crate::model::CantileverModel;
+use crate::roots::extremum;
+use crate::system::EventKind;
 use nalgebra::{DMatrix, DVector};
 
 /// The flow map over [τ0, τ1] with its Jacobian.
@@ -17,39 +17,35 @@ pub struct FlowMap {
     pub state: DVector<f64>,
     /// ∂z(τ1)/∂z(τ0), 2N×2N.
     pub jacobian: DMatrix<f64>,
-    /// Number of switchings.
+    /// Number of events (switchings, impacts, sticking, releases).
     pub switchings: usize,
-    /// Contacts (entries into region II).
+    /// Contacts: entries into region II and impacts.
     pub contacts: usize,
-    /// Smallest |V_T| at a local extremum of V_T, and smallest |dV_T/dτ| at a switching
-    /// (scaled by 1/Ω): how close the trajectory is to grazing the sample.
+    /// Smallest |V_T| at a local extremum of V_T, and smallest |dV_T/dτ| at an event (scaled by
+    /// 1/Ω): how close the trajectory is to grazing the sample.
     pub grazing_distance: f64,
-    /// Time spent in contact.
+    /// Time spent in region II (contact, or sticking for the impact law).
     pub contact_time: f64,
-    /// ∫ trace A_s dτ + Σ log|det S| (log of the phase-volume change; Liouville).
+    /// Σ ln|det J_step| + Σ ln|det S|: the log of the phase-volume change (for an affine
+    /// region ln det e^{A t} = t trace A, Liouville).
     pub log_volume: f64,
 }
 
-/// Trace of each region's state matrix, [free, contact].
-fn traces(model: &CantileverModel) -> [f64; 2] {
-    [Region::Free, Region::Contact].map(|r| model.dynamics(r).a.trace())
-}
-
-/// Integrate (τ0, z0) → τ1 with `prop`, multiplying the step Jacobians and saltation matrices.
+/// Integrate (τ0, z0) → τ1 with `integ`, multiplying the step Jacobians and saltation
+/// matrices. Switches the integrator's variational equations on.
 ///
 /// # Errors
-/// [`SimError`] from the propagator.
+/// [`SimError`] from the integrator, [`SimError::Unsupported`] for one without step Jacobians.
 pub fn flow_with_jacobian(
-    prop: &mut ExactPropagator,
+    integ: &mut dyn Integrator,
     tau0: f64,
     z0: &DVector<f64>,
     tau1: f64,
 ) -> Result<FlowMap, SimError> {
-    prop.reset(tau0, z0)?;
-    let model = prop.model().clone();
-    let p = *model.params();
-    let tr = traces(&model);
-    let dim = model.dim();
+    integ.set_variational(true);
+    integ.reset(tau0, z0)?;
+    let omega = integ.model().omega();
+    let dim = z0.len();
     let mut jac = DMatrix::identity(dim, dim);
     let mut out = FlowMap {
         state: z0.clone(),
@@ -61,41 +57,45 @@ pub fn flow_with_jacobian(
         log_volume: 0.0,
     };
     let mut before = z0.clone();
-    while prop.tau() < tau1 {
-        before.copy_from(prop.state());
-        let step = prop.step(tau1)?;
+    while integ.tau() < tau1 {
+        before.copy_from(integ.state());
+        let step = integ.step(tau1)?;
         let len = step.tau1 - step.tau0;
         if len <= 0.0 && step.event.is_none() {
             continue;
         }
-        jac = prop.last_step_jacobian() * jac;
-        out.log_volume += tr[step.region.index()] * len;
+        let j = integ.last_step_jacobian()?;
+        out.log_volume += j.clone().lu().determinant().abs().ln();
+        jac = j * jac;
         if step.region == Region::Contact {
             out.contact_time += len;
         }
         // local extrema of V_T inside the step: distance to grazing
-        let z1 = prop.state().clone();
-        let (d0, d1) = (
-            model.v_t_dot(step.tau0, &before),
-            model.v_t_dot(step.tau1, &z1),
-        );
+        let (d0, d1) = {
+            let m = integ.model();
+            let end = match &step.event {
+                Some(e) => m.v_t_dot(e.tau, &e.state),
+                None => m.v_t_dot(step.tau1, integ.state()),
+            };
+            (m.v_t_dot(step.tau0, &before), end)
+        };
         if len > 0.0 && (d0 > 0.0) != (d1 > 0.0) {
-            let mut vt = |t: f64| prop.dense_v_t(t);
+            let mut vt = |t: f64| integ.dense_v_t(t);
             let t = extremum(step.tau0, step.tau1, d0, &mut vt);
             out.grazing_distance = out.grazing_distance.min(vt(t)[0].abs());
         }
         if let Some(e) = &step.event {
-            let s = model.saltation(e.from, e.to, e.tau, &e.state);
-            out.log_volume += s.determinant().abs().ln();
+            let s = integ.model().saltation(e.from, e.tau, &e.state);
+            out.log_volume += s.clone().lu().determinant().abs().ln();
             jac = s * jac;
             out.switchings += 1;
-            if e.to == Region::Contact {
+            if e.to == Region::Contact || e.kind == EventKind::Impact {
                 out.contacts += 1;
             }
-            out.grazing_distance = out.grazing_distance.min(e.v_t_dot.abs() / p.omega);
+            out.grazing_distance = out.grazing_distance.min(e.v_t_dot.abs() / omega);
         }
     }
-    out.state = prop.state().clone();
+    out.state = integ.state().clone();
     out.jacobian = jac;
     Ok(out)
 }
@@ -103,12 +103,12 @@ pub fn flow_with_jacobian(
 /// The period-n stroboscopic map from drive phase 0 (τ = 0 → nT) with its monodromy matrix.
 ///
 /// # Errors
-/// [`SimError`] from the propagator.
+/// As [`flow_with_jacobian`].
 pub fn stroboscopic(
-    prop: &mut ExactPropagator,
+    integ: &mut dyn Integrator,
     z0: &DVector<f64>,
     n: usize,
 ) -> Result<FlowMap, SimError> {
-    let t = n as f64 * prop.model().period();
-    flow_with_jacobian(prop, 0.0, z0, t)
+    let t = n as f64 * integ.model().period();
+    flow_with_jacobian(integ, 0.0, z0, t)
 }

@@ -6,8 +6,7 @@
 
 use super::monodromy::{stroboscopic, FlowMap};
 use crate::error::SimError;
-use crate::integrate::exact::ExactPropagator;
-use crate::integrate::Integrator;
+use crate::integrate::{build, Integrator, IntegratorOptions};
 use crate::model::CantileverModel;
 use nalgebra::{Complex, DMatrix, DVector};
 use serde::Serialize;
@@ -101,7 +100,7 @@ pub fn floquet_multipliers(m: &DMatrix<f64>) -> Vec<Complex<f64>> {
 /// # Errors
 /// [`SimError::NoConvergence`] when Newton fails; [`SimError`] from the propagator.
 pub fn shoot_with(
-    prop: &mut ExactPropagator,
+    integ: &mut dyn Integrator,
     guess: &DVector<f64>,
     n: usize,
     opts: &ShootingOptions,
@@ -109,16 +108,16 @@ pub fn shoot_with(
     if n == 0 {
         return Err(SimError::out_of_range("period", n, "must be >= 1"));
     }
-    prop.model().check_state("initial guess", guess)?;
+    integ.model().check_state("initial guess", guess)?;
     let dim = guess.len();
     let mut z = guess.clone();
     let mut residuals = Vec::new();
-    let mut map = stroboscopic(prop, &z, n)?;
+    let mut map = stroboscopic(integ, &z, n)?;
     let mut res = (&map.state - &z).norm();
     for _ in 0..opts.max_iter {
         residuals.push(res);
         if res <= opts.tol * (1.0 + z.norm()) {
-            return finish(prop, z, n, map, residuals);
+            return finish(integ, z, n, map, residuals);
         }
         let a = &map.jacobian - DMatrix::identity(dim, dim);
         let delta = a
@@ -133,7 +132,7 @@ pub fn shoot_with(
         let mut lambda = 1.0;
         loop {
             let trial = &z + &delta * lambda;
-            let tmap = stroboscopic(prop, &trial, n)?;
+            let tmap = stroboscopic(integ, &trial, n)?;
             let tres = (&tmap.state - &trial).norm();
             if tres < res || lambda < 1e-3 {
                 z = trial;
@@ -146,7 +145,7 @@ pub fn shoot_with(
     }
     residuals.push(res);
     if res <= opts.tol * (1.0 + z.norm()) {
-        return finish(prop, z, n, map, residuals);
+        return finish(integ, z, n, map, residuals);
     }
     Err(SimError::NoConvergence {
         what: "shooting",
@@ -160,13 +159,13 @@ pub fn shoot_with(
 /// # Errors
 /// [`SimError`] from the propagator.
 pub fn section_points(
-    prop: &mut ExactPropagator,
+    integ: &mut dyn Integrator,
     z: &DVector<f64>,
     n: usize,
 ) -> Result<Vec<DVector<f64>>, SimError> {
     let mut section = vec![z.clone()];
     for _ in 1..n {
-        let next = stroboscopic(prop, section.last().expect("non-empty"), 1)?.state;
+        let next = stroboscopic(integ, section.last().expect("non-empty"), 1)?.state;
         section.push(next);
     }
     Ok(section)
@@ -181,13 +180,13 @@ pub fn floquet_stability(m: &DMatrix<f64>) -> (Vec<Complex<f64>>, bool, Instabil
 }
 
 fn finish(
-    prop: &mut ExactPropagator,
+    integ: &mut dyn Integrator,
     z: DVector<f64>,
     n: usize,
     map: FlowMap,
     residuals: Vec<f64>,
 ) -> Result<PeriodicOrbit, SimError> {
-    let section = section_points(prop, &z, n)?;
+    let section = section_points(integ, &z, n)?;
     let (multipliers, stable, critical) = floquet_stability(&map.jacobian);
     Ok(PeriodicOrbit {
         period: n,
@@ -214,6 +213,6 @@ pub fn shoot(
     n: usize,
     opts: &ShootingOptions,
 ) -> Result<PeriodicOrbit, SimError> {
-    let mut prop = ExactPropagator::try_new(model, 1)?;
-    shoot_with(&mut prop, guess, n, opts)
+    let mut integ = build(model, IntegratorOptions::default(), 0.0, &model.rest())?;
+    shoot_with(integ.as_mut(), guess, n, opts)
 }

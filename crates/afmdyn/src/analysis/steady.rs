@@ -5,6 +5,7 @@ use crate::error::SimError;
 use crate::galerkin::Region;
 use crate::integrate::{advance_dyn, Integrator, Step};
 use crate::model::BodyContactCheck;
+use crate::roots::extremum;
 use nalgebra::DVector;
 use serde::Serialize;
 use std::collections::VecDeque;
@@ -131,37 +132,6 @@ impl Default for StatsObserver {
             body_contact: false,
         }
     }
-}
-
-/// Zero of the derivative f′ of a dense quantity on [a, b] by safeguarded Newton, given
-/// f′(a), f′(b) of opposite signs; `f(τ)` returns (f, f′, f″).
-pub(crate) fn extremum(
-    mut a: f64,
-    mut b: f64,
-    fa_d: f64,
-    f: &mut dyn FnMut(f64) -> [f64; 3],
-) -> f64 {
-    let rising = fa_d > 0.0;
-    let mut t = 0.5 * (a + b);
-    for _ in 0..60 {
-        let [_, d, dd] = f(t);
-        if (d > 0.0) == rising {
-            a = t;
-        } else {
-            b = t;
-        }
-        let mut next = if dd != 0.0 { t - d / dd } else { f64::NAN };
-        if !(next > a && next < b) {
-            next = 0.5 * (a + b);
-        }
-        if (next - t).abs() <= 4.0 * f64::EPSILON * (1.0 + t.abs())
-            || b - a <= 4.0 * f64::EPSILON * (1.0 + t.abs())
-        {
-            return next;
-        }
-        t = next;
-    }
-    t
 }
 
 impl StatsObserver {

@@ -1,108 +1,358 @@
-//! Independent oracle: adaptive DOP853 (Hairer–Nørsett–Wanner) from the `differential-equations`
-//! crate, integrating one region at a time with a terminal event on the gap ±V_T (eq. 8).
+//! Adaptive integrator for any hybrid system: DOP853 (Hairer, Nørsett & Wanner, *Solving ODEs I*,
+//! 2nd ed., Springer 1993, §II.10; the stepper of the `differential-equations` crate) driven one
+//! step at a time, with located events, jumps, and the variational equations.
 //!
-//! The crate locates the crossing by Brent's method on its dense output, which is only as
-//! accurate as the interpolant; the switching time is then polished by Newton's method on
-//! g(τ) = ±V_T, every iterate integrated afresh from the step's start to land exactly on it.
-//! Steps are cut at a grid of `steps_per_period` points per drive period so that samples and
-//! Poincaré sections land on integration points.
+//! Everything here goes through [`HybridSystem`]: the vector field of the current mode, its
+//! Jacobian, the mode's guard g (positive inside the mode) and the jump map at the guard.
+//!
+//! **Events.** After every accepted step [t0, t1] the guard is checked on the step's dense output
+//! (the method's 7th-order interpolant): a zero is present when g(t1) < −ε, or when g has an
+//! interior minimum (g′ changes sign from − to +, found by safeguarded Newton on g′) with
+//! g < −ε — a dip below the guard that returns inside one step (grazing) is not missed. ε is a
+//! round-off dead band (1e-12 of the guard's scale) so that a trajectory leaving the surface
+//! tangentially (a release from sticking) does not re-trigger. The leftmost zero is bracketed
+//! from the last point where g > 0 (after an event: the first maximum of g) and located by
+//! safeguarded Newton on the dense output ([`crate::roots`]); it is then polished by Newton's
+//! method on g(τ) with every iterate integrated afresh from the step's start, so the event time
+//! is exact to the integration tolerance, not to the interpolant.
+//!
+//! **Variational equations.** With [`Integrator::set_variational`] the state is augmented by the
+//! d×d matrix Φ with Φ′ = ∂f/∂z Φ, Φ(t0) = I at the start of every step, so each step also
+//! returns its Jacobian ∂z(t1)/∂z(t0) (Hairer et al., §I.14). The saltation matrix of an event is
+//! applied by the analyses ([`crate::system::saltation`]).
 
-use super::exact::checked_start;
 use super::{HermiteStep, Integrator, Step};
 use crate::error::SimError;
 use crate::galerkin::Region;
 use crate::model::CantileverModel;
-use differential_equations::prelude::*;
-use nalgebra::DVector;
+use crate::roots::{extremum, safeguarded_newton};
+use crate::system::HybridSystem;
+use differential_equations::interpolate::Interpolation;
+use differential_equations::methods::{DormandPrince, ExplicitRungeKutta, Ordinary};
+use differential_equations::ode::{OrdinaryNumericalMethod, ODE};
+use nalgebra::{DMatrix, DMatrixView, DMatrixViewMut, DVector};
+use std::cell::RefCell;
 
-struct RegionOde<'a> {
-    model: &'a CantileverModel,
-    region: Region,
+/// The DOP853 stepper on `Vec<f64>` states.
+type Dop853 = ExplicitRungeKutta<Ordinary, DormandPrince, f64, Vec<f64>, 8, 12, 16>;
+
+/// Events within this many drive periods' ten-millionth that count as chattering.
+const CHATTER_COUNT: usize = 4096;
+
+/// The vector field of one mode, optionally with the variational equations.
+struct ModeOde<'a, S: HybridSystem + ?Sized> {
+    sys: &'a S,
+    mode: Region,
+    variational: bool,
+    jac: RefCell<DMatrix<f64>>,
 }
 
-impl ODE<f64, Vec<f64>> for RegionOde<'_> {
+impl<'a, S: HybridSystem + ?Sized> ModeOde<'a, S> {
+    fn new(sys: &'a S, mode: Region, variational: bool) -> Self {
+        let d = sys.dim();
+        ModeOde {
+            sys,
+            mode,
+            variational,
+            jac: RefCell::new(DMatrix::zeros(d, d)),
+        }
+    }
+}
+
+impl<S: HybridSystem + ?Sized> ODE<f64, Vec<f64>> for ModeOde<'_, S> {
     fn diff(&self, t: f64, y: &Vec<f64>, dydt: &mut Vec<f64>) {
-        let z = DVector::from_column_slice(y);
-        let mut dz = DVector::zeros(y.len());
-        self.model.rhs(self.region, t, &z, &mut dz);
-        dydt.copy_from_slice(dz.as_slice());
+        let d = self.sys.dim();
+        self.sys.rhs(self.mode, t, &y[..d], &mut dydt[..d]);
+        if self.variational {
+            let mut j = self.jac.borrow_mut();
+            self.sys.jacobian(self.mode, t, &y[..d], &mut j);
+            let phi = DMatrixView::from_slice(&y[d..], d, d);
+            let mut out = DMatrixViewMut::from_slice(&mut dydt[d..], d, d);
+            out.gemm(1.0, &j, &phi, 0.0);
+        }
     }
 }
 
-struct Gap<'a> {
-    model: &'a CantileverModel,
-    sigma: f64,
+/// The last accepted step, for dense output and its Jacobian.
+#[derive(Clone)]
+struct LastStep {
+    tau0: f64,
+    tau1: f64,
+    region: Region,
+    /// The stepper that made the step (its interpolant covers [tau0, tau1] or more).
+    dense: Option<Box<Dop853>>,
+    /// Fallback dense output for a degenerate (tiny) step.
+    hermite: HermiteStep,
+    /// ∂z(τ1)/∂z(τ0) when the variational equations were integrated.
+    jacobian: Option<DMatrix<f64>>,
 }
 
-impl Event<f64, Vec<f64>> for Gap<'_> {
-    fn config(&self) -> EventConfig {
-        EventConfig::new(CrossingDirection::Negative, Some(1))
-    }
-    fn event(&self, t: f64, y: &Vec<f64>) -> f64 {
-        self.sigma * self.model.v_t(t, &DVector::from_column_slice(y))
-    }
-}
-
-/// The DOP853 oracle integrator.
-#[derive(Debug, Clone)]
-pub struct AdaptiveOracle {
+/// The adaptive DOP853 integrator (see the module docs).
+#[derive(Clone)]
+pub struct Adaptive {
     model: CantileverModel,
     tol: f64,
-    grid: f64,
     tau: f64,
     z: DVector<f64>,
     region: Region,
-    last: HermiteStep,
+    variational: bool,
+    /// Persistent stepper of the current stint (no variational equations), rebuilt after events.
+    stepper: Option<Box<Dop853>>,
+    /// Step size to start a new stepper with.
+    h: f64,
+    /// The guard may sit at 0 at the start of the stint (just after an event).
+    just_switched: bool,
+    recent: std::collections::VecDeque<f64>,
+    last: LastStep,
 }
 
-impl AdaptiveOracle {
-    /// Relative and absolute tolerance `tol`; steps cut at 64 points per drive period.
+impl std::fmt::Debug for Adaptive {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Adaptive")
+            .field("tol", &self.tol)
+            .field("tau", &self.tau)
+            .field("region", &self.region)
+            .finish_non_exhaustive()
+    }
+}
+
+/// Backwards-compatible name of [`Adaptive`] (the linear law's independent oracle).
+pub type AdaptiveOracle = Adaptive;
+
+impl Adaptive {
+    /// Relative and absolute tolerance `tol` of the DOP853 error control.
     pub fn new(model: &CantileverModel, tol: f64) -> Self {
-        let z = DVector::zeros(model.dim());
-        AdaptiveOracle {
+        let d = model.dim();
+        Adaptive {
             model: model.clone(),
             tol,
-            grid: model.period() / 64.0,
             tau: 0.0,
-            z: z.clone(),
+            z: DVector::zeros(d),
             region: Region::Free,
-            last: HermiteStep::new(model.dim()),
+            variational: false,
+            stepper: None,
+            h: 0.0,
+            just_switched: true,
+            recent: Default::default(),
+            last: LastStep {
+                tau0: 0.0,
+                tau1: 0.0,
+                region: Region::Free,
+                dense: None,
+                hermite: HermiteStep::new(d),
+                jacobian: None,
+            },
         }
     }
 
-    fn integrate_to(
-        &self,
-        region: Region,
-        tau0: f64,
-        z0: &DVector<f64>,
-        t: f64,
-    ) -> Result<DVector<f64>, SimError> {
-        if t <= tau0 {
-            return Ok(z0.clone());
+    fn dim(&self) -> usize {
+        self.model.dim()
+    }
+
+    /// The augmented start vector: z, then Φ = I when variational.
+    fn augmented(&self, z: &[f64], variational: bool) -> Vec<f64> {
+        let d = z.len();
+        let mut y = z.to_vec();
+        if variational {
+            let mut id = vec![0.0; d * d];
+            for i in 0..d {
+                id[i * d + i] = 1.0;
+            }
+            y.extend(id);
         }
-        let ode = RegionOde {
-            model: &self.model,
-            region,
-        };
-        let sol = IVP::ode(&ode, tau0, t, z0.iter().copied().collect::<Vec<f64>>())
-            .t_eval([t])
-            .method(ExplicitRungeKutta::dop853().rtol(self.tol).atol(self.tol))
-            .solve()
+        y
+    }
+
+    /// A DOP853 stepper started at (τ, y) in `mode`.
+    fn new_stepper(
+        &self,
+        mode: Region,
+        tau: f64,
+        y: &[f64],
+        variational: bool,
+        h: f64,
+    ) -> Result<Box<Dop853>, SimError> {
+        let ode = ModeOde::new(&self.model, mode, variational);
+        let mut s = ExplicitRungeKutta::dop853()
+            .rtol(self.tol)
+            .atol(self.tol)
+            .max_steps(usize::MAX)
+            .h_max(self.model.period() / 8.0);
+        if h > 0.0 {
+            s = s.h0(h);
+        }
+        let mut s = Box::new(s);
+        let tf = tau + self.model.period();
+        s.init(&ode, tau, tf, &y.to_vec())
             .map_err(|e| SimError::Adaptive {
-                tau: tau0,
+                tau,
                 message: format!("{e:?}"),
             })?;
-        sol.y
-            .last()
-            .map(|y| DVector::from_column_slice(y))
-            .ok_or_else(|| SimError::Adaptive {
-                tau: tau0,
-                message: "no output point".into(),
-            })
+        Ok(s)
+    }
+
+    /// Take one accepted step of `stepper` in `mode`, never past `t_end` (landing on it exactly
+    /// when the step would pass it). Returns the end time.
+    fn advance(
+        &self,
+        stepper: &mut Dop853,
+        mode: Region,
+        variational: bool,
+        t_end: f64,
+    ) -> Result<f64, SimError> {
+        let ode = ModeOde::new(&self.model, mode, variational);
+        let t0 = stepper.t();
+        let h_nat = stepper.h();
+        let clamped = t0 + h_nat >= t_end;
+        if clamped {
+            stepper.set_h(t_end - t0);
+        }
+        for _ in 0..1000 {
+            stepper.step(&ode).map_err(|e| SimError::Adaptive {
+                tau: t0,
+                message: format!("{e:?}"),
+            })?;
+            if stepper.t() > t0 {
+                if clamped && stepper.t() >= t_end - 4.0 * f64::EPSILON * (1.0 + t_end.abs()) {
+                    // landed on t_end; keep the step size the method chose before clamping
+                    stepper.set_h(h_nat.max(stepper.h()));
+                    return Ok(t_end);
+                }
+                return Ok(stepper.t());
+            }
+            if clamped && stepper.h() > t_end - t0 {
+                stepper.set_h(t_end - t0);
+            }
+        }
+        Err(SimError::Adaptive {
+            tau: t0,
+            message: "1000 rejected steps in a row".into(),
+        })
+    }
+
+    /// Integrate from (t0, y0) in `mode` to exactly t1 with a fresh stepper; returns the end
+    /// vector (augmented when variational).
+    fn integrate_to(
+        &self,
+        mode: Region,
+        t0: f64,
+        y0: &[f64],
+        t1: f64,
+        variational: bool,
+    ) -> Result<Vec<f64>, SimError> {
+        if t1 <= t0 {
+            return Ok(y0.to_vec());
+        }
+        let mut s = self.new_stepper(mode, t0, y0, variational, t1 - t0)?;
+        let mut t = t0;
+        while t < t1 {
+            t = self.advance(&mut s, mode, variational, t1)?;
+        }
+        Ok(s.y().clone())
+    }
+
+    /// Dead band of the guard of `mode`: 1e-12 of its scale (module docs).
+    fn dead_band(&self, mode: Region, tau: f64, z: &[f64]) -> f64 {
+        let p = self.model.params();
+        let scale = if mode == Region::Contact && self.model.law().restitution().is_some() {
+            // constraint force: m_eff × (drive acceleration + tip acceleration scale)
+            let g = self.model.guard(mode, tau, z);
+            self.model.effective_mass() * p.alpha2 * p.omega * p.omega + g.value.abs()
+        } else {
+            1.0 + p.alpha2 + p.alpha5.abs()
+        };
+        1e-12 * scale
+    }
+
+    /// (g, dg/dτ) along the dense output of `stepper` at τ.
+    fn guard_on(&self, stepper: &mut Dop853, mode: Region, tau: f64) -> (f64, f64) {
+        let d = self.dim();
+        let y = stepper
+            .interpolate(tau)
+            .unwrap_or_else(|_| stepper.y().clone());
+        let z = &y[..d];
+        let g = self.model.guard(mode, tau, z);
+        let mut f = vec![0.0; d];
+        self.model.rhs_slice(mode, tau, z, &mut f);
+        (
+            g.value,
+            g.grad.iter().zip(&f).map(|(a, b)| a * b).sum::<f64>() + g.d_tau,
+        )
+    }
+
+    /// Leftmost guard zero in (t0, t1] on the dense output, or None (module docs).
+    fn find_zero(&self, stepper: &mut Dop853, mode: Region, t0: f64, t1: f64) -> Option<f64> {
+        let d = self.dim();
+        let z1 = stepper.y()[..d].to_vec();
+        let dead = self.dead_band(mode, t1, &z1);
+        let (g0, dg0) = self.guard_on(stepper, mode, t0);
+        let (g1, dg1) = self.guard_on(stepper, mode, t1);
+        // where g goes below −ε: the step end, or an interior minimum
+        let mut bottom = None;
+        if g1 < -dead {
+            bottom = Some((t1, g1));
+        } else if dg0 < 0.0 && dg1 > 0.0 {
+            let tm = extremum(t0, t1, dg0, &mut |t| {
+                let (g, dg) = self.guard_on(stepper, mode, t);
+                // g″ by a difference of g′ (the Newton step only steers; the bracket decides)
+                let h = 1e-7 * (t1 - t0);
+                let (_, dg2) = self.guard_on(stepper, mode, (t + h).min(t1));
+                [g, dg, (dg2 - dg) / h.max(f64::MIN_POSITIVE)]
+            });
+            let (gm, _) = self.guard_on(stepper, mode, tm);
+            if gm < -dead {
+                bottom = Some((tm, gm));
+            }
+        }
+        let (tb, gb) = bottom?;
+        // left end of the bracket: t0 when g(t0) > 0 and not on the surface, else the first
+        // maximum of g before the bottom
+        let (mut ta, mut ga) = (t0, g0);
+        if self.just_switched || g0 <= 0.0 {
+            ta = t0;
+            ga = g0;
+            if dg0 > 0.0 {
+                let (_, dgb) = self.guard_on(stepper, mode, tb);
+                if dgb < 0.0 {
+                    let h = 1e-7 * (tb - t0);
+                    let tm = extremum(t0, tb, dg0, &mut |t| {
+                        let (g, dg) = self.guard_on(stepper, mode, t);
+                        let (_, dg2) = self.guard_on(stepper, mode, (t + h).min(tb));
+                        [g, dg, (dg2 - dg) / h.max(f64::MIN_POSITIVE)]
+                    });
+                    let (gm, _) = self.guard_on(stepper, mode, tm);
+                    ta = tm;
+                    ga = gm;
+                }
+            }
+            if ga <= 0.0 {
+                // never clearly inside the mode: the event is at the start of the step
+                return Some(t0);
+            }
+        }
+        Some(safeguarded_newton(ta, ga, tb, gb.min(0.0), 0.0, &mut |t| {
+            self.guard_on(stepper, mode, t)
+        }))
+    }
+
+    fn chatter_check(&mut self, tau: f64) -> Result<(), SimError> {
+        self.recent.push_back(tau);
+        while self.recent.len() > CHATTER_COUNT {
+            self.recent.pop_front();
+        }
+        let window = 1e-7 * self.model.period();
+        if self.recent.len() == CHATTER_COUNT && tau - self.recent[0] < window {
+            return Err(SimError::Chattering {
+                tau,
+                count: CHATTER_COUNT,
+                window: tau - self.recent[0],
+            });
+        }
+        Ok(())
     }
 }
 
-impl Integrator for AdaptiveOracle {
+impl Integrator for Adaptive {
     fn model(&self) -> &CantileverModel {
         &self.model
     }
@@ -119,23 +369,30 @@ impl Integrator for AdaptiveOracle {
         "adaptive"
     }
 
+    fn set_variational(&mut self, on: bool) {
+        self.variational = on;
+    }
+
     fn reset(&mut self, tau: f64, z: &DVector<f64>) -> Result<(), SimError> {
-        self.region = checked_start(&self.model, tau, z)?;
+        self.region = self.model.checked_start(tau, z)?;
         self.tau = tau;
         self.z.copy_from(z);
+        self.stepper = None;
+        self.just_switched = true;
+        self.recent.clear();
+        self.last.dense = None;
+        self.last.jacobian = None;
+        self.last.tau0 = tau;
+        self.last.tau1 = tau;
+        self.last.region = self.region;
         Ok(())
     }
 
     fn step(&mut self, tau_max: f64) -> Result<Step, SimError> {
         let tau0 = self.tau;
-        let k = (tau0 / self.grid).floor() + 1.0;
-        let mut next = k * self.grid;
-        if next <= tau0 {
-            next += self.grid;
-        }
-        let tf = next.min(tau_max);
         let region = self.region;
-        if tf <= tau0 {
+        let d = self.dim();
+        if tau_max <= tau0 {
             return Ok(Step {
                 tau0,
                 tau1: tau0,
@@ -143,78 +400,145 @@ impl Integrator for AdaptiveOracle {
                 event: None,
             });
         }
-        let sigma = if region == Region::Free { 1.0 } else { -1.0 };
-        let ode = RegionOde {
-            model: &self.model,
-            region,
+        let var = self.variational;
+        let y0 = self.augmented(self.z.as_slice(), var);
+        // a fresh stepper per step with the variational equations (Φ(τ0) = I), else one per stint
+        let mut stepper = match self.stepper.take() {
+            Some(s) if !var => s,
+            _ => self.new_stepper(region, tau0, &y0, var, self.h)?,
         };
-        let gap = Gap {
-            model: &self.model,
-            sigma,
-        };
-        let y0: Vec<f64> = self.z.iter().copied().collect();
-        let sol = IVP::ode(&ode, tau0, tf, y0)
-            .t_eval([tf])
-            .event(&gap)
-            .method(ExplicitRungeKutta::dop853().rtol(self.tol).atol(self.tol))
-            .solve()
-            .map_err(|e| SimError::Adaptive {
-                tau: tau0,
-                message: format!("{e:?}"),
-            })?;
-        let interrupted = matches!(sol.status, Status::Interrupted);
-        let (t_end, y_end) = match (sol.t.last(), sol.y.last()) {
-            (Some(t), Some(y)) => (*t, DVector::from_column_slice(y)),
-            _ => {
-                return Err(SimError::Adaptive {
-                    tau: tau0,
-                    message: "no output point".into(),
-                })
+        let h_now = stepper.h();
+        // a remainder far below the step size: first-order update (error O(rem²) < round-off)
+        if tau_max - tau0 <= 1e-9 * h_now.abs() {
+            let rem = tau_max - tau0;
+            let mut f = vec![0.0; d];
+            self.model
+                .rhs_slice(region, tau0, self.z.as_slice(), &mut f);
+            let z0 = self.z.clone();
+            for (zi, fi) in self.z.iter_mut().zip(&f) {
+                *zi += rem * fi;
             }
-        };
-        let z0 = self.z.clone();
-        if !interrupted {
-            self.z = y_end;
-            self.tau = tf;
+            self.tau = tau_max;
+            self.last.tau0 = tau0;
+            self.last.tau1 = tau_max;
+            self.last.region = region;
+            self.last.dense = None;
             self.last
-                .record(&self.model, region, tau0, &z0, self.tau, &self.z);
+                .hermite
+                .record(&self.model, region, tau0, &z0, tau_max, &self.z);
+            self.last.jacobian = var.then(|| {
+                let mut j = DMatrix::zeros(d, d);
+                self.model.jacobian(region, tau0, z0.as_slice(), &mut j);
+                DMatrix::identity(d, d) + j * rem
+            });
+            self.stepper = None;
             return Ok(Step {
                 tau0,
-                tau1: tf,
+                tau1: tau_max,
                 region,
                 event: None,
             });
         }
-        // Newton on the event time, each iterate integrated afresh from the step's start (the
-        // crate's event point comes from its dense output, accurate only to the interpolant)
-        let mut tau_s = t_end;
-        let mut zs = y_end;
-        for _ in 0..8 {
-            let g = self.model.v_t(tau_s, &zs);
-            let dg = self.model.v_t_dot(tau_s, &zs);
-            if dg == 0.0 {
+        let t1 = self.advance(&mut stepper, region, var, tau_max)?;
+        self.h = stepper.h();
+        let zero = self.find_zero(&mut stepper, region, tau0, t1);
+        self.just_switched = false;
+        let Some(t_guess) = zero else {
+            let y1 = stepper.y().clone();
+            self.z.copy_from_slice(&y1[..d]);
+            self.tau = t1;
+            let norm = self.z.norm();
+            if norm.is_nan() || norm >= 1e12 {
+                return Err(SimError::Diverged { tau: t1, norm });
+            }
+            self.last.tau0 = tau0;
+            self.last.tau1 = t1;
+            self.last.region = region;
+            self.last.jacobian = var.then(|| DMatrix::from_column_slice(d, d, &y1[d..]));
+            self.last.dense = Some(stepper.clone());
+            if !var {
+                self.stepper = Some(stepper);
+            }
+            return Ok(Step {
+                tau0,
+                tau1: t1,
+                region,
+                event: None,
+            });
+        };
+        // polish: Newton on g(τ), each iterate integrated afresh from the step's start
+        let mut ts = t_guess;
+        let mut ys = self.integrate_to(region, tau0, &y0, ts, var)?;
+        for _ in 0..6 {
+            let g = self.model.guard(region, ts, &ys[..d]);
+            let mut f = vec![0.0; d];
+            self.model.rhs_slice(region, ts, &ys[..d], &mut f);
+            let rate = g.grad.iter().zip(&f).map(|(a, b)| a * b).sum::<f64>() + g.d_tau;
+            if rate == 0.0 || g.value == 0.0 {
                 break;
             }
-            let delta = -g / dg;
-            if delta.abs() <= 4.0 * f64::EPSILON * (1.0 + tau_s.abs()) {
+            let next = (ts - g.value / rate).clamp(tau0, t1);
+            if (next - ts).abs() <= 4.0 * f64::EPSILON * (1.0 + ts.abs()) || next <= tau0 {
                 break;
             }
-            tau_s += delta;
-            zs = self.integrate_to(region, tau0, &z0, tau_s)?;
+            ts = next;
+            ys = self.integrate_to(region, tau0, &y0, ts, var)?;
         }
-        self.z = zs;
-        self.tau = tau_s;
-        self.last
-            .record(&self.model, region, tau0, &z0, self.tau, &self.z);
-        self.region = region.other();
-        Ok(Step::switched(&self.model, tau0, region, tau_s, &self.z))
-    }
-
-    fn dense_tip(&mut self, tau: f64) -> [f64; 3] {
-        self.last.tip(&self.model, tau)
+        let z_minus = DVector::from_column_slice(&ys[..d]);
+        let jump = self.model.jump(region, ts, z_minus.as_slice());
+        self.last.tau0 = tau0;
+        self.last.tau1 = ts;
+        self.last.region = region;
+        self.last.jacobian = var.then(|| DMatrix::from_column_slice(d, d, &ys[d..]));
+        self.last.dense = Some(stepper);
+        self.z.copy_from(&jump.state);
+        self.tau = ts;
+        self.region = jump.to;
+        self.stepper = None;
+        self.just_switched = true;
+        self.chatter_check(ts)?;
+        Ok(Step::with_event(
+            &self.model,
+            tau0,
+            region,
+            ts,
+            &z_minus,
+            jump.to,
+            jump.kind,
+        ))
     }
 
     fn dense_state(&mut self, tau: f64) -> DVector<f64> {
-        self.last.state(tau)
+        let d = self.dim();
+        match self.last.dense.as_mut() {
+            Some(s) => {
+                let t = tau.clamp(s.t_prev(), s.t());
+                let y = s.interpolate(t).unwrap_or_else(|_| s.y().clone());
+                DVector::from_column_slice(&y[..d])
+            }
+            None => self.last.hermite.state(tau),
+        }
+    }
+
+    fn dense_tip(&mut self, tau: f64) -> [f64; 3] {
+        let n = self.model.modes();
+        if self.last.dense.is_none() {
+            return self.last.hermite.tip(&self.model, tau);
+        }
+        let z = self.dense_state(tau);
+        let mut f = vec![0.0; 2 * n];
+        self.model
+            .rhs_slice(self.last.region, tau, z.as_slice(), &mut f);
+        let tip = self.model.tip();
+        let dot = |x: &[f64]| tip.iter().zip(x).map(|(a, b)| a * b).sum::<f64>();
+        [dot(&z.as_slice()[..n]), dot(&f[..n]), dot(&f[n..])]
+    }
+
+    fn last_step_jacobian(&mut self) -> Result<DMatrix<f64>, SimError> {
+        self.last.jacobian.clone().ok_or(SimError::Unsupported {
+            integrator: "adaptive",
+            law: self.model.law().name(),
+            hint: "switch on the variational equations (Integrator::set_variational) first",
+        })
     }
 }

@@ -24,8 +24,8 @@
 //! starts where the lower parabola g'(0)s − Bs²/2 is largest, so the same event cannot fire twice.
 //! Many switchings in a vanishing time window are reported as [`SimError::Chattering`].
 
-use super::{Integrator, Step};
-use crate::error::{finite, SimError};
+use super::{matvec, Integrator, Step};
+use crate::error::SimError;
 use crate::galerkin::Region;
 use crate::model::CantileverModel;
 use nalgebra::{Complex, DMatrix, DVector};
@@ -40,25 +40,6 @@ const K: usize = 40;
 const CHATTER_COUNT: usize = 64;
 /// Time window of the chattering test.
 const CHATTER_WINDOW: f64 = 1e-9;
-
-/// y ← α A x (+ y when `accumulate`), A column-major with `x.len()` columns. Hand-written:
-/// nalgebra's dynamic gemv has a per-call overhead comparable to the 36 multiply–adds of N = 3,
-/// and this is the inner loop of the propagator.
-#[inline]
-fn matvec(a: &DMatrix<f64>, x: &[f64], y: &mut [f64], alpha: f64, accumulate: bool) {
-    let rows = a.nrows();
-    debug_assert_eq!(rows, y.len());
-    debug_assert_eq!(a.ncols(), x.len());
-    if !accumulate {
-        y.fill(0.0);
-    }
-    for (col, &xj) in a.as_slice().chunks_exact(rows).zip(x) {
-        let s = alpha * xj;
-        for (yi, aij) in y.iter_mut().zip(col) {
-            *yi += aij * s;
-        }
-    }
-}
 
 /// e^{Ã t} through the eigendecomposition Ã = V Λ V⁻¹ (complex), for partial steps of arbitrary
 /// length: one complex exponential per eigenvalue and two 2N×2N products, against ~30 Taylor
@@ -276,32 +257,9 @@ impl Search<'_> {
         self.leftmost(m, gm, b, gb, depth + 1)
     }
 
-    /// Safeguarded Newton on a bracket with g(lo) > 0 ≥ g(hi).
-    fn newton(&self, mut lo: f64, glo: f64, mut hi: f64, ghi: f64) -> f64 {
-        let mut t = if glo - ghi > 0.0 {
-            lo + (hi - lo) * glo / (glo - ghi)
-        } else {
-            0.5 * (lo + hi)
-        };
-        for _ in 0..100 {
-            let (g, d) = self.poly.g(t);
-            if g > 0.0 {
-                lo = t;
-            } else {
-                hi = t;
-            }
-            let mut next = if d != 0.0 { t - g / d } else { f64::NAN };
-            if !(next > lo && next < hi) {
-                next = 0.5 * (lo + hi);
-            }
-            let done = (next - t).abs() <= 2.0 * f64::EPSILON * (1.0 + (self.poly.tau0 + t).abs())
-                || hi - lo <= 4.0 * f64::EPSILON * (1.0 + (self.poly.tau0 + t).abs());
-            t = next;
-            if done {
-                break;
-            }
-        }
-        t.clamp(lo, hi)
+    /// Safeguarded Newton on a bracket with g(lo) > 0 ≥ g(hi) ([`crate::roots`]).
+    fn newton(&self, lo: f64, glo: f64, hi: f64, ghi: f64) -> f64 {
+        crate::roots::safeguarded_newton(lo, glo, hi, ghi, self.poly.tau0, &mut |t| self.poly.g(t))
     }
 }
 
@@ -379,8 +337,17 @@ impl ExactPropagator {
     /// As [`ExactPropagator::new`], with an error instead of a panic.
     ///
     /// # Errors
-    /// [`SimError::OutOfRange`] for Ω at an undamped resonance (see [`ExactPropagator::new`]).
+    /// [`SimError::OutOfRange`] for Ω at an undamped resonance (see [`ExactPropagator::new`]);
+    /// [`SimError::Unsupported`] for a law that is not affine (only the linear law is).
     pub fn try_new(model: &CantileverModel, min_steps_per_period: usize) -> Result<Self, SimError> {
+        if !model.law().is_affine() {
+            return Err(SimError::Unsupported {
+                integrator: "exact",
+                law: model.law().name(),
+                hint:
+                    "only the linear law is piecewise affine: use --integrator adaptive (or auto)",
+            });
+        }
         let n = model.modes();
         let dim = 2 * n;
         let omega = model.omega();
@@ -551,8 +518,8 @@ impl ExactPropagator {
     }
 
     /// Jacobian ∂z(τ1)/∂z(τ0) of the flow over the last step [τ0, τ1] inside its region
-    /// (without the saltation at a switching that ends it), 2N×2N.
-    pub fn last_step_jacobian(&self) -> DMatrix<f64> {
+    /// (without the saltation at a switching that ends it), 2N×2N: Φ_s or e^{A_s t}.
+    pub fn step_transition(&self) -> DMatrix<f64> {
         let len = self.tau - self.last.tau0;
         // a whole grid step that ended on the grid (a switching would have cut it short)
         if self.last.full && self.on_grid.is_some() {
@@ -735,7 +702,7 @@ impl Integrator for ExactPropagator {
     }
 
     fn reset(&mut self, tau: f64, z: &DVector<f64>) -> Result<(), SimError> {
-        self.region = checked_start(&self.model, tau, z)?;
+        self.region = self.model.checked_start(tau, z)?;
         self.tau = tau;
         self.z.copy_from(z);
         let j = self.next_grid(tau) - 1;
@@ -910,26 +877,8 @@ impl Integrator for ExactPropagator {
         self.state_in_last(tau - self.last.tau0, &mut out);
         out
     }
-}
 
-/// Validate a start (τ, z) and return its region (see [`entering_region`]).
-pub(crate) fn checked_start(
-    model: &CantileverModel,
-    tau: f64,
-    z: &DVector<f64>,
-) -> Result<Region, SimError> {
-    finite("initial time", tau)?;
-    model.check_state("initial state", z)?;
-    Ok(entering_region(model, tau, z))
-}
-
-/// Region of a state on entering the integration: contact when V_T < 0, or V_T = 0 moving
-/// inwards (dV_T/dτ ≤ 0); free otherwise.
-pub(crate) fn entering_region(model: &CantileverModel, tau: f64, z: &DVector<f64>) -> Region {
-    let v = model.v_t(tau, z);
-    if v < 0.0 || (v == 0.0 && model.v_t_dot(tau, z) <= 0.0) {
-        Region::Contact
-    } else {
-        Region::Free
+    fn last_step_jacobian(&mut self) -> Result<DMatrix<f64>, SimError> {
+        Ok(self.step_transition())
     }
 }

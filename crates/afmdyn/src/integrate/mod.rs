@@ -4,11 +4,17 @@
 //!   fixed grid aligned with the drive period) with rigorously located switchings. Default.
 //! * [`rk4::Rk4`] — the paper's fixed-step fourth-order Runge–Kutta, with located switchings
 //!   or, as in the paper, with the region chosen per stage from the sign of V_T.
-//! * [`adaptive::AdaptiveOracle`] — DOP853 from the `differential-equations` crate with terminal
-//!   events, an independent oracle.
+//! * [`adaptive::Adaptive`] — DOP853 (the `differential-equations` crate) driven step by step,
+//!   written against [`crate::system::HybridSystem`] only: any contact law, located events with
+//!   jumps (impacts, sticking), and the variational equations for step Jacobians. The default
+//!   for every law except the linear one, and the independent oracle for the linear law.
+//!
+//! [`IntegratorKind::Auto`] (the default) chooses the exact propagator for the linear law and
+//! the adaptive integrator otherwise.
 //!
 //! A driver calls [`Integrator::step`] until the target time; each step ends at a grid point,
-//! at `tau_max`, or at a switching, which it reports as a [`SwitchEvent`].
+//! at `tau_max`, or at an event (switching, impact, sticking, release), which it reports as a
+//! [`SwitchEvent`].
 
 pub mod adaptive;
 pub mod exact;
@@ -17,33 +23,60 @@ pub mod rk4;
 use crate::error::SimError;
 use crate::galerkin::Region;
 use crate::model::CantileverModel;
-use nalgebra::DVector;
+use crate::system::EventKind;
+use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 use std::str::FromStr;
 
-/// A located switching between the free and contact regions.
+/// A located event: a switching between the free and contact regions, an impact, the start of
+/// sticking or a release.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SwitchEvent {
-    /// Time of the switching (dimensionless τ).
+    /// Time of the event (dimensionless τ).
     pub tau: f64,
     /// Region before.
     pub from: Region,
     /// Region after.
     pub to: Region,
-    /// dV_T/dτ at the switching (impact velocity when entering contact).
+    /// What happened.
+    pub kind: EventKind,
+    /// dV_T/dτ just before the event (the impact velocity when entering contact).
     pub v_t_dot: f64,
-    /// State z = (a, ȧ) at the switching, shape `[2N]`.
+    /// State z⁻ = (a, ȧ) just before the event, shape `[2N]` (the state after it is the
+    /// integrator's state).
     pub state: DVector<f64>,
 }
 
 impl Step {
-    /// A step of `model` in region `from` that ends at a switching at (τ_s, z_s).
+    /// A step of `model` in region `from` that ends at a plain switching at (τ_s, z_s).
     pub fn switched(
         model: &CantileverModel,
         tau0: f64,
         from: Region,
         tau_s: f64,
         z_s: &DVector<f64>,
+    ) -> Step {
+        Self::with_event(
+            model,
+            tau0,
+            from,
+            tau_s,
+            z_s,
+            from.other(),
+            EventKind::Switching,
+        )
+    }
+
+    /// A step of `model` in region `from` that ends at an event of `kind` at (τ_s, z⁻) into
+    /// region `to`.
+    pub fn with_event(
+        model: &CantileverModel,
+        tau0: f64,
+        from: Region,
+        tau_s: f64,
+        z_minus: &DVector<f64>,
+        to: Region,
+        kind: EventKind,
     ) -> Step {
         Step {
             tau0,
@@ -52,9 +85,10 @@ impl Step {
             event: Some(SwitchEvent {
                 tau: tau_s,
                 from,
-                to: from.other(),
-                v_t_dot: model.v_t_dot(tau_s, z_s),
-                state: z_s.clone(),
+                to,
+                kind,
+                v_t_dot: model.v_t_dot(tau_s, z_minus),
+                state: z_minus.clone(),
             }),
         }
     }
@@ -106,6 +140,18 @@ pub trait Integrator: Send {
         let w = self.dense_tip(tau);
         self.model().v_t_from_tip(tau, w)
     }
+    /// Jacobian ∂z(τ1)/∂z(τ0) of the flow over the last step [τ0, τ1] inside its region,
+    /// 2N×2N, without the saltation of an event that ends it.
+    ///
+    /// # Errors
+    /// [`SimError::Unsupported`] for an integrator without step Jacobians (RK4), and for the
+    /// adaptive integrator unless [`Integrator::set_variational`] was switched on before the step.
+    fn last_step_jacobian(&mut self) -> Result<DMatrix<f64>, SimError>;
+    /// Integrate the variational equations along with the state (needed by
+    /// [`Integrator::last_step_jacobian`] of the adaptive integrator; free for the exact one).
+    fn set_variational(&mut self, on: bool) {
+        let _ = on;
+    }
     /// Integrator name.
     fn name(&self) -> &'static str;
 }
@@ -134,8 +180,10 @@ pub fn advance_dyn(
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "kebab-case")]
 pub enum IntegratorKind {
-    /// Exact piecewise-linear propagation (default).
+    /// The exact propagator for the linear law, the adaptive integrator otherwise (default).
     #[default]
+    Auto,
+    /// Exact piecewise-linear propagation (linear law only).
     Exact,
     /// Fixed-step RK4 with located switchings.
     Rk4,
@@ -149,12 +197,13 @@ impl FromStr for IntegratorKind {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
         match s.trim().to_ascii_lowercase().as_str() {
+            "auto" => Ok(IntegratorKind::Auto),
             "exact" => Ok(IntegratorKind::Exact),
             "rk4" => Ok(IntegratorKind::Rk4),
             "rk4-naive" | "rk4_naive" => Ok(IntegratorKind::Rk4Naive),
             "adaptive" | "dop853" => Ok(IntegratorKind::Adaptive),
             _ => Err(format!(
-                "integrator '{s}': expected exact, rk4, rk4-naive or adaptive"
+                "integrator '{s}': expected auto, exact, rk4, rk4-naive or adaptive"
             )),
         }
     }
@@ -172,20 +221,34 @@ pub struct IntegratorOptions {
     pub tolerance: f64,
 }
 
+impl IntegratorKind {
+    /// The concrete integrator for `model`: [`IntegratorKind::Auto`] resolves to `Exact` for an
+    /// affine (linear-law) model and to `Adaptive` otherwise; other kinds are returned as given.
+    pub fn resolve(self, model: &CantileverModel) -> IntegratorKind {
+        match self {
+            IntegratorKind::Auto if model.law().is_affine() => IntegratorKind::Exact,
+            IntegratorKind::Auto => IntegratorKind::Adaptive,
+            k => k,
+        }
+    }
+}
+
 impl Default for IntegratorOptions {
     fn default() -> Self {
         IntegratorOptions {
-            kind: IntegratorKind::Exact,
+            kind: IntegratorKind::Auto,
             steps_per_period: 1,
             tolerance: 1e-12,
         }
     }
 }
 
-/// Build an integrator of `model` starting at (τ, z).
+/// Build an integrator of `model` starting at (τ, z) ([`IntegratorKind::Auto`] resolved by
+/// [`IntegratorKind::resolve`]).
 ///
 /// # Errors
-/// [`SimError`] for invalid options or initial state.
+/// [`SimError`] for invalid options or initial state; [`SimError::Unsupported`] for the exact
+/// propagator with a nonlinear law, or RK4 with the impact law.
 pub fn build(
     model: &CantileverModel,
     opts: IntegratorOptions,
@@ -199,8 +262,18 @@ pub fn build(
             "must be in 1..=10000000",
         ));
     }
-    let mut integ: Box<dyn Integrator> = match opts.kind {
-        IntegratorKind::Exact => Box::new(exact::ExactPropagator::try_new(
+    let kind = opts.kind.resolve(model);
+    if matches!(kind, IntegratorKind::Rk4 | IntegratorKind::Rk4Naive)
+        && model.law().restitution().is_some()
+    {
+        return Err(SimError::Unsupported {
+            integrator: "rk4",
+            law: model.law().name(),
+            hint: "impacts need located events with jumps: use --integrator adaptive (or auto)",
+        });
+    }
+    let mut integ: Box<dyn Integrator> = match kind {
+        IntegratorKind::Auto | IntegratorKind::Exact => Box::new(exact::ExactPropagator::try_new(
             model,
             opts.steps_per_period,
         )?),
@@ -214,11 +287,30 @@ pub fn build(
                     "must be in (0, 1)",
                 ));
             }
-            Box::new(adaptive::AdaptiveOracle::new(model, opts.tolerance))
+            Box::new(adaptive::Adaptive::new(model, opts.tolerance))
         }
     };
     integ.reset(tau, z)?;
     Ok(integ)
+}
+
+/// y ← α A x (+ y when `accumulate`), A column-major with `x.len()` columns. Hand-written:
+/// nalgebra's dynamic gemv has a per-call overhead comparable to the 36 multiply–adds of N = 3,
+/// and this is the inner loop of the propagators and of the model's vector field.
+#[inline]
+pub(crate) fn matvec(a: &DMatrix<f64>, x: &[f64], y: &mut [f64], alpha: f64, accumulate: bool) {
+    let rows = a.nrows();
+    debug_assert_eq!(rows, y.len());
+    debug_assert_eq!(a.ncols(), x.len());
+    if !accumulate {
+        y.fill(0.0);
+    }
+    for (col, &xj) in a.as_slice().chunks_exact(rows).zip(x) {
+        let s = alpha * xj;
+        for (yi, aij) in y.iter_mut().zip(col) {
+            *yi += aij * s;
+        }
+    }
 }
 
 /// End points of the last step of a Runge–Kutta integrator, for Hermite dense output:

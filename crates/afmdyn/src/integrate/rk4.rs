@@ -9,12 +9,11 @@
 //!   overshoot the discontinuity; a switching is reported at the end of the step where the
 //!   region changed.
 
-use super::exact::checked_start;
 use super::{HermiteStep, Integrator, Step};
 use crate::error::SimError;
 use crate::galerkin::Region;
 use crate::model::CantileverModel;
-use nalgebra::DVector;
+use nalgebra::{DMatrix, DVector};
 
 /// Fixed-step RK4 integrator on a grid of `steps` sub-steps per drive period.
 #[derive(Debug, Clone)]
@@ -130,7 +129,7 @@ impl Integrator for Rk4 {
     }
 
     fn reset(&mut self, tau: f64, z: &DVector<f64>) -> Result<(), SimError> {
-        self.region = checked_start(&self.model, tau, z)?;
+        self.region = self.model.checked_start(tau, z)?;
         self.tau = tau;
         self.z.copy_from(z);
         Ok(())
@@ -244,6 +243,14 @@ impl Integrator for Rk4 {
 
     fn dense_state(&mut self, tau: f64) -> DVector<f64> {
         self.last.state(tau)
+    }
+
+    fn last_step_jacobian(&mut self) -> Result<DMatrix<f64>, SimError> {
+        Err(SimError::Unsupported {
+            integrator: self.name(),
+            law: self.model.law().name(),
+            hint: "step Jacobians need --integrator exact or adaptive",
+        })
     }
 }
 

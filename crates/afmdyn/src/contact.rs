@@ -1,0 +1,364 @@
+//! Tip–sample force laws F_c(δ, δ̇), in the paper's dimensionless units.
+//!
+//! δ = −V_T is the indentation (V_T of eq. 8) and δ̇ = −dV_T/dτ its rate. F_c is **repulsive
+//! positive** (it pushes the tip away from the sample) and enters the modal equations as the tip
+//! force φ(1)·F_c:
+//!
+//! M ä + C ȧ + K a = F^I(τ) + φ(1) F_c(δ, δ̇)   (eqs. 11–14 with the contact at ξ = 1).
+//!
+//! For the linear law F_c = α4 δ + α6 δ̇ this is exactly eqs. 15–18 (K^II = K^I + α4 φφᵀ,
+//! C^II = C^I + α6 φφᵀ, F^II = F^I − φ(α4(α2 sin Ωτ + α5) + α6 α2 Ω cos Ωτ)).
+//! A force is the scaled force F̃ = F L³/(EI g₀), the unit of α4 V_T.
+//!
+//! Laws ([`ContactLaw`]):
+//! * `linear` — the paper: F_c = α4 δ + α6 δ̇ while δ ≥ 0 (eqs. 16–18).
+//! * `hertz` — F_c = α4 δ^{3/2} + α6 δ̇ while δ ≥ 0 (Hertz 1882; Johnson, *Contact Mechanics*,
+//!   CUP 1985, §4.2: F = (4/3) E* √R δ^{3/2}, so α4 = (4/3) E* √(R g₀) L³/(EI)).
+//! * `dmt` — Derjaguin, Muller & Toporov, *J. Colloid Interface Sci.* 53 (1975) 314: with the
+//!   tip–sample distance d = V_T + a₀ (contact at d ≤ a₀, i.e. V_T ≤ 0),
+//!   F_c = −H/(a₀ + V_T)² outside contact (van der Waals, sphere–plane, H = H_amaker R/6 scaled:
+//!   H̃ = H_amaker R L³/(6 EI g₀³)), and
+//!   F_c = −H/a₀² + α4 δ^{3/2} + α6 √δ δ̇ in contact (constant DMT adhesion, Hertz repulsion,
+//!   Kelvin–Voigt damping ∝ contact radius √(Rδ); see García & San Paulo, *Phys. Rev. B* 60
+//!   (1999) 4961 and Garcia, *Amplitude Modulation AFM*, Wiley 2010, ch. 3). The force is
+//!   continuous at δ = 0, so the free flight is nonlinear but the switching has no force jump.
+//! * `impact` — the impact oscillator of the paper's Fig. 1b: a rigid sample at V_T = 0 with
+//!   Newton's coefficient of restitution r: dV_T/dτ⁺ = −r dV_T/dτ⁻ (Shaw & Holmes, *J. Sound Vib.*
+//!   90 (1983) 129; Nordmark, *J. Sound Vib.* 145 (1991) 279). No force acts in free flight; the
+//!   impulse and the sticking phase are handled by the model ([`crate::model`]).
+
+use serde::{Deserialize, Serialize};
+use std::fmt;
+use std::str::FromStr;
+
+/// A tip–sample law and its own dimensionless groups. The stiffness α4 and damping α6 of
+/// [`crate::Params`] are shared by the linear, Hertz and DMT laws.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
+#[serde(tag = "law", rename_all = "lowercase")]
+pub enum ContactLaw {
+    /// The paper's spring–damper: F_c = α4 δ + α6 δ̇ (eqs. 16–18).
+    #[default]
+    Linear,
+    /// Hertz sphere–flat repulsion with a viscous damper: F_c = α4 δ^{3/2} + α6 δ̇.
+    Hertz,
+    /// DMT: van der Waals attraction outside contact, adhesion + Hertz + Kelvin–Voigt inside.
+    Dmt {
+        /// H̃ = H_amaker R L³/(6 EI g₀³) ≥ 0: F_vdW = −H̃/d² with d = a₀ + V_T.
+        hamaker: f64,
+        /// ã₀ = a₀/g₀ > 0: intermolecular distance, the contact threshold.
+        intermolecular_distance: f64,
+    },
+    /// Rigid sample with coefficient of restitution r ∈ [0, 1] (impact oscillator, Fig. 1b).
+    Impact {
+        /// Newton's coefficient of restitution r.
+        restitution: f64,
+    },
+}
+
+impl ContactLaw {
+    /// The law's name: `linear`, `hertz`, `dmt` or `impact`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            ContactLaw::Linear => "linear",
+            ContactLaw::Hertz => "hertz",
+            ContactLaw::Dmt { .. } => "dmt",
+            ContactLaw::Impact { .. } => "impact",
+        }
+    }
+
+    /// Whether each region is affine in the state (the exact propagator applies).
+    pub fn is_affine(&self) -> bool {
+        matches!(self, ContactLaw::Linear)
+    }
+
+    /// Coefficient of restitution of the impact law.
+    pub fn restitution(&self) -> Option<f64> {
+        match self {
+            ContactLaw::Impact { restitution } => Some(*restitution),
+            _ => None,
+        }
+    }
+
+    /// Check the law's own groups: DMT H̃ ≥ 0 finite, 0 < ã₀ ≤ 1e6; impact 0 ≤ r ≤ 1.
+    ///
+    /// # Errors
+    /// [`crate::ParamError::Law`] naming the group and its allowed range.
+    pub fn validate(&self) -> Result<(), crate::ParamError> {
+        let bad = |name: &'static str, value: f64, range: &'static str| {
+            Err(crate::ParamError::Law { name, value, range })
+        };
+        match *self {
+            ContactLaw::Linear | ContactLaw::Hertz => Ok(()),
+            ContactLaw::Dmt {
+                hamaker,
+                intermolecular_distance,
+            } => {
+                if !(hamaker.is_finite() && (0.0..=1e12).contains(&hamaker)) {
+                    return bad("hamaker (DMT group H̃)", hamaker, "0 ≤ H̃ ≤ 1e12");
+                }
+                if !(intermolecular_distance.is_finite()
+                    && intermolecular_distance > 0.0
+                    && intermolecular_distance <= 1e6)
+                {
+                    return bad(
+                        "intermolecular_distance (DMT ã₀)",
+                        intermolecular_distance,
+                        "0 < ã₀ ≤ 1e6",
+                    );
+                }
+                Ok(())
+            }
+            ContactLaw::Impact { restitution } => {
+                if !(restitution.is_finite() && (0.0..=1.0).contains(&restitution)) {
+                    return bad("restitution (impact r)", restitution, "0 ≤ r ≤ 1");
+                }
+                Ok(())
+            }
+        }
+    }
+}
+
+impl fmt::Display for ContactLaw {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// The kind of a law without its groups, parsed from `linear|hertz|dmt|impact`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum LawKind {
+    /// [`ContactLaw::Linear`].
+    #[default]
+    Linear,
+    /// [`ContactLaw::Hertz`].
+    Hertz,
+    /// [`ContactLaw::Dmt`].
+    Dmt,
+    /// [`ContactLaw::Impact`].
+    Impact,
+}
+
+impl FromStr for LawKind {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "linear" => Ok(LawKind::Linear),
+            "hertz" => Ok(LawKind::Hertz),
+            "dmt" => Ok(LawKind::Dmt),
+            "impact" => Ok(LawKind::Impact),
+            _ => Err(format!(
+                "contact law '{s}': expected linear, hertz, dmt or impact"
+            )),
+        }
+    }
+}
+
+/// Default DMT groups: H̃ = 0.05, ã₀ = 0.01 (weak attraction next to α4 = 20).
+pub const DMT_DEFAULT_HAMAKER: f64 = 0.05;
+/// Default DMT intermolecular distance ã₀.
+pub const DMT_DEFAULT_A0: f64 = 0.01;
+/// Default coefficient of restitution of the impact law.
+pub const IMPACT_DEFAULT_RESTITUTION: f64 = 0.8;
+
+impl LawKind {
+    /// Build the law, filling groups that are not given with the defaults above.
+    pub fn with_groups(
+        self,
+        hamaker: Option<f64>,
+        intermolecular_distance: Option<f64>,
+        restitution: Option<f64>,
+    ) -> ContactLaw {
+        match self {
+            LawKind::Linear => ContactLaw::Linear,
+            LawKind::Hertz => ContactLaw::Hertz,
+            LawKind::Dmt => ContactLaw::Dmt {
+                hamaker: hamaker.unwrap_or(DMT_DEFAULT_HAMAKER),
+                intermolecular_distance: intermolecular_distance.unwrap_or(DMT_DEFAULT_A0),
+            },
+            LawKind::Impact => ContactLaw::Impact {
+                restitution: restitution.unwrap_or(IMPACT_DEFAULT_RESTITUTION),
+            },
+        }
+    }
+}
+
+/// F_c and its partial derivatives at (δ, δ̇).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ForceEval {
+    /// F_c (repulsive positive).
+    pub force: f64,
+    /// ∂F_c/∂δ.
+    pub d_delta: f64,
+    /// ∂F_c/∂δ̇.
+    pub d_rate: f64,
+}
+
+/// A tip–sample force law: the force in and out of contact with its partial derivatives, the
+/// conservative potential (for the energy) and the dissipative part (for the dissipation rate).
+pub trait TipSampleLaw {
+    /// F_c(δ, δ̇) with partials; `contact` is the region (δ ≥ 0 in contact for a smooth law).
+    fn force(&self, contact: bool, delta: f64, rate: f64) -> ForceEval;
+    /// Potential U(δ) of the conservative part, with −dU/dV_T = dU/dδ = F_cons (0 at δ = 0 for
+    /// the linear and Hertz laws; continuous across δ = 0).
+    fn potential(&self, contact: bool, delta: f64) -> f64;
+    /// Dissipative part F_d of F_c: the dissipation rate is F_d δ̇ ≥ 0.
+    fn dissipative(&self, contact: bool, delta: f64, rate: f64) -> f64;
+    /// Whether the law acts outside contact (δ < 0).
+    fn acts_outside(&self) -> bool;
+}
+
+/// A law with its stiffness α4 and damping α6: what the model evaluates.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TipSample {
+    /// The law.
+    pub law: ContactLaw,
+    /// α4: stiffness of the linear law, Hertz group of the Hertz and DMT laws.
+    pub stiffness: f64,
+    /// α6: damper of the linear and Hertz laws, Kelvin–Voigt group of DMT.
+    pub damping: f64,
+}
+
+impl TipSampleLaw for TipSample {
+    fn force(&self, contact: bool, delta: f64, rate: f64) -> ForceEval {
+        let (k, c) = (self.stiffness, self.damping);
+        match self.law {
+            ContactLaw::Linear if contact => ForceEval {
+                force: k * delta + c * rate,
+                d_delta: k,
+                d_rate: c,
+            },
+            ContactLaw::Hertz if contact => {
+                let d = delta.max(0.0);
+                let s = d.sqrt();
+                ForceEval {
+                    force: k * d * s + c * rate,
+                    d_delta: 1.5 * k * s,
+                    d_rate: c,
+                }
+            }
+            ContactLaw::Dmt {
+                hamaker,
+                intermolecular_distance: a0,
+            } => {
+                if contact {
+                    let d = delta.max(0.0);
+                    let s = d.sqrt();
+                    // ∂(√δ δ̇)/∂δ = δ̇/(2√δ): integrable singularity at δ = 0, 0 there
+                    let visc_d = if s > 0.0 { 0.5 * c * rate / s } else { 0.0 };
+                    ForceEval {
+                        force: -hamaker / (a0 * a0) + k * d * s + c * s * rate,
+                        d_delta: 1.5 * k * s + visc_d,
+                        d_rate: c * s,
+                    }
+                } else {
+                    // d = a₀ + V_T = a₀ − δ > a₀
+                    let d = a0 - delta;
+                    ForceEval {
+                        force: -hamaker / (d * d),
+                        d_delta: -2.0 * hamaker / (d * d * d),
+                        d_rate: 0.0,
+                    }
+                }
+            }
+            _ => ForceEval::default(),
+        }
+    }
+
+    fn potential(&self, contact: bool, delta: f64) -> f64 {
+        let k = self.stiffness;
+        match self.law {
+            ContactLaw::Linear if contact => 0.5 * k * delta * delta,
+            ContactLaw::Hertz if contact => 0.4 * k * delta.max(0.0).powf(2.5),
+            ContactLaw::Dmt {
+                hamaker,
+                intermolecular_distance: a0,
+            } => {
+                if contact {
+                    -hamaker / a0 - hamaker * delta / (a0 * a0) + 0.4 * k * delta.max(0.0).powf(2.5)
+                } else {
+                    -hamaker / (a0 - delta)
+                }
+            }
+            _ => 0.0,
+        }
+    }
+
+    fn dissipative(&self, contact: bool, delta: f64, rate: f64) -> f64 {
+        if !contact {
+            return 0.0;
+        }
+        match self.law {
+            ContactLaw::Linear | ContactLaw::Hertz => self.damping * rate,
+            ContactLaw::Dmt { .. } => self.damping * delta.max(0.0).sqrt() * rate,
+            ContactLaw::Impact { .. } => 0.0,
+        }
+    }
+
+    fn acts_outside(&self) -> bool {
+        matches!(self.law, ContactLaw::Dmt { .. })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn laws() -> Vec<TipSample> {
+        [
+            ContactLaw::Linear,
+            ContactLaw::Hertz,
+            ContactLaw::Dmt {
+                hamaker: 0.3,
+                intermolecular_distance: 0.02,
+            },
+        ]
+        .into_iter()
+        .map(|law| TipSample {
+            law,
+            stiffness: 20.0,
+            damping: 0.2,
+        })
+        .collect()
+    }
+
+    /// The partial derivatives are those of the force (central differences), and the
+    /// conservative part is −dU/dV_T = dU/dδ (definition of the potential).
+    #[test]
+    fn partials_and_potential_are_consistent() {
+        for ts in laws() {
+            for &(contact, delta, rate) in &[
+                (true, 0.07, 0.3),
+                (true, 0.5, -1.2),
+                (false, -0.05, 0.4),
+                (false, -0.8, -2.0),
+            ] {
+                let f = ts.force(contact, delta, rate);
+                let h = 1e-6;
+                let fd = (ts.force(contact, delta + h, rate).force
+                    - ts.force(contact, delta - h, rate).force)
+                    / (2.0 * h);
+                let fr = (ts.force(contact, delta, rate + h).force
+                    - ts.force(contact, delta, rate - h).force)
+                    / (2.0 * h);
+                assert!((f.d_delta - fd).abs() < 1e-6 * (1.0 + fd.abs()), "{ts:?}");
+                assert!((f.d_rate - fr).abs() < 1e-6 * (1.0 + fr.abs()), "{ts:?}");
+                let du = (ts.potential(contact, delta + h) - ts.potential(contact, delta - h))
+                    / (2.0 * h);
+                let cons = f.force - ts.dissipative(contact, delta, rate);
+                assert!((du - cons).abs() < 1e-6 * (1.0 + du.abs()), "{ts:?}");
+            }
+        }
+    }
+
+    /// DMT is continuous at the contact threshold (force and potential), the DMT adhesion
+    /// force is H̃/ã₀² there.
+    #[test]
+    fn dmt_is_continuous_at_contact() {
+        let ts = laws()[2];
+        let (inside, outside) = (ts.force(true, 0.0, 0.0), ts.force(false, 0.0, 0.0));
+        assert!((inside.force - outside.force).abs() < 1e-12);
+        assert!((inside.force + 0.3 / (0.02 * 0.02)).abs() < 1e-9);
+        assert!((ts.potential(true, 0.0) - ts.potential(false, 0.0)).abs() < 1e-12);
+    }
+}
