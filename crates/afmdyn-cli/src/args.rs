@@ -75,7 +75,7 @@ pub struct ModelArgs {
     /// Coefficient of restitution r of the impact law, 0..=1 (default 0.8)
     #[arg(long, value_name = "r", allow_negative_numbers = true)]
     pub restitution: Option<f64>,
-    /// DMT van der Waals group H̃ = H R L³/(6 EI g0³) ≥ 0 (default 0.05)
+    /// DMT van der Waals group H̃ = H R L³/(6 EI g0³) ≥ 0 (default 1e-5)
     #[arg(long, value_name = "H̃", allow_negative_numbers = true)]
     pub hamaker: Option<f64>,
     /// DMT intermolecular distance ã0 = a0/g0 > 0, the contact threshold (default 0.01)

@@ -154,8 +154,10 @@ impl FromStr for LawKind {
     }
 }
 
-/// Default DMT groups: H̃ = 0.05, ã₀ = 0.01 (weak attraction next to α4 = 20).
-pub const DMT_DEFAULT_HAMAKER: f64 = 0.05;
+/// Default DMT groups: H̃ = 1e-5, ã₀ = 0.01, an adhesion force H̃/ã₀² = 0.1, about 5 % of the
+/// largest repulsive force of the default tapping motion (α4 δ^{3/2} ≈ 2 at δ ≈ 0.1), as for a
+/// silicon tip on a polymer (F_ad ≈ 4 nN against k A₀ ≈ 400 nN).
+pub const DMT_DEFAULT_HAMAKER: f64 = 1e-5;
 /// Default DMT intermolecular distance ã₀.
 pub const DMT_DEFAULT_A0: f64 = 0.01;
 /// Default coefficient of restitution of the impact law.

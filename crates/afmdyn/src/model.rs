@@ -16,8 +16,8 @@
 //! §4.2; m_eff = 1/(φᵀM⁻¹φ) is the modal mass at the tip). Region II is **sticking**: the tip
 //! moves with the sample (V_T ≡ 0) under the constraint force λ = −m_eff V̈_T^free, the force that
 //! cancels the free tip acceleration relative to the sample; the tip leaves when λ falls to 0.
-//! A chattering sequence (impact velocities decaying as rᵏ) ends in sticking once
-//! |V̇_T⁻| ≤ [`STICK_VELOCITY`] and λ > 0.
+//! A chattering sequence (impact velocities decaying as rᵏ) ends in sticking once the next bounce
+//! would rise less than [`STICK_HEIGHT_TOLERANCES`] guard tolerances while λ > 0.
 
 use crate::contact::{ContactLaw, TipSample, TipSampleLaw};
 use crate::error::{ParamError, SimError};
@@ -26,10 +26,17 @@ use crate::params::Params;
 use crate::system::{EventKind, Guard, HybridSystem, Jump};
 use nalgebra::{DMatrix, DVector};
 
-/// Impact velocity below which a chattering sequence ends in sticking (units of g₀ per unit τ;
-/// the paper's drive velocity α2 Ω is ≈ 0.26). With r < 1 the impact velocities decay as rᵏ, so
-/// at most ln(1e-10/|V̇_T⁻(0)|)/ln r impacts precede the sticking.
-pub const STICK_VELOCITY: f64 = 1e-10;
+/// A chattering sequence ends in sticking when the next bounce would rise less than this many
+/// guard tolerances above the sample (1e3 × 1e-12 (1 + α2 + |α5|) ≈ 1e-9 of the gap g₀). The
+/// bounce after an impact at V̇_T⁻ rises h = m_eff (r V̇_T⁻)²/(2λ), λ > 0 the compressive force
+/// that would hold the tip on the sample; below this height single bounces are not resolved by
+/// the round-off dead band of the event search. The impact velocities decay as rᵏ, so at most
+/// ln(h_stick/h₀)/(2 ln r) impacts precede the sticking, and the sticking starts at most
+/// 2 r v/(|V̈_T|(1 − r)) before the accumulation point of the unresolved impacts.
+pub const STICK_HEIGHT_TOLERANCES: f64 = 1e3;
+
+/// Baumgarte rate of the sticking constraint, in units of Ω (see the sticking force λ).
+pub const BAUMGARTE_RATE: f64 = 10.0;
 
 /// First-order dynamics of one region: ż = A z + b_const + b_sin sin Ωτ + b_cos cos Ωτ.
 #[derive(Debug, Clone, PartialEq)]
@@ -204,9 +211,8 @@ impl CantileverModel {
         if linear {
             return;
         }
-        let (head, acc) = dz.split_at_mut(n);
-        let _ = head;
-        let f = self.tip_force_with(r, (s, c), z, acc);
+        let f = self.tip_force_with(r, tau, (s, c), z);
+        let acc = &mut dz[n..];
         if f != 0.0 {
             for (o, m) in acc.iter_mut().zip(self.mphi.iter()) {
                 *o += f * m;
@@ -217,25 +223,19 @@ impl CantileverModel {
     /// Tip force F_c (repulsive positive) in region r at (τ, z): the law's force, or in the
     /// sticking region of the impact law the constraint force λ.
     pub fn contact_force(&self, r: Region, tau: f64, z: &DVector<f64>) -> f64 {
-        let n = self.modes();
         let sc = (self.params.omega * tau).sin_cos();
-        let mut dz = vec![0.0; 2 * n];
-        if matches!(self.law.law, ContactLaw::Impact { .. }) && r == Region::Contact {
-            self.rhs_slice(Region::Free, tau, z.as_slice(), &mut dz);
-        }
-        self.tip_force_with(r, sc, z.as_slice(), &dz[n..])
+        self.tip_force_with(r, tau, sc, z.as_slice())
     }
 
-    /// F_c given sin/cos of Ωτ and, for sticking, the free modal acceleration `acc_free`.
-    fn tip_force_with(&self, r: Region, (s, c): (f64, f64), z: &[f64], acc_free: &[f64]) -> f64 {
+    /// F_c at τ given sin/cos of Ωτ.
+    fn tip_force_with(&self, r: Region, tau: f64, (s, c): (f64, f64), z: &[f64]) -> f64 {
         let p = &self.params;
         let n = p.modes;
         let contact = r == Region::Contact;
         match self.law.law {
             ContactLaw::Impact { .. } => {
                 if contact {
-                    let tip_acc: f64 = self.tip().iter().zip(acc_free).map(|(a, b)| a * b).sum();
-                    self.m_eff * (p.alpha2 * p.omega * p.omega * s - tip_acc)
+                    self.sticking_force(tau, z).value
                 } else {
                     0.0
                 }
@@ -254,8 +254,31 @@ impl CantileverModel {
 
     /// ∂ż/∂z at (τ, z) in region r into `jac` (2N×2N): A_I plus the rank-one tip-force term
     /// M⁻¹φ (∂F_c/∂z)ᵀ with ∂F_c/∂a = −(∂F_c/∂δ) φ, ∂F_c/∂ȧ = −(∂F_c/∂δ̇) φ; for sticking
-    /// ∂λ/∂z = −m_eff φᵀ[−M⁻¹K, −M⁻¹C]. The linear law gives A_s of eqs. 15–18.
+    /// ∂λ/∂z of the sticking force. The linear law gives A_s of eqs. 15–18.
     pub fn jacobian_into(&self, r: Region, tau: f64, z: &[f64], jac: &mut DMatrix<f64>) {
+        self.jacobian_parts(r, tau, z, jac, true);
+    }
+
+    /// The Kelvin–Voigt weight w = α6 √δ of DMT in contact (0 elsewhere): its τ-derivative
+    /// α6 δ̇/(2√δ) is the singular part of ∂F_c/∂δ at contact onset.
+    fn kelvin_voigt_weight(&self, r: Region, tau: f64, z: &[f64]) -> f64 {
+        if r != Region::Contact || !matches!(self.law.law, ContactLaw::Dmt { .. }) {
+            return 0.0;
+        }
+        let (v, _) = self.v_t_pair(tau, z);
+        self.law.damping * (-v).max(0.0).sqrt()
+    }
+
+    /// [`CantileverModel::jacobian_into`], without the singular Kelvin–Voigt term when
+    /// `singular` is false.
+    fn jacobian_parts(
+        &self,
+        r: Region,
+        tau: f64,
+        z: &[f64],
+        jac: &mut DMatrix<f64>,
+        singular: bool,
+    ) {
         let n = self.modes();
         let linear = self.law.law.is_affine();
         jac.copy_from(&self.regions[if linear { r.index() } else { 0 }].a);
@@ -266,7 +289,7 @@ impl CantileverModel {
         match self.law.law {
             ContactLaw::Impact { .. } => {
                 if r == Region::Contact {
-                    row.copy_from(&(-self.m_eff * &self.tip_acc));
+                    row.copy_from(&self.sticking_force(tau, z).grad);
                 }
             }
             _ => {
@@ -274,7 +297,14 @@ impl CantileverModel {
                     let [v, vd, _] = self
                         .v_t_from_tip(tau, [self.w_tip_slice(z, 0), self.w_tip_slice(z, n), 0.0]);
                     let f = self.law.force(r == Region::Contact, -v, -vd);
-                    row.rows_mut(0, n).copy_from(&(-f.d_delta * self.tip()));
+                    let w = self.kelvin_voigt_weight(r, tau, z);
+                    let d_delta = if singular || w == 0.0 {
+                        f.d_delta
+                    } else {
+                        // remove α6 δ̇/(2√δ) = α6² δ̇/(2w)
+                        f.d_delta - 0.5 * self.law.damping * self.law.damping * (-vd) / w
+                    };
+                    row.rows_mut(0, n).copy_from(&(-d_delta * self.tip()));
                     row.rows_mut(n, n).copy_from(&(-f.d_rate * self.tip()));
                 }
             }
@@ -384,18 +414,35 @@ impl CantileverModel {
     }
 
     /// Constraint force λ of sticking (impact law) at (τ, z), with its gradient and τ-rate:
-    /// λ = m_eff (α2 Ω² sin Ωτ − φᵀä_free).
+    /// λ = m_eff (α2 Ω² sin Ωτ − φᵀä_free − 2β V̇_T − β² V_T), the force that gives
+    /// V̈_T = −2β V̇_T − β² V_T: zero on the constraint V_T = V̇_T = 0, and Baumgarte's
+    /// stabilisation of the integration drift off it (Baumgarte, *Comput. Methods Appl. Mech.
+    /// Eng.* 1 (1972) 1), with β = [`BAUMGARTE_RATE`] Ω.
     fn sticking_force(&self, tau: f64, z: &[f64]) -> Guard {
         let p = &self.params;
+        let n = p.modes;
         let om = p.omega;
+        let beta = BAUMGARTE_RATE * om;
         let (s, c) = (om * tau).sin_cos();
         let [f0, fs, fc] = self.tip_acc_forcing;
         let acc =
             self.tip_acc.iter().zip(z).map(|(a, b)| a * b).sum::<f64>() + f0 + fs * s + fc * c;
+        let (v, vd) = self.v_t_pair(tau, z);
+        let mut grad = -self.m_eff * &self.tip_acc;
+        for (j, phi) in self.tip().iter().enumerate() {
+            grad[j] -= self.m_eff * beta * beta * phi;
+            grad[n + j] -= self.m_eff * 2.0 * beta * phi;
+        }
+        let dv_tau = p.alpha2 * om * c;
+        let dvd_tau = -p.alpha2 * om * om * s;
         Guard {
-            value: self.m_eff * (p.alpha2 * om * om * s - acc),
-            grad: -self.m_eff * &self.tip_acc,
-            d_tau: self.m_eff * (p.alpha2 * om * om * om * c - om * (fs * c - fc * s)),
+            value: self.m_eff * (p.alpha2 * om * om * s - acc - 2.0 * beta * vd - beta * beta * v),
+            grad,
+            d_tau: self.m_eff
+                * (p.alpha2 * om * om * om * c
+                    - om * (fs * c - fc * s)
+                    - 2.0 * beta * dvd_tau
+                    - beta * beta * dv_tau),
         }
     }
 
@@ -417,26 +464,54 @@ impl CantileverModel {
         Ok(())
     }
 
-    /// Check a start (τ, z) and return its region: [`CantileverModel::check_state`], a finite
-    /// τ, and for the impact law no penetration of the rigid sample (V_T ≥ 0).
+    /// Check a start (τ, z) and return its region and the state to start from:
+    /// [`CantileverModel::check_state`] and a finite τ. For the impact law a start inside the
+    /// rigid sample (V_T < 0, e.g. a Newton iterate next to an orbit that sticks at the section)
+    /// is first brought to the surface by a plastic contact ([`CantileverModel::start_projection`]).
     ///
     /// # Errors
-    /// [`SimError::NotFinite`], [`SimError::StateLength`], or [`SimError::OutOfRange`] for a
-    /// start inside the rigid sample.
-    pub fn checked_start(&self, tau: f64, z: &DVector<f64>) -> Result<Region, SimError> {
+    /// [`SimError::NotFinite`] or [`SimError::StateLength`].
+    pub fn checked_start(
+        &self,
+        tau: f64,
+        z: &DVector<f64>,
+    ) -> Result<(Region, DVector<f64>), SimError> {
         crate::error::finite("initial time", tau)?;
         self.check_state("initial state", z)?;
-        if matches!(self.law.law, ContactLaw::Impact { .. }) {
-            let v = self.v_t(tau, z);
-            if v < 0.0 {
-                return Err(SimError::out_of_range(
-                    "initial V_T",
-                    v,
-                    "must be >= 0 for the impact law (the sample is rigid)",
-                ));
-            }
+        let z = match self.start_projection(tau, z) {
+            Some((projected, _)) => projected,
+            None => z.clone(),
+        };
+        Ok((self.mode_at(tau, z.as_slice()), z))
+    }
+
+    /// Impact law, start inside the sample (V_T < 0): the plastic contact that places it on the
+    /// surface, a ← a − V_T m_eff M⁻¹φ and, when V̇_T < 0, ȧ ← ȧ − V̇_T m_eff M⁻¹φ (the smallest
+    /// change in the kinetic metric with V_T = 0, V̇_T ≥ 0), with its Jacobian (2N×2N). `None`
+    /// for every other start and law.
+    pub fn start_projection(
+        &self,
+        tau: f64,
+        z: &DVector<f64>,
+    ) -> Option<(DVector<f64>, DMatrix<f64>)> {
+        self.law.law.restitution()?;
+        let (v, vd) = self.v_t_pair(tau, z.as_slice());
+        if v >= 0.0 {
+            return None;
         }
-        Ok(self.mode_at(tau, z.as_slice()))
+        let n = self.modes();
+        let k = self.m_eff;
+        let mut out = z.clone();
+        let mut jac = DMatrix::identity(2 * n, 2 * n);
+        out.rows_mut(0, n).axpy(-k * v, &self.mphi, 1.0);
+        jac.view_mut((0, 0), (n, n))
+            .ger(-k, &self.mphi, self.tip(), 1.0);
+        if vd < 0.0 {
+            out.rows_mut(n, n).axpy(-k * vd, &self.mphi, 1.0);
+            jac.view_mut((n, n), (n, n))
+                .ger(-k, &self.mphi, self.tip(), 1.0);
+        }
+        Some((out, jac))
     }
 
     /// The state at rest (a = ȧ = 0).
@@ -538,8 +613,9 @@ impl HybridSystem for CantileverModel {
     }
 
     /// Switchings are the identity; the impact law's free-flight guard is an impact (module
-    /// docs), ending in sticking when |V̇_T⁻| ≤ [`STICK_VELOCITY`] and λ > 0 after a plastic
-    /// impact; sticking ends in a release (identity).
+    /// docs), ending in sticking (a plastic impact) when the bounce would rise less than
+    /// [`STICK_HEIGHT_TOLERANCES`] guard tolerances against λ > 0; sticking ends in a release
+    /// (identity).
     fn jump(&self, from: Region, tau: f64, z: &[f64]) -> Jump {
         let Some(r) = self.law.law.restitution() else {
             return Jump::switching(from.other(), z);
@@ -562,8 +638,14 @@ impl HybridSystem for CantileverModel {
             state
         };
         let plastic = apply(0.0);
-        let sticks = v_minus.abs() <= STICK_VELOCITY
-            && self.sticking_force(tau, plastic.as_slice()).value > 0.0;
+        // stick when λ is compressive (or within its dead band of 0: about to become so) and the
+        // bounce would rise less than the resolvable height
+        let lambda = self.sticking_force(tau, plastic.as_slice()).value;
+        let bounce = r * v_minus;
+        let h_stick =
+            STICK_HEIGHT_TOLERANCES * self.guard_tolerance(Region::Free, tau, plastic.as_slice());
+        let sticks = lambda > -self.guard_tolerance(Region::Contact, tau, plastic.as_slice())
+            && self.m_eff * bounce * bounce <= 2.0 * h_stick * lambda.max(0.0);
         let r_eff = if sticks { 0.0 } else { r };
         let state = if sticks { plastic } else { apply(r) };
         // R = I − (1 + r) m_eff [0 0; M⁻¹φ φᵀ 0] on the velocity block (V̇_T⁻ = φᵀȧ + α2Ω cos Ωτ)
@@ -594,6 +676,68 @@ impl HybridSystem for CantileverModel {
 
     fn is_affine(&self) -> bool {
         self.law.law.is_affine()
+    }
+
+    /// 1e-12 of the guard's scale: of V_T, 1 + α2 + |α5|; of the constraint force of sticking,
+    /// m_eff (1 + α2 Ω²).
+    fn guard_tolerance(&self, mode: Region, _tau: f64, _z: &[f64]) -> f64 {
+        let p = &self.params;
+        if mode == Region::Contact && self.law.law.restitution().is_some() {
+            1e-12 * self.m_eff * (1.0 + p.alpha2 * p.omega * p.omega)
+        } else {
+            1e-12 * (1.0 + p.alpha2 + p.alpha5.abs())
+        }
+    }
+
+    /// For DMT in contact the Kelvin–Voigt term makes ∂F_c/∂δ ∋ α6 δ̇/(2√δ), unbounded at contact
+    /// onset (integrable: the tangent flow stays finite). With the rank-one nilpotent
+    /// E = [0; M⁻¹φ] w [φᵀ 0], w = α6√δ, and Ψ = (I + E)Φ, the singular part cancels against
+    /// E′: Ψ′ = (J_reg + [0; M⁻¹φ] w [0 φᵀ]) (I − E) Ψ, all terms bounded (J_reg: the Jacobian
+    /// without the singular term; (I + E)⁻¹ = I − E since [φᵀ 0][0; M⁻¹φ] = 0).
+    fn variational_rhs(
+        &self,
+        mode: Region,
+        tau: f64,
+        z: &[f64],
+        psi: &[f64],
+        dpsi: &mut [f64],
+        jac: &mut DMatrix<f64>,
+    ) {
+        let d = self.dim();
+        let n = self.modes();
+        let w = self.kelvin_voigt_weight(mode, tau, z);
+        self.jacobian_parts(mode, tau, z, jac, w == 0.0);
+        let psi = nalgebra::DMatrixView::from_slice(psi, d, d);
+        let mut out = nalgebra::DMatrixViewMut::from_slice(dpsi, d, d);
+        if w == 0.0 {
+            out.gemm(1.0, jac, &psi, 0.0);
+            return;
+        }
+        // J_reg + [0; M⁻¹φ] w [0 φᵀ]
+        let mut row = DVector::zeros(d);
+        row.rows_mut(n, n).copy_from(&(w * self.tip()));
+        jac.rows_mut(n, n).ger(1.0, &self.mphi, &row, 1.0);
+        // (I − E) Ψ: velocity rows minus M⁻¹φ w (φᵀ Ψ_top)
+        let mut tmp = psi.into_owned();
+        let top = self.tip().transpose() * tmp.rows(0, n);
+        tmp.rows_mut(n, n)
+            .ger(-w, &self.mphi, &top.transpose(), 1.0);
+        out.gemm(1.0, jac, &tmp, 0.0);
+    }
+
+    /// Ψ = (I + E)Φ (forward) or Φ = (I − E)Ψ, E as in [`HybridSystem::variational_rhs`].
+    fn to_tangent_coords(&self, mode: Region, tau: f64, z: &[f64], m: &mut [f64], forward: bool) {
+        let w = self.kelvin_voigt_weight(mode, tau, z);
+        if w == 0.0 {
+            return;
+        }
+        let d = self.dim();
+        let n = self.modes();
+        let mut mat = nalgebra::DMatrixViewMut::from_slice(m, d, d);
+        let top = self.tip().transpose() * mat.rows(0, n);
+        let sign = if forward { w } else { -w };
+        mat.rows_mut(n, n)
+            .ger(sign, &self.mphi, &top.transpose(), 1.0);
     }
 }
 

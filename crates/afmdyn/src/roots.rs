@@ -17,11 +17,16 @@ pub fn safeguarded_newton(
     offset: f64,
     g: &mut dyn FnMut(f64) -> (f64, f64),
 ) -> f64 {
-    let mut t = if glo - ghi > 0.0 {
+    // regula falsi start inside a true bracket, else the midpoint (the iterates never leave
+    // [lo, hi], so a caller's wrong bracket gives a point of it, never a panic)
+    let mut t = if glo > 0.0 && ghi <= 0.0 {
         lo + (hi - lo) * glo / (glo - ghi)
     } else {
         0.5 * (lo + hi)
     };
+    if !(t >= lo && t <= hi) {
+        t = 0.5 * (lo + hi);
+    }
     for _ in 0..100 {
         let (v, d) = g(t);
         if v > 0.0 {
@@ -41,7 +46,7 @@ pub fn safeguarded_newton(
             break;
         }
     }
-    t.clamp(lo, hi)
+    t.clamp(lo.min(hi), hi.max(lo))
 }
 
 /// Zero of the derivative f′ of a dense quantity on [a, b], given f′(a) = `fa_d` and f′(b) of
@@ -71,5 +76,8 @@ mod tests {
         assert!((t - 1.0).abs() < 1e-5);
         let t = extremum(1.0, 2.0, 1f64.cos(), &mut |t| [t.sin(), t.cos(), -t.sin()]);
         assert!((t - std::f64::consts::FRAC_PI_2).abs() <= 4.0 * f64::EPSILON);
+        // no sign change: a point of the interval, no panic
+        let t = safeguarded_newton(0.0, 1.0, 1.0, 2.0, 0.0, &mut |t| (1.0 + t, 1.0));
+        assert!((0.0..=1.0).contains(&t));
     }
 }

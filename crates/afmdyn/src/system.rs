@@ -97,8 +97,39 @@ pub trait HybridSystem: Send + Sync {
     fn guard_value(&self, mode: Region, tau: f64, z: &[f64]) -> f64 {
         self.guard(mode, tau, z).value
     }
+    /// Round-off dead band of the guard of `mode` at (τ, z): a zero counts only where g falls
+    /// below −tolerance, so a trajectory leaving the guard surface tangentially does not
+    /// re-trigger (default 1e-12).
+    fn guard_tolerance(&self, mode: Region, tau: f64, z: &[f64]) -> f64 {
+        let _ = (mode, tau, z);
+        1e-12
+    }
     /// The jump map applied where the guard of mode `from` vanishes.
     fn jump(&self, from: Region, tau: f64, z: &[f64]) -> Jump;
+    /// Right-hand side of the variational equations in tangent coordinates: dΨ = (∂f/∂z) Ψ
+    /// for the default identity coordinates ([`HybridSystem::to_tangent_coords`]). `psi` and
+    /// `dpsi` are d×d column-major. Systems whose Jacobian has an integrable singularity override
+    /// this together with the coordinate change.
+    fn variational_rhs(
+        &self,
+        mode: Region,
+        tau: f64,
+        z: &[f64],
+        psi: &[f64],
+        dpsi: &mut [f64],
+        jac: &mut DMatrix<f64>,
+    ) {
+        let d = self.dim();
+        self.jacobian(mode, tau, z, jac);
+        let psi = nalgebra::DMatrixView::from_slice(psi, d, d);
+        let mut out = nalgebra::DMatrixViewMut::from_slice(dpsi, d, d);
+        out.gemm(1.0, jac, &psi, 0.0);
+    }
+    /// Tangent coordinates Ψ = P(τ, z) Φ of mode `mode` (in place; `forward = false` applies
+    /// P⁻¹). Default: the identity.
+    fn to_tangent_coords(&self, mode: Region, tau: f64, z: &[f64], m: &mut [f64], forward: bool) {
+        let _ = (mode, tau, z, m, forward);
+    }
     /// Whether every mode is affine in z with a harmonic forcing and linear guards (the exact
     /// propagator applies).
     fn is_affine(&self) -> bool;

@@ -46,7 +46,11 @@ pub fn flow_with_jacobian(
     integ.reset(tau0, z0)?;
     let omega = integ.model().omega();
     let dim = z0.len();
-    let mut jac = DMatrix::identity(dim, dim);
+    // a start inside a rigid sample is first projected onto it (impact law): its Jacobian
+    let mut jac = match integ.model().start_projection(tau0, z0) {
+        Some((_, p)) => p,
+        None => DMatrix::identity(dim, dim),
+    };
     let mut out = FlowMap {
         state: z0.clone(),
         jacobian: DMatrix::zeros(0, 0),

@@ -132,13 +132,19 @@ pub fn shoot_with(
         let mut lambda = 1.0;
         loop {
             let trial = &z + &delta * lambda;
-            let tmap = stroboscopic(integ, &trial, n)?;
-            let tres = (&tmap.state - &trial).norm();
-            if tres < res || lambda < 1e-3 {
-                z = trial;
-                map = tmap;
-                res = tres;
-                break;
+            // a trial the map cannot start from (e.g. inside a rigid sample) is a failed trial
+            match stroboscopic(integ, &trial, n) {
+                Ok(tmap) => {
+                    let tres = (&tmap.state - &trial).norm();
+                    if tres < res || lambda < 1e-3 {
+                        z = trial;
+                        map = tmap;
+                        res = tres;
+                        break;
+                    }
+                }
+                Err(e) if lambda < 1e-3 => return Err(e),
+                Err(_) => {}
             }
             lambda *= 0.5;
         }

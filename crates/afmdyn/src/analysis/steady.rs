@@ -148,10 +148,14 @@ impl StatsObserver {
         if matches!(&step.event, Some(e) if e.to == Region::Contact) {
             self.contacts += 1;
         }
-        // end-point values first (borrowing the model), then the dense-output searches
+        // end-point values first (borrowing the model), then the dense-output searches; a step
+        // that ends at an event ends at the state before its jump
         let ((w0, w1), (d0, d1), (v0, v1), (vd0, vd1)) = {
             let model = integ.model();
-            let z1 = integ.state();
+            let z1 = match &step.event {
+                Some(e) => &e.state,
+                None => integ.state(),
+            };
             let body = self
                 .body
                 .get_or_insert_with(|| BodyContactCheck::new(model, 32));

@@ -30,7 +30,7 @@ use crate::system::HybridSystem;
 use differential_equations::interpolate::Interpolation;
 use differential_equations::methods::{DormandPrince, ExplicitRungeKutta, Ordinary};
 use differential_equations::ode::{OrdinaryNumericalMethod, ODE};
-use nalgebra::{DMatrix, DMatrixView, DMatrixViewMut, DVector};
+use nalgebra::{DMatrix, DVector};
 use std::cell::RefCell;
 
 /// The DOP853 stepper on `Vec<f64>` states.
@@ -65,10 +65,9 @@ impl<S: HybridSystem + ?Sized> ODE<f64, Vec<f64>> for ModeOde<'_, S> {
         self.sys.rhs(self.mode, t, &y[..d], &mut dydt[..d]);
         if self.variational {
             let mut j = self.jac.borrow_mut();
-            self.sys.jacobian(self.mode, t, &y[..d], &mut j);
-            let phi = DMatrixView::from_slice(&y[d..], d, d);
-            let mut out = DMatrixViewMut::from_slice(&mut dydt[d..], d, d);
-            out.gemm(1.0, &j, &phi, 0.0);
+            let (z, psi) = y.split_at(d);
+            self.sys
+                .variational_rhs(self.mode, t, z, psi, &mut dydt[d..], &mut j);
         }
     }
 }
@@ -149,8 +148,9 @@ impl Adaptive {
         self.model.dim()
     }
 
-    /// The augmented start vector: z, then Φ = I when variational.
-    fn augmented(&self, z: &[f64], variational: bool) -> Vec<f64> {
+    /// The augmented start vector at (τ, z) in `mode`: z, then Ψ = P Φ with Φ = I when
+    /// variational ([`HybridSystem::to_tangent_coords`]).
+    fn augmented(&self, mode: Region, tau: f64, z: &[f64], variational: bool) -> Vec<f64> {
         let d = z.len();
         let mut y = z.to_vec();
         if variational {
@@ -158,9 +158,19 @@ impl Adaptive {
             for i in 0..d {
                 id[i * d + i] = 1.0;
             }
+            self.model.to_tangent_coords(mode, tau, z, &mut id, true);
             y.extend(id);
         }
         y
+    }
+
+    /// Φ = P⁻¹ Ψ from the augmented vector at the end of a step.
+    fn step_jacobian(&self, mode: Region, tau: f64, y: &[f64]) -> DMatrix<f64> {
+        let d = self.dim();
+        let mut m = y[d..].to_vec();
+        self.model
+            .to_tangent_coords(mode, tau, &y[..d], &mut m, false);
+        DMatrix::from_vec(d, d, m)
     }
 
     /// A DOP853 stepper started at (τ, y) in `mode`.
@@ -251,19 +261,6 @@ impl Adaptive {
         Ok(s.y().clone())
     }
 
-    /// Dead band of the guard of `mode`: 1e-12 of its scale (module docs).
-    fn dead_band(&self, mode: Region, tau: f64, z: &[f64]) -> f64 {
-        let p = self.model.params();
-        let scale = if mode == Region::Contact && self.model.law().restitution().is_some() {
-            // constraint force: m_eff × (drive acceleration + tip acceleration scale)
-            let g = self.model.guard(mode, tau, z);
-            self.model.effective_mass() * p.alpha2 * p.omega * p.omega + g.value.abs()
-        } else {
-            1.0 + p.alpha2 + p.alpha5.abs()
-        };
-        1e-12 * scale
-    }
-
     /// (g, dg/dτ) along the dense output of `stepper` at τ.
     fn guard_on(&self, stepper: &mut Dop853, mode: Region, tau: f64) -> (f64, f64) {
         let d = self.dim();
@@ -284,7 +281,7 @@ impl Adaptive {
     fn find_zero(&self, stepper: &mut Dop853, mode: Region, t0: f64, t1: f64) -> Option<f64> {
         let d = self.dim();
         let z1 = stepper.y()[..d].to_vec();
-        let dead = self.dead_band(mode, t1, &z1);
+        let dead = self.model.guard_tolerance(mode, t1, &z1);
         let (g0, dg0) = self.guard_on(stepper, mode, t0);
         let (g1, dg1) = self.guard_on(stepper, mode, t1);
         // where g goes below −ε: the step end, or an interior minimum
@@ -374,9 +371,10 @@ impl Integrator for Adaptive {
     }
 
     fn reset(&mut self, tau: f64, z: &DVector<f64>) -> Result<(), SimError> {
-        self.region = self.model.checked_start(tau, z)?;
+        let (region, z) = self.model.checked_start(tau, z)?;
+        self.region = region;
         self.tau = tau;
-        self.z.copy_from(z);
+        self.z.copy_from(&z);
         self.stepper = None;
         self.just_switched = true;
         self.recent.clear();
@@ -401,7 +399,7 @@ impl Integrator for Adaptive {
             });
         }
         let var = self.variational;
-        let y0 = self.augmented(self.z.as_slice(), var);
+        let y0 = self.augmented(region, tau0, self.z.as_slice(), var);
         // a fresh stepper per step with the variational equations (Φ(τ0) = I), else one per stint
         let mut stepper = match self.stepper.take() {
             Some(s) if !var => s,
@@ -454,7 +452,7 @@ impl Integrator for Adaptive {
             self.last.tau0 = tau0;
             self.last.tau1 = t1;
             self.last.region = region;
-            self.last.jacobian = var.then(|| DMatrix::from_column_slice(d, d, &y1[d..]));
+            self.last.jacobian = var.then(|| self.step_jacobian(region, t1, &y1));
             self.last.dense = Some(stepper.clone());
             if !var {
                 self.stepper = Some(stepper);
@@ -489,7 +487,7 @@ impl Integrator for Adaptive {
         self.last.tau0 = tau0;
         self.last.tau1 = ts;
         self.last.region = region;
-        self.last.jacobian = var.then(|| DMatrix::from_column_slice(d, d, &ys[d..]));
+        self.last.jacobian = var.then(|| self.step_jacobian(region, ts, &ys));
         self.last.dense = Some(stepper);
         self.z.copy_from(&jump.state);
         self.tau = ts;

@@ -702,7 +702,9 @@ impl Integrator for ExactPropagator {
     }
 
     fn reset(&mut self, tau: f64, z: &DVector<f64>) -> Result<(), SimError> {
-        self.region = self.model.checked_start(tau, z)?;
+        let (region, z) = self.model.checked_start(tau, z)?;
+        let z = &z;
+        self.region = region;
         self.tau = tau;
         self.z.copy_from(z);
         let j = self.next_grid(tau) - 1;

@@ -129,9 +129,10 @@ impl Integrator for Rk4 {
     }
 
     fn reset(&mut self, tau: f64, z: &DVector<f64>) -> Result<(), SimError> {
-        self.region = self.model.checked_start(tau, z)?;
+        let (region, z) = self.model.checked_start(tau, z)?;
+        self.region = region;
         self.tau = tau;
-        self.z.copy_from(z);
+        self.z.copy_from(&z);
         Ok(())
     }
 
