@@ -1,11 +1,12 @@
 //! Throughput of the integrators: forcing periods per second at the default parameters
-//! (paper eq. 26, Ω = 2.6) for N = 1, 3, 5, 10, and exact against RK4 at matched accuracy
-//! (state at τ = 40 within 1e-8 of the exact answer).
+//! (paper eq. 26, Ω = 2.6) for N = 1, 3, 5, 10 (linear law, exact propagator), the adaptive
+//! integrator with the Hertz and DMT laws (tolerance 1e-12) for N = 1, 3, and exact against RK4
+//! at matched accuracy (state at τ = 40 within 1e-8 of the exact answer).
 //!
 //! Run with `cargo bench -p afmdyn`; the matched-accuracy step count of RK4 is printed.
 
 use afmdyn::integrate::{advance_dyn, build, IntegratorKind, IntegratorOptions};
-use afmdyn::{CantileverModel, Params};
+use afmdyn::{CantileverModel, ContactLaw, Params};
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use nalgebra::DVector;
 use std::hint::black_box;
@@ -88,5 +89,51 @@ fn matched_accuracy(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, periods_per_second, matched_accuracy);
+fn nonlinear_laws(c: &mut Criterion) {
+    let mut g = c.benchmark_group("adaptive periods");
+    g.throughput(Throughput::Elements(20));
+    let adaptive = IntegratorOptions {
+        kind: IntegratorKind::Adaptive,
+        steps_per_period: 1,
+        tolerance: 1e-12,
+    };
+    for (name, law) in [
+        ("hertz", ContactLaw::Hertz),
+        (
+            "dmt",
+            ContactLaw::Dmt {
+                hamaker: 1e-5,
+                intermolecular_distance: 0.01,
+            },
+        ),
+    ] {
+        for n in [1usize, 3] {
+            let p = Params {
+                modes: n,
+                contact_law: law,
+                ..Params::default()
+            };
+            let m = CantileverModel::new(&p).unwrap();
+            let t0 = 50.0 * p.period();
+            let z0 = run(&m, adaptive, &m.rest(), t0);
+            let mut it = build(&m, adaptive, t0, &z0).unwrap();
+            g.bench_with_input(BenchmarkId::new(name, n), &n, |b, _| {
+                b.iter(|| {
+                    it.reset(t0, &z0).unwrap();
+                    advance_dyn(it.as_mut(), t0 + 20.0 * p.period(), &mut |_, _, _| Ok(()))
+                        .unwrap();
+                    black_box(it.state()[0])
+                })
+            });
+        }
+    }
+    g.finish();
+}
+
+criterion_group!(
+    benches,
+    periods_per_second,
+    nonlinear_laws,
+    matched_accuracy
+);
 criterion_main!(benches);
