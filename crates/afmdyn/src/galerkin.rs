@@ -38,6 +38,15 @@ impl Region {
         }
     }
 
+    /// Sign σ of the guard g = σ V_T of a region of the smooth laws: +1 in free flight (left
+    /// when V_T falls to 0), −1 in contact (left when V_T rises to 0).
+    pub fn guard_sign(self) -> f64 {
+        match self {
+            Region::Free => 1.0,
+            Region::Contact => -1.0,
+        }
+    }
+
     /// Region of a tip displacement V_T: contact when V_T ≤ 0 (eq. 10).
     pub fn of_v_t(v_t: f64) -> Region {
         if v_t <= 0.0 {

@@ -590,7 +590,7 @@ impl HybridSystem for CantileverModel {
         }
         let n = self.modes();
         let p = &self.params;
-        let sigma = if mode == Region::Free { 1.0 } else { -1.0 };
+        let sigma = mode.guard_sign();
         let mut grad = DVector::zeros(2 * n);
         grad.rows_mut(0, n).copy_from(&(sigma * self.tip()));
         Guard {
@@ -604,12 +604,7 @@ impl HybridSystem for CantileverModel {
         if mode == Region::Contact && self.law.law.restitution().is_some() {
             return self.sticking_force(tau, z).value;
         }
-        let v = self.v_t_pair(tau, z).0;
-        if mode == Region::Free {
-            v
-        } else {
-            -v
-        }
+        mode.guard_sign() * self.v_t_pair(tau, z).0
     }
 
     /// Switchings are the identity; the impact law's free-flight guard is an impact (module

@@ -24,6 +24,7 @@
 //! starts where the lower parabola g'(0)s − Bs²/2 is largest, so the same event cannot fire twice.
 //! Many switchings in a vanishing time window are reported as [`SimError::Chattering`].
 
+use super::grid::PeriodGrid;
 use super::{matvec, Integrator, Step};
 use crate::error::SimError;
 use crate::galerkin::Region;
@@ -528,24 +529,14 @@ impl ExactPropagator {
         self.transition(self.last.region, len)
     }
 
-    /// Grid time of global index j: (j div m) T + (j mod m) h.
+    /// Grid time of global index j ([`PeriodGrid::tau`]).
     fn grid_tau(&self, j: i64) -> f64 {
-        let m = self.m as i64;
-        j.div_euclid(m) as f64 * self.period + j.rem_euclid(m) as f64 * self.h
+        PeriodGrid::new(self.period, self.m).tau(j)
     }
 
-    /// Index of the first grid point strictly after τ.
+    /// Index of the first grid point strictly after τ ([`PeriodGrid::next_index`]).
     fn next_grid(&self, tau: f64) -> i64 {
-        let p = (tau / self.period).floor();
-        let rem = tau - p * self.period;
-        let mut j = p as i64 * self.m as i64 + (rem / self.h).floor() as i64 + 1;
-        while self.grid_tau(j - 1) > tau {
-            j -= 1;
-        }
-        while self.grid_tau(j) <= tau {
-            j += 1;
-        }
-        j
+        PeriodGrid::new(self.period, self.m).next_index(tau)
     }
 
     fn zp_into(rp: &RegionProp, omega: f64, tau: f64, out: &mut DVector<f64>) {
@@ -636,7 +627,7 @@ impl ExactPropagator {
             omega: p.omega,
             alpha2: p.alpha2,
             alpha5: p.alpha5,
-            sigma: if region == Region::Free { 1.0 } else { -1.0 },
+            sigma: region.guard_sign(),
             dead: self.dead,
             curv,
         }
@@ -788,7 +779,7 @@ impl Integrator for ExactPropagator {
             self.state_in_last(len, &mut z_b);
             (self.model.v_t(tau_b, &z_b), self.model.v_t_dot(tau_b, &z_b))
         };
-        let sigma = if region == Region::Free { 1.0 } else { -1.0 };
+        let sigma = region.guard_sign();
         let mut ga = sigma * self.vt.0 + self.dead;
         let da = sigma * self.vt.1;
         let gb = sigma * vt_b.0 + self.dead;

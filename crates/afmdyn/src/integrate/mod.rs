@@ -18,6 +18,7 @@
 
 pub mod adaptive;
 pub mod exact;
+pub mod grid;
 pub mod rk4;
 
 use crate::error::SimError;

@@ -9,6 +9,7 @@
 //!   overshoot the discontinuity; a switching is reported at the end of the step where the
 //!   region changed.
 
+use super::grid::PeriodGrid;
 use super::{HermiteStep, Integrator, Step};
 use crate::error::SimError;
 use crate::galerkin::Region;
@@ -19,7 +20,7 @@ use nalgebra::{DMatrix, DVector};
 #[derive(Debug, Clone)]
 pub struct Rk4 {
     model: CantileverModel,
-    h: f64,
+    grid: PeriodGrid,
     locate: bool,
     tau: f64,
     z: DVector<f64>,
@@ -42,7 +43,7 @@ impl Rk4 {
         let z = DVector::zeros(dim);
         Rk4 {
             model: model.clone(),
-            h: model.period() / steps.max(1) as f64,
+            grid: PeriodGrid::new(model.period(), steps),
             locate: locate_events,
             tau: 0.0,
             z: z.clone(),
@@ -95,15 +96,7 @@ impl Rk4 {
     }
 
     fn grid_next(&self, tau: f64) -> f64 {
-        let period = self.model.period();
-        let p = (tau / period).floor();
-        let mut k = ((tau - p * period) / self.h).floor() + 1.0;
-        let mut t = p * period + k * self.h;
-        while t <= tau {
-            k += 1.0;
-            t = p * period + k * self.h;
-        }
-        t
+        self.grid.next(tau)
     }
 }
 
@@ -179,7 +172,7 @@ impl Integrator for Rk4 {
             });
         }
         let mode = Mode::Fixed(region);
-        let sigma = if region == Region::Free { 1.0 } else { -1.0 };
+        let sigma = region.guard_sign();
         Self::rk4(&self.model, mode, tau0, &z0, len, &mut self.k, &mut out);
         let g = |m: &CantileverModel, t: f64, z: &DVector<f64>| sigma * m.v_t(t, z);
         let gb = g(&self.model, tau_b, &out);
