@@ -673,6 +673,19 @@ impl HybridSystem for CantileverModel {
         self.law.law.is_affine()
     }
 
+    /// σ dV_T/dτ = σ(φ·ȧ + α2 Ω cos Ωτ) for the V_T guards (ȧ = f's top half), without
+    /// allocating; the sticking guard through [`HybridSystem::guard`].
+    fn guard_rate(&self, mode: Region, tau: f64, z: &[f64], f: &[f64]) -> f64 {
+        if mode == Region::Contact && self.law.law.restitution().is_some() {
+            let g = self.sticking_force(tau, z);
+            return g.grad.iter().zip(f).map(|(a, b)| a * b).sum::<f64>() + g.d_tau;
+        }
+        let p = &self.params;
+        let n = p.modes;
+        let wd: f64 = self.tip().iter().zip(&f[..n]).map(|(a, b)| a * b).sum();
+        mode.guard_sign() * (wd + p.alpha2 * p.omega * (p.omega * tau).cos())
+    }
+
     /// 1e-12 of the guard's scale: of V_T, 1 + α2 + |α5|; of the constraint force of sticking,
     /// m_eff (1 + α2 Ω²).
     fn guard_tolerance(&self, mode: Region, _tau: f64, _z: &[f64]) -> f64 {

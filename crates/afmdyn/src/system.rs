@@ -97,6 +97,12 @@ pub trait HybridSystem: Send + Sync {
     fn guard_value(&self, mode: Region, tau: f64, z: &[f64]) -> f64 {
         self.guard(mode, tau, z).value
     }
+    /// dg/dτ along the flow, ∇g · f + ∂g/∂τ, given the vector field `f` at (τ, z) (the event
+    /// search calls it often; override to avoid the gradient's allocation).
+    fn guard_rate(&self, mode: Region, tau: f64, z: &[f64], f: &[f64]) -> f64 {
+        let g = self.guard(mode, tau, z);
+        g.grad.iter().zip(f).map(|(a, b)| a * b).sum::<f64>() + g.d_tau
+    }
     /// Round-off dead band of the guard of `mode` at (τ, z): a zero counts only where g falls
     /// below −tolerance, so a trajectory leaving the guard surface tangentially does not
     /// re-trigger (default 1e-12).

@@ -95,8 +95,9 @@ pub struct Adaptive {
     z: DVector<f64>,
     region: Region,
     variational: bool,
-    /// Persistent stepper of the current stint (no variational equations), rebuilt after events.
-    stepper: Option<Box<Dop853>>,
+    /// Whether `last.dense` can continue the current stint (no event, reset or first-order
+    /// step since it was made, and no variational equations).
+    stint_open: bool,
     /// Step size to start a new stepper with.
     h: f64,
     /// The guard may sit at 0 at the start of the stint (just after an event).
@@ -129,7 +130,7 @@ impl Adaptive {
             z: DVector::zeros(d),
             region: Region::Free,
             variational: false,
-            stepper: None,
+            stint_open: false,
             h: 0.0,
             just_switched: true,
             recent: Default::default(),
@@ -261,20 +262,30 @@ impl Adaptive {
         Ok(s.y().clone())
     }
 
-    /// (g, dg/dτ) along the dense output of `stepper` at τ.
+    /// (g, dg/dτ) at (τ, z) in `mode`.
+    fn guard_at(&self, mode: Region, tau: f64, z: &[f64]) -> (f64, f64) {
+        let mut f = [0.0; 2 * crate::params::MAX_MODES];
+        let f = &mut f[..z.len()];
+        self.model.rhs_slice(mode, tau, z, f);
+        (
+            self.model.guard_value(mode, tau, z),
+            self.model.guard_rate(mode, tau, z, f),
+        )
+    }
+
+    /// (g, dg/dτ) along the dense output of `stepper` at τ (its end points exactly).
     fn guard_on(&self, stepper: &mut Dop853, mode: Region, tau: f64) -> (f64, f64) {
         let d = self.dim();
+        if tau == stepper.t() {
+            return self.guard_at(mode, tau, &stepper.y()[..d]);
+        }
+        if tau == stepper.t_prev() {
+            return self.guard_at(mode, tau, &stepper.y_prev()[..d]);
+        }
         let y = stepper
             .interpolate(tau)
             .unwrap_or_else(|_| stepper.y().clone());
-        let z = &y[..d];
-        let g = self.model.guard(mode, tau, z);
-        let mut f = vec![0.0; d];
-        self.model.rhs_slice(mode, tau, z, &mut f);
-        (
-            g.value,
-            g.grad.iter().zip(&f).map(|(a, b)| a * b).sum::<f64>() + g.d_tau,
-        )
+        self.guard_at(mode, tau, &y[..d])
     }
 
     /// Leftmost guard zero in (t0, t1] on the dense output, or None (module docs).
@@ -375,7 +386,7 @@ impl Integrator for Adaptive {
         self.region = region;
         self.tau = tau;
         self.z.copy_from(&z);
-        self.stepper = None;
+        self.stint_open = false;
         self.just_switched = true;
         self.recent.clear();
         self.last.dense = None;
@@ -401,8 +412,8 @@ impl Integrator for Adaptive {
         let var = self.variational;
         let y0 = self.augmented(region, tau0, self.z.as_slice(), var);
         // a fresh stepper per step with the variational equations (Φ(τ0) = I), else one per stint
-        let mut stepper = match self.stepper.take() {
-            Some(s) if !var => s,
+        let mut stepper = match self.last.dense.take() {
+            Some(s) if self.stint_open && !var => s,
             _ => self.new_stepper(region, tau0, &y0, var, self.h)?,
         };
         let h_now = stepper.h();
@@ -429,7 +440,7 @@ impl Integrator for Adaptive {
                 self.model.jacobian(region, tau0, z0.as_slice(), &mut j);
                 DMatrix::identity(d, d) + j * rem
             });
-            self.stepper = None;
+            self.stint_open = false;
             return Ok(Step {
                 tau0,
                 tau1: tau_max,
@@ -453,10 +464,8 @@ impl Integrator for Adaptive {
             self.last.tau1 = t1;
             self.last.region = region;
             self.last.jacobian = var.then(|| self.step_jacobian(region, t1, &y1));
-            self.last.dense = Some(stepper.clone());
-            if !var {
-                self.stepper = Some(stepper);
-            }
+            self.last.dense = Some(stepper);
+            self.stint_open = !var;
             return Ok(Step {
                 tau0,
                 tau1: t1,
@@ -492,7 +501,7 @@ impl Integrator for Adaptive {
         self.z.copy_from(&jump.state);
         self.tau = ts;
         self.region = jump.to;
-        self.stepper = None;
+        self.stint_open = false;
         self.just_switched = true;
         self.chatter_check(ts)?;
         Ok(Step::with_event(
