@@ -410,7 +410,7 @@ pub fn lyapunov(a: &LyapunovArgs) -> Result<(), CliError> {
     if a.json {
         println!(
             "{}",
-            json!({ "params": p, "exponents": l.exponents, "uncertainty": l.uncertainty, "volume_rate": l.volume_rate, "zero_one": l.zero_one, "verdict": l.verdict, "periods": l.periods })
+            json!({ "params": p, "exponents": l.exponents, "uncertainty": l.uncertainty, "convergence": l.convergence, "volume_rate": l.volume_rate, "zero_one": l.zero_one, "verdict": l.verdict, "periods": l.periods })
         );
         return Ok(());
     }
@@ -418,8 +418,8 @@ pub fn lyapunov(a: &LyapunovArgs) -> Result<(), CliError> {
         "Lyapunov exponents (per unit τ) over {} periods at Ω = {}:",
         l.periods, p.omega
     );
-    for (e, u) in l.exponents.iter().zip(&l.uncertainty) {
-        println!("  {e:+.6} ± {u:.6}");
+    for ((e, u), c) in l.exponents.iter().zip(&l.uncertainty).zip(&l.convergence) {
+        println!("  {e:+.6} ± {u:.6} (statistical) ± {c:.6} (convergence, |λ(T) − λ(T/2)|)");
     }
     println!(
         "sum {:+.6}; mean phase-volume contraction {:+.6}",
