@@ -610,8 +610,14 @@ fn initial_modal(z: Option<&DVector<f64>>) -> String {
     format!("{};{}", join(&z.as_slice()[..n]), join(&z.as_slice()[n..]))
 }
 
-fn attractor_json(s: &SteadyState, basin: f64) -> serde_json::Value {
+fn attractor_json(
+    s: &SteadyState,
+    basin: f64,
+    orbit: Option<&afmdyn::analysis::shooting::PeriodicOrbit>,
+) -> serde_json::Value {
     json!({
+        "multipliers": orbit.map(|o| o.multipliers.iter().map(|m| [m.re, m.im]).collect::<Vec<_>>()),
+        "stable": orbit.map(|o| o.stable),
         "period": s.period(),
         "poincare": {
             "v_t": s.poincare.iter().map(|p| p.v_t).collect::<Vec<_>>(),
@@ -729,7 +735,7 @@ pub fn attractors(a: &AttractorsArgs) -> Result<(), CliError> {
         "params": p,
         "samples": a.samples,
         "failures": report.failures.len(),
-        "attractors": report.attractors.iter().map(|x| attractor_json(&x.steady, x.basin_fraction)).collect::<Vec<_>>(),
+        "attractors": report.attractors.iter().map(|x| attractor_json(&x.steady, x.basin_fraction, x.orbit.as_ref())).collect::<Vec<_>>(),
     });
     write_bytes(
         &a.out.join("attractors.json"),

@@ -1,11 +1,15 @@
 //! Coexisting attractors at fixed parameters: sample initial states, classify each steady
-//! state, cluster the distinct attractors and estimate their basin fractions.
+//! state, cluster the distinct attractors and estimate their basin fractions. Every periodic
+//! attractor is then polished by Newton shooting ([`super::shooting`]), so its Poincaré points
+//! are the orbit's to the shooting tolerance (not the last transient iterate, which is off by
+//! ~ tol/(1 − |μ₁|) for slowly contracting orbits) and its Floquet multipliers are reported.
 
 use super::bifurcation::random_state;
 use super::period::close;
-use super::steady::{steady_state, SteadyOptions, SteadyState};
+use super::shooting::{shoot_with, PeriodicOrbit, ShootingOptions};
+use super::steady::{steady_state, PoincarePoint, SteadyOptions, SteadyState};
 use crate::error::SimError;
-use crate::integrate::{build, IntegratorOptions};
+use crate::integrate::{build, IntegratorKind, IntegratorOptions};
 use crate::model::CantileverModel;
 use crate::params::Params;
 use nalgebra::DVector;
@@ -39,6 +43,10 @@ pub struct Attractor {
     pub count: usize,
     /// count / (number of successful starts).
     pub basin_fraction: f64,
+    /// The periodic orbit polished by shooting, with its Floquet multipliers and stability
+    /// (`None` for a nonperiodic motion, for an integrator without step Jacobians — RK4 — or when
+    /// Newton's method did not converge).
+    pub orbit: Option<PeriodicOrbit>,
 }
 
 /// The result of an attractor search.
@@ -109,6 +117,7 @@ pub fn find_attractors(spec: &AttractorSpec) -> Result<AttractorReport, SimError
                     initial: z0,
                     count: 1,
                     basin_fraction: 0.0,
+                    orbit: None,
                 }),
             },
         }
@@ -118,8 +127,46 @@ pub fn find_attractors(spec: &AttractorSpec) -> Result<AttractorReport, SimError
         a.basin_fraction = a.count as f64 / ok.max(1) as f64;
     }
     attractors.sort_by_key(|a| std::cmp::Reverse(a.count));
+    attractors
+        .par_iter_mut()
+        .with_max_len(1)
+        .for_each(|a| polish(&model, spec.integrator, a));
     Ok(AttractorReport {
         attractors,
         failures,
     })
+}
+
+/// Polish a periodic attractor by shooting from its last section point and replace its
+/// Poincaré points with the orbit's (the cycle keeps its phase: the point after the last one
+/// recorded is the first).
+fn polish(model: &CantileverModel, integrator: IntegratorOptions, a: &mut Attractor) {
+    let Some(n) = a.steady.period() else { return };
+    if !matches!(
+        integrator.kind.resolve(model),
+        IntegratorKind::Exact | IntegratorKind::Adaptive
+    ) {
+        return;
+    }
+    let guess = a.steady.end_state().clone();
+    let Ok(mut integ) = build(model, integrator, 0.0, &guess) else {
+        return;
+    };
+    let Ok(orbit) = shoot_with(integ.as_mut(), &guess, n, &ShootingOptions::default()) else {
+        return;
+    };
+    // section = [z*, P(z*), …]; z* replaces the last recorded point p_n, P(z*) the first
+    let k = a.steady.poincare.len();
+    if k == n {
+        for (i, p) in a.steady.poincare.iter_mut().enumerate() {
+            let z = &orbit.section[(i + 1) % n];
+            *p = PoincarePoint {
+                tau: p.tau,
+                v_t: model.v_t(p.tau, z),
+                w_tip: model.w_tip(z),
+                state: z.clone(),
+            };
+        }
+    }
+    a.orbit = Some(orbit);
 }
