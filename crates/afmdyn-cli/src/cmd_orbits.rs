@@ -7,7 +7,7 @@ use crate::error::CliError;
 use crate::output::{ensure_dir, f, write_csv};
 use crate::plot::{save, Figure, Series, Style};
 use afmdyn::analysis::continuation::{
-    continue_branch, switch_at_period_doubling, BranchPoint, ContinuationSpec,
+    continue_branch, continue_with_switching, BranchPoint, ContinuationSpec,
 };
 use afmdyn::analysis::lyapunov::{lyapunov_spectrum, LyapunovOptions};
 use afmdyn::analysis::shooting::{shoot, PeriodicOrbit, ShootingOptions};
@@ -142,7 +142,8 @@ pub struct ContinueArgs {
     /// Period n of the branch (default: the period of the steady state at --from)
     #[arg(long)]
     period: Option<usize>,
-    /// At each period doubling, switch to the period-2n branch and continue it too
+    /// At each period doubling, switch to the period-2n branch and continue it too, recursively
+    /// up to period 8n (the period-doubling cascade)
     #[arg(long)]
     switch: bool,
     /// Draw the branches over this bifurcation.csv (from `afmdyn bifurcation`)
@@ -190,54 +191,12 @@ pub fn continuation(a: &ContinueArgs) -> Result<(), CliError> {
     let (guess, found) = a.start.guess(&model)?;
     let n = a.period.or(found).unwrap_or(1);
     let spec = ContinuationSpec::new(base, a.param, a.from, a.to, n);
-    let mut branches: Vec<Vec<BranchPoint>> = vec![continue_branch(&spec, &guess)?];
-    if a.switch {
-        let pds: Vec<BranchPoint> = branches[0]
-            .iter()
-            .filter(|b| {
-                b.event == Some(afmdyn::analysis::continuation::BranchEvent::PeriodDoubling)
-            })
-            .cloned()
-            .collect();
-        for pd in pds {
-            if let Some((value, z)) = switch_at_period_doubling(&spec, &pd) {
-                // the two period doublings that bound a window start the same period-2n branch
-                let known = branches[1..].iter().flatten().any(|b| {
-                    (b.value - value).abs() < 1e-2
-                        && b.section
-                            .iter()
-                            .any(|q| (q - &z).norm() < 1e-3 * (1.0 + z.norm()))
-                });
-                if known {
-                    continue;
-                }
-                let sub = ContinuationSpec {
-                    from: value,
-                    period: 2 * n,
-                    ..spec.clone()
-                };
-                if let Ok(b) = continue_branch(&sub, &z) {
-                    // the same branch reached from the other end of its window: same bifurcations
-                    let marks = |br: &[BranchPoint]| -> Vec<(String, f64)> {
-                        br.iter()
-                            .filter_map(|x| x.event.map(|e| (format!("{e:?}"), x.value)))
-                            .collect()
-                    };
-                    let new = marks(&b);
-                    let duplicate = branches[1..].iter().any(|old| {
-                        let old = marks(old);
-                        !new.is_empty()
-                            && new.iter().all(|(e, v)| {
-                                old.iter().any(|(oe, ov)| oe == e && (ov - v).abs() < 1e-6)
-                            })
-                    });
-                    if !duplicate {
-                        branches.push(b);
-                    }
-                }
-            }
-        }
-    }
+    // --switch: the period-doubling cascade, periods n, 2n, 4n and 8n
+    let branches: Vec<Vec<BranchPoint>> = if a.switch {
+        continue_with_switching(&spec, &guess, 8 * n)?
+    } else {
+        vec![continue_branch(&spec, &guess)?]
+    };
     ensure_dir(&a.out)?;
     write_csv(
         &a.out.join("continuation.csv"),

@@ -231,6 +231,24 @@ impl Solver {
     }
 }
 
+/// Largest change of a Floquet multiplier allowed in one continuation step.
+pub const MAX_MULTIPLIER_STEP: f64 = 0.1;
+
+/// How far the multipliers moved: the largest distance from a multiplier of `b` to the nearest
+/// of `a` (and vice versa).
+fn multiplier_shift(a: &[Complex<f64>], b: &[Complex<f64>]) -> f64 {
+    let one_way = |x: &[Complex<f64>], y: &[Complex<f64>]| {
+        x.iter()
+            .map(|p| {
+                y.iter()
+                    .map(|q| (p - q).norm())
+                    .fold(f64::INFINITY, f64::min)
+            })
+            .fold(0.0, f64::max)
+    };
+    one_way(a, b).max(one_way(b, a))
+}
+
 /// Test functions of a point: (dp/ds, det(M + I), complex multipliers outside the circle, switchings).
 fn tests(
     t: &DVector<f64>,
@@ -330,6 +348,7 @@ pub fn continue_branch(
     let mut ds = spec.ds;
     let mut out = vec![point(&mut solver, s, &y, &map)?];
     let mut tf = tests(&t, &map.jacobian, &out[0].multipliers, map.switchings);
+    let mut mu_prev = out[0].multipliers.clone();
     let first = y.clone();
     while out.len() < spec.max_points {
         let y_pred = &y + &t * ds;
@@ -351,7 +370,19 @@ pub fn continue_branch(
             &pt.multipliers,
             map_new.switchings,
         );
-        if let Some(ev) = changed(&tf, &tf_new) {
+        // step control on the multipliers: a step may not move any multiplier by more than
+        // MAX_MULTIPLIER_STEP, nor change the number of unstable multipliers without a located
+        // event — else two crossings (of −1, say) could cancel in the test functions
+        let event = changed(&tf, &tf_new);
+        let unstable = |mu: &[Complex<f64>]| mu.iter().filter(|m| m.norm() > 1.0).count();
+        if (multiplier_shift(&mu_prev, &pt.multipliers) > MAX_MULTIPLIER_STEP
+            || (event.is_none() && unstable(&mu_prev) != unstable(&pt.multipliers)))
+            && ds > 16.0 * spec.ds_min
+        {
+            ds *= 0.5;
+            continue;
+        }
+        if let Some(ev) = event {
             // locate by bisection on the step from the previous point
             let f0 = which(ev, &tf, &tf);
             let (mut a, mut b) = (0.0, ds);
@@ -401,15 +432,24 @@ pub fn continue_branch(
         // it would trace the period-n branch again
         let closed = out.len() > 10 && (&y_new - &first).norm() < 0.5 * ds;
         let half = spec.period / 2;
-        let merged = spec.period.is_multiple_of(2)
-            && out.len() > 3
-            && (&pt.section[half] - &pt.section[0]).norm() < 1e-6 * (1.0 + pt.section[0].norm());
+        let half_gap = |b: &BranchPoint| {
+            (&b.section[half] - &b.section[0]).norm() / (1.0 + b.section[0].norm())
+        };
+        // a fold where the half-cycle nearly repeats is the tip of the pitchfork at which the
+        // period-2n branch meets its period-n parent (the gap closes like √|Δp|): beyond it the
+        // branch is its own phase-shifted copy
+        let at_parent = out
+            .last()
+            .is_some_and(|b| b.event == Some(BranchEvent::Fold) && half_gap(b) < 1e-2);
+        let merged =
+            spec.period.is_multiple_of(2) && out.len() > 3 && (half_gap(&pt) < 1e-6 || at_parent);
         s += ds;
         pt.s = s;
         out.push(pt);
         if closed || merged {
             break;
         }
+        mu_prev = out.last().expect("a point").multipliers.clone();
         y = y_new;
         t = t_new;
         tf = tf_new;
@@ -470,4 +510,73 @@ pub fn switch_at_period_doubling(
         }
     }
     None
+}
+
+/// Continue the branch of `spec` from `guess` and, recursively, the period-2n branches born at
+/// its period doublings ([`switch_at_period_doubling`]) up to period `max_period`: the
+/// period-doubling cascade. A branch reached again from the other end of its window (same
+/// bifurcations at the same parameter values) is kept once. Returns the branches, the first
+/// being the one of `spec`.
+///
+/// # Errors
+/// As [`continue_branch`] for the first branch; a sub-branch that fails is skipped.
+pub fn continue_with_switching(
+    spec: &ContinuationSpec,
+    guess: &DVector<f64>,
+    max_period: usize,
+) -> Result<Vec<Vec<BranchPoint>>, SimError> {
+    let mut branches = vec![continue_branch(spec, guess)?];
+    let mut next = 0;
+    while next < branches.len() {
+        let pds: Vec<BranchPoint> = branches[next]
+            .iter()
+            .filter(|b| b.event == Some(BranchEvent::PeriodDoubling))
+            .cloned()
+            .collect();
+        next += 1;
+        for pd in pds {
+            if 2 * pd.period > max_period {
+                continue;
+            }
+            let Some((value, z)) = switch_at_period_doubling(spec, &pd) else {
+                continue;
+            };
+            // the two period doublings that bound a window start the same period-2n branch
+            let known = branches.iter().flatten().any(|b| {
+                b.period == 2 * pd.period
+                    && (b.value - value).abs() < 1e-2
+                    && b.section
+                        .iter()
+                        .any(|q| (q - &z).norm() < 1e-3 * (1.0 + z.norm()))
+            });
+            if known {
+                continue;
+            }
+            let sub = ContinuationSpec {
+                from: value,
+                period: 2 * pd.period,
+                ..spec.clone()
+            };
+            let Ok(b) = continue_branch(&sub, &z) else {
+                continue;
+            };
+            let marks = |br: &[BranchPoint]| -> Vec<(BranchEvent, f64)> {
+                br.iter()
+                    .filter_map(|x| x.event.map(|e| (e, x.value)))
+                    .collect()
+            };
+            let new = marks(&b);
+            let duplicate = branches.iter().any(|old| {
+                let old = marks(old);
+                !new.is_empty()
+                    && new
+                        .iter()
+                        .all(|(e, v)| old.iter().any(|(oe, ov)| oe == e && (ov - v).abs() < 1e-6))
+            });
+            if !duplicate {
+                branches.push(b);
+            }
+        }
+    }
+    Ok(branches)
 }
