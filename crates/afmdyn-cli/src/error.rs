@@ -25,7 +25,8 @@ impl CliError {
                 afmdyn::SimError::Params(_)
                 | afmdyn::SimError::StateLength { .. }
                 | afmdyn::SimError::NotFinite { .. }
-                | afmdyn::SimError::OutOfRange { .. } => 2,
+                | afmdyn::SimError::OutOfRange { .. }
+                | afmdyn::SimError::Budget { .. } => 2,
                 _ => 1,
             },
             CliError::Io(_) => 1,
