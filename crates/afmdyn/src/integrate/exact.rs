@@ -400,7 +400,7 @@ impl ExactPropagator {
         let need_f = (period * rho / THETA).ceil().max(8.0);
         let m_f = base as f64 * (need_f / base as f64).ceil();
         let bytes = (dim as f64 + 2.0) * (m_f + 1.0) * 8.0;
-        if !(bytes <= crate::params::GRID_BUDGET_BYTES) {
+        if bytes.is_nan() || bytes > crate::params::GRID_BUDGET_BYTES {
             return Err(SimError::Budget {
                 what: "exact integrator grid",
                 needed: format!(

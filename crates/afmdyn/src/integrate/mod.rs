@@ -202,7 +202,7 @@ pub fn build(
     // up-front budgets: a start at or beyond the divergence threshold, and (adaptive) a period
     // that would need more steps than the budget, are refused before any work is done
     let norm = z.norm(); // +∞ when the squares overflow; NaN entries are rejected by reset
-    if z.iter().all(|v| v.is_finite()) && !(norm < crate::params::STATE_NORM_MAX) {
+    if z.iter().all(|v| v.is_finite()) && norm >= crate::params::STATE_NORM_MAX {
         return Err(SimError::out_of_range(
             "initial state",
             if norm.is_finite() {
@@ -219,7 +219,7 @@ pub fn build(
             .map(|&r| model.dynamics(r).a.norm())
             .fold(0.0, f64::max);
         let steps = rate * model.period();
-        if !(steps <= crate::params::ADAPTIVE_STEPS_BUDGET) {
+        if steps.is_nan() || steps > crate::params::ADAPTIVE_STEPS_BUDGET {
             return Err(SimError::Budget {
                 what: "adaptive integrator",
                 needed: format!("about {steps:.2e} steps per drive period"),
