@@ -323,6 +323,7 @@ pub fn continuation(a: &ContinueArgs) -> Result<(), CliError> {
     // plot: section points of each branch, stable solid, unstable dashed (as dots)
     let mut series = Vec::new();
     for (i, b) in branches.iter().enumerate() {
+        let first_series = series.len();
         let np = b.first().map_or(0, |x| x.section.len());
         for k in 0..np {
             let mut run: Vec<(f64, f64)> = Vec::new();
@@ -350,9 +351,18 @@ pub fn continuation(a: &ContinueArgs) -> Result<(), CliError> {
                 });
             }
         }
-    }
-    if let Some(first) = series.first_mut() {
-        first.label = format!("period-{n} branch (solid stable, dashed unstable)");
+        if let (Some(sr), Some(x)) = (series.get_mut(first_series), b.first()) {
+            sr.label = if i == 0 {
+                format!("period-{n} branch (solid stable, dashed unstable)")
+            } else {
+                format!(
+                    "period-{} branch from {} = {:.4}",
+                    x.period,
+                    a.param.symbol(),
+                    x.value
+                )
+            };
+        }
     }
     let events: Vec<(f64, f64)> = branches
         .iter()
