@@ -10,6 +10,7 @@
 
 use crate::error::CliError;
 use crate::output::write_bytes;
+use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::collections::HashSet;
@@ -214,18 +215,12 @@ fn bounds(fig: &Figure) -> (f64, f64, f64, f64) {
     if !b.0.is_finite() {
         return (0.0, 1.0, 0.0, 1.0);
     }
-    let pad = |lo: f64, hi: f64| {
-        let d = (hi - lo).abs().max(1e-12 * (1.0 + lo.abs()));
-        (lo - 0.03 * d, hi + 0.03 * d)
-    };
-    let (x0, x1) = pad(b.0, b.1);
-    let (y0, y1) = pad(b.2, b.3);
-    (x0, x1, y0, y1)
+    padded(b, 0.03)
 }
 
 /// A pixel column of a monotone line: column, (first, lowest, highest, last) point, and the
 /// position of each in the input.
-type Column = (i32, [(f64, f64); 4], [usize; 4]);
+type PixelColumn = (i32, [(f64, f64); 4], [usize; 4]);
 
 /// Decimate a line to the pixel grid `px` maps to. A series monotone in x keeps per pixel
 /// column its first, lowest, highest and last point (in their order), which draws the same
@@ -246,9 +241,9 @@ pub fn decimate_line(
     let mut run: Vec<(f64, f64)> = vec![];
     if monotone {
         // per column: (first, min, max, last) as indices into the column's points
-        let mut col: Option<Column> = None;
+        let mut col: Option<PixelColumn> = None;
         let mut k = 0usize;
-        let flush = |col: &mut Option<Column>, run: &mut Vec<(f64, f64)>| {
+        let flush = |col: &mut Option<PixelColumn>, run: &mut Vec<(f64, f64)>| {
             if let Some((_, p, order)) = col.take() {
                 let mut idx = [0usize, 1, 2, 3];
                 idx.sort_by_key(|&i| order[i]);
@@ -378,6 +373,45 @@ fn tick(v: f64, span: f64) -> String {
     s.to_string()
 }
 
+/// Pad a data range (x0, x1, y0, y1) by `frac` of its extent on each side.
+fn padded(b: (f64, f64, f64, f64), frac: f64) -> (f64, f64, f64, f64) {
+    let pad = |lo: f64, hi: f64| {
+        let d = (hi - lo).abs().max(1e-12 * (1.0 + lo.abs()));
+        (lo - frac * d, hi + frac * d)
+    };
+    let (x0, x1) = pad(b.0, b.1);
+    let (y0, y1) = pad(b.2, b.3);
+    (x0, x1, y0, y1)
+}
+
+/// The chart of a data area with its axes, mesh and labels over (x0, x1, y0, y1).
+fn chart<'a, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+    (x0, x1, y0, y1): (f64, f64, f64, f64),
+    labels: (&str, &str),
+) -> Result<ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>, String>
+where
+    DB::ErrorType: 'static,
+{
+    let mut chart = ChartBuilder::on(area)
+        .margin(12)
+        .x_label_area_size(45)
+        .y_label_area_size(70)
+        .build_cartesian_2d(x0..x1, y0..y1)
+        .map_err(|x| x.to_string())?;
+    let (xs, ys) = (x1 - x0, y1 - y0);
+    chart
+        .configure_mesh()
+        .x_desc(labels.0)
+        .y_desc(labels.1)
+        .x_label_formatter(&|v| tick(*v, xs))
+        .y_label_formatter(&|v| tick(*v, ys))
+        .label_style(("sans-serif", 15))
+        .draw()
+        .map_err(|x| x.to_string())?;
+    Ok(chart)
+}
+
 impl Painter for Figure {
     fn paint<DB: DrawingBackend>(
         &self,
@@ -402,22 +436,7 @@ impl Painter for Figure {
             .collect();
         let area = layout(root, &self.title, &legend)?;
         let (x0, x1, y0, y1) = bounds(self);
-        let mut chart = ChartBuilder::on(&area)
-            .margin(12)
-            .x_label_area_size(45)
-            .y_label_area_size(70)
-            .build_cartesian_2d(x0..x1, y0..y1)
-            .map_err(|x| e(&x))?;
-        let (xs, ys) = (x1 - x0, y1 - y0);
-        chart
-            .configure_mesh()
-            .x_desc(self.x_label.as_str())
-            .y_desc(self.y_label.as_str())
-            .x_label_formatter(&|v| tick(*v, xs))
-            .y_label_formatter(&|v| tick(*v, ys))
-            .label_style(("sans-serif", 15))
-            .draw()
-            .map_err(|x| e(&x))?;
+        let mut chart = chart(&area, (x0, x1, y0, y1), (&self.x_label, &self.y_label))?;
         let px = |x: f64, y: f64| chart.backend_coord(&(x, y));
         let shade_color = RGBColor(200, 200, 200).mix(0.5);
         let shade = merge_shade(&self.shade, |x| px(x, y0).0);
@@ -508,29 +527,7 @@ impl Painter for Scatter<'_> {
     {
         let e = |x: &dyn std::fmt::Display| x.to_string();
         let area = layout(root, self.title, self.legend)?;
-        let b = self.bounds;
-        let pad = |lo: f64, hi: f64| {
-            let d = (hi - lo).abs().max(1e-9);
-            (lo - 0.02 * d, hi + 0.02 * d)
-        };
-        let (x0, x1) = pad(b.0, b.1);
-        let (y0, y1) = pad(b.2, b.3);
-        let mut chart = ChartBuilder::on(&area)
-            .margin(12)
-            .x_label_area_size(45)
-            .y_label_area_size(70)
-            .build_cartesian_2d(x0..x1, y0..y1)
-            .map_err(|x| e(&x))?;
-        let (xs, ys) = (x1 - x0, y1 - y0);
-        chart
-            .configure_mesh()
-            .x_desc(self.labels.0)
-            .y_desc(self.labels.1)
-            .x_label_formatter(&|v| tick(*v, xs))
-            .y_label_formatter(&|v| tick(*v, ys))
-            .label_style(("sans-serif", 15))
-            .draw()
-            .map_err(|x| e(&x))?;
+        let mut chart = chart(&area, padded(self.bounds, 0.02), self.labels)?;
         // one marker per (pixel, colour): memory and file size stay bounded by the canvas,
         // not by the number of points (an SVG would otherwise grow with the sweep)
         let (w, h) = area.dim_in_pixel();

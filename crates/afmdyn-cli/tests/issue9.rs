@@ -78,6 +78,18 @@ fn json(o: &Output) -> serde_json::Value {
     serde_json::from_slice(&o.stdout).expect("one JSON document")
 }
 
+/// A finished run (exit 0) whose JSON `warnings` and stderr carry `needle`.
+fn warns(o: &Output, needle: &str) -> serde_json::Value {
+    let doc = json(o);
+    let w = doc["warnings"].as_array().expect("warnings");
+    assert!(
+        w.iter().any(|x| x.as_str().unwrap().contains(needle)),
+        "{doc}"
+    );
+    assert!(stderr(o).contains("afmdyn: warning: ") && stderr(o).contains(needle));
+    doc
+}
+
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
 }
@@ -379,15 +391,8 @@ fn an_inaccurate_run_carries_a_warning() {
         dir.path(),
         30,
     );
-    let doc = json(&o);
-    let w = doc["warnings"].as_array().unwrap();
-    assert!(
-        w.iter()
-            .any(|x| x.as_str().unwrap().contains("energy balance")),
-        "{doc}"
-    );
+    let doc = warns(&o, "energy balance");
     assert!(doc["energy_residual"]["max_relative"].as_f64().unwrap() > 1e-6);
-    assert!(stderr(&o).contains("warning: energy balance"));
 }
 
 fn wait_for(path: &Path, what: impl Fn(&str) -> bool) {
@@ -789,14 +794,7 @@ fn a_short_lyapunov_run_says_it_is_too_short() {
         dir.path(),
         30,
     );
-    let doc = json(&o);
-    let w = doc["warnings"].as_array().unwrap();
-    assert!(
-        w.iter()
-            .any(|x| x.as_str().unwrap().contains("only 3 periods")),
-        "{doc}"
-    );
-    assert!(stderr(&o).contains("warning"));
+    warns(&o, "only 3 periods");
 }
 
 /// Write the fuzz test's config file.
