@@ -133,6 +133,8 @@ impl ModelArgs {
             None => ModelFile::default(),
         };
         let pick = |flag: Option<f64>, file: Option<f64>, def: f64| flag.or(file).unwrap_or(def);
+        // `..defaults` carries any field without a flag (e.g. a contact law added to Params)
+        #[allow(clippy::needless_update)]
         let p = Params {
             modes: self.modes.or(file.modes).unwrap_or(defaults.modes),
             alpha1: pick(self.alpha1, file.tip_mass_ratio, defaults.alpha1),
@@ -142,6 +144,7 @@ impl ModelArgs {
             alpha5: pick(self.alpha5, file.gap, defaults.alpha5),
             alpha6: pick(self.alpha6, file.contact_damping, defaults.alpha6),
             omega: pick(self.omega, file.omega, defaults.omega),
+            ..defaults
         };
         p.validate().map_err(|e| CliError::Input(e.to_string()))?;
         Ok(p)

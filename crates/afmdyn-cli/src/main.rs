@@ -14,7 +14,14 @@ use error::CliError;
 
 /// Multi-modal tapping-mode AFM dynamics with intermittent contact.
 #[derive(Debug, Parser)]
-#[command(name = "afmdyn", version, about)]
+#[command(
+    name = "afmdyn",
+    version,
+    about,
+    after_help = "Output files, their columns and units, the input limits and the exit codes \
+                  (0 done, 1 failed, 2 bad input) are documented in docs/outputs.md; every .npy \
+                  comes with a .npy.json naming its columns."
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,

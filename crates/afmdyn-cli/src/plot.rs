@@ -131,7 +131,10 @@ fn svg<P: Painter>(size: (u32, u32), p: &P) -> Result<String, String> {
 /// Write `stem.png` and `stem.svg` of `p` in `dir`, each atomically.
 fn write_both<P: Painter>(dir: &Path, stem: &str, size: (u32, u32), p: &P) -> Result<(), CliError> {
     register_font();
-    let fail = |ext: &str, e: String| CliError::Io(format!("plot {stem}.{ext}: {e}"));
+    let fail = |ext: &str, e: String| {
+        let path = dir.join(format!("{stem}.{ext}"));
+        CliError::Io(format!("cannot draw {}: {e}", path.display()))
+    };
     let bytes = png(size, p).map_err(|e| fail("png", e))?;
     write_bytes(&dir.join(format!("{stem}.png")), &bytes)?;
     let text = svg(size, p).map_err(|e| fail("svg", e))?;
