@@ -1,12 +1,15 @@
 #!/usr/bin/env bash
 # Regenerate every figure of the paper that afmdyn covers (Figs. 3, 4, 5, 6-17, eq. 25) into
-# docs/figures/, plus the coarse-step RK4 reruns used in docs/paper-reproduction.md.
+# docs/figures/ (or $FIGURES), plus the coarse-step RK4 reruns used in docs/paper-reproduction.md,
+# and print the summaries that the docs quote.
 # Usage: bash scripts/reproduce.sh   (about a minute on 2 cores)
+# The outputs are deterministic: two runs write identical files (the sweep's rows are in a fixed
+# order whatever the thread count), so rerunning leaves a clean `git status`.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cargo build --release -q
 A=target/release/afmdyn
-F=docs/figures
+F=${FIGURES:-docs/figures}
 mkdir -p "$F"/continuation "$F"/lyapunov "$F"/fig4 "$F"/fig5 "$F"/fig6-7 "$F"/fig8-14 "$F"/fig15-17 "$F"/fig15-17-text
 S=${SAMPLES:-64}
 
@@ -34,7 +37,15 @@ for om in 2.0 2.05 2.1 2.15 2.6 20; do
   $A lyapunov --config examples/fig5.toml --omega "$om" --json > "$F/lyapunov/omega-$om.json"
   $A orbit --config examples/fig5.toml --omega "$om" --json > "$F/lyapunov/orbit-omega-$om.json"
 done
-# keep the pictures and summaries; drop the bulky vector and table copies
-find "$F" \( -name '*.svg' -o -name '*.npy' -o -name 'attractor-*.csv' \) -delete
+# keep the pictures and summaries; drop the bulky vector and table copies and the run
+# bookkeeping (lock files hold a process id, the sweep's ledger the arguments)
+find "$F" \( -name '*.svg' -o -name '*.npy' -o -name '*.npy.json' -o -name 'attractor-*.csv' \
+  -o -name '.afmdyn.lock' -o -name '.bifurcation.run.json' \) -delete
 rm -f "$F/fig5/bifurcation.csv"
+# what the docs quote
+for f in "$F"/eq25.json "$F"/*/summary.json "$F"/rk4-naive-*.json "$F"/lyapunov/*.json; do
+  echo "== ${f#"$F"/}"
+  cat "$f"
+  echo
+done
 echo "figures in $F"

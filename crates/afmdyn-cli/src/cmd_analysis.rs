@@ -2,8 +2,8 @@
 
 use crate::args::{IntegratorArgs, ModelArgs};
 use crate::error::CliError;
-use crate::output::{ensure_dir, f, temp_path, write_bytes, write_csv, write_npy};
-use crate::plot::{save, save_scatter_stream, ChunkSink, Figure, Series, Style};
+use crate::output::{f, io_error, temp_path, write_bytes, write_csv, Column, NpyStream, OutDir};
+use crate::plot::{save, save_scatter_stream, ChunkSink, Figure, LegendEntry, Series, Style};
 use afmdyn::analysis::attractors::{find_attractors, AttractorSpec};
 use afmdyn::analysis::bifurcation::{run_sweep, Branch, Resume, SweepPoint, SweepSpec};
 use afmdyn::analysis::steady::{SteadyOptions, SteadyState};
@@ -48,8 +48,11 @@ impl SteadyArgs {
                 self.max_period
             )));
         }
-        if self.max_periods == 0 {
-            return Err(CliError::Input("max-periods = 0: must be >= 1".into()));
+        if !(1..=10_000_000).contains(&self.max_periods) {
+            return Err(CliError::Input(format!(
+                "max-periods = {}: must be in 1..=10000000",
+                self.max_periods
+            )));
         }
         Ok(SteadyOptions {
             tol: self.tol,
@@ -93,12 +96,16 @@ pub struct BifurcationArgs {
     /// Worker threads (default: all cores)
     #[arg(long)]
     threads: Option<usize>,
-    /// Continue an interrupted sweep with the same arguments
+    /// Continue an interrupted sweep; refused unless the other arguments are those of the
+    /// interrupted run (recorded in OUT/.bifurcation.run.json)
     #[arg(long)]
     resume: bool,
-    /// Output directory
+    /// Output directory (locked during the run)
     #[arg(long, default_value = "afmdyn-out")]
     out: PathBuf,
+    /// Testing: abort the process, as if killed, after this many points are written
+    #[arg(long, hide = true)]
+    abort_after: Option<usize>,
     /// Print one JSON summary
     #[arg(long)]
     json: bool,
@@ -200,86 +207,226 @@ fn point_rows(param: SweepParam, p: &SweepPoint) -> Vec<Vec<String>> {
     }
 }
 
-/// Rewrite the partial file keeping only complete tasks (all their `points` rows present, the
-/// last line newline-terminated); collect what is done and the continuation states.
-fn scan_partial(path: &Path) -> Result<Resume, CliError> {
-    let mut resume = Resume::default();
-    let text_ok = path.exists();
-    if !text_ok {
-        return Ok(resume);
-    }
-    let clean = temp_path(&path.with_file_name("resume-scan.csv"));
-    {
-        let reader = BufReader::new(File::open(path)?);
-        let mut out = std::io::BufWriter::new(File::create(&clean)?);
-        let mut group: Vec<String> = Vec::new();
-        let mut lines = reader.split(b'\n').peekable();
-        let mut first = true;
-        let flush_group = |group: &mut Vec<String>,
-                           out: &mut dyn Write,
-                           resume: &mut Resume|
-         -> Result<(), CliError> {
-            if group.is_empty() {
-                return Ok(());
-            }
-            let cells: Vec<Vec<&str>> = group.iter().map(|l| l.split(',').collect()).collect();
-            let complete = cells.iter().all(|c| c.len() == HEADER.len())
-                && cells[0][COL_POINTS].parse::<usize>().ok() == Some(cells.len())
-                && cells
-                    .iter()
-                    .enumerate()
-                    .all(|(i, c)| c[COL_POINT].parse::<usize>().ok() == Some(i));
-            if complete {
-                let index: usize = cells[0][COL_INDEX]
-                    .parse()
-                    .map_err(|_| CliError::Io("resume: bad index".into()))?;
-                let branch: Branch = cells[0][COL_BRANCH].parse().map_err(CliError::Io)?;
-                resume.done.insert((index, branch));
-                if matches!(branch, Branch::Forward | Branch::Backward)
-                    && cells[0][COL_STATUS] != "error"
-                {
-                    let state: Vec<f64> = cells.last().expect("rows")[COL_STATE]
-                        .split(' ')
-                        .filter_map(|v| v.parse().ok())
-                        .collect();
-                    if !state.is_empty() {
-                        resume
-                            .chain
-                            .insert(branch, (index, DVector::from_vec(state)));
-                    }
-                }
-                for l in group.iter() {
-                    writeln!(out, "{l}")?;
-                }
+/// Key of a row group (one sweep task): (index, branch).
+fn row_key(line: &str) -> Option<(usize, Branch)> {
+    let mut cells = line.split(',').skip(COL_INDEX);
+    let index = cells.next()?.parse().ok()?;
+    let branch = cells.next()?.parse().ok()?;
+    Some((index, branch))
+}
+
+/// A task's rows in the partial file: key, byte range, lines.
+type Group = ((usize, Branch), std::ops::Range<u64>, Vec<String>);
+
+/// Complete groups of rows of the partial file, in file order.
+/// A group is complete when all its `points` rows are present in order and newline-terminated
+/// (a killed run may leave a cut row or an unfinished group at the end).
+fn partial_groups(path: &Path) -> Result<(String, Vec<Group>), CliError> {
+    let rd = |e| io_error("read", path, e);
+    let mut reader = BufReader::new(File::open(path).map_err(rd)?);
+    let mut header = String::new();
+    let mut groups = Vec::new();
+    let mut group: Vec<String> = Vec::new();
+    let mut start = 0u64;
+    let mut pos = 0u64;
+    let complete = |g: &[String]| {
+        let cells: Vec<Vec<&str>> = g.iter().map(|l| l.split(',').collect()).collect();
+        cells.iter().all(|c| c.len() == HEADER.len())
+            && cells[0][COL_POINTS].parse::<usize>().ok() == Some(cells.len())
+            && cells
+                .iter()
+                .enumerate()
+                .all(|(i, c)| c[COL_POINT].parse::<usize>().ok() == Some(i))
+    };
+    let mut buf = Vec::new();
+    loop {
+        buf.clear();
+        let n = reader.read_until(b'\n', &mut buf).map_err(rd)? as u64;
+        if n == 0 || buf.last() != Some(&b'\n') {
+            break; // end, or a cut row without its newline
+        }
+        let line = String::from_utf8_lossy(&buf[..buf.len() - 1]).to_string();
+        if header.is_empty() {
+            header = line;
+            pos += n;
+            start = pos;
+            continue;
+        }
+        if group.first().and_then(|g| row_key(g)) != row_key(&line) && !group.is_empty() {
+            if complete(&group) {
+                let key = row_key(&group[0]).expect("checked");
+                groups.push((key, start..pos, std::mem::take(&mut group)));
             }
             group.clear();
-            Ok(())
-        };
-        while let Some(line) = lines.next() {
-            let line = line?;
-            let complete_line = lines.peek().is_some();
-            if !complete_line {
-                break; // the last piece has no newline: a partial row
-            }
-            let line = String::from_utf8_lossy(&line).to_string();
-            if first {
-                first = false;
-                writeln!(out, "{line}")?;
-                continue;
-            }
-            let key = |l: &str| l.split(',').skip(2).take(2).collect::<Vec<_>>().join(",");
-            if let Some(g) = group.first() {
-                if key(g) != key(&line) {
-                    flush_group(&mut group, &mut out, &mut resume)?;
+            start = pos;
+        }
+        group.push(line);
+        pos += n;
+    }
+    if !group.is_empty() && complete(&group) {
+        let key = row_key(&group[0]).expect("checked");
+        groups.push((key, start..pos, group));
+    }
+    Ok((header, groups))
+}
+
+/// Rewrite the partial file keeping only complete tasks; collect what is done and the
+/// continuation states.
+fn scan_partial(path: &Path) -> Result<Resume, CliError> {
+    let mut resume = Resume::default();
+    let (header, groups) = partial_groups(path)?;
+    let mut text = header + "\n";
+    for ((index, branch), _, lines) in groups {
+        resume.done.insert((index, branch));
+        if matches!(branch, Branch::Forward | Branch::Backward) {
+            let last: Vec<&str> = lines.last().expect("rows").split(',').collect();
+            if last[COL_STATUS] != "error" {
+                let state: Vec<f64> = last[COL_STATE]
+                    .split(' ')
+                    .filter_map(|v| v.parse().ok())
+                    .collect();
+                if !state.is_empty() {
+                    resume
+                        .chain
+                        .insert(branch, (index, DVector::from_vec(state)));
                 }
             }
-            group.push(line);
         }
-        flush_group(&mut group, &mut out, &mut resume)?;
-        out.flush()?;
+        for l in lines {
+            text.push_str(&l);
+            text.push('\n');
+        }
     }
-    fs::rename(&clean, path)?;
+    write_bytes(path, text.as_bytes())?;
     Ok(resume)
+}
+
+/// Write the finished sweep to `final_csv` in a stable order — by value index, then forward,
+/// backward, start 0, 1, … — whatever order the workers finished in, so that two runs with the
+/// same arguments give identical files. Groups are copied by byte range (never all in memory).
+fn finish_sorted(partial: &Path, final_csv: &Path) -> Result<(), CliError> {
+    use std::io::{Read, Seek, SeekFrom};
+    let (header, mut groups) = partial_groups(partial)?;
+    groups.sort_by_key(|g| g.0);
+    let rd = |e| io_error("read", partial, e);
+    let mut src = File::open(partial).map_err(rd)?;
+    let sorted = final_csv.with_file_name(".bifurcation.sorted.csv");
+    let wr = |e| io_error("write", final_csv, e);
+    {
+        let mut out = std::io::BufWriter::new(File::create(&sorted).map_err(wr)?);
+        writeln!(out, "{header}").map_err(wr)?;
+        let mut buf = Vec::new();
+        for (_, range, _) in &groups {
+            buf.resize((range.end - range.start) as usize, 0);
+            src.seek(SeekFrom::Start(range.start)).map_err(rd)?;
+            src.read_exact(&mut buf).map_err(rd)?;
+            out.write_all(&buf).map_err(wr)?;
+        }
+        out.into_inner()
+            .map_err(|e| wr(e.into_error()))?
+            .sync_all()
+            .map_err(wr)?;
+    }
+    fs::rename(&sorted, final_csv).map_err(|e| io_error("finish", final_csv, e))?;
+    fs::remove_file(partial).map_err(|e| io_error("remove", partial, e))
+}
+
+/// The arguments that determine a sweep's rows; a partial run is resumed only with the same.
+fn fingerprint(a: &BifurcationArgs, spec: &SweepSpec) -> serde_json::Value {
+    json!({
+        "afmdyn": env!("CARGO_PKG_VERSION"),
+        "params": spec.base,
+        "param": spec.param.name(),
+        "from": a.from,
+        "to": a.to,
+        "steps": a.steps,
+        "continuation": spec.continuation,
+        "starts": spec.starts,
+        "seed": spec.seed,
+        "tol": spec.steady.tol,
+        "max_periods": spec.steady.max_periods,
+        "max_period": spec.steady.max_period,
+        "integrator": spec.integrator.kind,
+        "steps_per_period": spec.integrator.steps_per_period,
+        "tolerance": spec.integrator.tolerance,
+    })
+}
+
+/// Where a sweep stands in its output directory.
+enum SweepState {
+    Fresh,
+    Partial(Resume),
+    Finished,
+}
+
+/// The ledger `.bifurcation.run.json`: the fingerprint of the run that owns the directory's
+/// partial and final CSV, and whether it finished.
+fn read_ledger(path: &Path) -> Result<Option<serde_json::Value>, CliError> {
+    match fs::read_to_string(path) {
+        Ok(t) => serde_json::from_str(&t)
+            .map(Some)
+            .map_err(|e| CliError::Input(format!("{}: {e}", path.display()))),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
+        Err(e) => Err(io_error("read", path, e)),
+    }
+}
+
+fn write_ledger(path: &Path, args: &serde_json::Value, finished: bool) -> Result<(), CliError> {
+    let doc = json!({ "args": args, "finished": finished });
+    write_bytes(
+        path,
+        (serde_json::to_string_pretty(&doc).expect("json") + "\n").as_bytes(),
+    )
+}
+
+/// Decide how a `--resume` proceeds, refusing to mix in a run made with other arguments.
+fn resume_state(
+    dir: &Path,
+    ledger: &Path,
+    partial: &Path,
+    final_csv: &Path,
+    args: &serde_json::Value,
+) -> Result<SweepState, CliError> {
+    let have_data = partial.exists() || final_csv.exists();
+    let Some(doc) = read_ledger(ledger)? else {
+        if have_data {
+            return Err(CliError::Input(format!(
+                "--resume: {} has sweep results but no record of the arguments that made them \
+                 ({} is missing); rerun without --resume to start over",
+                dir.display(),
+                ledger.display()
+            )));
+        }
+        return Ok(SweepState::Fresh);
+    };
+    let old = &doc["args"];
+    if old != args {
+        let differ: Vec<String> = args
+            .as_object()
+            .into_iter()
+            .flatten()
+            .filter(|(k, v)| old.get(k.as_str()) != Some(*v))
+            .map(|(k, v)| {
+                format!(
+                    "{k} = {} there, {v} here",
+                    old.get(k.as_str()).unwrap_or(&json!(null))
+                )
+            })
+            .collect();
+        return Err(CliError::Input(format!(
+            "--resume: the sweep in {} was made with other arguments ({}); rerun with the same \
+             arguments, or without --resume to start over",
+            dir.display(),
+            differ.join("; ")
+        )));
+    }
+    if partial.exists() {
+        return Ok(SweepState::Partial(scan_partial(partial)?));
+    }
+    if doc["finished"] == json!(true) && final_csv.exists() {
+        return Ok(SweepState::Finished);
+    }
+    Ok(SweepState::Fresh)
 }
 
 fn status_code(status: &str, period: &str) -> f64 {
@@ -306,9 +453,10 @@ fn read_rows(
     path: &Path,
     each: &mut dyn FnMut(&csv::StringRecord) -> Result<(), String>,
 ) -> Result<(), CliError> {
-    let mut rd = csv::Reader::from_path(path)?;
-    for r in rd.records() {
-        let r = r?;
+    let rd = |e| io_error("read", path, e);
+    let mut rd_csv = csv::Reader::from_path(path).map_err(rd)?;
+    for r in rd_csv.records() {
+        let r = r.map_err(rd)?;
         each(&r).map_err(CliError::Io)?;
     }
     Ok(())
@@ -332,40 +480,41 @@ pub fn bifurcation(a: &BifurcationArgs) -> Result<(), CliError> {
     spec.validate()
         .map_err(|e| CliError::Input(e.to_string()))?;
     if let Some(t) = a.threads {
-        if t == 0 {
-            return Err(CliError::Input("threads = 0: must be >= 1".into()));
+        if !(1..=1024).contains(&t) {
+            return Err(CliError::Input(format!(
+                "threads = {t}: must be in 1..=1024"
+            )));
         }
     }
-    ensure_dir(&a.out)?;
-    let final_csv = a.out.join("bifurcation.csv");
+    let out = OutDir::lock(&a.out)?;
+    let final_csv = out.join("bifurcation.csv");
     let partial = temp_path(&final_csv);
-    let resume = if a.resume {
-        if !partial.exists() && final_csv.exists() {
-            // already finished: redo only the derived files
-            Resume {
-                done: (0..spec.values.len())
-                    .flat_map(|i| [(i, Branch::Forward), (i, Branch::Backward)])
-                    .collect(),
-                ..Resume::default()
-            }
-        } else {
-            scan_partial(&partial)?
-        }
+    let ledger = out.join(".bifurcation.run.json");
+    let args = fingerprint(a, &spec);
+    let state = if a.resume {
+        resume_state(out.path(), &ledger, &partial, &final_csv, &args)?
     } else {
-        Resume::default()
+        SweepState::Fresh
     };
-    let finished_already = a.resume && !partial.exists() && final_csv.exists();
-    if !finished_already {
-        let fresh = !a.resume || !partial.exists();
-        let mut file = OpenOptions::new()
-            .create(true)
-            .append(true)
-            .truncate(false)
-            .open(&partial)?;
-        if fresh {
-            file.set_len(0)?;
-            writeln!(file, "{}", HEADER.join(","))?;
+    let resume = match state {
+        SweepState::Finished => None,
+        SweepState::Partial(r) => Some(r),
+        SweepState::Fresh => {
+            // the old partial goes first, then the ledger names the new run
+            if partial.exists() {
+                fs::remove_file(&partial).map_err(|e| io_error("remove", &partial, e))?;
+            }
+            write_ledger(&ledger, &args, false)?;
+            let mut f = File::create(&partial).map_err(|e| io_error("create", &partial, e))?;
+            writeln!(f, "{}", HEADER.join(",")).map_err(|e| io_error("write", &partial, e))?;
+            Some(Resume::default())
         }
+    };
+    if let Some(resume) = resume {
+        let file = OpenOptions::new()
+            .append(true)
+            .open(&partial)
+            .map_err(|e| io_error("open", &partial, e))?;
         let writer = Mutex::new(std::io::BufWriter::new(file));
         let tasks = spec.values.len() * (usize::from(spec.continuation) * 2 + spec.starts as usize);
         let bar = ProgressBar::new(tasks as u64);
@@ -375,6 +524,7 @@ pub fn bifurcation(a: &BifurcationArgs) -> Result<(), CliError> {
         );
         bar.inc(resume.done.len() as u64);
         let failed = Mutex::new(None::<String>);
+        let written = std::sync::atomic::AtomicUsize::new(0);
         let sink = |p: SweepPoint| {
             let rows = point_rows(spec.param, &p);
             let mut w = writer.lock().expect("writer");
@@ -384,24 +534,32 @@ pub fn bifurcation(a: &BifurcationArgs) -> Result<(), CliError> {
                 text.push('\n');
             }
             if let Err(e) = w.write_all(text.as_bytes()).and_then(|_| w.flush()) {
-                *failed.lock().expect("flag") = Some(e.to_string());
+                failed.lock().expect("flag").get_or_insert(e.to_string());
             }
             bar.inc(1);
+            let n = written.fetch_add(1, std::sync::atomic::Ordering::SeqCst) + 1;
+            if a.abort_after == Some(n) {
+                std::process::abort();
+            }
         };
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(a.threads.unwrap_or(0))
             .build()
-            .map_err(|e| CliError::Io(e.to_string()))?;
+            .map_err(|e| CliError::Io(format!("cannot start worker threads: {e}")))?;
         pool.install(|| run_sweep(&spec, &resume, &sink));
         bar.finish_and_clear();
         if let Some(e) = failed.into_inner().expect("flag") {
-            return Err(CliError::Io(format!("writing {}: {e}", partial.display())));
+            return Err(io_error("write", &partial, e));
         }
-        writer.into_inner().expect("writer").flush()?;
-        fs::rename(&partial, &final_csv)?;
+        writer
+            .into_inner()
+            .expect("writer")
+            .flush()
+            .map_err(|e| io_error("write", &partial, e))?;
+        finish_sorted(&partial, &final_csv)?;
+        write_ledger(&ledger, &args, true)?;
     }
     // derived files, streamed from the finished CSV
-    let mut rows = 0usize;
     let mut b = (
         f64::INFINITY,
         f64::NEG_INFINITY,
@@ -412,7 +570,6 @@ pub fn bifurcation(a: &BifurcationArgs) -> Result<(), CliError> {
     );
     let (mut periodic, mut nonperiodic, mut errors) = (0usize, 0usize, 0usize);
     read_rows(&final_csv, &mut |r| {
-        rows += 1;
         let v: f64 = r[COL_VALUE].parse().unwrap_or(f64::NAN);
         let w: f64 = r[COL_W_TIP].parse().unwrap_or(f64::NAN);
         let x: f64 = r[COL_X_MAX].parse().unwrap_or(f64::NAN);
@@ -435,9 +592,9 @@ pub fn bifurcation(a: &BifurcationArgs) -> Result<(), CliError> {
         }
         Ok(())
     })?;
-    write_bifurcation_npy(&final_csv, &a.out.join("bifurcation.npy"), rows)?;
+    write_bifurcation_npy(&final_csv, &out.join("bifurcation.npy"), a.param.name())?;
     let sym = a.param.symbol();
-    let legend: Vec<(String, usize)> = [
+    let legend: Vec<LegendEntry> = [
         ("period 1", 1.0),
         ("period 2", 2.0),
         ("period 3", 3.0),
@@ -447,32 +604,44 @@ pub fn bifurcation(a: &BifurcationArgs) -> Result<(), CliError> {
         ("nonperiodic", -1.0),
     ]
     .iter()
-    .map(|(l, p)| (l.to_string(), period_color(*p)))
+    .map(|(l, p)| (l.to_string(), period_color(*p), true))
     .collect();
+    let mut branch_legend: Vec<LegendEntry> = Vec::new();
+    if spec.continuation {
+        branch_legend.push(("forward continuation".into(), 0, true));
+        branch_legend.push(("backward continuation".into(), 1, true));
+    }
+    if spec.starts > 0 {
+        branch_legend.push((
+            format!("random starts ({} per value)", spec.starts),
+            7,
+            true,
+        ));
+    }
     for (stem, col, title, ylab, by_branch) in [
         (
             "bifurcation",
-            10usize,
+            COL_W_TIP,
             "Bifurcation diagram: Poincaré points (drive phase 0)",
             "W(1,τ) at τ = 2πk/Ω",
             false,
         ),
         (
             "bifurcation-branches",
-            10usize,
-            "Poincaré points: forward (blue), backward (red), random starts (grey)",
+            COL_W_TIP,
+            "Poincaré points by how they were reached",
             "W(1,τ) at τ = 2πk/Ω",
             true,
         ),
         (
             "bifurcation-xmax",
-            11usize,
+            COL_X_MAX,
             "Bifurcation diagram: X_max",
             "X_max",
             false,
         ),
     ] {
-        let bounds = if col == 10 {
+        let bounds = if col == COL_W_TIP {
             (b.0, b.1, b.2, b.3)
         } else {
             (b.0, b.1, b.4, b.5)
@@ -482,7 +651,7 @@ pub fn bifurcation(a: &BifurcationArgs) -> Result<(), CliError> {
         } else {
             (0.0, 1.0, 0.0, 1.0)
         };
-        let leg = if by_branch { vec![] } else { legend.clone() };
+        let leg = if by_branch { &branch_legend } else { &legend };
         let feed = |draw: &mut ChunkSink<'_>| -> Result<(), CliError> {
             let mut chunk = Vec::with_capacity(4096);
             read_rows(&final_csv, &mut |r| {
@@ -510,12 +679,12 @@ pub fn bifurcation(a: &BifurcationArgs) -> Result<(), CliError> {
             draw(&chunk).map_err(CliError::Io)
         };
         save_scatter_stream(
-            &a.out,
+            out.path(),
             stem,
             title,
             (&format!("{} ({})", sym, a.param.name()), ylab),
             bounds,
-            &leg,
+            leg,
             &feed,
         )?;
     }
@@ -527,7 +696,7 @@ pub fn bifurcation(a: &BifurcationArgs) -> Result<(), CliError> {
         "nonperiodic": nonperiodic,
         "errors": errors,
         "csv": final_csv,
-        "npy": a.out.join("bifurcation.npy"),
+        "npy": out.join("bifurcation.npy"),
     });
     if a.json {
         println!("{summary}");
@@ -539,35 +708,90 @@ pub fn bifurcation(a: &BifurcationArgs) -> Result<(), CliError> {
             periodic,
             nonperiodic,
             errors,
-            a.out.display()
+            out.path().display()
         );
     }
     Ok(())
 }
 
-fn write_bifurcation_npy(csv_path: &Path, npy: &Path, rows: usize) -> Result<(), CliError> {
-    // columns: value, index, branch (0 fwd, 1 bwd, 2+k start k), period (−1 nonperiodic,
-    // −2 error), point, tau, v_t, w_tip, x_max, v_t_min, contact_fraction, contacts_per_period
-    let mut rd = csv::Reader::from_path(csv_path)?;
-    let it = rd.records().filter_map(Result::ok).map(|r| {
+/// Columns of `bifurcation.npy` (the numeric columns of `bifurcation.csv`, codes for the text).
+fn bifurcation_npy_columns(param: &str) -> Vec<Column> {
+    vec![
+        Column::new(
+            "value",
+            "as the parameter",
+            format!("value of the swept parameter ({param})"),
+        ),
+        Column::new(
+            "index",
+            "count",
+            "index of the value in the sweep (0-based)",
+        ),
+        Column::new(
+            "branch",
+            "code",
+            "0 forward continuation, 1 backward, 2 + k random start k",
+        ),
+        Column::new(
+            "period",
+            "drive periods",
+            "period n of a periodic motion; −1 nonperiodic; −2 failed point",
+        ),
+        Column::new(
+            "point",
+            "count",
+            "index of the Poincaré point in the recorded cycle",
+        ),
+        Column::new(
+            "tau",
+            "τ",
+            "time of the Poincaré point (a multiple of the drive period 2π/Ω)",
+        ),
+        Column::new("v_t", "g0", "V_T at the Poincaré point (eq. 8)"),
+        Column::new("w_tip", "g0", "tip deflection W(1,τ) at the Poincaré point"),
+        Column::new(
+            "x_max",
+            "g0",
+            "largest tip deflection W(1,τ) over the recorded steady state",
+        ),
+        Column::new(
+            "v_t_min",
+            "g0",
+            "smallest V_T over the recorded steady state (≤ 0: contact)",
+        ),
+        Column::new("contact_fraction", "1", "fraction of the time in contact"),
+        Column::new(
+            "contacts_per_period",
+            "1/period",
+            "contact entries per drive period",
+        ),
+    ]
+}
+
+fn write_bifurcation_npy(csv_path: &Path, npy: &Path, param: &str) -> Result<(), CliError> {
+    let rd = |e| io_error("read", csv_path, e);
+    let mut reader = csv::Reader::from_path(csv_path).map_err(rd)?;
+    let mut s = NpyStream::create(npy, bifurcation_npy_columns(param))?;
+    for r in reader.records() {
+        let r = r.map_err(rd)?;
         let num = |i: usize| r[i].parse::<f64>().unwrap_or(f64::NAN);
         let branch: Branch = r[COL_BRANCH].parse().unwrap_or(Branch::Start(u32::MAX));
-        vec![
-            num(1),
-            num(2),
+        s.push(&[
+            num(COL_VALUE),
+            num(COL_INDEX),
             branch_code(branch),
             status_code(&r[COL_STATUS], &r[COL_PERIOD]),
-            num(6),
+            num(COL_POINT),
             num(8),
             num(9),
-            num(10),
-            num(11),
+            num(COL_W_TIP),
+            num(COL_X_MAX),
             num(12),
             num(13),
             num(14),
-        ]
-    });
-    write_npy(npy, 12, it, rows)
+        ])?;
+    }
+    s.finish()
 }
 
 /// `afmdyn attractors` flags.
@@ -645,8 +869,14 @@ pub fn attractors(a: &AttractorsArgs) -> Result<(), CliError> {
         steady: a.steady.options()?,
         integrator: a.integrator.options(spp),
     };
+    if a.samples > 100_000 {
+        return Err(CliError::Input(format!(
+            "samples = {}: must be in 1..=100000",
+            a.samples
+        )));
+    }
+    let out = OutDir::lock(&a.out)?;
     let report = find_attractors(&spec)?;
-    ensure_dir(&a.out)?;
     let model = CantileverModel::new(&p)?;
     for (k, att) in report.attractors.iter().enumerate() {
         let periods = att.steady.period().unwrap_or(8).max(2);
@@ -665,7 +895,7 @@ pub fn attractors(a: &AttractorsArgs) -> Result<(), CliError> {
         )?;
         let stem = format!("attractor-{}", k + 1);
         write_csv(
-            &a.out.join(format!("{stem}.csv")),
+            &out.join(format!("{stem}.csv")),
             &["tau", "v_t", "w_tip", "w_tip_dot", "in_contact"],
             tr.samples.iter().map(|s| {
                 vec![
@@ -682,7 +912,7 @@ pub fn attractors(a: &AttractorsArgs) -> Result<(), CliError> {
             None => "nonperiodic".into(),
         };
         save(
-            &a.out,
+            out.path(),
             &format!("{stem}-time"),
             &Figure {
                 title: format!(
@@ -720,7 +950,7 @@ pub fn attractors(a: &AttractorsArgs) -> Result<(), CliError> {
             color: if k % 10 == 3 { 4 } else { 3 },
         });
         save(
-            &a.out,
+            out.path(),
             &format!("{stem}-phase"),
             &Figure {
                 title: format!("Attractor {} ({label}): phase plane", k + 1),
@@ -738,7 +968,7 @@ pub fn attractors(a: &AttractorsArgs) -> Result<(), CliError> {
         "attractors": report.attractors.iter().map(|x| attractor_json(&x.steady, x.basin_fraction, x.orbit.as_ref())).collect::<Vec<_>>(),
     });
     write_bytes(
-        &a.out.join("attractors.json"),
+        &out.join("attractors.json"),
         serde_json::to_string_pretty(&doc).expect("json").as_bytes(),
     )?;
     if a.json {
@@ -763,7 +993,7 @@ pub fn attractors(a: &AttractorsArgs) -> Result<(), CliError> {
                 if x.steady.stats.body_contact { "  (beam body touches the substrate: Fig. 2f)" } else { "" }
             );
         }
-        println!("outputs in {}", a.out.display());
+        println!("outputs in {}", out.path().display());
     }
     Ok(())
 }

@@ -2,7 +2,7 @@
 
 use crate::args::{read_toml, ModelArgs};
 use crate::error::CliError;
-use crate::output::{ensure_dir, f, write_csv};
+use crate::output::{f, write_csv, OutDir};
 use crate::plot::{save, Figure, Series, Style};
 use afmdyn::eigen::{fig3_sweep, spectrum, RegionSpectrum};
 use afmdyn::units::{
@@ -82,10 +82,10 @@ pub fn modes(a: &ModesArgs) -> Result<(), CliError> {
 fn fig3(a: &ModesArgs, p: &Params) -> Result<(), CliError> {
     let alpha1: Vec<f64> = (0..=10).map(|i| 0.05 * i as f64).collect();
     let alpha4: Vec<f64> = (0..=100).map(|i| 2.0 * i as f64).collect();
+    let out = OutDir::lock(&a.out)?;
     let pts = fig3_sweep(p.modes, &alpha1, &alpha4)?;
-    ensure_dir(&a.out)?;
     write_csv(
-        &a.out.join("fig3.csv"),
+        &out.join("fig3.csv"),
         &[
             "alpha1",
             "alpha4",
@@ -133,12 +133,12 @@ fn fig3(a: &ModesArgs, p: &Params) -> Result<(), CliError> {
             series,
             shade: vec![],
         };
-        save(&a.out, stem, &fig)?;
+        save(out.path(), stem, &fig)?;
     }
     if a.json {
         println!("{}", json!({ "params": p, "points": pts, "out": a.out }));
     } else {
-        println!("wrote {} points to {}", pts.len(), a.out.display());
+        println!("wrote {} points to {}", pts.len(), out.path().display());
     }
     Ok(())
 }

@@ -4,7 +4,7 @@ use crate::args::ModelArgs;
 use crate::cmd_analysis::{SteadyArgs, COL_VALUE, COL_W_TIP};
 use crate::cmd_simulate::initial_state;
 use crate::error::CliError;
-use crate::output::{ensure_dir, f, write_csv};
+use crate::output::{f, io_error, write_csv, OutDir};
 use crate::plot::{save, Figure, Series, Style};
 use afmdyn::analysis::continuation::{
     continue_branch, continue_with_switching, BranchPoint, ContinuationSpec,
@@ -17,7 +17,7 @@ use afmdyn::{CantileverModel, Params, SweepParam};
 use clap::Args;
 use nalgebra::DVector;
 use serde_json::json;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Initial-state flags of the orbit commands.
 #[derive(Debug, Clone, Args)]
@@ -181,12 +181,42 @@ fn branch_rows(model: &CantileverModel, id: usize, br: &[BranchPoint]) -> Vec<Ve
         .collect()
 }
 
+/// The overlay CSV checked before any computation: readable, with `value` and `w_tip` columns.
+fn check_overlay(path: &Path) -> Result<(), CliError> {
+    let mut rd = csv::Reader::from_path(path).map_err(|e| {
+        CliError::Input(format!(
+            "--overlay {}: {}",
+            path.display(),
+            e.to_string().replace('\n', " ")
+        ))
+    })?;
+    let header = rd.headers().map_err(|e| io_error("read", path, e))?;
+    let names: Vec<&str> = header.iter().collect();
+    if names.get(COL_VALUE) != Some(&"value") || names.get(COL_W_TIP) != Some(&"w_tip") {
+        return Err(CliError::Input(format!(
+            "--overlay {}: not a bifurcation.csv of `afmdyn bifurcation` (expected columns \
+             value and w_tip)",
+            path.display()
+        )));
+    }
+    Ok(())
+}
+
 /// Run `afmdyn continue`.
 pub fn continuation(a: &ContinueArgs) -> Result<(), CliError> {
     let base = a.model.params(Params::default())?;
     let p0 = base.with(a.param, a.from);
     p0.validate()?;
     base.with(a.param, a.to).validate()?;
+    if let Some(o) = &a.overlay {
+        check_overlay(o)?;
+    }
+    if let Some(n) = a.period {
+        if !(1..=64).contains(&n) {
+            return Err(CliError::Input(format!("period = {n}: must be in 1..=64")));
+        }
+    }
+    let out = OutDir::lock(&a.out)?;
     let model = CantileverModel::new(&p0)?;
     let (guess, found) = a.start.guess(&model)?;
     let n = a.period.or(found).unwrap_or(1);
@@ -197,9 +227,8 @@ pub fn continuation(a: &ContinueArgs) -> Result<(), CliError> {
     } else {
         vec![continue_branch(&spec, &guess)?]
     };
-    ensure_dir(&a.out)?;
     write_csv(
-        &a.out.join("continuation.csv"),
+        &out.join("continuation.csv"),
         &[
             "branch",
             "period",
@@ -221,6 +250,7 @@ pub fn continuation(a: &ContinueArgs) -> Result<(), CliError> {
     // plot: section points of each branch, stable solid, unstable dashed (as dots)
     let mut series = Vec::new();
     for (i, b) in branches.iter().enumerate() {
+        let first_series = series.len();
         let np = b.first().map_or(0, |x| x.section.len());
         for k in 0..np {
             let mut run: Vec<(f64, f64)> = Vec::new();
@@ -248,9 +278,18 @@ pub fn continuation(a: &ContinueArgs) -> Result<(), CliError> {
                 });
             }
         }
-    }
-    if let Some(first) = series.first_mut() {
-        first.label = format!("period-{n} branch (solid stable, dashed unstable)");
+        if let (Some(sr), Some(x)) = (series.get_mut(first_series), b.first()) {
+            sr.label = if i == 0 {
+                format!("period-{n} branch (solid stable, dashed unstable)")
+            } else {
+                format!(
+                    "period-{} branch from {} = {:.4}",
+                    x.period,
+                    a.param.symbol(),
+                    x.value
+                )
+            };
+        }
     }
     let events: Vec<(f64, f64)> = branches
         .iter()
@@ -268,9 +307,10 @@ pub fn continuation(a: &ContinueArgs) -> Result<(), CliError> {
     });
     let mut underlay = Vec::new();
     if let Some(csv_path) = &a.overlay {
-        let mut rd = csv::Reader::from_path(csv_path)?;
+        let err = |e| io_error("read", csv_path, e);
+        let mut rd = csv::Reader::from_path(csv_path).map_err(err)?;
         for r in rd.records() {
-            let r = r?;
+            let r = r.map_err(err)?;
             if let (Ok(v), Ok(w)) = (r[COL_VALUE].parse::<f64>(), r[COL_W_TIP].parse::<f64>()) {
                 underlay.push((v, w));
             }
@@ -288,7 +328,7 @@ pub fn continuation(a: &ContinueArgs) -> Result<(), CliError> {
         );
     }
     save(
-        &a.out,
+        out.path(),
         "continuation",
         &Figure {
             title: format!("Continuation of period-{n} orbits in {}", a.param.symbol()),
@@ -324,7 +364,7 @@ pub fn continuation(a: &ContinueArgs) -> Result<(), CliError> {
                 b.period
             );
         }
-        println!("outputs in {}", a.out.display());
+        println!("outputs in {}", out.path().display());
     }
     Ok(())
 }
@@ -351,11 +391,58 @@ pub struct LyapunovArgs {
     json: bool,
 }
 
+/// Fewest averaged periods for exponents worth reporting without a warning.
+const LYAPUNOV_MIN_PERIODS: usize = 200;
+
+/// Why a Lyapunov spectrum should not be trusted: too short a run, too few periods per block,
+/// or exponents not resolved from zero by their own uncertainty.
+fn lyapunov_warnings(
+    exponents: &[f64],
+    uncertainty: &[f64],
+    periods: usize,
+    blocks: usize,
+) -> Vec<String> {
+    let mut w = vec![];
+    if periods < LYAPUNOV_MIN_PERIODS {
+        w.push(format!(
+            "only {periods} periods averaged (at least {LYAPUNOV_MIN_PERIODS} recommended, default \
+             4000): the exponents have not converged and their signs are not reliable"
+        ));
+    }
+    if periods / blocks.max(1) < 20 {
+        w.push(format!(
+            "{} periods per block: the uncertainties are estimated from blocks too short to be \
+             independent",
+            periods / blocks.max(1)
+        ));
+    }
+    let unresolved: Vec<String> = exponents
+        .iter()
+        .zip(uncertainty)
+        .enumerate()
+        .filter(|(_, (e, u))| e.is_nan() || e.abs() <= 2.0 * **u)
+        .map(|(k, _)| (k + 1).to_string())
+        .collect();
+    if !unresolved.is_empty() {
+        w.push(format!(
+            "exponent(s) {} not resolved from zero (|λ| ≤ 2 × uncertainty): run more periods",
+            unresolved.join(", ")
+        ));
+    }
+    w
+}
+
 /// Run `afmdyn lyapunov`.
 pub fn lyapunov(a: &LyapunovArgs) -> Result<(), CliError> {
     let p = a.model.params(Params::default())?;
     let model = CantileverModel::new(&p)?;
     let z0 = initial_state(&model, &a.initial_modal)?;
+    if (a.transient as f64 + a.periods as f64) > crate::cmd_simulate::MAX_RUN_PERIODS {
+        return Err(CliError::Input(format!(
+            "periods = {} with transient = {}: a run may span at most 1e8 drive periods",
+            a.periods, a.transient
+        )));
+    }
     let l = lyapunov_spectrum(
         &model,
         &z0,
@@ -366,10 +453,14 @@ pub fn lyapunov(a: &LyapunovArgs) -> Result<(), CliError> {
             ..Default::default()
         },
     )?;
+    let warnings = lyapunov_warnings(&l.exponents, &l.uncertainty, a.periods, a.blocks);
+    for w in &warnings {
+        eprintln!("afmdyn: warning: {w}");
+    }
     if a.json {
         println!(
             "{}",
-            json!({ "params": p, "exponents": l.exponents, "uncertainty": l.uncertainty, "convergence": l.convergence, "volume_rate": l.volume_rate, "zero_one": l.zero_one, "verdict": l.verdict, "periods": l.periods })
+            json!({ "params": p, "exponents": l.exponents, "uncertainty": l.uncertainty, "convergence": l.convergence, "volume_rate": l.volume_rate, "zero_one": l.zero_one, "verdict": l.verdict, "periods": l.periods, "warnings": warnings })
         );
         return Ok(());
     }

@@ -2,16 +2,44 @@
 
 use crate::args::{IntegratorArgs, ModelArgs};
 use crate::error::CliError;
-use crate::output::{ensure_dir, f, write_csv, write_npy};
-use crate::plot::{save, Figure, Series, Style};
+use crate::output::{
+    csv_finish, csv_row, csv_stream, f, write_csv, Column, CsvStream, NpyStream, OutDir,
+};
+use crate::plot::{decimate_line, save, Figure, Series, Style};
 use afmdyn::analysis::converge::mode_convergence;
 use afmdyn::analysis::steady::SteadyOptions;
 use afmdyn::integrate::build;
-use afmdyn::trajectory::{record, RecordSpec, Trajectory};
+use afmdyn::trajectory::{record, RecordSpec, Sample, Trajectory};
 use afmdyn::{CantileverModel, Params, Region, SimError};
-use clap::Args;
+use clap::{Args, ValueEnum};
 use serde_json::json;
+use std::collections::VecDeque;
 use std::path::PathBuf;
+
+/// Which files a run writes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Files {
+    /// Data files and plots.
+    All,
+    /// Data files only (no plots).
+    Data,
+    /// Nothing: only the summary on stdout.
+    None,
+}
+
+/// Longest run, transient included, in drive periods: beyond, τ (a double) no longer resolves
+/// the integration grid.
+pub const MAX_RUN_PERIODS: f64 = 1e8;
+/// Largest time series written (timeseries.npy, plus timeseries.csv with --csv), in bytes.
+pub const MAX_SERIES_BYTES: f64 = 16.0 * 1024.0 * 1024.0 * 1024.0;
+/// Largest relative per-period energy-balance residual of an accurate run.
+pub const ENERGY_TOLERANCE: f64 = 1e-6;
+/// Samples kept for the phase portrait (the last ones).
+const PHASE_SAMPLES: usize = 50_000;
+/// Samples kept for the amplitude spectrum (the last ones).
+const SPECTRUM_SAMPLES: usize = 1 << 20;
+/// Samples held in memory at once (a chunk of the run).
+const CHUNK_SAMPLES: usize = 65_536;
 
 /// `afmdyn simulate` flags.
 #[derive(Debug, Args)]
@@ -20,7 +48,7 @@ pub struct SimulateArgs {
     model: ModelArgs,
     #[command(flatten)]
     integrator: IntegratorArgs,
-    /// Drive periods to record after the transient
+    /// Drive periods to record after the transient; transient + periods ≤ 1e8 [default: 50]
     #[arg(long, conflicts_with = "tau_end", allow_negative_numbers = true)]
     periods: Option<f64>,
     /// End time τ of the run (instead of --periods)
@@ -29,18 +57,27 @@ pub struct SimulateArgs {
     /// Drive periods discarded before recording
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     transient: f64,
-    /// Initial modal state "a1,..,aN;adot1,..,adotN" (default: rest)
+    /// Initial modal state "a1,..,aN;adot1,..,adotN" (default: rest); |z| < 1e12
     #[arg(long, allow_hyphen_values = true)]
     initial_modal: Option<String>,
-    /// Samples per drive period in the time series
+    /// Samples per drive period in the time series (1..=100000)
     #[arg(long, default_value_t = 200)]
     samples_per_period: usize,
-    /// Output directory
+    /// Files written: all (data and plots), data (no plots) or none (only the summary)
+    #[arg(long, value_enum, default_value = "all")]
+    files: Files,
+    /// Also write the time series as CSV (timeseries.csv); by default only timeseries.npy
+    #[arg(long)]
+    csv: bool,
+    /// Output directory (locked during the run)
     #[arg(long, default_value = "afmdyn-out/simulate")]
     out: PathBuf,
     /// Print one JSON summary instead of text
     #[arg(long)]
     json: bool,
+    /// Drive periods held in memory at once (testing the streaming; default from the samples)
+    #[arg(long, hide = true)]
+    chunk_periods: Option<usize>,
 }
 
 fn parse_list(s: &str, what: &'static str) -> Result<Vec<f64>, CliError> {
@@ -68,10 +105,115 @@ pub(crate) fn initial_state(
     })?;
     let a = parse_list(a, "displacements")?;
     let ad = parse_list(ad, "velocities")?;
-    Ok(model.state_from(&a, &ad)?)
+    let z = model.state_from(&a, &ad)?;
+    let norm = z.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    if norm >= afmdyn::params::STATE_NORM_MAX / 10.0 {
+        return Err(CliError::Input(format!(
+            "--initial-modal: largest entry {norm:e}: every entry must be below 1e11 (states \
+             of norm 1e12 count as diverged)"
+        )));
+    }
+    Ok(z)
 }
 
-/// Run `afmdyn simulate`.
+/// Contact intervals for shading, merged when closer than `min_gap` (bounded memory).
+struct Shade {
+    intervals: Vec<(f64, f64)>,
+    open: Option<f64>,
+    min_gap: f64,
+}
+
+impl Shade {
+    fn push(&mut self, a: f64, b: f64) {
+        match self.intervals.last_mut() {
+            Some(last) if a - last.1 <= self.min_gap => last.1 = last.1.max(b),
+            _ => self.intervals.push((a, b)),
+        }
+    }
+}
+
+/// What the plots need, gathered chunk by chunk in bounded memory.
+struct PlotData {
+    tip: Vec<(f64, f64)>,
+    vt: Vec<(f64, f64)>,
+    columns: f64,
+    t0: f64,
+    t1: f64,
+    shade: Shade,
+    phase: VecDeque<(f64, f64)>,
+}
+
+impl PlotData {
+    fn redecimate(&mut self) {
+        let (t0, t1, cols) = (self.t0, self.t1, self.columns);
+        let px = |x: f64, _y: f64| ((((x - t0) / (t1 - t0).max(1e-300)) * cols) as i32, 0);
+        for v in [&mut self.tip, &mut self.vt] {
+            if v.len() > 8 * cols as usize {
+                *v = decimate_line(v, px).concat();
+            }
+        }
+    }
+}
+
+/// The writers of a run's data files.
+struct DataFiles {
+    npy: NpyStream,
+    csv: Option<CsvStream>,
+    events: CsvStream,
+    poincare: CsvStream,
+    energy: CsvStream,
+}
+
+fn series_columns(n: usize) -> Vec<Column> {
+    let mut c =
+        vec![
+        Column::new("tau", "τ (eq. 5)", "dimensionless time τ = t √(EI/(mL⁴))"),
+        Column::new(
+            "v_t",
+            "g0",
+            "tip–sample distance V_T = W(1,τ) + α2 sin Ωτ + α5 (eq. 8); contact while V_T ≤ 0",
+        ),
+        Column::new("w_tip", "g0", "tip deflection W(1,τ) relative to the clamped base"),
+        Column::new("w_tip_dot", "g0 per unit τ", "tip velocity ∂W(1,τ)/∂τ"),
+        Column::new("in_contact", "0/1", "1 while the tip is in contact (region II)"),
+        Column::new(
+            "contact_force",
+            "EI g0/L³",
+            "F_c = α4 V_T + α6 dV_T/dτ in contact, 0 in free flight (F_c < 0 pushes the tip away)",
+        ),
+    ];
+    c.extend((1..=n).map(|j| {
+        Column::new(
+            format!("a_{j}"),
+            "g0",
+            format!("modal coordinate a_{j} (eq. 9)"),
+        )
+    }));
+    c.extend((1..=n).map(|j| {
+        Column::new(
+            format!("a_dot_{j}"),
+            "g0 per unit τ",
+            format!("modal velocity da_{j}/dτ"),
+        )
+    }));
+    c
+}
+
+fn sample_row(s: &Sample) -> Vec<f64> {
+    let mut r = vec![
+        s.tau,
+        s.v_t,
+        s.w_tip,
+        s.w_tip_dot,
+        f64::from(u8::from(s.region == Region::Contact)),
+        s.contact_force,
+    ];
+    r.extend(s.state.iter());
+    r
+}
+
+/// Run `afmdyn simulate`: the run is recorded in chunks of whole periods and every chunk is
+/// streamed to the files, so memory does not grow with the length of the run.
 pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
     let p = a.model.params(Params::default())?;
     let model = CantileverModel::new(&p)?;
@@ -88,9 +230,10 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
             a.transient
         )));
     }
-    let t_transient = a.transient * p.period();
+    let period = p.period();
+    let t_transient = a.transient * period;
     let record_tau = match (a.periods, a.tau_end) {
-        (Some(n), None) if n.is_finite() && n > 0.0 => n * p.period(),
+        (Some(n), None) if n.is_finite() && n > 0.0 => n * period,
         (Some(n), None) => {
             return Err(CliError::Input(format!(
                 "periods = {n}: must be finite and > 0"
@@ -102,183 +245,407 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
                 "tau-end = {t}: must be finite and > the transient ({t_transient})"
             )))
         }
-        _ => 50.0 * p.period(),
+        _ => 50.0 * period,
     };
-    let opts = a.integrator.options(a.samples_per_period);
-    let mut integ = build(&model, opts, 0.0, &z0)?;
-    let tr = record(
-        integ.as_mut(),
-        &RecordSpec {
-            transient_periods: a.transient,
-            record_tau,
-            samples_per_period: a.samples_per_period,
-            energy: true,
-            body_contact: true,
-        },
-    )?;
-    write_outputs(a, &model, &tr)?;
-    let zf = &tr.final_state;
+    let total_periods = a.transient + record_tau / period;
+    if total_periods > MAX_RUN_PERIODS {
+        return Err(CliError::Input(format!(
+            "periods = {:e} with the transient: a run may span at most 1e8 drive periods \
+             (beyond, τ no longer resolves the integration grid)",
+            total_periods
+        )));
+    }
+    let spp = a.samples_per_period;
     let n = p.modes;
-    let summary = json!({
+    let columns = series_columns(n);
+    let rows = (record_tau / period * spp as f64).floor() + 1.0;
+    if a.files != Files::None {
+        let per_value = if a.csv { 8.0 + 24.0 } else { 8.0 };
+        let bytes = rows * columns.len() as f64 * per_value;
+        if bytes > MAX_SERIES_BYTES {
+            return Err(CliError::Input(format!(
+                "the time series would be {:.1} GB ({rows:.3e} samples × {} columns{}), more \
+                 than the 16 GiB budget: lower --periods or --samples-per-period, or use \
+                 --files none",
+                bytes / 1e9,
+                columns.len(),
+                if a.csv { ", NPY and CSV" } else { "" }
+            )));
+        }
+    }
+    let opts = a.integrator.options(spp);
+    let mut integ = build(&model, opts, 0.0, &z0)?;
+    // inputs are valid: lock the output directory and open the files
+    let out = match a.files {
+        Files::None => None,
+        _ => Some(OutDir::lock(&a.out)?),
+    };
+    let mut files = match &out {
+        None => None,
+        Some(o) => Some(DataFiles {
+            npy: NpyStream::create(&o.join("timeseries.npy"), columns.clone())?,
+            csv: match a.csv {
+                true => {
+                    let hdr: Vec<&str> = columns.iter().map(|c| c.name.as_str()).collect();
+                    Some(csv_stream(&o.join("timeseries.csv"), &hdr)?)
+                }
+                false => None,
+            },
+            events: csv_stream(&o.join("events.csv"), &["tau", "from", "to", "v_t_dot"])?,
+            poincare: csv_stream(
+                &o.join("poincare.csv"),
+                &["tau", "v_t", "w_tip", "w_tip_dot"],
+            )?,
+            energy: csv_stream(
+                &o.join("energy.csv"),
+                &[
+                    "tau0",
+                    "e_start",
+                    "e_end",
+                    "base_work",
+                    "beam_dissipation",
+                    "contact_dissipation",
+                    "residual",
+                    "tau1",
+                ],
+            )?,
+        }),
+    };
+    let start = t_transient;
+    let end = start + record_tau;
+    let mut plots = (a.files == Files::All).then(|| PlotData {
+        tip: vec![],
+        vt: vec![],
+        columns: 2000.0,
+        t0: start,
+        t1: end,
+        shade: Shade {
+            intervals: vec![],
+            open: None,
+            min_gap: (end - start) / 4000.0,
+        },
+        phase: VecDeque::new(),
+    });
+    let mut spectrum: VecDeque<f64> = VecDeque::new();
+    let record_samples = if files.is_some() { spp } else { 0 };
+    let chunk = a
+        .chunk_periods
+        .unwrap_or(if record_samples > 0 {
+            (CHUNK_SAMPLES / spp).max(1)
+        } else {
+            4096
+        })
+        .max(1) as f64;
+    let bar = indicatif::ProgressBar::new(total_periods.ceil() as u64);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{bar:40} {pos}/{len} periods  {elapsed} / ~{duration}",
+        )
+        .expect("template"),
+    );
+    // chunks end on stroboscopic sections (so that no energy period is split) when the sample
+    // grid start + k·dt passes through them, i.e. when transient × samples-per-period is an
+    // integer; otherwise on the sample grid (energy.csv then has split rows, see its tau1)
+    let on_sections = record_samples == 0 || {
+        let x = a.transient * spp as f64;
+        (x - x.round()).abs() <= 1e-9 * (1.0 + x)
+    };
+    let first_section = (start / period - 1e-9).ceil();
+    let mut summary = RunSummary::default();
+    let mut last_sample = f64::NEG_INFINITY;
+    let mut last_section = f64::NEG_INFINITY;
+    let mut k = 0.0;
+    let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * (1.0 + a.abs());
+    loop {
+        k += 1.0;
+        let target = if on_sections {
+            (first_section + k * chunk) * period
+        } else {
+            start + k * chunk * period
+        }
+        .min(end);
+        let first = k == 1.0;
+        let now = integ.tau();
+        let tr = record(
+            integ.as_mut(),
+            &RecordSpec {
+                transient_periods: if first { a.transient } else { 0.0 },
+                record_tau: if first {
+                    target - start
+                } else {
+                    (target - now).max(0.0)
+                },
+                samples_per_period: record_samples,
+                energy: true,
+                body_contact: true,
+            },
+        )?;
+        summary.add(&tr);
+        let samples: Vec<&Sample> = tr
+            .samples
+            .iter()
+            .filter(|s| !close(s.tau, last_sample))
+            .collect();
+        if let Some(s) = samples.last() {
+            last_sample = s.tau;
+        }
+        let sections: Vec<_> = tr
+            .poincare
+            .iter()
+            .filter(|(t, _)| !close(*t, last_section))
+            .collect();
+        if let Some((t, _)) = sections.last() {
+            last_section = *t;
+        }
+        summary.sections += sections.len();
+        if let Some(fl) = files.as_mut() {
+            for s in &samples {
+                let row = sample_row(s);
+                fl.npy.push(&row)?;
+                if let Some(c) = fl.csv.as_mut() {
+                    csv_row(c, row.iter().map(|v| f(*v)))?;
+                }
+                if spectrum.len() == SPECTRUM_SAMPLES {
+                    spectrum.pop_front();
+                }
+                spectrum.push_back(s.w_tip);
+            }
+            for e in &tr.events {
+                csv_row(
+                    &mut fl.events,
+                    [
+                        f(e.tau),
+                        format!("{:?}", e.from).to_lowercase(),
+                        format!("{:?}", e.to).to_lowercase(),
+                        f(e.v_t_dot),
+                    ],
+                )?;
+            }
+            for (t, z) in &sections {
+                csv_row(
+                    &mut fl.poincare,
+                    [
+                        f(*t),
+                        f(model.v_t(*t, z)),
+                        f(model.w_tip(z)),
+                        f(model.w_tip_dot(z)),
+                    ],
+                )?;
+            }
+            for e in &tr.energy {
+                // each interval ends at the first stroboscopic section after its start
+                let tau1 = ((e.tau0 / period + 1e-9).floor() + 1.0) * period;
+                csv_row(
+                    &mut fl.energy,
+                    [
+                        f(e.tau0),
+                        f(e.e_start),
+                        f(e.e_end),
+                        f(e.base_work),
+                        f(e.beam_dissipation),
+                        f(e.contact_dissipation),
+                        f(e.residual()),
+                        f(tau1),
+                    ],
+                )?;
+            }
+        }
+        if let Some(pd) = plots.as_mut() {
+            let (a2, om) = (p.alpha2, p.omega);
+            for s in &samples {
+                pd.tip.push((s.tau, s.w_tip));
+                pd.vt.push((s.tau, s.v_t));
+                if pd.phase.len() == PHASE_SAMPLES {
+                    pd.phase.pop_front();
+                }
+                pd.phase
+                    .push_back((s.v_t, s.w_tip_dot + a2 * om * (om * s.tau).cos()));
+            }
+            if first
+                && tr
+                    .samples
+                    .first()
+                    .is_some_and(|s| s.region == Region::Contact)
+            {
+                pd.shade.open = Some(tr.samples[0].tau);
+            }
+            for e in &tr.events {
+                match e.to {
+                    Region::Contact => pd.shade.open = Some(e.tau),
+                    Region::Free => {
+                        if let Some(t0) = pd.shade.open.take() {
+                            pd.shade.push(t0, e.tau);
+                        }
+                    }
+                }
+            }
+            pd.redecimate();
+        }
+        bar.set_position((a.transient + (integ.tau() - start) / period) as u64);
+        summary.tau_end = tr.tau_end;
+        summary.final_state = Some(tr.final_state);
+        if integ.tau() >= end {
+            break;
+        }
+    }
+    bar.finish_and_clear();
+    if let Some(fl) = files {
+        fl.npy.finish()?;
+        if let Some(c) = fl.csv {
+            csv_finish(c)?;
+        }
+        csv_finish(fl.events)?;
+        csv_finish(fl.poincare)?;
+        csv_finish(fl.energy)?;
+    }
+    if let Some(o) = &out {
+        write_spectrum_and_plots(o, &p, spp, spectrum, plots, summary.tau_end)?;
+    }
+    let zf = summary.final_state.clone().unwrap_or_else(|| z0.clone());
+    let warnings = summary.warnings(opts.kind);
+    let doc = json!({
         "params": p,
-        "tau_end": tr.tau_end,
+        "tau_end": summary.tau_end,
         "final": {
-            "w_tip": model.w_tip(zf),
-            "w_tip_dot": model.w_tip_dot(zf),
-            "v_t": model.v_t(tr.tau_end, zf),
+            "w_tip": model.w_tip(&zf),
+            "w_tip_dot": model.w_tip_dot(&zf),
+            "v_t": model.v_t(summary.tau_end, &zf),
             "a": zf.rows(0, n).iter().collect::<Vec<_>>(),
             "a_dot": zf.rows(n, n).iter().collect::<Vec<_>>(),
         },
-        "switchings": tr.events.len(),
-        "body_contact": tr.body_contact,
+        "switchings": summary.switchings,
+        "body_contact": summary.body_contact,
+        "poincare_points": summary.sections,
+        "energy_residual": { "max_abs": summary.residual, "max_relative": summary.relative },
+        "files": a.files.to_possible_value().map(|v| v.get_name().to_string()),
+        "warnings": warnings,
     });
+    for w in &warnings {
+        eprintln!("afmdyn: warning: {w}");
+    }
     if a.json {
-        println!("{summary}");
+        println!("{doc}");
     } else {
-        let worst = tr
-            .energy
-            .iter()
-            .map(|e| e.residual().abs())
-            .fold(0.0, f64::max);
         println!(
             "integrator {}, τ from {:.6} to {:.6}",
             integ.name(),
             t_transient,
-            tr.tau_end
+            summary.tau_end
         );
         println!(
             "switchings: {}, Poincaré points: {}",
-            tr.events.len(),
-            tr.poincare.len()
+            summary.switchings, summary.sections
         );
         println!(
             "final W(1,τ) = {:.9}, V_T = {:.9}",
-            model.w_tip(zf),
-            model.v_t(tr.tau_end, zf)
+            model.w_tip(&zf),
+            model.v_t(summary.tau_end, &zf)
         );
-        println!("energy balance: largest per-period residual {worst:.3e}");
-        if tr.body_contact {
-            println!("warning: a point of the beam other than the tip reached the substrate (paper Fig. 2f)");
+        println!(
+            "energy balance: largest per-period residual {:.3e} ({:.1e} relative)",
+            summary.residual, summary.relative
+        );
+        match &out {
+            Some(o) => println!("outputs in {}", o.path().display()),
+            None => println!("no files written (--files none)"),
         }
-        println!("outputs in {}", a.out.display());
     }
     Ok(())
 }
 
-fn write_outputs(
-    a: &SimulateArgs,
-    model: &CantileverModel,
-    tr: &Trajectory,
-) -> Result<(), CliError> {
-    let n = model.modes();
-    ensure_dir(&a.out)?;
-    let mut header: Vec<String> = [
-        "tau",
-        "v_t",
-        "w_tip",
-        "w_tip_dot",
-        "in_contact",
-        "contact_force",
-    ]
-    .map(String::from)
-    .to_vec();
-    header.extend((1..=n).map(|j| format!("a_{j}")));
-    header.extend((1..=n).map(|j| format!("a_dot_{j}")));
-    let row = |s: &afmdyn::trajectory::Sample| -> Vec<f64> {
-        let mut r = vec![
-            s.tau,
-            s.v_t,
-            s.w_tip,
-            s.w_tip_dot,
-            f64::from(u8::from(s.region == Region::Contact)),
-            s.contact_force,
-        ];
-        r.extend(s.state.iter());
-        r
-    };
-    let hdr: Vec<&str> = header.iter().map(String::as_str).collect();
-    write_csv(
-        &a.out.join("timeseries.csv"),
-        &hdr,
-        tr.samples
+/// Totals of a chunked run.
+#[derive(Default)]
+struct RunSummary {
+    switchings: usize,
+    sections: usize,
+    body_contact: bool,
+    residual: f64,
+    relative: f64,
+    tau_end: f64,
+    final_state: Option<nalgebra::DVector<f64>>,
+}
+
+impl RunSummary {
+    fn add(&mut self, tr: &Trajectory) {
+        self.switchings += tr.events.len();
+        self.body_contact |= tr.body_contact;
+        for e in &tr.energy {
+            let r = e.residual().abs();
+            let scale = [
+                e.e_start,
+                e.e_end,
+                e.base_work,
+                e.beam_dissipation,
+                e.contact_dissipation,
+            ]
             .iter()
-            .map(|s| row(s).into_iter().map(f).collect()),
-    )?;
-    write_npy(
-        &a.out.join("timeseries.npy"),
-        header.len(),
-        tr.samples.iter().map(row),
-        tr.samples.len(),
-    )?;
-    write_csv(
-        &a.out.join("events.csv"),
-        &["tau", "from", "to", "v_t_dot"],
-        tr.events.iter().map(|e| {
-            vec![
-                f(e.tau),
-                format!("{:?}", e.from).to_lowercase(),
-                format!("{:?}", e.to).to_lowercase(),
-                f(e.v_t_dot),
-            ]
-        }),
-    )?;
-    write_csv(
-        &a.out.join("poincare.csv"),
-        &["tau", "v_t", "w_tip", "w_tip_dot"],
-        tr.poincare.iter().map(|(t, z)| {
-            vec![
-                f(*t),
-                f(model.v_t(*t, z)),
-                f(model.w_tip(z)),
-                f(model.w_tip_dot(z)),
-            ]
-        }),
-    )?;
-    write_csv(
-        &a.out.join("energy.csv"),
-        &[
-            "tau0",
-            "e_start",
-            "e_end",
-            "base_work",
-            "beam_dissipation",
-            "contact_dissipation",
-            "residual",
-        ],
-        tr.energy.iter().map(|e| {
-            vec![
-                f(e.tau0),
-                f(e.e_start),
-                f(e.e_end),
-                f(e.base_work),
-                f(e.beam_dissipation),
-                f(e.contact_dissipation),
-                f(e.residual()),
-            ]
-        }),
-    )?;
-    // plots
-    let mut shade = Vec::new();
-    let mut open: Option<f64> = tr
-        .samples
-        .first()
-        .filter(|s| s.region == Region::Contact)
-        .map(|s| s.tau);
-    for e in &tr.events {
-        match e.to {
-            Region::Contact => open = Some(e.tau),
-            Region::Free => {
-                if let Some(t0) = open.take() {
-                    shade.push((t0, e.tau));
-                }
+            .fold(0.0f64, |m, v| m.max(v.abs()));
+            self.residual = self.residual.max(r);
+            if scale > 0.0 {
+                self.relative = self.relative.max(r / scale);
+            } else if r > 0.0 || r.is_nan() {
+                self.relative = f64::INFINITY;
             }
         }
     }
-    if let (Some(t0), Some(last)) = (open, tr.samples.last()) {
-        shade.push((t0, last.tau));
+
+    /// The run's own accuracy checks that failed. The energy check is not applied to the
+    /// adaptive oracle: its dense output between its (long) steps is a cubic Hermite
+    /// interpolant, so the quadrature of the balance measures the interpolant, not the solution.
+    fn warnings(&self, kind: afmdyn::IntegratorKind) -> Vec<String> {
+        let mut w = vec![];
+        let checked = kind != afmdyn::IntegratorKind::Adaptive;
+        if checked && (self.relative.is_nan() || self.relative > ENERGY_TOLERANCE) {
+            w.push(format!(
+                "energy balance violated: a per-period residual of {:.1e} relative (tolerance \
+                 1e-6); the trajectory is not accurate (integrator too coarse, or parameters at \
+                 the edge of the valid range)",
+                self.relative
+            ));
+        }
+        if self.body_contact {
+            w.push(
+                "a point of the beam other than the tip reached the substrate (paper Fig. 2f): \
+                 outside the model's assumption"
+                    .into(),
+            );
+        }
+        w
     }
+}
+
+fn write_spectrum_and_plots(
+    out: &OutDir,
+    p: &Params,
+    spp: usize,
+    spectrum: VecDeque<f64>,
+    plots: Option<PlotData>,
+    tau_end: f64,
+) -> Result<(), CliError> {
+    let period = p.period();
+    let window = spectrum.len();
+    let data: Vec<f64> = spectrum.into();
+    let spec = amplitude_spectrum(&data, spp, p.omega);
+    write_csv(
+        &out.join("spectrum.csv"),
+        &["frequency", "amplitude"],
+        spec.iter().map(|(x, y)| vec![f(*x), f(*y)]),
+    )?;
+    let Some(mut pd) = plots else { return Ok(()) };
+    if let Some(t0) = pd.shade.open.take() {
+        pd.shade.push(t0, tau_end);
+    }
+    let recorded = (pd.t1 - pd.t0) / period;
+    let last = |n: usize, what: &str| {
+        let periods = n as f64 / spp as f64;
+        if periods + 1e-9 < recorded {
+            format!("{what} (last {periods:.0} periods)")
+        } else {
+            format!("{what} (recorded part)")
+        }
+    };
     save(
-        &a.out,
+        out.path(),
         "tip",
         &Figure {
             title: "Tip motion (contact intervals shaded)".into(),
@@ -287,73 +654,65 @@ fn write_outputs(
             series: vec![
                 Series {
                     label: "W(1,τ)".into(),
-                    points: tr.samples.iter().map(|s| (s.tau, s.w_tip)).collect(),
+                    points: pd.tip,
                     style: Style::Line,
                     color: 0,
                 },
                 Series {
                     label: "V_T".into(),
-                    points: tr.samples.iter().map(|s| (s.tau, s.v_t)).collect(),
+                    points: pd.vt,
                     style: Style::Line,
                     color: 1,
                 },
             ],
-            shade,
+            shade: pd.shade.intervals,
         },
     )?;
-    let p = model.params();
     save(
-        &a.out,
+        out.path(),
         "phase",
         &Figure {
-            title: "Phase portrait".into(),
+            title: last(pd.phase.len(), "Phase portrait"),
             x_label: "V_T".into(),
             y_label: "dV_T/dτ".into(),
             series: vec![Series {
                 label: String::new(),
-                points: tr
-                    .samples
-                    .iter()
-                    .map(|s| {
-                        (
-                            s.v_t,
-                            s.w_tip_dot + p.alpha2 * p.omega * (p.omega * s.tau).cos(),
-                        )
-                    })
-                    .collect(),
+                points: pd.phase.into(),
                 style: Style::Line,
                 color: 0,
             }],
             shade: vec![],
         },
     )?;
-    let spec = amplitude_spectrum(
-        &tr.samples.iter().map(|s| s.w_tip).collect::<Vec<_>>(),
-        a.samples_per_period,
-        p.omega,
-    );
-    write_csv(
-        &a.out.join("spectrum.csv"),
-        &["frequency", "amplitude"],
-        spec.iter().map(|(x, y)| vec![f(*x), f(*y)]),
-    )?;
+    let f_max = spectrum_axis_end(&spec, p.omega);
     save(
-        &a.out,
+        out.path(),
         "spectrum",
         &Figure {
-            title: "Amplitude spectrum of W(1,τ) (recorded part)".into(),
+            title: last(window, "Amplitude spectrum of W(1,τ)"),
             x_label: "frequency (dimensionless, Ω = drive)".into(),
             y_label: "amplitude".into(),
             series: vec![Series {
                 label: String::new(),
-                points: spec,
+                points: spec.into_iter().filter(|s| s.0 <= f_max).collect(),
                 style: Style::Line,
                 color: 0,
             }],
             shade: vec![],
         },
-    )?;
-    Ok(())
+    )
+}
+
+/// End of the spectrum plot's frequency axis: where the spectrum has died out (the last
+/// amplitude above 1e-3 of the peak, plus 10 %), at least 4Ω.
+fn spectrum_axis_end(spec: &[(f64, f64)], omega: f64) -> f64 {
+    let peak = spec.iter().map(|s| s.1).fold(0.0, f64::max);
+    let top = spec
+        .iter()
+        .rev()
+        .find(|s| s.1 >= 1e-3 * peak)
+        .map_or(0.0, |s| s.0);
+    (1.1 * top).max(4.0 * omega)
 }
 
 /// One-sided amplitude spectrum of uniformly sampled data (rustfft), frequencies in the units
@@ -416,6 +775,19 @@ pub fn converge(a: &ConvergeArgs) -> Result<(), CliError> {
             a.max_modes
         )));
     }
+    if a.samples_per_period == 0 || a.samples_per_period > 100_000 {
+        return Err(CliError::Input(format!(
+            "samples-per-period = {}: must be in 1..=100000",
+            a.samples_per_period
+        )));
+    }
+    if !(1..=10_000).contains(&a.periods) || a.periods * a.samples_per_period > 10_000_000 {
+        return Err(CliError::Input(format!(
+            "periods = {}: must be in 1..=10000, with periods × samples-per-period ≤ 1e7",
+            a.periods
+        )));
+    }
+    let out = OutDir::lock(&a.out)?;
     let runs = mode_convergence(
         &p,
         a.max_modes,
@@ -425,14 +797,13 @@ pub fn converge(a: &ConvergeArgs) -> Result<(), CliError> {
         a.integrator.options(a.samples_per_period),
     )
     .map_err(|e: SimError| CliError::from(e))?;
-    ensure_dir(&a.out)?;
     let k = runs.iter().map(|r| r.w_tip.len()).min().unwrap_or(0);
     let mut header = vec!["tau_from_section".to_string()];
     header.extend(runs.iter().map(|r| format!("w_tip_n{}", r.modes)));
     let hdr: Vec<&str> = header.iter().map(String::as_str).collect();
     let t0 = runs[0].tau[0];
     write_csv(
-        &a.out.join("converge.csv"),
+        &out.join("converge.csv"),
         &hdr,
         (0..k).map(|i| {
             let mut row = vec![f(runs[0].tau[i] - t0)];
@@ -441,7 +812,7 @@ pub fn converge(a: &ConvergeArgs) -> Result<(), CliError> {
         }),
     )?;
     save(
-        &a.out,
+        out.path(),
         "converge",
         &Figure {
             title: format!("Mode convergence, Ω = {} (paper Fig. 4)", p.omega),
@@ -486,4 +857,28 @@ pub fn converge(a: &ConvergeArgs) -> Result<(), CliError> {
         println!("outputs in {}", a.out.display());
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn spectrum_axis_ends_where_the_content_does() {
+        // content below 30, a round-off floor up to 260 (the issue's spectrum.png)
+        let spec: Vec<(f64, f64)> = (0..2600)
+            .map(|k| {
+                let f = k as f64 * 0.1;
+                let a = if f < 30.0 {
+                    0.05 * (-f / 10.0).exp()
+                } else {
+                    1e-9
+                };
+                (f, a)
+            })
+            .collect();
+        let end = spectrum_axis_end(&spec, 2.6);
+        assert!((25.0..40.0).contains(&end), "{end}");
+        assert_eq!(spectrum_axis_end(&[], 2.6), 4.0 * 2.6);
+    }
 }

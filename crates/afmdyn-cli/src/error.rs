@@ -11,7 +11,9 @@ pub enum CliError {
     /// A computation failed.
     #[error("{0}")]
     Sim(#[from] afmdyn::SimError),
-    /// Writing an output failed.
+    /// Reading or writing a file failed; the message names the file (see
+    /// [`crate::output::io_error`]). There is deliberately no conversion from `std::io::Error`,
+    /// which would lose the path.
     #[error("{0}")]
     Io(String),
 }
@@ -26,23 +28,12 @@ impl CliError {
                 | afmdyn::SimError::StateLength { .. }
                 | afmdyn::SimError::NotFinite { .. }
                 | afmdyn::SimError::OutOfRange { .. }
-                | afmdyn::SimError::Unsupported { .. } => 2,
+                | afmdyn::SimError::Unsupported { .. }
+                | afmdyn::SimError::Budget { .. } => 2,
                 _ => 1,
             },
             CliError::Io(_) => 1,
         }
-    }
-}
-
-impl From<std::io::Error> for CliError {
-    fn from(e: std::io::Error) -> Self {
-        CliError::Io(e.to_string())
-    }
-}
-
-impl From<csv::Error> for CliError {
-    fn from(e: csv::Error) -> Self {
-        CliError::Io(e.to_string())
     }
 }
 

@@ -14,7 +14,14 @@ use error::CliError;
 
 /// Multi-modal tapping-mode AFM dynamics with intermittent contact.
 #[derive(Debug, Parser)]
-#[command(name = "afmdyn", version, about)]
+#[command(
+    name = "afmdyn",
+    version,
+    about,
+    after_help = "Output files, their columns and units, the input limits and the exit codes \
+                  (0 done, 1 failed, 2 bad input) are documented in docs/outputs.md; every .npy \
+                  comes with a .npy.json naming its columns."
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -56,6 +63,20 @@ fn run(cli: Cli) -> Result<(), CliError> {
     }
 }
 
+/// A clap error as one line: its first line plus its "tip:" hints (e.g. a similar argument).
+fn one_line(text: &str) -> String {
+    let mut lines = text.lines().map(str::trim).filter(|l| !l.is_empty());
+    let mut out = lines
+        .next()
+        .unwrap_or("invalid arguments")
+        .trim_start_matches("error: ")
+        .to_string();
+    for tip in lines.filter_map(|l| l.strip_prefix("tip: ")) {
+        out.push_str(&format!(" ({tip})"));
+    }
+    out
+}
+
 fn main() {
     let cli = match Cli::try_parse() {
         Ok(c) => c,
@@ -76,12 +97,7 @@ fn main() {
                     },
                 );
             }
-            let text = e.to_string();
-            let line = text
-                .lines()
-                .find(|l| !l.trim().is_empty())
-                .unwrap_or("invalid arguments");
-            eprintln!("afmdyn: {}", line.trim_start_matches("error: "));
+            eprintln!("afmdyn: {}", one_line(&e.to_string()));
             std::process::exit(2);
         }
     };

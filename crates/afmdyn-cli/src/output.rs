@@ -1,15 +1,89 @@
 //! Output files: every finished file is written to a temporary name in the same directory and
-//! renamed into place, so a partial file is never mistaken for a finished one.
+//! renamed into place, so a partial file is never mistaken for a finished one. Every I/O error
+//! names its path. An output directory is locked for the duration of a run.
 
 use crate::error::CliError;
-use std::fs;
-use std::io::Write;
+use serde::Serialize;
+use std::fmt::Display;
+use std::fs::{self, File};
+use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
-/// Create the output directory.
-pub fn ensure_dir(dir: &Path) -> Result<(), CliError> {
-    fs::create_dir_all(dir)
-        .map_err(|e| CliError::Io(format!("cannot create {}: {e}", dir.display())))
+/// An I/O failure on `path`, as one readable line ("cannot write DIR/x.csv: No space left on
+/// device (os error 28)").
+pub fn io_error(verb: &str, path: &Path, e: impl Display) -> CliError {
+    CliError::Io(format!("cannot {verb} {}: {e}", path.display()))
+}
+
+/// Name of the lock file in a locked output directory.
+pub const LOCK_FILE: &str = ".afmdyn.lock";
+
+/// A locked output directory: created if needed; a second run on the same directory fails at
+/// once. The lock is an advisory file lock (`flock`) held by this process, so the kernel
+/// releases it when the process ends, however it ends: a killed run never leaves a stale lock.
+/// The lock file records the holder's process id for the message.
+#[derive(Debug)]
+pub struct OutDir {
+    dir: PathBuf,
+    _lock: File,
+}
+
+impl OutDir {
+    /// Create and lock `dir`.
+    ///
+    /// # Errors
+    /// [`CliError::Io`] when the directory cannot be created; [`CliError::Input`] when another
+    /// run holds it.
+    pub fn lock(dir: &Path) -> Result<OutDir, CliError> {
+        fs::create_dir_all(dir).map_err(|e| io_error("create", dir, e))?;
+        let path = dir.join(LOCK_FILE);
+        let mut file = fs::OpenOptions::new()
+            .read(true)
+            .write(true)
+            .create(true)
+            .truncate(false)
+            .open(&path)
+            .map_err(|e| io_error("open", &path, e))?;
+        match file.try_lock() {
+            Ok(()) => {}
+            Err(fs::TryLockError::WouldBlock) => {
+                let holder = fs::read_to_string(&path).unwrap_or_default();
+                let pid = holder
+                    .split_whitespace()
+                    .next()
+                    .filter(|p| p.chars().all(|c| c.is_ascii_digit()))
+                    .map_or(String::new(), |p| format!(" (process {p})"));
+                return Err(CliError::Input(format!(
+                    "output directory {} is in use by another afmdyn run{pid}; wait for it to \
+                     finish or choose another --out",
+                    dir.display()
+                )));
+            }
+            Err(fs::TryLockError::Error(e)) => {
+                // a file system without advisory locks: run unlocked rather than not at all
+                eprintln!(
+                    "afmdyn: warning: cannot lock {} ({e}); concurrent runs on it are not detected",
+                    dir.display()
+                );
+            }
+        }
+        file.set_len(0).map_err(|e| io_error("write", &path, e))?;
+        writeln!(file, "{} afmdyn", std::process::id()).map_err(|e| io_error("write", &path, e))?;
+        Ok(OutDir {
+            dir: dir.to_path_buf(),
+            _lock: file,
+        })
+    }
+
+    /// `dir/name`.
+    pub fn join(&self, name: impl AsRef<Path>) -> PathBuf {
+        self.dir.join(name)
+    }
+
+    /// The directory.
+    pub fn path(&self) -> &Path {
+        &self.dir
+    }
 }
 
 /// Temporary sibling of `path` keeping its extension (plotters picks the format from it).
@@ -22,24 +96,112 @@ pub fn temp_path(path: &Path) -> PathBuf {
     path.with_file_name(name)
 }
 
-/// Write `path` atomically with `write` filling a temporary file.
+/// Write `path` atomically with `write` filling a temporary file. On failure the temporary
+/// file is removed.
 pub fn atomic<F>(path: &Path, write: F) -> Result<(), CliError>
 where
     F: FnOnce(&Path) -> Result<(), CliError>,
 {
     let tmp = temp_path(path);
-    write(&tmp)?;
-    fs::rename(&tmp, path)
-        .map_err(|e| CliError::Io(format!("cannot finish {}: {e}", path.display())))
+    if let Err(e) = write(&tmp) {
+        let _ = fs::remove_file(&tmp);
+        return Err(e);
+    }
+    fs::rename(&tmp, path).map_err(|e| io_error("finish", path, e))
 }
 
 /// Write bytes atomically.
 pub fn write_bytes(path: &Path, bytes: &[u8]) -> Result<(), CliError> {
     atomic(path, |tmp| {
-        let mut f = fs::File::create(tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        Ok(())
+        let w = |e| io_error("write", path, e);
+        let mut f = File::create(tmp).map_err(w)?;
+        f.write_all(bytes).map_err(w)?;
+        f.sync_all().map_err(w)
+    })
+}
+
+/// A file written progressively (streamed) to its temporary name and renamed into place by
+/// [`Stream::finish`]; dropped unfinished, the temporary file is removed.
+pub struct Stream<W> {
+    path: PathBuf,
+    tmp: PathBuf,
+    inner: Option<W>,
+}
+
+impl<W> Stream<W> {
+    /// Open `path`'s temporary file and wrap the buffered file with `make`.
+    pub fn create(
+        path: &Path,
+        make: impl FnOnce(BufWriter<File>) -> std::io::Result<W>,
+    ) -> Result<Self, CliError> {
+        let tmp = temp_path(path);
+        let file = File::create(&tmp).map_err(|e| io_error("create", path, e))?;
+        let inner = make(BufWriter::new(file)).map_err(|e| io_error("write", path, e))?;
+        Ok(Stream {
+            path: path.to_path_buf(),
+            tmp,
+            inner: Some(inner),
+        })
+    }
+
+    /// The writer; errors from it should go through [`Stream::err`].
+    pub fn get(&mut self) -> &mut W {
+        self.inner.as_mut().expect("open stream")
+    }
+
+    /// A write error on this file.
+    pub fn err(&self, e: impl Display) -> CliError {
+        io_error("write", &self.path, e)
+    }
+
+    /// Close the writer with `close` and rename the file into place.
+    pub fn finish(mut self, close: impl FnOnce(W) -> Result<(), String>) -> Result<(), CliError> {
+        let inner = self.inner.take().expect("open stream");
+        close(inner).map_err(|e| io_error("write", &self.path, e))?;
+        fs::rename(&self.tmp, &self.path).map_err(|e| io_error("finish", &self.path, e))
+    }
+}
+
+impl<W> Drop for Stream<W> {
+    fn drop(&mut self) {
+        if self.inner.is_some() {
+            self.inner = None;
+            let _ = fs::remove_file(&self.tmp);
+        }
+    }
+}
+
+/// A streamed CSV table.
+pub type CsvStream = Stream<csv::Writer<BufWriter<File>>>;
+
+/// Start a streamed CSV table with its header row.
+pub fn csv_stream(path: &Path, header: &[&str]) -> Result<CsvStream, CliError> {
+    let mut s = Stream::create(path, |f| Ok(csv::Writer::from_writer(f)))?;
+    s.get()
+        .write_record(header)
+        .map_err(|e| io_error("write", path, e))?;
+    Ok(s)
+}
+
+/// Append one row to a streamed CSV table.
+pub fn csv_row<I, T>(s: &mut CsvStream, row: I) -> Result<(), CliError>
+where
+    I: IntoIterator<Item = T>,
+    T: AsRef<[u8]>,
+{
+    let r = s.get().write_record(row);
+    r.map_err(|e| s.err(e))
+}
+
+/// Finish a streamed CSV table.
+pub fn csv_finish(s: CsvStream) -> Result<(), CliError> {
+    s.finish(|mut w| {
+        w.flush().map_err(|e| e.to_string())?;
+        let f = w.into_inner().map_err(|e| e.error().to_string())?;
+        f.into_inner()
+            .map_err(|e| e.error().to_string())?
+            .sync_all()
+            .map_err(|e| e.to_string())
     })
 }
 
@@ -49,53 +211,106 @@ pub fn write_csv(
     header: &[&str],
     rows: impl IntoIterator<Item = Vec<String>>,
 ) -> Result<(), CliError> {
-    atomic(path, |tmp| {
-        let mut w = csv::Writer::from_path(tmp)?;
-        w.write_record(header)?;
-        for r in rows {
-            w.write_record(&r)?;
-        }
-        w.flush()?;
-        Ok(())
-    })
+    let mut s = csv_stream(path, header)?;
+    for r in rows {
+        csv_row(&mut s, &r)?;
+    }
+    csv_finish(s)
 }
 
-/// A 2-D float array (rows × cols) as NPY, written atomically and streamed row by row.
-pub fn write_npy(
-    path: &Path,
-    cols: usize,
-    rows: impl IntoIterator<Item = Vec<f64>>,
-    nrows: usize,
-) -> Result<(), CliError> {
-    use npyz::WriterBuilder;
-    atomic(path, |tmp| {
-        let file = std::io::BufWriter::new(fs::File::create(tmp)?);
-        let mut w = npyz::WriteOptions::new()
-            .default_dtype()
-            .shape(&[nrows as u64, cols as u64])
-            .writer(file)
-            .begin_nd()?;
-        let mut count = 0;
-        for r in rows {
-            if r.len() != cols {
-                return Err(CliError::Io(format!(
-                    "npy row of {} values, expected {cols}",
-                    r.len()
-                )));
-            }
-            for v in r {
-                w.push(&v)?;
-            }
-            count += 1;
+/// One column of a numeric table, as documented in its header file.
+#[derive(Debug, Clone, Serialize)]
+pub struct Column {
+    /// Column name (as in the CSV header).
+    pub name: String,
+    /// Unit.
+    pub unit: &'static str,
+    /// Meaning.
+    pub meaning: String,
+}
+
+impl Column {
+    /// A column.
+    pub fn new(name: impl Into<String>, unit: &'static str, meaning: impl Into<String>) -> Self {
+        Column {
+            name: name.into(),
+            unit,
+            meaning: meaning.into(),
         }
-        if count != nrows {
-            return Err(CliError::Io(format!(
-                "npy: {count} rows written, {nrows} announced"
+    }
+}
+
+/// The header file `X.npy.json` of `X.npy`: shape, dtype and the meaning and unit of each
+/// column, so that the array is self-describing (`docs/outputs.md` has the same tables).
+pub fn write_npy_header(npy: &Path, rows: u64, columns: &[Column]) -> Result<(), CliError> {
+    let name = npy
+        .file_name()
+        .and_then(|s| s.to_str())
+        .unwrap_or("data.npy");
+    let doc = serde_json::json!({
+        "file": name,
+        "dtype": "float64 (little-endian)",
+        "shape": [rows, columns.len()],
+        "columns": columns,
+    });
+    let text = serde_json::to_string_pretty(&doc).expect("json") + "\n";
+    write_bytes(&npy.with_file_name(format!("{name}.json")), text.as_bytes())
+}
+
+/// A streamed 2-D float64 NPY array (rows of `cols` values; the row count is written into the
+/// header at the end).
+pub struct NpyStream {
+    stream: Stream<npyz::NpyWriter<f64, BufWriter<File>>>,
+    cols: usize,
+    rows: u64,
+    columns: Vec<Column>,
+    npy: PathBuf,
+}
+
+impl NpyStream {
+    /// Start `path` with the given columns (its header file is written by [`NpyStream::finish`]).
+    pub fn create(path: &Path, columns: Vec<Column>) -> Result<Self, CliError> {
+        use npyz::WriterBuilder;
+        let cols = columns.len();
+        let stream = Stream::create(path, |f| {
+            npyz::WriteOptions::new()
+                .default_dtype()
+                .writer(f)
+                .begin_2d(cols as u64)
+        })?;
+        Ok(NpyStream {
+            stream,
+            cols,
+            rows: 0,
+            columns,
+            npy: path.to_path_buf(),
+        })
+    }
+
+    /// Append one row.
+    pub fn push(&mut self, row: &[f64]) -> Result<(), CliError> {
+        if row.len() != self.cols {
+            return Err(self.stream.err(format!(
+                "row of {} values, expected {}",
+                row.len(),
+                self.cols
             )));
         }
-        w.finish()?;
+        for v in row {
+            let r = self.stream.get().push(v);
+            r.map_err(|e| self.stream.err(e))?;
+        }
+        self.rows += 1;
         Ok(())
-    })
+    }
+
+    /// Finish the array and write its header file.
+    pub fn finish(self) -> Result<(), CliError> {
+        let (rows, columns, npy) = (self.rows, self.columns, self.npy);
+        self.stream
+            .finish(|w| w.finish().map_err(|e| e.to_string()))?;
+        write_npy_header(&npy, rows, &columns)
+    }
 }
 
 /// Format a float for CSV (shortest round-trip representation).

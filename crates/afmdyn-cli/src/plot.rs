@@ -1,8 +1,19 @@
 //! Plots (PNG and SVG) with plotters, using the bundled DejaVu Sans font (no system libraries).
+//!
+//! * Every figure is rendered in memory and written by [`crate::output`], so a failed write
+//!   names its file and never surfaces a backend's debug text.
+//! * Series are decimated to the canvas before drawing: a monotone series (a time series, a
+//!   spectrum) keeps per pixel column its first, lowest, highest and last point, which draws the
+//!   same picture as all points; any other line drops repeated pixels and already drawn
+//!   segments; markers keep one per pixel. Files stay small whatever the number of points.
+//! * Legends sit in a panel right of the data area, never over the data.
 
 use crate::error::CliError;
-use crate::output::atomic;
+use crate::output::write_bytes;
+use plotters::coord::types::RangedCoordf64;
+use plotters::coord::Shift;
 use plotters::prelude::*;
+use std::collections::HashSet;
 use std::path::Path;
 use std::sync::Once;
 
@@ -79,6 +90,117 @@ pub fn color(i: usize) -> RGBColor {
     P[i % P.len()]
 }
 
+/// A legend entry: label, palette index, marker (true) or line swatch.
+pub type LegendEntry = (String, usize, bool);
+
+/// Something drawn on a canvas of any backend.
+trait Painter {
+    /// Paint on `root`; `bitmap` for the raster backend.
+    fn paint<DB: DrawingBackend>(
+        &self,
+        root: DrawingArea<DB, Shift>,
+        bitmap: bool,
+    ) -> Result<(), String>
+    where
+        DB::ErrorType: 'static;
+}
+
+fn png<P: Painter>(size: (u32, u32), p: &P) -> Result<Vec<u8>, String> {
+    use image::ImageEncoder;
+    let mut buf = vec![255u8; size.0 as usize * size.1 as usize * 3];
+    {
+        let root = BitMapBackend::with_buffer(&mut buf, size).into_drawing_area();
+        p.paint(root, true)?;
+    }
+    let mut out = Vec::new();
+    image::codecs::png::PngEncoder::new(&mut out)
+        .write_image(&buf, size.0, size.1, image::ColorType::Rgb8)
+        .map_err(|e| e.to_string())?;
+    Ok(out)
+}
+
+fn svg<P: Painter>(size: (u32, u32), p: &P) -> Result<String, String> {
+    let mut text = String::new();
+    {
+        let root = SVGBackend::with_string(&mut text, size).into_drawing_area();
+        p.paint(root, false)?;
+    }
+    Ok(text)
+}
+
+/// Write `stem.png` and `stem.svg` of `p` in `dir`, each atomically.
+fn write_both<P: Painter>(dir: &Path, stem: &str, size: (u32, u32), p: &P) -> Result<(), CliError> {
+    register_font();
+    let fail = |ext: &str, e: String| {
+        let path = dir.join(format!("{stem}.{ext}"));
+        CliError::Io(format!("cannot draw {}: {e}", path.display()))
+    };
+    let bytes = png(size, p).map_err(|e| fail("png", e))?;
+    write_bytes(&dir.join(format!("{stem}.png")), &bytes)?;
+    let text = svg(size, p).map_err(|e| fail("svg", e))?;
+    write_bytes(&dir.join(format!("{stem}.svg")), text.as_bytes())
+}
+
+/// Break a legend label into lines of at most ~26 characters.
+fn wrap(label: &str) -> Vec<String> {
+    let mut lines = vec![String::new()];
+    for word in label.split(' ') {
+        let cur = lines.last_mut().expect("a line");
+        if !cur.is_empty() && cur.chars().count() + 1 + word.chars().count() > 26 {
+            lines.push(word.to_string());
+        } else {
+            if !cur.is_empty() {
+                cur.push(' ');
+            }
+            cur.push_str(word);
+        }
+    }
+    lines
+}
+
+/// Title on top; the rest split into the data area and, when there are legend entries, a
+/// legend panel on the right (drawn here).
+fn layout<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    title: &str,
+    legend: &[LegendEntry],
+) -> Result<DrawingArea<DB, Shift>, String>
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE).map_err(|e| e.to_string())?;
+    let body = root
+        .titled(title, ("sans-serif", 22))
+        .map_err(|e| e.to_string())?;
+    if legend.is_empty() {
+        return Ok(body);
+    }
+    let (w, _) = body.dim_in_pixel();
+    let (plot, panel) = body.split_horizontally(w.saturating_sub(215));
+    let font = ("sans-serif", 14).into_font().color(&BLACK);
+    let mut y = 40;
+    for (label, c, marker) in legend {
+        let col = color(*c);
+        if *marker {
+            panel
+                .draw(&Circle::new((20, y), 4, col.filled()))
+                .map_err(|e| e.to_string())?;
+        } else {
+            panel
+                .draw(&Rectangle::new([(10, y - 2), (30, y + 2)], col.filled()))
+                .map_err(|e| e.to_string())?;
+        }
+        for line in wrap(label) {
+            panel
+                .draw_text(&line, &font, (38, y - 8))
+                .map_err(|e| e.to_string())?;
+            y += 18;
+        }
+        y += 6;
+    }
+    Ok(plot)
+}
+
 fn bounds(fig: &Figure) -> (f64, f64, f64, f64) {
     let mut b = (
         f64::INFINITY,
@@ -96,104 +218,291 @@ fn bounds(fig: &Figure) -> (f64, f64, f64, f64) {
     if !b.0.is_finite() {
         return (0.0, 1.0, 0.0, 1.0);
     }
+    padded(b, 0.03)
+}
+
+/// A pixel column of a monotone line: column, (first, lowest, highest, last) point, and the
+/// position of each in the input.
+type PixelColumn = (i32, [(f64, f64); 4], [usize; 4]);
+
+/// Decimate a line to the pixel grid `px` maps to. A series monotone in x keeps per pixel
+/// column its first, lowest, highest and last point (in their order), which draws the same
+/// picture; any other line drops points on the pixel of the previous one and segments already
+/// drawn, splitting into runs. Non-finite points split runs too.
+pub fn decimate_line(
+    points: &[(f64, f64)],
+    px: impl Fn(f64, f64) -> (i32, i32),
+) -> Vec<Vec<(f64, f64)>> {
+    let finite = |p: &(f64, f64)| p.0.is_finite() && p.1.is_finite();
+    let monotone = points
+        .iter()
+        .filter(|p| finite(p))
+        .collect::<Vec<_>>()
+        .windows(2)
+        .all(|w| w[0].0 <= w[1].0);
+    let mut runs: Vec<Vec<(f64, f64)>> = vec![];
+    let mut run: Vec<(f64, f64)> = vec![];
+    if monotone {
+        // per column: (first, min, max, last) as indices into the column's points
+        let mut col: Option<PixelColumn> = None;
+        let mut k = 0usize;
+        let flush = |col: &mut Option<PixelColumn>, run: &mut Vec<(f64, f64)>| {
+            if let Some((_, p, order)) = col.take() {
+                let mut idx = [0usize, 1, 2, 3];
+                idx.sort_by_key(|&i| order[i]);
+                let mut last = None;
+                for i in idx {
+                    if last != Some(order[i]) {
+                        run.push(p[i]);
+                        last = Some(order[i]);
+                    }
+                }
+            }
+        };
+        for &q in points {
+            if !finite(&q) {
+                flush(&mut col, &mut run);
+                if !run.is_empty() {
+                    runs.push(std::mem::take(&mut run));
+                }
+                continue;
+            }
+            k += 1;
+            let (cx, _) = px(q.0, q.1);
+            match &mut col {
+                Some((c, p, order)) if *c == cx => {
+                    if q.1 < p[1].1 {
+                        (p[1], order[1]) = (q, k);
+                    }
+                    if q.1 > p[2].1 {
+                        (p[2], order[2]) = (q, k);
+                    }
+                    (p[3], order[3]) = (q, k);
+                }
+                _ => {
+                    flush(&mut col, &mut run);
+                    col = Some((cx, [q; 4], [k; 4]));
+                }
+            }
+        }
+        flush(&mut col, &mut run);
+    } else {
+        let mut drawn: HashSet<(i32, i32, i32, i32)> = HashSet::new();
+        let mut last_px: Option<(i32, i32)> = None;
+        for &q in points {
+            if !finite(&q) {
+                if run.len() > 1 {
+                    runs.push(std::mem::take(&mut run));
+                }
+                run.clear();
+                last_px = None;
+                continue;
+            }
+            let p = px(q.0, q.1);
+            match last_px {
+                Some(l) if l == p => continue,
+                Some(l) => {
+                    let key = if l <= p {
+                        (l.0, l.1, p.0, p.1)
+                    } else {
+                        (p.0, p.1, l.0, l.1)
+                    };
+                    if drawn.insert(key) {
+                        run.push(q);
+                    } else {
+                        // a segment already drawn: end the run, restart from here
+                        if run.len() > 1 {
+                            runs.push(std::mem::take(&mut run));
+                        }
+                        run.clear();
+                        run.push(q);
+                    }
+                }
+                None => run.push(q),
+            }
+            last_px = Some(p);
+        }
+    }
+    if !run.is_empty() {
+        runs.push(run);
+    }
+    runs
+}
+
+/// One marker per pixel.
+pub fn decimate_points(
+    points: &[(f64, f64)],
+    px: impl Fn(f64, f64) -> (i32, i32),
+) -> Vec<(f64, f64)> {
+    let mut seen = HashSet::new();
+    points
+        .iter()
+        .copied()
+        .filter(|q| q.0.is_finite() && q.1.is_finite() && seen.insert(px(q.0, q.1)))
+        .collect()
+}
+
+/// Merge shaded x-intervals whose pixel columns touch.
+fn merge_shade(shade: &[(f64, f64)], px: impl Fn(f64) -> i32) -> Vec<(f64, f64)> {
+    let mut out: Vec<(f64, f64, i32)> = Vec::new();
+    let mut sorted = shade.to_vec();
+    sorted.sort_by(|a, b| a.0.total_cmp(&b.0));
+    for (a, b) in sorted {
+        match out.last_mut() {
+            Some(last) if px(a) <= last.2 + 1 => {
+                if b > last.1 {
+                    last.1 = b;
+                    last.2 = px(b);
+                }
+            }
+            _ => out.push((a, b, px(b))),
+        }
+    }
+    out.into_iter().map(|(a, b, _)| (a, b)).collect()
+}
+
+/// A tick label: 0 for round-off around zero (never "-0.0"), plain decimals in 1e-3..1e5,
+/// else scientific notation.
+fn tick(v: f64, span: f64) -> String {
+    let a = v.abs();
+    if a <= 1e-9 * span {
+        return "0".into();
+    }
+    if !(1e-3..1e5).contains(&a) {
+        return format!("{v:.2e}");
+    }
+    let s = format!("{v:.4}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    s.to_string()
+}
+
+/// Pad a data range (x0, x1, y0, y1) by `frac` of its extent on each side.
+fn padded(b: (f64, f64, f64, f64), frac: f64) -> (f64, f64, f64, f64) {
     let pad = |lo: f64, hi: f64| {
-        let d = (hi - lo).abs().max(1e-12);
-        (lo - 0.03 * d, hi + 0.03 * d)
+        let d = (hi - lo).abs().max(1e-12 * (1.0 + lo.abs()));
+        (lo - frac * d, hi + frac * d)
     };
     let (x0, x1) = pad(b.0, b.1);
     let (y0, y1) = pad(b.2, b.3);
     (x0, x1, y0, y1)
 }
 
-fn draw<DB: DrawingBackend>(
-    root: DrawingArea<DB, plotters::coord::Shift>,
-    fig: &Figure,
-) -> Result<(), String>
+/// The chart of a data area with its axes, mesh and labels over (x0, x1, y0, y1).
+fn chart<'a, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+    (x0, x1, y0, y1): (f64, f64, f64, f64),
+    labels: (&str, &str),
+) -> Result<ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>, String>
 where
     DB::ErrorType: 'static,
 {
-    root.fill(&WHITE).map_err(|e| e.to_string())?;
-    let (x0, x1, y0, y1) = bounds(fig);
-    let mut chart = ChartBuilder::on(&root)
-        .caption(&fig.title, ("sans-serif", 22))
+    let mut chart = ChartBuilder::on(area)
         .margin(12)
         .x_label_area_size(45)
         .y_label_area_size(70)
         .build_cartesian_2d(x0..x1, y0..y1)
-        .map_err(|e| e.to_string())?;
+        .map_err(|x| x.to_string())?;
+    let (xs, ys) = (x1 - x0, y1 - y0);
     chart
         .configure_mesh()
-        .x_desc(fig.x_label.as_str())
-        .y_desc(fig.y_label.as_str())
+        .x_desc(labels.0)
+        .y_desc(labels.1)
+        .x_label_formatter(&|v| tick(*v, xs))
+        .y_label_formatter(&|v| tick(*v, ys))
         .label_style(("sans-serif", 15))
         .draw()
-        .map_err(|e| e.to_string())?;
-    let shade = RGBColor(200, 200, 200).mix(0.5);
-    chart
-        .draw_series(
-            fig.shade
-                .iter()
-                .map(|&(a, b)| Rectangle::new([(a, y0), (b, y1)], shade.filled())),
-        )
-        .map_err(|e| e.to_string())?;
-    let mut legend = false;
-    for s in &fig.series {
-        let c = color(s.color);
-        let anno = match s.style {
-            Style::Line => chart
-                .draw_series(LineSeries::new(s.points.iter().copied(), c.stroke_width(2)))
-                .map_err(|e| e.to_string())?,
-            Style::Points => chart
-                .draw_series(s.points.iter().map(|&p| Circle::new(p, 4, c.filled())))
-                .map_err(|e| e.to_string())?,
-            Style::Dots => chart
-                .draw_series(
-                    s.points
-                        .iter()
-                        .map(|&p| Circle::new(p, 1, c.mix(0.6).filled())),
+        .map_err(|x| x.to_string())?;
+    Ok(chart)
+}
+
+impl Painter for Figure {
+    fn paint<DB: DrawingBackend>(
+        &self,
+        root: DrawingArea<DB, Shift>,
+        bitmap: bool,
+    ) -> Result<(), String>
+    where
+        DB::ErrorType: 'static,
+    {
+        let e = |x: &dyn std::fmt::Display| x.to_string();
+        let legend: Vec<LegendEntry> = self
+            .series
+            .iter()
+            .filter(|s| !s.label.is_empty())
+            .map(|s| {
+                (
+                    s.label.clone(),
+                    s.color,
+                    matches!(s.style, Style::Points | Style::Dots),
                 )
-                .map_err(|e| e.to_string())?,
-            Style::Dashed => chart
-                .draw_series(DashedLineSeries::new(
-                    s.points.iter().copied(),
-                    6,
-                    4,
-                    c.stroke_width(2),
-                ))
-                .map_err(|e| e.to_string())?,
-        };
-        if !s.label.is_empty() {
-            legend = true;
-            anno.label(s.label.clone())
-                .legend(move |(x, y)| Rectangle::new([(x, y - 4), (x + 16, y + 4)], c.filled()));
+            })
+            .collect();
+        let area = layout(root, &self.title, &legend)?;
+        let (x0, x1, y0, y1) = bounds(self);
+        let mut chart = chart(&area, (x0, x1, y0, y1), (&self.x_label, &self.y_label))?;
+        let px = |x: f64, y: f64| chart.backend_coord(&(x, y));
+        let shade_color = RGBColor(200, 200, 200).mix(0.5);
+        let shade = merge_shade(&self.shade, |x| px(x, y0).0);
+        let mut shapes = Vec::new();
+        for s in &self.series {
+            let c = color(s.color);
+            match s.style {
+                Style::Line | Style::Dashed => {
+                    for run in decimate_line(&s.points, px) {
+                        shapes.push((run, c, s.style));
+                    }
+                }
+                Style::Points | Style::Dots => {
+                    shapes.push((decimate_points(&s.points, px), c, s.style));
+                }
+            }
         }
-    }
-    if legend {
         chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 14))
-            .position(SeriesLabelPosition::UpperRight)
-            .draw()
-            .map_err(|e| e.to_string())?;
+            .draw_series(
+                shade
+                    .iter()
+                    .map(|&(a, b)| Rectangle::new([(a, y0), (b, y1)], shade_color.filled())),
+            )
+            .map_err(|x| e(&x))?;
+        for (pts, c, style) in shapes {
+            match style {
+                // thick polylines get miter spikes at sharp turns in the bitmap backend: there,
+                // short lines are drawn segment by segment and dense (decimated) ones 1 px wide
+                Style::Line if bitmap && pts.len() <= 1500 => chart
+                    .draw_series(
+                        pts.windows(2)
+                            .map(|w| PathElement::new(vec![w[0], w[1]], c.stroke_width(2))),
+                    )
+                    .map(|_| ()),
+                Style::Line => chart
+                    .draw_series(LineSeries::new(
+                        pts,
+                        c.stroke_width(if bitmap { 1 } else { 2 }),
+                    ))
+                    .map(|_| ()),
+                Style::Dashed => chart
+                    .draw_series(DashedLineSeries::new(pts, 6, 4, c.stroke_width(2)))
+                    .map(|_| ()),
+                Style::Points => chart
+                    .draw_series(pts.into_iter().map(|p| Circle::new(p, 4, c.filled())))
+                    .map(|_| ()),
+                Style::Dots => chart
+                    .draw_series(
+                        pts.into_iter()
+                            .map(|p| Circle::new(p, 1, c.mix(0.6).filled())),
+                    )
+                    .map(|_| ()),
+            }
+            .map_err(|x| e(&x))?;
+        }
+        area.present().map_err(|x| e(&x))?;
+        Ok(())
     }
-    root.present().map_err(|e| e.to_string())?;
-    Ok(())
 }
 
 /// Write `stem.png` and `stem.svg` in `dir`, each atomically.
 pub fn save(dir: &Path, stem: &str, fig: &Figure) -> Result<(), CliError> {
-    register_font();
-    let size = (1000, 650);
-    atomic(&dir.join(format!("{stem}.png")), |tmp| {
-        draw(BitMapBackend::new(tmp, size).into_drawing_area(), fig)
-            .map_err(|e| CliError::Io(format!("plot {stem}.png: {e}")))
-    })?;
-    atomic(&dir.join(format!("{stem}.svg")), |tmp| {
-        draw(SVGBackend::new(tmp, size).into_drawing_area(), fig)
-            .map_err(|e| CliError::Io(format!("plot {stem}.svg: {e}")))
-    })
+    write_both(dir, stem, (1000, 650), fig)
 }
 
 /// Draws one chunk of (x, y, palette index) points.
@@ -201,58 +510,33 @@ pub type ChunkSink<'a> = dyn FnMut(&[(f64, f64, usize)]) -> Result<(), String> +
 /// Streams all chunks of a scatter plot into a [`ChunkSink`].
 pub type ChunkFeed<'a> = dyn Fn(&mut ChunkSink<'_>) -> Result<(), CliError> + 'a;
 
-/// A scatter plot drawn from a stream of points in chunks (the bifurcation diagram), so that the
-/// points are never all in memory. `bounds` = (x0, x1, y0, y1); `feed` is called once per
-/// backend and hands chunks of (x, y, palette index) to its callback.
-pub fn save_scatter_stream(
-    dir: &Path,
-    stem: &str,
-    title: &str,
-    labels: (&str, &str),
+struct Scatter<'a> {
+    title: &'a str,
+    labels: (&'a str, &'a str),
     bounds: (f64, f64, f64, f64),
-    legend: &[(String, usize)],
-    feed: &ChunkFeed<'_>,
-) -> Result<(), CliError> {
-    register_font();
-    fn go<DB: DrawingBackend>(
-        root: DrawingArea<DB, plotters::coord::Shift>,
-        title: &str,
-        labels: (&str, &str),
-        b: (f64, f64, f64, f64),
-        legend: &[(String, usize)],
-        feed: &ChunkFeed<'_>,
-    ) -> Result<(), CliError>
+    legend: &'a [LegendEntry],
+    feed: &'a ChunkFeed<'a>,
+    failure: std::cell::RefCell<Option<CliError>>,
+}
+
+impl Painter for Scatter<'_> {
+    fn paint<DB: DrawingBackend>(
+        &self,
+        root: DrawingArea<DB, Shift>,
+        _bitmap: bool,
+    ) -> Result<(), String>
     where
         DB::ErrorType: 'static,
     {
-        let e = |x: String| CliError::Io(format!("plot: {x}"));
-        root.fill(&WHITE).map_err(|x| e(x.to_string()))?;
-        let pad = |lo: f64, hi: f64| {
-            let d = (hi - lo).abs().max(1e-9);
-            (lo - 0.02 * d, hi + 0.02 * d)
-        };
-        let (x0, x1) = pad(b.0, b.1);
-        let (y0, y1) = pad(b.2, b.3);
-        let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 22))
-            .margin(12)
-            .x_label_area_size(45)
-            .y_label_area_size(70)
-            .build_cartesian_2d(x0..x1, y0..y1)
-            .map_err(|x| e(x.to_string()))?;
-        chart
-            .configure_mesh()
-            .x_desc(labels.0)
-            .y_desc(labels.1)
-            .label_style(("sans-serif", 15))
-            .draw()
-            .map_err(|x| e(x.to_string()))?;
+        let e = |x: &dyn std::fmt::Display| x.to_string();
+        let area = layout(root, self.title, self.legend)?;
+        let mut chart = chart(&area, padded(self.bounds, 0.02), self.labels)?;
         // one marker per (pixel, colour): memory and file size stay bounded by the canvas,
         // not by the number of points (an SVG would otherwise grow with the sweep)
-        let (w, h) = root.dim_in_pixel();
+        let (w, h) = area.dim_in_pixel();
         let (w, h) = (w as usize + 1, h as usize + 1);
         let mut seen = vec![0u64; (w * h * PALETTE).div_ceil(64)];
-        feed(&mut |chunk| {
+        let fed = (self.feed)(&mut |chunk| {
             let fresh: Vec<(f64, f64, usize)> = chunk
                 .iter()
                 .copied()
@@ -276,51 +560,118 @@ pub fn save_scatter_stream(
                 )
                 .map(|_| ())
                 .map_err(|x| x.to_string())
-        })?;
-        for (label, c) in legend {
-            let col = color(*c);
-            chart
-                .draw_series(std::iter::once(Circle::new(
-                    (f64::NAN, f64::NAN),
-                    0,
-                    col.filled(),
-                )))
-                .map_err(|x| e(x.to_string()))?
-                .label(label.clone())
-                .legend(move |(x, y)| Circle::new((x + 8, y), 4, col.filled()));
+        });
+        if let Err(err) = fed {
+            let msg = err.to_string();
+            *self.failure.borrow_mut() = Some(err);
+            return Err(msg);
         }
-        if !legend.is_empty() {
-            chart
-                .configure_series_labels()
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .label_font(("sans-serif", 14))
-                .position(SeriesLabelPosition::UpperRight)
-                .draw()
-                .map_err(|x| e(x.to_string()))?;
-        }
-        root.present().map_err(|x| e(x.to_string()))?;
+        area.present().map_err(|x| e(&x))?;
         Ok(())
     }
-    let size = (1200, 750);
-    atomic(&dir.join(format!("{stem}.png")), |tmp| {
-        go(
-            BitMapBackend::new(tmp, size).into_drawing_area(),
-            title,
-            labels,
-            bounds,
-            legend,
-            feed,
-        )
-    })?;
-    atomic(&dir.join(format!("{stem}.svg")), |tmp| {
-        go(
-            SVGBackend::new(tmp, size).into_drawing_area(),
-            title,
-            labels,
-            bounds,
-            legend,
-            feed,
-        )
-    })
+}
+
+/// A scatter plot drawn from a stream of points in chunks (the bifurcation diagram), so that the
+/// points are never all in memory. `bounds` = (x0, x1, y0, y1); `feed` is called once per
+/// backend and hands chunks of (x, y, palette index) to its callback.
+pub fn save_scatter_stream(
+    dir: &Path,
+    stem: &str,
+    title: &str,
+    labels: (&str, &str),
+    bounds: (f64, f64, f64, f64),
+    legend: &[LegendEntry],
+    feed: &ChunkFeed<'_>,
+) -> Result<(), CliError> {
+    let s = Scatter {
+        title,
+        labels,
+        bounds,
+        legend,
+        feed,
+        failure: std::cell::RefCell::new(None),
+    };
+    write_both(dir, stem, (1200, 750), &s).map_err(|e| s.failure.take().unwrap_or(e))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn monotone_line_keeps_first_min_max_last_per_column() {
+        let pts: Vec<(f64, f64)> = (0..100_000)
+            .map(|i| {
+                let x = i as f64 / 100_000.0;
+                (x, (x * 5000.0).sin())
+            })
+            .collect();
+        let runs = decimate_line(&pts, |x, y| ((x * 800.0) as i32, (y * 300.0) as i32));
+        assert_eq!(runs.len(), 1);
+        let n = runs[0].len();
+        assert!((2 * 800..=4 * 801).contains(&n), "{n} points");
+        // the envelope is kept: extremes of every column survive
+        let max = runs[0].iter().map(|p| p.1).fold(f64::MIN, f64::max);
+        assert_eq!(max, pts.iter().map(|p| p.1).fold(f64::MIN, f64::max));
+        assert!(runs[0].windows(2).all(|w| w[0].0 <= w[1].0), "order kept");
+    }
+
+    #[test]
+    fn closed_orbit_drawn_many_times_is_drawn_once() {
+        let pts: Vec<(f64, f64)> = (0..200_000)
+            .map(|i| {
+                let t = i as f64 * std::f64::consts::TAU / 500.0;
+                (t.cos(), t.sin())
+            })
+            .collect();
+        let n: usize = decimate_line(&pts, |x, y| ((x * 300.0) as i32, (y * 300.0) as i32))
+            .iter()
+            .map(Vec::len)
+            .sum();
+        assert!(n < 2000, "{n} points kept of 200000");
+    }
+
+    #[test]
+    fn thick_spiky_lines_stay_inside_the_data_area() {
+        // a spectrum-like series: zero with tall one-sample spikes; thick polylines drew miter
+        // spikes far below the x axis, through the tick labels
+        let points: Vec<(f64, f64)> = (0..4000)
+            .map(|k| (k as f64, if k % 97 == 0 { 1.0 } else { 0.0 }))
+            .collect();
+        let fig = Figure {
+            title: "spikes".into(),
+            x_label: "x".into(),
+            y_label: "y".into(),
+            series: vec![Series {
+                label: String::new(),
+                points,
+                style: Style::Line,
+                color: 0,
+            }],
+            shade: vec![],
+        };
+        register_font();
+        let (w, h) = (1000u32, 650u32);
+        let bytes = png((w, h), &fig).unwrap();
+        let img = image::load_from_memory(&bytes).unwrap().to_rgb8();
+        let blue = color(0);
+        // the x-axis label band: below the axis (margin 12 + label area 45 at the bottom)
+        let stray = (h - 45..h)
+            .flat_map(|y| (0..w).map(move |x| (x, y)))
+            .filter(|&(x, y)| {
+                let p = img.get_pixel(x, y);
+                (p[0], p[1], p[2]) == (blue.0, blue.1, blue.2)
+            })
+            .count();
+        assert_eq!(stray, 0, "series pixels below the x axis");
+    }
+
+    #[test]
+    fn legend_labels_wrap() {
+        let w = wrap("period-1 branch (solid stable, dashed unstable)");
+        assert!(
+            w.len() == 2 && w.iter().all(|l| l.chars().count() <= 26),
+            "{w:?}"
+        );
+    }
 }

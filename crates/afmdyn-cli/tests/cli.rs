@@ -140,11 +140,13 @@ fn simulate_writes_series_events_section_and_plots() {
         "2",
         "--samples-per-period",
         "50",
+        "--csv",
         "--json",
         "--out",
         out.to_str().unwrap(),
     ]));
     assert!(doc["switchings"].as_u64().unwrap() >= 6);
+    assert_eq!(doc["warnings"], serde_json::json!([]), "an accurate run");
     assert_eq!(doc["body_contact"], false);
     assert_eq!(doc["final"]["a"].as_array().unwrap().len(), 3);
     let t = doc["tau_end"].as_f64().unwrap();
@@ -261,11 +263,17 @@ fn bifurcation_resumes_after_a_kill_without_lost_or_duplicated_rows() {
     assert!(run(&[], &full).status.success());
     let reference = rows(&full.join("bifurcation.csv"));
     assert!(!reference.is_empty());
-    // a killed run: the partial file holds a prefix of the rows, cut inside a line
-    std::fs::create_dir_all(&cut).unwrap();
-    let text = std::fs::read_to_string(full.join("bifurcation.csv")).unwrap();
-    let cut_at = text.len() * 3 / 5;
-    std::fs::write(cut.join(".bifurcation.partial.csv"), &text[..cut_at]).unwrap();
+    // a killed run (aborted after 20 of its 36 points) leaves a partial file; a row cut in the
+    // middle is appended as a kill during a write would leave it
+    let killed = run(&["--abort-after", "20"], &cut);
+    assert!(!killed.status.success(), "the run was killed");
+    let partial = cut.join(".bifurcation.partial.csv");
+    let text = std::fs::read_to_string(&partial).unwrap();
+    assert!(
+        text.lines().count() > 20,
+        "rows of the killed run were kept"
+    );
+    std::fs::write(&partial, text + "omega,2.5,5,start-0,peri").unwrap();
     assert!(!cut.join("bifurcation.csv").exists());
     let out = run(&["--resume"], &cut);
     assert!(
@@ -279,7 +287,7 @@ fn bifurcation_resumes_after_a_kill_without_lost_or_duplicated_rows() {
         resumed, reference,
         "the resumed sweep equals the uninterrupted one"
     );
-    assert!(!cut.join(".bifurcation.partial.csv").exists());
+    assert!(!partial.exists());
     assert!(cut.join("bifurcation.npy").exists() && cut.join("bifurcation.png").exists());
 }
 

@@ -32,6 +32,19 @@ pub enum ParamError {
         /// The allowed range.
         range: &'static str,
     },
+    /// A finite value beyond the range where the numerics are meaningful (see the limits in
+    /// [`crate::params`]).
+    #[error("{name} = {value:e}: must lie in {range} ({reason})")]
+    Magnitude {
+        /// Field name with its paper symbol.
+        name: &'static str,
+        /// The rejected value.
+        value: f64,
+        /// The allowed range, e.g. `[0, 1e4]`.
+        range: &'static str,
+        /// Why the limit exists.
+        reason: &'static str,
+    },
 }
 
 /// A physical-unit input outside its allowed range (see [`crate::units`]).
@@ -164,6 +177,18 @@ pub enum SimError {
         tau: f64,
         /// The crate's message.
         message: String,
+    },
+    /// A run would exceed a documented memory or work budget; refused before allocating.
+    #[error("{what}: {needed} exceeds the budget of {budget} ({hint})")]
+    Budget {
+        /// What would be too large.
+        what: &'static str,
+        /// The estimate, with its unit.
+        needed: String,
+        /// The budget, with its unit.
+        budget: String,
+        /// How to stay within it.
+        hint: &'static str,
     },
 }
 

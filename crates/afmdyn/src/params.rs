@@ -9,19 +9,53 @@ use std::str::FromStr;
 /// Largest number of Galerkin modes supported (the mode shapes are accurate to ~1e-13 up to i = 20).
 pub const MAX_MODES: usize = 20;
 
+/// Largest tip-mass ratio α1: the mass matrix I + α1 φ(1)φ(1)ᵀ has condition number ≈ 4Nα1, and
+/// beyond 10⁴ beam masses its Cholesky factor (used by every integrator) loses too many digits.
+pub const ALPHA1_MAX: f64 = 1e4;
+/// Largest drive amplitude α2 and gap |α5|: displacements scale with them, and the integrators
+/// stop as diverged at a state norm of [`STATE_NORM_MAX`]; beyond 10⁶ products such as the
+/// squared gap in the contact energy leave the range where the switching search is reliable.
+pub const DISPLACEMENT_MAX: f64 = 1e6;
+/// Largest damping coefficients α3 and α6: the damping rate sets the stiffness of the system,
+/// and the exact grid needs about α·T steps per drive period (see [`GRID_BUDGET_BYTES`]).
+pub const DAMPING_MAX: f64 = 1e4;
+/// Largest contact stiffness α4: contact frequencies grow as √(4Nα4); beyond 10⁸ the contact
+/// system is both stiff and ill-conditioned.
+pub const ALPHA4_MAX: f64 = 1e8;
+/// Smallest drive frequency Ω: below it one drive period spans more than ~10⁴ oscillations of
+/// the first mode, a grid far beyond [`GRID_BUDGET_BYTES`] for any N > 1.
+pub const OMEGA_MIN: f64 = 1e-3;
+/// Largest drive frequency Ω: above it the inertial drive α2Ω² is so much larger than the
+/// response that the result is round-off (the per-period energy balance fails, 1e-7 relative at
+/// Ω = 1e8), and Ω is far above the highest Galerkin mode the model resolves (N ≤ 20).
+pub const OMEGA_MAX: f64 = 1e5;
+/// States with ‖z‖₂ at or above this are treated as diverged by the integrators; an initial
+/// state must lie below it.
+pub const STATE_NORM_MAX: f64 = 1e12;
+/// Memory budget of the exact propagator's period grid: (2N + 2)(m + 1) values of 8 bytes for
+/// m sub-steps per drive period. A parameter set whose grid would exceed it is refused before
+/// anything is allocated (Ω very small, or very stiff or heavily damped contact).
+pub const GRID_BUDGET_BYTES: f64 = 128.0 * 1024.0 * 1024.0;
+/// Budget of the adaptive oracle: the estimated number of steps per drive period, T‖A‖_F (the
+/// Frobenius norm bounds the fastest rate of the system), may not exceed this.
+pub const ADAPTIVE_STEPS_BUDGET: f64 = 1e7;
+
 /// Dimensionless model parameters (paper eq. 7), all in the units of eq. 5.
 ///
 /// | field | symbol | meaning | allowed |
 /// |---|---|---|---|
 /// | `modes` | N | number of Galerkin modes (eq. 9) | 1..=20 |
-/// | `alpha1` | α1 = M/(mL) | tip-mass ratio | finite, ≥ 0 |
-/// | `alpha2` | α2 = f/g0 | base-drive amplitude | finite, ≥ 0 |
-/// | `alpha3` | α3 | beam (viscous) damping | finite, ≥ 0 |
-/// | `alpha4` | α4 = K1 L³/(EI) | contact stiffness | finite, ≥ 0 |
-/// | `alpha5` | α5 = g1/g0 | tip–sample gap | finite |
-/// | `alpha6` | α6 | contact damping | finite, ≥ 0 |
-/// | `omega` | Ω | drive frequency (dimensionless) | finite, > 0 |
+/// | `alpha1` | α1 = M/(mL) | tip-mass ratio | 0 ..= 1e4 |
+/// | `alpha2` | α2 = f/g0 | base-drive amplitude | 0 ..= 1e6 |
+/// | `alpha3` | α3 | beam (viscous) damping | 0 ..= 1e4 |
+/// | `alpha4` | α4 = K1 L³/(EI) | contact stiffness | 0 ..= 1e8 |
+/// | `alpha5` | α5 = g1/g0 | tip–sample gap | −1e6 ..= 1e6 |
+/// | `alpha6` | α6 | contact damping | 0 ..= 1e4 |
+/// | `omega` | Ω | drive frequency (dimensionless) | 1e-3 ..= 1e5 |
 /// | `contact_law` | F_c(δ, δ̇) | tip–sample law and its groups ([`ContactLaw`]) | see the law |
+///
+/// The upper limits are where the numerics stop being meaningful (see [`ALPHA1_MAX`] and the
+/// other constants of this module for the reason of each).
 ///
 /// α4 and α6 are the stiffness and damping groups of whichever law is chosen (the Hertz group
 /// and the Kelvin–Voigt group for `hertz`/`dmt`, see [`crate::contact`]).
@@ -115,22 +149,83 @@ impl Params {
         if !(1..=MAX_MODES).contains(&self.modes) {
             return Err(ParamError::Modes(self.modes));
         }
-        for (name, value) in [
-            ("alpha1 (tip-mass ratio α1)", self.alpha1),
-            ("alpha2 (drive amplitude α2)", self.alpha2),
-            ("alpha3 (beam damping α3)", self.alpha3),
-            ("alpha4 (contact stiffness α4)", self.alpha4),
-            ("alpha6 (contact damping α6)", self.alpha6),
+        const TIP_MASS: &str = "the mass matrix becomes ill-conditioned";
+        const DISPLACEMENT: &str = "displacements scale with it and overflow the switching search";
+        const DAMPING: &str = "the system becomes too stiff for the integration grid";
+        for (name, value, max, range, reason) in [
+            (
+                "alpha1 (tip-mass ratio α1)",
+                self.alpha1,
+                ALPHA1_MAX,
+                "[0, 1e4]",
+                TIP_MASS,
+            ),
+            (
+                "alpha2 (drive amplitude α2)",
+                self.alpha2,
+                DISPLACEMENT_MAX,
+                "[0, 1e6]",
+                DISPLACEMENT,
+            ),
+            (
+                "alpha3 (beam damping α3)",
+                self.alpha3,
+                DAMPING_MAX,
+                "[0, 1e4]",
+                DAMPING,
+            ),
+            (
+                "alpha4 (contact stiffness α4)",
+                self.alpha4,
+                ALPHA4_MAX,
+                "[0, 1e8]",
+                "the contact system becomes too stiff and ill-conditioned",
+            ),
+            (
+                "alpha6 (contact damping α6)",
+                self.alpha6,
+                DAMPING_MAX,
+                "[0, 1e4]",
+                DAMPING,
+            ),
         ] {
             if !(value.is_finite() && value >= 0.0) {
                 return Err(ParamError::NonNegative { name, value });
+            }
+            if value > max {
+                return Err(ParamError::Magnitude {
+                    name,
+                    value,
+                    range,
+                    reason,
+                });
             }
         }
         if !self.alpha5.is_finite() {
             return Err(ParamError::Gap(self.alpha5));
         }
+        if self.alpha5.abs() > DISPLACEMENT_MAX {
+            return Err(ParamError::Magnitude {
+                name: "alpha5 (gap α5)",
+                value: self.alpha5,
+                range: "[-1e6, 1e6]",
+                reason: DISPLACEMENT,
+            });
+        }
         if !(self.omega.is_finite() && self.omega > 0.0) {
             return Err(ParamError::Omega(self.omega));
+        }
+        if !(OMEGA_MIN..=OMEGA_MAX).contains(&self.omega) {
+            return Err(ParamError::Magnitude {
+                name: "omega (drive frequency Ω)",
+                value: self.omega,
+                range: "[1e-3, 1e5]",
+                reason: if self.omega < OMEGA_MIN {
+                    "one drive period would need too many integration steps"
+                } else {
+                    "the drive swamps the response in round-off, far above the highest mode"
+                },
+            });
         }
         self.contact_law.validate()
     }

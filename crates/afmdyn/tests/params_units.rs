@@ -253,3 +253,80 @@ fn unit_errors_name_the_field() {
         })
     ));
 }
+
+#[test]
+fn magnitudes_beyond_the_numerics_are_rejected_naming_the_field() {
+    // issue 9: α1 = 1e300 panicked ("M is SPD"), α4 = 1e300 panicked ("K is SPD"), α2, α3, α5 and
+    // α4 = 1e308 (modes) looped forever, Ω = 1e-9 aborted allocating 4 TB, Ω = 1e9 was silently
+    // wrong. Each limit is accepted exactly and refused just beyond, with a message naming the
+    // field and the allowed range.
+    let d = Params::default();
+    let cases: [(Params, Params, &str, &str); 8] = [
+        (
+            Params { alpha1: 1e4, ..d },
+            Params {
+                alpha1: 1.01e4,
+                ..d
+            },
+            "alpha1",
+            "[0, 1e4]",
+        ),
+        (
+            Params { alpha2: 1e6, ..d },
+            Params { alpha2: 1e300, ..d },
+            "alpha2",
+            "[0, 1e6]",
+        ),
+        (
+            Params { alpha3: 1e4, ..d },
+            Params { alpha3: 1e300, ..d },
+            "alpha3",
+            "[0, 1e4]",
+        ),
+        (
+            Params { alpha4: 1e8, ..d },
+            Params { alpha4: 1e308, ..d },
+            "alpha4",
+            "[0, 1e8]",
+        ),
+        (
+            Params { alpha5: -1e6, ..d },
+            Params {
+                alpha5: -1e300,
+                ..d
+            },
+            "alpha5",
+            "[-1e6, 1e6]",
+        ),
+        (
+            Params { alpha6: 1e4, ..d },
+            Params { alpha6: 2e4, ..d },
+            "alpha6",
+            "[0, 1e4]",
+        ),
+        (
+            Params { omega: 1e-3, ..d },
+            Params { omega: 1e-9, ..d },
+            "omega",
+            "[1e-3, 1e5]",
+        ),
+        (
+            Params { omega: 1e5, ..d },
+            Params { omega: 1e9, ..d },
+            "omega",
+            "[1e-3, 1e5]",
+        ),
+    ];
+    for (at, beyond, field, range) in cases {
+        assert!(at.validate().is_ok(), "{field} at its limit");
+        let e = bad(beyond);
+        assert!(matches!(e, ParamError::Magnitude { .. }), "{field}: {e}");
+        let msg = e.to_string();
+        assert!(msg.starts_with(field) && msg.contains(range), "{msg}");
+    }
+    // the sign checks keep their own error
+    assert!(matches!(
+        bad(Params { alpha4: -1.0, ..d }),
+        ParamError::NonNegative { .. }
+    ));
+}

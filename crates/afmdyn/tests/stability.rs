@@ -1,7 +1,9 @@
 //! Monodromy matrices with saltation, Newton shooting, Floquet multipliers, continuation,
 //! Lyapunov exponents and the 0–1 test, each against an independent reference.
 
-use afmdyn::analysis::continuation::{continue_branch, BranchEvent, ContinuationSpec};
+use afmdyn::analysis::continuation::{
+    continue_branch, continue_with_switching, BranchEvent, ContinuationSpec,
+};
 use afmdyn::analysis::lyapunov::{lyapunov_spectrum, zero_one_test, LyapunovOptions, Verdict};
 use afmdyn::analysis::monodromy::stroboscopic;
 use afmdyn::analysis::shooting::{shoot, Instability, ShootingOptions};
@@ -199,8 +201,8 @@ fn lyapunov_spectrum_without_contact_is_the_real_parts_of_the_eigenvalues() {
     }
     // the reported error estimate covers the individual exponents' finite-time error, and is
     // not vacuous (issue: individual exponents off the exact pairs by up to 4.5e-4)
-    for i in 0..re.len() {
-        let err = (l.exponents[i] - re[i]).abs();
+    for (i, r) in re.iter().enumerate() {
+        let err = (l.exponents[i] - r).abs();
         let bound = l.uncertainty[i] + l.convergence[i];
         assert!(err <= bound, "λ{i}: error {err:e} > estimate {bound:e}");
         assert!(bound < 5e-3, "λ{i}: estimate {bound:e} is vacuous");
@@ -384,4 +386,103 @@ fn continuation_locates_the_period_doubling_near_omega_2_91() {
             _ => {}
         }
     }
+}
+
+/// The period-2 branch of the Fig. 5 set between Ω = 2.70 and 2.60: its multipliers cross −1 at
+/// 2.6975, 2.6515, 2.6371 and 2.6131 (each located crossing has a multiplier at −1). Without
+/// the step control on the multipliers the crossing at 2.6515 was stepped over (the branch
+/// jumped from 2.66739, unstable, to 2.64065, stable); stability changes only at a located event.
+#[test]
+fn continuation_does_not_step_over_a_period_doubling() {
+    let base = Params::default();
+    let p = base.with(SweepParam::Omega, 2.70);
+    let m = model(p);
+    let mut it = build(&m, IntegratorOptions::default(), 0.0, &m.rest()).unwrap();
+    let guess = steady_state(it.as_mut(), &SteadyOptions::default())
+        .unwrap()
+        .end_state()
+        .clone();
+    let spec = ContinuationSpec::new(base, SweepParam::Omega, 2.70, 2.60, 2);
+    let br = continue_branch(&spec, &guess).unwrap();
+    let pds: Vec<f64> = br
+        .iter()
+        .filter(|b| b.event == Some(BranchEvent::PeriodDoubling))
+        .map(|b| b.value)
+        .collect();
+    for want in [2.6975, 2.6515, 2.6371, 2.6131] {
+        assert!(
+            pds.iter().any(|v| (v - want).abs() < 1e-3),
+            "period doubling near {want} missing: {pds:?}"
+        );
+    }
+    for b in br
+        .iter()
+        .filter(|b| b.event == Some(BranchEvent::PeriodDoubling))
+    {
+        assert!(b.multipliers.iter().any(|mu| (mu + 1.0).norm() < 1e-3));
+    }
+    for w in br.windows(2) {
+        if w[1].event.is_none() && w[0].event.is_none() {
+            assert_eq!(
+                w[0].stable, w[1].stable,
+                "stability changed at Ω = {}",
+                w[1].value
+            );
+        }
+    }
+}
+
+/// The period-doubling cascade near Ω ≈ 2.69: from the period-2 branch, switching builds the
+/// period-4 branch (born at 2.6975, folding at the grazing point 2.6915 and again above 2.70,
+/// doubling at 2.6813) and the period-8 branch (doubling at 2.6744) — the sequence the
+/// bifurcation diagram shows.
+#[test]
+fn switching_builds_the_period_four_and_eight_branches() {
+    let base = Params::default();
+    let p = base.with(SweepParam::Omega, 2.75);
+    let m = model(p);
+    let mut it = build(&m, IntegratorOptions::default(), 0.0, &m.rest()).unwrap();
+    let guess = steady_state(it.as_mut(), &SteadyOptions::default())
+        .unwrap()
+        .end_state()
+        .clone();
+    let spec = ContinuationSpec::new(base, SweepParam::Omega, 2.75, 2.665, 2);
+    let branches = continue_with_switching(&spec, &guess, 8).unwrap();
+    let pd_on = |period: usize| -> Vec<f64> {
+        branches
+            .iter()
+            .flatten()
+            .filter(|b| b.period == period && b.event == Some(BranchEvent::PeriodDoubling))
+            .map(|b| b.value)
+            .collect()
+    };
+    eprintln!(
+        "{:?}",
+        branches
+            .iter()
+            .map(|b| (
+                b[0].period,
+                b[0].value,
+                b.last().unwrap().value,
+                b.iter()
+                    .filter_map(|x| x.event.map(|e| (e, x.value)))
+                    .collect::<Vec<_>>()
+            ))
+            .collect::<Vec<_>>()
+    );
+    assert!(
+        pd_on(2).iter().any(|v| (v - 2.6975).abs() < 1e-3),
+        "{:?}",
+        pd_on(2)
+    );
+    assert!(
+        pd_on(4).iter().any(|v| (v - 2.6813).abs() < 1e-3),
+        "{:?}",
+        pd_on(4)
+    );
+    assert!(
+        pd_on(8).iter().any(|v| (v - 2.6744).abs() < 1e-3),
+        "{:?}",
+        pd_on(8)
+    );
 }

@@ -19,6 +19,11 @@ use std::str::FromStr;
 /// gets a comparable share of energy; A = 0.6 gap units covers the paper's amplitudes 0.1–1.5).
 pub const RANDOM_AMPLITUDE: f64 = 0.6;
 
+/// Largest number of sweep points, values × (2 for continuation + random starts): each point is
+/// a steady-state computation, and the bookkeeping of a run (resume set, output index) grows
+/// with it. Checked before anything is allocated.
+pub const MAX_SWEEP_POINTS: usize = 1_000_000;
+
 /// A reproducible random initial state for sample `index` of the stream `seed`.
 pub fn random_state(model: &CantileverModel, seed: u64, index: u64) -> DVector<f64> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed ^ index.wrapping_mul(0x9E37_79B9_7F4A_7C15));
@@ -99,8 +104,12 @@ impl SweepSpec {
     pub fn linspace(from: f64, to: f64, steps: usize) -> Result<Vec<f64>, SimError> {
         crate::error::finite("from", from)?;
         crate::error::finite("to", to)?;
-        if steps == 0 {
-            return Err(SimError::out_of_range("steps", steps, "must be >= 1"));
+        if steps == 0 || steps > MAX_SWEEP_POINTS {
+            return Err(SimError::out_of_range(
+                "steps",
+                steps,
+                "must be in 1..=1000000",
+            ));
         }
         if steps == 1 {
             return Ok(vec![from]);
@@ -125,7 +134,24 @@ impl SweepSpec {
                 "must be >= 1 when continuation is off",
             ));
         }
-        Ok(())
+        let per_value = usize::from(self.continuation) * 2 + self.starts as usize;
+        match self.values.len().checked_mul(per_value) {
+            Some(n) if n <= MAX_SWEEP_POINTS => Ok(()),
+            _ => Err(SimError::out_of_range(
+                "sweep points",
+                format!(
+                    "{} values × {per_value} ({} starts{})",
+                    self.values.len(),
+                    self.starts,
+                    if self.continuation {
+                        " + forward + backward"
+                    } else {
+                        ""
+                    }
+                ),
+                "must be <= 1000000 in all (lower --steps or --starts)",
+            )),
+        }
     }
 }
 
@@ -167,23 +193,31 @@ enum Task {
 /// Points listed in `resume.done` are skipped; continuation chains restart from their saved
 /// state.
 pub fn run_sweep(spec: &SweepSpec, resume: &Resume, sink: &(dyn Fn(SweepPoint) + Sync)) {
-    let mut tasks = Vec::new();
-    if spec.continuation {
-        tasks.push(Task::Chain(Branch::Forward));
-        tasks.push(Task::Chain(Branch::Backward));
-    }
-    for i in 0..spec.values.len() {
-        for s in 0..spec.starts {
-            if !resume.done.contains(&(i, Branch::Start(s))) {
-                tasks.push(Task::Start(i, s));
-            }
+    // tasks by index (chains first, then the starts value by value), never all in memory
+    let chains = if spec.continuation { 2 } else { 0 };
+    let starts = spec.starts as usize;
+    let total = chains + spec.values.len() * starts;
+    let task = |k: usize| {
+        if k < chains {
+            Task::Chain(if k == 0 {
+                Branch::Forward
+            } else {
+                Branch::Backward
+            })
+        } else {
+            let j = k - chains;
+            Task::Start(j / starts, (j % starts) as u32)
         }
-    }
+    };
     let dim = 2 * spec.base.modes;
-    tasks
-        .par_iter()
+    (0..total)
+        .into_par_iter()
         .with_max_len(1)
-        .for_each(|task| match *task {
+        .map(task)
+        .filter(
+            |t| !matches!(*t, Task::Start(i, s) if resume.done.contains(&(i, Branch::Start(s)))),
+        )
+        .for_each(|task| match task {
             Task::Chain(branch) => {
                 let order: Vec<usize> = match branch {
                     Branch::Backward => (0..spec.values.len()).rev().collect(),

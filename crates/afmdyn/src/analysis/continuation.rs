@@ -46,6 +46,13 @@ pub struct ContinuationSpec {
     pub newton: ShootingOptions,
     /// Integrator of the stroboscopic map (default: auto, exact for the linear law).
     pub integrator: IntegratorOptions,
+    /// Parameter values of the parent branch's period doublings (a period-2n branch): a fold
+    /// located at one of them, where the half-cycles nearly coincide, is the pitchfork junction
+    /// with the parent — the branch is labelled a period doubling there and ends.
+    pub junctions: Vec<f64>,
+    /// The parameter range the branch may visit (default: between `from` and `to`); the branch
+    /// starts towards `to`.
+    pub range: Option<(f64, f64)>,
 }
 
 impl ContinuationSpec {
@@ -64,6 +71,8 @@ impl ContinuationSpec {
             max_points: 5000,
             newton: ShootingOptions::default(),
             integrator: IntegratorOptions::default(),
+            junctions: Vec::new(),
+            range: None,
         }
     }
 }
@@ -343,12 +352,15 @@ pub fn continue_branch(
     if t[dim] * dir < 0.0 {
         t = -t;
     }
-    let (lo, hi) = (spec.from.min(spec.to), spec.from.max(spec.to));
+    let (lo, hi) = spec
+        .range
+        .unwrap_or((spec.from.min(spec.to), spec.from.max(spec.to)));
     let mut s = 0.0;
     let mut ds = spec.ds;
     let mut out = vec![point(&mut solver, s, &y, &map)?];
     let mut tf = tests(&t, &map.jacobian, &out[0].multipliers, map.switchings);
     let mut mu_prev = out[0].multipliers.clone();
+    let mut widest = 0.0f64;
     let first = y.clone();
     while out.len() < spec.max_points {
         let y_pred = &y + &t * ds;
@@ -421,7 +433,19 @@ pub fn continue_branch(
                 continue;
             }
             if let Some(bp) = best {
-                out.push(bp);
+                // the same event located again within the resolution of the location (next to
+                // a junction the test function can change sign twice within 1e-4): keep one
+                let again = out
+                    .iter()
+                    .rev()
+                    .find(|b| b.event.is_some())
+                    .is_some_and(|b| {
+                        b.event == bp.event
+                            && (b.value - bp.value).abs() < 1e-4 * (1.0 + b.value.abs())
+                    });
+                if !again {
+                    out.push(bp);
+                }
             }
         }
         if !(lo..=hi).contains(&y_new[dim]) {
@@ -435,14 +459,34 @@ pub fn continue_branch(
         let half_gap = |b: &BranchPoint| {
             (&b.section[half] - &b.section[0]).norm() / (1.0 + b.section[0].norm())
         };
-        // a fold where the half-cycle nearly repeats is the tip of the pitchfork at which the
-        // period-2n branch meets its period-n parent (the gap closes like √|Δp|): beyond it the
-        // branch is its own phase-shifted copy
-        let at_parent = out
-            .last()
-            .is_some_and(|b| b.event == Some(BranchEvent::Fold) && half_gap(b) < 1e-2);
+        // a fold at a parent's period doubling where the half-cycle nearly repeats is the tip of
+        // the pitchfork at which the period-2n branch meets its parent (the gap closes like
+        // √|Δp|): beyond it the branch is its own phase-shifted copy
+        widest = widest.max(half_gap(&pt));
+        let at_parent = out.last().is_some_and(|b| {
+            b.event == Some(BranchEvent::Fold)
+                && half_gap(b) < 0.05 * widest
+                && spec
+                    .junctions
+                    .iter()
+                    .any(|j| (j - b.value).abs() <= 1e-4 * (1.0 + j.abs()))
+        });
         let merged =
             spec.period.is_multiple_of(2) && out.len() > 3 && (half_gap(&pt) < 1e-6 || at_parent);
+        if merged && at_parent {
+            // the junction is the parent's period doubling, seen from the period-2n branch; a
+            // period doubling located within 1e-4 before it is the same point
+            let k = out.len() - 1;
+            let at = out[k].value;
+            out[k].event = Some(BranchEvent::PeriodDoubling);
+            for b in out[..k].iter_mut().rev().take(4) {
+                if b.event == Some(BranchEvent::PeriodDoubling)
+                    && (b.value - at).abs() < 1e-4 * (1.0 + at.abs())
+                {
+                    b.event = None;
+                }
+            }
+        }
         s += ds;
         pt.s = s;
         out.push(pt);
@@ -466,29 +510,47 @@ pub fn continue_branch(
 
 /// Start of the period-2n branch at a located period-doubling point: shoot a period-2n orbit
 /// from the point displaced along the eigenvector of the multiplier nearest −1, at parameter
-/// values on either side. Returns (parameter, period-2n orbit state) when one is found that is
-/// not the period-n orbit itself.
+/// values on either side. Returns (parameter, period-2n orbit state) for the first orbit found
+/// that is not the period-n orbit itself ([`period_doubling_starts`] gives one per side).
 pub fn switch_at_period_doubling(
     spec: &ContinuationSpec,
     pd: &BranchPoint,
 ) -> Option<(f64, DVector<f64>)> {
+    period_doubling_starts(spec, pd).into_iter().next()
+}
+
+/// Starts of period-2n branches at a period doubling, at most one on each side of the
+/// parameter (the side the continuation goes to first). In a non-smooth system both sides can
+/// carry a period-2n orbit (e.g. a branch bounded by a grazing-induced fold).
+pub fn period_doubling_starts(
+    spec: &ContinuationSpec,
+    pd: &BranchPoint,
+) -> Vec<(f64, DVector<f64>)> {
     let z = pd.section[0].clone();
-    let model = CantileverModel::new(&spec.base.with(spec.param, pd.value)).ok()?;
-    let mut integ = build(&model, spec.integrator, 0.0, &model.rest()).ok()?;
-    let m = stroboscopic(integ.as_mut(), &z, pd.period).ok()?.jacobian;
     let dim = z.len();
-    // eigenvector of μ ≈ −1 by inverse iteration on M + (1 − 1e-8) I
-    let lu = (&m + DMatrix::identity(dim, dim) * (1.0 - 1e-8)).lu();
-    let mut v = DVector::from_element(dim, 1.0);
-    for _ in 0..4 {
-        v = lu.solve(&v)?.normalize();
-    }
+    let Some(v) = (|| {
+        let model = CantileverModel::new(&spec.base.with(spec.param, pd.value)).ok()?;
+        let mut integ = build(&model, spec.integrator, 0.0, &model.rest()).ok()?;
+        let m = stroboscopic(integ.as_mut(), &z, pd.period).ok()?.jacobian;
+        // eigenvector of μ ≈ −1 by inverse iteration on M + (1 − 1e-8) I
+        let lu = (&m + DMatrix::identity(dim, dim) * (1.0 - 1e-8)).lu();
+        let mut v = DVector::from_element(dim, 1.0);
+        for _ in 0..4 {
+            v = lu.solve(&v)?.normalize();
+        }
+        Some(v)
+    })() else {
+        return Vec::new();
+    };
     // the period-2n orbit bifurcates like √|Δp|: try a few parameter offsets, each with a
-    // displacement of the matching size, on both sides and both signs of the eigenvector
-    for rel in [1e-3, 1e-2] {
-        let dp = rel * pd.value.abs().max(1.0);
-        let eps = 3.0 * rel.sqrt() * (1.0 + z.norm());
-        for sign_p in [1.0, -1.0] {
+    // displacement of the matching size, and both signs of the eigenvector (deep in a cascade
+    // the windows are narrow: the smallest offsets first)
+    let ahead = if spec.to >= spec.from { 1.0 } else { -1.0 };
+    let mut starts = Vec::new();
+    for sign_p in [ahead, -ahead] {
+        'side: for (rel, k) in [(1e-4, 3.0), (1e-3, 1.0), (1e-3, 3.0), (1e-2, 3.0)] {
+            let dp = rel * pd.value.abs().max(1.0);
+            let eps = k * f64::sqrt(rel) * (1.0 + z.norm());
             let p = pd.value + sign_p * dp;
             let Ok(model) = CantileverModel::new(&spec.base.with(spec.param, p)) else {
                 continue;
@@ -498,18 +560,20 @@ pub fn switch_at_period_doubling(
             };
             for sign_v in [1.0, -1.0] {
                 let guess = &z + &v * (sign_v * eps);
-                if let Ok(o) = shoot_with(integ.as_mut(), &guess, 2 * pd.period, &spec.newton) {
-                    let half = stroboscopic(integ.as_mut(), &o.state, pd.period)
-                        .ok()?
-                        .state;
-                    if (&half - &o.state).norm() > 1e-6 * (1.0 + o.state.norm()) {
-                        return Some((p, o.state));
-                    }
+                let Ok(o) = shoot_with(integ.as_mut(), &guess, 2 * pd.period, &spec.newton) else {
+                    continue;
+                };
+                let Ok(half) = stroboscopic(integ.as_mut(), &o.state, pd.period) else {
+                    continue;
+                };
+                if (&half.state - &o.state).norm() > 1e-6 * (1.0 + o.state.norm()) {
+                    starts.push((p, o.state));
+                    break 'side;
                 }
             }
         }
     }
-    None
+    starts
 }
 
 /// Continue the branch of `spec` from `guess` and, recursively, the period-2n branches born at
@@ -535,47 +599,78 @@ pub fn continue_with_switching(
             .collect();
         next += 1;
         for pd in pds {
-            if 2 * pd.period > max_period {
+            // a period-2n branch born here needs a multiplier at −1 (not the +1 of a junction
+            // with the parent branch)
+            let flips = pd.multipliers.iter().any(|m| (m + 1.0).norm() < 0.05);
+            if 2 * pd.period > max_period || !flips {
                 continue;
             }
-            let Some((value, z)) = switch_at_period_doubling(spec, &pd) else {
-                continue;
-            };
-            // the two period doublings that bound a window start the same period-2n branch
-            let known = branches.iter().flatten().any(|b| {
-                b.period == 2 * pd.period
-                    && (b.value - value).abs() < 1e-2
-                    && b.section
+            for (value, z) in period_doubling_starts(spec, &pd) {
+                // the two period doublings that bound a window start the same period-2n branch
+                let known = branches.iter().flatten().any(|b| {
+                    b.period == 2 * pd.period
+                        && (b.value - value).abs() < 1e-2
+                        && b.section
+                            .iter()
+                            .any(|q| (q - &z).norm() < 1e-3 * (1.0 + z.norm()))
+                });
+                if known {
+                    continue;
+                }
+                let parent = &branches[next - 1];
+                // leave the junction: towards `to` on that side, else away from it, within the
+                // whole range
+                let (lo, hi) = spec
+                    .range
+                    .unwrap_or((spec.from.min(spec.to), spec.from.max(spec.to)));
+                let away = if value >= pd.value { hi } else { lo };
+                let sub = ContinuationSpec {
+                    from: value,
+                    to: away,
+                    range: Some((lo, hi)),
+                    period: 2 * pd.period,
+                    junctions: parent
                         .iter()
-                        .any(|q| (q - &z).norm() < 1e-3 * (1.0 + z.norm()))
-            });
-            if known {
-                continue;
+                        .filter(|b| b.event == Some(BranchEvent::PeriodDoubling))
+                        .map(|b| b.value)
+                        .collect(),
+                    ..spec.clone()
+                };
+                let Ok(b) = continue_branch(&sub, &z) else {
+                    continue;
+                };
+                let marks = |br: &[BranchPoint]| -> Vec<(BranchEvent, f64)> {
+                    br.iter()
+                        .filter_map(|x| x.event.map(|e| (e, x.value)))
+                        .collect()
+                };
+                let new = marks(&b);
+                let duplicate = branches.iter().any(|old| {
+                    let old = marks(old);
+                    !new.is_empty()
+                        && new.iter().all(|(e, v)| {
+                            old.iter().any(|(oe, ov)| oe == e && (ov - v).abs() < 1e-6)
+                        })
+                });
+                if !duplicate {
+                    branches.push(b);
+                }
             }
-            let sub = ContinuationSpec {
-                from: value,
-                period: 2 * pd.period,
-                ..spec.clone()
-            };
-            let Ok(b) = continue_branch(&sub, &z) else {
-                continue;
-            };
-            let marks = |br: &[BranchPoint]| -> Vec<(BranchEvent, f64)> {
-                br.iter()
-                    .filter_map(|x| x.event.map(|e| (e, x.value)))
-                    .collect()
-            };
-            let new = marks(&b);
-            let duplicate = branches.iter().any(|old| {
-                let old = marks(old);
-                !new.is_empty()
-                    && new
-                        .iter()
-                        .all(|(e, v)| old.iter().any(|(oe, ov)| oe == e && (ov - v).abs() < 1e-6))
-            });
-            if !duplicate {
-                branches.push(b);
-            }
+        }
+    }
+    // a bifurcation reached from both ends of a window is located on two branches of the same
+    // period: keep the first
+    let mut seen: Vec<(BranchEvent, usize, f64)> = Vec::new();
+    for b in branches.iter_mut().flatten() {
+        let Some(e) = b.event else { continue };
+        let tol = 1e-4 * (1.0 + b.value.abs());
+        if seen
+            .iter()
+            .any(|&(se, sp, sv)| se == e && sp == b.period && (sv - b.value).abs() < tol)
+        {
+            b.event = None;
+        } else {
+            seen.push((e, b.period, b.value));
         }
     }
     Ok(branches)

@@ -362,8 +362,25 @@ impl ExactPropagator {
             .map(|&r| &transforms[r.index()].0 * &model.dynamics(r).a * &transforms[r.index()].1)
             .collect();
         let rho = ats.iter().map(norm2).fold(0.0, f64::max);
-        let need = ((period * rho / THETA).ceil() as usize).max(8);
         let base = min_steps_per_period.max(1);
+        // budget: the grid of one period, (2N + 2)(m + 1) values, must fit in
+        // params::GRID_BUDGET_BYTES; checked in floating point before any allocation
+        let need_f = (period * rho / THETA).ceil().max(8.0);
+        let m_f = base as f64 * (need_f / base as f64).ceil();
+        let bytes = (dim as f64 + 2.0) * (m_f + 1.0) * 8.0;
+        if bytes.is_nan() || bytes > crate::params::GRID_BUDGET_BYTES {
+            return Err(SimError::Budget {
+                what: "exact integrator grid",
+                needed: format!(
+                    "{m_f:.3e} steps per drive period ({:.0} MiB)",
+                    bytes / (1024.0 * 1024.0)
+                ),
+                budget: "128 MiB".into(),
+                hint: "the system is too stiff for its drive period: raise Ω, lower α3, α4, α6 \
+                       or N, or lower the samples per period",
+            });
+        }
+        let need = need_f as usize;
         let m = base * need.div_ceil(base);
         let h = period / m as f64;
         let p = *model.params();

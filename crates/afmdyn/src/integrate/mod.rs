@@ -263,7 +263,36 @@ pub fn build(
             "must be in 1..=10000000",
         ));
     }
+    // up-front budgets: a start at or beyond the divergence threshold, and (adaptive) a period
+    // that would need more steps than the budget, are refused before any work is done
+    let norm = z.norm(); // +∞ when the squares overflow; NaN entries are rejected by reset
+    if z.iter().all(|v| v.is_finite()) && norm >= crate::params::STATE_NORM_MAX {
+        return Err(SimError::out_of_range(
+            "initial state",
+            if norm.is_finite() {
+                format!("|z| = {norm:e}")
+            } else {
+                "|z| > 1e154".to_string()
+            },
+            "must be < 1e12 (the divergence threshold of the integrators)",
+        ));
+    }
     let kind = opts.kind.resolve(model);
+    if kind == IntegratorKind::Adaptive {
+        let rate = [Region::Free, Region::Contact]
+            .iter()
+            .map(|&r| model.dynamics(r).a.norm())
+            .fold(0.0, f64::max);
+        let steps = rate * model.period();
+        if steps.is_nan() || steps > crate::params::ADAPTIVE_STEPS_BUDGET {
+            return Err(SimError::Budget {
+                what: "adaptive integrator",
+                needed: format!("about {steps:.2e} steps per drive period"),
+                budget: "1e7".into(),
+                hint: "use the exact integrator, or a larger Ω or softer contact",
+            });
+        }
+    }
     if matches!(kind, IntegratorKind::Rk4 | IntegratorKind::Rk4Naive)
         && model.law().restitution().is_some()
     {
