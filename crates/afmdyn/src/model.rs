@@ -446,10 +446,11 @@ impl CantileverModel {
         }
     }
 
-    /// Check a state: length 2N and finite components.
+    /// Check a state: length 2N, finite components, ‖z‖ below the integrators' divergence
+    /// threshold [`crate::params::STATE_NORM_MAX`].
     ///
     /// # Errors
-    /// [`SimError::StateLength`] or [`SimError::NotFinite`].
+    /// [`SimError::StateLength`], [`SimError::NotFinite`] or [`SimError::OutOfRange`].
     pub fn check_state(&self, name: &'static str, z: &DVector<f64>) -> Result<(), SimError> {
         if z.len() != self.dim() {
             return Err(SimError::StateLength {
@@ -460,6 +461,14 @@ impl CantileverModel {
         }
         if let Some(v) = z.iter().find(|v| !v.is_finite()) {
             return Err(SimError::NotFinite { name, value: *v });
+        }
+        let norm = z.norm();
+        if norm.is_nan() || norm >= crate::params::STATE_NORM_MAX {
+            return Err(SimError::out_of_range(
+                name,
+                format!("|z| = {norm:e}"),
+                "must be < 1e12 (the divergence threshold of the integrators)",
+            ));
         }
         Ok(())
     }

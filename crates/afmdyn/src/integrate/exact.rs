@@ -307,16 +307,35 @@ pub struct ExactPropagator {
     buf: [DVector<f64>; 4],
 }
 
-fn energy_transform(model: &CantileverModel, r: Region) -> (DMatrix<f64>, DMatrix<f64>) {
+fn energy_transform(
+    model: &CantileverModel,
+    r: Region,
+) -> Result<(DMatrix<f64>, DMatrix<f64>), SimError> {
     let n = model.modes();
     let g = model.galerkin().region(r);
-    let lk = g.stiffness.clone().cholesky().expect("K is SPD").l();
-    let lm = g.mass.clone().cholesky().expect("M is SPD").l();
+    let singular = |what: &'static str| {
+        SimError::out_of_range(what, "not positive definite", "needs validated parameters")
+    };
+    let lk = g
+        .stiffness
+        .clone()
+        .cholesky()
+        .ok_or_else(|| singular("stiffness matrix K"))?
+        .l();
+    let lm = g
+        .mass
+        .clone()
+        .cholesky()
+        .ok_or_else(|| singular("mass matrix M"))?
+        .l();
     let mut t = DMatrix::zeros(2 * n, 2 * n);
     t.view_mut((0, 0), (n, n)).copy_from(&lk.transpose());
     t.view_mut((n, n), (n, n)).copy_from(&lm.transpose());
-    let tinv = t.clone().try_inverse().expect("T is invertible");
-    (t, tinv)
+    let tinv = t
+        .clone()
+        .try_inverse()
+        .ok_or_else(|| singular("energy transform T"))?;
+    Ok((t, tinv))
 }
 
 /// Spectral norm (largest singular value).
@@ -354,8 +373,8 @@ impl ExactPropagator {
         let omega = model.omega();
         let period = model.period();
         let transforms = [
-            energy_transform(model, Region::Free),
-            energy_transform(model, Region::Contact),
+            energy_transform(model, Region::Free)?,
+            energy_transform(model, Region::Contact)?,
         ];
         let ats: Vec<DMatrix<f64>> = [Region::Free, Region::Contact]
             .iter()

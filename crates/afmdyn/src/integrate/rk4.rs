@@ -175,6 +175,7 @@ impl Integrator for Rk4 {
         let sigma = region.guard_sign();
         Self::rk4(&self.model, mode, tau0, &z0, len, &mut self.k, &mut out);
         let g = |m: &CantileverModel, t: f64, z: &DVector<f64>| sigma * m.v_t(t, z);
+        check_finite(tau_b, &out)?;
         let gb = g(&self.model, tau_b, &out);
         // a start on the switching surface (just switched) is not an event at s = 0
         if gb > 0.0 {
