@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Regenerate the "Per forcing period, by law" table of docs/performance.md: wall time, steps and
-# events per period for every law at N = 1, 3 (and the linear law at N = 10), and the exact
+# Regenerate the "Per forcing period, by law" section of docs/performance.md: wall time, steps and
+# events per period for every law at N = 1, 3 (and the linear law at N = 10), the wall time of
+# the default continuation and bifurcation runs, and the exact
 # propagator's instructions per period (callgrind, independent of machine load: the difference
 # of 400 and 200 periods / 200), the figure to compare across commits.
 # Usage: bash scripts/perf-laws.sh   (needs valgrind for the instruction counts)
@@ -24,6 +25,17 @@ table=$(mktemp)
     done
     echo "$best" | awk '{printf "| %s | %s | %s | %s | %s | %s µs |\n", $1, $2, $3, $4, $5, $6}'
   done
+  A=target/release/afmdyn
+  cargo build --release -q
+  tmp=$(mktemp -d)
+  t0=$(date +%s.%N); $A continue --from 5 --to 1 --out "$tmp/c" > /dev/null; t1=$(date +%s.%N)
+  pts=$(python3 -c "import csv;print(sum(1 for _ in csv.DictReader(open('$tmp/c/continuation.csv'))))")
+  echo ""
+  echo "Continuation of the default period-1 branch, Ω 5 → 1 (\`afmdyn continue --from 5 --to 1\`): $(python3 -c "print(f'{$t1-$t0:.1f}')") s for $pts points."
+  t0=$(date +%s.%N); $A bifurcation --out "$tmp/b" > /dev/null; t1=$(date +%s.%N)
+  echo ""
+  echo "Default bifurcation run (\`afmdyn bifurcation\`, 400 Ω, forward + backward, 2 threads): $(python3 -c "print(f'{$t1-$t0:.2f}')") s."
+  rm -rf "$tmp"
   if command -v valgrind >/dev/null; then
     for n in 3 10; do
       c() { valgrind --tool=callgrind --callgrind-out-file=/dev/null "$X" linear "$n" "$1" 2>&1 >/dev/null \

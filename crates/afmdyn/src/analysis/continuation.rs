@@ -241,7 +241,7 @@ impl Solver {
 }
 
 /// Largest change of a Floquet multiplier allowed in one continuation step.
-pub const MAX_MULTIPLIER_STEP: f64 = 0.1;
+pub const MAX_MULTIPLIER_STEP: f64 = 0.25;
 
 /// How far the multipliers moved: the largest distance from a multiplier of `b` to the nearest
 /// of `a` (and vice versa).
