@@ -388,6 +388,16 @@ fn continuation_locates_the_period_doubling_near_omega_2_91() {
     }
 }
 
+/// The end state of the steady motion from rest (a section point of the attractor).
+fn attractor_at(p: Params) -> DVector<f64> {
+    let m = model(p);
+    let mut it = build(&m, IntegratorOptions::default(), 0.0, &m.rest()).unwrap();
+    steady_state(it.as_mut(), &SteadyOptions::default())
+        .unwrap()
+        .end_state()
+        .clone()
+}
+
 /// The period-2 branch of the Fig. 5 set between Ω = 2.70 and 2.60: its multipliers cross −1 at
 /// 2.6975, 2.6515, 2.6371 and 2.6131 (each located crossing has a multiplier at −1). Without
 /// the step control on the multipliers the crossing at 2.6515 was stepped over (the branch
@@ -395,13 +405,7 @@ fn continuation_locates_the_period_doubling_near_omega_2_91() {
 #[test]
 fn continuation_does_not_step_over_a_period_doubling() {
     let base = Params::default();
-    let p = base.with(SweepParam::Omega, 2.70);
-    let m = model(p);
-    let mut it = build(&m, IntegratorOptions::default(), 0.0, &m.rest()).unwrap();
-    let guess = steady_state(it.as_mut(), &SteadyOptions::default())
-        .unwrap()
-        .end_state()
-        .clone();
+    let guess = attractor_at(base.with(SweepParam::Omega, 2.70));
     let spec = ContinuationSpec::new(base, SweepParam::Omega, 2.70, 2.60, 2);
     let br = continue_branch(&spec, &guess).unwrap();
     let pds: Vec<f64> = br
@@ -439,13 +443,7 @@ fn continuation_does_not_step_over_a_period_doubling() {
 #[test]
 fn switching_builds_the_period_four_and_eight_branches() {
     let base = Params::default();
-    let p = base.with(SweepParam::Omega, 2.75);
-    let m = model(p);
-    let mut it = build(&m, IntegratorOptions::default(), 0.0, &m.rest()).unwrap();
-    let guess = steady_state(it.as_mut(), &SteadyOptions::default())
-        .unwrap()
-        .end_state()
-        .clone();
+    let guess = attractor_at(base.with(SweepParam::Omega, 2.75));
     let spec = ContinuationSpec::new(base, SweepParam::Omega, 2.75, 2.665, 2);
     let branches = continue_with_switching(&spec, &guess, 8).unwrap();
     let pd_on = |period: usize| -> Vec<f64> {
