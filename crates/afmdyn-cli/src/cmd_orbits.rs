@@ -10,13 +10,12 @@ use afmdyn::analysis::continuation::{
     continue_branch, switch_at_period_doubling, BranchPoint, ContinuationSpec,
 };
 use afmdyn::analysis::lyapunov::{lyapunov_spectrum, LyapunovOptions};
-use afmdyn::analysis::shooting::{shoot, PeriodicOrbit, ShootingOptions};
+use afmdyn::analysis::shooting::{shoot, ShootingOptions};
 use afmdyn::analysis::steady::steady_state;
 use afmdyn::integrate::{build, IntegratorOptions};
 use afmdyn::{CantileverModel, Params, SweepParam};
 use clap::Args;
 use nalgebra::DVector;
-use serde_json::json;
 use std::path::PathBuf;
 
 /// Initial-state flags of the orbit commands.
@@ -58,24 +57,6 @@ pub struct OrbitArgs {
     json: bool,
 }
 
-fn orbit_json(model: &CantileverModel, o: &PeriodicOrbit) -> serde_json::Value {
-    json!({
-        "period": o.period,
-        "poincare": {
-            "v_t": o.section.iter().map(|z| model.v_t(0.0, z)).collect::<Vec<_>>(),
-            "w_tip": o.section.iter().map(|z| model.w_tip(z)).collect::<Vec<_>>(),
-        },
-        "multipliers": o.multipliers.iter().map(|m| [m.re, m.im]).collect::<Vec<_>>(),
-        "stable": o.stable,
-        "critical": o.critical,
-        "grazing": o.grazing,
-        "grazing_distance": o.grazing_distance,
-        "switchings": o.switchings,
-        "newton_residuals": o.residuals,
-        "state": o.state.iter().collect::<Vec<_>>(),
-    })
-}
-
 /// Run `afmdyn orbit`.
 pub fn orbit(a: &OrbitArgs) -> Result<(), CliError> {
     let p = a.model.params(Params::default())?;
@@ -87,9 +68,7 @@ pub fn orbit(a: &OrbitArgs) -> Result<(), CliError> {
     }
     let o = shoot(&model, &guess, n, &ShootingOptions::default())?;
     if a.json {
-        let mut doc = orbit_json(&model, &o);
-        doc["params"] = json!(p);
-        println!("{doc}");
+        println!("{}", afmdyn::report::orbit(&model, &o));
         return Ok(());
     }
     println!(
@@ -339,16 +318,10 @@ pub fn continuation(a: &ContinueArgs) -> Result<(), CliError> {
             shade: vec![],
         },
     )?;
-    let events: Vec<_> = branches
-        .iter()
-        .flatten()
-        .filter(|b| b.event.is_some())
-        .map(|b| json!({ "event": b.event, "value": b.value, "period": b.period, "stable": b.stable }))
-        .collect();
     if a.json {
         println!(
             "{}",
-            json!({ "params": base, "param": a.param.name(), "branches": branches.len(), "points": branches.iter().map(Vec::len).sum::<usize>(), "events": events })
+            afmdyn::report::continuation(&base, a.param, &branches)
         );
     } else {
         println!(
@@ -407,10 +380,7 @@ pub fn lyapunov(a: &LyapunovArgs) -> Result<(), CliError> {
         },
     )?;
     if a.json {
-        println!(
-            "{}",
-            json!({ "params": p, "exponents": l.exponents, "uncertainty": l.uncertainty, "volume_rate": l.volume_rate, "zero_one": l.zero_one, "verdict": l.verdict, "periods": l.periods })
-        );
+        println!("{}", afmdyn::report::lyapunov(&p, &l));
         return Ok(());
     }
     println!(

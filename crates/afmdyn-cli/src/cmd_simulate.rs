@@ -118,20 +118,7 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
     )?;
     write_outputs(a, &model, &tr)?;
     let zf = &tr.final_state;
-    let n = p.modes;
-    let summary = json!({
-        "params": p,
-        "tau_end": tr.tau_end,
-        "final": {
-            "w_tip": model.w_tip(zf),
-            "w_tip_dot": model.w_tip_dot(zf),
-            "v_t": model.v_t(tr.tau_end, zf),
-            "a": zf.rows(0, n).iter().collect::<Vec<_>>(),
-            "a_dot": zf.rows(n, n).iter().collect::<Vec<_>>(),
-        },
-        "switchings": tr.events.len(),
-        "body_contact": tr.body_contact,
-    });
+    let summary = afmdyn::report::simulate(&model, &tr);
     if a.json {
         println!("{summary}");
     } else {
@@ -464,12 +451,10 @@ pub fn converge(a: &ConvergeArgs) -> Result<(), CliError> {
             shade: vec![],
         },
     )?;
-    let rows: Vec<_> = runs
-        .iter()
-        .map(|r| json!({ "modes": r.modes, "period": r.period, "rms_change": r.rms_change }))
-        .collect();
     if a.json {
-        println!("{}", json!({ "params": p, "runs": rows, "out": a.out }));
+        let mut doc = afmdyn::report::converge(&p, &runs);
+        doc["out"] = json!(a.out);
+        println!("{doc}");
     } else {
         if p.alpha3 > 0.0 || p.alpha6 > 0.0 {
             println!("note: paper eq. 24 is undamped; using α3 = {}, α6 = {} (eq. 26) so a steady state exists", p.alpha3, p.alpha6);

@@ -10,7 +10,8 @@
 //! [`beam`] (mode shapes) → [`galerkin`] (eqs. 10–18) → [`eigen`] (eqs. 19–23) and [`units`]
 //! (eqs. 5, 7) → [`model`] (the switched system) → [`integrate`] (exact propagation, RK4, an
 //! adaptive oracle) → [`trajectory`] (observables, stroboscopic Poincaré section) →
-//! [`analysis`] (steady states, periods, bifurcation sweeps, attractors, mode convergence).
+//! [`analysis`] (steady states, periods, bifurcation sweeps, attractors, mode convergence);
+//! [`report`] builds the JSON result documents shared by the command line and Python.
 //!
 //! Time is the dimensionless τ of eq. 5 and displacements are in units of the beam gap g₀.
 //! States are `z: [f64; 2N]` = (a, ȧ), modal coordinates and their τ-derivatives.
@@ -39,6 +40,7 @@ pub mod galerkin;
 pub mod integrate;
 pub mod model;
 pub mod params;
+pub mod report;
 pub mod trajectory;
 pub mod units;
 
