@@ -106,6 +106,9 @@ fn modes_document_lists_both_regions() {
 #[test]
 fn initial_modal_is_displacements_then_velocities() {
     let z = DVector::from_vec(vec![0.5, -1.25, 3.0, 1e-20]);
-    assert_eq!(report::initial_modal(Some(&z)), "0.5,-1.25;3,0.00000000000000000001");
+    assert_eq!(
+        report::initial_modal(Some(&z)),
+        "0.5,-1.25;3,0.00000000000000000001"
+    );
     assert_eq!(report::initial_modal(None), "");
 }
