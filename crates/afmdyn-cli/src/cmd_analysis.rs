@@ -161,7 +161,7 @@ fn point_rows(param: SweepParam, p: &SweepPoint) -> Vec<Vec<String>> {
     match &p.result {
         Err(msg) => {
             let mut r = base("error", String::new(), 0, 1);
-            r.extend(std::iter::repeat_n(String::new(), 7));
+            r.extend(std::iter::repeat_n(String::new(), 8));
             r.push(msg.replace(['\n', ','], " "));
             r.push(String::new());
             vec![r]
