@@ -18,6 +18,7 @@ versions.
 
 from ._afmdyn import Params, SimulationError
 from ._api import (
+    Model,
     attractors,
     bifurcation,
     continuation,
@@ -41,6 +42,7 @@ __all__ = [
     "Attractor",
     "Attractors",
     "Lyapunov",
+    "Model",
     "Orbit",
     "Params",
     "RegionSpectrum",

@@ -15,7 +15,7 @@ computation fails (chattering, divergence, Newton not converging).
 from __future__ import annotations
 
 import json
-from typing import Any, Dict, Optional, Sequence, Union
+from typing import TYPE_CHECKING, Any, Dict, Optional, Sequence, TypedDict, Union
 
 import numpy as np
 import xarray as xr
@@ -25,7 +25,29 @@ from ._afmdyn import Params
 from ._progress import ProgressArg, reporter
 from ._results import Attractor, Attractors, Lyapunov, Orbit, RegionSpectrum, Spectrum
 
+if TYPE_CHECKING:  # annotations only (PEP 692): editors complete and check the keywords
+    from typing_extensions import Unpack
+
 StateLike = Union[None, Sequence[float], np.ndarray, Attractor, Orbit]
+
+
+class Model(TypedDict, total=False):
+    """The model keywords every analysis takes (see :class:`Params` for their ranges)."""
+
+    modes: int
+    tip_mass_ratio: float
+    alpha1: float
+    drive_amplitude: float
+    alpha2: float
+    beam_damping: float
+    alpha3: float
+    contact_stiffness: float
+    alpha4: float
+    gap: float
+    alpha5: float
+    contact_damping: float
+    alpha6: float
+    omega: float
 
 #: Global attributes of every dataset: the scales of the dimensionless units.
 UNITS_NOTE = (
@@ -38,7 +60,7 @@ _G = {"units": "g0"}
 _V = {"units": "g0/t0"}
 
 
-def _params(params: Optional[Params], model: Dict[str, Any], default: Optional[Params] = None) -> Params:
+def _params(params: Optional[Params], model: Any, default: Optional[Params] = None) -> Params:
     """``params`` (or ``default``, or the paper's set) with the ``model`` keywords applied."""
     if params is None:
         base = default if default is not None else Params()
@@ -71,13 +93,29 @@ def _attrs(p: Params, **extra: Any) -> Dict[str, Any]:
     return a
 
 
+_COUNTS = frozenset(
+    "samples_per_period steps_per_period max_modes periods steps starts seed threads "
+    "max_periods max_period samples period transient blocks".split()
+)
+
+
+def _run(fn: Any, desc: str, progress: ProgressArg, p: Params, **options: Any) -> Dict[str, Any]:
+    """Call the compiled ``fn`` with a progress reporter; negative counts are a ValueError
+    naming the option (the core's unsigned integers would raise OverflowError)."""
+    for k, v in options.items():
+        if k in _COUNTS and isinstance(v, int) and not isinstance(v, bool) and v < 0:
+            raise ValueError(f"{k} = {v}: must be >= 0")
+    with reporter(progress, desc) as cb:
+        return fn(p, progress=cb, **options)
+
+
 def summary(ds: xr.Dataset) -> Dict[str, Any]:
     """The command line's ``--json`` summary stored with a dataset (``simulate``,
     ``converge`` without its output path, ``continuation``)."""
     return json.loads(ds.attrs["summary"])
 
 
-def modes(params: Optional[Params] = None, /, **model: Any) -> Spectrum:
+def modes(params: Optional[Params] = None, /, **model: Unpack[Model]) -> Spectrum:
     """Natural frequencies and damped eigenvalues of the free and contact systems
     (paper eqs. 19–23).
 
@@ -106,7 +144,7 @@ def simulate(
     steps_per_period: Optional[int] = None,
     tolerance: float = 1e-12,
     progress: ProgressArg = None,
-    **model: Any,
+    **model: Unpack[Model],
 ) -> xr.Dataset:
     """Integrate one trajectory (``afmdyn simulate``).
 
@@ -132,19 +170,17 @@ def simulate(
         ``afmdyn simulate --json`` (see :func:`summary`).
     """
     p = _params(params, model)
-    with reporter(progress, "simulate") as cb:
-        d = _core.simulate(
-            p,
-            periods=periods,
-            tau_end=tau_end,
-            transient=transient,
-            initial=_state(initial),
-            samples_per_period=samples_per_period,
-            integrator=integrator,
-            steps_per_period=steps_per_period,
-            tolerance=tolerance,
-            progress=cb,
-        )
+    d = _run(_core.simulate, "simulate", progress,
+        p,
+        periods=periods,
+        tau_end=tau_end,
+        transient=transient,
+        initial=_state(initial),
+        samples_per_period=samples_per_period,
+        integrator=integrator,
+        steps_per_period=steps_per_period,
+        tolerance=tolerance,
+    )
     n = p.modes
     comp = [f"a_{j}" for j in range(1, n + 1)] + [f"a_dot_{j}" for j in range(1, n + 1)]
     ds = xr.Dataset(
@@ -231,7 +267,7 @@ def converge(
     steps_per_period: Optional[int] = None,
     tolerance: float = 1e-12,
     progress: ProgressArg = None,
-    **model: Any,
+    **model: Unpack[Model],
 ) -> xr.Dataset:
     """Mode-number convergence (paper Fig. 4, ``afmdyn converge``): the steady tip motion
     for N = 1..max_modes. Without ``params`` the model defaults to Ω = 4.1 (eq. 24 with the
@@ -245,17 +281,15 @@ def converge(
         ``tau_from_section`` ``[K]``.
     """
     p = _params(params, model, default=Params(omega=4.1))
-    with reporter(progress, "converge") as cb:
-        d = _core.converge(
-            p,
-            max_modes=max_modes,
-            periods=periods,
-            samples_per_period=samples_per_period,
-            integrator=integrator,
-            steps_per_period=steps_per_period,
-            tolerance=tolerance,
-            progress=cb,
-        )
+    d = _run(_core.converge, "converge", progress,
+        p,
+        max_modes=max_modes,
+        periods=periods,
+        samples_per_period=samples_per_period,
+        integrator=integrator,
+        steps_per_period=steps_per_period,
+        tolerance=tolerance,
+    )
     return xr.Dataset(
         data_vars={
             "w_tip": (("n_modes", "sample"), d["w_tip"], {**_G, "long_name": "tip deflection W(1,τ)"}),
@@ -292,7 +326,7 @@ def bifurcation(
     steps_per_period: Optional[int] = None,
     tolerance: float = 1e-12,
     progress: ProgressArg = None,
-    **model: Any,
+    **model: Unpack[Model],
 ) -> xr.Dataset:
     """Bifurcation diagram (paper Fig. 5, ``afmdyn bifurcation``): the steady state at each
     value of ``param`` by forward and backward continuation and ``starts`` random starts, in
@@ -317,26 +351,24 @@ def bifurcation(
     """
     p = _params(params, model)
     vals = None if values is None else np.asarray(values, dtype=np.float64).ravel().tolist()
-    with reporter(progress, "bifurcation") as cb:
-        d = _core.bifurcation(
-            p,
-            param=param,
-            values=vals,
-            from_=from_,
-            to=to,
-            steps=steps,
-            starts=starts,
-            seed=seed,
-            continuation=continuation,
-            threads=threads,
-            tol=tol,
-            max_periods=max_periods,
-            max_period=max_period,
-            integrator=integrator,
-            steps_per_period=steps_per_period,
-            tolerance=tolerance,
-            progress=cb,
-        )
+    d = _run(_core.bifurcation, "bifurcation", progress,
+        p,
+        param=param,
+        values=vals,
+        from_=from_,
+        to=to,
+        steps=steps,
+        starts=starts,
+        seed=seed,
+        continuation=continuation,
+        threads=threads,
+        tol=tol,
+        max_periods=max_periods,
+        max_period=max_period,
+        integrator=integrator,
+        steps_per_period=steps_per_period,
+        tolerance=tolerance,
+    )
     n = p.modes
     data: Dict[str, Any] = {
         "status": ("point", np.array(d["status"], dtype=str)),
@@ -382,7 +414,7 @@ def attractors(
     steps_per_period: Optional[int] = None,
     tolerance: float = 1e-12,
     progress: ProgressArg = None,
-    **model: Any,
+    **model: Unpack[Model],
 ) -> Attractors:
     """Coexisting attractors and basin fractions (paper Figs. 6–17, ``afmdyn attractors``)
     from ``samples`` seeded random initial states, in parallel.
@@ -392,20 +424,18 @@ def attractors(
         ``to_dict()`` is ``afmdyn attractors --json``, ``to_dataframe()`` a summary table.
     """
     p = _params(params, model)
-    with reporter(progress, "attractors") as cb:
-        d = _core.attractors(
-            p,
-            samples=samples,
-            seed=seed,
-            cluster_tol=cluster_tol,
-            tol=tol,
-            max_periods=max_periods,
-            max_period=max_period,
-            integrator=integrator,
-            steps_per_period=steps_per_period,
-            tolerance=tolerance,
-            progress=cb,
-        )
+    d = _run(_core.attractors, "attractors", progress,
+        p,
+        samples=samples,
+        seed=seed,
+        cluster_tol=cluster_tol,
+        tol=tol,
+        max_periods=max_periods,
+        max_period=max_period,
+        integrator=integrator,
+        steps_per_period=steps_per_period,
+        tolerance=tolerance,
+    )
     doc = json.loads(d["json"])
     found = [
         Attractor(
@@ -442,7 +472,7 @@ def orbit(
     max_periods: int = 1500,
     max_period: int = 64,
     progress: ProgressArg = None,
-    **model: Any,
+    **model: Unpack[Model],
 ) -> Orbit:
     """A period-n orbit by Newton shooting, with Floquet multipliers (``afmdyn orbit``).
 
@@ -460,16 +490,14 @@ def orbit(
     p = _params(params, model)
     if period is None and isinstance(initial, Attractor):
         period = initial.period or 1
-    with reporter(progress, "orbit") as cb:
-        d = _core.orbit(
-            p,
-            period=period,
-            initial=_state(initial),
-            tol=tol,
-            max_periods=max_periods,
-            max_period=max_period,
-            progress=cb,
-        )
+    d = _run(_core.orbit, "orbit", progress,
+        p,
+        period=period,
+        initial=_state(initial),
+        tol=tol,
+        max_periods=max_periods,
+        max_period=max_period,
+    )
     doc = json.loads(d["json"])
     return Orbit(
         params=p,
@@ -504,7 +532,7 @@ def continuation(
     max_periods: int = 1500,
     max_period: int = 64,
     progress: ProgressArg = None,
-    **model: Any,
+    **model: Unpack[Model],
 ) -> xr.Dataset:
     """Pseudo-arclength continuation of a period-n branch from ``from_`` towards ``to``, with
     located folds, period doublings, Neimark–Sacker and grazing points (``afmdyn continue``).
@@ -526,20 +554,18 @@ def continuation(
         ``attrs["summary"]`` is ``afmdyn continue --json``.
     """
     p = _params(params, model)
-    with reporter(progress, "continuation") as cb:
-        d = _core.continuation(
-            p,
-            param=param,
-            from_=from_,
-            to=to,
-            period=period,
-            switch=switch,
-            initial=_state(initial),
-            tol=tol,
-            max_periods=max_periods,
-            max_period=max_period,
-            progress=cb,
-        )
+    d = _run(_core.continuation, "continuation", progress,
+        p,
+        param=param,
+        from_=from_,
+        to=to,
+        period=period,
+        switch=switch,
+        initial=_state(initial),
+        tol=tol,
+        max_periods=max_periods,
+        max_period=max_period,
+    )
     return xr.Dataset(
         data_vars={
             "branch": ("point", d["branch"], {"long_name": "branch (0: the continued one)"}),
@@ -569,7 +595,7 @@ def lyapunov(
     periods: int = 4000,
     blocks: int = 10,
     progress: ProgressArg = None,
-    **model: Any,
+    **model: Unpack[Model],
 ) -> Lyapunov:
     """Lyapunov spectrum (tangent dynamics with saltation matrices) and the 0–1 test for chaos
     (``afmdyn lyapunov``), from ``initial`` (default rest) after ``transient`` drive periods,
@@ -579,10 +605,10 @@ def lyapunov(
         :class:`Lyapunov`; ``to_dict()`` is ``afmdyn lyapunov --json``.
     """
     p = _params(params, model)
-    with reporter(progress, "lyapunov") as cb:
-        d = _core.lyapunov(
-            p, initial=_state(initial), transient=transient, periods=periods, blocks=blocks, progress=cb
-        )
+    d = _run(
+        _core.lyapunov, "lyapunov", progress,
+        p, initial=_state(initial), transient=transient, periods=periods, blocks=blocks,
+    )
     doc = json.loads(d["json"])
     return Lyapunov(
         params=p,

@@ -53,7 +53,7 @@ class _Bar:
                 )
             else:
                 self.bar = tqdm(
-                    total=total, desc=self.desc, unit=self.unit, delay=self.delay, leave=False
+                    total=total, desc=self.desc, unit=self.unit, delay=self.delay, leave=True
                 )
         self.bar.update(done - self.bar.n)
 
