@@ -3,8 +3,8 @@ threads' simulations run in parallel."""
 
 from __future__ import annotations
 
+import multiprocessing
 import os
-import subprocess
 import threading
 import time
 
@@ -12,8 +12,6 @@ import numpy as np
 import pytest
 
 import afmdyn
-
-from conftest import _binary
 
 
 def _cores() -> int:
@@ -68,45 +66,41 @@ def test_results_computed_in_threads_equal_sequential_ones():
         np.testing.assert_array_equal(a, b)
 
 
-def _pair(run) -> float:
+def _job(_: int = 0) -> None:
+    afmdyn.simulate(periods=300, samples_per_period=50, progress=False)
+
+
+def _pair(sequential, parallel) -> float:
     """Wall time of two runs side by side over two runs one after the other."""
     t0 = time.perf_counter()
-    run()
-    run()
-    sequential = time.perf_counter() - t0
-    t0 = time.perf_counter()
-    run(2)
-    return (time.perf_counter() - t0) / sequential
+    sequential()
+    t1 = time.perf_counter()
+    parallel()
+    return (time.perf_counter() - t1) / (t1 - t0)
 
 
 @pytest.mark.skipif(_cores() < 2, reason="needs two cores")
-def test_two_threads_simulate_faster_than_one_after_the_other(cli, tmp_path):
-    def threads(k=1):
-        ts = [
-            threading.Thread(target=afmdyn.simulate, kwargs=dict(periods=300, samples_per_period=50, progress=False))
-            for _ in range(k)
-        ]
+def test_two_threads_simulate_faster_than_one_after_the_other():
+    def threads():
+        ts = [threading.Thread(target=_job) for _ in range(2)]
         for t in ts:
             t.start()
         for t in ts:
             t.join()
 
-    def processes(k=1):
-        # the same run as two command-line processes: what the machine allows without any GIL
-        args = ["simulate", "--periods", "300", "--samples-per-period", "50"]
-        procs = [
-            subprocess.Popen([str(_binary()), *args, "--out", str(tmp_path / f"p{i}")], stdout=subprocess.DEVNULL)
-            for i in range(k)
-        ]
-        for p in procs:
-            assert p.wait() == 0
-
-    attempts = []
-    for _ in range(4):  # the machine may be shared: interleaved attempts
-        t, p = _pair(threads), _pair(processes)
-        attempts.append((round(t, 2), round(p, 2)))
-        if t < 0.8:
-            return  # two threads ran in parallel: the GIL was released (held, the ratio is ≥ 1)
-    if min(p for _, p in attempts) >= 0.8:
+    # the reference: the same two runs in two processes, what the machine allows without a GIL
+    with multiprocessing.get_context("spawn").Pool(2) as pool:
+        pool.map(_job, [0, 1])  # both workers have imported afmdyn
+        attempts = []
+        for _ in range(4):  # the machine may be shared: interleaved attempts
+            t = _pair(lambda: (_job(), _job()), threads)
+            p = _pair(lambda: [pool.apply(_job) for _ in range(2)], lambda: pool.map(_job, [0, 1]))
+            attempts.append((round(t, 2), round(p, 2)))
+            if t < 0.8:
+                return  # two threads ran in parallel: the GIL was released (held: ratio ≥ 1)
+    best_t = min(t for t, _ in attempts)
+    best_p = min(p for _, p in attempts)
+    if best_p >= 0.8:
         pytest.skip(f"the machine is busy: two processes do not run in parallel either {attempts}")
-    pytest.fail(f"threads did not run in parallel while processes did: (threads, processes) {attempts}")
+    # processes ran in parallel; threads must come close (a held GIL gives ≥ 1)
+    assert best_t < min(0.95, best_p + 0.25), f"(threads, processes) {attempts}"
