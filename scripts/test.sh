@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The test command (README "Tests"; .ci/run calls it):
 #   1. the Rust tests: cargo test --workspace --release
-#   2. the Python package: a virtual environment in target/venv-test (created once, reused),
+#   2. the Python package: a virtual environment in target/venv-test (created once, reused;
+#      $AFMDYN_TEST_VENV chooses another),
 #      `pip install ./crates/afmdyn-py[test]` (maturin builds the extension into it), then
 #      pytest crates/afmdyn-py/tests, which also executes the example notebook and script.
 # Needs a Rust toolchain and Python >= 3.9 with network access to crates.io and PyPI.
@@ -11,7 +12,8 @@ set -uo pipefail
 cd "$(dirname "$0")/.."
 
 PYTHON=${PYTHON:-python3}
-VENV=${AFMDYN_TEST_VENV:-target/venv-test}
+TARGET=${CARGO_TARGET_DIR:-target}
+VENV=${AFMDYN_TEST_VENV:-$TARGET/venv-test}
 logs=$(mktemp -d)
 trap 'rm -rf "$logs"' EXIT
 status=0
@@ -44,7 +46,7 @@ if [ -x "$py" ]; then
     echo "== Python: pip install ./crates/afmdyn-py[test] (maturin builds the extension)"
     if "$py" -m pip install -q "./crates/afmdyn-py[test]"; then
         echo "== Python: pytest crates/afmdyn-py/tests"
-        AFMDYN_BIN=target/release/afmdyn "$py" -m pytest crates/afmdyn-py/tests -p no:cacheprovider -rs 2>&1 |
+        AFMDYN_BIN="$TARGET/release/afmdyn" "$py" -m pytest crates/afmdyn-py/tests -p no:cacheprovider -rs 2>&1 |
             tee "$logs/py.log"
         code=${PIPESTATUS[0]}
         # exit code 5: no tests were collected, which is a failure here
