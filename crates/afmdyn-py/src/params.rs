@@ -292,11 +292,17 @@ impl PyParams {
     }
 
     fn __repr__(&self) -> String {
-        let p = &self.inner;
-        format!(
-            "Params(modes={}, alpha1={:?}, alpha2={:?}, alpha3={:?}, alpha4={:?}, alpha5={:?}, alpha6={:?}, omega={:?})",
-            p.modes, p.alpha1, p.alpha2, p.alpha3, p.alpha4, p.alpha5, p.alpha6, p.omega
-        )
+        // every serialised field, the known ones in the paper's order first, so a field added
+        // to `afmdyn::Params` shows up here without a change
+        let value = serde_json::to_value(self.inner).expect("params");
+        let map = value.as_object().expect("a struct");
+        let order = [
+            "modes", "alpha1", "alpha2", "alpha3", "alpha4", "alpha5", "alpha6", "omega",
+        ];
+        let mut keys: Vec<&String> = map.keys().collect();
+        keys.sort_by_key(|k| order.iter().position(|o| o == k).unwrap_or(order.len()));
+        let fields: Vec<String> = keys.iter().map(|k| format!("{k}={}", map[*k])).collect();
+        format!("Params({})", fields.join(", "))
     }
 
     fn __reduce__<'py>(

@@ -49,6 +49,24 @@ def test_python_threads_run_while_the_engine_computes():
     assert during > 20_000 * elapsed, (during, elapsed)
 
 
+def test_two_threads_computations_overlap():
+    # each call reports progress from its own thread every 50 ms while it runs; the reports of
+    # two threads interleave only if neither call holds the GIL while the other computes
+    log = []
+
+    def work(name):
+        afmdyn.lyapunov(omega=2.6, transient=0, periods=4000, blocks=2, progress=lambda d, t: log.append(name))
+
+    threads = [threading.Thread(target=work, args=(n,)) for n in "ab"]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    switches = sum(1 for x, y in zip(log, log[1:]) if x != y)
+    assert log.count("a") > 2 and log.count("b") > 2, log
+    assert switches >= 2, log  # "aaaa…bbbb…" would be one switch: one call after the other
+
+
 def test_results_computed_in_threads_equal_sequential_ones():
     omegas = [2.7, 2.8, 2.9, 3.0]
     seq = [afmdyn.simulate(omega=w, periods=5).w_tip.values for w in omegas]
@@ -92,15 +110,15 @@ def test_two_threads_simulate_faster_than_one_after_the_other():
     with multiprocessing.get_context("spawn").Pool(2) as pool:
         pool.map(_job, [0, 1])  # both workers have imported afmdyn
         attempts = []
-        for _ in range(4):  # the machine may be shared: interleaved attempts
+        for _ in range(5):  # the machine may be shared: interleaved attempts
             t = _pair(lambda: (_job(), _job()), threads)
             p = _pair(lambda: [pool.apply(_job) for _ in range(2)], lambda: pool.map(_job, [0, 1]))
             attempts.append((round(t, 2), round(p, 2)))
             if t < 0.8:
                 return  # two threads ran in parallel: the GIL was released (held: ratio ≥ 1)
-    best_t = min(t for t, _ in attempts)
-    best_p = min(p for _, p in attempts)
-    if best_p >= 0.8:
+    if min(p for _, p in attempts) >= 0.8:
         pytest.skip(f"the machine is busy: two processes do not run in parallel either {attempts}")
-    # processes ran in parallel; threads must come close (a held GIL gives ≥ 1)
-    assert best_t < min(0.95, best_p + 0.25), f"(threads, processes) {attempts}"
+    # processes ran in parallel; threads must keep up with them, attempt by attempt (the load
+    # of a shared machine drifts between attempts; a held GIL gives threads ≥ 1 throughout)
+    excess = sorted(t - p for t, p in attempts)
+    assert excess[len(excess) // 2] < 0.2, f"(threads, processes) {attempts}"
