@@ -930,10 +930,13 @@ pub fn lyapunov<'py>(
     progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Dict<'py>> {
     let p = params.inner;
+    // the remaining options (if the library adds any) keep their defaults, as on the command line
+    #[allow(clippy::needless_update)]
     let opts = LyapunovOptions {
         transient_periods: transient,
         periods,
         blocks,
+        ..LyapunovOptions::default()
     };
     let l = run(
         py,

@@ -145,15 +145,10 @@ pub fn continuation(base: &Params, param: SweepParam, branches: &[Vec<BranchPoin
     })
 }
 
-/// `afmdyn lyapunov --json`: the Lyapunov spectrum and the 0–1 test at `params`.
+/// `afmdyn lyapunov --json`: the Lyapunov spectrum and the 0–1 test at `params` (every field of
+/// [`LyapunovSpectrum`], so a field added there reaches both front ends).
 pub fn lyapunov(params: &Params, l: &LyapunovSpectrum) -> Value {
-    json!({
-        "params": params,
-        "exponents": l.exponents,
-        "uncertainty": l.uncertainty,
-        "volume_rate": l.volume_rate,
-        "zero_one": l.zero_one,
-        "verdict": l.verdict,
-        "periods": l.periods,
-    })
+    let mut doc = serde_json::to_value(l).expect("a Lyapunov spectrum serialises");
+    doc["params"] = json!(params);
+    doc
 }
