@@ -31,18 +31,25 @@ use std::sync::Mutex;
 type Dict<'py> = Bound<'py, PyDict>;
 
 /// Integrator options exactly as the command line's `IntegratorArgs::options`: `exact` refines
-/// its grid from the sampling rate, rk4 takes `steps_per_period` (default 2000).
+/// its grid from the sampling rate, rk4 takes `steps_per_period` (default 2000). `None` is the
+/// library's default integrator.
 fn integrator_options(
-    kind: &str,
+    kind: Option<&str>,
     steps_per_period: Option<usize>,
     tolerance: f64,
     samples_per_period: usize,
 ) -> PyResult<IntegratorOptions> {
-    let kind: IntegratorKind = kind.parse().map_err(value_error)?;
-    let steps = match kind {
-        IntegratorKind::Exact => samples_per_period.max(1),
-        IntegratorKind::Rk4 | IntegratorKind::Rk4Naive => steps_per_period.unwrap_or(2000),
-        IntegratorKind::Adaptive => 1,
+    let kind: IntegratorKind = match kind {
+        Some(k) => k.parse().map_err(value_error)?,
+        None => IntegratorOptions::default().kind,
+    };
+    let steps = if matches!(kind, IntegratorKind::Rk4 | IntegratorKind::Rk4Naive) {
+        steps_per_period.unwrap_or(2000)
+    } else if kind == IntegratorKind::Adaptive {
+        1
+    } else {
+        // the exact propagator (also what an automatic choice picks for the linear law)
+        samples_per_period.max(1)
     };
     Ok(IntegratorOptions {
         kind,
@@ -219,7 +226,7 @@ fn simulate_columns(
 /// One trajectory: time series, switchings, stroboscopic section and energy balance.
 #[pyfunction]
 #[pyo3(signature = (params, periods=None, tau_end=None, transient=0.0, initial=None,
-    samples_per_period=200, integrator="exact", steps_per_period=None, tolerance=1e-12,
+    samples_per_period=200, integrator=None, steps_per_period=None, tolerance=1e-12,
     progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate<'py>(
@@ -230,7 +237,7 @@ pub fn simulate<'py>(
     transient: f64,
     initial: Option<Vec<f64>>,
     samples_per_period: usize,
-    integrator: &str,
+    integrator: Option<&str>,
     steps_per_period: Option<usize>,
     tolerance: f64,
     progress: Option<Bound<'py, PyAny>>,
@@ -319,7 +326,7 @@ pub fn simulate<'py>(
 
 /// Mode-number convergence (paper Fig. 4).
 #[pyfunction]
-#[pyo3(signature = (params, max_modes=4, periods=1, samples_per_period=200, integrator="exact",
+#[pyo3(signature = (params, max_modes=4, periods=1, samples_per_period=200, integrator=None,
     steps_per_period=None, tolerance=1e-12, progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn converge<'py>(
@@ -328,7 +335,7 @@ pub fn converge<'py>(
     max_modes: usize,
     periods: usize,
     samples_per_period: usize,
-    integrator: &str,
+    integrator: Option<&str>,
     steps_per_period: Option<usize>,
     tolerance: f64,
     progress: Option<Bound<'py, PyAny>>,
@@ -404,7 +411,7 @@ fn branch_order(b: Branch) -> (u8, u32) {
 #[pyfunction]
 #[pyo3(signature = (params, param="omega", values=None, from_=1.0, to=5.0, steps=400, starts=0,
     seed=1, continuation=true, threads=None, tol=1e-8, max_periods=1500, max_period=64,
-    integrator="exact", steps_per_period=None, tolerance=1e-12, progress=None))]
+    integrator=None, steps_per_period=None, tolerance=1e-12, progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn bifurcation<'py>(
     py: Python<'py>,
@@ -421,7 +428,7 @@ pub fn bifurcation<'py>(
     tol: f64,
     max_periods: usize,
     max_period: usize,
-    integrator: &str,
+    integrator: Option<&str>,
     steps_per_period: Option<usize>,
     tolerance: f64,
     progress: Option<Bound<'py, PyAny>>,
@@ -602,7 +609,7 @@ fn steady_dict<'py>(py: Python<'py>, s: &SteadyState) -> PyResult<Dict<'py>> {
 /// Coexisting attractors and their basin fractions at fixed parameters.
 #[pyfunction]
 #[pyo3(signature = (params, samples=64, seed=1, cluster_tol=1e-5, tol=1e-8, max_periods=1500,
-    max_period=64, integrator="exact", steps_per_period=None, tolerance=1e-12, progress=None))]
+    max_period=64, integrator=None, steps_per_period=None, tolerance=1e-12, progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn attractors<'py>(
     py: Python<'py>,
@@ -613,7 +620,7 @@ pub fn attractors<'py>(
     tol: f64,
     max_periods: usize,
     max_period: usize,
-    integrator: &str,
+    integrator: Option<&str>,
     steps_per_period: Option<usize>,
     tolerance: f64,
     progress: Option<Bound<'py, PyAny>>,

@@ -140,7 +140,7 @@ def simulate(
     transient: float = 0.0,
     initial: StateLike = None,
     samples_per_period: int = 200,
-    integrator: str = "exact",
+    integrator: Optional[str] = None,
     steps_per_period: Optional[int] = None,
     tolerance: float = 1e-12,
     progress: ProgressArg = None,
@@ -155,7 +155,8 @@ def simulate(
         initial: initial state (a₁…a_N, ȧ₁…ȧ_N), ``[2N]``, or an :class:`Attractor` /
             :class:`Orbit` (its state at drive phase 0); default: rest.
         samples_per_period: samples per drive period (1..=100000).
-        integrator: ``"exact"`` (default), ``"rk4"``, ``"rk4-naive"`` or ``"adaptive"``;
+        integrator: ``"exact"``, ``"rk4"``, ``"rk4-naive"`` or ``"adaptive"``; default
+            (``None``) the command line's default, the exact propagator;
             steps_per_period: rk4's fixed steps (default 2000); tolerance: the adaptive one's.
         progress: ``None`` (a bar for long runs), ``True``, ``False`` or ``callable(done, total)``.
 
@@ -263,7 +264,7 @@ def converge(
     max_modes: int = 4,
     periods: int = 1,
     samples_per_period: int = 200,
-    integrator: str = "exact",
+    integrator: Optional[str] = None,
     steps_per_period: Optional[int] = None,
     tolerance: float = 1e-12,
     progress: ProgressArg = None,
@@ -322,7 +323,7 @@ def bifurcation(
     tol: float = 1e-8,
     max_periods: int = 1500,
     max_period: int = 64,
-    integrator: str = "exact",
+    integrator: Optional[str] = None,
     steps_per_period: Optional[int] = None,
     tolerance: float = 1e-12,
     progress: ProgressArg = None,
@@ -410,7 +411,7 @@ def attractors(
     tol: float = 1e-8,
     max_periods: int = 1500,
     max_period: int = 64,
-    integrator: str = "exact",
+    integrator: Optional[str] = None,
     steps_per_period: Optional[int] = None,
     tolerance: float = 1e-12,
     progress: ProgressArg = None,
