@@ -40,7 +40,9 @@ def fig5(steps: int, out: Path) -> None:
     colours = [period_colour(n) for n in df.period]
     ax1.scatter(df.value, df.w_tip, s=1.5, c=colours)
     ax1.set_ylabel("W(1,τ) at τ = 2πk/Ω  [g0]")
-    ax1.set_title(f"Fig. 5: bifurcation diagram ({steps} values of Ω, forward, backward, 1 random start)")
+    ax1.set_title(
+        f"Fig. 5: bifurcation diagram ({steps} values of Ω, forward, backward, 1 random start)"
+    )
     ax2.scatter(df.value, df.x_max, s=1.5, c=colours)
     ax2.set_xlabel("Ω")
     ax2.set_ylabel("X_max  [g0]")
@@ -73,13 +75,21 @@ def omega_26(samples: int, periods: int, out: Path) -> None:
     ax = axes[0, 0]
     ax.plot(ts.tau, ts.w_tip, lw=0.8, label="W(1,τ)")
     ax.plot(ts.tau, ts.v_t, lw=0.8, label="V_T")
-    ax.fill_between(ts.tau, -0.15, 0.3, where=ts.in_contact, color="grey", alpha=0.2, label="in contact")
+    ax.fill_between(
+        ts.tau, -0.15, 0.3, where=ts.in_contact, color="grey", alpha=0.2, label="in contact"
+    )
     ax.set_xlabel("τ")
     ax.set_title(f"Ω = 2.6: attractor 1 of {len(atts)} (basin {100 * a.basin_fraction:.0f} %)")
     ax.legend(fontsize=8)
     ax = axes[0, 1]
     ax.plot(ts.w_tip, ts.w_tip_dot, lw=0.6)
-    ax.scatter(section.section_w_tip, section.section_w_tip_dot, s=2, c="tab:red", label=f"{periods} section points")
+    ax.scatter(
+        section.section_w_tip,
+        section.section_w_tip_dot,
+        s=2,
+        c="tab:red",
+        label=f"{periods} section points",
+    )
     ax.set_xlabel("W(1,τ)")
     ax.set_ylabel("∂W/∂τ")
     ax.set_title("phase plane and stroboscopic section")
@@ -98,7 +108,9 @@ def omega_26(samples: int, periods: int, out: Path) -> None:
     ax.set_aspect("equal")
     ax.set_xlabel("Re μ")
     ax.set_ylabel("Im μ")
-    ax.set_title(f"Floquet multipliers of the period-1 orbit ({'stable' if orbit.stable else 'unstable'})")
+    ax.set_title(
+        f"Floquet multipliers of the period-1 orbit ({'stable' if orbit.stable else 'unstable'})"
+    )
     fig.tight_layout()
     fig.savefig(out / "omega-2.6.png", dpi=120)
     plt.close(fig)

@@ -55,7 +55,9 @@ def main() -> None:
     a = ap.parse_args()
     if not EXAMPLE.exists():
         subprocess.run(
-            ["cargo", "build", "--release", "-q", "-p", "afmdyn", "--example", "timing"], cwd=REPO, check=True
+            ["cargo", "build", "--release", "-q", "-p", "afmdyn", "--example", "timing"],
+            cwd=REPO,
+            check=True,
         )
     cases = {
         f"simulate, {a.periods} periods": (
@@ -67,8 +69,12 @@ def main() -> None:
             lambda: python(lambda: afmdyn.bifurcation(progress=False)),
         ),
     }
-    print(f"best of {a.rounds} interleaved rounds; afmdyn {afmdyn.__version__}, Python {sys.version.split()[0]}")
-    print("wall: elapsed time; cpu: user + system time of all threads (less sensitive to other load)")
+    print(
+        f"best of {a.rounds} interleaved rounds; afmdyn {afmdyn.__version__}, Python {sys.version.split()[0]}"
+    )
+    print(
+        "wall: elapsed time; cpu: user + system time of all threads (less sensitive to other load)"
+    )
     print(f"{'case':<38} {'':>5} {'Rust (s)':>9} {'Python (s)':>11} {'overhead':>9}")
     worst = 0.0
     for name, (r, p) in cases.items():
@@ -82,7 +88,9 @@ def main() -> None:
             best_p = min(x[k] for x in pt)
             over = best_p / best_r - 1
             worst = max(worst, over)
-            print(f"{name if k == 0 else '':<38} {label:>5} {best_r:>9.4f} {best_p:>11.4f} {100 * over:>8.1f} %")
+            print(
+                f"{name if k == 0 else '':<38} {label:>5} {best_r:>9.4f} {best_p:>11.4f} {100 * over:>8.1f} %"
+            )
     print(f"largest overhead {100 * worst:.1f} % (target <= 5 %)")
 
 

@@ -16,10 +16,22 @@ def att28():
 
 
 def test_attractors_to_dict_is_the_command_lines_document(att28, cli_json, tmp_path):
-    assert att28.to_dict() == cli_json("attractors", "--omega", 2.8, "--samples", 6, "--out", tmp_path)
+    assert att28.to_dict() == cli_json(
+        "attractors", "--omega", 2.8, "--samples", 6, "--out", tmp_path
+    )
     a = afmdyn.attractors(omega=3.2, samples=5, seed=7, cluster_tol=1e-4)
     assert a.to_dict() == cli_json(
-        "attractors", "--omega", 3.2, "--samples", 5, "--seed", 7, "--cluster-tol", 1e-4, "--out", tmp_path
+        "attractors",
+        "--omega",
+        3.2,
+        "--samples",
+        5,
+        "--seed",
+        7,
+        "--cluster-tol",
+        1e-4,
+        "--out",
+        tmp_path,
     )
 
 
@@ -31,7 +43,9 @@ def test_attractor_objects(att28):
     assert a.initial.shape == (6,) and a.state.shape == (6,)
     assert a.section_w_tip.shape == a.section_v_t.shape == a.section_tau.shape == (2,)
     # section points at drive phase 0: τ = 2πk/Ω and V_T = W(1,τ) + α5
-    np.testing.assert_allclose(a.section_tau * 2.8 / (2 * np.pi), np.round(a.section_tau * 2.8 / (2 * np.pi)), atol=1e-9)
+    np.testing.assert_allclose(
+        a.section_tau * 2.8 / (2 * np.pi), np.round(a.section_tau * 2.8 / (2 * np.pi)), atol=1e-9
+    )
     np.testing.assert_allclose(a.section_v_t, a.section_w_tip, atol=1e-12)
     assert a.x_max >= a.section_w_tip.max() and a.x_min <= a.section_w_tip.min()
     assert a.to_dict() == att28.to_dict()["attractors"][0]
@@ -45,7 +59,9 @@ def test_attractor_handoff_to_orbit_matches_the_command_line(att28, cli_json):
     a = att28[0]
     o = a.orbit()
     # what the command line does with the attractor's initial_modal string
-    ref = cli_json("orbit", "--omega", 2.8, "--period", 2, "--initial-modal", a.to_dict()["initial_modal"])
+    ref = cli_json(
+        "orbit", "--omega", 2.8, "--period", 2, "--initial-modal", a.to_dict()["initial_modal"]
+    )
     assert o.to_dict() == ref
     assert o.stable and o.period == 2
     # the orbit found by shooting is the attractor: same section points (in some order)
@@ -105,27 +121,31 @@ def test_attractor_errors():
 
 def test_lyapunov_to_dict_and_liouville(cli_json):
     args = dict(omega=3.5, transient=100, periods=300, blocks=3)
-    l = afmdyn.lyapunov(**args)
-    assert l.to_dict() == cli_json("lyapunov", "--omega", 3.5, "--transient", 100, "--periods", 300, "--blocks", 3)
-    assert l.exponents.dtype == np.float64 and l.exponents.shape == (6,)
-    assert l.uncertainty.shape == (6,)
-    assert l.verdict == "periodic" and l.periods == 300
-    assert l.exponents.sum() == pytest.approx(l.volume_rate, abs=1e-9)  # Liouville
+    ly = afmdyn.lyapunov(**args)
+    assert ly.to_dict() == cli_json(
+        "lyapunov", "--omega", 3.5, "--transient", 100, "--periods", 300, "--blocks", 3
+    )
+    assert ly.exponents.dtype == np.float64 and ly.exponents.shape == (6,)
+    assert ly.uncertainty.shape == (6,)
+    assert ly.verdict == "periodic" and ly.periods == 300
+    assert ly.exponents.sum() == pytest.approx(ly.volume_rate, abs=1e-9)  # Liouville
 
 
 def test_lyapunov_of_a_linear_system():
     # α1 = 0 and a gap the tip never closes: M = I, C = α3 I, every exponent is −α3/2 and the
     # phase volume contracts at −N α3
-    l = afmdyn.lyapunov(modes=2, alpha1=0, beam_damping=0.1, gap=100, transient=10, periods=200, blocks=4)
-    assert l.volume_rate == pytest.approx(-0.2, abs=1e-12)
-    np.testing.assert_allclose(l.exponents, -0.05, atol=0.01)
-    assert l.exponents.mean() == pytest.approx(-0.05, abs=1e-12)
-    assert l.verdict == "periodic"
+    ly = afmdyn.lyapunov(
+        modes=2, alpha1=0, beam_damping=0.1, gap=100, transient=10, periods=200, blocks=4
+    )
+    assert ly.volume_rate == pytest.approx(-0.2, abs=1e-12)
+    np.testing.assert_allclose(ly.exponents, -0.05, atol=0.01)
+    assert ly.exponents.mean() == pytest.approx(-0.05, abs=1e-12)
+    assert ly.verdict == "periodic"
 
 
 def test_lyapunov_from_an_attractor_and_errors(att28):
-    l = afmdyn.lyapunov(att28[0].params, initial=att28[0], transient=0, periods=100, blocks=2)
-    assert l.exponents[0] < 0
+    ly = afmdyn.lyapunov(att28[0].params, initial=att28[0], transient=0, periods=100, blocks=2)
+    assert ly.exponents[0] < 0
     with pytest.raises(ValueError, match="periods / blocks"):
         afmdyn.lyapunov(periods=1, blocks=10)
     with pytest.raises(ValueError, match="blocks = -2"):

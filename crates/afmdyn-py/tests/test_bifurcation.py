@@ -15,13 +15,21 @@ ARGS = dict(from_=2.5, to=3.3, steps=9, starts=1, seed=3)
 
 
 def _reference(cli, out, *extra):
-    run = cli("bifurcation", "--from", 2.5, "--to", 3.3, "--steps", 9, "--starts", 1, "--seed", 3,
-              "--out", out, *extra)
+    args = "bifurcation --from 2.5 --to 3.3 --steps 9 --starts 1 --seed 3"
+    run = cli(*args.split(), "--out", out, *extra)
     assert run.returncode == 0, run.stderr
     ref = pd.read_csv(out / "bifurcation.csv", keep_default_na=False, na_values=[""])
     # the CLI writes points as they finish; the Python result is sorted by branch, then index
-    order = ref.branch.map(lambda b: {"forward": 0, "backward": 1}.get(b, 2 + int(b.split("-")[-1]) if b.startswith("start-") else 9))
-    return ref.assign(_o=order).sort_values(["_o", "index", "point"], kind="stable").reset_index(drop=True)
+    order = ref.branch.map(
+        lambda b: {"forward": 0, "backward": 1}.get(
+            b, 2 + int(b.split("-")[-1]) if b.startswith("start-") else 9
+        )
+    )
+    return (
+        ref.assign(_o=order)
+        .sort_values(["_o", "index", "point"], kind="stable")
+        .reset_index(drop=True)
+    )
 
 
 def test_rows_equal_the_command_lines_csv(cli, tmp_path):
@@ -34,7 +42,15 @@ def test_rows_equal_the_command_lines_csv(cli, tmp_path):
     assert ds.status.values.tolist() == ref.status.tolist()
     np.testing.assert_array_equal(ds.k.values, ref.point.values)
     np.testing.assert_array_equal(ds.n_points.values, ref.points.values)
-    for col in ["tau", "v_t", "w_tip", "x_max", "v_t_min", "contact_fraction", "contacts_per_period"]:
+    for col in [
+        "tau",
+        "v_t",
+        "w_tip",
+        "x_max",
+        "v_t_min",
+        "contact_fraction",
+        "contacts_per_period",
+    ]:
         np.testing.assert_array_equal(ds[col].values, ref[col].values, err_msg=col)
     periodic = ref.status == "periodic"
     np.testing.assert_array_equal(ds.period.values[periodic], ref.period[periodic].astype(int))
@@ -57,7 +73,9 @@ def test_long_format_and_tidy_dataframe():
     np.testing.assert_array_equal(ds.attrs["values"], [2.7, 2.8, 2.9])
     df = ds.to_dataframe()
     assert len(df) == ds.sizes["point"]
-    assert {"value", "branch", "status", "period", "w_tip", "x_max", "a_1", "a_dot_3"} <= set(df.columns)
+    assert {"value", "branch", "status", "period", "w_tip", "x_max", "a_1", "a_dot_3"} <= set(
+        df.columns
+    )
     # at drive phase 0, V_T = W(1,τ) + α5 (eq. 8 with sin 0 = 0)
     np.testing.assert_allclose(df.v_t, df.w_tip + ds.attrs["alpha5"], atol=1e-12)
     # the period-2 window near Ω = 2.8 (docs/paper-reproduction.md): two section points there
@@ -66,12 +84,18 @@ def test_long_format_and_tidy_dataframe():
 
 
 def test_other_parameters_and_explicit_values(cli, tmp_path):
-    ds = afmdyn.bifurcation(param="contact-stiffness", values=[10.0, 20.0], omega=2.8, continuation=False, starts=1)
+    ds = afmdyn.bifurcation(
+        param="contact-stiffness", values=[10.0, 20.0], omega=2.8, continuation=False, starts=1
+    )
     assert ds.attrs["param"] == "alpha4"
     assert sorted(set(ds.value.values.tolist())) == [10.0, 20.0]
     assert set(ds.branch.values.tolist()) == {"start-0"}
-    run = cli("bifurcation", "--param", "alpha4", "--from", 10, "--to", 20, "--steps", 2, "--omega", 2.8,
-              "--no-continuation", "--starts", 1, "--out", tmp_path)
+    run = cli(
+        *"bifurcation --param alpha4 --from 10 --to 20 --steps 2 --omega 2.8".split(),
+        *"--no-continuation --starts 1 --out".split(),
+        tmp_path,
+    )
+    assert run.returncode == 0, run.stderr
     ref = pd.read_csv(tmp_path / "bifurcation.csv").sort_values(["index", "point"])
     np.testing.assert_array_equal(ds.w_tip.values, ref.w_tip.values)
 
@@ -81,15 +105,18 @@ def test_a_failed_point_is_an_error_row_not_an_exception(cli, tmp_path):
     assert ds.status.values.tolist() == ["error"] * 4
     assert (ds.period.values == -2).all() and np.isnan(ds.w_tip.values).all()
     assert all(m.startswith("diverged at tau") for m in ds.message.values)
-    run = cli("bifurcation", "--from", 2.6, "--to", 2.7, "--steps", 2, "--integrator", "rk4",
-              "--steps-per-period", 5, "--out", tmp_path)
+    args = "bifurcation --from 2.6 --to 2.7 --steps 2 --integrator rk4 --steps-per-period 5"
+    run = cli(*args.split(), "--out", tmp_path)
+    assert run.returncode == 0, run.stderr  # the command line's error rows are readable too
     ref = pd.read_csv(tmp_path / "bifurcation.csv")
     assert sorted(ref.message) == sorted(ds.message.values.tolist())
 
 
 def test_progress_callback_sees_every_point():
     calls = []
-    ds = afmdyn.bifurcation(from_=2.0, to=3.0, steps=5, starts=1, progress=lambda d, t: calls.append((d, t)))
+    ds = afmdyn.bifurcation(
+        from_=2.0, to=3.0, steps=5, starts=1, progress=lambda d, t: calls.append((d, t))
+    )
     assert calls[-1] == (15, 15)  # 5 values × (forward + backward + 1 start)
     assert all(t == 15 for _, t in calls)
     assert [d for d, _ in calls] == sorted(d for d, _ in calls)

@@ -69,11 +69,19 @@ def test_continuation_with_branch_switching_equals_the_command_line(switched):
         np.testing.assert_array_equal(got[: len(row)], row)
         assert np.isnan(got[len(row) :]).all()
     # event names: the JSON's kebab-case; the CSV spells the Rust names
-    debug = {"": "", "fold": "Fold", "period-doubling": "PeriodDoubling", "neimark-sacker": "NeimarkSacker", "grazing": "Grazing"}
+    debug = {
+        "": "",
+        "fold": "Fold",
+        "period-doubling": "PeriodDoubling",
+        "neimark-sacker": "NeimarkSacker",
+        "grazing": "Grazing",
+    }
     assert [debug[e] for e in ds.event.values] == csv.event.tolist()
     assert set(ds.branch.values.tolist()) == {0, 1}
     assert ds.multipliers.dtype == np.complex128 and ds.multipliers.shape == (len(csv), 6)
-    np.testing.assert_allclose(np.abs(ds.multipliers.values).max(axis=1), ds.max_multiplier.values, rtol=1e-12)
+    np.testing.assert_allclose(
+        np.abs(ds.multipliers.values).max(axis=1), ds.max_multiplier.values, rtol=1e-12
+    )
 
 
 def test_continuation_closed_form_and_errors(cli_json, tmp_path):

@@ -17,8 +17,12 @@ pytestmark = pytest.mark.skipif(os.name != "posix", reason="SIGINT to a child pr
 
 
 def _interrupt(script: str, after: float = 1.5):
-    p = subprocess.Popen([sys.executable, "-c", textwrap.dedent(script)], stdout=subprocess.PIPE,
-                         stderr=subprocess.PIPE, text=True)
+    p = subprocess.Popen(
+        [sys.executable, "-c", textwrap.dedent(script)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     assert p.stdout.readline().strip() == "start"
     time.sleep(after)  # inside the computation (each takes far longer)
     sent = time.monotonic()

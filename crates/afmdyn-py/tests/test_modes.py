@@ -14,7 +14,9 @@ BETA = np.array([1.875104068711961, 4.694091132974175, 7.854757438237613])
 def test_to_dict_is_the_command_lines_document(cli_json):
     assert afmdyn.modes().to_dict() == cli_json("modes")
     args = {"modes": 5, "alpha3": 0, "alpha6": 0}
-    assert afmdyn.modes(**args).to_dict() == cli_json("modes", "--modes", 5, "--alpha3", 0, "--alpha6", 0)
+    assert afmdyn.modes(**args).to_dict() == cli_json(
+        "modes", "--modes", 5, "--alpha3", 0, "--alpha6", 0
+    )
 
 
 def test_paper_eq25_contact_frequencies():

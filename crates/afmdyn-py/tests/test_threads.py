@@ -55,7 +55,9 @@ def test_two_threads_computations_overlap():
     log = []
 
     def work(name):
-        afmdyn.lyapunov(omega=2.6, transient=0, periods=4000, blocks=2, progress=lambda d, t: log.append(name))
+        afmdyn.lyapunov(
+            omega=2.6, transient=0, periods=4000, blocks=2, progress=lambda d, t: log.append(name)
+        )
 
     threads = [threading.Thread(target=work, args=(n,)) for n in "ab"]
     for t in threads:

@@ -44,7 +44,16 @@ def _mypy(tmp_path: Path, code: str) -> subprocess.CompletedProcess:
     f = tmp_path / "snippet.py"
     f.write_text(textwrap.dedent(code))
     return subprocess.run(
-        [sys.executable, "-m", "mypy", "--strict", "--allow-any-generics", "--cache-dir", str(CACHE), str(f)],
+        [
+            sys.executable,
+            "-m",
+            "mypy",
+            "--strict",
+            "--allow-any-generics",
+            "--cache-dir",
+            str(CACHE),
+            str(f),
+        ],
         capture_output=True,
         text=True,
         cwd=tmp_path,
@@ -62,6 +71,8 @@ def test_mypy_accepts_correct_use_and_flags_mistakes(tmp_path):
     assert good.returncode == 0, good.stdout
     bad = _mypy(tmp_path, BAD)
     assert bad.returncode == 1
-    assert 'Argument "omega" to "simulate" has incompatible type "str"; expected "float"' in bad.stdout
+    assert (
+        'Argument "omega" to "simulate" has incompatible type "str"; expected "float"' in bad.stdout
+    )
     assert 'Unexpected keyword argument "omegaa" for "bifurcation"' in bad.stdout
     assert 'Property "omega" defined in "Params" is read-only' in bad.stdout

@@ -49,6 +49,7 @@ class Model(TypedDict, total=False):
     alpha6: float
     omega: float
 
+
 #: Global attributes of every dataset: the scales of the dimensionless units.
 UNITS_NOTE = (
     "dimensionless (paper eq. 5): time in t0 = sqrt(m L^4/(E I)), displacements in the beam "
@@ -78,7 +79,9 @@ def _state(initial: StateLike) -> Optional[list]:
         initial = initial.state
     z = np.asarray(initial, dtype=np.float64)
     if z.ndim != 1:
-        raise ValueError(f"initial: expected a 1-D state (a1..aN, adot1..adotN), got shape {z.shape}")
+        raise ValueError(
+            f"initial: expected a 1-D state (a1..aN, adot1..adotN), got shape {z.shape}"
+        )
     return z.tolist()
 
 
@@ -171,7 +174,10 @@ def simulate(
         ``afmdyn simulate --json`` (see :func:`summary`).
     """
     p = _params(params, model)
-    d = _run(_core.simulate, "simulate", progress,
+    d = _run(
+        _core.simulate,
+        "simulate",
+        progress,
         p,
         periods=periods,
         tau_end=tau_end,
@@ -194,7 +200,7 @@ def simulate(
             "contact_force": (
                 "tau",
                 d["contact_force"],
-                {"units": "E I g0/L^3", "long_name": "contact force α4 V_T + α6 dV_T/dτ"},
+                {"units": "E I g0/L^3", "long_name": "tip–sample contact force"},
             ),
             "a": (("tau", "mode"), d["a"], {**_G, "long_name": "modal displacement a_i"}),
             "a_dot": (("tau", "mode"), d["a_dot"], {**_V, "long_name": "modal velocity da_i/dτ"}),
@@ -211,7 +217,11 @@ def simulate(
             ),
             "section_tau": ("section", d["section_tau"], {**_T, "long_name": "section time 2πk/Ω"}),
             "section_v_t": ("section", d["section_v_t"], {**_G, "long_name": "V_T at the section"}),
-            "section_w_tip": ("section", d["section_w_tip"], {**_G, "long_name": "W(1,τ) at the section"}),
+            "section_w_tip": (
+                "section",
+                d["section_w_tip"],
+                {**_G, "long_name": "W(1,τ) at the section"},
+            ),
             "section_w_tip_dot": (
                 "section",
                 d["section_w_tip_dot"],
@@ -223,10 +233,26 @@ def simulate(
                 {"long_name": "state (a, da/dτ) at the section"},
             ),
             "energy_tau0": ("cycle", d["energy_tau0"], {**_T, "long_name": "start of the period"}),
-            "energy_start": ("cycle", d["energy_start"], {"units": "E I g0^2/L^3", "long_name": "stored energy at the start"}),
-            "energy_end": ("cycle", d["energy_end"], {"units": "E I g0^2/L^3", "long_name": "stored energy at the end"}),
-            "base_work": ("cycle", d["base_work"], {"units": "E I g0^2/L^3", "long_name": "work of the base drive"}),
-            "beam_dissipation": ("cycle", d["beam_dissipation"], {"units": "E I g0^2/L^3", "long_name": "beam damping loss"}),
+            "energy_start": (
+                "cycle",
+                d["energy_start"],
+                {"units": "E I g0^2/L^3", "long_name": "stored energy at the start"},
+            ),
+            "energy_end": (
+                "cycle",
+                d["energy_end"],
+                {"units": "E I g0^2/L^3", "long_name": "stored energy at the end"},
+            ),
+            "base_work": (
+                "cycle",
+                d["base_work"],
+                {"units": "E I g0^2/L^3", "long_name": "work of the base drive"},
+            ),
+            "beam_dissipation": (
+                "cycle",
+                d["beam_dissipation"],
+                {"units": "E I g0^2/L^3", "long_name": "beam damping loss"},
+            ),
             "contact_dissipation": (
                 "cycle",
                 d["contact_dissipation"],
@@ -282,7 +308,10 @@ def converge(
         ``tau_from_section`` ``[K]``.
     """
     p = _params(params, model, default=Params(omega=4.1))
-    d = _run(_core.converge, "converge", progress,
+    d = _run(
+        _core.converge,
+        "converge",
+        progress,
         p,
         max_modes=max_modes,
         periods=periods,
@@ -293,15 +322,31 @@ def converge(
     )
     return xr.Dataset(
         data_vars={
-            "w_tip": (("n_modes", "sample"), d["w_tip"], {**_G, "long_name": "tip deflection W(1,τ)"}),
+            "w_tip": (
+                ("n_modes", "sample"),
+                d["w_tip"],
+                {**_G, "long_name": "tip deflection W(1,τ)"},
+            ),
             "v_t": (("n_modes", "sample"), d["v_t"], {**_G, "long_name": "V_T"}),
             "tau": (("n_modes", "sample"), d["tau"], _T),
-            "period": ("n_modes", d["period"], {"long_name": "period of the steady state (−1: nonperiodic)"}),
-            "rms_change": ("n_modes", d["rms_change"], {**_G, "long_name": "RMS of W_tip(N) − W_tip(N−1)"}),
+            "period": (
+                "n_modes",
+                d["period"],
+                {"long_name": "period of the steady state (−1: nonperiodic)"},
+            ),
+            "rms_change": (
+                "n_modes",
+                d["rms_change"],
+                {**_G, "long_name": "RMS of W_tip(N) − W_tip(N−1)"},
+            ),
         },
         coords={
             "n_modes": ("n_modes", d["modes"], {"long_name": "number of Galerkin modes N"}),
-            "tau_from_section": ("sample", d["tau_from_section"], {**_T, "long_name": "τ − τ0 from a section point"}),
+            "tau_from_section": (
+                "sample",
+                d["tau_from_section"],
+                {**_T, "long_name": "τ − τ0 from a section point"},
+            ),
         },
         attrs=_attrs(p, summary=d["json"]),
     )
@@ -352,7 +397,10 @@ def bifurcation(
     """
     p = _params(params, model)
     vals = None if values is None else np.asarray(values, dtype=np.float64).ravel().tolist()
-    d = _run(_core.bifurcation, "bifurcation", progress,
+    d = _run(
+        _core.bifurcation,
+        "bifurcation",
+        progress,
         p,
         param=param,
         values=vals,
@@ -381,15 +429,35 @@ def bifurcation(
         "w_tip": ("point", d["w_tip"], {**_G, "long_name": "W(1,τ) at τ = 2πk/Ω"}),
         "x_max": ("point", d["x_max"], {**_G, "long_name": "X_max"}),
         "v_t_min": ("point", d["v_t_min"], {**_G, "long_name": "min V_T"}),
-        "contact_fraction": ("point", d["contact_fraction"], {"long_name": "fraction of time in contact"}),
-        "contacts_per_period": ("point", d["contacts_per_period"], {"long_name": "contacts per drive period"}),
-        "transient_periods": ("point", d["transient_periods"], {"long_name": "transient (drive periods)"}),
+        "contact_fraction": (
+            "point",
+            d["contact_fraction"],
+            {"long_name": "fraction of time in contact"},
+        ),
+        "contacts_per_period": (
+            "point",
+            d["contacts_per_period"],
+            {"long_name": "contacts per drive period"},
+        ),
+        "transient_periods": (
+            "point",
+            d["transient_periods"],
+            {"long_name": "transient (drive periods)"},
+        ),
         "message": ("point", np.array(d["message"], dtype=str)),
     }
     for j in range(n):
-        data[f"a_{j + 1}"] = ("point", d["state"][j], {**_G, "long_name": f"a_{j + 1} at the section"})
+        data[f"a_{j + 1}"] = (
+            "point",
+            d["state"][j],
+            {**_G, "long_name": f"a_{j + 1} at the section"},
+        )
     for j in range(n):
-        data[f"a_dot_{j + 1}"] = ("point", d["state"][n + j], {**_V, "long_name": f"da_{j + 1}/dτ at the section"})
+        data[f"a_dot_{j + 1}"] = (
+            "point",
+            d["state"][n + j],
+            {**_V, "long_name": f"da_{j + 1}/dτ at the section"},
+        )
     return xr.Dataset(
         data_vars=data,
         coords={
@@ -425,7 +493,10 @@ def attractors(
         ``to_dict()`` is ``afmdyn attractors --json``, ``to_dataframe()`` a summary table.
     """
     p = _params(params, model)
-    d = _run(_core.attractors, "attractors", progress,
+    d = _run(
+        _core.attractors,
+        "attractors",
+        progress,
         p,
         samples=samples,
         seed=seed,
@@ -491,7 +562,10 @@ def orbit(
     p = _params(params, model)
     if period is None and isinstance(initial, Attractor):
         period = initial.period or 1
-    d = _run(_core.orbit, "orbit", progress,
+    d = _run(
+        _core.orbit,
+        "orbit",
+        progress,
         p,
         period=period,
         initial=_state(initial),
@@ -555,7 +629,10 @@ def continuation(
         ``attrs["summary"]`` is ``afmdyn continue --json``.
     """
     p = _params(params, model)
-    d = _run(_core.continuation, "continuation", progress,
+    d = _run(
+        _core.continuation,
+        "continuation",
+        progress,
         p,
         param=param,
         from_=from_,
@@ -573,13 +650,29 @@ def continuation(
             "period": ("point", d["period"]),
             "s": ("point", d["s"], {"long_name": "arclength"}),
             "stable": ("point", d["stable"]),
-            "max_multiplier": ("point", d["max_multiplier"], {"long_name": "largest |Floquet multiplier|"}),
+            "max_multiplier": (
+                "point",
+                d["max_multiplier"],
+                {"long_name": "largest |Floquet multiplier|"},
+            ),
             "critical": ("point", np.array(d["critical"], dtype=str)),
             "switchings": ("point", d["switchings"], {"long_name": "switchings per cycle"}),
-            "grazing_distance": ("point", d["grazing_distance"], {**_G, "long_name": "distance to grazing"}),
+            "grazing_distance": (
+                "point",
+                d["grazing_distance"],
+                {**_G, "long_name": "distance to grazing"},
+            ),
             "event": ("point", np.array(d["event"], dtype=str)),
-            "w_tip_section": (("point", "k"), d["w_tip_section"], {**_G, "long_name": "W(1,τ) at the section points"}),
-            "multipliers": (("point", "multiplier"), d["multipliers"], {"long_name": "Floquet multipliers"}),
+            "w_tip_section": (
+                ("point", "k"),
+                d["w_tip_section"],
+                {**_G, "long_name": "W(1,τ) at the section points"},
+            ),
+            "multipliers": (
+                ("point", "multiplier"),
+                d["multipliers"],
+                {"long_name": "Floquet multipliers"},
+            ),
             "state": (("point", "component"), d["state"], {"long_name": "state at τ = 0"}),
         },
         coords={"value": ("point", d["value"], {"long_name": f"{d['symbol']} ({d['param']})"})},
@@ -607,8 +700,14 @@ def lyapunov(
     """
     p = _params(params, model)
     d = _run(
-        _core.lyapunov, "lyapunov", progress,
-        p, initial=_state(initial), transient=transient, periods=periods, blocks=blocks,
+        _core.lyapunov,
+        "lyapunov",
+        progress,
+        p,
+        initial=_state(initial),
+        transient=transient,
+        periods=periods,
+        blocks=blocks,
     )
     doc = json.loads(d["json"])
     return Lyapunov(

@@ -146,7 +146,12 @@ class Attractors(_Document, Sequence[Attractor]):
     """
 
     def __init__(
-        self, params: Params, samples: int, attractors: List[Attractor], failures: List[str], doc: str
+        self,
+        params: Params,
+        samples: int,
+        attractors: List[Attractor],
+        failures: List[str],
+        doc: str,
     ) -> None:
         self.params = params
         self.samples = samples
