@@ -1,6 +1,6 @@
 """What calling the engine through Python costs over the Rust library alone.
 
-    python crates/afmdyn-py/bench/overhead.py [--rounds 7]
+    python crates/afmdyn-py/bench/overhead.py [--rounds 7] [--instructions]
 
 Times the same work both ways, interleaved round by round (the machine may be shared), and
 reports the best time of each:
@@ -13,6 +13,11 @@ reports the best time of each:
 
 The Rust figures come from ``cargo run --release -p afmdyn --example timing`` (built here if
 missing). Target: at most 5 % overhead.
+
+On a shared machine the run-to-run spread of wall and CPU time can exceed the overhead;
+``--instructions`` counts executed instructions instead (valgrind's callgrind, a few minutes):
+the Rust example against the difference of two Python runs, one importing afmdyn and doing a
+trivial call, one also doing the computation.
 """
 
 from __future__ import annotations
@@ -48,10 +53,43 @@ def python(fn) -> tuple:
     return time.perf_counter() - t0, time.process_time() - c0
 
 
+def instructions(cmd: list) -> int:
+    """Instructions executed by ``cmd`` and all its threads (callgrind)."""
+    out = subprocess.run(
+        ["valgrind", "--tool=callgrind", "--callgrind-out-file=/dev/null", *cmd],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    for line in out.stderr.splitlines():
+        if "Collected :" in line:
+            return int(line.split(":")[-1])
+    raise RuntimeError(out.stderr[-2000:])
+
+
+def count_instructions(periods: int) -> None:
+    py = [sys.executable, "-c"]
+    setup = "import afmdyn; afmdyn.modes(); "
+    base = instructions([*py, setup])
+    print(f"{'case':<40} {'Rust (instr.)':>14} {'Python (instr.)':>16} {'overhead':>9}")
+    for name, rust_args, call in [
+        (
+            f"simulate, {periods} periods",
+            ["simulate", str(periods), "1"],
+            f"afmdyn.simulate(periods={periods}, progress=False)",
+        ),
+        ("default bifurcation run (800 points)", ["bifurcation", "1"], "afmdyn.bifurcation(progress=False)"),
+    ]:
+        r = instructions([str(EXAMPLE), *rust_args])
+        p = instructions([*py, setup + call]) - base
+        print(f"{name:<40} {r:>14.4e} {p:>16.4e} {100 * (p / r - 1):>8.1f} %")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--rounds", type=int, default=7)
     ap.add_argument("--periods", type=int, default=1000)
+    ap.add_argument("--instructions", action="store_true", help="count instructions (callgrind)")
     a = ap.parse_args()
     if not EXAMPLE.exists():
         subprocess.run(
@@ -59,6 +97,9 @@ def main() -> None:
             cwd=REPO,
             check=True,
         )
+    if a.instructions:
+        count_instructions(a.periods)
+        return
     cases = {
         f"simulate, {a.periods} periods": (
             lambda: rust("simulate", str(a.periods), "1"),
