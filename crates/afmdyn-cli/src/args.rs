@@ -164,32 +164,9 @@ impl ModelArgs {
         let a0 = self
             .intermolecular_distance
             .or(file.intermolecular_distance);
-        let contact_law = match kind {
-            Some(k) => {
-                for (given, name, law) in [
-                    (restitution.is_some(), "restitution", LawKind::Impact),
-                    (hamaker.is_some(), "hamaker", LawKind::Dmt),
-                    (a0.is_some(), "intermolecular_distance", LawKind::Dmt),
-                ] {
-                    if given && k != law {
-                        return Err(CliError::Input(format!(
-                            "{name} is a group of the {law:?} law, not of contact_law = {k:?} \
-                             (set --contact-law {})",
-                            format!("{law:?}").to_lowercase()
-                        )));
-                    }
-                }
-                k.with_groups(hamaker, a0, restitution)
-            }
-            None if restitution.is_some() || hamaker.is_some() || a0.is_some() => {
-                return Err(CliError::Input(
-                    "restitution / hamaker / intermolecular_distance need --contact-law \
-                     impact or dmt"
-                        .into(),
-                ))
-            }
-            None => defaults.contact_law,
-        };
+        let contact_law =
+            afmdyn::ContactLaw::from_parts(kind, hamaker, a0, restitution, defaults.contact_law)
+                .map_err(|e| CliError::Input(e.to_string()))?;
         // `..defaults` carries any field without a flag (e.g. a contact law added to Params)
         #[allow(clippy::needless_update)]
         let p = Params {

@@ -6,7 +6,7 @@ use crate::output::{f, io_error, temp_path, write_bytes, write_csv, Column, NpyS
 use crate::plot::{save, save_scatter_stream, ChunkSink, Figure, LegendEntry, Series, Style};
 use afmdyn::analysis::attractors::{find_attractors, AttractorSpec};
 use afmdyn::analysis::bifurcation::{run_sweep, Branch, Resume, SweepPoint, SweepSpec};
-use afmdyn::analysis::steady::{SteadyOptions, SteadyState};
+use afmdyn::analysis::steady::SteadyOptions;
 use afmdyn::integrate::build;
 use afmdyn::trajectory::{record, RecordSpec};
 use afmdyn::{CantileverModel, Params, SweepParam};
@@ -168,7 +168,7 @@ fn point_rows(param: SweepParam, p: &SweepPoint) -> Vec<Vec<String>> {
     match &p.result {
         Err(msg) => {
             let mut r = base("error", String::new(), 0, 1);
-            r.extend(std::iter::repeat_n(String::new(), 7));
+            r.extend(std::iter::repeat_n(String::new(), 8));
             r.push(msg.replace(['\n', ','], " "));
             r.push(String::new());
             vec![r]
@@ -820,43 +820,6 @@ pub struct AttractorsArgs {
     json: bool,
 }
 
-/// A section state as the `--initial-modal` string "a1,..,aN;adot1,..,adotN" (at drive phase 0),
-/// so that `afmdyn orbit --initial-modal` can start from an attractor.
-fn initial_modal(z: Option<&DVector<f64>>) -> String {
-    let Some(z) = z else { return String::new() };
-    let n = z.len() / 2;
-    let join = |v: &[f64]| {
-        v.iter()
-            .map(|x| format!("{x}"))
-            .collect::<Vec<_>>()
-            .join(",")
-    };
-    format!("{};{}", join(&z.as_slice()[..n]), join(&z.as_slice()[n..]))
-}
-
-fn attractor_json(
-    s: &SteadyState,
-    basin: f64,
-    orbit: Option<&afmdyn::analysis::shooting::PeriodicOrbit>,
-) -> serde_json::Value {
-    json!({
-        "multipliers": orbit.map(|o| o.multipliers.iter().map(|m| [m.re, m.im]).collect::<Vec<_>>()),
-        "stable": orbit.map(|o| o.stable),
-        "period": s.period(),
-        "poincare": {
-            "v_t": s.poincare.iter().map(|p| p.v_t).collect::<Vec<_>>(),
-            "w_tip": s.poincare.iter().map(|p| p.w_tip).collect::<Vec<_>>(),
-        },
-        "x_max": s.stats.x_max,
-        "v_t_min": s.stats.v_t_min,
-        "contact_fraction": s.stats.contact_fraction,
-        "contacts_per_period": s.stats.contacts_per_period,
-        "body_contact": s.stats.body_contact,
-        "basin_fraction": basin,
-        "initial_modal": initial_modal(s.poincare.first().map(|q| &q.state)),
-    })
-}
-
 /// Run `afmdyn attractors`.
 pub fn attractors(a: &AttractorsArgs) -> Result<(), CliError> {
     let p = a.model.params(Params::default())?;
@@ -961,12 +924,7 @@ pub fn attractors(a: &AttractorsArgs) -> Result<(), CliError> {
             },
         )?;
     }
-    let doc = json!({
-        "params": p,
-        "samples": a.samples,
-        "failures": report.failures.len(),
-        "attractors": report.attractors.iter().map(|x| attractor_json(&x.steady, x.basin_fraction, x.orbit.as_ref())).collect::<Vec<_>>(),
-    });
+    let doc = afmdyn::report::attractors(&p, a.samples, &report);
     write_bytes(
         &out.join("attractors.json"),
         serde_json::to_string_pretty(&doc).expect("json").as_bytes(),

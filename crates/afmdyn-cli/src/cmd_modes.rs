@@ -4,7 +4,7 @@ use crate::args::{read_toml, ModelArgs};
 use crate::error::CliError;
 use crate::output::{f, write_csv, OutDir};
 use crate::plot::{save, Figure, Series, Style};
-use afmdyn::eigen::{fig3_sweep, spectrum, RegionSpectrum};
+use afmdyn::eigen::{fig3_sweep, spectrum};
 use afmdyn::units::{
     beam_damping_from_q, contact_stiffness, material, Cantilever, ContactStiffness, Material,
     PhysicalModel, SILICON_TIP,
@@ -31,13 +31,6 @@ pub struct ModesArgs {
     out: PathBuf,
 }
 
-fn region_json(r: &RegionSpectrum) -> serde_json::Value {
-    json!({
-        "omega": r.omega,
-        "eigenvalues": r.eigenvalues.iter().map(|e| [e.re, e.im]).collect::<Vec<_>>(),
-    })
-}
-
 /// Run `afmdyn modes`.
 pub fn modes(a: &ModesArgs) -> Result<(), CliError> {
     let p = a.model.params(Params::default())?;
@@ -46,9 +39,7 @@ pub fn modes(a: &ModesArgs) -> Result<(), CliError> {
     }
     let (free, contact) = spectrum(&p)?;
     if a.json {
-        let doc =
-            json!({ "params": p, "free": region_json(&free), "contact": region_json(&contact) });
-        println!("{doc}");
+        println!("{}", afmdyn::report::modes(&p, &free, &contact));
         return Ok(());
     }
     println!(

@@ -10,13 +10,12 @@ use afmdyn::analysis::continuation::{
     continue_branch, continue_with_switching, BranchPoint, ContinuationSpec,
 };
 use afmdyn::analysis::lyapunov::{lyapunov_spectrum, LyapunovOptions};
-use afmdyn::analysis::shooting::{shoot, PeriodicOrbit, ShootingOptions};
+use afmdyn::analysis::shooting::{shoot, ShootingOptions};
 use afmdyn::analysis::steady::steady_state;
 use afmdyn::integrate::{build, IntegratorOptions};
 use afmdyn::{CantileverModel, Params, SweepParam};
 use clap::Args;
 use nalgebra::DVector;
-use serde_json::json;
 use std::path::{Path, PathBuf};
 
 /// Initial-state flags of the orbit commands.
@@ -58,24 +57,6 @@ pub struct OrbitArgs {
     json: bool,
 }
 
-fn orbit_json(model: &CantileverModel, o: &PeriodicOrbit) -> serde_json::Value {
-    json!({
-        "period": o.period,
-        "poincare": {
-            "v_t": o.section.iter().map(|z| model.v_t(0.0, z)).collect::<Vec<_>>(),
-            "w_tip": o.section.iter().map(|z| model.w_tip(z)).collect::<Vec<_>>(),
-        },
-        "multipliers": o.multipliers.iter().map(|m| [m.re, m.im]).collect::<Vec<_>>(),
-        "stable": o.stable,
-        "critical": o.critical,
-        "grazing": o.grazing,
-        "grazing_distance": o.grazing_distance,
-        "switchings": o.switchings,
-        "newton_residuals": o.residuals,
-        "state": o.state.iter().collect::<Vec<_>>(),
-    })
-}
-
 /// Run `afmdyn orbit`.
 pub fn orbit(a: &OrbitArgs) -> Result<(), CliError> {
     let p = a.model.params(Params::default())?;
@@ -87,9 +68,7 @@ pub fn orbit(a: &OrbitArgs) -> Result<(), CliError> {
     }
     let o = shoot(&model, &guess, n, &ShootingOptions::default())?;
     if a.json {
-        let mut doc = orbit_json(&model, &o);
-        doc["params"] = json!(p);
-        println!("{doc}");
+        println!("{}", afmdyn::report::orbit(&model, &o));
         return Ok(());
     }
     println!(
@@ -338,16 +317,10 @@ pub fn continuation(a: &ContinueArgs) -> Result<(), CliError> {
             shade: vec![],
         },
     )?;
-    let events: Vec<_> = branches
-        .iter()
-        .flatten()
-        .filter(|b| b.event.is_some())
-        .map(|b| json!({ "event": b.event, "value": b.value, "period": b.period, "stable": b.stable }))
-        .collect();
     if a.json {
         println!(
             "{}",
-            json!({ "params": base, "param": a.param.name(), "branches": branches.len(), "points": branches.iter().map(Vec::len).sum::<usize>(), "events": events })
+            afmdyn::report::continuation(&base, a.param, &branches)
         );
     } else {
         println!(
@@ -391,47 +364,6 @@ pub struct LyapunovArgs {
     json: bool,
 }
 
-/// Fewest averaged periods for exponents worth reporting without a warning.
-const LYAPUNOV_MIN_PERIODS: usize = 200;
-
-/// Why a Lyapunov spectrum should not be trusted: too short a run, too few periods per block,
-/// or exponents not resolved from zero by their own uncertainty.
-fn lyapunov_warnings(
-    exponents: &[f64],
-    uncertainty: &[f64],
-    periods: usize,
-    blocks: usize,
-) -> Vec<String> {
-    let mut w = vec![];
-    if periods < LYAPUNOV_MIN_PERIODS {
-        w.push(format!(
-            "only {periods} periods averaged (at least {LYAPUNOV_MIN_PERIODS} recommended, default \
-             4000): the exponents have not converged and their signs are not reliable"
-        ));
-    }
-    if periods / blocks.max(1) < 20 {
-        w.push(format!(
-            "{} periods per block: the uncertainties are estimated from blocks too short to be \
-             independent",
-            periods / blocks.max(1)
-        ));
-    }
-    let unresolved: Vec<String> = exponents
-        .iter()
-        .zip(uncertainty)
-        .enumerate()
-        .filter(|(_, (e, u))| e.is_nan() || e.abs() <= 2.0 * **u)
-        .map(|(k, _)| (k + 1).to_string())
-        .collect();
-    if !unresolved.is_empty() {
-        w.push(format!(
-            "exponent(s) {} not resolved from zero (|λ| ≤ 2 × uncertainty): run more periods",
-            unresolved.join(", ")
-        ));
-    }
-    w
-}
-
 /// Run `afmdyn lyapunov`.
 pub fn lyapunov(a: &LyapunovArgs) -> Result<(), CliError> {
     let p = a.model.params(Params::default())?;
@@ -453,15 +385,12 @@ pub fn lyapunov(a: &LyapunovArgs) -> Result<(), CliError> {
             ..Default::default()
         },
     )?;
-    let warnings = lyapunov_warnings(&l.exponents, &l.uncertainty, a.periods, a.blocks);
-    for w in &warnings {
+    let warnings = &l.warnings;
+    for w in warnings {
         eprintln!("afmdyn: warning: {w}");
     }
     if a.json {
-        println!(
-            "{}",
-            json!({ "params": p, "exponents": l.exponents, "uncertainty": l.uncertainty, "convergence": l.convergence, "volume_rate": l.volume_rate, "zero_one": l.zero_one, "verdict": l.verdict, "periods": l.periods, "warnings": warnings })
-        );
+        println!("{}", afmdyn::report::lyapunov(&p, &l));
         return Ok(());
     }
     println!(

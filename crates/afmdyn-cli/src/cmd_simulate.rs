@@ -32,8 +32,7 @@ pub enum Files {
 pub const MAX_RUN_PERIODS: f64 = 1e8;
 /// Largest time series written (timeseries.npy, plus timeseries.csv with --csv), in bytes.
 pub const MAX_SERIES_BYTES: f64 = 16.0 * 1024.0 * 1024.0 * 1024.0;
-/// Largest relative per-period energy-balance residual of an accurate run.
-pub const ENERGY_TOLERANCE: f64 = 1e-6;
+
 /// Samples kept for the phase portrait (the last ones).
 const PHASE_SAMPLES: usize = 50_000;
 /// Samples kept for the amplitude spectrum (the last ones).
@@ -504,24 +503,20 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
         write_spectrum_and_plots(o, &p, spp, spectrum, plots, summary.tau_end)?;
     }
     let zf = summary.final_state.clone().unwrap_or_else(|| z0.clone());
-    let warnings = summary.warnings();
-    let doc = json!({
-        "params": p,
-        "tau_end": summary.tau_end,
-        "final": {
-            "w_tip": model.w_tip(&zf),
-            "w_tip_dot": model.w_tip_dot(&zf),
-            "v_t": model.v_t(summary.tau_end, &zf),
-            "a": zf.rows(0, n).iter().collect::<Vec<_>>(),
-            "a_dot": zf.rows(n, n).iter().collect::<Vec<_>>(),
-        },
-        "switchings": summary.switchings,
-        "body_contact": summary.body_contact,
-        "poincare_points": summary.sections,
-        "energy_residual": { "max_abs": summary.residual, "max_relative": summary.relative },
-        "files": a.files.to_possible_value().map(|v| v.get_name().to_string()),
-        "warnings": warnings,
-    });
+    let run = afmdyn::report::SimulateSummary {
+        tau_end: summary.tau_end,
+        final_state: zf.clone(),
+        switchings: summary.switchings,
+        body_contact: summary.body_contact,
+        poincare_points: summary.sections,
+        energy_residual: (summary.residual, summary.relative),
+    };
+    let warnings = afmdyn::report::simulate_warnings(&run);
+    let mut doc = afmdyn::report::simulate_summary(&model, &run);
+    doc["files"] = json!(a
+        .files
+        .to_possible_value()
+        .map(|v| v.get_name().to_string()));
     for w in &warnings {
         eprintln!("afmdyn: warning: {w}");
     }
@@ -571,46 +566,13 @@ impl RunSummary {
     fn add(&mut self, tr: &Trajectory) {
         self.switchings += tr.events.len();
         self.body_contact |= tr.body_contact;
-        for e in &tr.energy {
-            let r = e.residual().abs();
-            let scale = [
-                e.e_start,
-                e.e_end,
-                e.base_work,
-                e.beam_dissipation,
-                e.contact_dissipation,
-            ]
-            .iter()
-            .fold(0.0f64, |m, v| m.max(v.abs()));
-            self.residual = self.residual.max(r);
-            if scale > 0.0 {
-                self.relative = self.relative.max(r / scale);
-            } else if r > 0.0 || r.is_nan() {
-                self.relative = f64::INFINITY;
-            }
-        }
-    }
-
-    /// The run's own accuracy checks that failed (the energy balance closes to ~1e-10 relative
-    /// with the exact propagator and with the adaptive integrator's DOP853 dense output).
-    fn warnings(&self) -> Vec<String> {
-        let mut w = vec![];
-        if self.relative.is_nan() || self.relative > ENERGY_TOLERANCE {
-            w.push(format!(
-                "energy balance violated: a per-period residual of {:.1e} relative (tolerance \
-                 1e-6); the trajectory is not accurate (integrator too coarse, or parameters at \
-                 the edge of the valid range)",
-                self.relative
-            ));
-        }
-        if self.body_contact {
-            w.push(
-                "a point of the beam other than the tip reached the substrate (paper Fig. 2f): \
-                 outside the model's assumption"
-                    .into(),
-            );
-        }
-        w
+        let (abs, rel) = afmdyn::report::energy_residual(&tr.energy);
+        self.residual = self.residual.max(abs);
+        self.relative = if rel.is_nan() {
+            rel
+        } else {
+            self.relative.max(rel)
+        };
     }
 }
 
@@ -835,12 +797,10 @@ pub fn converge(a: &ConvergeArgs) -> Result<(), CliError> {
             shade: vec![],
         },
     )?;
-    let rows: Vec<_> = runs
-        .iter()
-        .map(|r| json!({ "modes": r.modes, "period": r.period, "rms_change": r.rms_change }))
-        .collect();
     if a.json {
-        println!("{}", json!({ "params": p, "runs": rows, "out": a.out }));
+        let mut doc = afmdyn::report::converge(&p, &runs);
+        doc["out"] = json!(a.out);
+        println!("{doc}");
     } else {
         if p.alpha3 > 0.0 || p.alpha6 > 0.0 {
             println!("note: paper eq. 24 is undamped; using α3 = {}, α6 = {} (eq. 26) so a steady state exists", p.alpha3, p.alpha6);

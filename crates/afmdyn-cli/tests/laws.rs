@@ -133,7 +133,7 @@ fn every_subcommand_runs_every_law() {
 fn law_flags_are_checked() {
     for (args, needle) in [
         (vec!["orbit", "--contact-law", "elastic"], "contact law"),
-        (vec!["orbit", "--restitution", "0.5"], "contact-law"),
+        (vec!["orbit", "--restitution", "0.5"], "contact_law"),
         (
             vec!["orbit", "--contact-law", "hertz", "--restitution", "0.5"],
             "restitution",

@@ -185,6 +185,73 @@ impl LawKind {
     }
 }
 
+impl ContactLaw {
+    /// The law a front end asks for: its kind (or `base`'s when not given) and the groups it
+    /// sets, the others kept from `base` when it is of that kind, else the defaults. One place
+    /// for the CLI flags, the TOML keys and the Python keywords.
+    ///
+    /// # Errors
+    /// [`crate::ParamError::Group`] for a group of another law (e.g. `restitution` with
+    /// `contact_law = hertz`); the groups' ranges are checked by [`ContactLaw::validate`].
+    pub fn from_parts(
+        kind: Option<LawKind>,
+        hamaker: Option<f64>,
+        intermolecular_distance: Option<f64>,
+        restitution: Option<f64>,
+        base: ContactLaw,
+    ) -> Result<ContactLaw, crate::ParamError> {
+        let kind = kind.unwrap_or(match base {
+            ContactLaw::Linear => LawKind::Linear,
+            ContactLaw::Hertz => LawKind::Hertz,
+            ContactLaw::Dmt { .. } => LawKind::Dmt,
+            ContactLaw::Impact { .. } => LawKind::Impact,
+        });
+        for (given, group, owner) in [
+            (restitution.is_some(), "restitution", LawKind::Impact),
+            (hamaker.is_some(), "hamaker", LawKind::Dmt),
+            (
+                intermolecular_distance.is_some(),
+                "intermolecular_distance",
+                LawKind::Dmt,
+            ),
+        ] {
+            if given && kind != owner {
+                return Err(crate::ParamError::Group {
+                    group,
+                    owner: owner.name(),
+                    law: kind.name(),
+                });
+            }
+        }
+        // groups not given keep base's when base is of the same kind
+        let (h0, a0, r0) = match base {
+            ContactLaw::Dmt {
+                hamaker,
+                intermolecular_distance,
+            } => (Some(hamaker), Some(intermolecular_distance), None),
+            ContactLaw::Impact { restitution } => (None, None, Some(restitution)),
+            _ => (None, None, None),
+        };
+        Ok(kind.with_groups(
+            hamaker.or(h0),
+            intermolecular_distance.or(a0),
+            restitution.or(r0),
+        ))
+    }
+}
+
+impl LawKind {
+    /// The kind's name: `linear`, `hertz`, `dmt` or `impact`.
+    pub fn name(self) -> &'static str {
+        match self {
+            LawKind::Linear => "linear",
+            LawKind::Hertz => "hertz",
+            LawKind::Dmt => "dmt",
+            LawKind::Impact => "impact",
+        }
+    }
+}
+
 /// F_c and its partial derivatives at (δ, δ̇).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct ForceEval {

@@ -22,6 +22,16 @@ pub enum ParamError {
     /// The drive frequency Ω is not finite or not positive.
     #[error("omega (drive frequency Ω) = {0}: must be finite and > 0")]
     Omega(f64),
+    /// A group given for a law it does not belong to.
+    #[error("{group} is a group of the {owner} law, not of contact_law = {law} (set contact_law = {owner})")]
+    Group {
+        /// The group, e.g. `restitution`.
+        group: &'static str,
+        /// The law it belongs to.
+        owner: &'static str,
+        /// The law in force.
+        law: &'static str,
+    },
     /// A group of the tip–sample law (see [`crate::contact::ContactLaw`]) is out of range.
     #[error("{name} = {value}: must satisfy {range}")]
     Law {

@@ -11,7 +11,8 @@
 //! (eqs. 5, 7) → [`contact`] (tip–sample laws) → [`system`] (the hybrid-system interface,
 //! saltation) → [`model`] (the cantilever–sample system) → [`integrate`] (exact propagation, RK4, an
 //! adaptive oracle) → [`trajectory`] (observables, stroboscopic Poincaré section) →
-//! [`analysis`] (steady states, periods, bifurcation sweeps, attractors, mode convergence).
+//! [`analysis`] (steady states, periods, bifurcation sweeps, attractors, mode convergence);
+//! [`report`] builds the JSON result documents shared by the command line and Python.
 //!
 //! Time is the dimensionless τ of eq. 5 and displacements are in units of the beam gap g₀.
 //! States are `z: [f64; 2N]` = (a, ȧ), modal coordinates and their τ-derivatives.
@@ -41,6 +42,7 @@ pub mod galerkin;
 pub mod integrate;
 pub mod model;
 pub mod params;
+pub mod report;
 pub mod roots;
 pub mod system;
 pub mod trajectory;

@@ -14,6 +14,7 @@ use rayon::prelude::*;
 use std::collections::{HashMap, HashSet};
 use std::fmt;
 use std::str::FromStr;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Scale A of random initial states: a_j ~ U(−A, A)·β₁²/β_j², ȧ_j ~ U(−A, A)·β₁² (every mode
 /// gets a comparable share of energy; A = 0.6 gap units covers the paper's amplitudes 0.1–1.5).
@@ -193,6 +194,17 @@ enum Task {
 /// Points listed in `resume.done` are skipped; continuation chains restart from their saved
 /// state.
 pub fn run_sweep(spec: &SweepSpec, resume: &Resume, sink: &(dyn Fn(SweepPoint) + Sync)) {
+    run_sweep_cancellable(spec, resume, sink, &AtomicBool::new(false));
+}
+
+/// [`run_sweep`] that stops early once `cancel` is set: no new point is started (points
+/// already running finish and reach `sink`), so a front end can interrupt a long sweep.
+pub fn run_sweep_cancellable(
+    spec: &SweepSpec,
+    resume: &Resume,
+    sink: &(dyn Fn(SweepPoint) + Sync),
+    cancel: &AtomicBool,
+) {
     // tasks by index (chains first, then the starts value by value), never all in memory
     let chains = if spec.continuation { 2 } else { 0 };
     let starts = spec.starts as usize;
@@ -228,6 +240,9 @@ pub fn run_sweep(spec: &SweepSpec, resume: &Resume, sink: &(dyn Fn(SweepPoint) +
                     z = saved.clone();
                 }
                 for i in order {
+                    if cancel.load(Ordering::Relaxed) {
+                        return;
+                    }
                     if resume.done.contains(&(i, branch)) {
                         continue;
                     }
@@ -245,6 +260,9 @@ pub fn run_sweep(spec: &SweepSpec, resume: &Resume, sink: &(dyn Fn(SweepPoint) +
                 }
             }
             Task::Start(i, s) => {
+                if cancel.load(Ordering::Relaxed) {
+                    return;
+                }
                 let value = spec.values[i];
                 let p = spec.base.with(spec.param, value);
                 let result = CantileverModel::new(&p)

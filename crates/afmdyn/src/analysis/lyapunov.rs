@@ -77,6 +77,9 @@ pub struct LyapunovSpectrum {
     pub zero_one: f64,
     /// Periods averaged.
     pub periods: usize,
+    /// What limits the run's reliability: too few periods, blocks too short for independent
+    /// uncertainties, exponents not resolved from zero (|λ| ≤ 2 × (uncertainty + convergence)).
+    pub warnings: Vec<String>,
     /// Verdict.
     pub verdict: Verdict,
 }
@@ -156,6 +159,13 @@ pub fn lyapunov_spectrum(
     } else {
         Verdict::Undecided
     };
+    let warnings = run_warnings(
+        &exponents,
+        &uncertainty,
+        &convergence,
+        total_periods,
+        opts.blocks,
+    );
     Ok(LyapunovSpectrum {
         exponents,
         uncertainty,
@@ -164,7 +174,50 @@ pub fn lyapunov_spectrum(
         zero_one,
         periods: total_periods,
         verdict,
+        warnings,
     })
+}
+
+/// Fewest periods averaged for exponents whose signs are reliable (the default is 4000).
+pub const MIN_PERIODS: usize = 200;
+
+/// The warnings of [`LyapunovSpectrum::warnings`].
+fn run_warnings(
+    exponents: &[f64],
+    uncertainty: &[f64],
+    convergence: &[f64],
+    periods: usize,
+    blocks: usize,
+) -> Vec<String> {
+    let mut w = vec![];
+    if periods < MIN_PERIODS {
+        w.push(format!(
+            "only {periods} periods averaged (at least {MIN_PERIODS} recommended, default \
+             4000): the exponents have not converged and their signs are not reliable"
+        ));
+    }
+    if periods / blocks.max(1) < 20 {
+        w.push(format!(
+            "{} periods per block: the uncertainties are estimated from blocks too short to be \
+             independent",
+            periods / blocks.max(1)
+        ));
+    }
+    let unresolved: Vec<String> = exponents
+        .iter()
+        .zip(uncertainty.iter().zip(convergence))
+        .enumerate()
+        .filter(|(_, (e, (u, c)))| e.is_nan() || e.abs() <= 2.0 * (**u + **c))
+        .map(|(k, _)| (k + 1).to_string())
+        .collect();
+    if !unresolved.is_empty() {
+        w.push(format!(
+            "exponent(s) {} not resolved from zero (|λ| ≤ 2 × (uncertainty + convergence)): run \
+             more periods",
+            unresolved.join(", ")
+        ));
+    }
+    w
 }
 
 /// The 0–1 test for chaos (correlation method) on a scalar series φ_j: K = median over 100

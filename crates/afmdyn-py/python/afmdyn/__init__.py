@@ -1,0 +1,60 @@
+"""afmdyn — multi-modal tapping-mode AFM cantilever dynamics with intermittent contact.
+
+The Rust engine of the ``afmdyn`` command line, called directly (no subprocess): every
+analysis runs with the GIL released, can be interrupted with Ctrl-C, shows a progress bar
+when it runs long, and returns NumPy float64 arrays in ``xarray.Dataset`` objects (time
+series, sweeps, curves) or small result objects whose ``to_dict()`` is the command line's
+``--json`` document for the same arguments.
+
+>>> import afmdyn
+>>> afmdyn.modes(modes=5, beam_damping=0, contact_damping=0).contact.omega.round(2)[:3]
+array([ 7.79, 20.33, 55.81])
+
+Analyses: :func:`modes`, :func:`simulate`, :func:`converge`, :func:`bifurcation`,
+:func:`attractors`, :func:`orbit`, :func:`continuation`, :func:`lyapunov`. Physical units
+(``approach``, ``resonance``, probe files) and the contact-law keywords come with later
+versions.
+"""
+
+from ._afmdyn import Params, SimulationError
+from ._api import (
+    Model,
+    attractors,
+    bifurcation,
+    continuation,
+    converge,
+    lyapunov,
+    modes,
+    orbit,
+    simulate,
+    summary,
+)
+from ._results import Attractor, Attractors, Lyapunov, Orbit, RegionSpectrum, Spectrum
+
+try:
+    from importlib.metadata import version as _version
+
+    __version__ = _version("afmdyn")
+except Exception:  # pragma: no cover - not installed as a distribution
+    __version__ = "0+unknown"
+
+__all__ = [
+    "Attractor",
+    "Attractors",
+    "Lyapunov",
+    "Model",
+    "Orbit",
+    "Params",
+    "RegionSpectrum",
+    "SimulationError",
+    "Spectrum",
+    "attractors",
+    "bifurcation",
+    "continuation",
+    "converge",
+    "lyapunov",
+    "modes",
+    "orbit",
+    "simulate",
+    "summary",
+]

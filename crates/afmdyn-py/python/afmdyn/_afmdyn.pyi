@@ -1,0 +1,206 @@
+"""Type stubs of the compiled core ``afmdyn._afmdyn`` (use the ``afmdyn`` package: its
+functions wrap these and build the datasets and result objects)."""
+
+import os
+from typing import Any, Callable, Dict, List, Literal, Optional, Tuple, Union
+
+ProgressCallback = Callable[[int, Optional[int]], object]
+
+POLL_SECONDS: float
+MODEL_KEYWORDS: List[Tuple[str, str, str]]
+
+class SimulationError(RuntimeError):
+    """A computation failed (chattering, divergence, Newton not converging, integrator
+    failure); bad input raises ``ValueError`` instead."""
+
+class Params:
+    """Dimensionless model parameters (paper eq. 7), validated on construction.
+
+    Keywords: ``modes`` (N, 1..=20), ``tip_mass_ratio``/``alpha1`` (≥ 0),
+    ``drive_amplitude``/``alpha2`` (≥ 0), ``beam_damping``/``alpha3`` (≥ 0),
+    ``contact_stiffness``/``alpha4`` (≥ 0), ``gap``/``alpha5`` (finite),
+    ``contact_damping``/``alpha6`` (≥ 0), ``omega`` (Ω > 0), ``contact_law`` (``"linear"``,
+    ``"hertz"``, ``"dmt"``, ``"impact"``) with its groups ``restitution`` (0..=1, impact),
+    ``hamaker`` (≥ 0) and ``intermolecular_distance`` (> 0, DMT); the others keep the paper's
+    Figs. 5–14 set. Raises ``ValueError`` (field and range) or ``TypeError`` (unknown keyword,
+    wrong type).
+    """
+
+    def __init__(
+        self,
+        *,
+        modes: int = ...,
+        tip_mass_ratio: float = ...,
+        alpha1: float = ...,
+        drive_amplitude: float = ...,
+        alpha2: float = ...,
+        beam_damping: float = ...,
+        alpha3: float = ...,
+        contact_stiffness: float = ...,
+        alpha4: float = ...,
+        gap: float = ...,
+        alpha5: float = ...,
+        contact_damping: float = ...,
+        alpha6: float = ...,
+        omega: float = ...,
+        contact_law: Literal["linear", "hertz", "dmt", "impact"] = ...,
+        restitution: float = ...,
+        hamaker: float = ...,
+        intermolecular_distance: float = ...,
+    ) -> None: ...
+    def replace(
+        self,
+        *,
+        modes: int = ...,
+        tip_mass_ratio: float = ...,
+        alpha1: float = ...,
+        drive_amplitude: float = ...,
+        alpha2: float = ...,
+        beam_damping: float = ...,
+        alpha3: float = ...,
+        contact_stiffness: float = ...,
+        alpha4: float = ...,
+        gap: float = ...,
+        alpha5: float = ...,
+        contact_damping: float = ...,
+        alpha6: float = ...,
+        omega: float = ...,
+        contact_law: Literal["linear", "hertz", "dmt", "impact"] = ...,
+        restitution: float = ...,
+        hamaker: float = ...,
+        intermolecular_distance: float = ...,
+    ) -> "Params":
+        """A validated copy with the given keywords changed."""
+    @staticmethod
+    def from_toml(path: Union[str, "os.PathLike[str]"], **model: Any) -> "Params":
+        """Read a model config file (``--config FILE.toml`` of the command line); ``**model``
+        overrides it."""
+    @property
+    def modes(self) -> int: ...
+    @property
+    def alpha1(self) -> float: ...
+    @property
+    def alpha2(self) -> float: ...
+    @property
+    def alpha3(self) -> float: ...
+    @property
+    def alpha4(self) -> float: ...
+    @property
+    def alpha5(self) -> float: ...
+    @property
+    def alpha6(self) -> float: ...
+    @property
+    def omega(self) -> float: ...
+    @property
+    def contact_law(self) -> Literal["linear", "hertz", "dmt", "impact"]: ...
+    @property
+    def restitution(self) -> Optional[float]: ...
+    @property
+    def hamaker(self) -> Optional[float]: ...
+    @property
+    def intermolecular_distance(self) -> Optional[float]: ...
+    @property
+    def tip_mass_ratio(self) -> float: ...
+    @property
+    def drive_amplitude(self) -> float: ...
+    @property
+    def beam_damping(self) -> float: ...
+    @property
+    def contact_stiffness(self) -> float: ...
+    @property
+    def gap(self) -> float: ...
+    @property
+    def contact_damping(self) -> float: ...
+    @property
+    def period(self) -> float:
+        """Drive period T = 2π/Ω (in t0)."""
+    def to_dict(self) -> Dict[str, Any]:
+        """The ``"params"`` object of the command line's JSON documents."""
+    def __eq__(self, other: object) -> bool: ...
+    def __reduce__(self) -> Tuple[Any, Tuple[str]]: ...
+
+def modes(params: Params) -> Dict[str, Any]: ...
+def simulate(
+    params: Params,
+    periods: Optional[float] = None,
+    tau_end: Optional[float] = None,
+    transient: float = 0.0,
+    initial: Optional[List[float]] = None,
+    samples_per_period: int = 200,
+    integrator: Optional[str] = None,
+    steps_per_period: Optional[int] = None,
+    tolerance: float = 1e-12,
+    progress: Optional[ProgressCallback] = None,
+) -> Dict[str, Any]: ...
+def converge(
+    params: Params,
+    max_modes: int = 4,
+    periods: int = 1,
+    samples_per_period: int = 200,
+    integrator: Optional[str] = None,
+    steps_per_period: Optional[int] = None,
+    tolerance: float = 1e-12,
+    progress: Optional[ProgressCallback] = None,
+) -> Dict[str, Any]: ...
+def bifurcation(
+    params: Params,
+    param: str = "omega",
+    values: Optional[List[float]] = None,
+    from_: float = 1.0,
+    to: float = 5.0,
+    steps: int = 400,
+    starts: int = 0,
+    seed: int = 1,
+    continuation: bool = True,
+    threads: Optional[int] = None,
+    tol: float = 1e-8,
+    max_periods: int = 1500,
+    max_period: int = 64,
+    integrator: Optional[str] = None,
+    steps_per_period: Optional[int] = None,
+    tolerance: float = 1e-12,
+    progress: Optional[ProgressCallback] = None,
+) -> Dict[str, Any]: ...
+def attractors(
+    params: Params,
+    samples: int = 64,
+    seed: int = 1,
+    cluster_tol: float = 1e-5,
+    tol: float = 1e-8,
+    max_periods: int = 1500,
+    max_period: int = 64,
+    integrator: Optional[str] = None,
+    steps_per_period: Optional[int] = None,
+    tolerance: float = 1e-12,
+    progress: Optional[ProgressCallback] = None,
+) -> Dict[str, Any]: ...
+def orbit(
+    params: Params,
+    period: Optional[int] = None,
+    initial: Optional[List[float]] = None,
+    tol: float = 1e-8,
+    max_periods: int = 1500,
+    max_period: int = 64,
+    progress: Optional[ProgressCallback] = None,
+) -> Dict[str, Any]: ...
+def continuation(
+    params: Params,
+    param: str = "omega",
+    from_: float = 5.0,
+    to: float = 1.0,
+    period: Optional[int] = None,
+    switch: bool = False,
+    initial: Optional[List[float]] = None,
+    tol: float = 1e-8,
+    max_periods: int = 1500,
+    max_period: int = 64,
+    progress: Optional[ProgressCallback] = None,
+) -> Dict[str, Any]: ...
+def lyapunov(
+    params: Params,
+    initial: Optional[List[float]] = None,
+    transient: int = 500,
+    periods: int = 4000,
+    blocks: int = 10,
+    progress: Optional[ProgressCallback] = None,
+) -> Dict[str, Any]: ...

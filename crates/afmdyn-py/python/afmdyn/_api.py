@@ -1,0 +1,726 @@
+"""The analyses. Each takes the model as a :class:`Params` and/or keyword arguments, runs the
+Rust engine with the GIL released (Ctrl-C raises ``KeyboardInterrupt``; long runs show a
+progress bar) and returns NumPy arrays in xarray datasets or small result objects.
+
+Units (paper eq. 5): time τ in t0 = √(mL⁴/EI), displacements in the beam gap g0, forces in
+EI g0/L³, energies in EI g0²/L³. Model keywords: ``modes``, ``tip_mass_ratio``/``alpha1``,
+``drive_amplitude``/``alpha2``, ``beam_damping``/``alpha3``, ``contact_stiffness``/``alpha4``,
+``gap``/``alpha5``, ``contact_damping``/``alpha6``, ``omega`` (see :class:`Params`).
+
+Errors: ``ValueError`` for input out of range (the message names the field and its range),
+``TypeError`` for an unknown keyword or a wrong type, :class:`SimulationError` when a
+computation fails (chattering, divergence, Newton not converging).
+"""
+
+from __future__ import annotations
+
+import json
+from typing import Literal, TYPE_CHECKING, Any, Dict, Optional, Sequence, TypedDict, Union
+
+import numpy as np
+import xarray as xr
+
+from . import _afmdyn as _core
+from ._afmdyn import Params
+from ._progress import ProgressArg, reporter
+from ._results import Attractor, Attractors, Lyapunov, Orbit, RegionSpectrum, Spectrum
+
+if TYPE_CHECKING:  # annotations only (PEP 692): editors complete and check the keywords
+    from typing_extensions import Unpack
+
+StateLike = Union[None, Sequence[float], np.ndarray, Attractor, Orbit]
+
+
+class Model(TypedDict, total=False):
+    """The model keywords every analysis takes (see :class:`Params` for their ranges)."""
+
+    modes: int
+    tip_mass_ratio: float
+    alpha1: float
+    drive_amplitude: float
+    alpha2: float
+    beam_damping: float
+    alpha3: float
+    contact_stiffness: float
+    alpha4: float
+    gap: float
+    alpha5: float
+    contact_damping: float
+    alpha6: float
+    omega: float
+    contact_law: Literal["linear", "hertz", "dmt", "impact"]
+    restitution: float
+    hamaker: float
+    intermolecular_distance: float
+
+
+#: Global attributes of every dataset: the scales of the dimensionless units.
+UNITS_NOTE = (
+    "dimensionless (paper eq. 5): time in t0 = sqrt(m L^4/(E I)), displacements in the beam "
+    "gap g0, forces in E I g0/L^3, energies in E I g0^2/L^3"
+)
+
+_T = {"units": "t0", "long_name": "time τ"}
+_G = {"units": "g0"}
+_V = {"units": "g0/t0"}
+
+
+def _params(params: Optional[Params], model: Any, default: Optional[Params] = None) -> Params:
+    """``params`` (or ``default``, or the paper's set) with the ``model`` keywords applied."""
+    if params is None:
+        base = default if default is not None else Params()
+    elif isinstance(params, Params):
+        base = params
+    else:
+        raise TypeError(f"params: expected afmdyn.Params or None, got {type(params).__name__}")
+    return base.replace(**model) if model else base
+
+
+def _state(initial: StateLike) -> Optional[list]:
+    if initial is None:
+        return None
+    if isinstance(initial, (Attractor, Orbit)):
+        initial = initial.state
+    z = np.asarray(initial, dtype=np.float64)
+    if z.ndim != 1:
+        raise ValueError(
+            f"initial: expected a 1-D state (a1..aN, adot1..adotN), got shape {z.shape}"
+        )
+    return z.tolist()
+
+
+def _param_attrs(p: Params) -> Dict[str, Any]:
+    return {k: v for k, v in p.to_dict().items() if isinstance(v, (int, float, str))}
+
+
+def _attrs(p: Params, **extra: Any) -> Dict[str, Any]:
+    a = _param_attrs(p)
+    a["units_note"] = UNITS_NOTE
+    a.update(extra)
+    return a
+
+
+_COUNTS = frozenset(
+    "samples_per_period steps_per_period max_modes periods steps starts seed threads "
+    "max_periods max_period samples period transient blocks".split()
+)
+
+
+def _run(fn: Any, desc: str, progress: ProgressArg, p: Params, **options: Any) -> Dict[str, Any]:
+    """Call the compiled ``fn`` with a progress reporter; negative counts are a ValueError
+    naming the option (the core's unsigned integers would raise OverflowError)."""
+    for k, v in options.items():
+        if k in _COUNTS and isinstance(v, int) and not isinstance(v, bool) and v < 0:
+            raise ValueError(f"{k} = {v}: must be >= 0")
+    with reporter(progress, desc) as cb:
+        return fn(p, progress=cb, **options)
+
+
+def summary(ds: xr.Dataset) -> Dict[str, Any]:
+    """The command line's ``--json`` summary stored with a dataset (``simulate``,
+    ``converge`` without its output path, ``continuation``)."""
+    return json.loads(ds.attrs["summary"])
+
+
+def modes(params: Optional[Params] = None, /, **model: Unpack[Model]) -> Spectrum:
+    """Natural frequencies and damped eigenvalues of the free and contact systems
+    (paper eqs. 19–23).
+
+    Returns a :class:`Spectrum` (``.free``, ``.contact``: ω float64 ``[N]``, eigenvalues
+    complex128, ζ); ``to_dict()`` is ``afmdyn modes --json``.
+    """
+    p = _params(params, model)
+    d = _core.modes(p)
+
+    def region(name: str) -> RegionSpectrum:
+        return RegionSpectrum(d[f"{name}_omega"], d[f"{name}_eigenvalues"], d[f"{name}_zeta"])
+
+    return Spectrum(p, region("free"), region("contact"), d["json"])
+
+
+def simulate(
+    params: Optional[Params] = None,
+    /,
+    *,
+    periods: Optional[float] = None,
+    tau_end: Optional[float] = None,
+    transient: float = 0.0,
+    initial: StateLike = None,
+    samples_per_period: int = 200,
+    integrator: Optional[str] = None,
+    steps_per_period: Optional[int] = None,
+    tolerance: float = 1e-12,
+    progress: ProgressArg = None,
+    **model: Unpack[Model],
+) -> xr.Dataset:
+    """Integrate one trajectory (``afmdyn simulate``).
+
+    Args:
+        periods: drive periods recorded after the transient (default 50), or
+        tau_end: the end time τ instead.
+        transient: drive periods run and discarded first.
+        initial: initial state (a₁…a_N, ȧ₁…ȧ_N), ``[2N]``, or an :class:`Attractor` /
+            :class:`Orbit` (its state at drive phase 0); default: rest.
+        samples_per_period: samples per drive period (1..=100000).
+        integrator: ``"exact"``, ``"rk4"``, ``"rk4-naive"`` or ``"adaptive"``; default
+            (``None``) the command line's default, the exact propagator;
+            steps_per_period: rk4's fixed steps (default 2000); tolerance: the adaptive one's.
+        progress: ``None`` (a bar for long runs), ``True``, ``False`` or ``callable(done, total)``.
+
+    Returns:
+        ``xarray.Dataset`` with dims ``tau`` (S samples), ``mode`` (N), ``event`` (E
+        switchings), ``section`` (P section points τ = 2πk/Ω), ``component`` (2N) and ``cycle``
+        (C complete drive periods): ``v_t``, ``v_t_dot``, ``w_tip``, ``w_tip_dot``,
+        ``in_contact``, ``contact_force`` ``[S]``; ``a``, ``a_dot`` ``[S, N]``;
+        ``event_tau``, ``event_to_contact``, ``event_v_t_dot`` ``[E]``; ``section_tau``,
+        ``section_v_t``, ``section_w_tip``, ``section_w_tip_dot`` ``[P]``, ``section_state``
+        ``[P, 2N]``; the energy balance per period ``[C]``. ``attrs["summary"]`` holds
+        ``afmdyn simulate --json`` (see :func:`summary`).
+    """
+    p = _params(params, model)
+    d = _run(
+        _core.simulate,
+        "simulate",
+        progress,
+        p,
+        periods=periods,
+        tau_end=tau_end,
+        transient=transient,
+        initial=_state(initial),
+        samples_per_period=samples_per_period,
+        integrator=integrator,
+        steps_per_period=steps_per_period,
+        tolerance=tolerance,
+    )
+    n = p.modes
+    comp = [f"a_{j}" for j in range(1, n + 1)] + [f"a_dot_{j}" for j in range(1, n + 1)]
+    ds = xr.Dataset(
+        data_vars={
+            "v_t": ("tau", d["v_t"], {**_G, "long_name": "tip–sample distance V_T (eq. 8)"}),
+            "v_t_dot": ("tau", d["v_t_dot"], {**_V, "long_name": "dV_T/dτ"}),
+            "w_tip": ("tau", d["w_tip"], {**_G, "long_name": "tip deflection W(1,τ)"}),
+            "w_tip_dot": ("tau", d["w_tip_dot"], {**_V, "long_name": "∂W(1,τ)/∂τ"}),
+            "in_contact": ("tau", d["in_contact"], {"long_name": "tip on the sample (region II)"}),
+            "contact_force": (
+                "tau",
+                d["contact_force"],
+                {"units": "E I g0/L^3", "long_name": "tip–sample contact force"},
+            ),
+            "a": (("tau", "mode"), d["a"], {**_G, "long_name": "modal displacement a_i"}),
+            "a_dot": (("tau", "mode"), d["a_dot"], {**_V, "long_name": "modal velocity da_i/dτ"}),
+            "event_tau": ("event", d["event_tau"], {**_T, "long_name": "switching time"}),
+            "event_to_contact": (
+                "event",
+                d["event_to_contact"],
+                {"long_name": "switching into contact (else out of it)"},
+            ),
+            "event_v_t_dot": (
+                "event",
+                d["event_v_t_dot"],
+                {**_V, "long_name": "dV_T/dτ at the switching (impact velocity)"},
+            ),
+            "section_tau": ("section", d["section_tau"], {**_T, "long_name": "section time 2πk/Ω"}),
+            "section_v_t": ("section", d["section_v_t"], {**_G, "long_name": "V_T at the section"}),
+            "section_w_tip": (
+                "section",
+                d["section_w_tip"],
+                {**_G, "long_name": "W(1,τ) at the section"},
+            ),
+            "section_w_tip_dot": (
+                "section",
+                d["section_w_tip_dot"],
+                {**_V, "long_name": "∂W(1,τ)/∂τ at the section"},
+            ),
+            "section_state": (
+                ("section", "component"),
+                d["section_state"],
+                {"long_name": "state (a, da/dτ) at the section"},
+            ),
+            "energy_tau0": ("cycle", d["energy_tau0"], {**_T, "long_name": "start of the period"}),
+            "energy_start": (
+                "cycle",
+                d["energy_start"],
+                {"units": "E I g0^2/L^3", "long_name": "stored energy at the start"},
+            ),
+            "energy_end": (
+                "cycle",
+                d["energy_end"],
+                {"units": "E I g0^2/L^3", "long_name": "stored energy at the end"},
+            ),
+            "base_work": (
+                "cycle",
+                d["base_work"],
+                {"units": "E I g0^2/L^3", "long_name": "work of the base drive"},
+            ),
+            "beam_dissipation": (
+                "cycle",
+                d["beam_dissipation"],
+                {"units": "E I g0^2/L^3", "long_name": "beam damping loss"},
+            ),
+            "contact_dissipation": (
+                "cycle",
+                d["contact_dissipation"],
+                {"units": "E I g0^2/L^3", "long_name": "contact damping loss"},
+            ),
+            "energy_residual": (
+                "cycle",
+                d["energy_residual"],
+                {"units": "E I g0^2/L^3", "long_name": "ΔE − (work − losses)"},
+            ),
+        },
+        coords={
+            "tau": ("tau", d["tau"], _T),
+            "mode": ("mode", np.arange(1, n + 1), {"long_name": "Galerkin mode i"}),
+            "component": ("component", comp),
+        },
+        attrs=_attrs(
+            p,
+            summary=d["json"],
+            tau_end=d["tau_end"],
+            switchings=d["switchings"],
+            body_contact=int(d["body_contact"]),
+            integrator=d["integrator"],
+            transient_tau=d["transient_tau"],
+            samples_per_period=samples_per_period,
+        ),
+    )
+    return ds
+
+
+def converge(
+    params: Optional[Params] = None,
+    /,
+    *,
+    max_modes: int = 4,
+    periods: int = 1,
+    samples_per_period: int = 200,
+    integrator: Optional[str] = None,
+    steps_per_period: Optional[int] = None,
+    tolerance: float = 1e-12,
+    progress: ProgressArg = None,
+    **model: Unpack[Model],
+) -> xr.Dataset:
+    """Mode-number convergence (paper Fig. 4, ``afmdyn converge``): the steady tip motion
+    for N = 1..max_modes. Without ``params`` the model defaults to Ω = 4.1 (eq. 24 with the
+    damping of eq. 26), as on the command line.
+
+    Returns:
+        ``xarray.Dataset`` with dims ``n_modes`` (max_modes) and ``sample`` (K):
+        ``w_tip``, ``v_t``, ``tau`` ``[n_modes, K]`` over ``periods`` drive periods from a
+        section point; ``period`` ``[n_modes]`` (−1: nonperiodic); ``rms_change``
+        ``[n_modes]`` (RMS of W_tip(N) − W_tip(N−1), NaN for N = 1); coordinate
+        ``tau_from_section`` ``[K]``.
+    """
+    p = _params(params, model, default=Params(omega=4.1))
+    d = _run(
+        _core.converge,
+        "converge",
+        progress,
+        p,
+        max_modes=max_modes,
+        periods=periods,
+        samples_per_period=samples_per_period,
+        integrator=integrator,
+        steps_per_period=steps_per_period,
+        tolerance=tolerance,
+    )
+    return xr.Dataset(
+        data_vars={
+            "w_tip": (
+                ("n_modes", "sample"),
+                d["w_tip"],
+                {**_G, "long_name": "tip deflection W(1,τ)"},
+            ),
+            "v_t": (("n_modes", "sample"), d["v_t"], {**_G, "long_name": "V_T"}),
+            "tau": (("n_modes", "sample"), d["tau"], _T),
+            "period": (
+                "n_modes",
+                d["period"],
+                {"long_name": "period of the steady state (−1: nonperiodic)"},
+            ),
+            "rms_change": (
+                "n_modes",
+                d["rms_change"],
+                {**_G, "long_name": "RMS of W_tip(N) − W_tip(N−1)"},
+            ),
+        },
+        coords={
+            "n_modes": ("n_modes", d["modes"], {"long_name": "number of Galerkin modes N"}),
+            "tau_from_section": (
+                "sample",
+                d["tau_from_section"],
+                {**_T, "long_name": "τ − τ0 from a section point"},
+            ),
+        },
+        attrs=_attrs(p, summary=d["json"]),
+    )
+
+
+def bifurcation(
+    params: Optional[Params] = None,
+    /,
+    *,
+    param: str = "omega",
+    from_: float = 1.0,
+    to: float = 5.0,
+    steps: int = 400,
+    values: Optional[Sequence[float]] = None,
+    starts: int = 0,
+    seed: int = 1,
+    continuation: bool = True,
+    threads: Optional[int] = None,
+    tol: float = 1e-8,
+    max_periods: int = 1500,
+    max_period: int = 64,
+    integrator: Optional[str] = None,
+    steps_per_period: Optional[int] = None,
+    tolerance: float = 1e-12,
+    progress: ProgressArg = None,
+    **model: Unpack[Model],
+) -> xr.Dataset:
+    """Bifurcation diagram (paper Fig. 5, ``afmdyn bifurcation``): the steady state at each
+    value of ``param`` by forward and backward continuation and ``starts`` random starts, in
+    parallel (``threads`` workers, default all cores). Ctrl-C stops it within one point.
+
+    Args:
+        param: ``"omega"`` or ``"alpha1"``…``"alpha6"`` (or the descriptive names).
+        from_, to, steps: ``steps`` evenly spaced values (``from`` is a Python keyword), or
+        values: explicit values.
+        starts, seed: random initial states per value; continuation: forward/backward chains.
+        tol, max_periods, max_period: steady-state detection (as ``--tol`` etc.).
+
+    Returns:
+        ``xarray.Dataset`` in long format, dim ``point`` (one row per section point, as the
+        command line's ``bifurcation.csv``, sorted by branch then index): coordinates
+        ``value``, ``index``, ``branch`` (``"forward"``, ``"backward"``, ``"start-k"``);
+        ``status`` (``"periodic"``, ``"nonperiodic"``, ``"error"``), ``period`` (−1
+        nonperiodic, −2 error), ``k`` (position in the cycle), ``n_points``, ``tau``,
+        ``v_t``, ``w_tip``, ``x_max``, ``v_t_min``, ``contact_fraction``,
+        ``contacts_per_period``, ``transient_periods``, ``message``, ``a_1``…``a_N``,
+        ``a_dot_1``…``a_dot_N``. ``.to_dataframe()`` gives the tidy table.
+    """
+    p = _params(params, model)
+    vals = None if values is None else np.asarray(values, dtype=np.float64).ravel().tolist()
+    d = _run(
+        _core.bifurcation,
+        "bifurcation",
+        progress,
+        p,
+        param=param,
+        values=vals,
+        from_=from_,
+        to=to,
+        steps=steps,
+        starts=starts,
+        seed=seed,
+        continuation=continuation,
+        threads=threads,
+        tol=tol,
+        max_periods=max_periods,
+        max_period=max_period,
+        integrator=integrator,
+        steps_per_period=steps_per_period,
+        tolerance=tolerance,
+    )
+    n = p.modes
+    data: Dict[str, Any] = {
+        "status": ("point", np.array(d["status"], dtype=str)),
+        "period": ("point", d["period"], {"long_name": "period n (−1 nonperiodic, −2 error)"}),
+        "k": ("point", d["k"], {"long_name": "section point within the cycle"}),
+        "n_points": ("point", d["n_points"], {"long_name": "section points of the cycle"}),
+        "tau": ("point", d["tau"], {**_T, "long_name": "section time 2πk/Ω"}),
+        "v_t": ("point", d["v_t"], {**_G, "long_name": "V_T at the section"}),
+        "w_tip": ("point", d["w_tip"], {**_G, "long_name": "W(1,τ) at τ = 2πk/Ω"}),
+        "x_max": ("point", d["x_max"], {**_G, "long_name": "X_max"}),
+        "v_t_min": ("point", d["v_t_min"], {**_G, "long_name": "min V_T"}),
+        "contact_fraction": (
+            "point",
+            d["contact_fraction"],
+            {"long_name": "fraction of time in contact"},
+        ),
+        "contacts_per_period": (
+            "point",
+            d["contacts_per_period"],
+            {"long_name": "contacts per drive period"},
+        ),
+        "transient_periods": (
+            "point",
+            d["transient_periods"],
+            {"long_name": "transient (drive periods)"},
+        ),
+        "message": ("point", np.array(d["message"], dtype=str)),
+    }
+    for j in range(n):
+        data[f"a_{j + 1}"] = (
+            "point",
+            d["state"][j],
+            {**_G, "long_name": f"a_{j + 1} at the section"},
+        )
+    for j in range(n):
+        data[f"a_dot_{j + 1}"] = (
+            "point",
+            d["state"][n + j],
+            {**_V, "long_name": f"da_{j + 1}/dτ at the section"},
+        )
+    return xr.Dataset(
+        data_vars=data,
+        coords={
+            "value": ("point", d["value"], {"long_name": f"{d['symbol']} ({d['param']})"}),
+            "index": ("point", d["index"], {"long_name": "index of the value"}),
+            "branch": ("point", np.array(d["branch"], dtype=str)),
+        },
+        attrs=_attrs(p, param=d["param"], values=d["values"], starts=starts, seed=seed),
+    )
+
+
+def attractors(
+    params: Optional[Params] = None,
+    /,
+    *,
+    samples: int = 64,
+    seed: int = 1,
+    cluster_tol: float = 1e-5,
+    tol: float = 1e-8,
+    max_periods: int = 1500,
+    max_period: int = 64,
+    integrator: Optional[str] = None,
+    steps_per_period: Optional[int] = None,
+    tolerance: float = 1e-12,
+    progress: ProgressArg = None,
+    **model: Unpack[Model],
+) -> Attractors:
+    """Coexisting attractors and basin fractions (paper Figs. 6–17, ``afmdyn attractors``)
+    from ``samples`` seeded random initial states, in parallel.
+
+    Returns:
+        :class:`Attractors`, a sequence of :class:`Attractor` (most frequent first);
+        ``to_dict()`` is ``afmdyn attractors --json``, ``to_dataframe()`` a summary table.
+    """
+    p = _params(params, model)
+    d = _run(
+        _core.attractors,
+        "attractors",
+        progress,
+        p,
+        samples=samples,
+        seed=seed,
+        cluster_tol=cluster_tol,
+        tol=tol,
+        max_periods=max_periods,
+        max_period=max_period,
+        integrator=integrator,
+        steps_per_period=steps_per_period,
+        tolerance=tolerance,
+    )
+    doc = json.loads(d["json"])
+    found = [
+        Attractor(
+            params=p,
+            period=a["period"],
+            count=a["count"],
+            basin_fraction=a["basin_fraction"],
+            section_tau=a["section_tau"],
+            section_v_t=a["section_v_t"],
+            section_w_tip=a["section_w_tip"],
+            section_state=a["section_state"],
+            initial=a["initial"],
+            x_max=a["x_max"],
+            x_min=a["x_min"],
+            v_t_min=a["v_t_min"],
+            contact_fraction=a["contact_fraction"],
+            contacts_per_period=a["contacts_per_period"],
+            body_contact=a["body_contact"],
+            transient_periods=a["transient_periods"],
+            _doc=entry,
+        )
+        for a, entry in zip(d["attractors"], doc["attractors"])
+    ]
+    return Attractors(p, samples, found, list(d["failures"]), d["json"])
+
+
+def orbit(
+    params: Optional[Params] = None,
+    /,
+    *,
+    period: Optional[int] = None,
+    initial: StateLike = None,
+    tol: float = 1e-8,
+    max_periods: int = 1500,
+    max_period: int = 64,
+    progress: ProgressArg = None,
+    **model: Unpack[Model],
+) -> Orbit:
+    """A period-n orbit by Newton shooting, with Floquet multipliers (``afmdyn orbit``).
+
+    Args:
+        period: n (1..=64); default: the period of the steady state reached from rest (or
+            the attractor's period when ``initial`` is an :class:`Attractor`), else 1.
+        initial: start of Newton's iteration (``[2N]``, an :class:`Attractor` or an
+            :class:`Orbit`); default: the steady state reached from rest.
+        tol, max_periods, max_period: steady-state detection for the default start.
+
+    Returns:
+        :class:`Orbit`; ``to_dict()`` is ``afmdyn orbit --json``. Raises
+        :class:`SimulationError` when Newton's method does not converge.
+    """
+    p = _params(params, model)
+    if period is None and isinstance(initial, Attractor):
+        period = initial.period or 1
+    d = _run(
+        _core.orbit,
+        "orbit",
+        progress,
+        p,
+        period=period,
+        initial=_state(initial),
+        tol=tol,
+        max_periods=max_periods,
+        max_period=max_period,
+    )
+    doc = json.loads(d["json"])
+    return Orbit(
+        params=p,
+        period=doc["period"],
+        state=d["state"],
+        section=d["section"],
+        poincare_v_t=np.asarray(doc["poincare"]["v_t"], dtype=np.float64),
+        poincare_w_tip=np.asarray(doc["poincare"]["w_tip"], dtype=np.float64),
+        monodromy=d["monodromy"],
+        multipliers=d["multipliers"],
+        stable=doc["stable"],
+        critical=doc["critical"],
+        grazing=doc["grazing"],
+        grazing_distance=doc["grazing_distance"],
+        switchings=doc["switchings"],
+        newton_residuals=d["newton_residuals"],
+        _json=d["json"],
+    )
+
+
+def continuation(
+    params: Optional[Params] = None,
+    /,
+    *,
+    param: str = "omega",
+    from_: float = 5.0,
+    to: float = 1.0,
+    period: Optional[int] = None,
+    switch: bool = False,
+    initial: StateLike = None,
+    tol: float = 1e-8,
+    max_periods: int = 1500,
+    max_period: int = 64,
+    progress: ProgressArg = None,
+    **model: Unpack[Model],
+) -> xr.Dataset:
+    """Pseudo-arclength continuation of a period-n branch from ``from_`` towards ``to``, with
+    located folds, period doublings, Neimark–Sacker and grazing points (``afmdyn continue``).
+
+    Args:
+        param: continued parameter (``"omega"``, ``"alpha1"``…``"alpha6"``).
+        period: n (default: the period of the steady state at ``from_``).
+        switch: at each period doubling also continue the period-2n branch.
+        initial: starting guess (``[2N]``, an :class:`Attractor` or :class:`Orbit`);
+            default: the steady state reached from rest at ``from_``.
+
+    Returns:
+        ``xarray.Dataset`` with dim ``point`` (all branches in order): ``branch`` (0 the
+        main branch, 1… switched ones), ``period``, ``s`` (arclength), ``value``, ``stable``,
+        ``max_multiplier``, ``critical``, ``switchings``, ``grazing_distance``, ``event``
+        (``""`` or ``"fold"``, ``"period-doubling"``, ``"neimark-sacker"``, ``"grazing"``);
+        ``w_tip_section`` ``[point, k]`` (W(1,τ) at the section points, NaN-padded),
+        ``multipliers`` ``[point, 2N]`` complex128, ``state`` ``[point, 2N]``.
+        ``attrs["summary"]`` is ``afmdyn continue --json``.
+    """
+    p = _params(params, model)
+    d = _run(
+        _core.continuation,
+        "continuation",
+        progress,
+        p,
+        param=param,
+        from_=from_,
+        to=to,
+        period=period,
+        switch=switch,
+        initial=_state(initial),
+        tol=tol,
+        max_periods=max_periods,
+        max_period=max_period,
+    )
+    return xr.Dataset(
+        data_vars={
+            "branch": ("point", d["branch"], {"long_name": "branch (0: the continued one)"}),
+            "period": ("point", d["period"]),
+            "s": ("point", d["s"], {"long_name": "arclength"}),
+            "stable": ("point", d["stable"]),
+            "max_multiplier": (
+                "point",
+                d["max_multiplier"],
+                {"long_name": "largest |Floquet multiplier|"},
+            ),
+            "critical": ("point", np.array(d["critical"], dtype=str)),
+            "switchings": ("point", d["switchings"], {"long_name": "switchings per cycle"}),
+            "grazing_distance": (
+                "point",
+                d["grazing_distance"],
+                {**_G, "long_name": "distance to grazing"},
+            ),
+            "event": ("point", np.array(d["event"], dtype=str)),
+            "w_tip_section": (
+                ("point", "k"),
+                d["w_tip_section"],
+                {**_G, "long_name": "W(1,τ) at the section points"},
+            ),
+            "multipliers": (
+                ("point", "multiplier"),
+                d["multipliers"],
+                {"long_name": "Floquet multipliers"},
+            ),
+            "state": (("point", "component"), d["state"], {"long_name": "state at τ = 0"}),
+        },
+        coords={"value": ("point", d["value"], {"long_name": f"{d['symbol']} ({d['param']})"})},
+        attrs=_attrs(p, param=d["param"], summary=d["json"]),
+    )
+
+
+def lyapunov(
+    params: Optional[Params] = None,
+    /,
+    *,
+    initial: StateLike = None,
+    transient: int = 500,
+    periods: int = 4000,
+    blocks: int = 10,
+    progress: ProgressArg = None,
+    **model: Unpack[Model],
+) -> Lyapunov:
+    """Lyapunov spectrum (tangent dynamics with saltation matrices) and the 0–1 test for chaos
+    (``afmdyn lyapunov``), from ``initial`` (default rest) after ``transient`` drive periods,
+    averaged over ``periods`` in ``blocks`` blocks (periods ≥ blocks ≥ 2).
+
+    Returns:
+        :class:`Lyapunov`; ``to_dict()`` is ``afmdyn lyapunov --json``.
+    """
+    p = _params(params, model)
+    d = _run(
+        _core.lyapunov,
+        "lyapunov",
+        progress,
+        p,
+        initial=_state(initial),
+        transient=transient,
+        periods=periods,
+        blocks=blocks,
+    )
+    doc = json.loads(d["json"])
+    return Lyapunov(
+        params=p,
+        exponents=d["exponents"],
+        uncertainty=d["uncertainty"],
+        volume_rate=doc["volume_rate"],
+        zero_one=float("nan") if doc["zero_one"] is None else doc["zero_one"],
+        periods=doc["periods"],
+        verdict=doc["verdict"],
+        _json=d["json"],
+    )

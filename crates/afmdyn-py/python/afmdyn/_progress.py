@@ -1,0 +1,84 @@
+"""Progress bars for long computations: tqdm in a terminal, tqdm's widget in Jupyter.
+
+The compiled core calls ``callback(done, total)`` from the calling thread about every 50 ms
+while a computation runs (``total`` is ``None`` when the work cannot be counted); the bar shows
+up only once a run has lasted ``DELAY`` seconds, so quick calls print nothing.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import sys
+from typing import Callable, Iterator, Optional, Union
+
+ProgressArg = Union[None, bool, Callable[[int, Optional[int]], object]]
+
+#: Seconds a computation runs before its bar appears (with ``progress=None``).
+DELAY = 1.0
+
+
+def _tqdm_class():
+    # a Jupyter kernel has IPython imported already; do not import it otherwise (slow)
+    ipython = sys.modules.get("IPython")
+    if ipython is not None:
+        try:
+            shell = ipython.get_ipython()
+            if shell is not None and "IPKernelApp" in shell.config:
+                import ipywidgets  # noqa: F401  (the widget bar needs it)
+                from tqdm.notebook import tqdm as notebook_tqdm
+
+                return notebook_tqdm
+        except Exception:  # no widgets: the text bar works everywhere
+            pass
+    from tqdm import tqdm as text_tqdm
+
+    return text_tqdm
+
+
+class _Bar:
+    def __init__(self, desc: str, unit: str, delay: float) -> None:
+        self.desc, self.unit, self.delay = desc, unit, delay
+        self.bar = None
+
+    def __call__(self, done: int, total: Optional[int]) -> None:
+        if self.bar is None:
+            tqdm = _tqdm_class()
+            if total is None:
+                self.bar = tqdm(
+                    total=None,
+                    desc=self.desc,
+                    delay=self.delay,
+                    bar_format="{desc}: running {elapsed}",
+                    leave=False,
+                )
+            else:
+                self.bar = tqdm(
+                    total=total, desc=self.desc, unit=self.unit, delay=self.delay, leave=True
+                )
+        self.bar.update(done - self.bar.n)
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()
+
+
+@contextlib.contextmanager
+def reporter(
+    progress: ProgressArg, desc: str, unit: str = "point"
+) -> Iterator[Optional[Callable[[int, Optional[int]], object]]]:
+    """The callback to hand to the core for ``progress``: ``None``/``True`` a tqdm bar
+    (``True`` shows it at once), ``False`` nothing, a callable is called as is."""
+    if progress is False:
+        yield None
+    elif progress is None or progress is True:
+        bar = _Bar(desc, unit, 0.0 if progress is True else DELAY)
+        try:
+            yield bar
+        finally:
+            bar.close()
+    elif callable(progress):
+        yield progress
+    else:
+        raise TypeError(
+            f"progress: expected None, True, False or a callable(done, total), got {progress!r}"
+        )

@@ -1,0 +1,920 @@
+//! The analyses, called by the pure-Python layer (`afmdyn/__init__.py`), which turns the dicts
+//! returned here into xarray datasets and result objects. Each function validates its options
+//! as the command line does, runs the library without the GIL (see [`crate::run`]) and returns
+//! NumPy arrays that own the Rust buffers, plus the command line's JSON document where it has
+//! one (`"json"`).
+
+use crate::convert::Out;
+use crate::errors::{sim_error, value_error};
+use crate::params::PyParams;
+use crate::run::{run, Job, Stop};
+use afmdyn::analysis::attractors::{find_attractors, AttractorSpec};
+use afmdyn::analysis::bifurcation::{run_sweep_cancellable, Branch, Resume, SweepPoint, SweepSpec};
+use afmdyn::analysis::continuation::{
+    continue_branch, continue_with_switching, BranchEvent, BranchPoint, ContinuationSpec,
+};
+use afmdyn::analysis::converge::mode_convergence;
+use afmdyn::analysis::lyapunov::{lyapunov_spectrum, LyapunovOptions};
+use afmdyn::analysis::shooting::{shoot, ShootingOptions};
+use afmdyn::analysis::steady::{steady_state, SteadyOptions, SteadyState};
+use afmdyn::eigen::spectrum;
+use afmdyn::integrate::{build, IntegratorKind, IntegratorOptions};
+use afmdyn::trajectory::{record, RecordSpec};
+use afmdyn::{report, CantileverModel, Params, Region, SimError, SweepParam};
+use nalgebra::DVector;
+use numpy::Complex64;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+use std::sync::atomic::Ordering;
+use std::sync::Mutex;
+
+type Dict<'py> = Bound<'py, PyDict>;
+
+/// Integrator options exactly as the command line's `IntegratorArgs::options`: `exact` refines
+/// its grid from the sampling rate, rk4 takes `steps_per_period` (default 2000). `None` is the
+/// library's default integrator.
+fn integrator_options(
+    kind: Option<&str>,
+    steps_per_period: Option<usize>,
+    tolerance: f64,
+    samples_per_period: usize,
+) -> PyResult<IntegratorOptions> {
+    let kind: IntegratorKind = match kind {
+        Some(k) => k.parse().map_err(value_error)?,
+        None => IntegratorOptions::default().kind,
+    };
+    let steps = if matches!(kind, IntegratorKind::Rk4 | IntegratorKind::Rk4Naive) {
+        steps_per_period.unwrap_or(2000)
+    } else if kind == IntegratorKind::Adaptive {
+        1
+    } else {
+        // the exact propagator (also what an automatic choice picks for the linear law)
+        samples_per_period.max(1)
+    };
+    Ok(IntegratorOptions {
+        kind,
+        steps_per_period: steps,
+        tolerance,
+    })
+}
+
+/// Steady-state options validated as the command line's `SteadyArgs::options`.
+fn steady_options(tol: f64, max_periods: usize, max_period: usize) -> PyResult<SteadyOptions> {
+    if !(tol.is_finite() && tol > 0.0) {
+        return Err(value_error(format!("tol = {tol}: must be finite and > 0")));
+    }
+    if !(1..=64).contains(&max_period) {
+        return Err(value_error(format!(
+            "max_period = {max_period}: must be in 1..=64"
+        )));
+    }
+    if max_periods == 0 {
+        return Err(value_error("max_periods = 0: must be >= 1"));
+    }
+    Ok(SteadyOptions {
+        tol,
+        max_periods,
+        max_period,
+        ..SteadyOptions::default()
+    })
+}
+
+/// The initial state: `None` is rest, else 2N values (a₁…a_N, ȧ₁…ȧ_N).
+fn initial_state(model: &CantileverModel, initial: Option<Vec<f64>>) -> PyResult<DVector<f64>> {
+    let Some(z) = initial else {
+        return Ok(model.rest());
+    };
+    let n = model.modes();
+    if z.len() != 2 * n {
+        return Err(value_error(format!(
+            "initial: expected 2N = {} values (a1..aN, adot1..adotN), got {}",
+            2 * n,
+            z.len()
+        )));
+    }
+    model.state_from(&z[..n], &z[n..]).map_err(sim_error)
+}
+
+fn model_of(p: &Params) -> PyResult<CantileverModel> {
+    CantileverModel::new(p).map_err(crate::errors::param_error)
+}
+
+fn flatten(rows: impl IntoIterator<Item = DVector<f64>>) -> Vec<f64> {
+    rows.into_iter()
+        .flat_map(|z| z.iter().copied().collect::<Vec<_>>())
+        .collect()
+}
+
+/// Natural frequencies and damped eigenvalues of the free and contact systems (eqs. 19–23).
+#[pyfunction]
+pub fn modes<'py>(py: Python<'py>, params: PyRef<'_, PyParams>) -> PyResult<Dict<'py>> {
+    let p = params.inner;
+    let (free, contact) = py
+        .detach(move || spectrum(&p))
+        .map_err(crate::errors::param_error)?;
+    let out = Out::new(py);
+    out.json(&report::modes(&p, &free, &contact))?;
+    for (name, r) in [("free", &free), ("contact", &contact)] {
+        out.f64s(&format!("{name}_omega"), r.omega.clone())?;
+        out.complex(
+            &format!("{name}_eigenvalues"),
+            r.eigenvalues
+                .iter()
+                .map(|e| Complex64::new(e.re, e.im))
+                .collect(),
+        )?;
+        out.f64s(
+            &format!("{name}_zeta"),
+            r.eigenvalues.iter().map(|e| e.zeta).collect(),
+        )?;
+    }
+    Ok(out.finish())
+}
+
+/// The columns of a recorded run, built on the worker thread.
+struct SimColumns {
+    doc: serde_json::Value,
+    n: usize,
+    tau: Vec<f64>,
+    v_t: Vec<f64>,
+    v_t_dot: Vec<f64>,
+    w_tip: Vec<f64>,
+    w_tip_dot: Vec<f64>,
+    in_contact: Vec<bool>,
+    contact_force: Vec<f64>,
+    a: Vec<f64>,
+    a_dot: Vec<f64>,
+    event_tau: Vec<f64>,
+    event_to_contact: Vec<bool>,
+    event_v_t_dot: Vec<f64>,
+    section_tau: Vec<f64>,
+    section_v_t: Vec<f64>,
+    section_w_tip: Vec<f64>,
+    section_w_tip_dot: Vec<f64>,
+    section_state: Vec<f64>,
+    energy: [Vec<f64>; 7],
+    tau_end: f64,
+    switchings: usize,
+    body_contact: bool,
+    integrator: &'static str,
+}
+
+fn simulate_columns(
+    p: Params,
+    z0: Option<Vec<f64>>,
+    opts: IntegratorOptions,
+    spec: RecordSpec,
+) -> PyResult<SimColumns> {
+    let model = model_of(&p)?;
+    let z0 = initial_state(&model, z0)?;
+    let mut integ = build(&model, opts, 0.0, &z0).map_err(sim_error)?;
+    let tr = record(integ.as_mut(), &spec).map_err(sim_error)?;
+    let n = model.modes();
+    let len = tr.samples.len();
+    let mut c = SimColumns {
+        doc: report::simulate(&model, &tr),
+        n,
+        tau: Vec::with_capacity(len),
+        v_t: Vec::with_capacity(len),
+        v_t_dot: Vec::with_capacity(len),
+        w_tip: Vec::with_capacity(len),
+        w_tip_dot: Vec::with_capacity(len),
+        in_contact: Vec::with_capacity(len),
+        contact_force: Vec::with_capacity(len),
+        a: Vec::with_capacity(len * n),
+        a_dot: Vec::with_capacity(len * n),
+        event_tau: tr.events.iter().map(|e| e.tau).collect(),
+        event_to_contact: tr.events.iter().map(|e| e.to == Region::Contact).collect(),
+        event_v_t_dot: tr.events.iter().map(|e| e.v_t_dot).collect(),
+        section_tau: tr.poincare.iter().map(|(t, _)| *t).collect(),
+        section_v_t: tr.poincare.iter().map(|(t, z)| model.v_t(*t, z)).collect(),
+        section_w_tip: tr.poincare.iter().map(|(_, z)| model.w_tip(z)).collect(),
+        section_w_tip_dot: tr
+            .poincare
+            .iter()
+            .map(|(_, z)| model.w_tip_dot(z))
+            .collect(),
+        section_state: flatten(tr.poincare.iter().map(|(_, z)| z.clone())),
+        energy: [
+            tr.energy.iter().map(|e| e.tau0).collect(),
+            tr.energy.iter().map(|e| e.e_start).collect(),
+            tr.energy.iter().map(|e| e.e_end).collect(),
+            tr.energy.iter().map(|e| e.base_work).collect(),
+            tr.energy.iter().map(|e| e.beam_dissipation).collect(),
+            tr.energy.iter().map(|e| e.contact_dissipation).collect(),
+            tr.energy.iter().map(|e| e.residual()).collect(),
+        ],
+        tau_end: tr.tau_end,
+        switchings: tr.events.len(),
+        body_contact: tr.body_contact,
+        integrator: integ.name(),
+    };
+    for s in &tr.samples {
+        c.tau.push(s.tau);
+        c.v_t.push(s.v_t);
+        c.v_t_dot.push(model.v_t_dot(s.tau, &s.state));
+        c.w_tip.push(s.w_tip);
+        c.w_tip_dot.push(s.w_tip_dot);
+        c.in_contact.push(s.region == Region::Contact);
+        c.contact_force.push(s.contact_force);
+        c.a.extend(s.state.rows(0, n).iter());
+        c.a_dot.extend(s.state.rows(n, n).iter());
+    }
+    Ok(c)
+}
+
+/// One trajectory: time series, switchings, stroboscopic section and energy balance.
+#[pyfunction]
+#[pyo3(signature = (params, periods=None, tau_end=None, transient=0.0, initial=None,
+    samples_per_period=200, integrator=None, steps_per_period=None, tolerance=1e-12,
+    progress=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn simulate<'py>(
+    py: Python<'py>,
+    params: PyRef<'_, PyParams>,
+    periods: Option<f64>,
+    tau_end: Option<f64>,
+    transient: f64,
+    initial: Option<Vec<f64>>,
+    samples_per_period: usize,
+    integrator: Option<&str>,
+    steps_per_period: Option<usize>,
+    tolerance: f64,
+    progress: Option<Bound<'py, PyAny>>,
+) -> PyResult<Dict<'py>> {
+    let p = params.inner;
+    if samples_per_period == 0 || samples_per_period > 100_000 {
+        return Err(value_error(format!(
+            "samples_per_period = {samples_per_period}: must be in 1..=100000"
+        )));
+    }
+    if !(transient.is_finite() && transient >= 0.0) {
+        return Err(value_error(format!(
+            "transient = {transient}: must be finite and >= 0"
+        )));
+    }
+    let t_transient = transient * p.period();
+    let record_tau = match (periods, tau_end) {
+        (Some(_), Some(_)) => return Err(value_error("give periods or tau_end, not both")),
+        (Some(n), None) if n.is_finite() && n > 0.0 => n * p.period(),
+        (Some(n), None) => {
+            return Err(value_error(format!(
+                "periods = {n}: must be finite and > 0"
+            )))
+        }
+        (None, Some(t)) if t.is_finite() && t > t_transient => t - t_transient,
+        (None, Some(t)) => {
+            return Err(value_error(format!(
+                "tau_end = {t}: must be finite and > the transient ({t_transient})"
+            )))
+        }
+        (None, None) => 50.0 * p.period(),
+    };
+    let opts = integrator_options(integrator, steps_per_period, tolerance, samples_per_period)?;
+    let spec = RecordSpec {
+        transient_periods: transient,
+        record_tau,
+        samples_per_period,
+        energy: true,
+        body_contact: true,
+    };
+    let c = run(
+        py,
+        &Job::default(),
+        None,
+        progress.as_ref(),
+        Stop::Abandon,
+        move || simulate_columns(p, initial, opts, spec),
+    )??;
+    let out = Out::new(py);
+    out.json(&c.doc)?;
+    let s = c.tau.len();
+    let n = c.n;
+    out.f64s("tau", c.tau)?;
+    out.f64s("v_t", c.v_t)?;
+    out.f64s("v_t_dot", c.v_t_dot)?;
+    out.f64s("w_tip", c.w_tip)?;
+    out.f64s("w_tip_dot", c.w_tip_dot)?;
+    out.bools("in_contact", c.in_contact)?;
+    out.f64s("contact_force", c.contact_force)?;
+    out.matrix("a", s, n, c.a)?;
+    out.matrix("a_dot", s, n, c.a_dot)?;
+    out.f64s("event_tau", c.event_tau)?;
+    out.bools("event_to_contact", c.event_to_contact)?;
+    out.f64s("event_v_t_dot", c.event_v_t_dot)?;
+    let ps = c.section_tau.len();
+    out.f64s("section_tau", c.section_tau)?;
+    out.f64s("section_v_t", c.section_v_t)?;
+    out.f64s("section_w_tip", c.section_w_tip)?;
+    out.f64s("section_w_tip_dot", c.section_w_tip_dot)?;
+    out.matrix("section_state", ps, 2 * n, c.section_state)?;
+    let [tau0, e_start, e_end, base, beam, contact, residual] = c.energy;
+    out.f64s("energy_tau0", tau0)?;
+    out.f64s("energy_start", e_start)?;
+    out.f64s("energy_end", e_end)?;
+    out.f64s("base_work", base)?;
+    out.f64s("beam_dissipation", beam)?;
+    out.f64s("contact_dissipation", contact)?;
+    out.f64s("energy_residual", residual)?;
+    out.set("tau_end", c.tau_end)?;
+    out.set("switchings", c.switchings)?;
+    out.set("body_contact", c.body_contact)?;
+    out.set("integrator", c.integrator)?;
+    out.set("transient_tau", t_transient)?;
+    Ok(out.finish())
+}
+
+/// Mode-number convergence (paper Fig. 4).
+#[pyfunction]
+#[pyo3(signature = (params, max_modes=4, periods=1, samples_per_period=200, integrator=None,
+    steps_per_period=None, tolerance=1e-12, progress=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn converge<'py>(
+    py: Python<'py>,
+    params: PyRef<'_, PyParams>,
+    max_modes: usize,
+    periods: usize,
+    samples_per_period: usize,
+    integrator: Option<&str>,
+    steps_per_period: Option<usize>,
+    tolerance: f64,
+    progress: Option<Bound<'py, PyAny>>,
+) -> PyResult<Dict<'py>> {
+    let p = params.inner;
+    if !(1..=afmdyn::params::MAX_MODES).contains(&max_modes) {
+        return Err(value_error(format!(
+            "max_modes = {max_modes}: must be in 1..=20"
+        )));
+    }
+    let opts = integrator_options(integrator, steps_per_period, tolerance, samples_per_period)?;
+    let runs = run(
+        py,
+        &Job::default(),
+        None,
+        progress.as_ref(),
+        Stop::Abandon,
+        move || {
+            mode_convergence(
+                &p,
+                max_modes,
+                periods,
+                samples_per_period,
+                &SteadyOptions::default(),
+                opts,
+            )
+        },
+    )?
+    .map_err(sim_error)?;
+    let out = Out::new(py);
+    out.json(&report::converge(&p, &runs))?;
+    let k = runs.iter().map(|r| r.w_tip.len()).min().unwrap_or(0);
+    let r = runs.len();
+    let t0 = runs[0].tau[0];
+    out.f64s(
+        "tau_from_section",
+        runs[0].tau[..k].iter().map(|t| t - t0).collect(),
+    )?;
+    let grab = |f: &dyn Fn(&afmdyn::analysis::converge::ConvergenceRun) -> &Vec<f64>| {
+        runs.iter()
+            .flat_map(|x| f(x)[..k].to_vec())
+            .collect::<Vec<f64>>()
+    };
+    out.matrix("tau", r, k, grab(&|x| &x.tau))?;
+    out.matrix("w_tip", r, k, grab(&|x| &x.w_tip))?;
+    out.matrix("v_t", r, k, grab(&|x| &x.v_t))?;
+    out.i64s("modes", runs.iter().map(|x| x.modes as i64).collect())?;
+    out.i64s(
+        "period",
+        runs.iter()
+            .map(|x| x.period.map_or(-1, |n| n as i64))
+            .collect(),
+    )?;
+    out.f64s(
+        "rms_change",
+        runs.iter()
+            .map(|x| x.rms_change.unwrap_or(f64::NAN))
+            .collect(),
+    )?;
+    Ok(out.finish())
+}
+
+fn branch_order(b: Branch) -> (u8, u32) {
+    match b {
+        Branch::Forward => (0, 0),
+        Branch::Backward => (1, 0),
+        Branch::Start(k) => (2, k),
+    }
+}
+
+/// A bifurcation diagram: the steady state at each parameter value, one row per section point
+/// (the command line's `bifurcation.csv`, sorted by branch then index).
+#[pyfunction]
+#[pyo3(signature = (params, param="omega", values=None, from_=1.0, to=5.0, steps=400, starts=0,
+    seed=1, continuation=true, threads=None, tol=1e-8, max_periods=1500, max_period=64,
+    integrator=None, steps_per_period=None, tolerance=1e-12, progress=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn bifurcation<'py>(
+    py: Python<'py>,
+    params: PyRef<'_, PyParams>,
+    param: &str,
+    values: Option<Vec<f64>>,
+    from_: f64,
+    to: f64,
+    steps: usize,
+    starts: u32,
+    seed: u64,
+    continuation: bool,
+    threads: Option<usize>,
+    tol: f64,
+    max_periods: usize,
+    max_period: usize,
+    integrator: Option<&str>,
+    steps_per_period: Option<usize>,
+    tolerance: f64,
+    progress: Option<Bound<'py, PyAny>>,
+) -> PyResult<Dict<'py>> {
+    let param: SweepParam = param.parse().map_err(value_error)?;
+    let values = match values {
+        Some(v) if v.is_empty() => return Err(value_error("values: must not be empty")),
+        Some(v) => v,
+        None => SweepSpec::linspace(from_, to, steps).map_err(sim_error)?,
+    };
+    let spec = SweepSpec {
+        base: params.inner,
+        param,
+        values,
+        continuation,
+        starts,
+        seed,
+        steady: steady_options(tol, max_periods, max_period)?,
+        integrator: integrator_options(integrator, steps_per_period, tolerance, 1)?,
+    };
+    spec.validate().map_err(sim_error)?;
+    if threads == Some(0) {
+        return Err(value_error("threads = 0: must be >= 1"));
+    }
+    let total = spec.values.len() * (usize::from(spec.continuation) * 2 + spec.starts as usize);
+    let job = Job::default();
+    let worker_job = job.clone();
+    let worker_spec = spec.clone();
+    let points = run(
+        py,
+        &job,
+        Some(total),
+        progress.as_ref(),
+        Stop::Cancellable,
+        move || -> Result<Vec<SweepPoint>, String> {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads.unwrap_or(0))
+                .build()
+                .map_err(|e| e.to_string())?;
+            let found = Mutex::new(Vec::with_capacity(total));
+            let sink = |pt: SweepPoint| {
+                found.lock().expect("points").push(pt);
+                worker_job.done.fetch_add(1, Ordering::Relaxed);
+            };
+            pool.install(|| {
+                run_sweep_cancellable(&worker_spec, &Resume::default(), &sink, &worker_job.cancel)
+            });
+            Ok(found.into_inner().expect("points"))
+        },
+    )?
+    .map_err(pyo3::exceptions::PyRuntimeError::new_err)?;
+    let mut points = points;
+    points.sort_by_key(|pt| (branch_order(pt.branch), pt.index));
+    let n = spec.base.modes;
+    let rows: usize = points
+        .iter()
+        .map(|pt| pt.result.as_ref().map_or(1, |s| s.poincare.len()))
+        .sum();
+    let mut value = Vec::with_capacity(rows);
+    let mut index = Vec::with_capacity(rows);
+    let mut branch = Vec::with_capacity(rows);
+    let mut status = Vec::with_capacity(rows);
+    let mut period = Vec::with_capacity(rows);
+    let mut k = Vec::with_capacity(rows);
+    let mut n_points = Vec::with_capacity(rows);
+    let mut cols: [Vec<f64>; 7] = Default::default();
+    let mut transient = Vec::with_capacity(rows);
+    let mut message = Vec::with_capacity(rows);
+    let mut state = vec![Vec::with_capacity(rows); 2 * n];
+    for pt in &points {
+        match &pt.result {
+            Err(msg) => {
+                value.push(pt.value);
+                index.push(pt.index as i64);
+                branch.push(pt.branch.to_string());
+                status.push("error");
+                period.push(-2i64);
+                k.push(0i64);
+                n_points.push(1i64);
+                for c in cols.iter_mut() {
+                    c.push(f64::NAN);
+                }
+                transient.push(-1i64);
+                message.push(msg.clone());
+                for c in state.iter_mut() {
+                    c.push(f64::NAN);
+                }
+            }
+            Ok(s) => {
+                let (st, per) = match s.period() {
+                    Some(m) => ("periodic", m as i64),
+                    None => ("nonperiodic", -1),
+                };
+                for (i, q) in s.poincare.iter().enumerate() {
+                    value.push(pt.value);
+                    index.push(pt.index as i64);
+                    branch.push(pt.branch.to_string());
+                    status.push(st);
+                    period.push(per);
+                    k.push(i as i64);
+                    n_points.push(s.poincare.len() as i64);
+                    for (c, v) in cols.iter_mut().zip([
+                        q.tau,
+                        q.v_t,
+                        q.w_tip,
+                        s.stats.x_max,
+                        s.stats.v_t_min,
+                        s.stats.contact_fraction,
+                        s.stats.contacts_per_period,
+                    ]) {
+                        c.push(v);
+                    }
+                    transient.push(s.transient_periods as i64);
+                    message.push(String::new());
+                    for (c, v) in state.iter_mut().zip(q.state.iter()) {
+                        c.push(*v);
+                    }
+                }
+            }
+        }
+    }
+    let out = Out::new(py);
+    out.set("param", param.name())?;
+    out.set("symbol", param.symbol())?;
+    out.f64s("values", spec.values.clone())?;
+    out.f64s("value", value)?;
+    out.i64s("index", index)?;
+    out.set("branch", PyList::new(py, branch)?)?;
+    out.set("status", PyList::new(py, status)?)?;
+    out.i64s("period", period)?;
+    out.i64s("k", k)?;
+    out.i64s("n_points", n_points)?;
+    let [tau, v_t, w_tip, x_max, v_t_min, contact_fraction, contacts_per_period] = cols;
+    out.f64s("tau", tau)?;
+    out.f64s("v_t", v_t)?;
+    out.f64s("w_tip", w_tip)?;
+    out.f64s("x_max", x_max)?;
+    out.f64s("v_t_min", v_t_min)?;
+    out.f64s("contact_fraction", contact_fraction)?;
+    out.f64s("contacts_per_period", contacts_per_period)?;
+    out.i64s("transient_periods", transient)?;
+    out.set("message", PyList::new(py, message)?)?;
+    let state_list = PyList::empty(py);
+    for c in state {
+        state_list.append(numpy::IntoPyArray::into_pyarray(c, py))?;
+    }
+    out.set("state", state_list)?;
+    Ok(out.finish())
+}
+
+fn steady_dict<'py>(py: Python<'py>, s: &SteadyState) -> PyResult<Dict<'py>> {
+    let out = Out::new(py);
+    out.set("period", s.period())?;
+    out.set("transient_periods", s.transient_periods)?;
+    out.f64s("section_tau", s.poincare.iter().map(|q| q.tau).collect())?;
+    out.f64s("section_v_t", s.poincare.iter().map(|q| q.v_t).collect())?;
+    out.f64s(
+        "section_w_tip",
+        s.poincare.iter().map(|q| q.w_tip).collect(),
+    )?;
+    let dim = s.poincare.first().map_or(0, |q| q.state.len());
+    out.matrix(
+        "section_state",
+        s.poincare.len(),
+        dim,
+        flatten(s.poincare.iter().map(|q| q.state.clone())),
+    )?;
+    let st = &s.stats;
+    out.set("x_max", st.x_max)?;
+    out.set("x_min", st.x_min)?;
+    out.set("v_t_min", st.v_t_min)?;
+    out.set("contact_fraction", st.contact_fraction)?;
+    out.set("contacts_per_period", st.contacts_per_period)?;
+    out.set("body_contact", st.body_contact)?;
+    Ok(out.finish())
+}
+
+/// Coexisting attractors and their basin fractions at fixed parameters.
+#[pyfunction]
+#[pyo3(signature = (params, samples=64, seed=1, cluster_tol=1e-5, tol=1e-8, max_periods=1500,
+    max_period=64, integrator=None, steps_per_period=None, tolerance=1e-12, progress=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn attractors<'py>(
+    py: Python<'py>,
+    params: PyRef<'_, PyParams>,
+    samples: usize,
+    seed: u64,
+    cluster_tol: f64,
+    tol: f64,
+    max_periods: usize,
+    max_period: usize,
+    integrator: Option<&str>,
+    steps_per_period: Option<usize>,
+    tolerance: f64,
+    progress: Option<Bound<'py, PyAny>>,
+) -> PyResult<Dict<'py>> {
+    let p = params.inner;
+    // the command line samples its attractor plots at 200 per period and builds the integrator
+    // for that rate; the same options give the same attractors
+    let spec = AttractorSpec {
+        params: p,
+        samples,
+        seed,
+        cluster_tol,
+        steady: steady_options(tol, max_periods, max_period)?,
+        integrator: integrator_options(integrator, steps_per_period, tolerance, 200)?,
+    };
+    let report_ = run(
+        py,
+        &Job::default(),
+        None,
+        progress.as_ref(),
+        Stop::Abandon,
+        move || find_attractors(&spec),
+    )?
+    .map_err(sim_error)?;
+    let out = Out::new(py);
+    out.json(&report::attractors(&p, samples, &report_))?;
+    let list = PyList::empty(py);
+    for a in &report_.attractors {
+        let d = steady_dict(py, &a.steady)?;
+        d.set_item("count", a.count)?;
+        d.set_item("basin_fraction", a.basin_fraction)?;
+        d.set_item(
+            "initial",
+            numpy::IntoPyArray::into_pyarray(a.initial.as_slice().to_vec(), py),
+        )?;
+        list.append(d)?;
+    }
+    out.set("attractors", list)?;
+    out.set("failures", PyList::new(py, &report_.failures)?)?;
+    Ok(out.finish())
+}
+
+/// The guess of the orbit commands: the given state, or the end of the steady state reached
+/// from rest, with its period (the command line's `StartArgs::guess`).
+fn guess(
+    model: &CantileverModel,
+    initial: Option<Vec<f64>>,
+    steady: &SteadyOptions,
+) -> PyResult<(DVector<f64>, Option<usize>)> {
+    let given = initial.is_some();
+    let z0 = initial_state(model, initial)?;
+    if given {
+        return Ok((z0, None));
+    }
+    let mut integ = build(model, IntegratorOptions::default(), 0.0, &z0).map_err(sim_error)?;
+    let s = steady_state(integ.as_mut(), steady).map_err(sim_error)?;
+    Ok((s.end_state().clone(), s.period()))
+}
+
+/// A period-n orbit by Newton shooting, with its Floquet multipliers.
+#[pyfunction]
+#[pyo3(signature = (params, period=None, initial=None, tol=1e-8, max_periods=1500,
+    max_period=64, progress=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn orbit<'py>(
+    py: Python<'py>,
+    params: PyRef<'_, PyParams>,
+    period: Option<usize>,
+    initial: Option<Vec<f64>>,
+    tol: f64,
+    max_periods: usize,
+    max_period: usize,
+    progress: Option<Bound<'py, PyAny>>,
+) -> PyResult<Dict<'py>> {
+    let p = params.inner;
+    let steady = steady_options(tol, max_periods, max_period)?;
+    if let Some(n) = period {
+        if !(1..=64).contains(&n) {
+            return Err(value_error(format!("period = {n}: must be in 1..=64")));
+        }
+    }
+    let (doc, o) = run(
+        py,
+        &Job::default(),
+        None,
+        progress.as_ref(),
+        Stop::Abandon,
+        move || -> PyResult<_> {
+            let model = model_of(&p)?;
+            let (z, found) = guess(&model, initial, &steady)?;
+            let n = period.or(found).unwrap_or(1);
+            let o = shoot(&model, &z, n, &ShootingOptions::default()).map_err(sim_error)?;
+            Ok((report::orbit(&model, &o), o))
+        },
+    )??;
+    let out = Out::new(py);
+    out.json(&doc)?;
+    let dim = o.state.len();
+    out.f64s("state", o.state.as_slice().to_vec())?;
+    out.matrix("section", o.section.len(), dim, flatten(o.section.clone()))?;
+    // nalgebra stores column-major: transpose into a row-major (C-ordered) buffer
+    out.matrix(
+        "monodromy",
+        dim,
+        dim,
+        o.monodromy.transpose().as_slice().to_vec(),
+    )?;
+    out.complex(
+        "multipliers",
+        o.multipliers
+            .iter()
+            .map(|m| Complex64::new(m.re, m.im))
+            .collect(),
+    )?;
+    out.f64s("newton_residuals", o.residuals.clone())?;
+    Ok(out.finish())
+}
+
+fn event_name(e: BranchEvent) -> String {
+    serde_json::to_value(e)
+        .ok()
+        .and_then(|v| v.as_str().map(String::from))
+        .unwrap_or_default()
+}
+
+/// Continuation, and with `switch` the period-doubling cascade to period 8n, as the command
+/// line's `afmdyn continue --switch` ([`continue_with_switching`]).
+fn continue_and_switch(
+    spec: &ContinuationSpec,
+    guess: &DVector<f64>,
+    switch: bool,
+) -> Result<Vec<Vec<BranchPoint>>, SimError> {
+    if switch {
+        continue_with_switching(spec, guess, 8 * spec.period)
+    } else {
+        Ok(vec![continue_branch(spec, guess)?])
+    }
+}
+
+/// Pseudo-arclength continuation of a period-n branch, with located bifurcations.
+#[pyfunction]
+#[pyo3(signature = (params, param="omega", from_=5.0, to=1.0, period=None, switch=false,
+    initial=None, tol=1e-8, max_periods=1500, max_period=64, progress=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn continuation<'py>(
+    py: Python<'py>,
+    params: PyRef<'_, PyParams>,
+    param: &str,
+    from_: f64,
+    to: f64,
+    period: Option<usize>,
+    switch: bool,
+    initial: Option<Vec<f64>>,
+    tol: f64,
+    max_periods: usize,
+    max_period: usize,
+    progress: Option<Bound<'py, PyAny>>,
+) -> PyResult<Dict<'py>> {
+    let base = params.inner;
+    let param: SweepParam = param.parse().map_err(value_error)?;
+    let p0 = base.with(param, from_);
+    p0.validate().map_err(crate::errors::param_error)?;
+    base.with(param, to)
+        .validate()
+        .map_err(crate::errors::param_error)?;
+    let steady = steady_options(tol, max_periods, max_period)?;
+    if period == Some(0) {
+        return Err(value_error("period = 0: must be >= 1"));
+    }
+    let branches = run(
+        py,
+        &Job::default(),
+        None,
+        progress.as_ref(),
+        Stop::Abandon,
+        move || -> PyResult<_> {
+            let model = model_of(&p0)?;
+            let (z, found) = guess(&model, initial, &steady)?;
+            let n = period.or(found).unwrap_or(1);
+            let spec = ContinuationSpec::new(base, param, from_, to, n);
+            continue_and_switch(&spec, &z, switch).map_err(sim_error)
+        },
+    )??;
+    let model = model_of(&p0)?;
+    let dim = 2 * base.modes;
+    let rows: usize = branches.iter().map(Vec::len).sum();
+    let width = branches
+        .iter()
+        .flatten()
+        .map(|b| b.section.len())
+        .max()
+        .unwrap_or(1);
+    let mut id = Vec::with_capacity(rows);
+    let mut per = Vec::with_capacity(rows);
+    let mut s = Vec::with_capacity(rows);
+    let mut value = Vec::with_capacity(rows);
+    let mut stable = Vec::with_capacity(rows);
+    let mut max_mult = Vec::with_capacity(rows);
+    let mut critical = Vec::with_capacity(rows);
+    let mut switchings = Vec::with_capacity(rows);
+    let mut grazing = Vec::with_capacity(rows);
+    let mut event = Vec::with_capacity(rows);
+    let mut w_section = Vec::with_capacity(rows * width);
+    let mut mult = Vec::with_capacity(rows * dim);
+    let mut state = Vec::with_capacity(rows * dim);
+    for (i, br) in branches.iter().enumerate() {
+        for b in br {
+            id.push(i as i64);
+            per.push(b.period as i64);
+            s.push(b.s);
+            value.push(b.value);
+            stable.push(b.stable);
+            max_mult.push(b.multipliers[0].norm());
+            critical.push(
+                serde_json::to_value(b.critical)
+                    .ok()
+                    .and_then(|v| v.as_str().map(String::from))
+                    .unwrap_or_default(),
+            );
+            switchings.push(b.switchings as i64);
+            grazing.push(b.grazing_distance);
+            event.push(b.event.map_or(String::new(), event_name));
+            for j in 0..width {
+                w_section.push(b.section.get(j).map_or(f64::NAN, |z| model.w_tip(z)));
+            }
+            for j in 0..dim {
+                mult.push(
+                    b.multipliers
+                        .get(j)
+                        .map_or(Complex64::new(f64::NAN, f64::NAN), |m| {
+                            Complex64::new(m.re, m.im)
+                        }),
+                );
+            }
+            state.extend(b.section[0].iter());
+        }
+    }
+    let out = Out::new(py);
+    out.json(&report::continuation(&base, param, &branches))?;
+    out.set("param", param.name())?;
+    out.set("symbol", param.symbol())?;
+    out.i64s("branch", id)?;
+    out.i64s("period", per)?;
+    out.f64s("s", s)?;
+    out.f64s("value", value)?;
+    out.bools("stable", stable)?;
+    out.f64s("max_multiplier", max_mult)?;
+    out.set("critical", PyList::new(py, critical)?)?;
+    out.i64s("switchings", switchings)?;
+    out.f64s("grazing_distance", grazing)?;
+    out.set("event", PyList::new(py, event)?)?;
+    out.matrix("w_tip_section", rows, width, w_section)?;
+    let m = numpy::ndarray::Array2::from_shape_vec((rows, dim), mult).expect("rows × 2N");
+    out.set("multipliers", numpy::IntoPyArray::into_pyarray(m, py))?;
+    out.matrix("state", rows, dim, state)?;
+    Ok(out.finish())
+}
+
+/// Lyapunov spectrum (with saltation matrices) and the 0–1 test.
+#[pyfunction]
+#[pyo3(signature = (params, initial=None, transient=500, periods=4000, blocks=10, progress=None))]
+pub fn lyapunov<'py>(
+    py: Python<'py>,
+    params: PyRef<'_, PyParams>,
+    initial: Option<Vec<f64>>,
+    transient: usize,
+    periods: usize,
+    blocks: usize,
+    progress: Option<Bound<'py, PyAny>>,
+) -> PyResult<Dict<'py>> {
+    let p = params.inner;
+    // the remaining options (if the library adds any) keep their defaults, as on the command line
+    #[allow(clippy::needless_update)]
+    let opts = LyapunovOptions {
+        transient_periods: transient,
+        periods,
+        blocks,
+        ..LyapunovOptions::default()
+    };
+    let l = run(
+        py,
+        &Job::default(),
+        None,
+        progress.as_ref(),
+        Stop::Abandon,
+        move || -> PyResult<_> {
+            let model = model_of(&p)?;
+            let z0 = initial_state(&model, initial)?;
+            lyapunov_spectrum(&model, &z0, &opts).map_err(sim_error)
+        },
+    )??;
+    let out = Out::new(py);
+    out.json(&report::lyapunov(&p, &l))?;
+    out.f64s("exponents", l.exponents.clone())?;
+    out.f64s("uncertainty", l.uncertainty.clone())?;
+    Ok(out.finish())
+}

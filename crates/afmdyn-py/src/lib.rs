@@ -1,0 +1,41 @@
+//! `afmdyn._afmdyn`: the compiled part of the Python package `afmdyn`.
+//!
+//! The pure-Python layer (`python/afmdyn/`) is the public API; it calls these functions, which
+//! run the library's analyses with the GIL released and return dicts of NumPy arrays (owning
+//! the Rust buffers) and the command line's JSON documents, and turns them into xarray
+//! datasets and result objects.
+
+mod analyses;
+mod convert;
+mod errors;
+mod params;
+mod run;
+
+use pyo3::prelude::*;
+
+/// Compiled core of afmdyn (use the `afmdyn` package, not this module).
+#[pymodule]
+fn _afmdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<params::PyParams>()?;
+    m.add(
+        "SimulationError",
+        m.py().get_type::<errors::SimulationError>(),
+    )?;
+    m.add_function(wrap_pyfunction!(analyses::modes, m)?)?;
+    m.add_function(wrap_pyfunction!(analyses::simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(analyses::converge, m)?)?;
+    m.add_function(wrap_pyfunction!(analyses::bifurcation, m)?)?;
+    m.add_function(wrap_pyfunction!(analyses::attractors, m)?)?;
+    m.add_function(wrap_pyfunction!(analyses::orbit, m)?)?;
+    m.add_function(wrap_pyfunction!(analyses::continuation, m)?)?;
+    m.add_function(wrap_pyfunction!(analyses::lyapunov, m)?)?;
+    m.add("POLL_SECONDS", run::POLL.as_secs_f64())?;
+    m.add(
+        "MODEL_KEYWORDS",
+        params::MODEL_KEYWORDS
+            .iter()
+            .map(|(name, alias, doc)| (*name, *alias, *doc))
+            .collect::<Vec<_>>(),
+    )?;
+    Ok(())
+}

@@ -1,0 +1,390 @@
+//! `afmdyn.Params` and the one place where Python keyword arguments become an
+//! [`afmdyn::Params`]: [`params_from_kwargs`].
+
+use crate::errors::param_error;
+use afmdyn::Params;
+use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyBool, PyDict, PyString};
+
+/// The model keywords: (canonical snake_case name, paper alias, what it is).
+pub const MODEL_KEYWORDS: [(&str, &str, &str); 12] = [
+    ("modes", "modes", "number of Galerkin modes N, 1..=20"),
+    (
+        "tip_mass_ratio",
+        "alpha1",
+        "tip-mass ratio α1 = M/(mL), >= 0",
+    ),
+    (
+        "drive_amplitude",
+        "alpha2",
+        "base-drive amplitude α2 = f/g0, >= 0",
+    ),
+    ("beam_damping", "alpha3", "beam damping α3, >= 0"),
+    (
+        "contact_stiffness",
+        "alpha4",
+        "contact stiffness α4 = K1 L³/(EI), >= 0",
+    ),
+    (
+        "gap",
+        "alpha5",
+        "tip–sample gap α5 = g1/g0, any finite value",
+    ),
+    ("contact_damping", "alpha6", "contact damping α6, >= 0"),
+    ("omega", "omega", "dimensionless drive frequency Ω, > 0"),
+    (
+        "contact_law",
+        "contact_law",
+        "tip–sample law: linear, hertz, dmt or impact",
+    ),
+    (
+        "restitution",
+        "restitution",
+        "impact law: coefficient of restitution r, 0..=1",
+    ),
+    ("hamaker", "hamaker", "DMT: van der Waals group H̃, >= 0"),
+    (
+        "intermolecular_distance",
+        "intermolecular_distance",
+        "DMT: intermolecular distance ã0 = a0/g0, > 0",
+    ),
+];
+
+fn keyword_list() -> String {
+    MODEL_KEYWORDS
+        .iter()
+        .map(|(name, alias, _)| {
+            if name == alias {
+                (*name).to_string()
+            } else {
+                format!("{name} ({alias})")
+            }
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+fn float(name: &str, v: &Bound<'_, PyAny>) -> PyResult<f64> {
+    if v.is_instance_of::<PyBool>() || v.is_instance_of::<PyString>() {
+        return Err(PyTypeError::new_err(format!(
+            "{name}: expected a number, got {}",
+            v.get_type().name()?
+        )));
+    }
+    v.extract::<f64>().map_err(|_| {
+        PyTypeError::new_err(format!(
+            "{name}: expected a number, got {}",
+            v.get_type()
+                .name()
+                .map(|n| n.to_string())
+                .unwrap_or_default()
+        ))
+    })
+}
+
+fn integer(name: &str, v: &Bound<'_, PyAny>) -> PyResult<i64> {
+    if v.is_instance_of::<PyBool>() {
+        return Err(PyTypeError::new_err(format!(
+            "{name}: expected an integer, got bool"
+        )));
+    }
+    v.extract::<i64>().map_err(|_| {
+        PyTypeError::new_err(format!(
+            "{name}: expected an integer, got {}",
+            v.get_type()
+                .name()
+                .map(|n| n.to_string())
+                .unwrap_or_default()
+        ))
+    })
+}
+
+/// `base` with the model keywords in `kwargs` applied, validated. Every Python entry point
+/// (the `Params` constructor, `Params.replace`, the `**model` keywords of every analysis) goes
+/// through here, so a new model field needs one new arm.
+///
+/// Keywords: the command line's flag names in snake_case (`tip_mass_ratio`, …) or the paper's
+/// `alpha1`…`alpha6`, plus `modes` and `omega`.
+///
+/// # Errors
+/// `TypeError` for an unknown keyword or a value of the wrong type, `ValueError` for a value
+/// out of range or a field given twice (name and alias), naming the field and its range.
+pub fn params_from_kwargs(base: Params, kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<Params> {
+    let mut p = base;
+    let mut seen: Vec<(&str, String)> = Vec::new();
+    let (mut law, mut restitution, mut hamaker, mut a0) = (None, None, None, None);
+    if let Some(kw) = kwargs {
+        for (k, v) in kw.iter() {
+            let key: String = k
+                .extract()
+                .map_err(|_| PyTypeError::new_err("parameter names must be strings"))?;
+            let canonical = MODEL_KEYWORDS
+                .iter()
+                .find(|(name, alias, _)| key == *name || key == *alias)
+                .map(|(name, _, _)| *name)
+                .ok_or_else(|| {
+                    PyTypeError::new_err(format!(
+                        "unknown model parameter '{key}': expected {}",
+                        keyword_list()
+                    ))
+                })?;
+            if let Some((_, first)) = seen.iter().find(|(c, _)| *c == canonical) {
+                return Err(PyValueError::new_err(format!(
+                    "{key} and {first} both given: they are the same parameter"
+                )));
+            }
+            seen.push((canonical, key.clone()));
+            match canonical {
+                "modes" => {
+                    let n = integer(&key, &v)?;
+                    p.modes = usize::try_from(n).map_err(|_| {
+                        PyValueError::new_err(format!(
+                            "modes = {n}: the number of Galerkin modes N must be an integer in 1..=20"
+                        ))
+                    })?;
+                }
+                "tip_mass_ratio" => p.alpha1 = float(&key, &v)?,
+                "drive_amplitude" => p.alpha2 = float(&key, &v)?,
+                "beam_damping" => p.alpha3 = float(&key, &v)?,
+                "contact_stiffness" => p.alpha4 = float(&key, &v)?,
+                "gap" => p.alpha5 = float(&key, &v)?,
+                "contact_damping" => p.alpha6 = float(&key, &v)?,
+                "omega" => p.omega = float(&key, &v)?,
+                "contact_law" => {
+                    let name: String = v.extract().map_err(|_| {
+                        PyTypeError::new_err(format!(
+                            "{key}: expected a string (linear, hertz, dmt or impact)"
+                        ))
+                    })?;
+                    law = Some(
+                        name.parse::<afmdyn::LawKind>()
+                            .map_err(PyValueError::new_err)?,
+                    );
+                }
+                "restitution" => restitution = Some(float(&key, &v)?),
+                "hamaker" => hamaker = Some(float(&key, &v)?),
+                "intermolecular_distance" => a0 = Some(float(&key, &v)?),
+                _ => unreachable!("every keyword of MODEL_KEYWORDS has an arm"),
+            }
+        }
+    }
+    // the law and its groups resolved as on the command line
+    p.contact_law = afmdyn::ContactLaw::from_parts(law, hamaker, a0, restitution, p.contact_law)
+        .map_err(param_error)?;
+    p.validate().map_err(param_error)?;
+    Ok(p)
+}
+
+/// Dimensionless model parameters (paper eq. 7), validated on construction.
+///
+/// ``Params(**model)`` takes the keywords of every analysis: ``modes`` (N, 1..=20),
+/// ``tip_mass_ratio``/``alpha1`` (α1 ≥ 0), ``drive_amplitude``/``alpha2`` (α2 ≥ 0),
+/// ``beam_damping``/``alpha3`` (α3 ≥ 0), ``contact_stiffness``/``alpha4`` (α4 ≥ 0),
+/// ``gap``/``alpha5`` (α5, finite), ``contact_damping``/``alpha6`` (α6 ≥ 0) and ``omega``
+/// (Ω > 0). Missing ones take the paper's Figs. 5–14 set (N = 3, α1 = α2 = α3 = 0.1, α4 = 20,
+/// α5 = 0, α6 = 0.2, Ω = 2.6).
+///
+/// Raises ``ValueError`` naming the field and its range, ``TypeError`` for an unknown keyword.
+/// Instances are immutable; ``p.replace(omega=3.0)`` returns a modified copy.
+#[pyclass(frozen, eq, name = "Params", module = "afmdyn")]
+#[derive(Clone, PartialEq)]
+pub struct PyParams {
+    pub inner: Params,
+}
+
+#[pymethods]
+impl PyParams {
+    #[new]
+    #[pyo3(signature = (**model))]
+    fn new(model: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
+        Ok(PyParams {
+            inner: params_from_kwargs(Params::default(), model)?,
+        })
+    }
+
+    /// A copy with the given model keywords changed (validated).
+    #[pyo3(signature = (**model))]
+    fn replace(&self, model: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
+        Ok(PyParams {
+            inner: params_from_kwargs(self.inner, model)?,
+        })
+    }
+
+    /// Read a model config file (the command line's ``--config FILE.toml``: the same keywords,
+    /// snake_case names or ``alpha1``…``alpha6``; unknown keys are rejected). Keys the file
+    /// leaves out take the defaults; ``**model`` overrides the file.
+    #[staticmethod]
+    #[pyo3(signature = (path, **model))]
+    fn from_toml(
+        py: Python<'_>,
+        path: &Bound<'_, PyAny>,
+        model: Option<&Bound<'_, PyDict>>,
+    ) -> PyResult<Self> {
+        let toml = py
+            .import("tomllib")
+            .or_else(|_| py.import("tomli"))
+            .map_err(|_| {
+                PyTypeError::new_err("reading TOML needs Python >= 3.11 or the tomli package")
+            })?;
+        let file = py
+            .import("builtins")?
+            .getattr("open")?
+            .call1((path, "rb"))?;
+        let loaded = toml.getattr("load")?.call1((&file,));
+        file.call_method0("close")?;
+        let table = loaded?.cast_into::<PyDict>()?;
+        let p = params_from_kwargs(Params::default(), Some(&table)).map_err(|e| {
+            let msg = e.value(py).to_string();
+            let ty = e.get_type(py);
+            PyErr::from_type(ty, format!("{}: {msg}", path))
+        })?;
+        Ok(PyParams {
+            inner: params_from_kwargs(p, model)?,
+        })
+    }
+
+    /// Number of Galerkin modes N.
+    #[getter]
+    fn modes(&self) -> usize {
+        self.inner.modes
+    }
+    /// α1, tip-mass ratio M/(mL).
+    #[getter]
+    fn alpha1(&self) -> f64 {
+        self.inner.alpha1
+    }
+    /// α2, base-drive amplitude f/g0.
+    #[getter]
+    fn alpha2(&self) -> f64 {
+        self.inner.alpha2
+    }
+    /// α3, beam damping.
+    #[getter]
+    fn alpha3(&self) -> f64 {
+        self.inner.alpha3
+    }
+    /// α4, contact stiffness K1 L³/(EI).
+    #[getter]
+    fn alpha4(&self) -> f64 {
+        self.inner.alpha4
+    }
+    /// α5, tip–sample gap g1/g0.
+    #[getter]
+    fn alpha5(&self) -> f64 {
+        self.inner.alpha5
+    }
+    /// α6, contact damping.
+    #[getter]
+    fn alpha6(&self) -> f64 {
+        self.inner.alpha6
+    }
+    /// Ω, dimensionless drive frequency.
+    #[getter]
+    fn omega(&self) -> f64 {
+        self.inner.omega
+    }
+    /// The tip–sample law: ``"linear"``, ``"hertz"``, ``"dmt"`` or ``"impact"``.
+    #[getter]
+    fn contact_law(&self) -> &'static str {
+        self.inner.contact_law.name()
+    }
+    /// Coefficient of restitution r of the impact law (``None`` for the other laws).
+    #[getter]
+    fn restitution(&self) -> Option<f64> {
+        self.inner.contact_law.restitution()
+    }
+    /// DMT van der Waals group H̃ (``None`` for the other laws).
+    #[getter]
+    fn hamaker(&self) -> Option<f64> {
+        match self.inner.contact_law {
+            afmdyn::ContactLaw::Dmt { hamaker, .. } => Some(hamaker),
+            _ => None,
+        }
+    }
+    /// DMT intermolecular distance ã0 (``None`` for the other laws).
+    #[getter]
+    fn intermolecular_distance(&self) -> Option<f64> {
+        match self.inner.contact_law {
+            afmdyn::ContactLaw::Dmt {
+                intermolecular_distance,
+                ..
+            } => Some(intermolecular_distance),
+            _ => None,
+        }
+    }
+    /// α1 (alias).
+    #[getter]
+    fn tip_mass_ratio(&self) -> f64 {
+        self.inner.alpha1
+    }
+    /// α2 (alias).
+    #[getter]
+    fn drive_amplitude(&self) -> f64 {
+        self.inner.alpha2
+    }
+    /// α3 (alias).
+    #[getter]
+    fn beam_damping(&self) -> f64 {
+        self.inner.alpha3
+    }
+    /// α4 (alias).
+    #[getter]
+    fn contact_stiffness(&self) -> f64 {
+        self.inner.alpha4
+    }
+    /// α5 (alias).
+    #[getter]
+    fn gap(&self) -> f64 {
+        self.inner.alpha5
+    }
+    /// α6 (alias).
+    #[getter]
+    fn contact_damping(&self) -> f64 {
+        self.inner.alpha6
+    }
+    /// Drive period T = 2π/Ω (dimensionless τ).
+    #[getter]
+    fn period(&self) -> f64 {
+        self.inner.period()
+    }
+
+    /// The ``"params"`` object of the command line's JSON documents.
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        crate::convert::json_to_py(py, &serde_json::to_string(&self.inner).expect("params"))
+    }
+
+    fn __repr__(&self) -> String {
+        // every serialised field, the known ones in the paper's order first, so a field added
+        // to `afmdyn::Params` shows up here without a change
+        let value = serde_json::to_value(self.inner).expect("params");
+        let map = value.as_object().expect("a struct");
+        let order = [
+            "modes", "alpha1", "alpha2", "alpha3", "alpha4", "alpha5", "alpha6", "omega",
+        ];
+        let mut keys: Vec<&String> = map.keys().collect();
+        keys.sort_by_key(|k| order.iter().position(|o| o == k).unwrap_or(order.len()));
+        let fields: Vec<String> = keys.iter().map(|k| format!("{k}={}", map[*k])).collect();
+        format!("Params({})", fields.join(", "))
+    }
+
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+        py: Python<'py>,
+    ) -> PyResult<(Bound<'py, PyAny>, (String,))> {
+        let _ = py;
+        let from_json = slf.get_type().getattr("_from_json")?;
+        Ok((
+            from_json,
+            (serde_json::to_string(&slf.get().inner).expect("params"),),
+        ))
+    }
+
+    #[staticmethod]
+    fn _from_json(text: &str) -> PyResult<Self> {
+        let inner: Params = serde_json::from_str(text)
+            .map_err(|e| PyValueError::new_err(format!("Params: {e}")))?;
+        inner.validate().map_err(param_error)?;
+        Ok(PyParams { inner })
+    }
+}

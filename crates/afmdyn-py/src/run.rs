@@ -1,0 +1,107 @@
+//! Running a computation without the GIL: the work goes to a worker thread while the calling
+//! thread waits with the GIL released, waking every [`POLL`] to run Python's signal handlers
+//! (Ctrl-C raises `KeyboardInterrupt`) and to report progress.
+
+use pyo3::exceptions::PyRuntimeError;
+use pyo3::prelude::*;
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::mpsc::{channel, RecvTimeoutError};
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+
+/// How often the waiting thread checks for signals and reports progress.
+pub const POLL: Duration = Duration::from_millis(50);
+
+/// Shared between the worker and the waiting thread: units of work done, and the cancel flag.
+#[derive(Clone, Default)]
+pub struct Job {
+    /// Units of work finished (sweep points); 0 when the computation cannot count.
+    pub done: Arc<AtomicUsize>,
+    /// Set when the caller was interrupted: a cancellable computation stops at its next check.
+    pub cancel: Arc<AtomicBool>,
+}
+
+/// How the computation reacts to an interrupt.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub enum Stop {
+    /// It checks [`Job::cancel`]: wait for it to stop, then raise.
+    Cancellable,
+    /// It cannot stop early: raise at once and let the worker finish in the background (its
+    /// result is dropped; it holds no Python objects).
+    Abandon,
+}
+
+fn panic_message(p: Box<dyn std::any::Any + Send>) -> String {
+    if let Some(s) = p.downcast_ref::<&str>() {
+        (*s).to_string()
+    } else if let Some(s) = p.downcast_ref::<String>() {
+        s.clone()
+    } else {
+        "unknown panic".into()
+    }
+}
+
+/// Run `work` on a worker thread with the GIL released. `progress(done, total)` is called from
+/// the calling thread (with the GIL) at every poll and once at the end.
+///
+/// # Errors
+/// `KeyboardInterrupt` (or whatever a signal handler raises), an exception raised by
+/// `progress`, or `RuntimeError` if the computation panicked (a bug: reported, not a crash).
+pub fn run<T, F>(
+    py: Python<'_>,
+    job: &Job,
+    total: Option<usize>,
+    progress: Option<&Bound<'_, PyAny>>,
+    stop: Stop,
+    work: F,
+) -> PyResult<T>
+where
+    T: Send + 'static,
+    F: FnOnce() -> T + Send + 'static,
+{
+    let (tx, rx) = channel();
+    // the receiver is used from inside `detach`, which needs a `Sync` borrow
+    let rx = Mutex::new(rx);
+    std::thread::Builder::new()
+        .name("afmdyn-worker".into())
+        .spawn(move || {
+            let r = catch_unwind(AssertUnwindSafe(work)).map_err(panic_message);
+            let _ = tx.send(r);
+        })
+        .map_err(|e| PyRuntimeError::new_err(format!("cannot start a worker thread: {e}")))?;
+    let report = |py: Python<'_>| -> PyResult<()> {
+        if let Some(cb) = progress {
+            let _ = py;
+            cb.call1((job.done.load(Ordering::Relaxed), total))?;
+        }
+        Ok(())
+    };
+    loop {
+        match py.detach(|| rx.lock().expect("receiver").recv_timeout(POLL)) {
+            Ok(Ok(value)) => {
+                report(py)?;
+                return Ok(value);
+            }
+            Ok(Err(msg)) => {
+                return Err(PyRuntimeError::new_err(format!(
+                    "internal error in afmdyn (please report): {msg}"
+                )))
+            }
+            Err(RecvTimeoutError::Disconnected) => {
+                return Err(PyRuntimeError::new_err(
+                    "internal error in afmdyn: the worker thread ended without a result",
+                ))
+            }
+            Err(RecvTimeoutError::Timeout) => {}
+        }
+        if let Err(e) = py.check_signals().and_then(|_| report(py)) {
+            job.cancel.store(true, Ordering::Relaxed);
+            if stop == Stop::Cancellable {
+                // the points already running finish; no new one starts
+                let _ = py.detach(|| rx.lock().expect("receiver").recv());
+            }
+            return Err(e);
+        }
+    }
+}

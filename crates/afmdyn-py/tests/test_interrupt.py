@@ -1,0 +1,77 @@
+"""Ctrl-C during a computation raises KeyboardInterrupt promptly, without a crash, and leaves
+the extension usable: a sweep stops within a point per worker (it checks a cancel flag); other
+analyses return at once and finish their work in the background."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+
+import pytest
+
+pytestmark = pytest.mark.skipif(os.name != "posix", reason="SIGINT to a child process")
+
+
+def _interrupt(script: str, after: float = 1.5):
+    p = subprocess.Popen(
+        [sys.executable, "-c", textwrap.dedent(script)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    assert p.stdout.readline().strip() == "start"
+    time.sleep(after)  # inside the computation (each takes far longer)
+    sent = time.monotonic()
+    p.send_signal(signal.SIGINT)
+    out, err = p.communicate(timeout=120)
+    return p.returncode, out.split(), err, time.monotonic() - sent
+
+
+def test_ctrl_c_interrupts_a_long_bifurcation_run():
+    code, out, err, latency = _interrupt(
+        """
+        import afmdyn
+        print("start", flush=True)
+        try:
+            afmdyn.bifurcation(steps=4000, starts=2, progress=False)
+            print("finished", flush=True)
+        except KeyboardInterrupt:
+            print("interrupted", flush=True)
+        ds = afmdyn.bifurcation(from_=2.0, to=2.2, steps=3)  # usable afterwards
+        print("after", ds.sizes["point"], flush=True)
+        """
+    )
+    assert code == 0, err
+    assert out == ["interrupted", "after", "6"], (out, err)
+    assert latency < 10, latency  # not the end of the 16 000-point sweep
+
+
+@pytest.mark.parametrize(
+    "call",
+    [
+        "afmdyn.attractors(samples=5000, progress=False)",
+        "afmdyn.lyapunov(periods=10**7, blocks=10, progress=False)",
+        "afmdyn.simulate(periods=10**6, samples_per_period=1, progress=False)",
+    ],
+)
+def test_ctrl_c_interrupts_analyses_without_a_cancel_hook(call):
+    code, out, err, latency = _interrupt(
+        f"""
+        import afmdyn
+        print("start", flush=True)
+        try:
+            {call}
+            print("finished", flush=True)
+        except KeyboardInterrupt:
+            print("interrupted", flush=True)
+        print("after", afmdyn.modes().free.omega.size, flush=True)
+        """
+    )
+    assert code == 0, err
+    assert out == ["interrupted", "after", "3"], (out, err)
+    assert latency < 5, latency
+    assert "Traceback" not in err and "panicked" not in err, err

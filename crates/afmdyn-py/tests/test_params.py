@@ -1,0 +1,152 @@
+"""Params: keywords with the command line's names and the paper's aliases, validation errors
+that name the field and its range, config files."""
+
+from __future__ import annotations
+
+import math
+import pickle
+
+import pytest
+
+import afmdyn
+from afmdyn import Params
+
+from conftest import EXAMPLES
+
+NAMES = {
+    "tip_mass_ratio": "alpha1",
+    "drive_amplitude": "alpha2",
+    "beam_damping": "alpha3",
+    "contact_stiffness": "alpha4",
+    "gap": "alpha5",
+    "contact_damping": "alpha6",
+}
+
+
+def test_defaults_are_the_command_lines(cli_json):
+    # the paper's Figs. 5–14 set, as `afmdyn modes` resolves it without flags
+    assert Params().to_dict() == cli_json("modes")["params"]
+    paper = {
+        "modes": 3,
+        "alpha1": 0.1,
+        "alpha2": 0.1,
+        "alpha3": 0.1,
+        "alpha4": 20.0,
+        "alpha5": 0.0,
+        "alpha6": 0.2,
+        "omega": 2.6,
+    }
+    assert {k: Params().to_dict()[k] for k in paper} == paper
+
+
+@pytest.mark.parametrize("name,alias", NAMES.items())
+def test_descriptive_names_and_aliases_set_the_same_field(name, alias, cli_json):
+    a = Params(**{name: 0.37})
+    b = Params(**{alias: 0.37})
+    assert a == b
+    assert getattr(a, name) == getattr(a, alias) == 0.37
+    # the command line's flag of the same name sets the same value
+    flag = "--" + name.replace("_", "-")
+    assert cli_json("modes", flag, "0.37")["params"] == a.to_dict()
+
+
+def test_replace_returns_a_validated_copy():
+    p = Params(omega=3.0)
+    q = p.replace(omega=4.0, modes=2)
+    assert (p.omega, p.modes) == (3.0, 3)
+    assert (q.omega, q.modes) == (4.0, 2)
+    assert q.alpha4 == p.alpha4
+    with pytest.raises(ValueError, match="omega"):
+        p.replace(omega=0.0)
+
+
+def test_params_are_immutable_hashable_by_value_and_picklable():
+    p = Params(omega=3.3, modes=4)
+    with pytest.raises(AttributeError):
+        p.omega = 1.0  # type: ignore[misc]
+    assert p == Params(modes=4, omega=3.3)
+    assert p != Params(modes=4, omega=3.4)
+    assert pickle.loads(pickle.dumps(p)) == p
+    assert "omega=3.3" in repr(p) and "modes=4" in repr(p)
+    assert math.isclose(p.period, 2 * math.pi / 3.3, rel_tol=1e-15)
+
+
+@pytest.mark.parametrize(
+    "kwargs,field,allowed",
+    [
+        ({"modes": 0}, "modes", "1..=20"),
+        ({"modes": 21}, "modes", "1..=20"),
+        ({"modes": -1}, "modes", "1..=20"),
+        ({"tip_mass_ratio": -0.1}, "alpha1", ">= 0"),
+        ({"alpha2": float("nan")}, "alpha2", ">= 0"),
+        ({"beam_damping": -1}, "alpha3", ">= 0"),
+        ({"contact_stiffness": float("inf")}, "alpha4", ">= 0"),
+        ({"gap": float("nan")}, "alpha5", "finite"),
+        ({"contact_damping": -0.2}, "alpha6", ">= 0"),
+        ({"omega": 0.0}, "omega", "> 0"),
+        ({"omega": -2.6}, "omega", "> 0"),
+    ],
+)
+def test_out_of_range_values_raise_value_error_naming_field_and_range(kwargs, field, allowed):
+    with pytest.raises(ValueError) as e:
+        Params(**kwargs)
+    assert field in str(e.value) and allowed in str(e.value)
+    # the same through every analysis' keywords
+    with pytest.raises(ValueError, match=field):
+        afmdyn.modes(**kwargs)
+
+
+def test_unknown_keyword_and_wrong_types_raise_type_error():
+    with pytest.raises(
+        TypeError, match="unknown model parameter 'omegaa'.*tip_mass_ratio \\(alpha1\\)"
+    ):
+        Params(omegaa=2.0)
+    with pytest.raises(TypeError, match="unknown model parameter"):
+        afmdyn.simulate(periods=1, stiffness=3.0)
+    with pytest.raises(TypeError, match="omega: expected a number"):
+        Params(omega="2.6")
+    with pytest.raises(TypeError, match="modes: expected an integer"):
+        Params(modes=3.0)
+    with pytest.raises(TypeError, match="modes: expected an integer, got bool"):
+        Params(modes=True)
+    with pytest.raises(TypeError, match="gap: expected a number"):
+        Params(gap=None)
+
+
+def test_a_field_given_twice_is_rejected():
+    with pytest.raises(ValueError, match="both given"):
+        Params(alpha4=1.0, contact_stiffness=2.0)
+
+
+def test_integers_are_accepted_for_floats():
+    assert Params(omega=3, alpha5=-1).omega == 3.0
+
+
+def test_keywords_override_a_params_object_in_every_analysis():
+    p = Params(modes=2, omega=3.0)
+    s = afmdyn.modes(p, modes=4)
+    assert s.params == Params(modes=4, omega=3.0)
+    assert len(s.free.omega) == 4
+    with pytest.raises(TypeError, match="params"):
+        afmdyn.modes({"omega": 3.0})  # type: ignore[arg-type]
+
+
+def test_config_files_read_as_the_command_line_reads_them(cli_json, tmp_path):
+    for name in ["fig5.toml", "eq25.toml", "fig15-17-text.toml"]:
+        path = EXAMPLES / name
+        assert Params.from_toml(path).to_dict() == cli_json("modes", "--config", path)["params"]
+    # keywords override the file, as flags do
+    p = Params.from_toml(EXAMPLES / "fig5.toml", omega=3.1)
+    assert (
+        p.to_dict()
+        == cli_json("modes", "--config", EXAMPLES / "fig5.toml", "--omega", "3.1")["params"]
+    )
+    bad = tmp_path / "bad.toml"
+    bad.write_text("omega = 2.0\nstiffness = 3.0\n")
+    with pytest.raises(TypeError, match=r"bad\.toml.*unknown model parameter 'stiffness'"):
+        Params.from_toml(bad)
+    bad.write_text("omega = -2.0\n")
+    with pytest.raises(ValueError, match=r"bad\.toml.*omega"):
+        Params.from_toml(bad)
+    with pytest.raises(FileNotFoundError):
+        Params.from_toml(tmp_path / "missing.toml")

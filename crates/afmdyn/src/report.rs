@@ -1,0 +1,246 @@
+//! Result documents shared by the front ends: the JSON that `afmdyn … --json` prints and that
+//! the Python package's `to_dict()` returns. One place builds each document, so the command
+//! line and Python cannot drift apart; a front end adds only its own keys (output paths).
+//!
+//! Every function returns a [`serde_json::Value`] object; serialised with
+//! `serde_json::to_string` it is byte for byte what the command line prints.
+
+use crate::analysis::attractors::AttractorReport;
+use crate::analysis::continuation::BranchPoint;
+use crate::analysis::converge::ConvergenceRun;
+use crate::analysis::lyapunov::LyapunovSpectrum;
+use crate::analysis::shooting::PeriodicOrbit;
+use crate::analysis::steady::SteadyState;
+use crate::eigen::RegionSpectrum;
+use crate::model::CantileverModel;
+use crate::params::{Params, SweepParam};
+use crate::trajectory::{EnergyBalance, Trajectory};
+use nalgebra::DVector;
+use serde_json::{json, Value};
+
+/// One region of `afmdyn modes --json`: `{"omega": [ω_i], "eigenvalues": [[re, im], …]}`.
+pub fn region_spectrum(r: &RegionSpectrum) -> Value {
+    json!({
+        "omega": r.omega,
+        "eigenvalues": r.eigenvalues.iter().map(|e| [e.re, e.im]).collect::<Vec<_>>(),
+    })
+}
+
+/// `afmdyn modes --json`: the parameters and the free and contact spectra (eqs. 19–23).
+pub fn modes(params: &Params, free: &RegionSpectrum, contact: &RegionSpectrum) -> Value {
+    json!({ "params": params, "free": region_spectrum(free), "contact": region_spectrum(contact) })
+}
+
+/// Largest per-period residual of an energy balance (`trajectory::EnergyBalance::residual`):
+/// (absolute, relative to the period's largest term). The relative residual is +∞ for a nonzero
+/// (or NaN) residual of a period whose terms are all 0.
+pub fn energy_residual(energy: &[EnergyBalance]) -> (f64, f64) {
+    let (mut abs, mut rel) = (0.0f64, 0.0f64);
+    for e in energy {
+        let r = e.residual().abs();
+        let scale = [
+            e.e_start,
+            e.e_end,
+            e.base_work,
+            e.beam_dissipation,
+            e.contact_dissipation,
+        ]
+        .iter()
+        .fold(0.0f64, |m, v| m.max(v.abs()));
+        abs = abs.max(r);
+        if scale > 0.0 {
+            rel = rel.max(r / scale);
+        } else if r > 0.0 || r.is_nan() {
+            rel = f64::INFINITY;
+        }
+    }
+    (abs, rel)
+}
+
+/// What `afmdyn simulate --json` reports of a run (the front ends add their own keys, e.g. the
+/// files written and warnings).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SimulateSummary {
+    /// Final τ.
+    pub tau_end: f64,
+    /// Final state, shape `[2N]`.
+    pub final_state: DVector<f64>,
+    /// Number of events.
+    pub switchings: usize,
+    /// Whether the beam body touched the substrate.
+    pub body_contact: bool,
+    /// Stroboscopic section points recorded.
+    pub poincare_points: usize,
+    /// [`energy_residual`] of the run.
+    pub energy_residual: (f64, f64),
+}
+
+/// Relative per-period energy residual above which a run is reported as inaccurate (normal runs
+/// close to ~1e-10 with the exact propagator and with the adaptive integrator's dense output).
+pub const ENERGY_TOLERANCE: f64 = 1e-6;
+
+/// The run's own accuracy checks that failed: the energy balance beyond [`ENERGY_TOLERANCE`],
+/// and the beam body reaching the substrate (outside the paper's model, Fig. 2f).
+pub fn simulate_warnings(s: &SimulateSummary) -> Vec<String> {
+    let mut w = vec![];
+    let relative = s.energy_residual.1;
+    if relative.is_nan() || relative > ENERGY_TOLERANCE {
+        w.push(format!(
+            "energy balance violated: a per-period residual of {relative:.1e} relative \
+             (tolerance 1e-6); the trajectory is not accurate (integrator too coarse, or \
+             parameters at the edge of the valid range)"
+        ));
+    }
+    if s.body_contact {
+        w.push(
+            "a point of the beam other than the tip reached the substrate (paper Fig. 2f): \
+             outside the model's assumption"
+                .into(),
+        );
+    }
+    w
+}
+
+/// `afmdyn simulate --json`: final time and state, events, body contact, section points, the
+/// energy-balance residual and [`simulate_warnings`].
+pub fn simulate_summary(model: &CantileverModel, s: &SimulateSummary) -> Value {
+    let zf = &s.final_state;
+    let n = model.modes();
+    json!({
+        "params": model.params(),
+        "tau_end": s.tau_end,
+        "final": {
+            "w_tip": model.w_tip(zf),
+            "w_tip_dot": model.w_tip_dot(zf),
+            "v_t": model.v_t(s.tau_end, zf),
+            "a": zf.rows(0, n).iter().collect::<Vec<_>>(),
+            "a_dot": zf.rows(n, n).iter().collect::<Vec<_>>(),
+        },
+        "switchings": s.switchings,
+        "body_contact": s.body_contact,
+        "poincare_points": s.poincare_points,
+        "energy_residual": { "max_abs": s.energy_residual.0, "max_relative": s.energy_residual.1 },
+        "warnings": simulate_warnings(s),
+    })
+}
+
+/// [`simulate_summary`] of a whole [`Trajectory`].
+pub fn simulate(model: &CantileverModel, tr: &Trajectory) -> Value {
+    simulate_summary(
+        model,
+        &SimulateSummary {
+            tau_end: tr.tau_end,
+            final_state: tr.final_state.clone(),
+            switchings: tr.events.len(),
+            body_contact: tr.body_contact,
+            poincare_points: tr.poincare.len(),
+            energy_residual: energy_residual(&tr.energy),
+        },
+    )
+}
+
+/// `afmdyn converge --json` without the output directory: the parameters and, per N, the
+/// period and the RMS change of the tip motion against N − 1.
+pub fn converge(params: &Params, runs: &[ConvergenceRun]) -> Value {
+    let rows: Vec<_> = runs
+        .iter()
+        .map(|r| json!({ "modes": r.modes, "period": r.period, "rms_change": r.rms_change }))
+        .collect();
+    json!({ "params": params, "runs": rows })
+}
+
+/// A section state as the `--initial-modal` string "a1,..,aN;adot1,..,adotN" (at drive phase 0),
+/// so that `afmdyn orbit --initial-modal` can start from an attractor; empty for `None`.
+pub fn initial_modal(z: Option<&DVector<f64>>) -> String {
+    let Some(z) = z else { return String::new() };
+    let n = z.len() / 2;
+    let join = |v: &[f64]| {
+        v.iter()
+            .map(|x| format!("{x}"))
+            .collect::<Vec<_>>()
+            .join(",")
+    };
+    format!("{};{}", join(&z.as_slice()[..n]), join(&z.as_slice()[n..]))
+}
+
+/// One attractor of `afmdyn attractors --json`; `multipliers` ([re, im] pairs) and `stable` of
+/// the shooting-polished orbit, null for a nonperiodic motion.
+pub fn attractor(s: &SteadyState, basin: f64, orbit: Option<&PeriodicOrbit>) -> Value {
+    json!({
+        "multipliers": orbit.map(|o| o.multipliers.iter().map(|m| [m.re, m.im]).collect::<Vec<_>>()),
+        "stable": orbit.map(|o| o.stable),
+        "period": s.period(),
+        "poincare": {
+            "v_t": s.poincare.iter().map(|p| p.v_t).collect::<Vec<_>>(),
+            "w_tip": s.poincare.iter().map(|p| p.w_tip).collect::<Vec<_>>(),
+        },
+        "x_max": s.stats.x_max,
+        "v_t_min": s.stats.v_t_min,
+        "contact_fraction": s.stats.contact_fraction,
+        "contacts_per_period": s.stats.contacts_per_period,
+        "body_contact": s.stats.body_contact,
+        "basin_fraction": basin,
+        "initial_modal": initial_modal(s.poincare.first().map(|q| &q.state)),
+    })
+}
+
+/// `afmdyn attractors --json` (also written to `attractors.json`): `samples` starts at `params`.
+pub fn attractors(params: &Params, samples: usize, report: &AttractorReport) -> Value {
+    json!({
+        "params": params,
+        "samples": samples,
+        "failures": report.failures.len(),
+        "attractors": report
+            .attractors
+            .iter()
+            .map(|x| attractor(&x.steady, x.basin_fraction, x.orbit.as_ref()))
+            .collect::<Vec<_>>(),
+    })
+}
+
+/// `afmdyn orbit --json`: a period-n orbit of `model` with its Floquet multipliers.
+pub fn orbit(model: &CantileverModel, o: &PeriodicOrbit) -> Value {
+    let mut doc = json!({
+        "period": o.period,
+        "poincare": {
+            "v_t": o.section.iter().map(|z| model.v_t(0.0, z)).collect::<Vec<_>>(),
+            "w_tip": o.section.iter().map(|z| model.w_tip(z)).collect::<Vec<_>>(),
+        },
+        "multipliers": o.multipliers.iter().map(|m| [m.re, m.im]).collect::<Vec<_>>(),
+        "stable": o.stable,
+        "critical": o.critical,
+        "grazing": o.grazing,
+        "grazing_distance": o.grazing_distance,
+        "switchings": o.switchings,
+        "newton_residuals": o.residuals,
+        "state": o.state.iter().collect::<Vec<_>>(),
+    });
+    doc["params"] = json!(model.params());
+    doc
+}
+
+/// `afmdyn continue --json` without the output directory: the branches' sizes and their
+/// located bifurcations.
+pub fn continuation(base: &Params, param: SweepParam, branches: &[Vec<BranchPoint>]) -> Value {
+    let events: Vec<_> = branches
+        .iter()
+        .flatten()
+        .filter(|b| b.event.is_some())
+        .map(|b| json!({ "event": b.event, "value": b.value, "period": b.period, "stable": b.stable }))
+        .collect();
+    json!({
+        "params": base,
+        "param": param.name(),
+        "branches": branches.len(),
+        "points": branches.iter().map(Vec::len).sum::<usize>(),
+        "events": events,
+    })
+}
+
+/// `afmdyn lyapunov --json`: the Lyapunov spectrum and the 0–1 test at `params` (every field of
+/// [`LyapunovSpectrum`], so a field added there reaches both front ends).
+pub fn lyapunov(params: &Params, l: &LyapunovSpectrum) -> Value {
+    let mut doc = serde_json::to_value(l).expect("a Lyapunov spectrum serialises");
+    doc["params"] = json!(params);
+    doc
+}

@@ -1,0 +1,74 @@
+#!/usr/bin/env bash
+# The test command (README "Tests"; .ci/run calls it):
+#   1. the Rust tests: cargo test --workspace --release
+#   2. the Python package: a virtual environment in target/venv-test (created once, reused;
+#      $AFMDYN_TEST_VENV chooses another),
+#      `pip install ./crates/afmdyn-py[test]` (maturin builds the extension into it), then
+#      pytest crates/afmdyn-py/tests, which also executes the example notebook and script.
+# Needs a Rust toolchain and Python >= 3.9 with network access to crates.io and PyPI.
+# The last line is "N passed, N failed", Rust and Python together; the exit status is 0 only
+# when everything ran and passed.
+set -uo pipefail
+cd "$(dirname "$0")/.."
+
+PYTHON=${PYTHON:-python3}
+TARGET=${CARGO_TARGET_DIR:-target}
+VENV=${AFMDYN_TEST_VENV:-$TARGET/venv-test}
+logs=$(mktemp -d)
+trap 'rm -rf "$logs"' EXIT
+status=0
+extra_failed=0
+
+echo "== Rust: cargo test --workspace --release"
+cargo test --workspace --release 2>&1 | tee "$logs/rust.log"
+rust_code=${PIPESTATUS[0]}
+rust_passed=$(grep -Eo '^test result: [a-zA-Z]+\. [0-9]+ passed' "$logs/rust.log" | awk '{s += $4} END {print s + 0}')
+rust_failed=$(grep -Eo '[0-9]+ failed;' "$logs/rust.log" | awk '{s += $1} END {print s + 0}')
+if [ "$rust_code" -ne 0 ]; then
+    status=1
+    # a build failure runs no test: count it as one failure
+    [ "$rust_failed" -gt 0 ] || extra_failed=$((extra_failed + 1))
+fi
+
+echo "== Python: virtual environment $VENV"
+if [ ! -x "$VENV/bin/python" ]; then
+    mkdir -p "$(dirname "$VENV")"
+    # plain venv; where the venv module has no pip (Debian without python3-venv), virtualenv
+    "$PYTHON" -m venv "$VENV" 2>"$logs/venv.log" ||
+        { rm -rf "$VENV" && "$PYTHON" -m pip install -q --user virtualenv && "$PYTHON" -m virtualenv -q "$VENV"; } ||
+        { cat "$logs/venv.log"; echo "cannot create a virtual environment with $PYTHON"; status=1; }
+fi
+py="$VENV/bin/python"
+py_passed=0
+py_failed=0
+if [ -x "$py" ]; then
+    "$py" -m pip install -q --upgrade pip 2>&1 | tail -1
+    echo "== Python: pip install ./crates/afmdyn-py[test] (maturin builds the extension)"
+    if "$py" -m pip install -q "./crates/afmdyn-py[test]"; then
+        echo "== Python: pytest crates/afmdyn-py/tests"
+        AFMDYN_BIN="$TARGET/release/afmdyn" "$py" -m pytest crates/afmdyn-py/tests -p no:cacheprovider -rs 2>&1 |
+            tee "$logs/py.log"
+        code=${PIPESTATUS[0]}
+        # exit code 5: no tests were collected, which is a failure here
+        [ "$code" -eq 0 ] || status=1
+        summary=$(grep -E '^=+ .*(passed|failed|error|no tests ran).* in [0-9.]+s' "$logs/py.log" | tail -1)
+        py_passed=$(echo "$summary" | grep -Eo '[0-9]+ passed' | awk '{print $1}')
+        py_failed=$(echo "$summary" | grep -Eo '[0-9]+ (failed|errors?)' | awk '{s += $1} END {print s + 0}')
+        py_passed=${py_passed:-0}
+        if [ "$code" -ne 0 ] && [ "$py_failed" -eq 0 ]; then
+            echo "pytest exited with status $code"
+            extra_failed=$((extra_failed + 1))
+        fi
+    else
+        echo "building or installing the Python package failed"
+        status=1
+        extra_failed=$((extra_failed + 1))
+    fi
+else
+    status=1
+    extra_failed=$((extra_failed + 1))
+fi
+
+echo "Rust: ${rust_passed} passed, ${rust_failed} failed; Python: ${py_passed} passed, ${py_failed} failed"
+echo "$((rust_passed + py_passed)) passed, $((rust_failed + py_failed + extra_failed)) failed"
+exit "$status"
