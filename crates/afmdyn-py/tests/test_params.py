@@ -150,3 +150,39 @@ def test_config_files_read_as_the_command_line_reads_them(cli_json, tmp_path):
         Params.from_toml(bad)
     with pytest.raises(FileNotFoundError):
         Params.from_toml(tmp_path / "missing.toml")
+
+
+def test_contact_law_keywords_resolve_as_on_the_command_line(cli_json):
+    p = Params(contact_law="impact", restitution=0.5, modes=1, gap=0.05, omega=3.0)
+    assert (p.contact_law, p.restitution, p.hamaker) == ("impact", 0.5, None)
+    doc = cli_json(
+        "modes", "--contact-law", "impact", "--restitution", 0.5, "--modes", 1, "--gap", 0.05,
+        "--omega", 3.0,
+    )
+    assert p.to_dict() == doc["params"]
+    # DMT: the groups not given take the library's defaults, as on the command line
+    d = Params(contact_law="dmt", hamaker=2e-5)
+    assert d.to_dict() == cli_json("modes", "--contact-law", "dmt", "--hamaker", 2e-5)["params"]
+    assert d.intermolecular_distance == 0.01
+    # a group of the law in force may be changed alone; others are refused, naming both
+    assert p.replace(restitution=0.9).restitution == 0.9
+    with pytest.raises(ValueError, match="restitution is a group of the impact law"):
+        Params(contact_law="hertz", restitution=0.5)
+    with pytest.raises(ValueError, match="restitution"):
+        Params(contact_law="impact", restitution=1.5)
+    with pytest.raises(ValueError, match="contact law 'elastic'"):
+        Params(contact_law="elastic")
+    with pytest.raises(TypeError, match="contact_law"):
+        Params(contact_law=1)
+
+
+def test_every_law_runs_from_python_as_on_the_command_line(cli_json):
+    # the orbit document of each law equals the command line's for the same keywords
+    for law, extra in [("hertz", {}), ("dmt", {}), ("impact", {"restitution": 0.5})]:
+        model = {"contact_law": law, "modes": 1, "omega": 3.0, "gap": 0.05, **extra}
+        args = ["orbit"]
+        for k, v in model.items():
+            args += ["--" + k.replace("_", "-"), v]
+        o = afmdyn.orbit(**model)
+        assert o.to_dict() == cli_json(*args), law
+        assert o.stable, law

@@ -12,8 +12,9 @@ array([ 7.79, 20.33, 55.81])
 
 Analyses: :func:`modes`, :func:`simulate`, :func:`converge`, :func:`bifurcation`,
 :func:`attractors`, :func:`orbit`, :func:`continuation`, :func:`lyapunov`. Physical units
-(``approach``, ``resonance``, probe files) and the contact-law keywords come with later
-versions.
+(``approach``, ``resonance``, probe files) come with a later version. Tip–sample laws:
+``contact_law="linear" | "hertz" | "dmt" | "impact"`` with ``restitution`` (impact),
+``hamaker`` and ``intermolecular_distance`` (DMT) among the model keywords.
 """
 
 from ._afmdyn import Params, SimulationError
