@@ -235,7 +235,7 @@ impl CantileverModel {
         match self.law.law {
             ContactLaw::Impact { .. } => {
                 if contact {
-                    self.sticking_force(tau, z).value
+                    self.sticking_force_value(tau, z)
                 } else {
                     0.0
                 }
@@ -424,10 +424,7 @@ impl CantileverModel {
         let om = p.omega;
         let beta = BAUMGARTE_RATE * om;
         let (s, c) = (om * tau).sin_cos();
-        let [f0, fs, fc] = self.tip_acc_forcing;
-        let acc =
-            self.tip_acc.iter().zip(z).map(|(a, b)| a * b).sum::<f64>() + f0 + fs * s + fc * c;
-        let (v, vd) = self.v_t_pair(tau, z);
+        let [_, fs, fc] = self.tip_acc_forcing;
         let mut grad = -self.m_eff * &self.tip_acc;
         for (j, phi) in self.tip().iter().enumerate() {
             grad[j] -= self.m_eff * beta * beta * phi;
@@ -436,7 +433,7 @@ impl CantileverModel {
         let dv_tau = p.alpha2 * om * c;
         let dvd_tau = -p.alpha2 * om * om * s;
         Guard {
-            value: self.m_eff * (p.alpha2 * om * om * s - acc - 2.0 * beta * vd - beta * beta * v),
+            value: self.sticking_force_value(tau, z),
             grad,
             d_tau: self.m_eff
                 * (p.alpha2 * om * om * om * c
@@ -444,6 +441,20 @@ impl CantileverModel {
                     - 2.0 * beta * dvd_tau
                     - beta * beta * dv_tau),
         }
+    }
+
+    /// The value of the sticking force λ (see `sticking_force`), without its gradient: the
+    /// vector field of sticking calls it at every evaluation.
+    fn sticking_force_value(&self, tau: f64, z: &[f64]) -> f64 {
+        let p = &self.params;
+        let om = p.omega;
+        let beta = BAUMGARTE_RATE * om;
+        let (s, c) = (om * tau).sin_cos();
+        let [f0, fs, fc] = self.tip_acc_forcing;
+        let acc =
+            self.tip_acc.iter().zip(z).map(|(a, b)| a * b).sum::<f64>() + f0 + fs * s + fc * c;
+        let (v, vd) = self.v_t_pair(tau, z);
+        self.m_eff * (p.alpha2 * om * om * s - acc - 2.0 * beta * vd - beta * beta * v)
     }
 
     /// Check a state: length 2N, finite components, ‖z‖ below the integrators' divergence
@@ -572,7 +583,7 @@ impl HybridSystem for CantileverModel {
     fn mode_at(&self, tau: f64, z: &[f64]) -> Region {
         let (v, vd) = self.v_t_pair(tau, z);
         if self.law.law.restitution().is_some() {
-            if v <= 0.0 && vd == 0.0 && self.sticking_force(tau, z).value > 0.0 {
+            if v <= 0.0 && vd == 0.0 && self.sticking_force_value(tau, z) > 0.0 {
                 Region::Contact
             } else {
                 Region::Free
@@ -611,7 +622,7 @@ impl HybridSystem for CantileverModel {
 
     fn guard_value(&self, mode: Region, tau: f64, z: &[f64]) -> f64 {
         if mode == Region::Contact && self.law.law.restitution().is_some() {
-            return self.sticking_force(tau, z).value;
+            return self.sticking_force_value(tau, z);
         }
         mode.guard_sign() * self.v_t_pair(tau, z).0
     }
@@ -644,7 +655,7 @@ impl HybridSystem for CantileverModel {
         let plastic = apply(0.0);
         // stick when λ is compressive (or within its dead band of 0: about to become so) and the
         // bounce would rise less than the resolvable height
-        let lambda = self.sticking_force(tau, plastic.as_slice()).value;
+        let lambda = self.sticking_force_value(tau, plastic.as_slice());
         let bounce = r * v_minus;
         let h_stick =
             STICK_HEIGHT_TOLERANCES * self.guard_tolerance(Region::Free, tau, plastic.as_slice());
