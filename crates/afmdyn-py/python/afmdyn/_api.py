@@ -260,7 +260,7 @@ def simulate(
             "contact_dissipation": (
                 "cycle",
                 d["contact_dissipation"],
-                {"units": "E I g0^2/L^3", "long_name": "contact damping loss"},
+                {"units": "E I g0^2/L^3", "long_name": "dissipation in the sample (contact damping, impacts)"},
             ),
             "energy_residual": (
                 "cycle",
