@@ -260,7 +260,10 @@ def simulate(
             "contact_dissipation": (
                 "cycle",
                 d["contact_dissipation"],
-                {"units": "E I g0^2/L^3", "long_name": "dissipation in the sample (contact damping, impacts)"},
+                {
+                    "units": "E I g0^2/L^3",
+                    "long_name": "dissipation in the sample (contact damping, impacts)",
+                },
             ),
             "energy_residual": (
                 "cycle",
