@@ -735,12 +735,11 @@ impl HybridSystem for CantileverModel {
         let n = self.modes();
         let w = self.kelvin_voigt_weight(mode, tau, z);
         self.jacobian_parts(mode, tau, z, jac, w == 0.0);
-        let psi = nalgebra::DMatrixView::from_slice(psi, d, d);
-        let mut out = nalgebra::DMatrixViewMut::from_slice(dpsi, d, d);
         if w == 0.0 {
-            out.gemm(1.0, jac, &psi, 0.0);
+            crate::system::jacobian_product(jac, psi, dpsi);
             return;
         }
+        let psi = nalgebra::DMatrixView::from_slice(psi, d, d);
         // J_reg + [0; M⁻¹φ] w [0 φᵀ]
         let mut row = DVector::zeros(d);
         row.rows_mut(n, n).copy_from(&(w * self.tip()));
@@ -750,7 +749,7 @@ impl HybridSystem for CantileverModel {
         let top = self.tip().transpose() * tmp.rows(0, n);
         tmp.rows_mut(n, n)
             .ger(-w, &self.mphi, &top.transpose(), 1.0);
-        out.gemm(1.0, jac, &tmp, 0.0);
+        crate::system::jacobian_product(jac, tmp.as_slice(), dpsi);
     }
 
     /// Ψ = (I + E)Φ (forward) or Φ = (I − E)Ψ, E as in [`HybridSystem::variational_rhs`].

@@ -125,11 +125,8 @@ pub trait HybridSystem: Send + Sync {
         dpsi: &mut [f64],
         jac: &mut DMatrix<f64>,
     ) {
-        let d = self.dim();
         self.jacobian(mode, tau, z, jac);
-        let psi = nalgebra::DMatrixView::from_slice(psi, d, d);
-        let mut out = nalgebra::DMatrixViewMut::from_slice(dpsi, d, d);
-        out.gemm(1.0, jac, &psi, 0.0);
+        jacobian_product(jac, psi, dpsi);
     }
     /// Tangent coordinates Ψ = P(τ, z) Φ of mode `mode` (in place; `forward = false` applies
     /// P⁻¹). Default: the identity.
@@ -139,6 +136,14 @@ pub trait HybridSystem: Send + Sync {
     /// Whether every mode is affine in z with a harmonic forcing and linear guards (the exact
     /// propagator applies).
     fn is_affine(&self) -> bool;
+}
+
+/// dΨ = J Ψ for d×d column-major `psi` and `dpsi` (the variational equations' product).
+pub fn jacobian_product(jac: &DMatrix<f64>, psi: &[f64], dpsi: &mut [f64]) {
+    let d = jac.nrows();
+    let psi = nalgebra::DMatrixView::from_slice(psi, d, d);
+    let mut out = nalgebra::DMatrixViewMut::from_slice(dpsi, d, d);
+    out.gemm(1.0, jac, &psi, 0.0);
 }
 
 /// The saltation matrix S (module docs) of the event of mode `from` at (τ, z⁻), with the

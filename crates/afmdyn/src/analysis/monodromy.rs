@@ -26,8 +26,9 @@ pub struct FlowMap {
     pub grazing_distance: f64,
     /// Time spent in region II (contact, or sticking for the impact law).
     pub contact_time: f64,
-    /// Σ ln|det J_step| + Σ ln|det S|: the log of the phase-volume change (for an affine
-    /// region ln det e^{A t} = t trace A, Liouville).
+    /// ln|det ∂z(τ1)/∂z(τ0)| = Σ ln|det J_step| + Σ ln|det S|: the log of the phase-volume
+    /// change (for an affine region ln det e^{A t} = t trace A, Liouville), from one determinant
+    /// of the product.
     pub log_volume: f64,
 }
 
@@ -68,9 +69,7 @@ pub fn flow_with_jacobian(
         if len <= 0.0 && step.event.is_none() {
             continue;
         }
-        let j = integ.last_step_jacobian()?;
-        out.log_volume += j.clone().lu().determinant().abs().ln();
-        jac = j * jac;
+        jac = integ.last_step_jacobian()? * jac;
         if step.region == Region::Contact {
             out.contact_time += len;
         }
@@ -89,9 +88,7 @@ pub fn flow_with_jacobian(
             out.grazing_distance = out.grazing_distance.min(vt(t)[0].abs());
         }
         if let Some(e) = &step.event {
-            let s = integ.model().saltation(e.from, e.tau, &e.state);
-            out.log_volume += s.clone().lu().determinant().abs().ln();
-            jac = s * jac;
+            jac = integ.model().saltation(e.from, e.tau, &e.state) * jac;
             out.switchings += 1;
             if e.to == Region::Contact || e.kind == EventKind::Impact {
                 out.contacts += 1;
@@ -100,6 +97,7 @@ pub fn flow_with_jacobian(
         }
     }
     out.state = integ.state().clone();
+    out.log_volume = jac.clone().lu().determinant().abs().ln();
     out.jacobian = jac;
     Ok(out)
 }
