@@ -11,13 +11,14 @@ use afmdyn::analysis::monodromy::{flow_with_jacobian, stroboscopic};
 use afmdyn::analysis::shooting::{floquet_multipliers, shoot, shoot_with, ShootingOptions};
 use afmdyn::analysis::steady::{steady_state, Motion, SteadyOptions};
 use afmdyn::galerkin::Region;
-use afmdyn::integrate::{
-    advance_dyn, build, Integrator, IntegratorKind, IntegratorOptions, SwitchEvent,
-};
+use afmdyn::integrate::{advance_dyn, build, IntegratorKind, IntegratorOptions, SwitchEvent};
 use afmdyn::trajectory::{record, RecordSpec};
 use afmdyn::{CantileverModel, ContactLaw, EventKind, HybridSystem, Params, SimError, SweepParam};
 use nalgebra::{Complex, DMatrix, DVector};
 use proptest::prelude::*;
+
+mod common;
+use common::{events_until, harmonic_response};
 
 const DMT: ContactLaw = ContactLaw::Dmt {
     hamaker: 1e-5,
@@ -34,38 +35,6 @@ fn opts(kind: IntegratorKind, tol: f64) -> IntegratorOptions {
         },
         tolerance: tol,
     }
-}
-
-fn events_until(integ: &mut dyn Integrator, tau_end: f64) -> Vec<SwitchEvent> {
-    let mut ev = Vec::new();
-    advance_dyn(integ, tau_end, &mut |_, s, _| {
-        if let Some(e) = &s.event {
-            ev.push(e.clone());
-        }
-        Ok(())
-    })
-    .unwrap();
-    ev
-}
-
-/// Closed-form periodic response of the free beam (eqs. 11–14; as in `integrators.rs`).
-fn free_response(model: &CantileverModel, tau: f64) -> DVector<f64> {
-    let g = model.galerkin().region(Region::Free);
-    let w = model.omega();
-    let c = |m: &DMatrix<f64>| m.map(|v| Complex::new(v, 0.0));
-    let dyn_stiff = c(&g.stiffness) - c(&g.mass) * Complex::new(w * w, 0.0)
-        + c(&g.damping) * Complex::new(0.0, w);
-    let rhs =
-        g.forcing.cos.map(|v| Complex::new(v, 0.0)) - g.forcing.sin.map(|v| Complex::new(0.0, v));
-    let xh = dyn_stiff.lu().solve(&rhs).unwrap();
-    let e = Complex::new((w * tau).cos(), (w * tau).sin());
-    let n = model.modes();
-    let mut z = DVector::zeros(2 * n);
-    for j in 0..n {
-        z[j] = (xh[j] * e).re;
-        z[n + j] = (xh[j] * e * Complex::new(0.0, w)).re;
-    }
-    z
 }
 
 // ------------------------------------------------------------ conformance: law × integrator
@@ -88,10 +57,16 @@ fn conformance(law: ContactLaw, kind: IntegratorKind, tol: f64) {
         ..Params::default()
     };
     let m = CantileverModel::new(&p).unwrap();
-    let mut it = build(&m, opts(kind, 1e-13), 0.0, &free_response(&m, 0.0)).unwrap();
+    let mut it = build(
+        &m,
+        opts(kind, 1e-13),
+        0.0,
+        &harmonic_response(&m, Region::Free, 0.0),
+    )
+    .unwrap();
     assert!(events_until(it.as_mut(), 7.3).is_empty(), "{law} {kind:?}");
     assert_eq!(it.tau(), 7.3, "{law} {kind:?}");
-    let err = (it.state() - free_response(&m, 7.3)).amax();
+    let err = (it.state() - harmonic_response(&m, Region::Free, 7.3)).amax();
     assert!(err < tol, "{law} {kind:?}: {err:e}");
     // (b) with the sample: events chain region to region, sit on their guard, do not re-trigger
     let p = Params {
