@@ -56,6 +56,18 @@ pub enum ContactLaw {
 }
 
 impl ContactLaw {
+    /// Distance d − V_T between tip–sample distance and switching function: ã₀ for DMT
+    /// (d = a₀ + V_T, contact at d ≤ a₀), 0 for the other laws (contact at d = V_T ≤ 0).
+    pub fn distance_offset(&self) -> f64 {
+        match self {
+            ContactLaw::Dmt {
+                intermolecular_distance,
+                ..
+            } => *intermolecular_distance,
+            _ => 0.0,
+        }
+    }
+
     /// The law's name: `linear`, `hertz`, `dmt` or `impact`.
     pub fn name(&self) -> &'static str {
         match self {

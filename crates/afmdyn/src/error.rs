@@ -55,6 +55,14 @@ pub enum ParamError {
         /// Why the limit exists.
         reason: &'static str,
     },
+    /// A parameter the structural model does not allow (see [`crate::params::Structure`]).
+    #[error("{name}: got {value}")]
+    Structure {
+        /// Field and the allowed value.
+        name: &'static str,
+        /// The rejected value (NaN when it is not a number).
+        value: f64,
+    },
 }
 
 /// A physical-unit input outside its allowed range (see [`crate::units`]).

@@ -7,7 +7,7 @@
 
 use crate::beam::ModeShapes;
 use crate::error::ParamError;
-use crate::params::Params;
+use crate::params::{Params, Structure};
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
@@ -111,11 +111,21 @@ impl Galerkin {
         params.validate()?;
         let n = params.modes;
         let shapes = ModeShapes::new(n);
-        let tip = DVector::from_vec(shapes.tip());
-        let integrals = DVector::from_vec(shapes.integrals());
+        // the point-mass model (params::Structure): one coordinate z = V_T − α5 with φ(1) = 1,
+        // unit mass and stiffness, no distributed inertia (∫φ = 0) and a force drive
+        let point_mass = params.structure == Structure::PointMass;
+        let (tip, integrals, k_diag) = if point_mass {
+            (DVector::from_element(1, 1.0), DVector::zeros(1), vec![1.0])
+        } else {
+            (
+                DVector::from_vec(shapes.tip()),
+                DVector::from_vec(shapes.integrals()),
+                shapes.beta4(),
+            )
+        };
         let outer = &tip * tip.transpose();
         let mass = mass_matrix(params, &outer);
-        let k_free = DMatrix::from_diagonal(&DVector::from_vec(shapes.beta4()));
+        let k_free = DMatrix::from_diagonal(&DVector::from_vec(k_diag));
         let free = RegionMatrices {
             mass: mass.clone(),
             damping: damping_free(params, n),
@@ -172,9 +182,16 @@ fn mass_matrix(p: &Params, outer: &DMatrix<f64>) -> DMatrix<f64> {
     DMatrix::identity(p.modes, p.modes) + outer * p.alpha1
 }
 
-/// Eq. 12: C^I_ij = δ_ij α3 ∫φ_i φ_j dξ = α3 δ_ij.
+/// Eq. 12: C^I_ij = δ_ij α3 ∫φ_i φ_j dξ = α3 δ_ij, generalised to modal damping
+/// C^I = α3 diag(s_1 … s_N) with the profile s_j of [`Params::damping_profile`] (s_j = 1 in the
+/// paper); s_j = (β_j²/β_1²)(Q_1/Q_j) gives mode j of the bare beam the quality factor Q_j.
 fn damping_free(p: &Params, n: usize) -> DMatrix<f64> {
-    DMatrix::identity(n, n) * p.alpha3
+    DMatrix::from_diagonal(&DVector::from_fn(n, |j, _| p.alpha3 * profile(p, j)))
+}
+
+/// s_j of the damping profile (1 without one).
+fn profile(p: &Params, j: usize) -> f64 {
+    p.damping_profile.map_or(1.0, |s| s[j])
 }
 
 /// Eq. 16: C^II_ij = α3 δ_ij + α6 φ_i(1) φ_j(1).
@@ -187,21 +204,33 @@ fn stiffness_contact(p: &Params, k_free: &DMatrix<f64>, outer: &DMatrix<f64>) ->
     k_free + outer * p.alpha4
 }
 
-/// Eq. 14: F^I_i = α2 Ω² [α1 φ_i(1) + ∫φ_i] sin Ωτ − α2 α3 ∫φ_i cos Ωτ.
+/// Eq. 14: F^I_i = α2 Ω² [α1 φ_i(1) + ∫φ_i] sin Ωτ − α2 α3 s_i ∫φ_i cos Ωτ (s_i of the damping
+/// profile, 1 in the paper). The point-mass model has the force drive F^I = α2 cos Ωτ instead.
 fn forcing_free(p: &Params, tip: &DVector<f64>, integrals: &DVector<f64>) -> Forcing {
     let n = tip.len();
+    if p.structure == Structure::PointMass {
+        return Forcing {
+            constant: DVector::zeros(n),
+            sin: DVector::zeros(n),
+            cos: DVector::from_element(n, p.alpha2),
+        };
+    }
     Forcing {
         constant: DVector::zeros(n),
         sin: (tip * p.alpha1 + integrals) * (p.alpha2 * p.omega * p.omega),
-        cos: integrals * (-p.alpha2 * p.alpha3),
+        cos: DVector::from_fn(n, |i, _| {
+            -p.alpha2 * p.alpha3 * profile(p, i) * integrals[i]
+        }),
     }
 }
 
-/// Eq. 18: F^II_i = F^I_i − α2 α4 φ_i(1) sin Ωτ − α4 α5 φ_i(1) − α2 α6 Ω φ_i(1) cos Ωτ.
+/// Eq. 18: F^II_i = F^I_i − α2 α4 φ_i(1) sin Ωτ − α4 α5 φ_i(1) − α2 α6 Ω φ_i(1) cos Ωτ, the
+/// base terms with the base amplitude of V_T ([`Params::base_amplitude`], 0 for the point mass).
 fn forcing_contact(p: &Params, tip: &DVector<f64>, free: &Forcing) -> Forcing {
+    let b = p.base_amplitude();
     Forcing {
         constant: tip * (-p.alpha4 * p.alpha5),
-        sin: &free.sin - tip * (p.alpha2 * p.alpha4),
-        cos: &free.cos - tip * (p.alpha2 * p.alpha6 * p.omega),
+        sin: &free.sin - tip * (b * p.alpha4),
+        cos: &free.cos - tip * (b * p.alpha6 * p.omega),
     }
 }

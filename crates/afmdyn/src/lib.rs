@@ -53,5 +53,5 @@ pub use error::{ParamError, SimError, UnitsError};
 pub use galerkin::Region;
 pub use integrate::{Integrator, IntegratorKind, IntegratorOptions};
 pub use model::CantileverModel;
-pub use params::{Params, SweepParam};
+pub use params::{Params, Structure, SweepParam};
 pub use system::{EventKind, HybridSystem};

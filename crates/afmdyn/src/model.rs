@@ -245,8 +245,8 @@ impl CantileverModel {
                 let tip = self.tip().as_slice();
                 let w: f64 = tip.iter().zip(&z[..n]).map(|(a, b)| a * b).sum();
                 let wd: f64 = tip.iter().zip(&z[n..]).map(|(a, b)| a * b).sum();
-                let v = w + p.alpha2 * s + p.alpha5;
-                let vd = wd + p.alpha2 * p.omega * c;
+                let v = w + p.base_amplitude() * s + p.alpha5;
+                let vd = wd + p.base_amplitude() * p.omega * c;
                 self.law.force(contact, -v, -vd).force
             }
         }
@@ -339,9 +339,9 @@ impl CantileverModel {
         let p = &self.params;
         let (s, c) = (p.omega * tau).sin_cos();
         [
-            w[0] + p.alpha2 * s + p.alpha5,
-            w[1] + p.alpha2 * p.omega * c,
-            w[2] - p.alpha2 * p.omega * p.omega * s,
+            w[0] + p.base_amplitude() * s + p.alpha5,
+            w[1] + p.base_amplitude() * p.omega * c,
+            w[2] - p.base_amplitude() * p.omega * p.omega * s,
         ]
     }
     /// dV_T/dτ = ∂W(1,τ)/∂τ + α2 Ω cos Ωτ.
@@ -354,7 +354,11 @@ impl CantileverModel {
         Region::of_v_t(self.v_t(tau, z))
     }
     /// Beam deflection W(ξ,τ) = Σ a_j φ_j(ξ) (eq. 9).
+    /// For the point-mass model, the tip deflection z at every ξ.
     pub fn deflection(&self, xi: f64, z: &DVector<f64>) -> f64 {
+        if self.params.structure == crate::params::Structure::PointMass {
+            return z[0];
+        }
         let phi = self.galerkin.shapes().values(xi);
         phi.iter().zip(z.iter()).map(|(p, a)| p * a).sum()
     }
@@ -387,7 +391,7 @@ impl CantileverModel {
         let rate = -self.v_t_dot(tau, z);
         let delta = -self.v_t(tau, z);
         PowerTerms {
-            base: drive - p.alpha2 * p.omega * c * fc,
+            base: drive - p.base_amplitude() * p.omega * c * fc,
             beam_dissipation: beam,
             contact_dissipation: self.law.dissipative(r == Region::Contact, delta, rate) * rate,
         }
@@ -400,7 +404,7 @@ impl CantileverModel {
     /// ΔE = −loss + base (derivation in `docs/contact-laws.md`).
     pub fn impact_energy(&self, tau: f64, v_minus: f64, restitution: f64) -> (f64, f64) {
         let p = &self.params;
-        let base_velocity = p.alpha2 * p.omega * (p.omega * tau).cos();
+        let base_velocity = p.base_amplitude() * p.omega * (p.omega * tau).cos();
         let loss = 0.5 * (1.0 - restitution * restitution) * self.m_eff * v_minus * v_minus;
         let base = (1.0 + restitution) * self.m_eff * v_minus * base_velocity;
         (loss, base)
@@ -430,13 +434,13 @@ impl CantileverModel {
             grad[j] -= self.m_eff * beta * beta * phi;
             grad[n + j] -= self.m_eff * 2.0 * beta * phi;
         }
-        let dv_tau = p.alpha2 * om * c;
-        let dvd_tau = -p.alpha2 * om * om * s;
+        let dv_tau = p.base_amplitude() * om * c;
+        let dvd_tau = -p.base_amplitude() * om * om * s;
         Guard {
             value: self.sticking_force_value(tau, z),
             grad,
             d_tau: self.m_eff
-                * (p.alpha2 * om * om * om * c
+                * (p.base_amplitude() * om * om * om * c
                     - om * (fs * c - fc * s)
                     - 2.0 * beta * dvd_tau
                     - beta * beta * dv_tau),
@@ -454,7 +458,7 @@ impl CantileverModel {
         let acc =
             self.tip_acc.iter().zip(z).map(|(a, b)| a * b).sum::<f64>() + f0 + fs * s + fc * c;
         let (v, vd) = self.v_t_pair(tau, z);
-        self.m_eff * (p.alpha2 * om * om * s - acc - 2.0 * beta * vd - beta * beta * v)
+        self.m_eff * (p.base_amplitude() * om * om * s - acc - 2.0 * beta * vd - beta * beta * v)
     }
 
     /// Check a state: length 2N, finite components, ‖z‖ below the integrators' divergence
@@ -616,7 +620,7 @@ impl HybridSystem for CantileverModel {
         Guard {
             value: sigma * self.v_t_pair(tau, z).0,
             grad,
-            d_tau: sigma * p.alpha2 * p.omega * (p.omega * tau).cos(),
+            d_tau: sigma * p.base_amplitude() * p.omega * (p.omega * tau).cos(),
         }
     }
 
@@ -670,7 +674,7 @@ impl HybridSystem for CantileverModel {
         block.ger(-k, &self.mphi, self.tip(), 1.0);
         // ∂ȧ⁺/∂τ = −(1 + r) m_eff M⁻¹φ ∂V̇_T⁻/∂τ, ∂V̇_T⁻/∂τ = −α2 Ω² sin Ωτ
         let mut d_tau = DVector::zeros(2 * n);
-        let dv = -p.alpha2 * p.omega * p.omega * (p.omega * tau).sin();
+        let dv = -p.base_amplitude() * p.omega * p.omega * (p.omega * tau).sin();
         d_tau.rows_mut(n, n).copy_from(&(-k * dv * &self.mphi));
         Jump {
             to: if sticks {
@@ -703,7 +707,7 @@ impl HybridSystem for CantileverModel {
         let p = &self.params;
         let n = p.modes;
         let wd: f64 = self.tip().iter().zip(&f[..n]).map(|(a, b)| a * b).sum();
-        mode.guard_sign() * (wd + p.alpha2 * p.omega * (p.omega * tau).cos())
+        mode.guard_sign() * (wd + p.base_amplitude() * p.omega * (p.omega * tau).cos())
     }
 
     /// 1e-12 of the guard's scale: of V_T, 1 + α2 + |α5|; of the constraint force of sticking,
@@ -711,9 +715,9 @@ impl HybridSystem for CantileverModel {
     fn guard_tolerance(&self, mode: Region, _tau: f64, _z: &[f64]) -> f64 {
         let p = &self.params;
         if mode == Region::Contact && self.law.law.restitution().is_some() {
-            1e-12 * self.m_eff * (1.0 + p.alpha2 * p.omega * p.omega)
+            1e-12 * self.m_eff * (1.0 + p.base_amplitude() * p.omega * p.omega)
         } else {
-            1e-12 * (1.0 + p.alpha2 + p.alpha5.abs())
+            1e-12 * (1.0 + p.base_amplitude() + p.alpha5.abs())
         }
     }
 
@@ -780,6 +784,12 @@ impl BodyContactCheck {
     pub fn new(model: &CantileverModel, points: usize) -> Self {
         let n = model.modes();
         let shapes = model.galerkin().shapes();
+        // the point-mass model has no beam body
+        let points = if model.params().structure == crate::params::Structure::PointMass {
+            0
+        } else {
+            points
+        };
         let mut phi = DMatrix::zeros(points, n);
         for i in 0..points {
             let xi = 0.99 * (i + 1) as f64 / points as f64;
@@ -793,7 +803,7 @@ impl BodyContactCheck {
     /// Whether any station touches the substrate at (τ, z).
     pub fn touches(&self, model: &CantileverModel, tau: f64, z: &DVector<f64>) -> bool {
         let p = model.params();
-        let base = p.alpha2 * (p.omega * tau).sin() + 1.0;
+        let base = p.base_amplitude() * (p.omega * tau).sin() + 1.0;
         let n = model.modes();
         let w = &self.phi * z.rows(0, n);
         w.iter().any(|wi| wi + base <= 0.0)

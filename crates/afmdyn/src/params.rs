@@ -81,6 +81,56 @@ pub struct Params {
     /// The tip–sample force law (default: the paper's linear spring–damper).
     #[serde(default)]
     pub contact_law: ContactLaw,
+    /// The structural model: the paper's beam (default) or the point-mass model of the AFM
+    /// literature ([`Structure`]).
+    #[serde(default)]
+    pub structure: Structure,
+    /// Per-mode damping profile s_j of the beam, C^I = α3 diag(s_1 … s_N) (`None`: s_j = 1,
+    /// eq. 12). Only the first N entries are used; set from per-mode quality factors by
+    /// [`crate::probe`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub damping_profile: Option<[f64; MAX_MODES]>,
+}
+
+/// The structural model of the cantilever.
+///
+/// * `Beam` — the paper: N clamped–free Galerkin modes with a tip mass α1, driven by the base
+///   displacement α2 sin Ωτ (eqs. 8–18); V_T = W(1,τ) + α2 sin Ωτ + α5.
+/// * `PointMass` — the standard model of the AFM literature (García & Pérez, *Surf. Sci. Rep.*
+///   47 (2002) 197, eq. 6; García & San Paulo, *Phys. Rev. B* 60 (1999) 4961): one eigenmode
+///   driven by a force at the tip, m z̈ + (m ω₀/Q) ż + k z = F₀ cos ωt + F_ts(d, ḋ), d = z_c + z.
+///   In the units τ = ω₀ t and lengths of g₀ (forces of k g₀) it reads
+///   z'' + α3 z' + z = α2 cos Ωτ + F_c with α3 = 1/Q, α2 = F₀/(k g₀), Ω = ω/ω₀, and
+///   V_T = z + α5 (the base does not move): N = 1, φ(1) = 1, M = 1, K = 1, α1 = 0.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum Structure {
+    /// The paper's Euler–Bernoulli beam in N Galerkin modes, base-driven.
+    #[default]
+    Beam,
+    /// One eigenmode with a force drive (the point-mass model).
+    PointMass,
+}
+
+impl Structure {
+    /// `beam` or `point-mass`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Structure::Beam => "beam",
+            Structure::PointMass => "point-mass",
+        }
+    }
+}
+
+impl FromStr for Structure {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s.trim().to_ascii_lowercase().replace('_', "-").as_str() {
+            "beam" => Ok(Structure::Beam),
+            "point-mass" | "pointmass" => Ok(Structure::PointMass),
+            _ => Err(format!("model '{s}': expected beam or point-mass")),
+        }
+    }
 }
 
 impl Default for Params {
@@ -96,6 +146,8 @@ impl Default for Params {
             alpha6: 0.2,
             omega: 2.6,
             contact_law: ContactLaw::Linear,
+            structure: Structure::Beam,
+            damping_profile: None,
         }
     }
 }
@@ -125,7 +177,7 @@ impl Params {
             alpha5,
             alpha6,
             omega,
-            contact_law: ContactLaw::Linear,
+            ..Params::default()
         };
         p.validate()?;
         Ok(p)
@@ -227,7 +279,81 @@ impl Params {
                 },
             });
         }
-        self.contact_law.validate()
+        self.contact_law.validate()?;
+        if let Some(profile) = &self.damping_profile {
+            for &s in &profile[..self.modes] {
+                if !(s.is_finite() && s >= 0.0) {
+                    return Err(ParamError::NonNegative {
+                        name: "damping_profile (per-mode damping s_j)",
+                        value: s,
+                    });
+                }
+                if s * self.alpha3 > DAMPING_MAX {
+                    return Err(ParamError::Magnitude {
+                        name: "damping_profile (per-mode damping α3 s_j)",
+                        value: s * self.alpha3,
+                        range: "[0, 1e4]",
+                        reason: DAMPING,
+                    });
+                }
+            }
+        }
+        if self.structure == Structure::PointMass {
+            for (name, bad, value) in [
+                (
+                    "modes (point-mass model: exactly 1)",
+                    self.modes != 1,
+                    self.modes as f64,
+                ),
+                (
+                    "alpha1 (point-mass model: no tip mass, 0)",
+                    self.alpha1 != 0.0,
+                    self.alpha1,
+                ),
+            ] {
+                if bad {
+                    return Err(ParamError::Structure { name, value });
+                }
+            }
+            if self.damping_profile.is_some() {
+                return Err(ParamError::Structure {
+                    name: "damping_profile (point-mass model: one mode, use alpha3 = 1/Q)",
+                    value: f64::NAN,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Amplitude of the base displacement in V_T (eq. 8): α2 for the beam, 0 for the point-mass
+    /// model, whose drive is a force and whose base does not move. Every V_T formula uses this.
+    pub fn base_amplitude(&self) -> f64 {
+        match self.structure {
+            Structure::Beam => self.alpha2,
+            Structure::PointMass => 0.0,
+        }
+    }
+
+    /// Phase ψ of the drive: the drive is ∝ sin(Ωτ + ψ), ψ = 0 for the beam (base displacement
+    /// α2 sin Ωτ) and π/2 for the point-mass model (force α2 cos Ωτ). Phases of the response
+    /// are measured as lags behind it.
+    pub fn drive_phase(&self) -> f64 {
+        match self.structure {
+            Structure::Beam => 0.0,
+            Structure::PointMass => std::f64::consts::FRAC_PI_2,
+        }
+    }
+
+    /// The rest distance z_c between tip and sample (units of g₀): the tip–sample distance
+    /// d = V_T + ã₀ (DMT, [`ContactLaw::distance_offset`]) or d = V_T (other laws) with the
+    /// cantilever at rest, V_T = α5. The approach curve's abscissa.
+    pub fn rest_distance(&self) -> f64 {
+        self.alpha5 + self.contact_law.distance_offset()
+    }
+
+    /// α5 that gives the rest distance `z_c` (inverse of [`Params::rest_distance`]).
+    pub fn alpha5_for_rest_distance(&self, z_c: f64) -> f64 {
+        z_c - self.contact_law.distance_offset()
     }
 
     /// The drive period T = 2π/Ω.

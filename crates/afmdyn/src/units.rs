@@ -239,6 +239,7 @@ impl PhysicalModel {
             alpha5: self.tip_gap / self.beam_gap,
             alpha6: self.contact_damping * l / root,
             omega: std::f64::consts::TAU * self.drive_frequency_hz * c.time_scale(),
+            ..Params::default()
         };
         p.validate()?;
         Ok(p)

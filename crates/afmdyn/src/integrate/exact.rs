@@ -461,7 +461,7 @@ impl ExactPropagator {
                 row = at.transpose() * row;
             }
             let kappa2 = rows.row(2).norm();
-            let vp_curv = omega * omega * (wp[1] + p.alpha2).hypot(wp[2]);
+            let vp_curv = omega * omega * (wp[1] + p.base_amplitude()).hypot(wp[2]);
             let mut modal = ModalExp::new(&at);
             if let Some(me) = &mut modal {
                 let ct = rows.row(0).transpose().map(|x| Complex::new(x, 0.0));
@@ -491,7 +491,7 @@ impl ExactPropagator {
             .iter()
             .map(|r| r.wp[1].hypot(r.wp[2]) + r.wp[0].abs())
             .fold(0.0, f64::max);
-        let dead = 1e-15 * (1.0 + p.alpha5.abs() + p.alpha2 + scale);
+        let dead = 1e-15 * (1.0 + p.alpha5.abs() + p.base_amplitude() + scale);
         let zero = DVector::zeros(dim);
         Ok(ExactPropagator {
             model: model.clone(),
@@ -661,7 +661,7 @@ impl ExactPropagator {
             terms,
             wp: rp.wp,
             omega: p.omega,
-            alpha2: p.alpha2,
+            alpha2: p.base_amplitude(),
             alpha5: p.alpha5,
             sigma: region.guard_sign(),
             dead: self.dead,
@@ -808,8 +808,8 @@ impl Integrator for ExactPropagator {
             let zb = z_b.as_slice();
             let dot = |x: &[f64]| tip.iter().zip(x).map(|(a, b)| a * b).sum::<f64>();
             (
-                dot(&zb[..n]) + p.alpha2 * s + p.alpha5,
-                dot(&zb[n..]) + p.alpha2 * p.omega * c,
+                dot(&zb[..n]) + p.base_amplitude() * s + p.alpha5,
+                dot(&zb[n..]) + p.base_amplitude() * p.omega * c,
             )
         } else {
             self.state_in_last(len, &mut z_b);
