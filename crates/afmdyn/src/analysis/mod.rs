@@ -9,6 +9,7 @@ pub mod continuation;
 pub mod converge;
 pub mod lyapunov;
 pub mod monodromy;
+pub mod observables;
 pub mod period;
 pub mod shooting;
 pub mod steady;
