@@ -185,6 +185,9 @@ pub struct Observables {
     pub higher_sq: f64,
     /// Σ_{n≥2} n² A_n² over all n = 2⟨Ẇ²⟩/Ω² − A₁² (Parseval; ⟨Ẇ⟩ = 0 on a periodic orbit).
     pub higher_n2_sq: f64,
+    /// ⟨F_c⟩: time-averaged tip–sample force (with impulses); for the point mass the static
+    /// balance gives ⟨z⟩ = ⟨F_c⟩/k on a periodic orbit.
+    pub mean_force: f64,
     /// Largest finite F_c (repulsive positive; impulses of the impact law excluded).
     pub peak_force: f64,
     /// Smallest F_c (the largest attraction when negative).
@@ -310,6 +313,7 @@ struct Acc {
     e_dis: f64,
     impact_loss: f64,
     virial: f64,
+    force: f64,
     contact_time: f64,
     impacts: usize,
     drive: Vec<f64>,
@@ -392,6 +396,7 @@ pub fn observe(
         e_dis: 0.0,
         impact_loss: 0.0,
         virial: 0.0,
+        force: 0.0,
         contact_time: 0.0,
         impacts: 0,
         drive: vec![0.0; n],
@@ -455,6 +460,7 @@ pub fn observe(
                     }
                     acc.e_dis -= wq * nd.f * nd.v[1];
                     acc.virial += wq * nd.f * nd.w;
+                    acc.force += wq * nd.f;
                     free.forcing.eval_into(om, tau, &mut fi);
                     let (x_, xd, xdd) = (nd.z.rows(0, n), nd.z.rows(n, n), nd.dz.rows(n, n));
                     for j in 0..n {
@@ -518,6 +524,7 @@ pub fn observe(
                 acc.impact_loss += loss;
                 let imp = -(1.0 + rc) * model.effective_mass() * e.v_t_dot;
                 acc.virial += imp * model.w_tip(&e.state);
+                acc.force += imp;
                 let after = integ.state();
                 for j in 0..n {
                     let avg = 0.5 * (e.state[n + j] + after[n + j]);
@@ -580,6 +587,7 @@ pub fn observe(
         mean_deflection: mean,
         higher_sq,
         higher_n2_sq,
+        mean_force: acc.force / t_tot,
         peak_force: acc.f_max,
         min_force: acc.f_min,
         indentation: (-acc.v_min).max(0.0),
