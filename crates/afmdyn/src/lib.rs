@@ -42,6 +42,7 @@ pub mod galerkin;
 pub mod integrate;
 pub mod model;
 pub mod params;
+pub mod probe;
 pub mod report;
 pub mod roots;
 pub mod system;

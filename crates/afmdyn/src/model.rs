@@ -410,6 +410,39 @@ impl CantileverModel {
         (loss, base)
     }
 
+    /// Complex amplitude H of the free steady response of the tip deflection (no sample force,
+    /// the linear free system of eqs. 11–14): W(1,τ) = Im(H e^{i(Ωτ + ψ)}) with ψ the drive
+    /// phase ([`Params::drive_phase`]), so |H| is the free amplitude A₀ (units of g₀) and
+    /// −arg H the phase lag behind the drive. From (K − Ω²M + iΩC) X = F_s + i F_c for the
+    /// forcing F_s sin Ωτ + F_c cos Ωτ, H = φ(1)ᵀX e^{−iψ} (the harmonic-balance solution of a
+    /// linear system, e.g. Meirovitch, *Fundamentals of Vibrations*, McGraw-Hill 2001, §7.15).
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] when Ω is at an undamped natural frequency (no steady state).
+    pub fn free_tip_response(&self) -> Result<nalgebra::Complex<f64>, SimError> {
+        use nalgebra::Complex;
+        let g = self.galerkin.region(Region::Free);
+        let om = self.params.omega;
+        let dyn_stiff = DMatrix::from_fn(self.modes(), self.modes(), |i, j| {
+            Complex::new(
+                g.stiffness[(i, j)] - om * om * g.mass[(i, j)],
+                om * g.damping[(i, j)],
+            )
+        });
+        let f = DVector::from_fn(self.modes(), |i, _| {
+            Complex::new(g.forcing.sin[i], g.forcing.cos[i])
+        });
+        let x = dyn_stiff.lu().solve(&f).ok_or_else(|| {
+            SimError::out_of_range(
+                "omega",
+                om,
+                "the free system has no steady state at an undamped natural frequency",
+            )
+        })?;
+        let tip: Complex<f64> = self.tip().iter().zip(x.iter()).map(|(p, xi)| xi * *p).sum();
+        Ok(tip * Complex::from_polar(1.0, -self.params.drive_phase()))
+    }
+
     /// Saltation matrix (2N×2N) at an event of region `from` at (τ, z⁻): the generic
     /// [`crate::system::saltation`] of this system. For the linear law on V_T = 0 only the
     /// damper term α6 V̇_T jumps, so S ≠ I whenever α6 > 0.

@@ -1,0 +1,864 @@
+//! Probe files: a real cantilever, tip, sample and drive in SI units → the model's
+//! dimensionless set (α1 … α6, Ω and the law's groups) and the scales back to SI.
+//!
+//! ```toml
+//! model = "beam"                 # "beam" (N Galerkin modes, the paper) or "point-mass"
+//! modes = 3                      # beam only
+//! [cantilever]                   # calibrated values ...
+//! spring_constant = 40.0         # k (N/m), first-mode equivalent stiffness at the tip
+//! resonance_frequency = 300e3    # f₀ (Hz), first free resonance (tip mass included)
+//! quality_factor = 400           # Q₁; optional quality_factors = [...] per mode
+//! tip_mass_ratio = 0.0           # optional α1 = M/(mL) of the beam (default 0)
+//! # ... or geometry: length, width, thickness, youngs_modulus, density, tip_mass (+ quality_factor)
+//! [tip]
+//! radius = 10e-9                 # R (m)
+//! youngs_modulus = 130e9         # E_t (Pa)
+//! poisson_ratio = 0.27           # ν_t
+//! [sample]
+//! law = "dmt"                    # linear | hertz | dmt | impact
+//! youngs_modulus = 4e9           # E_s (Pa)            (hertz, dmt)
+//! poisson_ratio = 0.33           # ν_s                 (hertz, dmt)
+//! hamaker = 6.6e-20              # H (J)               (dmt)
+//! intermolecular_distance = 0.165e-9  # a₀ (m)         (dmt)
+//! viscosity = 0.0                # η (Pa·s), Kelvin–Voigt −η√(R(a₀ − d))·ḋ (dmt)
+//! # hertz: damping (N·s/m); linear: stiffness (N/m), damping (N·s/m); impact: restitution
+//! z_c = 8e-9                     # optional rest tip–sample distance (m), default A₀
+//! [drive]
+//! free_amplitude = 10e-9         # A₀ (m) at the drive frequency, far from the sample
+//! frequency = 300e3              # f (Hz), default f₀
+//! ```
+//!
+//! **Scales.** Lengths are measured in g₀ = A₀, so the dimensionless free amplitude is 1 and
+//! A/A₀ is read directly. Time: τ = ω̃₁ · 2πf₀ t, where ω̃₁ is the dimensionless first natural
+//! frequency of the model *with* the tip mass (1 for the point mass): t_s = ω̃₁/(2πf₀) seconds per
+//! unit τ. Force: the unit F_s = k g₀/k̃₁, where k̃₁ is the dimensionless first-mode stiffness at
+//! the tip.
+//!
+//! **Modal vs static stiffness (beam).** A calibrated k (thermal noise, Sader) is the stiffness
+//! of the first mode at the tip, k₁ = ω₁² m₁ with the modal mass referred to the tip
+//! m₁ = x₁ᵀ M x₁/(φ(1)ᵀx₁)² (Meirovitch, *Fundamentals of Vibrations*, McGraw-Hill 2001, §7.4;
+//! Butt & Jaschke, *Nanotechnology* 6 (1995) 1). In the units of eq. 5 that is
+//! k̃₁ = ω̃₁² x₁ᵀ M x₁/(φ(1)ᵀx₁)² times EI/L³: 3.09 for the bare beam (β₁⁴/4 = 3.0906, against the
+//! static 3EI/L³: the modal value is 3 % stiffer), so EI/L³ = k/k̃₁.
+//!
+//! **Damping.** α3 gives mode 1 the quality factor Q₁: with C^I = α3 diag(s) (eq. 12
+//! generalised, [`crate::Params::damping_profile`]), α3 = ω̃₁ x₁ᵀMx₁/(Q₁ x₁ᵀ diag(s) x₁) for the
+//! undamped mode x₁ (modal damping ratio 1/(2Q₁), Meirovitch §7.16). Per-mode quality factors
+//! set s_j = (β_j²/β₁²)(Q₁/Q_j), exact for the bare beam (α1 = 0), where mode j's damping
+//! ratio is α3 s_j/(2β_j²); with a tip mass the modes mix and the achieved Q_j (reported by
+//! `afmdyn modes`) differ slightly.
+//!
+//! **Drive.** The beam is base-driven (eq. 14); α2 is chosen so that the free tip deflection
+//! amplitude at Ω is A₀: α2 = 1/|H(Ω)|, H the tip response per unit α2 of the linear free system
+//! ([`crate::CantileverModel::free_tip_response`]). The point mass is force-driven:
+//! α2 = F₀/(k A₀) = √((1 − Ω²)² + (Ω/Q)²) (the harmonic oscillator's response).
+//!
+//! **Sample** (force unit F_s, length g₀, time t_s; E* from 1/E* = (1 − ν_t²)/E_t +
+//! (1 − ν_s²)/E_s, Johnson, *Contact Mechanics*, CUP 1985, eq. 4.22):
+//! * linear: α4 = K g₀/F_s, α6 = c g₀/(t_s F_s);
+//! * hertz: F = (4/3)E*√R δ^{3/2} (Johnson eq. 4.23): α4 = (4/3)E*√R g₀^{3/2}/F_s, α6 as linear;
+//! * dmt (Derjaguin, Muller & Toporov 1975; García & San Paulo, *Phys. Rev. B* 60 (1999) 4961):
+//!   α4 as hertz, H̃ = H R/(6 g₀² F_s), ã₀ = a₀/g₀, α6 = η √(R g₀) g₀/(t_s F_s) (the
+//!   Kelvin–Voigt term η√(Rδ) δ̇);
+//! * impact: the restitution r.
+//!
+//! The rest distance z_c sets α5 = z_c/g₀ − ã₀ (DMT) or z_c/g₀ ([`crate::Params::rest_distance`]).
+//!
+//! **Errors.** Every problem of a file is collected: unknown keys, missing keys (named with their
+//! section) and values out of range, all listed in one [`ProbeError::Invalid`].
+
+use crate::contact::ContactLaw;
+use crate::eigen::natural_modes;
+use crate::galerkin::{Galerkin, Region};
+use crate::model::CantileverModel;
+use crate::params::{Params, Structure, MAX_MODES};
+use serde::Serialize;
+use std::f64::consts::TAU;
+use std::path::Path;
+use thiserror::Error;
+
+/// A probe file that cannot be used.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum ProbeError {
+    /// The file could not be read.
+    #[error("{path}: {message}")]
+    Io {
+        /// The path.
+        path: String,
+        /// The operating system's message.
+        message: String,
+    },
+    /// Not TOML (with line and column from the parser).
+    #[error("{path}: {message}")]
+    Syntax {
+        /// The path, or `<string>`.
+        path: String,
+        /// The parser's message.
+        message: String,
+    },
+    /// Unknown, missing or out-of-range keys, all of them.
+    #[error("{path}: {}", .problems.join("; "))]
+    Invalid {
+        /// The path, or `<string>`.
+        path: String,
+        /// One entry per problem, each naming the key with its section.
+        problems: Vec<String>,
+    },
+}
+
+/// Scales from the dimensionless model back to SI.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Scales {
+    /// Metres per unit length (g₀ = A₀).
+    pub length_m: f64,
+    /// Seconds per unit τ.
+    pub time_s: f64,
+    /// Newtons per unit force.
+    pub force_n: f64,
+}
+
+impl Scales {
+    /// Joules per unit energy (force × length).
+    pub fn energy_j(&self) -> f64 {
+        self.force_n * self.length_m
+    }
+    /// Watts per unit power.
+    pub fn power_w(&self) -> f64 {
+        self.energy_j() / self.time_s
+    }
+    /// Frequency in Hz of a dimensionless angular frequency Ω.
+    pub fn frequency_hz(&self, omega: f64) -> f64 {
+        omega / (TAU * self.time_s)
+    }
+    /// Dimensionless Ω of a frequency in Hz.
+    pub fn omega(&self, hz: f64) -> f64 {
+        TAU * hz * self.time_s
+    }
+}
+
+/// The calibrated first-mode values of a probe (given, or derived from the geometry).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Calibration {
+    /// k (N/m), the first-mode stiffness at the tip.
+    pub spring_constant: f64,
+    /// f₀ (Hz), the first free resonance with the tip mass.
+    pub resonance_frequency: f64,
+    /// Q₁.
+    pub quality_factor: f64,
+    /// Q_j per mode when given (beam).
+    pub quality_factors: Option<Vec<f64>>,
+    /// α1, tip-mass ratio of the beam (0 for the point mass).
+    pub tip_mass_ratio: f64,
+    /// The static stiffness 3EI/L³ (N/m) of the beam (for comparison with k; 0 for the point
+    /// mass).
+    pub static_spring_constant: f64,
+}
+
+/// A resolved probe: the model's parameters and the scales to SI.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Probe {
+    /// The dimensionless set (α's, Ω, law, structure).
+    pub params: Params,
+    /// Scales back to SI.
+    pub scales: Scales,
+    /// The cantilever's first-mode calibration.
+    pub calibration: Calibration,
+    /// A₀ (m).
+    pub free_amplitude: f64,
+    /// Drive frequency f (Hz).
+    pub drive_frequency: f64,
+    /// Rest tip–sample distance z_c (m).
+    pub z_c: f64,
+}
+
+/// A TOML table walker that collects every problem instead of stopping at the first.
+struct Reader<'a> {
+    problems: &'a mut Vec<String>,
+}
+
+impl Reader<'_> {
+    fn table<'t>(
+        &mut self,
+        root: &'t toml::Table,
+        name: &str,
+        required: bool,
+    ) -> Option<&'t toml::Table> {
+        match root.get(name) {
+            Some(toml::Value::Table(t)) => Some(t),
+            Some(_) => {
+                self.problems.push(format!("[{name}] must be a table"));
+                None
+            }
+            None => {
+                if required {
+                    self.problems.push(format!("missing table [{name}]"));
+                }
+                None
+            }
+        }
+    }
+
+    fn unknown(&mut self, table: &toml::Table, section: &str, known: &[&str]) {
+        for k in table.keys() {
+            if !known.contains(&k.as_str()) {
+                self.problems.push(format!(
+                    "unknown key {}{k} (expected one of: {})",
+                    prefix(section),
+                    known.join(", ")
+                ));
+            }
+        }
+    }
+
+    /// A number (integers accepted), optional.
+    fn number(&mut self, table: &toml::Table, section: &str, key: &str) -> Option<f64> {
+        match table.get(key) {
+            None => None,
+            Some(toml::Value::Float(x)) => Some(*x),
+            Some(toml::Value::Integer(i)) => Some(*i as f64),
+            Some(_) => {
+                self.problems
+                    .push(format!("{}{key} must be a number", prefix(section)));
+                None
+            }
+        }
+    }
+
+    /// A number that must be present, finite and in `check` (described by `range`).
+    fn required(
+        &mut self,
+        table: &toml::Table,
+        section: &str,
+        key: &str,
+        unit: &str,
+        range: (&str, fn(f64) -> bool),
+    ) -> Option<f64> {
+        match self.number(table, section, key) {
+            None if !table.contains_key(key) => {
+                self.problems
+                    .push(format!("missing key {}{key} ({unit})", prefix(section)));
+                None
+            }
+            None => None,
+            Some(x) => self.check(section, key, unit, x, range),
+        }
+    }
+
+    fn optional(
+        &mut self,
+        table: &toml::Table,
+        section: &str,
+        key: &str,
+        unit: &str,
+        range: (&str, fn(f64) -> bool),
+    ) -> Option<f64> {
+        let x = self.number(table, section, key)?;
+        self.check(section, key, unit, x, range)
+    }
+
+    fn check(
+        &mut self,
+        section: &str,
+        key: &str,
+        unit: &str,
+        x: f64,
+        (range, ok): (&str, fn(f64) -> bool),
+    ) -> Option<f64> {
+        if x.is_finite() && ok(x) {
+            Some(x)
+        } else {
+            self.problems.push(format!(
+                "{}{key} = {x} ({unit}): must be {range}",
+                prefix(section)
+            ));
+            None
+        }
+    }
+
+    fn string<'t>(&mut self, table: &'t toml::Table, section: &str, key: &str) -> Option<&'t str> {
+        match table.get(key) {
+            None => None,
+            Some(toml::Value::String(s)) => Some(s),
+            Some(_) => {
+                self.problems
+                    .push(format!("{}{key} must be a string", prefix(section)));
+                None
+            }
+        }
+    }
+}
+
+fn prefix(section: &str) -> String {
+    if section.is_empty() {
+        String::new()
+    } else {
+        format!("[{section}].")
+    }
+}
+
+const POSITIVE: (&str, fn(f64) -> bool) = ("finite and > 0", |x| x > 0.0);
+const NON_NEGATIVE: (&str, fn(f64) -> bool) = ("finite and >= 0", |x| x >= 0.0);
+const POISSON: (&str, fn(f64) -> bool) = ("in (-1, 0.5]", |x| x > -1.0 && x <= 0.5);
+const UNIT_INTERVAL: (&str, fn(f64) -> bool) = ("in [0, 1]", |x| (0.0..=1.0).contains(&x));
+const ANY: (&str, fn(f64) -> bool) = ("finite", |_| true);
+
+/// The cantilever section, before the model is known.
+enum Beam {
+    Calibrated {
+        k: f64,
+        f0: f64,
+        alpha1: f64,
+    },
+    Geometry {
+        length: f64,
+        ei: f64,
+        mass_per_length: f64,
+        tip_mass: f64,
+    },
+}
+
+/// The sample section in SI.
+struct Sample {
+    law: String,
+    e_star: Option<f64>,
+    radius: Option<f64>,
+    hamaker: Option<f64>,
+    a0: Option<f64>,
+    viscosity: Option<f64>,
+    stiffness: Option<f64>,
+    damping: Option<f64>,
+    restitution: Option<f64>,
+    z_c: Option<f64>,
+}
+
+impl Probe {
+    /// Read and resolve a probe file.
+    ///
+    /// # Errors
+    /// [`ProbeError`] naming the path and every problem.
+    pub fn load(path: &Path) -> Result<Probe, ProbeError> {
+        let text = std::fs::read_to_string(path).map_err(|e| ProbeError::Io {
+            path: path.display().to_string(),
+            message: e.to_string(),
+        })?;
+        Self::parse(&text, &path.display().to_string())
+    }
+
+    /// Resolve a probe from TOML text; `origin` names it in errors.
+    ///
+    /// # Errors
+    /// [`ProbeError::Syntax`] for invalid TOML, [`ProbeError::Invalid`] listing every unknown,
+    /// missing or out-of-range key.
+    pub fn parse(text: &str, origin: &str) -> Result<Probe, ProbeError> {
+        let root: toml::Table = text
+            .parse()
+            .map_err(|e: toml::de::Error| ProbeError::Syntax {
+                path: origin.to_string(),
+                message: e.to_string().replace('\n', " "),
+            })?;
+        let mut problems = Vec::new();
+        let probe = Self::read(&root, &mut problems);
+        match probe {
+            Some(p) if problems.is_empty() => Ok(p),
+            _ => {
+                if problems.is_empty() {
+                    problems.push("invalid probe".into());
+                }
+                Err(ProbeError::Invalid {
+                    path: origin.to_string(),
+                    problems,
+                })
+            }
+        }
+    }
+
+    fn read(root: &toml::Table, problems: &mut Vec<String>) -> Option<Probe> {
+        let mut r = Reader { problems };
+        r.unknown(
+            root,
+            "",
+            &["model", "modes", "cantilever", "tip", "sample", "drive"],
+        );
+        let structure = match r.string(root, "", "model") {
+            None if !root.contains_key("model") => {
+                r.problems
+                    .push("missing key model (\"beam\" or \"point-mass\")".into());
+                None
+            }
+            None => None,
+            Some(s) => match s.parse::<Structure>() {
+                Ok(x) => Some(x),
+                Err(e) => {
+                    r.problems.push(e);
+                    None
+                }
+            },
+        };
+        let modes = match root.get("modes") {
+            None => None,
+            Some(toml::Value::Integer(i)) if (1..=MAX_MODES as i64).contains(i) => {
+                Some(*i as usize)
+            }
+            Some(v) => {
+                r.problems
+                    .push(format!("modes = {v}: must be an integer in 1..=20"));
+                None
+            }
+        };
+        let modes = match (structure, modes) {
+            (Some(Structure::PointMass), Some(n)) if n != 1 => {
+                r.problems.push(format!(
+                    "modes = {n}: the point-mass model has one mode (omit modes)"
+                ));
+                None
+            }
+            (Some(Structure::PointMass), _) => Some(1),
+            (Some(Structure::Beam), None) => {
+                r.problems
+                    .push("missing key modes (number of Galerkin modes, 1..=20)".into());
+                None
+            }
+            (_, n) => n,
+        };
+
+        // [cantilever]
+        let cant = r.table(root, "cantilever", true);
+        let (beam, q1, qs) = match cant {
+            Some(c) => Self::read_cantilever(&mut r, c),
+            None => (None, None, None),
+        };
+        // [tip]
+        let tip = r.table(root, "tip", false);
+        let mut tip_e = None;
+        let mut tip_nu = None;
+        let mut radius = None;
+        if let Some(t) = tip {
+            r.unknown(t, "tip", &["radius", "youngs_modulus", "poisson_ratio"]);
+            radius = r.optional(t, "tip", "radius", "m", POSITIVE);
+            tip_e = r.optional(t, "tip", "youngs_modulus", "Pa", POSITIVE);
+            tip_nu = r.optional(t, "tip", "poisson_ratio", "1", POISSON);
+        }
+        // [sample]
+        let sample = r
+            .table(root, "sample", true)
+            .and_then(|s| Self::read_sample(&mut r, s, tip, radius, tip_e, tip_nu));
+        // [drive]
+        let drive = r.table(root, "drive", true);
+        let (a0, freq) = match drive {
+            Some(d) => {
+                r.unknown(d, "drive", &["free_amplitude", "frequency"]);
+                (
+                    r.required(d, "drive", "free_amplitude", "m", POSITIVE),
+                    r.optional(d, "drive", "frequency", "Hz", POSITIVE),
+                )
+            }
+            None => (None, None),
+        };
+        if let (Some(Structure::PointMass), Some(_)) = (structure, &qs) {
+            r.problems.push(
+                "[cantilever].quality_factors: the point-mass model has one mode (use quality_factor)"
+                    .into(),
+            );
+        }
+        if let (Some(n), Some(q)) = (modes, &qs) {
+            if q.len() != n {
+                r.problems.push(format!(
+                    "[cantilever].quality_factors has {} values: give one per mode (modes = {n})",
+                    q.len()
+                ));
+            }
+        }
+        if !r.problems.is_empty() {
+            return None;
+        }
+        let (structure, modes, beam, q1, sample, a0) =
+            (structure?, modes?, beam?, q1?, sample?, a0?);
+        match Self::resolve(structure, modes, beam, q1, qs, sample, a0, freq) {
+            Ok(p) => Some(p),
+            Err(e) => {
+                r.problems.push(e);
+                None
+            }
+        }
+    }
+
+    #[allow(clippy::type_complexity)]
+    fn read_cantilever(
+        r: &mut Reader<'_>,
+        c: &toml::Table,
+    ) -> (Option<Beam>, Option<f64>, Option<Vec<f64>>) {
+        const S: &str = "cantilever";
+        const CAL: [&str; 3] = ["spring_constant", "resonance_frequency", "tip_mass_ratio"];
+        const GEO: [&str; 6] = [
+            "length",
+            "width",
+            "thickness",
+            "youngs_modulus",
+            "density",
+            "tip_mass",
+        ];
+        let mut known: Vec<&str> = CAL.iter().chain(GEO.iter()).copied().collect();
+        known.extend(["quality_factor", "quality_factors"]);
+        r.unknown(c, S, &known);
+        let has_cal = CAL[..2].iter().any(|k| c.contains_key(*k));
+        let has_geo = GEO.iter().any(|k| c.contains_key(*k));
+        let beam = match (has_cal, has_geo) {
+            (true, true) => {
+                r.problems.push(
+                    "[cantilever]: give either calibrated values (spring_constant, \
+                     resonance_frequency) or the geometry (length, width, thickness, \
+                     youngs_modulus, density, tip_mass), not both"
+                        .into(),
+                );
+                None
+            }
+            (false, true) => {
+                let length = r.required(c, S, "length", "m", POSITIVE);
+                let width = r.required(c, S, "width", "m", POSITIVE);
+                let thickness = r.required(c, S, "thickness", "m", POSITIVE);
+                let e = r.required(c, S, "youngs_modulus", "Pa", POSITIVE);
+                let rho = r.required(c, S, "density", "kg/m^3", POSITIVE);
+                let tip_mass = r.optional(c, S, "tip_mass", "kg", NON_NEGATIVE);
+                match (length, width, thickness, e, rho) {
+                    (Some(l), Some(b), Some(h), Some(e), Some(rho)) => Some(Beam::Geometry {
+                        length: l,
+                        ei: e * b * h.powi(3) / 12.0,
+                        mass_per_length: rho * b * h,
+                        tip_mass: tip_mass.unwrap_or(0.0),
+                    }),
+                    _ => None,
+                }
+            }
+            _ => {
+                let k = r.required(c, S, "spring_constant", "N/m", POSITIVE);
+                let f0 = r.required(c, S, "resonance_frequency", "Hz", POSITIVE);
+                let alpha1 = r
+                    .optional(c, S, "tip_mass_ratio", "1", NON_NEGATIVE)
+                    .unwrap_or(0.0);
+                match (k, f0) {
+                    (Some(k), Some(f0)) => Some(Beam::Calibrated { k, f0, alpha1 }),
+                    _ => None,
+                }
+            }
+        };
+        let qs = match c.get("quality_factors") {
+            None => None,
+            Some(toml::Value::Array(a)) => {
+                let mut v = Vec::with_capacity(a.len());
+                for (i, x) in a.iter().enumerate() {
+                    match x.as_float().or(x.as_integer().map(|i| i as f64)) {
+                        Some(q) if q.is_finite() && q > 0.0 => v.push(q),
+                        _ => r.problems.push(format!(
+                            "[cantilever].quality_factors[{i}] = {x}: must be a number > 0"
+                        )),
+                    }
+                }
+                Some(v)
+            }
+            Some(_) => {
+                r.problems
+                    .push("[cantilever].quality_factors must be an array of numbers".into());
+                None
+            }
+        };
+        let q1 = match (c.contains_key("quality_factor"), &qs) {
+            (true, _) => r.required(c, S, "quality_factor", "1", POSITIVE),
+            (false, Some(q)) => q.first().copied(),
+            (false, None) => {
+                r.problems
+                    .push("missing key [cantilever].quality_factor (Q of mode 1)".into());
+                None
+            }
+        };
+        if let (Some(q1), Some(q)) = (q1, &qs) {
+            if q.first().is_some_and(|&f| f != q1) {
+                r.problems.push(format!(
+                    "[cantilever].quality_factor = {q1} differs from quality_factors[0] = {}",
+                    q[0]
+                ));
+            }
+        }
+        (beam, q1, qs)
+    }
+
+    fn read_sample(
+        r: &mut Reader<'_>,
+        s: &toml::Table,
+        tip: Option<&toml::Table>,
+        radius: Option<f64>,
+        tip_e: Option<f64>,
+        tip_nu: Option<f64>,
+    ) -> Option<Sample> {
+        const S: &str = "sample";
+        let law = match r.string(s, S, "law") {
+            Some(l @ ("linear" | "hertz" | "dmt" | "impact")) => Some(l.to_string()),
+            Some(l) => {
+                r.problems.push(format!(
+                    "[sample].law = '{l}': expected linear, hertz, dmt or impact"
+                ));
+                None
+            }
+            None => {
+                if !s.contains_key("law") {
+                    r.problems
+                        .push("missing key [sample].law (linear, hertz, dmt or impact)".into());
+                }
+                None
+            }
+        }?;
+        let keys: &[&str] = match law.as_str() {
+            "linear" => &["law", "stiffness", "damping", "z_c"],
+            "hertz" => &["law", "youngs_modulus", "poisson_ratio", "damping", "z_c"],
+            "dmt" => &[
+                "law",
+                "youngs_modulus",
+                "poisson_ratio",
+                "hamaker",
+                "intermolecular_distance",
+                "viscosity",
+                "z_c",
+            ],
+            _ => &["law", "restitution", "z_c"],
+        };
+        r.unknown(s, S, keys);
+        let z_c = r.optional(s, S, "z_c", "m", ANY);
+        let mut out = Sample {
+            law: law.clone(),
+            e_star: None,
+            radius,
+            hamaker: None,
+            a0: None,
+            viscosity: None,
+            stiffness: None,
+            damping: None,
+            restitution: None,
+            z_c,
+        };
+        match law.as_str() {
+            "linear" => {
+                out.stiffness = r.required(s, S, "stiffness", "N/m", NON_NEGATIVE);
+                out.damping = r.optional(s, S, "damping", "N s/m", NON_NEGATIVE);
+                return out.stiffness.map(|_| out);
+            }
+            "impact" => {
+                out.restitution = r.required(s, S, "restitution", "1", UNIT_INTERVAL);
+                return out.restitution.map(|_| out);
+            }
+            _ => {}
+        }
+        // hertz and dmt need the tip
+        if tip.is_none() {
+            r.problems.push(format!(
+                "missing table [tip] (the {law} law needs radius, youngs_modulus, poisson_ratio)"
+            ));
+        } else {
+            for (key, v) in [
+                ("radius", radius),
+                ("youngs_modulus", tip_e),
+                ("poisson_ratio", tip_nu),
+            ] {
+                if v.is_none() && !tip.is_some_and(|t| t.contains_key(key)) {
+                    r.problems
+                        .push(format!("missing key [tip].{key} (needed by the {law} law)"));
+                }
+            }
+        }
+        let e_s = r.required(s, S, "youngs_modulus", "Pa", POSITIVE);
+        let nu_s = r.required(s, S, "poisson_ratio", "1", POISSON);
+        if let (Some(et), Some(nt), Some(es), Some(ns)) = (tip_e, tip_nu, e_s, nu_s) {
+            // Johnson, Contact Mechanics, eq. 4.22
+            out.e_star = Some(1.0 / ((1.0 - nt * nt) / et + (1.0 - ns * ns) / es));
+        }
+        if law == "hertz" {
+            out.damping = r.optional(s, S, "damping", "N s/m", NON_NEGATIVE);
+        } else {
+            out.hamaker = r.required(s, S, "hamaker", "J", NON_NEGATIVE);
+            out.a0 = r.required(s, S, "intermolecular_distance", "m", POSITIVE);
+            out.viscosity = r.optional(s, S, "viscosity", "Pa s", NON_NEGATIVE);
+        }
+        out.e_star.and(out.radius).map(|_| out)
+    }
+
+    /// The mapping of the module docs.
+    #[allow(clippy::too_many_arguments)]
+    fn resolve(
+        structure: Structure,
+        modes: usize,
+        beam: Beam,
+        q1: f64,
+        qs: Option<Vec<f64>>,
+        sample: Sample,
+        a0: f64,
+        freq: Option<f64>,
+    ) -> Result<Probe, String> {
+        let g0 = a0;
+        // tip-mass ratio of the beam, and for the geometry (L, EI, m)
+        let (beam_alpha1, geometry) = match beam {
+            Beam::Calibrated { alpha1, .. } => (alpha1, None),
+            Beam::Geometry {
+                length,
+                ei,
+                mass_per_length,
+                tip_mass,
+            } => (
+                tip_mass / (mass_per_length * length),
+                Some((length, ei, mass_per_length)),
+            ),
+        };
+        let alpha1 = match structure {
+            Structure::Beam => beam_alpha1,
+            Structure::PointMass => 0.0,
+        };
+        // undamped structure without drive or sample: ω̃₁ and k̃₁
+        let bare = Params {
+            modes,
+            alpha1,
+            alpha2: 0.0,
+            alpha3: 0.0,
+            alpha4: 0.0,
+            alpha5: 1.0,
+            alpha6: 0.0,
+            omega: 1.0,
+            contact_law: ContactLaw::Linear,
+            structure,
+            damping_profile: None,
+        };
+        let (w1, k1, x1) = first_mode(&bare).map_err(|e| e.to_string())?;
+        // k and f0, given or from the geometry (first mode of the beam with its tip mass)
+        let (k, f0, static_k) = match (beam, geometry) {
+            (Beam::Calibrated { k, f0, .. }, _) => (k, f0, 0.0),
+            (_, Some((l, ei, m))) => {
+                let ts = (m * l.powi(4) / ei).sqrt(); // eq. 5
+                let unit = ei / l.powi(3);
+                let (bw1, bk1, _) = first_mode(&Params {
+                    structure: Structure::Beam,
+                    modes: if structure == Structure::Beam {
+                        modes
+                    } else {
+                        6
+                    },
+                    alpha1: beam_alpha1,
+                    ..bare
+                })
+                .map_err(|e| e.to_string())?;
+                (bk1 * unit, bw1 / (TAU * ts), 3.0 * unit)
+            }
+            (Beam::Geometry { .. }, None) => unreachable!("geometry carries (L, EI, m)"),
+        };
+        let time_s = w1 / (TAU * f0);
+        let force_n = k * g0 / k1;
+        let scales = Scales {
+            length_m: g0,
+            time_s,
+            force_n,
+        };
+        let drive_hz = freq.unwrap_or(f0);
+        let omega = scales.omega(drive_hz);
+        // damping: profile from per-mode Q, then α3 from Q1
+        let profile = match (&qs, structure) {
+            (Some(q), Structure::Beam) => {
+                let mut s = [1.0; MAX_MODES];
+                for (j, qj) in q.iter().enumerate() {
+                    let bj = crate::beam::beta_root(j + 1).powi(2);
+                    let b1 = crate::beam::beta_root(1).powi(2);
+                    s[j] = (bj / b1) * (q1 / qj);
+                }
+                Some(s)
+            }
+            _ => None,
+        };
+        let with_profile = Params {
+            damping_profile: profile,
+            ..bare
+        };
+        let g = Galerkin::new(&with_profile).map_err(|e| e.to_string())?;
+        let m = &g.region(Region::Free).mass;
+        let sdiag = DVectorF::from_fn(modes, |j, _| profile.map_or(1.0, |s| s[j]));
+        let num = (m * &x1).dot(&x1);
+        let den: f64 = x1.iter().zip(sdiag.iter()).map(|(x, s)| x * x * s).sum();
+        let alpha3 = w1 * num / (q1 * den);
+        // sample groups
+        let t_s = time_s;
+        let mut law = ContactLaw::Linear;
+        let (mut alpha4, mut alpha6) = (0.0, 0.0);
+        match sample.law.as_str() {
+            "linear" => {
+                alpha4 = sample.stiffness.unwrap_or(0.0) * g0 / force_n;
+                alpha6 = sample.damping.unwrap_or(0.0) * g0 / (t_s * force_n);
+            }
+            "hertz" | "dmt" => {
+                let (e, rr) = (sample.e_star.unwrap_or(0.0), sample.radius.unwrap_or(0.0));
+                alpha4 = 4.0 / 3.0 * e * rr.sqrt() * g0.powf(1.5) / force_n;
+                if sample.law == "hertz" {
+                    law = ContactLaw::Hertz;
+                    alpha6 = sample.damping.unwrap_or(0.0) * g0 / (t_s * force_n);
+                } else {
+                    law = ContactLaw::Dmt {
+                        hamaker: sample.hamaker.unwrap_or(0.0) * rr / (6.0 * g0 * g0 * force_n),
+                        intermolecular_distance: sample.a0.unwrap_or(0.0) / g0,
+                    };
+                    alpha6 =
+                        sample.viscosity.unwrap_or(0.0) * (rr * g0).sqrt() * g0 / (t_s * force_n);
+                }
+            }
+            _ => {
+                law = ContactLaw::Impact {
+                    restitution: sample.restitution.unwrap_or(0.0),
+                };
+            }
+        }
+        let z_c = sample.z_c.unwrap_or(a0);
+        let mut params = Params {
+            alpha3,
+            alpha4,
+            alpha6,
+            omega,
+            contact_law: law,
+            alpha2: 1.0,
+            ..with_profile
+        };
+        params.alpha5 = params.alpha5_for_rest_distance(z_c / g0);
+        // drive amplitude: free tip amplitude A0 (= 1 in units of g0) at Ω
+        let unit_response = CantileverModel::new(&params)
+            .map_err(|e| e.to_string())?
+            .free_tip_response()
+            .map_err(|e| e.to_string())?
+            .norm();
+        params.alpha2 = 1.0 / unit_response;
+        params.validate().map_err(|e| e.to_string())?;
+        Ok(Probe {
+            params,
+            scales,
+            calibration: Calibration {
+                spring_constant: k,
+                resonance_frequency: f0,
+                quality_factor: q1,
+                quality_factors: qs,
+                tip_mass_ratio: alpha1,
+                static_spring_constant: static_k,
+            },
+            free_amplitude: a0,
+            drive_frequency: drive_hz,
+            z_c,
+        })
+    }
+
+    /// The rest distance z_c (m) of a parameter set under these scales.
+    pub fn z_c_of(&self, params: &Params) -> f64 {
+        params.rest_distance() * self.scales.length_m
+    }
+}
+
+type DVectorF = nalgebra::DVector<f64>;
+
+/// ω̃₁, k̃₁ (first-mode stiffness at the tip) and the undamped mode x₁ of a parameter set.
+fn first_mode(p: &Params) -> Result<(f64, f64, DVectorF), crate::ParamError> {
+    let g = Galerkin::new(p)?;
+    let free = g.region(Region::Free);
+    let modes = natural_modes(free);
+    let x1: DVectorF = modes.vectors.column(0).into_owned();
+    let w1 = modes.omega[0];
+    let tip = g.tip().dot(&x1);
+    let mass = (&free.mass * &x1).dot(&x1);
+    Ok((w1, w1 * w1 * mass / (tip * tip), x1))
+}

@@ -1,0 +1,302 @@
+//! Probe files (SI) → the dimensionless set: closed forms for the point mass, agreement with the
+//! independent geometry path of `units` for the beam, defining identities (f₀, k, Q₁, A₀) and
+//! the error list.
+
+use afmdyn::eigen::{damped_eigenvalues, natural_modes};
+use afmdyn::probe::{Probe, ProbeError};
+use afmdyn::units::{Cantilever, PhysicalModel};
+use afmdyn::{CantileverModel, ContactLaw, Region, Structure};
+use std::f64::consts::TAU;
+use std::path::Path;
+
+fn rel(a: f64, b: f64) -> f64 {
+    (a - b).abs() / b.abs().max(1e-300)
+}
+
+const POINT_MASS_DMT: &str = r#"
+model = "point-mass"
+[cantilever]
+spring_constant = 40.0
+resonance_frequency = 300e3
+quality_factor = 400
+[tip]
+radius = 10e-9
+youngs_modulus = 130e9
+poisson_ratio = 0.27
+[sample]
+law = "dmt"
+youngs_modulus = 4e9
+poisson_ratio = 0.33
+hamaker = 6.6e-20
+intermolecular_distance = 0.165e-9
+viscosity = 2.0
+z_c = 7e-9
+[drive]
+free_amplitude = 10e-9
+frequency = 301e3
+"#;
+
+/// Point mass: every group against its closed form written out here (García & San Paulo 1999
+/// scaling: τ = ω₀t, lengths of A₀, forces of kA₀).
+#[test]
+fn point_mass_groups_match_closed_forms() {
+    let p = Probe::parse(POINT_MASS_DMT, "test").unwrap();
+    let q = &p.params;
+    assert_eq!(q.structure, Structure::PointMass);
+    let (k, f0, qf, a0, f): (f64, f64, f64, f64, f64) = (40.0, 300e3, 400.0, 10e-9, 301e3);
+    let om = f / f0;
+    assert!(rel(q.omega, om) < 1e-14);
+    assert!(rel(q.alpha3, 1.0 / qf) < 1e-14);
+    // F0/(k A0) = |1 − Ω² + iΩ/Q| gives the free amplitude A0
+    let f0_drive = ((1.0 - om * om).powi(2) + (om / qf).powi(2)).sqrt();
+    assert!(rel(q.alpha2, f0_drive) < 1e-12, "{} {}", q.alpha2, f0_drive);
+    let e_star = 1.0 / ((1.0 - 0.27f64.powi(2)) / 130e9 + (1.0 - 0.33f64.powi(2)) / 4e9);
+    let r: f64 = 10e-9;
+    let force = k * a0;
+    assert!(
+        rel(
+            q.alpha4,
+            4.0 / 3.0 * e_star * r.sqrt() * a0.powf(1.5) / force
+        ) < 1e-12
+    );
+    let ContactLaw::Dmt {
+        hamaker,
+        intermolecular_distance,
+    } = q.contact_law
+    else {
+        panic!("dmt expected")
+    };
+    assert!(rel(hamaker, 6.6e-20 * r / (6.0 * a0 * a0 * force)) < 1e-12);
+    assert!(rel(intermolecular_distance, 0.165e-9 / a0) < 1e-12);
+    // Kelvin–Voigt η√(Rδ)δ̇: force unit kA0, rate A0 ω0
+    let w0 = TAU * f0;
+    assert!(rel(q.alpha6, 2.0 * (r * a0).sqrt() * a0 * w0 / force) < 1e-12);
+    // rest distance z_c = (α5 + ã0) A0
+    assert!(rel(p.z_c_of(q), 7e-9) < 1e-12);
+    assert!(rel(q.alpha5, 7e-9 / a0 - 0.165e-9 / a0) < 1e-12);
+    // scales
+    assert!(rel(p.scales.time_s, 1.0 / w0) < 1e-14);
+    assert!(rel(p.scales.force_n, force) < 1e-14);
+    assert!(rel(p.scales.frequency_hz(q.omega), f) < 1e-12);
+}
+
+/// The model built from the probe has the free amplitude A₀ (1 in units of g₀ = A₀) and, for
+/// the point mass at Ω = 1, the phase lag 90°.
+#[test]
+fn free_amplitude_is_a0() {
+    for text in [
+        POINT_MASS_DMT.to_string(),
+        POINT_MASS_DMT.replace("frequency = 301e3", "frequency = 300e3"),
+        std::fs::read_to_string(repo("examples/probe-beam-dmt.toml")).unwrap(),
+        std::fs::read_to_string(repo("examples/probe-geometry-hertz.toml")).unwrap(),
+    ] {
+        let p = Probe::parse(&text, "test").unwrap();
+        let m = CantileverModel::new(&p.params).unwrap();
+        let h = m.free_tip_response().unwrap();
+        assert!(rel(h.norm(), 1.0) < 1e-12, "{}", h.norm());
+        if p.params.structure == Structure::PointMass && p.params.omega == 1.0 {
+            assert!((-h.arg() - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+        }
+    }
+}
+
+fn repo(rel: &str) -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../..")
+        .join(rel)
+}
+
+/// Calibrated beam: the resolved model's first natural frequency is f₀ (tip mass included), its
+/// first-mode stiffness at the tip is k, and its first damped mode has quality factor Q₁
+/// (exactly for α1 = 0, where C = α3 I is proportional to M = I; to O(1/Q²) with a tip mass).
+#[test]
+fn calibrated_beam_reproduces_f0_k_q() {
+    for (alpha1, q_tol) in [(0.0, 1e-12), (0.5, 1e-5)] {
+        let text = format!(
+            r#"model = "beam"
+modes = 4
+[cantilever]
+spring_constant = 2.0
+resonance_frequency = 70e3
+quality_factor = 150
+tip_mass_ratio = {alpha1}
+[sample]
+law = "linear"
+stiffness = 5.0
+damping = 1e-8
+[drive]
+free_amplitude = 20e-9
+"#
+        );
+        let p = Probe::parse(&text, "test").unwrap();
+        let g = afmdyn::galerkin::Galerkin::new(&p.params).unwrap();
+        let free = g.region(Region::Free);
+        let modes = natural_modes(free);
+        let f1 = p.scales.frequency_hz(modes.omega[0]);
+        assert!(rel(f1, 70e3) < 1e-12, "f1 = {f1}");
+        let x1 = modes.vectors.column(0);
+        let tip = g.tip().dot(&x1);
+        // mass-normalised x1: k1 = ω1²/(φᵀx1)² in units of force/length
+        let k1 = modes.omega[0].powi(2) / (tip * tip) * p.scales.force_n / p.scales.length_m;
+        assert!(rel(k1, 2.0) < 1e-12, "k1 = {k1}");
+        let lam = damped_eigenvalues(free)[0];
+        let q = (lam.re * lam.re + lam.im * lam.im).sqrt() / (-2.0 * lam.re);
+        assert!(rel(q, 150.0) < q_tol, "alpha1 = {alpha1}: Q = {q}");
+        // the linear sample: α4 = K/(k/k̃1) with k̃1 = ω̃1²/(φᵀx1)²
+        let k1_dimless = modes.omega[0].powi(2) / (tip * tip);
+        assert!(rel(p.params.alpha4, 5.0 * k1_dimless / 2.0) < 1e-12);
+        assert_eq!(p.params.alpha1, alpha1);
+    }
+}
+
+/// Round trip against the independent path of `units`: a probe given by its geometry and the
+/// same system given to [`PhysicalModel::to_params`] (eqs. 5 and 7) give the same α's.
+#[test]
+fn geometry_probe_matches_units_path() {
+    let text = r#"model = "beam"
+modes = 3
+[cantilever]
+length = 125e-6
+width = 40e-6
+thickness = 3.7e-6
+youngs_modulus = 169e9
+density = 2330.0
+tip_mass = 5.0e-13
+quality_factor = 400
+[sample]
+law = "linear"
+stiffness = 12.0
+damping = 1e-7
+z_c = 3e-9
+[drive]
+free_amplitude = 10e-9
+frequency = 250e3
+"#;
+    let p = Probe::parse(text, "test").unwrap();
+    let cantilever = Cantilever {
+        length: 125e-6,
+        width: 40e-6,
+        thickness: 3.7e-6,
+        youngs_modulus: 169e9,
+        density: 2330.0,
+    };
+    let mut phys = PhysicalModel {
+        cantilever,
+        modes: 3,
+        tip_mass: 5.0e-13,
+        beam_damping: 0.0,
+        contact_stiffness: 12.0,
+        contact_damping: 1e-7,
+        drive_amplitude: p.params.alpha2 * 10e-9,
+        beam_gap: 10e-9,
+        tip_gap: 3e-9,
+        drive_frequency_hz: 250e3,
+    };
+    phys.beam_damping = afmdyn::units::beam_damping_from_q(&phys, 400.0).unwrap();
+    let u = phys.to_params().unwrap();
+    let q = &p.params;
+    for (name, a, b) in [
+        ("alpha1", q.alpha1, u.alpha1),
+        ("alpha2", q.alpha2, u.alpha2),
+        ("alpha3", q.alpha3, u.alpha3),
+        ("alpha4", q.alpha4, u.alpha4),
+        ("alpha5", q.alpha5, u.alpha5),
+        ("alpha6", q.alpha6, u.alpha6),
+        ("omega", q.omega, u.omega),
+    ] {
+        assert!(rel(a, b) < 1e-12, "{name}: probe {a} vs units {b}");
+    }
+    // the geometry gives the static stiffness 3EI/L³ and a modal k about 3 % above it
+    let c = &p.calibration;
+    assert!(rel(c.static_spring_constant, cantilever.spring_constant()) < 1e-14);
+    assert!(c.spring_constant > c.static_spring_constant);
+}
+
+/// Per-mode quality factors of the bare beam (α1 = 0) are reproduced by the modal damping profile.
+#[test]
+fn per_mode_quality_factors() {
+    let text = r#"model = "beam"
+modes = 3
+[cantilever]
+spring_constant = 40.0
+resonance_frequency = 300e3
+quality_factors = [400, 600, 900]
+[sample]
+law = "impact"
+restitution = 0.8
+[drive]
+free_amplitude = 10e-9
+"#;
+    let p = Probe::parse(text, "test").unwrap();
+    let g = afmdyn::galerkin::Galerkin::new(&p.params).unwrap();
+    let eig = damped_eigenvalues(g.region(Region::Free));
+    for (lam, want) in eig.iter().zip([400.0, 600.0, 900.0]) {
+        let q = (lam.re * lam.re + lam.im * lam.im).sqrt() / (-2.0 * lam.re);
+        // Re λ = −|λ|/(2Q) carries the eigensolver's round-off of |λ| amplified by 2Q
+        assert!(rel(q, want) < 1e-9, "Q = {q}, want {want}");
+    }
+}
+
+/// Every problem is listed at once, each naming its key and section.
+#[test]
+fn errors_list_every_problem() {
+    let text = r#"model = "beam"
+colour = "red"
+[cantilever]
+spring_constant = -1.0
+quality_factor = 400
+[tip]
+radius = 10e-9
+[sample]
+law = "dmt"
+youngs_modulus = 4e9
+poisson_ratio = 0.7
+"#;
+    let Err(ProbeError::Invalid { problems, .. }) = Probe::parse(text, "p.toml") else {
+        panic!("must fail")
+    };
+    let all = problems.join("\n");
+    for needle in [
+        "unknown key colour",
+        "missing key modes",
+        "[cantilever].spring_constant = -1",
+        "missing key [cantilever].resonance_frequency",
+        "missing key [tip].youngs_modulus",
+        "missing key [tip].poisson_ratio",
+        "[sample].poisson_ratio = 0.7",
+        "missing key [sample].hamaker",
+        "missing key [sample].intermolecular_distance",
+        "missing table [drive]",
+    ] {
+        assert!(all.contains(needle), "'{needle}' not in:\n{all}");
+    }
+    // one readable line
+    let msg = Probe::parse(text, "p.toml").unwrap_err().to_string();
+    assert!(!msg.contains('\n') && msg.starts_with("p.toml: "));
+    // syntax errors name the file; unreadable files their path
+    assert!(matches!(
+        Probe::parse("model = ", "x.toml"),
+        Err(ProbeError::Syntax { .. })
+    ));
+    assert!(matches!(
+        Probe::load(Path::new("/nonexistent/probe.toml")),
+        Err(ProbeError::Io { .. })
+    ));
+    // keys of another law are unknown for this one
+    let wrong = POINT_MASS_DMT.replace("viscosity = 2.0", "restitution = 0.5");
+    let e = Probe::parse(&wrong, "t").unwrap_err().to_string();
+    assert!(e.contains("unknown key [sample].restitution"), "{e}");
+}
+
+/// The example probe files resolve.
+#[test]
+fn examples_resolve() {
+    for f in [
+        "examples/probe-beam-dmt.toml",
+        "examples/probe-point-mass-dmt.toml",
+        "examples/probe-geometry-hertz.toml",
+    ] {
+        let p = Probe::load(&repo(f)).unwrap_or_else(|e| panic!("{f}: {e}"));
+        p.params.validate().unwrap();
+    }
+}
