@@ -7,7 +7,7 @@
 mod common;
 
 use afmdyn::analysis::observables::{observe_from, ObservableOptions, Observables};
-use afmdyn::analysis::shooting::{shoot, ShootingOptions};
+use afmdyn::analysis::shooting::{shoot, shoot_with, ShootingOptions};
 use afmdyn::analysis::steady::{steady_state, Motion, SteadyOptions};
 use afmdyn::integrate::{advance_dyn, build, IntegratorOptions};
 use afmdyn::trajectory::{record, RecordSpec};
@@ -33,29 +33,51 @@ fn point_mass(law: ContactLaw, omega: f64, alpha5: f64) -> Params {
     }
 }
 
+/// The integrator of the tests: the exact propagator for the linear law, the adaptive one at
+/// tolerance 1e-14 otherwise (its dense output then accurate well below the 1e-8 of the
+/// balances).
+const INTEG: IntegratorOptions = IntegratorOptions {
+    kind: afmdyn::IntegratorKind::Auto,
+    steps_per_period: 1,
+    tolerance: 1e-14,
+};
+
 /// A period-n orbit of `model` at τ = 0: a transient from rest, then Newton shooting; checked
 /// periodic by one more run of n periods.
 fn orbit(model: &CantileverModel, n: usize) -> DVector<f64> {
-    let mut it = build(model, IntegratorOptions::default(), 0.0, &model.rest()).unwrap();
+    let mut it = build(model, INTEG, 0.0, &model.rest()).unwrap();
     advance_dyn(it.as_mut(), 60.0 * model.period(), &mut |_, _, _| Ok(())).unwrap();
-    let o = shoot(model, it.state(), n, &ShootingOptions::default()).unwrap();
+    let guess = it.state().clone();
+    let opts = ShootingOptions {
+        tol: 1e-12,
+        ..ShootingOptions::default()
+    };
+    let o = shoot_with(it.as_mut(), &guess, n, &opts).unwrap();
     it.reset(0.0, &o.state).unwrap();
-    advance_dyn(it.as_mut(), n as f64 * model.period(), &mut |_, _, _| Ok(())).unwrap();
+    advance_dyn(
+        it.as_mut(),
+        n as f64 * model.period(),
+        &mut |_, _, _| Ok(()),
+    )
+    .unwrap();
     let gap = (it.state() - &o.state).norm();
-    assert!(gap <= 1e-10 * (1.0 + o.state.norm()), "not periodic: {gap:e}");
+    assert!(
+        gap <= 1e-10 * (1.0 + o.state.norm()),
+        "not periodic: {gap:e}"
+    );
     o.state
 }
 
-/// Observables from (0, z) with the default integrator (the exact propagator for the linear law;
-/// the adaptive one at tolerance 1e-14 otherwise, so its dense output is accurate well below the
-/// 1e-8 of the balances).
-fn observe(model: &CantileverModel, z: &DVector<f64>, periods: usize, harmonics: usize) -> Observables {
+/// Observables from (0, z) with [`INTEG`].
+fn observe(
+    model: &CantileverModel,
+    z: &DVector<f64>,
+    periods: usize,
+    harmonics: usize,
+) -> Observables {
     observe_from(
         model,
-        IntegratorOptions {
-            tolerance: 1e-14,
-            ..IntegratorOptions::default()
-        },
+        INTEG,
         0.0,
         z,
         &ObservableOptions { periods, harmonics },
@@ -81,15 +103,30 @@ fn free_oscillation_matches_the_harmonic_response() {
         let o = observe(&model, &z0, 2, 5);
         let a = p.alpha2 / ((1.0 - omega * omega).powi(2) + (p.alpha3 * omega).powi(2)).sqrt();
         let phi = (p.alpha3 * omega).atan2(1.0 - omega * omega);
-        assert!(rel(o.amplitude, a, a) <= 1e-9, "Ω = {omega}: {} vs {a}", o.amplitude);
-        assert!((o.phase - phi).abs() <= 1e-9, "Ω = {omega}: {} vs {phi}", o.phase);
+        assert!(
+            rel(o.amplitude, a, a) <= 1e-9,
+            "Ω = {omega}: {} vs {a}",
+            o.amplitude
+        );
+        assert!(
+            (o.phase - phi).abs() <= 1e-9,
+            "Ω = {omega}: {} vs {phi}",
+            o.phase
+        );
         assert!(rel(o.closed_form.free_amplitude, a, a) <= 1e-12);
         assert!((o.closed_form.free_phase - phi).abs() <= 1e-12);
         assert!(o.thd <= 1e-6, "harmonic response: THD {}", o.thd);
         assert!(o.mean_deflection.abs() <= 1e-9 * a);
-        assert_eq!((o.contact_fraction, o.energy_dissipated, o.virial), (0.0, 0.0, 0.0));
+        assert_eq!(
+            (o.contact_fraction, o.energy_dissipated, o.virial),
+            (0.0, 0.0, 0.0)
+        );
         if omega == 1.0 {
-            assert!((o.phase - FRAC_PI_2).abs() <= 1e-9, "phase at resonance {}", o.phase);
+            assert!(
+                (o.phase - FRAC_PI_2).abs() <= 1e-9,
+                "phase at resonance {}",
+                o.phase
+            );
         }
     }
     for omega in [0.5, 2.8, 3.4] {
@@ -103,11 +140,23 @@ fn free_oscillation_matches_the_harmonic_response() {
         let o = observe(&model, &z0, 1, 3);
         // W(τ) = Re ŵ cos Ωτ − Im ŵ sin Ωτ = A sin(Ωτ − φ)
         let w0 = model.w_tip(&z0);
-        let w1 = model.w_tip(&harmonic_response(&model, Region::Free, 0.25 * model.period()));
+        let w1 = model.w_tip(&harmonic_response(
+            &model,
+            Region::Free,
+            0.25 * model.period(),
+        ));
         let a = w0.hypot(w1);
         let phi = (-w0).atan2(w1);
-        assert!(rel(o.amplitude, a, a) <= 1e-9, "Ω = {omega}: {} vs {a}", o.amplitude);
-        assert!((o.phase - phi).abs() <= 1e-9, "Ω = {omega}: {} vs {phi}", o.phase);
+        assert!(
+            rel(o.amplitude, a, a) <= 1e-9,
+            "Ω = {omega}: {} vs {a}",
+            o.amplitude
+        );
+        assert!(
+            (o.phase - phi).abs() <= 1e-9,
+            "Ω = {omega}: {} vs {phi}",
+            o.phase
+        );
         assert!(rel(o.closed_form.free_amplitude, a, a) <= 1e-12);
         println!(
             "beam N = 3, Ω = {omega}: A₀ = {a:.6e}, φ₀ = {:.4}°, k̃ = {:.4}, Q₁ = {:.3}, ω₁ = {:.5}",
@@ -162,32 +211,50 @@ fn point_mass_period_balances_are_exact() {
         ];
         let v_scale = terms.iter().fold(0.0f64, |m, t| m.max(t.abs()));
         let v_err = rel(o.virial, terms.iter().sum(), v_scale);
-        assert!(o.energy_dissipated > 0.0 || name.contains("attractive"), "{name}");
-        assert!(e_err <= 1e-8, "{name} Ω = {omega}: energy balance off by {e_err:e}");
-        assert!(v_err <= 1e-8, "{name} Ω = {omega}: virial balance off by {v_err:e}");
+        assert!(
+            o.energy_dissipated > 0.0 || name.contains("attractive"),
+            "{name}"
+        );
+        assert!(
+            e_err <= 1e-8,
+            "{name} Ω = {omega}: energy balance off by {e_err:e}"
+        );
+        assert!(
+            v_err <= 1e-8,
+            "{name} Ω = {omega}: virial balance off by {v_err:e}"
+        );
         let cf = o.closed_form;
         if omega == 1.0 {
             let k = cf.stiffness;
             assert!(rel(k, 1.0, 1.0) <= 1e-12 && rel(cf.quality_factor, q, q) <= 1e-12);
             let de = cf.energy_dissipated - o.energy_dissipated;
-            assert!(rel(de, PI * k / q * s2, scale) <= 1e-8, "{name}: E_cf − E_dis");
+            assert!(
+                rel(de, PI * k / q * s2, scale) <= 1e-8,
+                "{name}: E_cf − E_dis"
+            );
             let dv = o.virial - cf.virial;
             let want = k * mean * mean + 0.5 * k * (s1 - s2);
             assert!(rel(dv, want, v_scale) <= 1e-8, "{name}: V − V_cf");
         }
         if let Some(rep) = repulsive {
-            assert_eq!(o.phase < FRAC_PI_2, rep, "{name}: φ = {}°", o.phase.to_degrees());
+            assert_eq!(
+                o.phase < FRAC_PI_2,
+                rep,
+                "{name}: φ = {}°",
+                o.phase.to_degrees()
+            );
             assert_eq!(o.virial < 0.0, rep, "{name}: V = {}", o.virial);
         }
         println!(
             "{name:17} Ω = {omega}: A = {a:.5}, φ = {:7.3}°, contact {:.3}, THD {:.2e}, \
-             E_dis = {:.6e} (balance {e_err:.1e}), E_cf off by {:+.2e} rel; \
+             E_dis = {:.6e} (balance {e_err:.1e}), E_cf off by {:+.2e} rel ({:+.2e} of πF₀A sin φ); \
              V = {:.6e} (balance {v_err:.1e}), V_cf off by {:+.2e} rel",
             phi.to_degrees(),
             o.contact_fraction,
             o.thd,
             o.energy_dissipated,
             (cf.energy_dissipated - o.energy_dissipated) / o.energy_dissipated,
+            (cf.energy_dissipated - o.energy_dissipated) / input,
             o.virial,
             (cf.virial - o.virial) / o.virial,
         );
@@ -204,7 +271,11 @@ fn point_mass_impacts_obey_the_balances() {
     let o = observe(&model, &z0, 1, 10);
     let (a, phi, f0, q) = (o.amplitude, o.phase, p.alpha2, 1.0 / p.alpha3);
     let (input, damping) = (PI * f0 * a * phi.sin(), PI / q * (a * a + o.higher_n2_sq));
-    let e_err = rel(o.energy_dissipated, input - damping, input.abs().max(damping.abs()));
+    let e_err = rel(
+        o.energy_dissipated,
+        input - damping,
+        input.abs().max(damping.abs()),
+    );
     let terms = [
         o.mean_deflection.powi(2),
         0.5 * (o.higher_sq - o.higher_n2_sq),
@@ -317,7 +388,11 @@ fn thd_mean_and_contact_fraction_agree_with_independent_checks() {
     assert!(rel(o.contact_time, contact, t) <= 1e-12);
     assert_eq!(o.impacts_per_period, 1.0);
     let listed: f64 = o.harmonics[1..].iter().map(|h| h.amplitude.powi(2)).sum();
-    assert!(rel(listed, o.higher_sq, o.higher_sq) <= 1e-8, "{listed} vs {}", o.higher_sq);
+    assert!(
+        rel(listed, o.higher_sq, o.higher_sq) <= 1e-8,
+        "{listed} vs {}",
+        o.higher_sq
+    );
     assert!(rel(o.thd, listed.sqrt() / o.amplitude, o.thd) <= 1e-8);
     assert!(rel(o.mean_deflection, o.mean_force, o.mean_force.abs()) <= 1e-10);
     assert!(rel(o.peak_force, p.alpha4 * o.indentation, o.peak_force) <= 1e-12);
@@ -334,11 +409,32 @@ fn thd_mean_and_contact_fraction_agree_with_independent_checks() {
 fn bad_options_are_typed_errors() {
     let model = CantileverModel::new(&point_mass(ContactLaw::Linear, 1.0, 1.0)).unwrap();
     for (opts, field) in [
-        (ObservableOptions { periods: 0, harmonics: 10 }, "periods"),
-        (ObservableOptions { periods: 1, harmonics: 0 }, "harmonics"),
+        (
+            ObservableOptions {
+                periods: 0,
+                harmonics: 10,
+            },
+            "periods",
+        ),
+        (
+            ObservableOptions {
+                periods: 1,
+                harmonics: 0,
+            },
+            "harmonics",
+        ),
     ] {
-        let err = observe_from(&model, IntegratorOptions::default(), 0.0, &model.rest(), &opts)
-            .unwrap_err();
-        assert!(matches!(err, SimError::OutOfRange { name, .. } if name == field), "{err}");
+        let err = observe_from(
+            &model,
+            IntegratorOptions::default(),
+            0.0,
+            &model.rest(),
+            &opts,
+        )
+        .unwrap_err();
+        assert!(
+            matches!(err, SimError::OutOfRange { name, .. } if name == field),
+            "{err}"
+        );
     }
 }
