@@ -10,6 +10,7 @@ use afmdyn::analysis::observables::{observe_from, ObservableOptions, Observables
 use afmdyn::analysis::shooting::{shoot, shoot_with, ShootingOptions};
 use afmdyn::analysis::steady::{steady_state, Motion, SteadyOptions};
 use afmdyn::integrate::{advance_dyn, build, IntegratorOptions};
+use afmdyn::report;
 use afmdyn::trajectory::{record, RecordSpec};
 use afmdyn::{CantileverModel, ContactLaw, Params, Region, SimError, Structure};
 use common::{events_until, harmonic_response};
@@ -85,6 +86,22 @@ fn observe(
     .unwrap()
 }
 
+/// The first harmonic of `o` is (a, φ) to 1e-9 (relative, resp. absolute in rad), and so is the
+/// free amplitude of its closed forms (1e-12).
+fn assert_free_response(o: &Observables, a: f64, phi: f64, omega: f64) {
+    assert!(
+        rel(o.amplitude, a, a) <= 1e-9,
+        "Ω = {omega}: {} vs {a}",
+        o.amplitude
+    );
+    assert!(
+        (o.phase - phi).abs() <= 1e-9,
+        "Ω = {omega}: {} vs {phi}",
+        o.phase
+    );
+    assert!(rel(o.closed_form.free_amplitude, a, a) <= 1e-12);
+}
+
 fn rel(a: f64, b: f64, scale: f64) -> f64 {
     (a - b).abs() / scale
 }
@@ -103,18 +120,13 @@ fn free_oscillation_matches_the_harmonic_response() {
         let o = observe(&model, &z0, 2, 5);
         let a = p.alpha2 / ((1.0 - omega * omega).powi(2) + (p.alpha3 * omega).powi(2)).sqrt();
         let phi = (p.alpha3 * omega).atan2(1.0 - omega * omega);
-        assert!(
-            rel(o.amplitude, a, a) <= 1e-9,
-            "Ω = {omega}: {} vs {a}",
-            o.amplitude
-        );
-        assert!(
-            (o.phase - phi).abs() <= 1e-9,
-            "Ω = {omega}: {} vs {phi}",
-            o.phase
-        );
-        assert!(rel(o.closed_form.free_amplitude, a, a) <= 1e-12);
+        assert_free_response(&o, a, phi, omega);
         assert!((o.closed_form.free_phase - phi).abs() <= 1e-12);
+        // a window that starts inside a period gives the same harmonics
+        let tau0 = 0.37 * model.period();
+        let z1 = harmonic_response(&model, Region::Free, tau0);
+        let o1 = observe_from(&model, INTEG, tau0, &z1, &ObservableOptions::default()).unwrap();
+        assert_free_response(&o1, a, phi, omega);
         assert!(o.thd <= 1e-6, "harmonic response: THD {}", o.thd);
         assert!(o.mean_deflection.abs() <= 1e-9 * a);
         assert_eq!(
@@ -147,17 +159,7 @@ fn free_oscillation_matches_the_harmonic_response() {
         ));
         let a = w0.hypot(w1);
         let phi = (-w0).atan2(w1);
-        assert!(
-            rel(o.amplitude, a, a) <= 1e-9,
-            "Ω = {omega}: {} vs {a}",
-            o.amplitude
-        );
-        assert!(
-            (o.phase - phi).abs() <= 1e-9,
-            "Ω = {omega}: {} vs {phi}",
-            o.phase
-        );
-        assert!(rel(o.closed_form.free_amplitude, a, a) <= 1e-12);
+        assert_free_response(&o, a, phi, omega);
         println!(
             "beam N = 3, Ω = {omega}: A₀ = {a:.6e}, φ₀ = {:.4}°, k̃ = {:.4}, Q₁ = {:.3}, ω₁ = {:.5}",
             phi.to_degrees(),
@@ -261,11 +263,19 @@ fn point_mass_period_balances_are_exact() {
     }
 }
 
-/// Impact law (r = 0.8): the impulses enter E_dis (the kinetic-energy loss ½(1 − r²) m_eff V̇²,
-/// Brogliato 2016 §4.2) and the virial (P z at the impact); the same exact balances hold.
+/// Impact law (r = 0.8, 0.2, 0 and 0 with sticking on a pre-loaded sample, α5 < 0): the impulses
+/// enter E_dis (the kinetic-energy loss ½(1 − r²) m_eff V̇², Brogliato 2016 §4.2) and the virial
+/// (P z at the impact); the same exact period balances hold to 1e-8 of the largest term; the
+/// peak sticking force is that of the static balance.
 #[test]
 fn point_mass_impacts_obey_the_balances() {
-    let p = point_mass(ContactLaw::Impact { restitution: 0.8 }, 1.0, 0.7);
+    for (r, alpha5) in [(0.8, 0.7), (0.2, 0.3), (0.0, 0.4), (0.0, -0.05)] {
+        impact_balances(r, alpha5);
+    }
+}
+
+fn impact_balances(r: f64, alpha5: f64) {
+    let p = point_mass(ContactLaw::Impact { restitution: r }, 1.0, alpha5);
     let model = CantileverModel::new(&p).unwrap();
     let z0 = orbit(&model, 1);
     let o = observe(&model, &z0, 1, 10);
@@ -284,16 +294,30 @@ fn point_mass_impacts_obey_the_balances() {
     let v_scale = terms.iter().fold(0.0f64, |m, t| m.max(t.abs()));
     let v_err = rel(o.virial, terms.iter().sum(), v_scale);
     println!(
-        "impact r = 0.8: {} impacts/period, E_dis = {:.6e} (loss {:.6e}, balance {e_err:.1e}), \
+        "impact r = {r}, α5 = {alpha5}: {} impacts/period, contact {:.3}, peak λ {:.4e}, E_dis = {:.6e} (loss {:.6e}, balance {e_err:.1e}), \
          V = {:.6e} (balance {v_err:.1e}), φ = {:.3}°",
         o.impacts_per_period,
+        o.contact_fraction,
+        o.peak_force,
         o.energy_dissipated,
         o.impact_loss,
         o.virial,
         o.phase.to_degrees()
     );
     assert!(o.impacts_per_period >= 1.0);
-    assert_eq!(o.energy_dissipated, o.impact_loss);
+    if alpha5 < 0.0 {
+        // sticking on the sample at z = −α5: λ = z − α2 cos Ωτ (the equation of motion with
+        // z' = z'' = 0), largest at Ωτ = π inside the sticking phase
+        assert!(o.contact_fraction > 0.0);
+        let peak = -alpha5 + p.alpha2;
+        assert!(
+            rel(o.peak_force, peak, peak) <= 1e-9,
+            "peak λ {} vs {peak}",
+            o.peak_force
+        );
+    }
+    // no dissipation outside the impacts: free flight has no force, sticking no motion
+    assert!(rel(o.energy_dissipated, o.impact_loss, o.impact_loss) <= 1e-9);
     assert!(e_err <= 1e-8, "energy balance off by {e_err:e}");
     assert!(v_err <= 1e-8, "virial balance off by {v_err:e}");
 }
@@ -437,4 +461,26 @@ fn bad_options_are_typed_errors() {
             "{err}"
         );
     }
+}
+
+/// `report::observables` carries every field under its name (the JSON shared by the command line
+/// and Python), with one balance per mode and non-finite values as null.
+#[test]
+fn report_document_has_every_field() {
+    let p = point_mass(ContactLaw::Linear, 1.0, 0.6);
+    let model = CantileverModel::new(&p).unwrap();
+    let o = observe(&model, &harmonic_response(&model, Region::Free, 0.0), 1, 4);
+    let doc = report::observables(&o);
+    assert_eq!(doc["amplitude"].as_f64(), Some(o.amplitude));
+    assert_eq!(doc["phase"].as_f64(), Some(o.phase));
+    assert_eq!(doc["energy_dissipated"].as_f64(), Some(o.energy_dissipated));
+    assert_eq!(doc["harmonics"].as_array().map(Vec::len), Some(4));
+    assert_eq!(doc["mode_balance"].as_array().map(Vec::len), Some(1));
+    assert_eq!(
+        doc["closed_form"]["quality_factor"].as_f64(),
+        Some(o.closed_form.quality_factor)
+    );
+    let mut inf = o.clone();
+    inf.closed_form.quality_factor = f64::INFINITY;
+    assert!(report::observables(&inf)["closed_form"]["quality_factor"].is_null());
 }
