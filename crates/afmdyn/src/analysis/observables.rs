@@ -43,6 +43,9 @@
 //! E_cf = (π k A²/Q)[(A₀/A) sin φ − ω/ω₀], and of San Paulo & García (2001), V_cf, plus the
 //! terms they neglect:
 //! E_cf − E_dis = (π k/Q)(ω/ω₀) Σ_{n≥2} n²Aₙ²,   V − V_cf = k⟨z⟩² + (k/2) Σ_{n≥2}(1 − n²ω²/ω₀²)Aₙ².
+//! Off resonance, with A₀ the free amplitude at ω (what [`ClosedForms`] uses, F₀ ≠ kA₀/Q),
+//! E_cf − E_dis gains π A sin φ (kA₀/Q − F₀) and V − V_cf gains
+//! (k/2)(1 − ω²/ω₀²)A² − ½ A cos φ (F₀ − kA₀/Q).
 //! The sums over all n ≥ 2 are exact here through Parseval ([`Observables::higher_sq`],
 //! [`Observables::higher_n2_sq`]), not truncated at [`ObservableOptions::harmonics`].
 //!
