@@ -366,6 +366,17 @@ fn beam_mode_balance_closes() {
     println!(
         "period {n}: Σ|residual| = {residual:.2e}, Σ coupling = {coupling:.2e}, largest term {big:.4e}"
     );
+    println!(
+        "beam closed forms (mode-1 point mass k̃ = {:.4}, Q₁ = {:.3}, A₀ = {:.4}): \
+         E_cf = {:.6e} vs E_dis = {:.6e}, V_cf = {:.6e} vs V = {:.6e}",
+        o.closed_form.stiffness,
+        o.closed_form.quality_factor,
+        o.closed_form.free_amplitude,
+        o.closed_form.energy_dissipated,
+        o.energy_dissipated,
+        o.closed_form.virial,
+        o.virial
+    );
     assert_eq!(o.mode_balance.len(), 3);
     assert!(residual <= 1e-9 * big, "residual {residual:e}");
     assert!(coupling.abs() <= 1e-9 * big, "coupling {coupling:e}");

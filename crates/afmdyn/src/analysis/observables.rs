@@ -255,7 +255,7 @@ pub fn closed_forms(model: &CantileverModel, a: f64, phase: f64) -> Result<Close
         natural_frequency: w0,
         stiffness: k,
         drive_force: k * a0 * ((1.0 - r * r).powi(2) + (r / q).powi(2)).sqrt(),
-        energy_dissipated: PI * k * a * a / q * ((a0 / a) * phase.sin() - r),
+        energy_dissipated: PI * k / q * (a * a0 * phase.sin() - r * a * a),
         virial: -k * a * a0 / (2.0 * q) * phase.cos(),
     })
 }
@@ -295,28 +295,24 @@ struct Ctx {
     harmonics: usize,
     /// Gauss–Legendre nodes and weights on [−1, 1], ascending.
     gl: Vec<(f64, f64)>,
-    /// Longest smooth piece.
-    h_max: f64,
+    /// Longest smooth piece in each region (free, contact).
+    h_max: [f64; 2],
 }
 
 impl Ctx {
     fn new(model: &CantileverModel, harmonics: usize) -> Self {
         let p = model.params();
-        // pieces short against the highest harmonic and the fastest eigenvalue, so each GL rule
-        // integrates to round-off (|λ| h ≤ π/2 on the half-length h)
-        let rho = [Region::Free, Region::Contact]
-            .iter()
-            .flat_map(|&r| {
-                model
-                    .dynamics(r)
-                    .a
-                    .complex_eigenvalues()
-                    .iter()
-                    .map(|l| l.norm())
-                    .collect::<Vec<_>>()
-            })
-            .fold(0.0f64, f64::max);
-        let h_max = (model.period() / (2.0 * harmonics as f64)).min(PI / rho.max(1e-300));
+        // pieces short against the highest harmonic and the region's fastest eigenvalue, so each
+        // GL rule integrates to round-off (|λ| h ≤ π/2 on the half-length h)
+        let h_max = [Region::Free, Region::Contact].map(|r| {
+            let rho = model
+                .dynamics(r)
+                .a
+                .complex_eigenvalues()
+                .iter()
+                .fold(0.0f64, |m, l| m.max(l.norm()));
+            (model.period() / (2.0 * harmonics as f64)).min(PI / rho.max(1e-300))
+        });
         let mut gl: Vec<(f64, f64)> = GaussLegendre::new(NonZeroUsize::new(GL_NODES).expect("16"))
             .iter()
             .map(|(x, w)| (*x, *w))
@@ -594,7 +590,7 @@ pub fn observe(
             if r == Region::Contact {
                 acc.contact_time += t1 - t0;
             }
-            let pieces = ((t1 - t0) / ctx.h_max).ceil().max(1.0) as usize;
+            let pieces = ((t1 - t0) / ctx.h_max[r.index()]).ceil().max(1.0) as usize;
             let hp = (t1 - t0) / pieces as f64;
             for k in 0..pieces {
                 let a = t0 + k as f64 * hp;
