@@ -108,7 +108,7 @@ pub struct Harmonic {
     pub n: usize,
     /// Amplitude A_n ≥ 0 (units of g₀).
     pub amplitude: f64,
-    /// Lag φ_n behind n times the drive phase, rad, in (−π/2, 3π/2].
+    /// Lag φ_n behind n(Ωτ + ψ), n times the drive's phase, rad, in (−π/2, 3π/2].
     pub phase: f64,
 }
 
@@ -135,7 +135,7 @@ pub struct ModeBalance {
 /// The free linear response of the tip at the drive frequency: W = A₀ sin(Ωτ + ψ − φ₀).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct FreeResponse {
-    /// Free amplitude A₀ = |φᵀ(K − Ω²M + iΩC)⁻¹F̂| (units of g₀).
+    /// Free amplitude A₀ = |φᵀ(K − Ω²M + iΩC)⁻¹(F_s + iF_c)| (units of g₀).
     pub amplitude: f64,
     /// Lag φ₀ behind the drive, rad, in (−π/2, 3π/2].
     pub phase: f64,
@@ -180,7 +180,8 @@ pub struct Observables {
     pub phase: f64,
     /// Harmonics n = 1..=[`ObservableOptions::harmonics`].
     pub harmonics: Vec<Harmonic>,
-    /// Total harmonic distortion √(Σ_{n≥2} A_n²)/A₁ over all n (Parseval, [`Self::higher_sq`]).
+    /// Total harmonic distortion √(Σ_{n≥2} A_n²)/A₁ over all n (Parseval, [`Self::higher_sq`];
+    /// NaN when A₁ = 0).
     pub thd: f64,
     /// ⟨W⟩: mean deflection.
     pub mean_deflection: f64,
@@ -232,7 +233,8 @@ pub fn free_response(model: &CantileverModel) -> Result<FreeResponse, SimError> 
     })
 }
 
-/// The closed forms for amplitude `a` and lag `phase` of `model` (see [`ClosedForms`]).
+/// The closed forms of `model` for a first-harmonic tip amplitude `a` (g₀) and lag `phase`
+/// (rad) (see [`ClosedForms`]; k̃, Q, ω₀ and A₀ depend on the model only).
 ///
 /// # Errors
 /// As [`free_response`].
