@@ -6,7 +6,7 @@
 
 mod common;
 
-use afmdyn::analysis::observables::{observe_from, ObservableOptions, Observables};
+use afmdyn::analysis::observables::{observe_from, observe_orbit, ObservableOptions, Observables};
 use afmdyn::analysis::shooting::{shoot, shoot_with, ShootingOptions};
 use afmdyn::analysis::steady::{steady_state, Motion, SteadyOptions};
 use afmdyn::integrate::{advance_dyn, build, IntegratorOptions};
@@ -349,10 +349,10 @@ fn beam_mode_balance_closes() {
     let Motion::Periodic { period: n } = s.motion else {
         panic!("expected a periodic orbit, got {:?}", s.motion)
     };
-    let z0 = shoot(&model, s.end_state(), n, &ShootingOptions::default())
-        .unwrap()
-        .state;
-    let o = observe(&model, &z0, n, 10);
+    let orbit = shoot(&model, s.end_state(), n, &ShootingOptions::default()).unwrap();
+    let z0 = orbit.state.clone();
+    let o = observe_orbit(&model, INTEG, &orbit, 10).unwrap();
+    assert_eq!(o.periods, n);
     let big = o
         .mode_balance
         .iter()

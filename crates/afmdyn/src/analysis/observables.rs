@@ -59,6 +59,7 @@
 //! ½ȧᵀM_off ȧ + ½aᵀK_off a: zero over a period of a periodic orbit. Σ_j sample_j = −∮F_c Ẇ
 //! differs from E_dis by the work of F_c on the moving base, ∮F_c α2Ω cos Ωτ (beam only).
 
+use super::shooting::PeriodicOrbit;
 use crate::contact::{TipSample, TipSampleLaw};
 use crate::eigen::{damped_eigenvalues, natural_modes};
 use crate::error::SimError;
@@ -703,4 +704,22 @@ pub fn observe_from(
 ) -> Result<Observables, SimError> {
     let mut it = build(model, integ, tau0, z0)?;
     observe(it.as_mut(), opts)
+}
+
+/// [`observe_from`] on a periodic orbit found by shooting ([`super::shooting`]): from its state
+/// at τ = 0 over its n drive periods, harmonics up to `harmonics`.
+///
+/// # Errors
+/// As [`observe_from`].
+pub fn observe_orbit(
+    model: &CantileverModel,
+    integ: IntegratorOptions,
+    orbit: &PeriodicOrbit,
+    harmonics: usize,
+) -> Result<Observables, SimError> {
+    let opts = ObservableOptions {
+        periods: orbit.period,
+        harmonics,
+    };
+    observe_from(model, integ, 0.0, &orbit.state, &opts)
 }
