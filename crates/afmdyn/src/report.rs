@@ -9,6 +9,7 @@ use crate::analysis::attractors::AttractorReport;
 use crate::analysis::continuation::BranchPoint;
 use crate::analysis::converge::ConvergenceRun;
 use crate::analysis::lyapunov::LyapunovSpectrum;
+use crate::analysis::observables::Observables;
 use crate::analysis::shooting::PeriodicOrbit;
 use crate::analysis::steady::SteadyState;
 use crate::eigen::RegionSpectrum;
@@ -320,4 +321,10 @@ pub fn si(probe: &crate::probe::Probe, params: &Params, doc: &Value) -> Value {
         }
     }
     out
+/// The observables of a steady state ([`Observables`], every field, so a field added there
+/// reaches both front ends): dimensionless units of the model (lengths g₀, time τ, forces F̃,
+/// energies F̃·g₀); phases in radians. Non-finite values (e.g. Q = ∞ without damping) become
+/// `null`.
+pub fn observables(o: &Observables) -> Value {
+    serde_json::to_value(o).expect("observables serialise")
 }
