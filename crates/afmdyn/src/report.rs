@@ -321,6 +321,8 @@ pub fn si(probe: &crate::probe::Probe, params: &Params, doc: &Value) -> Value {
         }
     }
     out
+}
+
 /// The observables of a steady state ([`Observables`], every field, so a field added there
 /// reaches both front ends): dimensionless units of the model (lengths g₀, time τ, forces F̃,
 /// energies F̃·g₀); phases in radians. Non-finite values (e.g. Q = ∞ without damping) become
