@@ -89,6 +89,11 @@ fn observe(
 /// The first harmonic of `o` is (a, φ) to 1e-9 (relative, resp. absolute in rad), and so is the
 /// free amplitude of its closed forms (1e-12).
 fn assert_free_response(o: &Observables, a: f64, phi: f64, omega: f64) {
+    println!(
+        "free response Ω = {omega}: ΔA/A = {:.1e}, Δφ = {:.1e} rad",
+        rel(o.amplitude, a, a),
+        o.phase - phi
+    );
     assert!(
         rel(o.amplitude, a, a) <= 1e-9,
         "Ω = {omega}: {} vs {a}",
