@@ -10,7 +10,8 @@
 //! an integrand analytic in the Bernstein ellipse E_ρ, bounded by M there, the n-point rule errs
 //! by at most (64/15) M ρ^{−2n}/(ρ² − 1) relative to the half-length (Trefethen, *Approximation
 //! Theory and Approximation Practice*, SIAM 2013, Thm. 19.3); with |λ|h ≤ π/2 for e^{λτ} on a
-//! piece of half-length h, ρ = 8 and n = 16 bound it by ~1e-23 M.) The adaptive integrator's
+//! piece of half-length h, ρ = 8 and n = 16 bound it by 1e-30 M, M ≤ e^{13} for a product of
+//! two such factors.) The adaptive integrator's
 //! dense output limits the accuracy to about 10³ × its tolerance (measured on the free point
 //! mass: 1.2e-9 relative amplitude at 1e-12, 4e-11 at 1e-14). No uniform sampling. Extrema (peak force, minimum distance) are located on the dense output by a
 //! safeguarded Newton iteration ([`crate::roots`]), not taken over quadrature nodes.
