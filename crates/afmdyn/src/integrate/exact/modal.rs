@@ -1,0 +1,181 @@
+//! e^{Ã t} in the eigenbasis Ã = V Λ V⁻¹ (complex), with one representative per
+//! complex-conjugate pair.
+//!
+//! Ã is real, so its eigenvalues are real or come in conjugate pairs (λ, λ̄) with eigenvectors
+//! (v, v̄), and for a real y the modal coordinates q = V⁻¹y of a pair are conjugate too. Hence
+//! y = V q = Σ_k w_k Re(v_k q_k) over the representatives (Im λ_k > 0 with weight w_k = 2, real
+//! λ_k with w_k = 1), and e^{Ãt} y = Σ_k w_k Re(v_k e^{λ_k t} q_k): a grid step costs one
+//! complex multiplication per representative (about N), against (2N)² multiply–adds for the
+//! dense Φ. Eigenvalues from nalgebra's real Schur form (Golub & Van Loan, *Matrix
+//! Computations*, 4th ed., §7.5), eigenvectors by inverse iteration (ibid. §7.6.1). Accepted
+//! only when V is well conditioned and the residual ‖ÃV − VΛ‖ is at round-off; otherwise the
+//! caller keeps the dense path.
+
+use nalgebra::{Complex, DMatrix, DVector};
+
+/// Largest state dimension 2N.
+pub(super) const MAXD: usize = 2 * crate::params::MAX_MODES;
+
+/// Largest accepted condition number ‖V‖_F ‖V⁻¹‖_F of the eigenvector basis.
+pub const MAX_MODAL_CONDITION: f64 = 1e4;
+
+type C = Complex<f64>;
+
+/// The eigendecomposition of one region's Ã (energy coordinates).
+#[derive(Debug, Clone)]
+pub(super) struct ModalExp {
+    /// Representative eigenvalues λ_k (r of them, r ≤ 2N).
+    pub(super) lambda: Vec<C>,
+    /// w_k v_k, 2N × r (energy coordinates).
+    pub(super) v: DMatrix<C>,
+    /// w_k T⁻¹ v_k, 2N × r (plain coordinates).
+    pub(super) tv: DMatrix<C>,
+    /// Rows of V⁻¹ of the representatives, r × 2N.
+    pub(super) vinv: DMatrix<C>,
+    /// w_k c̃ᵀv_k and w_k c̃ᵀv_k λ_k: the tip deflection and its rate per unit q_k.
+    pub(super) tip: Vec<C>,
+    pub(super) tip_dot: Vec<C>,
+    /// w_k |c̃ᵀv_k| |λ_k|²: curvature of the tip deflection per unit |q_k|.
+    pub(super) tip_lam2: Vec<f64>,
+}
+
+impl ModalExp {
+    /// Decompose `at` (Ã, 2N×2N) with tip row `ct` (c̃ᵀ) and inverse energy transform `tinv`;
+    /// `None` when the basis is ill conditioned or the decomposition inaccurate.
+    pub(super) fn new(at: &DMatrix<f64>, ct: &[f64], tinv: &DMatrix<f64>) -> Option<Self> {
+        let dim = at.nrows();
+        let all: Vec<C> = at.complex_eigenvalues().iter().copied().collect();
+        let pairs = all.iter().filter(|l| l.im > 0.0).count();
+        let below = all.iter().filter(|l| l.im < 0.0).count();
+        let mut lambda: Vec<C> = all.iter().copied().filter(|l| l.im > 0.0).collect();
+        lambda.extend(all.iter().copied().filter(|l| l.im == 0.0));
+        let r = lambda.len();
+        if pairs != below || r + pairs != dim {
+            return None;
+        }
+        let a = at.map(|x| C::new(x, 0.0));
+        let scale = at.norm().max(1.0);
+        // full basis: representatives, then the conjugates of the pairs
+        let mut full = DMatrix::<C>::zeros(dim, dim);
+        for (k, &l) in lambda.iter().enumerate() {
+            let shift = l + C::new(1e-10 * scale, 1e-10 * scale);
+            let lu = (&a - DMatrix::<C>::identity(dim, dim) * shift).lu();
+            let mut x = DVector::<C>::from_element(dim, C::new(1.0, 0.3));
+            for _ in 0..3 {
+                x = lu.solve(&x)?;
+                let norm = x.norm();
+                if !norm.is_finite() || norm == 0.0 {
+                    return None;
+                }
+                x /= C::new(norm, 0.0);
+            }
+            full.set_column(k, &x);
+            if k < pairs {
+                full.set_column(r + k, &x.map(|c| c.conj()));
+            }
+        }
+        let inv = full.clone().try_inverse()?;
+        let mut lam_full = lambda.clone();
+        lam_full.extend(lambda[..pairs].iter().map(|l| l.conj()));
+        let lam = DMatrix::from_diagonal(&DVector::from_vec(lam_full));
+        let residual = (&a * &full - &full * lam).norm();
+        let cond = full.norm() * inv.norm();
+        if !(residual <= 1e-12 * scale && cond <= MAX_MODAL_CONDITION) {
+            return None;
+        }
+        let weight = |k: usize| if k < pairs { 2.0 } else { 1.0 };
+        let mut v = full.columns(0, r).into_owned();
+        for k in 0..r {
+            v.column_mut(k).scale_mut(weight(k));
+        }
+        let tv = tinv.map(|x| C::new(x, 0.0)) * &v;
+        let vinv = inv.rows(0, r).into_owned();
+        let tip: Vec<C> = (0..r)
+            .map(|k| v.column(k).iter().zip(ct).map(|(vi, &c)| vi * c).sum::<C>())
+            .collect();
+        let tip_dot = tip.iter().zip(&lambda).map(|(t, l)| t * l).collect();
+        let tip_lam2 = tip
+            .iter()
+            .zip(&lambda)
+            .map(|(t, l)| t.norm() * l.norm_sqr())
+            .collect();
+        Some(ModalExp {
+            lambda,
+            v,
+            tv,
+            vinv,
+            tip,
+            tip_dot,
+            tip_lam2,
+        })
+    }
+
+    /// Number of representatives r.
+    pub(super) fn len(&self) -> usize {
+        self.lambda.len()
+    }
+
+    /// q = V⁻¹ y (representatives), `q.len() == r`.
+    pub(super) fn project(&self, y: &[f64], q: &mut [C]) {
+        let r = q.len();
+        q.fill(C::new(0.0, 0.0));
+        for (col, &yj) in self.vinv.as_slice().chunks_exact(r).zip(y) {
+            for (qi, vij) in q.iter_mut().zip(col) {
+                qi.re += vij.re * yj;
+                qi.im += vij.im * yj;
+            }
+        }
+    }
+
+    /// out = Σ_k Re(b_k q_k) for the columns b_k of `basis` (w_k v_k or w_k T⁻¹v_k), added to
+    /// `out` when `accumulate`.
+    pub(super) fn expand(basis: &DMatrix<C>, q: &[C], out: &mut [f64], accumulate: bool) {
+        if !accumulate {
+            out.fill(0.0);
+        }
+        for (col, qk) in basis.as_slice().chunks_exact(out.len()).zip(q) {
+            for (o, b) in out.iter_mut().zip(col) {
+                *o += b.re * qk.re - b.im * qk.im;
+            }
+        }
+    }
+
+    /// e^{λ_k t} for every representative into `out`.
+    pub(super) fn factors(&self, t: f64, out: &mut [C]) {
+        for (f, l) in out.iter_mut().zip(&self.lambda) {
+            *f = C::from_polar((l.re * t).exp(), l.im * t);
+        }
+    }
+
+    /// out = e^{Ã t} y0 (real).
+    pub(super) fn apply(&self, y0: &[f64], t: f64, out: &mut [f64]) {
+        let r = self.len();
+        let mut q = [C::new(0.0, 0.0); MAXD];
+        let mut f = [C::new(0.0, 0.0); MAXD];
+        self.project(y0, &mut q[..r]);
+        self.factors(t, &mut f[..r]);
+        for (qk, fk) in q.iter_mut().zip(&f[..r]) {
+            *qk *= fk;
+        }
+        Self::expand(&self.v, &q[..r], out, false);
+    }
+
+    /// Tip deflection and rate of the homogeneous part, Σ Re(w c̃ᵀv q) and Σ Re(w c̃ᵀv λ q).
+    pub(super) fn tip_of(&self, q: &[C]) -> (f64, f64) {
+        let mut w = 0.0;
+        let mut wd = 0.0;
+        for ((qk, t), td) in q.iter().zip(&self.tip).zip(&self.tip_dot) {
+            w += t.re * qk.re - t.im * qk.im;
+            wd += td.re * qk.re - td.im * qk.im;
+        }
+        (w, wd)
+    }
+
+    /// Σ_k w_k |c̃ᵀv_k| |λ_k|² |q_k|: bounds |W_hom''| for all later times (Re λ_k ≤ 0).
+    pub(super) fn curvature(&self, q: &[C]) -> f64 {
+        q.iter()
+            .zip(&self.tip_lam2)
+            .map(|(qk, w)| qk.norm() * w)
+            .sum()
+    }
+}
