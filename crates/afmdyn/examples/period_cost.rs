@@ -5,7 +5,8 @@
 //!
 //! `cargo run --release -p afmdyn --example period_cost -- <linear|hertz|dmt|impact> <N> [periods]
 //! [both|advance|observed]` (the last argument runs only one of the two timed loops, for
-//! instruction counts)
+//! instruction counts). With the linear law, `PROPAGATION=dense|modal` in the environment forces
+//! the exact propagator's path ([`Propagation`]).
 //!
 //! `... -- build <N> [reps]`: time of one exact-propagator build at the default parameters,
 //! without and with reuse of earlier builds ([`ExactOptions::reuse`]), and of a build after a
@@ -16,7 +17,7 @@
 
 use afmdyn::analysis::shooting::{shoot, ShootingOptions};
 use afmdyn::analysis::steady::{steady_state, SteadyOptions};
-use afmdyn::integrate::exact::{ExactOptions, ExactPropagator};
+use afmdyn::integrate::exact::{ExactOptions, ExactPropagator, Propagation};
 use afmdyn::integrate::{advance, advance_dyn, build, IntegratorOptions};
 use afmdyn::{CantileverModel, LawKind, Params};
 use nalgebra::DVector;
@@ -104,6 +105,19 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let m = CantileverModel::new(&p)?;
     let mut it = build(&m, IntegratorOptions::default(), 0.0, &m.rest())?;
+    let forced = match std::env::var("PROPAGATION").as_deref() {
+        Ok("dense") => Some(Propagation::Dense),
+        Ok("modal") => Some(Propagation::Modal),
+        _ => None,
+    };
+    if let Some(propagation) = forced {
+        let opts = ExactOptions {
+            propagation,
+            ..ExactOptions::default()
+        };
+        it = Box::new(ExactPropagator::try_with(&m, opts)?);
+        it.reset(0.0, &m.rest())?;
+    }
     advance(it.as_mut(), 50.0 * p.period())?;
     let (tau0, z0) = (it.tau(), it.state().clone());
     let t_end = tau0 + periods * p.period();

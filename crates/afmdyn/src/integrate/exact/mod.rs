@@ -69,6 +69,19 @@ const MODAL_MIN_MODES: usize = 7;
 type C = Complex<f64>;
 const C0: C = Complex::new(0.0, 0.0);
 
+/// 1/n!, n = 0..=K.
+const INV_FACT: [f64; K + 1] = {
+    let mut f = [1.0; K + 1];
+    let mut prod = 1.0;
+    let mut n = 1;
+    while n <= K {
+        prod *= n as f64;
+        f[n] = 1.0 / prod;
+        n += 1;
+    }
+    f
+};
+
 /// Amplitude of the base-displacement term α2 sin Ωτ of V_T = W(1,τ) + α2 sin Ωτ + α5 (eq. 8).
 fn base_amp(p: &Params) -> f64 {
     p.alpha2
@@ -167,8 +180,9 @@ pub struct ExactPropagator {
     just_switched: bool,
     recent: VecDeque<f64>,
     last: LastStep,
-    /// Tip polynomial of the last step, when built.
-    poly: Option<Box<TipPoly>>,
+    /// Tip polynomial of the last step, valid when `poly_built` (filled in place).
+    poly: Box<TipPoly>,
+    poly_built: bool,
     /// V_T and dV_T/dτ at the current state.
     vt: (f64, f64),
     /// Round-off dead band of the switching test: a region is left when V_T passes 0 by more
@@ -371,7 +385,8 @@ impl ExactPropagator {
                 modal: false,
                 full: false,
             },
-            poly: None,
+            poly: Box::new(TipPoly::empty()),
+            poly_built: false,
             vt: (0.0, 0.0),
             dead,
             trig,
@@ -500,50 +515,73 @@ impl ExactPropagator {
         self.stale = false;
     }
 
-    fn build_poly(&self, region: Region, tau0: f64, y0: &[f64], len: f64) -> TipPoly {
-        let sp = &self.spec[region.index()];
-        let fr = &self.forced[region.index()];
+    /// Fill `out` with the tip series of a step of `len` in region `r` from the homogeneous
+    /// state `y0` (energy coordinates) at τ0.
+    #[allow(clippy::too_many_arguments)]
+    fn build_poly(
+        sp: &Spectral,
+        fr: &Forced,
+        p: &Params,
+        dead: f64,
+        r: Region,
+        tau0: f64,
+        y0: &[f64],
+        len: f64,
+        out: &mut TipPoly,
+    ) {
         let mut mo = [0.0; K + 3];
         matvec(&sp.rows, y0, &mut mo, 1.0, false);
-        let inv_fact: [f64; K + 1] =
-            std::array::from_fn(|n| 1.0 / (1..=n).map(|k| k as f64).product::<f64>());
-        let mut c = [[0.0; K + 1]; 3];
-        for (d, row) in c.iter_mut().enumerate() {
-            for ((x, m), f) in row.iter_mut().zip(&mo[d..]).zip(&inv_fact) {
-                *x = m * f;
+        // the harmonic part a_s sin(Ωτ0 + Ωt) + a_c cos(Ωτ0 + Ωt) + const of V_T: its n-th
+        // t-derivative at 0 is Ωⁿ (S, C, −S, −C)[n mod 4]
+        let (s0, c0) = (p.omega * tau0).sin_cos();
+        let (a_s, a_c) = (fr.wp[1] + base_amp(p), fr.wp[2]);
+        let (sv, sd) = (a_s * s0 + a_c * c0, a_s * c0 - a_c * s0);
+        let cycle = [sv, sd, -sv, -sd];
+        let (om, mut om_n, mut lp) = (p.omega, 1.0, 1.0);
+        let mut curv = fr.vp_curv;
+        let mut size = [0.0; K + 1];
+        let mut biggest = 0.0f64;
+        for n in 0..=K {
+            let f = INV_FACT[n];
+            let (c0n, c1n, c2n) = (mo[n] * f, mo[n + 1] * f, mo[n + 2] * f);
+            let g0 = c0n + om_n * cycle[n % 4] * f;
+            let g1 = c1n + om_n * om * cycle[(n + 1) % 4] * f;
+            out.c[0][n] = c0n;
+            out.c[1][n] = c1n;
+            out.c[2][n] = c2n;
+            out.gc[0][n] = g0;
+            out.gc[1][n] = g1;
+            curv += c2n.abs() * lp;
+            // keep terms until the remaining tail of every series (homogeneous, and with the
+            // harmonic part) is below round-off over the step
+            // (sums rather than maxima: a bound as good, without NaN-aware max sequences)
+            size[n] = (c0n.abs() + c1n.abs() + c2n.abs() + g0.abs() + g1.abs()) * lp;
+            if size[n] > biggest {
+                biggest = size[n];
             }
+            om_n *= om;
+            lp *= len;
         }
-        let p = self.model.params();
-        let mut lp = [1.0; K + 1];
-        for n in 1..=K {
-            lp[n] = lp[n - 1] * len;
-        }
-        let curv = c[2].iter().zip(&lp).map(|(x, l)| x.abs() * l).sum::<f64>() + fr.vp_curv;
-        // keep terms until the remaining tail of every series is below round-off over the step
-        let size = |n: usize| c.iter().map(|row| row[n].abs()).fold(0.0, f64::max) * lp[n];
-        let scale =
-            (0..=K).map(size).fold(0.0, f64::max) + fr.wp.iter().map(|x| x.abs()).sum::<f64>();
+        out.gc[0][0] += fr.wp[0] + p.alpha5;
+        let scale = biggest + fr.wp.iter().map(|x| x.abs()).sum::<f64>();
         let mut terms = K + 1;
         let mut tail = 0.0;
         while terms > 1 {
-            tail += size(terms - 1);
+            tail += size[terms - 1];
             if tail > 1e-18 * scale {
                 break;
             }
             terms -= 1;
         }
-        TipPoly {
-            tau0,
-            c,
-            terms,
-            wp: fr.wp,
-            omega: p.omega,
-            base_amp: base_amp(p),
-            alpha5: p.alpha5,
-            sigma: region.guard_sign(),
-            dead: self.dead,
-            curv,
-        }
+        out.tau0 = tau0;
+        out.terms = terms;
+        out.wp = fr.wp;
+        out.omega = p.omega;
+        out.base_amp = base_amp(p);
+        out.alpha5 = p.alpha5;
+        out.sigma = r.guard_sign();
+        out.dead = dead;
+        out.curv = curv;
     }
 
     /// Start a stint in `region` at (τ, z): the bound on |W_hom''| over the whole stint — the
@@ -618,7 +656,7 @@ impl ExactPropagator {
         let ri = region.index();
         let modal = self.modal[ri];
         let dim = self.z.len();
-        self.poly = None;
+        self.poly_built = false;
         self.last.tau0 = tau0;
         self.last.region = region;
         self.last.full = full;
@@ -714,8 +752,20 @@ impl ExactPropagator {
         if !certified_positive(ga, da, gb, db, cheap, len) {
             let mut y0 = [0.0; MAXD];
             self.last_y0(&mut y0[..dim]);
-            let poly = self.build_poly(region, tau0, &y0[..dim], len);
-            let search = Search { poly: &poly };
+            Self::build_poly(
+                &self.spec[ri],
+                &self.forced[ri],
+                self.model.params(),
+                self.dead,
+                region,
+                tau0,
+                &y0[..dim],
+                len,
+                &mut self.poly,
+            );
+            self.poly_built = true;
+            let poly = &*self.poly;
+            let search = Search { poly };
             // start of the search: after a switching, where the lower parabola peaks
             let mut a = 0.0;
             let mut g_a = (ga, da);
@@ -732,7 +782,6 @@ impl ExactPropagator {
             } else {
                 hit = search.first(a, g_a, len, (gb, db), 0);
             }
-            self.poly = Some(Box::new(poly));
         }
         self.just_switched = false;
         match hit {
@@ -819,7 +868,7 @@ impl Integrator for ExactPropagator {
         self.last.q0 = [C0; MAXD];
         self.last.modal = false;
         self.last.full = false;
-        self.poly = None;
+        self.poly_built = false;
         self.vt = (self.model.v_t(tau, &z), self.model.v_t_dot(tau, &z));
         Ok(())
     }
@@ -842,18 +891,26 @@ impl Integrator for ExactPropagator {
 
     fn dense_tip(&mut self, tau: f64) -> [f64; 3] {
         let t = tau - self.last.tau0;
-        if self.poly.is_none() {
+        if !self.poly_built {
             let len = (self.tau - self.last.tau0).max(t);
             let dim = self.z.len();
             let mut y0 = [0.0; MAXD];
             self.last_y0(&mut y0[..dim]);
-            let poly = self.build_poly(self.last.region, self.last.tau0, &y0[..dim], len);
-            self.poly = Some(Box::new(poly));
+            let ri = self.last.region.index();
+            Self::build_poly(
+                &self.spec[ri],
+                &self.forced[ri],
+                self.model.params(),
+                self.dead,
+                self.last.region,
+                self.last.tau0,
+                &y0[..dim],
+                len,
+                &mut self.poly,
+            );
+            self.poly_built = true;
         }
-        match &self.poly {
-            Some(poly) => poly.w(t),
-            None => [f64::NAN; 3],
-        }
+        self.poly.w(t)
     }
 
     fn dense_state(&mut self, tau: f64) -> DVector<f64> {

@@ -9,6 +9,10 @@ pub(super) struct TipPoly {
     pub(super) tau0: f64,
     /// mo[n] / n!, mo[n+1]/n!, mo[n+2]/n! for n = 0..=K.
     pub(super) c: [[f64; K + 1]; 3],
+    /// Taylor coefficients of V_T and dV_T/dτ in local time: c[0], c[1] plus those of the
+    /// harmonic part W_p + α2 sin Ωτ + α5 (whose n-th derivative cycles through ±Ωⁿ(S, C)), so
+    /// that the gap costs two Horner sums and no sine.
+    pub(super) gc: [[f64; K + 1]; 2],
     /// Terms kept: the tail beyond is below round-off over the step.
     pub(super) terms: usize,
     pub(super) wp: [f64; 3],
@@ -24,6 +28,22 @@ pub(super) struct TipPoly {
 }
 
 impl TipPoly {
+    /// A polynomial to be filled by the propagator (all zero).
+    pub(super) fn empty() -> Self {
+        TipPoly {
+            tau0: 0.0,
+            c: [[0.0; K + 1]; 3],
+            gc: [[0.0; K + 1]; 2],
+            terms: 1,
+            wp: [0.0; 3],
+            omega: 0.0,
+            base_amp: 0.0,
+            alpha5: 0.0,
+            sigma: 1.0,
+            dead: 0.0,
+            curv: 0.0,
+        }
+    }
     fn horner(c: &[f64], t: f64) -> f64 {
         c.iter().rev().fold(0.0, |acc, &x| acc * t + x)
     }
@@ -40,13 +60,8 @@ impl TipPoly {
     }
     /// Gap g = σ V_T and its derivative at local time t.
     pub(super) fn g(&self, t: f64) -> (f64, f64) {
-        let (s, c) = (self.omega * (self.tau0 + t)).sin_cos();
-        let (w0, ws, wc) = (self.wp[0], self.wp[1], self.wp[2]);
-        let om = self.omega;
-        let w = Self::horner(&self.c[0][..self.terms], t) + w0 + ws * s + wc * c;
-        let dw = Self::horner(&self.c[1][..self.terms], t) + om * (ws * c - wc * s);
-        let v = w + self.base_amp * s + self.alpha5;
-        let dv = dw + self.base_amp * om * c;
+        let v = Self::horner(&self.gc[0][..self.terms], t);
+        let dv = Self::horner(&self.gc[1][..self.terms], t);
         (self.sigma * v + self.dead, self.sigma * dv)
     }
 }
