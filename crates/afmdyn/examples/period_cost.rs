@@ -39,10 +39,6 @@ fn builds(modes: usize, reps: usize) -> Result<(), Box<dyn std::error::Error>> {
         ..Params::default()
     };
     let m = CantileverModel::new(&p)?;
-    let m2 = CantileverModel::new(&Params {
-        omega: p.omega + 1e-6,
-        ..p
-    })?;
     let opts = |reuse| ExactOptions {
         reuse,
         ..ExactOptions::default()
@@ -54,11 +50,19 @@ fn builds(modes: usize, reps: usize) -> Result<(), Box<dyn std::error::Error>> {
     let warm = best_of(reps, || {
         std::hint::black_box(ExactPropagator::try_with(&m, opts(true)).ok());
     });
-    let mut flip = false;
+    let models: Vec<CantileverModel> = (1..=reps)
+        .map(|i| {
+            CantileverModel::new(&Params {
+                omega: p.omega + 1e-6 * i as f64,
+                ..p
+            })
+        })
+        .collect::<Result<_, _>>()?;
+    let mut next = models.iter();
     let omega_step = best_of(reps, || {
-        flip = !flip;
-        let model = if flip { &m2 } else { &m };
-        std::hint::black_box(ExactPropagator::try_with(model, opts(true)).ok());
+        if let Some(model) = next.next() {
+            std::hint::black_box(ExactPropagator::try_with(model, opts(true)).ok());
+        }
     });
     println!("build N = {modes}: {cold:.1} µs cold, {warm:.1} µs same parameters, {omega_step:.1} µs after an Ω step");
     Ok(())

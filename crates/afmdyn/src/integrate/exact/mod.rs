@@ -174,7 +174,8 @@ pub struct ExactPropagator {
     /// z lags behind q (inside [`Integrator::advance_to`]).
     stale: bool,
     region: Region,
-    on_grid: Option<i64>,
+    /// The grid point the state is on, as (period p, sub-step k < m): grid index j = p m + k.
+    on_grid: Option<(i64, usize)>,
     /// Bound on |W_hom''| over the current stint (see `enter_stint`).
     stint_curvature: f64,
     just_switched: bool,
@@ -373,7 +374,7 @@ impl ExactPropagator {
             q: [C0; MAXD],
             stale: false,
             region: Region::Free,
-            on_grid: Some(0),
+            on_grid: Some((0, 0)),
             stint_curvature: 0.0,
             just_switched: true,
             recent: VecDeque::new(),
@@ -413,12 +414,31 @@ impl ExactPropagator {
             return self.phi[r.index()].clone();
         }
         let dim = self.z.len();
-        let mut e = DMatrix::zeros(dim, dim);
-        for j in 0..dim {
-            let mut y = [0.0; MAXD];
-            Self::hom_energy(sp, sp.t.column(j).as_slice(), t, &mut y[..dim]);
-            e.column_mut(j).copy_from_slice(&y[..dim]);
-        }
+        let e = match &sp.modal {
+            // Re(V e^{Λt} V⁻¹) T: the exponentials once
+            Some(me) => {
+                let r = me.len();
+                let mut f = [C0; MAXD];
+                me.factors(t, &mut f[..r]);
+                let mut vf = me.v.clone();
+                for (k, fk) in f[..r].iter().enumerate() {
+                    for x in vf.column_mut(k).iter_mut() {
+                        *x *= fk;
+                    }
+                }
+                let vinv_t = &me.vinv * sp.t.map(|x| C::new(x, 0.0));
+                (vf * vinv_t).map(|c| c.re)
+            }
+            None => {
+                let mut e = DMatrix::zeros(dim, dim);
+                for j in 0..dim {
+                    let mut y = [0.0; MAXD];
+                    Self::hom_energy(sp, sp.t.column(j).as_slice(), t, &mut y[..dim]);
+                    e.column_mut(j).copy_from_slice(&y[..dim]);
+                }
+                e
+            }
+        };
         &sp.tinv * e
     }
 
@@ -435,7 +455,8 @@ impl ExactPropagator {
 
     fn zp_into(f: &Forced, omega: f64, tau: f64, out: &mut [f64]) {
         let (s, c) = (omega * tau).sin_cos();
-        for (((o, a), b), d) in out.iter_mut().zip(&f.p0).zip(&f.ps).zip(&f.pc) {
+        let (p0, ps, pc) = (f.p0.as_slice(), f.ps.as_slice(), f.pc.as_slice());
+        for (((o, a), b), d) in out.iter_mut().zip(p0).zip(ps).zip(pc) {
             *o = a + s * b + c * d;
         }
     }
@@ -541,6 +562,18 @@ impl ExactPropagator {
         let mut curv = fr.vp_curv;
         let mut size = [0.0; K + 1];
         let mut biggest = 0.0f64;
+        let wp_sum = fr.wp.iter().map(|x| x.abs()).sum::<f64>();
+        // a priori bound on the coefficients beyond n: |c̃ᵀÃ^{n+d}y0| lenⁿ/n! ≤
+        // ‖c̃‖‖y0‖ρ^{n+d} lenⁿ/n! and |harmonic| ≤ (|a_s| + |a_c|) Ω^{n+d} lenⁿ/n! (d ≤ 2), so
+        // with x = max(ρ, Ω) len every size below is ≤ bound xⁿ/n! and the tail from n on
+        // ≤ bound xⁿ/n! / (1 − x/(n+1)): the series stop as soon as that is below round-off
+        let y_norm = y0.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let (rho, amp) = (sp.rho, a_s.abs() + a_c.abs());
+        let bound =
+            sp.ct_norm * y_norm * (1.0 + rho + rho * rho) * 3.0 + amp * (1.0 + om + om * om) * 2.0;
+        let x = rho.max(om) * len;
+        let mut x_fact = 1.0;
+        let mut filled = K + 1;
         for n in 0..=K {
             let f = INV_FACT[n];
             let (c0n, c1n, c2n) = (mo[n] * f, mo[n + 1] * f, mo[n + 2] * f);
@@ -561,10 +594,18 @@ impl ExactPropagator {
             }
             om_n *= om;
             lp *= len;
+            x_fact *= x / (n + 1) as f64;
+            let ratio = x / (n + 2) as f64;
+            let rest = bound * x_fact / (1.0 - ratio);
+            if ratio < 0.5 && rest <= 1e-18 * (biggest + wp_sum) {
+                filled = n + 1;
+                curv += rest;
+                break;
+            }
         }
         out.gc[0][0] += fr.wp[0] + p.alpha5;
-        let scale = biggest + fr.wp.iter().map(|x| x.abs()).sum::<f64>();
-        let mut terms = K + 1;
+        let scale = biggest + wp_sum;
+        let mut terms = filled;
         let mut tail = 0.0;
         while terms > 1 {
             tail += size[terms - 1];
@@ -634,11 +675,17 @@ impl ExactPropagator {
         let region = self.region;
         let tau0 = self.tau;
         let omega = self.model.omega();
-        let j_next = match self.on_grid {
-            Some(j) => j + 1,
-            None => self.grid.next_index(tau0),
+        let m = self.grid.m;
+        let next = match self.on_grid {
+            Some((p, k)) if k + 1 < m => (p, k + 1),
+            Some((p, _)) => (p + 1, 0),
+            None => {
+                let j = self.grid.next_index(tau0);
+                (j.div_euclid(m as i64), j.rem_euclid(m as i64) as usize)
+            }
         };
-        let t_grid = self.grid.tau(j_next);
+        // as PeriodGrid::tau
+        let t_grid = next.0 as f64 * self.grid.period + next.1 as f64 * self.grid.h;
         let tau_b = t_grid.min(tau_max);
         let len = tau_b - tau0;
         if len <= 0.0 {
@@ -650,9 +697,7 @@ impl ExactPropagator {
             });
         }
         let full = self.on_grid.is_some() && tau_b == t_grid;
-        let k = self
-            .on_grid
-            .map_or(0, |j| j.rem_euclid(self.grid.m as i64) as usize);
+        let k = self.on_grid.map_or(0, |(_, k)| k);
         let ri = region.index();
         let modal = self.modal[ri];
         let dim = self.z.len();
@@ -794,9 +839,9 @@ impl ExactPropagator {
                 }
                 self.tau = tau_b;
                 self.vt = vt_b;
-                self.on_grid = (tau_b == t_grid).then_some(j_next);
-                if let Some(j) = self.on_grid {
-                    if j.rem_euclid(self.grid.m as i64) == 0 {
+                self.on_grid = (tau_b == t_grid).then_some(next);
+                if let Some((_, k_next)) = self.on_grid {
+                    if k_next == 0 {
                         self.materialize();
                         let norm = self.z.norm();
                         if norm.is_nan() || norm >= 1e12 {
@@ -858,7 +903,9 @@ impl Integrator for ExactPropagator {
         self.z.copy_from(&z);
         self.stale = false;
         let j = self.grid.next_index(tau) - 1;
-        self.on_grid = (self.grid.tau(j) == tau).then_some(j);
+        let m = self.grid.m as i64;
+        self.on_grid =
+            (self.grid.tau(j) == tau).then_some((j.div_euclid(m), j.rem_euclid(m) as usize));
         self.enter_stint(region, tau);
         self.just_switched = true;
         self.recent.clear();

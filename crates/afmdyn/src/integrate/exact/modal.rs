@@ -175,7 +175,7 @@ impl ModalExp {
     pub(super) fn curvature(&self, q: &[C]) -> f64 {
         q.iter()
             .zip(&self.tip_lam2)
-            .map(|(qk, w)| qk.norm() * w)
+            .map(|(qk, w)| qk.norm_sqr().sqrt() * w)
             .sum()
     }
 }
