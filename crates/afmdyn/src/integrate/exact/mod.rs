@@ -439,7 +439,7 @@ impl ExactPropagator {
                 e
             }
         };
-        &sp.tinv * e
+        spectral::matmul(&sp.tinv, &e)
     }
 
     /// Jacobian ∂z(τ1)/∂z(τ0) of the flow over the last step [τ0, τ1] inside its region

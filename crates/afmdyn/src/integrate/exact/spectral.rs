@@ -116,20 +116,45 @@ pub(super) fn expm(at: &DMatrix<f64>, h: f64, rho: f64) -> DMatrix<f64> {
         0
     };
     let x = at * (h / 2f64.powi(s));
-    let id = DMatrix::<f64>::identity(dim, dim);
     // Horner: P = I + X/1 (I + X/2 (… (I + X/14)))
-    let mut p = id.clone();
+    let mut p = DMatrix::<f64>::identity(dim, dim);
     let mut tmp = DMatrix::<f64>::zeros(dim, dim);
     for k in (1..=14).rev() {
-        tmp.gemm(1.0 / k as f64, &x, &p, 0.0);
-        p.copy_from(&id);
-        p += &tmp;
+        matmul_into(&x, &p, 1.0 / k as f64, &mut tmp);
+        for i in 0..dim {
+            tmp[(i, i)] += 1.0;
+        }
+        std::mem::swap(&mut p, &mut tmp);
     }
     for _ in 0..s {
-        tmp.gemm(1.0, &p, &p, 0.0);
+        matmul_into(&p, &p, 1.0, &mut tmp);
         std::mem::swap(&mut p, &mut tmp);
     }
     p
+}
+
+/// out = α A B for square column-major A, B of one size: up to 12×12 column by column as sums
+/// of [`crate::integrate::matvec_cols`] (a blocked product packs, and allocates, per call),
+/// above by nalgebra's blocked product.
+pub(super) fn matmul_into(a: &DMatrix<f64>, b: &DMatrix<f64>, alpha: f64, out: &mut DMatrix<f64>) {
+    let dim = a.nrows();
+    if dim > 12 {
+        return out.gemm(alpha, a, b, 0.0);
+    }
+    for (bj, oj) in b
+        .as_slice()
+        .chunks_exact(dim.max(1))
+        .zip(out.as_mut_slice().chunks_exact_mut(dim.max(1)))
+    {
+        crate::integrate::matvec_cols(a.as_slice(), dim, bj, oj, alpha, false);
+    }
+}
+
+/// A B for square matrices of one size ([`matmul_into`]).
+pub(super) fn matmul(a: &DMatrix<f64>, b: &DMatrix<f64>) -> DMatrix<f64> {
+    let mut out = DMatrix::zeros(a.nrows(), b.ncols());
+    matmul_into(a, b, 1.0, &mut out);
+    out
 }
 
 /// Φ_s = T⁻¹ e^{Ã_s h} T of both regions ([`expm`]; cached under `key` and h when `reuse`).
@@ -144,7 +169,7 @@ pub(super) fn grid_exp(
     cached(&GRID_EXP, &key, reuse, || {
         Ok(std::array::from_fn(|i| {
             let s = &spec[i];
-            &s.tinv * expm(&s.at, h, s.rho) * &s.t
+            matmul(&matmul(&s.tinv, &expm(&s.at, h, s.rho)), &s.t)
         }))
     })
 }
