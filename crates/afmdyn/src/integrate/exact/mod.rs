@@ -173,6 +173,8 @@ pub struct ExactPropagator {
     q: [C; MAXD],
     /// z lags behind q (inside [`Integrator::advance_to`]).
     stale: bool,
+    /// e^{λ_k t} of a partial modal step.
+    fac_tmp: [C; MAXD],
     region: Region,
     /// The grid point the state is on, as (period p, sub-step k < m): grid index j = p m + k.
     on_grid: Option<(i64, usize)>,
@@ -373,6 +375,7 @@ impl ExactPropagator {
             z: zero.clone(),
             q: [C0; MAXD],
             stale: false,
+            fac_tmp: [C0; MAXD],
             region: Region::Free,
             on_grid: Some((0, 0)),
             stint_curvature: 0.0,
@@ -713,18 +716,13 @@ impl ExactPropagator {
             (Some(me), true) => {
                 // q ← e^{Λ len} q; the tip from q
                 let r = me.len();
-                self.last.q0[..r].copy_from_slice(&self.q[..r]);
-                let mut f = [C0; MAXD];
                 let fac = if full {
                     &fr.grid_fac[..]
                 } else {
-                    me.factors(len, &mut f[..r]);
-                    &f[..r]
+                    me.factors(len, &mut self.fac_tmp[..r]);
+                    &self.fac_tmp[..r]
                 };
-                for (qk, fk) in self.q.iter_mut().zip(fac) {
-                    *qk *= fk;
-                }
-                let (w, wd) = me.tip_of(&self.q[..r]);
+                let (w, wd) = me.advance(&mut self.q[..r], &mut self.last.q0[..r], fac);
                 let (s, c) = if full {
                     self.trig[k + 1]
                 } else {

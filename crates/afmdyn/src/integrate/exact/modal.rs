@@ -160,13 +160,20 @@ impl ModalExp {
         Self::expand(&self.v, &q[..r], out, false);
     }
 
-    /// Tip deflection and rate of the homogeneous part, Σ Re(w c̃ᵀv q) and Σ Re(w c̃ᵀv λ q).
-    pub(super) fn tip_of(&self, q: &[C]) -> (f64, f64) {
+    /// One step of the modal coordinates: q0 ← q, q ← f q (f = e^{λ_k t}); returns the tip
+    /// deflection and rate of the homogeneous part at the end, Σ Re(w c̃ᵀv q) and
+    /// Σ Re(w c̃ᵀv λ q). One pass, real arithmetic.
+    pub(super) fn advance(&self, q: &mut [C], q0: &mut [C], f: &[C]) -> (f64, f64) {
         let mut w = 0.0;
         let mut wd = 0.0;
-        for ((qk, t), td) in q.iter().zip(&self.tip).zip(&self.tip_dot) {
-            w += t.re * qk.re - t.im * qk.im;
-            wd += td.re * qk.re - td.im * qk.im;
+        let tips = self.tip.iter().zip(&self.tip_dot);
+        for (((qk, q0k), fk), (t, td)) in q.iter_mut().zip(q0.iter_mut()).zip(f).zip(tips) {
+            let (a, b) = (qk.re, qk.im);
+            *q0k = *qk;
+            let (re, im) = (a * fk.re - b * fk.im, a * fk.im + b * fk.re);
+            *qk = C::new(re, im);
+            w += t.re * re - t.im * im;
+            wd += td.re * re - td.im * im;
         }
         (w, wd)
     }
