@@ -46,7 +46,7 @@ use crate::galerkin::Region;
 use crate::model::CantileverModel;
 use crate::params::Params;
 use kernel::MatVec;
-use modal::{ModalExp, MAXD};
+use modal::{ModalExp, Modes, MAXD};
 use nalgebra::{Complex, DMatrix, DVector};
 use search::{certified_positive, Search, TipPoly};
 use spectral::Spectral;
@@ -67,7 +67,6 @@ const CHATTER_WINDOW: f64 = 1e-9;
 const MODAL_MIN_MODES: usize = 7;
 
 type C = Complex<f64>;
-const C0: C = Complex::new(0.0, 0.0);
 
 /// 1/n!, n = 0..=K.
 const INV_FACT: [f64; K + 1] = {
@@ -136,7 +135,7 @@ struct Forced {
     /// Ω² · amplitude of V_p (bound on |V_p''|).
     vp_curv: f64,
     /// e^{λ_k h} of the modal representatives (empty without an eigendecomposition).
-    grid_fac: Vec<C>,
+    grid_fac: Modes,
 }
 
 /// The last step, kept for dense output.
@@ -147,7 +146,7 @@ struct LastStep {
     /// Homogeneous part δz(τ0) in plain coordinates (dense steps).
     dz0: DVector<f64>,
     /// Modal coordinates of the homogeneous part at τ0 (modal steps).
-    q0: [C; MAXD],
+    q0: Modes,
     /// Whether the step was modal.
     modal: bool,
     /// Whether the step was a whole grid step (its transition matrix is Φ_s).
@@ -170,11 +169,11 @@ pub struct ExactPropagator {
     tau: f64,
     z: DVector<f64>,
     /// Modal coordinates of the homogeneous part of the current state (valid in a modal region).
-    q: [C; MAXD],
+    q: Modes,
     /// z lags behind q (inside [`Integrator::advance_to`]).
     stale: bool,
     /// e^{λ_k t} of a partial modal step.
-    fac_tmp: [C; MAXD],
+    fac_tmp: Modes,
     region: Region,
     /// The grid point the state is on, as (period p, sub-step k < m): grid index j = p m + k.
     on_grid: Option<(i64, usize)>,
@@ -256,9 +255,8 @@ fn forced(
         tip.dot(&pc.rows(0, n)),
     ];
     let vp_curv = omega * omega * (wp[1] + base_amp(model.params())).hypot(wp[2]);
-    let mut grid_fac = Vec::new();
+    let mut grid_fac = Modes::ZERO;
     if let Some(me) = &spec.modal {
-        grid_fac = vec![C0; me.len()];
         me.factors(h, &mut grid_fac);
     }
     Ok(Forced {
@@ -373,9 +371,9 @@ impl ExactPropagator {
             grid: PeriodGrid::new(period, m),
             tau: 0.0,
             z: zero.clone(),
-            q: [C0; MAXD],
+            q: Modes::ZERO,
             stale: false,
-            fac_tmp: [C0; MAXD],
+            fac_tmp: Modes::ZERO,
             region: Region::Free,
             on_grid: Some((0, 0)),
             stint_curvature: 0.0,
@@ -385,7 +383,7 @@ impl ExactPropagator {
                 tau0: 0.0,
                 region: Region::Free,
                 dz0: zero.clone(),
-                q0: [C0; MAXD],
+                q0: Modes::ZERO,
                 modal: false,
                 full: false,
             },
@@ -420,11 +418,11 @@ impl ExactPropagator {
         let e = match &sp.modal {
             // Re(V e^{Λt} V⁻¹) T: the exponentials once
             Some(me) => {
-                let r = me.len();
-                let mut f = [C0; MAXD];
-                me.factors(t, &mut f[..r]);
+                let mut f = Modes::ZERO;
+                me.factors(t, &mut f);
                 let mut vf = me.v.clone();
-                for (k, fk) in f[..r].iter().enumerate() {
+                for k in 0..me.len() {
+                    let fk = C::new(f.re[k], f.im[k]);
                     for x in vf.column_mut(k).iter_mut() {
                         *x *= fk;
                     }
@@ -494,7 +492,7 @@ impl ExactPropagator {
     fn last_y0(&self, y0: &mut [f64]) {
         let sp = &self.spec[self.last.region.index()];
         match (&sp.modal, self.last.modal) {
-            (Some(me), true) => ModalExp::expand(&me.v, &self.last.q0[..me.len()], y0, false),
+            (Some(me), true) => ModalExp::expand(&me.v, &self.last.q0, y0, false),
             _ => matvec(&sp.t, self.last.dz0.as_slice(), y0, 1.0, false),
         }
     }
@@ -511,12 +509,10 @@ impl ExactPropagator {
         );
         if let (Some(me), true) = (&sp.modal, self.last.modal) {
             let r = me.len();
-            let mut q = [C0; MAXD];
-            me.factors(t, &mut q[..r]);
-            for (qk, q0) in q.iter_mut().zip(&self.last.q0[..r]) {
-                *qk *= q0;
-            }
-            return ModalExp::expand(&me.tv, &q[..r], out, true);
+            let mut q = Modes::ZERO;
+            me.factors(t, &mut q);
+            q.mul_assign(&self.last.q0, r);
+            return ModalExp::expand(&me.tv, &q, out, true);
         }
         let dim = out.len();
         let (mut y0, mut yt) = ([0.0; MAXD], [0.0; MAXD]);
@@ -534,7 +530,7 @@ impl ExactPropagator {
         if let Some(me) = &self.spec[ri].modal {
             let z = self.z.as_mut_slice();
             Self::zp_into(&self.forced[ri], self.model.omega(), self.tau, z);
-            ModalExp::expand(&me.tv, &self.q[..me.len()], z, true);
+            ModalExp::expand(&me.tv, &self.q, z, true);
         }
         self.stale = false;
     }
@@ -646,9 +642,8 @@ impl ExactPropagator {
         let energy = sp.kappa2 * y.iter().map(|v| v * v).sum::<f64>().sqrt();
         self.stint_curvature = match &sp.modal {
             Some(me) => {
-                let q = &mut self.q[..me.len()];
-                me.project(y, q);
-                energy.min(me.curvature(q) * (1.0 + 1e-12))
+                me.project(y, &mut self.q);
+                energy.min(me.curvature(&self.q) * (1.0 + 1e-12))
             }
             None => energy,
         };
@@ -715,14 +710,13 @@ impl ExactPropagator {
         let vt_b = match (&self.spec[ri].modal, modal) {
             (Some(me), true) => {
                 // q ← e^{Λ len} q; the tip from q
-                let r = me.len();
                 let fac = if full {
-                    &fr.grid_fac[..]
+                    &fr.grid_fac
                 } else {
-                    me.factors(len, &mut self.fac_tmp[..r]);
-                    &self.fac_tmp[..r]
+                    me.factors(len, &mut self.fac_tmp);
+                    &self.fac_tmp
                 };
-                let (w, wd) = me.advance(&mut self.q[..r], &mut self.last.q0[..r], fac);
+                let (w, wd) = me.advance(&mut self.q, &mut self.last.q0, fac);
                 let (s, c) = if full {
                     self.trig[k + 1]
                 } else {
@@ -737,7 +731,7 @@ impl ExactPropagator {
                     } else {
                         Self::zp_into(fr, omega, tau_b, zb);
                     }
-                    ModalExp::expand(&me.tv, &self.q[..r], zb, true);
+                    ModalExp::expand(&me.tv, &self.q, zb, true);
                 }
                 let [w0, ws, wc] = fr.wp;
                 (
@@ -910,7 +904,7 @@ impl Integrator for ExactPropagator {
         self.last.tau0 = tau;
         self.last.region = region;
         self.last.dz0.fill(0.0);
-        self.last.q0 = [C0; MAXD];
+        self.last.q0 = Modes::ZERO;
         self.last.modal = false;
         self.last.full = false;
         self.poly_built = false;

@@ -21,6 +21,64 @@ pub const MAX_MODAL_CONDITION: f64 = 1e4;
 
 type C = Complex<f64>;
 
+/// Complex modal values in structure-of-arrays form (real and imaginary parts apart, so that
+/// the grid step vectorizes); the first r entries are used.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Modes {
+    pub(super) re: [f64; MAXD],
+    pub(super) im: [f64; MAXD],
+}
+
+impl Modes {
+    /// All zero.
+    pub(super) const ZERO: Modes = Modes {
+        re: [0.0; MAXD],
+        im: [0.0; MAXD],
+    };
+
+    fn from(values: &[C]) -> Modes {
+        let mut m = Modes::ZERO;
+        for (k, v) in values.iter().enumerate().take(MAXD) {
+            m.re[k] = v.re;
+            m.im[k] = v.im;
+        }
+        m
+    }
+
+    /// self ← self ⊙ other elementwise over the first r entries.
+    pub(super) fn mul_assign(&mut self, other: &Modes, r: usize) {
+        let (re, im) = (&mut self.re[..r], &mut self.im[..r]);
+        for (((a, b), c), d) in re
+            .iter_mut()
+            .zip(im)
+            .zip(&other.re[..r])
+            .zip(&other.im[..r])
+        {
+            let (x, y) = (*a, *b);
+            *a = x * c - y * d;
+            *b = x * d + y * c;
+        }
+    }
+}
+
+/// Σ_k Re(x_k y_k) over the first r entries, in two interleaved partial sums (vectorizable).
+fn re_dot(x: &Modes, y: &Modes, r: usize) -> f64 {
+    let (xr, xi, yr, yi) = (&x.re[..r], &x.im[..r], &y.re[..r], &y.im[..r]);
+    let (xr2, xr1) = xr.as_chunks::<2>();
+    let (xi2, xi1) = xi.as_chunks::<2>();
+    let (yr2, yr1) = yr.as_chunks::<2>();
+    let (yi2, yi1) = yi.as_chunks::<2>();
+    let mut acc = [0.0; 2];
+    for (((a, b), c), d) in xr2.iter().zip(xi2).zip(yr2).zip(yi2) {
+        acc[0] += a[0] * c[0] - b[0] * d[0];
+        acc[1] += a[1] * c[1] - b[1] * d[1];
+    }
+    for (((a, b), c), d) in xr1.iter().zip(xi1).zip(yr1).zip(yi1) {
+        acc[0] += a * c - b * d;
+    }
+    acc[0] + acc[1]
+}
+
 /// The eigendecomposition of one region's Ã (energy coordinates).
 #[derive(Debug, Clone)]
 pub(super) struct ModalExp {
@@ -33,8 +91,8 @@ pub(super) struct ModalExp {
     /// Rows of V⁻¹ of the representatives, r × 2N.
     pub(super) vinv: DMatrix<C>,
     /// w_k c̃ᵀv_k and w_k c̃ᵀv_k λ_k: the tip deflection and its rate per unit q_k.
-    pub(super) tip: Vec<C>,
-    pub(super) tip_dot: Vec<C>,
+    pub(super) tip: Modes,
+    pub(super) tip_dot: Modes,
     /// w_k |c̃ᵀv_k| |λ_k|²: curvature of the tip deflection per unit |q_k|.
     pub(super) tip_lam2: Vec<f64>,
 }
@@ -93,12 +151,13 @@ impl ModalExp {
         let tip: Vec<C> = (0..r)
             .map(|k| v.column(k).iter().zip(ct).map(|(vi, &c)| vi * c).sum::<C>())
             .collect();
-        let tip_dot = tip.iter().zip(&lambda).map(|(t, l)| t * l).collect();
+        let tip_dot: Vec<C> = tip.iter().zip(&lambda).map(|(t, l)| t * l).collect();
         let tip_lam2 = tip
             .iter()
             .zip(&lambda)
             .map(|(t, l)| t.norm() * l.norm_sqr())
             .collect();
+        let (tip, tip_dot) = (Modes::from(&tip), Modes::from(&tip_dot));
         Some(ModalExp {
             lambda,
             v,
@@ -115,74 +174,70 @@ impl ModalExp {
         self.lambda.len()
     }
 
-    /// q = V⁻¹ y (representatives), `q.len() == r`.
-    pub(super) fn project(&self, y: &[f64], q: &mut [C]) {
-        let r = q.len();
-        q.fill(C::new(0.0, 0.0));
+    /// q = V⁻¹ y (representatives).
+    pub(super) fn project(&self, y: &[f64], q: &mut Modes) {
+        let r = self.len();
+        let (qr, qi) = (&mut q.re[..r], &mut q.im[..r]);
+        qr.fill(0.0);
+        qi.fill(0.0);
         for (col, &yj) in self.vinv.as_slice().chunks_exact(r).zip(y) {
-            for (qi, vij) in q.iter_mut().zip(col) {
-                qi.re += vij.re * yj;
-                qi.im += vij.im * yj;
+            for ((a, b), vij) in qr.iter_mut().zip(qi.iter_mut()).zip(col) {
+                *a += vij.re * yj;
+                *b += vij.im * yj;
             }
         }
     }
 
-    /// out = Σ_k Re(b_k q_k) for the columns b_k of `basis` (w_k v_k or w_k T⁻¹v_k), added to
-    /// `out` when `accumulate`.
-    pub(super) fn expand(basis: &DMatrix<C>, q: &[C], out: &mut [f64], accumulate: bool) {
+    /// out = Σ_k Re(b_k q_k) over the r columns b_k of `basis` (w_k v_k or w_k T⁻¹v_k), added
+    /// to `out` when `accumulate`.
+    pub(super) fn expand(basis: &DMatrix<C>, q: &Modes, out: &mut [f64], accumulate: bool) {
         if !accumulate {
             out.fill(0.0);
         }
-        for (col, qk) in basis.as_slice().chunks_exact(out.len()).zip(q) {
+        let r = basis.ncols();
+        let cols = basis.as_slice().chunks_exact(out.len().max(1));
+        for ((col, qr), qi) in cols.zip(&q.re[..r]).zip(&q.im[..r]) {
             for (o, b) in out.iter_mut().zip(col) {
-                *o += b.re * qk.re - b.im * qk.im;
+                *o += b.re * qr - b.im * qi;
             }
         }
     }
 
-    /// e^{λ_k t} for every representative into `out`.
-    pub(super) fn factors(&self, t: f64, out: &mut [C]) {
-        for (f, l) in out.iter_mut().zip(&self.lambda) {
-            *f = C::from_polar((l.re * t).exp(), l.im * t);
+    /// e^{λ_k t} for every representative.
+    pub(super) fn factors(&self, t: f64, out: &mut Modes) {
+        for (k, l) in self.lambda.iter().enumerate() {
+            let mag = (l.re * t).exp();
+            let (s, c) = (l.im * t).sin_cos();
+            out.re[k] = mag * c;
+            out.im[k] = mag * s;
         }
     }
 
     /// out = e^{Ã t} y0 (real).
     pub(super) fn apply(&self, y0: &[f64], t: f64, out: &mut [f64]) {
-        let r = self.len();
-        let mut q = [C::new(0.0, 0.0); MAXD];
-        let mut f = [C::new(0.0, 0.0); MAXD];
-        self.project(y0, &mut q[..r]);
-        self.factors(t, &mut f[..r]);
-        for (qk, fk) in q.iter_mut().zip(&f[..r]) {
-            *qk *= fk;
-        }
-        Self::expand(&self.v, &q[..r], out, false);
+        let mut q = Modes::ZERO;
+        let mut f = Modes::ZERO;
+        self.project(y0, &mut q);
+        self.factors(t, &mut f);
+        q.mul_assign(&f, self.len());
+        Self::expand(&self.v, &q, out, false);
     }
 
-    /// One step of the modal coordinates: q0 ← q, q ← f q (f = e^{λ_k t}); returns the tip
+    /// One step of the modal coordinates: q0 ← q, q ← f ⊙ q (f = e^{λ_k t}); returns the tip
     /// deflection and rate of the homogeneous part at the end, Σ Re(w c̃ᵀv q) and
-    /// Σ Re(w c̃ᵀv λ q). One pass, real arithmetic.
-    pub(super) fn advance(&self, q: &mut [C], q0: &mut [C], f: &[C]) -> (f64, f64) {
-        let mut w = 0.0;
-        let mut wd = 0.0;
-        let tips = self.tip.iter().zip(&self.tip_dot);
-        for (((qk, q0k), fk), (t, td)) in q.iter_mut().zip(q0.iter_mut()).zip(f).zip(tips) {
-            let (a, b) = (qk.re, qk.im);
-            *q0k = *qk;
-            let (re, im) = (a * fk.re - b * fk.im, a * fk.im + b * fk.re);
-            *qk = C::new(re, im);
-            w += t.re * re - t.im * im;
-            wd += td.re * re - td.im * im;
-        }
-        (w, wd)
+    /// Σ Re(w c̃ᵀv λ q).
+    pub(super) fn advance(&self, q: &mut Modes, q0: &mut Modes, f: &Modes) -> (f64, f64) {
+        let r = self.len();
+        q0.re[..r].copy_from_slice(&q.re[..r]);
+        q0.im[..r].copy_from_slice(&q.im[..r]);
+        q.mul_assign(f, r);
+        (re_dot(&self.tip, q, r), re_dot(&self.tip_dot, q, r))
     }
 
     /// Σ_k w_k |c̃ᵀv_k| |λ_k|² |q_k|: bounds |W_hom''| for all later times (Re λ_k ≤ 0).
-    pub(super) fn curvature(&self, q: &[C]) -> f64 {
-        q.iter()
-            .zip(&self.tip_lam2)
-            .map(|(qk, w)| qk.norm_sqr().sqrt() * w)
-            .sum()
+    pub(super) fn curvature(&self, q: &Modes) -> f64 {
+        let r = self.len();
+        let parts = q.re[..r].iter().zip(&q.im[..r]).zip(&self.tip_lam2);
+        parts.map(|((a, b), w)| (a * a + b * b).sqrt() * w).sum()
     }
 }
