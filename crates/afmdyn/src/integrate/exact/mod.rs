@@ -47,7 +47,7 @@ use crate::model::CantileverModel;
 use crate::params::Params;
 use kernel::MatVec;
 use modal::{ModalExp, Modes, MAXD};
-use nalgebra::{Complex, DMatrix, DVector};
+use nalgebra::{DMatrix, DVector};
 use search::{certified_positive, Search, TipPoly};
 use spectral::Spectral;
 use std::collections::VecDeque;
@@ -65,8 +65,6 @@ const CHATTER_WINDOW: f64 = 1e-9;
 /// Modal propagation is chosen automatically above this many modes (below it the fixed-size
 /// dense step is as fast and needs no change of coordinates).
 const MODAL_MIN_MODES: usize = 7;
-
-type C = Complex<f64>;
 
 /// 1/n!, n = 0..=K.
 const INV_FACT: [f64; K + 1] = {
@@ -417,19 +415,7 @@ impl ExactPropagator {
         let dim = self.z.len();
         let e = match &sp.modal {
             // Re(V e^{Λt} V⁻¹) T: the exponentials once
-            Some(me) => {
-                let mut f = Modes::ZERO;
-                me.factors(t, &mut f);
-                let mut vf = me.v.clone();
-                for k in 0..me.len() {
-                    let fk = C::new(f.re[k], f.im[k]);
-                    for x in vf.column_mut(k).iter_mut() {
-                        *x *= fk;
-                    }
-                }
-                let vinv_t = &me.vinv * sp.t.map(|x| C::new(x, 0.0));
-                (vf * vinv_t).map(|c| c.re)
-            }
+            Some(me) => me.transition_energy(t),
             None => {
                 let mut e = DMatrix::zeros(dim, dim);
                 for j in 0..dim {

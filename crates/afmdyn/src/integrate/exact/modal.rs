@@ -79,17 +79,36 @@ fn re_dot(x: &Modes, y: &Modes, r: usize) -> f64 {
     acc[0] + acc[1]
 }
 
+/// A complex matrix as its real and imaginary parts (column-major), for vectorizable real
+/// arithmetic.
+#[derive(Debug, Clone)]
+pub(super) struct Split {
+    pub(super) re: DMatrix<f64>,
+    pub(super) im: DMatrix<f64>,
+}
+
+impl Split {
+    fn new(m: &DMatrix<C>) -> Split {
+        Split {
+            re: m.map(|c| c.re),
+            im: m.map(|c| c.im),
+        }
+    }
+}
+
 /// The eigendecomposition of one region's Ã (energy coordinates).
 #[derive(Debug, Clone)]
 pub(super) struct ModalExp {
     /// Representative eigenvalues λ_k (r of them, r ≤ 2N).
     pub(super) lambda: Vec<C>,
     /// w_k v_k, 2N × r (energy coordinates).
-    pub(super) v: DMatrix<C>,
+    pub(super) v: Split,
     /// w_k T⁻¹ v_k, 2N × r (plain coordinates).
-    pub(super) tv: DMatrix<C>,
+    pub(super) tv: Split,
     /// Rows of V⁻¹ of the representatives, r × 2N.
     pub(super) vinv: DMatrix<C>,
+    /// V⁻¹ T of the representatives, r × 2N (plain coordinates to modal ones).
+    pub(super) vinv_t: Split,
     /// w_k c̃ᵀv_k and w_k c̃ᵀv_k λ_k: the tip deflection and its rate per unit q_k.
     pub(super) tip: Modes,
     pub(super) tip_dot: Modes,
@@ -146,8 +165,10 @@ impl ModalExp {
         for k in 0..r {
             v.column_mut(k).scale_mut(weight(k));
         }
-        let tv = tinv.map(|x| C::new(x, 0.0)) * &v;
+        let tv = Split::new(&(tinv.map(|x| C::new(x, 0.0)) * &v));
         let vinv = inv.rows(0, r).into_owned();
+        let t = tinv.clone().try_inverse()?;
+        let vinv_t = Split::new(&(&vinv * t.map(|x| C::new(x, 0.0))));
         let tip: Vec<C> = (0..r)
             .map(|k| v.column(k).iter().zip(ct).map(|(vi, &c)| vi * c).sum::<C>())
             .collect();
@@ -160,9 +181,10 @@ impl ModalExp {
         let (tip, tip_dot) = (Modes::from(&tip), Modes::from(&tip_dot));
         Some(ModalExp {
             lambda,
-            v,
+            v: Split::new(&v),
             tv,
             vinv,
+            vinv_t,
             tip,
             tip_dot,
             tip_lam2,
@@ -190,17 +212,55 @@ impl ModalExp {
 
     /// out = Σ_k Re(b_k q_k) over the r columns b_k of `basis` (w_k v_k or w_k T⁻¹v_k), added
     /// to `out` when `accumulate`.
-    pub(super) fn expand(basis: &DMatrix<C>, q: &Modes, out: &mut [f64], accumulate: bool) {
+    pub(super) fn expand(basis: &Split, q: &Modes, out: &mut [f64], accumulate: bool) {
         if !accumulate {
             out.fill(0.0);
         }
-        let r = basis.ncols();
-        let cols = basis.as_slice().chunks_exact(out.len().max(1));
-        for ((col, qr), qi) in cols.zip(&q.re[..r]).zip(&q.im[..r]) {
-            for (o, b) in out.iter_mut().zip(col) {
-                *o += b.re * qr - b.im * qi;
+        let n = out.len().max(1);
+        let r = basis.re.ncols();
+        let cols = basis.re.as_slice().chunks_exact(n);
+        let cols = cols.zip(basis.im.as_slice().chunks_exact(n));
+        for ((cr, ci), (qr, qi)) in cols.zip(q.re[..r].iter().zip(&q.im[..r])) {
+            for ((o, br), bi) in out.iter_mut().zip(cr).zip(ci) {
+                *o += br * qr - bi * qi;
             }
         }
+    }
+
+    /// E = Re(V e^{Λt} V⁻¹ T) (energy coordinates out, plain in), 2N×2N: the exponentials once,
+    /// then one real product per entry pair.
+    pub(super) fn transition_energy(&self, t: f64) -> DMatrix<f64> {
+        let (dim, r) = (self.v.re.nrows(), self.len());
+        let mut f = Modes::ZERO;
+        self.factors(t, &mut f);
+        // columns of V F
+        let mut vf = Split {
+            re: self.v.re.clone(),
+            im: self.v.im.clone(),
+        };
+        for k in 0..r {
+            let (fr, fi) = (f.re[k], f.im[k]);
+            for (a, b) in vf
+                .re
+                .column_mut(k)
+                .iter_mut()
+                .zip(vf.im.column_mut(k).iter_mut())
+            {
+                let (x, y) = (*a, *b);
+                *a = x * fr - y * fi;
+                *b = x * fi + y * fr;
+            }
+        }
+        let mut e = DMatrix::zeros(dim, dim);
+        for j in 0..dim {
+            let mut q = Modes::ZERO;
+            for k in 0..r {
+                q.re[k] = self.vinv_t.re[(k, j)];
+                q.im[k] = self.vinv_t.im[(k, j)];
+            }
+            Self::expand(&vf, &q, e.column_mut(j).as_mut_slice(), false);
+        }
+        e
     }
 
     /// e^{λ_k t} for every representative.
