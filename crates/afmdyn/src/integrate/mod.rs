@@ -192,7 +192,9 @@ pub fn advance_dyn(
     crate::error::finite("tau_end", tau_end)?;
     let mut before = integ.state().clone();
     while integ.tau() < tau_end {
-        before.copy_from(integ.state());
+        before
+            .as_mut_slice()
+            .copy_from_slice(integ.state().as_slice());
         let step = integ.step(tau_end)?;
         on_step(integ, &step, &before)?;
     }

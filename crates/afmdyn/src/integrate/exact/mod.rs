@@ -493,11 +493,20 @@ impl ExactPropagator {
             self.last.tau0 + t,
             out,
         );
-        if let (Some(me), true) = (&sp.modal, self.last.modal) {
+        if let Some(me) = &sp.modal {
+            // modal coordinates at τ0 (kept by a modal step, projected from δz by a dense one),
+            // advanced by e^{Λt}
             let r = me.len();
+            let mut q0 = Modes::ZERO;
+            let q0 = if self.last.modal {
+                &self.last.q0
+            } else {
+                me.project_plain(self.last.dz0.as_slice(), &mut q0);
+                &q0
+            };
             let mut q = Modes::ZERO;
             me.factors(t, &mut q);
-            q.mul_assign(&self.last.q0, r);
+            q.mul_assign(q0, r);
             return ModalExp::expand(&me.tv, &q, out, true);
         }
         let dim = out.len();

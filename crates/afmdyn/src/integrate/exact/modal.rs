@@ -210,6 +210,22 @@ impl ModalExp {
         }
     }
 
+    /// q = V⁻¹ T δz (representatives) from plain coordinates δz.
+    pub(super) fn project_plain(&self, dz: &[f64], q: &mut Modes) {
+        let r = self.len();
+        let (qr, qi) = (&mut q.re[..r], &mut q.im[..r]);
+        qr.fill(0.0);
+        qi.fill(0.0);
+        let cols = self.vinv_t.re.as_slice().chunks_exact(r);
+        let cols = cols.zip(self.vinv_t.im.as_slice().chunks_exact(r));
+        for ((cr, ci), &x) in cols.zip(dz) {
+            for (((a, b), vr), vi) in qr.iter_mut().zip(qi.iter_mut()).zip(cr).zip(ci) {
+                *a += vr * x;
+                *b += vi * x;
+            }
+        }
+    }
+
     /// out = Σ_k Re(b_k q_k) over the r columns b_k of `basis` (w_k v_k or w_k T⁻¹v_k), added
     /// to `out` when `accumulate`.
     pub(super) fn expand(basis: &Split, q: &Modes, out: &mut [f64], accumulate: bool) {
