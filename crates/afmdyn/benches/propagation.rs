@@ -37,23 +37,29 @@ fn exact() -> IntegratorOptions {
     }
 }
 
+/// The default model with `n` modes and a state on its attractor (after 100 periods from rest,
+/// so that the contacts per period are representative): (model, τ0, z0, τ0 + PERIODS T).
+fn on_attractor(n: usize) -> (CantileverModel, f64, DVector<f64>, f64) {
+    let p = Params {
+        modes: n,
+        ..Params::default()
+    };
+    let m = CantileverModel::new(&p).unwrap();
+    let t0 = 100.0 * p.period();
+    let z0 = run(&m, exact(), &m.rest(), t0);
+    (m, t0, z0, t0 + PERIODS as f64 * p.period())
+}
+
 fn periods_per_second(c: &mut Criterion) {
     let mut g = c.benchmark_group("exact periods");
     g.throughput(Throughput::Elements(PERIODS as u64));
     for n in [1usize, 3, 5, 10, 20] {
-        let p = Params {
-            modes: n,
-            ..Params::default()
-        };
-        let m = CantileverModel::new(&p).unwrap();
-        // start on the attractor so the contacts per period are representative
-        let z0 = run(&m, exact(), &m.rest(), 100.0 * p.period());
-        let t0 = 100.0 * p.period();
+        let (m, t0, z0, t1) = on_attractor(n);
         let mut it = build(&m, exact(), t0, &z0).unwrap();
         g.bench_with_input(BenchmarkId::from_parameter(n), &n, |b, _| {
             b.iter(|| {
                 it.reset(t0, &z0).unwrap();
-                advance(it.as_mut(), t0 + PERIODS as f64 * p.period()).unwrap();
+                advance(it.as_mut(), t1).unwrap();
                 black_box(it.state()[0])
             })
         });
@@ -65,14 +71,7 @@ fn paths(c: &mut Criterion) {
     let mut g = c.benchmark_group("exact paths");
     g.throughput(Throughput::Elements(PERIODS as u64));
     for n in [3usize, 10] {
-        let p = Params {
-            modes: n,
-            ..Params::default()
-        };
-        let m = CantileverModel::new(&p).unwrap();
-        let z0 = run(&m, exact(), &m.rest(), 100.0 * p.period());
-        let t0 = 100.0 * p.period();
-        let t1 = t0 + PERIODS as f64 * p.period();
+        let (m, t0, z0, t1) = on_attractor(n);
         for (name, propagation) in [("dense", Propagation::Dense), ("modal", Propagation::Modal)] {
             let opts = ExactOptions {
                 propagation,
