@@ -240,11 +240,11 @@ fn forced(
     let ps = sol.rows(0, dim).into_owned();
     let pc = sol.rows(dim, dim).into_owned();
     let mut zp_grid = DMatrix::zeros(dim, trig.len());
-    for (k, &(s, c)) in trig.iter().enumerate() {
-        let mut col = zp_grid.column_mut(k);
-        col.copy_from(&p0);
-        col.axpy(s, &ps, 1.0);
-        col.axpy(c, &pc, 1.0);
+    let (a, b, d) = (p0.as_slice(), ps.as_slice(), pc.as_slice());
+    for (col, &(s, c)) in zp_grid.as_mut_slice().chunks_exact_mut(dim).zip(trig) {
+        for (((o, a), b), d) in col.iter_mut().zip(a).zip(b).zip(d) {
+            *o = a + s * b + c * d;
+        }
     }
     let tip = model.tip();
     let wp = [
