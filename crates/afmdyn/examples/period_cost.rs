@@ -64,7 +64,10 @@ fn builds(modes: usize, reps: usize) -> Result<(), Box<dyn std::error::Error>> {
             std::hint::black_box(ExactPropagator::try_with(model, opts(true)).ok());
         }
     });
-    println!("build N = {modes}: {cold:.1} µs cold, {warm:.1} µs same parameters, {omega_step:.1} µs after an Ω step");
+    println!(
+        "build N = {modes}: {cold:.1} µs cold, {warm:.1} µs same parameters, \
+         {omega_step:.1} µs after an Ω step"
+    );
     Ok(())
 }
 

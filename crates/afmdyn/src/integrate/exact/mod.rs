@@ -8,9 +8,9 @@
 //! **Grid.** The drive period T is split into m sub-steps h = T/m with ‖Ã_s‖₂ h ≤ θ, where
 //! Ã_s = T_s A_s T_s⁻¹ is A_s in energy coordinates y = (L_Kᵀ a, L_Mᵀ ȧ) (K_s = L_K L_Kᵀ,
 //! M = L_M L_Mᵀ). Φ_s = e^{A_s h} and z_p at the grid points are precomputed, so a step costs one
-//! 2N×2N matrix–vector product ([`kernel`]: fixed-size for N ≤ 6). Partial steps (after a
-//! switching, to a requested time) use the eigendecomposition of Ã ([`modal`]) when it is well
-//! conditioned, else the Taylor series of e^{Ã t} y, which converges fast because ‖Ã t‖ ≤ θ.
+//! 2N×2N matrix–vector product (`exact/kernel.rs`: fixed-size for N ≤ 6). Partial steps (after a
+//! switching, to a requested time) use the eigendecomposition of Ã (`exact/modal.rs`) when it is
+//! well conditioned, else the Taylor series of e^{Ã t} y, which converges fast because ‖Ã t‖ ≤ θ.
 //!
 //! **Modal propagation** ([`Propagation`]). For N > 6, a region whose eigenvector basis is well
 //! conditioned keeps the homogeneous part in modal coordinates q = V⁻¹ T δz during a stint: a grid

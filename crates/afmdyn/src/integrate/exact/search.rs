@@ -21,7 +21,7 @@ pub(super) struct TipPoly {
     pub(super) base_amp: f64,
     pub(super) alpha5: f64,
     pub(super) sigma: f64,
-    /// Dead band added to the gap (see [`ExactPropagator`]'s `dead`).
+    /// Dead band added to the gap (see [`super::ExactPropagator`]'s `dead`).
     pub(super) dead: f64,
     /// Bound on |g''| over the step.
     pub(super) curv: f64,
