@@ -189,10 +189,35 @@ fn advance_equals_the_step_loop() {
 }
 
 /// A build that reuses earlier builds (same matrices; or the same region matrices after a
-/// change of Ω, α2 and α5) propagates bit for bit as a fresh build.
+/// change of Ω, α2 and α5) propagates bit for bit as a fresh build; a change of Ω alone keeps
+/// the spectral data and redoes the grid exponential, a change of α4 redoes both.
 #[test]
 fn reused_builds_propagate_as_fresh_ones() {
-    let p = Params::default();
+    // a parameter set of this test only (α1 = 0.137), so that the other tests' builds in the
+    // shared cache cannot be the ones reused
+    let p = Params {
+        alpha1: 0.137,
+        ..Params::default()
+    };
+    let first = prop(&CantileverModel::new(&p).unwrap(), Propagation::Auto, true);
+    assert_eq!(first.reused(), (false, false));
+    let again = prop(&CantileverModel::new(&p).unwrap(), Propagation::Auto, true);
+    assert_eq!(again.reused(), (true, true));
+    let omega = Params { omega: 2.61, ..p };
+    let shifted = prop(
+        &CantileverModel::new(&omega).unwrap(),
+        Propagation::Auto,
+        true,
+    );
+    assert_eq!(shifted.reused(), (true, false));
+    let stiffer = Params { alpha4: 21.0, ..p };
+    let other = prop(
+        &CantileverModel::new(&stiffer).unwrap(),
+        Propagation::Auto,
+        true,
+    );
+    assert_eq!(other.reused(), (false, false));
+
     for q in [
         p,
         Params {

@@ -161,6 +161,8 @@ pub struct ExactPropagator {
     forced: [Forced; 2],
     /// Whether each region's grid steps are modal.
     modal: [bool; 2],
+    /// Whether the spectral data and the grid exponential came from earlier builds.
+    reused: (bool, bool),
     /// Dense grid-step kernel for this dimension.
     kernel: MatVec,
     grid: PeriodGrid,
@@ -313,7 +315,7 @@ impl ExactPropagator {
         let omega = model.omega();
         let period = model.period();
         let key = spectral::matrix_key(model);
-        let spec = spectral::spectral(model, &key, opts.reuse)?;
+        let (spec, spec_reused) = spectral::spectral(model, &key, opts.reuse)?;
         let rho = spec[0].rho.max(spec[1].rho);
         let base = opts.min_steps_per_period.max(1);
         // budget: the grid of one period, (2N + 2)(m + 1) values, must fit in
@@ -336,7 +338,7 @@ impl ExactPropagator {
         let need = need_f as usize;
         let m = base * need.div_ceil(base);
         let h = period / m as f64;
-        let phi = spectral::grid_exp(&spec, &key, h, opts.reuse)?;
+        let (phi, phi_reused) = spectral::grid_exp(&spec, &key, h, opts.reuse)?;
         let trig: Vec<(f64, f64)> = (0..=m)
             .map(|k| (omega * (k as f64 * h)).sin_cos())
             .collect();
@@ -365,6 +367,7 @@ impl ExactPropagator {
             phi,
             forced,
             modal,
+            reused: (spec_reused, phi_reused),
             kernel: kernel::for_dim(dim),
             grid: PeriodGrid::new(period, m),
             tau: 0.0,
@@ -397,6 +400,12 @@ impl ExactPropagator {
     /// Sub-steps per drive period m.
     pub fn steps_per_period(&self) -> usize {
         self.grid.m
+    }
+
+    /// Whether this build reused earlier builds ([`ExactOptions::reuse`]): (the spectral data —
+    /// energy transforms, Ã_s, eigendecomposition —, the grid exponentials Φ_s).
+    pub fn reused(&self) -> (bool, bool) {
+        self.reused
     }
 
     /// Whether the grid steps of the free and the contact region (in that order) are modal.

@@ -43,20 +43,21 @@ type Cache<V> = Mutex<Vec<(Vec<u64>, Arc<V>)>>;
 static SPECTRAL: Cache<[Spectral; 2]> = Mutex::new(Vec::new());
 static GRID_EXP: Cache<[DMatrix<f64>; 2]> = Mutex::new(Vec::new());
 
-/// The cached value for `key`, or `make()` (stored when `reuse`). A poisoned lock is a miss.
+/// The cached value for `key`, or `make()` (stored when `reuse`), and whether it was cached. A
+/// poisoned lock is a miss.
 fn cached<V>(
     cache: &Cache<V>,
     key: &[u64],
     reuse: bool,
     make: impl FnOnce() -> Result<V, SimError>,
-) -> Result<Arc<V>, SimError> {
+) -> Result<(Arc<V>, bool), SimError> {
     if reuse {
         if let Ok(mut entries) = cache.lock() {
             if let Some(i) = entries.iter().position(|(k, _)| k.as_slice() == key) {
                 let entry = entries.remove(i);
                 let value = entry.1.clone();
                 entries.push(entry);
-                return Ok(value);
+                return Ok((value, true));
             }
         }
     }
@@ -69,7 +70,7 @@ fn cached<V>(
             entries.push((key.to_vec(), value.clone()));
         }
     }
-    Ok(value)
+    Ok((value, false))
 }
 
 /// The exact bits of A_s, M and K_s of both regions: the key of the spectral data.
@@ -84,7 +85,8 @@ pub(super) fn matrix_key(model: &CantileverModel) -> Vec<u64> {
     key
 }
 
-/// The spectral data of both regions (cached under `key` when `reuse`).
+/// The spectral data of both regions (cached under `key` when `reuse`) and whether it was
+/// reused.
 ///
 /// # Errors
 /// [`SimError::OutOfRange`] when M or K_s is not positive definite.
@@ -92,7 +94,7 @@ pub(super) fn spectral(
     model: &CantileverModel,
     key: &[u64],
     reuse: bool,
-) -> Result<Arc<[Spectral; 2]>, SimError> {
+) -> Result<(Arc<[Spectral; 2]>, bool), SimError> {
     cached(&SPECTRAL, key, reuse, || {
         Ok([
             region_spectral(model, Region::Free)?,
@@ -162,13 +164,14 @@ pub(super) fn matmul(a: &DMatrix<f64>, b: &DMatrix<f64>) -> DMatrix<f64> {
     out
 }
 
-/// Φ_s = T⁻¹ e^{Ã_s h} T of both regions ([`expm`]; cached under `key` and h when `reuse`).
+/// Φ_s = T⁻¹ e^{Ã_s h} T of both regions ([`expm`]; cached under `key` and h when `reuse`) and
+/// whether it was reused.
 pub(super) fn grid_exp(
     spec: &[Spectral; 2],
     key: &[u64],
     h: f64,
     reuse: bool,
-) -> Result<Arc<[DMatrix<f64>; 2]>, SimError> {
+) -> Result<(Arc<[DMatrix<f64>; 2]>, bool), SimError> {
     let mut key = key.to_vec();
     key.push(h.to_bits());
     cached(&GRID_EXP, &key, reuse, || {
