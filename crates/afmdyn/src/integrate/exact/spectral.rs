@@ -41,7 +41,10 @@ const CAPACITY: usize = 8;
 type Cache<V> = Mutex<Vec<(Vec<u64>, Arc<V>)>>;
 
 static SPECTRAL: Cache<[Spectral; 2]> = Mutex::new(Vec::new());
-static GRID_EXP: Cache<[DMatrix<f64>; 2]> = Mutex::new(Vec::new());
+static GRID_EXP: Cache<GridExp> = Mutex::new(Vec::new());
+
+/// Φ_s of the free and the contact region.
+pub(super) type GridExp = [DMatrix<f64>; 2];
 
 /// The cached value for `key`, or `make()` (stored when `reuse`), and whether it was cached. A
 /// poisoned lock is a miss.
@@ -171,7 +174,7 @@ pub(super) fn grid_exp(
     key: &[u64],
     h: f64,
     reuse: bool,
-) -> Result<(Arc<[DMatrix<f64>; 2]>, bool), SimError> {
+) -> Result<(Arc<GridExp>, bool), SimError> {
     let mut key = key.to_vec();
     key.push(h.to_bits());
     cached(&GRID_EXP, &key, reuse, || {
