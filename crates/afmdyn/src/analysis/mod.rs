@@ -3,6 +3,7 @@
 //! beyond the paper: monodromy matrices with saltation, Newton shooting, Floquet multipliers,
 //! pseudo-arclength continuation, Lyapunov exponents and the 0–1 test for chaos.
 
+pub mod approach;
 pub mod attractors;
 pub mod bifurcation;
 pub mod continuation;
@@ -11,5 +12,7 @@ pub mod lyapunov;
 pub mod monodromy;
 pub mod observables;
 pub mod period;
+pub mod resonance;
 pub mod shooting;
 pub mod steady;
+pub mod stepped;
