@@ -14,6 +14,11 @@ pub struct ModelArgs {
     /// TOML file with model parameters (snake_case names of these flags, or alpha1..alpha6)
     #[arg(long, value_name = "FILE.toml")]
     pub config: Option<PathBuf>,
+    /// Probe file in SI units (cantilever k, f0, Q or geometry; tip; sample law; drive A0, f;
+    /// see docs/afm-workflow.md): sets every parameter, the flags below override single ones,
+    /// and JSON output gains an "si" block with the scales and headline values in SI
+    #[arg(long, value_name = "PROBE.toml", conflicts_with = "config")]
+    pub probe: Option<PathBuf>,
     /// Number of Galerkin modes N (1..=20) [default: 3]
     #[arg(long, value_name = "N")]
     pub modes: Option<usize>,
@@ -151,8 +156,30 @@ pub fn parse_toml<T: for<'de> Deserialize<'de>>(text: &str) -> Result<T, String>
 }
 
 impl ModelArgs {
-    /// Resolve defaults ← config ← flags and validate.
+    /// Resolve defaults ← config ← flags and validate (without the probe's SI scales).
+    #[allow(dead_code)] // the subcommands that print no SI values
     pub fn params(&self, defaults: Params) -> Result<Params, CliError> {
+        Ok(self.resolve(defaults)?.0)
+    }
+
+    /// The probe file, when given (read once per call).
+    pub fn probe(&self) -> Result<Option<afmdyn::probe::Probe>, CliError> {
+        self.probe
+            .as_ref()
+            .map(|p| {
+                afmdyn::probe::Probe::load(p).map_err(|e| CliError::Input(format!("probe {e}")))
+            })
+            .transpose()
+    }
+
+    /// Resolve defaults ← probe or config ← flags and validate; the probe is returned for the
+    /// SI outputs.
+    pub fn resolve(
+        &self,
+        defaults: Params,
+    ) -> Result<(Params, Option<afmdyn::probe::Probe>), CliError> {
+        let probe = self.probe()?;
+        let defaults = probe.as_ref().map_or(defaults, |p| p.params);
         let file: ModelFile = match &self.config {
             Some(p) => read_toml(p)?,
             None => ModelFile::default(),
@@ -182,7 +209,7 @@ impl ModelArgs {
             ..defaults
         };
         p.validate().map_err(|e| CliError::Input(e.to_string()))?;
-        Ok(p)
+        Ok((p, probe))
     }
 }
 

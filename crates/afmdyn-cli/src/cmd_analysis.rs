@@ -464,7 +464,7 @@ fn read_rows(
 
 /// Run `afmdyn bifurcation`.
 pub fn bifurcation(a: &BifurcationArgs) -> Result<(), CliError> {
-    let base = a.model.params(Params::default())?;
+    let (base, probe) = a.model.resolve(Params::default())?;
     let values =
         SweepSpec::linspace(a.from, a.to, a.steps).map_err(|e| CliError::Input(e.to_string()))?;
     let spec = SweepSpec {
@@ -688,7 +688,7 @@ pub fn bifurcation(a: &BifurcationArgs) -> Result<(), CliError> {
             &feed,
         )?;
     }
-    let summary = json!({
+    let mut summary = json!({
         "params": base,
         "param": a.param.name(),
         "values": spec.values.len(),
@@ -698,6 +698,7 @@ pub fn bifurcation(a: &BifurcationArgs) -> Result<(), CliError> {
         "csv": final_csv,
         "npy": out.join("bifurcation.npy"),
     });
+    crate::output::add_si(&mut summary, probe.as_ref(), &base);
     if a.json {
         println!("{summary}");
     } else {
@@ -822,7 +823,7 @@ pub struct AttractorsArgs {
 
 /// Run `afmdyn attractors`.
 pub fn attractors(a: &AttractorsArgs) -> Result<(), CliError> {
-    let p = a.model.params(Params::default())?;
+    let (p, probe) = a.model.resolve(Params::default())?;
     let spp = 200;
     let spec = AttractorSpec {
         params: p,
@@ -924,7 +925,8 @@ pub fn attractors(a: &AttractorsArgs) -> Result<(), CliError> {
             },
         )?;
     }
-    let doc = afmdyn::report::attractors(&p, a.samples, &report);
+    let mut doc = afmdyn::report::attractors(&p, a.samples, &report);
+    crate::output::add_si(&mut doc, probe.as_ref(), &p);
     write_bytes(
         &out.join("attractors.json"),
         serde_json::to_string_pretty(&doc).expect("json").as_bytes(),

@@ -33,13 +33,15 @@ pub struct ModesArgs {
 
 /// Run `afmdyn modes`.
 pub fn modes(a: &ModesArgs) -> Result<(), CliError> {
-    let p = a.model.params(Params::default())?;
+    let (p, probe) = a.model.resolve(Params::default())?;
     if a.sweep.is_some() {
         return fig3(a, &p);
     }
     let (free, contact) = spectrum(&p)?;
     if a.json {
-        println!("{}", afmdyn::report::modes(&p, &free, &contact));
+        let mut doc = afmdyn::report::modes(&p, &free, &contact);
+        crate::output::add_si(&mut doc, probe.as_ref(), &p);
+        println!("{doc}");
         return Ok(());
     }
     println!(
@@ -137,9 +139,20 @@ fn fig3(a: &ModesArgs, p: &Params) -> Result<(), CliError> {
 /// `afmdyn units` flags.
 #[derive(Debug, Args)]
 pub struct UnitsArgs {
-    /// Probe description (TOML, SI units); see examples/probe.toml
-    #[arg(long, value_name = "FILE.toml")]
-    config: PathBuf,
+    /// Physical model in the paper's terms (TOML, SI units: geometry, tip mass, C or Q₁,
+    /// contact K₁ or Hertz, g₀, g₁, drive); see examples/probe.toml
+    #[arg(
+        long,
+        value_name = "FILE.toml",
+        required_unless_present = "probe",
+        conflicts_with = "probe"
+    )]
+    config: Option<PathBuf>,
+    /// Probe file (cantilever k, f0, Q or geometry; tip; sample law; drive A0, f; see
+    /// examples/probe-beam-dmt.toml and docs/afm-workflow.md): print its dimensionless set and
+    /// scales
+    #[arg(long, value_name = "PROBE.toml")]
+    probe: Option<PathBuf>,
     /// Print one JSON document
     #[arg(long)]
     json: bool,
@@ -181,7 +194,22 @@ struct HertzFile {
 
 /// Run `afmdyn units`.
 pub fn units(a: &UnitsArgs) -> Result<(), CliError> {
-    let pf: ProbeFile = read_toml(&a.config)?;
+    if let Some(path) = &a.probe {
+        let pr =
+            afmdyn::probe::Probe::load(path).map_err(|e| CliError::Input(format!("probe {e}")))?;
+        let p = pr.params;
+        let doc = json!({ "params": p, "si": afmdyn::report::si(&pr, &p, &json!({})) });
+        if a.json {
+            println!("{doc}");
+        } else {
+            println!("{}", serde_json::to_string_pretty(&doc).expect("json"));
+        }
+        return Ok(());
+    }
+    let Some(config) = &a.config else {
+        return Err(CliError::Input("give --config or --probe".into()));
+    };
+    let pf: ProbeFile = read_toml(config)?;
     let k1 = match (pf.contact_stiffness, &pf.hertz) {
         (Some(k), None) => contact_stiffness(ContactStiffness::Direct(k))?,
         (None, Some(h)) => {
@@ -261,8 +289,8 @@ pub fn units(a: &UnitsArgs) -> Result<(), CliError> {
     println!("  one unit of W = {:.6e} m", s.length_m);
     println!("  spring constant 3EI/L³ = {:.6e} N/m", s.spring_constant);
     println!(
-        "  first natural frequency f₁ = {:.6e} Hz",
-        s.first_frequency_hz
+        "  first natural frequency f₁ = {:.6e} Hz with the tip mass ({:.6e} Hz without)",
+        s.first_frequency_hz, s.bare_first_frequency_hz
     );
     Ok(())
 }

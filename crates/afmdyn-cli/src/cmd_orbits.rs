@@ -59,7 +59,7 @@ pub struct OrbitArgs {
 
 /// Run `afmdyn orbit`.
 pub fn orbit(a: &OrbitArgs) -> Result<(), CliError> {
-    let p = a.model.params(Params::default())?;
+    let (p, probe) = a.model.resolve(Params::default())?;
     let model = CantileverModel::new(&p)?;
     let (guess, found) = a.start.guess(&model)?;
     let n = a.period.or(found).unwrap_or(1);
@@ -68,7 +68,9 @@ pub fn orbit(a: &OrbitArgs) -> Result<(), CliError> {
     }
     let o = shoot(&model, &guess, n, &ShootingOptions::default())?;
     if a.json {
-        println!("{}", afmdyn::report::orbit(&model, &o));
+        let mut doc = afmdyn::report::orbit(&model, &o);
+        crate::output::add_si(&mut doc, probe.as_ref(), &p);
+        println!("{doc}");
         return Ok(());
     }
     println!(
@@ -183,7 +185,7 @@ fn check_overlay(path: &Path) -> Result<(), CliError> {
 
 /// Run `afmdyn continue`.
 pub fn continuation(a: &ContinueArgs) -> Result<(), CliError> {
-    let base = a.model.params(Params::default())?;
+    let (base, probe) = a.model.resolve(Params::default())?;
     let p0 = base.with(a.param, a.from);
     p0.validate()?;
     base.with(a.param, a.to).validate()?;
@@ -318,10 +320,9 @@ pub fn continuation(a: &ContinueArgs) -> Result<(), CliError> {
         },
     )?;
     if a.json {
-        println!(
-            "{}",
-            afmdyn::report::continuation(&base, a.param, &branches)
-        );
+        let mut doc = afmdyn::report::continuation(&base, a.param, &branches);
+        crate::output::add_si(&mut doc, probe.as_ref(), &base);
+        println!("{doc}");
     } else {
         println!(
             "{} branch(es), {} points; located:",
@@ -366,7 +367,7 @@ pub struct LyapunovArgs {
 
 /// Run `afmdyn lyapunov`.
 pub fn lyapunov(a: &LyapunovArgs) -> Result<(), CliError> {
-    let p = a.model.params(Params::default())?;
+    let (p, probe) = a.model.resolve(Params::default())?;
     let model = CantileverModel::new(&p)?;
     let z0 = initial_state(&model, &a.initial_modal)?;
     if (a.transient as f64 + a.periods as f64) > crate::cmd_simulate::MAX_RUN_PERIODS {
@@ -390,7 +391,9 @@ pub fn lyapunov(a: &LyapunovArgs) -> Result<(), CliError> {
         eprintln!("afmdyn: warning: {w}");
     }
     if a.json {
-        println!("{}", afmdyn::report::lyapunov(&p, &l));
+        let mut doc = afmdyn::report::lyapunov(&p, &l);
+        crate::output::add_si(&mut doc, probe.as_ref(), &p);
+        println!("{doc}");
         return Ok(());
     }
     println!(

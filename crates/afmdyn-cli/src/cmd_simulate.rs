@@ -216,7 +216,7 @@ fn sample_row(s: &Sample) -> Vec<f64> {
 /// Run `afmdyn simulate`: the run is recorded in chunks of whole periods and every chunk is
 /// streamed to the files, so memory does not grow with the length of the run.
 pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
-    let p = a.model.params(Params::default())?;
+    let (p, probe) = a.model.resolve(Params::default())?;
     let model = CantileverModel::new(&p)?;
     let z0 = initial_state(&model, &a.initial_modal)?;
     if a.samples_per_period == 0 || a.samples_per_period > 100_000 {
@@ -513,6 +513,7 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
     };
     let warnings = afmdyn::report::simulate_warnings(&run);
     let mut doc = afmdyn::report::simulate_summary(&model, &run);
+    crate::output::add_si(&mut doc, probe.as_ref(), &p);
     doc["files"] = json!(a
         .files
         .to_possible_value()
@@ -730,7 +731,7 @@ pub fn converge(a: &ConvergeArgs) -> Result<(), CliError> {
         omega: 4.1,
         ..Params::default()
     };
-    let p = a.model.params(defaults)?;
+    let (p, probe) = a.model.resolve(defaults)?;
     if !(1..=afmdyn::params::MAX_MODES).contains(&a.max_modes) {
         return Err(CliError::Input(format!(
             "max-modes = {}: must be in 1..=20",
@@ -799,6 +800,7 @@ pub fn converge(a: &ConvergeArgs) -> Result<(), CliError> {
     )?;
     if a.json {
         let mut doc = afmdyn::report::converge(&p, &runs);
+        crate::output::add_si(&mut doc, probe.as_ref(), &p);
         doc["out"] = json!(a.out);
         println!("{doc}");
     } else {

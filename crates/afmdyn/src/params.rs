@@ -9,6 +9,11 @@ use std::str::FromStr;
 /// Largest number of Galerkin modes supported (the mode shapes are accurate to ~1e-13 up to i = 20).
 pub const MAX_MODES: usize = 20;
 
+const _: () = assert!(
+    MAX_MODES == 20,
+    "Params::damping_profile has MAX_MODES entries"
+);
+
 /// Largest tip-mass ratio α1: the mass matrix I + α1 φ(1)φ(1)ᵀ has condition number ≈ 4Nα1, and
 /// beyond 10⁴ beam masses its Cholesky factor (used by every integrator) loses too many digits.
 pub const ALPHA1_MAX: f64 = 1e4;
@@ -89,7 +94,9 @@ pub struct Params {
     /// eq. 12). Only the first N entries are used; set from per-mode quality factors by
     /// [`crate::probe`].
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub damping_profile: Option<[f64; MAX_MODES]>,
+    // 20 = MAX_MODES, written as a literal: with the named constant, clippy-driver 1.95 stops
+    // with an internal compiler error on closures that capture a Params (tests/stability.rs)
+    pub damping_profile: Option<[f64; 20]>,
 }
 
 /// The structural model of the cantilever.

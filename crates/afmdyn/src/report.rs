@@ -469,6 +469,83 @@ pub fn lyapunov(params: &Params, l: &LyapunovSpectrum) -> Value {
     doc
 }
 
+/// The `"si"` block a front end adds to any document when the model came from a probe file
+/// ([`crate::probe`]): the scales back to SI (every dimensionless value of the document converts
+/// with them: lengths × `length_m`, τ × `time_s`, forces × `force_n`, energies × `energy_j`,
+/// Ω → Hz), the probe's drive, free amplitude and rest distance, and the headline quantities of
+/// the document in SI: natural frequencies in Hz (`modes`), X_max and V_T in m (`simulate`,
+/// `attractors`, `orbit`), the swept parameter (Ω in Hz, α5 as z_c in m; `continue`), Lyapunov
+/// exponents in 1/s (`lyapunov`).
+pub fn si(probe: &crate::probe::Probe, params: &Params, doc: &Value) -> Value {
+    let s = &probe.scales;
+    let hz = |om: &Value| om.as_f64().map(|w| s.frequency_hz(w));
+    let metres = |v: &Value| v.as_f64().map(|x| x * s.length_m);
+    let mut out = json!({
+        "scales": {
+            "length_m": s.length_m,
+            "time_s": s.time_s,
+            "force_n": s.force_n,
+            "energy_j": s.energy_j(),
+            "power_w": s.power_w(),
+        },
+        "calibration": probe.calibration,
+        "drive_frequency_hz": s.frequency_hz(params.omega),
+        "period_s": params.period() * s.time_s,
+        "free_amplitude_m": probe.free_amplitude,
+        "z_c_m": probe.z_c_of(params),
+    });
+    let map_array = |v: &Value, f: &dyn Fn(&Value) -> Option<f64>| -> Value {
+        v.as_array()
+            .map(|a| Value::from(a.iter().map(f).collect::<Vec<_>>()))
+            .unwrap_or(Value::Null)
+    };
+    for region in ["free", "contact"] {
+        if let Some(om) = doc.get(region).and_then(|r| r.get("omega")) {
+            out[format!("{region}_frequencies_hz")] = map_array(om, &hz);
+        }
+    }
+    if let Some(x) = doc.get("x_max") {
+        out["x_max_m"] = json!(metres(x));
+    }
+    if let Some(p) = doc.get("poincare").and_then(|p| p.get("v_t")) {
+        out["poincare_v_t_m"] = map_array(p, &metres);
+    }
+    if let Some(att) = doc.get("attractors").and_then(Value::as_array) {
+        out["attractors_x_max_m"] =
+            Value::from(att.iter().map(|a| metres(&a["x_max"])).collect::<Vec<_>>());
+    }
+    if let Some(ex) = doc.get("exponents") {
+        out["exponents_per_s"] = map_array(ex, &|v| v.as_f64().map(|l| l / s.time_s));
+    }
+    if let (Some(param), Some(events)) = (
+        doc.get("param").and_then(Value::as_str),
+        doc.get("events").and_then(Value::as_array),
+    ) {
+        let convert = |v: &Value| -> Option<f64> {
+            let x = v.as_f64()?;
+            match param {
+                "omega" => Some(s.frequency_hz(x)),
+                "alpha5" => Some(params.with(SweepParam::Alpha5, x).rest_distance() * s.length_m),
+                _ => None,
+            }
+        };
+        let unit = match param {
+            "omega" => "hz",
+            "alpha5" => "z_c_m",
+            _ => "",
+        };
+        if !unit.is_empty() {
+            out[format!("event_values_{unit}")] = Value::from(
+                events
+                    .iter()
+                    .map(|e| convert(&e["value"]))
+                    .collect::<Vec<_>>(),
+            );
+        }
+    }
+    out
+}
+
 /// The observables of a steady state ([`Observables`], every field, so a field added there
 /// reaches both front ends): dimensionless units of the model (lengths g₀, time τ, forces F̃,
 /// energies F̃·g₀); phases in radians. Non-finite values (e.g. Q = ∞ without damping) become

@@ -187,8 +187,12 @@ pub struct Scales {
     pub length_m: f64,
     /// Static spring constant K_c = 3EI/L³ (N/m).
     pub spring_constant: f64,
-    /// First natural frequency of the bare cantilever (Hz).
+    /// First natural frequency with the tip mass (Hz): ω₁ of K x = ω² M x with M of eq. 11
+    /// (what a resonance measurement of the probe gives).
     pub first_frequency_hz: f64,
+    /// First natural frequency of the bare cantilever without the tip mass (Hz),
+    /// β₁² √(EI/(mL⁴))/2π.
+    pub bare_first_frequency_hz: f64,
 }
 
 impl PhysicalModel {
@@ -279,11 +283,22 @@ impl PhysicalModel {
 
     /// Time and length scales.
     pub fn scales(&self) -> Scales {
+        let bare = self.cantilever.first_frequency_hz();
+        // with the tip mass: the first eigenvalue of the Galerkin system (eq. 11)
+        let with_tip = self
+            .to_params()
+            .ok()
+            .and_then(|p| Galerkin::new(&p).ok())
+            .map(|g| natural_modes(g.region(Region::Free)).omega[0])
+            .map_or(bare, |w| {
+                w / self.cantilever.time_scale() / std::f64::consts::TAU
+            });
         Scales {
             time_s: self.cantilever.time_scale(),
             length_m: self.beam_gap,
             spring_constant: self.cantilever.spring_constant(),
-            first_frequency_hz: self.cantilever.first_frequency_hz(),
+            first_frequency_hz: with_tip,
+            bare_first_frequency_hz: bare,
         }
     }
 }

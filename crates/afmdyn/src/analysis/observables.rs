@@ -43,6 +43,9 @@
 //! E_cf = (π k A²/Q)[(A₀/A) sin φ − ω/ω₀], and of San Paulo & García (2001), V_cf, plus the
 //! terms they neglect:
 //! E_cf − E_dis = (π k/Q)(ω/ω₀) Σ_{n≥2} n²Aₙ²,   V − V_cf = k⟨z⟩² + (k/2) Σ_{n≥2}(1 − n²ω²/ω₀²)Aₙ².
+//! Off resonance, with A₀ the free amplitude at ω (what [`ClosedForms`] uses, F₀ ≠ kA₀/Q),
+//! E_cf − E_dis gains π A sin φ (kA₀/Q − F₀) and V − V_cf gains
+//! (k/2)(1 − ω²/ω₀²)A² − ½ A cos φ (F₀ − kA₀/Q).
 //! The sums over all n ≥ 2 are exact here through Parseval ([`Observables::higher_sq`],
 //! [`Observables::higher_n2_sq`]), not truncated at [`ObservableOptions::harmonics`].
 //!
@@ -66,7 +69,7 @@ use crate::params::Params;
 use crate::roots::{extremum, safeguarded_newton};
 use crate::system::EventKind;
 use gauss_quad::legendre::GaussLegendre;
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DVector;
 use serde::Serialize;
 use std::f64::consts::{PI, TAU};
 use std::num::NonZeroUsize;
@@ -215,44 +218,17 @@ pub struct Observables {
     pub closed_form: ClosedForms,
 }
 
-/// The free linear response of the tip at the drive frequency Ω: with
-/// F^I(τ) = F_s sin Ωτ + F_c cos Ωτ = Im[(F_s + iF_c)e^{iΩτ}] (free region, eq. 14 or the
-/// point-mass force), X̂ = (K − Ω²M + iΩC)⁻¹(F_s + iF_c) and W = Im[φᵀX̂ e^{iΩτ}]
-/// (standard harmonic response, e.g. Meirovitch, *Fundamentals of Vibrations*, McGraw-Hill
-/// 2001, §7.4). The one place the free amplitude A₀ is computed.
+/// The free linear response of the tip at the drive frequency Ω, from the model's complex
+/// amplitude H ([`CantileverModel::free_tip_response`], W(1,τ) = Im(H e^{i(Ωτ + ψ)})):
+/// A₀ = |H|, lag φ₀ = −arg H. The one place the free amplitude of the closed forms comes from.
 ///
 /// # Errors
-/// [`SimError::OutOfRange`] when the dynamic stiffness is singular (undamped at resonance).
+/// [`SimError::OutOfRange`] when Ω is at an undamped natural frequency (no steady state).
 pub fn free_response(model: &CantileverModel) -> Result<FreeResponse, SimError> {
-    let n = model.modes();
-    let g = model.galerkin().region(Region::Free);
-    let om = model.omega();
-    let kd = &g.stiffness - &g.mass * (om * om);
-    let b = &g.damping * om;
-    let mut a = DMatrix::zeros(2 * n, 2 * n);
-    a.view_mut((0, 0), (n, n)).copy_from(&kd);
-    a.view_mut((0, n), (n, n)).copy_from(&(-&b));
-    a.view_mut((n, 0), (n, n)).copy_from(&b);
-    a.view_mut((n, n), (n, n)).copy_from(&kd);
-    let mut rhs = DVector::zeros(2 * n);
-    rhs.rows_mut(0, n).copy_from(&g.forcing.sin);
-    rhs.rows_mut(n, n).copy_from(&g.forcing.cos);
-    let x = a
-        .lu()
-        .solve(&rhs)
-        .filter(|x| x.iter().all(|v| v.is_finite()))
-        .ok_or_else(|| {
-            SimError::out_of_range(
-                "omega",
-                om,
-                "the free dynamic stiffness is singular (undamped drive at resonance)",
-            )
-        })?;
-    let tip = model.tip();
-    let (re, im) = (tip.dot(&x.rows(0, n)), tip.dot(&x.rows(n, n)));
+    let h = model.free_tip_response()?;
     Ok(FreeResponse {
-        amplitude: re.hypot(im),
-        phase: wrap_phase(model.params().drive_phase() - im.atan2(re)),
+        amplitude: h.norm(),
+        phase: wrap_phase(-h.arg()),
     })
 }
 
@@ -429,6 +405,17 @@ pub fn observe(
                 let f = model.contact_force(r, tau, &z);
                 Node { z, dz, w, wd, v, f }
             };
+            // dF_c/dτ: analytic for the smooth laws; a central difference inside the piece
+            // [lo, hi] for the sticking force of the impact law
+            let sticking = r == Region::Contact && p.contact_law.restitution().is_some();
+            let rate = |integ: &mut dyn Integrator, t: f64, nd: &Node, lo: f64, hi: f64| {
+                if !sticking {
+                    return force_rate(&law, r, nd);
+                }
+                let h = 1e-5 * (hi - lo);
+                let (tm, tp) = ((t - h).max(lo), (t + h).min(hi));
+                (eval(integ, tp).f - eval(integ, tm).f) / (tp - tm)
+            };
             for k in 0..pieces {
                 let a = t0 + k as f64 * hp;
                 let b = if k + 1 == pieces { t1 } else { a + hp };
@@ -436,15 +423,19 @@ pub fn observe(
                 let mid = 0.5 * (a + b);
                 // nodes for the extremum scan: the piece's ends and its GL nodes, in order
                 let mut scan: Vec<(f64, f64, f64)> = Vec::with_capacity(GL_NODES + 2);
-                let record =
-                    |tau: f64, nd: &Node, scan: &mut Vec<(f64, f64, f64)>, acc: &mut Acc| {
-                        scan.push((tau, force_rate(&law, r, nd), nd.v[1]));
-                        acc.f_max = acc.f_max.max(nd.f);
-                        acc.f_min = acc.f_min.min(nd.f);
-                        acc.v_min = acc.v_min.min(nd.v[0]);
-                    };
+                let record = |tau: f64,
+                              fr: f64,
+                              nd: &Node,
+                              scan: &mut Vec<(f64, f64, f64)>,
+                              acc: &mut Acc| {
+                    scan.push((tau, fr, nd.v[1]));
+                    acc.f_max = acc.f_max.max(nd.f);
+                    acc.f_min = acc.f_min.min(nd.f);
+                    acc.v_min = acc.v_min.min(nd.v[0]);
+                };
                 let na = eval(integ, a);
-                record(a, &na, &mut scan, &mut acc);
+                let fr = rate(integ, a, &na, a, b);
+                record(a, fr, &na, &mut scan, &mut acc);
                 for &(x, wt) in &gl {
                     let tau = mid + half * x;
                     let nd = eval(integ, tau);
@@ -477,18 +468,20 @@ pub fn observe(
                         }
                         acc.coupling[j] += wq * aj * c;
                     }
-                    record(tau, &nd, &mut scan, &mut acc);
+                    let fr = rate(integ, tau, &nd, a, b);
+                    record(tau, fr, &nd, &mut scan, &mut acc);
                 }
                 let nb = eval(integ, b);
-                record(b, &nb, &mut scan, &mut acc);
+                let fr = rate(integ, b, &nb, a, b);
+                record(b, fr, &nb, &mut scan, &mut acc);
                 // interior extrema of F_c and of V_T located on the dense output
                 for pair in scan.windows(2) {
                     let (ta, fda, vda) = pair[0];
                     let (tb, fdb, vdb) = pair[1];
-                    if fda.is_finite() && fdb.is_finite() && (fda > 0.0) != (fdb > 0.0) {
+                    if (fda > 0.0) != (fdb > 0.0) {
                         let mut g = |t: f64| {
                             let nd = eval(integ, t);
-                            force_rate(&law, r, &nd)
+                            rate(integ, t, &nd, a, b)
                         };
                         let t = root_of(ta, fda, tb, fdb, &mut g);
                         let f = eval(integ, t).f;
@@ -603,12 +596,9 @@ pub fn observe(
     })
 }
 
-/// dF_c/dτ at a node: ∂F/∂δ δ̇ + ∂F/∂δ̇ δ̈ for the smooth laws (δ = −V_T); NaN for the sticking
-/// force of the impact law (its extrema are then taken over the nodes only).
+/// dF_c/dτ at a node: ∂F/∂δ δ̇ + ∂F/∂δ̇ δ̈ for the smooth laws (δ = −V_T, partials of
+/// [`TipSampleLaw::force`]); 0 where no force acts.
 fn force_rate(law: &TipSample, r: Region, nd: &Node) -> f64 {
-    if law.law.restitution().is_some() {
-        return if r == Region::Contact { f64::NAN } else { 0.0 };
-    }
     let contact = r == Region::Contact;
     if !contact && !law.acts_outside() {
         return 0.0;

@@ -1,0 +1,119 @@
+//! `--probe FILE` on the subcommands: the model comes from the SI probe, flags override single
+//! parameters, JSON gains the "si" block, and a bad probe exits 2 with every problem on one line.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn run(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_afmdyn"))
+        .args(args)
+        .current_dir(repo())
+        .output()
+        .expect("runs")
+}
+
+fn json(args: &[&str]) -> serde_json::Value {
+    let out = run(args);
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("json")
+}
+
+/// The probe's parameters reach the model: `modes` reports the first free frequency f₀ of the
+/// probe in Hz (the calibration it was built from), and `orbit` the probe's α's.
+#[test]
+fn probe_sets_the_model_and_si_block() {
+    let probe = "examples/probe-beam-dmt.toml";
+    let modes = json(&["modes", "--probe", probe, "--json"]);
+    let f1 = modes["si"]["free_frequencies_hz"][0].as_f64().unwrap();
+    assert!((f1 - 300e3).abs() < 1e-6 * 300e3, "f1 = {f1}");
+    assert_eq!(modes["params"]["structure"], "beam");
+    assert_eq!(modes["params"]["contact_law"]["law"], "dmt");
+    let resolved = afmdyn::probe::Probe::load(&repo().join(probe)).unwrap();
+    // (serde_json's default float parsing is within 1 ulp)
+    let a2 = modes["params"]["alpha2"].as_f64().unwrap();
+    assert!((a2 - resolved.params.alpha2).abs() < 1e-15 * a2);
+    assert_eq!(modes["si"]["scales"]["length_m"].as_f64().unwrap(), 10e-9);
+    // a flag overrides one parameter of the probe
+    let m2 = json(&["modes", "--probe", probe, "--modes", "2", "--json"]);
+    assert_eq!(m2["params"]["modes"], 2);
+    assert_eq!(m2["params"]["alpha3"], modes["params"]["alpha3"]);
+}
+
+/// The point-mass probe: the orbit's JSON carries the SI block with z_c and the drive in Hz.
+#[test]
+fn point_mass_orbit_reports_si() {
+    let doc = json(&[
+        "orbit",
+        "--probe",
+        "examples/probe-point-mass-dmt.toml",
+        "--json",
+    ]);
+    assert_eq!(doc["params"]["structure"], "point-mass");
+    let si = &doc["si"];
+    assert!((si["z_c_m"].as_f64().unwrap() - 8e-9).abs() < 1e-20);
+    assert!((si["drive_frequency_hz"].as_f64().unwrap() - 300e3).abs() < 1e-6);
+    assert!(si["poincare_v_t_m"][0].as_f64().is_some());
+}
+
+/// Bad probes: exit 2, one line naming the file and every problem; --probe with --config is
+/// refused.
+#[test]
+fn bad_probe_exits_2_with_all_problems() {
+    let dir = std::env::temp_dir().join(format!("afmdyn-probe-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let bad = dir.join("bad.toml");
+    std::fs::write(
+        &bad,
+        "model = \"beam\"\nextra = 1\n[sample]\nlaw = \"hertz\"\n",
+    )
+    .unwrap();
+    let out = run(&[
+        "simulate",
+        "--probe",
+        bad.to_str().unwrap(),
+        "--files",
+        "none",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    for needle in [
+        "bad.toml",
+        "unknown key extra",
+        "missing key modes",
+        "missing table [cantilever]",
+        "missing table [drive]",
+        "missing key [sample].youngs_modulus",
+    ] {
+        assert!(err.contains(needle), "'{needle}' not in {err}");
+    }
+    let both = run(&[
+        "orbit",
+        "--probe",
+        "examples/probe-beam-dmt.toml",
+        "--config",
+        "examples/fig5.toml",
+    ]);
+    assert_eq!(both.status.code(), Some(2));
+    let units = json(&[
+        "units",
+        "--probe",
+        "examples/probe-geometry-hertz.toml",
+        "--json",
+    ]);
+    assert!(
+        units["si"]["calibration"]["static_spring_constant"]
+            .as_f64()
+            .unwrap()
+            > 0.0
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
