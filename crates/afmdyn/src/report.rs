@@ -422,6 +422,8 @@ fn curve_doc(
     json!({
         "params": params,
         "units": u.names(),
+        "scales": {"length": u.length, "force": u.force, "energy": u.energy,
+                   "hz_per_omega": u.hz_per_omega},
         names.0: sweep_doc(&x, &c.first, u),
         names.1: sweep_doc(&x, &c.second, u),
         "branches": branches,
@@ -442,7 +444,8 @@ fn curve_doc(
 /// period-n) and `reached` ([`crate::analysis::stepped::Reached`]); each branch the same
 /// columns with `stable`, `period` and `event` (null, "fold", "grazing", …). Also `folds` and
 /// `bistable` ([lo, hi] ranges of z_c between two folds), `jumps` ({sweep, from, to, fold}),
-/// `free_amplitude`, `units`, `params` and `warnings`.
+/// `free_amplitude`, `units` (names), `scales` (the [`CurveUnits`] factors), `params` and
+/// `warnings`.
 pub fn approach(params: &Params, c: &SteppedCurve, u: &CurveUnits) -> Value {
     let x = |a5: f64| crate::analysis::approach::rest_distance(params, a5) * u.length;
     curve_doc(params, c, ("z_c", &x), ("approach", "retract"), u)
