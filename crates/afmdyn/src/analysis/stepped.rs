@@ -426,6 +426,64 @@ fn integrator_at(
     build(&model, spec.integrator, 0.0, z)
 }
 
+/// Halvings of a grid step tried by [`continue_orbit`] before the sweep falls back on the
+/// transient (at most 2^depth sub-steps).
+pub const SUBSTEP_DEPTH: usize = 8;
+
+/// Follow the stable period-n orbit `z0` at `v0` to `v1` by Newton (from the secant prediction
+/// `z0 + slope (v1 − v0)`, then from `z0`): accepted when stable and within `jump_tol` of `z0`.
+/// Otherwise the step is halved (up to `depth` times) and each half continued in turn — a
+/// quasi-static sweep — unless three halvings in a row did not shrink the distance to the stable
+/// orbit Newton found below 0.95 of the distance over the longer step (`whole`: that distance
+/// and the halvings so far without shrinking): a jump, not a steep piece of branch (across a
+/// resonance much sharper than the step the distance shrinks slowly, but it shrinks). `None` when the orbit cannot be followed (it vanished or lost
+/// stability).
+#[allow(clippy::type_complexity, clippy::too_many_arguments)]
+fn continue_orbit(
+    spec: &SteppedSpec,
+    v0: f64,
+    z0: &DVector<f64>,
+    slope: Option<&DVector<f64>>,
+    v1: f64,
+    n: usize,
+    depth: usize,
+    whole: Option<(f64, usize)>,
+) -> Result<Option<(DVector<f64>, Vec<Complex<f64>>)>, SimError> {
+    let mut integ = integrator_at(spec, v1, z0)?;
+    let mut guesses = Vec::with_capacity(2);
+    if let Some(s) = slope {
+        guesses.push(z0 + s * (v1 - v0));
+    }
+    guesses.push(z0.clone());
+    let mut gap: Option<f64> = None;
+    for g in &guesses {
+        if let Ok(o) = shoot_with(integ.as_mut(), g, n, &spec.newton) {
+            if o.stable {
+                let d = relative_gap(&o.state, z0);
+                if d <= spec.jump_tol {
+                    return Ok(Some((o.state, o.multipliers)));
+                }
+                gap = Some(gap.map_or(d, |x: f64| x.min(d)));
+            }
+        }
+    }
+    // halvings in a row that did not shrink the distance
+    let stuck = match (gap, whole) {
+        (Some(g), Some((w, k))) if g > 0.95 * w => k + 1,
+        _ => 0,
+    };
+    if depth == 0 || stuck >= 3 {
+        return Ok(None);
+    }
+    let mid = 0.5 * (v0 + v1);
+    let first = gap.map(|g| (g, stuck));
+    let Some((zm, _)) = continue_orbit(spec, v0, z0, slope, mid, n, depth - 1, first)? else {
+        return Ok(None);
+    };
+    let half_slope = (&zm - z0) / (mid - v0);
+    continue_orbit(spec, mid, &zm, Some(&half_slope), v1, n, depth - 1, None)
+}
+
 /// The steady state at `value` reached from the previous point `prev` (or from rest); `before`
 /// is the point before `prev` on the same branch, for a secant predictor.
 fn step_point(
@@ -438,35 +496,42 @@ fn step_point(
     let last = prev.map_or_else(|| model.rest(), |p| p.state.clone());
     let n = prev.and_then(|p| p.period).unwrap_or(1);
     let mut integ = build(&model, spec.integrator, 0.0, &last)?;
-    // guesses: the secant prediction through the two previous orbits, then the previous orbit
-    let mut guesses = Vec::with_capacity(2);
-    if let (Some(p), Some(b)) = (prev, before) {
-        if p.period == b.period && p.reached != Reached::Settled && p.value != b.value {
-            let r = (value - p.value) / (p.value - b.value);
-            guesses.push(&p.state + (&p.state - &b.state) * r);
+    // the secant slope dz/dv through the two previous orbits of the same branch
+    let slope = match (prev, before) {
+        (Some(p), Some(b))
+            if p.period == b.period && p.reached != Reached::Settled && p.value != b.value =>
+        {
+            Some((&p.state - &b.state) / (p.value - b.value))
         }
-    }
-    guesses.push(last.clone());
-    let mut continued = None;
-    for g in &guesses {
-        if let Ok(o) = shoot_with(integ.as_mut(), g, n, &spec.newton) {
-            if o.stable && (prev.is_none() || relative_gap(&o.state, &last) <= spec.jump_tol) {
-                continued = Some(o);
-                break;
-            }
-        }
-    }
+        _ => None,
+    };
+    let continued = match prev {
+        Some(p) => continue_orbit(
+            spec,
+            p.value,
+            &last,
+            slope.as_ref(),
+            value,
+            n,
+            SUBSTEP_DEPTH,
+            None,
+        )?,
+        None => shoot_with(integ.as_mut(), &last, n, &spec.newton)
+            .ok()
+            .filter(|o| o.stable)
+            .map(|o| (o.state, o.multipliers)),
+    };
     let first = if prev.is_some() {
         Reached::Continued
     } else {
         Reached::Start
     };
     let (found, reached) = match continued {
-        Some(o) => (
+        Some((state, multipliers)) => (
             Found {
                 period: Some(n),
-                state: o.state,
-                multipliers: o.multipliers,
+                state,
+                multipliers,
                 stable: true,
             },
             first,
