@@ -324,7 +324,15 @@ fn plots(
             .expect("column")
     };
     let panels = [
-        ("amplitude_ratio", "A/A0".to_string(), "amplitude"),
+        if l.x_name == "z_c" {
+            ("amplitude_ratio", "A/A0".to_string(), "amplitude")
+        } else {
+            (
+                "amplitude",
+                format!("amplitude A {}", unit("(m)")),
+                "amplitude",
+            )
+        },
         ("phase_deg", "phase lag φ (deg)".to_string(), "phase"),
         (
             "energy_dissipated",

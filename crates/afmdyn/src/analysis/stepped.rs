@@ -256,8 +256,9 @@ pub struct SteppedCurve {
     pub jumps: Vec<Jump>,
     /// Parameter values of the located folds, ascending.
     pub folds: Vec<f64>,
-    /// Ranges [lo, hi] between two consecutive folds of a branch: where the branch has three
-    /// orbits (two stable ones and the unstable one between them), the bistable ranges.
+    /// Ranges [lo, hi] of the unstable stretches of the branches that run from a fold to a
+    /// fold: where a branch has three orbits (two stable ones and the unstable one between
+    /// them), the bistable ranges.
     pub bistable: Vec<(f64, f64)>,
     /// What could not be computed (e.g. a branch whose start failed).
     pub warnings: Vec<String>,
@@ -600,8 +601,10 @@ fn branch(spec: &SteppedSpec, from: &CurvePoint, to: f64) -> Result<Vec<BranchSa
     cs.integrator = spec.integrator;
     cs.max_points = spec.max_branch_points;
     cs.range = Some((lo, hi));
-    cs.ds = (hi - lo) / 100.0;
-    cs.ds_max = (hi - lo) / 25.0;
+    // arclength runs in (z, p): scale the steps by the larger of the range and the orbit
+    let scale = (hi - lo).max(from.state.norm());
+    cs.ds = scale / 100.0;
+    cs.ds_max = scale / 25.0;
     let points = continue_branch(&cs, &from.state)?;
     let mut out = Vec::with_capacity(points.len());
     for p in points {
@@ -681,6 +684,33 @@ fn branch_starts(
     starts
 }
 
+/// The parameter ranges of the unstable stretches of a branch that run from a fold to a fold:
+/// where the branch folds back over itself (an S), three orbits coexist, two of them stable.
+fn unstable_between_folds(br: &[BranchSample]) -> Vec<(f64, f64)> {
+    let mut out = Vec::new();
+    let mut start: Option<usize> = None;
+    for (i, s) in br.iter().enumerate() {
+        if s.point.event == Some(BranchEvent::Fold) {
+            if let Some(a) = start {
+                // a fold closing an unstable stretch opened at a fold
+                let run = &br[a..=i];
+                if run[1..run.len() - 1].iter().all(|x| !x.point.stable) && run.len() > 2 {
+                    let (lo, hi) = run
+                        .iter()
+                        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), x| {
+                            (l.min(x.point.value), h.max(x.point.value))
+                        });
+                    out.push((lo, hi));
+                }
+            }
+            start = Some(i);
+        } else if s.point.stable && start.is_some_and(|a| i > a) {
+            start = None;
+        }
+    }
+    out
+}
+
 /// Jumps of one sweep: points reached by settling on an orbit away from the previous one.
 fn jumps_of(which: Sweep, points: &[CurvePoint], folds: &[f64], jump_tol: f64) -> Vec<Jump> {
     let mut out = Vec::new();
@@ -757,15 +787,12 @@ pub fn stepped_sweep(spec: &SteppedSpec) -> Result<SteppedCurve, SimError> {
     let mut folds: Vec<f64> = Vec::new();
     let mut bistable = Vec::new();
     for br in &branches {
-        let f: Vec<f64> = br
-            .iter()
-            .filter(|s| s.point.event == Some(BranchEvent::Fold))
-            .map(|s| s.point.value)
-            .collect();
-        for w in f.windows(2) {
-            bistable.push((w[0].min(w[1]), w[0].max(w[1])));
-        }
-        folds.extend(f);
+        folds.extend(
+            br.iter()
+                .filter(|s| s.point.event == Some(BranchEvent::Fold))
+                .map(|s| s.point.value),
+        );
+        bistable.extend(unstable_between_folds(br));
     }
     folds.sort_by(f64::total_cmp);
     folds.dedup_by(|a, b| (*a - *b).abs() <= 1e-9 * (1.0 + b.abs()));
