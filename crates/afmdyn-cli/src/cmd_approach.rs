@@ -48,7 +48,12 @@ impl CurveArgs {
         }
     }
 
+    /// Check the options and the parameters at both ends of the grid (before any output
+    /// directory is created).
     fn configure(&self, spec: &mut SteppedSpec) -> Result<(), CliError> {
+        for v in [spec.values[0], spec.values[spec.values.len() - 1]] {
+            spec.base.with(spec.param, v).validate()?;
+        }
         if !(self.tolerance.is_finite() && self.tolerance > 0.0 && self.tolerance < 1e-3) {
             return Err(CliError::Input(format!(
                 "tolerance = {}: must be in (0, 1e-3)",
