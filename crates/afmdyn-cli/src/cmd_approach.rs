@@ -15,7 +15,7 @@ use afmdyn::analysis::stepped::{Spacing, SteppedCurve, SteppedSpec, Sweep};
 use afmdyn::report::{curve_row, CurveUnits, CURVE_COLUMNS};
 use afmdyn::{CantileverModel, Params};
 use clap::Args;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Grid, solver and output flags shared by `approach` and `resonance`.
 #[derive(Debug, Args)]
@@ -494,6 +494,58 @@ fn summary(c: &SteppedCurve, x: &dyn Fn(f64) -> f64, l: &Labels, out: Option<&Ou
     }
 }
 
+/// The parameters and the output units (SI with a probe; frequencies in Hz when `hz`), with
+/// `--from`/`--to` checked finite.
+fn setup(
+    model: &ModelArgs,
+    from: Option<f64>,
+    to: Option<f64>,
+    hz: bool,
+) -> Result<(Params, CurveUnits), CliError> {
+    let (base, probe) = model.resolve(Params::default())?;
+    check_finite("--from", from)?;
+    check_finite("--to", to)?;
+    let units = probe.as_ref().map_or_else(CurveUnits::dimensionless, |p| {
+        CurveUnits::from_scales(&p.scales, hz)
+    });
+    Ok((base, units))
+}
+
+/// The part of a run shared by both commands.
+struct Run<'a> {
+    args: &'a CurveArgs,
+    out: &'a Path,
+    units: &'a CurveUnits,
+    labels: &'a Labels,
+    x: &'a dyn Fn(f64) -> f64,
+}
+
+impl Run<'_> {
+    /// Check the options, lock the output directory, compute, write the files and print the
+    /// JSON document or the summary.
+    fn go(
+        &self,
+        spec: &mut SteppedSpec,
+        compute: fn(&SteppedSpec) -> Result<SteppedCurve, afmdyn::SimError>,
+        doc: impl Fn(&SteppedCurve) -> serde_json::Value,
+    ) -> Result<(), CliError> {
+        self.args.configure(spec)?;
+        let out = (self.args.files != Files::None)
+            .then(|| OutDir::lock(self.out))
+            .transpose()?;
+        let c = compute(spec)?;
+        if let Some(o) = &out {
+            write_files(o, self.args.files, &c, self.x, self.units, self.labels)?;
+        }
+        if self.args.json {
+            println!("{}", doc(&c));
+        } else {
+            summary(&c, self.x, self.labels, out.as_ref());
+        }
+        Ok(())
+    }
+}
+
 fn check_finite(name: &str, v: Option<f64>) -> Result<(), CliError> {
     match v {
         Some(x) if !x.is_finite() => Err(CliError::Input(format!(
@@ -505,22 +557,12 @@ fn check_finite(name: &str, v: Option<f64>) -> Result<(), CliError> {
 
 /// Run `afmdyn approach`.
 pub fn approach(a: &ApproachArgs) -> Result<(), CliError> {
-    let (base, probe) = a.model.resolve(Params::default())?;
-    check_finite("--from", a.from)?;
-    check_finite("--to", a.to)?;
-    let units = probe.as_ref().map_or_else(CurveUnits::dimensionless, |p| {
-        CurveUnits::from_scales(&p.scales, false)
-    });
+    let (base, units) = setup(&a.model, a.from, a.to, false)?;
     let a0 = free_response(&CantileverModel::new(&base)?)?.amplitude;
     let offset = base.contact_law.distance_offset();
     let from = a.from.map_or(1.2 * a0 + offset, |v| v / units.length);
     let to = a.to.map_or(0.1 * a0 + offset, |v| v / units.length);
     let mut spec = approach_spec(base, from, to, a.curve.spacing(units.length)?)?;
-    a.curve.configure(&mut spec)?;
-    let out = (a.curve.files != Files::None)
-        .then(|| OutDir::lock(&a.out))
-        .transpose()?;
-    let c = approach_retract(&spec)?;
     let x = |v: f64| rest_distance(&base, v) * units.length;
     let labels = Labels {
         stem: "approach",
@@ -531,35 +573,26 @@ pub fn approach(a: &ApproachArgs) -> Result<(), CliError> {
             if units.si { " (m)" } else { " (g0)" }
         ),
     };
-    if let Some(o) = &out {
-        write_files(o, a.curve.files, &c, &x, &units, &labels)?;
-    }
-    if a.curve.json {
-        println!("{}", afmdyn::report::approach(&base, &c, &units));
-    } else {
-        summary(&c, &x, &labels, out.as_ref());
-    }
-    Ok(())
+    let run = Run {
+        args: &a.curve,
+        out: &a.out,
+        units: &units,
+        labels: &labels,
+        x: &x,
+    };
+    run.go(&mut spec, approach_retract, |c| {
+        afmdyn::report::approach(&base, c, &units)
+    })
 }
 
 /// Run `afmdyn resonance`.
 pub fn resonance(a: &ResonanceArgs) -> Result<(), CliError> {
-    let (base, probe) = a.model.resolve(Params::default())?;
-    check_finite("--from", a.from)?;
-    check_finite("--to", a.to)?;
-    let units = probe.as_ref().map_or_else(CurveUnits::dimensionless, |p| {
-        CurveUnits::from_scales(&p.scales, true)
-    });
+    let (base, units) = setup(&a.model, a.from, a.to, true)?;
     let hz = units.hz_per_omega.unwrap_or(1.0);
     let (lo, hi) = mode_band(&base, a.mode)?;
     let from = a.from.map_or(lo, |v| v / hz);
     let to = a.to.map_or(hi, |v| v / hz);
     let mut spec = resonance_spec(base, from, to, a.curve.spacing(hz)?)?;
-    a.curve.configure(&mut spec)?;
-    let out = (a.curve.files != Files::None)
-        .then(|| OutDir::lock(&a.out))
-        .transpose()?;
-    let c = resonance_curve(&spec)?;
     let x = |v: f64| v * hz;
     let labels = Labels {
         stem: "resonance",
@@ -575,13 +608,14 @@ pub fn resonance(a: &ResonanceArgs) -> Result<(), CliError> {
             "drive frequency Ω".into()
         },
     };
-    if let Some(o) = &out {
-        write_files(o, a.curve.files, &c, &x, &units, &labels)?;
-    }
-    if a.curve.json {
-        println!("{}", afmdyn::report::resonance(&base, &c, &units));
-    } else {
-        summary(&c, &x, &labels, out.as_ref());
-    }
-    Ok(())
+    let run = Run {
+        args: &a.curve,
+        out: &a.out,
+        units: &units,
+        labels: &labels,
+        x: &x,
+    };
+    run.go(&mut spec, resonance_curve, |c| {
+        afmdyn::report::resonance(&base, c, &units)
+    })
 }
