@@ -19,6 +19,25 @@ pub struct ModelArgs {
     /// and JSON output gains an "si" block with the scales and headline values in SI
     #[arg(long, value_name = "PROBE.toml", conflicts_with = "config")]
     pub probe: Option<PathBuf>,
+    /// With --probe: the rest tip–sample distance z_c in metres (sets α5; overrides the probe's
+    /// z_c)
+    #[arg(
+        long = "z-c",
+        value_name = "METRES",
+        requires = "probe",
+        conflicts_with = "alpha5",
+        allow_negative_numbers = true
+    )]
+    pub z_c: Option<f64>,
+    /// With --probe: the drive frequency in Hz (sets Ω; the drive force or base amplitude is
+    /// kept, as in a frequency sweep of an instrument)
+    #[arg(
+        long = "drive-frequency",
+        value_name = "HZ",
+        requires = "probe",
+        conflicts_with = "omega"
+    )]
+    pub drive_frequency: Option<f64>,
     /// Number of Galerkin modes N (1..=20) [default: 3]
     #[arg(long, value_name = "N")]
     pub modes: Option<usize>,
@@ -208,6 +227,25 @@ impl ModelArgs {
             omega: pick(self.omega, file.omega, defaults.omega),
             ..defaults
         };
+        let mut p = p;
+        if let Some(pr) = &probe {
+            if let Some(z) = self.z_c {
+                if !z.is_finite() {
+                    return Err(CliError::Input(format!(
+                        "z-c = {z}: must be a finite distance in m"
+                    )));
+                }
+                p.alpha5 = p.alpha5_for_rest_distance(z / pr.scales.length_m);
+            }
+            if let Some(f) = self.drive_frequency {
+                if !(f.is_finite() && f > 0.0) {
+                    return Err(CliError::Input(format!(
+                        "drive-frequency = {f}: must be finite and > 0 (Hz)"
+                    )));
+                }
+                p.omega = pr.scales.omega(f);
+            }
+        }
         p.validate().map_err(|e| CliError::Input(e.to_string()))?;
         Ok((p, probe))
     }

@@ -78,6 +78,17 @@ fn one_line(text: &str) -> String {
         .unwrap_or("invalid arguments")
         .trim_start_matches("error: ")
         .to_string();
+    // "the following required arguments were not provided:" lists them on the next lines
+    if out.ends_with(':') {
+        let mut rest = lines.clone();
+        while let Some(l) = rest
+            .next()
+            .filter(|l| l.starts_with('-') || l.starts_with('<'))
+        {
+            out.push_str(&format!(" {l}"));
+            lines = rest.clone();
+        }
+    }
     for tip in lines.filter_map(|l| l.strip_prefix("tip: ")) {
         out.push_str(&format!(" ({tip})"));
     }

@@ -117,3 +117,27 @@ fn bad_probe_exits_2_with_all_problems() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// SI inputs with a probe: --z-c (m) sets α5 through the rest distance (DMT: z_c = (α5 + ã₀)A₀)
+/// and --drive-frequency (Hz) sets Ω = f/f₀ for the point mass; without a probe they are refused.
+#[test]
+fn si_inputs_need_the_probe() {
+    let doc = json(&[
+        "orbit",
+        "--probe",
+        "examples/probe-point-mass-dmt.toml",
+        "--z-c",
+        "6e-9",
+        "--drive-frequency",
+        "299e3",
+        "--json",
+    ]);
+    let a5 = doc["params"]["alpha5"].as_f64().unwrap();
+    assert!((a5 - (0.6 - 0.0165)).abs() < 1e-12, "alpha5 = {a5}");
+    let om = doc["params"]["omega"].as_f64().unwrap();
+    assert!((om - 299.0 / 300.0).abs() < 1e-12, "omega = {om}");
+    assert!((doc["si"]["z_c_m"].as_f64().unwrap() - 6e-9).abs() < 1e-21);
+    let out = run(&["orbit", "--z-c", "6e-9"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--probe"));
+}

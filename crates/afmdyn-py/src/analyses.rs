@@ -918,3 +918,80 @@ pub fn lyapunov<'py>(
     out.f64s("uncertainty", l.uncertainty.clone())?;
     Ok(out.finish())
 }
+
+/// A probe file (SI units, `afmdyn … --probe FILE`): its dimensionless parameters and the
+/// `"si"` block of the command line's JSON (scales, calibration, drive, A₀, z_c).
+#[pyfunction]
+pub fn probe(path: std::path::PathBuf) -> PyResult<(PyParams, String)> {
+    let pr = afmdyn::probe::Probe::load(&path).map_err(|e| value_error(format!("probe {e}")))?;
+    let si = report::si(&pr, &pr.params, &serde_json::json!({}));
+    Ok((PyParams { inner: pr.params }, si.to_string()))
+}
+
+/// Observables of the steady state reached from `initial` (default: rest): the steady state is
+/// found as by `orbit` (polished by Newton shooting when periodic), then
+/// [`afmdyn::analysis::observables::observe`] integrates `periods` orbit periods.
+#[pyfunction]
+#[pyo3(signature = (params, initial=None, periods=1, harmonics=10, tol=1e-8, max_periods=1500,
+    max_period=64, progress=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn observe<'py>(
+    py: Python<'py>,
+    params: PyRef<'_, PyParams>,
+    initial: Option<Vec<f64>>,
+    periods: usize,
+    harmonics: usize,
+    tol: f64,
+    max_periods: usize,
+    max_period: usize,
+    progress: Option<Bound<'py, PyAny>>,
+) -> PyResult<Dict<'py>> {
+    use afmdyn::analysis::observables::{observe_from, ObservableOptions};
+    let p = params.inner;
+    let steady = steady_options(tol, max_periods, max_period)?;
+    if !(1..=1_000_000).contains(&periods) {
+        return Err(value_error(format!(
+            "periods = {periods}: must be in 1..=1000000"
+        )));
+    }
+    let (doc, z, n) = run(
+        py,
+        &Job::default(),
+        None,
+        progress.as_ref(),
+        Stop::Abandon,
+        move || -> PyResult<_> {
+            let model = model_of(&p)?;
+            let (z, found) = guess(&model, initial, &steady)?;
+            // Newton polishes a periodic motion to round-off; a high-Q transient that has not
+            // settled within max_periods is tried as period-1 (or the period found); when
+            // Newton fails the steady-state end point is used as it is
+            let n = found.unwrap_or(1);
+            let newton = ShootingOptions {
+                tol: 1e-12,
+                ..ShootingOptions::default()
+            };
+            let (z, found) = match shoot(&model, &z, n, &newton) {
+                Ok(o) => (o.state, Some(n)),
+                Err(_) => (z, found),
+            };
+            let o = observe_from(
+                &model,
+                IntegratorOptions::default(),
+                0.0,
+                &z,
+                &ObservableOptions {
+                    periods: periods * n,
+                    harmonics,
+                },
+            )
+            .map_err(sim_error)?;
+            Ok((report::observables(&o), z, found))
+        },
+    )??;
+    let out = Out::new(py);
+    out.json(&doc)?;
+    out.f64s("state", z.as_slice().to_vec())?;
+    out.set("period", n)?;
+    Ok(out.finish())
+}

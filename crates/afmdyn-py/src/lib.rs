@@ -29,6 +29,8 @@ fn _afmdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(analyses::orbit, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::continuation, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::lyapunov, m)?)?;
+    m.add_function(wrap_pyfunction!(analyses::probe, m)?)?;
+    m.add_function(wrap_pyfunction!(analyses::observe, m)?)?;
     m.add("POLL_SECONDS", run::POLL.as_secs_f64())?;
     m.add(
         "MODEL_KEYWORDS",

@@ -244,6 +244,26 @@ impl PyParams {
         })
     }
 
+    /// The dimensionless set of a probe file in SI units (the command line's
+    /// ``--probe FILE``: cantilever k, f₀, Q or geometry; tip; sample law; drive A₀, f; see
+    /// ``docs/afm-workflow.md``); ``**model`` overrides single keywords. Raises ``ValueError``
+    /// listing every problem of the file.
+    #[staticmethod]
+    #[pyo3(signature = (path, **model))]
+    fn from_probe(path: std::path::PathBuf, model: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
+        let pr = afmdyn::probe::Probe::load(&path)
+            .map_err(|e| PyValueError::new_err(format!("probe {e}")))?;
+        Ok(PyParams {
+            inner: params_from_kwargs(pr.params, model)?,
+        })
+    }
+
+    /// The structural model: ``"beam"`` (the paper) or ``"point-mass"``.
+    #[getter]
+    fn structure(&self) -> &'static str {
+        self.inner.structure.name()
+    }
+
     /// Number of Galerkin modes N.
     #[getter]
     fn modes(&self) -> usize {

@@ -11,8 +11,9 @@ series, sweeps, curves) or small result objects whose ``to_dict()`` is the comma
 array([ 7.79, 20.33, 55.81])
 
 Analyses: :func:`modes`, :func:`simulate`, :func:`converge`, :func:`bifurcation`,
-:func:`attractors`, :func:`orbit`, :func:`continuation`, :func:`lyapunov`. Physical units
-(``approach``, ``resonance``, probe files) come with a later version. Tip–sample laws:
+:func:`attractors`, :func:`orbit`, :func:`continuation`, :func:`lyapunov`, :func:`observe`
+(amplitude, phase, dissipated energy, virial, forces of a steady state). Physical units: a probe
+file in SI (:func:`probe`, ``Params.from_probe``) sets every parameter. Tip–sample laws:
 ``contact_law="linear" | "hertz" | "dmt" | "impact"`` with ``restitution`` (impact),
 ``hamaker`` and ``intermolecular_distance`` (DMT) among the model keywords.
 """
@@ -26,7 +27,9 @@ from ._api import (
     converge,
     lyapunov,
     modes,
+    observe,
     orbit,
+    probe,
     simulate,
     summary,
 )
@@ -55,7 +58,9 @@ __all__ = [
     "converge",
     "lyapunov",
     "modes",
+    "observe",
     "orbit",
+    "probe",
     "simulate",
     "summary",
 ]

@@ -75,6 +75,12 @@ class Params:
     def from_toml(path: Union[str, "os.PathLike[str]"], **model: Any) -> "Params":
         """Read a model config file (``--config FILE.toml`` of the command line); ``**model``
         overrides it."""
+    @staticmethod
+    def from_probe(path: Union[str, "os.PathLike[str]"], **model: Any) -> "Params":
+        """The dimensionless set of a probe file in SI units (``--probe FILE``); ``**model``
+        overrides single keywords. Raises ``ValueError`` listing every problem of the file."""
+    @property
+    def structure(self) -> Literal["beam", "point-mass"]: ...
     @property
     def modes(self) -> int: ...
     @property
@@ -202,5 +208,16 @@ def lyapunov(
     transient: int = 500,
     periods: int = 4000,
     blocks: int = 10,
+    progress: Optional[ProgressCallback] = None,
+) -> Dict[str, Any]: ...
+def probe(path: Union[str, "os.PathLike[str]"]) -> Tuple[Params, str]: ...
+def observe(
+    params: Params,
+    initial: Optional[List[float]] = None,
+    periods: int = 1,
+    harmonics: int = 10,
+    tol: float = 1e-8,
+    max_periods: int = 1500,
+    max_period: int = 64,
     progress: Optional[ProgressCallback] = None,
 ) -> Dict[str, Any]: ...

@@ -15,6 +15,7 @@ computation fails (chattering, divergence, Newton not converging).
 from __future__ import annotations
 
 import json
+import os
 from typing import Literal, TYPE_CHECKING, Any, Dict, Optional, Sequence, TypedDict, Union
 
 import numpy as np
@@ -727,3 +728,65 @@ def lyapunov(
         verdict=doc["verdict"],
         _json=d["json"],
     )
+
+
+def probe(path: Union[str, "os.PathLike[str]"]) -> Dict[str, Any]:
+    """Read a probe file in SI units (the command line's ``--probe FILE``; format and mapping in
+    ``docs/afm-workflow.md``).
+
+    Returns:
+        ``{"params": Params, "si": dict}``: the dimensionless set, and the ``"si"`` block of the
+        command line's JSON documents — ``scales`` (``length_m`` = A₀, ``time_s`` per unit τ,
+        ``force_n``, ``energy_j``, ``power_w``), ``calibration`` (k, f₀, Q), the drive in Hz, the
+        period in s, ``free_amplitude_m`` and ``z_c_m``. Raises ``ValueError`` listing every
+        problem of the file.
+    """
+    p, si = _core.probe(path)
+    return {"params": p, "si": json.loads(si)}
+
+
+def observe(
+    params: Optional[Params] = None,
+    /,
+    *,
+    initial: StateLike = None,
+    periods: int = 1,
+    harmonics: int = 10,
+    tol: float = 1e-8,
+    max_periods: int = 1500,
+    max_period: int = 64,
+    progress: ProgressArg = None,
+    **model: Unpack[Model],
+) -> Dict[str, Any]:
+    """Observables of the steady state reached from ``initial`` (default: rest): first-harmonic
+    amplitude and phase lag of the tip deflection, harmonics and THD, mean deflection, peak and
+    minimum force, indentation, contact fraction and time, minimum distance, impacts, the energy
+    dissipated in the sample, the virial, the per-mode energy balance and the closed forms
+    (Cleveland/Anczykowski E_dis, San Paulo & García virial) beside the direct integrals.
+
+    The steady state is found as by :func:`orbit` and, when periodic, polished by Newton
+    shooting; ``periods`` orbit periods are integrated on the dense output (no sampling).
+    Dimensionless units (lengths g₀, time τ, forces F̃; phases in radians); with a probe,
+    multiply by the scales of :func:`probe`.
+
+    Returns:
+        The observables document (``afmdyn.analysis.observables``) plus ``state`` (the start,
+        ``[2N]``) and ``period`` (n of the period-n motion, ``None`` when not periodic).
+    """
+    p = _params(params, model)
+    d = _run(
+        _core.observe,
+        "observe",
+        progress,
+        p,
+        initial=_state(initial),
+        periods=periods,
+        harmonics=harmonics,
+        tol=tol,
+        max_periods=max_periods,
+        max_period=max_period,
+    )
+    doc: Dict[str, Any] = json.loads(d["json"])
+    doc["state"] = d["state"]
+    doc["period"] = d["period"]
+    return doc

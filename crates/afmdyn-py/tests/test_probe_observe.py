@@ -1,0 +1,68 @@
+"""Probe files and steady-state observables from Python (the command line's ``--probe`` and
+the library's ``analysis::observables``)."""
+
+import math
+import pathlib
+
+import pytest
+
+import afmdyn
+
+ROOT = pathlib.Path(__file__).resolve().parents[3]
+PM = ROOT / "examples" / "probe-point-mass-dmt.toml"
+BEAM = ROOT / "examples" / "probe-beam-dmt.toml"
+
+
+def test_probe_params_and_scales():
+    pr = afmdyn.probe(PM)
+    p = pr["params"]
+    assert p.structure == "point-mass" and p.modes == 1
+    # the point mass at f = f0: alpha3 = 1/Q, Omega = 1 (closed forms of the probe mapping)
+    assert p.alpha3 == pytest.approx(1 / 400, rel=1e-14)
+    assert p.omega == pytest.approx(1.0, rel=1e-14)
+    si = pr["si"]
+    assert si["scales"]["length_m"] == pytest.approx(10e-9)
+    assert si["scales"]["force_n"] == pytest.approx(40.0 * 10e-9)
+    assert si["z_c_m"] == pytest.approx(8e-9)
+    assert afmdyn.Params.from_probe(PM) == p
+    b = afmdyn.Params.from_probe(BEAM, modes=2)
+    assert b.structure == "beam" and b.modes == 2
+
+
+def test_bad_probe_lists_every_problem(tmp_path):
+    f = tmp_path / "bad.toml"
+    f.write_text('model = "beam"\ncolour = 1\n[sample]\nlaw = "hertz"\n')
+    with pytest.raises(ValueError) as e:
+        afmdyn.Params.from_probe(f)
+    msg = str(e.value)
+    for needle in ("unknown key colour", "missing key modes", "missing table [cantilever]",
+                   "missing table [drive]"):
+        assert needle in msg
+
+
+def test_observe_free_oscillation_matches_closed_form():
+    # far from the sample the point mass at f = f0 oscillates with A = A0 (1 in units of A0)
+    # and lags the force by 90 degrees (harmonic oscillator at resonance)
+    # (at 10⁴ A₀ the van der Waals force H̃/d² is 1e-13 of kA₀)
+    p = afmdyn.Params.from_probe(PM, gap=1e4)
+    o = afmdyn.observe(p)
+    assert o["period"] == 1
+    # (the adaptive integrator at its default tolerance 1e-12; the library's own test reaches
+    # 1e-9 at 1e-14)
+    assert o["amplitude"] == pytest.approx(1.0, rel=1e-8)
+    assert math.degrees(o["phase"]) == pytest.approx(90.0, abs=1e-7)
+    assert o["contact_fraction"] == 0.0
+
+
+def test_observe_tapping_repulsive_regime():
+    # z_c = 8 nm < A0 = 10 nm: the amplitude drops below A0 and, in
+    # the repulsive regime (phase < 90 deg), the virial is negative (San Paulo & Garcia 2001)
+    o = afmdyn.observe(afmdyn.Params.from_probe(PM))
+    assert 0.5 < o["amplitude"] < 1.0
+    assert o["peak_force"] > 0 and o["contact_fraction"] > 0
+    # DMT without viscosity is conservative: no energy goes into the sample
+    assert abs(o["energy_dissipated"]) < 1e-9
+    if o["phase"] < math.pi / 2:
+        assert o["virial"] < 0
+    with pytest.raises(ValueError):
+        afmdyn.observe(afmdyn.Params.from_probe(PM), periods=0)
