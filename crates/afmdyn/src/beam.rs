@@ -1,4 +1,4 @@
-//! Clamped–free Euler–Bernoulli beam modes φ_i(ξ) (paper eq. 9, Chang & Craig [36]).
+//! Clamped–free Euler–Bernoulli beam modes φ_i(ξ) (paper eq. 9, Chang & Craig, the paper's ref. 36).
 //!
 //! The mode shape is φ(ξ) = cosh βξ − cos βξ − σ (sinh βξ − sin βξ) with
 //! σ = (cosh β + cos β)/(sinh β + sin β) and β a root of 1 + cos β cosh β = 0.

@@ -19,7 +19,7 @@ pub struct Material {
     pub poisson_ratio: f64,
 }
 
-/// The paper's silicon tip (§4, from its ref. [44]): E₁ = 130 GPa, ν₁ = 0.27.
+/// The paper's silicon tip (§4, from its ref. 44): E₁ = 130 GPa, ν₁ = 0.27.
 pub const SILICON_TIP: Material = Material {
     youngs_modulus: 130e9,
     poisson_ratio: 0.27,
