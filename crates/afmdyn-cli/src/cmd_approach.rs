@@ -7,13 +7,13 @@ use crate::cmd_simulate::Files;
 use crate::error::CliError;
 use crate::output::{f, write_csv, Column, NpyStream, OutDir};
 use crate::plot::{save, Figure, Series, Style};
-use afmdyn::analysis::approach::{approach_retract, approach_spec, rest_distance};
+use afmdyn::analysis::approach::{approach_retract, approach_spec, default_range, rest_distance};
 use afmdyn::analysis::continuation::BranchEvent;
-use afmdyn::analysis::observables::{free_response, Observables};
+use afmdyn::analysis::observables::Observables;
 use afmdyn::analysis::resonance::{mode_band, resonance_curve, resonance_spec};
 use afmdyn::analysis::stepped::{Spacing, SteppedCurve, SteppedSpec, Sweep};
 use afmdyn::report::{curve_row, CurveUnits, CURVE_COLUMNS};
-use afmdyn::{CantileverModel, Params};
+use afmdyn::Params;
 use clap::Args;
 use std::path::{Path, PathBuf};
 
@@ -558,10 +558,9 @@ fn check_finite(name: &str, v: Option<f64>) -> Result<(), CliError> {
 /// Run `afmdyn approach`.
 pub fn approach(a: &ApproachArgs) -> Result<(), CliError> {
     let (base, units) = setup(&a.model, a.from, a.to, false)?;
-    let a0 = free_response(&CantileverModel::new(&base)?)?.amplitude;
-    let offset = base.contact_law.distance_offset();
-    let from = a.from.map_or(1.2 * a0 + offset, |v| v / units.length);
-    let to = a.to.map_or(0.1 * a0 + offset, |v| v / units.length);
+    let (far, near) = default_range(&base)?;
+    let from = a.from.map_or(far, |v| v / units.length);
+    let to = a.to.map_or(near, |v| v / units.length);
     let mut spec = approach_spec(base, from, to, a.curve.spacing(units.length)?)?;
     let x = |v: f64| rest_distance(&base, v) * units.length;
     let labels = Labels {

@@ -7,9 +7,23 @@
 //! Garcia & Garcia, *Beilstein J. Nanotechnol.* 6 (2015) 369) come from the shared driver
 //! [`super::stepped`].
 
+use super::observables::free_response;
 use super::stepped::{grid, stepped_sweep, Spacing, SteppedCurve, SteppedSpec};
 use crate::error::SimError;
+use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
+
+/// The default z_c range of an approach (units of g₀): from 1.2 A₀ to 0.1 A₀ above the contact
+/// threshold, A₀ the free amplitude of `base` ([`free_response`]): from where the sample is out
+/// of reach to deep in the repulsive regime.
+///
+/// # Errors
+/// [`SimError`] for invalid parameters or an undamped drive at resonance (no finite A₀).
+pub fn default_range(base: &Params) -> Result<(f64, f64), SimError> {
+    let a0 = free_response(&CantileverModel::new(base)?)?.amplitude;
+    let offset = base.contact_law.distance_offset();
+    Ok((1.2 * a0 + offset, 0.1 * a0 + offset))
+}
 
 /// The stepped-sweep spec of an approach from the larger to the smaller of `z_from` and `z_to`
 /// (units of g₀) with the given spacing of z_c, then the retract; the swept parameter is α5.
