@@ -6,18 +6,23 @@
 //! (Guzman, Garcia & Garcia, *Beilstein J. Nanotechnol.* 6 (2015) 369), the parameter is
 //! stepped through a grid and at each value the steady state is the one reached from the
 //! previous value's end state; then the sweep runs back (retract, or down-sweep). Instead of
-//! integrating ~Q/π periods of transient per value, each value is first tried by Newton
-//! shooting ([`super::shooting`]) from the previous orbit: a stable orbit near the previous one
-//! is its continuation, the state the motion settles on. When Newton fails, lands on an unstable
-//! orbit, or lands far from the previous orbit (the previous attractor vanished: a jump), the
+//! integrating ~Q/π periods of transient per value, the previous orbit is followed by Newton
+//! shooting ([`super::shooting`]) from a secant prediction: a stable orbit near the previous
+//! one is its continuation, the state the motion settles on; a step the orbit moves too far in
+//! is halved (quasi-static sub-steps, [`SUBSTEP_DEPTH`]) as long as halving brings the orbits
+//! closer. When the orbit cannot be followed — Newton fails or lands on an unstable orbit, or
+//! the distance does not shrink with the step: the attractor vanished at a fold, a jump — the
 //! motion is integrated from the previous end state in chunks of drive periods, Newton being
 //! retried from the transient until the trajectory is seen to approach a stable orbit
 //! ([`settle`]); a motion that never settles on a period-n orbit is classified by
 //! [`super::steady::steady_state`].
 //!
-//! **Branches.** The periodic-orbit branches through the first points of both sweeps are
-//! continued in the parameter by pseudo-arclength continuation ([`super::continuation`]), with
+//! **Branches.** The periodic-orbit branches through both ends of the range — the two sweeps'
+//! first orbits, and at each end the orbit Newton finds from the other end's (the other regime,
+//! e.g. the repulsive state of a disconnected branch) — are continued in the parameter by
+//! pseudo-arclength continuation ([`super::continuation`]; Keller 1977, Seydel 2010 ch. 4) with
 //! Floquet stability, folds (saddle-nodes: the edges of the bistable ranges) and grazing points.
+//! A start already on a computed branch is skipped.
 //!
 //! Every recorded orbit carries its [`Observables`] ([`super::observables`]).
 
