@@ -7,6 +7,7 @@
 
 mod analyses;
 mod convert;
+mod curves;
 mod errors;
 mod params;
 mod run;
@@ -29,6 +30,8 @@ fn _afmdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(analyses::orbit, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::continuation, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::lyapunov, m)?)?;
+    m.add_function(wrap_pyfunction!(curves::approach, m)?)?;
+    m.add_function(wrap_pyfunction!(curves::resonance, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::probe, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::observe, m)?)?;
     m.add("POLL_SECONDS", run::POLL.as_secs_f64())?;

@@ -12,7 +12,9 @@ array([ 7.79, 20.33, 55.81])
 
 Analyses: :func:`modes`, :func:`simulate`, :func:`converge`, :func:`bifurcation`,
 :func:`attractors`, :func:`orbit`, :func:`continuation`, :func:`lyapunov`, :func:`observe`
-(amplitude, phase, dissipated energy, virial, forces of a steady state). Physical units: a probe
+(amplitude, phase, dissipated energy, virial, forces of a steady state), :func:`approach`
+(approach–retract curves) and :func:`resonance` (resonance curves), both with branches and
+folds. Physical units: a probe
 file in SI (:func:`probe`, ``Params.from_probe``) sets every parameter. Tip–sample laws:
 ``contact_law="linear" | "hertz" | "dmt" | "impact"`` with ``restitution`` (impact),
 ``hamaker`` and ``intermolecular_distance`` (DMT) among the model keywords.
@@ -21,6 +23,7 @@ file in SI (:func:`probe`, ``Params.from_probe``) sets every parameter. Tip–sa
 from ._afmdyn import Params, SimulationError
 from ._api import (
     Model,
+    approach,
     attractors,
     bifurcation,
     continuation,
@@ -30,6 +33,7 @@ from ._api import (
     observe,
     orbit,
     probe,
+    resonance,
     simulate,
     summary,
 )
@@ -52,6 +56,7 @@ __all__ = [
     "RegionSpectrum",
     "SimulationError",
     "Spectrum",
+    "approach",
     "attractors",
     "bifurcation",
     "continuation",
@@ -61,6 +66,7 @@ __all__ = [
     "observe",
     "orbit",
     "probe",
+    "resonance",
     "simulate",
     "summary",
 ]

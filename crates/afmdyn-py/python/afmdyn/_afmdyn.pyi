@@ -221,3 +221,26 @@ def observe(
     max_period: int = 64,
     progress: Optional[ProgressCallback] = None,
 ) -> Dict[str, Any]: ...
+def approach(
+    params: Params,
+    from_: Optional[float] = None,
+    to: Optional[float] = None,
+    step: Optional[float] = None,
+    points: Optional[int] = None,
+    branches: bool = True,
+    tolerance: float = 1e-10,
+    probe: Optional[str] = None,
+    progress: Optional[ProgressCallback] = None,
+) -> Dict[str, Any]: ...
+def resonance(
+    params: Params,
+    mode: int = 1,
+    from_: Optional[float] = None,
+    to: Optional[float] = None,
+    step: Optional[float] = None,
+    points: Optional[int] = None,
+    branches: bool = True,
+    tolerance: float = 1e-10,
+    probe: Optional[str] = None,
+    progress: Optional[ProgressCallback] = None,
+) -> Dict[str, Any]: ...

@@ -790,3 +790,102 @@ def observe(
     doc["state"] = d["state"]
     doc["period"] = d["period"]
     return doc
+
+
+def approach(
+    params: Optional[Params] = None,
+    /,
+    *,
+    from_: Optional[float] = None,
+    to: Optional[float] = None,
+    step: Optional[float] = None,
+    points: Optional[int] = None,
+    branches: bool = True,
+    tolerance: float = 1e-10,
+    probe: Optional[Union[str, "os.PathLike[str]"]] = None,
+    progress: ProgressArg = None,
+    **model: Unpack[Model],
+) -> Dict[str, Any]:
+    """The amplitude-modulation approach–retract curve over the rest distance z_c
+    (``afmdyn approach``): the steady state stepped from ``from_`` down to ``to`` and back, each
+    value continued from the previous orbit, plus the periodic-orbit branches continued in z_c
+    with Floquet stability, the folds, the bistable ranges and the jumps.
+
+    Args:
+        from_, to: the z_c range (default 1.2 A₀ to 0.1 A₀ above contact), in m with
+            ``probe``, else in g₀.
+        step, points: the grid (a step in the same unit, or the number of values; default 120).
+        branches: also continue the branches.
+        tolerance: of the adaptive integrator.
+        probe: a probe file whose scales give SI outputs (pass its parameters as ``params``,
+            e.g. ``Params.from_probe(path)``).
+
+    Returns:
+        The ``afmdyn approach --json`` document: ``approach`` and ``retract`` (equal-length
+        lists ``z_c``, ``amplitude``, ``phase_deg``, …, ``stable``), ``branches``, ``folds``,
+        ``bistable``, ``jumps`` (``docs/outputs.md``).
+    """
+    p = _params(params, model)
+    d = _run(
+        _core.approach,
+        "approach",
+        progress,
+        p,
+        from_=from_,
+        to=to,
+        step=step,
+        points=points,
+        branches=branches,
+        tolerance=tolerance,
+        probe=None if probe is None else os.fspath(probe),
+    )
+    doc: Dict[str, Any] = json.loads(d["json"])
+    return doc
+
+
+def resonance(
+    params: Optional[Params] = None,
+    /,
+    *,
+    mode: int = 1,
+    from_: Optional[float] = None,
+    to: Optional[float] = None,
+    step: Optional[float] = None,
+    points: Optional[int] = None,
+    branches: bool = True,
+    tolerance: float = 1e-10,
+    probe: Optional[Union[str, "os.PathLike[str]"]] = None,
+    progress: ProgressArg = None,
+    **model: Unpack[Model],
+) -> Dict[str, Any]:
+    """Amplitude and phase against the drive frequency near mode ``mode``
+    (``afmdyn resonance``): up- and down-sweep, each value continued from the previous orbit,
+    plus the branches continued in Ω with their folds (the bent, multivalued resonance curves of
+    tapping mode).
+
+    Args:
+        from_, to: the band (default ω_k (1 ∓ max(6/Q_k, 0.02))), in Hz with ``probe``, else Ω.
+        step, points, branches, tolerance, probe: as :func:`approach`.
+
+    Returns:
+        The ``afmdyn resonance --json`` document: ``up`` and ``down`` (``omega`` or
+        ``frequency_hz``, ``amplitude``, ``phase_deg``, …), ``branches``, ``folds``,
+        ``bistable``, ``jumps``.
+    """
+    p = _params(params, model)
+    d = _run(
+        _core.resonance,
+        "resonance",
+        progress,
+        p,
+        mode=mode,
+        from_=from_,
+        to=to,
+        step=step,
+        points=points,
+        branches=branches,
+        tolerance=tolerance,
+        probe=None if probe is None else os.fspath(probe),
+    )
+    doc: Dict[str, Any] = json.loads(d["json"])
+    return doc

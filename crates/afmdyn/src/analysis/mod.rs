@@ -4,6 +4,7 @@
 //! pseudo-arclength continuation, Lyapunov exponents and the 0–1 test for chaos; the observables
 //! of a steady state (harmonics and phase, forces, sample dissipation, virial, energy balances).
 
+pub mod approach;
 pub mod attractors;
 pub mod bifurcation;
 pub mod continuation;
@@ -12,5 +13,7 @@ pub mod lyapunov;
 pub mod monodromy;
 pub mod observables;
 pub mod period;
+pub mod resonance;
 pub mod shooting;
 pub mod steady;
+pub mod stepped;

@@ -1,0 +1,198 @@
+//! `afmdyn approach` and `afmdyn resonance` end to end: the JSON contract of the issue, the
+//! files (CSV, NPY with its column header, plots) and bad input. The numerical identities are
+//! tested in `crates/afmdyn/tests/approach.rs`, the agreement with SciPy in
+//! `crates/afmdyn-py/tests/test_approach_scipy.py`.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn afmdyn(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_afmdyn"))
+        .args(args)
+        .current_dir(repo())
+        .output()
+        .expect("run afmdyn")
+}
+
+fn json(args: &[&str]) -> serde_json::Value {
+    let out = afmdyn(args);
+    assert!(
+        out.status.success(),
+        "stderr: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("one JSON document")
+}
+
+fn bad_input(args: &[&str], needle: &str) {
+    let out = afmdyn(args);
+    assert_eq!(out.status.code(), Some(2), "{args:?}");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.trim_end().lines().count(), 1, "one line: {err}");
+    assert!(
+        err.contains(needle),
+        "{args:?}: '{err}' should mention '{needle}'"
+    );
+    assert!(out.stdout.is_empty(), "no output presented as a result");
+}
+
+const KEYS: [&str; 12] = [
+    "z_c",
+    "amplitude",
+    "phase_deg",
+    "mean_deflection",
+    "peak_force",
+    "min_force",
+    "indentation",
+    "contact_fraction",
+    "min_distance",
+    "energy_dissipated",
+    "virial",
+    "stable",
+];
+
+#[test]
+fn approach_json_has_equal_length_si_arrays_and_a_marked_bistable_range() {
+    let doc = json(&[
+        "approach",
+        "--probe",
+        "examples/probe-point-mass-dmt.toml",
+        "--from",
+        "12e-9",
+        "--to",
+        "4e-9",
+        "--step",
+        "0.25e-9",
+        "--files",
+        "none",
+        "--json",
+    ]);
+    let n = 33; // 12 nm to 4 nm in steps of 0.25 nm
+    for sweep in ["approach", "retract"] {
+        for key in KEYS {
+            let a = doc[sweep][key]
+                .as_array()
+                .unwrap_or_else(|| panic!("{sweep}.{key}"));
+            assert_eq!(a.len(), n, "{sweep}.{key}");
+        }
+    }
+    let zc = |sweep: &str, i: usize| doc[sweep]["z_c"][i].as_f64().unwrap();
+    assert!((zc("approach", 0) - 12e-9).abs() < 1e-18 && (zc("retract", 0) - 4e-9).abs() < 1e-18);
+    // SI: amplitudes of nanometres, the far-away amplitude the probe's A0 = 10 nm
+    let a_far = doc["approach"]["amplitude"][0].as_f64().unwrap();
+    assert!((a_far - 10e-9).abs() < 0.01e-9, "A(12 nm) = {a_far}");
+    assert_eq!(doc["units"]["length"], "m");
+    // two folds bound one bistable range; each sweep jumps once, at a fold within one step
+    let folds: Vec<f64> = doc["folds"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    assert_eq!(folds.len(), 2, "{folds:?}");
+    let range = doc["bistable"][0].as_array().unwrap();
+    assert_eq!(range[0].as_f64().unwrap(), folds[0]);
+    assert_eq!(range[1].as_f64().unwrap(), folds[1]);
+    let jumps = doc["jumps"].as_array().unwrap();
+    assert_eq!(jumps.len(), 2, "{jumps:?}");
+    for j in jumps {
+        let fold = j["fold"].as_f64().expect("a fold at the jump");
+        for end in ["from", "to"] {
+            assert!((j[end].as_f64().unwrap() - fold).abs() <= 0.25e-9 * (1.0 + 1e-9));
+        }
+    }
+    // the branch has an unstable stretch, and every sweep point is stable
+    let br = &doc["branches"][0]["stable"];
+    assert!(br.as_array().unwrap().iter().any(|s| s == false));
+    for sweep in ["approach", "retract"] {
+        assert!(doc[sweep]["stable"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .all(|s| s == true));
+    }
+}
+
+#[test]
+fn approach_writes_csv_npy_and_plots() {
+    let dir = std::env::temp_dir().join(format!("afmdyn-approach-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let out = afmdyn(&[
+        "approach",
+        "--probe",
+        "examples/probe-point-mass-dmt.toml",
+        "--from",
+        "11e-9",
+        "--to",
+        "6e-9",
+        "--points",
+        "11",
+        "--no-branches",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let csv = std::fs::read_to_string(dir.join("approach.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    assert_eq!(&header[..3], &["sweep", "z_c", "amplitude"]);
+    assert_eq!(lines.count(), 22, "11 approach + 11 retract rows");
+    let meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("approach.npy.json")).unwrap())
+            .unwrap();
+    assert_eq!(meta["shape"][0], 22);
+    assert_eq!(meta["shape"][1], header.len());
+    for stem in ["amplitude", "phase", "dissipation", "virial", "peak-force"] {
+        assert!(dir.join(format!("approach-{stem}.png")).exists(), "{stem}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn resonance_json_has_up_and_down_sweeps() {
+    let doc = json(&[
+        "resonance",
+        "--points",
+        "7",
+        "--no-branches",
+        "--files",
+        "none",
+        "--json",
+    ]);
+    for sweep in ["up", "down"] {
+        assert_eq!(doc[sweep]["omega"].as_array().unwrap().len(), 7);
+        assert_eq!(doc[sweep]["amplitude"].as_array().unwrap().len(), 7);
+    }
+    let up = &doc["up"]["omega"];
+    assert!(up[0].as_f64().unwrap() < up[6].as_f64().unwrap());
+}
+
+#[test]
+fn bad_grids_exit_2_with_one_line() {
+    bad_input(&["approach", "--points", "1", "--files", "none"], "points");
+    bad_input(
+        &["approach", "--points", "100001", "--files", "none"],
+        "points",
+    );
+    bad_input(&["approach", "--step", "-0.1", "--files", "none"], "step");
+    bad_input(&["approach", "--step", "1e-12", "--files", "none"], "step");
+    bad_input(&["approach", "--from", "inf", "--files", "none"], "--from");
+    bad_input(
+        &["approach", "--tolerance", "0", "--files", "none"],
+        "tolerance",
+    );
+    bad_input(&["approach", "--from", "2e6", "--files", "none"], "alpha5");
+    bad_input(&["resonance", "--mode", "9", "--files", "none"], "mode");
+    bad_input(
+        &["resonance", "--from", "0", "--to", "1", "--files", "none"],
+        "omega",
+    );
+}

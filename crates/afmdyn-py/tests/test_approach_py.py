@@ -1,0 +1,45 @@
+"""``afmdyn.approach()`` and ``afmdyn.resonance()`` return the command line's documents
+(``afmdyn approach --json``, ``afmdyn resonance --json``): the same library call, so the same
+numbers, and bad input raises ValueError naming the option."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+import afmdyn
+
+REPO = Path(__file__).resolve().parents[3]
+PROBE = REPO / "examples" / "probe-point-mass-dmt.toml"
+
+
+def test_approach_equals_the_command_line(cli_json):
+    args = dict(from_=11e-9, to=5e-9, points=7, branches=False)
+    doc = afmdyn.approach(afmdyn.Params.from_probe(PROBE), probe=PROBE, **args)
+    ref = cli_json(
+        "approach", "--probe", str(PROBE), "--from", "11e-9", "--to", "5e-9", "--points", "7",
+        "--no-branches", "--files", "none",
+    )
+    for sweep in ("approach", "retract"):
+        for key in ("z_c", "amplitude", "phase_deg", "energy_dissipated", "virial", "stable"):
+            assert doc[sweep][key] == ref[sweep][key], (sweep, key)
+    assert doc["jumps"] == ref["jumps"]
+
+
+def test_resonance_equals_the_command_line(cli_json):
+    doc = afmdyn.resonance(points=5, branches=False)
+    ref = cli_json("resonance", "--points", "5", "--no-branches", "--files", "none")
+    assert doc["up"]["omega"] == ref["up"]["omega"]
+    assert doc["down"]["amplitude"] == ref["down"]["amplitude"]
+
+
+def test_bad_grids_raise_value_error():
+    with pytest.raises(ValueError, match="points"):
+        afmdyn.approach(points=1)
+    with pytest.raises(ValueError, match="step or points"):
+        afmdyn.approach(step=0.1, points=10)
+    with pytest.raises(ValueError, match="mode"):
+        afmdyn.resonance(mode=7)
+    with pytest.raises(ValueError, match="tolerance"):
+        afmdyn.resonance(tolerance=0.0)

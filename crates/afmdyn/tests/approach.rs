@@ -1,0 +1,246 @@
+//! The approach–retract curve and its branches (`analysis::approach`, `analysis::stepped`):
+//! identities that hold for any correct stepped sweep and continuation.
+//!
+//! The case is the example probe `examples/probe-point-mass-dmt.toml` (point-mass model, DMT
+//! contact, Q = 400, A0 = 10 nm, lengths in units of A0): tapping mode with coexisting
+//! attractive and repulsive states (García & San Paulo, *Phys. Rev. B* 60 (1999) 4961), so the
+//! approach and the retract jump at the two folds bounding the bistable range.
+
+use afmdyn::analysis::approach::{approach_retract, approach_spec, rest_distance};
+use afmdyn::analysis::continuation::BranchEvent;
+use afmdyn::analysis::resonance::{mode_band, resonance_curve, resonance_spec};
+use afmdyn::analysis::stepped::{
+    grid, is_fixed_point, BranchSample, Reached, Spacing, SteppedCurve, SteppedSpec, Sweep,
+};
+use afmdyn::probe::Probe;
+use afmdyn::{Params, SimError};
+use std::path::Path;
+use std::sync::OnceLock;
+
+const POINTS: usize = 41;
+
+fn probe_params() -> Params {
+    let path =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/probe-point-mass-dmt.toml");
+    Probe::load(&path).expect("example probe").params
+}
+
+/// The curve from z_c = 1.2 A0 to 0.2 A0 in 40 steps (0.025 A0), computed once.
+fn curve() -> &'static (SteppedSpec, SteppedCurve) {
+    static CURVE: OnceLock<(SteppedSpec, SteppedCurve)> = OnceLock::new();
+    CURVE.get_or_init(|| {
+        let base = probe_params();
+        let spec = approach_spec(base, 1.2, 0.2, Spacing::Points(POINTS)).expect("spec");
+        let c = approach_retract(&spec).expect("approach");
+        (spec, c)
+    })
+}
+
+fn step() -> f64 {
+    let (spec, _) = curve();
+    (spec.values[1] - spec.values[0]).abs()
+}
+
+/// The stable branch sample pair around `value` whose interpolated section state is nearest
+/// to `z`, with the interpolated amplitude: (relative state gap, amplitude).
+fn nearest_on_branches(
+    branches: &[Vec<BranchSample>],
+    value: f64,
+    z: &nalgebra::DVector<f64>,
+) -> Option<(f64, f64)> {
+    let mut best: Option<(f64, f64)> = None;
+    for b in branches {
+        for w in b.windows(2) {
+            let (p, q) = (&w[0], &w[1]);
+            let (lo, hi) = (
+                p.point.value.min(q.point.value),
+                p.point.value.max(q.point.value),
+            );
+            if !(p.point.stable && q.point.stable && (lo..=hi).contains(&value)) || lo == hi {
+                continue;
+            }
+            let t = (value - p.point.value) / (q.point.value - p.point.value);
+            let zi = &p.point.section[0] + (&q.point.section[0] - &p.point.section[0]) * t;
+            let gap = (&zi - z).norm() / (1.0 + z.norm());
+            let amp =
+                p.observables.amplitude + (q.observables.amplitude - p.observables.amplitude) * t;
+            if best.is_none_or(|(g, _)| gap < g) {
+                best = Some((gap, amp));
+            }
+        }
+    }
+    best
+}
+
+#[test]
+fn every_stable_point_is_a_fixed_point_of_the_map() {
+    let (spec, c) = curve();
+    let mut checked = 0;
+    for p in c.first.iter().chain(&c.second) {
+        let n = p.period.expect("period-1 orbits throughout this curve");
+        assert!(p.stable);
+        assert!(
+            is_fixed_point(spec, p.value, &p.state, n, 1e-8).unwrap(),
+            "sweep point at α5 = {}",
+            p.value
+        );
+        checked += 1;
+    }
+    for s in c.branches.iter().flatten().filter(|s| s.point.stable) {
+        assert!(
+            is_fixed_point(
+                spec,
+                s.point.value,
+                &s.point.section[0],
+                s.point.period,
+                1e-8
+            )
+            .unwrap(),
+            "branch point at α5 = {}",
+            s.point.value
+        );
+        checked += 1;
+    }
+    assert!(checked > 2 * POINTS);
+}
+
+#[test]
+fn stepped_sweeps_lie_on_stable_branches() {
+    let (_, c) = curve();
+    assert!(!c.branches.is_empty(), "warnings: {:?}", c.warnings);
+    let mut checked = 0;
+    for p in c.first.iter().chain(&c.second) {
+        // a branch ends at its last point inside the range: the sweep's end values may lie
+        // beyond it
+        let Some((gap, amp)) = nearest_on_branches(&c.branches, p.value, &p.state) else {
+            continue;
+        };
+        checked += 1;
+        // interpolation between branch points (arclength steps ≤ range/25) is the only error
+        assert!(gap < 5e-3, "α5 = {}: state gap {gap:e}", p.value);
+        assert!(
+            (amp - p.observables.amplitude).abs() < 5e-3,
+            "α5 = {}: A = {} on the sweep, {amp} on the branch",
+            p.value,
+            p.observables.amplitude
+        );
+    }
+    assert!(checked >= 2 * POINTS - 4, "{checked} points on branches");
+}
+
+#[test]
+fn the_bistable_range_is_bounded_by_two_folds() {
+    let (_, c) = curve();
+    assert_eq!(c.folds.len(), 2, "folds {:?}", c.folds);
+    assert_eq!(c.bistable.len(), 1, "bistable {:?}", c.bistable);
+    let (lo, hi) = c.bistable[0];
+    assert_eq!((lo, hi), (c.folds[0], c.folds[1]));
+    // approach and retract differ exactly inside the bistable range (up to one grid step)
+    let h = step();
+    for (a, r) in c.first.iter().zip(c.second.iter().rev()) {
+        assert_eq!(a.value, r.value);
+        let differ = (&a.state - &r.state).norm() > 1e-3 * (1.0 + a.state.norm());
+        let inside = a.value > lo + h && a.value < hi - h;
+        let outside = a.value < lo - h || a.value > hi + h;
+        if inside {
+            assert!(differ, "α5 = {} inside [{lo}, {hi}]: one state", a.value);
+        }
+        if outside {
+            assert!(!differ, "α5 = {} outside [{lo}, {hi}]: two states", a.value);
+        }
+    }
+    // the unstable branch between the folds: every fold joins a stable and an unstable part
+    let br = &c.branches[0];
+    for (i, s) in br.iter().enumerate() {
+        if s.point.event == Some(BranchEvent::Fold) {
+            let before = br[..i].iter().rev().find(|x| x.point.event.is_none());
+            let after = br[i + 1..].iter().find(|x| x.point.event.is_none());
+            let (b, a) = (before.expect("point before"), after.expect("point after"));
+            assert_ne!(b.point.stable, a.point.stable, "fold at {}", s.point.value);
+        }
+    }
+}
+
+#[test]
+fn each_sweep_jumps_once_at_a_fold_within_one_step() {
+    let (spec, c) = curve();
+    let h = step();
+    for (sweep, fold) in [(Sweep::First, c.folds[0]), (Sweep::Second, c.folds[1])] {
+        let jumps: Vec<_> = c.jumps.iter().filter(|j| j.sweep == sweep).collect();
+        assert_eq!(jumps.len(), 1, "{sweep:?}: {jumps:?}");
+        let j = jumps[0];
+        assert_eq!(j.fold, Some(fold));
+        assert!(
+            (j.from - fold).abs() <= h && (j.to - fold).abs() <= h,
+            "{j:?}"
+        );
+        // the approach jumps towards the sample from the attractive to the repulsive state
+        let pts = match sweep {
+            Sweep::First => &c.first,
+            Sweep::Second => &c.second,
+        };
+        assert_eq!(pts[j.index].reached, Reached::Settled);
+        let (before, after) = (&pts[j.index - 1], &pts[j.index]);
+        let ninety = std::f64::consts::FRAC_PI_2;
+        match sweep {
+            Sweep::First => {
+                assert!(before.observables.phase > ninety && after.observables.phase < ninety)
+            }
+            Sweep::Second => {
+                assert!(before.observables.phase < ninety && after.observables.phase > ninety)
+            }
+        }
+    }
+    // in z_c: the approach jumps at the lower fold, the retract at the upper one
+    let zc = |a5| rest_distance(&spec.base, a5);
+    assert!(zc(c.folds[0]) < zc(c.folds[1]));
+}
+
+#[test]
+fn far_from_the_sample_the_resonance_curve_is_the_linear_one() {
+    // the free oscillator (the sample 1e3 A0 away): every point of the up- and down-sweep has
+    // the closed-form free amplitude A0(Ω) = α2/√((1 − Ω²)² + (α3 Ω)²) (point mass)
+    let base = Params {
+        alpha5: 1e3,
+        ..probe_params()
+    };
+    let (lo, hi) = mode_band(&base, 1).unwrap();
+    let mut spec = resonance_spec(base, lo, hi, Spacing::Points(9)).unwrap();
+    spec.branches = false;
+    let c = resonance_curve(&spec).unwrap();
+    assert!(c.jumps.is_empty());
+    for p in c.first.iter().chain(&c.second) {
+        let om = p.value;
+        let a0 = base.alpha2 / f64::hypot(1.0 - om * om, base.alpha3 * om);
+        assert!(
+            (p.observables.amplitude - a0).abs() <= 1e-6 * a0,
+            "Ω = {om}: A = {}, closed form {a0}",
+            p.observables.amplitude
+        );
+    }
+}
+
+#[test]
+fn bad_grids_are_refused_with_the_field_named() {
+    let named = |r: Result<Vec<f64>, SimError>, field: &str| match r {
+        Err(SimError::OutOfRange { name, .. }) => assert_eq!(name, field),
+        other => panic!("expected an error naming {field}, got {other:?}"),
+    };
+    named(grid(1.0, 0.0, Spacing::Points(1)), "points");
+    named(grid(1.0, 0.0, Spacing::Points(100_001)), "points");
+    named(grid(1.0, 0.0, Spacing::Step(0.0)), "step");
+    named(grid(1.0, 0.0, Spacing::Step(-1.0)), "step");
+    named(grid(1.0, 0.0, Spacing::Step(1e-9)), "step");
+    named(grid(1.0, 0.0, Spacing::Step(2.0)), "step");
+    named(grid(1.0, 1.0, Spacing::Points(10)), "to");
+    assert!(matches!(
+        grid(f64::NAN, 0.0, Spacing::Points(10)),
+        Err(SimError::NotFinite { name: "from", .. })
+    ));
+    assert_eq!(grid(1.0, 0.0, Spacing::Step(0.25)).unwrap().len(), 5);
+    let base = probe_params();
+    assert!(matches!(
+        mode_band(&base, 2),
+        Err(SimError::OutOfRange { name: "mode", .. })
+    ));
+}
