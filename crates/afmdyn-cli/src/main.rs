@@ -2,6 +2,7 @@
 
 mod args;
 mod cmd_analysis;
+mod cmd_approach;
 mod cmd_modes;
 mod cmd_orbits;
 mod cmd_simulate;
@@ -47,6 +48,10 @@ enum Command {
     Continue(cmd_orbits::ContinueArgs),
     /// Lyapunov spectrum (with saltation matrices) and the 0–1 test for chaos
     Lyapunov(cmd_orbits::LyapunovArgs),
+    /// Approach–retract curve over the rest distance z_c: stepped both ways, branches, folds
+    Approach(cmd_approach::ApproachArgs),
+    /// Resonance curve near a mode: up- and down-sweep in frequency, branches, folds
+    Resonance(cmd_approach::ResonanceArgs),
 }
 
 fn run(cli: Cli) -> Result<(), CliError> {
@@ -60,6 +65,8 @@ fn run(cli: Cli) -> Result<(), CliError> {
         Command::Orbit(a) => cmd_orbits::orbit(&a),
         Command::Continue(a) => cmd_orbits::continuation(&a),
         Command::Lyapunov(a) => cmd_orbits::lyapunov(&a),
+        Command::Approach(a) => cmd_approach::approach(&a),
+        Command::Resonance(a) => cmd_approach::resonance(&a),
     }
 }
 

@@ -9,8 +9,10 @@ use crate::analysis::attractors::AttractorReport;
 use crate::analysis::continuation::BranchPoint;
 use crate::analysis::converge::ConvergenceRun;
 use crate::analysis::lyapunov::LyapunovSpectrum;
+use crate::analysis::observables::Observables;
 use crate::analysis::shooting::PeriodicOrbit;
 use crate::analysis::steady::SteadyState;
+use crate::analysis::stepped::{CurvePoint, SteppedCurve, Sweep};
 use crate::eigen::RegionSpectrum;
 use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
@@ -237,6 +239,228 @@ pub fn continuation(base: &Params, param: SweepParam, branches: &[Vec<BranchPoin
     })
 }
 
+/// Scales of a stepped-curve document ([`approach`], [`resonance`]): the factors that turn the
+/// model's lengths (g₀), forces (F̃) and energies (F̃·g₀) into the reported units, and Ω into Hz.
+/// The one place the curves are converted.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CurveUnits {
+    /// Reported length per g₀ (1, or metres per g₀).
+    pub length: f64,
+    /// Reported force per F̃ (1, or newtons).
+    pub force: f64,
+    /// Reported energy per F̃·g₀ (1, or joules).
+    pub energy: f64,
+    /// Hz per unit Ω, when frequencies are reported in Hz.
+    pub hz_per_omega: Option<f64>,
+    /// Whether the factors convert to SI (the unit names of the document).
+    pub si: bool,
+}
+
+impl CurveUnits {
+    /// The model's own units (every factor 1).
+    pub fn dimensionless() -> Self {
+        CurveUnits {
+            length: 1.0,
+            force: 1.0,
+            energy: 1.0,
+            hz_per_omega: None,
+            si: false,
+        }
+    }
+
+    /// SI units from a probe's scales ([`crate::probe::Scales`]): metres, newtons, joules;
+    /// frequencies in Hz when `hz` is set.
+    pub fn from_scales(s: &crate::probe::Scales, hz: bool) -> Self {
+        CurveUnits {
+            length: s.length_m,
+            force: s.force_n,
+            energy: s.energy_j(),
+            hz_per_omega: hz.then(|| s.frequency_hz(1.0)),
+            si: true,
+        }
+    }
+
+    fn names(&self) -> Value {
+        if self.si {
+            json!({"length": "m", "force": "N", "energy": "J", "phase": "deg",
+                   "frequency": if self.hz_per_omega.is_some() { "Hz" } else { "Ω" }})
+        } else {
+            json!({"length": "g0", "force": "F~ (k g0 for the point mass)",
+                   "energy": "F~ g0", "phase": "deg", "frequency": "Ω"})
+        }
+    }
+}
+
+/// The per-point columns of a stepped-curve document, in this order after the abscissa.
+pub const CURVE_COLUMNS: [&str; 12] = [
+    "amplitude",
+    "amplitude_ratio",
+    "phase_deg",
+    "mean_deflection",
+    "peak_force",
+    "min_force",
+    "indentation",
+    "contact_fraction",
+    "min_distance",
+    "energy_dissipated",
+    "virial",
+    "harmonic_distortion",
+];
+
+/// The [`CURVE_COLUMNS`] of one orbit's observables in `u`'s units: A, A/A₀ (A₀ the free
+/// amplitude at the same drive), φ in degrees, ⟨W⟩, max F_c, min F_c, indentation, contact
+/// fraction, min distance, E_dis, virial, THD.
+pub fn curve_row(o: &Observables, u: &CurveUnits) -> [f64; 12] {
+    [
+        o.amplitude * u.length,
+        o.amplitude / o.closed_form.free_amplitude,
+        o.phase.to_degrees(),
+        o.mean_deflection * u.length,
+        o.peak_force * u.force,
+        o.min_force * u.force,
+        o.indentation * u.length,
+        o.contact_fraction,
+        o.min_distance * u.length,
+        o.energy_dissipated * u.energy,
+        o.virial * u.energy,
+        o.thd,
+    ]
+}
+
+/// The abscissa of a stepped curve: (key, value of the swept parameter → reported value).
+type Abscissa<'a> = (&'static str, &'a dyn Fn(f64) -> f64);
+
+fn columns<'a>(
+    x: &Abscissa<'_>,
+    rows: impl Iterator<Item = (f64, &'a Observables, bool)>,
+    u: &CurveUnits,
+) -> serde_json::Map<String, Value> {
+    let mut xs = Vec::new();
+    let mut cols: Vec<Vec<f64>> = vec![Vec::new(); CURVE_COLUMNS.len()];
+    let mut stable = Vec::new();
+    for (v, o, s) in rows {
+        xs.push((x.1)(v));
+        for (c, val) in cols.iter_mut().zip(curve_row(o, u)) {
+            c.push(val);
+        }
+        stable.push(s);
+    }
+    let mut m = serde_json::Map::new();
+    m.insert(x.0.into(), json!(xs));
+    for (name, c) in CURVE_COLUMNS.iter().zip(cols) {
+        m.insert((*name).into(), json!(c));
+    }
+    m.insert("stable".into(), json!(stable));
+    m
+}
+
+fn sweep_doc(x: &Abscissa<'_>, points: &[CurvePoint], u: &CurveUnits) -> Value {
+    let mut m = columns(
+        x,
+        points.iter().map(|p| (p.value, &p.observables, p.stable)),
+        u,
+    );
+    m.insert(
+        "period".into(),
+        json!(points.iter().map(|p| p.period).collect::<Vec<_>>()),
+    );
+    m.insert(
+        "reached".into(),
+        json!(points.iter().map(|p| p.reached).collect::<Vec<_>>()),
+    );
+    Value::Object(m)
+}
+
+fn curve_doc(
+    params: &Params,
+    c: &SteppedCurve,
+    x: Abscissa<'_>,
+    names: (&str, &str),
+    u: &CurveUnits,
+) -> Value {
+    let branches: Vec<Value> = c
+        .branches
+        .iter()
+        .map(|b| {
+            let mut m = columns(
+                &x,
+                b.iter()
+                    .map(|s| (s.point.value, &s.observables, s.point.stable)),
+                u,
+            );
+            m.insert(
+                "period".into(),
+                json!(b.iter().map(|s| s.point.period).collect::<Vec<_>>()),
+            );
+            m.insert(
+                "event".into(),
+                json!(b.iter().map(|s| s.point.event).collect::<Vec<_>>()),
+            );
+            Value::Object(m)
+        })
+        .collect();
+    let sweep_name = |s: Sweep| match s {
+        Sweep::First => names.0,
+        Sweep::Second => names.1,
+    };
+    let jumps: Vec<Value> = c
+        .jumps
+        .iter()
+        .map(|j| {
+            json!({
+                "sweep": sweep_name(j.sweep),
+                "from": (x.1)(j.from),
+                "to": (x.1)(j.to),
+                "fold": j.fold.map(|f| (x.1)(f)),
+            })
+        })
+        .collect();
+    let free = c
+        .first
+        .first()
+        .map(|p| p.observables.closed_form.free_amplitude * u.length);
+    json!({
+        "params": params,
+        "units": u.names(),
+        names.0: sweep_doc(&x, &c.first, u),
+        names.1: sweep_doc(&x, &c.second, u),
+        "branches": branches,
+        "folds": c.folds.iter().map(|&f| (x.1)(f)).collect::<Vec<_>>(),
+        "bistable": c.bistable.iter().map(|&(a, b)| {
+            let (p, q) = ((x.1)(a), (x.1)(b));
+            [p.min(q), p.max(q)]
+        }).collect::<Vec<_>>(),
+        "jumps": jumps,
+        "free_amplitude": free,
+        "warnings": c.warnings,
+    })
+}
+
+/// `afmdyn approach --json`: `{"approach": {...}, "retract": {...}, "branches": [...], …}`.
+/// `approach` and `retract` hold equal-length arrays `z_c` (rest distance,
+/// [`Params::rest_distance`]) and the [`CURVE_COLUMNS`], plus `stable`, `period` (null when not
+/// period-n) and `reached` ([`crate::analysis::stepped::Reached`]); each branch the same
+/// columns with `stable`, `period` and `event` (null, "fold", "grazing", …). Also `folds` and
+/// `bistable` ([lo, hi] ranges of z_c between two folds), `jumps` ({sweep, from, to, fold}),
+/// `free_amplitude`, `units`, `params` and `warnings`.
+pub fn approach(params: &Params, c: &SteppedCurve, u: &CurveUnits) -> Value {
+    let x = |a5: f64| crate::analysis::approach::rest_distance(params, a5) * u.length;
+    curve_doc(params, c, ("z_c", &x), ("approach", "retract"), u)
+}
+
+/// `afmdyn resonance --json`: as [`approach`] with the abscissa `omega` (dimensionless Ω) or
+/// `frequency_hz` (with [`CurveUnits::hz_per_omega`]) and the sweeps `up` and `down`.
+pub fn resonance(params: &Params, c: &SteppedCurve, u: &CurveUnits) -> Value {
+    let scale = u.hz_per_omega.unwrap_or(1.0);
+    let key = if u.hz_per_omega.is_some() {
+        "frequency_hz"
+    } else {
+        "omega"
+    };
+    let x = move |om: f64| om * scale;
+    curve_doc(params, c, (key, &x), ("up", "down"), u)
+}
+
 /// `afmdyn lyapunov --json`: the Lyapunov spectrum and the 0–1 test at `params` (every field of
 /// [`LyapunovSpectrum`], so a field added there reaches both front ends).
 pub fn lyapunov(params: &Params, l: &LyapunovSpectrum) -> Value {
@@ -320,4 +544,12 @@ pub fn si(probe: &crate::probe::Probe, params: &Params, doc: &Value) -> Value {
         }
     }
     out
+}
+
+/// The observables of a steady state ([`Observables`], every field, so a field added there
+/// reaches both front ends): dimensionless units of the model (lengths g₀, time τ, forces F̃,
+/// energies F̃·g₀); phases in radians. Non-finite values (e.g. Q = ∞ without damping) become
+/// `null`.
+pub fn observables(o: &Observables) -> Value {
+    serde_json::to_value(o).expect("observables serialise")
 }

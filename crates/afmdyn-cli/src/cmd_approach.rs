@@ -1,0 +1,574 @@
+//! `afmdyn approach` (the approach–retract curve over the rest distance z_c) and `afmdyn
+//! resonance` (amplitude and phase against the drive frequency): stepped sweeps both ways plus
+//! branch continuation ([`afmdyn::analysis::stepped`]), written as CSV, NPY and plots.
+
+use crate::args::ModelArgs;
+use crate::cmd_simulate::Files;
+use crate::error::CliError;
+use crate::output::{f, write_csv, Column, NpyStream, OutDir};
+use crate::plot::{save, Figure, Series, Style};
+use afmdyn::analysis::approach::{approach_retract, approach_spec, rest_distance};
+use afmdyn::analysis::continuation::BranchEvent;
+use afmdyn::analysis::observables::{free_response, Observables};
+use afmdyn::analysis::resonance::{mode_band, resonance_curve, resonance_spec};
+use afmdyn::analysis::stepped::{Spacing, SteppedCurve, SteppedSpec, Sweep};
+use afmdyn::report::{curve_row, CurveUnits, CURVE_COLUMNS};
+use afmdyn::{CantileverModel, Params};
+use clap::Args;
+use std::path::PathBuf;
+
+/// Grid, solver and output flags shared by `approach` and `resonance`.
+#[derive(Debug, Args)]
+pub struct CurveArgs {
+    /// Grid step of the swept quantity (in the units of --from/--to); conflicts with --points
+    #[arg(long, conflicts_with = "points", allow_negative_numbers = true)]
+    step: Option<f64>,
+    /// Number of grid values, ends included (2..=100000) [default: 120]
+    #[arg(long)]
+    points: Option<usize>,
+    /// Skip the continuation of the periodic-orbit branches (stepped sweeps only)
+    #[arg(long)]
+    no_branches: bool,
+    /// Tolerance of the adaptive integrator (the exact propagator ignores it)
+    #[arg(long, default_value_t = afmdyn::analysis::stepped::DEFAULT_TOLERANCE)]
+    tolerance: f64,
+    /// Files written: all (data and plots), data (no plots) or none (only the summary)
+    #[arg(long, value_enum, default_value = "all")]
+    files: Files,
+    /// Print one JSON document
+    #[arg(long)]
+    json: bool,
+}
+
+impl CurveArgs {
+    fn spacing(&self, unit: f64) -> Result<Spacing, CliError> {
+        match (self.step, self.points) {
+            (Some(h), _) => Ok(Spacing::Step(h / unit)),
+            (None, n) => Ok(Spacing::Points(n.unwrap_or(120))),
+        }
+    }
+
+    fn configure(&self, spec: &mut SteppedSpec) -> Result<(), CliError> {
+        if !(self.tolerance.is_finite() && self.tolerance > 0.0 && self.tolerance < 1e-3) {
+            return Err(CliError::Input(format!(
+                "tolerance = {}: must be in (0, 1e-3)",
+                self.tolerance
+            )));
+        }
+        spec.integrator.tolerance = self.tolerance;
+        spec.branches = !self.no_branches;
+        Ok(())
+    }
+}
+
+/// `afmdyn approach` flags.
+#[derive(Debug, Args)]
+pub struct ApproachArgs {
+    #[command(flatten)]
+    model: ModelArgs,
+    /// Rest distance z_c where the approach starts (m with --probe, else units of g0)
+    /// [default: 1.2 × the free amplitude A0 from the sample]
+    #[arg(long, allow_negative_numbers = true)]
+    from: Option<f64>,
+    /// Rest distance z_c where the approach ends and the retract starts [default: 0.1 × A0]
+    #[arg(long, allow_negative_numbers = true)]
+    to: Option<f64>,
+    #[command(flatten)]
+    curve: CurveArgs,
+    /// Output directory (locked during the run)
+    #[arg(long, default_value = "afmdyn-out/approach")]
+    out: PathBuf,
+}
+
+/// `afmdyn resonance` flags.
+#[derive(Debug, Args)]
+pub struct ResonanceArgs {
+    #[command(flatten)]
+    model: ModelArgs,
+    /// Mode k whose natural frequency the default band surrounds (1..=N)
+    #[arg(long, default_value_t = 1)]
+    mode: usize,
+    /// Start of the band (Hz with --probe, else Ω) [default: ω_k (1 − w), w = max(6/Q_k, 0.02)]
+    #[arg(long, allow_negative_numbers = true)]
+    from: Option<f64>,
+    /// End of the band [default: ω_k (1 + w)]
+    #[arg(long, allow_negative_numbers = true)]
+    to: Option<f64>,
+    #[command(flatten)]
+    curve: CurveArgs,
+    /// Output directory (locked during the run)
+    #[arg(long, default_value = "afmdyn-out/resonance")]
+    out: PathBuf,
+}
+
+/// How one curve is labelled and converted.
+struct Labels {
+    /// File stem.
+    stem: &'static str,
+    /// Names of the two sweeps.
+    sweeps: (&'static str, &'static str),
+    /// Abscissa column name and axis label.
+    x_name: &'static str,
+    x_label: String,
+}
+
+fn event_code(e: Option<BranchEvent>) -> f64 {
+    match e {
+        None => 0.0,
+        Some(BranchEvent::Fold) => 1.0,
+        Some(BranchEvent::Grazing) => 2.0,
+        Some(BranchEvent::PeriodDoubling) => 3.0,
+        Some(BranchEvent::NeimarkSacker) => 4.0,
+    }
+}
+
+/// One table row per sweep point and branch point: (sweep code, x, columns, stable, period,
+/// event code) with the sweep's name and the event's name for the CSV.
+type Row = (String, Vec<f64>, String);
+
+fn rows(c: &SteppedCurve, x: &dyn Fn(f64) -> f64, u: &CurveUnits, l: &Labels) -> Vec<Row> {
+    let mut out = Vec::new();
+    let mut push = |name: String,
+                    code: f64,
+                    v: f64,
+                    o: &Observables,
+                    stable: bool,
+                    period: Option<usize>,
+                    event: Option<BranchEvent>| {
+        let mut r = vec![code, x(v)];
+        r.extend(curve_row(o, u));
+        r.push(if stable { 1.0 } else { 0.0 });
+        r.push(period.map_or(f64::NAN, |n| n as f64));
+        r.push(event_code(event));
+        out.push((
+            name,
+            r,
+            event.map_or(String::new(), |e| format!("{e:?}").to_lowercase()),
+        ));
+    };
+    for p in &c.first {
+        push(
+            l.sweeps.0.into(),
+            0.0,
+            p.value,
+            &p.observables,
+            p.stable,
+            p.period,
+            None,
+        );
+    }
+    for p in &c.second {
+        push(
+            l.sweeps.1.into(),
+            1.0,
+            p.value,
+            &p.observables,
+            p.stable,
+            p.period,
+            None,
+        );
+    }
+    for (k, b) in c.branches.iter().enumerate() {
+        for s in b {
+            let bp = &s.point;
+            push(
+                format!("branch-{k}"),
+                2.0 + k as f64,
+                bp.value,
+                &s.observables,
+                bp.stable,
+                Some(bp.period),
+                bp.event,
+            );
+        }
+    }
+    out
+}
+
+fn columns(l: &Labels, u: &CurveUnits) -> Vec<Column> {
+    let (len, force, energy) = if u.si {
+        ("m", "N", "J")
+    } else {
+        ("g0", "F~", "F~ g0")
+    };
+    let x_unit = match (l.x_name, u.si, u.hz_per_omega.is_some()) {
+        ("z_c", true, _) => "m",
+        ("z_c", false, _) => "g0",
+        (_, _, true) => "Hz",
+        _ => "1",
+    };
+    vec![
+        Column::new(
+            "sweep",
+            "1",
+            format!("0 {}, 1 {}, 2 + k branch k", l.sweeps.0, l.sweeps.1),
+        ),
+        Column::new(l.x_name, x_unit, l.x_label.clone()),
+        Column::new(
+            "amplitude",
+            len,
+            "first-harmonic amplitude A of the tip deflection",
+        ),
+        Column::new(
+            "amplitude_ratio",
+            "1",
+            "A/A0, A0 the free amplitude at the same drive",
+        ),
+        Column::new(
+            "phase_deg",
+            "deg",
+            "lag φ of the deflection behind the drive (90 free, >90 attractive, <90 repulsive)",
+        ),
+        Column::new("mean_deflection", len, "mean tip deflection"),
+        Column::new(
+            "peak_force",
+            force,
+            "largest tip–sample force (repulsive positive)",
+        ),
+        Column::new(
+            "min_force",
+            force,
+            "smallest tip–sample force (largest attraction)",
+        ),
+        Column::new("indentation", len, "largest indentation"),
+        Column::new("contact_fraction", "1", "fraction of the period in contact"),
+        Column::new("min_distance", len, "smallest tip–sample distance"),
+        Column::new(
+            "energy_dissipated",
+            energy,
+            "energy dissipated in the sample per period",
+        ),
+        Column::new("virial", energy, "virial (1/T)∫F_c W dτ"),
+        Column::new(
+            "harmonic_distortion",
+            "1",
+            "total harmonic distortion of the deflection",
+        ),
+        Column::new("stable", "1", "1 stable (Floquet), 0 unstable"),
+        Column::new(
+            "period",
+            "drive periods",
+            "period n of the orbit (NaN: not period-n)",
+        ),
+        Column::new(
+            "event",
+            "1",
+            "0 none, 1 fold, 2 grazing, 3 period doubling, 4 Neimark–Sacker",
+        ),
+    ]
+}
+
+/// The CSV, NPY and plots of one curve in `out`.
+fn write_files(
+    out: &OutDir,
+    files: Files,
+    c: &SteppedCurve,
+    x: &dyn Fn(f64) -> f64,
+    u: &CurveUnits,
+    l: &Labels,
+) -> Result<(), CliError> {
+    let table = rows(c, x, u, l);
+    let cols = columns(l, u);
+    let header: Vec<&str> = cols.iter().map(|c| c.name.as_str()).collect();
+    write_csv(
+        &out.join(format!("{}.csv", l.stem)),
+        &header,
+        table.iter().map(|(name, r, ev)| {
+            let mut s = vec![name.clone()];
+            s.extend(r[1..r.len() - 3].iter().map(|v| f(*v)));
+            s.push((r[r.len() - 3] == 1.0).to_string());
+            let period = r[r.len() - 2];
+            s.push(if period.is_nan() {
+                String::new()
+            } else {
+                f(period)
+            });
+            s.push(ev.clone());
+            s
+        }),
+    )?;
+    let mut npy = NpyStream::create(&out.join(format!("{}.npy", l.stem)), cols)?;
+    for (_, r, _) in &table {
+        npy.push(r)?;
+    }
+    npy.finish()?;
+    if files == Files::All {
+        plots(out, c, x, u, l)?;
+    }
+    Ok(())
+}
+
+/// One value of the observables, by CURVE_COLUMNS index.
+fn col(o: &Observables, u: &CurveUnits, k: usize) -> f64 {
+    curve_row(o, u)[k]
+}
+
+fn plots(
+    out: &OutDir,
+    c: &SteppedCurve,
+    x: &dyn Fn(f64) -> f64,
+    u: &CurveUnits,
+    l: &Labels,
+) -> Result<(), CliError> {
+    let unit = |base: &str| {
+        if u.si {
+            base.to_string()
+        } else {
+            String::new()
+        }
+    };
+    let idx = |name: &str| {
+        CURVE_COLUMNS
+            .iter()
+            .position(|c| *c == name)
+            .expect("column")
+    };
+    let panels = [
+        ("amplitude_ratio", "A/A0".to_string(), "amplitude"),
+        ("phase_deg", "phase lag φ (deg)".to_string(), "phase"),
+        (
+            "energy_dissipated",
+            format!("E_dis per period {}", unit("(J)")),
+            "dissipation",
+        ),
+        ("virial", format!("virial {}", unit("(J)")), "virial"),
+        (
+            "peak_force",
+            format!("peak force {}", unit("(N)")),
+            "peak-force",
+        ),
+    ];
+    for (name, y_label, suffix) in panels {
+        let k = idx(name);
+        let mut series = Vec::new();
+        // branches first (underneath): unstable parts dotted, stable parts as small dots
+        for b in &c.branches {
+            for stable in [false, true] {
+                let pts: Vec<(f64, f64)> = b
+                    .iter()
+                    .filter(|s| s.point.stable == stable)
+                    .map(|s| (x(s.point.value), col(&s.observables, u, k)))
+                    .collect();
+                if !pts.is_empty() {
+                    series.push(Series {
+                        label: String::new(),
+                        points: pts,
+                        style: Style::Dots,
+                        color: if stable { 7 } else { 3 },
+                    });
+                }
+            }
+        }
+        if let Some(s) = series.iter_mut().find(|s| s.color == 3) {
+            s.label = "unstable branch (dotted)".into();
+        }
+        if let Some(s) = series.iter_mut().find(|s| s.color == 7) {
+            s.label = "stable branch (continuation)".into();
+        }
+        for (sweep, style, color, label) in [
+            (&c.first, Style::Line, 0, format!("{} (solid)", l.sweeps.0)),
+            (
+                &c.second,
+                Style::Dashed,
+                1,
+                format!("{} (dashed)", l.sweeps.1),
+            ),
+        ] {
+            series.push(Series {
+                label,
+                points: sweep
+                    .iter()
+                    .map(|p| (x(p.value), col(&p.observables, u, k)))
+                    .collect(),
+                style,
+                color,
+            });
+        }
+        let mut marks = Vec::new();
+        for j in &c.jumps {
+            let sw = match j.sweep {
+                Sweep::First => &c.first,
+                Sweep::Second => &c.second,
+            };
+            for p in &sw[j.index - 1..=j.index] {
+                marks.push((x(p.value), col(&p.observables, u, k)));
+            }
+        }
+        if !marks.is_empty() {
+            series.push(Series {
+                label: "jumps".into(),
+                points: marks,
+                style: Style::Points,
+                color: 2,
+            });
+        }
+        let folds: Vec<(f64, f64)> = c
+            .branches
+            .iter()
+            .flatten()
+            .filter(|s| s.point.event == Some(BranchEvent::Fold))
+            .map(|s| (x(s.point.value), col(&s.observables, u, k)))
+            .collect();
+        if !folds.is_empty() {
+            series.push(Series {
+                label: "folds (saddle-node)".into(),
+                points: folds,
+                style: Style::Points,
+                color: 4,
+            });
+        }
+        save(
+            out.path(),
+            &format!("{}-{suffix}", l.stem),
+            &Figure {
+                title: format!("{} curve: {}", l.stem, name.replace('_', " ")),
+                x_label: l.x_label.clone(),
+                y_label,
+                series,
+                shade: c
+                    .bistable
+                    .iter()
+                    .map(|&(a, b)| {
+                        let (p, q) = (x(a), x(b));
+                        (p.min(q), p.max(q))
+                    })
+                    .collect(),
+            },
+        )?;
+    }
+    Ok(())
+}
+
+fn summary(c: &SteppedCurve, x: &dyn Fn(f64) -> f64, l: &Labels, out: Option<&OutDir>) {
+    println!(
+        "{}: {} values each way, {} branch(es) with {} points",
+        l.stem,
+        c.first.len(),
+        c.branches.len(),
+        c.branches.iter().map(Vec::len).sum::<usize>()
+    );
+    for fv in &c.folds {
+        println!("  fold at {} = {:.6e}", l.x_name, x(*fv));
+    }
+    for &(a, b) in &c.bistable {
+        let (p, q) = (x(a), x(b));
+        println!(
+            "  bistable for {} in [{:.6e}, {:.6e}]",
+            l.x_name,
+            p.min(q),
+            p.max(q)
+        );
+    }
+    for j in &c.jumps {
+        println!(
+            "  {} jumps between {} = {:.6e} and {:.6e}{}",
+            match j.sweep {
+                Sweep::First => l.sweeps.0,
+                Sweep::Second => l.sweeps.1,
+            },
+            l.x_name,
+            x(j.from),
+            x(j.to),
+            j.fold
+                .map_or(String::new(), |fv| format!(" (fold at {:.6e})", x(fv)))
+        );
+    }
+    for w in &c.warnings {
+        eprintln!("afmdyn: warning: {w}");
+    }
+    if let Some(o) = out {
+        println!("outputs in {}", o.path().display());
+    }
+}
+
+fn check_finite(name: &str, v: Option<f64>) -> Result<(), CliError> {
+    match v {
+        Some(x) if !x.is_finite() => Err(CliError::Input(format!(
+            "{name} = {x}: must be a finite number"
+        ))),
+        _ => Ok(()),
+    }
+}
+
+/// Run `afmdyn approach`.
+pub fn approach(a: &ApproachArgs) -> Result<(), CliError> {
+    let (base, probe) = a.model.resolve(Params::default())?;
+    check_finite("--from", a.from)?;
+    check_finite("--to", a.to)?;
+    let units = probe.as_ref().map_or_else(CurveUnits::dimensionless, |p| {
+        CurveUnits::from_scales(&p.scales, false)
+    });
+    let a0 = free_response(&CantileverModel::new(&base)?)?.amplitude;
+    let offset = base.contact_law.distance_offset();
+    let from = a.from.map_or(1.2 * a0 + offset, |v| v / units.length);
+    let to = a.to.map_or(0.1 * a0 + offset, |v| v / units.length);
+    let mut spec = approach_spec(base, from, to, a.curve.spacing(units.length)?)?;
+    a.curve.configure(&mut spec)?;
+    let out = (a.curve.files != Files::None)
+        .then(|| OutDir::lock(&a.out))
+        .transpose()?;
+    let c = approach_retract(&spec)?;
+    let x = |v: f64| rest_distance(&base, v) * units.length;
+    let labels = Labels {
+        stem: "approach",
+        sweeps: ("approach", "retract"),
+        x_name: "z_c",
+        x_label: format!(
+            "rest distance z_c{}",
+            if units.si { " (m)" } else { " (g0)" }
+        ),
+    };
+    if let Some(o) = &out {
+        write_files(o, a.curve.files, &c, &x, &units, &labels)?;
+    }
+    if a.curve.json {
+        println!("{}", afmdyn::report::approach(&base, &c, &units));
+    } else {
+        summary(&c, &x, &labels, out.as_ref());
+    }
+    Ok(())
+}
+
+/// Run `afmdyn resonance`.
+pub fn resonance(a: &ResonanceArgs) -> Result<(), CliError> {
+    let (base, probe) = a.model.resolve(Params::default())?;
+    check_finite("--from", a.from)?;
+    check_finite("--to", a.to)?;
+    let units = probe.as_ref().map_or_else(CurveUnits::dimensionless, |p| {
+        CurveUnits::from_scales(&p.scales, true)
+    });
+    let hz = units.hz_per_omega.unwrap_or(1.0);
+    let (lo, hi) = mode_band(&base, a.mode)?;
+    let from = a.from.map_or(lo, |v| v / hz);
+    let to = a.to.map_or(hi, |v| v / hz);
+    let mut spec = resonance_spec(base, from, to, a.curve.spacing(hz)?)?;
+    a.curve.configure(&mut spec)?;
+    let out = (a.curve.files != Files::None)
+        .then(|| OutDir::lock(&a.out))
+        .transpose()?;
+    let c = resonance_curve(&spec)?;
+    let x = |v: f64| v * hz;
+    let labels = Labels {
+        stem: "resonance",
+        sweeps: ("up", "down"),
+        x_name: if units.hz_per_omega.is_some() {
+            "frequency_hz"
+        } else {
+            "omega"
+        },
+        x_label: if units.hz_per_omega.is_some() {
+            "drive frequency (Hz)".into()
+        } else {
+            "drive frequency Ω".into()
+        },
+    };
+    if let Some(o) = &out {
+        write_files(o, a.curve.files, &c, &x, &units, &labels)?;
+    }
+    if a.curve.json {
+        println!("{}", afmdyn::report::resonance(&base, &c, &units));
+    } else {
+        summary(&c, &x, &labels, out.as_ref());
+    }
+    Ok(())
+}

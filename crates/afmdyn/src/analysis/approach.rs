@@ -1,0 +1,46 @@
+//! The amplitude-modulation approach–retract curve: the steady state against the rest
+//! distance z_c between tip and sample ([`Params::rest_distance`]), stepped towards the sample
+//! and back, with the periodic-orbit branches continued in the gap α5 = z_c − offset
+//! ([`Params::alpha5_for_rest_distance`]). The attractive (low) and repulsive (high) states of
+//! tapping mode, the unstable branch between them, the bistable range bounded by folds and the
+//! jumps of the stepped curves (García & San Paulo, *Phys. Rev. B* 60 (1999) 4961; Guzman,
+//! Garcia & Garcia, *Beilstein J. Nanotechnol.* 6 (2015) 369) come from the shared driver
+//! [`super::stepped`].
+
+use super::stepped::{grid, stepped_sweep, Spacing, SteppedCurve, SteppedSpec};
+use crate::error::SimError;
+use crate::params::{Params, SweepParam};
+
+/// The stepped-sweep spec of an approach from the larger to the smaller of `z_from` and `z_to`
+/// (units of g₀) with the given spacing of z_c, then the retract; the swept parameter is α5.
+///
+/// # Errors
+/// As [`grid`]: non-finite or equal ends, a bad step, more than 100 000 points.
+pub fn approach_spec(
+    base: Params,
+    z_from: f64,
+    z_to: f64,
+    spacing: Spacing,
+) -> Result<SteppedSpec, SimError> {
+    let (far, near) = (z_from.max(z_to), z_from.min(z_to));
+    let z_c = grid(far, near, spacing)?;
+    let values = z_c
+        .iter()
+        .map(|&z| base.alpha5_for_rest_distance(z))
+        .collect();
+    Ok(SteppedSpec::new(base, SweepParam::Alpha5, values))
+}
+
+/// The rest distance z_c of the gap value α5 = `alpha5` under `base`'s contact law.
+pub fn rest_distance(base: &Params, alpha5: f64) -> f64 {
+    base.with(SweepParam::Alpha5, alpha5).rest_distance()
+}
+
+/// Run the approach (the first sweep of the result), the retract (the second) and the branch
+/// continuation of `spec` (from [`approach_spec`]).
+///
+/// # Errors
+/// As [`stepped_sweep`].
+pub fn approach_retract(spec: &SteppedSpec) -> Result<SteppedCurve, SimError> {
+    stepped_sweep(spec)
+}

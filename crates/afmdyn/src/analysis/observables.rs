@@ -1,0 +1,635 @@
+//! Observables of a steady state: harmonics and phase of the tip deflection, forces, contact
+//! statistics, the energy dissipated in the sample, the virial, a per-mode energy balance, and
+//! the closed forms of the AFM literature beside the direct integrals.
+//!
+//! Everything is computed from the integrator's dense output over an integer number of drive
+//! periods: on every smooth piece (between steps and events, further cut so that each piece is
+//! short against the shortest harmonic period and the fastest eigenvalue) a 16-point
+//! Gauss–Legendre rule integrates each Fourier coefficient and each integral, so the results are
+//! exact to round-off for the exact propagator and to the interpolant's accuracy otherwise. No
+//! uniform sampling. Extrema (peak force, minimum distance) are located on the dense output by a
+//! safeguarded Newton iteration ([`crate::roots`]), not taken over quadrature nodes.
+//!
+//! Units are the model's: time τ (eq. 5), lengths in g₀, forces F̃ of [`crate::contact`] (the
+//! unit of α4 V_T; k g₀ for the point-mass model), energies F̃·g₀.
+//!
+//! # Conventions
+//! * **Harmonics.** W(1,τ) ≈ ⟨W⟩ + Σₙ Aₙ sin(n(Ωτ + ψ) − φₙ), ψ = [`Params::drive_phase`]
+//!   (drive ∝ sin(Ωτ + ψ)), so φ = φ₁ is the lag of the deflection behind the drive: 90° at the
+//!   free resonance, > 90° in the attractive and < 90° in the repulsive regime (García & San
+//!   Paulo, *Phys. Rev. B* 60 (1999) 4961). Phases are reported in (−π/2, 3π/2], so lags near 0
+//!   and near π do not wrap.
+//! * **Sample dissipation.** E_dis = −∮ F_c ḋ dτ per period, d the tip–sample distance
+//!   (ḋ = V̇_T; for the point mass ḋ = ż), plus the kinetic-energy losses of impacts
+//!   ([`CantileverModel::impact_energy`]). Conservative parts of F_c integrate to zero over a
+//!   closed orbit, so E_dis > 0 is the energy the sample takes per cycle.
+//! * **Virial.** V = (1/T)∫ F_c W(1,τ) dτ (with the impulses P W(τ_k) of impacts), F_c repulsive
+//!   positive and W positive away from the sample: V < 0 in the repulsive regime (φ < 90°),
+//!   V > 0 in the attractive one (φ > 90°), the sign convention of San Paulo & García, *Phys.
+//!   Rev. B* 64 (2001) 193411, where V_cf = −(k A A₀/(2Q)) cos φ.
+//!
+//! # Exact period balances (point-mass model)
+//! With z'' + (1/Q) z' + z = F₀ cos Ωτ + F_c (k = 1, ω₀ = 1, [`crate::params::Structure`]) and
+//! z = ⟨z⟩ + Σ Aₙ cos(nΩτ − φₙ) on a periodic orbit:
+//! * multiplying by z' and integrating over a period (∮ z''z' = ∮ z z' = 0, and
+//!   ∮ z'² = πΩ Σ n²Aₙ² by Parseval):
+//!   E_dis = −∮ F_c z' = π F₀ A₁ sin φ − (π/Q) Ω Σₙ n²Aₙ²;
+//! * multiplying by z and averaging (⟨z''z⟩ = −⟨z'²⟩, ⟨z z'⟩ = 0, Parseval):
+//!   V = ⟨F_c z⟩ = ⟨z⟩² + ½ Σₙ (1 − n²Ω²) Aₙ² − ½ F₀ A₁ cos φ.
+//!
+//! At the drive frequency of the AFM literature, ω = ω₀, the free amplitude is A₀ = Q F₀/k, and
+//! these become the closed forms of Cleveland et al. (*Appl. Phys. Lett.* 72 (1998) 2613) and
+//! Anczykowski et al. (*Appl. Surf. Sci.* 140 (1999) 376),
+//! E_cf = (π k A²/Q)[(A₀/A) sin φ − ω/ω₀], and of San Paulo & García (2001), V_cf, plus the
+//! terms they neglect:
+//! E_cf − E_dis = (π k/Q)(ω/ω₀) Σ_{n≥2} n²Aₙ²,   V − V_cf = k⟨z⟩² + (k/2) Σ_{n≥2}(1 − n²ω²/ω₀²)Aₙ².
+//! Off resonance, with A₀ the free amplitude at ω (what [`ClosedForms`] uses, F₀ ≠ kA₀/Q),
+//! E_cf − E_dis gains π A sin φ (kA₀/Q − F₀) and V − V_cf gains
+//! (k/2)(1 − ω²/ω₀²)A² − ½ A cos φ (F₀ − kA₀/Q).
+//! The sums over all n ≥ 2 are exact here through Parseval ([`Observables::higher_sq`],
+//! [`Observables::higher_n2_sq`]), not truncated at [`ObservableOptions::harmonics`].
+//!
+//! # Per-mode energy balance
+//! Row j of M ä + C ȧ + K a = F^I(τ) + φ F_c (free-region matrices, eqs. 11–14; the contact
+//! enters through F_c only) times ȧ_j, integrated over the window:
+//! ΔE_j = drive_j − beam_damping_j − sample_j − coupling_j, E_j = ½M_jj ȧ_j² + ½K_jj a_j²,
+//! drive_j = ∫F^I_j ȧ_j, beam_damping_j = ∫(Cȧ)_j ȧ_j, sample_j = −∫φ_j F_c ȧ_j (with the
+//! impulse P φ_j (ȧ_j⁻ + ȧ_j⁺)/2 of an impact), coupling_j = ∫ȧ_j Σ_{k≠j}(M_jk ä_k + K_jk a_k)
+//! (the tip mass α1 couples the modes through M). Σ_j coupling_j is the change of
+//! ½ȧᵀM_off ȧ + ½aᵀK_off a: zero over a period of a periodic orbit. Σ_j sample_j = −∮F_c Ẇ
+//! differs from E_dis by the work of F_c on the moving base, ∮F_c α2Ω cos Ωτ (beam only).
+
+use crate::contact::{TipSample, TipSampleLaw};
+use crate::eigen::{damped_eigenvalues, natural_modes};
+use crate::error::SimError;
+use crate::galerkin::Region;
+use crate::integrate::{build, Integrator, IntegratorOptions};
+use crate::model::CantileverModel;
+use crate::params::Params;
+use crate::roots::{extremum, safeguarded_newton};
+use crate::system::EventKind;
+use gauss_quad::legendre::GaussLegendre;
+use nalgebra::DVector;
+use serde::Serialize;
+use std::f64::consts::{PI, TAU};
+use std::num::NonZeroUsize;
+
+/// Largest accepted [`ObservableOptions::periods`].
+pub const MAX_PERIODS: usize = 1_000_000;
+/// Largest accepted [`ObservableOptions::harmonics`].
+pub const MAX_HARMONICS: usize = 10_000;
+/// Gauss–Legendre nodes per smooth piece.
+const GL_NODES: usize = 16;
+
+/// What to compute.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct ObservableOptions {
+    /// Number of drive periods T = 2π/Ω to integrate over, in 1..=[`MAX_PERIODS`] (a multiple of
+    /// the orbit's period for a period-n orbit).
+    pub periods: usize,
+    /// Highest harmonic n reported in [`Observables::harmonics`], in 1..=[`MAX_HARMONICS`]
+    /// (default 10).
+    pub harmonics: usize,
+}
+
+impl Default for ObservableOptions {
+    fn default() -> Self {
+        ObservableOptions {
+            periods: 1,
+            harmonics: 10,
+        }
+    }
+}
+
+/// One harmonic of the tip deflection: A_n sin(n(Ωτ + ψ) − φ_n).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Harmonic {
+    /// Order n ≥ 1 (multiple of the drive frequency Ω).
+    pub n: usize,
+    /// Amplitude A_n ≥ 0 (units of g₀).
+    pub amplitude: f64,
+    /// Lag φ_n behind n times the drive phase, rad, in (−π/2, 3π/2].
+    pub phase: f64,
+}
+
+/// Energy balance of one mode, per drive period (energies F̃·g₀; module docs):
+/// energy_change = drive − beam_damping − sample − coupling + residual.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ModeBalance {
+    /// Mode index j (0-based).
+    pub mode: usize,
+    /// ∫F^I_j ȧ_j dτ: work of the drive (eq. 14) on mode j.
+    pub drive: f64,
+    /// ∫(C^I ȧ)_j ȧ_j dτ: beam damping (eq. 12).
+    pub beam_damping: f64,
+    /// −∫φ_j F_c ȧ_j dτ (with impulses): energy mode j gives to the tip–sample force.
+    pub sample: f64,
+    /// ∫ȧ_j Σ_{k≠j}(M_jk ä_k + K_jk a_k) dτ: energy mode j passes to the other modes.
+    pub coupling: f64,
+    /// Change of E_j = ½M_jj ȧ_j² + ½K_jj a_j² over the window (0 on a periodic orbit).
+    pub energy_change: f64,
+    /// energy_change − (drive − beam_damping − sample − coupling): round-off.
+    pub residual: f64,
+}
+
+/// The free linear response of the tip at the drive frequency: W = A₀ sin(Ωτ + ψ − φ₀).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct FreeResponse {
+    /// Free amplitude A₀ = |φᵀ(K − Ω²M + iΩC)⁻¹F̂| (units of g₀).
+    pub amplitude: f64,
+    /// Lag φ₀ behind the drive, rad, in (−π/2, 3π/2].
+    pub phase: f64,
+}
+
+/// The closed forms of the AFM literature from (A, φ, A₀, Q, k), evaluated for the
+/// mode-1 equivalent point mass (module docs). Exact balances only for the point-mass model at
+/// ω = ω₀; elsewhere an approximation, reported to show how far it is off.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ClosedForms {
+    /// A₀: free tip amplitude at Ω from the linear free response ([`free_response`]), g₀.
+    pub free_amplitude: f64,
+    /// Lag of the free response behind the drive, rad.
+    pub free_phase: f64,
+    /// Q of mode 1, 1/(2ζ₁) from its damped eigenvalue (eqs. 20–21); 1/α3 for the point mass.
+    pub quality_factor: f64,
+    /// ω₀: undamped natural frequency of mode 1 (units of the τ scale; 1 for the point mass).
+    pub natural_frequency: f64,
+    /// k̃ = ω₁²/(φᵀx₁)², x₁ the mass-normalised mode 1: the stiffness of the equivalent point
+    /// mass at the tip (Melcher, Hu & Raman, *Appl. Phys. Lett.* 91 (2007) 053101); 1 for the
+    /// point mass. Units F̃/g₀.
+    pub stiffness: f64,
+    /// F₀ = k̃ A₀ √((1 − Ω²/ω₀²)² + (Ω/(ω₀Q))²): the harmonic force that gives A₀ in the
+    /// equivalent oscillator (α2 for the point mass).
+    pub drive_force: f64,
+    /// Cleveland/Anczykowski E_cf = (π k A²/Q)[(A₀/A) sin φ − Ω/ω₀] per period.
+    pub energy_dissipated: f64,
+    /// San Paulo & García V_cf = −(k A A₀/(2Q)) cos φ.
+    pub virial: f64,
+}
+
+/// Observables of a steady state over an integer number of drive periods. Lengths in g₀, time
+/// τ, forces F̃, energies F̃·g₀ (module docs for conventions and sources).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Observables {
+    /// Number of drive periods integrated over.
+    pub periods: usize,
+    /// A₁: first-harmonic amplitude of the tip deflection W(1,τ) (point mass: z).
+    pub amplitude: f64,
+    /// φ = φ₁: lag of the deflection behind the drive, rad, in (−π/2, 3π/2]; in [0, π] for a
+    /// driven damped response.
+    pub phase: f64,
+    /// Harmonics n = 1..=[`ObservableOptions::harmonics`].
+    pub harmonics: Vec<Harmonic>,
+    /// Total harmonic distortion √(Σ_{n≥2} A_n²)/A₁ over all n (Parseval, [`Self::higher_sq`]).
+    pub thd: f64,
+    /// ⟨W⟩: mean deflection.
+    pub mean_deflection: f64,
+    /// Σ_{n≥2} A_n² over all n = 2(⟨W²⟩ − ⟨W⟩²) − A₁² (Parseval).
+    pub higher_sq: f64,
+    /// Σ_{n≥2} n² A_n² over all n = 2⟨Ẇ²⟩/Ω² − A₁² (Parseval; ⟨Ẇ⟩ = 0 on a periodic orbit).
+    pub higher_n2_sq: f64,
+    /// ⟨F_c⟩: time-averaged tip–sample force (with impulses); for the point mass the static
+    /// balance gives ⟨z⟩ = ⟨F_c⟩/k on a periodic orbit.
+    pub mean_force: f64,
+    /// Largest finite F_c (repulsive positive; impulses of the impact law excluded).
+    pub peak_force: f64,
+    /// Smallest F_c (the largest attraction when negative).
+    pub min_force: f64,
+    /// Largest indentation max(−V_T, 0).
+    pub indentation: f64,
+    /// Fraction of the time in contact (V_T ≤ 0; sticking for the impact law).
+    pub contact_fraction: f64,
+    /// Time in contact per drive period, τ.
+    pub contact_time: f64,
+    /// Minimum tip–sample distance d = V_T + [`crate::ContactLaw::distance_offset`].
+    pub min_distance: f64,
+    /// Entries into contact per period (smooth laws), or impacts per period including the
+    /// plastic one that starts sticking (impact law).
+    pub impacts_per_period: f64,
+    /// E_dis = −∮F_c ḋ dτ + impact losses, per period.
+    pub energy_dissipated: f64,
+    /// Of which the kinetic-energy losses of impacts, per period.
+    pub impact_loss: f64,
+    /// V = (1/T)∫F_c W(1,τ) dτ (with impulses).
+    pub virial: f64,
+    /// Per-mode energy balance, per period, one entry per mode.
+    pub mode_balance: Vec<ModeBalance>,
+    /// The closed forms from (A, φ, A₀, Q, k).
+    pub closed_form: ClosedForms,
+}
+
+/// The free linear response of the tip at the drive frequency Ω, from the model's complex
+/// amplitude H ([`CantileverModel::free_tip_response`], W(1,τ) = Im(H e^{i(Ωτ + ψ)})):
+/// A₀ = |H|, lag φ₀ = −arg H. The one place the free amplitude of the closed forms comes from.
+///
+/// # Errors
+/// [`SimError::OutOfRange`] when Ω is at an undamped natural frequency (no steady state).
+pub fn free_response(model: &CantileverModel) -> Result<FreeResponse, SimError> {
+    let h = model.free_tip_response()?;
+    Ok(FreeResponse {
+        amplitude: h.norm(),
+        phase: wrap_phase(-h.arg()),
+    })
+}
+
+/// The closed forms for amplitude `a` and lag `phase` of `model` (see [`ClosedForms`]).
+///
+/// # Errors
+/// As [`free_response`].
+pub fn closed_forms(model: &CantileverModel, a: f64, phase: f64) -> Result<ClosedForms, SimError> {
+    let free = free_response(model)?;
+    let g = model.galerkin().region(Region::Free);
+    let modes = natural_modes(g);
+    let w0 = modes.omega[0];
+    let tip_disp = model.tip().dot(&modes.vectors.column(0));
+    let k = w0 * w0 / (tip_disp * tip_disp);
+    let eig = damped_eigenvalues(g);
+    let first = eig.iter().find(|e| e.im > 0.0).or(eig.first());
+    let q = first.map_or(f64::INFINITY, |e| 0.5 / e.zeta);
+    let r = model.omega() / w0;
+    let a0 = free.amplitude;
+    Ok(ClosedForms {
+        free_amplitude: a0,
+        free_phase: free.phase,
+        quality_factor: q,
+        natural_frequency: w0,
+        stiffness: k,
+        drive_force: k * a0 * ((1.0 - r * r).powi(2) + (r / q).powi(2)).sqrt(),
+        energy_dissipated: PI * k * a * a / q * ((a0 / a) * phase.sin() - r),
+        virial: -k * a * a0 / (2.0 * q) * phase.cos(),
+    })
+}
+
+/// A phase in (−π/2, 3π/2].
+fn wrap_phase(p: f64) -> f64 {
+    let mut x = p.rem_euclid(TAU);
+    if x > 1.5 * PI {
+        x -= TAU;
+    }
+    x
+}
+
+/// Values of the dense output at one τ of a smooth piece.
+struct Node {
+    z: DVector<f64>,
+    dz: DVector<f64>,
+    w: f64,
+    wd: f64,
+    v: [f64; 3],
+    f: f64,
+}
+
+/// Running integrals of [`observe`].
+struct Acc {
+    mean: f64,
+    w2: f64,
+    wd2: f64,
+    cos: Vec<f64>,
+    sin: Vec<f64>,
+    e_dis: f64,
+    impact_loss: f64,
+    virial: f64,
+    force: f64,
+    contact_time: f64,
+    impacts: usize,
+    drive: Vec<f64>,
+    damp: Vec<f64>,
+    sample: Vec<f64>,
+    coupling: Vec<f64>,
+    f_max: f64,
+    f_min: f64,
+    v_min: f64,
+}
+
+/// Observables over `opts.periods` drive periods starting at the integrator's current (τ, z),
+/// assumed on the steady state; τ need not be a multiple of T. The integrator is left at the
+/// end of the window.
+///
+/// # Errors
+/// [`SimError::OutOfRange`] for `periods` outside 1..=[`MAX_PERIODS`] or `harmonics` outside
+/// 1..=[`MAX_HARMONICS`], or from [`free_response`]; [`SimError`] from the integrator.
+pub fn observe(
+    integ: &mut dyn Integrator,
+    opts: &ObservableOptions,
+) -> Result<Observables, SimError> {
+    if !(1..=MAX_PERIODS).contains(&opts.periods) {
+        return Err(SimError::out_of_range(
+            "periods",
+            opts.periods,
+            "must be in 1..=1000000 (an integer number of drive periods)",
+        ));
+    }
+    if !(1..=MAX_HARMONICS).contains(&opts.harmonics) {
+        return Err(SimError::out_of_range(
+            "harmonics",
+            opts.harmonics,
+            "must be in 1..=10000 (the highest harmonic reported)",
+        ));
+    }
+    let model = integ.model().clone();
+    let p: Params = *model.params();
+    let n = model.modes();
+    let nh = opts.harmonics;
+    let period = model.period();
+    let om = p.omega;
+    let psi = p.drive_phase();
+    let law = TipSample {
+        law: p.contact_law,
+        stiffness: p.alpha4,
+        damping: p.alpha6,
+    };
+    let free = model.galerkin().region(Region::Free).clone();
+    let tip = model.tip().clone();
+    // pieces short against the highest harmonic and the fastest eigenvalue: |λ| h ≤ π/2
+    let rho = [Region::Free, Region::Contact]
+        .iter()
+        .flat_map(|&r| {
+            model
+                .dynamics(r)
+                .a
+                .complex_eigenvalues()
+                .iter()
+                .map(|l| l.norm())
+                .collect::<Vec<_>>()
+        })
+        .fold(0.0f64, f64::max);
+    let h_max = (period / (2.0 * nh as f64)).min(PI / rho.max(1e-300));
+    let mut gl: Vec<(f64, f64)> = GaussLegendre::new(NonZeroUsize::new(GL_NODES).expect("16"))
+        .iter()
+        .map(|(x, w)| (*x, *w))
+        .collect();
+    gl.sort_by(|a, b| a.0.total_cmp(&b.0));
+
+    let tau_start = integ.tau();
+    let end = tau_start + opts.periods as f64 * period;
+    let z_start = integ.state().clone();
+    let mut acc = Acc {
+        mean: 0.0,
+        w2: 0.0,
+        wd2: 0.0,
+        cos: vec![0.0; nh],
+        sin: vec![0.0; nh],
+        e_dis: 0.0,
+        impact_loss: 0.0,
+        virial: 0.0,
+        force: 0.0,
+        contact_time: 0.0,
+        impacts: 0,
+        drive: vec![0.0; n],
+        damp: vec![0.0; n],
+        sample: vec![0.0; n],
+        coupling: vec![0.0; n],
+        f_max: f64::NEG_INFINITY,
+        f_min: f64::INFINITY,
+        v_min: f64::INFINITY,
+    };
+    let mut fi = DVector::zeros(n);
+    while integ.tau() < end {
+        let step = integ.step(end)?;
+        let r = step.region;
+        let (t0, t1) = (step.tau0, step.tau1);
+        if t1 > t0 {
+            if r == Region::Contact {
+                acc.contact_time += t1 - t0;
+            }
+            let pieces = ((t1 - t0) / h_max).ceil().max(1.0) as usize;
+            let hp = (t1 - t0) / pieces as f64;
+            let eval = |integ: &mut dyn Integrator, tau: f64| -> Node {
+                let z = integ.dense_state(tau);
+                let mut dz = DVector::zeros(2 * n);
+                model.rhs(r, tau, &z, &mut dz);
+                let w = tip.dot(&z.rows(0, n));
+                let wd = tip.dot(&z.rows(n, n));
+                let wdd = tip.dot(&dz.rows(n, n));
+                let v = model.v_t_from_tip(tau, [w, wd, wdd]);
+                let f = model.contact_force(r, tau, &z);
+                Node { z, dz, w, wd, v, f }
+            };
+            // dF_c/dτ: analytic for the smooth laws; a central difference inside the piece
+            // [lo, hi] for the sticking force of the impact law
+            let sticking = r == Region::Contact && p.contact_law.restitution().is_some();
+            let rate = |integ: &mut dyn Integrator, t: f64, nd: &Node, lo: f64, hi: f64| {
+                if !sticking {
+                    return force_rate(&law, r, nd);
+                }
+                let h = 1e-5 * (hi - lo);
+                let (tm, tp) = ((t - h).max(lo), (t + h).min(hi));
+                (eval(integ, tp).f - eval(integ, tm).f) / (tp - tm)
+            };
+            for k in 0..pieces {
+                let a = t0 + k as f64 * hp;
+                let b = if k + 1 == pieces { t1 } else { a + hp };
+                let half = 0.5 * (b - a);
+                let mid = 0.5 * (a + b);
+                // nodes for the extremum scan: the piece's ends and its GL nodes, in order
+                let mut scan: Vec<(f64, f64, f64)> = Vec::with_capacity(GL_NODES + 2);
+                let record = |tau: f64,
+                              fr: f64,
+                              nd: &Node,
+                              scan: &mut Vec<(f64, f64, f64)>,
+                              acc: &mut Acc| {
+                    scan.push((tau, fr, nd.v[1]));
+                    acc.f_max = acc.f_max.max(nd.f);
+                    acc.f_min = acc.f_min.min(nd.f);
+                    acc.v_min = acc.v_min.min(nd.v[0]);
+                };
+                let na = eval(integ, a);
+                let fr = rate(integ, a, &na, a, b);
+                record(a, fr, &na, &mut scan, &mut acc);
+                for &(x, wt) in &gl {
+                    let tau = mid + half * x;
+                    let nd = eval(integ, tau);
+                    let wq = half * wt;
+                    acc.mean += wq * nd.w;
+                    acc.w2 += wq * nd.w * nd.w;
+                    acc.wd2 += wq * nd.wd * nd.wd;
+                    let theta = om * tau + psi;
+                    for h in 0..nh {
+                        let (s, c) = ((h + 1) as f64 * theta).sin_cos();
+                        acc.sin[h] += wq * nd.w * s;
+                        acc.cos[h] += wq * nd.w * c;
+                    }
+                    acc.e_dis -= wq * nd.f * nd.v[1];
+                    acc.virial += wq * nd.f * nd.w;
+                    acc.force += wq * nd.f;
+                    free.forcing.eval_into(om, tau, &mut fi);
+                    let (x_, xd, xdd) = (nd.z.rows(0, n), nd.z.rows(n, n), nd.dz.rows(n, n));
+                    for j in 0..n {
+                        let aj = xd[j];
+                        acc.drive[j] += wq * fi[j] * aj;
+                        acc.damp[j] += wq * free.damping.row(j).dot(&xd.transpose()) * aj;
+                        acc.sample[j] -= wq * tip[j] * nd.f * aj;
+                        let mut c = 0.0;
+                        for kk in 0..n {
+                            if kk != j {
+                                c +=
+                                    free.mass[(j, kk)] * xdd[kk] + free.stiffness[(j, kk)] * x_[kk];
+                            }
+                        }
+                        acc.coupling[j] += wq * aj * c;
+                    }
+                    let fr = rate(integ, tau, &nd, a, b);
+                    record(tau, fr, &nd, &mut scan, &mut acc);
+                }
+                let nb = eval(integ, b);
+                let fr = rate(integ, b, &nb, a, b);
+                record(b, fr, &nb, &mut scan, &mut acc);
+                // interior extrema of F_c and of V_T located on the dense output
+                for pair in scan.windows(2) {
+                    let (ta, fda, vda) = pair[0];
+                    let (tb, fdb, vdb) = pair[1];
+                    if (fda > 0.0) != (fdb > 0.0) {
+                        let mut g = |t: f64| {
+                            let nd = eval(integ, t);
+                            rate(integ, t, &nd, a, b)
+                        };
+                        let t = root_of(ta, fda, tb, fdb, &mut g);
+                        let f = eval(integ, t).f;
+                        acc.f_max = acc.f_max.max(f);
+                        acc.f_min = acc.f_min.min(f);
+                    }
+                    if vda < 0.0 && vdb > 0.0 {
+                        let mut vt = |t: f64| integ.dense_v_t(t);
+                        let t = extremum(ta, tb, vda, &mut vt);
+                        acc.v_min = acc.v_min.min(vt(t)[0]);
+                    }
+                }
+            }
+        }
+        if let Some(e) = &step.event {
+            let entered = match e.kind {
+                EventKind::Switching => e.to == Region::Contact,
+                EventKind::Impact | EventKind::Stick => true,
+                EventKind::Release => false,
+            };
+            if entered {
+                acc.impacts += 1;
+            }
+            let restitution = match e.kind {
+                EventKind::Impact => model.law().restitution(),
+                EventKind::Stick => Some(0.0),
+                _ => None,
+            };
+            if let Some(rc) = restitution {
+                // the impulse P φ at the tip, P = −(1 + r) m_eff V̇_T⁻ (model docs)
+                let (loss, _) = model.impact_energy(e.tau, e.v_t_dot, rc);
+                acc.e_dis += loss;
+                acc.impact_loss += loss;
+                let imp = -(1.0 + rc) * model.effective_mass() * e.v_t_dot;
+                acc.virial += imp * model.w_tip(&e.state);
+                acc.force += imp;
+                let after = integ.state();
+                for j in 0..n {
+                    let avg = 0.5 * (e.state[n + j] + after[n + j]);
+                    acc.sample[j] -= imp * tip[j] * avg;
+                    let mut c = 0.0;
+                    for kk in 0..n {
+                        if kk != j {
+                            c += free.mass[(j, kk)] * (after[n + kk] - e.state[n + kk]);
+                        }
+                    }
+                    acc.coupling[j] += c * avg;
+                }
+            }
+        }
+    }
+    let z_end = integ.state().clone();
+    let t_tot = integ.tau() - tau_start;
+    let per = opts.periods as f64;
+    let harmonics: Vec<Harmonic> = (0..nh)
+        .map(|h| {
+            let s = 2.0 * acc.sin[h] / t_tot;
+            let c = 2.0 * acc.cos[h] / t_tot;
+            Harmonic {
+                n: h + 1,
+                amplitude: s.hypot(c),
+                phase: wrap_phase((-c).atan2(s)),
+            }
+        })
+        .collect();
+    let mean = acc.mean / t_tot;
+    let a1 = harmonics[0].amplitude;
+    let higher_sq = 2.0 * (acc.w2 / t_tot - mean * mean) - a1 * a1;
+    let higher_n2_sq = 2.0 * acc.wd2 / t_tot / (om * om) - a1 * a1;
+    let mode_energy = |z: &DVector<f64>, j: usize| {
+        0.5 * free.mass[(j, j)] * z[n + j] * z[n + j] + 0.5 * free.stiffness[(j, j)] * z[j] * z[j]
+    };
+    let mode_balance = (0..n)
+        .map(|j| {
+            let de = mode_energy(&z_end, j) - mode_energy(&z_start, j);
+            let (d, b, s, c) = (acc.drive[j], acc.damp[j], acc.sample[j], acc.coupling[j]);
+            ModeBalance {
+                mode: j,
+                drive: d / per,
+                beam_damping: b / per,
+                sample: s / per,
+                coupling: c / per,
+                energy_change: de / per,
+                residual: (de - (d - b - s - c)) / per,
+            }
+        })
+        .collect();
+    let phase = harmonics[0].phase;
+    let closed_form = closed_forms(&model, a1, phase)?;
+    Ok(Observables {
+        periods: opts.periods,
+        amplitude: a1,
+        phase,
+        thd: higher_sq.max(0.0).sqrt() / a1,
+        harmonics,
+        mean_deflection: mean,
+        higher_sq,
+        higher_n2_sq,
+        mean_force: acc.force / t_tot,
+        peak_force: acc.f_max,
+        min_force: acc.f_min,
+        indentation: (-acc.v_min).max(0.0),
+        contact_fraction: acc.contact_time / t_tot,
+        contact_time: acc.contact_time / per,
+        min_distance: acc.v_min + p.contact_law.distance_offset(),
+        impacts_per_period: acc.impacts as f64 / per,
+        energy_dissipated: acc.e_dis / per,
+        impact_loss: acc.impact_loss / per,
+        virial: acc.virial / t_tot,
+        mode_balance,
+        closed_form,
+    })
+}
+
+/// dF_c/dτ at a node: ∂F/∂δ δ̇ + ∂F/∂δ̇ δ̈ for the smooth laws (δ = −V_T, partials of
+/// [`TipSampleLaw::force`]); 0 where no force acts.
+fn force_rate(law: &TipSample, r: Region, nd: &Node) -> f64 {
+    let contact = r == Region::Contact;
+    if !contact && !law.acts_outside() {
+        return 0.0;
+    }
+    let e = law.force(contact, -nd.v[0], -nd.v[1]);
+    -e.d_delta * nd.v[1] - e.d_rate * nd.v[2]
+}
+
+/// Zero of g on [a, b] between values of opposite signs, by the safeguarded Newton iteration
+/// with a central-difference slope (the extremum's value is second-order in the location).
+fn root_of(a: f64, ga: f64, b: f64, gb: f64, g: &mut dyn FnMut(f64) -> f64) -> f64 {
+    let s = if ga > 0.0 { 1.0 } else { -1.0 };
+    let h = 1e-6 * (b - a);
+    safeguarded_newton(a, s * ga, b, s * gb, 0.0, &mut |t| {
+        let v = s * g(t);
+        let d = s * (g((t + h).min(b)) - g((t - h).max(a))) / ((t + h).min(b) - (t - h).max(a));
+        (v, d)
+    })
+}
+
+/// [`observe`] from a start state: builds the integrator of `model` with `integ` at (τ₀, z₀).
+///
+/// # Errors
+/// As [`build`] and [`observe`].
+pub fn observe_from(
+    model: &CantileverModel,
+    integ: IntegratorOptions,
+    tau0: f64,
+    z0: &DVector<f64>,
+    opts: &ObservableOptions,
+) -> Result<Observables, SimError> {
+    let mut it = build(model, integ, tau0, z0)?;
+    observe(it.as_mut(), opts)
+}

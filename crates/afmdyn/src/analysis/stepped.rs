@@ -1,0 +1,734 @@
+//! Stepped sweeps of the steady state with branch continuation: the driver shared by the
+//! approach–retract curve ([`super::approach`], the rest distance z_c) and the resonance curve
+//! ([`super::resonance`], the drive frequency Ω).
+//!
+//! **Stepped sweeps.** As in an experiment and in the stepped approach of VEDA and dForce
+//! (Guzman, Garcia & Garcia, *Beilstein J. Nanotechnol.* 6 (2015) 369), the parameter is
+//! stepped through a grid and at each value the steady state is the one reached from the
+//! previous value's end state; then the sweep runs back (retract, or down-sweep). Instead of
+//! integrating ~Q/π periods of transient per value, each value is first tried by Newton
+//! shooting ([`super::shooting`]) from the previous orbit: a stable orbit near the previous one
+//! is its continuation, the state the motion settles on. When Newton fails, lands on an unstable
+//! orbit, or lands far from the previous orbit (the previous attractor vanished: a jump), the
+//! motion is integrated from the previous end state in chunks of drive periods, Newton being
+//! retried from the transient until the trajectory is seen to approach a stable orbit
+//! ([`settle`]); a motion that never settles on a period-n orbit is classified by
+//! [`super::steady::steady_state`].
+//!
+//! **Branches.** The periodic-orbit branches through the first points of both sweeps are
+//! continued in the parameter by pseudo-arclength continuation ([`super::continuation`]), with
+//! Floquet stability, folds (saddle-nodes: the edges of the bistable ranges) and grazing points.
+//!
+//! Every recorded orbit carries its [`Observables`] ([`super::observables`]).
+
+use super::bifurcation::SweepSpec;
+use super::continuation::{continue_branch, BranchEvent, BranchPoint, ContinuationSpec};
+use super::monodromy::stroboscopic;
+use super::observables::{observe, ObservableOptions, Observables};
+use super::shooting::{shoot_with, ShootingOptions};
+use super::steady::{steady_state, SteadyOptions};
+use crate::error::SimError;
+use crate::integrate::{advance_dyn, build, Integrator, IntegratorOptions};
+use crate::model::CantileverModel;
+use crate::params::{Params, SweepParam};
+use nalgebra::{Complex, DVector};
+use serde::Serialize;
+
+/// Largest number of values of a stepped sweep (each is a steady-state computation, twice).
+pub const MAX_CURVE_POINTS: usize = 100_000;
+
+/// Chunks of [`SteppedSpec::chunk_periods`] during which [`settle`] retries Newton before it
+/// classifies the motion by integration alone.
+pub const NEWTON_CHUNKS: usize = 40;
+
+/// Relative distance (to 1 + ‖z‖) within which [`settle`] takes a transient to have reached
+/// the stable orbit it is approaching.
+pub const SETTLED: f64 = 5e-2;
+
+/// Default tolerance of the adaptive integrator in stepped sweeps: 1e-10 instead of the
+/// library's 1e-12 makes a map ~3× cheaper, and changes A and φ of the point-mass DMT
+/// approach curve (Q = 400) by < 5e-8 (relative to A₀, and rad) — below the 1e-6 agreement
+/// with an independent integrator that the tests require.
+pub const DEFAULT_TOLERANCE: f64 = 1e-10;
+
+/// How the grid of a stepped sweep is spaced.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Spacing {
+    /// A fixed step (> 0, in the units of the swept value); the last value is the last grid
+    /// point not beyond the end.
+    Step(f64),
+    /// This many evenly spaced values, ends included (2..=[`MAX_CURVE_POINTS`]).
+    Points(usize),
+}
+
+/// The values of a stepped sweep from `from` to `to` (in that order).
+///
+/// # Errors
+/// [`SimError::OutOfRange`] for non-finite or equal ends, a step that is not finite and > 0,
+/// or more than [`MAX_CURVE_POINTS`] values.
+pub fn grid(from: f64, to: f64, spacing: Spacing) -> Result<Vec<f64>, SimError> {
+    crate::error::finite("from", from)?;
+    crate::error::finite("to", to)?;
+    if from == to {
+        return Err(SimError::out_of_range(
+            "to",
+            to,
+            "must differ from the start of the sweep",
+        ));
+    }
+    let points = match spacing {
+        Spacing::Points(n) => {
+            if !(2..=MAX_CURVE_POINTS).contains(&n) {
+                return Err(SimError::out_of_range("points", n, "must be in 2..=100000"));
+            }
+            n
+        }
+        Spacing::Step(h) => {
+            if !(h.is_finite() && h > 0.0) {
+                return Err(SimError::out_of_range("step", h, "must be finite and > 0"));
+            }
+            let intervals = ((to - from).abs() / h * (1.0 + 1e-12)).floor();
+            if intervals + 1.0 > MAX_CURVE_POINTS as f64 {
+                return Err(SimError::out_of_range(
+                    "step",
+                    h,
+                    "gives more than 100000 points over the range: use a larger step",
+                ));
+            }
+            if intervals < 1.0 {
+                return Err(SimError::out_of_range(
+                    "step",
+                    h,
+                    "is longer than the range: no second point",
+                ));
+            }
+            let n = intervals as usize + 1;
+            let last = from + (to - from).signum() * h * intervals;
+            return SweepSpec::linspace(from, last, n);
+        }
+    };
+    SweepSpec::linspace(from, to, points)
+}
+
+/// A stepped sweep with branch continuation.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SteppedSpec {
+    /// Parameters held fixed (the swept one is overwritten).
+    pub base: Params,
+    /// The swept parameter.
+    pub param: SweepParam,
+    /// Its values in the order of the first sweep (the second runs back), at least 2.
+    pub values: Vec<f64>,
+    /// Integrator of every orbit and observable (default: auto with tolerance
+    /// [`DEFAULT_TOLERANCE`]).
+    pub integrator: IntegratorOptions,
+    /// Newton shooting from the previous orbit.
+    pub newton: ShootingOptions,
+    /// Classification of a motion that does not settle on an orbit (`max_periods` also caps
+    /// the transient of [`settle`]).
+    pub steady: SteadyOptions,
+    /// Drive periods between Newton attempts while settling.
+    pub chunk_periods: usize,
+    /// An orbit found by Newton farther than this from the previous one (relative to
+    /// 1 + ‖z‖) is checked by integrating the transient (a possible jump).
+    pub jump_tol: f64,
+    /// Observables of every orbit (`periods` is set to the orbit's period).
+    pub observables: ObservableOptions,
+    /// Continue the periodic-orbit branches.
+    pub branches: bool,
+    /// Cap on the points of one branch.
+    pub max_branch_points: usize,
+}
+
+impl SteppedSpec {
+    /// Defaults for a sweep of `param` through `values`.
+    pub fn new(base: Params, param: SweepParam, values: Vec<f64>) -> Self {
+        SteppedSpec {
+            base,
+            param,
+            values,
+            integrator: IntegratorOptions {
+                tolerance: DEFAULT_TOLERANCE,
+                ..IntegratorOptions::default()
+            },
+            newton: ShootingOptions {
+                tol: 1e-10,
+                max_iter: 12,
+            },
+            steady: SteadyOptions {
+                tol: 1e-8,
+                max_periods: 20_000,
+                max_period: 16,
+                nonperiodic_record: 16,
+            },
+            chunk_periods: 25,
+            jump_tol: 0.1,
+            observables: ObservableOptions::default(),
+            branches: true,
+            max_branch_points: 2000,
+        }
+    }
+}
+
+/// How the steady state of a sweep point was reached.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Reached {
+    /// The first point: Newton from rest (or from the transient from rest).
+    Start,
+    /// Newton from the previous orbit converged to a stable orbit near it.
+    Continued,
+    /// The transient from the previous end state was integrated until it settled.
+    Settled,
+}
+
+/// One point of a stepped sweep.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CurvePoint {
+    /// Value of the swept parameter.
+    pub value: f64,
+    /// Period n of the orbit (in drive periods), `None` for a motion that is not period-n.
+    pub period: Option<usize>,
+    /// State at drive phase 0 (τ = 0 mod T), shape `[2N]`; the last recorded state for a
+    /// non-periodic motion.
+    pub state: DVector<f64>,
+    /// Floquet multipliers of the orbit, decreasing modulus (empty for a non-periodic motion).
+    pub multipliers: Vec<Complex<f64>>,
+    /// Stable: all multipliers inside the unit circle (a non-periodic motion reached by
+    /// integration is an attractor and counts as stable).
+    pub stable: bool,
+    /// How it was reached.
+    pub reached: Reached,
+    /// Observables over one cycle (n periods; `steady.nonperiodic_record` periods otherwise).
+    pub observables: Observables,
+}
+
+/// One point of a continued branch with its observables.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BranchSample {
+    /// The branch point (parameter value, section states, multipliers, stability, event).
+    pub point: BranchPoint,
+    /// Observables over one cycle of the orbit.
+    pub observables: Observables,
+}
+
+/// Which sweep.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Sweep {
+    /// The first sweep, through `values` in order (approach, up-sweep).
+    First,
+    /// The sweep back (retract, down-sweep).
+    Second,
+}
+
+/// A jump of a stepped sweep: the attractor followed so far vanished (or lost stability)
+/// between two grid values and the motion settled on another one.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Jump {
+    /// Which sweep.
+    pub sweep: Sweep,
+    /// Index of the point after the jump in that sweep.
+    pub index: usize,
+    /// Value before the jump.
+    pub from: f64,
+    /// Value after the jump.
+    pub to: f64,
+    /// The fold (saddle-node) of a continued branch within one grid step of the jump, if any:
+    /// the located parameter value of the vanishing attractor.
+    pub fold: Option<f64>,
+}
+
+/// The result of [`stepped_sweep`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct SteppedCurve {
+    /// The swept parameter.
+    pub param: SweepParam,
+    /// The first sweep, in the order of `values`.
+    pub first: Vec<CurvePoint>,
+    /// The sweep back, in the reverse order (its first point is the first sweep's last).
+    pub second: Vec<CurvePoint>,
+    /// Continued periodic-orbit branches, each in arclength order.
+    pub branches: Vec<Vec<BranchSample>>,
+    /// Jumps of both sweeps.
+    pub jumps: Vec<Jump>,
+    /// Parameter values of the located folds, ascending.
+    pub folds: Vec<f64>,
+    /// Ranges [lo, hi] between two consecutive folds of a branch: where the branch has three
+    /// orbits (two stable ones and the unstable one between them), the bistable ranges.
+    pub bistable: Vec<(f64, f64)>,
+    /// What could not be computed (e.g. a branch whose start failed).
+    pub warnings: Vec<String>,
+}
+
+/// Observables of a period-n orbit (or `record` periods of a motion) from `z` at τ = 0.
+fn measure(
+    integ: &mut dyn Integrator,
+    z: &DVector<f64>,
+    periods: usize,
+    opts: &ObservableOptions,
+) -> Result<Observables, SimError> {
+    integ.set_variational(false);
+    integ.reset(0.0, z)?;
+    observe(
+        integ,
+        &ObservableOptions {
+            periods: periods.max(1),
+            ..*opts
+        },
+    )
+}
+
+fn relative_gap(a: &DVector<f64>, b: &DVector<f64>) -> f64 {
+    (a - b).norm() / (1.0 + b.norm())
+}
+
+/// The steady state a sweep point settles on.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Found {
+    /// Period n, `None` for a motion that is not period-n.
+    pub period: Option<usize>,
+    /// State at drive phase 0, shape `[2N]` (the last recorded state of a non-periodic motion).
+    pub state: DVector<f64>,
+    /// Floquet multipliers, decreasing modulus (empty for a non-periodic motion).
+    pub multipliers: Vec<Complex<f64>>,
+    /// Stable (an attractor).
+    pub stable: bool,
+}
+
+/// Integrate from `z0` (τ = 0) at the integrator's parameters until the motion settles: every
+/// `spec.chunk_periods` periods Newton is tried from the current state (period `n`); a stable
+/// orbit it finds is accepted once the trajectory has come closer to it over two further chunks
+/// and within [`SETTLED`] of it, or has twice come closer at the rate of the orbit's leading
+/// Floquet multiplier (the linear regime around it), or has arrived on it — so it is the
+/// attractor the motion goes to, not another orbit Newton happened to reach. After a failed
+/// attempt the next one waits 1.5 times as many chunks. After [`NEWTON_CHUNKS`] chunks without
+/// that, the motion is classified by [`steady_state`] within `spec.steady` (a period-m orbit is
+/// then polished by Newton).
+///
+/// # Errors
+/// [`SimError`] from the integrator.
+pub fn settle(
+    integ: &mut dyn Integrator,
+    z0: &DVector<f64>,
+    n: usize,
+    spec: &SteppedSpec,
+) -> Result<Found, SimError> {
+    let period = integ.model().period();
+    let chunk = spec.chunk_periods.max(1);
+    let mut x = z0.clone();
+    let mut elapsed = 0usize;
+    let mut candidate: Option<Candidate> = None;
+    // Newton from the transient for at most NEWTON_CHUNKS chunks, then classification; after a
+    // failed attempt the next one waits 1.5 times longer
+    let newton_periods = spec.steady.max_periods.min(NEWTON_CHUNKS * chunk);
+    let (mut chunks, mut next_try, mut wait) = (0usize, 1usize, 1.0f64);
+    while elapsed < newton_periods {
+        integ.set_variational(false);
+        integ.reset(0.0, &x)?;
+        advance_dyn(integ, chunk as f64 * period, &mut |_, _, _| Ok(()))?;
+        elapsed += chunk;
+        chunks += 1;
+        x = integ.state().clone();
+        if let Some(mut c) = candidate.take() {
+            let d = (&x - &c.state).norm();
+            let scale = 1.0 + c.state.norm();
+            // the transient approaches the orbit at the rate of its leading multiplier
+            let rate = c.multipliers[0].norm().powi(chunk as i32);
+            let ratio = d / c.distance;
+            let linear = ratio <= 1.0 && (ratio - rate).abs() <= 0.25 * (1.0 - rate) + 1e-3;
+            if d <= 1e-9 * scale {
+                return Ok(c.found(n));
+            }
+            if d < c.distance {
+                c.approaches += 1;
+                c.linear = if linear { c.linear + 1 } else { 0 };
+                c.distance = d;
+                if (d <= SETTLED * scale && c.approaches >= 2) || c.linear >= 2 {
+                    return Ok(c.found(n));
+                }
+                candidate = Some(c);
+                continue;
+            }
+        }
+        if chunks < next_try {
+            continue;
+        }
+        match shoot_with(integ, &x, n, &spec.newton) {
+            Ok(o) if o.stable => {
+                candidate = Some(Candidate {
+                    distance: (&x - &o.state).norm(),
+                    state: o.state,
+                    multipliers: o.multipliers,
+                    approaches: 0,
+                    linear: 0,
+                });
+                wait = 1.0;
+            }
+            _ => wait *= 1.5,
+        }
+        next_try = chunks + wait.round() as usize;
+    }
+    // no settling on a period-n orbit: classify the motion
+    integ.set_variational(false);
+    integ.reset(0.0, &x)?;
+    let s = steady_state(integ, &spec.steady)?;
+    if let Some(m) = s.period() {
+        if let Ok(o) = shoot_with(integ, s.end_state(), m, &spec.newton) {
+            if o.stable {
+                return Ok(Found {
+                    period: Some(m),
+                    state: o.state,
+                    multipliers: o.multipliers,
+                    stable: true,
+                });
+            }
+        }
+    }
+    Ok(Found {
+        period: None,
+        state: s.end_state().clone(),
+        multipliers: Vec::new(),
+        stable: true,
+    })
+}
+
+/// A stable orbit found by Newton from a transient, and how the transient approaches it.
+struct Candidate {
+    state: DVector<f64>,
+    multipliers: Vec<Complex<f64>>,
+    /// Distance of the transient from the orbit at the last check.
+    distance: f64,
+    /// Consecutive checks at which the distance decreased.
+    approaches: usize,
+    /// Consecutive checks at which it decreased at the rate of the leading multiplier.
+    linear: usize,
+}
+
+impl Candidate {
+    fn found(self, n: usize) -> Found {
+        Found {
+            period: Some(n),
+            state: self.state,
+            multipliers: self.multipliers,
+            stable: true,
+        }
+    }
+}
+
+/// The integrator at one parameter value, started at `z` (τ = 0).
+fn integrator_at(
+    spec: &SteppedSpec,
+    value: f64,
+    z: &DVector<f64>,
+) -> Result<Box<dyn Integrator>, SimError> {
+    let model = CantileverModel::new(&spec.base.with(spec.param, value))?;
+    build(&model, spec.integrator, 0.0, z)
+}
+
+/// The steady state at `value` reached from the previous point `prev` (or from rest); `before`
+/// is the point before `prev` on the same branch, for a secant predictor.
+fn step_point(
+    spec: &SteppedSpec,
+    value: f64,
+    prev: Option<&CurvePoint>,
+    before: Option<&CurvePoint>,
+) -> Result<CurvePoint, SimError> {
+    let model = CantileverModel::new(&spec.base.with(spec.param, value))?;
+    let last = prev.map_or_else(|| model.rest(), |p| p.state.clone());
+    let n = prev.and_then(|p| p.period).unwrap_or(1);
+    let mut integ = build(&model, spec.integrator, 0.0, &last)?;
+    // guesses: the secant prediction through the two previous orbits, then the previous orbit
+    let mut guesses = Vec::with_capacity(2);
+    if let (Some(p), Some(b)) = (prev, before) {
+        if p.period == b.period && p.reached != Reached::Settled && p.value != b.value {
+            let r = (value - p.value) / (p.value - b.value);
+            guesses.push(&p.state + (&p.state - &b.state) * r);
+        }
+    }
+    guesses.push(last.clone());
+    let mut continued = None;
+    for g in &guesses {
+        if let Ok(o) = shoot_with(integ.as_mut(), g, n, &spec.newton) {
+            if o.stable && (prev.is_none() || relative_gap(&o.state, &last) <= spec.jump_tol) {
+                continued = Some(o);
+                break;
+            }
+        }
+    }
+    let first = if prev.is_some() {
+        Reached::Continued
+    } else {
+        Reached::Start
+    };
+    let (found, reached) = match continued {
+        Some(o) => (
+            Found {
+                period: Some(n),
+                state: o.state,
+                multipliers: o.multipliers,
+                stable: true,
+            },
+            first,
+        ),
+        None => (
+            settle(integ.as_mut(), &last, n, spec)?,
+            if prev.is_some() {
+                Reached::Settled
+            } else {
+                Reached::Start
+            },
+        ),
+    };
+    let periods = found.period.unwrap_or(spec.steady.nonperiodic_record);
+    let observables = measure(integ.as_mut(), &found.state, periods, &spec.observables)?;
+    Ok(CurvePoint {
+        value,
+        period: found.period,
+        state: found.state,
+        multipliers: found.multipliers,
+        stable: found.stable,
+        reached,
+        observables,
+    })
+}
+
+/// One sweep through `values`, starting from `start` (the previous sweep's last point, at
+/// `values[0]`) or from rest.
+fn sweep(
+    spec: &SteppedSpec,
+    values: &[f64],
+    start: Option<&CurvePoint>,
+) -> Result<Vec<CurvePoint>, SimError> {
+    let mut out: Vec<CurvePoint> = Vec::with_capacity(values.len());
+    for (i, &v) in values.iter().enumerate() {
+        let p = match (i, start) {
+            (0, Some(s)) => s.clone(),
+            _ => {
+                let k = out.len();
+                let before = if k >= 2 { out.get(k - 2) } else { None };
+                step_point(spec, v, out.last(), before)?
+            }
+        };
+        out.push(p);
+    }
+    Ok(out)
+}
+
+/// Continue the branch through `from` (a stable orbit of a sweep) towards `to`, with
+/// observables at every point.
+fn branch(spec: &SteppedSpec, from: &CurvePoint, to: f64) -> Result<Vec<BranchSample>, SimError> {
+    let n = from.period.ok_or(SimError::out_of_range(
+        "branch start",
+        from.value,
+        "the motion there is not period-n: no branch to continue",
+    ))?;
+    let (lo, hi) = spec
+        .values
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
+            (l.min(v), h.max(v))
+        });
+    let mut cs = ContinuationSpec::new(spec.base, spec.param, from.value, to, n);
+    cs.integrator = spec.integrator;
+    cs.max_points = spec.max_branch_points;
+    cs.range = Some((lo, hi));
+    cs.ds = (hi - lo) / 100.0;
+    cs.ds_max = (hi - lo) / 25.0;
+    let points = continue_branch(&cs, &from.state)?;
+    let mut out = Vec::with_capacity(points.len());
+    for p in points {
+        let mut integ = integrator_at(spec, p.value, &p.section[0])?;
+        let observables = measure(integ.as_mut(), &p.section[0], p.period, &spec.observables)?;
+        out.push(BranchSample {
+            point: p,
+            observables,
+        });
+    }
+    Ok(out)
+}
+
+/// Whether the orbit `z` at `value` lies on the branch: within 1e-2 (relative) of the branch's
+/// section state interpolated linearly between the two branch points around `value` (or
+/// extrapolated by up to one segment beyond the branch's ends).
+fn on_branch(br: &[BranchSample], value: f64, z: &DVector<f64>) -> bool {
+    let last = br.len().saturating_sub(2);
+    br.windows(2).enumerate().any(|(i, w)| {
+        let (a, b) = (&w[0].point, &w[1].point);
+        if b.value == a.value {
+            return false;
+        }
+        // inside the segment, or up to one segment beyond an end of the branch (which stops
+        // at its last point inside the range)
+        let t = (value - a.value) / (b.value - a.value);
+        let (t_lo, t_hi) = (
+            if i == 0 { -1.0 } else { 0.0 },
+            if i == last { 2.0 } else { 1.0 },
+        );
+        if !(t_lo..=t_hi).contains(&t) {
+            return false;
+        }
+        let zi = &a.section[0] + (&b.section[0] - &a.section[0]) * t;
+        relative_gap(&zi, z) < 1e-2
+    })
+}
+
+/// Orbits to continue branches from: the two sweeps' first points (both ends of the range) and,
+/// at each end, the orbit Newton finds from the other end's orbit (a state of the other
+/// regime, e.g. the free oscillation of the far end started near the sample), when it differs
+/// from the sweep's.
+fn branch_starts(
+    spec: &SteppedSpec,
+    first: &[CurvePoint],
+    second: &[CurvePoint],
+) -> Vec<CurvePoint> {
+    let (a, b) = (&first[0], &second[0]);
+    let mut starts = vec![a.clone(), b.clone()];
+    for (at, from) in [(b, a), (a, b)] {
+        let (Some(n), Some(_)) = (from.period, at.period) else {
+            continue;
+        };
+        let Ok(mut integ) = integrator_at(spec, at.value, &from.state) else {
+            continue;
+        };
+        let Ok(o) = shoot_with(integ.as_mut(), &from.state, n, &spec.newton) else {
+            continue;
+        };
+        if relative_gap(&o.state, &at.state) < 1e-3 {
+            continue;
+        }
+        let periods = n;
+        let Ok(observables) = measure(integ.as_mut(), &o.state, periods, &spec.observables) else {
+            continue;
+        };
+        starts.push(CurvePoint {
+            value: at.value,
+            period: Some(n),
+            state: o.state,
+            stable: o.stable,
+            multipliers: o.multipliers,
+            reached: Reached::Start,
+            observables,
+        });
+    }
+    starts
+}
+
+/// Jumps of one sweep: points reached by settling on an orbit away from the previous one.
+fn jumps_of(which: Sweep, points: &[CurvePoint], folds: &[f64], jump_tol: f64) -> Vec<Jump> {
+    let mut out = Vec::new();
+    for i in 1..points.len() {
+        let (a, b) = (&points[i - 1], &points[i]);
+        if b.reached != Reached::Settled || relative_gap(&b.state, &a.state) <= jump_tol {
+            continue;
+        }
+        let step = (b.value - a.value).abs();
+        let (lo, hi) = (a.value.min(b.value) - step, a.value.max(b.value) + step);
+        let mid = 0.5 * (a.value + b.value);
+        let fold = folds
+            .iter()
+            .copied()
+            .filter(|f| (lo..=hi).contains(f))
+            .min_by(|x, y| (x - mid).abs().total_cmp(&(y - mid).abs()));
+        out.push(Jump {
+            sweep: which,
+            index: i,
+            from: a.value,
+            to: b.value,
+            fold,
+        });
+    }
+    out
+}
+
+/// Run the stepped sweep through `spec.values` and back, then (with `spec.branches`) continue
+/// the periodic-orbit branches through both sweeps' first points.
+///
+/// # Errors
+/// [`SimError::OutOfRange`] for fewer than 2 or more than [`MAX_CURVE_POINTS`] values or
+/// non-finite ones; [`SimError::Params`] when a value is outside its parameter's range;
+/// [`SimError`] from the integrator. A branch that cannot be continued is a warning.
+pub fn stepped_sweep(spec: &SteppedSpec) -> Result<SteppedCurve, SimError> {
+    if !(2..=MAX_CURVE_POINTS).contains(&spec.values.len()) {
+        return Err(SimError::out_of_range(
+            "points",
+            spec.values.len(),
+            "a stepped sweep needs 2..=100000 values",
+        ));
+    }
+    for &v in &spec.values {
+        crate::error::finite("sweep value", v)?;
+    }
+    for &v in [spec.values[0], spec.values[spec.values.len() - 1]].iter() {
+        spec.base.with(spec.param, v).validate()?;
+    }
+    let first = sweep(spec, &spec.values, None)?;
+    let back: Vec<f64> = spec.values.iter().rev().copied().collect();
+    let second = sweep(spec, &back, first.last())?;
+    let mut warnings = Vec::new();
+    let mut branches: Vec<Vec<BranchSample>> = Vec::new();
+    if spec.branches {
+        for start in branch_starts(spec, &first, &second) {
+            if branches
+                .iter()
+                .any(|b| on_branch(b, start.value, &start.state))
+            {
+                continue;
+            }
+            let (lo, hi) = (spec.values[0], spec.values[spec.values.len() - 1]);
+            let to = if start.value == lo { hi } else { lo };
+            match branch(spec, &start, to) {
+                Ok(br) => branches.push(br),
+                Err(e) => warnings.push(format!(
+                    "branch from {} = {}: {e}",
+                    spec.param.name(),
+                    start.value
+                )),
+            }
+        }
+    }
+    let mut folds: Vec<f64> = Vec::new();
+    let mut bistable = Vec::new();
+    for br in &branches {
+        let f: Vec<f64> = br
+            .iter()
+            .filter(|s| s.point.event == Some(BranchEvent::Fold))
+            .map(|s| s.point.value)
+            .collect();
+        for w in f.windows(2) {
+            bistable.push((w[0].min(w[1]), w[0].max(w[1])));
+        }
+        folds.extend(f);
+    }
+    folds.sort_by(f64::total_cmp);
+    folds.dedup_by(|a, b| (*a - *b).abs() <= 1e-9 * (1.0 + b.abs()));
+    let mut jumps = jumps_of(Sweep::First, &first, &folds, spec.jump_tol);
+    jumps.extend(jumps_of(Sweep::Second, &second, &folds, spec.jump_tol));
+    Ok(SteppedCurve {
+        param: spec.param,
+        first,
+        second,
+        branches,
+        jumps,
+        folds,
+        bistable,
+        warnings,
+    })
+}
+
+/// Whether `z` is a fixed point of the period-n stroboscopic map at `value` to `tol`
+/// (‖Pⁿ(z) − z‖ ≤ tol (1 + ‖z‖)): the check that a recorded orbit is a steady state.
+///
+/// # Errors
+/// [`SimError`] from the model or the integrator.
+pub fn is_fixed_point(
+    spec: &SteppedSpec,
+    value: f64,
+    z: &DVector<f64>,
+    n: usize,
+    tol: f64,
+) -> Result<bool, SimError> {
+    let mut integ = integrator_at(spec, value, z)?;
+    let m = stroboscopic(integ.as_mut(), z, n)?;
+    Ok((&m.state - z).norm() <= tol * (1.0 + z.norm()))
+}
