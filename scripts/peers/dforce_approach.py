@@ -243,15 +243,26 @@ def afmdyn_json(cmd):
     return json.loads(out.stdout)
 
 
-def afmdyn_orbits(afmdyn, probe, P, zcs):
-    """Period-1 orbits of afmdyn along the approach, each from the previous orbit's state."""
+def afmdyn_orbits(afmdyn, probe, P, zcs, appr=None):
+    """Period-1 orbits of afmdyn along the approach. With afmdyn's approach curve at hand, each
+    orbit is started from the first harmonic that curve reports (so Newton lands on the branch
+    the approach followed); otherwise from the previous orbit's state (continuation), retried
+    with a long transient when that lands on an unstable orbit."""
     orbits, init = [], None
-    for zc in zcs:
+    for i, zc in enumerate(zcs):
         alpha5 = (zc - P.a0) / P.A0
         cmd = [afmdyn, "orbit", "--probe", probe, "--gap", repr(alpha5), "--period", "1", "--json"]
+        if appr is not None:
+            ar = appr["approach"]
+            j = int(np.argmin(np.abs(np.array(ar["z_c"]) - zc)))
+            A, ph, mean = ar["amplitude"][j], math.radians(ar["phase_deg"][j]), ar["mean_deflection"][j]
+            # z = mean + A cos(Om s - phi) at the section s = 0, in units of A0 (g0 of the probe)
+            init = ((mean + A * math.cos(ph)) / P.A0, A * P.Om * math.sin(ph) / P.A0)
         if init is not None:
             cmd += ["--initial-modal", "%r;%r" % (init[0], init[1])]
         o = afmdyn_json(cmd)
+        if not o.get("stable", False) and appr is None:
+            o = afmdyn_json(cmd + ["--max-periods", "20000"])
         if not o.get("stable", False) or o.get("period") != 1:
             print("warning: z_c = %.3g nm: afmdyn orbit period %s stable %s"
                   % (zc * 1e9, o.get("period"), o.get("stable")), file=sys.stderr)
@@ -397,8 +408,8 @@ def main():
 
     # afmdyn
     t0 = time.time()
-    orbits = afmdyn_orbits(a.afmdyn, a.probe, P, zcs)
     appr = afmdyn_approach(a.afmdyn, a.probe, zcs)
+    orbits = afmdyn_orbits(a.afmdyn, a.probe, P, zcs, appr)
     print("afmdyn: %d orbits%s, %.1f s" % (len(orbits), " + approach" if appr else " (no approach command: afmdyn column = SciPy integration of afmdyn's orbit)", time.time() - t0))
 
     tgrid, dt = dforce_grid(P, peer["nper"], peer["npp"], peer["nperfin"])
