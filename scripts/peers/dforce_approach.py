@@ -7,11 +7,12 @@ the directory given with --dforce, drives its approach-curve routine general.run
 stand-in object answers the few GUI variables runner reads, and odeint is wrapped only to record
 the time series runner computes), and reads the zcdom*.csv file runner writes.
 
-The afmdyn side is, for every z_c of the approach (continuation: each z_c starts from the orbit
-of the previous one),
-  * `afmdyn orbit --probe P --gap alpha5 --initial-modal ... --json`: the period-1 orbit (Newton
-    shooting) and its Poincare state, and, when the binary has it,
-    `afmdyn approach --probe P --from --to --step --json`: afmdyn's own observables;
+The afmdyn side is
+  * `afmdyn approach --probe P --from --to --step --json`: afmdyn's own observables, and for every
+    z_c `afmdyn orbit --probe P --gap alpha5 --initial-modal ... --json`, the period-1 orbit
+    (Newton shooting) started from the approach's first harmonic, so that it lies on the branch
+    the sweep followed (without the approach command: from the previous z_c's orbit, and the
+    afmdyn column is then the SciPy integration below);
   * an independent SciPy integration (DOP853, rtol 1e-13, the contact threshold d = a0 located
     as an event) of the point-mass model written here from the SI probe, started from afmdyn's
     orbit state: it must close after one period (checked) and gives the reference time series.
@@ -28,7 +29,7 @@ simulators):
     python3 scripts/peers/dforce_approach.py --dforce /tmp/dforce
         [--afmdyn target/release/afmdyn] [--probe examples/probe-point-mass-dmt.toml]
         [--from-nm 12 --to-nm 3 --step-nm 0.5] [--tolerance 14] [--periods 1500]
-        [--peer-json FILE (cache: reuse a saved dForce run)] [--json OUT]
+        [--retract] [--peer-json FILE (cache: reuse a saved dForce run)] [--json OUT]
 
 The first run creates target/venv-peers (pip install of the versions dForce 2.0 pins in its
 requirements.txt: numpy 1.26.3, scipy 1.12.0, matplotlib 3.8.2) and re-runs itself there.
@@ -243,7 +244,7 @@ def afmdyn_json(cmd):
     return json.loads(out.stdout)
 
 
-def afmdyn_orbits(afmdyn, probe, P, zcs, appr=None):
+def afmdyn_orbits(afmdyn, probe, P, zcs, appr=None, sweep="approach"):
     """Period-1 orbits of afmdyn along the approach. With afmdyn's approach curve at hand, each
     orbit is started from the first harmonic that curve reports (so Newton lands on the branch
     the approach followed); otherwise from the previous orbit's state (continuation), retried
@@ -253,7 +254,7 @@ def afmdyn_orbits(afmdyn, probe, P, zcs, appr=None):
         alpha5 = (zc - P.a0) / P.A0
         cmd = [afmdyn, "orbit", "--probe", probe, "--gap", repr(alpha5), "--period", "1", "--json"]
         if appr is not None:
-            ar = appr["approach"]
+            ar = appr[sweep]
             j = int(np.argmin(np.abs(np.array(ar["z_c"]) - zc)))
             A, ph, mean = ar["amplitude"][j], math.radians(ar["phase_deg"][j]), ar["mean_deflection"][j]
             # z = mean + A cos(Om s - phi) at the section s = 0, in units of A0 (g0 of the probe)
@@ -385,6 +386,8 @@ def main():
     ap.add_argument("--periods", type=int, default=1500, help="dForce 'Number of periods' per z_c (GUI default 400)")
     ap.add_argument("--npp", type=int, default=128, help="dForce 'Number of points per period' (GUI default 128)")
     ap.add_argument("--nperfin", type=int, default=128, help="dForce steady-state window in periods (GUI default 128)")
+    ap.add_argument("--retract", action="store_true",
+                    help="also the retract sweep (dForce's 'Retraction' option: the z_c grid run back up)")
     ap.add_argument("--peer-json", help="cache of the dForce run: read if it exists, else written")
     ap.add_argument("--json", help="write every number of the comparison here")
     ap.add_argument("--no-venv", action="store_true", help="run in the current interpreter")
@@ -399,7 +402,7 @@ def main():
         with open(a.peer_json) as fh:
             peer = json.load(fh)
     else:
-        peer = run_dforce(a.dforce, P, zcs, a.tolerance, a.periods, a.npp, a.nperfin)
+        peer = run_dforce(a.dforce, P, zcs, a.tolerance, a.periods, a.npp, a.nperfin, a.retract)
         if a.peer_json:
             with open(a.peer_json, "w") as fh:
                 json.dump(peer, fh)
@@ -409,38 +412,43 @@ def main():
     # afmdyn
     t0 = time.time()
     appr = afmdyn_approach(a.afmdyn, a.probe, zcs)
-    orbits = afmdyn_orbits(a.afmdyn, a.probe, P, zcs, appr)
-    print("afmdyn: %d orbits%s, %.1f s" % (len(orbits), " + approach" if appr else " (no approach command: afmdyn column = SciPy integration of afmdyn's orbit)", time.time() - t0))
+    sweeps = [("approach", zcs)]
+    if len(peer["records"]) == 2 * len(zcs):     # dForce ran the retrace too
+        sweeps.append(("retract", zcs[::-1]))
+    orbits = {name: afmdyn_orbits(a.afmdyn, a.probe, P, g, appr, name) for name, g in sweeps}
+    print("afmdyn: %d orbits%s, %.1f s" % (sum(len(o) for o in orbits.values()), " + approach" if appr else " (no approach command: afmdyn column = SciPy integration of afmdyn's orbit)", time.time() - t0))
 
     tgrid, dt = dforce_grid(P, peer["nper"], peer["npp"], peer["nperfin"])
     rows = []
-    for i, (zc, o) in enumerate(zip(zcs, orbits)):
-        L, T = o["si"]["scales"]["length_m"], o["si"]["scales"]["time_s"]
-        ref = Reference(P, zc, o["state"][0] * L, o["state"][1] * L / T)
-        zr, vr = ref.dforce_samples(tgrid)
-        ref_df = dforce_conventions(P, zc, tgrid, zr, vr, dt, peer["npp"], peer["nperfin"])
-        rec = peer["records"][i]
-        assert abs(rec["zc"] - zc) < 1e-15, (rec["zc"], zc)
-        tp, zp, vp = (np.array(rec[k]) for k in ("t", "z", "v"))
-        peer_df_check = dforce_conventions(P, zc, tp, zp, vp, dt, peer["npp"], peer["nperfin"])
-        peer_fit = harmonic_fit(P, tp, zp)
-        zd = {k: v[i] for k, v in peer["zcdom"].items()}
-        peer_df = dict(amplitude=zd["Amplitude"] * 1e-9, phase_deg=zd["Phase"],
-                       energy_dissipated=zd["Energy_diss"] * 1e-20, virial=zd["Virial1"] * 1e-20,
-                       peak_force=zd["Force_max"] * 1e-12, mean_deflection=zd["Deflection"] * 1e-9)
-        # my re-implementation of dForce's conventions must reproduce its own file
-        for kk in peer_df:
-            assert abs(rel(peer_df_check[kk], peer_df[kk])) < 1e-9 or abs(peer_df_check[kk] - peer_df[kk]) < 1e-25, (kk, peer_df_check[kk], peer_df[kk])
-        afm = dict(ref.obs)
-        if appr:
-            ar = appr["approach"]
-            j = int(np.argmin(np.abs(np.array(ar["z_c"]) - zc)))
-            afm = dict(amplitude=ar["amplitude"][j], phase_deg=ar["phase_deg"][j],
-                       energy_dissipated=ar["energy_dissipated"][j], virial=ar["virial"][j],
-                       peak_force=ar["peak_force"][j], min_force=ar["min_force"][j])
-        rows.append(dict(zc=zc, afmdyn=afm, ref=ref.obs, ref_dforce=ref_df, dforce=peer_df,
-                         dforce_fit=peer_fit, closure=ref.closure, nfe=rec["nfe"], nst=rec["nst"],
-                         multipliers=o.get("multipliers")))
+    for si, (name, grid) in enumerate(sweeps):
+        for ii, (zc, o) in enumerate(zip(grid, orbits[name])):
+            i = si * len(zcs) + ii                  # row of dForce's zcdom file
+            L, T = o["si"]["scales"]["length_m"], o["si"]["scales"]["time_s"]
+            ref = Reference(P, zc, o["state"][0] * L, o["state"][1] * L / T)
+            zr, vr = ref.dforce_samples(tgrid)
+            ref_df = dforce_conventions(P, zc, tgrid, zr, vr, dt, peer["npp"], peer["nperfin"])
+            rec = peer["records"][i]
+            assert abs(rec["zc"] - zc) < 1e-15, (rec["zc"], zc)
+            tp, zp, vp = (np.array(rec[k]) for k in ("t", "z", "v"))
+            peer_df_check = dforce_conventions(P, zc, tp, zp, vp, dt, peer["npp"], peer["nperfin"])
+            peer_fit = harmonic_fit(P, tp, zp)
+            zd = {k: v[i] for k, v in peer["zcdom"].items()}
+            peer_df = dict(amplitude=zd["Amplitude"] * 1e-9, phase_deg=zd["Phase"],
+                           energy_dissipated=zd["Energy_diss"] * 1e-20, virial=zd["Virial1"] * 1e-20,
+                           peak_force=zd["Force_max"] * 1e-12, mean_deflection=zd["Deflection"] * 1e-9)
+            # the re-implementation of dForce's conventions must reproduce its own file
+            for kk in peer_df:
+                assert abs(rel(peer_df_check[kk], peer_df[kk])) < 1e-9 or abs(peer_df_check[kk] - peer_df[kk]) < 1e-25, (kk, peer_df_check[kk], peer_df[kk])
+            afm = dict(ref.obs)
+            if appr:
+                ar = appr[name]
+                j = int(np.argmin(np.abs(np.array(ar["z_c"]) - zc)))
+                afm = dict(amplitude=ar["amplitude"][j], phase_deg=ar["phase_deg"][j],
+                           energy_dissipated=ar["energy_dissipated"][j], virial=ar["virial"][j],
+                           peak_force=ar["peak_force"][j], min_force=ar["min_force"][j])
+            rows.append(dict(sweep=name, zc=zc, afmdyn=afm, ref=ref.obs, ref_dforce=ref_df, dforce=peer_df,
+                             dforce_fit=peer_fit, closure=ref.closure, nfe=rec["nfe"], nst=rec["nst"],
+                             multipliers=o.get("multipliers")))
 
     def table(title, key, scale, unit, peer_fit_key=None, df_peak=False):
         print("\n%s (%s)" % (title, unit))
@@ -451,7 +459,9 @@ def main():
         if peer_fit_key:
             hdr += " %10s" % "fit rel"
         print(hdr)
-        for r in rows:
+        for k, r in enumerate(rows):
+            if k and r["sweep"] != rows[k - 1]["sweep"]:
+                print("  -- %s --" % r["sweep"])
             afm, rf, rd, dfv = r["afmdyn"][key], r["ref"][key], r["ref_dforce"][key], r["dforce"][key]
             if df_peak:  # dForce reports max|F|: compare with afmdyn's max(peak, -min)
                 afm = max(afm, -r["afmdyn"]["min_force"])
