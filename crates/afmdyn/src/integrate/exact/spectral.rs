@@ -1,18 +1,19 @@
 //! The parts of a propagator build that depend only on the region matrices, and their reuse.
 //!
-//! The energy transforms, Ã_s, ‖Ã_s‖₂, the eigendecomposition and the tip moment rows depend on
-//! A_s, M and K_s only — not on Ω, α2 or α5 — and the grid exponential Φ_s = e^{A_s h} on those
-//! and h. Both are kept in small process-wide caches keyed by the exact bits of the matrices
-//! (and of h), so the repeated builds of shooting at one parameter set reuse everything and a
-//! continuation step in Ω reuses the spectral data and redoes only Φ_s and the particular
-//! solution. A hit returns the very values a rebuild would compute (the build is deterministic).
+//! The energy transforms, Ã_s, ‖Ã_s‖₂, the eigendecomposition, the tip moment rows and the LU
+//! factorization of A_s depend on A_s, M and K_s only — not on Ω, α2 or α5 — and the grid
+//! exponential Φ_s = e^{A_s h} on those and h. Both are kept in small process-wide caches keyed
+//! by the exact bits of the matrices (and of h), so the repeated builds of shooting at one
+//! parameter set reuse everything and a continuation step in Ω reuses the spectral data and
+//! redoes only Φ_s and the particular solution. A hit returns the very values a rebuild would compute (the build is deterministic).
 
 use super::modal::ModalExp;
 use super::K;
 use crate::error::SimError;
 use crate::galerkin::Region;
 use crate::model::CantileverModel;
-use nalgebra::{DMatrix, DVector};
+use nalgebra::linalg::LU;
+use nalgebra::{DMatrix, DVector, Dyn};
 use std::sync::{Arc, Mutex};
 
 /// Build-time data of one region that depends on A_s, M and K_s only.
@@ -33,6 +34,8 @@ pub(super) struct Spectral {
     pub(super) kappa2: f64,
     /// ‖c̃‖₂.
     pub(super) ct_norm: f64,
+    /// LU factorization of A_s (for the constant part of the particular solution).
+    pub(super) a_lu: LU<f64, Dyn, Dyn>,
 }
 
 /// Entries kept per cache (least recently used dropped first).
@@ -248,6 +251,7 @@ fn region_spectral(model: &CantileverModel, r: Region) -> Result<Spectral, SimEr
         rows,
         kappa2,
         ct_norm,
+        a_lu: model.dynamics(r).a.clone().lu(),
     })
 }
 
