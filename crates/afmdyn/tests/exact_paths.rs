@@ -199,24 +199,14 @@ fn reused_builds_propagate_as_fresh_ones() {
         alpha1: 0.137,
         ..Params::default()
     };
-    let first = prop(&CantileverModel::new(&p).unwrap(), Propagation::Auto, true);
-    assert_eq!(first.reused(), (false, false));
-    let again = prop(&CantileverModel::new(&p).unwrap(), Propagation::Auto, true);
-    assert_eq!(again.reused(), (true, true));
-    let omega = Params { omega: 2.61, ..p };
-    let shifted = prop(
-        &CantileverModel::new(&omega).unwrap(),
-        Propagation::Auto,
-        true,
-    );
-    assert_eq!(shifted.reused(), (true, false));
-    let stiffer = Params { alpha4: 21.0, ..p };
-    let other = prop(
-        &CantileverModel::new(&stiffer).unwrap(),
-        Propagation::Auto,
-        true,
-    );
-    assert_eq!(other.reused(), (false, false));
+    let reused = |q: Params| {
+        let m = CantileverModel::new(&q).unwrap();
+        prop(&m, Propagation::Auto, true).reused()
+    };
+    assert_eq!(reused(p), (false, false));
+    assert_eq!(reused(p), (true, true));
+    assert_eq!(reused(Params { omega: 2.61, ..p }), (true, false));
+    assert_eq!(reused(Params { alpha4: 21.0, ..p }), (false, false));
 
     for q in [
         p,

@@ -211,11 +211,10 @@ fn forced(
     let dim = 2 * n;
     let omega = model.omega();
     let d = model.dynamics(r);
-    let p0 =
-        d.a.clone()
-            .lu()
-            .solve(&(-&d.b_const))
-            .ok_or_else(|| SimError::out_of_range("state matrix", "singular", "K must be SPD"))?;
+    let p0 = spec
+        .a_lu
+        .solve(&(-&d.b_const))
+        .ok_or_else(|| SimError::out_of_range("state matrix", "singular", "K must be SPD"))?;
     let mut big = DMatrix::zeros(2 * dim, 2 * dim);
     big.view_mut((0, 0), (dim, dim)).copy_from(&d.a);
     big.view_mut((dim, dim), (dim, dim)).copy_from(&d.a);
