@@ -282,7 +282,8 @@ def afmdyn_approach(afmdyn, probe, zcs):
         return None
     step = zcs[0] - zcs[1]
     return afmdyn_json([afmdyn, "approach", "--probe", probe, "--from", repr(zcs[0]),
-                        "--to", repr(zcs[-1]), "--step", repr(step), "--json"])
+                        "--to", repr(zcs[-1]), "--step", repr(step), "--files", "none",
+                        "--out", tempfile.mkdtemp(prefix="afmdyn-approach-"), "--json"])
 
 
 # ----------------------------------------------------------------------------- reference
