@@ -12,6 +12,7 @@ use afmdyn::analysis::continuation::BranchEvent;
 use afmdyn::analysis::observables::Observables;
 use afmdyn::analysis::resonance::{mode_band, resonance_curve, resonance_spec};
 use afmdyn::analysis::stepped::{Spacing, SteppedCurve, SteppedSpec, Sweep};
+use afmdyn::probe::Probe;
 use afmdyn::report::{curve_row, CurveUnits, CURVE_COLUMNS};
 use afmdyn::Params;
 use clap::Args;
@@ -494,21 +495,21 @@ fn summary(c: &SteppedCurve, x: &dyn Fn(f64) -> f64, l: &Labels, out: Option<&Ou
     }
 }
 
-/// The parameters and the output units (SI with a probe; frequencies in Hz when `hz`), with
-/// `--from`/`--to` checked finite.
+/// The parameters, the output units (SI with a probe; frequencies in Hz when `hz`) and the
+/// probe, with `--from`/`--to` checked finite.
 fn setup(
     model: &ModelArgs,
     from: Option<f64>,
     to: Option<f64>,
     hz: bool,
-) -> Result<(Params, CurveUnits), CliError> {
+) -> Result<(Params, CurveUnits, Option<Probe>), CliError> {
     let (base, probe) = model.resolve(Params::default())?;
     check_finite("--from", from)?;
     check_finite("--to", to)?;
     let units = probe.as_ref().map_or_else(CurveUnits::dimensionless, |p| {
         CurveUnits::from_scales(&p.scales, hz)
     });
-    Ok((base, units))
+    Ok((base, units, probe))
 }
 
 /// The part of a run shared by both commands.
@@ -557,7 +558,7 @@ fn check_finite(name: &str, v: Option<f64>) -> Result<(), CliError> {
 
 /// Run `afmdyn approach`.
 pub fn approach(a: &ApproachArgs) -> Result<(), CliError> {
-    let (base, units) = setup(&a.model, a.from, a.to, false)?;
+    let (base, units, probe) = setup(&a.model, a.from, a.to, false)?;
     let (far, near) = default_range(&base)?;
     let from = a.from.map_or(far, |v| v / units.length);
     let to = a.to.map_or(near, |v| v / units.length);
@@ -580,13 +581,17 @@ pub fn approach(a: &ApproachArgs) -> Result<(), CliError> {
         x: &x,
     };
     run.go(&mut spec, approach_retract, |c| {
-        afmdyn::report::approach(&base, c, &units)
+        afmdyn::report::with_si(
+            afmdyn::report::approach(&base, c, &units),
+            probe.as_ref(),
+            &base,
+        )
     })
 }
 
 /// Run `afmdyn resonance`.
 pub fn resonance(a: &ResonanceArgs) -> Result<(), CliError> {
-    let (base, units) = setup(&a.model, a.from, a.to, true)?;
+    let (base, units, probe) = setup(&a.model, a.from, a.to, true)?;
     let hz = units.hz_per_omega.unwrap_or(1.0);
     let (lo, hi) = mode_band(&base, a.mode)?;
     let from = a.from.map_or(lo, |v| v / hz);
@@ -615,6 +620,10 @@ pub fn resonance(a: &ResonanceArgs) -> Result<(), CliError> {
         x: &x,
     };
     run.go(&mut spec, resonance_curve, |c| {
-        afmdyn::report::resonance(&base, c, &units)
+        afmdyn::report::with_si(
+            afmdyn::report::resonance(&base, c, &units),
+            probe.as_ref(),
+            &base,
+        )
     })
 }

@@ -438,6 +438,16 @@ fn curve_doc(
     })
 }
 
+/// `doc` with the [`si`] block of `probe` added, when the model came from a probe file (the
+/// curve documents: their values are already in SI, the block carries the scales, drive, A₀
+/// and z_c).
+pub fn with_si(mut doc: Value, probe: Option<&crate::probe::Probe>, params: &Params) -> Value {
+    if let Some(p) = probe {
+        doc["si"] = si(p, params, &json!({}));
+    }
+    doc
+}
+
 /// `afmdyn approach --json`: `{"approach": {...}, "retract": {...}, "branches": [...], …}`.
 /// `approach` and `retract` hold equal-length arrays `z_c` (rest distance,
 /// [`Params::rest_distance`]) and the [`CURVE_COLUMNS`], plus `stable`, `period` (null when not
