@@ -1,11 +1,16 @@
 //! Throughput of the integrators: forcing periods per second at the default parameters
-//! (paper eq. 26, Ω = 2.6) for N = 1, 3, 5, 10 (linear law, exact propagator), the adaptive
+//! (paper eq. 26, Ω = 2.6) for N = 1, 3, 5, 10, 20 (linear law, exact propagator, through
+//! `advance`; the observed step loop `advance_dyn` and the dense and modal paths forced at
+//! N = 3 and 10 for comparison), the adaptive
 //! integrator with the Hertz and DMT laws (tolerance 1e-12) for N = 1, 3, and exact against RK4
 //! at matched accuracy (state at τ = 40 within 1e-8 of the exact answer).
 //!
 //! Run with `cargo bench -p afmdyn`; the matched-accuracy step count of RK4 is printed.
 
-use afmdyn::integrate::{advance_dyn, build, IntegratorKind, IntegratorOptions};
+use afmdyn::integrate::exact::{ExactOptions, ExactPropagator, Propagation};
+use afmdyn::integrate::{
+    advance, advance_dyn, build, Integrator, IntegratorKind, IntegratorOptions,
+};
 use afmdyn::{CantileverModel, ContactLaw, Params};
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use nalgebra::DVector;
@@ -32,28 +37,60 @@ fn exact() -> IntegratorOptions {
     }
 }
 
+/// The default model with `n` modes and a state on its attractor (after 100 periods from rest,
+/// so that the contacts per period are representative): (model, τ0, z0, τ0 + PERIODS T).
+fn on_attractor(n: usize) -> (CantileverModel, f64, DVector<f64>, f64) {
+    let p = Params {
+        modes: n,
+        ..Params::default()
+    };
+    let m = CantileverModel::new(&p).unwrap();
+    let t0 = 100.0 * p.period();
+    let z0 = run(&m, exact(), &m.rest(), t0);
+    (m, t0, z0, t0 + PERIODS as f64 * p.period())
+}
+
 fn periods_per_second(c: &mut Criterion) {
     let mut g = c.benchmark_group("exact periods");
     g.throughput(Throughput::Elements(PERIODS as u64));
-    for n in [1usize, 3, 5, 10] {
-        let p = Params {
-            modes: n,
-            ..Params::default()
-        };
-        let m = CantileverModel::new(&p).unwrap();
-        // start on the attractor so the contacts per period are representative
-        let z0 = run(&m, exact(), &m.rest(), 100.0 * p.period());
-        let t0 = 100.0 * p.period();
+    for n in [1usize, 3, 5, 10, 20] {
+        let (m, t0, z0, t1) = on_attractor(n);
         let mut it = build(&m, exact(), t0, &z0).unwrap();
         g.bench_with_input(BenchmarkId::from_parameter(n), &n, |b, _| {
             b.iter(|| {
                 it.reset(t0, &z0).unwrap();
-                advance_dyn(
-                    it.as_mut(),
-                    t0 + PERIODS as f64 * p.period(),
-                    &mut |_, _, _| Ok(()),
-                )
-                .unwrap();
+                advance(it.as_mut(), t1).unwrap();
+                black_box(it.state()[0])
+            })
+        });
+    }
+    g.finish();
+}
+
+fn paths(c: &mut Criterion) {
+    let mut g = c.benchmark_group("exact paths");
+    g.throughput(Throughput::Elements(PERIODS as u64));
+    for n in [3usize, 10] {
+        let (m, t0, z0, t1) = on_attractor(n);
+        for (name, propagation) in [("dense", Propagation::Dense), ("modal", Propagation::Modal)] {
+            let opts = ExactOptions {
+                propagation,
+                ..ExactOptions::default()
+            };
+            let mut it = ExactPropagator::try_with(&m, opts).unwrap();
+            g.bench_with_input(BenchmarkId::new(name, n), &n, |b, _| {
+                b.iter(|| {
+                    it.reset(t0, &z0).unwrap();
+                    advance(&mut it, t1).unwrap();
+                    black_box(it.state()[0])
+                })
+            });
+        }
+        let mut it = build(&m, exact(), t0, &z0).unwrap();
+        g.bench_with_input(BenchmarkId::new("observed", n), &n, |b, _| {
+            b.iter(|| {
+                it.reset(t0, &z0).unwrap();
+                advance_dyn(it.as_mut(), t1, &mut |_, _, _| Ok(())).unwrap();
                 black_box(it.state()[0])
             })
         });
@@ -133,6 +170,7 @@ fn nonlinear_laws(c: &mut Criterion) {
 criterion_group!(
     benches,
     periods_per_second,
+    paths,
     nonlinear_laws,
     matched_accuracy
 );

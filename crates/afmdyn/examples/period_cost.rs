@@ -1,17 +1,110 @@
 //! Cost of one forcing period for a law and a mode count: accepted steps and events per period
-//! and wall time per period, after a transient of 50 periods on the attractor (default
-//! parameters, paper eq. 26, Ω = 2.6; `auto` integrator).
+//! (counted with [`advance_dyn`]) and wall time per period with [`advance`] (no observer), after
+//! a transient of 50 periods on the attractor (default parameters, paper eq. 26, Ω = 2.6; `auto`
+//! integrator). The last column is the time per period through [`advance_dyn`] with an observer.
 //!
-//! `cargo run --release -p afmdyn --example period_cost -- <linear|hertz|dmt|impact> <N> [periods]`
+//! `cargo run --release -p afmdyn --example period_cost -- <linear|hertz|dmt|impact> <N> [periods]
+//! [both|advance|observed]` (the last argument runs only one of the two timed loops, for
+//! instruction counts). With the linear law, `PROPAGATION=dense|modal` in the environment forces
+//! the exact propagator's path ([`Propagation`]).
+//!
+//! `... -- build <N> [reps]`: time of one exact-propagator build at the default parameters,
+//! without and with reuse of earlier builds ([`ExactOptions::reuse`]), and of a build after a
+//! change of Ω by 1e-6 (spectral data reused, grid exponential and particular solution redone).
+//!
+//! `... -- shoot <N> [reps]`: time of one shooting solve of the period-1 orbit at Ω = 3.5 from
+//! the attractor perturbed by 1e-3 (as `benches/stability.rs`).
 
-use afmdyn::integrate::{advance_dyn, build, IntegratorOptions};
+use afmdyn::analysis::shooting::{shoot, ShootingOptions};
+use afmdyn::analysis::steady::{steady_state, SteadyOptions};
+use afmdyn::integrate::exact::{ExactOptions, ExactPropagator, Propagation};
+use afmdyn::integrate::{advance, advance_dyn, build, IntegratorOptions};
 use afmdyn::{CantileverModel, LawKind, Params};
+use nalgebra::DVector;
+use std::time::Instant;
+
+fn best_of(reps: usize, mut f: impl FnMut()) -> f64 {
+    (0..reps)
+        .map(|_| {
+            let t = Instant::now();
+            f();
+            t.elapsed().as_secs_f64() * 1e6
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+fn builds(modes: usize, reps: usize) -> Result<(), Box<dyn std::error::Error>> {
+    let p = Params {
+        modes,
+        ..Params::default()
+    };
+    let m = CantileverModel::new(&p)?;
+    let opts = |reuse| ExactOptions {
+        reuse,
+        ..ExactOptions::default()
+    };
+    let cold = best_of(reps, || {
+        std::hint::black_box(ExactPropagator::try_with(&m, opts(false)).ok());
+    });
+    ExactPropagator::try_with(&m, opts(true))?;
+    let warm = best_of(reps, || {
+        std::hint::black_box(ExactPropagator::try_with(&m, opts(true)).ok());
+    });
+    let models: Vec<CantileverModel> = (1..=reps)
+        .map(|i| {
+            CantileverModel::new(&Params {
+                omega: p.omega + 1e-6 * i as f64,
+                ..p
+            })
+        })
+        .collect::<Result<_, _>>()?;
+    let mut next = models.iter();
+    let omega_step = best_of(reps, || {
+        if let Some(model) = next.next() {
+            std::hint::black_box(ExactPropagator::try_with(model, opts(true)).ok());
+        }
+    });
+    println!(
+        "build N = {modes}: {cold:.1} µs cold, {warm:.1} µs same parameters, \
+         {omega_step:.1} µs after an Ω step"
+    );
+    Ok(())
+}
+
+fn shooting(modes: usize, reps: usize) -> Result<(), Box<dyn std::error::Error>> {
+    let p = Params {
+        modes,
+        omega: 3.5,
+        ..Params::default()
+    };
+    let m = CantileverModel::new(&p)?;
+    let mut it = build(&m, IntegratorOptions::default(), 0.0, &m.rest())?;
+    let z = steady_state(it.as_mut(), &SteadyOptions::default())?
+        .end_state()
+        .clone();
+    let guess = z + DVector::from_element(m.dim(), 1e-3);
+    let iters = shoot(&m, &guess, 1, &ShootingOptions::default())?
+        .residuals
+        .len();
+    let us = best_of(reps, || {
+        std::hint::black_box(shoot(&m, &guess, 1, &ShootingOptions::default()).ok());
+    });
+    println!("shoot N = {modes}: {us:.1} µs ({iters} residual evaluations)");
+    Ok(())
+}
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
-    let law: LawKind = args.next().unwrap_or_else(|| "linear".into()).parse()?;
+    let first = args.next().unwrap_or_else(|| "linear".into());
     let modes: usize = args.next().map_or(Ok(3), |s| s.parse())?;
+    match first.as_str() {
+        "build" => return builds(modes, args.next().map_or(Ok(200), |s| s.parse())?),
+        "shoot" => return shooting(modes, args.next().map_or(Ok(200), |s| s.parse())?),
+        _ => {}
+    }
+    let law: LawKind = first.parse()?;
     let periods: f64 = args.next().map_or(Ok(200.0), |s| s.parse())?;
+    let which = args.next().unwrap_or_else(|| "both".into());
     let p = Params {
         modes,
         contact_law: law.with_groups(None, None, None),
@@ -19,18 +112,40 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let m = CantileverModel::new(&p)?;
     let mut it = build(&m, IntegratorOptions::default(), 0.0, &m.rest())?;
-    advance_dyn(it.as_mut(), 50.0 * p.period(), &mut |_, _, _| Ok(()))?;
-    let (mut steps, mut events) = (0usize, 0usize);
-    let t_end = it.tau() + periods * p.period();
-    let start = std::time::Instant::now();
-    advance_dyn(it.as_mut(), t_end, &mut |_, s, _| {
-        steps += 1;
-        events += usize::from(s.event.is_some());
-        Ok(())
-    })?;
+    let forced = match std::env::var("PROPAGATION").as_deref() {
+        Ok("dense") => Some(Propagation::Dense),
+        Ok("modal") => Some(Propagation::Modal),
+        _ => None,
+    };
+    if let Some(propagation) = forced {
+        let opts = ExactOptions {
+            propagation,
+            ..ExactOptions::default()
+        };
+        it = Box::new(ExactPropagator::try_with(&m, opts)?);
+        it.reset(0.0, &m.rest())?;
+    }
+    advance(it.as_mut(), 50.0 * p.period())?;
+    let (tau0, z0) = (it.tau(), it.state().clone());
+    let t_end = tau0 + periods * p.period();
+    let start = Instant::now();
+    if which != "observed" {
+        advance(it.as_mut(), t_end)?;
+    }
     let us = start.elapsed().as_secs_f64() * 1e6 / periods;
+    it.reset(tau0, &z0)?;
+    let (mut steps, mut events) = (0usize, 0usize);
+    let start = Instant::now();
+    if which != "advance" {
+        advance_dyn(it.as_mut(), t_end, &mut |_, s, _| {
+            steps += 1;
+            events += usize::from(s.event.is_some());
+            Ok(())
+        })?;
+    }
+    let us_observed = start.elapsed().as_secs_f64() * 1e6 / periods;
     println!(
-        "{} {modes} {} {:.1} {:.2} {us:.1}",
+        "{} {modes} {} {:.1} {:.2} {us:.1} {us_observed:.1}",
         p.contact_law.name(),
         it.name(),
         steps as f64 / periods,

@@ -155,6 +155,28 @@ pub trait Integrator: Send {
     }
     /// Integrator name.
     fn name(&self) -> &'static str;
+    /// Advance to exactly `tau_end` without observing the steps: the same steps and events as
+    /// calling [`Integrator::step`] until `tau_end`, but an integrator may keep its state in an
+    /// internal representation in between (the exact propagator's modal coordinates).
+    ///
+    /// # Errors
+    /// As [`Integrator::step`].
+    fn advance_to(&mut self, tau_end: f64) -> Result<(), SimError> {
+        while self.tau() < tau_end {
+            self.step(tau_end)?;
+        }
+        Ok(())
+    }
+}
+
+/// Advance `integ` to exactly `tau_end` ([`Integrator::advance_to`]); use it instead of
+/// [`advance_dyn`] with an observer that does nothing.
+///
+/// # Errors
+/// As [`Integrator::step`]; [`SimError::NotFinite`] for a non-finite `tau_end`.
+pub fn advance(integ: &mut dyn Integrator, tau_end: f64) -> Result<(), SimError> {
+    crate::error::finite("tau_end", tau_end)?;
+    integ.advance_to(tau_end)
 }
 
 /// Advance `integ` to exactly `tau_end`, calling `on_step(integ, step, z_before)` after every
@@ -170,7 +192,9 @@ pub fn advance_dyn(
     crate::error::finite("tau_end", tau_end)?;
     let mut before = integ.state().clone();
     while integ.tau() < tau_end {
-        before.copy_from(integ.state());
+        before
+            .as_mut_slice()
+            .copy_from_slice(integ.state().as_slice());
         let step = integ.step(tau_end)?;
         on_step(integ, &step, &before)?;
     }
@@ -329,13 +353,25 @@ pub fn build(
 /// and this is the inner loop of the propagators and of the model's vector field.
 #[inline]
 pub(crate) fn matvec(a: &DMatrix<f64>, x: &[f64], y: &mut [f64], alpha: f64, accumulate: bool) {
-    let rows = a.nrows();
-    debug_assert_eq!(rows, y.len());
+    debug_assert_eq!(a.nrows(), y.len());
     debug_assert_eq!(a.ncols(), x.len());
+    matvec_cols(a.as_slice(), a.nrows(), x, y, alpha, accumulate);
+}
+
+/// [`matvec`] on the column-major storage `a` of a matrix with `rows` rows.
+#[inline]
+pub(crate) fn matvec_cols(
+    a: &[f64],
+    rows: usize,
+    x: &[f64],
+    y: &mut [f64],
+    alpha: f64,
+    accumulate: bool,
+) {
     if !accumulate {
         y.fill(0.0);
     }
-    for (col, &xj) in a.as_slice().chunks_exact(rows).zip(x) {
+    for (col, &xj) in a.chunks_exact(rows.max(1)).zip(x) {
         let s = alpha * xj;
         for (yi, aij) in y.iter_mut().zip(col) {
             *yi += aij * s;

@@ -1,0 +1,968 @@
+//! Exact propagation of the piecewise-linear model with located switchings.
+//!
+//! Between switchings each region is linear and time-invariant with constant plus harmonic
+//! forcing (eq. 10), so with δz = z − z_p(τ) (z_p the periodic particular solution)
+//!
+//! z(τ + t) = z_p(τ + t) + e^{A_s t} δz(τ).
+//!
+//! **Grid.** The drive period T is split into m sub-steps h = T/m with ‖Ã_s‖₂ h ≤ θ, where
+//! Ã_s = T_s A_s T_s⁻¹ is A_s in energy coordinates y = (L_Kᵀ a, L_Mᵀ ȧ) (K_s = L_K L_Kᵀ,
+//! M = L_M L_Mᵀ). Φ_s = e^{A_s h} and z_p at the grid points are precomputed, so a step costs one
+//! 2N×2N matrix–vector product (`exact/kernel.rs`: fixed-size for N ≤ 6). Partial steps (after a
+//! switching, to a requested time) use the eigendecomposition of Ã (`exact/modal.rs`) when it is
+//! well conditioned, else the Taylor series of e^{Ã t} y, which converges fast because ‖Ã t‖ ≤ θ.
+//!
+//! **Modal propagation** ([`Propagation`]). For N > 6, a region whose eigenvector basis is well
+//! conditioned keeps the homogeneous part in modal coordinates q = V⁻¹ T δz during a stint: a grid
+//! step multiplies q by e^{Λh} (about N complex products) and evaluates the tip from q; the
+//! plain state z = z_p + T⁻¹ V q is formed only when asked for ([`Integrator::step`] returns it
+//! after every step, [`Integrator::advance_to`] only at events and at the end). The
+//! eigendecomposition also tightens the curvature bound below.
+//!
+//! **Switching detection** on the gap g = ±V_T (eq. 8; + in region I, − in region II) is rigorous:
+//! in energy coordinates the homogeneous flow does not increase ‖y‖ (Ã + Ãᵀ ⪯ 0 since C ⪰ 0),
+//! so |g''| ≤ ‖Ãᵀ² c̃‖ ‖y(τ_entry)‖ + Ω²|V_p| bounds the curvature over the stint. A step is
+//! accepted without search when the two parabolas g(a) + g'(a)s − Bs²/2 and
+//! g(b) − g'(b)s − Bs²/2 prove g > 0 over it; otherwise the tip motion in the step is expanded as
+//! a power series (moments c̃ᵀÃⁿy), the bound is tightened, and a pruned bisection finds the
+//! *leftmost* zero — also a dip below V_T = 0 that returns between two grid points (grazing) —
+//! which a safeguarded Newton iteration polishes to round-off.
+//!
+//! **No re-trigger.** Right after a switching g = 0 and g' > 0 in the new region; the search
+//! starts where the lower parabola g'(0)s − Bs²/2 is largest, so the same event cannot fire twice.
+//! Many switchings in a vanishing time window are reported as [`SimError::Chattering`].
+
+mod kernel;
+mod modal;
+mod search;
+mod spectral;
+
+pub use modal::MAX_MODAL_CONDITION;
+
+use super::grid::PeriodGrid;
+use super::{matvec, Integrator, Step};
+use crate::error::SimError;
+use crate::galerkin::Region;
+use crate::model::CantileverModel;
+use crate::params::Params;
+use kernel::MatVec;
+use modal::{ModalExp, Modes, MAXD};
+use nalgebra::{DMatrix, DVector};
+use search::{certified_positive, Search, TipPoly};
+use spectral::Spectral;
+use std::collections::VecDeque;
+use std::sync::Arc;
+
+/// Bound on ‖Ã‖₂ h for the grid step (radians of the fastest mode per step).
+pub const THETA: f64 = 4.0;
+/// Number of Taylor terms kept in partial steps and tip polynomials (‖Ãt‖ ≤ θ = 4:
+/// θ^41/41! ≈ 1e-25, below round-off even after the largest term, θ⁴/4! ≈ 11).
+const K: usize = 40;
+/// Switchings within [`CHATTER_WINDOW`] of τ that count as chattering.
+const CHATTER_COUNT: usize = 64;
+/// Time window of the chattering test.
+const CHATTER_WINDOW: f64 = 1e-9;
+/// Modal propagation is chosen automatically above this many modes (below it the fixed-size
+/// dense step is as fast and needs no change of coordinates).
+const MODAL_MIN_MODES: usize = 7;
+
+/// 1/n!, n = 0..=K.
+const INV_FACT: [f64; K + 1] = {
+    let mut f = [1.0; K + 1];
+    let mut prod = 1.0;
+    let mut n = 1;
+    while n <= K {
+        prod *= n as f64;
+        f[n] = 1.0 / prod;
+        n += 1;
+    }
+    f
+};
+
+/// Amplitude of the base-displacement term α2 sin Ωτ of V_T = W(1,τ) + α2 sin Ωτ + α5 (eq. 8):
+/// [`Params::base_amplitude`] (0 for the point-mass model, whose base does not move).
+fn base_amp(p: &Params) -> f64 {
+    p.base_amplitude()
+}
+
+/// How the grid steps of a region are propagated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Propagation {
+    /// Dense for N ≤ 6, modal above where the eigenvector basis is well conditioned (default).
+    #[default]
+    Auto,
+    /// Always the dense Φ_s (fixed-size kernel for N ≤ 6).
+    Dense,
+    /// Modal wherever the eigenvector basis is well conditioned (condition number ≤
+    /// [`MAX_MODAL_CONDITION`] and residual at round-off), dense elsewhere.
+    Modal,
+}
+
+/// Build options of [`ExactPropagator::try_with`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ExactOptions {
+    /// The grid has a multiple of this many sub-steps per period (≥ 1).
+    pub min_steps_per_period: usize,
+    /// Propagation of the grid steps.
+    pub propagation: Propagation,
+    /// Reuse the spectral data and grid exponentials of earlier builds with bit-identical
+    /// region matrices (and grid step) — the same values a rebuild computes.
+    pub reuse: bool,
+}
+
+impl Default for ExactOptions {
+    fn default() -> Self {
+        ExactOptions {
+            min_steps_per_period: 1,
+            propagation: Propagation::Auto,
+            reuse: true,
+        }
+    }
+}
+
+/// Data of one region that depends on the forcing (Ω, α2, α5) and the grid step.
+#[derive(Debug, Clone)]
+struct Forced {
+    /// Particular solution z_p(τ) = p0 + ps sin Ωτ + pc cos Ωτ.
+    p0: DVector<f64>,
+    ps: DVector<f64>,
+    pc: DVector<f64>,
+    /// z_p at the m + 1 grid points of one period (columns).
+    zp_grid: DMatrix<f64>,
+    /// Tip part of z_p: W_p = w0 + ws sin + wc cos.
+    wp: [f64; 3],
+    /// Ω² · amplitude of V_p (bound on |V_p''|).
+    vp_curv: f64,
+    /// e^{λ_k h} of the modal representatives (empty without an eigendecomposition).
+    grid_fac: Modes,
+}
+
+/// The last step, kept for dense output.
+#[derive(Debug, Clone)]
+struct LastStep {
+    tau0: f64,
+    region: Region,
+    /// Homogeneous part δz(τ0) in plain coordinates (dense steps).
+    dz0: DVector<f64>,
+    /// Modal coordinates of the homogeneous part at τ0 (modal steps).
+    q0: Modes,
+    /// Whether the step was modal.
+    modal: bool,
+    /// Whether the step was a whole grid step (its transition matrix is Φ_s).
+    full: bool,
+}
+
+/// Exact propagator (see the module docs).
+#[derive(Debug, Clone)]
+pub struct ExactPropagator {
+    model: CantileverModel,
+    spec: Arc<[Spectral; 2]>,
+    /// Φ_s = e^{A_s h} in plain coordinates.
+    phi: Arc<[DMatrix<f64>; 2]>,
+    forced: [Forced; 2],
+    /// Whether each region's grid steps are modal.
+    modal: [bool; 2],
+    /// Whether the spectral data and the grid exponential came from earlier builds.
+    reused: (bool, bool),
+    /// Dense grid-step kernel for this dimension.
+    kernel: MatVec,
+    grid: PeriodGrid,
+    tau: f64,
+    z: DVector<f64>,
+    /// Modal coordinates of the homogeneous part of the current state (valid in a modal region).
+    q: Modes,
+    /// z lags behind q (inside [`Integrator::advance_to`]).
+    stale: bool,
+    /// e^{λ_k t} of a partial modal step.
+    fac_tmp: Modes,
+    region: Region,
+    /// The grid point the state is on, as (period p, sub-step k < m): grid index j = p m + k.
+    on_grid: Option<(i64, usize)>,
+    /// Bound on |W_hom''| over the current stint (see `enter_stint`).
+    stint_curvature: f64,
+    just_switched: bool,
+    recent: VecDeque<f64>,
+    last: LastStep,
+    /// Tip polynomial of the last step, valid when `poly_built` (filled in place).
+    poly: Box<TipPoly>,
+    poly_built: bool,
+    /// V_T and dV_T/dτ at the current state.
+    vt: (f64, f64),
+    /// Round-off dead band of the switching test: a region is left when V_T passes 0 by more
+    /// than this (1e-15 of the displacement scale). A tip resting on the sample with zero force
+    /// (V_T = V̇_T = 0, e.g. α2 = α5 = 0 from rest) then stays put instead of chattering; a real
+    /// switching is located within dead/|dV_T/dτ| ≈ 1e-14 of V_T = 0.
+    dead: f64,
+    /// sin Ωτ_k and cos Ωτ_k on the grid of one period (k = 0..=m).
+    trig: Vec<(f64, f64)>,
+    zb: DVector<f64>,
+}
+
+/// Particular solution of one region and its grid values: A p0 = −b_const and
+/// [[A, ΩI], [−ΩI, A]] (ps, pc) = −(b_sin, b_cos) (eq. 10 with harmonic forcing).
+fn forced(
+    model: &CantileverModel,
+    r: Region,
+    spec: &Spectral,
+    trig: &[(f64, f64)],
+    h: f64,
+) -> Result<Forced, SimError> {
+    let n = model.modes();
+    let dim = 2 * n;
+    let omega = model.omega();
+    let d = model.dynamics(r);
+    let p0 = spec
+        .a_lu
+        .solve(&(-&d.b_const))
+        .ok_or_else(|| SimError::out_of_range("state matrix", "singular", "K must be SPD"))?;
+    let mut big = DMatrix::zeros(2 * dim, 2 * dim);
+    big.view_mut((0, 0), (dim, dim)).copy_from(&d.a);
+    big.view_mut((dim, dim), (dim, dim)).copy_from(&d.a);
+    for i in 0..dim {
+        big[(i, dim + i)] = omega;
+        big[(dim + i, i)] = -omega;
+    }
+    let mut rhs = DVector::zeros(2 * dim);
+    rhs.rows_mut(0, dim).copy_from(&(-&d.b_sin));
+    rhs.rows_mut(dim, dim).copy_from(&(-&d.b_cos));
+    let resonance = || {
+        SimError::out_of_range(
+            "omega",
+            omega,
+            "is an undamped natural frequency: no periodic forced response (add damping)",
+        )
+    };
+    let big_norm = big.norm();
+    let sol = big.lu().solve(&rhs).ok_or_else(resonance)?;
+    // numerically singular (Ω within round-off of an undamped resonance)
+    let amplification = sol.norm() * big_norm;
+    if rhs.norm() > 0.0 && (amplification.is_nan() || amplification > 1e13 * rhs.norm()) {
+        return Err(resonance());
+    }
+    let ps = sol.rows(0, dim).into_owned();
+    let pc = sol.rows(dim, dim).into_owned();
+    let mut zp_grid = DMatrix::zeros(dim, trig.len());
+    let (a, b, d) = (p0.as_slice(), ps.as_slice(), pc.as_slice());
+    for (col, &(s, c)) in zp_grid.as_mut_slice().chunks_exact_mut(dim).zip(trig) {
+        for (((o, a), b), d) in col.iter_mut().zip(a).zip(b).zip(d) {
+            *o = a + s * b + c * d;
+        }
+    }
+    let tip = model.tip();
+    let wp = [
+        tip.dot(&p0.rows(0, n)),
+        tip.dot(&ps.rows(0, n)),
+        tip.dot(&pc.rows(0, n)),
+    ];
+    let vp_curv = omega * omega * (wp[1] + base_amp(model.params())).hypot(wp[2]);
+    let mut grid_fac = Modes::ZERO;
+    if let Some(me) = &spec.modal {
+        me.factors(h, &mut grid_fac);
+    }
+    Ok(Forced {
+        p0,
+        ps,
+        pc,
+        zp_grid,
+        wp,
+        vp_curv,
+        grid_fac,
+    })
+}
+
+impl ExactPropagator {
+    /// Build the propagator; the grid has a multiple of `min_steps_per_period` sub-steps per
+    /// period, refined until ‖Ã_s‖₂ h ≤ θ in both regions.
+    ///
+    /// # Panics
+    /// When the forced response is singular: Ω exactly at an undamped natural frequency
+    /// (α3 = 0 and no contact damping), where no periodic particular solution exists.
+    pub fn new(model: &CantileverModel, min_steps_per_period: usize) -> Self {
+        Self::try_new(model, min_steps_per_period).expect("forced response exists")
+    }
+
+    /// As [`ExactPropagator::new`], with an error instead of a panic.
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] for Ω at an undamped resonance (see [`ExactPropagator::new`]);
+    /// [`SimError::Unsupported`] for a law that is not affine (only the linear law is).
+    pub fn try_new(model: &CantileverModel, min_steps_per_period: usize) -> Result<Self, SimError> {
+        Self::try_with(
+            model,
+            ExactOptions {
+                min_steps_per_period,
+                ..ExactOptions::default()
+            },
+        )
+    }
+
+    /// Build with explicit [`ExactOptions`] (propagation path, reuse of earlier builds).
+    ///
+    /// # Errors
+    /// As [`ExactPropagator::try_new`]; [`SimError::Budget`] when the grid of one period would
+    /// exceed [`crate::params::GRID_BUDGET_BYTES`].
+    pub fn try_with(model: &CantileverModel, opts: ExactOptions) -> Result<Self, SimError> {
+        if !model.law().is_affine() {
+            return Err(SimError::Unsupported {
+                integrator: "exact",
+                law: model.law().name(),
+                hint:
+                    "only the linear law is piecewise affine: use --integrator adaptive (or auto)",
+            });
+        }
+        let n = model.modes();
+        let dim = 2 * n;
+        let omega = model.omega();
+        let period = model.period();
+        let key = spectral::matrix_key(model);
+        let (spec, spec_reused) = spectral::spectral(model, &key, opts.reuse)?;
+        let rho = spec[0].rho.max(spec[1].rho);
+        let base = opts.min_steps_per_period.max(1);
+        // budget: the grid of one period, (2N + 2)(m + 1) values, must fit in
+        // params::GRID_BUDGET_BYTES; checked in floating point before any allocation
+        let need_f = (period * rho / THETA).ceil().max(8.0);
+        let m_f = base as f64 * (need_f / base as f64).ceil();
+        let bytes = (dim as f64 + 2.0) * (m_f + 1.0) * 8.0;
+        if bytes.is_nan() || bytes > crate::params::GRID_BUDGET_BYTES {
+            return Err(SimError::Budget {
+                what: "exact integrator grid",
+                needed: format!(
+                    "{m_f:.3e} steps per drive period ({:.0} MiB)",
+                    bytes / (1024.0 * 1024.0)
+                ),
+                budget: "128 MiB".into(),
+                hint: "the system is too stiff for its drive period: raise Ω, lower α3, α4, α6 \
+                       or N, or lower the samples per period",
+            });
+        }
+        let need = need_f as usize;
+        let m = base * need.div_ceil(base);
+        let h = period / m as f64;
+        let (phi, phi_reused) = spectral::grid_exp(&spec, &key, h, opts.reuse)?;
+        let trig: Vec<(f64, f64)> = (0..=m)
+            .map(|k| (omega * (k as f64 * h)).sin_cos())
+            .collect();
+        let forced = [
+            forced(model, Region::Free, &spec[0], &trig, h)?,
+            forced(model, Region::Contact, &spec[1], &trig, h)?,
+        ];
+        let modal = std::array::from_fn(|i| {
+            spec[i].modal.is_some()
+                && match opts.propagation {
+                    Propagation::Auto => n >= MODAL_MIN_MODES,
+                    Propagation::Dense => false,
+                    Propagation::Modal => true,
+                }
+        });
+        let p = model.params();
+        let scale = forced
+            .iter()
+            .map(|r| r.wp[1].hypot(r.wp[2]) + r.wp[0].abs())
+            .fold(0.0, f64::max);
+        let dead = 1e-15 * (1.0 + p.alpha5.abs() + base_amp(p) + scale);
+        let zero = DVector::zeros(dim);
+        Ok(ExactPropagator {
+            model: model.clone(),
+            spec,
+            phi,
+            forced,
+            modal,
+            reused: (spec_reused, phi_reused),
+            kernel: kernel::for_dim(dim),
+            grid: PeriodGrid::new(period, m),
+            tau: 0.0,
+            z: zero.clone(),
+            q: Modes::ZERO,
+            stale: false,
+            fac_tmp: Modes::ZERO,
+            region: Region::Free,
+            on_grid: Some((0, 0)),
+            stint_curvature: 0.0,
+            just_switched: true,
+            recent: VecDeque::new(),
+            last: LastStep {
+                tau0: 0.0,
+                region: Region::Free,
+                dz0: zero.clone(),
+                q0: Modes::ZERO,
+                modal: false,
+                full: false,
+            },
+            poly: Box::new(TipPoly::empty()),
+            poly_built: false,
+            vt: (0.0, 0.0),
+            dead,
+            trig,
+            zb: zero,
+        })
+    }
+
+    /// Sub-steps per drive period m.
+    pub fn steps_per_period(&self) -> usize {
+        self.grid.m
+    }
+
+    /// Whether this build reused earlier builds ([`ExactOptions::reuse`]): (the spectral data —
+    /// energy transforms, Ã_s, eigendecomposition —, the grid exponentials Φ_s).
+    pub fn reused(&self) -> (bool, bool) {
+        self.reused
+    }
+
+    /// Whether the grid steps of the free and the contact region (in that order) are modal.
+    pub fn modal_regions(&self) -> [bool; 2] {
+        self.modal
+    }
+
+    /// Transition matrix e^{A_s t} of region `r` in plain coordinates (2N×2N), for
+    /// 0 ≤ t ≤ one grid step: the precomputed Φ_s when t is the grid step, else
+    /// T⁻¹ e^{Ã t} T column by column (eigendecomposition, or the Taylor series).
+    pub fn transition(&self, r: Region, t: f64) -> DMatrix<f64> {
+        let sp = &self.spec[r.index()];
+        if t == self.grid.h {
+            return self.phi[r.index()].clone();
+        }
+        let dim = self.z.len();
+        let e = match &sp.modal {
+            // Re(V e^{Λt} V⁻¹) T: the exponentials once
+            Some(me) => me.transition_energy(t),
+            None => {
+                let mut e = DMatrix::zeros(dim, dim);
+                for j in 0..dim {
+                    let mut y = [0.0; MAXD];
+                    Self::hom_energy(sp, sp.t.column(j).as_slice(), t, &mut y[..dim]);
+                    e.column_mut(j).copy_from_slice(&y[..dim]);
+                }
+                e
+            }
+        };
+        spectral::matmul(&sp.tinv, &e)
+    }
+
+    /// Jacobian ∂z(τ1)/∂z(τ0) of the flow over the last step [τ0, τ1] inside its region
+    /// (without the saltation at a switching that ends it), 2N×2N: Φ_s or e^{A_s t}.
+    pub fn step_transition(&self) -> DMatrix<f64> {
+        let len = self.tau - self.last.tau0;
+        // a whole grid step that ended on the grid (a switching would have cut it short)
+        if self.last.full && self.on_grid.is_some() {
+            return self.phi[self.last.region.index()].clone();
+        }
+        self.transition(self.last.region, len)
+    }
+
+    fn zp_into(f: &Forced, omega: f64, tau: f64, out: &mut [f64]) {
+        let (s, c) = (omega * tau).sin_cos();
+        let (p0, ps, pc) = (f.p0.as_slice(), f.ps.as_slice(), f.pc.as_slice());
+        for (((o, a), b), d) in out.iter_mut().zip(p0).zip(ps).zip(pc) {
+            *o = a + s * b + c * d;
+        }
+    }
+
+    /// out = e^{Ã t} y0 in energy coordinates: the eigendecomposition when available, else
+    /// the Taylor series Σ Ãⁿ y0 tⁿ/n!.
+    fn hom_energy(sp: &Spectral, y0: &[f64], t: f64, out: &mut [f64]) {
+        if let Some(me) = &sp.modal {
+            return me.apply(y0, t, out);
+        }
+        let dim = y0.len();
+        let mut term = [0.0; MAXD];
+        let mut tmp = [0.0; MAXD];
+        let (mut term, mut tmp) = (&mut term[..dim], &mut tmp[..dim]);
+        out.copy_from_slice(y0);
+        term.copy_from_slice(y0);
+        let norm2 = |x: &[f64]| x.iter().map(|v| v * v).sum::<f64>();
+        let floor = 1e-34 * norm2(y0);
+        for n in 1..=K {
+            matvec(&sp.at, term, tmp, t / n as f64, false);
+            std::mem::swap(&mut term, &mut tmp);
+            for (o, x) in out.iter_mut().zip(term.iter()) {
+                *o += x;
+            }
+            if norm2(term) <= floor {
+                break;
+            }
+        }
+    }
+
+    /// Homogeneous part at the start of the last step in energy coordinates.
+    fn last_y0(&self, y0: &mut [f64]) {
+        let sp = &self.spec[self.last.region.index()];
+        match (&sp.modal, self.last.modal) {
+            (Some(me), true) => ModalExp::expand(&me.v, &self.last.q0, y0, false),
+            _ => matvec(&sp.t, self.last.dz0.as_slice(), y0, 1.0, false),
+        }
+    }
+
+    /// State at local time t of the last step, in plain coordinates.
+    fn state_in_last(&self, t: f64, out: &mut [f64]) {
+        let ri = self.last.region.index();
+        let sp = &self.spec[ri];
+        Self::zp_into(
+            &self.forced[ri],
+            self.model.omega(),
+            self.last.tau0 + t,
+            out,
+        );
+        if let Some(me) = &sp.modal {
+            // modal coordinates at τ0 (kept by a modal step, projected from δz by a dense one),
+            // advanced by e^{Λt}
+            let r = me.len();
+            let mut q0 = Modes::ZERO;
+            let q0 = if self.last.modal {
+                &self.last.q0
+            } else {
+                me.project_plain(self.last.dz0.as_slice(), &mut q0);
+                &q0
+            };
+            let mut q = Modes::ZERO;
+            me.factors(t, &mut q);
+            q.mul_assign(q0, r);
+            return ModalExp::expand(&me.tv, &q, out, true);
+        }
+        let dim = out.len();
+        let (mut y0, mut yt) = ([0.0; MAXD], [0.0; MAXD]);
+        self.last_y0(&mut y0[..dim]);
+        Self::hom_energy(sp, &y0[..dim], t, &mut yt[..dim]);
+        matvec(&sp.tinv, &yt[..dim], out, 1.0, true);
+    }
+
+    /// z = z_p(τ) + T⁻¹ V q in a modal region, when z lags behind q.
+    fn materialize(&mut self) {
+        if !self.stale {
+            return;
+        }
+        let ri = self.region.index();
+        if let Some(me) = &self.spec[ri].modal {
+            let z = self.z.as_mut_slice();
+            Self::zp_into(&self.forced[ri], self.model.omega(), self.tau, z);
+            ModalExp::expand(&me.tv, &self.q, z, true);
+        }
+        self.stale = false;
+    }
+
+    /// Fill `out` with the tip series of a step of `len` in region `r` from the homogeneous
+    /// state `y0` (energy coordinates) at τ0.
+    #[allow(clippy::too_many_arguments)]
+    fn build_poly(
+        sp: &Spectral,
+        fr: &Forced,
+        p: &Params,
+        dead: f64,
+        r: Region,
+        tau0: f64,
+        y0: &[f64],
+        len: f64,
+        out: &mut TipPoly,
+    ) {
+        let mut mo = [0.0; K + 3];
+        matvec(&sp.rows, y0, &mut mo, 1.0, false);
+        // the harmonic part a_s sin(Ωτ0 + Ωt) + a_c cos(Ωτ0 + Ωt) + const of V_T: its n-th
+        // t-derivative at 0 is Ωⁿ (S, C, −S, −C)[n mod 4]
+        let (s0, c0) = (p.omega * tau0).sin_cos();
+        let (a_s, a_c) = (fr.wp[1] + base_amp(p), fr.wp[2]);
+        let (sv, sd) = (a_s * s0 + a_c * c0, a_s * c0 - a_c * s0);
+        let cycle = [sv, sd, -sv, -sd];
+        let (om, mut om_n, mut lp) = (p.omega, 1.0, 1.0);
+        let mut curv = fr.vp_curv;
+        let mut size = [0.0; K + 1];
+        let mut biggest = 0.0f64;
+        let wp_sum = fr.wp.iter().map(|x| x.abs()).sum::<f64>();
+        // a priori bound on the coefficients beyond n: |c̃ᵀÃ^{n+d}y0| lenⁿ/n! ≤
+        // ‖c̃‖‖y0‖ρ^{n+d} lenⁿ/n! and |harmonic| ≤ (|a_s| + |a_c|) Ω^{n+d} lenⁿ/n! (d ≤ 2), so
+        // with x = max(ρ, Ω) len every size below is ≤ bound xⁿ/n! and the tail from n on
+        // ≤ bound xⁿ/n! / (1 − x/(n+1)): the series stop as soon as that is below round-off
+        let y_norm = y0.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let (rho, amp) = (sp.rho, a_s.abs() + a_c.abs());
+        let bound =
+            sp.ct_norm * y_norm * (1.0 + rho + rho * rho) * 3.0 + amp * (1.0 + om + om * om) * 2.0;
+        let x = rho.max(om) * len;
+        let mut x_fact = 1.0;
+        let mut filled = K + 1;
+        for n in 0..=K {
+            let f = INV_FACT[n];
+            let (c0n, c1n, c2n) = (mo[n] * f, mo[n + 1] * f, mo[n + 2] * f);
+            let g0 = c0n + om_n * cycle[n % 4] * f;
+            let g1 = c1n + om_n * om * cycle[(n + 1) % 4] * f;
+            out.c[0][n] = c0n;
+            out.c[1][n] = c1n;
+            out.c[2][n] = c2n;
+            out.gc[0][n] = g0;
+            out.gc[1][n] = g1;
+            curv += c2n.abs() * lp;
+            // keep terms until the remaining tail of every series (homogeneous, and with the
+            // harmonic part) is below round-off over the step
+            // (sums rather than maxima: a bound as good, without NaN-aware max sequences)
+            size[n] = (c0n.abs() + c1n.abs() + c2n.abs() + g0.abs() + g1.abs()) * lp;
+            if size[n] > biggest {
+                biggest = size[n];
+            }
+            om_n *= om;
+            lp *= len;
+            x_fact *= x / (n + 1) as f64;
+            let ratio = x / (n + 2) as f64;
+            let rest = bound * x_fact / (1.0 - ratio);
+            if ratio < 0.5 && rest <= 1e-18 * (biggest + wp_sum) {
+                filled = n + 1;
+                curv += rest;
+                break;
+            }
+        }
+        out.gc[0][0] += fr.wp[0] + p.alpha5;
+        let scale = biggest + wp_sum;
+        let mut terms = filled;
+        let mut tail = 0.0;
+        while terms > 1 {
+            tail += size[terms - 1];
+            if tail > 1e-18 * scale {
+                break;
+            }
+            terms -= 1;
+        }
+        out.tau0 = tau0;
+        out.terms = terms;
+        out.wp = fr.wp;
+        out.omega = p.omega;
+        out.base_amp = base_amp(p);
+        out.alpha5 = p.alpha5;
+        out.sigma = r.guard_sign();
+        out.dead = dead;
+        out.curv = curv;
+    }
+
+    /// Start a stint in `region` at (τ, z): the bound on |W_hom''| over the whole stint — the
+    /// smaller of the energy bound ‖c̃ᵀÃ²‖ ‖y‖ (‖e^{Ãt}‖₂ ≤ 1) and, with the eigendecomposition
+    /// y(t) = Σ v_k e^{λ_k t} q_k, the modal bound Σ |c̃ᵀv_k| |λ_k|² |q_k| (Re λ_k ≤ 0) — and,
+    /// in a modal region, the modal coordinates q of the homogeneous part.
+    fn enter_stint(&mut self, region: Region, tau: f64) {
+        let ri = region.index();
+        let sp = &self.spec[ri];
+        let dim = self.z.len();
+        let (mut dz, mut y) = ([0.0; MAXD], [0.0; MAXD]);
+        let (dz, y) = (&mut dz[..dim], &mut y[..dim]);
+        Self::zp_into(&self.forced[ri], self.model.omega(), tau, dz);
+        for (d, z) in dz.iter_mut().zip(self.z.as_slice()) {
+            *d = z - *d;
+        }
+        matvec(&sp.t, dz, y, 1.0, false);
+        let energy = sp.kappa2 * y.iter().map(|v| v * v).sum::<f64>().sqrt();
+        self.stint_curvature = match &sp.modal {
+            Some(me) => {
+                me.project(y, &mut self.q);
+                energy.min(me.curvature(&self.q) * (1.0 + 1e-12))
+            }
+            None => energy,
+        };
+    }
+
+    fn chatter_check(&mut self, tau: f64) -> Result<(), SimError> {
+        self.recent.push_back(tau);
+        while self.recent.len() > CHATTER_COUNT {
+            self.recent.pop_front();
+        }
+        if self.recent.len() == CHATTER_COUNT {
+            let window = tau - self.recent[0];
+            if window < CHATTER_WINDOW {
+                return Err(SimError::Chattering {
+                    tau,
+                    count: CHATTER_COUNT,
+                    window,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// One step (see [`Integrator::step`]); in a modal region the plain state at the end of a
+    /// whole grid step is formed only when `materialize` (else z lags behind q).
+    fn step_impl(&mut self, tau_max: f64, materialize: bool) -> Result<Step, SimError> {
+        let region = self.region;
+        let tau0 = self.tau;
+        let omega = self.model.omega();
+        let m = self.grid.m;
+        let next = match self.on_grid {
+            Some((p, k)) if k + 1 < m => (p, k + 1),
+            Some((p, _)) => (p + 1, 0),
+            None => {
+                let j = self.grid.next_index(tau0);
+                (j.div_euclid(m as i64), j.rem_euclid(m as i64) as usize)
+            }
+        };
+        // as PeriodGrid::tau
+        let t_grid = next.0 as f64 * self.grid.period + next.1 as f64 * self.grid.h;
+        let tau_b = t_grid.min(tau_max);
+        let len = tau_b - tau0;
+        if len <= 0.0 {
+            return Ok(Step {
+                tau0,
+                tau1: tau0,
+                region,
+                event: None,
+            });
+        }
+        let full = self.on_grid.is_some() && tau_b == t_grid;
+        let k = self.on_grid.map_or(0, |(_, k)| k);
+        let ri = region.index();
+        let modal = self.modal[ri];
+        let dim = self.z.len();
+        self.poly_built = false;
+        self.last.tau0 = tau0;
+        self.last.region = region;
+        self.last.full = full;
+        self.last.modal = modal;
+        let p = self.model.params();
+        let fr = &self.forced[ri];
+        let mut end_state = true;
+        let vt_b = match (&self.spec[ri].modal, modal) {
+            (Some(me), true) => {
+                // q ← e^{Λ len} q; the tip from q
+                let fac = if full {
+                    &fr.grid_fac
+                } else {
+                    me.factors(len, &mut self.fac_tmp);
+                    &self.fac_tmp
+                };
+                let (w, wd) = me.advance(&mut self.q, &mut self.last.q0, fac);
+                let (s, c) = if full {
+                    self.trig[k + 1]
+                } else {
+                    (omega * tau_b).sin_cos()
+                };
+                if full && !materialize {
+                    end_state = false;
+                } else {
+                    let zb = self.zb.as_mut_slice();
+                    if full {
+                        zb.copy_from_slice(&fr.zp_grid.as_slice()[(k + 1) * dim..(k + 2) * dim]);
+                    } else {
+                        Self::zp_into(fr, omega, tau_b, zb);
+                    }
+                    ModalExp::expand(&me.tv, &self.q, zb, true);
+                }
+                let [w0, ws, wc] = fr.wp;
+                (
+                    w + w0 + ws * s + wc * c + base_amp(p) * s + p.alpha5,
+                    wd + omega * (ws * c - wc * s) + base_amp(p) * omega * c,
+                )
+            }
+            _ if full => {
+                // z_b = z_p(τ_{k+1}) + Φ (z − z_p(τ_k))
+                let zp = fr.zp_grid.as_slice();
+                let (zk, zk1) = (
+                    &zp[k * dim..(k + 1) * dim],
+                    &zp[(k + 1) * dim..(k + 2) * dim],
+                );
+                let dz0 = self.last.dz0.as_mut_slice();
+                for ((d, z), zp) in dz0.iter_mut().zip(self.z.as_slice()).zip(zk) {
+                    *d = z - zp;
+                }
+                let zb = self.zb.as_mut_slice();
+                zb.copy_from_slice(zk1);
+                (self.kernel)(self.phi[ri].as_slice(), dz0, zb);
+                let (s, c) = self.trig[k + 1];
+                let n = p.modes;
+                let tip = self.model.tip().as_slice();
+                let dot = |x: &[f64]| tip.iter().zip(x).map(|(a, b)| a * b).sum::<f64>();
+                (
+                    dot(&zb[..n]) + base_amp(p) * s + p.alpha5,
+                    dot(&zb[n..]) + base_amp(p) * p.omega * c,
+                )
+            }
+            _ => {
+                let dz0 = self.last.dz0.as_mut_slice();
+                Self::zp_into(fr, omega, tau0, dz0);
+                for (d, z) in dz0.iter_mut().zip(self.z.as_slice()) {
+                    *d = z - *d;
+                }
+                let mut zb = std::mem::take(&mut self.zb);
+                self.state_in_last(len, zb.as_mut_slice());
+                let v = (self.model.v_t(tau_b, &zb), self.model.v_t_dot(tau_b, &zb));
+                self.zb = zb;
+                v
+            }
+        };
+        let sigma = region.guard_sign();
+        let mut ga = sigma * self.vt.0 + self.dead;
+        let da = sigma * self.vt.1;
+        let gb = sigma * vt_b.0 + self.dead;
+        let db = sigma * vt_b.1;
+        let switched = self.just_switched || ga <= 0.0;
+        if switched {
+            ga = ga.max(0.0);
+        }
+        let cheap = self.stint_curvature + self.forced[ri].vp_curv;
+        let mut hit = None;
+        if !certified_positive(ga, da, gb, db, cheap, len) {
+            let mut y0 = [0.0; MAXD];
+            self.last_y0(&mut y0[..dim]);
+            Self::build_poly(
+                &self.spec[ri],
+                &self.forced[ri],
+                self.model.params(),
+                self.dead,
+                region,
+                tau0,
+                &y0[..dim],
+                len,
+                &mut self.poly,
+            );
+            self.poly_built = true;
+            let poly = &*self.poly;
+            let search = Search { poly };
+            // start of the search: after a switching, where the lower parabola peaks
+            let mut a = 0.0;
+            let mut g_a = (ga, da);
+            if switched {
+                a = if da > 0.0 && poly.curv > 0.0 {
+                    (da / poly.curv).min(0.5 * len)
+                } else {
+                    (4.0 * f64::EPSILON * (1.0 + tau0.abs())).min(0.5 * len)
+                };
+                g_a = poly.g(a);
+            }
+            if g_a.0 <= 0.0 {
+                hit = Some(a);
+            } else {
+                hit = search.first(a, g_a, len, (gb, db), 0);
+            }
+        }
+        self.just_switched = false;
+        match hit {
+            None => {
+                if end_state {
+                    std::mem::swap(&mut self.z, &mut self.zb);
+                    self.stale = false;
+                } else {
+                    self.stale = true;
+                }
+                self.tau = tau_b;
+                self.vt = vt_b;
+                self.on_grid = (tau_b == t_grid).then_some(next);
+                if let Some((_, k_next)) = self.on_grid {
+                    if k_next == 0 {
+                        self.materialize();
+                        let norm = self.z.norm();
+                        if norm.is_nan() || norm >= 1e12 {
+                            return Err(SimError::Diverged { tau: tau_b, norm });
+                        }
+                    }
+                }
+                Ok(Step {
+                    tau0,
+                    tau1: tau_b,
+                    region,
+                    event: None,
+                })
+            }
+            Some(t) => {
+                let mut zs = std::mem::take(&mut self.z);
+                self.state_in_last(t, zs.as_mut_slice());
+                self.z = zs;
+                self.stale = false;
+                let tau_s = tau0 + t;
+                let to = region.other();
+                self.tau = tau_s;
+                self.vt = (
+                    self.model.v_t(tau_s, &self.z),
+                    self.model.v_t_dot(tau_s, &self.z),
+                );
+                self.region = to;
+                self.on_grid = None;
+                self.just_switched = true;
+                self.enter_stint(to, tau_s);
+                self.chatter_check(tau_s)?;
+                Ok(Step::switched(&self.model, tau0, region, tau_s, &self.z))
+            }
+        }
+    }
+}
+
+impl Integrator for ExactPropagator {
+    fn model(&self) -> &CantileverModel {
+        &self.model
+    }
+    fn tau(&self) -> f64 {
+        self.tau
+    }
+    fn state(&self) -> &DVector<f64> {
+        &self.z
+    }
+    fn region(&self) -> Region {
+        self.region
+    }
+    fn name(&self) -> &'static str {
+        "exact"
+    }
+
+    fn reset(&mut self, tau: f64, z: &DVector<f64>) -> Result<(), SimError> {
+        let (region, z) = self.model.checked_start(tau, z)?;
+        self.region = region;
+        self.tau = tau;
+        self.z.copy_from(&z);
+        self.stale = false;
+        let j = self.grid.next_index(tau) - 1;
+        let m = self.grid.m as i64;
+        self.on_grid =
+            (self.grid.tau(j) == tau).then_some((j.div_euclid(m), j.rem_euclid(m) as usize));
+        self.enter_stint(region, tau);
+        self.just_switched = true;
+        self.recent.clear();
+        self.last.tau0 = tau;
+        self.last.region = region;
+        self.last.dz0.fill(0.0);
+        self.last.q0 = Modes::ZERO;
+        self.last.modal = false;
+        self.last.full = false;
+        self.poly_built = false;
+        self.vt = (self.model.v_t(tau, &z), self.model.v_t_dot(tau, &z));
+        Ok(())
+    }
+
+    fn step(&mut self, tau_max: f64) -> Result<Step, SimError> {
+        self.step_impl(tau_max, true)
+    }
+
+    fn advance_to(&mut self, tau_end: f64) -> Result<(), SimError> {
+        let mut out = Ok(());
+        while self.tau < tau_end {
+            if let Err(e) = self.step_impl(tau_end, false) {
+                out = Err(e);
+                break;
+            }
+        }
+        self.materialize();
+        out
+    }
+
+    fn dense_tip(&mut self, tau: f64) -> [f64; 3] {
+        let t = tau - self.last.tau0;
+        if !self.poly_built {
+            let len = (self.tau - self.last.tau0).max(t);
+            let dim = self.z.len();
+            let mut y0 = [0.0; MAXD];
+            self.last_y0(&mut y0[..dim]);
+            let ri = self.last.region.index();
+            Self::build_poly(
+                &self.spec[ri],
+                &self.forced[ri],
+                self.model.params(),
+                self.dead,
+                self.last.region,
+                self.last.tau0,
+                &y0[..dim],
+                len,
+                &mut self.poly,
+            );
+            self.poly_built = true;
+        }
+        self.poly.w(t)
+    }
+
+    fn dense_state(&mut self, tau: f64) -> DVector<f64> {
+        let mut out = DVector::zeros(self.z.len());
+        self.state_in_last(tau - self.last.tau0, out.as_mut_slice());
+        out
+    }
+
+    fn last_step_jacobian(&mut self) -> Result<DMatrix<f64>, SimError> {
+        Ok(self.step_transition())
+    }
+}

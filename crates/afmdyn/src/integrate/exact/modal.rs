@@ -1,0 +1,319 @@
+//! e^{Ã t} in the eigenbasis Ã = V Λ V⁻¹ (complex), with one representative per
+//! complex-conjugate pair.
+//!
+//! Ã is real, so its eigenvalues are real or come in conjugate pairs (λ, λ̄) with eigenvectors
+//! (v, v̄), and for a real y the modal coordinates q = V⁻¹y of a pair are conjugate too. Hence
+//! y = V q = Σ_k w_k Re(v_k q_k) over the representatives (Im λ_k > 0 with weight w_k = 2, real
+//! λ_k with w_k = 1), and e^{Ãt} y = Σ_k w_k Re(v_k e^{λ_k t} q_k): a grid step costs one
+//! complex multiplication per representative (about N), against (2N)² multiply–adds for the
+//! dense Φ. Eigenvalues from nalgebra's real Schur form (Golub & Van Loan, *Matrix
+//! Computations*, 4th ed., §7.5), eigenvectors by inverse iteration (ibid. §7.6.1). Accepted
+//! only when V is well conditioned and the residual ‖ÃV − VΛ‖ is at round-off; otherwise the
+//! caller keeps the dense path.
+
+use nalgebra::{Complex, DMatrix, DVector};
+
+/// Largest state dimension 2N.
+pub(super) const MAXD: usize = 2 * crate::params::MAX_MODES;
+
+/// Largest accepted condition number ‖V‖_F ‖V⁻¹‖_F of the eigenvector basis.
+pub const MAX_MODAL_CONDITION: f64 = 1e4;
+
+type C = Complex<f64>;
+
+/// Complex modal values in structure-of-arrays form (real and imaginary parts apart, so that
+/// the grid step vectorizes); the first r entries are used.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Modes {
+    pub(super) re: [f64; MAXD],
+    pub(super) im: [f64; MAXD],
+}
+
+impl Modes {
+    /// All zero.
+    pub(super) const ZERO: Modes = Modes {
+        re: [0.0; MAXD],
+        im: [0.0; MAXD],
+    };
+
+    fn from(values: &[C]) -> Modes {
+        let mut m = Modes::ZERO;
+        for (k, v) in values.iter().enumerate().take(MAXD) {
+            m.re[k] = v.re;
+            m.im[k] = v.im;
+        }
+        m
+    }
+
+    /// self ← self ⊙ other elementwise over the first r entries.
+    pub(super) fn mul_assign(&mut self, other: &Modes, r: usize) {
+        let (re, im) = (&mut self.re[..r], &mut self.im[..r]);
+        for (((a, b), c), d) in re
+            .iter_mut()
+            .zip(im)
+            .zip(&other.re[..r])
+            .zip(&other.im[..r])
+        {
+            let (x, y) = (*a, *b);
+            *a = x * c - y * d;
+            *b = x * d + y * c;
+        }
+    }
+}
+
+/// Σ_k Re(x_k y_k) over the first r entries, in two interleaved partial sums (vectorizable).
+fn re_dot(x: &Modes, y: &Modes, r: usize) -> f64 {
+    let (xr, xi, yr, yi) = (&x.re[..r], &x.im[..r], &y.re[..r], &y.im[..r]);
+    let (xr2, xr1) = xr.as_chunks::<2>();
+    let (xi2, xi1) = xi.as_chunks::<2>();
+    let (yr2, yr1) = yr.as_chunks::<2>();
+    let (yi2, yi1) = yi.as_chunks::<2>();
+    let mut acc = [0.0; 2];
+    for (((a, b), c), d) in xr2.iter().zip(xi2).zip(yr2).zip(yi2) {
+        acc[0] += a[0] * c[0] - b[0] * d[0];
+        acc[1] += a[1] * c[1] - b[1] * d[1];
+    }
+    for (((a, b), c), d) in xr1.iter().zip(xi1).zip(yr1).zip(yi1) {
+        acc[0] += a * c - b * d;
+    }
+    acc[0] + acc[1]
+}
+
+/// A complex matrix as its real and imaginary parts (column-major), for vectorizable real
+/// arithmetic.
+#[derive(Debug, Clone)]
+pub(super) struct Split {
+    pub(super) re: DMatrix<f64>,
+    pub(super) im: DMatrix<f64>,
+}
+
+impl Split {
+    fn new(m: &DMatrix<C>) -> Split {
+        Split {
+            re: m.map(|c| c.re),
+            im: m.map(|c| c.im),
+        }
+    }
+}
+
+/// The eigendecomposition of one region's Ã (energy coordinates).
+#[derive(Debug, Clone)]
+pub(super) struct ModalExp {
+    /// Representative eigenvalues λ_k (r of them, r ≤ 2N).
+    pub(super) lambda: Vec<C>,
+    /// w_k v_k, 2N × r (energy coordinates).
+    pub(super) v: Split,
+    /// w_k T⁻¹ v_k, 2N × r (plain coordinates).
+    pub(super) tv: Split,
+    /// Rows of V⁻¹ of the representatives, r × 2N.
+    pub(super) vinv: DMatrix<C>,
+    /// V⁻¹ T of the representatives, r × 2N (plain coordinates to modal ones).
+    pub(super) vinv_t: Split,
+    /// w_k c̃ᵀv_k and w_k c̃ᵀv_k λ_k: the tip deflection and its rate per unit q_k.
+    pub(super) tip: Modes,
+    pub(super) tip_dot: Modes,
+    /// w_k |c̃ᵀv_k| |λ_k|²: curvature of the tip deflection per unit |q_k|.
+    pub(super) tip_lam2: Vec<f64>,
+}
+
+impl ModalExp {
+    /// Decompose `at` (Ã, 2N×2N) with tip row `ct` (c̃ᵀ) and inverse energy transform `tinv`;
+    /// `None` when the basis is ill conditioned or the decomposition inaccurate.
+    pub(super) fn new(at: &DMatrix<f64>, ct: &[f64], tinv: &DMatrix<f64>) -> Option<Self> {
+        let dim = at.nrows();
+        let all: Vec<C> = at.complex_eigenvalues().iter().copied().collect();
+        let pairs = all.iter().filter(|l| l.im > 0.0).count();
+        let below = all.iter().filter(|l| l.im < 0.0).count();
+        let mut lambda: Vec<C> = all.iter().copied().filter(|l| l.im > 0.0).collect();
+        lambda.extend(all.iter().copied().filter(|l| l.im == 0.0));
+        let r = lambda.len();
+        if pairs != below || r + pairs != dim {
+            return None;
+        }
+        let a = at.map(|x| C::new(x, 0.0));
+        let scale = at.norm().max(1.0);
+        // full basis: representatives, then the conjugates of the pairs
+        let mut full = DMatrix::<C>::zeros(dim, dim);
+        for (k, &l) in lambda.iter().enumerate() {
+            let shift = l + C::new(1e-10 * scale, 1e-10 * scale);
+            let lu = (&a - DMatrix::<C>::identity(dim, dim) * shift).lu();
+            let mut x = DVector::<C>::from_element(dim, C::new(1.0, 0.3));
+            for _ in 0..3 {
+                x = lu.solve(&x)?;
+                let norm = x.norm();
+                if !norm.is_finite() || norm == 0.0 {
+                    return None;
+                }
+                x /= C::new(norm, 0.0);
+            }
+            full.set_column(k, &x);
+            if k < pairs {
+                full.set_column(r + k, &x.map(|c| c.conj()));
+            }
+        }
+        let inv = full.clone().try_inverse()?;
+        let mut lam_full = lambda.clone();
+        lam_full.extend(lambda[..pairs].iter().map(|l| l.conj()));
+        let lam = DMatrix::from_diagonal(&DVector::from_vec(lam_full));
+        let residual = (&a * &full - &full * lam).norm();
+        let cond = full.norm() * inv.norm();
+        if !(residual <= 1e-12 * scale && cond <= MAX_MODAL_CONDITION) {
+            return None;
+        }
+        let weight = |k: usize| if k < pairs { 2.0 } else { 1.0 };
+        let mut v = full.columns(0, r).into_owned();
+        for k in 0..r {
+            v.column_mut(k).scale_mut(weight(k));
+        }
+        let tv = Split::new(&(tinv.map(|x| C::new(x, 0.0)) * &v));
+        let vinv = inv.rows(0, r).into_owned();
+        let t = tinv.clone().try_inverse()?;
+        let vinv_t = Split::new(&(&vinv * t.map(|x| C::new(x, 0.0))));
+        let tip: Vec<C> = (0..r)
+            .map(|k| v.column(k).iter().zip(ct).map(|(vi, &c)| vi * c).sum::<C>())
+            .collect();
+        let tip_dot: Vec<C> = tip.iter().zip(&lambda).map(|(t, l)| t * l).collect();
+        let tip_lam2 = tip
+            .iter()
+            .zip(&lambda)
+            .map(|(t, l)| t.norm() * l.norm_sqr())
+            .collect();
+        let (tip, tip_dot) = (Modes::from(&tip), Modes::from(&tip_dot));
+        Some(ModalExp {
+            lambda,
+            v: Split::new(&v),
+            tv,
+            vinv,
+            vinv_t,
+            tip,
+            tip_dot,
+            tip_lam2,
+        })
+    }
+
+    /// Number of representatives r.
+    pub(super) fn len(&self) -> usize {
+        self.lambda.len()
+    }
+
+    /// q = V⁻¹ y (representatives).
+    pub(super) fn project(&self, y: &[f64], q: &mut Modes) {
+        let r = self.len();
+        let (qr, qi) = (&mut q.re[..r], &mut q.im[..r]);
+        qr.fill(0.0);
+        qi.fill(0.0);
+        for (col, &yj) in self.vinv.as_slice().chunks_exact(r).zip(y) {
+            for ((a, b), vij) in qr.iter_mut().zip(qi.iter_mut()).zip(col) {
+                *a += vij.re * yj;
+                *b += vij.im * yj;
+            }
+        }
+    }
+
+    /// q = V⁻¹ T δz (representatives) from plain coordinates δz.
+    pub(super) fn project_plain(&self, dz: &[f64], q: &mut Modes) {
+        let r = self.len();
+        let (qr, qi) = (&mut q.re[..r], &mut q.im[..r]);
+        qr.fill(0.0);
+        qi.fill(0.0);
+        let cols = self.vinv_t.re.as_slice().chunks_exact(r);
+        let cols = cols.zip(self.vinv_t.im.as_slice().chunks_exact(r));
+        for ((cr, ci), &x) in cols.zip(dz) {
+            for (((a, b), vr), vi) in qr.iter_mut().zip(qi.iter_mut()).zip(cr).zip(ci) {
+                *a += vr * x;
+                *b += vi * x;
+            }
+        }
+    }
+
+    /// out = Σ_k Re(b_k q_k) over the r columns b_k of `basis` (w_k v_k or w_k T⁻¹v_k), added
+    /// to `out` when `accumulate`.
+    pub(super) fn expand(basis: &Split, q: &Modes, out: &mut [f64], accumulate: bool) {
+        if !accumulate {
+            out.fill(0.0);
+        }
+        let n = out.len().max(1);
+        let r = basis.re.ncols();
+        let cols = basis.re.as_slice().chunks_exact(n);
+        let cols = cols.zip(basis.im.as_slice().chunks_exact(n));
+        for ((cr, ci), (qr, qi)) in cols.zip(q.re[..r].iter().zip(&q.im[..r])) {
+            for ((o, br), bi) in out.iter_mut().zip(cr).zip(ci) {
+                *o += br * qr - bi * qi;
+            }
+        }
+    }
+
+    /// E = Re(V e^{Λt} V⁻¹ T) (energy coordinates out, plain in), 2N×2N: the exponentials once,
+    /// then one real product per entry pair.
+    pub(super) fn transition_energy(&self, t: f64) -> DMatrix<f64> {
+        let (dim, r) = (self.v.re.nrows(), self.len());
+        let mut f = Modes::ZERO;
+        self.factors(t, &mut f);
+        // columns of V F
+        let mut vf = Split {
+            re: self.v.re.clone(),
+            im: self.v.im.clone(),
+        };
+        for k in 0..r {
+            let (fr, fi) = (f.re[k], f.im[k]);
+            for (a, b) in vf
+                .re
+                .column_mut(k)
+                .iter_mut()
+                .zip(vf.im.column_mut(k).iter_mut())
+            {
+                let (x, y) = (*a, *b);
+                *a = x * fr - y * fi;
+                *b = x * fi + y * fr;
+            }
+        }
+        let mut e = DMatrix::zeros(dim, dim);
+        for j in 0..dim {
+            let mut q = Modes::ZERO;
+            for k in 0..r {
+                q.re[k] = self.vinv_t.re[(k, j)];
+                q.im[k] = self.vinv_t.im[(k, j)];
+            }
+            Self::expand(&vf, &q, e.column_mut(j).as_mut_slice(), false);
+        }
+        e
+    }
+
+    /// e^{λ_k t} for every representative.
+    pub(super) fn factors(&self, t: f64, out: &mut Modes) {
+        for (k, l) in self.lambda.iter().enumerate() {
+            let mag = (l.re * t).exp();
+            let (s, c) = (l.im * t).sin_cos();
+            out.re[k] = mag * c;
+            out.im[k] = mag * s;
+        }
+    }
+
+    /// out = e^{Ã t} y0 (real).
+    pub(super) fn apply(&self, y0: &[f64], t: f64, out: &mut [f64]) {
+        let mut q = Modes::ZERO;
+        let mut f = Modes::ZERO;
+        self.project(y0, &mut q);
+        self.factors(t, &mut f);
+        q.mul_assign(&f, self.len());
+        Self::expand(&self.v, &q, out, false);
+    }
+
+    /// One step of the modal coordinates: q0 ← q, q ← f ⊙ q (f = e^{λ_k t}); returns the tip
+    /// deflection and rate of the homogeneous part at the end, Σ Re(w c̃ᵀv q) and
+    /// Σ Re(w c̃ᵀv λ q).
+    pub(super) fn advance(&self, q: &mut Modes, q0: &mut Modes, f: &Modes) -> (f64, f64) {
+        let r = self.len();
+        q0.re[..r].copy_from_slice(&q.re[..r]);
+        q0.im[..r].copy_from_slice(&q.im[..r]);
+        q.mul_assign(f, r);
+        (re_dot(&self.tip, q, r), re_dot(&self.tip_dot, q, r))
+    }
+
+    /// Σ_k w_k |c̃ᵀv_k| |λ_k|² |q_k|: bounds |W_hom''| for all later times (Re λ_k ≤ 0).
+    pub(super) fn curvature(&self, q: &Modes) -> f64 {
+        let r = self.len();
+        let parts = q.re[..r].iter().zip(&q.im[..r]).zip(&self.tip_lam2);
+        parts.map(|((a, b), w)| (a * a + b * b).sqrt() * w).sum()
+    }
+}

@@ -1,0 +1,145 @@
+//! The tip motion inside one step as a power series, the certified parabola test and the
+//! pruned leftmost-root search (see the parent module's docs).
+
+use super::K;
+
+/// The tip motion inside one step as a truncated power series plus the harmonic part.
+#[derive(Debug, Clone)]
+pub(super) struct TipPoly {
+    pub(super) tau0: f64,
+    /// mo[n] / n!, mo[n+1]/n!, mo[n+2]/n! for n = 0..=K.
+    pub(super) c: [[f64; K + 1]; 3],
+    /// Taylor coefficients of V_T and dV_T/dτ in local time: c[0], c[1] plus those of the
+    /// harmonic part W_p + α2 sin Ωτ + α5 (whose n-th derivative cycles through ±Ωⁿ(S, C)), so
+    /// that the gap costs two Horner sums and no sine.
+    pub(super) gc: [[f64; K + 1]; 2],
+    /// Terms kept: the tail beyond is below round-off over the step.
+    pub(super) terms: usize,
+    pub(super) wp: [f64; 3],
+    pub(super) omega: f64,
+    /// Base-drive amplitude of V_T (α2 for the beam).
+    pub(super) base_amp: f64,
+    pub(super) alpha5: f64,
+    pub(super) sigma: f64,
+    /// Dead band added to the gap (see [`super::ExactPropagator`]'s `dead`).
+    pub(super) dead: f64,
+    /// Bound on |g''| over the step.
+    pub(super) curv: f64,
+}
+
+impl TipPoly {
+    /// A polynomial to be filled by the propagator (all zero).
+    pub(super) fn empty() -> Self {
+        TipPoly {
+            tau0: 0.0,
+            c: [[0.0; K + 1]; 3],
+            gc: [[0.0; K + 1]; 2],
+            terms: 1,
+            wp: [0.0; 3],
+            omega: 0.0,
+            base_amp: 0.0,
+            alpha5: 0.0,
+            sigma: 1.0,
+            dead: 0.0,
+            curv: 0.0,
+        }
+    }
+    fn horner(c: &[f64], t: f64) -> f64 {
+        c.iter().rev().fold(0.0, |acc, &x| acc * t + x)
+    }
+    /// [W, W', W''] of the tip at local time t.
+    pub(super) fn w(&self, t: f64) -> [f64; 3] {
+        let (s, c) = (self.omega * (self.tau0 + t)).sin_cos();
+        let (w0, ws, wc) = (self.wp[0], self.wp[1], self.wp[2]);
+        let om = self.omega;
+        [
+            Self::horner(&self.c[0][..self.terms], t) + w0 + ws * s + wc * c,
+            Self::horner(&self.c[1][..self.terms], t) + om * (ws * c - wc * s),
+            Self::horner(&self.c[2][..self.terms], t) - om * om * (ws * s + wc * c),
+        ]
+    }
+    /// Gap g = σ V_T and its derivative at local time t.
+    pub(super) fn g(&self, t: f64) -> (f64, f64) {
+        let v = Self::horner(&self.gc[0][..self.terms], t);
+        let dv = Self::horner(&self.gc[1][..self.terms], t);
+        (self.sigma * v + self.dead, self.sigma * dv)
+    }
+}
+
+/// Positive root of g + d s − B s²/2 (∞ when it never vanishes, 0 when g ≤ 0 and d ≤ 0).
+fn parabola_root(g: f64, d: f64, b: f64) -> f64 {
+    if b <= 0.0 {
+        return if d >= 0.0 {
+            f64::INFINITY
+        } else {
+            (g / -d).max(0.0)
+        };
+    }
+    let disc = d * d + 2.0 * b * g;
+    if disc < 0.0 {
+        return 0.0;
+    }
+    ((d + disc.sqrt()) / b).max(0.0)
+}
+
+/// True when the curvature bound proves g > 0 on the open interval (0, len).
+pub(super) fn certified_positive(ga: f64, da: f64, gb: f64, db: f64, b: f64, len: f64) -> bool {
+    gb > 0.0 && parabola_root(ga, da, b) + parabola_root(gb, -db, b) > len
+}
+
+pub(super) struct Search<'a> {
+    pub(super) poly: &'a TipPoly,
+}
+
+impl Search<'_> {
+    /// Leftmost t in (a, b] with g(t) ≤ 0, given g(a) > 0; None when g > 0 on (a, b].
+    pub(super) fn first(
+        &self,
+        a: f64,
+        ga: (f64, f64),
+        b: f64,
+        gb: (f64, f64),
+        depth: u32,
+    ) -> Option<f64> {
+        if gb.0 <= 0.0 {
+            return Some(self.leftmost(a, ga, b, gb, depth));
+        }
+        let width = b - a;
+        if certified_positive(ga.0, ga.1, gb.0, gb.1, self.poly.curv, width)
+            || depth > 64
+            || width <= 4.0 * f64::EPSILON * (1.0 + self.poly.tau0.abs())
+        {
+            return None;
+        }
+        let m = 0.5 * (a + b);
+        let gm = self.poly.g(m);
+        if gm.0 <= 0.0 {
+            return Some(self.leftmost(a, ga, m, gm, depth + 1));
+        }
+        self.first(a, ga, m, gm, depth + 1)
+            .or_else(|| self.first(m, gm, b, gb, depth + 1))
+    }
+
+    /// Leftmost zero in [a, b] with g(a) > 0 ≥ g(b).
+    fn leftmost(&self, a: f64, ga: (f64, f64), b: f64, gb: (f64, f64), depth: u32) -> f64 {
+        let width = b - a;
+        let monotone = ga.1 < 0.0 && gb.1 < 0.0 && -(ga.1 + gb.1) > self.poly.curv * width;
+        if monotone || depth > 64 || width <= 4.0 * f64::EPSILON * (1.0 + self.poly.tau0.abs()) {
+            return self.newton(a, ga.0, b, gb.0);
+        }
+        let m = 0.5 * (a + b);
+        let gm = self.poly.g(m);
+        if gm.0 <= 0.0 {
+            return self.leftmost(a, ga, m, gm, depth + 1);
+        }
+        if let Some(t) = self.first(a, ga, m, gm, depth + 1) {
+            return t;
+        }
+        self.leftmost(m, gm, b, gb, depth + 1)
+    }
+
+    /// Safeguarded Newton on a bracket with g(lo) > 0 ≥ g(hi) ([`crate::roots`]).
+    fn newton(&self, lo: f64, glo: f64, hi: f64, ghi: f64) -> f64 {
+        crate::roots::safeguarded_newton(lo, glo, hi, ghi, self.poly.tau0, &mut |t| self.poly.g(t))
+    }
+}

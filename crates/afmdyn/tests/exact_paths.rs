@@ -1,0 +1,234 @@
+//! The exact propagator's propagation paths (issue 11): the modal (eigenbasis) grid steps and
+//! the fixed-size dense kernel against the dense Φ_s path, the fallback to the dense path for an
+//! ill-conditioned eigenvector basis, `advance` against the observed step loop, and the reuse
+//! of earlier builds.
+//!
+//! The reference is the dense path: Φ_s = e^{A_s h} by scaling and squaring, an independent
+//! computation from the eigendecomposition the modal path uses. Orbits are taken on stable
+//! periodic attractors (Ω = 3.5 and 5) so that round-off differences decay instead of growing as
+//! they would on the chaotic attractor at Ω = 2.6.
+
+mod common;
+
+use afmdyn::galerkin::Region;
+use afmdyn::integrate::exact::{ExactOptions, ExactPropagator, Propagation};
+use afmdyn::integrate::{advance, advance_dyn, Integrator, SwitchEvent};
+use afmdyn::{CantileverModel, Params};
+use common::{events_until, harmonic_response};
+use nalgebra::DVector;
+
+fn prop(m: &CantileverModel, propagation: Propagation, reuse: bool) -> ExactPropagator {
+    ExactPropagator::try_with(
+        m,
+        ExactOptions {
+            propagation,
+            reuse,
+            ..ExactOptions::default()
+        },
+    )
+    .unwrap()
+}
+
+/// Relative difference ‖a − b‖∞ / (1 + ‖b‖∞).
+fn rel(a: &DVector<f64>, b: &DVector<f64>) -> f64 {
+    (a - b).amax() / (1.0 + b.amax())
+}
+
+/// Run both propagators from (0, z0) to `tau_end`, comparing every event (time, direction,
+/// state) and the final state to `tol` relative; returns the number of events.
+fn compare_runs(
+    a: &mut ExactPropagator,
+    b: &mut ExactPropagator,
+    z0: &DVector<f64>,
+    tau_end: f64,
+    tol: f64,
+) -> usize {
+    a.reset(0.0, z0).unwrap();
+    b.reset(0.0, z0).unwrap();
+    let ea: Vec<SwitchEvent> = events_until(a, tau_end);
+    let eb: Vec<SwitchEvent> = events_until(b, tau_end);
+    assert_eq!(ea.len(), eb.len(), "event counts differ");
+    for (x, y) in ea.iter().zip(&eb) {
+        assert_eq!((x.from, x.to), (y.from, y.to));
+        assert!(
+            (x.tau - y.tau).abs() <= tol * (1.0 + y.tau.abs()),
+            "event at {} vs {}",
+            x.tau,
+            y.tau
+        );
+        assert!(rel(&x.state, &y.state) <= tol, "event state");
+    }
+    let d = rel(a.state(), b.state());
+    assert!(d <= tol, "final states differ by {d:e}");
+    ea.len()
+}
+
+/// Modal grid steps (N = 3 forced, N = 8 and 10 automatic) agree with the dense Φ_s path to
+/// 1e-12 over 40 periods of an impacting period-1 orbit: every switching and the final state.
+#[test]
+fn modal_path_agrees_with_the_dense_path() {
+    for (modes, omega) in [(3usize, 3.5), (3, 5.0), (8, 3.5), (10, 3.5)] {
+        let p = Params {
+            modes,
+            omega,
+            ..Params::default()
+        };
+        let m = CantileverModel::new(&p).unwrap();
+        let mut dense = prop(&m, Propagation::Dense, false);
+        let mut modal = prop(
+            &m,
+            if modes > 6 {
+                Propagation::Auto
+            } else {
+                Propagation::Modal
+            },
+            false,
+        );
+        assert_eq!(dense.modal_regions(), [false, false]);
+        assert_eq!(modal.modal_regions(), [true, true], "N = {modes}");
+        let events = compare_runs(&mut dense, &mut modal, &m.rest(), 40.0 * p.period(), 1e-12);
+        assert!(
+            events >= 40,
+            "N = {modes}, Ω = {omega}: {events} switchings"
+        );
+    }
+}
+
+/// A grazing contact — the tip dips 1e-6 below the sample for a sliver far shorter than a grid
+/// step (the construction of `integrators.rs`) — is found by both paths at the same time.
+#[test]
+fn modal_path_finds_the_same_grazing_contact() {
+    for modes in [3usize, 8] {
+        let p0 = Params {
+            modes,
+            alpha5: 10.0,
+            ..Params::default()
+        };
+        let m0 = CantileverModel::new(&p0).unwrap();
+        // amplitude of the free periodic tip motion (V_T − α5) from its minimum on a fine grid
+        let n = 4096;
+        let r_amp = -(0..n)
+            .map(|k| {
+                let t = p0.period() * k as f64 / n as f64;
+                m0.v_t(t, &harmonic_response(&m0, Region::Free, t)) - 10.0
+            })
+            .fold(f64::INFINITY, f64::min);
+        let p = Params {
+            alpha5: r_amp - 1e-6,
+            ..p0
+        };
+        let m = CantileverModel::new(&p).unwrap();
+        let z0 = harmonic_response(&m, Region::Free, 0.0);
+        let mut dense = prop(&m, Propagation::Dense, false);
+        let mut modal = prop(&m, Propagation::Modal, false);
+        assert!(modal.modal_regions()[0]);
+        let events = compare_runs(&mut dense, &mut modal, &z0, 3.0 * p.period(), 1e-12);
+        assert!(events >= 2, "N = {modes}: grazing contact missed");
+    }
+}
+
+/// Critical damping of the single mode (α3² = 4 k m, a double eigenvalue with one eigenvector)
+/// makes the eigenvector basis of the free region singular: modal propagation is refused there
+/// and the dense path used, while the contact region (stiffer, not critical) stays modal; the
+/// run agrees with the all-dense one.
+#[test]
+fn ill_conditioned_basis_falls_back_to_dense() {
+    let p0 = Params {
+        modes: 1,
+        ..Params::default()
+    };
+    let m0 = CantileverModel::new(&p0).unwrap();
+    assert_eq!(
+        prop(&m0, Propagation::Modal, false).modal_regions(),
+        [true, true]
+    );
+    let g = m0.galerkin().region(Region::Free);
+    let (k, mass) = (g.stiffness[(0, 0)], g.mass[(0, 0)]);
+    let p = Params {
+        alpha3: 2.0 * (k * mass).sqrt(),
+        omega: 3.5,
+        ..p0
+    };
+    let m = CantileverModel::new(&p).unwrap();
+    // the free region's state matrix has a double eigenvalue −α3/(2m)
+    let a = &m.dynamics(Region::Free).a;
+    let disc = (a[(1, 1)] * a[(1, 1)] + 4.0 * a[(1, 0)]) / (a[(1, 1)] * a[(1, 1)]);
+    assert!(disc.abs() < 1e-12, "not critically damped: {disc:e}");
+    let mut modal = prop(&m, Propagation::Modal, false);
+    assert_eq!(modal.modal_regions(), [false, true]);
+    let mut dense = prop(&m, Propagation::Dense, false);
+    compare_runs(&mut dense, &mut modal, &m.rest(), 20.0 * p.period(), 1e-12);
+}
+
+/// `advance` (the plain state formed only at events and at the end) reaches bit for bit the
+/// state of the observed step loop, on the modal path (N = 10) and the dense one (N = 3), on the
+/// chaotic attractor at Ω = 2.6.
+#[test]
+fn advance_equals_the_step_loop() {
+    for modes in [3usize, 10] {
+        let p = Params {
+            modes,
+            ..Params::default()
+        };
+        let m = CantileverModel::new(&p).unwrap();
+        let mut a = prop(&m, Propagation::Auto, true);
+        let mut b = prop(&m, Propagation::Auto, true);
+        a.reset(0.0, &m.rest()).unwrap();
+        b.reset(0.0, &m.rest()).unwrap();
+        let tau_end = 30.5 * p.period();
+        advance(&mut a, tau_end).unwrap();
+        advance_dyn(&mut b, tau_end, &mut |_, _, _| Ok(())).unwrap();
+        assert_eq!(a.tau(), b.tau());
+        assert_eq!(a.region(), b.region());
+        assert_eq!(a.state(), b.state(), "N = {modes}");
+        // and the next steps continue identically
+        a.step(f64::INFINITY).unwrap();
+        b.step(f64::INFINITY).unwrap();
+        assert_eq!(a.state(), b.state());
+    }
+}
+
+/// A build that reuses earlier builds (same matrices; or the same region matrices after a
+/// change of Ω, α2 and α5) propagates bit for bit as a fresh build; a change of Ω alone keeps
+/// the spectral data and redoes the grid exponential, a change of α4 redoes both.
+#[test]
+fn reused_builds_propagate_as_fresh_ones() {
+    // a parameter set of this test only (α1 = 0.137), so that the other tests' builds in the
+    // shared cache cannot be the ones reused
+    let p = Params {
+        alpha1: 0.137,
+        ..Params::default()
+    };
+    let reused = |q: Params| {
+        let m = CantileverModel::new(&q).unwrap();
+        prop(&m, Propagation::Auto, true).reused()
+    };
+    assert_eq!(reused(p), (false, false));
+    assert_eq!(reused(p), (true, true));
+    assert_eq!(reused(Params { omega: 2.61, ..p }), (true, false));
+    assert_eq!(reused(Params { alpha4: 21.0, ..p }), (false, false));
+
+    for q in [
+        p,
+        Params {
+            omega: 2.7,
+            alpha2: 0.12,
+            alpha5: -0.01,
+            ..p
+        },
+    ] {
+        let m = CantileverModel::new(&q).unwrap();
+        let mut fresh = prop(&m, Propagation::Auto, false);
+        let _ = prop(&m, Propagation::Auto, true);
+        let mut reused = prop(&m, Propagation::Auto, true);
+        for it in [&mut fresh, &mut reused] {
+            it.reset(0.0, &m.rest()).unwrap();
+            advance(it, 20.0 * q.period()).unwrap();
+        }
+        assert_eq!(fresh.state(), reused.state());
+        assert_eq!(
+            fresh.transition(Region::Contact, 0.1),
+            reused.transition(Region::Contact, 0.1)
+        );
+    }
+}
