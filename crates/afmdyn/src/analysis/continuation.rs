@@ -10,7 +10,7 @@
 //! circle (Neimark–Sacker) and the number of switchings per cycle (grazing); each sign change
 //! is located by bisection on the arclength step.
 
-use super::monodromy::{stroboscopic, FlowMap};
+use super::monodromy::{flow_state, stroboscopic, FlowMap};
 use super::shooting::{
     floquet_stability, section_points, shoot_with, Instability, ShootingOptions,
 };
@@ -151,11 +151,19 @@ impl Solver {
         stroboscopic(self.at(p)?, z, n)
     }
 
+    /// Pⁿ(z) alone (the state of [`Solver::map`] without the monodromy matrix).
+    fn map_state(&mut self, z: &DVector<f64>, p: f64) -> Result<DVector<f64>, SimError> {
+        let t = self.spec.period as f64;
+        let integ = self.at(p)?;
+        let t = t * integ.model().period();
+        flow_state(integ, 0.0, z, t)
+    }
+
     /// ∂Pⁿ/∂p by central differences.
     fn dp(&mut self, z: &DVector<f64>, p: f64) -> Result<DVector<f64>, SimError> {
         let d = 1e-6 * p.abs().max(1.0);
-        let plus = self.map(z, p + d)?.state;
-        let minus = self.map(z, p - d)?.state;
+        let plus = self.map_state(z, p + d)?;
+        let minus = self.map_state(z, p - d)?;
         Ok((plus - minus) / (2.0 * d))
     }
 

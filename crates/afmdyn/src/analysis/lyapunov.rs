@@ -13,7 +13,7 @@
 
 use super::monodromy::flow_with_jacobian;
 use crate::error::SimError;
-use crate::integrate::{advance_dyn, build, IntegratorOptions};
+use crate::integrate::{advance, build, IntegratorOptions};
 use crate::model::CantileverModel;
 use nalgebra::{DMatrix, DVector};
 use rand::{RngExt, SeedableRng};
@@ -104,7 +104,7 @@ pub fn lyapunov_spectrum(
     let dim = model.dim();
     let mut integ = build(model, opts.integrator, 0.0, z0)?;
     let t0 = opts.transient_periods as f64 * period;
-    advance_dyn(integ.as_mut(), t0, &mut |_, _, _| Ok(()))?;
+    advance(integ.as_mut(), t0)?;
     let mut z = integ.state().clone();
     let mut q = DMatrix::<f64>::identity(dim, dim);
     let per_block = opts.periods / opts.blocks;

@@ -62,6 +62,9 @@ pub fn flow_with_jacobian(
         log_volume: 0.0,
     };
     let mut before = z0.clone();
+    // scratch for the step Jacobian and the product (no allocation per step)
+    let mut step_jac = DMatrix::zeros(dim, dim);
+    let mut prod = DMatrix::zeros(dim, dim);
     while integ.tau() < tau1 {
         before.copy_from(integ.state());
         let step = integ.step(tau1)?;
@@ -69,7 +72,14 @@ pub fn flow_with_jacobian(
         if len <= 0.0 && step.event.is_none() {
             continue;
         }
-        jac = integ.last_step_jacobian()? * jac;
+        // M ← J_step M: the product rule of the monodromy matrix M = Π S_k Φ_k (Leine &
+        // Nijmeijer 2004, ch. 7), into the scratch matrix and swapped back
+        integ.last_step_jacobian_into(&mut step_jac)?;
+        if prod.shape() != (step_jac.nrows(), jac.ncols()) {
+            prod = DMatrix::zeros(step_jac.nrows(), jac.ncols());
+        }
+        step_jac.mul_to(&jac, &mut prod);
+        std::mem::swap(&mut jac, &mut prod);
         if step.region == Region::Contact {
             out.contact_time += len;
         }
@@ -113,4 +123,23 @@ pub fn stroboscopic(
 ) -> Result<FlowMap, SimError> {
     let t = n as f64 * integ.model().period();
     flow_with_jacobian(integ, 0.0, z0, t)
+}
+
+/// The state z(τ1) of the flow from (τ0, z0), without its Jacobian: the `state` of
+/// [`flow_with_jacobian`] from the same steps and events (the variational equations are switched
+/// on as there, so an integrator whose step control sees them takes the same steps), at the
+/// cost of the propagation alone ([`Integrator::advance_to`]).
+///
+/// # Errors
+/// [`SimError`] from the integrator.
+pub fn flow_state(
+    integ: &mut dyn Integrator,
+    tau0: f64,
+    z0: &DVector<f64>,
+    tau1: f64,
+) -> Result<DVector<f64>, SimError> {
+    integ.set_variational(true);
+    integ.reset(tau0, z0)?;
+    crate::integrate::advance(integ, tau1)?;
+    Ok(integ.state().clone())
 }

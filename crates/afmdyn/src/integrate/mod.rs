@@ -148,6 +148,17 @@ pub trait Integrator: Send {
     /// [`SimError::Unsupported`] for an integrator without step Jacobians (RK4), and for the
     /// adaptive integrator unless [`Integrator::set_variational`] was switched on before the step.
     fn last_step_jacobian(&mut self) -> Result<DMatrix<f64>, SimError>;
+    /// [`Integrator::last_step_jacobian`] written into `out` (resized to 2N×2N if needed), so
+    /// that a caller multiplying the step Jacobians of many steps allocates nothing per step
+    /// where the integrator can avoid it. The default calls
+    /// [`Integrator::last_step_jacobian`].
+    ///
+    /// # Errors
+    /// As [`Integrator::last_step_jacobian`].
+    fn last_step_jacobian_into(&mut self, out: &mut DMatrix<f64>) -> Result<(), SimError> {
+        *out = self.last_step_jacobian()?;
+        Ok(())
+    }
     /// Integrate the variational equations along with the state (needed by
     /// [`Integrator::last_step_jacobian`] of the adaptive integrator; free for the exact one).
     fn set_variational(&mut self, on: bool) {

@@ -965,4 +965,19 @@ impl Integrator for ExactPropagator {
     fn last_step_jacobian(&mut self) -> Result<DMatrix<f64>, SimError> {
         Ok(self.step_transition())
     }
+
+    fn last_step_jacobian_into(&mut self, out: &mut DMatrix<f64>) -> Result<(), SimError> {
+        // a whole grid step: copy the cached Φ_s without allocating (as step_transition)
+        if self.last.full && self.on_grid.is_some() {
+            let phi = &self.phi[self.last.region.index()];
+            if out.shape() == phi.shape() {
+                out.copy_from(phi);
+            } else {
+                *out = phi.clone();
+            }
+            return Ok(());
+        }
+        *out = self.step_transition();
+        Ok(())
+    }
 }
