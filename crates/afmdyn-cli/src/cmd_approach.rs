@@ -12,6 +12,7 @@ use afmdyn::analysis::continuation::BranchEvent;
 use afmdyn::analysis::observables::Observables;
 use afmdyn::analysis::resonance::{mode_band, resonance_curve, resonance_spec};
 use afmdyn::analysis::stepped::{Spacing, SteppedCurve, SteppedSpec, Sweep};
+use afmdyn::probe::Probe;
 use afmdyn::report::{curve_row, CurveUnits, CURVE_COLUMNS};
 use afmdyn::Params;
 use clap::Args;
@@ -127,104 +128,138 @@ fn event_code(e: Option<BranchEvent>) -> f64 {
     }
 }
 
-/// One table row per sweep point and branch point: (sweep code, x, columns, stable, period,
-/// event code) with the sweep's name and the event's name for the CSV.
-type Row = (String, Vec<f64>, String);
+/// The leading columns of the table: dForce 2.0's `zcdom` table (Gisbert & Garcia, *Soft
+/// Matter* 19 (2023) 5857; the header of its `zcdom*.csv`), in its order, with afmdyn's
+/// definitions and SI units (dForce writes nm, pN, 1e-20 J).
+const DFORCE: [&str; 9] = [
+    "Amplitude",
+    "Phase",
+    "Distance_min",
+    "Force_max",
+    "Energy_diss",
+    "Virial1",
+    "Deflection",
+    "Contact_time",
+    "Power_diss",
+];
 
-fn rows(c: &SteppedCurve, x: &dyn Fn(f64) -> f64, u: &CurveUnits, l: &Labels) -> Vec<Row> {
+/// One numeric row per sweep point and branch point, in the order of [`columns`].
+#[allow(clippy::too_many_arguments)]
+fn row(
+    x: f64,
+    o: &Observables,
+    omega: f64,
+    u: &CurveUnits,
+    code: f64,
+    stable: bool,
+    period: Option<usize>,
+    event: Option<BranchEvent>,
+) -> Vec<f64> {
+    let period_s = std::f64::consts::TAU / omega * u.time;
+    let mut r = vec![
+        x,
+        o.amplitude * u.length,
+        o.phase.to_degrees(),
+        o.min_distance * u.length,
+        o.peak_force.max(-o.min_force) * u.force,
+        o.energy_dissipated * u.energy,
+        o.virial * u.energy,
+        o.mean_deflection * u.length,
+        o.contact_time * u.time,
+        o.energy_dissipated * u.energy / period_s,
+        code,
+        o.amplitude / o.closed_form.free_amplitude,
+        o.peak_force * u.force,
+        o.min_force * u.force,
+        o.indentation * u.length,
+        o.contact_fraction,
+        o.thd,
+    ];
+    r.push(if stable { 1.0 } else { 0.0 });
+    r.push(period.map_or(f64::NAN, |n| n as f64));
+    r.push(event_code(event));
+    r
+}
+
+fn rows(c: &SteppedCurve, x: &dyn Fn(f64) -> f64, u: &CurveUnits, base: &Params) -> Vec<Vec<f64>> {
+    let omega = |v: f64| base.with(c.param, v).omega;
     let mut out = Vec::new();
-    let mut push = |name: String,
-                    code: f64,
-                    v: f64,
-                    o: &Observables,
-                    stable: bool,
-                    period: Option<usize>,
-                    event: Option<BranchEvent>| {
-        let mut r = vec![code, x(v)];
-        r.extend(curve_row(o, u));
-        r.push(if stable { 1.0 } else { 0.0 });
-        r.push(period.map_or(f64::NAN, |n| n as f64));
-        r.push(event_code(event));
-        out.push((
-            name,
-            r,
-            event.map_or(String::new(), |e| format!("{e:?}").to_lowercase()),
-        ));
-    };
-    for p in &c.first {
-        push(
-            l.sweeps.0.into(),
-            0.0,
-            p.value,
-            &p.observables,
-            p.stable,
-            p.period,
-            None,
-        );
-    }
-    for p in &c.second {
-        push(
-            l.sweeps.1.into(),
-            1.0,
-            p.value,
-            &p.observables,
-            p.stable,
-            p.period,
-            None,
-        );
+    for (code, sweep) in [(0.0, &c.first), (1.0, &c.second)] {
+        for p in sweep {
+            out.push(row(
+                x(p.value),
+                &p.observables,
+                omega(p.value),
+                u,
+                code,
+                p.stable,
+                p.period,
+                None,
+            ));
+        }
     }
     for (k, b) in c.branches.iter().enumerate() {
         for s in b {
             let bp = &s.point;
-            push(
-                format!("branch-{k}"),
-                2.0 + k as f64,
-                bp.value,
+            out.push(row(
+                x(bp.value),
                 &s.observables,
+                omega(bp.value),
+                u,
+                2.0 + k as f64,
                 bp.stable,
                 Some(bp.period),
                 bp.event,
-            );
+            ));
         }
     }
     out
 }
 
 fn columns(l: &Labels, u: &CurveUnits) -> Vec<Column> {
-    let (len, force, energy) = if u.si {
-        ("m", "N", "J")
+    let (len, force, energy, time, power) = if u.si {
+        ("m", "N", "J", "s", "W")
     } else {
-        ("g0", "F~", "F~ g0")
+        ("g0", "F~", "F~ g0", "tau", "F~ g0 / tau")
     };
     let x_unit = match (l.x_name, u.si, u.hz_per_omega.is_some()) {
-        ("z_c", true, _) => "m",
-        ("z_c", false, _) => "g0",
+        ("zc", true, _) => "m",
+        ("zc", false, _) => "g0",
         (_, _, true) => "Hz",
         _ => "1",
     };
-    vec![
+    let meaning = [
+        (len, "first-harmonic amplitude A of the tip deflection"),
+        (
+            "deg",
+            "lag φ of the deflection behind the drive (90 free, >90 attractive, <90 repulsive)",
+        ),
+        (len, "smallest tip–sample distance"),
+        (
+            force,
+            "largest |tip–sample force| (dForce's definition; see peak_force)",
+        ),
+        (energy, "energy dissipated in the sample per period"),
+        (energy, "virial (1/T)∫F_c W dτ"),
+        (len, "mean tip deflection"),
+        (time, "time in contact per period"),
+        (power, "dissipated power: Energy_diss per period / period"),
+    ];
+    let mut cols = vec![Column::new(l.x_name, x_unit, l.x_label.clone())];
+    for (name, (unit, what)) in DFORCE.iter().zip(meaning) {
+        cols.push(Column::new(*name, unit, what));
+    }
+    cols.extend([
         Column::new(
             "sweep",
             "1",
             format!("0 {}, 1 {}, 2 + k branch k", l.sweeps.0, l.sweeps.1),
-        ),
-        Column::new(l.x_name, x_unit, l.x_label.clone()),
-        Column::new(
-            "amplitude",
-            len,
-            "first-harmonic amplitude A of the tip deflection",
         ),
         Column::new(
             "amplitude_ratio",
             "1",
             "A/A0, A0 the free amplitude at the same drive",
         ),
-        Column::new(
-            "phase_deg",
-            "deg",
-            "lag φ of the deflection behind the drive (90 free, >90 attractive, <90 repulsive)",
-        ),
-        Column::new("mean_deflection", len, "mean tip deflection"),
         Column::new(
             "peak_force",
             force,
@@ -237,13 +272,6 @@ fn columns(l: &Labels, u: &CurveUnits) -> Vec<Column> {
         ),
         Column::new("indentation", len, "largest indentation"),
         Column::new("contact_fraction", "1", "fraction of the period in contact"),
-        Column::new("min_distance", len, "smallest tip–sample distance"),
-        Column::new(
-            "energy_dissipated",
-            energy,
-            "energy dissipated in the sample per period",
-        ),
-        Column::new("virial", energy, "virial (1/T)∫F_c W dτ"),
         Column::new(
             "harmonic_distortion",
             "1",
@@ -260,10 +288,12 @@ fn columns(l: &Labels, u: &CurveUnits) -> Vec<Column> {
             "1",
             "0 none, 1 fold, 2 grazing, 3 period doubling, 4 Neimark–Sacker",
         ),
-    ]
+    ]);
+    cols
 }
 
-/// The CSV, NPY and plots of one curve in `out`.
+/// The CSV (the same numeric columns as the NPY, dForce's `zcdom` columns first), NPY and
+/// plots of one curve in `out`.
 fn write_files(
     out: &OutDir,
     files: Files,
@@ -271,29 +301,18 @@ fn write_files(
     x: &dyn Fn(f64) -> f64,
     u: &CurveUnits,
     l: &Labels,
+    base: &Params,
 ) -> Result<(), CliError> {
-    let table = rows(c, x, u, l);
+    let table = rows(c, x, u, base);
     let cols = columns(l, u);
     let header: Vec<&str> = cols.iter().map(|c| c.name.as_str()).collect();
     write_csv(
         &out.join(format!("{}.csv", l.stem)),
         &header,
-        table.iter().map(|(name, r, ev)| {
-            let mut s = vec![name.clone()];
-            s.extend(r[1..r.len() - 3].iter().map(|v| f(*v)));
-            s.push((r[r.len() - 3] == 1.0).to_string());
-            let period = r[r.len() - 2];
-            s.push(if period.is_nan() {
-                String::new()
-            } else {
-                f(period)
-            });
-            s.push(ev.clone());
-            s
-        }),
+        table.iter().map(|r| r.iter().map(|v| f(*v)).collect()),
     )?;
     let mut npy = NpyStream::create(&out.join(format!("{}.npy", l.stem)), cols)?;
-    for (_, r, _) in &table {
+    for r in &table {
         npy.push(r)?;
     }
     npy.finish()?;
@@ -329,7 +348,7 @@ fn plots(
             .expect("column")
     };
     let panels = [
-        if l.x_name == "z_c" {
+        if l.x_name == "zc" {
             ("amplitude_ratio", "A/A0".to_string(), "amplitude")
         } else {
             (
@@ -494,26 +513,27 @@ fn summary(c: &SteppedCurve, x: &dyn Fn(f64) -> f64, l: &Labels, out: Option<&Ou
     }
 }
 
-/// The parameters and the output units (SI with a probe; frequencies in Hz when `hz`), with
-/// `--from`/`--to` checked finite.
+/// The parameters, the output units (SI with a probe; frequencies in Hz when `hz`) and the
+/// probe, with `--from`/`--to` checked finite.
 fn setup(
     model: &ModelArgs,
     from: Option<f64>,
     to: Option<f64>,
     hz: bool,
-) -> Result<(Params, CurveUnits), CliError> {
+) -> Result<(Params, CurveUnits, Option<Probe>), CliError> {
     let (base, probe) = model.resolve(Params::default())?;
     check_finite("--from", from)?;
     check_finite("--to", to)?;
     let units = probe.as_ref().map_or_else(CurveUnits::dimensionless, |p| {
         CurveUnits::from_scales(&p.scales, hz)
     });
-    Ok((base, units))
+    Ok((base, units, probe))
 }
 
 /// The part of a run shared by both commands.
 struct Run<'a> {
     args: &'a CurveArgs,
+    base: &'a Params,
     out: &'a Path,
     units: &'a CurveUnits,
     labels: &'a Labels,
@@ -535,7 +555,15 @@ impl Run<'_> {
             .transpose()?;
         let c = compute(spec)?;
         if let Some(o) = &out {
-            write_files(o, self.args.files, &c, self.x, self.units, self.labels)?;
+            write_files(
+                o,
+                self.args.files,
+                &c,
+                self.x,
+                self.units,
+                self.labels,
+                self.base,
+            )?;
         }
         if self.args.json {
             println!("{}", doc(&c));
@@ -557,7 +585,7 @@ fn check_finite(name: &str, v: Option<f64>) -> Result<(), CliError> {
 
 /// Run `afmdyn approach`.
 pub fn approach(a: &ApproachArgs) -> Result<(), CliError> {
-    let (base, units) = setup(&a.model, a.from, a.to, false)?;
+    let (base, units, probe) = setup(&a.model, a.from, a.to, false)?;
     let (far, near) = default_range(&base)?;
     let from = a.from.map_or(far, |v| v / units.length);
     let to = a.to.map_or(near, |v| v / units.length);
@@ -566,7 +594,7 @@ pub fn approach(a: &ApproachArgs) -> Result<(), CliError> {
     let labels = Labels {
         stem: "approach",
         sweeps: ("approach", "retract"),
-        x_name: "z_c",
+        x_name: "zc",
         x_label: format!(
             "rest distance z_c{}",
             if units.si { " (m)" } else { " (g0)" }
@@ -574,19 +602,24 @@ pub fn approach(a: &ApproachArgs) -> Result<(), CliError> {
     };
     let run = Run {
         args: &a.curve,
+        base: &base,
         out: &a.out,
         units: &units,
         labels: &labels,
         x: &x,
     };
     run.go(&mut spec, approach_retract, |c| {
-        afmdyn::report::approach(&base, c, &units)
+        afmdyn::report::with_si(
+            afmdyn::report::approach(&base, c, &units),
+            probe.as_ref(),
+            &base,
+        )
     })
 }
 
 /// Run `afmdyn resonance`.
 pub fn resonance(a: &ResonanceArgs) -> Result<(), CliError> {
-    let (base, units) = setup(&a.model, a.from, a.to, true)?;
+    let (base, units, probe) = setup(&a.model, a.from, a.to, true)?;
     let hz = units.hz_per_omega.unwrap_or(1.0);
     let (lo, hi) = mode_band(&base, a.mode)?;
     let from = a.from.map_or(lo, |v| v / hz);
@@ -609,12 +642,17 @@ pub fn resonance(a: &ResonanceArgs) -> Result<(), CliError> {
     };
     let run = Run {
         args: &a.curve,
+        base: &base,
         out: &a.out,
         units: &units,
         labels: &labels,
         x: &x,
     };
     run.go(&mut spec, resonance_curve, |c| {
-        afmdyn::report::resonance(&base, c, &units)
+        afmdyn::report::with_si(
+            afmdyn::report::resonance(&base, c, &units),
+            probe.as_ref(),
+            &base,
+        )
     })
 }

@@ -143,7 +143,23 @@ fn approach_writes_csv_npy_and_plots() {
     let csv = std::fs::read_to_string(dir.join("approach.csv")).unwrap();
     let mut lines = csv.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    assert_eq!(&header[..3], &["sweep", "z_c", "amplitude"]);
+    // dForce 2.0's zcdom columns first, in its order (header of its zcdom*.csv)
+    assert_eq!(
+        &header[..10],
+        &[
+            "zc",
+            "Amplitude",
+            "Phase",
+            "Distance_min",
+            "Force_max",
+            "Energy_diss",
+            "Virial1",
+            "Deflection",
+            "Contact_time",
+            "Power_diss"
+        ]
+    );
+    assert_eq!(header[10], "sweep");
     assert_eq!(lines.count(), 22, "11 approach + 11 retract rows");
     let meta: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("approach.npy.json")).unwrap())

@@ -9,20 +9,20 @@ use crate::run::{run, Job, Stop};
 use afmdyn::analysis::approach::{approach_retract, approach_spec, default_range};
 use afmdyn::analysis::resonance::{mode_band, resonance_curve, resonance_spec};
 use afmdyn::analysis::stepped::{Spacing, SteppedCurve, SteppedSpec};
+use afmdyn::probe::Probe;
 use afmdyn::report::{self, CurveUnits};
 use afmdyn::{Params, SimError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::PathBuf;
 
-/// The units of a probe file (SI), or the model's own; `hz`: frequencies in Hz.
-fn units(probe: Option<PathBuf>, hz: bool) -> PyResult<CurveUnits> {
+/// The units of a probe file (SI), or the model's own, and the probe; `hz`: frequencies in Hz.
+fn units(probe: Option<PathBuf>, hz: bool) -> PyResult<(CurveUnits, Option<Probe>)> {
     match probe {
-        None => Ok(CurveUnits::dimensionless()),
+        None => Ok((CurveUnits::dimensionless(), None)),
         Some(path) => {
-            let p =
-                afmdyn::probe::Probe::load(&path).map_err(|e| value_error(format!("probe {e}")))?;
-            Ok(CurveUnits::from_scales(&p.scales, hz))
+            let p = Probe::load(&path).map_err(|e| value_error(format!("probe {e}")))?;
+            Ok((CurveUnits::from_scales(&p.scales, hz), Some(p)))
         }
     }
 }
@@ -92,7 +92,7 @@ pub fn approach<'py>(
     progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let base: Params = params.inner;
-    let u = units(probe, false)?;
+    let (u, probe) = units(probe, false)?;
     let (far, near) = default_range(&base).map_err(sim_error)?;
     let from = from_.map_or(far, |v| v / u.length);
     let to = to.map_or(near, |v| v / u.length);
@@ -105,7 +105,7 @@ pub fn approach<'py>(
         tolerance,
         progress,
         approach_retract,
-        |c| report::approach(&base, c, &u),
+        |c| report::with_si(report::approach(&base, c, &u), probe.as_ref(), &base),
     )
 }
 
@@ -128,7 +128,7 @@ pub fn resonance<'py>(
     progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let base: Params = params.inner;
-    let u = units(probe, true)?;
+    let (u, probe) = units(probe, true)?;
     let hz = u.hz_per_omega.unwrap_or(1.0);
     let (lo, hi) = mode_band(&base, mode).map_err(sim_error)?;
     let from = from_.map_or(lo, |v| v / hz);
@@ -141,6 +141,6 @@ pub fn resonance<'py>(
         tolerance,
         progress,
         resonance_curve,
-        |c| report::resonance(&base, c, &u),
+        |c| report::with_si(report::resonance(&base, c, &u), probe.as_ref(), &base),
     )
 }

@@ -250,6 +250,8 @@ pub struct CurveUnits {
     pub force: f64,
     /// Reported energy per F̃·g₀ (1, or joules).
     pub energy: f64,
+    /// Reported time per unit τ (1, or seconds).
+    pub time: f64,
     /// Hz per unit Ω, when frequencies are reported in Hz.
     pub hz_per_omega: Option<f64>,
     /// Whether the factors convert to SI (the unit names of the document).
@@ -263,6 +265,7 @@ impl CurveUnits {
             length: 1.0,
             force: 1.0,
             energy: 1.0,
+            time: 1.0,
             hz_per_omega: None,
             si: false,
         }
@@ -275,6 +278,7 @@ impl CurveUnits {
             length: s.length_m,
             force: s.force_n,
             energy: s.energy_j(),
+            time: s.time_s,
             hz_per_omega: hz.then(|| s.frequency_hz(1.0)),
             si: true,
         }
@@ -422,7 +426,7 @@ fn curve_doc(
     json!({
         "params": params,
         "units": u.names(),
-        "scales": {"length": u.length, "force": u.force, "energy": u.energy,
+        "scales": {"length": u.length, "force": u.force, "energy": u.energy, "time": u.time,
                    "hz_per_omega": u.hz_per_omega},
         names.0: sweep_doc(&x, &c.first, u),
         names.1: sweep_doc(&x, &c.second, u),
@@ -436,6 +440,16 @@ fn curve_doc(
         "free_amplitude": free,
         "warnings": c.warnings,
     })
+}
+
+/// `doc` with the [`si`] block of `probe` added, when the model came from a probe file (the
+/// curve documents: their values are already in SI, the block carries the scales, drive, A₀
+/// and z_c).
+pub fn with_si(mut doc: Value, probe: Option<&crate::probe::Probe>, params: &Params) -> Value {
+    if let Some(p) = probe {
+        doc["si"] = si(p, params, &json!({}));
+    }
+    doc
 }
 
 /// `afmdyn approach --json`: `{"approach": {...}, "retract": {...}, "branches": [...], …}`.

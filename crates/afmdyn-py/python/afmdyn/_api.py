@@ -792,6 +792,21 @@ def observe(
     return doc
 
 
+def _curve(
+    fn: Any,
+    desc: str,
+    progress: ProgressArg,
+    p: Params,
+    probe: Optional[Union[str, "os.PathLike[str]"]],
+    **options: Any,
+) -> Dict[str, Any]:
+    """Run a stepped-curve analysis (:func:`approach`, :func:`resonance`) and return its
+    JSON document."""
+    d = _run(fn, desc, progress, p, probe=None if probe is None else os.fspath(probe), **options)
+    doc: Dict[str, Any] = json.loads(d["json"])
+    return doc
+
+
 def approach(
     params: Optional[Params] = None,
     /,
@@ -825,22 +840,19 @@ def approach(
         lists ``z_c``, ``amplitude``, ``phase_deg``, …, ``stable``), ``branches``, ``folds``,
         ``bistable``, ``jumps`` (``docs/outputs.md``).
     """
-    p = _params(params, model)
-    d = _run(
+    return _curve(
         _core.approach,
         "approach",
         progress,
-        p,
+        _params(params, model),
+        probe,
         from_=from_,
         to=to,
         step=step,
         points=points,
         branches=branches,
         tolerance=tolerance,
-        probe=None if probe is None else os.fspath(probe),
     )
-    doc: Dict[str, Any] = json.loads(d["json"])
-    return doc
 
 
 def resonance(
@@ -872,12 +884,12 @@ def resonance(
         ``frequency_hz``, ``amplitude``, ``phase_deg``, …), ``branches``, ``folds``,
         ``bistable``, ``jumps``.
     """
-    p = _params(params, model)
-    d = _run(
+    return _curve(
         _core.resonance,
         "resonance",
         progress,
-        p,
+        _params(params, model),
+        probe,
         mode=mode,
         from_=from_,
         to=to,
@@ -885,7 +897,4 @@ def resonance(
         points=points,
         branches=branches,
         tolerance=tolerance,
-        probe=None if probe is None else os.fspath(probe),
     )
-    doc: Dict[str, Any] = json.loads(d["json"])
-    return doc

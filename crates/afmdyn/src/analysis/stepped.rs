@@ -492,27 +492,51 @@ fn continue_orbit(
     continue_orbit(spec, mid, &zm, Some(&half_slope), v1, n, depth - 1, None)
 }
 
-/// The steady state at `value` reached from the previous point `prev` (or from rest); `before`
-/// is the point before `prev` on the same branch, for a secant predictor.
+/// The slope s with which `z_last + s (value − v_last)` predicts the orbit at `value` from the
+/// previous points of the same branch (same period, none reached by settling after the first):
+/// the quadratic (Lagrange) extrapolation through the last three, else the secant through the
+/// last two, else none.
+fn prediction_slope(history: &[CurvePoint], value: f64) -> Option<DVector<f64>> {
+    let k = history.len();
+    let last = history.last()?;
+    // the longest tail of the same branch, at most three points
+    let mut m = 1;
+    while m < k.min(3) {
+        let (a, b) = (&history[k - m - 1], &history[k - m]);
+        if a.period != b.period || b.reached == Reached::Settled || a.value == b.value {
+            break;
+        }
+        m += 1;
+    }
+    let pts = &history[k - m..];
+    let dv = value - last.value;
+    match pts {
+        [b, a] => Some((&a.state - &b.state) / (a.value - b.value)),
+        [c, b, a] if c.value != a.value => {
+            let (x0, x1, x2) = (c.value, b.value, a.value);
+            let l0 = (value - x1) * (value - x2) / ((x0 - x1) * (x0 - x2));
+            let l1 = (value - x0) * (value - x2) / ((x1 - x0) * (x1 - x2));
+            let l2 = (value - x0) * (value - x1) / ((x2 - x0) * (x2 - x1));
+            let pred = &c.state * l0 + &b.state * l1 + &a.state * l2;
+            (dv != 0.0).then(|| (pred - &a.state) / dv)
+        }
+        _ => None,
+    }
+}
+
+/// The steady state at `value` reached from the last point of `history` (or from rest), the
+/// previous points of its branch giving the predictor ([`prediction_slope`]).
 fn step_point(
     spec: &SteppedSpec,
     value: f64,
-    prev: Option<&CurvePoint>,
-    before: Option<&CurvePoint>,
+    history: &[CurvePoint],
 ) -> Result<CurvePoint, SimError> {
+    let prev = history.last();
     let model = CantileverModel::new(&spec.base.with(spec.param, value))?;
     let last = prev.map_or_else(|| model.rest(), |p| p.state.clone());
     let n = prev.and_then(|p| p.period).unwrap_or(1);
     let mut integ = build(&model, spec.integrator, 0.0, &last)?;
-    // the secant slope dz/dv through the two previous orbits of the same branch
-    let slope = match (prev, before) {
-        (Some(p), Some(b))
-            if p.period == b.period && p.reached != Reached::Settled && p.value != b.value =>
-        {
-            Some((&p.state - &b.state) / (p.value - b.value))
-        }
-        _ => None,
-    };
+    let slope = prediction_slope(history, value);
     let continued = match prev {
         Some(p) => continue_orbit(
             spec,
@@ -579,8 +603,7 @@ fn sweep(
             (0, Some(s)) => s.clone(),
             _ => {
                 let k = out.len();
-                let before = if k >= 2 { out.get(k - 2) } else { None };
-                step_point(spec, v, out.last(), before)?
+                step_point(spec, v, &out[k.saturating_sub(3)..])?
             }
         };
         out.push(p);
