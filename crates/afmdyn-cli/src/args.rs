@@ -175,12 +175,6 @@ pub fn parse_toml<T: for<'de> Deserialize<'de>>(text: &str) -> Result<T, String>
 }
 
 impl ModelArgs {
-    /// Resolve defaults ← config ← flags and validate (without the probe's SI scales).
-    #[allow(dead_code)] // the subcommands that print no SI values
-    pub fn params(&self, defaults: Params) -> Result<Params, CliError> {
-        Ok(self.resolve(defaults)?.0)
-    }
-
     /// The probe file, when given (read once per call).
     pub fn probe(&self) -> Result<Option<afmdyn::probe::Probe>, CliError> {
         self.probe

@@ -68,7 +68,6 @@
 //! section) and values out of range, all listed in one [`ProbeError::Invalid`].
 
 use crate::contact::ContactLaw;
-use crate::eigen::natural_modes;
 use crate::galerkin::{Galerkin, Region};
 use crate::model::CantileverModel;
 use crate::params::{Params, Structure, MAX_MODES};
@@ -692,17 +691,18 @@ impl Probe {
         freq: Option<f64>,
     ) -> Result<Probe, String> {
         let g0 = a0;
-        // tip-mass ratio of the beam, and for the geometry (L, EI, m)
+        // tip-mass ratio α1 of the beam, and for the geometry the time scale t = τ √(mL⁴/EI)
+        // (eq. 5), the force unit EI/L³ and the static stiffness 3EI/L³
         let (beam_alpha1, geometry) = match beam {
-            Beam::Calibrated { alpha1, .. } => (alpha1, None),
+            Beam::Calibrated { alpha1, k, f0 } => (alpha1, Err((k, f0))),
             Beam::Geometry {
-                length,
+                length: l,
                 ei,
-                mass_per_length,
+                mass_per_length: m,
                 tip_mass,
             } => (
-                tip_mass / (mass_per_length * length),
-                Some((length, ei, mass_per_length)),
+                tip_mass / (m * l),
+                Ok(((m * l.powi(4) / ei).sqrt(), ei / l.powi(3))),
             ),
         };
         let alpha1 = match structure {
@@ -723,14 +723,13 @@ impl Probe {
             structure,
             damping_profile: None,
         };
-        let (w1, k1, x1) = first_mode(&bare).map_err(|e| e.to_string())?;
-        // k and f0, given or from the geometry (first mode of the beam with its tip mass)
-        let (k, f0, static_k) = match (beam, geometry) {
-            (Beam::Calibrated { k, f0, .. }, _) => (k, f0, 0.0),
-            (_, Some((l, ei, m))) => {
-                let ts = (m * l.powi(4) / ei).sqrt(); // eq. 5
-                let unit = ei / l.powi(3);
-                let (bw1, bk1, _) = first_mode(&Params {
+        let (w1, x1, k1) = first_mode(&bare).map_err(|e| e.to_string())?;
+        // k and f0, given or from the geometry (first mode of the beam with its tip mass; the
+        // point mass takes the first mode of a 6-mode beam)
+        let (k, f0, static_k) = match geometry {
+            Err((k, f0)) => (k, f0, 0.0),
+            Ok((ts, unit)) => {
+                let (bw1, _, bk1) = first_mode(&Params {
                     structure: Structure::Beam,
                     modes: if structure == Structure::Beam {
                         modes
@@ -743,7 +742,6 @@ impl Probe {
                 .map_err(|e| e.to_string())?;
                 (bk1 * unit, bw1 / (TAU * ts), 3.0 * unit)
             }
-            (Beam::Geometry { .. }, None) => unreachable!("geometry carries (L, EI, m)"),
         };
         let time_s = w1 / (TAU * f0);
         let force_n = k * g0 / k1;
@@ -771,12 +769,13 @@ impl Probe {
             damping_profile: profile,
             ..bare
         };
-        let g = Galerkin::new(&with_profile).map_err(|e| e.to_string())?;
-        let m = &g.region(Region::Free).mass;
-        let sdiag = DVectorF::from_fn(modes, |j, _| profile.map_or(1.0, |s| s[j]));
-        let num = (m * &x1).dot(&x1);
-        let den: f64 = x1.iter().zip(sdiag.iter()).map(|(x, s)| x * x * s).sum();
-        let alpha3 = w1 * num / (q1 * den);
+        // x₁ is mass-normalised (x₁ᵀMx₁ = 1): α3 = ω̃₁/(Q₁ x₁ᵀ diag(s) x₁)
+        let s_x1: f64 = x1
+            .iter()
+            .enumerate()
+            .map(|(j, x)| x * x * profile.map_or(1.0, |s| s[j]))
+            .sum();
+        let alpha3 = w1 / (q1 * s_x1);
         // sample groups
         let t_s = time_s;
         let mut law = ContactLaw::Linear;
@@ -851,14 +850,12 @@ impl Probe {
 
 type DVectorF = nalgebra::DVector<f64>;
 
-/// ω̃₁, k̃₁ (first-mode stiffness at the tip) and the undamped mode x₁ of a parameter set.
-fn first_mode(p: &Params) -> Result<(f64, f64, DVectorF), crate::ParamError> {
+/// ω̃₁, the mass-normalised undamped mode x₁ and k̃₁ of a parameter set
+/// ([`crate::eigen::first_mode_at_tip`]).
+fn first_mode(p: &Params) -> Result<(f64, DVectorF, f64), crate::ParamError> {
     let g = Galerkin::new(p)?;
-    let free = g.region(Region::Free);
-    let modes = natural_modes(free);
-    let x1: DVectorF = modes.vectors.column(0).into_owned();
-    let w1 = modes.omega[0];
-    let tip = g.tip().dot(&x1);
-    let mass = (&free.mass * &x1).dot(&x1);
-    Ok((w1, w1 * w1 * mass / (tip * tip), x1))
+    Ok(crate::eigen::first_mode_at_tip(
+        g.region(Region::Free),
+        g.tip(),
+    ))
 }

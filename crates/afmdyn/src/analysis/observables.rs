@@ -67,7 +67,7 @@
 
 use super::shooting::PeriodicOrbit;
 use crate::contact::{TipSample, TipSampleLaw};
-use crate::eigen::{damped_eigenvalues, natural_modes};
+use crate::eigen::{damped_eigenvalues, first_mode_at_tip};
 use crate::error::SimError;
 use crate::galerkin::{Region, RegionMatrices};
 use crate::integrate::{build, Integrator, IntegratorOptions, SwitchEvent};
@@ -248,10 +248,7 @@ pub fn free_response(model: &CantileverModel) -> Result<FreeResponse, SimError> 
 pub fn closed_forms(model: &CantileverModel, a: f64, phase: f64) -> Result<ClosedForms, SimError> {
     let free = free_response(model)?;
     let g = model.galerkin().region(Region::Free);
-    let modes = natural_modes(g);
-    let w0 = modes.omega[0];
-    let tip_disp = model.tip().dot(&modes.vectors.column(0));
-    let k = w0 * w0 / (tip_disp * tip_disp);
+    let (w0, _, k) = first_mode_at_tip(g, model.tip());
     let eig = damped_eigenvalues(g);
     let first = eig.iter().find(|e| e.im > 0.0).or(eig.first());
     let q = first.map_or(f64::INFINITY, |e| 0.5 / e.zeta);
