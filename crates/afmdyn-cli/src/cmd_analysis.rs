@@ -698,7 +698,7 @@ pub fn bifurcation(a: &BifurcationArgs) -> Result<(), CliError> {
         "csv": final_csv,
         "npy": out.join("bifurcation.npy"),
     });
-    crate::output::add_si(&mut summary, probe.as_ref(), &base);
+    summary = afmdyn::report::with_si(summary, probe.as_ref(), &base);
     if a.json {
         println!("{summary}");
     } else {
@@ -926,7 +926,7 @@ pub fn attractors(a: &AttractorsArgs) -> Result<(), CliError> {
         )?;
     }
     let mut doc = afmdyn::report::attractors(&p, a.samples, &report);
-    crate::output::add_si(&mut doc, probe.as_ref(), &p);
+    doc = afmdyn::report::with_si(doc, probe.as_ref(), &p);
     write_bytes(
         &out.join("attractors.json"),
         serde_json::to_string_pretty(&doc).expect("json").as_bytes(),

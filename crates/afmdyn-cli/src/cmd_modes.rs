@@ -40,7 +40,7 @@ pub fn modes(a: &ModesArgs) -> Result<(), CliError> {
     let (free, contact) = spectrum(&p)?;
     if a.json {
         let mut doc = afmdyn::report::modes(&p, &free, &contact);
-        crate::output::add_si(&mut doc, probe.as_ref(), &p);
+        doc = afmdyn::report::with_si(doc, probe.as_ref(), &p);
         println!("{doc}");
         return Ok(());
     }

@@ -69,7 +69,7 @@ pub fn orbit(a: &OrbitArgs) -> Result<(), CliError> {
     let o = shoot(&model, &guess, n, &ShootingOptions::default())?;
     if a.json {
         let mut doc = afmdyn::report::orbit(&model, &o);
-        crate::output::add_si(&mut doc, probe.as_ref(), &p);
+        doc = afmdyn::report::with_si(doc, probe.as_ref(), &p);
         println!("{doc}");
         return Ok(());
     }
@@ -321,7 +321,7 @@ pub fn continuation(a: &ContinueArgs) -> Result<(), CliError> {
     )?;
     if a.json {
         let mut doc = afmdyn::report::continuation(&base, a.param, &branches);
-        crate::output::add_si(&mut doc, probe.as_ref(), &base);
+        doc = afmdyn::report::with_si(doc, probe.as_ref(), &base);
         println!("{doc}");
     } else {
         println!(
@@ -392,7 +392,7 @@ pub fn lyapunov(a: &LyapunovArgs) -> Result<(), CliError> {
     }
     if a.json {
         let mut doc = afmdyn::report::lyapunov(&p, &l);
-        crate::output::add_si(&mut doc, probe.as_ref(), &p);
+        doc = afmdyn::report::with_si(doc, probe.as_ref(), &p);
         println!("{doc}");
         return Ok(());
     }

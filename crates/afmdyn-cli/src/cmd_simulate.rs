@@ -513,7 +513,7 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
     };
     let warnings = afmdyn::report::simulate_warnings(&run);
     let mut doc = afmdyn::report::simulate_summary(&model, &run);
-    crate::output::add_si(&mut doc, probe.as_ref(), &p);
+    doc = afmdyn::report::with_si(doc, probe.as_ref(), &p);
     doc["files"] = json!(a
         .files
         .to_possible_value()
@@ -800,7 +800,7 @@ pub fn converge(a: &ConvergeArgs) -> Result<(), CliError> {
     )?;
     if a.json {
         let mut doc = afmdyn::report::converge(&p, &runs);
-        crate::output::add_si(&mut doc, probe.as_ref(), &p);
+        doc = afmdyn::report::with_si(doc, probe.as_ref(), &p);
         doc["out"] = json!(a.out);
         println!("{doc}");
     } else {

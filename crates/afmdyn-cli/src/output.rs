@@ -317,15 +317,3 @@ impl NpyStream {
 pub fn f(v: f64) -> String {
     format!("{v}")
 }
-
-/// Add the `"si"` block of [`afmdyn::report::si`] to a document when the model came from a
-/// probe file.
-pub fn add_si(
-    doc: &mut serde_json::Value,
-    probe: Option<&afmdyn::probe::Probe>,
-    p: &afmdyn::Params,
-) {
-    if let Some(pr) = probe {
-        doc["si"] = afmdyn::report::si(pr, p, doc);
-    }
-}

@@ -442,12 +442,12 @@ fn curve_doc(
     })
 }
 
-/// `doc` with the [`si`] block of `probe` added, when the model came from a probe file (the
-/// curve documents: their values are already in SI, the block carries the scales, drive, A₀
-/// and z_c).
+/// `doc` with the [`si`] block of `probe` added (built from `doc` itself, so its headline values
+/// appear in SI), when the model came from a probe file; `doc` unchanged otherwise. Every front
+/// end adds the block through this one function.
 pub fn with_si(mut doc: Value, probe: Option<&crate::probe::Probe>, params: &Params) -> Value {
     if let Some(p) = probe {
-        doc["si"] = si(p, params, &json!({}));
+        doc["si"] = si(p, params, &doc);
     }
     doc
 }
