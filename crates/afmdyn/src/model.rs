@@ -245,8 +245,7 @@ impl CantileverModel {
                 let tip = self.tip().as_slice();
                 let w: f64 = tip.iter().zip(&z[..n]).map(|(a, b)| a * b).sum();
                 let wd: f64 = tip.iter().zip(&z[n..]).map(|(a, b)| a * b).sum();
-                let v = w + p.base_amplitude() * s + p.alpha5;
-                let vd = wd + p.base_amplitude() * p.omega * c;
+                let [v, vd, _] = self.v_t_at((s, c), [w, wd, 0.0]);
                 self.law.force(contact, -v, -vd).force
             }
         }
@@ -336,8 +335,12 @@ impl CantileverModel {
     /// [V_T, dV_T/dτ, d²V_T/dτ²] at τ from the tip deflection and its derivatives
     /// [W(1,τ), W', W''] (eq. 8 differentiated twice).
     pub fn v_t_from_tip(&self, tau: f64, w: [f64; 3]) -> [f64; 3] {
+        self.v_t_at((self.params.omega * tau).sin_cos(), w)
+    }
+    /// [`CantileverModel::v_t_from_tip`] given (sin Ωτ, cos Ωτ): eq. 8, the one place V_T is
+    /// formed from the tip deflection.
+    fn v_t_at(&self, (s, c): (f64, f64), w: [f64; 3]) -> [f64; 3] {
         let p = &self.params;
-        let (s, c) = (p.omega * tau).sin_cos();
         [
             w[0] + p.base_amplitude() * s + p.alpha5,
             w[1] + p.base_amplitude() * p.omega * c,
