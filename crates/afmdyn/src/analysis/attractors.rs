@@ -7,9 +7,11 @@
 use super::bifurcation::random_state;
 use super::period::close;
 use super::shooting::{shoot_with, PeriodicOrbit, ShootingOptions};
+use super::steady::steady_states;
 use super::steady::{steady_state, PoincarePoint, SteadyOptions, SteadyState};
 use crate::error::SimError;
-use crate::integrate::{build, IntegratorKind, IntegratorOptions};
+use crate::integrate::exact::ExactBatch;
+use crate::integrate::{build, build_exact, check_start, IntegratorKind, IntegratorOptions};
 use crate::model::CantileverModel;
 use crate::params::Params;
 use nalgebra::DVector;
@@ -92,16 +94,7 @@ pub fn find_attractors(spec: &AttractorSpec) -> Result<AttractorReport, SimError
         ));
     }
     let model = CantileverModel::new(&spec.params)?;
-    let results: Vec<(DVector<f64>, Result<SteadyState, SimError>)> = (0..spec.samples)
-        .into_par_iter()
-        .with_max_len(1)
-        .map(|i| {
-            let z0 = random_state(&model, spec.seed, i as u64);
-            let r = build(&model, spec.integrator, 0.0, &z0)
-                .and_then(|mut it| steady_state(it.as_mut(), &spec.steady));
-            (z0, r)
-        })
-        .collect();
+    let results = steady_states_of_starts(&model, spec)?;
     let mut attractors: Vec<Attractor> = Vec::new();
     let mut failures = Vec::new();
     for (z0, r) in results {
@@ -135,6 +128,72 @@ pub fn find_attractors(spec: &AttractorSpec) -> Result<AttractorReport, SimError
         attractors,
         failures,
     })
+}
+
+/// A start and the steady state it reaches.
+type StartResult = (DVector<f64>, Result<SteadyState, SimError>);
+
+/// Lanes per batch of the exact propagator (the batches run in parallel).
+const BATCH_LANES: usize = 32;
+
+/// The steady state from every random start: batched ([`steady_states`]) with the exact
+/// propagator, whose lanes share one build; one by one otherwise. Both give the same results
+/// (the batch is bit-identical to its lanes alone).
+fn steady_states_of_starts(
+    model: &CantileverModel,
+    spec: &AttractorSpec,
+) -> Result<Vec<StartResult>, SimError> {
+    let starts: Vec<DVector<f64>> = (0..spec.samples)
+        .map(|i| random_state(model, spec.seed, i as u64))
+        .collect();
+    let alone = |z0: &DVector<f64>| {
+        build(model, spec.integrator, 0.0, z0)
+            .and_then(|mut it| steady_state(it.as_mut(), &spec.steady))
+    };
+    // (a build that fails, fails every start alone with its own error, as before)
+    let proto = match build_exact(model, spec.integrator) {
+        Ok(Some(p)) => p,
+        _ => {
+            return Ok(starts
+                .into_par_iter()
+                .with_max_len(1)
+                .map(|z0| {
+                    let r = alone(&z0);
+                    (z0, r)
+                })
+                .collect())
+        }
+    };
+    let chunks: Vec<Vec<StartResult>> = starts
+        .par_chunks(BATCH_LANES)
+        .with_max_len(1)
+        .map(|chunk| {
+            let mut batch = ExactBatch::new(&proto);
+            // a start the batch refuses (as `build` would) fails alone, with build's error
+            let mut lane_of = Vec::with_capacity(chunk.len());
+            for z0 in chunk {
+                let ok = check_start(z0).is_ok() && batch.push(0.0, z0).is_ok();
+                lane_of.push(ok.then(|| batch.len() - 1));
+            }
+            let Ok(results) = steady_states(&mut batch, &spec.steady) else {
+                // invalid options: every start fails alone with the error
+                return chunk.iter().map(|z0| (z0.clone(), alone(z0))).collect();
+            };
+            let mut results = results.into_iter();
+            chunk
+                .iter()
+                .zip(lane_of)
+                .map(|(z0, lane)| {
+                    let r = match lane {
+                        Some(_) => results.next().expect("one result per lane"),
+                        None => alone(z0),
+                    };
+                    (z0.clone(), r)
+                })
+                .collect()
+        })
+        .collect();
+    Ok(chunks.into_iter().flatten().collect())
 }
 
 /// Polish a periodic attractor by shooting from its last section point and replace its

@@ -3,6 +3,7 @@
 use super::period::{detect_period, minimal_divisor, MAX_PERIOD, MERGE_FACTOR};
 use crate::error::SimError;
 use crate::galerkin::Region;
+use crate::integrate::exact::ExactBatch;
 use crate::integrate::{advance, advance_dyn, Integrator, Step};
 use crate::model::BodyContactCheck;
 use crate::roots::extremum;
@@ -208,9 +209,7 @@ fn next_section(
     integ: &mut dyn Integrator,
     stats: Option<&mut StatsObserver>,
 ) -> Result<(), SimError> {
-    let period = integ.model().period();
-    let k = (integ.tau() / period + 1e-9).floor() + 1.0;
-    let target = k * period;
+    let target = section_after(integ.tau(), integ.model().period());
     match stats {
         // nothing observed per step: the state only at events and the end
         None => advance(integ, target),
@@ -232,16 +231,54 @@ fn point(integ: &dyn Integrator) -> PoincarePoint {
     }
 }
 
-/// Iterate the stroboscopic map from the integrator's current state until the returns repeat
-/// with some period n ≤ `max_period` (then record one cycle) or the cap is reached (then record
-/// `nonperiodic_record` periods as a nonperiodic motion).
-///
-/// # Errors
-/// [`SimError`] from the integrator (divergence, chattering) or for invalid options.
-pub fn steady_state(
-    integ: &mut dyn Integrator,
-    opts: &SteadyOptions,
-) -> Result<SteadyState, SimError> {
+/// The period search of [`steady_state`] on the stroboscopic returns, fed one return at a
+/// time (shared by the one-trajectory and the batched search).
+struct ReturnHistory {
+    history: VecDeque<DVector<f64>>,
+    confirm: Vec<usize>,
+    /// Returns pushed (periods of transient so far).
+    k: usize,
+}
+
+impl ReturnHistory {
+    fn new(opts: &SteadyOptions, first: &DVector<f64>) -> Self {
+        let mut history = VecDeque::with_capacity(3 * opts.max_period + 2);
+        history.push_back(first.clone());
+        ReturnHistory {
+            history,
+            confirm: Vec::new(),
+            k: 0,
+        }
+    }
+
+    /// Whether the transient cap is reached.
+    fn exhausted(&self, opts: &SteadyOptions) -> bool {
+        self.k >= opts.max_periods
+    }
+
+    /// Account for the next return; `Some(n)` once a period n is confirmed.
+    fn push(&mut self, z: &DVector<f64>, opts: &SteadyOptions) -> Option<usize> {
+        self.k += 1;
+        if self.history.len() == 3 * opts.max_period + 1 {
+            self.history.pop_front();
+        }
+        self.history.push_back(z.clone());
+        if let Some(n) = detect_period(self.history.make_contiguous(), opts.tol, opts.max_period) {
+            self.confirm.push(n);
+            // a candidate must hold for two more cycles, then be reduced to its smallest
+            // divisor within the merge tolerance (see `minimal_divisor`)
+            if self.confirm.len() > 2 * n {
+                let h = self.history.make_contiguous();
+                return Some(minimal_divisor(h, n, opts.tol * MERGE_FACTOR));
+            }
+        } else {
+            self.confirm.clear();
+        }
+        None
+    }
+}
+
+fn check_options(opts: &SteadyOptions) -> Result<(), SimError> {
     if !(opts.tol.is_finite() && opts.tol > 0.0) {
         return Err(SimError::out_of_range(
             "tolerance",
@@ -256,37 +293,28 @@ pub fn steady_state(
             "must be in 1..=64",
         ));
     }
-    // align on the section
-    let period = integ.model().period();
-    let phase = integ.tau() / period;
-    if (phase - phase.round()).abs() > 1e-9 {
-        next_section(integ, None)?;
-    }
-    let mut history: VecDeque<DVector<f64>> = VecDeque::with_capacity(3 * opts.max_period + 2);
-    history.push_back(integ.state().clone());
-    let mut found = None;
-    let mut confirm: Vec<usize> = Vec::new();
-    let mut k = 0;
-    while k < opts.max_periods {
-        next_section(integ, None)?;
-        k += 1;
-        if history.len() == 3 * opts.max_period + 1 {
-            history.pop_front();
-        }
-        history.push_back(integ.state().clone());
-        if let Some(n) = detect_period(history.make_contiguous(), opts.tol, opts.max_period) {
-            confirm.push(n);
-            // a candidate must hold for two more cycles, then be reduced to its smallest
-            // divisor within the merge tolerance (see `minimal_divisor`)
-            if confirm.len() > 2 * n {
-                let h = history.make_contiguous();
-                found = Some(minimal_divisor(h, n, opts.tol * MERGE_FACTOR));
-                break;
-            }
-        } else {
-            confirm.clear();
-        }
-    }
+    Ok(())
+}
+
+/// The next section time τ = 2πk/Ω after `tau`.
+fn section_after(tau: f64, period: f64) -> f64 {
+    ((tau / period + 1e-9).floor() + 1.0) * period
+}
+
+/// Whether `tau` is on the section (to 1e-9 of a period).
+fn on_section(tau: f64, period: f64) -> bool {
+    let phase = tau / period;
+    (phase - phase.round()).abs() <= 1e-9
+}
+
+/// Record one cycle (period n = `found`) or `nonperiodic_record` periods after a transient of
+/// `transient` periods.
+fn record(
+    integ: &mut dyn Integrator,
+    found: Option<usize>,
+    transient: usize,
+    opts: &SteadyOptions,
+) -> Result<SteadyState, SimError> {
     let record = found.unwrap_or(opts.nonperiodic_record.max(1));
     let mut obs = StatsObserver::default();
     let mut poincare = Vec::with_capacity(record);
@@ -299,8 +327,98 @@ pub fn steady_state(
             Some(period) => Motion::Periodic { period },
             None => Motion::Nonperiodic,
         },
-        transient_periods: k,
+        transient_periods: transient,
         poincare,
         stats: obs.finish(record),
     })
+}
+
+/// Iterate the stroboscopic map from the integrator's current state until the returns repeat
+/// with some period n ≤ `max_period` (then record one cycle) or the cap is reached (then record
+/// `nonperiodic_record` periods as a nonperiodic motion).
+///
+/// # Errors
+/// [`SimError`] from the integrator (divergence, chattering) or for invalid options.
+pub fn steady_state(
+    integ: &mut dyn Integrator,
+    opts: &SteadyOptions,
+) -> Result<SteadyState, SimError> {
+    check_options(opts)?;
+    // align on the section
+    if !on_section(integ.tau(), integ.model().period()) {
+        next_section(integ, None)?;
+    }
+    let mut returns = ReturnHistory::new(opts, integ.state());
+    let mut found = None;
+    while !returns.exhausted(opts) {
+        next_section(integ, None)?;
+        found = returns.push(integ.state(), opts);
+        if found.is_some() {
+            break;
+        }
+    }
+    record(integ, found, returns.k, opts)
+}
+
+/// [`steady_state`] for every lane of a batch of exact-propagator trajectories at one
+/// parameter set: the transients of all lanes still searching are advanced together
+/// ([`ExactBatch::advance_to`], section by section), each lane's returns go through the same
+/// period search, and a lane that has found its period (or reached the cap) records its cycle
+/// alone. The results are those of [`steady_state`] on each lane alone, bit for bit.
+///
+/// # Errors
+/// The outer error for invalid options; the inner ones per lane, as [`steady_state`]'s.
+pub fn steady_states(
+    batch: &mut ExactBatch,
+    opts: &SteadyOptions,
+) -> Result<Vec<Result<SteadyState, SimError>>, SimError> {
+    check_options(opts)?;
+    let lanes = batch.len();
+    let mut out: Vec<Option<Result<SteadyState, SimError>>> = (0..lanes).map(|_| None).collect();
+    let mut returns = Vec::with_capacity(lanes);
+    for (i, slot) in out.iter_mut().enumerate() {
+        let lane = batch.lane_mut(i);
+        let period = lane.model().period();
+        if !on_section(lane.tau(), period) {
+            if let Err(e) = next_section(lane, None) {
+                *slot = Some(Err(e));
+            }
+        }
+        returns.push(ReturnHistory::new(opts, batch.lane(i).state()));
+    }
+    loop {
+        let active: Vec<bool> = out.iter().map(Option::is_none).collect();
+        let Some(tau) = (0..lanes)
+            .filter(|&i| active[i])
+            .map(|i| batch.lane(i).tau())
+            .min_by(f64::total_cmp)
+        else {
+            break;
+        };
+        // the lanes on the earliest section go on together (all of them when they started
+        // together)
+        let period = batch.lane(0).model().period();
+        let target = section_after(tau, period);
+        let go: Vec<bool> = (0..lanes)
+            .map(|i| active[i] && section_after(batch.lane(i).tau(), period) == target)
+            .collect();
+        let results = batch.advance_to(target, &go)?;
+        for (i, r) in results.into_iter().enumerate() {
+            if !go[i] {
+                continue;
+            }
+            if let Err(e) = r {
+                out[i] = Some(Err(e));
+                continue;
+            }
+            let found = returns[i].push(batch.lane(i).state(), opts);
+            if found.is_some() || returns[i].exhausted(opts) {
+                out[i] = Some(record(batch.lane_mut(i), found, returns[i].k, opts));
+            }
+        }
+    }
+    Ok(out
+        .into_iter()
+        .map(|r| r.expect("every lane ends with a result"))
+        .collect())
 }

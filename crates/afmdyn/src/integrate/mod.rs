@@ -291,27 +291,10 @@ pub fn build(
     tau: f64,
     z: &DVector<f64>,
 ) -> Result<Box<dyn Integrator>, SimError> {
-    if opts.steps_per_period == 0 || opts.steps_per_period > 10_000_000 {
-        return Err(SimError::out_of_range(
-            "steps per period",
-            opts.steps_per_period,
-            "must be in 1..=10000000",
-        ));
-    }
+    check_steps_per_period(opts.steps_per_period)?;
     // up-front budgets: a start at or beyond the divergence threshold, and (adaptive) a period
     // that would need more steps than the budget, are refused before any work is done
-    let norm = z.norm(); // +∞ when the squares overflow; NaN entries are rejected by reset
-    if z.iter().all(|v| v.is_finite()) && norm >= crate::params::STATE_NORM_MAX {
-        return Err(SimError::out_of_range(
-            "initial state",
-            if norm.is_finite() {
-                format!("|z| = {norm:e}")
-            } else {
-                "|z| > 1e154".to_string()
-            },
-            "must be < 1e12 (the divergence threshold of the integrators)",
-        ));
-    }
+    check_start(z)?;
     let kind = opts.kind.resolve(model);
     if kind == IntegratorKind::Adaptive {
         let rate = [Region::Free, Region::Contact]
@@ -357,6 +340,58 @@ pub fn build(
     };
     integ.reset(tau, z)?;
     Ok(integ)
+}
+
+/// Refuse a start at or beyond the divergence threshold of the integrators (|z| ≥ 1e12,
+/// [`crate::params::STATE_NORM_MAX`]), as [`build`] does before any work.
+///
+/// # Errors
+/// [`SimError::OutOfRange`] naming the initial state.
+pub fn check_start(z: &DVector<f64>) -> Result<(), SimError> {
+    let norm = z.norm(); // +∞ when the squares overflow; NaN entries are rejected by reset
+    if z.iter().all(|v| v.is_finite()) && norm >= crate::params::STATE_NORM_MAX {
+        return Err(SimError::out_of_range(
+            "initial state",
+            if norm.is_finite() {
+                format!("|z| = {norm:e}")
+            } else {
+                "|z| > 1e154".to_string()
+            },
+            "must be < 1e12 (the divergence threshold of the integrators)",
+        ));
+    }
+    Ok(())
+}
+
+/// The exact propagator [`build`] would make for `opts` (before its reset to a start), or
+/// `None` when `opts` resolve to another integrator — the shared build of an
+/// [`exact::ExactBatch`].
+///
+/// # Errors
+/// As [`build`] for the steps per period and the exact propagator's construction.
+pub fn build_exact(
+    model: &CantileverModel,
+    opts: IntegratorOptions,
+) -> Result<Option<exact::ExactPropagator>, SimError> {
+    check_steps_per_period(opts.steps_per_period)?;
+    match opts.kind.resolve(model) {
+        IntegratorKind::Auto | IntegratorKind::Exact => Ok(Some(exact::ExactPropagator::try_new(
+            model,
+            opts.steps_per_period,
+        )?)),
+        _ => Ok(None),
+    }
+}
+
+fn check_steps_per_period(steps: usize) -> Result<(), SimError> {
+    if steps == 0 || steps > 10_000_000 {
+        return Err(SimError::out_of_range(
+            "steps per period",
+            steps,
+            "must be in 1..=10000000",
+        ));
+    }
+    Ok(())
 }
 
 /// y ← α A x (+ y when `accumulate`), A column-major with `x.len()` columns. Hand-written:

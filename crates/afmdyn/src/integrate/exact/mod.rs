@@ -32,11 +32,13 @@
 //! starts where the lower parabola g'(0)s − Bs²/2 is largest, so the same event cannot fire twice.
 //! Many switchings in a vanishing time window are reported as [`SimError::Chattering`].
 
+mod batch;
 mod kernel;
 mod modal;
 mod search;
 mod spectral;
 
+pub use batch::ExactBatch;
 pub use modal::MAX_MODAL_CONDITION;
 
 use super::grid::PeriodGrid;
@@ -159,7 +161,9 @@ pub struct ExactPropagator {
     spec: Arc<[Spectral; 2]>,
     /// Φ_s = e^{A_s h} in plain coordinates.
     phi: Arc<[DMatrix<f64>; 2]>,
-    forced: [Forced; 2],
+    /// Forcing-dependent data of both regions (shared by clones, e.g. the lanes of an
+    /// [`ExactBatch`]).
+    forced: Arc<[Forced; 2]>,
     /// Whether each region's grid steps are modal.
     modal: [bool; 2],
     /// Whether the spectral data and the grid exponential came from earlier builds.
@@ -194,7 +198,7 @@ pub struct ExactPropagator {
     /// switching is located within dead/|dV_T/dτ| ≈ 1e-14 of V_T = 0.
     dead: f64,
     /// sin Ωτ_k and cos Ωτ_k on the grid of one period (k = 0..=m).
-    trig: Vec<(f64, f64)>,
+    trig: Arc<[(f64, f64)]>,
     zb: DVector<f64>,
 }
 
@@ -342,10 +346,10 @@ impl ExactPropagator {
         let trig: Vec<(f64, f64)> = (0..=m)
             .map(|k| (omega * (k as f64 * h)).sin_cos())
             .collect();
-        let forced = [
+        let forced = Arc::new([
             forced(model, Region::Free, &spec[0], &trig, h)?,
             forced(model, Region::Contact, &spec[1], &trig, h)?,
-        ];
+        ]);
         let modal = std::array::from_fn(|i| {
             spec[i].modal.is_some()
                 && match opts.propagation {
@@ -392,7 +396,7 @@ impl ExactPropagator {
             poly_built: false,
             vt: (0.0, 0.0),
             dead,
-            trig,
+            trig: trig.into(),
             zb: zero,
         })
     }
@@ -537,6 +541,25 @@ impl ExactPropagator {
             ModalExp::expand(&me.tv, &self.q, z, true);
         }
         self.stale = false;
+    }
+
+    /// Make the last step a zero-length step at the current state, so that dense output and
+    /// the step Jacobian refer to it (after [`ExactBatch::advance_to`], whose shared grid steps
+    /// keep no per-lane step data).
+    fn rest_here(&mut self) {
+        self.materialize();
+        let ri = self.region.index();
+        let dz0 = self.last.dz0.as_mut_slice();
+        Self::zp_into(&self.forced[ri], self.model.omega(), self.tau, dz0);
+        for (d, z) in dz0.iter_mut().zip(self.z.as_slice()) {
+            *d = z - *d;
+        }
+        self.last.tau0 = self.tau;
+        self.last.region = self.region;
+        self.last.q0 = self.q;
+        self.last.modal = self.modal[ri];
+        self.last.full = false;
+        self.poly_built = false;
     }
 
     /// Fill `out` with the tip series of a step of `len` in region `r` from the homogeneous
