@@ -31,6 +31,26 @@ use nalgebra::DVector;
 /// Lanes per pass of the modal step (the slot capacity of a block is a multiple of it).
 const W: usize = 4;
 
+/// One mode of the modal step for W lanes: (oa, ob) = e^{λh} ⊙ (a, b) (Modes::mul_assign) and
+/// w += Re(tip · q), d += Re(tip_dot · q) (the terms of modal::re_dot), with
+/// `t` = (Re tip, Im tip, Re tip_dot, Im tip_dot).
+#[inline(always)]
+fn modal_mode(
+    (a, b): (&[f64; W], &[f64; W]),
+    (oa, ob): (&mut [f64; W], &mut [f64; W]),
+    (fc, fd): (f64, f64),
+    t: [f64; 4],
+    (w, d): (&mut [f64; W], &mut [f64; W]),
+) {
+    for l in 0..W {
+        let (yre, yim) = (a[l] * fc - b[l] * fd, a[l] * fd + b[l] * fc);
+        oa[l] = yre;
+        ob[l] = yim;
+        w[l] += t[0] * yre - t[1] * yim;
+        d[l] += t[2] * yre - t[3] * yim;
+    }
+}
+
 /// Where a lane is during [`ExactBatch::advance_to`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Lane {
@@ -211,22 +231,30 @@ impl Block {
                 let (yr, yi) = yc.split_at_mut(r * W);
                 let (xr, xi) = (xr.as_chunks::<W>().0, xi.as_chunks::<W>().0);
                 let (yr, yi) = (yr.as_chunks_mut::<W>().0, yi.as_chunks_mut::<W>().0);
-                let mut w = [[0.0; W]; 2];
-                let mut wd = [[0.0; W]; 2];
-                let rows = xr.iter().zip(xi).zip(yr.iter_mut().zip(yi.iter_mut()));
-                for (kk, ((a, b), (oa, ob))) in rows.enumerate() {
-                    let (fc, fd) = (f.re[kk], f.im[kk]);
-                    let (tr, ti) = (tip.re[kk], tip.im[kk]);
-                    let (dr, di) = (tip_dot.re[kk], tip_dot.im[kk]);
-                    let (ws, wds) = (&mut w[kk % 2], &mut wd[kk % 2]);
-                    for l in 0..W {
-                        let (yre, yim) = (a[l] * fc - b[l] * fd, a[l] * fd + b[l] * fc);
-                        oa[l] = yre;
-                        ob[l] = yim;
-                        ws[l] += tr * yre - ti * yim;
-                        wds[l] += dr * yre - di * yim;
-                    }
+                // even modes into (w0, d0), odd ones into (w1, d1), unrolled by two so that
+                // the accumulators stay in registers
+                let (mut w0, mut w1, mut d0, mut d1) = ([0.0; W], [0.0; W], [0.0; W], [0.0; W]);
+                type Lanes<'a> = &'a mut [f64; W];
+                let mode = |kk: usize, oa: Lanes, ob: Lanes, w: Lanes, d: Lanes| {
+                    modal_mode(
+                        (&xr[kk], &xi[kk]),
+                        (oa, ob),
+                        (f.re[kk], f.im[kk]),
+                        [tip.re[kk], tip.im[kk], tip_dot.re[kk], tip_dot.im[kk]],
+                        (w, d),
+                    )
+                };
+                let mut kk = 0;
+                while kk + 1 < r {
+                    mode(kk, &mut yr[kk], &mut yi[kk], &mut w0, &mut d0);
+                    mode(kk + 1, &mut yr[kk + 1], &mut yi[kk + 1], &mut w1, &mut d1);
+                    kk += 2;
                 }
+                if kk < r {
+                    mode(kk, &mut yr[kk], &mut yi[kk], &mut w0, &mut d0);
+                }
+                let w = [w0, w1];
+                let wd = [d0, d1];
                 let [w0, ws, wc] = fr.wp;
                 for l in 0..W {
                     let (w, wd) = (w[0][l] + w[1][l], wd[0][l] + wd[1][l]);
