@@ -5,6 +5,7 @@
 
 use crate::error::SimError;
 use crate::galerkin::Region;
+use crate::integrate::exact::matmul_into;
 use crate::integrate::Integrator;
 use crate::roots::extremum;
 use crate::system::EventKind;
@@ -73,12 +74,10 @@ pub fn flow_with_jacobian(
             continue;
         }
         // M ← J_step M: the product rule of the monodromy matrix M = Π S_k Φ_k (Leine &
-        // Nijmeijer 2004, ch. 7), into the scratch matrix and swapped back
+        // Nijmeijer 2004, ch. 7), into the scratch matrix and swapped back (2N×2N products:
+        // fixed-size column kernels up to 12×12, whose products do not pack or allocate)
         integ.last_step_jacobian_into(&mut step_jac)?;
-        if prod.shape() != (step_jac.nrows(), jac.ncols()) {
-            prod = DMatrix::zeros(step_jac.nrows(), jac.ncols());
-        }
-        step_jac.mul_to(&jac, &mut prod);
+        matmul_into(&step_jac, &jac, 1.0, &mut prod);
         std::mem::swap(&mut jac, &mut prod);
         if step.region == Region::Contact {
             out.contact_time += len;
@@ -98,7 +97,9 @@ pub fn flow_with_jacobian(
             out.grazing_distance = out.grazing_distance.min(vt(t)[0].abs());
         }
         if let Some(e) = &step.event {
-            jac = integ.model().saltation(e.from, e.tau, &e.state) * jac;
+            let s = integ.model().saltation(e.from, e.tau, &e.state);
+            matmul_into(&s, &jac, 1.0, &mut prod);
+            std::mem::swap(&mut jac, &mut prod);
             out.switchings += 1;
             if e.to == Region::Contact || e.kind == EventKind::Impact {
                 out.contacts += 1;

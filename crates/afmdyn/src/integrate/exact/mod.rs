@@ -40,6 +40,7 @@ mod spectral;
 
 pub use batch::ExactBatch;
 pub use modal::MAX_MODAL_CONDITION;
+pub(crate) use spectral::matmul_into;
 
 use super::grid::PeriodGrid;
 use super::{matvec, Integrator, Step};
@@ -421,14 +422,28 @@ impl ExactPropagator {
     /// 0 ≤ t ≤ one grid step: the precomputed Φ_s when t is the grid step, else
     /// T⁻¹ e^{Ã t} T column by column (eigendecomposition, or the Taylor series).
     pub fn transition(&self, r: Region, t: f64) -> DMatrix<f64> {
-        let sp = &self.spec[r.index()];
-        if t == self.grid.h {
-            return self.phi[r.index()].clone();
-        }
         let dim = self.z.len();
-        let e = match &sp.modal {
-            // Re(V e^{Λt} V⁻¹) T: the exponentials once
-            Some(me) => me.transition_energy(t),
+        let mut out = DMatrix::zeros(dim, dim);
+        self.transition_into(r, t, &mut out);
+        out
+    }
+
+    /// [`ExactPropagator::transition`] into `out` (resized to 2N×2N if needed); allocates
+    /// nothing with the precomputed Φ_s or the eigendecomposition.
+    fn transition_into(&self, r: Region, t: f64, out: &mut DMatrix<f64>) {
+        let sp = &self.spec[r.index()];
+        let dim = self.z.len();
+        if out.shape() != (dim, dim) {
+            *out = DMatrix::zeros(dim, dim);
+        }
+        if t == self.grid.h {
+            out.as_mut_slice()
+                .copy_from_slice(self.phi[r.index()].as_slice());
+            return;
+        }
+        match &sp.modal {
+            // Σ_k Re((T⁻¹v_k) e^{λ_k t} (V⁻¹T)_k): the exponentials once
+            Some(me) => me.transition_plain_into(t, out),
             None => {
                 let mut e = DMatrix::zeros(dim, dim);
                 for j in 0..dim {
@@ -436,10 +451,9 @@ impl ExactPropagator {
                     Self::hom_energy(sp, sp.t.column(j).as_slice(), t, &mut y[..dim]);
                     e.column_mut(j).copy_from_slice(&y[..dim]);
                 }
-                e
+                spectral::matmul_into(&sp.tinv, &e, 1.0, out);
             }
-        };
-        spectral::matmul(&sp.tinv, &e)
+        }
     }
 
     /// Jacobian ∂z(τ1)/∂z(τ0) of the flow over the last step [τ0, τ1] inside its region
@@ -990,17 +1004,13 @@ impl Integrator for ExactPropagator {
     }
 
     fn last_step_jacobian_into(&mut self, out: &mut DMatrix<f64>) -> Result<(), SimError> {
-        // a whole grid step: copy the cached Φ_s without allocating (as step_transition)
+        // as step_transition, without allocating: the cached Φ_s after a whole grid step
+        let r = self.last.region;
         if self.last.full && self.on_grid.is_some() {
-            let phi = &self.phi[self.last.region.index()];
-            if out.shape() == phi.shape() {
-                out.copy_from(phi);
-            } else {
-                *out = phi.clone();
-            }
-            return Ok(());
+            self.transition_into(r, self.grid.h, out);
+        } else {
+            self.transition_into(r, self.tau - self.last.tau0, out);
         }
-        *out = self.step_transition();
         Ok(())
     }
 }

@@ -243,40 +243,21 @@ impl ModalExp {
         }
     }
 
-    /// E = Re(V e^{Λt} V⁻¹ T) (energy coordinates out, plain in), 2N×2N: the exponentials once,
-    /// then one real product per entry pair.
-    pub(super) fn transition_energy(&self, t: f64) -> DMatrix<f64> {
-        let (dim, r) = (self.v.re.nrows(), self.len());
+    /// e^{A t} in plain coordinates, T⁻¹ V e^{Λt} V⁻¹ T = Σ_k w_k Re((T⁻¹v_k) e^{λ_k t} (V⁻¹T)_k),
+    /// into `out` (2N×2N) column by column, without allocating.
+    pub(super) fn transition_plain_into(&self, t: f64, out: &mut DMatrix<f64>) {
+        let (dim, r) = (self.tv.re.nrows(), self.len());
         let mut f = Modes::ZERO;
         self.factors(t, &mut f);
-        // columns of V F
-        let mut vf = Split {
-            re: self.v.re.clone(),
-            im: self.v.im.clone(),
-        };
-        for k in 0..r {
-            let (fr, fi) = (f.re[k], f.im[k]);
-            for (a, b) in vf
-                .re
-                .column_mut(k)
-                .iter_mut()
-                .zip(vf.im.column_mut(k).iter_mut())
-            {
-                let (x, y) = (*a, *b);
-                *a = x * fr - y * fi;
-                *b = x * fi + y * fr;
-            }
-        }
-        let mut e = DMatrix::zeros(dim, dim);
         for j in 0..dim {
             let mut q = Modes::ZERO;
             for k in 0..r {
-                q.re[k] = self.vinv_t.re[(k, j)];
-                q.im[k] = self.vinv_t.im[(k, j)];
+                let (a, b) = (self.vinv_t.re[(k, j)], self.vinv_t.im[(k, j)]);
+                q.re[k] = a * f.re[k] - b * f.im[k];
+                q.im[k] = a * f.im[k] + b * f.re[k];
             }
-            Self::expand(&vf, &q, e.column_mut(j).as_mut_slice(), false);
+            Self::expand(&self.tv, &q, out.column_mut(j).as_mut_slice(), false);
         }
-        e
     }
 
     /// e^{λ_k t} for every representative.

@@ -163,13 +163,13 @@ pub(super) fn expm(at: &DMatrix<f64>, h: f64, rho: f64) -> DMatrix<f64> {
 /// out = α A B for square column-major A, B of one size: up to 12×12 column by column with the
 /// fixed-size kernel (a blocked product packs, and allocates, per call), above by nalgebra's
 /// blocked product.
-pub(super) fn matmul_into(a: &DMatrix<f64>, b: &DMatrix<f64>, alpha: f64, out: &mut DMatrix<f64>) {
+pub(crate) fn matmul_into(a: &DMatrix<f64>, b: &DMatrix<f64>, alpha: f64, out: &mut DMatrix<f64>) {
     let dim = a.nrows();
     if dim > 12 {
         return out.gemm(alpha, a, b, 0.0);
     }
     let kernel = super::kernel::for_dim(dim);
-    out.fill(0.0);
+    out.as_mut_slice().fill(0.0);
     for (bj, oj) in b
         .as_slice()
         .chunks_exact(dim.max(1))
