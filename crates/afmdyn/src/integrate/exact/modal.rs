@@ -62,6 +62,9 @@ impl Modes {
 }
 
 /// Σ_k Re(x_k y_k) over the first r entries, in two interleaved partial sums (vectorizable).
+/// Kept out of line: inlined into the grid step it compiles to more instructions (callgrind,
+/// N = 10: 355 000 against 349 000 per forcing period).
+#[inline(never)]
 fn re_dot(x: &Modes, y: &Modes, r: usize) -> f64 {
     let (xr, xi, yr, yi) = (&x.re[..r], &x.im[..r], &y.re[..r], &y.im[..r]);
     let (xr2, xr1) = xr.as_chunks::<2>();
