@@ -236,3 +236,59 @@ fn attractor_census_reports_polished_orbits_with_multipliers() {
     }
     assert!(checked >= 1);
 }
+
+/// The census runs the exact propagator's starts in batches of lanes (`ExactBatch`); its
+/// result must be the one-by-one census: with more starts than one batch (70 > 32), each
+/// attractor's count, its first start, its period and its (unpolished) statistics are those of
+/// clustering the steady states of `steady_state` run on each start alone, in start order.
+#[test]
+fn batched_census_equals_the_census_one_by_one() {
+    use afmdyn::analysis::bifurcation::random_state;
+    use afmdyn::analysis::steady::steady_state;
+    let p = Params {
+        omega: 1.8,
+        ..Params::default()
+    };
+    let spec = AttractorSpec {
+        params: p,
+        samples: 70,
+        seed: 3,
+        cluster_tol: 1e-5,
+        steady: SteadyOptions::default(),
+        integrator: IntegratorOptions::default(),
+    };
+    let report = find_attractors(&spec).unwrap();
+    let m = CantileverModel::new(&p).unwrap();
+    // one by one: (first start, steady state, count) per attractor in order of discovery
+    let mut alone: Vec<(
+        nalgebra::DVector<f64>,
+        afmdyn::analysis::steady::SteadyState,
+        usize,
+    )> = Vec::new();
+    for i in 0..spec.samples {
+        let z0 = random_state(&m, spec.seed, i as u64);
+        let mut it = build(&m, spec.integrator, 0.0, &z0).unwrap();
+        let s = steady_state(it.as_mut(), &spec.steady).unwrap();
+        match alone
+            .iter_mut()
+            .find(|(_, t, _)| same_attractor(t, &s, spec.cluster_tol))
+        {
+            Some(a) => a.2 += 1,
+            None => alone.push((z0, s, 1)),
+        }
+    }
+    assert!(alone.len() >= 2, "two attractors coexist at Ω = 1.8");
+    assert_eq!(report.attractors.len(), alone.len());
+    assert!(report.failures.is_empty());
+    for (z0, s, count) in &alone {
+        let a = report
+            .attractors
+            .iter()
+            .find(|a| &a.initial == z0)
+            .expect("the same first start");
+        assert_eq!(a.count, *count);
+        assert_eq!(a.steady.motion, s.motion);
+        assert_eq!(a.steady.transient_periods, s.transient_periods);
+        assert_eq!(a.steady.stats, s.stats);
+    }
+}
