@@ -94,7 +94,7 @@ pub fn find_attractors(spec: &AttractorSpec) -> Result<AttractorReport, SimError
         ));
     }
     let model = CantileverModel::new(&spec.params)?;
-    let results = steady_states_of_starts(&model, spec)?;
+    let results = steady_states_of_starts(&model, spec);
     let mut attractors: Vec<Attractor> = Vec::new();
     let mut failures = Vec::new();
     for (z0, r) in results {
@@ -139,10 +139,7 @@ const BATCH_LANES: usize = 32;
 /// The steady state from every random start: batched ([`steady_states`]) with the exact
 /// propagator, whose lanes share one build; one by one otherwise. Both give the same results
 /// (the batch is bit-identical to its lanes alone).
-fn steady_states_of_starts(
-    model: &CantileverModel,
-    spec: &AttractorSpec,
-) -> Result<Vec<StartResult>, SimError> {
+fn steady_states_of_starts(model: &CantileverModel, spec: &AttractorSpec) -> Vec<StartResult> {
     let starts: Vec<DVector<f64>> = (0..spec.samples)
         .map(|i| random_state(model, spec.seed, i as u64))
         .collect();
@@ -154,14 +151,14 @@ fn steady_states_of_starts(
     let proto = match build_exact(model, spec.integrator) {
         Ok(Some(p)) => p,
         _ => {
-            return Ok(starts
+            return starts
                 .into_par_iter()
                 .with_max_len(1)
                 .map(|z0| {
                     let r = alone(&z0);
                     (z0, r)
                 })
-                .collect())
+                .collect();
         }
     };
     let chunks: Vec<Vec<StartResult>> = starts
@@ -179,21 +176,18 @@ fn steady_states_of_starts(
                 // invalid options: every start fails alone with the error
                 return chunk.iter().map(|z0| (z0.clone(), alone(z0))).collect();
             };
-            let mut results = results.into_iter();
+            let mut results: Vec<Option<_>> = results.into_iter().map(Some).collect();
             chunk
                 .iter()
                 .zip(lane_of)
                 .map(|(z0, lane)| {
-                    let r = match lane {
-                        Some(_) => results.next().expect("one result per lane"),
-                        None => alone(z0),
-                    };
-                    (z0.clone(), r)
+                    let r = lane.and_then(|l| results.get_mut(l).and_then(Option::take));
+                    (z0.clone(), r.unwrap_or_else(|| alone(z0)))
                 })
                 .collect()
         })
         .collect();
-    Ok(chunks.into_iter().flatten().collect())
+    chunks.into_iter().flatten().collect()
 }
 
 /// Polish a periodic attractor by shooting from its last section point and replace its
