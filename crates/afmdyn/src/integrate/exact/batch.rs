@@ -516,10 +516,8 @@ impl ExactBatch {
                         let l = b.ids[s];
                         let lane = &mut self.lanes[l];
                         b.scatter(s, lane, tau_b, next_at);
-                        lane.materialize();
-                        let norm = lane.z.norm();
-                        if norm.is_nan() || norm >= 1e12 {
-                            out[l] = Err(SimError::Diverged { tau: tau_b, norm });
+                        if let Err(e) = lane.check_divergence() {
+                            out[l] = Err(e);
                             state[l] = Lane::Done;
                             b.remove(s);
                         }

@@ -557,6 +557,20 @@ impl ExactPropagator {
         self.stale = false;
     }
 
+    /// At the end of a period: form the plain state and stop with [`SimError::Diverged`] when
+    /// its norm is NaN or reaches 1e12 ([`crate::params::STATE_NORM_MAX`]).
+    fn check_divergence(&mut self) -> Result<(), SimError> {
+        self.materialize();
+        let norm = self.z.norm();
+        if norm.is_nan() || norm >= crate::params::STATE_NORM_MAX {
+            return Err(SimError::Diverged {
+                tau: self.tau,
+                norm,
+            });
+        }
+        Ok(())
+    }
+
     /// Make the last step a zero-length step at the current state, so that dense output and
     /// the step Jacobian refer to it (after [`ExactBatch::advance_to`], whose shared grid steps
     /// keep no per-lane step data).
@@ -875,11 +889,7 @@ impl ExactPropagator {
                 self.on_grid = (tau_b == t_grid).then_some(next);
                 if let Some((_, k_next)) = self.on_grid {
                     if k_next == 0 {
-                        self.materialize();
-                        let norm = self.z.norm();
-                        if norm.is_nan() || norm >= 1e12 {
-                            return Err(SimError::Diverged { tau: tau_b, norm });
-                        }
+                        self.check_divergence()?;
                     }
                 }
                 Ok(Step {
