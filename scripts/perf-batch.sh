@@ -52,12 +52,5 @@ table=$(mktemp)
   done
   echo "<!-- batch:end -->"
 } > "$table"
-python3 - "$table" <<'PY'
-import re, sys
-doc = open("docs/performance.md").read()
-new = open(sys.argv[1]).read().strip()
-pat = re.compile(r"<!-- batch:begin.*?<!-- batch:end -->", re.S)
-doc = pat.sub(new, doc) if pat.search(doc) else doc.rstrip() + "\n\n## Many trajectories at one parameter set\n\n" + new + "\n"
-open("docs/performance.md", "w").write(doc)
-PY
+python3 scripts/doc_section.py batch "$table" "Many trajectories at one parameter set"
 sed -n '/batch:begin/,/batch:end/p' docs/performance.md

@@ -59,12 +59,5 @@ table=$(mktemp)
   fi
   echo "<!-- laws:end -->"
 } > "$table"
-python3 - "$table" <<'PY'
-import re, sys
-doc = open("docs/performance.md").read()
-new = open(sys.argv[1]).read().strip()
-pat = re.compile(r"<!-- laws:begin.*?<!-- laws:end -->", re.S)
-doc = pat.sub(new, doc) if pat.search(doc) else doc.rstrip() + "\n\n## Per forcing period, by law\n\n" + new + "\n"
-open("docs/performance.md", "w").write(doc)
-PY
+python3 scripts/doc_section.py laws "$table" "Per forcing period, by law"
 sed -n '/laws:begin/,/laws:end/p' docs/performance.md
