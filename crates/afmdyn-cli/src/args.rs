@@ -179,9 +179,7 @@ impl ModelArgs {
     pub fn probe(&self) -> Result<Option<afmdyn::probe::Probe>, CliError> {
         self.probe
             .as_ref()
-            .map(|p| {
-                afmdyn::probe::Probe::load(p).map_err(|e| CliError::Input(format!("probe {e}")))
-            })
+            .map(|p| afmdyn::probe::Probe::load(p).map_err(CliError::from))
             .transpose()
     }
 

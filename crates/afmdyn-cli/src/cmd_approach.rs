@@ -7,11 +7,11 @@ use crate::cmd_simulate::Files;
 use crate::error::CliError;
 use crate::output::{f, write_csv, Column, NpyStream, OutDir};
 use crate::plot::{save, Figure, Series, Style};
-use afmdyn::analysis::approach::{approach_retract, approach_spec, default_range, rest_distance};
+use afmdyn::analysis::approach::{approach_request, approach_retract, rest_distance};
 use afmdyn::analysis::continuation::BranchEvent;
 use afmdyn::analysis::observables::Observables;
-use afmdyn::analysis::resonance::{mode_band, resonance_curve, resonance_spec};
-use afmdyn::analysis::stepped::{Spacing, SteppedCurve, SteppedSpec, Sweep};
+use afmdyn::analysis::resonance::{resonance_curve, resonance_request};
+use afmdyn::analysis::stepped::{CurveRequest, SteppedCurve, SteppedSpec, Sweep};
 use afmdyn::probe::Probe;
 use afmdyn::report::{curve_row, CurveUnits, CURVE_COLUMNS};
 use afmdyn::Params;
@@ -42,28 +42,17 @@ pub struct CurveArgs {
 }
 
 impl CurveArgs {
-    fn spacing(&self, unit: f64) -> Result<Spacing, CliError> {
-        match (self.step, self.points) {
-            (Some(h), _) => Ok(Spacing::Step(h / unit)),
-            (None, n) => Ok(Spacing::Points(n.unwrap_or(120))),
+    /// The request of these flags with the ends `from`, `to` (the library checks and applies
+    /// it: [`CurveRequest`]).
+    fn request(&self, from: Option<f64>, to: Option<f64>) -> CurveRequest {
+        CurveRequest {
+            from,
+            to,
+            step: self.step,
+            points: self.points,
+            branches: !self.no_branches,
+            tolerance: self.tolerance,
         }
-    }
-
-    /// Check the options and the parameters at both ends of the grid (before any output
-    /// directory is created).
-    fn configure(&self, spec: &mut SteppedSpec) -> Result<(), CliError> {
-        for v in [spec.values[0], spec.values[spec.values.len() - 1]] {
-            spec.base.with(spec.param, v).validate()?;
-        }
-        if !(self.tolerance.is_finite() && self.tolerance > 0.0 && self.tolerance < 1e-3) {
-            return Err(CliError::Input(format!(
-                "tolerance = {}: must be in (0, 1e-3)",
-                self.tolerance
-            )));
-        }
-        spec.integrator.tolerance = self.tolerance;
-        spec.branches = !self.no_branches;
-        Ok(())
     }
 }
 
@@ -541,15 +530,14 @@ struct Run<'a> {
 }
 
 impl Run<'_> {
-    /// Check the options, lock the output directory, compute, write the files and print the
-    /// JSON document or the summary.
+    /// Lock the output directory, compute, write the files and print the JSON document or the
+    /// summary.
     fn go(
         &self,
-        spec: &mut SteppedSpec,
+        spec: &SteppedSpec,
         compute: fn(&SteppedSpec) -> Result<SteppedCurve, afmdyn::SimError>,
         doc: impl Fn(&SteppedCurve) -> serde_json::Value,
     ) -> Result<(), CliError> {
-        self.args.configure(spec)?;
         let out = (self.args.files != Files::None)
             .then(|| OutDir::lock(self.out))
             .transpose()?;
@@ -586,10 +574,7 @@ fn check_finite(name: &str, v: Option<f64>) -> Result<(), CliError> {
 /// Run `afmdyn approach`.
 pub fn approach(a: &ApproachArgs) -> Result<(), CliError> {
     let (base, units, probe) = setup(&a.model, a.from, a.to, false)?;
-    let (far, near) = default_range(&base)?;
-    let from = a.from.map_or(far, |v| v / units.length);
-    let to = a.to.map_or(near, |v| v / units.length);
-    let mut spec = approach_spec(base, from, to, a.curve.spacing(units.length)?)?;
+    let spec = approach_request(base, &a.curve.request(a.from, a.to), units.length)?;
     let x = |v: f64| rest_distance(&base, v) * units.length;
     let labels = Labels {
         stem: "approach",
@@ -608,7 +593,7 @@ pub fn approach(a: &ApproachArgs) -> Result<(), CliError> {
         labels: &labels,
         x: &x,
     };
-    run.go(&mut spec, approach_retract, |c| {
+    run.go(&spec, approach_retract, |c| {
         afmdyn::report::with_si(
             afmdyn::report::approach(&base, c, &units),
             probe.as_ref(),
@@ -621,10 +606,7 @@ pub fn approach(a: &ApproachArgs) -> Result<(), CliError> {
 pub fn resonance(a: &ResonanceArgs) -> Result<(), CliError> {
     let (base, units, probe) = setup(&a.model, a.from, a.to, true)?;
     let hz = units.hz_per_omega.unwrap_or(1.0);
-    let (lo, hi) = mode_band(&base, a.mode)?;
-    let from = a.from.map_or(lo, |v| v / hz);
-    let to = a.to.map_or(hi, |v| v / hz);
-    let mut spec = resonance_spec(base, from, to, a.curve.spacing(hz)?)?;
+    let spec = resonance_request(base, a.mode, &a.curve.request(a.from, a.to), hz)?;
     let x = |v: f64| v * hz;
     let labels = Labels {
         stem: "resonance",
@@ -648,7 +630,7 @@ pub fn resonance(a: &ResonanceArgs) -> Result<(), CliError> {
         labels: &labels,
         x: &x,
     };
-    run.go(&mut spec, resonance_curve, |c| {
+    run.go(&spec, resonance_curve, |c| {
         afmdyn::report::with_si(
             afmdyn::report::resonance(&base, c, &units),
             probe.as_ref(),

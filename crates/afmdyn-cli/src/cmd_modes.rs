@@ -195,8 +195,7 @@ struct HertzFile {
 /// Run `afmdyn units`.
 pub fn units(a: &UnitsArgs) -> Result<(), CliError> {
     if let Some(path) = &a.probe {
-        let pr =
-            afmdyn::probe::Probe::load(path).map_err(|e| CliError::Input(format!("probe {e}")))?;
+        let pr = afmdyn::probe::Probe::load(path)?;
         let p = pr.params;
         let doc = json!({ "params": p, "si": afmdyn::report::si(&pr, &p, &json!({})) });
         if a.json {

@@ -43,6 +43,12 @@ impl From<afmdyn::ParamError> for CliError {
     }
 }
 
+impl From<afmdyn::probe::ProbeError> for CliError {
+    fn from(e: afmdyn::probe::ProbeError) -> Self {
+        CliError::Input(format!("probe {e}"))
+    }
+}
+
 impl From<afmdyn::UnitsError> for CliError {
     fn from(e: afmdyn::UnitsError) -> Self {
         CliError::Input(e.to_string())

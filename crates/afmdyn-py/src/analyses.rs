@@ -5,7 +5,7 @@
 //! one (`"json"`).
 
 use crate::convert::Out;
-use crate::errors::{sim_error, value_error};
+use crate::errors::{probe_error, sim_error, value_error};
 use crate::params::PyParams;
 use crate::run::{run, Job, Stop};
 use afmdyn::analysis::attractors::{find_attractors, AttractorSpec};
@@ -923,7 +923,7 @@ pub fn lyapunov<'py>(
 /// `"si"` block of the command line's JSON (scales, calibration, drive, A₀, z_c).
 #[pyfunction]
 pub fn probe(path: std::path::PathBuf) -> PyResult<(PyParams, String)> {
-    let pr = afmdyn::probe::Probe::load(&path).map_err(|e| value_error(format!("probe {e}")))?;
+    let pr = afmdyn::probe::Probe::load(&path).map_err(probe_error)?;
     let si = report::si(&pr, &pr.params, &serde_json::json!({}));
     Ok((PyParams { inner: pr.params }, si.to_string()))
 }

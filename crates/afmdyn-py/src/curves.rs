@@ -3,12 +3,12 @@
 //! (`afmdyn approach --json`, `afmdyn resonance --json`; [`afmdyn::report::approach`]).
 
 use crate::convert::Out;
-use crate::errors::{sim_error, value_error};
+use crate::errors::{probe_error, sim_error};
 use crate::params::PyParams;
 use crate::run::{run, Job, Stop};
-use afmdyn::analysis::approach::{approach_retract, approach_spec, default_range};
-use afmdyn::analysis::resonance::{mode_band, resonance_curve, resonance_spec};
-use afmdyn::analysis::stepped::{Spacing, SteppedCurve, SteppedSpec};
+use afmdyn::analysis::approach::{approach_request, approach_retract};
+use afmdyn::analysis::resonance::{resonance_curve, resonance_request};
+use afmdyn::analysis::stepped::{CurveRequest, SteppedCurve, SteppedSpec};
 use afmdyn::probe::Probe;
 use afmdyn::report::{self, CurveUnits};
 use afmdyn::{Params, SimError};
@@ -21,46 +21,20 @@ fn units(probe: Option<PathBuf>, hz: bool) -> PyResult<(CurveUnits, Option<Probe
     match probe {
         None => Ok((CurveUnits::dimensionless(), None)),
         Some(path) => {
-            let p = Probe::load(&path).map_err(|e| value_error(format!("probe {e}")))?;
+            let p = Probe::load(&path).map_err(probe_error)?;
             Ok((CurveUnits::from_scales(&p.scales, hz), Some(p)))
         }
     }
 }
 
-/// The grid spacing from `step` (in units of `unit`) or `points` (default 120), not both.
-fn spacing(step: Option<f64>, points: Option<usize>, unit: f64) -> PyResult<Spacing> {
-    match (step, points) {
-        (Some(_), Some(_)) => Err(value_error("give step or points, not both")),
-        (Some(h), None) => Ok(Spacing::Step(h / unit)),
-        (None, n) => Ok(Spacing::Points(n.unwrap_or(120))),
-    }
-}
-
-/// Set the options, check both grid ends, run `compute` with the GIL released and return
-/// `{"json": document}`.
-#[allow(clippy::too_many_arguments)]
+/// Run `compute` on `spec` with the GIL released and return `{"json": document}`.
 fn go<'py>(
     py: Python<'py>,
-    mut spec: SteppedSpec,
-    branches: bool,
-    tolerance: f64,
+    spec: SteppedSpec,
     progress: Option<Bound<'py, PyAny>>,
     compute: fn(&SteppedSpec) -> Result<SteppedCurve, SimError>,
     doc: impl Fn(&SteppedCurve) -> serde_json::Value,
 ) -> PyResult<Bound<'py, PyDict>> {
-    if !(tolerance.is_finite() && tolerance > 0.0 && tolerance < 1e-3) {
-        return Err(value_error(format!(
-            "tolerance = {tolerance}: must be in (0, 1e-3)"
-        )));
-    }
-    spec.integrator.tolerance = tolerance;
-    spec.branches = branches;
-    for v in [spec.values[0], spec.values[spec.values.len() - 1]] {
-        spec.base
-            .with(spec.param, v)
-            .validate()
-            .map_err(crate::errors::param_error)?;
-    }
     let c = run(
         py,
         &Job::default(),
@@ -93,20 +67,18 @@ pub fn approach<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let base: Params = params.inner;
     let (u, probe) = units(probe, false)?;
-    let (far, near) = default_range(&base).map_err(sim_error)?;
-    let from = from_.map_or(far, |v| v / u.length);
-    let to = to.map_or(near, |v| v / u.length);
-    let spec =
-        approach_spec(base, from, to, spacing(step, points, u.length)?).map_err(sim_error)?;
-    go(
-        py,
-        spec,
+    let request = CurveRequest {
+        from: from_,
+        to,
+        step,
+        points,
         branches,
         tolerance,
-        progress,
-        approach_retract,
-        |c| report::with_si(report::approach(&base, c, &u), probe.as_ref(), &base),
-    )
+    };
+    let spec = approach_request(base, &request, u.length).map_err(sim_error)?;
+    go(py, spec, progress, approach_retract, |c| {
+        report::with_si(report::approach(&base, c, &u), probe.as_ref(), &base)
+    })
 }
 
 /// The resonance curve near mode `mode` (`afmdyn resonance`).
@@ -130,17 +102,16 @@ pub fn resonance<'py>(
     let base: Params = params.inner;
     let (u, probe) = units(probe, true)?;
     let hz = u.hz_per_omega.unwrap_or(1.0);
-    let (lo, hi) = mode_band(&base, mode).map_err(sim_error)?;
-    let from = from_.map_or(lo, |v| v / hz);
-    let to = to.map_or(hi, |v| v / hz);
-    let spec = resonance_spec(base, from, to, spacing(step, points, hz)?).map_err(sim_error)?;
-    go(
-        py,
-        spec,
+    let request = CurveRequest {
+        from: from_,
+        to,
+        step,
+        points,
         branches,
         tolerance,
-        progress,
-        resonance_curve,
-        |c| report::with_si(report::resonance(&base, c, &u), probe.as_ref(), &base),
-    )
+    };
+    let spec = resonance_request(base, mode, &request, hz).map_err(sim_error)?;
+    go(py, spec, progress, resonance_curve, |c| {
+        report::with_si(report::resonance(&base, c, &u), probe.as_ref(), &base)
+    })
 }

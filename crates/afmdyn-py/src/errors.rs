@@ -30,6 +30,12 @@ pub fn sim_error(e: SimError) -> PyErr {
     }
 }
 
+/// `ValueError` for a probe file that cannot be read or resolved (the message names the file
+/// and every problem).
+pub fn probe_error(e: afmdyn::probe::ProbeError) -> PyErr {
+    PyValueError::new_err(format!("probe {e}"))
+}
+
 /// `ValueError` with a message.
 pub fn value_error(msg: impl Into<String>) -> PyErr {
     PyValueError::new_err(msg.into())

@@ -251,8 +251,7 @@ impl PyParams {
     #[staticmethod]
     #[pyo3(signature = (path, **model))]
     fn from_probe(path: std::path::PathBuf, model: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
-        let pr = afmdyn::probe::Probe::load(&path)
-            .map_err(|e| PyValueError::new_err(format!("probe {e}")))?;
+        let pr = afmdyn::probe::Probe::load(&path).map_err(crate::errors::probe_error)?;
         Ok(PyParams {
             inner: params_from_kwargs(pr.params, model)?,
         })

@@ -232,17 +232,15 @@ impl Reader<'_> {
         unit: &str,
         range: (&str, fn(f64) -> bool),
     ) -> Option<f64> {
-        match self.number(table, section, key) {
-            None if !table.contains_key(key) => {
-                self.problems
-                    .push(format!("missing key {}{key} ({unit})", prefix(section)));
-                None
-            }
-            None => None,
-            Some(x) => self.check(section, key, unit, x, range),
+        if !table.contains_key(key) {
+            self.problems
+                .push(format!("missing key {}{key} ({unit})", prefix(section)));
+            return None;
         }
+        self.optional(table, section, key, unit, range)
     }
 
+    /// A number that may be absent; when present, finite and in `check`.
     fn optional(
         &mut self,
         table: &toml::Table,

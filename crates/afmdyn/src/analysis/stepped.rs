@@ -66,6 +66,80 @@ pub enum Spacing {
     Points(usize),
 }
 
+/// Grid points of a curve request that gives neither a step nor a count.
+pub const DEFAULT_CURVE_POINTS: usize = 120;
+
+/// A stepped-curve request as a front end takes it (`afmdyn approach` / `resonance` flags, the
+/// Python keywords): the ends and the step in the front end's unit of the swept quantity (one
+/// dimensionless unit = `unit` of them: g₀ in m, or Hz per unit Ω), `None` for the command's
+/// default range; [`approach::approach_request`](super::approach::approach_request) and
+/// [`resonance::resonance_request`](super::resonance::resonance_request) turn it into a
+/// [`SteppedSpec`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CurveRequest {
+    /// First end of the swept quantity (front-end unit).
+    pub from: Option<f64>,
+    /// Other end (front-end unit).
+    pub to: Option<f64>,
+    /// Grid step (front-end unit); excludes `points`.
+    pub step: Option<f64>,
+    /// Number of grid values, ends included (default [`DEFAULT_CURVE_POINTS`]).
+    pub points: Option<usize>,
+    /// Continue the periodic-orbit branches.
+    pub branches: bool,
+    /// Tolerance of the adaptive integrator, in (0, 1e-3).
+    pub tolerance: f64,
+}
+
+impl CurveRequest {
+    /// The ends in dimensionless units: the requested ones divided by `unit`, else `default`.
+    pub fn ends(&self, default: (f64, f64), unit: f64) -> (f64, f64) {
+        (
+            self.from.map_or(default.0, |v| v / unit),
+            self.to.map_or(default.1, |v| v / unit),
+        )
+    }
+
+    /// The grid spacing in dimensionless units.
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] when both a step and a count are given.
+    pub fn spacing(&self, unit: f64) -> Result<Spacing, SimError> {
+        match (self.step, self.points) {
+            (Some(h), Some(_)) => Err(SimError::out_of_range(
+                "step",
+                h,
+                "give step or points, not both",
+            )),
+            (Some(h), None) => Ok(Spacing::Step(h / unit)),
+            (None, n) => Ok(Spacing::Points(n.unwrap_or(DEFAULT_CURVE_POINTS))),
+        }
+    }
+
+    /// Set the tolerance and branch option of `spec` and check the parameters at both ends of
+    /// its grid (before any work or output).
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] for a tolerance outside (0, 1e-3); [`SimError::Params`] for
+    /// parameters invalid at an end of the grid.
+    pub fn configure(&self, mut spec: SteppedSpec) -> Result<SteppedSpec, SimError> {
+        let tol = self.tolerance;
+        if !(tol.is_finite() && tol > 0.0 && tol < 1e-3) {
+            return Err(SimError::out_of_range(
+                "tolerance",
+                tol,
+                "must be in (0, 1e-3)",
+            ));
+        }
+        for v in [spec.values[0], spec.values[spec.values.len() - 1]] {
+            spec.base.with(spec.param, v).validate()?;
+        }
+        spec.integrator.tolerance = tol;
+        spec.branches = self.branches;
+        Ok(spec)
+    }
+}
+
 /// The values of a stepped sweep from `from` to `to` (in that order).
 ///
 /// # Errors
