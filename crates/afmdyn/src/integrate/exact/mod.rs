@@ -722,8 +722,10 @@ impl ExactPropagator {
         Ok(())
     }
 
-    /// One step (see [`Integrator::step`]); in a modal region the plain state at the end of a
-    /// whole grid step is formed only when `materialize` (else z lags behind q).
+    /// One step (see [`Integrator::step`]). Without `materialize` (inside
+    /// [`Integrator::advance_to`], which reads only the result's `Ok`/`Err`): in a modal region
+    /// the plain state at the end of a whole grid step is not formed (z lags behind q), and a
+    /// switching is returned without its event record (no copy of the state).
     fn step_impl(&mut self, tau_max: f64, materialize: bool) -> Result<Step, SimError> {
         let region = self.region;
         let tau0 = self.tau;
@@ -916,6 +918,14 @@ impl ExactPropagator {
                 self.just_switched = true;
                 self.enter_stint(to, tau_s);
                 self.chatter_check(tau_s)?;
+                if !materialize {
+                    return Ok(Step {
+                        tau0,
+                        tau1: tau_s,
+                        region,
+                        event: None,
+                    });
+                }
                 Ok(Step::switched(&self.model, tau0, region, tau_s, &self.z))
             }
         }
