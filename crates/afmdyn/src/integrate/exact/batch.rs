@@ -437,7 +437,6 @@ impl ExactBatch {
         });
         // grid point of the blocks (all blocked lanes are on it)
         let mut at: Option<i64> = None;
-        let mut rejoin: Vec<usize> = Vec::new();
         loop {
             // lanes alone: step until on a grid point whose step ends by tau_end, or done
             for (l, st) in state.iter_mut().enumerate() {
@@ -491,19 +490,13 @@ impl ExactBatch {
                     b.scatter(s, lane, tau_a, (j.div_euclid(m), k));
                     b.remove(s);
                     state[l] = Lane::Loose;
+                    // (back on the grid at τ_{j+1}, it is parked there by the next pass)
                     while lane.tau < tau_b {
                         if let Err(e) = lane.step_impl(tau_b, false) {
                             out[l] = Err(e);
                             state[l] = Lane::Done;
                             break;
                         }
-                    }
-                    if state[l] == Lane::Loose
-                        && lane.on_grid == Some(next_at)
-                        && lane.tau == tau_b
-                        && grid_tau(next + 1) <= tau_end
-                    {
-                        rejoin.push(l);
                     }
                 }
                 b.commit();
@@ -523,11 +516,6 @@ impl ExactBatch {
                         }
                     }
                 }
-            }
-            for l in rejoin.drain(..) {
-                let lane = &self.lanes[l];
-                blocks[lane.region.index()].insert(l, lane);
-                state[l] = Lane::Blocked;
             }
             at = blocks.iter().any(|b| b.len() > 0).then_some(next);
             // the next step would end beyond tau_end: the rest alone
