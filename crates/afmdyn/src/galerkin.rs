@@ -7,7 +7,7 @@
 
 use crate::beam::ModeShapes;
 use crate::error::ParamError;
-use crate::params::{Params, Structure};
+use crate::params::{Params, Structure, SweepParam};
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
@@ -174,6 +174,42 @@ impl Galerkin {
             Region::Free => &self.free,
             Region::Contact => &self.contact,
         }
+    }
+
+    /// ∂F_s/∂p of the free and the contact region (in that order) for a parameter that enters
+    /// the forcing only — Ω, α2, α5, on which M, C_s and K_s (eq. 11, 12, 13, 15–17) do not
+    /// depend; `None` for α1, α3, α4, α6, which change the matrices.
+    ///
+    /// The forcing of eq. 14 and eq. 18 is a polynomial of degree ≤ 2 in each of Ω, α2 and α5
+    /// (α2 Ω², α2 α6 Ω, α2, α4 α5), and for such a polynomial the central difference
+    /// (F(p + δ) − F(p − δ)) / 2δ is the derivative exactly, for any δ; the same formulas are
+    /// evaluated at p ± δ with δ = 1 + |p|, so the derivative is exact up to round-off and the
+    /// formulas exist once.
+    pub fn forcing_derivative(&self, param: SweepParam) -> Option<[Forcing; 2]> {
+        let p0 = self.params;
+        let value = match param {
+            SweepParam::Omega => p0.omega,
+            SweepParam::Alpha2 => p0.alpha2,
+            SweepParam::Alpha5 => p0.alpha5,
+            SweepParam::Alpha1 | SweepParam::Alpha3 | SweepParam::Alpha4 | SweepParam::Alpha6 => {
+                return None
+            }
+        };
+        let delta = 1.0 + value.abs();
+        let at = |v: f64| {
+            let p = p0.with(param, v);
+            let free = forcing_free(&p, &self.tip, &self.integrals);
+            let contact = forcing_contact(&p, &self.tip, &free);
+            [free, contact]
+        };
+        let (plus, minus) = (at(value + delta), at(value - delta));
+        let diff = |a: &DVector<f64>, b: &DVector<f64>| (a - b) / (2.0 * delta);
+        let region = |i: usize| Forcing {
+            constant: diff(&plus[i].constant, &minus[i].constant),
+            sin: diff(&plus[i].sin, &minus[i].sin),
+            cos: diff(&plus[i].cos, &minus[i].cos),
+        };
+        Some([region(0), region(1)])
     }
 }
 

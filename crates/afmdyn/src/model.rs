@@ -22,7 +22,7 @@
 use crate::contact::{ContactLaw, TipSample, TipSampleLaw};
 use crate::error::{ParamError, SimError};
 use crate::galerkin::{Galerkin, Region};
-use crate::params::Params;
+use crate::params::{Params, SweepParam};
 use crate::system::{EventKind, Guard, HybridSystem, Jump};
 use nalgebra::{DMatrix, DVector};
 
@@ -49,6 +49,21 @@ pub struct RegionDynamics {
     pub b_sin: DVector<f64>,
     /// Coefficient of cos Ωτ, shape `[2N]`.
     pub b_cos: DVector<f64>,
+}
+
+/// ∂/∂p of the inputs of one region's dynamics ([`RegionDynamics`]) for a parameter p that
+/// enters the forcing only (Ω, α2, α5: A_s does not depend on it), see
+/// [`CantileverModel::forcing_derivative`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct ForcingDerivative {
+    /// ∂b_const/∂p, shape `[2N]`.
+    pub b_const: DVector<f64>,
+    /// ∂b_sin/∂p, shape `[2N]`.
+    pub b_sin: DVector<f64>,
+    /// ∂b_cos/∂p, shape `[2N]`.
+    pub b_cos: DVector<f64>,
+    /// ∂Ω/∂p: 1 for p = Ω (the harmonics sin Ωτ, cos Ωτ then depend on p), else 0.
+    pub d_omega: f64,
 }
 
 /// Rates of the energy balance dE/dτ = P_base − D_beam − D_contact (see [`CantileverModel::power`]).
@@ -446,11 +461,69 @@ impl CantileverModel {
         Ok(tip * Complex::from_polar(1.0, -self.params.drive_phase()))
     }
 
+    /// ∂b/∂p of the free and the contact region (in that order) for a parameter p that enters
+    /// the forcing only: b = (0, M⁻¹F) lifted from [`Galerkin::forcing_derivative`] (Ω, α2,
+    /// α5); `None` for α1, α3, α4, α6, on which A_s depends.
+    pub fn forcing_derivative(&self, param: SweepParam) -> Option<[ForcingDerivative; 2]> {
+        let df = self.galerkin.forcing_derivative(param)?;
+        let n = self.modes();
+        let chol = self.galerkin.region(Region::Free).mass.clone().cholesky()?;
+        let lift = |f: &DVector<f64>| {
+            let mut v = DVector::zeros(2 * n);
+            v.rows_mut(n, n).copy_from(&chol.solve(f));
+            v
+        };
+        let d_omega = f64::from(u8::from(param == SweepParam::Omega));
+        let region = |f: &crate::galerkin::Forcing| ForcingDerivative {
+            b_const: lift(&f.constant),
+            b_sin: lift(&f.sin),
+            b_cos: lift(&f.cos),
+            d_omega,
+        };
+        Some([region(&df[0]), region(&df[1])])
+    }
+
+    /// ∂g/∂p of the guard of `mode` at fixed (τ, z) for the guards σ V_T (eq. 8: V_T = W(1,τ) +
+    /// α2 sin Ωτ + α5, so ∂V_T/∂Ω = α2 τ cos Ωτ, ∂V_T/∂α2 = sin Ωτ for the beam and 0 for the
+    /// point mass, ∂V_T/∂α5 = 1, and 0 for the parameters that enter only the dynamics).
+    /// `None` for laws with restitution, whose guards and jump maps depend on the parameters
+    /// in other ways (sticking force, impact).
+    pub fn guard_param_derivative(&self, mode: Region, param: SweepParam, tau: f64) -> Option<f64> {
+        if self.law.law.restitution().is_some() {
+            return None;
+        }
+        let p = &self.params;
+        let (s, c) = (p.omega * tau).sin_cos();
+        // base_amplitude() is α2 or 0: linear in α2, so its value at α2 = 1 is its derivative
+        let unit = p.with(SweepParam::Alpha2, 1.0).base_amplitude();
+        let dv = match param {
+            SweepParam::Omega => p.base_amplitude() * tau * c,
+            SweepParam::Alpha2 => unit * s,
+            SweepParam::Alpha5 => 1.0,
+            SweepParam::Alpha1 | SweepParam::Alpha3 | SweepParam::Alpha4 | SweepParam::Alpha6 => {
+                0.0
+            }
+        };
+        Some(mode.guard_sign() * dv)
+    }
+
     /// Saltation matrix (2N×2N) at an event of region `from` at (τ, z⁻): the generic
     /// [`crate::system::saltation`] of this system. For the linear law on V_T = 0 only the
     /// damper term α6 V̇_T jumps, so S ≠ I whenever α6 > 0.
     pub fn saltation(&self, from: Region, tau: f64, z: &DVector<f64>) -> DMatrix<f64> {
         crate::system::saltation(self, from, tau, z.as_slice()).0
+    }
+
+    /// [`CantileverModel::saltation`] with the event shift w of
+    /// [`crate::system::saltation_with_shift`] (shape `[2N]`).
+    pub fn saltation_with_shift(
+        &self,
+        from: Region,
+        tau: f64,
+        z: &DVector<f64>,
+    ) -> (DMatrix<f64>, DVector<f64>) {
+        let (s, _, w) = crate::system::saltation_with_shift(self, from, tau, z.as_slice());
+        (s, w)
     }
 
     /// Constraint force λ of sticking (impact law) at (τ, z), with its gradient and τ-rate:

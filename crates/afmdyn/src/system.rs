@@ -154,6 +154,22 @@ pub fn saltation<S: HybridSystem + ?Sized>(
     tau: f64,
     z_minus: &[f64],
 ) -> (DMatrix<f64>, Jump) {
+    let (s, jump, _) = saltation_with_shift(sys, from, tau, z_minus);
+    (s, jump)
+}
+
+/// [`saltation`] with the event shift w = (f⁺ − R f⁻ − ∂r/∂τ) / ġ (zero when ġ = 0), so that
+/// S = R + w ∇_z gᵀ. A parameter p that moves the guard by ∂g/∂p at fixed (τ, z) moves the
+/// event by δτ = −(∂g/∂p) δp / ġ, and the post-event state at the nominal event time by
+/// w (∂g/∂p) δp: the sensitivity s = ∂z/∂p crosses the event as s⁺ = S s⁻ + w ∂g/∂p (the
+/// parameter column of the saltation matrix of the system extended by ṗ = 0; Leine &
+/// Nijmeijer 2004, §7.1, with p as a state).
+pub fn saltation_with_shift<S: HybridSystem + ?Sized>(
+    sys: &S,
+    from: Region,
+    tau: f64,
+    z_minus: &[f64],
+) -> (DMatrix<f64>, Jump, DVector<f64>) {
     let d = sys.dim();
     let jump = sys.jump(from, tau, z_minus);
     let guard = sys.guard(from, tau, z_minus);
@@ -164,9 +180,11 @@ pub fn saltation<S: HybridSystem + ?Sized>(
     let f_minus = DVector::from_vec(f_minus);
     let rate = guard.grad.dot(&f_minus) + guard.d_tau;
     let mut s = jump.jacobian.clone();
+    let mut shift = DVector::zeros(d);
     if rate != 0.0 {
         let num = DVector::from_vec(f_plus) - &jump.jacobian * &f_minus - &jump.d_tau;
-        s += num * guard.grad.transpose() / rate;
+        s += &num * guard.grad.transpose() / rate;
+        shift = num / rate;
     }
-    (s, jump)
+    (s, jump, shift)
 }

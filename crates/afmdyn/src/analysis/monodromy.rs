@@ -7,6 +7,7 @@ use crate::error::SimError;
 use crate::galerkin::Region;
 use crate::integrate::exact::matmul_into;
 use crate::integrate::Integrator;
+use crate::params::SweepParam;
 use crate::roots::extremum;
 use crate::system::EventKind;
 use nalgebra::{DMatrix, DVector};
@@ -31,6 +32,9 @@ pub struct FlowMap {
     /// change (for an affine region ln det e^{A t} = t trace A, Liouville), from one determinant
     /// of the product.
     pub log_volume: f64,
+    /// ∂z(τ1)/∂p at fixed τ1, shape `[2N]`, when asked for ([`flow_with_param_derivative`]) and
+    /// the integrator provides it ([`Integrator::last_step_param_derivative_into`]); else `None`.
+    pub param_derivative: Option<DVector<f64>>,
 }
 
 /// Integrate (τ0, z0) → τ1 with `integ`, multiplying the step Jacobians and saltation
@@ -44,15 +48,50 @@ pub fn flow_with_jacobian(
     z0: &DVector<f64>,
     tau1: f64,
 ) -> Result<FlowMap, SimError> {
+    flow(integ, tau0, z0, tau1, None)
+}
+
+/// [`flow_with_jacobian`] with the parameter sensitivity s = ∂z(τ1)/∂p at fixed τ1 in
+/// [`FlowMap::param_derivative`]: s(τ0) = 0, s ← J s + ∂z(τ_b)/∂p|_{z(τ_a)} over each step
+/// (variational equation of the parameter, Hairer, Nørsett & Wanner, *Solving ODEs I*, §I.14)
+/// and s⁺ = S s⁻ + w ∂g/∂p at each event ([`crate::system::saltation_with_shift`]). `None` there
+/// when the integrator or the law does not provide it (then ∂z/∂p needs finite differences).
+///
+/// # Errors
+/// As [`flow_with_jacobian`].
+pub fn flow_with_param_derivative(
+    integ: &mut dyn Integrator,
+    tau0: f64,
+    z0: &DVector<f64>,
+    tau1: f64,
+    param: SweepParam,
+) -> Result<FlowMap, SimError> {
+    flow(integ, tau0, z0, tau1, Some(param))
+}
+
+fn flow(
+    integ: &mut dyn Integrator,
+    tau0: f64,
+    z0: &DVector<f64>,
+    tau1: f64,
+    mut param: Option<SweepParam>,
+) -> Result<FlowMap, SimError> {
     integ.set_variational(true);
     integ.reset(tau0, z0)?;
     let omega = integ.model().omega();
     let dim = z0.len();
     // a start inside a rigid sample is first projected onto it (impact law): its Jacobian
     let mut jac = match integ.model().start_projection(tau0, z0) {
-        Some((_, p)) => p,
+        Some((_, p)) => {
+            // the projection's own parameter dependence is not modelled
+            param = None;
+            p
+        }
         None => DMatrix::identity(dim, dim),
     };
+    // parameter sensitivity, the step's ∂z/∂p and scratch
+    let mut sens = DVector::zeros(dim);
+    let (mut step_dp, mut tmp) = (DVector::zeros(dim), DVector::zeros(dim));
     let mut out = FlowMap {
         state: z0.clone(),
         jacobian: DMatrix::zeros(0, 0),
@@ -61,6 +100,7 @@ pub fn flow_with_jacobian(
         grazing_distance: f64::INFINITY,
         contact_time: 0.0,
         log_volume: 0.0,
+        param_derivative: None,
     };
     let mut before = z0.clone();
     // scratch for the step Jacobian and the product (no allocation per step)
@@ -79,6 +119,15 @@ pub fn flow_with_jacobian(
         integ.last_step_jacobian_into(&mut step_jac)?;
         matmul_into(&step_jac, &jac, 1.0, &mut prod);
         std::mem::swap(&mut jac, &mut prod);
+        if let Some(p) = param {
+            if integ.last_step_param_derivative_into(p, &mut step_dp)? {
+                tmp.gemv(1.0, &step_jac, &sens, 0.0);
+                sens.copy_from(&tmp);
+                sens += &step_dp;
+            } else {
+                param = None;
+            }
+        }
         if step.region == Region::Contact {
             out.contact_time += len;
         }
@@ -91,15 +140,28 @@ pub fn flow_with_jacobian(
             };
             (m.v_t_dot(step.tau0, &before), end)
         };
-        if len > 0.0 && (d0 > 0.0) != (d1 > 0.0) {
+        if len > 0.0
+            && (d0 > 0.0) != (d1 > 0.0)
+            && !farther(integ, step.tau0, &before, &step, d0, out.grazing_distance)
+        {
             let mut vt = |t: f64| integ.dense_v_t(t);
             let t = extremum(step.tau0, step.tau1, d0, &mut vt);
             out.grazing_distance = out.grazing_distance.min(vt(t)[0].abs());
         }
         if let Some(e) = &step.event {
-            let s = integ.model().saltation(e.from, e.tau, &e.state);
+            let (s, shift) = integ.model().saltation_with_shift(e.from, e.tau, &e.state);
             matmul_into(&s, &jac, 1.0, &mut prod);
             std::mem::swap(&mut jac, &mut prod);
+            if let Some(p) = param {
+                match integ.model().guard_param_derivative(e.from, p, e.tau) {
+                    Some(dg) => {
+                        tmp.gemv(1.0, &s, &sens, 0.0);
+                        sens.copy_from(&tmp);
+                        sens.axpy(dg, &shift, 1.0);
+                    }
+                    None => param = None,
+                }
+            }
             out.switchings += 1;
             if e.to == Region::Contact || e.kind == EventKind::Impact {
                 out.contacts += 1;
@@ -108,9 +170,35 @@ pub fn flow_with_jacobian(
         }
     }
     out.state = integ.state().clone();
+    out.param_derivative = param.map(|_| sens);
     out.log_volume = jac.clone().lu().determinant().abs().ln();
     out.jacobian = jac;
     Ok(out)
+}
+
+/// Whether the local extremum of V_T inside `step` (V_T' = `d0` at its start) is provably no
+/// nearer to V_T = 0 than `nearest`: a maximum lies above both ends, V_T(t*) ≥ max(V_a, V_b), and
+/// a minimum below both, so when that end value is ≥ `nearest` in the direction away from 0
+/// (σ max(σV_a, σV_b) ≥ nearest, σ = +1 for a maximum, −1 for a minimum), |V_T(t*)| is too and
+/// the extremum search cannot lower the grazing distance.
+fn farther(
+    integ: &dyn Integrator,
+    tau0: f64,
+    before: &DVector<f64>,
+    step: &crate::integrate::Step,
+    d0: f64,
+    nearest: f64,
+) -> bool {
+    if !nearest.is_finite() {
+        return false;
+    }
+    let m = integ.model();
+    let end = match &step.event {
+        Some(e) => m.v_t(e.tau, &e.state),
+        None => m.v_t(step.tau1, integ.state()),
+    };
+    let sigma = if d0 > 0.0 { 1.0 } else { -1.0 };
+    (sigma * m.v_t(tau0, before)).max(sigma * end) >= nearest
 }
 
 /// The period-n stroboscopic map from drive phase 0 (τ = 0 → nT) with its monodromy matrix.
@@ -124,6 +212,29 @@ pub fn stroboscopic(
 ) -> Result<FlowMap, SimError> {
     let t = n as f64 * integ.model().period();
     flow_with_jacobian(integ, 0.0, z0, t)
+}
+
+/// [`stroboscopic`] with ∂Pⁿ/∂p in [`FlowMap::param_derivative`] (see
+/// [`flow_with_param_derivative`]): for p = Ω the end time nT = 2πn/Ω moves too, which adds
+/// ż(nT) d(nT)/dΩ = −ż(nT) nT/Ω.
+///
+/// # Errors
+/// As [`flow_with_jacobian`].
+pub fn stroboscopic_with_param_derivative(
+    integ: &mut dyn Integrator,
+    z0: &DVector<f64>,
+    n: usize,
+    param: SweepParam,
+) -> Result<FlowMap, SimError> {
+    let t = n as f64 * integ.model().period();
+    let mut map = flow_with_param_derivative(integ, 0.0, z0, t, param)?;
+    if let (Some(d), SweepParam::Omega) = (&mut map.param_derivative, param) {
+        let mut f = DVector::zeros(z0.len());
+        let m = integ.model();
+        m.rhs(integ.region(), t, &map.state, &mut f);
+        d.axpy(-t / m.omega(), &f, 1.0);
+    }
+    Ok(map)
 }
 
 /// The state z(τ1) of the flow from (τ0, z0), without its Jacobian: the `state` of

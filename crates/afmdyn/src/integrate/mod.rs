@@ -24,6 +24,7 @@ pub mod rk4;
 use crate::error::SimError;
 use crate::galerkin::Region;
 use crate::model::CantileverModel;
+use crate::params::SweepParam;
 use crate::system::EventKind;
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
@@ -158,6 +159,24 @@ pub trait Integrator: Send {
     fn last_step_jacobian_into(&mut self, out: &mut DMatrix<f64>) -> Result<(), SimError> {
         *out = self.last_step_jacobian()?;
         Ok(())
+    }
+    /// ∂z(τ1)/∂p of the last step [τ0, τ1] inside its region, at fixed z(τ0), τ0 and τ1, written
+    /// into `out` (resized to `[2N]`), for a parameter p that enters the forcing only (Ω, α2,
+    /// α5; [`CantileverModel::forcing_derivative`]). With the step Jacobians J and the event
+    /// shifts of [`crate::system::saltation_with_shift`] it gives the parameter sensitivity of
+    /// a flow, s ← J s + this (see [`crate::analysis::monodromy::flow_with_param_derivative`]).
+    /// `Ok(false)`, with `out` untouched, where the integrator does not provide it (the default;
+    /// the exact propagator provides it for Ω, α2 and α5).
+    ///
+    /// # Errors
+    /// As [`Integrator::last_step_jacobian`].
+    fn last_step_param_derivative_into(
+        &mut self,
+        param: SweepParam,
+        out: &mut DVector<f64>,
+    ) -> Result<bool, SimError> {
+        let _ = (param, out);
+        Ok(false)
     }
     /// Integrate the variational equations along with the state (needed by
     /// [`Integrator::last_step_jacobian`] of the adaptive integrator; free for the exact one).

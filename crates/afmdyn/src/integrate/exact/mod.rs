@@ -48,9 +48,10 @@ use crate::error::SimError;
 use crate::galerkin::Region;
 use crate::model::CantileverModel;
 use crate::params::Params;
+use crate::params::SweepParam;
 use kernel::MatVec;
 use modal::{ModalExp, Modes, MAXD};
-use nalgebra::{DMatrix, DVector};
+use nalgebra::{DMatrix, DVector, Dyn, LU};
 use search::{certified_positive, Search, TipPoly};
 use spectral::Spectral;
 use std::collections::VecDeque;
@@ -138,6 +139,20 @@ struct Forced {
     vp_curv: f64,
     /// e^{λ_k h} of the modal representatives (empty without an eigendecomposition).
     grid_fac: Modes,
+    /// LU of [[A, ΩI], [−ΩI, A]] (4N×4N), kept for the parameter derivatives of (ps, pc).
+    harmonic_lu: LU<f64, Dyn, Dyn>,
+}
+
+/// ∂z_p/∂p of one region's particular solution for a parameter p of the forcing:
+/// ∂z_p/∂p(τ) = p0 + ps sin Ωτ + pc cos Ωτ + (∂Ω/∂p) τ (ps⁰ cos Ωτ − pc⁰ sin Ωτ), (ps⁰, pc⁰) those of
+/// [`Forced`]; eq. 10's particular solution differentiated at fixed A: A p0 = −∂b_const/∂p and
+/// [[A, ΩI], [−ΩI, A]] (ps, pc) = −(∂b_sin/∂p, ∂b_cos/∂p) − (∂Ω/∂p) (pc⁰, −ps⁰).
+#[derive(Debug, Clone)]
+struct ParticularDerivative {
+    p0: DVector<f64>,
+    ps: DVector<f64>,
+    pc: DVector<f64>,
+    d_omega: f64,
 }
 
 /// The last step, kept for dense output.
@@ -201,6 +216,11 @@ pub struct ExactPropagator {
     /// sin Ωτ_k and cos Ωτ_k on the grid of one period (k = 0..=m).
     trig: Arc<[(f64, f64)]>,
     zb: DVector<f64>,
+    /// ∂z_p/∂p of both regions for the last parameter asked for
+    /// ([`Integrator::last_step_param_derivative_into`]).
+    param_data: Option<(SweepParam, Arc<[ParticularDerivative; 2]>)>,
+    /// ∂z_p/∂p at the end (τ, region) of the last step it was asked for.
+    param_end: Option<(f64, Region, [f64; MAXD])>,
 }
 
 /// Particular solution of one region and its grid values: A p0 = −b_const and
@@ -238,7 +258,8 @@ fn forced(
         )
     };
     let big_norm = big.norm();
-    let sol = big.lu().solve(&rhs).ok_or_else(resonance)?;
+    let harmonic_lu = big.lu();
+    let sol = harmonic_lu.solve(&rhs).ok_or_else(resonance)?;
     // numerically singular (Ω within round-off of an undamped resonance)
     let amplification = sol.norm() * big_norm;
     if rhs.norm() > 0.0 && (amplification.is_nan() || amplification > 1e13 * rhs.norm()) {
@@ -272,6 +293,7 @@ fn forced(
         wp,
         vp_curv,
         grid_fac,
+        harmonic_lu,
     })
 }
 
@@ -399,6 +421,8 @@ impl ExactPropagator {
             dead,
             trig: trig.into(),
             zb: zero,
+            param_data: None,
+            param_end: None,
         })
     }
 
@@ -465,6 +489,64 @@ impl ExactPropagator {
             return self.phi[self.last.region.index()].clone();
         }
         self.transition(self.last.region, len)
+    }
+
+    /// ∂z_p/∂p of both regions for `param` (cached for the last parameter); `None` for a
+    /// parameter on which A_s depends.
+    fn particular_derivative(
+        &mut self,
+        param: SweepParam,
+    ) -> Result<Option<Arc<[ParticularDerivative; 2]>>, SimError> {
+        if let Some((p, d)) = &self.param_data {
+            if *p == param {
+                return Ok(Some(d.clone()));
+            }
+        }
+        let Some(df) = self.model.forcing_derivative(param) else {
+            return Ok(None);
+        };
+        let singular = || SimError::out_of_range("state matrix", "singular", "K must be SPD");
+        let region = |ri: usize| -> Result<ParticularDerivative, SimError> {
+            let (fr, d) = (&self.forced[ri], &df[ri]);
+            let dim = fr.p0.len();
+            let p0 = self.spec[ri]
+                .a_lu
+                .solve(&(-&d.b_const))
+                .ok_or_else(singular)?;
+            let mut rhs = DVector::zeros(2 * dim);
+            rhs.rows_mut(0, dim)
+                .copy_from(&(-&d.b_sin - &fr.pc * d.d_omega));
+            rhs.rows_mut(dim, dim)
+                .copy_from(&(-&d.b_cos + &fr.ps * d.d_omega));
+            let sol = fr.harmonic_lu.solve(&rhs).ok_or_else(singular)?;
+            Ok(ParticularDerivative {
+                p0,
+                ps: sol.rows(0, dim).into_owned(),
+                pc: sol.rows(dim, dim).into_owned(),
+                d_omega: d.d_omega,
+            })
+        };
+        let data = Arc::new([region(0)?, region(1)?]);
+        self.param_data = Some((param, data.clone()));
+        self.param_end = None;
+        Ok(Some(data))
+    }
+
+    /// ∂z_p/∂p(τ) of one region (see [`ParticularDerivative`]) into `out`, given
+    /// (sin Ωτ, cos Ωτ).
+    fn zpp_into(
+        d: &ParticularDerivative,
+        f: &Forced,
+        tau: f64,
+        (s, c): (f64, f64),
+        out: &mut [f64],
+    ) {
+        let k = d.d_omega * tau;
+        let (p0, dps, dpc) = (d.p0.as_slice(), d.ps.as_slice(), d.pc.as_slice());
+        let (ps, pc) = (f.ps.as_slice(), f.pc.as_slice());
+        for (i, o) in out.iter_mut().enumerate() {
+            *o = p0[i] + s * dps[i] + c * dpc[i] + k * (ps[i] * c - pc[i] * s);
+        }
     }
 
     fn zp_into(f: &Forced, omega: f64, tau: f64, out: &mut [f64]) {
@@ -677,6 +759,32 @@ impl ExactPropagator {
         out.sigma = r.guard_sign();
         out.dead = dead;
         out.curv = curv;
+        out.gc2_ready = false;
+    }
+
+    /// Build the tip series of the last step (unless the step built it), covering local time
+    /// t (dense output).
+    fn poly_for_last(&mut self, t: f64) {
+        if self.poly_built {
+            return;
+        }
+        let len = (self.tau - self.last.tau0).max(t);
+        let dim = self.z.len();
+        let mut y0 = [0.0; MAXD];
+        self.last_y0(&mut y0[..dim]);
+        let ri = self.last.region.index();
+        Self::build_poly(
+            &self.spec[ri],
+            &self.forced[ri],
+            self.model.params(),
+            self.dead,
+            self.last.region,
+            self.last.tau0,
+            &y0[..dim],
+            len,
+            &mut self.poly,
+        );
+        self.poly_built = true;
     }
 
     /// Start a stint in `region` at (τ, z): the bound on |W_hom''| over the whole stint — the
@@ -969,6 +1077,7 @@ impl Integrator for ExactPropagator {
         self.last.modal = false;
         self.last.full = false;
         self.poly_built = false;
+        self.param_end = None;
         self.vt = (self.model.v_t(tau, &z), self.model.v_t_dot(tau, &z));
         Ok(())
     }
@@ -991,26 +1100,16 @@ impl Integrator for ExactPropagator {
 
     fn dense_tip(&mut self, tau: f64) -> [f64; 3] {
         let t = tau - self.last.tau0;
-        if !self.poly_built {
-            let len = (self.tau - self.last.tau0).max(t);
-            let dim = self.z.len();
-            let mut y0 = [0.0; MAXD];
-            self.last_y0(&mut y0[..dim]);
-            let ri = self.last.region.index();
-            Self::build_poly(
-                &self.spec[ri],
-                &self.forced[ri],
-                self.model.params(),
-                self.dead,
-                self.last.region,
-                self.last.tau0,
-                &y0[..dim],
-                len,
-                &mut self.poly,
-            );
-            self.poly_built = true;
-        }
+        self.poly_for_last(t);
         self.poly.w(t)
+    }
+
+    /// From the tip series of the last step, whose coefficients include the harmonic part of
+    /// V_T (eq. 8): no sine per call, unlike the default through [`Integrator::dense_tip`].
+    fn dense_v_t(&mut self, tau: f64) -> [f64; 3] {
+        let t = tau - self.last.tau0;
+        self.poly_for_last(t);
+        self.poly.v_t(t)
     }
 
     fn dense_state(&mut self, tau: f64) -> DVector<f64> {
@@ -1021,6 +1120,53 @@ impl Integrator for ExactPropagator {
 
     fn last_step_jacobian(&mut self) -> Result<DMatrix<f64>, SimError> {
         Ok(self.step_transition())
+    }
+
+    /// z(τ1) = z_p(τ1) + e^{A t}(z(τ0) − z_p(τ0)) with A independent of p, so at fixed z(τ0)
+    /// ∂z(τ1)/∂p = ∂z_p/∂p(τ1) − e^{A t} ∂z_p/∂p(τ0).
+    fn last_step_param_derivative_into(
+        &mut self,
+        param: SweepParam,
+        out: &mut DVector<f64>,
+    ) -> Result<bool, SimError> {
+        let Some(d) = self.particular_derivative(param)? else {
+            return Ok(false);
+        };
+        let dim = self.z.len();
+        if out.len() != dim {
+            *out = DVector::zeros(dim);
+        }
+        let (r, ta, tb) = (self.last.region, self.last.tau0, self.tau);
+        let ri = r.index();
+        let omega = self.model.omega();
+        // ∂z_p/∂p at τa: the τb value of the previous call when the steps join in one region
+        // (every grid step of a stint), and sin, cos from the grid table on the grid
+        let mut xa = [0.0; MAXD];
+        let xa = &mut xa[..dim];
+        match &self.param_end {
+            Some((tau, region, x)) if *tau == ta && *region == r => xa.copy_from_slice(&x[..dim]),
+            _ => Self::zpp_into(&d[ri], &self.forced[ri], ta, (omega * ta).sin_cos(), xa),
+        }
+        let trig_b = match self.on_grid {
+            Some((_, k)) => self.trig[k],
+            None => (omega * tb).sin_cos(),
+        };
+        Self::zpp_into(&d[ri], &self.forced[ri], tb, trig_b, out.as_mut_slice());
+        let end = self.param_end.get_or_insert((0.0, r, [0.0; MAXD]));
+        end.0 = tb;
+        end.1 = r;
+        end.2[..dim].copy_from_slice(out.as_slice());
+        // out −= e^{A t} xa: Φ_s after a whole grid step, else T⁻¹ e^{Ã t} T xa
+        let sp = &self.spec[ri];
+        if self.last.full && self.on_grid.is_some() {
+            matvec(&self.phi[ri], xa, out.as_mut_slice(), -1.0, true);
+        } else {
+            let (mut y0, mut yt) = ([0.0; MAXD], [0.0; MAXD]);
+            matvec(&sp.t, xa, &mut y0[..dim], 1.0, false);
+            Self::hom_energy(sp, &y0[..dim], tb - ta, &mut yt[..dim]);
+            matvec(&sp.tinv, &yt[..dim], out.as_mut_slice(), -1.0, true);
+        }
+        Ok(true)
     }
 
     fn last_step_jacobian_into(&mut self, out: &mut DMatrix<f64>) -> Result<(), SimError> {

@@ -13,6 +13,11 @@ pub(super) struct TipPoly {
     /// harmonic part W_p + α2 sin Ωτ + α5 (whose n-th derivative cycles through ±Ωⁿ(S, C)), so
     /// that the gap costs two Horner sums and no sine.
     pub(super) gc: [[f64; K + 1]; 2],
+    /// Taylor coefficients of d²V_T/dτ², filled on first use by [`TipPoly::v_t`] (dense output
+    /// only; the search does not need them).
+    gc2: [f64; K + 1],
+    /// Whether `gc2` belongs to this polynomial.
+    pub(super) gc2_ready: bool,
     /// Terms kept: the tail beyond is below round-off over the step.
     pub(super) terms: usize,
     pub(super) wp: [f64; 3],
@@ -34,6 +39,8 @@ impl TipPoly {
             tau0: 0.0,
             c: [[0.0; K + 1]; 3],
             gc: [[0.0; K + 1]; 2],
+            gc2: [0.0; K + 1],
+            gc2_ready: false,
             terms: 1,
             wp: [0.0; 3],
             omega: 0.0,
@@ -56,6 +63,29 @@ impl TipPoly {
             Self::horner(&self.c[0][..self.terms], t) + w0 + ws * s + wc * c,
             Self::horner(&self.c[1][..self.terms], t) + om * (ws * c - wc * s),
             Self::horner(&self.c[2][..self.terms], t) - om * om * (ws * s + wc * c),
+        ]
+    }
+    /// [V_T, dV_T/dτ, d²V_T/dτ²] at local time t: three Horner sums, no sine (the harmonic
+    /// part is in the coefficients; those of V_T'' are formed on the first call, as `gc` by the
+    /// propagator's `build_poly`: cᵢ[2] plus the n-th derivative Ωⁿ⁺² (S, C, −S, −C)[(n+2) mod 4]
+    /// of the harmonic part at τ0).
+    pub(super) fn v_t(&mut self, t: f64) -> [f64; 3] {
+        if !self.gc2_ready {
+            let (s0, c0) = (self.omega * self.tau0).sin_cos();
+            let (a_s, a_c) = (self.wp[1] + self.base_amp, self.wp[2]);
+            let (sv, sd) = (a_s * s0 + a_c * c0, a_s * c0 - a_c * s0);
+            let cycle = [sv, sd, -sv, -sd];
+            let mut om_n = self.omega * self.omega;
+            for n in 0..self.terms {
+                self.gc2[n] = self.c[2][n] + om_n * cycle[(n + 2) % 4] * super::INV_FACT[n];
+                om_n *= self.omega;
+            }
+            self.gc2_ready = true;
+        }
+        [
+            Self::horner(&self.gc[0][..self.terms], t),
+            Self::horner(&self.gc[1][..self.terms], t),
+            Self::horner(&self.gc2[..self.terms], t),
         ]
     }
     /// Gap g = σ V_T and its derivative at local time t.
