@@ -5,12 +5,14 @@
 //! Unknowns y = (z, p) ∈ R^{2N+1}; F(z, p) = Pⁿ(z; p) − z = 0 augmented by the arclength
 //! condition tᵀ(y − y_pred) = 0 (Keller 1977; Seydel, *Practical Bifurcation and Stability
 //! Analysis*, 3rd ed., Springer 2010, ch. 4). ∂F/∂z = M − I with M the monodromy matrix;
-//! ∂F/∂p by central differences of the map. Test functions between accepted points: dp/ds
+//! ∂F/∂p from the parameter sensitivity along the same flow where the integrator provides it
+//! (the exact propagator for Ω, α2, α5: [`stroboscopic_with_param_derivative`]), else by central
+//! differences of the map. Test functions between accepted points: dp/ds
 //! (fold), det(M + I) (period doubling), the number of complex multipliers outside the unit
 //! circle (Neimark–Sacker) and the number of switchings per cycle (grazing); each sign change
 //! is located by bisection on the arclength step.
 
-use super::monodromy::{flow_state, stroboscopic, FlowMap};
+use super::monodromy::{flow_state, stroboscopic, stroboscopic_with_param_derivative, FlowMap};
 use super::shooting::{
     floquet_stability, section_points, shoot_with, Instability, ShootingOptions,
 };
@@ -146,9 +148,18 @@ impl Solver {
         Ok(self.cache[i].1.as_mut())
     }
 
+    /// Pⁿ(z) with its monodromy matrix and, where the integrator provides it, ∂Pⁿ/∂p.
     fn map(&mut self, z: &DVector<f64>, p: f64) -> Result<FlowMap, SimError> {
-        let n = self.spec.period;
-        stroboscopic(self.at(p)?, z, n)
+        let (n, param) = (self.spec.period, self.spec.param);
+        stroboscopic_with_param_derivative(self.at(p)?, z, n, param)
+    }
+
+    /// ∂Pⁿ/∂p at (z, p): that of `map` when known, else central differences.
+    fn dp_of(&mut self, map: &FlowMap, z: &DVector<f64>, p: f64) -> Result<DVector<f64>, SimError> {
+        match &map.param_derivative {
+            Some(d) => Ok(d.clone()),
+            None => self.dp(z, p),
+        }
     }
 
     /// Pⁿ(z) alone (the state of [`Solver::map`] without the monodromy matrix).
@@ -209,7 +220,8 @@ impl Solver {
     ) -> Result<(DVector<f64>, FlowMap, usize, DVector<f64>), SimError> {
         let dim = y_pred.len() - 1;
         let mut y = y_pred.clone();
-        let mut fp = self.dp(&y.rows(0, dim).into_owned(), y[dim])?;
+        // ∂F/∂p of the previous iterate (central differences are not redone at convergence)
+        let mut fp_prev: Option<DVector<f64>> = None;
         for it in 0..10 {
             let (z, p) = (y.rows(0, dim).into_owned(), y[dim]);
             let map = self.map(&z, p)?;
@@ -219,11 +231,14 @@ impl Solver {
             if res <= self.spec.newton.tol * (1.0 + z.norm())
                 && arc.abs() <= 1e-12 * (1.0 + y.norm())
             {
+                let fp = match (&map.param_derivative, fp_prev) {
+                    (Some(d), _) => d.clone(),
+                    (None, Some(fp)) => fp,
+                    (None, None) => self.dp(&z, p)?,
+                };
                 return Ok((y, map, it, fp));
             }
-            if it > 0 {
-                fp = self.dp(&z, p)?;
-            }
+            let fp = self.dp_of(&map, &z, p)?;
             let mut g = DVector::zeros(dim + 1);
             g.rows_mut(0, dim).copy_from(&f);
             g[dim] = arc;
@@ -236,6 +251,7 @@ impl Solver {
                     residual: res,
                 })?;
             y += delta;
+            fp_prev = Some(fp);
             if !y.iter().all(|v| v.is_finite()) {
                 break;
             }
@@ -355,7 +371,7 @@ pub fn continue_branch(
     let mut t0 = DVector::zeros(dim + 1);
     t0[dim] = dir;
     let map = solver.map(&orbit.state, spec.from)?;
-    let fp0 = solver.dp(&orbit.state, spec.from)?;
+    let fp0 = solver.dp_of(&map, &orbit.state, spec.from)?;
     let mut t = Solver::tangent(&map.jacobian, &fp0, &t0)?;
     if t[dim] * dir < 0.0 {
         t = -t;
@@ -462,7 +478,13 @@ pub fn continue_branch(
         // stop when the branch closes on itself (an isola back at its first point), or when a
         // period-2n branch has merged into a period-n orbit (its half-cycle repeats): beyond that
         // it would trace the period-n branch again
-        let closed = out.len() > 10 && (&y_new - &first).norm() < 0.5 * ds;
+        // (the step's chord from y to y_new passes within half its length of the first point:
+        // the end points alone can both miss it by more than that when ds has changed)
+        let closed = out.len() > 10 && {
+            let (u, w) = (&y_new - &y, &first - &y);
+            let along = (w.dot(&u) / u.norm_squared().max(f64::MIN_POSITIVE)).clamp(0.0, 1.0);
+            (w - &u * along).norm() < 0.5 * u.norm()
+        };
         let half = spec.period / 2;
         let half_gap = |b: &BranchPoint| {
             (&b.section[half] - &b.section[0]).norm() / (1.0 + b.section[0].norm())
