@@ -15,6 +15,9 @@
 //! `... -- shoot <N> [reps]`: time of one shooting solve of the period-1 orbit at Ω = 3.5 from
 //! the attractor perturbed by 1e-3 (as `benches/stability.rs`).
 //!
+//! `... -- continuation <N> [reps]`: time of the continuation of the default period-1 branch
+//! over Ω from 5 down to 1 (as `benches/stability.rs`), best of `reps`, and its number of points.
+//!
 //! `... -- batch <N> [lanes] [periods]`: many trajectories at one parameter set (default, Ω =
 //! 2.6): `lanes` random starts (`random_state`, seed 1), each first taken 50 periods onto the
 //! attractor, then advanced `periods` more one by one ([`advance`] per lane) and as one
@@ -28,12 +31,13 @@
 //! `RAYON_NUM_THREADS=1` for one core.
 
 use afmdyn::analysis::bifurcation::random_state;
+use afmdyn::analysis::continuation::{continue_branch, ContinuationSpec};
 use afmdyn::analysis::shooting::{shoot, ShootingOptions};
 use afmdyn::analysis::steady::{steady_state, steady_states, SteadyOptions};
 use afmdyn::integrate::exact::{ExactBatch, ExactOptions, ExactPropagator, Propagation};
 use afmdyn::integrate::Integrator;
 use afmdyn::integrate::{advance, advance_dyn, build, IntegratorOptions};
-use afmdyn::{CantileverModel, LawKind, Params};
+use afmdyn::{CantileverModel, LawKind, Params, SweepParam};
 use nalgebra::DVector;
 use std::time::Instant;
 
@@ -104,6 +108,29 @@ fn shooting(modes: usize, reps: usize) -> Result<(), Box<dyn std::error::Error>>
         std::hint::black_box(shoot(&m, &guess, 1, &ShootingOptions::default()).ok());
     });
     println!("shoot N = {modes}: {us:.1} µs ({iters} residual evaluations)");
+    Ok(())
+}
+
+fn continuation(modes: usize, reps: usize) -> Result<(), Box<dyn std::error::Error>> {
+    let base = Params {
+        modes,
+        ..Params::default()
+    };
+    let p = Params { omega: 5.0, ..base };
+    let m = CantileverModel::new(&p)?;
+    let mut it = build(&m, IntegratorOptions::default(), 0.0, &m.rest())?;
+    let guess = steady_state(it.as_mut(), &SteadyOptions::default())?
+        .end_state()
+        .clone();
+    let spec = ContinuationSpec::new(base, SweepParam::Omega, 5.0, 1.0, 1);
+    let mut points = 0;
+    let us = best_of(reps, || {
+        points = continue_branch(&spec, &guess).map_or(0, |b| b.len());
+    });
+    println!(
+        "continuation N = {modes}, Ω 5 → 1: {:.3} s ({points} points)",
+        us * 1e-6
+    );
     Ok(())
 }
 
@@ -224,6 +251,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     match first.as_str() {
         "build" => return builds(modes, args.next().map_or(Ok(200), |s| s.parse())?),
         "shoot" => return shooting(modes, args.next().map_or(Ok(200), |s| s.parse())?),
+        "continuation" => {
+            return continuation(modes, args.next().map_or(Ok(3), |s| s.parse())?);
+        }
         "census" => {
             let samples = args.next().map_or(Ok(64), |s| s.parse())?;
             let omega = args.next().map_or(Ok(2.6), |s| s.parse())?;
