@@ -485,12 +485,13 @@ fn switching_builds_the_period_four_and_eight_branches() {
     );
 }
 
-/// ∂Pⁿ/∂p of the n-period map (n = 1, 2) from the parameter sensitivity (the exact propagator's step
-/// derivatives and the event shifts of the saltation, with the moving end time T = 2π/Ω for Ω)
-/// equals the central difference (P(p + δ) − P(p − δ)) / 2δ of maps built at p ± δ, for Ω, α2
-/// and α5, on contact orbits (α6 = 0.2, so the event term is not zero): N = 3 (dense grid
-/// steps) and N = 8 (modal grid steps). The differences with δ = h and h/2 (h = 1e-5 (1 + |p|))
-/// are Richardson-extrapolated (truncation error O(h⁴)); they agree to ≤ 2e-10 (round-off ≈ 1e-16/h).
+/// ∂Pⁿ/∂p of the n-period map (n = 1, 2) from the parameter sensitivity (the exact
+/// propagator's step derivatives and the event shifts of the saltation, with the moving end time
+/// nT = 2πn/Ω for Ω) equals the central difference (P(p + δ) − P(p − δ)) / 2δ of maps built at
+/// p ± δ, for Ω, α2 and α5, on contact orbits (α6 = 0.2, so the event term is not zero): N = 3
+/// (dense grid steps) and N = 8 (modal grid steps). The differences with δ = h and h/2
+/// (h = 1e-5 (1 + |p|)) are Richardson-extrapolated (truncation error O(h⁴)); they agree to
+/// ≤ 2e-10 (round-off ≈ 1e-16/h).
 #[test]
 fn parameter_derivative_of_the_map_equals_central_differences() {
     for (modes, omega, n) in [(3, 3.5, 1), (3, 2.6, 1), (3, 2.6, 2), (8, 3.5, 1)] {

@@ -177,10 +177,10 @@ fn flow(
 }
 
 /// Whether the local extremum of V_T inside `step` (V_T' = `d0` at its start) is provably no
-/// nearer to V_T = 0 than `nearest`: a maximum lies above both ends, V_T(t*) ≥ max(V_a, V_b), and
-/// a minimum below both, so when that end value is ≥ `nearest` in the direction away from 0
-/// (σ max(σV_a, σV_b) ≥ nearest, σ = +1 for a maximum, −1 for a minimum), |V_T(t*)| is too and
-/// the extremum search cannot lower the grazing distance.
+/// nearer to V_T = 0 than `nearest`: with σ = +1 for a maximum and −1 for a minimum,
+/// σV_T(t*) ≥ max(σV_a, σV_b) (a maximum lies above both ends of its step, a minimum below
+/// both), so when max(σV_a, σV_b) ≥ `nearest` ≥ 0, |V_T(t*)| ≥ `nearest` too and the extremum
+/// search cannot lower the grazing distance (up to the round-off of the located extremum).
 fn farther(
     integ: &dyn Integrator,
     tau0: f64,

@@ -144,9 +144,10 @@ struct Forced {
 }
 
 /// ∂z_p/∂p of one region's particular solution for a parameter p of the forcing:
-/// ∂z_p/∂p(τ) = p0 + ps sin Ωτ + pc cos Ωτ + (∂Ω/∂p) τ (ps⁰ cos Ωτ − pc⁰ sin Ωτ), (ps⁰, pc⁰) those of
-/// [`Forced`]; eq. 10's particular solution differentiated at fixed A: A p0 = −∂b_const/∂p and
-/// [[A, ΩI], [−ΩI, A]] (ps, pc) = −(∂b_sin/∂p, ∂b_cos/∂p) − (∂Ω/∂p) (pc⁰, −ps⁰).
+/// ∂z_p/∂p(τ) = p0 + ps sin Ωτ + pc cos Ωτ + (∂Ω/∂p) τ (ps⁰ cos Ωτ − pc⁰ sin Ωτ), with
+/// (ps⁰, pc⁰) those of [`Forced`]; eq. 10's particular solution differentiated at fixed A:
+/// A p0 = −∂b_const/∂p and [[A, ΩI], [−ΩI, A]] (ps, pc) = −(∂b_sin/∂p, ∂b_cos/∂p) −
+/// (∂Ω/∂p) (pc⁰, −ps⁰).
 #[derive(Debug, Clone)]
 struct ParticularDerivative {
     p0: DVector<f64>,
