@@ -131,19 +131,23 @@ fn flow(
         if step.region == Region::Contact {
             out.contact_time += len;
         }
-        // local extrema of V_T inside the step: distance to grazing
-        let (d0, d1) = {
+        // local extrema of V_T inside the step: distance to grazing (dV_T/dτ at both ends; V_T
+        // there only to rule an extremum out once a distance is known)
+        let (d0, search) = {
             let m = integ.model();
-            let end = match &step.event {
-                Some(e) => m.v_t_dot(e.tau, &e.state),
-                None => m.v_t_dot(step.tau1, integ.state()),
+            let (tau_b, z_b) = match &step.event {
+                Some(e) => (e.tau, &e.state),
+                None => (step.tau1, integ.state()),
             };
-            (m.v_t_dot(step.tau0, &before), end)
+            let (d0, d1) = (m.v_t_dot(step.tau0, &before), m.v_t_dot(tau_b, z_b));
+            let nearest = out.grazing_distance;
+            let search = len > 0.0
+                && (d0 > 0.0) != (d1 > 0.0)
+                && !(nearest.is_finite()
+                    && farther(m.v_t(step.tau0, &before), m.v_t(tau_b, z_b), d0, nearest));
+            (d0, search)
         };
-        if len > 0.0
-            && (d0 > 0.0) != (d1 > 0.0)
-            && !farther(integ, step.tau0, &before, &step, d0, out.grazing_distance)
-        {
+        if search {
             let mut vt = |t: f64| integ.dense_v_t(t);
             let t = extremum(step.tau0, step.tau1, d0, &mut vt);
             out.grazing_distance = out.grazing_distance.min(vt(t)[0].abs());
@@ -176,29 +180,15 @@ fn flow(
     Ok(out)
 }
 
-/// Whether the local extremum of V_T inside `step` (V_T' = `d0` at its start) is provably no
-/// nearer to V_T = 0 than `nearest`: with σ = +1 for a maximum and −1 for a minimum,
-/// σV_T(t*) ≥ max(σV_a, σV_b) (a maximum lies above both ends of its step, a minimum below
-/// both), so when max(σV_a, σV_b) ≥ `nearest` ≥ 0, |V_T(t*)| ≥ `nearest` too and the extremum
-/// search cannot lower the grazing distance (up to the round-off of the located extremum).
-fn farther(
-    integ: &dyn Integrator,
-    tau0: f64,
-    before: &DVector<f64>,
-    step: &crate::integrate::Step,
-    d0: f64,
-    nearest: f64,
-) -> bool {
-    if !nearest.is_finite() {
-        return false;
-    }
-    let m = integ.model();
-    let end = match &step.event {
-        Some(e) => m.v_t(e.tau, &e.state),
-        None => m.v_t(step.tau1, integ.state()),
-    };
+/// Whether the local extremum of V_T inside a step (V_T = `va`, `vb` at its ends, V_T' = `d0` at
+/// its start) is provably no nearer to V_T = 0 than `nearest`: with σ = +1 for a maximum and
+/// −1 for a minimum, σV_T(t*) ≥ max(σV_a, σV_b) (a maximum lies above both ends of its step, a
+/// minimum below both), so when max(σV_a, σV_b) ≥ `nearest` ≥ 0, |V_T(t*)| ≥ `nearest` too and
+/// the extremum search cannot lower the grazing distance (up to the round-off of the located
+/// extremum).
+fn farther(va: f64, vb: f64, d0: f64, nearest: f64) -> bool {
     let sigma = if d0 > 0.0 { 1.0 } else { -1.0 };
-    (sigma * m.v_t(tau0, before)).max(sigma * end) >= nearest
+    (sigma * va).max(sigma * vb) >= nearest
 }
 
 /// The period-n stroboscopic map from drive phase 0 (τ = 0 → nT) with its monodromy matrix.
