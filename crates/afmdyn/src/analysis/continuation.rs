@@ -264,6 +264,16 @@ impl Solver {
     }
 }
 
+/// Whether the chord of a step from `a` to `b` passes within half its length of `point` (the
+/// closure test of an isola at its first point). Testing the step's end alone can miss: the
+/// ends on either side of the point are each more than half their own step away when the
+/// step length has grown.
+fn chord_passes(a: &DVector<f64>, b: &DVector<f64>, point: &DVector<f64>) -> bool {
+    let (u, w) = (b - a, point - a);
+    let along = (w.dot(&u) / u.norm_squared().max(f64::MIN_POSITIVE)).clamp(0.0, 1.0);
+    (w - &u * along).norm() < 0.5 * u.norm()
+}
+
 /// Largest change of a Floquet multiplier allowed in one continuation step.
 pub const MAX_MULTIPLIER_STEP: f64 = 0.25;
 
@@ -478,13 +488,7 @@ pub fn continue_branch(
         // stop when the branch closes on itself (an isola back at its first point), or when a
         // period-2n branch has merged into a period-n orbit (its half-cycle repeats): beyond that
         // it would trace the period-n branch again
-        // (the step's chord from y to y_new passes within half its length of the first point:
-        // the end points alone can both miss it by more than that when ds has changed)
-        let closed = out.len() > 10 && {
-            let (u, w) = (&y_new - &y, &first - &y);
-            let along = (w.dot(&u) / u.norm_squared().max(f64::MIN_POSITIVE)).clamp(0.0, 1.0);
-            (w - &u * along).norm() < 0.5 * u.norm()
-        };
+        let closed = out.len() > 10 && chord_passes(&y, &y_new, &first);
         let half = spec.period / 2;
         let half_gap = |b: &BranchPoint| {
             (&b.section[half] - &b.section[0]).norm() / (1.0 + b.section[0].norm())
@@ -704,4 +708,23 @@ pub fn continue_with_switching(
         }
     }
     Ok(branches)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::chord_passes;
+    use nalgebra::DVector;
+
+    /// The isola's first point at the origin, the last two steps of the loop ending 0.4 before
+    /// it (a step of 0.5) and 0.6 after it (a step of 1): each end is more than half its own
+    /// step away, the chord passes through it. A chord that passes 0.6 step lengths away, or
+    /// whose ends both lie on one side beyond it, does not close.
+    #[test]
+    fn closure_on_the_chord() {
+        let v = |x: f64, y: f64| DVector::from_vec(vec![x, y]);
+        let first = v(0.0, 0.0);
+        assert!(chord_passes(&v(-0.4, 0.0), &v(0.6, 0.0), &first));
+        assert!(!chord_passes(&v(-0.4, 0.6), &v(0.6, 0.6), &first));
+        assert!(!chord_passes(&v(0.6, 0.0), &v(1.6, 0.0), &first));
+    }
 }
