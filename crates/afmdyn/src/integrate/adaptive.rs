@@ -21,7 +21,7 @@
 //! returns its Jacobian ∂z(t1)/∂z(t0) (Hairer et al., §I.14). The saltation matrix of an event is
 //! applied by the analyses ([`crate::system::saltation`]).
 
-use super::{HermiteStep, Integrator, Step};
+use super::{ChatterWindow, HermiteStep, Integrator, Step};
 use crate::error::SimError;
 use crate::galerkin::Region;
 use crate::model::CantileverModel;
@@ -102,7 +102,7 @@ pub struct Adaptive {
     h: f64,
     /// The guard may sit at 0 at the start of the stint (just after an event).
     just_switched: bool,
-    recent: std::collections::VecDeque<f64>,
+    chatter: ChatterWindow,
     last: LastStep,
 }
 
@@ -133,7 +133,7 @@ impl Adaptive {
             stint_open: false,
             h: 0.0,
             just_switched: true,
-            recent: Default::default(),
+            chatter: ChatterWindow::new(CHATTER_COUNT, 1e-7 * model.period()),
             last: LastStep {
                 tau0: 0.0,
                 tau1: 0.0,
@@ -342,22 +342,6 @@ impl Adaptive {
             self.guard_on(stepper, mode, t)
         }))
     }
-
-    fn chatter_check(&mut self, tau: f64) -> Result<(), SimError> {
-        self.recent.push_back(tau);
-        while self.recent.len() > CHATTER_COUNT {
-            self.recent.pop_front();
-        }
-        let window = 1e-7 * self.model.period();
-        if self.recent.len() == CHATTER_COUNT && tau - self.recent[0] < window {
-            return Err(SimError::Chattering {
-                tau,
-                count: CHATTER_COUNT,
-                window: tau - self.recent[0],
-            });
-        }
-        Ok(())
-    }
 }
 
 impl Integrator for Adaptive {
@@ -388,7 +372,7 @@ impl Integrator for Adaptive {
         self.z.copy_from(&z);
         self.stint_open = false;
         self.just_switched = true;
-        self.recent.clear();
+        self.chatter.clear();
         self.last.dense = None;
         self.last.jacobian = None;
         self.last.tau0 = tau;
@@ -503,7 +487,7 @@ impl Integrator for Adaptive {
         self.region = jump.to;
         self.stint_open = false;
         self.just_switched = true;
-        self.chatter_check(ts)?;
+        self.chatter.record(ts)?;
         Ok(Step::with_event(
             &self.model,
             tau0,

@@ -444,6 +444,54 @@ pub(crate) fn matvec_cols(
     }
 }
 
+/// The chattering test of an integrator: `count` events within `window` of the latest one are
+/// reported as [`SimError::Chattering`] (an accumulation of switchings or impacts that the event
+/// loop would otherwise follow forever).
+#[derive(Debug, Clone)]
+pub(crate) struct ChatterWindow {
+    count: usize,
+    window: f64,
+    recent: std::collections::VecDeque<f64>,
+}
+
+impl ChatterWindow {
+    /// `count` events within a time `window`.
+    pub(crate) fn new(count: usize, window: f64) -> Self {
+        ChatterWindow {
+            count,
+            window,
+            recent: std::collections::VecDeque::with_capacity(count + 1),
+        }
+    }
+
+    /// Record an event at `tau`.
+    ///
+    /// # Errors
+    /// [`SimError::Chattering`] when it is the `count`-th within the window.
+    pub(crate) fn record(&mut self, tau: f64) -> Result<(), SimError> {
+        self.recent.push_back(tau);
+        while self.recent.len() > self.count {
+            self.recent.pop_front();
+        }
+        if self.recent.len() == self.count {
+            let window = tau - self.recent[0];
+            if window < self.window {
+                return Err(SimError::Chattering {
+                    tau,
+                    count: self.count,
+                    window,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Forget the recorded events (a new start).
+    pub(crate) fn clear(&mut self) {
+        self.recent.clear();
+    }
+}
+
 /// End points of the last step of a Runge–Kutta integrator, for Hermite dense output:
 /// (τ0, z0, ż0) and (τ1, z1, ż1).
 #[derive(Debug, Clone)]

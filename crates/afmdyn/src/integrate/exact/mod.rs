@@ -43,7 +43,7 @@ pub use modal::MAX_MODAL_CONDITION;
 pub(crate) use spectral::matmul_into;
 
 use super::grid::PeriodGrid;
-use super::{matvec, Integrator, Step};
+use super::{matvec, ChatterWindow, Integrator, Step};
 use crate::error::SimError;
 use crate::galerkin::Region;
 use crate::model::CantileverModel;
@@ -54,7 +54,6 @@ use modal::{ModalExp, Modes, MAXD};
 use nalgebra::{DMatrix, DVector, Dyn, LU};
 use search::{certified_positive, Search, TipPoly};
 use spectral::Spectral;
-use std::collections::VecDeque;
 use std::sync::Arc;
 
 /// Bound on ‖Ã‖₂ h for the grid step (radians of the fastest mode per step).
@@ -202,7 +201,7 @@ pub struct ExactPropagator {
     /// Bound on |W_hom''| over the current stint (see `enter_stint`).
     stint_curvature: f64,
     just_switched: bool,
-    recent: VecDeque<f64>,
+    chatter: ChatterWindow,
     last: LastStep,
     /// Tip polynomial of the last step, valid when `poly_built` (filled in place).
     poly: Box<TipPoly>,
@@ -407,7 +406,7 @@ impl ExactPropagator {
             on_grid: Some((0, 0)),
             stint_curvature: 0.0,
             just_switched: true,
-            recent: VecDeque::new(),
+            chatter: ChatterWindow::new(CHATTER_COUNT, CHATTER_WINDOW),
             last: LastStep {
                 tau0: 0.0,
                 region: Region::Free,
@@ -813,24 +812,6 @@ impl ExactPropagator {
         };
     }
 
-    fn chatter_check(&mut self, tau: f64) -> Result<(), SimError> {
-        self.recent.push_back(tau);
-        while self.recent.len() > CHATTER_COUNT {
-            self.recent.pop_front();
-        }
-        if self.recent.len() == CHATTER_COUNT {
-            let window = tau - self.recent[0];
-            if window < CHATTER_WINDOW {
-                return Err(SimError::Chattering {
-                    tau,
-                    count: CHATTER_COUNT,
-                    window,
-                });
-            }
-        }
-        Ok(())
-    }
-
     /// One step (see [`Integrator::step`]). Without `materialize` (inside
     /// [`Integrator::advance_to`], which reads only the result's `Ok`/`Err`): in a modal region
     /// the plain state at the end of a whole grid step is not formed (z lags behind q), and a
@@ -1026,7 +1007,7 @@ impl ExactPropagator {
                 self.on_grid = None;
                 self.just_switched = true;
                 self.enter_stint(to, tau_s);
-                self.chatter_check(tau_s)?;
+                self.chatter.record(tau_s)?;
                 if !materialize {
                     return Ok(Step {
                         tau0,
@@ -1070,7 +1051,7 @@ impl Integrator for ExactPropagator {
             (self.grid.tau(j) == tau).then_some((j.div_euclid(m), j.rem_euclid(m) as usize));
         self.enter_stint(region, tau);
         self.just_switched = true;
-        self.recent.clear();
+        self.chatter.clear();
         self.last.tau0 = tau;
         self.last.region = region;
         self.last.dz0.fill(0.0);
