@@ -7,7 +7,7 @@
 use crate::convert::Out;
 use crate::errors::{probe_error, sim_error, value_error};
 use crate::params::PyParams;
-use crate::run::{run, Job, Stop};
+use crate::run::{run, run_abandonable, Job, Stop};
 use afmdyn::analysis::attractors::{find_attractors, AttractorSpec};
 use afmdyn::analysis::bifurcation::{run_sweep_cancellable, Branch, Resume, SweepPoint, SweepSpec};
 use afmdyn::analysis::continuation::{
@@ -278,14 +278,9 @@ pub fn simulate<'py>(
         energy: true,
         body_contact: true,
     };
-    let c = run(
-        py,
-        &Job::default(),
-        None,
-        progress.as_ref(),
-        Stop::Abandon,
-        move || simulate_columns(p, initial, opts, spec),
-    )??;
+    let c = run_abandonable(py, progress.as_ref(), move || {
+        simulate_columns(p, initial, opts, spec)
+    })??;
     let out = Out::new(py);
     out.json(&c.doc)?;
     let s = c.tau.len();
@@ -347,23 +342,16 @@ pub fn converge<'py>(
         )));
     }
     let opts = integrator_options(integrator, steps_per_period, tolerance, samples_per_period)?;
-    let runs = run(
-        py,
-        &Job::default(),
-        None,
-        progress.as_ref(),
-        Stop::Abandon,
-        move || {
-            mode_convergence(
-                &p,
-                max_modes,
-                periods,
-                samples_per_period,
-                &SteadyOptions::default(),
-                opts,
-            )
-        },
-    )?
+    let runs = run_abandonable(py, progress.as_ref(), move || {
+        mode_convergence(
+            &p,
+            max_modes,
+            periods,
+            samples_per_period,
+            &SteadyOptions::default(),
+            opts,
+        )
+    })?
     .map_err(sim_error)?;
     let out = Out::new(py);
     out.json(&report::converge(&p, &runs))?;
@@ -636,15 +624,8 @@ pub fn attractors<'py>(
         steady: steady_options(tol, max_periods, max_period)?,
         integrator: integrator_options(integrator, steps_per_period, tolerance, 200)?,
     };
-    let report_ = run(
-        py,
-        &Job::default(),
-        None,
-        progress.as_ref(),
-        Stop::Abandon,
-        move || find_attractors(&spec),
-    )?
-    .map_err(sim_error)?;
+    let report_ = run_abandonable(py, progress.as_ref(), move || find_attractors(&spec))?
+        .map_err(sim_error)?;
     let out = Out::new(py);
     out.json(&report::attractors(&p, samples, &report_))?;
     let list = PyList::empty(py);
@@ -702,20 +683,13 @@ pub fn orbit<'py>(
             return Err(value_error(format!("period = {n}: must be in 1..=64")));
         }
     }
-    let (doc, o) = run(
-        py,
-        &Job::default(),
-        None,
-        progress.as_ref(),
-        Stop::Abandon,
-        move || -> PyResult<_> {
-            let model = model_of(&p)?;
-            let (z, found) = guess(&model, initial, &steady)?;
-            let n = period.or(found).unwrap_or(1);
-            let o = shoot(&model, &z, n, &ShootingOptions::default()).map_err(sim_error)?;
-            Ok((report::orbit(&model, &o), o))
-        },
-    )??;
+    let (doc, o) = run_abandonable(py, progress.as_ref(), move || -> PyResult<_> {
+        let model = model_of(&p)?;
+        let (z, found) = guess(&model, initial, &steady)?;
+        let n = period.or(found).unwrap_or(1);
+        let o = shoot(&model, &z, n, &ShootingOptions::default()).map_err(sim_error)?;
+        Ok((report::orbit(&model, &o), o))
+    })??;
     let out = Out::new(py);
     out.json(&doc)?;
     let dim = o.state.len();
@@ -790,20 +764,13 @@ pub fn continuation<'py>(
     if period == Some(0) {
         return Err(value_error("period = 0: must be >= 1"));
     }
-    let branches = run(
-        py,
-        &Job::default(),
-        None,
-        progress.as_ref(),
-        Stop::Abandon,
-        move || -> PyResult<_> {
-            let model = model_of(&p0)?;
-            let (z, found) = guess(&model, initial, &steady)?;
-            let n = period.or(found).unwrap_or(1);
-            let spec = ContinuationSpec::new(base, param, from_, to, n);
-            continue_and_switch(&spec, &z, switch).map_err(sim_error)
-        },
-    )??;
+    let branches = run_abandonable(py, progress.as_ref(), move || -> PyResult<_> {
+        let model = model_of(&p0)?;
+        let (z, found) = guess(&model, initial, &steady)?;
+        let n = period.or(found).unwrap_or(1);
+        let spec = ContinuationSpec::new(base, param, from_, to, n);
+        continue_and_switch(&spec, &z, switch).map_err(sim_error)
+    })??;
     let model = model_of(&p0)?;
     let dim = 2 * base.modes;
     let rows: usize = branches.iter().map(Vec::len).sum();
@@ -900,18 +867,11 @@ pub fn lyapunov<'py>(
         blocks,
         ..LyapunovOptions::default()
     };
-    let l = run(
-        py,
-        &Job::default(),
-        None,
-        progress.as_ref(),
-        Stop::Abandon,
-        move || -> PyResult<_> {
-            let model = model_of(&p)?;
-            let z0 = initial_state(&model, initial)?;
-            lyapunov_spectrum(&model, &z0, &opts).map_err(sim_error)
-        },
-    )??;
+    let l = run_abandonable(py, progress.as_ref(), move || -> PyResult<_> {
+        let model = model_of(&p)?;
+        let z0 = initial_state(&model, initial)?;
+        lyapunov_spectrum(&model, &z0, &opts).map_err(sim_error)
+    })??;
     let out = Out::new(py);
     out.json(&report::lyapunov(&p, &l))?;
     out.f64s("exponents", l.exponents.clone())?;
@@ -954,41 +914,34 @@ pub fn observe<'py>(
             "periods = {periods}: must be in 1..=1000000"
         )));
     }
-    let (doc, z, n) = run(
-        py,
-        &Job::default(),
-        None,
-        progress.as_ref(),
-        Stop::Abandon,
-        move || -> PyResult<_> {
-            let model = model_of(&p)?;
-            let (z, found) = guess(&model, initial, &steady)?;
-            // Newton polishes a periodic motion to round-off; a high-Q transient that has not
-            // settled within max_periods is tried as period-1 (or the period found); when
-            // Newton fails the steady-state end point is used as it is
-            let n = found.unwrap_or(1);
-            let newton = ShootingOptions {
-                tol: 1e-12,
-                ..ShootingOptions::default()
-            };
-            let (z, found) = match shoot(&model, &z, n, &newton) {
-                Ok(o) => (o.state, Some(n)),
-                Err(_) => (z, found),
-            };
-            let o = observe_from(
-                &model,
-                IntegratorOptions::default(),
-                0.0,
-                &z,
-                &ObservableOptions {
-                    periods: periods * n,
-                    harmonics,
-                },
-            )
-            .map_err(sim_error)?;
-            Ok((report::observables(&o), z, found))
-        },
-    )??;
+    let (doc, z, n) = run_abandonable(py, progress.as_ref(), move || -> PyResult<_> {
+        let model = model_of(&p)?;
+        let (z, found) = guess(&model, initial, &steady)?;
+        // Newton polishes a periodic motion to round-off; a high-Q transient that has not
+        // settled within max_periods is tried as period-1 (or the period found); when
+        // Newton fails the steady-state end point is used as it is
+        let n = found.unwrap_or(1);
+        let newton = ShootingOptions {
+            tol: 1e-12,
+            ..ShootingOptions::default()
+        };
+        let (z, found) = match shoot(&model, &z, n, &newton) {
+            Ok(o) => (o.state, Some(n)),
+            Err(_) => (z, found),
+        };
+        let o = observe_from(
+            &model,
+            IntegratorOptions::default(),
+            0.0,
+            &z,
+            &ObservableOptions {
+                periods: periods * n,
+                harmonics,
+            },
+        )
+        .map_err(sim_error)?;
+        Ok((report::observables(&o), z, found))
+    })??;
     let out = Out::new(py);
     out.json(&doc)?;
     out.f64s("state", z.as_slice().to_vec())?;

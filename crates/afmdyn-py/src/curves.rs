@@ -5,7 +5,7 @@
 use crate::convert::Out;
 use crate::errors::{probe_error, sim_error};
 use crate::params::PyParams;
-use crate::run::{run, Job, Stop};
+use crate::run::run_abandonable;
 use afmdyn::analysis::approach::{approach_request, approach_retract};
 use afmdyn::analysis::resonance::{resonance_curve, resonance_request};
 use afmdyn::analysis::stepped::{CurveRequest, SteppedCurve, SteppedSpec};
@@ -35,14 +35,9 @@ fn go<'py>(
     compute: fn(&SteppedSpec) -> Result<SteppedCurve, SimError>,
     doc: impl Fn(&SteppedCurve) -> serde_json::Value,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let c = run(
-        py,
-        &Job::default(),
-        None,
-        progress.as_ref(),
-        Stop::Abandon,
-        move || -> PyResult<_> { compute(&spec).map_err(sim_error) },
-    )??;
+    let c = run_abandonable(py, progress.as_ref(), move || -> PyResult<_> {
+        compute(&spec).map_err(sim_error)
+    })??;
     let out = Out::new(py);
     out.json(&doc(&c))?;
     Ok(out.finish())
