@@ -142,6 +142,13 @@ fn shooting_converges_quadratically_to_the_period_two_orbit() {
         "the attractor's orbit"
     );
     assert!(o.stable);
+    // the Newton iterates skip the grazing searches; the orbit's distance is the one the full
+    // map gives at the converged point
+    let mut it = ExactPropagator::try_new(&m, 1).unwrap();
+    let map = stroboscopic(&mut it, &o.state, 2).unwrap();
+    assert!(map.grazing_distance.is_finite() && map.grazing_distance > 0.0);
+    assert_eq!(o.grazing_distance, map.grazing_distance);
+    assert_eq!(o.monodromy, map.jacobian);
 }
 
 #[test]
@@ -558,4 +565,57 @@ fn parameter_derivative_is_none_where_unsupported() {
     let mut it = build(&m, opts, 0.0, &z).unwrap();
     let map = stroboscopic_with_param_derivative(it.as_mut(), &z, 1, SweepParam::Omega).unwrap();
     assert!(map.param_derivative.is_none());
+}
+
+/// The monodromy matrix from one transition matrix e^{A_s t} per stint between events
+/// ([`afmdyn::integrate::Integrator::region_transition_into`], taken without a parameter
+/// sensitivity) equals the product of the step Jacobians (taken with one), events included;
+/// and the region transition obeys the semigroup law e^{A(s+t)} = e^{As} e^{At} and equals the
+/// grid step's Φ_s at t = h.
+#[test]
+fn stint_transitions_equal_the_product_of_step_jacobians() {
+    use afmdyn::integrate::Integrator;
+    for (modes, omega, n) in [(3, 3.5, 1), (3, 2.6, 2), (8, 3.5, 1)] {
+        let m = model(Params {
+            modes,
+            omega,
+            ..Params::default()
+        });
+        let (z, _) = attractor(&m);
+        let mut it = ExactPropagator::try_new(&m, 1).unwrap();
+        assert!(
+            it.has_region_transition(Region::Free) && it.has_region_transition(Region::Contact)
+        );
+        let stints = stroboscopic(&mut it, &z, n).unwrap();
+        let steps = stroboscopic_with_param_derivative(&mut it, &z, n, SweepParam::Alpha2).unwrap();
+        assert!(stints.contacts >= 1, "N = {modes}, Ω = {omega}: no contact");
+        assert_eq!(stints.state, steps.state);
+        let err = (&stints.jacobian - &steps.jacobian).norm();
+        eprintln!(
+            "N = {modes}, Ω = {omega}, n = {n}: {err:.2e} (|M| = {:.2e})",
+            steps.jacobian.norm()
+        );
+        assert!(
+            err <= 1e-11 * steps.jacobian.norm(),
+            "N = {modes}, Ω = {omega}: {err:.2e}"
+        );
+        for r in [Region::Free, Region::Contact] {
+            let dim = m.dim();
+            let e = |t: f64| {
+                let mut out = DMatrix::zeros(dim, dim);
+                assert!(it.region_transition_into(r, t, &mut out));
+                out
+            };
+            let (s, t) = (0.37, 5.3);
+            let scale = e(s).norm() * e(t).norm();
+            let err = (e(s + t) - e(s) * e(t)).norm();
+            eprintln!("{r:?}: semigroup {err:.2e} (|e^(As)| |e^(At)| = {scale:.2e})");
+            assert!(err <= 1e-11 * scale, "{r:?}: semigroup {err:.2e}");
+            let h = m.period() / it.steps_per_period() as f64;
+            let phi = it.transition(r, h);
+            let err = (e(h) - &phi).norm();
+            eprintln!("{r:?}: Φ_s {err:.2e} (|Φ_s| = {:.2e})", phi.norm());
+            assert!(err <= 1e-12 * phi.norm(), "{r:?}: Φ_s {err:.2e}");
+        }
+    }
 }

@@ -6,7 +6,7 @@
 use crate::error::SimError;
 use crate::galerkin::Region;
 use crate::integrate::exact::matmul_into;
-use crate::integrate::Integrator;
+use crate::integrate::{Integrator, Step};
 use crate::params::SweepParam;
 use crate::roots::extremum;
 use crate::system::EventKind;
@@ -24,7 +24,8 @@ pub struct FlowMap {
     /// Contacts: entries into region II and impacts.
     pub contacts: usize,
     /// Smallest |V_T| at a local extremum of V_T, and smallest |dV_T/dτ| at an event (scaled by
-    /// 1/Ω): how close the trajectory is to grazing the sample.
+    /// 1/Ω): how close the trajectory is to grazing the sample. NaN from
+    /// [`stroboscopic_unwatched`], which does not search.
     pub grazing_distance: f64,
     /// Time spent in region II (contact, or sticking for the impact law).
     pub contact_time: f64,
@@ -48,7 +49,7 @@ pub fn flow_with_jacobian(
     z0: &DVector<f64>,
     tau1: f64,
 ) -> Result<FlowMap, SimError> {
-    flow(integ, tau0, z0, tau1, None)
+    flow(integ, tau0, z0, tau1, None, true)
 }
 
 /// [`flow_with_jacobian`] with the parameter sensitivity s = ∂z(τ1)/∂p at fixed τ1 in
@@ -66,7 +67,7 @@ pub fn flow_with_param_derivative(
     tau1: f64,
     param: SweepParam,
 ) -> Result<FlowMap, SimError> {
-    flow(integ, tau0, z0, tau1, Some(param))
+    flow(integ, tau0, z0, tau1, Some(param), true)
 }
 
 fn flow(
@@ -75,10 +76,10 @@ fn flow(
     z0: &DVector<f64>,
     tau1: f64,
     mut param: Option<SweepParam>,
+    grazing: bool,
 ) -> Result<FlowMap, SimError> {
     integ.set_variational(true);
     integ.reset(tau0, z0)?;
-    let omega = integ.model().omega();
     let dim = z0.len();
     // a start inside a rigid sample is first projected onto it (impact law): its Jacobian
     let mut jac = match integ.model().start_projection(tau0, z0) {
@@ -97,7 +98,7 @@ fn flow(
         jacobian: DMatrix::zeros(0, 0),
         switchings: 0,
         contacts: 0,
-        grazing_distance: f64::INFINITY,
+        grazing_distance: if grazing { f64::INFINITY } else { f64::NAN },
         contact_time: 0.0,
         log_volume: 0.0,
         param_derivative: None,
@@ -106,6 +107,8 @@ fn flow(
     // scratch for the step Jacobian and the product (no allocation per step)
     let mut step_jac = DMatrix::zeros(dim, dim);
     let mut prod = DMatrix::zeros(dim, dim);
+    // the open stint (region, start time) whose Jacobian is taken at its end
+    let mut stint: Option<(Region, f64)> = None;
     while integ.tau() < tau1 {
         before.copy_from(integ.state());
         let step = integ.step(tau1)?;
@@ -113,12 +116,16 @@ fn flow(
         if len <= 0.0 && step.event.is_none() {
             continue;
         }
-        // M ← J_step M: the product rule of the monodromy matrix M = Π S_k Φ_k (Leine &
-        // Nijmeijer 2004, ch. 7), into the scratch matrix and swapped back (2N×2N products:
-        // fixed-size column kernels up to 12×12, whose products do not pack or allocate)
-        integ.last_step_jacobian_into(&mut step_jac)?;
-        matmul_into(&step_jac, &jac, 1.0, &mut prod);
-        std::mem::swap(&mut jac, &mut prod);
+        // without a parameter sensitivity (which needs every step), a stint in a region with
+        // a transition matrix for any duration (affine, [`Integrator::region_transition_into`])
+        // takes one Jacobian e^{A_r t} at its end instead of one product per step
+        if stint.is_none() && param.is_none() && integ.has_region_transition(step.region) {
+            stint = Some((step.region, step.tau0));
+        }
+        if stint.is_none() {
+            integ.last_step_jacobian_into(&mut step_jac)?;
+            left_mul(&step_jac, &mut jac, &mut prod);
+        }
         if let Some(p) = param {
             if integ.last_step_param_derivative_into(p, &mut step_dp)? {
                 tmp.gemv(1.0, &step_jac, &sens, 0.0);
@@ -131,31 +138,15 @@ fn flow(
         if step.region == Region::Contact {
             out.contact_time += len;
         }
-        // local extrema of V_T inside the step: distance to grazing (dV_T/dτ at both ends; V_T
-        // there only to rule an extremum out once a distance is known)
-        let (d0, search) = {
-            let m = integ.model();
-            let (tau_b, z_b) = match &step.event {
-                Some(e) => (e.tau, &e.state),
-                None => (step.tau1, integ.state()),
-            };
-            let (d0, d1) = (m.v_t_dot(step.tau0, &before), m.v_t_dot(tau_b, z_b));
-            let nearest = out.grazing_distance;
-            let search = len > 0.0
-                && (d0 > 0.0) != (d1 > 0.0)
-                && !(nearest.is_finite()
-                    && farther(m.v_t(step.tau0, &before), m.v_t(tau_b, z_b), d0, nearest));
-            (d0, search)
-        };
-        if search {
-            let mut vt = |t: f64| integ.dense_v_t(t);
-            let t = extremum(step.tau0, step.tau1, d0, &mut vt);
-            out.grazing_distance = out.grazing_distance.min(vt(t)[0].abs());
+        if grazing {
+            watch_grazing(integ, &step, &before, &mut out.grazing_distance);
         }
         if let Some(e) = &step.event {
+            if let Some((r, t0)) = stint.take() {
+                close_stint(integ, r, e.tau - t0, &mut step_jac, &mut jac, &mut prod);
+            }
             let (s, shift) = integ.model().saltation_with_shift(e.from, e.tau, &e.state);
-            matmul_into(&s, &jac, 1.0, &mut prod);
-            std::mem::swap(&mut jac, &mut prod);
+            left_mul(&s, &mut jac, &mut prod);
             if let Some(p) = param {
                 match integ.model().guard_param_derivative(e.from, p, e.tau) {
                     Some(dg) => {
@@ -170,14 +161,80 @@ fn flow(
             if e.to == Region::Contact || e.kind == EventKind::Impact {
                 out.contacts += 1;
             }
-            out.grazing_distance = out.grazing_distance.min(e.v_t_dot.abs() / omega);
         }
+    }
+    if let Some((r, t0)) = stint.take() {
+        close_stint(
+            integ,
+            r,
+            integ.tau() - t0,
+            &mut step_jac,
+            &mut jac,
+            &mut prod,
+        );
     }
     out.state = integ.state().clone();
     out.param_derivative = param.map(|_| sens);
     out.log_volume = jac.clone().lu().determinant().abs().ln();
     out.jacobian = jac;
     Ok(out)
+}
+
+/// M ← J M: the product rule of the monodromy matrix M = Π S_k Φ_k (Leine & Nijmeijer 2004,
+/// ch. 7), into the scratch matrix `prod` and swapped back (2N×2N products: fixed-size column
+/// kernels up to 12×12, whose products do not pack or allocate).
+fn left_mul(j: &DMatrix<f64>, m: &mut DMatrix<f64>, prod: &mut DMatrix<f64>) {
+    matmul_into(j, m, 1.0, prod);
+    std::mem::swap(m, prod);
+}
+
+/// M ← e^{A_r t} M for a stint of length t in region r
+/// ([`Integrator::region_transition_into`], which [`Integrator::has_region_transition`]
+/// promised), with `scratch` for the transition matrix.
+fn close_stint(
+    integ: &dyn Integrator,
+    r: Region,
+    t: f64,
+    scratch: &mut DMatrix<f64>,
+    m: &mut DMatrix<f64>,
+    prod: &mut DMatrix<f64>,
+) {
+    let done = integ.region_transition_into(r, t, scratch);
+    debug_assert!(done, "has_region_transition promised the transition");
+    left_mul(scratch, m, prod);
+}
+
+/// Lower `nearest` to the distance to grazing within `step` (from `before`, the state at its
+/// start): |V_T| at a local extremum of V_T inside the step, searched where dV_T/dτ changes sign
+/// between its ends (V_T at the ends only to rule an extremum out once a distance is known,
+/// [`farther`]), and |dV_T/dτ|/Ω at an event that ends it.
+fn watch_grazing(
+    integ: &mut dyn Integrator,
+    step: &Step,
+    before: &DVector<f64>,
+    nearest: &mut f64,
+) {
+    let (d0, search) = {
+        let m = integ.model();
+        let (tau_b, z_b) = match &step.event {
+            Some(e) => (e.tau, &e.state),
+            None => (step.tau1, integ.state()),
+        };
+        let (d0, d1) = (m.v_t_dot(step.tau0, before), m.v_t_dot(tau_b, z_b));
+        let search = step.tau1 > step.tau0
+            && (d0 > 0.0) != (d1 > 0.0)
+            && !(nearest.is_finite()
+                && farther(m.v_t(step.tau0, before), m.v_t(tau_b, z_b), d0, *nearest));
+        (d0, search)
+    };
+    if search {
+        let mut vt = |t: f64| integ.dense_v_t(t);
+        let t = extremum(step.tau0, step.tau1, d0, &mut vt);
+        *nearest = nearest.min(vt(t)[0].abs());
+    }
+    if let Some(e) = &step.event {
+        *nearest = nearest.min(e.v_t_dot.abs() / integ.model().omega());
+    }
 }
 
 /// Whether the local extremum of V_T inside a step (V_T = `va`, `vb` at its ends, V_T' = `d0` at
@@ -202,6 +259,49 @@ pub fn stroboscopic(
 ) -> Result<FlowMap, SimError> {
     let t = n as f64 * integ.model().period();
     flow_with_jacobian(integ, 0.0, z0, t)
+}
+
+/// [`stroboscopic`] without the distance to grazing ([`FlowMap::grazing_distance`] is NaN):
+/// the state and the monodromy matrix for the iterates of a Newton solve, whose converged point
+/// then takes [`grazing_distance`] once (the local-extremum searches of V_T are a sixth of a
+/// period-1 shooting solve at N = 3).
+///
+/// # Errors
+/// As [`flow_with_jacobian`].
+pub fn stroboscopic_unwatched(
+    integ: &mut dyn Integrator,
+    z0: &DVector<f64>,
+    n: usize,
+) -> Result<FlowMap, SimError> {
+    let t = n as f64 * integ.model().period();
+    flow(integ, 0.0, z0, t, None, false)
+}
+
+/// The distance to grazing of the flow from (τ0, z0) to τ1 ([`FlowMap::grazing_distance`]),
+/// without the Jacobian: the same steps as [`flow_with_jacobian`] (variational equations
+/// switched on as there) and the same searches, so the same value.
+///
+/// # Errors
+/// [`SimError`] from the integrator.
+pub fn grazing_distance(
+    integ: &mut dyn Integrator,
+    tau0: f64,
+    z0: &DVector<f64>,
+    tau1: f64,
+) -> Result<f64, SimError> {
+    integ.set_variational(true);
+    integ.reset(tau0, z0)?;
+    let mut before = z0.clone();
+    let mut nearest = f64::INFINITY;
+    while integ.tau() < tau1 {
+        before.copy_from(integ.state());
+        let step = integ.step(tau1)?;
+        if step.tau1 <= step.tau0 && step.event.is_none() {
+            continue;
+        }
+        watch_grazing(integ, &step, &before, &mut nearest);
+    }
+    Ok(nearest)
 }
 
 /// [`stroboscopic`] with ∂Pⁿ/∂p in [`FlowMap::param_derivative`] (see

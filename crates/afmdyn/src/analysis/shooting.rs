@@ -4,7 +4,7 @@
 //! monodromy matrix of Pⁿ ([`super::monodromy`]); it converges quadratically to stable and
 //! unstable orbits alike. The Floquet multipliers are the eigenvalues of M.
 
-use super::monodromy::{stroboscopic, FlowMap};
+use super::monodromy::{grazing_distance, stroboscopic, stroboscopic_unwatched, FlowMap};
 use crate::error::SimError;
 use crate::integrate::{build, Integrator, IntegratorOptions};
 use crate::model::CantileverModel;
@@ -112,7 +112,8 @@ pub fn shoot_with(
     let dim = guess.len();
     let mut z = guess.clone();
     let mut residuals = Vec::new();
-    let mut map = stroboscopic(integ, &z, n)?;
+    // the iterates without the grazing searches; the converged orbit gets them in `finish`
+    let mut map = stroboscopic_unwatched(integ, &z, n)?;
     let mut res = (&map.state - &z).norm();
     for _ in 0..opts.max_iter {
         residuals.push(res);
@@ -133,7 +134,7 @@ pub fn shoot_with(
         loop {
             let trial = &z + &delta * lambda;
             // a trial the map cannot start from (e.g. inside a rigid sample) is a failed trial
-            match stroboscopic(integ, &trial, n) {
+            match stroboscopic_unwatched(integ, &trial, n) {
                 Ok(tmap) => {
                     let tres = (&tmap.state - &trial).norm();
                     if tres < res || lambda < 1e-3 {
@@ -193,6 +194,8 @@ fn finish(
     residuals: Vec<f64>,
 ) -> Result<PeriodicOrbit, SimError> {
     let section = section_points(integ, &z, n)?;
+    let period = integ.model().period();
+    let grazing_distance = grazing_distance(integ, 0.0, &z, n as f64 * period)?;
     let (multipliers, stable, critical) = floquet_stability(&map.jacobian);
     Ok(PeriodicOrbit {
         period: n,
@@ -202,8 +205,8 @@ fn finish(
         stable,
         critical,
         multipliers,
-        grazing: map.grazing_distance < GRAZING_TOL,
-        grazing_distance: map.grazing_distance,
+        grazing: grazing_distance < GRAZING_TOL,
+        grazing_distance,
         switchings: map.switchings,
         residuals,
     })

@@ -160,6 +160,23 @@ pub trait Integrator: Send {
         *out = self.last_step_jacobian()?;
         Ok(())
     }
+    /// Whether [`Integrator::region_transition_into`] gives the transition matrix of region `r`
+    /// (the default: no).
+    fn has_region_transition(&self, r: Region) -> bool {
+        let _ = r;
+        false
+    }
+    /// Transition matrix e^{A_r t} = ∂z(τ + t)/∂z(τ) of the flow that stays in region `r` for a
+    /// time t ≥ 0, any number of steps long, written into `out` (resized to 2N×2N): for an
+    /// affine region ż = A_r z + b_r(τ) it does not depend on τ or z, so the Jacobian of a
+    /// whole stint between two events is one matrix instead of the product of its step
+    /// Jacobians. `false`, with `out` untouched, where the integrator does not provide it (the
+    /// default; the exact propagator provides it for a region with an eigendecomposition,
+    /// [`Integrator::has_region_transition`]).
+    fn region_transition_into(&self, r: Region, t: f64, out: &mut DMatrix<f64>) -> bool {
+        let _ = (r, t, out);
+        false
+    }
     /// ∂z(τ1)/∂p of the last step [τ0, τ1] inside its region, at fixed z(τ0), τ0 and τ1, written
     /// into `out` (resized to `[2N]`), for a parameter p that enters the forcing only (Ω, α2,
     /// α5; [`CantileverModel::forcing_derivative`]). With the step Jacobians J and the event

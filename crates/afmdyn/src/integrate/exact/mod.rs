@@ -1151,6 +1151,24 @@ impl Integrator for ExactPropagator {
         Ok(true)
     }
 
+    fn has_region_transition(&self, r: Region) -> bool {
+        self.spec[r.index()].modal.is_some()
+    }
+
+    /// T⁻¹ V e^{Λt} V⁻¹ T from the eigendecomposition (accurate for any t ≥ 0: Re λ_k ≤ 0 and
+    /// the basis is well conditioned, [`modal::MAX_MODAL_CONDITION`]).
+    fn region_transition_into(&self, r: Region, t: f64, out: &mut DMatrix<f64>) -> bool {
+        let Some(me) = &self.spec[r.index()].modal else {
+            return false;
+        };
+        let dim = self.z.len();
+        if out.shape() != (dim, dim) {
+            *out = DMatrix::zeros(dim, dim);
+        }
+        me.transition_plain_into(t, out);
+        true
+    }
+
     fn last_step_jacobian_into(&mut self, out: &mut DMatrix<f64>) -> Result<(), SimError> {
         // as step_transition, without allocating: the cached Φ_s after a whole grid step
         let r = self.last.region;

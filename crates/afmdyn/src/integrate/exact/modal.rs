@@ -252,14 +252,21 @@ impl ModalExp {
         let (dim, r) = (self.tv.re.nrows(), self.len());
         let mut f = Modes::ZERO;
         self.factors(t, &mut f);
-        for j in 0..dim {
-            let mut q = Modes::ZERO;
+        // column j = Σ_k Re(b_k q_k), q_k = (V⁻¹T)_{kj} e^{λ_k t}, straight into `out` (no
+        // per-column modal scratch: a `Modes` is 2·MAXD values to clear)
+        let (vr, vi) = (self.vinv_t.re.as_slice(), self.vinv_t.im.as_slice());
+        let (br, bi) = (self.tv.re.as_slice(), self.tv.im.as_slice());
+        for (j, col) in out.as_mut_slice().chunks_exact_mut(dim).enumerate() {
+            col.fill(0.0);
             for k in 0..r {
-                let (a, b) = (self.vinv_t.re[(k, j)], self.vinv_t.im[(k, j)]);
-                q.re[k] = a * f.re[k] - b * f.im[k];
-                q.im[k] = a * f.im[k] + b * f.re[k];
+                let (a, b) = (vr[j * r + k], vi[j * r + k]);
+                let qr = a * f.re[k] - b * f.im[k];
+                let qi = a * f.im[k] + b * f.re[k];
+                let (cr, ci) = (&br[k * dim..(k + 1) * dim], &bi[k * dim..(k + 1) * dim]);
+                for ((o, x), y) in col.iter_mut().zip(cr).zip(ci) {
+                    *o += x * qr - y * qi;
+                }
             }
-            Self::expand(&self.tv, &q, out.column_mut(j).as_mut_slice(), false);
         }
     }
 
