@@ -514,18 +514,6 @@ impl CantileverModel {
         crate::system::saltation(self, from, tau, z.as_slice()).0
     }
 
-    /// [`CantileverModel::saltation`] with the event shift w of
-    /// [`crate::system::saltation_with_shift`] (shape `[2N]`).
-    pub fn saltation_with_shift(
-        &self,
-        from: Region,
-        tau: f64,
-        z: &DVector<f64>,
-    ) -> (DMatrix<f64>, DVector<f64>) {
-        let (s, _, w) = crate::system::saltation_with_shift(self, from, tau, z.as_slice());
-        (s, w)
-    }
-
     /// Constraint force λ of sticking (impact law) at (τ, z), with its gradient and τ-rate:
     /// λ = m_eff (α2 Ω² sin Ωτ − φᵀä_free − 2β V̇_T − β² V_T), the force that gives
     /// V̈_T = −2β V̇_T − β² V_T: zero on the constraint V_T = V̇_T = 0, and Baumgarte's

@@ -170,21 +170,69 @@ pub fn saltation_with_shift<S: HybridSystem + ?Sized>(
     tau: f64,
     z_minus: &[f64],
 ) -> (DMatrix<f64>, Jump, DVector<f64>) {
+    let parts = saltation_parts(sys, from, tau, z_minus);
+    let mut s = parts.jump.jacobian.clone();
+    s.ger(1.0, &parts.shift, &parts.grad, 1.0);
+    (s, parts.jump, parts.shift)
+}
+
+/// The saltation matrix S = R + w ∇_z gᵀ of an event as its parts ([`saltation_parts`]), to
+/// apply it without forming it: S M = R M + w (∇_z gᵀ M) is a rank-one update of R M, and R = I
+/// at a switching.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SaltationParts {
+    /// The jump (with R = ∂z⁺/∂z⁻).
+    pub jump: Jump,
+    /// ∇_z g of the guard left, shape `[d]`.
+    pub grad: DVector<f64>,
+    /// The event shift w of [`saltation_with_shift`], shape `[d]`.
+    pub shift: DVector<f64>,
+}
+
+impl SaltationParts {
+    /// M ← S M for M of d rows (column-major `m`, any number of columns: the monodromy matrix,
+    /// or one sensitivity vector), with `scratch` of d values; allocates nothing.
+    pub fn apply(&self, m: &mut [f64], scratch: &mut [f64]) {
+        let d = self.shift.len();
+        let identity = self.jump.kind == EventKind::Switching;
+        for col in m.chunks_exact_mut(d) {
+            let gm: f64 = self.grad.iter().zip(col.iter()).map(|(g, x)| g * x).sum();
+            if !identity {
+                scratch.copy_from_slice(col);
+                crate::integrate::matvec(&self.jump.jacobian, scratch, col, 1.0, false);
+            }
+            for (c, w) in col.iter_mut().zip(self.shift.iter()) {
+                *c += w * gm;
+            }
+        }
+    }
+}
+
+/// The parts R, ∇_z g and w of the saltation matrix of the event of mode `from` at (τ, z⁻)
+/// (module docs; w as in [`saltation_with_shift`], zero when ġ = 0).
+pub fn saltation_parts<S: HybridSystem + ?Sized>(
+    sys: &S,
+    from: Region,
+    tau: f64,
+    z_minus: &[f64],
+) -> SaltationParts {
     let d = sys.dim();
     let jump = sys.jump(from, tau, z_minus);
     let guard = sys.guard(from, tau, z_minus);
-    let mut f_minus = vec![0.0; d];
-    let mut f_plus = vec![0.0; d];
-    sys.rhs(from, tau, z_minus, &mut f_minus);
-    sys.rhs(jump.to, tau, jump.state.as_slice(), &mut f_plus);
-    let f_minus = DVector::from_vec(f_minus);
-    let rate = guard.grad.dot(&f_minus) + guard.d_tau;
-    let mut s = jump.jacobian.clone();
+    let mut f_minus = DVector::zeros(d);
     let mut shift = DVector::zeros(d);
+    sys.rhs(from, tau, z_minus, f_minus.as_mut_slice());
+    let rate = guard.grad.dot(&f_minus) + guard.d_tau;
     if rate != 0.0 {
-        let num = DVector::from_vec(f_plus) - &jump.jacobian * &f_minus - &jump.d_tau;
-        s += &num * guard.grad.transpose() / rate;
-        shift = num / rate;
+        // w = (f⁺ − R f⁻ − ∂r/∂τ) / ġ
+        sys.rhs(jump.to, tau, jump.state.as_slice(), shift.as_mut_slice());
+        shift.gemv(-1.0, &jump.jacobian, &f_minus, 1.0);
+        shift -= &jump.d_tau;
+        shift /= rate;
     }
-    (s, jump, shift)
+    SaltationParts {
+        jump,
+        grad: guard.grad,
+        shift,
+    }
 }

@@ -867,3 +867,51 @@ fn every_analysis_on_every_law() {
         );
     }
 }
+
+/// Applying the saltation matrix from its parts (R M + w (∇gᵀ M), no product when R = I) gives
+/// S M with S formed ([`afmdyn::system::saltation`]), for a switching of the linear law, of
+/// the Hertz law, and for an impact (R ≠ I) and a release from sticking of the impact law.
+#[test]
+fn saltation_parts_apply_the_saltation_matrix() {
+    use afmdyn::system::{saltation, saltation_parts};
+    let cases = [
+        (ContactLaw::Linear, Region::Free),
+        (ContactLaw::Linear, Region::Contact),
+        (ContactLaw::Hertz, Region::Free),
+        (ContactLaw::Impact { restitution: 0.6 }, Region::Free),
+        (ContactLaw::Impact { restitution: 0.6 }, Region::Contact),
+    ];
+    for (law, from) in cases {
+        let m = CantileverModel::new(&Params {
+            contact_law: law,
+            alpha6: 0.3,
+            ..Params::default()
+        })
+        .unwrap();
+        let d = m.dim();
+        let (tau, z) = (
+            0.7,
+            DVector::from_fn(d, |i, _| 0.05 * (i as f64 + 1.0).sin()),
+        );
+        let (s, _) = saltation(&m, from, tau, z.as_slice());
+        let parts = saltation_parts(&m, from, tau, z.as_slice());
+        // `apply` skips R at a switching: the state is continuous there
+        if parts.jump.kind == EventKind::Switching {
+            assert_eq!(
+                parts.jump.jacobian,
+                DMatrix::identity(d, d),
+                "{law:?} {from:?}"
+            );
+        }
+        assert!(parts.shift.norm() > 0.0, "{law:?} {from:?}: S = R");
+        let mut mm = DMatrix::from_fn(d, d, |i, j| ((i * d + j) as f64).cos());
+        let want = &s * &mm;
+        let mut scratch = vec![0.0; d];
+        parts.apply(mm.as_mut_slice(), &mut scratch);
+        let err = (&mm - &want).amax();
+        assert!(
+            err <= 1e-14 * (1.0 + want.amax()),
+            "{law:?} {from:?}: {err:.2e}"
+        );
+    }
+}

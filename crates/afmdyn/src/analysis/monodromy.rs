@@ -9,7 +9,7 @@ use crate::integrate::exact::matmul_into;
 use crate::integrate::{Integrator, Step};
 use crate::params::SweepParam;
 use crate::roots::extremum;
-use crate::system::EventKind;
+use crate::system::{saltation_parts, EventKind};
 use nalgebra::{DMatrix, DVector};
 
 /// The flow map over [τ0, τ1] with its Jacobian.
@@ -145,14 +145,14 @@ fn flow(
             if let Some((r, t0)) = stint.take() {
                 close_stint(integ, r, e.tau - t0, &mut step_jac, &mut jac, &mut prod);
             }
-            let (s, shift) = integ.model().saltation_with_shift(e.from, e.tau, &e.state);
-            left_mul(&s, &mut jac, &mut prod);
+            // M ← S M and s ← S s + w ∂g/∂p, S = R + w ∇gᵀ applied as a rank-one update
+            let salt = saltation_parts(integ.model(), e.from, e.tau, e.state.as_slice());
+            salt.apply(jac.as_mut_slice(), tmp.as_mut_slice());
             if let Some(p) = param {
                 match integ.model().guard_param_derivative(e.from, p, e.tau) {
                     Some(dg) => {
-                        tmp.gemv(1.0, &s, &sens, 0.0);
-                        sens.copy_from(&tmp);
-                        sens.axpy(dg, &shift, 1.0);
+                        salt.apply(sens.as_mut_slice(), tmp.as_mut_slice());
+                        sens.axpy(dg, &salt.shift, 1.0);
                     }
                     None => param = None,
                 }
