@@ -190,7 +190,8 @@ fn advance_equals_the_step_loop() {
 
 /// A build that reuses earlier builds (same matrices; or the same region matrices after a
 /// change of Ω, α2 and α5) propagates bit for bit as a fresh build; a change of Ω alone keeps
-/// the spectral data and redoes the grid exponential, a change of α4 redoes both.
+/// the spectral data and redoes the grid exponential and the forcing data, a change of α2 or
+/// α5 redoes the forcing data only, a change of α4 redoes all three.
 #[test]
 fn reused_builds_propagate_as_fresh_ones() {
     // a parameter set of this test only (α1 = 0.137), so that the other tests' builds in the
@@ -203,10 +204,12 @@ fn reused_builds_propagate_as_fresh_ones() {
         let m = CantileverModel::new(&q).unwrap();
         prop(&m, Propagation::Auto, true).reused()
     };
-    assert_eq!(reused(p), (false, false));
-    assert_eq!(reused(p), (true, true));
-    assert_eq!(reused(Params { omega: 2.61, ..p }), (true, false));
-    assert_eq!(reused(Params { alpha4: 21.0, ..p }), (false, false));
+    assert_eq!(reused(p), (false, false, false));
+    assert_eq!(reused(p), (true, true, true));
+    assert_eq!(reused(Params { omega: 2.61, ..p }), (true, false, false));
+    assert_eq!(reused(Params { alpha2: 0.11, ..p }), (true, true, false));
+    assert_eq!(reused(Params { alpha5: 0.02, ..p }), (true, true, false));
+    assert_eq!(reused(Params { alpha4: 21.0, ..p }), (false, false, false));
 
     for q in [
         p,

@@ -182,8 +182,9 @@ pub struct ExactPropagator {
     forced: Arc<[Forced; 2]>,
     /// Whether each region's grid steps are modal.
     modal: [bool; 2],
-    /// Whether the spectral data and the grid exponential came from earlier builds.
-    reused: (bool, bool),
+    /// Whether the spectral data, the grid exponential and the forcing data came from earlier
+    /// builds.
+    reused: (bool, bool, bool),
     /// Dense grid-step kernel for this dimension.
     kernel: MatVec,
     grid: PeriodGrid,
@@ -221,6 +222,28 @@ pub struct ExactPropagator {
     param_data: Option<(SweepParam, Arc<[ParticularDerivative; 2]>)>,
     /// ∂z_p/∂p at the end (τ, region) of the last step it was asked for.
     param_end: Option<(f64, Region, [f64; MAXD])>,
+}
+
+/// The forcing data of a build, shared by every build with the same key ([`forcing_key`]):
+/// both regions' [`Forced`] and sin/cos of Ωτ_k on the grid.
+type Forcing = (Arc<[Forced; 2]>, Arc<[(f64, f64)]>);
+
+/// Recent forcing data (see [`spectral`]'s module docs).
+static FORCING: spectral::Cache<Forcing> = std::sync::Mutex::new(Vec::new());
+
+/// Everything [`forced`] and the grid's sin/cos read: the spectral key (A_s, M, K_s), h, Ω,
+/// the base-drive amplitude, the tip row and b_const, b_sin, b_cos of both regions, as bits.
+fn forcing_key(model: &CantileverModel, spectral_key: &[u64], h: f64) -> Vec<u64> {
+    let mut key = spectral_key.to_vec();
+    key.extend([h, model.omega(), base_amp(model.params())].map(f64::to_bits));
+    key.extend(model.tip().iter().map(|x| x.to_bits()));
+    for r in [Region::Free, Region::Contact] {
+        let d = model.dynamics(r);
+        for b in [&d.b_const, &d.b_sin, &d.b_cos] {
+            key.extend(b.iter().map(|x| x.to_bits()));
+        }
+    }
+    key
 }
 
 /// Particular solution of one region and its grid values: A p0 = −b_const and
@@ -366,13 +389,18 @@ impl ExactPropagator {
         let m = base * need.div_ceil(base);
         let h = period / m as f64;
         let (phi, phi_reused) = spectral::grid_exp(&spec, &key, h, opts.reuse)?;
-        let trig: Vec<(f64, f64)> = (0..=m)
-            .map(|k| (omega * (k as f64 * h)).sin_cos())
-            .collect();
-        let forced = Arc::new([
-            forced(model, Region::Free, &spec[0], &trig, h)?,
-            forced(model, Region::Contact, &spec[1], &trig, h)?,
-        ]);
+        let (forcing, forcing_reused) =
+            spectral::cached(&FORCING, &forcing_key(model, &key, h), opts.reuse, || {
+                let trig: Vec<(f64, f64)> = (0..=m)
+                    .map(|k| (omega * (k as f64 * h)).sin_cos())
+                    .collect();
+                let forced = Arc::new([
+                    forced(model, Region::Free, &spec[0], &trig, h)?,
+                    forced(model, Region::Contact, &spec[1], &trig, h)?,
+                ]);
+                Ok((forced, trig.into()))
+            })?;
+        let (forced, trig) = (forcing.0.clone(), forcing.1.clone());
         let modal = std::array::from_fn(|i| {
             spec[i].modal.is_some()
                 && match opts.propagation {
@@ -394,7 +422,7 @@ impl ExactPropagator {
             phi,
             forced,
             modal,
-            reused: (spec_reused, phi_reused),
+            reused: (spec_reused, phi_reused, forcing_reused),
             kernel: kernel::for_dim(dim),
             grid: PeriodGrid::new(period, m),
             tau: 0.0,
@@ -419,7 +447,7 @@ impl ExactPropagator {
             poly_built: false,
             vt: (0.0, 0.0),
             dead,
-            trig: trig.into(),
+            trig,
             zb: zero,
             param_data: None,
             param_end: None,
@@ -432,8 +460,9 @@ impl ExactPropagator {
     }
 
     /// Whether this build reused earlier builds ([`ExactOptions::reuse`]): (the spectral data —
-    /// energy transforms, Ã_s, eigendecomposition —, the grid exponentials Φ_s).
-    pub fn reused(&self) -> (bool, bool) {
+    /// energy transforms, Ã_s, eigendecomposition —, the grid exponentials Φ_s, the forcing
+    /// data — particular solutions, their grid values, sin/cos on the grid).
+    pub fn reused(&self) -> (bool, bool, bool) {
         self.reused
     }
 

@@ -41,7 +41,7 @@ pub(super) struct Spectral {
 /// Entries kept per cache (least recently used dropped first).
 const CAPACITY: usize = 8;
 
-type Cache<V> = Mutex<Vec<(Vec<u64>, Arc<V>)>>;
+pub(super) type Cache<V> = Mutex<Vec<(Vec<u64>, Arc<V>)>>;
 
 static SPECTRAL: Cache<[Spectral; 2]> = Mutex::new(Vec::new());
 static GRID_EXP: Cache<GridExp> = Mutex::new(Vec::new());
@@ -51,7 +51,7 @@ pub(super) type GridExp = [DMatrix<f64>; 2];
 
 /// The cached value for `key`, or `make()` (stored when `reuse`), and whether it was cached. A
 /// poisoned lock is a miss.
-fn cached<V>(
+pub(super) fn cached<V>(
     cache: &Cache<V>,
     key: &[u64],
     reuse: bool,
