@@ -210,6 +210,16 @@ fn reused_builds_propagate_as_fresh_ones() {
     assert_eq!(reused(Params { alpha2: 0.11, ..p }), (true, true, false));
     assert_eq!(reused(Params { alpha5: 0.02, ..p }), (true, true, false));
     assert_eq!(reused(Params { alpha4: 21.0, ..p }), (false, false, false));
+    // forcing data above 2 MiB (N = 20 at 7000 steps per period: 2.2 MiB) is not kept
+    let big = CantileverModel::new(&Params { modes: 20, ..p }).unwrap();
+    let opts = ExactOptions {
+        min_steps_per_period: 7000,
+        ..ExactOptions::default()
+    };
+    let _ = ExactPropagator::try_with(&big, opts).unwrap();
+    let again = ExactPropagator::try_with(&big, opts).unwrap();
+    assert_eq!(again.steps_per_period(), 7000);
+    assert_eq!(again.reused(), (true, true, false));
 
     for q in [
         p,

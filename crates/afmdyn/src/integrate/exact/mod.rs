@@ -231,6 +231,10 @@ type Forcing = (Arc<[Forced; 2]>, Arc<[(f64, f64)]>);
 /// Recent forcing data (see [`spectral`]'s module docs).
 static FORCING: spectral::Cache<Forcing> = std::sync::Mutex::new(Vec::new());
 
+/// Largest forcing data kept in [`FORCING`] (both regions' grid values and the grid's sin/cos):
+/// 2 MiB, so its 8 entries hold at most 16 MiB (N = 20 at the default parameters: 1.4 MiB).
+const FORCING_KEEP_BYTES: f64 = 2.0 * 1024.0 * 1024.0;
+
 /// Everything [`forced`] and the grid's sin/cos read: the spectral key (A_s, M, K_s), h, Ω,
 /// the base-drive amplitude, the tip row and b_const, b_sin, b_cos of both regions, as bits.
 fn forcing_key(model: &CantileverModel, spectral_key: &[u64], h: f64) -> Vec<u64> {
@@ -389,8 +393,14 @@ impl ExactPropagator {
         let m = base * need.div_ceil(base);
         let h = period / m as f64;
         let (phi, phi_reused) = spectral::grid_exp(&spec, &key, h, opts.reuse)?;
-        let (forcing, forcing_reused) =
-            spectral::cached(&FORCING, &forcing_key(model, &key, h), opts.reuse, || {
+        // kept only while small: a cache entry outlives the propagators that use it, and the
+        // grid of a stiff, large-N build may take up to params::GRID_BUDGET_BYTES
+        let keep = (2 * dim + 2) as f64 * (m as f64 + 1.0) * 8.0 <= FORCING_KEEP_BYTES;
+        let (forcing, forcing_reused) = spectral::cached(
+            &FORCING,
+            &forcing_key(model, &key, h),
+            opts.reuse && keep,
+            || {
                 let trig: Vec<(f64, f64)> = (0..=m)
                     .map(|k| (omega * (k as f64 * h)).sin_cos())
                     .collect();
@@ -399,7 +409,8 @@ impl ExactPropagator {
                     forced(model, Region::Contact, &spec[1], &trig, h)?,
                 ]);
                 Ok((forced, trig.into()))
-            })?;
+            },
+        )?;
         let (forced, trig) = (forcing.0.clone(), forcing.1.clone());
         let modal = std::array::from_fn(|i| {
             spec[i].modal.is_some()
