@@ -190,16 +190,18 @@ pub struct SaltationParts {
 }
 
 impl SaltationParts {
-    /// M ← S M for M of d rows (column-major `m`, any number of columns: the monodromy matrix,
-    /// or one sensitivity vector), with `scratch` of d values; allocates nothing.
-    pub fn apply(&self, m: &mut [f64], scratch: &mut [f64]) {
+    /// M ← S M for M of d rows (column-major `m`, any number of whole columns: the monodromy
+    /// matrix, or one sensitivity vector; a trailing partial column is left alone). Allocates
+    /// nothing at a switching (R = I), one column of scratch otherwise.
+    pub fn apply(&self, m: &mut [f64]) {
         let d = self.shift.len();
         let identity = self.jump.kind == EventKind::Switching;
-        for col in m.chunks_exact_mut(d) {
+        let mut scratch = if identity { Vec::new() } else { vec![0.0; d] };
+        for col in m.chunks_exact_mut(d.max(1)) {
             let gm: f64 = self.grad.iter().zip(col.iter()).map(|(g, x)| g * x).sum();
             if !identity {
                 scratch.copy_from_slice(col);
-                crate::integrate::matvec(&self.jump.jacobian, scratch, col, 1.0, false);
+                crate::integrate::matvec(&self.jump.jacobian, &scratch, col, 1.0, false);
             }
             for (c, w) in col.iter_mut().zip(self.shift.iter()) {
                 *c += w * gm;

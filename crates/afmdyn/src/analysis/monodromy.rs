@@ -147,11 +147,11 @@ fn flow(
             }
             // M ← S M and s ← S s + w ∂g/∂p, S = R + w ∇gᵀ applied as a rank-one update
             let salt = saltation_parts(integ.model(), e.from, e.tau, e.state.as_slice());
-            salt.apply(jac.as_mut_slice(), tmp.as_mut_slice());
+            salt.apply(jac.as_mut_slice());
             if let Some(p) = param {
                 match integ.model().guard_param_derivative(e.from, p, e.tau) {
                     Some(dg) => {
-                        salt.apply(sens.as_mut_slice(), tmp.as_mut_slice());
+                        salt.apply(sens.as_mut_slice());
                         sens.axpy(dg, &salt.shift, 1.0);
                     }
                     None => param = None,
