@@ -216,18 +216,12 @@ fn energy_transform(
     let singular = |what: &'static str| {
         SimError::out_of_range(what, "not positive definite", "needs validated parameters")
     };
-    let lk = g
-        .stiffness
-        .clone()
-        .cholesky()
-        .ok_or_else(|| singular("stiffness matrix K"))?
-        .l();
-    let lm = g
-        .mass
-        .clone()
-        .cholesky()
-        .ok_or_else(|| singular("mass matrix M"))?
-        .l();
+    // the Cholesky factor L of an SPD matrix (K = L_K L_Kᵀ, M = L_M L_Mᵀ)
+    let factor = |m: &DMatrix<f64>, what| -> Result<DMatrix<f64>, SimError> {
+        Ok(m.clone().cholesky().ok_or_else(|| singular(what))?.l())
+    };
+    let lk = factor(&g.stiffness, "stiffness matrix K")?;
+    let lm = factor(&g.mass, "mass matrix M")?;
     let mut t = DMatrix::zeros(2 * n, 2 * n);
     t.view_mut((0, 0), (n, n)).copy_from(&lk.transpose());
     t.view_mut((n, n), (n, n)).copy_from(&lm.transpose());
