@@ -354,7 +354,7 @@ impl CantileverModel {
     }
     /// [`CantileverModel::v_t_from_tip`] given (sin Ωτ, cos Ωτ): eq. 8, the one place V_T is
     /// formed from the tip deflection.
-    fn v_t_at(&self, (s, c): (f64, f64), w: [f64; 3]) -> [f64; 3] {
+    pub(crate) fn v_t_at(&self, (s, c): (f64, f64), w: [f64; 3]) -> [f64; 3] {
         let p = &self.params;
         [
             w[0] + p.base_amplitude() * s + p.alpha5,

@@ -22,7 +22,7 @@
 //! alone. What it saves is the per-step bookkeeping of the scalar step, and the loops over
 //! lanes vectorize.
 
-use super::{base_amp, search::certified_positive, ExactPropagator};
+use super::{modal_v_t, search::StepEnds, ExactPropagator};
 use crate::error::SimError;
 use crate::galerkin::Region;
 use crate::integrate::Integrator;
@@ -32,7 +32,7 @@ use nalgebra::DVector;
 const W: usize = 4;
 
 /// One mode of the modal step for W lanes: (oa, ob) = e^{λh} ⊙ (a, b) (Modes::mul_assign) and
-/// w += Re(tip · q), d += Re(tip_dot · q) (the terms of modal::re_dot), with
+/// w += Re(tip · q), d += Re(tip_dot · q) (the terms of ModalExp::advance_into), with
 /// `t` = (Re tip, Im tip, Re tip_dot, Im tip_dot).
 #[inline(always)]
 fn modal_mode(
@@ -208,9 +208,7 @@ impl Block {
         let used = n_s.div_ceil(W);
         let ri = self.region.index();
         let fr = &p.forced[ri];
-        let par = p.model.params();
         let (sn, cn) = p.trig[k + 1];
-        let (omega, bamp, a5) = (p.model.omega(), base_amp(par), par.alpha5);
         let xs = self.x[..used * chunk].chunks_exact(chunk);
         let ys = self.y[..used * chunk].chunks_exact_mut(chunk);
         let vbs = self.vb[..used * W].as_chunks_mut::<W>().0.iter_mut();
@@ -223,9 +221,9 @@ impl Block {
             let f = &fr.grid_fac;
             let (tip, tip_dot) = (&me.tip, &me.tip_dot);
             // per chunk, the modes innermost so that the sums stay in registers:
-            // q ← e^{λh} ⊙ q (ModalExp::advance / Modes::mul_assign) and Σ Re(tip_k q_k) for the
+            // q ← e^{λh} ⊙ q (ModalExp::advance_into) and Σ Re(tip_k q_k) for the
             // tip deflection and rate, each in the two interleaved partial sums of
-            // modal::re_dot (even k, odd k)
+            // ModalExp::advance_into (even k, odd k)
             for (((xc, yc), vb), vdb) in xs.zip(ys).zip(vbs).zip(vdbs) {
                 let (xr, xi) = xc.split_at(r * W);
                 let (yr, yi) = yc.split_at_mut(r * W);
@@ -253,13 +251,9 @@ impl Block {
                 if kk < r {
                     mode(kk, &mut yr[kk], &mut yi[kk], &mut w0, &mut d0);
                 }
-                let w = [w0, w1];
-                let wd = [d0, d1];
-                let [w0, ws, wc] = fr.wp;
                 for l in 0..W {
-                    let (w, wd) = (w[0][l] + w[1][l], wd[0][l] + wd[1][l]);
-                    vb[l] = w + w0 + ws * sn + wc * cn + bamp * sn + a5;
-                    vdb[l] = wd + omega * (ws * cn - wc * sn) + bamp * omega * cn;
+                    let tip = (w0[l] + w1[l], d0[l] + d1[l]);
+                    (vb[l], vdb[l]) = modal_v_t(&p.model, fr, tip, (sn, cn));
                 }
             }
         } else {
@@ -305,8 +299,7 @@ impl Block {
                     }
                 }
                 for l in 0..W {
-                    vb[l] = v[l] + bamp * sn + a5;
-                    vdb[l] = vd[l] + bamp * par.omega * cn;
+                    [vb[l], vdb[l], _] = p.model.v_t_at((sn, cn), [v[l], vd[l], 0.0]);
                 }
             }
         }
@@ -314,14 +307,14 @@ impl Block {
         let sigma = self.region.guard_sign();
         let (dead, vp) = (p.dead, fr.vp_curv);
         for s in 0..n_s {
-            let mut ga = sigma * self.v[s] + dead;
-            let da = sigma * self.vd[s];
-            let gb = sigma * self.vb[s] + dead;
-            let db = sigma * self.vdb[s];
-            if self.switched[s] || ga <= 0.0 {
-                ga = ga.max(0.0);
-            }
-            self.ok[s] = certified_positive(ga, da, gb, db, self.curv[s] + vp, len);
+            let ends = StepEnds::new(
+                sigma,
+                dead,
+                (self.v[s], self.vd[s]),
+                (self.vb[s], self.vdb[s]),
+                self.switched[s],
+            );
+            self.ok[s] = ends.certified(self.curv[s] + vp, len);
         }
     }
 

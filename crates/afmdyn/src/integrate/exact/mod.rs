@@ -52,7 +52,7 @@ use crate::params::SweepParam;
 use kernel::MatVec;
 use modal::{ModalExp, Modes, MAXD};
 use nalgebra::{DMatrix, DVector, Dyn, LU};
-use search::{certified_positive, Search, TipPoly};
+use search::{Search, StepEnds, TipPoly};
 use spectral::Spectral;
 use std::sync::Arc;
 
@@ -86,6 +86,174 @@ const INV_FACT: [f64; K + 1] = {
 /// [`Params::base_amplitude`] (0 for the point-mass model, whose base does not move).
 fn base_amp(p: &Params) -> f64 {
     p.base_amplitude()
+}
+
+/// [V_T, dV_T/dτ] in a modal region at a time with (sin Ωτ, cos Ωτ) = `sc`, from the tip
+/// deflection and rate (w, ẇ) of the homogeneous part: W = w + W_p with the particular part
+/// W_p = w0 + ws sin Ωτ + wc cos Ωτ of [`Forced`], then eq. 8
+/// ([`CantileverModel::v_t_at`]).
+fn modal_v_t(
+    model: &CantileverModel,
+    fr: &Forced,
+    (w, wd): (f64, f64),
+    sc: (f64, f64),
+) -> (f64, f64) {
+    let [w0, ws, wc] = fr.wp;
+    let (s, c) = sc;
+    let om = model.omega();
+    let tip = [w + w0 + ws * s + wc * c, wd + om * (ws * c - wc * s), 0.0];
+    let [v, vd, _] = model.v_t_at(sc, tip);
+    (v, vd)
+}
+
+/// One whole dense grid step k → k + 1: δz = z − z_p(τ_k) into `dz`,
+/// y = z_p(τ_{k+1}) + Φ_s δz into `y` (`phi`: Φ_s column-major with its kernel), and
+/// [V_T, dV_T/dτ] at τ_{k+1} (eq. 8), given `trig` = (sin Ωτ_{k+1}, cos Ωτ_{k+1}). Slices of
+/// length 2N.
+#[inline(always)]
+fn dense_grid_step(
+    model: &CantileverModel,
+    fr: &Forced,
+    (phi, kernel): (&[f64], MatVec),
+    (k, trig): (usize, (f64, f64)),
+    z: &[f64],
+    dz: &mut [f64],
+    y: &mut [f64],
+) -> (f64, f64) {
+    let dim = z.len();
+    let zp = fr.zp_grid.as_slice();
+    let (zk, zk1) = (
+        &zp[k * dim..(k + 1) * dim],
+        &zp[(k + 1) * dim..(k + 2) * dim],
+    );
+    for ((d, x), a) in dz.iter_mut().zip(z).zip(zk) {
+        *d = x - a;
+    }
+    y.copy_from_slice(zk1);
+    kernel(phi, dz, y);
+    let n = dim / 2;
+    let tip = model.tip().as_slice();
+    let dot = |x: &[f64]| tip.iter().zip(x).map(|(a, b)| a * b).sum::<f64>();
+    let [v, vd, _] = model.v_t_at(trig, [dot(&y[..n]), dot(&y[n..]), 0.0]);
+    (v, vd)
+}
+
+/// What a run of whole grid steps ([`ExactPropagator`]'s `grid_run`) needs besides the state:
+/// the grid and sin/cos Ωτ on it, the end time, and the certified test's guard sign σ, dead
+/// band and curvature bound.
+struct RunLimits {
+    grid: PeriodGrid,
+    trig: Arc<[(f64, f64)]>,
+    tau_end: f64,
+    sigma: f64,
+    dead: f64,
+    curv: f64,
+}
+
+/// The whole grid step of one propagation path, for [`RunLimits::run`].
+trait GridSteps {
+    /// The step from grid point k (sub-step index) into scratch, not yet taken; returns
+    /// [V_T, dV_T/dτ] at its end, given `trig` = (sin Ωτ_{k+1}, cos Ωτ_{k+1}).
+    fn try_step(&mut self, k: usize, trig: (f64, f64)) -> (f64, f64);
+    /// Take the step tried last (its start is kept as the start of the last step).
+    fn accept(&mut self);
+}
+
+impl RunLimits {
+    /// Whole grid steps from grid point `at` at (τ, (V_T, dV_T/dτ)) = (`tau`, `vt`), each
+    /// taken when it ends by `tau_end` and passes the certified test, up to the end of the
+    /// current period; the step loop of `step_impl` for these steps, with the same t_grid
+    /// ([`PeriodGrid::tau`]) and test. Returns the start time of the last step taken (`None`:
+    /// none) and whether the run ended at the period end.
+    fn run(
+        &self,
+        tau: &mut f64,
+        vt: &mut (f64, f64),
+        at: &mut (i64, usize),
+        steps: &mut impl GridSteps,
+    ) -> (Option<f64>, bool) {
+        let mut tau_last = None;
+        loop {
+            let (p, k) = *at;
+            let next = if k + 1 < self.grid.m {
+                (p, k + 1)
+            } else {
+                (p + 1, 0)
+            };
+            let t_grid = next.0 as f64 * self.grid.period + next.1 as f64 * self.grid.h;
+            let len = t_grid - *tau;
+            if !(t_grid <= self.tau_end && len > 0.0) {
+                return (tau_last, false);
+            }
+            let vt_b = steps.try_step(k, self.trig[k + 1]);
+            if !StepEnds::new(self.sigma, self.dead, *vt, vt_b, false).certified(self.curv, len) {
+                return (tau_last, false);
+            }
+            steps.accept();
+            tau_last = Some(*tau);
+            *tau = t_grid;
+            *vt = vt_b;
+            *at = next;
+            if next.1 == 0 {
+                return (tau_last, true);
+            }
+        }
+    }
+}
+
+/// Dense whole grid steps ([`dense_grid_step`]): the state z and the step's end y swap on
+/// acceptance, as do the δz of the step tried and of the last step taken.
+struct DenseSteps<'a> {
+    model: &'a CantileverModel,
+    fr: &'a Forced,
+    phi: (&'a [f64], MatVec),
+    z: &'a mut DVector<f64>,
+    zb: &'a mut DVector<f64>,
+    dz_try: &'a mut [f64],
+    dz_last: &'a mut [f64],
+}
+
+impl GridSteps for DenseSteps<'_> {
+    fn try_step(&mut self, k: usize, trig: (f64, f64)) -> (f64, f64) {
+        dense_grid_step(
+            self.model,
+            self.fr,
+            self.phi,
+            (k, trig),
+            self.z.as_slice(),
+            self.dz_try,
+            self.zb.as_mut_slice(),
+        )
+    }
+    fn accept(&mut self) {
+        std::mem::swap(self.z, self.zb);
+        std::mem::swap(&mut self.dz_try, &mut self.dz_last);
+    }
+}
+
+/// Modal whole grid steps ([`ModalExp::advance_into`] with e^{Λh}): the current modal
+/// coordinates, those of the step tried and the start of the last step taken rotate on
+/// acceptance (no copies).
+struct ModalSteps<'a> {
+    model: &'a CantileverModel,
+    me: &'a ModalExp,
+    fr: &'a Forced,
+    cur: &'a mut Modes,
+    tried: &'a mut Modes,
+    prev: &'a mut Modes,
+}
+
+impl GridSteps for ModalSteps<'_> {
+    fn try_step(&mut self, _k: usize, trig: (f64, f64)) -> (f64, f64) {
+        let tip = self
+            .me
+            .advance_into(self.cur, &self.fr.grid_fac, self.tried);
+        modal_v_t(self.model, self.fr, tip, trig)
+    }
+    fn accept(&mut self) {
+        std::mem::swap(&mut self.prev, &mut self.cur);
+        std::mem::swap(&mut self.cur, &mut self.tried);
+    }
 }
 
 /// How the grid steps of a region are propagated.
@@ -665,7 +833,10 @@ impl ExactPropagator {
         matvec(&sp.tinv, &yt[..dim], out, 1.0, true);
     }
 
-    /// z = z_p(τ) + T⁻¹ V q in a modal region, when z lags behind q.
+    /// z = z_p(τ) + T⁻¹ V q in a modal region, when z lags behind q. z lags only after whole
+    /// grid steps, so on a grid point z_p is the grid table's value at the end of the step that
+    /// arrived there (column k, or m at a period end), as a materialising step of `step_impl`
+    /// forms it: [`Integrator::advance_to`] and the step loop agree bit for bit.
     fn materialize(&mut self) {
         if !self.stale {
             return;
@@ -673,7 +844,14 @@ impl ExactPropagator {
         let ri = self.region.index();
         if let Some(me) = &self.spec[ri].modal {
             let z = self.z.as_mut_slice();
-            Self::zp_into(&self.forced[ri], self.model.omega(), self.tau, z);
+            let fr = &self.forced[ri];
+            match self.on_grid {
+                Some((_, k)) => {
+                    let (dim, col) = (z.len(), if k == 0 { self.grid.m } else { k });
+                    z.copy_from_slice(&fr.zp_grid.as_slice()[col * dim..(col + 1) * dim]);
+                }
+                None => Self::zp_into(fr, self.model.omega(), self.tau, z),
+            }
             ModalExp::expand(&me.tv, &self.q, z, true);
         }
         self.stale = false;
@@ -852,6 +1030,140 @@ impl ExactPropagator {
         };
     }
 
+    /// Whole grid steps from the current grid point, as long as each ends by `tau_end` and
+    /// passes the certified test — the common case between switchings — exactly as
+    /// [`Self::step_impl`] without `materialize` takes them (the same operations in the same
+    /// order, so bit for bit the same states, V_T and last step), without its per-step
+    /// bookkeeping. Stops before a step that would end off the grid or beyond `tau_end`, or
+    /// that fails the test (`step_impl` then takes it, with the search), and right after a
+    /// switching or [`Integrator::reset`]. At each period end the plain state is formed and
+    /// checked as `step_impl` does ([`Self::check_divergence`]).
+    fn grid_run(&mut self, tau_end: f64) -> Result<(), SimError> {
+        if self.just_switched {
+            return Ok(());
+        }
+        let ri = self.region.index();
+        let modal = self.modal[ri] && self.spec[ri].modal.is_some();
+        loop {
+            let at_period_end = if modal {
+                self.modal_run(tau_end)
+            } else {
+                self.dense_run(tau_end)
+            };
+            if !at_period_end {
+                return Ok(());
+            }
+            self.check_divergence()?;
+        }
+    }
+
+    /// [`Self::grid_run`] in a dense region: z ← z_p(τ_{k+1}) + Φ_s (z − z_p(τ_k)). Returns
+    /// whether it stopped at the end of a period.
+    fn dense_run(&mut self, tau_end: f64) -> bool {
+        let Some(mut at) = self.on_grid else {
+            return false;
+        };
+        let limits = self.run_limits(tau_end);
+        let ExactPropagator {
+            ref model,
+            ref phi,
+            ref forced,
+            kernel,
+            ref mut tau,
+            ref mut vt,
+            ref mut z,
+            ref mut zb,
+            region,
+            ref mut last,
+            ..
+        } = *self;
+        let (ri, dim) = (region.index(), z.len());
+        let fr = &forced[ri];
+        let (mut dz_a, mut dz_b) = ([0.0; MAXD], [0.0; MAXD]);
+        let mut steps = DenseSteps {
+            model,
+            fr,
+            phi: (phi[ri].as_slice(), kernel),
+            z,
+            zb,
+            dz_try: &mut dz_a[..dim],
+            dz_last: &mut dz_b[..dim],
+        };
+        let (ran, period_end) = limits.run(tau, vt, &mut at, &mut steps);
+        let Some(tau0) = ran else {
+            return false;
+        };
+        last.dz0.as_mut_slice().copy_from_slice(steps.dz_last);
+        self.finish_run(tau0, at, false);
+        period_end
+    }
+
+    /// [`Self::grid_run`] in a modal region: q ← e^{Λh} ⊙ q, the plain state not formed (as
+    /// `step_impl` without `materialize`). Returns whether it stopped at the end of a period.
+    fn modal_run(&mut self, tau_end: f64) -> bool {
+        let Some(mut at) = self.on_grid else {
+            return false;
+        };
+        let limits = self.run_limits(tau_end);
+        let ExactPropagator {
+            ref model,
+            ref spec,
+            ref forced,
+            ref mut tau,
+            ref mut vt,
+            ref mut q,
+            region,
+            ref mut last,
+            ..
+        } = *self;
+        let ri = region.index();
+        let (Some(me), fr) = (&spec[ri].modal, &forced[ri]) else {
+            return false;
+        };
+        let (mut qa, mut qb, mut qc) = (*q, Modes::ZERO, Modes::ZERO);
+        let mut steps = ModalSteps {
+            model,
+            me,
+            fr,
+            cur: &mut qa,
+            tried: &mut qb,
+            prev: &mut qc,
+        };
+        let (ran, period_end) = limits.run(tau, vt, &mut at, &mut steps);
+        let Some(tau0) = ran else {
+            return false;
+        };
+        *q = *steps.cur;
+        last.q0 = *steps.prev;
+        self.finish_run(tau0, at, true);
+        period_end
+    }
+
+    /// The limits of a run in the current stint up to `tau_end`.
+    fn run_limits(&self, tau_end: f64) -> RunLimits {
+        RunLimits {
+            grid: self.grid,
+            trig: self.trig.clone(),
+            tau_end,
+            sigma: self.region.guard_sign(),
+            dead: self.dead,
+            curv: self.stint_curvature + self.forced[self.region.index()].vp_curv,
+        }
+    }
+
+    /// After a run that took whole grid steps, the last of them from `tau0`, to grid point
+    /// `at`: the last-step record of a whole grid step (as `step_impl` leaves it).
+    fn finish_run(&mut self, tau0: f64, at: (i64, usize), modal: bool) {
+        self.last.tau0 = tau0;
+        self.last.region = self.region;
+        self.last.full = true;
+        self.last.modal = modal;
+        self.on_grid = Some(at);
+        self.poly_built = false;
+        // z lags behind q after modal grid steps (formed by materialize)
+        self.stale = modal;
+    }
+
     /// One step (see [`Integrator::step`]). Without `materialize` (inside
     /// [`Integrator::advance_to`], which reads only the result's `Ok`/`Err`): in a modal region
     /// the plain state at the end of a whole grid step is not formed (z lags behind q), and a
@@ -891,7 +1203,6 @@ impl ExactPropagator {
         self.last.region = region;
         self.last.full = full;
         self.last.modal = modal;
-        let p = self.model.params();
         let fr = &self.forced[ri];
         let mut end_state = true;
         let vt_b = match (&self.spec[ri].modal, modal) {
@@ -903,7 +1214,8 @@ impl ExactPropagator {
                     me.factors(len, &mut self.fac_tmp);
                     &self.fac_tmp
                 };
-                let (w, wd) = me.advance(&mut self.q, &mut self.last.q0, fac);
+                self.last.q0 = self.q;
+                let (w, wd) = me.advance_into(&self.last.q0, fac, &mut self.q);
                 let (s, c) = if full {
                     self.trig[k + 1]
                 } else {
@@ -920,35 +1232,17 @@ impl ExactPropagator {
                     }
                     ModalExp::expand(&me.tv, &self.q, zb, true);
                 }
-                let [w0, ws, wc] = fr.wp;
-                (
-                    w + w0 + ws * s + wc * c + base_amp(p) * s + p.alpha5,
-                    wd + omega * (ws * c - wc * s) + base_amp(p) * omega * c,
-                )
+                modal_v_t(&self.model, fr, (w, wd), (s, c))
             }
-            _ if full => {
-                // z_b = z_p(τ_{k+1}) + Φ (z − z_p(τ_k))
-                let zp = fr.zp_grid.as_slice();
-                let (zk, zk1) = (
-                    &zp[k * dim..(k + 1) * dim],
-                    &zp[(k + 1) * dim..(k + 2) * dim],
-                );
-                let dz0 = self.last.dz0.as_mut_slice();
-                for ((d, z), zp) in dz0.iter_mut().zip(self.z.as_slice()).zip(zk) {
-                    *d = z - zp;
-                }
-                let zb = self.zb.as_mut_slice();
-                zb.copy_from_slice(zk1);
-                (self.kernel)(self.phi[ri].as_slice(), dz0, zb);
-                let (s, c) = self.trig[k + 1];
-                let n = p.modes;
-                let tip = self.model.tip().as_slice();
-                let dot = |x: &[f64]| tip.iter().zip(x).map(|(a, b)| a * b).sum::<f64>();
-                (
-                    dot(&zb[..n]) + base_amp(p) * s + p.alpha5,
-                    dot(&zb[n..]) + base_amp(p) * p.omega * c,
-                )
-            }
+            _ if full => dense_grid_step(
+                &self.model,
+                fr,
+                (self.phi[ri].as_slice(), self.kernel),
+                (k, self.trig[k + 1]),
+                self.z.as_slice(),
+                self.last.dz0.as_mut_slice(),
+                self.zb.as_mut_slice(),
+            ),
             _ => {
                 let dz0 = self.last.dz0.as_mut_slice();
                 Self::zp_into(fr, omega, tau0, dz0);
@@ -962,18 +1256,23 @@ impl ExactPropagator {
                 v
             }
         };
-        let sigma = region.guard_sign();
-        let mut ga = sigma * self.vt.0 + self.dead;
-        let da = sigma * self.vt.1;
-        let gb = sigma * vt_b.0 + self.dead;
-        let db = sigma * vt_b.1;
-        let switched = self.just_switched || ga <= 0.0;
-        if switched {
-            ga = ga.max(0.0);
-        }
+        let ends = StepEnds::new(
+            region.guard_sign(),
+            self.dead,
+            self.vt,
+            vt_b,
+            self.just_switched,
+        );
+        let StepEnds {
+            ga,
+            da,
+            gb,
+            db,
+            switched,
+        } = ends;
         let cheap = self.stint_curvature + self.forced[ri].vp_curv;
         let mut hit = None;
-        if !certified_positive(ga, da, gb, db, cheap, len) {
+        if !ends.certified(cheap, len) {
             let mut y0 = [0.0; MAXD];
             self.last_y0(&mut y0[..dim]);
             Self::build_poly(
@@ -1111,7 +1410,15 @@ impl Integrator for ExactPropagator {
     fn advance_to(&mut self, tau_end: f64) -> Result<(), SimError> {
         let mut out = Ok(());
         while self.tau < tau_end {
-            if let Err(e) = self.step_impl(tau_end, false) {
+            // the certified whole grid steps in one tight loop, the next step (a possible
+            // switching, or a partial step) by step_impl
+            let step = self.grid_run(tau_end).and_then(|()| {
+                if self.tau < tau_end {
+                    self.step_impl(tau_end, false)?;
+                }
+                Ok(())
+            });
+            if let Err(e) = step {
                 out = Err(e);
                 break;
             }

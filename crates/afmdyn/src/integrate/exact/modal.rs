@@ -61,27 +61,6 @@ impl Modes {
     }
 }
 
-/// Σ_k Re(x_k y_k) over the first r entries, in two interleaved partial sums (vectorizable).
-/// Kept out of line: inlined into the grid step it compiles to more instructions (callgrind,
-/// N = 10: 355 000 against 349 000 per forcing period).
-#[inline(never)]
-fn re_dot(x: &Modes, y: &Modes, r: usize) -> f64 {
-    let (xr, xi, yr, yi) = (&x.re[..r], &x.im[..r], &y.re[..r], &y.im[..r]);
-    let (xr2, xr1) = xr.as_chunks::<2>();
-    let (xi2, xi1) = xi.as_chunks::<2>();
-    let (yr2, yr1) = yr.as_chunks::<2>();
-    let (yi2, yi1) = yi.as_chunks::<2>();
-    let mut acc = [0.0; 2];
-    for (((a, b), c), d) in xr2.iter().zip(xi2).zip(yr2).zip(yi2) {
-        acc[0] += a[0] * c[0] - b[0] * d[0];
-        acc[1] += a[1] * c[1] - b[1] * d[1];
-    }
-    for (((a, b), c), d) in xr1.iter().zip(xi1).zip(yr1).zip(yi1) {
-        acc[0] += a * c - b * d;
-    }
-    acc[0] + acc[1]
-}
-
 /// A complex matrix as its real and imaginary parts (column-major), for vectorizable real
 /// arithmetic.
 #[derive(Debug, Clone)]
@@ -290,15 +269,45 @@ impl ModalExp {
         Self::expand(&self.v, &q, out, false);
     }
 
-    /// One step of the modal coordinates: q0 ← q, q ← f ⊙ q (f = e^{λ_k t}); returns the tip
-    /// deflection and rate of the homogeneous part at the end, Σ Re(w c̃ᵀv q) and
-    /// Σ Re(w c̃ᵀv λ q).
-    pub(super) fn advance(&self, q: &mut Modes, q0: &mut Modes, f: &Modes) -> (f64, f64) {
+    /// One step of the modal coordinates into `out`: out = f ⊙ q (f = e^{λ_k t}, the product of
+    /// [`Modes::mul_assign`]); returns the tip deflection and rate of the homogeneous part at
+    /// the end, Σ Re(w c̃ᵀv out) and Σ Re(w c̃ᵀv λ out), each in two interleaved partial sums
+    /// (even k, odd k; the batched step of `exact/batch.rs` sums in the same order). One pass
+    /// over the modes, taken in pairs so that a pair is one vector.
+    pub(super) fn advance_into(&self, q: &Modes, f: &Modes, out: &mut Modes) -> (f64, f64) {
         let r = self.len();
-        q0.re[..r].copy_from_slice(&q.re[..r]);
-        q0.im[..r].copy_from_slice(&q.im[..r]);
-        q.mul_assign(f, r);
-        (re_dot(&self.tip, q, r), re_dot(&self.tip_dot, q, r))
+        let (tip, tip_dot) = (&self.tip, &self.tip_dot);
+        // modes in pairs (lane 0: even k, lane 1: odd k), so that the pair is one vector
+        fn pairs(x: &[f64; MAXD], r: usize) -> (&[[f64; 2]], &[f64]) {
+            x[..r].as_chunks::<2>()
+        }
+        let ((qr, qr1), (qi, qi1)) = (pairs(&q.re, r), pairs(&q.im, r));
+        let ((fr, fr1), (fi, fi1)) = (pairs(&f.re, r), pairs(&f.im, r));
+        let ((tr, tr1), (ti, ti1)) = (pairs(&tip.re, r), pairs(&tip.im, r));
+        let ((dr, dr1), (di, di1)) = (pairs(&tip_dot.re, r), pairs(&tip_dot.im, r));
+        let (or, or1) = out.re[..r].split_at_mut(r & !1);
+        let (oim, oi1) = out.im[..r].split_at_mut(r & !1);
+        let (or, oim) = (or.as_chunks_mut::<2>().0, oim.as_chunks_mut::<2>().0);
+        let (mut w, mut d) = ([0.0; 2], [0.0; 2]);
+        for k in 0..qr.len() {
+            for l in 0..2 {
+                let (x, y, c, s) = (qr[k][l], qi[k][l], fr[k][l], fi[k][l]);
+                let (a, b) = (x * c - y * s, x * s + y * c);
+                or[k][l] = a;
+                oim[k][l] = b;
+                w[l] += tr[k][l] * a - ti[k][l] * b;
+                d[l] += dr[k][l] * a - di[k][l] * b;
+            }
+        }
+        if let (Some(&x), Some(&y)) = (qr1.first(), qi1.first()) {
+            let (c, s) = (fr1[0], fi1[0]);
+            let (a, b) = (x * c - y * s, x * s + y * c);
+            or1[0] = a;
+            oi1[0] = b;
+            w[0] += tr1[0] * a - ti1[0] * b;
+            d[0] += dr1[0] * a - di1[0] * b;
+        }
+        (w[0] + w[1], d[0] + d[1])
     }
 
     /// Σ_k w_k |c̃ᵀv_k| |λ_k|² |q_k|: bounds |W_hom''| for all later times (Re λ_k ≤ 0).

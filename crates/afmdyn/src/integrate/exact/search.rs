@@ -117,6 +117,47 @@ pub(super) fn certified_positive(ga: f64, da: f64, gb: f64, db: f64, b: f64, len
     gb > 0.0 && parabola_root(ga, da, b) + parabola_root(gb, -db, b) > len
 }
 
+/// The gap g = σ V_T + dead and its rate g′ = σ dV_T/dτ at the start (`ga`, `da`) and the end
+/// (`gb`, `db`) of a step, from (V_T, dV_T/dτ) at both ends and the guard sign σ of the region.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct StepEnds {
+    pub(super) ga: f64,
+    pub(super) da: f64,
+    pub(super) gb: f64,
+    pub(super) db: f64,
+    /// The step starts at a switching (`just_switched`), or on the sample within the dead band
+    /// (g(a) ≤ 0); g(a) is then taken as 0.
+    pub(super) switched: bool,
+}
+
+impl StepEnds {
+    pub(super) fn new(
+        sigma: f64,
+        dead: f64,
+        (va, vda): (f64, f64),
+        (vb, vdb): (f64, f64),
+        just_switched: bool,
+    ) -> StepEnds {
+        let mut ga = sigma * va + dead;
+        let switched = just_switched || ga <= 0.0;
+        if switched {
+            ga = ga.max(0.0);
+        }
+        StepEnds {
+            ga,
+            da: sigma * vda,
+            gb: sigma * vb + dead,
+            db: sigma * vdb,
+            switched,
+        }
+    }
+
+    /// [`certified_positive`] over a step of `len` with curvature bound `curv`.
+    pub(super) fn certified(&self, curv: f64, len: f64) -> bool {
+        certified_positive(self.ga, self.da, self.gb, self.db, curv, len)
+    }
+}
+
 pub(super) struct Search<'a> {
     pub(super) poly: &'a TipPoly,
 }
