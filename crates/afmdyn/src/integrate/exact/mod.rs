@@ -22,8 +22,9 @@
 //! **Switching detection** on the gap g = ±V_T (eq. 8; + in region I, − in region II) is rigorous:
 //! in energy coordinates the homogeneous flow does not increase ‖y‖ (Ã + Ãᵀ ⪯ 0 since C ⪰ 0),
 //! so |g''| ≤ ‖Ãᵀ² c̃‖ ‖y(τ_entry)‖ + Ω²|V_p| bounds the curvature over the stint. A step is
-//! accepted without search when the two parabolas g(a) + g'(a)s − Bs²/2 and
-//! g(b) − g'(b)s − Bs²/2 prove g > 0 over it; otherwise the tip motion in the step is expanded as
+//! accepted without search when g(a) + min(g'(a), 0) len − B len²/2 > 0 (the lower parabola from
+//! a stays positive: most steps away from the sample, with no square root), or when the two
+//! parabolas g(a) + g'(a)s − Bs²/2 and g(b) − g'(b)s − Bs²/2 prove g > 0 over it; otherwise the tip motion in the step is expanded as
 //! a power series (moments c̃ᵀÃⁿy), the bound is tightened, and a pruned bisection finds the
 //! *leftmost* zero — also a dip below V_T = 0 that returns between two grid points (grazing) —
 //! which a safeguarded Newton iteration polishes to round-off.
