@@ -132,10 +132,18 @@ fn dense_grid_step(
     }
     y.copy_from_slice(zk1);
     kernel(phi, dz, y);
-    let n = dim / 2;
+    tip_v_t(model, y, trig)
+}
+
+/// [V_T, dV_T/dτ] (eq. 8) of a plain state `z: [f64; 2N]` as (a, ȧ) at a time with
+/// (sin Ωτ, cos Ωτ) = `sc`: the tip deflection and rate Σ a_j φ_j(1), Σ ȧ_j φ_j(1) (as
+/// [`CantileverModel::w_tip`]), then [`CantileverModel::v_t_at`].
+#[inline(always)]
+fn tip_v_t(model: &CantileverModel, z: &[f64], sc: (f64, f64)) -> (f64, f64) {
+    let n = z.len() / 2;
     let tip = model.tip().as_slice();
     let dot = |x: &[f64]| tip.iter().zip(x).map(|(a, b)| a * b).sum::<f64>();
-    let [v, vd, _] = model.v_t_at(trig, [dot(&y[..n]), dot(&y[n..]), 0.0]);
+    let [v, vd, _] = model.v_t_at(sc, [dot(&z[..n]), dot(&z[n..]), 0.0]);
     (v, vd)
 }
 
@@ -378,6 +386,8 @@ pub struct ExactPropagator {
     poly_built: bool,
     /// V_T and dV_T/dτ at the current state.
     vt: (f64, f64),
+    /// τ of the last switching or reset and (sin Ωτ, cos Ωτ) there (the start of the next step).
+    entry_trig: (f64, (f64, f64)),
     /// Round-off dead band of the switching test: a region is left when V_T passes 0 by more
     /// than this (1e-15 of the displacement scale). A tip resting on the sample with zero force
     /// (V_T = V̇_T = 0, e.g. α2 = α5 = 0 from rest) then stays put instead of chattering; a real
@@ -626,6 +636,7 @@ impl ExactPropagator {
             poly: Box::new(TipPoly::empty()),
             poly_built: false,
             vt: (0.0, 0.0),
+            entry_trig: (f64::NAN, (0.0, 1.0)),
             dead,
             trig,
             zb: zero,
@@ -759,7 +770,11 @@ impl ExactPropagator {
     }
 
     fn zp_into(f: &Forced, omega: f64, tau: f64, out: &mut [f64]) {
-        let (s, c) = (omega * tau).sin_cos();
+        Self::zp_at(f, (omega * tau).sin_cos(), out);
+    }
+
+    /// z_p(τ) into `out`, given (sin Ωτ, cos Ωτ).
+    fn zp_at(f: &Forced, (s, c): (f64, f64), out: &mut [f64]) {
         let (p0, ps, pc) = (f.p0.as_slice(), f.ps.as_slice(), f.pc.as_slice());
         for (((o, a), b), d) in out.iter_mut().zip(p0).zip(ps).zip(pc) {
             *o = a + s * b + c * d;
@@ -803,14 +818,15 @@ impl ExactPropagator {
 
     /// State at local time t of the last step, in plain coordinates.
     fn state_in_last(&self, t: f64, out: &mut [f64]) {
+        let sc = (self.model.omega() * (self.last.tau0 + t)).sin_cos();
+        self.state_in_last_at(t, sc, out);
+    }
+
+    /// [`Self::state_in_last`] given `sc` = (sin Ωτ, cos Ωτ) at τ = τ0 + t.
+    fn state_in_last_at(&self, t: f64, sc: (f64, f64), out: &mut [f64]) {
         let ri = self.last.region.index();
         let sp = &self.spec[ri];
-        Self::zp_into(
-            &self.forced[ri],
-            self.model.omega(),
-            self.last.tau0 + t,
-            out,
-        );
+        Self::zp_at(&self.forced[ri], sc, out);
         if let Some(me) = &sp.modal {
             // modal coordinates at τ0 (kept by a modal step, projected from δz by a dense one),
             // advanced by e^{Λt}
@@ -1010,13 +1026,14 @@ impl ExactPropagator {
     /// smaller of the energy bound ‖c̃ᵀÃ²‖ ‖y‖ (‖e^{Ãt}‖₂ ≤ 1) and, with the eigendecomposition
     /// y(t) = Σ v_k e^{λ_k t} q_k, the modal bound Σ |c̃ᵀv_k| |λ_k|² |q_k| (Re λ_k ≤ 0) — and,
     /// in a modal region, the modal coordinates q of the homogeneous part.
-    fn enter_stint(&mut self, region: Region, tau: f64) {
+    /// `sc` = (sin Ωτ, cos Ωτ) at the entry time τ.
+    fn enter_stint(&mut self, region: Region, sc: (f64, f64)) {
         let ri = region.index();
         let sp = &self.spec[ri];
         let dim = self.z.len();
         let (mut dz, mut y) = ([0.0; MAXD], [0.0; MAXD]);
         let (dz, y) = (&mut dz[..dim], &mut y[..dim]);
-        Self::zp_into(&self.forced[ri], self.model.omega(), tau, dz);
+        Self::zp_at(&self.forced[ri], sc, dz);
         for (d, z) in dz.iter_mut().zip(self.z.as_slice()) {
             *d = z - *d;
         }
@@ -1245,14 +1262,26 @@ impl ExactPropagator {
                 self.zb.as_mut_slice(),
             ),
             _ => {
+                // sin, cos at τ0 kept from the switching or reset there; at τ_b once (τ0 + len
+                // is τ_b but for rounding, when τ_b > 2τ0)
+                let sc0 = match self.entry_trig {
+                    (tau, sc) if tau == tau0 => sc,
+                    _ => (omega * tau0).sin_cos(),
+                };
                 let dz0 = self.last.dz0.as_mut_slice();
-                Self::zp_into(fr, omega, tau0, dz0);
+                Self::zp_at(fr, sc0, dz0);
                 for (d, z) in dz0.iter_mut().zip(self.z.as_slice()) {
                     *d = z - *d;
                 }
+                let sc_b = (omega * tau_b).sin_cos();
+                let sc_end = if tau0 + len == tau_b {
+                    sc_b
+                } else {
+                    (omega * (tau0 + len)).sin_cos()
+                };
                 let mut zb = std::mem::take(&mut self.zb);
-                self.state_in_last(len, zb.as_mut_slice());
-                let v = (self.model.v_t(tau_b, &zb), self.model.v_t_dot(tau_b, &zb));
+                self.state_in_last_at(len, sc_end, zb.as_mut_slice());
+                let v = tip_v_t(&self.model, zb.as_slice(), sc_b);
                 self.zb = zb;
                 v
             }
@@ -1332,21 +1361,20 @@ impl ExactPropagator {
                 })
             }
             Some(t) => {
+                let tau_s = tau0 + t;
+                let sc = (omega * tau_s).sin_cos();
                 let mut zs = std::mem::take(&mut self.z);
-                self.state_in_last(t, zs.as_mut_slice());
+                self.state_in_last_at(t, sc, zs.as_mut_slice());
                 self.z = zs;
                 self.stale = false;
-                let tau_s = tau0 + t;
                 let to = region.other();
                 self.tau = tau_s;
-                self.vt = (
-                    self.model.v_t(tau_s, &self.z),
-                    self.model.v_t_dot(tau_s, &self.z),
-                );
+                self.vt = tip_v_t(&self.model, self.z.as_slice(), sc);
                 self.region = to;
                 self.on_grid = None;
                 self.just_switched = true;
-                self.enter_stint(to, tau_s);
+                self.entry_trig = (tau_s, sc);
+                self.enter_stint(to, sc);
                 self.chatter.record(tau_s)?;
                 if !materialize {
                     return Ok(Step {
@@ -1389,7 +1417,9 @@ impl Integrator for ExactPropagator {
         let m = self.grid.m as i64;
         self.on_grid =
             (self.grid.tau(j) == tau).then_some((j.div_euclid(m), j.rem_euclid(m) as usize));
-        self.enter_stint(region, tau);
+        let sc = (self.model.omega() * tau).sin_cos();
+        self.entry_trig = (tau, sc);
+        self.enter_stint(region, sc);
         self.just_switched = true;
         self.chatter.clear();
         self.last.tau0 = tau;
@@ -1400,7 +1430,7 @@ impl Integrator for ExactPropagator {
         self.last.full = false;
         self.poly_built = false;
         self.param_end = None;
-        self.vt = (self.model.v_t(tau, &z), self.model.v_t_dot(tau, &z));
+        self.vt = tip_v_t(&self.model, z.as_slice(), sc);
         Ok(())
     }
 
