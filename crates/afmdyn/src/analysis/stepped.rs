@@ -508,8 +508,8 @@ fn integrator_at(
     build(&model, spec.integrator, 0.0, z)
 }
 
-/// Halvings of a grid step tried by [`continue_orbit`] before the sweep falls back on the
-/// transient (at most 2^depth sub-steps).
+/// Halvings of a grid step tried by the sweep's orbit continuation (quasi-static sub-steps, see
+/// the module docs) before it falls back on the transient (at most 2^depth sub-steps).
 pub const SUBSTEP_DEPTH: usize = 8;
 
 /// Follow the stable period-n orbit `z0` at `v0` to `v1` by Newton (from the secant prediction

@@ -147,12 +147,11 @@ fn tip_v_t(model: &CantileverModel, z: &[f64], sc: (f64, f64)) -> (f64, f64) {
     (v, vd)
 }
 
-/// What a run of whole grid steps ([`ExactPropagator`]'s `grid_run`) needs besides the state:
-/// the grid and sin/cos Ωτ on it, the end time, and the certified test's guard sign σ, dead
-/// band and curvature bound.
+/// What a run of whole grid steps ([`ExactPropagator`]'s `grid_run`) needs besides the state
+/// and sin/cos Ωτ on the grid: the grid, the end time, and the certified test's guard sign σ,
+/// dead band and curvature bound.
 struct RunLimits {
     grid: PeriodGrid,
-    trig: Arc<[(f64, f64)]>,
     tau_end: f64,
     sigma: f64,
     dead: f64,
@@ -169,13 +168,15 @@ trait GridSteps {
 }
 
 impl RunLimits {
-    /// Whole grid steps from grid point `at` at (τ, (V_T, dV_T/dτ)) = (`tau`, `vt`), each
+    /// Whole grid steps from grid point `at` at (τ, (V_T, dV_T/dτ)) = (`tau`, `vt`) (`trig`:
+    /// sin/cos Ωτ on the grid of one period), each
     /// taken when it ends by `tau_end` and passes the certified test, up to the end of the
     /// current period; the step loop of `step_impl` for these steps, with the same t_grid
     /// ([`PeriodGrid::tau`]) and test. Returns the start time of the last step taken (`None`:
     /// none) and whether the run ended at the period end.
     fn run(
         &self,
+        trig: &[(f64, f64)],
         tau: &mut f64,
         vt: &mut (f64, f64),
         at: &mut (i64, usize),
@@ -194,7 +195,7 @@ impl RunLimits {
             if !(t_grid <= self.tau_end && len > 0.0) {
                 return (tau_last, false);
             }
-            let vt_b = steps.try_step(k, self.trig[k + 1]);
+            let vt_b = steps.try_step(k, trig[k + 1]);
             if !StepEnds::new(self.sigma, self.dead, *vt, vt_b, false).certified(self.curv, len) {
                 return (tau_last, false);
             }
@@ -211,15 +212,16 @@ impl RunLimits {
 }
 
 /// Dense whole grid steps ([`dense_grid_step`]): the state z and the step's end y swap on
-/// acceptance, as do the δz of the step tried and of the last step taken.
+/// acceptance, as do the δz of the step tried and of the last step taken (the propagator's own
+/// buffers: no copies, nothing to clear).
 struct DenseSteps<'a> {
     model: &'a CantileverModel,
     fr: &'a Forced,
     phi: (&'a [f64], MatVec),
     z: &'a mut DVector<f64>,
     zb: &'a mut DVector<f64>,
-    dz_try: &'a mut [f64],
-    dz_last: &'a mut [f64],
+    dz_try: &'a mut DVector<f64>,
+    dz_last: &'a mut DVector<f64>,
 }
 
 impl GridSteps for DenseSteps<'_> {
@@ -230,13 +232,13 @@ impl GridSteps for DenseSteps<'_> {
             self.phi,
             (k, trig),
             self.z.as_slice(),
-            self.dz_try,
+            self.dz_try.as_mut_slice(),
             self.zb.as_mut_slice(),
         )
     }
     fn accept(&mut self) {
         std::mem::swap(self.z, self.zb);
-        std::mem::swap(&mut self.dz_try, &mut self.dz_last);
+        std::mem::swap(self.dz_try, self.dz_last);
     }
 }
 
@@ -396,6 +398,8 @@ pub struct ExactPropagator {
     /// sin Ωτ_k and cos Ωτ_k on the grid of one period (k = 0..=m).
     trig: Arc<[(f64, f64)]>,
     zb: DVector<f64>,
+    /// δz of the step tried by a dense run (the other buffer is the last step's `dz0`).
+    dz_run: DVector<f64>,
     /// ∂z_p/∂p of both regions for the last parameter asked for
     /// ([`Integrator::last_step_param_derivative_into`]).
     param_data: Option<(SweepParam, Arc<[ParticularDerivative; 2]>)>,
@@ -639,7 +643,8 @@ impl ExactPropagator {
             entry_trig: (f64::NAN, (0.0, 1.0)),
             dead,
             trig,
-            zb: zero,
+            zb: zero.clone(),
+            dz_run: zero,
             param_data: None,
             param_end: None,
         })
@@ -1087,31 +1092,30 @@ impl ExactPropagator {
             ref phi,
             ref forced,
             kernel,
+            ref trig,
             ref mut tau,
             ref mut vt,
             ref mut z,
             ref mut zb,
+            ref mut dz_run,
             region,
             ref mut last,
             ..
         } = *self;
-        let (ri, dim) = (region.index(), z.len());
-        let fr = &forced[ri];
-        let (mut dz_a, mut dz_b) = ([0.0; MAXD], [0.0; MAXD]);
+        let ri = region.index();
         let mut steps = DenseSteps {
             model,
-            fr,
+            fr: &forced[ri],
             phi: (phi[ri].as_slice(), kernel),
             z,
             zb,
-            dz_try: &mut dz_a[..dim],
-            dz_last: &mut dz_b[..dim],
+            dz_try: dz_run,
+            dz_last: &mut last.dz0,
         };
-        let (ran, period_end) = limits.run(tau, vt, &mut at, &mut steps);
+        let (ran, period_end) = limits.run(trig, tau, vt, &mut at, &mut steps);
         let Some(tau0) = ran else {
             return false;
         };
-        last.dz0.as_mut_slice().copy_from_slice(steps.dz_last);
         self.finish_run(tau0, at, false);
         period_end
     }
@@ -1127,6 +1131,7 @@ impl ExactPropagator {
             ref model,
             ref spec,
             ref forced,
+            ref trig,
             ref mut tau,
             ref mut vt,
             ref mut q,
@@ -1147,7 +1152,7 @@ impl ExactPropagator {
             tried: &mut qb,
             prev: &mut qc,
         };
-        let (ran, period_end) = limits.run(tau, vt, &mut at, &mut steps);
+        let (ran, period_end) = limits.run(trig, tau, vt, &mut at, &mut steps);
         let Some(tau0) = ran else {
             return false;
         };
@@ -1161,7 +1166,6 @@ impl ExactPropagator {
     fn run_limits(&self, tau_end: f64) -> RunLimits {
         RunLimits {
             grid: self.grid,
-            trig: self.trig.clone(),
             tau_end,
             sigma: self.region.guard_sign(),
             dead: self.dead,
