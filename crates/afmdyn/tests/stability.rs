@@ -567,11 +567,61 @@ fn parameter_derivative_is_none_where_unsupported() {
     assert!(map.param_derivative.is_none());
 }
 
-/// The monodromy matrix from one transition matrix e^{A_s t} per stint between events
-/// ([`afmdyn::integrate::Integrator::region_transition_into`], taken without a parameter
-/// sensitivity) equals the product of the step Jacobians (taken with one), events included;
-/// and the region transition obeys the semigroup law e^{A(s+t)} = e^{As} e^{At} and equals the
-/// grid step's Φ_s at t = h.
+/// The exact propagator with its region transitions hidden: the monodromy flow then takes
+/// the per-step path (one step Jacobian and one parameter-derivative term per grid step) — the
+/// independent reference for the stint path.
+struct PerStep<'a>(&'a mut ExactPropagator);
+
+impl afmdyn::integrate::Integrator for PerStep<'_> {
+    fn model(&self) -> &afmdyn::CantileverModel {
+        self.0.model()
+    }
+    fn tau(&self) -> f64 {
+        self.0.tau()
+    }
+    fn state(&self) -> &DVector<f64> {
+        self.0.state()
+    }
+    fn region(&self) -> Region {
+        self.0.region()
+    }
+    fn reset(&mut self, tau: f64, z: &DVector<f64>) -> Result<(), afmdyn::SimError> {
+        self.0.reset(tau, z)
+    }
+    fn step(&mut self, tau_max: f64) -> Result<afmdyn::integrate::Step, afmdyn::SimError> {
+        self.0.step(tau_max)
+    }
+    fn dense_tip(&mut self, tau: f64) -> [f64; 3] {
+        self.0.dense_tip(tau)
+    }
+    fn dense_v_t(&mut self, tau: f64) -> [f64; 3] {
+        self.0.dense_v_t(tau)
+    }
+    fn dense_state(&mut self, tau: f64) -> DVector<f64> {
+        self.0.dense_state(tau)
+    }
+    fn last_step_jacobian(&mut self) -> Result<DMatrix<f64>, afmdyn::SimError> {
+        self.0.last_step_jacobian()
+    }
+    fn last_step_param_derivative_into(
+        &mut self,
+        param: SweepParam,
+        out: &mut DVector<f64>,
+    ) -> Result<bool, afmdyn::SimError> {
+        self.0.last_step_param_derivative_into(param, out)
+    }
+    fn name(&self) -> &'static str {
+        "exact, per step"
+    }
+}
+
+/// The monodromy matrix and the parameter sensitivity ∂Pⁿ/∂p from one transition matrix
+/// e^{A_s t} per stint between events ([`afmdyn::integrate::Integrator::region_transition_into`],
+/// the sensitivity telescoped over the stint with
+/// [`afmdyn::integrate::Integrator::region_particular_param_derivative_into`]) equal the product
+/// of the step Jacobians and the per-step sensitivity terms, events included; and the region
+/// transition obeys the semigroup law e^{A(s+t)} = e^{As} e^{At} and equals the grid step's Φ_s
+/// at t = h.
 #[test]
 fn stint_transitions_equal_the_product_of_step_jacobians() {
     use afmdyn::integrate::Integrator;
@@ -586,19 +636,35 @@ fn stint_transitions_equal_the_product_of_step_jacobians() {
         assert!(
             it.has_region_transition(Region::Free) && it.has_region_transition(Region::Contact)
         );
-        let stints = stroboscopic(&mut it, &z, n).unwrap();
-        let steps = stroboscopic_with_param_derivative(&mut it, &z, n, SweepParam::Alpha2).unwrap();
-        assert!(stints.contacts >= 1, "N = {modes}, Ω = {omega}: no contact");
-        assert_eq!(stints.state, steps.state);
-        let err = (&stints.jacobian - &steps.jacobian).norm();
-        eprintln!(
-            "N = {modes}, Ω = {omega}, n = {n}: {err:.2e} (|M| = {:.2e})",
-            steps.jacobian.norm()
-        );
-        assert!(
-            err <= 1e-11 * steps.jacobian.norm(),
-            "N = {modes}, Ω = {omega}: {err:.2e}"
-        );
+        for param in [SweepParam::Omega, SweepParam::Alpha2, SweepParam::Alpha5] {
+            let stints = stroboscopic_with_param_derivative(&mut it, &z, n, param).unwrap();
+            let steps =
+                stroboscopic_with_param_derivative(&mut PerStep(&mut it), &z, n, param).unwrap();
+            let plain = stroboscopic(&mut it, &z, n).unwrap();
+            assert!(stints.contacts >= 1, "N = {modes}, Ω = {omega}: no contact");
+            assert_eq!(stints.state, steps.state);
+            assert_eq!(plain.jacobian, stints.jacobian);
+            let err = (&stints.jacobian - &steps.jacobian).norm();
+            let (ds, dp) = (
+                stints.param_derivative.unwrap(),
+                steps.param_derivative.unwrap(),
+            );
+            let err_p = (&ds - &dp).norm();
+            eprintln!(
+                "N = {modes}, Ω = {omega}, n = {n}, {param:?}: M {err:.2e} (|M| = {:.2e}), \
+                 ∂P/∂p {err_p:.2e} (|∂P/∂p| = {:.2e})",
+                steps.jacobian.norm(),
+                dp.norm()
+            );
+            assert!(
+                err <= 1e-11 * steps.jacobian.norm(),
+                "N = {modes}, Ω = {omega}: {err:.2e}"
+            );
+            assert!(
+                err_p <= 1e-10 * dp.norm(),
+                "N = {modes}, Ω = {omega}, {param:?}: {err_p:.2e}"
+            );
+        }
         for r in [Region::Free, Region::Contact] {
             let dim = m.dim();
             let e = |t: f64| {

@@ -90,7 +90,8 @@ fn flow(
         }
         None => DMatrix::identity(dim, dim),
     };
-    // parameter sensitivity, the step's ∂z/∂p and scratch
+    // parameter sensitivity, the step's ∂z/∂p (or ∂z_p/∂p at the open stint's start) and
+    // scratch
     let mut sens = DVector::zeros(dim);
     let (mut step_dp, mut tmp) = (DVector::zeros(dim), DVector::zeros(dim));
     let mut out = FlowMap {
@@ -116,23 +117,35 @@ fn flow(
         if len <= 0.0 && step.event.is_none() {
             continue;
         }
-        // without a parameter sensitivity (which needs every step), a stint in a region with
-        // a transition matrix for any duration (affine, [`Integrator::region_transition_into`])
-        // takes one Jacobian e^{A_r t} at its end instead of one product per step
-        if stint.is_none() && param.is_none() && integ.has_region_transition(step.region) {
-            stint = Some((step.region, step.tau0));
+        // a stint in a region with a transition matrix for any duration (affine,
+        // [`Integrator::region_transition_into`]) takes one Jacobian e^{A_r t} at its end
+        // instead of one product per step, and the parameter sensitivity telescopes over it
+        // ([`Integrator::region_particular_param_derivative_into`]: ∂z_p/∂p at its start now)
+        if stint.is_none() && integ.has_region_transition(step.region) {
+            let open = match param {
+                Some(p) => integ.region_particular_param_derivative_into(
+                    p,
+                    step.region,
+                    step.tau0,
+                    &mut step_dp,
+                )?,
+                None => true,
+            };
+            if open {
+                stint = Some((step.region, step.tau0));
+            }
         }
         if stint.is_none() {
             integ.last_step_jacobian_into(&mut step_jac)?;
             left_mul(&step_jac, &mut jac, &mut prod);
-        }
-        if let Some(p) = param {
-            if integ.last_step_param_derivative_into(p, &mut step_dp)? {
-                tmp.gemv(1.0, &step_jac, &sens, 0.0);
-                sens.copy_from(&tmp);
-                sens += &step_dp;
-            } else {
-                param = None;
+            if let Some(p) = param {
+                if integ.last_step_param_derivative_into(p, &mut step_dp)? {
+                    tmp.gemv(1.0, &step_jac, &sens, 0.0);
+                    sens.copy_from(&tmp);
+                    sens += &step_dp;
+                } else {
+                    param = None;
+                }
             }
         }
         if step.region == Region::Contact {
@@ -143,7 +156,13 @@ fn flow(
         }
         if let Some(e) = &step.event {
             if let Some((r, t0)) = stint.take() {
-                close_stint(integ, r, e.tau - t0, &mut step_jac, &mut jac, &mut prod);
+                let t = e.tau - t0;
+                close_stint(integ, r, t, &mut step_jac, &mut jac, &mut prod);
+                if let Some(p) = param {
+                    close_stint_sensitivity(
+                        integ, p, r, e.tau, &step_jac, &mut sens, &step_dp, &mut tmp,
+                    )?;
+                }
             }
             // M ← S M and s ← S s + w ∂g/∂p, S = R + w ∇gᵀ applied as a rank-one update
             let salt = saltation_parts(integ.model(), e.from, e.tau, e.state.as_slice());
@@ -164,14 +183,11 @@ fn flow(
         }
     }
     if let Some((r, t0)) = stint.take() {
-        close_stint(
-            integ,
-            r,
-            integ.tau() - t0,
-            &mut step_jac,
-            &mut jac,
-            &mut prod,
-        );
+        let tau = integ.tau();
+        close_stint(integ, r, tau - t0, &mut step_jac, &mut jac, &mut prod);
+        if let Some(p) = param {
+            close_stint_sensitivity(integ, p, r, tau, &step_jac, &mut sens, &step_dp, &mut tmp)?;
+        }
     }
     out.state = integ.state().clone();
     out.param_derivative = param.map(|_| sens);
@@ -202,6 +218,28 @@ fn close_stint(
     let done = integ.region_transition_into(r, t, scratch);
     debug_assert!(done, "has_region_transition promised the transition");
     left_mul(scratch, m, prod);
+}
+
+/// s ← e^{A_r t}(s − ∂z_p/∂p(τ0)) + ∂z_p/∂p(τ) at the end τ of a stint in region r that
+/// started at τ0 (see [`Integrator::region_particular_param_derivative_into`]): `phi` holds
+/// e^{A_r t} (from [`close_stint`]), `dzp0` ∂z_p/∂p(τ0); `tmp` is scratch.
+#[allow(clippy::too_many_arguments)]
+fn close_stint_sensitivity(
+    integ: &mut dyn Integrator,
+    p: SweepParam,
+    r: Region,
+    tau: f64,
+    phi: &DMatrix<f64>,
+    sens: &mut DVector<f64>,
+    dzp0: &DVector<f64>,
+    tmp: &mut DVector<f64>,
+) -> Result<(), SimError> {
+    *sens -= dzp0;
+    tmp.gemv(1.0, phi, sens, 0.0);
+    let done = integ.region_particular_param_derivative_into(p, r, tau, sens)?;
+    debug_assert!(done, "provided at the stint's start");
+    *sens += &*tmp;
+    Ok(())
 }
 
 /// Lower `nearest` to the distance to grazing within `step` (from `before`, the state at its

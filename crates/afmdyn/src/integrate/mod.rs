@@ -195,6 +195,28 @@ pub trait Integrator: Send {
         let _ = (param, out);
         Ok(false)
     }
+    /// ∂z_p/∂p(τ) of the periodic particular solution z_p of region `r` (eq. 10), written into
+    /// `out` (resized to `[2N]`), for a parameter p that enters the forcing only (Ω, α2, α5;
+    /// [`CantileverModel::forcing_derivative`]). In a region with a transition matrix
+    /// ([`Integrator::has_region_transition`]) the flow is z(τ) = z_p(τ) + e^{A_r t}(z(τ0) −
+    /// z_p(τ0)) with A_r independent of p, so over a whole stint the parameter sensitivity
+    /// telescopes to s(τ) = e^{A_r t}(s(τ0) − ∂z_p/∂p(τ0)) + ∂z_p/∂p(τ) — one product per stint
+    /// instead of one per step ([`crate::analysis::monodromy::flow_with_param_derivative`]).
+    /// `Ok(false)`, with `out` untouched, where the integrator does not provide it (the
+    /// default; the exact propagator provides it for Ω, α2 and α5).
+    ///
+    /// # Errors
+    /// As [`Integrator::last_step_param_derivative_into`].
+    fn region_particular_param_derivative_into(
+        &mut self,
+        param: SweepParam,
+        r: Region,
+        tau: f64,
+        out: &mut DVector<f64>,
+    ) -> Result<bool, SimError> {
+        let _ = (param, r, tau, out);
+        Ok(false)
+    }
     /// Integrate the variational equations along with the state (needed by
     /// [`Integrator::last_step_jacobian`] of the adaptive integrator; free for the exact one).
     fn set_variational(&mut self, on: bool) {

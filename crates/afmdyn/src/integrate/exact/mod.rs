@@ -757,6 +757,21 @@ impl ExactPropagator {
         Ok(Some(data))
     }
 
+    /// [`Self::particular_derivative`], with `out` resized to 2N when it is provided.
+    #[allow(clippy::type_complexity)]
+    fn particular_derivative_for(
+        &mut self,
+        param: SweepParam,
+        out: &mut DVector<f64>,
+    ) -> Result<Option<Arc<[ParticularDerivative; 2]>>, SimError> {
+        let d = self.particular_derivative(param)?;
+        let dim = self.z.len();
+        if d.is_some() && out.len() != dim {
+            *out = DVector::zeros(dim);
+        }
+        Ok(d)
+    }
+
     /// ∂z_p/∂p(τ) of one region (see [`ParticularDerivative`]) into `out`, given
     /// (sin Ωτ, cos Ωτ).
     fn zpp_into(
@@ -1493,13 +1508,10 @@ impl Integrator for ExactPropagator {
         param: SweepParam,
         out: &mut DVector<f64>,
     ) -> Result<bool, SimError> {
-        let Some(d) = self.particular_derivative(param)? else {
+        let Some(d) = self.particular_derivative_for(param, out)? else {
             return Ok(false);
         };
         let dim = self.z.len();
-        if out.len() != dim {
-            *out = DVector::zeros(dim);
-        }
         let (r, ta, tb) = (self.last.region, self.last.tau0, self.tau);
         let ri = r.index();
         let omega = self.model.omega();
@@ -1530,6 +1542,22 @@ impl Integrator for ExactPropagator {
             Self::hom_energy(sp, &y0[..dim], tb - ta, &mut yt[..dim]);
             matvec(&sp.tinv, &yt[..dim], out.as_mut_slice(), -1.0, true);
         }
+        Ok(true)
+    }
+
+    fn region_particular_param_derivative_into(
+        &mut self,
+        param: SweepParam,
+        r: Region,
+        tau: f64,
+        out: &mut DVector<f64>,
+    ) -> Result<bool, SimError> {
+        let Some(d) = self.particular_derivative_for(param, out)? else {
+            return Ok(false);
+        };
+        let ri = r.index();
+        let sc = (self.model.omega() * tau).sin_cos();
+        Self::zpp_into(&d[ri], &self.forced[ri], tau, sc, out.as_mut_slice());
         Ok(true)
     }
 
