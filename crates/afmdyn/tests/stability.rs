@@ -373,6 +373,26 @@ fn continuation_locates_the_period_doubling_near_omega_2_91() {
             < 1e-3,
         "μ = −1 at the located point"
     );
+    // the reported distance to grazing is the watched map's at the converged point (the
+    // corrector's iterates skip the grazing searches; the converged point's distance comes from
+    // the predicted last iterate or from one pass)
+    let mut checked = 0;
+    for b in br.iter().step_by(5) {
+        let m = model(Params {
+            omega: b.value,
+            ..base
+        });
+        let mut integ = build(&m, spec.integrator, 0.0, &m.rest()).unwrap();
+        let map = stroboscopic(integ.as_mut(), &b.section[0], 1).unwrap();
+        assert_eq!(
+            map.grazing_distance, b.grazing_distance,
+            "at Ω = {}",
+            b.value
+        );
+        assert!(b.grazing_distance.is_finite());
+        checked += 1;
+    }
+    assert!(checked >= 5, "{checked} points");
     // every located fold has a multiplier +1 and every period doubling one at −1
     let nearest = |b: &afmdyn::analysis::continuation::BranchPoint, target: f64| {
         b.multipliers

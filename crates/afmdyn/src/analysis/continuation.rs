@@ -12,7 +12,10 @@
 //! circle (Neimark–Sacker) and the number of switchings per cycle (grazing); each sign change
 //! is located by bisection on the arclength step.
 
-use super::monodromy::{flow_state, stroboscopic, stroboscopic_with_param_derivative, FlowMap};
+use super::monodromy::{
+    flow_state, grazing_distance, stroboscopic, stroboscopic_with_param_derivative,
+    stroboscopic_with_param_derivative_unwatched, FlowMap,
+};
 use super::shooting::{
     floquet_stability, section_points, shoot_with, Instability, ShootingOptions,
 };
@@ -148,10 +151,25 @@ impl Solver {
         Ok(self.cache[i].1.as_mut())
     }
 
-    /// Pⁿ(z) with its monodromy matrix and, where the integrator provides it, ∂Pⁿ/∂p.
-    fn map(&mut self, z: &DVector<f64>, p: f64) -> Result<FlowMap, SimError> {
+    /// Pⁿ(z) with its monodromy matrix and, where the integrator provides it, ∂Pⁿ/∂p; the
+    /// distance to grazing only when `watched` (else NaN).
+    fn map(&mut self, z: &DVector<f64>, p: f64, watched: bool) -> Result<FlowMap, SimError> {
         let (n, param) = (self.spec.period, self.spec.param);
-        stroboscopic_with_param_derivative(self.at(p)?, z, n, param)
+        let integ = self.at(p)?;
+        if watched {
+            stroboscopic_with_param_derivative(integ, z, n, param)
+        } else {
+            stroboscopic_with_param_derivative_unwatched(integ, z, n, param)
+        }
+    }
+
+    /// The distance to grazing of Pⁿ(z) (as the watched [`Solver::map`] reports it: the same
+    /// steps and searches).
+    fn grazing(&mut self, z: &DVector<f64>, p: f64) -> Result<f64, SimError> {
+        let n = self.spec.period as f64;
+        let integ = self.at(p)?;
+        let t = n * integ.model().period();
+        grazing_distance(integ, 0.0, z, t)
     }
 
     /// ∂Pⁿ/∂p at (z, p): that of `map` when known, else central differences.
@@ -222,15 +240,23 @@ impl Solver {
         let mut y = y_pred.clone();
         // ∂F/∂p of the previous iterate (central differences are not redone at convergence)
         let mut fp_prev: Option<DVector<f64>> = None;
+        // the iterates skip the grazing searches (a fifth of a map) except the one expected to
+        // converge, after a correction that Newton's quadratic rate makes the last; the
+        // converged point gets its distance to grazing from one pass otherwise
+        let mut last_delta = f64::INFINITY;
         for it in 0..10 {
             let (z, p) = (y.rows(0, dim).into_owned(), y[dim]);
-            let map = self.map(&z, p)?;
+            let watched = last_delta <= 1e-7 * (1.0 + y.norm());
+            let mut map = self.map(&z, p, watched)?;
             let f = &map.state - &z;
             let arc = t.dot(&(&y - y_pred));
             let res = f.norm();
             if res <= self.spec.newton.tol * (1.0 + z.norm())
                 && arc.abs() <= 1e-12 * (1.0 + y.norm())
             {
+                if !watched {
+                    map.grazing_distance = self.grazing(&z, p)?;
+                }
                 let fp = match (&map.param_derivative, fp_prev) {
                     (Some(d), _) => d.clone(),
                     (None, Some(fp)) => fp,
@@ -250,6 +276,7 @@ impl Solver {
                     iterations: it,
                     residual: res,
                 })?;
+            last_delta = delta.norm();
             y += delta;
             fp_prev = Some(fp);
             if !y.iter().all(|v| v.is_finite()) {
@@ -380,7 +407,7 @@ pub fn continue_branch(
     let dir = if spec.to >= spec.from { 1.0 } else { -1.0 };
     let mut t0 = DVector::zeros(dim + 1);
     t0[dim] = dir;
-    let map = solver.map(&orbit.state, spec.from)?;
+    let map = solver.map(&orbit.state, spec.from, true)?;
     let fp0 = solver.dp_of(&map, &orbit.state, spec.from)?;
     let mut t = Solver::tangent(&map.jacobian, &fp0, &t0)?;
     if t[dim] * dir < 0.0 {

@@ -354,8 +354,33 @@ pub fn stroboscopic_with_param_derivative(
     n: usize,
     param: SweepParam,
 ) -> Result<FlowMap, SimError> {
+    param_map(integ, z0, n, param, true)
+}
+
+/// [`stroboscopic_with_param_derivative`] without the distance to grazing
+/// ([`FlowMap::grazing_distance`] is NaN), for the iterates of a Newton corrector (as
+/// [`stroboscopic_unwatched`]).
+///
+/// # Errors
+/// As [`flow_with_jacobian`].
+pub fn stroboscopic_with_param_derivative_unwatched(
+    integ: &mut dyn Integrator,
+    z0: &DVector<f64>,
+    n: usize,
+    param: SweepParam,
+) -> Result<FlowMap, SimError> {
+    param_map(integ, z0, n, param, false)
+}
+
+fn param_map(
+    integ: &mut dyn Integrator,
+    z0: &DVector<f64>,
+    n: usize,
+    param: SweepParam,
+    grazing: bool,
+) -> Result<FlowMap, SimError> {
     let t = n as f64 * integ.model().period();
-    let mut map = flow_with_param_derivative(integ, 0.0, z0, t, param)?;
+    let mut map = flow(integ, 0.0, z0, t, Some(param), grazing)?;
     if let (Some(d), SweepParam::Omega) = (&mut map.param_derivative, param) {
         let mut f = DVector::zeros(z0.len());
         let m = integ.model();
