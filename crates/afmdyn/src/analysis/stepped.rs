@@ -928,3 +928,86 @@ pub fn is_fixed_point(
     let m = stroboscopic(integ.as_mut(), z, n)?;
     Ok((&m.state - z).norm() <= tol * (1.0 + z.norm()))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn request() -> CurveRequest {
+        CurveRequest {
+            from: None,
+            to: None,
+            step: None,
+            points: None,
+            branches: false,
+            tolerance: 1e-9,
+        }
+    }
+
+    fn out_of_range_name(e: SimError) -> &'static str {
+        match e {
+            SimError::OutOfRange { name, .. } => name,
+            other => panic!("not OutOfRange: {other:?}"),
+        }
+    }
+
+    /// The ends and the step are converted from the front end's unit (one dimensionless unit =
+    /// `unit`), missing ends take the command's default, a missing spacing the default count.
+    #[test]
+    fn curve_request_converts_units_and_takes_defaults() {
+        let unit = 2.5e-9;
+        assert_eq!(request().ends((1.0, 3.0), unit), (1.0, 3.0));
+        let r = CurveRequest {
+            from: Some(5e-9),
+            step: Some(1e-10),
+            ..request()
+        };
+        let (from, to) = r.ends((1.0, 3.0), unit);
+        assert_eq!((from, to), (5e-9 / unit, 3.0));
+        assert_eq!(r.spacing(unit).unwrap(), Spacing::Step(1e-10 / unit));
+        assert_eq!(
+            request().spacing(unit).unwrap(),
+            Spacing::Points(DEFAULT_CURVE_POINTS)
+        );
+        let r = CurveRequest {
+            points: Some(7),
+            ..request()
+        };
+        assert_eq!(r.spacing(unit).unwrap(), Spacing::Points(7));
+        // both a step and a count: refused, naming the step
+        let r = CurveRequest {
+            step: Some(1e-10),
+            points: Some(7),
+            ..request()
+        };
+        assert_eq!(out_of_range_name(r.spacing(unit).unwrap_err()), "step");
+    }
+
+    /// `configure` sets the tolerance and the branch option, refuses a tolerance outside
+    /// (0, 1e-3) and parameters invalid at an end of the grid, before any work.
+    #[test]
+    fn curve_request_configures_the_spec() {
+        let base = Params::default();
+        let spec = SteppedSpec::new(base, SweepParam::Omega, vec![2.0, 2.5, 3.0]);
+        let r = CurveRequest {
+            branches: true,
+            tolerance: 1e-8,
+            ..request()
+        };
+        let done = r.configure(spec.clone()).unwrap();
+        assert_eq!(done.integrator.tolerance, 1e-8);
+        assert!(done.branches);
+        assert_eq!(done.values, spec.values);
+        for tol in [0.0, -1e-9, 1e-3, f64::NAN, f64::INFINITY] {
+            let r = CurveRequest {
+                tolerance: tol,
+                ..request()
+            };
+            let e = r.configure(spec.clone()).unwrap_err();
+            assert_eq!(out_of_range_name(e), "tolerance", "tolerance {tol}");
+        }
+        // Ω ≤ 0 at the last value of the grid: a parameter error
+        let bad = SteppedSpec::new(base, SweepParam::Omega, vec![1.0, 0.0, -1.0]);
+        assert!(matches!(request().configure(bad), Err(SimError::Params(_))));
+    }
+}
