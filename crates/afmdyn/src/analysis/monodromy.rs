@@ -55,8 +55,10 @@ pub fn flow_with_jacobian(
 /// [`flow_with_jacobian`] with the parameter sensitivity s = ∂z(τ1)/∂p at fixed τ1 in
 /// [`FlowMap::param_derivative`]: s(τ0) = 0, s ← J s + ∂z(τ_b)/∂p|_{z(τ_a)} over each step
 /// (variational equation of the parameter, Hairer, Nørsett & Wanner, *Solving ODEs I*, §I.14)
-/// and s⁺ = S s⁻ + w ∂g/∂p at each event ([`crate::system::saltation_with_shift`]). `None` there
-/// when the integrator or the law does not provide it (then ∂z/∂p needs finite differences).
+/// — over a whole stint at once in an affine region
+/// ([`Integrator::region_particular_param_derivative_into`]) — and s⁺ = S s⁻ + w ∂g/∂p at each
+/// event ([`crate::system::saltation_with_shift`]). `None` there when the integrator or the law
+/// does not provide it (then ∂z/∂p needs finite differences).
 ///
 /// # Errors
 /// As [`flow_with_jacobian`].

@@ -24,8 +24,9 @@
 //! so |g''| ≤ ‖Ãᵀ² c̃‖ ‖y(τ_entry)‖ + Ω²|V_p| bounds the curvature over the stint. A step is
 //! accepted without search when g(a) + min(g'(a), 0) len − B len²/2 > 0 (the lower parabola from
 //! a stays positive: most steps away from the sample, with no square root), or when the two
-//! parabolas g(a) + g'(a)s − Bs²/2 and g(b) − g'(b)s − Bs²/2 prove g > 0 over it; otherwise the tip motion in the step is expanded as
-//! a power series (moments c̃ᵀÃⁿy), the bound is tightened, and a pruned bisection finds the
+//! parabolas g(a) + g'(a)s − Bs²/2 and g(b) − g'(b)s − Bs²/2 prove g > 0 over it; otherwise the
+//! tip motion in the step is expanded as a power series (moments c̃ᵀÃⁿy), the bound is
+//! tightened, and a pruned bisection finds the
 //! *leftmost* zero — also a dip below V_T = 0 that returns between two grid points (grazing) —
 //! which a safeguarded Newton iteration polishes to round-off.
 //!
@@ -168,12 +169,11 @@ trait GridSteps {
 }
 
 impl RunLimits {
-    /// Whole grid steps from grid point `at` at (τ, (V_T, dV_T/dτ)) = (`tau`, `vt`) (`trig`:
-    /// sin/cos Ωτ on the grid of one period), each
-    /// taken when it ends by `tau_end` and passes the certified test, up to the end of the
-    /// current period; the step loop of `step_impl` for these steps, with the same t_grid
-    /// ([`PeriodGrid::tau`]) and test. Returns the start time of the last step taken (`None`:
-    /// none) and whether the run ended at the period end.
+    /// Whole grid steps from grid point `at` at (τ, (V_T, dV_T/dτ)) = (`tau`, `vt`), each taken
+    /// when it ends by `tau_end` and passes the certified test, up to the end of the current
+    /// period (`trig`: sin/cos Ωτ on the grid of one period); the step loop of `step_impl` for
+    /// these steps, with the same t_grid ([`PeriodGrid::tau`]) and test. Returns the start time
+    /// of the last step taken (`None`: none) and whether the run ended at the period end.
     fn run(
         &self,
         trig: &[(f64, f64)],
