@@ -25,7 +25,8 @@ pub struct FlowMap {
     pub contacts: usize,
     /// Smallest |V_T| at a local extremum of V_T, and smallest |dV_T/dτ| at an event (scaled by
     /// 1/Ω): how close the trajectory is to grazing the sample. NaN from
-    /// [`stroboscopic_unwatched`], which does not search.
+    /// [`stroboscopic_unwatched`] and [`stroboscopic_with_param_derivative_unwatched`], which
+    /// do not search.
     pub grazing_distance: f64,
     /// Time spent in region II (contact, or sticking for the impact law).
     pub contact_time: f64,
@@ -34,7 +35,8 @@ pub struct FlowMap {
     /// of the product.
     pub log_volume: f64,
     /// ∂z(τ1)/∂p at fixed τ1, shape `[2N]`, when asked for ([`flow_with_param_derivative`]) and
-    /// the integrator provides it ([`Integrator::last_step_param_derivative_into`]); else `None`.
+    /// the integrator provides it ([`Integrator::last_step_param_derivative_into`] per step,
+    /// [`Integrator::region_particular_param_derivative_into`] per stint); else `None`.
     pub param_derivative: Option<DVector<f64>>,
 }
 

@@ -708,12 +708,27 @@ impl ExactPropagator {
     /// Jacobian ∂z(τ1)/∂z(τ0) of the flow over the last step [τ0, τ1] inside its region
     /// (without the saltation at a switching that ends it), 2N×2N: Φ_s or e^{A_s t}.
     pub fn step_transition(&self) -> DMatrix<f64> {
-        let len = self.tau - self.last.tau0;
-        // a whole grid step that ended on the grid (a switching would have cut it short)
-        if self.last.full && self.on_grid.is_some() {
-            return self.phi[self.last.region.index()].clone();
-        }
-        self.transition(self.last.region, len)
+        let dim = self.z.len();
+        let mut out = DMatrix::zeros(dim, dim);
+        self.step_transition_into(&mut out);
+        out
+    }
+
+    /// [`ExactPropagator::step_transition`] into `out` (resized to 2N×2N if needed): the
+    /// cached Φ_s after a whole grid step, without allocating.
+    fn step_transition_into(&self, out: &mut DMatrix<f64>) {
+        let len = if self.last_was_grid_step() {
+            self.grid.h
+        } else {
+            self.tau - self.last.tau0
+        };
+        self.transition_into(self.last.region, len, out);
+    }
+
+    /// Whether the last step was a whole grid step that ended on the grid (a switching would
+    /// have cut it short): its transition matrix is Φ_s.
+    fn last_was_grid_step(&self) -> bool {
+        self.last.full && self.on_grid.is_some()
     }
 
     /// ∂z_p/∂p of both regions for `param` (cached for the last parameter); `None` for a
@@ -1009,8 +1024,7 @@ impl ExactPropagator {
         out.terms = terms;
         out.wp = fr.wp;
         out.omega = p.omega;
-        out.base_amp = base_amp(p);
-        out.alpha5 = p.alpha5;
+        out.cycle = cycle;
         out.sigma = r.guard_sign();
         out.dead = dead;
         out.curv = curv;
@@ -1534,7 +1548,7 @@ impl Integrator for ExactPropagator {
         end.2[..dim].copy_from_slice(out.as_slice());
         // out −= e^{A t} xa: Φ_s after a whole grid step, else T⁻¹ e^{Ã t} T xa
         let sp = &self.spec[ri];
-        if self.last.full && self.on_grid.is_some() {
+        if self.last_was_grid_step() {
             matvec(&self.phi[ri], xa, out.as_mut_slice(), -1.0, true);
         } else {
             let (mut y0, mut yt) = ([0.0; MAXD], [0.0; MAXD]);
@@ -1580,13 +1594,7 @@ impl Integrator for ExactPropagator {
     }
 
     fn last_step_jacobian_into(&mut self, out: &mut DMatrix<f64>) -> Result<(), SimError> {
-        // as step_transition, without allocating: the cached Φ_s after a whole grid step
-        let r = self.last.region;
-        if self.last.full && self.on_grid.is_some() {
-            self.transition_into(r, self.grid.h, out);
-        } else {
-            self.transition_into(r, self.tau - self.last.tau0, out);
-        }
+        self.step_transition_into(out);
         Ok(())
     }
 }

@@ -22,9 +22,9 @@ pub(super) struct TipPoly {
     pub(super) terms: usize,
     pub(super) wp: [f64; 3],
     pub(super) omega: f64,
-    /// Base-drive amplitude of V_T (α2 for the beam).
-    pub(super) base_amp: f64,
-    pub(super) alpha5: f64,
+    /// The harmonic part a_s sin Ωτ + a_c cos Ωτ of V_T (W_p plus the base drive) and its
+    /// derivatives at τ0 without their factors Ωⁿ: the n-th derivative is Ωⁿ cycle[n mod 4].
+    pub(super) cycle: [f64; 4],
     pub(super) sigma: f64,
     /// Dead band added to the gap (see [`super::ExactPropagator`]'s `dead`).
     pub(super) dead: f64,
@@ -44,8 +44,7 @@ impl TipPoly {
             terms: 1,
             wp: [0.0; 3],
             omega: 0.0,
-            base_amp: 0.0,
-            alpha5: 0.0,
+            cycle: [0.0; 4],
             sigma: 1.0,
             dead: 0.0,
             curv: 0.0,
@@ -67,17 +66,13 @@ impl TipPoly {
     }
     /// [V_T, dV_T/dτ, d²V_T/dτ²] at local time t: three Horner sums, no sine (the harmonic
     /// part is in the coefficients; those of V_T'' are formed on the first call, as `gc` by the
-    /// propagator's `build_poly`: cᵢ[2] plus the n-th derivative Ωⁿ⁺² (S, C, −S, −C)[(n+2) mod 4]
-    /// of the harmonic part at τ0).
+    /// propagator's `build_poly`: cᵢ[2] plus the n-th derivative Ωⁿ⁺² `cycle`[(n+2) mod 4] of
+    /// the harmonic part at τ0).
     pub(super) fn v_t(&mut self, t: f64) -> [f64; 3] {
         if !self.gc2_ready {
-            let (s0, c0) = (self.omega * self.tau0).sin_cos();
-            let (a_s, a_c) = (self.wp[1] + self.base_amp, self.wp[2]);
-            let (sv, sd) = (a_s * s0 + a_c * c0, a_s * c0 - a_c * s0);
-            let cycle = [sv, sd, -sv, -sd];
             let mut om_n = self.omega * self.omega;
             for n in 0..self.terms {
-                self.gc2[n] = self.c[2][n] + om_n * cycle[(n + 2) % 4] * super::INV_FACT[n];
+                self.gc2[n] = self.c[2][n] + om_n * self.cycle[(n + 2) % 4] * super::INV_FACT[n];
                 om_n *= self.omega;
             }
             self.gc2_ready = true;
