@@ -1265,7 +1265,7 @@ impl ExactPropagator {
                     me.factors(len, &mut self.fac_tmp);
                     &self.fac_tmp
                 };
-                self.last.q0 = self.q;
+                self.last.q0.copy_prefix(&self.q, me.len());
                 let (w, wd) = me.advance_into(&self.last.q0, fac, &mut self.q);
                 let (s, c) = if full {
                     self.trig[k + 1]

@@ -45,6 +45,12 @@ impl Modes {
         m
     }
 
+    /// self ← other over the first r entries (the rest is not read by anyone).
+    pub(super) fn copy_prefix(&mut self, other: &Modes, r: usize) {
+        self.re[..r].copy_from_slice(&other.re[..r]);
+        self.im[..r].copy_from_slice(&other.im[..r]);
+    }
+
     /// self ← self ⊙ other elementwise over the first r entries.
     pub(super) fn mul_assign(&mut self, other: &Modes, r: usize) {
         let (re, im) = (&mut self.re[..r], &mut self.im[..r]);
