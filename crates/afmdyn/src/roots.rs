@@ -27,6 +27,8 @@ pub fn safeguarded_newton(
     if !(t >= lo && t <= hi) {
         t = 0.5 * (lo + hi);
     }
+    // the last Newton correction taken (None after a bisection)
+    let mut prev_step: Option<f64> = None;
     for _ in 0..100 {
         let (v, d) = g(t);
         if v > 0.0 {
@@ -34,13 +36,30 @@ pub fn safeguarded_newton(
         } else {
             hi = t;
         }
-        let mut next = if d != 0.0 { t - v / d } else { f64::NAN };
-        if !(next > lo && next < hi) {
-            next = 0.5 * (lo + hi);
-        }
         let scale = 1.0 + (offset + t).abs();
-        let done =
-            (next - t).abs() <= 2.0 * f64::EPSILON * scale || hi - lo <= 4.0 * f64::EPSILON * scale;
+        let tol = 2.0 * f64::EPSILON * scale;
+        let newton = if d != 0.0 { t - v / d } else { f64::NAN };
+        // a Newton correction at round-off ends the iteration wherever it lands: converging
+        // from one side, it can land on (or just past) the end of the bracket that the
+        // iterates themselves moved, and a bisection from there would start over from the
+        // far end
+        let step = (newton - t).abs();
+        if step <= tol {
+            t = newton;
+            break;
+        }
+        let inside = newton > lo && newton < hi;
+        // quadratic convergence: δ_{k+1} ≈ C δ_k² with C ≈ δ_k/δ_{k−1}², so the correction
+        // after this one is about δ_k³/δ_{k−1}²; when that is below round-off, this Newton
+        // step is the last one and needs no evaluation to confirm it
+        if inside && prev_step.is_some_and(|p| step < p && step * step * step <= 0.25 * tol * p * p)
+        {
+            t = newton;
+            break;
+        }
+        prev_step = inside.then_some(step);
+        let next = if inside { newton } else { 0.5 * (lo + hi) };
+        let done = (next - t).abs() <= tol || hi - lo <= 2.0 * tol;
         t = next;
         if done {
             break;
