@@ -72,7 +72,7 @@ fn paths(c: &mut Criterion) {
     g.throughput(Throughput::Elements(PERIODS as u64));
     for n in [3usize, 10] {
         let (m, t0, z0, t1) = on_attractor(n);
-        for (name, propagation) in [("dense", Propagation::Dense), ("modal", Propagation::Modal)] {
+        for (name, propagation) in [("dense", Propagation::Dense), ("modal", Propagation::Auto)] {
             let opts = ExactOptions {
                 propagation,
                 ..ExactOptions::default()

@@ -278,7 +278,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut it = build(&m, IntegratorOptions::default(), 0.0, &m.rest())?;
     let forced = match std::env::var("PROPAGATION").as_deref() {
         Ok("dense") => Some(Propagation::Dense),
-        Ok("modal") => Some(Propagation::Modal),
+        Ok("modal") => Some(Propagation::Auto),
         _ => None,
     };
     if let Some(propagation) = forced {

@@ -79,13 +79,14 @@ fn check(p: &Params, propagation: Propagation, lanes: usize, off_grid: bool) -> 
 
 #[test]
 fn batch_equals_lanes_alone_dense_fixed_kernel() {
-    let n = check(&Params::default(), Propagation::Auto, 9, false);
+    let n = check(&Params::default(), Propagation::Dense, 9, false);
     assert!(n > 0);
 }
 
 #[test]
 fn batch_equals_lanes_alone_from_off_grid_starts() {
     check(&Params::default(), Propagation::Auto, 7, true);
+    check(&Params::default(), Propagation::Dense, 5, true);
 }
 
 #[test]
@@ -95,7 +96,8 @@ fn batch_equals_lanes_alone_modal() {
         ..Params::default()
     };
     check(&p, Propagation::Auto, 6, false);
-    check(&p, Propagation::Modal, 5, true);
+    check(&p, Propagation::Auto, 5, true);
+    check(&Params::default(), Propagation::Auto, 6, false);
 }
 
 #[test]

@@ -63,7 +63,7 @@ fn compare_runs(
     ea.len()
 }
 
-/// Modal grid steps (N = 3 forced, N = 8 and 10 automatic) agree with the dense Φ_s path to
+/// Modal grid steps (N = 3, 8 and 10, the automatic choice) agree with the dense Φ_s path to
 /// 1e-12 over 40 periods of an impacting period-1 orbit: every switching and the final state.
 #[test]
 fn modal_path_agrees_with_the_dense_path() {
@@ -75,15 +75,7 @@ fn modal_path_agrees_with_the_dense_path() {
         };
         let m = CantileverModel::new(&p).unwrap();
         let mut dense = prop(&m, Propagation::Dense, false);
-        let mut modal = prop(
-            &m,
-            if modes > 6 {
-                Propagation::Auto
-            } else {
-                Propagation::Modal
-            },
-            false,
-        );
+        let mut modal = prop(&m, Propagation::Auto, false);
         assert_eq!(dense.modal_regions(), [false, false]);
         assert_eq!(modal.modal_regions(), [true, true], "N = {modes}");
         let events = compare_runs(&mut dense, &mut modal, &m.rest(), 40.0 * p.period(), 1e-12);
@@ -120,7 +112,7 @@ fn modal_path_finds_the_same_grazing_contact() {
         let m = CantileverModel::new(&p).unwrap();
         let z0 = harmonic_response(&m, Region::Free, 0.0);
         let mut dense = prop(&m, Propagation::Dense, false);
-        let mut modal = prop(&m, Propagation::Modal, false);
+        let mut modal = prop(&m, Propagation::Auto, false);
         assert!(modal.modal_regions()[0]);
         let events = compare_runs(&mut dense, &mut modal, &z0, 3.0 * p.period(), 1e-12);
         assert!(events >= 2, "N = {modes}: grazing contact missed");
@@ -139,7 +131,7 @@ fn ill_conditioned_basis_falls_back_to_dense() {
     };
     let m0 = CantileverModel::new(&p0).unwrap();
     assert_eq!(
-        prop(&m0, Propagation::Modal, false).modal_regions(),
+        prop(&m0, Propagation::Auto, false).modal_regions(),
         [true, true]
     );
     let g = m0.galerkin().region(Region::Free);
@@ -154,7 +146,7 @@ fn ill_conditioned_basis_falls_back_to_dense() {
     let a = &m.dynamics(Region::Free).a;
     let disc = (a[(1, 1)] * a[(1, 1)] + 4.0 * a[(1, 0)]) / (a[(1, 1)] * a[(1, 1)]);
     assert!(disc.abs() < 1e-12, "not critically damped: {disc:e}");
-    let mut modal = prop(&m, Propagation::Modal, false);
+    let mut modal = prop(&m, Propagation::Auto, false);
     assert_eq!(modal.modal_regions(), [false, true]);
     let mut dense = prop(&m, Propagation::Dense, false);
     compare_runs(&mut dense, &mut modal, &m.rest(), 20.0 * p.period(), 1e-12);
@@ -162,28 +154,33 @@ fn ill_conditioned_basis_falls_back_to_dense() {
 
 /// `advance` (the plain state formed only at events and at the end; whole grid steps that pass
 /// the certified test in one tight loop) reaches bit for bit the state of the observed step
-/// loop, on the modal path (N = 10) and the dense one (N = 3), on the chaotic attractor at
+/// loop, on the modal path (N = 3 and 10) and the dense one (N = 3), on the chaotic attractor at
 /// Ω = 2.6 — ending off the grid, on a grid point inside a period and at a period end; its last
 /// step (dense output, step Jacobian) is the step loop's, and the next steps continue
 /// identically.
 #[test]
 fn advance_equals_the_step_loop() {
-    for modes in [3usize, 10] {
+    for (modes, path) in [
+        (3usize, Propagation::Dense),
+        (3, Propagation::Auto),
+        (10, Propagation::Auto),
+    ] {
         let p = Params {
             modes,
             ..Params::default()
         };
         let m = CantileverModel::new(&p).unwrap();
-        let steps = prop(&m, Propagation::Auto, true).steps_per_period() as f64;
+        let steps = prop(&m, path, true).steps_per_period() as f64;
         for periods in [30.5, 30.0 + 7.0 / steps, 30.0] {
-            let mut a = prop(&m, Propagation::Auto, true);
-            let mut b = prop(&m, Propagation::Auto, true);
+            let mut a = prop(&m, path, true);
+            let mut b = prop(&m, path, true);
+            assert_eq!(a.modal_regions()[0], path == Propagation::Auto);
             a.reset(0.0, &m.rest()).unwrap();
             b.reset(0.0, &m.rest()).unwrap();
             let tau_end = periods * p.period();
             advance(&mut a, tau_end).unwrap();
             advance_dyn(&mut b, tau_end, &mut |_, _, _| Ok(())).unwrap();
-            let at = format!("N = {modes}, {periods} periods");
+            let at = format!("N = {modes}, {path:?}, {periods} periods");
             assert_eq!(a.tau(), b.tau(), "{at}");
             assert_eq!(a.region(), b.region(), "{at}");
             assert_eq!(a.state(), b.state(), "{at}");

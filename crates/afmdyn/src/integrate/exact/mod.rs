@@ -7,13 +7,13 @@
 //!
 //! **Grid.** The drive period T is split into m sub-steps h = T/m with ‖Ã_s‖₂ h ≤ θ, where
 //! Ã_s = T_s A_s T_s⁻¹ is A_s in energy coordinates y = (L_Kᵀ a, L_Mᵀ ȧ) (K_s = L_K L_Kᵀ,
-//! M = L_M L_Mᵀ). Φ_s = e^{A_s h} and z_p at the grid points are precomputed, so a step costs one
-//! 2N×2N matrix–vector product (`exact/kernel.rs`: fixed-size for N ≤ 6). Partial steps (after a
+//! M = L_M L_Mᵀ). Φ_s = e^{A_s h} and z_p at the grid points are precomputed, so a dense step costs
+//! one 2N×2N matrix–vector product (`exact/kernel.rs`: fixed-size for N ≤ 6). Partial steps (after a
 //! switching, to a requested time) use the eigendecomposition of Ã (`exact/modal.rs`) when it is
 //! well conditioned, else the Taylor series of e^{Ã t} y, which converges fast because ‖Ã t‖ ≤ θ.
 //!
-//! **Modal propagation** ([`Propagation`]). For N > 6, a region whose eigenvector basis is well
-//! conditioned keeps the homogeneous part in modal coordinates q = V⁻¹ T δz during a stint: a grid
+//! **Modal propagation** ([`Propagation`]). A region whose eigenvector basis is well
+//! conditioned (at any N) keeps the homogeneous part in modal coordinates q = V⁻¹ T δz during a stint: a grid
 //! step multiplies q by e^{Λh} (about N complex products) and evaluates the tip from q; the
 //! plain state z = z_p + T⁻¹ V q is formed only when asked for ([`Integrator::step`] returns it
 //! after every step, [`Integrator::advance_to`] only at events and at the end). The
@@ -61,24 +61,35 @@ use std::sync::Arc;
 /// Bound on ‖Ã‖₂ h for the grid step (radians of the fastest mode per step).
 pub const THETA: f64 = 4.0;
 /// Number of Taylor terms kept in partial steps and tip polynomials (‖Ãt‖ ≤ θ = 4:
-/// θ^41/41! ≈ 1e-25, below round-off even after the largest term, θ⁴/4! ≈ 11).
-const K: usize = 40;
+/// θ^40/40! ≈ 1.5e-24, below round-off even after the largest term, θ⁴/4! ≈ 11).
+const K: usize = 39;
+/// The K + 1 terms of a tip series in blocks of four (`build_poly`).
+const TERM_BLOCKS: usize = (K + 1) / 4;
+const _: () = assert!((K + 1).is_multiple_of(4));
 /// Switchings within [`CHATTER_WINDOW`] of τ that count as chattering.
 const CHATTER_COUNT: usize = 64;
 /// Time window of the chattering test.
 const CHATTER_WINDOW: f64 = 1e-9;
-/// Modal propagation is chosen automatically above this many modes (below it the fixed-size
-/// dense step is as fast and needs no change of coordinates).
-const MODAL_MIN_MODES: usize = 7;
 
-/// 1/n!, n = 0..=K.
-const INV_FACT: [f64; K + 1] = {
-    let mut f = [1.0; K + 1];
+/// 1/n!, n = 0..=K + 1.
+const INV_FACT: [f64; K + 2] = {
+    let mut f = [1.0; K + 2];
     let mut prod = 1.0;
     let mut n = 1;
-    while n <= K {
+    while n <= K + 1 {
         prod *= n as f64;
         f[n] = 1.0 / prod;
+        n += 1;
+    }
+    f
+};
+
+/// 1/n, n = 0..=K + 2 (entry 0 unused): the series' tail test without a division.
+const INV_INT: [f64; K + 3] = {
+    let mut f = [0.0; K + 3];
+    let mut n = 1;
+    while n <= K + 2 {
+        f[n] = 1.0 / n as f64;
         n += 1;
     }
     f
@@ -270,14 +281,13 @@ impl GridSteps for ModalSteps<'_> {
 /// How the grid steps of a region are propagated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Propagation {
-    /// Dense for N ≤ 6, modal above where the eigenvector basis is well conditioned (default).
+    /// Modal wherever the eigenvector basis is well conditioned (condition number ≤
+    /// [`MAX_MODAL_CONDITION`] and residual at round-off), dense elsewhere (default): the
+    /// faster path at every N measured, N = 1 included (`docs/performance.md`).
     #[default]
     Auto,
     /// Always the dense Φ_s (fixed-size kernel for N ≤ 6).
     Dense,
-    /// Modal wherever the eigenvector basis is well conditioned (condition number ≤
-    /// [`MAX_MODAL_CONDITION`] and residual at round-off), dense elsewhere.
-    Modal,
 }
 
 /// Build options of [`ExactPropagator::try_with`].
@@ -315,6 +325,9 @@ struct Forced {
     wp: [f64; 3],
     /// Ω² · amplitude of V_p (bound on |V_p''|).
     vp_curv: f64,
+    /// Ωⁿ/n! and Ωⁿ⁺¹/n!, n = 0..=K: the Taylor factors of the harmonic part of V_T and of
+    /// its rate (`build_poly`).
+    harm_fact: [[f64; K + 1]; 2],
     /// e^{λ_k h} of the modal representatives (empty without an eigendecomposition).
     grid_fac: Modes,
     /// LU of [[A, ΩI], [−ΩI, A]] (4N×4N), kept for the parameter derivatives of (ps, pc).
@@ -495,6 +508,13 @@ fn forced(
     if let Some(me) = &spec.modal {
         me.factors(h, &mut grid_fac);
     }
+    let mut harm_fact = [[0.0; K + 1]; 2];
+    let mut om_n = 1.0;
+    for n in 0..=K {
+        harm_fact[0][n] = om_n * INV_FACT[n];
+        harm_fact[1][n] = om_n * omega * INV_FACT[n];
+        om_n *= omega;
+    }
     Ok(Forced {
         p0,
         ps,
@@ -502,6 +522,7 @@ fn forced(
         zp_grid,
         wp,
         vp_curv,
+        harm_fact,
         grid_fac,
         harmonic_lu,
     })
@@ -596,12 +617,7 @@ impl ExactPropagator {
         )?;
         let (forced, trig) = (forcing.0.clone(), forcing.1.clone());
         let modal = std::array::from_fn(|i| {
-            spec[i].modal.is_some()
-                && match opts.propagation {
-                    Propagation::Auto => n >= MODAL_MIN_MODES,
-                    Propagation::Dense => false,
-                    Propagation::Modal => true,
-                }
+            spec[i].modal.is_some() && opts.propagation == Propagation::Auto
         });
         let p = model.params();
         let scale = forced
@@ -943,7 +959,10 @@ impl ExactPropagator {
     }
 
     /// Fill `out` with the tip series of a step of `len` in region `r` from the homogeneous
-    /// state `y0` (energy coordinates) at τ0.
+    /// state `y0` (energy coordinates) at τ0: the moments c̃ᵀÃⁿy0 (one product with the
+    /// precomputed rows), then the Taylor coefficients of g and g′ for every n ≤ K in one loop
+    /// without branches (the harmonic factors Ωⁿ/n! from [`Forced`]), then the number of terms
+    /// by the a priori tail bound (1/n! and 1/n from tables: no division until it passes).
     #[allow(clippy::too_many_arguments)]
     fn build_poly(
         sp: &Spectral,
@@ -956,59 +975,68 @@ impl ExactPropagator {
         len: f64,
         out: &mut TipPoly,
     ) {
-        let mut mo = [0.0; K + 3];
-        matvec(&sp.rows, y0, &mut mo, 1.0, false);
+        let mo = &mut out.mo;
+        matvec(&sp.rows, y0, mo, 1.0, false);
         // the harmonic part a_s sin(Ωτ0 + Ωt) + a_c cos(Ωτ0 + Ωt) + const of V_T: its n-th
         // t-derivative at 0 is Ωⁿ (S, C, −S, −C)[n mod 4]
         let (s0, c0) = (p.omega * tau0).sin_cos();
         let (a_s, a_c) = (fr.wp[1] + base_amp(p), fr.wp[2]);
         let (sv, sd) = (a_s * s0 + a_c * c0, a_s * c0 - a_c * s0);
         let cycle = [sv, sd, -sv, -sd];
-        let (om, mut om_n, mut lp) = (p.omega, 1.0, 1.0);
-        let mut curv = fr.vp_curv;
-        let mut size = [0.0; K + 1];
-        let mut biggest = 0.0f64;
-        let wp_sum = fr.wp.iter().map(|x| x.abs()).sum::<f64>();
+        let mut lp = [0.0; K + 1];
+        let mut l = 1.0;
+        for o in lp.iter_mut() {
+            *o = l;
+            l *= len;
+        }
+        // every term's coefficients, the size of its contribution over the step (sums rather
+        // than maxima: a bound as good, without NaN-aware max sequences) and its share of the
+        // bound on |g''|
+        let (mut size, mut curv_n) = ([0.0; K + 1], [0.0; K + 1]);
+        let [hf0, hf1] = &fr.harm_fact;
+        // in blocks of four terms, so that the harmonic cycle is the same in every block and
+        // the lanes are independent
+        let cyc1 = [sd, -sv, -sd, sv];
+        for j in 0..TERM_BLOCKS {
+            for i in 0..4 {
+                let n = 4 * j + i;
+                let f = INV_FACT[n];
+                let (c0n, c1n, c2n) = (mo[n] * f, mo[n + 1] * f, mo[n + 2] * f);
+                let g0 = c0n + hf0[n] * cycle[i];
+                let g1 = c1n + hf1[n] * cyc1[i];
+                out.gc[0][n] = g0;
+                out.gc[1][n] = g1;
+                curv_n[n] = c2n.abs() * lp[n];
+                size[n] = (c0n.abs() + c1n.abs() + c2n.abs() + g0.abs() + g1.abs()) * lp[n];
+            }
+        }
         // a priori bound on the coefficients beyond n: |c̃ᵀÃ^{n+d}y0| lenⁿ/n! ≤
         // ‖c̃‖‖y0‖ρ^{n+d} lenⁿ/n! and |harmonic| ≤ (|a_s| + |a_c|) Ω^{n+d} lenⁿ/n! (d ≤ 2), so
-        // with x = max(ρ, Ω) len every size below is ≤ bound xⁿ/n! and the tail from n on
+        // with x = max(ρ, Ω) len every size is ≤ bound xⁿ/n! and the tail from n on
         // ≤ bound xⁿ/n! / (1 − x/(n+1)): the series stop as soon as that is below round-off
+        // of the largest term so far
         let y_norm = y0.iter().map(|v| v * v).sum::<f64>().sqrt();
-        let (rho, amp) = (sp.rho, a_s.abs() + a_c.abs());
+        let (rho, om, amp) = (sp.rho, p.omega, a_s.abs() + a_c.abs());
         let bound =
             sp.ct_norm * y_norm * (1.0 + rho + rho * rho) * 3.0 + amp * (1.0 + om + om * om) * 2.0;
+        let wp_sum = fr.wp.iter().map(|x| x.abs()).sum::<f64>();
         let x = rho.max(om) * len;
-        let mut x_fact = 1.0;
-        let mut filled = K + 1;
-        for n in 0..=K {
-            let f = INV_FACT[n];
-            let (c0n, c1n, c2n) = (mo[n] * f, mo[n + 1] * f, mo[n + 2] * f);
-            let g0 = c0n + om_n * cycle[n % 4] * f;
-            let g1 = c1n + om_n * om * cycle[(n + 1) % 4] * f;
-            out.c[0][n] = c0n;
-            out.c[1][n] = c1n;
-            out.c[2][n] = c2n;
-            out.gc[0][n] = g0;
-            out.gc[1][n] = g1;
-            curv += c2n.abs() * lp;
-            // keep terms until the remaining tail of every series (homogeneous, and with the
-            // harmonic part) is below round-off over the step
-            // (sums rather than maxima: a bound as good, without NaN-aware max sequences)
-            size[n] = (c0n.abs() + c1n.abs() + c2n.abs() + g0.abs() + g1.abs()) * lp;
-            if size[n] > biggest {
-                biggest = size[n];
+        let (mut biggest, mut x_pow, mut filled, mut rest) = (0.0f64, x, K + 1, 0.0);
+        for (n, &sz) in size.iter().enumerate() {
+            if sz > biggest {
+                biggest = sz;
             }
-            om_n *= om;
-            lp *= len;
-            x_fact *= x / (n + 1) as f64;
-            let ratio = x / (n + 2) as f64;
-            let rest = bound * x_fact / (1.0 - ratio);
-            if ratio < 0.5 && rest <= 1e-18 * (biggest + wp_sum) {
+            // the tail from n + 1 on: bound xⁿ⁺¹/(n+1)! / (1 − x/(n+2))
+            let x_fact = x_pow * INV_FACT[n + 1];
+            let ratio = x * INV_INT[n + 2];
+            x_pow *= x;
+            if ratio < 0.5 && bound * x_fact <= 1e-18 * (biggest + wp_sum) * (1.0 - ratio) {
                 filled = n + 1;
-                curv += rest;
+                rest = bound * x_fact / (1.0 - ratio);
                 break;
             }
         }
+        let curv = curv_n[..filled].iter().fold(fr.vp_curv, |a, c| a + c) + rest;
         out.gc[0][0] += fr.wp[0] + p.alpha5;
         let scale = biggest + wp_sum;
         let mut terms = filled;

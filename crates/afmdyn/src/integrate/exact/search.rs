@@ -7,9 +7,10 @@ use super::K;
 #[derive(Debug, Clone)]
 pub(super) struct TipPoly {
     pub(super) tau0: f64,
-    /// mo[n] / n!, mo[n+1]/n!, mo[n+2]/n! for n = 0..=K.
-    pub(super) c: [[f64; K + 1]; 3],
-    /// Taylor coefficients of V_T and dV_T/dτ in local time: c[0], c[1] plus those of the
+    /// The moments mo[n] = c̃ᵀÃⁿy0, n = 0..=K + 2: the homogeneous tip deflection W_hom and its
+    /// first two derivatives have the Taylor coefficients mo[n + i] / n! (i = 0, 1, 2).
+    pub(super) mo: [f64; K + 3],
+    /// Taylor coefficients of V_T and dV_T/dτ in local time: mo[n]/n!, mo[n+1]/n! plus those of the
     /// harmonic part W_p + α2 sin Ωτ + α5 (whose n-th derivative cycles through ±Ωⁿ(S, C)), so
     /// that the gap costs two Horner sums and no sine.
     pub(super) gc: [[f64; K + 1]; 2],
@@ -37,7 +38,7 @@ impl TipPoly {
     pub(super) fn empty() -> Self {
         TipPoly {
             tau0: 0.0,
-            c: [[0.0; K + 1]; 3],
+            mo: [0.0; K + 3],
             gc: [[0.0; K + 1]; 2],
             gc2: [0.0; K + 1],
             gc2_ready: false,
@@ -50,8 +51,31 @@ impl TipPoly {
             curv: 0.0,
         }
     }
+    /// Σ cₙ tⁿ as Σ_{i<4} tⁱ Pᵢ(t⁴), the coefficients n ≡ i (mod 4) in four independent
+    /// Horner chains (Estrin's splitting, Knuth, *TAOCP* vol. 2, §4.6.4): a quarter of the
+    /// latency of one chain over all the terms, which bounds the search's evaluations.
+    #[inline]
     fn horner(c: &[f64], t: f64) -> f64 {
-        c.iter().rev().fold(0.0, |acc, &x| acc * t + x)
+        let t2 = t * t;
+        let t4 = t2 * t2;
+        let (quads, rest) = c.as_chunks::<4>();
+        // the top (len mod 4) coefficients start the chains
+        let mut p = [0.0; 4];
+        p[..rest.len()].copy_from_slice(rest);
+        for q in quads.iter().rev() {
+            for (pi, &ci) in p.iter_mut().zip(q) {
+                *pi = *pi * t4 + ci;
+            }
+        }
+        (p[0] + t * p[1]) + t2 * (p[2] + t * p[3])
+    }
+    /// Σ mo[n + i] tⁿ/n! over the kept terms: the i-th derivative of W_hom at local time t.
+    fn hom(&self, i: usize, t: f64) -> f64 {
+        let mut c = [0.0; K + 1];
+        for (n, o) in c[..self.terms].iter_mut().enumerate() {
+            *o = self.mo[n + i] * super::INV_FACT[n];
+        }
+        Self::horner(&c[..self.terms], t)
     }
     /// [W, W', W''] of the tip at local time t.
     pub(super) fn w(&self, t: f64) -> [f64; 3] {
@@ -59,20 +83,21 @@ impl TipPoly {
         let (w0, ws, wc) = (self.wp[0], self.wp[1], self.wp[2]);
         let om = self.omega;
         [
-            Self::horner(&self.c[0][..self.terms], t) + w0 + ws * s + wc * c,
-            Self::horner(&self.c[1][..self.terms], t) + om * (ws * c - wc * s),
-            Self::horner(&self.c[2][..self.terms], t) - om * om * (ws * s + wc * c),
+            self.hom(0, t) + w0 + ws * s + wc * c,
+            self.hom(1, t) + om * (ws * c - wc * s),
+            self.hom(2, t) - om * om * (ws * s + wc * c),
         ]
     }
     /// [V_T, dV_T/dτ, d²V_T/dτ²] at local time t: three Horner sums, no sine (the harmonic
     /// part is in the coefficients; those of V_T'' are formed on the first call, as `gc` by the
-    /// propagator's `build_poly`: cᵢ[2] plus the n-th derivative Ωⁿ⁺² `cycle`[(n+2) mod 4] of
-    /// the harmonic part at τ0).
+    /// propagator's `build_poly`: mo[n + 2]/n! plus the n-th derivative Ωⁿ⁺² `cycle`[(n+2) mod 4]
+    /// of the harmonic part at τ0, over n!).
     pub(super) fn v_t(&mut self, t: f64) -> [f64; 3] {
         if !self.gc2_ready {
             let mut om_n = self.omega * self.omega;
             for n in 0..self.terms {
-                self.gc2[n] = self.c[2][n] + om_n * self.cycle[(n + 2) % 4] * super::INV_FACT[n];
+                let f = super::INV_FACT[n];
+                self.gc2[n] = self.mo[n + 2] * f + om_n * self.cycle[(n + 2) % 4] * f;
                 om_n *= self.omega;
             }
             self.gc2_ready = true;
