@@ -330,6 +330,9 @@ struct Forced {
     harm_fact: [[f64; K + 1]; 2],
     /// e^{λ_k h} of the modal representatives (empty without an eigendecomposition).
     grid_fac: Modes,
+    /// e^{λ_k h/2}: the modal coordinates at the middle of a grid step, where its tip series
+    /// is centred (`step_impl`).
+    half_fac: Modes,
     /// LU of [[A, ΩI], [−ΩI, A]] (4N×4N), kept for the parameter derivatives of (ps, pc).
     harmonic_lu: LU<f64, Dyn, Dyn>,
 }
@@ -504,9 +507,10 @@ fn forced(
         tip.dot(&pc.rows(0, n)),
     ];
     let vp_curv = omega * omega * (wp[1] + base_amp(model.params())).hypot(wp[2]);
-    let mut grid_fac = Modes::ZERO;
+    let (mut grid_fac, mut half_fac) = (Modes::ZERO, Modes::ZERO);
     if let Some(me) = &spec.modal {
         me.factors(h, &mut grid_fac);
+        me.factors(0.5 * h, &mut half_fac);
     }
     let mut harm_fact = [[0.0; K + 1]; 2];
     let mut om_n = 1.0;
@@ -524,6 +528,7 @@ fn forced(
         vp_curv,
         harm_fact,
         grid_fac,
+        half_fac,
         harmonic_lu,
     })
 }
@@ -958,8 +963,10 @@ impl ExactPropagator {
         self.poly_built = false;
     }
 
-    /// Fill `out` with the tip series of a step of `len` in region `r` from the homogeneous
-    /// state `y0` (energy coordinates) at τ0: the moments c̃ᵀÃⁿy0 (one product with the
+    /// Fill `out` with the tip series of a step [τ0, τ0 + len] in region `r`, centred at local
+    /// time `center`, from the homogeneous state `y0` (energy coordinates) at τ0 + center: the
+    /// series reaches |t − center| ≤ max(center, len − center), half the step when centred, so
+    /// the terms fall off twice as fast. The moments c̃ᵀÃⁿy0 (one product with the
     /// precomputed rows), then the Taylor coefficients of g and g′ for every n ≤ K in one loop
     /// without branches (the harmonic factors Ωⁿ/n! from [`Forced`]), then the number of terms
     /// by the a priori tail bound (1/n! and 1/n from tables: no division until it passes).
@@ -970,33 +977,44 @@ impl ExactPropagator {
         p: &Params,
         dead: f64,
         r: Region,
-        tau0: f64,
+        (tau0, center): (f64, f64),
         y0: &[f64],
         len: f64,
         out: &mut TipPoly,
     ) {
-        let mo = &mut out.mo;
-        matvec(&sp.rows, y0, mo, 1.0, false);
-        // the harmonic part a_s sin(Ωτ0 + Ωt) + a_c cos(Ωτ0 + Ωt) + const of V_T: its n-th
-        // t-derivative at 0 is Ωⁿ (S, C, −S, −C)[n mod 4]
-        let (s0, c0) = (p.omega * tau0).sin_cos();
+        let radius = center.max(len - center);
+        // the harmonic part a_s sin(Ωτc + Ωu) + a_c cos(Ωτc + Ωu) + const of V_T (τc = τ0 +
+        // center, u = t − center): its n-th u-derivative at 0 is Ωⁿ (S, C, −S, −C)[n mod 4]
+        let (s0, c0) = (p.omega * (tau0 + center)).sin_cos();
         let (a_s, a_c) = (fr.wp[1] + base_amp(p), fr.wp[2]);
         let (sv, sd) = (a_s * s0 + a_c * c0, a_s * c0 - a_c * s0);
-        let cycle = [sv, sd, -sv, -sd];
+        let (cycle, cyc1) = ([sv, sd, -sv, -sd], [sd, -sv, -sd, sv]);
+        // a priori bound on the coefficients beyond n: |c̃ᵀÃ^{n+d}y0| rⁿ/n! ≤
+        // ‖c̃‖‖y0‖ρ^{n+d} rⁿ/n! and |harmonic| ≤ (|a_s| + |a_c|) Ω^{n+d} rⁿ/n! (d ≤ 2, r the
+        // radius), so with x = max(ρ, Ω) r every size below is ≤ bound xⁿ/n! and the tail from
+        // n on ≤ bound xⁿ/n! / (1 − x/(n+1)): the series stop as soon as that is below
+        // round-off of the largest term so far
+        let y_norm = y0.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let (rho, om, amp) = (sp.rho, p.omega, a_s.abs() + a_c.abs());
+        let bound =
+            sp.ct_norm * y_norm * (1.0 + rho + rho * rho) * 3.0 + amp * (1.0 + om + om * om) * 2.0;
+        let wp_sum = fr.wp.iter().map(|x| x.abs()).sum::<f64>();
+        let x = rho.max(om) * radius;
+        let [hf0, hf1] = &fr.harm_fact;
+        // the moments c̃ᵀÃⁿy0
+        let mo = &mut out.mo;
+        matvec(&sp.rows, y0, mo, 1.0, false);
         let mut lp = [0.0; K + 1];
         let mut l = 1.0;
         for o in lp.iter_mut() {
             *o = l;
-            l *= len;
+            l *= radius;
         }
         // every term's coefficients, the size of its contribution over the step (sums rather
         // than maxima: a bound as good, without NaN-aware max sequences) and its share of the
-        // bound on |g''|
+        // bound on |g''|, in blocks of four terms, so that the harmonic cycle is the same in
+        // every block and the lanes are independent (no branch: the loop vectorizes)
         let (mut size, mut curv_n) = ([0.0; K + 1], [0.0; K + 1]);
-        let [hf0, hf1] = &fr.harm_fact;
-        // in blocks of four terms, so that the harmonic cycle is the same in every block and
-        // the lanes are independent
-        let cyc1 = [sd, -sv, -sd, sv];
         for j in 0..TERM_BLOCKS {
             for i in 0..4 {
                 let n = 4 * j + i;
@@ -1010,17 +1028,7 @@ impl ExactPropagator {
                 size[n] = (c0n.abs() + c1n.abs() + c2n.abs() + g0.abs() + g1.abs()) * lp[n];
             }
         }
-        // a priori bound on the coefficients beyond n: |c̃ᵀÃ^{n+d}y0| lenⁿ/n! ≤
-        // ‖c̃‖‖y0‖ρ^{n+d} lenⁿ/n! and |harmonic| ≤ (|a_s| + |a_c|) Ω^{n+d} lenⁿ/n! (d ≤ 2), so
-        // with x = max(ρ, Ω) len every size is ≤ bound xⁿ/n! and the tail from n on
-        // ≤ bound xⁿ/n! / (1 − x/(n+1)): the series stop as soon as that is below round-off
-        // of the largest term so far
-        let y_norm = y0.iter().map(|v| v * v).sum::<f64>().sqrt();
-        let (rho, om, amp) = (sp.rho, p.omega, a_s.abs() + a_c.abs());
-        let bound =
-            sp.ct_norm * y_norm * (1.0 + rho + rho * rho) * 3.0 + amp * (1.0 + om + om * om) * 2.0;
-        let wp_sum = fr.wp.iter().map(|x| x.abs()).sum::<f64>();
-        let x = rho.max(om) * len;
+        // the first n whose a priori tail is below round-off
         let (mut biggest, mut x_pow, mut filled, mut rest) = (0.0f64, x, K + 1, 0.0);
         for (n, &sz) in size.iter().enumerate() {
             if sz > biggest {
@@ -1049,6 +1057,7 @@ impl ExactPropagator {
             terms -= 1;
         }
         out.tau0 = tau0;
+        out.center = center;
         out.terms = terms;
         out.wp = fr.wp;
         out.omega = p.omega;
@@ -1076,7 +1085,7 @@ impl ExactPropagator {
             self.model.params(),
             self.dead,
             self.last.region,
-            self.last.tau0,
+            (self.last.tau0, 0.0),
             &y0[..dim],
             len,
             &mut self.poly,
@@ -1364,20 +1373,37 @@ impl ExactPropagator {
         let cheap = self.stint_curvature + self.forced[ri].vp_curv;
         let mut hit = None;
         if !ends.certified(cheap, len) {
+            // a whole modal grid step: the series centred at its middle, from the modal
+            // coordinates there (q0 e^{Λh/2}); otherwise from the start
             let mut y0 = [0.0; MAXD];
-            self.last_y0(&mut y0[..dim]);
+            let center = match (&self.spec[ri].modal, modal && full) {
+                (Some(me), true) => {
+                    let mid = &mut self.fac_tmp;
+                    mid.copy_prefix(&self.last.q0, me.len());
+                    mid.mul_assign(&self.forced[ri].half_fac, me.len());
+                    ModalExp::expand(&me.v, mid, &mut y0[..dim], false);
+                    0.5 * len
+                }
+                _ => {
+                    self.last_y0(&mut y0[..dim]);
+                    0.0
+                }
+            };
             Self::build_poly(
                 &self.spec[ri],
                 &self.forced[ri],
                 self.model.params(),
                 self.dead,
                 region,
-                tau0,
+                (tau0, center),
                 &y0[..dim],
                 len,
                 &mut self.poly,
             );
             self.poly_built = true;
+            // both bound |g''| over the step: the series' sum of absolute terms (a cosh-like
+            // overestimate of an oscillation) is often the larger one
+            self.poly.curv = self.poly.curv.min(cheap);
             let poly = &*self.poly;
             let search = Search { poly };
             // start of the search: after a switching, where the lower parabola peaks

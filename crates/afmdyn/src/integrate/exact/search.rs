@@ -7,6 +7,8 @@ use super::K;
 #[derive(Debug, Clone)]
 pub(super) struct TipPoly {
     pub(super) tau0: f64,
+    /// The local time the series is expanded about: every sum is in u = t − center.
+    pub(super) center: f64,
     /// The moments mo[n] = c̃ᵀÃⁿy0, n = 0..=K + 2: the homogeneous tip deflection W_hom and its
     /// first two derivatives have the Taylor coefficients mo[n + i] / n! (i = 0, 1, 2).
     pub(super) mo: [f64; K + 3],
@@ -38,6 +40,7 @@ impl TipPoly {
     pub(super) fn empty() -> Self {
         TipPoly {
             tau0: 0.0,
+            center: 0.0,
             mo: [0.0; K + 3],
             gc: [[0.0; K + 1]; 2],
             gc2: [0.0; K + 1],
@@ -69,13 +72,13 @@ impl TipPoly {
         }
         (p[0] + t * p[1]) + t2 * (p[2] + t * p[3])
     }
-    /// Σ mo[n + i] tⁿ/n! over the kept terms: the i-th derivative of W_hom at local time t.
+    /// Σ mo[n + i] uⁿ/n! over the kept terms: the i-th derivative of W_hom at local time t.
     fn hom(&self, i: usize, t: f64) -> f64 {
         let mut c = [0.0; K + 1];
         for (n, o) in c[..self.terms].iter_mut().enumerate() {
             *o = self.mo[n + i] * super::INV_FACT[n];
         }
-        Self::horner(&c[..self.terms], t)
+        Self::horner(&c[..self.terms], t - self.center)
     }
     /// [W, W', W''] of the tip at local time t.
     pub(super) fn w(&self, t: f64) -> [f64; 3] {
@@ -102,16 +105,18 @@ impl TipPoly {
             }
             self.gc2_ready = true;
         }
+        let u = t - self.center;
         [
-            Self::horner(&self.gc[0][..self.terms], t),
-            Self::horner(&self.gc[1][..self.terms], t),
-            Self::horner(&self.gc2[..self.terms], t),
+            Self::horner(&self.gc[0][..self.terms], u),
+            Self::horner(&self.gc[1][..self.terms], u),
+            Self::horner(&self.gc2[..self.terms], u),
         ]
     }
     /// Gap g = σ V_T and its derivative at local time t.
     pub(super) fn g(&self, t: f64) -> (f64, f64) {
-        let v = Self::horner(&self.gc[0][..self.terms], t);
-        let dv = Self::horner(&self.gc[1][..self.terms], t);
+        let u = t - self.center;
+        let v = Self::horner(&self.gc[0][..self.terms], u);
+        let dv = Self::horner(&self.gc[1][..self.terms], u);
         (self.sigma * v + self.dead, self.sigma * dv)
     }
 }
