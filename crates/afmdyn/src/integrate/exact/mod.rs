@@ -1652,3 +1652,72 @@ impl Integrator for ExactPropagator {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The tip series of a step, expanded at its start and centred at its middle, both equal
+    /// the gap g = σ V_T + dead and its rate from the closed-form homogeneous solution
+    /// c̃ᵀ e^{Ãt} y0 (eigendecomposition, [`ModalExp::apply`]) plus the harmonic part of eq. 8,
+    /// to round-off over the whole step, in both regions, at N = 1, 3 and 8.
+    #[test]
+    fn centred_and_start_series_equal_the_closed_form() {
+        for modes in [1usize, 3, 8] {
+            let p = Params {
+                modes,
+                ..Params::default()
+            };
+            let model = CantileverModel::new(&p).unwrap();
+            let prop = ExactPropagator::try_new(&model, 1).unwrap();
+            let (h, dim) = (prop.grid.h, 2 * modes);
+            for (ri, r) in [Region::Free, Region::Contact].into_iter().enumerate() {
+                let (sp, fr) = (&prop.spec[ri], &prop.forced[ri]);
+                let me = sp.modal.as_ref().expect("well conditioned");
+                let y0: Vec<f64> = (0..dim).map(|j| (0.7 * j as f64 + 0.3).sin()).collect();
+                let tau0 = 1.234;
+                let row =
+                    |n: usize, y: &[f64]| -> f64 { (0..dim).map(|j| sp.rows[(n, j)] * y[j]).sum() };
+                let (amp, om) = (fr.wp[1] + base_amp(&p), p.omega);
+                let exact = |t: f64| -> (f64, f64) {
+                    let mut y = vec![0.0; dim];
+                    me.apply(&y0, t, &mut y);
+                    let (s, c) = (om * (tau0 + t)).sin_cos();
+                    let v = row(0, &y) + fr.wp[0] + p.alpha5 + amp * s + fr.wp[2] * c;
+                    let dv = row(1, &y) + om * (amp * c - fr.wp[2] * s);
+                    let sigma = r.guard_sign();
+                    (sigma * v + prop.dead, sigma * dv)
+                };
+                let mut y_mid = vec![0.0; dim];
+                me.apply(&y0, 0.5 * h, &mut y_mid);
+                let scale =
+                    sp.ct_norm * y0.iter().map(|v| v * v).sum::<f64>().sqrt() * (1.0 + sp.rho)
+                        + fr.wp.iter().map(|w| w.abs()).sum::<f64>()
+                        + amp.abs() * (1.0 + om);
+                for (center, y) in [(0.0, &y0), (0.5 * h, &y_mid)] {
+                    let mut poly = TipPoly::empty();
+                    ExactPropagator::build_poly(
+                        sp,
+                        fr,
+                        &p,
+                        prop.dead,
+                        r,
+                        (tau0, center),
+                        y,
+                        h,
+                        &mut poly,
+                    );
+                    assert_eq!(poly.center, center);
+                    for k in 0..=40 {
+                        let t = h * k as f64 / 40.0;
+                        let (g, dg) = poly.g(t);
+                        let (ge, dge) = exact(t);
+                        let at = format!("N = {modes}, {r:?}, centre {center}, t = {t}");
+                        assert!((g - ge).abs() <= 1e-13 * scale, "{at}: g {g} vs {ge}");
+                        assert!((dg - dge).abs() <= 1e-12 * scale, "{at}: g' {dg} vs {dge}");
+                    }
+                }
+            }
+        }
+    }
+}
