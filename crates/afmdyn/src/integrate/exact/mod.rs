@@ -967,9 +967,9 @@ impl ExactPropagator {
     /// time `center`, from the homogeneous state `y0` (energy coordinates) at τ0 + center: the
     /// series reaches |t − center| ≤ max(center, len − center), half the step when centred, so
     /// the terms fall off twice as fast. The moments c̃ᵀÃⁿy0 (one product with the
-    /// precomputed rows), then the Taylor coefficients of g and g′ for every n ≤ K in one loop
-    /// without branches (the harmonic factors Ωⁿ/n! from [`Forced`]), then the number of terms
-    /// by the a priori tail bound (1/n! and 1/n from tables: no division until it passes).
+    /// precomputed rows), then the Taylor coefficients of g and g′ four terms at a time (the
+    /// harmonic factors Ωⁿ/n! from [`Forced`]) until the a priori tail bound is below round-off
+    /// (1/n! and 1/n from tables: no division until it passes).
     #[allow(clippy::too_many_arguments)]
     fn build_poly(
         sp: &Spectral,
@@ -1010,12 +1010,14 @@ impl ExactPropagator {
             *o = l;
             l *= radius;
         }
-        // every term's coefficients, the size of its contribution over the step (sums rather
-        // than maxima: a bound as good, without NaN-aware max sequences) and its share of the
-        // bound on |g''|, in blocks of four terms, so that the harmonic cycle is the same in
-        // every block and the lanes are independent (no branch: the loop vectorizes)
+        // in blocks of four terms (the harmonic cycle is the same in every block, and the lanes
+        // of a block are independent): every term's coefficients, the size of its contribution
+        // over the step (sums rather than maxima: a bound as good, without NaN-aware max
+        // sequences) and its share of the bound on |g''|; then the block's terms in order until
+        // the a priori tail is below round-off
         let (mut size, mut curv_n) = ([0.0; K + 1], [0.0; K + 1]);
-        for j in 0..TERM_BLOCKS {
+        let (mut biggest, mut x_pow, mut filled, mut rest) = (0.0f64, x, K + 1, 0.0);
+        'blocks: for j in 0..TERM_BLOCKS {
             for i in 0..4 {
                 let n = 4 * j + i;
                 let f = INV_FACT[n];
@@ -1027,21 +1029,19 @@ impl ExactPropagator {
                 curv_n[n] = c2n.abs() * lp[n];
                 size[n] = (c0n.abs() + c1n.abs() + c2n.abs() + g0.abs() + g1.abs()) * lp[n];
             }
-        }
-        // the first n whose a priori tail is below round-off
-        let (mut biggest, mut x_pow, mut filled, mut rest) = (0.0f64, x, K + 1, 0.0);
-        for (n, &sz) in size.iter().enumerate() {
-            if sz > biggest {
-                biggest = sz;
-            }
-            // the tail from n + 1 on: bound xⁿ⁺¹/(n+1)! / (1 − x/(n+2))
-            let x_fact = x_pow * INV_FACT[n + 1];
-            let ratio = x * INV_INT[n + 2];
-            x_pow *= x;
-            if ratio < 0.5 && bound * x_fact <= 1e-18 * (biggest + wp_sum) * (1.0 - ratio) {
-                filled = n + 1;
-                rest = bound * x_fact / (1.0 - ratio);
-                break;
+            for n in 4 * j..4 * j + 4 {
+                if size[n] > biggest {
+                    biggest = size[n];
+                }
+                // the tail from n + 1 on: bound xⁿ⁺¹/(n+1)! / (1 − x/(n+2))
+                let x_fact = x_pow * INV_FACT[n + 1];
+                let ratio = x * INV_INT[n + 2];
+                x_pow *= x;
+                if ratio < 0.5 && bound * x_fact <= 1e-18 * (biggest + wp_sum) * (1.0 - ratio) {
+                    filled = n + 1;
+                    rest = bound * x_fact / (1.0 - ratio);
+                    break 'blocks;
+                }
             }
         }
         let curv = curv_n[..filled].iter().fold(fr.vp_curv, |a, c| a + c) + rest;
