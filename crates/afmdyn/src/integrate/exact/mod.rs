@@ -255,7 +255,7 @@ impl GridSteps for DenseSteps<'_> {
 
 /// Modal whole grid steps ([`ModalExp::advance_into`] with e^{Λh}): the current modal
 /// coordinates, those of the step tried and the start of the last step taken rotate on
-/// acceptance (no copies).
+/// acceptance (no copies), `accepted` times.
 struct ModalSteps<'a> {
     model: &'a CantileverModel,
     me: &'a ModalExp,
@@ -263,6 +263,7 @@ struct ModalSteps<'a> {
     cur: &'a mut Modes,
     tried: &'a mut Modes,
     prev: &'a mut Modes,
+    accepted: usize,
 }
 
 impl GridSteps for ModalSteps<'_> {
@@ -275,6 +276,7 @@ impl GridSteps for ModalSteps<'_> {
     fn accept(&mut self) {
         std::mem::swap(&mut self.prev, &mut self.cur);
         std::mem::swap(&mut self.cur, &mut self.tried);
+        self.accepted += 1;
     }
 }
 
@@ -389,8 +391,9 @@ pub struct ExactPropagator {
     q: Modes,
     /// z lags behind q (inside [`Integrator::advance_to`]).
     stale: bool,
-    /// e^{λ_k t} of a partial modal step.
-    fac_tmp: Modes,
+    /// Modal scratch: e^{λ_k t} of a partial step, the coordinates at the centre of a tip
+    /// series, the step tried by a run of grid steps.
+    scratch: Modes,
     region: Region,
     /// The grid point the state is on, as (period p, sub-step k < m): grid index j = p m + k.
     on_grid: Option<(i64, usize)>,
@@ -644,7 +647,7 @@ impl ExactPropagator {
             z: zero.clone(),
             q: Modes::ZERO,
             stale: false,
-            fac_tmp: Modes::ZERO,
+            scratch: Modes::ZERO,
             region: Region::Free,
             on_grid: Some((0, 0)),
             stint_curvature: 0.0,
@@ -886,18 +889,12 @@ impl ExactPropagator {
         if let Some(me) = &sp.modal {
             // modal coordinates at τ0 (kept by a modal step, projected from δz by a dense one),
             // advanced by e^{Λt}
-            let r = me.len();
+            if self.last.modal {
+                return me.expand_advanced(&self.last.q0, t, out);
+            }
             let mut q0 = Modes::ZERO;
-            let q0 = if self.last.modal {
-                &self.last.q0
-            } else {
-                me.project_plain(self.last.dz0.as_slice(), &mut q0);
-                &q0
-            };
-            let mut q = Modes::ZERO;
-            me.factors(t, &mut q);
-            q.mul_assign(q0, r);
-            return ModalExp::expand(&me.tv, &q, out, true);
+            me.project_plain(self.last.dz0.as_slice(), &mut q0);
+            return me.expand_advanced(&q0, t, out);
         }
         let dim = out.len();
         let (mut y0, mut yt) = ([0.0; MAXD], [0.0; MAXD]);
@@ -1015,8 +1012,10 @@ impl ExactPropagator {
         // over the step (sums rather than maxima: a bound as good, without NaN-aware max
         // sequences) and its share of the bound on |g''|; then the block's terms in order until
         // the a priori tail is below round-off
-        let (mut size, mut curv_n) = ([0.0; K + 1], [0.0; K + 1]);
-        let (mut biggest, mut x_pow, mut filled, mut rest) = (0.0f64, x, K + 1, 0.0);
+        let mut size = [0.0; K + 1];
+        let mut curv_n = [0.0; 4];
+        let (mut biggest, mut x_pow, mut filled) = (0.0f64, x, K + 1);
+        let mut curv = fr.vp_curv;
         'blocks: for j in 0..TERM_BLOCKS {
             for i in 0..4 {
                 let n = 4 * j + i;
@@ -1026,25 +1025,25 @@ impl ExactPropagator {
                 let g1 = c1n + hf1[n] * cyc1[i];
                 out.gc[0][n] = g0;
                 out.gc[1][n] = g1;
-                curv_n[n] = c2n.abs() * lp[n];
+                curv_n[i] = c2n.abs() * lp[n];
                 size[n] = (c0n.abs() + c1n.abs() + c2n.abs() + g0.abs() + g1.abs()) * lp[n];
             }
             for n in 4 * j..4 * j + 4 {
                 if size[n] > biggest {
                     biggest = size[n];
                 }
+                curv += curv_n[n - 4 * j];
                 // the tail from n + 1 on: bound xⁿ⁺¹/(n+1)! / (1 − x/(n+2))
                 let x_fact = x_pow * INV_FACT[n + 1];
                 let ratio = x * INV_INT[n + 2];
                 x_pow *= x;
                 if ratio < 0.5 && bound * x_fact <= 1e-18 * (biggest + wp_sum) * (1.0 - ratio) {
                     filled = n + 1;
-                    rest = bound * x_fact / (1.0 - ratio);
+                    curv += bound * x_fact / (1.0 - ratio);
                     break 'blocks;
                 }
             }
         }
-        let curv = curv_n[..filled].iter().fold(fr.vp_curv, |a, c| a + c) + rest;
         out.gc[0][0] += fr.wp[0] + p.alpha5;
         let scale = biggest + wp_sum;
         let mut terms = filled;
@@ -1201,6 +1200,7 @@ impl ExactPropagator {
             ref mut tau,
             ref mut vt,
             ref mut q,
+            ref mut scratch,
             region,
             ref mut last,
             ..
@@ -1209,21 +1209,34 @@ impl ExactPropagator {
         let (Some(me), fr) = (&spec[ri].modal, &forced[ri]) else {
             return false;
         };
-        let (mut qa, mut qb, mut qc) = (*q, Modes::ZERO, Modes::ZERO);
         let mut steps = ModalSteps {
             model,
             me,
             fr,
-            cur: &mut qa,
-            tried: &mut qb,
-            prev: &mut qc,
+            cur: q,
+            tried: scratch,
+            prev: &mut last.q0,
+            accepted: 0,
         };
         let (ran, period_end) = limits.run(trig, tau, vt, &mut at, &mut steps);
+        let accepted = steps.accepted;
         let Some(tau0) = ran else {
             return false;
         };
-        *q = *steps.cur;
-        last.q0 = *steps.prev;
+        // the buffers rotate (prev ← cur ← tried ← prev) with every step taken: the current
+        // coordinates back into q, the last step's start into last.q0 (r entries each)
+        let r = me.len();
+        match accepted % 3 {
+            1 => {
+                last.q0.copy_prefix(q, r);
+                q.copy_prefix(scratch, r);
+            }
+            2 => {
+                q.copy_prefix(&last.q0, r);
+                last.q0.copy_prefix(scratch, r);
+            }
+            _ => {}
+        }
         self.finish_run(tau0, at, true);
         period_end
     }
@@ -1299,8 +1312,8 @@ impl ExactPropagator {
                 let fac = if full {
                     &fr.grid_fac
                 } else {
-                    me.factors(len, &mut self.fac_tmp);
-                    &self.fac_tmp
+                    me.factors(len, &mut self.scratch);
+                    &self.scratch
                 };
                 self.last.q0.copy_prefix(&self.q, me.len());
                 let (w, wd) = me.advance_into(&self.last.q0, fac, &mut self.q);
@@ -1378,7 +1391,7 @@ impl ExactPropagator {
             let mut y0 = [0.0; MAXD];
             let center = match (&self.spec[ri].modal, modal && full) {
                 (Some(me), true) => {
-                    let mid = &mut self.fac_tmp;
+                    let mid = &mut self.scratch;
                     mid.copy_prefix(&self.last.q0, me.len());
                     mid.mul_assign(&self.forced[ri].half_fac, me.len());
                     ModalExp::expand(&me.v, mid, &mut y0[..dim], false);

@@ -231,6 +231,25 @@ impl ModalExp {
         }
     }
 
+    /// out += Σ_k Re(b_k e^{λ_k t} q_k) over the columns b_k = w_k T⁻¹v_k of `tv`: the
+    /// homogeneous part in plain coordinates t after modal coordinates q, without forming
+    /// e^{Λt} q (the products of [`Modes::mul_assign`] and the sums of [`ModalExp::expand`], in
+    /// the same order).
+    pub(super) fn expand_advanced(&self, q: &Modes, t: f64, out: &mut [f64]) {
+        let n = out.len().max(1);
+        let cols = self.tv.re.as_slice().chunks_exact(n);
+        let cols = cols.zip(self.tv.im.as_slice().chunks_exact(n));
+        for (k, ((cr, ci), l)) in cols.zip(&self.lambda).enumerate() {
+            let mag = (l.re * t).exp();
+            let (s, c) = (l.im * t).sin_cos();
+            let (fr, fi) = (mag * c, mag * s);
+            let (qr, qi) = (fr * q.re[k] - fi * q.im[k], fr * q.im[k] + fi * q.re[k]);
+            for ((o, br), bi) in out.iter_mut().zip(cr).zip(ci) {
+                *o += br * qr - bi * qi;
+            }
+        }
+    }
+
     /// e^{A t} in plain coordinates, T⁻¹ V e^{Λt} V⁻¹ T = Σ_k w_k Re((T⁻¹v_k) e^{λ_k t} (V⁻¹T)_k),
     /// into `out` (2N×2N) column by column, without allocating.
     pub(super) fn transition_plain_into(&self, t: f64, out: &mut DMatrix<f64>) {
