@@ -397,6 +397,9 @@ pub struct ExactPropagator {
     region: Region,
     /// The grid point the state is on, as (period p, sub-step k < m): grid index j = p m + k.
     on_grid: Option<(i64, usize)>,
+    /// Off the grid, the next grid point and its time, as the last step found it (valid while
+    /// τ is before that time; `None` after a reset).
+    between: Option<((i64, usize), f64)>,
     /// Bound on |W_hom''| over the current stint (see `enter_stint`).
     stint_curvature: f64,
     just_switched: bool,
@@ -650,6 +653,7 @@ impl ExactPropagator {
             scratch: Modes::ZERO,
             region: Region::Free,
             on_grid: Some((0, 0)),
+            between: None,
             stint_curvature: 0.0,
             just_switched: true,
             chatter: ChatterWindow::new(CHATTER_COUNT, CHATTER_WINDOW),
@@ -1277,10 +1281,13 @@ impl ExactPropagator {
         let next = match self.on_grid {
             Some((p, k)) if k + 1 < m => (p, k + 1),
             Some((p, _)) => (p + 1, 0),
-            None => {
-                let j = self.grid.next_index(tau0);
-                (j.div_euclid(m as i64), j.rem_euclid(m as i64) as usize)
-            }
+            None => match self.between {
+                Some((next, t_next)) if tau0 < t_next => next,
+                _ => {
+                    let j = self.grid.next_index(tau0);
+                    (j.div_euclid(m as i64), j.rem_euclid(m as i64) as usize)
+                }
+            },
         };
         // as PeriodGrid::tau
         let t_grid = next.0 as f64 * self.grid.period + next.1 as f64 * self.grid.h;
@@ -1295,6 +1302,8 @@ impl ExactPropagator {
             });
         }
         let full = self.on_grid.is_some() && tau_b == t_grid;
+        // every time up to t_grid that this step ends at lies before the same grid point
+        self.between = Some((next, t_grid));
         let k = self.on_grid.map_or(0, |(_, k)| k);
         let ri = region.index();
         let modal = self.modal[ri];
@@ -1306,6 +1315,13 @@ impl ExactPropagator {
         self.last.modal = modal;
         let fr = &self.forced[ri];
         let mut end_state = true;
+        // sin, cos Ωτ_b: from the grid's table when the step ends on a grid point (column k, or
+        // m at a period end, as a whole grid step to it and `materialize` take them)
+        let trig_b = if tau_b == t_grid {
+            self.trig[if next.1 == 0 { m } else { next.1 }]
+        } else {
+            (omega * tau_b).sin_cos()
+        };
         let vt_b = match (&self.spec[ri].modal, modal) {
             (Some(me), true) => {
                 // q ← e^{Λ len} q; the tip from q
@@ -1317,11 +1333,6 @@ impl ExactPropagator {
                 };
                 self.last.q0.copy_prefix(&self.q, me.len());
                 let (w, wd) = me.advance_into(&self.last.q0, fac, &mut self.q);
-                let (s, c) = if full {
-                    self.trig[k + 1]
-                } else {
-                    (omega * tau_b).sin_cos()
-                };
                 if full && !materialize {
                     end_state = false;
                 } else {
@@ -1329,11 +1340,11 @@ impl ExactPropagator {
                     if full {
                         zb.copy_from_slice(&fr.zp_grid.as_slice()[(k + 1) * dim..(k + 2) * dim]);
                     } else {
-                        Self::zp_into(fr, omega, tau_b, zb);
+                        Self::zp_at(fr, trig_b, zb);
                     }
                     ModalExp::expand(&me.tv, &self.q, zb, true);
                 }
-                modal_v_t(&self.model, fr, (w, wd), (s, c))
+                modal_v_t(&self.model, fr, (w, wd), trig_b)
             }
             _ if full => dense_grid_step(
                 &self.model,
@@ -1356,7 +1367,7 @@ impl ExactPropagator {
                 for (d, z) in dz0.iter_mut().zip(self.z.as_slice()) {
                     *d = z - *d;
                 }
-                let sc_b = (omega * tau_b).sin_cos();
+                let sc_b = trig_b;
                 let sc_end = if tau0 + len == tau_b {
                     sc_b
                 } else {
@@ -1517,6 +1528,7 @@ impl Integrator for ExactPropagator {
         let m = self.grid.m as i64;
         self.on_grid =
             (self.grid.tau(j) == tau).then_some((j.div_euclid(m), j.rem_euclid(m) as usize));
+        self.between = None;
         let sc = (self.model.omega() * tau).sin_cos();
         self.entry_trig = (tau, sc);
         self.enter_stint(region, sc);

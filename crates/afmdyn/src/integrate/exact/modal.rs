@@ -94,7 +94,7 @@ pub(super) struct ModalExp {
     /// w_k T⁻¹ v_k, 2N × r (plain coordinates).
     pub(super) tv: Split,
     /// Rows of V⁻¹ of the representatives, r × 2N.
-    pub(super) vinv: DMatrix<C>,
+    pub(super) vinv: Split,
     /// V⁻¹ T of the representatives, r × 2N (plain coordinates to modal ones).
     pub(super) vinv_t: Split,
     /// w_k c̃ᵀv_k and w_k c̃ᵀv_k λ_k: the tip deflection and its rate per unit q_k.
@@ -171,7 +171,7 @@ impl ModalExp {
             lambda,
             v: Split::new(&v),
             tv,
-            vinv,
+            vinv: Split::new(&vinv),
             vinv_t,
             tip,
             tip_dot,
@@ -186,30 +186,26 @@ impl ModalExp {
 
     /// q = V⁻¹ y (representatives).
     pub(super) fn project(&self, y: &[f64], q: &mut Modes) {
-        let r = self.len();
-        let (qr, qi) = (&mut q.re[..r], &mut q.im[..r]);
-        qr.fill(0.0);
-        qi.fill(0.0);
-        for (col, &yj) in self.vinv.as_slice().chunks_exact(r).zip(y) {
-            for ((a, b), vij) in qr.iter_mut().zip(qi.iter_mut()).zip(col) {
-                *a += vij.re * yj;
-                *b += vij.im * yj;
-            }
-        }
+        Self::apply_rows(&self.vinv, y, q);
     }
 
     /// q = V⁻¹ T δz (representatives) from plain coordinates δz.
     pub(super) fn project_plain(&self, dz: &[f64], q: &mut Modes) {
-        let r = self.len();
+        Self::apply_rows(&self.vinv_t, dz, q);
+    }
+
+    /// q = B x for an r × 2N complex `rows` B and a real x, column by column.
+    fn apply_rows(rows: &Split, x: &[f64], q: &mut Modes) {
+        let r = rows.re.nrows();
         let (qr, qi) = (&mut q.re[..r], &mut q.im[..r]);
         qr.fill(0.0);
         qi.fill(0.0);
-        let cols = self.vinv_t.re.as_slice().chunks_exact(r);
-        let cols = cols.zip(self.vinv_t.im.as_slice().chunks_exact(r));
-        for ((cr, ci), &x) in cols.zip(dz) {
+        let cols = rows.re.as_slice().chunks_exact(r.max(1));
+        let cols = cols.zip(rows.im.as_slice().chunks_exact(r.max(1)));
+        for ((cr, ci), &xj) in cols.zip(x) {
             for (((a, b), vr), vi) in qr.iter_mut().zip(qi.iter_mut()).zip(cr).zip(ci) {
-                *a += vr * x;
-                *b += vi * x;
+                *a += vr * xj;
+                *b += vi * xj;
             }
         }
     }
