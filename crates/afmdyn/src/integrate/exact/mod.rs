@@ -907,10 +907,10 @@ impl ExactPropagator {
         matvec(&sp.tinv, &yt[..dim], out, 1.0, true);
     }
 
-    /// z = z_p(τ) + T⁻¹ V q in a modal region, when z lags behind q. z lags only after whole
-    /// grid steps, so on a grid point z_p is the grid table's value at the end of the step that
-    /// arrived there (column k, or m at a period end), as a materialising step of `step_impl`
-    /// forms it: [`Integrator::advance_to`] and the step loop agree bit for bit.
+    /// z = z_p(τ) + T⁻¹ V q in a modal region, when z lags behind q (after modal steps inside
+    /// [`Integrator::advance_to`]). On a grid point z_p is the grid table's value (column k,
+    /// or m at a period end), elsewhere z_p(τ) from sin/cos Ωτ, as a materialising step of
+    /// `step_impl` forms it: [`Integrator::advance_to`] and the step loop agree bit for bit.
     fn materialize(&mut self) {
         if !self.stale {
             return;
@@ -1265,14 +1265,14 @@ impl ExactPropagator {
         self.last.modal = modal;
         self.on_grid = Some(at);
         self.poly_built = false;
-        // z lags behind q after modal grid steps (formed by materialize)
+        // z lags behind q after modal steps (formed by materialize)
         self.stale = modal;
     }
 
     /// One step (see [`Integrator::step`]). Without `materialize` (inside
     /// [`Integrator::advance_to`], which reads only the result's `Ok`/`Err`): in a modal region
-    /// the plain state at the end of a whole grid step is not formed (z lags behind q), and a
-    /// switching is returned without its event record (no copy of the state).
+    /// the plain state at the end of a step is not formed (z lags behind q), and a switching is
+    /// returned without its event record (no copy of the state).
     fn step_impl(&mut self, tau_max: f64, materialize: bool) -> Result<Step, SimError> {
         let region = self.region;
         let tau0 = self.tau;
@@ -1333,7 +1333,7 @@ impl ExactPropagator {
                 };
                 self.last.q0.copy_prefix(&self.q, me.len());
                 let (w, wd) = me.advance_into(&self.last.q0, fac, &mut self.q);
-                if full && !materialize {
+                if !materialize {
                     end_state = false;
                 } else {
                     let zb = self.zb.as_mut_slice();
