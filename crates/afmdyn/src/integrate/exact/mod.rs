@@ -419,6 +419,9 @@ pub struct ExactPropagator {
     dead: f64,
     /// sin Ωτ_k and cos Ωτ_k on the grid of one period (k = 0..=m).
     trig: Arc<[(f64, f64)]>,
+    /// The same at the middles of the grid steps, τ_k + h/2 (k < m): the centres of the tip
+    /// series of whole grid steps.
+    trig_mid: Arc<[(f64, f64)]>,
     zb: DVector<f64>,
     /// δz of the step tried by a dense run (the other buffer is the last step's `dz0`).
     dz_run: DVector<f64>,
@@ -430,8 +433,9 @@ pub struct ExactPropagator {
 }
 
 /// The forcing data of a build, shared by every build with the same key ([`forcing_key`]):
-/// both regions' [`Forced`] and sin/cos of Ωτ_k on the grid.
-type Forcing = (Arc<[Forced; 2]>, Arc<[(f64, f64)]>);
+/// both regions' [`Forced`], sin/cos of Ωτ_k on the grid (k = 0..=m) and at the middles of its
+/// steps (k + 1/2, k < m).
+type Forcing = (Arc<[Forced; 2]>, Arc<[(f64, f64)]>, Arc<[(f64, f64)]>);
 
 /// Recent forcing data (see [`spectral`]'s module docs).
 static FORCING: spectral::Cache<Forcing> = std::sync::Mutex::new(Vec::new());
@@ -619,14 +623,17 @@ impl ExactPropagator {
                 let trig: Vec<(f64, f64)> = (0..=m)
                     .map(|k| (omega * (k as f64 * h)).sin_cos())
                     .collect();
+                let trig_mid: Vec<(f64, f64)> = (0..m)
+                    .map(|k| (omega * ((2 * k + 1) as f64 * (0.5 * h))).sin_cos())
+                    .collect();
                 let forced = Arc::new([
                     forced(model, Region::Free, &spec[0], &trig, h)?,
                     forced(model, Region::Contact, &spec[1], &trig, h)?,
                 ]);
-                Ok((forced, trig.into()))
+                Ok((forced, trig.into(), trig_mid.into()))
             },
         )?;
-        let (forced, trig) = (forcing.0.clone(), forcing.1.clone());
+        let (forced, trig, trig_mid) = (forcing.0.clone(), forcing.1.clone(), forcing.2.clone());
         let modal = std::array::from_fn(|i| {
             spec[i].modal.is_some() && opts.propagation == Propagation::Auto
         });
@@ -671,6 +678,7 @@ impl ExactPropagator {
             entry_trig: (f64::NAN, (0.0, 1.0)),
             dead,
             trig,
+            trig_mid,
             zb: zero.clone(),
             dz_run: zero,
             param_data: None,
@@ -965,7 +973,8 @@ impl ExactPropagator {
     }
 
     /// Fill `out` with the tip series of a step [τ0, τ0 + len] in region `r`, centred at local
-    /// time `center`, from the homogeneous state `y0` (energy coordinates) at τ0 + center: the
+    /// time `center` (with sin, cos Ω(τ0 + center)), from the homogeneous state `y0` (energy
+    /// coordinates) at τ0 + center: the
     /// series reaches |t − center| ≤ max(center, len − center), half the step when centred, so
     /// the terms fall off twice as fast. The moments c̃ᵀÃⁿy0 (one product with the
     /// precomputed rows), then the Taylor coefficients of g and g′ four terms at a time (the
@@ -978,7 +987,7 @@ impl ExactPropagator {
         p: &Params,
         dead: f64,
         r: Region,
-        (tau0, center): (f64, f64),
+        (tau0, center, (s0, c0)): (f64, f64, (f64, f64)),
         y0: &[f64],
         len: f64,
         out: &mut TipPoly,
@@ -986,7 +995,6 @@ impl ExactPropagator {
         let radius = center.max(len - center);
         // the harmonic part a_s sin(Ωτc + Ωu) + a_c cos(Ωτc + Ωu) + const of V_T (τc = τ0 +
         // center, u = t − center): its n-th u-derivative at 0 is Ωⁿ (S, C, −S, −C)[n mod 4]
-        let (s0, c0) = (p.omega * (tau0 + center)).sin_cos();
         let (a_s, a_c) = (fr.wp[1] + base_amp(p), fr.wp[2]);
         let (sv, sd) = (a_s * s0 + a_c * c0, a_s * c0 - a_c * s0);
         let (cycle, cyc1) = ([sv, sd, -sv, -sd], [sd, -sv, -sd, sv]);
@@ -1088,7 +1096,11 @@ impl ExactPropagator {
             self.model.params(),
             self.dead,
             self.last.region,
-            (self.last.tau0, 0.0),
+            (
+                self.last.tau0,
+                0.0,
+                (self.model.omega() * self.last.tau0).sin_cos(),
+            ),
             &y0[..dim],
             len,
             &mut self.poly,
@@ -1406,11 +1418,15 @@ impl ExactPropagator {
                     mid.copy_prefix(&self.last.q0, me.len());
                     mid.mul_assign(&self.forced[ri].half_fac, me.len());
                     ModalExp::expand(&me.v, mid, &mut y0[..dim], false);
-                    0.5 * len
+                    (tau0, 0.5 * len, self.trig_mid[k])
                 }
                 _ => {
                     self.last_y0(&mut y0[..dim]);
-                    0.0
+                    let sc0 = match self.entry_trig {
+                        (tau, sc) if tau == tau0 => sc,
+                        _ => (omega * tau0).sin_cos(),
+                    };
+                    (tau0, 0.0, sc0)
                 }
             };
             Self::build_poly(
@@ -1419,7 +1435,7 @@ impl ExactPropagator {
                 self.model.params(),
                 self.dead,
                 region,
-                (tau0, center),
+                center,
                 &y0[..dim],
                 len,
                 &mut self.poly,
@@ -1727,7 +1743,7 @@ mod tests {
                         &p,
                         prop.dead,
                         r,
-                        (tau0, center),
+                        (tau0, center, (om * (tau0 + center)).sin_cos()),
                         y,
                         h,
                         &mut poly,
