@@ -1013,12 +1013,6 @@ impl ExactPropagator {
         // the moments c̃ᵀÃⁿy0
         let mo = &mut out.mo;
         matvec(&sp.rows, y0, mo, 1.0, false);
-        let mut lp = [0.0; K + 1];
-        let mut l = 1.0;
-        for o in lp.iter_mut() {
-            *o = l;
-            l *= radius;
-        }
         // in blocks of four terms (the harmonic cycle is the same in every block, and the lanes
         // of a block are independent): every term's coefficients, the size of its contribution
         // over the step (sums rather than maxima: a bound as good, without NaN-aware max
@@ -1028,7 +1022,14 @@ impl ExactPropagator {
         let mut curv_n = [0.0; 4];
         let (mut biggest, mut x_pow, mut filled) = (0.0f64, x, K + 1);
         let mut curv = fr.vp_curv;
+        let mut l = 1.0;
         'blocks: for j in 0..TERM_BLOCKS {
+            // rⁿ of the block's terms
+            let mut lp = [0.0; 4];
+            for o in lp.iter_mut() {
+                *o = l;
+                l *= radius;
+            }
             for i in 0..4 {
                 let n = 4 * j + i;
                 let f = INV_FACT[n];
@@ -1037,8 +1038,8 @@ impl ExactPropagator {
                 let g1 = c1n + hf1[n] * cyc1[i];
                 out.gc[0][n] = g0;
                 out.gc[1][n] = g1;
-                curv_n[i] = c2n.abs() * lp[n];
-                size[n] = (c0n.abs() + c1n.abs() + c2n.abs() + g0.abs() + g1.abs()) * lp[n];
+                curv_n[i] = c2n.abs() * lp[i];
+                size[n] = (c0n.abs() + c1n.abs() + c2n.abs() + g0.abs() + g1.abs()) * lp[i];
             }
             for n in 4 * j..4 * j + 4 {
                 if size[n] > biggest {
@@ -1116,9 +1117,8 @@ impl ExactPropagator {
     fn enter_stint(&mut self, region: Region, sc: (f64, f64)) {
         let ri = region.index();
         let sp = &self.spec[ri];
-        let dim = self.z.len();
-        let (mut dz, mut y) = ([0.0; MAXD], [0.0; MAXD]);
-        let (dz, y) = (&mut dz[..dim], &mut y[..dim]);
+        // δz and y in the two scratch vectors (free between steps)
+        let (dz, y) = (self.zb.as_mut_slice(), self.dz_run.as_mut_slice());
         Self::zp_at(&self.forced[ri], sc, dz);
         for (d, z) in dz.iter_mut().zip(self.z.as_slice()) {
             *d = z - *d;
