@@ -7,11 +7,9 @@
 use super::bifurcation::random_state;
 use super::period::close;
 use super::shooting::{shoot_with, PeriodicOrbit, ShootingOptions};
-use super::steady::steady_states;
 use super::steady::{steady_state, PoincarePoint, SteadyOptions, SteadyState};
 use crate::error::SimError;
-use crate::integrate::exact::ExactBatch;
-use crate::integrate::{build, build_exact, check_start, IntegratorKind, IntegratorOptions};
+use crate::integrate::{build, IntegratorKind, IntegratorOptions};
 use crate::model::CantileverModel;
 use crate::params::Params;
 use nalgebra::DVector;
@@ -133,61 +131,22 @@ pub fn find_attractors(spec: &AttractorSpec) -> Result<AttractorReport, SimError
 /// A start and the steady state it reaches.
 type StartResult = (DVector<f64>, Result<SteadyState, SimError>);
 
-/// Lanes per batch of the exact propagator (the batches run in parallel).
-const BATCH_LANES: usize = 32;
-
-/// The steady state from every random start: batched ([`steady_states`]) with the exact
-/// propagator, whose lanes share one build; one by one otherwise. Both give the same results
-/// (the batch is bit-identical to its lanes alone).
+/// The steady state from every random start, one by one in parallel. (The batched search,
+/// [`super::steady::steady_states`], gives the same results bit for bit, but since the scalar
+/// propagator takes its certified grid steps in tight runs the batch no longer gains: 0.92–0.96×
+/// at N = 3 and 0.90–1.00× at N = 10 in `period_cost census`, and a batch of 32 lanes keeps one
+/// core busy where the starts alone spread over all of them; `docs/performance.md`.)
 fn steady_states_of_starts(model: &CantileverModel, spec: &AttractorSpec) -> Vec<StartResult> {
-    let starts: Vec<DVector<f64>> = (0..spec.samples)
-        .map(|i| random_state(model, spec.seed, i as u64))
-        .collect();
-    let alone = |z0: &DVector<f64>| {
-        build(model, spec.integrator, 0.0, z0)
-            .and_then(|mut it| steady_state(it.as_mut(), &spec.steady))
-    };
-    // (a build that fails, fails every start alone with its own error, as before)
-    let proto = match build_exact(model, spec.integrator) {
-        Ok(Some(p)) => p,
-        _ => {
-            return starts
-                .into_par_iter()
-                .with_max_len(1)
-                .map(|z0| {
-                    let r = alone(&z0);
-                    (z0, r)
-                })
-                .collect();
-        }
-    };
-    let chunks: Vec<Vec<StartResult>> = starts
-        .par_chunks(BATCH_LANES)
+    (0..spec.samples)
+        .into_par_iter()
         .with_max_len(1)
-        .map(|chunk| {
-            let mut batch = ExactBatch::new(&proto);
-            // a start the batch refuses (as `build` would) fails alone, with build's error
-            let mut lane_of = Vec::with_capacity(chunk.len());
-            for z0 in chunk {
-                let ok = check_start(z0).is_ok() && batch.push(0.0, z0).is_ok();
-                lane_of.push(ok.then(|| batch.len() - 1));
-            }
-            let Ok(results) = steady_states(&mut batch, &spec.steady) else {
-                // invalid options: every start fails alone with the error
-                return chunk.iter().map(|z0| (z0.clone(), alone(z0))).collect();
-            };
-            let mut results: Vec<Option<_>> = results.into_iter().map(Some).collect();
-            chunk
-                .iter()
-                .zip(lane_of)
-                .map(|(z0, lane)| {
-                    let r = lane.and_then(|l| results.get_mut(l).and_then(Option::take));
-                    (z0.clone(), r.unwrap_or_else(|| alone(z0)))
-                })
-                .collect()
+        .map(|i| {
+            let z0 = random_state(model, spec.seed, i as u64);
+            let r = build(model, spec.integrator, 0.0, &z0)
+                .and_then(|mut it| steady_state(it.as_mut(), &spec.steady));
+            (z0, r)
         })
-        .collect();
-    chunks.into_iter().flatten().collect()
+        .collect()
 }
 
 /// Polish a periodic attractor by shooting from its last section point and replace its
