@@ -314,6 +314,14 @@ impl Default for ExactOptions {
     }
 }
 
+/// The homogeneous state a tip series is expanded from (`build_poly`): energy coordinates y,
+/// or the modal coordinates q of y = V q.
+#[derive(Clone, Copy)]
+enum SeriesStart<'a> {
+    Energy(&'a [f64]),
+    Modal(&'a ModalExp, &'a Modes),
+}
+
 /// Data of one region that depends on the forcing (Ω, α2, α5) and the grid step.
 #[derive(Debug, Clone)]
 struct Forced {
@@ -988,7 +996,7 @@ impl ExactPropagator {
         dead: f64,
         r: Region,
         (tau0, center, (s0, c0)): (f64, f64, (f64, f64)),
-        y0: &[f64],
+        start: SeriesStart,
         len: f64,
         out: &mut TipPoly,
     ) {
@@ -999,20 +1007,26 @@ impl ExactPropagator {
         let (sv, sd) = (a_s * s0 + a_c * c0, a_s * c0 - a_c * s0);
         let (cycle, cyc1) = ([sv, sd, -sv, -sd], [sd, -sv, -sd, sv]);
         // a priori bound on the coefficients beyond n: |c̃ᵀÃ^{n+d}y0| rⁿ/n! ≤
-        // ‖c̃‖‖y0‖ρ^{n+d} rⁿ/n! and |harmonic| ≤ (|a_s| + |a_c|) Ω^{n+d} rⁿ/n! (d ≤ 2, r the
+        // M ρ^{n+d} rⁿ/n! and |harmonic| ≤ (|a_s| + |a_c|) Ω^{n+d} rⁿ/n! (d ≤ 2, r the
         // radius), so with x = max(ρ, Ω) r every size below is ≤ bound xⁿ/n! and the tail from
         // n on ≤ bound xⁿ/n! / (1 − x/(n+1)): the series stop as soon as that is below
         // round-off of the largest term so far
-        let y_norm = y0.iter().map(|v| v * v).sum::<f64>().sqrt();
-        let (rho, om, amp) = (sp.rho, p.omega, a_s.abs() + a_c.abs());
-        let bound =
-            sp.ct_norm * y_norm * (1.0 + rho + rho * rho) * 3.0 + amp * (1.0 + om + om * om) * 2.0;
+        // the moments c̃ᵀÃⁿy0 and a bound M ρⁿ on them (from the energy coordinates,
+        // ‖c̃‖‖y0‖ ‖Ã‖₂ⁿ; from modal ones, Σ|w c̃ᵀv_k||q_k| max|λ_k|ⁿ)
+        let mo = &mut out.mo;
+        let (m_amp, rho) = match start {
+            SeriesStart::Energy(y0) => {
+                matvec(&sp.rows, y0, mo, 1.0, false);
+                let y_norm = y0.iter().map(|v| v * v).sum::<f64>().sqrt();
+                (sp.ct_norm * y_norm, sp.rho)
+            }
+            SeriesStart::Modal(me, q) => (me.moments(q, mo), me.lambda_max),
+        };
+        let (om, amp) = (p.omega, a_s.abs() + a_c.abs());
+        let bound = m_amp * (1.0 + rho + rho * rho) * 3.0 + amp * (1.0 + om + om * om) * 2.0;
         let wp_sum = fr.wp.iter().map(|x| x.abs()).sum::<f64>();
         let x = rho.max(om) * radius;
         let [hf0, hf1] = &fr.harm_fact;
-        // the moments c̃ᵀÃⁿy0
-        let mo = &mut out.mo;
-        matvec(&sp.rows, y0, mo, 1.0, false);
         // in blocks of four terms (the harmonic cycle is the same in every block, and the lanes
         // of a block are independent): every term's coefficients, the size of its contribution
         // over the step (sums rather than maxima: a bound as good, without NaN-aware max
@@ -1102,7 +1116,7 @@ impl ExactPropagator {
                 0.0,
                 (self.model.omega() * self.last.tau0).sin_cos(),
             ),
-            &y0[..dim],
+            SeriesStart::Energy(&y0[..dim]),
             len,
             &mut self.poly,
         );
@@ -1412,13 +1426,15 @@ impl ExactPropagator {
             // a whole modal grid step: the series centred at its middle, from the modal
             // coordinates there (q0 e^{Λh/2}); otherwise from the start
             let mut y0 = [0.0; MAXD];
-            let center = match (&self.spec[ri].modal, modal && full) {
+            let (center, start) = match (&self.spec[ri].modal, modal && full) {
                 (Some(me), true) => {
                     let mid = &mut self.scratch;
                     mid.copy_prefix(&self.last.q0, me.len());
                     mid.mul_assign(&self.forced[ri].half_fac, me.len());
-                    ModalExp::expand(&me.v, mid, &mut y0[..dim], false);
-                    (tau0, 0.5 * len, self.trig_mid[k])
+                    (
+                        (tau0, 0.5 * len, self.trig_mid[k]),
+                        SeriesStart::Modal(me, &self.scratch),
+                    )
                 }
                 _ => {
                     self.last_y0(&mut y0[..dim]);
@@ -1426,7 +1442,7 @@ impl ExactPropagator {
                         (tau, sc) if tau == tau0 => sc,
                         _ => (omega * tau0).sin_cos(),
                     };
-                    (tau0, 0.0, sc0)
+                    ((tau0, 0.0, sc0), SeriesStart::Energy(&y0[..dim]))
                 }
             };
             Self::build_poly(
@@ -1436,7 +1452,7 @@ impl ExactPropagator {
                 self.dead,
                 region,
                 center,
-                &y0[..dim],
+                start,
                 len,
                 &mut self.poly,
             );
@@ -1698,12 +1714,14 @@ impl Integrator for ExactPropagator {
 mod tests {
     use super::*;
 
-    /// The tip series of a step, expanded at its start and centred at its middle, both equal
-    /// the gap g = σ V_T + dead and its rate from the closed-form homogeneous solution
-    /// c̃ᵀ e^{Ãt} y0 (eigendecomposition, [`ModalExp::apply`]) plus the harmonic part of eq. 8,
-    /// to round-off over the whole step, in both regions, at N = 1, 3 and 8.
+    /// The tip series of a step — expanded at its start, and centred at its middle from the
+    /// energy coordinates there or from the modal ones (the moments of
+    /// [`ModalExp::moments`]) — equal the gap g = σ V_T + dead and its rate from the closed-form
+    /// homogeneous solution c̃ᵀ e^{Ãt} y0 (nalgebra's matrix exponential, independent of the
+    /// eigendecomposition) plus the harmonic part of eq. 8, to round-off over the whole step,
+    /// in both regions, at N = 1, 3 and 8.
     #[test]
-    fn centred_and_start_series_equal_the_closed_form() {
+    fn tip_series_equal_the_closed_form() {
         for modes in [1usize, 3, 8] {
             let p = Params {
                 modes,
@@ -1715,27 +1733,33 @@ mod tests {
             for (ri, r) in [Region::Free, Region::Contact].into_iter().enumerate() {
                 let (sp, fr) = (&prop.spec[ri], &prop.forced[ri]);
                 let me = sp.modal.as_ref().expect("well conditioned");
-                let y0: Vec<f64> = (0..dim).map(|j| (0.7 * j as f64 + 0.3).sin()).collect();
+                let y0 = DVector::from_fn(dim, |j, _| (0.7 * j as f64 + 0.3).sin());
                 let tau0 = 1.234;
-                let row =
-                    |n: usize, y: &[f64]| -> f64 { (0..dim).map(|j| sp.rows[(n, j)] * y[j]).sum() };
+                let y_at = |t: f64| (&sp.at * t).exp() * &y0;
+                let row = |n: usize, y: &DVector<f64>| -> f64 {
+                    (0..dim).map(|j| sp.rows[(n, j)] * y[j]).sum()
+                };
                 let (amp, om) = (fr.wp[1] + base_amp(&p), p.omega);
                 let exact = |t: f64| -> (f64, f64) {
-                    let mut y = vec![0.0; dim];
-                    me.apply(&y0, t, &mut y);
+                    let y = y_at(t);
                     let (s, c) = (om * (tau0 + t)).sin_cos();
                     let v = row(0, &y) + fr.wp[0] + p.alpha5 + amp * s + fr.wp[2] * c;
                     let dv = row(1, &y) + om * (amp * c - fr.wp[2] * s);
                     let sigma = r.guard_sign();
                     (sigma * v + prop.dead, sigma * dv)
                 };
-                let mut y_mid = vec![0.0; dim];
-                me.apply(&y0, 0.5 * h, &mut y_mid);
-                let scale =
-                    sp.ct_norm * y0.iter().map(|v| v * v).sum::<f64>().sqrt() * (1.0 + sp.rho)
-                        + fr.wp.iter().map(|w| w.abs()).sum::<f64>()
-                        + amp.abs() * (1.0 + om);
-                for (center, y) in [(0.0, &y0), (0.5 * h, &y_mid)] {
+                let y_mid = y_at(0.5 * h);
+                let mut q_mid = Modes::ZERO;
+                me.project(y_mid.as_slice(), &mut q_mid);
+                let scale = sp.ct_norm * y0.norm() * (1.0 + sp.rho)
+                    + fr.wp.iter().map(|w| w.abs()).sum::<f64>()
+                    + amp.abs() * (1.0 + om);
+                let starts = [
+                    (0.0, SeriesStart::Energy(y0.as_slice())),
+                    (0.5 * h, SeriesStart::Energy(y_mid.as_slice())),
+                    (0.5 * h, SeriesStart::Modal(me, &q_mid)),
+                ];
+                for (case, (center, start)) in starts.into_iter().enumerate() {
                     let mut poly = TipPoly::empty();
                     ExactPropagator::build_poly(
                         sp,
@@ -1744,7 +1768,7 @@ mod tests {
                         prop.dead,
                         r,
                         (tau0, center, (om * (tau0 + center)).sin_cos()),
-                        y,
+                        start,
                         h,
                         &mut poly,
                     );
@@ -1753,7 +1777,7 @@ mod tests {
                         let t = h * k as f64 / 40.0;
                         let (g, dg) = poly.g(t);
                         let (ge, dge) = exact(t);
-                        let at = format!("N = {modes}, {r:?}, centre {center}, t = {t}");
+                        let at = format!("N = {modes}, {r:?}, start {case}, t = {t}");
                         assert!((g - ge).abs() <= 1e-13 * scale, "{at}: g {g} vs {ge}");
                         assert!((dg - dge).abs() <= 1e-12 * scale, "{at}: g' {dg} vs {dge}");
                     }

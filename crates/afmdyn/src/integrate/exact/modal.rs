@@ -11,6 +11,7 @@
 //! only when V is well conditioned and the residual ‖ÃV − VΛ‖ is at round-off; otherwise the
 //! caller keeps the dense path.
 
+use super::K;
 use nalgebra::{Complex, DMatrix, DVector};
 
 /// Largest state dimension 2N.
@@ -102,6 +103,12 @@ pub(super) struct ModalExp {
     pub(super) tip_dot: Modes,
     /// w_k |c̃ᵀv_k| |λ_k|²: curvature of the tip deflection per unit |q_k|.
     pub(super) tip_lam2: Vec<f64>,
+    /// w_k c̃ᵀv_k λ_kⁿ, n = 0..=K + 2 ((K + 3) × r): the tip moments c̃ᵀÃⁿ y per unit q_k.
+    pub(super) tip_pow: Split,
+    /// w_k |c̃ᵀv_k|: bound on the tip moments per unit |q_k| and |λ_k|ⁿ.
+    pub(super) tip_abs: Vec<f64>,
+    /// max_k |λ_k|.
+    pub(super) lambda_max: f64,
 }
 
 impl ModalExp {
@@ -166,6 +173,9 @@ impl ModalExp {
             .zip(&lambda)
             .map(|(t, l)| t.norm() * l.norm_sqr())
             .collect();
+        let tip_pow = DMatrix::from_fn(K + 3, r, |n, k| tip[k] * lambda[k].powi(n as i32));
+        let tip_abs = tip.iter().map(|t| t.norm()).collect();
+        let lambda_max = lambda.iter().map(|l| l.norm()).fold(0.0, f64::max);
         let (tip, tip_dot) = (Modes::from(&tip), Modes::from(&tip_dot));
         Some(ModalExp {
             lambda,
@@ -176,6 +186,9 @@ impl ModalExp {
             tip,
             tip_dot,
             tip_lam2,
+            tip_pow: Split::new(&tip_pow),
+            tip_abs,
+            lambda_max,
         })
     }
 
@@ -329,6 +342,23 @@ impl ModalExp {
             d[0] += dr1[0] * a - di1[0] * b;
         }
         (w[0] + w[1], d[0] + d[1])
+    }
+
+    /// The tip moments mo[n] = c̃ᵀÃⁿ y = Σ_k Re(w_k c̃ᵀv_k λ_kⁿ q_k) of y = V q (n = 0..=K + 2),
+    /// and Σ_k w_k |c̃ᵀv_k| |q_k|, which bounds |mo[n]| / max_k |λ_k|ⁿ.
+    pub(super) fn moments(&self, q: &Modes, mo: &mut [f64; K + 3]) -> f64 {
+        mo.fill(0.0);
+        let cols = self.tip_pow.re.as_slice().chunks_exact(K + 3);
+        let cols = cols.zip(self.tip_pow.im.as_slice().chunks_exact(K + 3));
+        let mut amp = 0.0;
+        for (k, ((pr, pi), w)) in cols.zip(&self.tip_abs).enumerate() {
+            let (a, b) = (q.re[k], q.im[k]);
+            for ((m, x), y) in mo.iter_mut().zip(pr).zip(pi) {
+                *m += x * a - y * b;
+            }
+            amp += w * (a * a + b * b).sqrt();
+        }
+        amp
     }
 
     /// Σ_k w_k |c̃ᵀv_k| |λ_k|² |q_k|: bounds |W_hom''| for all later times (Re λ_k ≤ 0).
