@@ -347,14 +347,14 @@ impl ModalExp {
     /// The tip moments mo[n] = c̃ᵀÃⁿ y = Σ_k Re(w_k c̃ᵀv_k λ_kⁿ q_k) of y = V q (n = 0..=K + 2),
     /// and Σ_k w_k |c̃ᵀv_k| |q_k|, which bounds |mo[n]| / max_k |λ_k|ⁿ.
     pub(super) fn moments(&self, q: &Modes, mo: &mut [f64; K + 3]) -> f64 {
-        mo.fill(0.0);
-        let cols = self.tip_pow.re.as_slice().chunks_exact(K + 3);
-        let cols = cols.zip(self.tip_pow.im.as_slice().chunks_exact(K + 3));
+        *mo = [0.0; K + 3];
+        let (cols_re, _) = self.tip_pow.re.as_slice().as_chunks::<{ K + 3 }>();
+        let (cols_im, _) = self.tip_pow.im.as_slice().as_chunks::<{ K + 3 }>();
         let mut amp = 0.0;
-        for (k, ((pr, pi), w)) in cols.zip(&self.tip_abs).enumerate() {
+        for (k, ((pr, pi), w)) in cols_re.iter().zip(cols_im).zip(&self.tip_abs).enumerate() {
             let (a, b) = (q.re[k], q.im[k]);
-            for ((m, x), y) in mo.iter_mut().zip(pr).zip(pi) {
-                *m += x * a - y * b;
+            for n in 0..K + 3 {
+                mo[n] += pr[n] * a - pi[n] * b;
             }
             amp += w * (a * a + b * b).sqrt();
         }
