@@ -22,7 +22,7 @@
 //! alone. What it saves is the per-step bookkeeping of the scalar step, and the loops over
 //! lanes vectorize.
 
-use super::{modal_v_t, search::StepEnds, ExactPropagator};
+use super::{grid_v_t, search::StepEnds, ExactPropagator};
 use crate::error::SimError;
 use crate::galerkin::Region;
 use crate::integrate::Integrator;
@@ -253,7 +253,7 @@ impl Block {
                 }
                 for l in 0..W {
                     let tip = (w0[l] + w1[l], d0[l] + d1[l]);
-                    (vb[l], vdb[l]) = modal_v_t(&p.model, fr, tip, (sn, cn));
+                    (vb[l], vdb[l]) = grid_v_t(fr, k + 1, tip);
                 }
             }
         } else {

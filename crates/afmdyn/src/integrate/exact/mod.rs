@@ -119,6 +119,15 @@ fn modal_v_t(
     (v, vd)
 }
 
+/// [`modal_v_t`] at grid point k of a period from the particular part's V_T there
+/// ([`Forced`]'s `vp_grid`, formed by `modal_v_t` with w = ẇ = 0): V_T is affine in (w, ẇ), so
+/// the whole grid steps of a modal region add two numbers instead of forming eq. 8 again.
+#[inline(always)]
+fn grid_v_t(fr: &Forced, k: usize, (w, wd): (f64, f64)) -> (f64, f64) {
+    let (v, vd) = fr.vp_grid[k];
+    (w + v, wd + vd)
+}
+
 /// One whole dense grid step k → k + 1: δz = z − z_p(τ_k) into `dz`,
 /// y = z_p(τ_{k+1}) + Φ_s δz into `y` (`phi`: Φ_s column-major with its kernel), and
 /// [V_T, dV_T/dτ] at τ_{k+1} (eq. 8), given `trig` = (sin Ωτ_{k+1}, cos Ωτ_{k+1}). Slices of
@@ -257,7 +266,6 @@ impl GridSteps for DenseSteps<'_> {
 /// coordinates, those of the step tried and the start of the last step taken rotate on
 /// acceptance (no copies), `accepted` times.
 struct ModalSteps<'a> {
-    model: &'a CantileverModel,
     me: &'a ModalExp,
     fr: &'a Forced,
     cur: &'a mut Modes,
@@ -267,11 +275,11 @@ struct ModalSteps<'a> {
 }
 
 impl GridSteps for ModalSteps<'_> {
-    fn try_step(&mut self, _k: usize, trig: (f64, f64)) -> (f64, f64) {
+    fn try_step(&mut self, k: usize, _trig: (f64, f64)) -> (f64, f64) {
         let tip = self
             .me
             .advance_into(self.cur, &self.fr.grid_fac, self.tried);
-        modal_v_t(self.model, self.fr, tip, trig)
+        grid_v_t(self.fr, k + 1, tip)
     }
     fn accept(&mut self) {
         std::mem::swap(&mut self.prev, &mut self.cur);
@@ -335,6 +343,8 @@ struct Forced {
     wp: [f64; 3],
     /// Ω² · amplitude of V_p (bound on |V_p''|).
     vp_curv: f64,
+    /// [V_T, dV_T/dτ] of the particular solution at the grid points (k = 0..=m).
+    vp_grid: Vec<(f64, f64)>,
     /// Ωⁿ/n! and Ωⁿ⁺¹/n!, n = 0..=K: the Taylor factors of the harmonic part of V_T and of
     /// its rate (`build_poly`).
     harm_fact: [[f64; K + 1]; 2],
@@ -525,6 +535,7 @@ fn forced(
         tip.dot(&pc.rows(0, n)),
     ];
     let vp_curv = omega * omega * (wp[1] + base_amp(model.params())).hypot(wp[2]);
+    let mut vp_grid = Vec::with_capacity(trig.len());
     let (mut grid_fac, mut half_fac) = (Modes::ZERO, Modes::ZERO);
     if let Some(me) = &spec.modal {
         me.factors(h, &mut grid_fac);
@@ -537,7 +548,7 @@ fn forced(
         harm_fact[1][n] = om_n * omega * INV_FACT[n];
         om_n *= omega;
     }
-    Ok(Forced {
+    let mut fr = Forced {
         p0,
         ps,
         pc,
@@ -548,7 +559,11 @@ fn forced(
         grid_fac,
         half_fac,
         harmonic_lu,
-    })
+        vp_grid: Vec::new(),
+    };
+    vp_grid.extend(trig.iter().map(|&sc| modal_v_t(model, &fr, (0.0, 0.0), sc)));
+    fr.vp_grid = vp_grid;
+    Ok(fr)
 }
 
 impl ExactPropagator {
@@ -1223,7 +1238,6 @@ impl ExactPropagator {
         };
         let limits = self.run_limits(tau_end);
         let ExactPropagator {
-            ref model,
             ref spec,
             ref forced,
             ref trig,
@@ -1240,7 +1254,6 @@ impl ExactPropagator {
             return false;
         };
         let mut steps = ModalSteps {
-            model,
             me,
             fr,
             cur: q,
@@ -1370,7 +1383,11 @@ impl ExactPropagator {
                     }
                     ModalExp::expand(&me.tv, &self.q, zb, true);
                 }
-                modal_v_t(&self.model, fr, (w, wd), trig_b)
+                if full {
+                    grid_v_t(fr, k + 1, (w, wd))
+                } else {
+                    modal_v_t(&self.model, fr, (w, wd), trig_b)
+                }
             }
             _ if full => dense_grid_step(
                 &self.model,
