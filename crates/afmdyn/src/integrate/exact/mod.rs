@@ -7,13 +7,14 @@
 //!
 //! **Grid.** The drive period T is split into m sub-steps h = T/m with ‖Ã_s‖₂ h ≤ θ, where
 //! Ã_s = T_s A_s T_s⁻¹ is A_s in energy coordinates y = (L_Kᵀ a, L_Mᵀ ȧ) (K_s = L_K L_Kᵀ,
-//! M = L_M L_Mᵀ). Φ_s = e^{A_s h} and z_p at the grid points are precomputed, so a dense step costs
-//! one 2N×2N matrix–vector product (`exact/kernel.rs`: fixed-size for N ≤ 6). Partial steps (after a
-//! switching, to a requested time) use the eigendecomposition of Ã (`exact/modal.rs`) when it is
-//! well conditioned, else the Taylor series of e^{Ã t} y, which converges fast because ‖Ã t‖ ≤ θ.
+//! M = L_M L_Mᵀ). Φ_s = e^{A_s h} and z_p at the grid points are precomputed, so a dense step
+//! costs one 2N×2N matrix–vector product (`exact/kernel.rs`: fixed-size for N ≤ 6). Partial steps
+//! (after a switching, to a requested time) use the eigendecomposition of Ã (`exact/modal.rs`)
+//! when it is well conditioned, else the Taylor series of e^{Ã t} y, which converges fast because
+//! ‖Ã t‖ ≤ θ.
 //!
-//! **Modal propagation** ([`Propagation`]). A region whose eigenvector basis is well
-//! conditioned (at any N) keeps the homogeneous part in modal coordinates q = V⁻¹ T δz during a stint: a grid
+//! **Modal propagation** ([`Propagation`]). A region whose eigenvector basis is well conditioned
+//! (at any N) keeps the homogeneous part in modal coordinates q = V⁻¹ T δz during a stint: a grid
 //! step multiplies q by e^{Λh} (about N complex products) and evaluates the tip from q; the
 //! plain state z = z_p + T⁻¹ V q is formed only when asked for ([`Integrator::step`] returns it
 //! after every step, [`Integrator::advance_to`] only at events and at the end). The
@@ -463,10 +464,12 @@ static FORCING: spectral::Cache<Forcing> = std::sync::Mutex::new(Vec::new());
 const FORCING_KEEP_BYTES: f64 = 2.0 * 1024.0 * 1024.0;
 
 /// Everything [`forced`] and the grid's sin/cos read: the spectral key (A_s, M, K_s), h, Ω,
-/// the base-drive amplitude, the tip row and b_const, b_sin, b_cos of both regions, as bits.
+/// the base-drive amplitude, the gap α5 (V_T on the grid), the tip row and b_const, b_sin, b_cos
+/// of both regions, as bits.
 fn forcing_key(model: &CantileverModel, spectral_key: &[u64], h: f64) -> Vec<u64> {
     let mut key = spectral_key.to_vec();
-    key.extend([h, model.omega(), base_amp(model.params())].map(f64::to_bits));
+    let p = model.params();
+    key.extend([h, model.omega(), base_amp(p), p.alpha5].map(f64::to_bits));
     key.extend(model.tip().iter().map(|x| x.to_bits()));
     for r in [Region::Free, Region::Contact] {
         let d = model.dynamics(r);
@@ -535,7 +538,6 @@ fn forced(
         tip.dot(&pc.rows(0, n)),
     ];
     let vp_curv = omega * omega * (wp[1] + base_amp(model.params())).hypot(wp[2]);
-    let mut vp_grid = Vec::with_capacity(trig.len());
     let (mut grid_fac, mut half_fac) = (Modes::ZERO, Modes::ZERO);
     if let Some(me) = &spec.modal {
         me.factors(h, &mut grid_fac);
@@ -561,8 +563,10 @@ fn forced(
         harmonic_lu,
         vp_grid: Vec::new(),
     };
-    vp_grid.extend(trig.iter().map(|&sc| modal_v_t(model, &fr, (0.0, 0.0), sc)));
-    fr.vp_grid = vp_grid;
+    fr.vp_grid = trig
+        .iter()
+        .map(|&sc| modal_v_t(model, &fr, (0.0, 0.0), sc))
+        .collect();
     Ok(fr)
 }
 
@@ -996,13 +1000,13 @@ impl ExactPropagator {
     }
 
     /// Fill `out` with the tip series of a step [τ0, τ0 + len] in region `r`, centred at local
-    /// time `center` (with sin, cos Ω(τ0 + center)), from the homogeneous state `y0` (energy
-    /// coordinates) at τ0 + center: the
-    /// series reaches |t − center| ≤ max(center, len − center), half the step when centred, so
-    /// the terms fall off twice as fast. The moments c̃ᵀÃⁿy0 (one product with the
-    /// precomputed rows), then the Taylor coefficients of g and g′ four terms at a time (the
-    /// harmonic factors Ωⁿ/n! from [`Forced`]) until the a priori tail bound is below round-off
-    /// (1/n! and 1/n from tables: no division until it passes).
+    /// time `center` (with sin, cos Ω(τ0 + center)), from the homogeneous state at τ0 + center
+    /// (`start`: energy or modal coordinates). The series reaches |t − center| ≤ max(center,
+    /// len − center), half the step when centred, so its terms fall off twice as fast. The
+    /// moments c̃ᵀÃⁿy (one product with the precomputed rows, or with the modal table of
+    /// [`ModalExp::moments`]), then the Taylor coefficients of g and g′ four terms at a time
+    /// (the harmonic factors Ωⁿ/n! from [`Forced`]) until the a priori tail bound is below
+    /// round-off (1/n! and 1/n from tables: no division until it passes).
     #[allow(clippy::too_many_arguments)]
     fn build_poly(
         sp: &Spectral,
@@ -1021,13 +1025,8 @@ impl ExactPropagator {
         let (a_s, a_c) = (fr.wp[1] + base_amp(p), fr.wp[2]);
         let (sv, sd) = (a_s * s0 + a_c * c0, a_s * c0 - a_c * s0);
         let (cycle, cyc1) = ([sv, sd, -sv, -sd], [sd, -sv, -sd, sv]);
-        // a priori bound on the coefficients beyond n: |c̃ᵀÃ^{n+d}y0| rⁿ/n! ≤
-        // M ρ^{n+d} rⁿ/n! and |harmonic| ≤ (|a_s| + |a_c|) Ω^{n+d} rⁿ/n! (d ≤ 2, r the
-        // radius), so with x = max(ρ, Ω) r every size below is ≤ bound xⁿ/n! and the tail from
-        // n on ≤ bound xⁿ/n! / (1 − x/(n+1)): the series stop as soon as that is below
-        // round-off of the largest term so far
-        // the moments c̃ᵀÃⁿy0 and a bound M ρⁿ on them (from the energy coordinates,
-        // ‖c̃‖‖y0‖ ‖Ã‖₂ⁿ; from modal ones, Σ|w c̃ᵀv_k||q_k| max|λ_k|ⁿ)
+        // the moments c̃ᵀÃⁿy and a bound |c̃ᵀÃⁿy| ≤ M ρⁿ (from energy coordinates,
+        // ‖c̃‖‖y‖ ‖Ã‖₂ⁿ; from modal ones, Σ|w c̃ᵀv_k||q_k| max|λ_k|ⁿ)
         let mo = &mut out.mo;
         let (m_amp, rho) = match start {
             SeriesStart::Energy(y0) => {
@@ -1037,6 +1036,11 @@ impl ExactPropagator {
             }
             SeriesStart::Modal(me, q) => (me.moments(q, mo), me.lambda_max),
         };
+        // a priori bound on the coefficients beyond n: |c̃ᵀÃ^{n+d}y| rⁿ/n! ≤ M ρ^{n+d} rⁿ/n!
+        // and |harmonic| ≤ (|a_s| + |a_c|) Ω^{n+d} rⁿ/n! (d ≤ 2, r the radius), so with
+        // x = max(ρ, Ω) r every size below is ≤ bound xⁿ/n! and the tail from n on
+        // ≤ bound xⁿ/n! / (1 − x/(n+1)): the series stop as soon as that is below round-off of
+        // the largest term so far
         let (om, amp) = (p.omega, a_s.abs() + a_c.abs());
         let bound = m_amp * (1.0 + rho + rho * rho) * 3.0 + amp * (1.0 + om + om * om) * 2.0;
         let wp_sum = fr.wp.iter().map(|x| x.abs()).sum::<f64>();
@@ -1343,7 +1347,7 @@ impl ExactPropagator {
             });
         }
         let full = self.on_grid.is_some() && tau_b == t_grid;
-        // every time up to t_grid that this step ends at lies before the same grid point
+        // this step ends by t_grid, and until t_grid the next grid point stays `next`
         self.between = Some((next, t_grid));
         let k = self.on_grid.map_or(0, |(_, k)| k);
         let ri = region.index();
@@ -1802,6 +1806,41 @@ mod tests {
                     }
                 }
             }
+        }
+    }
+
+    /// The cached forcing data (particular solution, grid tables) belong to the parameters that
+    /// made them: a build that differs only in the gap α5 — with no contact stiffness or damping,
+    /// so that no region's forcing vector sees α5 — gets V_T on the grid of its own α5, as a
+    /// build without reuse does.
+    #[test]
+    fn forcing_cache_tells_gaps_apart() {
+        let p = Params {
+            alpha4: 0.0,
+            alpha6: 0.0,
+            alpha5: 0.3,
+            ..Params::default()
+        };
+        let q = Params { alpha5: 0.7, ..p };
+        let (mp, mq) = (
+            CantileverModel::new(&p).unwrap(),
+            CantileverModel::new(&q).unwrap(),
+        );
+        let _cached = ExactPropagator::try_new(&mp, 1).unwrap();
+        let reused = ExactPropagator::try_new(&mq, 1).unwrap();
+        let fresh = ExactPropagator::try_with(
+            &mq,
+            ExactOptions {
+                reuse: false,
+                ..ExactOptions::default()
+            },
+        )
+        .unwrap();
+        for ri in 0..2 {
+            assert_eq!(
+                reused.forced[ri].vp_grid, fresh.forced[ri].vp_grid,
+                "region {ri}"
+            );
         }
     }
 }
