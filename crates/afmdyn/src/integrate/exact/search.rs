@@ -9,12 +9,13 @@ pub(super) struct TipPoly {
     pub(super) tau0: f64,
     /// The local time the series is expanded about: every sum is in u = t − center.
     pub(super) center: f64,
-    /// The moments mo[n] = c̃ᵀÃⁿy0, n = 0..=K + 2: the homogeneous tip deflection W_hom and its
-    /// first two derivatives have the Taylor coefficients mo[n + i] / n! (i = 0, 1, 2).
+    /// The moments mo[n] = c̃ᵀÃⁿy, n = 0..=K + 2, of the homogeneous state y at the centre: the
+    /// tip deflection W_hom and its first two derivatives have the Taylor coefficients
+    /// mo[n + i] / n! (i = 0, 1, 2).
     pub(super) mo: [f64; K + 3],
-    /// Taylor coefficients of V_T and dV_T/dτ in local time: mo[n]/n!, mo[n+1]/n! plus those of the
-    /// harmonic part W_p + α2 sin Ωτ + α5 (whose n-th derivative cycles through ±Ωⁿ(S, C)), so
-    /// that the gap costs two Horner sums and no sine.
+    /// Taylor coefficients of V_T and dV_T/dτ in u = t − center: mo[n]/n!, mo[n+1]/n! plus those
+    /// of the harmonic part W_p + α2 sin Ωτ + α5 (whose n-th derivative cycles through
+    /// ±Ωⁿ(S, C)), so that the gap costs two Horner sums and no sine.
     pub(super) gc: [[f64; K + 1]; 2],
     /// Taylor coefficients of d²V_T/dτ², filled on first use by [`TipPoly::v_t`] (dense output
     /// only; the search does not need them).
@@ -26,7 +27,8 @@ pub(super) struct TipPoly {
     pub(super) wp: [f64; 3],
     pub(super) omega: f64,
     /// The harmonic part a_s sin Ωτ + a_c cos Ωτ of V_T (W_p plus the base drive) and its
-    /// derivatives at τ0 without their factors Ωⁿ: the n-th derivative is Ωⁿ cycle[n mod 4].
+    /// derivatives at the centre without their factors Ωⁿ: the n-th derivative is
+    /// Ωⁿ cycle[n mod 4].
     pub(super) cycle: [f64; 4],
     pub(super) sigma: f64,
     /// Dead band added to the gap (see [`super::ExactPropagator`]'s `dead`).
@@ -55,8 +57,8 @@ impl TipPoly {
         }
     }
     /// Σ cₙ tⁿ as Σ_{i<4} tⁱ Pᵢ(t⁴), the coefficients n ≡ i (mod 4) in four independent
-    /// Horner chains (Estrin's splitting, Knuth, *TAOCP* vol. 2, §4.6.4): a quarter of the
-    /// latency of one chain over all the terms, which bounds the search's evaluations.
+    /// Horner chains (the k-th order Horner scheme, Knuth, *TAOCP* vol. 2, §4.6.4): a quarter of
+    /// the latency of one chain over all the terms, which bounds the search's evaluations.
     #[inline]
     fn horner(c: &[f64], t: f64) -> f64 {
         let t2 = t * t;
@@ -94,7 +96,7 @@ impl TipPoly {
     /// [V_T, dV_T/dτ, d²V_T/dτ²] at local time t: three Horner sums, no sine (the harmonic
     /// part is in the coefficients; those of V_T'' are formed on the first call, as `gc` by the
     /// propagator's `build_poly`: mo[n + 2]/n! plus the n-th derivative Ωⁿ⁺² `cycle`[(n+2) mod 4]
-    /// of the harmonic part at τ0, over n!).
+    /// of the harmonic part at the centre, over n!).
     pub(super) fn v_t(&mut self, t: f64) -> [f64; 3] {
         if !self.gc2_ready {
             let mut om_n = self.omega * self.omega;
