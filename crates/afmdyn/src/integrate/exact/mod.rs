@@ -183,7 +183,8 @@ struct RunLimits {
 /// The whole grid step of one propagation path, for [`RunLimits::run`].
 trait GridSteps {
     /// The step from grid point k (sub-step index) into scratch, not yet taken; returns
-    /// [V_T, dV_T/dτ] at its end, given `trig` = (sin Ωτ_{k+1}, cos Ωτ_{k+1}).
+    /// [V_T, dV_T/dτ] at its end, given `trig` = (sin Ωτ_{k+1}, cos Ωτ_{k+1}) (the dense step
+    /// forms eq. 8 with it; the modal one reads the particular part from [`grid_v_t`]'s table).
     fn try_step(&mut self, k: usize, trig: (f64, f64)) -> (f64, f64);
     /// Take the step tried last (its start is kept as the start of the last step).
     fn accept(&mut self);
