@@ -13,6 +13,7 @@
 
 use super::K;
 use nalgebra::{Complex, DMatrix, DVector};
+use wide::f64x2;
 
 /// Largest state dimension 2N.
 pub(super) const MAXD: usize = 2 * crate::params::MAX_MODES;
@@ -322,17 +323,20 @@ impl ModalExp {
         let (or, or1) = out.re[..r].split_at_mut(r & !1);
         let (oim, oi1) = out.im[..r].split_at_mut(r & !1);
         let (or, oim) = (or.as_chunks_mut::<2>().0, oim.as_chunks_mut::<2>().0);
-        let (mut w, mut d) = ([0.0; 2], [0.0; 2]);
+        // explicit two-lane vectors: left to itself the compiler pairs (w, ẇ) of one mode
+        // instead of two modes, with shuffles in every iteration (the same operations in the
+        // same order, so the same values)
+        let (mut w2, mut d2) = (f64x2::ZERO, f64x2::ZERO);
         for k in 0..qr.len() {
-            for l in 0..2 {
-                let (x, y, c, s) = (qr[k][l], qi[k][l], fr[k][l], fi[k][l]);
-                let (a, b) = (x * c - y * s, x * s + y * c);
-                or[k][l] = a;
-                oim[k][l] = b;
-                w[l] += tr[k][l] * a - ti[k][l] * b;
-                d[l] += dr[k][l] * a - di[k][l] * b;
-            }
+            let (x, y) = (f64x2::from(qr[k]), f64x2::from(qi[k]));
+            let (c, s) = (f64x2::from(fr[k]), f64x2::from(fi[k]));
+            let (a, b) = (x * c - y * s, x * s + y * c);
+            or[k] = a.to_array();
+            oim[k] = b.to_array();
+            w2 += f64x2::from(tr[k]) * a - f64x2::from(ti[k]) * b;
+            d2 += f64x2::from(dr[k]) * a - f64x2::from(di[k]) * b;
         }
+        let (mut w, mut d) = (w2.to_array(), d2.to_array());
         if let (Some(&x), Some(&y)) = (qr1.first(), qi1.first()) {
             let (c, s) = (fr1[0], fi1[0]);
             let (a, b) = (x * c - y * s, x * s + y * c);
