@@ -24,6 +24,9 @@
 //! [`ExactBatch`]; prints µs per trajectory-period of both (best of 3) and their ratio, after
 //! checking that both give the same final states bit for bit.
 //!
+//! `... -- grid <N>`: the exact propagator's grid sub-steps per forcing period at the default
+//! parameters (for `scripts/perf-floor.sh`).
+//!
 //! `... -- census <N> [samples] [omega]`: the steady states of `samples` random starts (the
 //! attractor census of `find_attractors`, default Ω = 2.6, transient cap 300 periods) one by
 //! one ([`steady_state`] per start) and batched ([`steady_states`], one batch); prints ms per
@@ -253,6 +256,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "shoot" => return shooting(modes, args.next().map_or(Ok(200), |s| s.parse())?),
         "continuation" => {
             return continuation(modes, args.next().map_or(Ok(3), |s| s.parse())?);
+        }
+        "grid" => {
+            let m = CantileverModel::new(&Params {
+                modes,
+                ..Params::default()
+            })?;
+            println!(
+                "{}",
+                ExactPropagator::try_with(&m, ExactOptions::default())?.steps_per_period()
+            );
+            return Ok(());
         }
         "census" => {
             let samples = args.next().map_or(Ok(64), |s| s.parse())?;
