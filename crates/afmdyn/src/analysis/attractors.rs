@@ -134,8 +134,9 @@ type StartResult = (DVector<f64>, Result<SteadyState, SimError>);
 /// The steady state from every random start, one by one in parallel. (The batched search,
 /// [`super::steady::steady_states`], gives the same results bit for bit, but since the scalar
 /// propagator takes its certified grid steps in tight runs the batch no longer gains: 0.8–1.0×
-/// at N = 3 and 0.6–1.3× at N = 10 in `period_cost census` over several runs, and a batch of 32 lanes keeps one
-/// core busy where the starts alone spread over all of them; `docs/performance.md`.)
+/// at N = 3 and 0.6–1.3× at N = 10 in `period_cost census` over several runs, and a batch of
+/// 32 lanes keeps one core busy where the starts alone spread over all of them;
+/// `docs/performance.md`.)
 fn steady_states_of_starts(model: &CantileverModel, spec: &AttractorSpec) -> Vec<StartResult> {
     (0..spec.samples)
         .into_par_iter()
