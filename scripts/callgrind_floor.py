@@ -44,7 +44,7 @@ def self_costs(path):
     costs = {}
     for line in out.splitlines():
         m = re.match(r"\s*([\d,]+)\s+\([^)]*\)\s+[^:]*:(.*?)(\s+\[.*\])?$", line)
-        if m and not re.search(r"\(\d[\d,]*x\)$", m.group(2)):
+        if m:
             name = m.group(2).strip()
             costs[name] = costs.get(name, 0) + int(m.group(1).replace(",", ""))
     return costs
