@@ -7,23 +7,33 @@ pub const MAX_PERIOD: usize = 64;
 
 /// Whether two returns coincide: ‖a − b‖ ≤ tol (1 + ‖a‖).
 pub fn close(a: &DVector<f64>, b: &DVector<f64>, tol: f64) -> bool {
-    let scale = 1.0 + a.norm();
+    within(a.as_slice(), b.as_slice(), tol * (1.0 + a.norm()))
+}
+
+/// ‖a − b‖ ≤ `bound` (the test of [`close`], with its bound tol (1 + ‖a‖) given: the same
+/// sum in the same order, on slices).
+fn within(a: &[f64], b: &[f64], bound: f64) -> bool {
     a.iter()
-        .zip(b.iter())
+        .zip(b)
         .map(|(x, y)| (x - y).powi(2))
         .sum::<f64>()
         .sqrt()
-        <= tol * scale
+        <= bound
 }
 
 /// The smallest n ≤ `max_period` such that the last n returns each repeat the return n
 /// earlier: P_{k−j} ≈ P_{k−j−n} for j = 0..n (so a whole period-n cycle has converged).
 /// `history` is ordered oldest first. None when no such n exists in the history.
+///
+/// Called on every return of a transient, where the first test (the last return against
+/// the one n earlier) fails for every n: its bound tol (1 + ‖P_k‖) is formed once.
 pub fn detect_period(history: &[DVector<f64>], tol: f64, max_period: usize) -> Option<usize> {
     let len = history.len();
     let last = len.checked_sub(1)?;
+    let newest = history[last].as_slice();
+    let bound = tol * (1.0 + history[last].norm());
     (1..=max_period.min(len / 2)).find(|&n| {
-        close(&history[last], &history[last - n], tol)
+        within(newest, history[last - n].as_slice(), bound)
             && (1..n).all(|j| close(&history[last - j], &history[last - j - n], tol))
     })
 }
