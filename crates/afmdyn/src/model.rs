@@ -330,6 +330,7 @@ impl CantileverModel {
     fn w_tip_slice(&self, z: &[f64], offset: usize) -> f64 {
         let n = self.modes();
         self.tip()
+            .as_slice()
             .iter()
             .zip(&z[offset..offset + n])
             .map(|(a, b)| a * b)
@@ -803,7 +804,13 @@ impl HybridSystem for CantileverModel {
         }
         let p = &self.params;
         let n = p.modes;
-        let wd: f64 = self.tip().iter().zip(&f[..n]).map(|(a, b)| a * b).sum();
+        let wd: f64 = self
+            .tip()
+            .as_slice()
+            .iter()
+            .zip(&f[..n])
+            .map(|(a, b)| a * b)
+            .sum();
         mode.guard_sign() * (wd + p.base_amplitude() * p.omega * (p.omega * tau).cos())
     }
 
@@ -874,6 +881,8 @@ impl HybridSystem for CantileverModel {
 #[derive(Debug, Clone)]
 pub struct BodyContactCheck {
     phi: DMatrix<f64>,
+    /// max_i |φ_j(ξ_i)| per mode j, shape `[N]`: |W(ξ_i)| ≤ Σ_j reach_j |a_j| at every station.
+    reach: Vec<f64>,
 }
 
 impl BodyContactCheck {
@@ -894,15 +903,86 @@ impl BodyContactCheck {
                 phi[(i, j)] = v;
             }
         }
-        BodyContactCheck { phi }
+        let reach = (0..n)
+            .map(|j| phi.column(j).iter().fold(0.0f64, |m, v| m.max(v.abs())))
+            .collect();
+        BodyContactCheck { phi, reach }
     }
 
     /// Whether any station touches the substrate at (τ, z).
+    ///
+    /// Every station's W(ξ_i) = Σ_j φ_j(ξ_i) a_j is bounded by Σ_j reach_j |a_j|; while that
+    /// bound, widened by 1e-9 (far beyond the ≤ 2N ulp by which the computed sums can exceed
+    /// it), stays below α2 sin Ωτ + 1, no station can touch and none is formed — the common
+    /// case away from the sample. Otherwise the stations are formed one by one, each sum in
+    /// the order of the matrix–vector product (mode 0 first), without allocating.
     pub fn touches(&self, model: &CantileverModel, tau: f64, z: &DVector<f64>) -> bool {
         let p = model.params();
         let base = p.base_amplitude() * (p.omega * tau).sin() + 1.0;
-        let n = model.modes();
-        let w = &self.phi * z.rows(0, n);
-        w.iter().any(|wi| wi + base <= 0.0)
+        let a = &z.as_slice()[..model.modes()];
+        let bound: f64 = self.reach.iter().zip(a).map(|(r, x)| r * x.abs()).sum();
+        if bound * (1.0 + 1e-9) < base {
+            return false;
+        }
+        (0..self.phi.nrows()).any(|i| {
+            let w = a
+                .iter()
+                .enumerate()
+                .skip(1)
+                .fold(self.phi[(i, 0)] * a[0], |w, (j, x)| {
+                    w + self.phi[(i, j)] * x
+                });
+            w + base <= 0.0
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::analysis::bifurcation::random_state;
+
+    /// The bound that spares forming the stations never changes the answer: on states scaled
+    /// from far inside to far beyond the substrate (where the bound fails and stations touch),
+    /// `touches` agrees with every station formed by the matrix–vector product, V(ξ_i) ≤ 0.
+    #[test]
+    fn body_contact_bound_never_changes_the_answer() {
+        for modes in [1, 3, 10] {
+            let model = CantileverModel::new(&Params {
+                modes,
+                ..Params::default()
+            })
+            .unwrap();
+            let check = BodyContactCheck::new(&model, 32);
+            let p = model.params();
+            let (mut touched, mut spared) = (0, 0);
+            for k in 0..400u64 {
+                let scale = 0.05 * (k % 80) as f64;
+                let z = random_state(&model, 7, k) * scale;
+                let tau = 0.37 * k as f64;
+                let base = p.base_amplitude() * (p.omega * tau).sin() + 1.0;
+                let w = &check.phi * z.rows(0, modes);
+                let reference = w.iter().any(|wi| wi + base <= 0.0);
+                assert_eq!(
+                    check.touches(&model, tau, &z),
+                    reference,
+                    "N = {modes}, k = {k}"
+                );
+                touched += usize::from(reference);
+                let bound: f64 = check
+                    .reach
+                    .iter()
+                    .zip(z.iter())
+                    .map(|(r, a)| r * a.abs())
+                    .sum();
+                spared += usize::from(bound * (1.0 + 1e-9) < base);
+            }
+            // both outcomes and both paths are exercised
+            assert!(
+                touched > 0 && touched < 400,
+                "N = {modes}: {touched} touching"
+            );
+            assert!(spared > 0 && spared < 400, "N = {modes}: {spared} spared");
+        }
     }
 }
