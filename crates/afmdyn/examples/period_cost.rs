@@ -4,8 +4,9 @@
 //! integrator). The last column is the time per period through [`advance_dyn`] with an observer.
 //!
 //! `cargo run --release -p afmdyn --example period_cost -- <linear|hertz|dmt|impact> <N> [periods]
-//! [both|advance|observed]` (the last argument runs only one of the two timed loops, for
-//! instruction counts). With the linear law, `PROPAGATION=dense|modal` in the environment forces
+//! [both|advance|observed|recorded]` (the last argument runs only one of the two timed loops,
+//! for instruction counts; `recorded` runs the observed one with the statistics observer of a
+//! steady-state recording, [`StatsObserver`], after every step). With the linear law, `PROPAGATION=dense|modal` in the environment forces
 //! the exact propagator's path ([`Propagation`]).
 //!
 //! `... -- build <N> [reps]`: time of one exact-propagator build at the default parameters,
@@ -36,7 +37,7 @@
 use afmdyn::analysis::bifurcation::random_state;
 use afmdyn::analysis::continuation::{continue_branch, ContinuationSpec};
 use afmdyn::analysis::shooting::{shoot, ShootingOptions};
-use afmdyn::analysis::steady::{steady_state, steady_states, SteadyOptions};
+use afmdyn::analysis::steady::{steady_state, steady_states, StatsObserver, SteadyOptions};
 use afmdyn::integrate::exact::{ExactBatch, ExactOptions, ExactPropagator, Propagation};
 use afmdyn::integrate::Integrator;
 use afmdyn::integrate::{advance, advance_dyn, build, IntegratorOptions};
@@ -314,7 +315,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     it.reset(tau0, &z0)?;
     let (mut steps, mut events) = (0usize, 0usize);
     let start = Instant::now();
-    if which != "advance" {
+    if which == "recorded" {
+        // the recording of a steady state (`analysis::steady`): the statistics observer
+        let mut stats = StatsObserver::default();
+        advance_dyn(it.as_mut(), t_end, &mut |it, s, before| {
+            steps += 1;
+            events += usize::from(s.event.is_some());
+            stats.observe(it, s, before);
+            Ok(())
+        })?;
+    } else if which != "advance" {
         advance_dyn(it.as_mut(), t_end, &mut |_, s, _| {
             steps += 1;
             events += usize::from(s.event.is_some());
