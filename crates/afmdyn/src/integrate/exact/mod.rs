@@ -1743,7 +1743,7 @@ mod tests {
     /// [`ModalExp::moments`]) — equal the gap g = σ V_T + dead and its rate from the closed-form
     /// homogeneous solution c̃ᵀ e^{Ãt} y0 (nalgebra's matrix exponential, independent of the
     /// eigendecomposition) plus the harmonic part of eq. 8, to round-off over the whole step,
-    /// in both regions, at N = 1, 3 and 8.
+    /// in both regions, at N = 1, 3 and 8; and so does the dense tip deflection [W, W', W''].
     #[test]
     fn tip_series_equal_the_closed_form() {
         for modes in [1usize, 3, 8] {
@@ -1771,6 +1771,17 @@ mod tests {
                     let dv = row(1, &y) + om * (amp * c - fr.wp[2] * s);
                     let sigma = r.guard_sign();
                     (sigma * v + prop.dead, sigma * dv)
+                };
+                // W_hom = c̃ᵀy and its derivatives c̃ᵀÃy, c̃ᵀÃ²y, plus W_p = wp·(1, sin, cos)
+                let tip_exact = |t: f64| -> [f64; 3] {
+                    let y = y_at(t);
+                    let (s, c) = (om * (tau0 + t)).sin_cos();
+                    let (w0, ws, wc) = (fr.wp[0], fr.wp[1], fr.wp[2]);
+                    [
+                        row(0, &y) + w0 + ws * s + wc * c,
+                        row(1, &y) + om * (ws * c - wc * s),
+                        row(2, &y) - om * om * (ws * s + wc * c),
+                    ]
                 };
                 let y_mid = y_at(0.5 * h);
                 let mut q_mid = Modes::ZERO;
@@ -1804,6 +1815,14 @@ mod tests {
                         let at = format!("N = {modes}, {r:?}, start {case}, t = {t}");
                         assert!((g - ge).abs() <= 1e-13 * scale, "{at}: g {g} vs {ge}");
                         assert!((dg - dge).abs() <= 1e-12 * scale, "{at}: g' {dg} vs {dge}");
+                        // the dense tip deflection [W, W', W''] (eq. 9 at ξ = 1, with the
+                        // particular part W_p), W'' against c̃ᵀÃ²y
+                        let w = poly.w(t);
+                        let we = tip_exact(t);
+                        for (d, tol) in [(0, 1e-13), (1, 1e-12), (2, 1e-11 * (1.0 + sp.rho))] {
+                            let (a, b) = (w[d], we[d]);
+                            assert!((a - b).abs() <= tol * scale, "{at}: W^({d}) {a} vs {b}");
+                        }
                     }
                 }
             }
