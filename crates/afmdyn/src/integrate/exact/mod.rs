@@ -1111,7 +1111,7 @@ impl ExactPropagator {
         out.sigma = r.guard_sign();
         out.dead = dead;
         out.curv = curv;
-        out.gc2_ready = false;
+        out.refilled();
     }
 
     /// Build the tip series of the last step (unless the step built it), covering local time

@@ -21,7 +21,12 @@ pub(super) struct TipPoly {
     /// only; the search does not need them).
     gc2: [f64; K + 1],
     /// Whether `gc2` belongs to this polynomial.
-    pub(super) gc2_ready: bool,
+    gc2_ready: bool,
+    /// Taylor coefficients mo[n + i]/n! of W_hom and its first two derivatives (i = 0, 1, 2),
+    /// filled on first use by [`TipPoly::w`] (dense output only).
+    hc: [[f64; K + 1]; 3],
+    /// Whether `hc` belongs to this polynomial.
+    hc_ready: bool,
     /// Terms kept: the tail beyond is below round-off over the step.
     pub(super) terms: usize,
     pub(super) wp: [f64; 3],
@@ -47,6 +52,8 @@ impl TipPoly {
             gc: [[0.0; K + 1]; 2],
             gc2: [0.0; K + 1],
             gc2_ready: false,
+            hc: [[0.0; K + 1]; 3],
+            hc_ready: false,
             terms: 1,
             wp: [0.0; 3],
             omega: 0.0,
@@ -74,23 +81,33 @@ impl TipPoly {
         }
         (p[0] + t * p[1]) + t2 * (p[2] + t * p[3])
     }
-    /// Σ mo[n + i] uⁿ/n! over the kept terms: the i-th derivative of W_hom at local time t.
-    fn hom(&self, i: usize, t: f64) -> f64 {
-        let mut c = [0.0; K + 1];
-        for (n, o) in c[..self.terms].iter_mut().enumerate() {
-            *o = self.mo[n + i] * super::INV_FACT[n];
-        }
-        Self::horner(&c[..self.terms], t - self.center)
+    /// The coefficients derived on first use (`gc2`, `hc`) no longer belong to the series: the
+    /// propagator's `build_poly` has filled it anew.
+    pub(super) fn refilled(&mut self) {
+        self.gc2_ready = false;
+        self.hc_ready = false;
     }
-    /// [W, W', W''] of the tip at local time t.
-    pub(super) fn w(&self, t: f64) -> [f64; 3] {
+    /// [W, W', W''] of the tip at local time t: Σ mo[n + i] uⁿ/n! over the kept terms (the
+    /// i-th derivative of W_hom, its coefficients formed on the first call) plus the harmonic
+    /// part W_p.
+    pub(super) fn w(&mut self, t: f64) -> [f64; 3] {
+        if !self.hc_ready {
+            for (i, hc) in self.hc.iter_mut().enumerate() {
+                for (n, o) in hc[..self.terms].iter_mut().enumerate() {
+                    *o = self.mo[n + i] * super::INV_FACT[n];
+                }
+            }
+            self.hc_ready = true;
+        }
         let (s, c) = (self.omega * (self.tau0 + t)).sin_cos();
         let (w0, ws, wc) = (self.wp[0], self.wp[1], self.wp[2]);
         let om = self.omega;
+        let u = t - self.center;
+        let hom = |i: usize| Self::horner(&self.hc[i][..self.terms], u);
         [
-            self.hom(0, t) + w0 + ws * s + wc * c,
-            self.hom(1, t) + om * (ws * c - wc * s),
-            self.hom(2, t) - om * om * (ws * s + wc * c),
+            hom(0) + w0 + ws * s + wc * c,
+            hom(1) + om * (ws * c - wc * s),
+            hom(2) - om * om * (ws * s + wc * c),
         ]
     }
     /// [V_T, dV_T/dτ, d²V_T/dτ²] at local time t: three Horner sums, no sine (the harmonic
