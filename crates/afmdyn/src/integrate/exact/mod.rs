@@ -1114,6 +1114,15 @@ impl ExactPropagator {
         out.refilled();
     }
 
+    /// (sin Ωτ, cos Ωτ): kept from the last switching or reset when τ is its time (the start
+    /// of the step after it), formed otherwise.
+    fn trig_at(&self, tau: f64) -> (f64, f64) {
+        match self.entry_trig {
+            (t, sc) if t == tau => sc,
+            _ => (self.model.omega() * tau).sin_cos(),
+        }
+    }
+
     /// Build the tip series of the last step (unless the step built it), covering local time
     /// t (dense output).
     fn poly_for_last(&mut self, t: f64) {
@@ -1131,11 +1140,7 @@ impl ExactPropagator {
             self.model.params(),
             self.dead,
             self.last.region,
-            (
-                self.last.tau0,
-                0.0,
-                (self.model.omega() * self.last.tau0).sin_cos(),
-            ),
+            (self.last.tau0, 0.0, self.trig_at(self.last.tau0)),
             SeriesStart::Energy(&y0[..dim]),
             len,
             &mut self.poly,
@@ -1406,12 +1411,9 @@ impl ExactPropagator {
                 self.zb.as_mut_slice(),
             ),
             _ => {
-                // sin, cos at τ0 kept from the switching or reset there; at τ_b once (τ0 + len
+                // sin, cos at τ0 (kept from a switching or reset there); at τ_b once (τ0 + len
                 // is τ_b but for rounding, when τ_b > 2τ0)
-                let sc0 = match self.entry_trig {
-                    (tau, sc) if tau == tau0 => sc,
-                    _ => (omega * tau0).sin_cos(),
-                };
+                let sc0 = self.trig_at(tau0);
                 let dz0 = self.last.dz0.as_mut_slice();
                 Self::zp_at(fr, sc0, dz0);
                 for (d, z) in dz0.iter_mut().zip(self.z.as_slice()) {
@@ -1462,11 +1464,10 @@ impl ExactPropagator {
                 }
                 _ => {
                     self.last_y0(&mut y0[..dim]);
-                    let sc0 = match self.entry_trig {
-                        (tau, sc) if tau == tau0 => sc,
-                        _ => (omega * tau0).sin_cos(),
-                    };
-                    ((tau0, 0.0, sc0), SeriesStart::Energy(&y0[..dim]))
+                    (
+                        (tau0, 0.0, self.trig_at(tau0)),
+                        SeriesStart::Energy(&y0[..dim]),
+                    )
                 }
             };
             Self::build_poly(
