@@ -33,7 +33,7 @@ use super::observables::{observe, ObservableOptions, Observables};
 use super::shooting::{shoot_with, ShootingOptions};
 use super::steady::{steady_state, SteadyOptions};
 use crate::error::SimError;
-use crate::integrate::{advance_dyn, build, Integrator, IntegratorOptions};
+use crate::integrate::{advance, build, Integrator, IntegratorOptions};
 use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
 use nalgebra::{Complex, DVector};
@@ -408,7 +408,7 @@ pub fn settle(
     while elapsed < newton_periods {
         integ.set_variational(false);
         integ.reset(0.0, &x)?;
-        advance_dyn(integ, chunk as f64 * period, &mut |_, _, _| Ok(()))?;
+        advance(integ, chunk as f64 * period)?;
         elapsed += chunk;
         chunks += 1;
         x = integ.state().clone();
