@@ -6,7 +6,7 @@
 //! `cargo run --release -p afmdyn --example period_cost -- <linear|hertz|dmt|impact> <N> [periods]
 //! [both|advance|observed|recorded]` (the last argument runs only one of the two timed loops,
 //! for instruction counts; `recorded` runs the observed one with the statistics observer of a
-//! steady-state recording, [`StatsObserver`], after every step). With the linear law, `PROPAGATION=dense|modal` in the environment forces
+//! steady-state recording, [`StatsObserver`] through [`advance_observed`], after every step). With the linear law, `PROPAGATION=dense|modal` in the environment forces
 //! the exact propagator's path ([`Propagation`]).
 //!
 //! `... -- build <N> [reps]`: time of one exact-propagator build at the default parameters,
@@ -40,10 +40,32 @@ use afmdyn::analysis::shooting::{shoot, ShootingOptions};
 use afmdyn::analysis::steady::{steady_state, steady_states, StatsObserver, SteadyOptions};
 use afmdyn::integrate::exact::{ExactBatch, ExactOptions, ExactPropagator, Propagation};
 use afmdyn::integrate::Integrator;
-use afmdyn::integrate::{advance, advance_dyn, build, IntegratorOptions};
+use afmdyn::integrate::{
+    advance, advance_dyn, advance_observed, build, IntegratorOptions, Observed, Observer, Step,
+};
 use afmdyn::{CantileverModel, LawKind, Params, SweepParam};
 use nalgebra::DVector;
 use std::time::Instant;
+
+/// The statistics observer of a steady-state recording ([`StatsObserver`] through
+/// [`advance_observed`], as `analysis::steady` records), counting the steps and events.
+#[derive(Default)]
+struct Counted {
+    stats: StatsObserver,
+    steps: usize,
+    events: usize,
+}
+
+impl Observer for Counted {
+    fn start(&mut self, it: &mut Observed<'_>) -> Result<(), afmdyn::SimError> {
+        self.stats.start(it)
+    }
+    fn step(&mut self, it: &mut Observed<'_>, s: &Step) -> Result<(), afmdyn::SimError> {
+        self.steps += 1;
+        self.events += usize::from(s.event.is_some());
+        self.stats.step(it, s)
+    }
+}
 
 fn best_of(reps: usize, mut f: impl FnMut()) -> f64 {
     (0..reps)
@@ -308,7 +330,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let (tau0, z0) = (it.tau(), it.state().clone());
     let t_end = tau0 + periods * p.period();
     let start = Instant::now();
-    if which != "observed" {
+    if matches!(which.as_str(), "both" | "advance") {
         advance(it.as_mut(), t_end)?;
     }
     let us = start.elapsed().as_secs_f64() * 1e6 / periods;
@@ -317,13 +339,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let start = Instant::now();
     if which == "recorded" {
         // the recording of a steady state (`analysis::steady`): the statistics observer
-        let mut stats = StatsObserver::default();
-        advance_dyn(it.as_mut(), t_end, &mut |it, s, before| {
-            steps += 1;
-            events += usize::from(s.event.is_some());
-            stats.observe(it, s, before);
-            Ok(())
-        })?;
+        let mut rec = Counted::default();
+        advance_observed(it.as_mut(), t_end, &mut rec)?;
+        (steps, events) = (rec.steps, rec.events);
     } else if which != "advance" {
         advance_dyn(it.as_mut(), t_end, &mut |_, s, _| {
             steps += 1;

@@ -22,6 +22,7 @@
 use crate::contact::{ContactLaw, TipSample, TipSampleLaw};
 use crate::error::{ParamError, SimError};
 use crate::galerkin::{Galerkin, Region};
+use crate::integrate::Observed;
 use crate::params::{Params, SweepParam};
 use crate::system::{EventKind, Guard, HybridSystem, Jump};
 use nalgebra::{DMatrix, DVector};
@@ -362,6 +363,13 @@ impl CantileverModel {
             w[1] + p.base_amplitude() * p.omega * c,
             w[2] - p.base_amplitude() * p.omega * p.omega * s,
         ]
+    }
+    /// [W(1,τ), ∂W(1,τ)/∂τ, V_T, dV_T/dτ] at (τ, z), `z: [f64; 2N]` as (a, ȧ): the tip
+    /// deflection and rate (eq. 9 at ξ = 1) and eq. 8 from one sin/cos Ωτ.
+    pub fn tip_values(&self, tau: f64, z: &DVector<f64>) -> [f64; 4] {
+        let (w, w_dot) = (self.w_tip(z), self.w_tip_dot(z));
+        let [v_t, v_t_dot, _] = self.v_t_from_tip(tau, [w, w_dot, 0.0]);
+        [w, w_dot, v_t, v_t_dot]
     }
     /// dV_T/dτ = ∂W(1,τ)/∂τ + α2 Ω cos Ωτ.
     pub fn v_t_dot(&self, tau: f64, z: &DVector<f64>) -> f64 {
@@ -917,11 +925,12 @@ impl BodyContactCheck {
     /// case away from the sample. Otherwise the stations are formed one by one, each sum in
     /// the order of the matrix–vector product (mode 0 first), without allocating.
     pub fn touches(&self, model: &CantileverModel, tau: f64, z: &DVector<f64>) -> bool {
-        let p = model.params();
-        let base = p.base_amplitude() * (p.omega * tau).sin() + 1.0;
-        let a = &z.as_slice()[..model.modes()];
-        let bound: f64 = self.reach.iter().zip(a).map(|(r, x)| r * x.abs()).sum();
-        if bound * (1.0 + 1e-9) < base {
+        self.touches_at(Self::base(model, tau), &z.as_slice()[..model.modes()])
+    }
+
+    /// [`BodyContactCheck::touches`] given the base α2 sin Ωτ + 1 and the displacements a.
+    fn touches_at(&self, base: f64, a: &[f64]) -> bool {
+        if Self::spared(weighted_displacement(&self.reach, a), base) {
             return false;
         }
         (0..self.phi.nrows()).any(|i| {
@@ -935,6 +944,38 @@ impl BodyContactCheck {
             w + base <= 0.0
         })
     }
+
+    /// [`BodyContactCheck::touches`] at the state an observer of
+    /// [`crate::integrate::advance_observed`] sees, without forming it where the integrator's
+    /// bound ([`Observed::displacement_bound`], ≥ Σ_j reach_j |a_j|) already spares the
+    /// stations: the same answer as `touches` on the formed state.
+    pub fn touches_observed(&self, it: &mut Observed<'_>) -> bool {
+        let base = Self::base(it.model(), it.tau());
+        if Self::spared(it.displacement_bound(&self.reach), base) {
+            return false;
+        }
+        let n = it.model().modes();
+        self.touches_at(base, &it.state().as_slice()[..n])
+    }
+
+    /// α2 sin Ωτ + 1: a station touches when W(ξ_i, τ) + this ≤ 0.
+    fn base(model: &CantileverModel, tau: f64) -> f64 {
+        let p = model.params();
+        p.base_amplitude() * (p.omega * tau).sin() + 1.0
+    }
+
+    /// Whether a bound of Σ_j reach_j |a_j| keeps every station off the substrate: the bound,
+    /// widened by 1e-9 (far beyond the ≤ 2N ulp by which the computed sums can exceed it),
+    /// below the base.
+    fn spared(bound: f64, base: f64) -> bool {
+        bound * (1.0 + 1e-9) < base
+    }
+}
+
+/// Σ_j c_j |a_j| over `weights` c (≥ 0) and the leading entries of `a` (the modal
+/// displacements of a state (a, ȧ)), in index order.
+pub fn weighted_displacement(weights: &[f64], a: &[f64]) -> f64 {
+    weights.iter().zip(a).map(|(c, x)| c * x.abs()).sum()
 }
 
 #[cfg(test)]

@@ -224,6 +224,33 @@ pub trait Integrator: Send {
     }
     /// Integrator name.
     fn name(&self) -> &'static str;
+    /// [W(1,τ), ∂W(1,τ)/∂τ, V_T, dV_T/dτ] at the current state (eq. 8 and 9). The default
+    /// forms them from [`Integrator::state`] ([`CantileverModel::tip_values`]); the exact
+    /// propagator takes V_T from its switching test and W from its modal coordinates, without
+    /// forming the plain state (equal to round-off).
+    fn tip_values(&self) -> [f64; 4] {
+        self.model().tip_values(self.tau(), self.state())
+    }
+    /// An upper bound of Σ_j c_j |a_j| at the current state (`weights` c_j ≥ 0, shape `[N]`, a
+    /// the modal displacements). The default forms it from [`Integrator::state`]
+    /// ([`crate::model::weighted_displacement`]); the exact propagator bounds it from its modal
+    /// coordinates without forming the plain state.
+    fn displacement_bound(&mut self, weights: &[f64]) -> f64 {
+        crate::model::weighted_displacement(weights, self.state().as_slice())
+    }
+    /// One step as [`Integrator::step`], after which the plain state may lag behind the
+    /// integrator's own representation until [`Integrator::form_state`]: [`Integrator::state`]
+    /// is then not the current state. The default is `step` (the state always formed). Called
+    /// by [`advance_observed`], whose observers see the integrator through [`Observed`], which
+    /// forms the state before handing it out.
+    ///
+    /// # Errors
+    /// As [`Integrator::step`].
+    fn step_deferred(&mut self, tau_max: f64) -> Result<Step, SimError> {
+        self.step(tau_max)
+    }
+    /// Form the plain state after [`Integrator::step_deferred`] (the default: nothing to do).
+    fn form_state(&mut self) {}
     /// Advance to exactly `tau_end` without observing the steps: the same steps and events as
     /// calling [`Integrator::step`] until `tau_end`, but an integrator may keep its state in an
     /// internal representation in between (the exact propagator's modal coordinates).
@@ -268,6 +295,103 @@ pub fn advance_dyn(
         on_step(integ, &step, &before)?;
     }
     Ok(())
+}
+
+/// The integrator as an observer of [`advance_observed`] sees it after a step: time, region,
+/// the tip values and the displacement bound at the current state (cheap), dense output over
+/// the last step, and the plain state, formed on request.
+pub struct Observed<'a> {
+    integ: &'a mut dyn Integrator,
+}
+
+impl Observed<'_> {
+    /// The model.
+    pub fn model(&self) -> &CantileverModel {
+        self.integ.model()
+    }
+    /// Current time τ.
+    pub fn tau(&self) -> f64 {
+        self.integ.tau()
+    }
+    /// Region in force at the current state.
+    pub fn region(&self) -> Region {
+        self.integ.region()
+    }
+    /// [W(1,τ), ∂W(1,τ)/∂τ, V_T, dV_T/dτ] at the current state ([`Integrator::tip_values`]).
+    pub fn tip_values(&self) -> [f64; 4] {
+        self.integ.tip_values()
+    }
+    /// An upper bound of Σ_j c_j |a_j| at the current state
+    /// ([`Integrator::displacement_bound`]).
+    pub fn displacement_bound(&mut self, weights: &[f64]) -> f64 {
+        self.integ.displacement_bound(weights)
+    }
+    /// The current state z = (a, ȧ), shape `[2N]`, formed if it lags behind.
+    pub fn state(&mut self) -> &DVector<f64> {
+        self.integ.form_state();
+        self.integ.state()
+    }
+    /// [`Integrator::dense_tip`] inside the last step.
+    pub fn dense_tip(&mut self, tau: f64) -> [f64; 3] {
+        self.integ.dense_tip(tau)
+    }
+    /// [`Integrator::dense_v_t`] inside the last step.
+    pub fn dense_v_t(&mut self, tau: f64) -> [f64; 3] {
+        self.integ.dense_v_t(tau)
+    }
+    /// The integrator itself, with its plain state formed.
+    pub fn integrator(&mut self) -> &mut dyn Integrator {
+        self.integ.form_state();
+        &mut *self.integ
+    }
+}
+
+/// An observer of the steps of [`advance_observed`].
+pub trait Observer {
+    /// At the start of an [`advance_observed`] call, before its first step (the default does
+    /// nothing).
+    ///
+    /// # Errors
+    /// What the observer returns; it ends the run.
+    fn start(&mut self, it: &mut Observed<'_>) -> Result<(), SimError> {
+        let _ = it;
+        Ok(())
+    }
+    /// After every step; `it` is at the step's end (after the jump of an event that ends it;
+    /// the state before the event is the event's).
+    ///
+    /// # Errors
+    /// What the observer returns; it ends the run.
+    fn step(&mut self, it: &mut Observed<'_>, step: &Step) -> Result<(), SimError>;
+}
+
+/// Advance `integ` to exactly `tau_end`, calling `obs` after every step: the same steps, events
+/// and final state as [`advance_dyn`] (bit for bit), but the plain state is formed only where
+/// the observer asks for it ([`Observed::state`]) and at the end — the observer sees what the
+/// exact propagator has at hand in modal coordinates (tip values, displacement bound, dense
+/// output) instead of a state formed after every step ((2N)² work, the cost of the observed
+/// path at large N: `docs/performance.md`).
+///
+/// # Errors
+/// As [`Integrator::step`], or what `obs` returns; [`SimError::NotFinite`] for a non-finite
+/// `tau_end`. The plain state is formed also when a step or the observer fails.
+pub fn advance_observed(
+    integ: &mut dyn Integrator,
+    tau_end: f64,
+    obs: &mut dyn Observer,
+) -> Result<(), SimError> {
+    crate::error::finite("tau_end", tau_end)?;
+    let mut run = || -> Result<(), SimError> {
+        obs.start(&mut Observed { integ: &mut *integ })?;
+        while integ.tau() < tau_end {
+            let step = integ.step_deferred(tau_end)?;
+            obs.step(&mut Observed { integ: &mut *integ }, &step)?;
+        }
+        Ok(())
+    };
+    let out = run();
+    integ.form_state();
+    out
 }
 
 /// Which integrator to use.

@@ -22,7 +22,7 @@
 //! alone. What it saves is the per-step bookkeeping of the scalar step, and the loops over
 //! lanes vectorize.
 
-use super::{grid_v_t, search::StepEnds, ExactPropagator};
+use super::{grid_v_t, search::StepEnds, ExactPropagator, Form};
 use crate::error::SimError;
 use crate::galerkin::Region;
 use crate::integrate::Integrator;
@@ -447,7 +447,7 @@ impl ExactBatch {
                             break Lane::Parked(j);
                         }
                     }
-                    if let Err(e) = lane.step_impl(tau_end, false) {
+                    if let Err(e) = lane.step_impl(tau_end, Form::Nothing) {
                         out[l] = Err(e);
                         break Lane::Done;
                     }
@@ -485,7 +485,7 @@ impl ExactBatch {
                     state[l] = Lane::Loose;
                     // (back on the grid at τ_{j+1}, it is parked there by the next pass)
                     while lane.tau < tau_b {
-                        if let Err(e) = lane.step_impl(tau_b, false) {
+                        if let Err(e) = lane.step_impl(tau_b, Form::Nothing) {
                             out[l] = Err(e);
                             state[l] = Lane::Done;
                             break;

@@ -112,12 +112,17 @@ fn modal_v_t(
     (w, wd): (f64, f64),
     sc: (f64, f64),
 ) -> (f64, f64) {
-    let [w0, ws, wc] = fr.wp;
-    let (s, c) = sc;
-    let om = model.omega();
-    let tip = [w + w0 + ws * s + wc * c, wd + om * (ws * c - wc * s), 0.0];
-    let [v, vd, _] = model.v_t_at(sc, tip);
+    let tip = modal_tip(model.omega(), fr, (w, wd), sc);
+    let [v, vd, _] = model.v_t_at(sc, [tip.0, tip.1, 0.0]);
     (v, vd)
+}
+
+/// (W(1,τ), ∂W(1,τ)/∂τ) in a modal region at a time with (sin Ωτ, cos Ωτ) = `sc`, from the tip
+/// deflection and rate (w, ẇ) of the homogeneous part: W = w + W_p (see [`modal_v_t`]).
+#[inline(always)]
+fn modal_tip(omega: f64, fr: &Forced, (w, wd): (f64, f64), (s, c): (f64, f64)) -> (f64, f64) {
+    let [w0, ws, wc] = fr.wp;
+    (w + w0 + ws * s + wc * c, wd + omega * (ws * c - wc * s))
 }
 
 /// [`modal_v_t`] at grid point k of a period from the particular part's V_T there
@@ -387,6 +392,19 @@ struct LastStep {
     full: bool,
 }
 
+/// What [`ExactPropagator::step_impl`] forms besides the propagation itself.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Form {
+    /// The plain state after every step and the record of an event ([`Integrator::step`]).
+    All,
+    /// The record of an event; after a step in a modal region the plain state lags behind q
+    /// ([`Integrator::step_deferred`]).
+    Events,
+    /// Neither (inside [`Integrator::advance_to`] and the batch, which read only the result's
+    /// `Ok`/`Err`).
+    Nothing,
+}
+
 /// Exact propagator (see the module docs).
 #[derive(Debug, Clone)]
 pub struct ExactPropagator {
@@ -450,6 +468,16 @@ pub struct ExactPropagator {
     param_data: Option<(SweepParam, Arc<[ParticularDerivative; 2]>)>,
     /// ∂z_p/∂p at the end (τ, region) of the last step it was asked for.
     param_end: Option<(f64, Region, [f64; MAXD])>,
+    /// The column sums of [`Integrator::displacement_bound`] for the last weights.
+    bound_cols: BoundCols,
+}
+
+/// Σ_j c_j |b_jk| over the first N rows of T⁻¹V, per modal representative k, for weights c
+/// (per region, formed on first use).
+#[derive(Debug, Clone, Default)]
+struct BoundCols {
+    weights: Vec<f64>,
+    cols: [Vec<f64>; 2],
 }
 
 /// The forcing data of a build, shared by every build with the same key ([`forcing_key`]):
@@ -711,6 +739,7 @@ impl ExactPropagator {
             dz_run: zero,
             param_data: None,
             param_end: None,
+            bound_cols: BoundCols::default(),
         })
     }
 
@@ -953,18 +982,34 @@ impl ExactPropagator {
         }
         let ri = self.region.index();
         if let Some(me) = &self.spec[ri].modal {
-            let z = self.z.as_mut_slice();
-            let fr = &self.forced[ri];
-            match self.on_grid {
-                Some((_, k)) => {
-                    let (dim, col) = (z.len(), if k == 0 { self.grid.m } else { k });
-                    z.copy_from_slice(&fr.zp_grid.as_slice()[col * dim..(col + 1) * dim]);
-                }
-                None => Self::zp_into(fr, self.model.omega(), self.tau, z),
-            }
-            ModalExp::expand(&me.tv, &self.q, z, true);
+            let mut z = std::mem::take(&mut self.z);
+            self.zp_now(z.as_mut_slice());
+            ModalExp::expand(&me.tv, &self.q, z.as_mut_slice(), true);
+            self.z = z;
         }
         self.stale = false;
+    }
+
+    /// z_p at the current τ in the current region into `out` (`[2N]`): on a grid point the grid
+    /// table's value (column k, or m at a period end), elsewhere from sin/cos Ωτ.
+    fn zp_now(&self, out: &mut [f64]) {
+        let fr = &self.forced[self.region.index()];
+        match self.on_grid {
+            Some((_, k)) => {
+                let (dim, col) = (out.len(), if k == 0 { self.grid.m } else { k });
+                out.copy_from_slice(&fr.zp_grid.as_slice()[col * dim..(col + 1) * dim]);
+            }
+            None => Self::zp_into(fr, self.model.omega(), self.tau, out),
+        }
+    }
+
+    /// (sin Ωτ, cos Ωτ) at the current τ: on a grid point from the grid's table (column k, or m
+    /// at a period end, as [`Self::zp_now`]), elsewhere [`Self::trig_at`].
+    fn trig_now(&self) -> (f64, f64) {
+        match self.on_grid {
+            Some((_, k)) => self.trig[if k == 0 { self.grid.m } else { k }],
+            None => self.trig_at(self.tau),
+        }
     }
 
     /// At the end of a period: form the plain state and stop with [`SimError::Diverged`] when
@@ -1177,7 +1222,7 @@ impl ExactPropagator {
 
     /// Whole grid steps from the current grid point, as long as each ends by `tau_end` and
     /// passes the certified test — the common case between switchings — exactly as
-    /// [`Self::step_impl`] without `materialize` takes them (the same operations in the same
+    /// [`Self::step_impl`] with [`Form::Nothing`] takes them (the same operations in the same
     /// order, so bit for bit the same states, V_T and last step), without its per-step
     /// bookkeeping. Stops before a step that would end off the grid or beyond `tau_end`, or
     /// that fails the test (`step_impl` then takes it, with the search), and right after a
@@ -1243,7 +1288,7 @@ impl ExactPropagator {
     }
 
     /// [`Self::grid_run`] in a modal region: q ← e^{Λh} ⊙ q, the plain state not formed (as
-    /// `step_impl` without `materialize`). Returns whether it stopped at the end of a period.
+    /// `step_impl` with [`Form::Nothing`]). Returns whether it stopped at the end of a period.
     fn modal_run(&mut self, tau_end: f64) -> bool {
         let Some(mut at) = self.on_grid else {
             return false;
@@ -1320,11 +1365,11 @@ impl ExactPropagator {
         self.stale = modal;
     }
 
-    /// One step (see [`Integrator::step`]). Without `materialize` (inside
-    /// [`Integrator::advance_to`], which reads only the result's `Ok`/`Err`): in a modal region
-    /// the plain state at the end of a step is not formed (z lags behind q), and a switching is
+    /// One step (see [`Integrator::step`]), forming what `form` asks for: with
+    /// [`Form::Events`] and [`Form::Nothing`] the plain state at the end of a step in a modal
+    /// region is not formed (z lags behind q), and with [`Form::Nothing`] a switching is
     /// returned without its event record (no copy of the state).
-    fn step_impl(&mut self, tau_max: f64, materialize: bool) -> Result<Step, SimError> {
+    pub(super) fn step_impl(&mut self, tau_max: f64, form: Form) -> Result<Step, SimError> {
         let region = self.region;
         let tau0 = self.tau;
         let omega = self.model.omega();
@@ -1384,7 +1429,7 @@ impl ExactPropagator {
                 };
                 self.last.q0.copy_prefix(&self.q, me.len());
                 let (w, wd) = me.advance_into(&self.last.q0, fac, &mut self.q);
-                if !materialize {
+                if form != Form::All {
                     end_state = false;
                 } else {
                     let zb = self.zb.as_mut_slice();
@@ -1544,7 +1589,7 @@ impl ExactPropagator {
                 self.entry_trig = (tau_s, sc);
                 self.enter_stint(to, sc);
                 self.chatter.record(tau_s)?;
-                if !materialize {
+                if form == Form::Nothing {
                     return Ok(Step {
                         tau0,
                         tau1: tau_s,
@@ -1604,7 +1649,76 @@ impl Integrator for ExactPropagator {
     }
 
     fn step(&mut self, tau_max: f64) -> Result<Step, SimError> {
-        self.step_impl(tau_max, true)
+        self.step_impl(tau_max, Form::All)
+    }
+
+    fn step_deferred(&mut self, tau_max: f64) -> Result<Step, SimError> {
+        self.step_impl(tau_max, Form::Events)
+    }
+
+    fn form_state(&mut self) {
+        self.materialize();
+    }
+
+    /// V_T and dV_T/dτ of the switching test at the end of the last step; W and ∂W/∂τ from the
+    /// plain state, or, while it lags behind, from the modal coordinates: Σ_k Re(w_k c̃ᵀv_k q_k)
+    /// (and with λ_k) plus the particular part (`modal_tip`).
+    fn tip_values(&self) -> [f64; 4] {
+        let (v, vd) = self.vt;
+        let ri = self.region.index();
+        let (w, wd) = match (&self.spec[ri].modal, self.stale) {
+            (Some(me), true) => modal_tip(
+                self.model.omega(),
+                &self.forced[ri],
+                me.tip_of(&self.q),
+                self.trig_now(),
+            ),
+            _ => (self.model.w_tip(&self.z), self.model.w_tip_dot(&self.z)),
+        };
+        [w, wd, v, vd]
+    }
+
+    /// While the plain state lags behind the modal coordinates: a = a_p(τ) + Σ_k Re(b_k q_k)
+    /// (the first N rows b_k of T⁻¹V, `ModalExp::expand`), and |Re(b q)| ≤ |b| |q|, so the
+    /// bound is Σ_j c_j |a_p,j| plus Σ_k (Σ_j c_j |b_jk|) |q_k|, the column sums kept per region
+    /// for the last weights (|q_k| as √(Re² + Im²): within a few ulp, which the 1e-9 widening
+    /// of the body-contact test covers; the states are below 1e12, far from overflow).
+    /// Otherwise the sum itself.
+    fn displacement_bound(&mut self, weights: &[f64]) -> f64 {
+        let ri = self.region.index();
+        let (Some(me), true) = (&self.spec[ri].modal, self.stale) else {
+            return crate::model::weighted_displacement(weights, self.z.as_slice());
+        };
+        let n = self.model.modes();
+        let cache = &mut self.bound_cols;
+        let same = cache.weights.len() == weights.len()
+            && cache
+                .weights
+                .iter()
+                .zip(weights)
+                .all(|(a, b)| a.to_bits() == b.to_bits());
+        if !same {
+            cache.weights.clear();
+            cache.weights.extend_from_slice(weights);
+            cache.cols.iter_mut().for_each(Vec::clear);
+        }
+        let cols = &mut cache.cols[ri];
+        if cols.is_empty() {
+            cols.extend((0..me.len()).map(|k| {
+                (0..n.min(weights.len()))
+                    .map(|j| weights[j] * me.tv.re[(j, k)].hypot(me.tv.im[(j, k)]))
+                    .sum::<f64>()
+            }));
+        }
+        let hom: f64 = cols
+            .iter()
+            .zip(self.q.re.iter().zip(&self.q.im))
+            .map(|(c, (x, y))| c * (x * x + y * y).sqrt())
+            .sum();
+        let mut zp = [0.0; MAXD];
+        let dim = self.z.len();
+        self.zp_now(&mut zp[..dim]);
+        crate::model::weighted_displacement(weights, &zp[..n]) + hom
     }
 
     fn advance_to(&mut self, tau_end: f64) -> Result<(), SimError> {
@@ -1614,7 +1728,7 @@ impl Integrator for ExactPropagator {
             // switching, or a partial step) by step_impl
             let step = self.grid_run(tau_end).and_then(|()| {
                 if self.tau < tau_end {
-                    self.step_impl(tau_end, false)?;
+                    self.step_impl(tau_end, Form::Nothing)?;
                 }
                 Ok(())
             });

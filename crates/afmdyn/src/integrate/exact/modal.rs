@@ -348,6 +348,20 @@ impl ModalExp {
         (w[0] + w[1], d[0] + d[1])
     }
 
+    /// The tip deflection and rate of the homogeneous part y = V q: Σ_k Re(w_k c̃ᵀv_k q_k) and
+    /// Σ_k Re(w_k c̃ᵀv_k λ_k q_k) (the sums of [`ModalExp::advance_into`] without the step, in
+    /// mode order).
+    pub(super) fn tip_of(&self, q: &Modes) -> (f64, f64) {
+        let r = self.len();
+        let (mut w, mut d) = (0.0, 0.0);
+        for k in 0..r {
+            let (x, y) = (q.re[k], q.im[k]);
+            w += self.tip.re[k] * x - self.tip.im[k] * y;
+            d += self.tip_dot.re[k] * x - self.tip_dot.im[k] * y;
+        }
+        (w, d)
+    }
+
     /// The tip moments mo[n] = c̃ᵀÃⁿ y = Σ_k Re(w_k c̃ᵀv_k λ_kⁿ q_k) of y = V q (n = 0..=K + 2),
     /// and Σ_k w_k |c̃ᵀv_k| |q_k|, which bounds |mo[n]| / max_k |λ_k|ⁿ.
     pub(super) fn moments(&self, q: &Modes, mo: &mut [f64; K + 3]) -> f64 {
