@@ -964,9 +964,8 @@ impl BodyContactCheck {
         p.base_amplitude() * (p.omega * tau).sin() + 1.0
     }
 
-    /// Whether a bound of Σ_j reach_j |a_j| keeps every station off the substrate: the bound,
-    /// widened by 1e-9 (far beyond the ≤ 2N ulp by which the computed sums can exceed it),
-    /// below the base.
+    /// Whether a bound of Σ_j reach_j |a_j|, widened by 1e-9 (see [`BodyContactCheck::touches`]),
+    /// keeps every station off the substrate.
     fn spared(bound: f64, base: f64) -> bool {
         bound * (1.0 + 1e-9) < base
     }

@@ -44,6 +44,17 @@ impl PeriodGrid {
         j
     }
 
+    /// The column of a one-period table over the grid points k = 0..=m (sin/cos Ωτ_k, z_p at
+    /// τ_k) for grid point k of some period reached by a step: m at a period end (k = 0), so
+    /// that the values are those at the end of the period the step ran in.
+    pub fn table_column(&self, k: usize) -> usize {
+        if k == 0 {
+            self.m
+        } else {
+            k
+        }
+    }
+
     /// The first grid time strictly after τ.
     pub fn next(&self, tau: f64) -> f64 {
         self.tau(self.next_index(tau))

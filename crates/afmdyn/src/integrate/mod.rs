@@ -339,11 +339,6 @@ impl Observed<'_> {
     pub fn dense_v_t(&mut self, tau: f64) -> [f64; 3] {
         self.integ.dense_v_t(tau)
     }
-    /// The integrator itself, with its plain state formed.
-    pub fn integrator(&mut self) -> &mut dyn Integrator {
-        self.integ.form_state();
-        &mut *self.integ
-    }
 }
 
 /// An observer of the steps of [`advance_observed`].

@@ -996,7 +996,7 @@ impl ExactPropagator {
         let fr = &self.forced[self.region.index()];
         match self.on_grid {
             Some((_, k)) => {
-                let (dim, col) = (out.len(), if k == 0 { self.grid.m } else { k });
+                let (dim, col) = (out.len(), self.grid.table_column(k));
                 out.copy_from_slice(&fr.zp_grid.as_slice()[col * dim..(col + 1) * dim]);
             }
             None => Self::zp_into(fr, self.model.omega(), self.tau, out),
@@ -1007,7 +1007,7 @@ impl ExactPropagator {
     /// at a period end, as [`Self::zp_now`]), elsewhere [`Self::trig_at`].
     fn trig_now(&self) -> (f64, f64) {
         match self.on_grid {
-            Some((_, k)) => self.trig[if k == 0 { self.grid.m } else { k }],
+            Some((_, k)) => self.trig[self.grid.table_column(k)],
             None => self.trig_at(self.tau),
         }
     }
@@ -1414,7 +1414,7 @@ impl ExactPropagator {
         // sin, cos Ωτ_b: from the grid's table when the step ends on a grid point (column k, or
         // m at a period end, as a whole grid step to it and `materialize` take them)
         let trig_b = if tau_b == t_grid {
-            self.trig[if next.1 == 0 { m } else { next.1 }]
+            self.trig[self.grid.table_column(next.1)]
         } else {
             (omega * tau_b).sin_cos()
         };
@@ -1715,10 +1715,12 @@ impl Integrator for ExactPropagator {
             .zip(self.q.re.iter().zip(&self.q.im))
             .map(|(c, (x, y))| c * (x * x + y * y).sqrt())
             .sum();
-        let mut zp = [0.0; MAXD];
-        let dim = self.z.len();
-        self.zp_now(&mut zp[..dim]);
-        crate::model::weighted_displacement(weights, &zp[..n]) + hom
+        // z_p in the scratch vector (free between steps)
+        let mut zp = std::mem::take(&mut self.zb);
+        self.zp_now(zp.as_mut_slice());
+        let bound = crate::model::weighted_displacement(weights, zp.as_slice()) + hom;
+        self.zb = zp;
+        bound
     }
 
     fn advance_to(&mut self, tau_end: f64) -> Result<(), SimError> {
