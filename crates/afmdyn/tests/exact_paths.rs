@@ -219,15 +219,21 @@ struct Probe {
     worst_tip: f64,
     /// Steps whose W differs in its bits from the one formed (read from the modal coordinates).
     modal_reads: usize,
-    /// Smallest bound / formed Σ c_j |a_j| (≥ 1 for a sound bound).
+    /// Smallest bound / formed Σ c_j |a_j| (≥ 1 for a sound bound), over the tightest bound
+    /// and the loosest the integrator may return.
     tightest: f64,
+    /// Steps where the loosest bound (the stint's, in a modal region) differs from the tightest.
+    loose_reads: usize,
+    /// Steps where the loosest bound is below the tightest (never, for the bounds of one state).
+    loose_below: usize,
     weights: Vec<f64>,
 }
 
 impl Observer for Probe {
     fn step(&mut self, it: &mut Observed<'_>, st: &Step) -> Result<(), SimError> {
         let tip = it.tip_values();
-        let bound = it.displacement_bound(&self.weights);
+        let bound = it.displacement_bound(&self.weights, 0.0);
+        let loose = it.displacement_bound(&self.weights, f64::INFINITY);
         let tau = it.tau();
         let z = it.state().clone();
         let formed = it.model().tip_values(tau, &z);
@@ -236,7 +242,9 @@ impl Observer for Probe {
         }
         self.modal_reads += usize::from(tip[0].to_bits() != formed[0].to_bits());
         let sum = weighted_displacement(&self.weights, z.as_slice());
-        self.tightest = self.tightest.min(bound * (1.0 + 1e-9) / sum);
+        self.tightest = self.tightest.min(bound.min(loose) * (1.0 + 1e-9) / sum);
+        self.loose_reads += usize::from(loose != bound);
+        self.loose_below += usize::from(loose < bound);
         self.steps.push(st.clone());
         Ok(())
     }
@@ -246,19 +254,24 @@ impl Observer for Probe {
 /// and ends at its state, though the plain state is formed only when the observer asks; what
 /// it reads before that — the tip values (eq. 8 and 9) and the bound of Σ c_j |a_j| — agree
 /// with the state formed: the tip values to round-off, the bound never below the sum (so the
-/// body-contact test it spares gives the same answer). Modal (N = 1, 3, 10, 20) and dense
-/// paths, on the attractor at Ω = 2.6 over 10 periods.
+/// body-contact test it spares gives the same answer), neither the tightest nor the one formed
+/// once per stint. Modal (N = 1, 3, 10, 20) and dense paths, on the attractor at Ω = 2.6 over
+/// 10 periods, and a motion that never touches the sample (α2 = 0.01 and a gap α5 = 1: one
+/// stint over all 10 periods, whose bound is formed again after each period).
 #[test]
 fn observed_steps_read_the_modal_coordinates_soundly() {
-    for (modes, path) in [
-        (1usize, Propagation::Auto),
-        (3, Propagation::Auto),
-        (3, Propagation::Dense),
-        (10, Propagation::Auto),
-        (20, Propagation::Auto),
+    for (modes, path, (alpha2, alpha5)) in [
+        (1usize, Propagation::Auto, (0.1, 0.0)),
+        (3, Propagation::Auto, (0.1, 0.0)),
+        (3, Propagation::Dense, (0.1, 0.0)),
+        (10, Propagation::Auto, (0.1, 0.0)),
+        (20, Propagation::Auto, (0.1, 0.0)),
+        (10, Propagation::Auto, (0.01, 1.0)),
     ] {
         let p = Params {
             modes,
+            alpha2,
+            alpha5,
             ..Params::default()
         };
         let m = CantileverModel::new(&p).unwrap();
@@ -280,10 +293,11 @@ fn observed_steps_read_the_modal_coordinates_soundly() {
             ..Probe::default()
         };
         advance_observed(&mut a, tau_end, &mut probe).unwrap();
-        let at = format!("N = {modes}, {path:?}");
+        let at = format!("N = {modes}, {path:?}, α2 = {alpha2}");
         assert_eq!(probe.steps, want, "{at}");
         assert_eq!(a.state(), b.state(), "{at}");
-        assert!(probe.steps.iter().any(|s| s.event.is_some()), "{at}");
+        let touching = probe.steps.iter().any(|s| s.event.is_some());
+        assert_eq!(touching, alpha5 == 0.0, "{at}");
         // (7e-14 at N = 20: sin Ωτ from the grid's table against sin of Ωτ ≈ 300 formed)
         assert!(
             probe.worst_tip <= 1e-12,
@@ -295,11 +309,13 @@ fn observed_steps_read_the_modal_coordinates_soundly() {
             "{at}: bound / sum {}",
             probe.tightest
         );
+        assert_eq!(probe.loose_below, 0, "{at}");
         if path == Propagation::Auto {
             assert!(
                 probe.modal_reads > 0,
                 "{at}: read from the modal coordinates"
             );
+            assert!(probe.loose_reads > 0, "{at}: the stint's bound");
         }
     }
 }

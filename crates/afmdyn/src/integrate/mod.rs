@@ -232,10 +232,13 @@ pub trait Integrator: Send {
         self.model().tip_values(self.tau(), self.state())
     }
     /// An upper bound of Σ_j c_j |a_j| at the current state (`weights` c_j ≥ 0, shape `[N]`, a
-    /// the modal displacements). The default forms it from [`Integrator::state`]
-    /// ([`crate::model::weighted_displacement`]); the exact propagator bounds it from its modal
-    /// coordinates without forming the plain state.
-    fn displacement_bound(&mut self, weights: &[f64]) -> f64 {
+    /// the modal displacements), for a caller that needs to know whether the sum is below
+    /// `enough`: an integrator may return a cheaper, looser bound when it is below `enough`,
+    /// and otherwise returns its tightest (pass 0 for the tightest). The default forms the sum
+    /// from [`Integrator::state`] ([`crate::model::weighted_displacement`]); the exact
+    /// propagator bounds it from its modal coordinates without forming the plain state.
+    fn displacement_bound(&mut self, weights: &[f64], enough: f64) -> f64 {
+        let _ = enough;
         crate::model::weighted_displacement(weights, self.state().as_slice())
     }
     /// One step as [`Integrator::step`], after which the plain state may lag behind the
@@ -321,10 +324,10 @@ impl Observed<'_> {
     pub fn tip_values(&self) -> [f64; 4] {
         self.integ.tip_values()
     }
-    /// An upper bound of Σ_j c_j |a_j| at the current state
-    /// ([`Integrator::displacement_bound`]).
-    pub fn displacement_bound(&mut self, weights: &[f64]) -> f64 {
-        self.integ.displacement_bound(weights)
+    /// An upper bound of Σ_j c_j |a_j| at the current state, possibly a looser one below
+    /// `enough` ([`Integrator::displacement_bound`]).
+    pub fn displacement_bound(&mut self, weights: &[f64], enough: f64) -> f64 {
+        self.integ.displacement_bound(weights, enough)
     }
     /// The current state z = (a, ȧ), shape `[2N]`, formed if it lags behind.
     pub fn state(&mut self) -> &DVector<f64> {

@@ -160,6 +160,7 @@ impl Block {
                 lane.q.im[k] = self.x[self.at(r + k, s)];
             }
             lane.stale = true;
+            lane.tip_hom = None;
         } else {
             for (i, z) in lane.z.iter_mut().enumerate() {
                 *z = self.x[self.at(i, s)];

@@ -427,6 +427,11 @@ pub struct ExactPropagator {
     z: DVector<f64>,
     /// Modal coordinates of the homogeneous part of the current state (valid in a modal region).
     q: Modes,
+    /// The homogeneous part's tip deflection and rate at q, as the step of `step_impl` that
+    /// formed q returned them (`ModalExp::advance_into`, equal bit for bit to
+    /// `ModalExp::tip_of(q)`); `None` where q was formed otherwise (a run of grid steps, the
+    /// batch, a stint entry).
+    tip_hom: Option<(f64, f64)>,
     /// z lags behind q (inside [`Integrator::advance_to`]).
     stale: bool,
     /// Modal scratch: e^{λ_k t} of a partial step, the coordinates at the centre of a tip
@@ -472,12 +477,64 @@ pub struct ExactPropagator {
     bound_cols: BoundCols,
 }
 
-/// Σ_j c_j |b_jk| over the first N rows of T⁻¹V, per modal representative k, for weights c
-/// (per region, formed on first use).
+/// Most grid steps over which the stint's bound of [`Integrator::displacement_bound`] is kept
+/// (see there).
+const STINT_BOUND_STEPS: f64 = 1e5;
+
+/// The tables of [`Integrator::displacement_bound`] for weights c (per region, formed on
+/// first use), and the bound of the current stint's homogeneous part.
 #[derive(Debug, Clone, Default)]
 struct BoundCols {
     weights: Vec<f64>,
+    /// Σ_j c_j |b_jk| over the first N rows of T⁻¹V, per modal representative k.
     cols: [Vec<f64>; 2],
+    /// Σ_j c_j |a_p,j(τ_k)| at the grid points k = 0..=m (the particular part, from the grid
+    /// table of z_p).
+    grid: [Vec<f64>; 2],
+    /// Whether Re λ_k ≤ 0 for every representative (|q_k| never grows).
+    holds: [bool; 2],
+    /// (τ, bound) of the homogeneous part formed in the current stint.
+    stint: Option<(f64, f64)>,
+}
+
+impl BoundCols {
+    /// Make the tables those of `weights` in region `ri`.
+    fn prepare(&mut self, weights: &[f64], ri: usize, me: &ModalExp, fr: &Forced, n: usize) {
+        let same = self.weights.len() == weights.len()
+            && self
+                .weights
+                .iter()
+                .zip(weights)
+                .all(|(a, b)| a.to_bits() == b.to_bits());
+        if !same {
+            self.weights.clear();
+            self.weights.extend_from_slice(weights);
+            self.cols.iter_mut().for_each(Vec::clear);
+            self.grid.iter_mut().for_each(Vec::clear);
+            self.stint = None;
+        }
+        if self.cols[ri].is_empty() {
+            let nw = n.min(weights.len());
+            self.cols[ri].extend((0..me.len()).map(|k| {
+                (0..nw)
+                    .map(|j| weights[j] * me.tv.re[(j, k)].hypot(me.tv.im[(j, k)]))
+                    .sum::<f64>()
+            }));
+            let dim = fr.zp_grid.nrows();
+            let zp = fr.zp_grid.as_slice().chunks_exact(dim.max(1));
+            self.grid[ri].extend(zp.map(|z| crate::model::weighted_displacement(weights, z)));
+            self.holds[ri] = me.lambda.iter().all(|l| l.re <= 0.0);
+        }
+    }
+
+    /// Σ_k cols_k |q_k| in region `ri` (after [`Self::prepare`]).
+    fn hom(&self, ri: usize, q: &Modes) -> f64 {
+        self.cols[ri]
+            .iter()
+            .zip(q.re.iter().zip(&q.im))
+            .map(|(c, (x, y))| c * (x * x + y * y).sqrt())
+            .sum()
+    }
 }
 
 /// The forcing data of a build, shared by every build with the same key ([`forcing_key`]):
@@ -712,6 +769,7 @@ impl ExactPropagator {
             tau: 0.0,
             z: zero.clone(),
             q: Modes::ZERO,
+            tip_hom: None,
             stale: false,
             scratch: Modes::ZERO,
             region: Region::Free,
@@ -990,6 +1048,12 @@ impl ExactPropagator {
         self.stale = false;
     }
 
+    /// Grid steps over which the stint's bound of [`Integrator::displacement_bound`] is kept:
+    /// a period, at most [`STINT_BOUND_STEPS`].
+    fn stint_bound_steps(&self) -> f64 {
+        (self.grid.m as f64).min(STINT_BOUND_STEPS)
+    }
+
     /// z_p at the current τ in the current region into `out` (`[2N]`): on a grid point the grid
     /// table's value (column k, or m at a period end), elsewhere from sin/cos Ωτ.
     fn zp_now(&self, out: &mut [f64]) {
@@ -1208,6 +1272,8 @@ impl ExactPropagator {
         for (d, z) in dz.iter_mut().zip(self.z.as_slice()) {
             *d = z - *d;
         }
+        self.bound_cols.stint = None;
+        self.tip_hom = None;
         self.stint_curvature = match &sp.modal {
             Some(me) => {
                 me.project_plain(dz, &mut self.q);
@@ -1337,6 +1403,8 @@ impl ExactPropagator {
             }
             _ => {}
         }
+        // (the runs of `advance_to` keep no tip: nobody reads it there)
+        self.tip_hom = None;
         self.finish_run(tau0, at, true);
         period_end
     }
@@ -1429,6 +1497,7 @@ impl ExactPropagator {
                 };
                 self.last.q0.copy_prefix(&self.q, me.len());
                 let (w, wd) = me.advance_into(&self.last.q0, fac, &mut self.q);
+                self.tip_hom = Some((w, wd));
                 if form != Form::All {
                     end_state = false;
                 } else {
@@ -1662,7 +1731,8 @@ impl Integrator for ExactPropagator {
 
     /// V_T and dV_T/dτ of the switching test at the end of the last step; W and ∂W/∂τ from the
     /// plain state, or, while it lags behind, from the modal coordinates: Σ_k Re(w_k c̃ᵀv_k q_k)
-    /// (and with λ_k) plus the particular part (`modal_tip`).
+    /// (and with λ_k; as the last step returned them, else `ModalExp::tip_of`) plus the
+    /// particular part (`modal_tip`).
     fn tip_values(&self) -> [f64; 4] {
         let (v, vd) = self.vt;
         let ri = self.region.index();
@@ -1670,7 +1740,7 @@ impl Integrator for ExactPropagator {
             (Some(me), true) => modal_tip(
                 self.model.omega(),
                 &self.forced[ri],
-                me.tip_of(&self.q),
+                self.tip_hom.unwrap_or_else(|| me.tip_of(&self.q)),
                 self.trig_now(),
             ),
             _ => (self.model.w_tip(&self.z), self.model.w_tip_dot(&self.z)),
@@ -1679,48 +1749,51 @@ impl Integrator for ExactPropagator {
     }
 
     /// While the plain state lags behind the modal coordinates: a = a_p(τ) + Σ_k Re(b_k q_k)
-    /// (the first N rows b_k of T⁻¹V, `ModalExp::expand`), and |Re(b q)| ≤ |b| |q|, so the
-    /// bound is Σ_j c_j |a_p,j| plus Σ_k (Σ_j c_j |b_jk|) |q_k|, the column sums kept per region
-    /// for the last weights (|q_k| as √(Re² + Im²): within a few ulp, which the 1e-9 widening
-    /// of the body-contact test covers; the states are below 1e12, far from overflow).
-    /// Otherwise the sum itself.
-    fn displacement_bound(&mut self, weights: &[f64]) -> f64 {
+    /// (the first N rows b_k of T⁻¹V, `ModalExp::expand`), and |Re(b q)| ≤ |b| |q|, so
+    /// Σ_j c_j |a_j| ≤ Σ_j c_j |a_p,j| + Σ_k (Σ_j c_j |b_jk|) |q_k| (|q_k| as √(Re² + Im²):
+    /// within a few ulp, which the 1e-9 widening of the body-contact test covers; the states
+    /// are below 1e12, far from overflow). Where Re λ_k ≤ 0 for every k, |q_k| does not grow
+    /// along a stint (q_k(τ) = e^{λ_k (τ − τ_0)} q_k(τ_0)), so the homogeneous part's sum
+    /// formed once in a stint bounds it at every later point of the stint: with the
+    /// particular part from a table on the grid that is O(1) per step, returned when below
+    /// `enough`. It is widened by 1e-10 and formed again after a period or 10⁵ grid steps,
+    /// whichever is shorter: the rounding of one step's complex product can grow a computed
+    /// |q_k| by a few ulp, at most about 6e-11 over 10⁵ steps. Otherwise the sum at the
+    /// current q. Without modal coordinates, the sum itself.
+    fn displacement_bound(&mut self, weights: &[f64], enough: f64) -> f64 {
         let ri = self.region.index();
         let (Some(me), true) = (&self.spec[ri].modal, self.stale) else {
             return crate::model::weighted_displacement(weights, self.z.as_slice());
         };
-        let n = self.model.modes();
         let cache = &mut self.bound_cols;
-        let same = cache.weights.len() == weights.len()
-            && cache
-                .weights
-                .iter()
-                .zip(weights)
-                .all(|(a, b)| a.to_bits() == b.to_bits());
-        if !same {
-            cache.weights.clear();
-            cache.weights.extend_from_slice(weights);
-            cache.cols.iter_mut().for_each(Vec::clear);
+        cache.prepare(weights, ri, me, &self.forced[ri], self.model.modes());
+        let part = match self.on_grid {
+            Some((_, k)) => cache.grid[ri][self.grid.table_column(k)],
+            None => {
+                // z_p in the scratch vector (free between steps)
+                let mut zp = std::mem::take(&mut self.zb);
+                self.zp_now(zp.as_mut_slice());
+                let part = crate::model::weighted_displacement(weights, zp.as_slice());
+                self.zb = zp;
+                part
+            }
+        };
+        let window = self.grid.h * self.stint_bound_steps();
+        let cache = &mut self.bound_cols;
+        if cache.holds[ri] {
+            let stint = match cache.stint {
+                Some((tau, h)) if self.tau - tau <= window => h,
+                _ => {
+                    let h = cache.hom(ri, &self.q) * (1.0 + 1e-10);
+                    cache.stint = Some((self.tau, h));
+                    h
+                }
+            };
+            if part + stint < enough {
+                return part + stint;
+            }
         }
-        let cols = &mut cache.cols[ri];
-        if cols.is_empty() {
-            cols.extend((0..me.len()).map(|k| {
-                (0..n.min(weights.len()))
-                    .map(|j| weights[j] * me.tv.re[(j, k)].hypot(me.tv.im[(j, k)]))
-                    .sum::<f64>()
-            }));
-        }
-        let hom: f64 = cols
-            .iter()
-            .zip(self.q.re.iter().zip(&self.q.im))
-            .map(|(c, (x, y))| c * (x * x + y * y).sqrt())
-            .sum();
-        // z_p in the scratch vector (free between steps)
-        let mut zp = std::mem::take(&mut self.zb);
-        self.zp_now(zp.as_mut_slice());
-        let bound = crate::model::weighted_displacement(weights, zp.as_slice()) + hom;
-        self.zb = zp;
-        bound
+        part + cache.hom(ri, &self.q)
     }
 
     fn advance_to(&mut self, tau_end: f64) -> Result<(), SimError> {
@@ -1861,6 +1934,44 @@ mod tests {
     /// homogeneous solution c̃ᵀ e^{Ãt} y0 (nalgebra's matrix exponential, independent of the
     /// eigendecomposition) plus the harmonic part of eq. 8, to round-off over the whole step,
     /// in both regions, at N = 1, 3 and 8; and so does the dense tip deflection [W, W', W''].
+    /// The homogeneous tip deflection and rate a modal grid step returns are those
+    /// `ModalExp::tip_of` reads from its result, bit for bit (the propagator keeps the first for
+    /// `tip_values`, and the batch's lanes read the second), and both are c̃ᵀy and c̃ᵀÃy of the
+    /// state y = V q formed in energy coordinates, to round-off; an odd (N = 1, 3) and an even
+    /// (N = 8) number of representatives, both regions.
+    #[test]
+    fn modal_step_tip_is_the_tip_of_its_result() {
+        for modes in [1usize, 3, 8] {
+            let model = CantileverModel::new(&Params {
+                modes,
+                ..Params::default()
+            })
+            .unwrap();
+            let prop = ExactPropagator::try_new(&model, 1).unwrap();
+            let dim = 2 * modes;
+            for ri in 0..2 {
+                let (sp, fr) = (&prop.spec[ri], &prop.forced[ri]);
+                let me = sp.modal.as_ref().expect("well conditioned");
+                let y0 = DVector::from_fn(dim, |j, _| (0.7 * j as f64 + 0.3).sin());
+                let (mut q, mut out) = (Modes::ZERO, Modes::ZERO);
+                me.project(y0.as_slice(), &mut q);
+                for _ in 0..5 {
+                    let stepped = me.advance_into(&q, &fr.grid_fac, &mut out);
+                    let read = me.tip_of(&out);
+                    assert_eq!(stepped.0.to_bits(), read.0.to_bits(), "N = {modes}");
+                    assert_eq!(stepped.1.to_bits(), read.1.to_bits(), "N = {modes}");
+                    let mut y = vec![0.0; dim];
+                    ModalExp::expand(&me.v, &out, &mut y, false);
+                    let row = |n: usize| (0..dim).map(|j| sp.rows[(n, j)] * y[j]).sum::<f64>();
+                    let scale = sp.ct_norm * y0.norm() * (1.0 + sp.rho);
+                    assert!((read.0 - row(0)).abs() <= 1e-13 * scale, "N = {modes}");
+                    assert!((read.1 - row(1)).abs() <= 1e-13 * scale, "N = {modes}");
+                    q = out;
+                }
+            }
+        }
+    }
+
     #[test]
     fn tip_series_equal_the_closed_form() {
         for modes in [1usize, 3, 8] {

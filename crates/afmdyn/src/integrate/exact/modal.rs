@@ -69,6 +69,12 @@ impl Modes {
     }
 }
 
+/// The first r modes in pairs (lane 0: even k, lane 1: odd k, so that a pair is one vector)
+/// and the odd one left over.
+fn pairs(x: &[f64; MAXD], r: usize) -> (&[[f64; 2]], &[f64]) {
+    x[..r].as_chunks::<2>()
+}
+
 /// A complex matrix as its real and imaginary parts (column-major), for vectorizable real
 /// arithmetic.
 #[derive(Debug, Clone)]
@@ -312,10 +318,6 @@ impl ModalExp {
     pub(super) fn advance_into(&self, q: &Modes, f: &Modes, out: &mut Modes) -> (f64, f64) {
         let r = self.len();
         let (tip, tip_dot) = (&self.tip, &self.tip_dot);
-        // modes in pairs (lane 0: even k, lane 1: odd k), so that the pair is one vector
-        fn pairs(x: &[f64; MAXD], r: usize) -> (&[[f64; 2]], &[f64]) {
-            x[..r].as_chunks::<2>()
-        }
         let ((qr, qr1), (qi, qi1)) = (pairs(&q.re, r), pairs(&q.im, r));
         let ((fr, fr1), (fi, fi1)) = (pairs(&f.re, r), pairs(&f.im, r));
         let ((tr, tr1), (ti, ti1)) = (pairs(&tip.re, r), pairs(&tip.im, r));
@@ -349,17 +351,27 @@ impl ModalExp {
     }
 
     /// The tip deflection and rate of the homogeneous part y = V q: Σ_k Re(w_k c̃ᵀv_k q_k) and
-    /// Σ_k Re(w_k c̃ᵀv_k λ_k q_k) (the sums of [`ModalExp::advance_into`] without the step, in
-    /// mode order).
+    /// Σ_k Re(w_k c̃ᵀv_k λ_k q_k) — the sums of [`ModalExp::advance_into`] without the step, in
+    /// its order (two interleaved partial sums over even and odd k), so that after a step
+    /// they are its returned values bit for bit.
     pub(super) fn tip_of(&self, q: &Modes) -> (f64, f64) {
         let r = self.len();
-        let (mut w, mut d) = (0.0, 0.0);
-        for k in 0..r {
-            let (x, y) = (q.re[k], q.im[k]);
-            w += self.tip.re[k] * x - self.tip.im[k] * y;
-            d += self.tip_dot.re[k] * x - self.tip_dot.im[k] * y;
+        let (tip, tip_dot) = (&self.tip, &self.tip_dot);
+        let ((qr, qr1), (qi, qi1)) = (pairs(&q.re, r), pairs(&q.im, r));
+        let ((tr, tr1), (ti, ti1)) = (pairs(&tip.re, r), pairs(&tip.im, r));
+        let ((dr, dr1), (di, di1)) = (pairs(&tip_dot.re, r), pairs(&tip_dot.im, r));
+        let (mut w2, mut d2) = (f64x2::ZERO, f64x2::ZERO);
+        for k in 0..qr.len() {
+            let (a, b) = (f64x2::from(qr[k]), f64x2::from(qi[k]));
+            w2 += f64x2::from(tr[k]) * a - f64x2::from(ti[k]) * b;
+            d2 += f64x2::from(dr[k]) * a - f64x2::from(di[k]) * b;
         }
-        (w, d)
+        let (mut w, mut d) = (w2.to_array(), d2.to_array());
+        if let (Some(&a), Some(&b)) = (qr1.first(), qi1.first()) {
+            w[0] += tr1[0] * a - ti1[0] * b;
+            d[0] += dr1[0] * a - di1[0] * b;
+        }
+        (w[0] + w[1], d[0] + d[1])
     }
 
     /// The tip moments mo[n] = c̃ᵀÃⁿ y = Σ_k Re(w_k c̃ᵀv_k λ_kⁿ q_k) of y = V q (n = 0..=K + 2),
