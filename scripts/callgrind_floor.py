@@ -6,7 +6,8 @@ Floor (issue 11): the grid steps actually needed, one propagation each, plus the
 - one propagation: the mean instructions of one call of `ModalExp::advance_into` (e^{Λh} ⊙ q and
   the tip deflection and rate), times m, the grid sub-steps of a period (a grid interval that
   holds a switching counts as one propagation, and its two partial propagations as event work);
-- event work: the functions that serve a switching — the tip series (`build_poly`, `TipPoly`),
+- event work: the functions that serve a switching — the tip series (`build_last_series`, which
+  now holds the inlined `build_poly`, and `TipPoly`),
   the leftmost-root search and Newton polish (`Search`, `safeguarded_newton`), the state at the
   switching and the partial steps around it (`state_in_last_at`, `ModalExp::expand*`,
   `apply_rows`, libm's exp and sincos), the stint entry (`enter_stint`);
@@ -22,6 +23,7 @@ import sys
 
 PROPAGATION = "ModalExp::advance_into"
 EVENT = (
+    "build_last_series",
     "build_poly",
     "TipPoly::",
     "Search::",

@@ -390,6 +390,8 @@ struct LastStep {
     modal: bool,
     /// Whether the step was a whole grid step (its transition matrix is Φ_s).
     full: bool,
+    /// Sub-step index of the grid point a whole grid step started from.
+    k: usize,
 }
 
 /// What [`ExactPropagator::step_impl`] forms besides the propagation itself.
@@ -785,6 +787,7 @@ impl ExactPropagator {
                 q0: Modes::ZERO,
                 modal: false,
                 full: false,
+                k: 0,
             },
             poly: Box::new(TipPoly::empty()),
             poly_built: false,
@@ -1238,19 +1241,49 @@ impl ExactPropagator {
         if self.poly_built {
             return;
         }
-        let len = (self.tau - self.last.tau0).max(t);
+        let step = self.tau - self.last.tau0;
+        self.build_last_series(step.max(t), t <= step);
+    }
+
+    /// Build the tip series of the last step over local times [0, `len`]: for a whole modal
+    /// grid step (when `centred`), centred at its middle from the modal coordinates there
+    /// (q0 e^{Λh/2}), so that it reaches half the step; otherwise from the step's start in
+    /// energy coordinates. The switching search (`step_impl`) and dense output
+    /// ([`Self::poly_for_last`]) use the same series of a step.
+    fn build_last_series(&mut self, len: f64, centred: bool) {
+        let ri = self.last.region.index();
         let dim = self.z.len();
         let mut y0 = [0.0; MAXD];
-        self.last_y0(&mut y0[..dim]);
-        let ri = self.last.region.index();
+        let (center, start) = match (
+            &self.spec[ri].modal,
+            centred && self.last.modal && self.last.full,
+        ) {
+            (Some(me), true) => {
+                let mid = &mut self.scratch;
+                mid.copy_prefix(&self.last.q0, me.len());
+                mid.mul_assign(&self.forced[ri].half_fac, me.len());
+                (
+                    (self.last.tau0, 0.5 * len, self.trig_mid[self.last.k]),
+                    SeriesStart::Modal(me, &self.scratch),
+                )
+            }
+            _ => {
+                self.last_y0(&mut y0[..dim]);
+                let tau0 = self.last.tau0;
+                (
+                    (tau0, 0.0, self.trig_at(tau0)),
+                    SeriesStart::Energy(&y0[..dim]),
+                )
+            }
+        };
         Self::build_poly(
             &self.spec[ri],
             &self.forced[ri],
             self.model.params(),
             self.dead,
             self.last.region,
-            (self.last.tau0, 0.0, self.trig_at(self.last.tau0)),
-            SeriesStart::Energy(&y0[..dim]),
+            center,
+            start,
             len,
             &mut self.poly,
         );
@@ -1427,6 +1460,7 @@ impl ExactPropagator {
         self.last.region = self.region;
         self.last.full = true;
         self.last.modal = modal;
+        self.last.k = at.1.checked_sub(1).unwrap_or(self.grid.m - 1);
         self.on_grid = Some(at);
         self.poly_built = false;
         // z lags behind q after modal steps (formed by materialize)
@@ -1477,6 +1511,7 @@ impl ExactPropagator {
         self.last.region = region;
         self.last.full = full;
         self.last.modal = modal;
+        self.last.k = k;
         let fr = &self.forced[ri];
         let mut end_state = true;
         // sin, cos Ωτ_b: from the grid's table when the step ends on a grid point (column k, or
@@ -1563,39 +1598,7 @@ impl ExactPropagator {
         let cheap = self.stint_curvature + self.forced[ri].vp_curv;
         let mut hit = None;
         if !ends.certified(cheap, len) {
-            // a whole modal grid step: the series centred at its middle, from the modal
-            // coordinates there (q0 e^{Λh/2}); otherwise from the start
-            let mut y0 = [0.0; MAXD];
-            let (center, start) = match (&self.spec[ri].modal, modal && full) {
-                (Some(me), true) => {
-                    let mid = &mut self.scratch;
-                    mid.copy_prefix(&self.last.q0, me.len());
-                    mid.mul_assign(&self.forced[ri].half_fac, me.len());
-                    (
-                        (tau0, 0.5 * len, self.trig_mid[k]),
-                        SeriesStart::Modal(me, &self.scratch),
-                    )
-                }
-                _ => {
-                    self.last_y0(&mut y0[..dim]);
-                    (
-                        (tau0, 0.0, self.trig_at(tau0)),
-                        SeriesStart::Energy(&y0[..dim]),
-                    )
-                }
-            };
-            Self::build_poly(
-                &self.spec[ri],
-                &self.forced[ri],
-                self.model.params(),
-                self.dead,
-                region,
-                center,
-                start,
-                len,
-                &mut self.poly,
-            );
-            self.poly_built = true;
+            self.build_last_series(len, true);
             // both bound |g''| over the step: the series' sum of absolute terms (a cosh-like
             // overestimate of an oscillation) is often the larger one
             self.poly.curv = self.poly.curv.min(cheap);
