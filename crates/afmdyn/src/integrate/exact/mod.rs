@@ -1219,6 +1219,7 @@ impl ExactPropagator {
         out.terms = terms;
         out.wp = fr.wp;
         out.omega = p.omega;
+        out.trig_c = (s0, c0);
         out.cycle = cycle;
         out.sigma = r.guard_sign();
         out.dead = dead;

@@ -31,6 +31,9 @@ pub(super) struct TipPoly {
     pub(super) terms: usize,
     pub(super) wp: [f64; 3],
     pub(super) omega: f64,
+    /// (sin Ωτ, cos Ωτ) at the centre, as the series was built with (from the grid's table at
+    /// the middle of a whole grid step).
+    pub(super) trig_c: (f64, f64),
     /// The harmonic part a_s sin Ωτ + a_c cos Ωτ of V_T (W_p plus the base drive) and its
     /// derivatives at the centre without their factors Ωⁿ: the n-th derivative is
     /// Ωⁿ cycle[n mod 4].
@@ -57,6 +60,7 @@ impl TipPoly {
             terms: 1,
             wp: [0.0; 3],
             omega: 0.0,
+            trig_c: (0.0, 1.0),
             cycle: [0.0; 4],
             sigma: 1.0,
             dead: 0.0,
@@ -89,7 +93,9 @@ impl TipPoly {
     }
     /// [W, W', W''] of the tip at local time t: Σ mo[n + i] uⁿ/n! over the kept terms (the
     /// i-th derivative of W_hom, its coefficients formed on the first call) plus the harmonic
-    /// part W_p.
+    /// part W_p, its sine and cosine turned from the centre's by Ωu (the angle-addition
+    /// formulas): the phase is that of the series' V_T and of the grid steps, whatever the
+    /// size of τ, where sin Ωτ of a large τ would carry the rounding of Ωτ (about τ ulp).
     pub(super) fn w(&mut self, t: f64) -> [f64; 3] {
         if !self.hc_ready {
             for (i, hc) in self.hc.iter_mut().enumerate() {
@@ -99,10 +105,12 @@ impl TipPoly {
             }
             self.hc_ready = true;
         }
-        let (s, c) = (self.omega * (self.tau0 + t)).sin_cos();
+        let u = t - self.center;
+        let (su, cu) = (self.omega * u).sin_cos();
+        let (sc, cc) = self.trig_c;
+        let (s, c) = (sc * cu + cc * su, cc * cu - sc * su);
         let (w0, ws, wc) = (self.wp[0], self.wp[1], self.wp[2]);
         let om = self.omega;
-        let u = t - self.center;
         let hom = |i: usize| Self::horner(&self.hc[i][..self.terms], u);
         [
             hom(0) + w0 + ws * s + wc * c,
