@@ -157,7 +157,7 @@ pub fn record(integ: &mut dyn Integrator, spec: &RecordSpec) -> Result<Trajector
             *k_period += 1;
         }
     };
-    record_section(integ.tau(), &integ.state().clone(), &mut out, &mut k_period);
+    record_section(integ.tau(), integ.state(), &mut out, &mut k_period);
     let mut acc = EnergyBalance {
         tau0: integ.tau(),
         e_start: model.energy(integ.region(), integ.tau(), integ.state()),
@@ -192,9 +192,9 @@ pub fn record(integ: &mut dyn Integrator, spec: &RecordSpec) -> Result<Trajector
             acc.contact_dissipation += half * dc;
         }
         let tau = integ.tau();
-        let z = integ.state().clone();
+        let z = integ.state();
         if let Some(b) = &body {
-            out.body_contact |= b.touches(&model, tau, &z);
+            out.body_contact |= b.touches(&model, tau, z);
         }
         if let Some(e) = step.event {
             // an impact's impulse: energy lost in the sample and work done on the clamped frame
@@ -214,11 +214,11 @@ pub fn record(integ: &mut dyn Integrator, spec: &RecordSpec) -> Result<Trajector
             && (tau >= next_energy_cut
                 || (tau - next_energy_cut).abs() <= 1e-12 * (1.0 + tau.abs()))
         {
-            acc.e_end = model.energy(step.region, tau, &z);
+            acc.e_end = model.energy(step.region, tau, z);
             out.energy.push(acc);
             acc = EnergyBalance {
                 tau0: tau,
-                e_start: model.energy(integ.region(), tau, &z),
+                e_start: model.energy(integ.region(), tau, z),
                 e_end: 0.0,
                 base_work: 0.0,
                 beam_dissipation: 0.0,
@@ -228,10 +228,10 @@ pub fn record(integ: &mut dyn Integrator, spec: &RecordSpec) -> Result<Trajector
         }
         if spec.samples_per_period > 0 && (tau - next_sample).abs() <= 1e-12 * (1.0 + tau.abs()) {
             out.samples
-                .push(Sample::new(&model, integ.region(), tau, &z));
+                .push(Sample::new(&model, integ.region(), tau, z));
             k_sample += 1;
         }
-        record_section(tau, &z, &mut out, &mut k_period);
+        record_section(tau, z, &mut out, &mut k_period);
     }
     out.tau_end = integ.tau();
     out.final_state = integ.state().clone();
