@@ -269,16 +269,16 @@ impl GridSteps for DenseSteps<'_> {
     }
 }
 
-/// Modal whole grid steps ([`ModalExp::advance_into`] with e^{Λh}): the current modal
-/// coordinates, those of the step tried and the start of the last step taken rotate on
-/// acceptance (no copies), `accepted` times.
+/// Modal whole grid steps ([`ModalExp::advance_into`] with e^{Λh}): on acceptance the
+/// propagator's three boxed buffers trade places (prev ← cur ← tried ← prev, by pointer), so
+/// that after a run q holds the current modal coordinates, `last.q0` the start of the last
+/// step and the scratch the free one, without copies.
 struct ModalSteps<'a> {
     me: &'a ModalExp,
     fr: &'a Forced,
-    cur: &'a mut Modes,
-    tried: &'a mut Modes,
-    prev: &'a mut Modes,
-    accepted: usize,
+    cur: &'a mut Box<Modes>,
+    tried: &'a mut Box<Modes>,
+    prev: &'a mut Box<Modes>,
 }
 
 impl GridSteps for ModalSteps<'_> {
@@ -289,9 +289,8 @@ impl GridSteps for ModalSteps<'_> {
         grid_v_t(self.fr, k + 1, tip)
     }
     fn accept(&mut self) {
-        std::mem::swap(&mut self.prev, &mut self.cur);
-        std::mem::swap(&mut self.cur, &mut self.tried);
-        self.accepted += 1;
+        std::mem::swap(self.prev, self.cur);
+        std::mem::swap(self.cur, self.tried);
     }
 }
 
@@ -384,8 +383,9 @@ struct LastStep {
     region: Region,
     /// Homogeneous part δz(τ0) in plain coordinates (dense steps).
     dz0: DVector<f64>,
-    /// Modal coordinates of the homogeneous part at τ0 (modal steps).
-    q0: Modes,
+    /// Modal coordinates of the homogeneous part at τ0 (modal steps; boxed, as the current
+    /// coordinates and the scratch, so that a step's buffers trade places by pointer).
+    q0: Box<Modes>,
     /// Whether the step was modal.
     modal: bool,
     /// Whether the step was a whole grid step (its transition matrix is Φ_s).
@@ -428,7 +428,7 @@ pub struct ExactPropagator {
     tau: f64,
     z: DVector<f64>,
     /// Modal coordinates of the homogeneous part of the current state (valid in a modal region).
-    q: Modes,
+    q: Box<Modes>,
     /// The homogeneous part's tip deflection and rate at q, as the step of `step_impl` that
     /// formed q returned them (`ModalExp::advance_into`, equal bit for bit to
     /// `ModalExp::tip_of(q)`); `None` where q was formed otherwise (a run of grid steps, the
@@ -438,7 +438,7 @@ pub struct ExactPropagator {
     stale: bool,
     /// Modal scratch: e^{λ_k t} of a partial step, the coordinates at the centre of a tip
     /// series, the step tried by a run of grid steps.
-    scratch: Modes,
+    scratch: Box<Modes>,
     region: Region,
     /// The grid point the state is on, as (period p, sub-step k < m): grid index j = p m + k.
     on_grid: Option<(i64, usize)>,
@@ -770,10 +770,10 @@ impl ExactPropagator {
             grid: PeriodGrid::new(period, m),
             tau: 0.0,
             z: zero.clone(),
-            q: Modes::ZERO,
+            q: Box::new(Modes::ZERO),
             tip_hom: None,
             stale: false,
-            scratch: Modes::ZERO,
+            scratch: Box::new(Modes::ZERO),
             region: Region::Free,
             on_grid: Some((0, 0)),
             between: None,
@@ -784,7 +784,7 @@ impl ExactPropagator {
                 tau0: 0.0,
                 region: Region::Free,
                 dz0: zero.clone(),
-                q0: Modes::ZERO,
+                q0: Box::new(Modes::ZERO),
                 modal: false,
                 full: false,
                 k: 0,
@@ -1106,7 +1106,7 @@ impl ExactPropagator {
         }
         self.last.tau0 = self.tau;
         self.last.region = self.region;
-        self.last.q0 = self.q;
+        *self.last.q0 = *self.q;
         self.last.modal = self.modal[ri];
         self.last.full = false;
         self.poly_built = false;
@@ -1416,27 +1416,11 @@ impl ExactPropagator {
             cur: q,
             tried: scratch,
             prev: &mut last.q0,
-            accepted: 0,
         };
         let (ran, period_end) = limits.run(trig, tau, vt, &mut at, &mut steps);
-        let accepted = steps.accepted;
         let Some(tau0) = ran else {
             return false;
         };
-        // the buffers rotate (prev ← cur ← tried ← prev) with every step taken: the current
-        // coordinates back into q, the last step's start into last.q0 (r entries each)
-        let r = me.len();
-        match accepted % 3 {
-            1 => {
-                last.q0.copy_prefix(q, r);
-                q.copy_prefix(scratch, r);
-            }
-            2 => {
-                q.copy_prefix(&last.q0, r);
-                last.q0.copy_prefix(scratch, r);
-            }
-            _ => {}
-        }
         // (the runs of `advance_to` keep no tip: nobody reads it there)
         self.tip_hom = None;
         self.finish_run(tau0, at, true);
@@ -1531,8 +1515,9 @@ impl ExactPropagator {
                     me.factors(len, &mut self.scratch);
                     &self.scratch
                 };
-                self.last.q0.copy_prefix(&self.q, me.len());
-                let (w, wd) = me.advance_into(&self.last.q0, fac, &mut self.q);
+                // into last.q0, then the two trade places: q the step's end, last.q0 its start
+                let (w, wd) = me.advance_into(&self.q, fac, &mut self.last.q0);
+                std::mem::swap(&mut self.q, &mut self.last.q0);
                 self.tip_hom = Some((w, wd));
                 if form != Form::All {
                     end_state = false;
@@ -1712,7 +1697,7 @@ impl Integrator for ExactPropagator {
         self.last.tau0 = tau;
         self.last.region = region;
         self.last.dz0.fill(0.0);
-        self.last.q0 = Modes::ZERO;
+        *self.last.q0 = Modes::ZERO;
         self.last.modal = false;
         self.last.full = false;
         self.poly_built = false;
