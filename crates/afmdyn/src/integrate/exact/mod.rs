@@ -502,12 +502,14 @@ struct BoundCols {
 impl BoundCols {
     /// Make the tables those of `weights` in region `ri`.
     fn prepare(&mut self, weights: &[f64], ri: usize, me: &ModalExp, fr: &Forced, n: usize) {
+        // the same bits (without an early exit, so that the comparison vectorizes)
         let same = self.weights.len() == weights.len()
             && self
                 .weights
                 .iter()
                 .zip(weights)
-                .all(|(a, b)| a.to_bits() == b.to_bits());
+                .fold(0, |d, (a, b)| d | (a.to_bits() ^ b.to_bits()))
+                == 0;
         if !same {
             self.weights.clear();
             self.weights.extend_from_slice(weights);
