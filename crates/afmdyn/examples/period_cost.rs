@@ -6,8 +6,9 @@
 //! `cargo run --release -p afmdyn --example period_cost -- <linear|hertz|dmt|impact> <N> [periods]
 //! [both|advance|observed|recorded]` (the last argument runs only one of the two timed loops,
 //! for instruction counts; `recorded` runs the observed one with the statistics observer of a
-//! steady-state recording, [`StatsObserver`] through [`advance_observed`], after every step). With the linear law, `PROPAGATION=dense|modal` in the environment forces
-//! the exact propagator's path ([`Propagation`]).
+//! steady-state recording, [`StatsObserver`] through [`advance_observed`], after every step).
+//! With the linear law, `PROPAGATION=dense|modal` in the environment forces the exact
+//! propagator's path ([`Propagation`]).
 //!
 //! `... -- build <N> [reps]`: time of one exact-propagator build at the default parameters,
 //! without and with reuse of earlier builds ([`ExactOptions::reuse`]), and of a build after a

@@ -1020,13 +1020,8 @@ mod tests {
                     "N = {modes}, k = {k}"
                 );
                 touched += usize::from(reference);
-                let bound: f64 = check
-                    .reach
-                    .iter()
-                    .zip(z.iter())
-                    .map(|(r, a)| r * a.abs())
-                    .sum();
-                spared += usize::from(bound * (1.0 + 1e-9) < base);
+                let bound = weighted_displacement(&check.reach, z.as_slice());
+                spared += usize::from(BodyContactCheck::spared(bound, base));
             }
             // both outcomes and both paths are exercised
             assert!(

@@ -33,6 +33,22 @@ fn prop(m: &CantileverModel, propagation: Propagation, reuse: bool) -> ExactProp
     .unwrap()
 }
 
+/// The default parameters with `modes` modes, and their model.
+fn default_model(modes: usize) -> (Params, CantileverModel) {
+    let p = Params {
+        modes,
+        ..Params::default()
+    };
+    (p, CantileverModel::new(&p).unwrap())
+}
+
+/// The paths the tests on the chaotic attractor run: dense (N = 3) and modal (N = 3, 10).
+const PATHS: [(usize, Propagation); 3] = [
+    (3, Propagation::Dense),
+    (3, Propagation::Auto),
+    (10, Propagation::Auto),
+];
+
 /// Relative difference ‖a − b‖∞ / (1 + ‖b‖∞).
 fn rel(a: &DVector<f64>, b: &DVector<f64>) -> f64 {
     (a - b).amax() / (1.0 + b.amax())
@@ -164,16 +180,8 @@ fn ill_conditioned_basis_falls_back_to_dense() {
 /// identically.
 #[test]
 fn advance_equals_the_step_loop() {
-    for (modes, path) in [
-        (3usize, Propagation::Dense),
-        (3, Propagation::Auto),
-        (10, Propagation::Auto),
-    ] {
-        let p = Params {
-            modes,
-            ..Params::default()
-        };
-        let m = CantileverModel::new(&p).unwrap();
+    for (modes, path) in PATHS {
+        let (p, m) = default_model(modes);
         let steps = prop(&m, path, true).steps_per_period() as f64;
         for periods in [30.5, 30.0 + 7.0 / steps, 30.0] {
             let mut a = prop(&m, path, true);
@@ -387,16 +395,8 @@ fn reused_builds_propagate_as_fresh_ones() {
 /// `advance`), modal (N = 3, 10) and dense (N = 3).
 #[test]
 fn dense_tip_is_the_tip_of_the_dense_state() {
-    for (modes, path) in [
-        (3usize, Propagation::Auto),
-        (3, Propagation::Dense),
-        (10, Propagation::Auto),
-    ] {
-        let p = Params {
-            modes,
-            ..Params::default()
-        };
-        let m = CantileverModel::new(&p).unwrap();
+    for (modes, path) in PATHS {
+        let (p, m) = default_model(modes);
         let mut a = prop(&m, path, true);
         a.reset(0.0, &m.rest()).unwrap();
         let at = format!("N = {modes}, {path:?}");

@@ -224,8 +224,8 @@ pub trait Integrator: Send {
     }
     /// Integrator name.
     fn name(&self) -> &'static str;
-    /// [W(1,τ), ∂W(1,τ)/∂τ, V_T, dV_T/dτ] at the current state (eq. 8 and 9). The default
-    /// forms them from [`Integrator::state`] ([`CantileverModel::tip_values`]); the exact
+    /// [W(1,τ), ∂W(1,τ)/∂τ, V_T, dV_T/dτ] at the current state. The default forms them from
+    /// [`Integrator::state`] ([`CantileverModel::tip_values`], where the equations are); the exact
     /// propagator takes V_T from its switching test and W from its modal coordinates, without
     /// forming the plain state (equal to round-off).
     fn tip_values(&self) -> [f64; 4] {

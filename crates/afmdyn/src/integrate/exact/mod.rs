@@ -1053,12 +1053,6 @@ impl ExactPropagator {
         self.stale = false;
     }
 
-    /// Grid steps over which the stint's bound of [`Integrator::displacement_bound`] is kept:
-    /// a period, at most [`STINT_BOUND_STEPS`].
-    fn stint_bound_steps(&self) -> f64 {
-        (self.grid.m as f64).min(STINT_BOUND_STEPS)
-    }
-
     /// z_p at the current τ in the current region into `out` (`[2N]`): on a grid point the grid
     /// table's value (column k, or m at a period end), elsewhere from sin/cos Ωτ.
     fn zp_now(&self, out: &mut [f64]) {
@@ -1769,7 +1763,8 @@ impl Integrator for ExactPropagator {
                 part
             }
         };
-        let window = self.grid.h * self.stint_bound_steps();
+        // the stint's bound is kept over a period, at most STINT_BOUND_STEPS grid steps
+        let window = self.grid.h * (self.grid.m as f64).min(STINT_BOUND_STEPS);
         let cache = &mut self.bound_cols;
         if cache.holds[ri] {
             let stint = match cache.stint {
@@ -1919,17 +1914,11 @@ impl Integrator for ExactPropagator {
 mod tests {
     use super::*;
 
-    /// The tip series of a step — expanded at its start, and centred at its middle from the
-    /// energy coordinates there or from the modal ones (the moments of
-    /// [`ModalExp::moments`]) — equal the gap g = σ V_T + dead and its rate from the closed-form
-    /// homogeneous solution c̃ᵀ e^{Ãt} y0 (nalgebra's matrix exponential, independent of the
-    /// eigendecomposition) plus the harmonic part of eq. 8, to round-off over the whole step,
-    /// in both regions, at N = 1, 3 and 8; and so does the dense tip deflection [W, W', W''].
     /// The homogeneous tip deflection and rate a modal grid step returns are those
-    /// `ModalExp::tip_of` reads from its result, bit for bit (the propagator keeps the first for
-    /// `tip_values`, and the batch's lanes read the second), and both are c̃ᵀy and c̃ᵀÃy of the
-    /// state y = V q formed in energy coordinates, to round-off; an odd (N = 1, 3) and an even
-    /// (N = 8) number of representatives, both regions.
+    /// `ModalExp::tip_of` reads from its result, bit for bit (`tip_values` takes the first after
+    /// a step of `step_impl`, the second after a run or the batch), and both are c̃ᵀy and c̃ᵀÃy
+    /// of the state y = V q formed in energy coordinates, to round-off; an odd (N = 1, 3) and
+    /// an even (N = 8) number of representatives, both regions.
     #[test]
     fn modal_step_tip_is_the_tip_of_its_result() {
         for modes in [1usize, 3, 8] {
@@ -1963,6 +1952,12 @@ mod tests {
         }
     }
 
+    /// The tip series of a step — expanded at its start, and centred at its middle from the
+    /// energy coordinates there or from the modal ones (the moments of
+    /// [`ModalExp::moments`]) — equal the gap g = σ V_T + dead and its rate from the closed-form
+    /// homogeneous solution c̃ᵀ e^{Ãt} y0 (nalgebra's matrix exponential, independent of the
+    /// eigendecomposition) plus the harmonic part of eq. 8, to round-off over the whole step,
+    /// in both regions, at N = 1, 3 and 8; and so does the dense tip deflection [W, W', W''].
     #[test]
     fn tip_series_equal_the_closed_form() {
         for modes in [1usize, 3, 8] {
