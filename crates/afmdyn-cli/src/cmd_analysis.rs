@@ -4,10 +4,11 @@ use crate::args::{IntegratorArgs, ModelArgs};
 use crate::error::CliError;
 use crate::output::{f, io_error, temp_path, write_bytes, write_csv, Column, NpyStream, OutDir};
 use crate::plot::{save, save_scatter_stream, ChunkSink, Figure, LegendEntry, Series, Style};
-use afmdyn::analysis::attractors::{find_attractors, AttractorSpec};
+use afmdyn::analysis::attractors::find_attractors;
 use afmdyn::analysis::bifurcation::{run_sweep, Branch, Resume, SweepPoint, SweepSpec};
-use afmdyn::analysis::steady::SteadyOptions;
 use afmdyn::integrate::build;
+use afmdyn::request::limits::ATTRACTOR_SAMPLES_PER_PERIOD;
+use afmdyn::request::{AttractorsRequest, BifurcationRequest, SteadyRequest};
 use afmdyn::trajectory::{record, RecordSpec};
 use afmdyn::{CantileverModel, Params, SweepParam};
 use clap::Args;
@@ -34,32 +35,13 @@ pub struct SteadyArgs {
 }
 
 impl SteadyArgs {
-    /// Steady-state options, validated.
-    pub fn options(&self) -> Result<SteadyOptions, CliError> {
-        if !(self.tol.is_finite() && self.tol > 0.0) {
-            return Err(CliError::Input(format!(
-                "tol = {}: must be finite and > 0",
-                self.tol
-            )));
-        }
-        if !(1..=64).contains(&self.max_period) {
-            return Err(CliError::Input(format!(
-                "max-period = {}: must be in 1..=64",
-                self.max_period
-            )));
-        }
-        if !(1..=10_000_000).contains(&self.max_periods) {
-            return Err(CliError::Input(format!(
-                "max-periods = {}: must be in 1..=10000000",
-                self.max_periods
-            )));
-        }
-        Ok(SteadyOptions {
+    /// The library's request ([`SteadyRequest::options`] validates it).
+    pub fn request(&self) -> SteadyRequest {
+        SteadyRequest {
             tol: self.tol,
             max_periods: self.max_periods,
             max_period: self.max_period,
-            ..SteadyOptions::default()
-        })
+        }
     }
 }
 
@@ -465,27 +447,22 @@ fn read_rows(
 /// Run `afmdyn bifurcation`.
 pub fn bifurcation(a: &BifurcationArgs) -> Result<(), CliError> {
     let (base, probe) = a.model.resolve(Params::default())?;
-    let values =
-        SweepSpec::linspace(a.from, a.to, a.steps).map_err(|e| CliError::Input(e.to_string()))?;
-    let spec = SweepSpec {
-        base,
+    let request = BifurcationRequest {
         param: a.param,
-        values,
-        continuation: !a.no_continuation,
+        values: None,
+        from: a.from,
+        to: a.to,
+        steps: a.steps,
         starts: a.starts,
         seed: a.seed,
-        steady: a.steady.options()?,
-        integrator: a.integrator.options(1),
+        continuation: !a.no_continuation,
+        threads: a.threads,
+        steady: a.steady.request(),
+        integrator: a.integrator.request(),
     };
-    spec.validate()
-        .map_err(|e| CliError::Input(e.to_string()))?;
-    if let Some(t) = a.threads {
-        if !(1..=1024).contains(&t) {
-            return Err(CliError::Input(format!(
-                "threads = {t}: must be in 1..=1024"
-            )));
-        }
-    }
+    let spec = request
+        .spec(&base)
+        .map_err(|e| CliError::Input(crate::error::spell(&e)))?;
     let out = OutDir::lock(&a.out)?;
     let final_csv = out.join("bifurcation.csv");
     let partial = temp_path(&final_csv);
@@ -824,21 +801,15 @@ pub struct AttractorsArgs {
 /// Run `afmdyn attractors`.
 pub fn attractors(a: &AttractorsArgs) -> Result<(), CliError> {
     let (p, probe) = a.model.resolve(Params::default())?;
-    let spp = 200;
-    let spec = AttractorSpec {
-        params: p,
+    let spp = ATTRACTOR_SAMPLES_PER_PERIOD;
+    let spec = AttractorsRequest {
         samples: a.samples,
         seed: a.seed,
         cluster_tol: a.cluster_tol,
-        steady: a.steady.options()?,
-        integrator: a.integrator.options(spp),
-    };
-    if a.samples > 100_000 {
-        return Err(CliError::Input(format!(
-            "samples = {}: must be in 1..=100000",
-            a.samples
-        )));
+        steady: a.steady.request(),
+        integrator: a.integrator.request(),
     }
+    .spec(&p)?;
     let out = OutDir::lock(&a.out)?;
     let report = find_attractors(&spec)?;
     let model = CantileverModel::new(&p)?;

@@ -2,20 +2,14 @@
 
 use crate::args::ModelArgs;
 use crate::cmd_analysis::{SteadyArgs, COL_VALUE, COL_W_TIP};
-use crate::cmd_simulate::initial_state;
+use crate::cmd_simulate::parse_initial;
 use crate::error::CliError;
 use crate::output::{f, io_error, write_csv, OutDir};
 use crate::plot::{save, Figure, Series, Style};
-use afmdyn::analysis::continuation::{
-    continue_branch, continue_with_switching, BranchPoint, ContinuationSpec,
-};
-use afmdyn::analysis::lyapunov::{lyapunov_spectrum, LyapunovOptions};
-use afmdyn::analysis::shooting::{shoot, ShootingOptions};
-use afmdyn::analysis::steady::steady_state;
-use afmdyn::integrate::{build, IntegratorOptions};
+use afmdyn::analysis::continuation::BranchPoint;
+use afmdyn::request::{ContinuationRequest, LyapunovRequest, OrbitRequest, StartRequest};
 use afmdyn::{CantileverModel, Params, SweepParam};
 use clap::Args;
-use nalgebra::DVector;
 use std::path::{Path, PathBuf};
 
 /// Initial-state flags of the orbit commands.
@@ -29,16 +23,12 @@ pub struct StartArgs {
 }
 
 impl StartArgs {
-    /// The guess: the given state, or the end of the steady state reached from it (or from rest),
-    /// with its period when one was detected.
-    fn guess(&self, model: &CantileverModel) -> Result<(DVector<f64>, Option<usize>), CliError> {
-        let z0 = initial_state(model, &self.initial_modal)?;
-        if self.initial_modal.is_some() {
-            return Ok((z0, None));
-        }
-        let mut integ = build(model, IntegratorOptions::default(), 0.0, &z0)?;
-        let s = steady_state(integ.as_mut(), &self.steady.options()?)?;
-        Ok((s.end_state().clone(), s.period()))
+    /// The library's start: the given state, or the steady state reached from rest.
+    fn request(&self, modes: usize) -> Result<StartRequest, CliError> {
+        Ok(StartRequest {
+            initial: parse_initial(&self.initial_modal, modes)?,
+            steady: self.steady.request(),
+        })
     }
 }
 
@@ -61,12 +51,12 @@ pub struct OrbitArgs {
 pub fn orbit(a: &OrbitArgs) -> Result<(), CliError> {
     let (p, probe) = a.model.resolve(Params::default())?;
     let model = CantileverModel::new(&p)?;
-    let (guess, found) = a.start.guess(&model)?;
-    let n = a.period.or(found).unwrap_or(1);
-    if !(1..=64).contains(&n) {
-        return Err(CliError::Input(format!("period = {n}: must be in 1..=64")));
-    }
-    let o = shoot(&model, &guess, n, &ShootingOptions::default())?;
+    let request = OrbitRequest {
+        period: a.period,
+        start: a.start.request(p.modes)?,
+    };
+    let o = request.run(&p)?;
+    let n = o.period;
     if a.json {
         let mut doc = afmdyn::report::orbit(&model, &o);
         doc = afmdyn::report::with_si(doc, probe.as_ref(), &p);
@@ -186,28 +176,22 @@ fn check_overlay(path: &Path) -> Result<(), CliError> {
 /// Run `afmdyn continue`.
 pub fn continuation(a: &ContinueArgs) -> Result<(), CliError> {
     let (base, probe) = a.model.resolve(Params::default())?;
-    let p0 = base.with(a.param, a.from);
-    p0.validate()?;
-    base.with(a.param, a.to).validate()?;
+    let request = ContinuationRequest {
+        param: a.param,
+        from: a.from,
+        to: a.to,
+        period: a.period,
+        switch: a.switch,
+        start: a.start.request(base.modes)?,
+    };
+    request.validate(&base)?;
     if let Some(o) = &a.overlay {
         check_overlay(o)?;
     }
-    if let Some(n) = a.period {
-        if !(1..=64).contains(&n) {
-            return Err(CliError::Input(format!("period = {n}: must be in 1..=64")));
-        }
-    }
     let out = OutDir::lock(&a.out)?;
-    let model = CantileverModel::new(&p0)?;
-    let (guess, found) = a.start.guess(&model)?;
-    let n = a.period.or(found).unwrap_or(1);
-    let spec = ContinuationSpec::new(base, a.param, a.from, a.to, n);
-    // --switch: the period-doubling cascade, periods n, 2n, 4n and 8n
-    let branches: Vec<Vec<BranchPoint>> = if a.switch {
-        continue_with_switching(&spec, &guess, 8 * n)?
-    } else {
-        vec![continue_branch(&spec, &guess)?]
-    };
+    let branches: Vec<Vec<BranchPoint>> = request.run(&base)?;
+    let model = CantileverModel::new(&base.with(a.param, a.from))?;
+    let n = branches[0].first().map_or(1, |b| b.period);
     write_csv(
         &out.join("continuation.csv"),
         &[
@@ -368,24 +352,13 @@ pub struct LyapunovArgs {
 /// Run `afmdyn lyapunov`.
 pub fn lyapunov(a: &LyapunovArgs) -> Result<(), CliError> {
     let (p, probe) = a.model.resolve(Params::default())?;
-    let model = CantileverModel::new(&p)?;
-    let z0 = initial_state(&model, &a.initial_modal)?;
-    if (a.transient as f64 + a.periods as f64) > crate::cmd_simulate::MAX_RUN_PERIODS {
-        return Err(CliError::Input(format!(
-            "periods = {} with transient = {}: a run may span at most 1e8 drive periods",
-            a.periods, a.transient
-        )));
+    let l = LyapunovRequest {
+        initial: parse_initial(&a.initial_modal, p.modes)?,
+        transient: a.transient,
+        periods: a.periods,
+        blocks: a.blocks,
     }
-    let l = lyapunov_spectrum(
-        &model,
-        &z0,
-        &LyapunovOptions {
-            transient_periods: a.transient,
-            periods: a.periods,
-            blocks: a.blocks,
-            ..Default::default()
-        },
-    )?;
+    .run(&p)?;
     let warnings = &l.warnings;
     for w in warnings {
         eprintln!("afmdyn: warning: {w}");

@@ -6,11 +6,10 @@ use crate::output::{
     csv_finish, csv_row, csv_stream, f, write_csv, Column, CsvStream, NpyStream, OutDir,
 };
 use crate::plot::{decimate_line, save, Figure, Series, Style};
-use afmdyn::analysis::converge::mode_convergence;
-use afmdyn::analysis::steady::SteadyOptions;
 use afmdyn::integrate::build;
+use afmdyn::request::{ConvergeRequest, SeriesStore, SimulateRequest};
 use afmdyn::trajectory::{record, RecordSpec, Sample, Trajectory};
-use afmdyn::{CantileverModel, Params, Region, SimError};
+use afmdyn::{CantileverModel, Params, Region};
 use clap::{Args, ValueEnum};
 use serde_json::json;
 use std::collections::VecDeque;
@@ -26,12 +25,6 @@ pub enum Files {
     /// Nothing: only the summary on stdout.
     None,
 }
-
-/// Longest run, transient included, in drive periods: beyond, τ (a double) no longer resolves
-/// the integration grid.
-pub const MAX_RUN_PERIODS: f64 = 1e8;
-/// Largest time series written (timeseries.npy, plus timeseries.csv with --csv), in bytes.
-pub const MAX_SERIES_BYTES: f64 = 16.0 * 1024.0 * 1024.0 * 1024.0;
 
 /// Samples kept for the phase portrait (the last ones).
 const PHASE_SAMPLES: usize = 50_000;
@@ -92,29 +85,31 @@ fn parse_list(s: &str, what: &'static str) -> Result<Vec<f64>, CliError> {
         .collect()
 }
 
-pub(crate) fn initial_state(
-    model: &CantileverModel,
+/// The `--initial-modal "a1,..,aN;adot1,..,adotN"` flag as the library's 2N values for N =
+/// `modes` (its syntax only: the magnitudes are checked by
+/// [`afmdyn::request::analyses::initial_state`]).
+pub(crate) fn parse_initial(
     spec: &Option<String>,
-) -> Result<nalgebra::DVector<f64>, CliError> {
+    modes: usize,
+) -> Result<Option<Vec<f64>>, CliError> {
     let Some(s) = spec else {
-        return Ok(model.rest());
+        return Ok(None);
     };
     let (a, ad) = s.split_once(';').ok_or_else(|| {
         CliError::Input("--initial-modal: expected \"a1,..,aN;adot1,..,adotN\"".into())
     })?;
-    let a = parse_list(a, "displacements")?;
+    let mut z = parse_list(a, "displacements")?;
     let ad = parse_list(ad, "velocities")?;
-    let z = model
-        .state_from(&a, &ad)
-        .map_err(|e| CliError::Input(format!("--initial-modal: {e}")))?;
-    let norm = z.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    if norm >= afmdyn::params::STATE_NORM_MAX / 10.0 {
+    if z.len() != modes || ad.len() != modes {
         return Err(CliError::Input(format!(
-            "--initial-modal: largest entry {norm:e}: every entry must be below 1e11 (states \
-             of norm 1e12 count as diverged)"
+            "--initial-modal: expected {modes} displacements and {modes} velocities (N = \
+             {modes}), got {} and {}",
+            z.len(),
+            ad.len()
         )));
     }
-    Ok(z)
+    z.extend(ad);
+    Ok(Some(z))
 }
 
 /// Contact intervals for shading, merged when closer than `min_gap` (bounded memory).
@@ -218,63 +213,31 @@ fn sample_row(s: &Sample) -> Vec<f64> {
 pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
     let (p, probe) = a.model.resolve(Params::default())?;
     let model = CantileverModel::new(&p)?;
-    let z0 = initial_state(&model, &a.initial_modal)?;
-    if a.samples_per_period == 0 || a.samples_per_period > 100_000 {
-        return Err(CliError::Input(format!(
-            "samples-per-period = {}: must be in 1..=100000",
-            a.samples_per_period
-        )));
-    }
-    if !(a.transient.is_finite() && a.transient >= 0.0) {
-        return Err(CliError::Input(format!(
-            "transient = {}: must be finite and >= 0",
-            a.transient
-        )));
-    }
-    let period = p.period();
-    let t_transient = a.transient * period;
-    let record_tau = match (a.periods, a.tau_end) {
-        (Some(n), None) if n.is_finite() && n > 0.0 => n * period,
-        (Some(n), None) => {
-            return Err(CliError::Input(format!(
-                "periods = {n}: must be finite and > 0"
-            )))
-        }
-        (None, Some(t)) if t.is_finite() && t > t_transient => t - t_transient,
-        (None, Some(t)) => {
-            return Err(CliError::Input(format!(
-                "tau-end = {t}: must be finite and > the transient ({t_transient})"
-            )))
-        }
-        _ => 50.0 * period,
+    let request = SimulateRequest {
+        periods: a.periods,
+        tau_end: a.tau_end,
+        transient: a.transient,
+        initial: parse_initial(&a.initial_modal, p.modes)?,
+        samples_per_period: a.samples_per_period,
+        integrator: a.integrator.request(),
     };
-    let total_periods = a.transient + record_tau / period;
-    if total_periods > MAX_RUN_PERIODS {
-        return Err(CliError::Input(format!(
-            "periods = {:e} with the transient: a run may span at most 1e8 drive periods \
-             (beyond, τ no longer resolves the integration grid)",
-            total_periods
-        )));
-    }
-    let spp = a.samples_per_period;
+    let z0 = afmdyn::request::analyses::initial_state(&model, request.initial.as_deref())?;
     let n = p.modes;
     let columns = series_columns(n);
-    let rows = (record_tau / period * spp as f64).floor() + 1.0;
-    if a.files != Files::None {
-        let per_value = if a.csv { 8.0 + 24.0 } else { 8.0 };
-        let bytes = rows * columns.len() as f64 * per_value;
-        if bytes > MAX_SERIES_BYTES {
-            return Err(CliError::Input(format!(
-                "the time series would be {:.1} GB ({rows:.3e} samples × {} columns{}), more \
-                 than the 16 GiB budget: lower --periods or --samples-per-period, or use \
-                 --files none",
-                bytes / 1e9,
-                columns.len(),
-                if a.csv { ", NPY and CSV" } else { "" }
-            )));
-        }
-    }
-    let opts = a.integrator.options(spp);
+    let (store, bytes_per_value) = match a.files {
+        Files::None => (SeriesStore::Nothing, 0.0),
+        // NPY 8 bytes a value, CSV up to 24 more
+        _ => (SeriesStore::Files, if a.csv { 8.0 + 24.0 } else { 8.0 }),
+    };
+    let span = request.validate(&p, store, columns.len(), bytes_per_value)?;
+    let (period, t_transient, record_tau, total_periods) = (
+        p.period(),
+        span.transient_tau,
+        span.record_tau,
+        span.total_periods,
+    );
+    let spp = a.samples_per_period;
+    let opts = request.integrator.options(spp);
     let mut integ = build(&model, opts, 0.0, &z0)?;
     // inputs are valid: lock the output directory and open the files
     let out = match a.files {
@@ -725,41 +688,18 @@ pub struct ConvergeArgs {
 
 /// Run `afmdyn converge`.
 pub fn converge(a: &ConvergeArgs) -> Result<(), CliError> {
-    // paper Fig. 4: eq. 24 at Ω = 4.1, with the damping of eq. 26 (α3 = 0.1, α6 = 0.2) so that a
-    // steady state exists; --beam-damping 0 --contact-damping 0 restores eq. 24 exactly.
-    let defaults = Params {
-        omega: 4.1,
-        ..Params::default()
+    let (p, probe) = a
+        .model
+        .resolve(afmdyn::request::analyses::converge_defaults())?;
+    let request = ConvergeRequest {
+        max_modes: a.max_modes,
+        periods: a.periods,
+        samples_per_period: a.samples_per_period,
+        integrator: a.integrator.request(),
     };
-    let (p, probe) = a.model.resolve(defaults)?;
-    if !(1..=afmdyn::params::MAX_MODES).contains(&a.max_modes) {
-        return Err(CliError::Input(format!(
-            "max-modes = {}: must be in 1..=20",
-            a.max_modes
-        )));
-    }
-    if a.samples_per_period == 0 || a.samples_per_period > 100_000 {
-        return Err(CliError::Input(format!(
-            "samples-per-period = {}: must be in 1..=100000",
-            a.samples_per_period
-        )));
-    }
-    if !(1..=10_000).contains(&a.periods) || a.periods * a.samples_per_period > 10_000_000 {
-        return Err(CliError::Input(format!(
-            "periods = {}: must be in 1..=10000, with periods × samples-per-period ≤ 1e7",
-            a.periods
-        )));
-    }
+    request.validate()?;
     let out = OutDir::lock(&a.out)?;
-    let runs = mode_convergence(
-        &p,
-        a.max_modes,
-        a.periods,
-        a.samples_per_period,
-        &SteadyOptions::default(),
-        a.integrator.options(a.samples_per_period),
-    )
-    .map_err(|e: SimError| CliError::from(e))?;
+    let runs = request.run(&p)?;
     let k = runs.iter().map(|r| r.w_tip.len()).min().unwrap_or(0);
     let mut header = vec!["tau_from_section".to_string()];
     header.extend(runs.iter().map(|r| format!("w_tip_n{}", r.modes)));

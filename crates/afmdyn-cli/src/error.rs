@@ -8,14 +8,32 @@ pub enum CliError {
     /// Invalid flags, config or parameters: exit code 2.
     #[error("{0}")]
     Input(String),
-    /// A computation failed.
-    #[error("{0}")]
+    /// A computation failed, or the library refused an option (the message names the flag,
+    /// see [`spell`]).
+    #[error("{}", spell(.0))]
     Sim(#[from] afmdyn::SimError),
     /// Reading or writing a file failed; the message names the file (see
     /// [`crate::output::io_error`]). There is deliberately no conversion from `std::io::Error`,
     /// which would lose the path.
     #[error("{0}")]
     Io(String),
+}
+
+/// The library's message with a request parameter spelled as its flag: `samples_per_period`
+/// → `samples-per-period`, `initial` → `--initial-modal`; the hints of a budget name the
+/// flags that lower it.
+pub fn spell(e: &afmdyn::SimError) -> String {
+    let msg = e.spelled(|name| match name {
+        "initial" => "--initial-modal".to_string(),
+        _ => name.replace('_', "-"),
+    });
+    match e {
+        afmdyn::SimError::Budget { .. } => msg
+            .replace("lower periods", "lower --periods")
+            .replace("samples_per_period", "--samples-per-period")
+            .replace("keep no time series", "use --files none"),
+        _ => msg,
+    }
 }
 
 impl CliError {

@@ -10,7 +10,7 @@ mod error;
 mod output;
 mod plot;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use error::CliError;
 
 /// Multi-modal tapping-mode AFM dynamics with intermittent contact.
@@ -95,8 +95,45 @@ fn one_line(text: &str) -> String {
     out
 }
 
+/// The help of every model flag from the library's one table of model parameters
+/// ([`afmdyn::request::MODEL_PARAMETERS`]): what it is, its range and its default.
+fn with_table_help(mut cmd: clap::Command) -> clap::Command {
+    let names: Vec<String> = cmd
+        .get_subcommands()
+        .map(|s| s.get_name().to_string())
+        .collect();
+    for name in names {
+        cmd = cmd.mut_subcommand(name, |mut sub| {
+            for p in &afmdyn::request::MODEL_PARAMETERS {
+                // the flag's id is the paper's name where it has one (alpha1 …), else the name
+                let id = p.alias.unwrap_or(p.name);
+                if sub.get_arguments().any(|a| a.get_id() == id) {
+                    let default = if sub.get_name() == "converge" && p.name == "omega" {
+                        afmdyn::request::analyses::converge_defaults()
+                            .omega
+                            .to_string()
+                    } else {
+                        p.default.to_string()
+                    };
+                    let mut help = format!("{}; {} [default: {default}]", p.help, p.range);
+                    help[..1].make_ascii_uppercase();
+                    sub = sub.mut_arg(id, |a| a.help(help));
+                }
+            }
+            sub
+        });
+    }
+    cmd
+}
+
+/// Parse the command line ([`Cli`] with [`with_table_help`]).
+fn parse() -> Result<Cli, clap::Error> {
+    let matches = with_table_help(Cli::command()).try_get_matches()?;
+    Cli::from_arg_matches(&matches)
+}
+
 fn main() {
-    let cli = match Cli::try_parse() {
+    let cli = match parse() {
         Ok(c) => c,
         Err(e) => {
             use clap::error::ErrorKind;

@@ -8,19 +8,19 @@ use crate::convert::Out;
 use crate::errors::{probe_error, sim_error, value_error};
 use crate::params::PyParams;
 use crate::run::{run, run_abandonable, Job, Stop};
-use afmdyn::analysis::attractors::{find_attractors, AttractorSpec};
-use afmdyn::analysis::bifurcation::{run_sweep_cancellable, Branch, Resume, SweepPoint, SweepSpec};
-use afmdyn::analysis::continuation::{
-    continue_branch, continue_with_switching, BranchEvent, BranchPoint, ContinuationSpec,
-};
-use afmdyn::analysis::converge::mode_convergence;
-use afmdyn::analysis::lyapunov::{lyapunov_spectrum, LyapunovOptions};
-use afmdyn::analysis::shooting::{shoot, ShootingOptions};
-use afmdyn::analysis::steady::{steady_state, SteadyOptions, SteadyState};
+use afmdyn::analysis::attractors::find_attractors;
+use afmdyn::analysis::bifurcation::{run_sweep_cancellable, Branch, Resume, SweepPoint};
+use afmdyn::analysis::continuation::BranchEvent;
+use afmdyn::analysis::steady::SteadyState;
 use afmdyn::eigen::spectrum;
-use afmdyn::integrate::{build, IntegratorKind, IntegratorOptions};
+use afmdyn::integrate::{build, IntegratorOptions};
+use afmdyn::request::{
+    AttractorsRequest, BifurcationRequest, ContinuationRequest, ConvergeRequest, IntegratorRequest,
+    LyapunovRequest, ObserveRequest, OrbitRequest, SeriesStore, SimulateRequest, StartRequest,
+    SteadyRequest,
+};
 use afmdyn::trajectory::{record, RecordSpec};
-use afmdyn::{report, CantileverModel, Params, Region, SimError, SweepParam};
+use afmdyn::{report, CantileverModel, Params, Region, SweepParam};
 use nalgebra::DVector;
 use numpy::Complex64;
 use pyo3::prelude::*;
@@ -30,69 +30,47 @@ use std::sync::Mutex;
 
 type Dict<'py> = Bound<'py, PyDict>;
 
-/// Integrator options exactly as the command line's `IntegratorArgs::options`: `exact` refines
-/// its grid from the sampling rate, rk4 takes `steps_per_period` (default 2000). `None` is the
-/// library's default integrator.
-fn integrator_options(
+/// The integrator request of the keywords (`None`: the library's default integrator).
+fn integrator_request(
     kind: Option<&str>,
     steps_per_period: Option<usize>,
     tolerance: f64,
-    samples_per_period: usize,
-) -> PyResult<IntegratorOptions> {
-    let kind: IntegratorKind = match kind {
-        Some(k) => k.parse().map_err(value_error)?,
-        None => IntegratorOptions::default().kind,
-    };
-    let steps = if matches!(kind, IntegratorKind::Rk4 | IntegratorKind::Rk4Naive) {
-        steps_per_period.unwrap_or(2000)
-    } else if kind == IntegratorKind::Adaptive {
-        1
-    } else {
-        // the exact propagator (also what an automatic choice picks for the linear law)
-        samples_per_period.max(1)
-    };
-    Ok(IntegratorOptions {
-        kind,
-        steps_per_period: steps,
+) -> PyResult<IntegratorRequest> {
+    Ok(IntegratorRequest {
+        integrator: match kind {
+            Some(k) => k.parse().map_err(value_error)?,
+            None => IntegratorRequest::default().integrator,
+        },
+        steps_per_period,
         tolerance,
     })
 }
 
-/// Steady-state options validated as the command line's `SteadyArgs::options`.
-fn steady_options(tol: f64, max_periods: usize, max_period: usize) -> PyResult<SteadyOptions> {
-    if !(tol.is_finite() && tol > 0.0) {
-        return Err(value_error(format!("tol = {tol}: must be finite and > 0")));
-    }
-    if !(1..=64).contains(&max_period) {
-        return Err(value_error(format!(
-            "max_period = {max_period}: must be in 1..=64"
-        )));
-    }
-    if max_periods == 0 {
-        return Err(value_error("max_periods = 0: must be >= 1"));
-    }
-    Ok(SteadyOptions {
+/// The steady-state search of the keywords `tol`, `max_periods`, `max_period`.
+fn steady(tol: f64, max_periods: usize, max_period: usize) -> SteadyRequest {
+    SteadyRequest {
         tol,
         max_periods,
         max_period,
-        ..SteadyOptions::default()
-    })
+    }
+}
+
+/// The start of the orbit analyses: `initial`, or the steady state reached from rest.
+fn start(
+    initial: Option<Vec<f64>>,
+    tol: f64,
+    max_periods: usize,
+    max_period: usize,
+) -> StartRequest {
+    StartRequest {
+        initial,
+        steady: steady(tol, max_periods, max_period),
+    }
 }
 
 /// The initial state: `None` is rest, else 2N values (a₁…a_N, ȧ₁…ȧ_N).
 fn initial_state(model: &CantileverModel, initial: Option<Vec<f64>>) -> PyResult<DVector<f64>> {
-    let Some(z) = initial else {
-        return Ok(model.rest());
-    };
-    let n = model.modes();
-    if z.len() != 2 * n {
-        return Err(value_error(format!(
-            "initial: expected 2N = {} values (a1..aN, adot1..adotN), got {}",
-            2 * n,
-            z.len()
-        )));
-    }
-    model.state_from(&z[..n], &z[n..]).map_err(sim_error)
+    afmdyn::request::analyses::initial_state(model, initial.as_deref()).map_err(sim_error)
 }
 
 fn model_of(p: &Params) -> PyResult<CantileverModel> {
@@ -243,41 +221,28 @@ pub fn simulate<'py>(
     progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Dict<'py>> {
     let p = params.inner;
-    if samples_per_period == 0 || samples_per_period > 100_000 {
-        return Err(value_error(format!(
-            "samples_per_period = {samples_per_period}: must be in 1..=100000"
-        )));
-    }
-    if !(transient.is_finite() && transient >= 0.0) {
-        return Err(value_error(format!(
-            "transient = {transient}: must be finite and >= 0"
-        )));
-    }
-    let t_transient = transient * p.period();
-    let record_tau = match (periods, tau_end) {
-        (Some(_), Some(_)) => return Err(value_error("give periods or tau_end, not both")),
-        (Some(n), None) if n.is_finite() && n > 0.0 => n * p.period(),
-        (Some(n), None) => {
-            return Err(value_error(format!(
-                "periods = {n}: must be finite and > 0"
-            )))
-        }
-        (None, Some(t)) if t.is_finite() && t > t_transient => t - t_transient,
-        (None, Some(t)) => {
-            return Err(value_error(format!(
-                "tau_end = {t}: must be finite and > the transient ({t_transient})"
-            )))
-        }
-        (None, None) => 50.0 * p.period(),
+    let request = SimulateRequest {
+        periods,
+        tau_end,
+        transient,
+        initial,
+        samples_per_period,
+        integrator: integrator_request(integrator, steps_per_period, tolerance)?,
     };
-    let opts = integrator_options(integrator, steps_per_period, tolerance, samples_per_period)?;
+    // held in memory: τ, V_T, V̇_T, W, Ẇ, contact, force and the 2N modal coordinates
+    let span = request
+        .validate(&p, SeriesStore::Memory, 7 + 2 * p.modes, 8.0)
+        .map_err(sim_error)?;
+    let t_transient = span.transient_tau;
+    let opts = request.integrator.options(samples_per_period);
     let spec = RecordSpec {
         transient_periods: transient,
-        record_tau,
+        record_tau: span.record_tau,
         samples_per_period,
         energy: true,
         body_contact: true,
     };
+    let initial = request.initial;
     let c = run_abandonable(py, progress.as_ref(), move || {
         simulate_columns(p, initial, opts, spec)
     })??;
@@ -336,23 +301,15 @@ pub fn converge<'py>(
     progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Dict<'py>> {
     let p = params.inner;
-    if !(1..=afmdyn::params::MAX_MODES).contains(&max_modes) {
-        return Err(value_error(format!(
-            "max_modes = {max_modes}: must be in 1..=20"
-        )));
-    }
-    let opts = integrator_options(integrator, steps_per_period, tolerance, samples_per_period)?;
-    let runs = run_abandonable(py, progress.as_ref(), move || {
-        mode_convergence(
-            &p,
-            max_modes,
-            periods,
-            samples_per_period,
-            &SteadyOptions::default(),
-            opts,
-        )
-    })?
-    .map_err(sim_error)?;
+    let request = ConvergeRequest {
+        max_modes,
+        periods,
+        samples_per_period,
+        integrator: integrator_request(integrator, steps_per_period, tolerance)?,
+    };
+    request.validate().map_err(sim_error)?;
+    let runs =
+        run_abandonable(py, progress.as_ref(), move || request.run(&p))?.map_err(sim_error)?;
     let out = Out::new(py);
     out.json(&report::converge(&p, &runs))?;
     let k = runs.iter().map(|r| r.w_tip.len()).min().unwrap_or(0);
@@ -422,25 +379,21 @@ pub fn bifurcation<'py>(
     progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Dict<'py>> {
     let param: SweepParam = param.parse().map_err(value_error)?;
-    let values = match values {
-        Some(v) if v.is_empty() => return Err(value_error("values: must not be empty")),
-        Some(v) => v,
-        None => SweepSpec::linspace(from_, to, steps).map_err(sim_error)?,
-    };
-    let spec = SweepSpec {
-        base: params.inner,
+    let spec = BifurcationRequest {
         param,
         values,
-        continuation,
+        from: from_,
+        to,
+        steps,
         starts,
         seed,
-        steady: steady_options(tol, max_periods, max_period)?,
-        integrator: integrator_options(integrator, steps_per_period, tolerance, 1)?,
-    };
-    spec.validate().map_err(sim_error)?;
-    if threads == Some(0) {
-        return Err(value_error("threads = 0: must be >= 1"));
+        continuation,
+        threads,
+        steady: steady(tol, max_periods, max_period),
+        integrator: integrator_request(integrator, steps_per_period, tolerance)?,
     }
+    .spec(&params.inner)
+    .map_err(sim_error)?;
     let total = spec.values.len() * (usize::from(spec.continuation) * 2 + spec.starts as usize);
     let job = Job::default();
     let worker_job = job.clone();
@@ -614,16 +567,15 @@ pub fn attractors<'py>(
     progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Dict<'py>> {
     let p = params.inner;
-    // the command line samples its attractor plots at 200 per period and builds the integrator
-    // for that rate; the same options give the same attractors
-    let spec = AttractorSpec {
-        params: p,
+    let spec = AttractorsRequest {
         samples,
         seed,
         cluster_tol,
-        steady: steady_options(tol, max_periods, max_period)?,
-        integrator: integrator_options(integrator, steps_per_period, tolerance, 200)?,
-    };
+        steady: steady(tol, max_periods, max_period),
+        integrator: integrator_request(integrator, steps_per_period, tolerance)?,
+    }
+    .spec(&p)
+    .map_err(sim_error)?;
     let report_ = run_abandonable(py, progress.as_ref(), move || find_attractors(&spec))?
         .map_err(sim_error)?;
     let out = Out::new(py);
@@ -644,23 +596,6 @@ pub fn attractors<'py>(
     Ok(out.finish())
 }
 
-/// The guess of the orbit commands: the given state, or the end of the steady state reached
-/// from rest, with its period (the command line's `StartArgs::guess`).
-fn guess(
-    model: &CantileverModel,
-    initial: Option<Vec<f64>>,
-    steady: &SteadyOptions,
-) -> PyResult<(DVector<f64>, Option<usize>)> {
-    let given = initial.is_some();
-    let z0 = initial_state(model, initial)?;
-    if given {
-        return Ok((z0, None));
-    }
-    let mut integ = build(model, IntegratorOptions::default(), 0.0, &z0).map_err(sim_error)?;
-    let s = steady_state(integ.as_mut(), steady).map_err(sim_error)?;
-    Ok((s.end_state().clone(), s.period()))
-}
-
 /// A period-n orbit by Newton shooting, with its Floquet multipliers.
 #[pyfunction]
 #[pyo3(signature = (params, period=None, initial=None, tol=1e-8, max_periods=1500,
@@ -677,18 +612,14 @@ pub fn orbit<'py>(
     progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Dict<'py>> {
     let p = params.inner;
-    let steady = steady_options(tol, max_periods, max_period)?;
-    if let Some(n) = period {
-        if !(1..=64).contains(&n) {
-            return Err(value_error(format!("period = {n}: must be in 1..=64")));
-        }
-    }
+    let request = OrbitRequest {
+        period,
+        start: start(initial, tol, max_periods, max_period),
+    };
+    request.validate().map_err(sim_error)?;
     let (doc, o) = run_abandonable(py, progress.as_ref(), move || -> PyResult<_> {
-        let model = model_of(&p)?;
-        let (z, found) = guess(&model, initial, &steady)?;
-        let n = period.or(found).unwrap_or(1);
-        let o = shoot(&model, &z, n, &ShootingOptions::default()).map_err(sim_error)?;
-        Ok((report::orbit(&model, &o), o))
+        let o = request.run(&p).map_err(sim_error)?;
+        Ok((report::orbit(&model_of(&p)?, &o), o))
     })??;
     let out = Out::new(py);
     out.json(&doc)?;
@@ -720,20 +651,6 @@ fn event_name(e: BranchEvent) -> String {
         .unwrap_or_default()
 }
 
-/// Continuation, and with `switch` the period-doubling cascade to period 8n, as the command
-/// line's `afmdyn continue --switch` ([`continue_with_switching`]).
-fn continue_and_switch(
-    spec: &ContinuationSpec,
-    guess: &DVector<f64>,
-    switch: bool,
-) -> Result<Vec<Vec<BranchPoint>>, SimError> {
-    if switch {
-        continue_with_switching(spec, guess, 8 * spec.period)
-    } else {
-        Ok(vec![continue_branch(spec, guess)?])
-    }
-}
-
 /// Pseudo-arclength continuation of a period-n branch, with located bifurcations.
 #[pyfunction]
 #[pyo3(signature = (params, param="omega", from_=5.0, to=1.0, period=None, switch=false,
@@ -755,22 +672,18 @@ pub fn continuation<'py>(
 ) -> PyResult<Dict<'py>> {
     let base = params.inner;
     let param: SweepParam = param.parse().map_err(value_error)?;
+    let request = ContinuationRequest {
+        param,
+        from: from_,
+        to,
+        period,
+        switch,
+        start: start(initial, tol, max_periods, max_period),
+    };
+    request.validate(&base).map_err(sim_error)?;
     let p0 = base.with(param, from_);
-    p0.validate().map_err(crate::errors::param_error)?;
-    base.with(param, to)
-        .validate()
-        .map_err(crate::errors::param_error)?;
-    let steady = steady_options(tol, max_periods, max_period)?;
-    if period == Some(0) {
-        return Err(value_error("period = 0: must be >= 1"));
-    }
-    let branches = run_abandonable(py, progress.as_ref(), move || -> PyResult<_> {
-        let model = model_of(&p0)?;
-        let (z, found) = guess(&model, initial, &steady)?;
-        let n = period.or(found).unwrap_or(1);
-        let spec = ContinuationSpec::new(base, param, from_, to, n);
-        continue_and_switch(&spec, &z, switch).map_err(sim_error)
-    })??;
+    let branches =
+        run_abandonable(py, progress.as_ref(), move || request.run(&base))?.map_err(sim_error)?;
     let model = model_of(&p0)?;
     let dim = 2 * base.modes;
     let rows: usize = branches.iter().map(Vec::len).sum();
@@ -859,19 +772,14 @@ pub fn lyapunov<'py>(
     progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Dict<'py>> {
     let p = params.inner;
-    // the remaining options (if the library adds any) keep their defaults, as on the command line
-    #[allow(clippy::needless_update)]
-    let opts = LyapunovOptions {
-        transient_periods: transient,
+    let request = LyapunovRequest {
+        initial,
+        transient,
         periods,
         blocks,
-        ..LyapunovOptions::default()
     };
-    let l = run_abandonable(py, progress.as_ref(), move || -> PyResult<_> {
-        let model = model_of(&p)?;
-        let z0 = initial_state(&model, initial)?;
-        lyapunov_spectrum(&model, &z0, &opts).map_err(sim_error)
-    })??;
+    request.validate().map_err(sim_error)?;
+    let l = run_abandonable(py, progress.as_ref(), move || request.run(&p))?.map_err(sim_error)?;
     let out = Out::new(py);
     out.json(&report::lyapunov(&p, &l))?;
     out.f64s("exponents", l.exponents.clone())?;
@@ -906,41 +814,16 @@ pub fn observe<'py>(
     max_period: usize,
     progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Dict<'py>> {
-    use afmdyn::analysis::observables::{observe_from, ObservableOptions};
     let p = params.inner;
-    let steady = steady_options(tol, max_periods, max_period)?;
-    if !(1..=1_000_000).contains(&periods) {
-        return Err(value_error(format!(
-            "periods = {periods}: must be in 1..=1000000"
-        )));
-    }
+    let request = ObserveRequest {
+        periods,
+        harmonics,
+        start: start(initial, tol, max_periods, max_period),
+    };
+    request.validate().map_err(sim_error)?;
     let (doc, z, n) = run_abandonable(py, progress.as_ref(), move || -> PyResult<_> {
-        let model = model_of(&p)?;
-        let (z, found) = guess(&model, initial, &steady)?;
-        // Newton polishes a periodic motion to round-off; a high-Q transient that has not
-        // settled within max_periods is tried as period-1 (or the period found); when
-        // Newton fails the steady-state end point is used as it is
-        let n = found.unwrap_or(1);
-        let newton = ShootingOptions {
-            tol: 1e-12,
-            ..ShootingOptions::default()
-        };
-        let (z, found) = match shoot(&model, &z, n, &newton) {
-            Ok(o) => (o.state, Some(n)),
-            Err(_) => (z, found),
-        };
-        let o = observe_from(
-            &model,
-            IntegratorOptions::default(),
-            0.0,
-            &z,
-            &ObservableOptions {
-                periods: periods * n,
-                harmonics,
-            },
-        )
-        .map_err(sim_error)?;
-        Ok((report::observables(&o), z, found))
+        let o = request.run(&p).map_err(sim_error)?;
+        Ok((report::observables(&o.observables), o.state, o.period))
     })??;
     let out = Out::new(py);
     out.json(&doc)?;

@@ -35,11 +35,14 @@ fn _afmdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(analyses::probe, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::observe, m)?)?;
     m.add("POLL_SECONDS", run::POLL.as_secs_f64())?;
+    m.add_function(wrap_pyfunction!(params::resolve, m)?)?;
+    m.add_function(wrap_pyfunction!(params::with_si, m)?)?;
+    // the one table of model parameters: (name, alias or name, unit, range, help)
     m.add(
-        "MODEL_KEYWORDS",
-        params::MODEL_KEYWORDS
+        "MODEL_PARAMETERS",
+        afmdyn::request::MODEL_PARAMETERS
             .iter()
-            .map(|(name, alias, doc)| (*name, *alias, *doc))
+            .map(|p| (p.name, p.alias.unwrap_or(p.name), p.unit, p.range, p.help))
             .collect::<Vec<_>>(),
     )?;
     Ok(())

@@ -2,64 +2,18 @@
 //! [`afmdyn::Params`]: [`params_from_kwargs`].
 
 use crate::errors::param_error;
+use afmdyn::request::{parameter, ModelSpec, MODEL_PARAMETERS};
 use afmdyn::Params;
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyString};
 
-/// The model keywords: (canonical snake_case name, paper alias, what it is).
-pub const MODEL_KEYWORDS: [(&str, &str, &str); 12] = [
-    ("modes", "modes", "number of Galerkin modes N, 1..=20"),
-    (
-        "tip_mass_ratio",
-        "alpha1",
-        "tip-mass ratio α1 = M/(mL), >= 0",
-    ),
-    (
-        "drive_amplitude",
-        "alpha2",
-        "base-drive amplitude α2 = f/g0, >= 0",
-    ),
-    ("beam_damping", "alpha3", "beam damping α3, >= 0"),
-    (
-        "contact_stiffness",
-        "alpha4",
-        "contact stiffness α4 = K1 L³/(EI), >= 0",
-    ),
-    (
-        "gap",
-        "alpha5",
-        "tip–sample gap α5 = g1/g0, any finite value",
-    ),
-    ("contact_damping", "alpha6", "contact damping α6, >= 0"),
-    ("omega", "omega", "dimensionless drive frequency Ω, > 0"),
-    (
-        "contact_law",
-        "contact_law",
-        "tip–sample law: linear, hertz, dmt or impact",
-    ),
-    (
-        "restitution",
-        "restitution",
-        "impact law: coefficient of restitution r, 0..=1",
-    ),
-    ("hamaker", "hamaker", "DMT: van der Waals group H̃, >= 0"),
-    (
-        "intermolecular_distance",
-        "intermolecular_distance",
-        "DMT: intermolecular distance ã0 = a0/g0, > 0",
-    ),
-];
-
 fn keyword_list() -> String {
-    MODEL_KEYWORDS
+    MODEL_PARAMETERS
         .iter()
-        .map(|(name, alias, _)| {
-            if name == alias {
-                (*name).to_string()
-            } else {
-                format!("{name} ({alias})")
-            }
+        .map(|p| match p.alias {
+            None => p.name.to_string(),
+            Some(alias) => format!("{} ({alias})", p.name),
         })
         .collect::<Vec<_>>()
         .join(", ")
@@ -100,80 +54,130 @@ fn integer(name: &str, v: &Bound<'_, PyAny>) -> PyResult<i64> {
     })
 }
 
-/// `base` with the model keywords in `kwargs` applied, validated. Every Python entry point
-/// (the `Params` constructor, `Params.replace`, the `**model` keywords of every analysis) goes
-/// through here, so a new model field needs one new arm.
-///
-/// Keywords: the command line's flag names in snake_case (`tip_mass_ratio`, …) or the paper's
-/// `alpha1`…`alpha6`, plus `modes` and `omega`.
+/// The model keywords in `kwargs` as the library's [`ModelSpec`] (names from the one table,
+/// [`MODEL_PARAMETERS`]; types checked here, ranges by the library).
 ///
 /// # Errors
-/// `TypeError` for an unknown keyword or a value of the wrong type, `ValueError` for a value
-/// out of range or a field given twice (name and alias), naming the field and its range.
-pub fn params_from_kwargs(base: Params, kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<Params> {
-    let mut p = base;
+/// `TypeError` for an unknown keyword or a value of the wrong type, `ValueError` for a field
+/// given twice (name and alias).
+pub fn model_spec(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<ModelSpec> {
+    let mut m = ModelSpec::default();
     let mut seen: Vec<(&str, String)> = Vec::new();
-    let (mut law, mut restitution, mut hamaker, mut a0) = (None, None, None, None);
-    if let Some(kw) = kwargs {
-        for (k, v) in kw.iter() {
-            let key: String = k
-                .extract()
-                .map_err(|_| PyTypeError::new_err("parameter names must be strings"))?;
-            let canonical = MODEL_KEYWORDS
-                .iter()
-                .find(|(name, alias, _)| key == *name || key == *alias)
-                .map(|(name, _, _)| *name)
-                .ok_or_else(|| {
+    let Some(kw) = kwargs else { return Ok(m) };
+    for (k, v) in kw.iter() {
+        let key: String = k
+            .extract()
+            .map_err(|_| PyTypeError::new_err("parameter names must be strings"))?;
+        let canonical = parameter(&key).map(|p| p.name).ok_or_else(|| {
+            PyTypeError::new_err(format!(
+                "unknown model parameter '{key}': expected {}",
+                keyword_list()
+            ))
+        })?;
+        if let Some((_, first)) = seen.iter().find(|(c, _)| *c == canonical) {
+            return Err(PyValueError::new_err(format!(
+                "{key} and {first} both given: they are the same parameter"
+            )));
+        }
+        seen.push((canonical, key.clone()));
+        let x = || float(&key, &v).map(Some);
+        match canonical {
+            "modes" => {
+                let n = integer(&key, &v)?;
+                m.modes = Some(usize::try_from(n).map_err(|_| {
+                    PyValueError::new_err(format!(
+                        "modes = {n}: the number of Galerkin modes N must be an integer in 1..=20"
+                    ))
+                })?);
+            }
+            "tip_mass_ratio" => m.tip_mass_ratio = x()?,
+            "drive_amplitude" => m.drive_amplitude = x()?,
+            "beam_damping" => m.beam_damping = x()?,
+            "contact_stiffness" => m.contact_stiffness = x()?,
+            "gap" => m.gap = x()?,
+            "contact_damping" => m.contact_damping = x()?,
+            "omega" => m.omega = x()?,
+            "restitution" => m.restitution = x()?,
+            "hamaker" => m.hamaker = x()?,
+            "intermolecular_distance" => m.intermolecular_distance = x()?,
+            "z_c" => m.z_c = x()?,
+            "drive_frequency" => m.drive_frequency = x()?,
+            "contact_law" => {
+                let name: String = v.extract().map_err(|_| {
                     PyTypeError::new_err(format!(
-                        "unknown model parameter '{key}': expected {}",
-                        keyword_list()
+                        "{key}: expected a string (linear, hertz, dmt or impact)"
                     ))
                 })?;
-            if let Some((_, first)) = seen.iter().find(|(c, _)| *c == canonical) {
-                return Err(PyValueError::new_err(format!(
-                    "{key} and {first} both given: they are the same parameter"
-                )));
+                m.contact_law = Some(
+                    name.parse::<afmdyn::LawKind>()
+                        .map_err(PyValueError::new_err)?,
+                );
             }
-            seen.push((canonical, key.clone()));
-            match canonical {
-                "modes" => {
-                    let n = integer(&key, &v)?;
-                    p.modes = usize::try_from(n).map_err(|_| {
-                        PyValueError::new_err(format!(
-                            "modes = {n}: the number of Galerkin modes N must be an integer in 1..=20"
-                        ))
-                    })?;
-                }
-                "tip_mass_ratio" => p.alpha1 = float(&key, &v)?,
-                "drive_amplitude" => p.alpha2 = float(&key, &v)?,
-                "beam_damping" => p.alpha3 = float(&key, &v)?,
-                "contact_stiffness" => p.alpha4 = float(&key, &v)?,
-                "gap" => p.alpha5 = float(&key, &v)?,
-                "contact_damping" => p.alpha6 = float(&key, &v)?,
-                "omega" => p.omega = float(&key, &v)?,
-                "contact_law" => {
-                    let name: String = v.extract().map_err(|_| {
-                        PyTypeError::new_err(format!(
-                            "{key}: expected a string (linear, hertz, dmt or impact)"
-                        ))
-                    })?;
-                    law = Some(
-                        name.parse::<afmdyn::LawKind>()
-                            .map_err(PyValueError::new_err)?,
-                    );
-                }
-                "restitution" => restitution = Some(float(&key, &v)?),
-                "hamaker" => hamaker = Some(float(&key, &v)?),
-                "intermolecular_distance" => a0 = Some(float(&key, &v)?),
-                _ => unreachable!("every keyword of MODEL_KEYWORDS has an arm"),
-            }
+            _ => unreachable!("every row of MODEL_PARAMETERS has an arm"),
         }
     }
-    // the law and its groups resolved as on the command line
-    p.contact_law = afmdyn::ContactLaw::from_parts(law, hamaker, a0, restitution, p.contact_law)
-        .map_err(param_error)?;
-    p.validate().map_err(param_error)?;
-    Ok(p)
+    Ok(m)
+}
+
+/// `base` with the model keywords in `kwargs` applied, validated ([`ModelSpec::resolve`]).
+/// Every Python entry point (the `Params` constructor, `Params.replace`, the `**model`
+/// keywords of every analysis) goes through here.
+///
+/// # Errors
+/// As [`model_spec`], and `ValueError` naming the field and its range.
+pub fn params_from_kwargs(base: Params, kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<Params> {
+    model_spec(kwargs)?
+        .resolve(base, None)
+        .map_err(crate::errors::sim_error)
+}
+
+/// The parameter set of an analysis call (the command line's `--probe`, `--config` and model
+/// flags): `params` (an `afmdyn.Params`, like a config file), or the probe file's set, or
+/// `default`, or the paper's set, with the keywords applied ([`ModelSpec::resolve`]: `z_c`
+/// and `drive_frequency` need the probe). `params` and `probe` together must agree (the
+/// pattern `f(Params.from_probe(path), probe=path)`): the probe sets every parameter and the
+/// keywords override single ones.
+#[pyfunction]
+#[pyo3(signature = (params=None, default=None, probe=None, model=None))]
+pub fn resolve(
+    params: Option<PyRef<'_, PyParams>>,
+    default: Option<PyRef<'_, PyParams>>,
+    probe: Option<std::path::PathBuf>,
+    model: Option<&Bound<'_, PyDict>>,
+) -> PyResult<PyParams> {
+    let spec = model_spec(model)?;
+    let probe = probe
+        .map(|p| afmdyn::probe::Probe::load(&p).map_err(crate::errors::probe_error))
+        .transpose()?;
+    let base = match (&params, &probe) {
+        (Some(given), Some(pr)) if given.inner != pr.params => {
+            return Err(PyValueError::new_err(
+                "params and probe both given and they differ: pass probe= alone (it sets every \
+                 parameter; keywords override single ones)",
+            ))
+        }
+        (Some(given), _) => given.inner,
+        (None, _) => default.map_or_else(Params::default, |d| d.inner),
+    };
+    Ok(PyParams {
+        inner: spec
+            .resolve(base, probe.as_ref())
+            .map_err(crate::errors::sim_error)?,
+    })
+}
+
+/// The command line's JSON document `json` with the `"si"` block of the probe file at `probe`
+/// ([`afmdyn::report::with_si`]), for the analyses called with `probe=`.
+#[pyfunction]
+pub fn with_si(
+    json: &str,
+    probe: std::path::PathBuf,
+    params: PyRef<'_, PyParams>,
+) -> PyResult<String> {
+    let pr = afmdyn::probe::Probe::load(&probe).map_err(crate::errors::probe_error)?;
+    let doc: serde_json::Value = serde_json::from_str(json)
+        .map_err(|e| PyValueError::new_err(format!("with_si: not a JSON document: {e}")))?;
+    Ok(afmdyn::report::with_si(doc, Some(&pr), &params.inner).to_string())
 }
 
 /// Dimensionless model parameters (paper eq. 7), validated on construction.

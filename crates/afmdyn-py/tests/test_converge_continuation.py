@@ -36,7 +36,7 @@ def test_converge_errors():
         afmdyn.converge(max_modes=0)
     with pytest.raises(ValueError, match="max_modes = 21"):
         afmdyn.converge(max_modes=21)
-    with pytest.raises(ValueError, match="periods / samples per period"):
+    with pytest.raises(ValueError, match="periods = 0: must be in 1..=10000"):
         afmdyn.converge(periods=0)
 
 

@@ -211,6 +211,23 @@ pub enum SimError {
 }
 
 impl SimError {
+    /// The message with the parameter of an [`SimError::OutOfRange`] or
+    /// [`SimError::NotFinite`] spelled as a front end spells it (`samples_per_period` is
+    /// `--samples-per-period` on the command line); other errors as [`std::fmt::Display`].
+    pub fn spelled(&self, spell: impl Fn(&str) -> String) -> String {
+        match self {
+            SimError::OutOfRange {
+                name,
+                value,
+                allowed,
+            } => format!("{} = {value}: {allowed}", spell(name)),
+            SimError::NotFinite { name, value } => {
+                format!("{} = {value}: must be a finite number", spell(name))
+            }
+            other => other.to_string(),
+        }
+    }
+
     /// Shorthand for [`SimError::OutOfRange`].
     pub fn out_of_range(name: &'static str, value: impl ToString, allowed: &'static str) -> Self {
         SimError::OutOfRange {

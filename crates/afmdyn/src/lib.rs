@@ -12,6 +12,7 @@
 //! saltation) → [`model`] (the cantilever–sample system) → [`integrate`] (exact propagation, RK4, an
 //! adaptive oracle) → [`trajectory`] (observables, stroboscopic Poincaré section) →
 //! [`analysis`] (steady states, periods, bifurcation sweeps, attractors, mode convergence);
+//! [`request`] is what every front end hands the library (parameters by name, defaults, limits);
 //! [`report`] builds the JSON result documents shared by the command line and Python.
 //!
 //! Time is the dimensionless τ of eq. 5 and displacements are in units of the beam gap g₀.
@@ -44,6 +45,7 @@ pub mod model;
 pub mod params;
 pub mod probe;
 pub mod report;
+pub mod request;
 pub mod roots;
 pub mod system;
 pub mod trajectory;

@@ -7,7 +7,9 @@ from typing import Any, Callable, Dict, List, Literal, Optional, Tuple, Union
 ProgressCallback = Callable[[int, Optional[int]], object]
 
 POLL_SECONDS: float
-MODEL_KEYWORDS: List[Tuple[str, str, str]]
+#: The one table of model parameters (the library's ``afmdyn::request::MODEL_PARAMETERS``):
+#: (name, alias or name, unit, range, help).
+MODEL_PARAMETERS: List[Tuple[str, str, str, str, str]]
 
 class SimulationError(RuntimeError):
     """A computation failed (chattering, divergence, Newton not converging, integrator
@@ -211,6 +213,13 @@ def lyapunov(
     progress: Optional[ProgressCallback] = None,
 ) -> Dict[str, Any]: ...
 def probe(path: Union[str, "os.PathLike[str]"]) -> Tuple[Params, str]: ...
+def resolve(
+    params: Optional[Params] = None,
+    default: Optional[Params] = None,
+    probe: Optional[str] = None,
+    model: Optional[Dict[str, Any]] = None,
+) -> Params: ...
+def with_si(json: str, probe: str, params: Params) -> str: ...
 def observe(
     params: Params,
     initial: Optional[List[float]] = None,

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import json
 import os
-from typing import Literal, TYPE_CHECKING, Any, Dict, Optional, Sequence, TypedDict, Union
+from typing import Literal, TYPE_CHECKING, Any, Dict, Optional, Sequence, Tuple, TypedDict, Union
 
 import numpy as np
 import xarray as xr
@@ -33,7 +33,11 @@ StateLike = Union[None, Sequence[float], np.ndarray, Attractor, Orbit]
 
 
 class Model(TypedDict, total=False):
-    """The model keywords every analysis takes (see :class:`Params` for their ranges)."""
+    """The model keywords every analysis takes (see :class:`Params` for their ranges; the one
+    table of them is ``afmdyn._afmdyn.MODEL_PARAMETERS``). ``probe`` is a probe file in SI (the
+    command line's ``--probe``): it sets every parameter, the other keywords override single
+    ones, and ``z_c`` (m) and ``drive_frequency`` (Hz) set α5 and Ω through its scales; the
+    result's ``to_dict()`` then carries the command line's ``"si"`` block."""
 
     modes: int
     tip_mass_ratio: float
@@ -53,6 +57,9 @@ class Model(TypedDict, total=False):
     restitution: float
     hamaker: float
     intermolecular_distance: float
+    z_c: float
+    drive_frequency: float
+    probe: Union[str, "os.PathLike[str]"]
 
 
 #: Global attributes of every dataset: the scales of the dimensionless units.
@@ -66,15 +73,20 @@ _G = {"units": "g0"}
 _V = {"units": "g0/t0"}
 
 
-def _params(params: Optional[Params], model: Any, default: Optional[Params] = None) -> Params:
-    """``params`` (or ``default``, or the paper's set) with the ``model`` keywords applied."""
-    if params is None:
-        base = default if default is not None else Params()
-    elif isinstance(params, Params):
-        base = params
-    else:
+def _params(
+    params: Optional[Params], model: Any, default: Optional[Params] = None
+) -> Tuple[Params, Optional[str]]:
+    """The parameter set of an analysis call and its probe file (or ``None``), resolved by the
+    library as the command line resolves ``--probe``/``--config`` and the model flags:
+    ``params`` (or the probe's set, or ``default``, or the paper's set) with the ``model``
+    keywords applied."""
+    if params is not None and not isinstance(params, Params):
         raise TypeError(f"params: expected afmdyn.Params or None, got {type(params).__name__}")
-    return base.replace(**model) if model else base
+    model = dict(model)
+    probe = model.pop("probe", None)
+    if probe is not None:
+        probe = os.fspath(probe)
+    return _core.resolve(params, default, probe, model), probe
 
 
 def _state(initial: StateLike) -> Optional[list]:
@@ -107,14 +119,20 @@ _COUNTS = frozenset(
 )
 
 
-def _run(fn: Any, desc: str, progress: ProgressArg, p: Params, **options: Any) -> Dict[str, Any]:
+def _run(
+    fn: Any, desc: str, progress: ProgressArg, p: Params, si: Optional[str] = None, **options: Any
+) -> Dict[str, Any]:
     """Call the compiled ``fn`` with a progress reporter; negative counts are a ValueError
-    naming the option (the core's unsigned integers would raise OverflowError)."""
+    naming the option (the core's unsigned integers would raise OverflowError). With ``si`` (a
+    probe file) the JSON document gains the command line's ``"si"`` block."""
     for k, v in options.items():
         if k in _COUNTS and isinstance(v, int) and not isinstance(v, bool) and v < 0:
             raise ValueError(f"{k} = {v}: must be >= 0")
     with reporter(progress, desc) as cb:
-        return fn(p, progress=cb, **options)
+        d = fn(p, progress=cb, **options)
+    if si is not None and "json" in d:
+        d["json"] = _core.with_si(d["json"], si, p)
+    return d
 
 
 def summary(ds: xr.Dataset) -> Dict[str, Any]:
@@ -130,8 +148,10 @@ def modes(params: Optional[Params] = None, /, **model: Unpack[Model]) -> Spectru
     Returns a :class:`Spectrum` (``.free``, ``.contact``: ω float64 ``[N]``, eigenvalues
     complex128, ζ); ``to_dict()`` is ``afmdyn modes --json``.
     """
-    p = _params(params, model)
+    p, probe = _params(params, model)
     d = _core.modes(p)
+    if probe is not None:
+        d["json"] = _core.with_si(d["json"], probe, p)
 
     def region(name: str) -> RegionSpectrum:
         return RegionSpectrum(d[f"{name}_omega"], d[f"{name}_eigenvalues"], d[f"{name}_zeta"])
@@ -178,12 +198,13 @@ def simulate(
         ``[P, 2N]``; the energy balance per period ``[C]``. ``attrs["summary"]`` holds
         ``afmdyn simulate --json`` (see :func:`summary`).
     """
-    p = _params(params, model)
+    p, probe = _params(params, model)
     d = _run(
         _core.simulate,
         "simulate",
         progress,
         p,
+        si=probe,
         periods=periods,
         tau_end=tau_end,
         transient=transient,
@@ -315,12 +336,13 @@ def converge(
         ``[n_modes]`` (RMS of W_tip(N) − W_tip(N−1), NaN for N = 1); coordinate
         ``tau_from_section`` ``[K]``.
     """
-    p = _params(params, model, default=Params(omega=4.1))
+    p, probe = _params(params, model, default=Params(omega=4.1))
     d = _run(
         _core.converge,
         "converge",
         progress,
         p,
+        si=probe,
         max_modes=max_modes,
         periods=periods,
         samples_per_period=samples_per_period,
@@ -403,13 +425,14 @@ def bifurcation(
         ``contacts_per_period``, ``transient_periods``, ``message``, ``a_1``…``a_N``,
         ``a_dot_1``…``a_dot_N``. ``.to_dataframe()`` gives the tidy table.
     """
-    p = _params(params, model)
+    p, probe = _params(params, model)
     vals = None if values is None else np.asarray(values, dtype=np.float64).ravel().tolist()
     d = _run(
         _core.bifurcation,
         "bifurcation",
         progress,
         p,
+        si=probe,
         param=param,
         values=vals,
         from_=from_,
@@ -500,12 +523,13 @@ def attractors(
         :class:`Attractors`, a sequence of :class:`Attractor` (most frequent first);
         ``to_dict()`` is ``afmdyn attractors --json``, ``to_dataframe()`` a summary table.
     """
-    p = _params(params, model)
+    p, probe = _params(params, model)
     d = _run(
         _core.attractors,
         "attractors",
         progress,
         p,
+        si=probe,
         samples=samples,
         seed=seed,
         cluster_tol=cluster_tol,
@@ -567,7 +591,7 @@ def orbit(
         :class:`Orbit`; ``to_dict()`` is ``afmdyn orbit --json``. Raises
         :class:`SimulationError` when Newton's method does not converge.
     """
-    p = _params(params, model)
+    p, probe = _params(params, model)
     if period is None and isinstance(initial, Attractor):
         period = initial.period or 1
     d = _run(
@@ -575,6 +599,7 @@ def orbit(
         "orbit",
         progress,
         p,
+        si=probe,
         period=period,
         initial=_state(initial),
         tol=tol,
@@ -636,12 +661,13 @@ def continuation(
         ``multipliers`` ``[point, 2N]`` complex128, ``state`` ``[point, 2N]``.
         ``attrs["summary"]`` is ``afmdyn continue --json``.
     """
-    p = _params(params, model)
+    p, probe = _params(params, model)
     d = _run(
         _core.continuation,
         "continuation",
         progress,
         p,
+        si=probe,
         param=param,
         from_=from_,
         to=to,
@@ -706,12 +732,13 @@ def lyapunov(
     Returns:
         :class:`Lyapunov`; ``to_dict()`` is ``afmdyn lyapunov --json``.
     """
-    p = _params(params, model)
+    p, probe = _params(params, model)
     d = _run(
         _core.lyapunov,
         "lyapunov",
         progress,
         p,
+        si=probe,
         initial=_state(initial),
         transient=transient,
         periods=periods,
@@ -773,12 +800,13 @@ def observe(
         The observables document (``afmdyn.analysis.observables``) plus ``state`` (the start,
         ``[2N]``) and ``period`` (n of the period-n motion, ``None`` when not periodic).
     """
-    p = _params(params, model)
+    p, probe = _params(params, model)
     d = _run(
         _core.observe,
         "observe",
         progress,
         p,
+        si=probe,
         initial=_state(initial),
         periods=periods,
         harmonics=harmonics,
@@ -796,13 +824,14 @@ def _curve(
     fn: Any,
     desc: str,
     progress: ProgressArg,
-    p: Params,
-    probe: Optional[Union[str, "os.PathLike[str]"]],
+    params: Optional[Params],
+    model: Any,
     **options: Any,
 ) -> Dict[str, Any]:
     """Run a stepped-curve analysis (:func:`approach`, :func:`resonance`) and return its
-    JSON document."""
-    d = _run(fn, desc, progress, p, probe=None if probe is None else os.fspath(probe), **options)
+    JSON document (in SI with a probe)."""
+    p, probe = _params(params, model)
+    d = _run(fn, desc, progress, p, probe=probe, **options)
     doc: Dict[str, Any] = json.loads(d["json"])
     return doc
 
@@ -817,7 +846,6 @@ def approach(
     points: Optional[int] = None,
     branches: bool = True,
     tolerance: float = 1e-10,
-    probe: Optional[Union[str, "os.PathLike[str]"]] = None,
     progress: ProgressArg = None,
     **model: Unpack[Model],
 ) -> Dict[str, Any]:
@@ -832,8 +860,8 @@ def approach(
         step, points: the grid (a step in the same unit, or the number of values; default 120).
         branches: also continue the branches.
         tolerance: of the adaptive integrator.
-        probe: a probe file whose scales give SI outputs (pass its parameters as ``params``,
-            e.g. ``Params.from_probe(path)``).
+        probe: a probe file (a model keyword, as ``--probe``): it sets the model, and its
+            scales give SI inputs (``from_``, ``to``, ``step`` in m) and outputs.
 
     Returns:
         The ``afmdyn approach --json`` document: ``approach`` and ``retract`` (equal-length
@@ -844,8 +872,8 @@ def approach(
         _core.approach,
         "approach",
         progress,
-        _params(params, model),
-        probe,
+        params,
+        model,
         from_=from_,
         to=to,
         step=step,
@@ -866,7 +894,6 @@ def resonance(
     points: Optional[int] = None,
     branches: bool = True,
     tolerance: float = 1e-10,
-    probe: Optional[Union[str, "os.PathLike[str]"]] = None,
     progress: ProgressArg = None,
     **model: Unpack[Model],
 ) -> Dict[str, Any]:
@@ -877,7 +904,8 @@ def resonance(
 
     Args:
         from_, to: the band (default ω_k (1 ∓ max(6/Q_k, 0.02))), in Hz with ``probe``, else Ω.
-        step, points, branches, tolerance, probe: as :func:`approach`.
+        step, points, branches, tolerance: as :func:`approach`; ``probe`` (a model keyword)
+            sets the model and gives frequencies in Hz.
 
     Returns:
         The ``afmdyn resonance --json`` document: ``up`` and ``down`` (``omega`` or
@@ -888,8 +916,8 @@ def resonance(
         _core.resonance,
         "resonance",
         progress,
-        _params(params, model),
-        probe,
+        params,
+        model,
         mode=mode,
         from_=from_,
         to=to,

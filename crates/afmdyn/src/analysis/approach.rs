@@ -8,7 +8,7 @@
 //! [`super::stepped`].
 
 use super::observables::free_response;
-use super::stepped::{grid, stepped_sweep, CurveRequest, Spacing, SteppedCurve, SteppedSpec};
+use super::stepped::{grid, stepped_sweep, Spacing, SteppedCurve, SteppedSpec};
 use crate::error::SimError;
 use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
@@ -43,20 +43,6 @@ pub fn approach_spec(
         .map(|&z| base.alpha5_for_rest_distance(z))
         .collect();
     Ok(SteppedSpec::new(base, SweepParam::Alpha5, values))
-}
-
-/// The approach spec of a front end's request, z_c in units of `length` (m per g₀, or 1):
-/// [`default_range`] for missing ends, [`approach_spec`], then [`CurveRequest::configure`].
-///
-/// # Errors
-/// As those three.
-pub fn approach_request(
-    base: Params,
-    request: &CurveRequest,
-    length: f64,
-) -> Result<SteppedSpec, SimError> {
-    let (from, to) = request.ends(default_range(&base)?, length);
-    request.configure(approach_spec(base, from, to, request.spacing(length)?)?)
 }
 
 /// The rest distance z_c of the gap value α5 = `alpha5` under `base`'s contact law.

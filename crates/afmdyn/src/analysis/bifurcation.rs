@@ -150,7 +150,7 @@ impl SweepSpec {
                         ""
                     }
                 ),
-                "must be <= 1000000 in all (lower --steps or --starts)",
+                "must be <= 1000000 in all (fewer steps or starts)",
             )),
         }
     }

@@ -4,7 +4,7 @@
 //! multivalued, bent resonance curves of the intermittent contact (e.g. Lee, Howell & Raman,
 //! *Phys. Rev. B* 66 (2002) 115409) are traced whole. The driver is [`super::stepped`].
 
-use super::stepped::{grid, stepped_sweep, CurveRequest, Spacing, SteppedCurve, SteppedSpec};
+use super::stepped::{grid, stepped_sweep, Spacing, SteppedCurve, SteppedSpec};
 use crate::eigen::spectrum;
 use crate::error::SimError;
 use crate::params::{Params, SweepParam, OMEGA_MAX, OMEGA_MIN};
@@ -52,22 +52,6 @@ pub fn resonance_spec(
 ) -> Result<SteppedSpec, SimError> {
     let values = grid(from.min(to), from.max(to), spacing)?;
     Ok(SteppedSpec::new(base, SweepParam::Omega, values))
-}
-
-/// The resonance spec of a front end's request near mode `mode`, Ω in units of `hz` (Hz per
-/// unit Ω, or 1): [`mode_band`] for missing ends, [`resonance_spec`], then
-/// [`CurveRequest::configure`].
-///
-/// # Errors
-/// As those three.
-pub fn resonance_request(
-    base: Params,
-    mode: usize,
-    request: &CurveRequest,
-    hz: f64,
-) -> Result<SteppedSpec, SimError> {
-    let (from, to) = request.ends(mode_band(&base, mode)?, hz);
-    request.configure(resonance_spec(base, from, to, request.spacing(hz)?)?)
 }
 
 /// Run the up-sweep (the first sweep of the result), the down-sweep (the second) and the

@@ -1,0 +1,843 @@
+//! One request per analysis: its options with their defaults (those of `afmdyn <command>
+//! --help` and of the Python functions), `validate()` holding every limit ([`super::limits`]),
+//! and, where the analysis is one library call, `run(params)`. Errors name the library's
+//! parameters (`samples_per_period`, `max_period`); a front end spells them its own way
+//! ([`SimError::spelled`]).
+//!
+//! Model values are not part of these requests: they resolve first, through
+//! [`super::ModelSpec::resolve`], into the [`Params`] every `validate` and `run` takes.
+
+use super::limits::*;
+use crate::analysis::attractors::{find_attractors, AttractorReport, AttractorSpec};
+use crate::analysis::bifurcation::SweepSpec;
+use crate::analysis::continuation::{
+    continue_branch, continue_with_switching, BranchPoint, ContinuationSpec,
+};
+use crate::analysis::converge::{mode_convergence, ConvergenceRun};
+use crate::analysis::lyapunov::{lyapunov_spectrum, LyapunovOptions, LyapunovSpectrum};
+use crate::analysis::observables::{observe_from, ObservableOptions, Observables};
+use crate::analysis::period::MAX_PERIOD;
+use crate::analysis::shooting::{shoot, PeriodicOrbit, ShootingOptions};
+use crate::analysis::steady::{steady_state, SteadyOptions};
+use crate::error::SimError;
+use crate::integrate::{build, IntegratorKind, IntegratorOptions};
+use crate::model::CantileverModel;
+use crate::params::{Params, SweepParam};
+use nalgebra::DVector;
+use serde::{Deserialize, Serialize};
+
+/// The steady-state search of every analysis that starts from a transient.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SteadyRequest {
+    /// Relative tolerance for two returns of the stroboscopic map to coincide, > 0.
+    pub tol: f64,
+    /// Cap on the transient, in drive periods, 1..=[`MAX_STEADY_PERIODS`].
+    pub max_periods: usize,
+    /// Largest period searched, 1..=64 ([`MAX_PERIOD`]).
+    pub max_period: usize,
+}
+
+impl Default for SteadyRequest {
+    fn default() -> Self {
+        let d = SteadyOptions::default();
+        SteadyRequest {
+            tol: d.tol,
+            max_periods: d.max_periods,
+            max_period: d.max_period,
+        }
+    }
+}
+
+impl SteadyRequest {
+    /// The validated options.
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming `tol`, `max_period` or `max_periods`.
+    pub fn options(&self) -> Result<SteadyOptions, SimError> {
+        if !(self.tol.is_finite() && self.tol > 0.0) {
+            return Err(SimError::out_of_range(
+                "tol",
+                self.tol,
+                "must be finite and > 0",
+            ));
+        }
+        if !(1..=MAX_PERIOD).contains(&self.max_period) {
+            return Err(SimError::out_of_range(
+                "max_period",
+                self.max_period,
+                "must be in 1..=64",
+            ));
+        }
+        if !(1..=MAX_STEADY_PERIODS).contains(&self.max_periods) {
+            return Err(SimError::out_of_range(
+                "max_periods",
+                self.max_periods,
+                "must be in 1..=10000000",
+            ));
+        }
+        Ok(SteadyOptions {
+            tol: self.tol,
+            max_periods: self.max_periods,
+            max_period: self.max_period,
+            ..SteadyOptions::default()
+        })
+    }
+}
+
+/// The integrator of an analysis that lets the user choose it.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct IntegratorRequest {
+    /// `auto` (exact for the linear law, adaptive otherwise), `exact`, `rk4`, `rk4-naive` or
+    /// `adaptive`.
+    pub integrator: IntegratorKind,
+    /// Fixed steps per drive period of `rk4` / `rk4-naive` (default 2000).
+    pub steps_per_period: Option<usize>,
+    /// Relative and absolute tolerance of the adaptive integrator.
+    pub tolerance: f64,
+}
+
+impl Default for IntegratorRequest {
+    fn default() -> Self {
+        IntegratorRequest {
+            integrator: IntegratorKind::Auto,
+            steps_per_period: None,
+            tolerance: 1e-12,
+        }
+    }
+}
+
+impl IntegratorRequest {
+    /// The options: `exact` (and `auto`, which picks it for the linear law) refines its own
+    /// grid from `samples_per_period` so that samples land on grid points; `rk4` takes
+    /// `steps_per_period` (default 2000); `adaptive` chooses its steps.
+    pub fn options(&self, samples_per_period: usize) -> IntegratorOptions {
+        let steps = match self.integrator {
+            IntegratorKind::Auto | IntegratorKind::Exact => samples_per_period.max(1),
+            IntegratorKind::Rk4 | IntegratorKind::Rk4Naive => self.steps_per_period.unwrap_or(2000),
+            IntegratorKind::Adaptive => 1,
+        };
+        IntegratorOptions {
+            kind: self.integrator,
+            steps_per_period: steps,
+            tolerance: self.tolerance,
+        }
+    }
+}
+
+/// The initial state `z = (a, ȧ)` (2N values) of `model`, or rest when `None`.
+///
+/// # Errors
+/// [`SimError::StateLength`] for a length other than 2N, [`SimError::OutOfRange`] naming
+/// `initial` for an entry not finite or at or above [`MAX_INITIAL_ENTRY`].
+pub fn initial_state(
+    model: &CantileverModel,
+    initial: Option<&[f64]>,
+) -> Result<DVector<f64>, SimError> {
+    let Some(z) = initial else {
+        return Ok(model.rest());
+    };
+    let n = model.modes();
+    if z.len() != 2 * n {
+        return Err(SimError::StateLength {
+            name: "initial (a1..aN, adot1..adotN)",
+            expected: 2 * n,
+            got: z.len(),
+        });
+    }
+    let largest = z.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    if largest >= MAX_INITIAL_ENTRY || z.iter().any(|v| !v.is_finite()) {
+        return Err(SimError::out_of_range(
+            "initial",
+            format!("largest entry {largest:e}"),
+            "every entry must be finite and below 1e11 (states of norm 1e12 count as diverged)",
+        ));
+    }
+    model.state_from(&z[..n], &z[n..])
+}
+
+/// Where an orbit analysis starts: a given state, or the steady state reached from rest.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct StartRequest {
+    /// The initial state (2N values a1..aN, ȧ1..ȧN) used as the guess as it is; `None`: the
+    /// end of the steady state reached from rest.
+    pub initial: Option<Vec<f64>>,
+    /// The steady-state search from rest.
+    pub steady: SteadyRequest,
+}
+
+impl StartRequest {
+    /// The guess and, when a steady state was searched, its period.
+    ///
+    /// # Errors
+    /// As [`initial_state`], [`SteadyRequest::options`] and [`steady_state`].
+    pub fn guess(
+        &self,
+        model: &CantileverModel,
+    ) -> Result<(DVector<f64>, Option<usize>), SimError> {
+        let steady = self.steady.options()?;
+        let z0 = initial_state(model, self.initial.as_deref())?;
+        if self.initial.is_some() {
+            return Ok((z0, None));
+        }
+        let mut integ = build(model, IntegratorOptions::default(), 0.0, &z0)?;
+        let s = steady_state(integ.as_mut(), &steady)?;
+        Ok((s.end_state().clone(), s.period()))
+    }
+}
+
+fn check_period(period: Option<usize>) -> Result<(), SimError> {
+    match period {
+        Some(n) if !(1..=MAX_PERIOD).contains(&n) => {
+            Err(SimError::out_of_range("period", n, "must be in 1..=64"))
+        }
+        _ => Ok(()),
+    }
+}
+
+/// `orbit`: a period-n orbit by Newton shooting, with its Floquet multipliers.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct OrbitRequest {
+    /// The period n (1..=64); `None`: the period of the steady state reached, else 1.
+    pub period: Option<usize>,
+    /// The start.
+    #[serde(flatten)]
+    pub start: StartRequest,
+}
+
+impl OrbitRequest {
+    /// Check every option.
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming the option.
+    pub fn validate(&self) -> Result<(), SimError> {
+        check_period(self.period)?;
+        self.start.steady.options().map(|_| ())
+    }
+
+    /// The orbit of `params`.
+    ///
+    /// # Errors
+    /// As [`Self::validate`], [`StartRequest::guess`] and [`shoot`].
+    pub fn run(&self, params: &Params) -> Result<PeriodicOrbit, SimError> {
+        self.validate()?;
+        let model = CantileverModel::new(params)?;
+        let (guess, found) = self.start.guess(&model)?;
+        let n = self.period.or(found).unwrap_or(1);
+        shoot(&model, &guess, n, &ShootingOptions::default())
+    }
+}
+
+/// `continuation`: pseudo-arclength continuation of a period-n branch in one parameter, and
+/// with `switch` the period-doubling cascade to [`CASCADE_FACTOR`] n.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ContinuationRequest {
+    /// The continued parameter.
+    pub param: SweepParam,
+    /// First value.
+    pub from: f64,
+    /// Last value.
+    pub to: f64,
+    /// The period n (1..=64); `None`: the period of the steady state reached at `from`, else 1.
+    pub period: Option<usize>,
+    /// Switch branches at period doublings (periods n, 2n, 4n, 8n).
+    pub switch: bool,
+    /// The start at `from`.
+    #[serde(flatten)]
+    pub start: StartRequest,
+}
+
+impl Default for ContinuationRequest {
+    fn default() -> Self {
+        ContinuationRequest {
+            param: SweepParam::Omega,
+            from: 5.0,
+            to: 1.0,
+            period: None,
+            switch: false,
+            start: StartRequest::default(),
+        }
+    }
+}
+
+impl ContinuationRequest {
+    /// Check every option against `base`: both ends must be valid parameter sets.
+    ///
+    /// # Errors
+    /// [`SimError::Params`] for an end out of range, [`SimError::OutOfRange`] naming the option.
+    pub fn validate(&self, base: &Params) -> Result<(), SimError> {
+        base.with(self.param, self.from).validate()?;
+        base.with(self.param, self.to).validate()?;
+        check_period(self.period)?;
+        self.start.steady.options().map(|_| ())
+    }
+
+    /// The branches: one without `switch`, the cascade with it.
+    ///
+    /// # Errors
+    /// As [`Self::validate`], [`StartRequest::guess`], [`continue_branch`] and
+    /// [`continue_with_switching`].
+    pub fn run(&self, base: &Params) -> Result<Vec<Vec<BranchPoint>>, SimError> {
+        self.validate(base)?;
+        let model = CantileverModel::new(&base.with(self.param, self.from))?;
+        let (guess, found) = self.start.guess(&model)?;
+        let n = self.period.or(found).unwrap_or(1);
+        let spec = ContinuationSpec::new(*base, self.param, self.from, self.to, n);
+        if self.switch {
+            continue_with_switching(&spec, &guess, CASCADE_FACTOR * n)
+        } else {
+            Ok(vec![continue_branch(&spec, &guess)?])
+        }
+    }
+}
+
+/// `lyapunov`: the Lyapunov spectrum with saltation matrices and the 0–1 test.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct LyapunovRequest {
+    /// The initial state (2N values); `None`: rest.
+    pub initial: Option<Vec<f64>>,
+    /// Drive periods discarded first.
+    pub transient: usize,
+    /// Drive periods averaged; transient + periods ≤ [`MAX_RUN_PERIODS`].
+    pub periods: usize,
+    /// Blocks for the uncertainty, 2..=periods.
+    pub blocks: usize,
+}
+
+impl Default for LyapunovRequest {
+    fn default() -> Self {
+        let d = LyapunovOptions::default();
+        LyapunovRequest {
+            initial: None,
+            transient: d.transient_periods,
+            periods: d.periods,
+            blocks: d.blocks,
+        }
+    }
+}
+
+impl LyapunovRequest {
+    /// Check every option.
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming `periods` or `blocks`.
+    pub fn validate(&self) -> Result<(), SimError> {
+        if self.transient as f64 + self.periods as f64 > MAX_RUN_PERIODS {
+            return Err(SimError::out_of_range(
+                "periods",
+                format!("{} with transient = {}", self.periods, self.transient),
+                "a run may span at most 1e8 drive periods, transient included",
+            ));
+        }
+        if self.blocks < 2 || self.periods < self.blocks {
+            return Err(SimError::out_of_range(
+                "blocks",
+                format!("{} with periods = {}", self.blocks, self.periods),
+                "need periods >= blocks >= 2",
+            ));
+        }
+        Ok(())
+    }
+
+    /// The spectrum of `params` from the initial state.
+    ///
+    /// # Errors
+    /// As [`Self::validate`], [`initial_state`] and [`lyapunov_spectrum`].
+    pub fn run(&self, params: &Params) -> Result<LyapunovSpectrum, SimError> {
+        self.validate()?;
+        let model = CantileverModel::new(params)?;
+        let z0 = initial_state(&model, self.initial.as_deref())?;
+        let opts = LyapunovOptions {
+            transient_periods: self.transient,
+            periods: self.periods,
+            blocks: self.blocks,
+            ..LyapunovOptions::default()
+        };
+        lyapunov_spectrum(&model, &z0, &opts)
+    }
+}
+
+/// `attractors`: the coexisting attractors and their basin fractions from random starts.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct AttractorsRequest {
+    /// Random initial states, 1..=[`MAX_ATTRACTOR_SAMPLES`].
+    pub samples: usize,
+    /// Seed of the initial states.
+    pub seed: u64,
+    /// Relative tolerance for two Poincaré point sets to be the same attractor, > 0.
+    pub cluster_tol: f64,
+    /// The steady-state search of every start.
+    #[serde(flatten)]
+    pub steady: SteadyRequest,
+    /// The integrator.
+    #[serde(flatten)]
+    pub integrator: IntegratorRequest,
+}
+
+impl Default for AttractorsRequest {
+    fn default() -> Self {
+        AttractorsRequest {
+            samples: 64,
+            seed: 1,
+            cluster_tol: 1e-5,
+            steady: SteadyRequest::default(),
+            integrator: IntegratorRequest::default(),
+        }
+    }
+}
+
+impl AttractorsRequest {
+    /// The validated census of `params` (integrator built for
+    /// [`ATTRACTOR_SAMPLES_PER_PERIOD`]).
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming `samples`, `cluster_tol` or a steady-state option.
+    pub fn spec(&self, params: &Params) -> Result<AttractorSpec, SimError> {
+        if !(1..=MAX_ATTRACTOR_SAMPLES).contains(&self.samples) {
+            return Err(SimError::out_of_range(
+                "samples",
+                self.samples,
+                "must be in 1..=100000",
+            ));
+        }
+        if !(self.cluster_tol.is_finite() && self.cluster_tol > 0.0) {
+            return Err(SimError::out_of_range(
+                "cluster_tol",
+                self.cluster_tol,
+                "must be finite and > 0",
+            ));
+        }
+        Ok(AttractorSpec {
+            params: *params,
+            samples: self.samples,
+            seed: self.seed,
+            cluster_tol: self.cluster_tol,
+            steady: self.steady.options()?,
+            integrator: self.integrator.options(ATTRACTOR_SAMPLES_PER_PERIOD),
+        })
+    }
+
+    /// The census of `params`.
+    ///
+    /// # Errors
+    /// As [`Self::spec`] and [`find_attractors`].
+    pub fn run(&self, params: &Params) -> Result<AttractorReport, SimError> {
+        find_attractors(&self.spec(params)?)
+    }
+}
+
+/// `observe`: the observables of the steady state reached from a start (polished by Newton
+/// shooting when periodic).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ObserveRequest {
+    /// Orbit periods integrated, 1..=[`MAX_OBSERVE_PERIODS`].
+    pub periods: usize,
+    /// Highest harmonic reported.
+    pub harmonics: usize,
+    /// The start.
+    #[serde(flatten)]
+    pub start: StartRequest,
+}
+
+impl Default for ObserveRequest {
+    fn default() -> Self {
+        ObserveRequest {
+            periods: 1,
+            harmonics: 10,
+            start: StartRequest::default(),
+        }
+    }
+}
+
+/// The result of [`ObserveRequest::run`].
+#[derive(Debug, Clone)]
+pub struct ObserveResult {
+    /// The observables.
+    pub observables: Observables,
+    /// The state at τ = 0 they were integrated from (Newton-polished when periodic).
+    pub state: DVector<f64>,
+    /// The period n of the motion, when it is periodic.
+    pub period: Option<usize>,
+}
+
+impl ObserveRequest {
+    /// Check every option.
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming `periods` or a steady-state option.
+    pub fn validate(&self) -> Result<(), SimError> {
+        if !(1..=MAX_OBSERVE_PERIODS).contains(&self.periods) {
+            return Err(SimError::out_of_range(
+                "periods",
+                self.periods,
+                "must be in 1..=1000000",
+            ));
+        }
+        self.start.steady.options().map(|_| ())
+    }
+
+    /// The observables of `params`: the steady state from the start, polished by Newton
+    /// shooting to 1e-12 when periodic (a transient that has not settled is tried as period 1;
+    /// when Newton fails the steady state's end point is used as it is), integrated over
+    /// `periods` of its periods.
+    ///
+    /// # Errors
+    /// As [`Self::validate`], [`StartRequest::guess`] and [`observe_from`].
+    pub fn run(&self, params: &Params) -> Result<ObserveResult, SimError> {
+        self.validate()?;
+        let model = CantileverModel::new(params)?;
+        let (z, found) = self.start.guess(&model)?;
+        let n = found.unwrap_or(1);
+        let newton = ShootingOptions {
+            tol: 1e-12,
+            ..ShootingOptions::default()
+        };
+        let (state, period) = match shoot(&model, &z, n, &newton) {
+            Ok(o) => (o.state, Some(n)),
+            Err(_) => (z, found),
+        };
+        let observables = observe_from(
+            &model,
+            IntegratorOptions::default(),
+            0.0,
+            &state,
+            &ObservableOptions {
+                periods: self.periods * n,
+                harmonics: self.harmonics,
+            },
+        )?;
+        Ok(ObserveResult {
+            observables,
+            state,
+            period,
+        })
+    }
+}
+
+/// `converge`: the steady tip motion for N = 1..=`max_modes` (paper Fig. 4).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ConvergeRequest {
+    /// Largest number of modes, 1..=20.
+    pub max_modes: usize,
+    /// Drive periods of steady state compared, 1..=[`MAX_CONVERGE_PERIODS`].
+    pub periods: usize,
+    /// Samples per drive period, 1..=[`MAX_SAMPLES_PER_PERIOD`];
+    /// periods × samples_per_period ≤ [`MAX_CONVERGE_SAMPLES`].
+    pub samples_per_period: usize,
+    /// The integrator.
+    #[serde(flatten)]
+    pub integrator: IntegratorRequest,
+}
+
+impl Default for ConvergeRequest {
+    fn default() -> Self {
+        ConvergeRequest {
+            max_modes: 4,
+            periods: 1,
+            samples_per_period: 200,
+            integrator: IntegratorRequest::default(),
+        }
+    }
+}
+
+/// The defaults of `converge`: the paper's Fig. 4 is eq. 24 at Ω = 4.1, here with the damping
+/// of eq. 26 (α3 = 0.1, α6 = 0.2) so that a steady state exists (`beam_damping = 0`,
+/// `contact_damping = 0` restore eq. 24 exactly).
+pub fn converge_defaults() -> Params {
+    Params {
+        omega: 4.1,
+        ..Params::default()
+    }
+}
+
+impl ConvergeRequest {
+    /// Check every option.
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming the option.
+    pub fn validate(&self) -> Result<(), SimError> {
+        if !(1..=crate::params::MAX_MODES).contains(&self.max_modes) {
+            return Err(SimError::out_of_range(
+                "max_modes",
+                self.max_modes,
+                "must be in 1..=20",
+            ));
+        }
+        check_samples_per_period(self.samples_per_period)?;
+        if !(1..=MAX_CONVERGE_PERIODS).contains(&self.periods)
+            || self.periods * self.samples_per_period > MAX_CONVERGE_SAMPLES
+        {
+            return Err(SimError::out_of_range(
+                "periods",
+                self.periods,
+                "must be in 1..=10000, with at most 1e7 samples in all (periods × samples per period)",
+            ));
+        }
+        Ok(())
+    }
+
+    /// The runs N = 1..=max_modes of `params` (its own N is replaced).
+    ///
+    /// # Errors
+    /// As [`Self::validate`] and [`mode_convergence`].
+    pub fn run(&self, params: &Params) -> Result<Vec<ConvergenceRun>, SimError> {
+        self.validate()?;
+        mode_convergence(
+            params,
+            self.max_modes,
+            self.periods,
+            self.samples_per_period,
+            &SteadyOptions::default(),
+            self.integrator.options(self.samples_per_period),
+        )
+    }
+}
+
+fn check_samples_per_period(spp: usize) -> Result<(), SimError> {
+    if !(1..=MAX_SAMPLES_PER_PERIOD).contains(&spp) {
+        return Err(SimError::out_of_range(
+            "samples_per_period",
+            spp,
+            "must be in 1..=100000",
+        ));
+    }
+    Ok(())
+}
+
+/// Where a recorded time series goes, which sets its budget.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SeriesStore {
+    /// Streamed to files in chunks: [`MAX_SERIES_BYTES`] on disk.
+    Files,
+    /// Held whole in memory (a Python call): [`MAX_SERIES_MEMORY_BYTES`].
+    Memory,
+    /// Not kept (only the summary).
+    Nothing,
+}
+
+/// `simulate`: one trajectory recorded after a transient.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SimulateRequest {
+    /// Drive periods recorded after the transient (> 0); default 50 when `tau_end` is not
+    /// given either.
+    pub periods: Option<f64>,
+    /// End time τ of the run, instead of `periods`.
+    pub tau_end: Option<f64>,
+    /// Drive periods discarded before recording, >= 0.
+    pub transient: f64,
+    /// The initial state (2N values); `None`: rest.
+    pub initial: Option<Vec<f64>>,
+    /// Samples per drive period, 1..=[`MAX_SAMPLES_PER_PERIOD`].
+    pub samples_per_period: usize,
+    /// The integrator.
+    #[serde(flatten)]
+    pub integrator: IntegratorRequest,
+}
+
+impl Default for SimulateRequest {
+    fn default() -> Self {
+        SimulateRequest {
+            periods: None,
+            tau_end: None,
+            transient: 0.0,
+            initial: None,
+            samples_per_period: 200,
+            integrator: IntegratorRequest::default(),
+        }
+    }
+}
+
+/// The time span of a validated [`SimulateRequest`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SimulateSpan {
+    /// τ at which recording starts (the transient).
+    pub transient_tau: f64,
+    /// Length of the recording in τ.
+    pub record_tau: f64,
+    /// Drive periods in all, transient included.
+    pub total_periods: f64,
+    /// Samples of the recorded series (ends included).
+    pub rows: f64,
+}
+
+impl SimulateRequest {
+    /// Check every option for `params` and return the span; `columns` values of
+    /// `bytes_per_value` bytes per sample are kept in `store`.
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming the option, [`SimError::Budget`] for a series beyond
+    /// the store's budget.
+    pub fn validate(
+        &self,
+        params: &Params,
+        store: SeriesStore,
+        columns: usize,
+        bytes_per_value: f64,
+    ) -> Result<SimulateSpan, SimError> {
+        check_samples_per_period(self.samples_per_period)?;
+        if !(self.transient.is_finite() && self.transient >= 0.0) {
+            return Err(SimError::out_of_range(
+                "transient",
+                self.transient,
+                "must be finite and >= 0",
+            ));
+        }
+        let period = params.period();
+        let transient_tau = self.transient * period;
+        let record_tau = match (self.periods, self.tau_end) {
+            (Some(n), Some(t)) => {
+                return Err(SimError::out_of_range(
+                    "periods",
+                    format!("{n} with tau_end = {t}"),
+                    "give periods or tau_end, not both",
+                ))
+            }
+            (Some(n), None) if n.is_finite() && n > 0.0 => n * period,
+            (Some(n), None) => {
+                return Err(SimError::out_of_range(
+                    "periods",
+                    n,
+                    "must be finite and > 0",
+                ))
+            }
+            (None, Some(t)) if t.is_finite() && t > transient_tau => t - transient_tau,
+            (None, Some(t)) => {
+                return Err(SimError::out_of_range(
+                    "tau_end",
+                    format!("{t} (the transient ends at τ = {transient_tau})"),
+                    "must be finite and > the end of the transient",
+                ))
+            }
+            (None, None) => 50.0 * period,
+        };
+        let total_periods = self.transient + record_tau / period;
+        if total_periods > MAX_RUN_PERIODS {
+            return Err(SimError::out_of_range(
+                "periods",
+                format!("{total_periods:e} with the transient"),
+                "a run may span at most 1e8 drive periods (beyond, τ no longer resolves the \
+                 integration grid)",
+            ));
+        }
+        let rows = (record_tau / period * self.samples_per_period as f64).floor() + 1.0;
+        let budget = match store {
+            SeriesStore::Files => MAX_SERIES_BYTES,
+            SeriesStore::Memory => MAX_SERIES_MEMORY_BYTES,
+            SeriesStore::Nothing => f64::INFINITY,
+        };
+        let bytes = rows * columns as f64 * bytes_per_value;
+        if bytes > budget {
+            return Err(SimError::Budget {
+                what: "the time series",
+                needed: format!(
+                    "{:.1} GB ({rows:.3e} samples × {columns} columns)",
+                    bytes / 1e9
+                ),
+                budget: format!("{:.0} GiB", budget / (1024.0 * 1024.0 * 1024.0)),
+                hint: "lower periods or samples_per_period, or keep no time series",
+            });
+        }
+        Ok(SimulateSpan {
+            transient_tau,
+            record_tau,
+            total_periods,
+            rows,
+        })
+    }
+}
+
+/// `bifurcation`: the steady state over a grid of one parameter, continued forward and
+/// backward and from seeded random starts.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct BifurcationRequest {
+    /// The swept parameter.
+    pub param: SweepParam,
+    /// Explicit values instead of `from`, `to`, `steps`.
+    pub values: Option<Vec<f64>>,
+    /// First value.
+    pub from: f64,
+    /// Last value.
+    pub to: f64,
+    /// Number of values.
+    pub steps: usize,
+    /// Random initial states per value (besides continuation).
+    pub starts: u32,
+    /// Seed of the random initial states.
+    pub seed: u64,
+    /// Forward and backward continuation.
+    pub continuation: bool,
+    /// Worker threads, 1..=[`MAX_THREADS`]; `None`: all cores.
+    pub threads: Option<usize>,
+    /// The steady-state search of every point.
+    #[serde(flatten)]
+    pub steady: SteadyRequest,
+    /// The integrator.
+    #[serde(flatten)]
+    pub integrator: IntegratorRequest,
+}
+
+impl Default for BifurcationRequest {
+    fn default() -> Self {
+        BifurcationRequest {
+            param: SweepParam::Omega,
+            values: None,
+            from: 1.0,
+            to: 5.0,
+            steps: 400,
+            starts: 0,
+            seed: 1,
+            continuation: true,
+            threads: None,
+            steady: SteadyRequest::default(),
+            integrator: IntegratorRequest::default(),
+        }
+    }
+}
+
+impl BifurcationRequest {
+    /// The validated sweep of `base`.
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming the option, [`SimError::Params`] for a value out of
+    /// the parameter's range.
+    pub fn spec(&self, base: &Params) -> Result<SweepSpec, SimError> {
+        if let Some(t) = self.threads {
+            if !(1..=MAX_THREADS).contains(&t) {
+                return Err(SimError::out_of_range("threads", t, "must be in 1..=1024"));
+            }
+        }
+        let values = match &self.values {
+            Some(v) if v.is_empty() => {
+                return Err(SimError::out_of_range(
+                    "values",
+                    "[]",
+                    "must hold at least one value",
+                ))
+            }
+            Some(v) => v.clone(),
+            None => SweepSpec::linspace(self.from, self.to, self.steps)?,
+        };
+        let spec = SweepSpec {
+            base: *base,
+            param: self.param,
+            values,
+            continuation: self.continuation,
+            starts: self.starts,
+            seed: self.seed,
+            steady: self.steady.options()?,
+            integrator: self.integrator.options(1),
+        };
+        spec.validate()?;
+        Ok(spec)
+    }
+}

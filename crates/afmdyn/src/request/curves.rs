@@ -1,0 +1,194 @@
+//! The request of a stepped curve (`approach`, `resonance`): its ends, step or number of points
+//! and tolerance as a front end takes them, in the front end's unit of the swept quantity, and
+//! the [`SteppedSpec`] they give ([`approach_request`], [`resonance_request`]).
+
+use crate::analysis::approach::{approach_spec, default_range};
+use crate::analysis::resonance::{mode_band, resonance_spec};
+use crate::analysis::stepped::{Spacing, SteppedSpec, DEFAULT_CURVE_POINTS};
+use crate::error::SimError;
+use crate::params::Params;
+
+/// A stepped-curve request as a front end takes it (`afmdyn approach` / `resonance` flags, the
+/// Python keywords): the ends and the step in the front end's unit of the swept quantity (one
+/// dimensionless unit = `unit` of them: g₀ in m, or Hz per unit Ω), `None` for the command's
+/// default range; [`approach_request`] and
+/// [`resonance_request`] turn it into a
+/// [`SteppedSpec`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CurveRequest {
+    /// First end of the swept quantity (front-end unit).
+    pub from: Option<f64>,
+    /// Other end (front-end unit).
+    pub to: Option<f64>,
+    /// Grid step (front-end unit); excludes `points`.
+    pub step: Option<f64>,
+    /// Number of grid values, ends included (default [`DEFAULT_CURVE_POINTS`]).
+    pub points: Option<usize>,
+    /// Continue the periodic-orbit branches.
+    pub branches: bool,
+    /// Tolerance of the adaptive integrator, in (0, 1e-3).
+    pub tolerance: f64,
+}
+
+impl CurveRequest {
+    /// The ends in dimensionless units: the requested ones divided by `unit`, else `default`.
+    pub fn ends(&self, default: (f64, f64), unit: f64) -> (f64, f64) {
+        (
+            self.from.map_or(default.0, |v| v / unit),
+            self.to.map_or(default.1, |v| v / unit),
+        )
+    }
+
+    /// The grid spacing in dimensionless units.
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] when both a step and a count are given.
+    pub fn spacing(&self, unit: f64) -> Result<Spacing, SimError> {
+        match (self.step, self.points) {
+            (Some(h), Some(_)) => Err(SimError::out_of_range(
+                "step",
+                h,
+                "give step or points, not both",
+            )),
+            (Some(h), None) => Ok(Spacing::Step(h / unit)),
+            (None, n) => Ok(Spacing::Points(n.unwrap_or(DEFAULT_CURVE_POINTS))),
+        }
+    }
+
+    /// Set the tolerance and branch option of `spec` and check the parameters at both ends of
+    /// its grid (before any work or output).
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] for a tolerance outside (0, 1e-3); [`SimError::Params`] for
+    /// parameters invalid at an end of the grid.
+    pub fn configure(&self, mut spec: SteppedSpec) -> Result<SteppedSpec, SimError> {
+        let tol = self.tolerance;
+        if !(tol.is_finite() && tol > 0.0 && tol < 1e-3) {
+            return Err(SimError::out_of_range(
+                "tolerance",
+                tol,
+                "must be in (0, 1e-3)",
+            ));
+        }
+        for v in [spec.values[0], spec.values[spec.values.len() - 1]] {
+            spec.base.with(spec.param, v).validate()?;
+        }
+        spec.integrator.tolerance = tol;
+        spec.branches = self.branches;
+        Ok(spec)
+    }
+}
+
+/// The approach spec of a front end's request, z_c in units of `length` (m per g₀, or 1):
+/// [`default_range`] for missing ends, [`approach_spec`], then [`CurveRequest::configure`].
+///
+/// # Errors
+/// As those three.
+pub fn approach_request(
+    base: Params,
+    request: &CurveRequest,
+    length: f64,
+) -> Result<SteppedSpec, SimError> {
+    let (from, to) = request.ends(default_range(&base)?, length);
+    request.configure(approach_spec(base, from, to, request.spacing(length)?)?)
+}
+
+/// The resonance spec of a front end's request near mode `mode`, Ω in units of `hz` (Hz per
+/// unit Ω, or 1): [`mode_band`] for missing ends, [`resonance_spec`], then
+/// [`CurveRequest::configure`].
+///
+/// # Errors
+/// As those three.
+pub fn resonance_request(
+    base: Params,
+    mode: usize,
+    request: &CurveRequest,
+    hz: f64,
+) -> Result<SteppedSpec, SimError> {
+    let (from, to) = request.ends(mode_band(&base, mode)?, hz);
+    request.configure(resonance_spec(base, from, to, request.spacing(hz)?)?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::params::SweepParam;
+
+    fn request() -> CurveRequest {
+        CurveRequest {
+            from: None,
+            to: None,
+            step: None,
+            points: None,
+            branches: false,
+            tolerance: 1e-9,
+        }
+    }
+
+    fn out_of_range_name(e: SimError) -> &'static str {
+        match e {
+            SimError::OutOfRange { name, .. } => name,
+            other => panic!("not OutOfRange: {other:?}"),
+        }
+    }
+
+    /// The ends and the step are converted from the front end's unit (one dimensionless unit =
+    /// `unit`), missing ends take the command's default, a missing spacing the default count.
+    #[test]
+    fn curve_request_converts_units_and_takes_defaults() {
+        let unit = 2.5e-9;
+        assert_eq!(request().ends((1.0, 3.0), unit), (1.0, 3.0));
+        let r = CurveRequest {
+            from: Some(5e-9),
+            step: Some(1e-10),
+            ..request()
+        };
+        let (from, to) = r.ends((1.0, 3.0), unit);
+        assert_eq!((from, to), (5e-9 / unit, 3.0));
+        assert_eq!(r.spacing(unit).unwrap(), Spacing::Step(1e-10 / unit));
+        assert_eq!(
+            request().spacing(unit).unwrap(),
+            Spacing::Points(DEFAULT_CURVE_POINTS)
+        );
+        let r = CurveRequest {
+            points: Some(7),
+            ..request()
+        };
+        assert_eq!(r.spacing(unit).unwrap(), Spacing::Points(7));
+        // both a step and a count: refused, naming the step
+        let r = CurveRequest {
+            step: Some(1e-10),
+            points: Some(7),
+            ..request()
+        };
+        assert_eq!(out_of_range_name(r.spacing(unit).unwrap_err()), "step");
+    }
+
+    /// `configure` sets the tolerance and the branch option, refuses a tolerance outside
+    /// (0, 1e-3) and parameters invalid at an end of the grid, before any work.
+    #[test]
+    fn curve_request_configures_the_spec() {
+        let base = Params::default();
+        let spec = SteppedSpec::new(base, SweepParam::Omega, vec![2.0, 2.5, 3.0]);
+        let r = CurveRequest {
+            branches: true,
+            tolerance: 1e-8,
+            ..request()
+        };
+        let done = r.configure(spec.clone()).unwrap();
+        assert_eq!(done.integrator.tolerance, 1e-8);
+        assert!(done.branches);
+        assert_eq!(done.values, spec.values);
+        for tol in [0.0, -1e-9, 1e-3, f64::NAN, f64::INFINITY] {
+            let r = CurveRequest {
+                tolerance: tol,
+                ..request()
+            };
+            let e = r.configure(spec.clone()).unwrap_err();
+            assert_eq!(out_of_range_name(e), "tolerance", "tolerance {tol}");
+        }
+        // Ω ≤ 0 at the last value of the grid: a parameter error
+        let bad = SteppedSpec::new(base, SweepParam::Omega, vec![1.0, 0.0, -1.0]);
+        assert!(matches!(request().configure(bad), Err(SimError::Params(_))));
+    }
+}

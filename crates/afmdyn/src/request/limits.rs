@@ -1,0 +1,39 @@
+//! The limits of a request beyond the model's ranges ([`crate::params`]), each with its reason.
+//! One place: the command line, Python and any later front end refuse the same values with the
+//! same message because they all validate through [`super`].
+
+/// Longest run, transient included, in drive periods: beyond, τ (a double) no longer resolves
+/// the integration grid (the grid step of a period is ~1e-3 of it, and τ at 1e8 periods has an
+/// ulp of ~1e-8 of a period).
+pub const MAX_RUN_PERIODS: f64 = 1e8;
+/// Largest time series streamed to files (`afmdyn simulate` writes timeseries.npy, and
+/// timeseries.csv on request), in bytes.
+pub const MAX_SERIES_BYTES: f64 = 16.0 * 1024.0 * 1024.0 * 1024.0;
+/// Largest time series held in memory (a Python call returns its arrays whole), in bytes: a
+/// quarter of this machine class's 24 GiB less room for the caller.
+pub const MAX_SERIES_MEMORY_BYTES: f64 = 4.0 * 1024.0 * 1024.0 * 1024.0;
+/// Largest number of samples per drive period of a time series.
+pub const MAX_SAMPLES_PER_PERIOD: usize = 100_000;
+/// Largest transient cap of a steady-state search, in drive periods.
+pub const MAX_STEADY_PERIODS: usize = 10_000_000;
+/// Largest number of random initial states of an attractor census (each is a steady-state
+/// search kept in memory with its Poincaré points).
+pub const MAX_ATTRACTOR_SAMPLES: usize = 100_000;
+/// Samples per drive period at which attractors are recorded (their plots and files); the
+/// integrator of the census is built for this rate, so the same request gives the same
+/// attractors in every front end.
+pub const ATTRACTOR_SAMPLES_PER_PERIOD: usize = 200;
+/// Largest number of worker threads a sweep may ask for.
+pub const MAX_THREADS: usize = 1024;
+/// Depth of a period-doubling cascade followed by branch switching: periods n, 2n, 4n and 8n.
+pub const CASCADE_FACTOR: usize = 8;
+/// Largest number of drive periods compared by the mode-convergence study (Fig. 4), and the
+/// largest number of samples it holds: `periods × samples_per_period`.
+pub const MAX_CONVERGE_PERIODS: usize = 10_000;
+/// See [`MAX_CONVERGE_PERIODS`].
+pub const MAX_CONVERGE_SAMPLES: usize = 10_000_000;
+/// Largest number of orbit periods integrated for the observables.
+pub const MAX_OBSERVE_PERIODS: usize = crate::analysis::observables::MAX_PERIODS;
+/// Largest modal state entry of an initial state: states of norm
+/// [`crate::params::STATE_NORM_MAX`] count as diverged.
+pub const MAX_INITIAL_ENTRY: f64 = crate::params::STATE_NORM_MAX / 10.0;

@@ -1,0 +1,31 @@
+//! The request layer every front end shares (the command line, Python, later WebAssembly and
+//! Dask): what a user asks of an analysis, by name, with its defaults and every limit.
+//!
+//! - [`model`]: the model values of a request ([`ModelSpec`]: α1…α6, Ω, N, the tip–sample law,
+//!   and with a probe file the SI values z_c and drive frequency), resolved into [`Params`]
+//!   in one precedence; and the one table of their names, aliases, units, ranges and help
+//!   ([`MODEL_PARAMETERS`]).
+//! - [`analyses`]: one request per analysis (`simulate`, `converge`, `bifurcation`,
+//!   `attractors`, `orbit`, `continuation`, `lyapunov`, `observe`) with `validate`, and `run`
+//!   where the analysis is one library call.
+//! - [`curves`]: the stepped curves (`approach`, `resonance`).
+//! - [`limits`]: the limits beyond the model's ranges, each with its reason.
+//!
+//! A front end maps its spelling of a name to a request field and nothing else; errors name
+//! the library's parameter (`samples_per_period`) and a front end respells them
+//! ([`crate::SimError::spelled`]: `--samples-per-period`).
+//!
+//! [`Params`]: crate::Params
+
+pub mod analyses;
+pub mod curves;
+pub mod limits;
+pub mod model;
+
+pub use analyses::{
+    AttractorsRequest, BifurcationRequest, ContinuationRequest, ConvergeRequest, IntegratorRequest,
+    LyapunovRequest, ObserveRequest, OrbitRequest, SeriesStore, SimulateRequest, StartRequest,
+    SteadyRequest,
+};
+pub use curves::{approach_request, resonance_request, CurveRequest};
+pub use model::{parameter, ModelSpec, ParamInfo, MODEL_PARAMETERS};

@@ -1,0 +1,523 @@
+//! The model part of every request: the parameter values a user gave, by name, and the one
+//! table of those names ([`MODEL_PARAMETERS`]) that the command line's flags and help, the TOML
+//! config keys, the Python keywords, their docstrings and type stubs are checked against.
+//!
+//! Precedence, the same for every front end: the defaults of the analysis (the paper's
+//! Figs. 5–14 set, [`Params::default`]) ← a probe file in SI ([`crate::probe::Probe`]) ← the
+//! single values of [`ModelSpec`] ← the SI overrides `z_c` (sets α5) and `drive_frequency`
+//! (sets Ω), which need the probe's scales.
+
+use crate::contact::{ContactLaw, LawKind};
+use crate::error::SimError;
+use crate::params::Params;
+use crate::probe::Probe;
+use serde::{Deserialize, Serialize};
+
+/// What kind of value a model parameter takes (for the front ends' type checks and stubs).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ValueKind {
+    /// A non-negative integer.
+    Integer,
+    /// A real number.
+    Real,
+    /// One of `linear`, `hertz`, `dmt`, `impact`.
+    Law,
+}
+
+/// One model parameter: its library name, the paper's alias, symbol, unit, range and help.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ParamInfo {
+    /// The library's name (snake_case): the TOML key, the Python keyword; the flag is the same
+    /// in kebab-case (`tip_mass_ratio` → `--tip-mass-ratio`).
+    pub name: &'static str,
+    /// The paper's name (`alpha1` … `alpha6`), accepted everywhere as well; `None` when the
+    /// name is the paper's.
+    pub alias: Option<&'static str>,
+    /// The symbol as the paper writes it.
+    pub symbol: &'static str,
+    /// The unit: `1` (dimensionless, eq. 5 and 7), `m` or `Hz` (SI, with a probe).
+    pub unit: &'static str,
+    /// The allowed range in words (the limits of [`crate::params`]).
+    pub range: &'static str,
+    /// The default in words.
+    pub default: &'static str,
+    /// One line of help.
+    pub help: &'static str,
+    /// Integer, real or law name.
+    pub kind: ValueKind,
+}
+
+#[allow(clippy::too_many_arguments)] // one row of the table, every column named at the call
+const fn info(
+    name: &'static str,
+    alias: Option<&'static str>,
+    symbol: &'static str,
+    unit: &'static str,
+    range: &'static str,
+    default: &'static str,
+    help: &'static str,
+    kind: ValueKind,
+) -> ParamInfo {
+    ParamInfo {
+        name,
+        alias,
+        symbol,
+        unit,
+        range,
+        default,
+        help,
+        kind,
+    }
+}
+
+/// Every model parameter a request takes, in the order the front ends list them. The ranges
+/// are those [`Params::validate`] and [`ContactLaw::validate`] enforce; `z_c` and
+/// `drive_frequency` are SI values that need a probe file.
+pub const MODEL_PARAMETERS: [ParamInfo; 14] = [
+    info(
+        "modes",
+        None,
+        "N",
+        "1",
+        "1..=20",
+        "3",
+        "number of Galerkin modes N (eq. 9)",
+        ValueKind::Integer,
+    ),
+    info(
+        "tip_mass_ratio",
+        Some("alpha1"),
+        "α1",
+        "1",
+        "0..=1e4",
+        "0.1",
+        "tip-mass ratio α1 = M/(mL)",
+        ValueKind::Real,
+    ),
+    info(
+        "drive_amplitude",
+        Some("alpha2"),
+        "α2",
+        "1",
+        "0..=1e6",
+        "0.1",
+        "base-drive amplitude α2 = f/g0",
+        ValueKind::Real,
+    ),
+    info(
+        "beam_damping",
+        Some("alpha3"),
+        "α3",
+        "1",
+        "0..=1e4",
+        "0.1",
+        "beam damping α3",
+        ValueKind::Real,
+    ),
+    info(
+        "contact_stiffness",
+        Some("alpha4"),
+        "α4",
+        "1",
+        "0..=1e8",
+        "20",
+        "contact stiffness α4 = K1 L³/(EI)",
+        ValueKind::Real,
+    ),
+    info(
+        "gap",
+        Some("alpha5"),
+        "α5",
+        "1",
+        "-1e6..=1e6",
+        "0",
+        "tip–sample gap α5 = g1/g0 (may be negative)",
+        ValueKind::Real,
+    ),
+    info(
+        "contact_damping",
+        Some("alpha6"),
+        "α6",
+        "1",
+        "0..=1e4",
+        "0.2",
+        "contact damping α6",
+        ValueKind::Real,
+    ),
+    info(
+        "omega",
+        None,
+        "Ω",
+        "1",
+        "1e-3..=1e5",
+        "2.6",
+        "dimensionless drive frequency Ω",
+        ValueKind::Real,
+    ),
+    info(
+        "contact_law",
+        None,
+        "F_c",
+        "1",
+        "linear, hertz, dmt or impact",
+        "linear",
+        "tip–sample law: linear (α4 δ + α6 δ̇), hertz (α4 δ^1.5 + α6 δ̇), dmt (van der Waals + \
+         adhesion + Hertz + α6 √δ δ̇) or impact (rigid sample, restitution r)",
+        ValueKind::Law,
+    ),
+    info(
+        "restitution",
+        None,
+        "r",
+        "1",
+        "0..=1",
+        "0.8",
+        "impact law: coefficient of restitution r",
+        ValueKind::Real,
+    ),
+    info(
+        "hamaker",
+        None,
+        "H̃",
+        "1",
+        ">= 0",
+        "1e-5",
+        "DMT: van der Waals group H̃ = H R L³/(6 EI g0³)",
+        ValueKind::Real,
+    ),
+    info(
+        "intermolecular_distance",
+        None,
+        "ã0",
+        "1",
+        "> 0",
+        "0.01",
+        "DMT: intermolecular distance ã0 = a0/g0, the contact threshold",
+        ValueKind::Real,
+    ),
+    info(
+        "z_c",
+        None,
+        "z_c",
+        "m",
+        "finite",
+        "the probe's",
+        "with a probe: the rest tip–sample distance z_c in metres (sets α5)",
+        ValueKind::Real,
+    ),
+    info(
+        "drive_frequency",
+        None,
+        "f",
+        "Hz",
+        "> 0",
+        "the probe's",
+        "with a probe: the drive frequency in Hz (sets Ω; the drive force or base amplitude is \
+         kept)",
+        ValueKind::Real,
+    ),
+];
+
+/// The entry of [`MODEL_PARAMETERS`] named `key` (its name or its alias).
+pub fn parameter(key: &str) -> Option<&'static ParamInfo> {
+    MODEL_PARAMETERS
+        .iter()
+        .find(|p| p.name == key || p.alias == Some(key))
+}
+
+/// The model values of a request, each optional (a missing one keeps the value below it in the
+/// precedence of this module). Serialised with the names of [`MODEL_PARAMETERS`]; the paper's
+/// `alpha1` … `alpha6` are accepted as aliases; unknown keys are refused (this is also the
+/// schema of a `--config FILE.toml`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModelSpec {
+    /// N.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub modes: Option<usize>,
+    /// α1.
+    #[serde(alias = "alpha1", skip_serializing_if = "Option::is_none")]
+    pub tip_mass_ratio: Option<f64>,
+    /// α2.
+    #[serde(alias = "alpha2", skip_serializing_if = "Option::is_none")]
+    pub drive_amplitude: Option<f64>,
+    /// α3.
+    #[serde(alias = "alpha3", skip_serializing_if = "Option::is_none")]
+    pub beam_damping: Option<f64>,
+    /// α4.
+    #[serde(alias = "alpha4", skip_serializing_if = "Option::is_none")]
+    pub contact_stiffness: Option<f64>,
+    /// α5.
+    #[serde(alias = "alpha5", skip_serializing_if = "Option::is_none")]
+    pub gap: Option<f64>,
+    /// α6.
+    #[serde(alias = "alpha6", skip_serializing_if = "Option::is_none")]
+    pub contact_damping: Option<f64>,
+    /// Ω.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub omega: Option<f64>,
+    /// The tip–sample law.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub contact_law: Option<LawKind>,
+    /// Impact law: r.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub restitution: Option<f64>,
+    /// DMT: H̃.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub hamaker: Option<f64>,
+    /// DMT: ã0.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub intermolecular_distance: Option<f64>,
+    /// With a probe: z_c in m.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub z_c: Option<f64>,
+    /// With a probe: the drive frequency in Hz.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub drive_frequency: Option<f64>,
+}
+
+impl ModelSpec {
+    /// `self`'s values, and `lower`'s where `self` has none (flags over a config file).
+    pub fn over(self, lower: ModelSpec) -> ModelSpec {
+        ModelSpec {
+            modes: self.modes.or(lower.modes),
+            tip_mass_ratio: self.tip_mass_ratio.or(lower.tip_mass_ratio),
+            drive_amplitude: self.drive_amplitude.or(lower.drive_amplitude),
+            beam_damping: self.beam_damping.or(lower.beam_damping),
+            contact_stiffness: self.contact_stiffness.or(lower.contact_stiffness),
+            gap: self.gap.or(lower.gap),
+            contact_damping: self.contact_damping.or(lower.contact_damping),
+            omega: self.omega.or(lower.omega),
+            contact_law: self.contact_law.or(lower.contact_law),
+            restitution: self.restitution.or(lower.restitution),
+            hamaker: self.hamaker.or(lower.hamaker),
+            intermolecular_distance: self
+                .intermolecular_distance
+                .or(lower.intermolecular_distance),
+            z_c: self.z_c.or(lower.z_c),
+            drive_frequency: self.drive_frequency.or(lower.drive_frequency),
+        }
+    }
+
+    /// The parameter set: `defaults`, or the probe's set when a probe is given, with this
+    /// spec's values applied, then `z_c` (α5 = [`Params::alpha5_for_rest_distance`] of z_c in
+    /// units of the probe's length scale) and `drive_frequency` (Ω from the probe's time
+    /// scale), validated.
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming `z_c` or `drive_frequency` when given without a probe or
+    /// not finite (not positive); [`SimError::Params`] for a law group of another law or a
+    /// value out of range ([`Params::validate`]).
+    pub fn resolve(&self, defaults: Params, probe: Option<&Probe>) -> Result<Params, SimError> {
+        let base = probe.map_or(defaults, |p| p.params);
+        let contact_law = ContactLaw::from_parts(
+            self.contact_law,
+            self.hamaker,
+            self.intermolecular_distance,
+            self.restitution,
+            base.contact_law,
+        )?;
+        let mut p = Params {
+            contact_law,
+            modes: self.modes.unwrap_or(base.modes),
+            alpha1: self.tip_mass_ratio.unwrap_or(base.alpha1),
+            alpha2: self.drive_amplitude.unwrap_or(base.alpha2),
+            alpha3: self.beam_damping.unwrap_or(base.alpha3),
+            alpha4: self.contact_stiffness.unwrap_or(base.alpha4),
+            alpha5: self.gap.unwrap_or(base.alpha5),
+            alpha6: self.contact_damping.unwrap_or(base.alpha6),
+            omega: self.omega.unwrap_or(base.omega),
+            ..base
+        };
+        if let Some(z) = self.z_c {
+            let probe = probe.ok_or_else(|| {
+                SimError::out_of_range("z_c", z, "needs a probe file (z_c is in m, SI)")
+            })?;
+            if self.gap.is_some() {
+                return Err(SimError::out_of_range(
+                    "z_c",
+                    z,
+                    "give z_c or gap (alpha5), not both: both set α5",
+                ));
+            }
+            if !z.is_finite() {
+                return Err(SimError::out_of_range(
+                    "z_c",
+                    z,
+                    "must be a finite distance in m",
+                ));
+            }
+            p.alpha5 = p.alpha5_for_rest_distance(z / probe.scales.length_m);
+        }
+        if let Some(f) = self.drive_frequency {
+            let probe = probe.ok_or_else(|| {
+                SimError::out_of_range(
+                    "drive_frequency",
+                    f,
+                    "needs a probe file (drive_frequency is in Hz, SI)",
+                )
+            })?;
+            if self.omega.is_some() {
+                return Err(SimError::out_of_range(
+                    "drive_frequency",
+                    f,
+                    "give drive_frequency or omega, not both: both set Ω",
+                ));
+            }
+            if !(f.is_finite() && f > 0.0) {
+                return Err(SimError::out_of_range(
+                    "drive_frequency",
+                    f,
+                    "must be finite and > 0 (Hz)",
+                ));
+            }
+            p.omega = probe.scales.omega(f);
+        }
+        p.validate().map_err(SimError::from)?;
+        Ok(p)
+    }
+}
+
+/// A model spec that could not be read (a config file's text): the parser's message.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{0}")]
+pub struct ModelSpecError(pub String);
+
+impl ModelSpec {
+    /// Read a config file's text (TOML, the keys of [`MODEL_PARAMETERS`]); the error is one
+    /// line: `line L, column C: message`.
+    ///
+    /// # Errors
+    /// [`ModelSpecError`] for a syntax error, an unknown key or a value of the wrong type.
+    pub fn from_toml(text: &str) -> Result<ModelSpec, ModelSpecError> {
+        parse_toml(text).map_err(ModelSpecError)
+    }
+}
+
+/// Parse TOML text into `T`; the error is one line: "line L, column C: message" (for a
+/// duplicate key, the key).
+pub fn parse_toml<T: for<'de> Deserialize<'de>>(text: &str) -> Result<T, String> {
+    toml::from_str(text).map_err(|e| {
+        let mut msg = e.message().trim().replace('\n', " ");
+        let Some(span) = e.span() else { return msg };
+        let start = span.start.min(text.len());
+        let before = &text[..start];
+        let line = before.matches('\n').count() + 1;
+        let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+        if msg.starts_with("duplicate key") {
+            let key = text.get(span.clone()).unwrap_or("").trim();
+            if !key.is_empty() && !msg.contains(key) {
+                msg = format!("duplicate key `{key}`");
+            }
+        }
+        format!("line {line}, column {column}: {msg}")
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every field of [`ModelSpec`] is a row of the table and every row a field: a spec with
+    /// every value set serialises to exactly the table's names.
+    #[test]
+    fn the_table_names_every_field_of_the_spec() {
+        let full = ModelSpec {
+            modes: Some(1),
+            tip_mass_ratio: Some(0.0),
+            drive_amplitude: Some(0.0),
+            beam_damping: Some(0.0),
+            contact_stiffness: Some(0.0),
+            gap: Some(0.0),
+            contact_damping: Some(0.0),
+            omega: Some(1.0),
+            contact_law: Some(LawKind::Linear),
+            restitution: Some(0.5),
+            hamaker: Some(0.0),
+            intermolecular_distance: Some(1.0),
+            z_c: Some(0.0),
+            drive_frequency: Some(1.0),
+        };
+        let v = serde_json::to_value(full).unwrap();
+        let keys: Vec<&str> = v.as_object().unwrap().keys().map(String::as_str).collect();
+        let mut names: Vec<&str> = MODEL_PARAMETERS.iter().map(|p| p.name).collect();
+        let mut keys_sorted = keys.clone();
+        keys_sorted.sort_unstable();
+        names.sort_unstable();
+        assert_eq!(keys_sorted, names);
+        // and the aliases are accepted as keys
+        for p in &MODEL_PARAMETERS {
+            if let Some(alias) = p.alias {
+                let spec = ModelSpec::from_toml(&format!("{alias} = 0.5")).unwrap();
+                let direct = ModelSpec::from_toml(&format!("{} = 0.5", p.name)).unwrap();
+                assert_eq!(spec, direct, "{alias}");
+            }
+        }
+    }
+
+    /// The precedence: defaults ← probe ← values ← z_c; z_c without a probe is refused naming
+    /// it; z_c and gap together are refused (both set α5).
+    #[test]
+    fn precedence_and_the_si_overrides() {
+        let spec = ModelSpec {
+            omega: Some(3.0),
+            ..ModelSpec::default()
+        };
+        let p = spec.resolve(Params::default(), None).unwrap();
+        assert_eq!(
+            p,
+            Params {
+                omega: 3.0,
+                ..Params::default()
+            }
+        );
+        let e = ModelSpec {
+            z_c: Some(1e-9),
+            ..ModelSpec::default()
+        }
+        .resolve(Params::default(), None)
+        .unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with("z_c = 0.000000001: needs a probe"),
+            "{e}"
+        );
+        let probe = Probe::parse(
+            include_str!("../../../../examples/probe-point-mass-dmt.toml"),
+            "probe-point-mass-dmt.toml",
+        )
+        .unwrap();
+        // the probe's own set when nothing is given
+        assert_eq!(
+            ModelSpec::default()
+                .resolve(Params::default(), Some(&probe))
+                .unwrap(),
+            probe.params
+        );
+        // z_c sets α5 through the probe's length scale (z_c = the probe's own gives its α5)
+        let at = ModelSpec {
+            z_c: Some(probe.z_c),
+            ..ModelSpec::default()
+        }
+        .resolve(Params::default(), Some(&probe))
+        .unwrap();
+        assert!((at.alpha5 - probe.params.alpha5).abs() <= 1e-12 * probe.params.alpha5.abs());
+        // the drive frequency sets Ω through the probe's time scale
+        let f = ModelSpec {
+            drive_frequency: Some(probe.drive_frequency),
+            ..ModelSpec::default()
+        }
+        .resolve(Params::default(), Some(&probe))
+        .unwrap();
+        assert!((f.omega - probe.params.omega).abs() <= 1e-12 * probe.params.omega);
+        let both = ModelSpec {
+            z_c: Some(1e-9),
+            gap: Some(0.1),
+            ..ModelSpec::default()
+        }
+        .resolve(Params::default(), Some(&probe))
+        .unwrap_err();
+        assert!(both.to_string().contains("not both"), "{both}");
+    }
+}
