@@ -24,8 +24,8 @@
 
 use super::{grid_v_t, search::StepEnds, ExactPropagator, Form};
 use crate::error::SimError;
-use crate::galerkin::Region;
 use crate::integrate::Integrator;
+use crate::system::Region;
 use nalgebra::DVector;
 
 /// Lanes per pass of the modal step (the slot capacity of a block is a multiple of it).

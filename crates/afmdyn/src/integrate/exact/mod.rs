@@ -8,7 +8,7 @@
 //! **Grid.** The drive period T is split into m sub-steps h = T/m with ‖Ã_s‖₂ h ≤ θ, where
 //! Ã_s = T_s A_s T_s⁻¹ is A_s in energy coordinates y = (L_Kᵀ a, L_Mᵀ ȧ) (K_s = L_K L_Kᵀ,
 //! M = L_M L_Mᵀ). Φ_s = e^{A_s h} and z_p at the grid points are precomputed, so a dense step
-//! costs one 2N×2N matrix–vector product (`exact/kernel.rs`: fixed-size for N ≤ 6). Partial steps
+//! costs one 2N×2N matrix–vector product (`linalg/kernel.rs`: fixed-size for N ≤ 6). Partial steps
 //! (after a switching, to a requested time) use the eigendecomposition of Ã (`exact/modal.rs`)
 //! when it is well conditioned, else the Taylor series of e^{Ã t} y, which converges fast because
 //! ‖Ã t‖ ≤ θ.
@@ -36,23 +36,23 @@
 //! Many switchings in a vanishing time window are reported as [`SimError::Chattering`].
 
 mod batch;
-mod kernel;
 mod modal;
 mod search;
 mod spectral;
 
+pub(crate) use crate::linalg::matmul_into;
 pub use batch::ExactBatch;
 pub use modal::MAX_MODAL_CONDITION;
-pub(crate) use spectral::matmul_into;
 
 use super::grid::PeriodGrid;
-use super::{matvec, ChatterWindow, Integrator, Step};
+use super::{ChatterWindow, Integrator, Step};
 use crate::error::SimError;
-use crate::galerkin::Region;
+use crate::linalg::kernel::{self, MatVec};
+use crate::linalg::matvec;
 use crate::model::CantileverModel;
 use crate::params::Params;
 use crate::params::SweepParam;
-use kernel::MatVec;
+use crate::system::Region;
 use modal::{ModalExp, Modes, MAXD};
 use nalgebra::{DMatrix, DVector, Dyn, LU};
 use search::{Search, StepEnds, TipPoly};
@@ -856,7 +856,7 @@ impl ExactPropagator {
                     Self::hom_energy(sp, sp.t.column(j).as_slice(), t, &mut y[..dim]);
                     e.column_mut(j).copy_from_slice(&y[..dim]);
                 }
-                spectral::matmul_into(&sp.tinv, &e, 1.0, out);
+                matmul_into(&sp.tinv, &e, 1.0, out);
             }
         }
     }

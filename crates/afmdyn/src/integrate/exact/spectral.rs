@@ -10,8 +10,9 @@
 use super::modal::ModalExp;
 use super::K;
 use crate::error::SimError;
-use crate::galerkin::Region;
+use crate::linalg::{matmul, matmul_into};
 use crate::model::CantileverModel;
+use crate::system::Region;
 use nalgebra::linalg::LU;
 use nalgebra::{DMatrix, DVector, Dyn};
 use std::sync::{Arc, Mutex};
@@ -158,35 +159,6 @@ pub(super) fn expm(at: &DMatrix<f64>, h: f64, rho: f64) -> DMatrix<f64> {
         std::mem::swap(&mut p, &mut tmp);
     }
     p
-}
-
-/// out = α A B for square column-major A, B of one size: up to 12×12 column by column with the
-/// fixed-size kernel (a blocked product packs, and allocates, per call), above by nalgebra's
-/// blocked product.
-pub(crate) fn matmul_into(a: &DMatrix<f64>, b: &DMatrix<f64>, alpha: f64, out: &mut DMatrix<f64>) {
-    let dim = a.nrows();
-    if dim > 12 {
-        return out.gemm(alpha, a, b, 0.0);
-    }
-    let kernel = super::kernel::for_dim(dim);
-    out.as_mut_slice().fill(0.0);
-    for (bj, oj) in b
-        .as_slice()
-        .chunks_exact(dim.max(1))
-        .zip(out.as_mut_slice().chunks_exact_mut(dim.max(1)))
-    {
-        kernel(a.as_slice(), bj, oj);
-    }
-    if alpha != 1.0 {
-        *out *= alpha;
-    }
-}
-
-/// A B for square matrices of one size ([`matmul_into`]).
-pub(super) fn matmul(a: &DMatrix<f64>, b: &DMatrix<f64>) -> DMatrix<f64> {
-    let mut out = DMatrix::zeros(a.nrows(), b.ncols());
-    matmul_into(a, b, 1.0, &mut out);
-    out
 }
 
 /// Φ_s = T⁻¹ e^{Ã_s h} T of both regions ([`expm`]; cached under `key` and h when `reuse`) and
