@@ -5,7 +5,10 @@
 //! exponential Φ_s = e^{A_s h} on those and h. Both are kept in small process-wide caches keyed
 //! by the exact bits of the matrices (and of h), so the repeated builds of shooting at one
 //! parameter set reuse everything and a continuation step in Ω reuses the spectral data and
-//! redoes only Φ_s and the particular solution. A hit returns the very values a rebuild would compute (the build is deterministic).
+//! redoes only Φ_s and the particular solution. A hit returns the very values a rebuild would
+//! compute (the build is deterministic). Each of the three process-wide caches states its key,
+//! its bound and why results do not depend on it where it is defined: [`SPECTRAL`],
+//! [`GRID_EXP`] and [`FORCING`](super::forcing::FORCING).
 
 use super::modal::ModalExp;
 use super::K;
@@ -42,9 +45,33 @@ pub(super) struct Spectral {
 /// Entries kept per cache (least recently used dropped first).
 const CAPACITY: usize = 8;
 
+/// A process-wide cache: (key, value) entries, the most recently used last ([`cached`]).
 pub(super) type Cache<V> = Mutex<Vec<(Vec<u64>, Arc<V>)>>;
 
+/// The spectral data of both regions ([`Spectral`]) of recent builds ([`spectral`]).
+///
+/// - **Key**: [`matrix_key`], the state dimension and the exact bits of A_s, M and K_s of both
+///   regions. They fix everything [`region_spectral`] reads: the tip row φ(1) of the moment
+///   rows is fixed by N and the structure, which K_s tells apart (the point mass's K = 1, the
+///   beam's β_j⁴).
+/// - **Bound**: [`CAPACITY`] = 8 entries, the least recently used dropped first. An entry holds
+///   at most 12 d² + 132 d + 160 numbers per region (d = 2N: T, T⁻¹, Ã, the LU of A_s, the
+///   moment rows, the eigendecomposition) and a key of 2(d² + 2N²) + 1 words: 0.42 MiB at
+///   N = 20 ([`crate::params::MAX_MODES`]), so at most 3.4 MiB in all.
+/// - **Results do not depend on it**: the data is computed from the keyed bits alone, by the
+///   same operations in the same order on one thread, so a hit returns the very bits a miss
+///   computes ([`cached`]: a poisoned lock counts as a miss; `reuse = false` bypasses it).
 static SPECTRAL: Cache<[Spectral; 2]> = Mutex::new(Vec::new());
+
+/// The grid exponentials Φ_s = T⁻¹ e^{Ã_s h} T of both regions ([`GridExp`]) of recent builds
+/// ([`grid_exp`]).
+///
+/// - **Key**: [`matrix_key`] and the bits of the grid step h (Φ_s is computed from the
+///   spectral data, fixed by that key as in [`SPECTRAL`], and h).
+/// - **Bound**: [`CAPACITY`] = 8 entries, the least recently used dropped first; an entry is
+///   2 d² numbers and a key of 2(d² + 2N²) + 2 words: 63 KiB at N = 20, 0.5 MiB in all.
+/// - **Results do not depend on it**: as for [`SPECTRAL`], a hit returns the bits a miss
+///   computes.
 static GRID_EXP: Cache<GridExp> = Mutex::new(Vec::new());
 
 /// Φ_s of the free and the contact region.
