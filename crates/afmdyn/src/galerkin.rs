@@ -9,53 +9,9 @@ use crate::beam::ModeShapes;
 use crate::error::ParamError;
 use crate::params::{Params, Structure, SweepParam};
 use nalgebra::{DMatrix, DVector};
-use serde::{Deserialize, Serialize};
 
-/// The two regions of the switched model (eq. 10).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
-pub enum Region {
-    /// Region I: tip free, V_T > 0.
-    #[default]
-    Free,
-    /// Region II: tip in contact with the sample spring α4 and damper α6, V_T ≤ 0.
-    Contact,
-}
-
-impl Region {
-    /// Index 0 (free) or 1 (contact).
-    pub fn index(self) -> usize {
-        match self {
-            Region::Free => 0,
-            Region::Contact => 1,
-        }
-    }
-
-    /// The other region.
-    pub fn other(self) -> Region {
-        match self {
-            Region::Free => Region::Contact,
-            Region::Contact => Region::Free,
-        }
-    }
-
-    /// Sign σ of the guard g = σ V_T of a region of the smooth laws: +1 in free flight (left
-    /// when V_T falls to 0), −1 in contact (left when V_T rises to 0).
-    pub fn guard_sign(self) -> f64 {
-        match self {
-            Region::Free => 1.0,
-            Region::Contact => -1.0,
-        }
-    }
-
-    /// Region of a tip displacement V_T: contact when V_T ≤ 0 (eq. 10).
-    pub fn of_v_t(v_t: f64) -> Region {
-        if v_t <= 0.0 {
-            Region::Contact
-        } else {
-            Region::Free
-        }
-    }
-}
+/// The two regions (the modes of the hybrid system), defined with it in [`crate::system`].
+pub use crate::system::Region;
 
 /// Modal forcing F_s(τ) = `constant` + `sin` · sin Ωτ + `cos` · cos Ωτ, each of shape `[N]`.
 #[derive(Debug, Clone, PartialEq)]

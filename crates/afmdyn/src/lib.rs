@@ -41,6 +41,7 @@ pub mod eigen;
 pub mod error;
 pub mod galerkin;
 pub mod integrate;
+mod linalg;
 pub mod model;
 pub mod params;
 pub mod probe;
@@ -53,8 +54,7 @@ pub mod units;
 
 pub use contact::{ContactLaw, LawKind};
 pub use error::{ParamError, SimError, UnitsError};
-pub use galerkin::Region;
 pub use integrate::{Integrator, IntegratorKind, IntegratorOptions};
 pub use model::CantileverModel;
 pub use params::{Params, Structure, SweepParam};
-pub use system::{EventKind, HybridSystem};
+pub use system::{EventKind, HybridSystem, Region};

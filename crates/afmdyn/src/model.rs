@@ -21,11 +21,14 @@
 
 use crate::contact::{ContactLaw, TipSample, TipSampleLaw};
 use crate::error::{ParamError, SimError};
-use crate::galerkin::{Galerkin, Region};
-use crate::integrate::Observed;
+use crate::galerkin::Galerkin;
 use crate::params::{Params, SweepParam};
-use crate::system::{EventKind, Guard, HybridSystem, Jump};
+use crate::system::{EventKind, Guard, HybridSystem, Jump, Region};
 use nalgebra::{DMatrix, DVector};
+
+mod body_contact;
+
+pub use body_contact::{weighted_displacement, BodyContactCheck};
 
 /// A chattering sequence ends in sticking when the next bounce would rise less than this many
 /// guard tolerances above the sample (1e3 × 1e-12 (1 + α2 + |α5|) ≈ 1e-9 of the gap g₀). The
@@ -223,7 +226,7 @@ impl CantileverModel {
         for (i, o) in dz.iter_mut().enumerate() {
             *o = d.b_const[i] + s * d.b_sin[i] + c * d.b_cos[i];
         }
-        crate::integrate::matvec(&d.a, z, dz, 1.0, true);
+        crate::linalg::matvec(&d.a, z, dz, 1.0, true);
         if linear {
             return;
         }
@@ -881,154 +884,5 @@ impl HybridSystem for CantileverModel {
         let sign = if forward { w } else { -w };
         mat.rows_mut(n, n)
             .ger(sign, &self.mphi, &top.transpose(), 1.0);
-    }
-}
-
-/// Body-contact check (the paper's Fig. 2f assumption): true when some point ξ < 1 of the
-/// beam reaches the substrate, V(ξ,τ) = W(ξ,τ) + α2 sin Ωτ + 1 ≤ 0.
-#[derive(Debug, Clone)]
-pub struct BodyContactCheck {
-    phi: DMatrix<f64>,
-    /// max_i |φ_j(ξ_i)| per mode j, shape `[N]`: |W(ξ_i)| ≤ Σ_j reach_j |a_j| at every station.
-    reach: Vec<f64>,
-}
-
-impl BodyContactCheck {
-    /// Sample the beam at `points` interior stations ξ_i = 0.99 i / points, i = 1..=points.
-    pub fn new(model: &CantileverModel, points: usize) -> Self {
-        let n = model.modes();
-        let shapes = model.galerkin().shapes();
-        // the point-mass model has no beam body
-        let points = if model.params().structure == crate::params::Structure::PointMass {
-            0
-        } else {
-            points
-        };
-        let mut phi = DMatrix::zeros(points, n);
-        for i in 0..points {
-            let xi = 0.99 * (i + 1) as f64 / points as f64;
-            for (j, v) in shapes.values(xi).into_iter().enumerate() {
-                phi[(i, j)] = v;
-            }
-        }
-        let reach = (0..n)
-            .map(|j| phi.column(j).iter().fold(0.0f64, |m, v| m.max(v.abs())))
-            .collect();
-        BodyContactCheck { phi, reach }
-    }
-
-    /// Whether any station touches the substrate at (τ, z).
-    ///
-    /// Every station's W(ξ_i) = Σ_j φ_j(ξ_i) a_j is bounded by Σ_j reach_j |a_j|; while that
-    /// bound, widened by 1e-9 (far beyond the ≤ 2N ulp by which the computed sums can exceed
-    /// it), stays below α2 sin Ωτ + 1, no station can touch and none is formed — the common
-    /// case away from the sample. Otherwise the stations are formed one by one, each sum in
-    /// the order of the matrix–vector product (mode 0 first), without allocating.
-    pub fn touches(&self, model: &CantileverModel, tau: f64, z: &DVector<f64>) -> bool {
-        self.touches_at(Self::base(model, tau), &z.as_slice()[..model.modes()])
-    }
-
-    /// [`BodyContactCheck::touches`] given the base α2 sin Ωτ + 1 and the displacements a.
-    fn touches_at(&self, base: f64, a: &[f64]) -> bool {
-        if Self::spared(weighted_displacement(&self.reach, a), base) {
-            return false;
-        }
-        (0..self.phi.nrows()).any(|i| {
-            let w = a
-                .iter()
-                .enumerate()
-                .skip(1)
-                .fold(self.phi[(i, 0)] * a[0], |w, (j, x)| {
-                    w + self.phi[(i, j)] * x
-                });
-            w + base <= 0.0
-        })
-    }
-
-    /// [`BodyContactCheck::touches`] at the state an observer of
-    /// [`crate::integrate::advance_observed`] sees, without forming it where the integrator's
-    /// bound ([`Observed::displacement_bound`], ≥ Σ_j reach_j |a_j|) already spares the
-    /// stations: the same answer as `touches` on the formed state. The bound is held first
-    /// against the lowest base 1 − |α2| ≤ α2 sin Ωτ + 1 (less 4 ulp for its rounding), which
-    /// needs no sine and spares most steps away from the sample (about 19 of 20 on the
-    /// default attractor at N = 10), then against the base at τ.
-    pub fn touches_observed(&self, it: &mut Observed<'_>) -> bool {
-        let lowest = (1.0 - it.model().params().base_amplitude().abs()) - 4.0 * f64::EPSILON;
-        let bound = it.displacement_bound(&self.reach, lowest / (1.0 + 1e-9));
-        if Self::spared(bound, lowest) {
-            return false;
-        }
-        let base = Self::base(it.model(), it.tau());
-        if Self::spared(
-            it.displacement_bound(&self.reach, base / (1.0 + 1e-9)),
-            base,
-        ) {
-            return false;
-        }
-        let n = it.model().modes();
-        self.touches_at(base, &it.state().as_slice()[..n])
-    }
-
-    /// α2 sin Ωτ + 1: a station touches when W(ξ_i, τ) + this ≤ 0.
-    fn base(model: &CantileverModel, tau: f64) -> f64 {
-        let p = model.params();
-        p.base_amplitude() * (p.omega * tau).sin() + 1.0
-    }
-
-    /// Whether a bound of Σ_j reach_j |a_j|, widened by 1e-9 (see [`BodyContactCheck::touches`]),
-    /// keeps every station off the substrate.
-    fn spared(bound: f64, base: f64) -> bool {
-        bound * (1.0 + 1e-9) < base
-    }
-}
-
-/// Σ_j c_j |a_j| over `weights` c (≥ 0) and the leading entries of `a` (the modal
-/// displacements of a state (a, ȧ)), in index order.
-pub fn weighted_displacement(weights: &[f64], a: &[f64]) -> f64 {
-    weights.iter().zip(a).map(|(c, x)| c * x.abs()).sum()
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::analysis::bifurcation::random_state;
-
-    /// The bound that spares forming the stations never changes the answer: on states scaled
-    /// from far inside to far beyond the substrate (where the bound fails and stations touch),
-    /// `touches` agrees with every station formed by the matrix–vector product, V(ξ_i) ≤ 0.
-    #[test]
-    fn body_contact_bound_never_changes_the_answer() {
-        for modes in [1, 3, 10] {
-            let model = CantileverModel::new(&Params {
-                modes,
-                ..Params::default()
-            })
-            .unwrap();
-            let check = BodyContactCheck::new(&model, 32);
-            let p = model.params();
-            let (mut touched, mut spared) = (0, 0);
-            for k in 0..400u64 {
-                let scale = 0.05 * (k % 80) as f64;
-                let z = random_state(&model, 7, k) * scale;
-                let tau = 0.37 * k as f64;
-                let base = p.base_amplitude() * (p.omega * tau).sin() + 1.0;
-                let w = &check.phi * z.rows(0, modes);
-                let reference = w.iter().any(|wi| wi + base <= 0.0);
-                assert_eq!(
-                    check.touches(&model, tau, &z),
-                    reference,
-                    "N = {modes}, k = {k}"
-                );
-                touched += usize::from(reference);
-                let bound = weighted_displacement(&check.reach, z.as_slice());
-                spared += usize::from(BodyContactCheck::spared(bound, base));
-            }
-            // both outcomes and both paths are exercised
-            assert!(
-                touched > 0 && touched < 400,
-                "N = {modes}: {touched} touching"
-            );
-            assert!(spared > 0 && spared < 400, "N = {modes}: {spared} spared");
-        }
     }
 }

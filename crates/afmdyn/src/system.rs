@@ -17,9 +17,54 @@
 //! event time is then r + R(δz + f⁻δτ) + ∂r/∂τ δτ − f⁺δτ.) At a grazing event ġ → 0 and S grows
 //! like 1/ġ — the square-root singularity of the impact map (Nordmark 1991).
 
-use crate::galerkin::Region;
 use nalgebra::{DMatrix, DVector};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
+
+/// The two regions of the switched model (eq. 10).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+pub enum Region {
+    /// Region I: tip free, V_T > 0.
+    #[default]
+    Free,
+    /// Region II: tip in contact with the sample spring α4 and damper α6, V_T ≤ 0.
+    Contact,
+}
+
+impl Region {
+    /// Index 0 (free) or 1 (contact).
+    pub fn index(self) -> usize {
+        match self {
+            Region::Free => 0,
+            Region::Contact => 1,
+        }
+    }
+
+    /// The other region.
+    pub fn other(self) -> Region {
+        match self {
+            Region::Free => Region::Contact,
+            Region::Contact => Region::Free,
+        }
+    }
+
+    /// Sign σ of the guard g = σ V_T of a region of the smooth laws: +1 in free flight (left
+    /// when V_T falls to 0), −1 in contact (left when V_T rises to 0).
+    pub fn guard_sign(self) -> f64 {
+        match self {
+            Region::Free => 1.0,
+            Region::Contact => -1.0,
+        }
+    }
+
+    /// Region of a tip displacement V_T: contact when V_T ≤ 0 (eq. 10).
+    pub fn of_v_t(v_t: f64) -> Region {
+        if v_t <= 0.0 {
+            Region::Contact
+        } else {
+            Region::Free
+        }
+    }
+}
 
 /// Value and first derivatives of a guard function g_s(τ, z) (positive inside mode s).
 #[derive(Debug, Clone, PartialEq)]
@@ -201,7 +246,7 @@ impl SaltationParts {
             let gm: f64 = self.grad.iter().zip(col.iter()).map(|(g, x)| g * x).sum();
             if !identity {
                 scratch.copy_from_slice(col);
-                crate::integrate::matvec(&self.jump.jacobian, &scratch, col, 1.0, false);
+                crate::linalg::matvec(&self.jump.jacobian, &scratch, col, 1.0, false);
             }
             for (c, w) in col.iter_mut().zip(self.shift.iter()) {
                 *c += w * gm;

@@ -23,10 +23,10 @@
 
 use super::{ChatterWindow, HermiteStep, Integrator, Step};
 use crate::error::SimError;
-use crate::galerkin::Region;
 use crate::model::CantileverModel;
 use crate::roots::{extremum, safeguarded_newton};
 use crate::system::HybridSystem;
+use crate::system::Region;
 use differential_equations::interpolate::Interpolation;
 use differential_equations::methods::{DormandPrince, ExplicitRungeKutta, Ordinary};
 use differential_equations::ode::{OrdinaryNumericalMethod, ODE};

@@ -12,8 +12,8 @@
 use super::grid::PeriodGrid;
 use super::{HermiteStep, Integrator, Step};
 use crate::error::SimError;
-use crate::galerkin::Region;
 use crate::model::CantileverModel;
+use crate::system::Region;
 use nalgebra::{DMatrix, DVector};
 
 /// Fixed-step RK4 integrator on a grid of `steps` sub-steps per drive period.

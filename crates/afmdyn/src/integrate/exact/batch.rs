@@ -22,10 +22,13 @@
 //! alone. What it saves is the per-step bookkeeping of the scalar step, and the loops over
 //! lanes vectorize.
 
-use super::{grid_v_t, search::StepEnds, ExactPropagator, Form};
+use super::forcing::grid_v_t;
+use super::search::StepEnds;
+use super::step::Form;
+use super::ExactPropagator;
 use crate::error::SimError;
-use crate::galerkin::Region;
 use crate::integrate::Integrator;
+use crate::system::Region;
 use nalgebra::DVector;
 
 /// Lanes per pass of the modal step (the slot capacity of a block is a multiple of it).

@@ -5,13 +5,17 @@
 //! exponential Φ_s = e^{A_s h} on those and h. Both are kept in small process-wide caches keyed
 //! by the exact bits of the matrices (and of h), so the repeated builds of shooting at one
 //! parameter set reuse everything and a continuation step in Ω reuses the spectral data and
-//! redoes only Φ_s and the particular solution. A hit returns the very values a rebuild would compute (the build is deterministic).
+//! redoes only Φ_s and the particular solution. A hit returns the very values a rebuild would
+//! compute (the build is deterministic). Each of the three process-wide caches states its key,
+//! its bound and why results do not depend on it where it is defined: [`SPECTRAL`],
+//! [`GRID_EXP`] and [`FORCING`](super::forcing::FORCING).
 
 use super::modal::ModalExp;
 use super::K;
 use crate::error::SimError;
-use crate::galerkin::Region;
+use crate::linalg::{matmul, matmul_into};
 use crate::model::CantileverModel;
+use crate::system::Region;
 use nalgebra::linalg::LU;
 use nalgebra::{DMatrix, DVector, Dyn};
 use std::sync::{Arc, Mutex};
@@ -41,9 +45,33 @@ pub(super) struct Spectral {
 /// Entries kept per cache (least recently used dropped first).
 const CAPACITY: usize = 8;
 
+/// A process-wide cache: (key, value) entries, the most recently used last ([`cached`]).
 pub(super) type Cache<V> = Mutex<Vec<(Vec<u64>, Arc<V>)>>;
 
+/// The spectral data of both regions ([`Spectral`]) of recent builds ([`spectral`]).
+///
+/// - **Key**: [`matrix_key`], the state dimension and the exact bits of A_s, M and K_s of both
+///   regions. They fix everything [`region_spectral`] reads: the tip row φ(1) of the moment
+///   rows is fixed by N and the structure, which K_s tells apart (the point mass's K = 1, the
+///   beam's β_j⁴).
+/// - **Bound**: [`CAPACITY`] = 8 entries, the least recently used dropped first. An entry holds
+///   at most 12 d² + 132 d + 160 numbers per region (d = 2N: T, T⁻¹, Ã, the LU of A_s, the
+///   moment rows, the eigendecomposition) and a key of 2(d² + 2N²) + 1 words: 0.42 MiB at
+///   N = 20 ([`crate::params::MAX_MODES`]), so at most 3.4 MiB in all.
+/// - **Results do not depend on it**: the data is computed from the keyed bits alone, by the
+///   same operations in the same order on one thread, so a hit returns the very bits a miss
+///   computes ([`cached`]: a poisoned lock counts as a miss; `reuse = false` bypasses it).
 static SPECTRAL: Cache<[Spectral; 2]> = Mutex::new(Vec::new());
+
+/// The grid exponentials Φ_s = T⁻¹ e^{Ã_s h} T of both regions ([`GridExp`]) of recent builds
+/// ([`grid_exp`]).
+///
+/// - **Key**: [`matrix_key`] and the bits of the grid step h (Φ_s is computed from the
+///   spectral data, fixed by that key as in [`SPECTRAL`], and h).
+/// - **Bound**: [`CAPACITY`] = 8 entries, the least recently used dropped first; an entry is
+///   2 d² numbers and a key of 2(d² + 2N²) + 2 words: 63 KiB at N = 20, 0.5 MiB in all.
+/// - **Results do not depend on it**: as for [`SPECTRAL`], a hit returns the bits a miss
+///   computes.
 static GRID_EXP: Cache<GridExp> = Mutex::new(Vec::new());
 
 /// Φ_s of the free and the contact region.
@@ -158,35 +186,6 @@ pub(super) fn expm(at: &DMatrix<f64>, h: f64, rho: f64) -> DMatrix<f64> {
         std::mem::swap(&mut p, &mut tmp);
     }
     p
-}
-
-/// out = α A B for square column-major A, B of one size: up to 12×12 column by column with the
-/// fixed-size kernel (a blocked product packs, and allocates, per call), above by nalgebra's
-/// blocked product.
-pub(crate) fn matmul_into(a: &DMatrix<f64>, b: &DMatrix<f64>, alpha: f64, out: &mut DMatrix<f64>) {
-    let dim = a.nrows();
-    if dim > 12 {
-        return out.gemm(alpha, a, b, 0.0);
-    }
-    let kernel = super::kernel::for_dim(dim);
-    out.as_mut_slice().fill(0.0);
-    for (bj, oj) in b
-        .as_slice()
-        .chunks_exact(dim.max(1))
-        .zip(out.as_mut_slice().chunks_exact_mut(dim.max(1)))
-    {
-        kernel(a.as_slice(), bj, oj);
-    }
-    if alpha != 1.0 {
-        *out *= alpha;
-    }
-}
-
-/// A B for square matrices of one size ([`matmul_into`]).
-pub(super) fn matmul(a: &DMatrix<f64>, b: &DMatrix<f64>) -> DMatrix<f64> {
-    let mut out = DMatrix::zeros(a.nrows(), b.ncols());
-    matmul_into(a, b, 1.0, &mut out);
-    out
 }
 
 /// Φ_s = T⁻¹ e^{Ã_s h} T of both regions ([`expm`]; cached under `key` and h when `reuse`) and

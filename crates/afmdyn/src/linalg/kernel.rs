@@ -1,16 +1,16 @@
 //! The dense grid step y += Φ x, monomorphised for the small state dimensions.
 //!
 //! With the dimension a compile-time constant the column loop is unrolled and the accumulator
-//! lives in registers; the dynamic loop ([`crate::integrate::matvec_cols`]) re-reads and
+//! lives in registers; the dynamic loop ([`super::matvec_cols`]) re-reads and
 //! re-writes y for every column. Chosen once per propagator by [`for_dim`].
 
-use crate::integrate::matvec_cols;
+use super::matvec_cols;
 
 /// y += A x for a column-major dim×dim A (`a.len() == dim²`, `x.len() == y.len() == dim`).
-pub(super) type MatVec = fn(&[f64], &[f64], &mut [f64]);
+pub(crate) type MatVec = fn(&[f64], &[f64], &mut [f64]);
 
 /// The kernel for a state dimension `dim`: fixed-size for 2N ≤ 12 (N ≤ 6), else dynamic.
-pub(super) fn for_dim(dim: usize) -> MatVec {
+pub(crate) fn for_dim(dim: usize) -> MatVec {
     match dim {
         2 => fixed::<2>,
         4 => fixed::<4>,

@@ -1,0 +1,189 @@
+//! [`Integrator`] for [`ExactPropagator`].
+
+use super::forcing::modal_tip;
+use super::modal::Modes;
+use super::step::Form;
+use super::tip::tip_v_t;
+use super::ExactPropagator;
+use crate::error::SimError;
+use crate::integrate::{Integrator, Step};
+use crate::model::CantileverModel;
+use crate::params::SweepParam;
+use crate::system::Region;
+use nalgebra::{DMatrix, DVector};
+
+impl Integrator for ExactPropagator {
+    fn model(&self) -> &CantileverModel {
+        &self.model
+    }
+    fn tau(&self) -> f64 {
+        self.tau
+    }
+    fn state(&self) -> &DVector<f64> {
+        &self.z
+    }
+    fn region(&self) -> Region {
+        self.region
+    }
+    fn name(&self) -> &'static str {
+        "exact"
+    }
+
+    fn reset(&mut self, tau: f64, z: &DVector<f64>) -> Result<(), SimError> {
+        let (region, z) = self.model.checked_start(tau, z)?;
+        self.region = region;
+        self.tau = tau;
+        self.z.copy_from(&z);
+        self.stale = false;
+        let j = self.grid.next_index(tau) - 1;
+        let m = self.grid.m as i64;
+        self.on_grid =
+            (self.grid.tau(j) == tau).then_some((j.div_euclid(m), j.rem_euclid(m) as usize));
+        self.between = None;
+        let sc = (self.model.omega() * tau).sin_cos();
+        self.entry_trig = (tau, sc);
+        self.enter_stint(region, sc);
+        self.just_switched = true;
+        self.chatter.clear();
+        self.last.tau0 = tau;
+        self.last.region = region;
+        self.last.dz0.fill(0.0);
+        *self.last.q0 = Modes::ZERO;
+        self.last.modal = false;
+        self.last.full = false;
+        self.poly_built = false;
+        self.param_end = None;
+        self.vt = tip_v_t(&self.model, z.as_slice(), sc);
+        Ok(())
+    }
+
+    fn step(&mut self, tau_max: f64) -> Result<Step, SimError> {
+        self.step_impl(tau_max, Form::All)
+    }
+
+    fn step_deferred(&mut self, tau_max: f64) -> Result<Step, SimError> {
+        self.step_impl(tau_max, Form::Events)
+    }
+
+    fn form_state(&mut self) {
+        self.materialize();
+    }
+
+    /// V_T and dV_T/dτ of the switching test at the end of the last step; W and ∂W/∂τ from the
+    /// plain state, or, while it lags behind, from the modal coordinates: Σ_k Re(w_k c̃ᵀv_k q_k)
+    /// (and with λ_k; as the last step returned them, else `ModalExp::tip_of`) plus the
+    /// particular part (`modal_tip`).
+    fn tip_values(&self) -> [f64; 4] {
+        let (v, vd) = self.vt;
+        let ri = self.region.index();
+        let (w, wd) = match (&self.spec[ri].modal, self.stale) {
+            (Some(me), true) => modal_tip(
+                self.model.omega(),
+                &self.forced[ri],
+                self.tip_hom.unwrap_or_else(|| me.tip_of(&self.q)),
+                self.trig_now(),
+            ),
+            _ => (self.model.w_tip(&self.z), self.model.w_tip_dot(&self.z)),
+        };
+        [w, wd, v, vd]
+    }
+
+    // the bound and its proof: `bound.rs`
+    fn displacement_bound(&mut self, weights: &[f64], enough: f64) -> f64 {
+        self.displacement_bound_impl(weights, enough)
+    }
+
+    fn advance_to(&mut self, tau_end: f64) -> Result<(), SimError> {
+        let mut out = Ok(());
+        while self.tau < tau_end {
+            // the certified whole grid steps in one tight loop, the next step (a possible
+            // switching, or a partial step) by step_impl
+            let step = self.grid_run(tau_end).and_then(|()| {
+                if self.tau < tau_end {
+                    self.step_impl(tau_end, Form::Nothing)?;
+                }
+                Ok(())
+            });
+            if let Err(e) = step {
+                out = Err(e);
+                break;
+            }
+        }
+        self.materialize();
+        out
+    }
+
+    fn dense_tip(&mut self, tau: f64) -> [f64; 3] {
+        let t = tau - self.last.tau0;
+        self.poly_for_last(t);
+        self.poly.w(t)
+    }
+
+    /// From the tip series of the last step, whose coefficients include the harmonic part of
+    /// V_T (eq. 8): no sine per call, unlike the default through [`Integrator::dense_tip`].
+    fn dense_v_t(&mut self, tau: f64) -> [f64; 3] {
+        let t = tau - self.last.tau0;
+        self.poly_for_last(t);
+        self.poly.v_t(t)
+    }
+
+    fn dense_state(&mut self, tau: f64) -> DVector<f64> {
+        let mut out = DVector::zeros(self.z.len());
+        self.state_in_last(tau - self.last.tau0, out.as_mut_slice());
+        out
+    }
+
+    fn last_step_jacobian(&mut self) -> Result<DMatrix<f64>, SimError> {
+        Ok(self.step_transition())
+    }
+
+    // the derivative and its derivation: `sensitivity.rs`
+    fn last_step_param_derivative_into(
+        &mut self,
+        param: SweepParam,
+        out: &mut DVector<f64>,
+    ) -> Result<bool, SimError> {
+        self.last_step_param_derivative_impl(param, out)
+    }
+
+    fn region_particular_param_derivative_into(
+        &mut self,
+        param: SweepParam,
+        r: Region,
+        tau: f64,
+        out: &mut DVector<f64>,
+    ) -> Result<bool, SimError> {
+        let Some(d) = self.particular_derivative_for(param, out)? else {
+            return Ok(false);
+        };
+        let ri = r.index();
+        let sc = (self.model.omega() * tau).sin_cos();
+        Self::zpp_into(&d[ri], &self.forced[ri], tau, sc, out.as_mut_slice());
+        Ok(true)
+    }
+
+    fn has_region_transition(&self, r: Region) -> bool {
+        self.spec[r.index()].modal.is_some()
+    }
+
+    /// T⁻¹ V e^{Λt} V⁻¹ T from the eigendecomposition (accurate for any t ≥ 0: Re λ_k ≤ 0 and
+    /// the basis is well conditioned, [`modal::MAX_MODAL_CONDITION`]).
+    ///
+    /// [`modal::MAX_MODAL_CONDITION`]: super::MAX_MODAL_CONDITION
+    fn region_transition_into(&self, r: Region, t: f64, out: &mut DMatrix<f64>) -> bool {
+        let Some(me) = &self.spec[r.index()].modal else {
+            return false;
+        };
+        let dim = self.z.len();
+        if out.shape() != (dim, dim) {
+            *out = DMatrix::zeros(dim, dim);
+        }
+        me.transition_plain_into(t, out);
+        true
+    }
+
+    fn last_step_jacobian_into(&mut self, out: &mut DMatrix<f64>) -> Result<(), SimError> {
+        self.step_transition_into(out);
+        Ok(())
+    }
+}
