@@ -32,6 +32,20 @@
 //! assert!(orbit.stats.contact_fraction > 0.0);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
+//!
+//! ## Features
+//!
+//! Both are on by default; the command line and the Python module use them.
+//!
+//! * `parallel` — the independent runs of [`analysis::bifurcation`] (sweep points, chains and
+//!   random starts) and [`analysis::attractors`] (random starts, polishing) on rayon's thread
+//!   pool. Without it the same code runs them one after another; every seed comes from the
+//!   run's index, so the results are the same.
+//! * `files` — reading files: `Probe::load(path)`. [`probe::Probe::parse`] takes the TOML text
+//!   and is always there.
+//!
+//! With `--no-default-features` the library builds for `wasm32-unknown-unknown` (CI checks
+//! `cargo build -p afmdyn --lib --target wasm32-unknown-unknown --no-default-features`).
 #![warn(missing_docs)]
 
 pub mod analysis;

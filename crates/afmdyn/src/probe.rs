@@ -73,6 +73,7 @@ use crate::model::CantileverModel;
 use crate::params::{Params, Structure, MAX_MODES};
 use serde::Serialize;
 use std::f64::consts::TAU;
+#[cfg(feature = "files")]
 use std::path::Path;
 use thiserror::Error;
 
@@ -333,6 +334,7 @@ impl Probe {
     ///
     /// # Errors
     /// [`ProbeError`] naming the path and every problem.
+    #[cfg(feature = "files")]
     pub fn load(path: &Path) -> Result<Probe, ProbeError> {
         let text = std::fs::read_to_string(path).map_err(|e| ProbeError::Io {
             path: path.display().to_string(),

@@ -6,6 +6,8 @@
 
 use super::bifurcation::random_state;
 use super::period::close;
+#[cfg(not(feature = "parallel"))]
+use super::sequential::*;
 use super::shooting::{shoot_with, PeriodicOrbit, ShootingOptions};
 use super::steady::{steady_state, PoincarePoint, SteadyOptions, SteadyState};
 use crate::error::SimError;
@@ -13,6 +15,7 @@ use crate::integrate::{build, IntegratorKind, IntegratorOptions};
 use crate::model::CantileverModel;
 use crate::params::Params;
 use nalgebra::DVector;
+#[cfg(feature = "parallel")]
 use rayon::prelude::*;
 
 /// An attractor search.

@@ -2,6 +2,8 @@
 //! backward, revealing hysteresis) and seeded multistart, in parallel (rayon), streaming each
 //! finished point to a sink so that no sweep is held in memory.
 
+#[cfg(not(feature = "parallel"))]
+use super::sequential::*;
 use super::steady::{steady_state, SteadyOptions, SteadyState};
 use crate::error::SimError;
 use crate::integrate::{build, IntegratorOptions};
@@ -10,6 +12,7 @@ use crate::params::{Params, SweepParam};
 use nalgebra::DVector;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+#[cfg(feature = "parallel")]
 use rayon::prelude::*;
 use std::collections::{HashMap, HashSet};
 use std::fmt;

@@ -17,3 +17,35 @@ pub mod resonance;
 pub mod shooting;
 pub mod steady;
 pub mod stepped;
+
+/// Without the `parallel` feature: the few rayon adaptors the analyses call, on plain
+/// iterators, so the same code runs its independent tasks one after another (each task's seed
+/// comes from its index, so the results do not depend on the feature).
+#[cfg(not(feature = "parallel"))]
+mod sequential {
+    /// `into_par_iter` is `into_iter`.
+    pub(crate) trait IntoParallelIterator: IntoIterator + Sized {
+        fn into_par_iter(self) -> Self::IntoIter {
+            self.into_iter()
+        }
+    }
+    impl<I: IntoIterator> IntoParallelIterator for I {}
+
+    /// `par_iter_mut` is `iter_mut`.
+    pub(crate) trait ParallelSliceMut<T> {
+        fn par_iter_mut(&mut self) -> std::slice::IterMut<'_, T>;
+    }
+    impl<T> ParallelSliceMut<T> for [T] {
+        fn par_iter_mut(&mut self) -> std::slice::IterMut<'_, T> {
+            self.iter_mut()
+        }
+    }
+
+    /// `with_max_len` (rayon's split granularity) has nothing to do.
+    pub(crate) trait IndexedParallelIterator: Iterator + Sized {
+        fn with_max_len(self, _max: usize) -> Self {
+            self
+        }
+    }
+    impl<I: Iterator> IndexedParallelIterator for I {}
+}
