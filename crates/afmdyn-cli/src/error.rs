@@ -21,7 +21,7 @@ pub enum CliError {
 
 /// The library's message with a request parameter spelled as its flag: `samples_per_period`
 /// → `samples-per-period`, `initial` → `--initial-modal`; the hints of a budget name the
-/// flags that lower it.
+/// flags that lower it, those of an unsupported integrator the `--integrator` flag.
 pub fn spell(e: &afmdyn::SimError) -> String {
     let msg = e.spelled(|name| match name {
         "initial" => "--initial-modal".to_string(),
@@ -32,6 +32,10 @@ pub fn spell(e: &afmdyn::SimError) -> String {
             .replace("lower periods", "lower --periods")
             .replace("samples_per_period", "--samples-per-period")
             .replace("keep no time series", "use --files none"),
+        // `use integrator = "adaptive" (or "auto")` → `use --integrator adaptive (or auto)`
+        afmdyn::SimError::Unsupported { .. } => msg
+            .replace("integrator = ", "--integrator ")
+            .replace('"', ""),
         _ => msg,
     }
 }

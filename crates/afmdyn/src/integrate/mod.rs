@@ -525,7 +525,7 @@ pub fn build(
         return Err(SimError::Unsupported {
             integrator: "rk4",
             law: model.law().name(),
-            hint: "impacts need located events with jumps: use --integrator adaptive (or auto)",
+            hint: "impacts need located events with jumps: use integrator = \"adaptive\" (or \"auto\")",
         });
     }
     let mut integ: Box<dyn Integrator> = match kind {

@@ -244,7 +244,7 @@ impl Integrator for Rk4 {
         Err(SimError::Unsupported {
             integrator: self.name(),
             law: self.model.law().name(),
-            hint: "step Jacobians need --integrator exact or adaptive",
+            hint: "step Jacobians need integrator = \"exact\" or \"adaptive\"",
         })
     }
 }

@@ -89,7 +89,7 @@ impl ExactPropagator {
                 integrator: "exact",
                 law: model.law().name(),
                 hint:
-                    "only the linear law is piecewise affine: use --integrator adaptive (or auto)",
+                    "only the linear law is piecewise affine: use integrator = \"adaptive\" (or \"auto\")",
             });
         }
         let n = model.modes();
