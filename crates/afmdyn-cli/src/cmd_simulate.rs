@@ -6,9 +6,11 @@ use crate::output::{
     csv_finish, csv_row, csv_stream, f, write_csv, Column, CsvStream, NpyStream, OutDir,
 };
 use crate::plot::{decimate_line, save, Figure, Series, Style};
+use afmdyn::analysis::spectrum::{amplitude_spectrum, SPECTRUM_SAMPLES};
 use afmdyn::integrate::build;
 use afmdyn::request::{ConvergeRequest, SeriesStore, SimulateRequest};
-use afmdyn::trajectory::{record, RecordSpec, Sample, Trajectory};
+use afmdyn::trajectory::chunked::{record_chunked, Chunk, ChunkedSpec};
+use afmdyn::trajectory::Sample;
 use afmdyn::{CantileverModel, Params, Region};
 use clap::{Args, ValueEnum};
 use serde_json::json;
@@ -28,10 +30,6 @@ pub enum Files {
 
 /// Samples kept for the phase portrait (the last ones).
 const PHASE_SAMPLES: usize = 50_000;
-/// Samples kept for the amplitude spectrum (the last ones).
-const SPECTRUM_SAMPLES: usize = 1 << 20;
-/// Samples held in memory at once (a chunk of the run).
-const CHUNK_SAMPLES: usize = 65_536;
 
 /// `afmdyn simulate` flags.
 #[derive(Debug, Args)]
@@ -292,14 +290,6 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
     });
     let mut spectrum: VecDeque<f64> = VecDeque::new();
     let record_samples = if files.is_some() { spp } else { 0 };
-    let chunk = a
-        .chunk_periods
-        .unwrap_or(if record_samples > 0 {
-            (CHUNK_SAMPLES / spp).max(1)
-        } else {
-            4096
-        })
-        .max(1) as f64;
     let bar = indicatif::ProgressBar::new(total_periods.ceil() as u64);
     bar.set_style(
         indicatif::ProgressStyle::with_template(
@@ -307,74 +297,26 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
         )
         .expect("template"),
     );
-    // chunks end on stroboscopic sections (so that no energy period is split) when the sample
-    // grid start + k·dt passes through them, i.e. when transient × samples-per-period is an
-    // integer; otherwise on the sample grid (energy.csv then has split rows, see its tau1)
-    let on_sections = record_samples == 0 || {
-        let x = a.transient * spp as f64;
-        (x - x.round()).abs() <= 1e-9 * (1.0 + x)
+    let spec = ChunkedSpec {
+        transient_periods: a.transient,
+        record_tau,
+        samples_per_period: record_samples,
+        chunk_periods: a.chunk_periods,
     };
-    let first_section = (start / period - 1e-9).ceil();
-    let mut summary = RunSummary::default();
-    let mut last_sample = f64::NEG_INFINITY;
-    let mut last_section = f64::NEG_INFINITY;
-    let mut k = 0.0;
-    let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * (1.0 + a.abs());
-    loop {
-        k += 1.0;
-        let target = if on_sections {
-            (first_section + k * chunk) * period
-        } else {
-            start + k * chunk * period
-        }
-        .min(end);
-        let first = k == 1.0;
-        let now = integ.tau();
-        let tr = record(
-            integ.as_mut(),
-            &RecordSpec {
-                transient_periods: if first { a.transient } else { 0.0 },
-                record_tau: if first {
-                    target - start
-                } else {
-                    (target - now).max(0.0)
-                },
-                samples_per_period: record_samples,
-                energy: true,
-                body_contact: true,
-            },
-        )?;
-        summary.add(&tr);
-        let samples: Vec<&Sample> = tr
-            .samples
-            .iter()
-            .filter(|s| !close(s.tau, last_sample))
-            .collect();
-        if let Some(s) = samples.last() {
-            last_sample = s.tau;
-        }
-        let sections: Vec<_> = tr
-            .poincare
-            .iter()
-            .filter(|(t, _)| !close(*t, last_section))
-            .collect();
-        if let Some((t, _)) = sections.last() {
-            last_section = *t;
-        }
-        summary.sections += sections.len();
+    let each = |c: &Chunk<'_>| -> Result<(), CliError> {
         if let Some(fl) = files.as_mut() {
-            for s in &samples {
+            for s in &c.samples {
                 let row = sample_row(s);
                 fl.npy.push(&row)?;
-                if let Some(c) = fl.csv.as_mut() {
-                    csv_row(c, row.iter().map(|v| f(*v)))?;
+                if let Some(csv) = fl.csv.as_mut() {
+                    csv_row(csv, row.iter().map(|v| f(*v)))?;
                 }
                 if spectrum.len() == SPECTRUM_SAMPLES {
                     spectrum.pop_front();
                 }
                 spectrum.push_back(s.w_tip);
             }
-            for e in &tr.events {
+            for e in c.events() {
                 csv_row(
                     &mut fl.events,
                     [
@@ -385,7 +327,7 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
                     ],
                 )?;
             }
-            for (t, z) in &sections {
+            for (t, z) in &c.sections {
                 csv_row(
                     &mut fl.poincare,
                     [
@@ -396,7 +338,7 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
                     ],
                 )?;
             }
-            for e in &tr.energy {
+            for e in c.energy() {
                 // each interval ends at the first stroboscopic section after its start
                 let tau1 = ((e.tau0 / period + 1e-9).floor() + 1.0) * period;
                 csv_row(
@@ -416,7 +358,7 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
         }
         if let Some(pd) = plots.as_mut() {
             let (a2, om) = (p.alpha2, p.omega);
-            for s in &samples {
+            for s in &c.samples {
                 pd.tip.push((s.tau, s.w_tip));
                 pd.vt.push((s.tau, s.v_t));
                 if pd.phase.len() == PHASE_SAMPLES {
@@ -425,7 +367,8 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
                 pd.phase
                     .push_back((s.v_t, s.w_tip_dot + a2 * om * (om * s.tau).cos()));
             }
-            if first
+            let tr = c.trajectory;
+            if c.first
                 && tr
                     .samples
                     .first()
@@ -433,7 +376,7 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
             {
                 pd.shade.open = Some(tr.samples[0].tau);
             }
-            for e in &tr.events {
+            for e in c.events() {
                 match e.to {
                     Region::Contact => pd.shade.open = Some(e.tau),
                     Region::Free => {
@@ -445,13 +388,11 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
             }
             pd.redecimate();
         }
-        bar.set_position((a.transient + (integ.tau() - start) / period) as u64);
-        summary.tau_end = tr.tau_end;
-        summary.final_state = Some(tr.final_state);
-        if integ.tau() >= end {
-            break;
-        }
-    }
+        Ok(())
+    };
+    let summary = record_chunked(integ.as_mut(), &spec, each, |done| {
+        bar.set_position(done as u64)
+    })?;
     bar.finish_and_clear();
     if let Some(fl) = files {
         fl.npy.finish()?;
@@ -512,32 +453,6 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
         }
     }
     Ok(())
-}
-
-/// Totals of a chunked run.
-#[derive(Default)]
-struct RunSummary {
-    switchings: usize,
-    sections: usize,
-    body_contact: bool,
-    residual: f64,
-    relative: f64,
-    tau_end: f64,
-    final_state: Option<nalgebra::DVector<f64>>,
-}
-
-impl RunSummary {
-    fn add(&mut self, tr: &Trajectory) {
-        self.switchings += tr.events.len();
-        self.body_contact |= tr.body_contact;
-        let (abs, rel) = afmdyn::report::energy_residual(&tr.energy);
-        self.residual = self.residual.max(abs);
-        self.relative = if rel.is_nan() {
-            rel
-        } else {
-            self.relative.max(rel)
-        };
-    }
 }
 
 fn write_spectrum_and_plots(
@@ -639,27 +554,6 @@ fn spectrum_axis_end(spec: &[(f64, f64)], omega: f64) -> f64 {
         .find(|s| s.1 >= 1e-3 * peak)
         .map_or(0.0, |s| s.0);
     (1.1 * top).max(4.0 * omega)
-}
-
-/// One-sided amplitude spectrum of uniformly sampled data (rustfft), frequencies in the units
-/// of Ω; the mean is removed.
-fn amplitude_spectrum(x: &[f64], samples_per_period: usize, omega: f64) -> Vec<(f64, f64)> {
-    use rustfft::{num_complex::Complex, FftPlanner};
-    let len = x.len().saturating_sub(1);
-    if len < 4 {
-        return vec![];
-    }
-    let mean = x[..len].iter().sum::<f64>() / len as f64;
-    let mut buf: Vec<Complex<f64>> = x[..len]
-        .iter()
-        .map(|v| Complex::new(v - mean, 0.0))
-        .collect();
-    FftPlanner::new().plan_fft_forward(len).process(&mut buf);
-    let dt = std::f64::consts::TAU / omega / samples_per_period as f64;
-    let df = std::f64::consts::TAU / (len as f64 * dt);
-    (0..=len / 2)
-        .map(|k| (k as f64 * df, 2.0 * buf[k].norm() / len as f64))
-        .collect()
 }
 
 /// `afmdyn converge` flags.

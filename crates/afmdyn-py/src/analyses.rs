@@ -11,6 +11,7 @@ use crate::run::{run, run_abandonable, Job, Stop};
 use afmdyn::analysis::attractors::find_attractors;
 use afmdyn::analysis::bifurcation::{run_sweep_cancellable, Branch, Resume, SweepPoint};
 use afmdyn::analysis::continuation::BranchEvent;
+use afmdyn::analysis::spectrum::{amplitude_spectrum, SPECTRUM_SAMPLES};
 use afmdyn::analysis::steady::SteadyState;
 use afmdyn::eigen::spectrum;
 use afmdyn::integrate::{build, IntegratorOptions};
@@ -253,6 +254,14 @@ pub fn simulate<'py>(
     out.f64s("tau", c.tau)?;
     out.f64s("v_t", c.v_t)?;
     out.f64s("v_t_dot", c.v_t_dot)?;
+    // the amplitude spectrum of W(1,τ) over the last samples, as the command line's
+    // spectrum.csv
+    let tail = &c.w_tip[c.w_tip.len().saturating_sub(SPECTRUM_SAMPLES)..];
+    let (freq, amp): (Vec<f64>, Vec<f64>) = amplitude_spectrum(tail, samples_per_period, p.omega)
+        .into_iter()
+        .unzip();
+    out.f64s("spectrum_frequency", freq)?;
+    out.f64s("spectrum", amp)?;
     out.f64s("w_tip", c.w_tip)?;
     out.f64s("w_tip_dot", c.w_tip_dot)?;
     out.bools("in_contact", c.in_contact)?;

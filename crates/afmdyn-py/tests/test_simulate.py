@@ -53,6 +53,13 @@ def test_equals_the_command_lines_output_files(reference):
         en = list(csv.DictReader(f))
     np.testing.assert_array_equal(ds.base_work.values, [float(r["base_work"]) for r in en])
     np.testing.assert_array_equal(ds.energy_residual.values, [float(r["residual"]) for r in en])
+    # the amplitude spectrum is the same library function on the same samples
+    with open(out / "spectrum.csv") as f:
+        sp = list(csv.DictReader(f))
+    np.testing.assert_array_equal(ds.frequency.values, [float(r["frequency"]) for r in sp])
+    np.testing.assert_array_equal(ds.spectrum.values, [float(r["amplitude"]) for r in sp])
+    # on whole drive periods (20): bin 20 is Ω
+    assert ds.frequency.values[20] == pytest.approx(2.8, rel=1e-12)
 
 
 def test_dims_dtypes_units_and_no_copies():

@@ -16,7 +16,7 @@ use crate::analysis::stepped::{CurvePoint, SteppedCurve, Sweep};
 use crate::eigen::RegionSpectrum;
 use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
-use crate::trajectory::{EnergyBalance, Trajectory};
+use crate::trajectory::Trajectory;
 use nalgebra::DVector;
 use serde_json::{json, Value};
 
@@ -33,31 +33,7 @@ pub fn modes(params: &Params, free: &RegionSpectrum, contact: &RegionSpectrum) -
     json!({ "params": params, "free": region_spectrum(free), "contact": region_spectrum(contact) })
 }
 
-/// Largest per-period residual of an energy balance (`trajectory::EnergyBalance::residual`):
-/// (absolute, relative to the period's largest term). The relative residual is +∞ for a nonzero
-/// (or NaN) residual of a period whose terms are all 0.
-pub fn energy_residual(energy: &[EnergyBalance]) -> (f64, f64) {
-    let (mut abs, mut rel) = (0.0f64, 0.0f64);
-    for e in energy {
-        let r = e.residual().abs();
-        let scale = [
-            e.e_start,
-            e.e_end,
-            e.base_work,
-            e.beam_dissipation,
-            e.contact_dissipation,
-        ]
-        .iter()
-        .fold(0.0f64, |m, v| m.max(v.abs()));
-        abs = abs.max(r);
-        if scale > 0.0 {
-            rel = rel.max(r / scale);
-        } else if r > 0.0 || r.is_nan() {
-            rel = f64::INFINITY;
-        }
-    }
-    (abs, rel)
-}
+pub use crate::trajectory::energy_residual;
 
 /// What `afmdyn simulate --json` reports of a run (the front ends add their own keys, e.g. the
 /// files written and warnings).

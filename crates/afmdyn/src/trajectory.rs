@@ -1,5 +1,8 @@
 //! Trajectories: sampled time series, switching events, the stroboscopic Poincaré section,
-//! per-period energy bookkeeping and the body-contact check.
+//! per-period energy bookkeeping and the body-contact check; [`chunked`]: a long run recorded in
+//! chunks of whole periods.
+
+pub mod chunked;
 
 use crate::error::{finite, SimError};
 use crate::galerkin::Region;
@@ -67,6 +70,32 @@ impl EnergyBalance {
         (self.e_end - self.e_start)
             - (self.base_work - self.beam_dissipation - self.contact_dissipation)
     }
+}
+
+/// Largest per-period residual of an energy balance ([`EnergyBalance::residual`]):
+/// (absolute, relative to the period's largest term). The relative residual is +∞ for a nonzero
+/// (or NaN) residual of a period whose terms are all 0.
+pub fn energy_residual(energy: &[EnergyBalance]) -> (f64, f64) {
+    let (mut abs, mut rel) = (0.0f64, 0.0f64);
+    for e in energy {
+        let r = e.residual().abs();
+        let scale = [
+            e.e_start,
+            e.e_end,
+            e.base_work,
+            e.beam_dissipation,
+            e.contact_dissipation,
+        ]
+        .iter()
+        .fold(0.0f64, |m, v| m.max(v.abs()));
+        abs = abs.max(r);
+        if scale > 0.0 {
+            rel = rel.max(r / scale);
+        } else if r > 0.0 || r.is_nan() {
+            rel = f64::INFINITY;
+        }
+    }
+    (abs, rel)
 }
 
 /// What to record along a run.

@@ -195,7 +195,9 @@ def simulate(
         ``in_contact``, ``contact_force`` ``[S]``; ``a``, ``a_dot`` ``[S, N]``;
         ``event_tau``, ``event_to_contact``, ``event_v_t_dot`` ``[E]``; ``section_tau``,
         ``section_v_t``, ``section_w_tip``, ``section_w_tip_dot`` ``[P]``, ``section_state``
-        ``[P, 2N]``; the energy balance per period ``[C]``. ``attrs["summary"]`` holds
+        ``[P, 2N]``; the energy balance per period ``[C]``; ``spectrum`` ``[F]`` over dim
+        ``frequency`` (the amplitude spectrum of W(1,τ) over the last ≤ 2²⁰ samples, the
+        command line's ``spectrum.csv``). ``attrs["summary"]`` holds
         ``afmdyn simulate --json`` (see :func:`summary`).
     """
     p, probe = _params(params, model)
@@ -292,8 +294,18 @@ def simulate(
                 d["energy_residual"],
                 {"units": "E I g0^2/L^3", "long_name": "ΔE − (work − losses)"},
             ),
+            "spectrum": (
+                "frequency",
+                d["spectrum"],
+                {**_G, "long_name": "amplitude spectrum of W(1,τ) (spectrum.csv)"},
+            ),
         },
         coords={
+            "frequency": (
+                "frequency",
+                d["spectrum_frequency"],
+                {"units": "Ω units (1/t0)", "long_name": "frequency"},
+            ),
             "tau": ("tau", d["tau"], _T),
             "mode": ("mode", np.arange(1, n + 1), {"long_name": "Galerkin mode i"}),
             "component": ("component", comp),

@@ -2,7 +2,8 @@
 //! sweeps (bifurcation diagrams), coexisting attractors and basins, mode convergence (Fig. 4);
 //! beyond the paper: monodromy matrices with saltation, Newton shooting, Floquet multipliers,
 //! pseudo-arclength continuation, Lyapunov exponents and the 0–1 test for chaos; the observables
-//! of a steady state (harmonics and phase, forces, sample dissipation, virial, energy balances).
+//! of a steady state (harmonics and phase, forces, sample dissipation, virial, energy balances);
+//! the amplitude spectrum of a time series.
 
 pub mod approach;
 pub mod attractors;
@@ -15,6 +16,7 @@ pub mod observables;
 pub mod period;
 pub mod resonance;
 pub mod shooting;
+pub mod spectrum;
 pub mod steady;
 pub mod stepped;
 
