@@ -185,9 +185,12 @@ pub fn with_si(
 /// ``Params(**model)`` takes the keywords of every analysis: ``modes`` (N, 1..=20),
 /// ``tip_mass_ratio``/``alpha1`` (α1 ≥ 0), ``drive_amplitude``/``alpha2`` (α2 ≥ 0),
 /// ``beam_damping``/``alpha3`` (α3 ≥ 0), ``contact_stiffness``/``alpha4`` (α4 ≥ 0),
-/// ``gap``/``alpha5`` (α5, finite), ``contact_damping``/``alpha6`` (α6 ≥ 0) and ``omega``
-/// (Ω > 0). Missing ones take the paper's Figs. 5–14 set (N = 3, α1 = α2 = α3 = 0.1, α4 = 20,
-/// α5 = 0, α6 = 0.2, Ω = 2.6).
+/// ``gap``/``alpha5`` (α5, finite), ``contact_damping``/``alpha6`` (α6 ≥ 0), ``omega``
+/// (Ω > 0), ``contact_law`` (``"linear"``, ``"hertz"``, ``"dmt"``, ``"impact"``) with its groups
+/// ``restitution`` (0..=1, impact), ``hamaker`` (≥ 0) and ``intermolecular_distance`` (> 0,
+/// DMT). Missing ones take the paper's Figs. 5–14 set (N = 3, α1 = α2 = α3 = 0.1, α4 = 20,
+/// α5 = 0, α6 = 0.2, Ω = 2.6). The names, ranges and help are the library's one table
+/// (``afmdyn._afmdyn.MODEL_PARAMETERS``).
 ///
 /// Raises ``ValueError`` naming the field and its range, ``TypeError`` for an unknown keyword.
 /// Instances are immutable; ``p.replace(omega=3.0)`` returns a modified copy.

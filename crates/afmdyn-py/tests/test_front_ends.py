@@ -217,3 +217,29 @@ def test_the_table_of_model_parameters_is_every_front_ends() -> None:
     for name, alias, _unit, _range, _help in core.MODEL_PARAMETERS:
         names.update({name, alias})
     assert names | {"probe"} == set(Model.__annotations__)
+
+
+def test_the_stubs_and_docstrings_follow_the_table() -> None:
+    """``Params(...)`` and ``Params.replace(...)`` in the stubs take exactly the table's
+    dimensionless keywords (``z_c`` and ``drive_frequency`` need a probe: analyses only), and
+    the Params docstring names each of them."""
+    import ast
+
+    from afmdyn import _afmdyn as core
+
+    stub = Path(afmdyn.__file__).parent / "_afmdyn.pyi"
+    tree = ast.parse(stub.read_text())
+    params = next(n for n in tree.body if isinstance(n, ast.ClassDef) and n.name == "Params")
+    si_only = {"z_c", "drive_frequency"}
+    expected = set()
+    for name, alias, unit, _range, _help in core.MODEL_PARAMETERS:
+        if name not in si_only:
+            expected.update({name, alias})
+    for fn in params.body:
+        if isinstance(fn, ast.FunctionDef) and fn.name in ("__init__", "replace"):
+            assert {a.arg for a in fn.args.kwonlyargs} == expected, fn.name
+    doc = afmdyn.Params.__doc__ or ""
+    for name in expected:
+        assert f"``{name}``" in doc, name
+    with pytest.raises(ValueError, match="z_c = .*: needs a probe file"):
+        afmdyn.Params(z_c=1e-9)
