@@ -138,6 +138,7 @@ impl fmt::Display for ContactLaw {
 
 /// The kind of a law without its groups, parsed from `linear|hertz|dmt|impact`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(rename_all = "lowercase")]
 pub enum LawKind {
     /// [`ContactLaw::Linear`].

@@ -399,6 +399,7 @@ impl Params {
 
 /// A continuous parameter that sweeps and continuation can vary.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(rename_all = "lowercase")]
 pub enum SweepParam {
     /// Ω, drive frequency.

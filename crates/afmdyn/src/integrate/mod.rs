@@ -422,6 +422,7 @@ pub fn advance_observed(
 
 /// Which integrator to use.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(rename_all = "kebab-case")]
 pub enum IntegratorKind {
     /// The exact propagator for the linear law, the adaptive integrator otherwise (default).

@@ -28,6 +28,7 @@ use serde::{Deserialize, Serialize};
 
 /// The steady-state search of every analysis that starts from a transient.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(default, deny_unknown_fields)]
 pub struct SteadyRequest {
     /// Relative tolerance for two returns of the stroboscopic map to coincide, > 0.
@@ -87,6 +88,7 @@ impl SteadyRequest {
 
 /// The integrator of an analysis that lets the user choose it.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(default, deny_unknown_fields)]
 pub struct IntegratorRequest {
     /// `auto` (exact for the linear law, adaptive otherwise), `exact`, `rk4`, `rk4-naive` or
@@ -159,6 +161,7 @@ pub fn initial_state(
 
 /// Where an orbit analysis starts: a given state, or the steady state reached from rest.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(default, deny_unknown_fields)]
 pub struct StartRequest {
     /// The initial state (2N values a1..aN, ȧ1..ȧN) used as the guess as it is; `None`: the
@@ -199,6 +202,7 @@ fn check_period(period: Option<usize>) -> Result<(), SimError> {
 
 /// `orbit`: a period-n orbit by Newton shooting, with its Floquet multipliers.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(default, deny_unknown_fields)]
 pub struct OrbitRequest {
     /// The period n (1..=64); `None`: the period of the steady state reached, else 1.
@@ -234,6 +238,7 @@ impl OrbitRequest {
 /// `continuation`: pseudo-arclength continuation of a period-n branch in one parameter, and
 /// with `switch` the period-doubling cascade to [`CASCADE_FACTOR`] n.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(default, deny_unknown_fields)]
 pub struct ContinuationRequest {
     /// The continued parameter.
@@ -297,6 +302,7 @@ impl ContinuationRequest {
 
 /// `lyapunov`: the Lyapunov spectrum with saltation matrices and the 0–1 test.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(default, deny_unknown_fields)]
 pub struct LyapunovRequest {
     /// The initial state (2N values); `None`: rest.
@@ -364,6 +370,7 @@ impl LyapunovRequest {
 
 /// `attractors`: the coexisting attractors and their basin fractions from random starts.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(default, deny_unknown_fields)]
 pub struct AttractorsRequest {
     /// Random initial states, 1..=[`MAX_ATTRACTOR_SAMPLES`].
@@ -435,6 +442,7 @@ impl AttractorsRequest {
 /// `observe`: the observables of the steady state reached from a start (polished by Newton
 /// shooting when periodic).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(default, deny_unknown_fields)]
 pub struct ObserveRequest {
     /// Orbit periods integrated, 1..=[`MAX_OBSERVE_PERIODS`].
@@ -523,6 +531,7 @@ impl ObserveRequest {
 
 /// `converge`: the steady tip motion for N = 1..=`max_modes` (paper Fig. 4).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(default, deny_unknown_fields)]
 pub struct ConvergeRequest {
     /// Largest number of modes, 1..=20.
@@ -625,6 +634,7 @@ pub enum SeriesStore {
 
 /// `simulate`: one trajectory recorded after a transient.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(default, deny_unknown_fields)]
 pub struct SimulateRequest {
     /// Drive periods recorded after the transient (> 0); default 50 when `tau_end` is not
@@ -758,6 +768,7 @@ impl SimulateRequest {
 /// `bifurcation`: the steady state over a grid of one parameter, continued forward and
 /// backward and from seeded random starts.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(default, deny_unknown_fields)]
 pub struct BifurcationRequest {
     /// The swept parameter.

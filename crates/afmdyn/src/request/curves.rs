@@ -4,9 +4,10 @@
 
 use crate::analysis::approach::{approach_spec, default_range};
 use crate::analysis::resonance::{mode_band, resonance_spec};
-use crate::analysis::stepped::{Spacing, SteppedSpec, DEFAULT_CURVE_POINTS};
+use crate::analysis::stepped::{Spacing, SteppedSpec, DEFAULT_CURVE_POINTS, DEFAULT_TOLERANCE};
 use crate::error::SimError;
 use crate::params::Params;
+use serde::{Deserialize, Serialize};
 
 /// A stepped-curve request as a front end takes it (`afmdyn approach` / `resonance` flags, the
 /// Python keywords): the ends and the step in the front end's unit of the swept quantity (one
@@ -14,7 +15,9 @@ use crate::params::Params;
 /// default range; [`approach_request`] and
 /// [`resonance_request`] turn it into a
 /// [`SteppedSpec`].
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[serde(default, deny_unknown_fields)]
 pub struct CurveRequest {
     /// First end of the swept quantity (front-end unit).
     pub from: Option<f64>,
@@ -28,6 +31,21 @@ pub struct CurveRequest {
     pub branches: bool,
     /// Tolerance of the adaptive integrator, in (0, 1e-3).
     pub tolerance: f64,
+}
+
+impl Default for CurveRequest {
+    /// The defaults of `afmdyn approach` / `resonance` and the Python functions: the command's
+    /// range, [`DEFAULT_CURVE_POINTS`] values, branches continued, [`DEFAULT_TOLERANCE`].
+    fn default() -> Self {
+        CurveRequest {
+            from: None,
+            to: None,
+            step: None,
+            points: None,
+            branches: true,
+            tolerance: DEFAULT_TOLERANCE,
+        }
+    }
 }
 
 impl CurveRequest {

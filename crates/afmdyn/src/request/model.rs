@@ -231,6 +231,7 @@ pub fn parameter(key: &str) -> Option<&'static ParamInfo> {
 /// `alpha1` … `alpha6` are accepted as aliases; unknown keys are refused (this is also the
 /// schema of a `--config FILE.toml`).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct ModelSpec {
     /// N.
