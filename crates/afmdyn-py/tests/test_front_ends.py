@@ -37,7 +37,15 @@ def _doc(result: Any) -> Dict[str, Any]:
 
 
 # (name, Python call, command line arguments): the same request through both front ends
+def _units(path: str) -> Dict[str, Any]:
+    """``afmdyn.probe`` as the document of ``afmdyn units --probe``."""
+    p = afmdyn.probe(path)
+    return {"params": p["params"].to_dict(), "si": p["si"]}
+
+
 SAME = [
+    ("units of a probe", lambda: _units(PM), ["units", "--probe", PM]),
+    ("units of a beam probe", lambda: _units(BEAM), ["units", "--probe", BEAM]),
     ("modes with a probe", lambda: afmdyn.modes(probe=PM), ["modes", "--probe", PM]),
     (
         "orbit with a probe and z_c",
