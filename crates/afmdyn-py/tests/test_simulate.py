@@ -130,7 +130,7 @@ def test_tau_end_initial_state_and_integrators(cli, tmp_path):
         ({"samples_per_period": 0}, ValueError, "samples_per_period"),
         ({"samples_per_period": 100_001}, ValueError, "samples_per_period"),
         ({"integrator": "euler"}, ValueError, "integrator 'euler'"),
-        ({"integrator": "rk4", "steps_per_period": 0}, ValueError, "steps per period"),
+        ({"integrator": "rk4", "steps_per_period": 0}, ValueError, "steps_per_period = 0"),
         ({"integrator": "adaptive", "tolerance": 2.0}, ValueError, "tolerance"),
         ({"initial": [0.1, 0.2]}, ValueError, "initial.*expected 6 values, got 2"),
         ({"initial": [[0.1] * 6]}, ValueError, "1-D"),

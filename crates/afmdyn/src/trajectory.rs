@@ -139,18 +139,18 @@ pub struct Trajectory {
 /// # Errors
 /// [`SimError`] for negative or non-finite lengths, or a failure of the integrator.
 pub fn record(integ: &mut dyn Integrator, spec: &RecordSpec) -> Result<Trajectory, SimError> {
-    finite("transient periods", spec.transient_periods)?;
-    finite("record length", spec.record_tau)?;
+    finite("transient_periods", spec.transient_periods)?;
+    finite("record_tau", spec.record_tau)?;
     if spec.transient_periods < 0.0 {
         return Err(SimError::out_of_range(
-            "transient periods",
+            "transient_periods",
             spec.transient_periods,
             "must be >= 0",
         ));
     }
     if spec.record_tau < 0.0 {
         return Err(SimError::out_of_range(
-            "periods",
+            "record_tau",
             spec.record_tau,
             "must be >= 0",
         ));

@@ -353,14 +353,14 @@ fn bad_run_lengths_are_rejected() {
     assert!(matches!(
         record(it.as_mut(), &spec(0.0, -1.0)),
         Err(SimError::OutOfRange {
-            name: "periods",
+            name: "record_tau",
             ..
         })
     ));
     assert!(matches!(
         record(it.as_mut(), &spec(-1.0, 1.0)),
         Err(SimError::OutOfRange {
-            name: "transient periods",
+            name: "transient_periods",
             ..
         })
     ));

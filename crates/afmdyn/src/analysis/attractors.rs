@@ -89,7 +89,7 @@ pub fn find_attractors(spec: &AttractorSpec) -> Result<AttractorReport, SimError
     }
     if !(spec.cluster_tol.is_finite() && spec.cluster_tol > 0.0) {
         return Err(SimError::out_of_range(
-            "cluster tolerance",
+            "cluster_tol",
             spec.cluster_tol,
             "must be finite and > 0",
         ));

@@ -323,7 +323,7 @@ fn check_options(opts: &SteadyOptions) -> Result<(), SimError> {
     }
     if opts.max_period == 0 || opts.max_period > MAX_PERIOD {
         return Err(SimError::out_of_range(
-            "max period",
+            "max_period",
             opts.max_period,
             "must be in 1..=64",
         ));

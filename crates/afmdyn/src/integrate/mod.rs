@@ -595,7 +595,7 @@ pub fn build_exact(
 fn check_steps_per_period(steps: usize) -> Result<(), SimError> {
     if steps == 0 || steps > 10_000_000 {
         return Err(SimError::out_of_range(
-            "steps per period",
+            "steps_per_period",
             steps,
             "must be in 1..=10000000",
         ));
