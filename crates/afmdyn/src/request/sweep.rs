@@ -18,7 +18,8 @@ use serde_json::{json, Value};
 pub struct RecordColumn {
     /// Name, as in the CSV header.
     pub name: &'static str,
-    /// Unit (`g0`: the gap g0; `text`: not a number; `code`: see the meaning).
+    /// Unit (`g0`: the gap g0; `τ`: dimensionless time; `text`: not a number; `code`: see the
+    /// meaning).
     pub unit: &'static str,
     /// Meaning.
     pub meaning: &'static str,
