@@ -477,10 +477,20 @@ fn resume_refuses_a_run_made_with_other_arguments() {
     for (extra, needle) in [
         (
             &["--resume", "--steps", "400"][..],
-            "steps = 12 there, 400 here",
+            "--resume: steps = 12 in the interrupted run, 400 now;",
         ),
-        (&["--resume", "--alpha4", "30"][..], "alpha4"),
-        (&["--resume", "--starts", "1"][..], "starts"),
+        (
+            &["--resume", "--alpha4", "30"][..],
+            "--resume: alpha4 = 20.0 in the interrupted run, 30.0 now;",
+        ),
+        (
+            &["--resume", "--starts", "1"][..],
+            "--resume: starts = 0 in the interrupted run, 1 now;",
+        ),
+        (
+            &["--resume", "--max-periods", "200"][..],
+            "--resume: max-periods = 300 in the interrupted run, 200 now;",
+        ),
     ] {
         let o = sweep(&out, extra, dir.path());
         let err = stderr(&o);
@@ -500,7 +510,7 @@ fn resume_refuses_a_run_made_with_other_arguments() {
     let o = sweep(&out, &["--resume", "--to", "3.0"], dir.path());
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(
-        stderr(&o).contains("to = 2.9 there, 3.0 here"),
+        stderr(&o).contains("to = 2.9 in the interrupted run, 3.0 now"),
         "{}",
         stderr(&o)
     );

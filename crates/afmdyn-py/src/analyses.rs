@@ -9,12 +9,14 @@ use crate::errors::{probe_error, sim_error, value_error};
 use crate::params::PyParams;
 use crate::run::{run, run_abandonable, Job, Stop};
 use afmdyn::analysis::attractors::find_attractors;
-use afmdyn::analysis::bifurcation::{run_sweep_cancellable, Branch, Resume, SweepPoint};
+use afmdyn::analysis::bifurcation::{SweepPoint, SweepSpec};
 use afmdyn::analysis::continuation::BranchEvent;
 use afmdyn::analysis::spectrum::{amplitude_spectrum, SPECTRUM_SAMPLES};
 use afmdyn::analysis::steady::SteadyState;
 use afmdyn::eigen::spectrum;
 use afmdyn::integrate::{build, IntegratorOptions};
+use afmdyn::request::checkpoint::{self, Checkpoint, CheckpointError};
+use afmdyn::request::{fingerprint, FileCheckpoint, MemoryCheckpoint, SweepRecord};
 use afmdyn::request::{
     AttractorsRequest, BifurcationRequest, ContinuationRequest, ConvergeRequest, IntegratorRequest,
     LyapunovRequest, ObserveRequest, OrbitRequest, SeriesStore, SimulateRequest, StartRequest,
@@ -27,7 +29,6 @@ use numpy::Complex64;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use std::sync::atomic::Ordering;
-use std::sync::Mutex;
 
 type Dict<'py> = Bound<'py, PyDict>;
 
@@ -352,20 +353,53 @@ pub fn converge<'py>(
     Ok(out.finish())
 }
 
-fn branch_order(b: Branch) -> (u8, u32) {
-    match b {
-        Branch::Forward => (0, 0),
-        Branch::Backward => (1, 0),
-        Branch::Start(k) => (2, k),
+/// A checkpoint error as Python sees it: a store of another request (or of none) is a
+/// `ValueError` naming the field, a file that cannot be read or written an `OSError`.
+fn checkpoint_error(e: CheckpointError) -> PyErr {
+    match e {
+        CheckpointError::Io { .. } => pyo3::exceptions::PyOSError::new_err(e.to_string()),
+        CheckpointError::Mismatch { .. } => value_error(format!(
+            "resume: {e}; call with the same arguments, or with resume=False to start over"
+        )),
+        _ => value_error(format!("resume: {e}")),
     }
 }
 
+/// Compute what `store` leaves of `spec` (all of it without `resume`) and finish it, unless
+/// cancelled; `job` counts the points done.
+fn sweep_into<C: Checkpoint>(
+    store: &mut C,
+    request: &BifurcationRequest,
+    spec: &SweepSpec,
+    resume: bool,
+    job: &Job,
+) -> Result<(), CheckpointError> {
+    let fp = fingerprint(request, spec);
+    let Some(left) = checkpoint::open(store, &fp, resume)? else {
+        job.done
+            .store(checkpoint::point_count(spec), Ordering::Relaxed);
+        return Ok(()); // finished before
+    };
+    job.done.store(left.done.len(), Ordering::Relaxed);
+    let each = |_: &SweepPoint| {
+        job.done.fetch_add(1, Ordering::Relaxed);
+    };
+    checkpoint::run(spec, &left, store, &job.cancel, &each)?;
+    if job.cancel.load(Ordering::Relaxed) {
+        return Ok(()); // interrupted: the store keeps what is done, for a resume
+    }
+    store.finish(&fp)
+}
+
 /// A bifurcation diagram: the steady state at each parameter value, one row per section point
-/// (the command line's `bifurcation.csv`, sorted by branch then index).
+/// in the command line's order (`bifurcation.csv`: by value index, then forward, backward,
+/// start 0, 1, …). With `store`, the sweep is checkpointed in that directory (the command
+/// line's `--out` layout) and `resume` continues it.
 #[pyfunction]
 #[pyo3(signature = (params, param="omega", values=None, from_=1.0, to=5.0, steps=400, starts=0,
     seed=1, continuation=true, threads=None, tol=1e-8, max_periods=1500, max_period=64,
-    integrator=None, steps_per_period=None, tolerance=1e-12, progress=None))]
+    integrator=None, steps_per_period=None, tolerance=1e-12, progress=None, store=None,
+    resume=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn bifurcation<'py>(
     py: Python<'py>,
@@ -386,9 +420,11 @@ pub fn bifurcation<'py>(
     steps_per_period: Option<usize>,
     tolerance: f64,
     progress: Option<Bound<'py, PyAny>>,
+    store: Option<std::path::PathBuf>,
+    resume: bool,
 ) -> PyResult<Dict<'py>> {
     let param: SweepParam = param.parse().map_err(value_error)?;
-    let spec = BifurcationRequest {
+    let request = BifurcationRequest {
         param,
         values,
         from: from_,
@@ -400,43 +436,46 @@ pub fn bifurcation<'py>(
         threads,
         steady: steady(tol, max_periods, max_period),
         integrator: integrator_request(integrator, steps_per_period, tolerance)?,
+    };
+    let spec = request.spec(&params.inner).map_err(sim_error)?;
+    if resume && store.is_none() {
+        return Err(value_error(
+            "resume=True needs store= (the directory of the interrupted sweep)",
+        ));
     }
-    .spec(&params.inner)
-    .map_err(sim_error)?;
-    let total = spec.values.len() * (usize::from(spec.continuation) * 2 + spec.starts as usize);
+    let total = checkpoint::point_count(&spec);
     let job = Job::default();
     let worker_job = job.clone();
     let worker_spec = spec.clone();
-    let points = run(
+    let records = run(
         py,
         &job,
         Some(total),
         progress.as_ref(),
         Stop::Cancellable,
-        move || -> Result<Vec<SweepPoint>, String> {
+        move || -> PyResult<Vec<SweepRecord>> {
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(threads.unwrap_or(0))
                 .build()
-                .map_err(|e| e.to_string())?;
-            let found = Mutex::new(Vec::with_capacity(total));
-            let sink = |pt: SweepPoint| {
-                found.lock().expect("points").push(pt);
-                worker_job.done.fetch_add(1, Ordering::Relaxed);
-            };
-            pool.install(|| {
-                run_sweep_cancellable(&worker_spec, &Resume::default(), &sink, &worker_job.cancel)
-            });
-            Ok(found.into_inner().expect("points"))
+                .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string()))?;
+            let (spec, job) = (&worker_spec, &worker_job);
+            pool.install(|| match store {
+                Some(dir) => {
+                    let mut s = FileCheckpoint::new(&dir)?;
+                    sweep_into(&mut s, &request, spec, resume, job)?;
+                    s.records()
+                }
+                None => {
+                    let mut s = MemoryCheckpoint::default();
+                    sweep_into(&mut s, &request, spec, false, job)?;
+                    Ok(s.into_records())
+                }
+            })
+            .map_err(checkpoint_error)
         },
-    )?
-    .map_err(pyo3::exceptions::PyRuntimeError::new_err)?;
-    let mut points = points;
-    points.sort_by_key(|pt| (branch_order(pt.branch), pt.index));
+    )??;
     let n = spec.base.modes;
-    let rows: usize = points
-        .iter()
-        .map(|pt| pt.result.as_ref().map_or(1, |s| s.poincare.len()))
-        .sum();
+    let rows = records.len();
     let mut value = Vec::with_capacity(rows);
     let mut index = Vec::with_capacity(rows);
     let mut branch = Vec::with_capacity(rows);
@@ -448,57 +487,30 @@ pub fn bifurcation<'py>(
     let mut transient = Vec::with_capacity(rows);
     let mut message = Vec::with_capacity(rows);
     let mut state = vec![Vec::with_capacity(rows); 2 * n];
-    for pt in &points {
-        match &pt.result {
-            Err(msg) => {
-                value.push(pt.value);
-                index.push(pt.index as i64);
-                branch.push(pt.branch.to_string());
-                status.push("error");
-                period.push(-2i64);
-                k.push(0i64);
-                n_points.push(1i64);
-                for c in cols.iter_mut() {
-                    c.push(f64::NAN);
-                }
-                transient.push(-1i64);
-                message.push(msg.clone());
-                for c in state.iter_mut() {
-                    c.push(f64::NAN);
-                }
-            }
-            Ok(s) => {
-                let (st, per) = match s.period() {
-                    Some(m) => ("periodic", m as i64),
-                    None => ("nonperiodic", -1),
-                };
-                for (i, q) in s.poincare.iter().enumerate() {
-                    value.push(pt.value);
-                    index.push(pt.index as i64);
-                    branch.push(pt.branch.to_string());
-                    status.push(st);
-                    period.push(per);
-                    k.push(i as i64);
-                    n_points.push(s.poincare.len() as i64);
-                    for (c, v) in cols.iter_mut().zip([
-                        q.tau,
-                        q.v_t,
-                        q.w_tip,
-                        s.stats.x_max,
-                        s.stats.v_t_min,
-                        s.stats.contact_fraction,
-                        s.stats.contacts_per_period,
-                    ]) {
-                        c.push(v);
-                    }
-                    transient.push(s.transient_periods as i64);
-                    message.push(String::new());
-                    for (c, v) in state.iter_mut().zip(q.state.iter()) {
-                        c.push(*v);
-                    }
-                }
-            }
+    for r in records {
+        value.push(r.value);
+        index.push(r.index as i64);
+        branch.push(r.branch.to_string());
+        status.push(r.status.name());
+        period.push(r.status.code());
+        k.push(r.point as i64);
+        n_points.push(r.points as i64);
+        for (c, v) in cols.iter_mut().zip([
+            r.tau,
+            r.v_t,
+            r.w_tip,
+            r.x_max,
+            r.v_t_min,
+            r.contact_fraction,
+            r.contacts_per_period,
+        ]) {
+            c.push(v);
         }
+        transient.push(r.transient_periods.map_or(-1, |t| t as i64));
+        for (j, c) in state.iter_mut().enumerate() {
+            c.push(r.state.get(j).copied().unwrap_or(f64::NAN));
+        }
+        message.push(r.message);
     }
     let out = Out::new(py);
     out.set("param", param.name())?;

@@ -1,9 +1,11 @@
 """bifurcation(): the long-format dataset equals the command line's bifurcation.csv row for
-row; the tidy DataFrame; progress; Ctrl-C; errors."""
+row, in its order; the tidy DataFrame; progress; Ctrl-C; a store resumed across front ends;
+errors."""
 
 from __future__ import annotations
 
 import time
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -18,23 +20,15 @@ def _reference(cli, out, *extra):
     args = "bifurcation --from 2.5 --to 3.3 --steps 9 --starts 1 --seed 3"
     run = cli(*args.split(), "--out", out, *extra)
     assert run.returncode == 0, run.stderr
-    ref = pd.read_csv(out / "bifurcation.csv", keep_default_na=False, na_values=[""])
-    # the CLI writes points as they finish; the Python result is sorted by branch, then index
-    order = ref.branch.map(
-        lambda b: {"forward": 0, "backward": 1}.get(
-            b, 2 + int(b.split("-")[-1]) if b.startswith("start-") else 9
-        )
-    )
-    return (
-        ref.assign(_o=order)
-        .sort_values(["_o", "index", "point"], kind="stable")
-        .reset_index(drop=True)
-    )
+    return _read(out)
 
 
-def test_rows_equal_the_command_lines_csv(cli, tmp_path):
-    ref = _reference(cli, tmp_path)
-    ds = afmdyn.bifurcation(**ARGS)
+def _read(out: Path) -> pd.DataFrame:
+    return pd.read_csv(out / "bifurcation.csv", keep_default_na=False, na_values=[""])
+
+
+def _assert_rows_equal(ds, ref):
+    """The dataset holds the CSV's rows in the CSV's order."""
     assert ds.sizes["point"] == len(ref)
     np.testing.assert_array_equal(ds.value.values, ref.value.values)
     np.testing.assert_array_equal(ds["index"].values, ref["index"].values)
@@ -60,6 +54,16 @@ def test_rows_equal_the_command_lines_csv(cli, tmp_path):
     for j in range(n):
         np.testing.assert_array_equal(ds[f"a_{j + 1}"].values, state[:, j])
         np.testing.assert_array_equal(ds[f"a_dot_{j + 1}"].values, state[:, n + j])
+
+
+def test_rows_equal_the_command_lines_csv_in_its_order(cli, tmp_path):
+    ref = _reference(cli, tmp_path)
+    ds = afmdyn.bifurcation(**ARGS)
+    _assert_rows_equal(ds, ref)
+    # one order for both front ends: by value index, then forward, backward, start k, then k
+    rank = {"forward": 0, "backward": 1, "start-0": 2}
+    keys = list(zip(ds["index"].values, [rank[b] for b in ds.branch.values], ds.k.values))
+    assert keys == sorted(keys)
     # 9 values × (forward, backward, one random start), every one reached
     keys = set(zip(ds["index"].values.tolist(), ds.branch.values.tolist()))
     assert len(keys) == 27
@@ -96,7 +100,7 @@ def test_other_parameters_and_explicit_values(cli, tmp_path):
         tmp_path,
     )
     assert run.returncode == 0, run.stderr
-    ref = pd.read_csv(tmp_path / "bifurcation.csv").sort_values(["index", "point"])
+    ref = pd.read_csv(tmp_path / "bifurcation.csv")
     np.testing.assert_array_equal(ds.w_tip.values, ref.w_tip.values)
 
 
@@ -171,3 +175,104 @@ def test_threads_option():
 def test_errors(kwargs, exc, needle):
     with pytest.raises(exc, match=needle):
         afmdyn.bifurcation(**kwargs)
+
+
+def _killed(cli, out, after=10):
+    """The command line's sweep of ARGS in `out`, killed after `after` points."""
+    args = "bifurcation --from 2.5 --to 3.3 --steps 9 --starts 1 --seed 3"
+    run = cli(*args.split(), "--out", out, "--abort-after", after)
+    assert run.returncode != 0, "killed"
+    assert (out / ".bifurcation.partial.csv").exists() and not (out / "bifurcation.csv").exists()
+
+
+def test_resume_of_a_store_killed_on_the_command_line(cli, tmp_path):
+    ref = _reference(cli, tmp_path / "full")
+    store = tmp_path / "cut"
+    _killed(cli, store)
+    ds = afmdyn.bifurcation(**ARGS, store=store, resume=True)
+    _assert_rows_equal(ds, ref)
+    for name in ["bifurcation.csv", ".bifurcation.run.json"]:
+        assert (store / name).read_bytes() == (tmp_path / "full" / name).read_bytes(), name
+    assert not (store / ".bifurcation.partial.csv").exists()
+    # a finished store is read back
+    _assert_rows_equal(afmdyn.bifurcation(**ARGS, store=store, resume=True), ref)
+    # and the command line resumes a Python store
+    run = cli(
+        *"bifurcation --from 2.5 --to 3.3 --steps 9 --starts 1 --seed 3 --resume --out".split(),
+        store,
+    )
+    assert run.returncode == 0, run.stderr
+    assert _read(store).equals(ref)
+
+
+def _mark(path: Path, marker: str) -> set:
+    """Set `w_tip` of every row of a rows file to `marker`; the (index, branch) marked."""
+    lines = path.read_text().split("\n")
+    marked = set()
+    for i, line in enumerate(lines[1:], start=1):
+        cells = line.split(",")
+        if len(cells) == 18:
+            cells[10] = marker
+            marked.add((int(cells[2]), cells[3]))
+            lines[i] = ",".join(cells)
+    path.write_text("\n".join(lines))
+    return marked
+
+
+def test_resume_skips_exactly_the_points_written(cli, tmp_path):
+    ref = _reference(cli, tmp_path / "full")
+    store = tmp_path / "cut"
+    _killed(cli, store, after=12)
+    # rows of the stored points read back with a mark: a point computed again loses it
+    stored = _mark(store / ".bifurcation.partial.csv", "9.5")
+    assert len(stored) >= 12
+    ds = afmdyn.bifurcation(**ARGS, store=store, resume=True)
+    keys = list(zip(ds["index"].values.tolist(), ds.branch.values.tolist()))
+    marked = ds.w_tip.values == 9.5
+    assert {k for k, m in zip(keys, marked) if m} == stored
+    assert not any(k in stored for k, m in zip(keys, marked) if not m)
+    np.testing.assert_array_equal(ds.w_tip.values[~marked], ref.w_tip.values[~marked])
+    np.testing.assert_array_equal(ds.x_max.values, ref.x_max.values)
+    # a finished store is read back, not computed
+    _mark(store / "bifurcation.csv", "8.5")
+    again = afmdyn.bifurcation(**ARGS, store=store, resume=True)
+    assert (again.w_tip.values == 8.5).all()
+
+
+def test_resume_with_another_request_is_refused_naming_the_field(cli, tmp_path):
+    _killed(cli, tmp_path)
+    partial = (tmp_path / ".bifurcation.partial.csv").read_bytes()
+    for kwargs, needle in [
+        ({"steps": 10}, "steps = 9 in the interrupted run, 10 now"),
+        ({"seed": 4}, "seed = 3 in the interrupted run, 4 now"),
+        ({"alpha4": 30.0}, "alpha4 = 20.0 in the interrupted run, 30.0 now"),
+        ({"values": [2.5, 2.6]}, "from = 2.5 in the interrupted run, absent now"),
+    ]:
+        with pytest.raises(ValueError, match=needle):
+            afmdyn.bifurcation(**{**ARGS, **kwargs}, store=tmp_path, resume=True)
+        assert (tmp_path / ".bifurcation.partial.csv").read_bytes() == partial, kwargs
+    with pytest.raises(ValueError, match="resume=True needs store="):
+        afmdyn.bifurcation(**ARGS, resume=True)
+    # without resume the store starts over
+    ds = afmdyn.bifurcation(**{**ARGS, "steps": 3}, store=tmp_path)
+    _assert_rows_equal(ds, _read(tmp_path))
+
+
+def test_a_python_sweep_stopped_early_resumes_from_its_store(tmp_path):
+    kw = dict(from_=2.0, to=3.0, steps=300)
+
+    def stop(done, total):
+        if done > 0:
+            raise RuntimeError("enough")
+
+    with pytest.raises(RuntimeError, match="enough"):
+        afmdyn.bifurcation(**kw, store=tmp_path, progress=stop)
+    assert (tmp_path / ".bifurcation.partial.csv").exists(), "kept for a resume"
+    assert not (tmp_path / "bifurcation.csv").exists(), "not finished"
+    stored = _mark(tmp_path / ".bifurcation.partial.csv", "9.5")
+    ds = afmdyn.bifurcation(**kw, store=tmp_path, resume=True)
+    assert (ds.w_tip.values == 9.5).sum() >= len(stored) > 0, "not computed again"
+    ds["w_tip"] = ds.w_tip.where(ds.w_tip != 9.5, afmdyn.bifurcation(**kw).w_tip)
+    ref = afmdyn.bifurcation(**kw)
+    for col in ["value", "index", "branch", "status", "k", "w_tip", "x_max", "a_1"]:
+        np.testing.assert_array_equal(ds[col].values, ref[col].values, err_msg=col)

@@ -168,6 +168,8 @@ def bifurcation(
     steps_per_period: Optional[int] = None,
     tolerance: float = 1e-12,
     progress: Optional[ProgressCallback] = None,
+    store: Optional[str] = None,
+    resume: bool = False,
 ) -> Dict[str, Any]: ...
 def attractors(
     params: Params,

@@ -414,11 +414,21 @@ def bifurcation(
     steps_per_period: Optional[int] = None,
     tolerance: float = 1e-12,
     progress: ProgressArg = None,
+    store: Union[str, "os.PathLike[str]", None] = None,
+    resume: bool = False,
     **model: Unpack[Model],
 ) -> xr.Dataset:
     """Bifurcation diagram (paper Fig. 5, ``afmdyn bifurcation``): the steady state at each
     value of ``param`` by forward and backward continuation and ``starts`` random starts, in
     parallel (``threads`` workers, default all cores). Ctrl-C stops it within one point.
+
+    With ``store``, each finished point is also written to that directory (created if needed;
+    the layout of ``afmdyn bifurcation --out DIR``: ``bifurcation.csv`` when finished, the
+    ledger ``.bifurcation.run.json`` and the partial rows of an unfinished sweep), and
+    ``resume=True`` continues the sweep stored there, computing only the points not yet
+    written (``--resume``): an interrupted sweep, from Python or the command line, resumes;
+    a finished one is read back without computing anything. Without ``resume`` the store is
+    started over.
 
     Args:
         param: ``"omega"`` or ``"alpha1"``…``"alpha6"`` (or the descriptive names).
@@ -426,10 +436,18 @@ def bifurcation(
         values: explicit values.
         starts, seed: random initial states per value; continuation: forward/backward chains.
         tol, max_periods, max_period: steady-state detection (as ``--tol`` etc.).
+        store: directory checkpointing the sweep; resume: continue the sweep stored there.
+
+    Raises:
+        ValueError: ``resume=True`` on a store made by another request (the message names the
+            first field that differs and both values, e.g. ``steps = 60 in the interrupted
+            run, 30 now``), on a store holding rows without a ledger, or without ``store``.
+        OSError: the store cannot be read or written.
 
     Returns:
-        ``xarray.Dataset`` in long format, dim ``point`` (one row per section point, as the
-        command line's ``bifurcation.csv``, sorted by branch then index): coordinates
+        ``xarray.Dataset`` in long format, dim ``point`` (one row per section point, in the
+        order of the command line's ``bifurcation.csv``: by value index, then ``forward``,
+        ``backward``, ``start-0``, ``start-1``, …, then ``k``): coordinates
         ``value``, ``index``, ``branch`` (``"forward"``, ``"backward"``, ``"start-k"``);
         ``status`` (``"periodic"``, ``"nonperiodic"``, ``"error"``), ``period`` (−1
         nonperiodic, −2 error), ``k`` (position in the cycle), ``n_points``, ``tau``,
@@ -460,6 +478,8 @@ def bifurcation(
         integrator=integrator,
         steps_per_period=steps_per_period,
         tolerance=tolerance,
+        store=None if store is None else os.fspath(store),
+        resume=resume,
     )
     n = p.modes
     data: Dict[str, Any] = {

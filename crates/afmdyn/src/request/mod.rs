@@ -10,6 +10,10 @@
 //!   where the analysis is one library call.
 //! - [`curves`]: the stepped curves (`approach`, `resonance`).
 //! - [`limits`]: the limits beyond the model's ranges, each with its reason.
+//! - [`sweep`]: the records of a bifurcation sweep (columns, codes, the one row order) and the
+//!   fingerprint of its request.
+//! - [`checkpoint`]: resumable sweeps: the [`Checkpoint`] a store implements, in memory or
+//!   (feature `files`) in a directory ([`checkpoint_file`]).
 //!
 //! A front end maps its spelling of a name to a request field and nothing else; errors name
 //! the library's parameter (`samples_per_period`) and a front end respells them
@@ -18,14 +22,22 @@
 //! [`Params`]: crate::Params
 
 pub mod analyses;
+pub mod checkpoint;
+#[cfg(feature = "files")]
+pub mod checkpoint_file;
 pub mod curves;
 pub mod limits;
 pub mod model;
+pub mod sweep;
 
 pub use analyses::{
     AttractorsRequest, BifurcationRequest, ContinuationRequest, ConvergeRequest, IntegratorRequest,
     LyapunovRequest, ObserveRequest, OrbitRequest, SeriesStore, SimulateRequest, StartRequest,
     SteadyRequest,
 };
+pub use checkpoint::{Checkpoint, CheckpointError, MemoryCheckpoint};
+#[cfg(feature = "files")]
+pub use checkpoint_file::FileCheckpoint;
 pub use curves::{approach_request, resonance_request, CurveRequest};
 pub use model::{parameter, ModelSpec, ParamInfo, MODEL_PARAMETERS};
+pub use sweep::{fingerprint, SweepRecord};

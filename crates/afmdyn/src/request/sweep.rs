@@ -1,0 +1,491 @@
+//! The records of a bifurcation sweep, the same for every front end: the rows of a
+//! [`SweepPoint`] with their columns (names, units, meaning), the status and branch codes, the
+//! one row order, and the fingerprint of a request that a resumed sweep must match.
+//!
+//! A point gives one row per Poincaré point of its steady state (one row when it failed). The
+//! rows of a finished sweep are ordered by value index, then branch (forward, backward,
+//! start 0, 1, …), then Poincaré point ([`order_key`]), whatever order the workers finished in.
+//! The command line writes them as `bifurcation.csv` ([`SweepRecord::csv_line`], [`HEADER`]);
+//! Python returns them as columns.
+
+use super::analyses::BifurcationRequest;
+use crate::analysis::bifurcation::{Branch, SweepPoint, SweepSpec};
+use crate::params::SweepParam;
+use serde_json::{json, Value};
+
+/// A column of the sweep's records: name (as in the CSV header), unit and meaning.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct RecordColumn {
+    /// Name, as in the CSV header.
+    pub name: &'static str,
+    /// Unit (`g0`: the gap g0; `τ`: dimensionless time; `text`: not a number; `code`: see the
+    /// meaning).
+    pub unit: &'static str,
+    /// Meaning.
+    pub meaning: &'static str,
+}
+
+const fn col(name: &'static str, unit: &'static str, meaning: &'static str) -> RecordColumn {
+    RecordColumn {
+        name,
+        unit,
+        meaning,
+    }
+}
+
+/// The 18 columns of a record, in the order of `bifurcation.csv`.
+pub const COLUMNS: [RecordColumn; 18] = [
+    col(
+        "param",
+        "text",
+        "name of the swept parameter (omega, alpha1 … alpha6)",
+    ),
+    col("value", "as the parameter", "value of the swept parameter"),
+    col(
+        "index",
+        "count",
+        "index of the value in the sweep (0-based)",
+    ),
+    col(
+        "branch",
+        "text",
+        "forward, backward or start-k (random start k)",
+    ),
+    col("status", "text", "periodic, nonperiodic or error"),
+    col(
+        "period",
+        "drive periods",
+        "period n of a periodic motion (empty otherwise)",
+    ),
+    col(
+        "point",
+        "count",
+        "index of the Poincaré point in the recorded cycle",
+    ),
+    col(
+        "points",
+        "count",
+        "Poincaré points of this sweep point (rows of its group)",
+    ),
+    col(
+        "tau",
+        "τ",
+        "time of the Poincaré point (a multiple of the drive period 2π/Ω)",
+    ),
+    col("v_t", "g0", "V_T at the Poincaré point (eq. 8)"),
+    col("w_tip", "g0", "tip deflection W(1,τ) at the Poincaré point"),
+    col(
+        "x_max",
+        "g0",
+        "largest tip deflection W(1,τ) over the recorded steady state",
+    ),
+    col(
+        "v_t_min",
+        "g0",
+        "smallest V_T over the recorded steady state (≤ 0: contact)",
+    ),
+    col("contact_fraction", "1", "fraction of the time in contact"),
+    col(
+        "contacts_per_period",
+        "1/period",
+        "contact entries per drive period",
+    ),
+    col(
+        "transient_periods",
+        "drive periods",
+        "length of the transient discarded",
+    ),
+    col("message", "text", "why the point failed (empty otherwise)"),
+    col(
+        "state",
+        "modal",
+        "state (a_1…a_N, ȧ_1…ȧ_N) at the Poincaré point, space-separated",
+    ),
+];
+
+/// The records as numbers (the command line's `bifurcation.npy`): the numeric columns of
+/// [`COLUMNS`] with the branch ([`branch_code`]) and the status ([`PointStatus::code`]) as codes.
+pub const NUMERIC_COLUMNS: [RecordColumn; 12] = [
+    COLUMNS[COL_VALUE],
+    COLUMNS[COL_INDEX],
+    col(
+        "branch",
+        "code",
+        "0 forward continuation, 1 backward, 2 + k random start k",
+    ),
+    col(
+        "period",
+        "drive periods",
+        "period n of a periodic motion; −1 nonperiodic; −2 failed point",
+    ),
+    COLUMNS[COL_POINT],
+    COLUMNS[COL_TAU],
+    COLUMNS[9],
+    COLUMNS[COL_W_TIP],
+    COLUMNS[COL_X_MAX],
+    COLUMNS[12],
+    COLUMNS[13],
+    COLUMNS[14],
+];
+
+/// The CSV header: the names of [`COLUMNS`].
+pub const HEADER: [&str; 18] = {
+    let mut h = [""; 18];
+    let mut i = 0;
+    while i < 18 {
+        h[i] = COLUMNS[i].name;
+        i += 1;
+    }
+    h
+};
+
+/// Position of `value` in [`COLUMNS`].
+pub const COL_VALUE: usize = 1;
+/// Position of `index`.
+pub const COL_INDEX: usize = 2;
+/// Position of `branch`.
+pub const COL_BRANCH: usize = 3;
+/// Position of `status`.
+pub const COL_STATUS: usize = 4;
+/// Position of `period`.
+pub const COL_PERIOD: usize = 5;
+/// Position of `point`.
+pub const COL_POINT: usize = 6;
+/// Position of `points`.
+pub const COL_POINTS: usize = 7;
+/// Position of `tau`.
+pub const COL_TAU: usize = 8;
+/// Position of `w_tip`.
+pub const COL_W_TIP: usize = 10;
+/// Position of `x_max`.
+pub const COL_X_MAX: usize = 11;
+/// Position of `state`.
+pub const COL_STATE: usize = 17;
+
+/// The numeric code of a branch: 0 forward, 1 backward, 2 + k random start k.
+pub fn branch_code(b: Branch) -> f64 {
+    match b {
+        Branch::Forward => 0.0,
+        Branch::Backward => 1.0,
+        Branch::Start(k) => 2.0 + f64::from(k),
+    }
+}
+
+/// How a point ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PointStatus {
+    /// A periodic motion of period n (drive periods).
+    Periodic(usize),
+    /// No period up to the largest searched.
+    Nonperiodic,
+    /// The point failed (its message says why).
+    Error,
+}
+
+impl PointStatus {
+    /// `periodic`, `nonperiodic` or `error` (the `status` column).
+    pub fn name(self) -> &'static str {
+        match self {
+            PointStatus::Periodic(_) => "periodic",
+            PointStatus::Nonperiodic => "nonperiodic",
+            PointStatus::Error => "error",
+        }
+    }
+
+    /// The numeric code: the period n, −1 nonperiodic, −2 failed.
+    pub fn code(self) -> i64 {
+        match self {
+            PointStatus::Periodic(n) => n as i64,
+            PointStatus::Nonperiodic => -1,
+            PointStatus::Error => -2,
+        }
+    }
+}
+
+/// The numeric code of the `status` and `period` cells of a CSV row: the period n, −1
+/// nonperiodic, −2 anything else; NaN for `periodic` without a readable period.
+pub fn status_code(status: &str, period: &str) -> f64 {
+    match status {
+        "periodic" => period.parse().unwrap_or(f64::NAN),
+        "nonperiodic" => -1.0,
+        _ => -2.0,
+    }
+}
+
+/// One row: one Poincaré point of a sweep point (or the one row of a failed point).
+/// Lengths in units of the gap g0, times in τ; the numbers of a failed point are NaN.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SweepRecord {
+    /// The swept parameter.
+    pub param: SweepParam,
+    /// Its value.
+    pub value: f64,
+    /// Index of the value in the sweep.
+    pub index: usize,
+    /// How the point was reached.
+    pub branch: Branch,
+    /// How it ended.
+    pub status: PointStatus,
+    /// Index of this Poincaré point in the recorded cycle (0 for a failed point).
+    pub point: usize,
+    /// Poincaré points of the sweep point (1 for a failed point).
+    pub points: usize,
+    /// τ of the Poincaré point.
+    pub tau: f64,
+    /// V_T at the Poincaré point.
+    pub v_t: f64,
+    /// W(1,τ) at the Poincaré point.
+    pub w_tip: f64,
+    /// Largest W(1,τ) over the recorded steady state.
+    pub x_max: f64,
+    /// Smallest V_T over the recorded steady state.
+    pub v_t_min: f64,
+    /// Fraction of the time in contact.
+    pub contact_fraction: f64,
+    /// Contact entries per drive period.
+    pub contacts_per_period: f64,
+    /// Transient discarded, in drive periods (`None` for a failed point).
+    pub transient_periods: Option<usize>,
+    /// Why the point failed, with newlines and commas replaced by spaces (empty otherwise).
+    pub message: String,
+    /// Modal state (length 2N) at the Poincaré point (empty for a failed point).
+    pub state: Vec<f64>,
+}
+
+/// The records of a point, one per Poincaré point (one for a failed point), in order.
+pub fn records(param: SweepParam, p: &SweepPoint) -> Vec<SweepRecord> {
+    let base = |status, point, points| SweepRecord {
+        param,
+        value: p.value,
+        index: p.index,
+        branch: p.branch,
+        status,
+        point,
+        points,
+        tau: f64::NAN,
+        v_t: f64::NAN,
+        w_tip: f64::NAN,
+        x_max: f64::NAN,
+        v_t_min: f64::NAN,
+        contact_fraction: f64::NAN,
+        contacts_per_period: f64::NAN,
+        transient_periods: None,
+        message: String::new(),
+        state: Vec::new(),
+    };
+    match &p.result {
+        Err(msg) => vec![SweepRecord {
+            message: msg.replace(['\n', ','], " "),
+            ..base(PointStatus::Error, 0, 1)
+        }],
+        Ok(s) => {
+            let status = s
+                .period()
+                .map_or(PointStatus::Nonperiodic, PointStatus::Periodic);
+            let n = s.poincare.len();
+            s.poincare
+                .iter()
+                .enumerate()
+                .map(|(i, q)| SweepRecord {
+                    tau: q.tau,
+                    v_t: q.v_t,
+                    w_tip: q.w_tip,
+                    x_max: s.stats.x_max,
+                    v_t_min: s.stats.v_t_min,
+                    contact_fraction: s.stats.contact_fraction,
+                    contacts_per_period: s.stats.contacts_per_period,
+                    transient_periods: Some(s.transient_periods),
+                    state: q.state.iter().copied().collect(),
+                    ..base(status, i, n)
+                })
+                .collect()
+        }
+    }
+}
+
+/// The position of a record in the one row order: (value index, branch, Poincaré point).
+pub fn order_key(r: &SweepRecord) -> (usize, Branch, usize) {
+    (r.index, r.branch, r.point)
+}
+
+impl SweepRecord {
+    /// The row as a CSV line of [`HEADER`]'s columns, without its newline (numbers in Rust's
+    /// shortest round-trip form, empty cells for what a failed point lacks).
+    pub fn csv_line(&self) -> String {
+        let num = |v: f64| {
+            if self.status == PointStatus::Error {
+                String::new()
+            } else {
+                format!("{v}")
+            }
+        };
+        let period = match self.status {
+            PointStatus::Periodic(n) => n.to_string(),
+            _ => String::new(),
+        };
+        let state: Vec<String> = self.state.iter().map(|v| format!("{v}")).collect();
+        [
+            self.param.name().to_string(),
+            format!("{}", self.value),
+            self.index.to_string(),
+            self.branch.to_string(),
+            self.status.name().to_string(),
+            period,
+            self.point.to_string(),
+            self.points.to_string(),
+            num(self.tau),
+            num(self.v_t),
+            num(self.w_tip),
+            num(self.x_max),
+            num(self.v_t_min),
+            num(self.contact_fraction),
+            num(self.contacts_per_period),
+            self.transient_periods
+                .map_or(String::new(), |t| t.to_string()),
+            self.message.clone(),
+            state.join(" "),
+        ]
+        .join(",")
+    }
+
+    /// Read a line written by [`SweepRecord::csv_line`].
+    ///
+    /// # Errors
+    /// A message naming the column that cannot be read.
+    pub fn parse_csv(line: &str) -> Result<SweepRecord, String> {
+        let c: Vec<&str> = line.split(',').collect();
+        if c.len() != HEADER.len() {
+            return Err(format!("{} cells, expected {}", c.len(), HEADER.len()));
+        }
+        let bad = |i: usize| format!("{} = '{}' cannot be read", HEADER[i], c[i]);
+        let int = |i: usize| c[i].parse::<usize>().map_err(|_| bad(i));
+        let num = |i: usize| match c[i] {
+            "" => Ok(f64::NAN),
+            s => s.parse::<f64>().map_err(|_| bad(i)),
+        };
+        let status = match (c[COL_STATUS], c[COL_PERIOD]) {
+            ("periodic", _) => PointStatus::Periodic(int(COL_PERIOD)?),
+            ("nonperiodic", _) => PointStatus::Nonperiodic,
+            ("error", _) => PointStatus::Error,
+            _ => return Err(bad(COL_STATUS)),
+        };
+        Ok(SweepRecord {
+            param: c[0].parse().map_err(|_| bad(0))?,
+            value: num(COL_VALUE)?,
+            index: int(COL_INDEX)?,
+            branch: c[COL_BRANCH].parse().map_err(|_| bad(COL_BRANCH))?,
+            status,
+            point: int(COL_POINT)?,
+            points: int(COL_POINTS)?,
+            tau: num(COL_TAU)?,
+            v_t: num(9)?,
+            w_tip: num(COL_W_TIP)?,
+            x_max: num(COL_X_MAX)?,
+            v_t_min: num(12)?,
+            contact_fraction: num(13)?,
+            contacts_per_period: num(14)?,
+            transient_periods: match c[15] {
+                "" => None,
+                _ => Some(int(15)?),
+            },
+            message: c[16].to_string(),
+            state: match c[COL_STATE] {
+                "" => Vec::new(),
+                s => s
+                    .split(' ')
+                    .map(|v| v.parse::<f64>().map_err(|_| bad(COL_STATE)))
+                    .collect::<Result<_, _>>()?,
+            },
+        })
+    }
+}
+
+/// The fingerprint of a sweep: everything that determines its rows (the library's version,
+/// the resolved parameters, the swept parameter and its values, every sweep option); a sweep
+/// is resumed only with the same fingerprint. The worker threads are not part of it.
+///
+/// The values are `from`, `to`, `steps`, or `values` when the request lists them.
+pub fn fingerprint(request: &BifurcationRequest, spec: &SweepSpec) -> Value {
+    let mut doc = json!({
+        "afmdyn": env!("CARGO_PKG_VERSION"),
+        "params": spec.base,
+        "param": spec.param.name(),
+        "continuation": spec.continuation,
+        "starts": spec.starts,
+        "seed": spec.seed,
+        "tol": spec.steady.tol,
+        "max_periods": spec.steady.max_periods,
+        "max_period": spec.steady.max_period,
+        "integrator": spec.integrator.kind,
+        "steps_per_period": spec.integrator.steps_per_period,
+        "tolerance": spec.integrator.tolerance,
+    });
+    if let Some(map) = doc.as_object_mut() {
+        match &request.values {
+            Some(v) => {
+                map.insert("values".into(), json!(v));
+            }
+            None => {
+                map.insert("from".into(), json!(request.from));
+                map.insert("to".into(), json!(request.to));
+                map.insert("steps".into(), json!(request.steps));
+            }
+        }
+    }
+    doc
+}
+
+/// The order in which [`first_difference`] compares a fingerprint's fields.
+const FIELD_ORDER: [&str; 16] = [
+    "afmdyn",
+    "params",
+    "param",
+    "from",
+    "to",
+    "steps",
+    "values",
+    "continuation",
+    "starts",
+    "seed",
+    "tol",
+    "max_periods",
+    "max_period",
+    "integrator",
+    "steps_per_period",
+    "tolerance",
+];
+
+/// The first field in which two fingerprints differ, with its value in each (`absent` where a
+/// field is missing): `("steps", "60", "30")`. A model parameter is named without its
+/// `params.` prefix (`alpha4`, `contact_law.kind`). `None` when they are equal.
+pub fn first_difference(then: &Value, now: &Value) -> Option<(String, String, String)> {
+    fn show(v: Option<&Value>) -> String {
+        match v {
+            None => "absent".into(),
+            Some(Value::String(s)) => s.clone(),
+            Some(v) => v.to_string(),
+        }
+    }
+    fn walk(path: &str, a: Option<&Value>, b: Option<&Value>) -> Option<(String, String, String)> {
+        if a == b {
+            return None;
+        }
+        if let (Some(Value::Object(x)), Some(Value::Object(y))) = (a, b) {
+            let mut keys: Vec<&String> = x.keys().chain(y.keys()).collect();
+            keys.sort_by_key(|k| {
+                let pos = FIELD_ORDER.iter().position(|f| f == k);
+                (pos.unwrap_or(usize::MAX), k.to_string())
+            });
+            keys.dedup();
+            return keys.into_iter().find_map(|k| {
+                let sub = match path {
+                    "" | "params" => k.clone(),
+                    p => format!("{p}.{k}"),
+                };
+                walk(&sub, x.get(k), y.get(k))
+            });
+        }
+        Some((path.to_string(), show(a), show(b)))
+    }
+    walk("", Some(then), Some(now))
+}
