@@ -276,3 +276,19 @@ def test_a_python_sweep_stopped_early_resumes_from_its_store(tmp_path):
     ref = afmdyn.bifurcation(**kw)
     for col in ["value", "index", "branch", "status", "k", "w_tip", "x_max", "a_1"]:
         np.testing.assert_array_equal(ds[col].values, ref[col].values, err_msg=col)
+
+
+def test_a_probe_sweep_equals_the_command_lines(cli, tmp_path):
+    """`probe=` and `z_c=` mean what `--probe` and `--z-c` mean: the point-mass DMT probe swept
+    in Ω around its resonance gives the command line's rows."""
+    probe = str(Path(__file__).resolve().parents[3] / "examples" / "probe-point-mass-dmt.toml")
+    run = cli(
+        "bifurcation", "--probe", probe, "--z-c", "8e-9", "--from", "0.99", "--to", "1.01",
+        "--steps", "3", "--max-periods", "300", "--out", tmp_path,
+    )
+    assert run.returncode == 0, run.stderr
+    ds = afmdyn.bifurcation(
+        probe=probe, z_c=8e-9, from_=0.99, to=1.01, steps=3, max_periods=300
+    )
+    assert ds.attrs["structure"] == "point-mass"
+    _assert_rows_equal(ds, _read(tmp_path))
