@@ -148,11 +148,20 @@ pub fn initial_state(
             got: z.len(),
         });
     }
-    let largest = z.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    if largest >= MAX_INITIAL_ENTRY || z.iter().any(|v| !v.is_finite()) {
+    // the first entry that is not finite, else the largest in magnitude
+    let worst = z
+        .iter()
+        .copied()
+        .find(|v| !v.is_finite())
+        .unwrap_or_else(|| z.iter().fold(0.0f64, |m, v| m.max(v.abs())));
+    if !worst.is_finite() || worst >= MAX_INITIAL_ENTRY {
         return Err(SimError::out_of_range(
             "initial",
-            format!("largest entry {largest:e}"),
+            if worst.is_finite() {
+                format!("largest entry {worst:e}")
+            } else {
+                format!("an entry {worst}")
+            },
             "every entry must be finite and below 1e11 (states of norm 1e12 count as diverged)",
         ));
     }
