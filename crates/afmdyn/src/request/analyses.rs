@@ -861,3 +861,7 @@ impl BifurcationRequest {
         Ok(spec)
     }
 }
+
+#[cfg(test)]
+#[path = "analyses_tests.rs"]
+mod tests;
