@@ -126,9 +126,37 @@ fn with_table_help(mut cmd: clap::Command) -> clap::Command {
     cmd
 }
 
+/// The arguments with every negative number joined to the flag before it (`--gap -5e-1` →
+/// `--gap=-5e-1`): clap's lexer takes `-5e-1` (a negative exponent) for a cluster of short
+/// flags. afmdyn has no positional arguments, so a number after a flag is always its value.
+fn joined_negative_numbers(
+    args: impl IntoIterator<Item = std::ffi::OsString>,
+) -> Vec<std::ffi::OsString> {
+    let mut out: Vec<std::ffi::OsString> = Vec::new();
+    for arg in args {
+        let number = arg
+            .to_str()
+            .is_some_and(|a| a.starts_with('-') && a.parse::<f64>().is_ok());
+        match out.last_mut() {
+            Some(flag)
+                if number
+                    && flag.to_str().is_some_and(|f| {
+                        f.starts_with("--") && f.len() > 2 && !f.contains('=')
+                    }) =>
+            {
+                flag.push("=");
+                flag.push(&arg);
+            }
+            _ => out.push(arg),
+        }
+    }
+    out
+}
+
 /// Parse the command line ([`Cli`] with [`with_table_help`]).
 fn parse() -> Result<Cli, clap::Error> {
-    let matches = with_table_help(Cli::command()).try_get_matches()?;
+    let matches = with_table_help(Cli::command())
+        .try_get_matches_from(joined_negative_numbers(std::env::args_os()))?;
     Cli::from_arg_matches(&matches)
 }
 

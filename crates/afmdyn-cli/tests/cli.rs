@@ -486,3 +486,17 @@ fn continue_writes_branch_csv_and_overlay_plot() {
     assert!(csv.lines().count() > 10);
     assert!(out.join("continuation.png").exists() && out.join("continuation.svg").exists());
 }
+
+/// A negative number with an exponent is a flag's value (clap's lexer alone read `-5e-1` as
+/// short flags: "unexpected argument '-5' found"), on every numeric flag alike.
+#[test]
+fn negative_numbers_with_exponents_are_values() {
+    let written = json(&afmdyn(&["orbit", "--json", "--gap", "-5e-1"]));
+    let plain = json(&afmdyn(&["orbit", "--json", "--gap=-0.5"]));
+    assert_eq!(written, plain);
+    assert_eq!(written["params"]["alpha5"], -0.5);
+    // a negative value where only positive ones are valid reaches the range check
+    bad_input(&["orbit", "--omega", "-1e-3"], "omega (drive frequency Ω) = -0.001");
+    // a boolean flag takes no value, negative or not
+    bad_input(&["orbit", "--json", "-1e-3"], "--json");
+}
