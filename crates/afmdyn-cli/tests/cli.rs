@@ -496,7 +496,10 @@ fn negative_numbers_with_exponents_are_values() {
     assert_eq!(written, plain);
     assert_eq!(written["params"]["alpha5"], -0.5);
     // a negative value where only positive ones are valid reaches the range check
-    bad_input(&["orbit", "--omega", "-1e-3"], "omega (drive frequency Ω) = -0.001");
+    bad_input(
+        &["orbit", "--omega", "-1e-3"],
+        "omega (drive frequency Ω) = -0.001",
+    );
     // a boolean flag takes no value, negative or not
     bad_input(&["orbit", "--json", "-1e-3"], "--json");
 }

@@ -498,6 +498,35 @@ fn impact_model(r: f64, modes: usize, gap: f64, omega: f64) -> CantileverModel {
     .unwrap()
 }
 
+/// An attractor of the impact law touches the sample: its contacts per period count the
+/// impacts (no region II is entered), as many as the observables' impacts per period and the
+/// orbit's switchings (1 per period for this period-1 orbit).
+#[test]
+fn impact_contacts_per_period_count_the_impacts() {
+    use afmdyn::analysis::observables::{observe_from, ObservableOptions};
+    let m = impact_model(0.5, 1, 0.05, 3.0);
+    let mut it = build(&m, IntegratorOptions::default(), 0.0, &m.rest()).unwrap();
+    let s = steady_state(it.as_mut(), &SteadyOptions::default()).unwrap();
+    let n = s.period().expect("a periodic orbit");
+    let o = observe_from(
+        &m,
+        IntegratorOptions::default(),
+        0.0,
+        s.end_state(),
+        &ObservableOptions {
+            periods: n,
+            harmonics: 2,
+        },
+    )
+    .unwrap();
+    assert!(o.impacts_per_period > 0.0);
+    assert_eq!(s.stats.contacts_per_period, o.impacts_per_period);
+    assert_eq!(
+        s.stats.contact_fraction, 0.0,
+        "no time is spent in region II"
+    );
+}
+
 /// N = 1 between impacts is m ẍ + c ẋ + k x = F_s sin Ωτ + F_c cos Ωτ: its closed-form solution
 /// from each post-impact state, the next impact by bisection on V_T, and Newton's law applied by
 /// hand, against the adaptive integrator for the first impacts.

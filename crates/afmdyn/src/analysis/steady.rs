@@ -7,6 +7,7 @@ use crate::integrate::exact::ExactBatch;
 use crate::integrate::{advance, advance_observed, Integrator, Observed, Observer, Step};
 use crate::model::BodyContactCheck;
 use crate::roots::extremum;
+use crate::system::EventKind;
 use nalgebra::DVector;
 use serde::Serialize;
 use std::collections::VecDeque;
@@ -72,7 +73,8 @@ pub struct OrbitStats {
     pub v_t_min: f64,
     /// Fraction of time in contact.
     pub contact_fraction: f64,
-    /// Contacts (entries into region II) per drive period.
+    /// Contacts per drive period: entries into region II, and impacts on a rigid sample (the
+    /// impact law's contacts, which leave the tip in free flight).
     pub contacts_per_period: f64,
     /// Whether a beam point other than the tip reached the substrate at a step end (the
     /// paper's Fig. 2f assumption is violated).
@@ -181,7 +183,8 @@ impl Observer for StatsObserver {
         if step.region == Region::Contact {
             self.contact_time += len;
         }
-        if matches!(&step.event, Some(e) if e.to == Region::Contact) {
+        if matches!(&step.event, Some(e) if e.to == Region::Contact || e.kind == EventKind::Impact)
+        {
             self.contacts += 1;
         }
         let body = self
