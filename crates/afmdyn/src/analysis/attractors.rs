@@ -35,6 +35,35 @@ pub struct AttractorSpec {
     pub integrator: IntegratorOptions,
 }
 
+/// Largest number of random initial states of a census (each is a steady-state search kept in
+/// memory with its Poincaré points).
+pub const MAX_ATTRACTOR_SAMPLES: usize = 100_000;
+
+impl AttractorSpec {
+    /// Check the census's options (the one place of their limits).
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming `samples` (1..=[`MAX_ATTRACTOR_SAMPLES`]) or
+    /// `cluster_tol` (finite, > 0), or a steady-state option ([`SteadyOptions::validate`]).
+    pub fn validate(&self) -> Result<(), SimError> {
+        if !(1..=MAX_ATTRACTOR_SAMPLES).contains(&self.samples) {
+            return Err(SimError::out_of_range(
+                "samples",
+                self.samples,
+                "must be in 1..=100000",
+            ));
+        }
+        if !(self.cluster_tol.is_finite() && self.cluster_tol > 0.0) {
+            return Err(SimError::out_of_range(
+                "cluster_tol",
+                self.cluster_tol,
+                "must be finite and > 0",
+            ));
+        }
+        self.steady.validate()
+    }
+}
+
 /// One attractor with its basin estimate.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Attractor {
@@ -84,16 +113,7 @@ pub fn same_attractor(a: &SteadyState, b: &SteadyState, tol: f64) -> bool {
 /// [`SimError`] for invalid parameters or options (individual failing starts are reported in
 /// [`AttractorReport::failures`]).
 pub fn find_attractors(spec: &AttractorSpec) -> Result<AttractorReport, SimError> {
-    if spec.samples == 0 {
-        return Err(SimError::out_of_range("samples", 0, "must be >= 1"));
-    }
-    if !(spec.cluster_tol.is_finite() && spec.cluster_tol > 0.0) {
-        return Err(SimError::out_of_range(
-            "cluster_tol",
-            spec.cluster_tol,
-            "must be finite and > 0",
-        ));
-    }
+    spec.validate()?;
     let model = CantileverModel::new(&spec.params)?;
     let results = steady_states_of_starts(&model, spec);
     let mut attractors: Vec<Attractor> = Vec::new();

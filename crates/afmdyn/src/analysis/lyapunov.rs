@@ -44,6 +44,23 @@ impl Default for LyapunovOptions {
     }
 }
 
+impl LyapunovOptions {
+    /// Check the options (the one place of their limits).
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming `blocks` unless periods ≥ blocks ≥ 2.
+    pub fn validate(&self) -> Result<(), SimError> {
+        if self.blocks < 2 || self.periods < self.blocks {
+            return Err(SimError::out_of_range(
+                "blocks",
+                format!("{} with periods = {}", self.blocks, self.periods),
+                "need periods >= blocks >= 2",
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// Verdict from the exponents and the 0–1 test.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
@@ -93,13 +110,7 @@ pub fn lyapunov_spectrum(
     z0: &DVector<f64>,
     opts: &LyapunovOptions,
 ) -> Result<LyapunovSpectrum, SimError> {
-    if opts.blocks < 2 || opts.periods < opts.blocks {
-        return Err(SimError::out_of_range(
-            "periods / blocks",
-            opts.periods,
-            "need periods >= blocks >= 2",
-        ));
-    }
+    opts.validate()?;
     let period = model.period();
     let dim = model.dim();
     let mut integ = build(model, opts.integrator, 0.0, z0)?;

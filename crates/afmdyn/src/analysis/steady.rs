@@ -316,22 +316,39 @@ impl ReturnHistory {
     }
 }
 
-fn check_options(opts: &SteadyOptions) -> Result<(), SimError> {
-    if !(opts.tol.is_finite() && opts.tol > 0.0) {
-        return Err(SimError::out_of_range(
-            "tolerance",
-            opts.tol,
-            "must be finite and > 0",
-        ));
+/// Largest transient cap of a steady-state search, in drive periods.
+pub const MAX_STEADY_PERIODS: usize = 10_000_000;
+
+impl SteadyOptions {
+    /// Check the options (the one place of their limits; the request layer calls it).
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming `tol` (finite, > 0), `max_period` (1..=64) or
+    /// `max_periods` (1..=[`MAX_STEADY_PERIODS`]).
+    pub fn validate(&self) -> Result<(), SimError> {
+        if !(self.tol.is_finite() && self.tol > 0.0) {
+            return Err(SimError::out_of_range(
+                "tol",
+                self.tol,
+                "must be finite and > 0",
+            ));
+        }
+        if !(1..=MAX_PERIOD).contains(&self.max_period) {
+            return Err(SimError::out_of_range(
+                "max_period",
+                self.max_period,
+                "must be in 1..=64",
+            ));
+        }
+        if !(1..=MAX_STEADY_PERIODS).contains(&self.max_periods) {
+            return Err(SimError::out_of_range(
+                "max_periods",
+                self.max_periods,
+                "must be in 1..=10000000",
+            ));
+        }
+        Ok(())
     }
-    if opts.max_period == 0 || opts.max_period > MAX_PERIOD {
-        return Err(SimError::out_of_range(
-            "max_period",
-            opts.max_period,
-            "must be in 1..=64",
-        ));
-    }
-    Ok(())
 }
 
 /// The next section time τ = 2πk/Ω after `tau`.
@@ -381,7 +398,7 @@ pub fn steady_state(
     integ: &mut dyn Integrator,
     opts: &SteadyOptions,
 ) -> Result<SteadyState, SimError> {
-    check_options(opts)?;
+    opts.validate()?;
     // align on the section
     if !on_section(integ.tau(), integ.model().period()) {
         next_section(integ, None)?;
@@ -410,7 +427,7 @@ pub fn steady_states(
     batch: &mut ExactBatch,
     opts: &SteadyOptions,
 ) -> Result<Vec<Result<SteadyState, SimError>>, SimError> {
-    check_options(opts)?;
+    opts.validate()?;
     let lanes = batch.len();
     let mut out: Vec<Option<Result<SteadyState, SimError>>> = (0..lanes).map(|_| None).collect();
     let mut returns = Vec::with_capacity(lanes);

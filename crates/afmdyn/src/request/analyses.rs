@@ -51,38 +51,19 @@ impl Default for SteadyRequest {
 }
 
 impl SteadyRequest {
-    /// The validated options.
+    /// The validated options ([`SteadyOptions::validate`]).
     ///
     /// # Errors
     /// [`SimError::OutOfRange`] naming `tol`, `max_period` or `max_periods`.
     pub fn options(&self) -> Result<SteadyOptions, SimError> {
-        if !(self.tol.is_finite() && self.tol > 0.0) {
-            return Err(SimError::out_of_range(
-                "tol",
-                self.tol,
-                "must be finite and > 0",
-            ));
-        }
-        if !(1..=MAX_PERIOD).contains(&self.max_period) {
-            return Err(SimError::out_of_range(
-                "max_period",
-                self.max_period,
-                "must be in 1..=64",
-            ));
-        }
-        if !(1..=MAX_STEADY_PERIODS).contains(&self.max_periods) {
-            return Err(SimError::out_of_range(
-                "max_periods",
-                self.max_periods,
-                "must be in 1..=10000000",
-            ));
-        }
-        Ok(SteadyOptions {
+        let opts = SteadyOptions {
             tol: self.tol,
             max_periods: self.max_periods,
             max_period: self.max_period,
             ..SteadyOptions::default()
-        })
+        };
+        opts.validate()?;
+        Ok(opts)
     }
 }
 
@@ -340,7 +321,7 @@ impl LyapunovRequest {
     /// Check every option.
     ///
     /// # Errors
-    /// [`SimError::OutOfRange`] naming `periods` or `blocks`.
+    /// [`SimError::OutOfRange`] naming `periods` or `blocks` ([`LyapunovOptions::validate`]).
     pub fn validate(&self) -> Result<(), SimError> {
         if self.transient as f64 + self.periods as f64 > MAX_RUN_PERIODS {
             return Err(SimError::out_of_range(
@@ -349,14 +330,16 @@ impl LyapunovRequest {
                 "a run may span at most 1e8 drive periods, transient included",
             ));
         }
-        if self.blocks < 2 || self.periods < self.blocks {
-            return Err(SimError::out_of_range(
-                "blocks",
-                format!("{} with periods = {}", self.blocks, self.periods),
-                "need periods >= blocks >= 2",
-            ));
+        self.options().validate()
+    }
+
+    fn options(&self) -> LyapunovOptions {
+        LyapunovOptions {
+            transient_periods: self.transient,
+            periods: self.periods,
+            blocks: self.blocks,
+            ..LyapunovOptions::default()
         }
-        Ok(())
     }
 
     /// The spectrum of `params` from the initial state.
@@ -367,13 +350,7 @@ impl LyapunovRequest {
         self.validate()?;
         let model = CantileverModel::new(params)?;
         let z0 = initial_state(&model, self.initial.as_deref())?;
-        let opts = LyapunovOptions {
-            transient_periods: self.transient,
-            periods: self.periods,
-            blocks: self.blocks,
-            ..LyapunovOptions::default()
-        };
-        lyapunov_spectrum(&model, &z0, &opts)
+        lyapunov_spectrum(&model, &z0, &self.options())
     }
 }
 
@@ -409,34 +386,22 @@ impl Default for AttractorsRequest {
 }
 
 impl AttractorsRequest {
-    /// The validated census of `params` (integrator built for
+    /// The validated census of `params` ([`AttractorSpec::validate`]; the integrator built for
     /// [`ATTRACTOR_SAMPLES_PER_PERIOD`]).
     ///
     /// # Errors
     /// [`SimError::OutOfRange`] naming `samples`, `cluster_tol` or a steady-state option.
     pub fn spec(&self, params: &Params) -> Result<AttractorSpec, SimError> {
-        if !(1..=MAX_ATTRACTOR_SAMPLES).contains(&self.samples) {
-            return Err(SimError::out_of_range(
-                "samples",
-                self.samples,
-                "must be in 1..=100000",
-            ));
-        }
-        if !(self.cluster_tol.is_finite() && self.cluster_tol > 0.0) {
-            return Err(SimError::out_of_range(
-                "cluster_tol",
-                self.cluster_tol,
-                "must be finite and > 0",
-            ));
-        }
-        Ok(AttractorSpec {
+        let spec = AttractorSpec {
             params: *params,
             samples: self.samples,
             seed: self.seed,
             cluster_tol: self.cluster_tol,
             steady: self.steady.options()?,
             integrator: self.integrator.options(ATTRACTOR_SAMPLES_PER_PERIOD),
-        })
+        };
+        spec.validate()?;
+        Ok(spec)
     }
 
     /// The census of `params`.

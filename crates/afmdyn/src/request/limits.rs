@@ -14,11 +14,8 @@ pub const MAX_SERIES_BYTES: f64 = 16.0 * 1024.0 * 1024.0 * 1024.0;
 pub const MAX_SERIES_MEMORY_BYTES: f64 = 4.0 * 1024.0 * 1024.0 * 1024.0;
 /// Largest number of samples per drive period of a time series.
 pub const MAX_SAMPLES_PER_PERIOD: usize = 100_000;
-/// Largest transient cap of a steady-state search, in drive periods.
-pub const MAX_STEADY_PERIODS: usize = 10_000_000;
-/// Largest number of random initial states of an attractor census (each is a steady-state
-/// search kept in memory with its Poincaré points).
-pub const MAX_ATTRACTOR_SAMPLES: usize = 100_000;
+pub use crate::analysis::attractors::MAX_ATTRACTOR_SAMPLES;
+pub use crate::analysis::steady::MAX_STEADY_PERIODS;
 /// Samples per drive period at which attractors are recorded (their plots and files); the
 /// integrator of the census is built for this rate, so the same request gives the same
 /// attractors in every front end.
