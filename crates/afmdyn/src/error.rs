@@ -188,6 +188,13 @@ pub enum SimError {
         /// What to use instead.
         hint: &'static str,
     },
+    /// An analysis that needs the cantilever's Galerkin structure was given another
+    /// [`crate::tip_sample::TipSampleSystem`].
+    #[error("{analysis} needs the cantilever model (its Galerkin matrices and mode shapes); this system is not one")]
+    NotCantilever {
+        /// The analysis.
+        analysis: &'static str,
+    },
     /// The adaptive oracle integrator reported a failure.
     #[error("adaptive integrator failed at tau = {tau}: {message}")]
     Adaptive {

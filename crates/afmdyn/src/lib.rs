@@ -9,7 +9,8 @@
 //! The tree follows the paper:
 //! [`beam`] (mode shapes) → [`galerkin`] (eqs. 10–18) → [`eigen`] (eqs. 19–23) and [`units`]
 //! (eqs. 5, 7) → [`contact`] (tip–sample laws) → [`system`] (the hybrid-system interface,
-//! saltation) → [`model`] (the cantilever–sample system) → [`integrate`] (exact propagation, RK4, an
+//! saltation) → [`model`] (the cantilever–sample system) → [`tip_sample`] (what integrators and
+//! analyses need of a probe over a sample) → [`integrate`] (exact propagation, RK4, an
 //! adaptive oracle) → [`trajectory`] (observables, stroboscopic Poincaré section) →
 //! [`analysis`] (steady states, periods, bifurcation sweeps, attractors, mode convergence);
 //! [`request`] is what every front end hands the library (parameters by name, defaults, limits);
@@ -63,6 +64,7 @@ pub mod report;
 pub mod request;
 pub mod roots;
 pub mod system;
+pub mod tip_sample;
 pub mod trajectory;
 pub mod units;
 
@@ -72,3 +74,4 @@ pub use integrate::{Integrator, IntegratorKind, IntegratorOptions};
 pub use model::CantileverModel;
 pub use params::{Params, Structure, SweepParam};
 pub use system::{EventKind, HybridSystem, Region};
+pub use tip_sample::TipSampleSystem;

@@ -570,54 +570,6 @@ impl CantileverModel {
         self.m_eff * (p.base_amplitude() * om * om * s - acc - 2.0 * beta * vd - beta * beta * v)
     }
 
-    /// Check a state: length 2N, finite components, ‖z‖ below the integrators' divergence
-    /// threshold [`crate::params::STATE_NORM_MAX`].
-    ///
-    /// # Errors
-    /// [`SimError::StateLength`], [`SimError::NotFinite`] or [`SimError::OutOfRange`].
-    pub fn check_state(&self, name: &'static str, z: &DVector<f64>) -> Result<(), SimError> {
-        if z.len() != self.dim() {
-            return Err(SimError::StateLength {
-                name,
-                expected: self.dim(),
-                got: z.len(),
-            });
-        }
-        if let Some(v) = z.iter().find(|v| !v.is_finite()) {
-            return Err(SimError::NotFinite { name, value: *v });
-        }
-        let norm = z.norm();
-        if norm.is_nan() || norm >= crate::params::STATE_NORM_MAX {
-            return Err(SimError::out_of_range(
-                name,
-                format!("|z| = {norm:e}"),
-                "must be < 1e12 (the divergence threshold of the integrators)",
-            ));
-        }
-        Ok(())
-    }
-
-    /// Check a start (τ, z) and return its region and the state to start from:
-    /// [`CantileverModel::check_state`] and a finite τ. For the impact law a start inside the
-    /// rigid sample (V_T < 0, e.g. a Newton iterate next to an orbit that sticks at the section)
-    /// is first brought to the surface by a plastic contact ([`CantileverModel::start_projection`]).
-    ///
-    /// # Errors
-    /// [`SimError::NotFinite`] or [`SimError::StateLength`].
-    pub fn checked_start(
-        &self,
-        tau: f64,
-        z: &DVector<f64>,
-    ) -> Result<(Region, DVector<f64>), SimError> {
-        crate::error::finite("initial time", tau)?;
-        self.check_state("initial state", z)?;
-        let z = match self.start_projection(tau, z) {
-            Some((projected, _)) => projected,
-            None => z.clone(),
-        };
-        Ok((self.mode_at(tau, z.as_slice()), z))
-    }
-
     /// Impact law, start inside the sample (V_T < 0): the plastic contact that places it on the
     /// surface, a ← a − V_T m_eff M⁻¹φ and, when V̇_T < 0, ȧ ← ȧ − V̇_T m_eff M⁻¹φ (the smallest
     /// change in the kinetic metric with V_T = 0, V̇_T ≥ 0), with its Jacobian (2N×2N). `None`
@@ -671,7 +623,7 @@ impl CantileverModel {
             }
         }
         let z = DVector::from_iterator(2 * n, a.iter().chain(a_dot).copied());
-        self.check_state("initial state", &z)?;
+        crate::system::check_state("initial state", self.dim(), &z)?;
         Ok(z)
     }
 

@@ -17,6 +17,7 @@
 //! event time is then r + R(δz + f⁻δτ) + ∂r/∂τ δτ − f⁺δτ.) At a grazing event ġ → 0 and S grows
 //! like 1/ġ — the square-root singularity of the impact map (Nordmark 1991).
 
+use crate::error::SimError;
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
@@ -181,6 +182,34 @@ pub trait HybridSystem: Send + Sync {
     /// Whether every mode is affine in z with a harmonic forcing and linear guards (the exact
     /// propagator applies).
     fn is_affine(&self) -> bool;
+}
+
+/// Check a state of a system of dimension `dim`: length `dim`, finite entries, ‖z‖ below the
+/// integrators' divergence threshold [`crate::params::STATE_NORM_MAX`] (1e12).
+///
+/// # Errors
+/// [`SimError::StateLength`], [`SimError::NotFinite`] or [`SimError::OutOfRange`], naming
+/// `name`.
+pub fn check_state(name: &'static str, dim: usize, z: &DVector<f64>) -> Result<(), SimError> {
+    if z.len() != dim {
+        return Err(SimError::StateLength {
+            name,
+            expected: dim,
+            got: z.len(),
+        });
+    }
+    if let Some(v) = z.iter().find(|v| !v.is_finite()) {
+        return Err(SimError::NotFinite { name, value: *v });
+    }
+    let norm = z.norm();
+    if norm.is_nan() || norm >= crate::params::STATE_NORM_MAX {
+        return Err(SimError::out_of_range(
+            name,
+            format!("|z| = {norm:e}"),
+            "must be < 1e12 (the divergence threshold of the integrators)",
+        ));
+    }
+    Ok(())
 }
 
 /// dΨ = J Ψ for d×d column-major `psi` and `dpsi` (the variational equations' product).

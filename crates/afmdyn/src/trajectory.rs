@@ -155,7 +155,8 @@ pub fn record(integ: &mut dyn Integrator, spec: &RecordSpec) -> Result<Trajector
             "must be >= 0",
         ));
     }
-    let model = integ.model().clone();
+    let model =
+        crate::tip_sample::require_cantilever(integ.system(), "the recorded trajectory")?.clone();
     let period = model.period();
     let start = integ.tau() + spec.transient_periods * period;
     advance(integ, start)?;
@@ -223,7 +224,7 @@ pub fn record(integ: &mut dyn Integrator, spec: &RecordSpec) -> Result<Trajector
         let tau = integ.tau();
         let z = integ.state();
         if let Some(b) = &body {
-            out.body_contact |= b.touches(&model, tau, z);
+            out.body_contact |= b.touches(tau, z);
         }
         if let Some(e) = step.event {
             // an impact's impulse: energy lost in the sample and work done on the clamped frame

@@ -244,7 +244,7 @@ impl Observer for Probe {
         let loose = it.displacement_bound(&self.weights, f64::INFINITY);
         let tau = it.tau();
         let z = it.state().clone();
-        let formed = it.model().tip_values(tau, &z);
+        let formed = it.system().tip_values(tau, &z);
         for (a, b) in tip.iter().zip(formed) {
             self.worst_tip = self.worst_tip.max((a - b).abs() / (1.0 + b.abs()));
         }

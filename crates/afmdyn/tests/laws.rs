@@ -634,7 +634,7 @@ fn impact_law_energy_and_restitution() {
         advance_dyn(it2.as_mut(), tr.tau_end, &mut |integ, s, _| {
             if let Some(e) = &s.event {
                 if e.kind == EventKind::Impact {
-                    let after = integ.model().v_t_dot(e.tau, integ.state());
+                    let after = integ.system().v_t_dot(e.tau, integ.state());
                     assert!((after + r * e.v_t_dot).abs() < 1e-12 * (1.0 + e.v_t_dot.abs()));
                 }
             }

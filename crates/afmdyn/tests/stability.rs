@@ -593,7 +593,7 @@ fn parameter_derivative_is_none_where_unsupported() {
 struct PerStep<'a>(&'a mut ExactPropagator);
 
 impl afmdyn::integrate::Integrator for PerStep<'_> {
-    fn model(&self) -> &afmdyn::CantileverModel {
+    fn system(&self) -> &dyn afmdyn::TipSampleSystem {
         self.0.model()
     }
     fn tau(&self) -> f64 {

@@ -168,7 +168,7 @@ impl Solver {
     fn grazing(&mut self, z: &DVector<f64>, p: f64) -> Result<f64, SimError> {
         let n = self.spec.period as f64;
         let integ = self.at(p)?;
-        let t = n * integ.model().period();
+        let t = n * integ.system().period();
         grazing_distance(integ, 0.0, z, t)
     }
 
@@ -184,7 +184,7 @@ impl Solver {
     fn map_state(&mut self, z: &DVector<f64>, p: f64) -> Result<DVector<f64>, SimError> {
         let t = self.spec.period as f64;
         let integ = self.at(p)?;
-        let t = t * integ.model().period();
+        let t = t * integ.system().period();
         flow_state(integ, 0.0, z, t)
     }
 

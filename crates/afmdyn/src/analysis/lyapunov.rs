@@ -13,6 +13,7 @@
 
 use super::monodromy::flow_with_jacobian;
 use crate::error::SimError;
+use crate::integrate::Integrator;
 use crate::integrate::{advance, build, IntegratorOptions};
 use crate::model::CantileverModel;
 use nalgebra::{DMatrix, DVector};
@@ -111,11 +112,28 @@ pub fn lyapunov_spectrum(
     opts: &LyapunovOptions,
 ) -> Result<LyapunovSpectrum, SimError> {
     opts.validate()?;
-    let period = model.period();
-    let dim = model.dim();
     let mut integ = build(model, opts.integrator, 0.0, z0)?;
+    lyapunov_spectrum_with(integ.as_mut(), opts)
+}
+
+/// [`lyapunov_spectrum`] with a given integrator of any [`crate::TipSampleSystem`], from its
+/// current state (moved to τ = 0 if it is not there; `opts.integrator` is not used).
+///
+/// # Errors
+/// As [`lyapunov_spectrum`].
+pub fn lyapunov_spectrum_with(
+    integ: &mut dyn Integrator,
+    opts: &LyapunovOptions,
+) -> Result<LyapunovSpectrum, SimError> {
+    opts.validate()?;
+    let period = integ.system().period();
+    let dim = integ.system().dim();
+    if integ.tau() != 0.0 {
+        let z0 = integ.state().clone();
+        integ.reset(0.0, &z0)?;
+    }
     let t0 = opts.transient_periods as f64 * period;
-    advance(integ.as_mut(), t0)?;
+    advance(&mut *integ, t0)?;
     let mut z = integ.state().clone();
     let mut q = DMatrix::<f64>::identity(dim, dim);
     let per_block = opts.periods / opts.blocks;
@@ -126,7 +144,7 @@ pub fn lyapunov_spectrum(
     for k in 0..total_periods {
         // one period of the flow with its Jacobian (step propagators × saltation matrices)
         let (ta, tb) = (t0 + k as f64 * period, t0 + (k + 1) as f64 * period);
-        let map = flow_with_jacobian(integ.as_mut(), ta, &z, tb)?;
+        let map = flow_with_jacobian(&mut *integ, ta, &z, tb)?;
         log_volume += map.log_volume;
         q = map.jacobian * q;
         z = map.state;
@@ -136,7 +154,7 @@ pub fn lyapunov_spectrum(
             *acc += r[(i, i)].abs().ln();
         }
         q = qr.q();
-        section.push(model.v_t(tb, &z));
+        section.push(integ.system().v_t(tb, &z));
     }
     let block_time = per_block as f64 * period;
     let half = opts.blocks / 2;

@@ -86,7 +86,7 @@ fn flow(
     integ.reset(tau0, z0)?;
     let dim = z0.len();
     // a start inside a rigid sample is first projected onto it (impact law): its Jacobian
-    let mut jac = match integ.model().start_projection(tau0, z0) {
+    let mut jac = match integ.system().start_projection(tau0, z0) {
         Some((_, p)) => {
             // the projection's own parameter dependence is not modelled
             param = None;
@@ -169,10 +169,10 @@ fn flow(
                 }
             }
             // M ← S M and s ← S s + w ∂g/∂p, S = R + w ∇gᵀ applied as a rank-one update
-            let salt = saltation_parts(integ.model(), e.from, e.tau, e.state.as_slice());
+            let salt = saltation_parts(integ.system(), e.from, e.tau, e.state.as_slice());
             salt.apply(jac.as_mut_slice());
             if let Some(p) = param {
-                match integ.model().guard_param_derivative(e.from, p, e.tau) {
+                match integ.system().guard_param_derivative(e.from, p, e.tau) {
                     Some(dg) => {
                         salt.apply(sens.as_mut_slice());
                         sens.axpy(dg, &salt.shift, 1.0);
@@ -257,7 +257,7 @@ fn watch_grazing(
     nearest: &mut f64,
 ) {
     let (d0, search) = {
-        let m = integ.model();
+        let m = integ.system();
         let (tau_b, z_b) = match &step.event {
             Some(e) => (e.tau, &e.state),
             None => (step.tau1, integ.state()),
@@ -275,7 +275,7 @@ fn watch_grazing(
         *nearest = nearest.min(vt(t)[0].abs());
     }
     if let Some(e) = &step.event {
-        *nearest = nearest.min(e.v_t_dot.abs() / integ.model().omega());
+        *nearest = nearest.min(e.v_t_dot.abs() / integ.system().omega());
     }
 }
 
@@ -299,7 +299,7 @@ pub fn stroboscopic(
     z0: &DVector<f64>,
     n: usize,
 ) -> Result<FlowMap, SimError> {
-    let t = n as f64 * integ.model().period();
+    let t = n as f64 * integ.system().period();
     flow_with_jacobian(integ, 0.0, z0, t)
 }
 
@@ -315,7 +315,7 @@ pub fn stroboscopic_unwatched(
     z0: &DVector<f64>,
     n: usize,
 ) -> Result<FlowMap, SimError> {
-    let t = n as f64 * integ.model().period();
+    let t = n as f64 * integ.system().period();
     flow(integ, 0.0, z0, t, None, false)
 }
 
@@ -383,12 +383,12 @@ fn param_map(
     param: SweepParam,
     grazing: bool,
 ) -> Result<FlowMap, SimError> {
-    let t = n as f64 * integ.model().period();
+    let t = n as f64 * integ.system().period();
     let mut map = flow(integ, 0.0, z0, t, Some(param), grazing)?;
     if let (Some(d), SweepParam::Omega) = (&mut map.param_derivative, param) {
         let mut f = DVector::zeros(z0.len());
-        let m = integ.model();
-        m.rhs(integ.region(), t, &map.state, &mut f);
+        let m = integ.system();
+        m.rhs(integ.region(), t, map.state.as_slice(), f.as_mut_slice());
         d.axpy(-t / m.omega(), &f, 1.0);
     }
     Ok(map)

@@ -580,7 +580,8 @@ pub fn observe(
             "must be in 1..=10000 (the highest harmonic reported)",
         ));
     }
-    let ctx = Ctx::new(integ.model(), opts.harmonics);
+    let model = crate::tip_sample::require_cantilever(integ.system(), "the AFM observables")?;
+    let ctx = Ctx::new(model, opts.harmonics);
     let (model, free) = (&ctx.model, &ctx.free);
     let p: Params = *model.params();
     let (n, nh, om) = (model.modes(), opts.harmonics, p.omega);

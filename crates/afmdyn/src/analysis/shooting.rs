@@ -108,7 +108,7 @@ pub fn shoot_with(
     if n == 0 {
         return Err(SimError::out_of_range("period", n, "must be >= 1"));
     }
-    integ.model().check_state("initial guess", guess)?;
+    integ.system().check_state("initial guess", guess)?;
     let dim = guess.len();
     let mut z = guess.clone();
     let mut residuals = Vec::new();
@@ -194,7 +194,7 @@ fn finish(
     residuals: Vec<f64>,
 ) -> Result<PeriodicOrbit, SimError> {
     let section = section_points(integ, &z, n)?;
-    let period = integ.model().period();
+    let period = integ.system().period();
     let grazing_distance = grazing_distance(integ, 0.0, &z, n as f64 * period)?;
     let (multipliers, stable, critical) = floquet_stability(&map.jacobian);
     Ok(PeriodicOrbit {

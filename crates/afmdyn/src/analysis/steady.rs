@@ -120,7 +120,7 @@ pub struct StatsObserver {
     contact_time: f64,
     contacts: usize,
     time: f64,
-    body: Option<BodyContactCheck>,
+    body: Option<Option<BodyContactCheck>>,
     body_contact: bool,
     /// The [`EndValues`] of the integrator's state where the next step starts (the end of the
     /// last step, after the jump of an event; the start of the run).
@@ -187,16 +187,23 @@ impl Observer for StatsObserver {
         {
             self.contacts += 1;
         }
-        let body = self
-            .body
-            .get_or_insert_with(|| BodyContactCheck::new(it.model(), 32));
+        // the beam's body: of the cantilever only (another system has no body to check)
+        let body = self.body.get_or_insert_with(|| {
+            it.system()
+                .cantilever()
+                .map(|m| BodyContactCheck::new(m, 32))
+        });
         let e1 = match &step.event {
             Some(e) => {
-                self.body_contact |= body.touches(it.model(), step.tau1, &e.state);
-                it.model().tip_values(step.tau1, &e.state).into()
+                if let Some(body) = body {
+                    self.body_contact |= body.touches(step.tau1, &e.state);
+                }
+                it.system().tip_values(step.tau1, &e.state).into()
             }
             None => {
-                self.body_contact |= body.touches_observed(it);
+                if let Some(body) = body {
+                    self.body_contact |= body.touches_observed(it);
+                }
                 after
             }
         };
@@ -250,7 +257,7 @@ fn next_section(
     integ: &mut dyn Integrator,
     stats: Option<&mut StatsObserver>,
 ) -> Result<(), SimError> {
-    let target = section_after(integ.tau(), integ.model().period());
+    let target = section_after(integ.tau(), integ.system().period());
     match stats {
         // nothing observed per step: the state only at events and the end
         None => advance(integ, target),
@@ -259,12 +266,12 @@ fn next_section(
 }
 
 fn point(integ: &dyn Integrator) -> PoincarePoint {
-    let m = integ.model();
+    let m = integ.system();
     let z = integ.state();
     PoincarePoint {
         tau: integ.tau(),
         v_t: m.v_t(integ.tau(), z),
-        w_tip: m.w_tip(z),
+        w_tip: m.tip_values(integ.tau(), z)[0],
         state: z.clone(),
     }
 }
@@ -400,7 +407,7 @@ pub fn steady_state(
 ) -> Result<SteadyState, SimError> {
     opts.validate()?;
     // align on the section
-    if !on_section(integ.tau(), integ.model().period()) {
+    if !on_section(integ.tau(), integ.system().period()) {
         next_section(integ, None)?;
     }
     let mut returns = ReturnHistory::new(opts, integ.state());
@@ -513,7 +520,7 @@ mod tests {
             let (tau0, z0) = self.before.take().expect("started");
             assert_eq!(tau0, st.tau0);
             let got = self.inner.next_start.expect("started");
-            let want = it.model().tip_values(tau0, &z0);
+            let want = it.system().tip_values(tau0, &z0);
             let got = [got.w, got.w_dot, got.v_t, got.v_t_dot];
             for (g, w) in got.iter().zip(want) {
                 self.worst_start = self.worst_start.max(rel(*g, w));

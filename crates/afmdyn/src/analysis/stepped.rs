@@ -325,7 +325,7 @@ pub fn settle(
     n: usize,
     spec: &SteppedSpec,
 ) -> Result<Found, SimError> {
-    let period = integ.model().period();
+    let period = integ.system().period();
     let chunk = spec.chunk_periods.max(1);
     let mut x = z0.clone();
     let mut elapsed = 0usize;

@@ -27,6 +27,7 @@ use crate::model::CantileverModel;
 use crate::roots::{extremum, safeguarded_newton};
 use crate::system::HybridSystem;
 use crate::system::Region;
+use crate::tip_sample::TipSampleSystem;
 use differential_equations::interpolate::Interpolation;
 use differential_equations::methods::{DormandPrince, ExplicitRungeKutta, Ordinary};
 use differential_equations::ode::{OrdinaryNumericalMethod, ODE};
@@ -86,10 +87,11 @@ struct LastStep {
     jacobian: Option<DMatrix<f64>>,
 }
 
-/// The adaptive DOP853 integrator (see the module docs).
+/// The adaptive DOP853 integrator of a [`TipSampleSystem`] `S` (see the module docs); the
+/// cantilever model by default.
 #[derive(Clone)]
-pub struct Adaptive {
-    model: CantileverModel,
+pub struct Adaptive<S: TipSampleSystem + Clone = CantileverModel> {
+    model: S,
     tol: f64,
     tau: f64,
     z: DVector<f64>,
@@ -106,7 +108,7 @@ pub struct Adaptive {
     last: LastStep,
 }
 
-impl std::fmt::Debug for Adaptive {
+impl<S: TipSampleSystem + Clone> std::fmt::Debug for Adaptive<S> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Adaptive")
             .field("tol", &self.tol)
@@ -119,9 +121,10 @@ impl std::fmt::Debug for Adaptive {
 /// Backwards-compatible name of [`Adaptive`] (the linear law's independent oracle).
 pub type AdaptiveOracle = Adaptive;
 
-impl Adaptive {
-    /// Relative and absolute tolerance `tol` of the DOP853 error control.
-    pub fn new(model: &CantileverModel, tol: f64) -> Self {
+impl<S: TipSampleSystem + Clone> Adaptive<S> {
+    /// An integrator of `model` with relative and absolute tolerance `tol` of the DOP853 error
+    /// control.
+    pub fn new(model: &S, tol: f64) -> Self {
         let d = model.dim();
         Adaptive {
             model: model.clone(),
@@ -264,9 +267,15 @@ impl Adaptive {
 
     /// (g, dg/dτ) at (τ, z) in `mode`.
     fn guard_at(&self, mode: Region, tau: f64, z: &[f64]) -> (f64, f64) {
-        let mut f = [0.0; 2 * crate::params::MAX_MODES];
-        let f = &mut f[..z.len()];
-        self.model.rhs_slice(mode, tau, z, f);
+        let mut buf = [0.0; 2 * crate::params::MAX_MODES];
+        let mut heap = Vec::new();
+        let f = if z.len() <= buf.len() {
+            &mut buf[..z.len()]
+        } else {
+            heap.resize(z.len(), 0.0);
+            &mut heap[..]
+        };
+        self.model.rhs(mode, tau, z, f);
         (
             self.model.guard_value(mode, tau, z),
             self.model.guard_rate(mode, tau, z, f),
@@ -344,8 +353,8 @@ impl Adaptive {
     }
 }
 
-impl Integrator for Adaptive {
-    fn model(&self) -> &CantileverModel {
+impl<S: TipSampleSystem + Clone + 'static> Integrator for Adaptive<S> {
+    fn system(&self) -> &dyn TipSampleSystem {
         &self.model
     }
     fn tau(&self) -> f64 {
@@ -405,8 +414,7 @@ impl Integrator for Adaptive {
         if tau_max - tau0 <= 1e-9 * h_now.abs() {
             let rem = tau_max - tau0;
             let mut f = vec![0.0; d];
-            self.model
-                .rhs_slice(region, tau0, self.z.as_slice(), &mut f);
+            self.model.rhs(region, tau0, self.z.as_slice(), &mut f);
             let z0 = self.z.clone();
             for (zi, fi) in self.z.iter_mut().zip(&f) {
                 *zi += rem * fi;
@@ -463,7 +471,7 @@ impl Integrator for Adaptive {
         for _ in 0..6 {
             let g = self.model.guard(region, ts, &ys[..d]);
             let mut f = vec![0.0; d];
-            self.model.rhs_slice(region, ts, &ys[..d], &mut f);
+            self.model.rhs(region, ts, &ys[..d], &mut f);
             let rate = g.grad.iter().zip(&f).map(|(a, b)| a * b).sum::<f64>() + g.d_tau;
             if rate == 0.0 || g.value == 0.0 {
                 break;
@@ -518,8 +526,7 @@ impl Integrator for Adaptive {
         }
         let z = self.dense_state(tau);
         let mut f = vec![0.0; 2 * n];
-        self.model
-            .rhs_slice(self.last.region, tau, z.as_slice(), &mut f);
+        self.model.rhs(self.last.region, tau, z.as_slice(), &mut f);
         let tip = self.model.tip();
         let dot = |x: &[f64]| tip.iter().zip(x).map(|(a, b)| a * b).sum::<f64>();
         [dot(&z.as_slice()[..n]), dot(&f[..n]), dot(&f[n..])]
@@ -528,7 +535,7 @@ impl Integrator for Adaptive {
     fn last_step_jacobian(&mut self) -> Result<DMatrix<f64>, SimError> {
         self.last.jacobian.clone().ok_or(SimError::Unsupported {
             integrator: "adaptive",
-            law: self.model.law().name(),
+            law: self.model.law_name(),
             hint: "switch on the variational equations (Integrator::set_variational) first",
         })
     }

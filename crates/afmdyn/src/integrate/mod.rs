@@ -1,13 +1,18 @@
-//! Integrators of the switched model behind one interface.
+//! Integrators of the switched model behind one interface, [`Integrator`], which hands out the
+//! system it integrates as a [`TipSampleSystem`] ([`Integrator::system`]): the analyses written
+//! against `Integrator` never see the cantilever.
 //!
 //! * [`exact::ExactPropagator`] — exact piecewise-linear propagation (matrix exponential on a
-//!   fixed grid aligned with the drive period) with rigorously located switchings. Default.
+//!   fixed grid aligned with the drive period) with rigorously located switchings. Default. The
+//!   cantilever's own: it needs the affine regions of the linear law.
 //! * [`rk4::Rk4`] — the paper's fixed-step fourth-order Runge–Kutta, with located switchings
-//!   or, as in the paper, with the region chosen per stage from the sign of V_T.
+//!   or, as in the paper, with the region chosen per stage from the sign of V_T. Generic over
+//!   the [`TipSampleSystem`] (`Rk4<S>`, the cantilever by default).
 //! * [`adaptive::Adaptive`] — DOP853 (the `differential-equations` crate) driven step by step,
-//!   written against [`crate::system::HybridSystem`] only: any contact law, located events with
-//!   jumps (impacts, sticking), and the variational equations for step Jacobians. The default
-//!   for every law except the linear one, and the independent oracle for the linear law.
+//!   generic over the [`TipSampleSystem`] (`Adaptive<S>`) and written against
+//!   [`crate::system::HybridSystem`]: any contact law, located events with jumps (impacts,
+//!   sticking), and the variational equations for step Jacobians. The default for every law
+//!   except the linear one, and the independent oracle for the linear law.
 //!
 //! [`IntegratorKind::Auto`] (the default) chooses the exact propagator for the linear law and
 //! the adaptive integrator otherwise.
@@ -26,6 +31,7 @@ use crate::model::{BodyContactCheck, CantileverModel};
 use crate::params::SweepParam;
 use crate::system::EventKind;
 use crate::system::Region;
+use crate::tip_sample::TipSampleSystem;
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 use std::str::FromStr;
@@ -51,8 +57,8 @@ pub struct SwitchEvent {
 
 impl Step {
     /// A step of `model` in region `from` that ends at a plain switching at (τ_s, z_s).
-    pub fn switched(
-        model: &CantileverModel,
+    pub fn switched<S: TipSampleSystem + ?Sized>(
+        model: &S,
         tau0: f64,
         from: Region,
         tau_s: f64,
@@ -71,8 +77,8 @@ impl Step {
 
     /// A step of `model` in region `from` that ends at an event of `kind` at (τ_s, z⁻) into
     /// region `to`.
-    pub fn with_event(
-        model: &CantileverModel,
+    pub fn with_event<S: TipSampleSystem + ?Sized>(
+        model: &S,
         tau0: f64,
         from: Region,
         tau_s: f64,
@@ -113,10 +119,10 @@ pub struct Step {
 pub type StepObserver<'a> =
     dyn FnMut(&mut dyn Integrator, &Step, &DVector<f64>) -> Result<(), SimError> + 'a;
 
-/// A time integrator of [`CantileverModel`].
+/// A time integrator of a [`TipSampleSystem`] (the cantilever model of the paper, or another).
 pub trait Integrator: Send {
-    /// The model.
-    fn model(&self) -> &CantileverModel;
+    /// The system integrated.
+    fn system(&self) -> &dyn TipSampleSystem;
     /// Current time τ.
     fn tau(&self) -> f64;
     /// Current state z = (a, ȧ), shape `[2N]`.
@@ -140,7 +146,7 @@ pub trait Integrator: Send {
     /// [V_T, dV_T/dτ, d²V_T/dτ²] at `tau` inside the last step (from [`Integrator::dense_tip`]).
     fn dense_v_t(&mut self, tau: f64) -> [f64; 3] {
         let w = self.dense_tip(tau);
-        self.model().v_t_from_tip(tau, w)
+        self.system().v_t_from_tip(tau, w)
     }
     /// Jacobian ∂z(τ1)/∂z(τ0) of the flow over the last step [τ0, τ1] inside its region,
     /// 2N×2N, without the saltation of an event that ends it.
@@ -225,11 +231,11 @@ pub trait Integrator: Send {
     /// Integrator name.
     fn name(&self) -> &'static str;
     /// [W(1,τ), ∂W(1,τ)/∂τ, V_T, dV_T/dτ] at the current state. The default forms them from
-    /// [`Integrator::state`] ([`CantileverModel::tip_values`], where the equations are); the exact
+    /// [`Integrator::state`] ([`TipSampleSystem::tip_values`], where the equations are); the exact
     /// propagator takes V_T from its switching test and W from its modal coordinates, without
     /// forming the plain state (equal to round-off).
     fn tip_values(&self) -> [f64; 4] {
-        self.model().tip_values(self.tau(), self.state())
+        self.system().tip_values(self.tau(), self.state())
     }
     /// An upper bound of Σ_j c_j |a_j| at the current state (`weights` c_j ≥ 0, shape `[N]`, a
     /// the modal displacements), for a caller that needs to know whether the sum is below
@@ -308,9 +314,9 @@ pub struct Observed<'a> {
 }
 
 impl Observed<'_> {
-    /// The model.
-    pub fn model(&self) -> &CantileverModel {
-        self.integ.model()
+    /// The system integrated.
+    pub fn system(&self) -> &dyn TipSampleSystem {
+        self.integ.system()
     }
     /// Current time τ.
     pub fn tau(&self) -> f64 {
@@ -355,19 +361,19 @@ impl BodyContactCheck {
     /// needs no sine and spares most steps away from the sample (about 19 of 20 on the
     /// default attractor at N = 10), then against the base at τ.
     pub fn touches_observed(&self, it: &mut Observed<'_>) -> bool {
-        let lowest = (1.0 - it.model().params().base_amplitude().abs()) - 4.0 * f64::EPSILON;
+        let lowest = self.lowest_base() - 4.0 * f64::EPSILON;
         let bound = it.displacement_bound(&self.reach, lowest / (1.0 + 1e-9));
         if Self::spared(bound, lowest) {
             return false;
         }
-        let base = Self::base(it.model(), it.tau());
+        let base = self.base(it.tau());
         if Self::spared(
             it.displacement_bound(&self.reach, base / (1.0 + 1e-9)),
             base,
         ) {
             return false;
         }
-        let n = it.model().modes();
+        let n = self.reach.len();
         self.touches_at(base, &it.state().as_slice()[..n])
     }
 }
@@ -677,9 +683,9 @@ impl HermiteStep {
     }
 
     /// Record a step of `model` in region `r` from (t0, z0) to (t1, z1).
-    pub(crate) fn record(
+    pub(crate) fn record<S: TipSampleSystem + ?Sized>(
         &mut self,
-        model: &CantileverModel,
+        model: &S,
         r: Region,
         t0: f64,
         z0: &DVector<f64>,
@@ -688,14 +694,14 @@ impl HermiteStep {
     ) {
         self.t0 = t0;
         self.z0.copy_from(z0);
-        model.rhs(r, t0, z0, &mut self.f0);
+        model.rhs(r, t0, z0.as_slice(), self.f0.as_mut_slice());
         self.t1 = t1;
         self.z1.copy_from(z1);
-        model.rhs(r, t1, z1, &mut self.f1);
+        model.rhs(r, t1, z1.as_slice(), self.f1.as_mut_slice());
     }
 
     /// [W, W', W''] of the tip at τ.
-    pub(crate) fn tip(&self, model: &CantileverModel, tau: f64) -> [f64; 3] {
+    pub(crate) fn tip<S: TipSampleSystem + ?Sized>(&self, model: &S, tau: f64) -> [f64; 3] {
         let n = model.modes();
         let tip = model.tip();
         let w0 = [tip.dot(&self.z0.rows(0, n)), tip.dot(&self.f0.rows(0, n))];

@@ -14,12 +14,14 @@ use super::{HermiteStep, Integrator, Step};
 use crate::error::SimError;
 use crate::model::CantileverModel;
 use crate::system::Region;
+use crate::tip_sample::TipSampleSystem;
 use nalgebra::{DMatrix, DVector};
 
-/// Fixed-step RK4 integrator on a grid of `steps` sub-steps per drive period.
+/// Fixed-step RK4 integrator of a [`TipSampleSystem`] `S` (the cantilever model by default) on a
+/// grid of `steps` sub-steps per drive period.
 #[derive(Debug, Clone)]
-pub struct Rk4 {
-    model: CantileverModel,
+pub struct Rk4<S: TipSampleSystem + Clone = CantileverModel> {
+    model: S,
     grid: PeriodGrid,
     locate: bool,
     tau: f64,
@@ -36,9 +38,9 @@ enum Mode {
     PerStage,
 }
 
-impl Rk4 {
+impl<S: TipSampleSystem + Clone> Rk4<S> {
     /// `steps` fixed steps per drive period; `locate_events` as in the module docs.
-    pub fn new(model: &CantileverModel, steps: usize, locate_events: bool) -> Self {
+    pub fn new(model: &S, steps: usize, locate_events: bool) -> Self {
         let dim = model.dim();
         let z = DVector::zeros(dim);
         Rk4 {
@@ -53,23 +55,17 @@ impl Rk4 {
         }
     }
 
-    fn rhs(
-        model: &CantileverModel,
-        mode: Mode,
-        tau: f64,
-        z: &DVector<f64>,
-        out: &mut DVector<f64>,
-    ) {
+    fn rhs(model: &S, mode: Mode, tau: f64, z: &DVector<f64>, out: &mut DVector<f64>) {
         let r = match mode {
             Mode::Fixed(r) => r,
             Mode::PerStage => model.region_at(tau, z),
         };
-        model.rhs(r, tau, z, out);
+        model.rhs(r, tau, z.as_slice(), out.as_mut_slice());
     }
 
     /// One RK4 step of length h from (τ, z) into `out`.
     fn rk4(
-        model: &CantileverModel,
+        model: &S,
         mode: Mode,
         tau: f64,
         z: &DVector<f64>,
@@ -100,8 +96,8 @@ impl Rk4 {
     }
 }
 
-impl Integrator for Rk4 {
-    fn model(&self) -> &CantileverModel {
+impl<S: TipSampleSystem + Clone + 'static> Integrator for Rk4<S> {
+    fn system(&self) -> &dyn TipSampleSystem {
         &self.model
     }
     fn tau(&self) -> f64 {
@@ -174,7 +170,7 @@ impl Integrator for Rk4 {
         let mode = Mode::Fixed(region);
         let sigma = region.guard_sign();
         Self::rk4(&self.model, mode, tau0, &z0, len, &mut self.k, &mut out);
-        let g = |m: &CantileverModel, t: f64, z: &DVector<f64>| sigma * m.v_t(t, z);
+        let g = |m: &S, t: f64, z: &DVector<f64>| sigma * m.v_t(t, z);
         check_finite(tau_b, &out)?;
         let gb = g(&self.model, tau_b, &out);
         // a start on the switching surface (just switched) is not an event at s = 0
@@ -243,7 +239,7 @@ impl Integrator for Rk4 {
     fn last_step_jacobian(&mut self) -> Result<DMatrix<f64>, SimError> {
         Err(SimError::Unsupported {
             integrator: self.name(),
-            law: self.model.law().name(),
+            law: self.model.law_name(),
             hint: "step Jacobians need integrator = \"exact\" or \"adaptive\"",
         })
     }

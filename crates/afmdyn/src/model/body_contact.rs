@@ -11,6 +11,8 @@ pub struct BodyContactCheck {
     phi: DMatrix<f64>,
     /// max_i |φ_j(ξ_i)| per mode j, shape `[N]`: |W(ξ_i)| ≤ Σ_j reach_j |a_j| at every station.
     pub(crate) reach: Vec<f64>,
+    /// The base drive's amplitude (α2, or 0 for the point mass) and Ω.
+    drive: (f64, f64),
 }
 
 impl BodyContactCheck {
@@ -34,7 +36,12 @@ impl BodyContactCheck {
         let reach = (0..n)
             .map(|j| phi.column(j).iter().fold(0.0f64, |m, v| m.max(v.abs())))
             .collect();
-        BodyContactCheck { phi, reach }
+        let p = model.params();
+        BodyContactCheck {
+            phi,
+            reach,
+            drive: (p.base_amplitude(), p.omega),
+        }
     }
 
     /// Whether any station touches the substrate at (τ, z).
@@ -44,8 +51,9 @@ impl BodyContactCheck {
     /// it), stays below α2 sin Ωτ + 1, no station can touch and none is formed — the common
     /// case away from the sample. Otherwise the stations are formed one by one, each sum in
     /// the order of the matrix–vector product (mode 0 first), without allocating.
-    pub fn touches(&self, model: &CantileverModel, tau: f64, z: &DVector<f64>) -> bool {
-        self.touches_at(Self::base(model, tau), &z.as_slice()[..model.modes()])
+    /// `z: [f64; 2N]` as (a, ȧ), of the model the check was built for.
+    pub fn touches(&self, tau: f64, z: &DVector<f64>) -> bool {
+        self.touches_at(self.base(tau), &z.as_slice()[..self.reach.len()])
     }
 
     /// [`BodyContactCheck::touches`] given the base α2 sin Ωτ + 1 and the displacements a.
@@ -66,9 +74,14 @@ impl BodyContactCheck {
     }
 
     /// α2 sin Ωτ + 1: a station touches when W(ξ_i, τ) + this ≤ 0.
-    pub(crate) fn base(model: &CantileverModel, tau: f64) -> f64 {
-        let p = model.params();
-        p.base_amplitude() * (p.omega * tau).sin() + 1.0
+    pub(crate) fn base(&self, tau: f64) -> f64 {
+        let (amplitude, omega) = self.drive;
+        amplitude * (omega * tau).sin() + 1.0
+    }
+
+    /// The lowest base over a period, 1 − |α2| (or 1 for the point mass).
+    pub(crate) fn lowest_base(&self) -> f64 {
+        1.0 - self.drive.0.abs()
     }
 
     /// Whether a bound of Σ_j reach_j |a_j|, widened by 1e-9 (see [`BodyContactCheck::touches`]),
@@ -111,11 +124,7 @@ mod tests {
                 let base = p.base_amplitude() * (p.omega * tau).sin() + 1.0;
                 let w = &check.phi * z.rows(0, modes);
                 let reference = w.iter().any(|wi| wi + base <= 0.0);
-                assert_eq!(
-                    check.touches(&model, tau, &z),
-                    reference,
-                    "N = {modes}, k = {k}"
-                );
+                assert_eq!(check.touches(tau, &z), reference, "N = {modes}, k = {k}");
                 touched += usize::from(reference);
                 let bound = weighted_displacement(&check.reach, z.as_slice());
                 spared += usize::from(BodyContactCheck::spared(bound, base));

@@ -104,7 +104,7 @@ pub fn record_chunked<E: From<SimError>>(
     mut each: impl FnMut(&Chunk<'_>) -> Result<(), E>,
     mut progress: impl FnMut(f64),
 ) -> Result<ChunkedSummary, E> {
-    let period = integ.model().period();
+    let period = integ.system().period();
     let spp = spec.samples_per_period;
     let start = integ.tau() + spec.transient_periods * period;
     let end = start + spec.record_tau;

@@ -53,6 +53,12 @@ impl Default for ExactOptions {
 }
 
 impl ExactPropagator {
+    /// The cantilever model propagated (the exact propagator is the cantilever's own: it needs
+    /// the affine regions of the linear law, eqs. 10–18).
+    pub fn model(&self) -> &CantileverModel {
+        &self.model
+    }
+
     /// Build the propagator; the grid has a multiple of `min_steps_per_period` sub-steps per
     /// period, refined until ‖Ã_s‖₂ h ≤ θ in both regions.
     ///

@@ -7,13 +7,13 @@ use super::tip::tip_v_t;
 use super::ExactPropagator;
 use crate::error::SimError;
 use crate::integrate::{Integrator, Step};
-use crate::model::CantileverModel;
 use crate::params::SweepParam;
 use crate::system::Region;
+use crate::tip_sample::TipSampleSystem;
 use nalgebra::{DMatrix, DVector};
 
 impl Integrator for ExactPropagator {
-    fn model(&self) -> &CantileverModel {
+    fn system(&self) -> &dyn TipSampleSystem {
         &self.model
     }
     fn tau(&self) -> f64 {
