@@ -4,7 +4,6 @@ use crate::args::{IntegratorArgs, ModelArgs};
 use crate::error::CliError;
 use crate::output::{f, io_error, write_bytes, write_csv, Column, NpyStream, OutDir};
 use crate::plot::{save, save_scatter_stream, ChunkSink, Figure, LegendEntry, Series, Style};
-use afmdyn::analysis::attractors::find_attractors;
 use afmdyn::analysis::bifurcation::{Branch, SweepPoint};
 use afmdyn::integrate::build;
 use afmdyn::request::checkpoint::{self, Checkpoint, CheckpointError};
@@ -14,6 +13,7 @@ use afmdyn::request::sweep::{
     COL_STATUS, COL_TAU, COL_X_MAX, NUMERIC_COLUMNS,
 };
 use afmdyn::request::{AttractorsRequest, BifurcationRequest, FileCheckpoint, SteadyRequest};
+use afmdyn::request::{Document, Resolved};
 use afmdyn::trajectory::{record, RecordSpec};
 use afmdyn::{CantileverModel, Params, SweepParam};
 use clap::Args;
@@ -411,16 +411,19 @@ pub struct AttractorsArgs {
 pub fn attractors(a: &AttractorsArgs) -> Result<(), CliError> {
     let (p, probe) = a.model.resolve(Params::default())?;
     let spp = ATTRACTOR_SAMPLES_PER_PERIOD;
-    let spec = AttractorsRequest {
+    let request = AttractorsRequest {
         samples: a.samples,
         seed: a.seed,
         cluster_tol: a.cluster_tol,
         steady: a.steady.request(),
         integrator: a.integrator.request(),
-    }
-    .spec(&p)?;
+    };
+    let spec = request.spec(&p)?;
     let out = OutDir::lock(&a.out)?;
-    let report = find_attractors(&spec)?;
+    let Document {
+        output: report,
+        json: doc,
+    } = crate::progress::run(&request, &Resolved { params: p, probe }, "starts")?;
     let model = CantileverModel::new(&p)?;
     for (k, att) in report.attractors.iter().enumerate() {
         let periods = att.steady.period().unwrap_or(8).max(2);
@@ -505,8 +508,6 @@ pub fn attractors(a: &AttractorsArgs) -> Result<(), CliError> {
             },
         )?;
     }
-    let mut doc = afmdyn::report::attractors(&p, a.samples, &report);
-    doc = afmdyn::report::with_si(doc, probe.as_ref(), &p);
     write_bytes(
         &out.join("attractors.json"),
         serde_json::to_string_pretty(&doc).expect("json").as_bytes(),

@@ -7,14 +7,15 @@ use crate::cmd_simulate::Files;
 use crate::error::CliError;
 use crate::output::{f, write_csv, Column, NpyStream, OutDir};
 use crate::plot::{save, Figure, Series, Style};
-use afmdyn::analysis::approach::{approach_retract, rest_distance};
+use afmdyn::analysis::approach::rest_distance;
 use afmdyn::analysis::continuation::BranchEvent;
 use afmdyn::analysis::observables::Observables;
-use afmdyn::analysis::resonance::resonance_curve;
-use afmdyn::analysis::stepped::{SteppedCurve, SteppedSpec, Sweep};
+use afmdyn::analysis::stepped::{SteppedCurve, Sweep};
 use afmdyn::probe::Probe;
 use afmdyn::report::{curve_row, CurveUnits, CURVE_COLUMNS};
-use afmdyn::request::{approach_request, resonance_request, CurveRequest};
+use afmdyn::request::{
+    Analysis, ApproachRequest, CurveRequest, Document, Resolved, ResonanceRequest,
+};
 use afmdyn::Params;
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -533,16 +534,16 @@ struct Run<'a> {
 impl Run<'_> {
     /// Lock the output directory, compute, write the files and print the JSON document or the
     /// summary.
-    fn go(
+    fn go<A: Analysis<Output = SteppedCurve>>(
         &self,
-        spec: &SteppedSpec,
-        compute: fn(&SteppedSpec) -> Result<SteppedCurve, afmdyn::SimError>,
-        doc: impl Fn(&SteppedCurve) -> serde_json::Value,
+        request: &A,
+        model: &Resolved,
     ) -> Result<(), CliError> {
+        request.validate(model)?;
         let out = (self.args.files != Files::None)
             .then(|| OutDir::lock(self.out))
             .transpose()?;
-        let c = compute(spec)?;
+        let Document { output: c, json } = crate::progress::run(request, model, "points")?;
         if let Some(o) = &out {
             write_files(
                 o,
@@ -555,7 +556,7 @@ impl Run<'_> {
             )?;
         }
         if self.args.json {
-            println!("{}", doc(&c));
+            println!("{json}");
         } else {
             summary(&c, self.x, self.labels, out.as_ref());
         }
@@ -575,7 +576,9 @@ fn check_finite(name: &str, v: Option<f64>) -> Result<(), CliError> {
 /// Run `afmdyn approach`.
 pub fn approach(a: &ApproachArgs) -> Result<(), CliError> {
     let (base, units, probe) = setup(&a.model, a.from, a.to, false)?;
-    let spec = approach_request(base, &a.curve.request(a.from, a.to), units.length)?;
+    let request = ApproachRequest {
+        curve: a.curve.request(a.from, a.to),
+    };
     let x = |v: f64| rest_distance(&base, v) * units.length;
     let labels = Labels {
         stem: "approach",
@@ -594,20 +597,23 @@ pub fn approach(a: &ApproachArgs) -> Result<(), CliError> {
         labels: &labels,
         x: &x,
     };
-    run.go(&spec, approach_retract, |c| {
-        afmdyn::report::with_si(
-            afmdyn::report::approach(&base, c, &units),
-            probe.as_ref(),
-            &base,
-        )
-    })
+    run.go(
+        &request,
+        &Resolved {
+            params: base,
+            probe,
+        },
+    )
 }
 
 /// Run `afmdyn resonance`.
 pub fn resonance(a: &ResonanceArgs) -> Result<(), CliError> {
     let (base, units, probe) = setup(&a.model, a.from, a.to, true)?;
     let hz = units.hz_per_omega.unwrap_or(1.0);
-    let spec = resonance_request(base, a.mode, &a.curve.request(a.from, a.to), hz)?;
+    let request = ResonanceRequest {
+        mode: a.mode,
+        curve: a.curve.request(a.from, a.to),
+    };
     let x = |v: f64| v * hz;
     let labels = Labels {
         stem: "resonance",
@@ -631,11 +637,11 @@ pub fn resonance(a: &ResonanceArgs) -> Result<(), CliError> {
         labels: &labels,
         x: &x,
     };
-    run.go(&spec, resonance_curve, |c| {
-        afmdyn::report::with_si(
-            afmdyn::report::resonance(&base, c, &units),
-            probe.as_ref(),
-            &base,
-        )
-    })
+    run.go(
+        &request,
+        &Resolved {
+            params: base,
+            probe,
+        },
+    )
 }

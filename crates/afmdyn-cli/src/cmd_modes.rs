@@ -4,7 +4,9 @@ use crate::args::{read_toml, ModelArgs};
 use crate::error::CliError;
 use crate::output::{f, write_csv, OutDir};
 use crate::plot::{save, Figure, Series, Style};
-use afmdyn::eigen::{fig3_sweep, spectrum};
+use afmdyn::analysis::progress::Progress;
+use afmdyn::eigen::fig3_sweep;
+use afmdyn::request::{self, Document, ModesRequest, Resolved};
 use afmdyn::units::{
     beam_damping_from_q, contact_stiffness, material, Cantilever, ContactStiffness, Material,
     PhysicalModel, SILICON_TIP,
@@ -37,11 +39,16 @@ pub fn modes(a: &ModesArgs) -> Result<(), CliError> {
     if a.sweep.is_some() {
         return fig3(a, &p);
     }
-    let (free, contact) = spectrum(&p)?;
+    let Document {
+        output: (free, contact),
+        json,
+    } = request::run(
+        &ModesRequest {},
+        &Resolved { params: p, probe },
+        &Progress::new(),
+    )?;
     if a.json {
-        let mut doc = afmdyn::report::modes(&p, &free, &contact);
-        doc = afmdyn::report::with_si(doc, probe.as_ref(), &p);
-        println!("{doc}");
+        println!("{json}");
         return Ok(());
     }
     println!(

@@ -6,7 +6,10 @@ use crate::cmd_simulate::parse_initial;
 use crate::error::CliError;
 use crate::output::{f, io_error, write_csv, OutDir};
 use crate::plot::{save, Figure, Series, Style};
+use crate::progress;
 use afmdyn::analysis::continuation::BranchPoint;
+use afmdyn::analysis::progress::Progress;
+use afmdyn::request::{self, Document, Resolved};
 use afmdyn::request::{ContinuationRequest, LyapunovRequest, OrbitRequest, StartRequest};
 use afmdyn::{CantileverModel, Params, SweepParam};
 use clap::Args;
@@ -50,17 +53,15 @@ pub struct OrbitArgs {
 /// Run `afmdyn orbit`.
 pub fn orbit(a: &OrbitArgs) -> Result<(), CliError> {
     let (p, probe) = a.model.resolve(Params::default())?;
-    let model = CantileverModel::new(&p)?;
     let request = OrbitRequest {
         period: a.period,
         start: a.start.request(p.modes)?,
     };
-    let o = request.run(&p)?;
+    let Document { output: o, json } =
+        request::run(&request, &Resolved { params: p, probe }, &Progress::new())?;
     let n = o.period;
     if a.json {
-        let mut doc = afmdyn::report::orbit(&model, &o);
-        doc = afmdyn::report::with_si(doc, probe.as_ref(), &p);
-        println!("{doc}");
+        println!("{json}");
         return Ok(());
     }
     println!(
@@ -88,6 +89,7 @@ pub fn orbit(a: &OrbitArgs) -> Result<(), CliError> {
         o.grazing_distance,
         if o.grazing { " (grazing)" } else { "" }
     );
+    let model = CantileverModel::new(&p)?;
     for (k, z) in o.section.iter().enumerate() {
         println!("  section {k}: W(1,τ) = {:.9}", model.w_tip(z));
     }
@@ -189,7 +191,14 @@ pub fn continuation(a: &ContinueArgs) -> Result<(), CliError> {
         check_overlay(o)?;
     }
     let out = OutDir::lock(&a.out)?;
-    let branches: Vec<Vec<BranchPoint>> = request.run(&base)?;
+    let model = Resolved {
+        params: base,
+        probe,
+    };
+    let Document {
+        output: branches,
+        json,
+    } = progress::run(&request, &model, "branch points")?;
     let model = CantileverModel::new(&base.with(a.param, a.from))?;
     let n = branches[0].first().map_or(1, |b| b.period);
     write_csv(
@@ -304,9 +313,7 @@ pub fn continuation(a: &ContinueArgs) -> Result<(), CliError> {
         },
     )?;
     if a.json {
-        let mut doc = afmdyn::report::continuation(&base, a.param, &branches);
-        doc = afmdyn::report::with_si(doc, probe.as_ref(), &base);
-        println!("{doc}");
+        println!("{json}");
     } else {
         println!(
             "{} branch(es), {} points; located:",
@@ -352,21 +359,20 @@ pub struct LyapunovArgs {
 /// Run `afmdyn lyapunov`.
 pub fn lyapunov(a: &LyapunovArgs) -> Result<(), CliError> {
     let (p, probe) = a.model.resolve(Params::default())?;
-    let l = LyapunovRequest {
+    let request = LyapunovRequest {
         initial: parse_initial(&a.initial_modal, p.modes)?,
         transient: a.transient,
         periods: a.periods,
         blocks: a.blocks,
-    }
-    .run(&p)?;
+    };
+    let Document { output: l, json } =
+        progress::run(&request, &Resolved { params: p, probe }, "periods")?;
     let warnings = &l.warnings;
     for w in warnings {
         eprintln!("afmdyn: warning: {w}");
     }
     if a.json {
-        let mut doc = afmdyn::report::lyapunov(&p, &l);
-        doc = afmdyn::report::with_si(doc, probe.as_ref(), &p);
-        println!("{doc}");
+        println!("{json}");
         return Ok(());
     }
     println!(

@@ -9,6 +9,7 @@ use crate::plot::{decimate_line, save, Figure, Series, Style};
 use afmdyn::analysis::spectrum::{amplitude_spectrum, SPECTRUM_SAMPLES};
 use afmdyn::integrate::build;
 use afmdyn::request::{ConvergeRequest, SeriesStore, SimulateRequest};
+use afmdyn::request::{Document, Resolved};
 use afmdyn::trajectory::chunked::{record_chunked, Chunk, ChunkedSpec};
 use afmdyn::trajectory::Sample;
 use afmdyn::{CantileverModel, Params, Region};
@@ -593,7 +594,8 @@ pub fn converge(a: &ConvergeArgs) -> Result<(), CliError> {
     };
     request.validate()?;
     let out = OutDir::lock(&a.out)?;
-    let runs = request.run(&p)?;
+    let Document { output: runs, json } =
+        crate::progress::run(&request, &Resolved { params: p, probe }, "mode counts")?;
     let k = runs.iter().map(|r| r.w_tip.len()).min().unwrap_or(0);
     let mut header = vec!["tau_from_section".to_string()];
     header.extend(runs.iter().map(|r| format!("w_tip_n{}", r.modes)));
@@ -633,8 +635,7 @@ pub fn converge(a: &ConvergeArgs) -> Result<(), CliError> {
         },
     )?;
     if a.json {
-        let mut doc = afmdyn::report::converge(&p, &runs);
-        doc = afmdyn::report::with_si(doc, probe.as_ref(), &p);
+        let mut doc = json;
         doc["out"] = json!(a.out);
         println!("{doc}");
     } else {

@@ -9,6 +9,7 @@ mod cmd_simulate;
 mod error;
 mod output;
 mod plot;
+mod progress;
 
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use error::CliError;

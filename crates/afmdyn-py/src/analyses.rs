@@ -8,14 +8,14 @@ use crate::convert::Out;
 use crate::errors::{probe_error, sim_error, value_error};
 use crate::params::PyParams;
 use crate::run::{run, run_abandonable, Job, Stop};
-use afmdyn::analysis::attractors::find_attractors;
 use afmdyn::analysis::bifurcation::{SweepPoint, SweepSpec};
 use afmdyn::analysis::continuation::BranchEvent;
 use afmdyn::analysis::spectrum::{amplitude_spectrum, SPECTRUM_SAMPLES};
 use afmdyn::analysis::steady::SteadyState;
-use afmdyn::eigen::spectrum;
 use afmdyn::integrate::{build, IntegratorOptions};
+use afmdyn::probe::Probe;
 use afmdyn::request::checkpoint::{self, Checkpoint, CheckpointError};
+use afmdyn::request::{self, Analysis, Document, ModesRequest, Resolved};
 use afmdyn::request::{fingerprint, FileCheckpoint, MemoryCheckpoint, SweepRecord};
 use afmdyn::request::{
     AttractorsRequest, BifurcationRequest, ContinuationRequest, ConvergeRequest, IntegratorRequest,
@@ -28,7 +28,7 @@ use nalgebra::DVector;
 use numpy::Complex64;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
-use std::sync::atomic::Ordering;
+use std::path::PathBuf;
 
 type Dict<'py> = Bound<'py, PyDict>;
 
@@ -75,6 +75,41 @@ fn initial_state(model: &CantileverModel, initial: Option<Vec<f64>>) -> PyResult
     afmdyn::request::analyses::initial_state(model, initial.as_deref()).map_err(sim_error)
 }
 
+/// The library's [`request::run`] of `request` on `params` (with the probe file's SI block in
+/// the document) on a worker thread without the GIL: validated first, here; a `counted`
+/// analysis reports its progress and stops at its next check on an interrupt
+/// ([`Stop::Cancellable`]), the others are abandoned ([`Stop::Abandon`]).
+pub fn analysis<A>(
+    py: Python<'_>,
+    request: A,
+    params: Params,
+    probe: Option<PathBuf>,
+    progress: Option<&Bound<'_, PyAny>>,
+    counted: bool,
+) -> PyResult<Document<A::Output>>
+where
+    A: Analysis + Send + 'static,
+    A::Output: Send + 'static,
+{
+    let probe = probe
+        .map(|path| Probe::load(&path))
+        .transpose()
+        .map_err(probe_error)?;
+    let model = Resolved { params, probe };
+    request.validate(&model).map_err(sim_error)?;
+    let job = Job::default();
+    let worker = job.clone();
+    let stop = if counted {
+        Stop::Cancellable
+    } else {
+        Stop::Abandon
+    };
+    run(py, &job, None, progress, stop, move || {
+        request::run(&request, &model, &worker.progress)
+    })?
+    .map_err(sim_error)
+}
+
 fn model_of(p: &Params) -> PyResult<CantileverModel> {
     CantileverModel::new(p).map_err(crate::errors::param_error)
 }
@@ -87,13 +122,16 @@ fn flatten(rows: impl IntoIterator<Item = DVector<f64>>) -> Vec<f64> {
 
 /// Natural frequencies and damped eigenvalues of the free and contact systems (eqs. 19–23).
 #[pyfunction]
-pub fn modes<'py>(py: Python<'py>, params: PyRef<'_, PyParams>) -> PyResult<Dict<'py>> {
-    let p = params.inner;
-    let (free, contact) = py
-        .detach(move || spectrum(&p))
-        .map_err(crate::errors::param_error)?;
+#[pyo3(signature = (params, probe=None))]
+pub fn modes<'py>(
+    py: Python<'py>,
+    params: PyRef<'_, PyParams>,
+    probe: Option<PathBuf>,
+) -> PyResult<Dict<'py>> {
+    let doc = analysis(py, ModesRequest {}, params.inner, probe, None, false)?;
+    let (free, contact) = doc.output;
     let out = Out::new(py);
-    out.json(&report::modes(&p, &free, &contact))?;
+    out.json(&doc.json)?;
     for (name, r) in [("free", &free), ("contact", &contact)] {
         out.f64s(&format!("{name}_omega"), r.omega.clone())?;
         out.complex(
@@ -207,7 +245,7 @@ fn simulate_columns(
 #[pyfunction]
 #[pyo3(signature = (params, periods=None, tau_end=None, transient=0.0, initial=None,
     samples_per_period=200, integrator=None, steps_per_period=None, tolerance=1e-12,
-    progress=None))]
+    progress=None, probe=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate<'py>(
     py: Python<'py>,
@@ -221,8 +259,13 @@ pub fn simulate<'py>(
     steps_per_period: Option<usize>,
     tolerance: f64,
     progress: Option<Bound<'py, PyAny>>,
+    probe: Option<PathBuf>,
 ) -> PyResult<Dict<'py>> {
     let p = params.inner;
+    let probe = probe
+        .map(|path| Probe::load(&path))
+        .transpose()
+        .map_err(probe_error)?;
     let request = SimulateRequest {
         periods,
         tau_end,
@@ -249,7 +292,7 @@ pub fn simulate<'py>(
         simulate_columns(p, initial, opts, spec)
     })??;
     let out = Out::new(py);
-    out.json(&c.doc)?;
+    out.json(&report::with_si(c.doc.clone(), probe.as_ref(), &p))?;
     let s = c.tau.len();
     let n = c.n;
     out.f64s("tau", c.tau)?;
@@ -297,7 +340,7 @@ pub fn simulate<'py>(
 /// Mode-number convergence (paper Fig. 4).
 #[pyfunction]
 #[pyo3(signature = (params, max_modes=4, periods=1, samples_per_period=200, integrator=None,
-    steps_per_period=None, tolerance=1e-12, progress=None))]
+    steps_per_period=None, tolerance=1e-12, progress=None, probe=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn converge<'py>(
     py: Python<'py>,
@@ -309,19 +352,18 @@ pub fn converge<'py>(
     steps_per_period: Option<usize>,
     tolerance: f64,
     progress: Option<Bound<'py, PyAny>>,
+    probe: Option<PathBuf>,
 ) -> PyResult<Dict<'py>> {
-    let p = params.inner;
     let request = ConvergeRequest {
         max_modes,
         periods,
         samples_per_period,
         integrator: integrator_request(integrator, steps_per_period, tolerance)?,
     };
-    request.validate().map_err(sim_error)?;
-    let runs =
-        run_abandonable(py, progress.as_ref(), move || request.run(&p))?.map_err(sim_error)?;
+    let doc = analysis(py, request, params.inner, probe, progress.as_ref(), true)?;
+    let runs = doc.output;
     let out = Out::new(py);
-    out.json(&report::converge(&p, &runs))?;
+    out.json(&doc.json)?;
     let k = runs.iter().map(|r| r.w_tip.len()).min().unwrap_or(0);
     let r = runs.len();
     let t0 = runs[0].tau[0];
@@ -376,16 +418,13 @@ fn sweep_into<C: Checkpoint>(
 ) -> Result<(), CheckpointError> {
     let fp = fingerprint(request, spec);
     let Some(left) = checkpoint::open(store, &fp, resume)? else {
-        job.done
-            .store(checkpoint::point_count(spec), Ordering::Relaxed);
+        job.progress.advance(checkpoint::point_count(spec));
         return Ok(()); // finished before
     };
-    job.done.store(left.done.len(), Ordering::Relaxed);
-    let each = |_: &SweepPoint| {
-        job.done.fetch_add(1, Ordering::Relaxed);
-    };
-    checkpoint::run(spec, &left, store, &job.cancel, &each)?;
-    if job.cancel.load(Ordering::Relaxed) {
+    job.progress.advance(left.done.len());
+    let each = |_: &SweepPoint| job.progress.tick();
+    checkpoint::run(spec, &left, store, job.progress.cancel_flag(), &each)?;
+    if job.progress.is_cancelled() {
         return Ok(()); // interrupted: the store keeps what is done, for a resume
     }
     store.finish(&fp)
@@ -571,7 +610,8 @@ fn steady_dict<'py>(py: Python<'py>, s: &SteadyState) -> PyResult<Dict<'py>> {
 /// Coexisting attractors and their basin fractions at fixed parameters.
 #[pyfunction]
 #[pyo3(signature = (params, samples=64, seed=1, cluster_tol=1e-5, tol=1e-8, max_periods=1500,
-    max_period=64, integrator=None, steps_per_period=None, tolerance=1e-12, progress=None))]
+    max_period=64, integrator=None, steps_per_period=None, tolerance=1e-12, progress=None,
+    probe=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn attractors<'py>(
     py: Python<'py>,
@@ -586,21 +626,19 @@ pub fn attractors<'py>(
     steps_per_period: Option<usize>,
     tolerance: f64,
     progress: Option<Bound<'py, PyAny>>,
+    probe: Option<PathBuf>,
 ) -> PyResult<Dict<'py>> {
-    let p = params.inner;
-    let spec = AttractorsRequest {
+    let request = AttractorsRequest {
         samples,
         seed,
         cluster_tol,
         steady: steady(tol, max_periods, max_period),
         integrator: integrator_request(integrator, steps_per_period, tolerance)?,
-    }
-    .spec(&p)
-    .map_err(sim_error)?;
-    let report_ = run_abandonable(py, progress.as_ref(), move || find_attractors(&spec))?
-        .map_err(sim_error)?;
+    };
+    let doc = analysis(py, request, params.inner, probe, progress.as_ref(), true)?;
+    let report_ = doc.output;
     let out = Out::new(py);
-    out.json(&report::attractors(&p, samples, &report_))?;
+    out.json(&doc.json)?;
     let list = PyList::empty(py);
     for a in &report_.attractors {
         let d = steady_dict(py, &a.steady)?;
@@ -620,7 +658,7 @@ pub fn attractors<'py>(
 /// A period-n orbit by Newton shooting, with its Floquet multipliers.
 #[pyfunction]
 #[pyo3(signature = (params, period=None, initial=None, tol=1e-8, max_periods=1500,
-    max_period=64, progress=None))]
+    max_period=64, progress=None, probe=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn orbit<'py>(
     py: Python<'py>,
@@ -631,19 +669,16 @@ pub fn orbit<'py>(
     max_periods: usize,
     max_period: usize,
     progress: Option<Bound<'py, PyAny>>,
+    probe: Option<PathBuf>,
 ) -> PyResult<Dict<'py>> {
-    let p = params.inner;
     let request = OrbitRequest {
         period,
         start: start(initial, tol, max_periods, max_period),
     };
-    request.validate().map_err(sim_error)?;
-    let (doc, o) = run_abandonable(py, progress.as_ref(), move || -> PyResult<_> {
-        let o = request.run(&p).map_err(sim_error)?;
-        Ok((report::orbit(&model_of(&p)?, &o), o))
-    })??;
+    let doc = analysis(py, request, params.inner, probe, progress.as_ref(), false)?;
+    let o = doc.output;
     let out = Out::new(py);
-    out.json(&doc)?;
+    out.json(&doc.json)?;
     let dim = o.state.len();
     out.f64s("state", o.state.as_slice().to_vec())?;
     out.matrix("section", o.section.len(), dim, flatten(o.section.clone()))?;
@@ -675,7 +710,7 @@ fn event_name(e: BranchEvent) -> String {
 /// Pseudo-arclength continuation of a period-n branch, with located bifurcations.
 #[pyfunction]
 #[pyo3(signature = (params, param="omega", from_=5.0, to=1.0, period=None, switch=false,
-    initial=None, tol=1e-8, max_periods=1500, max_period=64, progress=None))]
+    initial=None, tol=1e-8, max_periods=1500, max_period=64, progress=None, probe=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn continuation<'py>(
     py: Python<'py>,
@@ -690,6 +725,7 @@ pub fn continuation<'py>(
     max_periods: usize,
     max_period: usize,
     progress: Option<Bound<'py, PyAny>>,
+    probe: Option<PathBuf>,
 ) -> PyResult<Dict<'py>> {
     let base = params.inner;
     let param: SweepParam = param.parse().map_err(value_error)?;
@@ -701,10 +737,9 @@ pub fn continuation<'py>(
         switch,
         start: start(initial, tol, max_periods, max_period),
     };
-    request.validate(&base).map_err(sim_error)?;
     let p0 = base.with(param, from_);
-    let branches =
-        run_abandonable(py, progress.as_ref(), move || request.run(&base))?.map_err(sim_error)?;
+    let doc = analysis(py, request, base, probe, progress.as_ref(), true)?;
+    let branches = doc.output;
     let model = model_of(&p0)?;
     let dim = 2 * base.modes;
     let rows: usize = branches.iter().map(Vec::len).sum();
@@ -760,7 +795,7 @@ pub fn continuation<'py>(
         }
     }
     let out = Out::new(py);
-    out.json(&report::continuation(&base, param, &branches))?;
+    out.json(&doc.json)?;
     out.set("param", param.name())?;
     out.set("symbol", param.symbol())?;
     out.i64s("branch", id)?;
@@ -782,7 +817,9 @@ pub fn continuation<'py>(
 
 /// Lyapunov spectrum (with saltation matrices) and the 0–1 test.
 #[pyfunction]
-#[pyo3(signature = (params, initial=None, transient=500, periods=4000, blocks=10, progress=None))]
+#[pyo3(signature = (params, initial=None, transient=500, periods=4000, blocks=10, progress=None,
+    probe=None))]
+#[allow(clippy::too_many_arguments)]
 pub fn lyapunov<'py>(
     py: Python<'py>,
     params: PyRef<'_, PyParams>,
@@ -791,18 +828,18 @@ pub fn lyapunov<'py>(
     periods: usize,
     blocks: usize,
     progress: Option<Bound<'py, PyAny>>,
+    probe: Option<PathBuf>,
 ) -> PyResult<Dict<'py>> {
-    let p = params.inner;
     let request = LyapunovRequest {
         initial,
         transient,
         periods,
         blocks,
     };
-    request.validate().map_err(sim_error)?;
-    let l = run_abandonable(py, progress.as_ref(), move || request.run(&p))?.map_err(sim_error)?;
+    let doc = analysis(py, request, params.inner, probe, progress.as_ref(), true)?;
+    let l = doc.output;
     let out = Out::new(py);
-    out.json(&report::lyapunov(&p, &l))?;
+    out.json(&doc.json)?;
     out.f64s("exponents", l.exponents.clone())?;
     out.f64s("uncertainty", l.uncertainty.clone())?;
     Ok(out.finish())
@@ -822,7 +859,7 @@ pub fn probe(path: std::path::PathBuf) -> PyResult<(PyParams, String)> {
 /// [`afmdyn::analysis::observables::observe`] integrates `periods` orbit periods.
 #[pyfunction]
 #[pyo3(signature = (params, initial=None, periods=1, harmonics=10, tol=1e-8, max_periods=1500,
-    max_period=64, progress=None))]
+    max_period=64, progress=None, probe=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn observe<'py>(
     py: Python<'py>,
@@ -834,21 +871,17 @@ pub fn observe<'py>(
     max_periods: usize,
     max_period: usize,
     progress: Option<Bound<'py, PyAny>>,
+    probe: Option<PathBuf>,
 ) -> PyResult<Dict<'py>> {
-    let p = params.inner;
     let request = ObserveRequest {
         periods,
         harmonics,
         start: start(initial, tol, max_periods, max_period),
     };
-    request.validate().map_err(sim_error)?;
-    let (doc, z, n) = run_abandonable(py, progress.as_ref(), move || -> PyResult<_> {
-        let o = request.run(&p).map_err(sim_error)?;
-        Ok((report::observables(&o.observables), o.state, o.period))
-    })??;
+    let doc = analysis(py, request, params.inner, probe, progress.as_ref(), false)?;
     let out = Out::new(py);
-    out.json(&doc)?;
-    out.f64s("state", z.as_slice().to_vec())?;
-    out.set("period", n)?;
+    out.json(&doc.json)?;
+    out.f64s("state", doc.output.state.as_slice().to_vec())?;
+    out.set("period", doc.output.period)?;
     Ok(out.finish())
 }

@@ -36,7 +36,6 @@ fn _afmdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(analyses::observe, m)?)?;
     m.add("POLL_SECONDS", run::POLL.as_secs_f64())?;
     m.add_function(wrap_pyfunction!(params::resolve, m)?)?;
-    m.add_function(wrap_pyfunction!(params::with_si, m)?)?;
     // the one table of model parameters: (name, alias or name, unit, range, help)
     m.add(
         "MODEL_PARAMETERS",

@@ -166,20 +166,6 @@ pub fn resolve(
     })
 }
 
-/// The command line's JSON document `json` with the `"si"` block of the probe file at `probe`
-/// ([`afmdyn::report::with_si`]), for the analyses called with `probe=`.
-#[pyfunction]
-pub fn with_si(
-    json: &str,
-    probe: std::path::PathBuf,
-    params: PyRef<'_, PyParams>,
-) -> PyResult<String> {
-    let pr = afmdyn::probe::Probe::load(&probe).map_err(crate::errors::probe_error)?;
-    let doc: serde_json::Value = serde_json::from_str(json)
-        .map_err(|e| PyValueError::new_err(format!("with_si: not a JSON document: {e}")))?;
-    Ok(afmdyn::report::with_si(doc, Some(&pr), &params.inner).to_string())
-}
-
 /// Dimensionless model parameters (paper eq. 7), validated on construction.
 ///
 /// ``Params(**model)`` takes the keywords of every analysis: ``modes`` (N, 1..=20),

@@ -2,10 +2,10 @@
 //! thread waits with the GIL released, waking every [`POLL`] to run Python's signal handlers
 //! (Ctrl-C raises `KeyboardInterrupt`) and to report progress.
 
+use afmdyn::analysis::progress::Progress;
 use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
 use std::panic::{catch_unwind, AssertUnwindSafe};
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::mpsc::{channel, RecvTimeoutError};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
@@ -13,13 +13,14 @@ use std::time::Duration;
 /// How often the waiting thread checks for signals and reports progress.
 pub const POLL: Duration = Duration::from_millis(50);
 
-/// Shared between the worker and the waiting thread: units of work done, and the cancel flag.
+/// Shared between the worker and the waiting thread: the library's [`Progress`] of the run,
+/// the units of work done (sweep points, random starts, curve points, periods) and the cancel
+/// flag, set when the caller was interrupted (a cancellable computation stops at its next
+/// check).
 #[derive(Clone, Default)]
 pub struct Job {
-    /// Units of work finished (sweep points); 0 when the computation cannot count.
-    pub done: Arc<AtomicUsize>,
-    /// Set when the caller was interrupted: a cancellable computation stops at its next check.
-    pub cancel: Arc<AtomicBool>,
+    /// The run's progress and cancel flag.
+    pub progress: Arc<Progress>,
 }
 
 /// How the computation reacts to an interrupt.
@@ -43,7 +44,8 @@ fn panic_message(p: Box<dyn std::any::Any + Send>) -> String {
 }
 
 /// Run `work` on a worker thread with the GIL released. `progress(done, total)` is called from
-/// the calling thread (with the GIL) at every poll and once at the end.
+/// the calling thread (with the GIL) at every poll and once at the end; `total` is the given
+/// one, else the one the run counts in [`Job::progress`].
 ///
 /// # Errors
 /// `KeyboardInterrupt` (or whatever a signal handler raises), an exception raised by
@@ -73,7 +75,7 @@ where
     let report = |py: Python<'_>| -> PyResult<()> {
         if let Some(cb) = progress {
             let _ = py;
-            cb.call1((job.done.load(Ordering::Relaxed), total))?;
+            cb.call1((job.progress.done(), total.or(job.progress.total())))?;
         }
         Ok(())
     };
@@ -96,7 +98,7 @@ where
             Err(RecvTimeoutError::Timeout) => {}
         }
         if let Err(e) = py.check_signals().and_then(|_| report(py)) {
-            job.cancel.store(true, Ordering::Relaxed);
+            job.progress.cancel();
             if stop == Stop::Cancellable {
                 // the points already running finish; no new one starts
                 let _ = py.detach(|| rx.lock().expect("receiver").recv());

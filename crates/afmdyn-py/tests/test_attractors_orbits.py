@@ -150,3 +150,18 @@ def test_lyapunov_from_an_attractor_and_errors(att28):
         afmdyn.lyapunov(periods=1, blocks=10)
     with pytest.raises(ValueError, match="blocks = -2"):
         afmdyn.lyapunov(blocks=-2)
+
+
+def test_counted_analyses_report_their_progress():
+    """The library counts the units of work of a run (random starts, curve points, periods,
+    mode counts) and the callback sees the count and its total."""
+    calls = []
+    afmdyn.attractors(samples=4, progress=lambda d, t: calls.append((d, t)))
+    assert calls[-1] == (4, 4)
+    calls.clear()
+    afmdyn.lyapunov(transient=10, periods=40, blocks=4, progress=lambda d, t: calls.append((d, t)))
+    assert calls[-1] == (50, 50)
+    calls.clear()
+    afmdyn.approach(points=5, branches=False, progress=lambda d, t: calls.append((d, t)))
+    assert calls[-1] == (10, 10)  # approach and retract
+    assert [d for d, _ in calls] == sorted(d for d, _ in calls)

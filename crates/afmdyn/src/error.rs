@@ -195,6 +195,9 @@ pub enum SimError {
         /// The analysis.
         analysis: &'static str,
     },
+    /// The caller cancelled the run ([`crate::analysis::progress::Progress::cancel`]).
+    #[error("cancelled")]
+    Cancelled,
     /// The adaptive oracle integrator reported a failure.
     #[error("adaptive integrator failed at tau = {tau}: {message}")]
     Adaptive {

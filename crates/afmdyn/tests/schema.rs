@@ -6,6 +6,7 @@
 //! here it must deserialise back to the default.
 #![cfg(feature = "schema")]
 
+use afmdyn::request::{ApproachRequest, ModesRequest, ResonanceRequest};
 use afmdyn::request::{
     AttractorsRequest, BifurcationRequest, ContinuationRequest, ConvergeRequest, CurveRequest,
     IntegratorRequest, LyapunovRequest, ModelSpec, ObserveRequest, OrbitRequest, SimulateRequest,
@@ -59,6 +60,9 @@ fn schemas() -> Vec<(&'static str, Value)> {
         ("simulate", schema::<SimulateRequest>("simulate")),
         ("bifurcation", schema::<BifurcationRequest>("bifurcation")),
         ("curve", schema::<CurveRequest>("curve")),
+        ("modes", schema::<ModesRequest>("modes")),
+        ("approach", schema::<ApproachRequest>("approach")),
+        ("resonance", schema::<ResonanceRequest>("resonance")),
     ]
 }
 

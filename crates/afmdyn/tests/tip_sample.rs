@@ -211,7 +211,7 @@ fn an_orbit_that_touches_the_sample_keeps_liouvilles_volume_law() {
             ..LyapunovOptions::default()
         };
         it.reset(0.0, &orbit.state).unwrap();
-        let l = lyapunov_spectrum_with(it.as_mut(), &opts).unwrap();
+        let l = lyapunov_spectrum_with(it.as_mut(), &opts, &Default::default()).unwrap();
         let sum: f64 = l.exponents.iter().sum();
         assert!((sum + 2.0 * sys.zeta).abs() < 1e-9, "λ1 + λ2 = {sum}");
         assert!(l.exponents[0] < 0.0);

@@ -127,7 +127,7 @@ class Params:
     def __eq__(self, other: object) -> bool: ...
     def __reduce__(self) -> Tuple[Any, Tuple[str]]: ...
 
-def modes(params: Params) -> Dict[str, Any]: ...
+def modes(params: Params, probe: Optional[str] = None) -> Dict[str, Any]: ...
 def simulate(
     params: Params,
     periods: Optional[float] = None,
@@ -139,6 +139,7 @@ def simulate(
     steps_per_period: Optional[int] = None,
     tolerance: float = 1e-12,
     progress: Optional[ProgressCallback] = None,
+    probe: Optional[str] = None,
 ) -> Dict[str, Any]: ...
 def converge(
     params: Params,
@@ -149,6 +150,7 @@ def converge(
     steps_per_period: Optional[int] = None,
     tolerance: float = 1e-12,
     progress: Optional[ProgressCallback] = None,
+    probe: Optional[str] = None,
 ) -> Dict[str, Any]: ...
 def bifurcation(
     params: Params,
@@ -183,6 +185,7 @@ def attractors(
     steps_per_period: Optional[int] = None,
     tolerance: float = 1e-12,
     progress: Optional[ProgressCallback] = None,
+    probe: Optional[str] = None,
 ) -> Dict[str, Any]: ...
 def orbit(
     params: Params,
@@ -192,6 +195,7 @@ def orbit(
     max_periods: int = 1500,
     max_period: int = 64,
     progress: Optional[ProgressCallback] = None,
+    probe: Optional[str] = None,
 ) -> Dict[str, Any]: ...
 def continuation(
     params: Params,
@@ -205,6 +209,7 @@ def continuation(
     max_periods: int = 1500,
     max_period: int = 64,
     progress: Optional[ProgressCallback] = None,
+    probe: Optional[str] = None,
 ) -> Dict[str, Any]: ...
 def lyapunov(
     params: Params,
@@ -213,6 +218,7 @@ def lyapunov(
     periods: int = 4000,
     blocks: int = 10,
     progress: Optional[ProgressCallback] = None,
+    probe: Optional[str] = None,
 ) -> Dict[str, Any]: ...
 def probe(path: Union[str, "os.PathLike[str]"]) -> Tuple[Params, str]: ...
 def resolve(
@@ -221,7 +227,6 @@ def resolve(
     probe: Optional[str] = None,
     model: Optional[Dict[str, Any]] = None,
 ) -> Params: ...
-def with_si(json: str, probe: str, params: Params) -> str: ...
 def observe(
     params: Params,
     initial: Optional[List[float]] = None,
@@ -231,6 +236,7 @@ def observe(
     max_periods: int = 1500,
     max_period: int = 64,
     progress: Optional[ProgressCallback] = None,
+    probe: Optional[str] = None,
 ) -> Dict[str, Any]: ...
 def approach(
     params: Params,

@@ -124,14 +124,15 @@ def _run(
 ) -> Dict[str, Any]:
     """Call the compiled ``fn`` with a progress reporter; negative counts are a ValueError
     naming the option (the core's unsigned integers would raise OverflowError). With ``si`` (a
-    probe file) the JSON document gains the command line's ``"si"`` block."""
+    probe file) ``fn`` gets ``probe=si``, and its JSON document the command line's ``"si"``
+    block (added by the library's request layer)."""
     for k, v in options.items():
         if k in _COUNTS and isinstance(v, int) and not isinstance(v, bool) and v < 0:
             raise ValueError(f"{k} = {v}: must be >= 0")
+    if si is not None:
+        options["probe"] = si
     with reporter(progress, desc) as cb:
         d = fn(p, progress=cb, **options)
-    if si is not None and "json" in d:
-        d["json"] = _core.with_si(d["json"], si, p)
     return d
 
 
@@ -149,9 +150,7 @@ def modes(params: Optional[Params] = None, /, **model: Unpack[Model]) -> Spectru
     complex128, ζ); ``to_dict()`` is ``afmdyn modes --json``.
     """
     p, probe = _params(params, model)
-    d = _core.modes(p)
-    if probe is not None:
-        d["json"] = _core.with_si(d["json"], probe, p)
+    d = _core.modes(p, probe=probe)
 
     def region(name: str) -> RegionSpectrum:
         return RegionSpectrum(d[f"{name}_omega"], d[f"{name}_eigenvalues"], d[f"{name}_zeta"])
@@ -457,12 +456,12 @@ def bifurcation(
     """
     p, probe = _params(params, model)
     vals = None if values is None else np.asarray(values, dtype=np.float64).ravel().tolist()
+    # the sweep's records carry no JSON document, so no "si" block: the probe only resolved p
     d = _run(
         _core.bifurcation,
         "bifurcation",
         progress,
         p,
-        si=probe,
         param=param,
         values=vals,
         from_=from_,

@@ -10,6 +10,7 @@ use super::period::close;
 use super::sequential::*;
 use super::shooting::{shoot_with, PeriodicOrbit, ShootingOptions};
 use super::steady::{steady_state, PoincarePoint, SteadyOptions, SteadyState};
+use crate::analysis::progress::Progress;
 use crate::error::SimError;
 use crate::integrate::{build, IntegratorKind, IntegratorOptions};
 use crate::model::CantileverModel;
@@ -113,9 +114,23 @@ pub fn same_attractor(a: &SteadyState, b: &SteadyState, tol: f64) -> bool {
 /// [`SimError`] for invalid parameters or options (individual failing starts are reported in
 /// [`AttractorReport::failures`]).
 pub fn find_attractors(spec: &AttractorSpec) -> Result<AttractorReport, SimError> {
+    find_attractors_with(spec, &Progress::new())
+}
+
+/// [`find_attractors`] counting the random starts done in `progress` (its total grows by
+/// `samples`) and stopping when it is cancelled.
+///
+/// # Errors
+/// As [`find_attractors`]; [`SimError::Cancelled`] once `progress` is cancelled.
+pub fn find_attractors_with(
+    spec: &AttractorSpec,
+    progress: &Progress,
+) -> Result<AttractorReport, SimError> {
     spec.validate()?;
     let model = CantileverModel::new(&spec.params)?;
-    let results = steady_states_of_starts(&model, spec);
+    progress.add_total(spec.samples);
+    let results = steady_states_of_starts(&model, spec, progress);
+    progress.check()?;
     let mut attractors: Vec<Attractor> = Vec::new();
     let mut failures = Vec::new();
     for (z0, r) in results {
@@ -160,14 +175,21 @@ type StartResult = (DVector<f64>, Result<SteadyState, SimError>);
 /// at N = 3 and 0.6–1.3× at N = 10 in `period_cost census` over several runs, and a batch of
 /// 32 lanes keeps one core busy where the starts alone spread over all of them;
 /// `docs/performance.md`.)
-fn steady_states_of_starts(model: &CantileverModel, spec: &AttractorSpec) -> Vec<StartResult> {
+fn steady_states_of_starts(
+    model: &CantileverModel,
+    spec: &AttractorSpec,
+    progress: &Progress,
+) -> Vec<StartResult> {
     (0..spec.samples)
         .into_par_iter()
         .with_max_len(1)
         .map(|i| {
             let z0 = random_state(model, spec.seed, i as u64);
-            let r = build(model, spec.integrator, 0.0, &z0)
-                .and_then(|mut it| steady_state(it.as_mut(), &spec.steady));
+            let r = progress.check().and_then(|()| {
+                build(model, spec.integrator, 0.0, &z0)
+                    .and_then(|mut it| steady_state(it.as_mut(), &spec.steady))
+            });
+            progress.tick();
             (z0, r)
         })
         .collect()

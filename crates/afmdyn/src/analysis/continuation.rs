@@ -19,6 +19,7 @@ use super::monodromy::{
 use super::shooting::{
     floquet_stability, section_points, shoot_with, Instability, ShootingOptions,
 };
+use crate::analysis::progress::Progress;
 use crate::error::SimError;
 use crate::integrate::{build, Integrator, IntegratorOptions};
 use crate::model::CantileverModel;
@@ -396,6 +397,19 @@ pub fn continue_branch(
     spec: &ContinuationSpec,
     guess: &DVector<f64>,
 ) -> Result<Vec<BranchPoint>, SimError> {
+    continue_branch_with(spec, guess, &Progress::new())
+}
+
+/// [`continue_branch`] counting every branch point in `progress` (a branch's length is not
+/// known ahead: the total is left as it is) and stopping when it is cancelled.
+///
+/// # Errors
+/// As [`continue_branch`]; [`SimError::Cancelled`] once `progress` is cancelled.
+pub fn continue_branch_with(
+    spec: &ContinuationSpec,
+    guess: &DVector<f64>,
+    progress: &Progress,
+) -> Result<Vec<BranchPoint>, SimError> {
     spec.base.with(spec.param, spec.from).validate()?;
     spec.base.with(spec.param, spec.to).validate()?;
     let mut solver = Solver::new(spec)?;
@@ -423,7 +437,9 @@ pub fn continue_branch(
     let mut mu_prev = out[0].multipliers.clone();
     let mut widest = 0.0f64;
     let first = y.clone();
+    progress.tick();
     while out.len() < spec.max_points {
+        progress.check()?;
         let y_pred = &y + &t * ds;
         let (y_new, map_new, iters, fp_new) = match solver.correct(&y_pred, &t) {
             Ok(r) => r,
@@ -506,6 +522,7 @@ pub fn continue_branch(
                     });
                 if !again {
                     out.push(bp);
+                    progress.tick();
                 }
             }
         }
@@ -551,6 +568,7 @@ pub fn continue_branch(
         s += ds;
         pt.s = s;
         out.push(pt);
+        progress.tick();
         if closed || merged {
             break;
         }
@@ -650,7 +668,22 @@ pub fn continue_with_switching(
     guess: &DVector<f64>,
     max_period: usize,
 ) -> Result<Vec<Vec<BranchPoint>>, SimError> {
-    let mut branches = vec![continue_branch(spec, guess)?];
+    continue_with_switching_with(spec, guess, max_period, &Progress::new())
+}
+
+/// [`continue_with_switching`] counting every branch point in `progress` and stopping when it
+/// is cancelled.
+///
+/// # Errors
+/// As [`continue_with_switching`]; [`SimError::Cancelled`] once `progress` is cancelled (also
+/// inside a sub-branch, whose other failures are skipped).
+pub fn continue_with_switching_with(
+    spec: &ContinuationSpec,
+    guess: &DVector<f64>,
+    max_period: usize,
+    progress: &Progress,
+) -> Result<Vec<Vec<BranchPoint>>, SimError> {
+    let mut branches = vec![continue_branch_with(spec, guess, progress)?];
     let mut next = 0;
     while next < branches.len() {
         let pds: Vec<BranchPoint> = branches[next]
@@ -697,8 +730,10 @@ pub fn continue_with_switching(
                         .collect(),
                     ..spec.clone()
                 };
-                let Ok(b) = continue_branch(&sub, &z) else {
-                    continue;
+                let b = match continue_branch_with(&sub, &z, progress) {
+                    Ok(b) => b,
+                    Err(SimError::Cancelled) => return Err(SimError::Cancelled),
+                    Err(_) => continue,
                 };
                 let marks = |br: &[BranchPoint]| -> Vec<(BranchEvent, f64)> {
                     br.iter()

@@ -1,5 +1,6 @@
 //! Mode-number convergence (paper Fig. 4): the steady-state tip motion for N = 1..N_max.
 
+use super::progress::Progress;
 use super::steady::{steady_state, SteadyOptions};
 use crate::error::SimError;
 use crate::integrate::{build, IntegratorOptions};
@@ -37,6 +38,31 @@ pub fn mode_convergence(
     steady: &SteadyOptions,
     integrator: IntegratorOptions,
 ) -> Result<Vec<ConvergenceRun>, SimError> {
+    mode_convergence_with(
+        params,
+        max_modes,
+        periods,
+        samples_per_period,
+        steady,
+        integrator,
+        &Progress::new(),
+    )
+}
+
+/// [`mode_convergence`] counting the runs done (N = 1..=`max_modes`) in `progress` and
+/// stopping when it is cancelled.
+///
+/// # Errors
+/// As [`mode_convergence`]; [`SimError::Cancelled`] once `progress` is cancelled.
+pub fn mode_convergence_with(
+    params: &Params,
+    max_modes: usize,
+    periods: usize,
+    samples_per_period: usize,
+    steady: &SteadyOptions,
+    integrator: IntegratorOptions,
+    progress: &Progress,
+) -> Result<Vec<ConvergenceRun>, SimError> {
     if periods == 0 || samples_per_period == 0 {
         return Err(SimError::out_of_range(
             "periods / samples per period",
@@ -45,7 +71,9 @@ pub fn mode_convergence(
         ));
     }
     let mut runs: Vec<ConvergenceRun> = Vec::with_capacity(max_modes);
+    progress.add_total(max_modes);
     for n in 1..=max_modes {
+        progress.check()?;
         let p = Params {
             modes: n,
             ..*params
@@ -91,6 +119,7 @@ pub fn mode_convergence(
             w_tip,
             rms_change,
         });
+        progress.tick();
     }
     Ok(runs)
 }

@@ -12,6 +12,7 @@
 //! motion. It uses no derivative information, so it checks the exponents independently.
 
 use super::monodromy::flow_with_jacobian;
+use crate::analysis::progress::Progress;
 use crate::error::SimError;
 use crate::integrate::Integrator;
 use crate::integrate::{advance, build, IntegratorOptions};
@@ -113,17 +114,20 @@ pub fn lyapunov_spectrum(
 ) -> Result<LyapunovSpectrum, SimError> {
     opts.validate()?;
     let mut integ = build(model, opts.integrator, 0.0, z0)?;
-    lyapunov_spectrum_with(integ.as_mut(), opts)
+    lyapunov_spectrum_with(integ.as_mut(), opts, &Progress::new())
 }
 
 /// [`lyapunov_spectrum`] with a given integrator of any [`crate::TipSampleSystem`], from its
-/// current state (moved to τ = 0 if it is not there; `opts.integrator` is not used).
+/// current state (moved to τ = 0 if it is not there; `opts.integrator` is not used), counting
+/// the drive periods done in `progress` (transient and recorded) and stopping when it is
+/// cancelled (checked before and after the transient, then every period).
 ///
 /// # Errors
-/// As [`lyapunov_spectrum`].
+/// As [`lyapunov_spectrum`]; [`SimError::Cancelled`] once `progress` is cancelled.
 pub fn lyapunov_spectrum_with(
     integ: &mut dyn Integrator,
     opts: &LyapunovOptions,
+    progress: &Progress,
 ) -> Result<LyapunovSpectrum, SimError> {
     opts.validate()?;
     let period = integ.system().period();
@@ -133,15 +137,21 @@ pub fn lyapunov_spectrum_with(
         integ.reset(0.0, &z0)?;
     }
     let t0 = opts.transient_periods as f64 * period;
+    let per_block = opts.periods / opts.blocks;
+    progress.add_total(opts.transient_periods + per_block * opts.blocks);
+    // the transient in one call (slicing it would change the adaptive integrator's steps):
+    // a cancel is seen after it, then every period
+    progress.check()?;
     advance(&mut *integ, t0)?;
+    progress.advance(opts.transient_periods);
     let mut z = integ.state().clone();
     let mut q = DMatrix::<f64>::identity(dim, dim);
-    let per_block = opts.periods / opts.blocks;
     let mut block_sums = vec![vec![0.0; dim]; opts.blocks];
     let mut log_volume = 0.0;
     let mut section = Vec::with_capacity(opts.periods);
     let total_periods = per_block * opts.blocks;
     for k in 0..total_periods {
+        progress.check()?;
         // one period of the flow with its Jacobian (step propagators × saltation matrices)
         let (ta, tb) = (t0 + k as f64 * period, t0 + (k + 1) as f64 * period);
         let map = flow_with_jacobian(&mut *integ, ta, &z, tb)?;
@@ -155,6 +165,7 @@ pub fn lyapunov_spectrum_with(
         }
         q = qr.q();
         section.push(integ.system().v_t(tb, &z));
+        progress.tick();
     }
     let block_time = per_block as f64 * period;
     let half = opts.blocks / 2;

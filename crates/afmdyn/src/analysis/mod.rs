@@ -14,6 +14,7 @@ pub mod lyapunov;
 pub mod monodromy;
 pub mod observables;
 pub mod period;
+pub mod progress;
 pub mod resonance;
 pub mod shooting;
 pub mod spectrum;

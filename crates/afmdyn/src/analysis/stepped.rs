@@ -27,9 +27,10 @@
 //! Every recorded orbit carries its [`Observables`] ([`super::observables`]).
 
 use super::bifurcation::SweepSpec;
-use super::continuation::{continue_branch, BranchEvent, BranchPoint, ContinuationSpec};
+use super::continuation::{continue_branch_with, BranchEvent, BranchPoint, ContinuationSpec};
 use super::monodromy::stroboscopic;
 use super::observables::{observe, ObservableOptions, Observables};
+use super::progress::Progress;
 use super::shooting::{shoot_with, ShootingOptions};
 use super::steady::{steady_state, SteadyOptions};
 use crate::error::SimError;
@@ -599,9 +600,11 @@ fn sweep(
     spec: &SteppedSpec,
     values: &[f64],
     start: Option<&CurvePoint>,
+    progress: &Progress,
 ) -> Result<Vec<CurvePoint>, SimError> {
     let mut out: Vec<CurvePoint> = Vec::with_capacity(values.len());
     for (i, &v) in values.iter().enumerate() {
+        progress.check()?;
         let p = match (i, start) {
             (0, Some(s)) => s.clone(),
             _ => {
@@ -610,13 +613,19 @@ fn sweep(
             }
         };
         out.push(p);
+        progress.tick();
     }
     Ok(out)
 }
 
 /// Continue the branch through `from` (a stable orbit of a sweep) towards `to`, with
 /// observables at every point.
-fn branch(spec: &SteppedSpec, from: &CurvePoint, to: f64) -> Result<Vec<BranchSample>, SimError> {
+fn branch(
+    spec: &SteppedSpec,
+    from: &CurvePoint,
+    to: f64,
+    progress: &Progress,
+) -> Result<Vec<BranchSample>, SimError> {
     let n = from.period.ok_or(SimError::out_of_range(
         "branch start",
         from.value,
@@ -636,9 +645,12 @@ fn branch(spec: &SteppedSpec, from: &CurvePoint, to: f64) -> Result<Vec<BranchSa
     let scale = (hi - lo).max(from.state.norm());
     cs.ds = scale / 100.0;
     cs.ds_max = scale / 25.0;
-    let points = continue_branch(&cs, &from.state)?;
+    // the branch's points were counted as they came; its length is known only now
+    let points = continue_branch_with(&cs, &from.state, progress)?;
+    progress.add_total(points.len());
     let mut out = Vec::with_capacity(points.len());
     for p in points {
+        progress.check()?;
         let mut integ = integrator_at(spec, p.value, &p.section[0])?;
         let observables = measure(integ.as_mut(), &p.section[0], p.period, &spec.observables)?;
         out.push(BranchSample {
@@ -777,6 +789,19 @@ fn jumps_of(which: Sweep, points: &[CurvePoint], folds: &[f64], jump_tol: f64) -
 /// non-finite ones; [`SimError::Params`] when a value is outside its parameter's range;
 /// [`SimError`] from the integrator. A branch that cannot be continued is a warning.
 pub fn stepped_sweep(spec: &SteppedSpec) -> Result<SteppedCurve, SimError> {
+    stepped_sweep_with(spec, &Progress::new())
+}
+
+/// [`stepped_sweep`] counting in `progress` the points of both sweeps (its total grows by
+/// twice the number of values) and of the branches (whose lengths are not known ahead), and
+/// stopping when it is cancelled.
+///
+/// # Errors
+/// As [`stepped_sweep`]; [`SimError::Cancelled`] once `progress` is cancelled.
+pub fn stepped_sweep_with(
+    spec: &SteppedSpec,
+    progress: &Progress,
+) -> Result<SteppedCurve, SimError> {
     if !(2..=MAX_CURVE_POINTS).contains(&spec.values.len()) {
         return Err(SimError::out_of_range(
             "points",
@@ -790,9 +815,10 @@ pub fn stepped_sweep(spec: &SteppedSpec) -> Result<SteppedCurve, SimError> {
     for &v in [spec.values[0], spec.values[spec.values.len() - 1]].iter() {
         spec.base.with(spec.param, v).validate()?;
     }
-    let first = sweep(spec, &spec.values, None)?;
+    progress.add_total(2 * spec.values.len());
+    let first = sweep(spec, &spec.values, None, progress)?;
     let back: Vec<f64> = spec.values.iter().rev().copied().collect();
-    let second = sweep(spec, &back, first.last())?;
+    let second = sweep(spec, &back, first.last(), progress)?;
     let mut warnings = Vec::new();
     let mut branches: Vec<Vec<BranchSample>> = Vec::new();
     if spec.branches {
@@ -805,8 +831,9 @@ pub fn stepped_sweep(spec: &SteppedSpec) -> Result<SteppedCurve, SimError> {
             }
             let (lo, hi) = (spec.values[0], spec.values[spec.values.len() - 1]);
             let to = if start.value == lo { hi } else { lo };
-            match branch(spec, &start, to) {
+            match branch(spec, &start, to, progress) {
                 Ok(br) => branches.push(br),
+                Err(SimError::Cancelled) => return Err(SimError::Cancelled),
                 Err(e) => warnings.push(format!(
                     "branch from {} = {}: {e}",
                     spec.param.name(),

@@ -8,15 +8,16 @@
 //! [`super::ModelSpec::resolve`], into the [`Params`] every `validate` and `run` takes.
 
 use super::limits::*;
-use crate::analysis::attractors::{find_attractors, AttractorReport, AttractorSpec};
+use crate::analysis::attractors::{find_attractors_with, AttractorReport, AttractorSpec};
 use crate::analysis::bifurcation::SweepSpec;
 use crate::analysis::continuation::{
-    continue_branch, continue_with_switching, BranchPoint, ContinuationSpec,
+    continue_branch_with, continue_with_switching_with, BranchPoint, ContinuationSpec,
 };
-use crate::analysis::converge::{mode_convergence, ConvergenceRun};
-use crate::analysis::lyapunov::{lyapunov_spectrum, LyapunovOptions, LyapunovSpectrum};
+use crate::analysis::converge::{mode_convergence_with, ConvergenceRun};
+use crate::analysis::lyapunov::{lyapunov_spectrum_with, LyapunovOptions, LyapunovSpectrum};
 use crate::analysis::observables::{observe_from, ObservableOptions, Observables};
 use crate::analysis::period::MAX_PERIOD;
+use crate::analysis::progress::Progress;
 use crate::analysis::shooting::{shoot, PeriodicOrbit, ShootingOptions};
 use crate::analysis::steady::{steady_state, SteadyOptions};
 use crate::error::SimError;
@@ -276,16 +277,21 @@ impl ContinuationRequest {
     /// # Errors
     /// As [`Self::validate`], [`StartRequest::guess`], [`continue_branch`] and
     /// [`continue_with_switching`].
-    pub fn run(&self, base: &Params) -> Result<Vec<Vec<BranchPoint>>, SimError> {
+    /// Every branch point is counted in `progress`, which also cancels the run.
+    pub fn run(
+        &self,
+        base: &Params,
+        progress: &Progress,
+    ) -> Result<Vec<Vec<BranchPoint>>, SimError> {
         self.validate(base)?;
         let model = CantileverModel::new(&base.with(self.param, self.from))?;
         let (guess, found) = self.start.guess(&model)?;
         let n = self.period.or(found).unwrap_or(1);
         let spec = ContinuationSpec::new(*base, self.param, self.from, self.to, n);
         if self.switch {
-            continue_with_switching(&spec, &guess, CASCADE_FACTOR * n)
+            continue_with_switching_with(&spec, &guess, CASCADE_FACTOR * n, progress)
         } else {
-            Ok(vec![continue_branch(&spec, &guess)?])
+            Ok(vec![continue_branch_with(&spec, &guess, progress)?])
         }
     }
 }
@@ -342,15 +348,18 @@ impl LyapunovRequest {
         }
     }
 
-    /// The spectrum of `params` from the initial state.
+    /// The spectrum of `params` from the initial state, the drive periods counted in
+    /// `progress`, which also cancels the run.
     ///
     /// # Errors
-    /// As [`Self::validate`], [`initial_state`] and [`lyapunov_spectrum`].
-    pub fn run(&self, params: &Params) -> Result<LyapunovSpectrum, SimError> {
+    /// As [`Self::validate`], [`initial_state`] and [`lyapunov_spectrum_with`].
+    pub fn run(&self, params: &Params, progress: &Progress) -> Result<LyapunovSpectrum, SimError> {
         self.validate()?;
         let model = CantileverModel::new(params)?;
         let z0 = initial_state(&model, self.initial.as_deref())?;
-        lyapunov_spectrum(&model, &z0, &self.options())
+        let opts = self.options();
+        let mut integ = build(&model, opts.integrator, 0.0, &z0)?;
+        lyapunov_spectrum_with(integ.as_mut(), &opts, progress)
     }
 }
 
@@ -404,12 +413,13 @@ impl AttractorsRequest {
         Ok(spec)
     }
 
-    /// The census of `params`.
+    /// The census of `params`, the random starts counted in `progress`, which also cancels
+    /// the run.
     ///
     /// # Errors
-    /// As [`Self::spec`] and [`find_attractors`].
-    pub fn run(&self, params: &Params) -> Result<AttractorReport, SimError> {
-        find_attractors(&self.spec(params)?)
+    /// As [`Self::spec`] and [`find_attractors_with`].
+    pub fn run(&self, params: &Params, progress: &Progress) -> Result<AttractorReport, SimError> {
+        find_attractors_with(&self.spec(params)?, progress)
     }
 }
 
@@ -571,15 +581,21 @@ impl ConvergeRequest {
     ///
     /// # Errors
     /// As [`Self::validate`] and [`mode_convergence`].
-    pub fn run(&self, params: &Params) -> Result<Vec<ConvergenceRun>, SimError> {
+    /// Each run is counted in `progress`, which also cancels the whole.
+    pub fn run(
+        &self,
+        params: &Params,
+        progress: &Progress,
+    ) -> Result<Vec<ConvergenceRun>, SimError> {
         self.validate()?;
-        mode_convergence(
+        mode_convergence_with(
             params,
             self.max_modes,
             self.periods,
             self.samples_per_period,
             &SteadyOptions::default(),
             self.integrator.options(self.samples_per_period),
+            progress,
         )
     }
 }

@@ -9,6 +9,8 @@
 //!   `attractors`, `orbit`, `continuation`, `lyapunov`, `observe`) with `validate`, and `run`
 //!   where the analysis is one library call.
 //! - [`curves`]: the stepped curves (`approach`, `resonance`).
+//! - [`run`](mod@run): [`run()`]`(analysis, model, progress)` → [`Document`], the typed result and
+//!   its JSON document, for every analysis whose result is one value ([`Analysis`]).
 //! - [`limits`]: the limits beyond the model's ranges, each with its reason.
 //! - [`sweep`]: the records of a bifurcation sweep (columns, codes, the one row order) and the
 //!   fingerprint of its request.
@@ -28,6 +30,7 @@ pub mod checkpoint_file;
 pub mod curves;
 pub mod limits;
 pub mod model;
+pub mod run;
 pub mod sweep;
 
 pub use analyses::{
@@ -40,4 +43,5 @@ pub use checkpoint::{Checkpoint, CheckpointError, MemoryCheckpoint};
 pub use checkpoint_file::FileCheckpoint;
 pub use curves::{approach_request, resonance_request, CurveRequest};
 pub use model::{parameter, ModelSpec, ParamInfo, MODEL_PARAMETERS};
+pub use run::{run, Analysis, ApproachRequest, Document, ModesRequest, Resolved, ResonanceRequest};
 pub use sweep::{fingerprint, SweepRecord};

@@ -1,0 +1,71 @@
+//! The progress bar of a long analysis: a [`Progress`] the library counts in, read every
+//! 100 ms by a thread that draws an indicatif bar on stderr (only on a terminal, and only once
+//! the run has taken a second), cleared when the run ends.
+
+use afmdyn::analysis::progress::Progress;
+use afmdyn::request::{self, Analysis, Document, Resolved};
+use afmdyn::SimError;
+use indicatif::{ProgressBar, ProgressStyle};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+/// Run `work` with a bar counting `unit`s (e.g. "starts", "points").
+pub fn with_bar<T>(unit: &'static str, work: impl FnOnce(&Progress) -> T) -> T {
+    let progress = Progress::new();
+    let finished = AtomicBool::new(false);
+    std::thread::scope(|s| {
+        let poller = s.spawn(|| draw(&progress, &finished, unit));
+        let out = work(&progress);
+        finished.store(true, Ordering::Relaxed);
+        poller.thread().unpark();
+        out
+    })
+}
+
+fn draw(progress: &Progress, finished: &AtomicBool, unit: &'static str) {
+    let start = Instant::now();
+    let mut bar: Option<(ProgressBar, bool)> = None;
+    while !finished.load(Ordering::Relaxed) {
+        std::thread::park_timeout(Duration::from_millis(100));
+        if start.elapsed() < Duration::from_secs(1) || finished.load(Ordering::Relaxed) {
+            continue;
+        }
+        let (done, total) = (progress.done(), progress.total());
+        let counted = total.is_some();
+        let b = match &mut bar {
+            Some((b, c)) if *c == counted => b,
+            _ => {
+                if let Some((old, _)) = bar.take() {
+                    old.finish_and_clear();
+                }
+                let b = ProgressBar::new(0);
+                let template = if counted {
+                    format!("{{bar:40}} {{pos}}/{{len}} {unit}  {{elapsed}} / ~{{duration}}")
+                } else {
+                    format!("{{spinner}} {{pos}} {unit}  {{elapsed}}")
+                };
+                b.set_style(ProgressStyle::with_template(&template).expect("template"));
+                &mut bar.insert((b, counted)).0
+            }
+        };
+        // a run that learns its size as it goes can be ahead of the total for a while
+        b.set_length(total.unwrap_or(0).max(done) as u64);
+        b.set_position(done as u64);
+        b.tick();
+    }
+    if let Some((b, _)) = bar {
+        b.finish_and_clear();
+    }
+}
+
+/// [`request::run`] with a bar counting `unit`s.
+///
+/// # Errors
+/// As [`request::run`].
+pub fn run<A: Analysis + ?Sized>(
+    analysis: &A,
+    model: &Resolved,
+    unit: &'static str,
+) -> Result<Document<A::Output>, SimError> {
+    with_bar(unit, |progress| request::run(analysis, model, progress))
+}

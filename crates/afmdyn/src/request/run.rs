@@ -1,0 +1,355 @@
+//! From a request to its document in one call: [`run`]`(analysis, model, progress)` →
+//! [`Document`], the typed result together with the JSON document that `--json` prints and
+//! Python's `to_dict()` returns (with the `"si"` block when the model came from a probe file).
+//!
+//! Every analysis whose result is one value implements [`Analysis`]: `modes`, `orbit`,
+//! `continuation`, `lyapunov`, `attractors`, `observe`, `converge`, `approach`, `resonance`.
+//! The two whose results are streams run through their own entry points, which take the same
+//! [`Progress`]: `simulate` records in chunks to a sink
+//! ([`crate::trajectory::chunked::record_chunked`], budgets by
+//! [`crate::request::SimulateRequest::span`]) and `bifurcation` writes its records to a
+//! [`crate::request::Checkpoint`] ([`crate::request::checkpoint::run`]).
+//!
+//! [`Progress`] is the sink of the run's progress and its cancel flag: the analyses count
+//! their units of work in it (random starts, curve and branch points, drive periods, mode
+//! counts) and stop with [`SimError::Cancelled`] when it is cancelled. `modes`, `orbit` and
+//! `observe` are one short computation each and neither count nor check it.
+
+use super::analyses::{
+    AttractorsRequest, ContinuationRequest, ConvergeRequest, LyapunovRequest, ObserveRequest,
+    ObserveResult, OrbitRequest,
+};
+use super::curves::{approach_request, resonance_request, CurveRequest};
+use crate::analysis::attractors::AttractorReport;
+use crate::analysis::continuation::BranchPoint;
+use crate::analysis::converge::ConvergenceRun;
+use crate::analysis::lyapunov::LyapunovSpectrum;
+use crate::analysis::progress::Progress;
+use crate::analysis::shooting::PeriodicOrbit;
+use crate::analysis::stepped::{stepped_sweep_with, SteppedCurve, SteppedSpec};
+use crate::eigen::{spectrum, RegionSpectrum};
+use crate::error::SimError;
+use crate::model::CantileverModel;
+use crate::params::Params;
+use crate::probe::Probe;
+use crate::report::{self, CurveUnits};
+use serde::{Deserialize, Serialize};
+use serde_json::Value;
+
+/// The model of a run: the resolved parameters and the probe file they came from, if any
+/// (the SI scales of the document; [`crate::request::ModelSpec::resolve`] gives both).
+#[derive(Debug, Clone)]
+pub struct Resolved {
+    /// The dimensionless parameters (α1…α6, Ω, N, the law).
+    pub params: Params,
+    /// The probe, when the model was built from one.
+    pub probe: Option<Probe>,
+}
+
+impl Resolved {
+    /// A model given by its parameters alone (no SI block in the documents).
+    pub fn plain(params: Params) -> Self {
+        Resolved {
+            params,
+            probe: None,
+        }
+    }
+}
+
+/// A typed result and its JSON document.
+#[derive(Debug, Clone)]
+pub struct Document<T> {
+    /// The result.
+    pub output: T,
+    /// The document (`--json`, Python's `to_dict()`), with `"si"` for a probe's model.
+    pub json: Value,
+}
+
+/// An analysis request that [`run`] takes from its model to its [`Document`].
+pub trait Analysis {
+    /// The typed result.
+    type Output;
+    /// Check every option on `model` without computing (a front end calls it before its side
+    /// effects, such as locking an output directory; [`run`] calls it first).
+    ///
+    /// # Errors
+    /// The request's validation errors, naming the parameter and its range.
+    fn validate(&self, model: &Resolved) -> Result<(), SimError>;
+    /// Validate the request and compute its result on `model`, counting in `progress`.
+    ///
+    /// # Errors
+    /// The request's validation errors (naming the parameter and its range) and the
+    /// analysis' failures; [`SimError::Cancelled`] when `progress` is cancelled.
+    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError>;
+    /// The document of a result, without the SI block ([`run`] adds it).
+    ///
+    /// # Errors
+    /// [`SimError`] where the document needs the model built again (an invalid `params`).
+    fn report(&self, model: &Resolved, output: &Self::Output) -> Result<Value, SimError>;
+}
+
+/// Run `analysis` on `model`: [`Analysis::validate`], [`Analysis::execute`], then its document with the SI block of
+/// the probe ([`report::with_si`]).
+///
+/// # Errors
+/// As [`Analysis::execute`] and [`Analysis::report`]; [`SimError::Cancelled`] when `progress`
+/// is cancelled before the start.
+pub fn run<A: Analysis + ?Sized>(
+    analysis: &A,
+    model: &Resolved,
+    progress: &Progress,
+) -> Result<Document<A::Output>, SimError> {
+    progress.check()?;
+    analysis.validate(model)?;
+    let output = analysis.execute(model, progress)?;
+    let doc = analysis.report(model, &output)?;
+    Ok(Document {
+        json: report::with_si(doc, model.probe.as_ref(), &model.params),
+        output,
+    })
+}
+
+/// `modes`: natural frequencies and damped eigenvalues of the free and contact systems
+/// (eqs. 19–23). No options.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[serde(deny_unknown_fields)]
+pub struct ModesRequest {}
+
+impl Analysis for ModesRequest {
+    type Output = (RegionSpectrum, RegionSpectrum);
+    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
+        Ok(model.params.validate()?)
+    }
+    fn execute(&self, model: &Resolved, _: &Progress) -> Result<Self::Output, SimError> {
+        Ok(spectrum(&model.params)?)
+    }
+    fn report(&self, model: &Resolved, (free, contact): &Self::Output) -> Result<Value, SimError> {
+        Ok(report::modes(&model.params, free, contact))
+    }
+}
+
+impl Analysis for OrbitRequest {
+    type Output = PeriodicOrbit;
+    fn validate(&self, _: &Resolved) -> Result<(), SimError> {
+        OrbitRequest::validate(self)
+    }
+    fn execute(&self, model: &Resolved, _: &Progress) -> Result<PeriodicOrbit, SimError> {
+        self.run(&model.params)
+    }
+    fn report(&self, model: &Resolved, o: &PeriodicOrbit) -> Result<Value, SimError> {
+        Ok(report::orbit(&CantileverModel::new(&model.params)?, o))
+    }
+}
+
+impl Analysis for ContinuationRequest {
+    type Output = Vec<Vec<BranchPoint>>;
+    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
+        ContinuationRequest::validate(self, &model.params)
+    }
+    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
+        self.run(&model.params, progress)
+    }
+    fn report(&self, model: &Resolved, branches: &Self::Output) -> Result<Value, SimError> {
+        Ok(report::continuation(&model.params, self.param, branches))
+    }
+}
+
+impl Analysis for LyapunovRequest {
+    type Output = LyapunovSpectrum;
+    fn validate(&self, _: &Resolved) -> Result<(), SimError> {
+        LyapunovRequest::validate(self)
+    }
+    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
+        self.run(&model.params, progress)
+    }
+    fn report(&self, model: &Resolved, l: &Self::Output) -> Result<Value, SimError> {
+        Ok(report::lyapunov(&model.params, l))
+    }
+}
+
+impl Analysis for AttractorsRequest {
+    type Output = AttractorReport;
+    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
+        self.spec(&model.params).map(|_| ())
+    }
+    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
+        self.run(&model.params, progress)
+    }
+    fn report(&self, model: &Resolved, r: &Self::Output) -> Result<Value, SimError> {
+        Ok(report::attractors(&model.params, self.samples, r))
+    }
+}
+
+impl Analysis for ObserveRequest {
+    type Output = ObserveResult;
+    fn validate(&self, _: &Resolved) -> Result<(), SimError> {
+        ObserveRequest::validate(self)
+    }
+    fn execute(&self, model: &Resolved, _: &Progress) -> Result<Self::Output, SimError> {
+        self.run(&model.params)
+    }
+    fn report(&self, _: &Resolved, o: &Self::Output) -> Result<Value, SimError> {
+        Ok(report::observables(&o.observables))
+    }
+}
+
+impl Analysis for ConvergeRequest {
+    type Output = Vec<ConvergenceRun>;
+    fn validate(&self, _: &Resolved) -> Result<(), SimError> {
+        ConvergeRequest::validate(self)
+    }
+    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
+        self.run(&model.params, progress)
+    }
+    fn report(&self, model: &Resolved, runs: &Self::Output) -> Result<Value, SimError> {
+        Ok(report::converge(&model.params, runs))
+    }
+}
+
+/// `approach`: the approach–retract curve over the rest distance z_c with its branches
+/// ([`crate::analysis::approach`]); `from`/`to`/`step` in metres with a probe, else in g₀.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[serde(default, deny_unknown_fields)]
+pub struct ApproachRequest {
+    /// The curve's range and options.
+    #[serde(flatten)]
+    pub curve: CurveRequest,
+}
+
+impl ApproachRequest {
+    /// The units of the curve: SI (m, N, J) with a probe, else the model's.
+    pub fn units(model: &Resolved) -> CurveUnits {
+        match &model.probe {
+            Some(p) => CurveUnits::from_scales(&p.scales, false),
+            None => CurveUnits::dimensionless(),
+        }
+    }
+}
+
+impl ApproachRequest {
+    /// The stepped sweep of `model` ([`approach_request`]).
+    ///
+    /// # Errors
+    /// As [`approach_request`].
+    pub fn spec(&self, model: &Resolved) -> Result<SteppedSpec, SimError> {
+        approach_request(model.params, &self.curve, Self::units(model).length)
+    }
+}
+
+impl Analysis for ApproachRequest {
+    type Output = SteppedCurve;
+    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
+        self.spec(model).map(|_| ())
+    }
+    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
+        stepped_sweep_with(&self.spec(model)?, progress)
+    }
+    fn report(&self, model: &Resolved, c: &Self::Output) -> Result<Value, SimError> {
+        Ok(report::approach(&model.params, c, &Self::units(model)))
+    }
+}
+
+/// `resonance`: the resonance curve near mode `mode` with its branches
+/// ([`crate::analysis::resonance`]); `from`/`to`/`step` in Hz with a probe, else in Ω.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[serde(default, deny_unknown_fields)]
+pub struct ResonanceRequest {
+    /// The mode k (1-based) whose resonance is swept.
+    pub mode: usize,
+    /// The curve's range and options.
+    #[serde(flatten)]
+    pub curve: CurveRequest,
+}
+
+impl Default for ResonanceRequest {
+    fn default() -> Self {
+        ResonanceRequest {
+            mode: 1,
+            curve: CurveRequest::default(),
+        }
+    }
+}
+
+impl ResonanceRequest {
+    /// The units of the curve: SI (m, N, J, Hz) with a probe, else the model's.
+    pub fn units(model: &Resolved) -> CurveUnits {
+        match &model.probe {
+            Some(p) => CurveUnits::from_scales(&p.scales, true),
+            None => CurveUnits::dimensionless(),
+        }
+    }
+}
+
+impl ResonanceRequest {
+    /// The stepped sweep of `model` ([`resonance_request`]).
+    ///
+    /// # Errors
+    /// As [`resonance_request`].
+    pub fn spec(&self, model: &Resolved) -> Result<SteppedSpec, SimError> {
+        let hz = Self::units(model).hz_per_omega.unwrap_or(1.0);
+        resonance_request(model.params, self.mode, &self.curve, hz)
+    }
+}
+
+impl Analysis for ResonanceRequest {
+    type Output = SteppedCurve;
+    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
+        self.spec(model).map(|_| ())
+    }
+    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
+        stepped_sweep_with(&self.spec(model)?, progress)
+    }
+    fn report(&self, model: &Resolved, c: &Self::Output) -> Result<Value, SimError> {
+        Ok(report::resonance(&model.params, c, &Self::units(model)))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The document of `run` is the report of the typed result with the SI block, and a
+    /// cancelled progress stops a run before it starts.
+    #[test]
+    fn run_builds_the_reports_document_and_honours_cancel() {
+        let model = Resolved::plain(Params {
+            omega: 2.8,
+            ..Params::default()
+        });
+        let request = OrbitRequest::default();
+        let progress = Progress::new();
+        let doc = run(&request, &model, &progress).unwrap();
+        let want = report::orbit(&CantileverModel::new(&model.params).unwrap(), &doc.output);
+        assert_eq!(doc.json, want);
+        assert_eq!(doc.output.period, 2);
+        progress.cancel();
+        assert!(matches!(
+            run(&request, &model, &progress),
+            Err(SimError::Cancelled)
+        ));
+    }
+
+    /// Counted analyses count: the attractor census ticks once per random start, and a
+    /// cancel between starts ends it with `Cancelled`.
+    #[test]
+    fn attractors_count_their_starts() {
+        let model = Resolved::plain(Params::default());
+        let request = AttractorsRequest {
+            samples: 6,
+            ..AttractorsRequest::default()
+        };
+        let progress = Progress::new();
+        let doc = run(&request, &model, &progress).unwrap();
+        assert_eq!((progress.done(), progress.total()), (6, Some(6)));
+        assert_eq!(doc.json["samples"], 6);
+        // cancelled before the starts: every start is refused and the census with it
+        let cancelled = Progress::new();
+        cancelled.cancel();
+        let err = request.execute(&model, &cancelled).unwrap_err();
+        assert!(matches!(err, SimError::Cancelled), "{err}");
+        assert_eq!(cancelled.done(), 6);
+    }
+}
