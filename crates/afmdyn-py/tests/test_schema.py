@@ -276,7 +276,8 @@ REQUEST_NAMES = sorted(p.stem for p in REQUESTS.glob("*.json"))
 def test_every_request_has_a_schema() -> None:
     assert REQUEST_NAMES == sorted(
         ["model", "steady", "integrator", "start", "orbit", "continuation", "lyapunov",
-         "attractors", "observe", "converge", "simulate", "bifurcation", "curve"]
+         "attractors", "observe", "converge", "simulate", "bifurcation", "curve", "modes",
+         "approach", "resonance"]
     )
 
 
@@ -288,7 +289,9 @@ def test_request_schema_accepts_the_default_and_refuses_unknown_keys(name: str) 
     v.validate(default)
     with pytest.raises(ValidationError):
         v.validate(dict(default, unexpected_key=1))
-    # a key of the wrong type: an object for the first property
+    # a key of the wrong type: an object for the first property (modes has none)
+    if not schema.get("properties"):
+        return
     key = next(iter(schema["properties"]))
     with pytest.raises(ValidationError):
         v.validate(dict(default, **{key: {"wrong": "type"}}))
