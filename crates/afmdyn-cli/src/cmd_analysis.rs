@@ -160,7 +160,7 @@ pub fn bifurcation(a: &BifurcationArgs) -> Result<(), CliError> {
         .spec(&base)
         .map_err(|e| CliError::Input(crate::error::spell(&e)))?;
     let out = OutDir::lock(&a.out)?;
-    let mut store = FileCheckpoint::new(out.path()).map_err(checkpoint_error)?;
+    let mut store = FileCheckpoint::new(out.dir_lock());
     let final_csv = store.final_csv();
     let args = fingerprint(&request, &spec);
     if let Some(resume) = checkpoint::open(&mut store, &args, a.resume).map_err(checkpoint_error)? {

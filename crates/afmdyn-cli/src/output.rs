@@ -3,6 +3,7 @@
 //! names its path. An output directory is locked for the duration of a run.
 
 use crate::error::CliError;
+use afmdyn::request::{DirLock, LockError};
 use serde::Serialize;
 use std::fmt::Display;
 use std::fs::{self, File};
@@ -15,17 +16,12 @@ pub fn io_error(verb: &str, path: &Path, e: impl Display) -> CliError {
     CliError::Io(format!("cannot {verb} {}: {e}", path.display()))
 }
 
-/// Name of the lock file in a locked output directory.
-pub const LOCK_FILE: &str = ".afmdyn.lock";
-
 /// A locked output directory: created if needed; a second run on the same directory fails at
-/// once. The lock is an advisory file lock (`flock`) held by this process, so the kernel
-/// releases it when the process ends, however it ends: a killed run never leaves a stale lock.
-/// The lock file records the holder's process id for the message.
+/// once (the library's [`DirLock`]: an advisory file lock the kernel releases when the process
+/// ends, however it ends).
 #[derive(Debug)]
 pub struct OutDir {
-    dir: PathBuf,
-    _lock: File,
+    lock: DirLock,
 }
 
 impl OutDir {
@@ -35,54 +31,35 @@ impl OutDir {
     /// [`CliError::Io`] when the directory cannot be created; [`CliError::Input`] when another
     /// run holds it.
     pub fn lock(dir: &Path) -> Result<OutDir, CliError> {
-        fs::create_dir_all(dir).map_err(|e| io_error("create", dir, e))?;
-        let path = dir.join(LOCK_FILE);
-        let mut file = fs::OpenOptions::new()
-            .read(true)
-            .write(true)
-            .create(true)
-            .truncate(false)
-            .open(&path)
-            .map_err(|e| io_error("open", &path, e))?;
-        match file.try_lock() {
-            Ok(()) => {}
-            Err(fs::TryLockError::WouldBlock) => {
-                let holder = fs::read_to_string(&path).unwrap_or_default();
-                let pid = holder
-                    .split_whitespace()
-                    .next()
-                    .filter(|p| p.chars().all(|c| c.is_ascii_digit()))
-                    .map_or(String::new(), |p| format!(" (process {p})"));
-                return Err(CliError::Input(format!(
-                    "output directory {} is in use by another afmdyn run{pid}; wait for it to \
-                     finish or choose another --out",
-                    dir.display()
-                )));
-            }
-            Err(fs::TryLockError::Error(e)) => {
-                // a file system without advisory locks: run unlocked rather than not at all
-                eprintln!(
-                    "afmdyn: warning: cannot lock {} ({e}); concurrent runs on it are not detected",
-                    dir.display()
-                );
-            }
+        let lock = DirLock::acquire(dir).map_err(|e| match e {
+            LockError::InUse { .. } => CliError::Input(format!(
+                "{e}; wait for it to finish or choose another --out"
+            )),
+            LockError::Io { .. } => CliError::Io(e.to_string()),
+        })?;
+        if !lock.is_locked() {
+            // a file system without advisory locks: run unlocked rather than not at all
+            eprintln!(
+                "afmdyn: warning: cannot lock {}; concurrent runs on it are not detected",
+                dir.display()
+            );
         }
-        file.set_len(0).map_err(|e| io_error("write", &path, e))?;
-        writeln!(file, "{} afmdyn", std::process::id()).map_err(|e| io_error("write", &path, e))?;
-        Ok(OutDir {
-            dir: dir.to_path_buf(),
-            _lock: file,
-        })
+        Ok(OutDir { lock })
+    }
+
+    /// The lock held on the directory.
+    pub fn dir_lock(&self) -> &DirLock {
+        &self.lock
     }
 
     /// `dir/name`.
     pub fn join(&self, name: impl AsRef<Path>) -> PathBuf {
-        self.dir.join(name)
+        self.lock.path().join(name)
     }
 
     /// The directory.
     pub fn path(&self) -> &Path {
-        &self.dir
+        self.lock.path()
     }
 }
 

@@ -16,7 +16,9 @@ use afmdyn::integrate::{build, IntegratorOptions};
 use afmdyn::probe::Probe;
 use afmdyn::request::checkpoint::{self, Checkpoint, CheckpointError};
 use afmdyn::request::{self, Analysis, Document, ModesRequest, Resolved};
-use afmdyn::request::{fingerprint, FileCheckpoint, MemoryCheckpoint, SweepRecord};
+use afmdyn::request::{
+    fingerprint, DirLock, FileCheckpoint, LockError, MemoryCheckpoint, SweepRecord,
+};
 use afmdyn::request::{
     AttractorsRequest, BifurcationRequest, ContinuationRequest, ConvergeRequest, IntegratorRequest,
     LyapunovRequest, ObserveRequest, OrbitRequest, SeriesStore, SimulateRequest, StartRequest,
@@ -482,6 +484,16 @@ pub fn bifurcation<'py>(
             "resume=True needs store= (the directory of the interrupted sweep)",
         ));
     }
+    // the store is locked here, before any work: a second run on it is refused at once
+    let lock = store
+        .map(|dir| DirLock::acquire(&dir))
+        .transpose()
+        .map_err(|e| match e {
+            LockError::InUse { .. } => value_error(format!(
+                "store: {e}; wait for it to finish or choose another store="
+            )),
+            LockError::Io { .. } => pyo3::exceptions::PyOSError::new_err(e.to_string()),
+        })?;
     let total = checkpoint::point_count(&spec);
     let job = Job::default();
     let worker_job = job.clone();
@@ -498,9 +510,9 @@ pub fn bifurcation<'py>(
                 .build()
                 .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string()))?;
             let (spec, job) = (&worker_spec, &worker_job);
-            pool.install(|| match store {
-                Some(dir) => {
-                    let mut s = FileCheckpoint::new(&dir)?;
+            pool.install(|| match &lock {
+                Some(lock) => {
+                    let mut s = FileCheckpoint::new(lock);
                     sweep_into(&mut s, &request, spec, resume, job)?;
                     s.records()
                 }

@@ -292,3 +292,38 @@ def test_a_probe_sweep_equals_the_command_lines(cli, tmp_path):
     )
     assert ds.attrs["structure"] == "point-mass"
     _assert_rows_equal(ds, _read(tmp_path))
+
+
+def test_a_store_in_use_by_another_run_is_refused(tmp_path, cli):
+    """One run writes a store at a time, whichever front end started it: the library locks the
+    directory (``DirLock``) for the command line's ``--out`` and Python's ``store=`` alike."""
+    import subprocess
+    import sys
+
+    store = tmp_path / "sweep"
+    holder = subprocess.Popen(
+        [
+            sys.executable,
+            "-c",
+            f"import afmdyn; afmdyn.bifurcation(steps=20000, store={str(store)!r}, progress=False)",
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
+    try:
+        lock = store / ".afmdyn.lock"
+        t0 = time.monotonic()
+        while not (lock.exists() and lock.read_text().strip()) and time.monotonic() - t0 < 30:
+            time.sleep(0.05)
+        busy = rf"in use by another afmdyn run \(process {holder.pid}\)"
+        with pytest.raises(ValueError, match=busy):
+            afmdyn.bifurcation(from_=2.0, to=2.2, steps=3, store=store)
+        run = cli("bifurcation", "--from", "2", "--to", "2.2", "--steps", "3", "--out", store)
+        assert run.returncode == 2, run.stderr
+        assert f"(process {holder.pid}); wait for it to finish or choose another --out" in run.stderr
+    finally:
+        holder.kill()
+        holder.wait()
+    # the kernel released the killed holder's lock: the store is usable again
+    ds = afmdyn.bifurcation(from_=2.0, to=2.2, steps=3, store=store)
+    assert ds.sizes["point"] >= 6

@@ -10,6 +10,7 @@
 //! `afmdyn.bifurcation(store=DIR)` uses the same, so either resumes the other's sweep.
 
 use super::checkpoint::{end_state, Checkpoint, CheckpointError, DonePoint, Ledger, StoreStatus};
+use super::dir_lock::DirLock;
 use super::sweep::{SweepRecord, COL_INDEX, COL_POINT, COL_POINTS, HEADER};
 use crate::analysis::bifurcation::Branch;
 use serde_json::{json, Value};
@@ -27,9 +28,10 @@ pub const LEDGER: &str = ".bifurcation.run.json";
 /// The finished rows while they are being sorted.
 const SORTED_CSV: &str = ".bifurcation.sorted.csv";
 
-/// A sweep's checkpoint in a directory (see the module).
+/// A sweep's checkpoint in a directory (see the module), which the caller holds locked.
 #[derive(Debug)]
-pub struct FileCheckpoint {
+pub struct FileCheckpoint<'a> {
+    lock: &'a DirLock,
     dir: PathBuf,
     writer: Option<BufWriter<File>>,
 }
@@ -125,17 +127,20 @@ fn groups(path: &Path) -> Result<(String, Vec<Group>), CheckpointError> {
     Ok((header, groups))
 }
 
-impl FileCheckpoint {
-    /// The store in `dir` (created if needed).
-    ///
-    /// # Errors
-    /// [`CheckpointError::Io`] when the directory cannot be created.
-    pub fn new(dir: &Path) -> Result<FileCheckpoint, CheckpointError> {
-        fs::create_dir_all(dir).map_err(io("create", dir))?;
-        Ok(FileCheckpoint {
-            dir: dir.to_path_buf(),
+impl<'a> FileCheckpoint<'a> {
+    /// The store in the directory `lock` holds ([`DirLock::acquire`] creates and locks it, so
+    /// that no two runs write one store).
+    pub fn new(lock: &'a DirLock) -> FileCheckpoint<'a> {
+        FileCheckpoint {
+            lock,
+            dir: lock.path().to_path_buf(),
             writer: None,
-        })
+        }
+    }
+
+    /// The lock the store is written under.
+    pub fn lock(&self) -> &DirLock {
+        self.lock
     }
 
     /// The finished rows, `DIR/bifurcation.csv`.
@@ -178,7 +183,7 @@ impl FileCheckpoint {
     }
 }
 
-impl Checkpoint for FileCheckpoint {
+impl Checkpoint for FileCheckpoint<'_> {
     fn status(&mut self) -> Result<StoreStatus, CheckpointError> {
         let path = self.ledger_path();
         let ledger = match fs::read_to_string(&path) {

@@ -212,11 +212,13 @@ fn records_without_a_ledger_are_not_resumed() {
 #[test]
 fn the_file_store_resumes_a_killed_sweep_and_drops_a_cut_row() {
     use crate::request::checkpoint_file::{FileCheckpoint, LEDGER, PARTIAL_CSV};
+    use crate::request::dir_lock::DirLock;
     let r = request();
     let (unfinished, reference) = uninterrupted(&r);
     let dir = std::env::temp_dir().join(format!("afmdyn-checkpoint-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
-    let mut store = FileCheckpoint::new(&dir).unwrap();
+    let lock = DirLock::acquire(&dir).unwrap();
+    let mut store = FileCheckpoint::new(&lock);
     let s = spec(&r);
     let fp = fingerprint(&r, &s);
     assert!(
@@ -228,12 +230,14 @@ fn the_file_store_resumes_a_killed_sweep_and_drops_a_cut_row() {
         store.append(p).unwrap();
     }
     drop(store);
+    drop(lock);
     // a kill in the middle of a write leaves a cut row
     let partial = dir.join(PARTIAL_CSV);
     let mut text = std::fs::read_to_string(&partial).unwrap();
     text.push_str("omega,2.5,1,start-0,peri");
     std::fs::write(&partial, text).unwrap();
-    let mut store = FileCheckpoint::new(&dir).unwrap();
+    let lock = DirLock::acquire(&dir).unwrap();
+    let mut store = FileCheckpoint::new(&lock);
     let computed = resume_into(&mut store, &r).unwrap();
     assert_eq!(computed.len(), unfinished.points.len() - k);
     assert_eq!(lines(&store.records().unwrap()), lines(&reference));

@@ -15,7 +15,8 @@
 //! - [`sweep`]: the records of a bifurcation sweep (columns, codes, the one row order) and the
 //!   fingerprint of its request.
 //! - [`checkpoint`]: resumable sweeps: the [`Checkpoint`] a store implements, in memory or
-//!   (feature `files`) in a directory ([`checkpoint_file`]).
+//!   (feature `files`) in a directory ([`checkpoint_file`]), locked for one run at a time
+//!   ([`dir_lock`]).
 //!
 //! A front end maps its spelling of a name to a request field and nothing else; errors name
 //! the library's parameter (`samples_per_period`) and a front end respells them
@@ -28,6 +29,8 @@ pub mod checkpoint;
 #[cfg(feature = "files")]
 pub mod checkpoint_file;
 pub mod curves;
+#[cfg(feature = "files")]
+pub mod dir_lock;
 pub mod limits;
 pub mod model;
 pub mod run;
@@ -42,6 +45,8 @@ pub use checkpoint::{Checkpoint, CheckpointError, MemoryCheckpoint};
 #[cfg(feature = "files")]
 pub use checkpoint_file::FileCheckpoint;
 pub use curves::{approach_request, resonance_request, CurveRequest};
+#[cfg(feature = "files")]
+pub use dir_lock::{DirLock, LockError};
 pub use model::{parameter, ModelSpec, ParamInfo, MODEL_PARAMETERS};
 pub use run::{run, Analysis, ApproachRequest, Document, ModesRequest, Resolved, ResonanceRequest};
 pub use sweep::{fingerprint, SweepRecord};

@@ -1,0 +1,135 @@
+//! The lock of an output directory (feature `files`): one run writes a directory at a time,
+//! whatever front end started it (`afmdyn … --out DIR`, Python's `store=DIR`).
+//!
+//! The lock is an advisory file lock (`flock`, [`std::fs::File::try_lock`]) on
+//! `DIR/.afmdyn.lock`, held by this process, so the kernel releases it when the process ends,
+//! however it ends: a killed run never leaves a stale lock. The file records the holder's
+//! process id, for the message of the run that is refused. On a file system without advisory
+//! locks the directory is used unlocked ([`DirLock::is_locked`] is false) rather than not at
+//! all.
+
+use std::fs::{self, File};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// Name of the lock file in a locked directory.
+pub const LOCK_FILE: &str = ".afmdyn.lock";
+
+/// Why a directory could not be locked.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum LockError {
+    /// Another run holds the lock.
+    #[error("output directory {dir} is in use by another afmdyn run{holder}")]
+    InUse {
+        /// The directory.
+        dir: String,
+        /// " (process PID)" when the holder recorded its id, else empty.
+        holder: String,
+    },
+    /// The directory or its lock file cannot be created or written.
+    #[error("cannot {action} {path}: {message}")]
+    Io {
+        /// What failed ("create", "open", "write").
+        action: &'static str,
+        /// The path.
+        path: String,
+        /// The system's message.
+        message: String,
+    },
+}
+
+fn io(action: &'static str, path: &Path) -> impl FnOnce(std::io::Error) -> LockError {
+    let path = path.display().to_string();
+    move |e| LockError::Io {
+        action,
+        path,
+        message: e.to_string(),
+    }
+}
+
+/// A locked directory (see the module docs); the lock is released when this is dropped.
+#[derive(Debug)]
+pub struct DirLock {
+    dir: PathBuf,
+    _file: File,
+    locked: bool,
+}
+
+impl DirLock {
+    /// Create `dir` if needed and lock it.
+    ///
+    /// # Errors
+    /// [`LockError::InUse`] when another run holds it; [`LockError::Io`] when the directory or
+    /// its lock file cannot be created or written.
+    pub fn acquire(dir: &Path) -> Result<DirLock, LockError> {
+        fs::create_dir_all(dir).map_err(io("create", dir))?;
+        let path = dir.join(LOCK_FILE);
+        let mut file = fs::OpenOptions::new()
+            .read(true)
+            .write(true)
+            .create(true)
+            .truncate(false)
+            .open(&path)
+            .map_err(io("open", &path))?;
+        let locked = match file.try_lock() {
+            Ok(()) => true,
+            Err(fs::TryLockError::WouldBlock) => {
+                let holder = fs::read_to_string(&path).unwrap_or_default();
+                let holder = holder
+                    .split_whitespace()
+                    .next()
+                    .filter(|p| p.chars().all(|c| c.is_ascii_digit()))
+                    .map_or(String::new(), |p| format!(" (process {p})"));
+                return Err(LockError::InUse {
+                    dir: dir.display().to_string(),
+                    holder,
+                });
+            }
+            Err(fs::TryLockError::Error(_)) => false,
+        };
+        file.set_len(0).map_err(io("write", &path))?;
+        writeln!(file, "{} afmdyn", std::process::id()).map_err(io("write", &path))?;
+        Ok(DirLock {
+            dir: dir.to_path_buf(),
+            _file: file,
+            locked,
+        })
+    }
+
+    /// The directory.
+    pub fn path(&self) -> &Path {
+        &self.dir
+    }
+
+    /// Whether the lock is held (false on a file system without advisory locks, where the
+    /// directory is used unlocked and concurrent runs are not detected).
+    pub fn is_locked(&self) -> bool {
+        self.locked
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_second_lock_on_the_same_directory_is_refused_until_the_first_is_dropped() {
+        let dir = std::env::temp_dir().join(format!("afmdyn-lock-{}", std::process::id()));
+        let _ = fs::remove_dir_all(&dir);
+        let first = DirLock::acquire(&dir).unwrap();
+        if first.is_locked() {
+            let err = DirLock::acquire(&dir).unwrap_err();
+            assert_eq!(
+                err.to_string(),
+                format!(
+                    "output directory {} is in use by another afmdyn run (process {})",
+                    dir.display(),
+                    std::process::id()
+                )
+            );
+        }
+        drop(first);
+        assert!(DirLock::acquire(&dir).is_ok());
+        fs::remove_dir_all(&dir).unwrap();
+    }
+}
