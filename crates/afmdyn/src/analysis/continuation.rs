@@ -189,12 +189,29 @@ impl Solver {
         flow_state(integ, 0.0, z, t)
     }
 
-    /// ∂Pⁿ/∂p by central differences.
+    /// ∂Pⁿ/∂p by central differences; one-sided (first order) at the edge of the parameter's
+    /// valid range, so that a branch continued up to a limit (Ω = 1e5, say) never evaluates the
+    /// model at a value the user did not give and the validation refuses.
     fn dp(&mut self, z: &DVector<f64>, p: f64) -> Result<DVector<f64>, SimError> {
         let d = 1e-6 * p.abs().max(1.0);
-        let plus = self.map_state(z, p + d)?;
-        let minus = self.map_state(z, p - d)?;
-        Ok((plus - minus) / (2.0 * d))
+        let valid = |q: f64| self.spec.base.with(self.spec.param, q).validate().is_ok();
+        match (valid(p + d), valid(p - d)) {
+            (false, true) => {
+                let here = self.map_state(z, p)?;
+                let minus = self.map_state(z, p - d)?;
+                Ok((here - minus) / d)
+            }
+            (true, false) => {
+                let plus = self.map_state(z, p + d)?;
+                let here = self.map_state(z, p)?;
+                Ok((plus - here) / d)
+            }
+            _ => {
+                let plus = self.map_state(z, p + d)?;
+                let minus = self.map_state(z, p - d)?;
+                Ok((plus - minus) / (2.0 * d))
+            }
+        }
     }
 
     /// Bordered Jacobian [[M − I, F_p], [tᵀ]].
