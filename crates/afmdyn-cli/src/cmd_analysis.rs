@@ -9,8 +9,8 @@ use afmdyn::integrate::build;
 use afmdyn::request::checkpoint::{self, Checkpoint, CheckpointError};
 use afmdyn::request::limits::ATTRACTOR_SAMPLES_PER_PERIOD;
 use afmdyn::request::sweep::{
-    branch_code, fingerprint, status_code, COL_BRANCH, COL_INDEX, COL_PERIOD, COL_POINT,
-    COL_STATUS, COL_TAU, COL_X_MAX, NUMERIC_COLUMNS,
+    branch_code, fingerprint, status_code, COL_BRANCH, COL_INDEX, COL_MESSAGE, COL_PERIOD,
+    COL_POINT, COL_STATUS, COL_TAU, COL_X_MAX, NUMERIC_COLUMNS,
 };
 use afmdyn::request::{AttractorsRequest, BifurcationRequest, FileCheckpoint, SteadyRequest};
 use afmdyn::request::{Document, Resolved};
@@ -198,6 +198,7 @@ pub fn bifurcation(a: &BifurcationArgs) -> Result<(), CliError> {
         f64::NEG_INFINITY,
     );
     let (mut periodic, mut nonperiodic, mut errors) = (0usize, 0usize, 0usize);
+    let mut first_error: Option<String> = None;
     read_rows(&final_csv, &mut |r| {
         let v: f64 = r[COL_VALUE].parse().unwrap_or(f64::NAN);
         let w: f64 = r[COL_W_TIP].parse().unwrap_or(f64::NAN);
@@ -206,7 +207,10 @@ pub fn bifurcation(a: &BifurcationArgs) -> Result<(), CliError> {
             match &r[COL_STATUS] {
                 "periodic" => periodic += 1,
                 "nonperiodic" => nonperiodic += 1,
-                _ => errors += 1,
+                _ => {
+                    errors += 1;
+                    first_error.get_or_insert_with(|| r[COL_MESSAGE].to_string());
+                }
             }
         }
         if w.is_finite() {
@@ -328,6 +332,24 @@ pub fn bifurcation(a: &BifurcationArgs) -> Result<(), CliError> {
         "npy": out.join("bifurcation.npy"),
     });
     summary = afmdyn::report::with_si(summary, probe.as_ref(), &base);
+    // the exit-code rule (docs/outputs.md): failed points are reported on stderr too, and a
+    // sweep with no point computed has no answer (exit 1)
+    if let Some(first) = &first_error {
+        if periodic + nonperiodic == 0 {
+            if a.json {
+                println!("{summary}");
+            }
+            return Err(CliError::Sim(afmdyn::SimError::EveryRunFailed {
+                what: "sweep points",
+                runs: errors,
+                first: first.clone(),
+            }));
+        }
+        eprintln!(
+            "afmdyn: warning: {errors} of {} sweep points failed; the first: {first}",
+            periodic + nonperiodic + errors
+        );
+    }
     if a.json {
         println!("{summary}");
     } else {
@@ -507,6 +529,13 @@ pub fn attractors(a: &AttractorsArgs) -> Result<(), CliError> {
                 shade: vec![],
             },
         )?;
+    }
+    if let Some(first) = report.failures.first() {
+        eprintln!(
+            "afmdyn: warning: {} of {} random starts failed; the first: {first}",
+            report.failures.len(),
+            a.samples
+        );
     }
     write_bytes(
         &out.join("attractors.json"),

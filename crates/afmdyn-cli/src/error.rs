@@ -45,15 +45,8 @@ impl CliError {
     pub fn code(&self) -> i32 {
         match self {
             CliError::Input(_) => 2,
-            CliError::Sim(e) => match e {
-                afmdyn::SimError::Params(_)
-                | afmdyn::SimError::StateLength { .. }
-                | afmdyn::SimError::NotFinite { .. }
-                | afmdyn::SimError::OutOfRange { .. }
-                | afmdyn::SimError::Unsupported { .. }
-                | afmdyn::SimError::Budget { .. } => 2,
-                _ => 1,
-            },
+            CliError::Sim(e) if e.is_input_error() => 2,
+            CliError::Sim(_) => 1,
             CliError::Io(_) => 1,
         }
     }

@@ -503,3 +503,31 @@ fn negative_numbers_with_exponents_are_values() {
     // a boolean flag takes no value, negative or not
     bad_input(&["orbit", "--json", "-1e-3"], "--json");
 }
+
+/// The exit-code rule (docs/outputs.md): an attractor census whose every start failed has no
+/// answer — exit 1 with the count and the first error (it exited 0 with `"attractors": []`
+/// and nothing on stderr; issue 27).
+#[test]
+fn an_attractor_census_whose_every_start_failed_exits_1() {
+    let dir = std::env::temp_dir().join(format!("afmdyn-cli-att-{}", std::process::id()));
+    let out = afmdyn(&[
+        "attractors",
+        "--contact-law",
+        "hertz",
+        "--omega",
+        "1e-3",
+        "--samples",
+        "4",
+        "--json",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.starts_with("afmdyn: every one of the 4 random starts failed; the first: adaptive"),
+        "{err}"
+    );
+    assert_eq!(err.lines().count(), 1, "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

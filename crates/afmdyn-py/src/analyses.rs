@@ -525,6 +525,9 @@ pub fn bifurcation<'py>(
             .map_err(checkpoint_error)
         },
     )??;
+    if let Some(e) = afmdyn::request::sweep::every_point_failed(&records) {
+        return Err(sim_error(e));
+    }
     let n = spec.base.modes;
     let rows = records.len();
     let mut value = Vec::with_capacity(rows);

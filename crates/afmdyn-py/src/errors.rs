@@ -18,18 +18,13 @@ pub fn param_error(e: ParamError) -> PyErr {
     PyValueError::new_err(e.to_string())
 }
 
-/// Input errors (parameters, state lengths, non-finite values, out-of-range options, an
-/// integrator that cannot integrate the law, a run beyond a budget: the command line's exit
-/// code 2) are `ValueError`; everything else is `SimulationError`.
+/// Input errors ([`SimError::is_input_error`]: the command line's exit code 2) are
+/// `ValueError`; everything else is `SimulationError` (exit code 1).
 pub fn sim_error(e: SimError) -> PyErr {
-    match e {
-        SimError::Params(_)
-        | SimError::StateLength { .. }
-        | SimError::NotFinite { .. }
-        | SimError::OutOfRange { .. }
-        | SimError::Unsupported { .. }
-        | SimError::Budget { .. } => PyValueError::new_err(e.to_string()),
-        _ => SimulationError::new_err(e.to_string()),
+    if e.is_input_error() {
+        PyValueError::new_err(e.to_string())
+    } else {
+        SimulationError::new_err(e.to_string())
     }
 }
 

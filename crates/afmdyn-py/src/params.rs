@@ -43,6 +43,13 @@ fn integer(name: &str, v: &Bound<'_, PyAny>) -> PyResult<i64> {
             "{name}: expected an integer, got bool"
         )));
     }
+    if v.is_instance_of::<pyo3::types::PyInt>() {
+        // an integer beyond 64 bits: a value out of range, not a wrong type
+        return v.extract::<i64>().map_err(|_| {
+            let range = afmdyn::request::parameter(name).map_or("", |p| p.range);
+            PyValueError::new_err(format!("{name} = {v}: must be in {range}"))
+        });
+    }
     v.extract::<i64>().map_err(|_| {
         PyTypeError::new_err(format!(
             "{name}: expected an integer, got {}",

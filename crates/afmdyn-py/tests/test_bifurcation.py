@@ -105,15 +105,27 @@ def test_other_parameters_and_explicit_values(cli, tmp_path):
 
 
 def test_a_failed_point_is_an_error_row_not_an_exception(cli, tmp_path):
-    ds = afmdyn.bifurcation(values=[2.6, 2.7], integrator="rk4", steps_per_period=5)
-    assert ds.status.values.tolist() == ["error"] * 4
-    assert (ds.period.values == -2).all() and np.isnan(ds.w_tip.values).all()
-    assert all(m.startswith("diverged at tau") for m in ds.message.values)
+    # Ω = 2.6 diverges (RK4 at 5 steps per period), Ω = 60 (a shorter step) is computed
+    ds = afmdyn.bifurcation(values=[2.6, 60.0], integrator="rk4", steps_per_period=5)
+    st = ds.status.values.tolist()
+    assert "error" in st and set(st) - {"error"}, st
+    bad = ds.status.values == "error"
+    assert (ds.period.values[bad] == -2).all() and np.isnan(ds.w_tip.values[bad]).all()
+    assert all(m.startswith("diverged at tau") for m in ds.message.values[bad])
+
+
+def test_a_sweep_whose_every_point_failed_is_a_failure(cli, tmp_path):
+    """The exit-code rule (docs/outputs.md): no point computed, no answer — SimulationError in
+    Python, exit 1 from the command line, which still writes its readable error rows."""
+    with pytest.raises(afmdyn.SimulationError, match="every one of the 4 sweep points failed"):
+        afmdyn.bifurcation(values=[2.6, 2.7], integrator="rk4", steps_per_period=5)
     args = "bifurcation --from 2.6 --to 2.7 --steps 2 --integrator rk4 --steps-per-period 5"
     run = cli(*args.split(), "--out", tmp_path)
-    assert run.returncode == 0, run.stderr  # the command line's error rows are readable too
+    assert run.returncode == 1, run.stderr
+    assert "every one of the 4 sweep points failed; the first: diverged at tau" in run.stderr
     ref = pd.read_csv(tmp_path / "bifurcation.csv")
-    assert sorted(ref.message) == sorted(ds.message.values.tolist())
+    assert (ref.status == "error").all()
+    assert all(m.startswith("diverged at tau") for m in ref.message)
 
 
 def test_progress_callback_sees_every_point():

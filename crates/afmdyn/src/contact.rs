@@ -118,6 +118,16 @@ impl ContactLaw {
                         "0 < ã₀ ≤ 1e6",
                     );
                 }
+                // the adhesion force at contact, H̃/ã₀² (the force law below): beyond 1e12 the
+                // force, its derivative 2H̃/ã₀³ and the step sizes leave floating point
+                let adhesion = hamaker / (intermolecular_distance * intermolecular_distance);
+                if !(adhesion.is_finite() && adhesion <= 1e12) {
+                    return bad(
+                        "intermolecular_distance (DMT ã₀)",
+                        intermolecular_distance,
+                        "H̃/ã₀² ≤ 1e12 (the adhesion force at contact; raise ã₀ or lower H̃)",
+                    );
+                }
                 Ok(())
             }
             ContactLaw::Impact { restitution } => {

@@ -33,7 +33,7 @@ pub enum ParamError {
         law: &'static str,
     },
     /// A group of the tip–sample law (see [`crate::contact::ContactLaw`]) is out of range.
-    #[error("{name} = {value}: must satisfy {range}")]
+    #[error("{name} = {}: must satisfy {range}", number(*value))]
     Law {
         /// The group's name with its symbol.
         name: &'static str,
@@ -112,6 +112,16 @@ pub enum UnitsError {
     /// The derived dimensionless set is invalid.
     #[error(transparent)]
     Params(#[from] ParamError),
+}
+
+/// `v` as a reader writes it: plain between 1e-4 and 1e16, else in scientific notation (Rust's
+/// `{}` spells 1e-300 with 300 zeros).
+pub fn number(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() || (1e-4..1e16).contains(&v.abs()) {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
 }
 
 /// Failure of a trajectory computation.
@@ -195,6 +205,17 @@ pub enum SimError {
         /// The analysis.
         analysis: &'static str,
     },
+    /// Every independent run of an analysis failed (every random start of an attractor census,
+    /// every point of a sweep): there is no answer to report.
+    #[error("every one of the {runs} {what} failed; the first: {first}")]
+    EveryRunFailed {
+        /// What the runs are ("random starts", "sweep points").
+        what: &'static str,
+        /// How many there were.
+        runs: usize,
+        /// The first one's error.
+        first: String,
+    },
     /// The caller cancelled the run ([`crate::analysis::progress::Progress::cancel`]).
     #[error("cancelled")]
     Cancelled,
@@ -236,6 +257,22 @@ impl SimError {
             }
             other => other.to_string(),
         }
+    }
+
+    /// Whether the error is about the input (a value out of range, a state of the wrong length,
+    /// a non-finite number, an integrator that cannot integrate the law, a run beyond a budget)
+    /// rather than a computation that failed: the command line's exit code 2 against 1, and
+    /// Python's `ValueError` against `afmdyn.SimulationError`.
+    pub fn is_input_error(&self) -> bool {
+        matches!(
+            self,
+            SimError::Params(_)
+                | SimError::StateLength { .. }
+                | SimError::NotFinite { .. }
+                | SimError::OutOfRange { .. }
+                | SimError::Unsupported { .. }
+                | SimError::Budget { .. }
+        )
     }
 
     /// Shorthand for [`SimError::OutOfRange`].

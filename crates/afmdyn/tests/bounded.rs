@@ -4,8 +4,8 @@
 
 use afmdyn::analysis::progress::Progress;
 use afmdyn::contact::ContactLaw;
-use afmdyn::request::ContinuationRequest;
-use afmdyn::{Params, SweepParam};
+use afmdyn::request::{AttractorsRequest, ContinuationRequest};
+use afmdyn::{Params, SimError, SweepParam};
 
 /// A branch continued from the largest Ω the model accepts (1e5) needs ∂Pⁿ/∂Ω at its first
 /// point: a central difference there evaluated Ω = 1.000001e5, which the validation refuses,
@@ -25,4 +25,48 @@ fn continuation_from_the_largest_omega_does_not_step_outside_the_range() {
     let branches = request.run(&base, &Progress::new()).unwrap();
     assert!(branches[0].len() > 2, "{} points", branches[0].len());
     assert!(branches[0].iter().all(|b| b.value <= 1e5));
+}
+
+/// At Ω = 1e-3 with the Hertz law every random start exceeds the adaptive integrator's step
+/// budget: the census used to return no attractor and exit 0; now it is a failure (exit 1,
+/// Python's SimulationError) that names the count and the first start's error.
+#[test]
+fn an_attractor_census_whose_every_start_fails_is_a_failure() {
+    let params = Params {
+        omega: 1e-3,
+        contact_law: ContactLaw::Hertz,
+        ..Params::default()
+    };
+    let request = AttractorsRequest {
+        samples: 4,
+        ..AttractorsRequest::default()
+    };
+    let err = request.run(&params, &Progress::new()).unwrap_err();
+    assert!(
+        matches!(err, SimError::EveryRunFailed { runs: 4, .. }),
+        "{err}"
+    );
+    assert!(!err.is_input_error());
+    assert!(err
+        .to_string()
+        .starts_with("every one of the 4 random starts failed; the first: adaptive integrator"));
+}
+
+/// A DMT adhesion force beyond floating point (ã₀ = 1e-300) is refused naming ã₀ and why; it
+/// used to reach the ODE crate ("Initial step size (0.0) cannot be zero").
+#[test]
+fn a_dmt_adhesion_force_beyond_floating_point_is_refused() {
+    let params = Params {
+        contact_law: ContactLaw::Dmt {
+            hamaker: 1e-5,
+            intermolecular_distance: 1e-300,
+        },
+        ..Params::default()
+    };
+    let err = params.validate().unwrap_err().to_string();
+    assert_eq!(
+        err,
+        "intermolecular_distance (DMT ã₀) = 1e-300: must satisfy H̃/ã₀² ≤ 1e12 (the adhesion \
+         force at contact; raise ã₀ or lower H̃)"
+    );
 }

@@ -14,9 +14,25 @@ computation fails (chattering, divergence, Newton not converging).
 
 from __future__ import annotations
 
+import functools
+import inspect
 import json
+import numbers
 import os
-from typing import Literal, TYPE_CHECKING, Any, Dict, Optional, Sequence, Tuple, TypedDict, Union
+from typing import (
+    Literal,
+    TYPE_CHECKING,
+    Any,
+    Callable,
+    Dict,
+    Optional,
+    Sequence,
+    Tuple,
+    TypedDict,
+    TypeVar,
+    Union,
+    cast,
+)
 
 import numpy as np
 import xarray as xr
@@ -113,6 +129,53 @@ def _attrs(p: Params, **extra: Any) -> Dict[str, Any]:
     return a
 
 
+_KINDS: Dict[str, Tuple[Any, str]] = {
+    "int": (numbers.Integral, "an integer"),
+    "float": (numbers.Real, "a number"),
+    "bool": ((bool, np.bool_), "True or False"),
+    "str": (str, "a string"),
+}
+
+
+_F = TypeVar("_F", bound=Callable[..., Any])
+
+
+def _typed(f: _F) -> _F:
+    """Check the keywords of the public function ``f`` against its annotations before any
+    work: ``int``/``float``/``bool``/``str`` and their ``Optional[...]``. A wrong type is a
+    ``TypeError`` naming the keyword and what it takes; an integer beyond 64 bits a
+    ``ValueError`` naming it (the core's conversions would say neither)."""
+    sig = inspect.signature(f)
+    checks: Dict[str, Tuple[str, bool]] = {}
+    for name, prm in sig.parameters.items():
+        ann = prm.annotation if isinstance(prm.annotation, str) else ""
+        optional = ann.startswith("Optional[") and ann.endswith("]")
+        base = ann[len("Optional["):-1] if optional else ann
+        if base in _KINDS:
+            checks[name] = (base, optional)
+
+    @functools.wraps(f)
+    def checked(*args: Any, **kwargs: Any) -> Any:
+        for name, value in sig.bind_partial(*args, **kwargs).arguments.items():
+            if name not in checks:
+                continue
+            base, optional = checks[name]
+            if value is None and optional:
+                continue
+            kind, what = _KINDS[base]
+            numeric_bool = base in ("int", "float") and isinstance(value, (bool, np.bool_))
+            if numeric_bool or not isinstance(value, kind):
+                takes = what + (" or None" if optional else "")
+                raise TypeError(
+                    f"{f.__name__}(): {name} must be {takes}, got {type(value).__name__} {value!r}"
+                )
+            if base == "int" and not -(2**63) <= int(value) < 2**63:
+                raise ValueError(f"{name} = {value}: out of range (far beyond every limit)")
+        return f(*args, **kwargs)
+
+    return cast(_F, checked)
+
+
 _COUNTS = frozenset(
     "samples_per_period steps_per_period max_modes periods steps starts seed threads "
     "max_periods max_period samples period transient blocks".split()
@@ -142,6 +205,7 @@ def summary(ds: xr.Dataset) -> Dict[str, Any]:
     return json.loads(ds.attrs["summary"])
 
 
+@_typed
 def modes(params: Optional[Params] = None, /, **model: Unpack[Model]) -> Spectrum:
     """Natural frequencies and damped eigenvalues of the free and contact systems
     (paper eqs. 19–23).
@@ -158,6 +222,7 @@ def modes(params: Optional[Params] = None, /, **model: Unpack[Model]) -> Spectru
     return Spectrum(p, region("free"), region("contact"), d["json"])
 
 
+@_typed
 def simulate(
     params: Optional[Params] = None,
     /,
@@ -323,6 +388,7 @@ def simulate(
     return ds
 
 
+@_typed
 def converge(
     params: Optional[Params] = None,
     /,
@@ -393,6 +459,7 @@ def converge(
     )
 
 
+@_typed
 def bifurcation(
     params: Optional[Params] = None,
     /,
@@ -531,6 +598,7 @@ def bifurcation(
     )
 
 
+@_typed
 def attractors(
     params: Optional[Params] = None,
     /,
@@ -597,6 +665,7 @@ def attractors(
     return Attractors(p, samples, found, list(d["failures"]), d["json"])
 
 
+@_typed
 def orbit(
     params: Optional[Params] = None,
     /,
@@ -657,6 +726,7 @@ def orbit(
     )
 
 
+@_typed
 def continuation(
     params: Optional[Params] = None,
     /,
@@ -745,6 +815,7 @@ def continuation(
     )
 
 
+@_typed
 def lyapunov(
     params: Optional[Params] = None,
     /,
@@ -803,6 +874,7 @@ def probe(path: Union[str, "os.PathLike[str]"]) -> Dict[str, Any]:
     return {"params": p, "si": json.loads(si)}
 
 
+@_typed
 def observe(
     params: Optional[Params] = None,
     /,
@@ -867,6 +939,7 @@ def _curve(
     return doc
 
 
+@_typed
 def approach(
     params: Optional[Params] = None,
     /,
@@ -914,6 +987,7 @@ def approach(
     )
 
 
+@_typed
 def resonance(
     params: Optional[Params] = None,
     /,

@@ -414,12 +414,23 @@ impl AttractorsRequest {
     }
 
     /// The census of `params`, the random starts counted in `progress`, which also cancels
-    /// the run.
+    /// the run. Starts that fail are listed in [`AttractorReport::failures`].
     ///
     /// # Errors
-    /// As [`Self::spec`] and [`find_attractors_with`].
+    /// As [`Self::spec`] and [`find_attractors_with`]; [`SimError::EveryRunFailed`] when every
+    /// start failed (there is no attractor to report).
     pub fn run(&self, params: &Params, progress: &Progress) -> Result<AttractorReport, SimError> {
-        find_attractors_with(&self.spec(params)?, progress)
+        let report = find_attractors_with(&self.spec(params)?, progress)?;
+        if report.attractors.is_empty() {
+            if let Some(first) = report.failures.first() {
+                return Err(SimError::EveryRunFailed {
+                    what: "random starts",
+                    runs: report.failures.len(),
+                    first: first.clone(),
+                });
+            }
+        }
+        Ok(report)
     }
 }
 

@@ -49,6 +49,19 @@ impl Default for CurveRequest {
 }
 
 impl CurveRequest {
+    /// The given ends and step are finite numbers (a NaN end was reported as the other one).
+    ///
+    /// # Errors
+    /// [`SimError::NotFinite`] naming `from`, `to` or `step`.
+    pub fn check_finite(&self) -> Result<(), SimError> {
+        for (name, v) in [("from", self.from), ("to", self.to), ("step", self.step)] {
+            if let Some(x) = v {
+                crate::error::finite(name, x)?;
+            }
+        }
+        Ok(())
+    }
+
     /// The ends in dimensionless units: the requested ones divided by `unit`, else `default`.
     pub fn ends(&self, default: (f64, f64), unit: f64) -> (f64, f64) {
         (
@@ -107,6 +120,7 @@ pub fn approach_request(
     request: &CurveRequest,
     length: f64,
 ) -> Result<SteppedSpec, SimError> {
+    request.check_finite()?;
     let (from, to) = request.ends(default_range(&base)?, length);
     request.configure(approach_spec(base, from, to, request.spacing(length)?)?)
 }
@@ -123,6 +137,7 @@ pub fn resonance_request(
     request: &CurveRequest,
     hz: f64,
 ) -> Result<SteppedSpec, SimError> {
+    request.check_finite()?;
     let (from, to) = request.ends(mode_band(&base, mode)?, hz);
     request.configure(resonance_spec(base, from, to, request.spacing(hz)?)?)
 }

@@ -139,6 +139,21 @@ pub const HEADER: [&str; 18] = {
     h
 };
 
+/// [`crate::SimError::EveryRunFailed`] when no point of a sweep's `records` was computed (the
+/// exit-code rule of `docs/outputs.md`: a sweep with no answer is a failure), else `None`.
+pub fn every_point_failed(records: &[SweepRecord]) -> Option<crate::SimError> {
+    let points: Vec<&SweepRecord> = records.iter().filter(|r| r.point == 0).collect();
+    let failed = |r: &&SweepRecord| r.status == PointStatus::Error;
+    if points.is_empty() || !points.iter().all(failed) {
+        return None;
+    }
+    Some(crate::SimError::EveryRunFailed {
+        what: "sweep points",
+        runs: points.len(),
+        first: points[0].message.clone(),
+    })
+}
+
 /// Position of `value` in [`COLUMNS`].
 pub const COL_VALUE: usize = 1;
 /// Position of `index`.
@@ -159,6 +174,8 @@ pub const COL_TAU: usize = 8;
 pub const COL_W_TIP: usize = 10;
 /// Position of `x_max`.
 pub const COL_X_MAX: usize = 11;
+/// Position of `message`.
+pub const COL_MESSAGE: usize = 16;
 /// Position of `state`.
 pub const COL_STATE: usize = 17;
 
