@@ -44,6 +44,13 @@ pub const GRID_BUDGET_BYTES: f64 = 128.0 * 1024.0 * 1024.0;
 /// Budget of the adaptive oracle: the estimated number of steps per drive period, T‖A‖_F (the
 /// Frobenius norm bounds the fastest rate of the system), may not exceed this.
 pub const ADAPTIVE_STEPS_BUDGET: f64 = 1e7;
+/// Budget of the adaptive integrator while it runs: the DOP853 steps (accepted and rejected)
+/// it may take within one drive period. The estimate of [`ADAPTIVE_STEPS_BUDGET`] sees the
+/// linear part only; a nonlinear law can grow far stiffer where the motion goes (a tip captured
+/// by a strong DMT adhesion needs ~3e5 steps per period, ~2 s, where the default Hertz orbit
+/// needs ~200). 1e5 steps (~1 s at N = 3) is 500× the default's; beyond, the run ends with
+/// [`crate::SimError::Budget`] naming what to change, rather than running for hours.
+pub const ADAPTIVE_STEPS_PER_PERIOD: usize = 100_000;
 
 /// Dimensionless model parameters (paper eq. 7), all in the units of eq. 5.
 ///

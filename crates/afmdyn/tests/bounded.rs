@@ -4,7 +4,7 @@
 
 use afmdyn::analysis::progress::Progress;
 use afmdyn::contact::ContactLaw;
-use afmdyn::request::{AttractorsRequest, ContinuationRequest};
+use afmdyn::request::{AttractorsRequest, ContinuationRequest, OrbitRequest};
 use afmdyn::{Params, SimError, SweepParam};
 
 /// A branch continued from the largest Ω the model accepts (1e5) needs ∂Pⁿ/∂Ω at its first
@@ -69,4 +69,38 @@ fn a_dmt_adhesion_force_beyond_floating_point_is_refused() {
         "intermolecular_distance (DMT ã₀) = 1e-300: must satisfy H̃/ã₀² ≤ 1e12 (the adhesion \
          force at contact; raise ã₀ or lower H̃)"
     );
+}
+
+/// Inputs the validation accepts whose motion grows too stiff for the adaptive integrator (a
+/// tip captured by a strong DMT adhesion, a tip resting 1e6 g₀ deep in the sample) ran for
+/// minutes to hours (`orbit --contact-law dmt --hamaker 1e6` > 120 s; `--gap -1e6` 437 s).
+/// Now the run ends at the first drive period that needs more than
+/// [`afmdyn::params::ADAPTIVE_STEPS_PER_PERIOD`] steps, with a budget error naming what to
+/// change — counted in steps, so the answer does not depend on the machine.
+#[test]
+fn a_motion_too_stiff_to_resolve_ends_with_a_budget_error() {
+    for params in [
+        Params {
+            contact_law: ContactLaw::Dmt {
+                hamaker: 1e6,
+                intermolecular_distance: 0.01,
+            },
+            ..Params::default()
+        },
+        Params {
+            contact_law: ContactLaw::Hertz,
+            alpha5: -1e6,
+            ..Params::default()
+        },
+    ] {
+        let err = OrbitRequest::default().run(&params).unwrap_err();
+        assert!(matches!(err, SimError::Budget { .. }), "{err}");
+        assert!(err.is_input_error());
+        let msg = err.to_string();
+        assert!(
+            msg.starts_with("adaptive integrator: more than 1e5 steps within the drive period"),
+            "{msg}"
+        );
+        assert!(msg.contains("soften the law"), "{msg}");
+    }
 }

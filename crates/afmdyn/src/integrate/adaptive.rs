@@ -32,7 +32,7 @@ use differential_equations::interpolate::Interpolation;
 use differential_equations::methods::{DormandPrince, ExplicitRungeKutta, Ordinary};
 use differential_equations::ode::{OrdinaryNumericalMethod, ODE};
 use nalgebra::{DMatrix, DVector};
-use std::cell::RefCell;
+use std::cell::{Cell, RefCell};
 
 /// The DOP853 stepper on `Vec<f64>` states.
 type Dop853 = ExplicitRungeKutta<Ordinary, DormandPrince, f64, Vec<f64>, 8, 12, 16>;
@@ -106,6 +106,9 @@ pub struct Adaptive<S: TipSampleSystem + Clone = CantileverModel> {
     just_switched: bool,
     chatter: ChatterWindow,
     last: LastStep,
+    /// The drive period the step count is of (⌊τ/T⌋ at the steps' start) and the DOP853 steps
+    /// taken in it, accepted and rejected ([`crate::params::ADAPTIVE_STEPS_PER_PERIOD`]).
+    budget: Cell<(i64, usize)>,
 }
 
 impl<S: TipSampleSystem + Clone> std::fmt::Debug for Adaptive<S> {
@@ -137,6 +140,7 @@ impl<S: TipSampleSystem + Clone> Adaptive<S> {
             h: 0.0,
             just_switched: true,
             chatter: ChatterWindow::new(CHATTER_COUNT, 1e-7 * model.period()),
+            budget: Cell::new((i64::MIN, 0)),
             last: LastStep {
                 tau0: 0.0,
                 tau1: 0.0,
@@ -222,6 +226,7 @@ impl<S: TipSampleSystem + Clone> Adaptive<S> {
             stepper.set_h(t_end - t0);
         }
         for _ in 0..1000 {
+            self.count_step(t0)?;
             stepper.step(&ode).map_err(|e| SimError::Adaptive {
                 tau: t0,
                 message: format!("{e:?}"),
@@ -242,6 +247,33 @@ impl<S: TipSampleSystem + Clone> Adaptive<S> {
             tau: t0,
             message: "1000 rejected steps in a row".into(),
         })
+    }
+
+    /// Count one DOP853 step taken at `tau` against the budget of its drive period.
+    ///
+    /// # Errors
+    /// [`SimError::Budget`] beyond [`crate::params::ADAPTIVE_STEPS_PER_PERIOD`] steps in one
+    /// drive period.
+    fn count_step(&self, tau: f64) -> Result<(), SimError> {
+        let period = self.model.period();
+        let k = (tau / period).floor() as i64;
+        let (at, n) = self.budget.get();
+        let n = if at == k { n + 1 } else { 1 };
+        self.budget.set((k, n));
+        if n > crate::params::ADAPTIVE_STEPS_PER_PERIOD {
+            return Err(SimError::Budget {
+                what: "adaptive integrator",
+                needed: format!(
+                    "more than 1e5 steps within the drive period from τ = {:.6e}",
+                    k as f64 * period
+                ),
+                budget: "1e5 steps per drive period".into(),
+                hint: "the tip–sample force grew too stiff to resolve where the motion went: \
+                       soften the law (contact_stiffness, hamaker), check the gap (alpha5), \
+                       or use a larger Ω",
+            });
+        }
+        Ok(())
     }
 
     /// Integrate from (t0, y0) in `mode` to exactly t1 with a fresh stepper; returns the end
@@ -382,6 +414,7 @@ impl<S: TipSampleSystem + Clone + 'static> Integrator for Adaptive<S> {
         self.stint_open = false;
         self.just_switched = true;
         self.chatter.clear();
+        self.budget.set((i64::MIN, 0));
         self.last.dense = None;
         self.last.jacobian = None;
         self.last.tau0 = tau;
