@@ -43,3 +43,18 @@ def test_bad_grids_raise_value_error():
         afmdyn.resonance(mode=7)
     with pytest.raises(ValueError, match="tolerance"):
         afmdyn.resonance(tolerance=0.0)
+
+
+@pytest.mark.parametrize(
+    "call,needle",
+    [
+        # the grid's refusals quote the value as written, in metres or hertz (issue 27: they
+        # said "to = 0.8", "step = 100000000", "step = -0.00133…")
+        (lambda: afmdyn.approach(probe=PROBE, from_=8e-9, to=8e-9), "to = 8e-9: must differ"),
+        (lambda: afmdyn.approach(probe=PROBE, step=1.0), "step = 1: is longer than the range"),
+        (lambda: afmdyn.resonance(probe=PROBE, step=-400.0), "step = -400: must be finite and > 0"),
+    ],
+)
+def test_curve_refusals_quote_the_users_units(call, needle):
+    with pytest.raises(ValueError, match=needle):
+        call()

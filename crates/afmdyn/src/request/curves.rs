@@ -122,7 +122,8 @@ pub fn approach_request(
 ) -> Result<SteppedSpec, SimError> {
     request.check_finite()?;
     let (from, to) = request.ends(default_range(&base)?, length);
-    request.configure(approach_spec(base, from, to, request.spacing(length)?)?)
+    let spec = approach_spec(base, from, to, request.spacing(length)?);
+    request.configure(spec.map_err(|e| in_units(e, length))?)
 }
 
 /// The resonance spec of a front end's request near mode `mode`, Ω in units of `hz` (Hz per
@@ -139,7 +140,33 @@ pub fn resonance_request(
 ) -> Result<SteppedSpec, SimError> {
     request.check_finite()?;
     let (from, to) = request.ends(mode_band(&base, mode)?, hz);
-    request.configure(resonance_spec(base, from, to, request.spacing(hz)?)?)
+    let spec = resonance_spec(base, from, to, request.spacing(hz)?);
+    request.configure(spec.map_err(|e| in_units(e, hz))?)
+}
+
+/// An error of the grid ([`crate::analysis::stepped::grid`], in dimensionless units) about
+/// `from`, `to` or `step` with the value in the request's units (`unit` per dimensionless
+/// unit: m per g₀ or Hz per unit Ω with a probe), as the user wrote it.
+fn in_units(e: SimError, unit: f64) -> SimError {
+    match e {
+        SimError::OutOfRange {
+            name: name @ ("from" | "to" | "step"),
+            value,
+            allowed,
+        } => match value.parse::<f64>() {
+            Ok(v) => SimError::OutOfRange {
+                name,
+                value: crate::error::number(v * unit),
+                allowed,
+            },
+            Err(_) => SimError::OutOfRange {
+                name,
+                value,
+                allowed,
+            },
+        },
+        e => e,
+    }
 }
 
 #[cfg(test)]
