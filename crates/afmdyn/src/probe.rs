@@ -106,6 +106,31 @@ pub enum ProbeError {
     },
 }
 
+/// A refusal of a dimensionless group derived from the probe's keys, with the keys it was
+/// derived from: the user wrote those, not the group (a tiny `free_amplitude` was refused as
+/// "alpha5 = 7.8e21").
+fn derived(message: String) -> String {
+    let group = message.split([' ', '(']).next().unwrap_or("");
+    let keys = match group {
+        "alpha1" => "[tip] mass, [cantilever] spring_constant and resonance_frequency",
+        "alpha2" => "[drive] free_amplitude and frequency",
+        "alpha3" => "[cantilever] quality_factor or quality_factors",
+        "alpha4" => {
+            "[sample] youngs_modulus, poisson_ratio or stiffness, [tip] radius and modulus, \
+             [cantilever] spring_constant and [drive] free_amplitude"
+        }
+        "alpha5" => "[sample] z_c and [drive] free_amplitude, lengths in units of A₀",
+        "alpha6" => "[sample] damping or viscosity and [cantilever] resonance_frequency",
+        "omega" => "[drive] frequency and [cantilever] resonance_frequency",
+        "hamaker" => "[sample] hamaker, [tip] radius and [drive] free_amplitude",
+        "intermolecular_distance" => {
+            "[sample] intermolecular_distance and hamaker, and [drive] free_amplitude"
+        }
+        _ => return message,
+    };
+    format!("from {keys}: {message}")
+}
+
 /// Scales from the dimensionless model back to SI.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Scales {
@@ -412,7 +437,8 @@ impl Probe {
                 None
             }
             (Some(Structure::PointMass), _) => Some(1),
-            (Some(Structure::Beam), None) => {
+            // (a modes key that is present but invalid was reported above)
+            (Some(Structure::Beam), None) if !root.contains_key("modes") => {
                 r.problems
                     .push("missing key modes (number of Galerkin modes, 1..=20)".into());
                 None
@@ -459,11 +485,15 @@ impl Probe {
                     .into(),
             );
         }
-        if let (Some(n), Some(q)) = (modes, &qs) {
-            if q.len() != n {
+        // the count as written (an entry refused above is still one value)
+        let written = match cant.and_then(|c| c.get("quality_factors")) {
+            Some(toml::Value::Array(a)) => Some(a.len()),
+            _ => None,
+        };
+        if let (Some(n), Some(len)) = (modes, written) {
+            if len != n {
                 r.problems.push(format!(
-                    "[cantilever].quality_factors has {} values: give one per mode (modes = {n})",
-                    q.len()
+                    "[cantilever].quality_factors has {len} values: give one per mode (modes = {n})"
                 ));
             }
         }
@@ -819,12 +849,12 @@ impl Probe {
         params.alpha5 = params.alpha5_for_rest_distance(z_c / g0);
         // drive amplitude: free tip amplitude A0 (= 1 in units of g0) at Ω
         let unit_response = CantileverModel::new(&params)
-            .map_err(|e| e.to_string())?
+            .map_err(|e| derived(e.to_string()))?
             .free_tip_response()
-            .map_err(|e| e.to_string())?
+            .map_err(|e| derived(e.to_string()))?
             .norm();
         params.alpha2 = 1.0 / unit_response;
-        params.validate().map_err(|e| e.to_string())?;
+        params.validate().map_err(|e| derived(e.to_string()))?;
         Ok(Probe {
             params,
             scales,

@@ -104,3 +104,50 @@ fn a_motion_too_stiff_to_resolve_ends_with_a_budget_error() {
         assert!(msg.contains("soften the law"), "{msg}");
     }
 }
+
+/// A probe file's refusals name the keys the user wrote (issue 27): a derived group out of
+/// range says which keys it came from; a present but invalid `modes` is not also "missing"; a
+/// refused entry of `quality_factors` still counts as written.
+#[test]
+fn probe_refusals_name_the_keys_written() {
+    let pm = include_str!("../../../examples/probe-point-mass-dmt.toml");
+    let beam = include_str!("../../../examples/probe-beam-dmt.toml");
+    let with = |text: &str, key: &str, line: &str| -> String {
+        let out: Vec<String> = text
+            .lines()
+            .map(|l| {
+                if l.starts_with(&format!("{key} =")) {
+                    line.to_string()
+                } else {
+                    l.to_string()
+                }
+            })
+            .collect();
+        let err = afmdyn::probe::Probe::parse(&out.join("\n"), "probe.toml").unwrap_err();
+        err.to_string()
+    };
+    let cases = [
+        (
+            with(pm, "free_amplitude", "free_amplitude = 1e-30"),
+            "from [sample] z_c and [drive] free_amplitude",
+        ),
+        (
+            with(pm, "quality_factor", "quality_factor = 1e-6"),
+            "from [cantilever] quality_factor",
+        ),
+        (
+            with(pm, "resonance_frequency", "resonance_frequency = 1e15"),
+            "from [drive] frequency and [cantilever] resonance_frequency",
+        ),
+    ];
+    for (msg, needle) in &cases {
+        assert!(msg.contains(needle), "{msg}");
+    }
+    let msg = with(beam, "modes", "modes = 0");
+    assert_eq!(msg, "probe.toml: modes = 0: must be an integer in 1..=20");
+    let msg = with(beam, "quality_factor", "quality_factors = [400, -1, 900]");
+    assert_eq!(
+        msg,
+        "probe.toml: [cantilever].quality_factors[1] = -1: must be a number > 0"
+    );
+}
