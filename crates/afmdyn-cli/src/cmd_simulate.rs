@@ -304,7 +304,10 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
         samples_per_period: record_samples,
         chunk_periods: a.chunk_periods,
     };
+    crate::error::stop_on_signal();
     let each = |c: &Chunk<'_>| -> Result<(), CliError> {
+        // SIGINT/SIGTERM: end here; the streams' partial files are removed as they are dropped
+        crate::error::interrupted()?;
         if let Some(fl) = files.as_mut() {
             for s in &c.samples {
                 let row = sample_row(s);

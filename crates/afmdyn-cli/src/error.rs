@@ -17,6 +17,32 @@ pub enum CliError {
     /// which would lose the path.
     #[error("{0}")]
     Io(String),
+    /// SIGINT or SIGTERM ended the run (exit code 130).
+    #[error("interrupted; the partial files of this run were removed")]
+    Interrupted,
+}
+
+/// Set by the handler [`stop_on_signal`] installs.
+static SIGNALLED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Catch SIGINT and SIGTERM (and SIGHUP) for a run that streams files with no resume
+/// (`simulate`): the first signal asks it to stop at its next check ([`interrupted`]), so that
+/// its partial files are removed on the way out; a second one exits at once (130).
+pub fn stop_on_signal() {
+    let _ = ctrlc::set_handler(|| {
+        if SIGNALLED.swap(true, std::sync::atomic::Ordering::SeqCst) {
+            std::process::exit(130);
+        }
+    });
+}
+
+/// [`CliError::Interrupted`] once a signal arrived ([`stop_on_signal`]).
+pub fn interrupted() -> Result<(), CliError> {
+    if SIGNALLED.load(std::sync::atomic::Ordering::SeqCst) {
+        Err(CliError::Interrupted)
+    } else {
+        Ok(())
+    }
 }
 
 /// The library's message with a request parameter spelled as its flag: `samples_per_period`
@@ -48,6 +74,7 @@ impl CliError {
             CliError::Sim(e) if e.is_input_error() => 2,
             CliError::Sim(_) => 1,
             CliError::Io(_) => 1,
+            CliError::Interrupted => 130,
         }
     }
 }

@@ -75,3 +75,29 @@ def test_ctrl_c_interrupts_analyses_without_a_cancel_hook(call):
     assert out == ["interrupted", "after", "3"], (out, err)
     assert latency < 5, latency
     assert "Traceback" not in err and "panicked" not in err, err
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
+def test_an_interrupted_simulate_leaves_no_partial_files(cli, tmp_path, sig):
+    """``afmdyn simulate`` streams its series to ``.partial`` files (100 MB within seconds) and
+    cannot be resumed: on SIGINT/SIGTERM it stops at its next chunk and removes them, exit 130
+    (they stayed until the next run there; issue 27)."""
+    from conftest import _binary
+
+    out = tmp_path / "sim"
+    p = subprocess.Popen(
+        [str(_binary()), "simulate", "--periods", "100000", "--out", str(out)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    t0 = time.monotonic()
+    while not any(out.glob(".*.partial*")) and time.monotonic() - t0 < 30:
+        time.sleep(0.05)
+    assert any(out.glob(".*.partial*")), "the run did not start writing"
+    p.send_signal(sig)
+    _, err = p.communicate(timeout=60)
+    assert p.returncode == 130, err
+    assert err.strip() == "afmdyn: interrupted; the partial files of this run were removed"
+    left = sorted(f.name for f in out.iterdir())
+    assert left == [".afmdyn.lock"], left
