@@ -106,6 +106,11 @@ pub enum ProbeError {
     },
 }
 
+/// The largest free amplitude A₀ a probe may give (m): 10 µm, a thousand times the tapping-mode
+/// amplitudes (1–100 nm). Lengths are in units of A₀, so beyond it the tip–sample lengths
+/// vanish against it.
+pub const MAX_FREE_AMPLITUDE: f64 = 1e-5;
+
 /// A refusal of a dimensionless group derived from the probe's keys, with the keys it was
 /// derived from: the user wrote those, not the group (a tiny `free_amplitude` was refused as
 /// "alpha5 = 7.8e21").
@@ -478,6 +483,19 @@ impl Probe {
                 )
             }
             None => (None, None),
+        };
+        // lengths are in units of A₀: an amplitude of metres makes every other length vanish
+        // and the motion unresolvable (a probe with A₀ = 1 m ran for minutes; issue 27)
+        let a0 = match a0 {
+            Some(a) if a > MAX_FREE_AMPLITUDE => {
+                r.problems.push(format!(
+                    "[drive].free_amplitude = {} m: must be ≤ 1e-5 m (10 µm; tapping-mode \
+                     amplitudes are nanometres)",
+                    crate::error::number(a)
+                ));
+                None
+            }
+            a => a,
         };
         if let (Some(Structure::PointMass), Some(_)) = (structure, &qs) {
             r.problems.push(

@@ -143,6 +143,11 @@ fn probe_refusals_name_the_keys_written() {
     for (msg, needle) in &cases {
         assert!(msg.contains(needle), "{msg}");
     }
+    let msg = with(pm, "free_amplitude", "free_amplitude = 1.0");
+    assert!(
+        msg.ends_with("[drive].free_amplitude = 1 m: must be ≤ 1e-5 m (10 µm; tapping-mode amplitudes are nanometres)"),
+        "{msg}"
+    );
     let msg = with(beam, "modes", "modes = 0");
     assert_eq!(msg, "probe.toml: modes = 0: must be an integer in 1..=20");
     let msg = with(beam, "quality_factor", "quality_factors = [400, -1, 900]");
