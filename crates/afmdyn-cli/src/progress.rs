@@ -15,11 +15,20 @@ pub fn with_bar<T>(unit: &'static str, work: impl FnOnce(&Progress) -> T) -> T {
     let finished = AtomicBool::new(false);
     std::thread::scope(|s| {
         let poller = s.spawn(|| draw(&progress, &finished, unit));
-        let out = work(&progress);
-        finished.store(true, Ordering::Relaxed);
-        poller.thread().unpark();
-        out
+        // the bar ends however the work ends (a panic too: the scope joins the poller first)
+        let _done = Finished(&finished, poller.thread().clone());
+        work(&progress)
     })
+}
+
+/// Ends the poller when dropped.
+struct Finished<'a>(&'a AtomicBool, std::thread::Thread);
+
+impl Drop for Finished<'_> {
+    fn drop(&mut self) {
+        self.0.store(true, Ordering::Relaxed);
+        self.1.unpark();
+    }
 }
 
 fn draw(progress: &Progress, finished: &AtomicBool, unit: &'static str) {
