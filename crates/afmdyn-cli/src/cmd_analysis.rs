@@ -9,8 +9,8 @@ use afmdyn::integrate::build;
 use afmdyn::request::checkpoint::{self, Checkpoint, CheckpointError};
 use afmdyn::request::limits::ATTRACTOR_SAMPLES_PER_PERIOD;
 use afmdyn::request::sweep::{
-    branch_code, fingerprint, status_code, COL_BRANCH, COL_INDEX, COL_MESSAGE, COL_PERIOD,
-    COL_POINT, COL_STATUS, COL_TAU, COL_X_MAX, NUMERIC_COLUMNS,
+    branch_code, fingerprint, status_code, sweep_failure, COL_BRANCH, COL_INDEX, COL_MESSAGE,
+    COL_PERIOD, COL_POINT, COL_STATUS, COL_TAU, COL_X_MAX, NUMERIC_COLUMNS,
 };
 use afmdyn::request::{AttractorsRequest, BifurcationRequest, FileCheckpoint, SteadyRequest};
 use afmdyn::request::{Document, Resolved};
@@ -334,17 +334,14 @@ pub fn bifurcation(a: &BifurcationArgs) -> Result<(), CliError> {
     summary = afmdyn::report::with_si(summary, probe.as_ref(), &base);
     // the exit-code rule (docs/outputs.md): failed points are reported on stderr too, and a
     // sweep with no point computed has no answer (exit 1)
-    if let Some(first) = &first_error {
-        if periodic + nonperiodic == 0 {
-            if a.json {
-                println!("{summary}");
-            }
-            return Err(CliError::Sim(afmdyn::SimError::EveryRunFailed {
-                what: "sweep points",
-                runs: errors,
-                first: first.clone(),
-            }));
+    let failed = sweep_failure(periodic + nonperiodic, errors, first_error.as_deref());
+    if let Some(e) = failed {
+        if a.json {
+            println!("{summary}");
         }
+        return Err(CliError::Sim(e));
+    }
+    if let Some(first) = &first_error {
         eprintln!(
             "afmdyn: warning: {errors} of {} sweep points failed; the first: {first}",
             periodic + nonperiodic + errors

@@ -260,14 +260,16 @@ impl<S: TipSampleSystem + Clone> Adaptive<S> {
         let (at, n) = self.budget.get();
         let n = if at == k { n + 1 } else { 1 };
         self.budget.set((k, n));
-        if n > crate::params::ADAPTIVE_STEPS_PER_PERIOD {
+        let cap = crate::params::ADAPTIVE_STEPS_PER_PERIOD;
+        if n > cap {
+            let cap = cap as f64;
             return Err(SimError::Budget {
                 what: "adaptive integrator",
                 needed: format!(
-                    "more than 1e5 steps within the drive period from τ = {:.6e}",
+                    "more than {cap:e} steps within the drive period from τ = {:.6e}",
                     k as f64 * period
                 ),
-                budget: "1e5 steps per drive period".into(),
+                budget: format!("{cap:e} steps per drive period"),
                 hint: "the tip–sample force grew too stiff to resolve where the motion went: \
                        soften the law (contact_stiffness, hamaker), check the gap (alpha5), \
                        or use a larger Ω",

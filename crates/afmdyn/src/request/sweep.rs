@@ -139,19 +139,35 @@ pub const HEADER: [&str; 18] = {
     h
 };
 
-/// [`crate::SimError::EveryRunFailed`] when no point of a sweep's `records` was computed (the
-/// exit-code rule of `docs/outputs.md`: a sweep with no answer is a failure), else `None`.
-pub fn every_point_failed(records: &[SweepRecord]) -> Option<crate::SimError> {
-    let points: Vec<&SweepRecord> = records.iter().filter(|r| r.point == 0).collect();
-    let failed = |r: &&SweepRecord| r.status == PointStatus::Error;
-    if points.is_empty() || !points.iter().all(failed) {
-        return None;
+/// [`crate::SimError::EveryRunFailed`] when no point of a sweep was computed (the exit-code
+/// rule of `docs/outputs.md`: a sweep with no answer is a failure), else `None`; from the
+/// counts of its points (the first row of each, `point` = 0) computed and failed, and the
+/// first failure's message.
+pub fn sweep_failure(
+    computed: usize,
+    failed: usize,
+    first: Option<&str>,
+) -> Option<crate::SimError> {
+    match first {
+        Some(first) if computed == 0 && failed > 0 => Some(crate::SimError::EveryRunFailed {
+            what: "sweep points",
+            runs: failed,
+            first: first.to_string(),
+        }),
+        _ => None,
     }
-    Some(crate::SimError::EveryRunFailed {
-        what: "sweep points",
-        runs: points.len(),
-        first: points[0].message.clone(),
-    })
+}
+
+/// [`sweep_failure`] of a sweep's `records`.
+pub fn every_point_failed(records: &[SweepRecord]) -> Option<crate::SimError> {
+    let points = records.iter().filter(|r| r.point == 0);
+    let (failed, computed): (Vec<&SweepRecord>, Vec<&SweepRecord>) =
+        points.partition(|r| r.status == PointStatus::Error);
+    sweep_failure(
+        computed.len(),
+        failed.len(),
+        failed.first().map(|r| r.message.as_str()),
+    )
 }
 
 /// Position of `value` in [`COLUMNS`].
