@@ -266,12 +266,12 @@ fn next_section(
 }
 
 fn point(integ: &dyn Integrator) -> PoincarePoint {
-    let m = integ.system();
     let z = integ.state();
+    let [w_tip, _, v_t, _] = integ.system().tip_values(integ.tau(), z);
     PoincarePoint {
         tau: integ.tau(),
-        v_t: m.v_t(integ.tau(), z),
-        w_tip: m.tip_values(integ.tau(), z)[0],
+        v_t,
+        w_tip,
         state: z.clone(),
     }
 }
