@@ -43,6 +43,12 @@ table=$(mktemp)
   pts=$(python3 -c "import csv;print(sum(1 for _ in csv.DictReader(open('$tmp/c/continuation.csv'))))")
   echo ""
   echo "Continuation of the default period-1 branch, Ω 5 → 1 (\`afmdyn continue --from 5 --to 1\`): $(python3 -c "print(f'{$t1-$t0:.1f}')") s for $pts points."
+  for law in hertz dmt; do
+    t0=$(date +%s.%N); $A continue --contact-law $law --from 5 --to 4.5 --out "$tmp/c-$law" > /dev/null; t1=$(date +%s.%N)
+    pts=$(python3 -c "import csv;print(sum(1 for _ in csv.DictReader(open('$tmp/c-$law/continuation.csv'))))")
+    echo ""
+    echo "Continuation of the period-1 branch with the $law law, Ω 5 → 4.5 (adaptive DOP853 with the variational equations): $(python3 -c "print(f'{$t1-$t0:.2f}')") s for $pts points."
+  done
   t0=$(date +%s.%N); $A bifurcation --out "$tmp/b" > /dev/null; t1=$(date +%s.%N)
   echo ""
   echo "Default bifurcation run (\`afmdyn bifurcation\`, 400 Ω, forward + backward, 2 threads): $(python3 -c "print(f'{$t1-$t0:.2f}')") s."

@@ -312,13 +312,16 @@ pub fn continuation(a: &ContinueArgs) -> Result<(), CliError> {
             shade: vec![],
         },
     )?;
+    for w in afmdyn::report::continuation_warnings(a.param, &branches) {
+        eprintln!("afmdyn: warning: {w}");
+    }
     if a.json {
         println!("{json}");
     } else {
         println!(
             "{} branch(es), {} points; located:",
             branches.len(),
-            branches.iter().map(Vec::len).sum::<usize>()
+            branches.iter().map(|b| b.len()).sum::<usize>()
         );
         for b in branches.iter().flatten().filter(|b| b.event.is_some()) {
             println!(

@@ -757,7 +757,7 @@ pub fn continuation<'py>(
     let branches = doc.output;
     let model = model_of(&p0)?;
     let dim = 2 * base.modes;
-    let rows: usize = branches.iter().map(Vec::len).sum();
+    let rows: usize = branches.iter().map(|b| b.len()).sum();
     let width = branches
         .iter()
         .flatten()

@@ -303,11 +303,22 @@ impl CantileverModel {
         if linear {
             return;
         }
-        let mut row = DVector::zeros(2 * n);
+        // the rank-one term M⁻¹φ rowᵀ of the tip force, added to the velocity rows
+        let mut add_row = |row: &dyn Fn(usize) -> f64| {
+            for c in 0..2 * n {
+                let rc = row(c);
+                if rc != 0.0 {
+                    for i in 0..n {
+                        jac[(n + i, c)] += self.mphi[i] * rc;
+                    }
+                }
+            }
+        };
         match self.law.law {
             ContactLaw::Impact { .. } => {
                 if r == Region::Contact {
-                    row.copy_from(&self.sticking_force(tau, z).grad);
+                    let g = self.sticking_force(tau, z).grad;
+                    add_row(&|c| g[c]);
                 }
             }
             _ => {
@@ -322,13 +333,17 @@ impl CantileverModel {
                         // remove α6 δ̇/(2√δ) = α6² δ̇/(2w)
                         f.d_delta - 0.5 * self.law.damping * self.law.damping * (-vd) / w
                     };
-                    row.rows_mut(0, n).copy_from(&(-d_delta * self.tip()));
-                    row.rows_mut(n, n).copy_from(&(-f.d_rate * self.tip()));
+                    let tip = self.tip();
+                    add_row(&|c| {
+                        if c < n {
+                            -d_delta * tip[c]
+                        } else {
+                            -f.d_rate * tip[c - n]
+                        }
+                    });
                 }
             }
         }
-        let mut lower = jac.rows_mut(n, n);
-        lower.ger(1.0, &self.mphi, &row, 1.0);
     }
 
     fn w_tip_slice(&self, z: &[f64], offset: usize) -> f64 {
@@ -807,20 +822,32 @@ impl HybridSystem for CantileverModel {
         let w = self.kelvin_voigt_weight(mode, tau, z);
         self.jacobian_parts(mode, tau, z, jac, w == 0.0);
         if w == 0.0 {
-            crate::system::jacobian_product(jac, psi, dpsi);
+            second_order_product(jac, n, psi, dpsi);
             return;
         }
-        let psi = nalgebra::DMatrixView::from_slice(psi, d, d);
-        // J_reg + [0; M⁻¹φ] w [0 φᵀ]
-        let mut row = DVector::zeros(d);
-        row.rows_mut(n, n).copy_from(&(w * self.tip()));
-        jac.rows_mut(n, n).ger(1.0, &self.mphi, &row, 1.0);
-        // (I − E) Ψ: velocity rows minus M⁻¹φ w (φᵀ Ψ_top)
-        let mut tmp = psi.into_owned();
-        let top = self.tip().transpose() * tmp.rows(0, n);
-        tmp.rows_mut(n, n)
-            .ger(-w, &self.mphi, &top.transpose(), 1.0);
-        crate::system::jacobian_product(jac, tmp.as_slice(), dpsi);
+        // J = J_reg + [0; M⁻¹φ] w [0 φᵀ] (velocity rows, velocity columns)
+        let tip = self.tip();
+        for j in 0..n {
+            let wt = w * tip[j];
+            for i in 0..n {
+                jac[(n + i, n + j)] += self.mphi[i] * wt;
+            }
+        }
+        // J (I − E) Ψ = J Ψ − (J u) vᵀ with E Ψ = u vᵀ, u = [0; M⁻¹φ], v_c = w φᵀ Ψ_top[:, c]
+        second_order_product(jac, n, psi, dpsi);
+        let mut ju = [0.0; 2 * crate::params::MAX_MODES];
+        ju[..n].copy_from_slice(self.mphi.as_slice());
+        for i in 0..n {
+            ju[n + i] = (0..n).map(|j| jac[(n + i, n + j)] * self.mphi[j]).sum();
+        }
+        for (out, col) in dpsi.chunks_exact_mut(d).zip(psi.chunks_exact(d)) {
+            let v = w * (0..n).map(|j| tip[j] * col[j]).sum::<f64>();
+            if v != 0.0 {
+                for (o, u) in out.iter_mut().zip(&ju[..d]) {
+                    *o -= u * v;
+                }
+            }
+        }
     }
 
     /// Ψ = (I + E)Φ (forward) or Φ = (I − E)Ψ, E as in [`HybridSystem::variational_rhs`].
@@ -831,10 +858,37 @@ impl HybridSystem for CantileverModel {
         }
         let d = self.dim();
         let n = self.modes();
-        let mut mat = nalgebra::DMatrixViewMut::from_slice(m, d, d);
-        let top = self.tip().transpose() * mat.rows(0, n);
         let sign = if forward { w } else { -w };
-        mat.rows_mut(n, n)
-            .ger(sign, &self.mphi, &top.transpose(), 1.0);
+        let tip = self.tip();
+        // velocity rows ± M⁻¹φ w (φᵀ M_top), column by column
+        for col in m.chunks_exact_mut(d) {
+            let top = sign * (0..n).map(|j| tip[j] * col[j]).sum::<f64>();
+            if top != 0.0 {
+                for (o, u) in col[n..].iter_mut().zip(self.mphi.iter()) {
+                    *o += u * top;
+                }
+            }
+        }
+    }
+}
+
+/// J Ψ for the Jacobian of a second-order system in z = (a, ȧ), J = [[0, I], [L]] with L the
+/// lower n × 2n block (`jac`'s top rows are not read): the top rows of the product are Ψ's lower
+/// rows, the lower rows L Ψ — half the work of [`crate::system::jacobian_product`], and no
+/// allocation. Ψ and the output are 2n × 2n column-major.
+fn second_order_product(jac: &DMatrix<f64>, n: usize, psi: &[f64], dpsi: &mut [f64]) {
+    let d = 2 * n;
+    let j = jac.as_slice();
+    for (out, col) in dpsi.chunks_exact_mut(d).zip(psi.chunks_exact(d)) {
+        let (top, low) = out.split_at_mut(n);
+        top.copy_from_slice(&col[n..]);
+        low.fill(0.0);
+        for (k, &p) in col.iter().enumerate() {
+            if p != 0.0 {
+                for (o, a) in low.iter_mut().zip(&j[k * d + n..(k + 1) * d]) {
+                    *o += a * p;
+                }
+            }
+        }
     }
 }

@@ -6,7 +6,7 @@
 //! `serde_json::to_string` it is byte for byte what the command line prints.
 
 use crate::analysis::attractors::AttractorReport;
-use crate::analysis::continuation::BranchPoint;
+use crate::analysis::continuation::Branch;
 use crate::analysis::converge::ConvergenceRun;
 use crate::analysis::lyapunov::LyapunovSpectrum;
 use crate::analysis::observables::Observables;
@@ -199,7 +199,7 @@ pub fn orbit(model: &CantileverModel, o: &PeriodicOrbit) -> Value {
 
 /// `afmdyn continue --json` without the output directory: the branches' sizes and their
 /// located bifurcations.
-pub fn continuation(base: &Params, param: SweepParam, branches: &[Vec<BranchPoint>]) -> Value {
+pub fn continuation(base: &Params, param: SweepParam, branches: &[Branch]) -> Value {
     let events: Vec<_> = branches
         .iter()
         .flatten()
@@ -210,9 +210,20 @@ pub fn continuation(base: &Params, param: SweepParam, branches: &[Vec<BranchPoin
         "params": base,
         "param": param.name(),
         "branches": branches.len(),
-        "points": branches.iter().map(Vec::len).sum::<usize>(),
+        "points": branches.iter().map(|b| b.len()).sum::<usize>(),
         "events": events,
+        "ends": branches.iter().map(|b| b.end).collect::<Vec<_>>(),
+        "warnings": continuation_warnings(param, branches),
     })
+}
+
+/// One line for every branch that ended before covering what was asked
+/// ([`crate::analysis::continuation::BranchEnd::warning`]).
+pub fn continuation_warnings(param: SweepParam, branches: &[Branch]) -> Vec<String> {
+    branches
+        .iter()
+        .filter_map(|b| b.end.warning(param, b.first().map_or(1, |p| p.period)))
+        .collect()
 }
 
 /// Scales of a stepped-curve document ([`approach`], [`resonance`]): the factors that turn the

@@ -5,7 +5,7 @@
 //! Jacobians against finite differences; the impact law against the closed-form N = 1 flight,
 //! its energy loss, the grazing singularity and chattering; every analysis on every law.
 
-use afmdyn::analysis::continuation::{continue_branch, ContinuationSpec};
+use afmdyn::analysis::continuation::{continue_branch, BranchEnd, ContinuationSpec};
 use afmdyn::analysis::lyapunov::{lyapunov_spectrum, LyapunovOptions};
 use afmdyn::analysis::monodromy::{flow_with_jacobian, stroboscopic};
 use afmdyn::analysis::shooting::{floquet_multipliers, shoot, shoot_with, ShootingOptions};
@@ -721,7 +721,10 @@ fn chattering_ends_in_sticking_within_bounded_impacts() {
                 .axpy(-m.effective_mass() * e.v_t_dot, m.tip_mobility(), 1.0);
             m.guard(Region::Contact, e.tau, zp.as_slice()).value
         };
-        let mut chatter: Option<(usize, f64)> = None;
+        // (impacts in the sequence, its first bounce height, the last one): a bounce higher than
+        // the last starts a new sequence (the drive can lift the tip again before it settles;
+        // the geometric decay holds from the highest bounce on)
+        let mut chatter: Option<(usize, f64, f64)> = None;
         for e in &ev {
             match e.kind {
                 EventKind::Impact => {
@@ -729,21 +732,19 @@ fn chattering_ends_in_sticking_within_bounded_impacts() {
                     if lambda > 0.0 {
                         let h = m.effective_mass() * (r * e.v_t_dot).powi(2) / (2.0 * lambda);
                         assert!(h > h_stick, "r = {r}: bounce of {h:e} not stuck");
-                    }
-                    match &mut chatter {
-                        Some((count, _)) if lambda > 0.0 => *count += 1,
-                        _ if lambda > 0.0 => {
-                            let h0 = m.effective_mass() * (r * e.v_t_dot).powi(2) / (2.0 * lambda);
-                            chatter = Some((1, h0));
-                        }
-                        _ => chatter = None,
+                        chatter = match chatter {
+                            Some((count, h0, last)) if h <= last => Some((count + 1, h0, h)),
+                            _ => Some((1, h, h)),
+                        };
+                    } else {
+                        chatter = None;
                     }
                 }
                 EventKind::Stick => {
                     let h =
                         m.effective_mass() * (r * e.v_t_dot).powi(2) / (2.0 * lambda_plastic(e));
                     assert!(h <= h_stick, "r = {r}: stuck at a bounce of {h:e}");
-                    if let Some((count, h0)) = chatter {
+                    if let Some((count, h0, _)) = chatter {
                         let bound =
                             (1.5 * (h_stick / h0).ln() / (2.0 * r.ln())).max(0.0) as usize + 6;
                         assert!(count <= bound, "r = {r}: {count} impacts, bound {bound}");
@@ -861,6 +862,13 @@ fn every_analysis_on_every_law() {
         spec.max_points = 6;
         let branch = continue_branch(&spec, &o.state).unwrap();
         assert!(branch.len() >= 3, "{}: {} points", c.law, branch.len());
+        // six points do not reach Ω + 0.03: the branch says it stopped at its cap, where
+        let last = branch.last().unwrap().value;
+        match branch.end {
+            BranchEnd::MaxPoints { value } => assert_eq!(value, last, "{}", c.law),
+            BranchEnd::Range => assert!(branch.len() < 6, "{}", c.law),
+            e => panic!("{}: ended by {e:?}", c.law),
+        }
         for bp in &branch {
             let mb = CantileverModel::new(&p.with(SweepParam::Omega, bp.value)).unwrap();
             let mut ib = build(&mb, IntegratorOptions::default(), 0.0, &mb.rest()).unwrap();
@@ -942,4 +950,45 @@ fn saltation_parts_apply_the_saltation_matrix() {
             "{law:?} {from:?}: {err:.2e}"
         );
     }
+}
+
+/// The continuation's work budget: a Hertz branch allowed 20 000 adaptive steps stops after
+/// spending them (the budget is checked before each predictor step, so at most one corrector's
+/// worth beyond it), names the parameter value of its last point, and says what to change; the
+/// same branch with the default budget covers its range.
+#[test]
+fn a_branch_ends_when_its_work_budget_is_spent() {
+    let p = Params {
+        contact_law: ContactLaw::Hertz,
+        ..Params::default()
+    };
+    let m = CantileverModel::new(&p.with(SweepParam::Omega, 5.0)).unwrap();
+    let o = shoot(&m, &m.rest(), 1, &ShootingOptions::default()).unwrap();
+    let mut spec = ContinuationSpec::new(p, SweepParam::Omega, 5.0, 4.9, 1);
+    let full = continue_branch(&spec, &o.state).unwrap();
+    assert_eq!(full.end, BranchEnd::Range);
+    assert!(full.end.warning(SweepParam::Omega, 1).is_none());
+    spec.max_work = 20_000;
+    let cut = continue_branch(&spec, &o.state).unwrap();
+    let BranchEnd::Budget { value, steps } = cut.end else {
+        panic!("ended by {:?}", cut.end);
+    };
+    assert!(steps > 20_000 && steps < 200_000, "{steps} steps");
+    assert_eq!(value, cut.last().unwrap().value);
+    assert!(
+        cut.len() < full.len(),
+        "{} vs {} points",
+        cut.len(),
+        full.len()
+    );
+    assert_eq!(
+        cut.points[..],
+        full.points[..cut.len()],
+        "the same points up to the cut"
+    );
+    let w = cut.end.warning(SweepParam::Omega, 1).unwrap();
+    assert!(
+        w.contains("omega = ") && w.contains("work budget") && w.contains("--from"),
+        "{w}"
+    );
 }

@@ -22,6 +22,7 @@ file in SI (:func:`probe`, ``Params.from_probe``) sets every parameter. Tip–sa
 
 from ._afmdyn import Params, SimulationError
 from ._api import (
+    AfmdynWarning,
     Model,
     approach,
     attractors,
@@ -47,6 +48,7 @@ except Exception:  # pragma: no cover - not installed as a distribution
     __version__ = "0+unknown"
 
 __all__ = [
+    "AfmdynWarning",
     "Attractor",
     "Attractors",
     "Lyapunov",

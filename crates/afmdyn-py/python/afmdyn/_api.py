@@ -19,6 +19,7 @@ import inspect
 import json
 import numbers
 import os
+import warnings
 from typing import (
     Literal,
     TYPE_CHECKING,
@@ -182,6 +183,24 @@ _COUNTS = frozenset(
 )
 
 
+class AfmdynWarning(UserWarning):
+    """A computed answer with a caveat the command line prints as ``afmdyn: warning: …`` on
+    stderr (a branch that ended before the end of its range, points of a sweep that failed,
+    an energy balance that did not close); the same lines are in the summary's ``warnings``."""
+
+
+def _warn(doc: Any) -> None:
+    """Issue every line of a JSON document's ``warnings`` list as an :class:`AfmdynWarning`."""
+    if isinstance(doc, str):
+        try:
+            doc = json.loads(doc)
+        except ValueError:
+            return
+    if isinstance(doc, dict):
+        for w in doc.get("warnings") or []:
+            warnings.warn(str(w), AfmdynWarning, stacklevel=5)
+
+
 def _run(
     fn: Any, desc: str, progress: ProgressArg, p: Params, si: Optional[str] = None, **options: Any
 ) -> Dict[str, Any]:
@@ -196,6 +215,8 @@ def _run(
         options["probe"] = si
     with reporter(progress, desc) as cb:
         d = fn(p, progress=cb, **options)
+    if isinstance(d, dict):
+        _warn(d.get("json"))
     return d
 
 

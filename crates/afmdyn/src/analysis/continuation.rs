@@ -48,6 +48,10 @@ pub struct ContinuationSpec {
     pub ds_max: f64,
     /// Cap on the number of points.
     pub max_points: usize,
+    /// Work budget of one branch: adaptive integrator steps ([`Integrator::work`]) over all its
+    /// flows (corrector, ∂F/∂p, event location); the exact propagator's steps are not counted.
+    /// The branch ends with [`BranchEnd::Budget`] once it is spent.
+    pub max_work: u64,
     /// Newton options (also for the corrector).
     pub newton: ShootingOptions,
     /// Integrator of the stroboscopic map (default: auto, exact for the linear law).
@@ -75,11 +79,121 @@ impl ContinuationSpec {
             ds_min: span * 1e-9,
             ds_max: span / 50.0,
             max_points: 5000,
+            max_work: WORK_BUDGET,
             newton: ShootingOptions::default(),
             integrator: IntegratorOptions::default(),
             junctions: Vec::new(),
             range: None,
         }
+    }
+}
+
+/// Default [`ContinuationSpec::max_work`]: 10⁸ adaptive steps per branch. The default
+/// three-mode branches from Ω = 5 to 1 take 1.4·10⁷ (Hertz, 1340 points) and 3.0·10⁷ (DMT,
+/// 2295 points); the budget ends a branch that winds on without end (an undamped beam, say)
+/// after a bounded, reproducible amount of work, with a warning naming where it stopped.
+pub const WORK_BUDGET: u64 = 100_000_000;
+
+/// Why a branch ended.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(rename_all = "kebab-case", tag = "reason")]
+pub enum BranchEnd {
+    /// The parameter left the range: the branch is complete.
+    Range,
+    /// The branch closed on its first point (an isola).
+    Closed,
+    /// A period-2n branch merged into its period-n parent.
+    Merged,
+    /// The corrector failed down to the smallest arclength step at this parameter value (a
+    /// singular point the predictor cannot pass, or the orbit ceased to exist).
+    StepFloor {
+        /// Parameter value of the last point.
+        value: f64,
+    },
+    /// [`ContinuationSpec::max_points`] points.
+    MaxPoints {
+        /// Parameter value of the last point.
+        value: f64,
+    },
+    /// [`ContinuationSpec::max_work`] adaptive steps spent.
+    Budget {
+        /// Parameter value of the last point.
+        value: f64,
+        /// Steps spent.
+        steps: u64,
+    },
+}
+
+impl BranchEnd {
+    /// Whether the branch covers what was asked (range left, closed or merged).
+    pub fn complete(&self) -> bool {
+        matches!(
+            self,
+            BranchEnd::Range | BranchEnd::Closed | BranchEnd::Merged
+        )
+    }
+
+    /// A one-line warning for a branch that ended early, naming the parameter `param` at which
+    /// it stopped and what to change; `None` for a complete branch.
+    pub fn warning(&self, param: SweepParam, period: usize) -> Option<String> {
+        let p = param.name();
+        let v = |x: f64| crate::error::number(x);
+        match *self {
+            BranchEnd::Range | BranchEnd::Closed | BranchEnd::Merged => None,
+            BranchEnd::StepFloor { value } => Some(format!(
+                "the period-{period} branch ended at {p} = {}: the corrector failed down to the \
+                 smallest arclength step (a singular point, or the orbit ceases to exist there)",
+                v(value)
+            )),
+            BranchEnd::MaxPoints { value } => Some(format!(
+                "the period-{period} branch ended at {p} = {} after its cap of points; \
+                 continue from there with --from",
+                v(value)
+            )),
+            BranchEnd::Budget { value, steps } => Some(format!(
+                "the period-{period} branch ended at {p} = {} after {steps} adaptive steps \
+                 (its work budget); narrow --from/--to, or continue from there with --from",
+                v(value)
+            )),
+        }
+    }
+}
+
+/// A continued branch: its points in arclength order and why it ended.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Branch {
+    /// The points, located bifurcations labelled.
+    pub points: Vec<BranchPoint>,
+    /// Why the branch ended.
+    pub end: BranchEnd,
+}
+
+impl std::ops::Deref for Branch {
+    type Target = Vec<BranchPoint>;
+    fn deref(&self) -> &Vec<BranchPoint> {
+        &self.points
+    }
+}
+
+impl std::ops::DerefMut for Branch {
+    fn deref_mut(&mut self) -> &mut Vec<BranchPoint> {
+        &mut self.points
+    }
+}
+
+impl<'a> IntoIterator for &'a Branch {
+    type Item = &'a BranchPoint;
+    type IntoIter = std::slice::Iter<'a, BranchPoint>;
+    fn into_iter(self) -> Self::IntoIter {
+        self.points.iter()
+    }
+}
+
+impl<'a> IntoIterator for &'a mut Branch {
+    type Item = &'a mut BranchPoint;
+    type IntoIter = std::slice::IterMut<'a, BranchPoint>;
+    fn into_iter(self) -> Self::IntoIter {
+        self.points.iter_mut()
     }
 }
 
@@ -126,6 +240,8 @@ struct Solver {
     spec: ContinuationSpec,
     /// Propagators of the last few parameter values (p and p ± δ for ∂F/∂p).
     cache: Vec<(f64, Box<dyn Integrator>)>,
+    /// Work of the propagators dropped from the cache.
+    retired: u64,
 }
 
 impl Solver {
@@ -133,7 +249,13 @@ impl Solver {
         Ok(Solver {
             spec: spec.clone(),
             cache: Vec::new(),
+            retired: 0,
         })
+    }
+
+    /// Adaptive steps spent so far ([`Integrator::work`] of every propagator built).
+    fn work(&self) -> u64 {
+        self.retired + self.cache.iter().map(|(_, i)| i.work()).sum::<u64>()
     }
 
     fn at(&mut self, p: f64) -> Result<&mut dyn Integrator, SimError> {
@@ -142,7 +264,7 @@ impl Solver {
             None => {
                 let model = CantileverModel::new(&self.spec.base.with(self.spec.param, p))?;
                 if self.cache.len() == 6 {
-                    self.cache.remove(0);
+                    self.retired += self.cache.remove(0).1.work();
                 }
                 let integ = build(&model, self.spec.integrator, 0.0, &model.rest())?;
                 self.cache.push((p, integ));
@@ -410,10 +532,7 @@ fn point(
 ///
 /// # Errors
 /// [`SimError`] when the first orbit cannot be found or the parameters are invalid.
-pub fn continue_branch(
-    spec: &ContinuationSpec,
-    guess: &DVector<f64>,
-) -> Result<Vec<BranchPoint>, SimError> {
+pub fn continue_branch(spec: &ContinuationSpec, guess: &DVector<f64>) -> Result<Branch, SimError> {
     continue_branch_with(spec, guess, &Progress::new())
 }
 
@@ -426,7 +545,7 @@ pub fn continue_branch_with(
     spec: &ContinuationSpec,
     guess: &DVector<f64>,
     progress: &Progress,
-) -> Result<Vec<BranchPoint>, SimError> {
+) -> Result<Branch, SimError> {
     spec.base.with(spec.param, spec.from).validate()?;
     spec.base.with(spec.param, spec.to).validate()?;
     let mut solver = Solver::new(spec)?;
@@ -455,15 +574,25 @@ pub fn continue_branch_with(
     let mut widest = 0.0f64;
     let first = y.clone();
     progress.tick();
-    while out.len() < spec.max_points {
+    let end = loop {
+        if out.len() >= spec.max_points {
+            break BranchEnd::MaxPoints { value: y[dim] };
+        }
         progress.check()?;
+        let steps = solver.work();
+        if steps > spec.max_work {
+            break BranchEnd::Budget {
+                value: y[dim],
+                steps,
+            };
+        }
         let y_pred = &y + &t * ds;
         let (y_new, map_new, iters, fp_new) = match solver.correct(&y_pred, &t) {
             Ok(r) => r,
             Err(_) => {
                 ds *= 0.5;
                 if ds < spec.ds_min {
-                    break;
+                    break BranchEnd::StepFloor { value: y[dim] };
                 }
                 continue;
             }
@@ -544,7 +673,7 @@ pub fn continue_branch_with(
             }
         }
         if !(lo..=hi).contains(&y_new[dim]) {
-            break;
+            break BranchEnd::Range;
         }
         // stop when the branch closes on itself (an isola back at its first point), or when a
         // period-2n branch has merged into a period-n orbit (its half-cycle repeats): beyond that
@@ -586,8 +715,11 @@ pub fn continue_branch_with(
         pt.s = s;
         out.push(pt);
         progress.tick();
-        if closed || merged {
-            break;
+        if closed {
+            break BranchEnd::Closed;
+        }
+        if merged {
+            break BranchEnd::Merged;
         }
         mu_prev = out.last().expect("a point").multipliers.clone();
         y = y_new;
@@ -600,8 +732,8 @@ pub fn continue_branch_with(
         } else {
             ds
         };
-    }
-    Ok(out)
+    };
+    Ok(Branch { points: out, end })
 }
 
 /// Start of the period-2n branch at a located period-doubling point: shoot a period-2n orbit
@@ -684,7 +816,7 @@ pub fn continue_with_switching(
     spec: &ContinuationSpec,
     guess: &DVector<f64>,
     max_period: usize,
-) -> Result<Vec<Vec<BranchPoint>>, SimError> {
+) -> Result<Vec<Branch>, SimError> {
     continue_with_switching_with(spec, guess, max_period, &Progress::new())
 }
 
@@ -699,7 +831,7 @@ pub fn continue_with_switching_with(
     guess: &DVector<f64>,
     max_period: usize,
     progress: &Progress,
-) -> Result<Vec<Vec<BranchPoint>>, SimError> {
+) -> Result<Vec<Branch>, SimError> {
     let mut branches = vec![continue_branch_with(spec, guess, progress)?];
     let mut next = 0;
     while next < branches.len() {

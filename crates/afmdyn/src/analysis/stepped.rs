@@ -27,7 +27,9 @@
 //! Every recorded orbit carries its [`Observables`] ([`super::observables`]).
 
 use super::bifurcation::SweepSpec;
-use super::continuation::{continue_branch_with, BranchEvent, BranchPoint, ContinuationSpec};
+use super::continuation::{
+    continue_branch_with, Branch, BranchEnd, BranchEvent, BranchPoint, ContinuationSpec,
+};
 use super::monodromy::stroboscopic;
 use super::observables::{observe, ObservableOptions, Observables};
 use super::progress::Progress;
@@ -625,7 +627,7 @@ fn branch(
     from: &CurvePoint,
     to: f64,
     progress: &Progress,
-) -> Result<Vec<BranchSample>, SimError> {
+) -> Result<(Vec<BranchSample>, BranchEnd), SimError> {
     let n = from.period.ok_or(SimError::out_of_range(
         "branch start",
         from.value,
@@ -646,7 +648,7 @@ fn branch(
     cs.ds = scale / 100.0;
     cs.ds_max = scale / 25.0;
     // the branch's points were counted as they came; its length is known only now
-    let points = continue_branch_with(&cs, &from.state, progress)?;
+    let Branch { points, end } = continue_branch_with(&cs, &from.state, progress)?;
     progress.add_total(points.len());
     let mut out = Vec::with_capacity(points.len());
     for p in points {
@@ -658,7 +660,7 @@ fn branch(
             observables,
         });
     }
-    Ok(out)
+    Ok((out, end))
 }
 
 /// Whether the orbit `z` at `value` lies on the branch: within 1e-2 (relative) of the branch's
@@ -832,7 +834,23 @@ pub fn stepped_sweep_with(
             let (lo, hi) = (spec.values[0], spec.values[spec.values.len() - 1]);
             let to = if start.value == lo { hi } else { lo };
             match branch(spec, &start, to, progress) {
-                Ok(br) => branches.push(br),
+                Ok((br, end)) => {
+                    if !end.complete() {
+                        // the curve's parameter is reported in the user's units by the front
+                        // end: the warning names the reason, not the internal value
+                        let why = match end {
+                            BranchEnd::Budget { .. } => "its work budget of adaptive steps",
+                            BranchEnd::MaxPoints { .. } => "its cap of points",
+                            _ => "the corrector failed down to the smallest arclength step",
+                        };
+                        warnings.push(format!(
+                            "a period-{} branch ended before the end of the range ({why}); \
+                             folds beyond it are not located",
+                            start.period.unwrap_or(1)
+                        ));
+                    }
+                    branches.push(br);
+                }
                 Err(SimError::Cancelled) => return Err(SimError::Cancelled),
                 Err(e) => warnings.push(format!(
                     "branch from {} = {}: {e}",

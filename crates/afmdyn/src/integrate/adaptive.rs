@@ -1,6 +1,7 @@
 //! Adaptive integrator for any hybrid system: DOP853 (Hairer, Nørsett & Wanner, *Solving ODEs I*,
-//! 2nd ed., Springer 1993, §II.10; the stepper of the `differential-equations` crate) driven one
-//! step at a time, with located events, jumps, and the variational equations.
+//! 2nd ed., Springer 1993, §II.5–II.6; our stepper in `integrate/dop853.rs`, which allocates
+//! nothing per stage or step) driven one step at a time, with located events, jumps, and the
+//! variational equations.
 //!
 //! Everything here goes through [`HybridSystem`]: the vector field of the current mode, its
 //! Jacobian, the mode's guard g (positive inside the mode) and the jump map at the guard.
@@ -18,9 +19,10 @@
 //!
 //! **Variational equations.** With [`Integrator::set_variational`] the state is augmented by the
 //! d×d matrix Φ with Φ′ = ∂f/∂z Φ, Φ(t0) = I at the start of every step, so each step also
-//! returns its Jacobian ∂z(t1)/∂z(t0) (Hairer et al., §I.14). The saltation matrix of an event is
-//! applied by the analyses ([`crate::system::saltation`]).
+//! returns its Jacobian ∂z(t1)/∂z(t0) (Hairer et al., §I.14). The saltation matrix of an event
+//! is applied by the analyses ([`crate::system::saltation`]).
 
+use super::dop853::{Dop853, Field};
 use super::{ChatterWindow, HermiteStep, Integrator, Step};
 use crate::error::SimError;
 use crate::model::CantileverModel;
@@ -28,40 +30,23 @@ use crate::roots::{extremum, safeguarded_newton};
 use crate::system::HybridSystem;
 use crate::system::Region;
 use crate::tip_sample::TipSampleSystem;
-use differential_equations::interpolate::Interpolation;
-use differential_equations::methods::{DormandPrince, ExplicitRungeKutta, Ordinary};
-use differential_equations::ode::{OrdinaryNumericalMethod, ODE};
 use nalgebra::{DMatrix, DVector};
 use std::cell::{Cell, RefCell};
-
-/// The DOP853 stepper on `Vec<f64>` states.
-type Dop853 = ExplicitRungeKutta<Ordinary, DormandPrince, f64, Vec<f64>, 8, 12, 16>;
 
 /// Events within this many drive periods' ten-millionth that count as chattering.
 const CHATTER_COUNT: usize = 4096;
 
-/// The vector field of one mode, optionally with the variational equations.
+/// The vector field of one mode, optionally with the variational equations; `jac` is the
+/// integrator's Jacobian buffer (d×d), borrowed so that forming the field allocates nothing.
 struct ModeOde<'a, S: HybridSystem + ?Sized> {
     sys: &'a S,
     mode: Region,
     variational: bool,
-    jac: RefCell<DMatrix<f64>>,
+    jac: &'a RefCell<DMatrix<f64>>,
 }
 
-impl<'a, S: HybridSystem + ?Sized> ModeOde<'a, S> {
-    fn new(sys: &'a S, mode: Region, variational: bool) -> Self {
-        let d = sys.dim();
-        ModeOde {
-            sys,
-            mode,
-            variational,
-            jac: RefCell::new(DMatrix::zeros(d, d)),
-        }
-    }
-}
-
-impl<S: HybridSystem + ?Sized> ODE<f64, Vec<f64>> for ModeOde<'_, S> {
-    fn diff(&self, t: f64, y: &Vec<f64>, dydt: &mut Vec<f64>) {
+impl<S: HybridSystem + ?Sized> Field for ModeOde<'_, S> {
+    fn eval(&self, t: f64, y: &[f64], dydt: &mut [f64]) {
         let d = self.sys.dim();
         self.sys.rhs(self.mode, t, &y[..d], &mut dydt[..d]);
         if self.variational {
@@ -109,6 +94,15 @@ pub struct Adaptive<S: TipSampleSystem + Clone = CantileverModel> {
     /// The drive period the step count is of (⌊τ/T⌋ at the steps' start) and the DOP853 steps
     /// taken in it, accepted and rejected ([`crate::params::ADAPTIVE_STEPS_PER_PERIOD`]).
     budget: Cell<(i64, usize)>,
+    /// DOP853 steps taken since construction ([`Integrator::work`]).
+    work: Cell<u64>,
+    /// The augmented start vector of the current step (its storage reused step after step).
+    start: Vec<f64>,
+    /// The Jacobian buffer of the variational equations (d×d).
+    jac: RefCell<DMatrix<f64>>,
+    /// A stepper no longer in use, re-initialised by the next [`Adaptive::new_stepper`] of the
+    /// same dimension (with the variational equations every step starts one).
+    spare: RefCell<Option<Box<Dop853>>>,
 }
 
 impl<S: TipSampleSystem + Clone> std::fmt::Debug for Adaptive<S> {
@@ -141,6 +135,10 @@ impl<S: TipSampleSystem + Clone> Adaptive<S> {
             just_switched: true,
             chatter: ChatterWindow::new(CHATTER_COUNT, 1e-7 * model.period()),
             budget: Cell::new((i64::MIN, 0)),
+            work: Cell::new(0),
+            spare: RefCell::new(None),
+            start: Vec::new(),
+            jac: RefCell::new(DMatrix::zeros(d, d)),
             last: LastStep {
                 tau0: 0.0,
                 tau1: 0.0,
@@ -156,32 +154,60 @@ impl<S: TipSampleSystem + Clone> Adaptive<S> {
         self.model.dim()
     }
 
-    /// The augmented start vector at (τ, z) in `mode`: z, then Ψ = P Φ with Φ = I when
-    /// variational ([`HybridSystem::to_tangent_coords`]).
-    fn augmented(&self, mode: Region, tau: f64, z: &[f64], variational: bool) -> Vec<f64> {
+    /// The vector field of `mode` (with the variational equations when `variational`).
+    fn field(&self, mode: Region, variational: bool) -> ModeOde<'_, S> {
+        ModeOde {
+            sys: &self.model,
+            mode,
+            variational,
+            jac: &self.jac,
+        }
+    }
+
+    /// The augmented start vector at (τ, z) in `mode` into `y`: z, then Ψ = P Φ with Φ = I when
+    /// variational ([`HybridSystem::to_tangent_coords`]). `y`'s capacity is reused.
+    fn augmented_into(
+        &self,
+        mode: Region,
+        tau: f64,
+        z: &[f64],
+        variational: bool,
+        y: &mut Vec<f64>,
+    ) {
         let d = z.len();
-        let mut y = z.to_vec();
+        y.clear();
+        y.extend_from_slice(z);
         if variational {
-            let mut id = vec![0.0; d * d];
+            y.resize(d + d * d, 0.0);
+            let id = &mut y[d..];
             for i in 0..d {
                 id[i * d + i] = 1.0;
             }
-            self.model.to_tangent_coords(mode, tau, z, &mut id, true);
-            y.extend(id);
+            self.model.to_tangent_coords(mode, tau, z, id, true);
         }
-        y
     }
 
-    /// Φ = P⁻¹ Ψ from the augmented vector at the end of a step.
-    fn step_jacobian(&self, mode: Region, tau: f64, y: &[f64]) -> DMatrix<f64> {
+    /// Φ = P⁻¹ Ψ from the augmented vector at the end of a step, into `out` (d×d; its storage
+    /// is reused).
+    fn step_jacobian_into(
+        &self,
+        mode: Region,
+        tau: f64,
+        y: &[f64],
+        out: &mut Option<DMatrix<f64>>,
+    ) {
         let d = self.dim();
-        let mut m = y[d..].to_vec();
+        let m = match out {
+            Some(m) if m.nrows() == d && m.ncols() == d => m,
+            _ => out.insert(DMatrix::zeros(d, d)),
+        };
+        m.as_mut_slice().copy_from_slice(&y[d..d + d * d]);
         self.model
-            .to_tangent_coords(mode, tau, &y[..d], &mut m, false);
-        DMatrix::from_vec(d, d, m)
+            .to_tangent_coords(mode, tau, &y[..d], m.as_mut_slice(), false);
     }
 
-    /// A DOP853 stepper started at (τ, y) in `mode`.
+    /// A DOP853 stepper started at (τ, y) in `mode` with step `h` (> 0), or the starting step
+    /// of [`Dop853::init`].
     fn new_stepper(
         &self,
         mode: Region,
@@ -190,23 +216,37 @@ impl<S: TipSampleSystem + Clone> Adaptive<S> {
         variational: bool,
         h: f64,
     ) -> Result<Box<Dop853>, SimError> {
-        let ode = ModeOde::new(&self.model, mode, variational);
-        let mut s = ExplicitRungeKutta::dop853()
-            .rtol(self.tol)
-            .atol(self.tol)
-            .max_steps(usize::MAX)
-            .h_max(self.model.period() / 8.0);
-        if h > 0.0 {
-            s = s.h0(h);
-        }
-        let mut s = Box::new(s);
-        let tf = tau + self.model.period();
-        s.init(&ode, tau, tf, &y.to_vec())
-            .map_err(|e| SimError::Adaptive {
+        let ode = self.field(mode, variational);
+        let mut s = match self.spare.take() {
+            Some(s) if s.y().len() == y.len() => s,
+            _ => Box::new(Dop853::new(
+                y.len(),
+                self.tol,
+                self.tol,
+                self.model.period() / 8.0,
+            )),
+        };
+        s.init(&ode, tau, y, h);
+        if s.h().is_nan() || s.h() <= 0.0 {
+            return Err(SimError::Adaptive {
                 tau,
-                message: format!("{e:?}"),
-            })?;
+                message: format!("no valid starting step (h = {:e})", s.h()),
+            });
+        }
         Ok(s)
+    }
+
+    /// Keep `stepper` for the next [`Adaptive::new_stepper`].
+    fn recycle(&self, stepper: Option<Box<Dop853>>) {
+        if stepper.is_some() {
+            *self.spare.borrow_mut() = stepper;
+        }
+    }
+
+    /// The vector field a stepper of `mode` integrates (with the variational equations when
+    /// the stepper's state is longer than the system's).
+    fn field_of(&self, stepper: &Dop853, mode: Region) -> ModeOde<'_, S> {
+        self.field(mode, stepper.y().len() > self.dim())
     }
 
     /// Take one accepted step of `stepper` in `mode`, never past `t_end` (landing on it exactly
@@ -218,7 +258,7 @@ impl<S: TipSampleSystem + Clone> Adaptive<S> {
         variational: bool,
         t_end: f64,
     ) -> Result<f64, SimError> {
-        let ode = ModeOde::new(&self.model, mode, variational);
+        let ode = self.field(mode, variational);
         let t0 = stepper.t();
         let h_nat = stepper.h();
         let clamped = t0 + h_nat >= t_end;
@@ -229,7 +269,7 @@ impl<S: TipSampleSystem + Clone> Adaptive<S> {
             self.count_step(t0)?;
             stepper.step(&ode).map_err(|e| SimError::Adaptive {
                 tau: t0,
-                message: format!("{e:?}"),
+                message: e.to_string(),
             })?;
             if stepper.t() > t0 {
                 if clamped && stepper.t() >= t_end - 4.0 * f64::EPSILON * (1.0 + t_end.abs()) {
@@ -257,6 +297,7 @@ impl<S: TipSampleSystem + Clone> Adaptive<S> {
     fn count_step(&self, tau: f64) -> Result<(), SimError> {
         let period = self.model.period();
         let k = (tau / period).floor() as i64;
+        self.work.set(self.work.get() + 1);
         let (at, n) = self.budget.get();
         let n = if at == k { n + 1 } else { 1 };
         self.budget.set((k, n));
@@ -296,7 +337,9 @@ impl<S: TipSampleSystem + Clone> Adaptive<S> {
         while t < t1 {
             t = self.advance(&mut s, mode, variational, t1)?;
         }
-        Ok(s.y().clone())
+        let y = s.y().to_vec();
+        self.recycle(Some(s));
+        Ok(y)
     }
 
     /// (g, dg/dτ) at (τ, z) in `mode`.
@@ -325,17 +368,17 @@ impl<S: TipSampleSystem + Clone> Adaptive<S> {
         if tau == stepper.t_prev() {
             return self.guard_at(mode, tau, &stepper.y_prev()[..d]);
         }
-        let y = stepper
-            .interpolate(tau)
-            .unwrap_or_else(|_| stepper.y().clone());
-        self.guard_at(mode, tau, &y[..d])
+        let mut buf = [0.0; 2 * crate::params::MAX_MODES];
+        let y = &mut buf[..d];
+        let ode = self.field_of(stepper, mode);
+        stepper.interpolate(&ode, tau, y);
+        self.guard_at(mode, tau, y)
     }
 
     /// Leftmost guard zero in (t0, t1] on the dense output, or None (module docs).
     fn find_zero(&self, stepper: &mut Dop853, mode: Region, t0: f64, t1: f64) -> Option<f64> {
         let d = self.dim();
-        let z1 = stepper.y()[..d].to_vec();
-        let dead = self.model.guard_tolerance(mode, t1, &z1);
+        let dead = self.model.guard_tolerance(mode, t1, &stepper.y()[..d]);
         let (g0, dg0) = self.guard_on(stepper, mode, t0);
         let (g1, dg1) = self.guard_on(stepper, mode, t1);
         // where g goes below −ε: the step end, or an interior minimum
@@ -403,6 +446,9 @@ impl<S: TipSampleSystem + Clone + 'static> Integrator for Adaptive<S> {
     fn name(&self) -> &'static str {
         "adaptive"
     }
+    fn work(&self) -> u64 {
+        self.work.get()
+    }
 
     fn set_variational(&mut self, on: bool) {
         self.variational = on;
@@ -417,7 +463,8 @@ impl<S: TipSampleSystem + Clone + 'static> Integrator for Adaptive<S> {
         self.just_switched = true;
         self.chatter.clear();
         self.budget.set((i64::MIN, 0));
-        self.last.dense = None;
+        let old = self.last.dense.take();
+        self.recycle(old);
         self.last.jacobian = None;
         self.last.tau0 = tau;
         self.last.tau1 = tau;
@@ -438,11 +485,15 @@ impl<S: TipSampleSystem + Clone + 'static> Integrator for Adaptive<S> {
             });
         }
         let var = self.variational;
-        let y0 = self.augmented(region, tau0, self.z.as_slice(), var);
+        let mut y0 = std::mem::take(&mut self.start);
+        self.augmented_into(region, tau0, self.z.as_slice(), var, &mut y0);
         // a fresh stepper per step with the variational equations (Φ(τ0) = I), else one per stint
         let mut stepper = match self.last.dense.take() {
             Some(s) if self.stint_open && !var => s,
-            _ => self.new_stepper(region, tau0, &y0, var, self.h)?,
+            old => {
+                self.recycle(old);
+                self.new_stepper(region, tau0, &y0, var, self.h)?
+            }
         };
         let h_now = stepper.h();
         // a remainder far below the step size: first-order update (error O(rem²) < round-off)
@@ -458,7 +509,7 @@ impl<S: TipSampleSystem + Clone + 'static> Integrator for Adaptive<S> {
             self.last.tau0 = tau0;
             self.last.tau1 = tau_max;
             self.last.region = region;
-            self.last.dense = None;
+            self.recycle(Some(stepper));
             self.last
                 .hermite
                 .record(&self.model, region, tau0, &z0, tau_max, &self.z);
@@ -468,6 +519,7 @@ impl<S: TipSampleSystem + Clone + 'static> Integrator for Adaptive<S> {
                 DMatrix::identity(d, d) + j * rem
             });
             self.stint_open = false;
+            self.start = y0;
             return Ok(Step {
                 tau0,
                 tau1: tau_max,
@@ -480,8 +532,7 @@ impl<S: TipSampleSystem + Clone + 'static> Integrator for Adaptive<S> {
         let zero = self.find_zero(&mut stepper, region, tau0, t1);
         self.just_switched = false;
         let Some(t_guess) = zero else {
-            let y1 = stepper.y().clone();
-            self.z.copy_from_slice(&y1[..d]);
+            self.z.copy_from_slice(&stepper.y()[..d]);
             self.tau = t1;
             let norm = self.z.norm();
             if norm.is_nan() || norm >= 1e12 {
@@ -490,9 +541,17 @@ impl<S: TipSampleSystem + Clone + 'static> Integrator for Adaptive<S> {
             self.last.tau0 = tau0;
             self.last.tau1 = t1;
             self.last.region = region;
-            self.last.jacobian = var.then(|| self.step_jacobian(region, t1, &y1));
-            self.last.dense = Some(stepper);
+            if var {
+                let mut jac = self.last.jacobian.take();
+                self.step_jacobian_into(region, t1, stepper.y(), &mut jac);
+                self.last.jacobian = jac;
+            } else {
+                self.last.jacobian = None;
+            }
+            let old = self.last.dense.replace(stepper);
+            self.recycle(old);
             self.stint_open = !var;
+            self.start = y0;
             return Ok(Step {
                 tau0,
                 tau1: t1,
@@ -523,14 +582,22 @@ impl<S: TipSampleSystem + Clone + 'static> Integrator for Adaptive<S> {
         self.last.tau0 = tau0;
         self.last.tau1 = ts;
         self.last.region = region;
-        self.last.jacobian = var.then(|| self.step_jacobian(region, ts, &ys));
-        self.last.dense = Some(stepper);
+        if var {
+            let mut jac = self.last.jacobian.take();
+            self.step_jacobian_into(region, ts, &ys, &mut jac);
+            self.last.jacobian = jac;
+        } else {
+            self.last.jacobian = None;
+        }
+        let old = self.last.dense.replace(stepper);
+        self.recycle(old);
         self.z.copy_from(&jump.state);
         self.tau = ts;
         self.region = jump.to;
         self.stint_open = false;
         self.just_switched = true;
         self.chatter.record(ts)?;
+        self.start = y0;
         Ok(Step::with_event(
             &self.model,
             tau0,
@@ -546,9 +613,15 @@ impl<S: TipSampleSystem + Clone + 'static> Integrator for Adaptive<S> {
         let d = self.dim();
         match self.last.dense.as_mut() {
             Some(s) => {
-                let t = tau.clamp(s.t_prev(), s.t());
-                let y = s.interpolate(t).unwrap_or_else(|_| s.y().clone());
-                DVector::from_column_slice(&y[..d])
+                let mut z = DVector::zeros(d);
+                let ode = ModeOde {
+                    sys: &self.model,
+                    mode: self.last.region,
+                    variational: s.y().len() > d,
+                    jac: &self.jac,
+                };
+                s.interpolate(&ode, tau, z.as_mut_slice());
+                z
             }
             None => self.last.hermite.state(tau),
         }

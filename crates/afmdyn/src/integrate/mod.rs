@@ -8,7 +8,7 @@
 //! * [`rk4::Rk4`] — the paper's fixed-step fourth-order Runge–Kutta, with located switchings
 //!   or, as in the paper, with the region chosen per stage from the sign of V_T. Generic over
 //!   the [`TipSampleSystem`] (`Rk4<S>`, the cantilever by default).
-//! * [`adaptive::Adaptive`] — DOP853 (the `differential-equations` crate) driven step by step,
+//! * [`adaptive::Adaptive`] — DOP853 (our allocation-free stepper, `integrate/dop853.rs`) driven step by step,
 //!   generic over the [`TipSampleSystem`] (`Adaptive<S>`) and written against
 //!   [`crate::system::HybridSystem`]: any contact law, located events with jumps (impacts,
 //!   sticking), and the variational equations for step Jacobians. The default for every law
@@ -22,6 +22,7 @@
 //! [`SwitchEvent`].
 
 pub mod adaptive;
+mod dop853;
 pub mod exact;
 pub mod grid;
 pub mod rk4;
@@ -230,6 +231,12 @@ pub trait Integrator: Send {
     }
     /// Integrator name.
     fn name(&self) -> &'static str;
+    /// Steps of an adaptive method taken since the integrator was built, accepted and rejected
+    /// (0 for the exact propagator, whose grid steps cost little): the unit of the work budgets
+    /// of the analyses that run many flows, such as [`crate::analysis::continuation`].
+    fn work(&self) -> u64 {
+        0
+    }
     /// [W(1,τ), ∂W(1,τ)/∂τ, V_T, dV_T/dτ] at the current state. The default forms them from
     /// [`Integrator::state`] ([`TipSampleSystem::tip_values`], where the equations are); the exact
     /// propagator takes V_T from its switching test and W from its modal coordinates, without

@@ -11,7 +11,7 @@ use super::limits::*;
 use crate::analysis::attractors::{find_attractors_with, AttractorReport, AttractorSpec};
 use crate::analysis::bifurcation::SweepSpec;
 use crate::analysis::continuation::{
-    continue_branch_with, continue_with_switching_with, BranchPoint, ContinuationSpec,
+    continue_branch_with, continue_with_switching_with, Branch, ContinuationSpec,
 };
 use crate::analysis::converge::{mode_convergence_with, ConvergenceRun};
 use crate::analysis::lyapunov::{lyapunov_spectrum_with, LyapunovOptions, LyapunovSpectrum};
@@ -278,11 +278,7 @@ impl ContinuationRequest {
     /// As [`Self::validate`], [`StartRequest::guess`], [`continue_branch`] and
     /// [`continue_with_switching`].
     /// Every branch point is counted in `progress`, which also cancels the run.
-    pub fn run(
-        &self,
-        base: &Params,
-        progress: &Progress,
-    ) -> Result<Vec<Vec<BranchPoint>>, SimError> {
+    pub fn run(&self, base: &Params, progress: &Progress) -> Result<Vec<Branch>, SimError> {
         self.validate(base)?;
         let model = CantileverModel::new(&base.with(self.param, self.from))?;
         let (guess, found) = self.start.guess(&model)?;

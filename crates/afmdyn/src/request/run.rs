@@ -21,7 +21,7 @@ use super::analyses::{
 };
 use super::curves::{approach_request, resonance_request, CurveRequest};
 use crate::analysis::attractors::AttractorReport;
-use crate::analysis::continuation::BranchPoint;
+use crate::analysis::continuation::Branch;
 use crate::analysis::converge::ConvergenceRun;
 use crate::analysis::lyapunov::LyapunovSpectrum;
 use crate::analysis::progress::Progress;
@@ -143,7 +143,7 @@ impl Analysis for OrbitRequest {
 }
 
 impl Analysis for ContinuationRequest {
-    type Output = Vec<Vec<BranchPoint>>;
+    type Output = Vec<Branch>;
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
         ContinuationRequest::validate(self, &model.params)
     }

@@ -1,0 +1,27 @@
+"""A computed answer with a caveat: the command line prints ``afmdyn: warning: …`` on stderr and
+lists it in the summary's ``warnings``; Python issues the same lines as ``AfmdynWarning``."""
+
+import warnings
+
+import pytest
+
+import afmdyn
+
+
+def test_a_caveat_is_an_afmdyn_warning_and_in_the_summary() -> None:
+    # 400 RK4 steps per period do not close the energy balance to 1e-6 (the coarse run of
+    # test_simulate.py): the answer is returned, with a warning
+    with pytest.warns(afmdyn.AfmdynWarning, match="energy balance") as caught:
+        a = afmdyn.simulate(
+            periods=2, integrator="rk4", steps_per_period=400, samples_per_period=20
+        )
+    lines = afmdyn.summary(a)["warnings"]
+    assert lines and [str(w.message) for w in caught] == lines
+    assert issubclass(afmdyn.AfmdynWarning, UserWarning)
+
+
+def test_no_caveat_no_warning() -> None:
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", afmdyn.AfmdynWarning)
+        a = afmdyn.simulate(periods=2, samples_per_period=20)
+    assert afmdyn.summary(a)["warnings"] == []
