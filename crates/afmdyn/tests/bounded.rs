@@ -4,7 +4,7 @@
 
 use afmdyn::analysis::progress::Progress;
 use afmdyn::contact::ContactLaw;
-use afmdyn::request::{AttractorsRequest, ContinuationRequest, OrbitRequest};
+use afmdyn::request::{AttractorsRequest, ContinuationRequest, LyapunovRequest, OrbitRequest};
 use afmdyn::{Params, SimError, SweepParam};
 
 /// A branch continued from the largest Ω the model accepts (1e5) needs ∂Pⁿ/∂Ω at its first
@@ -103,6 +103,29 @@ fn a_motion_too_stiff_to_resolve_ends_with_a_budget_error() {
         );
         assert!(msg.contains("soften the law"), "{msg}");
     }
+}
+
+/// The impact law with r = 0 (a plastic impact, a documented value): the default orbit and the
+/// Lyapunov spectrum are computed (issue 27: both ended in "4096 switchings within 0e0"). A
+/// plastic impact leaves the tip on the surface with V̇_T = 0; with V̈_T > 0 it lifts off, and
+/// the higher modes bring it back within 1e-4 of τ — the re-impact is located there, not at
+/// the start of the step again and again.
+#[test]
+fn a_plastic_impact_law_has_an_orbit_and_a_spectrum() {
+    let params = Params {
+        contact_law: ContactLaw::Impact { restitution: 0.0 },
+        ..Params::default()
+    };
+    let o = OrbitRequest::default().run(&params).unwrap();
+    assert!(o.switchings >= 2, "the orbit taps the sample");
+    let l = LyapunovRequest {
+        transient: 100,
+        periods: 400,
+        ..LyapunovRequest::default()
+    }
+    .run(&params, &Progress::new())
+    .unwrap();
+    assert!(l.exponents.iter().all(|x| x.is_finite()));
 }
 
 /// A probe file's refusals name the keys the user wrote (issue 27): a derived group out of

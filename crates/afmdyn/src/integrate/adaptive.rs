@@ -419,6 +419,32 @@ impl<S: TipSampleSystem + Clone> Adaptive<S> {
                     ga = gm;
                 }
             }
+            if ga <= 0.0 && dg0.abs() * (tb - t0) <= dead {
+                // on the surface with g′ = 0 to round-off (after a plastic impact, or a
+                // release): g may rise first and fall back within the step (the tip leaves with
+                // V̈_T > 0 and the higher modes bring it back). The highest point of that first
+                // rise is the bracket's left end, searched on the dense output at t0 + Δ 2⁻ᵏ
+                // (k = 40…6: a rise that ends within a sliver of the step), then at t0 + Δ k/32
+                let mut best: Option<(f64, f64)> = None;
+                let span = tb - t0;
+                let fractions = (6..=40)
+                    .rev()
+                    .map(|k| 0.5f64.powi(k))
+                    .chain((1..=32).map(|k| k as f64 / 32.0));
+                for x in fractions {
+                    let t = t0 + span * x;
+                    let (g, _) = self.guard_on(stepper, mode, t);
+                    if g > 0.0 && best.is_none_or(|(_, gm)| g > gm) {
+                        best = Some((t, g));
+                    } else if best.is_some() {
+                        break;
+                    }
+                }
+                if let Some((t, g)) = best {
+                    ta = t;
+                    ga = g;
+                }
+            }
             if ga <= 0.0 {
                 // never clearly inside the mode: the event is at the start of the step
                 return Some(t0);
