@@ -303,44 +303,41 @@ impl CantileverModel {
         if linear {
             return;
         }
-        // the rank-one term M⁻¹φ rowᵀ of the tip force, added to the velocity rows
-        let mut add_row = |row: &dyn Fn(usize) -> f64| {
-            for c in 0..2 * n {
-                let rc = row(c);
-                if rc != 0.0 {
-                    for i in 0..n {
-                        jac[(n + i, c)] += self.mphi[i] * rc;
-                    }
-                }
-            }
-        };
+        // the gradient row of the tip force (on the stack), then the rank-one term M⁻¹φ rowᵀ
+        // added to the velocity rows
+        let mut buf = [0.0; 2 * crate::params::MAX_MODES];
+        let row = &mut buf[..2 * n];
         match self.law.law {
             ContactLaw::Impact { .. } => {
-                if r == Region::Contact {
-                    let g = self.sticking_force(tau, z).grad;
-                    add_row(&|c| g[c]);
+                if r != Region::Contact {
+                    return;
                 }
+                row.copy_from_slice(self.sticking_force(tau, z).grad.as_slice());
             }
             _ => {
-                if r == Region::Contact || self.law.acts_outside() {
-                    let [v, vd, _] = self
-                        .v_t_from_tip(tau, [self.w_tip_slice(z, 0), self.w_tip_slice(z, n), 0.0]);
-                    let f = self.law.force(r == Region::Contact, -v, -vd);
-                    let w = self.kelvin_voigt_weight(r, tau, z);
-                    let d_delta = if singular || w == 0.0 {
-                        f.d_delta
-                    } else {
-                        // remove α6 δ̇/(2√δ) = α6² δ̇/(2w)
-                        f.d_delta - 0.5 * self.law.damping * self.law.damping * (-vd) / w
-                    };
-                    let tip = self.tip();
-                    add_row(&|c| {
-                        if c < n {
-                            -d_delta * tip[c]
-                        } else {
-                            -f.d_rate * tip[c - n]
-                        }
-                    });
+                if r != Region::Contact && !self.law.acts_outside() {
+                    return;
+                }
+                let [v, vd, _] =
+                    self.v_t_from_tip(tau, [self.w_tip_slice(z, 0), self.w_tip_slice(z, n), 0.0]);
+                let f = self.law.force(r == Region::Contact, -v, -vd);
+                let w = self.kelvin_voigt_weight(r, tau, z);
+                let d_delta = if singular || w == 0.0 {
+                    f.d_delta
+                } else {
+                    // remove α6 δ̇/(2√δ) = α6² δ̇/(2w)
+                    f.d_delta - 0.5 * self.law.damping * self.law.damping * (-vd) / w
+                };
+                for (j, t) in self.tip().iter().enumerate() {
+                    row[j] = -d_delta * t;
+                    row[n + j] = -f.d_rate * t;
+                }
+            }
+        }
+        for (c, &rc) in row.iter().enumerate() {
+            if rc != 0.0 {
+                for i in 0..n {
+                    jac[(n + i, c)] += self.mphi[i] * rc;
                 }
             }
         }
@@ -872,23 +869,12 @@ impl HybridSystem for CantileverModel {
     }
 }
 
-/// J Ψ for the Jacobian of a second-order system in z = (a, ȧ), J = [[0, I], [L]] with L the
-/// lower n × 2n block (`jac`'s top rows are not read): the top rows of the product are Ψ's lower
-/// rows, the lower rows L Ψ — half the work of [`crate::system::jacobian_product`], and no
-/// allocation. Ψ and the output are 2n × 2n column-major.
+/// J Ψ for the Jacobian of a second-order system in z = (a, ȧ), J = [[0, I], [L]] (`jac`'s top
+/// rows are not read): the top rows are Ψ's lower rows, the lower rows L Ψ
+/// ([`crate::system::jacobian_rows_product`]). Ψ and the output are 2n × 2n column-major.
 fn second_order_product(jac: &DMatrix<f64>, n: usize, psi: &[f64], dpsi: &mut [f64]) {
-    let d = 2 * n;
-    let j = jac.as_slice();
-    for (out, col) in dpsi.chunks_exact_mut(d).zip(psi.chunks_exact(d)) {
-        let (top, low) = out.split_at_mut(n);
-        top.copy_from_slice(&col[n..]);
-        low.fill(0.0);
-        for (k, &p) in col.iter().enumerate() {
-            if p != 0.0 {
-                for (o, a) in low.iter_mut().zip(&j[k * d + n..(k + 1) * d]) {
-                    *o += a * p;
-                }
-            }
-        }
+    for (out, col) in dpsi.chunks_exact_mut(2 * n).zip(psi.chunks_exact(2 * n)) {
+        out[..n].copy_from_slice(&col[n..]);
     }
+    crate::system::jacobian_rows_product(jac, n, psi, dpsi);
 }

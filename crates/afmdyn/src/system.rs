@@ -214,15 +214,23 @@ pub fn check_state(name: &'static str, dim: usize, z: &DVector<f64>) -> Result<(
 
 /// dΨ = J Ψ for d×d column-major `psi` and `dpsi` (the variational equations' product).
 pub fn jacobian_product(jac: &DMatrix<f64>, psi: &[f64], dpsi: &mut [f64]) {
-    // column by column as axpys over J's columns: for the small d of this model (2N ≤ 40) a
-    // plain loop beats a packed GEMM several times, and it allocates nothing
+    jacobian_rows_product(jac, 0, psi, dpsi);
+}
+
+/// Rows `row0..d` of dΨ = J Ψ (d×d column-major `psi` and `dpsi`; the other rows of `dpsi` are
+/// left as they are). Column by column as axpys over J's columns: for the small d of this model
+/// (2N ≤ 40) a plain loop beats a packed GEMM several times, and it allocates nothing. A
+/// second-order system in z = (a, ȧ) has J = [[0, I], [L]]: its top rows are a copy of Ψ's
+/// lower rows, and only the lower rows (`row0` = d/2) need this product.
+pub fn jacobian_rows_product(jac: &DMatrix<f64>, row0: usize, psi: &[f64], dpsi: &mut [f64]) {
     let d = jac.nrows();
     let j = jac.as_slice();
     for (out, col) in dpsi.chunks_exact_mut(d).zip(psi.chunks_exact(d)) {
+        let out = &mut out[row0..];
         out.fill(0.0);
         for (k, &p) in col.iter().enumerate() {
             if p != 0.0 {
-                for (o, a) in out.iter_mut().zip(&j[k * d..(k + 1) * d]) {
+                for (o, a) in out.iter_mut().zip(&j[k * d + row0..(k + 1) * d]) {
                     *o += a * p;
                 }
             }

@@ -127,35 +127,49 @@ pub enum BranchEnd {
 impl BranchEnd {
     /// Whether the branch covers what was asked (range left, closed or merged).
     pub fn complete(&self) -> bool {
-        matches!(
-            self,
-            BranchEnd::Range | BranchEnd::Closed | BranchEnd::Merged
-        )
+        self.cause().is_none()
+    }
+
+    /// Why an early end came, as a clause ("its work budget of adaptive steps", …); `None` for
+    /// a complete branch.
+    pub fn cause(&self) -> Option<&'static str> {
+        match self {
+            BranchEnd::Range | BranchEnd::Closed | BranchEnd::Merged => None,
+            BranchEnd::StepFloor { .. } => Some(
+                "the corrector failed down to the smallest arclength step (a singular point, \
+                 or the orbit ceases to exist there)",
+            ),
+            BranchEnd::MaxPoints { .. } => Some("its cap of points"),
+            BranchEnd::Budget { .. } => Some("its work budget of adaptive steps"),
+        }
     }
 
     /// A one-line warning for a branch that ended early, naming the parameter `param` at which
-    /// it stopped and what to change; `None` for a complete branch.
+    /// it stopped, the [`BranchEnd::cause`] and what to change; `None` for a complete branch.
     pub fn warning(&self, param: SweepParam, period: usize) -> Option<String> {
+        let cause = self.cause()?;
         let p = param.name();
-        let v = |x: f64| crate::error::number(x);
-        match *self {
-            BranchEnd::Range | BranchEnd::Closed | BranchEnd::Merged => None,
-            BranchEnd::StepFloor { value } => Some(format!(
-                "the period-{period} branch ended at {p} = {}: the corrector failed down to the \
-                 smallest arclength step (a singular point, or the orbit ceases to exist there)",
-                v(value)
-            )),
-            BranchEnd::MaxPoints { value } => Some(format!(
-                "the period-{period} branch ended at {p} = {} after its cap of points; \
-                 continue from there with --from",
-                v(value)
-            )),
-            BranchEnd::Budget { value, steps } => Some(format!(
-                "the period-{period} branch ended at {p} = {} after {steps} adaptive steps \
-                 (its work budget); narrow --from/--to, or continue from there with --from",
-                v(value)
-            )),
-        }
+        let at = |x: f64| {
+            format!(
+                "the period-{period} branch ended at {p} = {}",
+                crate::error::number(x)
+            )
+        };
+        Some(match *self {
+            BranchEnd::Budget { value, steps } => format!(
+                "{} after {steps} adaptive steps ({cause}); narrow --from/--to, or continue from \
+                 there with --from",
+                at(value)
+            ),
+            BranchEnd::MaxPoints { value } => {
+                format!(
+                    "{} after {cause}; continue from there with --from",
+                    at(value)
+                )
+            }
+            BranchEnd::StepFloor { value } => format!("{}: {cause}", at(value)),
+            BranchEnd::Range | BranchEnd::Closed | BranchEnd::Merged => unreachable!("complete"),
+        })
     }
 }
 

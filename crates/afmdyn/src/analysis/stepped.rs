@@ -835,14 +835,9 @@ pub fn stepped_sweep_with(
             let to = if start.value == lo { hi } else { lo };
             match branch(spec, &start, to, progress) {
                 Ok((br, end)) => {
-                    if !end.complete() {
+                    if let Some(why) = end.cause() {
                         // the curve's parameter is reported in the user's units by the front
-                        // end: the warning names the reason, not the internal value
-                        let why = match end {
-                            BranchEnd::Budget { .. } => "its work budget of adaptive steps",
-                            BranchEnd::MaxPoints { .. } => "its cap of points",
-                            _ => "the corrector failed down to the smallest arclength step",
-                        };
+                        // end: the warning names the cause, not the internal value
                         warnings.push(format!(
                             "a period-{} branch ended before the end of the range ({why}); \
                              folds beyond it are not located",

@@ -375,6 +375,36 @@ impl<S: TipSampleSystem + Clone> Adaptive<S> {
         self.guard_at(mode, tau, y)
     }
 
+    /// From a start on the surface with g′ = 0 to round-off (after a plastic impact, or a
+    /// release), g may rise first and fall back within the step (the tip leaves with V̈_T > 0 and
+    /// the higher modes bring it back). The highest point (τ, g > 0) of that first rise before
+    /// `tb`, searched on the dense output at t0 + Δ 2⁻ᵏ (k = 40…6: a rise that ends within a
+    /// sliver of the step), then at t0 + Δ k/32; `None` when g never rises above 0.
+    fn first_rise(
+        &self,
+        stepper: &mut Dop853,
+        mode: Region,
+        t0: f64,
+        tb: f64,
+    ) -> Option<(f64, f64)> {
+        let span = tb - t0;
+        let fractions = (6..=40)
+            .rev()
+            .map(|k| 0.5f64.powi(k))
+            .chain((1..=32).map(|k| k as f64 / 32.0));
+        let mut best: Option<(f64, f64)> = None;
+        for x in fractions {
+            let t = t0 + span * x;
+            let (g, _) = self.guard_on(stepper, mode, t);
+            if g > 0.0 && best.is_none_or(|(_, gm)| g > gm) {
+                best = Some((t, g));
+            } else if best.is_some() {
+                break;
+            }
+        }
+        best
+    }
+
     /// Leftmost guard zero in (t0, t1] on the dense output, or None (module docs).
     fn find_zero(&self, stepper: &mut Dop853, mode: Region, t0: f64, t1: f64) -> Option<f64> {
         let d = self.dim();
@@ -420,27 +450,7 @@ impl<S: TipSampleSystem + Clone> Adaptive<S> {
                 }
             }
             if ga <= 0.0 && dg0.abs() * (tb - t0) <= dead {
-                // on the surface with g′ = 0 to round-off (after a plastic impact, or a
-                // release): g may rise first and fall back within the step (the tip leaves with
-                // V̈_T > 0 and the higher modes bring it back). The highest point of that first
-                // rise is the bracket's left end, searched on the dense output at t0 + Δ 2⁻ᵏ
-                // (k = 40…6: a rise that ends within a sliver of the step), then at t0 + Δ k/32
-                let mut best: Option<(f64, f64)> = None;
-                let span = tb - t0;
-                let fractions = (6..=40)
-                    .rev()
-                    .map(|k| 0.5f64.powi(k))
-                    .chain((1..=32).map(|k| k as f64 / 32.0));
-                for x in fractions {
-                    let t = t0 + span * x;
-                    let (g, _) = self.guard_on(stepper, mode, t);
-                    if g > 0.0 && best.is_none_or(|(_, gm)| g > gm) {
-                        best = Some((t, g));
-                    } else if best.is_some() {
-                        break;
-                    }
-                }
-                if let Some((t, g)) = best {
+                if let Some((t, g)) = self.first_rise(stepper, mode, t0, tb) {
                     ta = t;
                     ga = g;
                 }
@@ -637,20 +647,13 @@ impl<S: TipSampleSystem + Clone + 'static> Integrator for Adaptive<S> {
 
     fn dense_state(&mut self, tau: f64) -> DVector<f64> {
         let d = self.dim();
-        match self.last.dense.as_mut() {
-            Some(s) => {
-                let mut z = DVector::zeros(d);
-                let ode = ModeOde {
-                    sys: &self.model,
-                    mode: self.last.region,
-                    variational: s.y().len() > d,
-                    jac: &self.jac,
-                };
-                s.interpolate(&ode, tau, z.as_mut_slice());
-                z
-            }
-            None => self.last.hermite.state(tau),
-        }
+        let Some(mut s) = self.last.dense.take() else {
+            return self.last.hermite.state(tau);
+        };
+        let mut z = DVector::zeros(d);
+        s.interpolate(&self.field_of(&s, self.last.region), tau, z.as_mut_slice());
+        self.last.dense = Some(s);
+        z
     }
 
     fn dense_tip(&mut self, tau: f64) -> [f64; 3] {
