@@ -202,7 +202,7 @@ fn polish(model: &CantileverModel, integrator: IntegratorOptions, a: &mut Attrac
     let Some(n) = a.steady.period() else { return };
     if !matches!(
         integrator.kind.resolve(model),
-        IntegratorKind::Exact | IntegratorKind::Adaptive
+        IntegratorKind::Exact | IntegratorKind::Adaptive | IntegratorKind::Split
     ) {
         return;
     }

@@ -539,9 +539,9 @@ mod tests {
     /// of W and V_T to round-off; and every step's start values, carried over from the step
     /// before, equal those formed at its start. Exact propagator N = 1, 3, 10, 20 on the
     /// attractor, N = 3 from a large start whose beam body touches the substrate, and the
-    /// impact law (adaptive integrator: the state formed anyway, so bit for bit), whose
-    /// restitution moves the state at every impact (the start after it is the state after the
-    /// jump).
+    /// impact law (split integrator: exact free flight in modal coordinates between impacts;
+    /// the statistics bit for bit), whose restitution moves the state at every impact (the
+    /// start after it is the state after the jump).
     #[test]
     fn stats_from_modal_coordinates_equal_stats_from_the_state() {
         for (law, modes, scale, body) in [
@@ -600,7 +600,6 @@ mod tests {
             );
             if law == LawKind::Impact {
                 assert_eq!(format!("{a:?}"), format!("{b:?}"), "{at}");
-                assert_eq!(formed.worst_start, 0.0, "{at}");
             }
         }
     }

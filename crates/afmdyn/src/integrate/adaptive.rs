@@ -154,6 +154,24 @@ impl<S: TipSampleSystem + Clone> Adaptive<S> {
         self.model.dim()
     }
 
+    /// Restart at (τ, z) in `region`, as [`Integrator::reset`] but with the region given (a
+    /// state on the switching surface after an event belongs to the region the event enters)
+    /// and without checking z (the caller did); the chattering test and the step budget of the
+    /// drive period go on (a hand-over from the free flight of [`super::split::Split`]).
+    pub(crate) fn restart_in(&mut self, tau: f64, z: &[f64], region: Region) {
+        self.region = region;
+        self.tau = tau;
+        self.z.as_mut_slice().copy_from_slice(z);
+        self.stint_open = false;
+        self.just_switched = true;
+        let old = self.last.dense.take();
+        self.recycle(old);
+        self.last.jacobian = None;
+        self.last.tau0 = tau;
+        self.last.tau1 = tau;
+        self.last.region = region;
+    }
+
     /// The vector field of `mode` (with the variational equations when `variational`).
     fn field(&self, mode: Region, variational: bool) -> ModeOde<'_, S> {
         ModeOde {
@@ -492,19 +510,9 @@ impl<S: TipSampleSystem + Clone + 'static> Integrator for Adaptive<S> {
 
     fn reset(&mut self, tau: f64, z: &DVector<f64>) -> Result<(), SimError> {
         let (region, z) = self.model.checked_start(tau, z)?;
-        self.region = region;
-        self.tau = tau;
-        self.z.copy_from(&z);
-        self.stint_open = false;
-        self.just_switched = true;
+        self.restart_in(tau, z.as_slice(), region);
         self.chatter.clear();
         self.budget.set((i64::MIN, 0));
-        let old = self.last.dense.take();
-        self.recycle(old);
-        self.last.jacobian = None;
-        self.last.tau0 = tau;
-        self.last.tau1 = tau;
-        self.last.region = self.region;
         Ok(())
     }
 

@@ -26,6 +26,7 @@ mod dop853;
 pub mod exact;
 pub mod grid;
 pub mod rk4;
+pub mod split;
 
 use crate::error::SimError;
 use crate::model::{BodyContactCheck, CantileverModel};
@@ -449,6 +450,8 @@ pub enum IntegratorKind {
     Rk4Naive,
     /// Adaptive DOP853 oracle with terminal events.
     Adaptive,
+    /// Exact free flight, adaptive DOP853 in contact ([`split::Split`]; every law but DMT).
+    Split,
 }
 
 impl FromStr for IntegratorKind {
@@ -460,8 +463,9 @@ impl FromStr for IntegratorKind {
             "rk4" => Ok(IntegratorKind::Rk4),
             "rk4-naive" | "rk4_naive" => Ok(IntegratorKind::Rk4Naive),
             "adaptive" | "dop853" => Ok(IntegratorKind::Adaptive),
+            "split" => Ok(IntegratorKind::Split),
             _ => Err(format!(
-                "integrator '{s}': expected auto, exact, rk4, rk4-naive or adaptive"
+                "integrator '{s}': expected auto, exact, rk4, rk4-naive, adaptive or split"
             )),
         }
     }
@@ -481,10 +485,14 @@ pub struct IntegratorOptions {
 
 impl IntegratorKind {
     /// The concrete integrator for `model`: [`IntegratorKind::Auto`] resolves to `Exact` for an
-    /// affine (linear-law) model and to `Adaptive` otherwise; other kinds are returned as given.
+    /// affine (linear-law) model, to `Split` for a law without force in free flight (Hertz,
+    /// impact) and to `Adaptive` otherwise (DMT); other kinds are returned as given. ([`build`]
+    /// falls back from `Split` to `Adaptive` for `Auto` where the exact free flight cannot be
+    /// built: Ω at an undamped resonance of the free beam, or a grid beyond its budget.)
     pub fn resolve(self, model: &CantileverModel) -> IntegratorKind {
         match self {
             IntegratorKind::Auto if model.law().is_affine() => IntegratorKind::Exact,
+            IntegratorKind::Auto if split::Split::applies(model) => IntegratorKind::Split,
             IntegratorKind::Auto => IntegratorKind::Adaptive,
             k => k,
         }
@@ -518,7 +526,7 @@ pub fn build(
     // that would need more steps than the budget, are refused before any work is done
     check_start(z)?;
     let kind = opts.kind.resolve(model);
-    if kind == IntegratorKind::Adaptive {
+    if matches!(kind, IntegratorKind::Adaptive | IntegratorKind::Split) {
         let rate = [Region::Free, Region::Contact]
             .iter()
             .map(|&r| model.dynamics(r).a.norm())
@@ -549,7 +557,7 @@ pub fn build(
         )?),
         IntegratorKind::Rk4 => Box::new(rk4::Rk4::new(model, opts.steps_per_period, true)),
         IntegratorKind::Rk4Naive => Box::new(rk4::Rk4::new(model, opts.steps_per_period, false)),
-        IntegratorKind::Adaptive => {
+        IntegratorKind::Adaptive | IntegratorKind::Split => {
             if !(opts.tolerance.is_finite() && opts.tolerance > 0.0 && opts.tolerance < 1.0) {
                 return Err(SimError::out_of_range(
                     "tolerance",
@@ -557,7 +565,20 @@ pub fn build(
                     "must be in (0, 1)",
                 ));
             }
-            Box::new(adaptive::Adaptive::new(model, opts.tolerance))
+            let adaptive = || Box::new(adaptive::Adaptive::new(model, opts.tolerance));
+            if kind == IntegratorKind::Adaptive {
+                adaptive()
+            } else {
+                match split::Split::try_new(model, opts.steps_per_period, opts.tolerance) {
+                    Ok(s) => Box::new(s),
+                    Err(SimError::OutOfRange { .. } | SimError::Budget { .. })
+                        if opts.kind == IntegratorKind::Auto =>
+                    {
+                        adaptive()
+                    }
+                    Err(e) => return Err(e),
+                }
+            }
         }
     };
     integ.reset(tau, z)?;

@@ -98,7 +98,9 @@ impl IntegratorRequest {
     /// `steps_per_period` (default 2000); `adaptive` chooses its steps.
     pub fn options(&self, samples_per_period: usize) -> IntegratorOptions {
         let steps = match self.integrator {
-            IntegratorKind::Auto | IntegratorKind::Exact => samples_per_period.max(1),
+            IntegratorKind::Auto | IntegratorKind::Exact | IntegratorKind::Split => {
+                samples_per_period.max(1)
+            }
             IntegratorKind::Rk4 | IntegratorKind::Rk4Naive => self.steps_per_period.unwrap_or(2000),
             IntegratorKind::Adaptive => 1,
         };

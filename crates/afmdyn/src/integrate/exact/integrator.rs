@@ -1,9 +1,7 @@
 //! [`Integrator`] for [`ExactPropagator`].
 
 use super::forcing::modal_tip;
-use super::modal::Modes;
 use super::step::Form;
-use super::tip::tip_v_t;
 use super::ExactPropagator;
 use crate::error::SimError;
 use crate::integrate::{Integrator, Step};
@@ -31,29 +29,7 @@ impl Integrator for ExactPropagator {
 
     fn reset(&mut self, tau: f64, z: &DVector<f64>) -> Result<(), SimError> {
         let (region, z) = self.model.checked_start(tau, z)?;
-        self.region = region;
-        self.tau = tau;
-        self.z.copy_from(&z);
-        self.stale = false;
-        let j = self.grid.next_index(tau) - 1;
-        let m = self.grid.m as i64;
-        self.on_grid =
-            (self.grid.tau(j) == tau).then_some((j.div_euclid(m), j.rem_euclid(m) as usize));
-        self.between = None;
-        let sc = (self.model.omega() * tau).sin_cos();
-        self.entry_trig = (tau, sc);
-        self.enter_stint(region, sc);
-        self.just_switched = true;
-        self.chatter.clear();
-        self.last.tau0 = tau;
-        self.last.region = region;
-        self.last.dz0.fill(0.0);
-        *self.last.q0 = Modes::ZERO;
-        self.last.modal = false;
-        self.last.full = false;
-        self.poly_built = false;
-        self.param_end = None;
-        self.vt = tip_v_t(&self.model, z.as_slice(), sc);
+        self.restart_in(tau, z.as_slice(), region, false);
         Ok(())
     }
 

@@ -53,6 +53,7 @@ mod batch;
 mod bound;
 mod build;
 mod forcing;
+mod handoff;
 mod integrator;
 mod modal;
 mod run;
