@@ -236,7 +236,10 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
         span.total_periods,
     );
     let spp = a.samples_per_period;
-    let opts = request.integrator.options(spp);
+    // the exact grid is made a multiple of the samples recorded (none without files)
+    let opts = request
+        .integrator
+        .options(if a.files == Files::None { 1 } else { spp });
     let mut integ = build(&model, opts, 0.0, &z0)?;
     // inputs are valid: lock the output directory and open the files
     let out = match a.files {

@@ -27,8 +27,10 @@ use crate::system::{EventKind, Guard, HybridSystem, Jump, Region};
 use nalgebra::{DMatrix, DVector};
 
 mod body_contact;
+mod rate_form;
 
 pub use body_contact::{weighted_displacement, BodyContactCheck};
+pub use rate_form::RateForm;
 
 /// A chattering sequence ends in sticking when the next bounce would rise less than this many
 /// guard tolerances above the sample (1e3 × 1e-12 (1 + α2 + |α5|) ≈ 1e-9 of the gap g₀). The

@@ -205,7 +205,16 @@ pub fn record(integ: &mut dyn Integrator, spec: &RecordSpec) -> Result<Trajector
         let next_section = k_period as f64 * period;
         let target = end.min(next_sample).min(next_section);
         let step = integ.step(target)?;
-        if spec.energy && step.tau1 > step.tau0 {
+        let closed = if spec.energy && step.tau1 > step.tau0 {
+            integ.last_step_rate_integrals()
+        } else {
+            None
+        };
+        if let Some([pb, db, dc]) = closed {
+            acc.base_work += pb;
+            acc.beam_dissipation += db;
+            acc.contact_dissipation += dc;
+        } else if spec.energy && step.tau1 > step.tau0 {
             let r = step.region;
             let (mut pb, mut db, mut dc) = (0.0, 0.0, 0.0);
             for (x, w) in gl.iter() {

@@ -225,6 +225,14 @@ pub trait Integrator: Send {
         let _ = (param, r, tau, out);
         Ok(false)
     }
+    /// The integrals over the last step of the energy-balance rates of
+    /// [`CantileverModel::power`] — [base work, beam dissipation, sample dissipation] — where the
+    /// integrator has them in closed form; `None` (the default) where the caller integrates
+    /// them by quadrature of the dense output. The exact propagator has them for whole grid
+    /// steps (`integrate/exact/energy.rs`).
+    fn last_step_rate_integrals(&mut self) -> Option<[f64; 3]> {
+        None
+    }
     /// Integrate the variational equations along with the state (needed by
     /// [`Integrator::last_step_jacobian`] of the adaptive integrator; free for the exact one).
     fn set_variational(&mut self, on: bool) {

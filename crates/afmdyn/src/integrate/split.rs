@@ -294,6 +294,15 @@ impl Integrator for Split {
         self.integ_mut(self.last).dense_state(tau)
     }
 
+    /// The exact half's closed form over its whole grid steps of free flight (where the
+    /// model's rates are those of the linear law's region I: no tip force).
+    fn last_step_rate_integrals(&mut self) -> Option<[f64; 3]> {
+        match self.last {
+            Half::Exact => self.exact.last_step_rate_integrals(),
+            Half::Adaptive => None,
+        }
+    }
+
     fn last_step_jacobian(&mut self) -> Result<DMatrix<f64>, SimError> {
         self.integ_mut(self.last).last_step_jacobian()
     }

@@ -200,6 +200,7 @@ impl ExactPropagator {
             dz_run: zero,
             param_data: None,
             param_end: None,
+            energy: None,
             bound_cols: BoundCols::default(),
         })
     }

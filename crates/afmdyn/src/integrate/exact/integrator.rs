@@ -109,6 +109,11 @@ impl Integrator for ExactPropagator {
         out
     }
 
+    // the tables and their derivation: `energy.rs`
+    fn last_step_rate_integrals(&mut self) -> Option<[f64; 3]> {
+        self.last_step_rate_integrals_impl()
+    }
+
     fn last_step_jacobian(&mut self) -> Result<DMatrix<f64>, SimError> {
         Ok(self.step_transition())
     }

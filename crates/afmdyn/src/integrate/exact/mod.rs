@@ -52,6 +52,7 @@
 mod batch;
 mod bound;
 mod build;
+mod energy;
 mod forcing;
 mod handoff;
 mod integrator;
@@ -197,6 +198,9 @@ pub struct ExactPropagator {
     param_data: Option<(SweepParam, Arc<[ParticularDerivative; 2]>)>,
     /// ∂z_p/∂p at the end (τ, region) of the last step it was asked for.
     param_end: Option<(f64, Region, [f64; MAXD])>,
+    /// The tables of the closed-form energy integrals over grid steps (`energy.rs`), built on
+    /// the first request.
+    energy: Option<Arc<[energy::EnergyTable; 2]>>,
     /// The column sums of [`Integrator::displacement_bound`] for the last weights.
     ///
     /// [`Integrator::displacement_bound`]: crate::integrate::Integrator::displacement_bound

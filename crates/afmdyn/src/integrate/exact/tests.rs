@@ -174,3 +174,85 @@ fn forcing_cache_tells_gaps_apart() {
         );
     }
 }
+
+/// The closed-form integrals of the energy-balance rates over whole grid steps (`energy.rs`)
+/// equal 24-point Gauss–Legendre quadrature of [`CantileverModel::power`] on the step's dense
+/// output, to 1e-12 of the step's scale h (1 + |z|²) (the rates are quadratic in z with
+/// coefficients of order 1; the closed form sums larger terms that cancel): both regions, modal and dense propagation,
+/// N = 1, 3 and 8, beam and point mass; partial steps (and a grid step cut by a switching)
+/// have none.
+#[test]
+fn closed_form_rate_integrals_equal_quadrature_of_the_dense_output() {
+    use super::build::Propagation;
+    use crate::integrate::Integrator;
+    use crate::params::Structure;
+    use gauss_quad::legendre::GaussLegendre;
+    use std::num::NonZeroUsize;
+    let gl = GaussLegendre::new(NonZeroUsize::new(24).unwrap());
+    for (modes, structure) in [
+        (1, Structure::Beam),
+        (3, Structure::Beam),
+        (8, Structure::Beam),
+        (1, Structure::PointMass),
+    ] {
+        let p = Params {
+            modes,
+            structure,
+            alpha1: if structure == Structure::Beam {
+                0.1
+            } else {
+                0.0
+            },
+            ..Params::default()
+        };
+        let model = CantileverModel::new(&p).unwrap();
+        for propagation in [Propagation::Auto, Propagation::Dense] {
+            let opts = ExactOptions {
+                propagation,
+                ..ExactOptions::default()
+            };
+            let mut prop = ExactPropagator::try_with(&model, opts).unwrap();
+            prop.reset(0.0, &model.rest()).unwrap();
+            let (mut full, mut regions) = (0, [false; 2]);
+            while prop.tau() < 20.0 * p.period() {
+                let step = prop.step(f64::INFINITY).unwrap();
+                let Some(got) = prop.last_step_rate_integrals() else {
+                    let whole = prop.last.full && step.event.is_none();
+                    assert!(!whole, "a whole grid step has them");
+                    continue;
+                };
+                full += 1;
+                regions[step.region.index()] = true;
+                let half = 0.5 * (step.tau1 - step.tau0);
+                let mut want = [0.0; 3];
+                for (x, w) in gl.iter() {
+                    let tau = step.tau0 + half * (x + 1.0);
+                    let pw = model.power(step.region, tau, &prop.dense_state(tau));
+                    for (o, v) in
+                        want.iter_mut()
+                            .zip([pw.base, pw.beam_dissipation, pw.contact_dissipation])
+                    {
+                        *o += half * w * v;
+                    }
+                }
+                // the rates are quadratic in z with coefficients of order 1 (α's, forcing)
+                let z2 = prop
+                    .state()
+                    .norm_squared()
+                    .max(prop.dense_state(step.tau0).norm_squared());
+                let scale = 2.0 * half * (1.0 + z2);
+                for (g, w) in got.iter().zip(want) {
+                    assert!(
+                        (g - w).abs() <= 1e-12 * scale,
+                        "N = {modes} {structure:?} {propagation:?} {:?}: {got:?} vs {want:?}",
+                        step.region
+                    );
+                }
+            }
+            assert!(full > 100, "{full} whole grid steps");
+            if structure == Structure::Beam {
+                assert_eq!(regions, [true, true], "both regions");
+            }
+        }
+    }
+}
