@@ -276,16 +276,21 @@ impl CantileverModel {
     /// M⁻¹φ (∂F_c/∂z)ᵀ with ∂F_c/∂a = −(∂F_c/∂δ) φ, ∂F_c/∂ȧ = −(∂F_c/∂δ̇) φ; for sticking
     /// ∂λ/∂z of the sticking force. The linear law gives A_s of eqs. 15–18.
     pub fn jacobian_into(&self, r: Region, tau: f64, z: &[f64], jac: &mut DMatrix<f64>) {
-        self.jacobian_parts(r, tau, z, jac, true);
+        self.jacobian_parts(r, tau, self.base_trig(tau), z, jac, true);
     }
 
     /// The Kelvin–Voigt weight w = α6 √δ of DMT in contact (0 elsewhere): its τ-derivative
     /// α6 δ̇/(2√δ) is the singular part of ∂F_c/∂δ at contact onset.
     fn kelvin_voigt_weight(&self, r: Region, tau: f64, z: &[f64]) -> f64 {
+        self.kelvin_voigt_weight_at(r, self.base_trig(tau), z)
+    }
+
+    /// [`Self::kelvin_voigt_weight`] given (sin Ωτ, cos Ωτ) = `sc` ([`Self::base_trig`]).
+    fn kelvin_voigt_weight_at(&self, r: Region, sc: (f64, f64), z: &[f64]) -> f64 {
         if r != Region::Contact || !matches!(self.law.law, ContactLaw::Dmt { .. }) {
             return 0.0;
         }
-        let (v, _) = self.v_t_pair(tau, z);
+        let [v, _, _] = self.v_t_at(sc, [self.w_tip_slice(z, 0), 0.0, 0.0]);
         self.law.damping * (-v).max(0.0).sqrt()
     }
 
@@ -295,6 +300,7 @@ impl CantileverModel {
         &self,
         r: Region,
         tau: f64,
+        sc: (f64, f64),
         z: &[f64],
         jac: &mut DMatrix<f64>,
         singular: bool,
@@ -321,9 +327,9 @@ impl CantileverModel {
                     return;
                 }
                 let [v, vd, _] =
-                    self.v_t_from_tip(tau, [self.w_tip_slice(z, 0), self.w_tip_slice(z, n), 0.0]);
+                    self.v_t_at(sc, [self.w_tip_slice(z, 0), self.w_tip_slice(z, n), 0.0]);
                 let f = self.law.force(r == Region::Contact, -v, -vd);
-                let w = self.kelvin_voigt_weight(r, tau, z);
+                let w = self.kelvin_voigt_weight_at(r, sc, z);
                 let d_delta = if singular || w == 0.0 {
                     f.d_delta
                 } else {
@@ -369,7 +375,16 @@ impl CantileverModel {
     /// [V_T, dV_T/dτ, d²V_T/dτ²] at τ from the tip deflection and its derivatives
     /// [W(1,τ), W', W''] (eq. 8 differentiated twice).
     pub fn v_t_from_tip(&self, tau: f64, w: [f64; 3]) -> [f64; 3] {
-        self.v_t_at((self.params.omega * tau).sin_cos(), w)
+        self.v_t_at(self.base_trig(tau), w)
+    }
+    /// (sin Ωτ, cos Ωτ) as V_T needs them (eq. 8): without the sine and cosine where the base
+    /// does not move (the point mass, whose V_T = W + α5), as they are multiplied by 0 there.
+    fn base_trig(&self, tau: f64) -> (f64, f64) {
+        if self.params.base_amplitude() == 0.0 {
+            (0.0, 0.0)
+        } else {
+            (self.params.omega * tau).sin_cos()
+        }
     }
     /// [`CantileverModel::v_t_from_tip`] given (sin Ωτ, cos Ωτ): eq. 8, the one place V_T is
     /// formed from the tip deflection.
@@ -818,8 +833,10 @@ impl HybridSystem for CantileverModel {
     ) {
         let d = self.dim();
         let n = self.modes();
-        let w = self.kelvin_voigt_weight(mode, tau, z);
-        self.jacobian_parts(mode, tau, z, jac, w == 0.0);
+        // sin, cos Ωτ once for V_T in the weight and the Jacobian
+        let sc = self.base_trig(tau);
+        let w = self.kelvin_voigt_weight_at(mode, sc, z);
+        self.jacobian_parts(mode, tau, sc, z, jac, w == 0.0);
         if w == 0.0 {
             second_order_product(jac, n, psi, dpsi);
             return;
