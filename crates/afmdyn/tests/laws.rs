@@ -248,6 +248,12 @@ fn unsupported_pairs_are_typed_errors() {
         })
     ));
     assert_eq!(IntegratorKind::Auto.resolve(&hertz), IntegratorKind::Split);
+    assert_eq!(IntegratorKind::Auto.resolve(&impact), IntegratorKind::Split);
+    let plastic = impact_model(0.0, 3, 0.0, 2.6);
+    assert_eq!(
+        IntegratorKind::Auto.resolve(&plastic),
+        IntegratorKind::Adaptive
+    );
     let (_, dmt) = law_model(DMT, 3, 2.6);
     assert_eq!(IntegratorKind::Auto.resolve(&dmt), IntegratorKind::Adaptive);
     let e = build(&dmt, opts(IntegratorKind::Split, 1e-12), 0.0, &dmt.rest());

@@ -494,12 +494,18 @@ pub struct IntegratorOptions {
 impl IntegratorKind {
     /// The concrete integrator for `model`: [`IntegratorKind::Auto`] resolves to `Exact` for an
     /// affine (linear-law) model, to `Split` for a law without force in free flight (Hertz,
-    /// impact) and to `Adaptive` otherwise (DMT); other kinds are returned as given. ([`build`]
+    /// impact with r > 0) and to `Adaptive` otherwise (DMT, and the plastic impact law r = 0,
+    /// whose free flights all start tangentially); other kinds are returned as given. ([`build`]
     /// falls back from `Split` to `Adaptive` for `Auto` where the exact free flight cannot be
     /// built: Ω at an undamped resonance of the free beam, or a grid beyond its budget.)
     pub fn resolve(self, model: &CantileverModel) -> IntegratorKind {
         match self {
             IntegratorKind::Auto if model.law().is_affine() => IntegratorKind::Exact,
+            // a plastic impact law (r = 0): every free flight starts tangentially (V̇_T⁺ = 0),
+            // which the split integrator hands to the adaptive half anyway
+            IntegratorKind::Auto if model.law().restitution() == Some(0.0) => {
+                IntegratorKind::Adaptive
+            }
             IntegratorKind::Auto if split::Split::applies(model) => IntegratorKind::Split,
             IntegratorKind::Auto => IntegratorKind::Adaptive,
             k => k,
