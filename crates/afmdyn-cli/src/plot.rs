@@ -376,10 +376,20 @@ fn tick(v: f64, span: f64) -> String {
     s.to_string()
 }
 
-/// Pad a data range (x0, x1, y0, y1) by `frac` of its extent on each side.
+/// Pad a data range (x0, x1, y0, y1) by `frac` of its extent on each side. A range of one
+/// value (within 1e-12 of its magnitude) gets an extent of 1e-3 of its magnitude (1 around 0):
+/// relative, so that data in SI units (energies of 1e-18 J, distances of 1e-9 m) fill the axis
+/// (issue 28: an absolute floor of 1e-12 drew them as flat lines on a ±3e-14 axis).
 fn padded(b: (f64, f64, f64, f64), frac: f64) -> (f64, f64, f64, f64) {
     let pad = |lo: f64, hi: f64| {
-        let d = (hi - lo).abs().max(1e-12 * (1.0 + lo.abs()));
+        let (span, scale) = ((hi - lo).abs(), lo.abs().max(hi.abs()));
+        let d = if span > 1e-12 * scale {
+            span
+        } else if scale > 0.0 {
+            1e-3 * scale
+        } else {
+            1.0
+        };
         (lo - frac * d, hi + frac * d)
     };
     let (x0, x1) = pad(b.0, b.1);
@@ -597,6 +607,22 @@ pub fn save_scatter_stream(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The padded range is the data's extent ± `frac` of it at any magnitude (SI energies of
+    /// 1e-18 J included), and a single value gets a range of its own magnitude's order.
+    #[test]
+    fn padding_is_relative_to_the_data() {
+        for (lo, hi) in [(1e-18, 3e-18), (-2e-9, -1e-9), (0.0, 1.0), (1e5, 3e5)] {
+            let (_, _, y0, y1) = padded((0.0, 1.0, lo, hi), 0.05);
+            let d = hi - lo;
+            assert!((y0 - (lo - 0.05 * d)).abs() <= 1e-12 * d, "{lo} {hi}: {y0}");
+            assert!((y1 - (hi + 0.05 * d)).abs() <= 1e-12 * d, "{lo} {hi}: {y1}");
+        }
+        let (_, _, y0, y1) = padded((0.0, 1.0, 2e-18, 2e-18), 0.05);
+        assert!(y0 < 2e-18 && y1 > 2e-18 && y1 - y0 < 1e-20, "{y0} {y1}");
+        let (_, _, y0, y1) = padded((0.0, 1.0, 0.0, 0.0), 0.05);
+        assert_eq!((y0, y1), (-0.05, 0.05));
+    }
 
     #[test]
     fn monotone_line_keeps_first_min_max_last_per_column() {
