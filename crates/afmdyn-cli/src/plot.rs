@@ -10,6 +10,7 @@
 
 use crate::error::CliError;
 use crate::output::write_bytes;
+use plotters::coord::ranged1d::{DefaultFormatting, KeyPointHint, Ranged};
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -397,12 +398,56 @@ fn padded(b: (f64, f64, f64, f64), frac: f64) -> (f64, f64, f64, f64) {
     (x0, x1, y0, y1)
 }
 
+/// An axis over [lo, hi] whose tick positions are plotters' own, computed at the scale of
+/// the data: plotters returns a single tick for a range narrower than f64::EPSILON (so an SI
+/// energy axis of 1e-18 J had one label); the key points of the range divided by a power of
+/// ten near its magnitude, multiplied back, are the same ticks at any scale.
+struct Axis {
+    inner: RangedCoordf64,
+    /// The power of ten the key points are computed at.
+    f: f64,
+}
+
+impl Axis {
+    fn new(lo: f64, hi: f64) -> Self {
+        let mag = lo.abs().max(hi.abs());
+        let f = if mag > 0.0 && mag.is_finite() {
+            10f64.powf(mag.log10().floor())
+        } else {
+            1.0
+        };
+        Axis {
+            inner: (lo..hi).into(),
+            f,
+        }
+    }
+}
+
+impl Ranged for Axis {
+    type ValueType = f64;
+    type FormatOption = DefaultFormatting;
+    fn map(&self, v: &f64, limit: (i32, i32)) -> i32 {
+        self.inner.map(v, limit)
+    }
+    fn key_points<H: KeyPointHint>(&self, hint: H) -> Vec<f64> {
+        let r = self.inner.range();
+        let unit: RangedCoordf64 = (r.start / self.f..r.end / self.f).into();
+        unit.key_points(hint)
+            .into_iter()
+            .map(|v| v * self.f)
+            .collect()
+    }
+    fn range(&self) -> std::ops::Range<f64> {
+        self.inner.range()
+    }
+}
+
 /// The chart of a data area with its axes, mesh and labels over (x0, x1, y0, y1).
 fn chart<'a, DB: DrawingBackend>(
     area: &'a DrawingArea<DB, Shift>,
     (x0, x1, y0, y1): (f64, f64, f64, f64),
     labels: (&str, &str),
-) -> Result<ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>, String>
+) -> Result<ChartContext<'a, DB, Cartesian2d<Axis, Axis>>, String>
 where
     DB::ErrorType: 'static,
 {
@@ -410,7 +455,7 @@ where
         .margin(12)
         .x_label_area_size(45)
         .y_label_area_size(70)
-        .build_cartesian_2d(x0..x1, y0..y1)
+        .build_cartesian_2d(Axis::new(x0, x1), Axis::new(y0, y1))
         .map_err(|x| x.to_string())?;
     let (xs, ys) = (x1 - x0, y1 - y0);
     chart
@@ -607,6 +652,20 @@ pub fn save_scatter_stream(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// An axis has as many ticks at 1e-18 as at 1 (plotters alone gives one below 2.2e-16).
+    #[test]
+    fn ticks_do_not_depend_on_the_scale() {
+        let unit = Axis::new(1.0, 3.0).key_points(10);
+        assert!(unit.len() >= 5, "{unit:?}");
+        for scale in [1e-18, 1e-9, 1e5] {
+            let k = Axis::new(scale, 3.0 * scale).key_points(10);
+            assert_eq!(k.len(), unit.len(), "{scale}: {k:?}");
+            for (a, b) in k.iter().zip(&unit) {
+                assert!((a / scale - b).abs() < 1e-9, "{scale}: {k:?}");
+            }
+        }
+    }
 
     /// The padded range is the data's extent ± `frac` of it at any magnitude (SI energies of
     /// 1e-18 J included), and a single value gets a range of its own magnitude's order.
