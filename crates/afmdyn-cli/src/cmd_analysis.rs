@@ -199,10 +199,15 @@ pub fn bifurcation(a: &BifurcationArgs) -> Result<(), CliError> {
     );
     let (mut periodic, mut nonperiodic, mut errors) = (0usize, 0usize, 0usize);
     let mut first_error: Option<String> = None;
+    // the colours of the period classes drawn: the legend lists only those (issue 28)
+    let mut drawn = std::collections::HashSet::new();
     read_rows(&final_csv, &mut |r| {
         let v: f64 = r[COL_VALUE].parse().unwrap_or(f64::NAN);
         let w: f64 = r[COL_W_TIP].parse().unwrap_or(f64::NAN);
         let x: f64 = r[COL_X_MAX].parse().unwrap_or(f64::NAN);
+        if w.is_finite() || x.is_finite() {
+            drawn.insert(period_color(status_code(&r[COL_STATUS], &r[COL_PERIOD])));
+        }
         if r[COL_POINT] == *"0" {
             match &r[COL_STATUS] {
                 "periodic" => periodic += 1,
@@ -238,6 +243,7 @@ pub fn bifurcation(a: &BifurcationArgs) -> Result<(), CliError> {
     ]
     .iter()
     .map(|(l, p)| (l.to_string(), period_color(*p), true))
+    .filter(|(_, c, _)| drawn.contains(c))
     .collect();
     let mut branch_legend: Vec<LegendEntry> = Vec::new();
     if spec.continuation {
