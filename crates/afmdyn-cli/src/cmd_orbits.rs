@@ -223,7 +223,10 @@ pub fn continuation(a: &ContinueArgs) -> Result<(), CliError> {
     )?;
     // plot: section points of each branch, stable solid, unstable dashed (as dots)
     let mut series = Vec::new();
-    for (i, b) in branches.iter().enumerate() {
+    // a colour per branch, avoiding the events' (3) and the sweep underlay's (7)
+    const BRANCH_COLORS: [usize; 8] = [0, 1, 2, 4, 5, 6, 8, 9];
+    for (ib, b) in branches.iter().enumerate() {
+        let i = BRANCH_COLORS[ib % BRANCH_COLORS.len()];
         let first_series = series.len();
         let np = b.first().map_or(0, |x| x.section.len());
         for k in 0..np {
@@ -253,7 +256,7 @@ pub fn continuation(a: &ContinueArgs) -> Result<(), CliError> {
             }
         }
         if let (Some(sr), Some(x)) = (series.get_mut(first_series), b.first()) {
-            sr.label = if i == 0 {
+            sr.label = if ib == 0 {
                 format!("period-{n} branch (solid stable, dashed unstable)")
             } else {
                 format!(
@@ -301,11 +304,30 @@ pub fn continuation(a: &ContinueArgs) -> Result<(), CliError> {
             },
         );
     }
+    // the periods the branches have (with --switch, the doubled branches too)
+    let mut periods: Vec<usize> = branches
+        .iter()
+        .filter_map(|b| b.first().map(|x| x.period))
+        .collect();
+    periods.sort_unstable();
+    periods.dedup();
+    let title = match periods.as_slice() {
+        [p] => format!("Continuation of period-{p} orbits in {}", a.param.symbol()),
+        [] => format!("Continuation of period-{n} orbits in {}", a.param.symbol()),
+        ps => format!(
+            "Continuation of periodic orbits in {} (periods {})",
+            a.param.symbol(),
+            ps.iter()
+                .map(|p| p.to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    };
     save(
         out.path(),
         "continuation",
         &Figure {
-            title: format!("Continuation of period-{n} orbits in {}", a.param.symbol()),
+            title,
             x_label: format!("{} ({})", a.param.symbol(), a.param.name()),
             y_label: "W(1,τ) at τ = 2πk/Ω".into(),
             series,
