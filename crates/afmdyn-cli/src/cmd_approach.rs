@@ -107,6 +107,47 @@ struct Labels {
     /// Abscissa column name and axis label.
     x_name: &'static str,
     x_label: String,
+    /// The abscissa's symbol in the printed summary and its SI unit (`None`: dimensionless).
+    x_text: &'static str,
+    x_unit: Option<&'static str>,
+}
+
+impl Labels {
+    /// An abscissa value as the summary prints it: with an SI prefix and the unit (13.4747 nm,
+    /// 300.000 kHz), or to 7 significant digits when dimensionless.
+    fn show(&self, v: f64) -> String {
+        match self.x_unit {
+            Some(unit) => si_value(v, unit),
+            None => format!("{v:.6e}"),
+        }
+    }
+}
+
+/// `v` in `unit` with the SI prefix that puts its mantissa in [1, 1000), 6 significant digits.
+fn si_value(v: f64, unit: &str) -> String {
+    const PREFIXES: [(i32, &str); 9] = [
+        (-15, "f"),
+        (-12, "p"),
+        (-9, "n"),
+        (-6, "µ"),
+        (-3, "m"),
+        (0, ""),
+        (3, "k"),
+        (6, "M"),
+        (9, "G"),
+    ];
+    if v == 0.0 || !v.is_finite() {
+        return format!("{v} {unit}");
+    }
+    let e = (v.abs().log10().floor() as i32).div_euclid(3) * 3;
+    let (e, p) = PREFIXES
+        .iter()
+        .copied()
+        .min_by_key(|(x, _)| (x - e).abs())
+        .unwrap_or((0, ""));
+    let m = v / 10f64.powi(e);
+    let digits = (5 - m.abs().log10().floor() as i32).clamp(0, 5) as usize;
+    format!("{m:.digits$} {p}{unit}")
 }
 
 fn event_code(e: Option<BranchEvent>) -> f64 {
@@ -471,29 +512,29 @@ fn summary(c: &SteppedCurve, x: &dyn Fn(f64) -> f64, l: &Labels, out: Option<&Ou
         c.branches.iter().map(Vec::len).sum::<usize>()
     );
     for fv in &c.folds {
-        println!("  fold at {} = {:.6e}", l.x_name, x(*fv));
+        println!("  fold at {} = {}", l.x_text, l.show(x(*fv)));
     }
     for &(a, b) in &c.bistable {
         let (p, q) = (x(a), x(b));
         println!(
-            "  bistable for {} in [{:.6e}, {:.6e}]",
-            l.x_name,
-            p.min(q),
-            p.max(q)
+            "  bistable for {} in [{}, {}]",
+            l.x_text,
+            l.show(p.min(q)),
+            l.show(p.max(q))
         );
     }
     for j in &c.jumps {
         println!(
-            "  {} jumps between {} = {:.6e} and {:.6e}{}",
+            "  {} jumps between {} = {} and {}{}",
             match j.sweep {
                 Sweep::First => l.sweeps.0,
                 Sweep::Second => l.sweeps.1,
             },
-            l.x_name,
-            x(j.from),
-            x(j.to),
+            l.x_text,
+            l.show(x(j.from)),
+            l.show(x(j.to)),
             j.fold
-                .map_or(String::new(), |fv| format!(" (fold at {:.6e})", x(fv)))
+                .map_or(String::new(), |fv| format!(" (fold at {})", l.show(x(fv))))
         );
     }
     for w in &c.warnings {
@@ -588,6 +629,8 @@ pub fn approach(a: &ApproachArgs) -> Result<(), CliError> {
             "rest distance z_c{}",
             if units.si { " (m)" } else { " (g0)" }
         ),
+        x_text: "z_c",
+        x_unit: units.si.then_some("m"),
     };
     let run = Run {
         args: &a.curve,
@@ -628,6 +671,12 @@ pub fn resonance(a: &ResonanceArgs) -> Result<(), CliError> {
         } else {
             "drive frequency Ω".into()
         },
+        x_text: if units.hz_per_omega.is_some() {
+            "f"
+        } else {
+            "Ω"
+        },
+        x_unit: units.hz_per_omega.map(|_| "Hz"),
     };
     let run = Run {
         args: &a.curve,
@@ -644,4 +693,19 @@ pub fn resonance(a: &ResonanceArgs) -> Result<(), CliError> {
             probe,
         },
     )
+}
+
+#[cfg(test)]
+mod si_tests {
+    use super::si_value;
+
+    /// SI prefixes with 6 significant digits.
+    #[test]
+    fn values_print_with_si_prefixes() {
+        assert_eq!(si_value(1.347465e-8, "m"), "13.4747 nm");
+        assert_eq!(si_value(3.0e5, "Hz"), "300.000 kHz");
+        assert_eq!(si_value(-2.5e-10, "m"), "-250.000 pm");
+        assert_eq!(si_value(1.0, "m"), "1.00000 m");
+        assert_eq!(si_value(0.0, "m"), "0 m");
+    }
 }
