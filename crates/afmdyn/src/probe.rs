@@ -637,9 +637,13 @@ impl Probe {
         tip_nu: Option<f64>,
     ) -> Option<Sample> {
         const S: &str = "sample";
-        let law = match r.string(s, S, "law") {
-            Some(l @ ("linear" | "hertz" | "dmt" | "impact")) => Some(l.to_string()),
-            Some(l) => {
+        // the law's name in any case ("DMT" as the literature writes it)
+        let law = match r
+            .string(s, S, "law")
+            .map(|l| (l, l.trim().to_ascii_lowercase()))
+        {
+            Some((_, l)) if matches!(l.as_str(), "linear" | "hertz" | "dmt" | "impact") => Some(l),
+            Some((l, _)) => {
                 r.problems.push(format!(
                     "[sample].law = '{l}': expected linear, hertz, dmt or impact"
                 ));

@@ -415,3 +415,16 @@ fn beam_n1_matches_point_mass_within_the_base_drive() {
     assert!(dphi <= b, "Δφ = {dphi:e} rad against b = {b:e}");
     assert!(dforce <= b, "peak force differs by {dforce:e}");
 }
+
+/// The law's name is read in any case (issue 28: `law = "DMT"`, as the literature writes it,
+/// was refused): the same parameters as `law = "dmt"`.
+#[test]
+fn law_names_are_read_in_any_case() {
+    let lower = Probe::parse(POINT_MASS_DMT, "test").unwrap();
+    for name in ["DMT", "Dmt", " dmt "] {
+        let text = POINT_MASS_DMT.replace("law = \"dmt\"", &format!("law = \"{name}\""));
+        assert_ne!(text, POINT_MASS_DMT);
+        let p = Probe::parse(&text, "test").unwrap();
+        assert_eq!(p.params, lower.params, "{name}");
+    }
+}
