@@ -76,8 +76,14 @@ pub fn model_spec(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<ModelSpec> {
             .extract()
             .map_err(|_| PyTypeError::new_err("parameter names must be strings"))?;
         let canonical = parameter(&key).map(|p| p.name).ok_or_else(|| {
+            // a Python keyword as an argument name: the functions take it with a trailing _
+            let hint = if key == "from" {
+                "'from' is a Python keyword: the start of a range is from_=...; "
+            } else {
+                ""
+            };
             PyTypeError::new_err(format!(
-                "unknown model parameter '{key}': expected {}",
+                "unknown model parameter '{key}': {hint}expected {}",
                 keyword_list()
             ))
         })?;

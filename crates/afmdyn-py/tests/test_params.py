@@ -103,6 +103,9 @@ def test_unknown_keyword_and_wrong_types_raise_type_error():
         Params(omegaa=2.0)
     with pytest.raises(TypeError, match="unknown model parameter"):
         afmdyn.simulate(periods=1, stiffness=3.0)
+    # 'from' is a Python keyword: the message names from_ (issue 28)
+    with pytest.raises(TypeError, match="Python keyword: the start of a range is from_"):
+        afmdyn.approach(**{"from": 20e-9}, to=2e-9, points=3)
     with pytest.raises(TypeError, match="omega: expected a number"):
         Params(omega="2.6")
     with pytest.raises(TypeError, match="modes: expected an integer"):
