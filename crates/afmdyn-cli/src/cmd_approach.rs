@@ -125,26 +125,10 @@ impl Labels {
 
 /// `v` in `unit` with the SI prefix that puts its mantissa in [1, 1000), 6 significant digits.
 fn si_value(v: f64, unit: &str) -> String {
-    const PREFIXES: [(i32, &str); 9] = [
-        (-15, "f"),
-        (-12, "p"),
-        (-9, "n"),
-        (-6, "µ"),
-        (-3, "m"),
-        (0, ""),
-        (3, "k"),
-        (6, "M"),
-        (9, "G"),
-    ];
     if v == 0.0 || !v.is_finite() {
         return format!("{v} {unit}");
     }
-    let e = (v.abs().log10().floor() as i32).div_euclid(3) * 3;
-    let (e, p) = PREFIXES
-        .iter()
-        .copied()
-        .min_by_key(|(x, _)| (x - e).abs())
-        .unwrap_or((0, ""));
+    let (e, p) = crate::plot::si_prefix(v.abs());
     let m = v / 10f64.powi(e);
     let digits = (5 - m.abs().log10().floor() as i32).clamp(0, 5) as usize;
     format!("{m:.digits$} {p}{unit}")

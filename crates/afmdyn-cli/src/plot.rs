@@ -442,6 +442,53 @@ impl Ranged for Axis {
     }
 }
 
+/// The description and tick divisor of an axis over [lo, hi] labelled `label`: a label that
+/// ends in an SI unit in parentheses — " (m)", " (Hz)", " (J)", " (N)", " (W)", " (s)",
+/// " (Pa)" — gets the prefix (a … G) of the axis's magnitude, and its ticks are divided by it
+/// (an approach curve's z_c axis reads 2, 4, 6 "(nm)" instead of 2.00e-9 "(m)").
+fn si_axis(label: &str, lo: f64, hi: f64) -> (String, f64) {
+    const UNITS: [&str; 7] = ["m", "Hz", "J", "N", "W", "s", "Pa"];
+    let unit = label
+        .strip_suffix(')')
+        .and_then(|l| l.rsplit_once(" ("))
+        .filter(|(_, u)| UNITS.contains(u));
+    let mag = lo.abs().max(hi.abs());
+    let Some((head, u)) = unit else {
+        return (label.to_string(), 1.0);
+    };
+    if !(mag > 0.0 && mag.is_finite()) {
+        return (label.to_string(), 1.0);
+    }
+    let (e, p) = si_prefix(mag);
+    (format!("{head} ({p}{u})"), 10f64.powi(e))
+}
+
+/// The SI prefix (a … G) for a magnitude: (its power of ten, the prefix), the one that puts
+/// the magnitude's mantissa in [1, 1000) within the range of prefixes.
+pub fn si_prefix(mag: f64) -> (i32, &'static str) {
+    const PREFIXES: [(i32, &str); 10] = [
+        (-18, "a"),
+        (-15, "f"),
+        (-12, "p"),
+        (-9, "n"),
+        (-6, "µ"),
+        (-3, "m"),
+        (0, ""),
+        (3, "k"),
+        (6, "M"),
+        (9, "G"),
+    ];
+    if !(mag > 0.0 && mag.is_finite()) {
+        return (0, "");
+    }
+    let e = (mag.log10().floor() as i32).div_euclid(3) * 3;
+    PREFIXES
+        .iter()
+        .copied()
+        .min_by_key(|(x, _)| (x - e).abs())
+        .unwrap_or((0, ""))
+}
+
 /// The chart of a data area with its axes, mesh and labels over (x0, x1, y0, y1).
 fn chart<'a, DB: DrawingBackend>(
     area: &'a DrawingArea<DB, Shift>,
@@ -457,13 +504,15 @@ where
         .y_label_area_size(70)
         .build_cartesian_2d(Axis::new(x0, x1), Axis::new(y0, y1))
         .map_err(|x| x.to_string())?;
-    let (xs, ys) = (x1 - x0, y1 - y0);
+    // an axis in an SI unit reads in the prefixed unit of its magnitude (nm, kHz, aJ)
+    let ((xd, fx), (yd, fy)) = (si_axis(labels.0, x0, x1), si_axis(labels.1, y0, y1));
+    let (xs, ys) = ((x1 - x0) / fx, (y1 - y0) / fy);
     chart
         .configure_mesh()
-        .x_desc(labels.0)
-        .y_desc(labels.1)
-        .x_label_formatter(&|v| tick(*v, xs))
-        .y_label_formatter(&|v| tick(*v, ys))
+        .x_desc(xd)
+        .y_desc(yd)
+        .x_label_formatter(&|v| tick(*v / fx, xs))
+        .y_label_formatter(&|v| tick(*v / fy, ys))
         .label_style(("sans-serif", 15))
         .draw()
         .map_err(|x| x.to_string())?;
@@ -652,6 +701,28 @@ pub fn save_scatter_stream(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// SI axes take the prefix of their magnitude; other labels are left alone.
+    #[test]
+    fn si_axes_take_the_prefix_of_their_magnitude() {
+        let (d, f) = si_axis("rest distance z_c (m)", 1e-9, 1.2e-8);
+        assert_eq!(d, "rest distance z_c (nm)");
+        assert!((f - 1e-9).abs() < 1e-24);
+        assert_eq!(
+            si_axis("drive frequency (Hz)", 2.9e5, 3.1e5).0,
+            "drive frequency (kHz)"
+        );
+        assert_eq!(si_axis("virial (J)", -2.5e-18, 2.5e-18).0, "virial (aJ)");
+        assert_eq!(
+            si_axis("amplitude A/A0", 0.0, 1.0),
+            ("amplitude A/A0".into(), 1.0)
+        );
+        assert_eq!(
+            si_axis("phase (deg)", 0.0, 90.0),
+            ("phase (deg)".into(), 1.0)
+        );
+        assert_eq!(si_axis("W(1,τ) (g0)", -1.0, 1.0).1, 1.0);
+    }
 
     /// An axis has as many ticks at 1e-18 as at 1 (plotters alone gives one below 2.2e-16).
     #[test]
