@@ -154,6 +154,14 @@ impl<S: TipSampleSystem + Clone> Adaptive<S> {
         self.model.dim()
     }
 
+    /// Forget the events and steps counted so far (the chattering test's window and the step
+    /// budget of the drive period), as [`Integrator::reset`] does: for a new run of
+    /// [`super::split::Split`] that starts in free flight (the split integrator's own reset).
+    pub(crate) fn forget_events(&mut self) {
+        self.chatter.clear();
+        self.budget.set((i64::MIN, 0));
+    }
+
     /// Restart at (τ, z) in `region`, as [`Integrator::reset`] but with the region given (a
     /// state on the switching surface after an event belongs to the region the event enters)
     /// and without checking z (the caller did); the chattering test and the step budget of the
@@ -511,8 +519,7 @@ impl<S: TipSampleSystem + Clone + 'static> Integrator for Adaptive<S> {
     fn reset(&mut self, tau: f64, z: &DVector<f64>) -> Result<(), SimError> {
         let (region, z) = self.model.checked_start(tau, z)?;
         self.restart_in(tau, z.as_slice(), region);
-        self.chatter.clear();
-        self.budget.set((i64::MIN, 0));
+        self.forget_events();
         Ok(())
     }
 

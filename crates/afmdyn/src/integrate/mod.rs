@@ -676,6 +676,11 @@ impl ChatterWindow {
     /// # Errors
     /// [`SimError::Chattering`] when it is the `count`-th within the window.
     pub(crate) fn record(&mut self, tau: f64) -> Result<(), SimError> {
+        // an event earlier than the last one belongs to a new run (a restart back in time):
+        // the window counts the events of one run only
+        if self.recent.back().is_some_and(|&t| tau < t) {
+            self.recent.clear();
+        }
         self.recent.push_back(tau);
         while self.recent.len() > self.count {
             self.recent.pop_front();

@@ -214,6 +214,9 @@ impl Integrator for Split {
     fn reset(&mut self, tau: f64, z: &DVector<f64>) -> Result<(), SimError> {
         let (region, z) = self.model.checked_start(tau, z)?;
         self.chatter.clear();
+        // a new run: neither half counts the events of the last one (a chattering window
+        // holding events of an earlier run, later in τ, would see a negative time span)
+        self.adaptive.forget_events();
         match region {
             Region::Free => {
                 self.exact
