@@ -83,7 +83,7 @@ fn integral_exp(mu: C, t: f64, exp_mt: C) -> C {
 }
 
 impl ModalRates {
-    fn new(me: &ModalExp, forms: &[RateForm; 3], fr_zp: [&DVector<f64>; 3], omega: f64) -> Self {
+    fn new(me: &ModalExp, forms: &[RateForm; 3], fr_zp: [&DVector<f64>; 3]) -> Self {
         let r = me.len();
         let dim = me.tv.re.nrows();
         let u: Vec<DVector<C>> = (0..r)
@@ -143,7 +143,6 @@ impl ModalRates {
             }
             coef
         });
-        let _ = omega;
         ModalRates {
             a,
             b,
@@ -287,7 +286,7 @@ impl ExactPropagator {
         let modal = self.spec[r.index()]
             .modal
             .as_ref()
-            .map(|me| ModalRates::new(me, &forms, [&fr.p0, &fr.ps, &fr.pc], omega));
+            .map(|me| ModalRates::new(me, &forms, [&fr.p0, &fr.ps, &fr.pc]));
         Some(EnergyTable { g, w, c, modal })
     }
 
