@@ -136,20 +136,25 @@ impl ModelArgs {
             .transpose()
     }
 
+    /// The model values of the flags over the config file, and the probe (unresolved: a
+    /// chart resolves them once per cell).
+    pub fn spec_and_probe(&self) -> Result<(ModelSpec, Option<afmdyn::probe::Probe>), CliError> {
+        let probe = self.probe()?;
+        let file: ModelSpec = match &self.config {
+            Some(p) => read_toml(p)?,
+            None => ModelSpec::default(),
+        };
+        Ok((self.spec().over(file), probe))
+    }
+
     /// The parameter set: [`ModelSpec::resolve`] of the flags over the config file, on
     /// `defaults` or the probe's set; the probe is returned for the SI outputs.
     pub fn resolve(
         &self,
         defaults: Params,
     ) -> Result<(Params, Option<afmdyn::probe::Probe>), CliError> {
-        let probe = self.probe()?;
-        let file: ModelSpec = match &self.config {
-            Some(p) => read_toml(p)?,
-            None => ModelSpec::default(),
-        };
-        let p = self
-            .spec()
-            .over(file)
+        let (spec, probe) = self.spec_and_probe()?;
+        let p = spec
             .resolve(defaults, probe.as_ref())
             .map_err(|e| CliError::Input(crate::error::spell(&e)))?;
         Ok((p, probe))

@@ -98,8 +98,9 @@ pub struct BifurcationArgs {
 /// Column positions in the library's sweep records (also read by `afmdyn continue --overlay`).
 pub(crate) use afmdyn::request::sweep::{COL_VALUE, COL_W_TIP};
 
-/// The command line's message for a checkpoint error (`--resume` names the flag).
-fn checkpoint_error(e: CheckpointError) -> CliError {
+/// The command line's message for a checkpoint error (`--resume` names the flag) of a store of
+/// `what` (`sweep`, `chart`) results.
+pub(crate) fn store_error(e: CheckpointError, what: &str) -> CliError {
     match e {
         CheckpointError::Io { .. } => CliError::Io(e.to_string()),
         CheckpointError::Mismatch { field, then, now } => CliError::Input(format!(
@@ -108,11 +109,15 @@ fn checkpoint_error(e: CheckpointError) -> CliError {
             field.replace('_', "-")
         )),
         CheckpointError::Unrecorded { store, ledger } => CliError::Input(format!(
-            "--resume: {store} has sweep results but no record of the arguments that made them \
+            "--resume: {store} has {what} results but no record of the arguments that made them \
              ({ledger} is missing); rerun without --resume to start over"
         )),
         CheckpointError::Corrupt { .. } => CliError::Input(e.to_string()),
     }
+}
+
+fn checkpoint_error(e: CheckpointError) -> CliError {
+    store_error(e, "sweep")
 }
 
 fn period_color(period: f64) -> usize {

@@ -3,6 +3,7 @@
 mod args;
 mod cmd_analysis;
 mod cmd_approach;
+mod cmd_chart;
 mod cmd_modes;
 mod cmd_orbits;
 mod cmd_simulate;
@@ -43,6 +44,8 @@ enum Command {
     Bifurcation(cmd_analysis::BifurcationArgs),
     /// Coexisting attractors and basin fractions at fixed parameters (paper Figs. 6–17)
     Attractors(cmd_analysis::AttractorsArgs),
+    /// Behaviour chart over two parameters: period, λ₁, X_max and basin fractions per cell
+    Chart(cmd_chart::ChartArgs),
     /// Find a period-n orbit by Newton shooting; Floquet multipliers and stability
     Orbit(cmd_orbits::OrbitArgs),
     /// Pseudo-arclength continuation of a period-n branch; folds, period doublings, grazing
@@ -63,6 +66,7 @@ fn run(cli: Cli) -> Result<(), CliError> {
         Command::Converge(a) => cmd_simulate::converge(&a),
         Command::Bifurcation(a) => cmd_analysis::bifurcation(&a),
         Command::Attractors(a) => cmd_analysis::attractors(&a),
+        Command::Chart(a) => cmd_chart::chart(&a),
         Command::Orbit(a) => cmd_orbits::orbit(&a),
         Command::Continue(a) => cmd_orbits::continuation(&a),
         Command::Lyapunov(a) => cmd_orbits::lyapunov(&a),

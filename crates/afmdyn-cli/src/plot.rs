@@ -169,6 +169,22 @@ fn layout<DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
+    let entries: Vec<(String, RGBColor, bool)> = legend
+        .iter()
+        .map(|(l, c, m)| (l.clone(), color(*c), *m))
+        .collect();
+    layout_rgb(root, title, &entries)
+}
+
+/// [`layout`] with the legend's colours given (marker: a dot; else a swatch).
+fn layout_rgb<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    title: &str,
+    legend: &[(String, RGBColor, bool)],
+) -> Result<DrawingArea<DB, Shift>, String>
+where
+    DB::ErrorType: 'static,
+{
     root.fill(&WHITE).map_err(|e| e.to_string())?;
     let body = root
         .titled(title, ("sans-serif", 22))
@@ -180,15 +196,14 @@ where
     let (plot, panel) = body.split_horizontally(w.saturating_sub(215));
     let font = ("sans-serif", 14).into_font().color(&BLACK);
     let mut y = 40;
-    for (label, c, marker) in legend {
-        let col = color(*c);
+    for (label, col, marker) in legend {
         if *marker {
             panel
                 .draw(&Circle::new((20, y), 4, col.filled()))
                 .map_err(|e| e.to_string())?;
         } else {
             panel
-                .draw(&Rectangle::new([(10, y - 2), (30, y + 2)], col.filled()))
+                .draw(&Rectangle::new([(10, y - 6), (30, y + 6)], col.filled()))
                 .map_err(|e| e.to_string())?;
         }
         for line in wrap(label) {
@@ -696,6 +711,83 @@ pub fn save_scatter_stream(
         failure: std::cell::RefCell::new(None),
     };
     write_both(dir, stem, (1200, 750), &s).map_err(|e| s.failure.take().unwrap_or(e))
+}
+
+/// A map over a grid of cells (a behaviour chart): cell (ix, iy) is a rectangle centred on
+/// (x[ix], y[iy]) reaching halfway to its neighbours, filled with its colour (`None`: left
+/// white); the legend (colours given) sits right of the data.
+pub struct CellMap<'a> {
+    /// Title.
+    pub title: &'a str,
+    /// Axis labels.
+    pub labels: (&'a str, &'a str),
+    /// x values (columns).
+    pub x: &'a [f64],
+    /// y values (rows).
+    pub y: &'a [f64],
+    /// Colour of each cell, row-major (y slowest).
+    pub cells: &'a [Option<RGBColor>],
+    /// Legend: label, colour.
+    pub legend: &'a [(String, RGBColor)],
+}
+
+/// The edges of the cells of an axis: midpoints between values, half a spacing beyond the
+/// ends (a single value gets ±0.5 of its magnitude's order, at least ±0.5).
+fn cell_edges(v: &[f64]) -> Vec<f64> {
+    let n = v.len();
+    if n == 1 {
+        let h = if v[0] != 0.0 { 0.05 * v[0].abs() } else { 0.5 };
+        return vec![v[0] - h, v[0] + h];
+    }
+    let mut e = Vec::with_capacity(n + 1);
+    e.push(v[0] - (v[1] - v[0]) / 2.0);
+    for w in v.windows(2) {
+        e.push((w[0] + w[1]) / 2.0);
+    }
+    e.push(v[n - 1] + (v[n - 1] - v[n - 2]) / 2.0);
+    e
+}
+
+impl Painter for CellMap<'_> {
+    fn paint<DB: DrawingBackend>(
+        &self,
+        root: DrawingArea<DB, Shift>,
+        _bitmap: bool,
+    ) -> Result<(), String>
+    where
+        DB::ErrorType: 'static,
+    {
+        let entries: Vec<(String, RGBColor, bool)> = self
+            .legend
+            .iter()
+            .map(|(l, c)| (l.clone(), *c, false))
+            .collect();
+        let area = layout_rgb(root, self.title, &entries)?;
+        let (ex, ey) = (cell_edges(self.x), cell_edges(self.y));
+        let lo_hi = |e: &[f64]| {
+            let (a, b) = (e[0], e[e.len() - 1]);
+            (a.min(b), a.max(b))
+        };
+        let ((x0, x1), (y0, y1)) = (lo_hi(&ex), lo_hi(&ey));
+        let mut chart = chart(&area, (x0, x1, y0, y1), self.labels)?;
+        let nx = self.x.len();
+        let rects = self.cells.iter().enumerate().filter_map(|(i, c)| {
+            let (ix, iy) = (i % nx, i / nx);
+            let c = (*c)?;
+            Some(Rectangle::new(
+                [(ex[ix], ey[iy]), (ex[ix + 1], ey[iy + 1])],
+                c.filled(),
+            ))
+        });
+        chart.draw_series(rects).map_err(|x| x.to_string())?;
+        area.present().map_err(|x| x.to_string())?;
+        Ok(())
+    }
+}
+
+/// Write `stem.png` and `stem.svg` of a cell map in `dir`, each atomically.
+pub fn save_map(dir: &Path, stem: &str, map: &CellMap<'_>) -> Result<(), CliError> {
+    write_both(dir, stem, (1100, 700), map)
 }
 
 #[cfg(test)]

@@ -13,7 +13,7 @@ use nalgebra::DVector;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 #[cfg(feature = "parallel")]
-use rayon::prelude::*;
+use rayon::{join, prelude::*};
 use std::collections::{HashMap, HashSet};
 use std::fmt;
 use std::str::FromStr;
@@ -41,6 +41,23 @@ pub fn random_state(model: &CantileverModel, seed: u64, index: u64) -> DVector<f
         z[n + j] = rng.random_range(-RANDOM_AMPLITUDE..RANDOM_AMPLITUDE) * b1;
     }
     z
+}
+
+/// A reproducible random initial state of random start `start` at the swept value `value`:
+/// the stream is keyed by the sweep's seed, the value's bits and the start number, so the same
+/// parameter point gets the same starts in any sweep that contains it, whatever its range,
+/// order of execution or thread count.
+pub fn start_state(model: &CantileverModel, seed: u64, value: f64, start: u32) -> DVector<f64> {
+    random_state(model, seed, mix64(value.to_bits()) ^ u64::from(start))
+}
+
+/// The splitmix64 finaliser (Steele, Lea & Flood, OOPSLA 2014): a bijection of u64 whose
+/// outputs differ in about half their bits for inputs one bit apart.
+pub(crate) fn mix64(x: u64) -> u64 {
+    let mut z = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
 }
 
 /// How a sweep point was reached.
@@ -177,8 +194,9 @@ pub struct SweepPoint {
 pub struct Resume {
     /// (index, branch) pairs already written.
     pub done: HashSet<(usize, Branch)>,
-    /// For each continuation branch, the last finished index and its end state.
-    pub chain: HashMap<Branch, (usize, DVector<f64>)>,
+    /// The end state of every written continuation point that did not fail, by (index,
+    /// branch): where its chain segment goes on.
+    pub chain: HashMap<(usize, Branch), DVector<f64>>,
 }
 
 fn solve_point(spec: &SweepSpec, value: f64, z0: &DVector<f64>) -> Result<SteadyState, SimError> {
@@ -188,65 +206,200 @@ fn solve_point(spec: &SweepSpec, value: f64, z0: &DVector<f64>) -> Result<Steady
     steady_state(integ.as_mut(), &spec.steady)
 }
 
-enum Task {
-    Chain(Branch),
+/// One task of a planned sweep ([`SweepPlan`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum SweepTask {
+    /// Stage 0: the coarse continuation of a branch over the first value of each of its
+    /// chunks, whose end states seed the chunks.
+    Coarse(Branch),
+    /// Stage 1: the continuation of a branch over chunk k of its values, from the coarse
+    /// pass's state at the chunk's first value (chunk 0: from rest).
+    Segment(Branch, usize),
+    /// Stage 1: random start s at value index i.
     Start(usize, u32),
 }
 
-/// Run the sweep; `sink` receives each point as soon as it is finished (from worker threads).
-/// Points listed in `resume.done` are skipped; continuation chains restart from their saved
-/// state.
-pub fn run_sweep(spec: &SweepSpec, resume: &Resume, sink: &(dyn Fn(SweepPoint) + Sync)) {
-    run_sweep_cancellable(spec, resume, sink, &AtomicBool::new(false));
+/// The seeds of the chain segments: for each branch, the initial state of each chunk (the
+/// coarse pass's end state at the chunk's first value; rest for chunk 0 and where the coarse
+/// point failed and no earlier one succeeded).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Seeds {
+    forward: Vec<DVector<f64>>,
+    backward: Vec<DVector<f64>>,
 }
 
-/// [`run_sweep`] that stops early once `cancel` is set: no new point is started (points
-/// already running finish and reach `sink`), so a front end can interrupt a long sweep.
-pub fn run_sweep_cancellable(
-    spec: &SweepSpec,
-    resume: &Resume,
-    sink: &(dyn Fn(SweepPoint) + Sync),
-    cancel: &AtomicBool,
-) {
-    // tasks by index (chains first, then the starts value by value), never all in memory
-    let chains = if spec.continuation { 2 } else { 0 };
-    let starts = spec.starts as usize;
-    let total = chains + spec.values.len() * starts;
-    let task = |k: usize| {
-        if k < chains {
-            Task::Chain(if k == 0 {
-                Branch::Forward
-            } else {
-                Branch::Backward
-            })
-        } else {
-            let j = k - chains;
-            Task::Start(j / starts, (j % starts) as u32)
+impl Seeds {
+    fn of(&self, branch: Branch) -> &[DVector<f64>] {
+        match branch {
+            Branch::Backward => &self.backward,
+            _ => &self.forward,
         }
-    };
-    let dim = 2 * spec.base.modes;
-    (0..total)
-        .into_par_iter()
-        .with_max_len(1)
-        .map(task)
-        .filter(
-            |t| !matches!(*t, Task::Start(i, s) if resume.done.contains(&(i, Branch::Start(s)))),
-        )
-        .for_each(|task| match task {
-            Task::Chain(branch) => {
-                let order: Vec<usize> = match branch {
-                    Branch::Backward => (0..spec.values.len()).rev().collect(),
-                    _ => (0..spec.values.len()).collect(),
-                };
-                let mut z = DVector::zeros(dim);
-                if let Some((_, saved)) = resume.chain.get(&branch) {
-                    z = saved.clone();
+    }
+}
+
+/// A sweep planned as independent tasks (issue 29): the forward and backward continuation
+/// chains are cut into chunks of consecutive values, each chunk a task seeded by a coarse
+/// continuation over the chunks' first values (stage 0, two short sequential tasks); every
+/// random start is a task. Each task is a pure function of the spec, the task and the seeds,
+/// so every executor and any thread count gives the same points bit for bit.
+///
+/// A chunk's first point starts from the coarse pass's steady state at that value, not from
+/// the fine chain's state at the value before: the two agree wherever the branch the chain
+/// follows still exists one chunk length further on (the coarse step is `chunk` values), and
+/// may differ within a chunk length of a fold, where a fine chain would hold on to the
+/// vanishing branch a little longer.
+///
+/// Chunks per branch: ⌈√n⌉ for n values (20 of 20 values at the default 400: 40 chain tasks
+/// plus the random starts), so the sequential coarse pass is √n points against the 2n of the
+/// chains: an Amdahl bound of 2n/(√n + 2n/T) on T threads (≈ 28× on 64 threads at n = 400).
+#[derive(Debug, Clone, Copy)]
+pub struct SweepPlan<'a> {
+    spec: &'a SweepSpec,
+    chunk: usize,
+    chunks: usize,
+}
+
+impl<'a> SweepPlan<'a> {
+    /// The plan of `spec`.
+    pub fn new(spec: &'a SweepSpec) -> SweepPlan<'a> {
+        let n = spec.values.len().max(1);
+        let chunks = ((n as f64).sqrt().ceil() as usize).clamp(1, n);
+        let chunk = n.div_ceil(chunks);
+        SweepPlan {
+            spec,
+            chunk,
+            chunks: n.div_ceil(chunk),
+        }
+    }
+
+    /// Values per chunk.
+    pub fn chunk_len(&self) -> usize {
+        self.chunk
+    }
+
+    /// Chunks per continuation branch (0 without continuation).
+    pub fn chunks(&self) -> usize {
+        if self.spec.continuation && !self.spec.values.is_empty() {
+            self.chunks
+        } else {
+            0
+        }
+    }
+
+    /// The tasks of `stage` (0: the coarse passes; 1: the chain segments, then the random
+    /// starts value by value); no tasks beyond stage 1.
+    pub fn tasks(&self, stage: usize) -> Vec<SweepTask> {
+        let branches = [Branch::Forward, Branch::Backward];
+        match stage {
+            0 if self.chunks() > 1 => branches.map(SweepTask::Coarse).to_vec(),
+            1 => {
+                let segments = branches
+                    .iter()
+                    .flat_map(|&b| (0..self.chunks()).map(move |k| SweepTask::Segment(b, k)));
+                let starts = (0..self.spec.values.len())
+                    .flat_map(|i| (0..self.spec.starts).map(move |s| SweepTask::Start(i, s)));
+                segments.chain(starts).collect()
+            }
+            _ => Vec::new(),
+        }
+    }
+
+    /// The number of tasks of every stage.
+    pub fn task_count(&self) -> usize {
+        self.tasks(0).len() + self.chunks() * 2 + self.spec.values.len() * self.spec.starts as usize
+    }
+
+    /// The value indices of `branch` in its order of continuation (increasing forward,
+    /// decreasing backward), chunk `k` of them.
+    pub fn chunk_indices(&self, branch: Branch, k: usize) -> Vec<usize> {
+        let n = self.spec.values.len();
+        let lo = (k * self.chunk).min(n);
+        let hi = ((k + 1) * self.chunk).min(n);
+        match branch {
+            Branch::Backward => (lo..hi).map(|j| n - 1 - j).collect(),
+            _ => (lo..hi).collect(),
+        }
+    }
+
+    /// The coarse pass of `branch` (stage 0): continuation over the first value of each chunk
+    /// from rest; returns the seed of every chunk. Stops early (with rest for the chunks not
+    /// reached) once `cancel` is set.
+    pub fn coarse(&self, branch: Branch, cancel: &AtomicBool) -> Vec<DVector<f64>> {
+        let dim = 2 * self.spec.base.modes;
+        let mut z = DVector::zeros(dim);
+        let mut seeds = vec![DVector::zeros(dim); self.chunks()];
+        for (k, seed) in seeds.iter_mut().enumerate() {
+            if cancel.load(Ordering::Relaxed) {
+                break;
+            }
+            let Some(&i) = self.chunk_indices(branch, k).first() else {
+                break;
+            };
+            if k > 0 {
+                if let Ok(s) = solve_point(self.spec, self.spec.values[i], &z) {
+                    z = s.end_state().clone();
                 }
-                for i in order {
+            }
+            *seed = z.clone();
+        }
+        seeds
+    }
+
+    /// The seeds of every chunk (both coarse passes, in parallel), computed only where a
+    /// chunk after the first still needs its seed (a resumed sweep whose chunks have all
+    /// started needs none).
+    pub fn seeds(&self, resume: &Resume, cancel: &AtomicBool) -> Seeds {
+        let needs = |b: Branch| {
+            (1..self.chunks()).any(|k| {
+                self.chunk_indices(b, k)
+                    .iter()
+                    .all(|&i| !resume.chain.contains_key(&(i, b)))
+                    && self
+                        .chunk_indices(b, k)
+                        .iter()
+                        .any(|&i| !resume.done.contains(&(i, b)))
+            })
+        };
+        let dim = 2 * self.spec.base.modes;
+        let pass = |b: Branch| {
+            if needs(b) {
+                self.coarse(b, cancel)
+            } else {
+                vec![DVector::zeros(dim); self.chunks()]
+            }
+        };
+        let (forward, backward) = join(|| pass(Branch::Forward), || pass(Branch::Backward));
+        Seeds { forward, backward }
+    }
+
+    /// Run one stage-1 task: each of its points not in `resume` goes to `sink` as soon as it
+    /// is finished. A chain segment goes on from the stored state of its done points. A
+    /// coarse task does nothing here (see [`SweepPlan::coarse`]).
+    pub fn run_task(
+        &self,
+        task: SweepTask,
+        seeds: &Seeds,
+        resume: &Resume,
+        sink: &(dyn Fn(SweepPoint) + Sync),
+        cancel: &AtomicBool,
+    ) {
+        let spec = self.spec;
+        match task {
+            SweepTask::Coarse(_) => {}
+            SweepTask::Segment(branch, k) => {
+                let mut z = seeds
+                    .of(branch)
+                    .get(k)
+                    .cloned()
+                    .unwrap_or_else(|| DVector::zeros(2 * spec.base.modes));
+                for i in self.chunk_indices(branch, k) {
                     if cancel.load(Ordering::Relaxed) {
                         return;
                     }
                     if resume.done.contains(&(i, branch)) {
+                        if let Some(saved) = resume.chain.get(&(i, branch)) {
+                            z = saved.clone();
+                        }
                         continue;
                     }
                     let value = spec.values[i];
@@ -262,8 +415,8 @@ pub fn run_sweep_cancellable(
                     });
                 }
             }
-            Task::Start(i, s) => {
-                if cancel.load(Ordering::Relaxed) {
+            SweepTask::Start(i, s) => {
+                if cancel.load(Ordering::Relaxed) || resume.done.contains(&(i, Branch::Start(s))) {
                     return;
                 }
                 let value = spec.values[i];
@@ -271,7 +424,7 @@ pub fn run_sweep_cancellable(
                 let result = CantileverModel::new(&p)
                     .map_err(SimError::from)
                     .and_then(|m| {
-                        let z0 = random_state(&m, spec.seed, (i as u64) << 20 | s as u64);
+                        let z0 = start_state(&m, spec.seed, value, s);
                         solve_point(spec, value, &z0)
                     })
                     .map_err(|e| e.to_string());
@@ -282,5 +435,32 @@ pub fn run_sweep_cancellable(
                     result,
                 });
             }
-        });
+        }
+    }
+}
+
+/// Run the sweep; `sink` receives each point as soon as it is finished (from worker threads).
+/// Points listed in `resume.done` are skipped; continuation chains restart from their saved
+/// state.
+pub fn run_sweep(spec: &SweepSpec, resume: &Resume, sink: &(dyn Fn(SweepPoint) + Sync)) {
+    run_sweep_cancellable(spec, resume, sink, &AtomicBool::new(false));
+}
+
+/// [`run_sweep`] that stops early once `cancel` is set: no new point is started (points
+/// already running finish and reach `sink`), so a front end can interrupt a long sweep.
+///
+/// The local executor of a [`SweepPlan`]: the coarse passes, then every stage-1 task on the
+/// current rayon pool (one task per work item, no shared lock: points go straight to `sink`).
+pub fn run_sweep_cancellable(
+    spec: &SweepSpec,
+    resume: &Resume,
+    sink: &(dyn Fn(SweepPoint) + Sync),
+    cancel: &AtomicBool,
+) {
+    let plan = SweepPlan::new(spec);
+    let seeds = plan.seeds(resume, cancel);
+    plan.tasks(1)
+        .into_par_iter()
+        .with_max_len(1)
+        .for_each(|task| plan.run_task(task, &seeds, resume, sink, cancel));
 }

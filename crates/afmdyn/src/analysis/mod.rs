@@ -8,6 +8,7 @@
 pub mod approach;
 pub mod attractors;
 pub mod bifurcation;
+pub mod chart;
 pub mod continuation;
 pub mod converge;
 pub mod lyapunov;
@@ -51,4 +52,13 @@ mod sequential {
         }
     }
     impl<I: Iterator> IndexedParallelIterator for I {}
+
+    /// `join` runs `a`, then `b`.
+    pub(crate) fn join<A, B, RA, RB>(a: A, b: B) -> (RA, RB)
+    where
+        A: FnOnce() -> RA,
+        B: FnOnce() -> RB,
+    {
+        (a(), b())
+    }
 }

@@ -133,15 +133,15 @@ pub trait Checkpoint: Send {
     }
 }
 
-/// What is done from the stored points: their keys, and for each continuation branch the last
-/// stored point that did not fail and its end state.
+/// What is done from the stored points: their keys, and the end state of every stored
+/// continuation point that did not fail (where its chain segment goes on).
 pub fn resume_of(done: Vec<DonePoint>) -> Resume {
     let mut resume = Resume::default();
     for d in done {
         resume.done.insert((d.index, d.branch));
         if let Some(z) = d.state {
             if matches!(d.branch, Branch::Forward | Branch::Backward) {
-                resume.chain.insert(d.branch, (d.index, z));
+                resume.chain.insert((d.index, d.branch), z);
             }
         }
     }

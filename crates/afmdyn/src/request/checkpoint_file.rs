@@ -48,7 +48,7 @@ fn io<'a>(
 }
 
 /// Write `bytes` to `path` through a temporary file renamed into place (`.NAME.partial.EXT`).
-fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), CheckpointError> {
+pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), CheckpointError> {
     let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("out");
     let tmp = path.with_file_name(match path.extension().and_then(|s| s.to_str()) {
         Some(ext) => format!(".{stem}.partial.{ext}"),

@@ -8,6 +8,8 @@
 //! - [`analyses`]: one request per analysis (`simulate`, `converge`, `bifurcation`,
 //!   `attractors`, `orbit`, `continuation`, `lyapunov`, `observe`) with `validate`, and `run`
 //!   where the analysis is one library call.
+//! - [`chart`](mod@chart): the two-parameter behaviour chart ([`ChartRequest`]), its limits,
+//!   fingerprint and result layout; [`chart_store`] its resumable directory (feature `files`).
 //! - [`curves`]: the stepped curves (`approach`, `resonance`).
 //! - [`run`](mod@run): [`run()`]`(analysis, model, progress)` → [`Document`], the typed result and
 //!   its JSON document, for every analysis whose result is one value ([`Analysis`]).
@@ -25,6 +27,9 @@
 //! [`Params`]: crate::Params
 
 pub mod analyses;
+pub mod chart;
+#[cfg(feature = "files")]
+pub mod chart_store;
 pub mod checkpoint;
 #[cfg(feature = "files")]
 pub mod checkpoint_file;
@@ -41,6 +46,7 @@ pub use analyses::{
     LyapunovRequest, ObserveRequest, OrbitRequest, SeriesStore, SimulateRequest, StartRequest,
     SteadyRequest,
 };
+pub use chart::{Chart, ChartArrays, ChartModel, ChartRequest};
 pub use checkpoint::{Checkpoint, CheckpointError, MemoryCheckpoint};
 #[cfg(feature = "files")]
 pub use checkpoint_file::FileCheckpoint;

@@ -1,0 +1,474 @@
+//! `afmdyn chart`: a behaviour chart over two parameters (issue 29). The request, its limits,
+//! its tasks, its store and its result layout are the library's
+//! ([`afmdyn::request::chart`], [`afmdyn::analysis::chart`],
+//! [`afmdyn::request::chart_store`]); this front end parses, runs the local executor with a
+//! progress bar, and writes `chart.csv`, `chart.nc` and the maps.
+
+use crate::args::{IntegratorArgs, ModelArgs};
+use crate::cmd_analysis::SteadyArgs;
+use crate::error::CliError;
+use crate::output::{atomic, write_bytes, OutDir};
+use crate::plot::{color, save_map, CellMap};
+use afmdyn::analysis::chart::{run_chart, ChartCell, ChartPlan};
+use afmdyn::request::chart::{axis_unit, csv_lines, document, ChartArrays, CSV_HEADER};
+use afmdyn::request::chart_store::ChartStore;
+use afmdyn::request::checkpoint::CheckpointError;
+use afmdyn::request::{parameter, ChartRequest};
+use afmdyn::Params;
+use clap::Args;
+use indicatif::{ProgressBar, ProgressStyle};
+use plotters::style::RGBColor;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::Mutex;
+
+/// `afmdyn chart` flags.
+#[derive(Debug, Args)]
+pub struct ChartArgs {
+    #[command(flatten)]
+    model: ModelArgs,
+    #[command(flatten)]
+    integrator: IntegratorArgs,
+    #[command(flatten)]
+    steady: SteadyArgs,
+    /// x parameter (columns): omega, alpha1..alpha6 or their names (drive-amplitude, gap, …),
+    /// restitution, hamaker, intermolecular-distance; with --probe also z-c (m) and
+    /// drive-frequency (Hz)
+    #[arg(long, default_value = "omega")]
+    x: String,
+    /// First x value
+    #[arg(long, default_value_t = 2.6, allow_negative_numbers = true)]
+    x_from: f64,
+    /// Last x value
+    #[arg(long, default_value_t = 3.0, allow_negative_numbers = true)]
+    x_to: f64,
+    /// Number of x values
+    #[arg(long, default_value_t = 9)]
+    x_steps: usize,
+    /// y parameter (rows), as --x
+    #[arg(long, default_value = "drive-amplitude")]
+    y: String,
+    /// First y value
+    #[arg(long, default_value_t = 0.1, allow_negative_numbers = true)]
+    y_from: f64,
+    /// Last y value
+    #[arg(long, default_value_t = 0.12, allow_negative_numbers = true)]
+    y_to: f64,
+    /// Number of y values
+    #[arg(long, default_value_t = 2)]
+    y_steps: usize,
+    /// Random initial states per cell (besides continuation from the neighbouring cells)
+    #[arg(long, default_value_t = 4)]
+    starts: u32,
+    /// Seed of the random initial states
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Cells per task: continuation runs along x within a tile of this many cells
+    #[arg(long, default_value_t = 8)]
+    tile: usize,
+    /// Drive periods of the λ₁ estimate of each nonperiodic attractor (0: none)
+    #[arg(long, default_value_t = 500)]
+    lyapunov_periods: usize,
+    /// Relative tolerance for two steady states to be one attractor
+    #[arg(long, default_value_t = 1e-5)]
+    cluster_tol: f64,
+    /// Worker threads (default: all cores)
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Continue an interrupted chart; refused unless the other arguments are those of the
+    /// interrupted run (recorded in OUT/.chart.run.json)
+    #[arg(long)]
+    resume: bool,
+    /// Output directory (locked during the run)
+    #[arg(long, default_value = "afmdyn-out")]
+    out: PathBuf,
+    /// Testing: abort the process, as if killed, after this many tasks are stored
+    #[arg(long, hide = true)]
+    abort_after: Option<usize>,
+    /// Print the chart as one JSON document
+    #[arg(long)]
+    json: bool,
+}
+
+fn store_error(e: CheckpointError) -> CliError {
+    crate::cmd_analysis::store_error(e, "chart")
+}
+
+/// The label of an axis: symbol, name and unit.
+fn axis_label(name: &str) -> String {
+    let symbol = parameter(name).map_or(name, |p| p.symbol);
+    let head = if symbol == name {
+        name.to_string()
+    } else {
+        format!("{symbol} {name}")
+    };
+    match axis_unit(name) {
+        "1" => head,
+        unit => format!("{head} ({unit})"),
+    }
+}
+
+/// Colour and legend label of a period class (the bifurcation diagram's classes).
+fn period_class(period: i32) -> (usize, &'static str) {
+    match period {
+        1 => (0, "period 1"),
+        2 => (1, "period 2"),
+        3 => (2, "period 3"),
+        4 => (3, "period 4"),
+        5..=8 => (4, "period 5–8"),
+        9..=64 => (5, "period 9–64"),
+        -1 => (6, "nonperiodic"),
+        _ => (7, "no attractor (failed)"),
+    }
+}
+
+/// A diverging colour for λ₁ in [−m, m]: blue (negative) through white to red (positive).
+fn diverging(v: f64, m: f64) -> RGBColor {
+    let t = (v / m).clamp(-1.0, 1.0);
+    let mix = |a: u8, b: u8, s: f64| (f64::from(a) + (f64::from(b) - f64::from(a)) * s) as u8;
+    if t < 0.0 {
+        let s = -t;
+        RGBColor(mix(255, 33, s), mix(255, 102, s), mix(255, 172, s))
+    } else {
+        RGBColor(mix(255, 178, t), mix(255, 24, t), mix(255, 43, t))
+    }
+}
+
+fn write_nc(path: &Path, a: &ChartArrays, x: &str, y: &str) -> Result<(), CliError> {
+    use netcdf3::{DataSet, FileWriter, Version};
+    let e = |m: String| CliError::Io(format!("cannot write {}: {m}", path.display()));
+    let d = |r: Result<(), netcdf3::error::InvalidDataSet>| r.map_err(|x| e(format!("{x:?}")));
+    let mut ds = DataSet::new();
+    let (nx, ny, ns) = (a.x.len(), a.y.len(), a.slots);
+    d(ds.add_fixed_dim("x", nx))?;
+    d(ds.add_fixed_dim("y", ny))?;
+    d(ds.add_fixed_dim("attractor", ns))?;
+    d(ds.add_var_f64("x", &["x"]))?;
+    d(ds.add_var_f64("y", &["y"]))?;
+    for (var, name) in [("x", x), ("y", y)] {
+        d(ds.add_var_attr_string(var, "long_name", name))?;
+        d(ds.add_var_attr_string(var, "units", axis_unit(name)))?;
+    }
+    let cell = ["y", "x"];
+    let slot = ["y", "x", "attractor"];
+    let ints: [(&str, &[&str], &str, &str); 4] = [
+        ("attractors", &cell, "1", "attractors found in the cell"),
+        ("failures", &cell, "1", "runs of the cell that failed"),
+        (
+            "dominant_period",
+            &cell,
+            "drive periods",
+            "period of the attractor most random starts reached; -1 nonperiodic, 0 none",
+        ),
+        (
+            "period",
+            &slot,
+            "drive periods",
+            "period n; -1 nonperiodic; 0 empty slot",
+        ),
+    ];
+    for (name, dims, unit, meaning) in ints {
+        d(ds.add_var_i32(name, dims))?;
+        d(ds.add_var_attr_string(name, "units", unit))?;
+        d(ds.add_var_attr_string(name, "long_name", meaning))?;
+    }
+    let floats: [(&str, &str, &str, &Vec<f64>); 6] = [
+        (
+            "lyapunov",
+            "1/tau",
+            "largest Lyapunov exponent of a nonperiodic attractor",
+            &a.lyapunov,
+        ),
+        (
+            "x_max",
+            "g0",
+            "largest tip deflection W(1,tau) over the steady state",
+            &a.x_max,
+        ),
+        (
+            "v_t_min",
+            "g0",
+            "smallest V_T over the steady state",
+            &a.v_t_min,
+        ),
+        (
+            "contacts_per_period",
+            "1/period",
+            "contact entries (impacts) per drive period",
+            &a.contacts_per_period,
+        ),
+        (
+            "contact_fraction",
+            "1",
+            "fraction of the time in contact",
+            &a.contact_fraction,
+        ),
+        (
+            "fraction",
+            "1",
+            "basin fraction among the random starts",
+            &a.fraction,
+        ),
+    ];
+    for (name, unit, meaning, _) in floats {
+        d(ds.add_var_f64(name, &slot))?;
+        d(ds.add_var_attr_string(name, "units", unit))?;
+        d(ds.add_var_attr_string(name, "long_name", meaning))?;
+    }
+    d(ds.add_global_attr_string("title", format!("afmdyn behaviour chart over {x} and {y}")))?;
+    d(ds.add_global_attr_string("source", format!("afmdyn {}", env!("CARGO_PKG_VERSION"))))?;
+    atomic(path, |tmp| {
+        let w = |x: netcdf3::error::WriteError| e(format!("{x:?}"));
+        let mut f = FileWriter::open(tmp).map_err(w)?;
+        f.set_def(&ds, Version::Offset64Bit, 0).map_err(w)?;
+        f.write_var_f64("x", &a.x).map_err(w)?;
+        f.write_var_f64("y", &a.y).map_err(w)?;
+        f.write_var_i32("attractors", &a.attractors).map_err(w)?;
+        f.write_var_i32("failures", &a.failures).map_err(w)?;
+        f.write_var_i32("dominant_period", &a.dominant_period)
+            .map_err(w)?;
+        f.write_var_i32("period", &a.period).map_err(w)?;
+        for (name, _, _, v) in floats {
+            f.write_var_f64(name, v).map_err(w)?;
+        }
+        f.close().map_err(w)
+    })
+}
+
+fn write_csv(path: &Path, cells: &[ChartCell]) -> Result<(), CliError> {
+    let mut text = CSV_HEADER.join(",");
+    text.push('\n');
+    for c in cells {
+        for line in csv_lines(c) {
+            text.push_str(&line);
+            text.push('\n');
+        }
+    }
+    write_bytes(path, text.as_bytes())
+}
+
+/// Run `afmdyn chart`.
+pub fn chart(a: &ChartArgs) -> Result<(), CliError> {
+    let (spec, probe) = a.model.spec_and_probe()?;
+    let request = ChartRequest {
+        x: a.x.clone(),
+        x_from: a.x_from,
+        x_to: a.x_to,
+        x_steps: a.x_steps,
+        y: a.y.clone(),
+        y_from: a.y_from,
+        y_to: a.y_to,
+        y_steps: a.y_steps,
+        starts: a.starts,
+        seed: a.seed,
+        tile: a.tile,
+        cluster_tol: a.cluster_tol,
+        lyapunov_periods: a.lyapunov_periods,
+        threads: a.threads,
+        steady: a.steady.request(),
+        integrator: a.integrator.request(),
+    };
+    let chart = request
+        .chart(spec, Params::default(), probe.as_ref())
+        .map_err(|e| CliError::Input(crate::error::spell(&e)))?;
+    let out = OutDir::lock(&a.out)?;
+    let mut store = ChartStore::new(out.dir_lock());
+    let done = store
+        .open(&chart.fingerprint, a.resume)
+        .map_err(store_error)?;
+    let plan = ChartPlan::new(&chart.spec, &chart.model);
+    if !(a.resume && store.finished().map_err(store_error)?) {
+        let cells = (chart.spec.x.len() * chart.spec.y.len()) as u64;
+        let bar = ProgressBar::new(cells);
+        bar.set_style(
+            ProgressStyle::with_template("{bar:40} {pos}/{len} cells  {elapsed} / ~{duration}")
+                .expect("template"),
+        );
+        bar.inc(done.iter().map(|&t| plan.tile(t).1.len() as u64).sum());
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(a.threads.unwrap_or(0))
+            .build()
+            .map_err(|e| CliError::Io(format!("cannot start worker threads: {e}")))?;
+        let cancel = AtomicBool::new(false);
+        let stored = AtomicUsize::new(0);
+        let shared = Mutex::new((&mut store, None::<CheckpointError>));
+        let sink = |t: usize, cells: Vec<ChartCell>| {
+            let n = cells.len() as u64;
+            let mut guard = shared.lock().unwrap_or_else(|e| e.into_inner());
+            let (s, failed) = &mut *guard;
+            if failed.is_none() {
+                if let Err(e) = s.append(t, cells) {
+                    *failed = Some(e);
+                    cancel.store(true, Ordering::Relaxed);
+                }
+            }
+            drop(guard);
+            bar.inc(n);
+            let k = stored.fetch_add(1, Ordering::SeqCst) + 1;
+            if a.abort_after == Some(k) {
+                std::process::abort();
+            }
+        };
+        pool.install(|| run_chart(&plan, &done, &sink, &cancel));
+        bar.finish_and_clear();
+        let (_, failed) = shared.into_inner().unwrap_or_else(|e| e.into_inner());
+        if let Some(e) = failed {
+            return Err(store_error(e));
+        }
+        store.finish(&chart.fingerprint).map_err(store_error)?;
+    }
+    let cells = store.cells();
+    let arrays = ChartArrays::new(&chart.spec.x, &chart.spec.y, &cells);
+    write_csv(&out.join("chart.csv"), &cells)?;
+    write_nc(&out.join("chart.nc"), &arrays, chart.model.x, chart.model.y)?;
+    draw_maps(out.path(), &chart, &arrays)?;
+    let failures: u64 = cells.iter().map(|c| u64::from(c.failures)).sum();
+    let empty = cells.iter().filter(|c| c.attractors.is_empty()).count();
+    if empty == cells.len() {
+        let first = cells
+            .iter()
+            .find_map(|c| c.message.clone())
+            .unwrap_or_default();
+        return Err(CliError::Sim(afmdyn::SimError::EveryRunFailed {
+            what: "chart cells",
+            runs: cells.len(),
+            first,
+        }));
+    }
+    if failures > 0 {
+        eprintln!(
+            "afmdyn: warning: {failures} runs failed in {} of {} cells{}",
+            cells.iter().filter(|c| c.failures > 0).count(),
+            cells.len(),
+            cells
+                .iter()
+                .find_map(|c| c.message.as_ref())
+                .map_or(String::new(), |m| format!("; the first: {m}"))
+        );
+    }
+    if a.json {
+        let mut doc = document(&chart, &cells);
+        doc["files"] = serde_json::json!({
+            "csv": out.join("chart.csv"),
+            "netcdf": out.join("chart.nc"),
+        });
+        println!("{doc}");
+    } else {
+        let multi = cells.iter().filter(|c| c.attractors.len() > 1).count();
+        println!(
+            "chart of {} × {} cells over {} × {}: {} with coexisting attractors, {} without any; \
+             outputs in {}",
+            chart.spec.x.len(),
+            chart.spec.y.len(),
+            chart.model.x,
+            chart.model.y,
+            multi,
+            empty,
+            out.path().display()
+        );
+    }
+    Ok(())
+}
+
+fn draw_maps(dir: &Path, chart: &afmdyn::request::Chart, a: &ChartArrays) -> Result<(), CliError> {
+    let (xl, yl) = (axis_label(chart.model.x), axis_label(chart.model.y));
+    let labels = (xl.as_str(), yl.as_str());
+    // period of the dominant attractor
+    let mut classes: Vec<(usize, &str)> = Vec::new();
+    let cells: Vec<Option<RGBColor>> = a
+        .dominant_period
+        .iter()
+        .map(|&p| {
+            let (c, label) = period_class(if p == 0 { -2 } else { p });
+            if !classes.contains(&(c, label)) {
+                classes.push((c, label));
+            }
+            Some(color(c))
+        })
+        .collect();
+    classes.sort();
+    let legend: Vec<(String, RGBColor)> = classes
+        .iter()
+        .map(|(c, l)| (l.to_string(), color(*c)))
+        .collect();
+    save_map(
+        dir,
+        "chart-period",
+        &CellMap {
+            title: "Period of the attractor most starts reach",
+            labels,
+            x: &a.x,
+            y: &a.y,
+            cells: &cells,
+            legend: &legend,
+        },
+    )?;
+    // λ₁ of the dominant attractor, where it is nonperiodic
+    let lyap: Vec<f64> = (0..a.dominant_period.len())
+        .map(|i| a.lyapunov[i * a.slots])
+        .collect();
+    let m = lyap
+        .iter()
+        .filter(|v| v.is_finite())
+        .fold(0.0f64, |m, v| m.max(v.abs()));
+    let m = if m > 0.0 { m } else { 1e-3 };
+    let grey = RGBColor(200, 200, 200);
+    let cells: Vec<Option<RGBColor>> = lyap
+        .iter()
+        .zip(&a.dominant_period)
+        .map(|(&v, &p)| {
+            if v.is_finite() {
+                Some(diverging(v, m))
+            } else if p > 0 {
+                Some(grey)
+            } else {
+                None
+            }
+        })
+        .collect();
+    let legend: Vec<(String, RGBColor)> = [-1.0, -0.5, 0.0, 0.5, 1.0]
+        .iter()
+        .map(|&t| (format!("λ₁ = {:.3e} /τ", t * m), diverging(t * m, m)))
+        .chain(std::iter::once(("periodic".to_string(), grey)))
+        .collect();
+    save_map(
+        dir,
+        "chart-lyapunov",
+        &CellMap {
+            title: "Largest Lyapunov exponent λ₁ of the nonperiodic attractors",
+            labels,
+            x: &a.x,
+            y: &a.y,
+            cells: &cells,
+            legend: &legend,
+        },
+    )?;
+    // coexisting attractors
+    let most = a.attractors.iter().copied().max().unwrap_or(0).max(1);
+    let cells: Vec<Option<RGBColor>> = a
+        .attractors
+        .iter()
+        .map(|&n| (n > 0).then(|| color((n as usize - 1) % 10)))
+        .collect();
+    let legend: Vec<(String, RGBColor)> = (1..=most.min(10))
+        .map(|n| {
+            (
+                format!("{n} attractor{}", if n == 1 { "" } else { "s" }),
+                color((n as usize - 1) % 10),
+            )
+        })
+        .collect();
+    save_map(
+        dir,
+        "chart-attractors",
+        &CellMap {
+            title: "Coexisting attractors per cell",
+            labels,
+            x: &a.x,
+            y: &a.y,
+            cells: &cells,
+            legend: &legend,
+        },
+    )?;
+    Ok(())
+}

@@ -1,0 +1,164 @@
+//! `afmdyn chart` end to end: the JSON contract, the files (CSV, NetCDF, maps), resuming a
+//! killed chart, refusing another request's store and a locked directory, bad axes.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn afmdyn(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_afmdyn"))
+        .args(args)
+        .output()
+        .expect("run afmdyn")
+}
+
+const SMALL: [&str; 12] = [
+    "chart",
+    "--x-steps",
+    "4",
+    "--y-steps",
+    "2",
+    "--starts",
+    "2",
+    "--tile",
+    "2",
+    "--lyapunov-periods",
+    "50",
+    "--json",
+];
+
+fn small(out: &Path, extra: &[&str]) -> Output {
+    let mut a: Vec<&str> = SMALL.to_vec();
+    a.extend(["--out", out.to_str().unwrap()]);
+    a.extend(extra);
+    afmdyn(&a)
+}
+
+#[test]
+fn chart_json_lists_every_cell_and_its_attractors() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = small(dir.path(), &[]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(doc["x"]["name"], "omega");
+    assert_eq!(doc["y"]["name"], "drive_amplitude");
+    assert_eq!(doc["x"]["values"].as_array().unwrap().len(), 4);
+    assert_eq!(doc["y"]["values"][1], 0.12);
+    let cells = doc["cells"].as_array().unwrap();
+    assert_eq!(cells.len(), 8);
+    for (k, c) in cells.iter().enumerate() {
+        assert_eq!(c["ix"], k % 4);
+        assert_eq!(c["iy"], k / 4);
+        let at = c["attractors"].as_array().unwrap();
+        assert!(!at.is_empty(), "{c}");
+        for a in at {
+            for key in [
+                "period",
+                "lyapunov",
+                "x_max",
+                "contacts_per_period",
+                "fraction",
+            ] {
+                assert!(a.get(key).is_some(), "{key} in {a}");
+            }
+            // λ₁ exactly for the nonperiodic ones
+            assert_eq!(a["period"].is_null(), !a["lyapunov"].is_null(), "{a}");
+        }
+    }
+    for f in [
+        "chart.csv",
+        "chart.nc",
+        "chart-period.png",
+        "chart-lyapunov.svg",
+    ] {
+        assert!(dir.path().join(f).metadata().unwrap().len() > 0, "{f}");
+    }
+    // NetCDF: the classic format's magic, version 2 (64-bit offsets)
+    let nc = std::fs::read(dir.path().join("chart.nc")).unwrap();
+    assert_eq!(&nc[..4], b"CDF\x02");
+}
+
+#[test]
+fn a_killed_chart_resumes_to_the_uninterrupted_files() {
+    let full = tempfile::tempdir().unwrap();
+    let cut = tempfile::tempdir().unwrap();
+    assert!(small(full.path(), &[]).status.success());
+    let killed = small(cut.path(), &["--threads", "1", "--abort-after", "2"]);
+    assert!(!killed.status.success(), "the run was killed");
+    let tiles = cut.path().join(".chart.tiles.jsonl");
+    let text = std::fs::read_to_string(&tiles).unwrap();
+    assert_eq!(text.lines().count(), 2, "two tasks stored");
+    // a line cut as a kill during a write would leave it
+    std::fs::write(&tiles, text + "{\"task\": 3, \"cells\": [{\"ix\"").unwrap();
+    let resumed = small(cut.path(), &["--resume"]);
+    assert!(
+        resumed.status.success(),
+        "{}",
+        String::from_utf8_lossy(&resumed.stderr)
+    );
+    for f in ["chart.csv", "chart.nc"] {
+        assert_eq!(
+            std::fs::read(full.path().join(f)).unwrap(),
+            std::fs::read(cut.path().join(f)).unwrap(),
+            "{f}: the resumed chart equals the uninterrupted one"
+        );
+    }
+    let stored = std::fs::read_to_string(&tiles).unwrap();
+    assert_eq!(stored.lines().count(), 4, "no lost or duplicated task");
+    // a finished store computes nothing on --resume; another request is refused
+    let again = small(cut.path(), &["--resume"]);
+    assert!(again.status.success());
+    assert_eq!(std::fs::read_to_string(&tiles).unwrap(), stored);
+    let other = small(cut.path(), &["--resume", "--seed", "2"]);
+    // (the refusal names the first field that differs)
+    assert_eq!(other.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&other.stderr);
+    assert!(
+        err.contains("seed = 1 in the interrupted run, 2 now"),
+        "{err}"
+    );
+}
+
+#[test]
+fn a_locked_directory_is_refused_at_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let lock = afmdyn::request::DirLock::acquire(dir.path()).unwrap();
+    if !lock.is_locked() {
+        return; // a file system without advisory locks
+    }
+    let t = std::time::Instant::now();
+    let out = small(dir.path(), &[]);
+    // exit 2, as every command refuses a directory in use (docs/outputs.md)
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("in use by another afmdyn run"),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(t.elapsed().as_secs() < 5);
+}
+
+#[test]
+fn bad_axes_are_refused_in_one_line() {
+    for (args, needle) in [
+        (vec!["chart", "--x", "modes"], "x = modes"),
+        (vec!["chart", "--y", "omega"], "y = omega"),
+        (vec!["chart", "--x-steps", "0"], "x-steps = 0"),
+        (vec!["chart", "--x", "z-c"], "probe"),
+        (
+            vec![
+                "chart", "--x", "gap", "--x-from", "-5e-1", "--x-to", "-1e-1", "--starts", "0",
+            ],
+            "starts = 0",
+        ),
+    ] {
+        let out = afmdyn(&args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+        assert!(err.contains(needle), "{args:?}: {err}");
+    }
+}

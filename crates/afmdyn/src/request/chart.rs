@@ -1,0 +1,488 @@
+//! `chart`: a behaviour chart over two model parameters (issue 29), the same request for
+//! every front end (`afmdyn chart`, Python's `afmdyn.chart` and `afmdyn.dask.chart`).
+//!
+//! An axis is any real model parameter of [`MODEL_PARAMETERS`] by its name or the paper's
+//! alias (`omega`, `alpha2` / `drive_amplitude`, `restitution`, `hamaker`, …), and with a
+//! probe file the SI quantities `z_c` (m) and `drive_frequency` (Hz); every cell's parameters
+//! resolve through [`ModelSpec::resolve`] like a single run's. The chart's cells and tasks are
+//! [`crate::analysis::chart`]'s; this module holds the request, its limits, its fingerprint
+//! (what a resumed chart must match) and the one layout of its results ([`ChartArrays`], the
+//! variables of `chart.nc` and of Python's `xarray.Dataset`; [`CSV_HEADER`], the rows of
+//! `chart.csv`).
+
+use super::analyses::{IntegratorRequest, SteadyRequest};
+use super::limits::MAX_THREADS;
+use super::model::{parameter, ModelSpec, ValueKind};
+use crate::analysis::bifurcation::SweepSpec;
+use crate::analysis::chart::{CellParams, ChartCell, ChartSpec};
+use crate::error::SimError;
+use crate::params::Params;
+use crate::probe::Probe;
+use serde::{Deserialize, Serialize};
+use serde_json::{json, Value};
+
+/// Largest number of cells of a chart (x_steps × y_steps).
+pub const MAX_CHART_CELLS: usize = 1_000_000;
+/// Largest number of random starts per cell.
+pub const MAX_CHART_STARTS: u32 = 1000;
+/// Largest number of steady-state runs from random starts in a chart (cells × starts).
+pub const MAX_CHART_RUNS: usize = 10_000_000;
+/// Largest tile (cells per task).
+pub const MAX_CHART_TILE: usize = 10_000;
+/// Largest number of drive periods of a λ₁ estimate.
+pub const MAX_CHART_LYAPUNOV_PERIODS: usize = 1_000_000;
+
+/// `chart`: period, λ₁, X_max, contacts and basin fractions of every attractor over a grid of
+/// two parameters.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[serde(default, deny_unknown_fields)]
+pub struct ChartRequest {
+    /// The x parameter (columns): a real model parameter's name or alias (`-` read as `_`).
+    pub x: String,
+    /// First x value (in the parameter's unit: dimensionless, m for z_c, Hz for
+    /// drive_frequency).
+    pub x_from: f64,
+    /// Last x value.
+    pub x_to: f64,
+    /// Number of x values, ≥ 1.
+    pub x_steps: usize,
+    /// The y parameter (rows).
+    pub y: String,
+    /// First y value.
+    pub y_from: f64,
+    /// Last y value.
+    pub y_to: f64,
+    /// Number of y values, ≥ 1.
+    pub y_steps: usize,
+    /// Random starts per cell, 1..=[`MAX_CHART_STARTS`].
+    pub starts: u32,
+    /// Seed of the random starts.
+    pub seed: u64,
+    /// Cells per task (continuation runs along x within a tile), 1..=[`MAX_CHART_TILE`].
+    pub tile: usize,
+    /// Clustering tolerance of two steady states, > 0.
+    pub cluster_tol: f64,
+    /// Drive periods of the λ₁ estimate of each nonperiodic attractor (0: none),
+    /// ≤ [`MAX_CHART_LYAPUNOV_PERIODS`].
+    pub lyapunov_periods: usize,
+    /// Worker threads, 1..=[`MAX_THREADS`]; `None`: all cores.
+    pub threads: Option<usize>,
+    /// The steady-state search of every run.
+    #[serde(flatten)]
+    pub steady: SteadyRequest,
+    /// The integrator.
+    #[serde(flatten)]
+    pub integrator: IntegratorRequest,
+}
+
+impl Default for ChartRequest {
+    fn default() -> Self {
+        ChartRequest {
+            x: "omega".into(),
+            x_from: 2.6,
+            x_to: 3.0,
+            x_steps: 9,
+            y: "drive_amplitude".into(),
+            y_from: 0.1,
+            y_to: 0.12,
+            y_steps: 2,
+            starts: 4,
+            seed: 1,
+            tile: 8,
+            cluster_tol: 1e-5,
+            lyapunov_periods: 500,
+            threads: None,
+            steady: SteadyRequest::default(),
+            integrator: IntegratorRequest::default(),
+        }
+    }
+}
+
+/// The canonical name of a chart axis (`alpha2`, `drive-amplitude` → `drive_amplitude`).
+///
+/// # Errors
+/// [`SimError::OutOfRange`] naming `field` for a name that is not a real model parameter.
+pub fn axis_name(field: &'static str, key: &str) -> Result<&'static str, SimError> {
+    let key = key.trim().to_ascii_lowercase().replace('-', "_");
+    match parameter(&key) {
+        Some(info) if info.kind == ValueKind::Real => Ok(info.name),
+        _ => Err(SimError::out_of_range(
+            field,
+            key,
+            "must be a real model parameter: omega, tip_mass_ratio (alpha1), drive_amplitude \
+             (alpha2), beam_damping (alpha3), contact_stiffness (alpha4), gap (alpha5), \
+             contact_damping (alpha6), restitution, hamaker, intermolecular_distance, or with a \
+             probe z_c (m) and drive_frequency (Hz)",
+        )),
+    }
+}
+
+/// The parameters of a chart's cells: the request's model values with the two axes set.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ChartModel {
+    /// The model values of the request (flags, config file).
+    pub base: ModelSpec,
+    /// The defaults below them (the paper's set).
+    pub defaults: Params,
+    /// The probe file, if any.
+    pub probe: Option<Probe>,
+    /// The x parameter's name.
+    pub x: &'static str,
+    /// The y parameter's name.
+    pub y: &'static str,
+}
+
+impl CellParams for ChartModel {
+    fn params(&self, x: f64, y: f64) -> Result<Params, SimError> {
+        let mut v = serde_json::to_value(self.base).unwrap_or_else(|_| json!({}));
+        if let Some(map) = v.as_object_mut() {
+            // the paper's aliases would clash with the names set here
+            for key in [self.x, self.y] {
+                if let Some(alias) = parameter(key).and_then(|p| p.alias) {
+                    map.remove(alias);
+                }
+            }
+            map.insert(self.x.into(), json!(x));
+            map.insert(self.y.into(), json!(y));
+        }
+        let spec: ModelSpec = serde_json::from_value(v)
+            .map_err(|_| SimError::out_of_range("x", format!("{x}"), "must be a finite number"))?;
+        spec.resolve(self.defaults, self.probe.as_ref())
+    }
+}
+
+/// A validated chart: its spec, its cell parameters, its fingerprint.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Chart {
+    /// The chart's values and options.
+    pub spec: ChartSpec,
+    /// The cells' parameters.
+    pub model: ChartModel,
+    /// What a resumed chart must match ([`fingerprint`]).
+    pub fingerprint: Value,
+}
+
+impl ChartRequest {
+    /// The validated chart of the model values `base` over `defaults` (with `probe`): axis
+    /// names and limits checked, and every cell on the chart's edges resolved (a parameter's
+    /// range is an interval, so an invalid value inside a valid edge cannot occur).
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming the option (`x`, `x_steps`, `starts`, `tile`, …),
+    /// [`SimError::Params`] (or the out-of-range error of `z_c`, `drive_frequency`) for an
+    /// axis value out of its parameter's range.
+    pub fn chart(
+        &self,
+        base: ModelSpec,
+        defaults: Params,
+        probe: Option<&Probe>,
+    ) -> Result<Chart, SimError> {
+        let x = axis_name("x", &self.x)?;
+        let y = axis_name("y", &self.y)?;
+        if x == y {
+            return Err(SimError::out_of_range(
+                "y",
+                y,
+                "must differ from the x parameter",
+            ));
+        }
+        if let Some(t) = self.threads {
+            if !(1..=MAX_THREADS).contains(&t) {
+                return Err(SimError::out_of_range("threads", t, "must be in 1..=1024"));
+            }
+        }
+        let steps = |name: &'static str, n: usize| {
+            if (1..=MAX_CHART_CELLS).contains(&n) {
+                Ok(())
+            } else {
+                Err(SimError::out_of_range(name, n, "must be in 1..=1000000"))
+            }
+        };
+        steps("x_steps", self.x_steps)?;
+        steps("y_steps", self.y_steps)?;
+        let cells = self.x_steps.saturating_mul(self.y_steps);
+        if cells > MAX_CHART_CELLS {
+            return Err(SimError::out_of_range(
+                "cells",
+                format!("{} × {}", self.x_steps, self.y_steps),
+                "must be <= 1000000 in all (fewer x_steps or y_steps)",
+            ));
+        }
+        if !(1..=MAX_CHART_STARTS).contains(&self.starts) {
+            return Err(SimError::out_of_range(
+                "starts",
+                self.starts,
+                "must be in 1..=1000",
+            ));
+        }
+        if cells.saturating_mul(self.starts as usize) > MAX_CHART_RUNS {
+            return Err(SimError::out_of_range(
+                "starts",
+                format!("{} × {cells} cells", self.starts),
+                "must be <= 10000000 runs in all (fewer starts or cells)",
+            ));
+        }
+        if !(1..=MAX_CHART_TILE).contains(&self.tile) {
+            return Err(SimError::out_of_range(
+                "tile",
+                self.tile,
+                "must be in 1..=10000",
+            ));
+        }
+        if !(self.cluster_tol.is_finite() && self.cluster_tol > 0.0) {
+            return Err(SimError::out_of_range(
+                "cluster_tol",
+                self.cluster_tol,
+                "must be finite and > 0",
+            ));
+        }
+        if self.lyapunov_periods > MAX_CHART_LYAPUNOV_PERIODS
+            || (1..10).contains(&self.lyapunov_periods)
+        {
+            return Err(SimError::out_of_range(
+                "lyapunov_periods",
+                self.lyapunov_periods,
+                "must be 0 (no λ₁) or in 10..=1000000",
+            ));
+        }
+        crate::error::finite("x_from", self.x_from)?;
+        crate::error::finite("x_to", self.x_to)?;
+        crate::error::finite("y_from", self.y_from)?;
+        crate::error::finite("y_to", self.y_to)?;
+        let xs = SweepSpec::linspace(self.x_from, self.x_to, self.x_steps)?;
+        let ys = SweepSpec::linspace(self.y_from, self.y_to, self.y_steps)?;
+        let model = ChartModel {
+            base,
+            defaults,
+            probe: probe.cloned(),
+            x,
+            y,
+        };
+        for &xv in &xs {
+            model.params(xv, ys[0])?;
+        }
+        for &yv in &ys {
+            model.params(xs[0], yv)?;
+        }
+        model.params(xs[xs.len() - 1], ys[ys.len() - 1])?;
+        let spec = ChartSpec {
+            x: xs,
+            y: ys,
+            starts: self.starts,
+            seed: self.seed,
+            tile: self.tile,
+            cluster_tol: self.cluster_tol,
+            lyapunov_periods: self.lyapunov_periods,
+            steady: self.steady.options()?,
+            integrator: self.integrator.options(1),
+        };
+        let fingerprint = fingerprint(self, &model);
+        Ok(Chart {
+            spec,
+            model,
+            fingerprint,
+        })
+    }
+}
+
+/// The fingerprint of a chart: everything that determines its cells (the library's version,
+/// the model values, the probe, every chart option but the threads).
+pub fn fingerprint(request: &ChartRequest, model: &ChartModel) -> Value {
+    let mut r = serde_json::to_value(request).unwrap_or(Value::Null);
+    if let Some(map) = r.as_object_mut() {
+        map.remove("threads");
+        map.insert("x".into(), json!(model.x));
+        map.insert("y".into(), json!(model.y));
+    }
+    json!({
+        "afmdyn": env!("CARGO_PKG_VERSION"),
+        "chart": r,
+        "model": model.base,
+        "defaults": model.defaults,
+        "probe": model.probe,
+    })
+}
+
+/// The unit of a chart axis, for labels and the files' `units` attributes.
+pub fn axis_unit(name: &str) -> &'static str {
+    parameter(name).map_or("1", |p| p.unit)
+}
+
+/// The columns of `chart.csv`: one row per attractor of a cell (one row, with `attractor`
+/// empty, for a cell without any).
+pub const CSV_HEADER: [&str; 17] = [
+    "ix",
+    "iy",
+    "x",
+    "y",
+    "attractor",
+    "status",
+    "period",
+    "lyapunov",
+    "x_max",
+    "v_t_min",
+    "contacts_per_period",
+    "contact_fraction",
+    "count",
+    "fraction",
+    "origin",
+    "failures",
+    "message",
+];
+
+/// The rows of a cell as CSV lines of [`CSV_HEADER`] (numbers in Rust's shortest round-trip
+/// form; messages with commas and newlines replaced by spaces).
+pub fn csv_lines(cell: &ChartCell) -> Vec<String> {
+    let message = cell
+        .message
+        .as_deref()
+        .unwrap_or("")
+        .replace(['\n', ',', '\r'], " ");
+    let head = format!("{},{},{},{}", cell.ix, cell.iy, cell.x, cell.y);
+    if cell.attractors.is_empty() {
+        return vec![format!("{head},,none,,,,,,,,,,{},{message}", cell.failures)];
+    }
+    cell.attractors
+        .iter()
+        .enumerate()
+        .map(|(k, a)| {
+            let origin = match a.origin {
+                crate::analysis::chart::Origin::Start => "start",
+                crate::analysis::chart::Origin::Left => "left",
+                crate::analysis::chart::Origin::Right => "right",
+            };
+            format!(
+                "{head},{k},{},{},{},{},{},{},{},{},{},{origin},{},{message}",
+                if a.period.is_some() {
+                    "periodic"
+                } else {
+                    "nonperiodic"
+                },
+                a.period.map_or(String::new(), |n| n.to_string()),
+                a.lyapunov.map_or(String::new(), |l| l.to_string()),
+                a.x_max,
+                a.v_t_min,
+                a.contacts_per_period,
+                a.contact_fraction,
+                a.count,
+                a.fraction,
+                cell.failures,
+            )
+        })
+        .collect()
+}
+
+/// A chart's results as arrays: per cell (y, x) and per attractor slot (y, x, attractor), the
+/// attractor slots of a cell in its order, padded to the largest count of any cell. Row-major,
+/// y slowest. The one layout of `chart.nc` and of Python's `xarray.Dataset`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ChartArrays {
+    /// x values.
+    pub x: Vec<f64>,
+    /// y values.
+    pub y: Vec<f64>,
+    /// Attractor slots per cell (≥ 1).
+    pub slots: usize,
+    /// (y, x): attractors found.
+    pub attractors: Vec<i32>,
+    /// (y, x): failed runs.
+    pub failures: Vec<i32>,
+    /// (y, x, attractor): period n; −1 nonperiodic; 0 empty slot.
+    pub period: Vec<i32>,
+    /// (y, x, attractor): λ₁ (NaN: periodic, not estimated, or empty).
+    pub lyapunov: Vec<f64>,
+    /// (y, x, attractor): X_max (g0).
+    pub x_max: Vec<f64>,
+    /// (y, x, attractor): smallest V_T (g0).
+    pub v_t_min: Vec<f64>,
+    /// (y, x, attractor): contacts per period.
+    pub contacts_per_period: Vec<f64>,
+    /// (y, x, attractor): fraction of the time in contact.
+    pub contact_fraction: Vec<f64>,
+    /// (y, x, attractor): basin fraction among the random starts.
+    pub fraction: Vec<f64>,
+    /// (y, x): the dominant attractor's period (the first slot's), −1 nonperiodic, 0 none.
+    pub dominant_period: Vec<i32>,
+}
+
+impl ChartArrays {
+    /// The arrays of `cells` (any order; each cell once) on the axes `x`, `y`.
+    pub fn new(x: &[f64], y: &[f64], cells: &[ChartCell]) -> ChartArrays {
+        let (nx, ny) = (x.len(), y.len());
+        let slots = cells
+            .iter()
+            .map(|c| c.attractors.len())
+            .max()
+            .unwrap_or(0)
+            .max(1);
+        let n = nx * ny;
+        let mut a = ChartArrays {
+            x: x.to_vec(),
+            y: y.to_vec(),
+            slots,
+            attractors: vec![0; n],
+            failures: vec![0; n],
+            period: vec![0; n * slots],
+            lyapunov: vec![f64::NAN; n * slots],
+            x_max: vec![f64::NAN; n * slots],
+            v_t_min: vec![f64::NAN; n * slots],
+            contacts_per_period: vec![f64::NAN; n * slots],
+            contact_fraction: vec![f64::NAN; n * slots],
+            fraction: vec![f64::NAN; n * slots],
+            dominant_period: vec![0; n],
+        };
+        for c in cells.iter().filter(|c| c.ix < nx && c.iy < ny) {
+            let cell = c.iy * nx + c.ix;
+            a.attractors[cell] = c.attractors.len() as i32;
+            a.failures[cell] = c.failures as i32;
+            for (k, at) in c.attractors.iter().enumerate() {
+                let i = cell * slots + k;
+                a.period[i] = at.period.map_or(-1, |p| p as i32);
+                a.lyapunov[i] = at.lyapunov.unwrap_or(f64::NAN);
+                a.x_max[i] = at.x_max;
+                a.v_t_min[i] = at.v_t_min;
+                a.contacts_per_period[i] = at.contacts_per_period;
+                a.contact_fraction[i] = at.contact_fraction;
+                a.fraction[i] = at.fraction;
+            }
+            a.dominant_period[cell] = a.period[cell * slots];
+        }
+        a
+    }
+}
+
+/// The `--json` document of a chart: axes with names, units and values; every cell with its
+/// attractors; the counts.
+pub fn document(chart: &Chart, cells: &[ChartCell]) -> Value {
+    let axis = |name: &str, values: &[f64]| json!({"name": name, "unit": axis_unit(name), "values": values});
+    let cells_json: Vec<Value> = cells
+        .iter()
+        .map(|c| {
+            json!({
+                "ix": c.ix,
+                "iy": c.iy,
+                "attractors": c.attractors.iter().map(|a| json!({
+                    "period": a.period,
+                    "lyapunov": a.lyapunov,
+                    "x_max": a.x_max,
+                    "v_t_min": a.v_t_min,
+                    "contacts_per_period": a.contacts_per_period,
+                    "contact_fraction": a.contact_fraction,
+                    "fraction": a.fraction,
+                    "origin": a.origin,
+                })).collect::<Vec<_>>(),
+                "failures": c.failures,
+                "message": c.message,
+            })
+        })
+        .collect();
+    json!({
+        "x": axis(chart.model.x, &chart.spec.x),
+        "y": axis(chart.model.y, &chart.spec.y),
+        "units": {"x_max": "g0", "v_t_min": "g0", "lyapunov": "1/τ"},
+        "starts": chart.spec.starts,
+        "cells": cells_json,
+        "failures": cells.iter().map(|c| c.failures as u64).sum::<u64>(),
+    })
+}

@@ -1,0 +1,222 @@
+//! The resumable store of a chart (feature `files`): a directory, locked by [`DirLock`], holding
+//!
+//! - `.chart.run.json`, the ledger: `{"args": fingerprint, "finished": bool}`;
+//! - `.chart.tiles.jsonl`, one line per finished task (tile), appended and flushed as each
+//!   finishes: `{"task": t, "cells": [ChartCell, …]}` (a killed run leaves at most a cut last
+//!   line, dropped on resume).
+//!
+//! A resumed chart computes only the tasks not stored, and only for the request that made the
+//! store ([`super::chart::fingerprint`]); a finished one computes nothing. The command line's
+//! `afmdyn chart --out DIR` keeps its store there; the files a user reads (`chart.csv`,
+//! `chart.nc`, the maps) are written from it.
+
+use super::checkpoint::{CheckpointError, Ledger};
+use super::checkpoint_file::write_atomic;
+use super::dir_lock::DirLock;
+use super::sweep::first_difference;
+use crate::analysis::chart::ChartCell;
+use serde::Deserialize;
+use serde_json::{json, Value};
+use std::collections::{BTreeMap, HashSet};
+use std::fs::{self, File, OpenOptions};
+use std::io::{BufRead, BufReader, BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+/// The ledger.
+pub const LEDGER: &str = ".chart.run.json";
+/// The finished tasks.
+pub const TILES: &str = ".chart.tiles.jsonl";
+
+#[derive(Deserialize)]
+struct Line {
+    task: usize,
+    cells: Vec<ChartCell>,
+}
+
+fn io<'p>(
+    action: &'static str,
+    path: &'p Path,
+) -> impl FnOnce(std::io::Error) -> CheckpointError + 'p {
+    move |e| CheckpointError::Io {
+        action,
+        path: path.display().to_string(),
+        message: e.to_string(),
+    }
+}
+
+/// A chart's store in the directory its lock holds.
+#[derive(Debug)]
+pub struct ChartStore<'a> {
+    lock: &'a DirLock,
+    writer: Option<BufWriter<File>>,
+    tiles: BTreeMap<usize, Vec<ChartCell>>,
+}
+
+impl<'a> ChartStore<'a> {
+    /// The store of the directory `lock` holds.
+    pub fn new(lock: &'a DirLock) -> ChartStore<'a> {
+        ChartStore {
+            lock,
+            writer: None,
+            tiles: BTreeMap::new(),
+        }
+    }
+
+    fn path(&self, name: &str) -> PathBuf {
+        self.lock.path().join(name)
+    }
+
+    fn ledger(&self) -> Result<Option<Ledger>, CheckpointError> {
+        let path = self.path(LEDGER);
+        let text = match fs::read_to_string(&path) {
+            Ok(t) => t,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+            Err(e) => return Err(io("read", &path)(e)),
+        };
+        let v: Value = serde_json::from_str(&text).map_err(|e| CheckpointError::Corrupt {
+            path: path.display().to_string(),
+            message: e.to_string(),
+        })?;
+        Ok(Some(Ledger {
+            fingerprint: v.get("args").cloned().unwrap_or(Value::Null),
+            finished: v.get("finished").and_then(Value::as_bool).unwrap_or(false),
+        }))
+    }
+
+    fn write_ledger(&self, fingerprint: &Value, finished: bool) -> Result<(), CheckpointError> {
+        let doc = json!({"args": fingerprint, "finished": finished});
+        write_atomic(&self.path(LEDGER), format!("{doc:#}\n").as_bytes())
+    }
+
+    /// Open the store for the chart `fingerprint`. Without `resume` a new chart begins (the
+    /// stored tasks are dropped). With `resume`: an empty store begins; a store of another
+    /// request is refused; otherwise the stored tasks are kept. Returns the tasks done.
+    ///
+    /// # Errors
+    /// [`CheckpointError::Mismatch`] naming the first field that differs,
+    /// [`CheckpointError::Unrecorded`] for tasks without a ledger, and the files' errors.
+    pub fn open(
+        &mut self,
+        fingerprint: &Value,
+        resume: bool,
+    ) -> Result<HashSet<usize>, CheckpointError> {
+        let tiles_path = self.path(TILES);
+        if resume {
+            match self.ledger()? {
+                None if tiles_path.exists() => {
+                    return Err(CheckpointError::Unrecorded {
+                        store: self.lock.path().display().to_string(),
+                        ledger: LEDGER.into(),
+                    })
+                }
+                None => {}
+                Some(ledger) => {
+                    let now: Value = serde_json::from_str(&fingerprint.to_string())
+                        .unwrap_or_else(|_| fingerprint.clone());
+                    if let Some((field, then, now)) = first_difference(&ledger.fingerprint, &now) {
+                        let field = field.strip_prefix("chart.").unwrap_or(&field).to_string();
+                        return Err(CheckpointError::Mismatch { field, then, now });
+                    }
+                    self.read_tiles()?;
+                    self.reopen_writer()?;
+                    return Ok(self.tiles.keys().copied().collect());
+                }
+            }
+        }
+        self.tiles.clear();
+        match fs::remove_file(&tiles_path) {
+            Ok(()) => {}
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+            Err(e) => return Err(io("remove", &tiles_path)(e)),
+        }
+        self.write_ledger(fingerprint, false)?;
+        self.reopen_writer()?;
+        Ok(HashSet::new())
+    }
+
+    /// The stored tasks: every complete line (a cut or unreadable last line is dropped, and
+    /// the file cut back to the complete lines so that appends follow them).
+    fn read_tiles(&mut self) -> Result<(), CheckpointError> {
+        let path = self.path(TILES);
+        let file = match File::open(&path) {
+            Ok(f) => f,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
+            Err(e) => return Err(io("read", &path)(e)),
+        };
+        let mut reader = BufReader::new(file);
+        let (mut good, mut buf) = (0u64, Vec::new());
+        loop {
+            buf.clear();
+            let n = reader
+                .read_until(b'\n', &mut buf)
+                .map_err(io("read", &path))?;
+            if n == 0 || buf.last() != Some(&b'\n') {
+                break;
+            }
+            match serde_json::from_slice::<Line>(&buf) {
+                Ok(line) => {
+                    self.tiles.insert(line.task, line.cells);
+                    good += n as u64;
+                }
+                Err(_) => break,
+            }
+        }
+        let f = OpenOptions::new()
+            .write(true)
+            .open(&path)
+            .map_err(io("write", &path))?;
+        f.set_len(good).map_err(io("write", &path))
+    }
+
+    fn reopen_writer(&mut self) -> Result<(), CheckpointError> {
+        let path = self.path(TILES);
+        let f = OpenOptions::new()
+            .create(true)
+            .append(true)
+            .open(&path)
+            .map_err(io("write", &path))?;
+        self.writer = Some(BufWriter::new(f));
+        Ok(())
+    }
+
+    /// Store the cells of a finished task (one line, flushed).
+    ///
+    /// # Errors
+    /// [`CheckpointError::Io`].
+    pub fn append(&mut self, task: usize, cells: Vec<ChartCell>) -> Result<(), CheckpointError> {
+        let path = self.path(TILES);
+        let line = json!({"task": task, "cells": &cells});
+        if let Some(w) = self.writer.as_mut() {
+            writeln!(w, "{line}")
+                .and_then(|()| w.flush())
+                .map_err(io("write", &path))?;
+        }
+        self.tiles.insert(task, cells);
+        Ok(())
+    }
+
+    /// Mark the chart finished.
+    ///
+    /// # Errors
+    /// [`CheckpointError::Io`].
+    pub fn finish(&mut self, fingerprint: &Value) -> Result<(), CheckpointError> {
+        if let Some(w) = self.writer.as_mut() {
+            let path = self.lock.path().join(TILES);
+            w.flush().map_err(io("write", &path))?;
+        }
+        self.write_ledger(fingerprint, true)
+    }
+
+    /// Whether the stored chart finished.
+    ///
+    /// # Errors
+    /// As the ledger's reading.
+    pub fn finished(&self) -> Result<bool, CheckpointError> {
+        Ok(self.ledger()?.is_some_and(|l| l.finished))
+    }
+
+    /// Every stored cell, in the order of the tasks (row by row, x increasing).
+    pub fn cells(&self) -> Vec<ChartCell> {
+        self.tiles.values().flatten().cloned().collect()
+    }
+}
