@@ -72,6 +72,10 @@ pub struct ChartArgs {
     /// Relative tolerance for two steady states to be one attractor
     #[arg(long, default_value_t = 1e-5)]
     cluster_tol: f64,
+    /// Attractor slots per cell in chart.nc (a cell with more keeps those most starts reached
+    /// there; chart.csv and --json list every one)
+    #[arg(long, default_value_t = 8)]
+    max_attractors: usize,
     /// Worker threads (default: all cores)
     #[arg(long)]
     threads: Option<usize>,
@@ -264,6 +268,7 @@ pub fn chart(a: &ChartArgs) -> Result<(), CliError> {
         tile: a.tile,
         cluster_tol: a.cluster_tol,
         lyapunov_periods: a.lyapunov_periods,
+        max_attractors: a.max_attractors,
         threads: a.threads,
         steady: a.steady.request(),
         integrator: a.integrator.request(),
@@ -318,7 +323,7 @@ pub fn chart(a: &ChartArgs) -> Result<(), CliError> {
         store.finish(&chart.fingerprint).map_err(store_error)?;
     }
     let cells = store.cells();
-    let arrays = ChartArrays::new(&chart.spec.x, &chart.spec.y, &cells);
+    let arrays = ChartArrays::new(&chart, &cells);
     write_csv(&out.join("chart.csv"), &cells)?;
     write_nc(&out.join("chart.nc"), &arrays, chart.model.x, chart.model.y)?;
     draw_maps(out.path(), &chart, &arrays)?;

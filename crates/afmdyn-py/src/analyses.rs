@@ -399,7 +399,18 @@ pub fn converge<'py>(
 
 /// A checkpoint error as Python sees it: a store of another request (or of none) is a
 /// `ValueError` naming the field, a file that cannot be read or written an `OSError`.
-fn checkpoint_error(e: CheckpointError) -> PyErr {
+/// Lock a store directory (created if needed) before any work: a second run on it is refused
+/// at once (`ValueError`), a directory that cannot be created or locked is an `OSError`.
+pub(crate) fn lock_store(dir: &std::path::Path) -> PyResult<DirLock> {
+    DirLock::acquire(dir).map_err(|e| match e {
+        LockError::InUse { .. } => value_error(format!(
+            "store: {e}; wait for it to finish or choose another store="
+        )),
+        LockError::Io { .. } => pyo3::exceptions::PyOSError::new_err(e.to_string()),
+    })
+}
+
+pub(crate) fn checkpoint_error(e: CheckpointError) -> PyErr {
     match e {
         CheckpointError::Io { .. } => pyo3::exceptions::PyOSError::new_err(e.to_string()),
         CheckpointError::Mismatch { .. } => value_error(format!(
@@ -485,15 +496,7 @@ pub fn bifurcation<'py>(
         ));
     }
     // the store is locked here, before any work: a second run on it is refused at once
-    let lock = store
-        .map(|dir| DirLock::acquire(&dir))
-        .transpose()
-        .map_err(|e| match e {
-            LockError::InUse { .. } => value_error(format!(
-                "store: {e}; wait for it to finish or choose another store="
-            )),
-            LockError::Io { .. } => pyo3::exceptions::PyOSError::new_err(e.to_string()),
-        })?;
+    let lock = store.map(|dir| lock_store(&dir)).transpose()?;
     let total = checkpoint::point_count(&spec);
     let job = Job::default();
     let worker_job = job.clone();
@@ -528,6 +531,16 @@ pub fn bifurcation<'py>(
     if let Some(e) = afmdyn::request::sweep::every_point_failed(&records) {
         return Err(sim_error(e));
     }
+    sweep_dict(py, &spec, records)
+}
+
+/// The dict of a sweep's records, in their order (the columns `bifurcation` returns).
+pub(crate) fn sweep_dict<'py>(
+    py: Python<'py>,
+    spec: &SweepSpec,
+    records: Vec<SweepRecord>,
+) -> PyResult<Dict<'py>> {
+    let param = spec.param;
     let n = spec.base.modes;
     let rows = records.len();
     let mut value = Vec::with_capacity(rows);

@@ -6,11 +6,13 @@
 //! datasets and result objects.
 
 mod analyses;
+mod chart;
 mod convert;
 mod curves;
 mod errors;
 mod params;
 mod run;
+mod sweep;
 
 use pyo3::prelude::*;
 
@@ -18,6 +20,9 @@ use pyo3::prelude::*;
 #[pymodule]
 fn _afmdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<params::PyParams>()?;
+    m.add_class::<chart::ChartStudy>()?;
+    m.add_class::<chart::StoreLock>()?;
+    m.add_class::<sweep::SweepStudy>()?;
     m.add(
         "SimulationError",
         m.py().get_type::<errors::SimulationError>(),

@@ -28,7 +28,7 @@ IMPACT_PY = dict(contact_law="impact", restitution=0.5, modes=1, gap=0.05, omega
 SHORT = ["--max-periods", 300]
 
 COMMANDS = ["modes", "units", "simulate", "converge", "bifurcation", "attractors", "orbit",
-            "continue", "lyapunov", "approach", "resonance"]
+            "continue", "lyapunov", "approach", "resonance", "chart"]
 SHARED = ["params", "si"]
 PYTHON_ONLY = ["observe"]
 
@@ -105,8 +105,12 @@ CLI_CASES: List[Tuple[str, List[Any]]] = [
     ("approach", ["--points", 5, "--no-branches", "--files", "none", "--probe", P1]),
     ("resonance", ["--points", 5, "--no-branches", "--files", "none"]),
     ("resonance", ["--points", 5, "--no-branches", "--files", "none", "--probe", P1]),
+    ("chart", ["--x-steps", 2, "--y-steps", 1, "--starts", 1, "--lyapunov-periods", 20, *SHORT]),
+    ("chart", ["--x", "z-c", "--x-from", 6e-9, "--x-to", 8e-9, "--x-steps", 2, "--y", "omega",
+               "--y-from", 0.99, "--y-to", 0.99, "--y-steps", 1, "--starts", 1, *SHORT,
+               "--probe", P1]),
 ]
-WRITES = {"simulate", "converge", "bifurcation", "attractors", "continue"}
+WRITES = {"simulate", "converge", "bifurcation", "attractors", "continue", "chart"}
 
 
 @pytest.fixture(scope="module")
@@ -189,8 +193,9 @@ def test_python_documents_conform(k: int) -> None:
 
 def test_every_python_document_has_a_case() -> None:
     py = {name for name, _, _ in PY_CASES}
-    # bifurcation has no document in Python (a dataset); observe none on the command line
-    assert py == (set(COMMANDS) - {"bifurcation"}) | set(PYTHON_ONLY)
+    # bifurcation and chart have no document in Python (datasets); observe none on the
+    # command line
+    assert py == (set(COMMANDS) - {"bifurcation", "chart"}) | set(PYTHON_ONLY)
 
 
 def test_one_attractor_conforms() -> None:
@@ -277,7 +282,7 @@ def test_every_request_has_a_schema() -> None:
     assert REQUEST_NAMES == sorted(
         ["model", "steady", "integrator", "start", "orbit", "continuation", "lyapunov",
          "attractors", "observe", "converge", "simulate", "bifurcation", "curve", "modes",
-         "approach", "resonance"]
+         "approach", "resonance", "chart"]
     )
 
 

@@ -6,7 +6,7 @@
 //! here it must deserialise back to the default.
 #![cfg(feature = "schema")]
 
-use afmdyn::request::{ApproachRequest, ModesRequest, ResonanceRequest};
+use afmdyn::request::{ApproachRequest, ChartRequest, ModesRequest, ResonanceRequest};
 use afmdyn::request::{
     AttractorsRequest, BifurcationRequest, ContinuationRequest, ConvergeRequest, CurveRequest,
     IntegratorRequest, LyapunovRequest, ModelSpec, ObserveRequest, OrbitRequest, SimulateRequest,
@@ -63,6 +63,7 @@ fn schemas() -> Vec<(&'static str, Value)> {
         ("modes", schema::<ModesRequest>("modes")),
         ("approach", schema::<ApproachRequest>("approach")),
         ("resonance", schema::<ResonanceRequest>("resonance")),
+        ("chart", schema::<ChartRequest>("chart")),
     ]
 }
 

@@ -11,7 +11,8 @@ series, sweeps, curves) or small result objects whose ``to_dict()`` is the comma
 array([ 7.79, 20.33, 55.81])
 
 Analyses: :func:`modes`, :func:`simulate`, :func:`converge`, :func:`bifurcation`,
-:func:`attractors`, :func:`orbit`, :func:`continuation`, :func:`lyapunov`, :func:`observe`
+:func:`attractors`, :func:`chart` (behaviour charts over two parameters; on a Dask cluster
+with :func:`afmdyn.dask.chart`), :func:`orbit`, :func:`continuation`, :func:`lyapunov`, :func:`observe`
 (amplitude, phase, dissipated energy, virial, forces of a steady state), :func:`approach`
 (approach–retract curves) and :func:`resonance` (resonance curves), both with branches and
 folds. Physical units: a probe
@@ -38,6 +39,7 @@ from ._api import (
     simulate,
     summary,
 )
+from ._chart import chart
 from ._results import Attractor, Attractors, Lyapunov, Orbit, RegionSpectrum, Spectrum
 
 try:
@@ -61,6 +63,7 @@ __all__ = [
     "approach",
     "attractors",
     "bifurcation",
+    "chart",
     "continuation",
     "converge",
     "lyapunov",

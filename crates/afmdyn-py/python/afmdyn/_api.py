@@ -569,6 +569,12 @@ def bifurcation(
         store=None if store is None else os.fspath(store),
         resume=resume,
     )
+    return _sweep_dataset(p, d, starts, seed)
+
+
+def _sweep_dataset(p: Params, d: Dict[str, Any], starts: int, seed: int) -> xr.Dataset:
+    """The long-format dataset of a sweep's columns ``d`` (``bifurcation``'s, and
+    ``afmdyn.dask.bifurcation``'s)."""
     n = p.modes
     data: Dict[str, Any] = {
         "status": ("point", np.array(d["status"], dtype=str)),

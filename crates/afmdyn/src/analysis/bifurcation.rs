@@ -229,6 +229,13 @@ pub struct Seeds {
 }
 
 impl Seeds {
+    /// The seeds from the coarse passes' results ([`SweepPlan::coarse`] of the forward and
+    /// the backward branch), as an executor that runs the passes as tasks of its own
+    /// assembles them.
+    pub fn new(forward: Vec<DVector<f64>>, backward: Vec<DVector<f64>>) -> Seeds {
+        Seeds { forward, backward }
+    }
+
     fn of(&self, branch: Branch) -> &[DVector<f64>] {
         match branch {
             Branch::Backward => &self.backward,

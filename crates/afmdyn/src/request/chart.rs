@@ -29,6 +29,8 @@ pub const MAX_CHART_STARTS: u32 = 1000;
 pub const MAX_CHART_RUNS: usize = 10_000_000;
 /// Largest tile (cells per task).
 pub const MAX_CHART_TILE: usize = 10_000;
+/// Largest number of attractor slots per cell in the result arrays.
+pub const MAX_CHART_SLOTS: usize = 64;
 /// Largest number of drive periods of a λ₁ estimate.
 pub const MAX_CHART_LYAPUNOV_PERIODS: usize = 1_000_000;
 
@@ -66,6 +68,11 @@ pub struct ChartRequest {
     /// Drive periods of the λ₁ estimate of each nonperiodic attractor (0: none),
     /// ≤ [`MAX_CHART_LYAPUNOV_PERIODS`].
     pub lyapunov_periods: usize,
+    /// Attractor slots per cell in the arrays of the results ([`ChartArrays`]: `chart.nc`,
+    /// Python's dataset, the Dask store), 1..=[`MAX_CHART_SLOTS`]: a cell with more keeps its
+    /// first ones (most random starts first) there, and its `attractors` count tells how many
+    /// it has; the CSV and JSON list every one.
+    pub max_attractors: usize,
     /// Worker threads, 1..=[`MAX_THREADS`]; `None`: all cores.
     pub threads: Option<usize>,
     /// The steady-state search of every run.
@@ -92,6 +99,7 @@ impl Default for ChartRequest {
             tile: 8,
             cluster_tol: 1e-5,
             lyapunov_periods: 500,
+            max_attractors: 8,
             threads: None,
             steady: SteadyRequest::default(),
             integrator: IntegratorRequest::default(),
@@ -157,6 +165,8 @@ impl CellParams for ChartModel {
 pub struct Chart {
     /// The chart's values and options.
     pub spec: ChartSpec,
+    /// Attractor slots per cell of its arrays.
+    pub slots: usize,
     /// The cells' parameters.
     pub model: ChartModel,
     /// What a resumed chart must match ([`fingerprint`]).
@@ -246,6 +256,13 @@ impl ChartRequest {
                 "must be 0 (no λ₁) or in 10..=1000000",
             ));
         }
+        if !(1..=MAX_CHART_SLOTS).contains(&self.max_attractors) {
+            return Err(SimError::out_of_range(
+                "max_attractors",
+                self.max_attractors,
+                "must be in 1..=64",
+            ));
+        }
         crate::error::finite("x_from", self.x_from)?;
         crate::error::finite("x_to", self.x_to)?;
         crate::error::finite("y_from", self.y_from)?;
@@ -280,6 +297,7 @@ impl ChartRequest {
         let fingerprint = fingerprint(self, &model);
         Ok(Chart {
             spec,
+            slots: self.max_attractors,
             model,
             fingerprint,
         })
@@ -374,8 +392,9 @@ pub fn csv_lines(cell: &ChartCell) -> Vec<String> {
 }
 
 /// A chart's results as arrays: per cell (y, x) and per attractor slot (y, x, attractor), the
-/// attractor slots of a cell in its order, padded to the largest count of any cell. Row-major,
-/// y slowest. The one layout of `chart.nc` and of Python's `xarray.Dataset`.
+/// attractor slots of a cell in its order ([`ChartRequest::max_attractors`] of them, empty
+/// ones padded: period 0, NaN). Row-major, y slowest. The one layout of `chart.nc`, of
+/// Python's `xarray.Dataset` and of the Dask store's regions.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ChartArrays {
     /// x values.
@@ -407,15 +426,29 @@ pub struct ChartArrays {
 }
 
 impl ChartArrays {
-    /// The arrays of `cells` (any order; each cell once) on the axes `x`, `y`.
-    pub fn new(x: &[f64], y: &[f64], cells: &[ChartCell]) -> ChartArrays {
+    /// The arrays of `cells` (any order; each cell once) of the whole chart.
+    pub fn new(chart: &Chart, cells: &[ChartCell]) -> ChartArrays {
+        ChartArrays::region(
+            chart,
+            (0, 0),
+            (chart.spec.x.len(), chart.spec.y.len()),
+            cells,
+        )
+    }
+
+    /// The arrays of the region of `size` = (columns, rows) from the cell `origin` = (ix, iy):
+    /// a task's tile is the region ((lo, iy), (hi − lo, 1)); cells outside it are left out.
+    pub fn region(
+        chart: &Chart,
+        origin: (usize, usize),
+        size: (usize, usize),
+        cells: &[ChartCell],
+    ) -> ChartArrays {
+        let slots = chart.slots.max(1);
+        let (x0, y0) = origin;
+        let x = &chart.spec.x[x0.min(chart.spec.x.len())..(x0 + size.0).min(chart.spec.x.len())];
+        let y = &chart.spec.y[y0.min(chart.spec.y.len())..(y0 + size.1).min(chart.spec.y.len())];
         let (nx, ny) = (x.len(), y.len());
-        let slots = cells
-            .iter()
-            .map(|c| c.attractors.len())
-            .max()
-            .unwrap_or(0)
-            .max(1);
         let n = nx * ny;
         let mut a = ChartArrays {
             x: x.to_vec(),
@@ -432,11 +465,13 @@ impl ChartArrays {
             fraction: vec![f64::NAN; n * slots],
             dominant_period: vec![0; n],
         };
-        for c in cells.iter().filter(|c| c.ix < nx && c.iy < ny) {
-            let cell = c.iy * nx + c.ix;
+        let inside =
+            |c: &&ChartCell| (x0..x0 + nx).contains(&c.ix) && (y0..y0 + ny).contains(&c.iy);
+        for c in cells.iter().filter(inside) {
+            let cell = (c.iy - y0) * nx + (c.ix - x0);
             a.attractors[cell] = c.attractors.len() as i32;
             a.failures[cell] = c.failures as i32;
-            for (k, at) in c.attractors.iter().enumerate() {
+            for (k, at) in c.attractors.iter().take(slots).enumerate() {
                 let i = cell * slots + k;
                 a.period[i] = at.period.map_or(-1, |p| p as i32);
                 a.lyapunov[i] = at.lyapunov.unwrap_or(f64::NAN);
@@ -452,8 +487,9 @@ impl ChartArrays {
     }
 }
 
-/// The `--json` document of a chart: axes with names, units and values; every cell with its
-/// attractors; the counts.
+/// The `--json` document of a chart: the parameters of its first cell (x₀, y₀; the other cells
+/// differ in the two axes), axes with names, units and values; every cell with its attractors;
+/// the counts; with a probe the `si` block of the first cell.
 pub fn document(chart: &Chart, cells: &[ChartCell]) -> Value {
     let axis = |name: &str, values: &[f64]| json!({"name": name, "unit": axis_unit(name), "values": values});
     let cells_json: Vec<Value> = cells
@@ -477,12 +513,18 @@ pub fn document(chart: &Chart, cells: &[ChartCell]) -> Value {
             })
         })
         .collect();
-    json!({
+    let first = chart.model.params(chart.spec.x[0], chart.spec.y[0]);
+    let doc = json!({
+        "params": first.as_ref().ok(),
         "x": axis(chart.model.x, &chart.spec.x),
         "y": axis(chart.model.y, &chart.spec.y),
         "units": {"x_max": "g0", "v_t_min": "g0", "lyapunov": "1/τ"},
         "starts": chart.spec.starts,
         "cells": cells_json,
         "failures": cells.iter().map(|c| c.failures as u64).sum::<u64>(),
-    })
+    });
+    match &first {
+        Ok(p) => crate::report::with_si(doc, chart.model.probe.as_ref(), p),
+        Err(_) => doc,
+    }
 }

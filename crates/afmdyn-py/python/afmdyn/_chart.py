@@ -1,0 +1,195 @@
+"""Behaviour charts over two parameters (``afmdyn chart``): the request, its tasks and its
+dataset, shared by :func:`afmdyn.chart` (this machine) and :func:`afmdyn.dask.chart` (a Dask
+cluster). The chart, its limits, its tasks and its result layout are the library's; this
+module builds the request and wraps the arrays in an ``xarray.Dataset``."""
+
+from __future__ import annotations
+
+import json
+import os
+from typing import TYPE_CHECKING, Any, Dict, Optional, Union
+
+import numpy as np
+import xarray as xr
+
+from . import _afmdyn as _core
+from ._afmdyn import Params
+from ._api import Model, _typed, _warn
+from ._progress import ProgressArg, reporter
+
+if TYPE_CHECKING:
+    from typing_extensions import Unpack
+
+#: The units of the model parameters by name and alias (the library's one table).
+_UNITS = {}
+for _name, _alias, _unit, _range, _help in _core.MODEL_PARAMETERS:
+    _UNITS[_name] = _unit
+    _UNITS[_alias] = _unit
+
+#: Per-cell and per-attractor variables: name → (long name, units).
+_CELL = {
+    "attractors": ("attractors found in the cell", "1"),
+    "failures": ("runs of the cell that failed", "1"),
+    "dominant_period": (
+        "period of the attractor most random starts reached; -1 nonperiodic, 0 none",
+        "drive periods",
+    ),
+}
+_SLOT = {
+    "period": ("period n; -1 nonperiodic; 0 empty slot", "drive periods"),
+    "lyapunov": ("largest Lyapunov exponent of a nonperiodic attractor", "1/tau"),
+    "x_max": ("largest tip deflection W(1,tau) over the steady state", "g0"),
+    "v_t_min": ("smallest V_T over the steady state", "g0"),
+    "contacts_per_period": ("contact entries (impacts) per drive period", "1/period"),
+    "contact_fraction": ("fraction of the time in contact", "1"),
+    "fraction": ("basin fraction among the random starts", "1"),
+}
+
+
+def study(
+    params: Optional[Params],
+    model: Dict[str, Any],
+    **request: Any,
+) -> "_core.ChartStudy":
+    """The validated chart of the options ``request`` (the library's ``ChartRequest``) over
+    ``params`` with the ``model`` keywords (``probe`` a probe file's path)."""
+    if params is not None and not isinstance(params, Params):
+        raise TypeError(f"params: expected afmdyn.Params or None, got {type(params).__name__}")
+    model = dict(model)
+    probe = model.pop("probe", None)
+    text = None
+    if probe is not None:
+        try:
+            with open(os.fspath(probe), encoding="utf-8") as f:
+                text = f.read()
+        except OSError as e:
+            raise ValueError(f"probe {os.fspath(probe)}: cannot read it: {e.strerror}") from None
+    for k in ("x_steps", "y_steps", "starts", "seed", "tile", "lyapunov_periods",
+              "max_attractors", "threads", "max_periods", "max_period"):
+        v = request.get(k)
+        if isinstance(v, int) and not isinstance(v, bool) and v < 0:
+            raise ValueError(f"{k} = {v}: must be >= 0")
+    request = {k: v for k, v in request.items() if v is not None}
+    return _core.ChartStudy.build(json.dumps(request), params, text, model)
+
+
+def dataset(s: "_core.ChartStudy", d: Dict[str, Any]) -> xr.Dataset:
+    """The ``xarray.Dataset`` of a chart's arrays ``d`` (dims ``y``, ``x``, ``attractor``)."""
+    ny, nx, ns = d["shape"]
+    fp = json.loads(s.fingerprint())
+    req = fp["chart"]
+    xname, yname = req["x"], req["y"]
+    data: Dict[str, Any] = {}
+    for k, (long, unit) in _CELL.items():
+        data[k] = (("y", "x"), np.asarray(d[k]).reshape(ny, nx), {"long_name": long, "units": unit})
+    for k, (long, unit) in _SLOT.items():
+        data[k] = (
+            ("y", "x", "attractor"),
+            np.asarray(d[k]).reshape(ny, nx, ns),
+            {"long_name": long, "units": unit},
+        )
+    attrs: Dict[str, Any] = {
+        "x_name": xname,
+        "y_name": yname,
+        "starts": req["starts"],
+        "seed": req["seed"],
+        "fingerprint": s.fingerprint(),
+    }
+    attrs["failed_runs"] = int(np.asarray(d["failures"]).sum())
+    return xr.Dataset(
+        data_vars=data,
+        coords={
+            "x": ("x", np.asarray(d["x"]), {"long_name": xname, "units": _UNITS.get(xname, "1")}),
+            "y": ("y", np.asarray(d["y"]), {"long_name": yname, "units": _UNITS.get(yname, "1")}),
+        },
+        attrs=attrs,
+    )
+
+
+@_typed
+def chart(
+    params: Optional[Params] = None,
+    /,
+    *,
+    x: str = "omega",
+    x_from: float = 2.6,
+    x_to: float = 3.0,
+    x_steps: int = 9,
+    y: str = "drive_amplitude",
+    y_from: float = 0.1,
+    y_to: float = 0.12,
+    y_steps: int = 2,
+    starts: int = 4,
+    seed: int = 1,
+    tile: int = 8,
+    cluster_tol: float = 1e-5,
+    lyapunov_periods: int = 500,
+    max_attractors: int = 8,
+    threads: Optional[int] = None,
+    tol: float = 1e-8,
+    max_periods: int = 1500,
+    max_period: int = 64,
+    integrator: Optional[str] = None,
+    steps_per_period: Optional[int] = None,
+    tolerance: float = 1e-12,
+    progress: ProgressArg = None,
+    store: Union[str, "os.PathLike[str]", None] = None,
+    resume: bool = False,
+    **model: Unpack[Model],
+) -> xr.Dataset:
+    """Behaviour chart over two parameters (``afmdyn chart``): every attractor that each cell's
+    ``starts`` random starts and the continuation from its neighbours along x reach, on all
+    cores (``threads``). Ctrl-C stops it within one task.
+
+    An axis is any real model parameter by name or alias (``"omega"``, ``"alpha2"`` /
+    ``"drive_amplitude"``, ``"gap"``, ``"restitution"``, ``"hamaker"``, …) and, with
+    ``probe=``, ``"z_c"`` (m) and ``"drive_frequency"`` (Hz). ``store`` keeps the command
+    line's resumable store there (``afmdyn chart --out DIR``), ``resume=True`` continues it.
+
+    Raises:
+        ValueError: an axis that is not a real model parameter, a value out of its range, an
+            option out of its limits (each named), or ``resume`` on another request's store.
+        SimulationError: no cell found any attractor.
+
+    Returns:
+        ``xarray.Dataset`` with dims ``(y, x, attractor)``: per cell ``attractors``,
+        ``failures``, ``dominant_period``; per attractor slot (most random starts first;
+        ``max_attractors`` slots, empty ones with period 0 and NaN) ``period`` (−1
+        nonperiodic), ``lyapunov`` (λ₁ per unit τ of a nonperiodic attractor), ``x_max``,
+        ``v_t_min`` (g0), ``contacts_per_period``, ``contact_fraction``, ``fraction``
+        (basin fraction among the random starts). The same values as ``chart.nc``.
+    """
+    s = study(
+        params,
+        model,
+        x=x,
+        x_from=x_from,
+        x_to=x_to,
+        x_steps=x_steps,
+        y=y,
+        y_from=y_from,
+        y_to=y_to,
+        y_steps=y_steps,
+        starts=starts,
+        seed=seed,
+        tile=tile,
+        cluster_tol=cluster_tol,
+        lyapunov_periods=lyapunov_periods,
+        max_attractors=max_attractors,
+        threads=threads,
+        tol=tol,
+        max_periods=max_periods,
+        max_period=max_period,
+        integrator=integrator,
+        steps_per_period=steps_per_period,
+        tolerance=tolerance,
+    )
+    with reporter(progress, "chart") as cb:
+        d, doc = s.run(
+            threads=threads,
+            progress=cb,
+            store=None if store is None else os.fspath(store),
+            resume=resume,
+        )
+    _warn(doc)
+    return dataset(s, d)

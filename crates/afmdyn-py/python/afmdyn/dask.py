@@ -1,0 +1,413 @@
+"""Studies on a Dask cluster (``pip install "afmdyn[dask]"``): the tasks the library plans for
+a study, mapped over a ``dask.distributed.Client`` — a ``LocalCluster`` on this machine by
+default, or any cluster (``dask_jobqueue.SLURMCluster`` and friends, see ``docs/cluster.md``).
+
+Every task is a pure function of the request and its number (its random starts are keyed by
+the seed and the cell, never by the worker or the order), so a chart computed here equals
+:func:`afmdyn.chart` on one machine bit for bit, whatever the cluster. A worker that dies has
+its tasks rerun elsewhere (Dask's own retry); with ``store=`` each finished task's cells are
+written to a Zarr store as they arrive, and a rerun with the same request resumes from it,
+computing only the tasks not stored (a finished store computes nothing).
+
+The store ``S`` is a plain Zarr group, the chart's variables as ``xarray.open_zarr(S)``
+reads them (dims ``y``, ``x``, ``attractor``; the fingerprint of the request in its
+attributes). Beside it, the directory ``S.afmdyn`` is locked while a run writes the store and
+holds ``done``, the numbers of the finished tasks, one per line, appended (and flushed) after
+the task's region is written: a killed driver loses at most the task it was writing.
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+import os
+import time
+from typing import TYPE_CHECKING, Any, Dict, Iterable, List, Optional, Sequence, Set, Union
+
+import numpy as np
+import xarray as xr
+
+from . import _afmdyn as _core
+from ._afmdyn import Params
+from ._chart import _CELL, _SLOT, dataset, study
+from ._progress import ProgressArg, reporter
+
+try:
+    import distributed
+except ImportError as e:  # pragma: no cover - depends on the installation
+    raise ImportError(
+        'afmdyn.dask needs dask.distributed and zarr: pip install "afmdyn[dask]"'
+    ) from e
+
+if TYPE_CHECKING:
+    from typing_extensions import Unpack
+
+    from ._api import Model
+
+#: The file of finished tasks, in the store's ledger directory ``STORE.afmdyn``.
+DONE = "done"
+
+
+def ledger_dir(store: str) -> str:
+    """The directory beside a store that is locked during a run and lists its finished tasks."""
+    return os.path.normpath(store) + ".afmdyn"
+
+
+@functools.lru_cache(maxsize=8)
+def _chart_of(recipe: str) -> "_core.ChartStudy":
+    return _core.ChartStudy(recipe)
+
+
+def run_chart_task(recipe: str, task: int) -> str:
+    """Task ``task`` of the chart of ``recipe`` (what a worker runs): its cells, JSON text.
+    The chart is built once per worker process and recipe."""
+    return _chart_of(recipe).run_task(task)
+
+
+def _template(s: "_core.ChartStudy") -> xr.Dataset:
+    """The store's dataset before any task: every cell empty (as a cell with no attractor)."""
+    d = s.arrays([])
+    return dataset(s, d)
+
+
+def _done(store: str) -> Set[int]:
+    """The finished tasks: every complete line of the ledger (a cut last line is dropped)."""
+    path = os.path.join(ledger_dir(store), DONE)
+    try:
+        with open(path, "rb") as f:
+            text = f.read()
+    except FileNotFoundError:
+        return set()
+    lines = text.split(b"\n")
+    return {int(x) for x in lines[:-1] if x.strip()}
+
+
+def _open_store(s: "_core.ChartStudy", store: str, resume: bool) -> Set[int]:
+    """The tasks already in ``store`` (none for a new one, which is written empty first)."""
+    import zarr
+
+    try:
+        group = zarr.open_group(store, mode="r")
+    except Exception:  # no store there yet (zarr raises its own not-found errors)
+        group = None
+    if group is None and os.path.exists(store) and (
+        not os.path.isdir(store) or os.listdir(store)
+    ):
+        # never overwrite what is not a store (mode "w" would delete the directory's files)
+        raise ValueError(f"store: {store} exists and is not a Zarr store; choose another store=")
+    if resume and group is not None:
+        then = group.attrs.get("fingerprint")
+        if then is None:
+            raise ValueError(
+                f"resume: {store} has no record of the request that made it; "
+                "call with resume=False to start over"
+            )
+        diff = s.compare(then)
+        if diff is not None:
+            field, a, b = diff
+            raise ValueError(
+                f"resume: {field} = {a} in the interrupted run, {b} now; call with the same "
+                "arguments, or with resume=False to start over"
+            )
+        return _done(store)
+    done = os.path.join(ledger_dir(store), DONE)
+    if os.path.exists(done):
+        os.remove(done)
+    # Zarr format 2: what every xarray and zarr version reads, with consolidated metadata
+    _template(s).to_zarr(store, mode="w", consolidated=False, zarr_format=2)
+    return set()
+
+
+class _Writer:
+    """Writes finished tasks' regions into the store, in batches (every ``batch`` tasks or
+    ``seconds``, and at the end), then records them as done (flushed to disk): a killed
+    driver loses at most the unwritten batch, which a rerun computes again."""
+
+    def __init__(self, store: str, s: "_core.ChartStudy", batch: int = 32, seconds: float = 2.0):
+        import zarr
+
+        self.store, self.s = store, s
+        self.group = zarr.open_group(store, mode="r+")
+        self.arrays = {k: self.group[k] for k in [*_CELL, *_SLOT]}
+        self.batch, self.seconds = batch, seconds
+        self.pending: list = []
+        self.last = time.monotonic()
+
+    def add(self, task: int, cells: str) -> None:
+        self.pending.append((task, cells))
+        if len(self.pending) >= self.batch or time.monotonic() - self.last >= self.seconds:
+            self.flush()
+
+    def flush(self) -> None:
+        if not self.pending:
+            return
+        # one read and one write per variable: the slab of rows the batch touches
+        tiles = [(self.s.tile(t), cells) for t, cells in self.pending]
+        y0 = min(iy for (iy, _, _), _ in tiles)
+        y1 = max(iy for (iy, _, _), _ in tiles) + 1
+        slabs = {k: a[y0:y1] for k, a in self.arrays.items()}
+        for (iy, lo, hi), cells in tiles:
+            d = self.s.arrays([cells], origin=(lo, iy), size=(hi - lo, 1))
+            ns = d["shape"][2]
+            for k in _CELL:
+                slabs[k][iy - y0, lo:hi] = np.asarray(d[k])
+            for k in _SLOT:
+                slabs[k][iy - y0, lo:hi, :] = np.asarray(d[k]).reshape(hi - lo, ns)
+        for k, a in self.arrays.items():
+            a[y0:y1] = slabs[k]
+        with open(os.path.join(ledger_dir(self.store), DONE), "a", encoding="utf-8") as f:
+            f.write("".join(f"{t}\n" for t, _ in self.pending))
+            f.flush()
+            os.fsync(f.fileno())
+        self.pending.clear()
+        self.last = time.monotonic()
+
+
+def _map(
+    client: "distributed.Client",
+    s: "_core.ChartStudy",
+    todo: Iterable[int],
+    each: Any,
+    cb: Any,
+    total: int,
+    done0: int,
+) -> None:
+    todo = list(todo)
+    futures = client.map(
+        run_chart_task, [s.recipe] * len(todo), todo, pure=False, retries=3
+    )
+    task_of = {f.key: t for f, t in zip(futures, todo)}
+    finished = done0
+    for fut in distributed.as_completed(futures):
+        each(task_of[fut.key], fut.result())
+        finished += 1
+        if cb is not None:
+            cb(finished, total)
+
+
+def chart(
+    params: Optional[Params] = None,
+    /,
+    *,
+    client: Optional["distributed.Client"] = None,
+    store: Union[str, "os.PathLike[str]", None] = None,
+    resume: bool = True,
+    checkpoint_seconds: float = 2.0,
+    x: str = "omega",
+    x_from: float = 2.6,
+    x_to: float = 3.0,
+    x_steps: int = 9,
+    y: str = "drive_amplitude",
+    y_from: float = 0.1,
+    y_to: float = 0.12,
+    y_steps: int = 2,
+    starts: int = 4,
+    seed: int = 1,
+    tile: int = 8,
+    cluster_tol: float = 1e-5,
+    lyapunov_periods: int = 500,
+    max_attractors: int = 8,
+    tol: float = 1e-8,
+    max_periods: int = 1500,
+    max_period: int = 64,
+    integrator: Optional[str] = None,
+    steps_per_period: Optional[int] = None,
+    tolerance: float = 1e-12,
+    progress: ProgressArg = None,
+    **model: "Unpack[Model]",
+) -> xr.Dataset:
+    """:func:`afmdyn.chart` with its tasks mapped over a Dask cluster: ``client`` (default: a
+    ``LocalCluster`` of this machine's cores, closed at the end). With ``store`` (a Zarr
+    directory, locked during the run) each finished task is written there at once and a
+    rerun resumes (``resume=False`` starts the store over); another request on the same store
+    is refused, naming the first option that differs. Finished tasks reach the store in
+    batches, at least every ``checkpoint_seconds`` (0: each task as it arrives) and at the
+    end: a killed driver loses at most that much work.
+
+    Returns the same ``xarray.Dataset`` as :func:`afmdyn.chart` with the same arguments.
+    """
+    s = study(
+        params,
+        model,
+        x=x,
+        x_from=x_from,
+        x_to=x_to,
+        x_steps=x_steps,
+        y=y,
+        y_from=y_from,
+        y_to=y_to,
+        y_steps=y_steps,
+        starts=starts,
+        seed=seed,
+        tile=tile,
+        cluster_tol=cluster_tol,
+        lyapunov_periods=lyapunov_periods,
+        max_attractors=max_attractors,
+        tol=tol,
+        max_periods=max_periods,
+        max_period=max_period,
+        integrator=integrator,
+        steps_per_period=steps_per_period,
+        tolerance=tolerance,
+    )
+    n = s.tasks()
+    own = client is None
+    cluster = None
+    if not (checkpoint_seconds >= 0 and np.isfinite(checkpoint_seconds)):
+        raise ValueError(f"checkpoint_seconds = {checkpoint_seconds}: must be finite and >= 0")
+    if own:
+        cluster = distributed.LocalCluster(threads_per_worker=1, dashboard_address=None)
+        client = distributed.Client(cluster)
+    assert client is not None
+    lock = None
+    try:
+        with reporter(progress, "chart (dask)") as cb:
+            if store is None:
+                results: Dict[int, str] = {}
+                _map(client, s, range(n), results.__setitem__, cb, n, 0)
+                ds = dataset(s, s.arrays([results[t] for t in range(n)]))
+            else:
+                import zarr
+
+                path = os.fspath(store)
+                lock = _core.StoreLock(ledger_dir(path))
+                done = _open_store(s, path, resume)
+                todo = [t for t in range(n) if t not in done]
+                writer = _Writer(path, s, seconds=checkpoint_seconds)
+                _map(client, s, todo, writer.add, cb, n, n - len(todo))
+                writer.flush()
+                zarr.consolidate_metadata(path)
+                ds = xr.open_zarr(path).load()
+                ds.attrs = {
+                    **_template(s).attrs,
+                    "failed_runs": int(ds["failures"].values.sum()),
+                }
+    finally:
+        if lock is not None:
+            lock.release()
+        if own:
+            client.close()
+            if cluster is not None:
+                cluster.close()
+    cells = ds["failures"].values
+    if (ds["attractors"].values == 0).all():
+        raise _core.SimulationError(
+            f"every chart cell failed ({cells.size} cells): no attractor found"
+        )
+    return ds
+
+
+@functools.lru_cache(maxsize=8)
+def _sweep_of(recipe: str) -> "_core.SweepStudy":
+    return _core.SweepStudy(recipe)
+
+
+def run_coarse_task(recipe: str, k: int) -> str:
+    """Stage-0 task ``k`` of the sweep of ``recipe`` (0 forward, 1 backward): the coarse
+    pass's seeds, JSON text."""
+    return _sweep_of(recipe).coarse(k)
+
+
+def run_sweep_task(
+    recipe: str, k: int, forward: Optional[str] = None, backward: Optional[str] = None
+) -> List[str]:
+    """Stage-1 task ``k`` of the sweep of ``recipe`` from the coarse passes' seeds: its rows
+    of ``bifurcation.csv``."""
+    return _sweep_of(recipe).run_task(k, forward, backward)
+
+
+def bifurcation(
+    params: Optional[Params] = None,
+    /,
+    *,
+    client: Optional["distributed.Client"] = None,
+    param: str = "omega",
+    from_: float = 1.0,
+    to: float = 5.0,
+    steps: int = 400,
+    values: Optional[Sequence[float]] = None,
+    starts: int = 0,
+    seed: int = 1,
+    continuation: bool = True,
+    tol: float = 1e-8,
+    max_periods: int = 1500,
+    max_period: int = 64,
+    integrator: Optional[str] = None,
+    steps_per_period: Optional[int] = None,
+    tolerance: float = 1e-12,
+    progress: ProgressArg = None,
+    **model: "Unpack[Model]",
+) -> xr.Dataset:
+    """:func:`afmdyn.bifurcation` with its tasks mapped over a Dask cluster (``client``;
+    default a ``LocalCluster`` of this machine's cores, closed at the end): the two coarse
+    continuation passes first, then every chain segment and random start, seeded by them.
+
+    Returns the same ``xarray.Dataset`` as :func:`afmdyn.bifurcation` with the same
+    arguments, bit for bit. (No store: a sweep's store is the command line's, which
+    ``afmdyn.bifurcation(store=...)`` resumes.)
+    """
+    from ._api import _params, _sweep_dataset
+
+    p, _probe = _params(params, model)
+    for k, v in dict(steps=steps, starts=starts, seed=seed, max_periods=max_periods,
+                     max_period=max_period).items():
+        if isinstance(v, int) and not isinstance(v, bool) and v < 0:
+            raise ValueError(f"{k} = {v}: must be >= 0")
+    request: Dict[str, Any] = dict(
+        param=param,
+        values=None if values is None else np.asarray(values, dtype=np.float64).ravel().tolist(),
+        to=to,
+        steps=steps,
+        starts=starts,
+        seed=seed,
+        continuation=continuation,
+        tol=tol,
+        max_periods=max_periods,
+        max_period=max_period,
+        tolerance=tolerance,
+    )
+    request["from"] = from_
+    if integrator is not None:
+        request["integrator"] = integrator
+    if steps_per_period is not None:
+        request["steps_per_period"] = steps_per_period
+    s = _core.SweepStudy.build(json.dumps(request), p)
+    own = client is None
+    cluster = None
+    if own:
+        cluster = distributed.LocalCluster(threads_per_worker=1, dashboard_address=None)
+        client = distributed.Client(cluster)
+    assert client is not None
+    try:
+        with reporter(progress, "bifurcation (dask)") as cb:
+            recipe = s.recipe
+            coarse = client.map(run_coarse_task, [recipe] * s.tasks(0), range(s.tasks(0)),
+                                pure=False, retries=3)
+            fwd, bwd = (coarse[0], coarse[1]) if coarse else (None, None)
+            n = s.tasks(1)
+            futures = [
+                client.submit(run_sweep_task, recipe, k, fwd, bwd, pure=False, retries=3)
+                for k in range(n)
+            ]
+            rows: List[str] = []
+            for i, fut in enumerate(distributed.as_completed(futures)):
+                rows.extend(fut.result())
+                if cb is not None:
+                    cb(i + 1, n)
+    finally:
+        if own:
+            client.close()
+            if cluster is not None:
+                cluster.close()
+    return _sweep_dataset(p, s.records(rows), starts, seed)
+
+
+__all__ = [
+    "DONE",
+    "bifurcation",
+    "chart",
+    "ledger_dir",
+    "run_chart_task",
+    "run_coarse_task",
+    "run_sweep_task",
+]
