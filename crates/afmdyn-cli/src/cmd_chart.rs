@@ -10,7 +10,7 @@ use crate::error::CliError;
 use crate::output::{atomic, write_bytes, OutDir};
 use crate::plot::{color, save_map, CellMap};
 use afmdyn::analysis::chart::{run_chart, ChartCell, ChartPlan};
-use afmdyn::request::chart::{axis_unit, csv_lines, document, ChartArrays, CSV_HEADER};
+use afmdyn::request::chart::{axis_unit, csv_lines, document, warnings, ChartArrays, CSV_HEADER};
 use afmdyn::request::chart_store::ChartStore;
 use afmdyn::request::checkpoint::CheckpointError;
 use afmdyn::request::{parameter, ChartRequest};
@@ -112,17 +112,32 @@ fn axis_label(name: &str) -> String {
     }
 }
 
-/// Colour and legend label of a period class (the bifurcation diagram's classes).
-fn period_class(period: i32) -> (usize, &'static str) {
-    match period {
-        1 => (0, "period 1"),
-        2 => (1, "period 2"),
-        3 => (2, "period 3"),
-        4 => (3, "period 4"),
-        5..=8 => (4, "period 5–8"),
-        9..=64 => (5, "period 9–64"),
-        -1 => (6, "nonperiodic"),
-        _ => (7, "no attractor (failed)"),
+/// Colour and legend label of the class of a period and motion code (the bifurcation
+/// diagram's period classes; nonperiodic split by λ₁).
+fn period_class(period: i32, motion: i32) -> (usize, &'static str) {
+    match (period, motion) {
+        (1, _) => (0, "period 1"),
+        (2, _) => (1, "period 2"),
+        (3, _) => (2, "period 3"),
+        (4, _) => (3, "period 4"),
+        (5..=8, _) => (4, "period 5–8"),
+        (9..=64, _) => (5, "period 9–64"),
+        (-1, 2) => (6, "chaotic (λ₁ > 0)"),
+        (-1, 3) => (9, "λ₁ ≈ 0: quasi-periodic or settling"),
+        (-1, 4) => (8, "not settled (λ₁ < 0)"),
+        (-1, _) => (7, "nonperiodic (no λ₁)"),
+        _ => (NO_ATTRACTOR, "no attractor (failed)"),
+    }
+}
+
+/// The class of a cell without an attractor (drawn black).
+const NO_ATTRACTOR: usize = usize::MAX;
+
+fn class_color(c: usize) -> RGBColor {
+    if c == NO_ATTRACTOR {
+        RGBColor(0, 0, 0)
+    } else {
+        color(c)
     }
 }
 
@@ -155,7 +170,7 @@ fn write_nc(path: &Path, a: &ChartArrays, x: &str, y: &str) -> Result<(), CliErr
     }
     let cell = ["y", "x"];
     let slot = ["y", "x", "attractor"];
-    let ints: [(&str, &[&str], &str, &str); 4] = [
+    let ints: [(&str, &[&str], &str, &str); 5] = [
         ("attractors", &cell, "1", "attractors found in the cell"),
         ("failures", &cell, "1", "runs of the cell that failed"),
         (
@@ -170,18 +185,31 @@ fn write_nc(path: &Path, a: &ChartArrays, x: &str, y: &str) -> Result<(), CliErr
             "drive periods",
             "period n; -1 nonperiodic; 0 empty slot",
         ),
+        (
+            "motion",
+            &slot,
+            "code",
+            "1 periodic, 2 chaotic, 3 quasi-periodic, 4 unsettled (lyapunov < 0), 5 nonperiodic \
+             without lyapunov; 0 empty slot",
+        ),
     ];
     for (name, dims, unit, meaning) in ints {
         d(ds.add_var_i32(name, dims))?;
         d(ds.add_var_attr_string(name, "units", unit))?;
         d(ds.add_var_attr_string(name, "long_name", meaning))?;
     }
-    let floats: [(&str, &str, &str, &Vec<f64>); 6] = [
+    let floats: [(&str, &str, &str, &Vec<f64>); 7] = [
         (
             "lyapunov",
             "1/tau",
             "largest Lyapunov exponent of a nonperiodic attractor",
             &a.lyapunov,
+        ),
+        (
+            "lyapunov_error",
+            "1/tau",
+            "its error: uncertainty over the blocks plus convergence estimate",
+            &a.lyapunov_error,
         ),
         (
             "x_max",
@@ -232,6 +260,7 @@ fn write_nc(path: &Path, a: &ChartArrays, x: &str, y: &str) -> Result<(), CliErr
         f.write_var_i32("dominant_period", &a.dominant_period)
             .map_err(w)?;
         f.write_var_i32("period", &a.period).map_err(w)?;
+        f.write_var_i32("motion", &a.motion).map_err(w)?;
         for (name, _, _, v) in floats {
             f.write_var_f64(name, v).map_err(w)?;
         }
@@ -322,12 +351,11 @@ pub fn chart(a: &ChartArgs) -> Result<(), CliError> {
         }
         store.finish(&chart.fingerprint).map_err(store_error)?;
     }
-    let cells = store.cells();
+    let cells = store.cells().map_err(store_error)?;
     let arrays = ChartArrays::new(&chart, &cells);
     write_csv(&out.join("chart.csv"), &cells)?;
     write_nc(&out.join("chart.nc"), &arrays, chart.model.x, chart.model.y)?;
     draw_maps(out.path(), &chart, &arrays)?;
-    let failures: u64 = cells.iter().map(|c| u64::from(c.failures)).sum();
     let empty = cells.iter().filter(|c| c.attractors.is_empty()).count();
     if empty == cells.len() {
         let first = cells
@@ -340,16 +368,8 @@ pub fn chart(a: &ChartArgs) -> Result<(), CliError> {
             first,
         }));
     }
-    if failures > 0 {
-        eprintln!(
-            "afmdyn: warning: {failures} runs failed in {} of {} cells{}",
-            cells.iter().filter(|c| c.failures > 0).count(),
-            cells.len(),
-            cells
-                .iter()
-                .find_map(|c| c.message.as_ref())
-                .map_or(String::new(), |m| format!("; the first: {m}"))
-        );
+    for w in warnings(&chart, &cells) {
+        eprintln!("afmdyn: warning: {w}");
     }
     if a.json {
         let mut doc = document(&chart, &cells);
@@ -383,18 +403,19 @@ fn draw_maps(dir: &Path, chart: &afmdyn::request::Chart, a: &ChartArrays) -> Res
     let cells: Vec<Option<RGBColor>> = a
         .dominant_period
         .iter()
-        .map(|&p| {
-            let (c, label) = period_class(if p == 0 { -2 } else { p });
+        .enumerate()
+        .map(|(i, &p)| {
+            let (c, label) = period_class(if p == 0 { -2 } else { p }, a.motion[i * a.slots]);
             if !classes.contains(&(c, label)) {
                 classes.push((c, label));
             }
-            Some(color(c))
+            Some(class_color(c))
         })
         .collect();
     classes.sort();
     let legend: Vec<(String, RGBColor)> = classes
         .iter()
-        .map(|(c, l)| (l.to_string(), color(*c)))
+        .map(|(c, l)| (l.to_string(), class_color(*c)))
         .collect();
     save_map(
         dir,

@@ -61,7 +61,9 @@ fn arrays_dict<'py>(py: Python<'py>, a: ChartArrays) -> PyResult<Bound<'py, PyDi
     out.i64s("failures", ints(a.failures))?;
     out.i64s("dominant_period", ints(a.dominant_period))?;
     out.i64s("period", ints(a.period))?;
+    out.i64s("motion", ints(a.motion))?;
     out.f64s("lyapunov", a.lyapunov)?;
+    out.f64s("lyapunov_error", a.lyapunov_error)?;
     out.f64s("x_max", a.x_max)?;
     out.f64s("v_t_min", a.v_t_min)?;
     out.f64s("contacts_per_period", a.contacts_per_period)?;
@@ -255,10 +257,10 @@ impl ChartStudy {
                         .map_err(checkpoint_error)?,
                     None => Default::default(),
                 };
-                if let Some(s) = &store {
+                if let Some(s) = store.as_mut() {
                     if resume && s.finished().map_err(checkpoint_error)? {
                         worker_job.progress.advance(total);
-                        return Ok(s.cells());
+                        return s.cells().map_err(checkpoint_error);
                     }
                 }
                 worker_job
@@ -292,7 +294,7 @@ impl ChartStudy {
                 }
                 if let Some(mut s) = store {
                     s.finish(&chart.fingerprint).map_err(checkpoint_error)?;
-                    return Ok(s.cells());
+                    return s.cells().map_err(checkpoint_error);
                 }
                 all.sort_by_key(|c| (c.iy, c.ix));
                 Ok(all)

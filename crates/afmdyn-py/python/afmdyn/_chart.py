@@ -37,7 +37,13 @@ _CELL = {
 }
 _SLOT = {
     "period": ("period n; -1 nonperiodic; 0 empty slot", "drive periods"),
+    "motion": (
+        "1 periodic, 2 chaotic, 3 quasi-periodic, 4 unsettled (lyapunov < 0), "
+        "5 nonperiodic without lyapunov; 0 empty slot",
+        "code",
+    ),
     "lyapunov": ("largest Lyapunov exponent of a nonperiodic attractor", "1/tau"),
+    "lyapunov_error": ("its error: uncertainty over the blocks plus convergence estimate", "1/tau"),
     "x_max": ("largest tip deflection W(1,tau) over the steady state", "g0"),
     "v_t_min": ("smallest V_T over the steady state", "g0"),
     "contacts_per_period": ("contact entries (impacts) per drive period", "1/period"),
@@ -155,7 +161,9 @@ def chart(
         ``xarray.Dataset`` with dims ``(y, x, attractor)``: per cell ``attractors``,
         ``failures``, ``dominant_period``; per attractor slot (most random starts first;
         ``max_attractors`` slots, empty ones with period 0 and NaN) ``period`` (−1
-        nonperiodic), ``lyapunov`` (λ₁ per unit τ of a nonperiodic attractor), ``x_max``,
+        nonperiodic), ``motion`` (1 periodic, 2 chaotic: λ₁ > 2 × its error, 3 quasi-periodic:
+        |λ₁| ≤ 2 × its error, 4 unsettled: λ₁ < −2 × its error, 5 nonperiodic without λ₁),
+        ``lyapunov`` (λ₁ per unit τ of a nonperiodic attractor), ``lyapunov_error``, ``x_max``,
         ``v_t_min`` (g0), ``contacts_per_period``, ``contact_fraction``, ``fraction``
         (basin fraction among the random starts). The same values as ``chart.nc``.
     """

@@ -89,6 +89,9 @@ pub struct ChartAttractor {
     /// Largest Lyapunov exponent λ₁ per unit τ of a nonperiodic attractor (`None` for a
     /// periodic one, or when not estimated or its run failed).
     pub lyapunov: Option<f64>,
+    /// The error of λ₁: its uncertainty over the blocks plus its convergence estimate
+    /// ([`super::lyapunov::LyapunovSpectrum`]); `None` with `lyapunov`.
+    pub lyapunov_error: Option<f64>,
     /// Largest tip deflection W(1,τ) over the recorded steady state (g0).
     pub x_max: f64,
     /// Smallest V_T over the recorded steady state (g0; ≤ 0: contact).
@@ -107,6 +110,62 @@ pub struct ChartAttractor {
     /// Modal state (a_1…a_N, ȧ_1…ȧ_N) at its last Poincaré point (τ a multiple of 2π/Ω):
     /// where continuation into the next cell starts.
     pub state: Vec<f64>,
+}
+
+/// What kind of motion an attractor of a chart is, from its period and λ₁.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MotionKind {
+    /// A period-n orbit.
+    Periodic(usize),
+    /// Nonperiodic with λ₁ > 2 × its error: chaos.
+    Chaotic,
+    /// Nonperiodic with |λ₁| ≤ 2 × its error: quasi-periodic (or undecided).
+    Quasiperiodic,
+    /// Nonperiodic with λ₁ < −2 × its error: a motion still converging (to a periodic orbit
+    /// of period > 64, or one the transient cap `max_periods` did not reach — high-Q
+    /// cantilevers settle over ~Q periods).
+    Unsettled,
+    /// Nonperiodic without a λ₁ estimate.
+    Nonperiodic,
+}
+
+impl MotionKind {
+    /// The numeric code of the result arrays: n ≥ 1 is not used here (see `period`); 1
+    /// periodic, 2 chaotic, 3 quasi-periodic, 4 unsettled, 5 nonperiodic without λ₁ (0: an
+    /// empty slot).
+    pub fn code(self) -> i32 {
+        match self {
+            MotionKind::Periodic(_) => 1,
+            MotionKind::Chaotic => 2,
+            MotionKind::Quasiperiodic => 3,
+            MotionKind::Unsettled => 4,
+            MotionKind::Nonperiodic => 5,
+        }
+    }
+
+    /// `periodic`, `chaotic`, `quasiperiodic`, `unsettled` or `nonperiodic`.
+    pub fn name(self) -> &'static str {
+        match self {
+            MotionKind::Periodic(_) => "periodic",
+            MotionKind::Chaotic => "chaotic",
+            MotionKind::Quasiperiodic => "quasiperiodic",
+            MotionKind::Unsettled => "unsettled",
+            MotionKind::Nonperiodic => "nonperiodic",
+        }
+    }
+}
+
+impl ChartAttractor {
+    /// Its kind of motion: the period, or the sign of λ₁ against twice its error.
+    pub fn motion(&self) -> MotionKind {
+        match (self.period, self.lyapunov, self.lyapunov_error) {
+            (Some(n), _, _) => MotionKind::Periodic(n),
+            (None, Some(l), Some(e)) if l > 2.0 * e => MotionKind::Chaotic,
+            (None, Some(l), Some(e)) if l < -2.0 * e => MotionKind::Unsettled,
+            (None, Some(_), Some(_)) => MotionKind::Quasiperiodic,
+            _ => MotionKind::Nonperiodic,
+        }
+    }
 }
 
 /// One cell of a chart.
@@ -326,13 +385,17 @@ impl<'a> ChartPlan<'a> {
                         };
                         lyapunov_spectrum(m, s.end_state(), &opts)
                             .ok()
-                            .and_then(|l| l.exponents.first().copied())
+                            .and_then(|l| {
+                                let err = l.uncertainty.first()? + l.convergence.first()?;
+                                Some((*l.exponents.first()?, err))
+                            })
                     }
                     _ => None,
                 };
                 ChartAttractor {
                     period,
-                    lyapunov,
+                    lyapunov: lyapunov.map(|l| l.0),
+                    lyapunov_error: lyapunov.map(|l| l.1),
                     x_max: s.stats.x_max,
                     v_t_min: s.stats.v_t_min,
                     contacts_per_period: s.stats.contacts_per_period,

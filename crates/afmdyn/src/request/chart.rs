@@ -329,7 +329,7 @@ pub fn axis_unit(name: &str) -> &'static str {
 
 /// The columns of `chart.csv`: one row per attractor of a cell (one row, with `attractor`
 /// empty, for a cell without any).
-pub const CSV_HEADER: [&str; 17] = [
+pub const CSV_HEADER: [&str; 18] = [
     "ix",
     "iy",
     "x",
@@ -338,6 +338,7 @@ pub const CSV_HEADER: [&str; 17] = [
     "status",
     "period",
     "lyapunov",
+    "lyapunov_error",
     "x_max",
     "v_t_min",
     "contacts_per_period",
@@ -371,14 +372,11 @@ pub fn csv_lines(cell: &ChartCell) -> Vec<String> {
                 crate::analysis::chart::Origin::Right => "right",
             };
             format!(
-                "{head},{k},{},{},{},{},{},{},{},{},{},{origin},{},{message}",
-                if a.period.is_some() {
-                    "periodic"
-                } else {
-                    "nonperiodic"
-                },
+                "{head},{k},{},{},{},{},{},{},{},{},{},{},{origin},{},{message}",
+                a.motion().name(),
                 a.period.map_or(String::new(), |n| n.to_string()),
                 a.lyapunov.map_or(String::new(), |l| l.to_string()),
+                a.lyapunov_error.map_or(String::new(), |l| l.to_string()),
                 a.x_max,
                 a.v_t_min,
                 a.contacts_per_period,
@@ -409,8 +407,13 @@ pub struct ChartArrays {
     pub failures: Vec<i32>,
     /// (y, x, attractor): period n; −1 nonperiodic; 0 empty slot.
     pub period: Vec<i32>,
+    /// (y, x, attractor): the kind of motion ([`crate::analysis::chart::MotionKind::code`]: 1 periodic, 2 chaotic, 3
+    /// quasi-periodic, 4 unsettled, 5 nonperiodic without λ₁; 0 empty slot).
+    pub motion: Vec<i32>,
     /// (y, x, attractor): λ₁ (NaN: periodic, not estimated, or empty).
     pub lyapunov: Vec<f64>,
+    /// (y, x, attractor): the error of λ₁ (NaN with it).
+    pub lyapunov_error: Vec<f64>,
     /// (y, x, attractor): X_max (g0).
     pub x_max: Vec<f64>,
     /// (y, x, attractor): smallest V_T (g0).
@@ -457,7 +460,9 @@ impl ChartArrays {
             attractors: vec![0; n],
             failures: vec![0; n],
             period: vec![0; n * slots],
+            motion: vec![0; n * slots],
             lyapunov: vec![f64::NAN; n * slots],
+            lyapunov_error: vec![f64::NAN; n * slots],
             x_max: vec![f64::NAN; n * slots],
             v_t_min: vec![f64::NAN; n * slots],
             contacts_per_period: vec![f64::NAN; n * slots],
@@ -474,7 +479,9 @@ impl ChartArrays {
             for (k, at) in c.attractors.iter().take(slots).enumerate() {
                 let i = cell * slots + k;
                 a.period[i] = at.period.map_or(-1, |p| p as i32);
+                a.motion[i] = at.motion().code();
                 a.lyapunov[i] = at.lyapunov.unwrap_or(f64::NAN);
+                a.lyapunov_error[i] = at.lyapunov_error.unwrap_or(f64::NAN);
                 a.x_max[i] = at.x_max;
                 a.v_t_min[i] = at.v_t_min;
                 a.contacts_per_period[i] = at.contacts_per_period;
@@ -485,6 +492,47 @@ impl ChartArrays {
         }
         a
     }
+}
+
+/// The caveats of a chart's answer (the `warnings` of its document): attractors that did not
+/// settle within the transient cap, runs that failed.
+pub fn warnings(chart: &Chart, cells: &[ChartCell]) -> Vec<String> {
+    let mut w = Vec::new();
+    use crate::analysis::chart::MotionKind;
+    let settling = |c: &&ChartCell| {
+        c.attractors.iter().any(|a| {
+            matches!(
+                a.motion(),
+                MotionKind::Unsettled | MotionKind::Quasiperiodic
+            )
+        })
+    };
+    let unsettled: Vec<&ChartCell> = cells.iter().filter(settling).collect();
+    if let Some(first) = unsettled.first() {
+        w.push(format!(
+            "{} of {} cells have a nonperiodic motion with λ₁ ≤ 0 (first at x = {}, y = {}): \
+             quasi-periodic, or still settling after max_periods = {}; raise max_periods to \
+             tell (a cantilever of quality factor Q settles over ~Q periods)",
+            unsettled.len(),
+            cells.len(),
+            first.x,
+            first.y,
+            chart.spec.steady.max_periods,
+        ));
+    }
+    let failed: u64 = cells.iter().map(|c| u64::from(c.failures)).sum();
+    if failed > 0 {
+        let first = cells
+            .iter()
+            .find_map(|c| c.message.as_deref())
+            .unwrap_or("");
+        w.push(format!(
+            "{failed} runs failed in {} of {} cells; the first: {first}",
+            cells.iter().filter(|c| c.failures > 0).count(),
+            cells.len()
+        ));
+    }
+    w
 }
 
 /// The `--json` document of a chart: the parameters of its first cell (x₀, y₀; the other cells
@@ -500,7 +548,9 @@ pub fn document(chart: &Chart, cells: &[ChartCell]) -> Value {
                 "iy": c.iy,
                 "attractors": c.attractors.iter().map(|a| json!({
                     "period": a.period,
+                    "motion": a.motion().name(),
                     "lyapunov": a.lyapunov,
+                    "lyapunov_error": a.lyapunov_error,
                     "x_max": a.x_max,
                     "v_t_min": a.v_t_min,
                     "contacts_per_period": a.contacts_per_period,
@@ -522,6 +572,7 @@ pub fn document(chart: &Chart, cells: &[ChartCell]) -> Value {
         "starts": chart.spec.starts,
         "cells": cells_json,
         "failures": cells.iter().map(|c| c.failures as u64).sum::<u64>(),
+        "warnings": warnings(chart, cells),
     });
     match &first {
         Ok(p) => crate::report::with_si(doc, chart.model.probe.as_ref(), p),

@@ -17,7 +17,7 @@ use super::sweep::first_difference;
 use crate::analysis::chart::ChartCell;
 use serde::Deserialize;
 use serde_json::{json, Value};
-use std::collections::{BTreeMap, HashSet};
+use std::collections::{BTreeMap, BTreeSet, HashSet};
 use std::fs::{self, File, OpenOptions};
 use std::io::{BufRead, BufReader, BufWriter, Write};
 use std::path::{Path, PathBuf};
@@ -49,7 +49,8 @@ fn io<'p>(
 pub struct ChartStore<'a> {
     lock: &'a DirLock,
     writer: Option<BufWriter<File>>,
-    tiles: BTreeMap<usize, Vec<ChartCell>>,
+    /// The tasks stored (their cells stay in the file: memory does not grow with the chart).
+    tasks: BTreeSet<usize>,
 }
 
 impl<'a> ChartStore<'a> {
@@ -58,7 +59,7 @@ impl<'a> ChartStore<'a> {
         ChartStore {
             lock,
             writer: None,
-            tiles: BTreeMap::new(),
+            tasks: BTreeSet::new(),
         }
     }
 
@@ -117,13 +118,13 @@ impl<'a> ChartStore<'a> {
                         let field = field.strip_prefix("chart.").unwrap_or(&field).to_string();
                         return Err(CheckpointError::Mismatch { field, then, now });
                     }
-                    self.read_tiles()?;
+                    self.tasks = self.read_tiles(|_, _| {})?;
                     self.reopen_writer()?;
-                    return Ok(self.tiles.keys().copied().collect());
+                    return Ok(self.tasks.iter().copied().collect());
                 }
             }
         }
-        self.tiles.clear();
+        self.tasks.clear();
         match fs::remove_file(&tiles_path) {
             Ok(()) => {}
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
@@ -134,13 +135,18 @@ impl<'a> ChartStore<'a> {
         Ok(HashSet::new())
     }
 
-    /// The stored tasks: every complete line (a cut or unreadable last line is dropped, and
-    /// the file cut back to the complete lines so that appends follow them).
-    fn read_tiles(&mut self) -> Result<(), CheckpointError> {
+    /// The stored tasks, each handed with its cells to `each`: every complete line (a cut or
+    /// unreadable last line is dropped, and the file cut back to the complete lines so that
+    /// appends follow them).
+    fn read_tiles(
+        &self,
+        mut each: impl FnMut(usize, Vec<ChartCell>),
+    ) -> Result<BTreeSet<usize>, CheckpointError> {
         let path = self.path(TILES);
+        let mut tasks = BTreeSet::new();
         let file = match File::open(&path) {
             Ok(f) => f,
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(tasks),
             Err(e) => return Err(io("read", &path)(e)),
         };
         let mut reader = BufReader::new(file);
@@ -155,7 +161,9 @@ impl<'a> ChartStore<'a> {
             }
             match serde_json::from_slice::<Line>(&buf) {
                 Ok(line) => {
-                    self.tiles.insert(line.task, line.cells);
+                    if tasks.insert(line.task) {
+                        each(line.task, line.cells);
+                    }
                     good += n as u64;
                 }
                 Err(_) => break,
@@ -165,7 +173,10 @@ impl<'a> ChartStore<'a> {
             .write(true)
             .open(&path)
             .map_err(io("write", &path))?;
-        f.set_len(good).map_err(io("write", &path))
+        if f.metadata().map_err(io("read", &path))?.len() != good {
+            f.set_len(good).map_err(io("write", &path))?;
+        }
+        Ok(tasks)
     }
 
     fn reopen_writer(&mut self) -> Result<(), CheckpointError> {
@@ -191,7 +202,7 @@ impl<'a> ChartStore<'a> {
                 .and_then(|()| w.flush())
                 .map_err(io("write", &path))?;
         }
-        self.tiles.insert(task, cells);
+        self.tasks.insert(task);
         Ok(())
     }
 
@@ -215,8 +226,20 @@ impl<'a> ChartStore<'a> {
         Ok(self.ledger()?.is_some_and(|l| l.finished))
     }
 
-    /// Every stored cell, in the order of the tasks (row by row, x increasing).
-    pub fn cells(&self) -> Vec<ChartCell> {
-        self.tiles.values().flatten().cloned().collect()
+    /// Every stored cell, in the order of the tasks (row by row, x increasing), read back
+    /// from the store.
+    ///
+    /// # Errors
+    /// [`CheckpointError::Io`].
+    pub fn cells(&mut self) -> Result<Vec<ChartCell>, CheckpointError> {
+        if let Some(w) = self.writer.as_mut() {
+            let path = self.lock.path().join(TILES);
+            w.flush().map_err(io("write", &path))?;
+        }
+        let mut tiles = BTreeMap::new();
+        self.read_tiles(|t, cells| {
+            tiles.insert(t, cells);
+        })?;
+        Ok(tiles.into_values().flatten().collect())
     }
 }
