@@ -23,6 +23,7 @@ fn _afmdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<chart::ChartStudy>()?;
     m.add_class::<chart::StoreLock>()?;
     m.add_class::<sweep::SweepStudy>()?;
+    m.add_class::<sweep::SweepStore>()?;
     m.add(
         "SimulationError",
         m.py().get_type::<errors::SimulationError>(),

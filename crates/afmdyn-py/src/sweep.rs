@@ -5,16 +5,19 @@
 //! Points travel as the rows of `bifurcation.csv` (numbers in shortest round-trip form), so a
 //! sweep assembled from tasks equals `afmdyn.bifurcation` bit for bit.
 
+use crate::analyses::{checkpoint_error, lock_store};
 use crate::errors::{sim_error, value_error};
 use crate::params::PyParams;
 use afmdyn::analysis::bifurcation::{Branch, Seeds, SweepPlan, SweepPoint, SweepSpec, SweepTask};
-use afmdyn::request::sweep::{order_key, records, SweepRecord};
-use afmdyn::request::BifurcationRequest;
+use afmdyn::request::checkpoint::{self, Checkpoint, CheckpointError};
+use afmdyn::request::sweep::{fingerprint, order_key, records, SweepRecord};
+use afmdyn::request::{BifurcationRequest, DirLock, FileCheckpoint};
 use afmdyn::Params;
 use nalgebra::DVector;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 use serde::{Deserialize, Serialize};
+use std::collections::HashSet;
 use std::sync::atomic::AtomicBool;
 use std::sync::Mutex;
 
@@ -29,6 +32,7 @@ struct Recipe {
 #[pyclass(frozen, module = "afmdyn._afmdyn")]
 pub struct SweepStudy {
     spec: SweepSpec,
+    request: BifurcationRequest,
     recipe: String,
 }
 
@@ -44,7 +48,11 @@ impl SweepStudy {
     fn of(recipe: Recipe) -> PyResult<Self> {
         let spec = recipe.request.spec(&recipe.params).map_err(sim_error)?;
         let text = serde_json::to_string(&recipe).map_err(|e| value_error(e.to_string()))?;
-        Ok(SweepStudy { spec, recipe: text })
+        Ok(SweepStudy {
+            spec,
+            request: recipe.request,
+            recipe: text,
+        })
     }
 }
 
@@ -162,5 +170,108 @@ impl SweepStudy {
             return Err(sim_error(e));
         }
         crate::analyses::sweep_dict(py, &self.spec, recs)
+    }
+}
+
+/// The command line's store of a sweep (`afmdyn bifurcation --out DIR`, `afmdyn.bifurcation(
+/// store=DIR)`), written by an executor that runs the sweep's tasks elsewhere: it stores the
+/// points of each finished task that are not stored yet, so a task computed again after an
+/// interruption (a chain segment runs whole from its seed, deterministically) adds nothing
+/// twice. Locked while it exists (released by [`SweepStore::release`] or when dropped).
+#[pyclass(module = "afmdyn._afmdyn")]
+pub struct SweepStore {
+    lock: Mutex<Option<DirLock>>,
+    done: Mutex<HashSet<(usize, Branch)>>,
+}
+
+impl SweepStore {
+    fn with<T>(
+        &self,
+        f: impl FnOnce(&mut FileCheckpoint<'_>) -> Result<T, CheckpointError>,
+    ) -> PyResult<T> {
+        let guard = self.lock.lock().unwrap_or_else(|e| e.into_inner());
+        let lock = guard
+            .as_ref()
+            .ok_or_else(|| value_error("the store was released"))?;
+        f(&mut FileCheckpoint::new(lock)).map_err(checkpoint_error)
+    }
+}
+
+#[pymethods]
+impl SweepStore {
+    #[new]
+    fn new(path: std::path::PathBuf) -> PyResult<Self> {
+        Ok(SweepStore {
+            lock: Mutex::new(Some(lock_store(&path)?)),
+            done: Mutex::new(HashSet::new()),
+        })
+    }
+
+    /// Where `study` stands in the store (a new sweep begins without `resume`): `None` when
+    /// it finished, else the stage-1 tasks with points still to store.
+    fn open(&self, study: PyRef<'_, SweepStudy>, resume: bool) -> PyResult<Option<Vec<usize>>> {
+        let fp = fingerprint(&study.request, &study.spec);
+        let Some(left) = self.with(|s| checkpoint::open(s, &fp, resume))? else {
+            return Ok(None);
+        };
+        let plan = SweepPlan::new(&study.spec);
+        let todo = plan
+            .tasks(1)
+            .iter()
+            .enumerate()
+            .filter(|(_, t)| match **t {
+                SweepTask::Segment(b, k) => plan
+                    .chunk_indices(b, k)
+                    .iter()
+                    .any(|&i| !left.done.contains(&(i, b))),
+                SweepTask::Start(i, s) => !left.done.contains(&(i, Branch::Start(s))),
+                SweepTask::Coarse(_) => false,
+            })
+            .map(|(k, _)| k)
+            .collect();
+        *self.done.lock().unwrap_or_else(|e| e.into_inner()) = left.done;
+        Ok(Some(todo))
+    }
+
+    /// Store the points of `rows` (a task's rows, [`SweepStudy::run_task`]) not stored yet.
+    fn append(&self, rows: Vec<String>) -> PyResult<()> {
+        let recs = rows
+            .iter()
+            .map(|l| SweepRecord::parse_csv(l).map_err(value_error))
+            .collect::<PyResult<Vec<_>>>()?;
+        let mut done = self.done.lock().unwrap_or_else(|e| e.into_inner());
+        self.with(|s| {
+            for point in recs.chunk_by(|a, b| (a.index, a.branch) == (b.index, b.branch)) {
+                let key = (point[0].index, point[0].branch);
+                if done.insert(key) {
+                    s.append(point)?;
+                }
+            }
+            Ok(())
+        })
+    }
+
+    /// Put the stored rows in the one order and mark the sweep finished.
+    fn finish(&self, study: PyRef<'_, SweepStudy>) -> PyResult<()> {
+        let fp = fingerprint(&study.request, &study.spec);
+        self.with(|s| s.finish(&fp))
+    }
+
+    /// The columns of the finished sweep (as `afmdyn.bifurcation` returns them).
+    fn records<'py>(
+        &self,
+        py: Python<'py>,
+        study: PyRef<'_, SweepStudy>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let recs = self.with(|s| s.records())?;
+        if let Some(e) = afmdyn::request::sweep::every_point_failed(&recs) {
+            return Err(sim_error(e));
+        }
+        crate::analyses::sweep_dict(py, &study.spec, recs)
+    }
+
+    /// Release the lock.
+    fn release(&self) {
+        self.lock.lock().unwrap_or_else(|e| e.into_inner()).take();
     }
 }

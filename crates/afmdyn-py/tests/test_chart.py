@@ -212,3 +212,22 @@ def test_dask_bifurcation_equals_the_local_sweep(client):
     xr.testing.assert_identical(
         afmdyn.dask.bifurcation(**kw, client=client), afmdyn.bifurcation(**kw)
     )
+
+
+def test_dask_bifurcation_stores_and_resumes_the_command_lines_sweep(client, cli, tmp_path):
+    args = "--from 2.0 --to 4.0 --steps 40 --starts 1 --seed 3".split()
+    ref = cli("bifurcation", *args, "--out", tmp_path / "ref")
+    assert ref.returncode == 0, ref.stderr
+    kw = dict(from_=2.0, to=4.0, steps=40, starts=1, seed=3)
+    # a command-line run killed after 30 points, resumed through Dask
+    cut = tmp_path / "cut"
+    killed = cli("bifurcation", *args, "--out", cut, "--threads", "1", "--abort-after", "30")
+    assert killed.returncode != 0
+    ds = afmdyn.dask.bifurcation(**kw, client=client, store=cut)
+    assert (cut / "bifurcation.csv").read_bytes() == (tmp_path / "ref" / "bifurcation.csv").read_bytes()
+    xr.testing.assert_identical(ds, afmdyn.bifurcation(**kw))
+    # finished: nothing computed again; another request refused
+    again = afmdyn.dask.bifurcation(**kw, client=client, store=cut)
+    xr.testing.assert_identical(again, ds)
+    with pytest.raises(ValueError, match="steps = 40 in the interrupted run, 41 now"):
+        afmdyn.dask.bifurcation(**{**kw, "steps": 41}, client=client, store=cut)

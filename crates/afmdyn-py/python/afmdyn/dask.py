@@ -321,6 +321,8 @@ def bifurcation(
     /,
     *,
     client: Optional["distributed.Client"] = None,
+    store: Union[str, "os.PathLike[str]", None] = None,
+    resume: bool = True,
     param: str = "omega",
     from_: float = 1.0,
     to: float = 5.0,
@@ -342,9 +344,14 @@ def bifurcation(
     default a ``LocalCluster`` of this machine's cores, closed at the end): the two coarse
     continuation passes first, then every chain segment and random start, seeded by them.
 
+    With ``store`` (a directory, locked during the run) the sweep is kept in the command
+    line's layout (``afmdyn bifurcation --out DIR``): each finished task's points are
+    appended as they arrive, and a rerun with the same request resumes — from a run of this
+    function, of ``afmdyn.bifurcation(store=...)`` or of the command line — computing only the
+    tasks with points not stored (``resume=False`` starts over; another request is refused).
+
     Returns the same ``xarray.Dataset`` as :func:`afmdyn.bifurcation` with the same
-    arguments, bit for bit. (No store: a sweep's store is the command line's, which
-    ``afmdyn.bifurcation(store=...)`` resumes.)
+    arguments, bit for bit.
     """
     from ._api import _params, _sweep_dataset
 
@@ -378,28 +385,46 @@ def bifurcation(
         cluster = distributed.LocalCluster(threads_per_worker=1, dashboard_address=None)
         client = distributed.Client(cluster)
     assert client is not None
+    sweep_store = None
     try:
-        with reporter(progress, "bifurcation (dask)") as cb:
-            recipe = s.recipe
-            coarse = client.map(run_coarse_task, [recipe] * s.tasks(0), range(s.tasks(0)),
-                                pure=False, retries=3)
-            fwd, bwd = (coarse[0], coarse[1]) if coarse else (None, None)
-            n = s.tasks(1)
-            futures = [
-                client.submit(run_sweep_task, recipe, k, fwd, bwd, pure=False, retries=3)
-                for k in range(n)
-            ]
-            rows: List[str] = []
-            for i, fut in enumerate(distributed.as_completed(futures)):
-                rows.extend(fut.result())
-                if cb is not None:
-                    cb(i + 1, n)
+        if store is not None:
+            sweep_store = _core.SweepStore(os.fspath(store))
+        todo: Optional[List[int]] = list(range(s.tasks(1)))
+        if sweep_store is not None:
+            todo = sweep_store.open(s, resume)
+        rows: List[str] = []
+        if todo:
+            with reporter(progress, "bifurcation (dask)") as cb:
+                recipe = s.recipe
+                coarse = client.map(run_coarse_task, [recipe] * s.tasks(0),
+                                    range(s.tasks(0)), pure=False, retries=3)
+                fwd, bwd = (coarse[0], coarse[1]) if coarse else (None, None)
+                futures = [
+                    client.submit(run_sweep_task, recipe, k, fwd, bwd, pure=False, retries=3)
+                    for k in todo
+                ]
+                for i, fut in enumerate(distributed.as_completed(futures)):
+                    task_rows = fut.result()
+                    if sweep_store is not None:
+                        sweep_store.append(task_rows)
+                    else:
+                        rows.extend(task_rows)
+                    if cb is not None:
+                        cb(i + 1, len(todo))
+        if sweep_store is not None:
+            if todo is not None:
+                sweep_store.finish(s)
+            d = sweep_store.records(s)
+        else:
+            d = s.records(rows)
     finally:
+        if sweep_store is not None:
+            sweep_store.release()
         if own:
             client.close()
             if cluster is not None:
                 cluster.close()
-    return _sweep_dataset(p, s.records(rows), starts, seed)
+    return _sweep_dataset(p, d, starts, seed)
 
 
 __all__ = [
