@@ -20,27 +20,13 @@
 //! `... -- continuation <N> [reps]`: time of the continuation of the default period-1 branch
 //! over Ω from 5 down to 1 (as `benches/stability.rs`), best of `reps`, and its number of points.
 //!
-//! `... -- batch <N> [lanes] [periods]`: many trajectories at one parameter set (default, Ω =
-//! 2.6): `lanes` random starts (`random_state`, seed 1), each first taken 50 periods onto the
-//! attractor, then advanced `periods` more one by one ([`advance`] per lane) and as one
-//! [`ExactBatch`]; prints µs per trajectory-period of both (best of 3) and their ratio, after
-//! checking that both give the same final states bit for bit.
-//!
 //! `... -- grid <N>`: the exact propagator's grid sub-steps per forcing period at the default
 //! parameters (for `scripts/perf-floor.sh`).
-//!
-//! `... -- census <N> [samples] [omega]`: the steady states of `samples` random starts (the
-//! attractor census of `find_attractors`, default Ω = 2.6, transient cap 300 periods) one by
-//! one ([`steady_state`] per start) and batched ([`steady_states`], one batch); prints ms per
-//! start of both and the ratio, after checking that the results are identical. Run with
-//! `RAYON_NUM_THREADS=1` for one core.
 
-use afmdyn::analysis::bifurcation::random_state;
 use afmdyn::analysis::continuation::{continue_branch, ContinuationSpec};
 use afmdyn::analysis::shooting::{shoot, ShootingOptions};
-use afmdyn::analysis::steady::{steady_state, steady_states, StatsObserver, SteadyOptions};
-use afmdyn::integrate::exact::{ExactBatch, ExactOptions, ExactPropagator, Propagation};
-use afmdyn::integrate::Integrator;
+use afmdyn::analysis::steady::{steady_state, StatsObserver, SteadyOptions};
+use afmdyn::integrate::exact::{ExactOptions, ExactPropagator, Propagation};
 use afmdyn::integrate::{
     advance, advance_dyn, advance_observed, build, IntegratorOptions, Observed, Observer, Step,
 };
@@ -161,116 +147,6 @@ fn continuation(modes: usize, reps: usize) -> Result<(), Box<dyn std::error::Err
     Ok(())
 }
 
-fn batched(modes: usize, lanes: usize, periods: f64) -> Result<(), Box<dyn std::error::Error>> {
-    let p = Params {
-        modes,
-        ..Params::default()
-    };
-    let m = CantileverModel::new(&p)?;
-    let proto = ExactPropagator::try_new(&m, 1)?;
-    let tau0 = 50.0 * p.period();
-    let t_end = tau0 + periods * p.period();
-    let mut starts = Vec::with_capacity(lanes);
-    for i in 0..lanes {
-        let mut it = proto.clone();
-        it.reset(0.0, &random_state(&m, 1, i as u64))?;
-        advance(&mut it, tau0)?;
-        starts.push(it.state().clone());
-    }
-    let mut ends_alone = Vec::new();
-    let alone = best_of(3, || {
-        ends_alone = starts
-            .iter()
-            .map(|z| {
-                let mut it = proto.clone();
-                it.reset(tau0, z).ok()?;
-                advance(&mut it, t_end).ok()?;
-                Some(it.state().clone())
-            })
-            .collect();
-    });
-    let mut ends_batch = Vec::new();
-    let together = best_of(3, || {
-        let mut batch = ExactBatch::new(&proto);
-        for z in &starts {
-            batch.push(tau0, z).ok();
-        }
-        let ok = batch.advance_to(t_end, &vec![true; lanes]).ok();
-        ends_batch = (0..lanes)
-            .map(|i| {
-                let fine = ok.as_ref().is_some_and(|r| r[i].is_ok());
-                fine.then(|| batch.lane(i).state().clone())
-            })
-            .collect();
-    });
-    if ends_alone != ends_batch {
-        return Err("batched and one-by-one final states differ".into());
-    }
-    let per = |us: f64| us / (lanes as f64 * periods);
-    println!(
-        "batch N = {modes}, {lanes} lanes: {:.2} µs per trajectory-period one by one, {:.2} µs \
-         batched ({:.2}x)",
-        per(alone),
-        per(together),
-        alone / together
-    );
-    Ok(())
-}
-
-fn census(modes: usize, samples: usize, omega: f64) -> Result<(), Box<dyn std::error::Error>> {
-    let p = Params {
-        modes,
-        omega,
-        ..Params::default()
-    };
-    let m = CantileverModel::new(&p)?;
-    let proto = ExactPropagator::try_new(&m, 1)?;
-    let opts = SteadyOptions {
-        max_periods: 300,
-        ..SteadyOptions::default()
-    };
-    let starts: Vec<DVector<f64>> = (0..samples)
-        .map(|i| random_state(&m, 1, i as u64))
-        .collect();
-    let mut alone = Vec::new();
-    let t_alone = best_of(3, || {
-        alone = starts
-            .iter()
-            .map(|z| {
-                let mut it = proto.clone();
-                it.reset(0.0, z).map_err(|e| e.to_string())?;
-                steady_state(&mut it, &opts).map_err(|e| e.to_string())
-            })
-            .collect();
-    });
-    let mut together = Vec::new();
-    let t_batch = best_of(3, || {
-        let mut batch = ExactBatch::new(&proto);
-        for z in &starts {
-            batch.push(0.0, z).ok();
-        }
-        together = match steady_states(&mut batch, &opts) {
-            Ok(r) => r
-                .into_iter()
-                .map(|r| r.map_err(|e| e.to_string()))
-                .collect(),
-            Err(e) => vec![Err(e.to_string())],
-        };
-    });
-    if alone != together {
-        return Err("batched and one-by-one steady states differ".into());
-    }
-    let per = |us: f64| us / 1e3 / samples as f64;
-    println!(
-        "census N = {modes}, Ω = {omega}, {samples} starts: {:.3} ms per start one by one, \
-         {:.3} ms batched ({:.2}x)",
-        per(t_alone),
-        per(t_batch),
-        t_alone / t_batch
-    );
-    Ok(())
-}
-
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
     let first = args.next().unwrap_or_else(|| "linear".into());
@@ -291,16 +167,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 ExactPropagator::try_with(&m, ExactOptions::default())?.steps_per_period()
             );
             return Ok(());
-        }
-        "census" => {
-            let samples = args.next().map_or(Ok(64), |s| s.parse())?;
-            let omega = args.next().map_or(Ok(2.6), |s| s.parse())?;
-            return census(modes, samples, omega);
-        }
-        "batch" => {
-            let lanes = args.next().map_or(Ok(64), |s| s.parse())?;
-            let periods = args.next().map_or(Ok(100.0), |s| s.parse())?;
-            return batched(modes, lanes, periods);
         }
         _ => {}
     }

@@ -237,12 +237,11 @@ fn attractor_census_reports_polished_orbits_with_multipliers() {
     assert!(checked >= 1);
 }
 
-/// The census runs the exact propagator's starts in batches of lanes (`ExactBatch`); its
-/// result must be the one-by-one census: with more starts than one batch (70 > 32), each
+/// The census runs its starts in parallel; its result must be the census one by one: each
 /// attractor's count, its first start, its period and its (unpolished) statistics are those of
 /// clustering the steady states of `steady_state` run on each start alone, in start order.
 #[test]
-fn batched_census_equals_the_census_one_by_one() {
+fn the_parallel_census_equals_the_census_one_by_one() {
     use afmdyn::analysis::bifurcation::random_state;
     use afmdyn::analysis::steady::steady_state;
     let p = Params {

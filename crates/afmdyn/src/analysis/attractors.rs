@@ -169,12 +169,9 @@ pub fn find_attractors_with(
 /// A start and the steady state it reaches.
 type StartResult = (DVector<f64>, Result<SteadyState, SimError>);
 
-/// The steady state from every random start, one by one in parallel. (The batched search,
-/// [`super::steady::steady_states`], gives the same results bit for bit, but since the scalar
-/// propagator takes its certified grid steps in tight runs the batch no longer gains: 0.8–1.0×
-/// at N = 3 and 0.6–1.3× at N = 10 in `period_cost census` over several runs, and a batch of
-/// 32 lanes keeps one core busy where the starts alone spread over all of them;
-/// `docs/performance.md`.)
+/// The steady state from every random start, one by one in parallel. (A batched exact
+/// propagator, lanes advanced together, measured 0.74–1.0× of one by one at N = 3 and kept one
+/// core busy where the starts spread over all of them; it was removed, issue 30.)
 fn steady_states_of_starts(
     model: &CantileverModel,
     spec: &AttractorSpec,

@@ -7,6 +7,7 @@
 
 pub mod approach;
 pub mod attractors;
+pub mod basin_entropy;
 pub mod bifurcation;
 pub mod chart;
 pub mod continuation;

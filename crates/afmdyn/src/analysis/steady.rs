@@ -3,7 +3,6 @@
 use super::period::{detect_period, minimal_divisor, MAX_PERIOD, MERGE_FACTOR};
 use crate::error::SimError;
 use crate::galerkin::Region;
-use crate::integrate::exact::ExactBatch;
 use crate::integrate::{advance, advance_observed, Integrator, Observed, Observer, Step};
 use crate::model::BodyContactCheck;
 use crate::roots::extremum;
@@ -420,69 +419,6 @@ pub fn steady_state(
         }
     }
     record(integ, found, returns.k, opts)
-}
-
-/// [`steady_state`] for every lane of a batch of exact-propagator trajectories at one
-/// parameter set: the transients of all lanes still searching are advanced together
-/// ([`ExactBatch::advance_to`], section by section), each lane's returns go through the same
-/// period search, and a lane that has found its period (or reached the cap) records its cycle
-/// alone. The results are those of [`steady_state`] on each lane alone, bit for bit.
-///
-/// # Errors
-/// The outer error for invalid options; the inner ones per lane, as [`steady_state`]'s.
-pub fn steady_states(
-    batch: &mut ExactBatch,
-    opts: &SteadyOptions,
-) -> Result<Vec<Result<SteadyState, SimError>>, SimError> {
-    opts.validate()?;
-    let lanes = batch.len();
-    let mut out: Vec<Option<Result<SteadyState, SimError>>> = (0..lanes).map(|_| None).collect();
-    let mut returns = Vec::with_capacity(lanes);
-    for (i, slot) in out.iter_mut().enumerate() {
-        let lane = batch.lane_mut(i);
-        let period = lane.model().period();
-        if !on_section(lane.tau(), period) {
-            if let Err(e) = next_section(lane, None) {
-                *slot = Some(Err(e));
-            }
-        }
-        returns.push(ReturnHistory::new(opts, batch.lane(i).state()));
-    }
-    loop {
-        let active: Vec<bool> = out.iter().map(Option::is_none).collect();
-        let Some(tau) = (0..lanes)
-            .filter(|&i| active[i])
-            .map(|i| batch.lane(i).tau())
-            .min_by(f64::total_cmp)
-        else {
-            break;
-        };
-        // the lanes on the earliest section go on together (all of them when they started
-        // together)
-        let period = batch.lane(0).model().period();
-        let target = section_after(tau, period);
-        let go: Vec<bool> = (0..lanes)
-            .map(|i| active[i] && section_after(batch.lane(i).tau(), period) == target)
-            .collect();
-        let results = batch.advance_to(target, &go)?;
-        for (i, r) in results.into_iter().enumerate() {
-            if !go[i] {
-                continue;
-            }
-            if let Err(e) = r {
-                out[i] = Some(Err(e));
-                continue;
-            }
-            let found = returns[i].push(batch.lane(i).state(), opts);
-            if found.is_some() || returns[i].exhausted(opts) {
-                out[i] = Some(record(batch.lane_mut(i), found, returns[i].k, opts));
-            }
-        }
-    }
-    Ok(out
-        .into_iter()
-        .map(|r| r.expect("every lane ends with a result"))
-        .collect())
 }
 
 #[cfg(test)]

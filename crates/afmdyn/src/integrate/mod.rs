@@ -620,26 +620,6 @@ pub fn check_start(z: &DVector<f64>) -> Result<(), SimError> {
     Ok(())
 }
 
-/// The exact propagator [`build`] would make for `opts` (before its reset to a start), or
-/// `None` when `opts` resolve to another integrator — the shared build of an
-/// [`exact::ExactBatch`].
-///
-/// # Errors
-/// As [`build`] for the steps per period and the exact propagator's construction.
-pub fn build_exact(
-    model: &CantileverModel,
-    opts: IntegratorOptions,
-) -> Result<Option<exact::ExactPropagator>, SimError> {
-    check_steps_per_period(opts.steps_per_period)?;
-    match opts.kind.resolve(model) {
-        IntegratorKind::Auto | IntegratorKind::Exact => Ok(Some(exact::ExactPropagator::try_new(
-            model,
-            opts.steps_per_period,
-        )?)),
-        _ => Ok(None),
-    }
-}
-
 fn check_steps_per_period(steps: usize) -> Result<(), SimError> {
     if steps == 0 || steps > 10_000_000 {
         return Err(SimError::out_of_range(

@@ -42,14 +42,13 @@
 //! `sensitivity.rs` (step Jacobians and ∂z/∂p), `bound.rs` (the displacement bound),
 //! `integrator.rs` (the [`Integrator`] implementation), `spectral.rs` and `modal.rs` (the
 //! spectral data of the region matrices, the eigendecomposition), `tip.rs` (V_T of a plain
-//! state), `batch.rs` (lanes in lockstep), `tests.rs`.
+//! state), `tests.rs`.
 //!
 //! [`Integrator`]: crate::integrate::Integrator
 //! [`Integrator::advance_to`]: crate::integrate::Integrator::advance_to
 //! [`Integrator::step`]: crate::integrate::Integrator::step
 //! [`SimError::Chattering`]: crate::error::SimError::Chattering
 
-mod batch;
 mod bound;
 mod build;
 mod energy;
@@ -69,7 +68,6 @@ mod tests;
 mod tip;
 
 pub(crate) use crate::linalg::matmul_into;
-pub use batch::ExactBatch;
 pub use build::{ExactOptions, Propagation};
 pub use modal::MAX_MODAL_CONDITION;
 
@@ -133,8 +131,7 @@ pub struct ExactPropagator {
     spec: Arc<[Spectral; 2]>,
     /// Φ_s = e^{A_s h} in plain coordinates.
     phi: Arc<[DMatrix<f64>; 2]>,
-    /// Forcing-dependent data of both regions (shared by clones, e.g. the lanes of an
-    /// [`ExactBatch`]).
+    /// Forcing-dependent data of both regions (shared by clones).
     forced: Arc<[Forced; 2]>,
     /// Whether each region's grid steps are modal.
     modal: [bool; 2],

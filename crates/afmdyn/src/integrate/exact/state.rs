@@ -77,27 +77,6 @@ impl ExactPropagator {
         Ok(())
     }
 
-    /// Make the last step a zero-length step at the current state, so that dense output and
-    /// the step Jacobian refer to it (after [`ExactBatch::advance_to`], whose shared grid steps
-    /// keep no per-lane step data).
-    ///
-    /// [`ExactBatch::advance_to`]: super::ExactBatch::advance_to
-    pub(super) fn rest_here(&mut self) {
-        self.materialize();
-        let ri = self.region.index();
-        let dz0 = self.last.dz0.as_mut_slice();
-        Self::zp_into(&self.forced[ri], self.model.omega(), self.tau, dz0);
-        for (d, z) in dz0.iter_mut().zip(self.z.as_slice()) {
-            *d = z - *d;
-        }
-        self.last.tau0 = self.tau;
-        self.last.region = self.region;
-        *self.last.q0 = *self.q;
-        self.last.modal = self.modal[ri];
-        self.last.full = false;
-        self.poly_built = false;
-    }
-
     /// (sin Ωτ, cos Ωτ): kept from the last switching or reset when τ is its time (the start
     /// of the step after it), formed otherwise.
     pub(super) fn trig_at(&self, tau: f64) -> (f64, f64) {
