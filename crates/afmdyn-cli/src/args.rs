@@ -136,6 +136,11 @@ impl ModelArgs {
             .transpose()
     }
 
+    /// The probe file's path, if given.
+    pub fn probe_path(&self) -> Option<&std::path::Path> {
+        self.probe.as_deref()
+    }
+
     /// The model values of the flags over the config file, and the probe (unresolved: a
     /// chart resolves them once per cell).
     pub fn spec_and_probe(&self) -> Result<(ModelSpec, Option<afmdyn::probe::Probe>), CliError> {

@@ -283,6 +283,14 @@ fn write_csv(path: &Path, cells: &[ChartCell]) -> Result<(), CliError> {
 /// Run `afmdyn chart`.
 pub fn chart(a: &ChartArgs) -> Result<(), CliError> {
     let (spec, probe) = a.model.spec_and_probe()?;
+    // the chart reads the probe file's text: an axis may be one of its values
+    let probe_text = match (&probe, a.model.probe_path()) {
+        (Some(_), Some(path)) => Some(
+            std::fs::read_to_string(path)
+                .map_err(|e| CliError::Input(format!("probe {}: {e}", path.display())))?,
+        ),
+        _ => None,
+    };
     let request = ChartRequest {
         x: a.x.clone(),
         x_from: a.x_from,
@@ -303,7 +311,7 @@ pub fn chart(a: &ChartArgs) -> Result<(), CliError> {
         integrator: a.integrator.request(),
     };
     let chart = request
-        .chart(spec, Params::default(), probe.as_ref())
+        .chart(spec, Params::default(), probe_text.as_deref())
         .map_err(|e| CliError::Input(crate::error::spell(&e)))?;
     let out = OutDir::lock(&a.out)?;
     let mut store = ChartStore::new(out.dir_lock());

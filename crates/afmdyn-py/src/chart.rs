@@ -32,14 +32,9 @@ struct Recipe {
 }
 
 fn build(recipe: &Recipe) -> PyResult<Chart> {
-    let probe = recipe
-        .probe
-        .as_deref()
-        .map(|t| Probe::parse(t, "probe").map_err(probe_error))
-        .transpose()?;
     recipe
         .request
-        .chart(recipe.model, recipe.defaults, probe.as_ref())
+        .chart(recipe.model, recipe.defaults, recipe.probe.as_deref())
         .map_err(sim_error)
 }
 
@@ -162,6 +157,13 @@ impl ChartStudy {
             serde_json::from_str(&self.chart.fingerprint.to_string()).unwrap_or_default();
         Ok(afmdyn::request::sweep::first_difference(&then, &now)
             .map(|(f, a, b)| (f.strip_prefix("chart.").unwrap_or(&f).to_string(), a, b)))
+    }
+
+    /// The axes: ((x name, x unit), (y name, y unit)).
+    fn axes(&self) -> ((String, String), (String, String)) {
+        let unit = afmdyn::request::chart::axis_unit;
+        let (x, y) = (self.chart.model.x, self.chart.model.y);
+        ((x.into(), unit(x).into()), (y.into(), unit(y).into()))
     }
 
     /// The number of tasks.

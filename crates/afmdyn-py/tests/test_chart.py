@@ -102,6 +102,16 @@ def test_a_probe_chart_runs_in_si():
     )
     assert ds.x.attrs["units"] == "m" and ds.y.attrs["units"] == "Hz"
     assert (ds.attractors > 0).all()
+    # a value of the probe file itself: the free amplitude A₀ (the length unit) and E_s
+    ds = afmdyn.chart(
+        x="free_amplitude", x_from=8e-9, x_to=12e-9, x_steps=2,
+        y="sample_modulus", y_from=2e9, y_to=4e9, y_steps=1,
+        starts=1, lyapunov_periods=0, max_periods=6000, probe=probe,
+    )
+    assert ds.x.attrs["units"] == "m" and ds.y.attrs["units"] == "Pa"
+    assert (ds.dominant_period == 1).all()
+    with pytest.raises(ValueError, match="needs a probe file"):
+        afmdyn.chart(x="free_amplitude", x_from=8e-9, x_to=12e-9)
 
 
 @pytest.fixture(scope="module")

@@ -148,6 +148,10 @@ pub enum SimError {
         /// Rejected value.
         value: f64,
     },
+    /// A probe file (or a chart's probe with one of its values set) that does not resolve:
+    /// the probe reader's message.
+    #[error("{0}")]
+    Probe(String),
     /// A run length, count or tolerance is out of range.
     #[error("{name} = {value}: {allowed}")]
     OutOfRange {
@@ -267,6 +271,7 @@ impl SimError {
         matches!(
             self,
             SimError::Params(_)
+                | SimError::Probe(_)
                 | SimError::StateLength { .. }
                 | SimError::NotFinite { .. }
                 | SimError::OutOfRange { .. }

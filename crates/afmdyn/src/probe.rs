@@ -385,8 +385,17 @@ impl Probe {
                 path: origin.to_string(),
                 message: e.to_string().replace('\n', " "),
             })?;
+        Self::from_table(&root, origin)
+    }
+
+    /// Resolve a probe from its parsed TOML table (a chart sets one of its values per cell,
+    /// [`crate::request::chart`]); `origin` names it in errors.
+    ///
+    /// # Errors
+    /// As [`Probe::parse`], but for the syntax.
+    pub fn from_table(root: &toml::Table, origin: &str) -> Result<Probe, ProbeError> {
         let mut problems = Vec::new();
-        let probe = Self::read(&root, &mut problems);
+        let probe = Self::read(root, &mut problems);
         match probe {
             Some(p) if problems.is_empty() => Ok(p),
             _ => {

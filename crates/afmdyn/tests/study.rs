@@ -313,7 +313,7 @@ fn chart_axes_resolve_like_a_single_run() {
         ..ChartRequest::default()
     };
     let chart = req
-        .chart(ModelSpec::default(), Params::default(), Some(&probe))
+        .chart(ModelSpec::default(), Params::default(), Some(&text))
         .unwrap();
     let single = ModelSpec {
         z_c: Some(7e-9),
@@ -326,6 +326,41 @@ fn chart_axes_resolve_like_a_single_run() {
         chart.model.params(7e-9, probe.drive_frequency).unwrap(),
         single
     );
+    // a value of the probe file as an axis: the cell's parameters are those of the file with
+    // that value written in it (here A₀ = 12 nm and E_s = 2 GPa, edited as text)
+    let req = ChartRequest {
+        x: "free-amplitude".into(),
+        x_from: 8e-9,
+        x_to: 14e-9,
+        y: "sample_modulus".into(),
+        y_from: 1e9,
+        y_to: 3e9,
+        ..ChartRequest::default()
+    };
+    let chart = req
+        .chart(ModelSpec::default(), Params::default(), Some(&text))
+        .unwrap();
+    let edited = text
+        .replace("free_amplitude = 10e-9", "free_amplitude = 12e-9")
+        .replace("youngs_modulus = 4e9", "youngs_modulus = 2e9");
+    assert_ne!(edited, text);
+    let by_hand = Probe::parse(&edited, "edited").unwrap().params;
+    assert_eq!(chart.model.params(12e-9, 2e9).unwrap(), by_hand);
+    assert_eq!(afmdyn::request::chart::axis_unit("sample_modulus"), "Pa");
+    // without a probe, a probe value is refused with the reason
+    let e = req
+        .chart(ModelSpec::default(), Params::default(), None)
+        .unwrap_err();
+    assert!(e.to_string().contains("probe"), "{e}");
+    let req = ChartRequest {
+        x: "z_c".into(),
+        x_from: 5e-9,
+        x_to: 10e-9,
+        y: "drive_frequency".into(),
+        y_from: 0.99 * probe.drive_frequency,
+        y_to: 1.01 * probe.drive_frequency,
+        ..ChartRequest::default()
+    };
     // without a probe, z_c is refused with the reason
     let e = req
         .chart(ModelSpec::default(), Params::default(), None)

@@ -20,12 +20,6 @@ from ._progress import ProgressArg, reporter
 if TYPE_CHECKING:
     from typing_extensions import Unpack
 
-#: The units of the model parameters by name and alias (the library's one table).
-_UNITS = {}
-for _name, _alias, _unit, _range, _help in _core.MODEL_PARAMETERS:
-    _UNITS[_name] = _unit
-    _UNITS[_alias] = _unit
-
 #: Per-cell and per-attractor variables: name → (long name, units).
 _CELL = {
     "attractors": ("attractors found in the cell", "1"),
@@ -84,7 +78,7 @@ def dataset(s: "_core.ChartStudy", d: Dict[str, Any]) -> xr.Dataset:
     ny, nx, ns = d["shape"]
     fp = json.loads(s.fingerprint())
     req = fp["chart"]
-    xname, yname = req["x"], req["y"]
+    (xname, xunit), (yname, yunit) = s.axes()
     data: Dict[str, Any] = {}
     for k, (long, unit) in _CELL.items():
         data[k] = (("y", "x"), np.asarray(d[k]).reshape(ny, nx), {"long_name": long, "units": unit})
@@ -105,8 +99,8 @@ def dataset(s: "_core.ChartStudy", d: Dict[str, Any]) -> xr.Dataset:
     return xr.Dataset(
         data_vars=data,
         coords={
-            "x": ("x", np.asarray(d["x"]), {"long_name": xname, "units": _UNITS.get(xname, "1")}),
-            "y": ("y", np.asarray(d["y"]), {"long_name": yname, "units": _UNITS.get(yname, "1")}),
+            "x": ("x", np.asarray(d["x"]), {"long_name": xname, "units": xunit}),
+            "y": ("y", np.asarray(d["y"]), {"long_name": yname, "units": yunit}),
         },
         attrs=attrs,
     )
@@ -149,7 +143,9 @@ def chart(
 
     An axis is any real model parameter by name or alias (``"omega"``, ``"alpha2"`` /
     ``"drive_amplitude"``, ``"gap"``, ``"restitution"``, ``"hamaker"``, …) and, with
-    ``probe=``, ``"z_c"`` (m) and ``"drive_frequency"`` (Hz). ``store`` keeps the command
+    ``probe=``, ``"z_c"`` (m), ``"drive_frequency"`` (Hz) and the probe file's own values
+    ``"free_amplitude"`` (m), ``"sample_modulus"`` (Pa), ``"quality_factor"``,
+    ``"spring_constant"`` (N/m), ``"tip_radius"`` (m). ``store`` keeps the command
     line's resumable store there (``afmdyn chart --out DIR``), ``resume=True`` continues it.
 
     Raises:

@@ -107,12 +107,33 @@ impl Default for ChartRequest {
     }
 }
 
+/// The chart axes that are values of the probe file (SI): name, TOML section, key, unit. A
+/// cell's probe is the file with that value replaced, resolved again (every scale follows: the
+/// free amplitude A₀ is the length unit g₀).
+pub const PROBE_AXES: [(&str, &str, &str, &str); 5] = [
+    ("free_amplitude", "drive", "free_amplitude", "m"),
+    ("sample_modulus", "sample", "youngs_modulus", "Pa"),
+    ("quality_factor", "cantilever", "quality_factor", "1"),
+    ("spring_constant", "cantilever", "spring_constant", "N/m"),
+    ("tip_radius", "tip", "radius", "m"),
+];
+
+fn probe_axis(
+    name: &str,
+) -> Option<&'static (&'static str, &'static str, &'static str, &'static str)> {
+    PROBE_AXES.iter().find(|a| a.0 == name)
+}
+
 /// The canonical name of a chart axis (`alpha2`, `drive-amplitude` → `drive_amplitude`).
 ///
 /// # Errors
-/// [`SimError::OutOfRange`] naming `field` for a name that is not a real model parameter.
+/// [`SimError::OutOfRange`] naming `field` for a name that is neither a real model parameter
+/// nor one of the probe values of [`PROBE_AXES`].
 pub fn axis_name(field: &'static str, key: &str) -> Result<&'static str, SimError> {
     let key = key.trim().to_ascii_lowercase().replace('-', "_");
+    if let Some(a) = probe_axis(&key) {
+        return Ok(a.0);
+    }
     match parameter(&key) {
         Some(info) if info.kind == ValueKind::Real => Ok(info.name),
         _ => Err(SimError::out_of_range(
@@ -120,8 +141,9 @@ pub fn axis_name(field: &'static str, key: &str) -> Result<&'static str, SimErro
             key,
             "must be a real model parameter: omega, tip_mass_ratio (alpha1), drive_amplitude \
              (alpha2), beam_damping (alpha3), contact_stiffness (alpha4), gap (alpha5), \
-             contact_damping (alpha6), restitution, hamaker, intermolecular_distance, or with a \
-             probe z_c (m) and drive_frequency (Hz)",
+             contact_damping (alpha6), restitution, hamaker, intermolecular_distance; or with a \
+             probe z_c (m), drive_frequency (Hz), free_amplitude (m), sample_modulus (Pa), \
+             quality_factor, spring_constant (N/m), tip_radius (m)",
         )),
     }
 }
@@ -135,6 +157,8 @@ pub struct ChartModel {
     pub defaults: Params,
     /// The probe file, if any.
     pub probe: Option<Probe>,
+    /// The probe file's table, when an axis is one of its values ([`PROBE_AXES`]).
+    pub probe_table: Option<toml::Table>,
     /// The x parameter's name.
     pub x: &'static str,
     /// The y parameter's name.
@@ -144,19 +168,42 @@ pub struct ChartModel {
 impl CellParams for ChartModel {
     fn params(&self, x: f64, y: f64) -> Result<Params, SimError> {
         let mut v = serde_json::to_value(self.base).unwrap_or_else(|_| json!({}));
-        if let Some(map) = v.as_object_mut() {
-            // the paper's aliases would clash with the names set here
-            for key in [self.x, self.y] {
+        let mut table = None;
+        for (key, value) in [(self.x, x), (self.y, y)] {
+            if let Some(&(name, section, k, _)) = probe_axis(key) {
+                let t = table.get_or_insert_with(|| self.probe_table.clone().unwrap_or_default());
+                match t.get_mut(section).and_then(toml::Value::as_table_mut) {
+                    Some(sec) => {
+                        sec.insert(k.into(), toml::Value::Float(value));
+                    }
+                    None => {
+                        return Err(SimError::out_of_range(
+                            if key == self.x { "x" } else { "y" },
+                            name,
+                            "needs a probe file with the section of this value",
+                        ))
+                    }
+                }
+                continue;
+            }
+            if let Some(map) = v.as_object_mut() {
+                // the paper's alias would clash with the name set here
                 if let Some(alias) = parameter(key).and_then(|p| p.alias) {
                     map.remove(alias);
                 }
+                map.insert(key.into(), json!(value));
             }
-            map.insert(self.x.into(), json!(x));
-            map.insert(self.y.into(), json!(y));
         }
         let spec: ModelSpec = serde_json::from_value(v)
             .map_err(|_| SimError::out_of_range("x", format!("{x}"), "must be a finite number"))?;
-        spec.resolve(self.defaults, self.probe.as_ref())
+        match table {
+            Some(t) => {
+                let probe = Probe::from_table(&t, "probe")
+                    .map_err(|e| SimError::Probe(format!("the probe at x = {x}, y = {y}: {e}")))?;
+                spec.resolve(self.defaults, Some(&probe))
+            }
+            None => spec.resolve(self.defaults, self.probe.as_ref()),
+        }
     }
 }
 
@@ -174,9 +221,10 @@ pub struct Chart {
 }
 
 impl ChartRequest {
-    /// The validated chart of the model values `base` over `defaults` (with `probe`): axis
-    /// names and limits checked, and every cell on the chart's edges resolved (a parameter's
-    /// range is an interval, so an invalid value inside a valid edge cannot occur).
+    /// The validated chart of the model values `base` over `defaults` (with the probe file's
+    /// text `probe`): axis names and limits checked, and every cell on the chart's edges
+    /// resolved (a parameter's range is an interval, so an invalid value inside a valid edge
+    /// cannot occur).
     ///
     /// # Errors
     /// [`SimError::OutOfRange`] naming the option (`x`, `x_steps`, `starts`, `tile`, …),
@@ -186,10 +234,32 @@ impl ChartRequest {
         &self,
         base: ModelSpec,
         defaults: Params,
-        probe: Option<&Probe>,
+        probe: Option<&str>,
     ) -> Result<Chart, SimError> {
         let x = axis_name("x", &self.x)?;
         let y = axis_name("y", &self.y)?;
+        let table: Option<toml::Table> = match probe {
+            Some(text) => Some(text.parse().map_err(|e: toml::de::Error| {
+                SimError::Probe(format!("probe: {}", e.to_string().replace('\n', " ")))
+            })?),
+            None => None,
+        };
+        let probe = match &table {
+            Some(t) => {
+                Some(Probe::from_table(t, "probe").map_err(|e| SimError::Probe(e.to_string()))?)
+            }
+            None => None,
+        };
+        for (field, name) in [("x", x), ("y", y)] {
+            if probe.is_none() && probe_axis(name).is_some() {
+                return Err(SimError::out_of_range(
+                    field,
+                    name,
+                    "needs a probe file (a value of the probe, in SI)",
+                ));
+            }
+        }
+        let uses_table = probe_axis(x).is_some() || probe_axis(y).is_some();
         if x == y {
             return Err(SimError::out_of_range(
                 "y",
@@ -272,7 +342,8 @@ impl ChartRequest {
         let model = ChartModel {
             base,
             defaults,
-            probe: probe.cloned(),
+            probe,
+            probe_table: table.filter(|_| uses_table),
             x,
             y,
         };
@@ -324,7 +395,7 @@ pub fn fingerprint(request: &ChartRequest, model: &ChartModel) -> Value {
 
 /// The unit of a chart axis, for labels and the files' `units` attributes.
 pub fn axis_unit(name: &str) -> &'static str {
-    parameter(name).map_or("1", |p| p.unit)
+    probe_axis(name).map_or_else(|| parameter(name).map_or("1", |p| p.unit), |a| a.3)
 }
 
 /// The columns of `chart.csv`: one row per attractor of a cell (one row, with `attractor`
