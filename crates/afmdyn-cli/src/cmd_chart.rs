@@ -435,6 +435,7 @@ fn draw_maps(dir: &Path, chart: &afmdyn::request::Chart, a: &ChartArrays) -> Res
             y: &a.y,
             cells: &cells,
             legend: &legend,
+            points: &[],
         },
     )?;
     // λ₁ of the dominant attractor, where it is nonperiodic
@@ -475,6 +476,7 @@ fn draw_maps(dir: &Path, chart: &afmdyn::request::Chart, a: &ChartArrays) -> Res
             y: &a.y,
             cells: &cells,
             legend: &legend,
+            points: &[],
         },
     )?;
     // coexisting attractors
@@ -502,6 +504,7 @@ fn draw_maps(dir: &Path, chart: &afmdyn::request::Chart, a: &ChartArrays) -> Res
             y: &a.y,
             cells: &cells,
             legend: &legend,
+            points: &[],
         },
     )?;
     Ok(())

@@ -3,6 +3,7 @@
 mod args;
 mod cmd_analysis;
 mod cmd_approach;
+mod cmd_basins;
 mod cmd_chart;
 mod cmd_modes;
 mod cmd_orbits;
@@ -46,6 +47,8 @@ enum Command {
     Attractors(cmd_analysis::AttractorsArgs),
     /// Behaviour chart over two parameters: period, λ₁, X_max and basin fractions per cell
     Chart(cmd_chart::ChartArgs),
+    /// Basins of attraction over two coordinates of the initial state; basin entropy
+    Basins(cmd_basins::BasinsArgs),
     /// Find a period-n orbit by Newton shooting; Floquet multipliers and stability
     Orbit(cmd_orbits::OrbitArgs),
     /// Pseudo-arclength continuation of a period-n branch; folds, period doublings, grazing
@@ -67,6 +70,7 @@ fn run(cli: Cli) -> Result<(), CliError> {
         Command::Bifurcation(a) => cmd_analysis::bifurcation(&a),
         Command::Attractors(a) => cmd_analysis::attractors(&a),
         Command::Chart(a) => cmd_chart::chart(&a),
+        Command::Basins(a) => cmd_basins::basins_cmd(&a),
         Command::Orbit(a) => cmd_orbits::orbit(&a),
         Command::Continue(a) => cmd_orbits::continuation(&a),
         Command::Lyapunov(a) => cmd_orbits::lyapunov(&a),

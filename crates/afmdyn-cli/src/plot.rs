@@ -729,6 +729,8 @@ pub struct CellMap<'a> {
     pub cells: &'a [Option<RGBColor>],
     /// Legend: label, colour.
     pub legend: &'a [(String, RGBColor)],
+    /// Points drawn over the cells (x, y): white rings.
+    pub points: &'a [(f64, f64)],
 }
 
 /// The edges of the cells of an axis: midpoints between values, half a spacing beyond the
@@ -780,6 +782,14 @@ impl Painter for CellMap<'_> {
             ))
         });
         chart.draw_series(rects).map_err(|x| x.to_string())?;
+        chart
+            .draw_series(
+                self.points
+                    .iter()
+                    .filter(|&&(x, y)| (x0..=x1).contains(&x) && (y0..=y1).contains(&y))
+                    .map(|&p| Circle::new(p, 5, WHITE.stroke_width(2))),
+            )
+            .map_err(|x| x.to_string())?;
         area.present().map_err(|x| x.to_string())?;
         Ok(())
     }

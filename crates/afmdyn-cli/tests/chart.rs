@@ -162,3 +162,60 @@ fn bad_axes_are_refused_in_one_line() {
         assert!(err.contains(needle), "{args:?}: {err}");
     }
 }
+
+#[test]
+fn basins_json_has_the_labels_attractors_and_measures() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = afmdyn(&[
+        "basins",
+        "--contact-law",
+        "impact",
+        "--restitution",
+        "0.8",
+        "--modes",
+        "1",
+        "--omega",
+        "2.0",
+        "--x-steps",
+        "12",
+        "--y-steps",
+        "10",
+        "--json",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(doc["x"]["name"], "a1");
+    assert_eq!(doc["y"]["name"], "adot1");
+    let labels = doc["labels"].as_array().unwrap();
+    assert_eq!(labels.len(), 10);
+    assert!(labels.iter().all(|r| r.as_array().unwrap().len() == 12));
+    let n = doc["attractors"].as_array().unwrap().len();
+    assert!(n >= 1);
+    let sum: f64 = doc["basin_fractions"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .sum();
+    let failed = doc["failed"].as_f64().unwrap() / 120.0;
+    assert!((sum + failed - 1.0).abs() < 1e-12);
+    for f in ["basins.csv", "basins.png", "basins.svg"] {
+        assert!(dir.path().join(f).metadata().unwrap().len() > 0, "{f}");
+    }
+    for (args, needle) in [
+        (vec!["basins", "--x", "b1"], "--x: 'b1'"),
+        (vec!["basins", "--x", "a4"], "x = a4"),
+        (vec!["basins", "--near-tol", "0"], "near-tol = 0"),
+    ] {
+        let out = afmdyn(&args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(needle), "{args:?}: {err}");
+    }
+}

@@ -8,6 +8,7 @@
 pub mod approach;
 pub mod attractors;
 pub mod basin_entropy;
+pub mod basins;
 pub mod bifurcation;
 pub mod chart;
 pub mod continuation;

@@ -1,0 +1,122 @@
+//! Basin maps (issue 30): the labels of the early-stopping map against running every start to
+//! its steady state (brute force, the census's way), thread independence, and the measures of
+//! the map.
+
+use afmdyn::analysis::attractors::same_attractor;
+use afmdyn::analysis::basin_entropy::basin_entropy;
+use afmdyn::analysis::basins::{
+    basins, BasinSpec, Decided, StateCoord, DEFAULT_BASIN_HITS, DEFAULT_CELL,
+    DEFAULT_DISCOVER_AFTER, DEFAULT_NEAR_TOL,
+};
+use afmdyn::analysis::bifurcation::SweepSpec;
+use afmdyn::analysis::steady::{steady_state, SteadyOptions};
+use afmdyn::integrate::{build, IntegratorOptions};
+use afmdyn::{CantileverModel, ContactLaw, Params};
+use nalgebra::DVector;
+
+/// The impact oscillator N = 1, r = 0.8, Ω = 2.0: two coexisting period-1 orbits (the census of
+/// 64 random starts finds them with basin fractions 0.92 and 0.08).
+fn impact() -> Params {
+    Params {
+        modes: 1,
+        omega: 2.0,
+        contact_law: ContactLaw::Impact { restitution: 0.8 },
+        ..Params::default()
+    }
+}
+
+fn spec(p: Params, steps: usize) -> BasinSpec {
+    BasinSpec {
+        params: p,
+        x: StateCoord::A(1),
+        xs: SweepSpec::linspace(-0.6, 0.6, steps).unwrap(),
+        y: StateCoord::ADot(1),
+        ys: SweepSpec::linspace(-1.2, 1.2, steps).unwrap(),
+        base: DVector::zeros(2 * p.modes),
+        near_tol: DEFAULT_NEAR_TOL,
+        cell: DEFAULT_CELL,
+        basin_hits: DEFAULT_BASIN_HITS,
+        discover_after: DEFAULT_DISCOVER_AFTER,
+        steady: SteadyOptions::default(),
+        cluster_tol: 1e-5,
+        integrator: IntegratorOptions::default(),
+    }
+}
+
+/// Every cell's label against the steady state its start reaches when run to convergence (the
+/// transient cap and detection of `steady_state`, as the attractor census runs each start),
+/// matched to the map's attractors: at least 99.5 % agree, both attractors have a basin, and
+/// most cells were decided before the steady-state search.
+#[test]
+fn labels_agree_with_running_every_start_to_convergence() {
+    let s = spec(impact(), 30);
+    let map = basins(&s).unwrap();
+    assert_eq!(map.attractors.len(), 2, "the two period-1 orbits");
+    let model = CantileverModel::new(&s.params).unwrap();
+    let (mut agree, mut total, mut early) = (0, 0, 0);
+    for (k, cell) in map.cells.iter().enumerate() {
+        let (ix, iy) = (k % s.xs.len(), k / s.xs.len());
+        let mut z0 = s.base.clone();
+        s.x.set(&model, &mut z0, s.xs[ix]);
+        s.y.set(&model, &mut z0, s.ys[iy]);
+        let mut it = build(&model, s.integrator, 0.0, &z0).unwrap();
+        let brute = steady_state(it.as_mut(), &SteadyOptions::default())
+            .ok()
+            .and_then(|st| {
+                map.attractors
+                    .iter()
+                    .position(|a| same_attractor(a, &st, 1e-4))
+            })
+            .map_or(-2, |i| i as i64);
+        total += 1;
+        agree += usize::from(brute == cell.label);
+        early += usize::from(matches!(cell.decided, Decided::Near | Decided::Recurrence));
+    }
+    let share = agree as f64 / total as f64;
+    assert!(share >= 0.995, "{agree} of {total} labels agree");
+    let labels = map.labels();
+    for a in 0..2 {
+        assert!(labels.iter().any(|&l| l == a), "attractor {a} has a basin");
+    }
+    assert!(early * 2 > total, "{early} of {total} decided early");
+    // a map with a basin boundary has boundary boxes
+    let e = basin_entropy(&labels, s.xs.len(), 5).unwrap();
+    assert!(e.boundary_boxes > 0 && e.basin_entropy > 0.0, "{e:?}");
+}
+
+/// The map does not depend on the thread count (rows are pure tasks, attractors matched in row
+/// order).
+#[test]
+fn the_map_does_not_depend_on_threads() {
+    let s = spec(impact(), 12);
+    let run = |t: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(t)
+            .build()
+            .unwrap()
+            .install(|| basins(&s).unwrap())
+    };
+    assert_eq!(format!("{:?}", run(1)), format!("{:?}", run(2)));
+}
+
+#[test]
+fn coordinates_parse_and_set_the_state() {
+    assert_eq!("a2".parse::<StateCoord>().unwrap(), StateCoord::A(2));
+    assert_eq!("ADOT1".parse::<StateCoord>().unwrap(), StateCoord::ADot(1));
+    assert_eq!("wdot".parse::<StateCoord>().unwrap(), StateCoord::WDot);
+    assert!("a0".parse::<StateCoord>().is_err() && "b1".parse::<StateCoord>().is_err());
+    // the tip deflection is set through mode 1, the other modes kept
+    let p = Params::default();
+    let m = CantileverModel::new(&p).unwrap();
+    let mut z = DVector::zeros(6);
+    z[1] = 0.01;
+    StateCoord::W.set(&m, &mut z, 0.3);
+    assert!((m.w_tip(&z) - 0.3).abs() < 1e-15 && z[1] == 0.01);
+    StateCoord::WDot.set(&m, &mut z, -0.2);
+    assert!((m.w_tip_dot(&z) + 0.2).abs() < 1e-15);
+    let bad = BasinSpec {
+        x: StateCoord::A(4),
+        ..spec(p, 3)
+    };
+    assert!(basins(&bad).is_err());
+}
