@@ -35,7 +35,7 @@ use std::path::PathBuf;
 type Dict<'py> = Bound<'py, PyDict>;
 
 /// The integrator request of the keywords (`None`: the library's default integrator).
-fn integrator_request(
+pub(crate) fn integrator_request(
     kind: Option<&str>,
     steps_per_period: Option<usize>,
     tolerance: f64,

@@ -6,6 +6,7 @@
 //! datasets and result objects.
 
 mod analyses;
+mod basins;
 mod chart;
 mod convert;
 mod curves;
@@ -33,6 +34,7 @@ fn _afmdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(analyses::converge, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::bifurcation, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::attractors, m)?)?;
+    m.add_function(wrap_pyfunction!(basins::basins, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::orbit, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::continuation, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::lyapunov, m)?)?;

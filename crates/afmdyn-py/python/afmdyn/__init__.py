@@ -39,6 +39,7 @@ from ._api import (
     simulate,
     summary,
 )
+from ._basins import basins
 from ._chart import chart
 from ._results import Attractor, Attractors, Lyapunov, Orbit, RegionSpectrum, Spectrum
 
@@ -62,6 +63,7 @@ __all__ = [
     "Spectrum",
     "approach",
     "attractors",
+    "basins",
     "bifurcation",
     "chart",
     "continuation",

@@ -327,3 +327,28 @@ class SweepStore:
     def finish(self, study: SweepStudy) -> None: ...
     def records(self, study: SweepStudy) -> Dict[str, Any]: ...
     def release(self) -> None: ...
+
+def basins(
+    params: Params,
+    x: str,
+    x_from: float,
+    x_to: float,
+    x_steps: int,
+    y: str,
+    y_from: float,
+    y_to: float,
+    y_steps: int,
+    near_tol: float,
+    cell: float,
+    basin_hits: int,
+    discover_after: int,
+    cluster_tol: float,
+    tol: float,
+    max_periods: int,
+    max_period: int,
+    integrator: Optional[str] = None,
+    steps_per_period: Optional[int] = None,
+    tolerance: float = 1e-12,
+    threads: Optional[int] = None,
+    progress: Optional[ProgressCallback] = None,
+) -> Dict[str, Any]: ...
