@@ -191,9 +191,7 @@ pub fn basins_cmd(a: &BasinsArgs) -> Result<(), CliError> {
     let entropy = basin_entropy(&labels, nx, 5);
     let uncertainty = uncertainty_exponent(&labels, nx);
     let count = |d: Decided| map.cells.iter().filter(|c| c.decided == d).count();
-    let fractions: Vec<f64> = (0..map.attractors.len())
-        .map(|i| labels.iter().filter(|&&l| l == i as i64).count() as f64 / labels.len() as f64)
-        .collect();
+    let fractions = map.basin_fractions();
     let doc = json!({
         "params": p,
         "x": {"name": x.to_string(), "values": spec.xs},

@@ -111,6 +111,7 @@ pub fn basins<'py>(
             .map(|s| s.period().map_or(-1, |n| n as i64))
             .collect(),
     )?;
+    out.f64s("basin_fraction", map.basin_fractions())?;
     out.f64s(
         "attractor_x_max",
         map.attractors.iter().map(|s| s.stats.x_max).collect(),

@@ -88,7 +88,6 @@ def basins(
     ny, nx = len(d["y"]), len(d["x"])
     labels = np.asarray(d["label"]).reshape(ny, nx)
     n = len(d["attractor_period"])
-    fractions = np.array([(labels == k).mean() for k in range(n)])
 
     def num(v: Any) -> float:
         return float("nan") if v is None else float(v)
@@ -101,7 +100,7 @@ def basins(
                         {"long_name": "drive periods the start ran"}),
             "period": ("attractor", d["attractor_period"], {"long_name": "period n (-1 nonperiodic)"}),
             "x_max": ("attractor", d["attractor_x_max"], {"units": "g0", "long_name": "X_max"}),
-            "basin_fraction": ("attractor", fractions),
+            "basin_fraction": ("attractor", d["basin_fraction"]),
         },
         coords={
             "x": ("x", d["x"], {"long_name": f"{d['x_name']} at τ = 0"}),

@@ -270,6 +270,15 @@ impl BasinMap {
     pub fn labels(&self) -> Vec<i64> {
         self.cells.iter().map(|c| c.label).collect()
     }
+
+    /// The basin fraction of each attractor: its share of all cells (failed cells included in
+    /// the total, so the fractions add up to 1 less the failed share).
+    pub fn basin_fractions(&self) -> Vec<f64> {
+        let n = self.cells.len().max(1) as f64;
+        (0..self.attractors.len())
+            .map(|i| self.cells.iter().filter(|c| c.label == i as i64).count() as f64 / n)
+            .collect()
+    }
 }
 
 struct Row {

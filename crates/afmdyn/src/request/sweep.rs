@@ -441,6 +441,9 @@ impl SweepRecord {
 pub fn fingerprint(request: &BifurcationRequest, spec: &SweepSpec) -> Value {
     let mut doc = json!({
         "afmdyn": env!("CARGO_PKG_VERSION"),
+        // how the sweep is cut into tasks and its starts keyed (issue 29): a store written by
+        // the two sequential chains of before is not resumed with segments
+        "plan": PLAN,
         "params": spec.base,
         "param": spec.param.name(),
         "continuation": spec.continuation,
@@ -468,9 +471,14 @@ pub fn fingerprint(request: &BifurcationRequest, spec: &SweepSpec) -> Value {
     doc
 }
 
+/// The plan of a sweep's tasks in its fingerprint: chains cut into ⌈√n⌉ chunks seeded by a
+/// coarse pass, random starts keyed by (seed, value, start).
+pub const PLAN: &str = "chunks-sqrt, starts keyed by value";
+
 /// The order in which [`first_difference`] compares a fingerprint's fields.
-const FIELD_ORDER: [&str; 16] = [
+const FIELD_ORDER: [&str; 17] = [
     "afmdyn",
+    "plan",
     "params",
     "param",
     "from",
