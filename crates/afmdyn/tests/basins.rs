@@ -76,7 +76,7 @@ fn labels_agree_with_running_every_start_to_convergence() {
     assert!(share >= 0.995, "{agree} of {total} labels agree");
     let labels = map.labels();
     for a in 0..2 {
-        assert!(labels.iter().any(|&l| l == a), "attractor {a} has a basin");
+        assert!(labels.contains(&a), "attractor {a} has a basin");
     }
     assert!(early * 2 > total, "{early} of {total} decided early");
     // a map with a basin boundary has boundary boxes
