@@ -121,7 +121,10 @@ def _open_store(s: "_core.ChartStudy", store: str, resume: bool) -> Set[int]:
 class _Writer:
     """Writes finished tasks' regions into the store, in batches (every ``batch`` tasks or
     ``seconds``, and at the end), then records them as done (flushed to disk): a killed
-    driver loses at most the unwritten batch, which a rerun computes again."""
+    driver loses at most the unwritten batch, which a rerun computes again. A batch rewrites
+    the rows it touches whole; zarr writes each chunk file atomically (a temporary file
+    renamed into place), so the tasks already done in those rows keep their values whatever
+    chunk a kill interrupts."""
 
     def __init__(self, store: str, s: "_core.ChartStudy", batch: int = 32, seconds: float = 2.0):
         import zarr
