@@ -205,6 +205,13 @@ where
             panel
                 .draw(&Rectangle::new([(10, y - 6), (30, y + 6)], col.filled()))
                 .map_err(|e| e.to_string())?;
+            // an outline, so that a white swatch (λ₁ = 0 on a diverging scale) shows
+            panel
+                .draw(&Rectangle::new(
+                    [(10, y - 6), (30, y + 6)],
+                    RGBColor(120, 120, 120).stroke_width(1),
+                ))
+                .map_err(|e| e.to_string())?;
         }
         for line in wrap(label) {
             panel
