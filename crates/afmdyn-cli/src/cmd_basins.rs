@@ -200,6 +200,10 @@ pub fn basins_cmd(a: &BasinsArgs) -> Result<(), CliError> {
         "attractors": map.attractors.iter().enumerate().map(|(i, s)| json!({
             "id": i,
             "period": s.period(),
+            "multipliers": map.orbits[i].as_ref().map(|o| o.multipliers.iter()
+                .map(|m| [m.re, m.im]).collect::<Vec<_>>()),
+            "stable": map.orbits[i].as_ref().map(|o| o.stable),
+            "lyapunov": map.lyapunov[i],
             "poincare": {"state": s.poincare.iter()
                 .map(|q| q.state.iter().copied().collect::<Vec<f64>>())
                 .collect::<Vec<_>>()},

@@ -112,6 +112,17 @@ pub fn basins<'py>(
             .collect(),
     )?;
     out.f64s("basin_fraction", map.basin_fractions())?;
+    out.set(
+        "attractor_stable",
+        map.orbits
+            .iter()
+            .map(|o| o.as_ref().map(|o| o.stable))
+            .collect::<Vec<_>>(),
+    )?;
+    out.f64s(
+        "attractor_lyapunov",
+        map.lyapunov.iter().map(|l| l.unwrap_or(f64::NAN)).collect(),
+    )?;
     out.f64s(
         "attractor_x_max",
         map.attractors.iter().map(|s| s.stats.x_max).collect(),

@@ -74,6 +74,14 @@ fn labels_agree_with_running_every_start_to_convergence() {
     }
     let share = agree as f64 / total as f64;
     assert!(share >= 0.995, "{agree} of {total} labels agree");
+    // an attractor is stable: both orbits, polished by shooting, have every |μ| < 1
+    for o in &map.orbits {
+        let o = o.as_ref().expect("a periodic orbit, polished");
+        assert!(
+            o.stable && o.multipliers.iter().all(|m| m.norm() < 1.0),
+            "{o:?}"
+        );
+    }
     let labels = map.labels();
     for a in 0..2 {
         assert!(labels.contains(&a), "attractor {a} has a basin");

@@ -54,7 +54,9 @@ def basins(
     Returns:
         ``xarray.Dataset`` with dims ``(y, x)``: ``label`` (attractor id, −2 failed),
         ``decided`` (``"near"``, ``"recurrence"``, ``"steady"``, ``"failed"``), ``periods``;
-        dim ``attractor``: ``period`` (−1 nonperiodic), ``x_max`` (g0), ``basin_fraction``;
+        dim ``attractor``: ``period`` (−1 nonperiodic), ``x_max`` (g0), ``basin_fraction``,
+        ``stable`` (1/0 from the Floquet multipliers of the orbit polished by shooting; NaN
+        nonperiodic), ``lyapunov`` (λ₁ of a nonperiodic attractor);
         attributes ``basin_entropy``, ``boundary_basin_entropy`` (Daza et al. 2016; NaN when
         undefined) and ``uncertainty_exponent`` (Grebogi et al. 1983).
     """
@@ -101,6 +103,13 @@ def basins(
             "period": ("attractor", d["attractor_period"], {"long_name": "period n (-1 nonperiodic)"}),
             "x_max": ("attractor", d["attractor_x_max"], {"units": "g0", "long_name": "X_max"}),
             "basin_fraction": ("attractor", d["basin_fraction"]),
+            "stable": (
+                "attractor",
+                np.array([np.nan if v is None else float(v) for v in d["attractor_stable"]]),
+                {"long_name": "1 stable periodic orbit (shooting), 0 unstable, NaN nonperiodic"},
+            ),
+            "lyapunov": ("attractor", d["attractor_lyapunov"],
+                         {"units": "1/tau", "long_name": "λ₁ of a nonperiodic attractor"}),
         },
         coords={
             "x": ("x", d["x"], {"long_name": f"{d['x_name']} at τ = 0"}),

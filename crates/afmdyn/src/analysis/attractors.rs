@@ -196,24 +196,32 @@ fn steady_states_of_starts(
 /// Poincaré points with the orbit's (the cycle keeps its phase: the point after the last one
 /// recorded is the first).
 fn polish(model: &CantileverModel, integrator: IntegratorOptions, a: &mut Attractor) {
-    let Some(n) = a.steady.period() else { return };
+    a.orbit = polish_steady(model, integrator, &mut a.steady);
+}
+
+/// Polish a periodic steady state by Newton shooting: its Poincaré points become the orbit's
+/// (to the shooting tolerance) and the orbit (multipliers, stability) is returned; `None` for
+/// a nonperiodic state, an integrator without step Jacobians, or shooting that fails (the
+/// state is left as it was).
+pub(crate) fn polish_steady(
+    model: &CantileverModel,
+    integrator: IntegratorOptions,
+    steady: &mut SteadyState,
+) -> Option<PeriodicOrbit> {
+    let n = steady.period()?;
     if !matches!(
         integrator.kind.resolve(model),
         IntegratorKind::Exact | IntegratorKind::Adaptive | IntegratorKind::Split
     ) {
-        return;
+        return None;
     }
-    let guess = a.steady.end_state().clone();
-    let Ok(mut integ) = build(model, integrator, 0.0, &guess) else {
-        return;
-    };
-    let Ok(orbit) = shoot_with(integ.as_mut(), &guess, n, &ShootingOptions::default()) else {
-        return;
-    };
+    let guess = steady.end_state().clone();
+    let mut integ = build(model, integrator, 0.0, &guess).ok()?;
+    let orbit = shoot_with(integ.as_mut(), &guess, n, &ShootingOptions::default()).ok()?;
     // section = [z*, P(z*), …]; z* replaces the last recorded point p_n, P(z*) the first
-    let k = a.steady.poincare.len();
+    let k = steady.poincare.len();
     if k == n {
-        for (i, p) in a.steady.poincare.iter_mut().enumerate() {
+        for (i, p) in steady.poincare.iter_mut().enumerate() {
             let z = &orbit.section[(i + 1) % n];
             *p = PoincarePoint {
                 tau: p.tau,
@@ -223,5 +231,5 @@ fn polish(model: &CantileverModel, integrator: IntegratorOptions, a: &mut Attrac
             };
         }
     }
-    a.orbit = Some(orbit);
+    Some(orbit)
 }

@@ -20,9 +20,11 @@
 //! A task is one row of the map (cells in order of x): pure in (spec, row), so any thread count
 //! gives the same map; the attractors of the rows are matched in row order into global ids.
 
-use super::attractors::same_attractor;
+use super::attractors::{polish_steady, same_attractor};
+use super::lyapunov::{lyapunov_spectrum, LyapunovOptions};
 #[cfg(not(feature = "parallel"))]
 use super::sequential::*;
+use super::shooting::PeriodicOrbit;
 use super::steady::{steady_state, SteadyOptions, SteadyState};
 use crate::error::SimError;
 use crate::integrate::{advance, build, IntegratorOptions};
@@ -261,9 +263,19 @@ pub struct BasinCell {
 pub struct BasinMap {
     /// nx × ny cells, row-major.
     pub cells: Vec<BasinCell>,
-    /// The attractors, in the order first found (row by row).
+    /// The attractors, in the order first found (row by row); a periodic one's Poincaré
+    /// points polished by shooting.
     pub attractors: Vec<SteadyState>,
+    /// Each periodic attractor's orbit from Newton shooting (Floquet multipliers, stability);
+    /// `None` for a nonperiodic one or where shooting failed.
+    pub orbits: Vec<Option<PeriodicOrbit>>,
+    /// Each nonperiodic attractor's largest Lyapunov exponent λ₁ (per unit τ, over
+    /// [`LYAPUNOV_PERIODS`] drive periods); `None` for a periodic one or a failed run.
+    pub lyapunov: Vec<Option<f64>>,
 }
+
+/// Drive periods of the λ₁ estimate of a nonperiodic attractor of a basin map.
+pub const LYAPUNOV_PERIODS: usize = 500;
 
 impl BasinMap {
     /// The labels, row-major.
@@ -449,5 +461,38 @@ pub fn basins(spec: &BasinSpec) -> Result<BasinMap, SimError> {
             c
         }));
     }
-    Ok(BasinMap { cells, attractors })
+    // polish: shooting for the periodic attractors, λ₁ for the others
+    let polished: Vec<(SteadyState, Option<PeriodicOrbit>, Option<f64>)> = attractors
+        .into_par_iter()
+        .with_max_len(1)
+        .map(|mut s| {
+            let orbit = polish_steady(&model, spec.integrator, &mut s);
+            let lyapunov = if s.period().is_none() {
+                let opts = LyapunovOptions {
+                    transient_periods: 0,
+                    periods: LYAPUNOV_PERIODS,
+                    blocks: 10,
+                    integrator: spec.integrator,
+                };
+                lyapunov_spectrum(&model, s.end_state(), &opts)
+                    .ok()
+                    .and_then(|l| l.exponents.first().copied())
+            } else {
+                None
+            };
+            (s, orbit, lyapunov)
+        })
+        .collect();
+    let mut map = BasinMap {
+        cells,
+        attractors: Vec::new(),
+        orbits: Vec::new(),
+        lyapunov: Vec::new(),
+    };
+    for (s, o, l) in polished {
+        map.attractors.push(s);
+        map.orbits.push(o);
+        map.lyapunov.push(l);
+    }
+    Ok(map)
 }
