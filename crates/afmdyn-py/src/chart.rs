@@ -90,19 +90,27 @@ impl ChartStudy {
         })
     }
 
-    /// The chart of `request` (the chart options as JSON text; unknown keys are refused) over
-    /// `params` (or the probe's set, or the paper's) with the `model` keywords; `probe` is the
-    /// probe file's text.
+    /// The chart of `request` (the chart options as JSON text, but the integrator's; unknown
+    /// keys are refused) over `params` (or the probe's set, or the paper's) with the `model`
+    /// keywords; `probe` is the probe file's text; the integrator's options as every analysis
+    /// takes them.
     #[staticmethod]
-    #[pyo3(signature = (request, params=None, probe=None, model=None))]
+    #[pyo3(signature = (request, params=None, probe=None, model=None, integrator=None,
+        steps_per_period=None, tolerance=1e-12))]
     fn build(
         request: &str,
         params: Option<PyRef<'_, PyParams>>,
         probe: Option<String>,
         model: Option<&Bound<'_, PyDict>>,
+        integrator: Option<&str>,
+        steps_per_period: Option<usize>,
+        tolerance: f64,
     ) -> PyResult<Self> {
-        let request: ChartRequest = serde_json::from_str(request)
+        let mut request: ChartRequest = serde_json::from_str(request)
             .map_err(|e| pyo3::exceptions::PyTypeError::new_err(format!("chart options: {e}")))?;
+        // the integrator as every analysis reads it (a ValueError naming a bad kind)
+        request.integrator =
+            crate::analyses::integrator_request(integrator, steps_per_period, tolerance)?;
         let parsed = probe
             .as_deref()
             .map(|t| Probe::parse(t, "probe").map_err(probe_error))

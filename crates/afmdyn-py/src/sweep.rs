@@ -69,10 +69,20 @@ impl SweepStudy {
     /// The sweep of `request` (the options of `afmdyn.bifurcation` as JSON text; unknown keys
     /// are refused) over `params`.
     #[staticmethod]
-    fn build(request: &str, params: PyRef<'_, PyParams>) -> PyResult<Self> {
-        let request: BifurcationRequest = serde_json::from_str(request).map_err(|e| {
+    #[pyo3(signature = (request, params, integrator=None, steps_per_period=None,
+        tolerance=1e-12))]
+    fn build(
+        request: &str,
+        params: PyRef<'_, PyParams>,
+        integrator: Option<&str>,
+        steps_per_period: Option<usize>,
+        tolerance: f64,
+    ) -> PyResult<Self> {
+        let mut request: BifurcationRequest = serde_json::from_str(request).map_err(|e| {
             pyo3::exceptions::PyTypeError::new_err(format!("bifurcation options: {e}"))
         })?;
+        request.integrator =
+            crate::analyses::integrator_request(integrator, steps_per_period, tolerance)?;
         SweepStudy::of(Recipe {
             request,
             params: params.inner,

@@ -70,6 +70,7 @@ def test_a_stored_chart_resumes_and_refuses_another_request(tmp_path):
         (dict(x="z_c", x_from=1e-9, x_to=2e-9), "needs a probe"),
         (dict(max_attractors=0), "max_attractors = 0"),
         (dict(tile=-1), "tile = -1"),
+        (dict(integrator="nope"), "nope"),
     ],
 )
 def test_bad_charts_are_refused_naming_the_option(kwargs, match):

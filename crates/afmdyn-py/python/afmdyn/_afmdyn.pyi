@@ -272,6 +272,9 @@ class ChartStudy:
         params: Optional[Params] = None,
         probe: Optional[str] = None,
         model: Optional[Dict[str, Any]] = None,
+        integrator: Optional[str] = None,
+        steps_per_period: Optional[int] = None,
+        tolerance: float = 1e-12,
     ) -> ChartStudy: ...
     @property
     def recipe(self) -> str: ...
@@ -308,7 +311,13 @@ class SweepStudy:
 
     def __init__(self, recipe: str) -> None: ...
     @staticmethod
-    def build(request: str, params: Params) -> SweepStudy: ...
+    def build(
+        request: str,
+        params: Params,
+        integrator: Optional[str] = None,
+        steps_per_period: Optional[int] = None,
+        tolerance: float = 1e-12,
+    ) -> SweepStudy: ...
     @property
     def recipe(self) -> str: ...
     def tasks(self, stage: int) -> int: ...

@@ -69,8 +69,13 @@ def study(
         v = request.get(k)
         if isinstance(v, int) and not isinstance(v, bool) and v < 0:
             raise ValueError(f"{k} = {v}: must be >= 0")
+    integrator = request.pop("integrator", None)
+    steps_per_period = request.pop("steps_per_period", None)
+    tolerance = request.pop("tolerance", 1e-12)
     request = {k: v for k, v in request.items() if v is not None}
-    return _core.ChartStudy.build(json.dumps(request), params, text, model)
+    return _core.ChartStudy.build(
+        json.dumps(request), params, text, model, integrator, steps_per_period, tolerance
+    )
 
 
 def dataset(s: "_core.ChartStudy", d: Dict[str, Any]) -> xr.Dataset:

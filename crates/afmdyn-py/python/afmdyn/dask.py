@@ -374,14 +374,9 @@ def bifurcation(
         tol=tol,
         max_periods=max_periods,
         max_period=max_period,
-        tolerance=tolerance,
     )
     request["from"] = from_
-    if integrator is not None:
-        request["integrator"] = integrator
-    if steps_per_period is not None:
-        request["steps_per_period"] = steps_per_period
-    s = _core.SweepStudy.build(json.dumps(request), p)
+    s = _core.SweepStudy.build(json.dumps(request), p, integrator, steps_per_period, tolerance)
     own = client is None
     cluster = None
     if own:
