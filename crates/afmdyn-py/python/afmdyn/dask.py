@@ -292,10 +292,9 @@ def chart(
             client.close()
             if cluster is not None:
                 cluster.close()
-    cells = ds["failures"].values
     if (ds["attractors"].values == 0).all():
         raise _core.SimulationError(
-            f"every chart cell failed ({cells.size} cells): no attractor found"
+            f"every chart cell failed ({ds['attractors'].size} cells): no attractor found"
         )
     return ds
 

@@ -21,7 +21,7 @@
 //! gives the same map; the attractors of the rows are matched in row order into global ids.
 
 use super::attractors::{polish_steady, same_attractor};
-use super::lyapunov::{lyapunov_spectrum, LyapunovOptions};
+use super::lyapunov::largest_exponent;
 #[cfg(not(feature = "parallel"))]
 use super::sequential::*;
 use super::shooting::PeriodicOrbit;
@@ -467,19 +467,12 @@ pub fn basins(spec: &BasinSpec) -> Result<BasinMap, SimError> {
         .with_max_len(1)
         .map(|mut s| {
             let orbit = polish_steady(&model, spec.integrator, &mut s);
-            let lyapunov = if s.period().is_none() {
-                let opts = LyapunovOptions {
-                    transient_periods: 0,
-                    periods: LYAPUNOV_PERIODS,
-                    blocks: 10,
-                    integrator: spec.integrator,
-                };
-                lyapunov_spectrum(&model, s.end_state(), &opts)
-                    .ok()
-                    .and_then(|l| l.exponents.first().copied())
-            } else {
-                None
-            };
+            let lyapunov = s
+                .period()
+                .is_none()
+                .then(|| largest_exponent(&model, s.end_state(), LYAPUNOV_PERIODS, spec.integrator))
+                .flatten()
+                .map(|l| l.0);
             (s, orbit, lyapunov)
         })
         .collect();

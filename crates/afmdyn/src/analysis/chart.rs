@@ -21,7 +21,7 @@
 
 use super::attractors::same_attractor;
 use super::bifurcation::{mix64, random_state};
-use super::lyapunov::{lyapunov_spectrum, LyapunovOptions};
+use super::lyapunov::largest_exponent;
 #[cfg(not(feature = "parallel"))]
 use super::sequential::*;
 use super::steady::{steady_state, SteadyOptions, SteadyState};
@@ -375,20 +375,9 @@ impl<'a> ChartPlan<'a> {
             .into_iter()
             .map(|(s, count, origin)| {
                 let period = s.period();
-                let lyapunov = match (&w.model, period, spec.lyapunov_periods) {
-                    (Some(m), None, periods) if periods > 0 => {
-                        let opts = LyapunovOptions {
-                            transient_periods: 0,
-                            periods,
-                            blocks: 10.min(periods),
-                            integrator: spec.integrator,
-                        };
-                        lyapunov_spectrum(m, s.end_state(), &opts)
-                            .ok()
-                            .and_then(|l| {
-                                let err = l.uncertainty.first()? + l.convergence.first()?;
-                                Some((*l.exponents.first()?, err))
-                            })
+                let lyapunov = match (&w.model, period) {
+                    (Some(m), None) if spec.lyapunov_periods > 0 => {
+                        largest_exponent(m, s.end_state(), spec.lyapunov_periods, spec.integrator)
                     }
                     _ => None,
                 };

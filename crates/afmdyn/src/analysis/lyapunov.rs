@@ -103,6 +103,30 @@ pub struct LyapunovSpectrum {
     pub verdict: Verdict,
 }
 
+/// The largest exponent λ₁ of the motion from `z0` (a state on an attractor, at τ = 0) over
+/// `periods` drive periods without transient, in 10 blocks (fewer for a short run), and its
+/// error (uncertainty plus convergence estimate, as [`LyapunovSpectrum`] reports them);
+/// `None` when the run fails or is shorter than 2 periods. What a chart's or a basin map's
+/// nonperiodic attractor records.
+pub fn largest_exponent(
+    model: &CantileverModel,
+    z0: &DVector<f64>,
+    periods: usize,
+    integrator: IntegratorOptions,
+) -> Option<(f64, f64)> {
+    let opts = LyapunovOptions {
+        transient_periods: 0,
+        periods,
+        blocks: 10.min(periods),
+        integrator,
+    };
+    let l = lyapunov_spectrum(model, z0, &opts).ok()?;
+    Some((
+        *l.exponents.first()?,
+        l.uncertainty.first()? + l.convergence.first()?,
+    ))
+}
+
 /// Lyapunov spectrum from the state `z0` at τ = 0.
 ///
 /// # Errors
