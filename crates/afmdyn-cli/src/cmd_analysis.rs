@@ -3,8 +3,12 @@
 use crate::args::{IntegratorArgs, ModelArgs};
 use crate::error::CliError;
 use crate::output::{f, io_error, write_bytes, write_csv, Column, NpyStream, OutDir};
-use crate::plot::{save, save_scatter_stream, ChunkSink, Figure, LegendEntry, Series, Style};
+use crate::plot::{
+    save, save_scatter_stream, save_stacked, ChunkSink, Figure, IdSeries, LegendEntry, Series,
+    StackedFractions, Style,
+};
 use afmdyn::analysis::bifurcation::{Branch, SweepPoint};
+use afmdyn::analysis::global_continuation::DEFAULT_MATCH_TOL;
 use afmdyn::integrate::build;
 use afmdyn::request::checkpoint::{self, Checkpoint, CheckpointError};
 use afmdyn::request::limits::ATTRACTOR_SAMPLES_PER_PERIOD;
@@ -12,7 +16,9 @@ use afmdyn::request::sweep::{
     branch_code, fingerprint, status_code, sweep_failure, COL_BRANCH, COL_INDEX, COL_MESSAGE,
     COL_PERIOD, COL_POINT, COL_STATUS, COL_TAU, COL_X_MAX, NUMERIC_COLUMNS,
 };
-use afmdyn::request::{AttractorsRequest, BifurcationRequest, FileCheckpoint, SteadyRequest};
+use afmdyn::request::{
+    AttractorsRequest, BifurcationRequest, FileCheckpoint, GlobalContinuationRequest, SteadyRequest,
+};
 use afmdyn::request::{Document, Resolved};
 use afmdyn::trajectory::{record, RecordSpec};
 use afmdyn::{CantileverModel, Params, SweepParam};
@@ -429,6 +435,24 @@ pub struct AttractorsArgs {
     /// Relative tolerance for two Poincaré point sets to be the same attractor
     #[arg(long, default_value_t = 1e-5)]
     cluster_tol: f64,
+    /// Continue the attractors over this parameter (omega, alpha1..alpha6): a census at every
+    /// value, seeded from the previous value's attractors and matched to them (global
+    /// continuation); needs --from and --to
+    #[arg(long, requires_all = ["from", "to"])]
+    sweep: Option<SweepParam>,
+    /// First value of --sweep
+    #[arg(long, allow_negative_numbers = true, requires = "sweep")]
+    from: Option<f64>,
+    /// Last value of --sweep
+    #[arg(long, allow_negative_numbers = true, requires = "sweep")]
+    to: Option<f64>,
+    /// Number of values of --sweep
+    #[arg(long, default_value_t = 16, requires = "sweep")]
+    steps: usize,
+    /// Largest relative distance between the Poincaré point sets of two attractors at
+    /// consecutive values of --sweep that are one attractor
+    #[arg(long, default_value_t = DEFAULT_MATCH_TOL, requires = "sweep")]
+    match_tol: f64,
     /// Output directory
     #[arg(long, default_value = "afmdyn-out/attractors")]
     out: PathBuf,
@@ -448,6 +472,22 @@ pub fn attractors(a: &AttractorsArgs) -> Result<(), CliError> {
         steady: a.steady.request(),
         integrator: a.integrator.request(),
     };
+    if let Some(param) = a.sweep {
+        let sweep = GlobalContinuationRequest {
+            param,
+            values: None,
+            from: a.from.unwrap_or(f64::NAN),
+            to: a.to.unwrap_or(f64::NAN),
+            steps: a.steps,
+            match_tol: a.match_tol,
+            samples: request.samples,
+            seed: request.seed,
+            cluster_tol: request.cluster_tol,
+            steady: request.steady,
+            integrator: request.integrator,
+        };
+        return attractors_sweep(a, &sweep, Resolved { params: p, probe });
+    }
     let spec = request.spec(&p)?;
     let out = OutDir::lock(&a.out)?;
     let Document {
@@ -570,6 +610,130 @@ pub fn attractors(a: &AttractorsArgs) -> Result<(), CliError> {
                 x.steady.stats.contact_fraction,
                 if x.steady.stats.body_contact { "  (beam body touches the substrate: Fig. 2f)" } else { "" }
             );
+        }
+        println!("outputs in {}", out.path().display());
+    }
+    Ok(())
+}
+
+/// `afmdyn attractors --sweep`: the global continuation, its table, figure and document.
+fn attractors_sweep(
+    a: &AttractorsArgs,
+    request: &GlobalContinuationRequest,
+    model: Resolved,
+) -> Result<(), CliError> {
+    let p = model.params;
+    request.spec(&p)?;
+    let out = OutDir::lock(&a.out)?;
+    let Document {
+        output: steps,
+        json: doc,
+    } = crate::progress::run(request, &model, "starts")?;
+    let name = request.param.name();
+    let mut rows = Vec::new();
+    for s in &steps {
+        for (id, x) in &s.attractors {
+            rows.push(vec![
+                f(s.value),
+                id.to_string(),
+                x.steady
+                    .period()
+                    .map_or("nonperiodic".into(), |n| n.to_string()),
+                f(x.basin_fraction),
+                f(x.steady.stats.x_max),
+                f(x.steady.stats.v_t_min),
+                f(x.steady.stats.contact_fraction),
+                x.orbit
+                    .as_ref()
+                    .map_or(String::new(), |o| u8::from(o.stable).to_string()),
+            ]);
+        }
+    }
+    write_csv(
+        &out.join("attractors-sweep.csv"),
+        &[
+            name,
+            "id",
+            "period",
+            "basin_fraction",
+            "x_max",
+            "v_t_min",
+            "contact_fraction",
+            "stable",
+        ],
+        rows,
+    )?;
+    let ids = doc["ids"].as_u64().unwrap_or(0) as usize;
+    let per_id: Vec<IdSeries> = (0..ids)
+        .map(|id| {
+            let points: Vec<Option<(f64, f64)>> = steps
+                .iter()
+                .map(|s| {
+                    s.attractors
+                        .iter()
+                        .find(|(i, _)| *i == id)
+                        .map(|(_, x)| (x.basin_fraction, x.steady.stats.x_max))
+                })
+                .collect();
+            let periods: std::collections::BTreeSet<String> = steps
+                .iter()
+                .flat_map(|s| s.attractors.iter().filter(|(i, _)| *i == id))
+                .map(|(_, x)| {
+                    x.steady
+                        .period()
+                        .map_or("nonperiodic".into(), |n| format!("P{n}"))
+                })
+                .collect();
+            let kinds: Vec<String> = periods.into_iter().collect();
+            (format!("attractor {id}: {}", kinds.join(", ")), points)
+        })
+        .collect();
+    save_stacked(
+        out.path(),
+        "attractors-sweep",
+        &StackedFractions {
+            title: format!(
+                "Attractors over {} ({} random starts per value)",
+                request.param.symbol(),
+                request.samples
+            ),
+            x_label: request.param.symbol().into(),
+            values: steps.iter().map(|s| s.value).collect(),
+            ids: per_id,
+        },
+    )?;
+    write_bytes(
+        &out.join("attractors-sweep.json"),
+        serde_json::to_string_pretty(&doc).expect("json").as_bytes(),
+    )?;
+    for w in doc["warnings"].as_array().into_iter().flatten() {
+        eprintln!("afmdyn: warning: {}", w.as_str().unwrap_or_default());
+    }
+    if a.json {
+        println!("{doc}");
+    } else {
+        println!(
+            "{ids} attractors over {} values of {name} ({} random starts each):",
+            steps.len(),
+            request.samples
+        );
+        for s in &steps {
+            let line: Vec<String> = s
+                .attractors
+                .iter()
+                .map(|(id, x)| {
+                    format!(
+                        "#{id} {} {:.1} %",
+                        x.steady
+                            .period()
+                            .map_or("nonperiodic".into(), |n| format!("P{n}")),
+                        100.0 * x.basin_fraction
+                    )
+                })
+                .collect();
+            // 10 significant digits: a linspace value such as 1.7999999999999998 reads 1.8
+            let value: f64 = format!("{:.9e}", s.value).parse().unwrap_or(s.value);
+            println!("  {name} = {value:<10} {}", line.join("  "));
         }
         println!("outputs in {}", out.path().display());
     }

@@ -20,9 +20,9 @@ use afmdyn::request::{
     fingerprint, DirLock, FileCheckpoint, LockError, MemoryCheckpoint, SweepRecord,
 };
 use afmdyn::request::{
-    AttractorsRequest, BifurcationRequest, ContinuationRequest, ConvergeRequest, IntegratorRequest,
-    LyapunovRequest, ObserveRequest, OrbitRequest, SeriesStore, SimulateRequest, StartRequest,
-    SteadyRequest,
+    AttractorsRequest, BifurcationRequest, ContinuationRequest, ConvergeRequest,
+    GlobalContinuationRequest, IntegratorRequest, LyapunovRequest, ObserveRequest, OrbitRequest,
+    SeriesStore, SimulateRequest, StartRequest, SteadyRequest,
 };
 use afmdyn::trajectory::{record, RecordSpec};
 use afmdyn::{report, CantileverModel, Params, Region, SweepParam};
@@ -680,6 +680,54 @@ pub fn attractors<'py>(
     }
     out.set("attractors", list)?;
     out.set("failures", PyList::new(py, &report_.failures)?)?;
+    Ok(out.finish())
+}
+
+/// Attractors continued over a parameter (global continuation): the JSON document of
+/// `afmdyn attractors --sweep --json` (the Python layer builds the dataset from it).
+#[pyfunction]
+#[pyo3(signature = (params, param="omega", from_=1.5, to=3.0, steps=16, values=None,
+    match_tol=0.1, samples=16, seed=1, cluster_tol=1e-5, tol=1e-8, max_periods=1500,
+    max_period=64, integrator=None, steps_per_period=None, tolerance=1e-12, progress=None,
+    probe=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn global_continuation<'py>(
+    py: Python<'py>,
+    params: PyRef<'_, PyParams>,
+    param: &str,
+    from_: f64,
+    to: f64,
+    steps: usize,
+    values: Option<Vec<f64>>,
+    match_tol: f64,
+    samples: usize,
+    seed: u64,
+    cluster_tol: f64,
+    tol: f64,
+    max_periods: usize,
+    max_period: usize,
+    integrator: Option<&str>,
+    steps_per_period: Option<usize>,
+    tolerance: f64,
+    progress: Option<Bound<'py, PyAny>>,
+    probe: Option<PathBuf>,
+) -> PyResult<Dict<'py>> {
+    let request = GlobalContinuationRequest {
+        param: param.parse().map_err(value_error)?,
+        values,
+        from: from_,
+        to,
+        steps,
+        match_tol,
+        samples,
+        seed,
+        cluster_tol,
+        steady: steady(tol, max_periods, max_period),
+        integrator: integrator_request(integrator, steps_per_period, tolerance)?,
+    };
+    let doc = analysis(py, request, params.inner, probe, progress.as_ref(), true)?;
+    let out = Out::new(py);
+    out.json(&doc.json)?;
     Ok(out.finish())
 }
 

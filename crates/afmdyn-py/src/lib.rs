@@ -34,6 +34,7 @@ fn _afmdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(analyses::converge, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::bifurcation, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::attractors, m)?)?;
+    m.add_function(wrap_pyfunction!(analyses::global_continuation, m)?)?;
     m.add_function(wrap_pyfunction!(basins::basins, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::orbit, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::continuation, m)?)?;

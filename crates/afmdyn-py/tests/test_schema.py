@@ -92,6 +92,8 @@ CLI_CASES: List[Tuple[str, List[Any]]] = [
     ("attractors", ["--samples", 2, *SHORT]),
     ("attractors", ["--samples", 2, *SHORT, "--probe", P1]),
     ("attractors", ["--samples", 2, *SHORT, *IMPACT]),
+    ("attractors", ["--samples", 2, *SHORT, *IMPACT, "--sweep", "omega", "--from", 2.9, "--to", 3, "--steps", 2]),
+    ("attractors", ["--samples", 2, *SHORT, "--sweep", "omega", "--from", 2.6, "--to", 2.7, "--steps", 2, "--probe", P1]),
     ("orbit", SHORT),
     ("orbit", [*SHORT, "--probe", P2]),
     ("orbit", [*SHORT, *IMPACT]),
@@ -163,6 +165,8 @@ def _python_docs() -> List[Tuple[str, str, Callable[[], Any]]]:
             samples=2, max_periods=300, probe=P1).to_dict()),
         ("attractors", "attractors impact", lambda: afmdyn.attractors(
             samples=2, max_periods=300, **IMPACT_PY).to_dict()),
+        ("attractors", "global continuation", lambda: afmdyn.summary(afmdyn.global_continuation(
+            samples=2, max_periods=300, from_=2.9, to=3.0, steps=2, **IMPACT_PY))),
         ("orbit", "orbit", lambda: afmdyn.orbit(max_periods=300).to_dict()),
         ("orbit", "orbit probe", lambda: afmdyn.orbit(max_periods=300, probe=P2).to_dict()),
         ("continue", "continuation", lambda: afmdyn.summary(
@@ -282,7 +286,7 @@ def test_every_request_has_a_schema() -> None:
     assert REQUEST_NAMES == sorted(
         ["model", "steady", "integrator", "start", "orbit", "continuation", "lyapunov",
          "attractors", "observe", "converge", "simulate", "bifurcation", "curve", "modes",
-         "approach", "resonance", "chart"]
+         "approach", "resonance", "chart", "global_continuation"]
     )
 
 

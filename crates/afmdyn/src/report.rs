@@ -8,6 +8,7 @@
 use crate::analysis::attractors::AttractorReport;
 use crate::analysis::continuation::Branch;
 use crate::analysis::converge::ConvergenceRun;
+use crate::analysis::global_continuation::ContinuationStep;
 use crate::analysis::lyapunov::LyapunovSpectrum;
 use crate::analysis::observables::Observables;
 use crate::analysis::shooting::PeriodicOrbit;
@@ -173,6 +174,61 @@ pub fn attractors(params: &Params, samples: usize, report: &AttractorReport) -> 
             .iter()
             .map(|x| attractor(&x.steady, x.basin_fraction, x.orbit.as_ref()))
             .collect::<Vec<_>>(),
+    })
+}
+
+/// `afmdyn attractors --sweep --json`: the attractors at every value with their ids, and the
+/// basin fractions as a values × ids table (0 where an id has no attractor).
+pub fn global_continuation(
+    base: &Params,
+    param: SweepParam,
+    samples: usize,
+    steps: &[ContinuationStep],
+) -> Value {
+    let ids = steps
+        .iter()
+        .flat_map(|s| s.attractors.iter().map(|(id, _)| id + 1))
+        .max()
+        .unwrap_or(0);
+    let fractions: Vec<Vec<f64>> = steps
+        .iter()
+        .map(|s| {
+            let mut row = vec![0.0; ids];
+            for (id, a) in &s.attractors {
+                row[*id] = a.basin_fraction;
+            }
+            row
+        })
+        .collect();
+    let warnings: Vec<String> = steps
+        .iter()
+        .filter(|s| s.attractors.is_empty())
+        .map(|s| {
+            format!(
+                "{} = {}: every run failed ({})",
+                param.name(),
+                s.value,
+                s.failures.first().map_or("", String::as_str)
+            )
+        })
+        .collect();
+    json!({
+        "params": base,
+        "param": param.name(),
+        "samples": samples,
+        "values": steps.iter().map(|s| s.value).collect::<Vec<_>>(),
+        "ids": ids,
+        "fractions": fractions,
+        "steps": steps.iter().map(|s| json!({
+            "value": s.value,
+            "failures": s.failures.len(),
+            "attractors": s.attractors.iter().map(|(id, a)| {
+                let mut d = attractor(&a.steady, a.basin_fraction, a.orbit.as_ref());
+                d["id"] = json!(id);
+                d
+            }).collect::<Vec<_>>(),
+        })).collect::<Vec<_>>(),
+        "warnings": warnings,
     })
 }
 

@@ -9,8 +9,8 @@
 use afmdyn::request::{ApproachRequest, ChartRequest, ModesRequest, ResonanceRequest};
 use afmdyn::request::{
     AttractorsRequest, BifurcationRequest, ContinuationRequest, ConvergeRequest, CurveRequest,
-    IntegratorRequest, LyapunovRequest, ModelSpec, ObserveRequest, OrbitRequest, SimulateRequest,
-    StartRequest, SteadyRequest,
+    GlobalContinuationRequest, IntegratorRequest, LyapunovRequest, ModelSpec, ObserveRequest,
+    OrbitRequest, SimulateRequest, StartRequest, SteadyRequest,
 };
 use schemars::{schema_for, JsonSchema};
 use serde::{de::DeserializeOwned, Serialize};
@@ -55,6 +55,10 @@ fn schemas() -> Vec<(&'static str, Value)> {
         ),
         ("lyapunov", schema::<LyapunovRequest>("lyapunov")),
         ("attractors", schema::<AttractorsRequest>("attractors")),
+        (
+            "global_continuation",
+            schema::<GlobalContinuationRequest>("global_continuation"),
+        ),
         ("observe", schema::<ObserveRequest>("observe")),
         ("converge", schema::<ConvergeRequest>("converge")),
         ("simulate", schema::<SimulateRequest>("simulate")),

@@ -11,7 +11,8 @@ series, sweeps, curves) or small result objects whose ``to_dict()`` is the comma
 array([ 7.79, 20.33, 55.81])
 
 Analyses: :func:`modes`, :func:`simulate`, :func:`converge`, :func:`bifurcation`,
-:func:`attractors`, :func:`chart` (behaviour charts over two parameters; on a Dask cluster
+:func:`attractors`, :func:`global_continuation` (attractors and basin fractions continued over a
+parameter), :func:`basins` (basins of attraction), :func:`chart` (behaviour charts over two parameters; on a Dask cluster
 with :func:`afmdyn.dask.chart`), :func:`orbit`, :func:`continuation`, :func:`lyapunov`, :func:`observe`
 (amplitude, phase, dissipated energy, virial, forces of a steady state), :func:`approach`
 (approach–retract curves) and :func:`resonance` (resonance curves), both with branches and
@@ -41,6 +42,7 @@ from ._api import (
 )
 from ._basins import basins
 from ._chart import chart
+from ._global_continuation import global_continuation
 from ._results import Attractor, Attractors, Lyapunov, Orbit, RegionSpectrum, Spectrum
 
 try:
@@ -68,6 +70,7 @@ __all__ = [
     "chart",
     "continuation",
     "converge",
+    "global_continuation",
     "lyapunov",
     "modes",
     "observe",

@@ -187,6 +187,26 @@ def attractors(
     progress: Optional[ProgressCallback] = None,
     probe: Optional[str] = None,
 ) -> Dict[str, Any]: ...
+def global_continuation(
+    params: Params,
+    param: str = "omega",
+    from_: float = 1.5,
+    to: float = 3.0,
+    steps: int = 16,
+    values: Optional[List[float]] = None,
+    match_tol: float = 0.1,
+    samples: int = 16,
+    seed: int = 1,
+    cluster_tol: float = 1e-5,
+    tol: float = 1e-8,
+    max_periods: int = 1500,
+    max_period: int = 64,
+    integrator: Optional[str] = None,
+    steps_per_period: Optional[int] = None,
+    tolerance: float = 1e-12,
+    progress: Optional[ProgressCallback] = None,
+    probe: Optional[str] = None,
+) -> Dict[str, Any]: ...
 def orbit(
     params: Params,
     period: Optional[int] = None,

@@ -128,23 +128,48 @@ pub fn find_attractors_with(
 ) -> Result<AttractorReport, SimError> {
     spec.validate()?;
     let model = CantileverModel::new(&spec.params)?;
-    progress.add_total(spec.samples);
-    let results = steady_states_of_starts(&model, spec, progress);
+    let starts: Vec<DVector<f64>> = (0..spec.samples)
+        .map(|i| random_state(&model, spec.seed, i as u64))
+        .collect();
+    census(&model, spec, starts, &[], progress)
+}
+
+/// The attractors reached from the random `starts` and from `seeds` (states not counted in the
+/// basin fractions: the previous value's attractors of a global continuation), every run in
+/// parallel, clustered with [`same_attractor`] in the order starts then seeds, the periodic
+/// ones polished by shooting. Counts every run in `progress` (its total grows by their number).
+///
+/// # Errors
+/// [`SimError::Cancelled`] once `progress` is cancelled (failing runs are reported in
+/// [`AttractorReport::failures`]: the failures of seeds among them).
+pub(crate) fn census(
+    model: &CantileverModel,
+    spec: &AttractorSpec,
+    starts: Vec<DVector<f64>>,
+    seeds: &[DVector<f64>],
+    progress: &Progress,
+) -> Result<AttractorReport, SimError> {
+    let random = starts.len();
+    let mut all = starts;
+    all.extend(seeds.iter().cloned());
+    progress.add_total(all.len());
+    let results = steady_states_of_starts(model, spec, all, progress);
     progress.check()?;
     let mut attractors: Vec<Attractor> = Vec::new();
     let mut failures = Vec::new();
-    for (z0, r) in results {
+    for (k, (z0, r)) in results.into_iter().enumerate() {
+        let counted = usize::from(k < random);
         match r {
             Err(e) => failures.push(e.to_string()),
             Ok(s) => match attractors
                 .iter_mut()
                 .find(|a| same_attractor(&a.steady, &s, spec.cluster_tol))
             {
-                Some(a) => a.count += 1,
+                Some(a) => a.count += counted,
                 None => attractors.push(Attractor {
                     steady: s,
                     initial: z0,
-                    count: 1,
+                    count: counted,
                     basin_fraction: 0.0,
                     orbit: None,
                 }),
@@ -155,11 +180,12 @@ pub fn find_attractors_with(
     for a in &mut attractors {
         a.basin_fraction = a.count as f64 / ok.max(1) as f64;
     }
+    // most frequent first (a stable sort: ties keep the order found)
     attractors.sort_by_key(|a| std::cmp::Reverse(a.count));
     attractors
         .par_iter_mut()
         .with_max_len(1)
-        .for_each(|a| polish(&model, spec.integrator, a));
+        .for_each(|a| polish(model, spec.integrator, a));
     Ok(AttractorReport {
         attractors,
         failures,
@@ -169,19 +195,19 @@ pub fn find_attractors_with(
 /// A start and the steady state it reaches.
 type StartResult = (DVector<f64>, Result<SteadyState, SimError>);
 
-/// The steady state from every random start, one by one in parallel. (A batched exact
+/// The steady state from every start, one by one in parallel. (A batched exact
 /// propagator, lanes advanced together, measured 0.74–1.0× of one by one at N = 3 and kept one
 /// core busy where the starts spread over all of them; it was removed, issue 30.)
 fn steady_states_of_starts(
     model: &CantileverModel,
     spec: &AttractorSpec,
+    starts: Vec<DVector<f64>>,
     progress: &Progress,
 ) -> Vec<StartResult> {
-    (0..spec.samples)
+    starts
         .into_par_iter()
         .with_max_len(1)
-        .map(|i| {
-            let z0 = random_state(model, spec.seed, i as u64);
+        .map(|z0| {
             let r = progress.check().and_then(|()| {
                 build(model, spec.integrator, 0.0, &z0)
                     .and_then(|mut it| steady_state(it.as_mut(), &spec.steady))

@@ -13,6 +13,7 @@ pub mod bifurcation;
 pub mod chart;
 pub mod continuation;
 pub mod converge;
+pub mod global_continuation;
 pub mod lyapunov;
 pub mod monodromy;
 pub mod observables;

@@ -14,6 +14,9 @@ use crate::analysis::continuation::{
     continue_branch_with, continue_with_switching_with, Branch, ContinuationSpec,
 };
 use crate::analysis::converge::{mode_convergence_with, ConvergenceRun};
+use crate::analysis::global_continuation::{
+    GlobalContinuationSpec, DEFAULT_MATCH_TOL, MAX_CONTINUATION_VALUES,
+};
 use crate::analysis::lyapunov::{lyapunov_spectrum_with, LyapunovOptions, LyapunovSpectrum};
 use crate::analysis::observables::{observe_from, ObservableOptions, Observables};
 use crate::analysis::period::MAX_PERIOD;
@@ -429,6 +432,95 @@ impl AttractorsRequest {
             }
         }
         Ok(report)
+    }
+}
+
+/// `attractors` continued over a parameter (`afmdyn attractors --sweep`): a census at every
+/// value seeded from the previous value's attractors, matched to them by set distance
+/// ([`crate::analysis::global_continuation`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[serde(default, deny_unknown_fields)]
+pub struct GlobalContinuationRequest {
+    /// The continued parameter.
+    pub param: SweepParam,
+    /// Explicit values (in the order continued) instead of `from`, `to`, `steps`.
+    pub values: Option<Vec<f64>>,
+    /// First value.
+    pub from: f64,
+    /// Last value.
+    pub to: f64,
+    /// Number of values, 1..=[`MAX_CONTINUATION_VALUES`].
+    pub steps: usize,
+    /// Largest relative set distance of two attractors at consecutive values that are one, ≥ 0.
+    pub match_tol: f64,
+    /// Random starts per value, 1..=[`MAX_ATTRACTOR_SAMPLES`].
+    pub samples: usize,
+    /// Seed of the random starts (keyed by value and start, as a sweep's).
+    pub seed: u64,
+    /// Relative tolerance for two Poincaré point sets at one value to be one attractor, > 0.
+    pub cluster_tol: f64,
+    /// The steady-state search of every start.
+    #[serde(flatten)]
+    pub steady: SteadyRequest,
+    /// The integrator.
+    #[serde(flatten)]
+    pub integrator: IntegratorRequest,
+}
+
+impl Default for GlobalContinuationRequest {
+    fn default() -> Self {
+        GlobalContinuationRequest {
+            param: SweepParam::Omega,
+            values: None,
+            from: 1.5,
+            to: 3.0,
+            steps: 16,
+            match_tol: DEFAULT_MATCH_TOL,
+            samples: 16,
+            seed: 1,
+            cluster_tol: 1e-5,
+            steady: SteadyRequest::default(),
+            integrator: IntegratorRequest::default(),
+        }
+    }
+}
+
+impl GlobalContinuationRequest {
+    /// The validated continuation of `base` ([`GlobalContinuationSpec::validate`]).
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming the option, [`SimError::Params`] for a value out of the
+    /// parameter's range.
+    pub fn spec(&self, base: &Params) -> Result<GlobalContinuationSpec, SimError> {
+        let values = match &self.values {
+            Some(v) => v.clone(),
+            None => {
+                if self.steps > MAX_CONTINUATION_VALUES {
+                    return Err(SimError::out_of_range(
+                        "steps",
+                        self.steps,
+                        "must be in 1..=10000",
+                    ));
+                }
+                SweepSpec::linspace(self.from, self.to, self.steps)?
+            }
+        };
+        let census = AttractorsRequest {
+            samples: self.samples,
+            seed: self.seed,
+            cluster_tol: self.cluster_tol,
+            steady: self.steady,
+            integrator: self.integrator,
+        };
+        let spec = GlobalContinuationSpec {
+            census: census.spec(base)?,
+            param: self.param,
+            values,
+            match_tol: self.match_tol,
+        };
+        spec.validate()?;
+        Ok(spec)
     }
 }
 

@@ -42,9 +42,9 @@ pub mod run;
 pub mod sweep;
 
 pub use analyses::{
-    AttractorsRequest, BifurcationRequest, ContinuationRequest, ConvergeRequest, IntegratorRequest,
-    LyapunovRequest, ObserveRequest, OrbitRequest, SeriesStore, SimulateRequest, StartRequest,
-    SteadyRequest,
+    AttractorsRequest, BifurcationRequest, ContinuationRequest, ConvergeRequest,
+    GlobalContinuationRequest, IntegratorRequest, LyapunovRequest, ObserveRequest, OrbitRequest,
+    SeriesStore, SimulateRequest, StartRequest, SteadyRequest,
 };
 pub use chart::{Chart, ChartArrays, ChartModel, ChartRequest};
 pub use checkpoint::{Checkpoint, CheckpointError, MemoryCheckpoint};

@@ -16,13 +16,14 @@
 //! `observe` are one short computation each and neither count nor check it.
 
 use super::analyses::{
-    AttractorsRequest, ContinuationRequest, ConvergeRequest, LyapunovRequest, ObserveRequest,
-    ObserveResult, OrbitRequest,
+    AttractorsRequest, ContinuationRequest, ConvergeRequest, GlobalContinuationRequest,
+    LyapunovRequest, ObserveRequest, ObserveResult, OrbitRequest,
 };
 use super::curves::{approach_request, resonance_request, CurveRequest};
 use crate::analysis::attractors::AttractorReport;
 use crate::analysis::continuation::Branch;
 use crate::analysis::converge::ConvergenceRun;
+use crate::analysis::global_continuation::{global_continuation, ContinuationStep};
 use crate::analysis::lyapunov::LyapunovSpectrum;
 use crate::analysis::progress::Progress;
 use crate::analysis::shooting::PeriodicOrbit;
@@ -178,6 +179,24 @@ impl Analysis for AttractorsRequest {
     }
     fn report(&self, model: &Resolved, r: &Self::Output) -> Result<Value, SimError> {
         Ok(report::attractors(&model.params, self.samples, r))
+    }
+}
+
+impl Analysis for GlobalContinuationRequest {
+    type Output = Vec<ContinuationStep>;
+    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
+        self.spec(&model.params).map(|_| ())
+    }
+    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
+        global_continuation(&self.spec(&model.params)?, progress)
+    }
+    fn report(&self, model: &Resolved, steps: &Self::Output) -> Result<Value, SimError> {
+        Ok(report::global_continuation(
+            &model.params,
+            self.param,
+            self.samples,
+            steps,
+        ))
     }
 }
 
