@@ -1,24 +1,23 @@
-//! `afmdyn basins`: a basin map over two coordinates of the initial state (issue 30). The map,
-//! its stopping rules and limits are the library's ([`afmdyn::analysis::basins`]), its
-//! measures too ([`afmdyn::analysis::basin_entropy`]); this front end parses, runs and writes
-//! `basins.csv`, the map and the JSON document.
+//! `afmdyn basins`: a basin map over two coordinates of the initial state (issue 30). The
+//! request, its limits, the map and its document are the library's
+//! ([`afmdyn::request::BasinsRequest`], [`afmdyn::analysis::basins`]); this front end parses,
+//! runs with a progress bar and writes `basins.csv`, `basins.nc`, the map and the JSON document.
 
 use crate::args::{IntegratorArgs, ModelArgs};
 use crate::cmd_analysis::SteadyArgs;
+use crate::cmd_simulate::parse_modal_state;
 use crate::error::CliError;
-use crate::output::{write_bytes, OutDir};
+use crate::output::{atomic, write_bytes, OutDir};
 use crate::plot::{color, save_map, CellMap};
-use afmdyn::analysis::basin_entropy::{basin_entropy, uncertainty_exponent};
 use afmdyn::analysis::basins::{
-    basins, BasinSpec, Decided, StateCoord, DEFAULT_BASIN_HITS, DEFAULT_CELL,
-    DEFAULT_DISCOVER_AFTER, DEFAULT_NEAR_TOL,
+    BasinSpec, Decided, DEFAULT_BASIN_HITS, DEFAULT_CELL, DEFAULT_DISCOVER_AFTER, DEFAULT_NEAR_TOL,
+    DEFAULT_STRIDE,
 };
-use afmdyn::analysis::bifurcation::SweepSpec;
+use afmdyn::request::{BasinArrays, BasinsRequest, Document, Resolved};
 use afmdyn::{CantileverModel, Params};
 use clap::Args;
 use plotters::style::RGBColor;
-use serde_json::json;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// `afmdyn basins` flags.
 #[derive(Debug, Args)]
@@ -64,6 +63,17 @@ pub struct BasinsArgs {
     /// Consecutive returns in cells of one basin that decide a start (0: no recurrence test)
     #[arg(long, default_value_t = DEFAULT_BASIN_HITS)]
     basin_hits: usize,
+    /// Returns tested before the steady-state search takes over
+    #[arg(long, default_value_t = DEFAULT_DISCOVER_AFTER)]
+    discover_after: usize,
+    /// Stride of the first pass's coarse grid, halved pass by pass (0: automatic, at least 25
+    /// nodes per axis; 1: one pass). Used when the map's plane is the whole section (N = 1, a
+    /// position and a velocity)
+    #[arg(long, default_value_t = DEFAULT_STRIDE)]
+    stride: usize,
+    /// The other coordinates of every start, "a1,..,aN;adot1,..,adotN" (default: at rest)
+    #[arg(long)]
+    base: Option<String>,
     /// Relative tolerance for two steady states to be one attractor
     #[arg(long, default_value_t = 1e-5)]
     cluster_tol: f64,
@@ -78,52 +88,36 @@ pub struct BasinsArgs {
     json: bool,
 }
 
-fn coord(field: &str, s: &str) -> Result<StateCoord, CliError> {
-    s.parse()
-        .map_err(|e: String| CliError::Input(format!("--{field}: {e}")))
-}
-
 /// Run `afmdyn basins`.
 pub fn basins_cmd(a: &BasinsArgs) -> Result<(), CliError> {
-    let (p, _probe) = a.model.resolve(Params::default())?;
-    let (x, y) = (coord("x", &a.x)?, coord("y", &a.y)?);
-    let input = |e: afmdyn::SimError| CliError::Input(crate::error::spell(&e));
-    let spec = BasinSpec {
-        params: p,
-        x,
-        xs: SweepSpec::linspace(a.x_from, a.x_to, a.x_steps).map_err(input)?,
-        y,
-        ys: SweepSpec::linspace(a.y_from, a.y_to, a.y_steps).map_err(input)?,
-        base: nalgebra::DVector::zeros(2 * p.modes),
+    let (p, probe) = a.model.resolve(Params::default())?;
+    let request = BasinsRequest {
+        x: a.x.clone(),
+        x_from: a.x_from,
+        x_to: a.x_to,
+        x_steps: a.x_steps,
+        y: a.y.clone(),
+        y_from: a.y_from,
+        y_to: a.y_to,
+        y_steps: a.y_steps,
+        base: parse_modal_state("base", &a.base, p.modes)?,
         near_tol: a.near_tol,
         cell: a.cell,
         basin_hits: a.basin_hits,
-        discover_after: DEFAULT_DISCOVER_AFTER,
-        steady: a.steady.request().options().map_err(input)?,
+        discover_after: a.discover_after,
+        stride: a.stride,
         cluster_tol: a.cluster_tol,
-        integrator: a.integrator.request().options(1),
+        threads: a.threads,
+        steady: a.steady.request(),
+        integrator: a.integrator.request(),
     };
-    spec.validate().map_err(input)?;
-    if let Some(t) = a.threads {
-        if !(1..=1024).contains(&t) {
-            return Err(CliError::Input(format!(
-                "threads = {t}: must be in 1..=1024"
-            )));
-        }
-    }
-    let model = CantileverModel::new(&p).map_err(|e| input(e.into()))?;
+    let spec = request.spec(&p)?;
+    let model = CantileverModel::new(&p)?;
     let out = OutDir::lock(&a.out)?;
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(a.threads.unwrap_or(0))
-        .build()
-        .map_err(|e| CliError::Io(format!("cannot start worker threads: {e}")))?;
-    let map = pool.install(|| basins(&spec)).map_err(|e| {
-        if e.is_input_error() {
-            input(e)
-        } else {
-            CliError::Sim(e)
-        }
-    })?;
+    let Document {
+        output: map,
+        json: mut doc,
+    } = crate::progress::run(&request, &Resolved { params: p, probe }, "starts")?;
     let (nx, ny) = (spec.xs.len(), spec.ys.len());
     let labels = map.labels();
     // basins.csv
@@ -140,6 +134,7 @@ pub fn basins_cmd(a: &BasinsArgs) -> Result<(), CliError> {
         ));
     }
     write_bytes(&out.join("basins.csv"), text.as_bytes())?;
+    write_nc(&out.join("basins.nc"), &spec, &BasinArrays::new(&map))?;
     // the map, the attractors' section points on it
     let colour = |l: i64| -> RGBColor {
         if l < 0 {
@@ -169,12 +164,15 @@ pub fn basins_cmd(a: &BasinsArgs) -> Result<(), CliError> {
         .flat_map(|s| s.poincare.iter())
         .map(|q| {
             (
-                BasinSpec::coordinate(&model, x, &q.state),
-                BasinSpec::coordinate(&model, y, &q.state),
+                BasinSpec::coordinate(&model, spec.x, &q.state),
+                BasinSpec::coordinate(&model, spec.y, &q.state),
             )
         })
         .collect();
-    let (xl, yl) = (format!("{x} at τ = 0"), format!("{y} at τ = 0"));
+    let (xl, yl) = (
+        format!("{} at τ = 0", spec.x),
+        format!("{} at τ = 0", spec.y),
+    );
     save_map(
         out.path(),
         "basins",
@@ -188,43 +186,12 @@ pub fn basins_cmd(a: &BasinsArgs) -> Result<(), CliError> {
             points: &points,
         },
     )?;
-    let entropy = basin_entropy(&labels, nx, 5);
-    let uncertainty = uncertainty_exponent(&labels, nx);
-    let count = |d: Decided| map.cells.iter().filter(|c| c.decided == d).count();
-    let fractions = map.basin_fractions();
-    let doc = json!({
-        "params": p,
-        "x": {"name": x.to_string(), "values": spec.xs},
-        "y": {"name": y.to_string(), "values": spec.ys},
-        "labels": labels.chunks(nx).collect::<Vec<_>>(),
-        "attractors": map.attractors.iter().enumerate().map(|(i, s)| json!({
-            "id": i,
-            "period": s.period(),
-            "multipliers": map.orbits[i].as_ref().map(|o| o.multipliers.iter()
-                .map(|m| [m.re, m.im]).collect::<Vec<_>>()),
-            "stable": map.orbits[i].as_ref().map(|o| o.stable),
-            "lyapunov": map.lyapunov[i],
-            "poincare": {"state": s.poincare.iter()
-                .map(|q| q.state.iter().copied().collect::<Vec<f64>>())
-                .collect::<Vec<_>>()},
-            "x_max": s.stats.x_max,
-            "v_t_min": s.stats.v_t_min,
-            "contacts_per_period": s.stats.contacts_per_period,
-        })).collect::<Vec<_>>(),
-        "basin_fractions": fractions,
-        "failed": labels.iter().filter(|&&l| l < 0).count(),
-        "decided": {
-            "near": count(Decided::Near),
-            "recurrence": count(Decided::Recurrence),
-            "steady": count(Decided::Steady),
-            "failed": count(Decided::Failed),
-        },
-        "periods": map.cells.iter().map(|c| c.periods as u64).sum::<u64>(),
-        "basin_entropy": entropy.map(|e| e.basin_entropy),
-        "boundary_basin_entropy": entropy.map(|e| e.boundary_basin_entropy),
-        "uncertainty_exponent": uncertainty.map(|u| u.0),
-        "csv": out.join("basins.csv"),
-    });
+    doc["csv"] = serde_json::json!(out.join("basins.csv"));
+    doc["netcdf"] = serde_json::json!(out.join("basins.nc"));
+    write_bytes(
+        &out.join("basins.json"),
+        serde_json::to_string_pretty(&doc).expect("json").as_bytes(),
+    )?;
     if a.json {
         println!("{doc}");
     } else {
@@ -233,7 +200,7 @@ pub fn basins_cmd(a: &BasinsArgs) -> Result<(), CliError> {
             nx,
             ny,
             map.attractors.len(),
-            fractions
+            map.basin_fractions()
                 .iter()
                 .map(|f| (f * 1000.0).round() / 1000.0)
                 .collect::<Vec<_>>(),
@@ -241,4 +208,115 @@ pub fn basins_cmd(a: &BasinsArgs) -> Result<(), CliError> {
         );
     }
     Ok(())
+}
+
+/// An integer variable of `basins.nc`: name, dimensions, units, long name, values.
+type IntVar<'a> = (&'a str, &'a [&'a str], &'a str, &'a str, &'a Vec<i32>);
+
+/// `basins.nc`: the map's arrays ([`BasinArrays`]) over (y, x) and (attractor), CF-style
+/// attributes (`decided` as flag values with their meanings).
+fn write_nc(path: &Path, spec: &BasinSpec, a: &BasinArrays) -> Result<(), CliError> {
+    use netcdf3::{DataSet, FileWriter, Version};
+    let e = |m: String| CliError::Io(format!("cannot write {}: {m}", path.display()));
+    let d = |r: Result<(), netcdf3::error::InvalidDataSet>| r.map_err(|x| e(format!("{x:?}")));
+    let mut ds = DataSet::new();
+    let (nx, ny, na) = (spec.xs.len(), spec.ys.len(), a.period.len());
+    d(ds.add_fixed_dim("x", nx))?;
+    d(ds.add_fixed_dim("y", ny))?;
+    d(ds.add_fixed_dim("attractor", na))?;
+    d(ds.add_var_f64("x", &["x"]))?;
+    d(ds.add_var_f64("y", &["y"]))?;
+    for (var, c) in [("x", spec.x), ("y", spec.y)] {
+        d(ds.add_var_attr_string(var, "long_name", format!("{c} at tau = 0")))?;
+        let velocity = matches!(
+            c,
+            afmdyn::analysis::basins::StateCoord::ADot(_)
+                | afmdyn::analysis::basins::StateCoord::WDot
+        );
+        d(ds.add_var_attr_string(
+            var,
+            "units",
+            if velocity { "g0 per unit tau" } else { "g0" },
+        ))?;
+    }
+    let cell = ["y", "x"];
+    let ints: [IntVar<'_>; 4] = [
+        ("label", &cell, "1", "attractor id; -2 failed", &a.label),
+        (
+            "decided",
+            &cell,
+            "1",
+            "how the cell was decided",
+            &a.decided,
+        ),
+        (
+            "periods",
+            &cell,
+            "drive periods",
+            "drive periods the start ran",
+            &a.periods,
+        ),
+        (
+            "period",
+            &["attractor"],
+            "drive periods",
+            "period n; -1 nonperiodic",
+            &a.period,
+        ),
+    ];
+    for (name, dims, unit, meaning, _) in ints {
+        d(ds.add_var_i32(name, dims))?;
+        d(ds.add_var_attr_string(name, "units", unit))?;
+        d(ds.add_var_attr_string(name, "long_name", meaning))?;
+    }
+    let codes: Vec<i32> = Decided::ALL.iter().map(|x| x.code()).collect();
+    let meanings: Vec<&str> = Decided::ALL.iter().map(|x| x.name()).collect();
+    d(ds.add_var_attr_i32("decided", "flag_values", codes))?;
+    d(ds.add_var_attr_string("decided", "flag_meanings", meanings.join(" ")))?;
+    let floats: [(&str, &str, &str, &Vec<f64>); 5] = [
+        ("x_max", "g0", "largest tip deflection W(1,tau)", &a.x_max),
+        ("v_t_min", "g0", "smallest V_T", &a.v_t_min),
+        (
+            "basin_fraction",
+            "1",
+            "share of the map's cells",
+            &a.basin_fraction,
+        ),
+        (
+            "stable",
+            "1",
+            "1 stable periodic orbit (shooting), 0 unstable, NaN unknown",
+            &a.stable,
+        ),
+        (
+            "lyapunov",
+            "1/tau",
+            "largest Lyapunov exponent of a nonperiodic attractor",
+            &a.lyapunov,
+        ),
+    ];
+    for (name, unit, meaning, _) in floats {
+        d(ds.add_var_f64(name, &["attractor"]))?;
+        d(ds.add_var_attr_string(name, "units", unit))?;
+        d(ds.add_var_attr_string(name, "long_name", meaning))?;
+    }
+    d(ds.add_global_attr_string(
+        "title",
+        format!("afmdyn basins of attraction over {} and {}", spec.x, spec.y),
+    ))?;
+    d(ds.add_global_attr_string("source", format!("afmdyn {}", env!("CARGO_PKG_VERSION"))))?;
+    atomic(path, |tmp| {
+        let w = |x: netcdf3::error::WriteError| e(format!("{x:?}"));
+        let mut f = FileWriter::open(tmp).map_err(w)?;
+        f.set_def(&ds, Version::Offset64Bit, 0).map_err(w)?;
+        f.write_var_f64("x", &spec.xs).map_err(w)?;
+        f.write_var_f64("y", &spec.ys).map_err(w)?;
+        for (name, _, _, _, v) in ints {
+            f.write_var_i32(name, v).map_err(w)?;
+        }
+        for (name, _, _, v) in floats {
+            f.write_var_f64(name, v).map_err(w)?;
+        }
+        f.close().map_err(w)
+    })
 }

@@ -71,15 +71,15 @@ pub struct SimulateArgs {
     chunk_periods: Option<usize>,
 }
 
-fn parse_list(s: &str, what: &'static str) -> Result<Vec<f64>, CliError> {
+fn parse_list(s: &str, flag: &str, what: &'static str) -> Result<Vec<f64>, CliError> {
     if s.trim().is_empty() {
         return Ok(vec![]);
     }
     s.split(',')
         .map(|t| {
-            t.trim().parse::<f64>().map_err(|_| {
-                CliError::Input(format!("--initial-modal: cannot read '{t}' in the {what}"))
-            })
+            t.trim()
+                .parse::<f64>()
+                .map_err(|_| CliError::Input(format!("--{flag}: cannot read '{t}' in the {what}")))
         })
         .collect()
 }
@@ -91,17 +91,26 @@ pub(crate) fn parse_initial(
     spec: &Option<String>,
     modes: usize,
 ) -> Result<Option<Vec<f64>>, CliError> {
+    parse_modal_state("initial-modal", spec, modes)
+}
+
+/// A modal state flag `--<flag> "a1,..,aN;adot1,..,adotN"` as 2N values (syntax only).
+pub(crate) fn parse_modal_state(
+    flag: &str,
+    spec: &Option<String>,
+    modes: usize,
+) -> Result<Option<Vec<f64>>, CliError> {
     let Some(s) = spec else {
         return Ok(None);
     };
     let (a, ad) = s.split_once(';').ok_or_else(|| {
-        CliError::Input("--initial-modal: expected \"a1,..,aN;adot1,..,adotN\"".into())
+        CliError::Input(format!("--{flag}: expected \"a1,..,aN;adot1,..,adotN\""))
     })?;
-    let mut z = parse_list(a, "displacements")?;
-    let ad = parse_list(ad, "velocities")?;
+    let mut z = parse_list(a, flag, "displacements")?;
+    let ad = parse_list(ad, flag, "velocities")?;
     if z.len() != modes || ad.len() != modes {
         return Err(CliError::Input(format!(
-            "--initial-modal: expected {modes} displacements and {modes} velocities (N = \
+            "--{flag}: expected {modes} displacements and {modes} velocities (N = \
              {modes}), got {} and {}",
             z.len(),
             ad.len()

@@ -8,6 +8,7 @@ import json
 import numpy as np
 import pandas as pd
 import pytest
+import xarray as xr
 
 import afmdyn
 
@@ -28,10 +29,36 @@ def test_basins_equal_the_command_line(cli, tmp_path):
     np.testing.assert_array_equal(csv["label"].values, ds.label.values.ravel())
     np.testing.assert_array_equal(csv["decided"].values, ds.decided.values.ravel())
     assert list(ds.period.values) == [a["period"] or -1 for a in doc["attractors"]]
+    # basins.nc holds the same arrays (the library's one layout of them)
+    nc = xr.open_dataset(tmp_path / "basins.nc")
+    np.testing.assert_array_equal(nc.label.values, ds.label.values)
+    names = nc.decided.attrs["flag_meanings"].split()
+    np.testing.assert_array_equal(np.array(names)[nc.decided.values - 1], ds.decided.values)
+    np.testing.assert_array_equal(nc.periods.values, ds.periods.values)
+    np.testing.assert_allclose(nc.basin_fraction.values, ds.basin_fraction.values, rtol=0, atol=0)
+    # the dataset's summary is the command line's document, but for the files it names
+    summary = json.loads(ds.attrs["summary"])
+    assert summary == {k: v for k, v in doc.items() if k not in ("csv", "netcdf")}
+
+
+def test_two_passes_and_a_base_state():
+    # 60 x 60 on N = 1: two passes (stride 2); most cells decided by the first pass's grid
+    ds = afmdyn.basins(**IMPACT, x_steps=60, y_steps=60)
+    assert json.loads(ds.attrs["summary"])["first_stride"] == 2
+    assert (ds.decided.values == "grid").sum() > 1800
+    one = afmdyn.basins(**IMPACT, x_steps=60, y_steps=60, stride=1)
+    assert (one.decided.values == "grid").sum() == 0
+    assert (one.label.values == ds.label.values).mean() >= 0.995
+    # a base state: w = 0.3 set through mode 1 with the second mode's velocity from the base
+    beam = afmdyn.basins(modes=2, x="w", x_from=0.0, x_to=0.3, x_steps=2, y="wdot", y_from=0.0,
+                         y_to=0.0, y_steps=1, base=[0.0, 0.0, 0.0, 0.05], max_periods=300)
+    assert json.loads(beam.attrs["summary"])["base"] == [0.0, 0.0, 0.0, 0.05]
+    with pytest.raises(ValueError, match="base"):
+        afmdyn.basins(modes=2, base=[0.0, 0.1], x_steps=2, y_steps=2)
 
 
 def test_bad_basins_are_refused():
-    with pytest.raises(ValueError, match="x: 'b1'"):
+    with pytest.raises(ValueError, match="x = b1"):
         afmdyn.basins(x="b1")
     with pytest.raises(ValueError, match="x = a4"):
         afmdyn.basins(x="a4", x_steps=2, y_steps=2)

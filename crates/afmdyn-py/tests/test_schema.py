@@ -28,7 +28,7 @@ IMPACT_PY = dict(contact_law="impact", restitution=0.5, modes=1, gap=0.05, omega
 SHORT = ["--max-periods", 300]
 
 COMMANDS = ["modes", "units", "simulate", "converge", "bifurcation", "attractors", "orbit",
-            "continue", "lyapunov", "approach", "resonance", "chart"]
+            "continue", "lyapunov", "approach", "resonance", "chart", "basins"]
 SHARED = ["params", "si"]
 PYTHON_ONLY = ["observe"]
 
@@ -108,11 +108,13 @@ CLI_CASES: List[Tuple[str, List[Any]]] = [
     ("resonance", ["--points", 5, "--no-branches", "--files", "none"]),
     ("resonance", ["--points", 5, "--no-branches", "--files", "none", "--probe", P1]),
     ("chart", ["--x-steps", 2, "--y-steps", 1, "--starts", 1, "--lyapunov-periods", 20, *SHORT]),
+    ("basins", ["--x-steps", 3, "--y-steps", 2, *SHORT, *IMPACT]),
+    ("basins", ["--x-steps", 2, "--y-steps", 1, *SHORT, "--probe", P1]),
     ("chart", ["--x", "z-c", "--x-from", 6e-9, "--x-to", 8e-9, "--x-steps", 2, "--y", "omega",
                "--y-from", 0.99, "--y-to", 0.99, "--y-steps", 1, "--starts", 1, *SHORT,
                "--probe", P1]),
 ]
-WRITES = {"simulate", "converge", "bifurcation", "attractors", "continue", "chart"}
+WRITES = {"simulate", "converge", "bifurcation", "attractors", "continue", "chart", "basins"}
 
 
 @pytest.fixture(scope="module")
@@ -165,6 +167,8 @@ def _python_docs() -> List[Tuple[str, str, Callable[[], Any]]]:
             samples=2, max_periods=300, probe=P1).to_dict()),
         ("attractors", "attractors impact", lambda: afmdyn.attractors(
             samples=2, max_periods=300, **IMPACT_PY).to_dict()),
+        ("basins", "basins", lambda: afmdyn.summary(afmdyn.basins(
+            x_steps=3, y_steps=2, max_periods=300, **IMPACT_PY))),
         ("attractors", "global continuation", lambda: afmdyn.summary(afmdyn.global_continuation(
             samples=2, max_periods=300, from_=2.9, to=3.0, steps=2, **IMPACT_PY))),
         ("orbit", "orbit", lambda: afmdyn.orbit(max_periods=300).to_dict()),
@@ -286,7 +290,7 @@ def test_every_request_has_a_schema() -> None:
     assert REQUEST_NAMES == sorted(
         ["model", "steady", "integrator", "start", "orbit", "continuation", "lyapunov",
          "attractors", "observe", "converge", "simulate", "bifurcation", "curve", "modes",
-         "approach", "resonance", "chart", "global_continuation"]
+         "approach", "resonance", "chart", "global_continuation", "basins"]
     )
 
 

@@ -4,7 +4,8 @@
 //! `cargo run --release -p afmdyn --example basin_cost -- <impact|beam> <steps>`
 //!
 //! `impact`: N = 1, r = 0.8, Ω = 2.0 over (a1, ȧ1) ∈ [−0.6, 0.6] × [−1.2, 1.2]; `beam`: the
-//! default N = 3 linear-law beam at Ω = 2.8 over the same plane. Prints seconds of both, their
+//! default N = 3 linear-law beam at Ω = 2.8 over the same plane; `beam2`: the paper's Figs. 15–17
+//! beam (N = 3, α1 = 0, Ω = 20; a period-1 and a period-4 attractor) over [−1, 1] × [−20, 20]. Prints seconds of both, their
 //! ratio, the cells decided early, the agreement, the disagreements by how they were decided,
 //! and the mean drive periods per start of both. `NEAR`, `CELL`, `HITS` in the environment
 //! override the map's defaults.
@@ -12,7 +13,7 @@
 use afmdyn::analysis::attractors::same_attractor;
 use afmdyn::analysis::basins::{
     basins, BasinSpec, Decided, StateCoord, DEFAULT_BASIN_HITS, DEFAULT_CELL,
-    DEFAULT_DISCOVER_AFTER, DEFAULT_NEAR_TOL,
+    DEFAULT_DISCOVER_AFTER, DEFAULT_NEAR_TOL, DEFAULT_STRIDE,
 };
 use afmdyn::analysis::bifurcation::SweepSpec;
 use afmdyn::analysis::steady::{steady_state, SteadyOptions};
@@ -38,6 +39,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             omega: 2.8,
             ..Params::default()
         },
+        // the paper's Figs. 15–17 (captions): period-1 and period-4 coexist
+        "beam2" => Params {
+            modes: 3,
+            alpha1: 0.0,
+            alpha2: 0.1,
+            alpha3: 0.1,
+            alpha4: 20.0,
+            alpha5: 0.0,
+            alpha6: 0.2,
+            omega: 20.0,
+            ..Params::default()
+        },
         _ => Params {
             modes: 1,
             omega: 2.0,
@@ -45,17 +58,24 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             ..Params::default()
         },
     };
+    // the plane: (a1, ȧ1) ∈ [−0.6, 0.6] × [−1.2, 1.2], for beam2 [−1, 1] × [−20, 20]
+    let scale = if case == "beam2" {
+        (1.0 / 0.6, 20.0 / 1.2)
+    } else {
+        (1.0, 1.0)
+    };
     let spec = BasinSpec {
         params: p,
         x: StateCoord::A(1),
-        xs: SweepSpec::linspace(-0.6, 0.6, steps)?,
+        xs: SweepSpec::linspace(-0.6 * scale.0, 0.6 * scale.0, steps)?,
         y: StateCoord::ADot(1),
-        ys: SweepSpec::linspace(-1.2, 1.2, steps)?,
+        ys: SweepSpec::linspace(-1.2 * scale.1, 1.2 * scale.1, steps)?,
         base: DVector::zeros(2 * p.modes),
         near_tol: env("NEAR", DEFAULT_NEAR_TOL),
         cell: env("CELL", DEFAULT_CELL),
         basin_hits: env("HITS", DEFAULT_BASIN_HITS),
         discover_after: DEFAULT_DISCOVER_AFTER,
+        stride: env("STRIDE", DEFAULT_STRIDE),
         steady: SteadyOptions::default(),
         cluster_tol: 1e-5,
         integrator: IntegratorOptions::default(),
@@ -115,13 +135,23 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .iter()
         .filter(|c| c.decided == Decided::Near)
         .count();
+    let grid = map
+        .cells
+        .iter()
+        .filter(|c| c.decided == Decided::Grid)
+        .count();
     println!(
-        "periods per start: map {mean_map:.1}, one by one {mean_brute:.1} (transient + recorded); near {near}"
+        "periods per start: map {mean_map:.1}, one by one {mean_brute:.1} (transient + recorded); near {near}, grid {grid}"
     );
     let early = map
         .cells
         .iter()
-        .filter(|c| matches!(c.decided, Decided::Near | Decided::Recurrence))
+        .filter(|c| {
+            matches!(
+                c.decided,
+                Decided::Near | Decided::Recurrence | Decided::Grid
+            )
+        })
         .count();
     let n = map.cells.len();
     println!(

@@ -6,7 +6,7 @@ use afmdyn::analysis::attractors::same_attractor;
 use afmdyn::analysis::basin_entropy::basin_entropy;
 use afmdyn::analysis::basins::{
     basins, BasinSpec, Decided, StateCoord, DEFAULT_BASIN_HITS, DEFAULT_CELL,
-    DEFAULT_DISCOVER_AFTER, DEFAULT_NEAR_TOL,
+    DEFAULT_DISCOVER_AFTER, DEFAULT_NEAR_TOL, DEFAULT_STRIDE,
 };
 use afmdyn::analysis::bifurcation::SweepSpec;
 use afmdyn::analysis::steady::{steady_state, SteadyOptions};
@@ -37,6 +37,7 @@ fn spec(p: Params, steps: usize) -> BasinSpec {
         cell: DEFAULT_CELL,
         basin_hits: DEFAULT_BASIN_HITS,
         discover_after: DEFAULT_DISCOVER_AFTER,
+        stride: DEFAULT_STRIDE,
         steady: SteadyOptions::default(),
         cluster_tol: 1e-5,
         integrator: IntegratorOptions::default(),
@@ -46,11 +47,36 @@ fn spec(p: Params, steps: usize) -> BasinSpec {
 /// Every cell's label against the steady state its start reaches when run to convergence (the
 /// transient cap and detection of `steady_state`, as the attractor census runs each start),
 /// matched to the map's attractors: at least 99.5 % agree, both attractors have a basin, and
-/// most cells were decided before the steady-state search.
+/// most cells were decided before the steady-state search. One pass at 30 × 30.
 #[test]
 fn labels_agree_with_running_every_start_to_convergence() {
-    let s = spec(impact(), 30);
-    let map = basins(&s).unwrap();
+    let map = agree_with_brute_force(&BasinSpec {
+        stride: 1,
+        ..spec(impact(), 30)
+    });
+    assert!(map.cells.iter().all(|c| c.decided != Decided::Grid));
+}
+
+/// As above at 60 × 60 in two passes (the automatic stride 2: a 30 × 30 first grid): most
+/// cells of the second pass are decided by the first pass's grid.
+#[test]
+fn two_passes_agree_with_running_every_start_to_convergence() {
+    let s = spec(impact(), 60);
+    assert_eq!(s.first_stride(), 2);
+    let map = agree_with_brute_force(&s);
+    let grid = map
+        .cells
+        .iter()
+        .filter(|c| c.decided == Decided::Grid)
+        .count();
+    assert!(
+        grid * 2 > map.cells.len(),
+        "{grid} cells decided by the grid"
+    );
+}
+
+fn agree_with_brute_force(s: &BasinSpec) -> afmdyn::analysis::basins::BasinMap {
+    let map = basins(s).unwrap();
     assert_eq!(map.attractors.len(), 2, "the two period-1 orbits");
     let model = CantileverModel::new(&s.params).unwrap();
     let (mut agree, mut total, mut early) = (0, 0, 0);
@@ -70,7 +96,7 @@ fn labels_agree_with_running_every_start_to_convergence() {
             .map_or(-2, |i| i as i64);
         total += 1;
         agree += usize::from(brute == cell.label);
-        early += usize::from(matches!(cell.decided, Decided::Near | Decided::Recurrence));
+        early += usize::from(cell.decided != Decided::Steady);
     }
     let share = agree as f64 / total as f64;
     assert!(share >= 0.995, "{agree} of {total} labels agree");
@@ -90,13 +116,30 @@ fn labels_agree_with_running_every_start_to_convergence() {
     // a map with a basin boundary has boundary boxes
     let e = basin_entropy(&labels, s.xs.len(), 5).unwrap();
     assert!(e.boundary_boxes > 0 && e.basin_entropy > 0.0, "{e:?}");
+    map
+}
+
+/// The automatic stride keeps at least 25 nodes per axis in the first grid.
+#[test]
+fn the_automatic_stride_keeps_a_fine_enough_first_grid() {
+    for (n, stride) in [(10, 1), (49, 1), (50, 2), (100, 4), (199, 4), (200, 8)] {
+        assert_eq!(spec(impact(), n).first_stride(), stride, "{n} steps");
+    }
+    let s = BasinSpec {
+        stride: 3,
+        ..spec(impact(), 100)
+    };
+    assert_eq!(s.first_stride(), 3);
 }
 
 /// The map does not depend on the thread count (rows are pure tasks, attractors matched in row
-/// order).
+/// order), in three passes (strides 4, 2, 1).
 #[test]
 fn the_map_does_not_depend_on_threads() {
-    let s = spec(impact(), 12);
+    let s = BasinSpec {
+        stride: 4,
+        ..spec(impact(), 14)
+    };
     let run = |t: usize| {
         rayon::ThreadPoolBuilder::new()
             .num_threads(t)

@@ -6,7 +6,9 @@
 //! here it must deserialise back to the default.
 #![cfg(feature = "schema")]
 
-use afmdyn::request::{ApproachRequest, ChartRequest, ModesRequest, ResonanceRequest};
+use afmdyn::request::{
+    ApproachRequest, BasinsRequest, ChartRequest, ModesRequest, ResonanceRequest,
+};
 use afmdyn::request::{
     AttractorsRequest, BifurcationRequest, ContinuationRequest, ConvergeRequest, CurveRequest,
     GlobalContinuationRequest, IntegratorRequest, LyapunovRequest, ModelSpec, ObserveRequest,
@@ -68,6 +70,7 @@ fn schemas() -> Vec<(&'static str, Value)> {
         ("approach", schema::<ApproachRequest>("approach")),
         ("resonance", schema::<ResonanceRequest>("resonance")),
         ("chart", schema::<ChartRequest>("chart")),
+        ("basins", schema::<BasinsRequest>("basins")),
     ]
 }
 

@@ -180,7 +180,7 @@ def _typed(f: _F) -> _F:
 _COUNTS = frozenset(
     "samples_per_period steps_per_period max_modes periods steps starts seed threads "
     "max_periods max_period samples period transient blocks x_steps y_steps basin_hits "
-    "discover_after".split()
+    "discover_after stride".split()
 )
 
 

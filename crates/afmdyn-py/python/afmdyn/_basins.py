@@ -3,7 +3,8 @@ map and measures, as an ``xarray.Dataset``."""
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any, Optional
+import json
+from typing import TYPE_CHECKING, Any, List, Optional
 
 import numpy as np
 import xarray as xr
@@ -30,10 +31,12 @@ def basins(
     y_from: float = -1.2,
     y_to: float = 1.2,
     y_steps: int = 40,
+    base: Optional[List[float]] = None,
     near_tol: float = 0.02,
     cell: float = 0.01,
     basin_hits: int = 16,
     discover_after: int = 200,
+    stride: int = 0,
     cluster_tol: float = 1e-5,
     tol: float = 1e-8,
     max_periods: int = 1500,
@@ -46,26 +49,31 @@ def basins(
     **model: Unpack[Model],
 ) -> xr.Dataset:
     """Basins of attraction (``afmdyn basins``) over two coordinates of the initial state at
-    τ = 0 (``"a1"``…``"aN"``, ``"adot1"``…``"adotN"``, ``"w"``, ``"wdot"``; the others at
-    rest): each start stops as soon as it is near a known periodic attractor (3 returns within
-    ``near_tol``) or its returns recur in state-space cells of one basin (``basin_hits``
-    returns in cells of side ``cell``), else the steady-state search decides.
+    τ = 0 (``"a1"``…``"aN"``, ``"adot1"``…``"adotN"``, ``"w"``, ``"wdot"``; the others from
+    ``base``, 2N values a1…aN, ȧ1…ȧN, default at rest): each start stops as soon as it is near
+    a known periodic attractor (3 returns within ``near_tol``) or its returns recur in
+    state-space cells of one basin (``basin_hits`` returns in cells of side ``cell``), else the
+    steady-state search decides. Where the plane is the whole section (N = 1, a position and a
+    velocity) the map is made in passes from a coarse grid (``stride``; 0 automatic, 1 one
+    pass): a later start stops when a return lands inside a coarse cell of one basin.
 
     Returns:
         ``xarray.Dataset`` with dims ``(y, x)``: ``label`` (attractor id, −2 failed),
-        ``decided`` (``"near"``, ``"recurrence"``, ``"steady"``, ``"failed"``), ``periods``;
-        dim ``attractor``: ``period`` (−1 nonperiodic), ``x_max`` (g0), ``basin_fraction``,
-        ``stable`` (1/0 from the Floquet multipliers of the orbit polished by shooting; NaN
-        nonperiodic), ``lyapunov`` (λ₁ of a nonperiodic attractor);
+        ``decided`` (``"near"``, ``"recurrence"``, ``"grid"``, ``"steady"``, ``"failed"``),
+        ``periods``; dim ``attractor``: ``period`` (−1 nonperiodic), ``x_max``, ``v_t_min``
+        (g0), ``basin_fraction``, ``stable`` (1/0 from the Floquet multipliers of the orbit
+        polished by shooting; NaN nonperiodic), ``lyapunov`` (λ₁ of a nonperiodic attractor);
         attributes ``basin_entropy``, ``boundary_basin_entropy`` (Daza et al. 2016; NaN when
-        undefined) and ``uncertainty_exponent`` (Grebogi et al. 1983).
+        undefined), ``uncertainty_exponent`` (Grebogi et al. 1983) and ``summary`` (the
+        command line's JSON document).
     """
-    p, _probe = _params(params, model)
+    p, probe = _params(params, model)
     d = _run(
         _core.basins,
-        "basins",
+        "starts",
         progress,
         p,
+        si=probe,
         x=x,
         x_from=x_from,
         x_to=x_to,
@@ -74,10 +82,12 @@ def basins(
         y_from=y_from,
         y_to=y_to,
         y_steps=y_steps,
+        base=base,
         near_tol=near_tol,
         cell=cell,
         basin_hits=basin_hits,
         discover_after=discover_after,
+        stride=stride,
         cluster_tol=cluster_tol,
         tol=tol,
         max_periods=max_periods,
@@ -87,39 +97,41 @@ def basins(
         tolerance=tolerance,
         threads=threads,
     )
-    ny, nx = len(d["y"]), len(d["x"])
-    labels = np.asarray(d["label"]).reshape(ny, nx)
-    n = len(d["attractor_period"])
+    doc = json.loads(d["json"])
+    xs, ys = doc["x"]["values"], doc["y"]["values"]
+    ny, nx = len(ys), len(xs)
+    names = np.array(["", "near", "recurrence", "grid", "steady", "failed"])
+    n = len(d["period"])
 
     def num(v: Any) -> float:
         return float("nan") if v is None else float(v)
 
     return xr.Dataset(
         data_vars={
-            "label": (("y", "x"), labels, {"long_name": "attractor id (-2 failed)"}),
-            "decided": (("y", "x"), np.array(d["decided"], dtype=str).reshape(ny, nx)),
+            "label": (("y", "x"), np.asarray(d["label"]).reshape(ny, nx),
+                      {"long_name": "attractor id (-2 failed)"}),
+            "decided": (("y", "x"), names[np.asarray(d["decided"])].reshape(ny, nx)),
             "periods": (("y", "x"), np.asarray(d["periods"]).reshape(ny, nx),
                         {"long_name": "drive periods the start ran"}),
-            "period": ("attractor", d["attractor_period"], {"long_name": "period n (-1 nonperiodic)"}),
-            "x_max": ("attractor", d["attractor_x_max"], {"units": "g0", "long_name": "X_max"}),
+            "period": ("attractor", d["period"], {"long_name": "period n (-1 nonperiodic)"}),
+            "x_max": ("attractor", d["x_max"], {"units": "g0", "long_name": "X_max"}),
+            "v_t_min": ("attractor", d["v_t_min"], {"units": "g0", "long_name": "min V_T"}),
             "basin_fraction": ("attractor", d["basin_fraction"]),
-            "stable": (
-                "attractor",
-                np.array([np.nan if v is None else float(v) for v in d["attractor_stable"]]),
-                {"long_name": "1 stable periodic orbit (shooting), 0 unstable, NaN nonperiodic"},
-            ),
-            "lyapunov": ("attractor", d["attractor_lyapunov"],
+            "stable": ("attractor", d["stable"],
+                       {"long_name": "1 stable periodic orbit (shooting), 0 unstable, NaN nonperiodic"}),
+            "lyapunov": ("attractor", d["lyapunov"],
                          {"units": "1/tau", "long_name": "λ₁ of a nonperiodic attractor"}),
         },
         coords={
-            "x": ("x", d["x"], {"long_name": f"{d['x_name']} at τ = 0"}),
-            "y": ("y", d["y"], {"long_name": f"{d['y_name']} at τ = 0"}),
+            "x": ("x", xs, {"long_name": f"{doc['x']['name']} at τ = 0"}),
+            "y": ("y", ys, {"long_name": f"{doc['y']['name']} at τ = 0"}),
             "attractor": ("attractor", np.arange(n)),
         },
         attrs={
-            "basin_entropy": num(d["basin_entropy"]),
-            "boundary_basin_entropy": num(d["boundary_basin_entropy"]),
-            "uncertainty_exponent": num(d["uncertainty_exponent"]),
+            "basin_entropy": num(doc["basin_entropy"]),
+            "boundary_basin_entropy": num(doc["boundary_basin_entropy"]),
+            "uncertainty_exponent": num(doc["uncertainty_exponent"]),
+            "summary": json.dumps(doc),
             **{k: v for k, v in p.to_dict().items() if isinstance(v, (int, float, str))},
         },
     )

@@ -27,6 +27,7 @@
 //! [`Params`]: crate::Params
 
 pub mod analyses;
+pub mod basins;
 pub mod chart;
 #[cfg(feature = "files")]
 pub mod chart_store;
@@ -46,6 +47,7 @@ pub use analyses::{
     GlobalContinuationRequest, IntegratorRequest, LyapunovRequest, ObserveRequest, OrbitRequest,
     SeriesStore, SimulateRequest, StartRequest, SteadyRequest,
 };
+pub use basins::{in_pool, BasinArrays, BasinsRequest};
 pub use chart::{Chart, ChartArrays, ChartModel, ChartRequest};
 pub use checkpoint::{Checkpoint, CheckpointError, MemoryCheckpoint};
 #[cfg(feature = "files")]

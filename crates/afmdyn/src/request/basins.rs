@@ -1,0 +1,345 @@
+//! `basins`: the request of a basin map ([`crate::analysis::basins`]) that the command line
+//! and Python share — its options with their limits, the worker threads, the JSON document
+//! (`afmdyn basins --json`, Python's `summary`) and the per-cell arrays of `basins.nc` and
+//! Python's dataset ([`BasinArrays`]).
+
+use super::analyses::{initial_state, IntegratorRequest, SteadyRequest};
+use super::limits::MAX_THREADS;
+use super::run::{Analysis, Resolved};
+use crate::analysis::basin_entropy::{basin_entropy, uncertainty_exponent};
+use crate::analysis::basins::{
+    basins_with, BasinMap, BasinSpec, Decided, StateCoord, DEFAULT_BASIN_HITS, DEFAULT_CELL,
+    DEFAULT_DISCOVER_AFTER, DEFAULT_NEAR_TOL, DEFAULT_STRIDE,
+};
+use crate::analysis::bifurcation::SweepSpec;
+use crate::analysis::progress::Progress;
+use crate::error::SimError;
+use crate::model::CantileverModel;
+use crate::params::Params;
+use serde::{Deserialize, Serialize};
+use serde_json::{json, Value};
+
+/// Side of the boxes of the basin entropy, in cells ([`basin_entropy`]; Daza et al. use 5).
+pub const ENTROPY_BOX: usize = 5;
+
+/// `basins`: a basin map over two coordinates of the initial state at τ = 0.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[serde(default, deny_unknown_fields)]
+pub struct BasinsRequest {
+    /// x coordinate: `a1`…`aN`, `adot1`…`adotN`, `w` or `wdot` (the tip, set through mode 1).
+    pub x: String,
+    /// First x value (g0, or g0 per unit τ for a velocity).
+    pub x_from: f64,
+    /// Last x value.
+    pub x_to: f64,
+    /// Number of x values (columns).
+    pub x_steps: usize,
+    /// y coordinate, as `x`.
+    pub y: String,
+    /// First y value.
+    pub y_from: f64,
+    /// Last y value.
+    pub y_to: f64,
+    /// Number of y values (rows).
+    pub y_steps: usize,
+    /// The other coordinates of every start, 2N values (a1…aN, ȧ1…ȧN); `None`: the rest state.
+    pub base: Option<Vec<f64>>,
+    /// Relative distance to a periodic attractor's section point that counts as near, (0, 1].
+    pub near_tol: f64,
+    /// Side of the state-space cells of the recurrence test (g0; ×Ω for velocities), > 0.
+    pub cell: f64,
+    /// Consecutive returns in cells of one basin that decide a start (0: no recurrence test).
+    pub basin_hits: usize,
+    /// Returns tested before the steady-state search takes over.
+    pub discover_after: usize,
+    /// Stride of the first pass's coarse grid (0: automatic, 1: one pass).
+    pub stride: usize,
+    /// Relative tolerance for two steady states to be one attractor, > 0.
+    pub cluster_tol: f64,
+    /// Worker threads, 1..=[`MAX_THREADS`]; `None`: all cores.
+    pub threads: Option<usize>,
+    /// The steady-state search of a start the early tests leave undecided.
+    #[serde(flatten)]
+    pub steady: SteadyRequest,
+    /// The integrator.
+    #[serde(flatten)]
+    pub integrator: IntegratorRequest,
+}
+
+impl Default for BasinsRequest {
+    fn default() -> Self {
+        BasinsRequest {
+            x: "a1".into(),
+            x_from: -0.6,
+            x_to: 0.6,
+            x_steps: 40,
+            y: "adot1".into(),
+            y_from: -1.2,
+            y_to: 1.2,
+            y_steps: 40,
+            base: None,
+            near_tol: DEFAULT_NEAR_TOL,
+            cell: DEFAULT_CELL,
+            basin_hits: DEFAULT_BASIN_HITS,
+            discover_after: DEFAULT_DISCOVER_AFTER,
+            stride: DEFAULT_STRIDE,
+            cluster_tol: 1e-5,
+            threads: None,
+            steady: SteadyRequest::default(),
+            integrator: IntegratorRequest::default(),
+        }
+    }
+}
+
+fn coord(name: &'static str, s: &str) -> Result<StateCoord, SimError> {
+    s.parse()
+        .map_err(|_| SimError::out_of_range(name, s, "must be a1…aN, adot1…adotN, w or wdot"))
+}
+
+impl BasinsRequest {
+    /// The validated map of `params` ([`BasinSpec::validate`], the coordinates within the N
+    /// modes, the base state's length and entries, the thread count).
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming the option; [`SimError::StateLength`] for a base of
+    /// another length than 2N; [`SimError::Params`] for invalid parameters.
+    pub fn spec(&self, params: &Params) -> Result<BasinSpec, SimError> {
+        if let Some(t) = self.threads {
+            if !(1..=MAX_THREADS).contains(&t) {
+                return Err(SimError::out_of_range("threads", t, "must be in 1..=1024"));
+            }
+        }
+        let (x, y) = (coord("x", &self.x)?, coord("y", &self.y)?);
+        let n = params.modes;
+        for (name, c) in [("x", x), ("y", y)] {
+            if !c.fits(n) {
+                return Err(SimError::out_of_range(
+                    name,
+                    c,
+                    "must be a coordinate of the N modes (a1…aN, adot1…adotN, w, wdot)",
+                ));
+            }
+        }
+        let cells = self.x_steps.saturating_mul(self.y_steps);
+        if cells > crate::analysis::basins::MAX_BASIN_CELLS {
+            return Err(SimError::out_of_range(
+                "x_steps",
+                format!("{} × {}", self.x_steps, self.y_steps),
+                "x_steps × y_steps must be <= 4000000",
+            ));
+        }
+        let steps = |name: &'static str, v: usize| {
+            if v == 0 {
+                Err(SimError::out_of_range(name, v, "must be >= 1"))
+            } else {
+                Ok(())
+            }
+        };
+        steps("x_steps", self.x_steps)?;
+        steps("y_steps", self.y_steps)?;
+        let model = CantileverModel::new(params)?;
+        let spec = BasinSpec {
+            params: *params,
+            x,
+            xs: SweepSpec::linspace(self.x_from, self.x_to, self.x_steps)
+                .map_err(|e| rename(e, ["x_from", "x_to", "x_steps"]))?,
+            y,
+            ys: SweepSpec::linspace(self.y_from, self.y_to, self.y_steps)
+                .map_err(|e| rename(e, ["y_from", "y_to", "y_steps"]))?,
+            base: initial_state(&model, self.base.as_deref()).map_err(|e| match e {
+                SimError::StateLength { expected, got, .. } => SimError::StateLength {
+                    name: "base (a1..aN, adot1..adotN)",
+                    expected,
+                    got,
+                },
+                SimError::OutOfRange { value, allowed, .. } => SimError::OutOfRange {
+                    name: "base",
+                    value,
+                    allowed,
+                },
+                e => e,
+            })?,
+            near_tol: self.near_tol,
+            cell: self.cell,
+            basin_hits: self.basin_hits,
+            discover_after: self.discover_after,
+            stride: self.stride,
+            steady: self.steady.options()?,
+            cluster_tol: self.cluster_tol,
+            integrator: self.integrator.options(1),
+        };
+        spec.validate()?;
+        Ok(spec)
+    }
+}
+
+/// An error of [`SweepSpec::linspace`] named after the axis' option (`from`, `to`, `steps`).
+fn rename(e: SimError, [from, to, steps]: [&'static str; 3]) -> SimError {
+    match e {
+        SimError::OutOfRange {
+            name,
+            value,
+            allowed,
+        } => SimError::OutOfRange {
+            name: match name {
+                "from" => from,
+                "to" => to,
+                "steps" => steps,
+                other => other,
+            },
+            value,
+            allowed,
+        },
+        SimError::NotFinite { name, value } => SimError::NotFinite {
+            name: if name == "from" { from } else { to },
+            value,
+        },
+        e => e,
+    }
+}
+
+/// Run `f` on `threads` worker threads (`None`: all cores) — the one place where a request's
+/// thread count becomes a rayon pool.
+///
+/// # Errors
+/// [`SimError::OutOfRange`] naming `threads` when the pool cannot start; `f`'s errors.
+#[cfg(feature = "parallel")]
+pub fn in_pool<T: Send>(
+    threads: Option<usize>,
+    f: impl FnOnce() -> Result<T, SimError> + Send,
+) -> Result<T, SimError> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.unwrap_or(0))
+        .build()
+        .map_err(|e| SimError::out_of_range("threads", e, "cannot start the worker threads"))?
+        .install(f)
+}
+
+/// Without the `parallel` feature: `f` on the calling thread.
+///
+/// # Errors
+/// `f`'s errors.
+#[cfg(not(feature = "parallel"))]
+pub fn in_pool<T: Send>(
+    _threads: Option<usize>,
+    f: impl FnOnce() -> Result<T, SimError> + Send,
+) -> Result<T, SimError> {
+    f()
+}
+
+impl Analysis for BasinsRequest {
+    type Output = BasinMap;
+    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
+        self.spec(&model.params).map(|_| ())
+    }
+    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<BasinMap, SimError> {
+        let spec = self.spec(&model.params)?;
+        in_pool(self.threads, || basins_with(&spec, progress))
+    }
+    fn report(&self, model: &Resolved, map: &BasinMap) -> Result<Value, SimError> {
+        let spec = self.spec(&model.params)?;
+        Ok(document(&spec, map))
+    }
+}
+
+/// The document of a basin map (`afmdyn basins --json`): axes, labels (ny rows of nx ids),
+/// attractors (period, multipliers, stability, λ₁, Poincaré states, X_max, min V_T, contacts),
+/// basin fractions, failed cells, how the cells were decided, the drive periods run, basin
+/// entropy S_b and boundary basin entropy S_bb (boxes of [`ENTROPY_BOX`]² cells; null when no
+/// box fits) and the uncertainty exponent (null when no cell is uncertain).
+pub fn document(spec: &BasinSpec, map: &BasinMap) -> Value {
+    let nx = spec.xs.len();
+    let labels = map.labels();
+    let entropy = basin_entropy(&labels, nx, ENTROPY_BOX);
+    let count = |d: Decided| map.cells.iter().filter(|c| c.decided == d).count();
+    json!({
+        "params": spec.params,
+        "x": {"name": spec.x.to_string(), "values": spec.xs},
+        "y": {"name": spec.y.to_string(), "values": spec.ys},
+        "base": spec.base.iter().copied().collect::<Vec<f64>>(),
+        "labels": labels.chunks(nx).collect::<Vec<_>>(),
+        "attractors": map.attractors.iter().enumerate().map(|(i, s)| json!({
+            "id": i,
+            "period": s.period(),
+            "multipliers": map.orbits[i].as_ref().map(|o| o.multipliers.iter()
+                .map(|m| [m.re, m.im]).collect::<Vec<_>>()),
+            "stable": map.orbits[i].as_ref().map(|o| o.stable),
+            "lyapunov": map.lyapunov[i],
+            "poincare": {"state": s.poincare.iter()
+                .map(|q| q.state.iter().copied().collect::<Vec<f64>>())
+                .collect::<Vec<_>>()},
+            "x_max": s.stats.x_max,
+            "v_t_min": s.stats.v_t_min,
+            "contacts_per_period": s.stats.contacts_per_period,
+        })).collect::<Vec<_>>(),
+        "basin_fractions": map.basin_fractions(),
+        "failed": labels.iter().filter(|&&l| l < 0).count(),
+        "decided": {
+            "near": count(Decided::Near),
+            "recurrence": count(Decided::Recurrence),
+            "grid": count(Decided::Grid),
+            "steady": count(Decided::Steady),
+            "failed": count(Decided::Failed),
+        },
+        "first_stride": spec.first_stride(),
+        "periods": map.cells.iter().map(|c| c.periods as u64).sum::<u64>(),
+        "basin_entropy": entropy.map(|e| e.basin_entropy),
+        "boundary_basin_entropy": entropy.map(|e| e.boundary_basin_entropy),
+        "uncertainty_exponent": uncertainty_exponent(&labels, nx).map(|u| u.0),
+    })
+}
+
+/// The per-cell and per-attractor arrays of a basin map: the one layout of `basins.nc` and of
+/// Python's dataset (cells row-major, ny × nx).
+#[derive(Debug, Clone, PartialEq)]
+pub struct BasinArrays {
+    /// Attractor id per cell (−2 failed).
+    pub label: Vec<i32>,
+    /// How each cell was decided: [`Decided::code`].
+    pub decided: Vec<i32>,
+    /// Drive periods each start ran.
+    pub periods: Vec<i32>,
+    /// Per attractor: period n (−1 nonperiodic).
+    pub period: Vec<i32>,
+    /// Per attractor: X_max (g0).
+    pub x_max: Vec<f64>,
+    /// Per attractor: min V_T (g0).
+    pub v_t_min: Vec<f64>,
+    /// Per attractor: basin fraction.
+    pub basin_fraction: Vec<f64>,
+    /// Per attractor: 1 stable periodic orbit, 0 unstable, NaN unknown (nonperiodic, no
+    /// shooting).
+    pub stable: Vec<f64>,
+    /// Per attractor: λ₁ of a nonperiodic attractor (per unit τ), NaN otherwise.
+    pub lyapunov: Vec<f64>,
+}
+
+impl BasinArrays {
+    /// The arrays of `map`.
+    pub fn new(map: &BasinMap) -> Self {
+        let int = |v: usize| i32::try_from(v).unwrap_or(i32::MAX);
+        BasinArrays {
+            label: map.cells.iter().map(|c| c.label as i32).collect(),
+            decided: map.cells.iter().map(|c| c.decided.code()).collect(),
+            periods: map.cells.iter().map(|c| int(c.periods)).collect(),
+            period: map
+                .attractors
+                .iter()
+                .map(|s| s.period().map_or(-1, int))
+                .collect(),
+            x_max: map.attractors.iter().map(|s| s.stats.x_max).collect(),
+            v_t_min: map.attractors.iter().map(|s| s.stats.v_t_min).collect(),
+            basin_fraction: map.basin_fractions(),
+            stable: map
+                .orbits
+                .iter()
+                .map(|o| {
+                    o.as_ref()
+                        .map_or(f64::NAN, |o| f64::from(u8::from(o.stable)))
+                })
+                .collect(),
+            lyapunov: map.lyapunov.iter().map(|l| l.unwrap_or(f64::NAN)).collect(),
+        }
+    }
+}
