@@ -171,3 +171,64 @@ fn coordinates_parse_and_set_the_state() {
     };
     assert!(basins(&bad).is_err());
 }
+
+/// Labels against long brute-force runs: on cells away from basin boundaries (the 3 × 3 cells
+/// around them share the label) of the 60 × 60 two-pass map, 12 cells of each basin are run for
+/// 1 500 drive periods with the integrator alone, and its last return is nearest to a section
+/// point of the attractor the map labels it with (and within 1e-6 of it: converged).
+#[test]
+fn interior_labels_agree_with_1500_period_runs() {
+    let s = spec(impact(), 60);
+    let map = basins(&s).unwrap();
+    let model = CantileverModel::new(&s.params).unwrap();
+    let (nx, ny) = (s.xs.len(), s.ys.len());
+    let labels = map.labels();
+    let interior: Vec<usize> = (0..nx * ny)
+        .filter(|&k| {
+            let (ix, iy) = (k % nx, k / nx);
+            ix > 0
+                && iy > 0
+                && ix + 1 < nx
+                && iy + 1 < ny
+                && (iy - 1..=iy + 1)
+                    .all(|j| (ix - 1..=ix + 1).all(|i| labels[j * nx + i] == labels[k]))
+        })
+        .collect();
+    // 12 cells of each basin's interior, evenly spread over it
+    let picked: Vec<usize> = (0..2i64)
+        .flat_map(|l| {
+            let own: Vec<usize> = interior
+                .iter()
+                .copied()
+                .filter(|&k| labels[k] == l)
+                .collect();
+            let step = (own.len() / 12).max(1);
+            own.into_iter().step_by(step).take(12).collect::<Vec<_>>()
+        })
+        .collect();
+    assert!(picked.len() >= 20, "{} interior cells", interior.len());
+    let mut seen = [false; 2];
+    for k in picked {
+        let (ix, iy) = (k % nx, k / nx);
+        let mut z0 = s.base.clone();
+        s.x.set(&model, &mut z0, s.xs[ix]);
+        s.y.set(&model, &mut z0, s.ys[iy]);
+        let mut it = build(&model, s.integrator, 0.0, &z0).unwrap();
+        afmdyn::integrate::advance(it.as_mut(), 1500.0 * model.period()).unwrap();
+        let z = &it.state().clone();
+        let (id, d) = map
+            .attractors
+            .iter()
+            .enumerate()
+            .flat_map(|(i, a)| a.poincare.iter().map(move |p| (i, (z - &p.state).norm())))
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .unwrap();
+        assert_eq!(id as i64, labels[k], "cell ({ix}, {iy})");
+        assert!(
+            d < 1e-6,
+            "cell ({ix}, {iy}): {d} from its attractor after 1500 periods"
+        );
+        seen[id] = true;
+    }
+    assert!(seen[0] && seen[1], "both basins sampled");
+}
