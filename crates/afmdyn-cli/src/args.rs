@@ -20,6 +20,11 @@ pub struct ModelArgs {
     /// and JSON output gains an "si" block with the scales and headline values in SI
     #[arg(long, value_name = "PROBE.toml", conflicts_with = "config")]
     pub probe: Option<PathBuf>,
+    /// A cantilever of the library (`afmdyn cantilevers` lists them) for the probe file, which
+    /// then needs only [sample] and [drive]: its k, f0, Q and tip radius fill the keys the file
+    /// leaves out
+    #[arg(long, value_name = "NAME", requires = "probe")]
+    pub cantilever: Option<String>,
     // The help of the model flags comes from the library's table (afmdyn::request::
     // MODEL_PARAMETERS), set in main.rs.
     #[arg(
@@ -128,17 +133,29 @@ impl ModelArgs {
         }
     }
 
-    /// The probe file, when given (read once per call).
+    /// The probe file, when given (read once per call), with `--cantilever`'s name in it.
     pub fn probe(&self) -> Result<Option<afmdyn::probe::Probe>, CliError> {
-        self.probe
-            .as_ref()
-            .map(|p| afmdyn::probe::Probe::load(p).map_err(CliError::from))
-            .transpose()
+        let (Some(path), Some(text)) = (&self.probe, self.probe_text()?) else {
+            return Ok(None);
+        };
+        afmdyn::probe::Probe::parse(&text, &path.display().to_string())
+            .map(Some)
+            .map_err(CliError::from)
     }
 
-    /// The probe file's path, if given.
-    pub fn probe_path(&self) -> Option<&std::path::Path> {
-        self.probe.as_deref()
+    /// The probe file's text, with `[cantilever].name` set from `--cantilever`.
+    pub fn probe_text(&self) -> Result<Option<String>, CliError> {
+        let Some(path) = &self.probe else {
+            return Ok(None);
+        };
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| CliError::Input(format!("{}: {e}", path.display())))?;
+        match &self.cantilever {
+            None => Ok(Some(text)),
+            Some(name) => afmdyn::cantilevers::with_name(&text, name)
+                .map(Some)
+                .map_err(|e| CliError::Input(format!("{}: {e}", path.display()))),
+        }
     }
 
     /// The model values of the flags over the config file, and the probe (unresolved: a

@@ -284,12 +284,9 @@ fn write_csv(path: &Path, cells: &[ChartCell]) -> Result<(), CliError> {
 pub fn chart(a: &ChartArgs) -> Result<(), CliError> {
     let (spec, probe) = a.model.spec_and_probe()?;
     // the chart reads the probe file's text: an axis may be one of its values
-    let probe_text = match (&probe, a.model.probe_path()) {
-        (Some(_), Some(path)) => Some(
-            std::fs::read_to_string(path)
-                .map_err(|e| CliError::Input(format!("probe {}: {e}", path.display())))?,
-        ),
-        _ => None,
+    let probe_text = match probe {
+        Some(_) => a.model.probe_text()?,
+        None => None,
     };
     let request = ChartRequest {
         x: a.x.clone(),

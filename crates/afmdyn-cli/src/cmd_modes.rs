@@ -160,6 +160,9 @@ pub struct UnitsArgs {
     /// scales
     #[arg(long, value_name = "PROBE.toml")]
     probe: Option<PathBuf>,
+    /// A cantilever of the library for the probe file (as every command's --cantilever)
+    #[arg(long, value_name = "NAME", requires = "probe")]
+    cantilever: Option<String>,
     /// Print one JSON document
     #[arg(long)]
     json: bool,
@@ -202,7 +205,15 @@ struct HertzFile {
 /// Run `afmdyn units`.
 pub fn units(a: &UnitsArgs) -> Result<(), CliError> {
     if let Some(path) = &a.probe {
-        let pr = afmdyn::probe::Probe::load(path)?;
+        let origin = path.display().to_string();
+        let text =
+            std::fs::read_to_string(path).map_err(|e| CliError::Input(format!("{origin}: {e}")))?;
+        let text = match &a.cantilever {
+            Some(name) => afmdyn::cantilevers::with_name(&text, name)
+                .map_err(|e| CliError::Input(format!("{origin}: {e}")))?,
+            None => text,
+        };
+        let pr = afmdyn::probe::Probe::parse(&text, &origin)?;
         let p = pr.params;
         let doc = json!({ "params": p, "si": afmdyn::report::si(&pr, &p, &json!({})) });
         if a.json {
@@ -297,6 +308,45 @@ pub fn units(a: &UnitsArgs) -> Result<(), CliError> {
     println!(
         "  first natural frequency f₁ = {:.6e} Hz with the tip mass ({:.6e} Hz without)",
         s.first_frequency_hz, s.bare_first_frequency_hz
+    );
+    Ok(())
+}
+
+/// `afmdyn cantilevers` flags.
+#[derive(Debug, Args)]
+pub struct CantileversArgs {
+    /// Print one JSON document (every entry with its source)
+    #[arg(long)]
+    json: bool,
+}
+
+/// Run `afmdyn cantilevers`: the cantilever library, one line per cantilever.
+pub fn cantilevers(a: &CantileversArgs) -> Result<(), CliError> {
+    let all = afmdyn::cantilevers::cantilevers();
+    if a.json {
+        let doc = afmdyn::cantilevers::document();
+        println!("{doc}");
+        return Ok(());
+    }
+    println!(
+        "{:<16} {:<44} {:>9} {:>9} {:>6} {:>6}",
+        "name", "maker", "k (N/m)", "f0 (kHz)", "Q", "R (nm)"
+    );
+    for c in all {
+        println!(
+            "{:<16} {:<44} {:>9} {:>9} {:>6} {:>6}",
+            c.name,
+            c.maker,
+            c.spring_constant,
+            c.resonance_frequency / 1e3,
+            format!("{}{}", c.quality_factor, if c.q_typical { "*" } else { "" }),
+            (c.radius * 1e9 * 10.0).round() / 10.0
+        );
+    }
+    println!(
+        "* Q typical of the lever class in air, not a datasheet value. Nominal values: calibrate \
+         k, f0 and Q on the instrument. Use: --cantilever NAME --probe SAMPLE.toml (a probe \
+         file with [sample] and [drive]); sources: --json"
     );
     Ok(())
 }

@@ -37,6 +37,8 @@ enum Command {
     Modes(cmd_modes::ModesArgs),
     /// Convert a physical probe description (SI units) into the dimensionless α's and Ω
     Units(cmd_modes::UnitsArgs),
+    /// The cantilever library: nominal k, f0, Q and tip radius of common cantilevers
+    Cantilevers(cmd_modes::CantileversArgs),
     /// Integrate one trajectory and write time series, switchings, Poincaré points and plots
     Simulate(cmd_simulate::SimulateArgs),
     /// Steady-state tip motion for N = 1..N_max modes (paper Fig. 4)
@@ -65,6 +67,7 @@ fn run(cli: Cli) -> Result<(), CliError> {
     match cli.command {
         Command::Modes(a) => cmd_modes::modes(&a),
         Command::Units(a) => cmd_modes::units(&a),
+        Command::Cantilevers(a) => cmd_modes::cantilevers(&a),
         Command::Simulate(a) => cmd_simulate::simulate(&a),
         Command::Converge(a) => cmd_simulate::converge(&a),
         Command::Bifurcation(a) => cmd_analysis::bifurcation(&a),

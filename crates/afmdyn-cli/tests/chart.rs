@@ -205,11 +205,21 @@ fn basins_json_has_the_labels_attractors_and_measures() {
         .sum();
     let failed = doc["failed"].as_f64().unwrap() / 120.0;
     assert!((sum + failed - 1.0).abs() < 1e-12);
-    for f in ["basins.csv", "basins.png", "basins.svg"] {
+    for f in [
+        "basins.csv",
+        "basins.png",
+        "basins.svg",
+        "basins.nc",
+        "basins.json",
+    ] {
         assert!(dir.path().join(f).metadata().unwrap().len() > 0, "{f}");
     }
     for (args, needle) in [
-        (vec!["basins", "--x", "b1"], "--x: 'b1'"),
+        (vec!["basins", "--x", "b1"], "x = b1: must be a1…aN"),
+        (
+            vec!["basins", "--base", "0.1;0.2"],
+            "--base: expected 3 displacements",
+        ),
         (vec!["basins", "--x", "a4"], "x = a4"),
         (vec!["basins", "--near-tol", "0"], "near-tol = 0"),
     ] {

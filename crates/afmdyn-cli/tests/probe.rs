@@ -141,3 +141,60 @@ fn si_inputs_need_the_probe() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--probe"));
 }
+
+/// The cantilever library: `afmdyn cantilevers --json` lists it with sources, and
+/// `--cantilever NAME` with a file of [sample] and [drive] only gives the model of the probe
+/// file written out with the library's values (k, f0, Q, tip radius, silicon tip); an unknown
+/// name exits 2 naming the near ones.
+#[test]
+fn cantilever_library_composes_with_a_sample_file() {
+    let lib = json(&["cantilevers", "--json"]);
+    let all = lib["cantilevers"].as_array().unwrap();
+    assert!(all.len() >= 12);
+    let ac160 = all.iter().find(|c| c["name"] == "AC160TS-R3").unwrap();
+    assert_eq!(ac160["spring_constant"], 26.0);
+    assert!(ac160["source"].as_str().unwrap().starts_with("https://"));
+    let dir = tempfile::tempdir().unwrap();
+    let sample = "[sample]\nlaw = \"hertz\"\nyoungs_modulus = 1e9\npoisson_ratio = 0.3\n\
+                  z_c = 12e-9\n[drive]\nfree_amplitude = 15e-9\n";
+    let full = format!(
+        "model = \"point-mass\"\n[cantilever]\nspring_constant = 26.0\n\
+         resonance_frequency = 300e3\nquality_factor = 500\n[tip]\nradius = 7e-9\n\
+         youngs_modulus = 130e9\npoisson_ratio = 0.28\n{sample}"
+    );
+    let (s, f) = (dir.path().join("sample.toml"), dir.path().join("full.toml"));
+    std::fs::write(&s, sample).unwrap();
+    std::fs::write(&f, full).unwrap();
+    let (s, f) = (s.to_str().unwrap(), f.to_str().unwrap());
+    let a = json(&[
+        "units",
+        "--probe",
+        s,
+        "--cantilever",
+        "ac160ts_r3",
+        "--json",
+    ]);
+    let b = json(&["units", "--probe", f, "--json"]);
+    assert_eq!(a["params"], b["params"]);
+    let a = json(&[
+        "orbit",
+        "--probe",
+        s,
+        "--cantilever",
+        "AC160TS-R3",
+        "--json",
+    ]);
+    let b = json(&["orbit", "--probe", f, "--json"]);
+    assert_eq!(a["params"], b["params"]);
+    assert_eq!(a["period"], b["period"]);
+    let out = run(&["orbit", "--probe", s, "--cantilever", "ac160"]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("not in the cantilever library") && err.contains("AC160TS-R3"),
+        "{err}"
+    );
+    // without a cantilever the sample file says where k, f0 and Q may come from
+    let out = run(&["orbit", "--probe", s]);
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--cantilever NAME"));
+}

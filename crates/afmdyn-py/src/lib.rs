@@ -17,6 +17,12 @@ mod sweep;
 
 use pyo3::prelude::*;
 
+/// The cantilever library's JSON document ([`afmdyn::cantilevers::document`]).
+#[pyfunction]
+fn cantilevers() -> String {
+    afmdyn::cantilevers::document().to_string()
+}
+
 /// Compiled core of afmdyn (use the `afmdyn` package, not this module).
 #[pymodule]
 fn _afmdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -36,6 +42,7 @@ fn _afmdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(analyses::attractors, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::global_continuation, m)?)?;
     m.add_function(wrap_pyfunction!(basins::basins, m)?)?;
+    m.add_function(wrap_pyfunction!(cantilevers, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::orbit, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::continuation, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::lyapunov, m)?)?;

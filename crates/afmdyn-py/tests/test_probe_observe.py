@@ -66,3 +66,24 @@ def test_observe_tapping_repulsive_regime():
         assert o["virial"] < 0
     with pytest.raises(ValueError):
         afmdyn.observe(afmdyn.Params.from_probe(PM), periods=0)
+
+
+def test_cantilever_library(tmp_path):
+    """``afmdyn.cantilevers()`` is the command line's library; a probe file naming one of its
+    cantilevers gives the parameters of the file written out with the library's values."""
+    df = afmdyn.cantilevers()
+    assert len(df) >= 12 and df.loc["RTESPA-300", "spring_constant"] == 40.0
+    assert df["source"].str.startswith("https://").all()
+    sample = ('[sample]\nlaw = "hertz"\nyoungs_modulus = 1e9\npoisson_ratio = 0.3\n'
+              "z_c = 12e-9\n[drive]\nfree_amplitude = 15e-9\n")
+    named = tmp_path / "named.toml"
+    named.write_text('[cantilever]\nname = "rtespa-300"\n' + sample)
+    full = tmp_path / "full.toml"
+    full.write_text('model = "point-mass"\n[cantilever]\nspring_constant = 40.0\n'
+                    "resonance_frequency = 300e3\nquality_factor = 500\n[tip]\nradius = 8e-9\n"
+                    "youngs_modulus = 130e9\npoisson_ratio = 0.28\n" + sample)
+    assert afmdyn.Params.from_probe(str(named)).to_dict() == afmdyn.Params.from_probe(str(full)).to_dict()
+    bad = tmp_path / "bad.toml"
+    bad.write_text('[cantilever]\nname = "rtespa"\n' + sample)
+    with pytest.raises(ValueError, match="RTESPA-150, RTESPA-300"):
+        afmdyn.Params.from_probe(str(bad))

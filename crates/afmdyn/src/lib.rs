@@ -51,6 +51,7 @@
 
 pub mod analysis;
 pub mod beam;
+pub mod cantilevers;
 pub mod contact;
 pub mod eigen;
 pub mod error;

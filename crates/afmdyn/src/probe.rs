@@ -220,7 +220,14 @@ impl Reader<'_> {
                 None
             }
             None => {
-                if required {
+                if required && name == "cantilever" {
+                    self.problems.push(
+                        "missing table [cantilever] (k, f0, Q or the geometry; or a cantilever of \
+                         the library: [cantilever] name = \"…\" or --cantilever NAME, listed by \
+                         `afmdyn cantilevers`)"
+                            .into(),
+                    );
+                } else if required {
                     self.problems.push(format!("missing table [{name}]"));
                 }
                 None
@@ -394,8 +401,13 @@ impl Probe {
     /// # Errors
     /// As [`Probe::parse`], but for the syntax.
     pub fn from_table(root: &toml::Table, origin: &str) -> Result<Probe, ProbeError> {
+        // a cantilever of the library fills the keys the file leaves out
+        let root = crate::cantilevers::fill(root).map_err(|e| ProbeError::Invalid {
+            path: origin.to_string(),
+            problems: vec![e],
+        })?;
         let mut problems = Vec::new();
-        let probe = Self::read(root, &mut problems);
+        let probe = Self::read(&root, &mut problems);
         match probe {
             Some(p) if problems.is_empty() => Ok(p),
             _ => {

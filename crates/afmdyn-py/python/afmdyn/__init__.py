@@ -40,7 +40,7 @@ from ._api import (
     simulate,
     summary,
 )
-from ._basins import basins
+from ._basins import basins, cantilevers
 from ._chart import chart
 from ._global_continuation import global_continuation
 from ._results import Attractor, Attractors, Lyapunov, Orbit, RegionSpectrum, Spectrum
@@ -67,6 +67,7 @@ __all__ = [
     "attractors",
     "basins",
     "bifurcation",
+    "cantilevers",
     "chart",
     "continuation",
     "converge",

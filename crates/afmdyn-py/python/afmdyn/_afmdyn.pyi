@@ -187,6 +187,7 @@ def attractors(
     progress: Optional[ProgressCallback] = None,
     probe: Optional[str] = None,
 ) -> Dict[str, Any]: ...
+def cantilevers() -> str: ...
 def global_continuation(
     params: Params,
     param: str = "omega",
