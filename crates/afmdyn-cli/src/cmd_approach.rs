@@ -72,6 +72,11 @@ pub struct ApproachArgs {
     to: Option<f64>,
     #[command(flatten)]
     curve: CurveArgs,
+    /// Amplitude setpoint A_sp/A0 in (0, 1]: the operating points where the curve's amplitude
+    /// equals it on each stable branch (attractive and repulsive in the bistable range), with
+    /// phase, peak force, indentation and dissipated energy there ("setpoint" in --json)
+    #[arg(long, value_name = "RATIO")]
+    setpoint: Option<f64>,
     /// Output directory (locked during the run)
     #[arg(long, default_value = "afmdyn-out/approach")]
     out: PathBuf,
@@ -584,8 +589,49 @@ impl Run<'_> {
             println!("{json}");
         } else {
             summary(&c, self.x, self.labels, out.as_ref());
+            if let Some(sp) = json.get("setpoint") {
+                print_setpoint(sp, self.labels);
+            }
         }
         Ok(())
+    }
+}
+
+/// The operating points of the `"setpoint"` block, one line each.
+fn print_setpoint(sp: &serde_json::Value, labels: &Labels) {
+    let num = |v: &serde_json::Value, k: &str| v[k].as_f64().unwrap_or(f64::NAN);
+    let length = |x: f64| match labels.x_unit {
+        Some(u) => si_value(x, u),
+        None => format!("{x:.6}"),
+    };
+    let points = sp["points"].as_array().map_or(&[][..], |v| v.as_slice());
+    println!(
+        "setpoint A/A0 = {}: {} operating point(s){}",
+        num(sp, "ratio"),
+        points.len(),
+        if points.is_empty() {
+            " (the curve's stable stretches do not reach it)"
+        } else {
+            ":"
+        }
+    );
+    for p in points {
+        let force = match labels.x_unit {
+            Some(_) => si_value(num(p, "peak_force"), "N"),
+            None => format!("{:.6}", num(p, "peak_force")),
+        };
+        let energy = match labels.x_unit {
+            Some(_) => si_value(num(p, "energy_dissipated"), "J"),
+            None => format!("{:.6}", num(p, "energy_dissipated")),
+        };
+        println!(
+            "  {} ({}): z_c = {}, phase {:.2}°, peak force {force}, indentation {}, E_dis {energy}",
+            p["source"].as_str().unwrap_or(""),
+            p["regime"].as_str().unwrap_or(""),
+            length(num(p, "z_c")),
+            num(p, "phase_deg"),
+            length(num(p, "indentation")),
+        );
     }
 }
 
@@ -603,6 +649,7 @@ pub fn approach(a: &ApproachArgs) -> Result<(), CliError> {
     let (base, units, probe) = setup(&a.model, a.from, a.to, false)?;
     let request = ApproachRequest {
         curve: a.curve.request(a.from, a.to),
+        setpoint: a.setpoint,
     };
     let x = |v: f64| rest_distance(&base, v) * units.length;
     let labels = Labels {

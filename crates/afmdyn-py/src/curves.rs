@@ -33,7 +33,8 @@ fn curve(
 /// The approach–retract curve over the rest distance z_c (`afmdyn approach`).
 #[pyfunction]
 #[pyo3(signature = (params, from_=None, to=None, step=None, points=None, branches=true,
-    tolerance=afmdyn::analysis::stepped::DEFAULT_TOLERANCE, probe=None, progress=None))]
+    tolerance=afmdyn::analysis::stepped::DEFAULT_TOLERANCE, setpoint=None, probe=None,
+    progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn approach<'py>(
     py: Python<'py>,
@@ -44,11 +45,13 @@ pub fn approach<'py>(
     points: Option<usize>,
     branches: bool,
     tolerance: f64,
+    setpoint: Option<f64>,
     probe: Option<PathBuf>,
     progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let request = ApproachRequest {
         curve: curve(from_, to, step, points, branches, tolerance),
+        setpoint,
     };
     let doc = analysis(py, request, params.inner, probe, progress.as_ref(), true)?;
     let out = Out::new(py);

@@ -58,3 +58,22 @@ def test_bad_grids_raise_value_error():
 def test_curve_refusals_quote_the_users_units(call, needle):
     with pytest.raises(ValueError, match=needle):
         call()
+
+
+def test_setpoint_equals_the_command_line(cli_json):
+    """``setpoint=`` adds the command line's ``"setpoint"`` block: operating points on the
+    stable branches where A/A₀ equals it, the attractive one with its phase above 90°."""
+    args = dict(from_=11e-9, to=5e-9, points=31, setpoint=0.85)
+    doc = afmdyn.approach(probe=str(PROBE), **args)
+    cli = cli_json("approach", "--probe", str(PROBE), "--from", "11e-9", "--to", "5e-9",
+                   "--points", "31", "--setpoint", "0.85", "--files", "none")
+    assert doc["setpoint"] == cli["setpoint"]
+    sp = doc["setpoint"]
+    assert sp["ratio"] == 0.85 and abs(sp["amplitude"] - 0.85e-8) < 1e-20
+    regimes = {p["regime"]: p for p in sp["points"]}
+    assert set(regimes) == {"attractive", "repulsive"}
+    assert regimes["attractive"]["phase_deg"] > 90 > regimes["repulsive"]["phase_deg"]
+    for p in sp["points"]:
+        assert abs(p["amplitude_ratio"] - 0.85) < 1e-12
+    with pytest.raises(ValueError, match="setpoint = 1.5"):
+        afmdyn.approach(probe=str(PROBE), setpoint=1.5)

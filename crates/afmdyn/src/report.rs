@@ -508,6 +508,76 @@ pub fn approach(params: &Params, c: &SteppedCurve, u: &CurveUnits) -> Value {
     curve_doc(params, c, ("z_c", &x), ("approach", "retract"), u)
 }
 
+/// The `"setpoint"` block of `afmdyn approach --setpoint S --json`: the ratio A_sp/A₀, the
+/// amplitude it means (in `u`'s length), and per crossing of the curve
+/// ([`crate::analysis::setpoint::setpoint_crossings`]) its `source` (`"branch k"`,
+/// `"approach"`, `"retract"`), `z_c`, `regime` (`"attractive"` where the mean tip–sample force,
+/// k⟨W⟩ for the point mass, is negative, else `"repulsive"`; García & San Paulo 2000) and the
+/// [`CURVE_COLUMNS`] interpolated there.
+pub fn setpoint(params: &Params, c: &SteppedCurve, ratio: f64, u: &CurveUnits) -> Value {
+    use crate::analysis::setpoint::{setpoint_crossings, Source};
+    let x = |a5: f64| crate::analysis::approach::rest_distance(params, a5) * u.length;
+    let points: Vec<Value> = setpoint_crossings(c, ratio)
+        .into_iter()
+        .map(|k| {
+            let (name, a, b) = match k.source {
+                Source::Branch(j) => (
+                    format!("branch {j}"),
+                    &c.branches[j][k.index].observables,
+                    &c.branches[j][k.index + 1].observables,
+                ),
+                Source::Sweep(s) => {
+                    let pts = match s {
+                        Sweep::First => &c.first,
+                        Sweep::Second => &c.second,
+                    };
+                    let name = if s == Sweep::First {
+                        "approach"
+                    } else {
+                        "retract"
+                    };
+                    (
+                        name.to_string(),
+                        &pts[k.index].observables,
+                        &pts[k.index + 1].observables,
+                    )
+                }
+            };
+            let (ra, rb) = (curve_row(a, u), curve_row(b, u));
+            let mut m = serde_json::Map::new();
+            m.insert("source".into(), json!(name));
+            m.insert("z_c".into(), json!(x(k.value)));
+            let row: Vec<f64> = ra
+                .iter()
+                .zip(rb)
+                .map(|(p, q)| (1.0 - k.t) * p + k.t * q)
+                .collect();
+            let mean = row[3];
+            m.insert(
+                "regime".into(),
+                json!(if mean < 0.0 {
+                    "attractive"
+                } else {
+                    "repulsive"
+                }),
+            );
+            for (name, v) in CURVE_COLUMNS.iter().zip(row) {
+                m.insert((*name).into(), json!(v));
+            }
+            Value::Object(m)
+        })
+        .collect();
+    let a0 = c
+        .first
+        .first()
+        .map(|p| p.observables.closed_form.free_amplitude * u.length);
+    json!({
+        "ratio": ratio,
+        "amplitude": a0.map(|a| a * ratio),
+        "points": points,
+    })
+}
+
 /// `afmdyn resonance --json`: as [`approach`] with the abscissa `omega` (dimensionless Ω) or
 /// `frequency_hz` (with [`CurveUnits::hz_per_omega`]) and the sweeps `up` and `down`.
 pub fn resonance(params: &Params, c: &SteppedCurve, u: &CurveUnits) -> Value {

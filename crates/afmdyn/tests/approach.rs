@@ -244,3 +244,46 @@ fn bad_grids_are_refused_with_the_field_named() {
         Err(SimError::OutOfRange { name: "mode", .. })
     ));
 }
+
+/// The setpoint's operating points (`analysis::setpoint`): at A/A₀ = 0.85 the curve has one
+/// on the attractive and one on the repulsive branch (phase above and below 90°: García & San
+/// Paulo 2000); each lies on a stable stretch; and the orbit found by Newton shooting at the
+/// point's z_c, from the branch states interpolated there, has A/A₀ within 2e-4 of the setpoint
+/// (measured 3.5e-5 and 1.3e-7: the interpolation's error at this spacing).
+#[test]
+fn setpoint_points_are_orbits_with_the_setpoint_amplitude() {
+    use afmdyn::analysis::observables::observe_orbit;
+    use afmdyn::analysis::setpoint::{setpoint_crossings, Source};
+    use afmdyn::analysis::shooting::{shoot_with, ShootingOptions};
+    use afmdyn::integrate::{build, IntegratorOptions};
+    use afmdyn::{CantileverModel, SweepParam};
+    let (spec, c) = curve();
+    let ratio = 0.85;
+    let found = setpoint_crossings(c, ratio);
+    assert_eq!(found.len(), 2, "{found:?}");
+    let mut phases = Vec::new();
+    for k in &found {
+        let Source::Branch(j) = k.source else {
+            panic!("branches were continued: {k:?}");
+        };
+        let (a, b) = (&c.branches[j][k.index], &c.branches[j][k.index + 1]);
+        assert!(a.point.stable && b.point.stable);
+        let z = &a.point.section[0] * (1.0 - k.t) + &b.point.section[0] * k.t;
+        let p = spec.base.with(SweepParam::Alpha5, k.value);
+        let model = CantileverModel::new(&p).unwrap();
+        let integ = IntegratorOptions::default();
+        let mut it = build(&model, integ, 0.0, &z).unwrap();
+        let orbit = shoot_with(it.as_mut(), &z, 1, &ShootingOptions::default()).unwrap();
+        assert!(orbit.stable);
+        let o = observe_orbit(&model, integ, &orbit, 4).unwrap();
+        let r = o.amplitude / o.closed_form.free_amplitude;
+        assert!(
+            (r - ratio).abs() < 2e-4,
+            "A/A0 = {r} at z_c = {}",
+            rest_distance(&p, k.value)
+        );
+        phases.push(o.phase.to_degrees());
+    }
+    phases.sort_by(f64::total_cmp);
+    assert!(phases[0] < 90.0 && phases[1] > 90.0, "{phases:?}");
+}

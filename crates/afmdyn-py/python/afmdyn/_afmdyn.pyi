@@ -267,6 +267,7 @@ def approach(
     points: Optional[int] = None,
     branches: bool = True,
     tolerance: float = 1e-10,
+    setpoint: Optional[float] = None,
     probe: Optional[str] = None,
     progress: Optional[ProgressCallback] = None,
 ) -> Dict[str, Any]: ...

@@ -979,6 +979,7 @@ def approach(
     points: Optional[int] = None,
     branches: bool = True,
     tolerance: float = 1e-10,
+    setpoint: Optional[float] = None,
     progress: ProgressArg = None,
     **model: Unpack[Model],
 ) -> Dict[str, Any]:
@@ -993,6 +994,9 @@ def approach(
         step, points: the grid (a step in the same unit, or the number of values; default 120).
         branches: also continue the branches.
         tolerance: of the adaptive integrator.
+        setpoint: the amplitude setpoint A_sp/A₀ in (0, 1]: the document gains ``setpoint``
+            (``ratio``, ``amplitude``, ``points``: per stable branch crossing its ``source``,
+            ``z_c``, ``regime`` (attractive/repulsive), phase, peak force, indentation, E_dis…).
         probe: a probe file (a model keyword, as ``--probe``): it sets the model, and its
             scales give SI inputs (``from_``, ``to``, ``step`` in m) and outputs.
 
@@ -1013,6 +1017,7 @@ def approach(
         points=points,
         branches=branches,
         tolerance=tolerance,
+        setpoint=setpoint,
     )
 
 

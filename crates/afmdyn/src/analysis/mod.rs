@@ -20,6 +20,7 @@ pub mod observables;
 pub mod period;
 pub mod progress;
 pub mod resonance;
+pub mod setpoint;
 pub mod shooting;
 pub mod spectrum;
 pub mod steady;

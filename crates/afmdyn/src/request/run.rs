@@ -235,6 +235,10 @@ pub struct ApproachRequest {
     /// The curve's range and options.
     #[serde(flatten)]
     pub curve: CurveRequest,
+    /// The amplitude setpoint A_sp/A₀ in (0, 1]: the document gains a `"setpoint"` block with
+    /// the operating points where the curve's amplitude equals it
+    /// ([`crate::analysis::setpoint`]).
+    pub setpoint: Option<f64>,
 }
 
 impl ApproachRequest {
@@ -253,6 +257,15 @@ impl ApproachRequest {
     /// # Errors
     /// As [`approach_request`].
     pub fn spec(&self, model: &Resolved) -> Result<SteppedSpec, SimError> {
+        if let Some(s) = self.setpoint {
+            if !(s.is_finite() && s > 0.0 && s <= 1.0) {
+                return Err(SimError::out_of_range(
+                    "setpoint",
+                    s,
+                    "must be in (0, 1]: the amplitude setpoint A_sp/A0",
+                ));
+            }
+        }
         approach_request(model.params, &self.curve, Self::units(model).length)
     }
 }
@@ -266,7 +279,12 @@ impl Analysis for ApproachRequest {
         stepped_sweep_with(&self.spec(model)?, progress)
     }
     fn report(&self, model: &Resolved, c: &Self::Output) -> Result<Value, SimError> {
-        Ok(report::approach(&model.params, c, &Self::units(model)))
+        let u = Self::units(model);
+        let mut doc = report::approach(&model.params, c, &u);
+        if let Some(s) = self.setpoint {
+            doc["setpoint"] = report::setpoint(&model.params, c, s, &u);
+        }
+        Ok(doc)
     }
 }
 
