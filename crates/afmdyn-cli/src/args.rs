@@ -34,7 +34,7 @@ pub struct ModelArgs {
         conflicts_with = "alpha5",
         allow_negative_numbers = true
     )]
-    pub z_c: Option<f64>,
+    pub z_c: Option<Quantity>,
     #[arg(
         long = "drive-frequency",
         value_name = "HZ",
@@ -42,7 +42,7 @@ pub struct ModelArgs {
         conflicts_with = "omega",
         allow_negative_numbers = true
     )]
-    pub drive_frequency: Option<f64>,
+    pub drive_frequency: Option<Quantity>,
     #[arg(long, value_name = "N")]
     pub modes: Option<usize>,
     #[arg(
@@ -114,8 +114,11 @@ pub fn read_toml<T: for<'de> Deserialize<'de>>(path: &PathBuf) -> Result<T, CliE
 
 impl ModelArgs {
     /// The flags as the library's model values (names only; no numerics).
-    pub fn spec(&self) -> ModelSpec {
-        ModelSpec {
+    ///
+    /// # Errors
+    /// [`CliError::Input`] for a `--z-c` or `--drive-frequency` with a unit of the other kind.
+    pub fn spec(&self) -> Result<ModelSpec, CliError> {
+        Ok(ModelSpec {
             modes: self.modes,
             tip_mass_ratio: self.alpha1,
             drive_amplitude: self.alpha2,
@@ -128,9 +131,14 @@ impl ModelArgs {
             restitution: self.restitution,
             hamaker: self.hamaker,
             intermolecular_distance: self.intermolecular_distance,
-            z_c: self.z_c,
-            drive_frequency: self.drive_frequency,
-        }
+            z_c: quantity(self.z_c, "z-c", Dim::Length, true)?,
+            drive_frequency: quantity(
+                self.drive_frequency,
+                "drive-frequency",
+                Dim::Frequency,
+                true,
+            )?,
+        })
     }
 
     /// The probe file, when given (read once per call), with `--cantilever`'s name in it.
@@ -166,7 +174,7 @@ impl ModelArgs {
             Some(p) => read_toml(p)?,
             None => ModelSpec::default(),
         };
-        Ok((self.spec().over(file), probe))
+        Ok((self.spec()?.over(file), probe))
     }
 
     /// The parameter set: [`ModelSpec::resolve`] of the flags over the config file, on
@@ -214,4 +222,148 @@ impl IntegratorArgs {
             tolerance: self.tolerance,
         }
     }
+}
+
+/// What an SI unit suffix measures.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Dim {
+    /// m, mm, µm (um), nm, pm.
+    Length,
+    /// Hz, kHz, MHz.
+    Frequency,
+}
+
+impl Dim {
+    fn name(self) -> &'static str {
+        match self {
+            Dim::Length => "a length (m)",
+            Dim::Frequency => "a frequency (Hz)",
+        }
+    }
+}
+
+/// A number as a user writes it, with an optional SI unit: `20nm`, `20 nm`, `0.1nm`,
+/// `300kHz`, `-3e-9` (the value in the base unit, m or Hz, and the unit's dimension).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Quantity {
+    /// The value in m or Hz when a unit was written, else as written.
+    pub value: f64,
+    /// The unit's dimension, when a unit was written.
+    pub dim: Option<Dim>,
+}
+
+/// The SI units a number may carry on the command line, with their powers of ten to m or Hz.
+const UNITS: [(&str, i32, Dim); 9] = [
+    ("pm", -12, Dim::Length),
+    ("nm", -9, Dim::Length),
+    ("um", -6, Dim::Length),
+    ("µm", -6, Dim::Length),
+    ("mm", -3, Dim::Length),
+    ("m", 0, Dim::Length),
+    ("kHz", 3, Dim::Frequency),
+    ("MHz", 6, Dim::Frequency),
+    ("Hz", 0, Dim::Frequency),
+];
+
+impl std::str::FromStr for Quantity {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        let t = s.trim();
+        if let Ok(v) = t.parse::<f64>() {
+            return Ok(Quantity {
+                value: v,
+                dim: None,
+            });
+        }
+        for (unit, exp, dim) in UNITS {
+            if let Some(num) = t.strip_suffix(unit).map(str::trim_end) {
+                if let Ok(v) = num.parse::<f64>() {
+                    // `7nm` reads as `7e-9` exactly (7 × 1e-9 would be one ulp off)
+                    let value = if num.contains(['e', 'E']) {
+                        v * 10f64.powi(exp)
+                    } else {
+                        format!("{num}e{exp}")
+                            .parse()
+                            .unwrap_or(v * 10f64.powi(exp))
+                    };
+                    return Ok(Quantity {
+                        value,
+                        dim: Some(dim),
+                    });
+                }
+            }
+        }
+        Err(format!(
+            "'{s}': expected a number, optionally with a unit (pm, nm, um, mm, m, Hz, kHz, MHz)"
+        ))
+    }
+}
+
+impl Quantity {
+    /// The value of flag `--flag`, which takes `want` in SI when `si` (with a probe), else a
+    /// dimensionless number.
+    ///
+    /// # Errors
+    /// [`CliError::Input`] for a unit of another dimension, or a unit without a probe.
+    pub fn value(self, flag: &str, want: Dim, si: bool) -> Result<f64, CliError> {
+        match self.dim {
+            Some(d) if d != want => Err(CliError::Input(format!(
+                "--{flag}: the unit makes it {}, but --{flag} takes {}",
+                d.name(),
+                want.name()
+            ))),
+            Some(_) if !si => Err(CliError::Input(format!(
+                "--{flag}: a value with a unit needs --probe (without one, --{flag} is \
+                 dimensionless: g0 or Ω)"
+            ))),
+            _ => Ok(self.value),
+        }
+    }
+}
+
+#[cfg(test)]
+mod quantity_tests {
+    use super::{Dim, Quantity};
+
+    #[test]
+    fn numbers_read_with_and_without_units() {
+        let q = |s: &str| s.parse::<Quantity>().unwrap();
+        assert_eq!(
+            q("7nm"),
+            Quantity {
+                value: 7e-9,
+                dim: Some(Dim::Length)
+            }
+        );
+        assert_eq!(
+            q(" 0.5 nm "),
+            Quantity {
+                value: 0.5e-9,
+                dim: Some(Dim::Length)
+            }
+        );
+        assert_eq!(
+            q("-3e-9"),
+            Quantity {
+                value: -3e-9,
+                dim: None
+            }
+        );
+        assert_eq!(q("300kHz").value, 300e3);
+        assert_eq!(q("1.2MHz").value, 1.2e6);
+        assert_eq!(q("2e1nm").value, 20e-9);
+        assert_eq!(q("5µm").value, 5e-6);
+        assert!("7 parsecs".parse::<Quantity>().is_err());
+        assert!("nm".parse::<Quantity>().is_err());
+    }
+}
+
+/// `Option<Quantity>` → its value ([`Quantity::value`]).
+pub fn quantity(
+    q: Option<Quantity>,
+    flag: &str,
+    want: Dim,
+    si: bool,
+) -> Result<Option<f64>, CliError> {
+    q.map(|q| q.value(flag, want, si)).transpose()
 }

@@ -2,7 +2,7 @@
 //! resonance` (amplitude and phase against the drive frequency): stepped sweeps both ways plus
 //! branch continuation ([`afmdyn::analysis::stepped`]), written as CSV, NPY and plots.
 
-use crate::args::ModelArgs;
+use crate::args::{quantity, Dim, ModelArgs, Quantity};
 use crate::cmd_simulate::Files;
 use crate::error::CliError;
 use crate::output::{f, write_csv, Column, NpyStream, OutDir};
@@ -25,7 +25,7 @@ use std::path::{Path, PathBuf};
 pub struct CurveArgs {
     /// Grid step of the swept quantity (in the units of --from/--to); conflicts with --points
     #[arg(long, conflicts_with = "points", allow_negative_numbers = true)]
-    step: Option<f64>,
+    step: Option<Quantity>,
     /// Number of grid values, ends included (2..=100000) [default: 120]
     #[arg(long)]
     points: Option<usize>,
@@ -45,16 +45,22 @@ pub struct CurveArgs {
 
 impl CurveArgs {
     /// The request of these flags with the ends `from`, `to` (the library checks and applies
-    /// it: [`CurveRequest`]).
-    fn request(&self, from: Option<f64>, to: Option<f64>) -> CurveRequest {
-        CurveRequest {
+    /// it: [`CurveRequest`]); the step in `dim` when `si` (a probe).
+    fn request(
+        &self,
+        from: Option<f64>,
+        to: Option<f64>,
+        dim: Dim,
+        si: bool,
+    ) -> Result<CurveRequest, CliError> {
+        Ok(CurveRequest {
             from,
             to,
-            step: self.step,
+            step: quantity(self.step, "step", dim, si)?,
             points: self.points,
             branches: !self.no_branches,
             tolerance: self.tolerance,
-        }
+        })
     }
 }
 
@@ -64,12 +70,13 @@ pub struct ApproachArgs {
     #[command(flatten)]
     model: ModelArgs,
     /// Rest distance z_c where the approach starts (m with --probe, else units of g0)
-    /// [default: 1.2 × the free amplitude A0 from the sample]
+    /// [default: 1.2 × the free amplitude A0 from the sample]; with --probe a unit may follow
+    /// (20nm)
     #[arg(long, allow_negative_numbers = true)]
-    from: Option<f64>,
+    from: Option<Quantity>,
     /// Rest distance z_c where the approach ends and the retract starts [default: 0.1 × A0]
     #[arg(long, allow_negative_numbers = true)]
-    to: Option<f64>,
+    to: Option<Quantity>,
     #[command(flatten)]
     curve: CurveArgs,
     /// Amplitude setpoint A_sp/A0 in (0, 1]: the operating points where the curve's amplitude
@@ -90,12 +97,13 @@ pub struct ResonanceArgs {
     /// Mode k whose natural frequency the default band surrounds (1..=N)
     #[arg(long, default_value_t = 1)]
     mode: usize,
-    /// Start of the band (Hz with --probe, else Ω) [default: ω_k (1 − w), w = max(6/Q_k, 0.02)]
+    /// Start of the band (Hz with --probe, else Ω) [default: ω_k (1 − w), w = max(6/Q_k, 0.02)];
+    /// with --probe a unit may follow (295kHz)
     #[arg(long, allow_negative_numbers = true)]
-    from: Option<f64>,
+    from: Option<Quantity>,
     /// End of the band [default: ω_k (1 + w)]
     #[arg(long, allow_negative_numbers = true)]
-    to: Option<f64>,
+    to: Option<Quantity>,
     #[command(flatten)]
     curve: CurveArgs,
     /// Output directory (locked during the run)
@@ -646,9 +654,12 @@ fn check_finite(name: &str, v: Option<f64>) -> Result<(), CliError> {
 
 /// Run `afmdyn approach`.
 pub fn approach(a: &ApproachArgs) -> Result<(), CliError> {
-    let (base, units, probe) = setup(&a.model, a.from, a.to, false)?;
+    let si = a.model.probe.is_some();
+    let from = quantity(a.from, "from", Dim::Length, si)?;
+    let to = quantity(a.to, "to", Dim::Length, si)?;
+    let (base, units, probe) = setup(&a.model, from, to, false)?;
     let request = ApproachRequest {
-        curve: a.curve.request(a.from, a.to),
+        curve: a.curve.request(from, to, Dim::Length, si)?,
         setpoint: a.setpoint,
     };
     let x = |v: f64| rest_distance(&base, v) * units.length;
@@ -682,11 +693,14 @@ pub fn approach(a: &ApproachArgs) -> Result<(), CliError> {
 
 /// Run `afmdyn resonance`.
 pub fn resonance(a: &ResonanceArgs) -> Result<(), CliError> {
-    let (base, units, probe) = setup(&a.model, a.from, a.to, true)?;
+    let si = a.model.probe.is_some();
+    let from = quantity(a.from, "from", Dim::Frequency, si)?;
+    let to = quantity(a.to, "to", Dim::Frequency, si)?;
+    let (base, units, probe) = setup(&a.model, from, to, true)?;
     let hz = units.hz_per_omega.unwrap_or(1.0);
     let request = ResonanceRequest {
         mode: a.mode,
-        curve: a.curve.request(a.from, a.to),
+        curve: a.curve.request(from, to, Dim::Frequency, si)?,
     };
     let x = |v: f64| v * hz;
     let labels = Labels {

@@ -172,7 +172,27 @@ fn parse() -> Result<Cli, clap::Error> {
     Cli::from_arg_matches(&matches)
 }
 
+/// A reader that closes the pipe (`afmdyn … | head`) ends the run quietly with status 141, as
+/// SIGPIPE ends other Unix tools (Rust ignores SIGPIPE, and `println!` panics on the closed
+/// pipe instead); every other panic keeps the default report.
+fn quiet_broken_pipe() {
+    let default = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        let payload = info.payload();
+        let msg = payload
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| payload.downcast_ref::<&str>().copied())
+            .unwrap_or("");
+        if msg.contains("failed printing to stdout") && msg.contains("Broken pipe") {
+            std::process::exit(141);
+        }
+        default(info);
+    }));
+}
+
 fn main() {
+    quiet_broken_pipe();
     let cli = match parse() {
         Ok(c) => c,
         Err(e) => {

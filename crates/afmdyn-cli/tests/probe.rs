@@ -198,3 +198,115 @@ fn cantilever_library_composes_with_a_sample_file() {
     let out = run(&["orbit", "--probe", s]);
     assert!(String::from_utf8_lossy(&out.stderr).contains("--cantilever NAME"));
 }
+
+/// Numbers as users write them: SI units on the SI flags with a probe (`--z-c 7nm`,
+/// `--drive-frequency 299kHz`, `--from 12nm`, `--step 0.5nm`, resonance `--from 295kHz`) give
+/// the same runs as the plain numbers; a unit of the other kind, a unit without a probe and a
+/// length meant in nm but written in m are refused (exit 2) with a hint; a closed pipe ends a
+/// run quietly.
+#[test]
+fn si_flags_take_units_and_hint_at_misplaced_scales() {
+    let pm = "examples/probe-point-mass-dmt.toml";
+    let a = json(&[
+        "orbit",
+        "--probe",
+        pm,
+        "--z-c",
+        "7nm",
+        "--drive-frequency",
+        "299kHz",
+        "--json",
+    ]);
+    let b = json(&[
+        "orbit",
+        "--probe",
+        pm,
+        "--z-c",
+        "7e-9",
+        "--drive-frequency",
+        "299e3",
+        "--json",
+    ]);
+    assert_eq!(a["params"], b["params"]);
+    let a = json(&[
+        "approach",
+        "--probe",
+        pm,
+        "--from",
+        "12nm",
+        "--to",
+        "5 nm",
+        "--step",
+        "0.5nm",
+        "--no-branches",
+        "--files",
+        "none",
+        "--json",
+    ]);
+    let b = json(&[
+        "approach",
+        "--probe",
+        pm,
+        "--from",
+        "12e-9",
+        "--to",
+        "5e-9",
+        "--step",
+        "0.5e-9",
+        "--no-branches",
+        "--files",
+        "none",
+        "--json",
+    ]);
+    assert_eq!(a["approach"]["z_c"], b["approach"]["z_c"]);
+    let a = json(&[
+        "resonance",
+        "--probe",
+        pm,
+        "--from",
+        "295kHz",
+        "--to",
+        "0.305MHz",
+        "--points",
+        "3",
+        "--no-branches",
+        "--files",
+        "none",
+        "--json",
+    ]);
+    assert_eq!(a["up"]["frequency_hz"][0], 295e3);
+    for (args, needle) in [
+        (
+            vec!["approach", "--from", "12nm"],
+            "--from: a value with a unit needs --probe",
+        ),
+        (
+            vec!["approach", "--probe", pm, "--from", "12kHz"],
+            "takes a length (m)",
+        ),
+        (
+            vec!["orbit", "--probe", pm, "--z-c", "8"],
+            "z-c = 8 m: must lie within ±1e-4 m",
+        ),
+        (
+            vec!["approach", "--probe", pm, "--from", "20", "--to", "2"],
+            "from = 20 m",
+        ),
+        (
+            vec!["orbit", "--probe", pm, "--drive-frequency", "300"],
+            "300kHz",
+        ),
+        (
+            vec!["orbit", "--probe", pm, "--z-c", "7xx"],
+            "optionally with a unit",
+        ),
+    ] {
+        let out = run(&args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains(needle) && err.lines().count() == 1,
+            "{args:?}: {err}"
+        );
+    }
+}

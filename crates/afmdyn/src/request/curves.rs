@@ -121,6 +121,17 @@ pub fn approach_request(
     length: f64,
 ) -> Result<SteppedSpec, SimError> {
     request.check_finite()?;
+    if length != 1.0 {
+        for (name, v) in [
+            ("from", request.from),
+            ("to", request.to),
+            ("step", request.step),
+        ] {
+            if let Some(v) = v {
+                super::limits::si_distance(name, v)?;
+            }
+        }
+    }
     let (from, to) = request.ends(default_range(&base)?, length);
     let spec = approach_spec(base, from, to, request.spacing(length)?);
     request.configure(spec.map_err(|e| in_units(e, length))?)

@@ -34,3 +34,30 @@ pub const MAX_OBSERVE_PERIODS: usize = crate::analysis::observables::MAX_PERIODS
 /// Largest modal state entry of an initial state: states of norm
 /// [`crate::params::STATE_NORM_MAX`] count as diverged.
 pub const MAX_INITIAL_ENTRY: f64 = crate::params::STATE_NORM_MAX / 10.0;
+
+/// Largest |SI distance| (m) of a tip–sample rest distance or an approach range: 100 µm.
+/// Tapping-mode distances are nanometres; a value beyond this is a length meant in nm but
+/// written in m (1e9 too large), refused with that hint before it becomes a gap α5 the user
+/// never wrote (issues 27 and 28).
+pub const MAX_SI_DISTANCE: f64 = 1e-4;
+
+/// Drive frequencies (Hz) are accepted within [1e-2, 1e4] × the probe's own drive frequency:
+/// wider than the band of any of its 20 modes, narrow enough to catch a value meant in kHz or
+/// MHz but written in Hz (1e3 or 1e6 too small).
+pub const SI_FREQUENCY_RATIO: (f64, f64) = (1e-2, 1e4);
+
+/// Check an SI distance `v` (m) against [`MAX_SI_DISTANCE`].
+///
+/// # Errors
+/// [`SimError::OutOfRange`] naming `name`, with the hint that lengths are in metres.
+pub fn si_distance(name: &'static str, v: f64) -> Result<(), crate::SimError> {
+    if v.is_finite() && v.abs() > MAX_SI_DISTANCE {
+        return Err(crate::SimError::out_of_range(
+            name,
+            format!("{} m", crate::error::number(v)),
+            "must lie within ±1e-4 m: lengths are in metres and tapping-mode distances are \
+             nanometres (20 nm is 20e-9, or 20nm on the command line)",
+        ));
+    }
+    Ok(())
+}

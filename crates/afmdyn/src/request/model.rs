@@ -349,6 +349,7 @@ impl ModelSpec {
                     "must be a finite distance in m",
                 ));
             }
+            super::limits::si_distance("z_c", z)?;
             p.alpha5 = p.alpha5_for_rest_distance(z / probe.scales.length_m);
         }
         if let Some(f) = self.drive_frequency {
@@ -371,6 +372,21 @@ impl ModelSpec {
                     "drive_frequency",
                     f,
                     "must be finite and > 0 (Hz)",
+                ));
+            }
+            let (lo, hi) = super::limits::SI_FREQUENCY_RATIO;
+            let ratio = f / probe.drive_frequency;
+            if !(lo..=hi).contains(&ratio) {
+                return Err(SimError::out_of_range(
+                    "drive_frequency",
+                    format!(
+                        "{} Hz ({} × the probe's {} Hz)",
+                        crate::error::number(f),
+                        crate::error::number(ratio),
+                        crate::error::number(probe.drive_frequency)
+                    ),
+                    "must be within [0.01, 1e4] × the probe's drive frequency: frequencies are \
+                     in Hz (300 kHz is 300e3, or 300kHz on the command line)",
                 ));
             }
             p.omega = probe.scales.omega(f);
