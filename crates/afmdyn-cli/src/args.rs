@@ -321,6 +321,16 @@ impl Quantity {
     }
 }
 
+/// `Option<Quantity>` → its value ([`Quantity::value`]).
+pub fn quantity(
+    q: Option<Quantity>,
+    flag: &str,
+    want: Dim,
+    si: bool,
+) -> Result<Option<f64>, CliError> {
+    q.map(|q| q.value(flag, want, si)).transpose()
+}
+
 #[cfg(test)]
 mod quantity_tests {
     use super::{Dim, Quantity};
@@ -356,14 +366,4 @@ mod quantity_tests {
         assert!("7 parsecs".parse::<Quantity>().is_err());
         assert!("nm".parse::<Quantity>().is_err());
     }
-}
-
-/// `Option<Quantity>` → its value ([`Quantity::value`]).
-pub fn quantity(
-    q: Option<Quantity>,
-    flag: &str,
-    want: Dim,
-    si: bool,
-) -> Result<Option<f64>, CliError> {
-    q.map(|q| q.value(flag, want, si)).transpose()
 }
