@@ -78,9 +78,11 @@ pub fn model_spec(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<ModelSpec> {
         let canonical = parameter(&key).map(|p| p.name).ok_or_else(|| {
             // a Python keyword as an argument name: the functions take it with a trailing _
             let hint = if key == "from" {
-                "'from' is a Python keyword: the start of a range is from_=...; "
+                "'from' is a Python keyword: the start of a range is from_=...; ".to_string()
+            } else if let Some(near) = afmdyn::request::model::closest_parameter(&key) {
+                format!("did you mean {near}? ")
             } else {
-                ""
+                String::new()
             };
             PyTypeError::new_err(format!(
                 "unknown model parameter '{key}': {hint}expected {}",

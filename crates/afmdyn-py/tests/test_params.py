@@ -189,3 +189,12 @@ def test_every_law_runs_from_python_as_on_the_command_line(cli_json):
         o = afmdyn.orbit(**model)
         assert o.to_dict() == cli_json(*args), law
         assert o.stable, law
+
+
+def test_a_misspelt_keyword_gets_the_near_name():
+    with pytest.raises(TypeError, match="unknown model parameter 'omgea': did you mean omega?"):
+        afmdyn.orbit(omgea=2.0)
+    with pytest.raises(TypeError, match="did you mean beam_damping"):
+        afmdyn.orbit(beam_dampnig=0.1)
+    with pytest.raises(TypeError, match="unknown model parameter 'zzz': expected"):
+        afmdyn.orbit(zzz=1.0)

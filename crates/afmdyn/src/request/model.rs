@@ -226,6 +226,18 @@ pub fn parameter(key: &str) -> Option<&'static ParamInfo> {
         .find(|p| p.name == key || p.alias == Some(key))
 }
 
+/// The model parameter name (or alias) closest to a misspelt `key` — Jaro–Winkler similarity
+/// ≥ 0.85 (`omgea` → `omega`, `beam_dampnig` → `beam_damping`) — for a "did you mean" hint.
+pub fn closest_parameter(key: &str) -> Option<&'static str> {
+    MODEL_PARAMETERS
+        .iter()
+        .flat_map(|p| std::iter::once(p.name).chain(p.alias))
+        .map(|name| (strsim::jaro_winkler(key, name), name))
+        .filter(|(score, _)| *score >= 0.85)
+        .max_by(|a, b| a.0.total_cmp(&b.0))
+        .map(|(_, name)| name)
+}
+
 /// The model values of a request, each optional (a missing one keeps the value below it in the
 /// precedence of this module). Serialised with the names of [`MODEL_PARAMETERS`]; the paper's
 /// `alpha1` … `alpha6` are accepted as aliases; unknown keys are refused (this is also the
