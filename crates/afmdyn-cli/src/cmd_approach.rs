@@ -35,6 +35,11 @@ pub struct CurveArgs {
     /// Tolerance of the adaptive integrator (the exact propagator ignores it)
     #[arg(long, default_value_t = afmdyn::analysis::stepped::DEFAULT_TOLERANCE)]
     tolerance: f64,
+    /// Record one steady-state cycle per point of the first sweep (tip deflection, distance
+    /// V_T, tip–sample force), N samples per drive period (default 200): STEM-traces.nc, the
+    /// force–distance loops plot and "traces" in --json
+    #[arg(long, value_name = "N", num_args = 0..=1, default_missing_value = "200")]
+    traces: Option<usize>,
     /// Files written: all (data and plots), data (no plots) or none (only the summary)
     #[arg(long, value_enum, default_value = "all")]
     files: Files,
@@ -59,6 +64,7 @@ impl CurveArgs {
             step: quantity(self.step, "step", dim, si)?,
             points: self.points,
             branches: !self.no_branches,
+            traces: self.traces,
             tolerance: self.tolerance,
         })
     }
@@ -592,6 +598,9 @@ impl Run<'_> {
                 self.labels,
                 self.base,
             )?;
+            if let Some(t) = &c.traces {
+                write_traces(o, self.args.files, t, self.x, self.units, self.labels)?;
+            }
         }
         if self.args.json {
             println!("{json}");
@@ -603,6 +612,118 @@ impl Run<'_> {
         }
         Ok(())
     }
+}
+
+/// `STEM-traces.nc` (NetCDF 3: deflection, distance, force over (point, time), the swept
+/// quantity and the time axis in drive periods) and, with plots, `STEM-traces`: the
+/// force–distance loops of up to 8 points spread over the sweep.
+fn write_traces(
+    out: &OutDir,
+    files: Files,
+    t: &afmdyn::analysis::traces::Traces,
+    x: &dyn Fn(f64) -> f64,
+    units: &CurveUnits,
+    labels: &Labels,
+) -> Result<(), CliError> {
+    use netcdf3::{DataSet, FileWriter, Version};
+    let path = out.join(format!("{}-traces.nc", labels.stem));
+    let e = |m: String| CliError::Io(format!("cannot write {}: {m}", path.display()));
+    let d = |r: Result<(), netcdf3::error::InvalidDataSet>| r.map_err(|x| e(format!("{x:?}")));
+    let (np, ns) = (t.values.len(), t.time.len());
+    let xs: Vec<f64> = t.values.iter().map(|&v| x(v)).collect();
+    let scale = |v: &[f64], s: f64| v.iter().map(|a| a * s).collect::<Vec<f64>>();
+    let (length, force) = if units.si { ("m", "N") } else { ("g0", "F~") };
+    let vars: [(&str, &str, &str, Vec<f64>); 3] = [
+        (
+            "deflection",
+            length,
+            "tip deflection W(1,tau)",
+            scale(&t.deflection, units.length),
+        ),
+        (
+            "distance",
+            length,
+            "tip-sample distance V_T (<= 0 in contact)",
+            scale(&t.distance, units.length),
+        ),
+        (
+            "force",
+            force,
+            "tip-sample force",
+            scale(&t.force, units.force),
+        ),
+    ];
+    let mut ds = DataSet::new();
+    d(ds.add_fixed_dim("point", np))?;
+    d(ds.add_fixed_dim("time", ns))?;
+    d(ds.add_var_f64(labels.x_name, &["point"]))?;
+    d(ds.add_var_attr_string(labels.x_name, "units", labels.x_unit.unwrap_or("1")))?;
+    d(ds.add_var_f64("time", &["time"]))?;
+    d(ds.add_var_attr_string("time", "units", "drive periods"))?;
+    for (name, unit, meaning, _) in &vars {
+        d(ds.add_var_f64(name, &["point", "time"]))?;
+        d(ds.add_var_attr_string(name, "units", *unit))?;
+        d(ds.add_var_attr_string(name, "long_name", *meaning))?;
+    }
+    d(ds.add_global_attr_string(
+        "title",
+        format!(
+            "afmdyn {} traces: one steady-state cycle per point of the {}",
+            labels.stem, labels.sweeps.0
+        ),
+    ))?;
+    crate::output::atomic(&path, |tmp| {
+        let w = |x: netcdf3::error::WriteError| e(format!("{x:?}"));
+        let mut f = FileWriter::open(tmp).map_err(w)?;
+        f.set_def(&ds, Version::Offset64Bit, 0).map_err(w)?;
+        f.write_var_f64(labels.x_name, &xs).map_err(w)?;
+        f.write_var_f64("time", &t.time).map_err(w)?;
+        for (name, _, _, v) in &vars {
+            f.write_var_f64(name, v).map_err(w)?;
+        }
+        f.close().map_err(w)
+    })?;
+    if files != Files::All || np == 0 {
+        return Ok(());
+    }
+    let picks: Vec<usize> = if np <= 8 {
+        (0..np).collect()
+    } else {
+        (0..8).map(|k| k * (np - 1) / 7).collect()
+    };
+    let series = picks
+        .iter()
+        .enumerate()
+        .map(|(c, &i)| Series {
+            label: format!(
+                "{} = {}",
+                labels.x_text,
+                match labels.x_unit {
+                    Some(u) => si_value(xs[i], u),
+                    None => format!("{:.4}", xs[i]),
+                }
+            ),
+            points: (0..ns)
+                .map(|k| (vars[1].3[i * ns + k], vars[2].3[i * ns + k]))
+                .collect(),
+            style: Style::Line,
+            color: c,
+        })
+        .collect();
+    save(
+        out.path(),
+        &format!("{}-traces", labels.stem),
+        &Figure {
+            title: format!(
+                "Force–distance loops over one cycle ({}; the loop's area is E_dis)",
+                labels.sweeps.0
+            ),
+            x_label: format!("tip–sample distance V_T ({length})"),
+            y_label: format!("tip–sample force ({force})"),
+            series,
+            shade: vec![],
+        },
+    )
 }
 
 /// The operating points of the `"setpoint"` block, one line each.

@@ -19,6 +19,7 @@ fn curve(
     points: Option<usize>,
     branches: bool,
     tolerance: f64,
+    traces: Option<usize>,
 ) -> CurveRequest {
     CurveRequest {
         from,
@@ -27,14 +28,15 @@ fn curve(
         points,
         branches,
         tolerance,
+        traces,
     }
 }
 
 /// The approach–retract curve over the rest distance z_c (`afmdyn approach`).
 #[pyfunction]
 #[pyo3(signature = (params, from_=None, to=None, step=None, points=None, branches=true,
-    tolerance=afmdyn::analysis::stepped::DEFAULT_TOLERANCE, setpoint=None, probe=None,
-    progress=None))]
+    tolerance=afmdyn::analysis::stepped::DEFAULT_TOLERANCE, setpoint=None, traces=None,
+    probe=None, progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn approach<'py>(
     py: Python<'py>,
@@ -46,11 +48,12 @@ pub fn approach<'py>(
     branches: bool,
     tolerance: f64,
     setpoint: Option<f64>,
+    traces: Option<usize>,
     probe: Option<PathBuf>,
     progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let request = ApproachRequest {
-        curve: curve(from_, to, step, points, branches, tolerance),
+        curve: curve(from_, to, step, points, branches, tolerance, traces),
         setpoint,
     };
     let doc = analysis(py, request, params.inner, probe, progress.as_ref(), true)?;
@@ -62,7 +65,8 @@ pub fn approach<'py>(
 /// The resonance curve near mode `mode` (`afmdyn resonance`).
 #[pyfunction]
 #[pyo3(signature = (params, mode=1, from_=None, to=None, step=None, points=None, branches=true,
-    tolerance=afmdyn::analysis::stepped::DEFAULT_TOLERANCE, probe=None, progress=None))]
+    tolerance=afmdyn::analysis::stepped::DEFAULT_TOLERANCE, traces=None, probe=None,
+    progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn resonance<'py>(
     py: Python<'py>,
@@ -74,12 +78,13 @@ pub fn resonance<'py>(
     points: Option<usize>,
     branches: bool,
     tolerance: f64,
+    traces: Option<usize>,
     probe: Option<PathBuf>,
     progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let request = ResonanceRequest {
         mode,
-        curve: curve(from_, to, step, points, branches, tolerance),
+        curve: curve(from_, to, step, points, branches, tolerance, traces),
     };
     let doc = analysis(py, request, params.inner, probe, progress.as_ref(), true)?;
     let out = Out::new(py);

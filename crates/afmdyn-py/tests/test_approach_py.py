@@ -51,7 +51,8 @@ def test_bad_grids_raise_value_error():
         # the grid's refusals quote the value as written, in metres or hertz (issue 27: they
         # said "to = 0.8", "step = 100000000", "step = -0.00133…")
         (lambda: afmdyn.approach(probe=PROBE, from_=8e-9, to=8e-9), "to = 8e-9: must differ"),
-        (lambda: afmdyn.approach(probe=PROBE, step=1.0), "step = 1: is longer than the range"),
+        (lambda: afmdyn.approach(probe=PROBE, step=1.0), "step = 1 m: must lie within ±1e-4 m"),
+        (lambda: afmdyn.approach(probe=PROBE, step=5e-8), "step = 5e-8: is longer than the range"),
         (lambda: afmdyn.resonance(probe=PROBE, step=-400.0), "step = -400: must be finite and > 0"),
     ],
 )
@@ -77,3 +78,26 @@ def test_setpoint_equals_the_command_line(cli_json):
         assert abs(p["amplitude_ratio"] - 0.85) < 1e-12
     with pytest.raises(ValueError, match="setpoint = 1.5"):
         afmdyn.approach(probe=str(PROBE), setpoint=1.5)
+
+
+def test_traces_equal_the_command_line(cli_json, tmp_path):
+    """``traces=N`` keeps one steady-state cycle per z_c: the command line's document and
+    approach-traces.nc hold the same arrays; the force–distance loop of the point mass has
+    V_T − W constant (the gap)."""
+    import numpy as np
+    import xarray as xr
+
+    args = dict(from_=11e-9, to=5e-9, points=5, branches=False, traces=16)
+    doc = afmdyn.approach(probe=str(PROBE), **args)
+    cli = cli_json("approach", "--probe", str(PROBE), "--from", "11e-9", "--to", "5e-9",
+                   "--points", "5", "--no-branches", "--traces", "16", "--out", str(tmp_path),
+                   "--files", "data")
+    assert doc["traces"] == cli["traces"]
+    t = doc["traces"]
+    assert t["z_c"] == doc["approach"]["z_c"] and len(t["time_periods"]) == 16
+    nc = xr.open_dataset(tmp_path / "approach-traces.nc")
+    np.testing.assert_allclose(nc.force.values, np.array(t["force"]), rtol=0, atol=0)
+    gap = np.array(t["distance"]) - np.array(t["deflection"])
+    assert np.allclose(gap, gap[:, :1], rtol=0, atol=1e-18)
+    with pytest.raises(ValueError, match="traces = 1"):
+        afmdyn.approach(probe=str(PROBE), traces=1)

@@ -466,6 +466,24 @@ fn curve_doc(
         .first
         .first()
         .map(|p| p.observables.closed_form.free_amplitude * u.length);
+    let traces = c.traces.as_ref().map(|t| {
+        let n = t.time.len().max(1);
+        let rows = |v: &[f64], scale: f64| -> Vec<Vec<f64>> {
+            v.chunks(n)
+                .map(|r| r.iter().map(|x| x * scale).collect())
+                .collect()
+        };
+        json!({
+            "sweep": names.0,
+            "periods": t.periods,
+            "samples_per_period": t.samples_per_period,
+            x.0: t.values.iter().map(|&v| (x.1)(v)).collect::<Vec<_>>(),
+            "time_periods": t.time,
+            "deflection": rows(&t.deflection, u.length),
+            "distance": rows(&t.distance, u.length),
+            "force": rows(&t.force, u.force),
+        })
+    });
     json!({
         "params": params,
         "units": u.names(),
@@ -482,6 +500,7 @@ fn curve_doc(
         "jumps": jumps,
         "free_amplitude": free,
         "warnings": c.warnings,
+        "traces": traces,
     })
 }
 

@@ -268,6 +268,7 @@ def approach(
     branches: bool = True,
     tolerance: float = 1e-10,
     setpoint: Optional[float] = None,
+    traces: Optional[int] = None,
     probe: Optional[str] = None,
     progress: Optional[ProgressCallback] = None,
 ) -> Dict[str, Any]: ...
@@ -280,6 +281,7 @@ def resonance(
     points: Optional[int] = None,
     branches: bool = True,
     tolerance: float = 1e-10,
+    traces: Optional[int] = None,
     probe: Optional[str] = None,
     progress: Optional[ProgressCallback] = None,
 ) -> Dict[str, Any]: ...

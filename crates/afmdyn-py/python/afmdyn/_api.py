@@ -980,6 +980,7 @@ def approach(
     branches: bool = True,
     tolerance: float = 1e-10,
     setpoint: Optional[float] = None,
+    traces: Optional[int] = None,
     progress: ProgressArg = None,
     **model: Unpack[Model],
 ) -> Dict[str, Any]:
@@ -994,6 +995,10 @@ def approach(
         step, points: the grid (a step in the same unit, or the number of values; default 120).
         branches: also continue the branches.
         tolerance: of the adaptive integrator.
+        traces: samples per drive period of one steady-state cycle recorded at every z_c of
+            the approach (``traces`` in the document: ``z_c``, ``time_periods``, and per z_c
+            ``deflection``, ``distance`` V_T and ``force``; the force–distance loop's area is
+            E_dis).
         setpoint: the amplitude setpoint A_sp/A₀ in (0, 1]: the document gains ``setpoint``
             (``ratio``, ``amplitude``, ``points``: per stable branch crossing its ``source``,
             ``z_c``, ``regime`` (attractive/repulsive), phase, peak force, indentation, E_dis…).
@@ -1018,6 +1023,7 @@ def approach(
         branches=branches,
         tolerance=tolerance,
         setpoint=setpoint,
+        traces=traces,
     )
 
 
@@ -1033,6 +1039,7 @@ def resonance(
     points: Optional[int] = None,
     branches: bool = True,
     tolerance: float = 1e-10,
+    traces: Optional[int] = None,
     progress: ProgressArg = None,
     **model: Unpack[Model],
 ) -> Dict[str, Any]:
@@ -1043,7 +1050,8 @@ def resonance(
 
     Args:
         from_, to: the band (default ω_k (1 ∓ max(6/Q_k, 0.02))), in Hz with ``probe``, else Ω.
-        step, points, branches, tolerance: as :func:`approach`; ``probe`` (a model keyword)
+        step, points, branches, tolerance, traces: as :func:`approach` (traces per frequency
+            of the up-sweep); ``probe`` (a model keyword)
             sets the model and gives frequencies in Hz.
 
     Returns:
@@ -1064,4 +1072,5 @@ def resonance(
         points=points,
         branches=branches,
         tolerance=tolerance,
+        traces=traces,
     )

@@ -25,6 +25,7 @@ pub mod shooting;
 pub mod spectrum;
 pub mod steady;
 pub mod stepped;
+pub mod traces;
 
 /// Without the `parallel` feature: the few rayon adaptors the analyses call, on plain
 /// iterators, so the same code runs its independent tasks one after another (each task's seed

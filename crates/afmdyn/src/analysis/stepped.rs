@@ -151,6 +151,9 @@ pub struct SteppedSpec {
     pub branches: bool,
     /// Cap on the points of one branch.
     pub max_branch_points: usize,
+    /// Samples per drive period of the per-point traces of the first sweep
+    /// ([`super::traces`]); 0: none.
+    pub trace_samples: usize,
 }
 
 impl SteppedSpec {
@@ -179,6 +182,7 @@ impl SteppedSpec {
             observables: ObservableOptions::default(),
             branches: true,
             max_branch_points: 2000,
+            trace_samples: 0,
         }
     }
 }
@@ -273,6 +277,9 @@ pub struct SteppedCurve {
     pub bistable: Vec<(f64, f64)>,
     /// What could not be computed (e.g. a branch whose start failed).
     pub warnings: Vec<String>,
+    /// One steady-state cycle per point of the first sweep, when
+    /// [`SteppedSpec::trace_samples`] > 0.
+    pub traces: Option<super::traces::Traces>,
 }
 
 /// Observables of a period-n orbit (or `record` periods of a motion) from `z` at τ = 0.
@@ -869,6 +876,10 @@ pub fn stepped_sweep_with(
     folds.dedup_by(|a, b| (*a - *b).abs() <= 1e-9 * (1.0 + b.abs()));
     let mut jumps = jumps_of(Sweep::First, &first, &folds, spec.jump_tol);
     jumps.extend(jumps_of(Sweep::Second, &second, &folds, spec.jump_tol));
+    let traces = match spec.trace_samples {
+        0 => None,
+        n => Some(super::traces::traces(spec, &first, n)?),
+    };
     Ok(SteppedCurve {
         param: spec.param,
         first,
@@ -878,6 +889,7 @@ pub fn stepped_sweep_with(
         folds,
         bistable,
         warnings,
+        traces,
     })
 }
 

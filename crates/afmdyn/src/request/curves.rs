@@ -31,6 +31,9 @@ pub struct CurveRequest {
     pub branches: bool,
     /// Tolerance of the adaptive integrator, in (0, 1e-3).
     pub tolerance: f64,
+    /// Record one steady-state cycle per point of the first sweep with this many samples per
+    /// drive period (2..=10000; [`crate::analysis::traces`]); `None`: no traces.
+    pub traces: Option<usize>,
 }
 
 impl Default for CurveRequest {
@@ -44,6 +47,7 @@ impl Default for CurveRequest {
             points: None,
             branches: true,
             tolerance: DEFAULT_TOLERANCE,
+            traces: None,
         }
     }
 }
@@ -106,6 +110,16 @@ impl CurveRequest {
         }
         spec.integrator.tolerance = tol;
         spec.branches = self.branches;
+        if let Some(n) = self.traces {
+            if !(2..=crate::analysis::traces::MAX_TRACE_SAMPLES).contains(&n) {
+                return Err(SimError::out_of_range(
+                    "traces",
+                    n,
+                    "must be in 2..=10000 samples per drive period",
+                ));
+            }
+            spec.trace_samples = n;
+        }
         Ok(spec)
     }
 }
@@ -193,6 +207,7 @@ mod tests {
             points: None,
             branches: false,
             tolerance: 1e-9,
+            traces: None,
         }
     }
 
