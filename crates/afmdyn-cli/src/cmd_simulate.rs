@@ -31,6 +31,9 @@ pub enum Files {
 
 /// Samples kept for the phase portrait (the last ones).
 const PHASE_SAMPLES: usize = 50_000;
+/// Drive periods `tip.png` shows (the last ones) when more were recorded; `tip-all.png` then
+/// shows every recorded period (a 50-period chaotic record drawn whole is unreadable).
+const TIP_WINDOW_PERIODS: usize = 10;
 
 /// `afmdyn simulate` flags.
 #[derive(Debug, Args)]
@@ -145,6 +148,10 @@ struct PlotData {
     t1: f64,
     shade: Shade,
     phase: VecDeque<(f64, f64)>,
+    /// The last [`TIP_WINDOW_PERIODS`] periods: τ, W(1,τ), V_T, in contact.
+    recent: VecDeque<(f64, f64, f64, bool)>,
+    /// Its capacity (samples).
+    recent_cap: usize,
 }
 
 impl PlotData {
@@ -300,6 +307,8 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
             min_gap: (end - start) / 4000.0,
         },
         phase: VecDeque::new(),
+        recent: VecDeque::new(),
+        recent_cap: TIP_WINDOW_PERIODS * spp + 1,
     });
     let mut spectrum: VecDeque<f64> = VecDeque::new();
     let record_samples = if files.is_some() { spp } else { 0 };
@@ -382,6 +391,11 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
                 }
                 pd.phase
                     .push_back((s.v_t, s.w_tip_dot + a2 * om * (om * s.tau).cos()));
+                if pd.recent.len() == pd.recent_cap {
+                    pd.recent.pop_front();
+                }
+                pd.recent
+                    .push_back((s.tau, s.w_tip, s.v_t, s.region == afmdyn::Region::Contact));
             }
             let tr = c.trajectory;
             if c.first
@@ -501,30 +515,78 @@ fn write_spectrum_and_plots(
             format!("{what} (recorded part)")
         }
     };
-    save(
-        out.path(),
-        "tip",
-        &Figure {
-            title: "Tip motion (contact intervals shaded)".into(),
-            x_label: "τ".into(),
-            y_label: "W(1,τ), V_T".into(),
-            series: vec![
-                Series {
-                    label: "W(1,τ)".into(),
-                    points: pd.tip,
-                    style: Style::Line,
-                    color: 0,
-                },
-                Series {
-                    label: "V_T".into(),
-                    points: pd.vt,
-                    style: Style::Line,
-                    color: 1,
-                },
-            ],
-            shade: pd.shade.intervals,
-        },
-    )?;
+    let tip_figure = |title: String, tip: Vec<(f64, f64)>, vt: Vec<(f64, f64)>, shade| Figure {
+        title,
+        x_label: "τ".into(),
+        y_label: "W(1,τ), V_T".into(),
+        series: vec![
+            Series {
+                label: "W(1,τ)".into(),
+                points: tip,
+                style: Style::Line,
+                color: 0,
+            },
+            Series {
+                label: "V_T".into(),
+                points: vt,
+                style: Style::Line,
+                color: 1,
+            },
+        ],
+        shade,
+    };
+    if recorded > TIP_WINDOW_PERIODS as f64 + 1e-9 {
+        // the last periods, readable; every recorded period in tip-all
+        let mut shade: Vec<(f64, f64)> = Vec::new();
+        let mut open: Option<f64> = None;
+        for &(t, _, _, contact) in &pd.recent {
+            match (contact, open) {
+                (true, None) => open = Some(t),
+                (false, Some(t0)) => {
+                    shade.push((t0, t));
+                    open = None;
+                }
+                _ => {}
+            }
+        }
+        if let (Some(t0), Some(&(t1, ..))) = (open, pd.recent.back()) {
+            shade.push((t0, t1));
+        }
+        save(
+            out.path(),
+            "tip",
+            &tip_figure(
+                format!(
+                    "Tip motion, last {TIP_WINDOW_PERIODS} of {recorded:.0} periods (contact \
+                     shaded; all: tip-all)"
+                ),
+                pd.recent.iter().map(|&(t, w, ..)| (t, w)).collect(),
+                pd.recent.iter().map(|&(t, _, v, _)| (t, v)).collect(),
+                shade,
+            ),
+        )?;
+        save(
+            out.path(),
+            "tip-all",
+            &tip_figure(
+                format!("Tip motion, all {recorded:.0} recorded periods (contact shaded)"),
+                pd.tip,
+                pd.vt,
+                pd.shade.intervals,
+            ),
+        )?;
+    } else {
+        save(
+            out.path(),
+            "tip",
+            &tip_figure(
+                "Tip motion (contact intervals shaded)".into(),
+                pd.tip,
+                pd.vt,
+                pd.shade.intervals,
+            ),
+        )?;
+    }
     save(
         out.path(),
         "phase",

@@ -531,3 +531,24 @@ fn an_attractor_census_whose_every_start_failed_exits_1() {
     assert_eq!(err.lines().count(), 1, "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `tip.png` shows at most the last 10 drive periods (readable); a longer record is drawn whole
+/// in `tip-all.png`, which a short one does not write.
+#[test]
+fn the_tip_plot_shows_the_last_periods_of_a_long_record() {
+    let dir = tempfile::tempdir().unwrap();
+    for (periods, all) in [("5", false), ("20", true)] {
+        let out = dir.path().join(periods);
+        let o = out.to_str().unwrap();
+        let run = afmdyn(&["simulate", "--periods", periods, "--out", o]);
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        assert!(out.join("tip.png").exists());
+        assert_eq!(out.join("tip-all.png").exists(), all, "{periods} periods");
+        let svg = std::fs::read_to_string(out.join("tip.svg")).unwrap();
+        assert_eq!(svg.contains("last 10 of 20 periods"), all);
+    }
+}
