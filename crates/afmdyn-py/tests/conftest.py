@@ -17,7 +17,8 @@ EXAMPLES = REPO / "examples"
 
 def _binary() -> Path:
     env = os.environ.get("AFMDYN_BIN")
-    return Path(env) if env else REPO / "target" / "release" / "afmdyn"
+    # absolute, so that a run in another working directory finds it
+    return Path(env).resolve() if env else REPO / "target" / "release" / "afmdyn"
 
 
 @pytest.fixture(scope="session")
