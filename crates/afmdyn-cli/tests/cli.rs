@@ -552,3 +552,24 @@ fn the_tip_plot_shows_the_last_periods_of_a_long_record() {
         assert_eq!(svg.contains("last 10 of 20 periods"), all);
     }
 }
+
+/// An orbit search whose start shows no period says so when Newton fails (the impact
+/// oscillator at Ω = 5 with r = 0.7 is nonperiodic from rest): exit 1, one line.
+#[test]
+fn a_failed_orbit_search_says_the_start_was_nonperiodic() {
+    let out = afmdyn(&[
+        "orbit",
+        "--contact-law",
+        "impact",
+        "--restitution",
+        "0.7",
+        "--omega",
+        "5",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("showed no period") && err.lines().count() == 1,
+        "{err}"
+    );
+}

@@ -227,7 +227,21 @@ impl OrbitRequest {
         let model = CantileverModel::new(params)?;
         let (guess, found) = self.start.guess(&model)?;
         let n = self.period.or(found).unwrap_or(1);
-        shoot(&model, &guess, n, &ShootingOptions::default())
+        match shoot(&model, &guess, n, &ShootingOptions::default()) {
+            // say why Newton started where it did (issue 28: every early end says why)
+            Err(SimError::NoConvergence {
+                iterations,
+                residual,
+                ..
+            }) if self.period.is_none() && found.is_none() => Err(SimError::NoConvergence {
+                what: "shooting for a period-1 orbit from the last state of a motion that showed \
+                       no period up to max_period (nonperiodic from this start: give the period, \
+                       another start or more max_periods)",
+                iterations,
+                residual,
+            }),
+            r => r,
+        }
     }
 }
 
