@@ -298,7 +298,12 @@ fn traces_are_the_steady_cycles_of_the_curve() {
     use afmdyn::analysis::traces::traces;
     use afmdyn::CantileverModel;
     let (spec, c) = curve();
-    let t = traces(spec, &c.first, 400).unwrap();
+    let points: Vec<_> = c
+        .first
+        .iter()
+        .map(|p| (p.value, &p.state, p.period))
+        .collect();
+    let t = traces(&spec.base, spec.param, spec.integrator, &points, 400).unwrap();
     let n = t.time.len();
     assert_eq!(t.values.len(), c.first.len());
     assert_eq!(n, t.periods * 400);

@@ -878,7 +878,19 @@ pub fn stepped_sweep_with(
     jumps.extend(jumps_of(Sweep::Second, &second, &folds, spec.jump_tol));
     let traces = match spec.trace_samples {
         0 => None,
-        n => Some(super::traces::traces(spec, &first, n)?),
+        n => {
+            let points: Vec<super::traces::TracePoint<'_>> = first
+                .iter()
+                .map(|p| (p.value, &p.state, p.period))
+                .collect();
+            Some(super::traces::traces(
+                &spec.base,
+                spec.param,
+                spec.integrator,
+                &points,
+                n,
+            )?)
+        }
     };
     Ok(SteppedCurve {
         param: spec.param,

@@ -10,11 +10,16 @@
 //! points, at most [`MAX_TRACE_PERIODS`]), so the traces form arrays of shape
 //! `[points, periods × samples_per_period]` on one time axis.
 
-use super::stepped::{CurvePoint, SteppedSpec};
 use crate::error::SimError;
-use crate::integrate::build;
+use crate::integrate::{build, IntegratorOptions};
 use crate::model::CantileverModel;
+use crate::params::{Params, SweepParam};
 use crate::trajectory::{record, RecordSpec};
+use nalgebra::DVector;
+
+/// A point of a sweep to trace: the swept parameter's value, the state at τ = 0 (shape `[2N]`)
+/// and the period n (`None`: not period-n, traced over one period).
+pub type TracePoint<'a> = (f64, &'a DVector<f64>, Option<usize>);
 
 /// Most drive periods of a trace (a period-n orbit with n larger is recorded over this many).
 pub const MAX_TRACE_PERIODS: usize = 16;
@@ -41,14 +46,17 @@ pub struct Traces {
     pub force: Vec<f64>,
 }
 
-/// The traces of `points` (a sweep of `spec`), `samples_per_period` samples per drive period.
+/// The traces of `points` of a sweep of `param` over `base`, integrated with `integrator`,
+/// `samples_per_period` samples per drive period.
 ///
 /// # Errors
 /// [`SimError::OutOfRange`] naming `trace_samples` outside 2..=[`MAX_TRACE_SAMPLES`]; the
 /// model's or integrator's errors for a point.
 pub fn traces(
-    spec: &SteppedSpec,
-    points: &[CurvePoint],
+    base: &Params,
+    param: SweepParam,
+    integrator: IntegratorOptions,
+    points: &[TracePoint<'_>],
     samples_per_period: usize,
 ) -> Result<Traces, SimError> {
     if !(2..=MAX_TRACE_SAMPLES).contains(&samples_per_period) {
@@ -60,7 +68,7 @@ pub fn traces(
     }
     let periods = points
         .iter()
-        .map(|p| p.period.unwrap_or(1))
+        .map(|p| p.2.unwrap_or(1))
         .max()
         .unwrap_or(1)
         .min(MAX_TRACE_PERIODS);
@@ -74,9 +82,9 @@ pub fn traces(
         distance: Vec::with_capacity(points.len() * samples),
         force: Vec::with_capacity(points.len() * samples),
     };
-    for p in points {
-        let model = CantileverModel::new(&spec.base.with(spec.param, p.value))?;
-        let mut integ = build(&model, spec.integrator, 0.0, &p.state)?;
+    for &(value, state, _) in points {
+        let model = CantileverModel::new(&base.with(param, value))?;
+        let mut integ = build(&model, integrator, 0.0, state)?;
         let tr = record(
             integ.as_mut(),
             &RecordSpec {
@@ -104,7 +112,7 @@ pub fn traces(
         for v in [&mut out.deflection, &mut out.distance, &mut out.force] {
             v.resize(before + samples, f64::NAN);
         }
-        out.values.push(p.value);
+        out.values.push(value);
     }
     Ok(out)
 }
