@@ -523,8 +523,14 @@ pub fn with_si(mut doc: Value, probe: Option<&crate::probe::Probe>, params: &Par
 /// `free_amplitude`, `units` (names), `scales` (the [`CurveUnits`] factors), `params` and
 /// `warnings`.
 pub fn approach(params: &Params, c: &SteppedCurve, u: &CurveUnits) -> Value {
-    let x = |a5: f64| crate::analysis::approach::rest_distance(params, a5) * u.length;
+    let x = z_c_of(params, u);
     curve_doc(params, c, ("z_c", &x), ("approach", "retract"), u)
+}
+
+/// The abscissa of an approach document: z_c ([`crate::analysis::approach::rest_distance`]) of
+/// the gap α5, in `u`'s length.
+fn z_c_of<'a>(params: &'a Params, u: &'a CurveUnits) -> impl Fn(f64) -> f64 + 'a {
+    move |a5| crate::analysis::approach::rest_distance(params, a5) * u.length
 }
 
 /// The `"setpoint"` block of `afmdyn approach --setpoint S --json`: the ratio A_sp/A₀, the
@@ -535,7 +541,7 @@ pub fn approach(params: &Params, c: &SteppedCurve, u: &CurveUnits) -> Value {
 /// [`CURVE_COLUMNS`] interpolated there.
 pub fn setpoint(params: &Params, c: &SteppedCurve, ratio: f64, u: &CurveUnits) -> Value {
     use crate::analysis::setpoint::{setpoint_crossings, Source};
-    let x = |a5: f64| crate::analysis::approach::rest_distance(params, a5) * u.length;
+    let x = z_c_of(params, u);
     let points: Vec<Value> = setpoint_crossings(c, ratio)
         .into_iter()
         .map(|k| {

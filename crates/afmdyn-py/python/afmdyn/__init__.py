@@ -40,7 +40,8 @@ from ._api import (
     simulate,
     summary,
 )
-from ._basins import basins, cantilevers
+from ._basins import basins
+from ._cantilevers import cantilevers
 from ._chart import chart
 from ._global_continuation import global_continuation
 from ._results import Attractor, Attractors, Lyapunov, Orbit, RegionSpectrum, Spectrum

@@ -1,5 +1,5 @@
 """Basins of attraction over a plane of initial conditions (``afmdyn basins``): the library's
-map and measures, as an ``xarray.Dataset``; and the cantilever library (``afmdyn cantilevers``)."""
+map and measures, as an ``xarray.Dataset``."""
 
 from __future__ import annotations
 
@@ -15,7 +15,6 @@ from ._api import Model, _params, _run, _typed
 from ._progress import ProgressArg
 
 if TYPE_CHECKING:
-    import pandas as pd
     from typing_extensions import Unpack
 
 
@@ -137,15 +136,3 @@ def basins(
         },
     )
 
-
-def cantilevers() -> "pd.DataFrame":
-    """The cantilever library (``afmdyn cantilevers``): nominal datasheet values of common
-    tapping-mode, soft-tapping and biological-imaging cantilevers, one row per cantilever,
-    indexed by name: ``maker``, ``spring_constant`` (N/m), ``resonance_frequency`` (Hz),
-    ``quality_factor`` (in air; ``q_typical`` True where it is the lever class's typical value,
-    not the datasheet's), ``radius`` (tip radius, m), ``source``. A probe file names one with
-    ``[cantilever] name = "RTESPA-300"``; its own keys override the library's."""
-    import pandas as pd
-
-    doc = json.loads(_core.cantilevers())
-    return pd.DataFrame(doc["cantilevers"]).set_index("name")

@@ -191,8 +191,26 @@ impl BasinSpec {
     /// Check the options (the one place of their limits).
     ///
     /// # Errors
-    /// [`SimError::OutOfRange`] naming the option.
+    /// [`SimError::OutOfRange`] naming the option (`x`, `y` for a coordinate outside the N
+    /// modes); [`SimError::StateLength`] for a base state of another length than 2N.
     pub fn validate(&self) -> Result<(), SimError> {
+        let n = self.params.modes;
+        for (name, c) in [("x", self.x), ("y", self.y)] {
+            if !c.fits(n) {
+                return Err(SimError::out_of_range(
+                    name,
+                    c,
+                    "must be a coordinate of the N modes (a1…aN, adot1…adotN, w, wdot)",
+                ));
+            }
+        }
+        if self.base.len() != 2 * n {
+            return Err(SimError::StateLength {
+                name: "base",
+                expected: 2 * n,
+                got: self.base.len(),
+            });
+        }
         if self.xs.is_empty() || self.ys.is_empty() {
             return Err(SimError::out_of_range("steps", 0, "must be >= 1"));
         }
@@ -631,25 +649,8 @@ pub fn basins(spec: &BasinSpec) -> Result<BasinMap, SimError> {
 /// # Errors
 /// As [`basins`]; [`SimError::Cancelled`] once `progress` is cancelled.
 pub fn basins_with(spec: &BasinSpec, progress: &Progress) -> Result<BasinMap, SimError> {
-    let model = CantileverModel::new(&spec.params)?;
-    let n = model.modes();
-    for (name, c) in [("x", spec.x), ("y", spec.y)] {
-        if !c.fits(n) {
-            return Err(SimError::out_of_range(
-                name,
-                c,
-                "must be a coordinate of the N modes (a1…aN, adot1…adotN, w, wdot)",
-            ));
-        }
-    }
-    if spec.base.len() != 2 * n {
-        return Err(SimError::StateLength {
-            name: "base",
-            expected: 2 * n,
-            got: spec.base.len(),
-        });
-    }
     spec.validate()?;
+    let model = CantileverModel::new(&spec.params)?;
     let (nx, ny) = (spec.xs.len(), spec.ys.len());
     progress.add_total(nx * ny);
     let mut attractors: Vec<SteadyState> = Vec::new();

@@ -111,33 +111,6 @@ impl BasinsRequest {
             }
         }
         let (x, y) = (coord("x", &self.x)?, coord("y", &self.y)?);
-        let n = params.modes;
-        for (name, c) in [("x", x), ("y", y)] {
-            if !c.fits(n) {
-                return Err(SimError::out_of_range(
-                    name,
-                    c,
-                    "must be a coordinate of the N modes (a1…aN, adot1…adotN, w, wdot)",
-                ));
-            }
-        }
-        let cells = self.x_steps.saturating_mul(self.y_steps);
-        if cells > crate::analysis::basins::MAX_BASIN_CELLS {
-            return Err(SimError::out_of_range(
-                "x_steps",
-                format!("{} × {}", self.x_steps, self.y_steps),
-                "x_steps × y_steps must be <= 4000000",
-            ));
-        }
-        let steps = |name: &'static str, v: usize| {
-            if v == 0 {
-                Err(SimError::out_of_range(name, v, "must be >= 1"))
-            } else {
-                Ok(())
-            }
-        };
-        steps("x_steps", self.x_steps)?;
-        steps("y_steps", self.y_steps)?;
         let model = CantileverModel::new(params)?;
         let spec = BasinSpec {
             params: *params,
