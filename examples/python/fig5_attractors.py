@@ -7,8 +7,7 @@ Writes fig5.png (bifurcation diagram: section points and X_max over Ω, coloured
 omega-2.6.png (the attractor at Ω = 2.6: time series, phase plane with its Poincaré section,
 Lyapunov spectrum, and the Floquet multipliers of the unstable period-1 orbit it came from) and
 prints what it found. ``--quick`` uses fewer sweep values and samples (what the tests run).
-An approach curve (amplitude against the tip–sample gap in physical units) will be added with
-the physical-units interface.
+An approach curve in SI from a probe file is in the notebook ``afmdyn_tour.ipynb``.
 """
 
 from __future__ import annotations

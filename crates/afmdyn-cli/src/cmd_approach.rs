@@ -43,6 +43,11 @@ pub struct CurveArgs {
     /// Files written: all (data and plots), data (no plots) or none (only the summary)
     #[arg(long, value_enum, default_value = "all")]
     files: Files,
+    /// Name and order the CSV/NPY columns as dForce 2.0's zcdom table (zc, Amplitude, Phase,
+    /// Distance_min, Force_max, Energy_diss, Virial1, …) for scripts written for it; the
+    /// default names them as the JSON document (z_c, amplitude, phase_deg, …)
+    #[arg(long)]
+    dforce_columns: bool,
     /// Print one JSON document
     #[arg(long)]
     json: bool,
@@ -258,8 +263,8 @@ fn columns(l: &Labels, u: &CurveUnits) -> Vec<Column> {
         ("g0", "F~", "F~ g0", "tau", "F~ g0 / tau")
     };
     let x_unit = match (l.x_name, u.si, u.hz_per_omega.is_some()) {
-        ("zc", true, _) => "m",
-        ("zc", false, _) => "g0",
+        ("z_c", true, _) => "m",
+        ("z_c", false, _) => "g0",
         (_, _, true) => "Hz",
         _ => "1",
     };
@@ -280,7 +285,8 @@ fn columns(l: &Labels, u: &CurveUnits) -> Vec<Column> {
         (time, "time in contact per period"),
         (power, "dissipated power: Energy_diss per period / period"),
     ];
-    let mut cols = vec![Column::new(l.x_name, x_unit, l.x_label.clone())];
+    let x_name = if l.x_name == "z_c" { "zc" } else { l.x_name };
+    let mut cols = vec![Column::new(x_name, x_unit, l.x_label.clone())];
     for (name, (unit, what)) in DFORCE.iter().zip(meaning) {
         cols.push(Column::new(*name, unit, what));
     }
@@ -327,19 +333,72 @@ fn columns(l: &Labels, u: &CurveUnits) -> Vec<Column> {
     cols
 }
 
-/// The CSV (the same numeric columns as the NPY, dForce's `zcdom` columns first), NPY and
-/// plots of one curve in `out`.
+/// The table's columns named and ordered as the JSON document ([`CURVE_COLUMNS`] after the
+/// abscissa), then afmdyn's own: (name, index in the dForce layout of [`row`]/[`columns`]).
+const JSON_LAYOUT: [(&str, usize); 19] = [
+    ("amplitude", 1),
+    ("amplitude_ratio", 11),
+    ("phase_deg", 2),
+    ("mean_deflection", 7),
+    ("peak_force", 12),
+    ("min_force", 13),
+    ("indentation", 14),
+    ("contact_fraction", 15),
+    ("min_distance", 3),
+    ("energy_dissipated", 5),
+    ("virial", 6),
+    ("harmonic_distortion", 16),
+    ("stable", 17),
+    ("period", 18),
+    ("sweep", 10),
+    ("event", 19),
+    ("contact_time", 8),
+    ("max_abs_force", 4),
+    ("power_dissipated", 9),
+];
+
+/// `table` and `cols` (dForce's layout) in the JSON layout ([`JSON_LAYOUT`]; the abscissa
+/// keeps its place and takes the JSON's name `x_json`).
+fn json_layout(
+    table: Vec<Vec<f64>>,
+    cols: Vec<Column>,
+    x_json: &str,
+) -> (Vec<Vec<f64>>, Vec<Column>) {
+    let mut named = vec![Column::new(x_json, cols[0].unit, cols[0].meaning.clone())];
+    named.extend(
+        JSON_LAYOUT
+            .iter()
+            .map(|(name, k)| Column::new(*name, cols[*k].unit, cols[*k].meaning.clone())),
+    );
+    let rows = table
+        .into_iter()
+        .map(|r| {
+            std::iter::once(r[0])
+                .chain(JSON_LAYOUT.iter().map(|(_, k)| r[*k]))
+                .collect()
+        })
+        .collect();
+    (rows, named)
+}
+
+/// The CSV (the same numeric columns as the NPY: named as the JSON document, or dForce's
+/// `zcdom` columns first with `dforce`), NPY and plots of one curve in `out`.
+#[allow(clippy::too_many_arguments)]
 fn write_files(
     out: &OutDir,
     files: Files,
+    dforce: bool,
     c: &SteppedCurve,
     x: &dyn Fn(f64) -> f64,
     u: &CurveUnits,
     l: &Labels,
     base: &Params,
 ) -> Result<(), CliError> {
-    let table = rows(c, x, u, base);
-    let cols = columns(l, u);
+    let (table, cols) = if dforce {
+        (rows(c, x, u, base), columns(l, u))
+    } else {
+        json_layout(rows(c, x, u, base), columns(l, u), l.x_name)
+    };
     let header: Vec<&str> = cols.iter().map(|c| c.name.as_str()).collect();
     write_csv(
         &out.join(format!("{}.csv", l.stem)),
@@ -383,7 +442,7 @@ fn plots(
             .expect("column")
     };
     let panels = [
-        if l.x_name == "zc" {
+        if l.x_name == "z_c" {
             ("amplitude_ratio", "A/A0".to_string(), "amplitude")
         } else {
             (
@@ -592,6 +651,7 @@ impl Run<'_> {
             write_files(
                 o,
                 self.args.files,
+                self.args.dforce_columns,
                 &c,
                 self.x,
                 self.units,
@@ -787,7 +847,7 @@ pub fn approach(a: &ApproachArgs) -> Result<(), CliError> {
     let labels = Labels {
         stem: "approach",
         sweeps: ("approach", "retract"),
-        x_name: "zc",
+        x_name: "z_c",
         x_label: format!(
             "rest distance z_c{}",
             if units.si { " (m)" } else { " (g0)" }

@@ -143,9 +143,113 @@ fn approach_writes_csv_npy_and_plots() {
     let csv = std::fs::read_to_string(dir.join("approach.csv")).unwrap();
     let mut lines = csv.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    // named as the JSON document (issue 28 item 8), the abscissa and its columns first
+    assert_eq!(
+        &header[..13],
+        &[
+            "z_c",
+            "amplitude",
+            "amplitude_ratio",
+            "phase_deg",
+            "mean_deflection",
+            "peak_force",
+            "min_force",
+            "indentation",
+            "contact_fraction",
+            "min_distance",
+            "energy_dissipated",
+            "virial",
+            "harmonic_distortion",
+        ]
+    );
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 22, "11 approach + 11 retract rows");
+    // the columns hold the JSON's values: the approach's rows are its sweep
+    let doc = json(&[
+        "approach",
+        "--probe",
+        "examples/probe-point-mass-dmt.toml",
+        "--from",
+        "11e-9",
+        "--to",
+        "6e-9",
+        "--points",
+        "11",
+        "--no-branches",
+        "--files",
+        "none",
+        "--json",
+    ]);
+    for (k, name) in header[..13].iter().enumerate() {
+        for (i, r) in rows[..11].iter().enumerate() {
+            let want = doc["approach"][*name][i].as_f64().unwrap();
+            assert!((r[k] - want).abs() <= 1e-9 * want.abs(), "{name} row {i}");
+        }
+    }
+    let meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("approach.npy.json")).unwrap())
+            .unwrap();
+    assert_eq!(meta["shape"][0], 22);
+    assert_eq!(meta["shape"][1], header.len());
+    assert_eq!(meta["columns"][3]["name"], "phase_deg");
+    assert_eq!(meta["columns"][3]["unit"], "deg");
+    for stem in ["amplitude", "phase", "dissipation", "virial", "peak-force"] {
+        assert!(dir.join(format!("approach-{stem}.png")).exists(), "{stem}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn dforce_columns_keep_the_zcdom_header_and_values() {
+    let dir = std::env::temp_dir().join(format!("afmdyn-dforce-cols-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let args = |dforce: bool, sub: &str| {
+        let mut a = vec![
+            "approach".to_string(),
+            "--probe".into(),
+            "examples/probe-point-mass-dmt.toml".into(),
+            "--from".into(),
+            "11e-9".into(),
+            "--to".into(),
+            "6e-9".into(),
+            "--points".into(),
+            "5".into(),
+            "--no-branches".into(),
+            "--files".into(),
+            "data".into(),
+            "--out".into(),
+            dir.join(sub).to_str().unwrap().into(),
+        ];
+        if dforce {
+            a.push("--dforce-columns".into());
+        }
+        a
+    };
+    let read = |sub: &str| -> (Vec<String>, Vec<Vec<f64>>) {
+        let csv = std::fs::read_to_string(dir.join(sub).join("approach.csv")).unwrap();
+        let mut lines = csv.lines();
+        let header = lines.next().unwrap().split(',').map(String::from).collect();
+        let rows = lines
+            .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+            .collect();
+        (header, rows)
+    };
+    for (dforce, sub) in [(true, "d"), (false, "j")] {
+        let a = args(dforce, sub);
+        let out = afmdyn(&a.iter().map(String::as_str).collect::<Vec<_>>());
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    let (dh, drows) = read("d");
+    let (jh, jrows) = read("j");
     // dForce 2.0's zcdom columns first, in its order (header of its zcdom*.csv)
     assert_eq!(
-        &header[..10],
+        &dh[..11],
         &[
             "zc",
             "Amplitude",
@@ -156,18 +260,29 @@ fn approach_writes_csv_npy_and_plots() {
             "Virial1",
             "Deflection",
             "Contact_time",
-            "Power_diss"
+            "Power_diss",
+            "sweep"
         ]
     );
-    assert_eq!(header[10], "sweep");
-    assert_eq!(lines.count(), 22, "11 approach + 11 retract rows");
-    let meta: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("approach.npy.json")).unwrap())
-            .unwrap();
-    assert_eq!(meta["shape"][0], 22);
-    assert_eq!(meta["shape"][1], header.len());
-    for stem in ["amplitude", "phase", "dissipation", "virial", "peak-force"] {
-        assert!(dir.join(format!("approach-{stem}.png")).exists(), "{stem}");
+    assert_eq!(dh.len(), jh.len());
+    // the same numbers under both names
+    let pairs = [
+        ("zc", "z_c"),
+        ("Amplitude", "amplitude"),
+        ("Phase", "phase_deg"),
+        ("Virial1", "virial"),
+        ("Energy_diss", "energy_dissipated"),
+        ("Force_max", "max_abs_force"),
+        ("Power_diss", "power_dissipated"),
+    ];
+    for (d, j) in pairs {
+        let (kd, kj) = (
+            dh.iter().position(|h| h == d).unwrap(),
+            jh.iter().position(|h| h == j).unwrap(),
+        );
+        for (rd, rj) in drows.iter().zip(&jrows) {
+            assert_eq!(rd[kd].to_bits(), rj[kj].to_bits(), "{d} = {j}");
+        }
     }
     let _ = std::fs::remove_dir_all(&dir);
 }

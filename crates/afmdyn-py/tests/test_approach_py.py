@@ -1,6 +1,8 @@
-"""``afmdyn.approach()`` and ``afmdyn.resonance()`` return the command line's documents
-(``afmdyn approach --json``, ``afmdyn resonance --json``): the same library call, so the same
-numbers, and bad input raises ValueError naming the option."""
+"""``afmdyn.approach()`` and ``afmdyn.resonance()`` return datasets whose
+``ds.afmdyn.to_dict()`` is the command line's document (``afmdyn approach --json``,
+``afmdyn resonance --json``): the same library call, so the same numbers; the dataset's
+variables are the document's columns in SI with their units; bad input raises ValueError
+naming the option."""
 
 from __future__ import annotations
 
@@ -16,7 +18,8 @@ PROBE = REPO / "examples" / "probe-point-mass-dmt.toml"
 
 def test_approach_equals_the_command_line(cli_json):
     args = dict(from_=11e-9, to=5e-9, points=7, branches=False)
-    doc = afmdyn.approach(afmdyn.Params.from_probe(PROBE), probe=PROBE, **args)
+    ds = afmdyn.approach(afmdyn.Params.from_probe(PROBE), probe=PROBE, **args)
+    doc = ds.afmdyn.to_dict()
     ref = cli_json(
         "approach", "--probe", str(PROBE), "--from", "11e-9", "--to", "5e-9", "--points", "7",
         "--no-branches", "--files", "none",
@@ -25,13 +28,22 @@ def test_approach_equals_the_command_line(cli_json):
         for key in ("z_c", "amplitude", "phase_deg", "energy_dissipated", "virial", "stable"):
             assert doc[sweep][key] == ref[sweep][key], (sweep, key)
     assert doc["jumps"] == ref["jumps"]
+    # the dataset: both sweeps over the approach's grid, the retract's values at its z_c
+    assert ds.z_c.values.tolist() == ref["approach"]["z_c"]
+    assert ds.amplitude.sel(sweep="approach").values.tolist() == ref["approach"]["amplitude"]
+    retract = ds.phase_deg.sel(sweep="retract").values[::-1].tolist()
+    assert retract == ref["retract"]["phase_deg"]
+    assert ds.amplitude.attrs["units"] == "m" and ds.phase_deg.attrs["units"] == "degree"
+    assert ds.energy_dissipated.attrs["units"] == "J" and ds.peak_force.attrs["units"] == "N"
 
 
 def test_resonance_equals_the_command_line(cli_json):
-    doc = afmdyn.resonance(points=5, branches=False)
+    ds = afmdyn.resonance(points=5, branches=False)
     ref = cli_json("resonance", "--points", "5", "--no-branches", "--files", "none")
-    assert doc["up"]["omega"] == ref["up"]["omega"]
-    assert doc["down"]["amplitude"] == ref["down"]["amplitude"]
+    assert ds.afmdyn.to_dict() == ref
+    assert ds.omega.values.tolist() == ref["up"]["omega"]
+    assert ds.amplitude.sel(sweep="down").values[::-1].tolist() == ref["down"]["amplitude"]
+    assert ds.amplitude.attrs["units"] == "g0" and ds.sizes["branch_point"] == 0
 
 
 def test_bad_grids_raise_value_error():
@@ -65,7 +77,7 @@ def test_setpoint_equals_the_command_line(cli_json):
     """``setpoint=`` adds the command line's ``"setpoint"`` block: operating points on the
     stable branches where A/A₀ equals it, the attractive one with its phase above 90°."""
     args = dict(from_=11e-9, to=5e-9, points=31, setpoint=0.85)
-    doc = afmdyn.approach(probe=str(PROBE), **args)
+    doc = afmdyn.approach(probe=str(PROBE), **args).afmdyn.to_dict()
     cli = cli_json("approach", "--probe", str(PROBE), "--from", "11e-9", "--to", "5e-9",
                    "--points", "31", "--setpoint", "0.85", "--files", "none")
     assert doc["setpoint"] == cli["setpoint"]
@@ -88,7 +100,8 @@ def test_traces_equal_the_command_line(cli_json, tmp_path):
     import xarray as xr
 
     args = dict(from_=11e-9, to=5e-9, points=5, branches=False, traces=16)
-    doc = afmdyn.approach(probe=str(PROBE), **args)
+    ds = afmdyn.approach(probe=str(PROBE), **args)
+    doc = ds.afmdyn.to_dict()
     cli = cli_json("approach", "--probe", str(PROBE), "--from", "11e-9", "--to", "5e-9",
                    "--points", "5", "--no-branches", "--traces", "16", "--out", str(tmp_path),
                    "--files", "data")
@@ -97,6 +110,8 @@ def test_traces_equal_the_command_line(cli_json, tmp_path):
     assert t["z_c"] == doc["approach"]["z_c"] and len(t["time_periods"]) == 16
     nc = xr.open_dataset(tmp_path / "approach-traces.nc")
     np.testing.assert_allclose(nc.force.values, np.array(t["force"]), rtol=0, atol=0)
+    np.testing.assert_array_equal(ds.trace_force.values, nc.force.values)
+    assert ds.trace_z_c.values.tolist() == t["z_c"] and ds.trace_force.attrs["units"] == "N"
     gap = np.array(t["distance"]) - np.array(t["deflection"])
     assert np.allclose(gap, gap[:, :1], rtol=0, atol=1e-18)
     with pytest.raises(ValueError, match="traces = 1"):

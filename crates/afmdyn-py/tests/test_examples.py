@@ -16,7 +16,13 @@ def test_notebook_executes_and_shows_the_results():
     nbformat = pytest.importorskip("nbformat")
     nbclient = pytest.importorskip("nbclient")
     nb = nbformat.read(EXAMPLES / "afmdyn_tour.ipynb", as_version=4)
-    nbclient.NotebookClient(nb, timeout=600, kernel_name="python3", allow_errors=False).execute()
+    nbclient.NotebookClient(
+        nb,
+        timeout=600,
+        kernel_name="python3",
+        allow_errors=False,
+        resources={"metadata": {"path": str(EXAMPLES)}},  # run where Jupyter would
+    ).execute()
     text = []
     figures = 0
     for cell in nb.cells:
@@ -31,7 +37,9 @@ def test_notebook_executes_and_shows_the_results():
     assert "7.79,  20.33,  55.81" in text  # paper eq. 25
     assert "Attractor(nonperiodic" in text
     assert "chaotic" in text and "'critical': 'period-doubling'" in text
-    assert figures == 3
+    # the SI approach curve from a probe file: its bistable range and both setpoint regimes
+    assert "bistable z_c (nm): [[" in text and "'attractive'" in text and "'repulsive'" in text
+    assert figures == 4
 
 
 def test_script_writes_the_figures(tmp_path):

@@ -129,7 +129,7 @@ def test_a_probe_alone_runs_the_probe_not_the_paper_default() -> None:
     """`afmdyn.approach(probe=...)` ran the paper's linear beam scaled to SI (A = 4.6 nm for a
     probe with A0 = 10 nm): the probe's set is now the model, as `--probe` on the command
     line."""
-    doc = afmdyn.approach(probe=PM, from_=20e-9, to=2e-9, points=10, branches=False)
+    doc = afmdyn.approach(probe=PM, from_=20e-9, to=2e-9, points=10, branches=False).afmdyn.to_dict()
     probe = afmdyn.probe(PM)
     assert doc["params"] == probe["params"].to_dict()
     assert doc["params"]["structure"] == "point-mass"

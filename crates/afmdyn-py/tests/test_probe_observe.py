@@ -46,18 +46,20 @@ def test_observe_free_oscillation_matches_closed_form():
     # (at 10⁴ A₀ the van der Waals force H̃/d² is 1e-13 of kA₀)
     p = afmdyn.Params.from_probe(PM, gap=1e4)
     o = afmdyn.observe(p)
-    assert o["period"] == 1
+    assert o.period == 1
     # (the adaptive integrator at its default tolerance 1e-12; the library's own test reaches
     # 1e-9 at 1e-14)
-    assert o["amplitude"] == pytest.approx(1.0, rel=1e-8)
-    assert math.degrees(o["phase"]) == pytest.approx(90.0, abs=1e-7)
-    assert o["contact_fraction"] == 0.0
+    assert float(o.amplitude) == pytest.approx(1.0, rel=1e-8)
+    assert float(o.phase_deg) == pytest.approx(90.0, abs=1e-7)
+    assert o.contact_fraction == 0.0
+    doc = o.afmdyn.to_dict()
+    assert math.degrees(doc["phase"]) == float(o.phase_deg) and doc["period"] == 1
 
 
 def test_observe_tapping_repulsive_regime():
     # z_c = 8 nm < A0 = 10 nm: the amplitude drops below A0 and, in
     # the repulsive regime (phase < 90 deg), the virial is negative (San Paulo & Garcia 2001)
-    o = afmdyn.observe(afmdyn.Params.from_probe(PM))
+    o = afmdyn.observe(afmdyn.Params.from_probe(PM)).afmdyn.to_dict()
     assert 0.5 < o["amplitude"] < 1.0
     assert o["peak_force"] > 0 and o["contact_fraction"] > 0
     # DMT without viscosity is conservative: no energy goes into the sample
@@ -87,3 +89,24 @@ def test_cantilever_library(tmp_path):
     bad.write_text('[cantilever]\nname = "rtespa"\n' + sample)
     with pytest.raises(ValueError, match="RTESPA-150, RTESPA-300"):
         afmdyn.Params.from_probe(str(bad))
+
+
+def test_observe_with_a_probe_is_in_si():
+    """Issue 28 item 8: ``observe(probe=...)`` returned dimensionless values with the phase in
+    radians; its dataset is in SI (the probe's scales times the library's dimensionless
+    observables, which the summary keeps) with degrees, units in the attrs."""
+    ds = afmdyn.observe(probe=str(PM))
+    doc = ds.afmdyn.to_dict()
+    s = afmdyn.probe(PM)["si"]["scales"]
+    assert float(ds.amplitude) == pytest.approx(doc["amplitude"] * s["length_m"], rel=1e-15)
+    assert 5e-9 < float(ds.amplitude) < 1e-8  # A0 = 10 nm, z_c = 8 nm
+    assert float(ds.peak_force) == pytest.approx(doc["peak_force"] * s["force_n"], rel=1e-15)
+    assert float(ds.virial) == pytest.approx(doc["virial"] * s["energy_j"], rel=1e-15)
+    assert float(ds.contact_time) == pytest.approx(doc["contact_time"] * s["time_s"], rel=1e-15)
+    assert float(ds.phase_deg) == pytest.approx(math.degrees(doc["phase"]), rel=1e-15)
+    h = ds.harmonic_amplitude.sel(harmonic=2)
+    assert float(h) == pytest.approx(doc["harmonics"][1]["amplitude"] * s["length_m"], rel=1e-15)
+    units = {v: ds[v].attrs["units"] for v in ("amplitude", "peak_force", "virial", "phase_deg")}
+    assert units == {"amplitude": "m", "peak_force": "N", "virial": "J", "phase_deg": "degree"}
+    assert float(ds.mode_sample.sel(mode=0)) == pytest.approx(
+        doc["mode_balance"][0]["sample"] * s["energy_j"], rel=1e-15, abs=1e-40)

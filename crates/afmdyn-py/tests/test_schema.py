@@ -179,14 +179,14 @@ def _python_docs() -> List[Tuple[str, str, Callable[[], Any]]]:
             afmdyn.continuation(from_=3.0, to=2.5, max_periods=300))),
         ("lyapunov", "lyapunov", lambda: afmdyn.lyapunov(**lyap).to_dict()),
         ("lyapunov", "lyapunov probe", lambda: afmdyn.lyapunov(probe=P1, **lyap).to_dict()),
-        ("approach", "approach", lambda: afmdyn.approach(**curve)),
-        ("approach", "approach probe", lambda: afmdyn.approach(probe=P1, **curve)),
-        ("resonance", "resonance", lambda: afmdyn.resonance(**curve)),
-        ("resonance", "resonance probe z_c", lambda: afmdyn.resonance(
-            probe=P1, z_c=7e-9, **curve)),
-        ("observe", "observe", lambda: afmdyn.observe()),
-        ("observe", "observe probe", lambda: afmdyn.observe(probe=P1)),
-        ("observe", "observe impact", lambda: afmdyn.observe(**IMPACT_PY)),
+        ("approach", "approach", lambda: afmdyn.summary(afmdyn.approach(**curve))),
+        ("approach", "approach probe", lambda: afmdyn.summary(afmdyn.approach(probe=P1, **curve))),
+        ("resonance", "resonance", lambda: afmdyn.summary(afmdyn.resonance(**curve))),
+        ("resonance", "resonance probe z_c", lambda: afmdyn.summary(afmdyn.resonance(
+            probe=P1, z_c=7e-9, **curve))),
+        ("observe", "observe", lambda: afmdyn.summary(afmdyn.observe())),
+        ("observe", "observe probe", lambda: afmdyn.summary(afmdyn.observe(probe=P1))),
+        ("observe", "observe impact", lambda: afmdyn.summary(afmdyn.observe(**IMPACT_PY))),
     ]
 
 
@@ -260,7 +260,7 @@ def test_each_schema_refuses_a_missing_key_and_an_unknown_one(
 
 
 def test_observe_schema_refuses_a_missing_key() -> None:
-    doc = plain(afmdyn.observe())
+    doc = afmdyn.summary(afmdyn.observe())
     v = validator("observe")
     for key in ["amplitude", "closed_form", "state", "period"]:
         broken = dict(doc)

@@ -10,7 +10,7 @@ use crate::analysis::continuation::Branch;
 use crate::analysis::converge::ConvergenceRun;
 use crate::analysis::global_continuation::ContinuationStep;
 use crate::analysis::lyapunov::LyapunovSpectrum;
-use crate::analysis::observables::Observables;
+use crate::analysis::observables::{ModeBalance, Observables};
 use crate::analysis::shooting::PeriodicOrbit;
 use crate::analysis::steady::SteadyState;
 use crate::analysis::stepped::{CurvePoint, SteppedCurve, Sweep};
@@ -372,6 +372,52 @@ pub fn curve_row(o: &Observables, u: &CurveUnits) -> [f64; 12] {
         o.virial * u.energy,
         o.thd,
     ]
+}
+
+/// The observables of one steady state in `u`'s units — SI for a probe's model (m, N, J, s),
+/// the model's own otherwise (g₀, F̃, F̃·g₀, τ) — with phases in degrees: the [`CURVE_COLUMNS`]
+/// (as [`curve_row`]), then `contact_time`, `mean_force`, `impacts_per_period`, `impact_loss`,
+/// `harmonics` (arrays `n`, `amplitude`, `phase_deg`), `mode_balance` (arrays `mode`, `drive`,
+/// `beam_damping`, `sample`, `coupling`, `energy_change`, `residual`; energies per drive period)
+/// and `units` (the names). The `"reported"` block of `observe`'s document, which Python's
+/// dataset is built from.
+pub fn observed(o: &Observables, u: &CurveUnits) -> Value {
+    let mut m = serde_json::Map::new();
+    for (name, v) in CURVE_COLUMNS.iter().zip(curve_row(o, u)) {
+        m.insert((*name).into(), json!(v));
+    }
+    m.insert("contact_time".into(), json!(o.contact_time * u.time));
+    m.insert("mean_force".into(), json!(o.mean_force * u.force));
+    m.insert("impacts_per_period".into(), json!(o.impacts_per_period));
+    m.insert("impact_loss".into(), json!(o.impact_loss * u.energy));
+    let h = &o.harmonics;
+    m.insert(
+        "harmonics".into(),
+        json!({
+            "n": h.iter().map(|h| h.n).collect::<Vec<_>>(),
+            "amplitude": h.iter().map(|h| h.amplitude * u.length).collect::<Vec<_>>(),
+            "phase_deg": h.iter().map(|h| h.phase.to_degrees()).collect::<Vec<_>>(),
+        }),
+    );
+    let b = &o.mode_balance;
+    let energies =
+        |f: fn(&ModeBalance) -> f64| -> Vec<f64> { b.iter().map(|x| f(x) * u.energy).collect() };
+    m.insert(
+        "mode_balance".into(),
+        json!({
+            "mode": b.iter().map(|x| x.mode).collect::<Vec<_>>(),
+            "drive": energies(|x| x.drive),
+            "beam_damping": energies(|x| x.beam_damping),
+            "sample": energies(|x| x.sample),
+            "coupling": energies(|x| x.coupling),
+            "energy_change": energies(|x| x.energy_change),
+            "residual": energies(|x| x.residual),
+        }),
+    );
+    let mut units = u.names();
+    units["time"] = json!(if u.si { "s" } else { "τ" });
+    m.insert("units".into(), units);
+    Value::Object(m)
 }
 
 /// The abscissa of a stepped curve: (key, value of the swept parameter → reported value).

@@ -41,6 +41,7 @@ import xarray as xr
 from . import _afmdyn as _core
 from ._afmdyn import Params
 from ._progress import ProgressArg, reporter
+from ._curves import curve_dataset, observe_dataset
 from ._results import Attractor, Attractors, Lyapunov, Orbit, RegionSpectrum, Spectrum
 
 if TYPE_CHECKING:  # annotations only (PEP 692): editors complete and check the keywords
@@ -222,8 +223,9 @@ def _run(
 
 
 def summary(ds: xr.Dataset) -> Dict[str, Any]:
-    """The command line's ``--json`` summary stored with a dataset (``simulate``,
-    ``converge`` without its output path, ``continuation``)."""
+    """The command line's ``--json`` document stored with a dataset afmdyn returned
+    (``simulate``, ``converge``, ``continuation``, ``approach``, ``resonance``, ``observe``,
+    ``basins``, ``global_continuation``); the same as ``ds.afmdyn.to_dict()``."""
     return json.loads(ds.attrs["summary"])
 
 
@@ -916,7 +918,7 @@ def observe(
     max_period: int = 64,
     progress: ProgressArg = None,
     **model: Unpack[Model],
-) -> Dict[str, Any]:
+) -> xr.Dataset:
     """Observables of the steady state reached from ``initial`` (default: rest): first-harmonic
     amplitude and phase lag of the tip deflection, harmonics and THD, mean deflection, peak and
     minimum force, indentation, contact fraction and time, minimum distance, impacts, the energy
@@ -925,12 +927,19 @@ def observe(
 
     The steady state is found as by :func:`orbit` and, when periodic, polished by Newton
     shooting; ``periods`` orbit periods are integrated on the dense output (no sampling).
-    Dimensionless units (lengths g₀, time τ, forces F̃; phases in radians); with a probe,
-    multiply by the scales of :func:`probe`.
 
     Returns:
-        The observables document (``afmdyn.analysis.observables``) plus ``state`` (the start,
-        ``[2N]``) and ``period`` (n of the period-n motion, ``None`` when not periodic).
+        An ``xarray.Dataset`` in SI with a probe (m, N, J, s; the model's units g₀, F̃, F̃·g₀,
+        τ otherwise; ``units`` in each variable's attrs), phases in degrees: scalars
+        ``amplitude``, ``amplitude_ratio``, ``phase_deg``, ``mean_deflection``,
+        ``peak_force``, ``min_force``, ``indentation``, ``contact_fraction``,
+        ``min_distance``, ``energy_dissipated``, ``virial``, ``harmonic_distortion``,
+        ``contact_time``, ``mean_force``, ``impacts_per_period``, ``impact_loss``, ``period``
+        (NaN when not periodic); ``harmonic_amplitude``/``harmonic_phase_deg`` over
+        ``harmonic``; the energy balance ``mode_drive``, ``mode_sample``, … over ``mode``;
+        ``state`` ``[2N]`` (a, ȧ). ``ds.afmdyn.to_dict()`` is the library's document
+        (dimensionless, phases in radians, the closed forms; its ``reported`` block holds the
+        dataset's values).
     """
     p, probe = _params(params, model)
     d = _run(
@@ -949,7 +958,7 @@ def observe(
     doc: Dict[str, Any] = json.loads(d["json"])
     doc["state"] = d["state"]
     doc["period"] = d["period"]
-    return doc
+    return observe_dataset(doc)
 
 
 def _curve(
@@ -959,13 +968,12 @@ def _curve(
     params: Optional[Params],
     model: Any,
     **options: Any,
-) -> Dict[str, Any]:
+) -> xr.Dataset:
     """Run a stepped-curve analysis (:func:`approach`, :func:`resonance`) and return its
-    JSON document (in SI with a probe)."""
+    dataset (:func:`afmdyn._curves.curve_dataset`; in SI with a probe)."""
     p, probe = _params(params, model)
     d = _run(fn, desc, progress, p, probe=probe, **options)
-    doc: Dict[str, Any] = json.loads(d["json"])
-    return doc
+    return curve_dataset(desc, json.loads(d["json"]))
 
 
 @_typed
@@ -983,7 +991,7 @@ def approach(
     traces: Optional[int] = None,
     progress: ProgressArg = None,
     **model: Unpack[Model],
-) -> Dict[str, Any]:
+) -> xr.Dataset:
     """The amplitude-modulation approach–retract curve over the rest distance z_c
     (``afmdyn approach``): the steady state stepped from ``from_`` down to ``to`` and back, each
     value continued from the previous orbit, plus the periodic-orbit branches continued in z_c
@@ -1006,9 +1014,17 @@ def approach(
             scales give SI inputs (``from_``, ``to``, ``step`` in m) and outputs.
 
     Returns:
-        The ``afmdyn approach --json`` document: ``approach`` and ``retract`` (equal-length
-        lists ``z_c``, ``amplitude``, ``phase_deg``, …, ``stable``), ``branches``, ``folds``,
-        ``bistable``, ``jumps`` (``docs/outputs.md``).
+        An ``xarray.Dataset`` (SI with a probe: m, N, J, degrees; ``units`` in each variable's
+        attrs) over ``z_c`` (the approach's grid) and ``sweep`` = ``approach``/``retract``:
+        ``amplitude``, ``amplitude_ratio``, ``phase_deg``, ``mean_deflection``,
+        ``peak_force``, ``min_force``, ``indentation``, ``contact_fraction``,
+        ``min_distance``, ``energy_dissipated``, ``virial``, ``harmonic_distortion``,
+        ``stable``, ``period``, ``reached``; the branches along ``branch_point``
+        (``branch``, ``branch_z_c``, ``branch_amplitude``, …, ``branch_event``); with
+        ``traces``, ``trace_deflection``/``trace_distance``/``trace_force`` over (``trace``,
+        ``trace_time``). ``ds.afmdyn.to_dict()`` is the ``afmdyn approach --json`` document
+        (``folds``, ``bistable``, ``jumps``, ``setpoint``, ``warnings``;
+        ``docs/outputs.md``).
     """
     return _curve(
         _core.approach,
@@ -1042,7 +1058,7 @@ def resonance(
     traces: Optional[int] = None,
     progress: ProgressArg = None,
     **model: Unpack[Model],
-) -> Dict[str, Any]:
+) -> xr.Dataset:
     """Amplitude and phase against the drive frequency near mode ``mode``
     (``afmdyn resonance``): up- and down-sweep, each value continued from the previous orbit,
     plus the branches continued in Ω with their folds (the bent, multivalued resonance curves of
@@ -1055,9 +1071,9 @@ def resonance(
             sets the model and gives frequencies in Hz.
 
     Returns:
-        The ``afmdyn resonance --json`` document: ``up`` and ``down`` (``omega`` or
-        ``frequency_hz``, ``amplitude``, ``phase_deg``, …), ``branches``, ``folds``,
-        ``bistable``, ``jumps``.
+        An ``xarray.Dataset`` as :func:`approach`'s over ``frequency_hz`` (with a probe) or
+        ``omega`` and ``sweep`` = ``up``/``down``; ``ds.afmdyn.to_dict()`` is the
+        ``afmdyn resonance --json`` document.
     """
     return _curve(
         _core.resonance,

@@ -208,8 +208,14 @@ impl Analysis for ObserveRequest {
     fn execute(&self, model: &Resolved, _: &Progress) -> Result<Self::Output, SimError> {
         self.run(&model.params)
     }
-    fn report(&self, _: &Resolved, o: &Self::Output) -> Result<Value, SimError> {
-        Ok(report::observables(&o.observables))
+    fn report(&self, model: &Resolved, o: &Self::Output) -> Result<Value, SimError> {
+        let units = match &model.probe {
+            Some(p) => CurveUnits::from_scales(&p.scales, false),
+            None => CurveUnits::dimensionless(),
+        };
+        let mut doc = report::observables(&o.observables);
+        doc["reported"] = report::observed(&o.observables, &units);
+        Ok(doc)
     }
 }
 
