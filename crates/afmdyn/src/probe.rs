@@ -12,14 +12,14 @@
 //! # ... or geometry: length, width, thickness, youngs_modulus, density, tip_mass (+ quality_factor)
 //! [tip]
 //! radius = 10e-9                 # R (m)
-//! youngs_modulus = 130e9         # E_t (Pa)
-//! poisson_ratio = 0.27           # ν_t
+//! youngs_modulus = 130e9         # E_t (Pa), default 130e9 (silicon, Hopcroft et al. 2010)
+//! poisson_ratio = 0.27           # ν_t, default 0.28 (silicon)
 //! [sample]
 //! law = "dmt"                    # linear | hertz | dmt | impact
 //! youngs_modulus = 4e9           # E_s (Pa)            (hertz, dmt)
 //! poisson_ratio = 0.33           # ν_s                 (hertz, dmt)
 //! hamaker = 6.6e-20              # H (J)               (dmt)
-//! intermolecular_distance = 0.165e-9  # a₀ (m)         (dmt)
+//! intermolecular_distance = 0.165e-9  # a₀ (m), default 0.165e-9 (Israelachvili) (dmt)
 //! viscosity = 0.0                # η (Pa·s), Kelvin–Voigt −η√(R(a₀ − d))·ḋ (dmt)
 //! # hertz: damping (N·s/m); linear: stiffness (N/m), damping (N·s/m); impact: restitution
 //! z_c = 8e-9                     # optional rest tip–sample distance (m), default A₀
@@ -65,7 +65,13 @@
 //! The rest distance z_c sets α5 = z_c/g₀ − ã₀ (DMT) or z_c/g₀ ([`crate::Params::rest_distance`]).
 //!
 //! **Errors.** Every problem of a file is collected: unknown keys, missing keys (named with their
-//! section) and values out of range, all listed in one [`ProbeError::Invalid`].
+//! section), values out of range and values 1e3–1e12 off any probe's scale (a radius of 10 m,
+//! a modulus of 4 Pa, a resonance at 300 Hz: read as a unit slip, with the reading meant), all
+//! listed in one [`ProbeError::Invalid`].
+
+/// The intermolecular distance a₀ of the DMT law when a probe file omits it, m
+/// (Israelachvili 2011, §13.6).
+pub const DEFAULT_INTERMOLECULAR_DISTANCE: f64 = 0.165e-9;
 
 use crate::contact::ContactLaw;
 use crate::galerkin::{Galerkin, Region};
@@ -300,6 +306,11 @@ impl Reader<'_> {
         (range, ok): (&str, fn(f64) -> bool),
     ) -> Option<f64> {
         if x.is_finite() && ok(x) {
+            if let Some(hint) = scale_hint(section, key, x) {
+                self.problems
+                    .push(format!("{}{key} = {x} ({unit}): {hint}", prefix(section)));
+                return None;
+            }
             Some(x)
         } else {
             self.problems.push(format!(
@@ -320,6 +331,38 @@ impl Reader<'_> {
                 None
             }
         }
+    }
+}
+
+/// A value that is a unit slip rather than a measurement — a tip radius of 10 m written for
+/// 10 nm, a modulus of 4 Pa for 4 GPa, a resonance at 300 Hz for 300 kHz (below 1 kHz), a Hamaker constant
+/// of 6.6 J for 6.6e-20 J: values 1e3–1e12 off the range any AFM probe or sample takes, refused
+/// with the reading that was probably meant. `None` for a plausible value.
+fn scale_hint(section: &str, key: &str, x: f64) -> Option<String> {
+    let nano = |what: &str| {
+        format!("longer than 100 µm for {what}; probe files are in metres: {x} nm is {x}e-9")
+    };
+    match (section, key) {
+        ("tip", "radius") if x > 1e-4 => Some(nano("a tip radius")),
+        ("sample", "intermolecular_distance") if x > 1e-6 => Some(nano("a₀ (0.165e-9 m typical)")),
+        ("sample", "z_c") if x.abs() > 1e-4 => Some(nano("a rest distance")),
+        ("cantilever", "length" | "width" | "thickness") if x > 1e-2 => Some(format!(
+            "longer than 1 cm for a cantilever; probe files are in metres: {x} µm is {x}e-6"
+        )),
+        ("tip", "youngs_modulus") if x < 1e6 => Some(format!(
+            "below 1 MPa for a tip; moduli are in Pa: {x} GPa is {x}e9"
+        )),
+        ("sample", "youngs_modulus") if x < 100.0 => Some(format!(
+            "below 100 Pa (softer than any cell); moduli are in Pa: {x} MPa is {x}e6, {x} GPa \
+             is {x}e9"
+        )),
+        ("cantilever", "resonance_frequency") | ("drive", "frequency") if x < 1e3 => Some(format!(
+            "below 1 kHz for a cantilever; frequencies are in Hz: {x} kHz is {x}e3"
+        )),
+        ("sample", "hamaker") if x > 1e-17 => Some(format!(
+            "above 1e-17 J (Hamaker constants are ~1e-20 J); in J: {x}e-20"
+        )),
+        _ => None,
     }
 }
 
@@ -488,6 +531,14 @@ impl Probe {
             radius = r.optional(t, "tip", "radius", "m", POSITIVE);
             tip_e = r.optional(t, "tip", "youngs_modulus", "Pa", POSITIVE);
             tip_nu = r.optional(t, "tip", "poisson_ratio", "1", POISSON);
+            // a silicon tip where the section omits its elastic constants (Hopcroft, Nix &
+            // Kenny, J. Microelectromech. Syst. 19 (2010) 229: E = 130 GPa, ν = 0.28)
+            if !t.contains_key("youngs_modulus") {
+                tip_e = Some(crate::cantilevers::SILICON_YOUNGS_MODULUS);
+            }
+            if !t.contains_key("poisson_ratio") {
+                tip_nu = Some(crate::cantilevers::SILICON_POISSON_RATIO);
+            }
         }
         // [sample]
         let sample = r
@@ -718,22 +769,16 @@ impl Probe {
             }
             _ => {}
         }
-        // hertz and dmt need the tip
+        // hertz and dmt need the tip (its radius; E and ν default to silicon's)
         if tip.is_none() {
             r.problems.push(format!(
-                "missing table [tip] (the {law} law needs radius, youngs_modulus, poisson_ratio)"
+                "missing table [tip] (the {law} law needs the tip radius; youngs_modulus and \
+                 poisson_ratio default to silicon's)"
             ));
-        } else {
-            for (key, v) in [
-                ("radius", radius),
-                ("youngs_modulus", tip_e),
-                ("poisson_ratio", tip_nu),
-            ] {
-                if v.is_none() && !tip.is_some_and(|t| t.contains_key(key)) {
-                    r.problems
-                        .push(format!("missing key [tip].{key} (needed by the {law} law)"));
-                }
-            }
+        } else if radius.is_none() && !tip.is_some_and(|t| t.contains_key("radius")) {
+            r.problems.push(format!(
+                "missing key [tip].radius (m, needed by the {law} law)"
+            ));
         }
         let e_s = r.required(s, S, "youngs_modulus", "Pa", POSITIVE);
         let nu_s = r.required(s, S, "poisson_ratio", "1", POISSON);
@@ -745,7 +790,14 @@ impl Probe {
             out.damping = r.optional(s, S, "damping", "N s/m", NON_NEGATIVE);
         } else {
             out.hamaker = r.required(s, S, "hamaker", "J", NON_NEGATIVE);
-            out.a0 = r.required(s, S, "intermolecular_distance", "m", POSITIVE);
+            // a₀ = 0.165 nm when omitted (Israelachvili, Intermolecular and Surface Forces,
+            // 3rd ed., Academic Press 2011, §13.6: the contact separation D₀ that gives
+            // surface energies from Hamaker constants; García & San Paulo 1999 use it)
+            out.a0 = if s.contains_key("intermolecular_distance") {
+                r.optional(s, S, "intermolecular_distance", "m", POSITIVE)
+            } else {
+                Some(DEFAULT_INTERMOLECULAR_DISTANCE)
+            };
             out.viscosity = r.optional(s, S, "viscosity", "Pa s", NON_NEGATIVE);
         }
         out.e_star.and(out.radius).map(|_| out)

@@ -309,14 +309,19 @@ poisson_ratio = 0.7
         "missing key modes",
         "[cantilever].spring_constant = -1",
         "missing key [cantilever].resonance_frequency",
-        "missing key [tip].youngs_modulus",
-        "missing key [tip].poisson_ratio",
         "[sample].poisson_ratio = 0.7",
         "missing key [sample].hamaker",
-        "missing key [sample].intermolecular_distance",
         "missing table [drive]",
     ] {
         assert!(all.contains(needle), "'{needle}' not in:\n{all}");
+    }
+    // the tip's E and ν and a₀ have documented defaults: never reported missing
+    for default in [
+        "[tip].youngs_modulus",
+        "[tip].poisson_ratio",
+        "intermolecular_distance",
+    ] {
+        assert!(!all.contains(default), "'{default}' in:\n{all}");
     }
     // one readable line
     let msg = Probe::parse(text, "p.toml").unwrap_err().to_string();
@@ -427,4 +432,94 @@ fn law_names_are_read_in_any_case() {
         let p = Probe::parse(&text, "test").unwrap();
         assert_eq!(p.params, lower.params, "{name}");
     }
+}
+
+/// Issue 28 item 6: a tip section without E and ν is a silicon tip (Hopcroft et al. 2010:
+/// 130 GPa, 0.28) and a DMT sample without a₀ has a₀ = 0.165 nm (Israelachvili 2011): the
+/// parameters equal those of the file with the values written out.
+#[test]
+fn omitted_tip_constants_and_a0_take_their_documented_defaults() {
+    let full = std::fs::read_to_string("../../examples/probe-point-mass-dmt.toml").unwrap();
+    let mut lines: Vec<String> = full.lines().map(String::from).collect();
+    let set = |lines: &mut Vec<String>, key: &str, value: &str| {
+        for l in lines.iter_mut() {
+            if l.trim_start().starts_with(&format!("{key} ")) && l.contains('=') {
+                *l = format!("{key} = {value}");
+            }
+        }
+    };
+    // the written-out file with the defaults' values in the tip and for a₀
+    let mut written = lines.clone();
+    let mut in_tip = false;
+    for l in written.iter_mut() {
+        if l.starts_with('[') {
+            in_tip = l.trim() == "[tip]";
+        } else if in_tip && l.starts_with("youngs_modulus") {
+            *l = "youngs_modulus = 130e9".into();
+        } else if in_tip && l.starts_with("poisson_ratio") {
+            *l = "poisson_ratio = 0.28".into();
+        }
+    }
+    set(&mut written, "intermolecular_distance", "0.165e-9");
+    // the same file without them
+    let mut in_tip = false;
+    lines.retain(|l| {
+        if l.starts_with('[') {
+            in_tip = l.trim() == "[tip]";
+        }
+        !(in_tip && (l.starts_with("youngs_modulus") || l.starts_with("poisson_ratio")))
+            && !l.starts_with("intermolecular_distance")
+    });
+    let short = lines.join("\n");
+    assert!(!short.contains("intermolecular_distance"));
+    let a = Probe::parse(&written.join("\n"), "written.toml").unwrap();
+    let b = Probe::parse(&short, "short.toml").unwrap();
+    assert_eq!(a.params, b.params);
+    assert_eq!(
+        afmdyn::probe::DEFAULT_INTERMOLECULAR_DISTANCE,
+        0.165e-9,
+        "Israelachvili's D0"
+    );
+}
+
+/// Issue 28 item 6: values a unit slip away from any probe (a tip radius of 10 m for 10 nm, a
+/// sample modulus of 4 Pa for 4 GPa, f0 = 300 Hz for 300 kHz, H = 6.6 J) are refused with the
+/// reading that was meant, all at once.
+#[test]
+fn unit_slips_are_refused_with_the_meant_reading() {
+    let full = std::fs::read_to_string("../../examples/probe-point-mass-dmt.toml").unwrap();
+    let mut text = String::new();
+    let mut section = String::new();
+    for l in full.lines() {
+        if l.starts_with('[') {
+            section = l.trim().to_string();
+        }
+        let key = l.split('=').next().unwrap_or("").trim();
+        let line = match (section.as_str(), key) {
+            ("[tip]", "radius") => "radius = 10".to_string(),
+            ("[sample]", "youngs_modulus") => "youngs_modulus = 4".to_string(),
+            ("[sample]", "hamaker") => "hamaker = 6.6".to_string(),
+            ("[cantilever]", "resonance_frequency") => "resonance_frequency = 300".to_string(),
+            _ => l.to_string(),
+        };
+        text.push_str(&line);
+        text.push('\n');
+    }
+    let Err(ProbeError::Invalid { problems, .. }) = Probe::parse(&text, "slips.toml") else {
+        panic!("must fail")
+    };
+    let all = problems.join("\n");
+    for needle in [
+        "[tip].radius = 10 (m): longer than 100 µm for a tip radius; probe files are in metres: \
+         10 nm is 10e-9",
+        "[sample].youngs_modulus = 4 (Pa): below 100 Pa",
+        "4 GPa is 4e9",
+        "[sample].hamaker = 6.6 (J): above 1e-17 J",
+        "[cantilever].resonance_frequency = 300 (Hz): below 1 kHz for a cantilever; \
+         frequencies are in Hz: 300 kHz is 300e3",
+    ] {
+        assert!(all.contains(needle), "'{needle}' not in:\n{all}");
+    }
+    // the example itself passes every check
+    assert!(Probe::parse(&full, "example.toml").is_ok());
 }
