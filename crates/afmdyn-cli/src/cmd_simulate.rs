@@ -8,6 +8,7 @@ use crate::output::{
 use crate::plot::{decimate_line, save, Figure, Series, Style};
 use afmdyn::analysis::spectrum::{amplitude_spectrum, SPECTRUM_SAMPLES};
 use afmdyn::integrate::build;
+use afmdyn::report::CurveUnits;
 use afmdyn::request::{ConvergeRequest, SeriesStore, SimulateRequest};
 use afmdyn::request::{Document, Resolved};
 use afmdyn::trajectory::chunked::{record_chunked, Chunk, ChunkedSpec};
@@ -175,51 +176,122 @@ struct DataFiles {
     energy: CsvStream,
 }
 
-fn series_columns(n: usize) -> Vec<Column> {
+/// The units of `simulate`'s files and plots: the model's (τ, g₀, its force unit) or, with a
+/// probe, SI (s, m, m/s, N, J) from the probe's scales ([`CurveUnits::from_scales`]).
+#[derive(Debug, Clone, Copy)]
+struct SeriesUnits {
+    u: CurveUnits,
+    /// Hz per unit Ω (spectrum axis), with a probe.
+    hz_per_omega: Option<f64>,
+    point_mass: bool,
+}
+
+impl SeriesUnits {
+    fn new(p: &Params, probe: Option<&afmdyn::probe::Probe>) -> Self {
+        SeriesUnits {
+            u: probe.map_or_else(CurveUnits::dimensionless, |pr| {
+                CurveUnits::from_scales(&pr.scales, true)
+            }),
+            hz_per_omega: probe.map(|pr| pr.scales.frequency_hz(1.0)),
+            point_mass: p.structure == afmdyn::Structure::PointMass,
+        }
+    }
+    fn t(&self, tau: f64) -> f64 {
+        tau * self.u.time
+    }
+    fn x(&self, v: f64) -> f64 {
+        v * self.u.length
+    }
+    fn v(&self, v: f64) -> f64 {
+        v * self.u.length / self.u.time
+    }
+    fn force(&self, v: f64) -> f64 {
+        v * self.u.force
+    }
+    fn energy(&self, v: f64) -> f64 {
+        v * self.u.energy
+    }
+    /// (time column, time unit, length unit, velocity unit, force unit, energy unit).
+    fn names(
+        &self,
+    ) -> (
+        &'static str,
+        &'static str,
+        &'static str,
+        &'static str,
+        &'static str,
+        &'static str,
+    ) {
+        if self.u.si {
+            ("t", "s", "m", "m/s", "N", "J")
+        } else if self.point_mass {
+            ("tau", "τ (eq. 5)", "g0", "g0 per unit τ", "k g0", "k g0²")
+        } else {
+            (
+                "tau",
+                "τ (eq. 5)",
+                "g0",
+                "g0 per unit τ",
+                "EI g0/L³",
+                "EI g0²/L³",
+            )
+        }
+    }
+}
+
+fn series_columns(n: usize, su: &SeriesUnits) -> Vec<Column> {
+    let (t, tu, len, vel, force, _) = su.names();
+    let time = if su.u.si {
+        "time t = τ t_s (t_s: seconds per unit τ, the probe's scales)"
+    } else {
+        "dimensionless time τ = t √(EI/(mL⁴))"
+    };
     let mut c =
         vec![
-        Column::new("tau", "τ (eq. 5)", "dimensionless time τ = t √(EI/(mL⁴))"),
+        Column::new(t, tu, time),
         Column::new(
             "v_t",
-            "g0",
+            len,
             "tip–sample distance V_T = W(1,τ) + α2 sin Ωτ + α5 (eq. 8); contact while V_T ≤ 0",
         ),
-        Column::new("w_tip", "g0", "tip deflection W(1,τ) relative to the clamped base"),
-        Column::new("w_tip_dot", "g0 per unit τ", "tip velocity ∂W(1,τ)/∂τ"),
+        Column::new("w_tip", len, "tip deflection W(1,τ) relative to the clamped base"),
+        Column::new("w_tip_dot", vel, "tip velocity ∂W(1,τ)/∂τ"),
         Column::new("in_contact", "0/1", "1 while the tip is in contact (region II)"),
         Column::new(
             "contact_force",
-            "EI g0/L³",
+            force,
             "F_c = α4 V_T + α6 dV_T/dτ in contact, 0 in free flight (F_c < 0 pushes the tip away)",
         ),
     ];
     c.extend((1..=n).map(|j| {
         Column::new(
             format!("a_{j}"),
-            "g0",
+            len,
             format!("modal coordinate a_{j} (eq. 9)"),
         )
     }));
     c.extend((1..=n).map(|j| {
         Column::new(
             format!("a_dot_{j}"),
-            "g0 per unit τ",
+            vel,
             format!("modal velocity da_{j}/dτ"),
         )
     }));
     c
 }
 
-fn sample_row(s: &Sample) -> Vec<f64> {
+fn sample_row(s: &Sample, su: &SeriesUnits) -> Vec<f64> {
+    let n = s.state.len() / 2;
     let mut r = vec![
-        s.tau,
-        s.v_t,
-        s.w_tip,
-        s.w_tip_dot,
+        su.t(s.tau),
+        su.x(s.v_t),
+        su.x(s.w_tip),
+        su.v(s.w_tip_dot),
         f64::from(u8::from(s.region == Region::Contact)),
-        s.contact_force,
+        su.force(s.contact_force),
     ];
-    r.extend(s.state.iter());
+    r.extend(s.state.iter().take(n).map(|&a| su.x(a)));
+    r.extend(s.state.iter().skip(n).map(|&a| su.v(a)));
     r
 }
 
@@ -238,7 +310,8 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
     };
     let z0 = afmdyn::request::analyses::initial_state(&model, request.initial.as_deref())?;
     let n = p.modes;
-    let columns = series_columns(n);
+    let su = SeriesUnits::new(&p, probe.as_ref());
+    let columns = series_columns(n, &su);
     let (store, bytes_per_value) = match a.files {
         Files::None => (SeriesStore::Nothing, 0.0),
         // NPY 8 bytes a value, CSV up to 24 more
@@ -273,22 +346,25 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
                 }
                 false => None,
             },
-            events: csv_stream(&o.join("events.csv"), &["tau", "from", "to", "v_t_dot"])?,
+            events: csv_stream(
+                &o.join("events.csv"),
+                &[su.names().0, "from", "to", "v_t_dot"],
+            )?,
             poincare: csv_stream(
                 &o.join("poincare.csv"),
-                &["tau", "v_t", "w_tip", "w_tip_dot"],
+                &[su.names().0, "v_t", "w_tip", "w_tip_dot"],
             )?,
             energy: csv_stream(
                 &o.join("energy.csv"),
                 &[
-                    "tau0",
+                    if su.u.si { "t0" } else { "tau0" },
                     "e_start",
                     "e_end",
                     "base_work",
                     "beam_dissipation",
                     "contact_dissipation",
                     "residual",
-                    "tau1",
+                    if su.u.si { "t1" } else { "tau1" },
                 ],
             )?,
         }),
@@ -331,7 +407,7 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
         crate::error::interrupted()?;
         if let Some(fl) = files.as_mut() {
             for s in &c.samples {
-                let row = sample_row(s);
+                let row = sample_row(s, &su);
                 fl.npy.push(&row)?;
                 if let Some(csv) = fl.csv.as_mut() {
                     csv_row(csv, row.iter().map(|v| f(*v)))?;
@@ -345,10 +421,10 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
                 csv_row(
                     &mut fl.events,
                     [
-                        f(e.tau),
+                        f(su.t(e.tau)),
                         format!("{:?}", e.from).to_lowercase(),
                         format!("{:?}", e.to).to_lowercase(),
-                        f(e.v_t_dot),
+                        f(su.v(e.v_t_dot)),
                     ],
                 )?;
             }
@@ -356,10 +432,10 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
                 csv_row(
                     &mut fl.poincare,
                     [
-                        f(*t),
-                        f(model.v_t(*t, z)),
-                        f(model.w_tip(z)),
-                        f(model.w_tip_dot(z)),
+                        f(su.t(*t)),
+                        f(su.x(model.v_t(*t, z))),
+                        f(su.x(model.w_tip(z))),
+                        f(su.v(model.w_tip_dot(z))),
                     ],
                 )?;
             }
@@ -369,14 +445,14 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
                 csv_row(
                     &mut fl.energy,
                     [
-                        f(e.tau0),
-                        f(e.e_start),
-                        f(e.e_end),
-                        f(e.base_work),
-                        f(e.beam_dissipation),
-                        f(e.contact_dissipation),
-                        f(e.residual()),
-                        f(tau1),
+                        f(su.t(e.tau0)),
+                        f(su.energy(e.e_start)),
+                        f(su.energy(e.e_end)),
+                        f(su.energy(e.base_work)),
+                        f(su.energy(e.beam_dissipation)),
+                        f(su.energy(e.contact_dissipation)),
+                        f(su.energy(e.residual())),
+                        f(su.t(tau1)),
                     ],
                 )?;
             }
@@ -434,7 +510,7 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
         csv_finish(fl.energy)?;
     }
     if let Some(o) = &out {
-        write_spectrum_and_plots(o, &p, spp, spectrum, plots, summary.tau_end)?;
+        write_spectrum_and_plots(o, &p, &su, spp, spectrum, plots, summary.tau_end)?;
     }
     let zf = summary.final_state.clone().unwrap_or_else(|| z0.clone());
     let run = afmdyn::report::SimulateSummary {
@@ -473,6 +549,16 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
             model.w_tip(&zf),
             model.v_t(summary.tau_end, &zf)
         );
+        if su.u.si {
+            let nm = |v: f64| su.x(v) * 1e9;
+            println!(
+                "  in SI: t from {:.6} µs to {:.6} µs, final W = {:.6} nm, V_T = {:.6} nm",
+                su.t(t_transient) * 1e6,
+                su.t(summary.tau_end) * 1e6,
+                nm(model.w_tip(&zf)),
+                nm(model.v_t(summary.tau_end, &zf))
+            );
+        }
         println!(
             "energy balance: largest per-period residual {:.3e} ({:.1e} relative)",
             summary.residual, summary.relative
@@ -485,9 +571,12 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
     Ok(())
 }
 
+/// `spectrum.csv` and the plots, in `su`'s units (SI with a probe: time in s, lengths in m,
+/// frequencies in Hz; the plots' axes take the prefix of their range).
 fn write_spectrum_and_plots(
     out: &OutDir,
     p: &Params,
+    su: &SeriesUnits,
     spp: usize,
     spectrum: VecDeque<f64>,
     plots: Option<PlotData>,
@@ -496,16 +585,59 @@ fn write_spectrum_and_plots(
     let period = p.period();
     let window = spectrum.len();
     let data: Vec<f64> = spectrum.into();
-    let spec = amplitude_spectrum(&data, spp, p.omega);
+    let hz = su.hz_per_omega.unwrap_or(1.0);
+    let spec: Vec<(f64, f64)> = amplitude_spectrum(&data, spp, p.omega)
+        .into_iter()
+        .map(|(w, a)| (w * hz, su.x(a)))
+        .collect();
     write_csv(
         &out.join("spectrum.csv"),
-        &["frequency", "amplitude"],
+        &[
+            if su.u.si { "frequency_hz" } else { "frequency" },
+            "amplitude",
+        ],
         spec.iter().map(|(x, y)| vec![f(*x), f(*y)]),
     )?;
     let Some(mut pd) = plots else { return Ok(()) };
     if let Some(t0) = pd.shade.open.take() {
         pd.shade.push(t0, tau_end);
     }
+    // the plots' data in the files' units
+    let xy = |v: &mut Vec<(f64, f64)>| {
+        for pt in v.iter_mut() {
+            *pt = (su.t(pt.0), su.x(pt.1));
+        }
+    };
+    xy(&mut pd.tip);
+    xy(&mut pd.vt);
+    for pt in pd.phase.iter_mut() {
+        *pt = (su.x(pt.0), su.v(pt.1));
+    }
+    for r in pd.recent.iter_mut() {
+        *r = (su.t(r.0), su.x(r.1), su.x(r.2), r.3);
+    }
+    for iv in pd.shade.intervals.iter_mut() {
+        *iv = (su.t(iv.0), su.t(iv.1));
+    }
+    let (t_label, y_label, phase_x, phase_y, spec_x, spec_y) = if su.u.si {
+        (
+            "time t (s)",
+            "W(1,t), V_T (m)",
+            "V_T (m)",
+            "dV_T/dt (m/s)",
+            "frequency (Hz)".to_string(),
+            "amplitude (m)",
+        )
+    } else {
+        (
+            "τ",
+            "W(1,τ), V_T",
+            "V_T",
+            "dV_T/dτ",
+            "frequency (dimensionless, Ω = drive)".to_string(),
+            "amplitude",
+        )
+    };
     let recorded = (pd.t1 - pd.t0) / period;
     let last = |n: usize, what: &str| {
         let periods = n as f64 / spp as f64;
@@ -517,11 +649,11 @@ fn write_spectrum_and_plots(
     };
     let tip_figure = |title: String, tip: Vec<(f64, f64)>, vt: Vec<(f64, f64)>, shade| Figure {
         title,
-        x_label: "τ".into(),
-        y_label: "W(1,τ), V_T".into(),
+        x_label: t_label.into(),
+        y_label: y_label.into(),
         series: vec![
             Series {
-                label: "W(1,τ)".into(),
+                label: if su.u.si { "W(1,t)" } else { "W(1,τ)" }.into(),
                 points: tip,
                 style: Style::Line,
                 color: 0,
@@ -592,8 +724,8 @@ fn write_spectrum_and_plots(
         "phase",
         &Figure {
             title: last(pd.phase.len(), "Phase portrait"),
-            x_label: "V_T".into(),
-            y_label: "dV_T/dτ".into(),
+            x_label: phase_x.into(),
+            y_label: phase_y.into(),
             series: vec![Series {
                 label: String::new(),
                 points: pd.phase.into(),
@@ -603,14 +735,14 @@ fn write_spectrum_and_plots(
             shade: vec![],
         },
     )?;
-    let f_max = spectrum_axis_end(&spec, p.omega);
+    let f_max = spectrum_axis_end(&spec, p.omega * hz);
     save(
         out.path(),
         "spectrum",
         &Figure {
             title: last(window, "Amplitude spectrum of W(1,τ)"),
-            x_label: "frequency (dimensionless, Ω = drive)".into(),
-            y_label: "amplitude".into(),
+            x_label: spec_x,
+            y_label: spec_y.into(),
             series: vec![Series {
                 label: String::new(),
                 points: spec.into_iter().filter(|s| s.0 <= f_max).collect(),

@@ -290,7 +290,42 @@ impl NpyStream {
     }
 }
 
-/// Format a float for CSV (shortest round-trip representation).
+/// Format a float for CSV: the shortest round-trip representation, in exponent form when
+/// |v| < 1e-4 or ≥ 1e16 (SI values such as 1.37e-19 J would otherwise print as 24 zeros
+/// and their digits).
 pub fn f(v: f64) -> String {
-    format!("{v}")
+    let a = v.abs();
+    if a != 0.0 && a.is_finite() && !(1e-4..1e16).contains(&a) {
+        format!("{v:e}")
+    } else {
+        format!("{v}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::f;
+
+    #[test]
+    fn csv_numbers_round_trip_and_small_ones_use_exponents() {
+        for v in [
+            0.0,
+            1.0,
+            -2.5,
+            0.1,
+            1e-4,
+            3.3e-6,
+            1.3749999999999996e-20,
+            6.02e23,
+            -7.5e-13,
+            12345.678,
+        ] {
+            assert_eq!(f(v).parse::<f64>().unwrap().to_bits(), v.to_bits(), "{v}");
+        }
+        assert_eq!(f(1.375e-20), "1.375e-20");
+        assert_eq!(f(0.25), "0.25");
+        assert_eq!(f(0.0), "0");
+        assert_eq!(f(3.0), "3");
+        assert_eq!(f(f64::NAN), "NaN");
+    }
 }

@@ -310,3 +310,116 @@ fn si_flags_take_units_and_hint_at_misplaced_scales() {
         );
     }
 }
+
+fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap().split(',').map(String::from).collect();
+    let rows = lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    (header, rows)
+}
+
+/// Issue 28 item 1: `simulate --probe` wrote τ and g₀; its time series is now in SI (s, m,
+/// m/s, N; units in the `.npy.json`) and equals the dimensionless run of the same parameters
+/// (written out as a config file) times the probe's scales.
+#[test]
+fn simulate_with_a_probe_writes_si_time_series() {
+    let dir = std::env::temp_dir().join(format!("afmdyn-sim-si-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let probe = "examples/probe-beam-dmt.toml";
+    let units = json(&["units", "--probe", probe, "--json"]);
+    let p = &units["params"];
+    let law = &p["contact_law"];
+    let config = format!(
+        "modes = 3\nalpha1 = {:?}\nalpha2 = {:?}\nalpha3 = {:?}\n\
+         alpha4 = {:?}\nalpha5 = {:?}\nalpha6 = {:?}\nomega = {:?}\ncontact_law = \"dmt\"\n\
+         hamaker = {:?}\nintermolecular_distance = {:?}\n",
+        p["alpha1"].as_f64().unwrap(),
+        p["alpha2"].as_f64().unwrap(),
+        p["alpha3"].as_f64().unwrap(),
+        p["alpha4"].as_f64().unwrap(),
+        p["alpha5"].as_f64().unwrap(),
+        p["alpha6"].as_f64().unwrap(),
+        p["omega"].as_f64().unwrap(),
+        law["hamaker"].as_f64().unwrap(),
+        law["intermolecular_distance"].as_f64().unwrap(),
+    );
+    let cfg = dir.join("params.toml");
+    std::fs::write(&cfg, config).unwrap();
+    let (si_dir, plain_dir) = (dir.join("si"), dir.join("plain"));
+    let common = [
+        "--periods",
+        "500",
+        "--samples-per-period",
+        "20",
+        "--csv",
+        "--files",
+        "data",
+    ];
+    let mut a = vec![
+        "simulate",
+        "--probe",
+        probe,
+        "--out",
+        si_dir.to_str().unwrap(),
+    ];
+    a.extend(common);
+    json(&[a.as_slice(), &["--json"]].concat());
+    let mut b = vec!["simulate", "--config", cfg.to_str().unwrap(), "--out"];
+    b.push(plain_dir.to_str().unwrap());
+    b.extend(common);
+    json(&[b.as_slice(), &["--json"]].concat());
+    let (hs, si) = read_csv(&si_dir.join("timeseries.csv"));
+    let (hp, plain) = read_csv(&plain_dir.join("timeseries.csv"));
+    assert_eq!(
+        &hs[..6],
+        &[
+            "t",
+            "v_t",
+            "w_tip",
+            "w_tip_dot",
+            "in_contact",
+            "contact_force"
+        ]
+    );
+    assert_eq!(hp[0], "tau");
+    let s = &units["si"]["scales"];
+    let (ts, xs, fs) = (
+        s["time_s"].as_f64().unwrap(),
+        s["length_m"].as_f64().unwrap(),
+        s["force_n"].as_f64().unwrap(),
+    );
+    let v = xs / ts;
+    let scale = [ts, xs, xs, v, 1.0, fs, xs, xs, xs, v, v, v];
+    assert_eq!(si.len(), plain.len());
+    let mut contact = 0;
+    for (r, q) in si.iter().zip(&plain) {
+        for (k, (a, b)) in r.iter().zip(q).enumerate() {
+            let want = b * scale[k];
+            assert!(
+                (a - want).abs() <= 1e-14 * want.abs(),
+                "{}: {a} vs {want}",
+                hs[k]
+            );
+        }
+        contact += usize::from(r[4] == 1.0);
+    }
+    assert!(contact > 0, "the run taps the sample");
+    let meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(si_dir.join("timeseries.npy.json")).unwrap())
+            .unwrap();
+    let units: Vec<&str> = meta["columns"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["unit"].as_str().unwrap())
+        .collect();
+    assert_eq!(
+        units,
+        ["s", "m", "m", "m/s", "0/1", "N", "m", "m", "m", "m/s", "m/s", "m/s"]
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
