@@ -557,19 +557,35 @@ fn the_tip_plot_shows_the_last_periods_of_a_long_record() {
 /// oscillator at Ω = 5 with r = 0.7 is nonperiodic from rest): exit 1, one line.
 #[test]
 fn a_failed_orbit_search_says_the_start_was_nonperiodic() {
-    let out = afmdyn(&[
-        "orbit",
-        "--contact-law",
-        "impact",
-        "--restitution",
-        "0.7",
-        "--omega",
-        "5",
-    ]);
-    assert_eq!(out.status.code(), Some(1));
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        err.contains("showed no period") && err.lines().count() == 1,
-        "{err}"
-    );
+    // orbit, and the issue's continuation (which ended with a bare "shooting did not
+    // converge"); with the period given, Newton's failure is reported as it is
+    let dir = std::env::temp_dir().join(format!("afmdyn-cont-start-{}", std::process::id()));
+    let out_dir = dir.to_str().unwrap();
+    let law = ["--contact-law", "impact", "--restitution", "0.7"];
+    let orbit = [&["orbit"][..], &law, &["--omega", "5"]].concat();
+    let cont = [
+        &["continue"][..],
+        &law,
+        &["--from", "5", "--to", "1", "--switch", "--out", out_dir],
+    ]
+    .concat();
+    for (args, explained) in [
+        (orbit.clone(), true),
+        (cont.clone(), true),
+        ([&orbit[..], &["--period", "1"]].concat(), false),
+    ] {
+        let out = afmdyn(&args);
+        assert_eq!(out.status.code(), Some(1), "{args:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(
+            err.contains("showed no period"),
+            explained,
+            "{args:?}: {err}"
+        );
+        assert!(
+            err.lines().count() == 1 && err.contains("did not converge"),
+            "{err}"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
 }

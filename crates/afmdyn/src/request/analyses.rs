@@ -227,21 +227,36 @@ impl OrbitRequest {
         let model = CantileverModel::new(params)?;
         let (guess, found) = self.start.guess(&model)?;
         let n = self.period.or(found).unwrap_or(1);
-        match shoot(&model, &guess, n, &ShootingOptions::default()) {
-            // say why Newton started where it did (issue 28: every early end says why)
-            Err(SimError::NoConvergence {
-                iterations,
-                residual,
-                ..
-            }) if self.period.is_none() && found.is_none() => Err(SimError::NoConvergence {
-                what: "shooting for a period-1 orbit from the last state of a motion that showed \
-                       no period up to max_period (nonperiodic from this start: give the period, \
-                       another start or more max_periods)",
-                iterations,
-                residual,
-            }),
-            r => r,
-        }
+        explain_start(
+            shoot(&model, &guess, n, &ShootingOptions::default()),
+            self.period,
+            found,
+        )
+    }
+}
+
+/// `r` with a Newton failure explained when the period was guessed: the user gave none and
+/// the steady state from the start showed none, so Newton started from the last state of a
+/// nonperiodic motion (issue 28: every early end says why). The one place orbit searches and
+/// continuations say so.
+fn explain_start<T>(
+    r: Result<T, SimError>,
+    period: Option<usize>,
+    found: Option<usize>,
+) -> Result<T, SimError> {
+    match r {
+        Err(SimError::NoConvergence {
+            iterations,
+            residual,
+            ..
+        }) if period.is_none() && found.is_none() => Err(SimError::NoConvergence {
+            what: "shooting for a period-1 orbit from the last state of a motion that showed \
+                   no period up to max_period (nonperiodic from this start: give the period, \
+                   another start or more max_periods)",
+            iterations,
+            residual,
+        }),
+        r => r,
     }
 }
 
@@ -303,11 +318,12 @@ impl ContinuationRequest {
         let (guess, found) = self.start.guess(&model)?;
         let n = self.period.or(found).unwrap_or(1);
         let spec = ContinuationSpec::new(*base, self.param, self.from, self.to, n);
-        if self.switch {
+        let r = if self.switch {
             continue_with_switching_with(&spec, &guess, CASCADE_FACTOR * n, progress)
         } else {
-            Ok(vec![continue_branch_with(&spec, &guess, progress)?])
-        }
+            continue_branch_with(&spec, &guess, progress).map(|b| vec![b])
+        };
+        explain_start(r, self.period, found)
     }
 }
 
