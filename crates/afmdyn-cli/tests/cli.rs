@@ -589,3 +589,58 @@ fn a_failed_orbit_search_says_the_start_was_nonperiodic() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Issue 27 item 2, one meaning per exit code (docs/outputs.md, "Exit codes and warnings"):
+/// the adaptive stepper's up-front budget (Ω = 1e-3 with the Hertz law needs ~2e7 steps per
+/// period) is bad input — exit 2, one line naming the budget, nothing on stdout — in every
+/// analysis, the studies of many runs included (`attractors` exited 1 with "every one of the 4
+/// random starts failed", and before that 0 with `"attractors": []`).
+#[test]
+fn a_budget_refusal_exits_2_in_every_analysis() {
+    let dir = std::env::temp_dir().join(format!("afmdyn-budget-{}", std::process::id()));
+    let out = dir.to_str().unwrap();
+    let law = ["--contact-law", "hertz", "--omega", "1e-3"];
+    let cases: [&[&str]; 8] = [
+        &["orbit"],
+        &["continue", "--from", "1e-3", "--to", "2e-3", "--out", out],
+        &["lyapunov", "--periods", "200"],
+        &["attractors", "--samples", "4", "--json"],
+        &[
+            "bifurcation",
+            "--from",
+            "1e-3",
+            "--to",
+            "1",
+            "--steps",
+            "3",
+            "--out",
+            out,
+        ],
+        &["basins", "--x-steps", "3", "--y-steps", "3", "--out", out],
+        &[
+            "attractors",
+            "--sweep",
+            "omega",
+            "--from",
+            "1e-3",
+            "--to",
+            "2e-3",
+            "--steps",
+            "2",
+        ],
+        &[
+            "simulate",
+            "--periods",
+            "2",
+            "--integrator",
+            "adaptive",
+            "--out",
+            out,
+        ],
+    ];
+    for case in cases {
+        let args = [case, &law].concat();
+        bad_input(&args, "exceeds the budget of 1e7");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -45,7 +45,9 @@ impl AttractorSpec {
     ///
     /// # Errors
     /// [`SimError::OutOfRange`] naming `samples` (1..=[`MAX_ATTRACTOR_SAMPLES`]) or
-    /// `cluster_tol` (finite, > 0), or a steady-state option ([`SteadyOptions::validate`]).
+    /// `cluster_tol` (finite, > 0), or a steady-state option ([`SteadyOptions::validate`]);
+    /// an integrator that cannot be built for the parameters
+    /// ([`crate::integrate::check_buildable`]).
     pub fn validate(&self) -> Result<(), SimError> {
         if !(1..=MAX_ATTRACTOR_SAMPLES).contains(&self.samples) {
             return Err(SimError::out_of_range(
@@ -61,7 +63,8 @@ impl AttractorSpec {
                 "must be finite and > 0",
             ));
         }
-        self.steady.validate()
+        self.steady.validate()?;
+        crate::integrate::check_buildable(&self.params, self.integrator)
     }
 }
 

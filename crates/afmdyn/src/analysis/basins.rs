@@ -256,7 +256,8 @@ impl BasinSpec {
                 "basin_hits must be <= 10000 and discover_after <= 1000000",
             ));
         }
-        self.steady.validate()
+        self.steady.validate()?;
+        crate::integrate::check_buildable(&self.params, self.integrator)
     }
 
     /// The stride of the first pass: `stride`, or when 0 the largest power of two that leaves

@@ -157,7 +157,12 @@ impl SweepSpec {
         }
         let per_value = usize::from(self.continuation) * 2 + self.starts as usize;
         match self.values.len().checked_mul(per_value) {
-            Some(n) if n <= MAX_SWEEP_POINTS => Ok(()),
+            Some(n) if n <= MAX_SWEEP_POINTS => crate::integrate::check_buildable_over(
+                &self.base,
+                self.param,
+                &self.values,
+                self.integrator,
+            ),
             _ => Err(SimError::out_of_range(
                 "sweep points",
                 format!(

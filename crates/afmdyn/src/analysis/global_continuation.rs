@@ -91,7 +91,12 @@ impl GlobalContinuationSpec {
         for &v in &self.values {
             self.census.params.with(self.param, v).validate()?;
         }
-        Ok(())
+        crate::integrate::check_buildable_over(
+            &self.census.params,
+            self.param,
+            &self.values,
+            self.census.integrator,
+        )
     }
 }
 

@@ -523,6 +523,41 @@ impl Default for IntegratorOptions {
     }
 }
 
+/// Check that an integrator of `opts` can be built for `params` at the rest state — [`build`]'s
+/// up-front budgets and support checks (the adaptive stepper's steps per drive period, RK4
+/// with impacts, the exact propagator's limits) — without integrating. Studies of many runs
+/// (attractor censuses, basin maps, sweeps) call it in their validation, so that a refusal is
+/// one input error rather than every run failing alike.
+///
+/// # Errors
+/// As [`CantileverModel::new`] and [`build`].
+pub fn check_buildable(params: &crate::Params, opts: IntegratorOptions) -> Result<(), SimError> {
+    let model = CantileverModel::new(params)?;
+    build(&model, opts, 0.0, &DVector::zeros(2 * params.modes)).map(|_| ())
+}
+
+/// [`check_buildable`] at the smallest and the largest of `values` of `param` over `base` (the
+/// adaptive step budget grows as Ω falls and as the stiffness grows, so the ends of a sweep
+/// bound it).
+///
+/// # Errors
+/// As [`check_buildable`].
+pub fn check_buildable_over(
+    base: &crate::Params,
+    param: SweepParam,
+    values: &[f64],
+    opts: IntegratorOptions,
+) -> Result<(), SimError> {
+    let lo = values.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    for v in [lo, hi] {
+        if v.is_finite() {
+            check_buildable(&base.with(param, v), opts)?;
+        }
+    }
+    Ok(())
+}
+
 /// Build an integrator of `model` starting at (τ, z) ([`IntegratorKind::Auto`] resolved by
 /// [`IntegratorKind::resolve`]).
 ///
