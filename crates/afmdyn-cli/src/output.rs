@@ -291,15 +291,10 @@ impl NpyStream {
 }
 
 /// Format a float for CSV: the shortest round-trip representation, in exponent form when
-/// |v| < 1e-4 or ≥ 1e16 (SI values such as 1.37e-19 J would otherwise print as 24 zeros
-/// and their digits).
+/// |v| < 1e-4 or ≥ 1e16 ([`afmdyn::error::number`]; SI values such as 1.37e-19 J would
+/// otherwise print as 24 zeros and their digits).
 pub fn f(v: f64) -> String {
-    let a = v.abs();
-    if a != 0.0 && a.is_finite() && !(1e-4..1e16).contains(&a) {
-        format!("{v:e}")
-    } else {
-        format!("{v}")
-    }
+    afmdyn::error::number(v)
 }
 
 #[cfg(test)]

@@ -307,8 +307,11 @@ impl Reader<'_> {
     ) -> Option<f64> {
         if x.is_finite() && ok(x) {
             if let Some(hint) = scale_hint(section, key, x) {
-                self.problems
-                    .push(format!("{}{key} = {x} ({unit}): {hint}", prefix(section)));
+                self.problems.push(format!(
+                    "{}{key} = {} ({unit}): {hint}",
+                    prefix(section),
+                    crate::error::number(x)
+                ));
                 return None;
             }
             Some(x)
@@ -344,6 +347,11 @@ fn scale_hint(section: &str, key: &str, x: f64) -> Option<String> {
     };
     match (section, key) {
         ("tip", "radius") if x > 1e-4 => Some(nano("a tip radius")),
+        ("drive", "free_amplitude") if x < 1e-12 => Some(
+            "below 1 pm, under the lever's thermal motion (probe files are in metres: 10 nm is \
+             10e-9)"
+                .into(),
+        ),
         ("sample", "intermolecular_distance") if x > 1e-6 => Some(nano("a₀ (0.165e-9 m typical)")),
         ("sample", "z_c") if x.abs() > 1e-4 => Some(nano("a rest distance")),
         ("cantilever", "length" | "width" | "thickness") if x > 1e-2 => Some(format!(

@@ -500,6 +500,7 @@ fn unit_slips_are_refused_with_the_meant_reading() {
             ("[sample]", "youngs_modulus") => "youngs_modulus = 4".to_string(),
             ("[sample]", "hamaker") => "hamaker = 6.6".to_string(),
             ("[cantilever]", "resonance_frequency") => "resonance_frequency = 300".to_string(),
+            ("[drive]", "free_amplitude") => "free_amplitude = 1e-30".to_string(),
             _ => l.to_string(),
         };
         text.push_str(&line);
@@ -515,6 +516,8 @@ fn unit_slips_are_refused_with_the_meant_reading() {
         "[sample].youngs_modulus = 4 (Pa): below 100 Pa",
         "4 GPa is 4e9",
         "[sample].hamaker = 6.6 (J): above 1e-17 J",
+        // (it was refused naming alpha5 = 7.8e21, a group the user never wrote)
+        "[drive].free_amplitude = 1e-30 (m): below 1 pm",
         "[cantilever].resonance_frequency = 300 (Hz): below 1 kHz for a cantilever; \
          frequencies are in Hz: 300 kHz is 300e3",
     ] {
