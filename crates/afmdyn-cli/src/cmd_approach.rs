@@ -154,6 +154,10 @@ fn si_value(v: f64, unit: &str) -> String {
     }
     let (e, p) = crate::plot::si_prefix(v.abs());
     let m = v / 10f64.powi(e);
+    if !(1e-3..1e4).contains(&m.abs()) {
+        // plain SI (--units si): 8.033740e-9 m
+        return format!("{m:.6e} {p}{unit}");
+    }
     let digits = (5 - m.abs().log10().floor() as i32).clamp(0, 5) as usize;
     format!("{m:.digits$} {p}{unit}")
 }

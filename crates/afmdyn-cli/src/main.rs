@@ -29,6 +29,10 @@ use error::CliError;
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// Display units of text and plots in SI runs (--probe): afm (prefixed: nm, pN, kHz, aJ)
+    /// or si (plain m, N, Hz, J). Data files and JSON are always in plain SI
+    #[arg(long, value_enum, global = true, default_value = "afm")]
+    units: plot::DisplayUnits,
 }
 
 #[derive(Debug, Subcommand)]
@@ -64,6 +68,7 @@ enum Command {
 }
 
 fn run(cli: Cli) -> Result<(), CliError> {
+    plot::set_display_units(cli.units);
     match cli.command {
         Command::Modes(a) => cmd_modes::modes(&a),
         Command::Units(a) => cmd_modes::units(&a),

@@ -485,9 +485,30 @@ fn si_axis(label: &str, lo: f64, hi: f64) -> (String, f64) {
     (format!("{head} ({p}{u})"), 10f64.powi(e))
 }
 
+/// How SI quantities are displayed in text and on plot axes (`--units`): prefixed as AFM
+/// papers write them (nm, pN, kHz, aJ) or in plain SI units.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum DisplayUnits {
+    /// Prefixed units (the default): 8.03 nm, 6.9 nN, 300 kHz, 2.4 aJ.
+    Afm,
+    /// Plain SI units: 8.03e-9 m.
+    Si,
+}
+
+static PLAIN_SI: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Set the process's display units (once, from the command line).
+pub fn set_display_units(u: DisplayUnits) {
+    PLAIN_SI.store(u == DisplayUnits::Si, std::sync::atomic::Ordering::Relaxed);
+}
+
 /// The SI prefix (a … G) for a magnitude: (its power of ten, the prefix), the one that puts
-/// the magnitude's mantissa in [1, 1000) within the range of prefixes.
+/// the magnitude's mantissa in [1, 1000) within the range of prefixes; no prefix with
+/// `--units si`.
 pub fn si_prefix(mag: f64) -> (i32, &'static str) {
+    if PLAIN_SI.load(std::sync::atomic::Ordering::Relaxed) {
+        return (0, "");
+    }
     const PREFIXES: [(i32, &str); 10] = [
         (-18, "a"),
         (-15, "f"),

@@ -327,3 +327,51 @@ fn bad_grids_exit_2_with_one_line() {
         "omega",
     );
 }
+
+/// Issue 28 item 1: `--units afm` (the default) prints SI quantities prefixed as AFM papers
+/// write them, `--units si` in plain SI; the JSON is plain SI either way.
+#[test]
+fn display_units_choose_prefixed_or_plain_si() {
+    let run = |units: &str| {
+        let out = afmdyn(&[
+            "--units",
+            units,
+            "approach",
+            "--probe",
+            "examples/probe-point-mass-dmt.toml",
+            "--points",
+            "30",
+            "--files",
+            "none",
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8(out.stdout).unwrap()
+    };
+    let (afm, si) = (run("afm"), run("si"));
+    let fold = |text: &str| {
+        text.lines()
+            .find(|l| l.trim_start().starts_with("fold at z_c = "))
+            .unwrap()
+            .trim()
+            .to_string()
+    };
+    assert!(fold(&afm).ends_with(" nm"), "{afm}");
+    let plain = fold(&si);
+    assert!(plain.ends_with("e-9 m"), "{si}");
+    // the same fold in both spellings
+    let nm: f64 = fold(&afm)["fold at z_c = ".len()..]
+        .trim_end_matches(" nm")
+        .parse()
+        .unwrap();
+    let m: f64 = plain["fold at z_c = ".len()..]
+        .trim_end_matches(" m")
+        .parse()
+        .unwrap();
+    assert!((nm * 1e-9 - m).abs() < 1e-5 * m, "{nm} nm vs {m} m");
+    let bad = afmdyn(&["--units", "cgs", "approach"]);
+    assert_eq!(bad.status.code(), Some(2));
+}
