@@ -10,7 +10,7 @@ cd "$(dirname "$0")/.."
 cargo build --release -q
 A=target/release/afmdyn
 F=${FIGURES:-docs/figures}
-mkdir -p "$F"/continuation "$F"/lyapunov "$F"/fig4 "$F"/fig5 "$F"/fig6-7 "$F"/fig8-14 "$F"/fig15-17 "$F"/fig15-17-text
+mkdir -p "$F"/approach "$F"/continuation "$F"/lyapunov "$F"/fig4 "$F"/fig5 "$F"/fig6-7 "$F"/fig8-14 "$F"/fig15-17 "$F"/fig15-17-text
 S=${SAMPLES:-64}
 
 $A modes --config examples/eq25.toml --json > "$F/eq25.json"
@@ -37,6 +37,10 @@ for om in 2.0 2.05 2.1 2.15 2.6 20; do
   $A lyapunov --config examples/fig5.toml --omega "$om" --json > "$F/lyapunov/omega-$om.json"
   $A orbit --config examples/fig5.toml --omega "$om" --json > "$F/lyapunov/orbit-omega-$om.json"
 done
+# beyond the paper: the approach curve of the example probe (point mass, DMT on polystyrene,
+# A0 = 10 nm) at the command's default settings, plots in AFM units
+$A approach --probe examples/probe-point-mass-dmt.toml --json --out "$F/approach" > "$F/approach/summary.json"
+rm -f "$F"/approach/approach.csv
 # keep the pictures and summaries; drop the bulky vector and table copies and the run
 # bookkeeping (lock files hold a process id, the sweep's ledger the arguments)
 find "$F" \( -name '*.svg' -o -name '*.npy' -o -name '*.npy.json' -o -name 'attractor-*.csv' \

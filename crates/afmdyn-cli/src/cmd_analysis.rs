@@ -532,6 +532,7 @@ pub fn attractors(a: &AttractorsArgs) -> Result<(), CliError> {
             out.path(),
             &format!("{stem}-time"),
             &Figure {
+                y_min_span: 0.0,
                 title: format!(
                     "Attractor {} ({label}, basin {:.1} %), Ω = {}",
                     k + 1,
@@ -570,6 +571,7 @@ pub fn attractors(a: &AttractorsArgs) -> Result<(), CliError> {
             out.path(),
             &format!("{stem}-phase"),
             &Figure {
+                y_min_span: 0.0,
                 title: format!("Attractor {} ({label}): phase plane", k + 1),
                 x_label: "W(1,τ)".into(),
                 y_label: "∂W(1,τ)/∂τ".into(),

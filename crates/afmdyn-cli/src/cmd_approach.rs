@@ -551,6 +551,13 @@ fn plots(
             out.path(),
             &format!("{}-{suffix}", l.stem),
             &Figure {
+                // energies and forces below 1e-6 of the model's units are round-off (a
+                // conservative law's E_dis): drawn as zero on an axis of that extent
+                y_min_span: match name {
+                    "energy_dissipated" | "virial" => 1e-6 * u.energy,
+                    "peak_force" => 1e-6 * u.force,
+                    _ => 0.0,
+                },
                 title: format!("{} curve: {}", l.stem, name.replace('_', " ")),
                 x_label: l.x_label.clone(),
                 y_label,
@@ -778,6 +785,7 @@ fn write_traces(
         out.path(),
         &format!("{}-traces", labels.stem),
         &Figure {
+            y_min_span: 0.0,
             title: format!(
                 "Force–distance loops over one cycle ({}; the loop's area is E_dis)",
                 labels.sweeps.0

@@ -123,6 +123,7 @@ fn fig3(a: &ModesArgs, p: &Params) -> Result<(), CliError> {
             })
             .collect();
         let fig = Figure {
+            y_min_span: 0.0,
             title: format!("{title} (N = {})", p.modes),
             x_label: "contact stiffness α4".into(),
             y_label: if which == 1 {

@@ -327,6 +327,7 @@ pub fn continuation(a: &ContinueArgs) -> Result<(), CliError> {
         out.path(),
         "continuation",
         &Figure {
+            y_min_span: 0.0,
             title,
             x_label: format!("{} ({})", a.param.symbol(), a.param.name()),
             y_label: "W(1,τ) at τ = 2πk/Ω".into(),

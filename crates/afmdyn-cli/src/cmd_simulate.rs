@@ -648,6 +648,7 @@ fn write_spectrum_and_plots(
         }
     };
     let tip_figure = |title: String, tip: Vec<(f64, f64)>, vt: Vec<(f64, f64)>, shade| Figure {
+        y_min_span: 0.0,
         title,
         x_label: t_label.into(),
         y_label: y_label.into(),
@@ -723,6 +724,7 @@ fn write_spectrum_and_plots(
         out.path(),
         "phase",
         &Figure {
+            y_min_span: 0.0,
             title: last(pd.phase.len(), "Phase portrait"),
             x_label: phase_x.into(),
             y_label: phase_y.into(),
@@ -740,6 +742,7 @@ fn write_spectrum_and_plots(
         out.path(),
         "spectrum",
         &Figure {
+            y_min_span: 0.0,
             title: last(window, "Amplitude spectrum of W(1,τ)"),
             x_label: spec_x,
             y_label: spec_y.into(),
@@ -823,6 +826,7 @@ pub fn converge(a: &ConvergeArgs) -> Result<(), CliError> {
         out.path(),
         "converge",
         &Figure {
+            y_min_span: 0.0,
             title: format!("Mode convergence, Ω = {} (paper Fig. 4)", p.omega),
             x_label: "τ − τ₀ (from a section point)".into(),
             y_label: "W(1,τ)".into(),

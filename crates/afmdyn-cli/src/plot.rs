@@ -69,6 +69,10 @@ pub struct Figure {
     pub series: Vec<Series>,
     /// Shaded x-intervals (e.g. contact intervals).
     pub shade: Vec<(f64, f64)>,
+    /// The smallest extent of the y-axis (0: the data's own, padded): a physical scale below
+    /// which variations are round-off — a conservative law's E_dis of 1e-27 J on a problem
+    /// whose energies are 1e-15 J is drawn as the zero it is, not as noise filling the axis.
+    pub y_min_span: f64,
 }
 
 /// Number of palette colours.
@@ -241,6 +245,11 @@ fn bounds(fig: &Figure) -> (f64, f64, f64, f64) {
     if !b.0.is_finite() {
         return (0.0, 1.0, 0.0, 1.0);
     }
+    if b.3 - b.2 < fig.y_min_span {
+        let mid = 0.5 * (b.2 + b.3);
+        b.2 = mid - 0.5 * fig.y_min_span;
+        b.3 = mid + 0.5 * fig.y_min_span;
+    }
     padded(b, 0.03)
 }
 
@@ -384,18 +393,26 @@ fn merge_shade(shade: &[(f64, f64)], px: impl Fn(f64) -> i32) -> Vec<(f64, f64)>
     out.into_iter().map(|(a, b, _)| (a, b)).collect()
 }
 
-/// A tick label: 0 for round-off around zero (never "-0.0"), plain decimals in 1e-3..1e5,
-/// else scientific notation.
+/// A tick label: 0 for round-off around zero (never "-0.0"); one notation for the whole axis,
+/// chosen by its extent `span` (and the value's size): plain decimals, as many as the extent
+/// needs, when both lie in 1e-3..1e5, else scientific notation — an axis over ±0.002 reads
+/// 0.0015, 0.001, 0.0005, not 0.0015 beside 1.00e-3.
 fn tick(v: f64, span: f64) -> String {
     let a = v.abs();
     if a <= 1e-9 * span {
         return "0".into();
     }
-    if !(1e-3..1e5).contains(&a) {
+    let m = a.max(span.abs());
+    if !(1e-3..1e5).contains(&m) || a < 1e-4 * m {
         return format!("{v:.2e}");
     }
-    let s = format!("{v:.4}");
-    let s = s.trim_end_matches('0').trim_end_matches('.');
+    let decimals = (3 - span.abs().log10().floor() as i32).clamp(0, 8) as usize;
+    let s = format!("{v:.decimals$}");
+    let s = if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.')
+    } else {
+        &s
+    };
     s.to_string()
 }
 
@@ -541,15 +558,21 @@ fn chart<'a, DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
-    let mut chart = ChartBuilder::on(area)
-        .margin(12)
-        .x_label_area_size(45)
-        .y_label_area_size(70)
-        .build_cartesian_2d(Axis::new(x0, x1), Axis::new(y0, y1))
-        .map_err(|x| x.to_string())?;
     // an axis in an SI unit reads in the prefixed unit of its magnitude (nm, kHz, aJ)
     let ((xd, fx), (yd, fy)) = (si_axis(labels.0, x0, x1), si_axis(labels.1, y0, y1));
     let (xs, ys) = ((x1 - x0) / fx, (y1 - y0) / fy);
+    // room for the widest y tick label beside the axis description (never overprinted)
+    let widest = [y0, y1, 0.5 * (y0 + y1), 0.25 * y0 + 0.75 * y1]
+        .iter()
+        .map(|v| tick(*v / fy, ys).chars().count())
+        .max()
+        .unwrap_or(4) as u32;
+    let mut chart = ChartBuilder::on(area)
+        .margin(12)
+        .x_label_area_size(45)
+        .y_label_area_size((widest * 9 + 34).max(70))
+        .build_cartesian_2d(Axis::new(x0, x1), Axis::new(y0, y1))
+        .map_err(|x| x.to_string())?;
     chart
         .configure_mesh()
         .x_desc(xd)
@@ -990,6 +1013,46 @@ mod tests {
         }
     }
 
+    #[test]
+    fn ticks_of_one_axis_share_one_notation() {
+        let span = 0.0044;
+        let labels: Vec<String> = [0.0015, 0.001, 0.0005, -0.002, 0.0]
+            .iter()
+            .map(|v| tick(*v, span))
+            .collect();
+        assert_eq!(labels, ["0.0015", "0.001", "0.0005", "-0.002", "0"]);
+        assert_eq!(tick(2.5, 10.0), "2.5");
+        assert_eq!(tick(1200.0, 4000.0), "1200");
+        assert_eq!(tick(2e-9, 4e-9), "2.00e-9");
+        assert_eq!(tick(3e5, 1e6), "3.00e5");
+    }
+
+    /// A figure's y_min_span widens an axis whose data vary by less (round-off around zero
+    /// drawn as the zero it is), centred on the data; wider data keep their own range.
+    #[test]
+    fn the_y_axis_is_at_least_y_min_span_wide() {
+        let fig = |ys: &[f64], span: f64| Figure {
+            y_min_span: span,
+            title: String::new(),
+            x_label: String::new(),
+            y_label: String::new(),
+            series: vec![Series {
+                label: String::new(),
+                points: ys.iter().enumerate().map(|(i, y)| (i as f64, *y)).collect(),
+                style: Style::Line,
+                color: 0,
+            }],
+            shade: vec![],
+        };
+        let (_, _, y0, y1) = bounds(&fig(&[1e-27, -2e-27, 5e-28], 4e-21));
+        assert!(
+            y0 < -2e-21 && y1 > 2e-21 && (y0 + y1).abs() < 1e-22,
+            "{y0} {y1}"
+        );
+        let (_, _, y0, y1) = bounds(&fig(&[1e-18, 3e-18], 4e-21));
+        assert!(y0 > 0.9e-18 && y1 < 3.1e-18, "{y0} {y1}");
+    }
+
     /// The padded range is the data's extent ± `frac` of it at any magnitude (SI energies of
     /// 1e-18 J included), and a single value gets a range of its own magnitude's order.
     #[test]
@@ -1047,6 +1110,7 @@ mod tests {
             .map(|k| (k as f64, if k % 97 == 0 { 1.0 } else { 0.0 }))
             .collect();
         let fig = Figure {
+            y_min_span: 0.0,
             title: "spikes".into(),
             x_label: "x".into(),
             y_label: "y".into(),
