@@ -5,6 +5,7 @@
 use crate::args::{quantity, Dim, ModelArgs, Quantity};
 use crate::cmd_simulate::Files;
 use crate::error::CliError;
+use crate::netcdf::Var;
 use crate::output::{f, write_csv, Column, NpyStream, OutDir};
 use crate::plot::{save, Figure, Series, Style};
 use afmdyn::analysis::approach::rest_distance;
@@ -696,64 +697,57 @@ fn write_traces(
     units: &CurveUnits,
     labels: &Labels,
 ) -> Result<(), CliError> {
-    use netcdf3::{DataSet, FileWriter, Version};
     let path = out.join(format!("{}-traces.nc", labels.stem));
-    let e = |m: String| CliError::Io(format!("cannot write {}: {m}", path.display()));
-    let d = |r: Result<(), netcdf3::error::InvalidDataSet>| r.map_err(|x| e(format!("{x:?}")));
     let (np, ns) = (t.values.len(), t.time.len());
     let xs: Vec<f64> = t.values.iter().map(|&v| x(v)).collect();
     let scale = |v: &[f64], s: f64| v.iter().map(|a| a * s).collect::<Vec<f64>>();
     let (length, force) = if units.si { ("m", "N") } else { ("g0", "F~") };
-    let vars: [(&str, &str, &str, Vec<f64>); 3] = [
-        (
+    let (deflection, distance, force_values) = (
+        scale(&t.deflection, units.length),
+        scale(&t.distance, units.length),
+        scale(&t.force, units.force),
+    );
+    let grid: &[&str] = &["point", "time"];
+    let vars = [
+        Var::f64(
+            labels.x_name,
+            &["point"],
+            labels.x_unit.unwrap_or("1"),
+            labels.x_text,
+            &xs,
+        ),
+        Var::f64(
+            "time",
+            &["time"],
+            "drive periods",
+            "time within the cycle",
+            &t.time,
+        ),
+        Var::f64(
             "deflection",
+            grid,
             length,
             "tip deflection W(1,tau)",
-            scale(&t.deflection, units.length),
+            &deflection,
         ),
-        (
+        Var::f64(
             "distance",
+            grid,
             length,
             "tip-sample distance V_T (<= 0 in contact)",
-            scale(&t.distance, units.length),
+            &distance,
         ),
-        (
-            "force",
-            force,
-            "tip-sample force",
-            scale(&t.force, units.force),
-        ),
+        Var::f64("force", grid, force, "tip-sample force", &force_values),
     ];
-    let mut ds = DataSet::new();
-    d(ds.add_fixed_dim("point", np))?;
-    d(ds.add_fixed_dim("time", ns))?;
-    d(ds.add_var_f64(labels.x_name, &["point"]))?;
-    d(ds.add_var_attr_string(labels.x_name, "units", labels.x_unit.unwrap_or("1")))?;
-    d(ds.add_var_f64("time", &["time"]))?;
-    d(ds.add_var_attr_string("time", "units", "drive periods"))?;
-    for (name, unit, meaning, _) in &vars {
-        d(ds.add_var_f64(name, &["point", "time"]))?;
-        d(ds.add_var_attr_string(name, "units", *unit))?;
-        d(ds.add_var_attr_string(name, "long_name", *meaning))?;
-    }
-    d(ds.add_global_attr_string(
-        "title",
-        format!(
+    crate::netcdf::write(
+        &path,
+        &format!(
             "afmdyn {} traces: one steady-state cycle per point of the {}",
             labels.stem, labels.sweeps.0
         ),
-    ))?;
-    crate::output::atomic(&path, |tmp| {
-        let w = |x: netcdf3::error::WriteError| e(format!("{x:?}"));
-        let mut f = FileWriter::open(tmp).map_err(w)?;
-        f.set_def(&ds, Version::Offset64Bit, 0).map_err(w)?;
-        f.write_var_f64(labels.x_name, &xs).map_err(w)?;
-        f.write_var_f64("time", &t.time).map_err(w)?;
-        for (name, _, _, v) in &vars {
-            f.write_var_f64(name, v).map_err(w)?;
-        }
-        f.close().map_err(w)
-    })?;
+        &[("point", np), ("time", ns)],
+        &vars,
+    )?;
     if files != Files::All || np == 0 {
         return Ok(());
     }
@@ -775,7 +769,7 @@ fn write_traces(
                 }
             ),
             points: (0..ns)
-                .map(|k| (vars[1].3[i * ns + k], vars[2].3[i * ns + k]))
+                .map(|k| (distance[i * ns + k], force_values[i * ns + k]))
                 .collect(),
             style: Style::Line,
             color: c,

@@ -7,7 +7,7 @@ use crate::args::{IntegratorArgs, ModelArgs};
 use crate::cmd_analysis::SteadyArgs;
 use crate::cmd_simulate::parse_modal_state;
 use crate::error::CliError;
-use crate::output::{atomic, write_bytes, OutDir};
+use crate::output::{write_bytes, OutDir};
 use crate::plot::{color, save_map, CellMap};
 use afmdyn::analysis::basins::{
     BasinSpec, Decided, DEFAULT_BASIN_HITS, DEFAULT_CELL, DEFAULT_DISCOVER_AFTER, DEFAULT_NEAR_TOL,
@@ -210,113 +210,105 @@ pub fn basins_cmd(a: &BasinsArgs) -> Result<(), CliError> {
     Ok(())
 }
 
-/// An integer variable of `basins.nc`: name, dimensions, units, long name, values.
-type IntVar<'a> = (&'a str, &'a [&'a str], &'a str, &'a str, &'a Vec<i32>);
-
 /// `basins.nc`: the map's arrays ([`BasinArrays`]) over (y, x) and (attractor), CF-style
 /// attributes (`decided` as flag values with their meanings).
 fn write_nc(path: &Path, spec: &BasinSpec, a: &BasinArrays) -> Result<(), CliError> {
-    use netcdf3::{DataSet, FileWriter, Version};
-    let e = |m: String| CliError::Io(format!("cannot write {}: {m}", path.display()));
-    let d = |r: Result<(), netcdf3::error::InvalidDataSet>| r.map_err(|x| e(format!("{x:?}")));
-    let mut ds = DataSet::new();
-    let (nx, ny, na) = (spec.xs.len(), spec.ys.len(), a.period.len());
-    d(ds.add_fixed_dim("x", nx))?;
-    d(ds.add_fixed_dim("y", ny))?;
-    d(ds.add_fixed_dim("attractor", na))?;
-    d(ds.add_var_f64("x", &["x"]))?;
-    d(ds.add_var_f64("y", &["y"]))?;
-    for (var, c) in [("x", spec.x), ("y", spec.y)] {
-        d(ds.add_var_attr_string(var, "long_name", format!("{c} at tau = 0")))?;
-        let velocity = matches!(
-            c,
-            afmdyn::analysis::basins::StateCoord::ADot(_)
-                | afmdyn::analysis::basins::StateCoord::WDot
-        );
-        d(ds.add_var_attr_string(
-            var,
-            "units",
-            if velocity { "g0 per unit tau" } else { "g0" },
-        ))?;
-    }
-    let cell = ["y", "x"];
-    let ints: [IntVar<'_>; 4] = [
-        ("label", &cell, "1", "attractor id; -2 failed", &a.label),
+    use crate::netcdf::{write, Attr, Var};
+    let unit = |c: afmdyn::analysis::basins::StateCoord| {
+        use afmdyn::analysis::basins::StateCoord;
+        if matches!(c, StateCoord::ADot(_) | StateCoord::WDot) {
+            "g0 per unit tau"
+        } else {
+            "g0"
+        }
+    };
+    let (cell, att): (&[&str], &[&str]) = (&["y", "x"], &["attractor"]);
+    let mut decided = Var::i32("decided", cell, "1", "how the cell was decided", &a.decided);
+    decided.attrs = vec![
         (
-            "decided",
-            &cell,
-            "1",
-            "how the cell was decided",
-            &a.decided,
+            "flag_values",
+            Attr::I32(Decided::ALL.iter().map(|x| x.code()).collect()),
         ),
         (
+            "flag_meanings",
+            Attr::Text(
+                Decided::ALL
+                    .iter()
+                    .map(|x| x.name())
+                    .collect::<Vec<_>>()
+                    .join(" "),
+            ),
+        ),
+    ];
+    let vars = [
+        Var::f64(
+            "x",
+            &["x"],
+            unit(spec.x),
+            format!("{} at tau = 0", spec.x),
+            &spec.xs,
+        ),
+        Var::f64(
+            "y",
+            &["y"],
+            unit(spec.y),
+            format!("{} at tau = 0", spec.y),
+            &spec.ys,
+        ),
+        Var::i32("label", cell, "1", "attractor id; -2 failed", &a.label),
+        decided,
+        Var::i32(
             "periods",
-            &cell,
+            cell,
             "drive periods",
             "drive periods the start ran",
             &a.periods,
         ),
-        (
+        Var::i32(
             "period",
-            &["attractor"],
+            att,
             "drive periods",
             "period n; -1 nonperiodic",
             &a.period,
         ),
-    ];
-    for (name, dims, unit, meaning, _) in ints {
-        d(ds.add_var_i32(name, dims))?;
-        d(ds.add_var_attr_string(name, "units", unit))?;
-        d(ds.add_var_attr_string(name, "long_name", meaning))?;
-    }
-    let codes: Vec<i32> = Decided::ALL.iter().map(|x| x.code()).collect();
-    let meanings: Vec<&str> = Decided::ALL.iter().map(|x| x.name()).collect();
-    d(ds.add_var_attr_i32("decided", "flag_values", codes))?;
-    d(ds.add_var_attr_string("decided", "flag_meanings", meanings.join(" ")))?;
-    let floats: [(&str, &str, &str, &Vec<f64>); 5] = [
-        ("x_max", "g0", "largest tip deflection W(1,tau)", &a.x_max),
-        ("v_t_min", "g0", "smallest V_T", &a.v_t_min),
-        (
+        Var::f64(
+            "x_max",
+            att,
+            "g0",
+            "largest tip deflection W(1,tau)",
+            &a.x_max,
+        ),
+        Var::f64("v_t_min", att, "g0", "smallest V_T", &a.v_t_min),
+        Var::f64(
             "basin_fraction",
+            att,
             "1",
             "share of the map's cells",
             &a.basin_fraction,
         ),
-        (
+        Var::f64(
             "stable",
+            att,
             "1",
             "1 stable periodic orbit (shooting), 0 unstable, NaN unknown",
             &a.stable,
         ),
-        (
+        Var::f64(
             "lyapunov",
+            att,
             "1/tau",
             "largest Lyapunov exponent of a nonperiodic attractor",
             &a.lyapunov,
         ),
     ];
-    for (name, unit, meaning, _) in floats {
-        d(ds.add_var_f64(name, &["attractor"]))?;
-        d(ds.add_var_attr_string(name, "units", unit))?;
-        d(ds.add_var_attr_string(name, "long_name", meaning))?;
-    }
-    d(ds.add_global_attr_string(
-        "title",
-        format!("afmdyn basins of attraction over {} and {}", spec.x, spec.y),
-    ))?;
-    d(ds.add_global_attr_string("source", format!("afmdyn {}", env!("CARGO_PKG_VERSION"))))?;
-    atomic(path, |tmp| {
-        let w = |x: netcdf3::error::WriteError| e(format!("{x:?}"));
-        let mut f = FileWriter::open(tmp).map_err(w)?;
-        f.set_def(&ds, Version::Offset64Bit, 0).map_err(w)?;
-        f.write_var_f64("x", &spec.xs).map_err(w)?;
-        f.write_var_f64("y", &spec.ys).map_err(w)?;
-        for (name, _, _, _, v) in ints {
-            f.write_var_i32(name, v).map_err(w)?;
-        }
-        for (name, _, _, v) in floats {
-            f.write_var_f64(name, v).map_err(w)?;
-        }
-        f.close().map_err(w)
-    })
+    write(
+        path,
+        &format!("afmdyn basins of attraction over {} and {}", spec.x, spec.y),
+        &[
+            ("x", spec.xs.len()),
+            ("y", spec.ys.len()),
+            ("attractor", a.period.len()),
+        ],
+        &vars,
+    )
 }

@@ -7,7 +7,7 @@
 use crate::args::{IntegratorArgs, ModelArgs};
 use crate::cmd_analysis::SteadyArgs;
 use crate::error::CliError;
-use crate::output::{atomic, write_bytes, OutDir};
+use crate::output::{write_bytes, OutDir};
 use crate::plot::{color, save_map, CellMap};
 use afmdyn::analysis::chart::{run_chart, ChartCell, ChartPlan};
 use afmdyn::request::chart::{axis_unit, csv_lines, document, warnings, ChartArrays, CSV_HEADER};
@@ -153,119 +153,105 @@ fn diverging(v: f64, m: f64) -> RGBColor {
     }
 }
 
+/// `chart.nc`: the chart's arrays ([`ChartArrays`]) over (y, x) and (y, x, attractor slot).
 fn write_nc(path: &Path, a: &ChartArrays, x: &str, y: &str) -> Result<(), CliError> {
-    use netcdf3::{DataSet, FileWriter, Version};
-    let e = |m: String| CliError::Io(format!("cannot write {}: {m}", path.display()));
-    let d = |r: Result<(), netcdf3::error::InvalidDataSet>| r.map_err(|x| e(format!("{x:?}")));
-    let mut ds = DataSet::new();
-    let (nx, ny, ns) = (a.x.len(), a.y.len(), a.slots);
-    d(ds.add_fixed_dim("x", nx))?;
-    d(ds.add_fixed_dim("y", ny))?;
-    d(ds.add_fixed_dim("attractor", ns))?;
-    d(ds.add_var_f64("x", &["x"]))?;
-    d(ds.add_var_f64("y", &["y"]))?;
-    for (var, name) in [("x", x), ("y", y)] {
-        d(ds.add_var_attr_string(var, "long_name", name))?;
-        d(ds.add_var_attr_string(var, "units", axis_unit(name)))?;
-    }
-    let cell = ["y", "x"];
-    let slot = ["y", "x", "attractor"];
-    let ints: [(&str, &[&str], &str, &str); 5] = [
-        ("attractors", &cell, "1", "attractors found in the cell"),
-        ("failures", &cell, "1", "runs of the cell that failed"),
-        (
+    use crate::netcdf::{write, Var};
+    let (cell, slot): (&[&str], &[&str]) = (&["y", "x"], &["y", "x", "attractor"]);
+    let vars = [
+        Var::f64("x", &["x"], axis_unit(x), x, &a.x),
+        Var::f64("y", &["y"], axis_unit(y), y, &a.y),
+        Var::i32(
+            "attractors",
+            cell,
+            "1",
+            "attractors found in the cell",
+            &a.attractors,
+        ),
+        Var::i32(
+            "failures",
+            cell,
+            "1",
+            "runs of the cell that failed",
+            &a.failures,
+        ),
+        Var::i32(
             "dominant_period",
-            &cell,
+            cell,
             "drive periods",
             "period of the attractor most random starts reached; -1 nonperiodic, 0 none",
+            &a.dominant_period,
         ),
-        (
+        Var::i32(
             "period",
-            &slot,
+            slot,
             "drive periods",
             "period n; -1 nonperiodic; 0 empty slot",
+            &a.period,
         ),
-        (
+        Var::i32(
             "motion",
-            &slot,
+            slot,
             "code",
             "1 periodic, 2 chaotic, 3 quasi-periodic, 4 unsettled (lyapunov < 0), 5 nonperiodic \
              without lyapunov; 0 empty slot",
+            &a.motion,
         ),
-    ];
-    for (name, dims, unit, meaning) in ints {
-        d(ds.add_var_i32(name, dims))?;
-        d(ds.add_var_attr_string(name, "units", unit))?;
-        d(ds.add_var_attr_string(name, "long_name", meaning))?;
-    }
-    let floats: [(&str, &str, &str, &Vec<f64>); 7] = [
-        (
+        Var::f64(
             "lyapunov",
+            slot,
             "1/tau",
             "largest Lyapunov exponent of a nonperiodic attractor",
             &a.lyapunov,
         ),
-        (
+        Var::f64(
             "lyapunov_error",
+            slot,
             "1/tau",
             "its error: uncertainty over the blocks plus convergence estimate",
             &a.lyapunov_error,
         ),
-        (
+        Var::f64(
             "x_max",
+            slot,
             "g0",
             "largest tip deflection W(1,tau) over the steady state",
             &a.x_max,
         ),
-        (
+        Var::f64(
             "v_t_min",
+            slot,
             "g0",
             "smallest V_T over the steady state",
             &a.v_t_min,
         ),
-        (
+        Var::f64(
             "contacts_per_period",
+            slot,
             "1/period",
             "contact entries (impacts) per drive period",
             &a.contacts_per_period,
         ),
-        (
+        Var::f64(
             "contact_fraction",
+            slot,
             "1",
             "fraction of the time in contact",
             &a.contact_fraction,
         ),
-        (
+        Var::f64(
             "fraction",
+            slot,
             "1",
             "basin fraction among the random starts",
             &a.fraction,
         ),
     ];
-    for (name, unit, meaning, _) in floats {
-        d(ds.add_var_f64(name, &slot))?;
-        d(ds.add_var_attr_string(name, "units", unit))?;
-        d(ds.add_var_attr_string(name, "long_name", meaning))?;
-    }
-    d(ds.add_global_attr_string("title", format!("afmdyn behaviour chart over {x} and {y}")))?;
-    d(ds.add_global_attr_string("source", format!("afmdyn {}", env!("CARGO_PKG_VERSION"))))?;
-    atomic(path, |tmp| {
-        let w = |x: netcdf3::error::WriteError| e(format!("{x:?}"));
-        let mut f = FileWriter::open(tmp).map_err(w)?;
-        f.set_def(&ds, Version::Offset64Bit, 0).map_err(w)?;
-        f.write_var_f64("x", &a.x).map_err(w)?;
-        f.write_var_f64("y", &a.y).map_err(w)?;
-        f.write_var_i32("attractors", &a.attractors).map_err(w)?;
-        f.write_var_i32("failures", &a.failures).map_err(w)?;
-        f.write_var_i32("dominant_period", &a.dominant_period)
-            .map_err(w)?;
-        f.write_var_i32("period", &a.period).map_err(w)?;
-        f.write_var_i32("motion", &a.motion).map_err(w)?;
-        for (name, _, _, v) in floats {
-            f.write_var_f64(name, v).map_err(w)?;
-        }
-        f.close().map_err(w)
-    })
+    write(
+        path,
+        &format!("afmdyn behaviour chart over {x} and {y}"),
+        &[("x", a.x.len()), ("y", a.y.len()), ("attractor", a.slots)],
+        &vars,
+    )
 }
 
 fn write_csv(path: &Path, cells: &[ChartCell]) -> Result<(), CliError> {

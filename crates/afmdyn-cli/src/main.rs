@@ -9,6 +9,7 @@ mod cmd_modes;
 mod cmd_orbits;
 mod cmd_simulate;
 mod error;
+mod netcdf;
 mod output;
 mod plot;
 mod progress;
