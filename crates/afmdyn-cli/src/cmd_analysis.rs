@@ -189,10 +189,7 @@ pub fn bifurcation(a: &BifurcationArgs) -> Result<(), CliError> {
                 std::process::abort();
             }
         };
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(a.threads.unwrap_or(0))
-            .build()
-            .map_err(|e| CliError::Io(format!("cannot start worker threads: {e}")))?;
+        let pool = afmdyn::request::thread_pool(a.threads)?;
         let cancel = AtomicBool::new(false);
         let ran = pool.install(|| checkpoint::run(&spec, &resume, &mut store, &cancel, &each));
         bar.finish_and_clear();

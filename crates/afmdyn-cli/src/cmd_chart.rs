@@ -310,10 +310,7 @@ pub fn chart(a: &ChartArgs) -> Result<(), CliError> {
                 .expect("template"),
         );
         bar.inc(done.iter().map(|&t| plan.tile(t).1.len() as u64).sum());
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(a.threads.unwrap_or(0))
-            .build()
-            .map_err(|e| CliError::Io(format!("cannot start worker threads: {e}")))?;
+        let pool = afmdyn::request::thread_pool(a.threads)?;
         let cancel = AtomicBool::new(false);
         let stored = AtomicUsize::new(0);
         let shared = Mutex::new((&mut store, None::<CheckpointError>));

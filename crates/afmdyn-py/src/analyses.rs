@@ -508,10 +508,7 @@ pub fn bifurcation<'py>(
         progress.as_ref(),
         Stop::Cancellable,
         move || -> PyResult<Vec<SweepRecord>> {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads.unwrap_or(0))
-                .build()
-                .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string()))?;
+            let pool = afmdyn::request::thread_pool(threads).map_err(sim_error)?;
             let (spec, job) = (&worker_spec, &worker_job);
             pool.install(|| match &lock {
                 Some(lock) => {

@@ -254,10 +254,7 @@ impl ChartStudy {
             progress.as_ref(),
             Stop::Cancellable,
             move || -> PyResult<Vec<ChartCell>> {
-                let pool = rayon::ThreadPoolBuilder::new()
-                    .num_threads(threads.unwrap_or(0))
-                    .build()
-                    .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string()))?;
+                let pool = afmdyn::request::thread_pool(threads).map_err(sim_error)?;
                 let plan = ChartPlan::new(&chart.spec, &chart.model);
                 let cancel = worker_job.progress.cancel_flag();
                 let mut store = lock.as_ref().map(ChartStore::new);

@@ -172,35 +172,6 @@ fn rename(e: SimError, [from, to, steps]: [&'static str; 3]) -> SimError {
     }
 }
 
-/// Run `f` on `threads` worker threads (`None`: all cores) — the one place where a request's
-/// thread count becomes a rayon pool.
-///
-/// # Errors
-/// [`SimError::OutOfRange`] naming `threads` when the pool cannot start; `f`'s errors.
-#[cfg(feature = "parallel")]
-pub fn in_pool<T: Send>(
-    threads: Option<usize>,
-    f: impl FnOnce() -> Result<T, SimError> + Send,
-) -> Result<T, SimError> {
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(threads.unwrap_or(0))
-        .build()
-        .map_err(|e| SimError::out_of_range("threads", e, "cannot start the worker threads"))?
-        .install(f)
-}
-
-/// Without the `parallel` feature: `f` on the calling thread.
-///
-/// # Errors
-/// `f`'s errors.
-#[cfg(not(feature = "parallel"))]
-pub fn in_pool<T: Send>(
-    _threads: Option<usize>,
-    f: impl FnOnce() -> Result<T, SimError> + Send,
-) -> Result<T, SimError> {
-    f()
-}
-
 impl Analysis for BasinsRequest {
     type Output = BasinMap;
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
@@ -208,7 +179,7 @@ impl Analysis for BasinsRequest {
     }
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<BasinMap, SimError> {
         let spec = self.spec(&model.params)?;
-        in_pool(self.threads, || basins_with(&spec, progress))
+        super::pool::in_pool(self.threads, || basins_with(&spec, progress))
     }
     fn report(&self, model: &Resolved, map: &BasinMap) -> Result<Value, SimError> {
         let spec = self.spec(&model.params)?;

@@ -39,6 +39,7 @@ pub mod curves;
 pub mod dir_lock;
 pub mod limits;
 pub mod model;
+pub mod pool;
 pub mod run;
 pub mod sweep;
 
@@ -47,7 +48,7 @@ pub use analyses::{
     GlobalContinuationRequest, IntegratorRequest, LyapunovRequest, ObserveRequest, OrbitRequest,
     SeriesStore, SimulateRequest, StartRequest, SteadyRequest,
 };
-pub use basins::{in_pool, BasinArrays, BasinsRequest};
+pub use basins::{BasinArrays, BasinsRequest};
 pub use chart::{Chart, ChartArrays, ChartModel, ChartRequest};
 pub use checkpoint::{Checkpoint, CheckpointError, MemoryCheckpoint};
 #[cfg(feature = "files")]
@@ -56,5 +57,8 @@ pub use curves::{approach_request, resonance_request, CurveRequest};
 #[cfg(feature = "files")]
 pub use dir_lock::{DirLock, LockError};
 pub use model::{parameter, ModelSpec, ParamInfo, MODEL_PARAMETERS};
+pub use pool::in_pool;
+#[cfg(feature = "parallel")]
+pub use pool::thread_pool;
 pub use run::{run, Analysis, ApproachRequest, Document, ModesRequest, Resolved, ResonanceRequest};
 pub use sweep::{fingerprint, SweepRecord};
