@@ -280,19 +280,20 @@ fn series_columns(n: usize, su: &SeriesUnits) -> Vec<Column> {
     c
 }
 
-fn sample_row(s: &Sample, su: &SeriesUnits) -> Vec<f64> {
+/// The row of `s` (the columns of [`series_columns`]) in `r`, reused from row to row.
+fn sample_row(s: &Sample, su: &SeriesUnits, r: &mut Vec<f64>) {
     let n = s.state.len() / 2;
-    let mut r = vec![
+    r.clear();
+    r.extend([
         su.t(s.tau),
         su.x(s.v_t),
         su.x(s.w_tip),
         su.v(s.w_tip_dot),
         f64::from(u8::from(s.region == Region::Contact)),
         su.force(s.contact_force),
-    ];
+    ]);
     r.extend(s.state.iter().take(n).map(|&a| su.x(a)));
     r.extend(s.state.iter().skip(n).map(|&a| su.v(a)));
-    r
 }
 
 /// Run `afmdyn simulate`: the run is recorded in chunks of whole periods and every chunk is
@@ -402,12 +403,13 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
         chunk_periods: a.chunk_periods,
     };
     crate::error::stop_on_signal();
+    let mut row = Vec::with_capacity(columns.len());
     let each = |c: &Chunk<'_>| -> Result<(), CliError> {
         // SIGINT/SIGTERM: end here; the streams' partial files are removed as they are dropped
         crate::error::interrupted()?;
         if let Some(fl) = files.as_mut() {
             for s in &c.samples {
-                let row = sample_row(s, &su);
+                sample_row(s, &su, &mut row);
                 fl.npy.push(&row)?;
                 if let Some(csv) = fl.csv.as_mut() {
                     csv_row(csv, row.iter().map(|v| f(*v)))?;
