@@ -304,7 +304,7 @@ pub fn f(v: f64) -> String {
     let mut buf = ryu::Buffer::new();
     let s = buf.format_finite(v);
     let sci = s.contains('e');
-    if sci != !(1e-4..1e16).contains(&a) {
+    if sci == (1e-4..1e16).contains(&a) {
         return afmdyn::error::number(v);
     }
     s.strip_suffix(".0").unwrap_or(s).to_string()
