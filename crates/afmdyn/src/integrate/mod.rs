@@ -136,7 +136,8 @@ pub trait Integrator: Send {
     /// # Errors
     /// [`SimError`] for a non-finite τ or a state of the wrong length or with non-finite entries.
     fn reset(&mut self, tau: f64, z: &DVector<f64>) -> Result<(), SimError>;
-    /// Advance by one step, never past `tau_max`.
+    /// Advance by one step, never past `tau_max` (the exact propagator ends on its grid point
+    /// when `tau_max` is within 4 ulps short of it).
     ///
     /// # Errors
     /// [`SimError::Chattering`], [`SimError::Diverged`] or an integrator failure.

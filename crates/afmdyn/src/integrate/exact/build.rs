@@ -201,6 +201,7 @@ impl ExactPropagator {
             param_data: None,
             param_end: None,
             energy: None,
+            rate_cache: Default::default(),
             bound_cols: BoundCols::default(),
         })
     }

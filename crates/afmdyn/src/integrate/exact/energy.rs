@@ -66,6 +66,17 @@ struct ModalRates {
     lambda: Vec<C>,
 }
 
+/// The factors of [`ModalRates::integrals`] that depend on the step length t alone — the
+/// integrals E(λ_j + λ_k), E(λ_j + λ̄_k) and E(λ_k), E(λ_k ± iΩ) — kept for the last (region,
+/// t, Ω): a run of equal steps (samples between grid points, every step of a recorded period)
+/// computes their exponentials once, not at every step.
+#[derive(Debug, Clone, Default)]
+pub(super) struct RateCache {
+    key: Option<(usize, u64, u64)>,
+    ejk: Vec<(C, C)>,
+    ek: Vec<[C; 3]>,
+}
+
 /// ∫₀ᵗ e^{μs} ds = t φ₁(μt), φ₁(x) = (eˣ − 1)/x, given e^{μt} = `exp_mt`: by φ₁'s series
 /// below |μt| = 1/4 (13 terms: 4⁻¹³/14! < 1e-18), where eˣ − 1 would cancel, else directly.
 fn integral_exp(mu: C, t: f64, exp_mt: C) -> C {
@@ -152,12 +163,15 @@ impl ModalRates {
         }
     }
 
-    /// The three integrals over [τ₀, τ₀ + t] from the modal coordinates q of δz(τ₀).
-    fn integrals(&self, q: &Modes, tau0: f64, t: f64, omega: f64) -> [f64; 3] {
+    /// The step-length factors of [`Self::integrals`] for (region `ri`, t, Ω) in `cache`,
+    /// computed unless they are there already.
+    fn step_factors(&self, ri: usize, t: f64, omega: f64, cache: &mut RateCache) {
+        let key = (ri, t.to_bits(), omega.to_bits());
+        if cache.key == Some(key) {
+            return;
+        }
         let r = self.lambda.len();
-        let qk: Vec<C> = (0..r).map(|k| C::new(q.re[k], q.im[k])).collect();
         let iw = C::new(0.0, omega);
-        let rot = C::from_polar(1.0, omega * tau0);
         // e^{λ_k t} and e^{±iΩt}: the exponentials of the sums below are their products
         let f: Vec<C> = self.lambda.iter().map(|&l| (l * t).exp()).collect();
         let (wp, wm) = {
@@ -165,29 +179,45 @@ impl ModalRates {
             (g, g.conj())
         };
         // E(λ_j + λ_k), E(λ_j + λ̄_k) (shared by the rates)
-        let mut ejk = Vec::new();
+        cache.ejk.clear();
         if self.a.iter().any(|a| !a.is_empty()) {
-            ejk = (0..r * r)
-                .map(|jk| {
-                    let (j, k) = (jk / r, jk % r);
-                    let (lj, lk) = (self.lambda[j], self.lambda[k]);
-                    (
-                        integral_exp(lj + lk, t, f[j] * f[k]),
-                        integral_exp(lj + lk.conj(), t, f[j] * f[k].conj()),
-                    )
-                })
-                .collect();
+            cache.ejk.extend((0..r * r).map(|jk| {
+                let (j, k) = (jk / r, jk % r);
+                let (lj, lk) = (self.lambda[j], self.lambda[k]);
+                (
+                    integral_exp(lj + lk, t, f[j] * f[k]),
+                    integral_exp(lj + lk.conj(), t, f[j] * f[k].conj()),
+                )
+            }));
         }
-        let ek: Vec<[C; 3]> = (0..r)
-            .map(|k| {
-                let l = self.lambda[k];
-                [
-                    integral_exp(l, t, f[k]),
-                    integral_exp(l + iw, t, f[k] * wp),
-                    integral_exp(l - iw, t, f[k] * wm),
-                ]
-            })
-            .collect();
+        cache.ek.clear();
+        cache.ek.extend((0..r).map(|k| {
+            let l = self.lambda[k];
+            [
+                integral_exp(l, t, f[k]),
+                integral_exp(l + iw, t, f[k] * wp),
+                integral_exp(l - iw, t, f[k] * wm),
+            ]
+        }));
+        cache.key = Some(key);
+    }
+
+    /// The three integrals over [τ₀, τ₀ + t] from the modal coordinates q of δz(τ₀), in
+    /// region `ri` (the key of `cache`, which holds the step-length factors).
+    fn integrals(
+        &self,
+        q: &Modes,
+        tau0: f64,
+        t: f64,
+        omega: f64,
+        ri: usize,
+        cache: &mut RateCache,
+    ) -> [f64; 3] {
+        let r = self.lambda.len();
+        self.step_factors(ri, t, omega, cache);
+        let (ejk, ek) = (&cache.ejk, &cache.ek);
+        let qk = |k: usize| C::new(q.re[k], q.im[k]);
+        let rot = C::from_polar(1.0, omega * tau0);
         // the trigonometric integrals ∫cos nΩτ, ∫sin nΩτ over the step (n = 1, 2), in the
         // product form free of cancellation
         let trig_int = |n: f64| {
@@ -210,7 +240,7 @@ impl ModalRates {
             for kk in 0..r {
                 let vh = (pc[kk] - C::new(0.0, 1.0) * ps[kk]) * rot;
                 let vb = (pc[kk] + C::new(0.0, 1.0) * ps[kk]) * rot.conj();
-                lin += qk[kk] * (p0[kk] * ek[kk][0] + 0.5 * (vh * ek[kk][1] + vb * ek[kk][2]));
+                lin += qk(kk) * (p0[kk] * ek[kk][0] + 0.5 * (vh * ek[kk][1] + vb * ek[kk][2]));
             }
             out += lin.re;
             if !self.a[tr].is_empty() {
@@ -218,9 +248,10 @@ impl ModalRates {
                 for j in 0..r {
                     for kk in 0..r {
                         let (ea, eb) = ejk[j * r + kk];
-                        quad += qk[j]
-                            * (self.a[tr][j * r + kk] * qk[kk] * ea
-                                + self.b[tr][j * r + kk] * qk[kk].conj() * eb);
+                        let (qj, qkk) = (qk(j), qk(kk));
+                        quad += qj
+                            * (self.a[tr][j * r + kk] * qkk * ea
+                                + self.b[tr][j * r + kk] * qkk.conj() * eb);
                     }
                 }
                 out += 0.5 * quad.re;
@@ -318,7 +349,9 @@ impl ExactPropagator {
                 me.project_plain(self.last.dz0.as_slice(), &mut q);
                 q
             };
-            return Some(rates.integrals(&q0, self.last.tau0, len, self.model.omega()));
+            let omega = self.model.omega();
+            let (tau0, cache) = (self.last.tau0, &mut self.rate_cache);
+            return Some(rates.integrals(&q0, tau0, len, omega, ri, cache));
         }
         let dim = self.z.len();
         // δz₀ of the step in plain coordinates

@@ -198,6 +198,8 @@ pub struct ExactPropagator {
     /// The tables of the closed-form energy integrals over grid steps (`energy.rs`), built on
     /// the first request.
     energy: Option<Arc<[energy::EnergyTable; 2]>>,
+    /// The step-length factors of the modal closed form for the last (region, step length).
+    rate_cache: energy::RateCache,
     /// The column sums of [`Integrator::displacement_bound`] for the last weights.
     ///
     /// [`Integrator::displacement_bound`]: crate::integrate::Integrator::displacement_bound

@@ -54,7 +54,11 @@ impl ExactPropagator {
         };
         // as PeriodGrid::tau
         let t_grid = next.0 as f64 * self.grid.period + next.1 as f64 * self.grid.h;
-        let tau_b = t_grid.min(tau_max);
+        // a target a few ulps short of the grid point (a sample time start + k·T/S rounded
+        // apart from the grid's p·T + k·h) ends the step on the grid point: the step stays a
+        // whole one (its tables), not a partial one plus a step of an ulp
+        let snap = tau_max < t_grid && t_grid - tau_max <= 4.0 * f64::EPSILON * t_grid.abs();
+        let tau_b = if snap { t_grid } else { t_grid.min(tau_max) };
         let len = tau_b - tau0;
         if len <= 0.0 {
             return Ok(Step {
