@@ -8,7 +8,7 @@ use crate::output::{
 use crate::plot::{decimate_line, save, Figure, Series, Style};
 use afmdyn::analysis::spectrum::{amplitude_spectrum, SPECTRUM_SAMPLES};
 use afmdyn::integrate::build;
-use afmdyn::report::CurveUnits;
+use afmdyn::report::{SeriesNames, SeriesUnits};
 use afmdyn::request::{ConvergeRequest, SeriesStore, SimulateRequest};
 use afmdyn::request::{Document, Resolved};
 use afmdyn::trajectory::chunked::{record_chunked, Chunk, ChunkedSpec};
@@ -176,71 +176,15 @@ struct DataFiles {
     energy: CsvStream,
 }
 
-/// The units of `simulate`'s files and plots: the model's (τ, g₀, its force unit) or, with a
-/// probe, SI (s, m, m/s, N, J) from the probe's scales ([`CurveUnits::from_scales`]).
-#[derive(Debug, Clone, Copy)]
-struct SeriesUnits {
-    u: CurveUnits,
-    /// Hz per unit Ω (spectrum axis), with a probe.
-    hz_per_omega: Option<f64>,
-    point_mass: bool,
-}
-
-impl SeriesUnits {
-    fn new(p: &Params, probe: Option<&afmdyn::probe::Probe>) -> Self {
-        SeriesUnits {
-            u: probe.map_or_else(CurveUnits::dimensionless, |pr| {
-                CurveUnits::from_scales(&pr.scales, true)
-            }),
-            hz_per_omega: probe.map(|pr| pr.scales.frequency_hz(1.0)),
-            point_mass: p.structure == afmdyn::Structure::PointMass,
-        }
-    }
-    fn t(&self, tau: f64) -> f64 {
-        tau * self.u.time
-    }
-    fn x(&self, v: f64) -> f64 {
-        v * self.u.length
-    }
-    fn v(&self, v: f64) -> f64 {
-        v * self.u.length / self.u.time
-    }
-    fn force(&self, v: f64) -> f64 {
-        v * self.u.force
-    }
-    fn energy(&self, v: f64) -> f64 {
-        v * self.u.energy
-    }
-    /// (time column, time unit, length unit, velocity unit, force unit, energy unit).
-    fn names(
-        &self,
-    ) -> (
-        &'static str,
-        &'static str,
-        &'static str,
-        &'static str,
-        &'static str,
-        &'static str,
-    ) {
-        if self.u.si {
-            ("t", "s", "m", "m/s", "N", "J")
-        } else if self.point_mass {
-            ("tau", "τ (eq. 5)", "g0", "g0 per unit τ", "k g0", "k g0²")
-        } else {
-            (
-                "tau",
-                "τ (eq. 5)",
-                "g0",
-                "g0 per unit τ",
-                "EI g0/L³",
-                "EI g0²/L³",
-            )
-        }
-    }
-}
-
 fn series_columns(n: usize, su: &SeriesUnits) -> Vec<Column> {
-    let (t, tu, len, vel, force, _) = su.names();
+    let SeriesNames {
+        time: t,
+        time_unit: tu,
+        length: len,
+        velocity: vel,
+        force,
+        ..
+    } = su.names();
     let time = if su.u.si {
         "time t = τ t_s (t_s: seconds per unit τ, the probe's scales)"
     } else {
@@ -349,11 +293,11 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
             },
             events: csv_stream(
                 &o.join("events.csv"),
-                &[su.names().0, "from", "to", "v_t_dot"],
+                &[su.names().time, "from", "to", "v_t_dot"],
             )?,
             poincare: csv_stream(
                 &o.join("poincare.csv"),
-                &[su.names().0, "v_t", "w_tip", "w_tip_dot"],
+                &[su.names().time, "v_t", "w_tip", "w_tip_dot"],
             )?,
             energy: csv_stream(
                 &o.join("energy.csv"),

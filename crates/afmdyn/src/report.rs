@@ -338,6 +338,97 @@ impl CurveUnits {
     }
 }
 
+/// The units of a recorded trajectory's files and plots (`simulate`): the model's (τ, g₀, its
+/// force and energy units) or, with a probe, SI (s, m, m/s, N, J, Hz) from its scales
+/// ([`CurveUnits::from_scales`]). The one place a time series is converted; every factor
+/// multiplies a dimensionless value.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SeriesUnits {
+    /// The factors (time, length, force, energy; `si`).
+    pub u: CurveUnits,
+    /// Hz per unit Ω (a spectrum's frequencies), with a probe.
+    pub hz_per_omega: Option<f64>,
+    /// The point-mass model (force unit k g₀ rather than EI g₀/L³).
+    pub point_mass: bool,
+}
+
+/// The names of [`SeriesUnits`]: the time column and the units of each kind of quantity.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SeriesNames {
+    /// The time column: `t` (SI) or `tau`.
+    pub time: &'static str,
+    /// Its unit.
+    pub time_unit: &'static str,
+    /// Lengths (V_T, W, modal coordinates).
+    pub length: &'static str,
+    /// Velocities.
+    pub velocity: &'static str,
+    /// Forces.
+    pub force: &'static str,
+    /// Energies.
+    pub energy: &'static str,
+}
+
+impl SeriesUnits {
+    /// The units of `params`' trajectories, SI when `probe` is given.
+    pub fn new(params: &Params, probe: Option<&crate::probe::Probe>) -> Self {
+        SeriesUnits {
+            u: probe.map_or_else(CurveUnits::dimensionless, |pr| {
+                CurveUnits::from_scales(&pr.scales, true)
+            }),
+            hz_per_omega: probe.map(|pr| pr.scales.frequency_hz(1.0)),
+            point_mass: params.structure == crate::Structure::PointMass,
+        }
+    }
+    /// A time τ in the reported unit.
+    pub fn t(&self, tau: f64) -> f64 {
+        tau * self.u.time
+    }
+    /// A length (g₀) in the reported unit.
+    pub fn x(&self, v: f64) -> f64 {
+        v * self.u.length
+    }
+    /// A velocity (g₀ per unit τ) in the reported unit.
+    pub fn v(&self, v: f64) -> f64 {
+        v * self.u.length / self.u.time
+    }
+    /// A force in the reported unit.
+    pub fn force(&self, v: f64) -> f64 {
+        v * self.u.force
+    }
+    /// An energy in the reported unit.
+    pub fn energy(&self, v: f64) -> f64 {
+        v * self.u.energy
+    }
+    /// The names of the reported units.
+    pub fn names(&self) -> SeriesNames {
+        let (force, energy) = match (self.u.si, self.point_mass) {
+            (true, _) => ("N", "J"),
+            (false, true) => ("k g0", "k g0²"),
+            (false, false) => ("EI g0/L³", "EI g0²/L³"),
+        };
+        if self.u.si {
+            SeriesNames {
+                time: "t",
+                time_unit: "s",
+                length: "m",
+                velocity: "m/s",
+                force,
+                energy,
+            }
+        } else {
+            SeriesNames {
+                time: "tau",
+                time_unit: "τ (eq. 5)",
+                length: "g0",
+                velocity: "g0 per unit τ",
+                force,
+                energy,
+            }
+        }
+    }
+}
+
 /// The per-point columns of a stepped-curve document, in this order after the abscissa.
 pub const CURVE_COLUMNS: [&str; 12] = [
     "amplitude",

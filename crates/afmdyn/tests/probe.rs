@@ -526,3 +526,24 @@ fn unit_slips_are_refused_with_the_meant_reading() {
     // the example itself passes every check
     assert!(Probe::parse(&full, "example.toml").is_ok());
 }
+
+/// The units of a recorded trajectory: the probe's scales in SI (a velocity is a length over
+/// a time), the model's own without a probe (factors 1; the point mass's force unit k g0).
+#[test]
+fn series_units_are_the_probe_scales() {
+    use afmdyn::report::SeriesUnits;
+    let text = std::fs::read_to_string("../../examples/probe-point-mass-dmt.toml").unwrap();
+    let probe = Probe::parse(&text, "pm.toml").unwrap();
+    let s = &probe.scales;
+    let si = SeriesUnits::new(&probe.params, Some(&probe));
+    assert_eq!(si.t(2.0), 2.0 * s.time_s);
+    assert_eq!(si.x(3.0), 3.0 * s.length_m);
+    assert_eq!(si.v(1.0), s.length_m / s.time_s);
+    assert_eq!(si.force(1.0), s.force_n);
+    assert_eq!(si.energy(1.0), s.energy_j());
+    assert_eq!(si.hz_per_omega, Some(s.frequency_hz(1.0)));
+    assert_eq!((si.names().time, si.names().force), ("t", "N"));
+    let plain = SeriesUnits::new(&probe.params, None);
+    assert_eq!((plain.t(2.0), plain.x(3.0), plain.v(4.0)), (2.0, 3.0, 4.0));
+    assert_eq!((plain.names().time, plain.names().force), ("tau", "k g0"));
+}
