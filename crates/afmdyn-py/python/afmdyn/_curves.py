@@ -159,11 +159,9 @@ def curve_dataset(command: str, doc: Dict[str, Any]) -> xr.Dataset:
                 len(traces[x]), len(traces["time_periods"])
             )
             data[f"trace_{var}"] = (("trace", "trace_time"), values, _attrs(units, k, long_name))
-    attrs = {
-        "title": f"afmdyn {command}",
-        "summary": json.dumps(doc),
-        "free_amplitude": doc["free_amplitude"],
-    }
+    attrs: Dict[str, Any] = {"title": f"afmdyn {command}", "summary": json.dumps(doc)}
+    if doc.get("free_amplitude") is not None:  # attrs must be storable in NetCDF
+        attrs["free_amplitude"] = doc["free_amplitude"]
     return xr.Dataset(data, coords=coords, attrs=attrs)
 
 
