@@ -295,47 +295,68 @@ pub fn simulate<'py>(
     })??;
     let out = Out::new(py);
     out.json(&report::with_si(c.doc.clone(), probe.as_ref(), &p))?;
+    // with a probe every array in SI (s, m, m/s, N, J, Hz; the command line's simulate
+    // files), else the model's units: factors 1 (report::SeriesUnits)
+    let su = report::SeriesUnits::new(&p, probe.as_ref());
+    let by = |v: Vec<f64>, f: &dyn Fn(f64) -> f64| -> Vec<f64> { v.into_iter().map(f).collect() };
+    let (t, x, v, force, energy) = (
+        |a| su.t(a),
+        |a| su.x(a),
+        |a| su.v(a),
+        |a| su.force(a),
+        |a| su.energy(a),
+    );
     let s = c.tau.len();
     let n = c.n;
-    out.f64s("tau", c.tau)?;
-    out.f64s("v_t", c.v_t)?;
-    out.f64s("v_t_dot", c.v_t_dot)?;
     // the amplitude spectrum of W(1,τ) over the last samples, as the command line's
     // spectrum.csv
     let tail = &c.w_tip[c.w_tip.len().saturating_sub(SPECTRUM_SAMPLES)..];
+    let hz = su.hz_per_omega.unwrap_or(1.0);
     let (freq, amp): (Vec<f64>, Vec<f64>) = amplitude_spectrum(tail, samples_per_period, p.omega)
         .into_iter()
+        .map(|(w, a)| (w * hz, x(a)))
         .unzip();
+    out.f64s("tau", by(c.tau, &t))?;
+    out.f64s("v_t", by(c.v_t, &x))?;
+    out.f64s("v_t_dot", by(c.v_t_dot, &v))?;
     out.f64s("spectrum_frequency", freq)?;
     out.f64s("spectrum", amp)?;
-    out.f64s("w_tip", c.w_tip)?;
-    out.f64s("w_tip_dot", c.w_tip_dot)?;
+    out.f64s("w_tip", by(c.w_tip, &x))?;
+    out.f64s("w_tip_dot", by(c.w_tip_dot, &v))?;
     out.bools("in_contact", c.in_contact)?;
-    out.f64s("contact_force", c.contact_force)?;
-    out.matrix("a", s, n, c.a)?;
-    out.matrix("a_dot", s, n, c.a_dot)?;
-    out.f64s("event_tau", c.event_tau)?;
+    out.f64s("contact_force", by(c.contact_force, &force))?;
+    out.matrix("a", s, n, by(c.a, &x))?;
+    out.matrix("a_dot", s, n, by(c.a_dot, &v))?;
+    out.f64s("event_tau", by(c.event_tau, &t))?;
     out.bools("event_to_contact", c.event_to_contact)?;
-    out.f64s("event_v_t_dot", c.event_v_t_dot)?;
+    out.f64s("event_v_t_dot", by(c.event_v_t_dot, &v))?;
     let ps = c.section_tau.len();
-    out.f64s("section_tau", c.section_tau)?;
-    out.f64s("section_v_t", c.section_v_t)?;
-    out.f64s("section_w_tip", c.section_w_tip)?;
-    out.f64s("section_w_tip_dot", c.section_w_tip_dot)?;
-    out.matrix("section_state", ps, 2 * n, c.section_state)?;
+    out.f64s("section_tau", by(c.section_tau, &t))?;
+    out.f64s("section_v_t", by(c.section_v_t, &x))?;
+    out.f64s("section_w_tip", by(c.section_w_tip, &x))?;
+    out.f64s("section_w_tip_dot", by(c.section_w_tip_dot, &v))?;
+    // rows of (a, ȧ): the first N of each row lengths, the rest velocities
+    let state: Vec<f64> = c
+        .section_state
+        .into_iter()
+        .enumerate()
+        .map(|(i, a)| if i % (2 * n) < n { x(a) } else { v(a) })
+        .collect();
+    out.matrix("section_state", ps, 2 * n, state)?;
     let [tau0, e_start, e_end, base, beam, contact, residual] = c.energy;
-    out.f64s("energy_tau0", tau0)?;
-    out.f64s("energy_start", e_start)?;
-    out.f64s("energy_end", e_end)?;
-    out.f64s("base_work", base)?;
-    out.f64s("beam_dissipation", beam)?;
-    out.f64s("contact_dissipation", contact)?;
-    out.f64s("energy_residual", residual)?;
-    out.set("tau_end", c.tau_end)?;
+    out.f64s("energy_tau0", by(tau0, &t))?;
+    out.f64s("energy_start", by(e_start, &energy))?;
+    out.f64s("energy_end", by(e_end, &energy))?;
+    out.f64s("base_work", by(base, &energy))?;
+    out.f64s("beam_dissipation", by(beam, &energy))?;
+    out.f64s("contact_dissipation", by(contact, &energy))?;
+    out.f64s("energy_residual", by(residual, &energy))?;
+    out.set("tau_end", t(c.tau_end))?;
     out.set("switchings", c.switchings)?;
     out.set("body_contact", c.body_contact)?;
     out.set("integrator", c.integrator)?;
-    out.set("transient_tau", t_transient)?;
+    out.set("transient_tau", t(t_transient))?;
+    out.set("si", su.u.si)?;
     Ok(out.finish())
 }
 

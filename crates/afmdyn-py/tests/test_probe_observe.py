@@ -110,3 +110,28 @@ def test_observe_with_a_probe_is_in_si():
     assert units == {"amplitude": "m", "peak_force": "N", "virial": "J", "phase_deg": "degree"}
     assert float(ds.mode_sample.sel(mode=0)) == pytest.approx(
         doc["mode_balance"][0]["sample"] * s["energy_j"], rel=1e-15, abs=1e-40)
+
+
+def test_simulate_with_a_probe_is_in_si_as_the_command_line(cli, tmp_path):
+    """``simulate(probe=...)`` returns the command line's SI time series (``simulate --probe``
+    writes s, m, m/s, N): the same numbers, the units in the attrs; without a probe the
+    model's units (the point mass's force in k g0)."""
+    import numpy as np
+
+    ds = afmdyn.simulate(probe=str(PM), periods=40)
+    run = cli("simulate", "--probe", PM, "--periods", "40", "--files", "data", "--out", tmp_path)
+    assert run.returncode == 0, run.stderr
+    npy = np.load(tmp_path / "timeseries.npy")
+    names = ["t", "v_t", "w_tip", "w_tip_dot", "in_contact", "contact_force"]
+    for k, (name, var) in enumerate(zip(names, ["tau", "v_t", "w_tip", "w_tip_dot"])):
+        np.testing.assert_array_equal(ds[var].values, npy[:, k], err_msg=name)
+    np.testing.assert_array_equal(ds.contact_force.values, npy[:, 5])
+    np.testing.assert_array_equal(ds.a.values[:, 0], npy[:, 6])
+    units = {v: ds[v].attrs["units"] for v in ("tau", "w_tip", "w_tip_dot", "contact_force",
+                                               "energy_start", "frequency")}
+    assert units == {"tau": "s", "w_tip": "m", "w_tip_dot": "m/s", "contact_force": "N",
+                     "energy_start": "J", "frequency": "Hz"}
+    period = afmdyn.probe(PM)["si"]["period_s"]
+    assert abs(ds.section_tau.values[1] - ds.section_tau.values[0] - period) < 1e-9 * period
+    plain = afmdyn.simulate(afmdyn.Params.from_probe(PM), periods=2)
+    assert plain.contact_force.attrs["units"] == "k g0" and plain.tau.attrs["units"] == "t0"

@@ -287,7 +287,11 @@ def simulate(
         ``[P, 2N]``; the energy balance per period ``[C]``; ``spectrum`` ``[F]`` over dim
         ``frequency`` (the amplitude spectrum of W(1,τ) over the last ≤ 2²⁰ samples, the
         command line's ``spectrum.csv``). ``attrs["summary"]`` holds
-        ``afmdyn simulate --json`` (see :func:`summary`).
+        ``afmdyn simulate --json`` (see :func:`summary`). Units: the model's (τ in t0,
+        lengths in g0, forces E I g0/L³, or k g0 for the point mass); with ``probe`` every
+        array is in SI, as the command line's files — times (the ``tau`` coordinate, events,
+        sections) in s, lengths in m, velocities in m/s, forces in N, energies in J, the
+        spectrum's frequencies in Hz — each variable's unit in its attrs.
     """
     p, probe = _params(params, model)
     d = _run(
@@ -307,21 +311,30 @@ def simulate(
     )
     n = p.modes
     comp = [f"a_{j}" for j in range(1, n + 1)] + [f"a_dot_{j}" for j in range(1, n + 1)]
+    # with a probe the library returned every array in SI (report::SeriesUnits)
+    si = bool(d["si"])
+    point_mass = p.structure == "point-mass"
+    _t = {"units": "s", "long_name": "time t"} if si else _T
+    _g = {"units": "m"} if si else _G
+    _v = {"units": "m/s"} if si else _V
+    force = "N" if si else ("k g0" if point_mass else "E I g0/L^3")
+    energy = "J" if si else ("k g0^2" if point_mass else "E I g0^2/L^3")
+    freq = "Hz" if si else "Ω units (1/t0)"
     ds = xr.Dataset(
         data_vars={
-            "v_t": ("tau", d["v_t"], {**_G, "long_name": "tip–sample distance V_T (eq. 8)"}),
-            "v_t_dot": ("tau", d["v_t_dot"], {**_V, "long_name": "dV_T/dτ"}),
-            "w_tip": ("tau", d["w_tip"], {**_G, "long_name": "tip deflection W(1,τ)"}),
-            "w_tip_dot": ("tau", d["w_tip_dot"], {**_V, "long_name": "∂W(1,τ)/∂τ"}),
+            "v_t": ("tau", d["v_t"], {**_g, "long_name": "tip–sample distance V_T (eq. 8)"}),
+            "v_t_dot": ("tau", d["v_t_dot"], {**_v, "long_name": "dV_T/dτ"}),
+            "w_tip": ("tau", d["w_tip"], {**_g, "long_name": "tip deflection W(1,τ)"}),
+            "w_tip_dot": ("tau", d["w_tip_dot"], {**_v, "long_name": "∂W(1,τ)/∂τ"}),
             "in_contact": ("tau", d["in_contact"], {"long_name": "tip on the sample (region II)"}),
             "contact_force": (
                 "tau",
                 d["contact_force"],
-                {"units": "E I g0/L^3", "long_name": "tip–sample contact force"},
+                {"units": force, "long_name": "tip–sample contact force"},
             ),
-            "a": (("tau", "mode"), d["a"], {**_G, "long_name": "modal displacement a_i"}),
-            "a_dot": (("tau", "mode"), d["a_dot"], {**_V, "long_name": "modal velocity da_i/dτ"}),
-            "event_tau": ("event", d["event_tau"], {**_T, "long_name": "switching time"}),
+            "a": (("tau", "mode"), d["a"], {**_g, "long_name": "modal displacement a_i"}),
+            "a_dot": (("tau", "mode"), d["a_dot"], {**_v, "long_name": "modal velocity da_i/dτ"}),
+            "event_tau": ("event", d["event_tau"], {**_t, "long_name": "switching time"}),
             "event_to_contact": (
                 "event",
                 d["event_to_contact"],
@@ -330,72 +343,72 @@ def simulate(
             "event_v_t_dot": (
                 "event",
                 d["event_v_t_dot"],
-                {**_V, "long_name": "dV_T/dτ at the switching (impact velocity)"},
+                {**_v, "long_name": "dV_T/dτ at the switching (impact velocity)"},
             ),
-            "section_tau": ("section", d["section_tau"], {**_T, "long_name": "section time 2πk/Ω"}),
-            "section_v_t": ("section", d["section_v_t"], {**_G, "long_name": "V_T at the section"}),
+            "section_tau": ("section", d["section_tau"], {**_t, "long_name": "section time 2πk/Ω"}),
+            "section_v_t": ("section", d["section_v_t"], {**_g, "long_name": "V_T at the section"}),
             "section_w_tip": (
                 "section",
                 d["section_w_tip"],
-                {**_G, "long_name": "W(1,τ) at the section"},
+                {**_g, "long_name": "W(1,τ) at the section"},
             ),
             "section_w_tip_dot": (
                 "section",
                 d["section_w_tip_dot"],
-                {**_V, "long_name": "∂W(1,τ)/∂τ at the section"},
+                {**_v, "long_name": "∂W(1,τ)/∂τ at the section"},
             ),
             "section_state": (
                 ("section", "component"),
                 d["section_state"],
                 {"long_name": "state (a, da/dτ) at the section"},
             ),
-            "energy_tau0": ("cycle", d["energy_tau0"], {**_T, "long_name": "start of the period"}),
+            "energy_tau0": ("cycle", d["energy_tau0"], {**_t, "long_name": "start of the period"}),
             "energy_start": (
                 "cycle",
                 d["energy_start"],
-                {"units": "E I g0^2/L^3", "long_name": "stored energy at the start"},
+                {"units": energy, "long_name": "stored energy at the start"},
             ),
             "energy_end": (
                 "cycle",
                 d["energy_end"],
-                {"units": "E I g0^2/L^3", "long_name": "stored energy at the end"},
+                {"units": energy, "long_name": "stored energy at the end"},
             ),
             "base_work": (
                 "cycle",
                 d["base_work"],
-                {"units": "E I g0^2/L^3", "long_name": "work of the base drive"},
+                {"units": energy, "long_name": "work of the base drive"},
             ),
             "beam_dissipation": (
                 "cycle",
                 d["beam_dissipation"],
-                {"units": "E I g0^2/L^3", "long_name": "beam damping loss"},
+                {"units": energy, "long_name": "beam damping loss"},
             ),
             "contact_dissipation": (
                 "cycle",
                 d["contact_dissipation"],
                 {
-                    "units": "E I g0^2/L^3",
+                    "units": energy,
                     "long_name": "dissipation in the sample (contact damping, impacts)",
                 },
             ),
             "energy_residual": (
                 "cycle",
                 d["energy_residual"],
-                {"units": "E I g0^2/L^3", "long_name": "ΔE − (work − losses)"},
+                {"units": energy, "long_name": "ΔE − (work − losses)"},
             ),
             "spectrum": (
                 "frequency",
                 d["spectrum"],
-                {**_G, "long_name": "amplitude spectrum of W(1,τ) (spectrum.csv)"},
+                {**_g, "long_name": "amplitude spectrum of W(1,τ) (spectrum.csv)"},
             ),
         },
         coords={
             "frequency": (
                 "frequency",
                 d["spectrum_frequency"],
-                {"units": "Ω units (1/t0)", "long_name": "frequency"},
+                {"units": freq, "long_name": "frequency"},
             ),
-            "tau": ("tau", d["tau"], _T),
+            "tau": ("tau", d["tau"], _t),
             "mode": ("mode", np.arange(1, n + 1), {"long_name": "Galerkin mode i"}),
             "component": ("component", comp),
         },
