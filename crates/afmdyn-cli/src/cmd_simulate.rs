@@ -531,7 +531,7 @@ fn write_spectrum_and_plots(
     let period = p.period();
     let window = spectrum.len();
     let data: Vec<f64> = spectrum.into();
-    let hz = su.hz_per_omega.unwrap_or(1.0);
+    let hz = su.u.hz_per_omega.unwrap_or(1.0);
     let spec: Vec<(f64, f64)> = amplitude_spectrum(&data, spp, p.omega)
         .into_iter()
         .map(|(w, a)| (w * hz, su.x(a)))

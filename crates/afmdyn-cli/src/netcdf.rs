@@ -35,6 +35,24 @@ pub struct Var<'a> {
 }
 
 impl<'a> Var<'a> {
+    /// A variable of `values` with no further attributes.
+    fn new(
+        name: &'a str,
+        dims: &'a [&'a str],
+        units: &'a str,
+        long_name: impl Into<String>,
+        values: Values<'a>,
+    ) -> Self {
+        Var {
+            name,
+            dims,
+            units,
+            long_name: long_name.into(),
+            values,
+            attrs: Vec::new(),
+        }
+    }
+
     /// A float variable.
     pub fn f64(
         name: &'a str,
@@ -43,14 +61,7 @@ impl<'a> Var<'a> {
         long_name: impl Into<String>,
         values: &'a [f64],
     ) -> Self {
-        Var {
-            name,
-            dims,
-            units,
-            long_name: long_name.into(),
-            values: Values::F64(values),
-            attrs: Vec::new(),
-        }
+        Var::new(name, dims, units, long_name, Values::F64(values))
     }
 
     /// An integer variable.
@@ -61,14 +72,7 @@ impl<'a> Var<'a> {
         long_name: impl Into<String>,
         values: &'a [i32],
     ) -> Self {
-        Var {
-            name,
-            dims,
-            units,
-            long_name: long_name.into(),
-            values: Values::I32(values),
-            attrs: Vec::new(),
-        }
+        Var::new(name, dims, units, long_name, Values::I32(values))
     }
 }
 

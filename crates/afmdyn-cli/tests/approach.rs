@@ -117,11 +117,10 @@ fn approach_json_has_equal_length_si_arrays_and_a_marked_bistable_range() {
     }
 }
 
-#[test]
-fn approach_writes_csv_npy_and_plots() {
-    let dir = std::env::temp_dir().join(format!("afmdyn-approach-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    let out = afmdyn(&[
+/// `approach` on the example probe over z_c = 11 … 6 nm (11 points, no branches), then
+/// `extra`: the run the file tests share.
+fn probe_approach<'a>(extra: &[&'a str]) -> Vec<&'a str> {
+    let mut a = vec![
         "approach",
         "--probe",
         "examples/probe-point-mass-dmt.toml",
@@ -132,9 +131,16 @@ fn approach_writes_csv_npy_and_plots() {
         "--points",
         "11",
         "--no-branches",
-        "--out",
-        dir.to_str().unwrap(),
-    ]);
+    ];
+    a.extend_from_slice(extra);
+    a
+}
+
+#[test]
+fn approach_writes_csv_npy_and_plots() {
+    let dir = std::env::temp_dir().join(format!("afmdyn-approach-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let out = afmdyn(&probe_approach(&["--out", dir.to_str().unwrap()]));
     assert!(
         out.status.success(),
         "{}",
@@ -167,21 +173,7 @@ fn approach_writes_csv_npy_and_plots() {
         .collect();
     assert_eq!(rows.len(), 22, "11 approach + 11 retract rows");
     // the columns hold the JSON's values: the approach's rows are its sweep
-    let doc = json(&[
-        "approach",
-        "--probe",
-        "examples/probe-point-mass-dmt.toml",
-        "--from",
-        "11e-9",
-        "--to",
-        "6e-9",
-        "--points",
-        "11",
-        "--no-branches",
-        "--files",
-        "none",
-        "--json",
-    ]);
+    let doc = json(&probe_approach(&["--files", "none", "--json"]));
     for (k, name) in header[..13].iter().enumerate() {
         for (i, r) in rows[..11].iter().enumerate() {
             let want = doc["approach"][*name][i].as_f64().unwrap();

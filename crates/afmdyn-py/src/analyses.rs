@@ -311,7 +311,7 @@ pub fn simulate<'py>(
     // the amplitude spectrum of W(1,τ) over the last samples, as the command line's
     // spectrum.csv
     let tail = &c.w_tip[c.w_tip.len().saturating_sub(SPECTRUM_SAMPLES)..];
-    let hz = su.hz_per_omega.unwrap_or(1.0);
+    let hz = su.u.hz_per_omega.unwrap_or(1.0);
     let (freq, amp): (Vec<f64>, Vec<f64>) = amplitude_spectrum(tail, samples_per_period, p.omega)
         .into_iter()
         .map(|(w, a)| (w * hz, x(a)))

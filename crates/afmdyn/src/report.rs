@@ -344,10 +344,8 @@ impl CurveUnits {
 /// multiplies a dimensionless value.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SeriesUnits {
-    /// The factors (time, length, force, energy; `si`).
+    /// The factors (time, length, force, energy, Hz per unit Ω for a spectrum; `si`).
     pub u: CurveUnits,
-    /// Hz per unit Ω (a spectrum's frequencies), with a probe.
-    pub hz_per_omega: Option<f64>,
     /// The point-mass model (force unit k g₀ rather than EI g₀/L³).
     pub point_mass: bool,
 }
@@ -376,7 +374,6 @@ impl SeriesUnits {
             u: probe.map_or_else(CurveUnits::dimensionless, |pr| {
                 CurveUnits::from_scales(&pr.scales, true)
             }),
-            hz_per_omega: probe.map(|pr| pr.scales.frequency_hz(1.0)),
             point_mass: params.structure == crate::Structure::PointMass,
         }
     }

@@ -541,7 +541,7 @@ fn series_units_are_the_probe_scales() {
     assert_eq!(si.v(1.0), s.length_m / s.time_s);
     assert_eq!(si.force(1.0), s.force_n);
     assert_eq!(si.energy(1.0), s.energy_j());
-    assert_eq!(si.hz_per_omega, Some(s.frequency_hz(1.0)));
+    assert_eq!(si.u.hz_per_omega, Some(s.frequency_hz(1.0)));
     assert_eq!((si.names().time, si.names().force), ("t", "N"));
     let plain = SeriesUnits::new(&probe.params, None);
     assert_eq!((plain.t(2.0), plain.x(3.0), plain.v(4.0)), (2.0, 3.0, 4.0));
