@@ -196,7 +196,8 @@ impl ModelArgs {
 pub struct IntegratorArgs {
     /// Time integrator: auto (exact for the linear law, split for Hertz and impact, adaptive
     /// for DMT; default), exact (piecewise-exact), split (exact free flight, adaptive in
-    /// contact), rk4 (located switchings), rk4-naive (region per stage, as in the paper) or
+    /// contact), exponential (adaptive DOP853 of the deviation from the exact free flight:
+    /// Lawson), rk4 (located switchings), rk4-naive (region per stage, as in the paper) or
     /// adaptive (DOP853 with events and variational equations)
     #[arg(long, default_value = "auto", value_parser = parse_integrator)]
     pub integrator: IntegratorKind,

@@ -10,6 +10,10 @@
 //! With the linear law, `PROPAGATION=dense|modal` in the environment forces the exact
 //! propagator's path ([`Propagation`]).
 //!
+//! `... -- probe <FILE.toml> [periods] [...]`: the same for the model of a probe file. With
+//! `INTEGRATOR=<kind>` in the environment (auto, adaptive, exponential, split, ...) the
+//! integrator is that kind instead of `auto`.
+//!
 //! `... -- build <N> [reps]`: time of one exact-propagator build at the default parameters,
 //! without and with reuse of earlier builds ([`ExactOptions::reuse`]), and of a build after a
 //! change of Ω by 1e-6 (spectral data reused, grid exponential and particular solution redone).
@@ -150,7 +154,12 @@ fn continuation(modes: usize, reps: usize) -> Result<(), Box<dyn std::error::Err
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
     let first = args.next().unwrap_or_else(|| "linear".into());
-    let modes: usize = args.next().map_or(Ok(3), |s| s.parse())?;
+    let second = args.next();
+    let modes: usize = if first == "probe" {
+        1
+    } else {
+        second.as_deref().map_or(Ok(3), str::parse)?
+    };
     match first.as_str() {
         "build" => return builds(modes, args.next().map_or(Ok(200), |s| s.parse())?),
         "shoot" => return shooting(modes, args.next().map_or(Ok(200), |s| s.parse())?),
@@ -170,16 +179,30 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
         _ => {}
     }
-    let law: LawKind = first.parse()?;
     let periods: f64 = args.next().map_or(Ok(200.0), |s| s.parse())?;
     let which = args.next().unwrap_or_else(|| "both".into());
-    let p = Params {
-        modes,
-        contact_law: law.with_groups(None, None, None),
-        ..Params::default()
+    let p = if first == "probe" {
+        // `probe <file>`: the model of a probe file (the mode count argument is the file)
+        let path = std::env::args().nth(2).unwrap_or_default();
+        afmdyn::probe::Probe::parse(&std::fs::read_to_string(&path)?, &path)?.params
+    } else {
+        let law: LawKind = first.parse()?;
+        Params {
+            modes,
+            contact_law: law.with_groups(None, None, None),
+            ..Params::default()
+        }
     };
     let m = CantileverModel::new(&p)?;
-    let mut it = build(&m, IntegratorOptions::default(), 0.0, &m.rest())?;
+    let kind = match std::env::var("INTEGRATOR") {
+        Ok(k) => k.parse()?,
+        Err(_) => afmdyn::integrate::IntegratorKind::Auto,
+    };
+    let opts = IntegratorOptions {
+        kind,
+        ..IntegratorOptions::default()
+    };
+    let mut it = build(&m, opts, 0.0, &m.rest())?;
     let forced = match std::env::var("PROPAGATION").as_deref() {
         Ok("dense") => Some(Propagation::Dense),
         Ok("modal") => Some(Propagation::Auto),

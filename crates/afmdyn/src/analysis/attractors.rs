@@ -240,7 +240,10 @@ pub(crate) fn polish_steady(
     let n = steady.period()?;
     if !matches!(
         integrator.kind.resolve(model),
-        IntegratorKind::Exact | IntegratorKind::Adaptive | IntegratorKind::Split
+        IntegratorKind::Exact
+            | IntegratorKind::Adaptive
+            | IntegratorKind::Split
+            | IntegratorKind::Exponential
     ) {
         return None;
     }

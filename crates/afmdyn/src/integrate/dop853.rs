@@ -27,7 +27,7 @@ pub(crate) trait Field {
 
 /// Nodes c of the 12 stages and of the 3 dense-output stages (indices 13–15; 12 is the
 /// derivative at the step's end).
-const C: [f64; 16] = [
+pub(crate) const C: [f64; 16] = [
     0.0,
     5.260_015_195_876_773E-2,
     7.890_022_793_815_16E-2,

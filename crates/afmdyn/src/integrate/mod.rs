@@ -11,11 +11,17 @@
 //! * [`adaptive::Adaptive`] — DOP853 (our allocation-free stepper, `integrate/dop853.rs`) driven step by step,
 //!   generic over the [`TipSampleSystem`] (`Adaptive<S>`) and written against
 //!   [`crate::system::HybridSystem`]: any contact law, located events with jumps (impacts,
-//!   sticking), and the variational equations for step Jacobians. The default for every law
-//!   except the linear one, and the independent oracle for the linear law.
+//!   sticking), and the variational equations for step Jacobians. The default for DMT and the
+//!   independent oracle of every other integrator; in the exponential frame
+//!   ([`adaptive::Adaptive::exponential`], Lawson's transformation, `exact/lawson.rs`; opt-in,
+//!   see docs/performance.md for why it is not the default) it integrates only the deviation
+//!   from the exact free flight.
+//! * [`split::Split`] — the exact free flight and the adaptive integrator in contact: the
+//!   default for Hertz and impact.
 //!
-//! [`IntegratorKind::Auto`] (the default) chooses the exact propagator for the linear law and
-//! the adaptive integrator otherwise.
+//! [`IntegratorKind::Auto`] (the default) chooses the exact propagator for the linear law, the
+//! split integrator for Hertz and impact, and the adaptive integrator for DMT
+//! ([`IntegratorKind::resolve`]).
 //!
 //! A driver calls [`Integrator::step`] until the target time; each step ends at a grid point,
 //! at `tau_max`, or at an event (switching, impact, sticking, release), which it reports as a
@@ -448,7 +454,8 @@ pub fn advance_observed(
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(rename_all = "kebab-case")]
 pub enum IntegratorKind {
-    /// The exact propagator for the linear law, the adaptive integrator otherwise (default).
+    /// The exact propagator for the linear law, the split integrator for Hertz and impact, the
+    /// adaptive integrator for DMT (default; [`IntegratorKind::resolve`]).
     #[default]
     Auto,
     /// Exact piecewise-linear propagation (linear law only).
@@ -461,6 +468,11 @@ pub enum IntegratorKind {
     Adaptive,
     /// Exact free flight, adaptive DOP853 in contact ([`split::Split`]; every law but DMT).
     Split,
+    /// Adaptive DOP853 of the deviation from the exact free flight (Lawson's exponential frame,
+    /// [`adaptive::Adaptive::exponential`]): for DMT, whose van der Waals force acts in free
+    /// flight. Opt-in: fewer steps, but its dense output costs an exponential and two sines per
+    /// evaluation, so recorded runs are slower (docs/performance.md).
+    Exponential,
 }
 
 impl FromStr for IntegratorKind {
@@ -473,8 +485,10 @@ impl FromStr for IntegratorKind {
             "rk4-naive" | "rk4_naive" => Ok(IntegratorKind::Rk4Naive),
             "adaptive" | "dop853" => Ok(IntegratorKind::Adaptive),
             "split" => Ok(IntegratorKind::Split),
+            "exponential" | "lawson" => Ok(IntegratorKind::Exponential),
             _ => Err(format!(
-                "integrator '{s}': expected auto, exact, rk4, rk4-naive, adaptive or split"
+                "integrator '{s}': expected auto, exact, rk4, rk4-naive, adaptive, split or \
+                 exponential"
             )),
         }
     }
@@ -576,7 +590,10 @@ pub fn build(
     // that would need more steps than the budget, are refused before any work is done
     check_start(z)?;
     let kind = opts.kind.resolve(model);
-    if matches!(kind, IntegratorKind::Adaptive | IntegratorKind::Split) {
+    if matches!(
+        kind,
+        IntegratorKind::Adaptive | IntegratorKind::Split | IntegratorKind::Exponential
+    ) {
         let rate = [Region::Free, Region::Contact]
             .iter()
             .map(|&r| model.dynamics(r).a.norm())
@@ -607,7 +624,7 @@ pub fn build(
         )?),
         IntegratorKind::Rk4 => Box::new(rk4::Rk4::new(model, opts.steps_per_period, true)),
         IntegratorKind::Rk4Naive => Box::new(rk4::Rk4::new(model, opts.steps_per_period, false)),
-        IntegratorKind::Adaptive | IntegratorKind::Split => {
+        IntegratorKind::Adaptive | IntegratorKind::Split | IntegratorKind::Exponential => {
             if !(opts.tolerance.is_finite() && opts.tolerance > 0.0 && opts.tolerance < 1.0) {
                 return Err(SimError::out_of_range(
                     "tolerance",
@@ -618,6 +635,35 @@ pub fn build(
             let adaptive = || Box::new(adaptive::Adaptive::new(model, opts.tolerance));
             if kind == IntegratorKind::Adaptive {
                 adaptive()
+            } else if kind == IntegratorKind::Exponential {
+                // the frame's field is the law's force F_c(δ, δ̇) on the velocity rows: not the
+                // impact law's sticking constraint
+                let unsupported = |hint| SimError::Unsupported {
+                    integrator: "exponential",
+                    law: model.law().name(),
+                    hint,
+                };
+                if model.law().restitution().is_some() {
+                    return Err(unsupported(
+                        "impacts need the jump map of the adaptive or split integrator: use \
+                         integrator = \"auto\"",
+                    ));
+                }
+                if model.law().is_affine() {
+                    return Err(unsupported(
+                        "the linear law is propagated exactly: use integrator = \"exact\" (or \
+                         \"auto\")",
+                    ));
+                }
+                match adaptive::Adaptive::exponential(model, opts.tolerance)? {
+                    Some(e) => Box::new(e),
+                    None => {
+                        return Err(unsupported(
+                            "the free flight has no well-conditioned modal basis here: use \
+                             integrator = \"adaptive\" (or \"auto\")",
+                        ))
+                    }
+                }
             } else {
                 match split::Split::try_new(model, opts.steps_per_period, opts.tolerance) {
                     Ok(s) => Box::new(s),

@@ -55,6 +55,7 @@ mod energy;
 mod forcing;
 mod handoff;
 mod integrator;
+mod lawson;
 mod modal;
 mod run;
 mod search;
@@ -69,6 +70,7 @@ mod tip;
 
 pub(crate) use crate::linalg::matmul_into;
 pub use build::{ExactOptions, Propagation};
+pub(crate) use lawson::{Anchor, LinearFrame};
 pub use modal::MAX_MODAL_CONDITION;
 
 use super::grid::PeriodGrid;
