@@ -248,6 +248,24 @@ impl CantileverModel {
         self.tip_force_with(r, tau, sc, z.as_slice())
     }
 
+    /// [V_T, W(1,τ), ∂W(1,τ)/∂τ, F_c] at (τ, z) in region `r` given (sin Ωτ, cos Ωτ): the
+    /// values of a recorded sample (`trajectory`), as [`CantileverModel::v_t`],
+    /// [`CantileverModel::w_tip`], [`CantileverModel::w_tip_dot`] and
+    /// [`CantileverModel::contact_force`] form them, from the sine and cosine the caller has.
+    /// `z: [f64; 2N]`.
+    pub(crate) fn sample_values(
+        &self,
+        r: Region,
+        tau: f64,
+        (s, c): (f64, f64),
+        z: &[f64],
+    ) -> [f64; 4] {
+        let n = self.modes();
+        let (w, wd) = (self.w_tip_slice(z, 0), self.w_tip_slice(z, n));
+        let v = self.v_t_at((s, c), [w, 0.0, 0.0])[0];
+        [v, w, wd, self.tip_force_with(r, tau, (s, c), z)]
+    }
+
     /// F_c at τ given sin/cos of Ωτ.
     fn tip_force_with(&self, r: Region, tau: f64, (s, c): (f64, f64), z: &[f64]) -> f64 {
         let p = &self.params;
