@@ -3,7 +3,8 @@
 use crate::args::{IntegratorArgs, ModelArgs};
 use crate::error::CliError;
 use crate::output::{
-    csv_finish, csv_row, csv_stream, f, write_csv, Column, CsvStream, NpyStream, OutDir,
+    csv_finish, csv_line, csv_lines, csv_stream, f, write_csv, write_csv_numbers, Column,
+    CsvStream, Field, NpyStream, OutDir,
 };
 use crate::plot::{decimate_line, save, Figure, Series, Style};
 use afmdyn::analysis::spectrum::{amplitude_spectrum, SPECTRUM_SAMPLES};
@@ -351,16 +352,26 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
     };
     crate::error::stop_on_signal();
     let mut converted = Vec::new();
+    let mut lines = Vec::new();
+    // dimensionless units: the rows as they are (the conversion would multiply by 1)
+    let identity = [su.u.time, su.u.length, su.u.force] == [1.0; 3];
     let each = |c: &Chunk<'_>| -> Result<(), CliError> {
         // SIGINT/SIGTERM: end here; the streams' partial files are removed as they are dropped
         crate::error::interrupted()?;
         if let Some(fl) = files.as_mut() {
-            convert_rows(c.rows, c.width, &su, &mut converted);
-            fl.npy.push_rows(&converted)?;
+            let rows = if identity {
+                c.rows
+            } else {
+                convert_rows(c.rows, c.width, &su, &mut converted);
+                &converted
+            };
+            fl.npy.push_rows(rows)?;
             if let Some(csv) = fl.csv.as_mut() {
-                for row in converted.chunks_exact(c.width) {
-                    csv_row(csv, row.iter().map(|v| f(*v)))?;
+                lines.clear();
+                for row in rows.chunks_exact(c.width) {
+                    csv_line(&mut lines, row.iter().map(|&v| Field::Num(v)));
                 }
+                csv_lines(csv, &lines)?;
             }
             // the spectrum's window: the last SPECTRUM_SAMPLES values of W(1,τ)
             let new = c.samples().len();
@@ -368,45 +379,57 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
             let drop = (spectrum.len() + keep).saturating_sub(SPECTRUM_SAMPLES);
             spectrum.drain(..drop);
             spectrum.extend(c.samples().skip(new - keep).map(|s| s[2]));
+            let region = |r: Region| match r {
+                Region::Free => "free",
+                Region::Contact => "contact",
+            };
+            lines.clear();
             for e in c.events() {
-                csv_row(
-                    &mut fl.events,
+                csv_line(
+                    &mut lines,
                     [
-                        f(su.t(e.tau)),
-                        format!("{:?}", e.from).to_lowercase(),
-                        format!("{:?}", e.to).to_lowercase(),
-                        f(su.v(e.v_t_dot)),
+                        Field::Num(su.t(e.tau)),
+                        Field::Word(region(e.from)),
+                        Field::Word(region(e.to)),
+                        Field::Num(su.v(e.v_t_dot)),
                     ],
-                )?;
+                );
             }
+            csv_lines(&mut fl.events, &lines)?;
+            lines.clear();
             for (t, z) in &c.sections {
-                csv_row(
-                    &mut fl.poincare,
+                csv_line(
+                    &mut lines,
                     [
-                        f(su.t(*t)),
-                        f(su.x(model.v_t(*t, z))),
-                        f(su.x(model.w_tip(z))),
-                        f(su.v(model.w_tip_dot(z))),
-                    ],
-                )?;
+                        su.t(*t),
+                        su.x(model.v_t(*t, z)),
+                        su.x(model.w_tip(z)),
+                        su.v(model.w_tip_dot(z)),
+                    ]
+                    .map(Field::Num),
+                );
             }
+            csv_lines(&mut fl.poincare, &lines)?;
+            lines.clear();
             for e in c.energy() {
                 // each interval ends at the first stroboscopic section after its start
                 let tau1 = ((e.tau0 / period + 1e-9).floor() + 1.0) * period;
-                csv_row(
-                    &mut fl.energy,
+                csv_line(
+                    &mut lines,
                     [
-                        f(su.t(e.tau0)),
-                        f(su.energy(e.e_start)),
-                        f(su.energy(e.e_end)),
-                        f(su.energy(e.base_work)),
-                        f(su.energy(e.beam_dissipation)),
-                        f(su.energy(e.contact_dissipation)),
-                        f(su.energy(e.residual())),
-                        f(su.t(tau1)),
-                    ],
-                )?;
+                        su.t(e.tau0),
+                        su.energy(e.e_start),
+                        su.energy(e.e_end),
+                        su.energy(e.base_work),
+                        su.energy(e.beam_dissipation),
+                        su.energy(e.contact_dissipation),
+                        su.energy(e.residual()),
+                        su.t(tau1),
+                    ]
+                    .map(Field::Num),
+                );
             }
+            csv_lines(&mut fl.energy, &lines)?;
         }
         if let Some(pd) = plots.as_mut() {
             let new = c.samples().len();
@@ -539,13 +562,13 @@ fn write_spectrum_and_plots(
         .into_iter()
         .map(|(w, a)| (w * hz, su.x(a)))
         .collect();
-    write_csv(
+    write_csv_numbers(
         &out.join("spectrum.csv"),
         &[
             if su.u.si { "frequency_hz" } else { "frequency" },
             "amplitude",
         ],
-        spec.iter().map(|(x, y)| vec![f(*x), f(*y)]),
+        spec.iter().map(|&(x, y)| [x, y]),
     )?;
     let Some(mut pd) = plots else { return Ok(()) };
     if let Some(t0) = pd.shade.open.take() {

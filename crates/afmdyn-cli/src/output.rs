@@ -103,6 +103,8 @@ pub struct Stream<W> {
     path: PathBuf,
     tmp: PathBuf,
     inner: Option<W>,
+    /// Renamed into place (else the temporary file is removed when dropped).
+    done: bool,
 }
 
 impl<W> Stream<W> {
@@ -118,6 +120,7 @@ impl<W> Stream<W> {
             path: path.to_path_buf(),
             tmp,
             inner: Some(inner),
+            done: false,
         })
     }
 
@@ -135,13 +138,15 @@ impl<W> Stream<W> {
     pub fn finish(mut self, close: impl FnOnce(W) -> Result<(), String>) -> Result<(), CliError> {
         let inner = self.inner.take().expect("open stream");
         close(inner).map_err(|e| io_error("write", &self.path, e))?;
-        fs::rename(&self.tmp, &self.path).map_err(|e| io_error("finish", &self.path, e))
+        fs::rename(&self.tmp, &self.path).map_err(|e| io_error("finish", &self.path, e))?;
+        self.done = true;
+        Ok(())
     }
 }
 
 impl<W> Drop for Stream<W> {
     fn drop(&mut self) {
-        if self.inner.is_some() {
+        if !self.done {
             self.inner = None;
             let _ = fs::remove_file(&self.tmp);
         }
@@ -192,6 +197,25 @@ pub fn write_csv(
     for r in rows {
         csv_row(&mut s, &r)?;
     }
+    csv_finish(s)
+}
+
+/// A table of numbers written atomically (as [`write_csv`] with [`f`] of each value).
+pub fn write_csv_numbers<const C: usize>(
+    path: &Path,
+    header: &[&str],
+    rows: impl IntoIterator<Item = [f64; C]>,
+) -> Result<(), CliError> {
+    let mut s = csv_stream(path, header)?;
+    let mut buf = Vec::with_capacity(1 << 16);
+    for r in rows {
+        csv_line(&mut buf, r.map(Field::Num));
+        if buf.len() >= 1 << 16 {
+            csv_lines(&mut s, &buf)?;
+            buf.clear();
+        }
+    }
+    csv_lines(&mut s, &buf)?;
     csv_finish(s)
 }
 
@@ -327,8 +351,10 @@ impl NpyStream {
             )));
         }
         let f = self.stream.get();
-        for v in values {
-            f.buf.extend_from_slice(&v.to_le_bytes());
+        let at = f.buf.len();
+        f.buf.resize(at + 8 * values.len(), 0);
+        for (b, v) in f.buf[at..].chunks_exact_mut(8).zip(values) {
+            b.copy_from_slice(&v.to_le_bytes());
         }
         if f.buf.len() >= NPY_BUFFER {
             let r = f.file.write_all(&f.buf);
@@ -366,22 +392,102 @@ impl NpyStream {
 /// where two shortest forms exist it may pick the other). Where `ryu` chooses the other
 /// notation (|v| near 1e-5), the standard formatting is used.
 pub fn f(v: f64) -> String {
+    let mut out = Vec::with_capacity(24);
+    f_into(&mut out, v);
+    String::from_utf8(out).expect("ASCII")
+}
+
+/// [`f`] appended to `out` (no allocation but where the standard formatting is used).
+pub fn f_into(out: &mut Vec<u8>, v: f64) {
     let a = v.abs();
     if !v.is_finite() || a == 0.0 {
-        return afmdyn::error::number(v);
+        out.extend(afmdyn::error::number(v).as_bytes());
+        return;
     }
     let mut buf = ryu::Buffer::new();
     let s = buf.format_finite(v);
     let sci = s.contains('e');
     if sci == (1e-4..1e16).contains(&a) {
-        return afmdyn::error::number(v);
+        out.extend(afmdyn::error::number(v).as_bytes());
+        return;
     }
-    s.strip_suffix(".0").unwrap_or(s).to_string()
+    out.extend(s.strip_suffix(".0").unwrap_or(s).as_bytes());
+}
+
+/// A row of numbers (and words without commas, quotes or line breaks, which CSV writes as
+/// they are) appended to `out` as [`csv_row`] writes it: fields joined by commas, ended by a
+/// newline.
+pub fn csv_line<'a>(out: &mut Vec<u8>, fields: impl IntoIterator<Item = Field<'a>>) {
+    for (i, field) in fields.into_iter().enumerate() {
+        if i > 0 {
+            out.push(b',');
+        }
+        match field {
+            Field::Num(v) => f_into(out, v),
+            Field::Word(w) => {
+                debug_assert!(!w.bytes().any(|b| matches!(b, b',' | b'"' | b'\n' | b'\r')));
+                out.extend(w.as_bytes());
+            }
+        }
+    }
+    out.push(b'\n');
+}
+
+/// A field of [`csv_line`].
+#[derive(Debug, Clone, Copy)]
+pub enum Field<'a> {
+    /// A number, formatted by [`f`].
+    Num(f64),
+    /// A word written as it is.
+    Word(&'a str),
+}
+
+/// Append the lines in `bytes` (whole rows, from [`csv_line`]) to a streamed CSV table.
+pub fn csv_lines(s: &mut CsvStream, bytes: &[u8]) -> Result<(), CliError> {
+    // the csv writer's own buffer is written out first, so that the rows stay in order
+    if bytes.is_empty() {
+        return Ok(());
+    }
+    let w = s.inner.take().expect("open stream");
+    let mut file = w.into_inner().map_err(|e| s.err(e.error()))?;
+    file.write_all(bytes).map_err(|e| s.err(e))?;
+    s.inner = Some(csv::Writer::from_writer(file));
+    Ok(())
 }
 
 #[cfg(test)]
 mod tests {
     use super::f;
+
+    /// A row of `csv_line` is the row the csv crate writes for the same fields (`csv_row`).
+    #[test]
+    fn csv_lines_are_the_csv_crates_rows() {
+        use super::{csv_line, f, Field};
+        let values = [
+            0.0,
+            -0.0,
+            1.0,
+            -2.5,
+            1e-5,
+            3.25e-19,
+            1e16,
+            123456.789,
+            f64::NAN,
+            1.0 / 3.0,
+        ];
+        let mut ours = Vec::new();
+        let mut theirs = csv::Writer::from_writer(Vec::new());
+        for v in values {
+            csv_line(
+                &mut ours,
+                [Field::Num(v), Field::Word("contact"), Field::Num(-v)],
+            );
+            theirs
+                .write_record([f(v), "contact".to_string(), f(-v)])
+                .unwrap();
+        }
+        assert_eq!(ours, theirs.into_inner().unwrap());
+    }
 
     /// The streamed array is the file `npyz`'s own 2-D writer makes, byte for byte (an
     /// independent writer of the format), for a few shapes, rows pushed one by one and in

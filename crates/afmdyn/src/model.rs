@@ -262,8 +262,8 @@ impl CantileverModel {
     ) -> [f64; 4] {
         let n = self.modes();
         let (w, wd) = (self.w_tip_slice(z, 0), self.w_tip_slice(z, n));
-        let v = self.v_t_at((s, c), [w, 0.0, 0.0])[0];
-        [v, w, wd, self.tip_force_with(r, tau, (s, c), z)]
+        let [v, vd, _] = self.v_t_at((s, c), [w, wd, 0.0]);
+        [v, w, wd, self.tip_force_from(r, tau, z, (v, vd))]
     }
 
     /// F_c at τ given sin/cos of Ωτ.
@@ -287,6 +287,22 @@ impl CantileverModel {
                 let [v, vd, _] = self.v_t_at((s, c), [w, wd, 0.0]);
                 self.law.force(contact, -v, -vd).force
             }
+        }
+    }
+
+    /// [`Self::tip_force_with`] given V_T and dV_T/dτ at (τ, z) (the same value).
+    fn tip_force_from(&self, r: Region, tau: f64, z: &[f64], (v, vd): (f64, f64)) -> f64 {
+        let contact = r == Region::Contact;
+        match self.law.law {
+            ContactLaw::Impact { .. } => {
+                if contact {
+                    self.sticking_force_value(tau, z)
+                } else {
+                    0.0
+                }
+            }
+            _ if !contact && !self.law.acts_outside() => 0.0,
+            _ => self.law.force(contact, -v, -vd).force,
         }
     }
 
