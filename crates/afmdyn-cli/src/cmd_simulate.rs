@@ -3,7 +3,8 @@
 use crate::args::{IntegratorArgs, ModelArgs};
 use crate::error::CliError;
 use crate::output::{
-    csv_finish, csv_row, csv_stream, f, write_csv, Column, CsvStream, NpyStream, OutDir,
+    csv_finish, csv_line, csv_lines, csv_stream, f, write_csv, write_csv_numbers, Column,
+    CsvStream, Field, NpyStream, OutDir,
 };
 use crate::plot::{decimate_line, save, Figure, Series, Style};
 use afmdyn::analysis::spectrum::{amplitude_spectrum, SPECTRUM_SAMPLES};
@@ -12,7 +13,6 @@ use afmdyn::report::{SeriesNames, SeriesUnits};
 use afmdyn::request::{ConvergeRequest, SeriesStore, SimulateRequest};
 use afmdyn::request::{Document, Resolved};
 use afmdyn::trajectory::chunked::{record_chunked, Chunk, ChunkedSpec};
-use afmdyn::trajectory::Sample;
 use afmdyn::{CantileverModel, Params, Region};
 use clap::{Args, ValueEnum};
 use serde_json::json;
@@ -148,7 +148,8 @@ struct PlotData {
     t0: f64,
     t1: f64,
     shade: Shade,
-    phase: VecDeque<(f64, f64)>,
+    /// The last [`PHASE_SAMPLES`]: τ, V_T, ∂W(1,τ)/∂τ (dV_T/dτ formed at the end).
+    phase: VecDeque<(f64, f64, f64)>,
     /// The last [`TIP_WINDOW_PERIODS`] periods: τ, W(1,τ), V_T, in contact.
     recent: VecDeque<(f64, f64, f64, bool)>,
     /// Its capacity (samples).
@@ -224,20 +225,24 @@ fn series_columns(n: usize, su: &SeriesUnits) -> Vec<Column> {
     c
 }
 
-/// The row of `s` (the columns of [`series_columns`]) in `r`, reused from row to row.
-fn sample_row(s: &Sample, su: &SeriesUnits, r: &mut Vec<f64>) {
-    let n = s.state.len() / 2;
-    r.clear();
-    r.extend([
-        su.t(s.tau),
-        su.x(s.v_t),
-        su.x(s.w_tip),
-        su.v(s.w_tip_dot),
-        f64::from(u8::from(s.region == Region::Contact)),
-        su.force(s.contact_force),
-    ]);
-    r.extend(s.state.iter().take(n).map(|&a| su.x(a)));
-    r.extend(s.state.iter().skip(n).map(|&a| su.v(a)));
+/// The rows of samples (the library's [`afmdyn::trajectory::SampleRows`] layout, which is
+/// that of [`series_columns`]) in `su`'s units, appended to `out`.
+fn convert_rows(rows: &[f64], width: usize, su: &SeriesUnits, out: &mut Vec<f64>) {
+    let n = (width - 6) / 2;
+    out.clear();
+    out.reserve(rows.len());
+    for r in rows.chunks_exact(width) {
+        out.extend([
+            su.t(r[0]),
+            su.x(r[1]),
+            su.x(r[2]),
+            su.v(r[3]),
+            r[4],
+            su.force(r[5]),
+        ]);
+        out.extend(r[6..6 + n].iter().map(|&a| su.x(a)));
+        out.extend(r[6 + n..].iter().map(|&a| su.v(a)));
+    }
 }
 
 /// Run `afmdyn simulate`: the run is recorded in chunks of whole periods and every chunk is
@@ -270,10 +275,9 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
         span.total_periods,
     );
     let spp = a.samples_per_period;
-    // the exact grid is made a multiple of the samples recorded (none without files)
-    let opts = request
-        .integrator
-        .options(if a.files == Files::None { 1 } else { spp });
+    // the samples come from the steps' dense output: the exact grid is the one the physics
+    // needs, not a multiple of the samples
+    let opts = request.integrator.options(1);
     let mut integ = build(&model, opts, 0.0, &z0)?;
     // inputs are valid: lock the output directory and open the files
     let out = match a.files {
@@ -347,86 +351,108 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
         chunk_periods: a.chunk_periods,
     };
     crate::error::stop_on_signal();
-    let mut row = Vec::with_capacity(columns.len());
+    let mut converted = Vec::new();
+    let mut lines = Vec::new();
+    // dimensionless units: the rows as they are (the conversion would multiply by 1)
+    let identity = [su.u.time, su.u.length, su.u.force] == [1.0; 3];
     let each = |c: &Chunk<'_>| -> Result<(), CliError> {
         // SIGINT/SIGTERM: end here; the streams' partial files are removed as they are dropped
         crate::error::interrupted()?;
         if let Some(fl) = files.as_mut() {
-            for s in &c.samples {
-                sample_row(s, &su, &mut row);
-                fl.npy.push(&row)?;
-                if let Some(csv) = fl.csv.as_mut() {
-                    csv_row(csv, row.iter().map(|v| f(*v)))?;
+            let rows = if identity {
+                c.rows
+            } else {
+                convert_rows(c.rows, c.width, &su, &mut converted);
+                &converted
+            };
+            fl.npy.push_rows(rows)?;
+            if let Some(csv) = fl.csv.as_mut() {
+                lines.clear();
+                for row in rows.chunks_exact(c.width) {
+                    csv_line(&mut lines, row.iter().map(|&v| Field::Num(v)));
                 }
-                if spectrum.len() == SPECTRUM_SAMPLES {
-                    spectrum.pop_front();
-                }
-                spectrum.push_back(s.w_tip);
+                csv_lines(csv, &lines)?;
             }
+            // the spectrum's window: the last SPECTRUM_SAMPLES values of W(1,τ)
+            let new = c.samples().len();
+            let keep = new.min(SPECTRUM_SAMPLES);
+            let drop = (spectrum.len() + keep).saturating_sub(SPECTRUM_SAMPLES);
+            spectrum.drain(..drop);
+            spectrum.extend(c.samples().skip(new - keep).map(|s| s[2]));
+            let region = |r: Region| match r {
+                Region::Free => "free",
+                Region::Contact => "contact",
+            };
+            lines.clear();
             for e in c.events() {
-                csv_row(
-                    &mut fl.events,
+                csv_line(
+                    &mut lines,
                     [
-                        f(su.t(e.tau)),
-                        format!("{:?}", e.from).to_lowercase(),
-                        format!("{:?}", e.to).to_lowercase(),
-                        f(su.v(e.v_t_dot)),
+                        Field::Num(su.t(e.tau)),
+                        Field::Word(region(e.from)),
+                        Field::Word(region(e.to)),
+                        Field::Num(su.v(e.v_t_dot)),
                     ],
-                )?;
+                );
             }
+            csv_lines(&mut fl.events, &lines)?;
+            lines.clear();
             for (t, z) in &c.sections {
-                csv_row(
-                    &mut fl.poincare,
+                csv_line(
+                    &mut lines,
                     [
-                        f(su.t(*t)),
-                        f(su.x(model.v_t(*t, z))),
-                        f(su.x(model.w_tip(z))),
-                        f(su.v(model.w_tip_dot(z))),
-                    ],
-                )?;
+                        su.t(*t),
+                        su.x(model.v_t(*t, z)),
+                        su.x(model.w_tip(z)),
+                        su.v(model.w_tip_dot(z)),
+                    ]
+                    .map(Field::Num),
+                );
             }
+            csv_lines(&mut fl.poincare, &lines)?;
+            lines.clear();
             for e in c.energy() {
                 // each interval ends at the first stroboscopic section after its start
                 let tau1 = ((e.tau0 / period + 1e-9).floor() + 1.0) * period;
-                csv_row(
-                    &mut fl.energy,
+                csv_line(
+                    &mut lines,
                     [
-                        f(su.t(e.tau0)),
-                        f(su.energy(e.e_start)),
-                        f(su.energy(e.e_end)),
-                        f(su.energy(e.base_work)),
-                        f(su.energy(e.beam_dissipation)),
-                        f(su.energy(e.contact_dissipation)),
-                        f(su.energy(e.residual())),
-                        f(su.t(tau1)),
-                    ],
-                )?;
+                        su.t(e.tau0),
+                        su.energy(e.e_start),
+                        su.energy(e.e_end),
+                        su.energy(e.base_work),
+                        su.energy(e.beam_dissipation),
+                        su.energy(e.contact_dissipation),
+                        su.energy(e.residual()),
+                        su.t(tau1),
+                    ]
+                    .map(Field::Num),
+                );
             }
+            csv_lines(&mut fl.energy, &lines)?;
         }
         if let Some(pd) = plots.as_mut() {
-            let (a2, om) = (p.alpha2, p.omega);
-            for s in &c.samples {
-                pd.tip.push((s.tau, s.w_tip));
-                pd.vt.push((s.tau, s.v_t));
-                if pd.phase.len() == PHASE_SAMPLES {
-                    pd.phase.pop_front();
-                }
-                pd.phase
-                    .push_back((s.v_t, s.w_tip_dot + a2 * om * (om * s.tau).cos()));
-                if pd.recent.len() == pd.recent_cap {
-                    pd.recent.pop_front();
-                }
-                pd.recent
-                    .push_back((s.tau, s.w_tip, s.v_t, s.region == afmdyn::Region::Contact));
+            let new = c.samples().len();
+            for s in c.samples() {
+                pd.tip.push((s[0], s[2]));
+                pd.vt.push((s[0], s[1]));
             }
-            let tr = c.trajectory;
-            if c.first
-                && tr
-                    .samples
-                    .first()
-                    .is_some_and(|s| s.region == Region::Contact)
-            {
-                pd.shade.open = Some(tr.samples[0].tau);
+            // the phase portrait's and the tip window's last samples (only those kept)
+            let keep = new.min(PHASE_SAMPLES);
+            let drop = (pd.phase.len() + keep).saturating_sub(PHASE_SAMPLES);
+            pd.phase.drain(..drop);
+            pd.phase
+                .extend(c.samples().skip(new - keep).map(|s| (s[0], s[1], s[3])));
+            let keep = new.min(pd.recent_cap);
+            let drop = (pd.recent.len() + keep).saturating_sub(pd.recent_cap);
+            pd.recent.drain(..drop);
+            pd.recent.extend(
+                c.samples()
+                    .skip(new - keep)
+                    .map(|s| (s[0], s[2], s[1], s[4] != 0.0)),
+            );
+            if let Some(s) = c.samples().next().filter(|s| c.first && s[4] != 0.0) {
+                pd.shade.open = Some(s[0]);
             }
             for e in c.events() {
                 match e.to {
@@ -536,13 +562,13 @@ fn write_spectrum_and_plots(
         .into_iter()
         .map(|(w, a)| (w * hz, su.x(a)))
         .collect();
-    write_csv(
+    write_csv_numbers(
         &out.join("spectrum.csv"),
         &[
             if su.u.si { "frequency_hz" } else { "frequency" },
             "amplitude",
         ],
-        spec.iter().map(|(x, y)| vec![f(*x), f(*y)]),
+        spec.iter().map(|&(x, y)| [x, y]),
     )?;
     let Some(mut pd) = plots else { return Ok(()) };
     if let Some(t0) = pd.shade.open.take() {
@@ -556,9 +582,13 @@ fn write_spectrum_and_plots(
     };
     xy(&mut pd.tip);
     xy(&mut pd.vt);
-    for pt in pd.phase.iter_mut() {
-        *pt = (su.x(pt.0), su.v(pt.1));
-    }
+    // dV_T/dτ = ∂W(1,τ)/∂τ + α2 Ω cos Ωτ (eq. 8)
+    let (a2, om) = (p.alpha2, p.omega);
+    let phase: Vec<(f64, f64)> = pd
+        .phase
+        .iter()
+        .map(|&(tau, v_t, w_dot)| (su.x(v_t), su.v(w_dot + a2 * om * (om * tau).cos())))
+        .collect();
     for r in pd.recent.iter_mut() {
         *r = (su.t(r.0), su.x(r.1), su.x(r.2), r.3);
     }
@@ -671,12 +701,12 @@ fn write_spectrum_and_plots(
         "phase",
         &Figure {
             y_min_span: 0.0,
-            title: last(pd.phase.len(), "Phase portrait"),
+            title: last(phase.len(), "Phase portrait"),
             x_label: phase_x.into(),
             y_label: phase_y.into(),
             series: vec![Series {
                 label: String::new(),
-                points: pd.phase.into(),
+                points: phase,
                 style: Style::Line,
                 color: 0,
             }],

@@ -103,6 +103,8 @@ pub struct Stream<W> {
     path: PathBuf,
     tmp: PathBuf,
     inner: Option<W>,
+    /// Renamed into place (else the temporary file is removed when dropped).
+    done: bool,
 }
 
 impl<W> Stream<W> {
@@ -118,6 +120,7 @@ impl<W> Stream<W> {
             path: path.to_path_buf(),
             tmp,
             inner: Some(inner),
+            done: false,
         })
     }
 
@@ -135,13 +138,15 @@ impl<W> Stream<W> {
     pub fn finish(mut self, close: impl FnOnce(W) -> Result<(), String>) -> Result<(), CliError> {
         let inner = self.inner.take().expect("open stream");
         close(inner).map_err(|e| io_error("write", &self.path, e))?;
-        fs::rename(&self.tmp, &self.path).map_err(|e| io_error("finish", &self.path, e))
+        fs::rename(&self.tmp, &self.path).map_err(|e| io_error("finish", &self.path, e))?;
+        self.done = true;
+        Ok(())
     }
 }
 
 impl<W> Drop for Stream<W> {
     fn drop(&mut self) {
-        if self.inner.is_some() {
+        if !self.done {
             self.inner = None;
             let _ = fs::remove_file(&self.tmp);
         }
@@ -195,6 +200,25 @@ pub fn write_csv(
     csv_finish(s)
 }
 
+/// A table of numbers written atomically (as [`write_csv`] with [`f`] of each value).
+pub fn write_csv_numbers<const C: usize>(
+    path: &Path,
+    header: &[&str],
+    rows: impl IntoIterator<Item = [f64; C]>,
+) -> Result<(), CliError> {
+    let mut s = csv_stream(path, header)?;
+    let mut buf = Vec::with_capacity(1 << 16);
+    for r in rows {
+        csv_line(&mut buf, r.map(Field::Num));
+        if buf.len() >= 1 << 16 {
+            csv_lines(&mut s, &buf)?;
+            buf.clear();
+        }
+    }
+    csv_lines(&mut s, &buf)?;
+    csv_finish(s)
+}
+
 /// One column of a numeric table, as documented in its header file.
 #[derive(Debug, Clone, Serialize)]
 pub struct Column {
@@ -235,25 +259,66 @@ pub fn write_npy_header(npy: &Path, rows: u64, columns: &[Column]) -> Result<(),
 }
 
 /// A streamed 2-D float64 NPY array (rows of `cols` values; the row count is written into the
-/// header at the end).
+/// header at the end). The file is that of `npyz`'s `begin_2d` writer byte for byte (format
+/// version 1.0, the shape's row count in a field of 20 characters padded with spaces, the
+/// header padded to 64 bytes: the NPY format, numpy's `format.py`), the values written as
+/// little-endian bytes through one buffer instead of one call per value
+/// (`npy_stream_is_npyz_byte_for_byte`).
 pub struct NpyStream {
-    stream: Stream<npyz::NpyWriter<f64, BufWriter<File>>>,
+    stream: Stream<NpyFile>,
     cols: usize,
     rows: u64,
     columns: Vec<Column>,
     npy: PathBuf,
 }
 
+/// The open file of an [`NpyStream`] and its buffer of encoded values.
+pub struct NpyFile {
+    file: BufWriter<File>,
+    buf: Vec<u8>,
+}
+
+/// Bytes gathered before they are written.
+const NPY_BUFFER: usize = 1 << 20;
+/// The width of the row count's field in the header (npyz's placeholder).
+const NPY_ROWS_FIELD: usize = 20;
+
+/// The header of a C-ordered 2-D `<f8` NPY array of `cols` columns whose row count is `rows`
+/// (spaces-padded to [`NPY_ROWS_FIELD`]), and the offset of the row count in it.
+fn npy_header(rows: &str, cols: usize) -> (Vec<u8>, usize) {
+    let mut text = b"{'descr': '<f8', 'fortran_order': False, 'shape': (".to_vec();
+    let at = 10 + text.len();
+    text.extend(npy_shape(rows, cols));
+    // magic (6) + version (2) + length (2) + text + newline: a multiple of 64
+    let pad = 63 - (text.len() + 10) % 64;
+    text.extend(std::iter::repeat_n(b' ', pad));
+    text.push(b'\n');
+    let mut out = vec![0x93];
+    out.extend(b"NUMPY");
+    out.extend([1, 0]);
+    out.extend((text.len() as u16).to_le_bytes());
+    out.extend(text);
+    (out, at)
+}
+
+/// "ROWS, COLS), }" padded with spaces for the rows' field.
+fn npy_shape(rows: &str, cols: usize) -> Vec<u8> {
+    let mut s = format!("{rows}, {cols}), }}").into_bytes();
+    s.extend(std::iter::repeat_n(b' ', NPY_ROWS_FIELD - rows.len()));
+    s
+}
+
 impl NpyStream {
     /// Start `path` with the given columns (its header file is written by [`NpyStream::finish`]).
     pub fn create(path: &Path, columns: Vec<Column>) -> Result<Self, CliError> {
-        use npyz::WriterBuilder;
         let cols = columns.len();
-        let stream = Stream::create(path, |f| {
-            npyz::WriteOptions::new()
-                .default_dtype()
-                .writer(f)
-                .begin_2d(cols as u64)
+        let stream = Stream::create(path, |mut file| {
+            let (header, _) = npy_header(&"*".repeat(NPY_ROWS_FIELD), cols);
+            file.write_all(&header)?;
+            Ok(NpyFile {
+                file,
+                buf: Vec::with_capacity(NPY_BUFFER + 4096),
+            })
         })?;
         Ok(NpyStream {
             stream,
@@ -273,19 +338,49 @@ impl NpyStream {
                 self.cols
             )));
         }
-        for v in row {
-            let r = self.stream.get().push(v);
+        self.push_rows(row)
+    }
+
+    /// Append whole rows, one after the other in `values` (a multiple of the columns).
+    pub fn push_rows(&mut self, values: &[f64]) -> Result<(), CliError> {
+        if !values.len().is_multiple_of(self.cols.max(1)) {
+            return Err(self.stream.err(format!(
+                "{} values are not whole rows of {}",
+                values.len(),
+                self.cols
+            )));
+        }
+        let f = self.stream.get();
+        let at = f.buf.len();
+        f.buf.resize(at + 8 * values.len(), 0);
+        for (b, v) in f.buf[at..].chunks_exact_mut(8).zip(values) {
+            b.copy_from_slice(&v.to_le_bytes());
+        }
+        if f.buf.len() >= NPY_BUFFER {
+            let r = f.file.write_all(&f.buf);
+            f.buf.clear();
             r.map_err(|e| self.stream.err(e))?;
         }
-        self.rows += 1;
+        self.rows += (values.len() / self.cols.max(1)) as u64;
         Ok(())
     }
 
     /// Finish the array and write its header file.
     pub fn finish(self) -> Result<(), CliError> {
-        let (rows, columns, npy) = (self.rows, self.columns, self.npy);
-        self.stream
-            .finish(|w| w.finish().map_err(|e| e.to_string()))?;
+        use std::io::{Seek, SeekFrom};
+        let (rows, columns, npy, cols) = (self.rows, self.columns, self.npy, self.cols);
+        self.stream.finish(|mut f| {
+            let e = |e: std::io::Error| e.to_string();
+            f.file.write_all(&f.buf).map_err(e)?;
+            let (_, at) = npy_header("", cols);
+            let end = f.file.stream_position().map_err(e)?;
+            f.file.seek(SeekFrom::Start(at as u64)).map_err(e)?;
+            f.file
+                .write_all(&npy_shape(&rows.to_string(), cols))
+                .map_err(e)?;
+            f.file.seek(SeekFrom::Start(end)).map_err(e)?;
+            f.file.flush().map_err(e)
+        })?;
         write_npy_header(&npy, rows, &columns)
     }
 }
@@ -297,22 +392,147 @@ impl NpyStream {
 /// where two shortest forms exist it may pick the other). Where `ryu` chooses the other
 /// notation (|v| near 1e-5), the standard formatting is used.
 pub fn f(v: f64) -> String {
+    let mut out = Vec::with_capacity(24);
+    f_into(&mut out, v);
+    String::from_utf8(out).expect("ASCII")
+}
+
+/// [`f`] appended to `out` (no allocation but where the standard formatting is used).
+pub fn f_into(out: &mut Vec<u8>, v: f64) {
     let a = v.abs();
     if !v.is_finite() || a == 0.0 {
-        return afmdyn::error::number(v);
+        out.extend(afmdyn::error::number(v).as_bytes());
+        return;
     }
     let mut buf = ryu::Buffer::new();
     let s = buf.format_finite(v);
     let sci = s.contains('e');
     if sci == (1e-4..1e16).contains(&a) {
-        return afmdyn::error::number(v);
+        out.extend(afmdyn::error::number(v).as_bytes());
+        return;
     }
-    s.strip_suffix(".0").unwrap_or(s).to_string()
+    out.extend(s.strip_suffix(".0").unwrap_or(s).as_bytes());
+}
+
+/// A row of numbers (and words without commas, quotes or line breaks, which CSV writes as
+/// they are) appended to `out` as [`csv_row`] writes it: fields joined by commas, ended by a
+/// newline.
+pub fn csv_line<'a>(out: &mut Vec<u8>, fields: impl IntoIterator<Item = Field<'a>>) {
+    for (i, field) in fields.into_iter().enumerate() {
+        if i > 0 {
+            out.push(b',');
+        }
+        match field {
+            Field::Num(v) => f_into(out, v),
+            Field::Word(w) => {
+                debug_assert!(!w.bytes().any(|b| matches!(b, b',' | b'"' | b'\n' | b'\r')));
+                out.extend(w.as_bytes());
+            }
+        }
+    }
+    out.push(b'\n');
+}
+
+/// A field of [`csv_line`].
+#[derive(Debug, Clone, Copy)]
+pub enum Field<'a> {
+    /// A number, formatted by [`f`].
+    Num(f64),
+    /// A word written as it is.
+    Word(&'a str),
+}
+
+/// Append the lines in `bytes` (whole rows, from [`csv_line`]) to a streamed CSV table.
+pub fn csv_lines(s: &mut CsvStream, bytes: &[u8]) -> Result<(), CliError> {
+    // the csv writer's own buffer is written out first, so that the rows stay in order
+    if bytes.is_empty() {
+        return Ok(());
+    }
+    let w = s.inner.take().expect("open stream");
+    let mut file = w.into_inner().map_err(|e| s.err(e.error()))?;
+    file.write_all(bytes).map_err(|e| s.err(e))?;
+    s.inner = Some(csv::Writer::from_writer(file));
+    Ok(())
 }
 
 #[cfg(test)]
 mod tests {
     use super::f;
+
+    /// A row of `csv_line` is the row the csv crate writes for the same fields (`csv_row`).
+    #[test]
+    fn csv_lines_are_the_csv_crates_rows() {
+        use super::{csv_line, f, Field};
+        let values = [
+            0.0,
+            -0.0,
+            1.0,
+            -2.5,
+            1e-5,
+            3.25e-19,
+            1e16,
+            123456.789,
+            f64::NAN,
+            1.0 / 3.0,
+        ];
+        let mut ours = Vec::new();
+        let mut theirs = csv::Writer::from_writer(Vec::new());
+        for v in values {
+            csv_line(
+                &mut ours,
+                [Field::Num(v), Field::Word("contact"), Field::Num(-v)],
+            );
+            theirs
+                .write_record([f(v), "contact".to_string(), f(-v)])
+                .unwrap();
+        }
+        assert_eq!(ours, theirs.into_inner().unwrap());
+    }
+
+    /// The streamed array is the file `npyz`'s own 2-D writer makes, byte for byte (an
+    /// independent writer of the format), for a few shapes, rows pushed one by one and in
+    /// blocks.
+    #[test]
+    fn npy_stream_is_npyz_byte_for_byte() {
+        use super::{Column, NpyStream};
+        use npyz::WriterBuilder;
+        let dir = std::env::temp_dir().join(format!("afmdyn-npy-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        for (rows, cols) in [(0usize, 3usize), (1, 1), (7, 12), (1000, 5), (3, 40)] {
+            let values: Vec<f64> = (0..rows * cols)
+                .map(|i| (i as f64 * 0.37).sin() * 10f64.powi(i as i32 % 7 - 3))
+                .collect();
+            let mut expected = std::io::Cursor::new(Vec::new());
+            {
+                let mut w = npyz::WriteOptions::new()
+                    .default_dtype()
+                    .writer(&mut expected)
+                    .begin_2d(cols as u64)
+                    .unwrap();
+                for v in &values {
+                    w.push(v).unwrap();
+                }
+                w.finish().unwrap();
+            }
+            let columns: Vec<Column> = (0..cols)
+                .map(|c| Column::new(format!("c{c}"), "1", "test"))
+                .collect();
+            let path = dir.join(format!("a{rows}x{cols}.npy"));
+            let mut s = NpyStream::create(&path, columns).unwrap();
+            let (one, block) = values.split_at((rows / 2) * cols);
+            for r in one.chunks(cols) {
+                s.push(r).unwrap();
+            }
+            s.push_rows(block).unwrap();
+            s.finish().unwrap();
+            assert_eq!(
+                std::fs::read(&path).unwrap(),
+                expected.into_inner(),
+                "{rows} x {cols}"
+            );
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 
     #[test]
     fn csv_numbers_round_trip_and_small_ones_use_exponents() {

@@ -253,6 +253,24 @@ impl CantileverModel {
         self.tip_force_with(r, tau, sc, z.as_slice())
     }
 
+    /// [V_T, W(1,τ), ∂W(1,τ)/∂τ, F_c] at (τ, z) in region `r` given (sin Ωτ, cos Ωτ): the
+    /// values of a recorded sample (`trajectory`), as [`CantileverModel::v_t`],
+    /// [`CantileverModel::w_tip`], [`CantileverModel::w_tip_dot`] and
+    /// [`CantileverModel::contact_force`] form them, from the sine and cosine the caller has.
+    /// `z: [f64; 2N]`.
+    pub(crate) fn sample_values(
+        &self,
+        r: Region,
+        tau: f64,
+        (s, c): (f64, f64),
+        z: &[f64],
+    ) -> [f64; 4] {
+        let n = self.modes();
+        let (w, wd) = (self.w_tip_slice(z, 0), self.w_tip_slice(z, n));
+        let [v, vd, _] = self.v_t_at((s, c), [w, wd, 0.0]);
+        [v, w, wd, self.tip_force_from(r, tau, z, (v, vd))]
+    }
+
     /// F_c at τ given sin/cos of Ωτ.
     fn tip_force_with(&self, r: Region, tau: f64, (s, c): (f64, f64), z: &[f64]) -> f64 {
         let p = &self.params;
@@ -274,6 +292,22 @@ impl CantileverModel {
                 let [v, vd, _] = self.v_t_at((s, c), [w, wd, 0.0]);
                 self.law.force(contact, -v, -vd).force
             }
+        }
+    }
+
+    /// [`Self::tip_force_with`] given V_T and dV_T/dτ at (τ, z) (the same value).
+    fn tip_force_from(&self, r: Region, tau: f64, z: &[f64], (v, vd): (f64, f64)) -> f64 {
+        let contact = r == Region::Contact;
+        match self.law.law {
+            ContactLaw::Impact { .. } => {
+                if contact {
+                    self.sticking_force_value(tau, z)
+                } else {
+                    0.0
+                }
+            }
+            _ if !contact && !self.law.acts_outside() => 0.0,
+            _ => self.law.force(contact, -v, -vd).force,
         }
     }
 

@@ -7,7 +7,7 @@ pub mod chunked;
 use crate::error::{finite, SimError};
 use crate::galerkin::Region;
 use crate::integrate::{advance, Integrator, SwitchEvent};
-use crate::model::{BodyContactCheck, CantileverModel};
+use crate::model::{weighted_displacement, BodyContactCheck, CantileverModel};
 use crate::system::EventKind;
 use gauss_quad::legendre::GaussLegendre;
 use nalgebra::DVector;
@@ -134,11 +134,196 @@ pub struct Trajectory {
     pub final_region: Region,
 }
 
+/// The samples of a recording in one flat buffer, a row of [`SampleRows::width`] = 6 + 2N
+/// values per sample: τ, V_T, W(1,τ), ∂W(1,τ)/∂τ, in contact (1) or not (0), F_c, a_1..a_N,
+/// ȧ_1..ȧ_N — the columns of `afmdyn simulate`'s time series, with no allocation per sample.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SampleRows {
+    width: usize,
+    data: Vec<f64>,
+}
+
+impl SampleRows {
+    /// The values of a row before the state.
+    pub const LEADING: usize = 6;
+
+    /// Empty rows for states of `dim` = 2N values.
+    pub fn new(dim: usize) -> Self {
+        SampleRows {
+            width: Self::LEADING + dim,
+            data: Vec::new(),
+        }
+    }
+
+    /// Values per row, 6 + 2N.
+    pub fn width(&self) -> usize {
+        self.width
+    }
+
+    /// Number of samples.
+    pub fn len(&self) -> usize {
+        self.data.len().checked_div(self.width).unwrap_or(0)
+    }
+
+    /// Whether there is no sample.
+    pub fn is_empty(&self) -> bool {
+        self.data.is_empty()
+    }
+
+    /// All rows, one after the other.
+    pub fn as_slice(&self) -> &[f64] {
+        &self.data
+    }
+
+    /// Row `i`.
+    pub fn row(&self, i: usize) -> &[f64] {
+        &self.data[i * self.width..(i + 1) * self.width]
+    }
+
+    /// Sample `i` as a [`Sample`].
+    pub fn sample(&self, i: usize) -> Sample {
+        Sample::from_row(self.row(i))
+    }
+
+    fn clear(&mut self) {
+        self.data.clear();
+    }
+
+    /// Append the row of the state `z` at τ in region `r`, given (sin Ωτ, cos Ωτ).
+    fn push(&mut self, model: &CantileverModel, r: Region, tau: f64, sc: (f64, f64), z: &[f64]) {
+        let [v_t, w, wd, force] = model.sample_values(r, tau, sc, z);
+        let contact = f64::from(u8::from(r == Region::Contact));
+        self.data
+            .extend_from_slice(&[tau, v_t, w, wd, contact, force]);
+        self.data.extend_from_slice(z);
+    }
+}
+
+impl Sample {
+    /// The sample of a row of [`SampleRows`].
+    pub fn from_row(row: &[f64]) -> Self {
+        Sample {
+            tau: row[0],
+            v_t: row[1],
+            w_tip: row[2],
+            w_tip_dot: row[3],
+            region: if row[4] != 0.0 {
+                Region::Contact
+            } else {
+                Region::Free
+            },
+            contact_force: row[5],
+            state: DVector::from_column_slice(&row[SampleRows::LEADING..]),
+        }
+    }
+}
+
+/// Samples whose drive phase (sin Ωτ_i, cos Ωτ_i) is advanced by the rotation of one sample
+/// interval before it is formed again from τ_i (see [`SamplePhase`]).
+const PHASE_REANCHOR: u64 = 256;
+
+/// The drive phase at the sample times τ_i = start + i·dt: sin and cos of Ωτ_i formed at the
+/// first sample and every [`PHASE_REANCHOR`] samples, and turned by (sin Ω dt, cos Ω dt) in
+/// between (about an ulp of rounding per turn: ≤ 256 ε, below the ulp of Ωτ_i itself at
+/// τ ≳ 10⁻¹), instead of a sine and a cosine per sample.
+struct SamplePhase {
+    omega: f64,
+    rot: (f64, f64),
+    at: Option<(u64, u64, (f64, f64))>,
+}
+
+impl SamplePhase {
+    fn new(omega: f64, dt: f64) -> Self {
+        SamplePhase {
+            omega,
+            rot: (omega * dt).sin_cos(),
+            at: None,
+        }
+    }
+
+    /// (sin Ωτ_i, cos Ωτ_i) at τ_i = `tau`, sample `i`.
+    fn at(&mut self, i: u64, tau: f64) -> (f64, f64) {
+        let sc = match self.at {
+            Some((j, anchor, (s, c))) if i == j + 1 && i - anchor < PHASE_REANCHOR => {
+                let (sd, cd) = self.rot;
+                self.at = Some((i, anchor, (s * cd + c * sd, c * cd - s * sd)));
+                return self.at.map_or((0.0, 1.0), |a| a.2);
+            }
+            _ => (self.omega * tau).sin_cos(),
+        };
+        self.at = Some((i, i, sc));
+        sc
+    }
+}
+
+/// Samples formed at once from the last step's dense output (a buffer of states).
+const SAMPLE_BATCH: usize = 64;
+
+/// Whether the beam body touches the substrate at the end of the last step of `integ`
+/// ([`BodyContactCheck::touches`] at its state), the state formed only where the integrator's
+/// bound of Σ_j reach_j |a_j| does not already keep every station off the substrate — the
+/// answer of the formed state (as `BodyContactCheck::touches_observed`).
+fn step_touches(b: &BodyContactCheck, integ: &mut dyn Integrator) -> bool {
+    let lowest = b.lowest_base() - 4.0 * f64::EPSILON;
+    let bound = integ.displacement_bound(&b.reach, lowest / (1.0 + 1e-9));
+    if BodyContactCheck::spared(bound, lowest) {
+        return false;
+    }
+    let base = b.base(integ.tau());
+    if BodyContactCheck::spared(
+        integ.displacement_bound(&b.reach, base / (1.0 + 1e-9)),
+        base,
+    ) {
+        return false;
+    }
+    integ.form_state();
+    let n = b.reach.len();
+    b.touches_at(base, &integ.state().as_slice()[..n])
+}
+
+/// [`BodyContactCheck::touches`] at a sample (τ, z): the bound held against the lowest base
+/// first (no sine), then the stations.
+fn sample_touches(b: &BodyContactCheck, tau: f64, z: &[f64]) -> bool {
+    let a = &z[..b.reach.len()];
+    let lowest = b.lowest_base() - 4.0 * f64::EPSILON;
+    if BodyContactCheck::spared(weighted_displacement(&b.reach, a), lowest) {
+        return false;
+    }
+    b.touches_at(b.base(tau), a)
+}
+
 /// Run `integ` from its current state: a transient, then the recorded part.
 ///
 /// # Errors
 /// [`SimError`] for negative or non-finite lengths, or a failure of the integrator.
 pub fn record(integ: &mut dyn Integrator, spec: &RecordSpec) -> Result<Trajectory, SimError> {
+    let mut rows = SampleRows::default();
+    let mut out = record_rows(integ, spec, &mut rows)?;
+    out.samples = (0..rows.len()).map(|i| rows.sample(i)).collect();
+    Ok(out)
+}
+
+/// [`record`] with the samples written into `rows` (cleared first) instead of
+/// [`Trajectory::samples`], which stays empty: no allocation per sample.
+///
+/// The integrator takes its own steps ([`Integrator::step_deferred`]: the exact propagator's
+/// natural grid, ending only at the drive-period sections, the end and switchings), and the
+/// samples τ_i = start + i·T/S inside each step are formed from its dense output
+/// ([`Integrator::dense_states_into`]; for the exact propagator in closed form), not by ending
+/// a step at every sample. The energy balance is integrated over those steps (closed forms
+/// where the integrator has them, [`Integrator::last_step_rate_integrals`]); the plain state
+/// is formed only at the sections, the energy cuts, the events and where the body-contact
+/// bound does not decide. A sample at the end of a step that ended at an event, and the last
+/// one where it falls beyond the end by less than 1e-12 (1 + |τ|), are the integrator's state
+/// there (after the event's jump).
+///
+/// # Errors
+/// As [`record`].
+pub fn record_rows(
+    integ: &mut dyn Integrator,
+    spec: &RecordSpec,
+    rows: &mut SampleRows,
+) -> Result<Trajectory, SimError> {
     finite("transient_periods", spec.transient_periods)?;
     finite("record_tau", spec.record_tau)?;
     if spec.transient_periods < 0.0 {
@@ -161,33 +346,42 @@ pub fn record(integ: &mut dyn Integrator, spec: &RecordSpec) -> Result<Trajector
     let start = integ.tau() + spec.transient_periods * period;
     advance(integ, start)?;
     let end = start + spec.record_tau;
+    let dim = integ.state().len();
+    *rows = SampleRows::new(dim);
+    rows.clear();
     let mut out = Trajectory::default();
     let body = spec.body_contact.then(|| BodyContactCheck::new(&model, 64));
     let gl = GaussLegendre::new(NonZeroUsize::new(12).expect("nonzero"));
-    let dt = if spec.samples_per_period > 0 {
-        period / spec.samples_per_period as f64
+    let spp = spec.samples_per_period;
+    let dt = if spp > 0 {
+        period / spp as f64
     } else {
         f64::INFINITY
     };
-    let mut k_sample = 0usize;
+    let tol = |t: f64| 1e-12 * (1.0 + t.abs());
+    let mut phase = SamplePhase::new(model.omega(), dt);
+    let mut states = vec![0.0; SAMPLE_BATCH * dim];
+    // the next sample's index
+    let mut i_next = 0u64;
     let mut k_period = (start / period).ceil() as i64;
-    if spec.samples_per_period > 0 {
-        out.samples.push(Sample::new(
-            &model,
-            integ.region(),
-            integ.tau(),
-            integ.state(),
-        ));
-        k_sample = 1;
+    if spp > 0 {
+        let sc = phase.at(0, integ.tau());
+        let (tau, r) = (integ.tau(), integ.region());
+        rows.push(&model, r, tau, sc, integ.state().as_slice());
+        i_next = 1;
     }
     let record_section = |tau: f64, z: &DVector<f64>, out: &mut Trajectory, k_period: &mut i64| {
-        let t_sec = *k_period as f64 * period;
-        if tau == t_sec || (tau - t_sec).abs() <= 1e-12 * (1.0 + tau.abs()) {
-            out.poincare.push((tau, z.clone()));
-            *k_period += 1;
-        }
+        out.poincare.push((tau, z.clone()));
+        *k_period += 1;
     };
-    record_section(integ.tau(), integ.state(), &mut out, &mut k_period);
+    let at_section = |tau: f64, k_period: i64| {
+        let t_sec = k_period as f64 * period;
+        tau == t_sec || (tau - t_sec).abs() <= tol(tau)
+    };
+    if at_section(integ.tau(), k_period) {
+        let tau = integ.tau();
+        record_section(tau, integ.state(), &mut out, &mut k_period);
+    }
     let mut acc = EnergyBalance {
         tau0: integ.tau(),
         e_start: model.energy(integ.region(), integ.tau(), integ.state()),
@@ -201,10 +395,8 @@ pub fn record(integ: &mut dyn Integrator, spec: &RecordSpec) -> Result<Trajector
         next_energy_cut += period;
     }
     while integ.tau() < end {
-        let next_sample = start + k_sample as f64 * dt;
         let next_section = k_period as f64 * period;
-        let target = end.min(next_sample).min(next_section);
-        let step = integ.step(target)?;
+        let step = integ.step_deferred(end.min(next_section))?;
         let closed = if spec.energy && step.tau1 > step.tau0 {
             integ.last_step_rate_integrals()
         } else {
@@ -230,10 +422,52 @@ pub fn record(integ: &mut dyn Integrator, spec: &RecordSpec) -> Result<Trajector
             acc.beam_dissipation += half * db;
             acc.contact_dissipation += half * dc;
         }
+        // the samples inside the step, from its dense output; at its end after an event, and
+        // beyond the end of the recording by round-off, the state there
+        if spp > 0 {
+            let tau1 = step.tau1;
+            let limit = if tau1 >= end { tau1 + tol(tau1) } else { tau1 };
+            loop {
+                let mut count = 0usize;
+                while count < SAMPLE_BATCH {
+                    let t = start + (i_next + count as u64) as f64 * dt;
+                    let dense = t < tau1 || (t == tau1 && step.event.is_none());
+                    if !dense {
+                        break;
+                    }
+                    count += 1;
+                }
+                if count > 0 {
+                    let buf = &mut states[..count * dim];
+                    integ.dense_states_into(start, dt, i_next, buf);
+                    for (j, z) in buf.chunks_exact(dim).enumerate() {
+                        let i = i_next + j as u64;
+                        let t = start + i as f64 * dt;
+                        let sc = phase.at(i, t);
+                        rows.push(&model, step.region, t, sc, z);
+                        if let Some(b) = &body {
+                            out.body_contact |= sample_touches(b, t, z);
+                        }
+                    }
+                    i_next += count as u64;
+                }
+                if count < SAMPLE_BATCH {
+                    break;
+                }
+            }
+            let t = start + i_next as f64 * dt;
+            if t <= limit {
+                // at the step's end (after an event), or beyond the end by round-off: the
+                // state there
+                integ.form_state();
+                let sc = (model.omega() * tau1).sin_cos();
+                rows.push(&model, integ.region(), tau1, sc, integ.state().as_slice());
+                i_next += 1;
+            }
+        }
         let tau = integ.tau();
-        let z = integ.state();
         if let Some(b) = &body {
-            out.body_contact |= b.touches(tau, z);
+            out.body_contact |= step_touches(b, integ);
         }
         if let Some(e) = step.event {
             // an impact's impulse: energy lost in the sample and work done on the clamped frame
@@ -249,10 +483,9 @@ pub fn record(integ: &mut dyn Integrator, spec: &RecordSpec) -> Result<Trajector
             }
             out.events.push(e);
         }
-        if spec.energy
-            && (tau >= next_energy_cut
-                || (tau - next_energy_cut).abs() <= 1e-12 * (1.0 + tau.abs()))
-        {
+        if spec.energy && (tau >= next_energy_cut || (tau - next_energy_cut).abs() <= tol(tau)) {
+            integ.form_state();
+            let z = integ.state();
             acc.e_end = model.energy(step.region, tau, z);
             out.energy.push(acc);
             acc = EnergyBalance {
@@ -265,13 +498,12 @@ pub fn record(integ: &mut dyn Integrator, spec: &RecordSpec) -> Result<Trajector
             };
             next_energy_cut += period;
         }
-        if spec.samples_per_period > 0 && (tau - next_sample).abs() <= 1e-12 * (1.0 + tau.abs()) {
-            out.samples
-                .push(Sample::new(&model, integ.region(), tau, z));
-            k_sample += 1;
+        if at_section(tau, k_period) {
+            integ.form_state();
+            record_section(tau, integ.state(), &mut out, &mut k_period);
         }
-        record_section(tau, z, &mut out, &mut k_period);
     }
+    integ.form_state();
     out.tau_end = integ.tau();
     out.final_state = integ.state().clone();
     out.final_region = integ.region();

@@ -152,6 +152,17 @@ pub trait Integrator: Send {
     fn dense_tip(&mut self, tau: f64) -> [f64; 3];
     /// Full state at `tau` inside the last step, shape `[2N]`.
     fn dense_state(&mut self, tau: f64) -> DVector<f64>;
+    /// The states at the sample times τ_i = t0 + i·dt, i = `first`, `first` + 1, …, all inside
+    /// the last step, into `out` (one row of 2N values per sample, `out.len()` a multiple of
+    /// 2N): [`Integrator::dense_state`] at each (the default). The exact propagator advances its
+    /// modal coordinates from one sample to the next (`integrate/exact/sample.rs`).
+    fn dense_states_into(&mut self, t0: f64, dt: f64, first: u64, out: &mut [f64]) {
+        let dim = self.state().len();
+        for (j, row) in out.chunks_exact_mut(dim).enumerate() {
+            let tau = t0 + (first + j as u64) as f64 * dt;
+            row.copy_from_slice(self.dense_state(tau).as_slice());
+        }
+    }
     /// [V_T, dV_T/dτ, d²V_T/dτ²] at `tau` inside the last step (from [`Integrator::dense_tip`]).
     fn dense_v_t(&mut self, tau: f64) -> [f64; 3] {
         let w = self.dense_tip(tau);

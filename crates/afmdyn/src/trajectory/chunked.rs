@@ -1,10 +1,11 @@
 //! A long run recorded in chunks of whole drive periods, each handed to the caller as it is
 //! finished, so that memory does not grow with the length of the run (`afmdyn simulate`
-//! streams its files this way; any front end can). The chunks are [`record`] calls continued
+//! streams its files this way; any front end can). The chunks are [`record_rows`] calls
+//! continued
 //! from one another; samples and section points a chunk shares with the previous one are
 //! passed once.
 
-use super::{record, EnergyBalance, RecordSpec, Sample, Trajectory};
+use super::{record_rows, EnergyBalance, RecordSpec, SampleRows, Trajectory};
 use crate::error::SimError;
 use crate::integrate::{Integrator, SwitchEvent};
 use nalgebra::DVector;
@@ -33,8 +34,11 @@ pub struct ChunkedSpec {
 pub struct Chunk<'a> {
     /// Whether this is the first chunk (its first sample is the start of the recording).
     pub first: bool,
-    /// The new samples (those of the previous chunk's end left out).
-    pub samples: Vec<&'a Sample>,
+    /// The new samples (those of the previous chunk's end left out), rows of
+    /// [`Chunk::width`] values as [`SampleRows`] has them.
+    pub rows: &'a [f64],
+    /// Values per row of [`Chunk::rows`], 6 + 2N ([`SampleRows::width`]).
+    pub width: usize,
     /// The new stroboscopic section points (τ, z), z of shape `[2N]`.
     pub sections: Vec<&'a (f64, DVector<f64>)>,
     /// The chunk's recording, whole (switchings, energy, final state).
@@ -42,6 +46,11 @@ pub struct Chunk<'a> {
 }
 
 impl Chunk<'_> {
+    /// The new samples, row by row ([`SampleRows`]' layout).
+    pub fn samples(&self) -> std::slice::ChunksExact<'_, f64> {
+        self.rows.chunks_exact(self.width.max(1))
+    }
+
     /// The switchings of the chunk.
     pub fn events(&self) -> &[SwitchEvent] {
         &self.trajectory.events
@@ -126,6 +135,7 @@ pub fn record_chunked<E: From<SimError>>(
     let mut last_section = f64::NEG_INFINITY;
     let mut k = 0.0;
     let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * (1.0 + a.abs());
+    let mut rows = SampleRows::default();
     loop {
         k += 1.0;
         let target = if on_sections {
@@ -136,7 +146,7 @@ pub fn record_chunked<E: From<SimError>>(
         .min(end);
         let first = k == 1.0;
         let now = integ.tau();
-        let tr = record(
+        let tr = record_rows(
             integ,
             &RecordSpec {
                 transient_periods: if first { spec.transient_periods } else { 0.0 },
@@ -149,15 +159,16 @@ pub fn record_chunked<E: From<SimError>>(
                 energy: true,
                 body_contact: true,
             },
+            &mut rows,
         )?;
         summary.add(&tr);
-        let samples: Vec<&Sample> = tr
-            .samples
-            .iter()
-            .filter(|s| !close(s.tau, last_sample))
-            .collect();
-        if let Some(s) = samples.last() {
-            last_sample = s.tau;
+        let width = rows.width();
+        let skip = (0..rows.len())
+            .take_while(|&i| close(rows.row(i)[0], last_sample))
+            .count();
+        let new_rows = &rows.as_slice()[skip * width..];
+        if let Some(last) = new_rows.chunks_exact(width).last() {
+            last_sample = last[0];
         }
         let sections: Vec<_> = tr
             .poincare
@@ -170,7 +181,8 @@ pub fn record_chunked<E: From<SimError>>(
         summary.sections += sections.len();
         each(&Chunk {
             first,
-            samples,
+            rows: new_rows,
+            width,
             sections,
             trajectory: &tr,
         })?;
@@ -190,6 +202,7 @@ mod tests {
     use crate::integrate::{build, IntegratorOptions};
     use crate::model::CantileverModel;
     use crate::params::Params;
+    use crate::trajectory::record;
 
     /// The chunks, put together, are the run recorded at once: the same samples and section
     /// points, each once, whatever the chunk length (the defining property of the streaming),
@@ -230,7 +243,7 @@ mod tests {
                 },
                 |c| {
                     chunks += 1;
-                    taus.extend(c.samples.iter().map(|s| (s.tau, s.w_tip)));
+                    taus.extend(c.samples().map(|s| (s[0], s[2])));
                     sections.extend(c.sections.iter().map(|(t, z)| (*t, z[0])));
                     Ok(())
                 },

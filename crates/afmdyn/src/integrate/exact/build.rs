@@ -203,6 +203,8 @@ impl ExactPropagator {
             energy: None,
             rate_cache: Default::default(),
             bound_cols: BoundCols::default(),
+            stints: 0,
+            sampler: Default::default(),
         })
     }
 

@@ -52,6 +52,7 @@ impl ExactPropagator {
         self.on_grid =
             (self.grid.tau(j) == tau).then_some((j.div_euclid(m), j.rem_euclid(m) as usize));
         self.between = None;
+        self.sampler.clear();
         let sc = (self.model.omega() * tau).sin_cos();
         self.entry_trig = (tau, sc);
         self.enter_stint(region, sc);

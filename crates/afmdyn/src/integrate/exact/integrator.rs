@@ -109,6 +109,11 @@ impl Integrator for ExactPropagator {
         out
     }
 
+    // the sample sequence and its accuracy: `sample.rs`
+    fn dense_states_into(&mut self, t0: f64, dt: f64, first: u64, out: &mut [f64]) {
+        self.dense_states_impl(t0, dt, first, out);
+    }
+
     // the tables and their derivation: `energy.rs`
     fn last_step_rate_integrals(&mut self) -> Option<[f64; 3]> {
         self.last_step_rate_integrals_impl()

@@ -58,6 +58,7 @@ mod integrator;
 mod lawson;
 mod modal;
 mod run;
+mod sample;
 mod search;
 mod sensitivity;
 mod series;
@@ -206,4 +207,10 @@ pub struct ExactPropagator {
     ///
     /// [`Integrator::displacement_bound`]: crate::integrate::Integrator::displacement_bound
     bound_cols: BoundCols,
+    /// Stints entered (switchings and restarts), the stint a sample sequence belongs to.
+    stints: u64,
+    /// The sequence of dense samples ([`Integrator::dense_states_into`], `sample.rs`).
+    ///
+    /// [`Integrator::dense_states_into`]: crate::integrate::Integrator::dense_states_into
+    sampler: sample::SampleCursor,
 }

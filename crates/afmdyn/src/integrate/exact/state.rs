@@ -103,6 +103,7 @@ impl ExactPropagator {
         }
         self.bound_cols.stint = None;
         self.tip_hom = None;
+        self.stints = self.stints.wrapping_add(1);
         self.stint_curvature = match &sp.modal {
             Some(me) => {
                 me.project_plain(dz, &mut self.q);
