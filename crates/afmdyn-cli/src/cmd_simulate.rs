@@ -275,9 +275,7 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
         span.total_periods,
     );
     let spp = a.samples_per_period;
-    // the samples come from the steps' dense output: the exact grid is the one the physics
-    // needs, not a multiple of the samples
-    let opts = request.integrator.options(1);
+    let opts = request.integrator_options();
     let mut integ = build(&model, opts, 0.0, &z0)?;
     // inputs are valid: lock the output directory and open the files
     let out = match a.files {

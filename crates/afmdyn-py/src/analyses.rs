@@ -281,7 +281,7 @@ pub fn simulate<'py>(
         .validate(&p, SeriesStore::Memory, 7 + 2 * p.modes, 8.0)
         .map_err(sim_error)?;
     let t_transient = span.transient_tau;
-    let opts = request.integrator.options(samples_per_period);
+    let opts = request.integrator_options();
     let spec = RecordSpec {
         transient_periods: transient,
         record_tau: span.record_tau,

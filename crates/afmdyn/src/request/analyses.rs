@@ -801,6 +801,14 @@ pub struct SimulateSpan {
 }
 
 impl SimulateRequest {
+    /// The integrator options of the recording: the samples come from the steps' dense output
+    /// ([`crate::trajectory::record`]), so the exact grid is the one the physics needs, not a
+    /// multiple of the samples per period (both front ends record with these options, so the
+    /// command line's files and Python's arrays are the same numbers).
+    pub fn integrator_options(&self) -> IntegratorOptions {
+        self.integrator.options(1)
+    }
+
     /// Check every option for `params` and return the span; `columns` values of
     /// `bytes_per_value` bytes per sample are kept in `store`.
     ///

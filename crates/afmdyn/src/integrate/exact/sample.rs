@@ -11,7 +11,7 @@
 //! of Ωτ_i) at its first sample, after a stint entry, when an index is skipped, and every
 //! [`REANCHOR`] samples, so that the rounding of the products (about one ulp each, |e^{λdt}| ≤ 1
 //! as Re λ ≤ 0) grows over at most that many: ≤ 256 ε ≈ 6e-14 relative, against the ulp of τ the
-//! sample time has anyway (`exact_paths::dense_samples_equal_the_states_of_steps_ended_there`).
+//! sample time has anyway (`tests/dense_samples.rs`, `dense_samples_equal_the_states_of_steps_ended_there`).
 //! Where the region has no eigendecomposition each sample is the last step's dense state.
 //!
 //! [`Integrator::dense_states_into`]: crate::integrate::Integrator::dense_states_into
