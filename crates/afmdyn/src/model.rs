@@ -268,13 +268,33 @@ impl CantileverModel {
         let n = self.modes();
         let (w, wd) = (self.w_tip_slice(z, 0), self.w_tip_slice(z, n));
         let [v, vd, _] = self.v_t_at((s, c), [w, wd, 0.0]);
-        [v, w, wd, self.tip_force_from(r, tau, z, (v, vd))]
+        [v, w, wd, self.tip_force_from(r, tau, z, || (v, vd))]
     }
 
     /// F_c at τ given sin/cos of Ωτ.
-    fn tip_force_with(&self, r: Region, tau: f64, (s, c): (f64, f64), z: &[f64]) -> f64 {
-        let p = &self.params;
-        let n = p.modes;
+    fn tip_force_with(&self, r: Region, tau: f64, sc: (f64, f64), z: &[f64]) -> f64 {
+        self.tip_force_from(r, tau, z, || {
+            let [v, vd, _] = self.v_t_at(
+                sc,
+                [
+                    self.w_tip_slice(z, 0),
+                    self.w_tip_slice(z, self.modes()),
+                    0.0,
+                ],
+            );
+            (v, vd)
+        })
+    }
+
+    /// F_c in region r at (τ, z), with V_T and dV_T/dτ from `v_t` where the law needs them
+    /// (the impact law's sticking force λ and the laws without force outside contact do not).
+    fn tip_force_from(
+        &self,
+        r: Region,
+        tau: f64,
+        z: &[f64],
+        v_t: impl FnOnce() -> (f64, f64),
+    ) -> f64 {
         let contact = r == Region::Contact;
         match self.law.law {
             ContactLaw::Impact { .. } => {
@@ -286,28 +306,9 @@ impl CantileverModel {
             }
             _ if !contact && !self.law.acts_outside() => 0.0,
             _ => {
-                let tip = self.tip().as_slice();
-                let w: f64 = tip.iter().zip(&z[..n]).map(|(a, b)| a * b).sum();
-                let wd: f64 = tip.iter().zip(&z[n..]).map(|(a, b)| a * b).sum();
-                let [v, vd, _] = self.v_t_at((s, c), [w, wd, 0.0]);
+                let (v, vd) = v_t();
                 self.law.force(contact, -v, -vd).force
             }
-        }
-    }
-
-    /// [`Self::tip_force_with`] given V_T and dV_T/dτ at (τ, z) (the same value).
-    fn tip_force_from(&self, r: Region, tau: f64, z: &[f64], (v, vd): (f64, f64)) -> f64 {
-        let contact = r == Region::Contact;
-        match self.law.law {
-            ContactLaw::Impact { .. } => {
-                if contact {
-                    self.sticking_force_value(tau, z)
-                } else {
-                    0.0
-                }
-            }
-            _ if !contact && !self.law.acts_outside() => 0.0,
-            _ => self.law.force(contact, -v, -vd).force,
         }
     }
 

@@ -6,7 +6,7 @@ pub mod chunked;
 
 use crate::error::{finite, SimError};
 use crate::galerkin::Region;
-use crate::integrate::{advance, Integrator, SwitchEvent};
+use crate::integrate::{advance, Integrator, Observed, SwitchEvent};
 use crate::model::{weighted_displacement, BodyContactCheck, CantileverModel};
 use crate::system::EventKind;
 use gauss_quad::legendre::GaussLegendre;
@@ -259,26 +259,11 @@ impl SamplePhase {
 /// Samples formed at once from the last step's dense output (a buffer of states).
 const SAMPLE_BATCH: usize = 64;
 
-/// Whether the beam body touches the substrate at the end of the last step of `integ`
-/// ([`BodyContactCheck::touches`] at its state), the state formed only where the integrator's
-/// bound of Σ_j reach_j |a_j| does not already keep every station off the substrate — the
-/// answer of the formed state (as `BodyContactCheck::touches_observed`).
+/// Whether the beam body touches the substrate at the end of the last step of `integ`:
+/// [`BodyContactCheck::touches_observed`], the state formed only where the integrator's bound
+/// does not already keep every station off the substrate.
 fn step_touches(b: &BodyContactCheck, integ: &mut dyn Integrator) -> bool {
-    let lowest = b.lowest_base() - 4.0 * f64::EPSILON;
-    let bound = integ.displacement_bound(&b.reach, lowest / (1.0 + 1e-9));
-    if BodyContactCheck::spared(bound, lowest) {
-        return false;
-    }
-    let base = b.base(integ.tau());
-    if BodyContactCheck::spared(
-        integ.displacement_bound(&b.reach, base / (1.0 + 1e-9)),
-        base,
-    ) {
-        return false;
-    }
-    integ.form_state();
-    let n = b.reach.len();
-    b.touches_at(base, &integ.state().as_slice()[..n])
+    b.touches_observed(&mut Observed::new(integ))
 }
 
 /// [`BodyContactCheck::touches`] at a sample (τ, z): the bound held against the lowest base

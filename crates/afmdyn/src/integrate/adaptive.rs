@@ -554,13 +554,17 @@ impl<S: TipSampleSystem + Clone> Adaptive<S> {
     }
 
     /// Leftmost guard zero in (t0, t1] on the dense output, or None (module docs).
-    fn find_zero(&self, stepper: &mut Stepper, mode: Region, t0: f64, t1: f64) -> Option<f64> {
-        let mut end = [0.0; 2 * crate::params::MAX_MODES];
-        let end = &mut end[..self.dim()];
-        self.state_on(stepper, mode, t1, end);
-        let dead = self.model.guard_tolerance(mode, t1, end);
-        let (g0, dg0) = self.guard_on(stepper, mode, t0);
-        let (g1, dg1) = self.guard_on(stepper, mode, t1);
+    /// `(t0, z0)` and `(t1, z1)` are the step's ends (formed once by the caller).
+    fn find_zero(
+        &self,
+        stepper: &mut Stepper,
+        mode: Region,
+        (t0, z0): (f64, &[f64]),
+        (t1, z1): (f64, &[f64]),
+    ) -> Option<f64> {
+        let dead = self.model.guard_tolerance(mode, t1, z1);
+        let (g0, dg0) = self.guard_at(mode, t0, z0);
+        let (g1, dg1) = self.guard_at(mode, t1, z1);
         // where g goes below −ε: the step end, or an interior minimum
         let mut bottom = None;
         if g1 < -dead {
@@ -705,12 +709,14 @@ impl<S: TipSampleSystem + Clone + 'static> Integrator for Adaptive<S> {
         }
         let t1 = self.advance(&mut stepper, region, var, tau_max)?;
         self.h = stepper.h();
-        let zero = self.find_zero(&mut stepper, region, tau0, t1);
+        // the state at the step's end, formed once (in the exponential frame from the deviation)
+        let mut end = [0.0; 2 * crate::params::MAX_MODES];
+        let end = &mut end[..d];
+        self.state_on(&mut stepper, region, t1, end);
+        let zero = self.find_zero(&mut stepper, region, (tau0, self.z.as_slice()), (t1, end));
         self.just_switched = false;
         let Some(t_guess) = zero else {
-            let mut z = std::mem::take(&mut self.z);
-            self.state_on(&mut stepper, region, t1, z.as_mut_slice());
-            self.z = z;
+            self.z.copy_from_slice(end);
             self.tau = t1;
             let norm = self.z.norm();
             if norm.is_nan() || norm >= 1e12 {

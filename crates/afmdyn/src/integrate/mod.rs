@@ -347,7 +347,11 @@ pub struct Observed<'a> {
     integ: &'a mut dyn Integrator,
 }
 
-impl Observed<'_> {
+impl<'a> Observed<'a> {
+    /// The integrator `integ` as its observers see it.
+    pub(crate) fn new(integ: &'a mut dyn Integrator) -> Self {
+        Observed { integ }
+    }
     /// The system integrated.
     pub fn system(&self) -> &dyn TipSampleSystem {
         self.integ.system()

@@ -207,11 +207,7 @@ impl LinearFrame {
 
     /// z_p(τ) into `out` (2N).
     fn particular_into(&self, tau: f64, out: &mut [f64]) {
-        let (s, c) = (self.model.omega() * tau).sin_cos();
-        let f = &self.forced;
-        for (i, o) in out.iter_mut().enumerate() {
-            *o = f.p0[i] + f.ps[i] * s + f.pc[i] * c;
-        }
+        ExactPropagator::zp_at(&self.forced, (self.model.omega() * tau).sin_cos(), out);
     }
 
     /// The anchor at (τ, z): q_a = V⁻¹T (z − z_p(τ)).
@@ -232,31 +228,17 @@ impl LinearFrame {
         }
     }
 
-    /// e^{λ_k s}(q_a + y) for every representative into `q`, and e^{−λ_k s} into `inv`.
-    #[inline(always)]
-    fn modal_at(&self, a: &Anchor, t: f64, y: &[f64], q: &mut Modes, inv: &mut Modes) {
-        let s = t - a.tau;
-        let r = self.r;
-        let (yr, yi) = y.split_at(r);
-        for (k, l) in self.modal.lambda.iter().enumerate() {
-            let mag = (l.re * s).exp();
-            let (sn, cs) = (l.im * s).sin_cos();
-            let (xr, xi) = (a.q.re[k] + yr[k], a.q.im[k] + yi[k]);
-            q.re[k] = mag * (cs * xr - sn * xi);
-            q.im[k] = mag * (cs * xi + sn * xr);
-            let m = 1.0 / mag;
-            inv.re[k] = m * cs;
-            inv.im[k] = -m * sn;
-        }
-    }
-
     /// The plain state z(τ) = z_p(τ) + Σ_k w_k Re(T⁻¹v_k q_k(τ)) of the stepper state `y` at τ
     /// into `z` (2N).
     pub(crate) fn state_into(&self, a: &Anchor, t: f64, y: &[f64], z: &mut [f64]) {
-        let (mut q, mut inv) = (Modes::ZERO, Modes::ZERO);
-        self.modal_at(a, t, y, &mut q, &mut inv);
+        let r = self.r;
+        let mut q = a.q;
+        for (k, (yr, yi)) in y[..r].iter().zip(&y[r..2 * r]).enumerate() {
+            q.re[k] += yr;
+            q.im[k] += yi;
+        }
         self.particular_into(t, z);
-        ModalExp::expand(&self.modal.tv, &q, z, true);
+        self.modal.expand_advanced(&q, t - a.tau, z);
     }
 
     /// The stepper state with the variational equations, `y: [f64; 2r(1 + 2N)]` as (y, then Y
@@ -331,36 +313,32 @@ impl Field for LawsonField<'_> {
         // rate; e^{−λ_k s} kept in dy until F_c is known
         let (mut w, mut wd) = (0.0, 0.0);
         let model = &fr.model;
-        let sc = if let Some((row, (sn, cs))) = self.anchor.node(s) {
-            for k in 0..r {
-                let [er, ei, ir, ii] = [row[4 * k], row[4 * k + 1], row[4 * k + 2], row[4 * k + 3]];
-                let (xr, xi) = (q0.re[k] + yr[k], q0.im[k] + yi[k]);
-                let (qr, qi) = (er * xr - ei * xi, er * xi + ei * xr);
-                w += tip.re[k] * qr - tip.im[k] * qi;
-                wd += tip_dot.re[k] * qr - tip_dot.im[k] * qi;
-                dr[k] = ir;
-                di[k] = ii;
-                if variational {
-                    fac[k] = [er, ei];
+        let node = self.anchor.node(s);
+        for (k, l) in fr.modal.lambda.iter().enumerate() {
+            // e^{λ_k s} and e^{−λ_k s}: tabulated at the step's nodes, else formed here
+            let [er, ei, ir, ii] = match node {
+                Some((row, _)) => [row[4 * k], row[4 * k + 1], row[4 * k + 2], row[4 * k + 3]],
+                None => {
+                    let mag = (l.re * s).exp();
+                    let (sn, cs) = (l.im * s).sin_cos();
+                    [mag * cs, mag * sn, cs / mag, -sn / mag]
                 }
+            };
+            let (xr, xi) = (q0.re[k] + yr[k], q0.im[k] + yi[k]);
+            let (qr, qi) = (er * xr - ei * xi, er * xi + ei * xr);
+            w += tip.re[k] * qr - tip.im[k] * qi;
+            wd += tip_dot.re[k] * qr - tip_dot.im[k] * qi;
+            dr[k] = ir;
+            di[k] = ii;
+            fac[k] = [er, ei];
+        }
+        // sin, cos Ωτ: at a node by angle addition from the anchor's
+        let sc = match node {
+            Some((_, (sn, cs))) => {
+                let (s0, c0) = self.anchor.trig;
+                (s0 * cs + c0 * sn, c0 * cs - s0 * sn)
             }
-            // sin, cos Ω(τ_a + s) by angle addition
-            let (s0, c0) = self.anchor.trig;
-            (s0 * cs + c0 * sn, c0 * cs - s0 * sn)
-        } else {
-            for (k, l) in fr.modal.lambda.iter().enumerate() {
-                let mag = (l.re * s).exp();
-                let (sn, cs) = (l.im * s).sin_cos();
-                let (er, ei) = (mag * cs, mag * sn);
-                let (xr, xi) = (q0.re[k] + yr[k], q0.im[k] + yi[k]);
-                let (qr, qi) = (er * xr - ei * xi, er * xi + ei * xr);
-                w += tip.re[k] * qr - tip.im[k] * qi;
-                wd += tip_dot.re[k] * qr - tip_dot.im[k] * qi;
-                dr[k] = cs / mag;
-                di[k] = -sn / mag;
-                fac[k] = [er, ei];
-            }
-            (model.omega() * t).sin_cos()
+            None => (model.omega() * t).sin_cos(),
         };
         // eq. 8 with z_p's tip part, then the law's force
         let (wt, wdt) = modal_tip(model.omega(), &fr.forced, (w, wd), sc);
