@@ -3,8 +3,11 @@
 //! what validation accepts.
 
 use afmdyn::analysis::progress::Progress;
+use afmdyn::analysis::steady::{steady_state, SteadyOptions};
 use afmdyn::contact::ContactLaw;
+use afmdyn::integrate::{build, IntegratorKind, IntegratorOptions};
 use afmdyn::request::{AttractorsRequest, ContinuationRequest, LyapunovRequest, OrbitRequest};
+use afmdyn::CantileverModel;
 use afmdyn::{Params, SimError, SweepParam};
 
 /// A branch continued from the largest Ω the model accepts (1e5) needs ∂Pⁿ/∂Ω at its first
@@ -27,11 +30,13 @@ fn continuation_from_the_largest_omega_does_not_step_outside_the_range() {
     assert!(branches[0].iter().all(|b| b.value <= 1e5));
 }
 
-/// With the Hertz law pressed 1e6 g₀ into the sample every random start runs into the
-/// adaptive integrator's budget while it integrates (the force grows too stiff to resolve):
+/// With the Hertz law pressed 1e6 g₀ into the sample every random start of the adaptive
+/// integrator runs into its budget while it integrates (the force grows too stiff to resolve):
 /// the census used to return no attractor and exit 0; now it is a failure (exit 1, Python's
-/// SimulationError) that names the count and the first start's error. At Ω = 1e-3 the
-/// step budget is exceeded before any run: one input error (exit 2), checked in validation.
+/// SimulationError) that names the count and the first start's error. (The default integrator,
+/// Taylor series in the contact, resolves this motion: see
+/// `a_motion_too_stiff_to_resolve_ends_with_a_budget_error`.) At Ω = 1e-3 the step budget is
+/// exceeded before any run: one input error (exit 2), checked in validation.
 #[test]
 fn an_attractor_census_whose_every_start_fails_is_a_failure() {
     let params = Params {
@@ -39,10 +44,11 @@ fn an_attractor_census_whose_every_start_fails_is_a_failure() {
         contact_law: ContactLaw::Hertz,
         ..Params::default()
     };
-    let request = AttractorsRequest {
+    let mut request = AttractorsRequest {
         samples: 4,
         ..AttractorsRequest::default()
     };
+    request.integrator.integrator = IntegratorKind::Adaptive;
     let err = request.run(&params, &Progress::new()).unwrap_err();
     assert!(
         matches!(err, SimError::EveryRunFailed { runs: 4, .. }),
@@ -90,9 +96,12 @@ fn a_dmt_adhesion_force_beyond_floating_point_is_refused() {
 /// Inputs the validation accepts whose motion grows too stiff for the adaptive integrator (a
 /// tip captured by a strong DMT adhesion, a tip resting 1e6 g₀ deep in the sample) ran for
 /// minutes to hours (`orbit --contact-law dmt --hamaker 1e6` > 120 s; `--gap -1e6` 437 s).
-/// Now the run ends at the first drive period that needs more than
+/// Now the adaptive integrator ends at the first drive period that needs more than
 /// [`afmdyn::params::ADAPTIVE_STEPS_PER_PERIOD`] steps, with a budget error naming what to
-/// change — counted in steps, so the answer does not depend on the machine.
+/// change — counted in steps, so the answer does not depend on the machine. The default
+/// integrators (Taylor series, in the contact in its regularising time) resolve both motions
+/// within the same budget: the orbit request answers with a period-1 orbit, in contact all the
+/// time (no switching) for the tip deep in the sample.
 #[test]
 fn a_motion_too_stiff_to_resolve_ends_with_a_budget_error() {
     for params in [
@@ -109,7 +118,13 @@ fn a_motion_too_stiff_to_resolve_ends_with_a_budget_error() {
             ..Params::default()
         },
     ] {
-        let err = OrbitRequest::default().run(&params).unwrap_err();
+        let model = CantileverModel::new(&params).unwrap();
+        let opts = IntegratorOptions {
+            kind: IntegratorKind::Adaptive,
+            ..IntegratorOptions::default()
+        };
+        let mut it = build(&model, opts, 0.0, &model.rest()).unwrap();
+        let err = steady_state(it.as_mut(), &SteadyOptions::default()).unwrap_err();
         assert!(matches!(err, SimError::Budget { .. }), "{err}");
         assert!(err.is_input_error());
         let msg = err.to_string();
@@ -118,6 +133,9 @@ fn a_motion_too_stiff_to_resolve_ends_with_a_budget_error() {
             "{msg}"
         );
         assert!(msg.contains("soften the law"), "{msg}");
+        let orbit = OrbitRequest::default().run(&params).unwrap();
+        assert_eq!(orbit.period, 1, "{}", params.contact_law);
+        assert!(orbit.multipliers.iter().all(|m| m.norm() < 1.0));
     }
 }
 

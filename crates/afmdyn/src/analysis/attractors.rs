@@ -244,6 +244,7 @@ pub(crate) fn polish_steady(
             | IntegratorKind::Adaptive
             | IntegratorKind::Split
             | IntegratorKind::Exponential
+            | IntegratorKind::Taylor
     ) {
         return None;
     }

@@ -485,16 +485,21 @@ impl Acc {
         b: f64,
         fi: &mut DVector<f64>,
     ) {
-        let (half, mid) = (0.5 * (b - a), 0.5 * (a + b));
-        // (τ, dF_c/dτ, dV_T/dτ) at the ends and the GL nodes, in order
+        // (τ, dF_c/dτ, dV_T/dτ) at the ends and the GL nodes, in order; the nodes in the
+        // step's own smooth time ([`Integrator::smooth_time`]; τ itself but for the Taylor
+        // integrator's contact steps)
         let mut scan: Vec<(f64, f64, f64)> = Vec::with_capacity(GL_NODES + 2);
-        let taus = std::iter::once(a)
-            .chain(ctx.gl.iter().map(|&(x, _)| mid + half * x))
-            .chain(std::iter::once(b));
-        for (i, tau) in taus.enumerate() {
+        let nodes = std::iter::once((a, 0.0))
+            .chain(ctx.gl.iter().map(|&(x, w)| {
+                let (tau, dtau) = integ.smooth_time(a, b, 0.5 * (x + 1.0));
+                (tau, 0.5 * w * dtau)
+            }))
+            .chain(std::iter::once((b, 0.0)))
+            .collect::<Vec<_>>();
+        for (i, &(tau, weight)) in nodes.iter().enumerate() {
             let nd = ctx.node(integ, r, tau);
             if i >= 1 && i <= ctx.gl.len() {
-                self.quadrature(ctx, tau, half * ctx.gl[i - 1].1, &nd, fi);
+                self.quadrature(ctx, tau, weight, &nd, fi);
             }
             self.extremes(nd.f, nd.v[0]);
             scan.push((tau, ctx.rate(integ, r, tau, &nd, a, b), nd.v[1]));

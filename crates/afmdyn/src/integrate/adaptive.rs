@@ -24,7 +24,7 @@
 
 use super::dop853::{Dop853, Field};
 use super::exact::{Anchor, LinearFrame};
-use super::{ChatterWindow, HermiteStep, Integrator, Step};
+use super::{ChatterWindow, HermiteStep, Integrator, Step, StepBudget};
 use crate::error::SimError;
 use crate::model::CantileverModel;
 use crate::roots::{extremum, safeguarded_newton};
@@ -32,7 +32,7 @@ use crate::system::HybridSystem;
 use crate::system::Region;
 use crate::tip_sample::TipSampleSystem;
 use nalgebra::{DMatrix, DVector};
-use std::cell::{Cell, RefCell};
+use std::cell::RefCell;
 use std::sync::Arc;
 
 /// The start of a stepper in the exponential frame: y = 0 and Y = 0 (2r(1 + 2N) ≤ 4·MAX_MODES
@@ -126,11 +126,9 @@ pub struct Adaptive<S: TipSampleSystem + Clone = CantileverModel> {
     just_switched: bool,
     chatter: ChatterWindow,
     last: LastStep,
-    /// The drive period the step count is of (⌊τ/T⌋ at the steps' start) and the DOP853 steps
-    /// taken in it, accepted and rejected ([`crate::params::ADAPTIVE_STEPS_PER_PERIOD`]).
-    budget: Cell<(i64, usize)>,
-    /// DOP853 steps taken since construction ([`Integrator::work`]).
-    work: Cell<u64>,
+    /// The DOP853 steps taken, accepted and rejected: the budget of a drive period and the
+    /// work since construction.
+    budget: StepBudget,
     /// The augmented start vector of the current step (its storage reused step after step).
     start: Vec<f64>,
     /// The Jacobian buffer of the variational equations (d×d).
@@ -193,8 +191,7 @@ impl<S: TipSampleSystem + Clone> Adaptive<S> {
             h: 0.0,
             just_switched: true,
             chatter: ChatterWindow::new(CHATTER_COUNT, 1e-7 * model.period()),
-            budget: Cell::new((i64::MIN, 0)),
-            work: Cell::new(0),
+            budget: StepBudget::new("adaptive integrator", model.period()),
             spare: RefCell::new(None),
             frame: None,
             plain: RefCell::new(Vec::new()),
@@ -220,7 +217,7 @@ impl<S: TipSampleSystem + Clone> Adaptive<S> {
     /// [`super::split::Split`] that starts in free flight (the split integrator's own reset).
     pub(crate) fn forget_events(&mut self) {
         self.chatter.clear();
-        self.budget.set((i64::MIN, 0));
+        self.budget.forget();
     }
 
     /// Restart at (τ, z) in `region`, as [`Integrator::reset`] but with the region given (a
@@ -404,7 +401,7 @@ impl<S: TipSampleSystem + Clone> Adaptive<S> {
             stepper.set_h(t_end - t0);
         }
         for _ in 0..1000 {
-            self.count_step(t0)?;
+            self.budget.count(t0)?;
             if let Some((f, a)) = frame.as_mut() {
                 f.use_step(a, stepper.h());
             }
@@ -431,36 +428,6 @@ impl<S: TipSampleSystem + Clone> Adaptive<S> {
             tau: t0,
             message: "1000 rejected steps in a row".into(),
         })
-    }
-
-    /// Count one DOP853 step taken at `tau` against the budget of its drive period.
-    ///
-    /// # Errors
-    /// [`SimError::Budget`] beyond [`crate::params::ADAPTIVE_STEPS_PER_PERIOD`] steps in one
-    /// drive period.
-    fn count_step(&self, tau: f64) -> Result<(), SimError> {
-        let period = self.model.period();
-        let k = (tau / period).floor() as i64;
-        self.work.set(self.work.get() + 1);
-        let (at, n) = self.budget.get();
-        let n = if at == k { n + 1 } else { 1 };
-        self.budget.set((k, n));
-        let cap = crate::params::ADAPTIVE_STEPS_PER_PERIOD;
-        if n > cap {
-            let cap = cap as f64;
-            return Err(SimError::Budget {
-                what: "adaptive integrator",
-                needed: format!(
-                    "more than {cap:e} steps within the drive period from τ = {:.6e}",
-                    k as f64 * period
-                ),
-                budget: format!("{cap:e} steps per drive period"),
-                hint: "the tip–sample force grew too stiff to resolve where the motion went: \
-                       soften the law (contact_stiffness, hamaker), check the gap (alpha5), \
-                       or use a larger Ω",
-            });
-        }
-        Ok(())
     }
 
     /// Integrate from (t0, y0) in `mode` to exactly t1 with a fresh stepper; returns the end
@@ -637,7 +604,7 @@ impl<S: TipSampleSystem + Clone + 'static> Integrator for Adaptive<S> {
         "adaptive"
     }
     fn work(&self) -> u64 {
-        self.work.get()
+        self.budget.work()
     }
 
     fn set_variational(&mut self, on: bool) {

@@ -16,11 +16,14 @@
 //!   ([`adaptive::Adaptive::exponential`], Lawson's transformation, `exact/lawson.rs`; opt-in,
 //!   see docs/performance.md for why it is not the default) it integrates only the deviation
 //!   from the exact free flight.
-//! * [`split::Split`] — the exact free flight and the adaptive integrator in contact: the
-//!   default for Hertz and impact.
+//! * [`split::Split`] — the exact free flight, and in contact the Taylor integrator (Hertz) or
+//!   the adaptive one (the impact law's sticking): the default for Hertz and impact.
+//! * [`taylor::Taylor`] — a high-order Taylor series method, the free flight in τ and the
+//!   contact in a regularising time σ (dτ = 2√δ dσ) in which the δ^{3/2} force is a
+//!   polynomial: the default for DMT, whose van der Waals force acts in free flight.
 //!
 //! [`IntegratorKind::Auto`] (the default) chooses the exact propagator for the linear law, the
-//! split integrator for Hertz and impact, and the adaptive integrator for DMT
+//! split integrator for Hertz and impact, and the Taylor integrator for DMT
 //! ([`IntegratorKind::resolve`]).
 //!
 //! A driver calls [`Integrator::step`] until the target time; each step ends at a grid point,
@@ -33,6 +36,7 @@ pub mod exact;
 pub mod grid;
 pub mod rk4;
 pub mod split;
+pub mod taylor;
 
 use crate::error::SimError;
 use crate::model::{BodyContactCheck, CantileverModel};
@@ -250,6 +254,15 @@ pub trait Integrator: Send {
     /// steps (`integrate/exact/energy.rs`).
     fn last_step_rate_integrals(&mut self) -> Option<[f64; 3]> {
         None
+    }
+    /// The last step's own smooth time over a piece [a, b] of it: τ(u) and dτ/du for
+    /// u ∈ [0, 1], τ(0) = a, τ(1) = b, along a variable in which the solution is smooth, so
+    /// that a quadrature over the piece in u converges as for a smooth integrand (∫_a^b f dτ =
+    /// ∫_0^1 f(τ(u)) τ′(u) du). The default is τ itself, a + u(b − a); the Taylor
+    /// integrator's contact steps are smooth in their regularising time σ (τ − τ_c ∝ σ² at the
+    /// contact onset, where the Hertz force ∝ (τ − τ_c)^{3/2} is not smooth in τ).
+    fn smooth_time(&mut self, a: f64, b: f64, u: f64) -> (f64, f64) {
+        (a + u * (b - a), b - a)
     }
     /// Integrate the variational equations along with the state (needed by
     /// [`Integrator::last_step_jacobian`] of the adaptive integrator; free for the exact one).
@@ -470,7 +483,7 @@ pub fn advance_observed(
 #[serde(rename_all = "kebab-case")]
 pub enum IntegratorKind {
     /// The exact propagator for the linear law, the split integrator for Hertz and impact, the
-    /// adaptive integrator for DMT (default; [`IntegratorKind::resolve`]).
+    /// Taylor integrator for DMT (default; [`IntegratorKind::resolve`]).
     #[default]
     Auto,
     /// Exact piecewise-linear propagation (linear law only).
@@ -481,13 +494,18 @@ pub enum IntegratorKind {
     Rk4Naive,
     /// Adaptive DOP853 oracle with terminal events.
     Adaptive,
-    /// Exact free flight, adaptive DOP853 in contact ([`split::Split`]; every law but DMT).
+    /// Exact free flight; in contact the Taylor integrator (Hertz) or adaptive DOP853 (the
+    /// linear law, the impact law's sticking) ([`split::Split`]; every law but DMT).
     Split,
     /// Adaptive DOP853 of the deviation from the exact free flight (Lawson's exponential frame,
     /// [`adaptive::Adaptive::exponential`]): for DMT, whose van der Waals force acts in free
     /// flight. Opt-in: fewer steps, but its dense output costs an exponential and two sines per
     /// evaluation, so recorded runs are slower (docs/performance.md).
     Exponential,
+    /// A Taylor series method of high order ([`taylor::Taylor`]): DMT's free flight in τ, the
+    /// Hertz and DMT contact in a regularising time σ (dτ = 2√δ dσ) in which the δ^{3/2} force
+    /// is a polynomial; Hertz and DMT only.
+    Taylor,
 }
 
 impl FromStr for IntegratorKind {
@@ -501,9 +519,10 @@ impl FromStr for IntegratorKind {
             "adaptive" | "dop853" => Ok(IntegratorKind::Adaptive),
             "split" => Ok(IntegratorKind::Split),
             "exponential" | "lawson" => Ok(IntegratorKind::Exponential),
+            "taylor" => Ok(IntegratorKind::Taylor),
             _ => Err(format!(
-                "integrator '{s}': expected auto, exact, rk4, rk4-naive, adaptive, split or \
-                 exponential"
+                "integrator '{s}': expected auto, exact, rk4, rk4-naive, adaptive, split, \
+                 exponential or taylor"
             )),
         }
     }
@@ -524,10 +543,11 @@ pub struct IntegratorOptions {
 impl IntegratorKind {
     /// The concrete integrator for `model`: [`IntegratorKind::Auto`] resolves to `Exact` for an
     /// affine (linear-law) model, to `Split` for a law without force in free flight (Hertz,
-    /// impact with r > 0) and to `Adaptive` otherwise (DMT, and the plastic impact law r = 0,
-    /// whose free flights all start tangentially); other kinds are returned as given. ([`build`]
-    /// falls back from `Split` to `Adaptive` for `Auto` where the exact free flight cannot be
-    /// built: Ω at an undamped resonance of the free beam, or a grid beyond its budget.)
+    /// impact with r > 0), to `Adaptive` for the plastic impact law r = 0 (whose free flights
+    /// all start tangentially) and to `Taylor` for DMT; other kinds are returned as given.
+    /// ([`build`] falls back from `Split` to `Adaptive` for `Auto` where the exact free flight
+    /// cannot be built: Ω at an undamped resonance of the free beam, or a grid beyond its
+    /// budget.)
     pub fn resolve(self, model: &CantileverModel) -> IntegratorKind {
         match self {
             IntegratorKind::Auto if model.law().is_affine() => IntegratorKind::Exact,
@@ -537,7 +557,8 @@ impl IntegratorKind {
                 IntegratorKind::Adaptive
             }
             IntegratorKind::Auto if split::Split::applies(model) => IntegratorKind::Split,
-            IntegratorKind::Auto => IntegratorKind::Adaptive,
+            // DMT: its van der Waals force acts in free flight
+            IntegratorKind::Auto => IntegratorKind::Taylor,
             k => k,
         }
     }
@@ -607,7 +628,10 @@ pub fn build(
     let kind = opts.kind.resolve(model);
     if matches!(
         kind,
-        IntegratorKind::Adaptive | IntegratorKind::Split | IntegratorKind::Exponential
+        IntegratorKind::Adaptive
+            | IntegratorKind::Split
+            | IntegratorKind::Exponential
+            | IntegratorKind::Taylor
     ) {
         let rate = [Region::Free, Region::Contact]
             .iter()
@@ -616,7 +640,11 @@ pub fn build(
         let steps = rate * model.period();
         if steps.is_nan() || steps > crate::params::ADAPTIVE_STEPS_BUDGET {
             return Err(SimError::Budget {
-                what: "adaptive integrator",
+                what: match kind {
+                    IntegratorKind::Taylor => "taylor integrator",
+                    IntegratorKind::Split => "split integrator",
+                    _ => "adaptive integrator",
+                },
                 needed: format!("about {steps:.2e} steps per drive period"),
                 budget: "1e7".into(),
                 hint: "use the exact integrator, or a larger Ω or softer contact",
@@ -639,6 +667,7 @@ pub fn build(
         )?),
         IntegratorKind::Rk4 => Box::new(rk4::Rk4::new(model, opts.steps_per_period, true)),
         IntegratorKind::Rk4Naive => Box::new(rk4::Rk4::new(model, opts.steps_per_period, false)),
+        IntegratorKind::Taylor => Box::new(taylor::Taylor::new(model, opts.tolerance)?),
         IntegratorKind::Adaptive | IntegratorKind::Split | IntegratorKind::Exponential => {
             if !(opts.tolerance.is_finite() && opts.tolerance > 0.0 && opts.tolerance < 1.0) {
                 return Err(SimError::out_of_range(
@@ -778,6 +807,70 @@ impl ChatterWindow {
     /// Forget the recorded events (a new start).
     pub(crate) fn clear(&mut self) {
         self.recent.clear();
+    }
+}
+
+/// The steps of an integrator that chooses its own steps (adaptive DOP853, Taylor): the work
+/// since construction ([`Integrator::work`]) and the budget of one drive period
+/// ([`crate::params::ADAPTIVE_STEPS_PER_PERIOD`] steps within ⌊τ/T⌋, accepted and rejected).
+/// Interior mutability, so that the `&self` step loops can count.
+#[derive(Debug, Clone)]
+pub(crate) struct StepBudget {
+    what: &'static str,
+    period: f64,
+    /// The drive period counted and the steps taken in it.
+    current: std::cell::Cell<(i64, usize)>,
+    work: std::cell::Cell<u64>,
+}
+
+impl StepBudget {
+    /// A budget of the integrator named `what` (in its error) over drive periods of `period`.
+    pub(crate) fn new(what: &'static str, period: f64) -> Self {
+        StepBudget {
+            what,
+            period,
+            current: std::cell::Cell::new((i64::MIN, 0)),
+            work: std::cell::Cell::new(0),
+        }
+    }
+
+    /// Count one step taken at `tau`.
+    ///
+    /// # Errors
+    /// [`SimError::Budget`] beyond [`crate::params::ADAPTIVE_STEPS_PER_PERIOD`] steps in one
+    /// drive period.
+    pub(crate) fn count(&self, tau: f64) -> Result<(), SimError> {
+        let k = (tau / self.period).floor() as i64;
+        self.work.set(self.work.get() + 1);
+        let (at, n) = self.current.get();
+        let n = if at == k { n + 1 } else { 1 };
+        self.current.set((k, n));
+        let cap = crate::params::ADAPTIVE_STEPS_PER_PERIOD;
+        if n > cap {
+            let cap = cap as f64;
+            return Err(SimError::Budget {
+                what: self.what,
+                needed: format!(
+                    "more than {cap:e} steps within the drive period from τ = {:.6e}",
+                    k as f64 * self.period
+                ),
+                budget: format!("{cap:e} steps per drive period"),
+                hint: "the tip–sample force grew too stiff to resolve where the motion went: \
+                       soften the law (contact_stiffness, hamaker), check the gap (alpha5), \
+                       or use a larger Ω",
+            });
+        }
+        Ok(())
+    }
+
+    /// Forget the count of the current drive period (a new run).
+    pub(crate) fn forget(&self) {
+        self.current.set((i64::MIN, 0));
+    }
+
+    /// Steps taken since construction.
+    pub(crate) fn work(&self) -> u64 {
+        self.work.get()
     }
 }
 

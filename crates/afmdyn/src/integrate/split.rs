@@ -7,9 +7,11 @@
 //! missed) and its located switchings. At the switching into contact the split integrator
 //! applies the law's event: a plain switching into the law's contact flow (Hertz, linear),
 //! or the impact map (Newton's restitution, ending in sticking when the bounce would not rise;
-//! [`crate::model`]). The contact flow (the Hertz force α4 δ^{3/2} + α6 δ̇, sticking) is
-//! integrated by [`Adaptive`] (DOP853 with events and the variational equations) until it ends
-//! in a switching or release, where the exact free flight takes over again.
+//! [`crate::model`]). The contact flow is integrated until it ends in a switching or release,
+//! where the exact free flight takes over again: the Hertz force α4 δ^{3/2} + α6 δ̇ by the
+//! Taylor integrator ([`Taylor`], in the regularising time of the contact, where the force is a
+//! polynomial), the linear law's contact and the impact law's sticking by [`Adaptive`] (DOP853
+//! with events and the variational equations).
 //!
 //! Both halves share the free flight's dead band (the model's guard tolerance), so the split
 //! integrator leaves free flight where the adaptive integrator alone would; it is its oracle
@@ -20,6 +22,7 @@
 
 use super::adaptive::Adaptive;
 use super::exact::ExactPropagator;
+use super::taylor::Taylor;
 use super::{ChatterWindow, Integrator, Step};
 use crate::error::SimError;
 use crate::model::CantileverModel;
@@ -37,8 +40,49 @@ const CHATTER_COUNT: usize = 4096;
 enum Half {
     /// The exact propagator (free flight).
     Exact,
-    /// The adaptive integrator (contact, sticking).
+    /// The contact integrator (contact, sticking).
     Adaptive,
+}
+
+/// The integrator of the contact half: Taylor for the Hertz law, adaptive DOP853 for the others
+/// (the linear law's contact, the impact law's sticking and its tangential free flights).
+#[derive(Debug, Clone)]
+enum ContactHalf {
+    Adaptive(Adaptive),
+    Taylor(Taylor),
+}
+
+impl ContactHalf {
+    fn new(model: &CantileverModel, tol: f64) -> Result<Self, SimError> {
+        Ok(match model.law() {
+            crate::contact::ContactLaw::Hertz => ContactHalf::Taylor(Taylor::new(model, tol)?),
+            _ => ContactHalf::Adaptive(Adaptive::new(model, tol)),
+        })
+    }
+    fn integ(&self) -> &dyn Integrator {
+        match self {
+            ContactHalf::Adaptive(a) => a,
+            ContactHalf::Taylor(t) => t,
+        }
+    }
+    fn integ_mut(&mut self) -> &mut dyn Integrator {
+        match self {
+            ContactHalf::Adaptive(a) => a,
+            ContactHalf::Taylor(t) => t,
+        }
+    }
+    fn restart_in(&mut self, tau: f64, z: &[f64], region: Region) {
+        match self {
+            ContactHalf::Adaptive(a) => a.restart_in(tau, z, region),
+            ContactHalf::Taylor(t) => t.restart_in(tau, z, region),
+        }
+    }
+    fn forget_events(&mut self) {
+        match self {
+            ContactHalf::Adaptive(a) => a.forget_events(),
+            ContactHalf::Taylor(t) => t.forget_events(),
+        }
+    }
 }
 
 /// Exact free flight and adaptive contact (see the module docs).
@@ -46,7 +90,7 @@ enum Half {
 pub struct Split {
     model: CantileverModel,
     exact: ExactPropagator,
-    adaptive: Adaptive,
+    adaptive: ContactHalf,
     /// The half at the current state.
     active: Half,
     /// The half that made the last step (its dense output and Jacobian).
@@ -80,7 +124,7 @@ impl Split {
         Ok(Split {
             model: model.clone(),
             exact: ExactPropagator::free_flight(model, min_steps_per_period)?,
-            adaptive: Adaptive::new(model, tol),
+            adaptive: ContactHalf::new(model, tol)?,
             active: Half::Exact,
             last: Half::Exact,
             chatter: ChatterWindow::new(CHATTER_COUNT, 1e-7 * model.period()),
@@ -95,14 +139,14 @@ impl Split {
     fn integ(&self, h: Half) -> &dyn Integrator {
         match h {
             Half::Exact => &self.exact,
-            Half::Adaptive => &self.adaptive,
+            Half::Adaptive => self.adaptive.integ(),
         }
     }
 
     fn integ_mut(&mut self, h: Half) -> &mut dyn Integrator {
         match h {
             Half::Exact => &mut self.exact,
-            Half::Adaptive => &mut self.adaptive,
+            Half::Adaptive => self.adaptive.integ_mut(),
         }
     }
 
@@ -123,7 +167,7 @@ impl Split {
             self.active = Half::Exact;
         } else if self.active == Half::Adaptive {
             // the adaptive half's own event: it is in `region` at (τ, z) already
-            debug_assert_eq!(self.adaptive.region(), region);
+            debug_assert_eq!(self.adaptive.integ().region(), region);
         } else {
             self.adaptive.restart_in(tau, z, region);
             self.active = Half::Adaptive;
@@ -143,7 +187,7 @@ impl Split {
                 self.after_exact(s)
             }
             Half::Adaptive => {
-                let s = self.adaptive.step(tau_max)?;
+                let s = self.adaptive.integ_mut().step(tau_max)?;
                 self.after_adaptive(s)
             }
         }
@@ -176,8 +220,8 @@ impl Split {
         self.last = Half::Adaptive;
         if let Some(e) = &step.event {
             self.chatter.record(e.tau)?;
-            if self.adaptive.region() == Region::Free {
-                let z = self.adaptive.state().clone();
+            if self.adaptive.integ().region() == Region::Free {
+                let z = self.adaptive.integ().state().clone();
                 self.hand_over(e.tau, z.as_slice(), Region::Free, e.kind);
             }
         }
@@ -198,17 +242,17 @@ impl Integrator for Split {
     fn region(&self) -> Region {
         match self.active {
             Half::Exact => Region::Free,
-            Half::Adaptive => self.adaptive.region(),
+            Half::Adaptive => self.adaptive.integ().region(),
         }
     }
     fn name(&self) -> &'static str {
         "split"
     }
     fn work(&self) -> u64 {
-        self.adaptive.work()
+        self.adaptive.integ().work()
     }
     fn set_variational(&mut self, on: bool) {
-        self.adaptive.set_variational(on);
+        self.adaptive.integ_mut().set_variational(on);
     }
 
     fn reset(&mut self, tau: f64, z: &DVector<f64>) -> Result<(), SimError> {
@@ -224,7 +268,7 @@ impl Integrator for Split {
                 self.active = Half::Exact;
             }
             Region::Contact => {
-                self.adaptive.reset(tau, &z)?;
+                self.adaptive.integ_mut().reset(tau, &z)?;
                 self.active = Half::Adaptive;
             }
         }
@@ -259,7 +303,7 @@ impl Integrator for Split {
                         self.last = Half::Exact;
                     }
                     Half::Adaptive => {
-                        let s = self.adaptive.step(tau_end)?;
+                        let s = self.adaptive.integ_mut().step(tau_end)?;
                         self.after_adaptive(s)?;
                     }
                 }
@@ -298,12 +342,17 @@ impl Integrator for Split {
     }
 
     /// The exact half's closed form over its whole grid steps of free flight (where the
-    /// model's rates are those of the linear law's region I: no tip force).
+    /// model's rates are those of the linear law's region I: no tip force), the Taylor
+    /// contact's from its series.
     fn last_step_rate_integrals(&mut self) -> Option<[f64; 3]> {
         match self.last {
             Half::Exact => self.exact.last_step_rate_integrals(),
-            Half::Adaptive => None,
+            Half::Adaptive => self.adaptive.integ_mut().last_step_rate_integrals(),
         }
+    }
+
+    fn smooth_time(&mut self, a: f64, b: f64, u: f64) -> (f64, f64) {
+        self.integ_mut(self.last).smooth_time(a, b, u)
     }
 
     fn last_step_jacobian(&mut self) -> Result<DMatrix<f64>, SimError> {

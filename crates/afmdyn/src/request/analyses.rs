@@ -105,7 +105,7 @@ impl IntegratorRequest {
                 samples_per_period.max(1)
             }
             IntegratorKind::Rk4 | IntegratorKind::Rk4Naive => self.steps_per_period.unwrap_or(2000),
-            IntegratorKind::Adaptive | IntegratorKind::Exponential => 1,
+            IntegratorKind::Adaptive | IntegratorKind::Exponential | IntegratorKind::Taylor => 1,
         };
         IntegratorOptions {
             kind: self.integrator,

@@ -1,0 +1,814 @@
+//! Taylor coefficients of the cantilever's flow with a nonlinear tip force, by the recurrences
+//! of automatic differentiation (Moore, *Interval Analysis*, Prentice-Hall 1966, ch. 11;
+//! Griewank & Walther, *Evaluating Derivatives*, 2nd ed., SIAM 2008, §13.2): every quantity of
+//! the vector field is carried as its Taylor series in the independent variable, and the
+//! coefficient of order k + 1 of the state follows from those of order ≤ k of the field.
+//!
+//! The equations are those of [`crate::model`] with region I's matrices (the nonlinear laws
+//! add their tip force to the free flight's equations):
+//!
+//! ä = −M⁻¹K a − M⁻¹C ȧ + M⁻¹F^I(τ) + M⁻¹φ F_c,  V_T = φᵀa + α2_b sin Ωτ + α5 (eq. 8),
+//!
+//! with α2_b the base amplitude of V_T (α2 for the beam, 0 for the point mass) and
+//! F^I = f₀ + f_s sin Ωτ + f_c cos Ωτ (eq. 14).
+//!
+//! **Free flight, in τ** ([`Jet::free`]). DMT's van der Waals force F_c = −H̃u², u = 1/d,
+//! d = V_T + ã₀ > ã₀ (the reciprocal by u d = 1, [Griewank & Walther, Table 13.2]); the other
+//! laws exert no force there. sin Ωτ and cos Ωτ have the closed-form coefficients
+//! Ωᵏ/k! sin(Ωτ₀ + kπ/2).
+//!
+//! **Contact, in the regularising time σ** ([`Jet::contact`]). The Hertz force α4 δ^{3/2}
+//! (δ = −V_T) is not analytic where contact begins and ends: with δ ≈ v (τ − τ_c) the solution
+//! holds a term (τ − τ_c)^{7/2}, so a series in τ from the contact onset does not converge and
+//! steps shrink geometrically towards both ends of the contact (the adaptive integrator's 23
+//! steps of a DMT contact of the point-mass probe). With w = √δ and dτ/dσ = 2w the contact
+//! flow becomes
+//!
+//! dτ/dσ = 2w,  dz/dσ = 2w f(τ, z),  dw/dσ = δ̇ = −dV_T/dτ,
+//!
+//! whose right-hand side is a polynomial in (z, w) and trigonometric in τ: F_c = α4 wδ + α6 δ̇
+//! (Hertz), −H̃/ã₀² + α4 wδ + α6 wδ̇ (DMT, Kelvin–Voigt ∝ √δ). w² = δ is a first integral
+//! (d(w²)/dσ = 2wδ̇ = dδ/dσ), τ − τ_c ≈ v σ² at the onset (the square-root time of a
+//! regularised collision, Stiefel & Scheifele, *Linear and Regular Celestial Mechanics*,
+//! Springer 1971, §I.2), and contact ends where w falls through 0 — a simple root, not the
+//! double root of δ. sin Ωτ(σ) and cos Ωτ(σ) follow from S′ = Ω C τ′, C′ = −Ω S τ′.
+//!
+//! **Variational equations.** Φ = ∂z(τ)/∂z(τ₀), Φ′ = JΦ with the rank-one tip-force term
+//! J = A + [0; M⁻¹φ](F_V cᵀ + F_V̇ c′ᵀ), c = (φ, 0), c′ = (0, φ), F_V = ∂F_c/∂V_T,
+//! F_V̇ = ∂F_c/∂(dV_T/dτ). In σ, dΦ/dσ = 2wJΦ: the Jacobian over fixed times τ₀, τ₁ along the
+//! trajectory, reparametrised; 2wF_V = −3α4 δ (− α6 δ̇ for DMT) and 2wF_V̇ = −2α6 w (Hertz),
+//! −2α6 δ (DMT) are polynomial, so the √δ singularity of ∂F_c/∂δ at the contact onset
+//! (DMT's Kelvin–Voigt term) does not appear.
+//!
+//! Layout: order-major, the coefficient of order k of the state at `z[k·d .. (k+1)·d]`,
+//! d = 2N; of Φ (column-major d×d) at `phi[k·d² .. (k+1)·d²]`.
+
+// the recurrences index several series by the order k and by k − j at once
+#![allow(clippy::needless_range_loop)]
+
+use crate::contact::ContactLaw;
+use crate::model::CantileverModel;
+use crate::system::Region;
+
+/// Highest order the series are formed to (tolerances down to 1e-18 need order 22).
+pub(crate) const MAX_ORDER: usize = 40;
+
+/// The tip-force law as the recurrences need it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Law {
+    /// α4 δ^{3/2} + α6 δ̇ in contact, no force in free flight.
+    Hertz { k: f64, c: f64 },
+    /// −H̃/d² in free flight; −H̃/ã₀² + α4 δ^{3/2} + α6 √δ δ̇ in contact.
+    Dmt { h: f64, a0: f64, k: f64, c: f64 },
+}
+
+/// The model's data the recurrences read (see the module docs).
+#[derive(Debug, Clone)]
+pub(crate) struct Jet {
+    n: usize,
+    /// −M⁻¹K, row-major N×N.
+    ak: Vec<f64>,
+    /// −M⁻¹C, row-major N×N.
+    ac: Vec<f64>,
+    /// M⁻¹f₀, M⁻¹f_s, M⁻¹f_c (the lower halves of b_const, b_sin, b_cos), shape `[N]`.
+    b_const: Vec<f64>,
+    b_sin: Vec<f64>,
+    b_cos: Vec<f64>,
+    /// M⁻¹φ, shape `[N]`.
+    mphi: Vec<f64>,
+    /// φ(1), shape `[N]`.
+    phi: Vec<f64>,
+    /// α2_b: the base amplitude in V_T.
+    base: f64,
+    alpha5: f64,
+    omega: f64,
+    law: Law,
+    /// Ωᵏ/k!, k ≤ MAX_ORDER.
+    trig_factor: Vec<f64>,
+    /// The energy balance's rates ([`CantileverModel::power`]): the Galerkin forcing f_s, f_c
+    /// (not M⁻¹-scaled), α3.
+    power_sin: Vec<f64>,
+    power_cos: Vec<f64>,
+    alpha3: f64,
+}
+
+/// Coefficients per series: orders 0..=MAX_ORDER.
+const M: usize = MAX_ORDER + 1;
+
+/// The Taylor coefficients of one step (see the module docs for the layout), and the scratch
+/// series the recurrences need, allocated once per integrator.
+#[derive(Debug, Clone)]
+pub(crate) struct Series {
+    /// Order p: coefficients 0..=p are formed.
+    pub p: usize,
+    /// State dimension d = 2N.
+    pub d: usize,
+    /// Whether Φ is formed.
+    pub variational: bool,
+    /// Which flow: free flight (in τ) or contact (in σ).
+    pub region: Region,
+    /// Start time τ₀.
+    pub t0: f64,
+    /// The state's coefficients, M·d (orders 0..=p formed).
+    pub z: Vec<f64>,
+    /// Φ's coefficients, M·d² (empty without the variational equations).
+    pub phi: Vec<f64>,
+    /// Contact: τ − τ₀ as a series in σ.
+    pub theta: [f64; M],
+    /// Contact: w = √δ.
+    pub w: [f64; M],
+    /// V_T.
+    pub v: [f64; M],
+    /// The tip force F_c.
+    pub f: [f64; M],
+    // scratch series of the recurrences
+    s: [f64; M],
+    c: [f64; M],
+    del: [f64; M],
+    deld: [f64; M],
+    u: [f64; M],
+    u2: [f64; M],
+    u3: [f64; M],
+    fv: [f64; M],
+    fvd: [f64; M],
+    /// f(τ, z) per order (contact: the factor of 2w), M·d.
+    g: Vec<f64>,
+    /// AΦ per order, M·d².
+    gphi: Vec<f64>,
+    /// φᵀ(upper rows of Φ) and φᵀ(lower rows of Φ) per order, M·d each.
+    r: Vec<f64>,
+    rd: Vec<f64>,
+}
+
+impl Default for Series {
+    fn default() -> Self {
+        Series {
+            p: 0,
+            d: 0,
+            variational: false,
+            region: Region::Free,
+            t0: 0.0,
+            z: Vec::new(),
+            phi: Vec::new(),
+            theta: [0.0; M],
+            w: [0.0; M],
+            v: [0.0; M],
+            f: [0.0; M],
+            s: [0.0; M],
+            c: [0.0; M],
+            del: [0.0; M],
+            deld: [0.0; M],
+            u: [0.0; M],
+            u2: [0.0; M],
+            u3: [0.0; M],
+            fv: [0.0; M],
+            fvd: [0.0; M],
+            g: Vec::new(),
+            gphi: Vec::new(),
+            r: Vec::new(),
+            rd: Vec::new(),
+        }
+    }
+}
+
+/// Σ_{j=0..=k} a_j b_{k−j}: the coefficient of order k of the product of two series, in four
+/// independent partial sums (the recurrences are latency-bound: one chain of k additions would
+/// cost 4k cycles per coefficient).
+#[inline(always)]
+fn cauchy(a: &[f64], b: &[f64], k: usize) -> f64 {
+    let (a, b) = (&a[..=k], &b[..=k]);
+    let mut acc = [0.0; 4];
+    let (mut x, mut y) = (a.chunks_exact(4), b.rchunks_exact(4));
+    for (x, y) in x.by_ref().zip(y.by_ref()) {
+        acc[0] += x[0] * y[3];
+        acc[1] += x[1] * y[2];
+        acc[2] += x[2] * y[1];
+        acc[3] += x[3] * y[0];
+    }
+    let rest: f64 = x
+        .remainder()
+        .iter()
+        .zip(y.remainder().iter().rev())
+        .map(|(x, y)| x * y)
+        .sum();
+    (acc[0] + acc[1]) + (acc[2] + acc[3]) + rest
+}
+
+/// Σ_{j=0..=k} a_j a_{k−j}, the coefficient of order k of a², by symmetry.
+#[inline(always)]
+fn square(a: &[f64], k: usize) -> f64 {
+    let half = k.div_ceil(2);
+    let twice = if half == 0 {
+        0.0
+    } else {
+        // Σ_{j<half} a_j a_{k−j} = the Cauchy coefficient of order half − 1 of a[..half] and
+        // a[k + 1 − half..=k]
+        cauchy(&a[..half], &a[k + 1 - half..=k], half - 1)
+    };
+    let mid = if k.is_multiple_of(2) {
+        a[k / 2] * a[k / 2]
+    } else {
+        0.0
+    };
+    2.0 * twice + mid
+}
+
+/// The number of modes N, a constant of the monomorphised recurrences for small N (the loops
+/// over modes unrolled, the slices' bounds known) and a run-time value beyond.
+trait Width: Copy {
+    fn get(self) -> usize;
+}
+
+#[derive(Clone, Copy)]
+struct Fixed<const N: usize>;
+
+impl<const N: usize> Width for Fixed<N> {
+    #[inline(always)]
+    fn get(self) -> usize {
+        N
+    }
+}
+
+#[derive(Clone, Copy)]
+struct Runtime(usize);
+
+impl Width for Runtime {
+    #[inline(always)]
+    fn get(self) -> usize {
+        self.0
+    }
+}
+
+/// `$body` with `$w` the [`Width`] of `$n` modes: fixed for N ≤ 4, else at run time.
+macro_rules! with_width {
+    ($n:expr, $w:ident => $body:expr) => {
+        match $n {
+            1 => {
+                let $w = Fixed::<1>;
+                $body
+            }
+            2 => {
+                let $w = Fixed::<2>;
+                $body
+            }
+            3 => {
+                let $w = Fixed::<3>;
+                $body
+            }
+            4 => {
+                let $w = Fixed::<4>;
+                $body
+            }
+            n => {
+                let $w = Runtime(n);
+                $body
+            }
+        }
+    };
+}
+
+/// Σ_j x_j y_j.
+#[inline]
+fn dot(x: &[f64], y: &[f64]) -> f64 {
+    x.iter().zip(y).map(|(a, b)| a * b).sum()
+}
+
+impl Series {
+    /// Start the series of a step from (τ₀, z₀) to order `p`: buffers sized, z's order 0,
+    /// Φ(τ₀) = I when `variational`; returns (sin Ωτ₀, cos Ωτ₀).
+    #[allow(clippy::too_many_arguments)]
+    fn start(
+        &mut self,
+        p: usize,
+        d: usize,
+        variational: bool,
+        region: Region,
+        t0: f64,
+        z0: &[f64],
+        omega: f64,
+    ) -> (f64, f64) {
+        self.prepare(p, d, variational, region, t0);
+        self.z[..d].copy_from_slice(z0);
+        if variational {
+            let phi0 = &mut self.phi[..d * d];
+            phi0.fill(0.0);
+            for i in 0..d {
+                phi0[i * d + i] = 1.0;
+            }
+        }
+        (omega * t0).sin_cos()
+    }
+
+    /// Size the buffers for dimension `d` (allocated on the first step and when d changes).
+    fn prepare(&mut self, p: usize, d: usize, variational: bool, region: Region, t0: f64) {
+        assert!(p < M, "Taylor order {p} beyond {MAX_ORDER}");
+        self.p = p;
+        self.variational = variational;
+        self.region = region;
+        self.t0 = t0;
+        if self.d != d || self.z.len() != M * d {
+            self.d = d;
+            for v in [&mut self.z, &mut self.g, &mut self.r, &mut self.rd] {
+                v.clear();
+                v.resize(M * d, 0.0);
+            }
+            self.phi.clear();
+            self.gphi.clear();
+        }
+        if variational && self.phi.len() != M * d * d {
+            self.phi.resize(M * d * d, 0.0);
+            self.gphi.resize(M * d * d, 0.0);
+        }
+    }
+
+    /// The state at s (τ − τ₀ in free flight, σ in contact) into `out` (d), by Horner's scheme.
+    pub fn state_at(&self, s: f64, out: &mut [f64]) {
+        with_width!(self.d / 2, w => horner_fixed(w, &self.z, self.p, s, out))
+    }
+
+    /// Φ at s into `out` (d², column-major).
+    pub fn jacobian_at(&self, s: f64, out: &mut [f64]) {
+        let dd = self.d * self.d;
+        horner_vec(&self.phi, dd, self.p, s, out);
+    }
+
+    /// ∞-norms of the coefficients of order k of everything the step carries (state, Φ, the
+    /// drive's sin Ωτ and cos Ωτ — the energy balance integrates products with them —, and in
+    /// contact τ − τ₀ and w): the input of the step-size rule.
+    pub fn order_norm(&self, k: usize) -> f64 {
+        let d = self.d;
+        let mut m = self.z[k * d..(k + 1) * d]
+            .iter()
+            .fold(self.s[k].abs().max(self.c[k].abs()), |a, x| a.max(x.abs()));
+        if self.region == Region::Contact {
+            m = m.max(self.theta[k].abs()).max(self.w[k].abs());
+        }
+        if self.variational {
+            let dd = d * d;
+            m = self.phi[k * dd..(k + 1) * dd]
+                .iter()
+                .fold(m, |a, x| a.max(x.abs()));
+        }
+        m
+    }
+
+    /// The guard's series: V_T in free flight, w in contact (both positive inside the region).
+    pub fn guard(&self) -> &[f64] {
+        match self.region {
+            Region::Free => &self.v[..=self.p],
+            Region::Contact => &self.w[..=self.p],
+        }
+    }
+}
+
+/// [`horner_vec`] for the state (width 2N, a constant of the monomorphised loop for small N).
+#[inline(always)]
+fn horner_fixed<W: Width>(w: W, c: &[f64], p: usize, s: f64, out: &mut [f64]) {
+    let d = 2 * w.get();
+    let out = &mut out[..d];
+    out.copy_from_slice(&c[p * d..p * d + d]);
+    for k in (0..p).rev() {
+        let ck = &c[k * d..k * d + d];
+        for i in 0..d {
+            out[i] = out[i] * s + ck[i];
+        }
+    }
+}
+
+/// Σ_k c_k sᵏ for each of the `width` components of the order-major coefficients `c`
+/// (orders 0..=p), into `out`.
+pub(crate) fn horner_vec(c: &[f64], width: usize, p: usize, s: f64, out: &mut [f64]) {
+    let mut orders = c[..(p + 1) * width].chunks_exact(width).rev();
+    if let Some(top) = orders.next() {
+        out.copy_from_slice(top);
+    }
+    for ck in orders {
+        for (o, &x) in out.iter_mut().zip(ck) {
+            *o = *o * s + x;
+        }
+    }
+}
+
+impl Jet {
+    /// The data of `model`, or `None` for a law the recurrences do not carry (the linear law,
+    /// propagated exactly, and the impact law, whose contact is a constraint).
+    pub(crate) fn new(model: &CantileverModel) -> Option<Self> {
+        let p = model.params();
+        let law = match *model.law() {
+            ContactLaw::Hertz => Law::Hertz {
+                k: p.alpha4,
+                c: p.alpha6,
+            },
+            ContactLaw::Dmt {
+                hamaker,
+                intermolecular_distance,
+            } => Law::Dmt {
+                h: hamaker,
+                a0: intermolecular_distance,
+                k: p.alpha4,
+                c: p.alpha6,
+            },
+            ContactLaw::Linear | ContactLaw::Impact { .. } => return None,
+        };
+        let n = model.modes();
+        let free = model.dynamics(Region::Free);
+        let mut ak = vec![0.0; n * n];
+        let mut ac = vec![0.0; n * n];
+        for i in 0..n {
+            for j in 0..n {
+                ak[i * n + j] = free.a[(n + i, j)];
+                ac[i * n + j] = free.a[(n + i, n + j)];
+            }
+        }
+        let lower = |v: &nalgebra::DVector<f64>| v.as_slice()[n..].to_vec();
+        let omega = p.omega;
+        let mut trig_factor = vec![1.0; MAX_ORDER + 1];
+        for k in 1..=MAX_ORDER {
+            trig_factor[k] = trig_factor[k - 1] * omega / k as f64;
+        }
+        Some(Jet {
+            n,
+            ak,
+            ac,
+            b_const: lower(&free.b_const),
+            b_sin: lower(&free.b_sin),
+            b_cos: lower(&free.b_cos),
+            mphi: model.tip_mobility().as_slice().to_vec(),
+            phi: model.tip().as_slice().to_vec(),
+            base: p.base_amplitude(),
+            alpha5: p.alpha5,
+            omega,
+            law,
+            trig_factor,
+            power_sin: model
+                .galerkin()
+                .region(Region::Free)
+                .forcing
+                .sin
+                .as_slice()
+                .to_vec(),
+            power_cos: model
+                .galerkin()
+                .region(Region::Free)
+                .forcing
+                .cos
+                .as_slice()
+                .to_vec(),
+            alpha3: p.alpha3,
+        })
+    }
+
+    /// The integrals over [0, `end`] of the series variable of the energy balance's rates of
+    /// [`CantileverModel::power`] — [base work, beam dissipation, sample dissipation] — from the
+    /// step's series `s`: the rates as series (Cauchy products of the state's, the drive's and
+    /// the force's series; in contact times dτ/dσ = 2w), integrated term by term. Exact to the
+    /// truncation of the series.
+    pub(crate) fn rate_integrals(&self, s: &Series, end: f64) -> [f64; 3] {
+        let (n, d, p) = (self.n, s.d, s.p);
+        let mut y = [0.0; M];
+        let mut yc = [0.0; M];
+        let mut base = [0.0; M];
+        let mut beam = [0.0; M];
+        let mut sample = [0.0; M];
+        // Σ_i f_s,i ȧ_i and Σ_i f_c,i ȧ_i
+        for k in 0..=p {
+            let ad = &s.z[k * d + n..k * d + d];
+            y[k] = dot(&self.power_sin, ad);
+            yc[k] = dot(&self.power_cos, ad);
+        }
+        let bo = self.base * self.omega;
+        for k in 0..=p {
+            base[k] = cauchy(&y, &s.s, k) + cauchy(&yc, &s.c, k) - bo * cauchy(&s.c, &s.f, k);
+            let mut b = 0.0;
+            for i in 0..n {
+                // Σ_j ȧ_i,j ȧ_i,k−j over the strided coefficients of mode i
+                let mut acc = 0.0;
+                for j in 0..=k {
+                    acc += s.z[j * d + n + i] * s.z[(k - j) * d + n + i];
+                }
+                b += acc;
+            }
+            beam[k] = self.alpha3 * b;
+        }
+        if s.region == Region::Contact {
+            // the dissipative force F_d δ̇: α6 δ̇² (Hertz), α6 w δ̇² (DMT)
+            let mut rate2 = [0.0; M];
+            for k in 0..=p {
+                rate2[k] = square(&s.deld, k);
+            }
+            match self.law {
+                Law::Hertz { c, .. } => {
+                    for k in 0..=p {
+                        sample[k] = c * rate2[k];
+                    }
+                }
+                Law::Dmt { c, .. } => {
+                    for k in 0..=p {
+                        sample[k] = c * cauchy(&s.w, &rate2, k);
+                    }
+                }
+            }
+            // dτ = 2w dσ
+            for series in [&mut base, &mut beam, &mut sample] {
+                let copy = *series;
+                for k in 0..=p {
+                    series[k] = 2.0 * cauchy(&s.w, &copy, k);
+                }
+            }
+        }
+        [base, beam, sample].map(|c| {
+            // ∫₀^end Σ c_k uᵏ du = Σ c_k end^{k+1}/(k + 1), by Horner
+            let mut acc = 0.0;
+            for k in (0..=p).rev() {
+                acc = acc * end + c[k] / (k + 1) as f64;
+            }
+            acc * end
+        })
+    }
+
+    /// The coefficient of order k of V_T = φᵀa + α2_b sin Ωτ + α5 (eq. 8) from those of a
+    /// (`a`, N) and of sin Ωτ (`sk`).
+    #[inline(always)]
+    fn v_t_coefficient(&self, a: &[f64], k: usize, sk: f64) -> f64 {
+        dot(&self.phi[..a.len()], a) + self.base * sk + if k == 0 { self.alpha5 } else { 0.0 }
+    }
+
+    /// The lower half of f at one order: −M⁻¹K a_k − M⁻¹C ȧ_k + M⁻¹F^I_k + M⁻¹φ F_k into `out`
+    /// (N), given the forcing's coefficients (const only at order 0) and the force's.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn lower_field<W: Width>(
+        &self,
+        w: W,
+        zk: &[f64],
+        k: usize,
+        s: f64,
+        c: f64,
+        f: f64,
+        out: &mut [f64],
+    ) {
+        let n = w.get();
+        let (a, ad) = zk.split_at(n);
+        for i in 0..n {
+            let row_k = &self.ak[i * n..(i + 1) * n];
+            let row_c = &self.ac[i * n..(i + 1) * n];
+            let mut acc = dot(row_k, a) + dot(row_c, ad);
+            if k == 0 {
+                acc += self.b_const[i];
+            }
+            out[i] = acc + self.b_sin[i] * s + self.b_cos[i] * c + self.mphi[i] * f;
+        }
+    }
+
+    /// A (the free flight's state matrix) times the columns of Φ_k (d×d, column-major) into
+    /// `out`, and φᵀ of Φ_k's upper and lower rows into `r`, `rd` (d each).
+    #[inline(always)]
+    fn a_times_phi<W: Width>(
+        &self,
+        w: W,
+        phik: &[f64],
+        out: &mut [f64],
+        r: &mut [f64],
+        rd: &mut [f64],
+    ) {
+        let n = w.get();
+        let d = 2 * n;
+        for col in 0..d {
+            let x = &phik[col * d..(col + 1) * d];
+            let (a, ad) = x.split_at(n);
+            r[col] = dot(&self.phi, a);
+            rd[col] = dot(&self.phi, ad);
+            let o = &mut out[col * d..(col + 1) * d];
+            o[..n].copy_from_slice(ad);
+            for i in 0..n {
+                o[n + i] =
+                    dot(&self.ak[i * n..(i + 1) * n], a) + dot(&self.ac[i * n..(i + 1) * n], ad);
+            }
+        }
+    }
+
+    /// The series of the free flight from (τ₀, z₀) in τ − τ₀ to order `p` (with Φ(τ₀) = I when
+    /// `variational`), into `s`.
+    pub(crate) fn free(&self, s: &mut Series, t0: f64, z0: &[f64], variational: bool, p: usize) {
+        with_width!(self.n, w => self.free_w(w, s, t0, z0, variational, p))
+    }
+
+    fn free_w<W: Width>(
+        &self,
+        w: W,
+        s: &mut Series,
+        t0: f64,
+        z0: &[f64],
+        variational: bool,
+        p: usize,
+    ) {
+        let n = w.get();
+        let d = 2 * n;
+        let dd = d * d;
+        let (sn, cs) = s.start(p, d, variational, Region::Free, t0, z0, self.omega);
+        let quarter = [(sn, cs), (cs, -sn), (-sn, -cs), (-cs, sn)];
+        for k in 0..=p {
+            let (a, b) = quarter[k & 3];
+            let f = self.trig_factor[k];
+            s.s[k] = f * a;
+            s.c[k] = f * b;
+        }
+        let mut lower = [0.0; crate::params::MAX_MODES];
+        let lower = &mut lower[..n];
+        for k in 0..=p {
+            let (head, tail) = s.z.split_at_mut((k + 1) * d);
+            let zk = &head[k * d..];
+            let v = self.v_t_coefficient(&zk[..n], k, s.s[k]);
+            s.v[k] = v;
+            if k == p {
+                break;
+            }
+            // the tip force F_k and ∂F_c/∂V_T
+            let f = match self.law {
+                Law::Dmt { h, a0, .. } => {
+                    // d = V_T + ã₀; u = 1/d from u·d = 1
+                    s.u[k] = if k == 0 {
+                        1.0 / (s.v[0] + a0)
+                    } else {
+                        -cauchy(&s.v[1..], &s.u, k - 1) * s.u[0]
+                    };
+                    s.u2[k] = square(&s.u, k);
+                    if variational {
+                        s.u3[k] = cauchy(&s.u2, &s.u, k);
+                        s.fv[k] = 2.0 * h * s.u3[k];
+                    }
+                    -h * s.u2[k]
+                }
+                Law::Hertz { .. } => {
+                    s.fv[k] = 0.0;
+                    0.0
+                }
+            };
+            s.f[k] = f;
+            let inv = 1.0 / (k + 1) as f64;
+            self.lower_field(w, zk, k, s.s[k], s.c[k], f, lower);
+            let next = &mut tail[..d];
+            for i in 0..n {
+                next[i] = zk[n + i] * inv;
+                next[n + i] = lower[i] * inv;
+            }
+            if variational {
+                let (head, tail) = s.phi.split_at_mut((k + 1) * dd);
+                let phik = &head[k * dd..];
+                let next = &mut tail[..dd];
+                let gk = &mut s.gphi[..dd];
+                let (r, rd) = (&mut s.r[k * d..(k + 1) * d], &mut s.rd[k * d..(k + 1) * d]);
+                self.a_times_phi(w, phik, gk, r, rd);
+                for col in 0..d {
+                    // Σ_j F_V,j (φᵀΦ_{k−j})_col
+                    let mut rank = 0.0;
+                    for j in 0..=k {
+                        rank += s.fv[j] * s.r[(k - j) * d + col];
+                    }
+                    let g = &s.gphi[col * d..(col + 1) * d];
+                    let o = &mut next[col * d..(col + 1) * d];
+                    for i in 0..n {
+                        o[i] = g[i] * inv;
+                        o[n + i] = (g[n + i] + self.mphi[i] * rank) * inv;
+                    }
+                }
+            }
+        }
+    }
+
+    /// The series of the contact flow from (τ₀, z₀), w(0) = `w0` (= √δ₀), in σ to order `p`
+    /// (with Φ(τ₀) = I when `variational`), into `s`.
+    pub(crate) fn contact(
+        &self,
+        s: &mut Series,
+        t0: f64,
+        z0: &[f64],
+        w0: f64,
+        variational: bool,
+        p: usize,
+    ) {
+        with_width!(self.n, w => self.contact_w(w, s, t0, z0, w0, variational, p))
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn contact_w<W: Width>(
+        &self,
+        wd: W,
+        s: &mut Series,
+        t0: f64,
+        z0: &[f64],
+        w0: f64,
+        variational: bool,
+        p: usize,
+    ) {
+        let n = wd.get();
+        let d = 2 * n;
+        let dd = d * d;
+        let (sn, cs) = s.start(p, d, variational, Region::Contact, t0, z0, self.omega);
+        s.s[0] = sn;
+        s.c[0] = cs;
+        s.theta[0] = 0.0;
+        s.w[0] = w0;
+        let om = self.omega;
+        for k in 0..=p {
+            let (v, vd) = {
+                let zk = &s.z[k * d..(k + 1) * d];
+                (
+                    self.v_t_coefficient(&zk[..n], k, s.s[k]),
+                    dot(&self.phi[..n], &zk[n..]) + self.base * om * s.c[k],
+                )
+            };
+            s.v[k] = v;
+            s.del[k] = -v;
+            s.deld[k] = -vd;
+            if k == p {
+                break;
+            }
+            let inv = 1.0 / (k + 1) as f64;
+            s.w[k + 1] = s.deld[k] * inv;
+            s.theta[k + 1] = 2.0 * s.w[k] * inv;
+            // the tip force and 2w ∂F_c/∂V_T, 2w ∂F_c/∂(dV_T/dτ)
+            let wdel = cauchy(&s.w, &s.del, k);
+            let f = match self.law {
+                Law::Hertz { k: k4, c } => {
+                    if variational {
+                        s.fv[k] = -3.0 * k4 * s.del[k];
+                        s.fvd[k] = -2.0 * c * s.w[k];
+                    }
+                    k4 * wdel + c * s.deld[k]
+                }
+                Law::Dmt { h, a0, k: k4, c } => {
+                    if variational {
+                        s.fv[k] = -3.0 * k4 * s.del[k] - c * s.deld[k];
+                        s.fvd[k] = -2.0 * c * s.del[k];
+                    }
+                    let adhesion = if k == 0 { -h / (a0 * a0) } else { 0.0 };
+                    let kv = if c == 0.0 {
+                        0.0
+                    } else {
+                        c * cauchy(&s.w, &s.deld, k)
+                    };
+                    adhesion + k4 * wdel + kv
+                }
+            };
+            s.f[k] = f;
+            // g_k = f(τ, z)_k, then z_{k+1} = 2 (w ⋆ g)_k / (k + 1)
+            {
+                let (zs, gs) = (&s.z[k * d..(k + 1) * d], &mut s.g[k * d..(k + 1) * d]);
+                gs[..n].copy_from_slice(&zs[n..]);
+                self.lower_field(wd, zs, k, s.s[k], s.c[k], f, &mut gs[n..]);
+            }
+            {
+                let mut acc = [0.0; 2 * crate::params::MAX_MODES];
+                let acc = &mut acc[..d];
+                for j in 0..=k {
+                    let wj = s.w[j];
+                    let gk = &s.g[(k - j) * d..(k - j) * d + d];
+                    for i in 0..d {
+                        acc[i] += wj * gk[i];
+                    }
+                }
+                let next = &mut s.z[(k + 1) * d..(k + 1) * d + d];
+                let two = 2.0 * inv;
+                for i in 0..d {
+                    next[i] = two * acc[i];
+                }
+            }
+            // sin and cos of Ωτ(σ): S′ = Ω C τ′, C′ = −Ω S τ′, τ′ = 2w
+            s.s[k + 1] = 2.0 * om * cauchy(&s.c, &s.w, k) * inv;
+            s.c[k + 1] = -2.0 * om * cauchy(&s.s, &s.w, k) * inv;
+            if variational {
+                {
+                    let phik = &s.phi[k * dd..(k + 1) * dd];
+                    let (gk, r, rd) = (
+                        &mut s.gphi[k * dd..(k + 1) * dd],
+                        &mut s.r[k * d..(k + 1) * d],
+                        &mut s.rd[k * d..(k + 1) * d],
+                    );
+                    self.a_times_phi(wd, phik, gk, r, rd);
+                }
+                let next = &mut s.phi[(k + 1) * dd..(k + 1) * dd + dd];
+                next.fill(0.0);
+                for j in 0..=k {
+                    let wj = 2.0 * s.w[j] * inv;
+                    let gk = &s.gphi[(k - j) * dd..(k - j) * dd + dd];
+                    for i in 0..dd {
+                        next[i] += wj * gk[i];
+                    }
+                }
+                for col in 0..d {
+                    let mut rank = 0.0;
+                    for j in 0..=k {
+                        rank +=
+                            s.fv[j] * s.r[(k - j) * d + col] + s.fvd[j] * s.rd[(k - j) * d + col];
+                    }
+                    let rank = rank * inv;
+                    let o = &mut next[col * d + n..(col + 1) * d];
+                    for (oi, m) in o.iter_mut().zip(&self.mphi) {
+                        *oi += m * rank;
+                    }
+                }
+            }
+        }
+    }
+}

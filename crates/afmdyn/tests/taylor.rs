@@ -1,0 +1,176 @@
+//! The Taylor integrator (`integrate/taylor/`) against the adaptive DOP853 integrator at a
+//! tighter tolerance (1e-14), an independent method: the same events and states over 30 drive
+//! periods, the same period-1 orbits and monodromy matrices (its variational equations in the
+//! regularised contact time against DOP853's in τ, saltation at the switchings), for the
+//! point-mass DMT probe and the beam (N = 3) with the Hertz and DMT laws, DMT with its
+//! Kelvin–Voigt term; the conformance suite of every integrator; its refusals.
+
+use afmdyn::analysis::shooting::{shoot_with, ShootingOptions};
+use afmdyn::galerkin::Region;
+use afmdyn::integrate::{build, IntegratorKind, IntegratorOptions};
+use afmdyn::request::analyses::OrbitRequest;
+use afmdyn::{CantileverModel, ContactLaw, Params, SimError};
+
+mod common;
+use common::{against_adaptive_oracle, events_until, harmonic_response};
+
+const DMT: ContactLaw = ContactLaw::Dmt {
+    hamaker: 1e-5,
+    intermolecular_distance: 0.01,
+};
+
+fn opts(kind: IntegratorKind, tol: f64) -> IntegratorOptions {
+    IntegratorOptions {
+        kind,
+        steps_per_period: 1,
+        tolerance: tol,
+    }
+}
+
+fn probe_model() -> CantileverModel {
+    let probe = afmdyn::probe::Probe::parse(
+        include_str!("../../../examples/probe-point-mass-dmt.toml"),
+        "examples/probe-point-mass-dmt.toml",
+    )
+    .unwrap();
+    CantileverModel::new(&probe.params).unwrap()
+}
+
+fn beam(law: ContactLaw, alpha6: f64, omega: f64) -> CantileverModel {
+    CantileverModel::new(&Params {
+        modes: 3,
+        omega,
+        alpha6,
+        contact_law: law,
+        ..Params::default()
+    })
+    .unwrap()
+}
+
+/// The models of these tests: the point-mass DMT probe, the beam (N = 3) with Hertz (α6 = 0.2,
+/// the default damper), DMT without and with Kelvin–Voigt damping.
+fn models() -> Vec<(&'static str, CantileverModel)> {
+    vec![
+        ("point-mass dmt probe", probe_model()),
+        ("beam hertz", beam(ContactLaw::Hertz, 0.2, 2.8)),
+        ("beam dmt", beam(DMT, 0.0, 2.6)),
+        ("beam dmt kelvin-voigt", beam(DMT, 0.2, 2.8)),
+    ]
+}
+
+/// 30 drive periods from the steady state `afmdyn orbit` starts from: the same switchings
+/// (kind, regions, time to 1e-8) and the same final state (to 1e-8) as DOP853 at 1e-14, and a
+/// final state as accurate as DOP853's at the same tolerance 1e-12 (within a factor of 10).
+#[test]
+fn taylor_agrees_with_the_adaptive_oracle() {
+    for (name, m) in models() {
+        let c = against_adaptive_oracle(&m, IntegratorKind::Taylor, 1e-12);
+        let (worst, d, d_dop) = (c.worst_event, c.state, c.state_dop853);
+        eprintln!("{name}: events within {worst:e}, final state within {d:e} (DOP853 {d_dop:e})");
+        assert!(c.events >= 20, "{name}: {} events", c.events);
+        assert!(worst < 1e-8, "{name}: events differ by {worst:e}");
+        assert!(d < 1e-8, "{name}: final state differs by {d:e}");
+        // the tolerance means what it means for DOP853, within a factor of 10
+        assert!(
+            d <= 10.0 * d_dop.max(1e-12),
+            "{name}: {d:e} against DOP853's {d_dop:e} at the same tolerance"
+        );
+    }
+}
+
+/// The period-1 orbits by Newton shooting: the state to 1e-8 and the monodromy matrix (the
+/// Taylor integrator's variational equations, in σ through the contact) to 1e-7 relative of
+/// DOP853's at 1e-14, so the Floquet multipliers agree.
+#[test]
+fn taylor_orbits_and_monodromy_agree_with_the_adaptive_oracle() {
+    for (name, m) in models() {
+        let (guess, _) = OrbitRequest::default().start.guess(&m).unwrap();
+        let orbit = |kind, tol| {
+            let mut it = build(&m, opts(kind, tol), 0.0, &m.rest()).unwrap();
+            shoot_with(it.as_mut(), &guess, 1, &ShootingOptions::default())
+        };
+        let (Ok(a), Ok(b)) = (
+            orbit(IntegratorKind::Taylor, 1e-12),
+            orbit(IntegratorKind::Adaptive, 1e-14),
+        ) else {
+            panic!("{name}: no period-1 orbit");
+        };
+        assert!(a.switchings >= 1, "{name}: the orbit touches the sample");
+        let d = (&a.state - &b.state).amax();
+        let md = (&a.monodromy - &b.monodromy).amax() / b.monodromy.amax();
+        eprintln!("{name}: orbit within {d:e}, monodromy within {md:e} relative");
+        assert!(d < 1e-8, "{name}: orbit states differ by {d:e}");
+        assert!(md < 1e-7, "{name}: monodromies differ by {md:e} relative");
+        for (x, y) in a.multipliers.iter().zip(&b.multipliers) {
+            assert!((x - y).norm() < 1e-7, "{name}: multiplier {x} vs {y}");
+        }
+    }
+}
+
+/// The conformance checks every integrator passes: a sample out of reach (no event, the closed
+/// form of the free response, landing on the end time), events chaining region to region on
+/// their guard without re-triggering, bad starts refused.
+#[test]
+fn taylor_passes_the_conformance_checks() {
+    for law in [ContactLaw::Hertz, DMT] {
+        let far = match law {
+            ContactLaw::Dmt {
+                intermolecular_distance,
+                ..
+            } => ContactLaw::Dmt {
+                hamaker: 0.0,
+                intermolecular_distance,
+            },
+            l => l,
+        };
+        let m = CantileverModel::new(&Params {
+            alpha5: 5.0,
+            contact_law: far,
+            ..Params::default()
+        })
+        .unwrap();
+        let start = harmonic_response(&m, Region::Free, 0.0);
+        let mut it = build(&m, opts(IntegratorKind::Taylor, 1e-13), 0.0, &start).unwrap();
+        assert!(events_until(it.as_mut(), 7.3).is_empty(), "{law}");
+        assert_eq!(it.tau(), 7.3, "{law}");
+        let err = (it.state() - harmonic_response(&m, Region::Free, 7.3)).amax();
+        assert!(err < 1e-11, "{law}: {err:e}");
+        let m = CantileverModel::new(&Params {
+            contact_law: law,
+            ..Params::default()
+        })
+        .unwrap();
+        let mut it = build(&m, opts(IntegratorKind::Taylor, 1e-12), 0.0, &m.rest()).unwrap();
+        let ev = events_until(it.as_mut(), 30.0);
+        assert!(ev.len() > 5, "{law}: {} events", ev.len());
+        for w in ev.windows(2) {
+            assert_eq!(w[0].to, w[1].from, "{law}: chained");
+            assert!(w[1].tau - w[0].tau > 1e-6, "{law}: re-triggered");
+        }
+        let mut nan = m.rest();
+        nan[1] = f64::NAN;
+        assert!(matches!(
+            it.reset(0.0, &nan),
+            Err(SimError::NotFinite { .. })
+        ));
+    }
+    // the laws it does not carry are refused, naming the integrator
+    for law in [ContactLaw::Linear, ContactLaw::Impact { restitution: 0.6 }] {
+        let m = CantileverModel::new(&Params {
+            contact_law: law,
+            ..Params::default()
+        })
+        .unwrap();
+        let e = build(&m, opts(IntegratorKind::Taylor, 1e-12), 0.0, &m.rest());
+        assert!(
+            matches!(
+                e,
+                Err(SimError::Unsupported {
+                    integrator: "taylor",
+                    ..
+                })
+            ),
+            "{law}"
+        );
+    }
+}
