@@ -122,6 +122,10 @@ pub(crate) struct Series {
     /// The tip force F_c.
     pub f: [f64; M],
     // scratch series of the recurrences
+    /// u and w backwards (`urev[M − 1 − j] = u_j`), so that every product of series is a dot
+    /// product of two contiguous slices ([`dot`]).
+    urev: [f64; M],
+    wrev: [f64; M],
     s: [f64; M],
     c: [f64; M],
     del: [f64; M],
@@ -131,7 +135,7 @@ pub(crate) struct Series {
     u3: [f64; M],
     fv: [f64; M],
     fvd: [f64; M],
-    /// f(τ, z) per order (contact: the factor of 2w), M·d.
+    /// f(τ, z) per order (contact: the factor of 2w), component-major: `g[i·M + k]`, M·d.
     g: Vec<f64>,
     /// AΦ per order, M·d².
     gphi: Vec<f64>,
@@ -154,6 +158,8 @@ impl Default for Series {
             w: [0.0; M],
             v: [0.0; M],
             f: [0.0; M],
+            urev: [0.0; M],
+            wrev: [0.0; M],
             s: [0.0; M],
             c: [0.0; M],
             del: [0.0; M],
@@ -171,46 +177,51 @@ impl Default for Series {
     }
 }
 
-/// Σ_{j=0..=k} a_j b_{k−j}: the coefficient of order k of the product of two series, in four
-/// independent partial sums (the recurrences are latency-bound: one chain of k additions would
-/// cost 4k cycles per coefficient).
+/// Σ_j x_j y_j over two slices of one length, in four partial sums (vectorised; the
+/// recurrences are latency-bound, and one chain of additions would cost 4 cycles a term).
 #[inline(always)]
-fn cauchy(a: &[f64], b: &[f64], k: usize) -> f64 {
-    let (a, b) = (&a[..=k], &b[..=k]);
-    let mut acc = [0.0; 4];
-    let (mut x, mut y) = (a.chunks_exact(4), b.rchunks_exact(4));
-    for (x, y) in x.by_ref().zip(y.by_ref()) {
-        acc[0] += x[0] * y[3];
-        acc[1] += x[1] * y[2];
-        acc[2] += x[2] * y[1];
-        acc[3] += x[3] * y[0];
+fn dot(x: &[f64], y: &[f64]) -> f64 {
+    let n = x.len().min(y.len());
+    let (x, y) = (&x[..n], &y[..n]);
+    if n < 4 {
+        // the short products over modes (N a constant of the monomorphised recurrences)
+        return x.iter().zip(y).map(|(a, b)| a * b).sum();
     }
-    let rest: f64 = x
-        .remainder()
-        .iter()
-        .zip(y.remainder().iter().rev())
-        .map(|(x, y)| x * y)
-        .sum();
-    (acc[0] + acc[1]) + (acc[2] + acc[3]) + rest
+    let (cx, cy) = (x.chunks_exact(4), y.chunks_exact(4));
+    let (rx, ry) = (cx.remainder(), cy.remainder());
+    let mut acc = [0.0; 4];
+    for (a, b) in cx.zip(cy) {
+        for i in 0..4 {
+            acc[i] += a[i] * b[i];
+        }
+    }
+    let mut s = (acc[0] + acc[2]) + (acc[1] + acc[3]);
+    for (a, b) in rx.iter().zip(ry) {
+        s += a * b;
+    }
+    s
 }
 
-/// Σ_{j=0..=k} a_j a_{k−j}, the coefficient of order k of a², by symmetry.
+/// Σ_{j=0..=k} a_j b_{k−j}, the coefficient of order k of the product of two series, given b
+/// backwards (`brev[M − 1 − j] = b_j`): a dot product of contiguous slices.
 #[inline(always)]
-fn square(a: &[f64], k: usize) -> f64 {
-    let half = k.div_ceil(2);
-    let twice = if half == 0 {
-        0.0
-    } else {
-        // Σ_{j<half} a_j a_{k−j} = the Cauchy coefficient of order half − 1 of a[..half] and
-        // a[k + 1 − half..=k]
-        cauchy(&a[..half], &a[k + 1 - half..=k], half - 1)
-    };
-    let mid = if k.is_multiple_of(2) {
-        a[k / 2] * a[k / 2]
-    } else {
-        0.0
-    };
-    2.0 * twice + mid
+fn cauchy_rev(a: &[f64; M], brev: &[f64; M], k: usize) -> f64 {
+    let k = k.min(M - 1);
+    dot(&a[..=k], &brev[M - 1 - k..])
+}
+
+/// Σ_{j=0..=k} a_j b_{k−j} written out (the products made once per step: energy integrals,
+/// variational terms).
+#[inline(always)]
+fn cauchy(a: &[f64; M], b: &[f64; M], k: usize) -> f64 {
+    let k = k.min(M - 1);
+    (0..=k).map(|j| a[j] * b[k - j]).sum()
+}
+
+/// Σ_{j=0..=k} a_j a_{k−j} written out.
+#[inline(always)]
+fn square(a: &[f64; M], k: usize) -> f64 {
+    cauchy(a, a, k)
 }
 
 /// The number of modes N, a constant of the monomorphised recurrences for small N (the loops
@@ -265,12 +276,6 @@ macro_rules! with_width {
             }
         }
     };
-}
-
-/// Σ_j x_j y_j.
-#[inline]
-fn dot(x: &[f64], y: &[f64]) -> f64 {
-    x.iter().zip(y).map(|(a, b)| a * b).sum()
 }
 
 impl Series {
@@ -364,14 +369,28 @@ impl Series {
 /// [`horner_vec`] for the state (width 2N, a constant of the monomorphised loop for small N).
 #[inline(always)]
 fn horner_fixed<W: Width>(w: W, c: &[f64], p: usize, s: f64, out: &mut [f64]) {
+    // the even and the odd orders in two chains of Horner's scheme in s² (half the latency):
+    // Σ c_k sᵏ = E(s²) + s O(s²)
     let d = 2 * w.get();
-    let out = &mut out[..d];
-    out.copy_from_slice(&c[p * d..p * d + d]);
-    for k in (0..p).rev() {
-        let ck = &c[k * d..k * d + d];
+    let mut even = [0.0; 2 * crate::params::MAX_MODES];
+    let mut odd = [0.0; 2 * crate::params::MAX_MODES];
+    let (even, odd) = (&mut even[..d], &mut odd[..d]);
+    let s2 = s * s;
+    let top = p - p % 2;
+    for k in (0..=top).rev().step_by(2) {
+        let ce = &c[k * d..k * d + d];
         for i in 0..d {
-            out[i] = out[i] * s + ck[i];
+            even[i] = even[i] * s2 + ce[i];
         }
+        if k < p {
+            let co = &c[(k + 1) * d..(k + 1) * d + d];
+            for i in 0..d {
+                odd[i] = odd[i] * s2 + co[i];
+            }
+        }
+    }
+    for i in 0..d {
+        out[i] = even[i] + s * odd[i];
     }
 }
 
@@ -615,9 +634,12 @@ impl Jet {
         }
         let mut lower = [0.0; crate::params::MAX_MODES];
         let lower = &mut lower[..n];
+        // z_k in registers from one order to the next (not reloaded from the series)
+        let mut cur = [0.0; 2 * crate::params::MAX_MODES];
+        let cur = &mut cur[..d];
+        cur.copy_from_slice(z0);
         for k in 0..=p {
-            let (head, tail) = s.z.split_at_mut((k + 1) * d);
-            let zk = &head[k * d..];
+            let zk = &*cur;
             let v = self.v_t_coefficient(&zk[..n], k, s.s[k]);
             s.v[k] = v;
             if k == p {
@@ -627,14 +649,34 @@ impl Jet {
             let f = match self.law {
                 Law::Dmt { h, a0, .. } => {
                     // d = V_T + ã₀; u = 1/d from u·d = 1
-                    s.u[k] = if k == 0 {
+                    // the newest coefficients (v_k, then u_k) enter last: the terms of the
+                    // earlier orders are summed while v_k is formed (the latency chain of one
+                    // order is then a few operations long)
+                    let u0 = s.u[0];
+                    let uk = if k == 0 {
                         1.0 / (s.v[0] + a0)
                     } else {
-                        -cauchy(&s.v[1..], &s.u, k - 1) * s.u[0]
+                        // Σ_{j=1..=k} v_j u_{k−j}, u_{k−j} = urev[M − 1 − k + j]
+                        let old = dot(&s.v[1..k], &s.urev[M - k..M - 1]);
+                        -(old + v * u0) * u0
                     };
-                    s.u2[k] = square(&s.u, k);
+                    s.u[k] = uk;
+                    s.urev[M - 1 - k] = uk;
+                    s.u2[k] = if k == 0 {
+                        uk * uk
+                    } else {
+                        // 2 Σ_{0<j<k/2} u_j u_{k−j} + u_k²/₂ terms, then 2 u₀ u_k
+                        let half = k.div_ceil(2);
+                        let old = dot(&s.u[1..half], &s.urev[M - k..M - 1 - k + half]);
+                        let mid = if k.is_multiple_of(2) {
+                            s.u[k / 2] * s.u[k / 2]
+                        } else {
+                            0.0
+                        };
+                        2.0 * (old + s.u[0] * uk) + mid
+                    };
                     if variational {
-                        s.u3[k] = cauchy(&s.u2, &s.u, k);
+                        s.u3[k] = cauchy_rev(&s.u2, &s.urev, k);
                         s.fv[k] = 2.0 * h * s.u3[k];
                     }
                     -h * s.u2[k]
@@ -647,11 +689,14 @@ impl Jet {
             s.f[k] = f;
             let inv = 1.0 / (k + 1) as f64;
             self.lower_field(w, zk, k, s.s[k], s.c[k], f, lower);
-            let next = &mut tail[..d];
+            let mut nxt = [0.0; 2 * crate::params::MAX_MODES];
+            let nxt = &mut nxt[..d];
             for i in 0..n {
-                next[i] = zk[n + i] * inv;
-                next[n + i] = lower[i] * inv;
+                nxt[i] = zk[n + i] * inv;
+                nxt[n + i] = lower[i] * inv;
             }
+            s.z[(k + 1) * d..(k + 2) * d].copy_from_slice(nxt);
+            cur.copy_from_slice(nxt);
             if variational {
                 let (head, tail) = s.phi.split_at_mut((k + 1) * dd);
                 let phik = &head[k * dd..];
@@ -709,6 +754,7 @@ impl Jet {
         s.c[0] = cs;
         s.theta[0] = 0.0;
         s.w[0] = w0;
+        s.wrev[M - 1] = w0;
         let om = self.omega;
         for k in 0..=p {
             let (v, vd) = {
@@ -726,9 +772,10 @@ impl Jet {
             }
             let inv = 1.0 / (k + 1) as f64;
             s.w[k + 1] = s.deld[k] * inv;
+            s.wrev[M - 2 - k] = s.w[k + 1];
             s.theta[k + 1] = 2.0 * s.w[k] * inv;
             // the tip force and 2w ∂F_c/∂V_T, 2w ∂F_c/∂(dV_T/dτ)
-            let wdel = cauchy(&s.w, &s.del, k);
+            let wdel = cauchy_rev(&s.del, &s.wrev, k);
             let f = match self.law {
                 Law::Hertz { k: k4, c } => {
                     if variational {
@@ -746,37 +793,32 @@ impl Jet {
                     let kv = if c == 0.0 {
                         0.0
                     } else {
-                        c * cauchy(&s.w, &s.deld, k)
+                        c * cauchy_rev(&s.deld, &s.wrev, k)
                     };
                     adhesion + k4 * wdel + kv
                 }
             };
             s.f[k] = f;
-            // g_k = f(τ, z)_k, then z_{k+1} = 2 (w ⋆ g)_k / (k + 1)
+            // g_k = f(τ, z)_k (component-major), then z_{k+1} = 2 (w ⋆ g)_k / (k + 1)
             {
-                let (zs, gs) = (&s.z[k * d..(k + 1) * d], &mut s.g[k * d..(k + 1) * d]);
-                gs[..n].copy_from_slice(&zs[n..]);
-                self.lower_field(wd, zs, k, s.s[k], s.c[k], f, &mut gs[n..]);
+                let mut lower = [0.0; crate::params::MAX_MODES];
+                let zs = &s.z[k * d..(k + 1) * d];
+                self.lower_field(wd, zs, k, s.s[k], s.c[k], f, &mut lower[..n]);
+                for i in 0..n {
+                    s.g[i * M + k] = zs[n + i];
+                    s.g[(n + i) * M + k] = lower[i];
+                }
             }
             {
-                let mut acc = [0.0; 2 * crate::params::MAX_MODES];
-                let acc = &mut acc[..d];
-                for j in 0..=k {
-                    let wj = s.w[j];
-                    let gk = &s.g[(k - j) * d..(k - j) * d + d];
-                    for i in 0..d {
-                        acc[i] += wj * gk[i];
-                    }
-                }
-                let next = &mut s.z[(k + 1) * d..(k + 1) * d + d];
+                let wk = &s.wrev[M - 1 - k..];
                 let two = 2.0 * inv;
                 for i in 0..d {
-                    next[i] = two * acc[i];
+                    s.z[(k + 1) * d + i] = two * dot(&s.g[i * M..i * M + k + 1], wk);
                 }
             }
             // sin and cos of Ωτ(σ): S′ = Ω C τ′, C′ = −Ω S τ′, τ′ = 2w
-            s.s[k + 1] = 2.0 * om * cauchy(&s.c, &s.w, k) * inv;
-            s.c[k + 1] = -2.0 * om * cauchy(&s.s, &s.w, k) * inv;
+            s.s[k + 1] = 2.0 * om * cauchy_rev(&s.c, &s.wrev, k) * inv;
+            s.c[k + 1] = -2.0 * om * cauchy_rev(&s.s, &s.wrev, k) * inv;
             if variational {
                 {
                     let phik = &s.phi[k * dd..(k + 1) * dd];
@@ -809,6 +851,85 @@ impl Jet {
                     }
                 }
             }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The products of series are the Cauchy products written out (every order of every
+    /// length), and the square by symmetry is the product with itself.
+    #[test]
+    fn products_of_series_are_cauchy_products() {
+        let mut a = [0.0; M];
+        let mut b = [0.0; M];
+        for k in 0..M {
+            a[k] = (0.7 * k as f64 + 0.3).sin() / (1.0 + k as f64);
+            b[k] = (1.3 * k as f64).cos() * 0.9f64.powi(k as i32);
+        }
+        for k in 0..M {
+            let naive: f64 = (0..=k).map(|j| a[j] * b[k - j]).sum();
+            assert!(
+                (cauchy(&a, &b, k) - naive).abs() <= 1e-15 * (1.0 + naive.abs()),
+                "{k}"
+            );
+            let sq: f64 = (0..=k).map(|j| a[j] * a[k - j]).sum();
+            assert!(
+                (square(&a, k) - sq).abs() <= 1e-15 * (1.0 + sq.abs()),
+                "{k}"
+            );
+        }
+    }
+
+    /// The free flight's series of a model without a tip force are those of the linear
+    /// equations: the coefficients of e^{A s} z₀ + particular part satisfy
+    /// (k + 1) z_{k+1} = A z_k + b_k, checked against the model's A and b (the defining
+    /// recurrence, independent of the code's per-block products); Φ's series those of e^{As}.
+    #[test]
+    fn free_flight_series_solve_the_linear_equations() {
+        let m = CantileverModel::new(&crate::Params {
+            contact_law: ContactLaw::Hertz,
+            alpha5: 5.0,
+            ..crate::Params::default()
+        })
+        .unwrap();
+        let jet = Jet::new(&m).unwrap();
+        let d = m.dim();
+        let z0: Vec<f64> = (0..d).map(|i| 0.1 * (i as f64 + 1.0).sin()).collect();
+        let (t0, p) = (0.37, 20);
+        let mut s = Series::default();
+        jet.free(&mut s, t0, &z0, true, p);
+        let dy = m.dynamics(Region::Free);
+        let om = m.omega();
+        for k in 0..p {
+            let zk = nalgebra::DVector::from_column_slice(&s.z[k * d..(k + 1) * d]);
+            // the k-th coefficient of sin/cos Ω(t0 + s)
+            let fk = om.powi(k as i32) / (1..=k).map(|i| i as f64).product::<f64>();
+            let phase = om * t0 + k as f64 * std::f64::consts::FRAC_PI_2;
+            let mut rhs =
+                &dy.a * &zk + &dy.b_sin * (fk * phase.sin()) + &dy.b_cos * (fk * phase.cos());
+            if k == 0 {
+                rhs += &dy.b_const;
+            }
+            for i in 0..d {
+                let lhs = (k + 1) as f64 * s.z[(k + 1) * d + i];
+                assert!(
+                    (lhs - rhs[i]).abs() <= 1e-13 * (1.0 + rhs[i].abs()),
+                    "k {k}"
+                );
+            }
+            let phik =
+                nalgebra::DMatrix::from_column_slice(d, d, &s.phi[k * d * d..(k + 1) * d * d]);
+            let next = nalgebra::DMatrix::from_column_slice(
+                d,
+                d,
+                &s.phi[(k + 1) * d * d..(k + 2) * d * d],
+            ) * (k + 1) as f64;
+            let want = &dy.a * &phik;
+            let scale = 1.0 + dy.a.amax() * phik.amax();
+            assert!((next - want).amax() <= 1e-13 * scale, "Φ order {k}");
         }
     }
 }

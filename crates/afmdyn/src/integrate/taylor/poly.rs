@@ -24,10 +24,11 @@ pub(crate) fn order_for(tol: f64) -> usize {
 /// §3.2–3.3, absolute and relative tolerance alike; the safety factor of heyoka, Biscani & Izzo,
 /// *MNRAS* 504 (2021) 2614). `f64::INFINITY` when both norms vanish.
 pub(crate) fn step_size(x0: f64, norm_pm1: f64, norm_p: f64, p: usize, tol: f64) -> f64 {
-    let scale = x0.max(1.0);
-    let r1 = (scale / norm_pm1).powf(1.0 / (p - 1) as f64);
-    let r2 = (scale / norm_p).powf(1.0 / p as f64);
-    r1.min(r2) * (tol.ln() / p as f64 - 0.7 / (p - 1) as f64).exp()
+    // in logarithms: two logarithms and one exponential instead of two powers
+    let scale = x0.max(1.0).ln();
+    let l1 = (scale - norm_pm1.ln()) / (p - 1) as f64;
+    let l2 = (scale - norm_p.ln()) / p as f64;
+    (l1.min(l2) + tol.ln() / p as f64 - 0.7 / (p - 1) as f64).exp()
 }
 
 /// [P(s), P′(s), P″(s)] of the polynomial with coefficients `c` (c₀ + c₁s + …), by Horner.
@@ -56,27 +57,57 @@ const NODES: usize = 16;
 /// from the last point before it where P > 0, or 0 when P is never positive before it (the
 /// trajectory does not enter the region). `None` when P stays above −`dead`.
 ///
-/// Two certified bounds spare most steps: P(s) ≥ c₀ − Σ_{k≥1} |c_k| hᵏ, and
-/// P(s) ≥ c₀ + min(c₁, 0) h − Σ_{k≥2} |c_k| hᵏ (for c₀ > 0 off the surface). Otherwise P and P′
-/// are scanned at 16 equal sub-intervals: a zero where P falls below −`dead` at a node, a dip
-/// below it between nodes at a minimum of P (a sign change of P′ from − to +; the step of a
-/// Taylor method is a small fraction of the fastest oscillation, so P′ has at most a few zeros
-/// in a step and two of them within one sub-interval do not occur). `on_surface`: the step
-/// starts on the guard's zero (just after an event), so the zero at s = 0 does not count: the
-/// bracket starts at the first maximum of P.
+/// Certified bounds decide most steps without a search: P(s) ≥ c₀ − Σ_{k≥1} |c_k| hᵏ and
+/// P(s) ≥ c₀ + min(c₁, 0) h − Σ_{k≥2} |c_k| hᵏ (no zero for c₀ > 0 off the surface), and
+/// |c₁| > Σ_{k≥2} k |c_k| h^{k−1} (P′ keeps the sign of c₁ on [0, h]: P is monotone, so it
+/// crosses zero at most once, where P(h) < 0, and that zero is located at once). Otherwise P
+/// and P′ are scanned at 16 equal sub-intervals: a zero where P falls below −`dead` at a node,
+/// a dip below it between nodes at a minimum of P (a sign change of P′ from − to +; the step of
+/// a Taylor method is a small fraction of the fastest oscillation, so P′ has at most a few
+/// zeros in a step and two of them within one sub-interval do not occur). `on_surface`: the
+/// step starts on the guard's zero (just after an event), so the zero at s = 0 does not count:
+/// the bracket starts at the first maximum of P.
 pub(crate) fn leftmost_crossing(c: &[f64], h: f64, dead: f64, on_surface: bool) -> Option<f64> {
     let c0 = c[0];
-    if !on_surface && c0 > 0.0 {
-        let mut hk = h;
-        let mut tail = 0.0;
-        for &ck in &c[2..] {
-            hk *= h;
-            tail += ck.abs() * hk;
+    let first = c[1] * h;
+    // Σ_{k≥2} |c_k| hᵏ and h Σ_{k≥2} k |c_k| h^{k−1}
+    let (mut tail, mut slope_tail) = (0.0, 0.0);
+    let mut hk = h;
+    for (k, &ck) in c.iter().enumerate().skip(2) {
+        hk *= h;
+        let term = ck.abs() * hk;
+        tail += term;
+        slope_tail += k as f64 * term;
+    }
+    if !on_surface
+        && c0 > 0.0
+        && (c0 - first.abs() - tail > -dead || c0 + first.min(0.0) - tail > -dead)
+    {
+        return None;
+    }
+    if first.abs() > slope_tail {
+        // monotone on [0, h]
+        if first > 0.0 {
+            return (c0 <= -dead).then_some(0.0);
         }
-        let first = c[1] * h;
-        if c0 - first.abs() - tail > -dead || c0 + first.min(0.0) - tail > -dead {
+        let end = eval(c, h);
+        if end > -dead {
             return None;
         }
+        if c0 <= 0.0 {
+            return Some(0.0);
+        }
+        return Some(safeguarded_newton(
+            0.0,
+            c0,
+            h,
+            end.min(0.0),
+            0.0,
+            &mut |s| {
+                let [p, dp, _] = eval3(c, s);
+                (p, dp)
+            },
+        ));
     }
     let at = |s: f64| eval3(c, s);
     let mut f = |s: f64| {
