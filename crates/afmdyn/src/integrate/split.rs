@@ -48,27 +48,29 @@ enum Half {
 /// (the linear law's contact, the impact law's sticking and its tangential free flights).
 #[derive(Debug, Clone)]
 enum ContactHalf {
-    Adaptive(Adaptive),
-    Taylor(Taylor),
+    Adaptive(Box<Adaptive>),
+    Taylor(Box<Taylor>),
 }
 
 impl ContactHalf {
     fn new(model: &CantileverModel, tol: f64) -> Result<Self, SimError> {
         Ok(match model.law() {
-            crate::contact::ContactLaw::Hertz => ContactHalf::Taylor(Taylor::new(model, tol)?),
-            _ => ContactHalf::Adaptive(Adaptive::new(model, tol)),
+            crate::contact::ContactLaw::Hertz => {
+                ContactHalf::Taylor(Box::new(Taylor::new(model, tol)?))
+            }
+            _ => ContactHalf::Adaptive(Box::new(Adaptive::new(model, tol))),
         })
     }
     fn integ(&self) -> &dyn Integrator {
         match self {
-            ContactHalf::Adaptive(a) => a,
-            ContactHalf::Taylor(t) => t,
+            ContactHalf::Adaptive(a) => a.as_ref(),
+            ContactHalf::Taylor(t) => t.as_ref(),
         }
     }
     fn integ_mut(&mut self) -> &mut dyn Integrator {
         match self {
-            ContactHalf::Adaptive(a) => a,
-            ContactHalf::Taylor(t) => t,
+            ContactHalf::Adaptive(a) => a.as_mut(),
+            ContactHalf::Taylor(t) => t.as_mut(),
         }
     }
     fn restart_in(&mut self, tau: f64, z: &[f64], region: Region) {
