@@ -13,21 +13,31 @@
 //! 1e-16). A recorded grid step then costs three quadratic forms of size 2N instead of 12
 //! states of dense output with their rates (`trajectory::record`).
 //!
-//! **Steps of any length in a modal region** (those around a switching, to a requested time):
-//! with δz(s) = Σ_k Re(u_k q_k e^{λ_k s}) (u_k the weighted plain eigenvectors, `modal.rs`) and
-//! Re a Re b = ½ Re(ab + ā b),
+//! **Steps of any length in a modal region** (a span of steps over a stint, `span.rs`; the
+//! steps around a switching, to a requested time): with δz(s) = Σ_k Re(u_k q_k e^{λ_k s}) (u_k
+//! the weighted plain eigenvectors, `modal.rs`) and Re a Re b = ½ Re(ab + ā b),
 //!
 //! ∫₀ᵗ δzᵀQδz = ½ Re Σ_jk [(u_jᵀQu_k) q_j q_k E(λ_j + λ_k) + (u_jᵀQū_k) q_j q̄_k E(λ_j + λ̄_k)],
 //!
-//! E(μ) = ∫₀ᵗ e^{μs} ds = t φ₁(μt), φ₁(x) = (eˣ − 1)/x (its series for |x| < 1/4, free of the
-//! cancellation); the linear term v(τ)ᵀδz with v = 2Qz_p + l = v₀ + Re(v̂ e^{iΩs}),
-//! v̂ = (v_c − i v_s) e^{iΩτ₀}, gives Re Σ_k q_k [(v₀ᵀu_k) E(λ_k) + ½ (v̂ᵀu_k) E(λ_k + iΩ) +
-//! ½ (v̂̄ᵀu_k) E(λ_k − iΩ)]; the state-free part z_pᵀQz_p + lᵀz_p + k is a trigonometric
-//! polynomial of degree 2 in Ωτ (its five coefficients from five samples), integrated in closed
-//! form.
+//! E(μ) = ∫₀ᵗ e^{μs} ds = (e^{μt} − 1)/μ; the linear term v(τ)ᵀδz with v = 2Qz_p + l =
+//! v₀ + Re(v̂ e^{iΩs}), v̂ = (v_c − i v_s) e^{iΩτ₀}, gives Re Σ_k q_k [(v₀ᵀu_k) E(λ_k) +
+//! ½ (v̂ᵀu_k) E(λ_k + iΩ) + ½ (v̂̄ᵀu_k) E(λ_k − iΩ)]; the state-free part z_pᵀQz_p + lᵀz_p + k is
+//! a trigonometric polynomial of degree 2 in Ωτ (its five coefficients from five samples),
+//! integrated in closed form (from sin, cos nΩτ at the ends, or for |Ωt| < 1 in the product
+//! form cos, sin nΩ(τ₀ + t/2) · 2 sin(nΩt/2)/(nΩ), free of their cancellation).
+//!
+//! Every product of modal coordinates and e^{iΩτ} times E(μ) is the difference of its values
+//! at the two ends over μ — q_j q_k E(λ_j + λ_k) = (q_j(t) q_k(t) − q_j q_k)/(λ_j + λ_k),
+//! q_k e^{iΩτ₀} E(λ_k + iΩ) = (q_k(t) e^{iΩτ₁} − q_k e^{iΩτ₀})/(λ_k + iΩ), and so on — so given
+//! the modal coordinates at both ends (q(t) = e^{Λt} q, which a span has at hand) and sin, cos
+//! Ωτ there, a step costs no exponential and no sine. The difference's rounding, a few ulp of
+//! the products over |μ|, is a few ulp of |q|² t where |μt| ≥ 1/4; below that, where it would
+//! exceed it, E(μ) = t φ₁(μt), φ₁(x) = (eˣ − 1)/x, comes from φ₁'s series instead (in real
+//! arithmetic for the real μ = 2 Re λ_k of the lightly damped modes). The values at the ends
+//! carry the rounding of a span's grid steps, a few ulp each.
 
 use super::modal::{ModalExp, Modes};
-use super::ExactPropagator;
+use super::{ExactPropagator, INV_FACT};
 use crate::model::RateForm;
 use crate::system::Region;
 use gauss_quad::legendre::GaussLegendre;
@@ -52,84 +62,148 @@ pub(super) struct EnergyTable {
     modal: Option<ModalRates>,
 }
 
-/// The modal coefficients of one region's three rates (module docs): r representatives.
+/// The modal coefficients of one region's three rates (module docs): r representatives, the
+/// quadratic terms over the pairs j ≤ k only. Q is symmetric, so u_jᵀQu_k and E(λ_j + λ_k) are
+/// symmetric in (j, k), and the (k, j) term of the second sum is the conjugate of the (j, k)
+/// one (u_kᵀQū_j = conj(u_jᵀQū_k), E(λ_k + λ̄_j) = conj(E(λ_j + λ̄_k))): each sum is its
+/// diagonal plus twice the real part over j < k. The factors 2 and ½ are folded into the
+/// coefficients.
 #[derive(Debug)]
 struct ModalRates {
-    /// u_jᵀQu_k and u_jᵀQū_k, r×r row-major, per rate (empty where Q = 0).
+    /// The pairs (j, k), j ≤ k.
+    pairs: Vec<(usize, usize)>,
+    /// Whether some rate has a quadratic term.
+    quadratic: bool,
+    /// ½ u_jᵀQu_k and ½ u_jᵀQū_k per pair (twice that for j < k), per rate (empty where Q = 0).
     a: [Vec<C>; 3],
     b: [Vec<C>; 3],
-    /// v₀ᵀu_k, v_cᵀu_k, v_sᵀu_k per rate (r each).
+    /// v₀ᵀu_k, ½ (v_c − i v_s)ᵀu_k and ½ (v_c + i v_s)ᵀu_k per rate (r each).
     p: [[Vec<C>; 3]; 3],
     /// The state-free part: k₀ + Σ_{n=1,2} (α_n cos nΩτ + β_n sin nΩτ) as [k₀, α₁, β₁, α₂, β₂].
     trig: [[f64; 5]; 3],
-    /// λ_k.
-    lambda: Vec<C>,
+    /// The exponents μ of E(μ): λ_j + λ_k and λ_j + λ̄_k per pair, λ_k, λ_k + iΩ and λ_k − iΩ
+    /// per representative.
+    mu_pairs: Vec<[Exponent; 2]>,
+    mu_k: Vec<[Exponent; 3]>,
+    omega: f64,
 }
 
-/// The factors of [`ModalRates::integrals`] that depend on the step length t alone — the
-/// integrals E(λ_j + λ_k), E(λ_j + λ̄_k) and E(λ_k), E(λ_k ± iΩ) — kept for the last (region,
-/// t, Ω): a run of equal steps (samples between grid points, every step of a recorded period)
-/// computes their exponentials once, not at every step.
+/// The two ends of a step [τ₀, τ₀ + t] for [`ModalRates::integrals`]: the modal coordinates of
+/// δz at both (q1 = e^{Λt} q0) and (sin, cos) of Ωτ at both.
+pub(super) struct RateEnds<'a> {
+    pub(super) q0: &'a Modes,
+    pub(super) q1: &'a Modes,
+    pub(super) trig0: (f64, f64),
+    pub(super) trig1: (f64, f64),
+    pub(super) t: f64,
+}
+
+/// Scratch of [`ModalRates::integrals`]: the modal products of one step, shared by the rates.
 #[derive(Debug, Clone, Default)]
-pub(super) struct RateCache {
-    key: Option<(usize, u64, u64)>,
-    ejk: Vec<(C, C)>,
-    ek: Vec<[C; 3]>,
+pub(super) struct RateScratch {
+    lin: Vec<[C; 3]>,
+    prods: Vec<(C, C)>,
 }
 
-/// ∫₀ᵗ e^{μs} ds = t φ₁(μt), φ₁(x) = (eˣ − 1)/x, given e^{μt} = `exp_mt`: by φ₁'s series
-/// below |μt| = 1/4 (13 terms: 4⁻¹³/14! < 1e-18), where eˣ − 1 would cancel, else directly.
-fn integral_exp(mu: C, t: f64, exp_mt: C) -> C {
-    let x = mu * t;
-    if x.norm_sqr() < 0.0625 {
-        let (mut term, mut sum) = (C::new(1.0, 0.0), C::new(1.0, 0.0));
-        for n in 2..=14 {
-            term = term * x / n as f64;
-            sum += term;
+/// φ₁(x) = (eˣ − 1)/x by its series Σ xⁿ/(n+1)! for |x| < 1/4 (13 terms: 4⁻¹³/14! < 1e-18), in
+/// real arithmetic for a real x.
+#[cold]
+fn phi1(x: C) -> C {
+    if x.im == 0.0 {
+        let mut sum = INV_FACT[14];
+        for f in INV_FACT[1..14].iter().rev() {
+            sum = sum * x.re + f;
         }
-        sum * t
-    } else {
-        (exp_mt - 1.0) / mu
+        return C::new(sum, 0.0);
+    }
+    let mut sum = C::new(INV_FACT[14], 0.0);
+    for f in INV_FACT[1..14].iter().rev() {
+        sum = sum * x + f;
+    }
+    sum
+}
+
+/// An exponent μ of E(μ) as [`grown`] takes it: μ, 1/μ (∞ for μ = 0) and 1/(16|μ|²), the
+/// least t² with |μt| ≥ 1/4.
+#[derive(Debug, Clone, Copy)]
+struct Exponent {
+    mu: C,
+    inv: C,
+    t2_min: f64,
+}
+
+impl Exponent {
+    fn new(mu: C) -> Self {
+        Exponent {
+            mu,
+            inv: C::new(1.0, 0.0) / mu,
+            t2_min: 1.0 / (16.0 * mu.norm_sqr()),
+        }
     }
 }
 
+/// P₀ E(μ) over a step of length t (t2 = t²), given P₁ = e^{μt} P₀: (P₁ − P₀)/μ, or
+/// P₀ t φ₁(μt) below |μt| = 1/4 (module docs).
+#[inline(always)]
+fn grown(e: &Exponent, t: f64, t2: f64, p0: C, p1: C) -> C {
+    if t2 >= e.t2_min {
+        (p1 - p0) * e.inv
+    } else {
+        p0 * phi1(e.mu * t) * t
+    }
+}
+
+/// q_k as a complex number.
+#[inline(always)]
+fn mode(q: &Modes, k: usize) -> C {
+    C::new(q.re[k], q.im[k])
+}
+
 impl ModalRates {
-    fn new(me: &ModalExp, forms: &[RateForm; 3], fr_zp: [&DVector<f64>; 3]) -> Self {
+    fn new(me: &ModalExp, forms: &[RateForm; 3], fr_zp: [&DVector<f64>; 3], omega: f64) -> Self {
         let r = me.len();
         let dim = me.tv.re.nrows();
         let u: Vec<DVector<C>> = (0..r)
             .map(|k| DVector::from_fn(dim, |i, _| C::new(me.tv.re[(i, k)], me.tv.im[(i, k)])))
             .collect();
+        let pairs: Vec<(usize, usize)> = (0..r).flat_map(|j| (j..r).map(move |k| (j, k))).collect();
+        // ½ of the quadratic term, twice for the pairs j < k
+        let weight = |j: usize, k: usize| if j < k { 1.0 } else { 0.5 };
         let [p0, ps, pc] = fr_zp;
-        let cq = |q: &DMatrix<f64>| q.map(|x| C::new(x, 0.0));
-        let a = std::array::from_fn(|t| {
-            let q = cq(&forms[t].q);
-            if forms[t].q.amax() == 0.0 {
-                return Vec::new();
-            }
-            (0..r * r)
-                .map(|jk| u[jk / r].dot(&(&q * &u[jk % r])))
-                .collect()
-        });
-        let b = std::array::from_fn(|t| {
-            let q = cq(&forms[t].q);
-            if forms[t].q.amax() == 0.0 {
-                return Vec::new();
-            }
-            (0..r * r)
-                .map(|jk| u[jk / r].dot(&(&q * u[jk % r].map(|c| c.conj()))))
-                .collect()
-        });
+        let quad = |conj: bool| {
+            std::array::from_fn(|t| {
+                if forms[t].q.amax() == 0.0 {
+                    return Vec::new();
+                }
+                let q = forms[t].q.map(|x| C::new(x, 0.0));
+                pairs
+                    .iter()
+                    .map(|&(j, k)| {
+                        let uk = if conj {
+                            u[k].map(|c| c.conj())
+                        } else {
+                            u[k].clone()
+                        };
+                        u[j].dot(&(&q * uk)) * weight(j, k)
+                    })
+                    .collect()
+            })
+        };
+        let (a, b) = (quad(false), quad(true));
+        let i = C::new(0.0, 1.0);
         let p = std::array::from_fn(|t| {
             let f = &forms[t];
             // v = 2Q z_p + l: constant, cos and sin parts
             let v0 = 2.0 * &f.q * p0 + &f.l[0];
             let vc = 2.0 * &f.q * pc + &f.l[2];
             let vs = 2.0 * &f.q * ps + &f.l[1];
-            [v0, vc, vs].map(|v| {
+            let [d0, dc, ds] = [v0, vc, vs].map(|v| {
                 let v = v.map(|x| C::new(x, 0.0));
-                u.iter().map(|uk| v.dot(uk)).collect()
-            })
+                u.iter().map(|uk| v.dot(uk)).collect::<Vec<C>>()
+            });
+            let minus = dc.iter().zip(&ds).map(|(c, s)| 0.5 * (c - i * s)).collect();
+            let plus = dc.iter().zip(&ds).map(|(c, s)| 0.5 * (c + i * s)).collect();
+            [d0, minus, plus]
         });
         // the state-free part sampled at five phases θ_j = 2πj/5 (exact for degree 2)
         let trig = std::array::from_fn(|t| {
@@ -154,107 +228,95 @@ impl ModalRates {
             }
             coef
         });
+        let lambda = &me.lambda;
+        let with_inv = Exponent::new;
+        let iw = C::new(0.0, omega);
+        let mu_pairs = pairs
+            .iter()
+            .map(|&(j, k)| {
+                let (lj, lk) = (lambda[j], lambda[k]);
+                [with_inv(lj + lk), with_inv(lj + lk.conj())]
+            })
+            .collect();
+        let mu_k = lambda
+            .iter()
+            .map(|&l| [with_inv(l), with_inv(l + iw), with_inv(l - iw)])
+            .collect();
         ModalRates {
+            quadratic: a.iter().any(|a: &Vec<C>| !a.is_empty()),
+            pairs,
             a,
             b,
             p,
             trig,
-            lambda: me.lambda.clone(),
+            mu_pairs,
+            mu_k,
+            omega,
         }
     }
 
-    /// The step-length factors of [`Self::integrals`] for (region `ri`, t, Ω) in `cache`,
-    /// computed unless they are there already.
-    fn step_factors(&self, ri: usize, t: f64, omega: f64, cache: &mut RateCache) {
-        let key = (ri, t.to_bits(), omega.to_bits());
-        if cache.key == Some(key) {
-            return;
-        }
-        let r = self.lambda.len();
-        let iw = C::new(0.0, omega);
-        // e^{λ_k t} and e^{±iΩt}: the exponentials of the sums below are their products
-        let f: Vec<C> = self.lambda.iter().map(|&l| (l * t).exp()).collect();
-        let (wp, wm) = {
-            let g = C::from_polar(1.0, omega * t);
-            (g, g.conj())
-        };
-        // E(λ_j + λ_k), E(λ_j + λ̄_k) (shared by the rates)
-        cache.ejk.clear();
-        if self.a.iter().any(|a| !a.is_empty()) {
-            cache.ejk.extend((0..r * r).map(|jk| {
-                let (j, k) = (jk / r, jk % r);
-                let (lj, lk) = (self.lambda[j], self.lambda[k]);
-                (
-                    integral_exp(lj + lk, t, f[j] * f[k]),
-                    integral_exp(lj + lk.conj(), t, f[j] * f[k].conj()),
-                )
-            }));
-        }
-        cache.ek.clear();
-        cache.ek.extend((0..r).map(|k| {
-            let l = self.lambda[k];
+    /// The three integrals over the step between the ends `e` (module docs).
+    fn integrals(&self, e: &RateEnds, scratch: &mut RateScratch) -> [f64; 3] {
+        let (q0, q1, t) = (e.q0, e.q1, e.t);
+        let ((s0, c0), (s1, c1)) = (e.trig0, e.trig1);
+        let om = self.omega;
+        // ∫cos nΩτ, ∫sin nΩτ (n = 1, 2): from the ends (sin 2x = 2 sin x cos x, cos 2x =
+        // cos²x − sin²x), whose rounding costs ε/Ω absolutely; below |Ωt| = 1, where that
+        // exceeds ε t, in the product form cos, sin nΩ(τ₀ + t/2) · 2 sin(nΩt/2)/(nΩ) (one sine
+        // and cosine of Ωt/2, the middle turned from τ₀ by it)
+        let double = |(s, c): (f64, f64)| (2.0 * s * c, c * c - s * s);
+        let [ic1, is1, ic2, is2] = if (om * t).abs() >= 1.0 {
+            let ((sd0, cd0), (sd1, cd1)) = (double((s0, c0)), double((s1, c1)));
             [
-                integral_exp(l, t, f[k]),
-                integral_exp(l + iw, t, f[k] * wp),
-                integral_exp(l - iw, t, f[k] * wm),
+                (s1 - s0) / om,
+                (c0 - c1) / om,
+                (sd1 - sd0) / (2.0 * om),
+                (cd0 - cd1) / (2.0 * om),
             ]
-        }));
-        cache.key = Some(key);
-    }
-
-    /// The three integrals over [τ₀, τ₀ + t] from the modal coordinates q of δz(τ₀), in
-    /// region `ri` (the key of `cache`, which holds the step-length factors).
-    fn integrals(
-        &self,
-        q: &Modes,
-        tau0: f64,
-        t: f64,
-        omega: f64,
-        ri: usize,
-        cache: &mut RateCache,
-    ) -> [f64; 3] {
-        let r = self.lambda.len();
-        self.step_factors(ri, t, omega, cache);
-        let (ejk, ek) = (&cache.ejk, &cache.ek);
-        let qk = |k: usize| C::new(q.re[k], q.im[k]);
-        let rot = C::from_polar(1.0, omega * tau0);
-        // the trigonometric integrals ∫cos nΩτ, ∫sin nΩτ over the step (n = 1, 2), in the
-        // product form free of cancellation
-        let trig_int = |n: f64| {
-            let half = 0.5 * n * omega * t;
-            let (sm, cm) = (n * omega * (tau0 + 0.5 * t)).sin_cos();
-            let f = if half.abs() < 1e-300 {
-                t
+        } else {
+            let (sh, ch) = (0.5 * om * t).sin_cos();
+            let (sm, cm) = (s0 * ch + c0 * sh, c0 * ch - s0 * sh);
+            let (sm2, cm2) = double((sm, cm));
+            let (f1, f2) = if om == 0.0 {
+                (t, t)
             } else {
-                2.0 * half.sin() / (n * omega)
+                (2.0 * sh / om, 2.0 * sh * ch / om)
             };
-            (cm * f, sm * f)
+            [cm * f1, sm * f1, cm2 * f2, sm2 * f2]
         };
-        let (c1, s1) = trig_int(1.0);
-        let (c2, s2) = trig_int(2.0);
+        let (rot0, rot1) = (C::new(c0, s0), C::new(c1, s1));
+        let t2 = t * t;
+        // the modal products shared by the rates: q_k E(λ_k), q_k e^{±iΩτ₀} E(λ_k ± iΩ), and
+        // per pair q_j q_k E(λ_j + λ_k), q_j q̄_k E(λ_j + λ̄_k)
+        let RateScratch { lin, prods } = scratch;
+        let r = self.mu_k.len();
+        lin.resize(r, [C::new(0.0, 0.0); 3]);
+        for (k, (o, mu)) in lin.iter_mut().zip(&self.mu_k).enumerate() {
+            let (a, b) = (mode(q0, k), mode(q1, k));
+            *o = [
+                grown(&mu[0], t, t2, a, b),
+                grown(&mu[1], t, t2, a * rot0, b * rot1),
+                grown(&mu[2], t, t2, a * rot0.conj(), b * rot1.conj()),
+            ];
+        }
+        let np = if self.quadratic { self.pairs.len() } else { 0 };
+        prods.resize(np, (C::new(0.0, 0.0), C::new(0.0, 0.0)));
+        for (o, (&(j, k), mu)) in prods.iter_mut().zip(self.pairs.iter().zip(&self.mu_pairs)) {
+            let (aj, ak, bj, bk) = (mode(q0, j), mode(q0, k), mode(q1, j), mode(q1, k));
+            *o = (
+                grown(&mu[0], t, t2, aj * ak, bj * bk),
+                grown(&mu[1], t, t2, aj * ak.conj(), bj * bk.conj()),
+            );
+        }
         std::array::from_fn(|tr| {
             let k = &self.trig[tr];
-            let mut out = k[0] * t + k[1] * c1 + k[2] * s1 + k[3] * c2 + k[4] * s2;
-            let [p0, pc, ps] = &self.p[tr];
-            let mut lin = C::new(0.0, 0.0);
-            for kk in 0..r {
-                let vh = (pc[kk] - C::new(0.0, 1.0) * ps[kk]) * rot;
-                let vb = (pc[kk] + C::new(0.0, 1.0) * ps[kk]) * rot.conj();
-                lin += qk(kk) * (p0[kk] * ek[kk][0] + 0.5 * (vh * ek[kk][1] + vb * ek[kk][2]));
+            let mut out = k[0] * t + k[1] * ic1 + k[2] * is1 + k[3] * ic2 + k[4] * is2;
+            let [p0, pm, pp] = &self.p[tr];
+            for (kk, l) in lin.iter().enumerate() {
+                out += (p0[kk] * l[0] + pm[kk] * l[1] + pp[kk] * l[2]).re;
             }
-            out += lin.re;
-            if !self.a[tr].is_empty() {
-                let mut quad = C::new(0.0, 0.0);
-                for j in 0..r {
-                    for kk in 0..r {
-                        let (ea, eb) = ejk[j * r + kk];
-                        let (qj, qkk) = (qk(j), qk(kk));
-                        quad += qj
-                            * (self.a[tr][j * r + kk] * qkk * ea
-                                + self.b[tr][j * r + kk] * qkk.conj() * eb);
-                    }
-                }
-                out += 0.5 * quad.re;
+            for ((a, b), (pa, pb)) in self.a[tr].iter().zip(&self.b[tr]).zip(prods.iter()) {
+                out += (a * pa + b * pb).re;
             }
             out
         })
@@ -317,7 +379,7 @@ impl ExactPropagator {
         let modal = self.spec[r.index()]
             .modal
             .as_ref()
-            .map(|me| ModalRates::new(me, &forms, [&fr.p0, &fr.ps, &fr.pc]));
+            .map(|me| ModalRates::new(me, &forms, [&fr.p0, &fr.ps, &fr.pc], omega));
         Some(EnergyTable { g, w, c, modal })
     }
 
@@ -342,16 +404,35 @@ impl ExactPropagator {
         if !whole {
             let me = self.spec[ri].modal.as_ref()?;
             let rates = tab.modal.as_ref()?;
-            let q0 = if self.last.modal {
-                *self.last.q0
+            if self.last.span {
+                // a span has both ends at hand (`span.rs`)
+                let ends = RateEnds {
+                    q0: &self.last.q0,
+                    q1: &self.last.q1,
+                    trig0: self.last.trig0,
+                    trig1: self.last.trig1,
+                    t: len,
+                };
+                return Some(rates.integrals(&ends, &mut self.rate_scratch));
+            }
+            let r = me.len();
+            let mut q0 = Modes::ZERO;
+            if self.last.modal {
+                q0.copy_prefix(&self.last.q0, r);
             } else {
-                let mut q = Modes::ZERO;
-                me.project_plain(self.last.dz0.as_slice(), &mut q);
-                q
+                me.project_plain(self.last.dz0.as_slice(), &mut q0);
+            }
+            let mut q1 = Modes::ZERO;
+            me.factors(len, &mut q1);
+            q1.mul_assign(&q0, r);
+            let ends = RateEnds {
+                q0: &q0,
+                q1: &q1,
+                trig0: self.trig_at(self.last.tau0),
+                trig1: self.trig_now(),
+                t: len,
             };
-            let omega = self.model.omega();
-            let (tau0, cache) = (self.last.tau0, &mut self.rate_cache);
-            return Some(rates.integrals(&q0, tau0, len, omega, ri, cache));
+            return Some(rates.integrals(&ends, &mut self.rate_scratch));
         }
         let dim = self.z.len();
         // δz₀ of the step in plain coordinates
