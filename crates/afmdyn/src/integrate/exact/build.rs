@@ -205,7 +205,6 @@ impl ExactPropagator {
             param_data: None,
             param_end: None,
             energy: None,
-            rate_scratch: Default::default(),
             bound_cols: BoundCols::default(),
             span_guard: None,
             guard_stopped: false,

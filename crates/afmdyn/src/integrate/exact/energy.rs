@@ -62,30 +62,62 @@ pub(super) struct EnergyTable {
     modal: Option<ModalRates>,
 }
 
-/// The modal coefficients of one region's three rates (module docs): r representatives, the
-/// quadratic terms over the pairs j ≤ k only. Q is symmetric, so u_jᵀQu_k and E(λ_j + λ_k) are
-/// symmetric in (j, k), and the (k, j) term of the second sum is the conjugate of the (j, k)
-/// one (u_kᵀQū_j = conj(u_jᵀQū_k), E(λ_k + λ̄_j) = conj(E(λ_j + λ̄_k))): each sum is its
-/// diagonal plus twice the real part over j < k. The factors 2 and ½ are folded into the
-/// coefficients.
+/// The modal coefficients of one region's three rates (module docs), as terms c_r P E(μ) of
+/// the rates r = 0, 1, 2 for the modal products P: q_k, q_k e^{iΩτ}, q_k e^{−iΩτ} per
+/// representative (the linear term) and q_j q_k, q_j q̄_k per pair j ≤ k (the quadratic one).
+/// Q is symmetric, so u_jᵀQu_k and E(λ_j + λ_k) are symmetric in (j, k), and the (k, j) term
+/// of the second sum is the conjugate of the (j, k) one (u_kᵀQū_j = conj(u_jᵀQū_k),
+/// E(λ_k + λ̄_j) = conj(E(λ_j + λ̄_k))): each sum is its diagonal plus twice the real part over
+/// j < k. The factors 2 and ½ are folded into the coefficients.
 #[derive(Debug)]
 struct ModalRates {
-    /// The pairs (j, k), j ≤ k.
-    pairs: Vec<(usize, usize)>,
-    /// Whether some rate has a quadratic term.
-    quadratic: bool,
-    /// ½ u_jᵀQu_k and ½ u_jᵀQū_k per pair (twice that for j < k), per rate (empty where Q = 0).
-    a: [Vec<C>; 3],
-    b: [Vec<C>; 3],
-    /// v₀ᵀu_k, ½ (v_c − i v_s)ᵀu_k and ½ (v_c + i v_s)ᵀu_k per rate (r each).
-    p: [[Vec<C>; 3]; 3],
+    /// The linear terms of each representative k: P = q_k, q_k e^{iΩτ}, q_k e^{−iΩτ} with
+    /// μ = λ_k, λ_k + iΩ, λ_k − iΩ and c_r = v₀ᵀu_k, ½ (v_c − i v_s)ᵀu_k, ½ (v_c + i v_s)ᵀu_k.
+    lin: Vec<[Term; 3]>,
+    /// The quadratic terms of each pair (j, k), j ≤ k: P = q_j q_k, q_j q̄_k with μ = λ_j + λ_k,
+    /// λ_j + λ̄_k and c_r = ½ u_jᵀQu_k, ½ u_jᵀQū_k (twice that for j < k); none where no rate
+    /// has a quadratic part.
+    quad: Vec<((usize, usize), [Term; 2])>,
     /// The state-free part: k₀ + Σ_{n=1,2} (α_n cos nΩτ + β_n sin nΩτ) as [k₀, α₁, β₁, α₂, β₂].
     trig: [[f64; 5]; 3],
-    /// The exponents μ of E(μ): λ_j + λ_k and λ_j + λ̄_k per pair, λ_k, λ_k + iΩ and λ_k − iΩ
-    /// per representative.
-    mu_pairs: Vec<[Exponent; 2]>,
-    mu_k: Vec<[Exponent; 3]>,
     omega: f64,
+}
+
+/// One term of [`ModalRates`]: Σ_r c_r P E(μ) over a step, with c_r/μ kept for the difference
+/// form and 1/(16|μ|²), the least t² with |μt| ≥ 1/4, for the choice between the forms.
+#[derive(Debug, Clone, Copy)]
+struct Term {
+    mu: C,
+    t2_min: f64,
+    coef: [C; 3],
+    /// c_r/μ (∞ or NaN for μ = 0, never read: such a term takes the series).
+    over_mu: [C; 3],
+}
+
+impl Term {
+    fn new(mu: C, coef: [C; 3]) -> Self {
+        let inv = C::new(1.0, 0.0) / mu;
+        Term {
+            mu,
+            t2_min: 1.0 / (16.0 * mu.norm_sqr()),
+            coef,
+            over_mu: coef.map(|c| c * inv),
+        }
+    }
+
+    /// Add Re(c_r P₀ E(μ)) over a step of length t (t2 = t²) to `out`, given P₁ = e^{μt} P₀:
+    /// Re(c_r/μ (P₁ − P₀)), or Re(c_r P₀ t φ₁(μt)) below |μt| = 1/4 (module docs).
+    #[inline(always)]
+    fn add(&self, t: f64, t2: f64, p0: C, p1: C, out: &mut [f64; 3]) {
+        let (c, d) = if t2 >= self.t2_min {
+            (&self.over_mu, p1 - p0)
+        } else {
+            (&self.coef, p0 * phi1(self.mu * t) * t)
+        };
+        for (o, c) in out.iter_mut().zip(c) {
+            *o += c.re * d.re - c.im * d.im;
+        }
+    }
 }
 
 /// The two ends of a step [τ₀, τ₀ + t] for [`ModalRates::integrals`]: the modal coordinates of
@@ -96,13 +128,6 @@ pub(super) struct RateEnds<'a> {
     pub(super) trig0: (f64, f64),
     pub(super) trig1: (f64, f64),
     pub(super) t: f64,
-}
-
-/// Scratch of [`ModalRates::integrals`]: the modal products of one step, shared by the rates.
-#[derive(Debug, Clone, Default)]
-pub(super) struct RateScratch {
-    lin: Vec<[C; 3]>,
-    prods: Vec<(C, C)>,
 }
 
 /// φ₁(x) = (eˣ − 1)/x by its series Σ xⁿ/(n+1)! for |x| < 1/4 (13 terms: 4⁻¹³/14! < 1e-18), in
@@ -123,36 +148,6 @@ fn phi1(x: C) -> C {
     sum
 }
 
-/// An exponent μ of E(μ) as [`grown`] takes it: μ, 1/μ (∞ for μ = 0) and 1/(16|μ|²), the
-/// least t² with |μt| ≥ 1/4.
-#[derive(Debug, Clone, Copy)]
-struct Exponent {
-    mu: C,
-    inv: C,
-    t2_min: f64,
-}
-
-impl Exponent {
-    fn new(mu: C) -> Self {
-        Exponent {
-            mu,
-            inv: C::new(1.0, 0.0) / mu,
-            t2_min: 1.0 / (16.0 * mu.norm_sqr()),
-        }
-    }
-}
-
-/// P₀ E(μ) over a step of length t (t2 = t²), given P₁ = e^{μt} P₀: (P₁ − P₀)/μ, or
-/// P₀ t φ₁(μt) below |μt| = 1/4 (module docs).
-#[inline(always)]
-fn grown(e: &Exponent, t: f64, t2: f64, p0: C, p1: C) -> C {
-    if t2 >= e.t2_min {
-        (p1 - p0) * e.inv
-    } else {
-        p0 * phi1(e.mu * t) * t
-    }
-}
-
 /// q_k as a complex number.
 #[inline(always)]
 fn mode(q: &Modes, k: usize) -> C {
@@ -166,45 +161,52 @@ impl ModalRates {
         let u: Vec<DVector<C>> = (0..r)
             .map(|k| DVector::from_fn(dim, |i, _| C::new(me.tv.re[(i, k)], me.tv.im[(i, k)])))
             .collect();
-        let pairs: Vec<(usize, usize)> = (0..r).flat_map(|j| (j..r).map(move |k| (j, k))).collect();
-        // ½ of the quadratic term, twice for the pairs j < k
-        let weight = |j: usize, k: usize| if j < k { 1.0 } else { 0.5 };
         let [p0, ps, pc] = fr_zp;
-        let quad = |conj: bool| {
-            std::array::from_fn(|t| {
-                if forms[t].q.amax() == 0.0 {
-                    return Vec::new();
-                }
-                let q = forms[t].q.map(|x| C::new(x, 0.0));
-                pairs
-                    .iter()
-                    .map(|&(j, k)| {
-                        let uk = if conj {
-                            u[k].map(|c| c.conj())
-                        } else {
-                            u[k].clone()
-                        };
-                        u[j].dot(&(&q * uk)) * weight(j, k)
-                    })
-                    .collect()
-            })
-        };
-        let (a, b) = (quad(false), quad(true));
+        let lambda = &me.lambda;
+        let iw = C::new(0.0, omega);
         let i = C::new(0.0, 1.0);
-        let p = std::array::from_fn(|t| {
+        // v = 2Q z_p + l per rate: its constant, cos and sin parts against u_k
+        let v: [[Vec<C>; 3]; 3] = std::array::from_fn(|t| {
             let f = &forms[t];
-            // v = 2Q z_p + l: constant, cos and sin parts
             let v0 = 2.0 * &f.q * p0 + &f.l[0];
             let vc = 2.0 * &f.q * pc + &f.l[2];
             let vs = 2.0 * &f.q * ps + &f.l[1];
-            let [d0, dc, ds] = [v0, vc, vs].map(|v| {
+            [v0, vc, vs].map(|v| {
                 let v = v.map(|x| C::new(x, 0.0));
                 u.iter().map(|uk| v.dot(uk)).collect::<Vec<C>>()
-            });
-            let minus = dc.iter().zip(&ds).map(|(c, s)| 0.5 * (c - i * s)).collect();
-            let plus = dc.iter().zip(&ds).map(|(c, s)| 0.5 * (c + i * s)).collect();
-            [d0, minus, plus]
+            })
         });
+        let lin = (0..r)
+            .map(|k| {
+                let l = lambda[k];
+                let c0 = std::array::from_fn(|t| v[t][0][k]);
+                let cm = std::array::from_fn(|t| 0.5 * (v[t][1][k] - i * v[t][2][k]));
+                let cp = std::array::from_fn(|t| 0.5 * (v[t][1][k] + i * v[t][2][k]));
+                [
+                    Term::new(l, c0),
+                    Term::new(l + iw, cm),
+                    Term::new(l - iw, cp),
+                ]
+            })
+            .collect();
+        // ½ of the quadratic term, twice for the pairs j < k
+        let weight = |j: usize, k: usize| if j < k { 1.0 } else { 0.5 };
+        let qs: [DMatrix<C>; 3] = std::array::from_fn(|t| forms[t].q.map(|x| C::new(x, 0.0)));
+        let quadratic = forms.iter().any(|f| f.q.amax() > 0.0);
+        let quad = (0..r)
+            .flat_map(|j| (j..r).map(move |k| (j, k)))
+            .filter(|_| quadratic)
+            .map(|(j, k)| {
+                let w = weight(j, k);
+                let ca = std::array::from_fn(|t| u[j].dot(&(&qs[t] * &u[k])) * w);
+                let cb = std::array::from_fn(|t| u[j].dot(&(&qs[t] * u[k].map(|c| c.conj()))) * w);
+                let (lj, lk) = (lambda[j], lambda[k]);
+                (
+                    (j, k),
+                    [Term::new(lj + lk, ca), Term::new(lj + lk.conj(), cb)],
+                )
+            })
+            .collect();
         // the state-free part sampled at five phases θ_j = 2πj/5 (exact for degree 2)
         let trig = std::array::from_fn(|t| {
             let f = &forms[t];
@@ -228,35 +230,16 @@ impl ModalRates {
             }
             coef
         });
-        let lambda = &me.lambda;
-        let with_inv = Exponent::new;
-        let iw = C::new(0.0, omega);
-        let mu_pairs = pairs
-            .iter()
-            .map(|&(j, k)| {
-                let (lj, lk) = (lambda[j], lambda[k]);
-                [with_inv(lj + lk), with_inv(lj + lk.conj())]
-            })
-            .collect();
-        let mu_k = lambda
-            .iter()
-            .map(|&l| [with_inv(l), with_inv(l + iw), with_inv(l - iw)])
-            .collect();
         ModalRates {
-            quadratic: a.iter().any(|a: &Vec<C>| !a.is_empty()),
-            pairs,
-            a,
-            b,
-            p,
+            lin,
+            quad,
             trig,
-            mu_pairs,
-            mu_k,
             omega,
         }
     }
 
     /// The three integrals over the step between the ends `e` (module docs).
-    fn integrals(&self, e: &RateEnds, scratch: &mut RateScratch) -> [f64; 3] {
+    fn integrals(&self, e: &RateEnds) -> [f64; 3] {
         let (q0, q1, t) = (e.q0, e.q1, e.t);
         let ((s0, c0), (s1, c1)) = (e.trig0, e.trig1);
         let om = self.omega;
@@ -284,42 +267,24 @@ impl ModalRates {
             };
             [cm * f1, sm * f1, cm2 * f2, sm2 * f2]
         };
+        let mut out = std::array::from_fn(|tr| {
+            let k = &self.trig[tr];
+            k[0] * t + k[1] * ic1 + k[2] * is1 + k[3] * ic2 + k[4] * is2
+        });
         let (rot0, rot1) = (C::new(c0, s0), C::new(c1, s1));
         let t2 = t * t;
-        // the modal products shared by the rates: q_k E(λ_k), q_k e^{±iΩτ₀} E(λ_k ± iΩ), and
-        // per pair q_j q_k E(λ_j + λ_k), q_j q̄_k E(λ_j + λ̄_k)
-        let RateScratch { lin, prods } = scratch;
-        let r = self.mu_k.len();
-        lin.resize(r, [C::new(0.0, 0.0); 3]);
-        for (k, (o, mu)) in lin.iter_mut().zip(&self.mu_k).enumerate() {
+        for (k, [l0, lp, lm]) in self.lin.iter().enumerate() {
             let (a, b) = (mode(q0, k), mode(q1, k));
-            *o = [
-                grown(&mu[0], t, t2, a, b),
-                grown(&mu[1], t, t2, a * rot0, b * rot1),
-                grown(&mu[2], t, t2, a * rot0.conj(), b * rot1.conj()),
-            ];
+            l0.add(t, t2, a, b, &mut out);
+            lp.add(t, t2, a * rot0, b * rot1, &mut out);
+            lm.add(t, t2, a * rot0.conj(), b * rot1.conj(), &mut out);
         }
-        let np = if self.quadratic { self.pairs.len() } else { 0 };
-        prods.resize(np, (C::new(0.0, 0.0), C::new(0.0, 0.0)));
-        for (o, (&(j, k), mu)) in prods.iter_mut().zip(self.pairs.iter().zip(&self.mu_pairs)) {
+        for &((j, k), [ta, tb]) in &self.quad {
             let (aj, ak, bj, bk) = (mode(q0, j), mode(q0, k), mode(q1, j), mode(q1, k));
-            *o = (
-                grown(&mu[0], t, t2, aj * ak, bj * bk),
-                grown(&mu[1], t, t2, aj * ak.conj(), bj * bk.conj()),
-            );
+            ta.add(t, t2, aj * ak, bj * bk, &mut out);
+            tb.add(t, t2, aj * ak.conj(), bj * bk.conj(), &mut out);
         }
-        std::array::from_fn(|tr| {
-            let k = &self.trig[tr];
-            let mut out = k[0] * t + k[1] * ic1 + k[2] * is1 + k[3] * ic2 + k[4] * is2;
-            let [p0, pm, pp] = &self.p[tr];
-            for (kk, l) in lin.iter().enumerate() {
-                out += (p0[kk] * l[0] + pm[kk] * l[1] + pp[kk] * l[2]).re;
-            }
-            for ((a, b), (pa, pb)) in self.a[tr].iter().zip(&self.b[tr]).zip(prods.iter()) {
-                out += (a * pa + b * pb).re;
-            }
-            out
-        })
+        out
     }
 }
 
@@ -413,7 +378,7 @@ impl ExactPropagator {
                     trig1: self.last.trig1,
                     t: len,
                 };
-                return Some(rates.integrals(&ends, &mut self.rate_scratch));
+                return Some(rates.integrals(&ends));
             }
             let r = me.len();
             let mut q0 = Modes::ZERO;
@@ -432,7 +397,7 @@ impl ExactPropagator {
                 trig1: self.trig_now(),
                 t: len,
             };
-            return Some(rates.integrals(&ends, &mut self.rate_scratch));
+            return Some(rates.integrals(&ends));
         }
         let dim = self.z.len();
         // δz₀ of the step in plain coordinates

@@ -202,8 +202,6 @@ pub struct ExactPropagator {
     /// The tables of the closed-form energy integrals over grid steps (`energy.rs`), built on
     /// the first request.
     energy: Option<Arc<[energy::EnergyTable; 2]>>,
-    /// Scratch of the modal closed form of the energy integrals.
-    rate_scratch: energy::RateScratch,
     /// The column sums of [`Integrator::displacement_bound`] for the last weights.
     ///
     /// [`Integrator::displacement_bound`]: crate::integrate::Integrator::displacement_bound
