@@ -2,7 +2,7 @@
 # Regenerate the "Recording a run: afmdyn simulate" section of docs/performance.md: wall time per
 # drive period of `afmdyn simulate --periods 20000` (default parameters, N = 3, linear law, exact
 # propagator) with --files none (the summary only: energy balance, sections, events) and with the
-# default files (200 samples per period to NPY, events, sections, energy, plots), best of 3, against
+# default files (200 samples per period to NPY, events, sections, energy, plots), best of 5, against
 # the engine alone (`period_cost`: `advance` over the same parameters, best of 9).
 # Usage: bash scripts/perf-simulate.sh
 set -euo pipefail
@@ -13,9 +13,9 @@ A=target/release/afmdyn
 X=target/release/examples/period_cost
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-best() { # command... -> best wall seconds of 3
+best() { # command... -> best wall seconds of 5
   local b=""
-  for _ in 1 2 3; do
+  for _ in 1 2 3 4 5; do
     rm -rf "$tmp/out"
     local t0 t1
     t0=$(date +%s.%N); "$@" > /dev/null; t1=$(date +%s.%N)
@@ -38,10 +38,10 @@ none, files, engine, p = map(float, sys.argv[1:])
 print(f"| engine alone (`advance`, period_cost) | — | {engine:.1f} µs | 1× |")
 for name, t in [("`simulate --files none`", none), ("`simulate` (default files, 200 samples per period)", files)]:
     per = t / p * 1e6
-    print(f"| {name} | {t:.2f} s | {per:.1f} µs | {per / engine:.0f}× |")
+    print(f"| {name} | {t:.2f} s | {per:.1f} µs | {per / engine:.1f}× |")
 PY
   echo ""
-  echo "\`afmdyn simulate --periods $P\`, default parameters (N = 3, linear law, Ω = 2.6), best of 3; the engine best of 9."
+  echo "\`afmdyn simulate --periods $P\`, default parameters (N = 3, linear law, Ω = 2.6), best of 5; the engine best of 9."
   echo "<!-- simulate:end -->"
 } > "$section"
 python3 scripts/doc_section.py simulate "$section" "Recording a run: afmdyn simulate"

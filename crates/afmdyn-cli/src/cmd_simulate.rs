@@ -6,7 +6,7 @@ use crate::output::{
     csv_finish, csv_line, csv_lines, csv_stream, f, write_csv, write_csv_numbers, Column,
     CsvStream, Field, NpyStream, OutDir,
 };
-use crate::plot::{decimate_line, save, Figure, Series, Style};
+use crate::plot::{save, Figure, PixelColumns, Series, Style};
 use afmdyn::analysis::spectrum::{amplitude_spectrum, SPECTRUM_SAMPLES};
 use afmdyn::integrate::build;
 use afmdyn::report::{SeriesNames, SeriesUnits};
@@ -144,6 +144,11 @@ impl Shade {
 struct PlotData {
     tip: Vec<(f64, f64)>,
     vt: Vec<(f64, f64)>,
+    /// The open pixel columns of `tip` and `vt` once they are decimated as they come
+    /// (`streaming`: from the first chunk after which they hold more than 8 points a column).
+    tip_cols: PixelColumns,
+    vt_cols: PixelColumns,
+    streaming: bool,
     columns: f64,
     t0: f64,
     t1: f64,
@@ -157,14 +162,51 @@ struct PlotData {
 }
 
 impl PlotData {
-    fn redecimate(&mut self) {
-        let (t0, t1, cols) = (self.t0, self.t1, self.columns);
-        let px = |x: f64, _y: f64| ((((x - t0) / (t1 - t0).max(1e-300)) * cols) as i32, 0);
-        for v in [&mut self.tip, &mut self.vt] {
-            if v.len() > 8 * cols as usize {
-                *v = decimate_line(v, px).concat();
+    /// The pixel column of τ on the tip plots' grid.
+    fn column(&self, x: f64) -> i32 {
+        (((x - self.t0) / (self.t1 - self.t0).max(1e-300)) * self.columns) as i32
+    }
+
+    /// Add a sample (τ, W, V_T) to the tip plots' lines: as it is, or into its pixel column
+    /// once the lines are decimated as they come (the first, lowest, highest and last point
+    /// of every column, [`PixelColumns`]: what decimating the whole line keeps; a non-finite
+    /// value closes the column and is dropped, as there).
+    fn add(&mut self, t: f64, w: f64, v: f64) {
+        if !self.streaming {
+            self.tip.push((t, w));
+            self.vt.push((t, v));
+            return;
+        }
+        let cx = self.column(t);
+        for (q, cols, out) in [
+            ((t, w), &mut self.tip_cols, &mut self.tip),
+            ((t, v), &mut self.vt_cols, &mut self.vt),
+        ] {
+            if q.0.is_finite() && q.1.is_finite() {
+                cols.push(cx, q, out);
+            } else {
+                cols.flush(out);
             }
         }
+    }
+
+    /// After a chunk: once the lines hold more than 8 points a pixel column, decimate them
+    /// from then on as the samples come ([`PlotData::add`]).
+    fn redecimate(&mut self) {
+        if self.streaming || self.tip.len() <= 8 * self.columns as usize {
+            return;
+        }
+        self.streaming = true;
+        let (tip, vt) = (std::mem::take(&mut self.tip), std::mem::take(&mut self.vt));
+        for (&(t, w), &(_, v)) in tip.iter().zip(&vt) {
+            self.add(t, w, v);
+        }
+    }
+
+    /// Close the open pixel columns.
+    fn finish(&mut self) {
+        self.tip_cols.flush(&mut self.tip);
+        self.vt_cols.flush(&mut self.vt);
     }
 }
 
@@ -321,6 +363,9 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
     let mut plots = (a.files == Files::All).then(|| PlotData {
         tip: vec![],
         vt: vec![],
+        tip_cols: PixelColumns::default(),
+        vt_cols: PixelColumns::default(),
+        streaming: false,
         columns: 2000.0,
         t0: start,
         t1: end,
@@ -432,8 +477,7 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
         if let Some(pd) = plots.as_mut() {
             let new = c.samples().len();
             for s in c.samples() {
-                pd.tip.push((s[0], s[2]));
-                pd.vt.push((s[0], s[1]));
+                pd.add(s[0], s[2], s[1]);
             }
             // the phase portrait's and the tip window's last samples (only those kept)
             let keep = new.min(PHASE_SAMPLES);
@@ -569,6 +613,7 @@ fn write_spectrum_and_plots(
         spec.iter().map(|&(x, y)| [x, y]),
     )?;
     let Some(mut pd) = plots else { return Ok(()) };
+    pd.finish();
     if let Some(t0) = pd.shade.open.take() {
         pd.shade.push(t0, tau_end);
     }

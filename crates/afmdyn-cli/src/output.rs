@@ -280,6 +280,16 @@ pub struct NpyFile {
 
 /// Bytes gathered before they are written.
 const NPY_BUFFER: usize = 1 << 20;
+
+/// The little-endian bytes of `values` (NPY's `<f8`): the values' own bytes on a little-endian
+/// machine, no copy.
+fn le_bytes(values: &[f64]) -> std::borrow::Cow<'_, [u8]> {
+    if cfg!(target_endian = "little") {
+        std::borrow::Cow::Borrowed(bytemuck::cast_slice(values))
+    } else {
+        std::borrow::Cow::Owned(values.iter().flat_map(|v| v.to_le_bytes()).collect())
+    }
+}
 /// The width of the row count's field in the header (npyz's placeholder).
 const NPY_ROWS_FIELD: usize = 20;
 
@@ -350,14 +360,17 @@ impl NpyStream {
                 self.cols
             )));
         }
+        let bytes = le_bytes(values);
         let f = self.stream.get();
-        let at = f.buf.len();
-        f.buf.resize(at + 8 * values.len(), 0);
-        for (b, v) in f.buf[at..].chunks_exact_mut(8).zip(values) {
-            b.copy_from_slice(&v.to_le_bytes());
-        }
-        if f.buf.len() >= NPY_BUFFER {
-            let r = f.file.write_all(&f.buf);
+        // gathered while small, else written with what is gathered (a chunk of rows: straight
+        // from the caller's buffer)
+        if f.buf.len() + bytes.len() < NPY_BUFFER {
+            f.buf.extend_from_slice(&bytes);
+        } else {
+            let r = f
+                .file
+                .write_all(&f.buf)
+                .and_then(|()| f.file.write_all(&bytes));
             f.buf.clear();
             r.map_err(|e| self.stream.err(e))?;
         }

@@ -257,6 +257,57 @@ fn bounds(fig: &Figure) -> (f64, f64, f64, f64) {
 /// position of each in the input.
 type PixelColumn = (i32, [(f64, f64); 4], [usize; 4]);
 
+/// The pixel columns of a line monotone in x, point by point: per column its first, lowest,
+/// highest and last point, written out (in their order, each once) when the next column
+/// starts — the monotone case of [`decimate_line`], also streamed by a caller that gathers a
+/// long line (`afmdyn simulate`'s plots).
+#[derive(Debug, Clone, Default)]
+pub struct PixelColumns {
+    /// The open column; (first, min, max, last) as positions among the points pushed.
+    col: Option<PixelColumn>,
+    k: usize,
+}
+
+impl PixelColumns {
+    /// Add the finite point `q` of pixel column `cx` (columns non-decreasing), writing the
+    /// column before into `out` when `cx` starts a new one.
+    #[inline]
+    pub fn push(&mut self, cx: i32, q: (f64, f64), out: &mut Vec<(f64, f64)>) {
+        self.k += 1;
+        let k = self.k;
+        match &mut self.col {
+            Some((c, p, order)) if *c == cx => {
+                if q.1 < p[1].1 {
+                    (p[1], order[1]) = (q, k);
+                }
+                if q.1 > p[2].1 {
+                    (p[2], order[2]) = (q, k);
+                }
+                (p[3], order[3]) = (q, k);
+            }
+            _ => {
+                self.flush(out);
+                self.col = Some((cx, [q; 4], [k; 4]));
+            }
+        }
+    }
+
+    /// Write the open column into `out`.
+    pub fn flush(&mut self, out: &mut Vec<(f64, f64)>) {
+        if let Some((_, p, order)) = self.col.take() {
+            let mut idx = [0usize, 1, 2, 3];
+            idx.sort_by_key(|&i| order[i]);
+            let mut last = None;
+            for i in idx {
+                if last != Some(order[i]) {
+                    out.push(p[i]);
+                    last = Some(order[i]);
+                }
+            }
+        }
+    }
+}
+
 /// Decimate a line to the pixel grid `px` maps to. A series monotone in x keeps per pixel
 /// column its first, lowest, highest and last point (in their order), which draws the same
 /// picture; any other line drops points on the pixel of the previous one and segments already
@@ -275,49 +326,18 @@ pub fn decimate_line(
     let mut runs: Vec<Vec<(f64, f64)>> = vec![];
     let mut run: Vec<(f64, f64)> = vec![];
     if monotone {
-        // per column: (first, min, max, last) as indices into the column's points
-        let mut col: Option<PixelColumn> = None;
-        let mut k = 0usize;
-        let flush = |col: &mut Option<PixelColumn>, run: &mut Vec<(f64, f64)>| {
-            if let Some((_, p, order)) = col.take() {
-                let mut idx = [0usize, 1, 2, 3];
-                idx.sort_by_key(|&i| order[i]);
-                let mut last = None;
-                for i in idx {
-                    if last != Some(order[i]) {
-                        run.push(p[i]);
-                        last = Some(order[i]);
-                    }
-                }
-            }
-        };
+        let mut cols = PixelColumns::default();
         for &q in points {
             if !finite(&q) {
-                flush(&mut col, &mut run);
+                cols.flush(&mut run);
                 if !run.is_empty() {
                     runs.push(std::mem::take(&mut run));
                 }
                 continue;
             }
-            k += 1;
-            let (cx, _) = px(q.0, q.1);
-            match &mut col {
-                Some((c, p, order)) if *c == cx => {
-                    if q.1 < p[1].1 {
-                        (p[1], order[1]) = (q, k);
-                    }
-                    if q.1 > p[2].1 {
-                        (p[2], order[2]) = (q, k);
-                    }
-                    (p[3], order[3]) = (q, k);
-                }
-                _ => {
-                    flush(&mut col, &mut run);
-                    col = Some((cx, [q; 4], [k; 4]));
-                }
-            }
+            cols.push(px(q.0, q.1).0, q, &mut run);
         }
-        flush(&mut col, &mut run);
+        cols.flush(&mut run);
     } else {
         let mut drawn: HashSet<(i32, i32, i32, i32)> = HashSet::new();
         let mut last_px: Option<(i32, i32)> = None;

@@ -469,8 +469,15 @@ impl CantileverModel {
         let g = self.galerkin.region(Region::Free);
         let x = z.rows(0, n);
         let v = z.rows(n, n);
-        let kinetic = 0.5 * (&g.mass * v).dot(&v);
-        let bending = 0.5 * (&g.stiffness * x).dot(&x);
+        // the products into a buffer on the stack (the same gemv, no allocation)
+        let mut buf = [0.0; crate::params::MAX_MODES];
+        let mut quad = |m: &DMatrix<f64>, y| {
+            let mut out = nalgebra::DVectorViewMut::from_slice(&mut buf[..n], n);
+            m.mul_to(&y, &mut out);
+            out.dot(&y)
+        };
+        let kinetic = 0.5 * quad(&g.mass, v);
+        let bending = 0.5 * quad(&g.stiffness, x);
         kinetic + bending + self.law.potential(r == Region::Contact, -self.v_t(tau, z))
     }
 

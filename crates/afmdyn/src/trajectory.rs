@@ -291,14 +291,15 @@ pub fn record(integ: &mut dyn Integrator, spec: &RecordSpec) -> Result<Trajector
 /// [`record`] with the samples written into `rows` (cleared first) instead of
 /// [`Trajectory::samples`], which stays empty: no allocation per sample.
 ///
-/// The integrator takes its own steps ([`Integrator::step_deferred`]: the exact propagator's
-/// natural grid, ending only at the drive-period sections, the end and switchings), and the
-/// samples τ_i = start + i·T/S inside each step are formed from its dense output
-/// ([`Integrator::dense_states_into`]; for the exact propagator in closed form), not by ending
-/// a step at every sample. The energy balance is integrated over those steps (closed forms
-/// where the integrator has them, [`Integrator::last_step_rate_integrals`]); the plain state
-/// is formed only at the sections, the energy cuts, the events and where the body-contact
-/// bound does not decide. A sample at the end of a step that ended at an event, and the last
+/// The integrator takes its own steps, in spans ([`Integrator::step_span`]: the exact
+/// propagator's natural grid, a span ending only at the drive-period sections, the end,
+/// switchings, and where its bound of the beam's displacement does not keep the body off the
+/// substrate), and the samples τ_i = start + i·T/S inside each span are formed from its dense
+/// output ([`Integrator::dense_states_into`]; for the exact propagator in closed form), not by
+/// ending a step at every sample. The energy balance is integrated over those spans (closed
+/// forms where the integrator has them, [`Integrator::last_step_rate_integrals`]: for the
+/// exact propagator over a whole stint piece at once); the plain state is formed only at the
+/// sections, the energy cuts, the events and where the body-contact bound does not decide. A sample at the end of a step that ended at an event, and the last
 /// one where it falls beyond the end by less than 1e-12 (1 + |τ|), are the integrator's state
 /// there (after the event's jump).
 ///
@@ -381,7 +382,8 @@ pub fn record_rows(
     }
     while integ.tau() < end {
         let next_section = k_period as f64 * period;
-        let step = integ.step_deferred(end.min(next_section))?;
+        // a span proven free of body contact is checked at its end only
+        let step = integ.step_span(end.min(next_section), body.as_ref())?;
         let closed = if spec.energy && step.tau1 > step.tau0 {
             integ.last_step_rate_integrals()
         } else {
@@ -475,7 +477,12 @@ pub fn record_rows(
             out.energy.push(acc);
             acc = EnergyBalance {
                 tau0: tau,
-                e_start: model.energy(integ.region(), tau, z),
+                // the same state and region: the same energy
+                e_start: if integ.region() == step.region {
+                    acc.e_end
+                } else {
+                    model.energy(integ.region(), tau, z)
+                },
                 e_end: 0.0,
                 base_work: 0.0,
                 beam_dissipation: 0.0,

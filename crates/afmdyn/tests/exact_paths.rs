@@ -466,3 +466,128 @@ fn dense_output_ends_at_the_step_end_values() {
         assert!(worst_v <= tol, "{at}: V_T {worst_v:e}");
     }
 }
+
+/// A step of the step loop as `spans_are_the_steps_of_step_deferred` compares it: its end, the
+/// state formed there, its event, its Jacobian, its energy-rate integrals and whether the beam
+/// body touches the substrate there.
+struct LoopStep {
+    tau: f64,
+    z: DVector<f64>,
+    event: Option<SwitchEvent>,
+    jac: nalgebra::DMatrix<f64>,
+    rates: [f64; 3],
+    touches: bool,
+}
+
+/// Spans (`Integrator::step_span`, `integrate/exact/span.rs`) are the steps of the step loop
+/// run in one go: every span ends where a step of `Integrator::step` ends (the same time, bit
+/// for bit), with the same event, and the run ends in the same state bit for bit; the span as
+/// the last step gives the step loop's values at every step end inside it — the dense state
+/// and tip (to 1e-12 of the state), the Jacobian (the product of the steps' Jacobians, to 1e-10) and the
+/// energy-rate integrals (their sum over the steps, to 1e-11 of the terms' size) — and its
+/// body-contact guard is sound: no step end inside a span of several steps has the body on
+/// the substrate. On the attractor at N = 1, 3, 10 (no body contact, spans of up to a period),
+/// and from a large start at N = 3 whose beam body touches the substrate before it decays
+/// (the guard ends the spans there).
+#[test]
+fn spans_are_the_steps_of_step_deferred() {
+    use afmdyn::model::BodyContactCheck;
+    for (modes, touching) in [(1, false), (3, false), (10, false), (3, true)] {
+        let (p, m) = default_model(modes);
+        let period = p.period();
+        let body = BodyContactCheck::new(&m, 64);
+        let (z0, t0, periods) = if touching {
+            let z = afmdyn::analysis::bifurcation::random_state(&m, 3, 1) * 40.0;
+            (z, 0.0, 30.0)
+        } else {
+            (m.rest(), 40.0 * period, 10.0)
+        };
+        let (mut a, mut b) = (
+            prop(&m, Propagation::Auto, true),
+            prop(&m, Propagation::Auto, true),
+        );
+        for x in [&mut a, &mut b] {
+            x.reset(0.0, &z0).unwrap();
+            advance(x, t0).unwrap();
+        }
+        let end = t0 + periods * period;
+        let mut steps = Vec::new();
+        while b.tau() < end {
+            let st = b.step(end).unwrap();
+            steps.push(LoopStep {
+                tau: b.tau(),
+                z: b.state().clone(),
+                event: st.event,
+                jac: b.last_step_jacobian().unwrap(),
+                rates: b.last_step_rate_integrals().unwrap(),
+                touches: body.touches(b.tau(), b.state()),
+            });
+        }
+        let at = format!("N = {modes}, touching {touching}");
+        let (mut i, mut long_spans, mut guarded) = (0usize, 0usize, 0usize);
+        let mut k = (t0 / period).round() as i64 + 1;
+        while a.tau() < end {
+            let section = k as f64 * period;
+            let span = a.step_span(end.min(section), Some(&body)).unwrap();
+            if a.tau() >= section {
+                k += 1;
+            }
+            let first = i;
+            while steps[i].tau < span.tau1 {
+                i += 1;
+            }
+            let last = &steps[i];
+            assert_eq!(last.tau, span.tau1, "{at}: span end");
+            assert_eq!(last.event, span.event, "{at}: event");
+            let inside = &steps[first..=i];
+            long_spans += usize::from(inside.len() > 1);
+            // the guard: no step end before the span's end touches
+            for s in &inside[..inside.len() - 1] {
+                assert!(!s.touches, "{at}: body contact at {} inside a span", s.tau);
+            }
+            guarded += usize::from(last.touches);
+            // dense output at every step end of the span (before an event's jump)
+            for s in inside {
+                let z = s.event.as_ref().map_or(&s.z, |e| &e.state);
+                let dense = a.dense_state(s.tau);
+                assert!(
+                    rel(&dense, z) <= 1e-12,
+                    "{at}: dense state {}",
+                    rel(&dense, z)
+                );
+                // (to round-off of the state: the tip is a sum of the state's entries)
+                let tip = a.dense_tip(s.tau);
+                for (got, want) in tip[..2].iter().zip([m.w_tip(z), m.w_tip_dot(z)]) {
+                    assert!(
+                        (got - want).abs() <= 1e-12 * (1.0 + z.amax()),
+                        "{at}: dense tip {got} vs {want}"
+                    );
+                }
+            }
+            // the Jacobian and the rate integrals over the span
+            let jac = inside
+                .iter()
+                .fold(nalgebra::DMatrix::identity(2 * modes, 2 * modes), |j, s| {
+                    &s.jac * j
+                });
+            let got = a.last_step_jacobian().unwrap();
+            let d = (&got - &jac).amax() / (1.0 + jac.amax());
+            assert!(d <= 1e-10, "{at}: Jacobian {d:e}");
+            let rates = a.last_step_rate_integrals().unwrap();
+            for (r, got) in rates.iter().enumerate() {
+                let want: f64 = inside.iter().map(|s| s.rates[r]).sum();
+                let size: f64 = inside.iter().map(|s| s.rates[r].abs()).sum();
+                assert!(
+                    (got - want).abs() <= 1e-11 * (size + 1e-300),
+                    "{at}: rate {r}: {got} vs {want}"
+                );
+            }
+            i += 1;
+        }
+        a.form_state();
+        assert_eq!(i, steps.len(), "{at}: steps");
+        assert_eq!(a.state(), b.state(), "{at}: final state");
+        assert!(long_spans > 0, "{at}: spans of several steps");
+        assert_eq!(guarded > 0, touching, "{at}: body contact at span ends");
+    }
+}

@@ -307,6 +307,28 @@ pub trait Integrator: Send {
     }
     /// Form the plain state after [`Integrator::step_deferred`] (the default: nothing to do).
     fn form_state(&mut self) {}
+    /// One or more of the steps [`Integrator::step_deferred`] takes, reported as one step over
+    /// all of them, from the first one's start (a *span*): the span goes on while no step ends
+    /// at `tau_max` or at an event, and — given a body-contact check `body` — only while the
+    /// integrator shows, without forming the state, that no station of the beam body reaches
+    /// the substrate at any time of the span (so that a caller testing
+    /// [`BodyContactCheck::touches`] after every step tests the span's end only). After it,
+    /// the last step of the dense output, [`Integrator::last_step_rate_integrals`] and
+    /// [`Integrator::last_step_jacobian`] is the whole span. The default takes one step; the
+    /// exact propagator runs the steps of a stint in one loop (`integrate/exact/span.rs`), so
+    /// that a recorder ([`crate::trajectory::record_rows`]) works once per span instead of
+    /// once per grid step.
+    ///
+    /// # Errors
+    /// As [`Integrator::step`].
+    fn step_span(
+        &mut self,
+        tau_max: f64,
+        body: Option<&BodyContactCheck>,
+    ) -> Result<Step, SimError> {
+        let _ = body;
+        self.step_deferred(tau_max)
+    }
     /// Advance to exactly `tau_end` without observing the steps: the same steps and events as
     /// calling [`Integrator::step`] until `tau_end`, but an integrator may keep its state in an
     /// internal representation in between (the exact propagator's modal coordinates).

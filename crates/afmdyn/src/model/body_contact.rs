@@ -84,6 +84,12 @@ impl BodyContactCheck {
         1.0 - self.drive.0.abs()
     }
 
+    /// The base drive's amplitude (α2, or 0 for the point mass) and Ω: the base is
+    /// amplitude · sin Ωτ + 1.
+    pub(crate) fn drive(&self) -> (f64, f64) {
+        self.drive
+    }
+
     /// Whether a bound of Σ_j reach_j |a_j|, widened by 1e-9 (see [`BodyContactCheck::touches`]),
     /// keeps every station off the substrate.
     pub(crate) fn spared(bound: f64, base: f64) -> bool {

@@ -2,7 +2,6 @@
 //! the free flight of a law that exerts no force outside contact, restarted in a given region
 //! after an event the split integrator handled, and run until its next switching.
 
-use super::step::Form;
 use super::tip::tip_v_t;
 use super::ExactPropagator;
 use crate::contact::ContactLaw;
@@ -68,6 +67,7 @@ impl ExactPropagator {
         *self.last.q0 = super::modal::Modes::ZERO;
         self.last.modal = false;
         self.last.full = false;
+        self.last.span = false;
         self.poly_built = false;
         self.param_end = None;
     }
@@ -80,16 +80,6 @@ impl ExactPropagator {
     /// # Errors
     /// As [`crate::integrate::Integrator::step`].
     pub(crate) fn run_to_switching(&mut self, tau_end: f64) -> Result<Option<Step>, SimError> {
-        while self.tau < tau_end {
-            self.grid_run(tau_end)?;
-            if self.tau >= tau_end {
-                break;
-            }
-            let step = self.step_impl(tau_end, Form::Events)?;
-            if step.event.is_some() {
-                return Ok(Some(step));
-            }
-        }
-        Ok(None)
+        self.run_span(tau_end, f64::INFINITY)
     }
 }

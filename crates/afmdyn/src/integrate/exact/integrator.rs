@@ -5,6 +5,7 @@ use super::step::Form;
 use super::ExactPropagator;
 use crate::error::SimError;
 use crate::integrate::{Integrator, Step};
+use crate::model::BodyContactCheck;
 use crate::params::SweepParam;
 use crate::system::Region;
 use crate::tip_sample::TipSampleSystem;
@@ -43,6 +44,15 @@ impl Integrator for ExactPropagator {
 
     fn form_state(&mut self) {
         self.materialize();
+    }
+
+    // spans and what they change: `span.rs`
+    fn step_span(
+        &mut self,
+        tau_max: f64,
+        body: Option<&BodyContactCheck>,
+    ) -> Result<Step, SimError> {
+        self.step_span_impl(tau_max, body)
     }
 
     /// V_T and dV_T/dτ of the switching test at the end of the last step; W and ∂W/∂τ from the
@@ -90,17 +100,15 @@ impl Integrator for ExactPropagator {
     }
 
     fn dense_tip(&mut self, tau: f64) -> [f64; 3] {
-        let t = tau - self.last.tau0;
-        self.poly_for_last(t);
-        self.poly.w(t)
+        self.poly_for_last(tau - self.last.tau0);
+        self.poly.w(tau - self.poly.tau0)
     }
 
     /// From the tip series of the last step, whose coefficients include the harmonic part of
     /// V_T (eq. 8): no sine per call, unlike the default through [`Integrator::dense_tip`].
     fn dense_v_t(&mut self, tau: f64) -> [f64; 3] {
-        let t = tau - self.last.tau0;
-        self.poly_for_last(t);
-        self.poly.v_t(t)
+        self.poly_for_last(tau - self.last.tau0);
+        self.poly.v_t(tau - self.poly.tau0)
     }
 
     fn dense_state(&mut self, tau: f64) -> DVector<f64> {

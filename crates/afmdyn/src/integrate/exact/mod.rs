@@ -38,7 +38,7 @@
 //! **Parts.** `build.rs` (the options, the grid, the cached data), `forcing.rs` (the particular
 //! solutions, their grid tables and their cache), `state.rs` (the state between steps),
 //! `step.rs` (one step and the switching test; the search in `search.rs`), `run.rs` (runs of
-//! certified whole grid steps), `series.rs` (the last step, dense output, tip series),
+//! certified whole grid steps), `series.rs` (the last step, dense output, tip series), `span.rs` (spans of steps),
 //! `sensitivity.rs` (step Jacobians and ∂z/∂p), `bound.rs` (the displacement bound),
 //! `integrator.rs` (the [`Integrator`] implementation), `spectral.rs` and `modal.rs` (the
 //! spectral data of the region matrices, the eigendecomposition), `tip.rs` (V_T of a plain
@@ -62,6 +62,7 @@ mod sample;
 mod search;
 mod sensitivity;
 mod series;
+mod span;
 mod spectral;
 mod state;
 mod step;
@@ -201,12 +202,23 @@ pub struct ExactPropagator {
     /// The tables of the closed-form energy integrals over grid steps (`energy.rs`), built on
     /// the first request.
     energy: Option<Arc<[energy::EnergyTable; 2]>>,
-    /// The step-length factors of the modal closed form for the last (region, step length).
-    rate_cache: energy::RateCache,
     /// The column sums of [`Integrator::displacement_bound`] for the last weights.
     ///
     /// [`Integrator::displacement_bound`]: crate::integrate::Integrator::displacement_bound
     bound_cols: BoundCols,
+    /// The body-contact guard of the span being taken: the homogeneous part's bound at its
+    /// start (`span.rs`, `bound.rs`'s `StepGuard`); `None` outside a span or without a check.
+    span_guard: Option<f64>,
+    /// Whether the guard ended the span: the last step's end is not shown off the substrate.
+    guard_stopped: bool,
+    /// The modal coordinates at the start of a span ([`Integrator::step_span`], `span.rs`); they
+    /// trade places with the last step's start when the span becomes the last step.
+    ///
+    /// [`Integrator::step_span`]: crate::integrate::Integrator::step_span
+    span_q0: Box<Modes>,
+    /// The modal coordinates at the end of the last step that ended at a switching, in the
+    /// region it left (q0 e^{Λt}, formed with the switching's state).
+    q_switch: Box<Modes>,
     /// Stints entered (switchings and restarts), the stint a sample sequence belongs to.
     stints: u64,
     /// The sequence of dense samples ([`Integrator::dense_states_into`], `sample.rs`).

@@ -2,6 +2,7 @@
 //! certified test of [`RunLimits`] over the dense ([`DenseSteps`]) or the modal
 //! ([`ModalSteps`]) path, without the per-step bookkeeping of `step_impl`.
 
+use super::bound::StepGuard;
 use super::forcing::{grid_v_t, Forced};
 use super::modal::{ModalExp, Modes};
 use super::search::StepEnds;
@@ -58,8 +59,22 @@ trait GridSteps {
     /// [V_T, dV_T/dτ] at its end, given `trig` = (sin Ωτ_{k+1}, cos Ωτ_{k+1}) (the dense step
     /// forms eq. 8 with it; the modal one reads the particular part from [`grid_v_t`]'s table).
     fn try_step(&mut self, k: usize, trig: (f64, f64)) -> (f64, f64);
-    /// Take the step tried last (its start is kept as the start of the last step).
-    fn accept(&mut self);
+    /// Take the step tried last (its start is kept as the start of the last step), which ends
+    /// at grid point `k_next` (sub-step index); returns whether the run may go on after it
+    /// (false where a span's body-contact guard does not spare its end, `span.rs`).
+    fn accept(&mut self, k_next: usize) -> bool;
+}
+
+/// How a run of grid steps ended ([`RunLimits::run`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum RunEnd {
+    /// Before a step that would end off the grid or beyond the end time, or that fails the
+    /// certified test.
+    Stopped,
+    /// At the end of a period.
+    PeriodEnd,
+    /// After a step whose end the span's guard does not spare (at a period end too: `bool`).
+    Guard(bool),
 }
 
 impl RunLimits {
@@ -67,7 +82,7 @@ impl RunLimits {
     /// when it ends by `tau_end` and passes the certified test, up to the end of the current
     /// period (`trig`: sin/cos Ωτ on the grid of one period); the step loop of `step_impl` for
     /// these steps, with the same t_grid ([`PeriodGrid::tau`]) and test. Returns the start time
-    /// of the last step taken (`None`: none) and whether the run ended at the period end.
+    /// of the last step taken (`None`: none) and how the run ended.
     fn run(
         &self,
         trig: &[(f64, f64)],
@@ -75,7 +90,7 @@ impl RunLimits {
         vt: &mut (f64, f64),
         at: &mut (i64, usize),
         steps: &mut impl GridSteps,
-    ) -> (Option<f64>, bool) {
+    ) -> (Option<f64>, RunEnd) {
         let mut tau_last = None;
         loop {
             let (p, k) = *at;
@@ -87,19 +102,22 @@ impl RunLimits {
             let t_grid = next.0 as f64 * self.grid.period + next.1 as f64 * self.grid.h;
             let len = t_grid - *tau;
             if !(t_grid <= self.tau_end && len > 0.0) {
-                return (tau_last, false);
+                return (tau_last, RunEnd::Stopped);
             }
             let vt_b = steps.try_step(k, trig[k + 1]);
             if !StepEnds::new(self.sigma, self.dead, *vt, vt_b, false).certified(self.curv, len) {
-                return (tau_last, false);
+                return (tau_last, RunEnd::Stopped);
             }
-            steps.accept();
+            let go_on = steps.accept(next.1);
             tau_last = Some(*tau);
             *tau = t_grid;
             *vt = vt_b;
             *at = next;
+            if !go_on {
+                return (tau_last, RunEnd::Guard(next.1 == 0));
+            }
             if next.1 == 0 {
-                return (tau_last, true);
+                return (tau_last, RunEnd::PeriodEnd);
             }
         }
     }
@@ -130,34 +148,80 @@ impl GridSteps for DenseSteps<'_> {
             self.zb.as_mut_slice(),
         )
     }
-    fn accept(&mut self) {
+    fn accept(&mut self, _k_next: usize) -> bool {
         std::mem::swap(self.z, self.zb);
         std::mem::swap(self.dz_try, self.dz_last);
+        true
     }
 }
 
 /// Modal whole grid steps ([`ModalExp::advance_into`] with e^{Λh}): on acceptance the
 /// propagator's three boxed buffers trade places (prev ← cur ← tried ← prev, by pointer), so
 /// that after a run q holds the current modal coordinates, `last.q0` the start of the last
-/// step and the scratch the free one, without copies.
-struct ModalSteps<'a> {
+/// step and the scratch the free one, without copies; with a span's body-contact guard
+/// ([`StepGuard`]) the run stops after a step whose end it does not spare.
+struct ModalSteps<'a, G> {
     me: &'a ModalExp,
     fr: &'a Forced,
     cur: &'a mut Box<Modes>,
     tried: &'a mut Box<Modes>,
     prev: &'a mut Box<Modes>,
+    guard: G,
 }
 
-impl GridSteps for ModalSteps<'_> {
+impl<'a> ModalSteps<'a, ()> {
+    /// The same steps with a span's guard.
+    fn with_guard<G: Guard>(self, guard: G) -> ModalSteps<'a, G> {
+        let ModalSteps {
+            me,
+            fr,
+            cur,
+            tried,
+            prev,
+            ..
+        } = self;
+        ModalSteps {
+            me,
+            fr,
+            cur,
+            tried,
+            prev,
+            guard,
+        }
+    }
+}
+
+/// The guard of a run's steps: none (`()`, every step spared) or a span's [`StepGuard`].
+trait Guard {
+    /// Whether the step ending at grid point `k` with modal coordinates `q` is spared.
+    fn spared(&self, k: usize, q: &Modes) -> bool;
+}
+
+impl Guard for () {
+    #[inline(always)]
+    fn spared(&self, _k: usize, _q: &Modes) -> bool {
+        true
+    }
+}
+
+impl Guard for StepGuard<'_> {
+    #[inline(always)]
+    fn spared(&self, k: usize, q: &Modes) -> bool {
+        StepGuard::spared(self, k, q)
+    }
+}
+
+impl<G: Guard> GridSteps for ModalSteps<'_, G> {
     fn try_step(&mut self, k: usize, _trig: (f64, f64)) -> (f64, f64) {
         let tip = self
             .me
             .advance_into(self.cur, &self.fr.grid_fac, self.tried);
         grid_v_t(self.fr, k + 1, tip)
     }
-    fn accept(&mut self) {
+    fn accept(&mut self, k_next: usize) -> bool {
         std::mem::swap(self.prev, self.cur);
         std::mem::swap(self.cur, self.tried);
+        self.guard.spared(k_next, self.cur)
     }
 }
 
@@ -180,23 +244,28 @@ impl ExactPropagator {
         let ri = self.region.index();
         let modal = self.modal[ri] && self.spec[ri].modal.is_some();
         loop {
-            let at_period_end = if modal {
+            let end = if modal {
                 self.modal_run(tau_end)
             } else {
                 self.dense_run(tau_end)
             };
-            if !at_period_end {
+            if let RunEnd::Guard(_) = end {
+                self.guard_stopped = true;
+            }
+            if let RunEnd::PeriodEnd | RunEnd::Guard(true) = end {
+                self.check_divergence()?;
+            }
+            if end != RunEnd::PeriodEnd {
                 return Ok(());
             }
-            self.check_divergence()?;
         }
     }
 
     /// [`Self::grid_run`] in a dense region: z ← z_p(τ_{k+1}) + Φ_s (z − z_p(τ_k)). Returns
-    /// whether it stopped at the end of a period.
-    fn dense_run(&mut self, tau_end: f64) -> bool {
+    /// how it ended.
+    fn dense_run(&mut self, tau_end: f64) -> RunEnd {
         let Some(mut at) = self.on_grid else {
-            return false;
+            return RunEnd::Stopped;
         };
         let limits = self.run_limits(tau_end);
         let ExactPropagator {
@@ -224,24 +293,28 @@ impl ExactPropagator {
             dz_try: dz_run,
             dz_last: &mut last.dz0,
         };
-        let (ran, period_end) = limits.run(trig, tau, vt, &mut at, &mut steps);
+        let (ran, end) = limits.run(trig, tau, vt, &mut at, &mut steps);
         let Some(tau0) = ran else {
-            return false;
+            return RunEnd::Stopped;
         };
         self.finish_run(tau0, at, false);
-        period_end
+        end
     }
 
     /// [`Self::grid_run`] in a modal region: q ← e^{Λh} ⊙ q, the plain state not formed (as
-    /// `step_impl` with [`Form::Nothing`]). Returns whether it stopped at the end of a period.
+    /// `step_impl` with [`Form::Nothing`]); inside a span with a body-contact guard
+    /// (`span.rs`), up to the first step whose end the guard does not spare. Returns how it
+    /// ended.
     ///
     /// [`Form::Nothing`]: super::step::Form::Nothing
-    fn modal_run(&mut self, tau_end: f64) -> bool {
+    fn modal_run(&mut self, tau_end: f64) -> RunEnd {
         let Some(mut at) = self.on_grid else {
-            return false;
+            return RunEnd::Stopped;
         };
         let limits = self.run_limits(tau_end);
         let ExactPropagator {
+            ref bound_cols,
+            span_guard,
             ref spec,
             ref forced,
             ref trig,
@@ -255,7 +328,7 @@ impl ExactPropagator {
         } = *self;
         let ri = region.index();
         let (Some(me), fr) = (&spec[ri].modal, &forced[ri]) else {
-            return false;
+            return RunEnd::Stopped;
         };
         let mut steps = ModalSteps {
             me,
@@ -263,15 +336,20 @@ impl ExactPropagator {
             cur: q,
             tried: scratch,
             prev: &mut last.q0,
+            guard: (),
         };
-        let (ran, period_end) = limits.run(trig, tau, vt, &mut at, &mut steps);
+        // (the step loop without a guard for the runs outside a span: no test per step)
+        let (ran, end) = match span_guard.map(|stint| bound_cols.guard(ri, stint)) {
+            None => limits.run(trig, tau, vt, &mut at, &mut steps),
+            Some(g) => limits.run(trig, tau, vt, &mut at, &mut steps.with_guard(g)),
+        };
         let Some(tau0) = ran else {
-            return false;
+            return RunEnd::Stopped;
         };
         // (the runs of `advance_to` keep no tip: nobody reads it there)
         self.tip_hom = None;
         self.finish_run(tau0, at, true);
-        period_end
+        end
     }
 
     /// The limits of a run in the current stint up to `tau_end`.
@@ -291,6 +369,7 @@ impl ExactPropagator {
         self.last.tau0 = tau0;
         self.last.region = self.region;
         self.last.full = true;
+        self.last.span = false;
         self.last.modal = modal;
         self.last.k = at.1.checked_sub(1).unwrap_or(self.grid.m - 1);
         self.on_grid = Some(at);

@@ -16,7 +16,8 @@
 //!
 //! [`Integrator::dense_states_into`]: crate::integrate::Integrator::dense_states_into
 
-use super::modal::{ModalExp, Modes};
+use super::forcing::Forced;
+use super::modal::{ModalExp, Modes, Split};
 use super::ExactPropagator;
 
 /// Samples advanced by products before the sequence is anchored again.
@@ -115,8 +116,57 @@ impl ExactPropagator {
                 cur.key = key;
             }
             cur.i = i;
-            Self::zp_at(fr, cur.trig, row);
-            ModalExp::expand(&me.tv, &cur.q, row, true);
+            sample_row(fr, &me.tv, &cur.q, cur.trig, row);
         }
     }
+}
+
+/// z = z_p + Σ_k Re(b_k q_k) into `row` at (sin Ωτ, cos Ωτ) = `trig`: `zp_at` and
+/// `ModalExp::expand` (the same operations in the same order, so the same values), with the
+/// row's length fixed at compile time for N ≤ 6 (the loops unrolled: a sample is a few dozen
+/// instructions).
+#[inline(always)]
+fn sample_row(fr: &Forced, tv: &Split, q: &Modes, trig: (f64, f64), row: &mut [f64]) {
+    match row.len() {
+        2 => sample_row_fixed::<2>(fr, tv, q, trig, row),
+        4 => sample_row_fixed::<4>(fr, tv, q, trig, row),
+        6 => sample_row_fixed::<6>(fr, tv, q, trig, row),
+        8 => sample_row_fixed::<8>(fr, tv, q, trig, row),
+        10 => sample_row_fixed::<10>(fr, tv, q, trig, row),
+        12 => sample_row_fixed::<12>(fr, tv, q, trig, row),
+        _ => {
+            ExactPropagator::zp_at(fr, trig, row);
+            ModalExp::expand(tv, q, row, true);
+        }
+    }
+}
+
+/// [`sample_row`] for a row of `D` values.
+#[inline(always)]
+fn sample_row_fixed<const D: usize>(
+    fr: &Forced,
+    tv: &Split,
+    q: &Modes,
+    (s, c): (f64, f64),
+    row: &mut [f64],
+) {
+    let fixed = |v: &[f64]| -> [f64; D] { v[..D].try_into().expect("D values") };
+    let (p0, ps, pc) = (
+        fixed(fr.p0.as_slice()),
+        fixed(fr.ps.as_slice()),
+        fixed(fr.pc.as_slice()),
+    );
+    let mut o = [0.0; D];
+    for i in 0..D {
+        o[i] = p0[i] + s * ps[i] + c * pc[i];
+    }
+    let (re, im) = (tv.re.as_slice(), tv.im.as_slice());
+    for k in 0..tv.re.ncols() {
+        let (br, bi) = (fixed(&re[k * D..]), fixed(&im[k * D..]));
+        let (qr, qi) = (q.re[k], q.im[k]);
+        for i in 0..D {
+            o[i] += br[i] * qr - bi[i] * qi;
+        }
+    }
+    row.copy_from_slice(&o);
 }

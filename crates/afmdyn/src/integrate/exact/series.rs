@@ -35,6 +35,14 @@ pub(super) struct LastStep {
     pub(super) modal: bool,
     /// Whether the step was a whole grid step (its transition matrix is Φ_s).
     pub(super) full: bool,
+    /// Whether the last step is a span of several steps (`span.rs`): its tip series is built
+    /// around the time asked for, and the next three fields hold its end.
+    pub(super) span: bool,
+    /// A span's modal coordinates at its end, in its region (q0 e^{Λt}).
+    pub(super) q1: Box<Modes>,
+    /// A span's (sin Ωτ, cos Ωτ) at its start and end.
+    pub(super) trig0: (f64, f64),
+    pub(super) trig1: (f64, f64),
     /// Sub-step index of the grid point a whole grid step started from.
     pub(super) k: usize,
 }
@@ -219,35 +227,64 @@ impl ExactPropagator {
     }
 
     /// Build the tip series of the last step (unless the step built it), covering local time
-    /// t (dense output).
+    /// t (dense output). The series' own origin is `poly.tau0`: the last step's start, or for a
+    /// span (`span.rs`), longer than the series converges over, the start of a window of one
+    /// grid step centred at t, from the modal coordinates there (q0 e^{Λt}; kept while later
+    /// times fall inside it).
     pub(super) fn poly_for_last(&mut self, t: f64) {
+        if self.last.span {
+            let at = self.last.tau0 + t;
+            if !(self.poly_built && (0.0..=self.grid.h).contains(&(at - self.poly.tau0))) {
+                self.build_last_series(t, SeriesAt::Window);
+            }
+            return;
+        }
         if self.poly_built {
             return;
         }
         let step = self.tau - self.last.tau0;
-        self.build_last_series(step.max(t), t <= step);
+        self.build_last_series(
+            step.max(t),
+            if t <= step {
+                SeriesAt::Centred
+            } else {
+                SeriesAt::Start
+            },
+        );
     }
 
-    /// Build the tip series of the last step over local times [0, `len`]: for a whole modal
-    /// grid step (when `centred`), centred at its middle from the modal coordinates there
-    /// (q0 e^{Λh/2}), so that it reaches half the step; otherwise from the step's start in
-    /// energy coordinates. The switching search (`step_impl`) and dense output
+    /// Build the tip series of the last step: over local times [0, `t`] — for a whole modal
+    /// grid step ([`SeriesAt::Centred`]) centred at its middle from the modal coordinates
+    /// there (q0 e^{Λh/2}), so that it reaches half the step; otherwise from the step's start in
+    /// energy coordinates — or over the grid step centred at local time `t` of a span
+    /// ([`SeriesAt::Window`]). The switching search (`step_impl`) and dense output
     /// ([`Self::poly_for_last`]) use the same series of a step.
-    pub(super) fn build_last_series(&mut self, len: f64, centred: bool) {
+    pub(super) fn build_last_series(&mut self, t: f64, at: SeriesAt) {
         let ri = self.last.region.index();
         let dim = self.z.len();
+        let h = self.grid.h;
         let mut y0 = [0.0; MAXD];
-        let (center, start) = match (
-            &self.spec[ri].modal,
-            centred && self.last.modal && self.last.full,
-        ) {
-            (Some(me), true) => {
+        let (center, start, len) = match (&self.spec[ri].modal, at) {
+            (Some(me), SeriesAt::Window) => {
+                let mid = &mut self.scratch;
+                me.factors(t, mid);
+                mid.mul_assign(&self.last.q0, me.len());
+                let at = self.last.tau0 + t;
+                let sc = (self.model.omega() * at).sin_cos();
+                (
+                    (at - 0.5 * h, 0.5 * h, sc),
+                    SeriesStart::Modal(me, &self.scratch),
+                    h,
+                )
+            }
+            (Some(me), SeriesAt::Centred) if self.last.modal && self.last.full => {
                 let mid = &mut self.scratch;
                 mid.copy_prefix(&self.last.q0, me.len());
                 mid.mul_assign(&self.forced[ri].half_fac, me.len());
                 (
-                    (self.last.tau0, 0.5 * len, self.trig_mid[self.last.k]),
+                    (self.last.tau0, 0.5 * t, self.trig_mid[self.last.k]),
                     SeriesStart::Modal(me, &self.scratch),
+                    t,
                 )
             }
             _ => {
@@ -256,6 +293,7 @@ impl ExactPropagator {
                 (
                     (tau0, 0.0, self.trig_at(tau0)),
                     SeriesStart::Energy(&y0[..dim]),
+                    t,
                 )
             }
         };
@@ -272,4 +310,15 @@ impl ExactPropagator {
         );
         self.poly_built = true;
     }
+}
+
+/// Where [`ExactPropagator::build_last_series`] expands the last step's tip series.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum SeriesAt {
+    /// From the step's start.
+    Start,
+    /// At the middle of a whole modal grid step (else from the start).
+    Centred,
+    /// Over the grid step centred at a time inside a span.
+    Window,
 }

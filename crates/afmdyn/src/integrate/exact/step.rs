@@ -5,6 +5,7 @@ use super::forcing::{grid_v_t, modal_v_t};
 use super::modal::ModalExp;
 use super::run::dense_grid_step;
 use super::search::{Search, StepEnds};
+use super::series::SeriesAt;
 use super::tip::tip_v_t;
 use super::ExactPropagator;
 use crate::error::SimError;
@@ -79,6 +80,7 @@ impl ExactPropagator {
         self.last.tau0 = tau0;
         self.last.region = region;
         self.last.full = full;
+        self.last.span = false;
         self.last.modal = modal;
         self.last.k = k;
         let fr = &self.forced[ri];
@@ -168,7 +170,7 @@ impl ExactPropagator {
         let cheap = self.stint_curvature + self.forced[ri].vp_curv;
         let mut hit = None;
         if !ends.certified(cheap, len) {
-            self.build_last_series(len, true);
+            self.build_last_series(len, SeriesAt::Centred);
             // both bound |g''| over the step: the series' sum of absolute terms (a cosh-like
             // overestimate of an oscillation) is often the larger one
             self.poly.curv = self.poly.curv.min(cheap);
@@ -219,7 +221,18 @@ impl ExactPropagator {
                 let tau_s = tau0 + t;
                 let sc = (omega * tau_s).sin_cos();
                 let mut zs = std::mem::take(&mut self.z);
-                self.state_in_last_at(t, sc, zs.as_mut_slice());
+                match (&self.spec[ri].modal, modal) {
+                    // the state_in_last_at of a modal step, keeping q0 e^{Λt} (the same
+                    // products and sums, so the same state)
+                    (Some(me), true) => {
+                        let qs = &mut self.q_switch;
+                        me.factors(t, qs);
+                        qs.mul_assign(&self.last.q0, me.len());
+                        Self::zp_at(&self.forced[ri], sc, zs.as_mut_slice());
+                        ModalExp::expand(&me.tv, qs, zs.as_mut_slice(), true);
+                    }
+                    _ => self.state_in_last_at(t, sc, zs.as_mut_slice()),
+                }
                 self.z = zs;
                 self.stale = false;
                 let to = region.other();
