@@ -795,7 +795,8 @@ impl Jet {
                 }
             };
             s.f[k] = f;
-            // g_k = f(τ, z)_k (component-major), then z_{k+1} = 2 (w ⋆ g)_k / (k + 1)
+            // g_k = f(τ, z)_k (component-major), then z_{k+1} = 2 (w ⋆ g)_k / (k + 1): the terms
+            // of the earlier orders of g first, the newest, w₀ g_k, last
             {
                 let mut lower = [0.0; crate::params::MAX_MODES];
                 let zs = &s.z[k * d..(k + 1) * d];
@@ -806,10 +807,13 @@ impl Jet {
                 }
             }
             {
-                let wk = &s.wrev[M - 1 - k..];
-                let two = 2.0 * inv;
+                // Σ_{j=1..=k} w_j g_{k−j}: g_m pairs with w_{k−m} = wrev[M − 1 − k + m]
+                let wk = &s.wrev[M - 1 - k..M - 1];
+                let (w0, two) = (s.w[0], 2.0 * inv);
                 for i in 0..d {
-                    s.z[(k + 1) * d + i] = two * dot(&s.g[i * M..i * M + k + 1], wk);
+                    let gi = &s.g[i * M..i * M + k + 1];
+                    let old = dot(&gi[..k], wk);
+                    s.z[(k + 1) * d + i] = two * (old + w0 * gi[k]);
                 }
             }
             // sin and cos of Ωτ(σ): S′ = Ω C τ′, C′ = −Ω S τ′, τ′ = 2w
