@@ -174,3 +174,61 @@ fn taylor_passes_the_conformance_checks() {
         );
     }
 }
+
+/// A grazing contact: the free periodic orbit V_T = α5 + R cos(Ωτ − φ) (Hertz law, the sample
+/// placed so that the tip dips ε below it, ε = 1e-6 and 1e-10) enters contact within a tenth of
+/// the dip's width of where the closed-form orbit crosses V_T = 0, and leaves it again; the
+/// contact of the regularised time neither sticks nor misses the dip.
+#[test]
+fn a_grazing_contact_is_entered_and_left() {
+    let p0 = Params {
+        alpha5: 10.0,
+        contact_law: ContactLaw::Hertz,
+        ..Params::default()
+    };
+    let m0 = CantileverModel::new(&p0).unwrap();
+    // the free orbit's lowest V_T and its time, from the closed form (golden-section search)
+    let v = |t: f64| m0.v_t(t, &harmonic_response(&m0, Region::Free, t)) - 10.0;
+    let n = 2048;
+    let dt = p0.period() / n as f64;
+    let k = (0..n)
+        .min_by(|&i, &j| v(i as f64 * dt).total_cmp(&v(j as f64 * dt)))
+        .unwrap();
+    let (mut a, mut b) = (k as f64 * dt - dt, k as f64 * dt + dt);
+    let g = 0.5 * (5f64.sqrt() - 1.0);
+    for _ in 0..200 {
+        let (c, d) = (b - g * (b - a), a + g * (b - a));
+        if v(c) < v(d) {
+            b = d;
+        } else {
+            a = c;
+        }
+    }
+    let t_min = 0.5 * (a + b);
+    let r_amp = -v(t_min);
+    for eps in [1e-6, 1e-10] {
+        let p = Params {
+            alpha5: r_amp - eps,
+            ..p0
+        };
+        let m = CantileverModel::new(&p).unwrap();
+        let z0 = harmonic_response(&m, Region::Free, 0.0);
+        let mut it = build(&m, opts(IntegratorKind::Taylor, 1e-12), 0.0, &z0).unwrap();
+        let ev = events_until(it.as_mut(), p.period());
+        let curvature = p.omega * p.omega * r_amp;
+        let width = 2.0 * (2.0 * eps / curvature).sqrt();
+        assert!(ev.len() >= 2, "eps = {eps}: {} events", ev.len());
+        assert_eq!((ev[0].to, ev[1].to), (Region::Contact, Region::Free));
+        let enter = t_min - 0.5 * width;
+        assert!(
+            (ev[0].tau - enter).abs() < 0.1 * width,
+            "eps = {eps}: enters at {} (closed form {enter})",
+            ev[0].tau
+        );
+        assert!(
+            ev[1].tau > ev[0].tau && ev[1].tau - ev[0].tau < 2.0 * width,
+            "eps = {eps}: leaves at {}",
+            ev[1].tau
+        );
+    }
+}
