@@ -605,7 +605,72 @@ impl Jet {
     /// The series of the free flight from (τ₀, z₀) in τ − τ₀ to order `p` (with Φ(τ₀) = I when
     /// `variational`), into `s`.
     pub(crate) fn free(&self, s: &mut Series, t0: f64, z0: &[f64], variational: bool, p: usize) {
+        if let (1, false, Law::Dmt { h, a0, .. }) = (self.n, variational, self.law) {
+            return self.free_point_mass_dmt(s, t0, z0, p, h, a0);
+        }
         with_width!(self.n, w => self.free_w(w, s, t0, z0, variational, p))
+    }
+
+    /// [`Jet::free`] of one mode with the DMT law, without the variational equations (the
+    /// point-mass model's free flight, the path of `simulate`): the same recurrences as
+    /// [`Jet::free_w`] with the state's two coefficients in registers.
+    fn free_point_mass_dmt(&self, s: &mut Series, t0: f64, z0: &[f64], p: usize, h: f64, a0: f64) {
+        let (sn, cs) = s.start(p, 2, false, Region::Free, t0, z0, self.omega);
+        let quarter = [(sn, cs), (cs, -sn), (-sn, -cs), (-cs, sn)];
+        for k in 0..=p {
+            let (a, b) = quarter[k & 3];
+            let f = self.trig_factor[k];
+            s.s[k] = f * a;
+            s.c[k] = f * b;
+        }
+        let (phi, ak, ac, m) = (self.phi[0], self.ak[0], self.ac[0], self.mphi[0]);
+        let (b0, bs, bc) = (self.b_const[0], self.b_sin[0], self.b_cos[0]);
+        let (mut x, mut v) = (z0[0], z0[1]);
+        let mut u0 = 0.0;
+        for k in 0..=p {
+            let vt = phi * x + self.base * s.s[k] + if k == 0 { self.alpha5 } else { 0.0 };
+            s.v[k] = vt;
+            if k == p {
+                break;
+            }
+            // u = 1/d, d = V_T + ã₀, from u·d = 1; then u²: the newest terms last
+            let (uk, u2k) = if k == 0 {
+                u0 = 1.0 / (vt + a0);
+                (u0, u0 * u0)
+            } else {
+                // Σ_{j=1..k−1} v_j u_{k−j} with u_{k−1}, the latest, added last
+                let old = if k >= 2 {
+                    dot(&s.v[2..k], &s.urev[M - k + 1..M - 1]) + s.v[1] * s.u[k - 1]
+                } else {
+                    0.0
+                };
+                let uk = -(old + vt * u0) * u0;
+                let half = k.div_ceil(2);
+                // Σ_{0<j<half} u_j u_{k−j}, u_1 u_{k−1} last
+                let old2 = if half >= 2 {
+                    dot(&s.u[2..half], &s.urev[M - k + 1..M - 1 - k + half]) + s.u[1] * s.u[k - 1]
+                } else {
+                    0.0
+                };
+                let mid = if k.is_multiple_of(2) {
+                    s.u[k / 2] * s.u[k / 2]
+                } else {
+                    0.0
+                };
+                (uk, 2.0 * (old2 + u0 * uk) + mid)
+            };
+            s.u[k] = uk;
+            s.urev[M - 1 - k] = uk;
+            s.u2[k] = u2k;
+            let f = -h * u2k;
+            s.f[k] = f;
+            let inv = 1.0 / (k + 1) as f64;
+            let forcing = if k == 0 { b0 } else { 0.0 } + bs * s.s[k] + bc * s.c[k];
+            let (xn, vn) = (v * inv, (ak * x + ac * v + forcing + m * f) * inv);
+            s.z[2 * k + 2] = xn;
+            s.z[2 * k + 3] = vn;
+            (x, v) = (xn, vn);
+        }
     }
 
     fn free_w<W: Width>(
