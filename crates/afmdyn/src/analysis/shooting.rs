@@ -105,6 +105,70 @@ pub fn shoot_with(
     n: usize,
     opts: &ShootingOptions,
 ) -> Result<PeriodicOrbit, SimError> {
+    let (z, map, residuals) = newton(integ, guess, n, opts, Damping::Halve)?;
+    finish(integ, z, n, map, residuals)
+}
+
+/// A period-n orbit from [`shoot_undamped`]: what a stepped sweep keeps of it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ShotOrbit {
+    /// State at τ = 0 (drive phase 0), shape `[2N]`.
+    pub state: DVector<f64>,
+    /// Floquet multipliers, sorted by decreasing modulus.
+    pub multipliers: Vec<Complex<f64>>,
+    /// All multipliers inside the unit circle.
+    pub stable: bool,
+    /// ‖F‖ after each Newton iteration.
+    pub residuals: Vec<f64>,
+}
+
+/// Newton for F(z) = Pⁿ(z) − z from a guess close to the orbit (a predictor along a branch),
+/// without damping: a full Newton step that does not lower ‖F‖ ends the solve with
+/// [`SimError::NoConvergence`] at once — from a close guess it means the orbit is not there
+/// (it vanished at a fold between the guess's parameter and this one), and a caller that
+/// halves its parameter step gains nothing from the 10 halvings of a damped step (each a
+/// flow). Only the multipliers of the converged orbit are formed: no section points and no
+/// distance to grazing (the flows of [`shoot_with`]'s `finish`). The iterates and the
+/// converged orbit are those of [`shoot_with`] from the same guess whenever it takes full
+/// steps.
+///
+/// # Errors
+/// [`SimError::NoConvergence`] as above or after `opts.max_iter` iterations; [`SimError`] from
+/// the propagator.
+pub fn shoot_undamped(
+    integ: &mut dyn Integrator,
+    guess: &DVector<f64>,
+    n: usize,
+    opts: &ShootingOptions,
+) -> Result<ShotOrbit, SimError> {
+    let (state, map, residuals) = newton(integ, guess, n, opts, Damping::Stop)?;
+    let (multipliers, stable, _) = floquet_stability(&map.jacobian);
+    Ok(ShotOrbit {
+        state,
+        multipliers,
+        stable,
+        residuals,
+    })
+}
+
+/// What [`newton`] does with a full step that does not lower ‖F‖.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Damping {
+    /// Halve it until ‖F‖ drops, down to 1e-3 of the step.
+    Halve,
+    /// Stop: the solve fails.
+    Stop,
+}
+
+/// The Newton iteration of [`shoot_with`] and [`shoot_undamped`]: the converged z, its map
+/// (unwatched: no grazing searches) and the residuals.
+fn newton(
+    integ: &mut dyn Integrator,
+    guess: &DVector<f64>,
+    n: usize,
+    opts: &ShootingOptions,
+    damping: Damping,
+) -> Result<(DVector<f64>, FlowMap, Vec<f64>), SimError> {
     if n == 0 {
         return Err(SimError::out_of_range("period", n, "must be >= 1"));
     }
@@ -112,13 +176,14 @@ pub fn shoot_with(
     let dim = guess.len();
     let mut z = guess.clone();
     let mut residuals = Vec::new();
-    // the iterates without the grazing searches; the converged orbit gets them in `finish`
+    // the iterates without the grazing searches (`shoot_with`'s `finish` gives the converged
+    // orbit its distance to grazing)
     let mut map = stroboscopic_unwatched(integ, &z, n)?;
     let mut res = (&map.state - &z).norm();
     for _ in 0..opts.max_iter {
         residuals.push(res);
         if res <= opts.tol * (1.0 + z.norm()) {
-            return finish(integ, z, n, map, residuals);
+            return Ok((z, map, residuals));
         }
         let a = &map.jacobian - DMatrix::identity(dim, dim);
         let delta = a
@@ -134,6 +199,7 @@ pub fn shoot_with(
         loop {
             let trial = &z + &delta * lambda;
             // a trial the map cannot start from (e.g. inside a rigid sample) is a failed trial
+            let last = lambda < 1e-3 || damping == Damping::Stop;
             match stroboscopic_unwatched(integ, &trial, n) {
                 Ok(tmap) => {
                     let tres = (&tmap.state - &trial).norm();
@@ -143,8 +209,15 @@ pub fn shoot_with(
                         res = tres;
                         break;
                     }
+                    if last {
+                        return Err(SimError::NoConvergence {
+                            what: "shooting (a full Newton step did not lower the residual)",
+                            iterations: residuals.len(),
+                            residual: res,
+                        });
+                    }
                 }
-                Err(e) if lambda < 1e-3 => return Err(e),
+                Err(e) if last => return Err(e),
                 Err(_) => {}
             }
             lambda *= 0.5;
@@ -152,7 +225,7 @@ pub fn shoot_with(
     }
     residuals.push(res);
     if res <= opts.tol * (1.0 + z.norm()) {
-        return finish(integ, z, n, map, residuals);
+        return Ok((z, map, residuals));
     }
     Err(SimError::NoConvergence {
         what: "shooting",

@@ -33,7 +33,7 @@ use super::continuation::{
 use super::monodromy::stroboscopic;
 use super::observables::{observe, ObservableOptions, Observables};
 use super::progress::Progress;
-use super::shooting::{shoot_with, ShootingOptions};
+use super::shooting::{shoot_undamped, shoot_with, ShootingOptions};
 use super::steady::{steady_state, SteadyOptions};
 use crate::error::SimError;
 use crate::integrate::{advance, build, Integrator, IntegratorOptions};
@@ -452,7 +452,9 @@ fn integrator_at(
 pub const SUBSTEP_DEPTH: usize = 8;
 
 /// Follow the stable period-n orbit `z0` at `v0` to `v1` by Newton (from the secant prediction
-/// `z0 + slope (v1 − v0)`, then from `z0`): accepted when stable and within `jump_tol` of `z0`.
+/// `z0 + slope (v1 − v0)`, then from `z0`; undamped, [`shoot_undamped`]: a full step that does
+/// not lower the residual means the orbit is not near, and halving the parameter step is the
+/// remedy): accepted when stable and within `jump_tol` of `z0`.
 /// Otherwise the step is halved (up to `depth` times) and each half continued in turn — a
 /// quasi-static sweep — unless three halvings in a row did not shrink the distance to the stable
 /// orbit Newton found below 0.95 of the distance over the longer step (`whole`: that distance
@@ -478,7 +480,7 @@ fn continue_orbit(
     guesses.push(z0.clone());
     let mut gap: Option<f64> = None;
     for g in &guesses {
-        if let Ok(o) = shoot_with(integ.as_mut(), g, n, &spec.newton) {
+        if let Ok(o) = shoot_undamped(integ.as_mut(), g, n, &spec.newton) {
             if o.stable {
                 let d = relative_gap(&o.state, z0);
                 if d <= spec.jump_tol {
