@@ -6,11 +6,12 @@
 //! condition tᵀ(y − y_pred) = 0 (Keller 1977; Seydel, *Practical Bifurcation and Stability
 //! Analysis*, 3rd ed., Springer 2010, ch. 4). ∂F/∂z = M − I with M the monodromy matrix;
 //! ∂F/∂p from the parameter sensitivity along the same flow where the integrator provides it
-//! (the exact propagator for Ω, α2, α5: [`stroboscopic_with_param_derivative`]), else by central
-//! differences of the map. Test functions between accepted points: dp/ds
-//! (fold), det(M + I) (period doubling), the number of complex multipliers outside the unit
-//! circle (Neimark–Sacker) and the number of switchings per cycle (grazing); each sign change
-//! is located by bisection on the arclength step.
+//! (the exact propagator for Ω, α2, α5: [`stroboscopic_with_param_derivative`]), else by a
+//! one-sided difference of the map (one flow more per corrector iterate). Test functions
+//! between accepted points: dp/ds (fold), det(M + I) (period doubling), the number of complex
+//! multipliers outside the unit circle (Neimark–Sacker) and the number of switchings per cycle
+//! (grazing); each sign change is located on the arclength step, by bisection for the counts
+//! and by the Illinois secant for the two smooth test functions.
 
 use super::monodromy::{
     flow_state, grazing_distance, stroboscopic, stroboscopic_with_param_derivative,
@@ -309,11 +310,12 @@ impl Solver {
         grazing_distance(integ, 0.0, z, t)
     }
 
-    /// ∂Pⁿ/∂p at (z, p): that of `map` when known, else central differences.
+    /// ∂Pⁿ/∂p at (z, p): that of `map` (the map at (z, p)) when known, else finite
+    /// differences ([`Solver::dp`]).
     fn dp_of(&mut self, map: &FlowMap, z: &DVector<f64>, p: f64) -> Result<DVector<f64>, SimError> {
         match &map.param_derivative {
             Some(d) => Ok(d.clone()),
-            None => self.dp(z, p),
+            None => self.dp(z, p, &map.state),
         }
     }
 
@@ -325,29 +327,25 @@ impl Solver {
         flow_state(integ, 0.0, z, t)
     }
 
-    /// ∂Pⁿ/∂p by central differences; one-sided (first order) at the edge of the parameter's
-    /// valid range, so that a branch continued up to a limit (Ω = 1e5, say) never evaluates the
-    /// model at a value the user did not give and the validation refuses.
-    fn dp(&mut self, z: &DVector<f64>, p: f64) -> Result<DVector<f64>, SimError> {
+    /// ∂Pⁿ/∂p by a one-sided difference from `here` = Pⁿ(z) at p (the state of the map the
+    /// caller has: the same steps, so the difference is smooth in p), with step
+    /// δ = 1e-6 max(|p|, 1): one more flow. Forward, backward at the upper edge of the
+    /// parameter's valid range, so that a branch continued up to a limit (Ω = 1e5, say) never
+    /// evaluates the model at a value the user did not give and the validation refuses. Its
+    /// error δ|∂²P/∂p²|/2 (a central difference would cost two flows) is far below what the
+    /// corrector's Newton matrix and the tangent need: neither the converged points (zeros of
+    /// F) nor the folds (where M − I is singular) depend on it.
+    fn dp(
+        &mut self,
+        z: &DVector<f64>,
+        p: f64,
+        here: &DVector<f64>,
+    ) -> Result<DVector<f64>, SimError> {
         let d = 1e-6 * p.abs().max(1.0);
         let valid = |q: f64| self.spec.base.with(self.spec.param, q).validate().is_ok();
-        match (valid(p + d), valid(p - d)) {
-            (false, true) => {
-                let here = self.map_state(z, p)?;
-                let minus = self.map_state(z, p - d)?;
-                Ok((here - minus) / d)
-            }
-            (true, false) => {
-                let plus = self.map_state(z, p + d)?;
-                let here = self.map_state(z, p)?;
-                Ok((plus - here) / d)
-            }
-            _ => {
-                let plus = self.map_state(z, p + d)?;
-                let minus = self.map_state(z, p - d)?;
-                Ok((plus - minus) / (2.0 * d))
-            }
-        }
+        let h = if valid(p + d) { d } else { -d };
+        let other = self.map_state(z, p + h)?;
+        Ok((other - here) / h)
     }
 
     /// Bordered Jacobian [[M − I, F_p], [tᵀ]].
@@ -392,7 +390,7 @@ impl Solver {
     ) -> Result<(DVector<f64>, FlowMap, usize, DVector<f64>), SimError> {
         let dim = y_pred.len() - 1;
         let mut y = y_pred.clone();
-        // ∂F/∂p of the previous iterate (central differences are not redone at convergence)
+        // ∂F/∂p of the previous iterate (finite differences are not redone at convergence)
         let mut fp_prev: Option<DVector<f64>> = None;
         // the iterates skip the grazing searches (a fifth of a map) except the one expected to
         // converge, after a correction that Newton's quadratic rate makes the last; the
@@ -414,7 +412,7 @@ impl Solver {
                 let fp = match (&map.param_derivative, fp_prev) {
                     (Some(d), _) => d.clone(),
                     (None, Some(fp)) => fp,
-                    (None, None) => self.dp(&z, p)?,
+                    (None, None) => self.dp(&z, p, &map.state)?,
                 };
                 return Ok((y, map, it, fp));
             }
@@ -512,6 +510,84 @@ fn which(e: BranchEvent, t: &(f64, f64, usize, usize), a: &(f64, f64, usize, usi
         BranchEvent::PeriodDoubling => t.1 * a.1.signum(),
         BranchEvent::NeimarkSacker => same(t.2, a.2),
         BranchEvent::Grazing => same(t.3, a.3),
+    }
+}
+
+/// Whether the test function of event `e` is a smooth function of the arclength (dp/ds and
+/// det(M + I)) rather than a count.
+fn smooth(e: BranchEvent) -> bool {
+    matches!(e, BranchEvent::Fold | BranchEvent::PeriodDoubling)
+}
+
+/// The bracket [a, b] of the arclength step that holds a sign change of an event's test
+/// function (f(a) with the sign of the previous point, f(b) the other), shrunk by
+/// [`Bracket::next`] and [`Bracket::update`]: for a smooth test function the next point is the
+/// secant (regula falsi) point of the ends, the value at an end kept twice in a row halved
+/// (the Illinois method: Dowell & Jarratt, *BIT* 11 (1971) 168, superlinear), else the
+/// midpoint; either way a step that has not halved the bracket since the one before is
+/// followed by a midpoint, so the bracket shrinks at least as fast as by bisection every
+/// second step, also where the function jumps (a sign change of dp/ds at a non-smooth point).
+#[derive(Debug, Clone, Copy)]
+struct Bracket {
+    a: f64,
+    b: f64,
+    fa: f64,
+    fb: f64,
+    secant: bool,
+    /// The end kept by the last update (−1: a, +1: b, 0: none yet).
+    kept: i8,
+    /// The widths before the last two updates (older first).
+    widths: [f64; 2],
+}
+
+impl Bracket {
+    fn new(ds: f64, fa: f64, fb: f64, secant: bool) -> Self {
+        Bracket {
+            a: 0.0,
+            b: ds,
+            fa,
+            fb,
+            secant,
+            kept: 0,
+            widths: [f64::INFINITY; 2],
+        }
+    }
+
+    fn width(&self) -> f64 {
+        self.b - self.a
+    }
+
+    /// The next point strictly inside (a, b).
+    fn next(&self) -> f64 {
+        let (a, b, w) = (self.a, self.b, self.width());
+        let halved = w <= 0.5 * self.widths[0];
+        if self.secant && halved && self.fa.is_finite() && self.fb.is_finite() {
+            let x = b - self.fb * w / (self.fb - self.fa);
+            if x > a && x < b {
+                return x;
+            }
+        }
+        0.5 * (a + b)
+    }
+
+    /// Account for f(x) = `fx`; `true` when x became the a end (f with the sign of f(a)).
+    fn update(&mut self, x: f64, fx: f64) -> bool {
+        self.widths = [self.widths[1], self.width()];
+        let at_a = fx.signum() == self.fa.signum();
+        if at_a {
+            (self.a, self.fa) = (x, fx);
+            if self.kept == 1 {
+                self.fb *= 0.5;
+            }
+            self.kept = 1;
+        } else {
+            (self.b, self.fb) = (x, fx);
+            if self.kept == -1 {
+                self.fa *= 0.5;
+            }
+            self.kept = -1;
+        }
+        at_a
     }
 }
 
@@ -632,12 +708,14 @@ pub fn continue_branch_with(
             continue;
         }
         if let Some(ev) = event {
-            // locate by bisection on the step from the previous point
+            // locate on the step from the previous point: the bracket [a, b] of arclength
+            // shrunk to 1e-7 (1 + |s|), by bisection for the counts and, for the smooth test
+            // functions, by the secant through the bracket's ends (Illinois)
             let f0 = which(ev, &tf, &tf);
-            let (mut a, mut b) = (0.0, ds);
+            let mut bracket = Bracket::new(ds, f0, which(ev, &tf_new, &tf), smooth(ev));
             let mut best: Option<BranchPoint> = None;
             for _ in 0..30 {
-                let mid = 0.5 * (a + b);
+                let mid = bracket.next();
                 let Ok((ym, mm, _, fpm)) = solver.correct(&(&y + &t * mid), &t) else {
                     break;
                 };
@@ -648,14 +726,11 @@ pub fn continue_branch_with(
                     &tests(&tm, &mm.jacobian, &pm.multipliers, mm.switchings),
                     &tf,
                 );
-                if fm.signum() == f0.signum() {
-                    a = mid;
-                } else {
-                    b = mid;
+                if !bracket.update(mid, fm) {
                     pm.event = Some(ev);
                     best = Some(pm);
                 }
-                if b - a <= 1e-7 * (1.0 + s.abs()) {
+                if bracket.width() <= 1e-7 * (1.0 + s.abs()) {
                     break;
                 }
             }
