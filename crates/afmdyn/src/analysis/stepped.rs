@@ -15,7 +15,8 @@
 //! motion is integrated from the previous end state in chunks of drive periods, Newton being
 //! retried from the transient until the trajectory is seen to approach a stable orbit
 //! ([`settle`]); a motion that never settles on a period-n orbit is classified by
-//! [`super::steady::steady_state`].
+//! [`super::steady::steady_state`], the whole transient of the point within its
+//! [`transient_cap`].
 //!
 //! **Branches.** The periodic-orbit branches through both ends of the range — the two sweeps'
 //! first orbits, and at each end the orbit Newton finds from the other end's (the other regime,
@@ -35,10 +36,13 @@ use super::observables::{observe, ObservableOptions, Observables};
 use super::progress::Progress;
 use super::shooting::{shoot_undamped, shoot_with, ShootingOptions};
 use super::steady::{steady_state, SteadyOptions};
+use crate::eigen::damped_eigenvalues;
 use crate::error::SimError;
+use crate::galerkin::Region;
 use crate::integrate::{advance, build, Integrator, IntegratorOptions};
 use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
+use crate::tip_sample::TipSampleSystem;
 use nalgebra::{Complex, DVector};
 use serde::Serialize;
 
@@ -137,8 +141,9 @@ pub struct SteppedSpec {
     /// from the secant prediction Newton converges in ~3; one that has not converged by 6 is
     /// stalled at a non-smooth point or far from the orbit, and a halved step is cheaper).
     pub newton: ShootingOptions,
-    /// Classification of a motion that does not settle on an orbit (`max_periods` also caps
-    /// the transient of [`settle`]).
+    /// Classification of a motion that does not settle on an orbit; `max_periods` is the most
+    /// drive periods of transient a point may take, [`settle`] and classification together
+    /// (less where the damping is strong: [`transient_cap`]).
     pub steady: SteadyOptions,
     /// Drive periods between Newton attempts while settling.
     pub chunk_periods: usize,
@@ -317,6 +322,43 @@ pub struct Found {
     pub stable: bool,
 }
 
+/// Fewest drive periods of transient a point of a stepped sweep may take ([`transient_cap`]).
+pub const MIN_TRANSIENT_PERIODS: usize = 5_000;
+
+/// Decay times of the slowest free mode in a point's transient cap ([`transient_cap`]).
+pub const TRANSIENT_DECAY_TIMES: f64 = 9.0;
+
+/// The drive periods of transient a point of a stepped sweep may take, [`settle`] and the
+/// classification by [`steady_state`] together: [`TRANSIENT_DECAY_TIMES`] times the periods
+/// the slowest free mode of the cantilever (damped eigenvalue λ with the smallest |Re λ|,
+/// eqs. 20–21) takes to decay by the period search's tolerance, ln(1/tol)/(|Re λ| T), within
+/// [[`MIN_TRANSIENT_PERIODS`], `spec.steady.max_periods`]; `spec.steady.max_periods` for a
+/// system that is not the cantilever model. At Q = 400 (ln(1e8) Q/π = 2 345 periods) it is
+/// `max_periods` (20 000 by default), as before; a model with strong damping, whose transients
+/// onto an orbit take a few hundred periods (the default beam, Q ≈ 42: 248), has the floor.
+/// A motion still unsettled after the cap is classified nonperiodic: near the edge of a
+/// periodic window in a chaotic band that is a matter of the start state — the default
+/// resonance curve's classification there changes with round-off-level changes of its start
+/// — which no cap removes, while each nonperiodic point costs the whole cap.
+pub fn transient_cap(system: &dyn TipSampleSystem, spec: &SteppedSpec) -> usize {
+    let cap = spec.steady.max_periods;
+    let Some(model) = system.cantilever() else {
+        return cap;
+    };
+    let g = model.galerkin().region(Region::Free);
+    let slowest = damped_eigenvalues(g)
+        .iter()
+        .map(|e| e.re.abs())
+        .fold(f64::INFINITY, f64::min);
+    let per_period = slowest * model.period();
+    let decay = (1.0 / spec.steady.tol).ln() / per_period;
+    if !(decay.is_finite() && decay > 0.0) {
+        return cap;
+    }
+    let periods = (TRANSIENT_DECAY_TIMES * decay).ceil();
+    (periods.min(cap as f64) as usize).max(MIN_TRANSIENT_PERIODS.min(cap))
+}
+
 /// Integrate from `z0` (τ = 0) at the integrator's parameters until the motion settles: every
 /// `spec.chunk_periods` periods Newton is tried from the current state (period `n`); a stable
 /// orbit it finds is accepted once the trajectory has come closer to it over two further chunks
@@ -325,7 +367,7 @@ pub struct Found {
 /// attractor the motion goes to, not another orbit Newton happened to reach. After a failed
 /// attempt the next one waits 1.5 times as many chunks. After [`NEWTON_CHUNKS`] chunks without
 /// that, the motion is classified by [`steady_state`] within `spec.steady` (a period-m orbit is
-/// then polished by Newton).
+/// then polished by Newton), over the periods of the point's [`transient_cap`] not yet spent.
 ///
 /// # Errors
 /// [`SimError`] from the integrator.
@@ -342,7 +384,8 @@ pub fn settle(
     let mut candidate: Option<Candidate> = None;
     // Newton from the transient for at most NEWTON_CHUNKS chunks, then classification; after a
     // failed attempt the next one waits 1.5 times longer
-    let newton_periods = spec.steady.max_periods.min(NEWTON_CHUNKS * chunk);
+    let cap = transient_cap(integ.system(), spec);
+    let newton_periods = cap.min(NEWTON_CHUNKS * chunk);
     let (mut chunks, mut next_try, mut wait) = (0usize, 1usize, 1.0f64);
     while elapsed < newton_periods {
         integ.set_variational(false);
@@ -393,7 +436,11 @@ pub fn settle(
     // no settling on a period-n orbit: classify the motion
     integ.set_variational(false);
     integ.reset(0.0, &x)?;
-    let s = steady_state(integ, &spec.steady)?;
+    let steady = SteadyOptions {
+        max_periods: cap.saturating_sub(elapsed).max(1),
+        ..spec.steady
+    };
+    let s = steady_state(integ, &steady)?;
     if let Some(m) = s.period() {
         if let Ok(o) = shoot_with(integ, s.end_state(), m, &spec.newton) {
             if o.stable {
@@ -922,4 +969,46 @@ pub fn is_fixed_point(
     let mut integ = integrator_at(spec, value, z)?;
     let m = stroboscopic(integ.as_mut(), z, n)?;
     Ok((&m.state - z).norm() <= tol * (1.0 + z.norm()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::params::Structure;
+
+    /// The transient cap of the point-mass model z'' + α3 z' + z = … (damped eigenvalue
+    /// −α3/2 ± i√(1 − α3²/4)) against its closed form 9 ln(1/tol)/((α3/2) 2π/Ω), within
+    /// [5 000, max_periods]: Q = 400 takes the old cap of 20 000, Q = 200 the closed form,
+    /// Q = 42 the floor; a cap below the floor is kept.
+    #[test]
+    fn the_transient_cap_is_nine_decay_times_of_the_slowest_mode() {
+        for (q, omega) in [(400.0, 1.0), (200.0, 1.0), (200.0, 1.3), (42.0, 1.0)] {
+            let p = Params {
+                structure: Structure::PointMass,
+                modes: 1,
+                alpha1: 0.0,
+                alpha3: 1.0 / q,
+                omega,
+                ..Params::default()
+            };
+            let spec = SteppedSpec::new(p, SweepParam::Alpha5, vec![0.0, 0.1]);
+            let model = CantileverModel::new(&p).unwrap();
+            let integ = build(&model, spec.integrator, 0.0, &model.rest()).unwrap();
+            let decay = (1e8f64).ln() / (0.5 / q * std::f64::consts::TAU / omega);
+            let want = (9.0 * decay).ceil().clamp(5000.0, 20_000.0);
+            let got = transient_cap(integ.system(), &spec) as f64;
+            assert!(
+                (got - want).abs() <= 1.0,
+                "Q = {q}, Ω = {omega}: {got} vs {want}"
+            );
+            let low = SteppedSpec {
+                steady: SteadyOptions {
+                    max_periods: 3000,
+                    ..spec.steady
+                },
+                ..spec.clone()
+            };
+            assert_eq!(transient_cap(integ.system(), &low), 3000);
+        }
+    }
 }
