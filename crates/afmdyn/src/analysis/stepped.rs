@@ -360,7 +360,9 @@ pub fn transient_cap(system: &dyn TipSampleSystem, spec: &SteppedSpec) -> usize 
 }
 
 /// Integrate from `z0` (τ = 0) at the integrator's parameters until the motion settles: every
-/// `spec.chunk_periods` periods Newton is tried from the current state (period `n`); a stable
+/// `spec.chunk_periods` periods Newton is tried from the current state (period `n`; undamped,
+/// [`shoot_undamped`]: from a transient far from the orbit the damped iteration's halvings
+/// rarely converge and each costs a flow, and the next attempt starts nearer); a stable
 /// orbit it finds is accepted once the trajectory has come closer to it over two further chunks
 /// and within [`SETTLED`] of it, or has twice come closer at the rate of the orbit's leading
 /// Floquet multiplier (the linear regime around it), or has arrived on it — so it is the
@@ -418,7 +420,7 @@ pub fn settle(
         if chunks < next_try {
             continue;
         }
-        match shoot_with(integ, &x, n, &spec.newton) {
+        match shoot_undamped(integ, &x, n, &spec.newton) {
             Ok(o) if o.stable => {
                 candidate = Some(Candidate {
                     distance: (&x - &o.state).norm(),
