@@ -6,8 +6,8 @@
 //! condition tᵀ(y − y_pred) = 0 (Keller 1977; Seydel, *Practical Bifurcation and Stability
 //! Analysis*, 3rd ed., Springer 2010, ch. 4). ∂F/∂z = M − I with M the monodromy matrix;
 //! ∂F/∂p from the parameter sensitivity along the same flow where the integrator provides it
-//! (the exact propagator for Ω, α2, α5: [`stroboscopic_with_param_derivative`]), else by a
-//! one-sided difference of the map (one flow more per corrector iterate). Test functions
+//! (the exact propagator for Ω, α2, α5: [`stroboscopic_with_param_derivative`]), else by central
+//! differences of the map, by flows without the variational equations. Test functions
 //! between accepted points: dp/ds (fold), det(M + I) (period doubling), the number of complex
 //! multipliers outside the unit circle (Neimark–Sacker) and the number of switchings per cycle
 //! (grazing); each sign change is located on the arclength step, by bisection for the counts
@@ -310,16 +310,15 @@ impl Solver {
         grazing_distance(integ, 0.0, z, t)
     }
 
-    /// ∂Pⁿ/∂p at (z, p): that of `map` (the map at (z, p)) when known, else finite
-    /// differences ([`Solver::dp`]).
+    /// ∂Pⁿ/∂p at (z, p): that of `map` when known, else central differences.
     fn dp_of(&mut self, map: &FlowMap, z: &DVector<f64>, p: f64) -> Result<DVector<f64>, SimError> {
         match &map.param_derivative {
             Some(d) => Ok(d.clone()),
-            None => self.dp(z, p, &map.state),
+            None => self.dp(z, p),
         }
     }
 
-    /// Pⁿ(z) alone (the state of [`Solver::map`] without the monodromy matrix).
+    /// Pⁿ(z) alone, by a flow without the variational equations ([`flow_state`]).
     fn map_state(&mut self, z: &DVector<f64>, p: f64) -> Result<DVector<f64>, SimError> {
         let t = self.spec.period as f64;
         let integ = self.at(p)?;
@@ -327,25 +326,31 @@ impl Solver {
         flow_state(integ, 0.0, z, t)
     }
 
-    /// ∂Pⁿ/∂p by a one-sided difference from `here` = Pⁿ(z) at p (the state of the map the
-    /// caller has: the same steps, so the difference is smooth in p), with step
-    /// δ = 1e-6 max(|p|, 1): one more flow. Forward, backward at the upper edge of the
-    /// parameter's valid range, so that a branch continued up to a limit (Ω = 1e5, say) never
-    /// evaluates the model at a value the user did not give and the validation refuses. Its
-    /// error δ|∂²P/∂p²|/2 (a central difference would cost two flows) is far below what the
-    /// corrector's Newton matrix and the tangent need: neither the converged points (zeros of
-    /// F) nor the folds (where M − I is singular) depend on it.
-    fn dp(
-        &mut self,
-        z: &DVector<f64>,
-        p: f64,
-        here: &DVector<f64>,
-    ) -> Result<DVector<f64>, SimError> {
+    /// ∂Pⁿ/∂p by central differences of flows without the variational equations (two flows
+    /// whose steps are chosen alike, each a seventh of a variational flow at N = 3 for the
+    /// adaptive integrator); one-sided (first order) at the edge of the parameter's valid
+    /// range, so that a branch continued up to a limit (Ω = 1e5, say) never evaluates the
+    /// model at a value the user did not give and the validation refuses.
+    fn dp(&mut self, z: &DVector<f64>, p: f64) -> Result<DVector<f64>, SimError> {
         let d = 1e-6 * p.abs().max(1.0);
         let valid = |q: f64| self.spec.base.with(self.spec.param, q).validate().is_ok();
-        let h = if valid(p + d) { d } else { -d };
-        let other = self.map_state(z, p + h)?;
-        Ok((other - here) / h)
+        match (valid(p + d), valid(p - d)) {
+            (false, true) => {
+                let here = self.map_state(z, p)?;
+                let minus = self.map_state(z, p - d)?;
+                Ok((here - minus) / d)
+            }
+            (true, false) => {
+                let plus = self.map_state(z, p + d)?;
+                let here = self.map_state(z, p)?;
+                Ok((plus - here) / d)
+            }
+            _ => {
+                let plus = self.map_state(z, p + d)?;
+                let minus = self.map_state(z, p - d)?;
+                Ok((plus - minus) / (2.0 * d))
+            }
+        }
     }
 
     /// Bordered Jacobian [[M − I, F_p], [tᵀ]].
@@ -412,7 +417,7 @@ impl Solver {
                 let fp = match (&map.param_derivative, fp_prev) {
                     (Some(d), _) => d.clone(),
                     (None, Some(fp)) => fp,
-                    (None, None) => self.dp(&z, p, &map.state)?,
+                    (None, None) => self.dp(&z, p)?,
                 };
                 return Ok((y, map, it, fp));
             }
