@@ -34,16 +34,16 @@ use super::continuation::{
 use super::monodromy::stroboscopic;
 use super::observables::{observe, ObservableOptions, Observables};
 use super::progress::Progress;
-use super::shooting::{shoot_undamped, shoot_with, ShootingOptions};
+use super::shooting::{shoot_broyden, shoot_undamped, shoot_with, ShootingOptions, ShotOrbit};
 use super::steady::{steady_state, SteadyOptions};
 use crate::eigen::damped_eigenvalues;
 use crate::error::SimError;
 use crate::galerkin::Region;
-use crate::integrate::{advance, build, Integrator, IntegratorOptions};
+use crate::integrate::{advance, build, Integrator, IntegratorKind, IntegratorOptions};
 use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
 use crate::tip_sample::TipSampleSystem;
-use nalgebra::{Complex, DVector};
+use nalgebra::{Complex, DMatrix, DVector};
 use serde::Serialize;
 
 /// Largest number of values of a stepped sweep (each is a steady-state computation, twice).
@@ -216,6 +216,9 @@ pub struct CurvePoint {
     pub state: DVector<f64>,
     /// Floquet multipliers of the orbit, decreasing modulus (empty for a non-periodic motion).
     pub multipliers: Vec<Complex<f64>>,
+    /// Monodromy matrix of the orbit's period-n map, 2N×2N (`None` for a non-periodic motion):
+    /// the first Jacobian of the Newton solve at the next value.
+    pub monodromy: Option<DMatrix<f64>>,
     /// Stable: all multipliers inside the unit circle (a non-periodic motion reached by
     /// integration is an attractor and counts as stable).
     pub stable: bool,
@@ -318,6 +321,8 @@ pub struct Found {
     pub state: DVector<f64>,
     /// Floquet multipliers, decreasing modulus (empty for a non-periodic motion).
     pub multipliers: Vec<Complex<f64>>,
+    /// Monodromy matrix, 2N×2N (`None` for a non-periodic motion).
+    pub monodromy: Option<DMatrix<f64>>,
     /// Stable (an attractor).
     pub stable: bool,
 }
@@ -426,6 +431,7 @@ pub fn settle(
                     distance: (&x - &o.state).norm(),
                     state: o.state,
                     multipliers: o.multipliers,
+                    monodromy: o.monodromy,
                     approaches: 0,
                     linear: 0,
                 });
@@ -450,6 +456,7 @@ pub fn settle(
                     period: Some(m),
                     state: o.state,
                     multipliers: o.multipliers,
+                    monodromy: Some(o.monodromy),
                     stable: true,
                 });
             }
@@ -459,6 +466,7 @@ pub fn settle(
         period: None,
         state: s.end_state().clone(),
         multipliers: Vec::new(),
+        monodromy: None,
         stable: true,
     })
 }
@@ -467,6 +475,7 @@ pub fn settle(
 struct Candidate {
     state: DVector<f64>,
     multipliers: Vec<Complex<f64>>,
+    monodromy: DMatrix<f64>,
     /// Distance of the transient from the orbit at the last check.
     distance: f64,
     /// Consecutive checks at which the distance decreased.
@@ -481,6 +490,7 @@ impl Candidate {
             period: Some(n),
             state: self.state,
             multipliers: self.multipliers,
+            monodromy: Some(self.monodromy),
             stable: true,
         }
     }
@@ -500,10 +510,12 @@ fn integrator_at(
 /// the module docs) before it falls back on the transient (at most 2^depth sub-steps).
 pub const SUBSTEP_DEPTH: usize = 8;
 
-/// Follow the stable period-n orbit `z0` at `v0` to `v1` by Newton (from the secant prediction
-/// `z0 + slope (v1 − v0)`, then from `z0`; undamped, [`shoot_undamped`]: a full step that does
-/// not lower the residual means the orbit is not near, and halving the parameter step is the
-/// remedy): accepted when stable and within `jump_tol` of `z0`.
+/// Follow the stable period-n orbit `z0` at `v0` (monodromy matrix `m0`) to `v1` by Newton
+/// (from the secant prediction `z0 + slope (v1 − v0)`, then from `z0`; undamped,
+/// [`shoot_undamped`]: a full step that does not lower the residual means the orbit is not
+/// near, and halving the parameter step is the remedy; where the integrator integrates the
+/// variational equations step by step, [`broyden_pays`], first [`shoot_broyden`] with `m0` as
+/// the first Jacobian): accepted when stable and within `jump_tol` of `z0`.
 /// Otherwise the step is halved (up to `depth` times) and each half continued in turn — a
 /// quasi-static sweep — unless three halvings in a row did not shrink the distance to the stable
 /// orbit Newton found below 0.95 of the distance over the longer step (`whole`: that distance
@@ -517,11 +529,14 @@ fn continue_orbit(
     z0: &DVector<f64>,
     slope: Option<&DVector<f64>>,
     v1: f64,
+    m0: Option<&DMatrix<f64>>,
     n: usize,
     depth: usize,
     whole: Option<(f64, usize)>,
-) -> Result<Option<(DVector<f64>, Vec<Complex<f64>>)>, SimError> {
-    let mut integ = integrator_at(spec, v1, z0)?;
+) -> Result<Option<ShotOrbit>, SimError> {
+    let model = CantileverModel::new(&spec.base.with(spec.param, v1))?;
+    let mut integ = build(&model, spec.integrator, 0.0, z0)?;
+    let m0 = m0.filter(|_| broyden_pays(spec, &model));
     let mut guesses = Vec::with_capacity(2);
     if let Some(s) = slope {
         guesses.push(z0 + s * (v1 - v0));
@@ -529,11 +544,16 @@ fn continue_orbit(
     guesses.push(z0.clone());
     let mut gap: Option<f64> = None;
     for g in &guesses {
-        if let Ok(o) = shoot_undamped(integ.as_mut(), g, n, &spec.newton) {
+        let shot = match m0 {
+            Some(m) => shoot_broyden(integ.as_mut(), g, n, &spec.newton, m)
+                .or_else(|_| shoot_undamped(integ.as_mut(), g, n, &spec.newton)),
+            None => shoot_undamped(integ.as_mut(), g, n, &spec.newton),
+        };
+        if let Ok(o) = shot {
             if o.stable {
                 let d = relative_gap(&o.state, z0);
                 if d <= spec.jump_tol {
-                    return Ok(Some((o.state, o.multipliers)));
+                    return Ok(Some(o));
                 }
                 gap = Some(gap.map_or(d, |x: f64| x.min(d)));
             }
@@ -549,11 +569,34 @@ fn continue_orbit(
     }
     let mid = 0.5 * (v0 + v1);
     let first = gap.map(|g| (g, stuck));
-    let Some((zm, _)) = continue_orbit(spec, v0, z0, slope, mid, n, depth - 1, first)? else {
+    let Some(om) = continue_orbit(spec, v0, z0, slope, mid, m0, n, depth - 1, first)? else {
         return Ok(None);
     };
-    let half_slope = (&zm - z0) / (mid - v0);
-    continue_orbit(spec, mid, &zm, Some(&half_slope), v1, n, depth - 1, None)
+    let half_slope = (&om.state - z0) / (mid - v0);
+    let mm = Some(&om.monodromy);
+    continue_orbit(
+        spec,
+        mid,
+        &om.state,
+        Some(&half_slope),
+        v1,
+        mm,
+        n,
+        depth - 1,
+        None,
+    )
+}
+
+/// Whether the sweep's Newton solves start with [`shoot_broyden`]: where the integrator of
+/// `model` takes the monodromy matrix from variational equations integrated step by step (the
+/// adaptive integrator, also in the split integrator's contact stints: at N = 3 a variational
+/// step integrates 42 components instead of 6), so that iterates by flows without them and one
+/// variational flow at the converged orbit cost less than Newton's variational flow per
+/// iterate. Not with the exact propagator, whose monodromy matrix is a product of stint
+/// transitions at about the cost of the flow itself: there Broyden's extra iterations would
+/// cost more than they save.
+pub fn broyden_pays(spec: &SteppedSpec, model: &CantileverModel) -> bool {
+    spec.integrator.kind.resolve(model) != IntegratorKind::Exact
 }
 
 /// The slope s with which `z_last + s (value − v_last)` predicts the orbit at `value` from the
@@ -608,14 +651,16 @@ fn step_point(
             &last,
             slope.as_ref(),
             value,
+            p.monodromy.as_ref(),
             n,
             SUBSTEP_DEPTH,
             None,
-        )?,
+        )?
+        .map(|o| (o.state, o.multipliers, o.monodromy)),
         None => shoot_with(integ.as_mut(), &last, n, &spec.newton)
             .ok()
             .filter(|o| o.stable)
-            .map(|o| (o.state, o.multipliers)),
+            .map(|o| (o.state, o.multipliers, o.monodromy)),
     };
     let first = if prev.is_some() {
         Reached::Continued
@@ -623,11 +668,12 @@ fn step_point(
         Reached::Start
     };
     let (found, reached) = match continued {
-        Some((state, multipliers)) => (
+        Some((state, multipliers, monodromy)) => (
             Found {
                 period: Some(n),
                 state,
                 multipliers,
+                monodromy: Some(monodromy),
                 stable: true,
             },
             first,
@@ -648,6 +694,7 @@ fn step_point(
         period: found.period,
         state: found.state,
         multipliers: found.multipliers,
+        monodromy: found.monodromy,
         stable: found.stable,
         reached,
         observables,
@@ -780,6 +827,7 @@ fn branch_starts(
             state: o.state,
             stable: o.stable,
             multipliers: o.multipliers,
+            monodromy: Some(o.monodromy),
             reached: Reached::Start,
             observables,
         });
