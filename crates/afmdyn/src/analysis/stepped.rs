@@ -510,12 +510,14 @@ fn integrator_at(
 /// the module docs) before it falls back on the transient (at most 2^depth sub-steps).
 pub const SUBSTEP_DEPTH: usize = 8;
 
-/// Follow the stable period-n orbit `z0` at `v0` (monodromy matrix `m0`) to `v1` by Newton
+/// Follow the stable period-n orbit `z0` at `v0` (its monodromy matrix and trend `m0`) to `v1`
+/// by Newton
 /// (from the secant prediction `z0 + slope (v1 − v0)`, then from `z0`; undamped,
 /// [`shoot_undamped`]: a full step that does not lower the residual means the orbit is not
 /// near, and halving the parameter step is the remedy; where the integrator integrates the
-/// variational equations step by step, [`broyden_pays`], first [`shoot_broyden`] with `m0` as
-/// the first Jacobian): accepted when stable and within `jump_tol` of `z0`.
+/// variational equations step by step, [`broyden_pays`], first [`shoot_broyden`] with the
+/// trend's estimate at `v1` as the first Jacobian): accepted when stable and within `jump_tol`
+/// of `z0`.
 /// Otherwise the step is halved (up to `depth` times) and each half continued in turn — a
 /// quasi-static sweep — unless three halvings in a row did not shrink the distance to the stable
 /// orbit Newton found below 0.95 of the distance over the longer step (`whole`: that distance
@@ -529,14 +531,16 @@ fn continue_orbit(
     z0: &DVector<f64>,
     slope: Option<&DVector<f64>>,
     v1: f64,
-    m0: Option<&DMatrix<f64>>,
+    m0: Option<&Trend>,
     n: usize,
     depth: usize,
     whole: Option<(f64, usize)>,
 ) -> Result<Option<ShotOrbit>, SimError> {
     let model = CantileverModel::new(&spec.base.with(spec.param, v1))?;
     let mut integ = build(&model, spec.integrator, 0.0, z0)?;
-    let m0 = m0.filter(|_| broyden_pays(spec, &model));
+    let m1 = m0
+        .filter(|_| broyden_pays(spec, &model))
+        .map(|t| t.at(v1 - v0));
     let mut guesses = Vec::with_capacity(2);
     if let Some(s) = slope {
         guesses.push(z0 + s * (v1 - v0));
@@ -544,7 +548,7 @@ fn continue_orbit(
     guesses.push(z0.clone());
     let mut gap: Option<f64> = None;
     for g in &guesses {
-        let shot = match m0 {
+        let shot = match &m1 {
             Some(m) => shoot_broyden(integ.as_mut(), g, n, &spec.newton, m)
                 .or_else(|_| shoot_undamped(integ.as_mut(), g, n, &spec.newton)),
             None => shoot_undamped(integ.as_mut(), g, n, &spec.newton),
@@ -573,7 +577,8 @@ fn continue_orbit(
         return Ok(None);
     };
     let half_slope = (&om.state - z0) / (mid - v0);
-    let mm = Some(&om.monodromy);
+    let trend = m0.map(|t| Trend::through(&t.m, &om.monodromy, mid - v0));
+    let mm = trend.as_ref();
     continue_orbit(
         spec,
         mid,
@@ -585,6 +590,56 @@ fn continue_orbit(
         depth - 1,
         None,
     )
+}
+
+/// The monodromy matrix M of the orbit followed at v0 and, when the orbit before it is on the
+/// same branch, its rate of change along the sweep: the first Jacobian of [`shoot_broyden`] at
+/// v is M + (v − v0) dM/dv (linear extrapolation, the monodromy's counterpart of
+/// [`prediction_slope`]).
+#[derive(Debug, Clone)]
+struct Trend {
+    m: DMatrix<f64>,
+    rate: Option<DMatrix<f64>>,
+}
+
+impl Trend {
+    /// From M(v0 − dv) = `before` to M(v0) = `m`.
+    fn through(before: &DMatrix<f64>, m: &DMatrix<f64>, dv: f64) -> Self {
+        Trend {
+            m: m.clone(),
+            rate: Some((m - before) / dv),
+        }
+    }
+
+    /// The estimate dv after v0.
+    fn at(&self, dv: f64) -> DMatrix<f64> {
+        match &self.rate {
+            Some(r) => &self.m + r * dv,
+            None => self.m.clone(),
+        }
+    }
+
+    /// The trend of the last point of `history`: its monodromy matrix, with the secant through
+    /// the point before when both are on one branch (the same period, the last not reached by
+    /// settling, distinct values).
+    fn of(history: &[CurvePoint]) -> Option<Self> {
+        let k = history.len();
+        let last = history.last()?;
+        let m = last.monodromy.as_ref()?;
+        let before = (k >= 2)
+            .then(|| &history[k - 2])
+            .filter(|b| {
+                b.period == last.period && last.reached != Reached::Settled && b.value != last.value
+            })
+            .and_then(|b| b.monodromy.as_ref().map(|mb| (mb, last.value - b.value)));
+        Some(match before {
+            Some((mb, dv)) => Trend::through(mb, m, dv),
+            None => Trend {
+                m: m.clone(),
+                rate: None,
+            },
+        })
+    }
 }
 
 /// Whether the sweep's Newton solves start with [`shoot_broyden`]: where the integrator of
@@ -651,7 +706,7 @@ fn step_point(
             &last,
             slope.as_ref(),
             value,
-            p.monodromy.as_ref(),
+            Trend::of(history).as_ref(),
             n,
             SUBSTEP_DEPTH,
             None,
