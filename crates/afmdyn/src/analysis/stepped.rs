@@ -34,12 +34,14 @@ use super::continuation::{
 use super::monodromy::stroboscopic;
 use super::observables::{observe, ObservableOptions, Observables};
 use super::progress::Progress;
-use super::shooting::{shoot_broyden, shoot_undamped, shoot_with, ShootingOptions, ShotOrbit};
+use super::shooting::{
+    broyden_pays, shoot_broyden, shoot_undamped, shoot_with, ShootingOptions, ShotOrbit,
+};
 use super::steady::{steady_state, SteadyOptions};
 use crate::eigen::damped_eigenvalues;
 use crate::error::SimError;
 use crate::galerkin::Region;
-use crate::integrate::{advance, build, Integrator, IntegratorKind, IntegratorOptions};
+use crate::integrate::{advance, build, Integrator, IntegratorOptions};
 use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
 use crate::tip_sample::TipSampleSystem;
@@ -515,7 +517,7 @@ pub const SUBSTEP_DEPTH: usize = 8;
 /// (from the secant prediction `z0 + slope (v1 − v0)`, then from `z0`; undamped,
 /// [`shoot_undamped`]: a full step that does not lower the residual means the orbit is not
 /// near, and halving the parameter step is the remedy; where the integrator integrates the
-/// variational equations step by step, [`broyden_pays`], first [`shoot_broyden`] with the
+/// variational equations step by step ([`broyden_pays`]), first [`shoot_broyden`] with the
 /// trend's estimate at `v1` as the first Jacobian): accepted when stable and within `jump_tol`
 /// of `z0`.
 /// Otherwise the step is halved (up to `depth` times) and each half continued in turn — a
@@ -539,7 +541,7 @@ fn continue_orbit(
     let model = CantileverModel::new(&spec.base.with(spec.param, v1))?;
     let mut integ = build(&model, spec.integrator, 0.0, z0)?;
     let m1 = m0
-        .filter(|_| broyden_pays(spec, &model))
+        .filter(|_| broyden_pays(spec.integrator, &model))
         .map(|t| t.at(v1 - v0));
     let mut guesses = Vec::with_capacity(2);
     if let Some(s) = slope {
@@ -640,18 +642,6 @@ impl Trend {
             },
         })
     }
-}
-
-/// Whether the sweep's Newton solves start with [`shoot_broyden`]: where the integrator of
-/// `model` takes the monodromy matrix from variational equations integrated step by step (the
-/// adaptive integrator, also in the split integrator's contact stints: at N = 3 a variational
-/// step integrates 42 components instead of 6), so that iterates by flows without them and one
-/// variational flow at the converged orbit cost less than Newton's variational flow per
-/// iterate. Not with the exact propagator, whose monodromy matrix is a product of stint
-/// transitions at about the cost of the flow itself: there Broyden's extra iterations would
-/// cost more than they save.
-pub fn broyden_pays(spec: &SteppedSpec, model: &CantileverModel) -> bool {
-    spec.integrator.kind.resolve(model) != IntegratorKind::Exact
 }
 
 /// The slope s with which `z_last + s (value − v_last)` predicts the orbit at `value` from the
