@@ -7,7 +7,9 @@
 //! stepped through a grid and at each value the steady state is the one reached from the
 //! previous value's end state; then the sweep runs back (retract, or down-sweep). Instead of
 //! integrating ~Q/π periods of transient per value, the previous orbit is followed by Newton
-//! shooting ([`super::shooting`]) from a secant prediction: a stable orbit near the previous
+//! shooting ([`super::shooting`]) from a secant prediction (where the integrator integrates the
+//! variational equations step by step, Broyden's method from the previous orbits' monodromy
+//! matrix, [`super::shooting::shoot_broyden`]): a stable orbit near the previous
 //! one is its continuation, the state the motion settles on; a step the orbit moves too far in
 //! is halved (quasi-static sub-steps, [`SUBSTEP_DEPTH`]) as long as halving brings the orbits
 //! closer. When the orbit cannot be followed — Newton fails or lands on an unstable orbit, or
