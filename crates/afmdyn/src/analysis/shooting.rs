@@ -247,13 +247,13 @@ pub fn shoot_broyden(
 }
 
 /// Whether Newton solves with the integrator of `opts` for `model` gain from starting with
-/// Broyden's updates and flows without the variational equations ([`shoot_broyden`], the
-/// continuation's corrector): where the integrator takes the monodromy matrix from variational
-/// equations integrated step by step (the adaptive integrator, also in the split integrator's
-/// contact stints: at N = 3 a variational step integrates 42 components instead of 6; a
-/// variational flow of the beam DMT approach costs 7.8 plain ones), so that iterates by flows
-/// without them and one variational flow at the converged orbit cost less than a variational
-/// flow per iterate. Not with the exact propagator, whose monodromy matrix is a product of stint
+/// Broyden's updates and flows without the variational equations ([`shoot_broyden`]): where the
+/// integrator takes the monodromy matrix from variational equations integrated step by step
+/// (the adaptive integrator, also in the split integrator's contact stints: at N = 3 a
+/// variational step integrates 42 components instead of 6; a variational flow of the beam DMT
+/// approach costs 7.6 plain ones, of the point-mass one 4.1), so that iterates by flows without
+/// them and one variational flow at the converged orbit cost less than a variational flow per
+/// iterate. Not with the exact propagator, whose monodromy matrix is a product of stint
 /// transitions at about the cost of the flow itself: there Broyden's extra iterations would
 /// cost more than they save.
 pub fn broyden_pays(opts: IntegratorOptions, model: &CantileverModel) -> bool {
