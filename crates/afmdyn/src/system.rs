@@ -220,7 +220,7 @@ pub fn jacobian_product(jac: &DMatrix<f64>, psi: &[f64], dpsi: &mut [f64]) {
 /// Rows `row0..d` of dΨ = J Ψ (d×d column-major `psi` and `dpsi`; the other rows of `dpsi` are
 /// left as they are). Column by column as axpys over J's columns: for the small d of this model
 /// (2N ≤ 40) a plain loop beats a packed GEMM several times, and it allocates nothing. A
-/// second-order system in z = (a, ȧ) has J = [[0, I], [L]]: its top rows are a copy of Ψ's
+/// second-order system in z = (a, ȧ) has `J = [[0, I], [L]]`: its top rows are a copy of Ψ's
 /// lower rows, and only the lower rows (`row0` = d/2) need this product.
 #[inline]
 pub fn jacobian_rows_product(jac: &DMatrix<f64>, row0: usize, psi: &[f64], dpsi: &mut [f64]) {

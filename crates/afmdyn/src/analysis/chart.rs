@@ -14,7 +14,7 @@
 //!    branches, hysteresis).
 //!
 //! The runs of a cell are clustered into attractors by
-//! [`same_attractor`](super::attractors::same_attractor). A tile is a pure function of the
+//! [`super::attractors::same_attractor`]. A tile is a pure function of the
 //! spec and its number, so every executor and any thread count gives the same cells bit for
 //! bit. Continuation does not cross tile edges (nor rows): a wider tile follows branches
 //! further at the price of fewer, longer tasks.

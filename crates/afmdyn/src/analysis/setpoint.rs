@@ -28,7 +28,7 @@ pub struct Crossing {
     /// The first of the two points around the crossing.
     pub index: usize,
     /// The weight of the second point: a quantity q at the setpoint is
-    /// (1 − t)·q[index] + t·q[index + 1].
+    /// `(1 − t)·q[index] + t·q[index + 1]`.
     pub t: f64,
     /// The swept parameter (α5 for an approach) at the setpoint.
     pub value: f64,

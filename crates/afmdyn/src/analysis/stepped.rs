@@ -7,7 +7,9 @@
 //! stepped through a grid and at each value the steady state is the one reached from the
 //! previous value's end state; then the sweep runs back (retract, or down-sweep). Instead of
 //! integrating ~Q/π periods of transient per value, the previous orbit is followed by Newton
-//! shooting ([`super::shooting`]) from a secant prediction: a stable orbit near the previous
+//! shooting ([`super::shooting`]) from a secant prediction (where the integrator integrates the
+//! variational equations step by step, Broyden's method from the previous orbits' monodromy
+//! matrix, [`super::shooting::shoot_broyden`]): a stable orbit near the previous
 //! one is its continuation, the state the motion settles on; a step the orbit moves too far in
 //! is halved (quasi-static sub-steps, [`SUBSTEP_DEPTH`]) as long as halving brings the orbits
 //! closer. When the orbit cannot be followed — Newton fails or lands on an unstable orbit, or
@@ -15,7 +17,8 @@
 //! motion is integrated from the previous end state in chunks of drive periods, Newton being
 //! retried from the transient until the trajectory is seen to approach a stable orbit
 //! ([`settle`]); a motion that never settles on a period-n orbit is classified by
-//! [`super::steady::steady_state`].
+//! [`super::steady::steady_state`], the whole transient of the point within its
+//! [`transient_cap`].
 //!
 //! **Branches.** The periodic-orbit branches through both ends of the range — the two sweeps'
 //! first orbits, and at each end the orbit Newton finds from the other end's (the other regime,
@@ -33,13 +36,18 @@ use super::continuation::{
 use super::monodromy::stroboscopic;
 use super::observables::{observe, ObservableOptions, Observables};
 use super::progress::Progress;
-use super::shooting::{shoot_with, ShootingOptions};
+use super::shooting::{
+    broyden_pays, shoot_broyden, shoot_undamped, shoot_with, ShootingOptions, ShotOrbit,
+};
 use super::steady::{steady_state, SteadyOptions};
+use crate::eigen::damped_eigenvalues;
 use crate::error::SimError;
+use crate::galerkin::Region;
 use crate::integrate::{advance, build, Integrator, IntegratorOptions};
 use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
-use nalgebra::{Complex, DVector};
+use crate::tip_sample::TipSampleSystem;
+use nalgebra::{Complex, DMatrix, DVector};
 use serde::Serialize;
 
 /// Largest number of values of a stepped sweep (each is a steady-state computation, twice).
@@ -137,8 +145,9 @@ pub struct SteppedSpec {
     /// from the secant prediction Newton converges in ~3; one that has not converged by 6 is
     /// stalled at a non-smooth point or far from the orbit, and a halved step is cheaper).
     pub newton: ShootingOptions,
-    /// Classification of a motion that does not settle on an orbit (`max_periods` also caps
-    /// the transient of [`settle`]).
+    /// Classification of a motion that does not settle on an orbit; `max_periods` is the most
+    /// drive periods of transient a point may take, [`settle`] and classification together
+    /// (less where the damping is strong: [`transient_cap`]).
     pub steady: SteadyOptions,
     /// Drive periods between Newton attempts while settling.
     pub chunk_periods: usize,
@@ -211,6 +220,9 @@ pub struct CurvePoint {
     pub state: DVector<f64>,
     /// Floquet multipliers of the orbit, decreasing modulus (empty for a non-periodic motion).
     pub multipliers: Vec<Complex<f64>>,
+    /// Monodromy matrix of the orbit's period-n map, 2N×2N (`None` for a non-periodic motion):
+    /// the first Jacobian of the Newton solve at the next value.
+    pub monodromy: Option<DMatrix<f64>>,
     /// Stable: all multipliers inside the unit circle (a non-periodic motion reached by
     /// integration is an attractor and counts as stable).
     pub stable: bool,
@@ -313,19 +325,60 @@ pub struct Found {
     pub state: DVector<f64>,
     /// Floquet multipliers, decreasing modulus (empty for a non-periodic motion).
     pub multipliers: Vec<Complex<f64>>,
+    /// Monodromy matrix, 2N×2N (`None` for a non-periodic motion).
+    pub monodromy: Option<DMatrix<f64>>,
     /// Stable (an attractor).
     pub stable: bool,
 }
 
+/// Fewest drive periods of transient a point of a stepped sweep may take ([`transient_cap`]).
+pub const MIN_TRANSIENT_PERIODS: usize = 5_000;
+
+/// Decay times of the slowest free mode in a point's transient cap ([`transient_cap`]).
+pub const TRANSIENT_DECAY_TIMES: f64 = 9.0;
+
+/// The drive periods of transient a point of a stepped sweep may take, [`settle`] and the
+/// classification by [`steady_state`] together: [`TRANSIENT_DECAY_TIMES`] times the periods
+/// the slowest free mode of the cantilever (damped eigenvalue λ with the smallest |Re λ|,
+/// eqs. 20–21) takes to decay by the period search's tolerance, ln(1/tol)/(|Re λ| T), within
+/// [[`MIN_TRANSIENT_PERIODS`], `spec.steady.max_periods`]; `spec.steady.max_periods` for a
+/// system that is not the cantilever model. At Q = 400 (ln(1e8) Q/π = 2 345 periods) it is
+/// `max_periods` (20 000 by default), as before; a model with strong damping, whose transients
+/// onto an orbit take a few hundred periods (the default beam, Q ≈ 42: 248), has the floor.
+/// A motion still unsettled after the cap is classified nonperiodic: near the edge of a
+/// periodic window in a chaotic band that is a matter of the start state — the default
+/// resonance curve's classification there changes with round-off-level changes of its start
+/// — which no cap removes, while each nonperiodic point costs the whole cap.
+pub fn transient_cap(system: &dyn TipSampleSystem, spec: &SteppedSpec) -> usize {
+    let cap = spec.steady.max_periods;
+    let Some(model) = system.cantilever() else {
+        return cap;
+    };
+    let g = model.galerkin().region(Region::Free);
+    let slowest = damped_eigenvalues(g)
+        .iter()
+        .map(|e| e.re.abs())
+        .fold(f64::INFINITY, f64::min);
+    let per_period = slowest * model.period();
+    let decay = (1.0 / spec.steady.tol).ln() / per_period;
+    if !(decay.is_finite() && decay > 0.0) {
+        return cap;
+    }
+    let periods = (TRANSIENT_DECAY_TIMES * decay).ceil();
+    (periods.min(cap as f64) as usize).max(MIN_TRANSIENT_PERIODS.min(cap))
+}
+
 /// Integrate from `z0` (τ = 0) at the integrator's parameters until the motion settles: every
-/// `spec.chunk_periods` periods Newton is tried from the current state (period `n`); a stable
+/// `spec.chunk_periods` periods Newton is tried from the current state (period `n`; undamped,
+/// [`shoot_undamped`]: from a transient far from the orbit the damped iteration's halvings
+/// rarely converge and each costs a flow, and the next attempt starts nearer); a stable
 /// orbit it finds is accepted once the trajectory has come closer to it over two further chunks
 /// and within [`SETTLED`] of it, or has twice come closer at the rate of the orbit's leading
 /// Floquet multiplier (the linear regime around it), or has arrived on it — so it is the
 /// attractor the motion goes to, not another orbit Newton happened to reach. After a failed
 /// attempt the next one waits 1.5 times as many chunks. After [`NEWTON_CHUNKS`] chunks without
 /// that, the motion is classified by [`steady_state`] within `spec.steady` (a period-m orbit is
-/// then polished by Newton).
+/// then polished by Newton), over the periods of the point's [`transient_cap`] not yet spent.
 ///
 /// # Errors
 /// [`SimError`] from the integrator.
@@ -342,7 +395,8 @@ pub fn settle(
     let mut candidate: Option<Candidate> = None;
     // Newton from the transient for at most NEWTON_CHUNKS chunks, then classification; after a
     // failed attempt the next one waits 1.5 times longer
-    let newton_periods = spec.steady.max_periods.min(NEWTON_CHUNKS * chunk);
+    let cap = transient_cap(integ.system(), spec);
+    let newton_periods = cap.min(NEWTON_CHUNKS * chunk);
     let (mut chunks, mut next_try, mut wait) = (0usize, 1usize, 1.0f64);
     while elapsed < newton_periods {
         integ.set_variational(false);
@@ -375,12 +429,13 @@ pub fn settle(
         if chunks < next_try {
             continue;
         }
-        match shoot_with(integ, &x, n, &spec.newton) {
+        match shoot_undamped(integ, &x, n, &spec.newton) {
             Ok(o) if o.stable => {
                 candidate = Some(Candidate {
                     distance: (&x - &o.state).norm(),
                     state: o.state,
                     multipliers: o.multipliers,
+                    monodromy: o.monodromy,
                     approaches: 0,
                     linear: 0,
                 });
@@ -393,7 +448,11 @@ pub fn settle(
     // no settling on a period-n orbit: classify the motion
     integ.set_variational(false);
     integ.reset(0.0, &x)?;
-    let s = steady_state(integ, &spec.steady)?;
+    let steady = SteadyOptions {
+        max_periods: cap.saturating_sub(elapsed).max(1),
+        ..spec.steady
+    };
+    let s = steady_state(integ, &steady)?;
     if let Some(m) = s.period() {
         if let Ok(o) = shoot_with(integ, s.end_state(), m, &spec.newton) {
             if o.stable {
@@ -401,6 +460,7 @@ pub fn settle(
                     period: Some(m),
                     state: o.state,
                     multipliers: o.multipliers,
+                    monodromy: Some(o.monodromy),
                     stable: true,
                 });
             }
@@ -410,6 +470,7 @@ pub fn settle(
         period: None,
         state: s.end_state().clone(),
         multipliers: Vec::new(),
+        monodromy: None,
         stable: true,
     })
 }
@@ -418,6 +479,7 @@ pub fn settle(
 struct Candidate {
     state: DVector<f64>,
     multipliers: Vec<Complex<f64>>,
+    monodromy: DMatrix<f64>,
     /// Distance of the transient from the orbit at the last check.
     distance: f64,
     /// Consecutive checks at which the distance decreased.
@@ -432,6 +494,7 @@ impl Candidate {
             period: Some(n),
             state: self.state,
             multipliers: self.multipliers,
+            monodromy: Some(self.monodromy),
             stable: true,
         }
     }
@@ -451,8 +514,14 @@ fn integrator_at(
 /// the module docs) before it falls back on the transient (at most 2^depth sub-steps).
 pub const SUBSTEP_DEPTH: usize = 8;
 
-/// Follow the stable period-n orbit `z0` at `v0` to `v1` by Newton (from the secant prediction
-/// `z0 + slope (v1 − v0)`, then from `z0`): accepted when stable and within `jump_tol` of `z0`.
+/// Follow the stable period-n orbit `z0` at `v0` (its monodromy matrix and trend `m0`) to `v1`
+/// by Newton
+/// (from the secant prediction `z0 + slope (v1 − v0)`, then from `z0`; undamped,
+/// [`shoot_undamped`]: a full step that does not lower the residual means the orbit is not
+/// near, and halving the parameter step is the remedy; where the integrator integrates the
+/// variational equations step by step ([`broyden_pays`]), first [`shoot_broyden`] with the
+/// trend's estimate at `v1` as the first Jacobian): accepted when stable and within `jump_tol`
+/// of `z0`.
 /// Otherwise the step is halved (up to `depth` times) and each half continued in turn — a
 /// quasi-static sweep — unless three halvings in a row did not shrink the distance to the stable
 /// orbit Newton found below 0.95 of the distance over the longer step (`whole`: that distance
@@ -466,11 +535,16 @@ fn continue_orbit(
     z0: &DVector<f64>,
     slope: Option<&DVector<f64>>,
     v1: f64,
+    m0: Option<&Trend>,
     n: usize,
     depth: usize,
     whole: Option<(f64, usize)>,
-) -> Result<Option<(DVector<f64>, Vec<Complex<f64>>)>, SimError> {
-    let mut integ = integrator_at(spec, v1, z0)?;
+) -> Result<Option<ShotOrbit>, SimError> {
+    let model = CantileverModel::new(&spec.base.with(spec.param, v1))?;
+    let mut integ = build(&model, spec.integrator, 0.0, z0)?;
+    let m1 = m0
+        .filter(|_| broyden_pays(spec.integrator, &model))
+        .map(|t| t.at(v1 - v0));
     let mut guesses = Vec::with_capacity(2);
     if let Some(s) = slope {
         guesses.push(z0 + s * (v1 - v0));
@@ -478,11 +552,16 @@ fn continue_orbit(
     guesses.push(z0.clone());
     let mut gap: Option<f64> = None;
     for g in &guesses {
-        if let Ok(o) = shoot_with(integ.as_mut(), g, n, &spec.newton) {
+        let shot = match &m1 {
+            Some(m) => shoot_broyden(integ.as_mut(), g, n, &spec.newton, m)
+                .or_else(|_| shoot_undamped(integ.as_mut(), g, n, &spec.newton)),
+            None => shoot_undamped(integ.as_mut(), g, n, &spec.newton),
+        };
+        if let Ok(o) = shot {
             if o.stable {
                 let d = relative_gap(&o.state, z0);
                 if d <= spec.jump_tol {
-                    return Ok(Some((o.state, o.multipliers)));
+                    return Ok(Some(o));
                 }
                 gap = Some(gap.map_or(d, |x: f64| x.min(d)));
             }
@@ -498,11 +577,73 @@ fn continue_orbit(
     }
     let mid = 0.5 * (v0 + v1);
     let first = gap.map(|g| (g, stuck));
-    let Some((zm, _)) = continue_orbit(spec, v0, z0, slope, mid, n, depth - 1, first)? else {
+    let Some(om) = continue_orbit(spec, v0, z0, slope, mid, m0, n, depth - 1, first)? else {
         return Ok(None);
     };
-    let half_slope = (&zm - z0) / (mid - v0);
-    continue_orbit(spec, mid, &zm, Some(&half_slope), v1, n, depth - 1, None)
+    let half_slope = (&om.state - z0) / (mid - v0);
+    let trend = m0.map(|t| Trend::through(&t.m, &om.monodromy, mid - v0));
+    let mm = trend.as_ref();
+    continue_orbit(
+        spec,
+        mid,
+        &om.state,
+        Some(&half_slope),
+        v1,
+        mm,
+        n,
+        depth - 1,
+        None,
+    )
+}
+
+/// The monodromy matrix M of the orbit followed at v0 and, when the orbit before it is on the
+/// same branch, its rate of change along the sweep: the first Jacobian of [`shoot_broyden`] at
+/// v is M + (v − v0) dM/dv (linear extrapolation, the monodromy's counterpart of
+/// [`prediction_slope`]).
+#[derive(Debug, Clone)]
+struct Trend {
+    m: DMatrix<f64>,
+    rate: Option<DMatrix<f64>>,
+}
+
+impl Trend {
+    /// From M(v0 − dv) = `before` to M(v0) = `m`.
+    fn through(before: &DMatrix<f64>, m: &DMatrix<f64>, dv: f64) -> Self {
+        Trend {
+            m: m.clone(),
+            rate: Some((m - before) / dv),
+        }
+    }
+
+    /// The estimate dv after v0.
+    fn at(&self, dv: f64) -> DMatrix<f64> {
+        match &self.rate {
+            Some(r) => &self.m + r * dv,
+            None => self.m.clone(),
+        }
+    }
+
+    /// The trend of the last point of `history`: its monodromy matrix, with the secant through
+    /// the point before when both are on one branch (the same period, the last not reached by
+    /// settling, distinct values).
+    fn of(history: &[CurvePoint]) -> Option<Self> {
+        let k = history.len();
+        let last = history.last()?;
+        let m = last.monodromy.as_ref()?;
+        let before = (k >= 2)
+            .then(|| &history[k - 2])
+            .filter(|b| {
+                b.period == last.period && last.reached != Reached::Settled && b.value != last.value
+            })
+            .and_then(|b| b.monodromy.as_ref().map(|mb| (mb, last.value - b.value)));
+        Some(match before {
+            Some((mb, dv)) => Trend::through(mb, m, dv),
+            None => Trend {
+                m: m.clone(),
+                rate: None,
+            },
+        })
+    }
 }
 
 /// The slope s with which `z_last + s (value − v_last)` predicts the orbit at `value` from the
@@ -557,14 +698,16 @@ fn step_point(
             &last,
             slope.as_ref(),
             value,
+            Trend::of(history).as_ref(),
             n,
             SUBSTEP_DEPTH,
             None,
-        )?,
+        )?
+        .map(|o| (o.state, o.multipliers, o.monodromy)),
         None => shoot_with(integ.as_mut(), &last, n, &spec.newton)
             .ok()
             .filter(|o| o.stable)
-            .map(|o| (o.state, o.multipliers)),
+            .map(|o| (o.state, o.multipliers, o.monodromy)),
     };
     let first = if prev.is_some() {
         Reached::Continued
@@ -572,11 +715,12 @@ fn step_point(
         Reached::Start
     };
     let (found, reached) = match continued {
-        Some((state, multipliers)) => (
+        Some((state, multipliers, monodromy)) => (
             Found {
                 period: Some(n),
                 state,
                 multipliers,
+                monodromy: Some(monodromy),
                 stable: true,
             },
             first,
@@ -597,6 +741,7 @@ fn step_point(
         period: found.period,
         state: found.state,
         multipliers: found.multipliers,
+        monodromy: found.monodromy,
         stable: found.stable,
         reached,
         observables,
@@ -729,6 +874,7 @@ fn branch_starts(
             state: o.state,
             stable: o.stable,
             multipliers: o.multipliers,
+            monodromy: Some(o.monodromy),
             reached: Reached::Start,
             observables,
         });
@@ -920,4 +1066,46 @@ pub fn is_fixed_point(
     let mut integ = integrator_at(spec, value, z)?;
     let m = stroboscopic(integ.as_mut(), z, n)?;
     Ok((&m.state - z).norm() <= tol * (1.0 + z.norm()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::params::Structure;
+
+    /// The transient cap of the point-mass model z'' + α3 z' + z = … (damped eigenvalue
+    /// −α3/2 ± i√(1 − α3²/4)) against its closed form 9 ln(1/tol)/((α3/2) 2π/Ω), within
+    /// [5 000, max_periods]: Q = 400 takes the old cap of 20 000, Q = 200 the closed form,
+    /// Q = 42 the floor; a cap below the floor is kept.
+    #[test]
+    fn the_transient_cap_is_nine_decay_times_of_the_slowest_mode() {
+        for (q, omega) in [(400.0, 1.0), (200.0, 1.0), (200.0, 1.3), (42.0, 1.0)] {
+            let p = Params {
+                structure: Structure::PointMass,
+                modes: 1,
+                alpha1: 0.0,
+                alpha3: 1.0 / q,
+                omega,
+                ..Params::default()
+            };
+            let spec = SteppedSpec::new(p, SweepParam::Alpha5, vec![0.0, 0.1]);
+            let model = CantileverModel::new(&p).unwrap();
+            let integ = build(&model, spec.integrator, 0.0, &model.rest()).unwrap();
+            let decay = (1e8f64).ln() / (0.5 / q * std::f64::consts::TAU / omega);
+            let want = (9.0 * decay).ceil().clamp(5000.0, 20_000.0);
+            let got = transient_cap(integ.system(), &spec) as f64;
+            assert!(
+                (got - want).abs() <= 1.0,
+                "Q = {q}, Ω = {omega}: {got} vs {want}"
+            );
+            let low = SteppedSpec {
+                steady: SteadyOptions {
+                    max_periods: 3000,
+                    ..spec.steady
+                },
+                ..spec.clone()
+            };
+            assert_eq!(transient_cap(integ.system(), &low), 3000);
+        }
+    }
 }

@@ -157,7 +157,7 @@ impl<S: TipSampleSystem + Clone> std::fmt::Debug for Adaptive<S> {
 pub type AdaptiveOracle = Adaptive;
 
 impl Adaptive<CantileverModel> {
-    /// The adaptive integrator of `model` in the exponential frame ([`LinearFrame`], Lawson's
+    /// The adaptive integrator of `model` in the exponential frame (`LinearFrame`, Lawson's
     /// transformation): steps without the variational equations integrate only the deviation
     /// that the tip force causes from the exact free flight, so that their size is set by the
     /// force's variation, not the modes' oscillation; steps with the variational equations

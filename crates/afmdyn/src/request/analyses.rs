@@ -309,8 +309,8 @@ impl ContinuationRequest {
     /// The branches: one without `switch`, the cascade with it.
     ///
     /// # Errors
-    /// As [`Self::validate`], [`StartRequest::guess`], [`continue_branch`] and
-    /// [`continue_with_switching`].
+    /// As [`Self::validate`], [`StartRequest::guess`], [`crate::analysis::continuation::continue_branch`] and
+    /// [`crate::analysis::continuation::continue_with_switching`].
     /// Every branch point is counted in `progress`, which also cancels the run.
     pub fn run(&self, base: &Params, progress: &Progress) -> Result<Vec<Branch>, SimError> {
         self.validate(base)?;
@@ -711,7 +711,7 @@ impl ConvergeRequest {
     /// The runs N = 1..=max_modes of `params` (its own N is replaced).
     ///
     /// # Errors
-    /// As [`Self::validate`] and [`mode_convergence`].
+    /// As [`Self::validate`] and [`crate::analysis::converge::mode_convergence`].
     /// Each run is counted in `progress`, which also cancels the whole.
     pub fn run(
         &self,

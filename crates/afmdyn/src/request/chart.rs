@@ -1,7 +1,7 @@
 //! `chart`: a behaviour chart over two model parameters (issue 29), the same request for
 //! every front end (`afmdyn chart`, Python's `afmdyn.chart` and `afmdyn.dask.chart`).
 //!
-//! An axis is any real model parameter of [`MODEL_PARAMETERS`] by its name or the paper's
+//! An axis is any real model parameter of [`crate::request::model::MODEL_PARAMETERS`] by its name or the paper's
 //! alias (`omega`, `alpha2` / `drive_amplitude`, `restitution`, `hamaker`, …), and with a
 //! probe file the SI quantities `z_c` (m) and `drive_frequency` (Hz); every cell's parameters
 //! resolve through [`ModelSpec::resolve`] like a single run's. The chart's cells and tasks are

@@ -49,7 +49,7 @@ pub const SI_FREQUENCY_RATIO: (f64, f64) = (1e-2, 1e4);
 /// Check an SI distance `v` (m) against [`MAX_SI_DISTANCE`].
 ///
 /// # Errors
-/// [`SimError::OutOfRange`] naming `name`, with the hint that lengths are in metres.
+/// [`crate::SimError::OutOfRange`] naming `name`, with the hint that lengths are in metres.
 pub fn si_distance(name: &'static str, v: f64) -> Result<(), crate::SimError> {
     if v.is_finite() && v.abs() > MAX_SI_DISTANCE {
         return Err(crate::SimError::out_of_range(

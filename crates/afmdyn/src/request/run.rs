@@ -7,7 +7,7 @@
 //! The two whose results are streams run through their own entry points, which take the same
 //! [`Progress`]: `simulate` records in chunks to a sink
 //! ([`crate::trajectory::chunked::record_chunked`], budgets by
-//! [`crate::request::SimulateRequest::span`]) and `bifurcation` writes its records to a
+//! [`crate::request::analyses::SimulateSpan`]) and `bifurcation` writes its records to a
 //! [`crate::request::Checkpoint`] ([`crate::request::checkpoint::run`]).
 //!
 //! [`Progress`] is the sink of the run's progress and its cancel flag: the analyses count

@@ -16,7 +16,7 @@
 //! field is polynomial: a contact takes about 9 steps and ends at a simple zero of w.
 //!
 //! **Events** are zeros of the guard's Taylor polynomial — V_T in free flight, w in contact —
-//! located by safeguarded Newton on the polynomial itself ([`poly::leftmost_crossing`]; the
+//! located by safeguarded Newton on the polynomial itself (`poly::leftmost_crossing`; the
 //! polynomial is the solution to the tolerance, so no step is integrated again), with two
 //! certified bounds that spare the search in most steps and a scan that finds grazing dips.
 //! The state at the event comes from the series. The laws' switchings are plain (the force is
@@ -373,7 +373,7 @@ impl Integrator for Taylor {
     }
 
     /// The energy balance's rates integrated over the last step from its series, in closed form
-    /// to the truncation of the series ([`Jet::rate_integrals`]).
+    /// to the truncation of the series (`Jet::rate_integrals`).
     fn last_step_rate_integrals(&mut self) -> Option<[f64; 3]> {
         if !self.last.valid {
             return None;
