@@ -10,7 +10,9 @@
 //! it errs by at most 2.2e-18 (the short steps of the adaptive integrator) — so the results are
 //! exact to round-off for the exact propagator and to the interpolant's accuracy otherwise. A
 //! Taylor contact step takes its nodes in its own regularising time σ (dτ = 2w dσ, in which the
-//! contact force is smooth up to the contact edge; [`Integrator::smooth_time`]). (For an
+//! contact force is smooth up to the contact edge; [`Integrator::smooth_time`]), always with
+//! the 16-point rule (the stretch dτ/dσ varies over the step, so the |c| ≤ 1 test in τ does not
+//! carry over). (For an
 //! integrand analytic in the Bernstein ellipse E_ρ, bounded by M there, the
 //! n-point rule errs by at most (64/15) M ρ^{−2n}/(ρ² − 1) relative to the half-length
 //! (Trefethen, *Approximation Theory and Approximation Practice*, SIAM 2013, Thm. 19.3). With
@@ -544,8 +546,11 @@ impl Acc {
                 scan.push((a, ctx.rate(integ, r, a, &nd, a, b), nd.v[1]));
             }
         }
-        // the short rule where a product of two factors has |c| ≤ 1 on the piece (module docs)
-        let short = half * ctx.product_rate[r.index()] <= 1.0;
+        // the short rule where a product of two factors has |c| ≤ 1 on the piece (module docs),
+        // τ being the smooth time: a regularising time stretches the piece's rates unevenly
+        // (dτ/du is τ′ = b − a at both ends only when τ(u) is τ itself)
+        let in_tau = [0.0, 1.0].map(|u| integ.smooth_time(a, b, u).1) == [b - a; 2];
+        let short = in_tau && half * ctx.product_rate[r.index()] <= 1.0;
         for &(x, wx) in &ctx.gl[usize::from(short)] {
             let (tau, dtau) = integ.smooth_time(a, b, 0.5 * (x + 1.0));
             let nd = ctx.node(integ, r, tau);
