@@ -11,7 +11,7 @@ use afmdyn::analysis::steady::{steady_state, SteadyOptions};
 use afmdyn::galerkin::Region;
 use afmdyn::integrate::exact::ExactPropagator;
 use afmdyn::integrate::{build, IntegratorKind, IntegratorOptions};
-use afmdyn::{CantileverModel, Params, SweepParam};
+use afmdyn::{CantileverModel, ContactLaw, Params, SweepParam};
 use nalgebra::{Complex, DMatrix, DVector};
 use proptest::prelude::*;
 
@@ -176,6 +176,42 @@ fn broyden_shooting_from_an_estimated_jacobian_reaches_the_harmonic_orbit() {
             o.residuals
         );
     }
+}
+
+/// The same Broyden solve with the Taylor integrator (the DMT default, whose sweeps use it):
+/// a Hertz beam far from the sample never touches it, so the orbit is the forced harmonic
+/// response in closed form; and an estimate of the wrong shape is refused, not a panic.
+#[test]
+fn broyden_shooting_with_the_taylor_integrator_and_a_refused_estimate() {
+    let p = Params {
+        alpha5: 5.0,
+        contact_law: ContactLaw::Hertz,
+        ..Params::default()
+    };
+    let m = model(p);
+    let want = harmonic_response(&m, Region::Free, 0.0);
+    let exact = (&m.dynamics(Region::Free).a * p.period()).exp();
+    let dim = want.len();
+    let m0 = &exact + DMatrix::from_element(dim, dim, 0.01 * exact.norm());
+    let guess = &want + DVector::from_element(dim, 1e-3 * (1.0 + want.norm()));
+    let opts = ShootingOptions {
+        tol: 1e-11,
+        max_iter: 30,
+    };
+    let io = IntegratorOptions {
+        kind: IntegratorKind::Taylor,
+        tolerance: 1e-12,
+        ..IntegratorOptions::default()
+    };
+    let mut it = build(&m, io, 0.0, &guess).unwrap();
+    let o = shoot_broyden(it.as_mut(), &guess, 1, &opts, &m0).unwrap();
+    let err = (&o.state - &want).norm() / (1.0 + want.norm());
+    assert!(err < 1e-9, "orbit off by {err:e}");
+    let dist = (&o.monodromy - &exact).amax() / exact.amax();
+    assert!(dist < 1e-9, "monodromy off by {dist:e}");
+    let wrong = DMatrix::identity(dim + 2, dim + 2);
+    let e = shoot_broyden(it.as_mut(), &guess, 1, &opts, &wrong).unwrap_err();
+    assert!(e.to_string().contains("monodromy estimate"), "{e}");
 }
 
 #[test]

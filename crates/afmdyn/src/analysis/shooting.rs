@@ -174,7 +174,7 @@ pub fn shoot_undamped(
 /// ‖F‖ ends the solve, as there.
 ///
 /// # Errors
-/// As [`shoot_undamped`].
+/// As [`shoot_undamped`]; [`SimError::OutOfRange`] for an `m0` that is not 2N×2N.
 pub fn shoot_broyden(
     integ: &mut dyn Integrator,
     guess: &DVector<f64>,
@@ -187,6 +187,14 @@ pub fn shoot_broyden(
     }
     integ.system().check_state("initial guess", guess)?;
     let dim = guess.len();
+    if m0.shape() != (dim, dim) {
+        let (r, c) = m0.shape();
+        return Err(SimError::out_of_range(
+            "monodromy estimate",
+            format!("{r}x{c}"),
+            "must be 2N x 2N, N the model's mode count",
+        ));
+    }
     let t = n as f64 * integ.system().period();
     let mut z = guess.clone();
     let mut f = flow_state(integ, 0.0, &z, t)? - &z;
