@@ -33,6 +33,13 @@
 //! Springer 1971, §I.2), and contact ends where w falls through 0 — a simple root, not the
 //! double root of δ. sin Ωτ(σ) and cos Ωτ(σ) follow from S′ = Ω C τ′, C′ = −Ω S τ′.
 //!
+//! **Contact's interior, in τ** ([`Jet::contact_interior`]). Away from the contact's edges
+//! (δ ≥ δ_min > 0) the flow is analytic in τ: the state keeps the free flight's linear
+//! recurrence plus M⁻¹φ F_c, with w = √δ from w² = δ, w_k = (δ_k − Σ_{0<j<k} w_j w_{k−j})/(2w₀)
+//! [Griewank & Walther, Table 13.2], F_c as above, and for DMT's damper ∂F_c/∂δ through
+//! q = δ̇/w from w q = δ̇. Two or three products of series per order instead of one per state
+//! component in σ; the integrator chooses between the two (`Taylor`'s module docs).
+//!
 //! **Variational equations.** Φ = ∂z(τ)/∂z(τ₀), Φ′ = JΦ with the rank-one tip-force term
 //! J = A + [0; M⁻¹φ](F_V cᵀ + F_V̇ c′ᵀ), c = (φ, 0), c′ = (0, φ), F_V = ∂F_c/∂V_T,
 //! F_V̇ = ∂F_c/∂(dV_T/dτ). In σ, dΦ/dσ = 2wJΦ: the Jacobian over fixed times τ₀, τ₁ along the
@@ -110,8 +117,12 @@ pub(crate) struct Series {
     pub d: usize,
     /// Whether Φ is formed.
     pub variational: bool,
-    /// Which flow: free flight (in τ) or contact (in σ).
+    /// Which flow: free flight or contact.
     pub region: Region,
+    /// Whether the series variable is the regularising time σ (a contact step at the
+    /// contact's edges) rather than τ − τ₀ (free flight, and a contact step in the contact's
+    /// interior, [`Jet::contact_interior`]).
+    pub sigma: bool,
     /// Start time τ₀.
     pub t0: f64,
     /// The state's coefficients, M·d (orders 0..=p formed).
@@ -156,6 +167,7 @@ impl Default for Series {
             d: 0,
             variational: false,
             region: Region::Free,
+            sigma: false,
             t0: 0.0,
             z: Vec::new(),
             phi: Vec::new(),
@@ -301,6 +313,7 @@ impl Series {
         self.p = p;
         self.variational = variational;
         self.region = region;
+        self.sigma = region == Region::Contact;
         self.t0 = t0;
         if self.d != d || self.z.len() != M * d {
             self.d = d;
@@ -337,7 +350,10 @@ impl Series {
             .iter()
             .fold(self.s[k].abs().max(self.c[k].abs()), |a, x| a.max(x.abs()));
         if self.region == Region::Contact {
-            m = m.max(self.theta[k].abs()).max(self.w[k].abs());
+            m = m.max(self.w[k].abs());
+            if self.sigma {
+                m = m.max(self.theta[k].abs());
+            }
         }
         if self.variational {
             let dd = d * d;
@@ -346,6 +362,11 @@ impl Series {
                 .fold(m, |a, x| a.max(x.abs()));
         }
         m
+    }
+
+    /// The indentation δ = −V_T (contact).
+    pub fn depth(&self) -> &[f64] {
+        &self.del[..=self.p]
     }
 
     /// The guard's series: V_T in free flight, w in contact (both positive inside the region).
@@ -519,17 +540,19 @@ impl Jet {
         }
         let mut sample = [0.0; RATE_NODES];
         if s.region == Region::Contact {
-            // F_d δ̇ — α6 δ̇² (Hertz), α6 w δ̇² (DMT) — and every rate times dτ/dσ = 2w
+            // F_d δ̇ — α6 δ̇² (Hertz), α6 w δ̇² (DMT) — and in σ every rate times dτ/dσ = 2w
             let (w, rate) = (at(&|k| s.w[k]), at(&|k| s.deld[k]));
             for g in 0..RATE_NODES {
                 sample[g] = match self.law {
                     Law::Hertz { c, .. } => c * rate[g] * rate[g],
                     Law::Dmt { c, .. } => c * w[g] * rate[g] * rate[g],
                 };
-                let dt = 2.0 * w[g];
-                base[g] *= dt;
-                beam[g] *= dt;
-                sample[g] *= dt;
+                if s.sigma {
+                    let dt = 2.0 * w[g];
+                    base[g] *= dt;
+                    beam[g] *= dt;
+                    sample[g] *= dt;
+                }
             }
         }
         [base, beam, sample].map(|r| {
@@ -602,6 +625,72 @@ impl Jet {
         }
     }
 
+    /// sin Ωτ and cos Ωτ's coefficients from (sin Ωτ₀, cos Ωτ₀) = (`sn`, `cs`): the closed
+    /// forms Ωᵏ/k! sin(Ωτ₀ + kπ/2), Ωᵏ/k! cos(Ωτ₀ + kπ/2), k ≤ `p`.
+    fn trig_series(&self, s: &mut Series, sn: f64, cs: f64, p: usize) {
+        let quarter = [(sn, cs), (cs, -sn), (-sn, -cs), (-cs, sn)];
+        for k in 0..=p {
+            let (a, b) = quarter[k & 3];
+            let f = self.trig_factor[k];
+            s.s[k] = f * a;
+            s.c[k] = f * b;
+        }
+    }
+
+    /// The state's coefficient of order k + 1 in τ from that of order k (`cur`, d, replaced
+    /// by it) and the tip force's `f` of order k: (k + 1) z_{k+1} = (ȧ_k, lower field).
+    #[inline(always)]
+    fn next_order<W: Width>(&self, w: W, s: &mut Series, cur: &mut [f64], k: usize, f: f64) {
+        let n = w.get();
+        let d = 2 * n;
+        let inv = 1.0 / (k + 1) as f64;
+        let mut lower = [0.0; crate::params::MAX_MODES];
+        let lower = &mut lower[..n];
+        self.lower_field(w, cur, k, s.s[k], s.c[k], f, lower);
+        let mut nxt = [0.0; 2 * crate::params::MAX_MODES];
+        let nxt = &mut nxt[..d];
+        for i in 0..n {
+            nxt[i] = cur[n + i] * inv;
+            nxt[n + i] = lower[i] * inv;
+        }
+        s.z[(k + 1) * d..(k + 2) * d].copy_from_slice(nxt);
+        cur.copy_from_slice(nxt);
+    }
+
+    /// Φ's coefficient of order k + 1 in τ: (k + 1) Φ_{k+1} = A Φ_k + M⁻¹φ Σ_j r_j with
+    /// r_j = F_V,j φᵀΦ_{k−j} + F_V̇,j φᵀΦ̇_{k−j} (module docs), the F_V̇ terms only when `rate`
+    /// (the contact; DMT's van der Waals force depends on V_T alone).
+    #[inline(always)]
+    fn next_phi_order<W: Width>(&self, w: W, s: &mut Series, k: usize, rate: bool) {
+        let n = w.get();
+        let d = 2 * n;
+        let dd = d * d;
+        let inv = 1.0 / (k + 1) as f64;
+        let (head, tail) = s.phi.split_at_mut((k + 1) * dd);
+        let phik = &head[k * dd..];
+        let next = &mut tail[..dd];
+        let gk = &mut s.gphi[..dd];
+        let (r, rd) = (&mut s.r[k * d..(k + 1) * d], &mut s.rd[k * d..(k + 1) * d]);
+        self.a_times_phi(w, phik, gk, r, rd);
+        for col in 0..d {
+            let mut rank = 0.0;
+            for j in 0..=k {
+                rank += s.fv[j] * s.r[(k - j) * d + col];
+            }
+            if rate {
+                for j in 0..=k {
+                    rank += s.fvd[j] * s.rd[(k - j) * d + col];
+                }
+            }
+            let g = &s.gphi[col * d..(col + 1) * d];
+            let o = &mut next[col * d..(col + 1) * d];
+            for i in 0..n {
+                o[i] = g[i] * inv;
+                o[n + i] = (g[n + i] + self.mphi[i] * rank) * inv;
+            }
+        }
+    }
+
     /// The series of the free flight from (τ₀, z₀) in τ − τ₀ to order `p` (with Φ(τ₀) = I when
     /// `variational`), into `s`.
     pub(crate) fn free(&self, s: &mut Series, t0: f64, z0: &[f64], variational: bool, p: usize) {
@@ -616,13 +705,7 @@ impl Jet {
     /// [`Jet::free_w`] with the state's two coefficients in registers.
     fn free_point_mass_dmt(&self, s: &mut Series, t0: f64, z0: &[f64], p: usize, h: f64, a0: f64) {
         let (sn, cs) = s.start(p, 2, false, Region::Free, t0, z0, self.omega);
-        let quarter = [(sn, cs), (cs, -sn), (-sn, -cs), (-cs, sn)];
-        for k in 0..=p {
-            let (a, b) = quarter[k & 3];
-            let f = self.trig_factor[k];
-            s.s[k] = f * a;
-            s.c[k] = f * b;
-        }
+        self.trig_series(s, sn, cs, p);
         let (phi, ak, ac, m) = (self.phi[0], self.ak[0], self.ac[0], self.mphi[0]);
         let (b0, bs, bc) = (self.b_const[0], self.b_sin[0], self.b_cos[0]);
         let (mut x, mut v) = (z0[0], z0[1]);
@@ -684,17 +767,8 @@ impl Jet {
     ) {
         let n = w.get();
         let d = 2 * n;
-        let dd = d * d;
         let (sn, cs) = s.start(p, d, variational, Region::Free, t0, z0, self.omega);
-        let quarter = [(sn, cs), (cs, -sn), (-sn, -cs), (-cs, sn)];
-        for k in 0..=p {
-            let (a, b) = quarter[k & 3];
-            let f = self.trig_factor[k];
-            s.s[k] = f * a;
-            s.c[k] = f * b;
-        }
-        let mut lower = [0.0; crate::params::MAX_MODES];
-        let lower = &mut lower[..n];
+        self.trig_series(s, sn, cs, p);
         // z_k in registers from one order to the next (not reloaded from the series)
         let mut cur = [0.0; 2 * crate::params::MAX_MODES];
         let cur = &mut cur[..d];
@@ -748,36 +822,111 @@ impl Jet {
                 }
             };
             s.f[k] = f;
-            let inv = 1.0 / (k + 1) as f64;
-            self.lower_field(w, zk, k, s.s[k], s.c[k], f, lower);
-            let mut nxt = [0.0; 2 * crate::params::MAX_MODES];
-            let nxt = &mut nxt[..d];
-            for i in 0..n {
-                nxt[i] = zk[n + i] * inv;
-                nxt[n + i] = lower[i] * inv;
-            }
-            s.z[(k + 1) * d..(k + 2) * d].copy_from_slice(nxt);
-            cur.copy_from_slice(nxt);
+            self.next_order(w, s, cur, k, f);
             if variational {
-                let (head, tail) = s.phi.split_at_mut((k + 1) * dd);
-                let phik = &head[k * dd..];
-                let next = &mut tail[..dd];
-                let gk = &mut s.gphi[..dd];
-                let (r, rd) = (&mut s.r[k * d..(k + 1) * d], &mut s.rd[k * d..(k + 1) * d]);
-                self.a_times_phi(w, phik, gk, r, rd);
-                for col in 0..d {
-                    // Σ_j F_V,j (φᵀΦ_{k−j})_col
-                    let mut rank = 0.0;
-                    for j in 0..=k {
-                        rank += s.fv[j] * s.r[(k - j) * d + col];
+                self.next_phi_order(w, s, k, false);
+            }
+        }
+    }
+
+    /// The series of the contact flow from (τ₀, z₀) in τ − τ₀ to order `p` (with Φ(τ₀) = I
+    /// when `variational`), into `s`: a step inside the contact, δ₀ = `w0`² > 0. The field is
+    /// the free flight's linear one plus M⁻¹φ F_c with F_c from w = √δ, whose series follows
+    /// from w² = δ: w_k = (δ_k − Σ_{0<j<k} w_j w_{k−j})/(2w₀) (the square root's recurrence,
+    /// Jorba & Zou 2005 §2), analytic while δ stays off 0 — the radius the step rule reads is
+    /// the distance to the complex time where δ = 0. Per order: two or three products of series
+    /// (w², w δ, for DMT's damper w δ̇ and δ̇/w), where the σ-series of [`Jet::contact`] takes one
+    /// per state component.
+    pub(crate) fn contact_interior(
+        &self,
+        s: &mut Series,
+        t0: f64,
+        z0: &[f64],
+        w0: f64,
+        variational: bool,
+        p: usize,
+    ) {
+        with_width!(self.n, w => self.contact_interior_w(w, s, t0, z0, w0, variational, p))
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn contact_interior_w<W: Width>(
+        &self,
+        wd: W,
+        s: &mut Series,
+        t0: f64,
+        z0: &[f64],
+        w0: f64,
+        variational: bool,
+        p: usize,
+    ) {
+        let n = wd.get();
+        let d = 2 * n;
+        let (sn, cs) = s.start(p, d, variational, Region::Contact, t0, z0, self.omega);
+        s.sigma = false;
+        self.trig_series(s, sn, cs, p);
+        s.theta[..=p].fill(0.0);
+        let om = self.omega;
+        let mut cur = [0.0; 2 * crate::params::MAX_MODES];
+        let cur = &mut cur[..d];
+        cur.copy_from_slice(z0);
+        let inv_2w0 = 0.5 / w0;
+        for k in 0..=p {
+            let zk = &*cur;
+            let v = self.v_t_coefficient(&zk[..n], k, s.s[k]);
+            let vd = dot(&self.phi[..n], &zk[n..]) + self.base * om * s.c[k];
+            s.v[k] = v;
+            s.del[k] = -v;
+            s.deld[k] = -vd;
+            // w = √δ: 2 w₀ w_k = δ_k − Σ_{0<j<k} w_j w_{k−j}
+            let wk = if k == 0 {
+                w0
+            } else {
+                let old = dot(&s.w[1..k], &s.wrev[M - k..M - 1]);
+                (s.del[k] - old) * inv_2w0
+            };
+            s.w[k] = wk;
+            s.wrev[M - 1 - k] = wk;
+            if k == p {
+                break;
+            }
+            let wdel = cauchy_rev(&s.del, &s.wrev, k);
+            let f = match self.law {
+                Law::Hertz { k: k4, c } => {
+                    if variational {
+                        // ∂F_c/∂V_T = −(3/2) α4 w, ∂F_c/∂(dV_T/dτ) = −α6
+                        s.fv[k] = -1.5 * k4 * wk;
+                        s.fvd[k] = if k == 0 { -c } else { 0.0 };
                     }
-                    let g = &s.gphi[col * d..(col + 1) * d];
-                    let o = &mut next[col * d..(col + 1) * d];
-                    for i in 0..n {
-                        o[i] = g[i] * inv;
-                        o[n + i] = (g[n + i] + self.mphi[i] * rank) * inv;
-                    }
+                    k4 * wdel + c * s.deld[k]
                 }
+                Law::Dmt { h, a0, k: k4, c } => {
+                    let adhesion = if k == 0 { -h / (a0 * a0) } else { 0.0 };
+                    let kv = if c == 0.0 {
+                        0.0
+                    } else {
+                        c * cauchy_rev(&s.deld, &s.wrev, k)
+                    };
+                    if variational {
+                        // ∂F_c/∂δ = (3/2) α4 w + α6 δ̇/(2w), ∂F_c/∂δ̇ = α6 w; q = δ̇/w from
+                        // w q = δ̇ (in `u`)
+                        let q = if c == 0.0 {
+                            0.0
+                        } else {
+                            let old = dot(&s.u[..k], &s.wrev[M - 1 - k..M - 1]);
+                            (s.deld[k] - old) / w0
+                        };
+                        s.u[k] = q;
+                        s.fv[k] = -1.5 * k4 * wk - 0.5 * c * q;
+                        s.fvd[k] = -c * wk;
+                    }
+                    adhesion + k4 * wdel + kv
+                }
+            };
+            s.f[k] = f;
+            self.next_order(wd, s, cur, k, f);
+            if variational {
+                self.next_phi_order(wd, s, k, true);
             }
         }
     }
@@ -947,6 +1096,83 @@ mod tests {
             let naive: f64 = (0..=k).map(|j| a[j] * b[k - j]).sum();
             let got = cauchy_rev(&a, &brev, k);
             assert!((got - naive).abs() <= 1e-15 * (1.0 + naive.abs()), "{k}");
+        }
+    }
+
+    /// Inside a contact the τ series ([`Jet::contact_interior`]) and the σ series
+    /// ([`Jet::contact`]) are two different recurrences of one flow: at the same τ, their states
+    /// and Jacobians agree to the truncation (Hertz, and DMT with a Kelvin–Voigt damper, whose
+    /// ∂F/∂δ carries δ̇/(2w)); and the τ series' w² is δ at every order.
+    #[test]
+    fn interior_tau_series_match_the_sigma_series() {
+        for law in [
+            ContactLaw::Hertz,
+            ContactLaw::Dmt {
+                hamaker: 0.02,
+                intermolecular_distance: 0.05,
+            },
+        ] {
+            let m = CantileverModel::new(&crate::Params {
+                contact_law: law,
+                alpha6: 0.3,
+                ..crate::Params::default()
+            })
+            .unwrap();
+            let jet = Jet::new(&m).unwrap();
+            let (n, d) = (m.modes(), m.dim());
+            let tip = m.tip().as_slice().to_vec();
+            let t2: f64 = tip.iter().map(|x| x * x).sum();
+            // V_T = −0.1 at τ = 0 (sin Ωτ = 0), entering the sample at dV_T/dτ = −0.3
+            let alpha5 = m.params().alpha5;
+            let mut z0 = vec![0.0; d];
+            for i in 0..n {
+                z0[i] = -(alpha5 + 0.1) * tip[i] / t2;
+                z0[n + i] =
+                    -0.3 * tip[i] / t2 - m.params().base_amplitude() * m.omega() * tip[i] / t2;
+            }
+            let delta0 = -m.v_t(0.0, &nalgebra::DVector::from_column_slice(&z0));
+            assert!((delta0 - 0.1).abs() < 1e-12);
+            let p = 22;
+            let (mut st, mut ss) = (Series::default(), Series::default());
+            jet.contact_interior(&mut st, 0.0, &z0, delta0.sqrt(), true, p);
+            jet.contact(&mut ss, 0.0, &z0, delta0.sqrt(), true, p);
+            assert!(!st.sigma && ss.sigma && st.region == Region::Contact);
+            for k in 0..=p {
+                let w2: f64 = (0..=k).map(|j| st.w[j] * st.w[k - j]).sum();
+                let size: f64 = (0..=k).map(|j| (st.w[j] * st.w[k - j]).abs()).sum();
+                assert!(
+                    (w2 - st.del[k]).abs() <= 1e-14 * size.max(st.del[k].abs()),
+                    "{law:?} k {k}"
+                );
+            }
+            // at the shorter of the two steps the step rule takes (each series is its flow to
+            // the tolerance within its own step)
+            let ht = super::super::rule(&st, m.period(), 1e-12);
+            let hs = super::super::rule(&ss, m.period(), 1e-12);
+            let h = ht.min(super::super::poly::eval(&ss.theta[..=p], hs));
+            let sigma = super::super::Taylor::sigma_at(&ss.theta[..=p], h, hs);
+            let (mut a, mut b) = (vec![0.0; d], vec![0.0; d]);
+            st.state_at(h, &mut a);
+            ss.state_at(sigma, &mut b);
+            for i in 0..d {
+                assert!(
+                    (a[i] - b[i]).abs() <= 1e-11 * (1.0 + b[i].abs()),
+                    "{law:?} z{i}: {} {}",
+                    a[i],
+                    b[i]
+                );
+            }
+            let (mut ja, mut jb) = (vec![0.0; d * d], vec![0.0; d * d]);
+            st.jacobian_at(h, &mut ja);
+            ss.jacobian_at(sigma, &mut jb);
+            for i in 0..d * d {
+                assert!(
+                    (ja[i] - jb[i]).abs() <= 1e-10 * (1.0 + jb[i].abs()),
+                    "{law:?} Φ{i}: {} {}",
+                    ja[i],
+                    jb[i]
+                );
+            }
         }
     }
 
