@@ -50,7 +50,7 @@ table=$(mktemp)
     t0=$(date +%s.%N); $A continue --contact-law $law --from 5 --to 4.5 --out "$tmp/c-$law" > /dev/null; t1=$(date +%s.%N)
     pts=$(python3 -c "import csv;print(sum(1 for _ in csv.DictReader(open('$tmp/c-$law/continuation.csv'))))")
     echo ""
-    how="Taylor series with the variational equations, the contact in its regularising time"
+    how="Taylor series with the variational equations, the contact's edges in its regularising time, its interior in τ"
     [ "$law" = hertz ] && how="split: exact free flight, Taylor series with the variational equations in contact"
     echo "Continuation of the period-1 branch with the $law law, Ω 5 → 4.5 ($how): $(python3 -c "print(f'{$t1-$t0:.2f}')") s for $pts points."
   done
