@@ -361,13 +361,15 @@ impl Integrator for Taylor {
                 let hit = poly::leftmost_crossing(s.guard(), h, dead, self.just_switched);
                 let e = hit.unwrap_or(h);
                 let theta = &s.theta[..=p];
-                let out = if poly::eval(theta, e) >= remaining {
+                if poly::eval(theta, e) >= remaining {
                     (Self::sigma_at(theta, remaining, e), tau_max, false)
                 } else {
-                    (e, tau0 + poly::eval(theta, e), hit.is_some())
-                };
-                self.interior.advance = out.1 - tau0;
-                out
+                    // a whole σ step's advance (not one cut at τ_max): the yardstick of the τ
+                    // steps
+                    let advance = poly::eval(theta, e);
+                    self.interior.advance = advance;
+                    (e, tau0 + advance, hit.is_some())
+                }
             }
         };
         self.just_switched = false;
