@@ -26,9 +26,9 @@
 //! least as far as the last σ step and δ stays positive over it, and the contact returns to σ
 //! for good once a τ step is refused past the deepest point (or the deepest point is passed
 //! without one). On the default beam (N = 3, Hertz) a contact takes 4 σ steps, 10 τ steps
-//! and 4 σ steps: 234.5 M → 151.5 M instructions over 450 periods (`period_cost hertz 3 200`),
-//! DMT 219.6 M → 172.0 M; the point mass, whose 5 σ steps per contact are long, keeps them
-//! (its contact's τ steps are no longer: 728 M → 729 M for the probe).
+//! and 4 σ steps: 234.5 M → 152.2 M instructions over 450 periods (`period_cost hertz 3 200`),
+//! DMT 219.6 M → 170.0 M; the point mass, whose 5 σ steps per contact are long, keeps them
+//! (its contact's τ steps are no longer: 728 M → 732 M for the probe, the test of δ̇).
 //!
 //! **Events** are zeros of the guard's Taylor polynomial — V_T in free flight, w in contact —
 //! located by safeguarded Newton on the polynomial itself (`poly::leftmost_crossing`; the
