@@ -121,6 +121,35 @@ fn multipliers_of_a_never_touching_orbit_are_exp_lambda_t() {
     assert!(o.stable);
 }
 
+/// A Broyden solve's start for a beam off the sample: the forced harmonic response in closed
+/// form (`want`), e^{AT} (`exact`, the free flight's monodromy matrix), an estimate of it off
+/// by 1 % of its norm in every entry (`m0`), a guess off the orbit by 1e-3 and the options.
+struct BroydenStart {
+    want: DVector<f64>,
+    exact: DMatrix<f64>,
+    m0: DMatrix<f64>,
+    guess: DVector<f64>,
+    opts: ShootingOptions,
+}
+
+fn broyden_start(m: &CantileverModel) -> BroydenStart {
+    let want = harmonic_response(m, Region::Free, 0.0);
+    let exact = (&m.dynamics(Region::Free).a * m.period()).exp();
+    let dim = want.len();
+    let m0 = &exact + DMatrix::from_element(dim, dim, 0.01 * exact.norm());
+    let guess = &want + DVector::from_element(dim, 1e-3 * (1.0 + want.norm()));
+    BroydenStart {
+        want,
+        exact,
+        m0,
+        guess,
+        opts: ShootingOptions {
+            tol: 1e-11,
+            max_iter: 30,
+        },
+    }
+}
+
 /// Broyden shooting — iterates by flows without the variational equations, the first Jacobian
 /// an estimate of the monodromy matrix (e^{AT} off by 1 % of its norm in every entry) —
 /// reaches the orbit of a beam that never touches the sample, the forced harmonic response in
@@ -134,22 +163,20 @@ fn broyden_shooting_from_an_estimated_jacobian_reaches_the_harmonic_orbit() {
         ..Params::default()
     };
     let m = model(p);
-    let want = harmonic_response(&m, Region::Free, 0.0);
+    let BroydenStart {
+        want,
+        m0,
+        guess,
+        opts,
+        ..
+    } = broyden_start(&m);
     let a = &m.dynamics(Region::Free).a;
-    let exact = (a * p.period()).exp();
-    let dim = want.len();
-    let m0 = &exact + DMatrix::from_element(dim, dim, 0.01 * exact.norm());
-    let guess = &want + DVector::from_element(dim, 1e-3 * (1.0 + want.norm()));
     let mut lambda_t: Vec<Complex<f64>> = a
         .complex_eigenvalues()
         .iter()
         .map(|l| (l * p.period()).exp())
         .collect();
     lambda_t.sort_by(|x, y| y.norm().total_cmp(&x.norm()));
-    let opts = ShootingOptions {
-        tol: 1e-11,
-        max_iter: 30,
-    };
     for kind in [IntegratorKind::Adaptive, IntegratorKind::Exact] {
         let io = IntegratorOptions {
             kind,
@@ -189,15 +216,14 @@ fn broyden_shooting_with_the_taylor_integrator_and_a_refused_estimate() {
         ..Params::default()
     };
     let m = model(p);
-    let want = harmonic_response(&m, Region::Free, 0.0);
-    let exact = (&m.dynamics(Region::Free).a * p.period()).exp();
+    let BroydenStart {
+        want,
+        exact,
+        m0,
+        guess,
+        opts,
+    } = broyden_start(&m);
     let dim = want.len();
-    let m0 = &exact + DMatrix::from_element(dim, dim, 0.01 * exact.norm());
-    let guess = &want + DVector::from_element(dim, 1e-3 * (1.0 + want.norm()));
-    let opts = ShootingOptions {
-        tol: 1e-11,
-        max_iter: 30,
-    };
     let io = IntegratorOptions {
         kind: IntegratorKind::Taylor,
         tolerance: 1e-12,

@@ -548,9 +548,7 @@ impl Acc {
         }
         // the short rule where a product of two factors has |c| ≤ 1 on the piece (module docs),
         // τ being the smooth time: a regularising time stretches the piece's rates unevenly
-        // (dτ/du is τ′ = b − a at both ends only when τ(u) is τ itself)
-        let in_tau = [0.0, 1.0].map(|u| integ.smooth_time(a, b, u).1) == [b - a; 2];
-        let short = in_tau && half * ctx.product_rate[r.index()] <= 1.0;
+        let short = integ.smooth_time_is_tau() && half * ctx.product_rate[r.index()] <= 1.0;
         for &(x, wx) in &ctx.gl[usize::from(short)] {
             let (tau, dtau) = integ.smooth_time(a, b, 0.5 * (x + 1.0));
             let nd = ctx.node(integ, r, tau);

@@ -623,12 +623,7 @@ impl<S: TipSampleSystem + Clone + 'static> Integrator for Adaptive<S> {
         let region = self.region;
         let d = self.dim();
         if tau_max <= tau0 {
-            return Ok(Step {
-                tau0,
-                tau1: tau0,
-                region,
-                event: None,
-            });
+            return Ok(Step::plain(tau0, tau0, region));
         }
         let var = self.variational;
         let mut y0 = std::mem::take(&mut self.start);
@@ -667,12 +662,7 @@ impl<S: TipSampleSystem + Clone + 'static> Integrator for Adaptive<S> {
             });
             self.stint_open = false;
             self.start = y0;
-            return Ok(Step {
-                tau0,
-                tau1: tau_max,
-                region,
-                event: None,
-            });
+            return Ok(Step::plain(tau0, tau_max, region));
         }
         let t1 = self.advance(&mut stepper, region, var, tau_max)?;
         self.h = stepper.h();
@@ -712,12 +702,7 @@ impl<S: TipSampleSystem + Clone + 'static> Integrator for Adaptive<S> {
             self.recycle(old);
             self.stint_open = !var;
             self.start = y0;
-            return Ok(Step {
-                tau0,
-                tau1: t1,
-                region,
-                event: None,
-            });
+            return Ok(Step::plain(tau0, t1, region));
         };
         // polish: Newton on g(τ), each iterate integrated afresh from the step's start
         let mut ts = t_guess;

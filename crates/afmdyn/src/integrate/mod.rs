@@ -68,6 +68,16 @@ pub struct SwitchEvent {
 }
 
 impl Step {
+    /// A step over [τ₀, τ₁] in `region` that ends without an event (τ₁ = τ₀: no step taken).
+    pub fn plain(tau0: f64, tau1: f64, region: Region) -> Step {
+        Step {
+            tau0,
+            tau1,
+            region,
+            event: None,
+        }
+    }
+
     /// A step of `model` in region `from` that ends at a plain switching at (τ_s, z_s).
     pub fn switched<S: TipSampleSystem + ?Sized>(
         model: &S,
@@ -263,6 +273,11 @@ pub trait Integrator: Send {
     /// contact onset, where the Hertz force ∝ (τ − τ_c)^{3/2} is not smooth in τ).
     fn smooth_time(&mut self, a: f64, b: f64, u: f64) -> (f64, f64) {
         (a + u * (b - a), b - a)
+    }
+    /// Whether [`Integrator::smooth_time`] is τ itself over the last step (the default; not in
+    /// the Taylor integrator's σ steps).
+    fn smooth_time_is_tau(&self) -> bool {
+        true
     }
     /// Integrate the variational equations along with the state (needed by
     /// [`Integrator::last_step_jacobian`] of the adaptive integrator; free for the exact one).

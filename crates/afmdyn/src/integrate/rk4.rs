@@ -132,12 +132,7 @@ impl<S: TipSampleSystem + Clone + 'static> Integrator for Rk4<S> {
         let region = self.region;
         let z0 = self.z.clone();
         if len <= 0.0 {
-            return Ok(Step {
-                tau0,
-                tau1: tau0,
-                region,
-                event: None,
-            });
+            return Ok(Step::plain(tau0, tau0, region));
         }
         let mut out = DVector::zeros(z0.len());
         if !self.locate {
@@ -160,12 +155,7 @@ impl<S: TipSampleSystem + Clone + 'static> Integrator for Rk4<S> {
                 self.region = after;
                 return Ok(Step::switched(&self.model, tau0, region, tau_b, &self.z));
             }
-            return Ok(Step {
-                tau0,
-                tau1: tau_b,
-                region,
-                event: None,
-            });
+            return Ok(Step::plain(tau0, tau_b, region));
         }
         let mode = Mode::Fixed(region);
         let sigma = region.guard_sign();
@@ -180,12 +170,7 @@ impl<S: TipSampleSystem + Clone + 'static> Integrator for Rk4<S> {
             self.last
                 .record(&self.model, region, tau0, &z0, self.tau, &self.z);
             check_finite(tau_b, &self.z)?;
-            return Ok(Step {
-                tau0,
-                tau1: tau_b,
-                region,
-                event: None,
-            });
+            return Ok(Step::plain(tau0, tau_b, region));
         }
         // Illinois (modified regula falsi) on s ↦ g(RK4(z0, s)), s in (0, len]
         let (mut lo, mut glo) = (0.0, g(&self.model, tau0, &z0).max(f64::MIN_POSITIVE));

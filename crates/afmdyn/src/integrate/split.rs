@@ -357,6 +357,10 @@ impl Integrator for Split {
         self.integ_mut(self.last).smooth_time(a, b, u)
     }
 
+    fn smooth_time_is_tau(&self) -> bool {
+        self.integ(self.last).smooth_time_is_tau()
+    }
+
     fn last_step_jacobian(&mut self) -> Result<DMatrix<f64>, SimError> {
         self.integ_mut(self.last).last_step_jacobian()
     }

@@ -6,7 +6,7 @@ use afmdyn::integrate::{
     advance_dyn, build, Integrator, IntegratorKind, IntegratorOptions, SwitchEvent,
 };
 use afmdyn::request::analyses::OrbitRequest;
-use afmdyn::{CantileverModel, HybridSystem};
+use afmdyn::{CantileverModel, ContactLaw, HybridSystem, SimError};
 use nalgebra::{Complex, DMatrix, DVector};
 
 /// Closed-form periodic forced response of region `r` from the second-order equations
@@ -101,5 +101,29 @@ pub fn against_adaptive_oracle(
         state: (&z1 - &z2).amax(),
         state_dop853: (&z3 - &z2).amax(),
         work: (w1, w3),
+    }
+}
+
+/// Whether `built` is [`SimError::Unsupported`] naming `integrator` (and `law`, when given): an
+/// integrator refusing a law it does not integrate.
+#[allow(dead_code)]
+pub fn is_refusal<T>(built: &Result<T, SimError>, integrator: &str, law: Option<&str>) -> bool {
+    matches!(built, Err(SimError::Unsupported { integrator: i, law: l, .. })
+        if *i == integrator && law.is_none_or(|w| *l == w))
+}
+
+/// `law` without its long-range attraction (DMT with H̃ = 0; the other laws as they are): a
+/// sample out of reach then exerts no force.
+#[allow(dead_code)]
+pub fn without_attraction(law: ContactLaw) -> ContactLaw {
+    match law {
+        ContactLaw::Dmt {
+            intermolecular_distance,
+            ..
+        } => ContactLaw::Dmt {
+            hamaker: 0.0,
+            intermolecular_distance,
+        },
+        l => l,
     }
 }

@@ -62,12 +62,7 @@ impl ExactPropagator {
         let tau_b = if snap { t_grid } else { t_grid.min(tau_max) };
         let len = tau_b - tau0;
         if len <= 0.0 {
-            return Ok(Step {
-                tau0,
-                tau1: tau0,
-                region,
-                event: None,
-            });
+            return Ok(Step::plain(tau0, tau0, region));
         }
         let full = self.on_grid.is_some() && tau_b == t_grid;
         // this step ends by t_grid, and until t_grid the next grid point stays `next`
@@ -210,12 +205,7 @@ impl ExactPropagator {
                         self.check_divergence()?;
                     }
                 }
-                Ok(Step {
-                    tau0,
-                    tau1: tau_b,
-                    region,
-                    event: None,
-                })
+                Ok(Step::plain(tau0, tau_b, region))
             }
             Some(t) => {
                 let tau_s = tau0 + t;
@@ -245,12 +235,7 @@ impl ExactPropagator {
                 self.enter_stint(to, sc);
                 self.chatter.record(tau_s)?;
                 if form == Form::Nothing {
-                    return Ok(Step {
-                        tau0,
-                        tau1: tau_s,
-                        region,
-                        event: None,
-                    });
+                    return Ok(Step::plain(tau0, tau_s, region));
                 }
                 Ok(Step::switched(&self.model, tau0, region, tau_s, &self.z))
             }

@@ -829,11 +829,30 @@ impl Jet {
         }
     }
 
+    /// The tip force's coefficient of order k in contact from the series of δ, δ̇ and w (w up
+    /// to order k in `wrev`), in τ or in σ alike: F_c = α4 wδ + α6 δ̇ (Hertz),
+    /// −H̃/ã₀² + α4 wδ + α6 wδ̇ (DMT; module docs).
+    #[inline(always)]
+    fn contact_force(&self, s: &Series, k: usize) -> f64 {
+        let wdel = cauchy_rev(&s.del, &s.wrev, k);
+        match self.law {
+            Law::Hertz { k: k4, c } => k4 * wdel + c * s.deld[k],
+            Law::Dmt { h, a0, k: k4, c } => {
+                let adhesion = if k == 0 { -h / (a0 * a0) } else { 0.0 };
+                let kv = if c == 0.0 {
+                    0.0
+                } else {
+                    c * cauchy_rev(&s.deld, &s.wrev, k)
+                };
+                adhesion + k4 * wdel + kv
+            }
+        }
+    }
+
     /// The series of the contact flow from (τ₀, z₀) in τ − τ₀ to order `p` (with Φ(τ₀) = I
     /// when `variational`), into `s`: a step inside the contact, δ₀ = `w0`² > 0. The field is
     /// the free flight's linear one plus M⁻¹φ F_c with F_c from w = √δ, whose series follows
-    /// from w² = δ: w_k = (δ_k − Σ_{0<j<k} w_j w_{k−j})/(2w₀) (the square root's recurrence,
-    /// Jorba & Zou 2005 §2), analytic while δ stays off 0 — the radius the step rule reads is
+    /// from w² = δ (the square root's recurrence, module docs), analytic while δ stays off 0 — the radius the step rule reads is
     /// the distance to the complex time where δ = 0. Per order: two or three products of series
     /// (w², w δ, for DMT's damper w δ̇ and δ̇/w), where the σ-series of [`Jet::contact`] takes one
     /// per state component.
@@ -890,24 +909,14 @@ impl Jet {
             if k == p {
                 break;
             }
-            let wdel = cauchy_rev(&s.del, &s.wrev, k);
-            let f = match self.law {
-                Law::Hertz { k: k4, c } => {
-                    if variational {
+            if variational {
+                match self.law {
+                    Law::Hertz { k: k4, c } => {
                         // ∂F_c/∂V_T = −(3/2) α4 w, ∂F_c/∂(dV_T/dτ) = −α6
                         s.fv[k] = -1.5 * k4 * wk;
                         s.fvd[k] = if k == 0 { -c } else { 0.0 };
                     }
-                    k4 * wdel + c * s.deld[k]
-                }
-                Law::Dmt { h, a0, k: k4, c } => {
-                    let adhesion = if k == 0 { -h / (a0 * a0) } else { 0.0 };
-                    let kv = if c == 0.0 {
-                        0.0
-                    } else {
-                        c * cauchy_rev(&s.deld, &s.wrev, k)
-                    };
-                    if variational {
+                    Law::Dmt { k: k4, c, .. } => {
                         // ∂F_c/∂δ = (3/2) α4 w + α6 δ̇/(2w), ∂F_c/∂δ̇ = α6 w; q = δ̇/w from
                         // w q = δ̇ (in `u`)
                         let q = if c == 0.0 {
@@ -920,9 +929,9 @@ impl Jet {
                         s.fv[k] = -1.5 * k4 * wk - 0.5 * c * q;
                         s.fvd[k] = -c * wk;
                     }
-                    adhesion + k4 * wdel + kv
                 }
-            };
+            }
+            let f = self.contact_force(s, k);
             s.f[k] = f;
             self.next_order(wd, s, cur, k, f);
             if variational {
@@ -985,29 +994,20 @@ impl Jet {
             s.wrev[M - 2 - k] = s.w[k + 1];
             s.theta[k + 1] = 2.0 * s.w[k] * inv;
             // the tip force and 2w ∂F_c/∂V_T, 2w ∂F_c/∂(dV_T/dτ)
-            let wdel = cauchy_rev(&s.del, &s.wrev, k);
-            let f = match self.law {
-                Law::Hertz { k: k4, c } => {
-                    if variational {
+            if variational {
+                // 2w ∂F_c/∂V_T and 2w ∂F_c/∂(dV_T/dτ) (module docs)
+                match self.law {
+                    Law::Hertz { k: k4, c } => {
                         s.fv[k] = -3.0 * k4 * s.del[k];
                         s.fvd[k] = -2.0 * c * s.w[k];
                     }
-                    k4 * wdel + c * s.deld[k]
-                }
-                Law::Dmt { h, a0, k: k4, c } => {
-                    if variational {
+                    Law::Dmt { k: k4, c, .. } => {
                         s.fv[k] = -3.0 * k4 * s.del[k] - c * s.deld[k];
                         s.fvd[k] = -2.0 * c * s.del[k];
                     }
-                    let adhesion = if k == 0 { -h / (a0 * a0) } else { 0.0 };
-                    let kv = if c == 0.0 {
-                        0.0
-                    } else {
-                        c * cauchy_rev(&s.deld, &s.wrev, k)
-                    };
-                    adhesion + k4 * wdel + kv
                 }
-            };
+            }
+            let f = self.contact_force(s, k);
             s.f[k] = f;
             // g_k = f(τ, z)_k (component-major), then z_{k+1} = 2 (w ⋆ g)_k / (k + 1): the terms
             // of the earlier orders of g first, the newest, w₀ g_k, last

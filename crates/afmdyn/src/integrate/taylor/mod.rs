@@ -26,9 +26,9 @@
 //! least as far as the last σ step and δ stays positive over it, and the contact returns to σ
 //! for good once a τ step is refused past the deepest point (or the deepest point is passed
 //! without one). On the default beam (N = 3, Hertz) a contact takes 4 σ steps, 10 τ steps
-//! and 4 σ steps: 234.5 M → 152.2 M instructions over 450 periods (`period_cost hertz 3 200`),
-//! DMT 219.6 M → 170.0 M; the point mass, whose 5 σ steps per contact are long, keeps them
-//! (its contact's τ steps are no longer: 728 M → 732 M for the probe, the test of δ̇).
+//! and 4 σ steps: 234.5 M → 152.4 M instructions over 450 periods (`period_cost hertz 3 200`),
+//! DMT 219.6 M → 169.6 M; the point mass, whose 5 σ steps per contact are long, keeps them
+//! (its contact's τ steps are no longer: 728.2 M → 728.6 M for the probe).
 //!
 //! **Events** are zeros of the guard's Taylor polynomial — V_T in free flight, w in contact —
 //! located by safeguarded Newton on the polynomial itself (`poly::leftmost_crossing`; the
@@ -303,12 +303,7 @@ impl Integrator for Taylor {
         let tau0 = self.tau;
         let region = self.region;
         if tau_max <= tau0 {
-            return Ok(Step {
-                tau0,
-                tau1: tau0,
-                region,
-                event: None,
-            });
+            return Ok(Step::plain(tau0, tau0, region));
         }
         self.budget.count(tau0)?;
         let (p, var) = (self.order, self.variational);
@@ -328,10 +323,11 @@ impl Integrator for Taylor {
                 }
             }
             Region::Contact => 'contact: {
-                let v = self.model.v_t(tau0, &self.z);
+                // V_T and dV_T/dτ from one sin/cos of Ωτ₀
+                let [_, _, v, v_dot] = self.model.tip_values(tau0, &self.z);
                 let w0 = (-v).max(0.0).sqrt();
                 let it = &mut self.interior;
-                if it.open && !it.taken && self.model.v_t_dot(tau0, &self.z) >= 0.0 {
+                if it.open && !it.taken && v_dot >= 0.0 {
                     // past the deepest point without a τ step: σ to the contact's end
                     it.open = false;
                 }
@@ -403,12 +399,7 @@ impl Integrator for Taylor {
         if !hit {
             self.z.as_mut_slice().copy_from_slice(z1);
             self.tau = tau1;
-            return Ok(Step {
-                tau0,
-                tau1,
-                region,
-                event: None,
-            });
+            return Ok(Step::plain(tau0, tau1, region));
         }
         let z_minus = DVector::from_column_slice(z1);
         let jump = self.model.jump(region, tau1, z1);
@@ -466,9 +457,12 @@ impl Integrator for Taylor {
 
     /// In contact the step is smooth in σ: τ(u) = τ₀ + θ(σ(u)), σ linear in u between σ(a) and
     /// σ(b).
+    fn smooth_time_is_tau(&self) -> bool {
+        !(self.last.valid && self.last.series.sigma)
+    }
+
     fn smooth_time(&mut self, a: f64, b: f64, u: f64) -> (f64, f64) {
-        let l = &self.last;
-        if !l.valid || !l.series.sigma {
+        if self.smooth_time_is_tau() {
             return (a + u * (b - a), b - a);
         }
         let (sa, sb) = match self.smooth_piece {
