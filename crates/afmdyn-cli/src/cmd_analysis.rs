@@ -34,9 +34,11 @@ pub struct SteadyArgs {
     /// Relative tolerance for returns of the stroboscopic map to coincide
     #[arg(long, default_value_t = 1e-8)]
     tol: f64,
-    /// Cap on the transient, in drive periods
-    #[arg(long, default_value_t = 1500)]
-    max_periods: usize,
+    /// Cap on the transient, in drive periods [default: derived from the model's slowest free
+    /// decay: six times the periods it takes to decay by --tol, at least 1500; ≈ 1.9 Q
+    /// ln(1/tol) for a lever of quality factor Q]
+    #[arg(long)]
+    max_periods: Option<usize>,
     /// Largest period searched (≤ 64)
     #[arg(long, default_value_t = 64)]
     max_period: usize,
@@ -588,6 +590,9 @@ pub fn attractors(a: &AttractorsArgs) -> Result<(), CliError> {
         &out.join("attractors.json"),
         serde_json::to_string_pretty(&doc).expect("json").as_bytes(),
     )?;
+    for w in report.warnings() {
+        eprintln!("afmdyn: warning: {w}");
+    }
     if a.json {
         println!("{doc}");
     } else {
@@ -608,6 +613,14 @@ pub fn attractors(a: &AttractorsArgs) -> Result<(), CliError> {
                 x.steady.stats.v_t_min,
                 x.steady.stats.contact_fraction,
                 if x.steady.stats.body_contact { "  (beam body touches the substrate: Fig. 2f)" } else { "" }
+            );
+        }
+        for x in &report.unsettled {
+            println!(
+                "  unsettled: {} start(s) still converging after {} periods (λ₁ = {:.3e})",
+                x.count,
+                report.transient_cap,
+                x.lyapunov.map_or(f64::NAN, |l| l.0)
             );
         }
         println!("outputs in {}", out.path().display());

@@ -192,6 +192,9 @@ pub fn basins_cmd(a: &BasinsArgs) -> Result<(), CliError> {
         &out.join("basins.json"),
         serde_json::to_string_pretty(&doc).expect("json").as_bytes(),
     )?;
+    for w in doc["warnings"].as_array().into_iter().flatten() {
+        eprintln!("afmdyn: warning: {}", w.as_str().unwrap_or_default());
+    }
     if a.json {
         println!("{doc}");
     } else {

@@ -368,9 +368,10 @@ pub struct LyapunovArgs {
     /// Initial modal state "a1,..,aN;adot1,..,adotN" (default: rest)
     #[arg(long, allow_hyphen_values = true)]
     initial_modal: Option<String>,
-    /// Drive periods discarded first
-    #[arg(long, default_value_t = 500)]
-    transient: usize,
+    /// Drive periods discarded first [default: derived from the model's slowest free decay,
+    /// as the steady-state searches' --max-periods: 1500 for the paper's beam]
+    #[arg(long)]
+    transient: Option<usize>,
     /// Drive periods averaged
     #[arg(long, default_value_t = 4000)]
     periods: usize,

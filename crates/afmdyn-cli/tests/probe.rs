@@ -423,3 +423,58 @@ fn simulate_with_a_probe_writes_si_time_series() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A Q = 500 lever (`examples/probe-rtespa300-polystyrene.toml`) at z_c = 14.3 nm: at its
+/// defaults `attractors` finds the two period-1 orbits (before the transient cap followed Q it
+/// reported eight "nonperiodic" attractors and no warning, issue 42) with the cap in the
+/// document; cut off at 300 periods, it warns on stderr and in the JSON.
+#[test]
+fn attractors_of_a_high_q_lever_settle_at_defaults_and_warn_when_cut_short() {
+    let probe = "examples/probe-rtespa300-polystyrene.toml";
+    let dir = std::env::temp_dir().join(format!("afmdyn-highq-{}", std::process::id()));
+    let out = dir.to_str().unwrap();
+    let doc = json(&[
+        "attractors",
+        "--probe",
+        probe,
+        "--z-c",
+        "14.3nm",
+        "--samples",
+        "8",
+        "--json",
+        "--out",
+        out,
+    ]);
+    let periods: Vec<_> = doc["attractors"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|a| a["period"].as_u64())
+        .collect();
+    assert!(
+        !periods.is_empty() && periods.iter().all(|p| *p == Some(1)),
+        "{periods:?}"
+    );
+    assert!(doc["transient_cap"].as_u64().unwrap() > 17_000);
+    assert_eq!(doc["warnings"], serde_json::json!([]));
+    let cut = run(&[
+        "attractors",
+        "--probe",
+        probe,
+        "--z-c",
+        "14.3nm",
+        "--samples",
+        "4",
+        "--max-periods",
+        "300",
+        "--out",
+        out,
+    ]);
+    assert!(cut.status.success());
+    let err = String::from_utf8_lossy(&cut.stderr);
+    assert!(
+        err.contains("afmdyn: warning:") && err.contains("300 drive periods"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -51,7 +51,7 @@ pub(crate) fn integrator_request(
 }
 
 /// The steady-state search of the keywords `tol`, `max_periods`, `max_period`.
-fn steady(tol: f64, max_periods: usize, max_period: usize) -> SteadyRequest {
+fn steady(tol: f64, max_periods: Option<usize>, max_period: usize) -> SteadyRequest {
     SteadyRequest {
         tol,
         max_periods,
@@ -63,7 +63,7 @@ fn steady(tol: f64, max_periods: usize, max_period: usize) -> SteadyRequest {
 fn start(
     initial: Option<Vec<f64>>,
     tol: f64,
-    max_periods: usize,
+    max_periods: Option<usize>,
     max_period: usize,
 ) -> StartRequest {
     StartRequest {
@@ -470,7 +470,7 @@ fn sweep_into<C: Checkpoint>(
 /// line's `--out` layout) and `resume` continues it.
 #[pyfunction]
 #[pyo3(signature = (params, param="omega", values=None, from_=1.0, to=5.0, steps=400, starts=0,
-    seed=1, continuation=true, threads=None, tol=1e-8, max_periods=1500, max_period=64,
+    seed=1, continuation=true, threads=None, tol=1e-8, max_periods=None, max_period=64,
     integrator=None, steps_per_period=None, tolerance=1e-12, progress=None, store=None,
     resume=false))]
 #[allow(clippy::too_many_arguments)]
@@ -487,7 +487,7 @@ pub fn bifurcation<'py>(
     continuation: bool,
     threads: Option<usize>,
     tol: f64,
-    max_periods: usize,
+    max_periods: Option<usize>,
     max_period: usize,
     integrator: Option<&str>,
     steps_per_period: Option<usize>,
@@ -655,7 +655,7 @@ fn steady_dict<'py>(py: Python<'py>, s: &SteadyState) -> PyResult<Dict<'py>> {
 
 /// Coexisting attractors and their basin fractions at fixed parameters.
 #[pyfunction]
-#[pyo3(signature = (params, samples=64, seed=1, cluster_tol=1e-5, tol=1e-8, max_periods=1500,
+#[pyo3(signature = (params, samples=64, seed=1, cluster_tol=1e-5, tol=1e-8, max_periods=None,
     max_period=64, integrator=None, steps_per_period=None, tolerance=1e-12, progress=None,
     probe=None))]
 #[allow(clippy::too_many_arguments)]
@@ -666,7 +666,7 @@ pub fn attractors<'py>(
     seed: u64,
     cluster_tol: f64,
     tol: f64,
-    max_periods: usize,
+    max_periods: Option<usize>,
     max_period: usize,
     integrator: Option<&str>,
     steps_per_period: Option<usize>,
@@ -705,7 +705,7 @@ pub fn attractors<'py>(
 /// `afmdyn attractors --sweep --json` (the Python layer builds the dataset from it).
 #[pyfunction]
 #[pyo3(signature = (params, param="omega", from_=1.5, to=3.0, steps=16, values=None,
-    match_tol=0.1, samples=16, seed=1, cluster_tol=1e-5, tol=1e-8, max_periods=1500,
+    match_tol=0.1, samples=16, seed=1, cluster_tol=1e-5, tol=1e-8, max_periods=None,
     max_period=64, integrator=None, steps_per_period=None, tolerance=1e-12, progress=None,
     probe=None))]
 #[allow(clippy::too_many_arguments)]
@@ -722,7 +722,7 @@ pub fn global_continuation<'py>(
     seed: u64,
     cluster_tol: f64,
     tol: f64,
-    max_periods: usize,
+    max_periods: Option<usize>,
     max_period: usize,
     integrator: Option<&str>,
     steps_per_period: Option<usize>,
@@ -751,7 +751,7 @@ pub fn global_continuation<'py>(
 
 /// A period-n orbit by Newton shooting, with its Floquet multipliers.
 #[pyfunction]
-#[pyo3(signature = (params, period=None, initial=None, tol=1e-8, max_periods=1500,
+#[pyo3(signature = (params, period=None, initial=None, tol=1e-8, max_periods=None,
     max_period=64, progress=None, probe=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn orbit<'py>(
@@ -760,7 +760,7 @@ pub fn orbit<'py>(
     period: Option<usize>,
     initial: Option<Vec<f64>>,
     tol: f64,
-    max_periods: usize,
+    max_periods: Option<usize>,
     max_period: usize,
     progress: Option<Bound<'py, PyAny>>,
     probe: Option<PathBuf>,
@@ -804,7 +804,7 @@ fn event_name(e: BranchEvent) -> String {
 /// Pseudo-arclength continuation of a period-n branch, with located bifurcations.
 #[pyfunction]
 #[pyo3(signature = (params, param="omega", from_=5.0, to=1.0, period=None, switch=false,
-    initial=None, tol=1e-8, max_periods=1500, max_period=64, progress=None, probe=None))]
+    initial=None, tol=1e-8, max_periods=None, max_period=64, progress=None, probe=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn continuation<'py>(
     py: Python<'py>,
@@ -816,7 +816,7 @@ pub fn continuation<'py>(
     switch: bool,
     initial: Option<Vec<f64>>,
     tol: f64,
-    max_periods: usize,
+    max_periods: Option<usize>,
     max_period: usize,
     progress: Option<Bound<'py, PyAny>>,
     probe: Option<PathBuf>,
@@ -911,14 +911,14 @@ pub fn continuation<'py>(
 
 /// Lyapunov spectrum (with saltation matrices) and the 0–1 test.
 #[pyfunction]
-#[pyo3(signature = (params, initial=None, transient=500, periods=4000, blocks=10, progress=None,
+#[pyo3(signature = (params, initial=None, transient=None, periods=4000, blocks=10, progress=None,
     probe=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn lyapunov<'py>(
     py: Python<'py>,
     params: PyRef<'_, PyParams>,
     initial: Option<Vec<f64>>,
-    transient: usize,
+    transient: Option<usize>,
     periods: usize,
     blocks: usize,
     progress: Option<Bound<'py, PyAny>>,
@@ -952,7 +952,7 @@ pub fn probe(path: std::path::PathBuf) -> PyResult<(PyParams, String)> {
 /// found as by `orbit` (polished by Newton shooting when periodic), then
 /// [`afmdyn::analysis::observables::observe`] integrates `periods` orbit periods.
 #[pyfunction]
-#[pyo3(signature = (params, initial=None, periods=1, harmonics=10, tol=1e-8, max_periods=1500,
+#[pyo3(signature = (params, initial=None, periods=1, harmonics=10, tol=1e-8, max_periods=None,
     max_period=64, progress=None, probe=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn observe<'py>(
@@ -962,7 +962,7 @@ pub fn observe<'py>(
     periods: usize,
     harmonics: usize,
     tol: f64,
-    max_periods: usize,
+    max_periods: Option<usize>,
     max_period: usize,
     progress: Option<Bound<'py, PyAny>>,
     probe: Option<PathBuf>,

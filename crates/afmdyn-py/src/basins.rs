@@ -34,7 +34,7 @@ pub fn basins<'py>(
     stride: usize,
     cluster_tol: f64,
     tol: f64,
-    max_periods: usize,
+    max_periods: Option<usize>,
     max_period: usize,
     base: Option<Vec<f64>>,
     integrator: Option<&str>,

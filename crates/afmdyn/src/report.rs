@@ -5,7 +5,7 @@
 //! Every function returns a [`serde_json::Value`] object; serialised with
 //! `serde_json::to_string` it is byte for byte what the command line prints.
 
-use crate::analysis::attractors::AttractorReport;
+use crate::analysis::attractors::{Attractor, AttractorReport};
 use crate::analysis::continuation::Branch;
 use crate::analysis::converge::ConvergenceRun;
 use crate::analysis::global_continuation::ContinuationStep;
@@ -169,12 +169,33 @@ pub fn attractors(params: &Params, samples: usize, report: &AttractorReport) -> 
         "params": params,
         "samples": samples,
         "failures": report.failures.len(),
+        "transient_cap": report.transient_cap,
         "attractors": report
             .attractors
             .iter()
-            .map(|x| attractor(&x.steady, x.basin_fraction, x.orbit.as_ref()))
+            .map(|x| census_entry(x, x.basin_fraction))
             .collect::<Vec<_>>(),
+        "unsettled": report
+            .unsettled
+            .iter()
+            .map(|x| {
+                let mut d = census_entry(x, 0.0);
+                d["count"] = json!(x.count);
+                d
+            })
+            .collect::<Vec<_>>(),
+        "warnings": report.warnings(),
     })
+}
+
+/// One attractor of a census: [`attractor`] with λ₁ and its error for a nonperiodic one.
+fn census_entry(x: &Attractor, basin: f64) -> Value {
+    let mut d = attractor(&x.steady, basin, x.orbit.as_ref());
+    if let Some((l, e)) = x.lyapunov {
+        d["lyapunov"] = json!(l);
+        d["lyapunov_error"] = json!(e);
+    }
+    d
 }
 
 /// `afmdyn attractors --sweep --json`: the attractors at every value with their ids, and the
@@ -200,7 +221,7 @@ pub fn global_continuation(
             row
         })
         .collect();
-    let warnings: Vec<String> = steps
+    let mut warnings: Vec<String> = steps
         .iter()
         .filter(|s| s.attractors.is_empty())
         .map(|s| {
@@ -212,6 +233,11 @@ pub fn global_continuation(
             )
         })
         .collect();
+    for s in steps {
+        for w in &s.warnings {
+            warnings.push(format!("{} = {}: {w}", param.name(), s.value));
+        }
+    }
     json!({
         "params": base,
         "param": param.name(),

@@ -154,7 +154,7 @@ fn sweep_streams_every_point_once_and_resume_skips_done_points() {
         starts: 1,
         seed: 3,
         steady: SteadyOptions {
-            max_periods: 400,
+            max_periods: Some(400),
             ..SteadyOptions::default()
         },
         integrator: IntegratorOptions::default(),

@@ -153,7 +153,7 @@ fn a_plastic_impact_law_has_an_orbit_and_a_spectrum() {
     let o = OrbitRequest::default().run(&params).unwrap();
     assert!(o.switchings >= 2, "the orbit taps the sample");
     let l = LyapunovRequest {
-        transient: 100,
+        transient: Some(100),
         periods: 400,
         ..LyapunovRequest::default()
     }

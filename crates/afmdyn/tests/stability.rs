@@ -27,7 +27,7 @@ fn attractor(m: &CantileverModel) -> (DVector<f64>, Option<usize>) {
     let s = steady_state(
         it.as_mut(),
         &SteadyOptions {
-            max_periods: 600,
+            max_periods: Some(600),
             ..SteadyOptions::default()
         },
     )

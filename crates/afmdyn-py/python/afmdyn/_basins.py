@@ -39,7 +39,7 @@ def basins(
     stride: int = 0,
     cluster_tol: float = 1e-5,
     tol: float = 1e-8,
-    max_periods: int = 1500,
+    max_periods: Optional[int] = None,
     max_period: int = 64,
     integrator: Optional[str] = None,
     steps_per_period: Optional[int] = None,

@@ -132,7 +132,7 @@ def chart(
     max_attractors: int = 8,
     threads: Optional[int] = None,
     tol: float = 1e-8,
-    max_periods: int = 1500,
+    max_periods: Optional[int] = None,
     max_period: int = 64,
     integrator: Optional[str] = None,
     steps_per_period: Optional[int] = None,

@@ -5,6 +5,7 @@
 //! ~ tol/(1 − |μ₁|) for slowly contracting orbits) and its Floquet multipliers are reported.
 
 use super::bifurcation::random_state;
+use super::lyapunov::largest_exponent;
 use super::period::close;
 #[cfg(not(feature = "parallel"))]
 use super::sequential::*;
@@ -83,13 +84,34 @@ pub struct Attractor {
     /// (`None` for a nonperiodic motion, for an integrator without step Jacobians — RK4 — or when
     /// Newton's method did not converge).
     pub orbit: Option<PeriodicOrbit>,
+    /// The largest Lyapunov exponent λ₁ (per unit τ) of a nonperiodic motion and its error,
+    /// over [`CENSUS_LYAPUNOV_PERIODS`] drive periods from its last section point (`None` for
+    /// a periodic one, or when the estimate failed).
+    pub lyapunov: Option<(f64, f64)>,
 }
+
+impl Attractor {
+    /// A nonperiodic end whose λ₁ is below −2 × its error: a motion still converging (to an
+    /// orbit the transient cap did not reach, or of a period above the largest searched), not
+    /// an attractor.
+    pub fn unsettled(&self) -> bool {
+        self.steady.period().is_none() && matches!(self.lyapunov, Some((l, e)) if l < -2.0 * e)
+    }
+}
+
+/// Drive periods of the λ₁ estimate of a census's nonperiodic ends (as a chart's default).
+pub const CENSUS_LYAPUNOV_PERIODS: usize = 500;
 
 /// The result of an attractor search.
 #[derive(Debug, Clone, PartialEq)]
 pub struct AttractorReport {
     /// Attractors, most frequent first.
     pub attractors: Vec<Attractor>,
+    /// Ends that had not settled within the transient cap ([`Attractor::unsettled`]), grouped
+    /// as the attractors are; not attractors, and not counted in the basin fractions.
+    pub unsettled: Vec<Attractor>,
+    /// The transient cap of the runs, in drive periods ([`SteadyOptions::cap`]).
+    pub transient_cap: usize,
     /// Starts that failed (error messages).
     pub failures: Vec<String>,
 }
@@ -175,24 +197,89 @@ pub(crate) fn census(
                     count: counted,
                     basin_fraction: 0.0,
                     orbit: None,
+                    lyapunov: None,
                 }),
             },
         }
     }
+    attractors
+        .par_iter_mut()
+        .with_max_len(1)
+        .for_each(|a| polish(model, spec.integrator, a));
+    let (unsettled, attractors): (Vec<Attractor>, Vec<Attractor>) =
+        merge_polished(attractors, spec.cluster_tol)
+            .into_iter()
+            .partition(Attractor::unsettled);
+    let mut attractors = attractors;
     let ok: usize = attractors.iter().map(|a| a.count).sum();
     for a in &mut attractors {
         a.basin_fraction = a.count as f64 / ok.max(1) as f64;
     }
     // most frequent first (a stable sort: ties keep the order found)
     attractors.sort_by_key(|a| std::cmp::Reverse(a.count));
-    attractors
-        .par_iter_mut()
-        .with_max_len(1)
-        .for_each(|a| polish(model, spec.integrator, a));
     Ok(AttractorReport {
         attractors,
+        unsettled,
+        transient_cap: spec.steady.cap(model),
         failures,
     })
+}
+
+impl AttractorReport {
+    /// The caveats of the census (the `warnings` of its document): starts that ended unsettled.
+    pub fn warnings(&self) -> Vec<String> {
+        let mut w = Vec::new();
+        let undecided: usize = self
+            .attractors
+            .iter()
+            .filter(|a| matches!(a.lyapunov, Some((l, e)) if l.abs() <= 2.0 * e))
+            .map(|a| a.count)
+            .sum();
+        if undecided > 0 {
+            w.push(format!(
+                "{undecided} start(s) ended on a nonperiodic motion with λ₁ ≈ 0 (within twice \
+                 its error) after the transient cap of {} drive periods: quasi-periodic, or \
+                 still settling; raise max_periods to tell (a lever of quality factor Q \
+                 settles over ~Q periods)",
+                self.transient_cap
+            ));
+        }
+        let ends: usize = self.unsettled.iter().map(|a| a.count).sum();
+        if ends == 0 {
+            return w;
+        }
+        let worst = self
+            .unsettled
+            .iter()
+            .filter_map(|a| a.lyapunov.map(|l| l.0))
+            .fold(f64::NEG_INFINITY, f64::max);
+        w.push(format!(
+            "{ends} start(s) had not settled after the transient cap of {} drive periods \
+             (nonperiodic with λ₁ ≤ {worst:.3e} < 0: still converging; not counted as \
+             attractors): raise max_periods",
+            self.transient_cap
+        ));
+        w
+    }
+}
+
+/// One orbit, one attractor: clusters whose polished orbits coincide ([`same_attractor`] on
+/// the orbits' section points, which Newton put within its tolerance of the orbit) are merged
+/// into the first, their counts added. Runs are clustered on their last returns, which lie
+/// off the orbit by up to tol/(1 − |μ₁|) — more than the clustering tolerance for a slowly
+/// contracting orbit (|μ₁| ≈ 0.994 at Q = 500) — so two clusters can hold one orbit.
+fn merge_polished(attractors: Vec<Attractor>, tol: f64) -> Vec<Attractor> {
+    let mut merged: Vec<Attractor> = Vec::with_capacity(attractors.len());
+    for a in attractors {
+        let same = |b: &&mut Attractor| {
+            a.orbit.is_some() && b.orbit.is_some() && same_attractor(&b.steady, &a.steady, tol)
+        };
+        match merged.iter_mut().find(same) {
+            Some(b) => b.count += a.count,
+            None => merged.push(a),
+        }
+    }
+    merged
 }
 
 /// A start and the steady state it reaches.
@@ -224,8 +311,17 @@ fn steady_states_of_starts(
 /// Polish a periodic attractor by shooting from its last section point and replace its
 /// Poincaré points with the orbit's (the cycle keeps its phase: the point after the last one
 /// recorded is the first).
+/// A nonperiodic one gets its λ₁ estimate instead ([`Attractor::lyapunov`]).
 fn polish(model: &CantileverModel, integrator: IntegratorOptions, a: &mut Attractor) {
     a.orbit = polish_steady(model, integrator, &mut a.steady);
+    if a.steady.period().is_none() {
+        a.lyapunov = largest_exponent(
+            model,
+            a.steady.end_state(),
+            CENSUS_LYAPUNOV_PERIODS,
+            integrator,
+        );
+    }
 }
 
 /// Polish a periodic steady state by Newton shooting: its Poincaré points become the orbit's

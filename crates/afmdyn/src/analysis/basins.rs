@@ -491,6 +491,7 @@ fn run_row(
     // one integrator per row, reset to each start (building one costs more than the few
     // periods most starts of the second pass run)
     let mut integrator: Option<Box<dyn Integrator>> = None;
+    let cap = spec.steady.cap(model);
     for &ix in columns {
         progress.check()?;
         let xv = spec.xs[ix];
@@ -508,7 +509,7 @@ fn run_row(
             };
             let (mut near_run, mut cell_run) = ((usize::MAX, 0), (usize::MAX, 0));
             let mut grid_run = (usize::MAX, 0);
-            for k in 1..=spec.discover_after.min(spec.steady.max_periods) {
+            for k in 1..=spec.discover_after.min(cap) {
                 advance(integ.as_mut(), k as f64 * period)?;
                 let z = integ.state();
                 match grid.and_then(|g| g.lookup(spec, model, z)) {
@@ -541,7 +542,7 @@ fn run_row(
             }
             let done = visited.len();
             let opts = SteadyOptions {
-                max_periods: spec.steady.max_periods.saturating_sub(done).max(1),
+                max_periods: Some(cap.saturating_sub(done).max(1)),
                 ..spec.steady
             };
             // a motion without a period up to the cap is a nonperiodic attractor (chaotic or

@@ -110,6 +110,8 @@ pub struct ContinuationStep {
     pub attractors: Vec<(usize, Attractor)>,
     /// Runs that failed (random starts and seeds), their messages.
     pub failures: Vec<String>,
+    /// The census's caveats ([`super::attractors::AttractorReport::warnings`]).
+    pub warnings: Vec<String>,
 }
 
 /// The symmetric Hausdorff distance between two sets of Poincaré points, each distance
@@ -197,10 +199,12 @@ pub fn global_continuation(
         };
         let found = census(&model, &census_spec, starts, &seeds, progress)?;
         let ids = match_ids(previous, &found.attractors, spec.match_tol, &mut next_id);
+        let warnings = found.warnings();
         steps.push(ContinuationStep {
             value,
             attractors: ids.into_iter().zip(found.attractors).collect(),
             failures: found.failures,
+            warnings,
         });
     }
     Ok(steps)
@@ -237,6 +241,7 @@ mod tests {
             count: 1,
             basin_fraction: 0.0,
             orbit: None,
+            lyapunov: None,
         }
     }
 

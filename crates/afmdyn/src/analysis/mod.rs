@@ -21,6 +21,7 @@ pub mod period;
 pub mod progress;
 pub mod resonance;
 pub mod setpoint;
+pub mod settle;
 pub mod shooting;
 pub mod spectrum;
 pub mod steady;

@@ -1,12 +1,16 @@
 //! Steady state on the stroboscopic Poincaré map τ = 2πk/Ω (drive phase 0) and its statistics.
 
 use super::period::{detect_period, minimal_divisor, MAX_PERIOD, MERGE_FACTOR};
+use super::settle::{minimal_period, newton_from_transient, SettleOptions, CENSUS_SETTLED};
+use super::shooting::ShootingOptions;
+use crate::eigen::damped_eigenvalues;
 use crate::error::SimError;
 use crate::galerkin::Region;
 use crate::integrate::{advance, advance_observed, Integrator, Observed, Observer, Step};
 use crate::model::BodyContactCheck;
 use crate::roots::extremum;
 use crate::system::EventKind;
+use crate::tip_sample::TipSampleSystem;
 use nalgebra::DVector;
 use serde::Serialize;
 use std::collections::VecDeque;
@@ -16,22 +20,89 @@ use std::collections::VecDeque;
 pub struct SteadyOptions {
     /// Relative tolerance for two returns to coincide.
     pub tol: f64,
-    /// Cap on the transient, in drive periods.
-    pub max_periods: usize,
+    /// Cap on the transient, in drive periods; `None`: derived from the model's slowest free
+    /// decay ([`SteadyOptions::cap`], [`default_transient_cap`]).
+    pub max_periods: Option<usize>,
     /// Largest period searched (≤ 64).
     pub max_period: usize,
     /// Periods recorded for a motion classified nonperiodic.
     pub nonperiodic_record: usize,
+    /// On a slowly decaying model (one whose slowest free mode takes more than
+    /// [`NEWTON_DECAY_PERIODS`] to decay by `tol`: Q above ~170 at resonance), decide by Newton
+    /// shooting from the transient as soon as the motion is seen to go to a stable orbit
+    /// ([`super::settle`]) instead of waiting for its returns to repeat to `tol`.
+    pub newton: bool,
 }
 
 impl Default for SteadyOptions {
     fn default() -> Self {
         SteadyOptions {
             tol: 1e-8,
-            max_periods: 1500,
+            max_periods: None,
             max_period: MAX_PERIOD,
             nonperiodic_record: 64,
+            newton: true,
         }
+    }
+}
+
+/// Fewest drive periods of a derived transient cap ([`default_transient_cap`]): the cap that
+/// settles the paper's beam (Q ≈ 42, its slowest mode decaying by 1e-8 in 248 periods).
+pub const MIN_TRANSIENT_PERIODS: usize = 1_500;
+
+/// Drive periods of free decay by the tolerance ([`decay_periods`]) above which a search
+/// decides by Newton from the transient ([`SteadyOptions::newton`]). Below, the returns repeat
+/// within a few hundred periods, which Newton's attempts — each some six flows with the
+/// variational equations, every 100 periods — would not shorten: the paper's beam decays in
+/// 248 periods at Ω = 2.6 and 477 at Ω = 5, the RTESPA-300 (Q = 500) in 2 932.
+pub const NEWTON_DECAY_PERIODS: f64 = 1_000.0;
+
+/// Decay times ([`decay_periods`]) of the slowest free mode in a derived transient cap: a
+/// nonlinear orbit's leading Floquet multiplier may lie closer to the unit circle than the
+/// free decay e^{−π/Q} (near a fold); six times covers the margins measured on the
+/// RTESPA-300 probe (Q = 500), whose returns repeat to 1e-8 within 3 000 – 12 000 periods.
+pub const TRANSIENT_DECAY_TIMES: f64 = 6.0;
+
+/// Drive periods the slowest free mode of the cantilever takes to decay by the factor `tol`:
+/// ln(1/tol)/(|Re λ| T), λ the damped eigenvalue with the smallest |Re λ| (eqs. 20–21) and T
+/// the drive period — ≈ Q ln(1/tol)/π for a lever of quality factor Q driven at resonance.
+/// `None` for a system that is not the cantilever model or an undamped one.
+pub fn decay_periods(system: &dyn TipSampleSystem, tol: f64) -> Option<f64> {
+    let model = system.cantilever()?;
+    let g = model.galerkin().region(Region::Free);
+    let slowest = damped_eigenvalues(g)
+        .iter()
+        .map(|e| e.re.abs())
+        .fold(f64::INFINITY, f64::min);
+    let decay = (1.0 / tol).ln() / (slowest * model.period());
+    (decay.is_finite() && decay > 0.0).then_some(decay)
+}
+
+/// The default cap on a steady-state search's transient, the one rule of every analysis that
+/// waits for a steady state: [`TRANSIENT_DECAY_TIMES`] × [`decay_periods`], within
+/// [[`MIN_TRANSIENT_PERIODS`], [`MAX_STEADY_PERIODS`]] (the floor for a system without a
+/// decay rate). The paper's beam keeps 1 500 periods; the RTESPA-300 (Q = 500) gets 17 600.
+pub fn default_transient_cap(system: &dyn TipSampleSystem, tol: f64) -> usize {
+    let Some(decay) = decay_periods(system, tol) else {
+        return MIN_TRANSIENT_PERIODS;
+    };
+    (TRANSIENT_DECAY_TIMES * decay)
+        .ceil()
+        .clamp(MIN_TRANSIENT_PERIODS as f64, MAX_STEADY_PERIODS as f64) as usize
+}
+
+impl SteadyOptions {
+    /// The transient cap on `system`: `max_periods` when given, else
+    /// [`default_transient_cap`].
+    pub fn cap(&self, system: &dyn TipSampleSystem) -> usize {
+        self.max_periods
+            .unwrap_or_else(|| default_transient_cap(system, self.tol))
+    }
+
+    /// Whether the search decides by Newton from the transient on `system` (see
+    /// [`SteadyOptions::newton`]).
+    pub fn newton_on(&self, system: &dyn TipSampleSystem) -> bool {
+        self.newton && decay_periods(system, self.tol).is_some_and(|d| d > NEWTON_DECAY_PERIODS)
     }
 }
 
@@ -296,8 +367,8 @@ impl ReturnHistory {
     }
 
     /// Whether the transient cap is reached.
-    fn exhausted(&self, opts: &SteadyOptions) -> bool {
-        self.k >= opts.max_periods
+    fn exhausted(&self, cap: usize) -> bool {
+        self.k >= cap
     }
 
     /// Account for the next return; `Some(n)` once a period n is confirmed.
@@ -322,6 +393,13 @@ impl ReturnHistory {
     }
 }
 
+/// Smallest tolerance of the return test: returns of a map computed to round-off (~1e-15
+/// relative) coincide no closer.
+pub const MIN_TOL: f64 = 1e-14;
+/// Largest tolerance of the return test: beyond it a slowly converging transient or a
+/// chaotic motion is taken for a period-n orbit.
+pub const MAX_TOL: f64 = 1e-3;
+
 /// Largest transient cap of a steady-state search, in drive periods.
 pub const MAX_STEADY_PERIODS: usize = 10_000_000;
 
@@ -329,14 +407,14 @@ impl SteadyOptions {
     /// Check the options (the one place of their limits; the request layer calls it).
     ///
     /// # Errors
-    /// [`SimError::OutOfRange`] naming `tol` (finite, > 0), `max_period` (1..=64) or
-    /// `max_periods` (1..=[`MAX_STEADY_PERIODS`]).
+    /// [`SimError::OutOfRange`] naming `tol` ([[`MIN_TOL`], [`MAX_TOL`]]), `max_period`
+    /// (1..=64) or `max_periods` (1..=[`MAX_STEADY_PERIODS`]).
     pub fn validate(&self) -> Result<(), SimError> {
-        if !(self.tol.is_finite() && self.tol > 0.0) {
+        if !(MIN_TOL..=MAX_TOL).contains(&self.tol) {
             return Err(SimError::out_of_range(
                 "tol",
                 self.tol,
-                "must be finite and > 0",
+                "must be in [1e-14, 1e-3]",
             ));
         }
         if !(1..=MAX_PERIOD).contains(&self.max_period) {
@@ -346,12 +424,14 @@ impl SteadyOptions {
                 "must be in 1..=64",
             ));
         }
-        if !(1..=MAX_STEADY_PERIODS).contains(&self.max_periods) {
-            return Err(SimError::out_of_range(
-                "max_periods",
-                self.max_periods,
-                "must be in 1..=10000000",
-            ));
+        if let Some(m) = self.max_periods {
+            if !(1..=MAX_STEADY_PERIODS).contains(&m) {
+                return Err(SimError::out_of_range(
+                    "max_periods",
+                    m,
+                    "must be in 1..=10000000",
+                ));
+            }
         }
         Ok(())
     }
@@ -394,9 +474,14 @@ fn record(
     })
 }
 
-/// Iterate the stroboscopic map from the integrator's current state until the returns repeat
-/// with some period n ≤ `max_period` (then record one cycle) or the cap is reached (then record
-/// `nonperiodic_record` periods as a nonperiodic motion).
+/// The steady state from the integrator's current state: iterate the stroboscopic map until
+/// the returns repeat with some period n ≤ `max_period` (then record one cycle) or the
+/// transient cap [`SteadyOptions::cap`] is reached (then record `nonperiodic_record` periods as
+/// a nonperiodic motion). On a slowly decaying model ([`SteadyOptions::newton_on`]) Newton
+/// shooting from the transient decides first ([`super::settle`], within the cap): a motion
+/// seen to go to a stable period-n orbit is recorded on the orbit (its Poincaré points the
+/// orbit's to the shooting tolerance); one that is not is searched as above for the rest of
+/// the cap.
 ///
 /// # Errors
 /// [`SimError`] from the integrator (divergence, chattering) or for invalid options.
@@ -406,20 +491,55 @@ pub fn steady_state(
 ) -> Result<SteadyState, SimError> {
     opts.validate()?;
     // align on the section
-    if !on_section(integ.tau(), integ.system().period()) {
+    let period = integ.system().period();
+    if !on_section(integ.tau(), period) {
         next_section(integ, None)?;
     }
+    let cap = opts.cap(integ.system());
+    let mut spent = 0;
+    if opts.newton_on(integ.system()) {
+        let tau0 = integ.tau();
+        let z0 = integ.state().clone();
+        let settle = SettleOptions {
+            newton: ShootingOptions {
+                tol: (opts.tol * 1e-2).max(1e-12),
+                max_iter: 6,
+            },
+            chunk_periods: SETTLE_CHUNK,
+            max_period: opts.max_period,
+            max_wait: 4,
+            settled: CENSUS_SETTLED,
+            linear: false,
+        };
+        let budget = cap;
+        let s = newton_from_transient(integ, &z0, None, &settle, budget)?;
+        spent = s.periods;
+        if let Some(found) = s.found {
+            let n = found.period.unwrap_or(1);
+            let n = minimal_period(integ, &found.state, n, opts.tol);
+            integ.set_variational(false);
+            integ.reset(tau0 + spent as f64 * period, &found.state)?;
+            return record(integ, Some(n), spent, opts);
+        }
+        integ.set_variational(false);
+        integ.reset(tau0 + spent as f64 * period, &s.state)?;
+    }
+    let cap = cap.saturating_sub(spent).max(1);
     let mut returns = ReturnHistory::new(opts, integ.state());
     let mut found = None;
-    while !returns.exhausted(opts) {
+    while !returns.exhausted(cap) {
         next_section(integ, None)?;
         found = returns.push(integ.state(), opts);
         if found.is_some() {
             break;
         }
     }
-    record(integ, found, returns.k, opts)
+    record(integ, found, spent + returns.k, opts)
 }
+
+/// Drive periods between the Newton attempts of [`steady_state`] on a slowly decaying model
+/// (the stepped sweeps' chunk).
+pub const SETTLE_CHUNK: usize = 25;
 
 #[cfg(test)]
 mod tests {

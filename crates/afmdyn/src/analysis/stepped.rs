@@ -36,14 +36,14 @@ use super::continuation::{
 use super::monodromy::stroboscopic;
 use super::observables::{observe, ObservableOptions, Observables};
 use super::progress::Progress;
+pub use super::settle::Found;
+use super::settle::{newton_from_transient, SettleOptions, NEWTON_CHUNKS, SETTLED};
 use super::shooting::{
     broyden_pays, shoot_broyden, shoot_undamped, shoot_with, ShootingOptions, ShotOrbit,
 };
-use super::steady::{steady_state, SteadyOptions};
-use crate::eigen::damped_eigenvalues;
+use super::steady::{decay_periods, steady_state, SteadyOptions};
 use crate::error::SimError;
-use crate::galerkin::Region;
-use crate::integrate::{advance, build, Integrator, IntegratorOptions};
+use crate::integrate::{build, Integrator, IntegratorOptions};
 use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
 use crate::tip_sample::TipSampleSystem;
@@ -52,14 +52,6 @@ use serde::Serialize;
 
 /// Largest number of values of a stepped sweep (each is a steady-state computation, twice).
 pub const MAX_CURVE_POINTS: usize = 100_000;
-
-/// Chunks of [`SteppedSpec::chunk_periods`] during which [`settle`] retries Newton before it
-/// classifies the motion by integration alone.
-pub const NEWTON_CHUNKS: usize = 40;
-
-/// Relative distance (to 1 + ‖z‖) within which [`settle`] takes a transient to have reached
-/// the stable orbit it is approaching.
-pub const SETTLED: f64 = 5e-2;
 
 /// Default tolerance of the adaptive integrator in stepped sweeps: 1e-10 instead of the
 /// library's 1e-12 makes a map ~3× cheaper, and changes A and φ of the point-mass DMT
@@ -182,9 +174,10 @@ impl SteppedSpec {
             },
             steady: SteadyOptions {
                 tol: 1e-8,
-                max_periods: 20_000,
+                max_periods: Some(20_000),
                 max_period: 16,
                 nonperiodic_record: 16,
+                newton: false,
             },
             chunk_periods: 25,
             jump_tol: 0.1,
@@ -316,32 +309,17 @@ fn relative_gap(a: &DVector<f64>, b: &DVector<f64>) -> f64 {
     (a - b).norm() / (1.0 + b.norm())
 }
 
-/// The steady state a sweep point settles on.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Found {
-    /// Period n, `None` for a motion that is not period-n.
-    pub period: Option<usize>,
-    /// State at drive phase 0, shape `[2N]` (the last recorded state of a non-periodic motion).
-    pub state: DVector<f64>,
-    /// Floquet multipliers, decreasing modulus (empty for a non-periodic motion).
-    pub multipliers: Vec<Complex<f64>>,
-    /// Monodromy matrix, 2N×2N (`None` for a non-periodic motion).
-    pub monodromy: Option<DMatrix<f64>>,
-    /// Stable (an attractor).
-    pub stable: bool,
-}
-
 /// Fewest drive periods of transient a point of a stepped sweep may take ([`transient_cap`]).
-pub const MIN_TRANSIENT_PERIODS: usize = 5_000;
+pub const POINT_MIN_PERIODS: usize = 5_000;
 
 /// Decay times of the slowest free mode in a point's transient cap ([`transient_cap`]).
-pub const TRANSIENT_DECAY_TIMES: f64 = 9.0;
+pub const POINT_DECAY_TIMES: f64 = 9.0;
 
 /// The drive periods of transient a point of a stepped sweep may take, [`settle`] and the
-/// classification by [`steady_state`] together: [`TRANSIENT_DECAY_TIMES`] times the periods
+/// classification by [`steady_state`] together: [`POINT_DECAY_TIMES`] times the periods
 /// the slowest free mode of the cantilever (damped eigenvalue λ with the smallest |Re λ|,
 /// eqs. 20–21) takes to decay by the period search's tolerance, ln(1/tol)/(|Re λ| T), within
-/// [[`MIN_TRANSIENT_PERIODS`], `spec.steady.max_periods`]; `spec.steady.max_periods` for a
+/// [[`POINT_MIN_PERIODS`], `spec.steady.max_periods`]; `spec.steady.max_periods` for a
 /// system that is not the cantilever model. At Q = 400 (ln(1e8) Q/π = 2 345 periods) it is
 /// `max_periods` (20 000 by default), as before; a model with strong damping, whose transients
 /// onto an orbit take a few hundred periods (the default beam, Q ≈ 42: 248), has the floor.
@@ -350,35 +328,20 @@ pub const TRANSIENT_DECAY_TIMES: f64 = 9.0;
 /// resonance curve's classification there changes with round-off-level changes of its start
 /// — which no cap removes, while each nonperiodic point costs the whole cap.
 pub fn transient_cap(system: &dyn TipSampleSystem, spec: &SteppedSpec) -> usize {
-    let cap = spec.steady.max_periods;
-    let Some(model) = system.cantilever() else {
+    let cap = spec.steady.cap(system);
+    let Some(decay) = decay_periods(system, spec.steady.tol) else {
         return cap;
     };
-    let g = model.galerkin().region(Region::Free);
-    let slowest = damped_eigenvalues(g)
-        .iter()
-        .map(|e| e.re.abs())
-        .fold(f64::INFINITY, f64::min);
-    let per_period = slowest * model.period();
-    let decay = (1.0 / spec.steady.tol).ln() / per_period;
-    if !(decay.is_finite() && decay > 0.0) {
-        return cap;
-    }
-    let periods = (TRANSIENT_DECAY_TIMES * decay).ceil();
-    (periods.min(cap as f64) as usize).max(MIN_TRANSIENT_PERIODS.min(cap))
+    let periods = (POINT_DECAY_TIMES * decay).ceil();
+    (periods.min(cap as f64) as usize).max(POINT_MIN_PERIODS.min(cap))
 }
 
-/// Integrate from `z0` (τ = 0) at the integrator's parameters until the motion settles: every
-/// `spec.chunk_periods` periods Newton is tried from the current state (period `n`; undamped,
-/// [`shoot_undamped`]: from a transient far from the orbit the damped iteration's halvings
-/// rarely converge and each costs a flow, and the next attempt starts nearer); a stable
-/// orbit it finds is accepted once the trajectory has come closer to it over two further chunks
-/// and within [`SETTLED`] of it, or has twice come closer at the rate of the orbit's leading
-/// Floquet multiplier (the linear regime around it), or has arrived on it — so it is the
-/// attractor the motion goes to, not another orbit Newton happened to reach. After a failed
-/// attempt the next one waits 1.5 times as many chunks. After [`NEWTON_CHUNKS`] chunks without
-/// that, the motion is classified by [`steady_state`] within `spec.steady` (a period-m orbit is
-/// then polished by Newton), over the periods of the point's [`transient_cap`] not yet spent.
+/// Integrate from `z0` (τ = 0) at the integrator's parameters until the motion settles:
+/// Newton shooting for a period-`n` orbit from the transient every `spec.chunk_periods`
+/// periods, for at most [`NEWTON_CHUNKS`] chunks, until the trajectory is seen to go to a
+/// stable orbit ([`newton_from_transient`]); otherwise the motion is classified by
+/// [`steady_state`] within `spec.steady` (a period-m orbit is then polished by Newton), over
+/// the periods of the point's [`transient_cap`] not yet spent.
 ///
 /// # Errors
 /// [`SimError`] from the integrator.
@@ -388,68 +351,26 @@ pub fn settle(
     n: usize,
     spec: &SteppedSpec,
 ) -> Result<Found, SimError> {
-    let period = integ.system().period();
-    let chunk = spec.chunk_periods.max(1);
-    let mut x = z0.clone();
-    let mut elapsed = 0usize;
-    let mut candidate: Option<Candidate> = None;
-    // Newton from the transient for at most NEWTON_CHUNKS chunks, then classification; after a
-    // failed attempt the next one waits 1.5 times longer
     let cap = transient_cap(integ.system(), spec);
-    let newton_periods = cap.min(NEWTON_CHUNKS * chunk);
-    let (mut chunks, mut next_try, mut wait) = (0usize, 1usize, 1.0f64);
-    while elapsed < newton_periods {
-        integ.set_variational(false);
-        integ.reset(0.0, &x)?;
-        advance(integ, chunk as f64 * period)?;
-        elapsed += chunk;
-        chunks += 1;
-        x = integ.state().clone();
-        if let Some(mut c) = candidate.take() {
-            let d = (&x - &c.state).norm();
-            let scale = 1.0 + c.state.norm();
-            // the transient approaches the orbit at the rate of its leading multiplier
-            let rate = c.multipliers[0].norm().powi(chunk as i32);
-            let ratio = d / c.distance;
-            let linear = ratio <= 1.0 && (ratio - rate).abs() <= 0.25 * (1.0 - rate) + 1e-3;
-            if d <= 1e-9 * scale {
-                return Ok(c.found(n));
-            }
-            if d < c.distance {
-                c.approaches += 1;
-                c.linear = if linear { c.linear + 1 } else { 0 };
-                c.distance = d;
-                if (d <= SETTLED * scale && c.approaches >= 2) || c.linear >= 2 {
-                    return Ok(c.found(n));
-                }
-                candidate = Some(c);
-                continue;
-            }
-        }
-        if chunks < next_try {
-            continue;
-        }
-        match shoot_undamped(integ, &x, n, &spec.newton) {
-            Ok(o) if o.stable => {
-                candidate = Some(Candidate {
-                    distance: (&x - &o.state).norm(),
-                    state: o.state,
-                    multipliers: o.multipliers,
-                    monodromy: o.monodromy,
-                    approaches: 0,
-                    linear: 0,
-                });
-                wait = 1.0;
-            }
-            _ => wait *= 1.5,
-        }
-        next_try = chunks + wait.round() as usize;
+    let chunk = spec.chunk_periods.max(1);
+    let opts = SettleOptions {
+        newton: spec.newton,
+        chunk_periods: chunk,
+        max_period: spec.steady.max_period,
+        max_wait: usize::MAX,
+        settled: SETTLED,
+        linear: true,
+    };
+    let s = newton_from_transient(integ, z0, Some(n), &opts, cap.min(NEWTON_CHUNKS * chunk))?;
+    if let Some(found) = s.found {
+        return Ok(found);
     }
     // no settling on a period-n orbit: classify the motion
     integ.set_variational(false);
-    integ.reset(0.0, &x)?;
+    integ.reset(0.0, &s.state)?;
     let steady = SteadyOptions {
-        max_periods: cap.saturating_sub(elapsed).max(1),
+        max_periods: Some(cap.saturating_sub(s.periods).max(1)),
+        newton: false,
         ..spec.steady
     };
     let s = steady_state(integ, &steady)?;
@@ -473,31 +394,6 @@ pub fn settle(
         monodromy: None,
         stable: true,
     })
-}
-
-/// A stable orbit found by Newton from a transient, and how the transient approaches it.
-struct Candidate {
-    state: DVector<f64>,
-    multipliers: Vec<Complex<f64>>,
-    monodromy: DMatrix<f64>,
-    /// Distance of the transient from the orbit at the last check.
-    distance: f64,
-    /// Consecutive checks at which the distance decreased.
-    approaches: usize,
-    /// Consecutive checks at which it decreased at the rate of the leading multiplier.
-    linear: usize,
-}
-
-impl Candidate {
-    fn found(self, n: usize) -> Found {
-        Found {
-            period: Some(n),
-            state: self.state,
-            multipliers: self.multipliers,
-            monodromy: Some(self.monodromy),
-            stable: true,
-        }
-    }
 }
 
 /// The integrator at one parameter value, started at `z` (τ = 0).
@@ -1100,7 +996,7 @@ mod tests {
             );
             let low = SteppedSpec {
                 steady: SteadyOptions {
-                    max_periods: 3000,
+                    max_periods: Some(3000),
                     ..spec.steady
                 },
                 ..spec.clone()

@@ -22,7 +22,7 @@ use crate::analysis::observables::{observe_from, ObservableOptions, Observables}
 use crate::analysis::period::MAX_PERIOD;
 use crate::analysis::progress::Progress;
 use crate::analysis::shooting::{shoot, PeriodicOrbit, ShootingOptions};
-use crate::analysis::steady::{steady_state, SteadyOptions};
+use crate::analysis::steady::{default_transient_cap, steady_state, SteadyOptions};
 use crate::error::SimError;
 use crate::integrate::{build, IntegratorKind, IntegratorOptions};
 use crate::model::CantileverModel;
@@ -35,10 +35,14 @@ use serde::{Deserialize, Serialize};
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(default, deny_unknown_fields)]
 pub struct SteadyRequest {
-    /// Relative tolerance for two returns of the stroboscopic map to coincide, > 0.
+    /// Relative tolerance for two returns of the stroboscopic map to coincide, in
+    /// [1e-14, 1e-3].
     pub tol: f64,
-    /// Cap on the transient, in drive periods, 1..=[`MAX_STEADY_PERIODS`].
-    pub max_periods: usize,
+    /// Cap on the transient, in drive periods, 1..=[`MAX_STEADY_PERIODS`]; `None` (default):
+    /// derived from the model's slowest free decay, six times the periods it takes to decay by
+    /// `tol` and at least 1 500 (≈ 1.9 Q ln(1/tol) for a lever of quality factor Q:
+    /// [`crate::analysis::steady::default_transient_cap`]).
+    pub max_periods: Option<usize>,
     /// Largest period searched, 1..=64 ([`MAX_PERIOD`]).
     pub max_period: usize,
 }
@@ -334,8 +338,10 @@ impl ContinuationRequest {
 pub struct LyapunovRequest {
     /// The initial state (2N values); `None`: rest.
     pub initial: Option<Vec<f64>>,
-    /// Drive periods discarded first.
-    pub transient: usize,
+    /// Drive periods discarded first; `None` (default): the model's derived transient cap
+    /// ([`crate::analysis::steady::default_transient_cap`] at tol = 1e-8: 1 500 for the
+    /// paper's beam, ≈ 1.9 Q ln(1e8) for a lever of quality factor Q).
+    pub transient: Option<usize>,
     /// Drive periods averaged; transient + periods ≤ [`MAX_RUN_PERIODS`].
     pub periods: usize,
     /// Blocks for the uncertainty, 2..=periods.
@@ -347,7 +353,7 @@ impl Default for LyapunovRequest {
         let d = LyapunovOptions::default();
         LyapunovRequest {
             initial: None,
-            transient: d.transient_periods,
+            transient: None,
             periods: d.periods,
             blocks: d.blocks,
         }
@@ -360,19 +366,21 @@ impl LyapunovRequest {
     /// # Errors
     /// [`SimError::OutOfRange`] naming `periods` or `blocks` ([`LyapunovOptions::validate`]).
     pub fn validate(&self) -> Result<(), SimError> {
-        if self.transient as f64 + self.periods as f64 > MAX_RUN_PERIODS {
+        let transient = self.transient.unwrap_or(MAX_STEADY_PERIODS);
+        if transient as f64 + self.periods as f64 > MAX_RUN_PERIODS {
             return Err(SimError::out_of_range(
                 "periods",
-                format!("{} with transient = {}", self.periods, self.transient),
+                format!("{} with transient = {transient}", self.periods),
                 "a run may span at most 1e8 drive periods, transient included",
             ));
         }
-        self.options().validate()
+        self.options(0).validate()
     }
 
-    fn options(&self) -> LyapunovOptions {
+    /// The options, the transient `derived` where none is given.
+    fn options(&self, derived: usize) -> LyapunovOptions {
         LyapunovOptions {
-            transient_periods: self.transient,
+            transient_periods: self.transient.unwrap_or(derived),
             periods: self.periods,
             blocks: self.blocks,
             ..LyapunovOptions::default()
@@ -388,7 +396,7 @@ impl LyapunovRequest {
         self.validate()?;
         let model = CantileverModel::new(params)?;
         let z0 = initial_state(&model, self.initial.as_deref())?;
-        let opts = self.options();
+        let opts = self.options(default_transient_cap(&model, SteadyOptions::default().tol));
         let mut integ = build(&model, opts.integrator, 0.0, &z0)?;
         lyapunov_spectrum_with(integ.as_mut(), &opts, progress)
     }

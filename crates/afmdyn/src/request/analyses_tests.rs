@@ -31,7 +31,7 @@ fn defaults_pass_and_each_limit_names_its_parameter() {
     assert_eq!(span.rows, 10_001.0);
     let steady = |tol, max_periods, max_period| SteadyRequest {
         tol,
-        max_periods,
+        max_periods: Some(max_periods),
         max_period,
     };
     assert_eq!(name(steady(0.0, 10, 8).options().unwrap_err()), "tol");
@@ -59,7 +59,7 @@ fn defaults_pass_and_each_limit_names_its_parameter() {
     };
     assert_eq!(name(bif.spec(&p).unwrap_err()), "threads");
     let ly = LyapunovRequest {
-        transient: 50_000_001,
+        transient: Some(50_000_001),
         periods: 50_000_000,
         ..LyapunovRequest::default()
     };

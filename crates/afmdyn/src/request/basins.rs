@@ -231,7 +231,33 @@ pub fn document(spec: &BasinSpec, map: &BasinMap) -> Value {
         "basin_entropy": entropy.map(|e| e.basin_entropy),
         "boundary_basin_entropy": entropy.map(|e| e.boundary_basin_entropy),
         "uncertainty_exponent": uncertainty_exponent(&labels, nx).map(|u| u.0),
+        "warnings": warnings(spec, map),
     })
+}
+
+/// The caveats of a basin map (the `warnings` of its document): attractors that are
+/// nonperiodic with λ₁ ≤ 0 — quasi-periodic, or starts still converging at the transient cap
+/// whose cells carry a label that is not an attractor's.
+pub fn warnings(spec: &BasinSpec, map: &BasinMap) -> Vec<String> {
+    let model = CantileverModel::new(&spec.params).ok();
+    let cap = model.as_ref().map(|m| spec.steady.cap(m));
+    map.attractors
+        .iter()
+        .zip(&map.lyapunov)
+        .enumerate()
+        .filter_map(|(i, (s, l))| match (s.period(), l) {
+            (None, Some(l)) if *l <= 0.0 => {
+                let cells = map.cells.iter().filter(|c| c.label == i as i64).count();
+                Some(format!(
+                    "attractor {i} ({cells} cells) is nonperiodic with λ₁ = {l:.3e} ≤ 0 after \
+                     the transient cap of {} drive periods: quasi-periodic, or still settling; \
+                     raise max_periods to tell",
+                    cap.map_or("?".into(), |c| c.to_string())
+                ))
+            }
+            _ => None,
+        })
+        .collect()
 }
 
 /// The per-cell and per-attractor arrays of a basin map: the one layout of `basins.nc` and of

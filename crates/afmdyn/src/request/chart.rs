@@ -582,13 +582,16 @@ pub fn warnings(chart: &Chart, cells: &[ChartCell]) -> Vec<String> {
     if let Some(first) = unsettled.first() {
         w.push(format!(
             "{} of {} cells have a nonperiodic motion with λ₁ ≤ 0 (first at x = {}, y = {}): \
-             quasi-periodic, or still settling after max_periods = {}; raise max_periods to \
-             tell (a cantilever of quality factor Q settles over ~Q periods)",
+             quasi-periodic, or still settling after the transient cap ({}); raise \
+             max_periods to tell (a cantilever of quality factor Q settles over ~Q periods)",
             unsettled.len(),
             cells.len(),
             first.x,
             first.y,
-            chart.spec.steady.max_periods,
+            match chart.spec.steady.max_periods {
+                Some(m) => format!("max_periods = {m}"),
+                None => "derived from each cell's decay rate".to_string(),
+            },
         ));
     }
     let failed: u64 = cells.iter().map(|c| u64::from(c.failures)).sum();

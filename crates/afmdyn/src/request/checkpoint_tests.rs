@@ -16,7 +16,7 @@ fn request() -> BifurcationRequest {
         starts: 1,
         ..BifurcationRequest::default()
     };
-    r.steady.max_periods = 300;
+    r.steady.max_periods = Some(300);
     r
 }
 
@@ -167,7 +167,7 @@ fn another_request_is_refused_naming_the_first_field_that_differs() {
     );
     assert_eq!(store, unfinished, "untouched");
     let mut other = r.clone();
-    other.steady.max_periods = 200;
+    other.steady.max_periods = Some(200);
     assert_eq!(
         resume_into(&mut store, &other).unwrap_err(),
         CheckpointError::Mismatch {
