@@ -30,6 +30,26 @@ pub enum Files {
     None,
 }
 
+/// Every file `simulate` writes in its `--out` directory: a run removes their stale temporary
+/// siblings (`.NAME.partial.EXT`), which a run killed outright (a second Ctrl-C) leaves.
+const SIMULATE_OUTPUTS: &[&str] = &[
+    "timeseries.npy",
+    "timeseries.npy.json",
+    "timeseries.csv",
+    "events.csv",
+    "poincare.csv",
+    "energy.csv",
+    "spectrum.csv",
+    "tip.png",
+    "tip.svg",
+    "tip-all.png",
+    "tip-all.svg",
+    "phase.png",
+    "phase.svg",
+    "spectrum.png",
+    "spectrum.svg",
+];
+
 /// Samples kept for the phase portrait (the last ones).
 const PHASE_SAMPLES: usize = 50_000;
 /// Drive periods `tip.png` shows (the last ones) when more were recorded; `tip-all.png` then
@@ -319,10 +339,15 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
     let spp = a.samples_per_period;
     let opts = request.integrator_options();
     let mut integ = build(&model, opts, 0.0, &z0)?;
-    // inputs are valid: lock the output directory and open the files
+    // inputs are valid: lock the output directory (removing what a run killed outright left
+    // of these files) and open the files
     let out = match a.files {
         Files::None => None,
-        _ => Some(OutDir::lock(&a.out)?),
+        _ => {
+            let o = OutDir::lock(&a.out)?;
+            o.remove_partials(SIMULATE_OUTPUTS)?;
+            Some(o)
+        }
     };
     let mut files = match &out {
         None => None,

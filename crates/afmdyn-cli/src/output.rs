@@ -47,6 +47,18 @@ impl OutDir {
         Ok(OutDir { lock })
     }
 
+    /// Remove the stale temporary files of `outputs` (files of this command in the directory)
+    /// that a run killed outright left ([`DirLock::remove_partials`]).
+    ///
+    /// # Errors
+    /// [`CliError::Io`] naming a file that cannot be removed.
+    pub fn remove_partials(&self, outputs: &[&str]) -> Result<(), CliError> {
+        self.lock
+            .remove_partials(outputs)
+            .map(|_| ())
+            .map_err(|e| CliError::Io(e.to_string()))
+    }
+
     /// The lock held on the directory.
     pub fn dir_lock(&self) -> &DirLock {
         &self.lock
@@ -63,14 +75,10 @@ impl OutDir {
     }
 }
 
-/// Temporary sibling of `path` keeping its extension (plotters picks the format from it).
+/// Temporary sibling of `path` keeping its extension (plotters picks the format from it): the
+/// library's [`afmdyn::request::dir_lock::partial_path`].
 pub fn temp_path(path: &Path) -> PathBuf {
-    let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("out");
-    let name = match path.extension().and_then(|s| s.to_str()) {
-        Some(ext) => format!(".{stem}.partial.{ext}"),
-        None => format!(".{stem}.partial"),
-    };
-    path.with_file_name(name)
+    afmdyn::request::dir_lock::partial_path(path)
 }
 
 /// Write `path` atomically with `write` filling a temporary file. On failure the temporary

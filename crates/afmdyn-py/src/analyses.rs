@@ -437,7 +437,12 @@ pub(crate) fn checkpoint_error(e: CheckpointError) -> PyErr {
         CheckpointError::Mismatch { .. } => value_error(format!(
             "resume: {e}; call with the same arguments, or with resume=False to start over"
         )),
-        _ => value_error(format!("resume: {e}")),
+        // the library's advice names the command line's flag
+        _ => value_error(format!(
+            "resume: {}",
+            e.to_string()
+                .replace("rerun without --resume", "call with resume=False")
+        )),
     }
 }
 

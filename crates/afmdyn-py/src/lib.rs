@@ -51,6 +51,7 @@ fn _afmdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(analyses::probe, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::observe, m)?)?;
     m.add("POLL_SECONDS", run::POLL.as_secs_f64())?;
+    m.add_function(wrap_pyfunction!(run::cancel_running, m)?)?;
     m.add_function(wrap_pyfunction!(params::resolve, m)?)?;
     // the one table of model parameters: (name, alias or name, unit, range, help)
     m.add(

@@ -1,17 +1,38 @@
 //! Running a computation without the GIL: the work goes to a worker thread while the calling
 //! thread waits with the GIL released, waking every [`POLL`] to run Python's signal handlers
 //! (Ctrl-C raises `KeyboardInterrupt`) and to report progress.
+//!
+//! Python runs signal handlers on the main thread only, so a computation called from another
+//! thread (a `ThreadPoolExecutor`) never sees Ctrl-C through them. Every waiting thread
+//! therefore also watches a process-wide count of interrupts, [`INTERRUPTS`]: the package's
+//! SIGINT handler (`afmdyn/_interrupt.py`, wrapping the one it finds) bumps it through
+//! [`cancel_running`] before it raises `KeyboardInterrupt` in the main thread, and so does a
+//! `KeyboardInterrupt` raised in a wait on the main thread. A computation sees the count move
+//! past the value it started with at its next poll: it is cancelled (or abandoned) and its
+//! caller gets `KeyboardInterrupt`, whatever thread it runs in.
 
 use afmdyn::analysis::progress::Progress;
-use pyo3::exceptions::PyRuntimeError;
+use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError};
 use pyo3::prelude::*;
 use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::mpsc::{channel, RecvTimeoutError};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 /// How often the waiting thread checks for signals and reports progress.
 pub const POLL: Duration = Duration::from_millis(50);
+
+/// The interrupts so far (see the module): a computation running when it moves is cancelled.
+pub static INTERRUPTS: AtomicU64 = AtomicU64::new(0);
+
+/// Cancel every computation running now, in every thread: each raises `KeyboardInterrupt`
+/// within a poll ([`POLL`]); those started afterwards run as usual. The package's SIGINT
+/// handler calls it (`afmdyn.cancel_running()`).
+#[pyfunction]
+pub fn cancel_running() {
+    INTERRUPTS.fetch_add(1, Ordering::SeqCst);
+}
 
 /// Shared between the worker and the waiting thread: the library's [`Progress`] of the run,
 /// the units of work done (sweep points, random starts, curve points, periods) and the cancel
@@ -48,8 +69,9 @@ fn panic_message(p: Box<dyn std::any::Any + Send>) -> String {
 /// one, else the one the run counts in [`Job::progress`].
 ///
 /// # Errors
-/// `KeyboardInterrupt` (or whatever a signal handler raises), an exception raised by
-/// `progress`, or `RuntimeError` if the computation panicked (a bug: reported, not a crash).
+/// `KeyboardInterrupt` (or whatever a signal handler raises; also in a thread other than the
+/// main one, once [`cancel_running`] was called), an exception raised by `progress`, or
+/// `RuntimeError` if the computation panicked (a bug: reported, not a crash).
 pub fn run<T, F>(
     py: Python<'_>,
     job: &Job,
@@ -62,6 +84,11 @@ where
     T: Send + 'static,
     F: FnOnce() -> T + Send + 'static,
 {
+    // on the main thread: wrap the SIGINT handler again if other code replaced it
+    if let Ok(m) = py.import("afmdyn._interrupt") {
+        m.call_method0("install")?;
+    }
+    let generation = INTERRUPTS.load(Ordering::SeqCst);
     let (tx, rx) = channel();
     // the receiver is used from inside `detach`, which needs a `Sync` borrow
     let rx = Mutex::new(rx);
@@ -97,7 +124,24 @@ where
             }
             Err(RecvTimeoutError::Timeout) => {}
         }
-        if let Err(e) = py.check_signals().and_then(|_| report(py)) {
+        let interrupted = || {
+            if INTERRUPTS.load(Ordering::SeqCst) == generation {
+                Ok(())
+            } else {
+                Err(PyKeyboardInterrupt::new_err(
+                    "afmdyn: cancelled by Ctrl-C (KeyboardInterrupt in the main thread)",
+                ))
+            }
+        };
+        let checked = py
+            .check_signals()
+            .and_then(|_| interrupted())
+            .and_then(|_| report(py));
+        if let Err(e) = checked {
+            if e.is_instance_of::<PyKeyboardInterrupt>(py) {
+                // Ctrl-C here (the main thread) cancels the runs of the other threads too
+                cancel_running();
+            }
             job.progress.cancel();
             if stop == Stop::Cancellable {
                 // the points already running finish; no new one starts

@@ -5,6 +5,7 @@ errors."""
 from __future__ import annotations
 
 import time
+import zlib
 from pathlib import Path
 
 import numpy as np
@@ -218,15 +219,19 @@ def test_resume_of_a_store_killed_on_the_command_line(cli, tmp_path):
 
 
 def _mark(path: Path, marker: str) -> set:
-    """Set `w_tip` of every row of a rows file to `marker`; the (index, branch) marked."""
+    """Set `w_tip` of every row of a rows file to `marker`; the (index, branch) marked. The
+    checkpoint's rows end with the CRC-32 of the row's text (`crc32`): it is written anew, as
+    afmdyn would have written the marked row."""
     lines = path.read_text().split("\n")
+    sealed = lines[0].endswith(",crc32")
     marked = set()
     for i, line in enumerate(lines[1:], start=1):
         cells = line.split(",")
-        if len(cells) == 18:
+        if len(cells) == 18 + sealed:
             cells[10] = marker
             marked.add((int(cells[2]), cells[3]))
-            lines[i] = ",".join(cells)
+            row = ",".join(cells[:18])
+            lines[i] = f"{row},{zlib.crc32(row.encode()):08x}" if sealed else row
     path.write_text("\n".join(lines))
     return marked
 
@@ -249,6 +254,31 @@ def test_resume_skips_exactly_the_points_written(cli, tmp_path):
     _mark(store / "bifurcation.csv", "8.5")
     again = afmdyn.bifurcation(**ARGS, store=store, resume=True)
     assert (again.w_tip.values == 8.5).all()
+
+
+def test_a_damaged_store_is_refused_naming_its_file_and_line(cli, tmp_path):
+    """One digit changed in a stored row (its checksum left as written), or the header
+    removed: resume=True raises ValueError naming the file and the line, and returns no rows
+    (it returned the changed value, or lost the header; issue 42)."""
+    _killed(cli, tmp_path)
+    partial = tmp_path / ".bifurcation.partial.csv"
+    lines = partial.read_text().split("\n")
+    assert lines[0].endswith(",crc32")
+    cells = lines[2].split(",")
+    cells[10] = cells[10].replace(cells[10].lstrip("-")[0], "7" if cells[10].lstrip("-")[0] != "7" else "3", 1)
+    damaged = "\n".join([*lines[:2], ",".join(cells), *lines[3:]])
+    partial.write_text(damaged)
+    with pytest.raises(ValueError) as e:
+        afmdyn.bifurcation(**ARGS, store=tmp_path, resume=True)
+    assert ".bifurcation.partial.csv: line 3: checksum mismatch" in str(e.value), e.value
+    assert "resume=False" in str(e.value) and "--resume" not in str(e.value), e.value
+    assert partial.read_text() == damaged, "left as it was"
+    partial.write_text("\n".join(lines[1:]))
+    with pytest.raises(ValueError, match="line 1: the header is missing or changed"):
+        afmdyn.bifurcation(**ARGS, store=tmp_path, resume=True)
+    assert not (tmp_path / "bifurcation.csv").exists()
+    # resume=False starts over
+    _assert_rows_equal(afmdyn.bifurcation(**ARGS, store=tmp_path), _read(tmp_path))
 
 
 def test_resume_with_another_request_is_refused_naming_the_field(cli, tmp_path):

@@ -13,10 +13,12 @@ import time
 
 import pytest
 
+import afmdyn
+
 pytestmark = pytest.mark.skipif(os.name != "posix", reason="SIGINT to a child process")
 
 
-def _interrupt(script: str, after: float = 1.5):
+def _interrupt(script: str, after: float = 1.5, timeout: float = 120):
     p = subprocess.Popen(
         [sys.executable, "-c", textwrap.dedent(script)],
         stdout=subprocess.PIPE,
@@ -27,7 +29,12 @@ def _interrupt(script: str, after: float = 1.5):
     time.sleep(after)  # inside the computation (each takes far longer)
     sent = time.monotonic()
     p.send_signal(signal.SIGINT)
-    out, err = p.communicate(timeout=120)
+    try:
+        out, err = p.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        p.kill()
+        out, err = p.communicate()
+        pytest.fail(f"still running {timeout} s after SIGINT: {out!r} {err[-2000:]!r}")
     return p.returncode, out.split(), err, time.monotonic() - sent
 
 
@@ -75,6 +82,56 @@ def test_ctrl_c_interrupts_analyses_without_a_cancel_hook(call):
     assert out == ["interrupted", "after", "3"], (out, err)
     assert latency < 5, latency
     assert "Traceback" not in err and "panicked" not in err, err
+
+
+@pytest.mark.parametrize(
+    "call",
+    [
+        # abandoned on an interrupt (no cancel hook)
+        "afmdyn.lyapunov, periods=10**7, blocks=10, progress=False",
+        # cancelled at its next point
+        "afmdyn.bifurcation, steps=4000, starts=2, progress=False",
+    ],
+)
+def test_ctrl_c_cancels_an_analysis_running_in_a_worker_thread(call):
+    """Python runs signal handlers in the main thread only: an analysis in a
+    ThreadPoolExecutor ran on for minutes after Ctrl-C (issue 42), and the interpreter waited
+    for it at exit. Now the KeyboardInterrupt in the main thread cancels it: the future raises
+    KeyboardInterrupt too, and the process ends at once."""
+    code, out, err, latency = _interrupt(
+        f"""
+        import concurrent.futures as cf
+        import afmdyn
+        pool = cf.ThreadPoolExecutor(2)
+        futures = [pool.submit({call}) for _ in range(2)]
+        print("start", flush=True)
+        try:
+            futures[0].result()
+            print("finished", flush=True)
+        except KeyboardInterrupt:
+            print("interrupted", flush=True)
+        for f in futures:
+            try:
+                f.result(timeout=5)
+                print("finished", flush=True)
+            except KeyboardInterrupt:
+                print("cancelled", flush=True)
+        pool.shutdown()
+        print("after", afmdyn.modes().free.omega.size, flush=True)
+        """,
+        timeout=30,
+    )
+    assert code == 0, err
+    assert out == ["interrupted", "cancelled", "cancelled", "after", "3"], (out, err)
+    assert latency < 10, latency
+    assert "panicked" not in err, err
+
+
+def test_cancel_running_is_public_and_leaves_later_calls_alone():
+    """Code that installs its own SIGINT handler cancels afmdyn's analyses itself; a call
+    started afterwards runs as usual."""
+    afmdyn.cancel_running()
+    assert afmdyn.modes().free.omega.size == 3
 
 
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])

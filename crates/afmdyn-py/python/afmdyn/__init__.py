@@ -44,6 +44,8 @@ from ._basins import basins
 from ._cantilevers import cantilevers
 from ._chart import chart
 from ._global_continuation import global_continuation
+from ._interrupt import cancel_running
+from ._interrupt import install as _install_sigint
 from ._results import Attractor, Attractors, Lyapunov, Orbit, RegionSpectrum, Spectrum
 
 try:
@@ -52,6 +54,9 @@ try:
     __version__ = _version("afmdyn")
 except Exception:  # pragma: no cover - not installed as a distribution
     __version__ = "0+unknown"
+
+# Ctrl-C cancels the analyses running in every thread (see afmdyn._interrupt)
+_install_sigint()
 
 __all__ = [
     "AfmdynWarning",
@@ -68,6 +73,7 @@ __all__ = [
     "attractors",
     "basins",
     "bifurcation",
+    "cancel_running",
     "cantilevers",
     "chart",
     "continuation",

@@ -7,6 +7,8 @@ from typing import Any, Callable, Dict, List, Literal, Optional, Tuple, Union
 ProgressCallback = Callable[[int, Optional[int]], object]
 
 POLL_SECONDS: float
+
+def cancel_running() -> None: ...
 #: The one table of model parameters (the library's ``afmdyn::request::MODEL_PARAMETERS``):
 #: (name, alias or name, unit, range, help).
 MODEL_PARAMETERS: List[Tuple[str, str, str, str, str]]

@@ -1,9 +1,15 @@
 //! The resumable store of a chart (feature `files`): a directory, locked by [`DirLock`], holding
 //!
-//! - `.chart.run.json`, the ledger: `{"args": fingerprint, "finished": bool}`;
+//! - `.chart.run.json`, the ledger: `{"args": fingerprint, "finished": bool, "format": 2}`;
 //! - `.chart.tiles.jsonl`, one line per finished task (tile), appended and flushed as each
-//!   finishes: `{"task": t, "cells": [ChartCell, …]}` (a killed run leaves at most a cut last
-//!   line, dropped on resume).
+//!   finishes: `{"cells": [ChartCell, …], "task": t, "crc32": "89abcdef"}` (a killed run
+//!   leaves at most a cut last line, dropped on resume). `crc32` is the CRC-32 (zlib's) of the
+//!   line's text before `,"crc32":`, 8 lowercase hex digits.
+//!
+//! Reading the tiles (a resume, the files written from the store) refuses, naming the file
+//! and the line, a complete line whose checksum does not match or that cannot be read — a
+//! damaged store never becomes a chart. A store whose ledger has no `format` was written by
+//! an earlier version, without checksums: refused too (rerun without resuming).
 //!
 //! A resumed chart computes only the tasks not stored, and only for the request that made the
 //! store ([`super::chart::fingerprint`]); a finished one computes nothing. The command line's
@@ -11,7 +17,7 @@
 //! `chart.nc`, the maps) are written from it.
 
 use super::checkpoint::{CheckpointError, Ledger};
-use super::checkpoint_file::write_atomic;
+use super::checkpoint_file::{crc_hex, write_atomic, START_OVER};
 use super::dir_lock::DirLock;
 use super::sweep::first_difference;
 use crate::analysis::chart::ChartCell;
@@ -26,6 +32,10 @@ use std::path::{Path, PathBuf};
 pub const LEDGER: &str = ".chart.run.json";
 /// The finished tasks.
 pub const TILES: &str = ".chart.tiles.jsonl";
+/// The store's layout (the ledger's `format`): 2 since the lines carry checksums.
+pub const FORMAT: u64 = 2;
+/// What ends a tile's line before its checksum.
+const CRC_KEY: &str = ",\"crc32\":\"";
 
 #[derive(Deserialize)]
 struct Line {
@@ -78,6 +88,15 @@ impl<'a> ChartStore<'a> {
             path: path.display().to_string(),
             message: e.to_string(),
         })?;
+        if v.get("format").and_then(Value::as_u64) != Some(FORMAT) && self.path(TILES).exists() {
+            return Err(CheckpointError::Corrupt {
+                path: self.path(TILES).display().to_string(),
+                message: format!(
+                    "written by an earlier version of afmdyn (its lines carry no checksums); \
+                     {START_OVER}"
+                ),
+            });
+        }
         Ok(Some(Ledger {
             fingerprint: v.get("args").cloned().unwrap_or(Value::Null),
             finished: v.get("finished").and_then(Value::as_bool).unwrap_or(false),
@@ -85,7 +104,7 @@ impl<'a> ChartStore<'a> {
     }
 
     fn write_ledger(&self, fingerprint: &Value, finished: bool) -> Result<(), CheckpointError> {
-        let doc = json!({"args": fingerprint, "finished": finished});
+        let doc = json!({"args": fingerprint, "finished": finished, "format": FORMAT});
         write_atomic(&self.path(LEDGER), format!("{doc:#}\n").as_bytes())
     }
 
@@ -135,9 +154,13 @@ impl<'a> ChartStore<'a> {
         Ok(HashSet::new())
     }
 
-    /// The stored tasks, each handed with its cells to `each`: every complete line (a cut or
-    /// unreadable last line is dropped, and the file cut back to the complete lines so that
-    /// appends follow them).
+    /// The stored tasks, each handed with its cells to `each`: every complete line (a cut last
+    /// line is dropped, and the file cut back to the complete lines so that appends follow
+    /// them).
+    ///
+    /// # Errors
+    /// [`CheckpointError::Corrupt`] naming the line whose checksum does not match or which
+    /// cannot be read; [`CheckpointError::Io`].
     fn read_tiles(
         &self,
         mut each: impl FnMut(usize, Vec<ChartCell>),
@@ -150,7 +173,11 @@ impl<'a> ChartStore<'a> {
             Err(e) => return Err(io("read", &path)(e)),
         };
         let mut reader = BufReader::new(file);
-        let (mut good, mut buf) = (0u64, Vec::new());
+        let (mut good, mut buf, mut number) = (0u64, Vec::new(), 0usize);
+        let damaged = |number: usize, what: String| CheckpointError::Corrupt {
+            path: path.display().to_string(),
+            message: format!("line {number}: {what}; {START_OVER}"),
+        };
         loop {
             buf.clear();
             let n = reader
@@ -159,15 +186,27 @@ impl<'a> ChartStore<'a> {
             if n == 0 || buf.last() != Some(&b'\n') {
                 break;
             }
-            match serde_json::from_slice::<Line>(&buf) {
-                Ok(line) => {
-                    if tasks.insert(line.task) {
-                        each(line.task, line.cells);
-                    }
-                    good += n as u64;
+            number += 1;
+            let text = String::from_utf8_lossy(&buf[..n - 1]);
+            let sealed = text.rfind(CRC_KEY).and_then(|at| {
+                let crc = text[at + CRC_KEY.len()..].strip_suffix("\"}")?;
+                Some((at, crc))
+            });
+            match sealed {
+                Some((at, crc)) if crc_hex(&text[..at]) == crc => {}
+                _ => {
+                    return Err(damaged(
+                        number,
+                        "checksum mismatch (the line was changed after afmdyn wrote it)".into(),
+                    ))
                 }
-                Err(_) => break,
             }
+            let line = serde_json::from_str::<Line>(&text)
+                .map_err(|e| damaged(number, format!("cannot be read ({e})")))?;
+            if tasks.insert(line.task) {
+                each(line.task, line.cells);
+            }
+            good += n as u64;
         }
         let f = OpenOptions::new()
             .write(true)
@@ -196,7 +235,10 @@ impl<'a> ChartStore<'a> {
     /// [`CheckpointError::Io`].
     pub fn append(&mut self, task: usize, cells: Vec<ChartCell>) -> Result<(), CheckpointError> {
         let path = self.path(TILES);
-        let line = json!({"task": task, "cells": &cells});
+        let line = json!({"task": task, "cells": &cells}).to_string();
+        // the object without its closing brace, then the checksum of that text
+        let body = &line[..line.len() - 1];
+        let line = format!("{body}{CRC_KEY}{}\"}}", crc_hex(body));
         if let Some(w) = self.writer.as_mut() {
             writeln!(w, "{line}")
                 .and_then(|()| w.flush())

@@ -3,20 +3,26 @@
 //! - `.bifurcation.run.json`, the ledger: `{"args": fingerprint, "finished": bool}`;
 //! - `.bifurcation.partial.csv`, the rows of an unfinished sweep in the order the points
 //!   finished, appended and flushed point by point (a killed run leaves at most one point in
-//!   part, dropped on resume);
-//! - `bifurcation.csv`, the rows of the finished sweep in the one order.
+//!   part, dropped on resume). Its header is [`HEADER`] and a last column `crc32`; each row
+//!   ends with the CRC-32 (ISO-HDLC, the one of zlib and `crc32fast`; 8 lowercase hex digits)
+//!   of the row's text before that column. A resume refuses, naming the file and the line, a
+//!   header that is not this one (a store written before the checksums is named as such:
+//!   rerun without resuming) and a complete line whose checksum does not match (a record
+//!   changed after it was written) — never resuming into a corrupt result;
+//! - `bifurcation.csv`, the rows of the finished sweep in the one order (without the
+//!   checksums).
 //!
 //! The layout is the command line's `afmdyn bifurcation --out DIR`; Python's
 //! `afmdyn.bifurcation(store=DIR)` uses the same, so either resumes the other's sweep.
 
 use super::checkpoint::{end_state, Checkpoint, CheckpointError, DonePoint, Ledger, StoreStatus};
-use super::dir_lock::DirLock;
+use super::dir_lock::{partial_path, DirLock};
 use super::sweep::{SweepRecord, COL_INDEX, COL_POINT, COL_POINTS, HEADER};
 use crate::analysis::bifurcation::Branch;
 use serde_json::{json, Value};
+use std::collections::HashSet;
 use std::fs::{self, File, OpenOptions};
-use std::io::{BufRead, BufReader, BufWriter, Read, Seek, SeekFrom, Write};
-use std::ops::Range;
+use std::io::{BufRead, BufReader, BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 /// The finished rows.
@@ -27,6 +33,38 @@ pub const PARTIAL_CSV: &str = ".bifurcation.partial.csv";
 pub const LEDGER: &str = ".bifurcation.run.json";
 /// The finished rows while they are being sorted.
 const SORTED_CSV: &str = ".bifurcation.sorted.csv";
+/// The last column of the checkpoint's rows: the CRC-32 of the row's text before it.
+pub const CRC_COLUMN: &str = "crc32";
+/// What a damaged store's message tells the user to do.
+pub(crate) const START_OVER: &str = "rerun without --resume to start over";
+
+/// The checkpoint's header: [`HEADER`] and [`CRC_COLUMN`].
+pub fn partial_header() -> String {
+    format!("{},{CRC_COLUMN}", HEADER.join(","))
+}
+
+/// The CRC-32 of `text` as the stores write it: 8 lowercase hex digits.
+pub(crate) fn crc_hex(text: &str) -> String {
+    format!("{:08x}", crc32fast::hash(text.as_bytes()))
+}
+
+/// A row as the checkpoint stores it: the row and, in the last column, its checksum.
+pub fn sealed(row: &str) -> String {
+    format!("{row},{}", crc_hex(row))
+}
+
+/// The row of a stored line whose checksum matches (`None`: no checksum, or another one).
+pub fn unsealed(line: &str) -> Option<&str> {
+    let (row, crc) = line.rsplit_once(',')?;
+    (crc_hex(row) == crc).then_some(row)
+}
+
+fn corrupt(path: &Path, message: String) -> CheckpointError {
+    CheckpointError::Corrupt {
+        path: path.display().to_string(),
+        message,
+    }
+}
 
 /// A sweep's checkpoint in a directory (see the module), which the caller holds locked.
 #[derive(Debug)]
@@ -47,13 +85,9 @@ fn io<'a>(
     }
 }
 
-/// Write `bytes` to `path` through a temporary file renamed into place (`.NAME.partial.EXT`).
+/// Write `bytes` to `path` through a temporary file renamed into place ([`partial_path`]).
 pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), CheckpointError> {
-    let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("out");
-    let tmp = path.with_file_name(match path.extension().and_then(|s| s.to_str()) {
-        Some(ext) => format!(".{stem}.partial.{ext}"),
-        None => format!(".{stem}.partial"),
-    });
+    let tmp = partial_path(path);
     let written = File::create(&tmp)
         .and_then(|mut f| f.write_all(bytes).and_then(|_| f.sync_all()))
         .map_err(io("write", path));
@@ -64,8 +98,8 @@ pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), CheckpointEr
     fs::rename(&tmp, path).map_err(io("finish", path))
 }
 
-/// A point's rows in the partial file: key, byte range, lines.
-type Group = ((usize, Branch), Range<u64>, Vec<String>);
+/// A point's rows in the partial file: key and rows (checked, without their checksums).
+type Group = ((usize, Branch), Vec<String>);
 
 /// Key of a row (one sweep point): (index, branch).
 fn row_key(line: &str) -> Option<(usize, Branch)> {
@@ -86,45 +120,84 @@ fn complete(g: &[String]) -> bool {
             .all(|(i, c)| c[COL_POINT].parse::<usize>().ok() == Some(i))
 }
 
-/// The header and the complete points of a rows file, in file order. A killed run may leave
-/// a cut row (without its newline) or a point in part at the end: they are not listed.
-fn groups(path: &Path) -> Result<(String, Vec<Group>), CheckpointError> {
+/// The complete points of a checkpoint, in file order, their rows checked against their
+/// checksums. A killed run may leave a cut row (without its newline) or a point in part at
+/// the end: they are not listed (and so computed again).
+///
+/// # Errors
+/// [`CheckpointError::Corrupt`] naming the line: a first line that is not
+/// [`partial_header`] (a store written before the checksums, or a removed or changed
+/// header), a complete line whose checksum does not match, a point stored twice.
+fn groups(path: &Path) -> Result<Vec<Group>, CheckpointError> {
     let mut reader = BufReader::new(File::open(path).map_err(io("read", path))?);
-    let (mut header, mut groups, mut group) = (String::new(), Vec::new(), Vec::<String>::new());
-    let (mut start, mut pos) = (0u64, 0u64);
-    let mut close = |group: &mut Vec<String>, range: Range<u64>| {
+    let (mut groups, mut group) = (Vec::new(), Vec::<String>::new());
+    let mut seen = HashSet::new();
+    let mut close = |group: &mut Vec<String>, line: usize| -> Result<(), CheckpointError> {
         if let Some(key) = group.first().and_then(|g| row_key(g)) {
             if complete(group) {
-                groups.push((key, range, std::mem::take(group)));
+                if !seen.insert(key) {
+                    return Err(corrupt(
+                        path,
+                        format!(
+                            "line {line}: point {} ({}) is stored twice; {START_OVER}",
+                            key.0, key.1
+                        ),
+                    ));
+                }
+                groups.push((key, std::mem::take(group)));
             }
         }
         group.clear();
+        Ok(())
     };
     let mut buf = Vec::new();
+    let mut number = 0usize;
     loop {
         buf.clear();
         let n = reader
             .read_until(b'\n', &mut buf)
-            .map_err(io("read", path))? as u64;
+            .map_err(io("read", path))?;
         if n == 0 || buf.last() != Some(&b'\n') {
             break; // the end, or a cut row without its newline
         }
-        let line = String::from_utf8_lossy(&buf[..buf.len() - 1]).to_string();
-        if header.is_empty() {
-            header = line;
-            pos += n;
-            start = pos;
-            continue;
+        number += 1;
+        let line = String::from_utf8_lossy(&buf[..buf.len() - 1]);
+        if number == 1 {
+            if line == partial_header() {
+                continue;
+            }
+            return Err(corrupt(
+                path,
+                if line == HEADER.join(",") {
+                    format!(
+                        "written by an earlier version of afmdyn (its rows carry no \
+                         checksums); {START_OVER}"
+                    )
+                } else {
+                    format!(
+                        "line 1: the header is missing or changed (expected the columns {}); \
+                         {START_OVER}",
+                        partial_header()
+                    )
+                },
+            ));
         }
-        if !group.is_empty() && group.first().and_then(|g| row_key(g)) != row_key(&line) {
-            close(&mut group, start..pos);
-            start = pos;
+        let Some(row) = unsealed(&line) else {
+            return Err(corrupt(
+                path,
+                format!(
+                    "line {number}: checksum mismatch (the row was changed after afmdyn wrote \
+                     it); {START_OVER}"
+                ),
+            ));
+        };
+        if !group.is_empty() && group.first().and_then(|g| row_key(g)) != row_key(row) {
+            close(&mut group, number - 1)?;
         }
-        group.push(line);
-        pos += n;
+        group.push(row.to_string());
     }
-    close(&mut group, start..pos);
-    Ok((header, groups))
+    close(&mut group, number)?;
+    Ok(groups)
 }
 
 impl<'a> FileCheckpoint<'a> {
@@ -217,16 +290,16 @@ impl Checkpoint for FileCheckpoint<'_> {
         }
         self.write_ledger(fingerprint, false)?;
         let mut f = File::create(&partial).map_err(io("create", &partial))?;
-        writeln!(f, "{}", HEADER.join(",")).map_err(io("write", &partial))
+        writeln!(f, "{}", partial_header()).map_err(io("write", &partial))
     }
 
     fn done(&mut self) -> Result<Vec<DonePoint>, CheckpointError> {
         self.writer = None;
         let partial = self.partial();
-        let (header, groups) = groups(&partial)?;
-        let mut text = header + "\n";
+        let groups = groups(&partial)?;
+        let mut text = partial_header() + "\n";
         let mut done = Vec::with_capacity(groups.len());
-        for ((index, branch), _, lines) in groups {
+        for ((index, branch), lines) in groups {
             let state = lines
                 .last()
                 .and_then(|l| SweepRecord::parse_csv(l).ok())
@@ -237,7 +310,7 @@ impl Checkpoint for FileCheckpoint<'_> {
                 state,
             });
             for l in lines {
-                text.push_str(&l);
+                text.push_str(&sealed(&l));
                 text.push('\n');
             }
         }
@@ -257,7 +330,7 @@ impl Checkpoint for FileCheckpoint<'_> {
         }
         let mut text = String::new();
         for r in point {
-            text.push_str(&r.csv_line());
+            text.push_str(&sealed(&r.csv_line()));
             text.push('\n');
         }
         let w = self.writer.as_mut().ok_or_else(|| CheckpointError::Io {
@@ -270,29 +343,26 @@ impl Checkpoint for FileCheckpoint<'_> {
             .map_err(io("write", &partial))
     }
 
-    /// Sort the points by key (copying their rows by byte range, never all in memory) into
-    /// `bifurcation.csv`, remove the partial rows, mark the ledger finished.
+    /// Sort the points by key into `bifurcation.csv` (their rows checked and without their
+    /// checksums), remove the partial rows, mark the ledger finished.
     fn finish(&mut self, fingerprint: &Value) -> Result<(), CheckpointError> {
         let partial = self.partial();
         if let Some(mut w) = self.writer.take() {
             w.flush().map_err(io("write", &partial))?;
         }
         let final_csv = self.final_csv();
-        let (header, mut groups) = groups(&partial)?;
+        let mut groups = groups(&partial)?;
         groups.sort_by_key(|g| g.0);
-        let mut src = File::open(&partial).map_err(io("read", &partial))?;
         let sorted = self.dir.join(SORTED_CSV);
         {
             let wr = io("write", &final_csv);
             let mut out = BufWriter::new(File::create(&sorted).map_err(io("write", &final_csv))?);
             let mut copy = || -> std::io::Result<()> {
-                writeln!(out, "{header}")?;
-                let mut buf = Vec::new();
-                for (_, range, _) in &groups {
-                    buf.resize((range.end - range.start) as usize, 0);
-                    src.seek(SeekFrom::Start(range.start))?;
-                    src.read_exact(&mut buf)?;
-                    out.write_all(&buf)?;
+                writeln!(out, "{}", HEADER.join(","))?;
+                for (_, lines) in &groups {
+                    for l in lines {
+                        writeln!(out, "{l}")?;
+                    }
                 }
                 out.flush()?;
                 out.get_ref().sync_all()

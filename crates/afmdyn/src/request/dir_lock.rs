@@ -7,6 +7,12 @@
 //! process id, for the message of the run that is refused. On a file system without advisory
 //! locks the directory is used unlocked ([`DirLock::is_locked`] is false) rather than not at
 //! all.
+//!
+//! A file is written as its temporary sibling `.NAME.partial.EXT` ([`partial_path`]) and
+//! renamed into place. A run killed outright (a second Ctrl-C, SIGKILL) leaves that sibling;
+//! the next run on the directory, holding the lock so that no other run is writing it,
+//! removes the stale siblings of its own outputs ([`DirLock::remove_partials`]) — never those
+//! of other outputs (a bifurcation's `.bifurcation.partial.csv` is its checkpoint).
 
 use std::fs::{self, File};
 use std::io::Write;
@@ -14,6 +20,17 @@ use std::path::{Path, PathBuf};
 
 /// Name of the lock file in a locked directory.
 pub const LOCK_FILE: &str = ".afmdyn.lock";
+
+/// The temporary sibling `path` is written as before it is renamed into place:
+/// `DIR/NAME.EXT` → `DIR/.NAME.partial.EXT` (`DIR/.NAME.partial` without an extension; the
+/// extension stays last, for the writers that choose a format by it).
+pub fn partial_path(path: &Path) -> PathBuf {
+    let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("out");
+    path.with_file_name(match path.extension().and_then(|s| s.to_str()) {
+        Some(ext) => format!(".{stem}.partial.{ext}"),
+        None => format!(".{stem}.partial"),
+    })
+}
 
 /// Why a directory could not be locked.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -101,6 +118,26 @@ impl DirLock {
         &self.dir
     }
 
+    /// Remove the stale temporary siblings ([`partial_path`]) of `outputs`, the names of the
+    /// files a run writes in the directory (`timeseries.npy`, `events.csv`, …), which a run
+    /// killed before it could clean up left behind. Call it holding the lock (no other run
+    /// is then writing them). Returns the files removed.
+    ///
+    /// # Errors
+    /// [`LockError::Io`] naming a file that exists but cannot be removed.
+    pub fn remove_partials(&self, outputs: &[&str]) -> Result<Vec<PathBuf>, LockError> {
+        let mut removed = Vec::new();
+        for name in outputs {
+            let tmp = partial_path(&self.dir.join(name));
+            match fs::remove_file(&tmp) {
+                Ok(()) => removed.push(tmp),
+                Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+                Err(e) => return Err(io("remove", &tmp)(e)),
+            }
+        }
+        Ok(removed)
+    }
+
     /// Whether the lock is held (false on a file system without advisory locks, where the
     /// directory is used unlocked and concurrent runs are not detected).
     pub fn is_locked(&self) -> bool {
@@ -130,6 +167,34 @@ mod tests {
         }
         drop(first);
         assert!(DirLock::acquire(&dir).is_ok());
+        fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn stale_partials_of_the_named_outputs_are_removed_and_no_other_file() {
+        let dir = std::env::temp_dir().join(format!("afmdyn-partials-{}", std::process::id()));
+        let _ = fs::remove_dir_all(&dir);
+        let lock = DirLock::acquire(&dir).unwrap();
+        for name in [
+            ".a.partial.csv",
+            ".b.npy.partial.json",
+            ".c.partial",
+            ".d.partial.csv",
+        ] {
+            fs::write(dir.join(name), "x").unwrap();
+        }
+        fs::write(dir.join("a.csv"), "result").unwrap();
+        let removed = lock
+            .remove_partials(&["a.csv", "b.npy.json", "c", "e.csv"])
+            .unwrap();
+        assert_eq!(removed.len(), 3, "{removed:?}");
+        let mut left: Vec<String> = fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        left.sort();
+        assert_eq!(left, [".afmdyn.lock", ".d.partial.csv", "a.csv"]);
+        drop(lock);
         fs::remove_dir_all(&dir).unwrap();
     }
 }
