@@ -289,8 +289,8 @@ def simulate(
         command line's ``spectrum.csv``). ``attrs["summary"]`` holds
         ``afmdyn simulate --json`` (see :func:`summary`). Units: the model's (τ in t0,
         lengths in g0, forces E I g0/L³, or k g0 for the point mass); with ``probe`` every
-        array is in SI, as the command line's files — times (the ``tau`` coordinate, events,
-        sections) in s, lengths in m, velocities in m/s, forces in N, energies in J, the
+        array is in SI, as the command line's files — times (the coordinate ``t``, named
+        ``tau`` without a probe; events, sections) in s, lengths in m, velocities in m/s, forces in N, energies in J, the
         spectrum's frequencies in Hz — each variable's unit in its attrs.
     """
     p, probe = _params(params, model)
@@ -315,6 +315,8 @@ def simulate(
     si = bool(d["si"])
     point_mass = p.structure == "point-mass"
     _t = {"units": "s", "long_name": "time t"} if si else _T
+    # the time coordinate: t in s with a probe (as timeseries.csv names it), else τ
+    time = "t" if si else "tau"
     _g = {"units": "m"} if si else _G
     _v = {"units": "m/s"} if si else _V
     force = "N" if si else ("k g0" if point_mass else "E I g0/L^3")
@@ -322,18 +324,18 @@ def simulate(
     freq = "Hz" if si else "Ω units (1/t0)"
     ds = xr.Dataset(
         data_vars={
-            "v_t": ("tau", d["v_t"], {**_g, "long_name": "tip–sample distance V_T (eq. 8)"}),
-            "v_t_dot": ("tau", d["v_t_dot"], {**_v, "long_name": "dV_T/dτ"}),
-            "w_tip": ("tau", d["w_tip"], {**_g, "long_name": "tip deflection W(1,τ)"}),
-            "w_tip_dot": ("tau", d["w_tip_dot"], {**_v, "long_name": "∂W(1,τ)/∂τ"}),
-            "in_contact": ("tau", d["in_contact"], {"long_name": "tip on the sample (region II)"}),
+            "v_t": (time, d["v_t"], {**_g, "long_name": "tip–sample distance V_T (eq. 8)"}),
+            "v_t_dot": (time, d["v_t_dot"], {**_v, "long_name": "dV_T/dτ"}),
+            "w_tip": (time, d["w_tip"], {**_g, "long_name": "tip deflection W(1,τ)"}),
+            "w_tip_dot": (time, d["w_tip_dot"], {**_v, "long_name": "∂W(1,τ)/∂τ"}),
+            "in_contact": (time, d["in_contact"], {"long_name": "tip on the sample (region II)"}),
             "contact_force": (
-                "tau",
+                time,
                 d["contact_force"],
                 {"units": force, "long_name": "tip–sample contact force"},
             ),
-            "a": (("tau", "mode"), d["a"], {**_g, "long_name": "modal displacement a_i"}),
-            "a_dot": (("tau", "mode"), d["a_dot"], {**_v, "long_name": "modal velocity da_i/dτ"}),
+            "a": ((time, "mode"), d["a"], {**_g, "long_name": "modal displacement a_i"}),
+            "a_dot": ((time, "mode"), d["a_dot"], {**_v, "long_name": "modal velocity da_i/dτ"}),
             "event_tau": ("event", d["event_tau"], {**_t, "long_name": "switching time"}),
             "event_to_contact": (
                 "event",
@@ -408,7 +410,7 @@ def simulate(
                 d["spectrum_frequency"],
                 {"units": freq, "long_name": "frequency"},
             ),
-            "tau": ("tau", d["tau"], _t),
+            time: (time, d["tau"], _t),
             "mode": ("mode", np.arange(1, n + 1), {"long_name": "Galerkin mode i"}),
             "component": ("component", comp),
         },
