@@ -807,3 +807,41 @@ fn text_summaries_speak_si_under_a_probe() {
     let plain = text(&["orbit", "--omega", "2.8"]);
     assert!(plain.starts_with("period-2 orbit at Ω = 2.8 ("), "{plain}");
 }
+
+/// `attractors` under a probe prints the drive in kHz, z_c and each attractor's X_max in nm
+/// (issue 42: Ω = 1 and g0), X_max equal to the JSON document's `si.attractors_x_max_m`.
+#[test]
+fn attractors_text_speaks_si_under_a_probe() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().to_str().unwrap();
+    let pm = "examples/probe-point-mass-dmt.toml";
+    let args = [
+        "attractors",
+        "--probe",
+        pm,
+        "--samples",
+        "2",
+        "--max-periods",
+        "300",
+        "--out",
+        out,
+    ];
+    let t = text(&args);
+    assert!(t.contains("at f = 300.000 kHz, z_c = 8.00000 nm:"), "{t}");
+    assert!(!t.contains("Ω ="), "{t}");
+    let shown: f64 = t
+        .split("X_max = ")
+        .nth(1)
+        .unwrap()
+        .split(" nm")
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    let doc = json(&[&args[..], &["--json"]].concat());
+    let want = doc["si"]["attractors_x_max_m"][0].as_f64().unwrap();
+    assert!(
+        (shown * 1e-9 - want).abs() <= 1e-5 * want,
+        "{shown} nm against {want} m"
+    );
+}
