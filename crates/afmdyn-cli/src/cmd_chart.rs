@@ -11,7 +11,7 @@ use crate::output::{write_bytes, OutDir};
 use crate::plot::{color, save_map, CellMap};
 use afmdyn::analysis::chart::{run_chart, ChartCell, ChartPlan};
 use afmdyn::request::chart::{
-    axis_name, axis_unit, csv_lines, document, warnings, ChartArrays, CSV_HEADER,
+    axis_name, axis_unit, csv_lines, document, warnings, Chart, ChartArrays, CSV_HEADER,
 };
 use afmdyn::request::chart_store::ChartStore;
 use afmdyn::request::checkpoint::CheckpointError;
@@ -257,11 +257,11 @@ fn write_nc(path: &Path, a: &ChartArrays, x: &str, y: &str) -> Result<(), CliErr
     )
 }
 
-fn write_csv(path: &Path, cells: &[ChartCell]) -> Result<(), CliError> {
+fn write_csv(path: &Path, chart: &Chart, cells: &[ChartCell]) -> Result<(), CliError> {
     let mut text = CSV_HEADER.join(",");
     text.push('\n');
     for c in cells {
-        for line in csv_lines(c) {
+        for line in csv_lines(chart, c) {
             text.push_str(&line);
             text.push('\n');
         }
@@ -367,7 +367,7 @@ pub fn chart(a: &ChartArgs) -> Result<(), CliError> {
     }
     let cells = store.cells().map_err(store_error)?;
     let arrays = ChartArrays::new(&chart, &cells);
-    write_csv(&out.join("chart.csv"), &cells)?;
+    write_csv(&out.join("chart.csv"), &chart, &cells)?;
     write_nc(&out.join("chart.nc"), &arrays, chart.model.x, chart.model.y)?;
     draw_maps(out.path(), &chart, &arrays)?;
     let empty = cells.iter().filter(|c| c.attractors.is_empty()).count();

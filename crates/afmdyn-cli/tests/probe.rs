@@ -845,3 +845,75 @@ fn attractors_text_speaks_si_under_a_probe() {
         "{shown} nm against {want} m"
     );
 }
+
+/// `chart.csv` under a probe has its lengths in m, each row in its cell's length unit: along a
+/// free-amplitude axis A0 (the length unit g0) changes from cell to cell (issue 42: the column
+/// was in g0, a different length per row); the JSON cells stay in g0 with the axis value.
+#[test]
+fn chart_csv_lengths_are_in_metres_under_a_probe() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().to_str().unwrap();
+    let doc = json(&[
+        "chart",
+        "--probe",
+        "examples/probe-point-mass-dmt.toml",
+        "--x",
+        "free-amplitude",
+        "--x-from",
+        "8nm",
+        "--x-to",
+        "12nm",
+        "--x-steps",
+        "2",
+        "--y",
+        "sample-modulus",
+        "--y-from",
+        "2e9",
+        "--y-to",
+        "2e9",
+        "--y-steps",
+        "1",
+        "--starts",
+        "1",
+        "--lyapunov-periods",
+        "0",
+        "--max-periods",
+        "6000",
+        "--json",
+        "--out",
+        out,
+    ]);
+    // (text columns, status and origin, read as NaN)
+    let text = std::fs::read_to_string(dir.path().join("chart.csv")).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| {
+            l.split(',')
+                .map(|v| v.parse().unwrap_or(f64::NAN))
+                .collect()
+        })
+        .collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let (ix, x_max, v_t_min) = (col("ix"), col("x_max"), col("v_t_min"));
+    let a0 = [8e-9, 12e-9];
+    for r in &rows {
+        let i = r[ix] as usize;
+        let cell = doc["cells"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|c| c["ix"] == i)
+            .unwrap();
+        let g0 = cell["attractors"][0]["x_max"].as_f64().unwrap();
+        assert!(
+            (r[x_max] - g0 * a0[i]).abs() <= 1e-12 * r[x_max].abs(),
+            "{r:?}"
+        );
+        let v = cell["attractors"][0]["v_t_min"].as_f64().unwrap();
+        assert!((r[v_t_min] - v * a0[i]).abs() <= 1e-12 * r[v_t_min].abs().max(1e-30));
+        // a tapping amplitude, nanometres
+        assert!((1e-9..1e-7).contains(&r[x_max]), "{r:?}");
+    }
+    assert_eq!(rows.len(), 2);
+}
