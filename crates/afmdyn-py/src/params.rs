@@ -150,8 +150,9 @@ pub fn params_from_kwargs(base: Params, kwargs: Option<&Bound<'_, PyDict>>) -> P
 /// flags): `params` (an `afmdyn.Params`, like a config file), or the probe file's set, or
 /// `default`, or the paper's set, with the keywords applied ([`ModelSpec::resolve`]: `z_c`
 /// and `drive_frequency` need the probe). `params` and `probe` together must agree (the
-/// pattern `f(Params.from_probe(path), probe=path)`): the probe sets every parameter and the
-/// keywords override single ones.
+/// pattern `f(Params.from_probe(path), probe=path)`): the probe sets every parameter, the SI
+/// keywords and `modes`/`restitution` override it, the dimensionless ones it sets are refused
+/// ([`afmdyn::request::model::PROBE_SETS`]).
 #[pyfunction]
 #[pyo3(signature = (params=None, default=None, probe=None, model=None))]
 pub fn resolve(

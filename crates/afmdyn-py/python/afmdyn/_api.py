@@ -53,9 +53,12 @@ StateLike = Union[None, Sequence[float], np.ndarray, Attractor, Orbit]
 class Model(TypedDict, total=False):
     """The model keywords every analysis takes (see :class:`Params` for their ranges; the one
     table of them is ``afmdyn._afmdyn.MODEL_PARAMETERS``). ``probe`` is a probe file in SI (the
-    command line's ``--probe``): it sets every parameter, the other keywords override single
-    ones, and ``z_c`` (m) and ``drive_frequency`` (Hz) set α5 and Ω through its scales; the
-    result's ``to_dict()`` then carries the command line's ``"si"`` block."""
+    command line's ``--probe``): it sets every parameter in SI, ``z_c`` (m) and
+    ``drive_frequency`` (Hz) set α5 and Ω through its scales, ``modes`` and ``restitution`` are
+    taken, and the dimensionless keywords of the values it sets (``gap``, ``omega``, the α's,
+    ``hamaker``, ``intermolecular_distance``, ``contact_law``) raise ``ValueError`` naming the
+    probe key or SI keyword to use; the result's ``to_dict()`` then carries the command line's
+    ``"si"`` block."""
 
     modes: int
     tip_mass_ratio: float
