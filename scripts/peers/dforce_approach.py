@@ -9,7 +9,7 @@ the time series runner computes), and reads the zcdom*.csv file runner writes.
 
 The afmdyn side is
   * `afmdyn approach --probe P --from --to --step --json`: afmdyn's own observables, and for every
-    z_c `afmdyn orbit --probe P --gap alpha5 --initial-modal ... --json`, the period-1 orbit
+    z_c `afmdyn orbit --probe P --z-c Z_C --initial-modal ... --json`, the period-1 orbit
     (Newton shooting) started from the approach's first harmonic, so that it lies on the branch
     the sweep followed (without the approach command: from the previous z_c's orbit, and the
     afmdyn column is then the SciPy integration below);
@@ -251,8 +251,8 @@ def afmdyn_orbits(afmdyn, probe, P, zcs, appr=None, sweep="approach"):
     with a long transient when that lands on an unstable orbit."""
     orbits, init = [], None
     for i, zc in enumerate(zcs):
-        alpha5 = (zc - P.a0) / P.A0
-        cmd = [afmdyn, "orbit", "--probe", probe, "--gap", repr(alpha5), "--period", "1", "--json"]
+        # z_c in m (a probe refuses the dimensionless --gap; afmdyn sets α5 = (z_c − a0)/A0)
+        cmd = [afmdyn, "orbit", "--probe", probe, "--z-c", repr(zc), "--period", "1", "--json"]
         if appr is not None:
             ar = appr[sweep]
             j = int(np.argmin(np.abs(np.array(ar["z_c"]) - zc)))

@@ -32,7 +32,7 @@ pub struct ModelArgs {
         value_name = "METRES",
         requires = "probe",
         conflicts_with = "alpha5",
-        allow_negative_numbers = true
+        allow_hyphen_values = true
     )]
     pub z_c: Option<Quantity>,
     #[arg(
@@ -40,7 +40,7 @@ pub struct ModelArgs {
         value_name = "HZ",
         requires = "probe",
         conflicts_with = "omega",
-        allow_negative_numbers = true
+        allow_hyphen_values = true
     )]
     pub drive_frequency: Option<Quantity>,
     #[arg(long, value_name = "N")]

@@ -2,7 +2,7 @@
 
 use crate::args::{IntegratorArgs, ModelArgs};
 use crate::error::CliError;
-use crate::output::{f, io_error, write_bytes, write_csv, Column, NpyStream, OutDir};
+use crate::output::{f, io_error, write_bytes, write_csv, Column, NpyStream, OutDir, TextUnits};
 use crate::plot::{
     save, save_scatter_stream, save_stacked, ChunkSink, Figure, IdSeries, LegendEntry, Series,
     StackedFractions, Style,
@@ -489,6 +489,7 @@ pub fn attractors(a: &AttractorsArgs) -> Result<(), CliError> {
     }
     let spec = request.spec(&p)?;
     let out = OutDir::lock(&a.out)?;
+    let u = TextUnits::of(probe.as_ref());
     let Document {
         output: report,
         json: doc,
@@ -597,22 +598,41 @@ pub fn attractors(a: &AttractorsArgs) -> Result<(), CliError> {
         println!("{doc}");
     } else {
         println!(
-            "{} attractors from {} starts ({} failed) at Ω = {}:",
+            "{} attractors from {} starts ({} failed) at {}{}:",
             report.attractors.len(),
             a.samples,
             report.failures.len(),
-            p.omega
+            u.drive(p.omega),
+            if u.si() {
+                format!(", z_c = {}", u.length(p.rest_distance()))
+            } else {
+                String::new()
+            }
         );
         for (k, x) in report.attractors.iter().enumerate() {
+            // lengths in g0, or in m with a probe (13.4747 nm)
+            let length = |v: f64| {
+                if u.si() {
+                    u.length(v)
+                } else {
+                    format!("{v:.4}")
+                }
+            };
             println!(
-                "  {}: {:<12} basin {:>5.1} %  X_max = {:.4}  min V_T = {:.4}  contact fraction {:.3}{}",
+                "  {}: {:<12} basin {:>5.1} %  X_max = {}  min V_T = {}  contact fraction {:.3}{}",
                 k + 1,
-                x.steady.period().map_or("nonperiodic".into(), |n| format!("period-{n}")),
+                x.steady
+                    .period()
+                    .map_or("nonperiodic".into(), |n| format!("period-{n}")),
                 100.0 * x.basin_fraction,
-                x.steady.stats.x_max,
-                x.steady.stats.v_t_min,
+                length(x.steady.stats.x_max),
+                length(x.steady.stats.v_t_min),
                 x.steady.stats.contact_fraction,
-                if x.steady.stats.body_contact { "  (beam body touches the substrate: Fig. 2f)" } else { "" }
+                if x.steady.stats.body_contact {
+                    "  (beam body touches the substrate: Fig. 2f)"
+                } else {
+                    ""
+                }
             );
         }
         for x in &report.unsettled {

@@ -6,6 +6,7 @@ use crate::args::{quantity, Dim, ModelArgs, Quantity};
 use crate::cmd_simulate::Files;
 use crate::error::CliError;
 use crate::netcdf::Var;
+use crate::output::si_value;
 use crate::output::{f, write_csv, Column, NpyStream, OutDir};
 use crate::plot::{save, Figure, Series, Style};
 use afmdyn::analysis::approach::rest_distance;
@@ -25,7 +26,7 @@ use std::path::{Path, PathBuf};
 #[derive(Debug, Args)]
 pub struct CurveArgs {
     /// Grid step of the swept quantity (in the units of --from/--to); conflicts with --points
-    #[arg(long, conflicts_with = "points", allow_negative_numbers = true)]
+    #[arg(long, conflicts_with = "points", allow_hyphen_values = true)]
     step: Option<Quantity>,
     /// Number of grid values, ends included (2..=100000) [default: 120]
     #[arg(long)]
@@ -84,10 +85,10 @@ pub struct ApproachArgs {
     /// Rest distance z_c where the approach starts (m with --probe, else units of g0)
     /// [default: 1.2 × the free amplitude A0 from the sample]; with --probe a unit may follow
     /// (20nm)
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true)]
     from: Option<Quantity>,
     /// Rest distance z_c where the approach ends and the retract starts [default: 0.1 × A0]
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true)]
     to: Option<Quantity>,
     #[command(flatten)]
     curve: CurveArgs,
@@ -111,10 +112,10 @@ pub struct ResonanceArgs {
     mode: usize,
     /// Start of the band (Hz with --probe, else Ω) [default: ω_k (1 − w), w = max(6/Q_k, 0.02)];
     /// with --probe a unit may follow (295kHz)
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true)]
     from: Option<Quantity>,
     /// End of the band [default: ω_k (1 + w)]
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true)]
     to: Option<Quantity>,
     #[command(flatten)]
     curve: CurveArgs,
@@ -146,21 +147,6 @@ impl Labels {
             None => format!("{v:.6e}"),
         }
     }
-}
-
-/// `v` in `unit` with the SI prefix that puts its mantissa in [1, 1000), 6 significant digits.
-fn si_value(v: f64, unit: &str) -> String {
-    if v == 0.0 || !v.is_finite() {
-        return format!("{v} {unit}");
-    }
-    let (e, p) = crate::plot::si_prefix(v.abs());
-    let m = v / 10f64.powi(e);
-    if !(1e-3..1e4).contains(&m.abs()) {
-        // plain SI (--units si): 8.033740e-9 m
-        return format!("{m:.6e} {p}{unit}");
-    }
-    let digits = (5 - m.abs().log10().floor() as i32).clamp(0, 5) as usize;
-    format!("{m:.digits$} {p}{unit}")
 }
 
 fn event_code(e: Option<BranchEvent>) -> f64 {
@@ -925,19 +911,4 @@ pub fn resonance(a: &ResonanceArgs) -> Result<(), CliError> {
             probe,
         },
     )
-}
-
-#[cfg(test)]
-mod si_tests {
-    use super::si_value;
-
-    /// SI prefixes with 6 significant digits.
-    #[test]
-    fn values_print_with_si_prefixes() {
-        assert_eq!(si_value(1.347465e-8, "m"), "13.4747 nm");
-        assert_eq!(si_value(3.0e5, "Hz"), "300.000 kHz");
-        assert_eq!(si_value(-2.5e-10, "m"), "-250.000 pm");
-        assert_eq!(si_value(1.0, "m"), "1.00000 m");
-        assert_eq!(si_value(0.0, "m"), "0 m");
-    }
 }

@@ -4,13 +4,15 @@
 //! [`afmdyn::request::chart_store`]); this front end parses, runs the local executor with a
 //! progress bar, and writes `chart.csv`, `chart.nc` and the maps.
 
-use crate::args::{IntegratorArgs, ModelArgs};
+use crate::args::{Dim, IntegratorArgs, ModelArgs, Quantity};
 use crate::cmd_analysis::SteadyArgs;
 use crate::error::CliError;
 use crate::output::{write_bytes, OutDir};
 use crate::plot::{color, save_map, CellMap};
 use afmdyn::analysis::chart::{run_chart, ChartCell, ChartPlan};
-use afmdyn::request::chart::{axis_unit, csv_lines, document, warnings, ChartArrays, CSV_HEADER};
+use afmdyn::request::chart::{
+    axis_name, axis_unit, csv_lines, document, warnings, Chart, ChartArrays, CSV_HEADER,
+};
 use afmdyn::request::chart_store::ChartStore;
 use afmdyn::request::checkpoint::CheckpointError;
 use afmdyn::request::{parameter, ChartRequest};
@@ -36,12 +38,13 @@ pub struct ChartArgs {
     /// drive-frequency (Hz)
     #[arg(long, default_value = "omega")]
     x: String,
-    /// First x value
-    #[arg(long, default_value_t = 2.6, allow_negative_numbers = true)]
-    x_from: f64,
+    /// First x value, in the axis' unit (with --probe: z-c in m, drive-frequency in Hz; a unit
+    /// may follow: 5nm, 299kHz)
+    #[arg(long, default_value = "2.6", allow_hyphen_values = true)]
+    x_from: Quantity,
     /// Last x value
-    #[arg(long, default_value_t = 3.0, allow_negative_numbers = true)]
-    x_to: f64,
+    #[arg(long, default_value = "3.0", allow_hyphen_values = true)]
+    x_to: Quantity,
     /// Number of x values
     #[arg(long, default_value_t = 9)]
     x_steps: usize,
@@ -49,11 +52,11 @@ pub struct ChartArgs {
     #[arg(long, default_value = "drive-amplitude")]
     y: String,
     /// First y value
-    #[arg(long, default_value_t = 0.1, allow_negative_numbers = true)]
-    y_from: f64,
+    #[arg(long, default_value = "0.1", allow_hyphen_values = true)]
+    y_from: Quantity,
     /// Last y value
-    #[arg(long, default_value_t = 0.12, allow_negative_numbers = true)]
-    y_to: f64,
+    #[arg(long, default_value = "0.12", allow_hyphen_values = true)]
+    y_to: Quantity,
     /// Number of y values
     #[arg(long, default_value_t = 2)]
     y_steps: usize,
@@ -254,16 +257,39 @@ fn write_nc(path: &Path, a: &ChartArrays, x: &str, y: &str) -> Result<(), CliErr
     )
 }
 
-fn write_csv(path: &Path, cells: &[ChartCell]) -> Result<(), CliError> {
+fn write_csv(path: &Path, chart: &Chart, cells: &[ChartCell]) -> Result<(), CliError> {
     let mut text = CSV_HEADER.join(",");
     text.push('\n');
     for c in cells {
-        for line in csv_lines(c) {
+        for line in csv_lines(chart, c) {
             text.push_str(&line);
             text.push('\n');
         }
     }
     write_bytes(path, text.as_bytes())
+}
+
+/// The value of `--FLAG` on the axis `axis`: a unit (5nm, 299kHz) must be the axis' SI unit
+/// ([`afmdyn::request::chart::axis_unit`]: m or Hz); an axis in another unit or dimensionless
+/// takes a plain number.
+fn axis_value(q: Quantity, flag: &str, axis: &str) -> Result<f64, CliError> {
+    let name = axis_name("x", axis).map_or("", |n| n);
+    let want = match axis_unit(name) {
+        "m" => Some(Dim::Length),
+        "Hz" => Some(Dim::Frequency),
+        _ => None,
+    };
+    match (q.dim, want) {
+        (Some(_), None) => Err(CliError::Input(format!(
+            "--{flag}: the axis {axis} takes a plain number ({}), not a unit",
+            match axis_unit(name) {
+                "1" => "dimensionless".to_string(),
+                u => format!("in {u}"),
+            }
+        ))),
+        (_, Some(d)) => q.value(flag, d, true),
+        (None, None) => Ok(q.value),
+    }
 }
 
 /// Run `afmdyn chart`.
@@ -276,12 +302,12 @@ pub fn chart(a: &ChartArgs) -> Result<(), CliError> {
     };
     let request = ChartRequest {
         x: a.x.clone(),
-        x_from: a.x_from,
-        x_to: a.x_to,
+        x_from: axis_value(a.x_from, "x-from", &a.x)?,
+        x_to: axis_value(a.x_to, "x-to", &a.x)?,
         x_steps: a.x_steps,
         y: a.y.clone(),
-        y_from: a.y_from,
-        y_to: a.y_to,
+        y_from: axis_value(a.y_from, "y-from", &a.y)?,
+        y_to: axis_value(a.y_to, "y-to", &a.y)?,
         y_steps: a.y_steps,
         starts: a.starts,
         seed: a.seed,
@@ -341,7 +367,7 @@ pub fn chart(a: &ChartArgs) -> Result<(), CliError> {
     }
     let cells = store.cells().map_err(store_error)?;
     let arrays = ChartArrays::new(&chart, &cells);
-    write_csv(&out.join("chart.csv"), &cells)?;
+    write_csv(&out.join("chart.csv"), &chart, &cells)?;
     write_nc(&out.join("chart.nc"), &arrays, chart.model.x, chart.model.y)?;
     draw_maps(out.path(), &chart, &arrays)?;
     let empty = cells.iter().filter(|c| c.attractors.is_empty()).count();

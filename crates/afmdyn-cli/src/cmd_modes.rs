@@ -2,7 +2,7 @@
 
 use crate::args::{read_toml, ModelArgs};
 use crate::error::CliError;
-use crate::output::{f, write_csv, OutDir};
+use crate::output::{f, write_csv, OutDir, TextUnits};
 use crate::plot::{save, Figure, Series, Style};
 use afmdyn::analysis::progress::Progress;
 use afmdyn::eigen::fig3_sweep;
@@ -39,6 +39,7 @@ pub fn modes(a: &ModesArgs) -> Result<(), CliError> {
     if a.sweep.is_some() {
         return fig3(a, &p);
     }
+    let u = TextUnits::of(probe.as_ref());
     let Document {
         output: (free, contact),
         json,
@@ -51,15 +52,42 @@ pub fn modes(a: &ModesArgs) -> Result<(), CliError> {
         println!("{json}");
         return Ok(());
     }
-    println!(
-        "N = {}, α1 = {}, α3 = {}, α4 = {}, α6 = {} (dimensionless, eq. 5 time scale)",
-        p.modes, p.alpha1, p.alpha3, p.alpha4, p.alpha6
-    );
+    if u.si() {
+        println!(
+            "N = {}, {} structure (SI: the probe's scales; natural frequencies in Hz)",
+            p.modes,
+            p.structure.name()
+        );
+    } else {
+        println!(
+            "N = {}, α1 = {}, α3 = {}, α4 = {}, α6 = {} (dimensionless, eq. 5 time scale)",
+            p.modes, p.alpha1, p.alpha3, p.alpha4, p.alpha6
+        );
+    }
     for (name, r) in [
         ("free (region I)", &free),
         ("contact (region II)", &contact),
     ] {
         println!("\n{name}");
+        if u.si() {
+            // SI: the natural frequency and the damped one Im λ/2π, the decay rate Re λ in 1/s
+            println!(
+                "{:>4} {:>16} {:>16} {:>18} {:>10}",
+                "i", "f (undamped)", "Im λ/2π", "Re λ", "ζ"
+            );
+            for (i, w) in r.omega.iter().enumerate() {
+                let e = r.eigenvalues.get(i);
+                println!(
+                    "{:>4} {:>16} {:>16} {:>18} {:>10.5}",
+                    i + 1,
+                    u.frequency(*w),
+                    e.map_or("-".into(), |e| u.frequency(e.im)),
+                    e.map_or("-".into(), |e| u.rate(e.re)),
+                    e.map_or(f64::NAN, |e| e.zeta)
+                );
+            }
+            continue;
+        }
         println!(
             "{:>4} {:>14} {:>14} {:>14} {:>10}",
             "i", "ω (undamped)", "Re λ", "Im λ", "ζ"

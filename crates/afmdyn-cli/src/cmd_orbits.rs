@@ -4,7 +4,7 @@ use crate::args::ModelArgs;
 use crate::cmd_analysis::{SteadyArgs, COL_VALUE, COL_W_TIP};
 use crate::cmd_simulate::parse_initial;
 use crate::error::CliError;
-use crate::output::{f, io_error, write_csv, OutDir};
+use crate::output::{f, io_error, write_csv, OutDir, TextUnits};
 use crate::plot::{save, Figure, Series, Style};
 use crate::progress;
 use afmdyn::analysis::continuation::BranchPoint;
@@ -57,6 +57,7 @@ pub fn orbit(a: &OrbitArgs) -> Result<(), CliError> {
         period: a.period,
         start: a.start.request(p.modes)?,
     };
+    let u = TextUnits::of(probe.as_ref());
     let Document { output: o, json } =
         request::run(&request, &Resolved { params: p, probe }, &Progress::new())?;
     let n = o.period;
@@ -65,9 +66,14 @@ pub fn orbit(a: &OrbitArgs) -> Result<(), CliError> {
         return Ok(());
     }
     println!(
-        "period-{} orbit at Ω = {} ({}), {} switchings per cycle",
+        "period-{} orbit at {}{} ({}), {} switchings per cycle",
         n,
-        p.omega,
+        u.drive(p.omega),
+        if u.si() {
+            format!(", z_c = {}", u.length(p.rest_distance()))
+        } else {
+            String::new()
+        },
         if o.stable { "stable" } else { "unstable" },
         o.switchings
     );
@@ -84,14 +90,25 @@ pub fn orbit(a: &OrbitArgs) -> Result<(), CliError> {
         println!("  {:+.8} {:+.8}i   {:.8}", m.re, m.im, m.norm());
     }
     println!(
-        "critical multiplier type: {:?}; distance to grazing {:.3e}{}",
+        "critical multiplier type: {:?}; distance to grazing {}{}",
         o.critical,
-        o.grazing_distance,
+        if u.si() {
+            u.length(o.grazing_distance)
+        } else {
+            format!("{:.3e}", o.grazing_distance)
+        },
         if o.grazing { " (grazing)" } else { "" }
     );
     let model = CantileverModel::new(&p)?;
     for (k, z) in o.section.iter().enumerate() {
-        println!("  section {k}: W(1,τ) = {:.9}", model.w_tip(z));
+        if u.si() {
+            println!(
+                "  section {k}: tip deflection = {}",
+                u.length(model.w_tip(z))
+            );
+        } else {
+            println!("  section {k}: W(1,τ) = {:.9}", model.w_tip(z));
+        }
     }
     Ok(())
 }
@@ -191,6 +208,7 @@ pub fn continuation(a: &ContinueArgs) -> Result<(), CliError> {
         check_overlay(o)?;
     }
     let out = OutDir::lock(&a.out)?;
+    let u = TextUnits::of(probe.as_ref());
     let model = Resolved {
         params: base,
         probe,
@@ -347,11 +365,18 @@ pub fn continuation(a: &ContinueArgs) -> Result<(), CliError> {
             branches.iter().map(|b| b.len()).sum::<usize>()
         );
         for b in branches.iter().flatten().filter(|b| b.event.is_some()) {
+            // with a probe Ω reads as the drive frequency and α5 as the rest distance z_c
+            let at = match (u.si(), a.param) {
+                (true, SweepParam::Omega) => u.drive(b.value),
+                (true, SweepParam::Alpha5) => format!(
+                    "z_c = {}",
+                    u.length(base.with(SweepParam::Alpha5, b.value).rest_distance())
+                ),
+                _ => format!("{} = {:.6}", a.param.name(), b.value),
+            };
             println!(
-                "  {:<16} at {} = {:.6} (period {})",
+                "  {:<16} at {at} (period {})",
                 format!("{:?}", b.event.expect("event")),
-                a.param.name(),
-                b.value,
                 b.period
             );
         }
@@ -392,6 +417,7 @@ pub fn lyapunov(a: &LyapunovArgs) -> Result<(), CliError> {
         periods: a.periods,
         blocks: a.blocks,
     };
+    let u = TextUnits::of(probe.as_ref());
     let Document { output: l, json } =
         progress::run(&request, &Resolved { params: p, probe }, "periods")?;
     let warnings = &l.warnings;
@@ -403,16 +429,23 @@ pub fn lyapunov(a: &LyapunovArgs) -> Result<(), CliError> {
         return Ok(());
     }
     println!(
-        "Lyapunov exponents (per unit τ) over {} periods at Ω = {}:",
-        l.periods, p.omega
+        "Lyapunov exponents ({}) over {} periods at {}:",
+        if u.si() { "1/s" } else { "per unit τ" },
+        l.periods,
+        u.drive(p.omega)
     );
-    for ((e, u), c) in l.exponents.iter().zip(&l.uncertainty).zip(&l.convergence) {
-        println!("  {e:+.6} ± {u:.6} (statistical) ± {c:.6} (convergence, |λ(T) − λ(T/2)|)");
+    for ((e, s), c) in l.exponents.iter().zip(&l.uncertainty).zip(&l.convergence) {
+        println!(
+            "  {} ± {} (statistical) ± {} (convergence, |λ(T) − λ(T/2)|)",
+            u.rate(*e),
+            u.rate(*s).trim_start_matches('+'),
+            u.rate(*c).trim_start_matches('+')
+        );
     }
     println!(
-        "sum {:+.6}; mean phase-volume contraction {:+.6}",
-        l.exponents.iter().sum::<f64>(),
-        l.volume_rate
+        "sum {}; mean phase-volume contraction {}",
+        u.rate(l.exponents.iter().sum::<f64>()),
+        u.rate(l.volume_rate)
     );
     println!("0–1 test K = {:.3}; verdict: {:?}", l.zero_one, l.verdict);
     Ok(())

@@ -406,6 +406,67 @@ impl NpyStream {
     }
 }
 
+/// `v` in `unit` with the SI prefix that puts its mantissa in [1, 1000), 6 significant digits
+/// (13.4747 nm, 300.000 kHz), or plain SI with `--units si` (8.033740e-9 m): the one format of
+/// SI values in every text summary.
+pub fn si_value(v: f64, unit: &str) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return format!("{v} {unit}");
+    }
+    let (e, p) = crate::plot::si_prefix(v.abs());
+    let m = v / 10f64.powi(e);
+    if !(1e-3..1e4).contains(&m.abs()) {
+        // plain SI (--units si): 8.033740e-9 m
+        return format!("{m:.6e} {p}{unit}");
+    }
+    let digits = (5 - m.abs().log10().floor() as i32).clamp(0, 5) as usize;
+    format!("{m:.digits$} {p}{unit}")
+}
+
+/// The units of a text summary: SI with a probe (lengths, frequencies and rates through its
+/// scales, printed by [`si_value`]), else the model's (g₀, Ω, per unit τ).
+#[derive(Debug, Clone, Copy)]
+pub struct TextUnits(pub Option<afmdyn::probe::Scales>);
+
+impl TextUnits {
+    /// The units of a run on `probe` (SI) or without one.
+    pub fn of(probe: Option<&afmdyn::probe::Probe>) -> Self {
+        TextUnits(probe.map(|p| p.scales))
+    }
+    /// The drive: `f = 300.000 kHz` or `Ω = 2.6`.
+    pub fn drive(self, omega: f64) -> String {
+        match self.0 {
+            Some(s) => format!("f = {}", si_value(s.frequency_hz(omega), "Hz")),
+            None => format!("Ω = {omega}"),
+        }
+    }
+    /// An angular frequency ω (per unit τ) as a frequency: Hz, or ω itself.
+    pub fn frequency(self, omega: f64) -> String {
+        match self.0 {
+            Some(s) => si_value(s.frequency_hz(omega), "Hz"),
+            None => format!("{omega:.6}"),
+        }
+    }
+    /// A length in g₀: m, or g₀.
+    pub fn length(self, v: f64) -> String {
+        match self.0 {
+            Some(s) => si_value(v * s.length_m, "m"),
+            None => format!("{v:.9}"),
+        }
+    }
+    /// A rate per unit τ (a Lyapunov exponent, Re λ): 1/s, or per unit τ.
+    pub fn rate(self, v: f64) -> String {
+        match self.0 {
+            Some(s) => format!("{:+.6e} 1/s", v / s.time_s),
+            None => format!("{v:+.6}"),
+        }
+    }
+    /// Whether the summary speaks SI.
+    pub fn si(self) -> bool {
+        self.0.is_some()
+    }
+}
+
 /// Format a float for CSV: a shortest round-trip representation, in exponent form when
 /// |v| < 1e-4 or ≥ 1e16 — the notation of [`afmdyn::error::number`] (SI values such as
 /// 1.37e-19 J would otherwise print as 24 zeros and their digits), with the digits from `ryu`
@@ -478,7 +539,17 @@ pub fn csv_lines(s: &mut CsvStream, bytes: &[u8]) -> Result<(), CliError> {
 
 #[cfg(test)]
 mod tests {
-    use super::f;
+    use super::{f, si_value};
+
+    /// SI prefixes with 6 significant digits.
+    #[test]
+    fn values_print_with_si_prefixes() {
+        assert_eq!(si_value(1.347465e-8, "m"), "13.4747 nm");
+        assert_eq!(si_value(3.0e5, "Hz"), "300.000 kHz");
+        assert_eq!(si_value(-2.5e-10, "m"), "-250.000 pm");
+        assert_eq!(si_value(1.0, "m"), "1.00000 m");
+        assert_eq!(si_value(0.0, "m"), "0 m");
+    }
 
     /// A row of `csv_line` is the row the csv crate writes for the same fields (`csv_row`).
     #[test]

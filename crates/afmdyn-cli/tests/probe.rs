@@ -424,6 +424,500 @@ fn simulate_with_a_probe_writes_si_time_series() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// The issue-42 lever: RTESPA-300 from the cantilever library (k 40 N/m, f0 300 kHz, Q 500)
+/// over polystyrene (DMT, E 2.5 GPa, H 6.6e-20 J, η 10 Pa s), A0 = 15 nm.
+const RTESPA_PS: &str = "[cantilever]\nname = \"RTESPA-300\"\nspring_constant = 40.0\n\
+    resonance_frequency = 300e3\nquality_factor = 500\n[sample]\nlaw = \"dmt\"\n\
+    youngs_modulus = 2.5e9\npoisson_ratio = 0.33\nhamaker = 6.6e-20\nviscosity = 10.0\n\
+    [drive]\nfree_amplitude = 15e-9\n";
+
+fn probe_file(dir: &Path, name: &str, text: &str) -> String {
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path.to_str().unwrap().to_string()
+}
+
+/// Exit 2 with one line on stderr containing every needle.
+fn refused(args: &[&str], needles: &[&str]) {
+    let out = run(args);
+    assert_eq!(out.status.code(), Some(2), "{args:?}");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
+    for n in needles {
+        assert!(err.contains(n), "{args:?}: {err} lacks {n}");
+    }
+}
+
+/// A dimensionless model flag under a probe is refused naming the SI key or flag to use
+/// (issue 42: `--hamaker 6.6e-20` ran as H̃ and moved the peak force from 7.27 to 5.76 nN;
+/// `--drive-amplitude 20e-9` ran with no drive); the same flags run without a probe.
+#[test]
+fn dimensionless_flags_under_a_probe_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let ps = probe_file(dir.path(), "ps.toml", RTESPA_PS);
+    let p = ps.as_str();
+    refused(
+        &[
+            "approach",
+            "--probe",
+            p,
+            "--hamaker",
+            "6.6e-20",
+            "--files",
+            "none",
+        ],
+        &["hamaker = 6.6e-20", "[sample] hamaker (J)"],
+    );
+    refused(
+        &[
+            "approach",
+            "--probe",
+            p,
+            "--drive-amplitude",
+            "20e-9",
+            "--files",
+            "none",
+        ],
+        &["drive-amplitude = 2e-8", "[drive] free_amplitude (m)"],
+    );
+    refused(
+        &["orbit", "--probe", p, "--gap", "1"],
+        &["gap = 1", "--z-c"],
+    );
+    refused(
+        &["orbit", "--probe", p, "--alpha5", "1"],
+        &["gap = 1", "--z-c"],
+    );
+    refused(
+        &["orbit", "--probe", p, "--omega", "1"],
+        &["omega = 1", "--drive-frequency"],
+    );
+    refused(
+        &["orbit", "--probe", p, "--beam-damping", "0.002"],
+        &["beam-damping", "quality_factor"],
+    );
+    refused(
+        &["orbit", "--probe", p, "--contact-law", "hertz"],
+        &["contact-law = hertz", "[sample] law"],
+    );
+    // without a probe they are the paper's dimensionless values
+    json(&[
+        "orbit",
+        "--drive-amplitude",
+        "0.12",
+        "--omega",
+        "2.7",
+        "--json",
+    ]);
+    // what a probe leaves open: N and the SI values
+    json(&["orbit", "--probe", p, "--z-c", "14.3nm", "--json"]);
+}
+
+/// Negative SI values with units (`--z-c -5nm` was read as an unknown flag `-5`) and units on
+/// a chart's SI axes (`--x z-c --x-from 5nm` was refused) read as the plain numbers do; a unit
+/// on a dimensionless axis is refused.
+#[test]
+fn negative_values_and_chart_axes_take_units() {
+    let pm = "examples/probe-point-mass-dmt.toml";
+    let a = json(&["orbit", "--probe", pm, "--z-c", "-0.1nm", "--json"]);
+    let b = json(&["orbit", "--probe", pm, "--z-c=-0.1e-9", "--json"]);
+    assert_eq!(a["params"], b["params"]);
+    assert!((a["si"]["z_c_m"].as_f64().unwrap() + 0.1e-9).abs() < 1e-22);
+    let dir = tempfile::tempdir().unwrap();
+    let chart = |x: [&str; 2], y: [&str; 2]| {
+        json(&[
+            "chart",
+            "--probe",
+            pm,
+            "--x",
+            "z-c",
+            "--x-from",
+            x[0],
+            "--x-to",
+            x[1],
+            "--x-steps",
+            "2",
+            "--y",
+            "drive-frequency",
+            "--y-from",
+            y[0],
+            "--y-to",
+            y[1],
+            "--y-steps",
+            "1",
+            "--starts",
+            "1",
+            "--lyapunov-periods",
+            "0",
+            "--json",
+            "--out",
+            dir.path().to_str().unwrap(),
+        ])
+    };
+    let a = chart(["5nm", "6nm"], ["299kHz", "300kHz"]);
+    assert_eq!(a["x"]["values"], serde_json::json!([5e-9, 6e-9]));
+    assert_eq!(a["y"]["values"], serde_json::json!([299e3]));
+    let b = chart(["5e-9", "6e-9"], ["299e3", "300e3"]);
+    assert_eq!(a["cells"], b["cells"]);
+    refused(
+        &[
+            "chart",
+            "--x",
+            "omega",
+            "--x-from",
+            "2nm",
+            "--out",
+            dir.path().to_str().unwrap(),
+        ],
+        &["--x-from", "plain number"],
+    );
+    refused(
+        &[
+            "chart",
+            "--probe",
+            pm,
+            "--x",
+            "z-c",
+            "--x-from",
+            "5kHz",
+            "--out",
+            dir.path().to_str().unwrap(),
+        ],
+        &["--x-from", "takes a length (m)"],
+    );
+}
+
+/// Messages in the user's units: a z_c beyond the model's reach on a 10 pm probe names z_c in
+/// m and the range in m (was `alpha5 = 4.999983500000001e6`), a resonance end below the model's
+/// Ω range names the frequency and the range in Hz (was Ω = 1.17e-5).
+#[test]
+fn out_of_range_si_values_are_named_in_si() {
+    let dir = tempfile::tempdir().unwrap();
+    let small = probe_file(
+        dir.path(),
+        "small.toml",
+        &RTESPA_PS.replace("free_amplitude = 15e-9", "free_amplitude = 10e-12"),
+    );
+    refused(
+        &["orbit", "--probe", &small, "--z-c", "50um"],
+        &[
+            "z-c = 5e-5 m (this probe allows [-9.99",
+            "e-6, 1.00",
+            "e-5] m",
+        ],
+    );
+    let out = run(&["orbit", "--probe", &small, "--z-c", "50um"]);
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("alpha5"));
+    let ps = probe_file(dir.path(), "ps.toml", RTESPA_PS);
+    refused(
+        &[
+            "resonance",
+            "--probe",
+            &ps,
+            "--from",
+            "1Hz",
+            "--files",
+            "none",
+        ],
+        &["from = 1 Hz (this probe allows [", "] Hz)"],
+    );
+    let out = run(&[
+        "resonance",
+        "--probe",
+        &ps,
+        "--from",
+        "1Hz",
+        "--files",
+        "none",
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !err.contains("omega") && !err.starts_with("afmdyn: Ω"),
+        "{err}"
+    );
+}
+
+/// `resonance` under a probe is by default the free resonance — the tip 10 free amplitudes
+/// away (the file's z_c, A0 by default, is in contact at resonance) — on a grid no coarser
+/// than f0/(10 Q) = 60 Hz for the RTESPA-300 (was 100.8 Hz for a 600 Hz linewidth); its
+/// amplitude peaks at the free amplitude A0 = 15 nm near f0. A user's step and z_c still win.
+#[test]
+fn resonance_under_a_probe_is_the_free_resonance_on_a_fine_grid() {
+    let dir = tempfile::tempdir().unwrap();
+    let ps = probe_file(dir.path(), "ps.toml", RTESPA_PS);
+    let doc = json(&[
+        "resonance",
+        "--probe",
+        &ps,
+        "--no-branches",
+        "--files",
+        "none",
+        "--json",
+    ]);
+    let f: Vec<f64> = doc["up"]["frequency_hz"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    let step = f[1] - f[0];
+    assert!(
+        step <= 300e3 / (10.0 * 500.0) * (1.0 + 1e-9),
+        "step {step} Hz"
+    );
+    assert!(f[0] < 299.4e3 && *f.last().unwrap() > 300.6e3, "{f:?}");
+    let z_c = doc["si"]["z_c_m"].as_f64().unwrap();
+    assert!(z_c >= 10.0 * 15e-9 * 0.99, "z_c = {z_c} m");
+    let amp: Vec<f64> = doc["up"]["amplitude"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    let (i, peak) =
+        amp.iter()
+            .copied()
+            .enumerate()
+            .fold((0, 0.0), |m, (i, a)| if a > m.1 { (i, a) } else { m });
+    // the driven harmonic oscillator's peak, A0 at f0 (the drive is at f0): the grid point
+    // nearest f0 is at most step/2 away, where the response is A0/√(1 + (Q step/f0)²)
+    // (Lorentzian); within 1e-3 of those bounds (van der Waals at 10 A0)
+    let lo = 15e-9 / (1.0 + (500.0 * step / 300e3).powi(2)).sqrt();
+    assert!(
+        peak > lo * (1.0 - 1e-3) && peak < 15e-9 * (1.0 + 1e-3),
+        "peak {peak} m"
+    );
+    assert!((f[i] - 300e3).abs() <= step, "peak at {} Hz", f[i]);
+    assert!(doc["up"]["contact_fraction"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .all(|c| c.as_f64() == Some(0.0)));
+    // a user's step and rest distance win
+    let user = json(&[
+        "resonance",
+        "--probe",
+        &ps,
+        "--step",
+        "500Hz",
+        "--z-c",
+        "20nm",
+        "--no-branches",
+        "--files",
+        "none",
+        "--json",
+    ]);
+    let g = user["up"]["frequency_hz"].as_array().unwrap();
+    assert!((g[1].as_f64().unwrap() - g[0].as_f64().unwrap() - 500.0).abs() < 1e-6);
+    assert!((user["si"]["z_c_m"].as_f64().unwrap() - 20e-9).abs() < 1e-20);
+    // a probe file's own [sample] z_c is a given rest distance too
+    let file = json(&[
+        "resonance",
+        "--probe",
+        "examples/probe-point-mass-dmt.toml",
+        "--points",
+        "3",
+        "--no-branches",
+        "--files",
+        "none",
+        "--json",
+    ]);
+    assert!((file["si"]["z_c_m"].as_f64().unwrap() - 8e-9).abs() < 1e-20);
+}
+
+fn text(args: &[&str]) -> String {
+    let out = run(args);
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).unwrap()
+}
+
+/// The text summaries of `orbit`, `modes`, `lyapunov` and `continue` speak SI under a probe,
+/// with the prefixes of `--units` (issue 42: they printed Ω = 1, g0 and τ): the drive in kHz,
+/// z_c and the tip deflection in nm, natural frequencies in kHz, Lyapunov exponents in 1/s —
+/// the same numbers as the JSON document's `si` block; without a probe the model's units.
+#[test]
+fn text_summaries_speak_si_under_a_probe() {
+    let pm = "examples/probe-point-mass-dmt.toml";
+    let orbit = text(&["orbit", "--probe", pm]);
+    assert!(
+        orbit.starts_with("period-1 orbit at f = 300.000 kHz, z_c = 8.00000 nm ("),
+        "{orbit}"
+    );
+    assert!(orbit.contains("section 0: tip deflection = ") && orbit.contains(" nm\n"));
+    assert!(
+        !orbit.contains("Ω =") && !orbit.contains("W(1,τ)"),
+        "{orbit}"
+    );
+    let doc = json(&["orbit", "--probe", pm, "--json"]);
+    let v_t = doc["si"]["poincare_v_t_m"][0].as_f64().unwrap();
+    let shown: f64 = orbit
+        .split("tip deflection = ")
+        .nth(1)
+        .unwrap()
+        .split(" nm")
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    // V_T = W(1) + α5 and α5 g0 = z_c − a0 under DMT (a0 = 0.165 nm in the file)
+    let z_c = doc["si"]["z_c_m"].as_f64().unwrap();
+    assert!(
+        (shown * 1e-9 - (v_t - z_c + 0.165e-9)).abs() < 1e-5 * 1e-9,
+        "{shown} nm"
+    );
+    let modes = text(&["modes", "--probe", pm]);
+    assert!(modes.contains("300.000 kHz"), "{modes}");
+    assert!(!modes.contains("ω (undamped)"), "{modes}");
+    let args = [
+        "lyapunov",
+        "--probe",
+        pm,
+        "--transient",
+        "10",
+        "--periods",
+        "20",
+        "--blocks",
+        "2",
+    ];
+    let lya = text(&args);
+    assert!(
+        lya.starts_with("Lyapunov exponents (1/s) over 20 periods at f = 300.000 kHz:"),
+        "{lya}"
+    );
+    let first: f64 = lya
+        .lines()
+        .nth(1)
+        .unwrap()
+        .split_whitespace()
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    let doc = json(&[&args[..], &["--json"]].concat());
+    let want = doc["si"]["exponents_per_s"][0].as_f64().unwrap();
+    assert!(
+        (first - want).abs() <= 1e-6 * want.abs(),
+        "{first} against {want}"
+    );
+    // without a probe: the model's units, as before
+    let plain = text(&["orbit", "--omega", "2.8"]);
+    assert!(plain.starts_with("period-2 orbit at Ω = 2.8 ("), "{plain}");
+}
+
+/// `attractors` under a probe prints the drive in kHz, z_c and each attractor's X_max in nm
+/// (issue 42: Ω = 1 and g0), X_max equal to the JSON document's `si.attractors_x_max_m`.
+#[test]
+fn attractors_text_speaks_si_under_a_probe() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().to_str().unwrap();
+    let pm = "examples/probe-point-mass-dmt.toml";
+    let args = [
+        "attractors",
+        "--probe",
+        pm,
+        "--samples",
+        "2",
+        "--max-periods",
+        "300",
+        "--out",
+        out,
+    ];
+    let t = text(&args);
+    assert!(t.contains("at f = 300.000 kHz, z_c = 8.00000 nm:"), "{t}");
+    assert!(!t.contains("Ω ="), "{t}");
+    let shown: f64 = t
+        .split("X_max = ")
+        .nth(1)
+        .unwrap()
+        .split(" nm")
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    let doc = json(&[&args[..], &["--json"]].concat());
+    let want = doc["si"]["attractors_x_max_m"][0].as_f64().unwrap();
+    assert!(
+        (shown * 1e-9 - want).abs() <= 1e-5 * want,
+        "{shown} nm against {want} m"
+    );
+}
+
+/// `chart.csv` under a probe has its lengths in m, each row in its cell's length unit: along a
+/// free-amplitude axis A0 (the length unit g0) changes from cell to cell (issue 42: the column
+/// was in g0, a different length per row); the JSON cells stay in g0 with the axis value.
+#[test]
+fn chart_csv_lengths_are_in_metres_under_a_probe() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().to_str().unwrap();
+    let doc = json(&[
+        "chart",
+        "--probe",
+        "examples/probe-point-mass-dmt.toml",
+        "--x",
+        "free-amplitude",
+        "--x-from",
+        "8nm",
+        "--x-to",
+        "12nm",
+        "--x-steps",
+        "2",
+        "--y",
+        "sample-modulus",
+        "--y-from",
+        "2e9",
+        "--y-to",
+        "2e9",
+        "--y-steps",
+        "1",
+        "--starts",
+        "1",
+        "--lyapunov-periods",
+        "0",
+        "--max-periods",
+        "6000",
+        "--json",
+        "--out",
+        out,
+    ]);
+    // (text columns, status and origin, read as NaN)
+    let text = std::fs::read_to_string(dir.path().join("chart.csv")).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| {
+            l.split(',')
+                .map(|v| v.parse().unwrap_or(f64::NAN))
+                .collect()
+        })
+        .collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let (ix, x_max, v_t_min) = (col("ix"), col("x_max"), col("v_t_min"));
+    let a0 = [8e-9, 12e-9];
+    for r in &rows {
+        let i = r[ix] as usize;
+        let cell = doc["cells"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|c| c["ix"] == i)
+            .unwrap();
+        let g0 = cell["attractors"][0]["x_max"].as_f64().unwrap();
+        assert!(
+            (r[x_max] - g0 * a0[i]).abs() <= 1e-12 * r[x_max].abs(),
+            "{r:?}"
+        );
+        let v = cell["attractors"][0]["v_t_min"].as_f64().unwrap();
+        assert!((r[v_t_min] - v * a0[i]).abs() <= 1e-12 * r[v_t_min].abs().max(1e-30));
+        // a tapping amplitude, nanometres
+        assert!((1e-9..1e-7).contains(&r[x_max]), "{r:?}");
+    }
+    assert_eq!(rows.len(), 2);
+}
+
 /// A Q = 500 lever (`examples/probe-rtespa300-polystyrene.toml`) at z_c = 14.3 nm: at its
 /// defaults `attractors` finds the two period-1 orbits (before the transient cap followed Q it
 /// reported eight "nonperiodic" attractors and no warning, issue 42) with the cap in the

@@ -150,8 +150,9 @@ pub fn params_from_kwargs(base: Params, kwargs: Option<&Bound<'_, PyDict>>) -> P
 /// flags): `params` (an `afmdyn.Params`, like a config file), or the probe file's set, or
 /// `default`, or the paper's set, with the keywords applied ([`ModelSpec::resolve`]: `z_c`
 /// and `drive_frequency` need the probe). `params` and `probe` together must agree (the
-/// pattern `f(Params.from_probe(path), probe=path)`): the probe sets every parameter and the
-/// keywords override single ones.
+/// pattern `f(Params.from_probe(path), probe=path)`): the probe sets every parameter, the SI
+/// keywords and `modes`/`restitution` override it, the dimensionless ones it sets are refused
+/// ([`afmdyn::request::model::PROBE_SETS`]).
 #[pyfunction]
 #[pyo3(signature = (params=None, default=None, probe=None, model=None))]
 pub fn resolve(
@@ -254,14 +255,19 @@ impl PyParams {
 
     /// The dimensionless set of a probe file in SI units (the command line's
     /// ``--probe FILE``: cantilever k, f₀, Q or geometry; tip; sample law; drive A₀, f; see
-    /// ``docs/afm-workflow.md``); ``**model`` overrides single keywords. Raises ``ValueError``
-    /// listing every problem of the file.
+    /// ``docs/afm-workflow.md``); ``**model`` takes what a probe leaves open, as every
+    /// analysis' ``probe=`` does: ``modes``, ``restitution``, ``z_c`` (m) and
+    /// ``drive_frequency`` (Hz); a dimensionless value the probe sets (``gap``, ``omega``,
+    /// ``hamaker``, …) is refused naming the probe key or SI keyword to use. Raises
+    /// ``ValueError`` listing every problem of the file.
     #[staticmethod]
     #[pyo3(signature = (path, **model))]
     fn from_probe(path: std::path::PathBuf, model: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
         let pr = afmdyn::probe::Probe::load(&path).map_err(crate::errors::probe_error)?;
         Ok(PyParams {
-            inner: params_from_kwargs(pr.params, model)?,
+            inner: model_spec(model)?
+                .resolve(Params::default(), Some(&pr))
+                .map_err(crate::errors::sim_error)?,
         })
     }
 

@@ -43,8 +43,8 @@ def test_bad_probe_lists_every_problem(tmp_path):
 def test_observe_free_oscillation_matches_closed_form():
     # far from the sample the point mass at f = f0 oscillates with A = A0 (1 in units of A0)
     # and lags the force by 90 degrees (harmonic oscillator at resonance)
-    # (at 10⁴ A₀ the van der Waals force H̃/d² is 1e-13 of kA₀)
-    p = afmdyn.Params.from_probe(PM, gap=1e4)
+    # (at z_c = 10⁴ A₀ = 100 µm the van der Waals force H̃/d² is 1e-13 of kA₀)
+    p = afmdyn.Params.from_probe(PM, z_c=1e-4)
     o = afmdyn.observe(p)
     assert o.period == 1
     # (the adaptive integrator at its default tolerance 1e-12; the library's own test reaches
@@ -123,15 +123,66 @@ def test_simulate_with_a_probe_is_in_si_as_the_command_line(cli, tmp_path):
     assert run.returncode == 0, run.stderr
     npy = np.load(tmp_path / "timeseries.npy")
     names = ["t", "v_t", "w_tip", "w_tip_dot", "in_contact", "contact_force"]
-    for k, (name, var) in enumerate(zip(names, ["tau", "v_t", "w_tip", "w_tip_dot"])):
+    # the time coordinate is t in s, as the command line's column (issue 42: it was tau)
+    assert ds.w_tip.dims == ("t",) and "tau" not in ds.coords
+    for k, (name, var) in enumerate(zip(names, ["t", "v_t", "w_tip", "w_tip_dot"])):
         np.testing.assert_array_equal(ds[var].values, npy[:, k], err_msg=name)
     np.testing.assert_array_equal(ds.contact_force.values, npy[:, 5])
     np.testing.assert_array_equal(ds.a.values[:, 0], npy[:, 6])
-    units = {v: ds[v].attrs["units"] for v in ("tau", "w_tip", "w_tip_dot", "contact_force",
+    units = {v: ds[v].attrs["units"] for v in ("t", "w_tip", "w_tip_dot", "contact_force",
                                                "energy_start", "frequency")}
-    assert units == {"tau": "s", "w_tip": "m", "w_tip_dot": "m/s", "contact_force": "N",
+    assert units == {"t": "s", "w_tip": "m", "w_tip_dot": "m/s", "contact_force": "N",
                      "energy_start": "J", "frequency": "Hz"}
     period = afmdyn.probe(PM)["si"]["period_s"]
     assert abs(ds.section_tau.values[1] - ds.section_tau.values[0] - period) < 1e-9 * period
     plain = afmdyn.simulate(afmdyn.Params.from_probe(PM), periods=2)
     assert plain.contact_force.attrs["units"] == "k g0" and plain.tau.attrs["units"] == "t0"
+
+
+RTESPA_PS = """[cantilever]
+name = "RTESPA-300"
+spring_constant = 40.0
+resonance_frequency = 300e3
+quality_factor = 500
+[sample]
+law = "dmt"
+youngs_modulus = 2.5e9
+poisson_ratio = 0.33
+hamaker = 6.6e-20
+viscosity = 10.0
+[drive]
+free_amplitude = 15e-9
+"""
+
+
+@pytest.mark.parametrize(
+    "keyword, value, hint",
+    [
+        ("hamaker", 6.6e-20, "[sample] hamaker (J)"),
+        ("drive_amplitude", 20e-9, "[drive] free_amplitude (m)"),
+        ("alpha2", 20e-9, "[drive] free_amplitude (m)"),
+        ("gap", 1.0, "z_c=8e-9 in Python"),
+        ("omega", 1.0, "drive_frequency=300e3 in Python"),
+        ("beam_damping", 0.002, "[cantilever] quality_factor"),
+        ("contact_law", "hertz", "[sample] law"),
+    ],
+)
+def test_a_probe_refuses_the_dimensionless_values_it_sets(tmp_path, keyword, value, hint):
+    # issue 42: hamaker=6.6e-20 under a probe was taken as H̃ (the peak force moved from 7.27
+    # to 5.76 nN) and drive_amplitude=20e-9 ran with no drive; the command line refuses alike
+    probe = tmp_path / "ps.toml"
+    probe.write_text(RTESPA_PS)
+    for call in (
+        lambda: afmdyn.orbit(probe=probe, **{keyword: value}),
+        lambda: afmdyn.approach(probe=probe, points=3, branches=False, **{keyword: value}),
+        lambda: afmdyn.Params.from_probe(probe, **{keyword: value}),
+    ):
+        with pytest.raises(ValueError) as e:
+            call()
+        assert hint in str(e.value), str(e.value)
+    # without a probe the dimensionless value is taken (the law groups with their law)
+    if keyword not in ("hamaker",):
+        afmdyn.Params(**{keyword: value})
+    # what a probe leaves open: N (point mass: 1), z_c in m, the drive frequency in Hz
+    p = afmdyn.Params.from_probe(probe, z_c=14.3e-9, drive_frequency=299e3, modes=1)
+    assert p.omega == pytest.approx(299e3 / 300e3, rel=1e-12)

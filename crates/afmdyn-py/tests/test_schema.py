@@ -112,9 +112,10 @@ CLI_CASES: List[Tuple[str, List[Any]]] = [
     ("chart", ["--x-steps", 2, "--y-steps", 1, "--starts", 1, "--lyapunov-periods", 20, *SHORT]),
     ("basins", ["--x-steps", 3, "--y-steps", 2, *SHORT, *IMPACT]),
     ("basins", ["--x-steps", 2, "--y-steps", 1, *SHORT, "--probe", P1]),
-    ("chart", ["--x", "z-c", "--x-from", 6e-9, "--x-to", 8e-9, "--x-steps", 2, "--y", "omega",
-               "--y-from", 0.99, "--y-to", 0.99, "--y-steps", 1, "--starts", 1, *SHORT,
-               "--probe", P1]),
+    # (a probe refuses the dimensionless omega axis: the drive frequency in Hz, 0.99 f0)
+    ("chart", ["--x", "z-c", "--x-from", 6e-9, "--x-to", 8e-9, "--x-steps", 2, "--y",
+               "drive-frequency", "--y-from", "297kHz", "--y-to", "297kHz", "--y-steps", 1,
+               "--starts", 1, *SHORT, "--probe", P1]),
 ]
 WRITES = {"simulate", "converge", "bifurcation", "attractors", "continue", "chart", "basins"}
 

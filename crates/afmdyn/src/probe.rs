@@ -205,6 +205,10 @@ pub struct Probe {
     pub drive_frequency: f64,
     /// Rest tip–sample distance z_c (m).
     pub z_c: f64,
+    /// Whether the file gives `[sample] z_c` (else z_c is its default A₀; a resonance curve
+    /// then defaults to the free resonance, [`crate::request::curves::free_resonance_base`]).
+    #[serde(skip)]
+    pub z_c_in_file: bool,
 }
 
 /// A TOML table walker that collects every problem instead of stopping at the first.
@@ -939,6 +943,7 @@ impl Probe {
                 };
             }
         }
+        let z_c_in_file = sample.z_c.is_some();
         let z_c = sample.z_c.unwrap_or(a0);
         let mut params = Params {
             alpha3,
@@ -972,6 +977,7 @@ impl Probe {
             free_amplitude: a0,
             drive_frequency: drive_hz,
             z_c,
+            z_c_in_file,
         })
     }
 

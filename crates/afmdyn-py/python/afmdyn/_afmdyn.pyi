@@ -82,7 +82,10 @@ class Params:
     @staticmethod
     def from_probe(path: Union[str, "os.PathLike[str]"], **model: Any) -> "Params":
         """The dimensionless set of a probe file in SI units (``--probe FILE``); ``**model``
-        overrides single keywords. Raises ``ValueError`` listing every problem of the file."""
+        takes ``modes``, ``restitution``, ``z_c`` (m) and ``drive_frequency`` (Hz); a
+        dimensionless keyword of a value the probe sets (``gap``, ``omega``, ``hamaker``, …)
+        raises ``ValueError`` naming the probe key or SI keyword to use. Raises ``ValueError``
+        listing every problem of the file."""
     @property
     def structure(self) -> Literal["beam", "point-mass"]: ...
     @property

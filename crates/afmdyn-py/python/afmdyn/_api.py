@@ -53,9 +53,12 @@ StateLike = Union[None, Sequence[float], np.ndarray, Attractor, Orbit]
 class Model(TypedDict, total=False):
     """The model keywords every analysis takes (see :class:`Params` for their ranges; the one
     table of them is ``afmdyn._afmdyn.MODEL_PARAMETERS``). ``probe`` is a probe file in SI (the
-    command line's ``--probe``): it sets every parameter, the other keywords override single
-    ones, and ``z_c`` (m) and ``drive_frequency`` (Hz) set α5 and Ω through its scales; the
-    result's ``to_dict()`` then carries the command line's ``"si"`` block."""
+    command line's ``--probe``): it sets every parameter in SI, ``z_c`` (m) and
+    ``drive_frequency`` (Hz) set α5 and Ω through its scales, ``modes`` and ``restitution`` are
+    taken, and the dimensionless keywords of the values it sets (``gap``, ``omega``, the α's,
+    ``hamaker``, ``intermolecular_distance``, ``contact_law``) raise ``ValueError`` naming the
+    probe key or SI keyword to use; the result's ``to_dict()`` then carries the command line's
+    ``"si"`` block."""
 
     modes: int
     tip_mass_ratio: float
@@ -289,8 +292,8 @@ def simulate(
         command line's ``spectrum.csv``). ``attrs["summary"]`` holds
         ``afmdyn simulate --json`` (see :func:`summary`). Units: the model's (τ in t0,
         lengths in g0, forces E I g0/L³, or k g0 for the point mass); with ``probe`` every
-        array is in SI, as the command line's files — times (the ``tau`` coordinate, events,
-        sections) in s, lengths in m, velocities in m/s, forces in N, energies in J, the
+        array is in SI, as the command line's files — times (the coordinate ``t``, named
+        ``tau`` without a probe; events, sections) in s, lengths in m, velocities in m/s, forces in N, energies in J, the
         spectrum's frequencies in Hz — each variable's unit in its attrs.
     """
     p, probe = _params(params, model)
@@ -315,6 +318,8 @@ def simulate(
     si = bool(d["si"])
     point_mass = p.structure == "point-mass"
     _t = {"units": "s", "long_name": "time t"} if si else _T
+    # the time coordinate: t in s with a probe (as timeseries.csv names it), else τ
+    time = "t" if si else "tau"
     _g = {"units": "m"} if si else _G
     _v = {"units": "m/s"} if si else _V
     force = "N" if si else ("k g0" if point_mass else "E I g0/L^3")
@@ -322,18 +327,18 @@ def simulate(
     freq = "Hz" if si else "Ω units (1/t0)"
     ds = xr.Dataset(
         data_vars={
-            "v_t": ("tau", d["v_t"], {**_g, "long_name": "tip–sample distance V_T (eq. 8)"}),
-            "v_t_dot": ("tau", d["v_t_dot"], {**_v, "long_name": "dV_T/dτ"}),
-            "w_tip": ("tau", d["w_tip"], {**_g, "long_name": "tip deflection W(1,τ)"}),
-            "w_tip_dot": ("tau", d["w_tip_dot"], {**_v, "long_name": "∂W(1,τ)/∂τ"}),
-            "in_contact": ("tau", d["in_contact"], {"long_name": "tip on the sample (region II)"}),
+            "v_t": (time, d["v_t"], {**_g, "long_name": "tip–sample distance V_T (eq. 8)"}),
+            "v_t_dot": (time, d["v_t_dot"], {**_v, "long_name": "dV_T/dτ"}),
+            "w_tip": (time, d["w_tip"], {**_g, "long_name": "tip deflection W(1,τ)"}),
+            "w_tip_dot": (time, d["w_tip_dot"], {**_v, "long_name": "∂W(1,τ)/∂τ"}),
+            "in_contact": (time, d["in_contact"], {"long_name": "tip on the sample (region II)"}),
             "contact_force": (
-                "tau",
+                time,
                 d["contact_force"],
                 {"units": force, "long_name": "tip–sample contact force"},
             ),
-            "a": (("tau", "mode"), d["a"], {**_g, "long_name": "modal displacement a_i"}),
-            "a_dot": (("tau", "mode"), d["a_dot"], {**_v, "long_name": "modal velocity da_i/dτ"}),
+            "a": ((time, "mode"), d["a"], {**_g, "long_name": "modal displacement a_i"}),
+            "a_dot": ((time, "mode"), d["a_dot"], {**_v, "long_name": "modal velocity da_i/dτ"}),
             "event_tau": ("event", d["event_tau"], {**_t, "long_name": "switching time"}),
             "event_to_contact": (
                 "event",
@@ -408,7 +413,7 @@ def simulate(
                 d["spectrum_frequency"],
                 {"units": freq, "long_name": "frequency"},
             ),
-            "tau": ("tau", d["tau"], _t),
+            time: (time, d["tau"], _t),
             "mode": ("mode", np.arange(1, n + 1), {"long_name": "Galerkin mode i"}),
             "component": ("component", comp),
         },

@@ -17,6 +17,21 @@ use crate::params::{Params, SweepParam, OMEGA_MAX, OMEGA_MIN};
 /// # Errors
 /// [`SimError::OutOfRange`] for k outside 1..=N; [`SimError::Params`] for invalid parameters.
 pub fn mode_band(params: &Params, k: usize) -> Result<(f64, f64), SimError> {
+    let (omega, q) = mode_resonance(params, k)?;
+    let w = (6.0 / q).clamp(0.02, 0.5);
+    Ok((
+        (omega * (1.0 - w)).max(OMEGA_MIN),
+        (omega * (1.0 + w)).min(OMEGA_MAX),
+    ))
+}
+
+/// The k-th natural frequency ω_k (k ≥ 1) of the free cantilever and its quality factor
+/// Q_k = |λ_k|/(2|Re λ_k|) from the damped eigenvalue λ_k (∞ undamped): the linewidth ω_k/Q_k
+/// sets [`mode_band`] and the finest default grid of a resonance curve.
+///
+/// # Errors
+/// [`SimError::OutOfRange`] for k outside 1..=N; [`SimError::Params`] for invalid parameters.
+pub fn mode_resonance(params: &Params, k: usize) -> Result<(f64, f64), SimError> {
     let (free, _) = spectrum(params)?;
     if k == 0 || k > free.omega.len() {
         return Err(SimError::out_of_range(
@@ -32,11 +47,7 @@ pub fn mode_band(params: &Params, k: usize) -> Result<(f64, f64), SimError> {
         .filter(|e| e.im > 0.0)
         .nth(k - 1)
         .map_or(f64::INFINITY, |e| 0.5 / e.zeta.max(1e-300));
-    let w = (6.0 / q).clamp(0.02, 0.5);
-    Ok((
-        (omega * (1.0 - w)).max(OMEGA_MIN),
-        (omega * (1.0 + w)).min(OMEGA_MAX),
-    ))
+    Ok((omega, q))
 }
 
 /// The stepped-sweep spec of an up-sweep from the smaller to the larger of `from` and `to`

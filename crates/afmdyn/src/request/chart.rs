@@ -165,6 +165,22 @@ pub struct ChartModel {
     pub y: &'static str,
 }
 
+impl ChartModel {
+    /// Metres per unit length of the cell at (`x`, `y`) under the probe: its free amplitude A₀
+    /// (g₀ = A₀ for both structural models), the axis value where an axis is `free_amplitude`;
+    /// `None` without a probe (lengths stay in g₀).
+    pub fn length_m(&self, x: f64, y: f64) -> Option<f64> {
+        let probe = self.probe.as_ref()?;
+        Some(if self.x == "free_amplitude" {
+            x
+        } else if self.y == "free_amplitude" {
+            y
+        } else {
+            probe.scales.length_m
+        })
+    }
+}
+
 impl CellParams for ChartModel {
     fn params(&self, x: f64, y: f64) -> Result<Params, SimError> {
         let mut v = serde_json::to_value(self.base).unwrap_or_else(|_| json!({}));
@@ -422,8 +438,11 @@ pub const CSV_HEADER: [&str; 18] = [
 ];
 
 /// The rows of a cell as CSV lines of [`CSV_HEADER`] (numbers in Rust's shortest round-trip
-/// form; messages with commas and newlines replaced by spaces).
-pub fn csv_lines(cell: &ChartCell) -> Vec<String> {
+/// form; messages with commas and newlines replaced by spaces). The lengths `x_max` and
+/// `v_t_min` are in g₀, or in m with a probe (× [`ChartModel::length_m`] of the cell: the
+/// length unit changes from cell to cell along a `free_amplitude` axis).
+pub fn csv_lines(chart: &Chart, cell: &ChartCell) -> Vec<String> {
+    let length = chart.model.length_m(cell.x, cell.y).unwrap_or(1.0);
     let message = cell
         .message
         .as_deref()
@@ -448,8 +467,8 @@ pub fn csv_lines(cell: &ChartCell) -> Vec<String> {
                 a.period.map_or(String::new(), |n| n.to_string()),
                 a.lyapunov.map_or(String::new(), |l| l.to_string()),
                 a.lyapunov_error.map_or(String::new(), |l| l.to_string()),
-                a.x_max,
-                a.v_t_min,
+                a.x_max * length,
+                a.v_t_min * length,
                 a.contacts_per_period,
                 a.contact_fraction,
                 a.count,

@@ -3,10 +3,14 @@
 //! the [`SteppedSpec`] they give ([`approach_request`], [`resonance_request`]).
 
 use crate::analysis::approach::{approach_spec, default_range};
-use crate::analysis::resonance::{mode_band, resonance_spec};
-use crate::analysis::stepped::{Spacing, SteppedSpec, DEFAULT_CURVE_POINTS, DEFAULT_TOLERANCE};
+use crate::analysis::observables::free_response;
+use crate::analysis::resonance::{mode_band, mode_resonance, resonance_spec};
+use crate::analysis::stepped::{
+    Spacing, SteppedSpec, DEFAULT_CURVE_POINTS, DEFAULT_TOLERANCE, MAX_CURVE_POINTS,
+};
 use crate::error::SimError;
-use crate::params::Params;
+use crate::model::CantileverModel;
+use crate::params::{Params, OMEGA_MAX, OMEGA_MIN};
 use serde::{Deserialize, Serialize};
 
 /// A stepped-curve request as a front end takes it (`afmdyn approach` / `resonance` flags, the
@@ -157,6 +161,10 @@ pub fn approach_request(
 ///
 /// # Errors
 /// As those three.
+///
+/// In SI (`hz` ≠ 1, a probe) an end outside the model's Ω range is refused naming it in Hz with
+/// the probe's range in Hz, and without a step or count the grid is no coarser than a tenth of
+/// the mode's linewidth f_k/Q_k ([`linewidth_points`]).
 pub fn resonance_request(
     base: Params,
     mode: usize,
@@ -164,9 +172,84 @@ pub fn resonance_request(
     hz: f64,
 ) -> Result<SteppedSpec, SimError> {
     request.check_finite()?;
+    if hz != 1.0 {
+        for (name, v) in [("from", request.from), ("to", request.to)] {
+            match v {
+                Some(f) if !(OMEGA_MIN..=OMEGA_MAX).contains(&(f / hz)) => {
+                    return Err(SimError::out_of_range(
+                        name,
+                        format!(
+                            "{} Hz (this probe allows [{}, {}] Hz)",
+                            crate::error::number(f),
+                            crate::error::number(OMEGA_MIN * hz),
+                            crate::error::number(OMEGA_MAX * hz)
+                        ),
+                        "must lie within the model's drive frequencies (Ω in [1e-3, 1e5] of \
+                         the probe's time unit): frequencies are in Hz (300 kHz is 300e3, or \
+                         300kHz on the command line)",
+                    ))
+                }
+                _ => {}
+            }
+        }
+    }
     let (from, to) = request.ends(mode_band(&base, mode)?, hz);
-    let spec = resonance_spec(base, from, to, request.spacing(hz)?);
+    let mut spacing = request.spacing(hz)?;
+    if hz != 1.0 && request.step.is_none() && request.points.is_none() {
+        spacing = Spacing::Points(linewidth_points(&base, mode, from, to)?);
+    }
+    let spec = resonance_spec(base, from, to, spacing);
     request.configure(spec.map_err(|e| in_units(e, hz))?)
+}
+
+/// The default number of points of a resonance curve over [`from`, `to`] (Ω) near mode
+/// `mode` with a probe: a step no coarser than a tenth of the linewidth ω_k/Q_k
+/// ([`mode_resonance`]; 60 Hz for f₀ = 300 kHz, Q = 500), at least [`DEFAULT_CURVE_POINTS`],
+/// at most [`crate::analysis::stepped::MAX_CURVE_POINTS`].
+///
+/// # Errors
+/// As [`mode_resonance`].
+pub fn linewidth_points(base: &Params, mode: usize, from: f64, to: f64) -> Result<usize, SimError> {
+    let (omega, q) = mode_resonance(base, mode)?;
+    let step = omega / (10.0 * q);
+    let needed = if step > 0.0 && step.is_finite() {
+        ((to - from).abs() / step).ceil() + 1.0
+    } else {
+        0.0
+    };
+    Ok((needed.min(MAX_CURVE_POINTS as f64) as usize).max(DEFAULT_CURVE_POINTS))
+}
+
+/// The model of a resonance curve under a probe that gives no rest distance (no `[sample] z_c`
+/// in the file, z_c left at its default A₀ — touching the sample at resonance): the tip moved
+/// away, to 10 × the free amplitude at the mode's resonance, for the free resonance as an
+/// instrument's tune records it. Without a probe, with the file's `z_c`, or with a `--z-c` /
+/// `z_c=` other than A₀ (which moves α5 off the probe's), `base`.
+///
+/// # Errors
+/// As [`mode_resonance`] and [`free_response`].
+pub fn free_resonance_base(
+    base: Params,
+    probe: Option<&crate::probe::Probe>,
+    mode: usize,
+) -> Result<Params, SimError> {
+    let Some(probe) = probe else {
+        return Ok(base);
+    };
+    if probe.z_c_in_file || base.alpha5 != probe.params.alpha5 {
+        return Ok(base);
+    }
+    let (omega, _) = mode_resonance(&base, mode)?;
+    let at_peak = Params { omega, ..base };
+    // (an undamped mode has no finite peak: the free amplitude at the drive then)
+    let peak = free_response(&CantileverModel::new(&at_peak)?)
+        .or_else(|_| free_response(&CantileverModel::new(&base)?))?
+        .amplitude;
+    let far = 10.0 * peak.max(1.0);
+    Ok(Params {
+        alpha5: base.alpha5_for_rest_distance(far),
+        ..base
+    })
 }
 
 /// An error of the grid ([`crate::analysis::stepped::grid`], in dimensionless units) about

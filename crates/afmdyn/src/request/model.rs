@@ -323,6 +323,9 @@ impl ModelSpec {
     /// not finite (not positive); [`SimError::Params`] for a law group of another law or a
     /// value out of range ([`Params::validate`]).
     pub fn resolve(&self, defaults: Params, probe: Option<&Probe>) -> Result<Params, SimError> {
+        if probe.is_some() {
+            self.refuse_dimensionless_under_probe()?;
+        }
         let base = probe.map_or(defaults, |p| p.params);
         let contact_law = ContactLaw::from_parts(
             self.contact_law,
@@ -347,13 +350,6 @@ impl ModelSpec {
             let probe = probe.ok_or_else(|| {
                 SimError::out_of_range("z_c", z, "needs a probe file (z_c is in m, SI)")
             })?;
-            if self.gap.is_some() {
-                return Err(SimError::out_of_range(
-                    "z_c",
-                    z,
-                    "give z_c or gap (alpha5), not both: both set α5",
-                ));
-            }
             if !z.is_finite() {
                 return Err(SimError::out_of_range(
                     "z_c",
@@ -363,6 +359,23 @@ impl ModelSpec {
             }
             super::limits::si_distance("z_c", z)?;
             p.alpha5 = p.alpha5_for_rest_distance(z / probe.scales.length_m);
+            if p.alpha5.is_nan() || p.alpha5.abs() > crate::params::DISPLACEMENT_MAX {
+                // the model's range of α5 in the user's unit: z_c in m for this probe's A0
+                let edge =
+                    |a5: f64| Params { alpha5: a5, ..p }.rest_distance() * probe.scales.length_m;
+                return Err(SimError::out_of_range(
+                    "z_c",
+                    format!(
+                        "{} m (this probe allows [{}, {}] m: ±1e6 × its length unit A0 = {} m)",
+                        crate::error::number(z),
+                        crate::error::number(edge(-crate::params::DISPLACEMENT_MAX)),
+                        crate::error::number(edge(crate::params::DISPLACEMENT_MAX)),
+                        crate::error::number(probe.scales.length_m)
+                    ),
+                    "must lie within the probe's range: the model takes rest distances up to \
+                     1e6 free amplitudes A0 from the sample",
+                ));
+            }
         }
         if let Some(f) = self.drive_frequency {
             let probe = probe.ok_or_else(|| {
@@ -372,13 +385,6 @@ impl ModelSpec {
                     "needs a probe file (drive_frequency is in Hz, SI)",
                 )
             })?;
-            if self.omega.is_some() {
-                return Err(SimError::out_of_range(
-                    "drive_frequency",
-                    f,
-                    "give drive_frequency or omega, not both: both set Ω",
-                ));
-            }
             if !(f.is_finite() && f > 0.0) {
                 return Err(SimError::out_of_range(
                     "drive_frequency",
@@ -405,6 +411,100 @@ impl ModelSpec {
         }
         p.validate().map_err(SimError::from)?;
         Ok(p)
+    }
+}
+
+/// The model values a probe file sets in SI, refused as dimensionless values when a probe is
+/// given (its scales would not apply to them: `hamaker = 6.6e-20` taken as H̃ is not the
+/// Hamaker constant in J): the value's name and what to give instead. `modes` and
+/// `restitution` (pure numbers, the same in SI) and the SI values `z_c` and `drive_frequency`
+/// are taken with a probe.
+pub const PROBE_SETS: [(&str, &str); 10] = [
+    (
+        "tip_mass_ratio",
+        "is the dimensionless α1 and a probe sets it: give it in the probe file's [cantilever] \
+         tip_mass_ratio (beam)",
+    ),
+    (
+        "drive_amplitude",
+        "is the dimensionless α2 and a probe sets it: give the free amplitude in the probe \
+         file's [drive] free_amplitude (m)",
+    ),
+    (
+        "beam_damping",
+        "is the dimensionless α3 and a probe sets it: give the quality factor in the probe \
+         file's [cantilever] quality_factor",
+    ),
+    (
+        "contact_stiffness",
+        "is the dimensionless α4 and a probe sets it: give the sample in the probe file's \
+         [sample] youngs_modulus (Pa; linear law: stiffness in N/m)",
+    ),
+    (
+        "gap",
+        "is the dimensionless α5 and a probe sets it: give the rest distance z_c in m instead \
+         (--z-c 8nm on the command line, z_c=8e-9 in Python)",
+    ),
+    (
+        "contact_damping",
+        "is the dimensionless α6 and a probe sets it: give it in the probe file's [sample] \
+         viscosity (Pa s, DMT) or damping (N s/m, linear and Hertz)",
+    ),
+    (
+        "omega",
+        "is the dimensionless Ω and a probe sets it: give the drive frequency in Hz instead \
+         (--drive-frequency 300kHz on the command line, drive_frequency=300e3 in Python)",
+    ),
+    (
+        "contact_law",
+        "is set by the probe file's [sample] law (its constants are SI keys of that section): \
+         change the law there",
+    ),
+    (
+        "hamaker",
+        "is the dimensionless H̃ and a probe sets it: give the Hamaker constant in the probe \
+         file's [sample] hamaker (J)",
+    ),
+    (
+        "intermolecular_distance",
+        "is the dimensionless ã0 and a probe sets it: give a0 in the probe file's [sample] \
+         intermolecular_distance (m)",
+    ),
+];
+
+impl ModelSpec {
+    /// Refuse the values a probe sets in SI ([`PROBE_SETS`]): the first one given, named.
+    fn refuse_dimensionless_under_probe(&self) -> Result<(), SimError> {
+        let given = [
+            ("tip_mass_ratio", self.tip_mass_ratio),
+            ("drive_amplitude", self.drive_amplitude),
+            ("beam_damping", self.beam_damping),
+            ("contact_stiffness", self.contact_stiffness),
+            ("gap", self.gap),
+            ("contact_damping", self.contact_damping),
+            ("omega", self.omega),
+            ("contact_law", None),
+            ("hamaker", self.hamaker),
+            ("intermolecular_distance", self.intermolecular_distance),
+        ];
+        for ((name, value), (key, allowed)) in given.into_iter().zip(PROBE_SETS) {
+            debug_assert_eq!(name, key);
+            if let Some(v) = value {
+                return Err(SimError::out_of_range(
+                    key,
+                    crate::error::number(v),
+                    allowed,
+                ));
+            }
+        }
+        if let Some(law) = self.contact_law {
+            return Err(SimError::out_of_range(
+                "contact_law",
+                law.name(),
+                PROBE_SETS[7].1,
+            ));
+        }
+        Ok(())
     }
 }
 
@@ -547,6 +647,157 @@ mod tests {
         }
         .resolve(Params::default(), Some(&probe))
         .unwrap_err();
-        assert!(both.to_string().contains("not both"), "{both}");
+        assert!(
+            both.to_string()
+                .starts_with("gap = 0.1: is the dimensionless α5"),
+            "{both}"
+        );
+    }
+
+    /// Under a probe every dimensionless value the probe sets is refused, named, with the SI
+    /// key or flag to use (issue 42: `--hamaker 6.6e-20` was taken as H̃ and moved the peak
+    /// force; `--drive-amplitude 20e-9` ran with no drive); without a probe they are taken.
+    #[test]
+    fn a_probe_refuses_the_values_it_sets() {
+        let probe = Probe::parse(
+            include_str!("../../../../examples/probe-point-mass-dmt.toml"),
+            "probe-point-mass-dmt.toml",
+        )
+        .unwrap();
+        let cases: [(ModelSpec, &str); 10] = [
+            (
+                ModelSpec {
+                    tip_mass_ratio: Some(0.1),
+                    ..ModelSpec::default()
+                },
+                "[cantilever] tip_mass_ratio",
+            ),
+            (
+                ModelSpec {
+                    drive_amplitude: Some(20e-9),
+                    ..ModelSpec::default()
+                },
+                "[drive] free_amplitude (m)",
+            ),
+            (
+                ModelSpec {
+                    beam_damping: Some(0.1),
+                    ..ModelSpec::default()
+                },
+                "[cantilever] quality_factor",
+            ),
+            (
+                ModelSpec {
+                    contact_stiffness: Some(20.0),
+                    ..ModelSpec::default()
+                },
+                "[sample] youngs_modulus (Pa",
+            ),
+            (
+                ModelSpec {
+                    gap: Some(1.0),
+                    ..ModelSpec::default()
+                },
+                "z_c in m",
+            ),
+            (
+                ModelSpec {
+                    contact_damping: Some(0.2),
+                    ..ModelSpec::default()
+                },
+                "[sample] viscosity",
+            ),
+            (
+                ModelSpec {
+                    omega: Some(1.0),
+                    ..ModelSpec::default()
+                },
+                "drive frequency in Hz",
+            ),
+            (
+                ModelSpec {
+                    contact_law: Some(LawKind::Hertz),
+                    ..ModelSpec::default()
+                },
+                "[sample] law",
+            ),
+            (
+                ModelSpec {
+                    hamaker: Some(6.6e-20),
+                    ..ModelSpec::default()
+                },
+                "[sample] hamaker (J)",
+            ),
+            (
+                ModelSpec {
+                    intermolecular_distance: Some(0.01),
+                    ..ModelSpec::default()
+                },
+                "[sample] intermolecular_distance (m)",
+            ),
+        ];
+        for (spec, hint) in cases {
+            let e = spec.resolve(Params::default(), Some(&probe)).unwrap_err();
+            assert!(matches!(e, SimError::OutOfRange { .. }), "{e:?}");
+            assert!(e.to_string().contains(hint), "{e}");
+            // taken as the dimensionless value without a probe (the law groups need their law)
+            if spec.hamaker.is_none() && spec.intermolecular_distance.is_none() {
+                spec.resolve(Params::default(), None).unwrap();
+            }
+        }
+        let e = ModelSpec {
+            hamaker: Some(6.6e-20),
+            ..ModelSpec::default()
+        }
+        .resolve(Params::default(), Some(&probe))
+        .unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "hamaker = 6.6e-20: is the dimensionless H̃ and a probe sets it: give the Hamaker \
+             constant in the probe file's [sample] hamaker (J)"
+        );
+        // what a probe takes: N, r (its own law's), z_c in m and f in Hz
+        let ok = ModelSpec {
+            z_c: Some(12e-9),
+            drive_frequency: Some(299e3),
+            ..ModelSpec::default()
+        }
+        .resolve(Params::default(), Some(&probe))
+        .unwrap();
+        assert_eq!(ok.alpha3, probe.params.alpha3);
+    }
+
+    /// A z_c beyond the model's α5 range is refused naming z_c in m and the probe's range in
+    /// m, not α5 (issue 42: `--z-c 50um` on a 10 pm probe named `alpha5 = 4.999983500000001e6`).
+    #[test]
+    fn z_c_out_of_the_models_range_is_named_in_metres() {
+        let text = include_str!("../../../../examples/probe-point-mass-dmt.toml")
+            .replace("free_amplitude = 10e-9", "free_amplitude = 10e-12")
+            .replace("z_c = 8e-9", "z_c = 8e-12");
+        let probe = Probe::parse(&text, "small.toml").unwrap();
+        assert_eq!(probe.scales.length_m, 10e-12);
+        let e = ModelSpec {
+            z_c: Some(50e-6),
+            ..ModelSpec::default()
+        }
+        .resolve(Params::default(), Some(&probe))
+        .unwrap_err();
+        let msg = e.to_string();
+        assert!(
+            msg.starts_with("z_c = 5e-5 m (this probe allows [-"),
+            "{msg}"
+        );
+        assert!(!msg.contains("alpha5") && msg.contains("e-5] m"), "{msg}");
+        // just inside the range is taken
+        let edge = probe.z_c_of(&Params {
+            alpha5: 0.999_999 * crate::params::DISPLACEMENT_MAX,
+            ..probe.params
+        });
+        ModelSpec {
+            z_c: Some(edge),
+            ..ModelSpec::default()
+        }
+        .resolve(Params::default(), Some(&probe))
+        .unwrap();
     }
 }

@@ -19,7 +19,7 @@ use super::analyses::{
     AttractorsRequest, ContinuationRequest, ConvergeRequest, GlobalContinuationRequest,
     LyapunovRequest, ObserveRequest, ObserveResult, OrbitRequest,
 };
-use super::curves::{approach_request, resonance_request, CurveRequest};
+use super::curves::{approach_request, free_resonance_base, resonance_request, CurveRequest};
 use crate::analysis::attractors::AttractorReport;
 use crate::analysis::continuation::Branch;
 use crate::analysis::converge::ConvergenceRun;
@@ -87,6 +87,15 @@ pub trait Analysis {
     /// # Errors
     /// [`SimError`] where the document needs the model built again (an invalid `params`).
     fn report(&self, model: &Resolved, output: &Self::Output) -> Result<Value, SimError>;
+    /// The parameters the result was computed at, for the SI block: `model.params`, unless
+    /// the analysis moves them (a resonance curve under a probe is the free resonance,
+    /// [`super::curves::free_resonance_base`]).
+    ///
+    /// # Errors
+    /// As the analysis' validation.
+    fn computed_at(&self, model: &Resolved) -> Result<Params, SimError> {
+        Ok(model.params)
+    }
 }
 
 /// Run `analysis` on `model`: [`Analysis::validate`], [`Analysis::execute`], then its document with the SI block of
@@ -105,7 +114,7 @@ pub fn run<A: Analysis + ?Sized>(
     let output = analysis.execute(model, progress)?;
     let doc = analysis.report(model, &output)?;
     Ok(Document {
-        json: report::with_si(doc, model.probe.as_ref(), &model.params),
+        json: report::with_si(doc, model.probe.as_ref(), &analysis.computed_at(model)?),
         output,
     })
 }
@@ -333,7 +342,7 @@ impl ResonanceRequest {
     /// As [`resonance_request`].
     pub fn spec(&self, model: &Resolved) -> Result<SteppedSpec, SimError> {
         let hz = Self::units(model).hz_per_omega.unwrap_or(1.0);
-        resonance_request(model.params, self.mode, &self.curve, hz)
+        resonance_request(self.computed_at(model)?, self.mode, &self.curve, hz)
     }
 }
 
@@ -346,7 +355,14 @@ impl Analysis for ResonanceRequest {
         stepped_sweep_with(&self.spec(model)?, progress)
     }
     fn report(&self, model: &Resolved, c: &Self::Output) -> Result<Value, SimError> {
-        Ok(report::resonance(&model.params, c, &Self::units(model)))
+        Ok(report::resonance(
+            &self.computed_at(model)?,
+            c,
+            &Self::units(model),
+        ))
+    }
+    fn computed_at(&self, model: &Resolved) -> Result<Params, SimError> {
+        free_resonance_base(model.params, model.probe.as_ref(), self.mode)
     }
 }
 
