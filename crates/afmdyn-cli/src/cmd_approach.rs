@@ -309,12 +309,12 @@ fn columns(l: &Labels, u: &CurveUnits) -> Vec<Column> {
         Column::new(
             "peak_force",
             force,
-            "largest tip–sample force (repulsive positive)",
+            "largest tip–sample force F_c: the repulsive maximum (F_c > 0 pushes the tip away)",
         ),
         Column::new(
             "min_force",
             force,
-            "smallest tip–sample force (largest attraction)",
+            "smallest tip–sample force F_c: the adhesion minimum (F_c < 0 pulls the tip towards the sample)",
         ),
         Column::new("indentation", len, "largest indentation"),
         Column::new("contact_fraction", "1", "fraction of the period in contact"),
@@ -737,7 +737,13 @@ fn write_traces(
             "tip-sample distance V_T (<= 0 in contact)",
             &distance,
         ),
-        Var::f64("force", grid, force, "tip-sample force", &force_values),
+        Var::f64(
+            "force",
+            grid,
+            force,
+            "tip-sample force F_c (> 0 repulsive, < 0 attractive)",
+            &force_values,
+        ),
     ];
     crate::netcdf::write(
         &path,

@@ -233,21 +233,32 @@ fn series_columns(n: usize, su: &SeriesUnits) -> Vec<Column> {
     } else {
         "dimensionless time τ = t √(EI/(mL⁴))"
     };
-    let mut c =
-        vec![
+    let mut c = vec![
         Column::new(t, tu, time),
         Column::new(
             "v_t",
             len,
             "tip–sample distance V_T = W(1,τ) + α2 sin Ωτ + α5 (eq. 8); contact while V_T ≤ 0",
         ),
-        Column::new("w_tip", len, "tip deflection W(1,τ) relative to the clamped base"),
+        Column::new(
+            "w_tip",
+            len,
+            "tip deflection W(1,τ) relative to the clamped base",
+        ),
         Column::new("w_tip_dot", vel, "tip velocity ∂W(1,τ)/∂τ"),
-        Column::new("in_contact", "0/1", "1 while the tip is in contact (region II)"),
+        Column::new(
+            "in_contact",
+            "0/1",
+            "1 while the tip is in contact (region II)",
+        ),
         Column::new(
             "contact_force",
             force,
-            "F_c = α4 V_T + α6 dV_T/dτ in contact, 0 in free flight (F_c < 0 pushes the tip away)",
+            format!(
+                "tip–sample force F_c(δ, δ̇) on the tip, δ = −V_T the indentation (linear law: \
+                 α4 δ + α6 δ̇ in contact; 0 in free flight except DMT's van der Waals force): {}",
+                afmdyn::contact::FORCE_SIGN
+            ),
         ),
     ];
     c.extend((1..=n).map(|j| {

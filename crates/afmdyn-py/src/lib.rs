@@ -35,6 +35,7 @@ fn _afmdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
         "SimulationError",
         m.py().get_type::<errors::SimulationError>(),
     )?;
+    m.add("FORCE_SIGN", afmdyn::contact::FORCE_SIGN)?;
     m.add_function(wrap_pyfunction!(analyses::modes, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::simulate, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::converge, m)?)?;

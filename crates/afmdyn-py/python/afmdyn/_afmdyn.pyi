@@ -11,6 +11,8 @@ POLL_SECONDS: float
 #: (name, alias or name, unit, range, help).
 MODEL_PARAMETERS: List[Tuple[str, str, str, str, str]]
 
+FORCE_SIGN: str
+
 class SimulationError(RuntimeError):
     """A computation failed (chattering, divergence, Newton not converging, integrator
     failure); bad input raises ``ValueError`` instead."""

@@ -330,7 +330,11 @@ def simulate(
             "contact_force": (
                 "tau",
                 d["contact_force"],
-                {"units": force, "long_name": "tip–sample contact force"},
+                {
+                    "units": force,
+                    "long_name": "tip–sample force F_c on the tip (> 0 repulsive)",
+                    "sign_convention": _core.FORCE_SIGN,
+                },
             ),
             "a": (("tau", "mode"), d["a"], {**_g, "long_name": "modal displacement a_i"}),
             "a_dot": (("tau", "mode"), d["a_dot"], {**_v, "long_name": "modal velocity da_i/dτ"}),
