@@ -135,3 +135,44 @@ def test_simulate_with_a_probe_is_in_si_as_the_command_line(cli, tmp_path):
     assert abs(ds.section_tau.values[1] - ds.section_tau.values[0] - period) < 1e-9 * period
     plain = afmdyn.simulate(afmdyn.Params.from_probe(PM), periods=2)
     assert plain.contact_force.attrs["units"] == "k g0" and plain.tau.attrs["units"] == "t0"
+
+
+def test_probe_as_text_or_dict_and_a_library_cantilever(cli_json, tmp_path):
+    """Issue 42 §4: ``approach(probe=…, cantilever="RTESPA-300")`` was refused (``unknown
+    model parameter 'cantilever'``) and ``probe=`` took a path only. ``cantilever=`` is
+    ``--cantilever`` (the library's cantilever fills the keys the probe leaves out), and the
+    probe may be TOML text or a dict of its sections: the library's ``Probe::source_text``
+    gives every form the same parameters and SI block as the file."""
+    import tomllib
+
+    text = PM.read_text()
+    table = tomllib.loads(text)
+    by_path = afmdyn.probe(PM)
+    assert afmdyn.probe(text) == by_path
+    assert afmdyn.probe(table) == by_path
+    assert afmdyn.Params.from_probe(table) == by_path["params"]
+    o = afmdyn.orbit(probe=table, z_c=8e-9).to_dict()
+    assert o == afmdyn.orbit(probe=str(PM), z_c=8e-9).to_dict()
+
+    # the probe without its calibration: RTESPA-300 from the library supplies k, f0 and Q
+    bare = {k: v for k, v in table.items() if k != "cantilever"}
+    f = tmp_path / "bare.toml"
+    f.write_text("\n".join(line for line in text.splitlines()
+                           if not line.startswith(("[cantilever]", "spring_constant",
+                                                   "resonance_frequency", "quality_factor"))))
+    want = cli_json("units", "--probe", f, "--cantilever", "RTESPA-300")
+    got = afmdyn.probe(bare, cantilever="RTESPA-300")
+    assert got["si"] == want["si"]
+    row = afmdyn.cantilevers().loc["RTESPA-300"]
+    cal = got["si"]["calibration"]
+    for key in ("spring_constant", "resonance_frequency", "quality_factor"):
+        assert cal[key] == row[key], key
+    assert cal["quality_factor"] != table["cantilever"]["quality_factor"]
+    ds = afmdyn.approach(probe=bare, cantilever="RTESPA-300", points=8)
+    import json
+
+    assert json.loads(ds.attrs["summary"])["si"]["calibration"] == cal
+    with pytest.raises(ValueError, match="cantilever"):
+        afmdyn.approach(probe=bare, cantilever="NO-SUCH-LEVER", points=8)
+    with pytest.raises(ValueError, match="needs probe"):
+        afmdyn.orbit(cantilever="RTESPA-300")

@@ -417,6 +417,85 @@ struct Sample {
     z_c: Option<f64>,
 }
 
+/// A probe as a front end receives it: a file (the command line's `--probe FILE`, Python's
+/// `probe=path`), TOML text (`probe="[cantilever]\n…"`) or its table (Python's `probe={…}`).
+#[derive(Debug, Clone, Copy)]
+pub enum ProbeSource<'a> {
+    /// A probe file.
+    #[cfg(feature = "files")]
+    Path(&'a Path),
+    /// TOML text.
+    Text(&'a str),
+    /// A parsed TOML table (the sections `cantilever`, `tip`, `sample`, `drive` as tables).
+    Table(&'a toml::Table),
+}
+
+impl<'a> ProbeSource<'a> {
+    /// A front end's string argument: TOML text when it holds a line break or `=` (a key =
+    /// value line; no probe text is without one), else the path of a probe file.
+    #[cfg(feature = "files")]
+    pub fn of_str(s: &'a str) -> Self {
+        if s.contains(['\n', '=']) {
+            ProbeSource::Text(s)
+        } else {
+            ProbeSource::Path(Path::new(s))
+        }
+    }
+
+    /// How errors name the source: the path, `<string>` or `<table>`.
+    pub fn origin(&self) -> String {
+        match self {
+            #[cfg(feature = "files")]
+            ProbeSource::Path(p) => p.display().to_string(),
+            ProbeSource::Text(_) => "<string>".into(),
+            ProbeSource::Table(_) => "<table>".into(),
+        }
+    }
+}
+
+impl Probe {
+    /// The TOML text of the probe `source` with `[cantilever].name` set to `cantilever` when
+    /// given (the command line's `--cantilever NAME`, Python's `cantilever=`, which win over a
+    /// name in the probe: [`crate::cantilevers::with_name`]), checked by resolving it, so that
+    /// every later [`Probe::parse`] of the text succeeds; with the resolved probe.
+    ///
+    /// # Errors
+    /// [`ProbeError::Io`] for a file that cannot be read; as [`Probe::parse`], naming the
+    /// source ([`ProbeSource::origin`]); [`ProbeError::Invalid`] for a cantilever name that is
+    /// not in the library or a `cantilever` key that is not a table.
+    pub fn source_text(
+        source: ProbeSource<'_>,
+        cantilever: Option<&str>,
+    ) -> Result<(String, Probe), ProbeError> {
+        let origin = source.origin();
+        let text = match source {
+            #[cfg(feature = "files")]
+            ProbeSource::Path(path) => {
+                std::fs::read_to_string(path).map_err(|e| ProbeError::Io {
+                    path: origin.clone(),
+                    message: e.to_string(),
+                })?
+            }
+            ProbeSource::Text(t) => t.to_string(),
+            ProbeSource::Table(t) => toml::to_string(t).map_err(|e| ProbeError::Syntax {
+                path: origin.clone(),
+                message: e.to_string(),
+            })?,
+        };
+        let text = match cantilever {
+            None => text,
+            Some(name) => crate::cantilevers::with_name(&text, name).map_err(|message| {
+                ProbeError::Syntax {
+                    path: origin.clone(),
+                    message,
+                }
+            })?,
+        };
+        let probe = Self::parse(&text, &origin)?;
+        Ok((text, probe))
+    }
+}
+
 impl Probe {
     /// Read and resolve a probe file.
     ///

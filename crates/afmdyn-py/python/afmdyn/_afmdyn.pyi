@@ -80,7 +80,7 @@ class Params:
         """Read a model config file (``--config FILE.toml`` of the command line); ``**model``
         overrides it."""
     @staticmethod
-    def from_probe(path: Union[str, "os.PathLike[str]"], **model: Any) -> "Params":
+    def from_probe(path: Union[str, "os.PathLike[str]", Dict[str, Any]], **model: Any) -> "Params":
         """The dimensionless set of a probe file in SI units (``--probe FILE``); ``**model``
         overrides single keywords. Raises ``ValueError`` listing every problem of the file."""
     @property
@@ -243,7 +243,10 @@ def lyapunov(
     progress: Optional[ProgressCallback] = None,
     probe: Optional[str] = None,
 ) -> Dict[str, Any]: ...
-def probe(path: Union[str, "os.PathLike[str]"]) -> Tuple[Params, str]: ...
+def probe(text: str) -> Tuple[Params, str]: ...
+def probe_source(
+    probe: Union[str, "os.PathLike[str]", Dict[str, Any]], cantilever: Optional[str] = None
+) -> str: ...
 def resolve(
     params: Optional[Params] = None,
     default: Optional[Params] = None,
