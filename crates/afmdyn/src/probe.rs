@@ -185,8 +185,9 @@ pub struct Calibration {
     pub quality_factors: Option<Vec<f64>>,
     /// α1, tip-mass ratio of the beam (0 for the point mass).
     pub tip_mass_ratio: f64,
-    /// The static stiffness 3EI/L³ (N/m) of the beam (for comparison with k; 0 for the point
-    /// mass).
+    /// The static stiffness (N/m): the beam's 3EI/L³ (from the geometry, or from a calibrated
+    /// k as 3k/k̃₁, k̃₁ the Galerkin beam's modal stiffness at the tip in EI/L³; for comparison
+    /// with k), the point mass's its spring k.
     pub static_spring_constant: f64,
 }
 
@@ -954,6 +955,14 @@ impl Probe {
                 .map_err(|e| e.to_string())?;
                 (bk1 * unit, bw1 / (TAU * ts), 3.0 * unit)
             }
+        };
+        // the static stiffness: the point mass's is its spring k; the beam's 3EI/L³, from the
+        // geometry or from a calibrated k through the modal stiffness k = k̃₁ EI/L³ (issue 42:
+        // it was reported as 0 whenever k was given)
+        let static_k = match structure {
+            Structure::PointMass => k,
+            Structure::Beam if geometry.is_ok() => static_k,
+            Structure::Beam => 3.0 * k / k1,
         };
         let time_s = w1 / (TAU * f0);
         let force_n = k * g0 / k1;
