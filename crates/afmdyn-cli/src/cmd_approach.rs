@@ -472,22 +472,34 @@ fn plots(
     for (name, y_label, suffix) in panels {
         let k = idx(name);
         let mut series = Vec::new();
-        // branches first (underneath): unstable parts dotted, stable parts as small dots
+        // branches first (underneath): each unstable stretch a dotted line, stable points as
+        // small dots
         for b in &c.branches {
-            for stable in [false, true] {
-                let pts: Vec<(f64, f64)> = b
-                    .iter()
-                    .filter(|s| s.point.stable == stable)
-                    .map(|s| (x(s.point.value), col(&s.observables, u, k)))
-                    .collect();
-                if !pts.is_empty() {
+            let stable: Vec<(f64, f64)> = b
+                .iter()
+                .filter(|s| s.point.stable)
+                .map(|s| (x(s.point.value), col(&s.observables, u, k)))
+                .collect();
+            for run in b.chunk_by(|p, q| p.point.stable == q.point.stable) {
+                if !run[0].point.stable {
                     series.push(Series {
                         label: String::new(),
-                        points: pts,
-                        style: Style::Dots,
-                        color: if stable { 7 } else { 3 },
+                        points: run
+                            .iter()
+                            .map(|s| (x(s.point.value), col(&s.observables, u, k)))
+                            .collect(),
+                        style: Style::Dotted,
+                        color: 3,
                     });
                 }
+            }
+            if !stable.is_empty() {
+                series.push(Series {
+                    label: String::new(),
+                    points: stable,
+                    style: Style::Dots,
+                    color: 7,
+                });
             }
         }
         if let Some(s) = series.iter_mut().find(|s| s.color == 3) {
