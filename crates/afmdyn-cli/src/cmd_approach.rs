@@ -295,12 +295,12 @@ fn columns(l: &Labels, u: &CurveUnits) -> Vec<Column> {
         Column::new(
             "peak_force",
             force,
-            "largest tip–sample force (repulsive positive)",
+            "largest tip–sample force F_c: the repulsive maximum (F_c > 0 pushes the tip away)",
         ),
         Column::new(
             "min_force",
             force,
-            "smallest tip–sample force (largest attraction)",
+            "smallest tip–sample force F_c: the adhesion minimum (F_c < 0 pulls the tip towards the sample)",
         ),
         Column::new("indentation", len, "largest indentation"),
         Column::new("contact_fraction", "1", "fraction of the period in contact"),
@@ -458,22 +458,34 @@ fn plots(
     for (name, y_label, suffix) in panels {
         let k = idx(name);
         let mut series = Vec::new();
-        // branches first (underneath): unstable parts dotted, stable parts as small dots
+        // branches first (underneath): each unstable stretch a dotted line, stable points as
+        // small dots
         for b in &c.branches {
-            for stable in [false, true] {
-                let pts: Vec<(f64, f64)> = b
-                    .iter()
-                    .filter(|s| s.point.stable == stable)
-                    .map(|s| (x(s.point.value), col(&s.observables, u, k)))
-                    .collect();
-                if !pts.is_empty() {
+            let stable: Vec<(f64, f64)> = b
+                .iter()
+                .filter(|s| s.point.stable)
+                .map(|s| (x(s.point.value), col(&s.observables, u, k)))
+                .collect();
+            for run in b.chunk_by(|p, q| p.point.stable == q.point.stable) {
+                if !run[0].point.stable {
                     series.push(Series {
                         label: String::new(),
-                        points: pts,
-                        style: Style::Dots,
-                        color: if stable { 7 } else { 3 },
+                        points: run
+                            .iter()
+                            .map(|s| (x(s.point.value), col(&s.observables, u, k)))
+                            .collect(),
+                        style: Style::Dotted,
+                        color: 3,
                     });
                 }
+            }
+            if !stable.is_empty() {
+                series.push(Series {
+                    label: String::new(),
+                    points: stable,
+                    style: Style::Dots,
+                    color: 7,
+                });
             }
         }
         if let Some(s) = series.iter_mut().find(|s| s.color == 3) {
@@ -665,7 +677,7 @@ impl Run<'_> {
         } else {
             summary(&c, self.x, self.labels, out.as_ref());
             if let Some(sp) = json.get("setpoint") {
-                print_setpoint(sp, self.labels);
+                print_setpoint(sp, self.labels, self.units);
             }
         }
         Ok(())
@@ -723,7 +735,13 @@ fn write_traces(
             "tip-sample distance V_T (<= 0 in contact)",
             &distance,
         ),
-        Var::f64("force", grid, force, "tip-sample force", &force_values),
+        Var::f64(
+            "force",
+            grid,
+            force,
+            "tip-sample force F_c (> 0 repulsive, < 0 attractive)",
+            &force_values,
+        ),
     ];
     crate::netcdf::write(
         &path,
@@ -778,13 +796,39 @@ fn write_traces(
     )
 }
 
-/// The operating points of the `"setpoint"` block, one line each.
-fn print_setpoint(sp: &serde_json::Value, labels: &Labels) {
+/// Below this fraction of the model's force and energy units (F̃ and F̃·g₀: kA₀ and kA₀² for
+/// the point mass) a printed force or energy is the round-off of its computation and is printed
+/// as 0: the steady state is solved to 1e-10 of the state and the observables' quadratures are
+/// exact to ~1e-12 relative, so a conservative law's E_dis comes out as 1e-13 of the energy unit
+/// (5.5e-28 J against kA₀² = 4e-15 J for examples/probe-point-mass-dmt.toml), while the
+/// smallest dissipation of interest (air damping at Q = 1e4 over a period, 2π/Q · ½ of the unit)
+/// is 3e-4 of it. The same extent as the plots' smallest axis span (`y_min_span`).
+const PRINT_RESOLUTION: f64 = 1e-6;
+
+/// `v` as the summary prints it: 0 below [`PRINT_RESOLUTION`] of `unit_scale` (the model's unit
+/// in the reported one), else with its SI prefix (`si`) or six decimals.
+fn resolved(v: f64, unit_scale: f64, si: Option<&str>) -> String {
+    let v = if v.abs() < PRINT_RESOLUTION * unit_scale.abs() {
+        0.0
+    } else {
+        v
+    };
+    match si {
+        Some(unit) => si_value(v, unit),
+        None => format!("{v:.6}"),
+    }
+}
+
+/// The operating points of the `"setpoint"` block, one line each: the repulsive maximum of the
+/// tip–sample force (max F_c when positive, "none" else) and the adhesion minimum (min F_c when
+/// negative), energies and forces printed as 0 below [`PRINT_RESOLUTION`].
+fn print_setpoint(sp: &serde_json::Value, labels: &Labels, u: &CurveUnits) {
     let num = |v: &serde_json::Value, k: &str| v[k].as_f64().unwrap_or(f64::NAN);
     let length = |x: f64| match labels.x_unit {
         Some(u) => si_value(x, u),
         None => format!("{x:.6}"),
     };
+    let si = |unit| labels.x_unit.map(|_| unit);
     let points = sp["points"].as_array().map_or(&[][..], |v| v.as_slice());
     println!(
         "setpoint A/A0 = {}: {} operating point(s){}",
@@ -797,16 +841,22 @@ fn print_setpoint(sp: &serde_json::Value, labels: &Labels) {
         }
     );
     for p in points {
-        let force = match labels.x_unit {
-            Some(_) => si_value(num(p, "peak_force"), "N"),
-            None => format!("{:.6}", num(p, "peak_force")),
+        let (peak, least) = (num(p, "peak_force"), num(p, "min_force"));
+        let res = PRINT_RESOLUTION * u.force;
+        let repulsive = if peak > res {
+            resolved(peak, u.force, si("N"))
+        } else {
+            "none".into()
         };
-        let energy = match labels.x_unit {
-            Some(_) => si_value(num(p, "energy_dissipated"), "J"),
-            None => format!("{:.6}", num(p, "energy_dissipated")),
+        let adhesion = if least < -res {
+            resolved(least, u.force, si("N"))
+        } else {
+            "none".into()
         };
+        let energy = resolved(num(p, "energy_dissipated"), u.energy, si("J"));
         println!(
-            "  {} ({}): z_c = {}, phase {:.2}°, peak force {force}, indentation {}, E_dis {energy}",
+            "  {} ({}): z_c = {}, phase {:.2}°, repulsive peak force {repulsive}, adhesion \
+             (min force) {adhesion}, indentation {}, E_dis {energy}",
             p["source"].as_str().unwrap_or(""),
             p["regime"].as_str().unwrap_or(""),
             length(num(p, "z_c")),

@@ -253,21 +253,32 @@ fn series_columns(n: usize, su: &SeriesUnits) -> Vec<Column> {
     } else {
         "dimensionless time τ = t √(EI/(mL⁴))"
     };
-    let mut c =
-        vec![
+    let mut c = vec![
         Column::new(t, tu, time),
         Column::new(
             "v_t",
             len,
             "tip–sample distance V_T = W(1,τ) + α2 sin Ωτ + α5 (eq. 8); contact while V_T ≤ 0",
         ),
-        Column::new("w_tip", len, "tip deflection W(1,τ) relative to the clamped base"),
+        Column::new(
+            "w_tip",
+            len,
+            "tip deflection W(1,τ) relative to the clamped base",
+        ),
         Column::new("w_tip_dot", vel, "tip velocity ∂W(1,τ)/∂τ"),
-        Column::new("in_contact", "0/1", "1 while the tip is in contact (region II)"),
+        Column::new(
+            "in_contact",
+            "0/1",
+            "1 while the tip is in contact (region II)",
+        ),
         Column::new(
             "contact_force",
             force,
-            "F_c = α4 V_T + α6 dV_T/dτ in contact, 0 in free flight (F_c < 0 pushes the tip away)",
+            format!(
+                "tip–sample force F_c(δ, δ̇) on the tip, δ = −V_T the indentation (linear law: \
+                 α4 δ + α6 δ̇ in contact; 0 in free flight except DMT's van der Waals force): {}",
+                afmdyn::contact::FORCE_SIGN
+            ),
         ),
     ];
     c.extend((1..=n).map(|j| {
@@ -670,7 +681,7 @@ fn write_spectrum_and_plots(
             "V_T (m)",
             "dV_T/dt (m/s)",
             "frequency (Hz)".to_string(),
-            "amplitude (m)",
+            "log₁₀(amplitude / m)",
         )
     } else {
         (
@@ -679,7 +690,7 @@ fn write_spectrum_and_plots(
             "V_T",
             "dV_T/dτ",
             "frequency (dimensionless, Ω = drive)".to_string(),
-            "amplitude",
+            "log₁₀(amplitude / g0)",
         )
     };
     let recorded = (pd.t1 - pd.t0) / period;
@@ -792,13 +803,33 @@ fn write_spectrum_and_plots(
             y_label: spec_y.into(),
             series: vec![Series {
                 label: String::new(),
-                points: spec.into_iter().filter(|s| s.0 <= f_max).collect(),
+                points: log_spectrum(&spec, f_max),
                 style: Style::Line,
                 color: 0,
             }],
             shade: vec![],
         },
     )
+}
+
+/// How far below the spectrum's peak its log-scale plot reaches: 1e-10 of the peak, where the
+/// FFT of samples whose relative round-off is ~1e-15 (summed over up to 1e5 samples) is no
+/// longer signal, well under the higher harmonics of tapping (1e-2 to 1e-6 of the first).
+const SPECTRUM_DECADES: f64 = 10.0;
+
+/// The spectrum plot's points up to `f_max` on a logarithmic amplitude axis: (f, log₁₀ A),
+/// amplitudes below 10^−[`SPECTRUM_DECADES`] of the peak (zeros included) at that floor. On a
+/// linear axis every harmonic above the first is a flat line at zero.
+fn log_spectrum(spec: &[(f64, f64)], f_max: f64) -> Vec<(f64, f64)> {
+    let peak = spec.iter().map(|s| s.1).fold(0.0, f64::max);
+    if !(peak > 0.0 && peak.is_finite()) {
+        return Vec::new();
+    }
+    let floor = peak.log10() - SPECTRUM_DECADES;
+    spec.iter()
+        .filter(|s| s.0 <= f_max)
+        .map(|&(f, a)| (f, if a > 0.0 { a.log10().max(floor) } else { floor }))
+        .collect()
 }
 
 /// End of the spectrum plot's frequency axis: where the spectrum has died out (the last
@@ -916,6 +947,29 @@ pub fn converge(a: &ConvergeArgs) -> Result<(), CliError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Issue 42 §4: on the spectrum's linear axis a harmonic at 1e-4 of the first was a flat
+    /// line; on the log axis it stands 6 of the 10 decades above the floor, and the exact
+    /// decades are the amplitudes' log₁₀.
+    #[test]
+    fn the_spectrum_is_plotted_on_a_log_axis() {
+        let spec = [(1.0, 2.0), (2.0, 2e-4), (3.0, 2e-7), (4.0, 0.0), (5.0, 1.0)];
+        let pts = log_spectrum(&spec, 4.0);
+        assert_eq!(pts.len(), 4);
+        let want = [
+            2f64.log10(),
+            2e-4f64.log10(),
+            2e-7f64.log10(),
+            2f64.log10() - 10.0,
+        ];
+        for ((f, y), (g, w)) in pts.iter().zip(spec.iter().map(|s| s.0).zip(want)) {
+            assert_eq!(*f, g);
+            assert!((y - w).abs() < 1e-12, "{y} {w}");
+        }
+        let (lo, hi) = (want[3], want[0]);
+        assert!((pts[1].1 - lo) / (hi - lo) > 0.5);
+        assert!(log_spectrum(&[(1.0, 0.0)], 2.0).is_empty());
+    }
 
     #[test]
     fn spectrum_axis_ends_where_the_content_does() {

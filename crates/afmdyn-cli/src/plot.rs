@@ -41,6 +41,8 @@ pub enum Style {
     Dots,
     /// Dashed line.
     Dashed,
+    /// Dotted line (dots of 2 px, gaps of 4 px: e.g. an unstable branch).
+    Dotted,
 }
 
 /// One plotted series.
@@ -637,7 +639,7 @@ impl Painter for Figure {
         for s in &self.series {
             let c = color(s.color);
             match s.style {
-                Style::Line | Style::Dashed => {
+                Style::Line | Style::Dashed | Style::Dotted => {
                     for run in decimate_line(&s.points, px) {
                         shapes.push((run, c, s.style));
                     }
@@ -672,6 +674,9 @@ impl Painter for Figure {
                     .map(|_| ()),
                 Style::Dashed => chart
                     .draw_series(DashedLineSeries::new(pts, 6, 4, c.stroke_width(2)))
+                    .map(|_| ()),
+                Style::Dotted => chart
+                    .draw_series(DashedLineSeries::new(pts, 2, 4, c.stroke_width(2)))
                     .map(|_| ()),
                 Style::Points => chart
                     .draw_series(pts.into_iter().map(|p| Circle::new(p, 4, c.filled())))
@@ -996,6 +1001,61 @@ pub fn save_stacked(dir: &Path, stem: &str, fig: &StackedFractions) -> Result<()
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Issue 42 §4: "unstable branch (dotted)" was drawn as a solid run of dots. A Dotted
+    /// series is a broken line: along the row it is drawn on, its colour alternates with the
+    /// background (a Line's does not).
+    #[test]
+    fn a_dotted_series_is_drawn_broken() {
+        let gaps = |style: Style| {
+            let fig = Figure {
+                title: String::new(),
+                x_label: String::new(),
+                y_label: String::new(),
+                series: vec![
+                    Series {
+                        label: String::new(),
+                        points: (0..=100).map(|i| (f64::from(i) / 100.0, 0.5)).collect(),
+                        style,
+                        color: 3,
+                    },
+                    Series {
+                        label: String::new(),
+                        points: vec![(0.0, 0.0), (1.0, 1.0)],
+                        style: Style::Points,
+                        color: 0,
+                    },
+                ],
+                shade: vec![],
+                y_min_span: 0.0,
+            };
+            register_font();
+            let (w, h) = (600usize, 400usize);
+            let mut buf = vec![255u8; w * h * 3];
+            {
+                let root =
+                    BitMapBackend::with_buffer(&mut buf, (w as u32, h as u32)).into_drawing_area();
+                fig.paint(root, true).unwrap();
+            }
+            let c = color(3);
+            let is_c = |x: usize, y: usize| {
+                let i = 3 * (y * w + x);
+                (buf[i], buf[i + 1], buf[i + 2]) == (c.0, c.1, c.2)
+            };
+            // the row with the most pixels of the series' colour, and its runs of that colour
+            let row = (0..h)
+                .max_by_key(|&y| (0..w).filter(|&x| is_c(x, y)).count())
+                .unwrap();
+            let on: Vec<bool> = (0..w).map(|x| is_c(x, row)).collect();
+            assert!(
+                on.iter().filter(|&&b| b).count() > 50,
+                "the series is drawn"
+            );
+            on.windows(2).filter(|p| p[0] && !p[1]).count()
+        };
+        assert!(gaps(Style::Line) <= 1);
+        assert!(gaps(Style::Dotted) >= 20, "{}", gaps(Style::Dotted));
+    }
 
     /// SI axes take the prefix of their magnitude; other labels are left alone.
     #[test]

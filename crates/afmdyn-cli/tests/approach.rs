@@ -367,3 +367,58 @@ fn display_units_choose_prefixed_or_plain_si() {
     let bad = afmdyn(&["--units", "cgs", "approach"]);
     assert_eq!(bad.status.code(), Some(2));
 }
+
+/// Issue 42 §4: the setpoint summary printed one "peak force" (max F_c, which without
+/// repulsion is the far field's) and a conservative law's E_dis as `5.5e-10 aJ` (round-off).
+/// It now prints the repulsive maximum and the adhesion minimum, each as the JSON's value,
+/// and energies below 1e-6 of the model's unit (kA₀² here) as 0.
+#[test]
+fn setpoint_summary_prints_repulsive_peak_adhesion_and_resolved_zeros() {
+    let dir = std::env::temp_dir().join(format!("afmdyn-sp-sum-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let probe = repo().join("examples/probe-point-mass-dmt.toml");
+    let args = [
+        "approach",
+        "--probe",
+        probe.to_str().unwrap(),
+        "--setpoint",
+        "0.8",
+        "--files",
+        "none",
+        "--out",
+        dir.to_str().unwrap(),
+    ];
+    let out = afmdyn(&args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    let line = text
+        .lines()
+        .find(|l| l.contains("(repulsive): z_c"))
+        .unwrap_or_else(|| panic!("{text}"));
+    let _ = std::fs::remove_dir_all(&dir);
+    let doc = json(&[&args[..], &["--json"]].concat());
+    let p = &doc["setpoint"]["points"][0];
+    let (peak, least) = (
+        p["peak_force"].as_f64().unwrap(),
+        p["min_force"].as_f64().unwrap(),
+    );
+    // DMT: repulsion at the deepest indentation, adhesion −H/a0² · R/6 at contact
+    assert!(peak > 0.0 && least < 0.0, "{peak} {least}");
+    assert!(
+        line.contains(&format!("repulsive peak force {:.5} nN", peak * 1e9)),
+        "{line}"
+    );
+    assert!(
+        line.contains(&format!("adhesion (min force) {:.5} nN", least * 1e9)),
+        "{line}"
+    );
+    // the probe's sample has no viscosity: E_dis is round-off of the energy unit kA0²
+    let e = p["energy_dissipated"].as_f64().unwrap();
+    let unit = 40.0 * 10e-9 * 10e-9;
+    assert!(e.abs() < 1e-6 * unit, "E_dis {e:e}");
+    assert!(line.ends_with("E_dis 0 J"), "{line}");
+}

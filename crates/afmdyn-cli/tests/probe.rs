@@ -972,3 +972,64 @@ fn attractors_of_a_high_q_lever_settle_at_defaults_and_warn_when_cut_short() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Issue 42 §4: `contact_force` was documented as negative when pushing the tip away and 0 in
+/// free flight, while the data are positive at the deepest indentation and negative (van der
+/// Waals) in DMT's free flight. The data follow F_c > 0 repulsive: the `.npy.json`, the
+/// approach's columns and docs/outputs.md now say so, and the data are checked against it.
+#[test]
+fn contact_force_sign_in_data_matches_its_documentation() {
+    let dir = std::env::temp_dir().join(format!("afmdyn-force-sign-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let out = dir.to_str().unwrap();
+    json(&[
+        "simulate",
+        "--probe",
+        "examples/probe-point-mass-dmt.toml",
+        "--periods",
+        "20",
+        "--transient",
+        "300",
+        "--csv",
+        "--files",
+        "data",
+        "--out",
+        out,
+        "--json",
+    ]);
+    let (h, rows) = read_csv(&dir.join("timeseries.csv"));
+    assert_eq!(
+        (h[1].as_str(), h[4].as_str(), h[5].as_str()),
+        ("v_t", "in_contact", "contact_force")
+    );
+    let deepest = rows.iter().min_by(|a, b| a[1].total_cmp(&b[1])).unwrap();
+    assert!(
+        deepest[1] < 0.0 && deepest[4] == 1.0,
+        "the run indents the sample"
+    );
+    assert!(
+        deepest[5] > 0.0,
+        "F_c at the deepest indentation: {}",
+        deepest[5]
+    );
+    let free: Vec<f64> = rows.iter().filter(|r| r[4] == 0.0).map(|r| r[5]).collect();
+    assert!(
+        !free.is_empty() && free.iter().all(|&f| f < 0.0),
+        "DMT attracts in free flight"
+    );
+
+    let meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("timeseries.npy.json")).unwrap())
+            .unwrap();
+    let meaning = meta["columns"][5]["meaning"].as_str().unwrap();
+    assert!(meaning.contains(afmdyn::contact::FORCE_SIGN), "{meaning}");
+    assert!(afmdyn::contact::FORCE_SIGN.starts_with("positive when the sample pushes the tip away"));
+    let doc = include_str!("../../../docs/outputs.md");
+    let row = doc
+        .lines()
+        .find(|l| l.starts_with("| `contact_force` |"))
+        .unwrap();
+    assert!(row.contains("F_c > 0 pushes the tip away"), "{row}");
+    assert!(!row.contains("F_c < 0 pushes"), "{row}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -85,7 +85,7 @@ pub fn analysis<A>(
     py: Python<'_>,
     request: A,
     params: Params,
-    probe: Option<PathBuf>,
+    probe: Option<String>,
     progress: Option<&Bound<'_, PyAny>>,
     counted: bool,
 ) -> PyResult<Document<A::Output>>
@@ -94,7 +94,7 @@ where
     A::Output: Send + 'static,
 {
     let probe = probe
-        .map(|path| Probe::load(&path))
+        .map(|text| Probe::parse(&text, "probe"))
         .transpose()
         .map_err(probe_error)?;
     let model = Resolved { params, probe };
@@ -128,7 +128,7 @@ fn flatten(rows: impl IntoIterator<Item = DVector<f64>>) -> Vec<f64> {
 pub fn modes<'py>(
     py: Python<'py>,
     params: PyRef<'_, PyParams>,
-    probe: Option<PathBuf>,
+    probe: Option<String>,
 ) -> PyResult<Dict<'py>> {
     let doc = analysis(py, ModesRequest {}, params.inner, probe, None, false)?;
     let (free, contact) = doc.output;
@@ -261,11 +261,11 @@ pub fn simulate<'py>(
     steps_per_period: Option<usize>,
     tolerance: f64,
     progress: Option<Bound<'py, PyAny>>,
-    probe: Option<PathBuf>,
+    probe: Option<String>,
 ) -> PyResult<Dict<'py>> {
     let p = params.inner;
     let probe = probe
-        .map(|path| Probe::load(&path))
+        .map(|text| Probe::parse(&text, "probe"))
         .transpose()
         .map_err(probe_error)?;
     let request = SimulateRequest {
@@ -375,7 +375,7 @@ pub fn converge<'py>(
     steps_per_period: Option<usize>,
     tolerance: f64,
     progress: Option<Bound<'py, PyAny>>,
-    probe: Option<PathBuf>,
+    probe: Option<String>,
 ) -> PyResult<Dict<'py>> {
     let request = ConvergeRequest {
         max_modes,
@@ -677,7 +677,7 @@ pub fn attractors<'py>(
     steps_per_period: Option<usize>,
     tolerance: f64,
     progress: Option<Bound<'py, PyAny>>,
-    probe: Option<PathBuf>,
+    probe: Option<String>,
 ) -> PyResult<Dict<'py>> {
     let request = AttractorsRequest {
         samples,
@@ -733,7 +733,7 @@ pub fn global_continuation<'py>(
     steps_per_period: Option<usize>,
     tolerance: f64,
     progress: Option<Bound<'py, PyAny>>,
-    probe: Option<PathBuf>,
+    probe: Option<String>,
 ) -> PyResult<Dict<'py>> {
     let request = GlobalContinuationRequest {
         param: param.parse().map_err(value_error)?,
@@ -768,7 +768,7 @@ pub fn orbit<'py>(
     max_periods: Option<usize>,
     max_period: usize,
     progress: Option<Bound<'py, PyAny>>,
-    probe: Option<PathBuf>,
+    probe: Option<String>,
 ) -> PyResult<Dict<'py>> {
     let request = OrbitRequest {
         period,
@@ -824,7 +824,7 @@ pub fn continuation<'py>(
     max_periods: Option<usize>,
     max_period: usize,
     progress: Option<Bound<'py, PyAny>>,
-    probe: Option<PathBuf>,
+    probe: Option<String>,
 ) -> PyResult<Dict<'py>> {
     let base = params.inner;
     let param: SweepParam = param.parse().map_err(value_error)?;
@@ -927,7 +927,7 @@ pub fn lyapunov<'py>(
     periods: usize,
     blocks: usize,
     progress: Option<Bound<'py, PyAny>>,
-    probe: Option<PathBuf>,
+    probe: Option<String>,
 ) -> PyResult<Dict<'py>> {
     let request = LyapunovRequest {
         initial,
@@ -944,13 +944,52 @@ pub fn lyapunov<'py>(
     Ok(out.finish())
 }
 
-/// A probe file (SI units, `afmdyn … --probe FILE`): its dimensionless parameters and the
-/// `"si"` block of the command line's JSON (scales, calibration, drive, A₀, z_c).
+/// A probe (SI units, `afmdyn … --probe FILE`; its TOML text from [`probe_source`]): its
+/// dimensionless parameters and the `"si"` block of the command line's JSON (scales,
+/// calibration, drive, A₀, z_c).
 #[pyfunction]
-pub fn probe(path: std::path::PathBuf) -> PyResult<(PyParams, String)> {
-    let pr = afmdyn::probe::Probe::load(&path).map_err(probe_error)?;
+pub fn probe(text: &str) -> PyResult<(PyParams, String)> {
+    let pr = Probe::parse(text, "probe").map_err(probe_error)?;
     let si = report::si(&pr, &pr.params, &serde_json::json!({}));
     Ok((PyParams { inner: pr.params }, si.to_string()))
+}
+
+/// The TOML text of a probe given as Python's `probe=` takes it — a file's path (`str` or
+/// `os.PathLike`), TOML text (a `str` with a line break or `=`) or a `dict` of its sections —
+/// with `[cantilever].name` set from `cantilever` (the command line's `--cantilever`), checked:
+/// [`Probe::source_text`]. What the analyses then take as `probe`.
+///
+/// # Errors
+/// `ValueError` naming the source and every problem; `TypeError` for another type.
+#[pyfunction]
+#[pyo3(signature = (probe, cantilever=None))]
+pub fn probe_source(probe: &Bound<'_, PyAny>, cantilever: Option<String>) -> PyResult<String> {
+    use afmdyn::probe::ProbeSource;
+    let name = cantilever.as_deref();
+    let r = if let Ok(d) = probe.cast::<pyo3::types::PyDict>() {
+        let json: String = probe
+            .py()
+            .import("json")?
+            .call_method1("dumps", (d,))?
+            .extract()?;
+        let table: toml::Table = serde_json::from_str(&json).map_err(|e| {
+            value_error(format!(
+                "probe <table>: not a probe table ({e}): sections cantilever, tip, sample, \
+                 drive as dicts of numbers and strings"
+            ))
+        })?;
+        Probe::source_text(ProbeSource::Table(&table), name)
+    } else if let Ok(s) = probe.extract::<String>() {
+        Probe::source_text(ProbeSource::of_str(&s), name)
+    } else if let Ok(p) = probe.extract::<PathBuf>() {
+        Probe::source_text(ProbeSource::Path(&p), name)
+    } else {
+        return Err(pyo3::exceptions::PyTypeError::new_err(format!(
+            "probe: expected a path, TOML text or a dict, got {}",
+            probe.get_type().name()?
+        )));
+    };
+    r.map(|(text, _)| text).map_err(probe_error)
 }
 
 /// Observables of the steady state reached from `initial` (default: rest): the steady state is
@@ -970,7 +1009,7 @@ pub fn observe<'py>(
     max_periods: Option<usize>,
     max_period: usize,
     progress: Option<Bound<'py, PyAny>>,
-    probe: Option<PathBuf>,
+    probe: Option<String>,
 ) -> PyResult<Dict<'py>> {
     let request = ObserveRequest {
         periods,

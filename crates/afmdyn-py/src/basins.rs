@@ -7,7 +7,6 @@ use crate::params::PyParams;
 use afmdyn::request::{BasinArrays, BasinsRequest, SteadyRequest};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use std::path::PathBuf;
 
 /// A basin map over two coordinates of the initial state (see `afmdyn.basins`).
 #[pyfunction]
@@ -42,7 +41,7 @@ pub fn basins<'py>(
     tolerance: f64,
     threads: Option<usize>,
     progress: Option<Bound<'py, PyAny>>,
-    probe: Option<PathBuf>,
+    probe: Option<String>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let request = BasinsRequest {
         x: x.into(),

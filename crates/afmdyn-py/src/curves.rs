@@ -9,7 +9,6 @@ use crate::params::PyParams;
 use afmdyn::request::{ApproachRequest, CurveRequest, ResonanceRequest};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use std::path::PathBuf;
 
 /// The curve range and options of the keywords.
 fn curve(
@@ -49,7 +48,7 @@ pub fn approach<'py>(
     tolerance: f64,
     setpoint: Option<f64>,
     traces: Option<usize>,
-    probe: Option<PathBuf>,
+    probe: Option<String>,
     progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let request = ApproachRequest {
@@ -79,7 +78,7 @@ pub fn resonance<'py>(
     branches: bool,
     tolerance: f64,
     traces: Option<usize>,
-    probe: Option<PathBuf>,
+    probe: Option<String>,
     progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let request = ResonanceRequest {

@@ -35,6 +35,7 @@ fn _afmdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
         "SimulationError",
         m.py().get_type::<errors::SimulationError>(),
     )?;
+    m.add("FORCE_SIGN", afmdyn::contact::FORCE_SIGN)?;
     m.add_function(wrap_pyfunction!(analyses::modes, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::simulate, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::converge, m)?)?;
@@ -49,6 +50,7 @@ fn _afmdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(curves::approach, m)?)?;
     m.add_function(wrap_pyfunction!(curves::resonance, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::probe, m)?)?;
+    m.add_function(wrap_pyfunction!(analyses::probe_source, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::observe, m)?)?;
     m.add("POLL_SECONDS", run::POLL.as_secs_f64())?;
     m.add_function(wrap_pyfunction!(run::cancel_running, m)?)?;

@@ -158,12 +158,12 @@ pub fn params_from_kwargs(base: Params, kwargs: Option<&Bound<'_, PyDict>>) -> P
 pub fn resolve(
     params: Option<PyRef<'_, PyParams>>,
     default: Option<PyRef<'_, PyParams>>,
-    probe: Option<std::path::PathBuf>,
+    probe: Option<String>,
     model: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<PyParams> {
     let spec = model_spec(model)?;
     let probe = probe
-        .map(|p| afmdyn::probe::Probe::load(&p).map_err(crate::errors::probe_error))
+        .map(|t| afmdyn::probe::Probe::parse(&t, "probe").map_err(crate::errors::probe_error))
         .transpose()?;
     let base = match (&params, &probe) {
         (Some(given), Some(pr)) if given.inner != pr.params => {
@@ -255,15 +255,16 @@ impl PyParams {
 
     /// The dimensionless set of a probe file in SI units (the command line's
     /// ``--probe FILE``: cantilever k, f₀, Q or geometry; tip; sample law; drive A₀, f; see
-    /// ``docs/afm-workflow.md``); ``**model`` takes what a probe leaves open, as every
-    /// analysis' ``probe=`` does: ``modes``, ``restitution``, ``z_c`` (m) and
-    /// ``drive_frequency`` (Hz); a dimensionless value the probe sets (``gap``, ``omega``,
-    /// ``hamaker``, …) is refused naming the probe key or SI keyword to use. Raises
-    /// ``ValueError`` listing every problem of the file.
+    /// ``docs/afm-workflow.md``), also given as TOML text or a dict of its sections; ``**model``
+    /// takes what a probe leaves open, as every analysis' ``probe=`` does: ``modes``,
+    /// ``restitution``, ``z_c`` (m) and ``drive_frequency`` (Hz); a dimensionless value the
+    /// probe sets (``gap``, ``omega``, ``hamaker``, …) is refused naming the probe key or SI
+    /// keyword to use. Raises ``ValueError`` listing every problem of the file.
     #[staticmethod]
     #[pyo3(signature = (path, **model))]
-    fn from_probe(path: std::path::PathBuf, model: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
-        let pr = afmdyn::probe::Probe::load(&path).map_err(crate::errors::probe_error)?;
+    fn from_probe(path: &Bound<'_, PyAny>, model: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
+        let text = crate::analyses::probe_source(path, None)?;
+        let pr = afmdyn::probe::Probe::parse(&text, "probe").map_err(crate::errors::probe_error)?;
         Ok(PyParams {
             inner: model_spec(model)?
                 .resolve(Params::default(), Some(&pr))

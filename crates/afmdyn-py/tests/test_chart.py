@@ -242,3 +242,27 @@ def test_dask_bifurcation_stores_and_resumes_the_command_lines_sweep(client, cli
     xr.testing.assert_identical(again, ds)
     with pytest.raises(ValueError, match="steps = 40 in the interrupted run, 41 now"):
         afmdyn.dask.bifurcation(**{**kw, "steps": 41}, client=client, store=cut)
+
+
+def test_netcdf_files_open_with_the_packages_own_dependencies(cli, tmp_path):
+    """Issue 42 §4: after ``pip install afmdyn`` alone, ``xr.open_dataset("chart.nc")`` failed
+    (xarray needs SciPy or h5netcdf/netCDF4 for NetCDF). The package now requires SciPy, the
+    backend of NetCDF 3 files: its requirements outside every extra name it, and a chart.nc
+    the command line wrote opens with that backend, as does one Python writes."""
+    import importlib.metadata
+    import re
+
+    required = {
+        re.split(r"[\s<>=!~;\[]", r, maxsplit=1)[0].lower()
+        for r in importlib.metadata.requires("afmdyn") or []
+        if "extra ==" not in r
+    }
+    assert required & {"scipy", "h5netcdf", "netcdf4"}, sorted(required)
+    run = cli("chart", *FLAGS, "--out", tmp_path)
+    assert run.returncode == 0, run.stderr
+    nc = xr.open_dataset(tmp_path / "chart.nc", engine="scipy").load()
+    assert nc.sizes["x"] == 4 and nc.sizes["y"] == 2
+    ds = afmdyn.chart(**SMALL)
+    ds.to_netcdf(tmp_path / "python.nc", engine="scipy")
+    back = xr.open_dataset(tmp_path / "python.nc", engine="scipy").load()
+    np.testing.assert_array_equal(back.period.values, ds.period.values)

@@ -186,3 +186,44 @@ def test_a_probe_refuses_the_dimensionless_values_it_sets(tmp_path, keyword, val
     # what a probe leaves open: N (point mass: 1), z_c in m, the drive frequency in Hz
     p = afmdyn.Params.from_probe(probe, z_c=14.3e-9, drive_frequency=299e3, modes=1)
     assert p.omega == pytest.approx(299e3 / 300e3, rel=1e-12)
+
+
+def test_probe_as_text_or_dict_and_a_library_cantilever(cli_json, tmp_path):
+    """Issue 42 §4: ``approach(probe=…, cantilever="RTESPA-300")`` was refused (``unknown
+    model parameter 'cantilever'``) and ``probe=`` took a path only. ``cantilever=`` is
+    ``--cantilever`` (the library's cantilever fills the keys the probe leaves out), and the
+    probe may be TOML text or a dict of its sections: the library's ``Probe::source_text``
+    gives every form the same parameters and SI block as the file."""
+    import tomllib
+
+    text = PM.read_text()
+    table = tomllib.loads(text)
+    by_path = afmdyn.probe(PM)
+    assert afmdyn.probe(text) == by_path
+    assert afmdyn.probe(table) == by_path
+    assert afmdyn.Params.from_probe(table) == by_path["params"]
+    o = afmdyn.orbit(probe=table, z_c=8e-9).to_dict()
+    assert o == afmdyn.orbit(probe=str(PM), z_c=8e-9).to_dict()
+
+    # the probe without its calibration: RTESPA-300 from the library supplies k, f0 and Q
+    bare = {k: v for k, v in table.items() if k != "cantilever"}
+    f = tmp_path / "bare.toml"
+    f.write_text("\n".join(line for line in text.splitlines()
+                           if not line.startswith(("[cantilever]", "spring_constant",
+                                                   "resonance_frequency", "quality_factor"))))
+    want = cli_json("units", "--probe", f, "--cantilever", "RTESPA-300")
+    got = afmdyn.probe(bare, cantilever="RTESPA-300")
+    assert got["si"] == want["si"]
+    row = afmdyn.cantilevers().loc["RTESPA-300"]
+    cal = got["si"]["calibration"]
+    for key in ("spring_constant", "resonance_frequency", "quality_factor"):
+        assert cal[key] == row[key], key
+    assert cal["quality_factor"] != table["cantilever"]["quality_factor"]
+    ds = afmdyn.approach(probe=bare, cantilever="RTESPA-300", points=8)
+    import json
+
+    assert json.loads(ds.attrs["summary"])["si"]["calibration"] == cal
+    with pytest.raises(ValueError, match="cantilever"):
+        afmdyn.approach(probe=bare, cantilever="NO-SUCH-LEVER", points=8)
+    with pytest.raises(ValueError, match="needs probe"):
+        afmdyn.orbit(cantilever="RTESPA-300")

@@ -87,10 +87,14 @@ def test_eq8_and_the_contact_force_hold_on_the_samples():
     np.testing.assert_allclose(ds.v_t.values, v_t, rtol=0, atol=1e-14)
     v_dot = ds.w_tip_dot.values + p.alpha2 * p.omega * np.cos(p.omega * tau)
     np.testing.assert_allclose(ds.v_t_dot.values, v_dot, rtol=0, atol=1e-13)
-    # the paper's linear law, |F_c| = |α4 V_T + α6 dV_T/dτ| in contact, 0 off the sample (the
-    # sign is the library's convention)
-    force = np.where(ds.in_contact, p.alpha4 * ds.v_t + p.alpha6 * ds.v_t_dot, 0.0)
-    np.testing.assert_allclose(np.abs(ds.contact_force.values), np.abs(force), atol=1e-12)
+    # the paper's linear law, F_c = α4 δ + α6 δ̇ with δ = −V_T in contact, 0 off the sample:
+    # repulsive positive, as the variable's sign_convention says (issue 42 §4)
+    force = np.where(ds.in_contact, -(p.alpha4 * ds.v_t + p.alpha6 * ds.v_t_dot), 0.0)
+    np.testing.assert_allclose(ds.contact_force.values, force, atol=1e-12)
+    assert ds.contact_force.attrs["sign_convention"].startswith(
+        "positive when the sample pushes the tip away"
+    )
+    assert ds.contact_force.values[np.argmin(ds.v_t.values)] > 0
     assert ds.in_contact.any() and not ds.in_contact.all()
     # energy balance per period (exact propagation): residual at round-off
     assert np.abs(ds.energy_residual).max() < 1e-10

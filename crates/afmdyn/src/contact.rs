@@ -27,6 +27,14 @@
 //!   90 (1983) 129; Nordmark, *J. Sound Vib.* 145 (1991) 279). No force acts in free flight; the
 //!   impulse and the sticking phase are handled by the model ([`crate::model`]).
 
+/// The sign convention of every tip–sample force afmdyn outputs (the `contact_force` column of
+/// `simulate`, the approach's `peak_force`, `min_force`, `max_abs_force` and force traces,
+/// Python's `contact_force`): F_c is the force the sample exerts on the tip along the outward
+/// normal of the sample, the law's F_c(δ, δ̇) with δ = −V_T.
+pub const FORCE_SIGN: &str = "positive when the sample pushes the tip away (repulsion, e.g. at \
+    the deepest indentation), negative when it pulls the tip towards it (attraction, e.g. DMT's \
+    van der Waals force in free flight)";
+
 use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::str::FromStr;

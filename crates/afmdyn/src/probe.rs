@@ -185,8 +185,9 @@ pub struct Calibration {
     pub quality_factors: Option<Vec<f64>>,
     /// α1, tip-mass ratio of the beam (0 for the point mass).
     pub tip_mass_ratio: f64,
-    /// The static stiffness 3EI/L³ (N/m) of the beam (for comparison with k; 0 for the point
-    /// mass).
+    /// The static stiffness (N/m): the beam's 3EI/L³ (from the geometry, or from a calibrated
+    /// k as 3k/k̃₁, k̃₁ the Galerkin beam's modal stiffness at the tip in EI/L³; for comparison
+    /// with k), the point mass's its spring k.
     pub static_spring_constant: f64,
 }
 
@@ -419,6 +420,85 @@ struct Sample {
     damping: Option<f64>,
     restitution: Option<f64>,
     z_c: Option<f64>,
+}
+
+/// A probe as a front end receives it: a file (the command line's `--probe FILE`, Python's
+/// `probe=path`), TOML text (`probe="[cantilever]\n…"`) or its table (Python's `probe={…}`).
+#[derive(Debug, Clone, Copy)]
+pub enum ProbeSource<'a> {
+    /// A probe file.
+    #[cfg(feature = "files")]
+    Path(&'a Path),
+    /// TOML text.
+    Text(&'a str),
+    /// A parsed TOML table (the sections `cantilever`, `tip`, `sample`, `drive` as tables).
+    Table(&'a toml::Table),
+}
+
+impl<'a> ProbeSource<'a> {
+    /// A front end's string argument: TOML text when it holds a line break or `=` (a key =
+    /// value line; no probe text is without one), else the path of a probe file.
+    #[cfg(feature = "files")]
+    pub fn of_str(s: &'a str) -> Self {
+        if s.contains(['\n', '=']) {
+            ProbeSource::Text(s)
+        } else {
+            ProbeSource::Path(Path::new(s))
+        }
+    }
+
+    /// How errors name the source: the path, `<string>` or `<table>`.
+    pub fn origin(&self) -> String {
+        match self {
+            #[cfg(feature = "files")]
+            ProbeSource::Path(p) => p.display().to_string(),
+            ProbeSource::Text(_) => "<string>".into(),
+            ProbeSource::Table(_) => "<table>".into(),
+        }
+    }
+}
+
+impl Probe {
+    /// The TOML text of the probe `source` with `[cantilever].name` set to `cantilever` when
+    /// given (the command line's `--cantilever NAME`, Python's `cantilever=`, which win over a
+    /// name in the probe: [`crate::cantilevers::with_name`]), checked by resolving it, so that
+    /// every later [`Probe::parse`] of the text succeeds; with the resolved probe.
+    ///
+    /// # Errors
+    /// [`ProbeError::Io`] for a file that cannot be read; as [`Probe::parse`], naming the
+    /// source ([`ProbeSource::origin`]); [`ProbeError::Invalid`] for a cantilever name that is
+    /// not in the library or a `cantilever` key that is not a table.
+    pub fn source_text(
+        source: ProbeSource<'_>,
+        cantilever: Option<&str>,
+    ) -> Result<(String, Probe), ProbeError> {
+        let origin = source.origin();
+        let text = match source {
+            #[cfg(feature = "files")]
+            ProbeSource::Path(path) => {
+                std::fs::read_to_string(path).map_err(|e| ProbeError::Io {
+                    path: origin.clone(),
+                    message: e.to_string(),
+                })?
+            }
+            ProbeSource::Text(t) => t.to_string(),
+            ProbeSource::Table(t) => toml::to_string(t).map_err(|e| ProbeError::Syntax {
+                path: origin.clone(),
+                message: e.to_string(),
+            })?,
+        };
+        let text = match cantilever {
+            None => text,
+            Some(name) => crate::cantilevers::with_name(&text, name).map_err(|message| {
+                ProbeError::Syntax {
+                    path: origin.clone(),
+                    message,
+                }
+            })?,
+        };
+        let probe = Self::parse(&text, &origin)?;
+        Ok((text, probe))
+    }
 }
 
 impl Probe {
@@ -879,6 +959,14 @@ impl Probe {
                 .map_err(|e| e.to_string())?;
                 (bk1 * unit, bw1 / (TAU * ts), 3.0 * unit)
             }
+        };
+        // the static stiffness: the point mass's is its spring k; the beam's 3EI/L³, from the
+        // geometry or from a calibrated k through the modal stiffness k = k̃₁ EI/L³ (issue 42:
+        // it was reported as 0 whenever k was given)
+        let static_k = match structure {
+            Structure::PointMass => k,
+            Structure::Beam if geometry.is_ok() => static_k,
+            Structure::Beam => 3.0 * k / k1,
         };
         let time_s = w1 / (TAU * f0);
         let force_n = k * g0 / k1;

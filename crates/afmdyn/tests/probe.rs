@@ -547,3 +547,32 @@ fn series_units_are_the_probe_scales() {
     assert_eq!((plain.t(2.0), plain.x(3.0), plain.v(4.0)), (2.0, 3.0, 4.0));
     assert_eq!((plain.names().time, plain.names().force), ("tau", "k g0"));
 }
+
+/// Issue 42 §4: `static_spring_constant` was 0 for every probe given by its calibrated k (the
+/// point mass's included). The point mass's static stiffness is its spring k; a calibrated
+/// beam's is 3EI/L³ = 3k/k̃₁, which for the bare beam (α1 = 0, k̃₁ = β₁⁴/4 with β₁ = 1.8751…,
+/// the clamped–free root; Meirovitch §7.4) is k · 12/β₁⁴ (the modal stiffness 3 % above it).
+#[test]
+fn static_spring_constant_is_reported_for_every_probe() {
+    let pm = Probe::parse(POINT_MASS_DMT, "test").unwrap();
+    assert_eq!(pm.calibration.static_spring_constant, 40.0);
+    let text = r#"model = "beam"
+modes = 4
+[cantilever]
+spring_constant = 2.0
+resonance_frequency = 70e3
+quality_factor = 150
+tip_mass_ratio = 0.0
+[sample]
+law = "linear"
+stiffness = 5.0
+[drive]
+free_amplitude = 20e-9
+"#;
+    let beam = Probe::parse(text, "test").unwrap();
+    let b1 = afmdyn::beam::beta_root(1);
+    let want = 2.0 * 12.0 / b1.powi(4);
+    let got = beam.calibration.static_spring_constant;
+    // the 4-mode Galerkin beam's first mode is the exact one: k̃₁ = β₁⁴/4 to round-off
+    assert!(rel(got, want) < 1e-9, "static k = {got}, 3EI/L³ = {want}");
+}

@@ -827,3 +827,63 @@ fn stint_transitions_equal_the_product_of_step_jacobians() {
         }
     }
 }
+
+/// Issue 42 §4: the impact law at r = 0.8 and the default Ω = 2.6 settles on a chaotic
+/// attractor, and `orbit` at defaults once failed on it (undamped-from-one-start Newton:
+/// "did not converge: residual 0.17 after 40 iterations"). The orbit search must reach the
+/// unstable period-1 orbit embedded in it: F(z) = P(z) − z below the Newton tolerance, |μ| > 1,
+/// and the multipliers those of a central finite-difference Jacobian of the stroboscopic map
+/// (the map is smooth near the orbit: the same switchings at every perturbed start).
+#[test]
+fn orbit_request_finds_the_unstable_period_1_orbit_of_a_chaotic_impact_attractor() {
+    use afmdyn::analysis::shooting::floquet_multipliers;
+    use afmdyn::request::analyses::OrbitRequest;
+    let p = Params {
+        contact_law: ContactLaw::Impact { restitution: 0.8 },
+        ..Params::default()
+    };
+    let m = model(p);
+    // the start is chaotic: no period up to 64 after the default transient
+    let (_, found) = OrbitRequest::default().start.guess(&m).unwrap();
+    assert_eq!(
+        found, None,
+        "the attractor must be nonperiodic for this test"
+    );
+
+    let o = OrbitRequest::default().run(&p).unwrap();
+    assert_eq!(o.period, 1);
+    let mut it = build(&m, IntegratorOptions::default(), 0.0, &m.rest()).unwrap();
+    let map = stroboscopic(it.as_mut(), &o.state, 1).unwrap();
+    let tol = ShootingOptions::default().tol;
+    let res = (&map.state - &o.state).norm();
+    assert!(res <= tol * (1.0 + o.state.norm()), "‖P(z) − z‖ = {res:e}");
+    assert!(!o.stable);
+    assert!(o.multipliers[0].norm() > 1.0, "{:?}", o.multipliers[0]);
+
+    let h = 1e-7;
+    let dim = o.state.len();
+    let mut fd = DMatrix::zeros(dim, dim);
+    for j in 0..dim {
+        let (mut zp, mut zm) = (o.state.clone(), o.state.clone());
+        zp[j] += h;
+        zm[j] -= h;
+        let a = stroboscopic(it.as_mut(), &zp, 1).unwrap();
+        let b = stroboscopic(it.as_mut(), &zm, 1).unwrap();
+        assert_eq!(
+            (a.switchings, b.switchings),
+            (map.switchings, map.switchings)
+        );
+        fd.set_column(j, &((a.state - b.state) / (2.0 * h)));
+    }
+    let err = (&fd - &o.monodromy).amax() / o.monodromy.amax();
+    assert!(
+        err < 1e-5,
+        "monodromy against finite differences: relative error {err:e}"
+    );
+    let mu_fd = floquet_multipliers(&fd);
+    let (big, big_fd) = (o.multipliers[0], mu_fd[0]);
+    assert!(
+        (big - big_fd).norm() < 1e-5 * big.norm(),
+        "critical multiplier {big} against {big_fd} from finite differences"
+    );
+}

@@ -13,6 +13,8 @@ def cancel_running() -> None: ...
 #: (name, alias or name, unit, range, help).
 MODEL_PARAMETERS: List[Tuple[str, str, str, str, str]]
 
+FORCE_SIGN: str
+
 class SimulationError(RuntimeError):
     """A computation failed (chattering, divergence, Newton not converging, integrator
     failure); bad input raises ``ValueError`` instead."""
@@ -80,7 +82,7 @@ class Params:
         """Read a model config file (``--config FILE.toml`` of the command line); ``**model``
         overrides it."""
     @staticmethod
-    def from_probe(path: Union[str, "os.PathLike[str]"], **model: Any) -> "Params":
+    def from_probe(path: Union[str, "os.PathLike[str]", Dict[str, Any]], **model: Any) -> "Params":
         """The dimensionless set of a probe file in SI units (``--probe FILE``); ``**model``
         takes ``modes``, ``restitution``, ``z_c`` (m) and ``drive_frequency`` (Hz); a
         dimensionless keyword of a value the probe sets (``gap``, ``omega``, ``hamaker``, …)
@@ -246,7 +248,10 @@ def lyapunov(
     progress: Optional[ProgressCallback] = None,
     probe: Optional[str] = None,
 ) -> Dict[str, Any]: ...
-def probe(path: Union[str, "os.PathLike[str]"]) -> Tuple[Params, str]: ...
+def probe(text: str) -> Tuple[Params, str]: ...
+def probe_source(
+    probe: Union[str, "os.PathLike[str]", Dict[str, Any]], cantilever: Optional[str] = None
+) -> str: ...
 def resolve(
     params: Optional[Params] = None,
     default: Optional[Params] = None,

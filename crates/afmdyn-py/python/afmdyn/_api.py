@@ -52,13 +52,16 @@ StateLike = Union[None, Sequence[float], np.ndarray, Attractor, Orbit]
 
 class Model(TypedDict, total=False):
     """The model keywords every analysis takes (see :class:`Params` for their ranges; the one
-    table of them is ``afmdyn._afmdyn.MODEL_PARAMETERS``). ``probe`` is a probe file in SI (the
-    command line's ``--probe``): it sets every parameter in SI, ``z_c`` (m) and
-    ``drive_frequency`` (Hz) set α5 and Ω through its scales, ``modes`` and ``restitution`` are
-    taken, and the dimensionless keywords of the values it sets (``gap``, ``omega``, the α's,
-    ``hamaker``, ``intermolecular_distance``, ``contact_law``) raise ``ValueError`` naming the
-    probe key or SI keyword to use; the result's ``to_dict()`` then carries the command line's
-    ``"si"`` block."""
+    table of them is ``afmdyn._afmdyn.MODEL_PARAMETERS``). ``probe`` is a probe in SI (the
+    command line's ``--probe``): a file's path, its TOML text (a ``str`` with a line break or
+    ``=``) or a dict of its sections (``{"cantilever": {...}, "sample": {...}, ...}``); it sets
+    every parameter in SI, ``z_c`` (m) and ``drive_frequency`` (Hz) set α5 and Ω through its
+    scales, ``modes`` and ``restitution`` are taken, and the dimensionless keywords of the
+    values it sets (``gap``, ``omega``, the α's, ``hamaker``, ``intermolecular_distance``,
+    ``contact_law``) raise ``ValueError`` naming the probe key or SI keyword to use; the
+    result's ``to_dict()`` then carries the command line's ``"si"`` block. ``cantilever`` names
+    a cantilever of the library (:func:`afmdyn.cantilevers`) for the probe, as
+    ``--cantilever`` does: it fills the keys the probe leaves out and wins over a name in it."""
 
     modes: int
     tip_mass_ratio: float
@@ -80,7 +83,8 @@ class Model(TypedDict, total=False):
     intermolecular_distance: float
     z_c: float
     drive_frequency: float
-    probe: Union[str, "os.PathLike[str]"]
+    probe: Union[str, "os.PathLike[str]", Dict[str, Any]]
+    cantilever: str
 
 
 #: Global attributes of every dataset: the scales of the dimensionless units.
@@ -104,10 +108,24 @@ def _params(
     if params is not None and not isinstance(params, Params):
         raise TypeError(f"params: expected afmdyn.Params or None, got {type(params).__name__}")
     model = dict(model)
-    probe = model.pop("probe", None)
-    if probe is not None:
-        probe = os.fspath(probe)
+    probe = _probe_text(model)
     return _core.resolve(params, default, probe, model), probe
+
+
+def _probe_text(model: Dict[str, Any]) -> Optional[str]:
+    """Pop ``probe`` and ``cantilever`` from the model keywords: the probe's TOML text with the
+    cantilever's name set (the library's ``Probe::source_text``), checked, or ``None``."""
+    probe = model.pop("probe", None)
+    cantilever = model.pop("cantilever", None)
+    if cantilever is not None and not isinstance(cantilever, str):
+        raise TypeError(f"cantilever: expected a name (str), got {type(cantilever).__name__}")
+    if probe is None:
+        if cantilever is not None:
+            raise ValueError("cantilever needs probe= (as --cantilever needs --probe)")
+        return None
+    if not isinstance(probe, (str, dict)):
+        probe = os.fspath(probe)
+    return _core.probe_source(probe, cantilever)
 
 
 def _state(initial: StateLike) -> Optional[list]:
@@ -335,7 +353,11 @@ def simulate(
             "contact_force": (
                 time,
                 d["contact_force"],
-                {"units": force, "long_name": "tip–sample contact force"},
+                {
+                    "units": force,
+                    "long_name": "tip–sample force F_c on the tip (> 0 repulsive)",
+                    "sign_convention": _core.FORCE_SIGN,
+                },
             ),
             "a": ((time, "mode"), d["a"], {**_g, "long_name": "modal displacement a_i"}),
             "a_dot": ((time, "mode"), d["a_dot"], {**_v, "long_name": "modal velocity da_i/dτ"}),
@@ -908,9 +930,12 @@ def lyapunov(
     )
 
 
-def probe(path: Union[str, "os.PathLike[str]"]) -> Dict[str, Any]:
-    """Read a probe file in SI units (the command line's ``--probe FILE``; format and mapping in
-    ``docs/afm-workflow.md``).
+def probe(
+    path: Union[str, "os.PathLike[str]", Dict[str, Any]], cantilever: Optional[str] = None
+) -> Dict[str, Any]:
+    """Read a probe in SI units (the command line's ``--probe FILE``; format and mapping in
+    ``docs/afm-workflow.md``): a file's path, its TOML text or a dict of its sections, with
+    ``cantilever`` as ``--cantilever``.
 
     Returns:
         ``{"params": Params, "si": dict}``: the dimensionless set, and the ``"si"`` block of the
@@ -919,7 +944,7 @@ def probe(path: Union[str, "os.PathLike[str]"]) -> Dict[str, Any]:
         period in s, ``free_amplitude_m`` and ``z_c_m``. Raises ``ValueError`` listing every
         problem of the file.
     """
-    p, si = _core.probe(path)
+    p, si = _core.probe(_probe_text({"probe": path, "cantilever": cantilever}))
     return {"params": p, "si": json.loads(si)}
 
 

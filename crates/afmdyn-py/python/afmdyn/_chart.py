@@ -14,7 +14,7 @@ import xarray as xr
 
 from . import _afmdyn as _core
 from ._afmdyn import Params
-from ._api import Model, _typed, _warn
+from ._api import Model, _probe_text, _typed, _warn
 from ._progress import ProgressArg, reporter
 
 if TYPE_CHECKING:
@@ -56,14 +56,7 @@ def study(
     if params is not None and not isinstance(params, Params):
         raise TypeError(f"params: expected afmdyn.Params or None, got {type(params).__name__}")
     model = dict(model)
-    probe = model.pop("probe", None)
-    text = None
-    if probe is not None:
-        try:
-            with open(os.fspath(probe), encoding="utf-8") as f:
-                text = f.read()
-        except OSError as e:
-            raise ValueError(f"probe {os.fspath(probe)}: cannot read it: {e.strerror}") from None
+    text = _probe_text(model)
     for k in ("x_steps", "y_steps", "starts", "seed", "tile", "lyapunov_periods",
               "max_attractors", "threads", "max_periods", "max_period"):
         v = request.get(k)

@@ -19,8 +19,8 @@ COLUMNS: Dict[str, tuple] = {
     "amplitude_ratio": (None, "A/A0 (A0 the free amplitude at the same drive)"),
     "phase_deg": ("phase", "phase lag of the deflection behind the drive"),
     "mean_deflection": ("length", "mean deflection <W>"),
-    "peak_force": ("force", "largest tip-sample force (repulsive > 0)"),
-    "min_force": ("force", "smallest tip-sample force (largest attraction when < 0)"),
+    "peak_force": ("force", "largest tip-sample force F_c: the repulsive maximum (F_c > 0 pushes the tip away)"),
+    "min_force": ("force", "smallest tip-sample force F_c: the adhesion minimum (F_c < 0 pulls the tip)"),
     "indentation": ("length", "largest indentation max(-V_T, 0)"),
     "contact_fraction": (None, "fraction of the time in contact (V_T <= 0)"),
     "min_distance": ("length", "minimum tip-sample distance"),
@@ -153,7 +153,7 @@ def curve_dataset(command: str, doc: Dict[str, Any]) -> xr.Dataset:
         for var, k, long_name in (
             ("deflection", "length", "tip deflection W(1,tau)"),
             ("distance", "length", "tip-sample distance V_T (<= 0 in contact)"),
-            ("force", "force", "tip-sample force"),
+            ("force", "force", "tip-sample force F_c (> 0 repulsive, < 0 attractive)"),
         ):
             values = np.array(traces[var], dtype=np.float64).reshape(
                 len(traces[x]), len(traces["time_periods"])

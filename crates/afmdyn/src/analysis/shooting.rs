@@ -111,6 +111,102 @@ pub fn shoot_with(
     finish(integ, z, n, map, residuals)
 }
 
+/// [`shoot_with`] globalised: each Newton step is backtracked by a line search on ½‖F‖²
+/// with Armijo's sufficient-decrease condition ([`LINE_SEARCH_MIN_STEP`]; Dennis & Schnabel,
+/// *Numerical Methods for Unconstrained Optimization and Nonlinear Equations*, SIAM 1996,
+/// §6.3 and Algorithm A6.3.1), so that a guess farther from the orbit than Newton's basin of
+/// quadratic convergence — a point of a chaotic attractor near one of its unstable periodic
+/// orbits — still reaches it where ‖F‖ decreases towards it. Steps that the map accepts whole
+/// are [`shoot_with`]'s.
+///
+/// # Errors
+/// [`SimError::NoConvergence`] when the line search stalls or after `opts.max_iter`
+/// iterations; [`SimError`] from the propagator.
+pub fn shoot_globalised(
+    integ: &mut dyn Integrator,
+    guess: &DVector<f64>,
+    n: usize,
+    opts: &ShootingOptions,
+) -> Result<PeriodicOrbit, SimError> {
+    let (z, map, residuals) = newton(integ, guess, n, opts, Damping::LineSearch)?;
+    finish(integ, z, n, map, residuals)
+}
+
+/// How many section points of an attractor [`shoot_from_section`] tries as starts at most.
+pub const SECTION_STARTS: usize = 16;
+
+/// A period-n orbit near a recorded stretch of an attractor's stroboscopic section
+/// (`section[k]` = z(kT) of consecutive drive periods, e.g. the points a nonperiodic
+/// [`super::steady::SteadyState`] recorded): the points whose n-period return
+/// ‖z_{k+n} − z_k‖ is smallest (close returns: a chaotic orbit shadows the unstable periodic
+/// orbits embedded in it, and passes close to a period-n one where it nearly repeats after n
+/// periods; Auerbach, Cvitanović, Eckmann, Gunaratne & Procaccia, *Phys. Rev. Lett.* 58 (1987)
+/// 2387; Lathrop & Kostelich, *Phys. Rev. A* 40 (1989) 4028), up to [`SECTION_STARTS`] of them
+/// in increasing order of that return, each start polished by [`shoot_globalised`]; the first
+/// orbit reached is returned.
+///
+/// # Errors
+/// [`SimError::OutOfRange`] when `section` has fewer than n + 1 points or n = 0;
+/// [`SimError::NoConvergence`] (the smallest residual reached) when no start converges;
+/// [`SimError::Cancelled`] and the propagator's errors other than a failed start.
+pub fn shoot_from_section(
+    integ: &mut dyn Integrator,
+    section: &[DVector<f64>],
+    n: usize,
+    opts: &ShootingOptions,
+) -> Result<PeriodicOrbit, SimError> {
+    if n == 0 || section.len() <= n {
+        return Err(SimError::out_of_range(
+            "section points",
+            section.len(),
+            "must exceed the period n >= 1",
+        ));
+    }
+    let mut returns: Vec<(f64, usize)> = (0..section.len() - n)
+        .map(|k| ((&section[k + n] - &section[k]).norm(), k))
+        .filter(|(r, _)| r.is_finite())
+        .collect();
+    returns.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut best: Option<SimError> = None;
+    for &(_, k) in returns.iter().take(SECTION_STARTS) {
+        match shoot_globalised(integ, &section[k], n, opts) {
+            Ok(orbit) => return Ok(orbit),
+            Err(SimError::Cancelled) => return Err(SimError::Cancelled),
+            Err(e) => {
+                let better = match (&e, &best) {
+                    (_, None) => true,
+                    (
+                        SimError::NoConvergence { residual: a, .. },
+                        Some(SimError::NoConvergence { residual: b, .. }),
+                    ) => a < b,
+                    (SimError::NoConvergence { .. }, Some(_)) => true,
+                    _ => false,
+                };
+                if better {
+                    best = Some(e);
+                }
+            }
+        }
+    }
+    Err(match best {
+        Some(SimError::NoConvergence {
+            iterations,
+            residual,
+            ..
+        }) => SimError::NoConvergence {
+            what: "shooting from the closest returns of the attractor's section points",
+            iterations,
+            residual,
+        },
+        Some(e) => e,
+        None => SimError::NoConvergence {
+            what: "shooting from the attractor's section points (none finite)",
+            iterations: 0,
+            residual: f64::NAN,
+        },
+    })
+}
+
 /// A period-n orbit from [`shoot_undamped`]: what a stepped sweep keeps of it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ShotOrbit {
@@ -283,6 +379,63 @@ enum Damping {
     Halve,
     /// Stop: the solve fails.
     Stop,
+    /// Backtrack along the Newton direction until f = ½‖F‖² decreases sufficiently (Armijo),
+    /// see [`line_search`]; the solve fails when the step falls below [`LINE_SEARCH_MIN_STEP`].
+    LineSearch,
+}
+
+/// Armijo's constant c in f(z + λp) ≤ f(z) + c λ ∇fᵀp (Dennis & Schnabel, *Numerical Methods
+/// for Unconstrained Optimization and Nonlinear Equations*, SIAM 1996, §6.3.1: α = 1e-4).
+const ARMIJO: f64 = 1e-4;
+
+/// The smallest step fraction λ [`line_search`] tries: below it the Newton direction no longer
+/// lowers ‖F‖ (a local minimum of ‖F‖ that is not a zero, or a kink of the map at a switching)
+/// and the solve fails.
+pub const LINE_SEARCH_MIN_STEP: f64 = 1e-8;
+
+/// A backtracking line search for Newton's step `delta` from `z` (residual `res` = ‖F(z)‖) on
+/// the merit function f = ½‖F‖²: the first λ = 1, ρ₁λ, … with f(z + λδ) ≤ f(z) + c λ ∇fᵀδ,
+/// where ∇fᵀδ = Fᵀ(M − I)δ = −‖F‖² for the Newton direction (a descent direction of f), each
+/// backtrack the minimiser of the quadratic through f(z), its slope and f(z + λδ), safeguarded
+/// to [0.1 λ, 0.5 λ] (Dennis & Schnabel 1996, Algorithm A6.3.1; Nocedal & Wright, *Numerical
+/// Optimization*, 2nd ed., Springer 2006, §3.5 and §11.2). A trial the map cannot start from
+/// (e.g. inside a rigid sample) is a failed trial. `Ok(None)` when λ falls below
+/// [`LINE_SEARCH_MIN_STEP`].
+fn line_search(
+    integ: &mut dyn Integrator,
+    z: &DVector<f64>,
+    delta: &DVector<f64>,
+    res: f64,
+    n: usize,
+) -> Result<Option<(DVector<f64>, FlowMap, f64)>, SimError> {
+    let f0 = 0.5 * res * res;
+    let slope = -res * res;
+    let mut lambda = 1.0_f64;
+    while lambda >= LINE_SEARCH_MIN_STEP {
+        let trial = z + delta * lambda;
+        let f_trial = match stroboscopic_unwatched(integ, &trial, n) {
+            Ok(tmap) => {
+                let tres = (&tmap.state - &trial).norm();
+                let f1 = 0.5 * tres * tres;
+                if f1 <= f0 + ARMIJO * lambda * slope {
+                    return Ok(Some((trial, tmap, tres)));
+                }
+                f1
+            }
+            Err(SimError::Cancelled) => return Err(SimError::Cancelled),
+            Err(_) => f64::NAN,
+        };
+        // the quadratic q(t) = f0 + slope t + (f_trial − f0 − slope λ) t²/λ² has its minimum at
+        // −slope λ² / (2 (f_trial − f0 − slope λ)); a NaN trial halves
+        let curv = f_trial - f0 - slope * lambda;
+        let next = if curv.is_finite() && curv > 0.0 {
+            -slope * lambda * lambda / (2.0 * curv)
+        } else {
+            0.5 * lambda
+        };
+        lambda = next.clamp(0.1 * lambda, 0.5 * lambda);
+    }
+    Ok(None)
 }
 
 /// The Newton iteration of [`shoot_with`] and [`shoot_undamped`]: the converged z, its map
@@ -319,6 +472,24 @@ fn newton(
                 iterations: residuals.len(),
                 residual: res,
             })?;
+        if damping == Damping::LineSearch {
+            match line_search(integ, &z, &delta, res, n)? {
+                Some((trial, tmap, tres)) => {
+                    z = trial;
+                    map = tmap;
+                    res = tres;
+                    continue;
+                }
+                None => {
+                    return Err(SimError::NoConvergence {
+                        what: "shooting (the line search found no decrease of the residual \
+                               along the Newton direction)",
+                        iterations: residuals.len(),
+                        residual: res,
+                    })
+                }
+            }
+        }
         // damped Newton: halve the step while the residual grows
         let mut lambda = 1.0;
         loop {

@@ -21,7 +21,9 @@ use crate::analysis::lyapunov::{lyapunov_spectrum_with, LyapunovOptions, Lyapuno
 use crate::analysis::observables::{observe_from, ObservableOptions, Observables};
 use crate::analysis::period::MAX_PERIOD;
 use crate::analysis::progress::Progress;
-use crate::analysis::shooting::{shoot, PeriodicOrbit, ShootingOptions};
+use crate::analysis::shooting::{
+    shoot, shoot_from_section, shoot_globalised, PeriodicOrbit, ShootingOptions,
+};
 use crate::analysis::steady::{default_transient_cap, steady_state, SteadyOptions};
 use crate::error::SimError;
 use crate::integrate::{build, IntegratorKind, IntegratorOptions};
@@ -159,6 +161,10 @@ pub fn initial_state(
     model.state_from(&z[..n], &z[n..])
 }
 
+/// [`StartRequest::guess_with_section`]: the guess, the period found, the recorded section
+/// points (each of shape `[2N]`).
+pub type GuessWithSection = (DVector<f64>, Option<usize>, Vec<DVector<f64>>);
+
 /// Where an orbit analysis starts: a given state, or the steady state reached from rest.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
@@ -180,14 +186,29 @@ impl StartRequest {
         &self,
         model: &CantileverModel,
     ) -> Result<(DVector<f64>, Option<usize>), SimError> {
+        let (z, found, _) = self.guess_with_section(model)?;
+        Ok((z, found))
+    }
+
+    /// [`Self::guess`] with the section points the steady-state search recorded (z(kT) of
+    /// consecutive drive periods, the last one the guess; empty for a given `initial`): the
+    /// starts of [`shoot_from_section`] when Newton from the guess fails.
+    ///
+    /// # Errors
+    /// As [`Self::guess`].
+    pub fn guess_with_section(
+        &self,
+        model: &CantileverModel,
+    ) -> Result<GuessWithSection, SimError> {
         let steady = self.steady.options()?;
         let z0 = initial_state(model, self.initial.as_deref())?;
         if self.initial.is_some() {
-            return Ok((z0, None));
+            return Ok((z0, None, Vec::new()));
         }
         let mut integ = build(model, IntegratorOptions::default(), 0.0, &z0)?;
         let s = steady_state(integ.as_mut(), &steady)?;
-        Ok((s.end_state().clone(), s.period()))
+        let section = s.poincare.iter().map(|p| p.state.clone()).collect();
+        Ok((s.end_state().clone(), s.period(), section))
     }
 }
 
@@ -222,20 +243,35 @@ impl OrbitRequest {
         self.start.steady.options().map(|_| ())
     }
 
-    /// The orbit of `params`.
+    /// The orbit of `params`: Newton shooting ([`shoot`]) from the guess; when that fails to
+    /// converge, the globalised Newton ([`shoot_globalised`]: a line search on ½‖F‖²) from the
+    /// guess, then from the closest returns among the section points the steady-state search
+    /// recorded ([`shoot_from_section`]) — so that a chaotic attractor yields an unstable
+    /// periodic orbit embedded in it.
     ///
     /// # Errors
-    /// As [`Self::validate`], [`StartRequest::guess`] and [`shoot`].
+    /// As [`Self::validate`], [`StartRequest::guess`] and [`shoot`]; the
+    /// [`SimError::NoConvergence`] of the last search tried when none converges.
     pub fn run(&self, params: &Params) -> Result<PeriodicOrbit, SimError> {
         self.validate()?;
         let model = CantileverModel::new(params)?;
-        let (guess, found) = self.start.guess(&model)?;
+        let (guess, found, section) = self.start.guess_with_section(&model)?;
         let n = self.period.or(found).unwrap_or(1);
-        explain_start(
-            shoot(&model, &guess, n, &ShootingOptions::default()),
-            self.period,
-            found,
-        )
+        let opts = ShootingOptions::default();
+        let first = shoot(&model, &guess, n, &opts);
+        let r = match first {
+            Err(SimError::NoConvergence { .. }) => {
+                let mut integ = build(&model, IntegratorOptions::default(), 0.0, &model.rest())?;
+                match shoot_globalised(integ.as_mut(), &guess, n, &opts) {
+                    Err(SimError::NoConvergence { .. }) if section.len() > n => {
+                        shoot_from_section(integ.as_mut(), &section, n, &opts)
+                    }
+                    r => r,
+                }
+            }
+            r => r,
+        };
+        explain_start(r, self.period, found)
     }
 }
 
@@ -254,7 +290,7 @@ fn explain_start<T>(
             residual,
             ..
         }) if period.is_none() && found.is_none() => Err(SimError::NoConvergence {
-            what: "shooting for a period-1 orbit from the last state of a motion that showed \
+            what: "shooting for a period-1 orbit from the states of a motion that showed \
                    no period up to max_period (nonperiodic from this start: give the period, \
                    another start or more max_periods)",
             iterations,
