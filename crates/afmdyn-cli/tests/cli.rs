@@ -575,13 +575,12 @@ fn a_failed_orbit_search_says_the_start_was_nonperiodic() {
         &["--from", "5", "--to", "1", "--switch", "--out", out_dir],
     ]
     .concat();
-    // `orbit` without a period no longer fails here (issue 42 §4): after Newton from the last
-    // state, the line-searched Newton from it and from the section's closest returns reach a
-    // period-1 orbit; with period 7 given none of them converges, reported as it is
-    let shot = afmdyn(&orbit);
-    assert_eq!(shot.status.code(), Some(0), "{orbit:?}");
-    assert!(String::from_utf8_lossy(&shot.stdout).starts_with("period-1 orbit"));
+    // `orbit` without a period tries Newton from the last state, the line-searched Newton from
+    // it and from the section's closest returns (issue 42 §4); from this start's section (the
+    // transient cap derived from the beam's decay at Ω = 5: 2 862 periods) none converges, and
+    // the failure says the start was nonperiodic; with period 7 given it is reported as it is
     for (args, explained) in [
+        (orbit.clone(), true),
         (cont.clone(), true),
         ([&orbit[..], &["--period", "7"]].concat(), false),
     ] {
