@@ -577,8 +577,13 @@ fn plots(
     Ok(())
 }
 
-fn summary(c: &SteppedCurve, x: &dyn Fn(f64) -> f64, l: &Labels, out: Option<&OutDir>) {
-    println!(
+fn summary(
+    c: &SteppedCurve,
+    x: &dyn Fn(f64) -> f64,
+    l: &Labels,
+    out: Option<&OutDir>,
+) -> Result<(), CliError> {
+    outln!(
         "{}: {} values each way, {} branch(es) with {} points",
         l.stem,
         c.first.len(),
@@ -586,11 +591,11 @@ fn summary(c: &SteppedCurve, x: &dyn Fn(f64) -> f64, l: &Labels, out: Option<&Ou
         c.branches.iter().map(Vec::len).sum::<usize>()
     );
     for fv in &c.folds {
-        println!("  fold at {} = {}", l.x_text, l.show(x(*fv)));
+        outln!("  fold at {} = {}", l.x_text, l.show(x(*fv)));
     }
     for &(a, b) in &c.bistable {
         let (p, q) = (x(a), x(b));
-        println!(
+        outln!(
             "  bistable for {} in [{}, {}]",
             l.x_text,
             l.show(p.min(q)),
@@ -598,7 +603,7 @@ fn summary(c: &SteppedCurve, x: &dyn Fn(f64) -> f64, l: &Labels, out: Option<&Ou
         );
     }
     for j in &c.jumps {
-        println!(
+        outln!(
             "  {} jumps between {} = {} and {}{}",
             match j.sweep {
                 Sweep::First => l.sweeps.0,
@@ -612,11 +617,12 @@ fn summary(c: &SteppedCurve, x: &dyn Fn(f64) -> f64, l: &Labels, out: Option<&Ou
         );
     }
     for w in &c.warnings {
-        eprintln!("afmdyn: warning: {w}");
+        errln!("afmdyn: warning: {w}");
     }
     if let Some(o) = out {
-        println!("outputs in {}", o.path().display());
+        outln!("outputs in {}", o.path().display());
     }
+    Ok(())
 }
 
 /// The parameters, the output units (SI with a probe; frequencies in Hz when `hz`) and the
@@ -675,11 +681,11 @@ impl Run<'_> {
             }
         }
         if self.args.json {
-            println!("{json}");
+            outln!("{json}");
         } else {
-            summary(&c, self.x, self.labels, out.as_ref());
+            summary(&c, self.x, self.labels, out.as_ref())?;
             if let Some(sp) = json.get("setpoint") {
-                print_setpoint(sp, self.labels);
+                print_setpoint(sp, self.labels)?;
             }
         }
         Ok(())
@@ -793,14 +799,14 @@ fn write_traces(
 }
 
 /// The operating points of the `"setpoint"` block, one line each.
-fn print_setpoint(sp: &serde_json::Value, labels: &Labels) {
+fn print_setpoint(sp: &serde_json::Value, labels: &Labels) -> Result<(), CliError> {
     let num = |v: &serde_json::Value, k: &str| v[k].as_f64().unwrap_or(f64::NAN);
     let length = |x: f64| match labels.x_unit {
         Some(u) => si_value(x, u),
         None => format!("{x:.6}"),
     };
     let points = sp["points"].as_array().map_or(&[][..], |v| v.as_slice());
-    println!(
+    outln!(
         "setpoint A/A0 = {}: {} operating point(s){}",
         num(sp, "ratio"),
         points.len(),
@@ -819,7 +825,7 @@ fn print_setpoint(sp: &serde_json::Value, labels: &Labels) {
             Some(_) => si_value(num(p, "energy_dissipated"), "J"),
             None => format!("{:.6}", num(p, "energy_dissipated")),
         };
-        println!(
+        outln!(
             "  {} ({}): z_c = {}, phase {:.2}°, peak force {force}, indentation {}, E_dis {energy}",
             p["source"].as_str().unwrap_or(""),
             p["regime"].as_str().unwrap_or(""),
@@ -828,6 +834,7 @@ fn print_setpoint(sp: &serde_json::Value, labels: &Labels) {
             length(num(p, "indentation")),
         );
     }
+    Ok(())
 }
 
 fn check_finite(name: &str, v: Option<f64>) -> Result<(), CliError> {

@@ -193,9 +193,9 @@ pub fn basins_cmd(a: &BasinsArgs) -> Result<(), CliError> {
         serde_json::to_string_pretty(&doc).expect("json").as_bytes(),
     )?;
     if a.json {
-        println!("{doc}");
+        outln!("{doc}");
     } else {
-        println!(
+        outln!(
             "{} × {} starts: {} attractors, basin fractions {:?}; outputs in {}",
             nx,
             ny,

@@ -13,7 +13,57 @@ use std::path::{Path, PathBuf};
 /// An I/O failure on `path`, as one readable line ("cannot write DIR/x.csv: No space left on
 /// device (os error 28)").
 pub fn io_error(verb: &str, path: &Path, e: impl Display) -> CliError {
-    CliError::Io(format!("cannot {verb} {}: {e}", path.display()))
+    CliError::Io(format!(
+        "cannot {verb} {}: {}",
+        path.display(),
+        without_errno(&e.to_string())
+    ))
+}
+
+/// An operating system's message without its ` (os error N)`: `No space left on device`.
+fn without_errno(text: &str) -> &str {
+    match text.rfind(" (os error ") {
+        Some(i) if text.ends_with(')') => &text[..i],
+        _ => text,
+    }
+}
+
+/// A failed write to a standard stream: a closed pipe (`afmdyn … | head`) ends the run quietly
+/// with status 141, as SIGPIPE ends other Unix tools; any other failure (`> /dev/full`) is
+/// [`CliError::Io`] naming the stream and the cause, exit code 1.
+fn stream_error(stream: &str, e: &std::io::Error) -> CliError {
+    if e.kind() == std::io::ErrorKind::BrokenPipe {
+        std::process::exit(141);
+    }
+    CliError::Io(format!(
+        "cannot write to {stream}: {}",
+        afmdyn::error::io_message(e)
+    ))
+}
+
+/// Write `args` to standard output and flush it, so that a failure shows here (every print
+/// of the command line goes through this, by the `outln!` macro: `println!` would panic).
+///
+/// # Errors
+/// [`CliError::Io`] naming standard output.
+pub fn write_stdout(args: std::fmt::Arguments<'_>) -> Result<(), CliError> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    out.write_fmt(args)
+        .and_then(|()| out.flush())
+        .map_err(|e| stream_error("standard output", &e))
+}
+
+/// Write `args` to standard error (the `errln!` macro).
+///
+/// # Errors
+/// [`CliError::Io`] naming standard error.
+pub fn write_stderr(args: std::fmt::Arguments<'_>) -> Result<(), CliError> {
+    use std::io::Write;
+    let mut err = std::io::stderr().lock();
+    err.write_fmt(args)
+        .and_then(|()| err.flush())
+        .map_err(|e| stream_error("standard error", &e))
 }
 
 /// A locked output directory: created if needed; a second run on the same directory fails at
@@ -39,7 +89,7 @@ impl OutDir {
         })?;
         if !lock.is_locked() {
             // a file system without advisory locks: run unlocked rather than not at all
-            eprintln!(
+            errln!(
                 "afmdyn: warning: cannot lock {}; concurrent runs on it are not detected",
                 dir.display()
             );
