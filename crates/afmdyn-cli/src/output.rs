@@ -449,7 +449,7 @@ impl NpyStream {
 }
 
 /// Format a float for CSV: a shortest round-trip representation, in exponent form when
-/// |v| < 1e-4 or ≥ 1e16 — the notation of [`afmdyn::error::number`] (SI values such as
+/// |v| < 1e-4 or ≥ 1e16 — the notation of [`std_format`] (SI values such as
 /// 1.37e-19 J would otherwise print as 24 zeros and their digits), with the digits from `ryu`
 /// (several times faster than the standard library's; a spectrum writes a million of them;
 /// where two shortest forms exist it may pick the other). Where `ryu` chooses the other
@@ -460,18 +460,28 @@ pub fn f(v: f64) -> String {
     String::from_utf8(out).expect("ASCII")
 }
 
+/// `v` with every digit it needs to read back: plain between 1e-4 and 1e16, else in scientific
+/// notation (the library's `afmdyn::error::number` rounds for messages; data keep every digit).
+fn std_format(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() || (1e-4..1e16).contains(&v.abs()) {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
+}
+
 /// [`f`] appended to `out` (no allocation but where the standard formatting is used).
 pub fn f_into(out: &mut Vec<u8>, v: f64) {
     let a = v.abs();
     if !v.is_finite() || a == 0.0 {
-        out.extend(afmdyn::error::number(v).as_bytes());
+        out.extend(std_format(v).as_bytes());
         return;
     }
     let mut buf = ryu::Buffer::new();
     let s = buf.format_finite(v);
     let sci = s.contains('e');
     if sci == (1e-4..1e16).contains(&a) {
-        out.extend(afmdyn::error::number(v).as_bytes());
+        out.extend(std_format(v).as_bytes());
         return;
     }
     out.extend(s.strip_suffix(".0").unwrap_or(s).as_bytes());
@@ -520,7 +530,7 @@ pub fn csv_lines(s: &mut CsvStream, bytes: &[u8]) -> Result<(), CliError> {
 
 #[cfg(test)]
 mod tests {
-    use super::f;
+    use super::{f, std_format};
 
     /// A row of `csv_line` is the row the csv crate writes for the same fields (`csv_row`).
     #[test]
@@ -621,7 +631,7 @@ mod tests {
     }
 
     /// The fast path reads back to the same double and uses the notation of
-    /// afmdyn::error::number (the standard library's formatting), with as many digits, over
+    /// std_format (the standard library's formatting), with as many digits, over
     /// magnitudes from 1e-300 to 1e300 and the notation boundaries.
     #[test]
     fn csv_numbers_equal_the_standard_formatting() {
@@ -647,7 +657,7 @@ mod tests {
             values.push((x >> 11) as f64 / (1u64 << 53) as f64 * 10f64.powi(e));
         }
         for v in values {
-            let (fast, std) = (f(v), afmdyn::error::number(v));
+            let (fast, std) = (f(v), std_format(v));
             assert_eq!(fast.parse::<f64>().unwrap().to_bits(), v.to_bits(), "{v:e}");
             assert_eq!(
                 fast.contains('e'),
