@@ -538,8 +538,7 @@ mod tests {
         .resolve(Params::default(), None)
         .unwrap_err();
         assert!(
-            e.to_string()
-                .starts_with("z_c = 0.000000001: needs a probe"),
+            e.to_string().starts_with("z_c = 1e-9: needs a probe"),
             "{e}"
         );
         let probe = Probe::parse(
