@@ -105,11 +105,22 @@ fn parse_law(s: &str) -> Result<LawKind, String> {
 
 /// Read and parse a TOML file. Errors name the file, the line and column, and for a duplicate
 /// key the key ([`afmdyn::request::model::parse_toml`]).
-pub fn read_toml<T: for<'de> Deserialize<'de>>(path: &PathBuf) -> Result<T, CliError> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| CliError::Input(format!("config {}: {e}", path.display())))?;
+pub fn read_toml<T: for<'de> Deserialize<'de>>(path: &std::path::Path) -> Result<T, CliError> {
+    let text = read_text(path).map_err(|e| CliError::Input(format!("config {e}")))?;
     afmdyn::request::model::parse_toml(&text)
         .map_err(|msg| CliError::Input(format!("config {}: {msg}", path.display())))
+}
+
+/// The text of an input file (a probe or `--config` file), at most
+/// [`afmdyn::request::limits::MAX_INPUT_TEXT_BYTES`] bytes of UTF-8
+/// ([`afmdyn::request::limits::read_input`]).
+///
+/// # Errors
+/// The library's [`afmdyn::request::limits::InputFileError`] naming the file.
+pub fn read_text(
+    path: &std::path::Path,
+) -> Result<String, afmdyn::request::limits::InputFileError> {
+    afmdyn::request::limits::read_input(path, afmdyn::request::limits::MAX_INPUT_TEXT_BYTES)
 }
 
 impl ModelArgs {
@@ -156,8 +167,7 @@ impl ModelArgs {
         let Some(path) = &self.probe else {
             return Ok(None);
         };
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| CliError::Input(format!("{}: {e}", path.display())))?;
+        let text = read_text(path).map_err(|e| CliError::Input(format!("probe {e}")))?;
         match &self.cantilever {
             None => Ok(Some(text)),
             Some(name) => afmdyn::cantilevers::with_name(&text, name)

@@ -353,20 +353,20 @@ pub fn bifurcation(a: &BifurcationArgs) -> Result<(), CliError> {
     let failed = sweep_failure(periodic + nonperiodic, errors, first_error.as_deref());
     if let Some(e) = failed {
         if a.json {
-            println!("{summary}");
+            outln!("{summary}");
         }
         return Err(CliError::Sim(e));
     }
     if let Some(first) = &first_error {
-        eprintln!(
+        errln!(
             "afmdyn: warning: {errors} of {} sweep points failed; the first: {first}",
             periodic + nonperiodic + errors
         );
     }
     if a.json {
-        println!("{summary}");
+        outln!("{summary}");
     } else {
-        println!(
+        outln!(
             "{} values of {}: {} periodic, {} nonperiodic, {} failed points; outputs in {}",
             spec.values.len(),
             a.param.name(),
@@ -581,7 +581,7 @@ pub fn attractors(a: &AttractorsArgs) -> Result<(), CliError> {
         )?;
     }
     if let Some(first) = report.failures.first() {
-        eprintln!(
+        errln!(
             "afmdyn: warning: {} of {} random starts failed; the first: {first}",
             report.failures.len(),
             a.samples
@@ -592,12 +592,12 @@ pub fn attractors(a: &AttractorsArgs) -> Result<(), CliError> {
         serde_json::to_string_pretty(&doc).expect("json").as_bytes(),
     )?;
     for w in report.warnings() {
-        eprintln!("afmdyn: warning: {w}");
+        errln!("afmdyn: warning: {w}");
     }
     if a.json {
-        println!("{doc}");
+        outln!("{doc}");
     } else {
-        println!(
+        outln!(
             "{} attractors from {} starts ({} failed) at {}{}:",
             report.attractors.len(),
             a.samples,
@@ -618,7 +618,7 @@ pub fn attractors(a: &AttractorsArgs) -> Result<(), CliError> {
                     format!("{v:.4}")
                 }
             };
-            println!(
+            outln!(
                 "  {}: {:<12} basin {:>5.1} %  X_max = {}  min V_T = {}  contact fraction {:.3}{}",
                 k + 1,
                 x.steady
@@ -636,14 +636,14 @@ pub fn attractors(a: &AttractorsArgs) -> Result<(), CliError> {
             );
         }
         for x in &report.unsettled {
-            println!(
+            outln!(
                 "  unsettled: {} start(s) still converging after {} periods (λ₁ = {:.3e})",
                 x.count,
                 report.transient_cap,
                 x.lyapunov.map_or(f64::NAN, |l| l.0)
             );
         }
-        println!("outputs in {}", out.path().display());
+        outln!("outputs in {}", out.path().display());
     }
     Ok(())
 }
@@ -739,12 +739,12 @@ fn attractors_sweep(
         serde_json::to_string_pretty(&doc).expect("json").as_bytes(),
     )?;
     for w in doc["warnings"].as_array().into_iter().flatten() {
-        eprintln!("afmdyn: warning: {}", w.as_str().unwrap_or_default());
+        errln!("afmdyn: warning: {}", w.as_str().unwrap_or_default());
     }
     if a.json {
-        println!("{doc}");
+        outln!("{doc}");
     } else {
-        println!(
+        outln!(
             "{ids} attractors over {} values of {name} ({} random starts each):",
             steps.len(),
             request.samples
@@ -765,9 +765,9 @@ fn attractors_sweep(
                 .collect();
             // 10 significant digits: a linspace value such as 1.7999999999999998 reads 1.8
             let value: f64 = format!("{:.9e}", s.value).parse().unwrap_or(s.value);
-            println!("  {name} = {value:<10} {}", line.join("  "));
+            outln!("  {name} = {value:<10} {}", line.join("  "));
         }
-        println!("outputs in {}", out.path().display());
+        outln!("outputs in {}", out.path().display());
     }
     Ok(())
 }

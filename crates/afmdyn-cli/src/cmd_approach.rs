@@ -575,8 +575,13 @@ fn plots(
     Ok(())
 }
 
-fn summary(c: &SteppedCurve, x: &dyn Fn(f64) -> f64, l: &Labels, out: Option<&OutDir>) {
-    println!(
+fn summary(
+    c: &SteppedCurve,
+    x: &dyn Fn(f64) -> f64,
+    l: &Labels,
+    out: Option<&OutDir>,
+) -> Result<(), CliError> {
+    outln!(
         "{}: {} values each way, {} branch(es) with {} points",
         l.stem,
         c.first.len(),
@@ -584,11 +589,11 @@ fn summary(c: &SteppedCurve, x: &dyn Fn(f64) -> f64, l: &Labels, out: Option<&Ou
         c.branches.iter().map(Vec::len).sum::<usize>()
     );
     for fv in &c.folds {
-        println!("  fold at {} = {}", l.x_text, l.show(x(*fv)));
+        outln!("  fold at {} = {}", l.x_text, l.show(x(*fv)));
     }
     for &(a, b) in &c.bistable {
         let (p, q) = (x(a), x(b));
-        println!(
+        outln!(
             "  bistable for {} in [{}, {}]",
             l.x_text,
             l.show(p.min(q)),
@@ -596,7 +601,7 @@ fn summary(c: &SteppedCurve, x: &dyn Fn(f64) -> f64, l: &Labels, out: Option<&Ou
         );
     }
     for j in &c.jumps {
-        println!(
+        outln!(
             "  {} jumps between {} = {} and {}{}",
             match j.sweep {
                 Sweep::First => l.sweeps.0,
@@ -610,11 +615,12 @@ fn summary(c: &SteppedCurve, x: &dyn Fn(f64) -> f64, l: &Labels, out: Option<&Ou
         );
     }
     for w in &c.warnings {
-        eprintln!("afmdyn: warning: {w}");
+        errln!("afmdyn: warning: {w}");
     }
     if let Some(o) = out {
-        println!("outputs in {}", o.path().display());
+        outln!("outputs in {}", o.path().display());
     }
+    Ok(())
 }
 
 /// The parameters, the output units (SI with a probe; frequencies in Hz when `hz`) and the
@@ -673,11 +679,11 @@ impl Run<'_> {
             }
         }
         if self.args.json {
-            println!("{json}");
+            outln!("{json}");
         } else {
-            summary(&c, self.x, self.labels, out.as_ref());
+            summary(&c, self.x, self.labels, out.as_ref())?;
             if let Some(sp) = json.get("setpoint") {
-                print_setpoint(sp, self.labels, self.units);
+                print_setpoint(sp, self.labels, self.units)?;
             }
         }
         Ok(())
@@ -822,7 +828,7 @@ fn resolved(v: f64, unit_scale: f64, si: Option<&str>) -> String {
 /// The operating points of the `"setpoint"` block, one line each: the repulsive maximum of the
 /// tip–sample force (max F_c when positive, "none" else) and the adhesion minimum (min F_c when
 /// negative), energies and forces printed as 0 below [`PRINT_RESOLUTION`].
-fn print_setpoint(sp: &serde_json::Value, labels: &Labels, u: &CurveUnits) {
+fn print_setpoint(sp: &serde_json::Value, labels: &Labels, u: &CurveUnits) -> Result<(), CliError> {
     let num = |v: &serde_json::Value, k: &str| v[k].as_f64().unwrap_or(f64::NAN);
     let length = |x: f64| match labels.x_unit {
         Some(u) => si_value(x, u),
@@ -830,7 +836,7 @@ fn print_setpoint(sp: &serde_json::Value, labels: &Labels, u: &CurveUnits) {
     };
     let si = |unit| labels.x_unit.map(|_| unit);
     let points = sp["points"].as_array().map_or(&[][..], |v| v.as_slice());
-    println!(
+    outln!(
         "setpoint A/A0 = {}: {} operating point(s){}",
         num(sp, "ratio"),
         points.len(),
@@ -854,7 +860,7 @@ fn print_setpoint(sp: &serde_json::Value, labels: &Labels, u: &CurveUnits) {
             "none".into()
         };
         let energy = resolved(num(p, "energy_dissipated"), u.energy, si("J"));
-        println!(
+        outln!(
             "  {} ({}): z_c = {}, phase {:.2}°, repulsive peak force {repulsive}, adhesion \
              (min force) {adhesion}, indentation {}, E_dis {energy}",
             p["source"].as_str().unwrap_or(""),
@@ -864,6 +870,7 @@ fn print_setpoint(sp: &serde_json::Value, labels: &Labels, u: &CurveUnits) {
             length(num(p, "indentation")),
         );
     }
+    Ok(())
 }
 
 fn check_finite(name: &str, v: Option<f64>) -> Result<(), CliError> {

@@ -193,12 +193,12 @@ pub fn basins_cmd(a: &BasinsArgs) -> Result<(), CliError> {
         serde_json::to_string_pretty(&doc).expect("json").as_bytes(),
     )?;
     for w in doc["warnings"].as_array().into_iter().flatten() {
-        eprintln!("afmdyn: warning: {}", w.as_str().unwrap_or_default());
+        errln!("afmdyn: warning: {}", w.as_str().unwrap_or_default());
     }
     if a.json {
-        println!("{doc}");
+        outln!("{doc}");
     } else {
-        println!(
+        outln!(
             "{} × {} starts: {} attractors, basin fractions {:?}; outputs in {}",
             nx,
             ny,

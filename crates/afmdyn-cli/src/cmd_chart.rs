@@ -383,7 +383,7 @@ pub fn chart(a: &ChartArgs) -> Result<(), CliError> {
         }));
     }
     for w in warnings(&chart, &cells) {
-        eprintln!("afmdyn: warning: {w}");
+        errln!("afmdyn: warning: {w}");
     }
     if a.json {
         let mut doc = document(&chart, &cells);
@@ -391,10 +391,10 @@ pub fn chart(a: &ChartArgs) -> Result<(), CliError> {
             "csv": out.join("chart.csv"),
             "netcdf": out.join("chart.nc"),
         });
-        println!("{doc}");
+        outln!("{doc}");
     } else {
         let multi = cells.iter().filter(|c| c.attractors.len() > 1).count();
-        println!(
+        outln!(
             "chart of {} × {} cells over {} × {}: {} with coexisting attractors, {} without any; \
              outputs in {}",
             chart.spec.x.len(),

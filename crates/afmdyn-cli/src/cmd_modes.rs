@@ -49,35 +49,43 @@ pub fn modes(a: &ModesArgs) -> Result<(), CliError> {
         &Progress::new(),
     )?;
     if a.json {
-        println!("{json}");
+        outln!("{json}");
         return Ok(());
     }
     if u.si() {
-        println!(
+        outln!(
             "N = {}, {} structure (SI: the probe's scales; natural frequencies in Hz)",
             p.modes,
             p.structure.name()
         );
     } else {
-        println!(
+        outln!(
             "N = {}, α1 = {}, α3 = {}, α4 = {}, α6 = {} (dimensionless, eq. 5 time scale)",
-            p.modes, p.alpha1, p.alpha3, p.alpha4, p.alpha6
+            p.modes,
+            p.alpha1,
+            p.alpha3,
+            p.alpha4,
+            p.alpha6
         );
     }
     for (name, r) in [
         ("free (region I)", &free),
         ("contact (region II)", &contact),
     ] {
-        println!("\n{name}");
+        outln!("\n{name}");
         if u.si() {
             // SI: the natural frequency and the damped one Im λ/2π, the decay rate Re λ in 1/s
-            println!(
+            outln!(
                 "{:>4} {:>16} {:>16} {:>18} {:>10}",
-                "i", "f (undamped)", "Im λ/2π", "Re λ", "ζ"
+                "i",
+                "f (undamped)",
+                "Im λ/2π",
+                "Re λ",
+                "ζ"
             );
             for (i, w) in r.omega.iter().enumerate() {
                 let e = r.eigenvalues.get(i);
-                println!(
+                outln!(
                     "{:>4} {:>16} {:>16} {:>18} {:>10.5}",
                     i + 1,
                     u.frequency(*w),
@@ -88,13 +96,17 @@ pub fn modes(a: &ModesArgs) -> Result<(), CliError> {
             }
             continue;
         }
-        println!(
+        outln!(
             "{:>4} {:>14} {:>14} {:>14} {:>10}",
-            "i", "ω (undamped)", "Re λ", "Im λ", "ζ"
+            "i",
+            "ω (undamped)",
+            "Re λ",
+            "Im λ",
+            "ζ"
         );
         for (i, w) in r.omega.iter().enumerate() {
             let e = r.eigenvalues.get(i);
-            println!(
+            outln!(
                 "{:>4} {:>14.6} {:>14.6} {:>14.6} {:>10.5}",
                 i + 1,
                 w,
@@ -165,9 +177,9 @@ fn fig3(a: &ModesArgs, p: &Params) -> Result<(), CliError> {
         save(out.path(), stem, &fig)?;
     }
     if a.json {
-        println!("{}", json!({ "params": p, "points": pts, "out": a.out }));
+        outln!("{}", json!({ "params": p, "points": pts, "out": a.out }));
     } else {
-        println!("wrote {} points to {}", pts.len(), out.path().display());
+        outln!("wrote {} points to {}", pts.len(), out.path().display());
     }
     Ok(())
 }
@@ -236,7 +248,7 @@ pub fn units(a: &UnitsArgs) -> Result<(), CliError> {
     if let Some(path) = &a.probe {
         let origin = path.display().to_string();
         let text =
-            std::fs::read_to_string(path).map_err(|e| CliError::Input(format!("{origin}: {e}")))?;
+            crate::args::read_text(path).map_err(|e| CliError::Input(format!("probe {e}")))?;
         let text = match &a.cantilever {
             Some(name) => afmdyn::cantilevers::with_name(&text, name)
                 .map_err(|e| CliError::Input(format!("{origin}: {e}")))?,
@@ -246,9 +258,9 @@ pub fn units(a: &UnitsArgs) -> Result<(), CliError> {
         let p = pr.params;
         let doc = json!({ "params": p, "si": afmdyn::report::si(&pr, &p, &json!({})) });
         if a.json {
-            println!("{doc}");
+            outln!("{doc}");
         } else {
-            println!("{}", serde_json::to_string_pretty(&doc).expect("json"));
+            outln!("{}", serde_json::to_string_pretty(&doc).expect("json"));
         }
         return Ok(());
     }
@@ -315,28 +327,30 @@ pub fn units(a: &UnitsArgs) -> Result<(), CliError> {
     let p = model.to_params()?;
     let s = model.scales();
     if a.json {
-        println!("{}", json!({ "params": p, "scales": s, "physical": model }));
+        outln!("{}", json!({ "params": p, "scales": s, "physical": model }));
         return Ok(());
     }
-    println!("dimensionless parameters (eq. 7):");
-    println!("  N  = {}", p.modes);
-    println!("  α1 = {:.6e}  tip-mass ratio M/(mL)", p.alpha1);
-    println!("  α2 = {:.6e}  drive amplitude f/g0", p.alpha2);
-    println!("  α3 = {:.6e}  beam damping", p.alpha3);
-    println!(
+    outln!("dimensionless parameters (eq. 7):");
+    outln!("  N  = {}", p.modes);
+    outln!("  α1 = {:.6e}  tip-mass ratio M/(mL)", p.alpha1);
+    outln!("  α2 = {:.6e}  drive amplitude f/g0", p.alpha2);
+    outln!("  α3 = {:.6e}  beam damping", p.alpha3);
+    outln!(
         "  α4 = {:.6e}  contact stiffness K1 L³/(EI)  (K1 = {:.6e} N/m)",
-        p.alpha4, k1
+        p.alpha4,
+        k1
     );
-    println!("  α5 = {:.6e}  gap g1/g0", p.alpha5);
-    println!("  α6 = {:.6e}  contact damping", p.alpha6);
-    println!("  Ω  = {:.6e}  drive frequency", p.omega);
-    println!("scales (eq. 5):");
-    println!("  one unit of τ = {:.6e} s", s.time_s);
-    println!("  one unit of W = {:.6e} m", s.length_m);
-    println!("  spring constant 3EI/L³ = {:.6e} N/m", s.spring_constant);
-    println!(
+    outln!("  α5 = {:.6e}  gap g1/g0", p.alpha5);
+    outln!("  α6 = {:.6e}  contact damping", p.alpha6);
+    outln!("  Ω  = {:.6e}  drive frequency", p.omega);
+    outln!("scales (eq. 5):");
+    outln!("  one unit of τ = {:.6e} s", s.time_s);
+    outln!("  one unit of W = {:.6e} m", s.length_m);
+    outln!("  spring constant 3EI/L³ = {:.6e} N/m", s.spring_constant);
+    outln!(
         "  first natural frequency f₁ = {:.6e} Hz with the tip mass ({:.6e} Hz without)",
-        s.first_frequency_hz, s.bare_first_frequency_hz
+        s.first_frequency_hz,
+        s.bare_first_frequency_hz
     );
     Ok(())
 }
@@ -354,15 +368,20 @@ pub fn cantilevers(a: &CantileversArgs) -> Result<(), CliError> {
     let all = afmdyn::cantilevers::cantilevers();
     if a.json {
         let doc = afmdyn::cantilevers::document();
-        println!("{doc}");
+        outln!("{doc}");
         return Ok(());
     }
-    println!(
+    outln!(
         "{:<16} {:<44} {:>9} {:>9} {:>6} {:>6}",
-        "name", "maker", "k (N/m)", "f0 (kHz)", "Q", "R (nm)"
+        "name",
+        "maker",
+        "k (N/m)",
+        "f0 (kHz)",
+        "Q",
+        "R (nm)"
     );
     for c in all {
-        println!(
+        outln!(
             "{:<16} {:<44} {:>9} {:>9} {:>6} {:>6}",
             c.name,
             c.maker,
@@ -372,7 +391,7 @@ pub fn cantilevers(a: &CantileversArgs) -> Result<(), CliError> {
             (c.radius * 1e9 * 10.0).round() / 10.0
         );
     }
-    println!(
+    outln!(
         "* Q typical of the lever class in air, not a datasheet value. Nominal values: calibrate \
          k, f0 and Q on the instrument. Use: --cantilever NAME --probe SAMPLE.toml (a probe \
          file with [sample] and [drive]); sources: --json"

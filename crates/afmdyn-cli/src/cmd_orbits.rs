@@ -4,7 +4,7 @@ use crate::args::ModelArgs;
 use crate::cmd_analysis::{SteadyArgs, COL_VALUE, COL_W_TIP};
 use crate::cmd_simulate::parse_initial;
 use crate::error::CliError;
-use crate::output::{f, io_error, write_csv, OutDir, TextUnits};
+use crate::output::{f, write_csv, OutDir, TextUnits};
 use crate::plot::{save, Figure, Series, Style};
 use crate::progress;
 use afmdyn::analysis::continuation::BranchPoint;
@@ -62,10 +62,10 @@ pub fn orbit(a: &OrbitArgs) -> Result<(), CliError> {
         request::run(&request, &Resolved { params: p, probe }, &Progress::new())?;
     let n = o.period;
     if a.json {
-        println!("{json}");
+        outln!("{json}");
         return Ok(());
     }
-    println!(
+    outln!(
         "period-{} orbit at {}{} ({}), {} switchings per cycle",
         n,
         u.drive(p.omega),
@@ -77,7 +77,7 @@ pub fn orbit(a: &OrbitArgs) -> Result<(), CliError> {
         if o.stable { "stable" } else { "unstable" },
         o.switchings
     );
-    println!(
+    outln!(
         "Newton residuals: {}",
         o.residuals
             .iter()
@@ -85,11 +85,11 @@ pub fn orbit(a: &OrbitArgs) -> Result<(), CliError> {
             .collect::<Vec<_>>()
             .join(" → ")
     );
-    println!("Floquet multipliers (|μ|):");
+    outln!("Floquet multipliers (|μ|):");
     for m in &o.multipliers {
-        println!("  {:+.8} {:+.8}i   {:.8}", m.re, m.im, m.norm());
+        outln!("  {:+.8} {:+.8}i   {:.8}", m.re, m.im, m.norm());
     }
-    println!(
+    outln!(
         "critical multiplier type: {:?}; distance to grazing {}{}",
         o.critical,
         if u.si() {
@@ -102,12 +102,12 @@ pub fn orbit(a: &OrbitArgs) -> Result<(), CliError> {
     let model = CantileverModel::new(&p)?;
     for (k, z) in o.section.iter().enumerate() {
         if u.si() {
-            println!(
+            outln!(
                 "  section {k}: tip deflection = {}",
                 u.length(model.w_tip(z))
             );
         } else {
-            println!("  section {k}: W(1,τ) = {:.9}", model.w_tip(z));
+            outln!("  section {k}: W(1,τ) = {:.9}", model.w_tip(z));
         }
     }
     Ok(())
@@ -171,25 +171,42 @@ fn branch_rows(model: &CantileverModel, id: usize, br: &[BranchPoint]) -> Vec<Ve
         .collect()
 }
 
-/// The overlay CSV checked before any computation: readable, with `value` and `w_tip` columns.
-fn check_overlay(path: &Path) -> Result<(), CliError> {
-    let mut rd = csv::Reader::from_path(path).map_err(|e| {
-        CliError::Input(format!(
-            "--overlay {}: {}",
+/// The overlay CSV read and checked before any computation: readable, at most
+/// [`afmdyn::request::limits::MAX_INPUT_CSV_BYTES`] of UTF-8, with `value` and `w_tip`
+/// columns; its (value, w_tip) pairs. Every failure is bad input (exit code 2) naming the file.
+fn read_overlay(path: &Path) -> Result<Vec<(f64, f64)>, CliError> {
+    let bad = |m: String| CliError::Input(format!("--overlay {m}"));
+    let text =
+        afmdyn::request::limits::read_input(path, afmdyn::request::limits::MAX_INPUT_CSV_BYTES)
+            .map_err(|e| bad(e.to_string()))?;
+    let csv_error = |e: csv::Error| {
+        bad(format!(
+            "{}: {}",
             path.display(),
             e.to_string().replace('\n', " ")
         ))
-    })?;
-    let header = rd.headers().map_err(|e| io_error("read", path, e))?;
+    };
+    let mut rd = csv::Reader::from_reader(text.as_bytes());
+    let header = rd.headers().map_err(csv_error)?;
     let names: Vec<&str> = header.iter().collect();
     if names.get(COL_VALUE) != Some(&"value") || names.get(COL_W_TIP) != Some(&"w_tip") {
-        return Err(CliError::Input(format!(
-            "--overlay {}: not a bifurcation.csv of `afmdyn bifurcation` (expected columns \
-             value and w_tip)",
+        return Err(bad(format!(
+            "{}: not a bifurcation.csv of `afmdyn bifurcation` (expected columns value and \
+             w_tip)",
             path.display()
         )));
     }
-    Ok(())
+    let mut points = Vec::new();
+    for r in rd.records() {
+        let r = r.map_err(csv_error)?;
+        if let (Some(Ok(v)), Some(Ok(w))) = (
+            r.get(COL_VALUE).map(str::parse::<f64>),
+            r.get(COL_W_TIP).map(str::parse::<f64>),
+        ) {
+            points.push((v, w));
+        }
+    }
+    Ok(points)
 }
 
 /// Run `afmdyn continue`.
@@ -204,9 +221,10 @@ pub fn continuation(a: &ContinueArgs) -> Result<(), CliError> {
         start: a.start.request(base.modes)?,
     };
     request.validate(&base)?;
-    if let Some(o) = &a.overlay {
-        check_overlay(o)?;
-    }
+    let underlay = match &a.overlay {
+        Some(o) => read_overlay(o)?,
+        None => Vec::new(),
+    };
     let out = OutDir::lock(&a.out)?;
     let u = TextUnits::of(probe.as_ref());
     let model = Resolved {
@@ -300,17 +318,6 @@ pub fn continuation(a: &ContinueArgs) -> Result<(), CliError> {
         style: Style::Points,
         color: 3,
     });
-    let mut underlay = Vec::new();
-    if let Some(csv_path) = &a.overlay {
-        let err = |e| io_error("read", csv_path, e);
-        let mut rd = csv::Reader::from_path(csv_path).map_err(err)?;
-        for r in rd.records() {
-            let r = r.map_err(err)?;
-            if let (Ok(v), Ok(w)) = (r[COL_VALUE].parse::<f64>(), r[COL_W_TIP].parse::<f64>()) {
-                underlay.push((v, w));
-            }
-        }
-    }
     if !underlay.is_empty() {
         series.insert(
             0,
@@ -354,12 +361,12 @@ pub fn continuation(a: &ContinueArgs) -> Result<(), CliError> {
         },
     )?;
     for w in afmdyn::report::continuation_warnings(a.param, &branches) {
-        eprintln!("afmdyn: warning: {w}");
+        errln!("afmdyn: warning: {w}");
     }
     if a.json {
-        println!("{json}");
+        outln!("{json}");
     } else {
-        println!(
+        outln!(
             "{} branch(es), {} points; located:",
             branches.len(),
             branches.iter().map(|b| b.len()).sum::<usize>()
@@ -374,13 +381,13 @@ pub fn continuation(a: &ContinueArgs) -> Result<(), CliError> {
                 ),
                 _ => format!("{} = {:.6}", a.param.name(), b.value),
             };
-            println!(
+            outln!(
                 "  {:<16} at {at} (period {})",
                 format!("{:?}", b.event.expect("event")),
                 b.period
             );
         }
-        println!("outputs in {}", out.path().display());
+        outln!("outputs in {}", out.path().display());
     }
     Ok(())
 }
@@ -422,31 +429,31 @@ pub fn lyapunov(a: &LyapunovArgs) -> Result<(), CliError> {
         progress::run(&request, &Resolved { params: p, probe }, "periods")?;
     let warnings = &l.warnings;
     for w in warnings {
-        eprintln!("afmdyn: warning: {w}");
+        errln!("afmdyn: warning: {w}");
     }
     if a.json {
-        println!("{json}");
+        outln!("{json}");
         return Ok(());
     }
-    println!(
+    outln!(
         "Lyapunov exponents ({}) over {} periods at {}:",
         if u.si() { "1/s" } else { "per unit τ" },
         l.periods,
         u.drive(p.omega)
     );
     for ((e, s), c) in l.exponents.iter().zip(&l.uncertainty).zip(&l.convergence) {
-        println!(
+        outln!(
             "  {} ± {} (statistical) ± {} (convergence, |λ(T) − λ(T/2)|)",
             u.rate(*e),
             u.rate(*s).trim_start_matches('+'),
             u.rate(*c).trim_start_matches('+')
         );
     }
-    println!(
+    outln!(
         "sum {}; mean phase-volume contraction {}",
         u.rate(l.exponents.iter().sum::<f64>()),
         u.rate(l.volume_rate)
     );
-    println!("0–1 test K = {:.3}; verdict: {:?}", l.zero_one, l.verdict);
+    outln!("0–1 test K = {:.3}; verdict: {:?}", l.zero_one, l.verdict);
     Ok(())
 }

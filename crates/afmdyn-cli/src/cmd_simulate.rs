@@ -579,29 +579,30 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
         .to_possible_value()
         .map(|v| v.get_name().to_string()));
     for w in &warnings {
-        eprintln!("afmdyn: warning: {w}");
+        errln!("afmdyn: warning: {w}");
     }
     if a.json {
-        println!("{doc}");
+        outln!("{doc}");
     } else {
-        println!(
+        outln!(
             "integrator {}, τ from {:.6} to {:.6}",
             integ.name(),
             t_transient,
             summary.tau_end
         );
-        println!(
+        outln!(
             "switchings: {}, Poincaré points: {}",
-            summary.switchings, summary.sections
+            summary.switchings,
+            summary.sections
         );
-        println!(
+        outln!(
             "final W(1,τ) = {:.9}, V_T = {:.9}",
             model.w_tip(&zf),
             model.v_t(summary.tau_end, &zf)
         );
         if su.u.si {
             let nm = |v: f64| su.x(v) * 1e9;
-            println!(
+            outln!(
                 "  in SI: t from {:.6} µs to {:.6} µs, final W = {:.6} nm, V_T = {:.6} nm",
                 su.t(t_transient) * 1e6,
                 su.t(summary.tau_end) * 1e6,
@@ -609,13 +610,14 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
                 nm(model.v_t(summary.tau_end, &zf))
             );
         }
-        println!(
+        outln!(
             "energy balance: largest per-period residual {:.3e} ({:.1e} relative)",
-            summary.residual, summary.relative
+            summary.residual,
+            summary.relative
         );
         match &out {
-            Some(o) => println!("outputs in {}", o.path().display()),
-            None => println!("no files written (--files none)"),
+            Some(o) => outln!("outputs in {}", o.path().display()),
+            None => outln!("no files written (--files none)"),
         }
     }
     Ok(())
@@ -925,21 +927,21 @@ pub fn converge(a: &ConvergeArgs) -> Result<(), CliError> {
     if a.json {
         let mut doc = json;
         doc["out"] = json!(a.out);
-        println!("{doc}");
+        outln!("{doc}");
     } else {
         if p.alpha3 > 0.0 || p.alpha6 > 0.0 {
-            println!("note: paper eq. 24 is undamped; using α3 = {}, α6 = {} (eq. 26) so a steady state exists", p.alpha3, p.alpha6);
+            outln!("note: paper eq. 24 is undamped; using α3 = {}, α6 = {} (eq. 26) so a steady state exists", p.alpha3, p.alpha6);
         }
-        println!("{:>3} {:>8} {:>22}", "N", "period", "RMS ΔW_tip vs N−1");
+        outln!("{:>3} {:>8} {:>22}", "N", "period", "RMS ΔW_tip vs N−1");
         for r in &runs {
-            println!(
+            outln!(
                 "{:>3} {:>8} {:>22}",
                 r.modes,
                 r.period.map_or("nonper.".to_string(), |n| n.to_string()),
                 r.rms_change.map_or("-".to_string(), |v| format!("{v:.4e}"))
             );
         }
-        println!("outputs in {}", a.out.display());
+        outln!("outputs in {}", a.out.display());
     }
     Ok(())
 }

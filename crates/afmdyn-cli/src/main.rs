@@ -1,5 +1,32 @@
 //! `afmdyn` — command-line interface: parse flags, call the library, write outputs.
 
+/// `println!` that does not panic: a failed write to standard output returns
+/// [`CliError::Io`] naming it from the enclosing function ([`output::write_stdout`]).
+macro_rules! outln {
+    () => {
+        $crate::output::write_stdout(format_args!("\n"))?
+    };
+    ($($t:tt)*) => {
+        $crate::output::write_stdout(format_args!("{}\n", format_args!($($t)*)))?
+    };
+}
+
+/// `print!` that does not panic ([`outln!`]).
+#[allow(unused_macros)]
+macro_rules! out {
+    ($($t:tt)*) => {
+        $crate::output::write_stdout(format_args!($($t)*))?
+    };
+}
+
+/// `eprintln!` that does not panic: a failed write to standard error returns
+/// [`CliError::Io`] ([`output::write_stderr`]).
+macro_rules! errln {
+    ($($t:tt)*) => {
+        $crate::output::write_stderr(format_args!("{}\n", format_args!($($t)*)))?
+    };
+}
+
 mod args;
 mod cmd_analysis;
 mod cmd_approach;
@@ -16,6 +43,7 @@ mod progress;
 
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use error::CliError;
+use std::io::Write;
 
 /// Multi-modal tapping-mode AFM dynamics with intermittent contact.
 #[derive(Debug, Parser)]
@@ -218,12 +246,17 @@ fn main() {
                     },
                 );
             }
-            eprintln!("afmdyn: {}", one_line(&e.to_string()));
+            // a failed write of the message itself cannot be reported: the code still says it
+            let _ = writeln!(std::io::stderr(), "afmdyn: {}", one_line(&e.to_string()));
             std::process::exit(2);
         }
     };
     if let Err(e) = run(cli) {
-        eprintln!("afmdyn: {}", e.to_string().replace('\n', " "));
+        let _ = writeln!(
+            std::io::stderr(),
+            "afmdyn: {}",
+            e.to_string().replace('\n', " ")
+        );
         std::process::exit(e.code());
     }
 }

@@ -112,7 +112,11 @@ pub fn write(
     d(ds.add_global_attr_string("title", title))?;
     d(ds.add_global_attr_string("source", format!("afmdyn {}", env!("CARGO_PKG_VERSION"))))?;
     atomic(path, |tmp| {
-        let w = |x: netcdf3::error::WriteError| e(format!("{x:?}"));
+        // an I/O failure in words ("no space left on device"), not as `IOErrorKind(StorageFull)`
+        let w = |x: netcdf3::error::WriteError| match x {
+            netcdf3::error::WriteError::IOErrorKind(k) => e(afmdyn::error::io_kind_message(k)),
+            x => e(format!("{x:?}")),
+        };
         let mut f = FileWriter::open(tmp).map_err(w)?;
         f.set_def(&ds, Version::Offset64Bit, 0).map_err(w)?;
         for v in vars {

@@ -13,7 +13,57 @@ use std::path::{Path, PathBuf};
 /// An I/O failure on `path`, as one readable line ("cannot write DIR/x.csv: No space left on
 /// device (os error 28)").
 pub fn io_error(verb: &str, path: &Path, e: impl Display) -> CliError {
-    CliError::Io(format!("cannot {verb} {}: {e}", path.display()))
+    CliError::Io(format!(
+        "cannot {verb} {}: {}",
+        path.display(),
+        without_errno(&e.to_string())
+    ))
+}
+
+/// An operating system's message without its ` (os error N)`: `No space left on device`.
+fn without_errno(text: &str) -> &str {
+    match text.rfind(" (os error ") {
+        Some(i) if text.ends_with(')') => &text[..i],
+        _ => text,
+    }
+}
+
+/// A failed write to a standard stream: a closed pipe (`afmdyn … | head`) ends the run quietly
+/// with status 141, as SIGPIPE ends other Unix tools; any other failure (`> /dev/full`) is
+/// [`CliError::Io`] naming the stream and the cause, exit code 1.
+fn stream_error(stream: &str, e: &std::io::Error) -> CliError {
+    if e.kind() == std::io::ErrorKind::BrokenPipe {
+        std::process::exit(141);
+    }
+    CliError::Io(format!(
+        "cannot write to {stream}: {}",
+        afmdyn::error::io_message(e)
+    ))
+}
+
+/// Write `args` to standard output and flush it, so that a failure shows here (every print
+/// of the command line goes through this, by the `outln!` macro: `println!` would panic).
+///
+/// # Errors
+/// [`CliError::Io`] naming standard output.
+pub fn write_stdout(args: std::fmt::Arguments<'_>) -> Result<(), CliError> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    out.write_fmt(args)
+        .and_then(|()| out.flush())
+        .map_err(|e| stream_error("standard output", &e))
+}
+
+/// Write `args` to standard error (the `errln!` macro).
+///
+/// # Errors
+/// [`CliError::Io`] naming standard error.
+pub fn write_stderr(args: std::fmt::Arguments<'_>) -> Result<(), CliError> {
+    use std::io::Write;
+    let mut err = std::io::stderr().lock();
+    err.write_fmt(args)
+        .and_then(|()| err.flush())
+        .map_err(|e| stream_error("standard error", &e))
 }
 
 /// A locked output directory: created if needed; a second run on the same directory fails at
@@ -39,7 +89,7 @@ impl OutDir {
         })?;
         if !lock.is_locked() {
             // a file system without advisory locks: run unlocked rather than not at all
-            eprintln!(
+            errln!(
                 "afmdyn: warning: cannot lock {}; concurrent runs on it are not detected",
                 dir.display()
             );
@@ -468,7 +518,7 @@ impl TextUnits {
 }
 
 /// Format a float for CSV: a shortest round-trip representation, in exponent form when
-/// |v| < 1e-4 or ≥ 1e16 — the notation of [`afmdyn::error::number`] (SI values such as
+/// |v| < 1e-4 or ≥ 1e16 — the notation of [`std_format`] (SI values such as
 /// 1.37e-19 J would otherwise print as 24 zeros and their digits), with the digits from `ryu`
 /// (several times faster than the standard library's; a spectrum writes a million of them;
 /// where two shortest forms exist it may pick the other). Where `ryu` chooses the other
@@ -479,18 +529,28 @@ pub fn f(v: f64) -> String {
     String::from_utf8(out).expect("ASCII")
 }
 
+/// `v` with every digit it needs to read back: plain between 1e-4 and 1e16, else in scientific
+/// notation (the library's `afmdyn::error::number` rounds for messages; data keep every digit).
+fn std_format(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() || (1e-4..1e16).contains(&v.abs()) {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
+}
+
 /// [`f`] appended to `out` (no allocation but where the standard formatting is used).
 pub fn f_into(out: &mut Vec<u8>, v: f64) {
     let a = v.abs();
     if !v.is_finite() || a == 0.0 {
-        out.extend(afmdyn::error::number(v).as_bytes());
+        out.extend(std_format(v).as_bytes());
         return;
     }
     let mut buf = ryu::Buffer::new();
     let s = buf.format_finite(v);
     let sci = s.contains('e');
     if sci == (1e-4..1e16).contains(&a) {
-        out.extend(afmdyn::error::number(v).as_bytes());
+        out.extend(std_format(v).as_bytes());
         return;
     }
     out.extend(s.strip_suffix(".0").unwrap_or(s).as_bytes());
@@ -539,7 +599,7 @@ pub fn csv_lines(s: &mut CsvStream, bytes: &[u8]) -> Result<(), CliError> {
 
 #[cfg(test)]
 mod tests {
-    use super::{f, si_value};
+    use super::{f, si_value, std_format};
 
     /// SI prefixes with 6 significant digits.
     #[test]
@@ -650,7 +710,7 @@ mod tests {
     }
 
     /// The fast path reads back to the same double and uses the notation of
-    /// afmdyn::error::number (the standard library's formatting), with as many digits, over
+    /// std_format (the standard library's formatting), with as many digits, over
     /// magnitudes from 1e-300 to 1e300 and the notation boundaries.
     #[test]
     fn csv_numbers_equal_the_standard_formatting() {
@@ -676,7 +736,7 @@ mod tests {
             values.push((x >> 11) as f64 / (1u64 << 53) as f64 * 10f64.powi(e));
         }
         for v in values {
-            let (fast, std) = (f(v), afmdyn::error::number(v));
+            let (fast, std) = (f(v), std_format(v));
             assert_eq!(fast.parse::<f64>().unwrap().to_bits(), v.to_bits(), "{v:e}");
             assert_eq!(
                 fast.contains('e'),

@@ -26,6 +26,14 @@ fn float(name: &str, v: &Bound<'_, PyAny>) -> PyResult<f64> {
             v.get_type().name()?
         )));
     }
+    // an integer beyond a double's range (10**400) is a number out of range, not of a wrong
+    // type (Python's float() raises OverflowError)
+    if v.is_instance_of::<pyo3::types::PyInt>() && v.extract::<f64>().is_err() {
+        return Err(pyo3::exceptions::PyValueError::new_err(format!(
+            "{name} = an integer of {} digits: must be a finite number",
+            v.str()?.to_string().trim_start_matches('-').len()
+        )));
+    }
     v.extract::<f64>().map_err(|_| {
         PyTypeError::new_err(format!(
             "{name}: expected a number, got {}",

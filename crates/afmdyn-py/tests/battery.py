@@ -7,8 +7,21 @@ classified:
   ``ValueError`` / ``TypeError``, or a failure with its cause: exit 1 / ``SimulationError``;
 * ``hang`` — over the time cap; ``memory`` — over the memory cap; ``crash`` — a panic, a signal,
   or an exit code without a meaning; ``unclear`` — a message that is not one line starting with
-  ``afmdyn:``, that leaks a crate's internals, or (Python) an exception of another type, or a
+  ``afmdyn:``, that leaks a crate's internals or prints a number of 17 or more digits, an exit
+  code other than the one its class means, or (Python) an exception of another type, or a
   ``TypeError``/``ValueError`` that does not name the keyword.
+
+The classes: model flags at and beyond their ranges on every command and law (``cli``); probe
+files with a key mutated (``probe``); Python keywords of the wrong type or value (``python``);
+and the faults of issue 42's outside battery (``fault``, each with the exit code it must give):
+non-finite model values of ``chart``; integrator tolerances NaN, 0, negative, ≥ 1e-3 or below
+1e-16 for every law; input files without end or not text (``--probe /dev/zero``,
+``--config /dev/urandom``, ``continue --overlay /dev/zero``, a binary probe file, Python
+``probe="/dev/zero"``); budgets checked up front (``approach --traces`` memory, a chart's
+integrator budget, exit 2 as in ``attractors``); a missing ``--overlay`` (exit 2); writes to a full
+device (``> /dev/full``: exit 1 naming standard output); the contact law's name in capitals in a
+config file (exit 0); Python numbers beyond a double (``cluster_tol=10**400``: ``ValueError``
+naming it); a quality factor of 1e308 (exit 2 naming ``quality_factor``).
 
 The cases are a pure function of the seed, so a run is reproducible. ``test_battery.py`` runs a
 bounded slice in the test command; ``scripts/battery.sh`` runs the whole battery and rewrites
@@ -80,6 +93,54 @@ PY_CALLS = [
     ("resonance", {"mode": ["None", "0", "99"]}),
 ]
 
+_CHART = ["chart", "--x", "omega", "--x-from", "2.6", "--x-to", "3.0", "--x-steps", "2",
+          "--y", "drive-amplitude", "--y-from", "0.1", "--y-to", "0.12", "--y-steps", "2",
+          "--starts", "2", "--max-periods", "200", "--out", "{out}"]
+#: issue 42's faults: (argv, the exit code it must give, the keyword its message names, stdout
+#: file, probe text); "{zero}" is /dev/zero, "{binary}" a file of invalid UTF-8
+FAULTS: List[Tuple[List[str], int, Optional[str], Optional[str], Optional[str]]] = [
+    *[(_CHART + [flag, v], 2, flag[2:], None, None)
+      for flag in ("--contact-stiffness", "--hamaker", "--gap", "--omega")
+      for v in ("nan", "inf", "-inf")],
+    *[(["attractors", "--samples", "2", "--max-periods", "200", "--out", "{out}",
+        "--contact-law", law, "--tolerance", t], 2, "tolerance", None, None)
+      for law in LAWS for t in ("nan", "0", "-1", "1", "1e300", "1e-300")],
+    (["modes", "--probe", "/dev/zero"], 2, "/dev/zero", None, None),
+    (["units", "--probe", "/dev/zero"], 2, "/dev/zero", None, None),
+    (["modes", "--config", "/dev/urandom"], 2, "/dev/urandom", None, None),
+    (["modes", "--config", "/dev/zero"], 2, "/dev/zero", None, None),
+    (["continue", "--from", "2.8", "--to", "2.7", "--overlay", "/dev/zero", "--out", "{out}"],
+     2, "/dev/zero", None, None),
+    (["continue", "--from", "2.8", "--to", "2.7", "--overlay", "missing.csv", "--out", "{out}"],
+     2, "missing.csv", None, None),
+    (["modes", "--probe", "{binary}"], 2, "UTF-8", None, None),
+    (["approach", "--points", "1000", "--traces", "10000", "--files", "none"], 2, "traces",
+     None, None),
+    (_CHART + ["--contact-law", "hertz", "--contact-stiffness", "1e8"], 2, "budget", None, None),
+    (["modes"], 1, "standard output", "/dev/full", None),
+    (["modes", "--json"], 1, "standard output", "/dev/full", None),
+    (["cantilevers"], 1, "standard output", "/dev/full", None),
+    (["units", "--probe", str(PROBES[0])], 1, "standard output", "/dev/full", None),
+    (["modes", "--config", "{config}"], 0, None, None, 'contact_law = "HERTZ"\n'),
+    (["simulate", "--periods", "1e300", "--files", "none"], 2, "periods", None, None),
+    (["modes", "--probe", "{probe}"], 2, "quality_factor", None,
+     PROBES[0].read_text().replace("quality_factor = 400 ", "quality_factor = 1e308 ")),
+]
+#: issue 42's Python faults: (call, the keyword its ValueError must name)
+PY_FAULTS = [
+    ("afmdyn.attractors(cluster_tol=10**400, samples=2, progress=False)", "cluster_tol"),
+    ("afmdyn.chart(x='omega', x_from=2.6, x_to=3.0, x_steps=2, y='drive_amplitude', "
+     "y_from=0.1, y_to=0.12, y_steps=2, cluster_tol=10**400, progress=False)", "cluster_tol"),
+    ("afmdyn.modes(contact_stiffness=10**400)", "contact_stiffness"),
+    ("afmdyn.chart(x='omega', x_from=2.6, x_to=3.0, x_steps=2, y='drive_amplitude', "
+     "y_from=0.1, y_to=0.12, y_steps=2, contact_stiffness=float('inf'), progress=False)",
+     "contact_stiffness"),
+    ("afmdyn.modes(probe='/dev/zero')", "/dev/zero"),
+    ("afmdyn.simulate(periods=1, tolerance=float('nan'), progress=False)", "tolerance"),
+]
+#: a message that prints a double with all its digits (1e300 as 301 digits, 16 of round-off)
+LONG_NUMBER = re.compile(r"\d{17,}")
+
 INTERNALS = re.compile(
     r"panicked|RUST_BACKTRACE|called `(Option|Result)::unwrap|Initial step size|"
     r"Check your problem definition|memory allocation of"
@@ -95,6 +156,10 @@ class Case:
     label: str
     keyword: Optional[str] = None
     probe_text: Optional[str] = None
+    #: the exit code the case must give (issue 42's faults), else any code with a meaning
+    expect: Optional[int] = None
+    #: a file standard output goes to (``/dev/full``)
+    stdout: Optional[str] = None
 
 
 @dataclass
@@ -111,8 +176,17 @@ def cases(seed: int, n: int) -> List[Case]:
     rng = random.Random(seed)
     out: List[Case] = []
     for i in range(n):
-        kind = ("cli", "cli", "probe", "python")[i % 4]
-        if kind == "cli":
+        kind = ("cli", "cli", "probe", "python", "fault")[i % 5]
+        if kind == "fault" and rng.random() < 0.8:
+            argv, expect, keyword, stdout, text = rng.choice(FAULTS)
+            label = " ".join(argv) + (f" > {stdout}" if stdout else "")
+            out.append(Case("fault", list(argv), label, keyword=keyword, probe_text=text,
+                            expect=expect, stdout=stdout))
+        elif kind == "fault":
+            call, keyword = rng.choice(PY_FAULTS)
+            out.append(Case("python", [sys.executable, "-c", f"import afmdyn; {call}"], call,
+                            keyword=keyword))
+        elif kind == "cli":
             cmd = list(rng.choice(COMMANDS))
             law = rng.choice(LAWS)
             flag, value = rng.choice(FLAGS), rng.choice(EXTREMES)
@@ -161,17 +235,31 @@ def run(case: Case, binary: Path, workdir: Path, seconds: float, memory_bytes: i
     if case.kind == "python":
         argv = case.argv
     else:
-        argv = [str(binary.resolve())] + [a.replace("{out}", str(workdir / "out")) for a in case.argv]
+        binfile = workdir / "binary.toml"
+        binfile.write_bytes(b"a = \xff\xfe\n")
+        subst = {"{out}": str(workdir / "out"), "{binary}": str(binfile),
+                 "{config}": str(workdir / "config.toml"), "{probe}": str(workdir / "probe.toml")}
+        argv = [str(binary.resolve())] + [subst.get(a, a) for a in case.argv]
+        if case.kind == "fault" and case.probe_text is not None:
+            (workdir / "config.toml").write_text(case.probe_text)
+            (workdir / "probe.toml").write_text(case.probe_text)
         if case.kind == "probe":
             probe = workdir / "probe.toml"
             probe.write_text(case.probe_text or "")
             argv += ["--probe", str(probe)]
     t0 = time.monotonic()
     try:
-        p = subprocess.run(
-            argv, capture_output=True, text=True, timeout=seconds, cwd=workdir,
-            preexec_fn=_limits(memory_bytes),
-        )
+        if case.stdout is not None:
+            with open(case.stdout, "w") as sink:
+                p = subprocess.run(
+                    argv, stdout=sink, stderr=subprocess.PIPE, text=True, timeout=seconds,
+                    cwd=workdir, preexec_fn=_limits(memory_bytes),
+                )
+        else:
+            p = subprocess.run(
+                argv, capture_output=True, text=True, timeout=seconds, cwd=workdir,
+                preexec_fn=_limits(memory_bytes),
+            )
     except subprocess.TimeoutExpired:
         return Outcome(case, "hang", None, seconds, f"no answer in {seconds:.0f} s")
     dt = time.monotonic() - t0
@@ -191,6 +279,13 @@ def run(case: Case, binary: Path, workdir: Path, seconds: float, memory_bytes: i
             not l.startswith("afmdyn: ") for l in lines
         ):
             return Outcome(case, "unclear", code, dt, err[-300:])
+        if LONG_NUMBER.search(err):
+            return Outcome(case, "unclear", code, dt, f"a long number: {err[-300:]}")
+    if case.expect is not None and (
+        code != case.expect or (code != 0 and case.keyword and case.keyword not in err)
+    ):
+        return Outcome(case, "unclear", code, dt,
+                       f"expected exit {case.expect} naming {case.keyword}: {err[-300:]}")
     return Outcome(case, "ok", code, dt, err.splitlines()[-1] if err else "")
 
 
@@ -253,7 +348,10 @@ def main() -> None:  # pragma: no cover - run by scripts/battery.sh
         )
     total = time.monotonic() - t0
     c = counts(outcomes)
-    by_kind = {k: counts([o for o in outcomes if o.case.kind == k]) for k in ("cli", "probe", "python")}
+    by_kind = {
+        k: counts([o for o in outcomes if o.case.kind == k])
+        for k in ("cli", "probe", "python", "fault")
+    }
     slowest = sorted(outcomes, key=lambda o: -o.seconds)[:5]
     bad = [o for o in outcomes if o.verdict != "ok"]
     print(json.dumps({"counts": c, "by_kind": by_kind, "seconds": round(total, 1)}))
@@ -269,7 +367,12 @@ def main() -> None:  # pragma: no cover - run by scripts/battery.sh
             f"{a.cases} cases from seed {a.seed}, each in its own process capped at "
             f"{a.seconds:.0f} s and {a.memory_gib:g} GiB; {total:.0f} s in all. The classes, the "
             "verdicts and the generator are in `crates/afmdyn-py/tests/battery.py`; a slice of the "
-            "same generator runs in the test command (`test_battery.py`).",
+            "same generator runs in the test command (`test_battery.py`). Classes: `cli` (model "
+            "flags at and beyond their ranges), `probe` (mutated probe files), `python` (keywords "
+            "of the wrong type or value, and issue 42's Python faults), `fault` (issue 42's "
+            "outside battery: non-finite chart values, tolerances, input files without end or not "
+            "text, up-front budgets, writes to a full device, capitalised law names, a quality "
+            "factor of 1e308 — each with the exit code it must give).",
             "",
             "| class | ok | hang | memory | crash | unclear |",
             "|---|---|---|---|---|---|",

@@ -155,7 +155,11 @@ impl fmt::Display for ContactLaw {
 }
 
 /// The kind of a law without its groups, parsed from `linear|hertz|dmt|impact`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+///
+/// One parser for every front end: the name is taken in any case (`"HERTZ"`, `"DMT"` as the
+/// literature writes it) on the command line, in a `--config` file, a probe file and from
+/// Python ([`FromStr`], which [`Deserialize`] calls).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Default)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(rename_all = "lowercase")]
 pub enum LawKind {
@@ -182,6 +186,13 @@ impl FromStr for LawKind {
                 "contact law '{s}': expected linear, hertz, dmt or impact"
             )),
         }
+    }
+}
+
+impl<'de> Deserialize<'de> for LawKind {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let s = String::deserialize(d)?;
+        s.parse().map_err(serde::de::Error::custom)
     }
 }
 

@@ -9,7 +9,7 @@ pub enum ParamError {
     #[error("modes = {0}: the number of Galerkin modes N must be an integer in 1..=20")]
     Modes(usize),
     /// A non-negative coefficient (α1, α2, α3, α4, α6) is negative or not finite.
-    #[error("{name} = {value}: must be finite and >= 0")]
+    #[error("{name} = {}: must be finite and >= 0", number(*value))]
     NonNegative {
         /// Field name with its paper symbol, e.g. `alpha4 (contact stiffness α4)`.
         name: &'static str,
@@ -17,10 +17,10 @@ pub enum ParamError {
         value: f64,
     },
     /// The gap α5 is not finite.
-    #[error("alpha5 (gap α5) = {0}: must be a finite number")]
+    #[error("alpha5 (gap α5) = {}: must be a finite number", number(*.0))]
     Gap(f64),
     /// The drive frequency Ω is not finite or not positive.
-    #[error("omega (drive frequency Ω) = {0}: must be finite and > 0")]
+    #[error("omega (drive frequency Ω) = {}: must be finite and > 0", number(*.0))]
     Omega(f64),
     /// A group given for a law it does not belong to.
     #[error("{group} is a group of the {owner} law, not of contact_law = {law} (set contact_law = {owner})")]
@@ -44,7 +44,7 @@ pub enum ParamError {
     },
     /// A finite value beyond the range where the numerics are meaningful (see the limits in
     /// [`crate::params`]).
-    #[error("{name} = {value:e}: must lie in {range} ({reason})")]
+    #[error("{name} = {}: must lie in {range} ({reason})", number(*value))]
     Magnitude {
         /// Field name with its paper symbol.
         name: &'static str,
@@ -56,7 +56,7 @@ pub enum ParamError {
         reason: &'static str,
     },
     /// A parameter the structural model does not allow (see [`crate::params::Structure`]).
-    #[error("{name}: got {value}")]
+    #[error("{name}: got {}", number(*value))]
     Structure {
         /// Field and the allowed value.
         name: &'static str,
@@ -69,7 +69,7 @@ pub enum ParamError {
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum UnitsError {
     /// A quantity that must be finite and strictly positive is not.
-    #[error("{name} = {value}: must be finite and > 0 ({unit})")]
+    #[error("{name} = {}: must be finite and > 0 ({unit})", number(*value))]
     Positive {
         /// Field name.
         name: &'static str,
@@ -79,7 +79,7 @@ pub enum UnitsError {
         unit: &'static str,
     },
     /// A quantity that must be finite and non-negative is not.
-    #[error("{name} = {value}: must be finite and >= 0 ({unit})")]
+    #[error("{name} = {}: must be finite and >= 0 ({unit})", number(*value))]
     NonNegative {
         /// Field name.
         name: &'static str,
@@ -89,7 +89,7 @@ pub enum UnitsError {
         unit: &'static str,
     },
     /// A Poisson ratio outside (-1, 0.5].
-    #[error("{name} = {value}: a Poisson ratio must lie in (-1, 0.5]")]
+    #[error("{name} = {}: a Poisson ratio must lie in (-1, 0.5]", number(*value))]
     Poisson {
         /// Field name.
         name: &'static str,
@@ -97,7 +97,7 @@ pub enum UnitsError {
         value: f64,
     },
     /// A quantity that must be finite is not.
-    #[error("{name} = {value}: must be a finite number ({unit})")]
+    #[error("{name} = {}: must be a finite number ({unit})", number(*value))]
     Finite {
         /// Field name.
         name: &'static str,
@@ -114,13 +114,64 @@ pub enum UnitsError {
     Params(#[from] ParamError),
 }
 
-/// `v` as a reader writes it: plain between 1e-4 and 1e16, else in scientific notation (Rust's
-/// `{}` spells 1e-300 with 300 zeros).
+/// `v` as a reader writes it, rounded to at most 6 significant digits: plain between 1e-4 and
+/// 1e16, else in scientific notation (Rust's `{}` spells 1e-300 with 300 zeros, and a value
+/// derived from the user's one carries 16 digits of round-off). Every number of an error
+/// message goes through it.
 pub fn number(v: f64) -> String {
-    if v == 0.0 || !v.is_finite() || (1e-4..1e16).contains(&v.abs()) {
-        format!("{v}")
+    if v == 0.0 || !v.is_finite() {
+        return format!("{v}");
+    }
+    // rounded to 6 significant digits, then written in the shortest form that reads back as
+    // that rounded value
+    let r: f64 = format!("{v:.5e}").parse().unwrap_or(v);
+    if (1e-4..1e16).contains(&r.abs()) {
+        format!("{r}")
     } else {
-        format!("{v:e}")
+        format!("{r:e}")
+    }
+}
+
+/// [`number`] of a value given as text: a float (or an integer of more than 15 digits, as
+/// Rust writes 1e300) rounded; a count, a name or a pair as given.
+fn number_text(value: &str) -> String {
+    if value.contains(['.', 'e', 'E']) || value.trim_start_matches('-').len() > 15 {
+        match value.parse::<f64>() {
+            Ok(v) => number(v),
+            Err(_) => value.to_string(),
+        }
+    } else {
+        value.to_string()
+    }
+}
+
+/// The operating system's reason of an I/O error in words (`No space left on device`, without
+/// the `(os error 28)` of its `Display`), and for an error that only has a kind the kind's
+/// words ([`io_kind_message`]).
+pub fn io_message(e: &std::io::Error) -> String {
+    if e.raw_os_error().is_some() {
+        let text = e.to_string();
+        match text.rfind(" (os error ") {
+            Some(i) => text[..i].to_string(),
+            None => text,
+        }
+    } else if e.get_ref().is_some() {
+        e.to_string()
+    } else {
+        io_kind_message(e.kind())
+    }
+}
+
+/// An I/O error kind in words, as the operating system says it where it has the kind's
+/// errno (`StorageFull` is "no space left on device"), else the standard library's words.
+pub fn io_kind_message(kind: std::io::ErrorKind) -> String {
+    use std::io::ErrorKind as K;
+    match kind {
+        K::StorageFull => "no space left on device".into(),
+        K::PermissionDenied => "permission denied".into(),
+        K::NotFound => "no such file or directory".into(),
+        K::BrokenPipe => "broken pipe".into(),
+        k => std::io::Error::from(k).to_string(),
     }
 }
 
@@ -141,7 +192,7 @@ pub enum SimError {
         got: usize,
     },
     /// A state component or a time is NaN or infinite.
-    #[error("{name} = {value}: must be a finite number")]
+    #[error("{name} = {}: must be a finite number", number(*value))]
     NotFinite {
         /// Which input.
         name: &'static str,
@@ -153,7 +204,7 @@ pub enum SimError {
     #[error("{0}")]
     Probe(String),
     /// A run length, count or tolerance is out of range.
-    #[error("{name} = {value}: {allowed}")]
+    #[error("{name} = {}: {allowed}", number_text(value))]
     OutOfRange {
         /// Which input.
         name: &'static str,
@@ -255,9 +306,13 @@ impl SimError {
                 name,
                 value,
                 allowed,
-            } => format!("{} = {value}: {allowed}", spell(name)),
+            } => format!("{} = {}: {allowed}", spell(name), number_text(value)),
             SimError::NotFinite { name, value } => {
-                format!("{} = {value}: must be a finite number", spell(name))
+                format!(
+                    "{} = {}: must be a finite number",
+                    spell(name),
+                    number(*value)
+                )
             }
             other => other.to_string(),
         }

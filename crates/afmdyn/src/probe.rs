@@ -94,6 +94,10 @@ pub enum ProbeError {
         /// The operating system's message.
         message: String,
     },
+    /// The file could not be read, is larger than
+    /// [`crate::request::limits::MAX_INPUT_TEXT_BYTES`] or is not UTF-8 text.
+    #[error(transparent)]
+    File(crate::request::limits::InputFileError),
     /// Not TOML (with line and column from the parser).
     #[error("{path}: {message}")]
     Syntax {
@@ -111,6 +115,11 @@ pub enum ProbeError {
         problems: Vec<String>,
     },
 }
+
+/// The largest quality factor a probe may give: 1e7, beyond the Q of cantilevers and quartz
+/// sensors in vacuum (1e4–1e6); a larger one leaves the beam's damping α3 and the drive
+/// amplitude α2 = A₀/Q-scaled below the double's resolution (Q = 1e308 made α2 NaN).
+pub const MAX_QUALITY_FACTOR: f64 = 1e7;
 
 /// The largest free amplitude A₀ a probe may give (m): 10 µm, a thousand times the tapping-mode
 /// amplitudes (1–100 nm). Lengths are in units of A₀, so beyond it the tip–sample lengths
@@ -322,8 +331,9 @@ impl Reader<'_> {
             Some(x)
         } else {
             self.problems.push(format!(
-                "{}{key} = {x} ({unit}): must be {range}",
-                prefix(section)
+                "{}{key} = {} ({unit}): must be {range}",
+                prefix(section),
+                crate::error::number(x)
             ));
             None
         }
@@ -390,6 +400,8 @@ fn prefix(section: &str) -> String {
 const POSITIVE: (&str, fn(f64) -> bool) = ("finite and > 0", |x| x > 0.0);
 const NON_NEGATIVE: (&str, fn(f64) -> bool) = ("finite and >= 0", |x| x >= 0.0);
 const POISSON: (&str, fn(f64) -> bool) = ("in (-1, 0.5]", |x| x > -1.0 && x <= 0.5);
+/// A quality factor: up to [`MAX_QUALITY_FACTOR`].
+const QUALITY: (&str, fn(f64) -> bool) = ("in (0, 1e7]", |x| x > 0.0 && x <= MAX_QUALITY_FACTOR);
 const UNIT_INTERVAL: (&str, fn(f64) -> bool) = ("in [0, 1]", |x| (0.0..=1.0).contains(&x));
 const ANY: (&str, fn(f64) -> bool) = ("finite", |_| true);
 
@@ -505,12 +517,15 @@ impl Probe {
     /// Read and resolve a probe file.
     ///
     /// # Errors
-    /// [`ProbeError`] naming the path and every problem.
+    /// [`ProbeError`] naming the path and every problem; [`ProbeError::File`] for a file that
+    /// cannot be read, is larger than [`crate::request::limits::MAX_INPUT_TEXT_BYTES`] or is
+    /// not UTF-8 text.
     #[cfg(feature = "files")]
     pub fn load(path: &Path) -> Result<Probe, ProbeError> {
-        let text = std::fs::read_to_string(path).map_err(|e| ProbeError::Io {
-            path: path.display().to_string(),
-            message: e.to_string(),
+        use crate::request::limits::{read_input, InputFileError, MAX_INPUT_TEXT_BYTES};
+        let text = read_input(path, MAX_INPUT_TEXT_BYTES).map_err(|e| match e {
+            InputFileError::Io { path, message } => ProbeError::Io { path, message },
+            e => ProbeError::File(e),
         })?;
         Self::parse(&text, &path.display().to_string())
     }
@@ -758,9 +773,10 @@ impl Probe {
                 let mut v = Vec::with_capacity(a.len());
                 for (i, x) in a.iter().enumerate() {
                     match x.as_float().or(x.as_integer().map(|i| i as f64)) {
-                        Some(q) if q.is_finite() && q > 0.0 => v.push(q),
+                        Some(q) if q.is_finite() && q > 0.0 && q <= MAX_QUALITY_FACTOR => v.push(q),
                         _ => r.problems.push(format!(
-                            "[cantilever].quality_factors[{i}] = {x}: must be a number > 0"
+                            "[cantilever].quality_factors[{i}] = {}: must be a number in (0, 1e7]",
+                            x.as_float().map_or(x.to_string(), crate::error::number)
                         )),
                     }
                 }
@@ -773,7 +789,7 @@ impl Probe {
             }
         };
         let q1 = match (c.contains_key("quality_factor"), &qs) {
-            (true, _) => r.required(c, S, "quality_factor", "1", POSITIVE),
+            (true, _) => r.required(c, S, "quality_factor", "1", QUALITY),
             (false, Some(q)) => q.first().copied(),
             (false, None) => {
                 r.problems

@@ -211,6 +211,6 @@ fn probe_refusals_name_the_keys_written() {
     let msg = with(beam, "quality_factor", "quality_factors = [400, -1, 900]");
     assert_eq!(
         msg,
-        "probe.toml: [cantilever].quality_factors[1] = -1: must be a number > 0"
+        "probe.toml: [cantilever].quality_factors[1] = -1: must be a number in (0, 1e7]"
     );
 }

@@ -166,8 +166,9 @@ _F = TypeVar("_F", bound=Callable[..., Any])
 def _typed(f: _F) -> _F:
     """Check the keywords of the public function ``f`` against its annotations before any
     work: ``int``/``float``/``bool``/``str`` and their ``Optional[...]``. A wrong type is a
-    ``TypeError`` naming the keyword and what it takes; an integer beyond 64 bits a
-    ``ValueError`` naming it (the core's conversions would say neither)."""
+    ``TypeError`` naming the keyword and what it takes; an integer beyond 64 bits (or, for a
+    ``float`` keyword, beyond a double's range) a ``ValueError`` naming it (the core's
+    conversions would say neither)."""
     sig = inspect.signature(f)
     checks: Dict[str, Tuple[str, bool]] = {}
     for name, prm in sig.parameters.items():
@@ -194,6 +195,16 @@ def _typed(f: _F) -> _F:
                 )
             if base == "int" and not -(2**63) <= int(value) < 2**63:
                 raise ValueError(f"{name} = {value}: out of range (far beyond every limit)")
+            if base == "float" and isinstance(value, numbers.Integral):
+                # float(10**400) raises OverflowError: a number out of range is a ValueError
+                try:
+                    float(value)
+                except OverflowError:
+                    digits = len(str(abs(int(value))))
+                    raise ValueError(
+                        f"{name} = an integer of {digits} digits: must be a finite number "
+                        "(far beyond every limit)"
+                    ) from None
         return f(*args, **kwargs)
 
     return cast(_F, checked)

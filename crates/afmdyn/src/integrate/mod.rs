@@ -565,6 +565,28 @@ impl FromStr for IntegratorKind {
     }
 }
 
+/// The range of an integrator tolerance ([`IntegratorOptions::tolerance`]), checked by
+/// [`build`] for every integrator, those that ignore it (the exact propagator, RK4) included:
+/// below 1e-16 a relative tolerance is beneath a double's resolution (the steps would shrink
+/// without end), above 1e-3 it is no longer an accuracy.
+pub const TOLERANCE_RANGE: (f64, f64) = (1e-16, 1e-3);
+
+/// Check `tol` against [`TOLERANCE_RANGE`].
+///
+/// # Errors
+/// [`SimError::OutOfRange`] naming `tolerance`.
+pub fn check_tolerance(tol: f64) -> Result<(), SimError> {
+    if tol.is_finite() && (TOLERANCE_RANGE.0..=TOLERANCE_RANGE.1).contains(&tol) {
+        Ok(())
+    } else {
+        Err(SimError::out_of_range(
+            "tolerance",
+            crate::error::number(tol),
+            "must be in [1e-16, 1e-3] (the integrator's relative and absolute tolerance)",
+        ))
+    }
+}
+
 /// Options shared by the integrators.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct IntegratorOptions {
@@ -650,7 +672,8 @@ pub fn check_buildable_over(
 /// [`IntegratorKind::resolve`]).
 ///
 /// # Errors
-/// [`SimError`] for invalid options or initial state; [`SimError::Unsupported`] for the exact
+/// [`SimError`] for invalid options (a tolerance outside [`TOLERANCE_RANGE`] whatever the
+/// integrator) or initial state; [`SimError::Unsupported`] for the exact
 /// propagator with a nonlinear law, or RK4 with the impact law.
 pub fn build(
     model: &CantileverModel,
@@ -659,6 +682,7 @@ pub fn build(
     z: &DVector<f64>,
 ) -> Result<Box<dyn Integrator>, SimError> {
     check_steps_per_period(opts.steps_per_period)?;
+    check_tolerance(opts.tolerance)?;
     // up-front budgets: a start at or beyond the divergence threshold, and (adaptive) a period
     // that would need more steps than the budget, are refused before any work is done
     check_start(z)?;

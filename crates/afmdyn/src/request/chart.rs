@@ -243,7 +243,10 @@ impl ChartRequest {
     /// cannot occur).
     ///
     /// # Errors
+    /// [`SimError::NotFinite`] naming a model value that is not a finite number;
     /// [`SimError::OutOfRange`] naming the option (`x`, `x_steps`, `starts`, `tile`, …),
+    /// [`SimError::Budget`] or [`SimError::Unsupported`] for an integrator that cannot be built
+    /// at a corner of the chart ([`crate::integrate::check_buildable`]);
     /// [`SimError::Params`] (or the out-of-range error of `z_c`, `drive_frequency`) for an
     /// axis value out of its parameter's range.
     pub fn chart(
@@ -252,6 +255,7 @@ impl ChartRequest {
         defaults: Params,
         probe: Option<&str>,
     ) -> Result<Chart, SimError> {
+        base.check_finite()?;
         let x = axis_name("x", &self.x)?;
         let y = axis_name("y", &self.y)?;
         let table: Option<toml::Table> = match probe {
@@ -381,6 +385,18 @@ impl ChartRequest {
             steady: self.steady.options()?,
             integrator: self.integrator.options(1),
         };
+        // the integrator's up-front budgets (steps per period, support of the law) at the
+        // corners, as the attractor census checks them: an input error before any cell runs,
+        // not every cell failing alike
+        let (xs, ys) = (&spec.x, &spec.y);
+        for (xv, yv) in [
+            (xs[0], ys[0]),
+            (xs[xs.len() - 1], ys[0]),
+            (xs[0], ys[ys.len() - 1]),
+            (xs[xs.len() - 1], ys[ys.len() - 1]),
+        ] {
+            crate::integrate::check_buildable(&model.params(xv, yv)?, spec.integrator)?;
+        }
         let fingerprint = fingerprint(self, &model);
         Ok(Chart {
             spec,

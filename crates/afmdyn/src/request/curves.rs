@@ -56,6 +56,9 @@ impl Default for CurveRequest {
     }
 }
 
+/// Bytes in a GiB.
+const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
+
 impl CurveRequest {
     /// The given ends and step are finite numbers (a NaN end was reported as the other one).
     ///
@@ -98,8 +101,9 @@ impl CurveRequest {
     /// its grid (before any work or output).
     ///
     /// # Errors
-    /// [`SimError::OutOfRange`] for a tolerance outside (0, 1e-3); [`SimError::Params`] for
-    /// parameters invalid at an end of the grid.
+    /// [`SimError::OutOfRange`] for a tolerance outside (0, 1e-3) or traces samples outside
+    /// 2..=10000; [`SimError::Budget`] for traces beyond [`super::limits::MAX_TRACE_BYTES`];
+    /// [`SimError::Params`] for parameters invalid at an end of the grid.
     pub fn configure(&self, mut spec: SteppedSpec) -> Result<SteppedSpec, SimError> {
         let tol = self.tolerance;
         if !(tol.is_finite() && tol > 0.0 && tol < 1e-3) {
@@ -121,6 +125,23 @@ impl CurveRequest {
                     n,
                     "must be in 2..=10000 samples per drive period",
                 ));
+            }
+            // the worst case up front: every trace over MAX_TRACE_PERIODS periods
+            let bytes = spec.values.len() as f64
+                * (crate::analysis::traces::MAX_TRACE_PERIODS * n) as f64
+                * super::limits::TRACE_BYTES_PER_SAMPLE;
+            if bytes > super::limits::MAX_TRACE_BYTES {
+                return Err(SimError::Budget {
+                    what: "traces",
+                    needed: format!(
+                        "{} points × {n} samples per period × up to {} periods: up to {:.1} GiB",
+                        spec.values.len(),
+                        crate::analysis::traces::MAX_TRACE_PERIODS,
+                        bytes / GIB
+                    ),
+                    budget: "1 GiB".into(),
+                    hint: "fewer points or fewer traces samples per period",
+                });
             }
             spec.trace_samples = n;
         }

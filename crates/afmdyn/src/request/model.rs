@@ -313,6 +313,36 @@ impl ModelSpec {
         }
     }
 
+    /// Every given value is a finite number. A chart carries its model values through JSON to
+    /// set one per cell, where a NaN or an infinity would become `null` and silently the
+    /// default; the other analyses refuse them through [`ModelSpec::resolve`] alike.
+    ///
+    /// # Errors
+    /// [`SimError::NotFinite`] naming the first value that is not finite by its request name
+    /// (`contact_stiffness`, `z_c`, …).
+    pub fn check_finite(&self) -> Result<(), SimError> {
+        let values = [
+            ("tip_mass_ratio", self.tip_mass_ratio),
+            ("drive_amplitude", self.drive_amplitude),
+            ("beam_damping", self.beam_damping),
+            ("contact_stiffness", self.contact_stiffness),
+            ("gap", self.gap),
+            ("contact_damping", self.contact_damping),
+            ("omega", self.omega),
+            ("restitution", self.restitution),
+            ("hamaker", self.hamaker),
+            ("intermolecular_distance", self.intermolecular_distance),
+            ("z_c", self.z_c),
+            ("drive_frequency", self.drive_frequency),
+        ];
+        for (name, v) in values {
+            if let Some(x) = v {
+                crate::error::finite(name, x)?;
+            }
+        }
+        Ok(())
+    }
+
     /// The parameter set: `defaults`, or the probe's set when a probe is given, with this
     /// spec's values applied, then `z_c` (α5 = [`Params::alpha5_for_rest_distance`] of z_c in
     /// units of the probe's length scale) and `drive_frequency` (Ω from the probe's time
@@ -608,8 +638,7 @@ mod tests {
         .resolve(Params::default(), None)
         .unwrap_err();
         assert!(
-            e.to_string()
-                .starts_with("z_c = 0.000000001: needs a probe"),
+            e.to_string().starts_with("z_c = 1e-9: needs a probe"),
             "{e}"
         );
         let probe = Probe::parse(
