@@ -54,21 +54,33 @@ def inline_commands() -> List[tuple]:
     return found
 
 
-def block_commands() -> List[tuple]:
-    """The ``afmdyn …`` lines of docs/*.md's code blocks (``$ `` prompts stripped)."""
+def block_commands(refused: bool = False) -> List[tuple]:
+    """The ``afmdyn …`` lines of docs/*.md's code blocks (``$ `` prompts stripped); with
+    ``refused``, (file, args, message) of those the docs show refused: followed in their block
+    by the line ``afmdyn: …`` the command prints."""
     found = []
+    shown = []
     for path in DOCS:
         fence = None  # the open block's language, None outside a block
+        last = None
         for line in path.read_text(encoding="utf-8").splitlines():
             if line.startswith("```"):
                 fence = None if fence is not None else line[3:].strip()
+                last = None
                 continue
             line = line.strip()
+            if line.startswith("afmdyn: ") and last is not None:
+                shown.append((path.name, last, line))
+                continue
             if line.startswith("$ "):
                 line = line[2:]
+            last = None
             if fence in ("", "sh", "bash", "console") and line.startswith("afmdyn "):
-                found.append((path.name, shlex.split(line[len("afmdyn "):], comments=True)))
-    return found
+                last = shlex.split(line[len("afmdyn "):], comments=True)
+                found.append((path.name, last))
+    if refused:
+        return shown
+    return [(n, a) for n, a in found if not any(a is s[1] for s in shown)]
 
 
 def test_every_flag_the_docs_name_exists(cli):
@@ -118,3 +130,10 @@ def test_the_docs_code_block_commands_run(cli, tmp_path):
         assert run.returncode == 0, f"{name}: afmdyn {' '.join(args)}: {run.stderr}"
         ran += 1
     assert ran >= 4
+    # the refusals the docs show are what the command prints (bad.toml's is abridged there)
+    for name, args, message in block_commands(refused=True):
+        if any("bad" in a for a in args):
+            continue
+        run = cli(*args, cwd=tmp_path)
+        assert run.returncode == 2, f"{name}: afmdyn {' '.join(args)}: {run.stderr}"
+        assert run.stderr.strip() == message, f"{name}: {run.stderr!r} vs {message!r}"

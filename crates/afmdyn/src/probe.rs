@@ -487,12 +487,7 @@ impl Probe {
         let origin = source.origin();
         let text = match source {
             #[cfg(feature = "files")]
-            ProbeSource::Path(path) => {
-                std::fs::read_to_string(path).map_err(|e| ProbeError::Io {
-                    path: origin.clone(),
-                    message: e.to_string(),
-                })?
-            }
+            ProbeSource::Path(path) => Self::read_file(path)?,
             ProbeSource::Text(t) => t.to_string(),
             ProbeSource::Table(t) => toml::to_string(t).map_err(|e| ProbeError::Syntax {
                 path: origin.clone(),
@@ -522,12 +517,23 @@ impl Probe {
     /// not UTF-8 text.
     #[cfg(feature = "files")]
     pub fn load(path: &Path) -> Result<Probe, ProbeError> {
+        let text = Self::read_file(path)?;
+        Self::parse(&text, &path.display().to_string())
+    }
+
+    /// The text of a probe file, bounded: the one reader of [`Probe::load`] and
+    /// [`Probe::source_text`] (a `/dev/zero` is refused after
+    /// [`crate::request::limits::MAX_INPUT_TEXT_BYTES`], not read until memory runs out).
+    ///
+    /// # Errors
+    /// As [`Probe::load`].
+    #[cfg(feature = "files")]
+    fn read_file(path: &Path) -> Result<String, ProbeError> {
         use crate::request::limits::{read_input, InputFileError, MAX_INPUT_TEXT_BYTES};
-        let text = read_input(path, MAX_INPUT_TEXT_BYTES).map_err(|e| match e {
+        read_input(path, MAX_INPUT_TEXT_BYTES).map_err(|e| match e {
             InputFileError::Io { path, message } => ProbeError::Io { path, message },
             e => ProbeError::File(e),
-        })?;
-        Self::parse(&text, &path.display().to_string())
+        })
     }
 
     /// Resolve a probe from TOML text; `origin` names it in errors.

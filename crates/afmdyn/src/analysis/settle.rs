@@ -264,3 +264,29 @@ pub fn minimal_period(integ: &mut dyn Integrator, z: &DVector<f64>, n: usize, to
     }
     n
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Returns x_k = p_{k mod n} + c ρ^k rotating in from a period-n cycle: the guesses are 1
+    /// and n (the shift at which the newest return comes closest), and 1 alone for n = 1.
+    #[test]
+    fn the_period_guesses_are_one_and_the_cycle_being_approached() {
+        for n in [1usize, 2, 3, 5] {
+            let returns: Vec<DVector<f64>> = (0..25)
+                .map(|k| {
+                    let phase = 2.0 * std::f64::consts::PI * (k % n) as f64 / n as f64;
+                    let decay = 0.3 * 0.97f64.powi(k as i32);
+                    DVector::from_vec(vec![
+                        phase.cos() + decay * (0.1 * k as f64).cos(),
+                        phase.sin() + decay * (0.1 * k as f64).sin(),
+                    ])
+                })
+                .collect();
+            let want = if n == 1 { vec![1] } else { vec![1, n] };
+            assert_eq!(period_guesses(&returns, 16), want, "n = {n}");
+        }
+        assert_eq!(period_guesses(&[], 16), vec![1]);
+    }
+}
