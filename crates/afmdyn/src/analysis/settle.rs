@@ -144,6 +144,9 @@ pub fn period_guesses(returns: &[DVector<f64>], max_period: usize) -> Vec<usize>
 /// Integrate from `z0` (τ = 0) for at most `budget` drive periods, in chunks of
 /// `opts.chunk_periods`, trying Newton (period `period`, or the [`period_guesses`] of the
 /// chunk's returns) from the transient until it is seen to go to a stable orbit (module docs).
+/// Without a `period` every return is also handed to `on_return`, which ends the run (no
+/// orbit found, the state that return's) when it returns `true`: the caller's own test on the
+/// returns (they repeat) decides whichever comes first.
 /// After a failed attempt the next one waits 1.5 times as many chunks, at most
 /// [`SettleOptions::max_wait`].
 ///
@@ -155,6 +158,7 @@ pub fn newton_from_transient(
     period: Option<usize>,
     opts: &SettleOptions,
     budget: usize,
+    on_return: &mut dyn FnMut(&DVector<f64>) -> bool,
 ) -> Result<Settling, SimError> {
     let drive = integ.system().period();
     let chunk = opts.chunk_periods.max(1);
@@ -175,6 +179,13 @@ pub fn newton_from_transient(
             for k in 1..=chunk {
                 advance(integ, k as f64 * drive)?;
                 returns.push(integ.state().clone());
+                if on_return(integ.state()) {
+                    return Ok(Settling {
+                        found: None,
+                        state: integ.state().clone(),
+                        periods: elapsed + k,
+                    });
+                }
             }
         }
         elapsed += chunk;

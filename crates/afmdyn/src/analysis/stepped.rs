@@ -361,7 +361,8 @@ pub fn settle(
         settled: SETTLED,
         linear: true,
     };
-    let s = newton_from_transient(integ, z0, Some(n), &opts, cap.min(NEWTON_CHUNKS * chunk))?;
+    let budget = cap.min(NEWTON_CHUNKS * chunk);
+    let s = newton_from_transient(integ, z0, Some(n), &opts, budget, &mut |_| false)?;
     if let Some(found) = s.found {
         return Ok(found);
     }
