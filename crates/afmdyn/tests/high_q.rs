@@ -242,3 +242,26 @@ fn the_lyapunov_transient_is_derived_by_default() {
     .unwrap();
     assert_ne!(a.exponents, c.exponents);
 }
+
+/// A start on the saddle between the two orbits (|μ₁| = 1.0035) lingers there for thousands
+/// of periods, its returns repeating to 1e-8: they are a passage, not the steady state. The
+/// search goes on until the motion leaves for one of the two stable orbits (before, a basin
+/// map of this probe labelled 0.3 % of its cells with the saddle).
+#[test]
+fn a_passage_near_the_saddle_is_not_a_steady_state() {
+    use afmdyn::analysis::shooting::{shoot, ShootingOptions};
+    let p = lever(14.3e-9);
+    let model = CantileverModel::new(&p).unwrap();
+    // the saddle, from a state near it (a basin map's third "attractor")
+    let near = nalgebra::DVector::from_vec(vec![-0.2178, 0.9493]);
+    let saddle = shoot(&model, &near, 1, &ShootingOptions::default()).unwrap();
+    assert!(!saddle.stable && saddle.multipliers[0].norm() > 1.0);
+    let z0 = &saddle.state + nalgebra::DVector::from_vec(vec![1e-9, 0.0]);
+    let mut it = build(&model, IntegratorOptions::default(), 0.0, &z0).unwrap();
+    let s = steady_state(it.as_mut(), &SteadyOptions::default()).unwrap();
+    assert_eq!(s.period(), Some(1));
+    let end = s.end_state().clone();
+    let orbit = shoot(&model, &end, 1, &ShootingOptions::default()).unwrap();
+    assert!(orbit.stable, "ended on {:?}", orbit.multipliers[0]);
+    assert!((&orbit.state - &saddle.state).norm() > 0.05);
+}

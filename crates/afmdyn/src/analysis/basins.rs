@@ -727,10 +727,28 @@ pub fn basins_with(spec: &BasinSpec, progress: &Progress) -> Result<BasinMap, Si
         orbits: Vec::new(),
         lyapunov: Vec::new(),
     };
+    // one orbit, one attractor: an attractor whose polished orbit is an earlier one's takes its
+    // id (found from returns that repeat to tol, its points lie up to tol/(1 − |μ₁|) off the
+    // orbit, more than cluster_tol on a lightly damped lever), as the census merges its clusters
+    let mut ids = Vec::with_capacity(polished.len());
     for (s, o, l) in polished {
-        map.attractors.push(s);
-        map.orbits.push(o);
-        map.lyapunov.push(l);
+        let same = map.attractors.iter().zip(&map.orbits).position(|(a, ao)| {
+            o.is_some() && ao.is_some() && same_attractor(a, &s, spec.cluster_tol)
+        });
+        match same {
+            Some(i) => ids.push(i as i64),
+            None => {
+                ids.push(map.attractors.len() as i64);
+                map.attractors.push(s);
+                map.orbits.push(o);
+                map.lyapunov.push(l);
+            }
+        }
+    }
+    for c in &mut map.cells {
+        if c.label >= 0 {
+            c.label = ids[c.label as usize];
+        }
     }
     Ok(map)
 }

@@ -2,7 +2,7 @@
 
 use super::period::{detect_period, minimal_divisor, MAX_PERIOD, MERGE_FACTOR};
 use super::settle::{minimal_period, newton_from_transient, SettleOptions, CENSUS_SETTLED};
-use super::shooting::ShootingOptions;
+use super::shooting::{shoot_with, ShootingOptions};
 use crate::eigen::damped_eigenvalues;
 use crate::error::SimError;
 use crate::galerkin::Region;
@@ -366,11 +366,6 @@ impl ReturnHistory {
         }
     }
 
-    /// Whether the transient cap is reached.
-    fn exhausted(&self, cap: usize) -> bool {
-        self.k >= cap
-    }
-
     /// Account for the next return; `Some(n)` once a period n is confirmed.
     fn push(&mut self, z: &DVector<f64>, opts: &SteadyOptions) -> Option<usize> {
         self.k += 1;
@@ -500,9 +495,11 @@ pub fn steady_state(
     let cap = opts.cap(integ.system());
     let mut returns = ReturnHistory::new(opts, integ.state());
     let mut found = None;
+    // periods spent before `returns` was last restarted
+    let mut before = 0;
     if opts.newton_on(integ.system()) {
         let tau0 = integ.tau();
-        let z0 = integ.state().clone();
+        let mut z = integ.state().clone();
         let settle = SettleOptions {
             newton: ShootingOptions {
                 tol: (opts.tol * 1e-2).max(1e-12),
@@ -514,28 +511,46 @@ pub fn steady_state(
             settled: CENSUS_SETTLED,
             linear: false,
         };
-        // the returns keep their own test: whichever decides first
-        let mut on_return = |z: &DVector<f64>| {
-            found = returns.push(z, opts);
-            found.is_some()
-        };
-        let s = newton_from_transient(integ, &z0, None, &settle, cap, &mut on_return)?;
-        let spent = s.periods;
-        if let Some(orbit) = s.found {
-            let n = orbit.period.unwrap_or(1);
-            let n = minimal_period(integ, &orbit.state, n, opts.tol);
+        loop {
+            // the returns keep their own test: whichever decides first
+            let mut on_return = |z: &DVector<f64>| {
+                found = returns.push(z, opts);
+                found.is_some()
+            };
+            let budget = cap.saturating_sub(before);
+            let s = newton_from_transient(integ, &z, None, &settle, budget, &mut on_return)?;
+            let spent = before + s.periods;
             integ.set_variational(false);
-            integ.reset(tau0 + spent as f64 * period, &orbit.state)?;
-            return record(integ, Some(n), spent, opts);
+            if let Some(orbit) = s.found {
+                let n = orbit.period.unwrap_or(1);
+                let n = minimal_period(integ, &orbit.state, n, opts.tol);
+                integ.reset(tau0 + spent as f64 * period, &orbit.state)?;
+                return record(integ, Some(n), spent, opts);
+            }
+            // returns that repeat near an unstable orbit (a start near its stable manifold
+            // lingers there: |μ₁| = 1.0035 on the RTESPA-300 probe's saddle) are a passage,
+            // not the steady state: the transient goes on
+            let passage = match found {
+                Some(n) if spent < cap => {
+                    shoot_with(integ, &s.state, n, &settle.newton).is_ok_and(|o| !o.stable)
+                }
+                _ => false,
+            };
+            integ.reset(tau0 + spent as f64 * period, &s.state)?;
+            if !passage {
+                break;
+            }
+            found = None;
+            before = spent;
+            returns = ReturnHistory::new(opts, &s.state);
+            z = s.state;
         }
-        integ.set_variational(false);
-        integ.reset(tau0 + spent as f64 * period, &s.state)?;
     }
-    while found.is_none() && !returns.exhausted(cap) {
+    while found.is_none() && before + returns.k < cap {
         next_section(integ, None)?;
         found = returns.push(integ.state(), opts);
     }
-    record(integ, found, returns.k, opts)
+    record(integ, found, before + returns.k, opts)
 }
 
 /// Drive periods between the Newton attempts of [`steady_state`] on a slowly decaying model
