@@ -99,8 +99,9 @@ impl Attractor {
     }
 }
 
-/// Drive periods of the λ₁ estimate of a census's nonperiodic ends (as a chart's default).
-pub const CENSUS_LYAPUNOV_PERIODS: usize = 500;
+/// Drive periods of the λ₁ estimate of a census's nonperiodic ends: a basin map's
+/// ([`super::basins::LYAPUNOV_PERIODS`], as a chart's default).
+pub const CENSUS_LYAPUNOV_PERIODS: usize = super::basins::LYAPUNOV_PERIODS;
 
 /// The result of an attractor search.
 #[derive(Debug, Clone, PartialEq)]
