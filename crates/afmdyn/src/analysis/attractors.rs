@@ -264,6 +264,12 @@ impl AttractorReport {
     }
 }
 
+/// Two steady states, each with whether Newton polished it onto its orbit, are one orbit: both
+/// polished and [`same_attractor`] (the rule of the census's and the basin map's merges).
+pub(crate) fn same_orbit(a: (&SteadyState, bool), b: (&SteadyState, bool), tol: f64) -> bool {
+    a.1 && b.1 && same_attractor(a.0, b.0, tol)
+}
+
 /// One orbit, one attractor: clusters whose polished orbits coincide ([`same_attractor`] on
 /// the orbits' section points, which Newton put within its tolerance of the orbit) are merged
 /// into the first, their counts added. Runs are clustered on their last returns, which lie
@@ -273,7 +279,11 @@ fn merge_polished(attractors: Vec<Attractor>, tol: f64) -> Vec<Attractor> {
     let mut merged: Vec<Attractor> = Vec::with_capacity(attractors.len());
     for a in attractors {
         let same = |b: &&mut Attractor| {
-            a.orbit.is_some() && b.orbit.is_some() && same_attractor(&b.steady, &a.steady, tol)
+            same_orbit(
+                (&b.steady, b.orbit.is_some()),
+                (&a.steady, a.orbit.is_some()),
+                tol,
+            )
         };
         match merged.iter_mut().find(same) {
             Some(b) => b.count += a.count,

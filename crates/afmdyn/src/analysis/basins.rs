@@ -31,7 +31,7 @@
 //! result), so any thread count gives the same map; the attractors of the rows are matched in
 //! row order (the first pass's rows, then the second's) into global ids.
 
-use super::attractors::{polish_steady, same_attractor};
+use super::attractors::{polish_steady, same_attractor, same_orbit};
 use super::bifurcation::mix64;
 use super::lyapunov::largest_exponent;
 use super::progress::Progress;
@@ -732,9 +732,10 @@ pub fn basins_with(spec: &BasinSpec, progress: &Progress) -> Result<BasinMap, Si
     // orbit, more than cluster_tol on a lightly damped lever), as the census merges its clusters
     let mut ids = Vec::with_capacity(polished.len());
     for (s, o, l) in polished {
-        let same = map.attractors.iter().zip(&map.orbits).position(|(a, ao)| {
-            o.is_some() && ao.is_some() && same_attractor(a, &s, spec.cluster_tol)
-        });
+        let same =
+            map.attractors.iter().zip(&map.orbits).position(|(a, ao)| {
+                same_orbit((a, ao.is_some()), (&s, o.is_some()), spec.cluster_tol)
+            });
         match same {
             Some(i) => ids.push(i as i64),
             None => {
