@@ -7,14 +7,14 @@ use crate::plot::{
     save, save_scatter_stream, save_stacked, ChunkSink, Figure, IdSeries, LegendEntry, Series,
     StackedFractions, Style,
 };
-use afmdyn::analysis::bifurcation::{Branch, SweepPoint};
+use afmdyn::analysis::bifurcation::Branch;
 use afmdyn::analysis::global_continuation::DEFAULT_MATCH_TOL;
 use afmdyn::integrate::build;
-use afmdyn::request::checkpoint::{self, Checkpoint, CheckpointError};
+use afmdyn::request::checkpoint::{CheckpointError, SweepStudy};
 use afmdyn::request::limits::ATTRACTOR_SAMPLES_PER_PERIOD;
 use afmdyn::request::sweep::{
-    branch_code, fingerprint, status_code, sweep_failure, COL_BRANCH, COL_INDEX, COL_MESSAGE,
-    COL_PERIOD, COL_POINT, COL_STATUS, COL_TAU, COL_X_MAX, NUMERIC_COLUMNS,
+    branch_code, status_code, sweep_failure, COL_BRANCH, COL_INDEX, COL_MESSAGE, COL_PERIOD,
+    COL_POINT, COL_STATUS, COL_TAU, COL_X_MAX, NUMERIC_COLUMNS,
 };
 use afmdyn::request::{
     AttractorsRequest, BifurcationRequest, FileCheckpoint, GlobalContinuationRequest, SteadyRequest,
@@ -23,10 +23,8 @@ use afmdyn::request::{Document, Resolved};
 use afmdyn::trajectory::{record, RecordSpec};
 use afmdyn::{CantileverModel, Params, SweepParam};
 use clap::Args;
-use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 /// Steady-state flags.
 #[derive(Debug, Clone, Args)]
@@ -124,8 +122,12 @@ pub(crate) fn store_error(e: CheckpointError, what: &str) -> CliError {
     }
 }
 
-fn checkpoint_error(e: CheckpointError) -> CliError {
-    store_error(e, "sweep")
+/// The command line's message for a study that stopped ([`store_error`] for its store).
+pub(crate) fn study_error(e: afmdyn::study::StudyError, what: &str) -> CliError {
+    match e {
+        afmdyn::study::StudyError::Store(e) => store_error(e, what),
+        afmdyn::study::StudyError::Sim(e) => CliError::Sim(e),
+    }
 }
 
 fn period_color(period: f64) -> usize {
@@ -175,29 +177,16 @@ pub fn bifurcation(a: &BifurcationArgs) -> Result<(), CliError> {
     let out = OutDir::lock(&a.out)?;
     let mut store = FileCheckpoint::new(out.dir_lock());
     let final_csv = store.final_csv();
-    let args = fingerprint(&request, &spec);
-    if let Some(resume) = checkpoint::open(&mut store, &args, a.resume).map_err(checkpoint_error)? {
-        let bar = ProgressBar::new(checkpoint::point_count(&spec) as u64);
-        bar.set_style(
-            ProgressStyle::with_template("{bar:40} {pos}/{len} points  {elapsed} / ~{duration}")
-                .expect("template"),
-        );
-        bar.inc(resume.done.len() as u64);
-        let written = AtomicUsize::new(0);
-        let each = |_: &SweepPoint| {
-            bar.inc(1);
-            let n = written.fetch_add(1, Ordering::SeqCst) + 1;
-            if a.abort_after == Some(n) {
-                std::process::abort();
-            }
-        };
-        let pool = afmdyn::request::thread_pool(a.threads)?;
-        let cancel = AtomicBool::new(false);
-        let ran = pool.install(|| checkpoint::run(&spec, &resume, &mut store, &cancel, &each));
-        bar.finish_and_clear();
-        ran.and_then(|()| store.finish(&args))
-            .map_err(checkpoint_error)?;
-    }
+    let study = SweepStudy::new(&request, spec.clone());
+    crate::progress::study(
+        &study,
+        &mut store,
+        a.resume,
+        a.threads,
+        "points",
+        a.abort_after,
+    )
+    .map_err(|e| study_error(e, "sweep"))?;
     // derived files, streamed from the finished CSV
     let mut b = (
         f64::INFINITY,

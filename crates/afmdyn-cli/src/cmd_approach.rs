@@ -5,7 +5,6 @@
 use crate::args::{quantity, Dim, ModelArgs, Quantity};
 use crate::cmd_simulate::Files;
 use crate::error::CliError;
-use crate::netcdf::Var;
 use crate::output::si_value;
 use crate::output::{f, write_csv, Column, NpyStream, OutDir};
 use crate::plot::{save, Figure, Series, Style};
@@ -18,6 +17,7 @@ use afmdyn::report::{curve_row, CurveUnits, CURVE_COLUMNS};
 use afmdyn::request::{
     Analysis, ApproachRequest, CurveRequest, Document, Resolved, ResonanceRequest,
 };
+use afmdyn::study::{Layout, Variable};
 use afmdyn::Params;
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -187,24 +187,33 @@ fn row(
     event: Option<BranchEvent>,
 ) -> Vec<f64> {
     let period_s = std::f64::consts::TAU / omega * u.time;
+    // the library's values of the observables in u's units (one derivation: curve_row), in
+    // the order of this file's columns
+    let c = curve_row(o, u);
+    let at = |name: &str| {
+        c[CURVE_COLUMNS
+            .iter()
+            .position(|n| *n == name)
+            .expect("a curve column")]
+    };
     let mut r = vec![
         x,
-        o.amplitude * u.length,
-        o.phase.to_degrees(),
-        o.min_distance * u.length,
-        o.peak_force.max(-o.min_force) * u.force,
-        o.energy_dissipated * u.energy,
-        o.virial * u.energy,
-        o.mean_deflection * u.length,
+        at("amplitude"),
+        at("phase_deg"),
+        at("min_distance"),
+        at("peak_force").max(-at("min_force")),
+        at("energy_dissipated"),
+        at("virial"),
+        at("mean_deflection"),
         o.contact_time * u.time,
-        o.energy_dissipated * u.energy / period_s,
+        at("energy_dissipated") / period_s,
         code,
-        o.amplitude / o.closed_form.free_amplitude,
-        o.peak_force * u.force,
-        o.min_force * u.force,
-        o.indentation * u.length,
-        o.contact_fraction,
-        o.thd,
+        at("amplitude_ratio"),
+        at("peak_force"),
+        at("min_force"),
+        at("indentation"),
+        at("contact_fraction"),
+        at("harmonic_distortion"),
     ];
     r.push(if stable { 1.0 } else { 0.0 });
     r.push(period.map_or(f64::NAN, |n| n as f64));
@@ -712,36 +721,36 @@ fn write_traces(
         scale(&t.force, units.force),
     );
     let grid: &[&str] = &["point", "time"];
-    let vars = [
-        Var::f64(
+    let vars = vec![
+        Variable::f64(
             labels.x_name,
             &["point"],
             labels.x_unit.unwrap_or("1"),
             labels.x_text,
             &xs,
         ),
-        Var::f64(
+        Variable::f64(
             "time",
             &["time"],
             "drive periods",
             "time within the cycle",
             &t.time,
         ),
-        Var::f64(
+        Variable::f64(
             "deflection",
             grid,
             length,
             "tip deflection W(1,tau)",
             &deflection,
         ),
-        Var::f64(
+        Variable::f64(
             "distance",
             grid,
             length,
             "tip-sample distance V_T (<= 0 in contact)",
             &distance,
         ),
-        Var::f64(
+        Variable::f64(
             "force",
             grid,
             force,
@@ -749,14 +758,16 @@ fn write_traces(
             &force_values,
         ),
     ];
-    crate::netcdf::write(
+    crate::output::write_layout(
         &path,
-        &format!(
-            "afmdyn {} traces: one steady-state cycle per point of the {}",
-            labels.stem, labels.sweeps.0
+        &Layout::new(
+            format!(
+                "afmdyn {} traces: one steady-state cycle per point of the {}",
+                labels.stem, labels.sweeps.0
+            ),
+            &[("point", np), ("time", ns)],
+            vars,
         ),
-        &[("point", np), ("time", ns)],
-        &vars,
     )?;
     if files != Files::All || np == 0 {
         return Ok(());

@@ -10,14 +10,14 @@ use crate::error::CliError;
 use crate::output::{write_bytes, OutDir};
 use crate::plot::{color, save_map, CellMap};
 use afmdyn::analysis::basins::{
-    BasinSpec, Decided, DEFAULT_BASIN_HITS, DEFAULT_CELL, DEFAULT_DISCOVER_AFTER, DEFAULT_NEAR_TOL,
+    BasinSpec, DEFAULT_BASIN_HITS, DEFAULT_CELL, DEFAULT_DISCOVER_AFTER, DEFAULT_NEAR_TOL,
     DEFAULT_STRIDE,
 };
 use afmdyn::request::{BasinArrays, BasinsRequest, Document, Resolved};
 use afmdyn::{CantileverModel, Params};
 use clap::Args;
 use plotters::style::RGBColor;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// `afmdyn basins` flags.
 #[derive(Debug, Args)]
@@ -134,7 +134,10 @@ pub fn basins_cmd(a: &BasinsArgs) -> Result<(), CliError> {
         ));
     }
     write_bytes(&out.join("basins.csv"), text.as_bytes())?;
-    write_nc(&out.join("basins.nc"), &spec, &BasinArrays::new(&map))?;
+    crate::output::write_layout(
+        &out.join("basins.nc"),
+        &BasinArrays::new(&map).layout(&spec),
+    )?;
     // the map, the attractors' section points on it
     let colour = |l: i64| -> RGBColor {
         if l < 0 {
@@ -211,107 +214,4 @@ pub fn basins_cmd(a: &BasinsArgs) -> Result<(), CliError> {
         );
     }
     Ok(())
-}
-
-/// `basins.nc`: the map's arrays ([`BasinArrays`]) over (y, x) and (attractor), CF-style
-/// attributes (`decided` as flag values with their meanings).
-fn write_nc(path: &Path, spec: &BasinSpec, a: &BasinArrays) -> Result<(), CliError> {
-    use crate::netcdf::{write, Attr, Var};
-    let unit = |c: afmdyn::analysis::basins::StateCoord| {
-        use afmdyn::analysis::basins::StateCoord;
-        if matches!(c, StateCoord::ADot(_) | StateCoord::WDot) {
-            "g0 per unit tau"
-        } else {
-            "g0"
-        }
-    };
-    let (cell, att): (&[&str], &[&str]) = (&["y", "x"], &["attractor"]);
-    let mut decided = Var::i32("decided", cell, "1", "how the cell was decided", &a.decided);
-    decided.attrs = vec![
-        (
-            "flag_values",
-            Attr::I32(Decided::ALL.iter().map(|x| x.code()).collect()),
-        ),
-        (
-            "flag_meanings",
-            Attr::Text(
-                Decided::ALL
-                    .iter()
-                    .map(|x| x.name())
-                    .collect::<Vec<_>>()
-                    .join(" "),
-            ),
-        ),
-    ];
-    let vars = [
-        Var::f64(
-            "x",
-            &["x"],
-            unit(spec.x),
-            format!("{} at tau = 0", spec.x),
-            &spec.xs,
-        ),
-        Var::f64(
-            "y",
-            &["y"],
-            unit(spec.y),
-            format!("{} at tau = 0", spec.y),
-            &spec.ys,
-        ),
-        Var::i32("label", cell, "1", "attractor id; -2 failed", &a.label),
-        decided,
-        Var::i32(
-            "periods",
-            cell,
-            "drive periods",
-            "drive periods the start ran",
-            &a.periods,
-        ),
-        Var::i32(
-            "period",
-            att,
-            "drive periods",
-            "period n; -1 nonperiodic",
-            &a.period,
-        ),
-        Var::f64(
-            "x_max",
-            att,
-            "g0",
-            "largest tip deflection W(1,tau)",
-            &a.x_max,
-        ),
-        Var::f64("v_t_min", att, "g0", "smallest V_T", &a.v_t_min),
-        Var::f64(
-            "basin_fraction",
-            att,
-            "1",
-            "share of the map's cells",
-            &a.basin_fraction,
-        ),
-        Var::f64(
-            "stable",
-            att,
-            "1",
-            "1 stable periodic orbit (shooting), 0 unstable, NaN unknown",
-            &a.stable,
-        ),
-        Var::f64(
-            "lyapunov",
-            att,
-            "1/tau",
-            "largest Lyapunov exponent of a nonperiodic attractor",
-            &a.lyapunov,
-        ),
-    ];
-    write(
-        path,
-        &format!("afmdyn basins of attraction over {} and {}", spec.x, spec.y),
-        &[
-            ("x", spec.xs.len()),
-            ("y", spec.ys.len()),
-            ("attractor", a.period.len()),
-        ],
-        &vars,
-    )
 }

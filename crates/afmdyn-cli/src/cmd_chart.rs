@@ -9,7 +9,7 @@ use crate::cmd_analysis::SteadyArgs;
 use crate::error::CliError;
 use crate::output::{write_bytes, OutDir};
 use crate::plot::{color, save_map, CellMap};
-use afmdyn::analysis::chart::{run_chart, ChartCell, ChartPlan};
+use afmdyn::analysis::chart::ChartCell;
 use afmdyn::request::chart::{
     axis_name, axis_unit, csv_lines, document, warnings, Chart, ChartArrays, CSV_HEADER,
 };
@@ -18,11 +18,8 @@ use afmdyn::request::checkpoint::CheckpointError;
 use afmdyn::request::{parameter, ChartRequest};
 use afmdyn::Params;
 use clap::Args;
-use indicatif::{ProgressBar, ProgressStyle};
 use plotters::style::RGBColor;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use std::sync::Mutex;
 
 /// `afmdyn chart` flags.
 #[derive(Debug, Args)]
@@ -156,107 +153,6 @@ fn diverging(v: f64, m: f64) -> RGBColor {
     }
 }
 
-/// `chart.nc`: the chart's arrays ([`ChartArrays`]) over (y, x) and (y, x, attractor slot).
-fn write_nc(path: &Path, a: &ChartArrays, x: &str, y: &str) -> Result<(), CliError> {
-    use crate::netcdf::{write, Var};
-    let (cell, slot): (&[&str], &[&str]) = (&["y", "x"], &["y", "x", "attractor"]);
-    let vars = [
-        Var::f64("x", &["x"], axis_unit(x), x, &a.x),
-        Var::f64("y", &["y"], axis_unit(y), y, &a.y),
-        Var::i32(
-            "attractors",
-            cell,
-            "1",
-            "attractors found in the cell",
-            &a.attractors,
-        ),
-        Var::i32(
-            "failures",
-            cell,
-            "1",
-            "runs of the cell that failed",
-            &a.failures,
-        ),
-        Var::i32(
-            "dominant_period",
-            cell,
-            "drive periods",
-            "period of the attractor most random starts reached; -1 nonperiodic, 0 none",
-            &a.dominant_period,
-        ),
-        Var::i32(
-            "period",
-            slot,
-            "drive periods",
-            "period n; -1 nonperiodic; 0 empty slot",
-            &a.period,
-        ),
-        Var::i32(
-            "motion",
-            slot,
-            "code",
-            "1 periodic, 2 chaotic, 3 quasi-periodic, 4 unsettled (lyapunov < 0), 5 nonperiodic \
-             without lyapunov; 0 empty slot",
-            &a.motion,
-        ),
-        Var::f64(
-            "lyapunov",
-            slot,
-            "1/tau",
-            "largest Lyapunov exponent of a nonperiodic attractor",
-            &a.lyapunov,
-        ),
-        Var::f64(
-            "lyapunov_error",
-            slot,
-            "1/tau",
-            "its error: uncertainty over the blocks plus convergence estimate",
-            &a.lyapunov_error,
-        ),
-        Var::f64(
-            "x_max",
-            slot,
-            "g0",
-            "largest tip deflection W(1,tau) over the steady state",
-            &a.x_max,
-        ),
-        Var::f64(
-            "v_t_min",
-            slot,
-            "g0",
-            "smallest V_T over the steady state",
-            &a.v_t_min,
-        ),
-        Var::f64(
-            "contacts_per_period",
-            slot,
-            "1/period",
-            "contact entries (impacts) per drive period",
-            &a.contacts_per_period,
-        ),
-        Var::f64(
-            "contact_fraction",
-            slot,
-            "1",
-            "fraction of the time in contact",
-            &a.contact_fraction,
-        ),
-        Var::f64(
-            "fraction",
-            slot,
-            "1",
-            "basin fraction among the random starts",
-            &a.fraction,
-        ),
-    ];
-    write(
-        path,
-        &format!("afmdyn behaviour chart over {x} and {y}"),
-        &[("x", a.x.len()), ("y", a.y.len()), ("attractor", a.slots)],
-        &vars,
-    )
-}
-
 fn write_csv(path: &Path, chart: &Chart, cells: &[ChartCell]) -> Result<(), CliError> {
     let mut text = CSV_HEADER.join(",");
     text.push('\n');
@@ -324,64 +220,27 @@ pub fn chart(a: &ChartArgs) -> Result<(), CliError> {
         .map_err(|e| CliError::Input(crate::error::spell(&e)))?;
     let out = OutDir::lock(&a.out)?;
     let mut store = ChartStore::new(out.dir_lock());
-    let done = store
-        .open(&chart.fingerprint, a.resume)
-        .map_err(store_error)?;
-    let plan = ChartPlan::new(&chart.spec, &chart.model);
-    if !(a.resume && store.finished().map_err(store_error)?) {
-        let cells = (chart.spec.x.len() * chart.spec.y.len()) as u64;
-        let bar = ProgressBar::new(cells);
-        bar.set_style(
-            ProgressStyle::with_template("{bar:40} {pos}/{len} cells  {elapsed} / ~{duration}")
-                .expect("template"),
-        );
-        bar.inc(done.iter().map(|&t| plan.tile(t).1.len() as u64).sum());
-        let pool = afmdyn::request::thread_pool(a.threads)?;
-        let cancel = AtomicBool::new(false);
-        let stored = AtomicUsize::new(0);
-        let shared = Mutex::new((&mut store, None::<CheckpointError>));
-        let sink = |t: usize, cells: Vec<ChartCell>| {
-            let n = cells.len() as u64;
-            let mut guard = shared.lock().unwrap_or_else(|e| e.into_inner());
-            let (s, failed) = &mut *guard;
-            if failed.is_none() {
-                if let Err(e) = s.append(t, cells) {
-                    *failed = Some(e);
-                    cancel.store(true, Ordering::Relaxed);
-                }
-            }
-            drop(guard);
-            bar.inc(n);
-            let k = stored.fetch_add(1, Ordering::SeqCst) + 1;
-            if a.abort_after == Some(k) {
-                std::process::abort();
-            }
-        };
-        pool.install(|| run_chart(&plan, &done, &sink, &cancel));
-        bar.finish_and_clear();
-        let (_, failed) = shared.into_inner().unwrap_or_else(|e| e.into_inner());
-        if let Some(e) = failed {
-            return Err(store_error(e));
-        }
-        store.finish(&chart.fingerprint).map_err(store_error)?;
-    }
+    crate::progress::study(
+        &chart,
+        &mut store,
+        a.resume,
+        a.threads,
+        "cells",
+        a.abort_after,
+    )
+    .map_err(|e| crate::cmd_analysis::study_error(e, "chart"))?;
     let cells = store.cells().map_err(store_error)?;
     let arrays = ChartArrays::new(&chart, &cells);
     write_csv(&out.join("chart.csv"), &chart, &cells)?;
-    write_nc(&out.join("chart.nc"), &arrays, chart.model.x, chart.model.y)?;
+    crate::output::write_layout(
+        &out.join("chart.nc"),
+        &arrays.layout(chart.model.x, chart.model.y),
+    )?;
     draw_maps(out.path(), &chart, &arrays)?;
-    let empty = cells.iter().filter(|c| c.attractors.is_empty()).count();
-    if empty == cells.len() {
-        let first = cells
-            .iter()
-            .find_map(|c| c.message.clone())
-            .unwrap_or_default();
-        return Err(CliError::Sim(afmdyn::SimError::EveryRunFailed {
-            what: "chart cells",
-            runs: cells.len(),
-            first,
-        }));
+    if let Some(e) = Chart::every_cell_failed(&cells) {
+        return Err(CliError::Sim(e));
     }
+    let empty = cells.iter().filter(|c| c.attractors.is_empty()).count();
     for w in warnings(&chart, &cells) {
         errln!("afmdyn: warning: {w}");
     }

@@ -36,7 +36,6 @@ mod cmd_modes;
 mod cmd_orbits;
 mod cmd_simulate;
 mod error;
-mod netcdf;
 mod output;
 mod plot;
 mod progress;

@@ -145,6 +145,14 @@ where
     fs::rename(&tmp, path).map_err(|e| io_error("finish", path, e))
 }
 
+/// Write the NetCDF file of `layout` ([`afmdyn::study::netcdf`]).
+///
+/// # Errors
+/// [`CliError::Io`] naming the path.
+pub fn write_layout(path: &Path, layout: &afmdyn::study::Layout) -> Result<(), CliError> {
+    afmdyn::study::netcdf::write(path, layout).map_err(|e| CliError::Io(e.to_string()))
+}
+
 /// Write bytes atomically.
 pub fn write_bytes(path: &Path, bytes: &[u8]) -> Result<(), CliError> {
     atomic(path, |tmp| {

@@ -8,22 +8,21 @@ use crate::convert::Out;
 use crate::errors::{probe_error, sim_error, value_error};
 use crate::params::PyParams;
 use crate::run::{run, run_abandonable, Job, Stop};
-use afmdyn::analysis::bifurcation::{SweepPoint, SweepSpec};
+use afmdyn::analysis::bifurcation::SweepSpec;
 use afmdyn::analysis::continuation::BranchEvent;
 use afmdyn::analysis::spectrum::{amplitude_spectrum, SPECTRUM_SAMPLES};
 use afmdyn::analysis::steady::SteadyState;
 use afmdyn::integrate::{build, IntegratorOptions};
 use afmdyn::probe::Probe;
-use afmdyn::request::checkpoint::{self, Checkpoint, CheckpointError};
+use afmdyn::request::checkpoint::{self, CheckpointError, SweepStudy};
 use afmdyn::request::{self, Analysis, Document, ModesRequest, Resolved};
-use afmdyn::request::{
-    fingerprint, DirLock, FileCheckpoint, LockError, MemoryCheckpoint, SweepRecord,
-};
 use afmdyn::request::{
     AttractorsRequest, BifurcationRequest, ContinuationRequest, ConvergeRequest,
     GlobalContinuationRequest, IntegratorRequest, LyapunovRequest, ObserveRequest, OrbitRequest,
     SeriesStore, SimulateRequest, StartRequest, SteadyRequest,
 };
+use afmdyn::request::{DirLock, FileCheckpoint, LockError, MemoryCheckpoint, SweepRecord};
+use afmdyn::study::{execute, StudyError};
 use afmdyn::trajectory::{record, RecordSpec};
 use afmdyn::{report, CantileverModel, Params, Region, SweepParam};
 use nalgebra::DVector;
@@ -446,27 +445,12 @@ pub(crate) fn checkpoint_error(e: CheckpointError) -> PyErr {
     }
 }
 
-/// Compute what `store` leaves of `spec` (all of it without `resume`) and finish it, unless
-/// cancelled; `job` counts the points done.
-fn sweep_into<C: Checkpoint>(
-    store: &mut C,
-    request: &BifurcationRequest,
-    spec: &SweepSpec,
-    resume: bool,
-    job: &Job,
-) -> Result<(), CheckpointError> {
-    let fp = fingerprint(request, spec);
-    let Some(left) = checkpoint::open(store, &fp, resume)? else {
-        job.progress.advance(checkpoint::point_count(spec));
-        return Ok(()); // finished before
-    };
-    job.progress.advance(left.done.len());
-    let each = |_: &SweepPoint| job.progress.tick();
-    checkpoint::run(spec, &left, store, job.progress.cancel_flag(), &each)?;
-    if job.progress.is_cancelled() {
-        return Ok(()); // interrupted: the store keeps what is done, for a resume
+/// A study's error as Python raises it.
+pub(crate) fn study_error(e: StudyError) -> PyErr {
+    match e {
+        StudyError::Store(e) => checkpoint_error(e),
+        StudyError::Sim(e) => sim_error(e),
     }
-    store.finish(&fp)
 }
 
 /// A bifurcation diagram: the steady state at each parameter value, one row per section point
@@ -534,21 +518,20 @@ pub fn bifurcation<'py>(
         progress.as_ref(),
         Stop::Cancellable,
         move || -> PyResult<Vec<SweepRecord>> {
-            let pool = afmdyn::request::thread_pool(threads).map_err(sim_error)?;
-            let (spec, job) = (&worker_spec, &worker_job);
-            pool.install(|| match &lock {
+            let study = SweepStudy::new(&request, worker_spec);
+            let progress = &*worker_job.progress;
+            match &lock {
                 Some(lock) => {
                     let mut s = FileCheckpoint::new(lock);
-                    sweep_into(&mut s, &request, spec, resume, job)?;
-                    s.records()
+                    execute(&study, &mut s, resume, threads, progress).map_err(study_error)?;
+                    s.records().map_err(checkpoint_error)
                 }
                 None => {
                     let mut s = MemoryCheckpoint::default();
-                    sweep_into(&mut s, &request, spec, false, job)?;
+                    execute(&study, &mut s, false, threads, progress).map_err(study_error)?;
                     Ok(s.into_records())
                 }
-            })
-            .map_err(checkpoint_error)
+            }
         },
     )??;
     if let Some(e) = afmdyn::request::sweep::every_point_failed(&records) {

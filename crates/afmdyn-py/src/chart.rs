@@ -3,17 +3,16 @@
 //! the model values, the defaults and the probe file's text), so that it pickles to Dask
 //! workers as a few hundred bytes.
 
-use crate::analyses::{checkpoint_error, lock_store};
-use crate::convert::Out;
+use crate::analyses::{checkpoint_error, lock_store, study_error};
 use crate::errors::{probe_error, sim_error, value_error};
 use crate::params::{model_spec, PyParams};
 use crate::run::{run, Job, Stop};
-use afmdyn::analysis::chart::{run_chart, ChartCell, ChartPlan};
+use afmdyn::analysis::chart::{ChartCell, ChartPlan};
 use afmdyn::probe::Probe;
 use afmdyn::request::chart::Chart;
 use afmdyn::request::chart_store::ChartStore;
-use afmdyn::request::checkpoint::CheckpointError;
 use afmdyn::request::{ChartArrays, ChartRequest, DirLock, ModelSpec};
+use afmdyn::study::{execute, MemoryStore};
 use afmdyn::Params;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
@@ -45,26 +44,12 @@ pub struct ChartStudy {
     recipe: String,
 }
 
-fn arrays_dict<'py>(py: Python<'py>, a: ChartArrays) -> PyResult<Bound<'py, PyDict>> {
-    let out = Out::new(py);
-    let (ny, nx, s) = (a.y.len(), a.x.len(), a.slots);
-    let ints = |v: Vec<i32>| v.into_iter().map(i64::from).collect::<Vec<_>>();
-    out.f64s("x", a.x)?;
-    out.f64s("y", a.y)?;
-    out.set("shape", (ny, nx, s))?;
-    out.i64s("attractors", ints(a.attractors))?;
-    out.i64s("failures", ints(a.failures))?;
-    out.i64s("dominant_period", ints(a.dominant_period))?;
-    out.i64s("period", ints(a.period))?;
-    out.i64s("motion", ints(a.motion))?;
-    out.f64s("lyapunov", a.lyapunov)?;
-    out.f64s("lyapunov_error", a.lyapunov_error)?;
-    out.f64s("x_max", a.x_max)?;
-    out.f64s("v_t_min", a.v_t_min)?;
-    out.f64s("contacts_per_period", a.contacts_per_period)?;
-    out.f64s("contact_fraction", a.contact_fraction)?;
-    out.f64s("fraction", a.fraction)?;
-    Ok(out.finish())
+fn arrays_dict<'py>(
+    py: Python<'py>,
+    chart: &Chart,
+    a: ChartArrays,
+) -> PyResult<Bound<'py, PyDict>> {
+    crate::convert::layout_dict(py, a.layout(chart.model.x, chart.model.y))
 }
 
 fn cells_of(lines: &[String]) -> PyResult<Vec<ChartCell>> {
@@ -216,7 +201,11 @@ impl ChartStudy {
         let cells = cells_of(&tasks)?;
         let origin = origin.unwrap_or((0, 0));
         let size = size.unwrap_or((self.chart.spec.x.len(), self.chart.spec.y.len()));
-        arrays_dict(py, ChartArrays::region(&self.chart, origin, size, &cells))
+        arrays_dict(
+            py,
+            &self.chart,
+            ChartArrays::region(&self.chart, origin, size, &cells),
+        )
     }
 
     /// The `--json` document of the cells in `tasks`, as JSON text.
@@ -254,73 +243,30 @@ impl ChartStudy {
             progress.as_ref(),
             Stop::Cancellable,
             move || -> PyResult<Vec<ChartCell>> {
-                let pool = afmdyn::request::thread_pool(threads).map_err(sim_error)?;
-                let plan = ChartPlan::new(&chart.spec, &chart.model);
-                let cancel = worker_job.progress.cancel_flag();
-                let mut store = lock.as_ref().map(ChartStore::new);
-                let done = match store.as_mut() {
-                    Some(s) => s
-                        .open(&chart.fingerprint, resume)
-                        .map_err(checkpoint_error)?,
-                    None => Default::default(),
-                };
-                if let Some(s) = store.as_mut() {
-                    if resume && s.finished().map_err(checkpoint_error)? {
-                        worker_job.progress.advance(total);
-                        return s.cells().map_err(checkpoint_error);
+                let progress = &*worker_job.progress;
+                match lock.as_ref() {
+                    Some(lock) => {
+                        let mut s = ChartStore::new(lock);
+                        execute(&chart, &mut s, resume, threads, progress).map_err(study_error)?;
+                        s.cells().map_err(checkpoint_error)
+                    }
+                    None => {
+                        let mut s = MemoryStore::default();
+                        execute(&chart, &mut s, false, threads, progress).map_err(study_error)?;
+                        Ok(Chart::cells_of(s.records))
                     }
                 }
-                worker_job
-                    .progress
-                    .advance(done.iter().map(|&t| plan.tile(t).1.len()).sum::<usize>());
-                let shared = Mutex::new((store, Vec::new(), None::<CheckpointError>));
-                let sink = |t: usize, cells: Vec<ChartCell>| {
-                    let n = cells.len();
-                    let mut g = shared.lock().unwrap_or_else(|e| e.into_inner());
-                    let (store, all, failed) = &mut *g;
-                    match store.as_mut() {
-                        Some(s) if failed.is_none() => {
-                            if let Err(e) = s.append(t, cells) {
-                                *failed = Some(e);
-                            }
-                        }
-                        Some(_) => {}
-                        None => all.extend(cells),
-                    }
-                    drop(g);
-                    worker_job.progress.advance(n);
-                };
-                pool.install(|| run_chart(&plan, &done, &sink, cancel));
-                let (store, mut all, failed) =
-                    shared.into_inner().unwrap_or_else(|e| e.into_inner());
-                if let Some(e) = failed {
-                    return Err(checkpoint_error(e));
-                }
-                if worker_job.progress.is_cancelled() {
-                    return Ok(Vec::new());
-                }
-                if let Some(mut s) = store {
-                    s.finish(&chart.fingerprint).map_err(checkpoint_error)?;
-                    return s.cells().map_err(checkpoint_error);
-                }
-                all.sort_by_key(|c| (c.iy, c.ix));
-                Ok(all)
             },
         )??;
         let this = slf.get();
-        if cells.iter().all(|c| c.attractors.is_empty()) {
-            let first = cells
-                .iter()
-                .find_map(|c| c.message.clone())
-                .unwrap_or_default();
-            return Err(sim_error(afmdyn::SimError::EveryRunFailed {
-                what: "chart cells",
-                runs: cells.len(),
-                first,
-            }));
+        if let Some(e) = Chart::every_cell_failed(&cells) {
+            return Err(sim_error(e));
         }
         let doc = afmdyn::request::chart::document(&this.chart, &cells).to_string();
-        Ok((arrays_dict(py, ChartArrays::new(&this.chart, &cells))?, doc))
+        Ok((
+            arrays_dict(py, &this.chart, ChartArrays::new(&this.chart, &cells))?,
+            doc,
+        ))
     }
 }
 

@@ -57,3 +57,39 @@ impl<'py> Out<'py> {
         self.dict
     }
 }
+
+/// A result's [`afmdyn::study::Layout`] for the Python layer (`afmdyn._layout.dataset`):
+/// `{"title": str, "dims": [(name, length)], "variables": [(name, dims, units, long_name,
+/// values, attrs)]}`, values as flat NumPy arrays (float64, or int64 for integer variables)
+/// that the Python layer reshapes to the dims.
+pub fn layout_dict<'py>(
+    py: Python<'py>,
+    layout: afmdyn::study::Layout,
+) -> PyResult<Bound<'py, PyDict>> {
+    use afmdyn::study::layout::{Attr, Values};
+    let out = PyDict::new(py);
+    out.set_item("title", layout.title)?;
+    out.set_item("dims", layout.dims)?;
+    let mut vars = Vec::with_capacity(layout.variables.len());
+    for v in layout.variables {
+        let values = match v.values {
+            Values::F64(x) => x.into_pyarray(py).into_any(),
+            Values::I32(x) => x
+                .into_iter()
+                .map(i64::from)
+                .collect::<Vec<_>>()
+                .into_pyarray(py)
+                .into_any(),
+        };
+        let attrs = PyDict::new(py);
+        for (k, a) in v.attrs {
+            match a {
+                Attr::I32(x) => attrs.set_item(k, x)?,
+                Attr::Text(s) => attrs.set_item(k, s)?,
+            }
+        }
+        vars.push((v.name, v.dims, v.units, v.long_name, values, attrs));
+    }
+    out.set_item("variables", vars)?;
+    Ok(out)
+}

@@ -10,11 +10,13 @@
 //! [`beam`] (mode shapes) → [`galerkin`] (eqs. 10–18) → [`eigen`] (eqs. 19–23) and [`units`]
 //! (eqs. 5, 7) → [`contact`] (tip–sample laws) → [`system`] (the hybrid-system interface,
 //! saltation) → [`model`] (the cantilever–sample system) → [`tip_sample`] (what integrators and
-//! analyses need of a probe over a sample) → [`integrate`] (exact propagation, RK4, an
-//! adaptive oracle) → [`trajectory`] (observables, stroboscopic Poincaré section) →
+//! analyses need of a probe over a sample) → [`integrate`] (exact propagation, RK4, the
+//! adaptive DOP853 oracle, Taylor series, split) → [`trajectory`] (observables, stroboscopic Poincaré section) →
 //! [`analysis`] (steady states, periods, bifurcation sweeps, attractors, mode convergence);
 //! [`request`] is what every front end hands the library (parameters by name, defaults, limits);
-//! [`report`] builds the JSON result documents shared by the command line and Python.
+//! [`report`] builds the JSON result documents shared by the command line and Python;
+//! [`study`] runs the analyses made of many tasks (one executor, one kind of store, result
+//! layouts declared once).
 //!
 //! Time is the dimensionless τ of eq. 5 and displacements are in units of the beam gap g₀.
 //! States are `z: [f64; 2N]` = (a, ȧ), modal coordinates and their τ-derivatives.
@@ -36,14 +38,18 @@
 //!
 //! ## Features
 //!
-//! Both are on by default; the command line and the Python module use them.
+//! All three are on by default; the command line and the Python module use them.
 //!
 //! * `parallel` — the independent runs of [`analysis::bifurcation`] (sweep points, chains and
-//!   random starts) and [`analysis::attractors`] (random starts, polishing) on rayon's thread
-//!   pool. Without it the same code runs them one after another; every seed comes from the
-//!   run's index, so the results are the same.
-//! * `files` — reading files: `Probe::load(path)`. [`probe::Probe::parse`] takes the TOML text
-//!   and is always there.
+//!   random starts), [`analysis::attractors`] (random starts, polishing), charts and basin maps
+//!   on rayon's thread pool ([`study::execute`] builds it). Without it the same code runs them
+//!   one after another; every seed comes from the run's index, so the results are the same.
+//! * `files` — the library's I/O: reading probe files (`Probe::load(path)`; [`probe::Probe::parse`]
+//!   takes the TOML text and is always there), the studies' stores in locked directories
+//!   (`request::checkpoint_file`, `request::chart_store`, `request::dir_lock`) and NetCDF
+//!   writing (`study::netcdf`).
+//! * `schema` — JSON Schemas of the requests (`schemars::JsonSchema` on [`request`]'s types;
+//!   `docs/schema/` holds them).
 //!
 //! With `--no-default-features` the library builds for `wasm32-unknown-unknown` (CI checks
 //! `cargo build -p afmdyn --lib --target wasm32-unknown-unknown --no-default-features`).
@@ -64,6 +70,7 @@ pub mod probe;
 pub mod report;
 pub mod request;
 pub mod roots;
+pub mod study;
 pub mod system;
 pub mod tip_sample;
 pub mod trajectory;

@@ -13,38 +13,13 @@ import numpy as np
 import xarray as xr
 
 from . import _afmdyn as _core
+from . import _layout
 from ._afmdyn import Params
 from ._api import Model, _probe_text, _typed, _warn
 from ._progress import ProgressArg, reporter
 
 if TYPE_CHECKING:
     from typing_extensions import Unpack
-
-#: Per-cell and per-attractor variables: name → (long name, units).
-_CELL = {
-    "attractors": ("attractors found in the cell", "1"),
-    "failures": ("runs of the cell that failed", "1"),
-    "dominant_period": (
-        "period of the attractor most random starts reached; -1 nonperiodic, 0 none",
-        "drive periods",
-    ),
-}
-_SLOT = {
-    "period": ("period n; -1 nonperiodic; 0 empty slot", "drive periods"),
-    "motion": (
-        "1 periodic, 2 chaotic, 3 quasi-periodic, 4 unsettled (lyapunov < 0), "
-        "5 nonperiodic without lyapunov; 0 empty slot",
-        "code",
-    ),
-    "lyapunov": ("largest Lyapunov exponent of a nonperiodic attractor", "1/tau"),
-    "lyapunov_error": ("its error: uncertainty over the blocks plus convergence estimate", "1/tau"),
-    "x_max": ("largest tip deflection W(1,tau) over the steady state", "g0"),
-    "v_t_min": ("smallest V_T over the steady state", "g0"),
-    "contacts_per_period": ("contact entries (impacts) per drive period", "1/period"),
-    "contact_fraction": ("fraction of the time in contact", "1"),
-    "fraction": ("basin fraction among the random starts", "1"),
-}
-
 
 def study(
     params: Optional[Params],
@@ -72,35 +47,21 @@ def study(
 
 
 def dataset(s: "_core.ChartStudy", d: Dict[str, Any]) -> xr.Dataset:
-    """The ``xarray.Dataset`` of a chart's arrays ``d`` (dims ``y``, ``x``, ``attractor``)."""
-    ny, nx, ns = d["shape"]
-    fp = json.loads(s.fingerprint())
-    req = fp["chart"]
-    (xname, xunit), (yname, yunit) = s.axes()
-    data: Dict[str, Any] = {}
-    for k, (long, unit) in _CELL.items():
-        data[k] = (("y", "x"), np.asarray(d[k]).reshape(ny, nx), {"long_name": long, "units": unit})
-    for k, (long, unit) in _SLOT.items():
-        data[k] = (
-            ("y", "x", "attractor"),
-            np.asarray(d[k]).reshape(ny, nx, ns),
-            {"long_name": long, "units": unit},
-        )
-    attrs: Dict[str, Any] = {
-        "x_name": xname,
-        "y_name": yname,
-        "starts": req["starts"],
-        "seed": req["seed"],
-        "fingerprint": s.fingerprint(),
-    }
-    attrs["failed_runs"] = int(np.asarray(d["failures"]).sum())
-    return xr.Dataset(
-        data_vars=data,
-        coords={
-            "x": ("x", np.asarray(d["x"]), {"long_name": xname, "units": xunit}),
-            "y": ("y", np.asarray(d["y"]), {"long_name": yname, "units": yunit}),
+    """The ``xarray.Dataset`` of a chart's layout ``d`` (dims ``y``, ``x``, ``attractor``; the
+    variables and their attributes as ``chart.nc`` has them)."""
+    req = json.loads(s.fingerprint())["chart"]
+    (xname, _), (yname, _) = s.axes()
+    failures = _layout.variables(d)["failures"][1]
+    return _layout.dataset(
+        d,
+        {
+            "x_name": xname,
+            "y_name": yname,
+            "starts": req["starts"],
+            "seed": req["seed"],
+            "fingerprint": s.fingerprint(),
+            "failed_runs": int(np.asarray(failures).sum()),
         },
-        attrs=attrs,
     )
 
 

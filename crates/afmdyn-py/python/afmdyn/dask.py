@@ -29,7 +29,8 @@ import xarray as xr
 
 from . import _afmdyn as _core
 from ._afmdyn import Params
-from ._chart import _CELL, _SLOT, dataset, study
+from . import _layout
+from ._chart import dataset, study
 from ._progress import ProgressArg, reporter
 
 try:
@@ -131,7 +132,9 @@ class _Writer:
 
         self.store, self.s = store, s
         self.group = zarr.open_group(store, mode="r+")
-        self.arrays = {k: self.group[k] for k in [*_CELL, *_SLOT]}
+        # the per-cell variables of the chart's layout: over (y, x) and (y, x, attractor)
+        self.names = _layout.over(s.arrays([]), ("y", "x"))
+        self.arrays = {k: self.group[k] for k in self.names}
         self.batch, self.seconds = batch, seconds
         self.pending: list = []
         self.last = time.monotonic()
@@ -150,12 +153,9 @@ class _Writer:
         y1 = max(iy for (iy, _, _), _ in tiles) + 1
         slabs = {k: a[y0:y1] for k, a in self.arrays.items()}
         for (iy, lo, hi), cells in tiles:
-            d = self.s.arrays([cells], origin=(lo, iy), size=(hi - lo, 1))
-            ns = d["shape"][2]
-            for k in _CELL:
-                slabs[k][iy - y0, lo:hi] = np.asarray(d[k])
-            for k in _SLOT:
-                slabs[k][iy - y0, lo:hi, :] = np.asarray(d[k]).reshape(hi - lo, ns)
+            region = _layout.variables(self.s.arrays([cells], origin=(lo, iy), size=(hi - lo, 1)))
+            for k in self.names:
+                slabs[k][iy - y0, lo:hi] = region[k][1][0]
         for k, a in self.arrays.items():
             a[y0:y1] = slabs[k]
         with open(os.path.join(ledger_dir(self.store), DONE), "a", encoding="utf-8") as f:

@@ -995,11 +995,7 @@ impl BifurcationRequest {
     /// [`SimError::OutOfRange`] naming the option, [`SimError::Params`] for a value out of
     /// the parameter's range.
     pub fn spec(&self, base: &Params) -> Result<SweepSpec, SimError> {
-        if let Some(t) = self.threads {
-            if !(1..=MAX_THREADS).contains(&t) {
-                return Err(SimError::out_of_range("threads", t, "must be in 1..=1024"));
-            }
-        }
+        super::limits::check_threads(self.threads)?;
         let values = match &self.values {
             Some(v) if v.is_empty() => {
                 return Err(SimError::out_of_range(

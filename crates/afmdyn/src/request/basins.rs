@@ -4,7 +4,6 @@
 //! Python's dataset ([`BasinArrays`]).
 
 use super::analyses::{initial_state, IntegratorRequest, SteadyRequest};
-use super::limits::MAX_THREADS;
 use super::run::{Analysis, Resolved};
 use crate::analysis::basin_entropy::{basin_entropy, uncertainty_exponent};
 use crate::analysis::basins::{
@@ -16,6 +15,7 @@ use crate::analysis::progress::Progress;
 use crate::error::SimError;
 use crate::model::CantileverModel;
 use crate::params::Params;
+use crate::study::layout::{Attr, Layout, Variable};
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 
@@ -57,7 +57,7 @@ pub struct BasinsRequest {
     pub stride: usize,
     /// Relative tolerance for two steady states to be one attractor, > 0.
     pub cluster_tol: f64,
-    /// Worker threads, 1..=[`MAX_THREADS`]; `None`: all cores.
+    /// Worker threads, 1..=[`MAX_THREADS`](super::limits::MAX_THREADS); `None`: all cores.
     pub threads: Option<usize>,
     /// The steady-state search of a start the early tests leave undecided.
     #[serde(flatten)]
@@ -105,11 +105,7 @@ impl BasinsRequest {
     /// [`SimError::OutOfRange`] naming the option; [`SimError::StateLength`] for a base of
     /// another length than 2N; [`SimError::Params`] for invalid parameters.
     pub fn spec(&self, params: &Params) -> Result<BasinSpec, SimError> {
-        if let Some(t) = self.threads {
-            if !(1..=MAX_THREADS).contains(&t) {
-                return Err(SimError::out_of_range("threads", t, "must be in 1..=1024"));
-            }
-        }
+        super::limits::check_threads(self.threads)?;
         let (x, y) = (coord("x", &self.x)?, coord("y", &self.y)?);
         let model = CantileverModel::new(params)?;
         let spec = BasinSpec {
@@ -286,6 +282,106 @@ pub struct BasinArrays {
 }
 
 impl BasinArrays {
+    /// The map's layout (`basins.nc`, Python's dataset): coordinates `x`, `y` (the state's
+    /// coordinates at τ = 0, in g0 or g0 per unit τ), per cell (y, x) `label`, `decided` (CF
+    /// flag values and meanings), `periods`, and per attractor `period`, `x_max`, `v_t_min`,
+    /// `basin_fraction`, `stable`, `lyapunov`.
+    pub fn layout(&self, spec: &BasinSpec) -> Layout {
+        let unit = |c: StateCoord| {
+            if matches!(c, StateCoord::ADot(_) | StateCoord::WDot) {
+                "g0 per unit tau"
+            } else {
+                "g0"
+            }
+        };
+        let a = self;
+        let (cell, att): (&[&str], &[&str]) = (&["y", "x"], &["attractor"]);
+        let decided = Variable::i32("decided", cell, "1", "how the cell was decided", &a.decided)
+            .with(
+                "flag_values",
+                Attr::I32(Decided::ALL.iter().map(|x| x.code()).collect()),
+            )
+            .with(
+                "flag_meanings",
+                Attr::Text(
+                    Decided::ALL
+                        .iter()
+                        .map(|x| x.name())
+                        .collect::<Vec<_>>()
+                        .join(" "),
+                ),
+            );
+        Layout::new(
+            format!("afmdyn basins of attraction over {} and {}", spec.x, spec.y),
+            &[
+                ("x", spec.xs.len()),
+                ("y", spec.ys.len()),
+                ("attractor", a.period.len()),
+            ],
+            vec![
+                Variable::f64(
+                    "x",
+                    &["x"],
+                    unit(spec.x),
+                    format!("{} at tau = 0", spec.x),
+                    &spec.xs,
+                ),
+                Variable::f64(
+                    "y",
+                    &["y"],
+                    unit(spec.y),
+                    format!("{} at tau = 0", spec.y),
+                    &spec.ys,
+                ),
+                Variable::i32("label", cell, "1", "attractor id; -2 failed", &a.label),
+                decided,
+                Variable::i32(
+                    "periods",
+                    cell,
+                    "drive periods",
+                    "drive periods the start ran",
+                    &a.periods,
+                ),
+                Variable::i32(
+                    "period",
+                    att,
+                    "drive periods",
+                    "period n; -1 nonperiodic",
+                    &a.period,
+                ),
+                Variable::f64(
+                    "x_max",
+                    att,
+                    "g0",
+                    "largest tip deflection W(1,tau)",
+                    &a.x_max,
+                ),
+                Variable::f64("v_t_min", att, "g0", "smallest V_T", &a.v_t_min),
+                Variable::f64(
+                    "basin_fraction",
+                    att,
+                    "1",
+                    "share of the map's cells",
+                    &a.basin_fraction,
+                ),
+                Variable::f64(
+                    "stable",
+                    att,
+                    "1",
+                    "1 stable periodic orbit (shooting), 0 unstable, NaN unknown",
+                    &a.stable,
+                ),
+                Variable::f64(
+                    "lyapunov",
+                    att,
+                    "1/tau",
+                    "largest Lyapunov exponent of a nonperiodic attractor",
+                    &a.lyapunov,
+                ),
+            ],
+        )
+    }
+
     /// The arrays of `map`.
     pub fn new(map: &BasinMap) -> Self {
         let int = |v: usize| i32::try_from(v).unwrap_or(i32::MAX);

@@ -11,15 +11,17 @@
 //! `chart.csv`).
 
 use super::analyses::{IntegratorRequest, SteadyRequest};
-use super::limits::MAX_THREADS;
 use super::model::{parameter, ModelSpec, ValueKind};
 use crate::analysis::bifurcation::SweepSpec;
-use crate::analysis::chart::{CellParams, ChartCell, ChartSpec};
+use crate::analysis::chart::{run_chart, CellParams, ChartCell, ChartPlan, ChartSpec};
 use crate::error::SimError;
 use crate::params::Params;
 use crate::probe::Probe;
+use crate::study::{Layout, Study, Variable};
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
+use std::collections::HashSet;
+use std::sync::atomic::AtomicBool;
 
 /// Largest number of cells of a chart (x_steps × y_steps).
 pub const MAX_CHART_CELLS: usize = 1_000_000;
@@ -73,7 +75,7 @@ pub struct ChartRequest {
     /// first ones (most random starts first) there, and its `attractors` count tells how many
     /// it has; the CSV and JSON list every one.
     pub max_attractors: usize,
-    /// Worker threads, 1..=[`MAX_THREADS`]; `None`: all cores.
+    /// Worker threads, 1..=[`MAX_THREADS`](super::limits::MAX_THREADS); `None`: all cores.
     pub threads: Option<usize>,
     /// The steady-state search of every run.
     #[serde(flatten)]
@@ -236,6 +238,66 @@ pub struct Chart {
     pub fingerprint: Value,
 }
 
+impl Study for Chart {
+    /// A task's number and its cells.
+    type Record = (usize, Vec<ChartCell>);
+    /// The tasks stored.
+    type Done = HashSet<usize>;
+
+    fn fingerprint(&self) -> &Value {
+        &self.fingerprint
+    }
+
+    fn units(&self) -> u64 {
+        (self.spec.x.len() * self.spec.y.len()) as u64
+    }
+
+    fn done_units(&self, done: &HashSet<usize>) -> u64 {
+        let plan = ChartPlan::new(&self.spec, &self.model);
+        done.iter().map(|&t| plan.tile(t).1.len() as u64).sum()
+    }
+
+    fn record_units(&self, record: &(usize, Vec<ChartCell>)) -> u64 {
+        record.1.len() as u64
+    }
+
+    fn run(
+        &self,
+        done: &HashSet<usize>,
+        sink: &(dyn Fn((usize, Vec<ChartCell>)) + Sync),
+        cancel: &AtomicBool,
+    ) {
+        let plan = ChartPlan::new(&self.spec, &self.model);
+        run_chart(&plan, done, &|t, cells| sink((t, cells)), cancel);
+    }
+}
+
+impl Chart {
+    /// The cells of the tasks `records` (a [`crate::study::MemoryStore`]'s, in any order), row
+    /// by row, x increasing.
+    pub fn cells_of(records: Vec<(usize, Vec<ChartCell>)>) -> Vec<ChartCell> {
+        let mut cells: Vec<ChartCell> = records.into_iter().flat_map(|(_, c)| c).collect();
+        cells.sort_by_key(|c| (c.iy, c.ix));
+        cells
+    }
+
+    /// The chart's failure when no cell found any attractor: the one rule of every front end
+    /// (with the first cell's message).
+    pub fn every_cell_failed(cells: &[ChartCell]) -> Option<SimError> {
+        if !cells.iter().all(|c| c.attractors.is_empty()) {
+            return None;
+        }
+        Some(SimError::EveryRunFailed {
+            what: "chart cells",
+            runs: cells.len(),
+            first: cells
+                .iter()
+                .find_map(|c| c.message.clone())
+                .unwrap_or_default(),
+        })
+    }
+}
+
 impl ChartRequest {
     /// The validated chart of the model values `base` over `defaults` (with the probe file's
     /// text `probe`): axis names and limits checked, and every cell on the chart's edges
@@ -287,11 +349,7 @@ impl ChartRequest {
                 "must differ from the x parameter",
             ));
         }
-        if let Some(t) = self.threads {
-            if !(1..=MAX_THREADS).contains(&t) {
-                return Err(SimError::out_of_range("threads", t, "must be in 1..=1024"));
-            }
-        }
+        super::limits::check_threads(self.threads)?;
         let steps = |name: &'static str, n: usize| {
             if (1..=MAX_CHART_CELLS).contains(&n) {
                 Ok(())
@@ -535,6 +593,109 @@ pub struct ChartArrays {
 }
 
 impl ChartArrays {
+    /// The chart's layout (`chart.nc`, Python's dataset, the Dask Zarr store): coordinates `x`
+    /// and `y` in their axes' units (named by the axes `x_name`, `y_name`), per cell (y, x)
+    /// `attractors`, `failures`, `dominant_period`, and per attractor slot (y, x, attractor)
+    /// `period`, `motion`, `lyapunov`, `lyapunov_error`, `x_max`, `v_t_min`,
+    /// `contacts_per_period`, `contact_fraction`, `fraction`.
+    pub fn layout(&self, x_name: &str, y_name: &str) -> Layout {
+        let (cell, slot): (&[&str], &[&str]) = (&["y", "x"], &["y", "x", "attractor"]);
+        let a = self;
+        Layout::new(
+            format!("afmdyn behaviour chart over {x_name} and {y_name}"),
+            &[("x", a.x.len()), ("y", a.y.len()), ("attractor", a.slots)],
+            vec![
+                Variable::f64("x", &["x"], axis_unit(x_name), x_name, &a.x),
+                Variable::f64("y", &["y"], axis_unit(y_name), y_name, &a.y),
+                Variable::i32(
+                    "attractors",
+                    cell,
+                    "1",
+                    "attractors found in the cell",
+                    &a.attractors,
+                ),
+                Variable::i32(
+                    "failures",
+                    cell,
+                    "1",
+                    "runs of the cell that failed",
+                    &a.failures,
+                ),
+                Variable::i32(
+                    "dominant_period",
+                    cell,
+                    "drive periods",
+                    "period of the attractor most random starts reached; -1 nonperiodic, 0 none",
+                    &a.dominant_period,
+                ),
+                Variable::i32(
+                    "period",
+                    slot,
+                    "drive periods",
+                    "period n; -1 nonperiodic; 0 empty slot",
+                    &a.period,
+                ),
+                Variable::i32(
+                    "motion",
+                    slot,
+                    "code",
+                    "1 periodic, 2 chaotic, 3 quasi-periodic, 4 unsettled (lyapunov < 0), 5 \
+                     nonperiodic without lyapunov; 0 empty slot",
+                    &a.motion,
+                ),
+                Variable::f64(
+                    "lyapunov",
+                    slot,
+                    "1/tau",
+                    "largest Lyapunov exponent of a nonperiodic attractor",
+                    &a.lyapunov,
+                ),
+                Variable::f64(
+                    "lyapunov_error",
+                    slot,
+                    "1/tau",
+                    "its error: uncertainty over the blocks plus convergence estimate",
+                    &a.lyapunov_error,
+                ),
+                Variable::f64(
+                    "x_max",
+                    slot,
+                    "g0",
+                    "largest tip deflection W(1,tau) over the steady state",
+                    &a.x_max,
+                ),
+                Variable::f64(
+                    "v_t_min",
+                    slot,
+                    "g0",
+                    "smallest V_T over the steady state",
+                    &a.v_t_min,
+                ),
+                Variable::f64(
+                    "contacts_per_period",
+                    slot,
+                    "1/period",
+                    "contact entries (impacts) per drive period",
+                    &a.contacts_per_period,
+                ),
+                Variable::f64(
+                    "contact_fraction",
+                    slot,
+                    "1",
+                    "fraction of the time in contact",
+                    &a.contact_fraction,
+                ),
+                Variable::f64(
+                    "fraction",
+                    slot,
+                    "1",
+                    "basin fraction among the random starts",
+                    &a.fraction,
+                ),
+            ],
+        )
+    }
+
     /// The arrays of `cells` (any order; each cell once) of the whole chart.
     pub fn new(chart: &Chart, cells: &[ChartCell]) -> ChartArrays {
         ChartArrays::region(

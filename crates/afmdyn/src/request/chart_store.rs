@@ -285,3 +285,25 @@ impl<'a> ChartStore<'a> {
         Ok(tiles.into_values().flatten().collect())
     }
 }
+
+impl crate::study::Store<super::Chart> for ChartStore<'_> {
+    fn open(
+        &mut self,
+        chart: &super::Chart,
+        resume: bool,
+    ) -> Result<crate::study::Opened<HashSet<usize>>, CheckpointError> {
+        let done = ChartStore::open(self, &chart.fingerprint, resume)?;
+        if resume && self.finished()? {
+            return Ok(crate::study::Opened::Finished);
+        }
+        Ok(crate::study::Opened::Run(done))
+    }
+
+    fn append(&mut self, (task, cells): (usize, Vec<ChartCell>)) -> Result<(), CheckpointError> {
+        ChartStore::append(self, task, cells)
+    }
+
+    fn finish(&mut self, chart: &super::Chart) -> Result<(), CheckpointError> {
+        ChartStore::finish(self, &chart.fingerprint)
+    }
+}

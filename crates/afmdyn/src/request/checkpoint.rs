@@ -6,17 +6,18 @@
 //! with the `files` feature [`super::checkpoint_file::FileCheckpoint`] keeps them in a
 //! directory (the command line's `--out` with `--resume`, Python's `store=`).
 //!
-//! [`open`] decides where a sweep stands in its store, [`run`] computes the remaining points
-//! into it and [`Checkpoint::finish`] puts the rows in the one order ([`super::sweep::order_key`]).
+//! [`open`] decides where a sweep stands in its store; the sweep is a [`Study`]
+//! ([`SweepStudy`]) that [`crate::study::execute`] computes into it, and
+//! [`Checkpoint::finish`] puts the rows in the one order ([`super::sweep::order_key`]).
 //!
 //! [`fingerprint`]: super::sweep::fingerprint
 
 use super::sweep::{first_difference, records, SweepRecord};
 use crate::analysis::bifurcation::{run_sweep_cancellable, Branch, Resume, SweepPoint, SweepSpec};
+use crate::study::{Opened, Store, Study};
 use nalgebra::DVector;
 use serde_json::Value;
 use std::sync::atomic::AtomicBool;
-use std::sync::Mutex;
 use thiserror::Error;
 
 /// What can go wrong with a checkpoint.
@@ -190,37 +191,86 @@ pub fn open<C: Checkpoint + ?Sized>(
     Ok(Some(Resume::default()))
 }
 
-/// Compute the points of `spec` not in `resume` into `store`; `each` sees every point once it
-/// is stored (progress), from the worker threads. Stops early, with the stored points kept,
-/// when `cancel` is set. Runs on the current rayon pool (with the `parallel` feature).
-///
-/// # Errors
-/// The first error of the store (the sweep goes on to its end, storing nothing more).
-pub fn run<C: Checkpoint + ?Sized>(
-    spec: &SweepSpec,
-    resume: &Resume,
-    store: &mut C,
-    cancel: &AtomicBool,
-    each: &(dyn Fn(&SweepPoint) + Sync),
-) -> Result<(), CheckpointError> {
-    let store = Mutex::new((store, None::<CheckpointError>));
-    let sink = |p: SweepPoint| {
-        let rows = records(spec.param, &p);
-        {
-            let mut guard = store.lock().unwrap_or_else(|e| e.into_inner());
-            let (s, failed) = &mut *guard;
-            if failed.is_none() {
-                if let Err(e) = s.append(&rows) {
-                    *failed = Some(e);
-                }
+/// A bifurcation sweep as a [`Study`]: its spec and fingerprint. A task is one point (a
+/// value reached one way), stored as its records; a resume skips the stored points and goes on
+/// along each chain from its last stored state.
+#[derive(Debug, Clone)]
+pub struct SweepStudy {
+    /// The validated sweep.
+    pub spec: SweepSpec,
+    /// What a resumed sweep must match ([`super::sweep::fingerprint`]).
+    pub fingerprint: Value,
+}
+
+impl SweepStudy {
+    /// The study of `spec`, validated from `request`.
+    pub fn new(request: &super::BifurcationRequest, spec: SweepSpec) -> SweepStudy {
+        let fingerprint = super::sweep::fingerprint(request, &spec);
+        SweepStudy { spec, fingerprint }
+    }
+}
+
+impl Study for SweepStudy {
+    type Record = Vec<SweepRecord>;
+    type Done = Resume;
+
+    fn fingerprint(&self) -> &Value {
+        &self.fingerprint
+    }
+
+    fn units(&self) -> u64 {
+        point_count(&self.spec) as u64
+    }
+
+    fn done_units(&self, done: &Resume) -> u64 {
+        done.done.len() as u64
+    }
+
+    fn record_units(&self, _: &Vec<SweepRecord>) -> u64 {
+        1
+    }
+
+    fn run(&self, done: &Resume, sink: &(dyn Fn(Vec<SweepRecord>) + Sync), cancel: &AtomicBool) {
+        let param = self.spec.param;
+        run_sweep_cancellable(
+            &self.spec,
+            done,
+            &|p: SweepPoint| sink(records(param, &p)),
+            cancel,
+        );
+    }
+}
+
+/// [`Store`] of a sweep for a [`Checkpoint`]: [`open`], [`Checkpoint::append`],
+/// [`Checkpoint::finish`].
+macro_rules! sweep_store {
+    ($t:ty) => {
+        impl Store<SweepStudy> for $t {
+            fn open(
+                &mut self,
+                study: &SweepStudy,
+                resume: bool,
+            ) -> Result<Opened<Resume>, CheckpointError> {
+                Ok(match open(self, &study.fingerprint, resume)? {
+                    Some(r) => Opened::Run(r),
+                    None => Opened::Finished,
+                })
+            }
+
+            fn append(&mut self, record: Vec<SweepRecord>) -> Result<(), CheckpointError> {
+                Checkpoint::append(self, &record)
+            }
+
+            fn finish(&mut self, study: &SweepStudy) -> Result<(), CheckpointError> {
+                Checkpoint::finish(self, &study.fingerprint)
             }
         }
-        each(&p);
     };
-    run_sweep_cancellable(spec, resume, &sink, cancel);
-    let (_, failed) = store.into_inner().unwrap_or_else(|e| e.into_inner());
-    failed.map_or(Ok(()), Err)
 }
+
+sweep_store!(MemoryCheckpoint);
+#[cfg(feature = "files")]
+sweep_store!(super::checkpoint_file::FileCheckpoint<'_>);
 
 /// The number of points of a sweep: values × (2 with continuation + random starts).
 pub fn point_count(spec: &SweepSpec) -> usize {

@@ -3,10 +3,13 @@
 
 use super::*;
 use crate::analysis::bifurcation::SweepSpec;
+use crate::analysis::progress::Progress;
 use crate::params::Params;
 use crate::request::sweep::{fingerprint, order_key, PointStatus, HEADER};
 use crate::request::BifurcationRequest;
+use crate::study::{execute, StudyError};
 use std::collections::HashSet;
+use std::sync::Mutex;
 
 fn request() -> BifurcationRequest {
     let mut r = BifurcationRequest {
@@ -28,32 +31,63 @@ fn lines(records: &[SweepRecord]) -> Vec<String> {
     records.iter().map(SweepRecord::csv_line).collect()
 }
 
-/// Run what `store` leaves to do; the keys of the points computed.
-fn resume_into<C: Checkpoint + ?Sized>(
+/// A store that notes the keys of the points appended to `inner`.
+struct Noting<'a, C> {
+    inner: &'a mut C,
+    computed: Vec<(usize, Branch)>,
+}
+
+impl<C: Store<SweepStudy>> Store<SweepStudy> for Noting<'_, C> {
+    fn open(&mut self, s: &SweepStudy, resume: bool) -> Result<Opened<Resume>, CheckpointError> {
+        self.inner.open(s, resume)
+    }
+
+    fn append(&mut self, record: Vec<SweepRecord>) -> Result<(), CheckpointError> {
+        self.computed.push((record[0].index, record[0].branch));
+        self.inner.append(record)
+    }
+
+    fn finish(&mut self, s: &SweepStudy) -> Result<(), CheckpointError> {
+        self.inner.finish(s)
+    }
+}
+
+/// Run what `store` leaves to do (the one executor, resuming); the keys of the points computed.
+fn resume_into<C: Store<SweepStudy>>(
     store: &mut C,
     r: &BifurcationRequest,
 ) -> Result<Vec<(usize, Branch)>, CheckpointError> {
-    let s = spec(r);
-    let fp = fingerprint(r, &s);
-    let computed = Mutex::new(Vec::new());
-    if let Some(resume) = open(store, &fp, true)? {
-        let each = |p: &SweepPoint| computed.lock().unwrap().push((p.index, p.branch));
-        run(&s, &resume, store, &AtomicBool::new(false), &each)?;
-        store.finish(&fp)?;
-    }
-    Ok(computed.into_inner().unwrap())
+    let study = SweepStudy::new(r, spec(r));
+    let mut noting = Noting {
+        inner: store,
+        computed: Vec::new(),
+    };
+    execute(&study, &mut noting, true, None, &Progress::new()).map_err(|e| match e {
+        StudyError::Store(e) => e,
+        e => panic!("{e}"),
+    })?;
+    Ok(noting.computed)
 }
 
 /// An uninterrupted sweep: the store before `finish` (points in the order they finished) and
 /// the finished records.
 fn uninterrupted(r: &BifurcationRequest) -> (MemoryCheckpoint, Vec<SweepRecord>) {
     let mut store = MemoryCheckpoint::default();
-    let s = spec(r);
-    let fp = fingerprint(r, &s);
-    let resume = open(&mut store, &fp, false).unwrap().unwrap();
-    run(&s, &resume, &mut store, &AtomicBool::new(false), &|_| {}).unwrap();
+    let s = SweepStudy::new(r, spec(r));
+    let Opened::Run(resume) = Store::open(&mut store, &s, false).unwrap() else {
+        panic!("a new sweep runs")
+    };
+    let sink = Mutex::new(Vec::new());
+    s.run(
+        &resume,
+        &|rec| sink.lock().unwrap().push(rec),
+        &AtomicBool::new(false),
+    );
+    for rec in sink.into_inner().unwrap() {
+        Store::append(&mut store, rec).unwrap();
+    }
     let unfinished = store.clone();
-    store.finish(&fp).unwrap();
+    Store::finish(&mut store, &s).unwrap();
     (unfinished, store.into_records())
 }
 
@@ -227,7 +261,7 @@ fn the_file_store_resumes_a_killed_sweep_and_drops_a_cut_row() {
     );
     let k = 5;
     for p in &unfinished.points[..k] {
-        store.append(p).unwrap();
+        Checkpoint::append(&mut store, p).unwrap();
     }
     drop(store);
     drop(lock);

@@ -39,6 +39,24 @@ pub use crate::analysis::steady::MAX_STEADY_PERIODS;
 pub const ATTRACTOR_SAMPLES_PER_PERIOD: usize = 200;
 /// Largest number of worker threads a sweep may ask for.
 pub const MAX_THREADS: usize = 1024;
+// the bound as `check_threads`'s message spells it
+const _: () = assert!(MAX_THREADS == 1024);
+
+/// A request's thread count (`None`: all cores) checked against 1..=[`MAX_THREADS`]: the one
+/// rule of every study's `threads`.
+///
+/// # Errors
+/// [`crate::SimError::OutOfRange`] naming `threads`.
+pub fn check_threads(threads: Option<usize>) -> Result<(), crate::SimError> {
+    match threads {
+        Some(t) if !(1..=MAX_THREADS).contains(&t) => Err(crate::SimError::out_of_range(
+            "threads",
+            t,
+            "must be in 1..=1024",
+        )),
+        _ => Ok(()),
+    }
+}
 /// Depth of a period-doubling cascade followed by branch switching: periods n, 2n, 4n and 8n.
 pub const CASCADE_FACTOR: usize = 8;
 /// Largest number of drive periods compared by the mode-convergence study (Fig. 4), and the

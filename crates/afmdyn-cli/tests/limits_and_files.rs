@@ -1,5 +1,6 @@
-//! Issue 9, end to end: extreme inputs fail at once, long runs stream or are refused with their
-//! size, resume only the same run, a locked output directory, usable outputs, readable errors.
+//! Limits and files, end to end (issue 9): extreme inputs fail at once, long runs stream or are
+//! refused with their size, resume only the same run, a locked output directory, usable
+//! outputs, readable errors.
 
 use std::io::Read;
 use std::path::{Path, PathBuf};

@@ -1,0 +1,43 @@
+"""Results as the library lays them out (``afmdyn::study::Layout``): every variable's name,
+dimensions, units and long name are declared once in the library, which also writes the
+command line's NetCDF files from the same declaration; this module turns a layout into an
+``xarray.Dataset`` and gives the Dask Zarr writer its per-cell variables."""
+
+from __future__ import annotations
+
+from typing import Any, Dict, List, Optional, Tuple
+
+import numpy as np
+import xarray as xr
+
+#: One variable of a layout: (name, dims, units, long name, flat values, further attributes).
+Variable = Tuple[str, List[str], str, str, Any, Dict[str, Any]]
+
+
+def variables(
+    layout: Dict[str, Any],
+) -> Dict[str, Tuple[Tuple[str, ...], np.ndarray, Dict[str, Any]]]:
+    """Every variable of ``layout`` as (dims, values reshaped to the dims, attributes)."""
+    dims = dict(layout["dims"])
+    out = {}
+    for name, vdims, units, long_name, values, extra in layout["variables"]:
+        shape = tuple(dims[d] for d in vdims)
+        attrs = {"long_name": long_name, "units": units, **extra}
+        out[name] = (tuple(vdims), np.asarray(values).reshape(shape), attrs)
+    return out
+
+
+def dataset(layout: Dict[str, Any], attrs: Optional[Dict[str, Any]] = None) -> xr.Dataset:
+    """The ``xarray.Dataset`` of ``layout``: a variable named as its one dimension is that
+    dimension's coordinate, every other one a data variable."""
+    data, coords = {}, {}
+    for name, v in variables(layout).items():
+        (coords if v[0] == (name,) else data)[name] = v
+    return xr.Dataset(data_vars=data, coords=coords, attrs=attrs or {})
+
+
+def over(layout: Dict[str, Any], lead: Tuple[str, ...]) -> List[str]:
+    """The names of the variables whose leading dimensions are ``lead`` (a chart's per-cell
+    variables: ``("y", "x")``)."""
+    n = len(lead)
+    return [v[0] for v in layout["variables"] if tuple(v[1][:n]) == lead]

@@ -1,0 +1,204 @@
+//! Studies: analyses made of many independent tasks (a bifurcation sweep's points, a chart's
+//! tiles), run by one executor into one kind of store, whatever the front end.
+//!
+//! - [`Study`]: what a study is to the executor — its fingerprint (what a resumed run must
+//!   match), its size in progress units, and `run`, which computes every task not yet done and
+//!   hands each finished one to a sink. How a study cuts itself into tasks and orders them (a
+//!   sweep's coarse pass before its chain segments, a chart's tiles) stays the study's own.
+//! - [`Store`]: where finished tasks go — a fingerprinted ledger that says what is done,
+//!   appends a finished task, and finishes atomically (the files in the one order); the file
+//!   stores lock their directory for one run at a time
+//!   ([`crate::request::checkpoint_file::FileCheckpoint`], [`crate::request::chart_store`]);
+//!   [`MemoryStore`] keeps the tasks in memory.
+//! - [`execute`]: the one executor — opens the store (refusing a resume of another request),
+//!   builds the worker pool (the request's thread count, checked once by
+//!   [`crate::request::limits::check_threads`]), runs the study, appends each finished task
+//!   under one lock, reports progress to an [`Observer`], and finishes the store.
+//! - [`layout`]: a result's variables (name, dimensions, units, long name) declared once, from
+//!   which the NetCDF file ([`netcdf`], feature `files`), the Python `xarray.Dataset` and the
+//!   Dask Zarr store are written.
+//!
+//! Results never depend on the thread count or on the order tasks finish in: every seed comes
+//! from the request and the task, and a store puts its records in the one order when it
+//! finishes. Dask (`afmdyn.dask`) is another executor of the same tasks: it ships them to
+//! workers and writes through the same layout.
+
+pub mod layout;
+mod memory;
+#[cfg(feature = "files")]
+pub mod netcdf;
+
+pub use layout::{Layout, Values, Variable};
+pub use memory::MemoryStore;
+
+use crate::analysis::progress::Progress;
+use crate::error::SimError;
+use crate::request::checkpoint::CheckpointError;
+use serde_json::Value;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::Mutex;
+use thiserror::Error;
+
+/// A study: independent tasks whose results a [`Store`] keeps (see the module doc).
+pub trait Study: Sync {
+    /// One finished task, as a store keeps it.
+    type Record: Send;
+    /// What a resumed run skips, as its store reads it back (`Default`: nothing done).
+    type Done: Default + Send + Sync;
+
+    /// The fingerprint of the request (its options, model and defaults): what a resumed run
+    /// must match.
+    fn fingerprint(&self) -> &Value;
+
+    /// The study's size in progress units (points, cells).
+    fn units(&self) -> u64;
+
+    /// The units of what `done` holds.
+    fn done_units(&self, done: &Self::Done) -> u64;
+
+    /// The units of one finished task.
+    fn record_units(&self, record: &Self::Record) -> u64;
+
+    /// Compute every task not in `done` (on the current rayon pool with the `parallel`
+    /// feature), handing each finished task to `sink` from the worker threads; start no
+    /// further task once `cancel` is set (a task cut short is not sent).
+    fn run(&self, done: &Self::Done, sink: &(dyn Fn(Self::Record) + Sync), cancel: &AtomicBool);
+}
+
+/// Where a store stands when a run opens it.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Opened<D> {
+    /// The run computes what `D` does not hold.
+    Run(D),
+    /// A resumed store whose study finished: nothing to compute.
+    Finished,
+}
+
+/// A store of a study's finished tasks (see the module doc).
+pub trait Store<S: Study + ?Sized>: Send {
+    /// Open the store for `study`. Without `resume` a new run begins (stored tasks dropped).
+    /// With `resume`: an empty store begins; a store of another request is refused
+    /// ([`CheckpointError::Mismatch`] naming the first field that differs); an unfinished one
+    /// goes on after its stored tasks; a finished one is [`Opened::Finished`].
+    ///
+    /// # Errors
+    /// [`CheckpointError`]: a mismatch, records without a ledger, unreadable or corrupt files.
+    fn open(&mut self, study: &S, resume: bool) -> Result<Opened<S::Done>, CheckpointError>;
+
+    /// Keep one finished task (all of it, at once).
+    ///
+    /// # Errors
+    /// [`CheckpointError::Io`].
+    fn append(&mut self, record: S::Record) -> Result<(), CheckpointError>;
+
+    /// Mark the study finished, its records in the one order.
+    ///
+    /// # Errors
+    /// [`CheckpointError::Io`].
+    fn finish(&mut self, study: &S) -> Result<(), CheckpointError>;
+}
+
+/// What a run reports as it goes (a progress bar, a Python callback, a test hook). Every
+/// method is called from the worker threads.
+pub trait Observer: Sync {
+    /// The run starts: the study's size and the units its store already holds.
+    fn start(&self, total: u64, done: u64);
+    /// A finished task is stored: its units, and the number of tasks this run has stored.
+    fn stored(&self, units: u64, count: usize);
+    /// The flag the caller sets to stop the run (the study starts no further task).
+    fn cancel_flag(&self) -> &AtomicBool;
+}
+
+impl Observer for Progress {
+    fn start(&self, total: u64, done: u64) {
+        self.add_total(usize::try_from(total).unwrap_or(usize::MAX));
+        self.advance(usize::try_from(done).unwrap_or(usize::MAX));
+    }
+
+    fn stored(&self, units: u64, _count: usize) {
+        self.advance(usize::try_from(units).unwrap_or(usize::MAX));
+    }
+
+    fn cancel_flag(&self) -> &AtomicBool {
+        Progress::cancel_flag(self)
+    }
+}
+
+/// How a run ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Outcome {
+    /// Every task is stored and the store finished.
+    Finished,
+    /// The store held the finished study already (a resume): nothing was computed.
+    AlreadyFinished,
+    /// The caller cancelled the run: the tasks stored so far are kept, the store unfinished.
+    Cancelled,
+}
+
+/// What can stop a study.
+#[derive(Debug, Error)]
+pub enum StudyError {
+    /// The store refused the run or could not be written.
+    #[error(transparent)]
+    Store(#[from] CheckpointError),
+    /// The worker pool could not start.
+    #[error(transparent)]
+    Sim(#[from] SimError),
+}
+
+/// Run `study` into `store` on `threads` worker threads (`None`: all cores; with the
+/// `parallel` feature, else on the calling thread): open the store (`resume` as
+/// [`Store::open`]), compute every task it does not hold, append each under one lock as it
+/// finishes, report to `observer`, and finish the store unless cancelled. A store error
+/// cancels the run (the tasks already stored are kept) and is returned.
+///
+/// # Errors
+/// [`StudyError::Store`] from the store, [`StudyError::Sim`] when the pool cannot start.
+pub fn execute<S: Study + ?Sized, St: Store<S>>(
+    study: &S,
+    store: &mut St,
+    resume: bool,
+    threads: Option<usize>,
+    observer: &dyn Observer,
+) -> Result<Outcome, StudyError> {
+    let done = match store.open(study, resume)? {
+        Opened::Finished => {
+            observer.start(study.units(), study.units());
+            return Ok(Outcome::AlreadyFinished);
+        }
+        Opened::Run(done) => done,
+    };
+    observer.start(study.units(), study.done_units(&done));
+    let cancel = observer.cancel_flag();
+    let count = AtomicUsize::new(0);
+    let shared = Mutex::new((&mut *store, None::<CheckpointError>));
+    let sink = |record: S::Record| {
+        let units = study.record_units(&record);
+        let mut guard = shared.lock().unwrap_or_else(|e| e.into_inner());
+        let (s, failed) = &mut *guard;
+        if failed.is_none() {
+            if let Err(e) = s.append(record) {
+                *failed = Some(e);
+                cancel.store(true, Ordering::Relaxed);
+                return;
+            }
+        } else {
+            return;
+        }
+        drop(guard);
+        observer.stored(units, count.fetch_add(1, Ordering::SeqCst) + 1);
+    };
+    crate::request::in_pool(threads, || {
+        study.run(&done, &sink, cancel);
+        Ok(())
+    })?;
+    let (_, failed) = shared.into_inner().unwrap_or_else(|e| e.into_inner());
+    if let Some(e) = failed {
+        return Err(e.into());
+    }
+    if cancel.load(Ordering::Relaxed) {
+        return Ok(Outcome::Cancelled);
+    }
+    store.finish(study)?;
+    Ok(Outcome::Finished)
+}
