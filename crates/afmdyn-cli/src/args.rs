@@ -23,6 +23,8 @@ pub struct ModelArgs {
     /// A cantilever of the library (`afmdyn cantilevers` lists them) for the probe file, which
     /// then needs only [sample] and [drive]: its k, f0, Q and tip radius fill the keys the file
     /// leaves out
+    // the text is the flag's help: [sample] and [drive] are TOML sections, not links
+    #[allow(rustdoc::broken_intra_doc_links)]
     #[arg(long, value_name = "NAME", requires = "probe")]
     pub cantilever: Option<String>,
     // The help of the model flags comes from the library's table (afmdyn::request::

@@ -67,10 +67,10 @@ fn draw(progress: &Progress, finished: &AtomicBool, unit: &'static str) {
     }
 }
 
-/// [`request::run`] with a bar counting `unit`s.
+/// [`request::run()`] with a bar counting `unit`s.
 ///
 /// # Errors
-/// As [`request::run`].
+/// As [`request::run()`].
 pub fn run<A: Analysis + ?Sized>(
     analysis: &A,
     model: &Resolved,

@@ -388,7 +388,7 @@ enum Damping {
 /// for Unconstrained Optimization and Nonlinear Equations*, SIAM 1996, §6.3.1: α = 1e-4).
 const ARMIJO: f64 = 1e-4;
 
-/// The smallest step fraction λ [`line_search`] tries: below it the Newton direction no longer
+/// The smallest step fraction λ the line search of [`shoot_globalised`] tries: below it the Newton direction no longer
 /// lowers ‖F‖ (a local minimum of ‖F‖ that is not a zero, or a kink of the map at a switching)
 /// and the solve fails.
 pub const LINE_SEARCH_MIN_STEP: f64 = 1e-8;

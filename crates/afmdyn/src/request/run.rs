@@ -7,8 +7,9 @@
 //! The two whose results are streams run through their own entry points, which take the same
 //! [`Progress`]: `simulate` records in chunks to a sink
 //! ([`crate::trajectory::chunked::record_chunked`], budgets by
-//! [`crate::request::analyses::SimulateSpan`]) and `bifurcation` writes its records to a
-//! [`crate::request::Checkpoint`] ([`crate::request::checkpoint::run`]).
+//! [`crate::request::analyses::SimulateSpan`]) and `bifurcation` is a study
+//! ([`crate::request::checkpoint::SweepStudy`]) that [`crate::study::execute`] runs into a
+//! [`crate::request::Checkpoint`].
 //!
 //! [`Progress`] is the sink of the run's progress and its cancel flag: the analyses count
 //! their units of work in it (random starts, curve and branch points, drive periods, mode
