@@ -9,7 +9,7 @@ use crate::output::{
 use crate::plot::{save, Figure, PixelColumns, Series, Style};
 use afmdyn::analysis::spectrum::{amplitude_spectrum, SPECTRUM_SAMPLES};
 use afmdyn::integrate::build;
-use afmdyn::report::{SeriesNames, SeriesUnits};
+use afmdyn::report::SeriesUnits;
 use afmdyn::request::{ConvergeRequest, SeriesStore, SimulateRequest};
 use afmdyn::request::{Document, Resolved};
 use afmdyn::trajectory::chunked::{record_chunked, Chunk, ChunkedSpec};
@@ -240,62 +240,10 @@ struct DataFiles {
 }
 
 fn series_columns(n: usize, su: &SeriesUnits) -> Vec<Column> {
-    let SeriesNames {
-        time: t,
-        time_unit: tu,
-        length: len,
-        velocity: vel,
-        force,
-        ..
-    } = su.names();
-    let time = if su.u.si {
-        "time t = τ t_s (t_s: seconds per unit τ, the probe's scales)"
-    } else {
-        "dimensionless time τ = t √(EI/(mL⁴))"
-    };
-    let mut c = vec![
-        Column::new(t, tu, time),
-        Column::new(
-            "v_t",
-            len,
-            "tip–sample distance V_T = W(1,τ) + α2 sin Ωτ + α5 (eq. 8); contact while V_T ≤ 0",
-        ),
-        Column::new(
-            "w_tip",
-            len,
-            "tip deflection W(1,τ) relative to the clamped base",
-        ),
-        Column::new("w_tip_dot", vel, "tip velocity ∂W(1,τ)/∂τ"),
-        Column::new(
-            "in_contact",
-            "0/1",
-            "1 while the tip is in contact (region II)",
-        ),
-        Column::new(
-            "contact_force",
-            force,
-            format!(
-                "tip–sample force F_c(δ, δ̇) on the tip, δ = −V_T the indentation (linear law: \
-                 α4 δ + α6 δ̇ in contact; 0 in free flight except DMT's van der Waals force): {}",
-                afmdyn::contact::FORCE_SIGN
-            ),
-        ),
-    ];
-    c.extend((1..=n).map(|j| {
-        Column::new(
-            format!("a_{j}"),
-            len,
-            format!("modal coordinate a_{j} (eq. 9)"),
-        )
-    }));
-    c.extend((1..=n).map(|j| {
-        Column::new(
-            format!("a_dot_{j}"),
-            vel,
-            format!("modal velocity da_{j}/dτ"),
-        )
-    }));
-    c
+    su.columns(n)
+        .into_iter()
+        .map(|c| Column::new(c.name, c.unit, c.long_name))
+        .collect()
 }
 
 /// The rows of samples (the library's [`afmdyn::trajectory::SampleRows`] layout, which is

@@ -452,6 +452,80 @@ impl SeriesUnits {
     }
 }
 
+/// One column of a time series: its name, unit and meaning.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SeriesColumn {
+    /// The name (`tau` or `t`, `v_t`, `w_tip`, …, `a_1`, `a_dot_1`, …).
+    pub name: String,
+    /// Its unit ([`SeriesNames`]).
+    pub unit: &'static str,
+    /// What it is.
+    pub long_name: String,
+}
+
+impl SeriesUnits {
+    /// The columns of a trajectory of `n` modes, in their order (`timeseries.csv`, the `.npy`
+    /// and its `.npy.json`, Python's `simulate` dataset): time, V_T (eq. 8), W(1,τ), ∂W/∂τ,
+    /// the contact flag, F_c (sign [`crate::contact::FORCE_SIGN`]), a_1…a_n, ȧ_1…ȧ_n (eq. 9).
+    pub fn columns(&self, n: usize) -> Vec<SeriesColumn> {
+        let u = self.names();
+        let col = |name: String, unit, long_name: String| SeriesColumn {
+            name,
+            unit,
+            long_name,
+        };
+        let time = if self.u.si {
+            "time t = τ t_s (t_s: seconds per unit τ, the probe's scales)"
+        } else {
+            "dimensionless time τ = t √(EI/(mL⁴))"
+        };
+        let mut c = vec![
+            col(u.time.into(), u.time_unit, time.into()),
+            col(
+                "v_t".into(),
+                u.length,
+                "tip–sample distance V_T = W(1,τ) + α2 sin Ωτ + α5 (eq. 8); contact while V_T ≤ 0"
+                    .into(),
+            ),
+            col(
+                "w_tip".into(),
+                u.length,
+                "tip deflection W(1,τ) relative to the clamped base".into(),
+            ),
+            col("w_tip_dot".into(), u.velocity, "tip velocity ∂W(1,τ)/∂τ".into()),
+            col(
+                "in_contact".into(),
+                "0/1",
+                "1 while the tip is in contact (region II)".into(),
+            ),
+            col(
+                "contact_force".into(),
+                u.force,
+                format!(
+                    "tip–sample force F_c(δ, δ̇) on the tip, δ = −V_T the indentation (linear law: \
+                     α4 δ + α6 δ̇ in contact; 0 in free flight except DMT's van der Waals force): {}",
+                    crate::contact::FORCE_SIGN
+                ),
+            ),
+        ];
+        c.extend((1..=n).map(|j| {
+            col(
+                format!("a_{j}"),
+                u.length,
+                format!("modal coordinate a_{j} (eq. 9)"),
+            )
+        }));
+        c.extend((1..=n).map(|j| {
+            col(
+                format!("a_dot_{j}"),
+                u.velocity,
+                format!("modal velocity da_{j}/dτ"),
+            )
+        }));
+        c
+    }
+}
+
 /// The per-point columns of a stepped-curve document, in this order after the abscissa.
 pub const CURVE_COLUMNS: [&str; 12] = [
     "amplitude",
