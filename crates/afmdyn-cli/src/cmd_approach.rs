@@ -13,7 +13,7 @@ use afmdyn::analysis::continuation::BranchEvent;
 use afmdyn::analysis::observables::Observables;
 use afmdyn::analysis::stepped::{SteppedCurve, Sweep};
 use afmdyn::probe::Probe;
-use afmdyn::report::{curve_row, CurveUnits, CURVE_COLUMNS};
+use afmdyn::report::{curve_column_index, curve_row, CurveUnits, UnitKind, CURVE_COLUMNS};
 use afmdyn::request::{
     Analysis, ApproachRequest, CurveRequest, Document, Resolved, ResonanceRequest,
 };
@@ -190,12 +190,7 @@ fn row(
     // the library's values of the observables in u's units (one derivation: curve_row), in
     // the order of this file's columns
     let c = curve_row(o, u);
-    let at = |name: &str| {
-        c[CURVE_COLUMNS
-            .iter()
-            .position(|n| *n == name)
-            .expect("a curve column")]
-    };
+    let at = |name: &str| c[curve_column_index(name).expect("a curve column")];
     let mut r = vec![
         x,
         at("amplitude"),
@@ -257,10 +252,16 @@ fn rows(c: &SteppedCurve, x: &dyn Fn(f64) -> f64, u: &CurveUnits, base: &Params)
 }
 
 fn columns(l: &Labels, u: &CurveUnits) -> Vec<Column> {
-    let (len, force, energy, time, power) = if u.si {
-        ("m", "N", "J", "s", "W")
+    // the library's columns (name, unit, meaning: report::CURVE_COLUMNS) by name
+    let lib = |name: &str| {
+        let c = CURVE_COLUMNS[curve_column_index(name).expect("a curve column")];
+        (u.unit(c.kind), c.long_name)
+    };
+    let force = u.unit(UnitKind::Force);
+    let (time, power) = if u.si {
+        ("s", "W")
     } else {
-        ("g0", "F~", "F~ g0", "tau", "F~ g0 / tau")
+        ("tau", "F~ g0 / tau")
     };
     let x_unit = match (l.x_name, u.si, u.hz_per_omega.is_some()) {
         ("z_c", true, _) => "m",
@@ -269,19 +270,16 @@ fn columns(l: &Labels, u: &CurveUnits) -> Vec<Column> {
         _ => "1",
     };
     let meaning = [
-        (len, "first-harmonic amplitude A of the tip deflection"),
-        (
-            "deg",
-            "lag φ of the deflection behind the drive (90 free, >90 attractive, <90 repulsive)",
-        ),
-        (len, "smallest tip–sample distance"),
+        lib("amplitude"),
+        lib("phase_deg"),
+        lib("min_distance"),
         (
             force,
             "largest |tip–sample force| (dForce's definition; see peak_force)",
         ),
-        (energy, "energy dissipated in the sample per period"),
-        (energy, "virial (1/T)∫F_c W dτ"),
-        (len, "mean tip deflection"),
+        lib("energy_dissipated"),
+        lib("virial"),
+        lib("mean_deflection"),
         (time, "time in contact per period"),
         (power, "dissipated power: Energy_diss per period / period"),
     ];
@@ -290,34 +288,23 @@ fn columns(l: &Labels, u: &CurveUnits) -> Vec<Column> {
     for (name, (unit, what)) in DFORCE.iter().zip(meaning) {
         cols.push(Column::new(*name, unit, what));
     }
+    cols.push(Column::new(
+        "sweep",
+        "1",
+        format!("0 {}, 1 {}, 2 + k branch k", l.sweeps.0, l.sweeps.1),
+    ));
+    for name in [
+        "amplitude_ratio",
+        "peak_force",
+        "min_force",
+        "indentation",
+        "contact_fraction",
+        "harmonic_distortion",
+    ] {
+        let (unit, what) = lib(name);
+        cols.push(Column::new(name, unit, what));
+    }
     cols.extend([
-        Column::new(
-            "sweep",
-            "1",
-            format!("0 {}, 1 {}, 2 + k branch k", l.sweeps.0, l.sweeps.1),
-        ),
-        Column::new(
-            "amplitude_ratio",
-            "1",
-            "A/A0, A0 the free amplitude at the same drive",
-        ),
-        Column::new(
-            "peak_force",
-            force,
-            "largest tip–sample force F_c: the repulsive maximum (F_c > 0 pushes the tip away)",
-        ),
-        Column::new(
-            "min_force",
-            force,
-            "smallest tip–sample force F_c: the adhesion minimum (F_c < 0 pulls the tip towards the sample)",
-        ),
-        Column::new("indentation", len, "largest indentation"),
-        Column::new("contact_fraction", "1", "fraction of the period in contact"),
-        Column::new(
-            "harmonic_distortion",
-            "1",
-            "total harmonic distortion of the deflection",
-        ),
         Column::new("stable", "1", "1 stable (Floquet), 0 unstable"),
         Column::new(
             "period",
@@ -435,12 +422,7 @@ fn plots(
             String::new()
         }
     };
-    let idx = |name: &str| {
-        CURVE_COLUMNS
-            .iter()
-            .position(|c| *c == name)
-            .expect("column")
-    };
+    let idx = |name: &str| curve_column_index(name).expect("column");
     let panels = [
         if l.x_name == "z_c" {
             ("amplitude_ratio", "A/A0".to_string(), "amplitude")

@@ -186,7 +186,7 @@ fn approach_writes_csv_npy_and_plots() {
     assert_eq!(meta["shape"][0], 22);
     assert_eq!(meta["shape"][1], header.len());
     assert_eq!(meta["columns"][3]["name"], "phase_deg");
-    assert_eq!(meta["columns"][3]["unit"], "deg");
+    assert_eq!(meta["columns"][3]["unit"], "degree");
     for stem in ["amplitude", "phase", "dissipation", "virial", "peak-force"] {
         assert!(dir.join(format!("approach-{stem}.png")).exists(), "{stem}");
     }

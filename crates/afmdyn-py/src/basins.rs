@@ -67,19 +67,13 @@ pub fn basins<'py>(
         },
         integrator: integrator_request(integrator, steps_per_period, tolerance)?,
     };
+    let spec = request.spec(&params.inner).map_err(crate::errors::sim_error)?;
     let doc = analysis(py, request, params.inner, probe, progress.as_ref(), true)?;
-    let a = BasinArrays::new(&doc.output);
     let out = Out::new(py);
     out.json(&doc.json)?;
-    let ints = |v: Vec<i32>| v.into_iter().map(i64::from).collect();
-    out.i64s("label", ints(a.label))?;
-    out.i64s("decided", ints(a.decided))?;
-    out.i64s("periods", ints(a.periods))?;
-    out.i64s("period", ints(a.period))?;
-    out.f64s("x_max", a.x_max)?;
-    out.f64s("v_t_min", a.v_t_min)?;
-    out.f64s("basin_fraction", a.basin_fraction)?;
-    out.f64s("stable", a.stable)?;
-    out.f64s("lyapunov", a.lyapunov)?;
+    out.set(
+        "layout",
+        crate::convert::layout_dict(py, BasinArrays::new(&doc.output).layout(&spec))?,
+    )?;
     Ok(out.finish())
 }

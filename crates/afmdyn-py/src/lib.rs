@@ -63,5 +63,23 @@ fn _afmdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
             .map(|p| (p.name, p.alias.unwrap_or(p.name), p.unit, p.range, p.help))
             .collect::<Vec<_>>(),
     )?;
+    // the per-point columns of a stepped curve: (name, kind of unit or None, long name)
+    m.add(
+        "CURVE_COLUMNS",
+        afmdyn::report::CURVE_COLUMNS
+            .iter()
+            .map(|c| {
+                use afmdyn::report::UnitKind;
+                let kind = match c.kind {
+                    UnitKind::Length => Some("length"),
+                    UnitKind::Force => Some("force"),
+                    UnitKind::Energy => Some("energy"),
+                    UnitKind::Phase => Some("phase"),
+                    UnitKind::One => None,
+                };
+                (c.name, kind, c.long_name)
+            })
+            .collect::<Vec<_>>(),
+    )?;
     Ok(())
 }

@@ -353,14 +353,30 @@ impl CurveUnits {
         }
     }
 
-    fn names(&self) -> Value {
-        if self.si {
-            json!({"length": "m", "force": "N", "energy": "J", "phase": "deg",
-                   "frequency": if self.hz_per_omega.is_some() { "Hz" } else { "Ω" }})
-        } else {
-            json!({"length": "g0", "force": "F~ (k g0 for the point mass)",
-                   "energy": "F~ g0", "phase": "deg", "frequency": "Ω"})
+    /// The name of the unit of `kind` (the document's `units` block).
+    pub fn unit(&self, kind: UnitKind) -> &'static str {
+        match (kind, self.si) {
+            (UnitKind::Length, true) => "m",
+            (UnitKind::Length, false) => "g0",
+            (UnitKind::Force, true) => "N",
+            (UnitKind::Force, false) => "F~ (k g0 for the point mass)",
+            (UnitKind::Energy, true) => "J",
+            (UnitKind::Energy, false) => "F~ g0",
+            (UnitKind::Phase, _) => "degree",
+            (UnitKind::One, _) => "1",
         }
+    }
+
+    fn names(&self) -> Value {
+        let k = |kind| self.unit(kind);
+        let frequency = if self.si && self.hz_per_omega.is_some() {
+            "Hz"
+        } else {
+            "Ω"
+        };
+        json!({"length": k(UnitKind::Length), "force": k(UnitKind::Force),
+               "energy": k(UnitKind::Energy), "phase": k(UnitKind::Phase),
+               "frequency": frequency})
     }
 }
 
@@ -526,21 +542,110 @@ impl SeriesUnits {
     }
 }
 
+/// The kind of unit of a reported quantity ([`CurveUnits::unit`] names it).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum UnitKind {
+    /// A length (g₀, or m).
+    Length,
+    /// A force (F̃, or N).
+    Force,
+    /// An energy (F̃·g₀, or J).
+    Energy,
+    /// A phase in degrees.
+    Phase,
+    /// A pure number.
+    One,
+}
+
+/// A per-point column of a stepped curve: its name, its kind of unit and its meaning — the
+/// one declaration of the JSON document's keys, the command line's `.npy.json` meanings and
+/// Python's dataset attributes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct CurveColumn {
+    /// The key (`amplitude`, `phase_deg`, …).
+    pub name: &'static str,
+    /// Its kind of unit.
+    pub kind: UnitKind,
+    /// What it is.
+    pub long_name: &'static str,
+}
+
+const fn curve_column(name: &'static str, kind: UnitKind, long_name: &'static str) -> CurveColumn {
+    CurveColumn {
+        name,
+        kind,
+        long_name,
+    }
+}
+
 /// The per-point columns of a stepped-curve document, in this order after the abscissa.
-pub const CURVE_COLUMNS: [&str; 12] = [
-    "amplitude",
-    "amplitude_ratio",
-    "phase_deg",
-    "mean_deflection",
-    "peak_force",
-    "min_force",
-    "indentation",
-    "contact_fraction",
-    "min_distance",
-    "energy_dissipated",
-    "virial",
-    "harmonic_distortion",
+pub const CURVE_COLUMNS: [CurveColumn; 12] = [
+    curve_column(
+        "amplitude",
+        UnitKind::Length,
+        "first-harmonic amplitude A of the tip deflection",
+    ),
+    curve_column(
+        "amplitude_ratio",
+        UnitKind::One,
+        "A/A0 (A0 the free amplitude at the same drive)",
+    ),
+    curve_column(
+        "phase_deg",
+        UnitKind::Phase,
+        "phase lag of the deflection behind the drive (90 free, > 90 attractive, < 90 repulsive)",
+    ),
+    curve_column(
+        "mean_deflection",
+        UnitKind::Length,
+        "mean tip deflection <W>",
+    ),
+    curve_column(
+        "peak_force",
+        UnitKind::Force,
+        "largest tip-sample force F_c: the repulsive maximum (F_c > 0 pushes the tip away)",
+    ),
+    curve_column(
+        "min_force",
+        UnitKind::Force,
+        "smallest tip-sample force F_c: the adhesion minimum (F_c < 0 pulls the tip)",
+    ),
+    curve_column(
+        "indentation",
+        UnitKind::Length,
+        "largest indentation max(-V_T, 0)",
+    ),
+    curve_column(
+        "contact_fraction",
+        UnitKind::One,
+        "fraction of the time in contact (V_T <= 0)",
+    ),
+    curve_column(
+        "min_distance",
+        UnitKind::Length,
+        "minimum tip-sample distance",
+    ),
+    curve_column(
+        "energy_dissipated",
+        UnitKind::Energy,
+        "energy dissipated in the sample per drive period E_dis",
+    ),
+    curve_column(
+        "virial",
+        UnitKind::Energy,
+        "virial (1/T) integral of F_c W over a period",
+    ),
+    curve_column(
+        "harmonic_distortion",
+        UnitKind::One,
+        "total harmonic distortion of the deflection",
+    ),
 ];
+
+/// The column of [`CURVE_COLUMNS`] named `name`.
+pub fn curve_column_index(name: &str) -> Option<usize> {
+    CURVE_COLUMNS.iter().position(|c| c.name == name)
+}
 
 /// The [`CURVE_COLUMNS`] of one orbit's observables in `u`'s units: A, A/A₀ (A₀ the free
 /// amplitude at the same drive), φ in degrees, ⟨W⟩, max F_c, min F_c, indentation, contact
@@ -571,8 +676,8 @@ pub fn curve_row(o: &Observables, u: &CurveUnits) -> [f64; 12] {
 /// dataset is built from.
 pub fn observed(o: &Observables, u: &CurveUnits) -> Value {
     let mut m = serde_json::Map::new();
-    for (name, v) in CURVE_COLUMNS.iter().zip(curve_row(o, u)) {
-        m.insert((*name).into(), json!(v));
+    for (c, v) in CURVE_COLUMNS.iter().zip(curve_row(o, u)) {
+        m.insert(c.name.into(), json!(v));
     }
     m.insert("contact_time".into(), json!(o.contact_time * u.time));
     m.insert("mean_force".into(), json!(o.mean_force * u.force));
@@ -628,8 +733,8 @@ fn columns<'a>(
     }
     let mut m = serde_json::Map::new();
     m.insert(x.0.into(), json!(xs));
-    for (name, c) in CURVE_COLUMNS.iter().zip(cols) {
-        m.insert((*name).into(), json!(c));
+    for (col, c) in CURVE_COLUMNS.iter().zip(cols) {
+        m.insert(col.name.into(), json!(c));
     }
     m.insert("stable".into(), json!(stable));
     m
@@ -820,8 +925,8 @@ pub fn setpoint(params: &Params, c: &SteppedCurve, ratio: f64, u: &CurveUnits) -
                     "repulsive"
                 }),
             );
-            for (name, v) in CURVE_COLUMNS.iter().zip(row) {
-                m.insert((*name).into(), json!(v));
+            for (c, v) in CURVE_COLUMNS.iter().zip(row) {
+                m.insert(c.name.into(), json!(v));
             }
             Value::Object(m)
         })

@@ -14,6 +14,9 @@ def cancel_running() -> None: ...
 MODEL_PARAMETERS: List[Tuple[str, str, str, str, str]]
 
 FORCE_SIGN: str
+#: The per-point columns of a stepped curve (``afmdyn::report::CURVE_COLUMNS``): (name, kind of
+#: unit — "length", "force", "energy", "phase" or None for a pure number — long name).
+CURVE_COLUMNS: List[Tuple[str, Optional[str], str]]
 
 class SimulationError(RuntimeError):
     """A computation failed (chattering, divergence, Newton not converging, integrator

@@ -10,6 +10,7 @@ import numpy as np
 import xarray as xr
 
 from . import _afmdyn as _core
+from . import _layout
 from ._afmdyn import Params
 from ._api import Model, _params, _run, _typed
 from ._progress import ProgressArg
@@ -98,36 +99,14 @@ def basins(
         threads=threads,
     )
     doc = json.loads(d["json"])
-    xs, ys = doc["x"]["values"], doc["y"]["values"]
-    ny, nx = len(ys), len(xs)
-    names = np.array(["", "near", "recurrence", "grid", "steady", "failed"])
-    n = len(d["period"])
 
     def num(v: Any) -> float:
         return float("nan") if v is None else float(v)
 
-    return xr.Dataset(
-        data_vars={
-            "label": (("y", "x"), np.asarray(d["label"]).reshape(ny, nx),
-                      {"long_name": "attractor id (-2 failed)"}),
-            "decided": (("y", "x"), names[np.asarray(d["decided"])].reshape(ny, nx)),
-            "periods": (("y", "x"), np.asarray(d["periods"]).reshape(ny, nx),
-                        {"long_name": "drive periods the start ran"}),
-            "period": ("attractor", d["period"], {"long_name": "period n (-1 nonperiodic)"}),
-            "x_max": ("attractor", d["x_max"], {"units": "g0", "long_name": "X_max"}),
-            "v_t_min": ("attractor", d["v_t_min"], {"units": "g0", "long_name": "min V_T"}),
-            "basin_fraction": ("attractor", d["basin_fraction"]),
-            "stable": ("attractor", d["stable"],
-                       {"long_name": "1 stable periodic orbit (shooting), 0 unstable, NaN nonperiodic"}),
-            "lyapunov": ("attractor", d["lyapunov"],
-                         {"units": "1/tau", "long_name": "λ₁ of a nonperiodic attractor"}),
-        },
-        coords={
-            "x": ("x", xs, {"long_name": f"{doc['x']['name']} at τ = 0"}),
-            "y": ("y", ys, {"long_name": f"{doc['y']['name']} at τ = 0"}),
-            "attractor": ("attractor", np.arange(n)),
-        },
-        attrs={
+    # the variables as the library lays them out (basins.nc's), `decided` given by its meanings
+    ds = _layout.dataset(
+        d["layout"],
+        {
             "basin_entropy": num(doc["basin_entropy"]),
             "boundary_basin_entropy": num(doc["boundary_basin_entropy"]),
             "uncertainty_exponent": num(doc["uncertainty_exponent"]),
@@ -135,4 +114,10 @@ def basins(
             **{k: v for k, v in p.to_dict().items() if isinstance(v, (int, float, str))},
         },
     )
+    decided = ds["decided"]
+    meanings = dict(zip(decided.attrs["flag_values"], decided.attrs["flag_meanings"].split()))
+    names = np.array([meanings.get(int(c), "") for c in decided.values.ravel()])
+    attrs = {k: v for k, v in decided.attrs.items() if not k.startswith("flag_")}
+    ds["decided"] = (decided.dims, names.reshape(decided.shape), attrs)
+    return ds.assign_coords(attractor=("attractor", np.arange(ds.sizes["attractor"])))
 

@@ -12,22 +12,12 @@ from typing import Any, Dict, List, Optional, Sequence
 import numpy as np
 import xarray as xr
 
-# the per-point columns of a stepped curve (``afmdyn::report::CURVE_COLUMNS``) with the kind of
-# unit each takes from the document's ``units`` block and its long name
-COLUMNS: Dict[str, tuple] = {
-    "amplitude": ("length", "first-harmonic amplitude A of the tip deflection"),
-    "amplitude_ratio": (None, "A/A0 (A0 the free amplitude at the same drive)"),
-    "phase_deg": ("phase", "phase lag of the deflection behind the drive"),
-    "mean_deflection": ("length", "mean deflection <W>"),
-    "peak_force": ("force", "largest tip-sample force F_c: the repulsive maximum (F_c > 0 pushes the tip away)"),
-    "min_force": ("force", "smallest tip-sample force F_c: the adhesion minimum (F_c < 0 pulls the tip)"),
-    "indentation": ("length", "largest indentation max(-V_T, 0)"),
-    "contact_fraction": (None, "fraction of the time in contact (V_T <= 0)"),
-    "min_distance": ("length", "minimum tip-sample distance"),
-    "energy_dissipated": ("energy", "energy dissipated in the sample per drive period E_dis"),
-    "virial": ("energy", "virial (1/T) integral of F_c W over a period"),
-    "harmonic_distortion": (None, "total harmonic distortion of the deflection"),
-}
+from . import _afmdyn as _core
+
+# the per-point columns of a stepped curve, as the library declares them
+# (``afmdyn::report::CURVE_COLUMNS``): name → (kind of unit in the document's ``units`` block,
+# long name)
+COLUMNS: Dict[str, tuple] = {name: (kind, long) for name, kind, long in _core.CURVE_COLUMNS}
 
 # the stepped curves: command → (abscissa keys in order of preference, the two sweeps)
 SWEEPS = {
@@ -45,8 +35,6 @@ ABSCISSA = {
 def _unit(units: Dict[str, str], kind: Optional[str]) -> str:
     if kind is None:
         return "1"
-    if kind == "phase":
-        return "degree"
     return units.get(kind, kind)
 
 
