@@ -13,7 +13,7 @@ use afmdyn::analysis::chart::ChartCell;
 use afmdyn::request::chart::{
     axis_name, axis_unit, csv_lines, document, warnings, Chart, ChartArrays, CSV_HEADER,
 };
-use afmdyn::request::chart_store::ChartStore;
+use afmdyn::request::chart_store::{cells, chart_store};
 use afmdyn::request::checkpoint::CheckpointError;
 use afmdyn::request::{parameter, ChartRequest};
 use afmdyn::Params;
@@ -219,7 +219,7 @@ pub fn chart(a: &ChartArgs) -> Result<(), CliError> {
         .chart(spec, Params::default(), probe_text.as_deref())
         .map_err(|e| CliError::Input(crate::error::spell(&e)))?;
     let out = OutDir::lock(&a.out)?;
-    let mut store = ChartStore::new(out.dir_lock());
+    let mut store = chart_store(out.dir_lock());
     crate::progress::study(
         &chart,
         &mut store,
@@ -229,7 +229,7 @@ pub fn chart(a: &ChartArgs) -> Result<(), CliError> {
         a.abort_after,
     )
     .map_err(|e| crate::cmd_analysis::study_error(e, "chart"))?;
-    let cells = store.cells().map_err(store_error)?;
+    let cells = cells(&mut store).map_err(store_error)?;
     let arrays = ChartArrays::new(&chart, &cells);
     write_csv(&out.join("chart.csv"), &chart, &cells)?;
     crate::output::write_layout(

@@ -67,7 +67,9 @@ pub fn basins<'py>(
         },
         integrator: integrator_request(integrator, steps_per_period, tolerance)?,
     };
-    let spec = request.spec(&params.inner).map_err(crate::errors::sim_error)?;
+    let spec = request
+        .spec(&params.inner)
+        .map_err(crate::errors::sim_error)?;
     let doc = analysis(py, request, params.inner, probe, progress.as_ref(), true)?;
     let out = Out::new(py);
     out.json(&doc.json)?;

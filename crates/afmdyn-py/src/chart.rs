@@ -10,7 +10,7 @@ use crate::run::{run, Job, Stop};
 use afmdyn::analysis::chart::{ChartCell, ChartPlan};
 use afmdyn::probe::Probe;
 use afmdyn::request::chart::Chart;
-use afmdyn::request::chart_store::ChartStore;
+use afmdyn::request::chart_store::{cells, chart_store};
 use afmdyn::request::{ChartArrays, ChartRequest, DirLock, ModelSpec};
 use afmdyn::study::{execute, MemoryStore};
 use afmdyn::Params;
@@ -246,9 +246,9 @@ impl ChartStudy {
                 let progress = &*worker_job.progress;
                 match lock.as_ref() {
                     Some(lock) => {
-                        let mut s = ChartStore::new(lock);
+                        let mut s = chart_store(lock);
                         execute(&chart, &mut s, resume, threads, progress).map_err(study_error)?;
-                        s.cells().map_err(checkpoint_error)
+                        cells(&mut s).map_err(checkpoint_error)
                     }
                     None => {
                         let mut s = MemoryStore::default();

@@ -8,8 +8,9 @@
 //! - [`Store`]: where finished tasks go — a fingerprinted ledger that says what is done,
 //!   appends a finished task, and finishes atomically (the files in the one order); the file
 //!   stores lock their directory for one run at a time
-//!   ([`crate::request::checkpoint_file::FileCheckpoint`], [`crate::request::chart_store`]);
-//!   [`MemoryStore`] keeps the tasks in memory.
+//!   ([`crate::request::checkpoint_file::FileCheckpoint`] for sweeps; `task_store::TaskStore`,
+//!   feature `files`, for any study of numbered tasks whose records serialize — the chart's
+//!   `request::chart_store`); [`MemoryStore`] keeps the tasks in memory.
 //! - [`execute`]: the one executor — opens the store (refusing a resume of another request),
 //!   builds the worker pool (the request's thread count, checked once by
 //!   [`crate::request::limits::check_threads`]), runs the study, appends each finished task
@@ -27,6 +28,8 @@ pub mod layout;
 mod memory;
 #[cfg(feature = "files")]
 pub mod netcdf;
+#[cfg(feature = "files")]
+pub mod task_store;
 
 pub use layout::{Layout, Values, Variable};
 pub use memory::MemoryStore;

@@ -1,0 +1,411 @@
+//! A study's resumable store of tasks (feature `files`): a directory, locked by [`DirLock`],
+//! holding, for a study whose tasks are numbered and whose records serialize ([`TaskFiles`]
+//! names the files; the chart's are shown):
+//!
+//! - the ledger (`.chart.run.json`): `{"args": fingerprint, "finished": bool, "format": 2}`;
+//! - the records (`.chart.tiles.jsonl`), one line per finished task, appended and flushed as
+//!   each finishes: `{"cells": record, "task": t, "crc32": "89abcdef"}` (the record under the
+//!   study's key; a killed run leaves at most a cut last line, dropped on resume). `crc32` is
+//!   the CRC-32 (zlib's) of the line's text before `,"crc32":`, 8 lowercase hex digits.
+//!
+//! Reading the records (a resume, the files written from the store) refuses, naming the file
+//! and the line, a complete line whose checksum does not match or that cannot be read — a
+//! damaged store never becomes a result. A store whose ledger has no `format` was written by
+//! an earlier version, without checksums: refused too (rerun without resuming).
+//!
+//! A resumed study computes only the tasks not stored, and only for the request that made the
+//! store (its fingerprint); a finished one computes nothing. The command line's
+//! `afmdyn chart --out DIR` keeps its store there ([`crate::request::chart_store`]); the files
+//! a user reads (`chart.csv`, `chart.nc`, the maps) are written from it.
+
+use crate::request::checkpoint::{CheckpointError, Ledger};
+use crate::request::checkpoint_file::{crc_hex, write_atomic, START_OVER};
+use crate::request::dir_lock::DirLock;
+use crate::request::sweep::first_difference;
+use serde::de::DeserializeOwned;
+use serde::Serialize;
+use serde_json::{json, Value};
+use std::collections::{BTreeMap, BTreeSet, HashSet};
+use std::fs::{self, File, OpenOptions};
+use std::io::{BufRead, BufReader, BufWriter, Write};
+use std::marker::PhantomData;
+use std::path::{Path, PathBuf};
+
+use super::{Opened, Store, Study};
+
+/// The store's layout (the ledger's `format`): 2 since the lines carry checksums.
+pub const FORMAT: u64 = 2;
+/// What ends a record's line before its checksum.
+const CRC_KEY: &str = ",\"crc32\":\"";
+
+/// The files and keys of one kind of study's store.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct TaskFiles {
+    /// The ledger's file name.
+    pub ledger: &'static str,
+    /// The records' file name.
+    pub records: &'static str,
+    /// The key of a line's record.
+    pub key: &'static str,
+    /// The prefix of the fingerprint's fields that a mismatch's message leaves out
+    /// (`"chart."`), if any.
+    pub prefix: &'static str,
+}
+
+fn io<'p>(
+    action: &'static str,
+    path: &'p Path,
+) -> impl FnOnce(std::io::Error) -> CheckpointError + 'p {
+    move |e| CheckpointError::Io {
+        action,
+        path: path.display().to_string(),
+        message: e.to_string(),
+    }
+}
+
+/// A study's store of records `R` in the directory its lock holds.
+#[derive(Debug)]
+pub struct TaskStore<'a, R> {
+    files: TaskFiles,
+    lock: &'a DirLock,
+    writer: Option<BufWriter<File>>,
+    /// The tasks stored (their records stay in the file: memory does not grow with the study).
+    tasks: BTreeSet<usize>,
+    record: PhantomData<fn() -> R>,
+}
+
+impl<'a, R: Serialize + DeserializeOwned> TaskStore<'a, R> {
+    /// The store of the directory `lock` holds, in `files`.
+    pub fn new(lock: &'a DirLock, files: TaskFiles) -> TaskStore<'a, R> {
+        TaskStore {
+            files,
+            lock,
+            writer: None,
+            tasks: BTreeSet::new(),
+            record: PhantomData,
+        }
+    }
+
+    fn path(&self, name: &str) -> PathBuf {
+        self.lock.path().join(name)
+    }
+
+    fn ledger(&self) -> Result<Option<Ledger>, CheckpointError> {
+        let path = self.path(self.files.ledger);
+        let text = match fs::read_to_string(&path) {
+            Ok(t) => t,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+            Err(e) => return Err(io("read", &path)(e)),
+        };
+        let v: Value = serde_json::from_str(&text).map_err(|e| CheckpointError::Corrupt {
+            path: path.display().to_string(),
+            message: e.to_string(),
+        })?;
+        if v.get("format").and_then(Value::as_u64) != Some(FORMAT)
+            && self.path(self.files.records).exists()
+        {
+            return Err(CheckpointError::Corrupt {
+                path: self.path(self.files.records).display().to_string(),
+                message: format!(
+                    "written by an earlier version of afmdyn (its lines carry no checksums); \
+                     {START_OVER}"
+                ),
+            });
+        }
+        Ok(Some(Ledger {
+            fingerprint: v.get("args").cloned().unwrap_or(Value::Null),
+            finished: v.get("finished").and_then(Value::as_bool).unwrap_or(false),
+        }))
+    }
+
+    fn write_ledger(&self, fingerprint: &Value, finished: bool) -> Result<(), CheckpointError> {
+        let doc = json!({"args": fingerprint, "finished": finished, "format": FORMAT});
+        write_atomic(
+            &self.path(self.files.ledger),
+            format!("{doc:#}\n").as_bytes(),
+        )
+    }
+
+    /// Open the store for the study of `fingerprint`. Without `resume` a new study begins (the
+    /// stored tasks are dropped). With `resume`: an empty store begins; a store of another
+    /// request is refused; otherwise the stored tasks are kept. Returns the tasks done.
+    ///
+    /// # Errors
+    /// [`CheckpointError::Mismatch`] naming the first field that differs,
+    /// [`CheckpointError::Unrecorded`] for tasks without a ledger, and the files' errors.
+    pub fn open(
+        &mut self,
+        fingerprint: &Value,
+        resume: bool,
+    ) -> Result<HashSet<usize>, CheckpointError> {
+        let tiles_path = self.path(self.files.records);
+        if resume {
+            match self.ledger()? {
+                None if tiles_path.exists() => {
+                    return Err(CheckpointError::Unrecorded {
+                        store: self.lock.path().display().to_string(),
+                        ledger: self.files.ledger.into(),
+                    })
+                }
+                None => {}
+                Some(ledger) => {
+                    let now: Value = serde_json::from_str(&fingerprint.to_string())
+                        .unwrap_or_else(|_| fingerprint.clone());
+                    if let Some((field, then, now)) = first_difference(&ledger.fingerprint, &now) {
+                        let field = field
+                            .strip_prefix(self.files.prefix)
+                            .unwrap_or(&field)
+                            .to_string();
+                        return Err(CheckpointError::Mismatch { field, then, now });
+                    }
+                    self.tasks = self.read_records(|_, _| {})?;
+                    self.reopen_writer()?;
+                    return Ok(self.tasks.iter().copied().collect());
+                }
+            }
+        }
+        self.tasks.clear();
+        match fs::remove_file(&tiles_path) {
+            Ok(()) => {}
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+            Err(e) => return Err(io("remove", &tiles_path)(e)),
+        }
+        self.write_ledger(fingerprint, false)?;
+        self.reopen_writer()?;
+        Ok(HashSet::new())
+    }
+
+    /// The stored tasks, each handed with its cells to `each`: every complete line (a cut last
+    /// line is dropped, and the file cut back to the complete lines so that appends follow
+    /// them).
+    ///
+    /// # Errors
+    /// [`CheckpointError::Corrupt`] naming the line whose checksum does not match or which
+    /// cannot be read; [`CheckpointError::Io`].
+    fn read_records(
+        &self,
+        mut each: impl FnMut(usize, R),
+    ) -> Result<BTreeSet<usize>, CheckpointError> {
+        let path = self.path(self.files.records);
+        let mut tasks = BTreeSet::new();
+        let file = match File::open(&path) {
+            Ok(f) => f,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(tasks),
+            Err(e) => return Err(io("read", &path)(e)),
+        };
+        let mut reader = BufReader::new(file);
+        let (mut good, mut buf, mut number) = (0u64, Vec::new(), 0usize);
+        let damaged = |number: usize, what: String| CheckpointError::Corrupt {
+            path: path.display().to_string(),
+            message: format!("line {number}: {what}; {START_OVER}"),
+        };
+        loop {
+            buf.clear();
+            let n = reader
+                .read_until(b'\n', &mut buf)
+                .map_err(io("read", &path))?;
+            if n == 0 || buf.last() != Some(&b'\n') {
+                break;
+            }
+            number += 1;
+            let text = String::from_utf8_lossy(&buf[..n - 1]);
+            let sealed = text.rfind(CRC_KEY).and_then(|at| {
+                let crc = text[at + CRC_KEY.len()..].strip_suffix("\"}")?;
+                Some((at, crc))
+            });
+            match sealed {
+                Some((at, crc)) if crc_hex(&text[..at]) == crc => {}
+                _ => {
+                    return Err(damaged(
+                        number,
+                        "checksum mismatch (the line was changed after afmdyn wrote it)".into(),
+                    ))
+                }
+            }
+            let (task, record) = self
+                .parse(&text)
+                .map_err(|e| damaged(number, format!("cannot be read ({e})")))?;
+            if tasks.insert(task) {
+                each(task, record);
+            }
+            good += n as u64;
+        }
+        let f = OpenOptions::new()
+            .write(true)
+            .open(&path)
+            .map_err(io("write", &path))?;
+        if f.metadata().map_err(io("read", &path))?.len() != good {
+            f.set_len(good).map_err(io("write", &path))?;
+        }
+        Ok(tasks)
+    }
+
+    /// A line's task and record.
+    fn parse(&self, text: &str) -> Result<(usize, R), serde_json::Error> {
+        let mut v: serde_json::Map<String, Value> = serde_json::from_str(text)?;
+        let task = serde_json::from_value(v.remove("task").unwrap_or(Value::Null))?;
+        let record = serde_json::from_value(v.remove(self.files.key).unwrap_or(Value::Null))?;
+        Ok((task, record))
+    }
+
+    fn reopen_writer(&mut self) -> Result<(), CheckpointError> {
+        let path = self.path(self.files.records);
+        let f = OpenOptions::new()
+            .create(true)
+            .append(true)
+            .open(&path)
+            .map_err(io("write", &path))?;
+        self.writer = Some(BufWriter::new(f));
+        Ok(())
+    }
+
+    /// Store the record of a finished task (one line, flushed).
+    ///
+    /// # Errors
+    /// [`CheckpointError::Io`].
+    pub fn append(&mut self, task: usize, record: &R) -> Result<(), CheckpointError> {
+        let path = self.path(self.files.records);
+        let mut line = serde_json::Map::new();
+        line.insert("task".into(), json!(task));
+        line.insert(
+            self.files.key.into(),
+            serde_json::to_value(record).map_err(|e| CheckpointError::Io {
+                action: "write",
+                path: path.display().to_string(),
+                message: e.to_string(),
+            })?,
+        );
+        let line = Value::Object(line).to_string();
+        // the object without its closing brace, then the checksum of that text
+        let body = &line[..line.len() - 1];
+        let line = format!("{body}{CRC_KEY}{}\"}}", crc_hex(body));
+        if let Some(w) = self.writer.as_mut() {
+            writeln!(w, "{line}")
+                .and_then(|()| w.flush())
+                .map_err(io("write", &path))?;
+        }
+        self.tasks.insert(task);
+        Ok(())
+    }
+
+    /// Mark the study finished.
+    ///
+    /// # Errors
+    /// [`CheckpointError::Io`].
+    pub fn finish(&mut self, fingerprint: &Value) -> Result<(), CheckpointError> {
+        if let Some(w) = self.writer.as_mut() {
+            let path = self.lock.path().join(self.files.records);
+            w.flush().map_err(io("write", &path))?;
+        }
+        self.write_ledger(fingerprint, true)
+    }
+
+    /// Whether the stored study finished.
+    ///
+    /// # Errors
+    /// As the ledger's reading.
+    pub fn finished(&self) -> Result<bool, CheckpointError> {
+        Ok(self.ledger()?.is_some_and(|l| l.finished))
+    }
+
+    /// Every stored record with its task, in the order of the tasks, read back from the store.
+    ///
+    /// # Errors
+    /// [`CheckpointError::Io`]; [`CheckpointError::Corrupt`] for a damaged line.
+    pub fn records(&mut self) -> Result<Vec<(usize, R)>, CheckpointError> {
+        if let Some(w) = self.writer.as_mut() {
+            let path = self.lock.path().join(self.files.records);
+            w.flush().map_err(io("write", &path))?;
+        }
+        let mut records = BTreeMap::new();
+        self.read_records(|t, r| {
+            records.insert(t, r);
+        })?;
+        Ok(records.into_iter().collect())
+    }
+}
+
+impl<S, R> Store<S> for TaskStore<'_, R>
+where
+    S: Study<Record = (usize, R), Done = HashSet<usize>> + ?Sized,
+    R: Serialize + DeserializeOwned + Send,
+{
+    fn open(&mut self, study: &S, resume: bool) -> Result<Opened<HashSet<usize>>, CheckpointError> {
+        let done = TaskStore::open(self, study.fingerprint(), resume)?;
+        if resume && self.finished()? {
+            return Ok(Opened::Finished);
+        }
+        Ok(Opened::Run(done))
+    }
+
+    fn append(&mut self, (task, record): (usize, R)) -> Result<(), CheckpointError> {
+        TaskStore::append(self, task, &record)
+    }
+
+    fn finish(&mut self, study: &S) -> Result<(), CheckpointError> {
+        TaskStore::finish(self, study.fingerprint())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const FILES: TaskFiles = TaskFiles {
+        ledger: ".t.run.json",
+        records: ".t.jsonl",
+        key: "lines",
+        prefix: "t.",
+    };
+
+    /// Records read back as stored, in task order; a resume keeps them and names the tasks
+    /// done; a cut last line is dropped; a changed line is refused naming its number; another
+    /// fingerprint is refused naming the field without the prefix.
+    #[test]
+    fn records_round_trip_and_resume_only_the_same_study() {
+        let dir = std::env::temp_dir().join(format!("afmdyn-task-store-{}", std::process::id()));
+        let _ = fs::remove_dir_all(&dir);
+        let lock = DirLock::acquire(&dir).unwrap();
+        let fp = json!({"t": {"n": 3}});
+        let mut s: TaskStore<'_, Vec<String>> = TaskStore::new(&lock, FILES);
+        assert!(s.open(&fp, false).unwrap().is_empty());
+        s.append(2, &vec!["c".into()]).unwrap();
+        s.append(0, &vec!["a".into(), "b".into()]).unwrap();
+        assert!(!s.finished().unwrap());
+        let got = s.records().unwrap();
+        assert_eq!(
+            got,
+            vec![(0, vec!["a".into(), "b".into()]), (2, vec!["c".into()])]
+        );
+        // a cut last line (a killed run) is dropped on resume
+        let path = dir.join(FILES.records);
+        let mut text = fs::read_to_string(&path).unwrap();
+        text.push_str("{\"lines\":[\"d\"],\"task\":1");
+        fs::write(&path, &text).unwrap();
+        let mut r: TaskStore<'_, Vec<String>> = TaskStore::new(&lock, FILES);
+        let done = r.open(&fp, true).unwrap();
+        assert_eq!(done, HashSet::from([0, 2]));
+        r.finish(&fp).unwrap();
+        assert!(r.finished().unwrap());
+        // another request: refused naming the field (prefix left out)
+        let err = r.open(&json!({"t": {"n": 4}}), true).unwrap_err();
+        assert_eq!(
+            err,
+            CheckpointError::Mismatch {
+                field: "n".into(),
+                then: "3".into(),
+                now: "4".into()
+            }
+        );
+        // a changed line: refused naming it
+        let text = fs::read_to_string(&path).unwrap().replace("\"c\"", "\"x\"");
+        fs::write(&path, text).unwrap();
+        let err = r.records().unwrap_err();
+        assert!(
+            matches!(&err, CheckpointError::Corrupt { message, .. } if message.starts_with("line 1: checksum")),
+            "{err}"
+        );
+        drop(lock);
+        fs::remove_dir_all(&dir).unwrap();
+    }
+}
