@@ -684,6 +684,10 @@ fn attractors_sweep(
         ],
         rows,
     )?;
+    crate::output::write_layout(
+        &out.join("attractors-sweep.nc"),
+        &afmdyn::report::global_continuation_layout(request.param, &steps),
+    )?;
     let ids = doc["ids"].as_u64().unwrap_or(0) as usize;
     let per_id: Vec<IdSeries> = (0..ids)
         .map(|id| {

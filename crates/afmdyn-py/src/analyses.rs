@@ -731,9 +731,17 @@ pub fn global_continuation<'py>(
         steady: steady(tol, max_periods, max_period),
         integrator: integrator_request(integrator, steps_per_period, tolerance)?,
     };
+    let param = request.param;
     let doc = analysis(py, request, params.inner, probe, progress.as_ref(), true)?;
     let out = Out::new(py);
     out.json(&doc.json)?;
+    out.set(
+        "layout",
+        crate::convert::layout_dict(
+            py,
+            afmdyn::report::global_continuation_layout(param, &doc.output),
+        )?,
+    )?;
     Ok(out.finish())
 }
 

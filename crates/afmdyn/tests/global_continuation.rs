@@ -113,6 +113,20 @@ fn fractions_count_the_random_starts_only() {
             assert!((a.basin_fraction - *c as f64 / s.census.samples as f64).abs() < 1e-15);
         }
     }
+    // the layout (attractors-sweep.nc, Python's dataset) holds the document's fractions table
+    let layout = afmdyn::report::global_continuation_layout(s.param, &steps);
+    assert_eq!(layout.check(), Ok(()));
+    let doc = afmdyn::report::global_continuation(&s.census.params, s.param, 24, &steps);
+    let table: Vec<f64> = doc["fractions"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .flat_map(|row| row.as_array().unwrap().iter().map(|v| v.as_f64().unwrap()))
+        .collect();
+    match &layout.variable("basin_fraction").unwrap().values {
+        afmdyn::study::Values::F64(v) => assert_eq!(v, &table),
+        v => panic!("basin_fraction: {v:?}"),
+    }
 }
 
 /// Seeds keep an attractor the random starts miss: at Ω = 2.0 the small-basin orbit (about 3 %

@@ -6,10 +6,10 @@ from __future__ import annotations
 import json
 from typing import TYPE_CHECKING, List, Optional
 
-import numpy as np
 import xarray as xr
 
 from . import _afmdyn as _core
+from . import _layout
 from ._afmdyn import Params
 from ._api import Model, _params, _run, _typed
 from ._progress import ProgressArg
@@ -80,37 +80,9 @@ def global_continuation(
         tolerance=tolerance,
     )
     doc = json.loads(d["json"])
-    nv, ni = len(doc["values"]), int(doc["ids"])
-    fraction = np.zeros((nv, ni))
-    period = np.zeros((nv, ni), dtype=np.int64)
-    x_max = np.full((nv, ni), np.nan)
-    v_t_min = np.full((nv, ni), np.nan)
-    stable = np.full((nv, ni), np.nan)
-    for i, step in enumerate(doc["steps"]):
-        for a in step["attractors"]:
-            k = a["id"]
-            fraction[i, k] = a["basin_fraction"]
-            period[i, k] = -1 if a["period"] is None else a["period"]
-            x_max[i, k] = a["x_max"]
-            v_t_min[i, k] = a["v_t_min"]
-            if a["stable"] is not None:
-                stable[i, k] = float(a["stable"])
-    name = doc["param"]
-    return xr.Dataset(
-        data_vars={
-            "basin_fraction": (("value", "id"), fraction,
-                               {"long_name": "share of the random starts (0: none)"}),
-            "period": (("value", "id"), period, {"long_name": "period n (-1 nonperiodic, 0 absent)"}),
-            "x_max": (("value", "id"), x_max, {"units": "g0", "long_name": "X_max"}),
-            "v_t_min": (("value", "id"), v_t_min, {"units": "g0", "long_name": "min V_T"}),
-            "stable": (("value", "id"), stable,
-                       {"long_name": "1 stable periodic orbit (shooting), 0 unstable, NaN otherwise"}),
-            "failures": ("value", [s["failures"] for s in doc["steps"]]),
-        },
-        coords={
-            "value": ("value", doc["values"], {"long_name": name}),
-            "id": ("id", np.arange(ni)),
-        },
-        attrs={"param": name, "samples": samples, "match_tol": match_tol,
-               "summary": json.dumps(doc)},
+    # the library's layout (the command line's attractors-sweep.nc)
+    return _layout.dataset(
+        d["layout"],
+        {"param": doc["param"], "samples": samples, "match_tol": match_tol,
+         "summary": json.dumps(doc)},
     )

@@ -1,0 +1,312 @@
+//! The documents of the stepped curves (`approach`, `resonance`, the setpoint, `observe`'s
+//! reported block): the [`CURVE_COLUMNS`] of each point in its [`CurveUnits`].
+
+use super::*;
+
+/// The [`CURVE_COLUMNS`] of one orbit's observables in `u`'s units: A, A/A₀ (A₀ the free
+/// amplitude at the same drive), φ in degrees, ⟨W⟩, max F_c, min F_c, indentation, contact
+/// fraction, min distance, E_dis, virial, THD.
+pub fn curve_row(o: &Observables, u: &CurveUnits) -> [f64; 12] {
+    [
+        o.amplitude * u.length,
+        o.amplitude / o.closed_form.free_amplitude,
+        o.phase.to_degrees(),
+        o.mean_deflection * u.length,
+        o.peak_force * u.force,
+        o.min_force * u.force,
+        o.indentation * u.length,
+        o.contact_fraction,
+        o.min_distance * u.length,
+        o.energy_dissipated * u.energy,
+        o.virial * u.energy,
+        o.thd,
+    ]
+}
+
+/// The observables of one steady state in `u`'s units — SI for a probe's model (m, N, J, s),
+/// the model's own otherwise (g₀, F̃, F̃·g₀, τ) — with phases in degrees: the [`CURVE_COLUMNS`]
+/// (as [`curve_row`]), then `contact_time`, `mean_force`, `impacts_per_period`, `impact_loss`,
+/// `harmonics` (arrays `n`, `amplitude`, `phase_deg`), `mode_balance` (arrays `mode`, `drive`,
+/// `beam_damping`, `sample`, `coupling`, `energy_change`, `residual`; energies per drive period)
+/// and `units` (the names). The `"reported"` block of `observe`'s document, which Python's
+/// dataset is built from.
+pub fn observed(o: &Observables, u: &CurveUnits) -> Value {
+    let mut m = serde_json::Map::new();
+    for (c, v) in CURVE_COLUMNS.iter().zip(curve_row(o, u)) {
+        m.insert(c.name.into(), json!(v));
+    }
+    m.insert("contact_time".into(), json!(o.contact_time * u.time));
+    m.insert("mean_force".into(), json!(o.mean_force * u.force));
+    m.insert("impacts_per_period".into(), json!(o.impacts_per_period));
+    m.insert("impact_loss".into(), json!(o.impact_loss * u.energy));
+    let h = &o.harmonics;
+    m.insert(
+        "harmonics".into(),
+        json!({
+            "n": h.iter().map(|h| h.n).collect::<Vec<_>>(),
+            "amplitude": h.iter().map(|h| h.amplitude * u.length).collect::<Vec<_>>(),
+            "phase_deg": h.iter().map(|h| h.phase.to_degrees()).collect::<Vec<_>>(),
+        }),
+    );
+    let b = &o.mode_balance;
+    let energies =
+        |f: fn(&ModeBalance) -> f64| -> Vec<f64> { b.iter().map(|x| f(x) * u.energy).collect() };
+    m.insert(
+        "mode_balance".into(),
+        json!({
+            "mode": b.iter().map(|x| x.mode).collect::<Vec<_>>(),
+            "drive": energies(|x| x.drive),
+            "beam_damping": energies(|x| x.beam_damping),
+            "sample": energies(|x| x.sample),
+            "coupling": energies(|x| x.coupling),
+            "energy_change": energies(|x| x.energy_change),
+            "residual": energies(|x| x.residual),
+        }),
+    );
+    let mut units = u.names();
+    units["time"] = json!(if u.si { "s" } else { "τ" });
+    m.insert("units".into(), units);
+    Value::Object(m)
+}
+
+/// The abscissa of a stepped curve: (key, value of the swept parameter → reported value).
+type Abscissa<'a> = (&'static str, &'a dyn Fn(f64) -> f64);
+
+fn columns<'a>(
+    x: &Abscissa<'_>,
+    rows: impl Iterator<Item = (f64, &'a Observables, bool)>,
+    u: &CurveUnits,
+) -> serde_json::Map<String, Value> {
+    let mut xs = Vec::new();
+    let mut cols: Vec<Vec<f64>> = vec![Vec::new(); CURVE_COLUMNS.len()];
+    let mut stable = Vec::new();
+    for (v, o, s) in rows {
+        xs.push((x.1)(v));
+        for (c, val) in cols.iter_mut().zip(curve_row(o, u)) {
+            c.push(val);
+        }
+        stable.push(s);
+    }
+    let mut m = serde_json::Map::new();
+    m.insert(x.0.into(), json!(xs));
+    for (col, c) in CURVE_COLUMNS.iter().zip(cols) {
+        m.insert(col.name.into(), json!(c));
+    }
+    m.insert("stable".into(), json!(stable));
+    m
+}
+
+fn sweep_doc(x: &Abscissa<'_>, points: &[CurvePoint], u: &CurveUnits) -> Value {
+    let mut m = columns(
+        x,
+        points.iter().map(|p| (p.value, &p.observables, p.stable)),
+        u,
+    );
+    m.insert(
+        "period".into(),
+        json!(points.iter().map(|p| p.period).collect::<Vec<_>>()),
+    );
+    m.insert(
+        "reached".into(),
+        json!(points.iter().map(|p| p.reached).collect::<Vec<_>>()),
+    );
+    Value::Object(m)
+}
+
+fn curve_doc(
+    params: &Params,
+    c: &SteppedCurve,
+    x: Abscissa<'_>,
+    names: (&str, &str),
+    u: &CurveUnits,
+) -> Value {
+    let branches: Vec<Value> = c
+        .branches
+        .iter()
+        .map(|b| {
+            let mut m = columns(
+                &x,
+                b.iter()
+                    .map(|s| (s.point.value, &s.observables, s.point.stable)),
+                u,
+            );
+            m.insert(
+                "period".into(),
+                json!(b.iter().map(|s| s.point.period).collect::<Vec<_>>()),
+            );
+            m.insert(
+                "event".into(),
+                json!(b.iter().map(|s| s.point.event).collect::<Vec<_>>()),
+            );
+            Value::Object(m)
+        })
+        .collect();
+    let sweep_name = |s: Sweep| match s {
+        Sweep::First => names.0,
+        Sweep::Second => names.1,
+    };
+    let jumps: Vec<Value> = c
+        .jumps
+        .iter()
+        .map(|j| {
+            json!({
+                "sweep": sweep_name(j.sweep),
+                "from": (x.1)(j.from),
+                "to": (x.1)(j.to),
+                "fold": j.fold.map(|f| (x.1)(f)),
+            })
+        })
+        .collect();
+    let free = c
+        .first
+        .first()
+        .map(|p| p.observables.closed_form.free_amplitude * u.length);
+    let traces = c.traces.as_ref().map(|t| {
+        let n = t.time.len().max(1);
+        let rows = |v: &[f64], scale: f64| -> Vec<Vec<f64>> {
+            v.chunks(n)
+                .map(|r| r.iter().map(|x| x * scale).collect())
+                .collect()
+        };
+        json!({
+            "sweep": names.0,
+            "periods": t.periods,
+            "samples_per_period": t.samples_per_period,
+            x.0: t.values.iter().map(|&v| (x.1)(v)).collect::<Vec<_>>(),
+            "time_periods": t.time,
+            "deflection": rows(&t.deflection, u.length),
+            "distance": rows(&t.distance, u.length),
+            "force": rows(&t.force, u.force),
+        })
+    });
+    json!({
+        "params": params,
+        "units": u.names(),
+        "scales": {"length": u.length, "force": u.force, "energy": u.energy, "time": u.time,
+                   "hz_per_omega": u.hz_per_omega},
+        names.0: sweep_doc(&x, &c.first, u),
+        names.1: sweep_doc(&x, &c.second, u),
+        "branches": branches,
+        "folds": c.folds.iter().map(|&f| (x.1)(f)).collect::<Vec<_>>(),
+        "bistable": c.bistable.iter().map(|&(a, b)| {
+            let (p, q) = ((x.1)(a), (x.1)(b));
+            [p.min(q), p.max(q)]
+        }).collect::<Vec<_>>(),
+        "jumps": jumps,
+        "free_amplitude": free,
+        "warnings": c.warnings,
+        "traces": traces,
+    })
+}
+
+/// `doc` with the [`si`] block of `probe` added (built from `doc` itself, so its headline values
+/// appear in SI), when the model came from a probe file; `doc` unchanged otherwise. Every front
+/// end adds the block through this one function.
+pub fn with_si(mut doc: Value, probe: Option<&crate::probe::Probe>, params: &Params) -> Value {
+    if let Some(p) = probe {
+        doc["si"] = si(p, params, &doc);
+    }
+    doc
+}
+
+/// `afmdyn approach --json`: `{"approach": {...}, "retract": {...}, "branches": [...], …}`.
+/// `approach` and `retract` hold equal-length arrays `z_c` (rest distance,
+/// [`Params::rest_distance`]) and the [`CURVE_COLUMNS`], plus `stable`, `period` (null when not
+/// period-n) and `reached` ([`crate::analysis::stepped::Reached`]); each branch the same
+/// columns with `stable`, `period` and `event` (null, "fold", "grazing", …). Also `folds` and
+/// `bistable` ([lo, hi] ranges of z_c between two folds), `jumps` ({sweep, from, to, fold}),
+/// `free_amplitude`, `units` (names), `scales` (the [`CurveUnits`] factors), `params` and
+/// `warnings`.
+pub fn approach(params: &Params, c: &SteppedCurve, u: &CurveUnits) -> Value {
+    let x = z_c_of(params, u);
+    curve_doc(params, c, ("z_c", &x), ("approach", "retract"), u)
+}
+
+/// The abscissa of an approach document: z_c ([`crate::analysis::approach::rest_distance`]) of
+/// the gap α5, in `u`'s length.
+fn z_c_of<'a>(params: &'a Params, u: &'a CurveUnits) -> impl Fn(f64) -> f64 + 'a {
+    move |a5| crate::analysis::approach::rest_distance(params, a5) * u.length
+}
+
+/// The `"setpoint"` block of `afmdyn approach --setpoint S --json`: the ratio A_sp/A₀, the
+/// amplitude it means (in `u`'s length), and per crossing of the curve
+/// ([`crate::analysis::setpoint::setpoint_crossings`]) its `source` (`"branch k"`,
+/// `"approach"`, `"retract"`), `z_c`, `regime` (`"attractive"` where the mean tip–sample force,
+/// k⟨W⟩ for the point mass, is negative, else `"repulsive"`; García & San Paulo 2000) and the
+/// [`CURVE_COLUMNS`] interpolated there.
+pub fn setpoint(params: &Params, c: &SteppedCurve, ratio: f64, u: &CurveUnits) -> Value {
+    use crate::analysis::setpoint::{setpoint_crossings, Source};
+    let x = z_c_of(params, u);
+    let points: Vec<Value> = setpoint_crossings(c, ratio)
+        .into_iter()
+        .map(|k| {
+            let (name, a, b) = match k.source {
+                Source::Branch(j) => (
+                    format!("branch {j}"),
+                    &c.branches[j][k.index].observables,
+                    &c.branches[j][k.index + 1].observables,
+                ),
+                Source::Sweep(s) => {
+                    let pts = match s {
+                        Sweep::First => &c.first,
+                        Sweep::Second => &c.second,
+                    };
+                    let name = if s == Sweep::First {
+                        "approach"
+                    } else {
+                        "retract"
+                    };
+                    (
+                        name.to_string(),
+                        &pts[k.index].observables,
+                        &pts[k.index + 1].observables,
+                    )
+                }
+            };
+            let (ra, rb) = (curve_row(a, u), curve_row(b, u));
+            let mut m = serde_json::Map::new();
+            m.insert("source".into(), json!(name));
+            m.insert("z_c".into(), json!(x(k.value)));
+            let row: Vec<f64> = ra
+                .iter()
+                .zip(rb)
+                .map(|(p, q)| (1.0 - k.t) * p + k.t * q)
+                .collect();
+            let mean = row[3];
+            m.insert(
+                "regime".into(),
+                json!(if mean < 0.0 {
+                    "attractive"
+                } else {
+                    "repulsive"
+                }),
+            );
+            for (c, v) in CURVE_COLUMNS.iter().zip(row) {
+                m.insert(c.name.into(), json!(v));
+            }
+            Value::Object(m)
+        })
+        .collect();
+    let a0 = c
+        .first
+        .first()
+        .map(|p| p.observables.closed_form.free_amplitude * u.length);
+    json!({
+        "ratio": ratio,
+        "amplitude": a0.map(|a| a * ratio),
+        "points": points,
+    })
+}
+
+/// `afmdyn resonance --json`: as [`approach`] with the abscissa `omega` (dimensionless Ω) or
+/// `frequency_hz` (with [`CurveUnits::hz_per_omega`]) and the sweeps `up` and `down`.
+pub fn resonance(params: &Params, c: &SteppedCurve, u: &CurveUnits) -> Value {
+    let scale = u.hz_per_omega.unwrap_or(1.0);
+    let key = if u.hz_per_omega.is_some() {
+        "frequency_hz"
+    } else {
+        "omega"
+    };
+    let x = move |om: f64| om * scale;
+    curve_doc(params, c, (key, &x), ("up", "down"), u)
+}
