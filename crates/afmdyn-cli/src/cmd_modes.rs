@@ -7,13 +7,9 @@ use crate::plot::{save, Figure, Series, Style};
 use afmdyn::analysis::progress::Progress;
 use afmdyn::eigen::fig3_sweep;
 use afmdyn::request::{self, Document, ModesRequest, Resolved};
-use afmdyn::units::{
-    beam_damping_from_q, contact_stiffness, material, Cantilever, ContactStiffness, Material,
-    PhysicalModel, SILICON_TIP,
-};
+use afmdyn::units::PhysicalFile;
 use afmdyn::Params;
 use clap::Args;
-use serde::Deserialize;
 use serde_json::json;
 use std::path::PathBuf;
 
@@ -209,40 +205,6 @@ pub struct UnitsArgs {
     json: bool,
 }
 
-/// A probe file: cantilever, tip, sample and drive, in SI units.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct ProbeFile {
-    modes: Option<usize>,
-    length: f64,
-    width: f64,
-    thickness: f64,
-    youngs_modulus: f64,
-    density: f64,
-    tip_mass: f64,
-    beam_damping: Option<f64>,
-    quality_factor: Option<f64>,
-    contact_stiffness: Option<f64>,
-    hertz: Option<HertzFile>,
-    contact_damping: f64,
-    drive_amplitude: f64,
-    beam_gap: f64,
-    tip_gap: f64,
-    drive_frequency_hz: f64,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct HertzFile {
-    tip_radius: f64,
-    indentation: f64,
-    tip_youngs_modulus: Option<f64>,
-    tip_poisson_ratio: Option<f64>,
-    sample: Option<String>,
-    sample_youngs_modulus: Option<f64>,
-    sample_poisson_ratio: Option<f64>,
-}
-
 /// Run `afmdyn units`.
 pub fn units(a: &UnitsArgs) -> Result<(), CliError> {
     if let Some(path) = &a.probe {
@@ -267,63 +229,9 @@ pub fn units(a: &UnitsArgs) -> Result<(), CliError> {
     let Some(config) = &a.config else {
         return Err(CliError::Input("give --config or --probe".into()));
     };
-    let pf: ProbeFile = read_toml(config)?;
-    let k1 = match (pf.contact_stiffness, &pf.hertz) {
-        (Some(k), None) => contact_stiffness(ContactStiffness::Direct(k))?,
-        (None, Some(h)) => {
-            let sample = match (&h.sample, h.sample_youngs_modulus, h.sample_poisson_ratio) {
-                (Some(name), None, None) => material(name)?,
-                (None, Some(e), Some(nu)) => Material { youngs_modulus: e, poisson_ratio: nu },
-                _ => {
-                    return Err(CliError::Input(
-                        "hertz: give either sample = \"name\" or both sample_youngs_modulus and sample_poisson_ratio".into(),
-                    ))
-                }
-            };
-            let tip = Material {
-                youngs_modulus: h.tip_youngs_modulus.unwrap_or(SILICON_TIP.youngs_modulus),
-                poisson_ratio: h.tip_poisson_ratio.unwrap_or(SILICON_TIP.poisson_ratio),
-            };
-            contact_stiffness(ContactStiffness::Hertz {
-                tip,
-                sample,
-                radius: h.tip_radius,
-                indentation: h.indentation,
-            })?
-        }
-        _ => {
-            return Err(CliError::Input(
-                "give exactly one of contact_stiffness or [hertz]".into(),
-            ))
-        }
-    };
-    let mut model = PhysicalModel {
-        cantilever: Cantilever {
-            length: pf.length,
-            width: pf.width,
-            thickness: pf.thickness,
-            youngs_modulus: pf.youngs_modulus,
-            density: pf.density,
-        },
-        modes: pf.modes.unwrap_or(3),
-        tip_mass: pf.tip_mass,
-        beam_damping: 0.0,
-        contact_stiffness: k1,
-        contact_damping: pf.contact_damping,
-        drive_amplitude: pf.drive_amplitude,
-        beam_gap: pf.beam_gap,
-        tip_gap: pf.tip_gap,
-        drive_frequency_hz: pf.drive_frequency_hz,
-    };
-    model.beam_damping = match (pf.beam_damping, pf.quality_factor) {
-        (Some(c), None) => c,
-        (None, Some(q)) => beam_damping_from_q(&model, q)?,
-        _ => {
-            return Err(CliError::Input(
-                "give exactly one of beam_damping or quality_factor".into(),
-            ))
-        }
-    };
+    let pf: PhysicalFile = read_toml(config)?;
+    let model = pf.resolve()?;
+    let k1 = model.contact_stiffness;
     let p = model.to_params()?;
     let s = model.scales();
     if a.json {

@@ -404,3 +404,188 @@ fn non_negative(name: &'static str, value: f64, unit: &'static str) -> Result<f6
         Err(UnitsError::NonNegative { name, value, unit })
     }
 }
+
+/// The physical-model file of `afmdyn units --config` (`examples/probe.toml`): the paper's
+/// model in SI — the beam's geometry and material, the tip mass, the beam damping C or Q₁,
+/// the contact stiffness K₁ (given, or from Hertz at an indentation), the contact damping, the
+/// base drive, the gaps g₀ and g₁ and the drive frequency. [`PhysicalFile::resolve`] gives the
+/// [`PhysicalModel`].
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PhysicalFile {
+    /// Galerkin modes N (default 3).
+    pub modes: Option<usize>,
+    /// Beam length L (m).
+    pub length: f64,
+    /// Beam width b (m).
+    pub width: f64,
+    /// Beam thickness h (m).
+    pub thickness: f64,
+    /// Young's modulus E (Pa).
+    pub youngs_modulus: f64,
+    /// Density ρ (kg/m³).
+    pub density: f64,
+    /// Tip mass M (kg).
+    pub tip_mass: f64,
+    /// Beam damping per unit length C (N s/m²); exclusive with `quality_factor`.
+    pub beam_damping: Option<f64>,
+    /// Quality factor Q₁ of the first mode; exclusive with `beam_damping`.
+    pub quality_factor: Option<f64>,
+    /// Contact stiffness K₁ (N/m); exclusive with `[hertz]`.
+    pub contact_stiffness: Option<f64>,
+    /// K₁ from the Hertz contact at an indentation; exclusive with `contact_stiffness`.
+    pub hertz: Option<HertzFile>,
+    /// Contact damping C₁ (N s/m).
+    pub contact_damping: f64,
+    /// Base-drive amplitude f (m).
+    pub drive_amplitude: f64,
+    /// Beam–substrate gap g₀ (m).
+    pub beam_gap: f64,
+    /// Tip–sample gap g₁ (m).
+    pub tip_gap: f64,
+    /// Drive frequency (Hz).
+    pub drive_frequency_hz: f64,
+}
+
+/// The `[hertz]` table of a [`PhysicalFile`]: K₁ as the Hertz contact's tangent stiffness at
+/// an indentation ([`ContactStiffness::Hertz`]).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HertzFile {
+    /// Tip radius R (m).
+    pub tip_radius: f64,
+    /// Indentation δ (m) at which K₁ is taken.
+    pub indentation: f64,
+    /// Tip Young's modulus (Pa), default silicon ([`SILICON_TIP`]).
+    pub tip_youngs_modulus: Option<f64>,
+    /// Tip Poisson ratio, default silicon.
+    pub tip_poisson_ratio: Option<f64>,
+    /// A sample material by name ([`material`]); exclusive with the two moduli below.
+    pub sample: Option<String>,
+    /// Sample Young's modulus (Pa).
+    pub sample_youngs_modulus: Option<f64>,
+    /// Sample Poisson ratio.
+    pub sample_poisson_ratio: Option<f64>,
+}
+
+impl PhysicalFile {
+    /// The physical model of the file: K₁ from `contact_stiffness` or `[hertz]`, C from
+    /// `beam_damping` or Q₁ ([`beam_damping_from_q`]).
+    ///
+    /// # Errors
+    /// [`UnitsError::Choice`] when both or neither of an exclusive pair are given; the range
+    /// errors of [`contact_stiffness`], [`material`] and [`beam_damping_from_q`].
+    pub fn resolve(&self) -> Result<PhysicalModel, UnitsError> {
+        let choice = |m: &str| UnitsError::Choice(m.into());
+        let k1 = match (self.contact_stiffness, &self.hertz) {
+            (Some(k), None) => contact_stiffness(ContactStiffness::Direct(k))?,
+            (None, Some(h)) => {
+                let sample =
+                    match (&h.sample, h.sample_youngs_modulus, h.sample_poisson_ratio) {
+                        (Some(name), None, None) => material(name)?,
+                        (None, Some(e), Some(nu)) => Material {
+                            youngs_modulus: e,
+                            poisson_ratio: nu,
+                        },
+                        _ => return Err(choice(
+                            "hertz: give either sample = \"name\" or both sample_youngs_modulus \
+                             and sample_poisson_ratio",
+                        )),
+                    };
+                let tip = Material {
+                    youngs_modulus: h.tip_youngs_modulus.unwrap_or(SILICON_TIP.youngs_modulus),
+                    poisson_ratio: h.tip_poisson_ratio.unwrap_or(SILICON_TIP.poisson_ratio),
+                };
+                contact_stiffness(ContactStiffness::Hertz {
+                    tip,
+                    sample,
+                    radius: h.tip_radius,
+                    indentation: h.indentation,
+                })?
+            }
+            _ => return Err(choice("give exactly one of contact_stiffness or [hertz]")),
+        };
+        let mut model = PhysicalModel {
+            cantilever: Cantilever {
+                length: self.length,
+                width: self.width,
+                thickness: self.thickness,
+                youngs_modulus: self.youngs_modulus,
+                density: self.density,
+            },
+            modes: self.modes.unwrap_or(3),
+            tip_mass: self.tip_mass,
+            beam_damping: 0.0,
+            contact_stiffness: k1,
+            contact_damping: self.contact_damping,
+            drive_amplitude: self.drive_amplitude,
+            beam_gap: self.beam_gap,
+            tip_gap: self.tip_gap,
+            drive_frequency_hz: self.drive_frequency_hz,
+        };
+        model.beam_damping = match (self.beam_damping, self.quality_factor) {
+            (Some(c), None) => c,
+            (None, Some(q)) => beam_damping_from_q(&model, q)?,
+            _ => return Err(choice("give exactly one of beam_damping or quality_factor")),
+        };
+        Ok(model)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// examples/probe.toml resolves; K₁ given directly is kept; both or neither of an exclusive
+    /// pair is refused with the choice named; Q₁ gives the C whose first-mode Q is Q₁.
+    #[test]
+    fn a_physical_file_resolves_its_choices() {
+        let text = include_str!("../../../examples/probe.toml");
+        let file: PhysicalFile = toml::from_str(text).unwrap();
+        let m = file.resolve().unwrap();
+        assert!(m.contact_stiffness > 0.0 && m.beam_damping > 0.0);
+        let direct = PhysicalFile {
+            contact_stiffness: Some(5.0),
+            hertz: None,
+            ..file.clone()
+        };
+        assert_eq!(direct.resolve().unwrap().contact_stiffness, 5.0);
+        let both = PhysicalFile {
+            contact_stiffness: Some(5.0),
+            hertz: Some(HertzFile {
+                tip_radius: 1e-8,
+                indentation: 1e-9,
+                tip_youngs_modulus: None,
+                tip_poisson_ratio: None,
+                sample: Some("polystyrene".into()),
+                sample_youngs_modulus: None,
+                sample_poisson_ratio: None,
+            }),
+            ..file.clone()
+        };
+        assert_eq!(
+            both.resolve().unwrap_err().to_string(),
+            "give exactly one of contact_stiffness or [hertz]"
+        );
+        let q = PhysicalFile {
+            beam_damping: Some(1e-3),
+            quality_factor: Some(100.0),
+            ..direct.clone()
+        };
+        assert_eq!(
+            q.resolve().unwrap_err().to_string(),
+            "give exactly one of beam_damping or quality_factor"
+        );
+        let by_q = PhysicalFile {
+            beam_damping: None,
+            quality_factor: Some(100.0),
+            ..direct
+        };
+        let c = by_q.resolve().unwrap().beam_damping;
+        let model = PhysicalModel {
+            beam_damping: 0.0,
+            ..by_q.resolve().unwrap()
+        };
+        assert_eq!(c, beam_damping_from_q(&model, 100.0).unwrap());
+    }
+}
