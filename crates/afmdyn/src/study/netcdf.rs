@@ -2,6 +2,11 @@
 //! offsets; what xarray, netCDF4 and ncdump read), each variable with its `units` and
 //! `long_name` (CF conventions) and further attributes, the global `title` and `source`
 //! (afmdyn and its version), through a temporary file renamed into place.
+//!
+//! NetCDF 3 has no zero-length fixed dimension (only its one unlimited dimension may be empty,
+//! and only as a variable's first): a dimension of length 0 (a continuation that found no
+//! attractor) is left out with the variables over it, which hold no value, and the global
+//! attribute `empty_dimensions` names it.
 
 use super::layout::{Attr, Layout, Values};
 use std::path::Path;
@@ -31,10 +36,21 @@ pub fn write(path: &Path, layout: &Layout) -> Result<(), WriteError> {
     layout.check().map_err(e)?;
     let d = |r: Result<(), netcdf3::error::InvalidDataSet>| r.map_err(|x| e(format!("{x:?}")));
     let mut ds = DataSet::new();
-    for (name, len) in &layout.dims {
+    let empty: Vec<&str> = layout
+        .dims
+        .iter()
+        .filter(|(_, len)| *len == 0)
+        .map(|(n, _)| n.as_str())
+        .collect();
+    let written: Vec<_> = layout
+        .variables
+        .iter()
+        .filter(|v| !v.dims.iter().any(|d| empty.contains(&d.as_str())))
+        .collect();
+    for (name, len) in layout.dims.iter().filter(|(_, len)| *len > 0) {
         d(ds.add_fixed_dim(name, *len))?;
     }
-    for v in &layout.variables {
+    for v in &written {
         let dims: Vec<&str> = v.dims.iter().map(String::as_str).collect();
         match v.values {
             Values::F64(_) => d(ds.add_var_f64(&v.name, &dims))?,
@@ -51,6 +67,9 @@ pub fn write(path: &Path, layout: &Layout) -> Result<(), WriteError> {
     }
     d(ds.add_global_attr_string("title", layout.title.as_str()))?;
     d(ds.add_global_attr_string("source", format!("afmdyn {}", env!("CARGO_PKG_VERSION"))))?;
+    if !empty.is_empty() {
+        d(ds.add_global_attr_string("empty_dimensions", empty.join(" ")))?;
+    }
     let mut tmp = path.as_os_str().to_owned();
     tmp.push(".partial");
     let tmp = std::path::PathBuf::from(tmp);
@@ -62,7 +81,7 @@ pub fn write(path: &Path, layout: &Layout) -> Result<(), WriteError> {
     let written = (|| {
         let mut f = FileWriter::open(&tmp).map_err(w)?;
         f.set_def(&ds, Version::Offset64Bit, 0).map_err(w)?;
-        for v in &layout.variables {
+        for v in &written {
             match &v.values {
                 Values::F64(x) => f.write_var_f64(&v.name, x).map_err(w)?,
                 Values::I32(x) => f.write_var_i32(&v.name, x).map_err(w)?,
@@ -118,6 +137,25 @@ mod tests {
         );
         let err = write(&path, &bad).unwrap_err();
         assert!(err.to_string().contains("t.nc") && err.message.contains("1 values"));
+        // a zero-length dimension: its variables are left out and named in the attributes
+        let empty = Layout::new(
+            "e",
+            &[("value", 2), ("id", 0)],
+            vec![
+                Variable::f64("value", &["value"], "1", "v", &[1.0, 2.0]),
+                Variable::f64("fraction", &["value", "id"], "1", "f", &[]),
+            ],
+        );
+        write(&path, &empty).unwrap();
+        let mut r = netcdf3::FileReader::open(&path).unwrap();
+        assert_eq!(
+            r.data_set()
+                .get_global_attr_as_string("empty_dimensions")
+                .as_deref(),
+            Some("id")
+        );
+        assert!(r.data_set().get_var("fraction").is_none());
+        assert_eq!(r.read_var_f64("value").unwrap(), vec![1.0, 2.0]);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }
