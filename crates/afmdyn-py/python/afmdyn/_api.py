@@ -235,23 +235,58 @@ def _warn(doc: Any) -> None:
             warnings.warn(str(w), AfmdynWarning, stacklevel=5)
 
 
+_NOT_REQUEST = frozenset(("params", "progress", "model", "store", "resume"))
+
+
+def _request(names: Dict[str, Any], **given: Any) -> Dict[str, Any]:
+    """The request of an analysis: its keywords (``names``, the function's ``locals()``), but
+    the model's, ``params``, ``progress`` and a store's, with ``given`` ones replaced."""
+    r = {k: v for k, v in names.items() if k not in _NOT_REQUEST}
+    r.update(given)
+    return r
+
+
+def _start(request: Dict[str, Any]) -> Dict[str, Any]:
+    """The request of an orbit analysis (the library's ``StartRequest``): the steady-state
+    keywords ``tol``, ``max_periods``, ``max_period`` nested under ``steady``."""
+    request["steady"] = {k: request.pop(k) for k in ("tol", "max_periods", "max_period")}
+    return request
+
+
 def _run(
-    fn: Any, desc: str, progress: ProgressArg, p: Params, si: Optional[str] = None, **options: Any
+    fn: Any,
+    desc: str,
+    progress: ProgressArg,
+    p: Params,
+    si: Optional[str] = None,
+    request: Optional[Dict[str, Any]] = None,
+    **extra: Any,
 ) -> Dict[str, Any]:
-    """Call the compiled ``fn`` with a progress reporter; negative counts are a ValueError
-    naming the option (the core's unsigned integers would raise OverflowError). With ``si`` (a
-    probe file) ``fn`` gets ``probe=si``, and its JSON document the command line's ``"si"``
-    block (added by the library's request layer)."""
-    for k, v in options.items():
+    """Call the compiled ``fn`` on ``request`` (the keywords of the library's request, which
+    checks them) with a progress reporter; negative counts are a ValueError naming the option
+    (the core's unsigned integers would raise OverflowError). With ``si`` (a probe file)
+    ``fn`` gets ``probe=si``, and its JSON document the command line's ``"si"`` block (added
+    by the library's request layer)."""
+    for k, v in (request or {}).items():
         if k in _COUNTS and isinstance(v, int) and not isinstance(v, bool) and v < 0:
             raise ValueError(f"{k} = {v}: must be >= 0")
     if si is not None:
-        options["probe"] = si
+        extra["probe"] = si
     with reporter(progress, desc) as cb:
-        d = fn(p, progress=cb, **options)
+        d = fn(p, request, progress=cb, **extra)
     if isinstance(d, dict):
         _warn(d.get("json"))
     return d
+
+
+#: The defaults of every analysis' keywords: the library's requests' (``Default``).
+_DEFAULTS = {
+    name: _core.request_defaults(name)
+    for name in (
+        "simulate converge bifurcation attractors global_continuation orbit continuation "
+        "lyapunov observe approach resonance basins chart"
+    ).split()
+}
 
 
 def summary(ds: xr.Dataset) -> Dict[str, Any]:
@@ -285,12 +320,12 @@ def simulate(
     *,
     periods: Optional[float] = None,
     tau_end: Optional[float] = None,
-    transient: float = 0.0,
+    transient: float = _DEFAULTS["simulate"]["transient"],
     initial: StateLike = None,
-    samples_per_period: int = 200,
+    samples_per_period: int = _DEFAULTS["simulate"]["samples_per_period"],
     integrator: Optional[str] = None,
     steps_per_period: Optional[int] = None,
-    tolerance: float = 1e-12,
+    tolerance: float = _DEFAULTS["simulate"]["tolerance"],
     progress: ProgressArg = None,
     **model: Unpack[Model],
 ) -> xr.Dataset:
@@ -325,22 +360,9 @@ def simulate(
         ``tau`` without a probe; events, sections) in s, lengths in m, velocities in m/s, forces in N, energies in J, the
         spectrum's frequencies in Hz — each variable's unit in its attrs.
     """
+    req = _request(locals(), initial=_state(initial))
     p, probe = _params(params, model)
-    d = _run(
-        _core.simulate,
-        "simulate",
-        progress,
-        p,
-        si=probe,
-        periods=periods,
-        tau_end=tau_end,
-        transient=transient,
-        initial=_state(initial),
-        samples_per_period=samples_per_period,
-        integrator=integrator,
-        steps_per_period=steps_per_period,
-        tolerance=tolerance,
-    )
+    d = _run(_core.simulate, "simulate", progress, p, si=probe, request=req)
     n = p.modes
     comp = [f"a_{j}" for j in range(1, n + 1)] + [f"a_dot_{j}" for j in range(1, n + 1)]
     # with a probe the library returned every array in SI (report::SeriesUnits)
@@ -469,12 +491,12 @@ def converge(
     params: Optional[Params] = None,
     /,
     *,
-    max_modes: int = 4,
-    periods: int = 1,
-    samples_per_period: int = 200,
+    max_modes: int = _DEFAULTS["converge"]["max_modes"],
+    periods: int = _DEFAULTS["converge"]["periods"],
+    samples_per_period: int = _DEFAULTS["converge"]["samples_per_period"],
     integrator: Optional[str] = None,
     steps_per_period: Optional[int] = None,
-    tolerance: float = 1e-12,
+    tolerance: float = _DEFAULTS["converge"]["tolerance"],
     progress: ProgressArg = None,
     **model: Unpack[Model],
 ) -> xr.Dataset:
@@ -489,20 +511,9 @@ def converge(
         ``[n_modes]`` (RMS of W_tip(N) − W_tip(N−1), NaN for N = 1); coordinate
         ``tau_from_section`` ``[K]``.
     """
+    req = _request(locals())
     p, probe = _params(params, model, default=Params(omega=4.1))
-    d = _run(
-        _core.converge,
-        "converge",
-        progress,
-        p,
-        si=probe,
-        max_modes=max_modes,
-        periods=periods,
-        samples_per_period=samples_per_period,
-        integrator=integrator,
-        steps_per_period=steps_per_period,
-        tolerance=tolerance,
-    )
+    d = _run(_core.converge, "converge", progress, p, si=probe, request=req)
     return xr.Dataset(
         data_vars={
             "w_tip": (
@@ -540,21 +551,21 @@ def bifurcation(
     params: Optional[Params] = None,
     /,
     *,
-    param: str = "omega",
-    from_: float = 1.0,
-    to: float = 5.0,
-    steps: int = 400,
+    param: str = _DEFAULTS["bifurcation"]["param"],
+    from_: float = _DEFAULTS["bifurcation"]["from"],
+    to: float = _DEFAULTS["bifurcation"]["to"],
+    steps: int = _DEFAULTS["bifurcation"]["steps"],
     values: Optional[Sequence[float]] = None,
-    starts: int = 0,
-    seed: int = 1,
-    continuation: bool = True,
+    starts: int = _DEFAULTS["bifurcation"]["starts"],
+    seed: int = _DEFAULTS["bifurcation"]["seed"],
+    continuation: bool = _DEFAULTS["bifurcation"]["continuation"],
     threads: Optional[int] = None,
-    tol: float = 1e-8,
+    tol: float = _DEFAULTS["bifurcation"]["tol"],
     max_periods: Optional[int] = None,
-    max_period: int = 64,
+    max_period: int = _DEFAULTS["bifurcation"]["max_period"],
     integrator: Optional[str] = None,
     steps_per_period: Optional[int] = None,
-    tolerance: float = 1e-12,
+    tolerance: float = _DEFAULTS["bifurcation"]["tolerance"],
     progress: ProgressArg = None,
     store: Union[str, "os.PathLike[str]", None] = None,
     resume: bool = False,
@@ -597,29 +608,17 @@ def bifurcation(
         ``contacts_per_period``, ``transient_periods``, ``message``, ``a_1``…``a_N``,
         ``a_dot_1``…``a_dot_N``. ``.to_dataframe()`` gives the tidy table.
     """
+    req = _request(locals())
+    if values is not None:
+        req["values"] = np.asarray(values, dtype=np.float64).ravel().tolist()
     p, probe = _params(params, model)
-    vals = None if values is None else np.asarray(values, dtype=np.float64).ravel().tolist()
     # the sweep's records carry no JSON document, so no "si" block: the probe only resolved p
     d = _run(
         _core.bifurcation,
         "bifurcation",
         progress,
         p,
-        param=param,
-        values=vals,
-        from_=from_,
-        to=to,
-        steps=steps,
-        starts=starts,
-        seed=seed,
-        continuation=continuation,
-        threads=threads,
-        tol=tol,
-        max_periods=max_periods,
-        max_period=max_period,
-        integrator=integrator,
-        steps_per_period=steps_per_period,
-        tolerance=tolerance,
+        request=req,
         store=None if store is None else os.fspath(store),
         resume=resume,
     )
@@ -685,15 +684,15 @@ def attractors(
     params: Optional[Params] = None,
     /,
     *,
-    samples: int = 64,
-    seed: int = 1,
-    cluster_tol: float = 1e-5,
-    tol: float = 1e-8,
+    samples: int = _DEFAULTS["attractors"]["samples"],
+    seed: int = _DEFAULTS["attractors"]["seed"],
+    cluster_tol: float = _DEFAULTS["attractors"]["cluster_tol"],
+    tol: float = _DEFAULTS["attractors"]["tol"],
     max_periods: Optional[int] = None,
-    max_period: int = 64,
+    max_period: int = _DEFAULTS["attractors"]["max_period"],
     integrator: Optional[str] = None,
     steps_per_period: Optional[int] = None,
-    tolerance: float = 1e-12,
+    tolerance: float = _DEFAULTS["attractors"]["tolerance"],
     progress: ProgressArg = None,
     **model: Unpack[Model],
 ) -> Attractors:
@@ -704,23 +703,9 @@ def attractors(
         :class:`Attractors`, a sequence of :class:`Attractor` (most frequent first);
         ``to_dict()`` is ``afmdyn attractors --json``, ``to_dataframe()`` a summary table.
     """
+    req = _request(locals())
     p, probe = _params(params, model)
-    d = _run(
-        _core.attractors,
-        "attractors",
-        progress,
-        p,
-        si=probe,
-        samples=samples,
-        seed=seed,
-        cluster_tol=cluster_tol,
-        tol=tol,
-        max_periods=max_periods,
-        max_period=max_period,
-        integrator=integrator,
-        steps_per_period=steps_per_period,
-        tolerance=tolerance,
-    )
+    d = _run(_core.attractors, "attractors", progress, p, si=probe, request=req)
     doc = json.loads(d["json"])
     found = [
         Attractor(
@@ -754,9 +739,9 @@ def orbit(
     *,
     period: Optional[int] = None,
     initial: StateLike = None,
-    tol: float = 1e-8,
+    tol: float = _DEFAULTS["orbit"]["steady"]["tol"],
     max_periods: Optional[int] = None,
-    max_period: int = 64,
+    max_period: int = _DEFAULTS["orbit"]["steady"]["max_period"],
     progress: ProgressArg = None,
     **model: Unpack[Model],
 ) -> Orbit:
@@ -773,21 +758,12 @@ def orbit(
         :class:`Orbit`; ``to_dict()`` is ``afmdyn orbit --json``. Raises
         :class:`SimulationError` when Newton's method does not converge.
     """
+    names = dict(locals())
     p, probe = _params(params, model)
     if period is None and isinstance(initial, Attractor):
         period = initial.period or 1
-    d = _run(
-        _core.orbit,
-        "orbit",
-        progress,
-        p,
-        si=probe,
-        period=period,
-        initial=_state(initial),
-        tol=tol,
-        max_periods=max_periods,
-        max_period=max_period,
-    )
+    req = _start(_request(names, period=period, initial=_state(initial)))
+    d = _run(_core.orbit, "orbit", progress, p, si=probe, request=req)
     doc = json.loads(d["json"])
     return Orbit(
         params=p,
@@ -813,15 +789,15 @@ def continuation(
     params: Optional[Params] = None,
     /,
     *,
-    param: str = "omega",
-    from_: float = 5.0,
-    to: float = 1.0,
+    param: str = _DEFAULTS["continuation"]["param"],
+    from_: float = _DEFAULTS["continuation"]["from"],
+    to: float = _DEFAULTS["continuation"]["to"],
     period: Optional[int] = None,
-    switch: bool = False,
+    switch: bool = _DEFAULTS["continuation"]["switch"],
     initial: StateLike = None,
-    tol: float = 1e-8,
+    tol: float = _DEFAULTS["continuation"]["steady"]["tol"],
     max_periods: Optional[int] = None,
-    max_period: int = 64,
+    max_period: int = _DEFAULTS["continuation"]["steady"]["max_period"],
     progress: ProgressArg = None,
     **model: Unpack[Model],
 ) -> xr.Dataset:
@@ -844,23 +820,9 @@ def continuation(
         ``multipliers`` ``[point, 2N]`` complex128, ``state`` ``[point, 2N]``.
         ``attrs["summary"]`` is ``afmdyn continue --json``.
     """
+    req = _start(_request(locals(), initial=_state(initial)))
     p, probe = _params(params, model)
-    d = _run(
-        _core.continuation,
-        "continuation",
-        progress,
-        p,
-        si=probe,
-        param=param,
-        from_=from_,
-        to=to,
-        period=period,
-        switch=switch,
-        initial=_state(initial),
-        tol=tol,
-        max_periods=max_periods,
-        max_period=max_period,
-    )
+    d = _run(_core.continuation, "continuation", progress, p, si=probe, request=req)
     return xr.Dataset(
         data_vars={
             "branch": ("point", d["branch"], {"long_name": "branch (0: the continued one)"}),
@@ -904,8 +866,8 @@ def lyapunov(
     *,
     initial: StateLike = None,
     transient: Optional[int] = None,
-    periods: int = 4000,
-    blocks: int = 10,
+    periods: int = _DEFAULTS["lyapunov"]["periods"],
+    blocks: int = _DEFAULTS["lyapunov"]["blocks"],
     progress: ProgressArg = None,
     **model: Unpack[Model],
 ) -> Lyapunov:
@@ -916,18 +878,9 @@ def lyapunov(
     Returns:
         :class:`Lyapunov`; ``to_dict()`` is ``afmdyn lyapunov --json``.
     """
+    req = _request(locals(), initial=_state(initial))
     p, probe = _params(params, model)
-    d = _run(
-        _core.lyapunov,
-        "lyapunov",
-        progress,
-        p,
-        si=probe,
-        initial=_state(initial),
-        transient=transient,
-        periods=periods,
-        blocks=blocks,
-    )
+    d = _run(_core.lyapunov, "lyapunov", progress, p, si=probe, request=req)
     doc = json.loads(d["json"])
     return Lyapunov(
         params=p,
@@ -965,11 +918,11 @@ def observe(
     /,
     *,
     initial: StateLike = None,
-    periods: int = 1,
-    harmonics: int = 10,
-    tol: float = 1e-8,
+    periods: int = _DEFAULTS["observe"]["periods"],
+    harmonics: int = _DEFAULTS["observe"]["harmonics"],
+    tol: float = _DEFAULTS["observe"]["steady"]["tol"],
     max_periods: Optional[int] = None,
-    max_period: int = 64,
+    max_period: int = _DEFAULTS["observe"]["steady"]["max_period"],
     progress: ProgressArg = None,
     **model: Unpack[Model],
 ) -> xr.Dataset:
@@ -995,20 +948,9 @@ def observe(
         (dimensionless, phases in radians, the closed forms; its ``reported`` block holds the
         dataset's values).
     """
+    req = _start(_request(locals(), initial=_state(initial)))
     p, probe = _params(params, model)
-    d = _run(
-        _core.observe,
-        "observe",
-        progress,
-        p,
-        si=probe,
-        initial=_state(initial),
-        periods=periods,
-        harmonics=harmonics,
-        tol=tol,
-        max_periods=max_periods,
-        max_period=max_period,
-    )
+    d = _run(_core.observe, "observe", progress, p, si=probe, request=req)
     doc: Dict[str, Any] = json.loads(d["json"])
     doc["state"] = d["state"]
     doc["period"] = d["period"]
@@ -1021,12 +963,12 @@ def _curve(
     progress: ProgressArg,
     params: Optional[Params],
     model: Any,
-    **options: Any,
+    request: Dict[str, Any],
 ) -> xr.Dataset:
     """Run a stepped-curve analysis (:func:`approach`, :func:`resonance`) and return its
     dataset (:func:`afmdyn._curves.curve_dataset`; in SI with a probe)."""
     p, probe = _params(params, model)
-    d = _run(fn, desc, progress, p, probe=probe, **options)
+    d = _run(fn, desc, progress, p, si=probe, request=request)
     return curve_dataset(desc, json.loads(d["json"]))
 
 
@@ -1039,8 +981,8 @@ def approach(
     to: Optional[float] = None,
     step: Optional[float] = None,
     points: Optional[int] = None,
-    branches: bool = True,
-    tolerance: float = 1e-10,
+    branches: bool = _DEFAULTS["approach"]["branches"],
+    tolerance: float = _DEFAULTS["approach"]["tolerance"],
     setpoint: Optional[float] = None,
     traces: Optional[int] = None,
     progress: ProgressArg = None,
@@ -1080,21 +1022,7 @@ def approach(
         (``folds``, ``bistable``, ``jumps``, ``setpoint``, ``warnings``;
         ``docs/outputs.md``).
     """
-    return _curve(
-        _core.approach,
-        "approach",
-        progress,
-        params,
-        model,
-        from_=from_,
-        to=to,
-        step=step,
-        points=points,
-        branches=branches,
-        tolerance=tolerance,
-        setpoint=setpoint,
-        traces=traces,
-    )
+    return _curve(_core.approach, "approach", progress, params, model, _request(locals()))
 
 
 @_typed
@@ -1102,13 +1030,13 @@ def resonance(
     params: Optional[Params] = None,
     /,
     *,
-    mode: int = 1,
+    mode: int = _DEFAULTS["resonance"]["mode"],
     from_: Optional[float] = None,
     to: Optional[float] = None,
     step: Optional[float] = None,
     points: Optional[int] = None,
-    branches: bool = True,
-    tolerance: float = 1e-10,
+    branches: bool = _DEFAULTS["resonance"]["branches"],
+    tolerance: float = _DEFAULTS["resonance"]["tolerance"],
     traces: Optional[int] = None,
     progress: ProgressArg = None,
     **model: Unpack[Model],
@@ -1129,18 +1057,4 @@ def resonance(
         ``omega`` and ``sweep`` = ``up``/``down``; ``ds.afmdyn.to_dict()`` is the
         ``afmdyn resonance --json`` document.
     """
-    return _curve(
-        _core.resonance,
-        "resonance",
-        progress,
-        params,
-        model,
-        mode=mode,
-        from_=from_,
-        to=to,
-        step=step,
-        points=points,
-        branches=branches,
-        tolerance=tolerance,
-        traces=traces,
-    )
+    return _curve(_core.resonance, "resonance", progress, params, model, _request(locals()))
