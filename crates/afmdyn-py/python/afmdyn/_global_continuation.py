@@ -11,7 +11,7 @@ import xarray as xr
 
 from . import _afmdyn as _core
 from ._afmdyn import Params
-from ._api import _DEFAULTS, Model, _params, _request, _run, _typed
+from ._common import _DEFAULTS, Model, _params, _request, _run, _typed
 from ._progress import ProgressArg
 
 if TYPE_CHECKING:
