@@ -101,7 +101,7 @@ def test_the_defaults_are_the_requests() -> None:
     for fn, name in [(afmdyn.simulate, "simulate"), (afmdyn.bifurcation, "bifurcation"),
                      (afmdyn.attractors, "attractors"), (afmdyn.lyapunov, "lyapunov"),
                      (afmdyn.resonance, "resonance"), (afmdyn.basins, "basins"),
-                     (afmdyn.global_continuation, "global_continuation")]:
+                     (afmdyn.global_continuation, "global_continuation"), (afmdyn.chart, "chart")]:
         d = core.request_defaults(name)
         for key, prm in inspect.signature(fn).parameters.items():
             k = "from" if key == "from_" else key
