@@ -34,19 +34,21 @@ use std::path::PathBuf;
 
 type Dict<'py> = Bound<'py, PyDict>;
 
-/// The integrator request of the keywords (`None`: the library's default integrator).
+/// The integrator request of the keywords (`None`: the request's default integrator and
+/// tolerance).
 pub(crate) fn integrator_request(
     kind: Option<&str>,
     steps_per_period: Option<usize>,
-    tolerance: f64,
+    tolerance: Option<f64>,
 ) -> PyResult<IntegratorRequest> {
+    let d = IntegratorRequest::default();
     Ok(IntegratorRequest {
         integrator: match kind {
             Some(k) => k.parse().map_err(value_error)?,
-            None => IntegratorRequest::default().integrator,
+            None => d.integrator,
         },
         steps_per_period,
-        tolerance,
+        tolerance: tolerance.unwrap_or(d.tolerance),
     })
 }
 

@@ -482,7 +482,7 @@ class ChartStudy:
         model: Optional[Dict[str, Any]] = None,
         integrator: Optional[str] = None,
         steps_per_period: Optional[int] = None,
-        tolerance: float = 1e-12,
+        tolerance: Optional[float] = None,
     ) -> ChartStudy: ...
     @property
     def recipe(self) -> str: ...
@@ -524,7 +524,7 @@ class SweepStudy:
         params: Params,
         integrator: Optional[str] = None,
         steps_per_period: Optional[int] = None,
-        tolerance: float = 1e-12,
+        tolerance: Optional[float] = None,
     ) -> SweepStudy: ...
     @property
     def recipe(self) -> str: ...
