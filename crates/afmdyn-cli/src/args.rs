@@ -318,10 +318,10 @@ impl From<f64> for Quantity {
     }
 }
 
-/// As written without a unit (the `[default: …]` of `--help`).
+/// As written without a unit (the `[default: …]` of `--help`: `3.0`, as a number's `Debug`).
 impl std::fmt::Display for Quantity {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "{}", self.value)
+        write!(f, "{:?}", self.value)
     }
 }
 
