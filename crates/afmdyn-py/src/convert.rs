@@ -1,5 +1,6 @@
-//! Rust results to Python objects: NumPy arrays that take over the Rust buffers (no copy), and
-//! JSON documents as Python dicts.
+//! Python keywords to the library's requests ([`request`]: a dict deserialised by serde, so
+//! the request is the one signature), and Rust results to Python objects: NumPy arrays that
+//! take over the Rust buffers (no copy), and JSON documents as Python dicts.
 
 use numpy::ndarray::Array2;
 use numpy::{Complex64, IntoPyArray};
@@ -225,8 +226,10 @@ where
 /// its serde names, `deny_unknown_fields` and defaults).
 ///
 /// # Errors
-/// `TypeError` for a keyword the request does not have or a value of a type serde cannot
-/// take, `ValueError` for a value it refuses (a bad name, a negative count).
+/// `TypeError` for a keyword the request does not have (serde's `unknown field`, the
+/// request's names listed) or a Python object that is no number, string, list or dict;
+/// `ValueError` for a value the request refuses (a bad integrator or parameter name, a
+/// negative count, a wrong type; the Python layer checks the types first).
 pub fn request<R: serde::de::DeserializeOwned>(
     what: &str,
     kwargs: Option<&Bound<'_, PyDict>>,

@@ -1,4 +1,5 @@
-"""The analyses. Each takes the model as a :class:`Params` and/or keyword arguments, runs the
+"""The analyses (those with result objects of their own: :mod:`._orbits`, :mod:`._attractors`;
+the shared machinery: :mod:`._common`). Each takes the model as a :class:`Params` and/or keyword arguments, runs the
 Rust engine with the GIL released (Ctrl-C raises ``KeyboardInterrupt``; long runs show a
 progress bar) and returns NumPy arrays in xarray datasets or small result objects.
 
@@ -9,7 +10,9 @@ EI g0/L³, energies in EI g0²/L³. Model keywords: ``modes``, ``tip_mass_ratio`
 
 Errors: ``ValueError`` for input out of range (the message names the field and its range),
 ``TypeError`` for an unknown keyword or a wrong type, :class:`SimulationError` when a
-computation fails (chattering, divergence, Newton not converging).
+computation fails (chattering, divergence, Newton not converging). The keywords of an
+analysis are its library request's (``_afmdyn.request_defaults(name)`` gives their defaults):
+they go through serde into the request, which checks them.
 """
 
 from __future__ import annotations
