@@ -218,7 +218,7 @@ pub struct IntegratorArgs {
     #[arg(long, value_name = "M")]
     pub steps_per_period: Option<usize>,
     /// Relative/absolute tolerance of the adaptive integrator
-    #[arg(long, default_value_t = 1e-12)]
+    #[arg(long, default_value_t = IntegratorRequest::default().tolerance)]
     pub tolerance: f64,
 }
 
@@ -310,6 +310,20 @@ impl std::str::FromStr for Quantity {
         Err(format!(
             "'{s}': expected a number, optionally with a unit (pm, nm, um, mm, m, Hz, kHz, MHz)"
         ))
+    }
+}
+
+/// A plain number (a request's default): no unit.
+impl From<f64> for Quantity {
+    fn from(value: f64) -> Self {
+        Quantity { value, dim: None }
+    }
+}
+
+/// As written without a unit (the `[default: …]` of `--help`: `3.0`, as a number's `Debug`).
+impl std::fmt::Display for Quantity {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{:?}", self.value)
     }
 }
 

@@ -8,7 +8,6 @@ use crate::plot::{
     StackedFractions, Style,
 };
 use afmdyn::analysis::bifurcation::Branch;
-use afmdyn::analysis::global_continuation::DEFAULT_MATCH_TOL;
 use afmdyn::integrate::build;
 use afmdyn::request::checkpoint::{CheckpointError, SweepStudy};
 use afmdyn::request::limits::ATTRACTOR_SAMPLES_PER_PERIOD;
@@ -30,7 +29,7 @@ use std::path::{Path, PathBuf};
 #[derive(Debug, Clone, Args)]
 pub struct SteadyArgs {
     /// Relative tolerance for returns of the stroboscopic map to coincide
-    #[arg(long, default_value_t = 1e-8)]
+    #[arg(long, default_value_t = SteadyRequest::default().tol)]
     tol: f64,
     /// Cap on the transient, in drive periods [default: derived from the model's slowest free
     /// decay: six times the periods it takes to decay by --tol, at least 1500; ≈ 1.9 Q
@@ -38,7 +37,7 @@ pub struct SteadyArgs {
     #[arg(long)]
     max_periods: Option<usize>,
     /// Largest period searched (≤ 64)
-    #[arg(long, default_value_t = 64)]
+    #[arg(long, default_value_t = SteadyRequest::default().max_period)]
     max_period: usize,
 }
 
@@ -66,19 +65,19 @@ pub struct BifurcationArgs {
     #[arg(long, default_value = "omega")]
     param: SweepParam,
     /// First value
-    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = BifurcationRequest::default().from, allow_negative_numbers = true)]
     from: f64,
     /// Last value
-    #[arg(long, default_value_t = 5.0, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = BifurcationRequest::default().to, allow_negative_numbers = true)]
     to: f64,
     /// Number of values
-    #[arg(long, default_value_t = 400)]
+    #[arg(long, default_value_t = BifurcationRequest::default().steps)]
     steps: usize,
     /// Random initial states per value (in addition to continuation)
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = BifurcationRequest::default().starts)]
     starts: u32,
     /// Seed of the random initial states
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = BifurcationRequest::default().seed)]
     seed: u64,
     /// Only random starts, no forward/backward continuation
     #[arg(long)]
@@ -415,13 +414,13 @@ pub struct AttractorsArgs {
     #[command(flatten)]
     steady: SteadyArgs,
     /// Number of random initial states
-    #[arg(long, default_value_t = 64)]
+    #[arg(long, default_value_t = AttractorsRequest::default().samples)]
     samples: usize,
     /// Seed of the initial states
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = AttractorsRequest::default().seed)]
     seed: u64,
     /// Relative tolerance for two Poincaré point sets to be the same attractor
-    #[arg(long, default_value_t = 1e-5)]
+    #[arg(long, default_value_t = AttractorsRequest::default().cluster_tol)]
     cluster_tol: f64,
     /// Continue the attractors over this parameter (omega, alpha1..alpha6): a census at every
     /// value, seeded from the previous value's attractors and matched to them (global
@@ -435,11 +434,11 @@ pub struct AttractorsArgs {
     #[arg(long, allow_negative_numbers = true, requires = "sweep")]
     to: Option<f64>,
     /// Number of values of --sweep
-    #[arg(long, default_value_t = 16, requires = "sweep")]
+    #[arg(long, default_value_t = GlobalContinuationRequest::default().steps, requires = "sweep")]
     steps: usize,
     /// Largest relative distance between the Poincaré point sets of two attractors at
     /// consecutive values of --sweep that are one attractor
-    #[arg(long, default_value_t = DEFAULT_MATCH_TOL, requires = "sweep")]
+    #[arg(long, default_value_t = GlobalContinuationRequest::default().match_tol, requires = "sweep")]
     match_tol: f64,
     /// Output directory
     #[arg(long, default_value = "afmdyn-out/attractors")]

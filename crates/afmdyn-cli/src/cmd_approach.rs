@@ -35,7 +35,7 @@ pub struct CurveArgs {
     #[arg(long)]
     no_branches: bool,
     /// Tolerance of the adaptive integrator (the exact propagator ignores it)
-    #[arg(long, default_value_t = afmdyn::analysis::stepped::DEFAULT_TOLERANCE)]
+    #[arg(long, default_value_t = CurveRequest::default().tolerance)]
     tolerance: f64,
     /// Record one steady-state cycle per point of the first sweep (tip deflection, distance
     /// V_T, tip–sample force), N samples per drive period (default 200): STEM-traces.nc, the
@@ -108,7 +108,7 @@ pub struct ResonanceArgs {
     #[command(flatten)]
     model: ModelArgs,
     /// Mode k whose natural frequency the default band surrounds (1..=N)
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = ResonanceRequest::default().mode)]
     mode: usize,
     /// Start of the band (Hz with --probe, else Ω) [default: ω_k (1 − w), w = max(6/Q_k, 0.02)];
     /// with --probe a unit may follow (295kHz)

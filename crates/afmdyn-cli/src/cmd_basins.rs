@@ -9,10 +9,7 @@ use crate::cmd_simulate::parse_modal_state;
 use crate::error::CliError;
 use crate::output::{write_bytes, OutDir};
 use crate::plot::{color, save_map, CellMap};
-use afmdyn::analysis::basins::{
-    BasinSpec, DEFAULT_BASIN_HITS, DEFAULT_CELL, DEFAULT_DISCOVER_AFTER, DEFAULT_NEAR_TOL,
-    DEFAULT_STRIDE,
-};
+use afmdyn::analysis::basins::BasinSpec;
 use afmdyn::request::{BasinArrays, BasinsRequest, Document, Resolved};
 use afmdyn::{CantileverModel, Params};
 use clap::Args;
@@ -33,49 +30,49 @@ pub struct BasinsArgs {
     #[arg(long, default_value = "a1")]
     x: String,
     /// First x value
-    #[arg(long, default_value_t = -0.6, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = BasinsRequest::default().x_from, allow_negative_numbers = true)]
     x_from: f64,
     /// Last x value
-    #[arg(long, default_value_t = 0.6, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = BasinsRequest::default().x_to, allow_negative_numbers = true)]
     x_to: f64,
     /// Number of x values
-    #[arg(long, default_value_t = 40)]
+    #[arg(long, default_value_t = BasinsRequest::default().x_steps)]
     x_steps: usize,
     /// y coordinate, as --x
     #[arg(long, default_value = "adot1")]
     y: String,
     /// First y value
-    #[arg(long, default_value_t = -1.2, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = BasinsRequest::default().y_from, allow_negative_numbers = true)]
     y_from: f64,
     /// Last y value
-    #[arg(long, default_value_t = 1.2, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = BasinsRequest::default().y_to, allow_negative_numbers = true)]
     y_to: f64,
     /// Number of y values
-    #[arg(long, default_value_t = 40)]
+    #[arg(long, default_value_t = BasinsRequest::default().y_steps)]
     y_steps: usize,
     /// Relative distance to a periodic attractor's section point that decides a start (after
     /// 3 consecutive returns)
-    #[arg(long, default_value_t = DEFAULT_NEAR_TOL)]
+    #[arg(long, default_value_t = BasinsRequest::default().near_tol)]
     near_tol: f64,
     /// Side of the state-space cells of the recurrence test (g0; ×Ω for velocities)
-    #[arg(long, default_value_t = DEFAULT_CELL)]
+    #[arg(long, default_value_t = BasinsRequest::default().cell)]
     cell: f64,
     /// Consecutive returns in cells of one basin that decide a start (0: no recurrence test)
-    #[arg(long, default_value_t = DEFAULT_BASIN_HITS)]
+    #[arg(long, default_value_t = BasinsRequest::default().basin_hits)]
     basin_hits: usize,
     /// Returns tested before the steady-state search takes over
-    #[arg(long, default_value_t = DEFAULT_DISCOVER_AFTER)]
+    #[arg(long, default_value_t = BasinsRequest::default().discover_after)]
     discover_after: usize,
     /// Stride of the first pass's coarse grid, halved pass by pass (0: automatic, at least 25
     /// nodes per axis; 1: one pass). Used when the map's plane is the whole section (N = 1, a
     /// position and a velocity)
-    #[arg(long, default_value_t = DEFAULT_STRIDE)]
+    #[arg(long, default_value_t = BasinsRequest::default().stride)]
     stride: usize,
     /// The other coordinates of every start, "a1,..,aN;adot1,..,adotN" (default: at rest)
     #[arg(long)]
     base: Option<String>,
     /// Relative tolerance for two steady states to be one attractor
-    #[arg(long, default_value_t = 1e-5)]
+    #[arg(long, default_value_t = BasinsRequest::default().cluster_tol)]
     cluster_tol: f64,
     /// Worker threads (default: all cores)
     #[arg(long)]

@@ -37,44 +37,44 @@ pub struct ChartArgs {
     x: String,
     /// First x value, in the axis' unit (with --probe: z-c in m, drive-frequency in Hz; a unit
     /// may follow: 5nm, 299kHz)
-    #[arg(long, default_value = "2.6", allow_hyphen_values = true)]
+    #[arg(long, default_value_t = ChartRequest::default().x_from.into(), allow_hyphen_values = true)]
     x_from: Quantity,
     /// Last x value
-    #[arg(long, default_value = "3.0", allow_hyphen_values = true)]
+    #[arg(long, default_value_t = ChartRequest::default().x_to.into(), allow_hyphen_values = true)]
     x_to: Quantity,
     /// Number of x values
-    #[arg(long, default_value_t = 9)]
+    #[arg(long, default_value_t = ChartRequest::default().x_steps)]
     x_steps: usize,
     /// y parameter (rows), as --x
     #[arg(long, default_value = "drive-amplitude")]
     y: String,
     /// First y value
-    #[arg(long, default_value = "0.1", allow_hyphen_values = true)]
+    #[arg(long, default_value_t = ChartRequest::default().y_from.into(), allow_hyphen_values = true)]
     y_from: Quantity,
     /// Last y value
-    #[arg(long, default_value = "0.12", allow_hyphen_values = true)]
+    #[arg(long, default_value_t = ChartRequest::default().y_to.into(), allow_hyphen_values = true)]
     y_to: Quantity,
     /// Number of y values
-    #[arg(long, default_value_t = 2)]
+    #[arg(long, default_value_t = ChartRequest::default().y_steps)]
     y_steps: usize,
     /// Random initial states per cell (besides continuation from the neighbouring cells)
-    #[arg(long, default_value_t = 4)]
+    #[arg(long, default_value_t = ChartRequest::default().starts)]
     starts: u32,
     /// Seed of the random initial states
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = ChartRequest::default().seed)]
     seed: u64,
     /// Cells per task: continuation runs along x within a tile of this many cells
-    #[arg(long, default_value_t = 8)]
+    #[arg(long, default_value_t = ChartRequest::default().tile)]
     tile: usize,
     /// Drive periods of the λ₁ estimate of each nonperiodic attractor (0: none)
-    #[arg(long, default_value_t = 500)]
+    #[arg(long, default_value_t = ChartRequest::default().lyapunov_periods)]
     lyapunov_periods: usize,
     /// Relative tolerance for two steady states to be one attractor
-    #[arg(long, default_value_t = 1e-5)]
+    #[arg(long, default_value_t = ChartRequest::default().cluster_tol)]
     cluster_tol: f64,
     /// Attractor slots per cell in chart.nc (a cell with more keeps those most starts reached
     /// there; chart.csv and --json list every one)
-    #[arg(long, default_value_t = 8)]
+    #[arg(long, default_value_t = ChartRequest::default().max_attractors)]
     max_attractors: usize,
     /// Worker threads (default: all cores)
     #[arg(long)]

@@ -124,10 +124,10 @@ pub struct ContinueArgs {
     #[arg(long, default_value = "omega")]
     param: SweepParam,
     /// Start value
-    #[arg(long, default_value_t = 5.0, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = ContinuationRequest::default().from, allow_negative_numbers = true)]
     from: f64,
     /// End of the range
-    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = ContinuationRequest::default().to, allow_negative_numbers = true)]
     to: f64,
     /// Period n of the branch (default: the period of the steady state at --from)
     #[arg(long)]
@@ -405,10 +405,10 @@ pub struct LyapunovArgs {
     #[arg(long)]
     transient: Option<usize>,
     /// Drive periods averaged
-    #[arg(long, default_value_t = 4000)]
+    #[arg(long, default_value_t = LyapunovRequest::default().periods)]
     periods: usize,
     /// Blocks for the uncertainty
-    #[arg(long, default_value_t = 10)]
+    #[arg(long, default_value_t = LyapunovRequest::default().blocks)]
     blocks: usize,
     /// Print one JSON document
     #[arg(long)]

@@ -70,13 +70,13 @@ pub struct SimulateArgs {
     #[arg(long, allow_negative_numbers = true)]
     tau_end: Option<f64>,
     /// Drive periods discarded before recording
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = SimulateRequest::default().transient, allow_negative_numbers = true)]
     transient: f64,
     /// Initial modal state "a1,..,aN;adot1,..,adotN" (default: rest); |z| < 1e12
     #[arg(long, allow_hyphen_values = true)]
     initial_modal: Option<String>,
     /// Samples per drive period in the time series (1..=100000)
-    #[arg(long, default_value_t = 200)]
+    #[arg(long, default_value_t = SimulateRequest::default().samples_per_period)]
     samples_per_period: usize,
     /// Files written: all (data and plots), data (no plots) or none (only the summary)
     #[arg(long, value_enum, default_value = "all")]
@@ -802,13 +802,13 @@ pub struct ConvergeArgs {
     #[command(flatten)]
     integrator: IntegratorArgs,
     /// Largest number of modes N_max
-    #[arg(long, default_value_t = 4)]
+    #[arg(long, default_value_t = ConvergeRequest::default().max_modes)]
     max_modes: usize,
     /// Drive periods of steady state compared
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = ConvergeRequest::default().periods)]
     periods: usize,
     /// Samples per drive period
-    #[arg(long, default_value_t = 200)]
+    #[arg(long, default_value_t = ConvergeRequest::default().samples_per_period)]
     samples_per_period: usize,
     /// Output directory
     #[arg(long, default_value = "afmdyn-out/converge")]

@@ -19,12 +19,12 @@ use afmdyn::request::{self, Analysis, Document, ModesRequest, Resolved};
 use afmdyn::request::{
     AttractorsRequest, BifurcationRequest, ContinuationRequest, ConvergeRequest,
     GlobalContinuationRequest, IntegratorRequest, LyapunovRequest, ObserveRequest, OrbitRequest,
-    SeriesStore, SimulateRequest, StartRequest, SteadyRequest,
+    SeriesStore, SimulateRequest,
 };
 use afmdyn::request::{DirLock, FileCheckpoint, LockError, MemoryCheckpoint, SweepRecord};
 use afmdyn::study::{execute, StudyError};
 use afmdyn::trajectory::{record, RecordSpec};
-use afmdyn::{report, CantileverModel, Params, Region, SweepParam};
+use afmdyn::{report, CantileverModel, Params, Region};
 use nalgebra::DVector;
 use numpy::Complex64;
 use pyo3::prelude::*;
@@ -33,42 +33,22 @@ use std::path::PathBuf;
 
 type Dict<'py> = Bound<'py, PyDict>;
 
-/// The integrator request of the keywords (`None`: the library's default integrator).
+/// The integrator request of the keywords (`None`: the request's default integrator and
+/// tolerance).
 pub(crate) fn integrator_request(
     kind: Option<&str>,
     steps_per_period: Option<usize>,
-    tolerance: f64,
+    tolerance: Option<f64>,
 ) -> PyResult<IntegratorRequest> {
+    let d = IntegratorRequest::default();
     Ok(IntegratorRequest {
         integrator: match kind {
             Some(k) => k.parse().map_err(value_error)?,
-            None => IntegratorRequest::default().integrator,
+            None => d.integrator,
         },
         steps_per_period,
-        tolerance,
+        tolerance: tolerance.unwrap_or(d.tolerance),
     })
-}
-
-/// The steady-state search of the keywords `tol`, `max_periods`, `max_period`.
-fn steady(tol: f64, max_periods: Option<usize>, max_period: usize) -> SteadyRequest {
-    SteadyRequest {
-        tol,
-        max_periods,
-        max_period,
-    }
-}
-
-/// The start of the orbit analyses: `initial`, or the steady state reached from rest.
-fn start(
-    initial: Option<Vec<f64>>,
-    tol: f64,
-    max_periods: Option<usize>,
-    max_period: usize,
-) -> StartRequest {
-    StartRequest {
-        initial,
-        steady: steady(tol, max_periods, max_period),
-    }
 }
 
 /// The initial state: `None` is rest, else 2N values (a₁…a_N, ȧ₁…ȧ_N).
@@ -244,21 +224,11 @@ fn simulate_columns(
 
 /// One trajectory: time series, switchings, stroboscopic section and energy balance.
 #[pyfunction]
-#[pyo3(signature = (params, periods=None, tau_end=None, transient=0.0, initial=None,
-    samples_per_period=200, integrator=None, steps_per_period=None, tolerance=1e-12,
-    progress=None, probe=None))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (params, request=None, progress=None, probe=None))]
 pub fn simulate<'py>(
     py: Python<'py>,
     params: PyRef<'_, PyParams>,
-    periods: Option<f64>,
-    tau_end: Option<f64>,
-    transient: f64,
-    initial: Option<Vec<f64>>,
-    samples_per_period: usize,
-    integrator: Option<&str>,
-    steps_per_period: Option<usize>,
-    tolerance: f64,
+    request: Option<&Dict<'py>>,
     progress: Option<Bound<'py, PyAny>>,
     probe: Option<String>,
 ) -> PyResult<Dict<'py>> {
@@ -267,22 +237,16 @@ pub fn simulate<'py>(
         .map(|text| Probe::parse(&text, "probe"))
         .transpose()
         .map_err(probe_error)?;
-    let request = SimulateRequest {
-        periods,
-        tau_end,
-        transient,
-        initial,
-        samples_per_period,
-        integrator: integrator_request(integrator, steps_per_period, tolerance)?,
-    };
+    let request: SimulateRequest = crate::convert::request("simulate", request)?;
     // held in memory: τ, V_T, V̇_T, W, Ẇ, contact, force and the 2N modal coordinates
     let span = request
         .validate(&p, SeriesStore::Memory, 7 + 2 * p.modes, 8.0)
         .map_err(sim_error)?;
     let t_transient = span.transient_tau;
     let opts = request.integrator_options();
+    let samples_per_period = request.samples_per_period;
     let spec = RecordSpec {
-        transient_periods: transient,
+        transient_periods: request.transient,
         record_tau: span.record_tau,
         samples_per_period,
         energy: true,
@@ -361,27 +325,15 @@ pub fn simulate<'py>(
 
 /// Mode-number convergence (paper Fig. 4).
 #[pyfunction]
-#[pyo3(signature = (params, max_modes=4, periods=1, samples_per_period=200, integrator=None,
-    steps_per_period=None, tolerance=1e-12, progress=None, probe=None))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (params, request=None, progress=None, probe=None))]
 pub fn converge<'py>(
     py: Python<'py>,
     params: PyRef<'_, PyParams>,
-    max_modes: usize,
-    periods: usize,
-    samples_per_period: usize,
-    integrator: Option<&str>,
-    steps_per_period: Option<usize>,
-    tolerance: f64,
+    request: Option<&Dict<'py>>,
     progress: Option<Bound<'py, PyAny>>,
     probe: Option<String>,
 ) -> PyResult<Dict<'py>> {
-    let request = ConvergeRequest {
-        max_modes,
-        periods,
-        samples_per_period,
-        integrator: integrator_request(integrator, steps_per_period, tolerance)?,
-    };
+    let request: ConvergeRequest = crate::convert::request("converge", request)?;
     let doc = analysis(py, request, params.inner, probe, progress.as_ref(), true)?;
     let runs = doc.output;
     let out = Out::new(py);
@@ -458,47 +410,17 @@ pub(crate) fn study_error(e: StudyError) -> PyErr {
 /// start 0, 1, …). With `store`, the sweep is checkpointed in that directory (the command
 /// line's `--out` layout) and `resume` continues it.
 #[pyfunction]
-#[pyo3(signature = (params, param="omega", values=None, from_=1.0, to=5.0, steps=400, starts=0,
-    seed=1, continuation=true, threads=None, tol=1e-8, max_periods=None, max_period=64,
-    integrator=None, steps_per_period=None, tolerance=1e-12, progress=None, store=None,
-    resume=false))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (params, request=None, progress=None, store=None, resume=false))]
 pub fn bifurcation<'py>(
     py: Python<'py>,
     params: PyRef<'_, PyParams>,
-    param: &str,
-    values: Option<Vec<f64>>,
-    from_: f64,
-    to: f64,
-    steps: usize,
-    starts: u32,
-    seed: u64,
-    continuation: bool,
-    threads: Option<usize>,
-    tol: f64,
-    max_periods: Option<usize>,
-    max_period: usize,
-    integrator: Option<&str>,
-    steps_per_period: Option<usize>,
-    tolerance: f64,
+    request: Option<&Dict<'py>>,
     progress: Option<Bound<'py, PyAny>>,
     store: Option<std::path::PathBuf>,
     resume: bool,
 ) -> PyResult<Dict<'py>> {
-    let param: SweepParam = param.parse().map_err(value_error)?;
-    let request = BifurcationRequest {
-        param,
-        values,
-        from: from_,
-        to,
-        steps,
-        starts,
-        seed,
-        continuation,
-        threads,
-        steady: steady(tol, max_periods, max_period),
-        integrator: integrator_request(integrator, steps_per_period, tolerance)?,
-    };
+    let request: BifurcationRequest = crate::convert::request("bifurcation", request)?;
+    let threads = request.threads;
     let spec = request.spec(&params.inner).map_err(sim_error)?;
     if resume && store.is_none() {
         return Err(value_error(
@@ -643,32 +565,15 @@ fn steady_dict<'py>(py: Python<'py>, s: &SteadyState) -> PyResult<Dict<'py>> {
 
 /// Coexisting attractors and their basin fractions at fixed parameters.
 #[pyfunction]
-#[pyo3(signature = (params, samples=64, seed=1, cluster_tol=1e-5, tol=1e-8, max_periods=None,
-    max_period=64, integrator=None, steps_per_period=None, tolerance=1e-12, progress=None,
-    probe=None))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (params, request=None, progress=None, probe=None))]
 pub fn attractors<'py>(
     py: Python<'py>,
     params: PyRef<'_, PyParams>,
-    samples: usize,
-    seed: u64,
-    cluster_tol: f64,
-    tol: f64,
-    max_periods: Option<usize>,
-    max_period: usize,
-    integrator: Option<&str>,
-    steps_per_period: Option<usize>,
-    tolerance: f64,
+    request: Option<&Dict<'py>>,
     progress: Option<Bound<'py, PyAny>>,
     probe: Option<String>,
 ) -> PyResult<Dict<'py>> {
-    let request = AttractorsRequest {
-        samples,
-        seed,
-        cluster_tol,
-        steady: steady(tol, max_periods, max_period),
-        integrator: integrator_request(integrator, steps_per_period, tolerance)?,
-    };
+    let request: AttractorsRequest = crate::convert::request("attractors", request)?;
     let doc = analysis(py, request, params.inner, probe, progress.as_ref(), true)?;
     let report_ = doc.output;
     let out = Out::new(py);
@@ -692,45 +597,16 @@ pub fn attractors<'py>(
 /// Attractors continued over a parameter (global continuation): the JSON document of
 /// `afmdyn attractors --sweep --json` (the Python layer builds the dataset from it).
 #[pyfunction]
-#[pyo3(signature = (params, param="omega", from_=1.5, to=3.0, steps=16, values=None,
-    match_tol=0.1, samples=16, seed=1, cluster_tol=1e-5, tol=1e-8, max_periods=None,
-    max_period=64, integrator=None, steps_per_period=None, tolerance=1e-12, progress=None,
-    probe=None))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (params, request=None, progress=None, probe=None))]
 pub fn global_continuation<'py>(
     py: Python<'py>,
     params: PyRef<'_, PyParams>,
-    param: &str,
-    from_: f64,
-    to: f64,
-    steps: usize,
-    values: Option<Vec<f64>>,
-    match_tol: f64,
-    samples: usize,
-    seed: u64,
-    cluster_tol: f64,
-    tol: f64,
-    max_periods: Option<usize>,
-    max_period: usize,
-    integrator: Option<&str>,
-    steps_per_period: Option<usize>,
-    tolerance: f64,
+    request: Option<&Dict<'py>>,
     progress: Option<Bound<'py, PyAny>>,
     probe: Option<String>,
 ) -> PyResult<Dict<'py>> {
-    let request = GlobalContinuationRequest {
-        param: param.parse().map_err(value_error)?,
-        values,
-        from: from_,
-        to,
-        steps,
-        match_tol,
-        samples,
-        seed,
-        cluster_tol,
-        steady: steady(tol, max_periods, max_period),
-        integrator: integrator_request(integrator, steps_per_period, tolerance)?,
-    };
+    let request: GlobalContinuationRequest =
+        crate::convert::request("global_continuation", request)?;
     let param = request.param;
     let doc = analysis(py, request, params.inner, probe, progress.as_ref(), true)?;
     let out = Out::new(py);
@@ -747,24 +623,15 @@ pub fn global_continuation<'py>(
 
 /// A period-n orbit by Newton shooting, with its Floquet multipliers.
 #[pyfunction]
-#[pyo3(signature = (params, period=None, initial=None, tol=1e-8, max_periods=None,
-    max_period=64, progress=None, probe=None))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (params, request=None, progress=None, probe=None))]
 pub fn orbit<'py>(
     py: Python<'py>,
     params: PyRef<'_, PyParams>,
-    period: Option<usize>,
-    initial: Option<Vec<f64>>,
-    tol: f64,
-    max_periods: Option<usize>,
-    max_period: usize,
+    request: Option<&Dict<'py>>,
     progress: Option<Bound<'py, PyAny>>,
     probe: Option<String>,
 ) -> PyResult<Dict<'py>> {
-    let request = OrbitRequest {
-        period,
-        start: start(initial, tol, max_periods, max_period),
-    };
+    let request: OrbitRequest = crate::convert::request("orbit", request)?;
     let doc = analysis(py, request, params.inner, probe, progress.as_ref(), false)?;
     let o = doc.output;
     let out = Out::new(py);
@@ -799,35 +666,18 @@ fn event_name(e: BranchEvent) -> String {
 
 /// Pseudo-arclength continuation of a period-n branch, with located bifurcations.
 #[pyfunction]
-#[pyo3(signature = (params, param="omega", from_=5.0, to=1.0, period=None, switch=false,
-    initial=None, tol=1e-8, max_periods=None, max_period=64, progress=None, probe=None))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (params, request=None, progress=None, probe=None))]
 pub fn continuation<'py>(
     py: Python<'py>,
     params: PyRef<'_, PyParams>,
-    param: &str,
-    from_: f64,
-    to: f64,
-    period: Option<usize>,
-    switch: bool,
-    initial: Option<Vec<f64>>,
-    tol: f64,
-    max_periods: Option<usize>,
-    max_period: usize,
+    request: Option<&Dict<'py>>,
     progress: Option<Bound<'py, PyAny>>,
     probe: Option<String>,
 ) -> PyResult<Dict<'py>> {
+    let request: ContinuationRequest = crate::convert::request("continuation", request)?;
     let base = params.inner;
-    let param: SweepParam = param.parse().map_err(value_error)?;
-    let request = ContinuationRequest {
-        param,
-        from: from_,
-        to,
-        period,
-        switch,
-        start: start(initial, tol, max_periods, max_period),
-    };
-    let p0 = base.with(param, from_);
+    let param = request.param;
+    let p0 = base.with(param, request.from);
     let doc = analysis(py, request, base, probe, progress.as_ref(), true)?;
     let branches = doc.output;
     let model = model_of(&p0)?;
@@ -907,25 +757,15 @@ pub fn continuation<'py>(
 
 /// Lyapunov spectrum (with saltation matrices) and the 0–1 test.
 #[pyfunction]
-#[pyo3(signature = (params, initial=None, transient=None, periods=4000, blocks=10, progress=None,
-    probe=None))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (params, request=None, progress=None, probe=None))]
 pub fn lyapunov<'py>(
     py: Python<'py>,
     params: PyRef<'_, PyParams>,
-    initial: Option<Vec<f64>>,
-    transient: Option<usize>,
-    periods: usize,
-    blocks: usize,
+    request: Option<&Dict<'py>>,
     progress: Option<Bound<'py, PyAny>>,
     probe: Option<String>,
 ) -> PyResult<Dict<'py>> {
-    let request = LyapunovRequest {
-        initial,
-        transient,
-        periods,
-        blocks,
-    };
+    let request: LyapunovRequest = crate::convert::request("lyapunov", request)?;
     let doc = analysis(py, request, params.inner, probe, progress.as_ref(), true)?;
     let l = doc.output;
     let out = Out::new(py);
@@ -987,26 +827,15 @@ pub fn probe_source(probe: &Bound<'_, PyAny>, cantilever: Option<String>) -> PyR
 /// found as by `orbit` (polished by Newton shooting when periodic), then
 /// [`afmdyn::analysis::observables::observe`] integrates `periods` orbit periods.
 #[pyfunction]
-#[pyo3(signature = (params, initial=None, periods=1, harmonics=10, tol=1e-8, max_periods=None,
-    max_period=64, progress=None, probe=None))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (params, request=None, progress=None, probe=None))]
 pub fn observe<'py>(
     py: Python<'py>,
     params: PyRef<'_, PyParams>,
-    initial: Option<Vec<f64>>,
-    periods: usize,
-    harmonics: usize,
-    tol: f64,
-    max_periods: Option<usize>,
-    max_period: usize,
+    request: Option<&Dict<'py>>,
     progress: Option<Bound<'py, PyAny>>,
     probe: Option<String>,
 ) -> PyResult<Dict<'py>> {
-    let request = ObserveRequest {
-        periods,
-        harmonics,
-        start: start(initial, tol, max_periods, max_period),
-    };
+    let request: ObserveRequest = crate::convert::request("observe", request)?;
     let doc = analysis(py, request, params.inner, probe, progress.as_ref(), false)?;
     let out = Out::new(py);
     out.json(&doc.json)?;

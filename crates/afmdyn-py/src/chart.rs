@@ -81,7 +81,7 @@ impl ChartStudy {
     /// takes them.
     #[staticmethod]
     #[pyo3(signature = (request, params=None, probe=None, model=None, integrator=None,
-        steps_per_period=None, tolerance=1e-12))]
+        steps_per_period=None, tolerance=None))]
     fn build(
         request: &str,
         params: Option<PyRef<'_, PyParams>>,
@@ -89,7 +89,7 @@ impl ChartStudy {
         model: Option<&Bound<'_, PyDict>>,
         integrator: Option<&str>,
         steps_per_period: Option<usize>,
-        tolerance: f64,
+        tolerance: Option<f64>,
     ) -> PyResult<Self> {
         let mut request: ChartRequest = serde_json::from_str(request)
             .map_err(|e| pyo3::exceptions::PyTypeError::new_err(format!("chart options: {e}")))?;

@@ -1,5 +1,6 @@
-//! Rust results to Python objects: NumPy arrays that take over the Rust buffers (no copy), and
-//! JSON documents as Python dicts.
+//! Python keywords to the library's requests ([`request`]: a dict deserialised by serde, so
+//! the request is the one signature), and Rust results to Python objects: NumPy arrays that
+//! take over the Rust buffers (no copy), and JSON documents as Python dicts.
 
 use numpy::ndarray::Array2;
 use numpy::{Complex64, IntoPyArray};
@@ -92,4 +93,218 @@ pub fn layout_dict<'py>(
     }
     out.set_item("variables", vars)?;
     Ok(out)
+}
+
+/// A Python value as serde sees it: the keywords of an analysis on their way into the
+/// library's request (NaN and ±∞ kept, so that the request's own checks name them).
+enum Val {
+    Null,
+    Bool(bool),
+    Int(i64),
+    Float(f64),
+    Str(String),
+    Seq(Vec<Val>),
+    Map(Vec<(String, Val)>),
+}
+
+/// A serde error of [`request`]: an unknown key is a `TypeError`, every other a `ValueError`.
+#[derive(Debug)]
+struct DeError {
+    msg: String,
+    unknown: bool,
+}
+
+impl std::fmt::Display for DeError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.msg)
+    }
+}
+
+impl std::error::Error for DeError {}
+
+impl serde::de::Error for DeError {
+    fn custom<T: std::fmt::Display>(msg: T) -> Self {
+        DeError {
+            msg: msg.to_string(),
+            unknown: false,
+        }
+    }
+    fn unknown_field(field: &str, expected: &'static [&'static str]) -> Self {
+        DeError {
+            msg: format!(
+                "unknown keyword '{field}': expected {}",
+                expected.join(", ")
+            ),
+            unknown: true,
+        }
+    }
+}
+
+impl<'de> serde::de::IntoDeserializer<'de, DeError> for Val {
+    type Deserializer = Val;
+    fn into_deserializer(self) -> Val {
+        self
+    }
+}
+
+impl<'de> serde::Deserializer<'de> for Val {
+    type Error = DeError;
+    fn deserialize_any<V: serde::de::Visitor<'de>>(self, v: V) -> Result<V::Value, DeError> {
+        use serde::de::value::{MapDeserializer, SeqDeserializer};
+        match self {
+            Val::Null => v.visit_unit(),
+            Val::Bool(b) => v.visit_bool(b),
+            Val::Int(i) => v.visit_i64(i),
+            Val::Float(x) => v.visit_f64(x),
+            Val::Str(s) => v.visit_string(s),
+            Val::Seq(items) => v.visit_seq(SeqDeserializer::new(items.into_iter())),
+            Val::Map(entries) => v.visit_map(MapDeserializer::new(entries.into_iter())),
+        }
+    }
+    fn deserialize_option<V: serde::de::Visitor<'de>>(self, v: V) -> Result<V::Value, DeError> {
+        match self {
+            Val::Null => v.visit_none(),
+            other => v.visit_some(other),
+        }
+    }
+    fn deserialize_enum<V: serde::de::Visitor<'de>>(
+        self,
+        _name: &'static str,
+        _variants: &'static [&'static str],
+        v: V,
+    ) -> Result<V::Value, DeError> {
+        match self {
+            Val::Str(s) => v.visit_enum(serde::de::value::StringDeserializer::new(s)),
+            other => other.deserialize_any(v),
+        }
+    }
+    serde::forward_to_deserialize_any! {
+        bool i8 i16 i32 i64 i128 u8 u16 u32 u64 u128 f32 f64 char str string bytes byte_buf
+        unit unit_struct newtype_struct seq tuple tuple_struct map struct identifier
+        ignored_any
+    }
+}
+
+/// `v` as a [`Val`]; `key` names it in a `TypeError` for a type serde cannot take.
+fn val(key: &str, v: &Bound<'_, PyAny>) -> PyResult<Val> {
+    use pyo3::types::{PyBool, PyFloat, PyInt, PyList, PyString, PyTuple};
+    if v.is_none() {
+        Ok(Val::Null)
+    } else if v.is_instance_of::<PyBool>() {
+        Ok(Val::Bool(v.extract()?))
+    } else if v.is_instance_of::<PyString>() {
+        Ok(Val::Str(v.extract()?))
+    } else if v.is_instance_of::<PyFloat>() {
+        Ok(Val::Float(v.extract()?))
+    } else if v.is_instance_of::<PyInt>() {
+        v.extract().map(Val::Int).map_err(|_| {
+            crate::errors::value_error(format!("{key} = {v}: out of range (beyond 64 bits)"))
+        })
+    } else if v.is_instance_of::<PyList>() || v.is_instance_of::<PyTuple>() {
+        let items: PyResult<Vec<Val>> = v.try_iter()?.map(|x| val(key, &x?)).collect();
+        Ok(Val::Seq(items?))
+    } else if let Ok(d) = v.cast::<PyDict>() {
+        Ok(Val::Map(entries(d)?))
+    } else if let Ok(i) = v.extract::<i64>() {
+        Ok(Val::Int(i))
+    } else if let Ok(x) = v.extract::<f64>() {
+        Ok(Val::Float(x))
+    } else {
+        Err(pyo3::exceptions::PyTypeError::new_err(format!(
+            "{key}: a {} is not a request value",
+            v.get_type().name()?
+        )))
+    }
+}
+
+/// The entries of a dict of keywords, `None` ones left out (they mean the request's default),
+/// a keyword with the trailing `_` of a Python keyword (`from_`) under the request's name
+/// (`from`), and the names of the integrator and the swept parameter in the request's
+/// spelling (parsed as the command line parses them: a `ValueError` names a bad one).
+fn entries(d: &Bound<'_, PyDict>) -> PyResult<Vec<(String, Val)>> {
+    let mut out = Vec::with_capacity(d.len());
+    for (k, v) in d.iter() {
+        let key: String = k.extract()?;
+        let key = if key == "from_" {
+            "from".to_string()
+        } else {
+            key
+        };
+        let value = match (key.as_str(), val(&key, &v)?) {
+            (_, Val::Null) => continue,
+            ("integrator", Val::Str(s)) => {
+                Val::Str(canonical::<afmdyn::integrate::IntegratorKind>(&s)?)
+            }
+            ("param", Val::Str(s)) => Val::Str(canonical::<afmdyn::SweepParam>(&s)?),
+            (_, other) => other,
+        };
+        out.push((key, value));
+    }
+    Ok(out)
+}
+
+/// `s` parsed by `T`'s `FromStr` (its message as the `ValueError`), in `T`'s serde spelling.
+fn canonical<T>(s: &str) -> PyResult<String>
+where
+    T: std::str::FromStr + serde::Serialize,
+    T::Err: std::fmt::Display,
+{
+    let t: T = s
+        .parse()
+        .map_err(|e: T::Err| crate::errors::value_error(e.to_string()))?;
+    match serde_json::to_value(t) {
+        Ok(serde_json::Value::String(name)) => Ok(name),
+        _ => Ok(s.to_string()),
+    }
+}
+
+/// The library's request `R` of an analysis' keywords (the request is the one signature:
+/// its serde names, `deny_unknown_fields` and defaults).
+///
+/// # Errors
+/// `TypeError` for a keyword the request does not have (serde's `unknown field`, the
+/// request's names listed) or a Python object that is no number, string, list or dict;
+/// `ValueError` for a value the request refuses (a bad integrator or parameter name, a
+/// negative count, a wrong type; the Python layer checks the types first).
+pub fn request<R: serde::de::DeserializeOwned>(
+    what: &str,
+    kwargs: Option<&Bound<'_, PyDict>>,
+) -> PyResult<R> {
+    let map = match kwargs {
+        Some(d) => entries(d)?,
+        None => Vec::new(),
+    };
+    R::deserialize(Val::Map(map)).map_err(|e| {
+        let msg = format!("{what}: {e}");
+        if e.unknown {
+            pyo3::exceptions::PyTypeError::new_err(msg)
+        } else {
+            pyo3::exceptions::PyValueError::new_err(msg)
+        }
+    })
+}
+
+/// The default request of analysis `name` as a dict (`None`: no such analysis): what the
+/// Python functions' keywords default to.
+pub fn request_default(name: &str) -> Option<serde_json::Value> {
+    use afmdyn::request::*;
+    fn v<T: serde::Serialize + Default>() -> Option<serde_json::Value> {
+        serde_json::to_value(T::default()).ok()
+    }
+    match name {
+        "simulate" => v::<SimulateRequest>(),
+        "converge" => v::<ConvergeRequest>(),
+        "bifurcation" => v::<BifurcationRequest>(),
+        "attractors" => v::<AttractorsRequest>(),
+        "global_continuation" => v::<GlobalContinuationRequest>(),
+        "orbit" => v::<OrbitRequest>(),
+        "continuation" => v::<ContinuationRequest>(),
+        "lyapunov" => v::<LyapunovRequest>(),
+        "observe" => v::<ObserveRequest>(),
+        "approach" => v::<ApproachRequest>(),
+        "resonance" => v::<ResonanceRequest>(),
+        "basins" => v::<BasinsRequest>(),
+        "chart" => v::<ChartRequest>(),
+        _ => None,
+    }
 }

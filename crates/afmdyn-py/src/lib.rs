@@ -23,6 +23,15 @@ fn cantilevers() -> String {
     afmdyn::cantilevers::document().to_string()
 }
 
+/// The default request of analysis `name` (`"simulate"`, `"bifurcation"`, …) as a dict of its
+/// keywords: the one source of the Python functions' defaults. `KeyError` for another name.
+#[pyfunction]
+fn request_defaults<'py>(py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
+    let d = convert::request_default(name)
+        .ok_or_else(|| pyo3::exceptions::PyKeyError::new_err(name.to_string()))?;
+    convert::json_to_py(py, &d.to_string())
+}
+
 /// Compiled core of afmdyn (use the `afmdyn` package, not this module).
 #[pymodule]
 fn _afmdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -44,6 +53,7 @@ fn _afmdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(analyses::global_continuation, m)?)?;
     m.add_function(wrap_pyfunction!(basins::basins, m)?)?;
     m.add_function(wrap_pyfunction!(cantilevers, m)?)?;
+    m.add_function(wrap_pyfunction!(request_defaults, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::orbit, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::continuation, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::lyapunov, m)?)?;

@@ -70,13 +70,13 @@ impl SweepStudy {
     /// are refused) over `params`.
     #[staticmethod]
     #[pyo3(signature = (request, params, integrator=None, steps_per_period=None,
-        tolerance=1e-12))]
+        tolerance=None))]
     fn build(
         request: &str,
         params: PyRef<'_, PyParams>,
         integrator: Option<&str>,
         steps_per_period: Option<usize>,
-        tolerance: f64,
+        tolerance: Option<f64>,
     ) -> PyResult<Self> {
         let mut request: BifurcationRequest = serde_json::from_str(request).map_err(|e| {
             pyo3::exceptions::PyTypeError::new_err(format!("bifurcation options: {e}"))

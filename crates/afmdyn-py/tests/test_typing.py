@@ -76,3 +76,34 @@ def test_mypy_accepts_correct_use_and_flags_mistakes(tmp_path):
     )
     assert 'Unexpected keyword argument "omegaa" for "bifurcation"' in bad.stdout
     assert 'Property "omega" defined in "Params" is read-only' in bad.stdout
+
+
+def test_the_request_stubs_are_generated_from_the_schemas() -> None:
+    """The requests' TypedDicts and the compiled functions in ``_afmdyn.pyi`` are what
+    ``scripts/gen_stubs.py`` writes from ``docs/schema/requests`` (the library's request
+    types): a stub left stale after a request changed fails here."""
+    script = REPO / "scripts" / "gen_stubs.py"
+    run = subprocess.run([sys.executable, str(script), "--check"], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    # the installed stub is the repository's
+    installed = Path(afmdyn.__file__).parent / "_afmdyn.pyi"
+    source = REPO / "crates" / "afmdyn-py" / "python" / "afmdyn" / "_afmdyn.pyi"
+    assert installed.read_text() == source.read_text(), "reinstall the package (pip install)"
+
+
+def test_the_defaults_are_the_requests() -> None:
+    """Every keyword default of an analysis that the request holds is the request's
+    ``Default`` (``request_defaults``): one signature, no literals in the front end."""
+    import inspect
+
+    from afmdyn import _afmdyn as core
+
+    for fn, name in [(afmdyn.simulate, "simulate"), (afmdyn.bifurcation, "bifurcation"),
+                     (afmdyn.attractors, "attractors"), (afmdyn.lyapunov, "lyapunov"),
+                     (afmdyn.resonance, "resonance"), (afmdyn.basins, "basins"),
+                     (afmdyn.global_continuation, "global_continuation"), (afmdyn.chart, "chart")]:
+        d = core.request_defaults(name)
+        for key, prm in inspect.signature(fn).parameters.items():
+            k = "from" if key == "from_" else key
+            if k in d and d[k] is not None and prm.default is not None:
+                assert prm.default == d[k], (name, key)

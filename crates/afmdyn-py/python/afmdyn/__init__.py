@@ -24,29 +24,26 @@ file in SI (:func:`probe`, ``Params.from_probe``) sets every parameter. Tip–sa
 
 from ._afmdyn import Params, SimulationError
 from ._api import (
-    AfmdynWarning,
-    Model,
     approach,
-    attractors,
     bifurcation,
     continuation,
     converge,
-    lyapunov,
     modes,
     observe,
-    orbit,
     probe,
     resonance,
     simulate,
-    summary,
 )
+from ._attractors import Attractor, Attractors, attractors
 from ._basins import basins
 from ._cantilevers import cantilevers
 from ._chart import chart
 from ._global_continuation import global_continuation
+from ._common import AfmdynWarning, Model, summary
 from ._interrupt import cancel_running
 from ._interrupt import install as _install_sigint
-from ._results import Attractor, Attractors, Lyapunov, Orbit, RegionSpectrum, Spectrum
+from ._orbits import lyapunov, orbit
+from ._results import Lyapunov, Orbit, RegionSpectrum, Spectrum
 
 try:
     from importlib.metadata import version as _version

@@ -1,4 +1,5 @@
-"""The analyses. Each takes the model as a :class:`Params` and/or keyword arguments, runs the
+"""The analyses (those with result objects of their own: :mod:`._orbits`, :mod:`._attractors`;
+the shared machinery: :mod:`._common`). Each takes the model as a :class:`Params` and/or keyword arguments, runs the
 Rust engine with the GIL released (Ctrl-C raises ``KeyboardInterrupt``; long runs show a
 progress bar) and returns NumPy arrays in xarray datasets or small result objects.
 
@@ -9,256 +10,46 @@ EI g0/L³, energies in EI g0²/L³. Model keywords: ``modes``, ``tip_mass_ratio`
 
 Errors: ``ValueError`` for input out of range (the message names the field and its range),
 ``TypeError`` for an unknown keyword or a wrong type, :class:`SimulationError` when a
-computation fails (chattering, divergence, Newton not converging).
+computation fails (chattering, divergence, Newton not converging). The keywords of an
+analysis are its library request's (``_afmdyn.request_defaults(name)`` gives their defaults):
+they go through serde into the request, which checks them.
 """
 
 from __future__ import annotations
 
-import functools
-import inspect
 import json
-import numbers
 import os
-import warnings
-from typing import (
-    Literal,
-    TYPE_CHECKING,
-    Any,
-    Callable,
-    Dict,
-    Optional,
-    Sequence,
-    Tuple,
-    TypedDict,
-    TypeVar,
-    Union,
-    cast,
-)
+from typing import TYPE_CHECKING, Any, Dict, Optional, Sequence, Union
 
 import numpy as np
 import xarray as xr
 
 from . import _afmdyn as _core
 from ._afmdyn import Params
-from ._progress import ProgressArg, reporter
+from ._common import (  # noqa: F401 (_params, _probe_text, _typed, _warn: used by _chart, dask)
+    _DEFAULTS,
+    _G,
+    _T,
+    _V,
+    Model,
+    StateLike,
+    _attrs,
+    _params,
+    _probe_text,
+    _request,
+    _run,
+    _start,
+    _state,
+    _typed,
+    _warn,
+    summary,
+)
 from ._curves import curve_dataset, observe_dataset
-from ._results import Attractor, Attractors, Lyapunov, Orbit, RegionSpectrum, Spectrum
+from ._progress import ProgressArg
+from ._results import RegionSpectrum, Spectrum
 
 if TYPE_CHECKING:  # annotations only (PEP 692): editors complete and check the keywords
     from typing_extensions import Unpack
-
-StateLike = Union[None, Sequence[float], np.ndarray, Attractor, Orbit]
-
-
-class Model(TypedDict, total=False):
-    """The model keywords every analysis takes (see :class:`Params` for their ranges; the one
-    table of them is ``afmdyn._afmdyn.MODEL_PARAMETERS``). ``probe`` is a probe in SI (the
-    command line's ``--probe``): a file's path, its TOML text (a ``str`` with a line break or
-    ``=``) or a dict of its sections (``{"cantilever": {...}, "sample": {...}, ...}``); it sets
-    every parameter in SI, ``z_c`` (m) and ``drive_frequency`` (Hz) set α5 and Ω through its
-    scales, ``modes`` and ``restitution`` are taken, and the dimensionless keywords of the
-    values it sets (``gap``, ``omega``, the α's, ``hamaker``, ``intermolecular_distance``,
-    ``contact_law``) raise ``ValueError`` naming the probe key or SI keyword to use; the
-    result's ``to_dict()`` then carries the command line's ``"si"`` block. ``cantilever`` names
-    a cantilever of the library (:func:`afmdyn.cantilevers`) for the probe, as
-    ``--cantilever`` does: it fills the keys the probe leaves out and wins over a name in it."""
-
-    modes: int
-    tip_mass_ratio: float
-    alpha1: float
-    drive_amplitude: float
-    alpha2: float
-    beam_damping: float
-    alpha3: float
-    contact_stiffness: float
-    alpha4: float
-    gap: float
-    alpha5: float
-    contact_damping: float
-    alpha6: float
-    omega: float
-    contact_law: Literal["linear", "hertz", "dmt", "impact"]
-    restitution: float
-    hamaker: float
-    intermolecular_distance: float
-    z_c: float
-    drive_frequency: float
-    probe: Union[str, "os.PathLike[str]", Dict[str, Any]]
-    cantilever: str
-
-
-#: Global attributes of every dataset: the scales of the dimensionless units.
-UNITS_NOTE = (
-    "dimensionless (paper eq. 5): time in t0 = sqrt(m L^4/(E I)), displacements in the beam "
-    "gap g0, forces in E I g0/L^3, energies in E I g0^2/L^3"
-)
-
-_T = {"units": "t0", "long_name": "time τ"}
-_G = {"units": "g0"}
-_V = {"units": "g0/t0"}
-
-
-def _params(
-    params: Optional[Params], model: Any, default: Optional[Params] = None
-) -> Tuple[Params, Optional[str]]:
-    """The parameter set of an analysis call and its probe file (or ``None``), resolved by the
-    library as the command line resolves ``--probe``/``--config`` and the model flags:
-    ``params`` (or the probe's set, or ``default``, or the paper's set) with the ``model``
-    keywords applied."""
-    if params is not None and not isinstance(params, Params):
-        raise TypeError(f"params: expected afmdyn.Params or None, got {type(params).__name__}")
-    model = dict(model)
-    probe = _probe_text(model)
-    return _core.resolve(params, default, probe, model), probe
-
-
-def _probe_text(model: Dict[str, Any]) -> Optional[str]:
-    """Pop ``probe`` and ``cantilever`` from the model keywords: the probe's TOML text with the
-    cantilever's name set (the library's ``Probe::source_text``), checked, or ``None``."""
-    probe = model.pop("probe", None)
-    cantilever = model.pop("cantilever", None)
-    if cantilever is not None and not isinstance(cantilever, str):
-        raise TypeError(f"cantilever: expected a name (str), got {type(cantilever).__name__}")
-    if probe is None:
-        if cantilever is not None:
-            raise ValueError("cantilever needs probe= (as --cantilever needs --probe)")
-        return None
-    if not isinstance(probe, (str, dict)):
-        probe = os.fspath(probe)
-    return _core.probe_source(probe, cantilever)
-
-
-def _state(initial: StateLike) -> Optional[list]:
-    if initial is None:
-        return None
-    if isinstance(initial, (Attractor, Orbit)):
-        initial = initial.state
-    z = np.asarray(initial, dtype=np.float64)
-    if z.ndim != 1:
-        raise ValueError(
-            f"initial: expected a 1-D state (a1..aN, adot1..adotN), got shape {z.shape}"
-        )
-    return z.tolist()
-
-
-def _param_attrs(p: Params) -> Dict[str, Any]:
-    return {k: v for k, v in p.to_dict().items() if isinstance(v, (int, float, str))}
-
-
-def _attrs(p: Params, **extra: Any) -> Dict[str, Any]:
-    a = _param_attrs(p)
-    a["units_note"] = UNITS_NOTE
-    a.update(extra)
-    return a
-
-
-_KINDS: Dict[str, Tuple[Any, str]] = {
-    "int": (numbers.Integral, "an integer"),
-    "float": (numbers.Real, "a number"),
-    "bool": ((bool, np.bool_), "True or False"),
-    "str": (str, "a string"),
-}
-
-
-_F = TypeVar("_F", bound=Callable[..., Any])
-
-
-def _typed(f: _F) -> _F:
-    """Check the keywords of the public function ``f`` against its annotations before any
-    work: ``int``/``float``/``bool``/``str`` and their ``Optional[...]``. A wrong type is a
-    ``TypeError`` naming the keyword and what it takes; an integer beyond 64 bits (or, for a
-    ``float`` keyword, beyond a double's range) a ``ValueError`` naming it (the core's
-    conversions would say neither)."""
-    sig = inspect.signature(f)
-    checks: Dict[str, Tuple[str, bool]] = {}
-    for name, prm in sig.parameters.items():
-        ann = prm.annotation if isinstance(prm.annotation, str) else ""
-        optional = ann.startswith("Optional[") and ann.endswith("]")
-        base = ann[len("Optional["):-1] if optional else ann
-        if base in _KINDS:
-            checks[name] = (base, optional)
-
-    @functools.wraps(f)
-    def checked(*args: Any, **kwargs: Any) -> Any:
-        for name, value in sig.bind_partial(*args, **kwargs).arguments.items():
-            if name not in checks:
-                continue
-            base, optional = checks[name]
-            if value is None and optional:
-                continue
-            kind, what = _KINDS[base]
-            numeric_bool = base in ("int", "float") and isinstance(value, (bool, np.bool_))
-            if numeric_bool or not isinstance(value, kind):
-                takes = what + (" or None" if optional else "")
-                raise TypeError(
-                    f"{f.__name__}(): {name} must be {takes}, got {type(value).__name__} {value!r}"
-                )
-            if base == "int" and not -(2**63) <= int(value) < 2**63:
-                raise ValueError(f"{name} = {value}: out of range (far beyond every limit)")
-            if base == "float" and isinstance(value, numbers.Integral):
-                # float(10**400) raises OverflowError: a number out of range is a ValueError
-                try:
-                    float(value)
-                except OverflowError:
-                    digits = len(str(abs(int(value))))
-                    raise ValueError(
-                        f"{name} = an integer of {digits} digits: must be a finite number "
-                        "(far beyond every limit)"
-                    ) from None
-        return f(*args, **kwargs)
-
-    return cast(_F, checked)
-
-
-_COUNTS = frozenset(
-    "samples_per_period steps_per_period max_modes periods steps starts seed threads "
-    "max_periods max_period samples period transient blocks x_steps y_steps basin_hits "
-    "discover_after stride".split()
-)
-
-
-class AfmdynWarning(UserWarning):
-    """A computed answer with a caveat the command line prints as ``afmdyn: warning: …`` on
-    stderr (a branch that ended before the end of its range, points of a sweep that failed,
-    an energy balance that did not close); the same lines are in the summary's ``warnings``."""
-
-
-def _warn(doc: Any) -> None:
-    """Issue every line of a JSON document's ``warnings`` list as an :class:`AfmdynWarning`."""
-    if isinstance(doc, str):
-        try:
-            doc = json.loads(doc)
-        except ValueError:
-            return
-    if isinstance(doc, dict):
-        for w in doc.get("warnings") or []:
-            warnings.warn(str(w), AfmdynWarning, stacklevel=5)
-
-
-def _run(
-    fn: Any, desc: str, progress: ProgressArg, p: Params, si: Optional[str] = None, **options: Any
-) -> Dict[str, Any]:
-    """Call the compiled ``fn`` with a progress reporter; negative counts are a ValueError
-    naming the option (the core's unsigned integers would raise OverflowError). With ``si`` (a
-    probe file) ``fn`` gets ``probe=si``, and its JSON document the command line's ``"si"``
-    block (added by the library's request layer)."""
-    for k, v in options.items():
-        if k in _COUNTS and isinstance(v, int) and not isinstance(v, bool) and v < 0:
-            raise ValueError(f"{k} = {v}: must be >= 0")
-    if si is not None:
-        options["probe"] = si
-    with reporter(progress, desc) as cb:
-        d = fn(p, progress=cb, **options)
-    if isinstance(d, dict):
-        _warn(d.get("json"))
-    return d
-
-
-def summary(ds: xr.Dataset) -> Dict[str, Any]:
-    """The command line's ``--json`` document stored with a dataset afmdyn returned
-    (``simulate``, ``converge``, ``continuation``, ``approach``, ``resonance``, ``observe``,
-    ``basins``, ``global_continuation``); the same as ``ds.afmdyn.to_dict()``."""
-    return json.loads(ds.attrs["summary"])
 
 
 @_typed
@@ -285,12 +76,12 @@ def simulate(
     *,
     periods: Optional[float] = None,
     tau_end: Optional[float] = None,
-    transient: float = 0.0,
+    transient: float = _DEFAULTS["simulate"]["transient"],
     initial: StateLike = None,
-    samples_per_period: int = 200,
+    samples_per_period: int = _DEFAULTS["simulate"]["samples_per_period"],
     integrator: Optional[str] = None,
     steps_per_period: Optional[int] = None,
-    tolerance: float = 1e-12,
+    tolerance: float = _DEFAULTS["simulate"]["tolerance"],
     progress: ProgressArg = None,
     **model: Unpack[Model],
 ) -> xr.Dataset:
@@ -325,22 +116,9 @@ def simulate(
         ``tau`` without a probe; events, sections) in s, lengths in m, velocities in m/s, forces in N, energies in J, the
         spectrum's frequencies in Hz — each variable's unit in its attrs.
     """
+    req = _request(locals(), initial=_state(initial))
     p, probe = _params(params, model)
-    d = _run(
-        _core.simulate,
-        "simulate",
-        progress,
-        p,
-        si=probe,
-        periods=periods,
-        tau_end=tau_end,
-        transient=transient,
-        initial=_state(initial),
-        samples_per_period=samples_per_period,
-        integrator=integrator,
-        steps_per_period=steps_per_period,
-        tolerance=tolerance,
-    )
+    d = _run(_core.simulate, "simulate", progress, p, si=probe, request=req)
     n = p.modes
     comp = [f"a_{j}" for j in range(1, n + 1)] + [f"a_dot_{j}" for j in range(1, n + 1)]
     # with a probe the library returned every array in SI (report::SeriesUnits)
@@ -469,12 +247,12 @@ def converge(
     params: Optional[Params] = None,
     /,
     *,
-    max_modes: int = 4,
-    periods: int = 1,
-    samples_per_period: int = 200,
+    max_modes: int = _DEFAULTS["converge"]["max_modes"],
+    periods: int = _DEFAULTS["converge"]["periods"],
+    samples_per_period: int = _DEFAULTS["converge"]["samples_per_period"],
     integrator: Optional[str] = None,
     steps_per_period: Optional[int] = None,
-    tolerance: float = 1e-12,
+    tolerance: float = _DEFAULTS["converge"]["tolerance"],
     progress: ProgressArg = None,
     **model: Unpack[Model],
 ) -> xr.Dataset:
@@ -489,20 +267,9 @@ def converge(
         ``[n_modes]`` (RMS of W_tip(N) − W_tip(N−1), NaN for N = 1); coordinate
         ``tau_from_section`` ``[K]``.
     """
+    req = _request(locals())
     p, probe = _params(params, model, default=Params(omega=4.1))
-    d = _run(
-        _core.converge,
-        "converge",
-        progress,
-        p,
-        si=probe,
-        max_modes=max_modes,
-        periods=periods,
-        samples_per_period=samples_per_period,
-        integrator=integrator,
-        steps_per_period=steps_per_period,
-        tolerance=tolerance,
-    )
+    d = _run(_core.converge, "converge", progress, p, si=probe, request=req)
     return xr.Dataset(
         data_vars={
             "w_tip": (
@@ -540,21 +307,21 @@ def bifurcation(
     params: Optional[Params] = None,
     /,
     *,
-    param: str = "omega",
-    from_: float = 1.0,
-    to: float = 5.0,
-    steps: int = 400,
+    param: str = _DEFAULTS["bifurcation"]["param"],
+    from_: float = _DEFAULTS["bifurcation"]["from"],
+    to: float = _DEFAULTS["bifurcation"]["to"],
+    steps: int = _DEFAULTS["bifurcation"]["steps"],
     values: Optional[Sequence[float]] = None,
-    starts: int = 0,
-    seed: int = 1,
-    continuation: bool = True,
+    starts: int = _DEFAULTS["bifurcation"]["starts"],
+    seed: int = _DEFAULTS["bifurcation"]["seed"],
+    continuation: bool = _DEFAULTS["bifurcation"]["continuation"],
     threads: Optional[int] = None,
-    tol: float = 1e-8,
+    tol: float = _DEFAULTS["bifurcation"]["tol"],
     max_periods: Optional[int] = None,
-    max_period: int = 64,
+    max_period: int = _DEFAULTS["bifurcation"]["max_period"],
     integrator: Optional[str] = None,
     steps_per_period: Optional[int] = None,
-    tolerance: float = 1e-12,
+    tolerance: float = _DEFAULTS["bifurcation"]["tolerance"],
     progress: ProgressArg = None,
     store: Union[str, "os.PathLike[str]", None] = None,
     resume: bool = False,
@@ -597,29 +364,17 @@ def bifurcation(
         ``contacts_per_period``, ``transient_periods``, ``message``, ``a_1``…``a_N``,
         ``a_dot_1``…``a_dot_N``. ``.to_dataframe()`` gives the tidy table.
     """
+    req = _request(locals())
+    if values is not None:
+        req["values"] = np.asarray(values, dtype=np.float64).ravel().tolist()
     p, probe = _params(params, model)
-    vals = None if values is None else np.asarray(values, dtype=np.float64).ravel().tolist()
     # the sweep's records carry no JSON document, so no "si" block: the probe only resolved p
     d = _run(
         _core.bifurcation,
         "bifurcation",
         progress,
         p,
-        param=param,
-        values=vals,
-        from_=from_,
-        to=to,
-        steps=steps,
-        starts=starts,
-        seed=seed,
-        continuation=continuation,
-        threads=threads,
-        tol=tol,
-        max_periods=max_periods,
-        max_period=max_period,
-        integrator=integrator,
-        steps_per_period=steps_per_period,
-        tolerance=tolerance,
+        request=req,
         store=None if store is None else os.fspath(store),
         resume=resume,
     )
@@ -681,147 +436,19 @@ def _sweep_dataset(p: Params, d: Dict[str, Any], starts: int, seed: int) -> xr.D
 
 
 @_typed
-def attractors(
-    params: Optional[Params] = None,
-    /,
-    *,
-    samples: int = 64,
-    seed: int = 1,
-    cluster_tol: float = 1e-5,
-    tol: float = 1e-8,
-    max_periods: Optional[int] = None,
-    max_period: int = 64,
-    integrator: Optional[str] = None,
-    steps_per_period: Optional[int] = None,
-    tolerance: float = 1e-12,
-    progress: ProgressArg = None,
-    **model: Unpack[Model],
-) -> Attractors:
-    """Coexisting attractors and basin fractions (paper Figs. 6–17, ``afmdyn attractors``)
-    from ``samples`` seeded random initial states, in parallel.
-
-    Returns:
-        :class:`Attractors`, a sequence of :class:`Attractor` (most frequent first);
-        ``to_dict()`` is ``afmdyn attractors --json``, ``to_dataframe()`` a summary table.
-    """
-    p, probe = _params(params, model)
-    d = _run(
-        _core.attractors,
-        "attractors",
-        progress,
-        p,
-        si=probe,
-        samples=samples,
-        seed=seed,
-        cluster_tol=cluster_tol,
-        tol=tol,
-        max_periods=max_periods,
-        max_period=max_period,
-        integrator=integrator,
-        steps_per_period=steps_per_period,
-        tolerance=tolerance,
-    )
-    doc = json.loads(d["json"])
-    found = [
-        Attractor(
-            params=p,
-            period=a["period"],
-            count=a["count"],
-            basin_fraction=a["basin_fraction"],
-            section_tau=a["section_tau"],
-            section_v_t=a["section_v_t"],
-            section_w_tip=a["section_w_tip"],
-            section_state=a["section_state"],
-            initial=a["initial"],
-            x_max=a["x_max"],
-            x_min=a["x_min"],
-            v_t_min=a["v_t_min"],
-            contact_fraction=a["contact_fraction"],
-            contacts_per_period=a["contacts_per_period"],
-            body_contact=a["body_contact"],
-            transient_periods=a["transient_periods"],
-            _doc=entry,
-        )
-        for a, entry in zip(d["attractors"], doc["attractors"])
-    ]
-    return Attractors(p, samples, found, list(d["failures"]), d["json"])
-
-
-@_typed
-def orbit(
-    params: Optional[Params] = None,
-    /,
-    *,
-    period: Optional[int] = None,
-    initial: StateLike = None,
-    tol: float = 1e-8,
-    max_periods: Optional[int] = None,
-    max_period: int = 64,
-    progress: ProgressArg = None,
-    **model: Unpack[Model],
-) -> Orbit:
-    """A period-n orbit by Newton shooting, with Floquet multipliers (``afmdyn orbit``).
-
-    Args:
-        period: n (1..=64); default: the period of the steady state reached from rest (or
-            the attractor's period when ``initial`` is an :class:`Attractor`), else 1.
-        initial: start of Newton's iteration (``[2N]``, an :class:`Attractor` or an
-            :class:`Orbit`); default: the steady state reached from rest.
-        tol, max_periods, max_period: steady-state detection for the default start.
-
-    Returns:
-        :class:`Orbit`; ``to_dict()`` is ``afmdyn orbit --json``. Raises
-        :class:`SimulationError` when Newton's method does not converge.
-    """
-    p, probe = _params(params, model)
-    if period is None and isinstance(initial, Attractor):
-        period = initial.period or 1
-    d = _run(
-        _core.orbit,
-        "orbit",
-        progress,
-        p,
-        si=probe,
-        period=period,
-        initial=_state(initial),
-        tol=tol,
-        max_periods=max_periods,
-        max_period=max_period,
-    )
-    doc = json.loads(d["json"])
-    return Orbit(
-        params=p,
-        period=doc["period"],
-        state=d["state"],
-        section=d["section"],
-        poincare_v_t=np.asarray(doc["poincare"]["v_t"], dtype=np.float64),
-        poincare_w_tip=np.asarray(doc["poincare"]["w_tip"], dtype=np.float64),
-        monodromy=d["monodromy"],
-        multipliers=d["multipliers"],
-        stable=doc["stable"],
-        critical=doc["critical"],
-        grazing=doc["grazing"],
-        grazing_distance=doc["grazing_distance"],
-        switchings=doc["switchings"],
-        newton_residuals=d["newton_residuals"],
-        _json=d["json"],
-    )
-
-
-@_typed
 def continuation(
     params: Optional[Params] = None,
     /,
     *,
-    param: str = "omega",
-    from_: float = 5.0,
-    to: float = 1.0,
+    param: str = _DEFAULTS["continuation"]["param"],
+    from_: float = _DEFAULTS["continuation"]["from"],
+    to: float = _DEFAULTS["continuation"]["to"],
     period: Optional[int] = None,
-    switch: bool = False,
+    switch: bool = _DEFAULTS["continuation"]["switch"],
     initial: StateLike = None,
-    tol: float = 1e-8,
+    tol: float = _DEFAULTS["continuation"]["steady"]["tol"],
     max_periods: Optional[int] = None,
-    max_period: int = 64,
+    max_period: int = _DEFAULTS["continuation"]["steady"]["max_period"],
     progress: ProgressArg = None,
     **model: Unpack[Model],
 ) -> xr.Dataset:
@@ -844,23 +471,9 @@ def continuation(
         ``multipliers`` ``[point, 2N]`` complex128, ``state`` ``[point, 2N]``.
         ``attrs["summary"]`` is ``afmdyn continue --json``.
     """
+    req = _start(_request(locals(), initial=_state(initial)))
     p, probe = _params(params, model)
-    d = _run(
-        _core.continuation,
-        "continuation",
-        progress,
-        p,
-        si=probe,
-        param=param,
-        from_=from_,
-        to=to,
-        period=period,
-        switch=switch,
-        initial=_state(initial),
-        tol=tol,
-        max_periods=max_periods,
-        max_period=max_period,
-    )
+    d = _run(_core.continuation, "continuation", progress, p, si=probe, request=req)
     return xr.Dataset(
         data_vars={
             "branch": ("point", d["branch"], {"long_name": "branch (0: the continued one)"}),
@@ -897,50 +510,6 @@ def continuation(
     )
 
 
-@_typed
-def lyapunov(
-    params: Optional[Params] = None,
-    /,
-    *,
-    initial: StateLike = None,
-    transient: Optional[int] = None,
-    periods: int = 4000,
-    blocks: int = 10,
-    progress: ProgressArg = None,
-    **model: Unpack[Model],
-) -> Lyapunov:
-    """Lyapunov spectrum (tangent dynamics with saltation matrices) and the 0–1 test for chaos
-    (``afmdyn lyapunov``), from ``initial`` (default rest) after ``transient`` drive periods,
-    averaged over ``periods`` in ``blocks`` blocks (periods ≥ blocks ≥ 2).
-
-    Returns:
-        :class:`Lyapunov`; ``to_dict()`` is ``afmdyn lyapunov --json``.
-    """
-    p, probe = _params(params, model)
-    d = _run(
-        _core.lyapunov,
-        "lyapunov",
-        progress,
-        p,
-        si=probe,
-        initial=_state(initial),
-        transient=transient,
-        periods=periods,
-        blocks=blocks,
-    )
-    doc = json.loads(d["json"])
-    return Lyapunov(
-        params=p,
-        exponents=d["exponents"],
-        uncertainty=d["uncertainty"],
-        volume_rate=doc["volume_rate"],
-        zero_one=float("nan") if doc["zero_one"] is None else doc["zero_one"],
-        periods=doc["periods"],
-        verdict=doc["verdict"],
-        _json=d["json"],
-    )
-
-
 def probe(
     path: Union[str, "os.PathLike[str]", Dict[str, Any]], cantilever: Optional[str] = None
 ) -> Dict[str, Any]:
@@ -965,11 +534,11 @@ def observe(
     /,
     *,
     initial: StateLike = None,
-    periods: int = 1,
-    harmonics: int = 10,
-    tol: float = 1e-8,
+    periods: int = _DEFAULTS["observe"]["periods"],
+    harmonics: int = _DEFAULTS["observe"]["harmonics"],
+    tol: float = _DEFAULTS["observe"]["steady"]["tol"],
     max_periods: Optional[int] = None,
-    max_period: int = 64,
+    max_period: int = _DEFAULTS["observe"]["steady"]["max_period"],
     progress: ProgressArg = None,
     **model: Unpack[Model],
 ) -> xr.Dataset:
@@ -995,20 +564,9 @@ def observe(
         (dimensionless, phases in radians, the closed forms; its ``reported`` block holds the
         dataset's values).
     """
+    req = _start(_request(locals(), initial=_state(initial)))
     p, probe = _params(params, model)
-    d = _run(
-        _core.observe,
-        "observe",
-        progress,
-        p,
-        si=probe,
-        initial=_state(initial),
-        periods=periods,
-        harmonics=harmonics,
-        tol=tol,
-        max_periods=max_periods,
-        max_period=max_period,
-    )
+    d = _run(_core.observe, "observe", progress, p, si=probe, request=req)
     doc: Dict[str, Any] = json.loads(d["json"])
     doc["state"] = d["state"]
     doc["period"] = d["period"]
@@ -1021,12 +579,12 @@ def _curve(
     progress: ProgressArg,
     params: Optional[Params],
     model: Any,
-    **options: Any,
+    request: Dict[str, Any],
 ) -> xr.Dataset:
     """Run a stepped-curve analysis (:func:`approach`, :func:`resonance`) and return its
     dataset (:func:`afmdyn._curves.curve_dataset`; in SI with a probe)."""
     p, probe = _params(params, model)
-    d = _run(fn, desc, progress, p, probe=probe, **options)
+    d = _run(fn, desc, progress, p, si=probe, request=request)
     return curve_dataset(desc, json.loads(d["json"]))
 
 
@@ -1039,8 +597,8 @@ def approach(
     to: Optional[float] = None,
     step: Optional[float] = None,
     points: Optional[int] = None,
-    branches: bool = True,
-    tolerance: float = 1e-10,
+    branches: bool = _DEFAULTS["approach"]["branches"],
+    tolerance: float = _DEFAULTS["approach"]["tolerance"],
     setpoint: Optional[float] = None,
     traces: Optional[int] = None,
     progress: ProgressArg = None,
@@ -1080,21 +638,7 @@ def approach(
         (``folds``, ``bistable``, ``jumps``, ``setpoint``, ``warnings``;
         ``docs/outputs.md``).
     """
-    return _curve(
-        _core.approach,
-        "approach",
-        progress,
-        params,
-        model,
-        from_=from_,
-        to=to,
-        step=step,
-        points=points,
-        branches=branches,
-        tolerance=tolerance,
-        setpoint=setpoint,
-        traces=traces,
-    )
+    return _curve(_core.approach, "approach", progress, params, model, _request(locals()))
 
 
 @_typed
@@ -1102,13 +646,13 @@ def resonance(
     params: Optional[Params] = None,
     /,
     *,
-    mode: int = 1,
+    mode: int = _DEFAULTS["resonance"]["mode"],
     from_: Optional[float] = None,
     to: Optional[float] = None,
     step: Optional[float] = None,
     points: Optional[int] = None,
-    branches: bool = True,
-    tolerance: float = 1e-10,
+    branches: bool = _DEFAULTS["resonance"]["branches"],
+    tolerance: float = _DEFAULTS["resonance"]["tolerance"],
     traces: Optional[int] = None,
     progress: ProgressArg = None,
     **model: Unpack[Model],
@@ -1129,18 +673,4 @@ def resonance(
         ``omega`` and ``sweep`` = ``up``/``down``; ``ds.afmdyn.to_dict()`` is the
         ``afmdyn resonance --json`` document.
     """
-    return _curve(
-        _core.resonance,
-        "resonance",
-        progress,
-        params,
-        model,
-        mode=mode,
-        from_=from_,
-        to=to,
-        step=step,
-        points=points,
-        branches=branches,
-        tolerance=tolerance,
-        traces=traces,
-    )
+    return _curve(_core.resonance, "resonance", progress, params, model, _request(locals()))

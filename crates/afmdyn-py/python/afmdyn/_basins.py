@@ -12,7 +12,7 @@ import xarray as xr
 from . import _afmdyn as _core
 from . import _layout
 from ._afmdyn import Params
-from ._api import Model, _params, _run, _typed
+from ._common import _DEFAULTS, Model, _params, _request, _run, _typed
 from ._progress import ProgressArg
 
 if TYPE_CHECKING:
@@ -24,27 +24,27 @@ def basins(
     params: Optional[Params] = None,
     /,
     *,
-    x: str = "a1",
-    x_from: float = -0.6,
-    x_to: float = 0.6,
-    x_steps: int = 40,
-    y: str = "adot1",
-    y_from: float = -1.2,
-    y_to: float = 1.2,
-    y_steps: int = 40,
+    x: str = _DEFAULTS["basins"]["x"],
+    x_from: float = _DEFAULTS["basins"]["x_from"],
+    x_to: float = _DEFAULTS["basins"]["x_to"],
+    x_steps: int = _DEFAULTS["basins"]["x_steps"],
+    y: str = _DEFAULTS["basins"]["y"],
+    y_from: float = _DEFAULTS["basins"]["y_from"],
+    y_to: float = _DEFAULTS["basins"]["y_to"],
+    y_steps: int = _DEFAULTS["basins"]["y_steps"],
     base: Optional[List[float]] = None,
-    near_tol: float = 0.02,
-    cell: float = 0.01,
-    basin_hits: int = 16,
-    discover_after: int = 200,
-    stride: int = 0,
-    cluster_tol: float = 1e-5,
-    tol: float = 1e-8,
+    near_tol: float = _DEFAULTS["basins"]["near_tol"],
+    cell: float = _DEFAULTS["basins"]["cell"],
+    basin_hits: int = _DEFAULTS["basins"]["basin_hits"],
+    discover_after: int = _DEFAULTS["basins"]["discover_after"],
+    stride: int = _DEFAULTS["basins"]["stride"],
+    cluster_tol: float = _DEFAULTS["basins"]["cluster_tol"],
+    tol: float = _DEFAULTS["basins"]["tol"],
     max_periods: Optional[int] = None,
-    max_period: int = 64,
+    max_period: int = _DEFAULTS["basins"]["max_period"],
     integrator: Optional[str] = None,
     steps_per_period: Optional[int] = None,
-    tolerance: float = 1e-12,
+    tolerance: float = _DEFAULTS["basins"]["tolerance"],
     threads: Optional[int] = None,
     progress: ProgressArg = None,
     **model: Unpack[Model],
@@ -68,36 +68,9 @@ def basins(
         undefined), ``uncertainty_exponent`` (Grebogi et al. 1983) and ``summary`` (the
         command line's JSON document).
     """
+    req = _request(locals())
     p, probe = _params(params, model)
-    d = _run(
-        _core.basins,
-        "starts",
-        progress,
-        p,
-        si=probe,
-        x=x,
-        x_from=x_from,
-        x_to=x_to,
-        x_steps=x_steps,
-        y=y,
-        y_from=y_from,
-        y_to=y_to,
-        y_steps=y_steps,
-        base=base,
-        near_tol=near_tol,
-        cell=cell,
-        basin_hits=basin_hits,
-        discover_after=discover_after,
-        stride=stride,
-        cluster_tol=cluster_tol,
-        tol=tol,
-        max_periods=max_periods,
-        max_period=max_period,
-        integrator=integrator,
-        steps_per_period=steps_per_period,
-        tolerance=tolerance,
-        threads=threads,
-    )
+    d = _run(_core.basins, "starts", progress, p, si=probe, request=req)
     doc = json.loads(d["json"])
 
     def num(v: Any) -> float:

@@ -15,7 +15,7 @@ import xarray as xr
 from . import _afmdyn as _core
 from . import _layout
 from ._afmdyn import Params
-from ._api import Model, _probe_text, _typed, _warn
+from ._common import _DEFAULTS, Model, _probe_text, _typed, _warn
 from ._progress import ProgressArg, reporter
 
 if TYPE_CHECKING:
@@ -70,27 +70,27 @@ def chart(
     params: Optional[Params] = None,
     /,
     *,
-    x: str = "omega",
-    x_from: float = 2.6,
-    x_to: float = 3.0,
-    x_steps: int = 9,
-    y: str = "drive_amplitude",
-    y_from: float = 0.1,
-    y_to: float = 0.12,
-    y_steps: int = 2,
-    starts: int = 4,
-    seed: int = 1,
-    tile: int = 8,
-    cluster_tol: float = 1e-5,
-    lyapunov_periods: int = 500,
-    max_attractors: int = 8,
+    x: str = _DEFAULTS["chart"]["x"],
+    x_from: float = _DEFAULTS["chart"]["x_from"],
+    x_to: float = _DEFAULTS["chart"]["x_to"],
+    x_steps: int = _DEFAULTS["chart"]["x_steps"],
+    y: str = _DEFAULTS["chart"]["y"],
+    y_from: float = _DEFAULTS["chart"]["y_from"],
+    y_to: float = _DEFAULTS["chart"]["y_to"],
+    y_steps: int = _DEFAULTS["chart"]["y_steps"],
+    starts: int = _DEFAULTS["chart"]["starts"],
+    seed: int = _DEFAULTS["chart"]["seed"],
+    tile: int = _DEFAULTS["chart"]["tile"],
+    cluster_tol: float = _DEFAULTS["chart"]["cluster_tol"],
+    lyapunov_periods: int = _DEFAULTS["chart"]["lyapunov_periods"],
+    max_attractors: int = _DEFAULTS["chart"]["max_attractors"],
     threads: Optional[int] = None,
-    tol: float = 1e-8,
+    tol: float = _DEFAULTS["chart"]["tol"],
     max_periods: Optional[int] = None,
-    max_period: int = 64,
+    max_period: int = _DEFAULTS["chart"]["max_period"],
     integrator: Optional[str] = None,
     steps_per_period: Optional[int] = None,
-    tolerance: float = 1e-12,
+    tolerance: float = _DEFAULTS["chart"]["tolerance"],
     progress: ProgressArg = None,
     store: Union[str, "os.PathLike[str]", None] = None,
     resume: bool = False,

@@ -11,7 +11,7 @@ import xarray as xr
 from . import _afmdyn as _core
 from . import _layout
 from ._afmdyn import Params
-from ._api import Model, _params, _run, _typed
+from ._common import _DEFAULTS, Model, _params, _request, _run, _typed
 from ._progress import ProgressArg
 
 if TYPE_CHECKING:
@@ -23,21 +23,21 @@ def global_continuation(
     params: Optional[Params] = None,
     /,
     *,
-    param: str = "omega",
-    from_: float = 1.5,
-    to: float = 3.0,
-    steps: int = 16,
+    param: str = _DEFAULTS["global_continuation"]["param"],
+    from_: float = _DEFAULTS["global_continuation"]["from"],
+    to: float = _DEFAULTS["global_continuation"]["to"],
+    steps: int = _DEFAULTS["global_continuation"]["steps"],
     values: Optional[List[float]] = None,
-    match_tol: float = 0.1,
-    samples: int = 16,
-    seed: int = 1,
-    cluster_tol: float = 1e-5,
-    tol: float = 1e-8,
+    match_tol: float = _DEFAULTS["global_continuation"]["match_tol"],
+    samples: int = _DEFAULTS["global_continuation"]["samples"],
+    seed: int = _DEFAULTS["global_continuation"]["seed"],
+    cluster_tol: float = _DEFAULTS["global_continuation"]["cluster_tol"],
+    tol: float = _DEFAULTS["global_continuation"]["tol"],
     max_periods: Optional[int] = None,
-    max_period: int = 64,
+    max_period: int = _DEFAULTS["global_continuation"]["max_period"],
     integrator: Optional[str] = None,
     steps_per_period: Optional[int] = None,
-    tolerance: float = 1e-12,
+    tolerance: float = _DEFAULTS["global_continuation"]["tolerance"],
     progress: ProgressArg = None,
     **model: Unpack[Model],
 ) -> xr.Dataset:
@@ -56,29 +56,9 @@ def global_continuation(
         NaN otherwise); dim ``value``: ``failures`` (runs that failed). Attribute ``summary``:
         the command line's JSON document (Poincaré points, multipliers of every attractor).
     """
+    req = _request(locals())
     p, probe = _params(params, model)
-    d = _run(
-        _core.global_continuation,
-        "starts",
-        progress,
-        p,
-        si=probe,
-        param=param,
-        from_=from_,
-        to=to,
-        steps=steps,
-        values=values,
-        match_tol=match_tol,
-        samples=samples,
-        seed=seed,
-        cluster_tol=cluster_tol,
-        tol=tol,
-        max_periods=max_periods,
-        max_period=max_period,
-        integrator=integrator,
-        steps_per_period=steps_per_period,
-        tolerance=tolerance,
-    )
+    d = _run(_core.global_continuation, "starts", progress, p, si=probe, request=req)
     doc = json.loads(d["json"])
     # the library's layout (the command line's attractors-sweep.nc)
     return _layout.dataset(

@@ -461,8 +461,8 @@ impl Default for AttractorsRequest {
     fn default() -> Self {
         AttractorsRequest {
             samples: 64,
-            seed: 1,
-            cluster_tol: 1e-5,
+            seed: super::DEFAULT_SEED,
+            cluster_tol: super::DEFAULT_CLUSTER_TOL,
             steady: SteadyRequest::default(),
             integrator: IntegratorRequest::default(),
         }
@@ -552,8 +552,8 @@ impl Default for GlobalContinuationRequest {
             steps: 16,
             match_tol: DEFAULT_MATCH_TOL,
             samples: 16,
-            seed: 1,
-            cluster_tol: 1e-5,
+            seed: super::DEFAULT_SEED,
+            cluster_tol: super::DEFAULT_CLUSTER_TOL,
             steady: SteadyRequest::default(),
             integrator: IntegratorRequest::default(),
         }
@@ -979,7 +979,7 @@ impl Default for BifurcationRequest {
             to: 5.0,
             steps: 400,
             starts: 0,
-            seed: 1,
+            seed: super::DEFAULT_SEED,
             continuation: true,
             threads: None,
             steady: SteadyRequest::default(),

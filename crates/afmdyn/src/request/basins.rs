@@ -84,7 +84,7 @@ impl Default for BasinsRequest {
             basin_hits: DEFAULT_BASIN_HITS,
             discover_after: DEFAULT_DISCOVER_AFTER,
             stride: DEFAULT_STRIDE,
-            cluster_tol: 1e-5,
+            cluster_tol: super::DEFAULT_CLUSTER_TOL,
             threads: None,
             steady: SteadyRequest::default(),
             integrator: IntegratorRequest::default(),

@@ -62,3 +62,10 @@ pub use pool::in_pool;
 pub use pool::thread_pool;
 pub use run::{run, Analysis, ApproachRequest, Document, ModesRequest, Resolved, ResonanceRequest};
 pub use sweep::{fingerprint, SweepRecord};
+
+/// The default relative distance within which two Poincaré point sets are one attractor
+/// (`cluster_tol` of the census, its global continuation, the basin map and the chart).
+pub const DEFAULT_CLUSTER_TOL: f64 = 1e-5;
+/// The default seed of the random initial states (`seed` of the sweep, the census, its global
+/// continuation and the chart).
+pub const DEFAULT_SEED: u64 = 1;

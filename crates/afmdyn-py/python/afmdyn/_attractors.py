@@ -1,0 +1,217 @@
+"""Coexisting attractors at fixed parameters: :func:`attractors`, and the result types
+:class:`Attractor` (which continues into :meth:`Attractor.orbit` and
+:meth:`Attractor.simulate`) and :class:`Attractors`."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any, Dict, Iterator, List, Optional, Sequence, overload
+
+import numpy as np
+
+from ._afmdyn import Params
+from . import _afmdyn as _core
+from ._api import simulate
+from ._common import _DEFAULTS, Model, _params, _request, _run, _typed
+from ._orbits import orbit
+from ._progress import ProgressArg
+from ._results import Orbit, _Document
+
+if TYPE_CHECKING:
+    import pandas as pd
+    import xarray as xr
+    from typing_extensions import Unpack
+
+
+@dataclass(frozen=True, repr=False)
+class Attractor:
+    """One attractor found by :func:`afmdyn.attractors`.
+
+    Attributes:
+        params: the parameters.
+        period: n of a period-n orbit of the stroboscopic map, ``None`` if nonperiodic.
+        count: random starts that reached it; ``basin_fraction`` = count / successful starts.
+        section_tau, section_v_t, section_w_tip: the recorded section points τ = 2πk/Ω,
+            float64 ``[n]`` (n = period, or 64 for a nonperiodic motion); τ in t0, V_T and
+            W(1,τ) in g0.
+        section_state: the states (a, ȧ) at those points, float64 ``[n, 2N]``.
+        state: ``section_state[0]``, a state on the attractor at drive phase 0 (what the
+            command line's ``initial_modal`` string encodes).
+        initial: the random initial state that reached it, float64 ``[2N]``.
+        x_max, x_min, v_t_min, contact_fraction, contacts_per_period, body_contact: orbit
+            statistics over the recorded periods (g0; fractions per time or per period).
+        transient_periods: drive periods before the motion settled.
+    """
+
+    params: Params
+    period: Optional[int]
+    count: int
+    basin_fraction: float
+    section_tau: np.ndarray
+    section_v_t: np.ndarray
+    section_w_tip: np.ndarray
+    section_state: np.ndarray
+    initial: np.ndarray
+    x_max: float
+    x_min: float
+    v_t_min: float
+    contact_fraction: float
+    contacts_per_period: float
+    body_contact: bool
+    transient_periods: int
+    _doc: Dict[str, Any] = field(repr=False)
+
+    @property
+    def periodic(self) -> bool:
+        return self.period is not None
+
+    @property
+    def state(self) -> np.ndarray:
+        return self.section_state[0]
+
+    def to_dict(self) -> Dict[str, Any]:
+        """This attractor's entry of ``afmdyn attractors --json`` (a new dict)."""
+        return json.loads(json.dumps(self._doc))
+
+    def orbit(self, **options: Any) -> "Orbit":
+        """Newton shooting from this attractor (its period, starting on it): Floquet
+        multipliers and stability. Options as :func:`afmdyn.orbit`."""
+        return orbit(self.params, initial=self, **options)
+
+    def simulate(self, periods: Optional[float] = None, **options: Any) -> "xr.Dataset":
+        """Time series on the attractor from τ = 0 (drive phase 0), ``periods`` drive periods
+        (default: max(period, 2), or 8 for a nonperiodic motion, as the command line plots).
+        Options as :func:`afmdyn.simulate`."""
+        if periods is None:
+            periods = max(self.period or 8, 2)
+        return simulate(self.params, periods=periods, initial=self.state, **options)
+
+    def __repr__(self) -> str:
+        kind = f"period-{self.period}" if self.period else "nonperiodic"
+        return (
+            f"Attractor({kind}, basin {100 * self.basin_fraction:.1f} %, "
+            f"X_max = {self.x_max:.4f}, min V_T = {self.v_t_min:.4f})"
+        )
+
+
+class Attractors(_Document, Sequence[Attractor]):
+    """Coexisting attractors, most frequent first (a sequence of :class:`Attractor`);
+    ``to_dict()`` is ``afmdyn attractors --json``.
+
+    Attributes:
+        params: the parameters; samples: random starts; failures: error messages of the
+        starts that failed.
+    """
+
+    def __init__(
+        self,
+        params: Params,
+        samples: int,
+        attractors: List[Attractor],
+        failures: List[str],
+        doc: str,
+    ) -> None:
+        self.params = params
+        self.samples = samples
+        self.attractors = attractors
+        self.failures = failures
+        self._json = doc
+
+    def __len__(self) -> int:
+        return len(self.attractors)
+
+    @overload
+    def __getitem__(self, i: int) -> Attractor: ...
+
+    @overload
+    def __getitem__(self, i: slice) -> List[Attractor]: ...
+
+    def __getitem__(self, i):  # type: ignore[no-untyped-def]
+        return self.attractors[i]
+
+    def __iter__(self) -> Iterator[Attractor]:
+        return iter(self.attractors)
+
+    def to_dataframe(self) -> "pd.DataFrame":
+        """One row per attractor: period, basin fraction, count and orbit statistics."""
+        import pandas as pd
+
+        return pd.DataFrame(
+            [
+                {
+                    "period": a.period,
+                    "basin_fraction": a.basin_fraction,
+                    "count": a.count,
+                    "x_max": a.x_max,
+                    "x_min": a.x_min,
+                    "v_t_min": a.v_t_min,
+                    "contact_fraction": a.contact_fraction,
+                    "contacts_per_period": a.contacts_per_period,
+                    "body_contact": a.body_contact,
+                    "transient_periods": a.transient_periods,
+                }
+                for a in self.attractors
+            ],
+            index=pd.RangeIndex(1, len(self.attractors) + 1, name="attractor"),
+        )
+
+    def __repr__(self) -> str:
+        inner = "\n".join(f"  {k + 1}: {a!r}" for k, a in enumerate(self.attractors))
+        return (
+            f"Attractors({len(self)} from {self.samples} starts at Ω = {self.params.omega}, "
+            f"{len(self.failures)} failed)\n{inner}"
+        )
+
+
+@_typed
+def attractors(
+    params: Optional[Params] = None,
+    /,
+    *,
+    samples: int = _DEFAULTS["attractors"]["samples"],
+    seed: int = _DEFAULTS["attractors"]["seed"],
+    cluster_tol: float = _DEFAULTS["attractors"]["cluster_tol"],
+    tol: float = _DEFAULTS["attractors"]["tol"],
+    max_periods: Optional[int] = None,
+    max_period: int = _DEFAULTS["attractors"]["max_period"],
+    integrator: Optional[str] = None,
+    steps_per_period: Optional[int] = None,
+    tolerance: float = _DEFAULTS["attractors"]["tolerance"],
+    progress: ProgressArg = None,
+    **model: Unpack[Model],
+) -> Attractors:
+    """Coexisting attractors and basin fractions (paper Figs. 6–17, ``afmdyn attractors``)
+    from ``samples`` seeded random initial states, in parallel.
+
+    Returns:
+        :class:`Attractors`, a sequence of :class:`Attractor` (most frequent first);
+        ``to_dict()`` is ``afmdyn attractors --json``, ``to_dataframe()`` a summary table.
+    """
+    req = _request(locals())
+    p, probe = _params(params, model)
+    d = _run(_core.attractors, "attractors", progress, p, si=probe, request=req)
+    doc = json.loads(d["json"])
+    found = [
+        Attractor(
+            params=p,
+            period=a["period"],
+            count=a["count"],
+            basin_fraction=a["basin_fraction"],
+            section_tau=a["section_tau"],
+            section_v_t=a["section_v_t"],
+            section_w_tip=a["section_w_tip"],
+            section_state=a["section_state"],
+            initial=a["initial"],
+            x_max=a["x_max"],
+            x_min=a["x_min"],
+            v_t_min=a["v_t_min"],
+            contact_fraction=a["contact_fraction"],
+            contacts_per_period=a["contacts_per_period"],
+            body_contact=a["body_contact"],
+            transient_periods=a["transient_periods"],
+            _doc=entry,
+        )
+        for a, entry in zip(d["attractors"], doc["attractors"])
+    ]
+    return Attractors(p, samples, found, list(d["failures"]), d["json"])

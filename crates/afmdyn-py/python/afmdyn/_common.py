@@ -1,0 +1,296 @@
+"""What every analysis shares: the model keywords (:class:`Model`), the parameter set and probe
+of a call, the type check of the keywords, the request of the library an analysis' keywords
+become (its defaults, :data:`_DEFAULTS`, are the requests'), the call of the compiled function
+with a progress reporter, and the warnings of its document. It imports no analysis and no
+result type, so that every module of the package can import it."""
+
+from __future__ import annotations
+
+import functools
+import inspect
+import json
+import numbers
+import os
+import warnings
+from typing import (
+    Literal,
+    TYPE_CHECKING,
+    Any,
+    Callable,
+    Dict,
+    Optional,
+    Sequence,
+    Tuple,
+    TypedDict,
+    TypeVar,
+    Union,
+    cast,
+)
+
+import numpy as np
+import xarray as xr
+
+from . import _afmdyn as _core
+from ._afmdyn import Params
+from ._progress import ProgressArg, reporter
+
+if TYPE_CHECKING:
+    from ._attractors import Attractor
+    from ._results import Orbit
+
+#: An initial state: 2N values, or an :class:`Attractor` / :class:`Orbit` (its ``state``).
+StateLike = Union[None, Sequence[float], np.ndarray, "Attractor", "Orbit"]
+
+
+class Model(TypedDict, total=False):
+    """The model keywords every analysis takes (see :class:`Params` for their ranges; the one
+    table of them is ``afmdyn._afmdyn.MODEL_PARAMETERS``). ``probe`` is a probe in SI (the
+    command line's ``--probe``): a file's path, its TOML text (a ``str`` with a line break or
+    ``=``) or a dict of its sections (``{"cantilever": {...}, "sample": {...}, ...}``); it sets
+    every parameter in SI, ``z_c`` (m) and ``drive_frequency`` (Hz) set α5 and Ω through its
+    scales, ``modes`` and ``restitution`` are taken, and the dimensionless keywords of the
+    values it sets (``gap``, ``omega``, the α's, ``hamaker``, ``intermolecular_distance``,
+    ``contact_law``) raise ``ValueError`` naming the probe key or SI keyword to use; the
+    result's ``to_dict()`` then carries the command line's ``"si"`` block. ``cantilever`` names
+    a cantilever of the library (:func:`afmdyn.cantilevers`) for the probe, as
+    ``--cantilever`` does: it fills the keys the probe leaves out and wins over a name in it."""
+
+    modes: int
+    tip_mass_ratio: float
+    alpha1: float
+    drive_amplitude: float
+    alpha2: float
+    beam_damping: float
+    alpha3: float
+    contact_stiffness: float
+    alpha4: float
+    gap: float
+    alpha5: float
+    contact_damping: float
+    alpha6: float
+    omega: float
+    contact_law: Literal["linear", "hertz", "dmt", "impact"]
+    restitution: float
+    hamaker: float
+    intermolecular_distance: float
+    z_c: float
+    drive_frequency: float
+    probe: Union[str, "os.PathLike[str]", Dict[str, Any]]
+    cantilever: str
+
+
+#: Global attributes of every dataset: the scales of the dimensionless units.
+UNITS_NOTE = (
+    "dimensionless (paper eq. 5): time in t0 = sqrt(m L^4/(E I)), displacements in the beam "
+    "gap g0, forces in E I g0/L^3, energies in E I g0^2/L^3"
+)
+
+_T = {"units": "t0", "long_name": "time τ"}
+_G = {"units": "g0"}
+_V = {"units": "g0/t0"}
+
+
+def _params(
+    params: Optional[Params], model: Any, default: Optional[Params] = None
+) -> Tuple[Params, Optional[str]]:
+    """The parameter set of an analysis call and its probe file (or ``None``), resolved by the
+    library as the command line resolves ``--probe``/``--config`` and the model flags:
+    ``params`` (or the probe's set, or ``default``, or the paper's set) with the ``model``
+    keywords applied."""
+    if params is not None and not isinstance(params, Params):
+        raise TypeError(f"params: expected afmdyn.Params or None, got {type(params).__name__}")
+    model = dict(model)
+    probe = _probe_text(model)
+    return _core.resolve(params, default, probe, model), probe
+
+
+def _probe_text(model: Dict[str, Any]) -> Optional[str]:
+    """Pop ``probe`` and ``cantilever`` from the model keywords: the probe's TOML text with the
+    cantilever's name set (the library's ``Probe::source_text``), checked, or ``None``."""
+    probe = model.pop("probe", None)
+    cantilever = model.pop("cantilever", None)
+    if cantilever is not None and not isinstance(cantilever, str):
+        raise TypeError(f"cantilever: expected a name (str), got {type(cantilever).__name__}")
+    if probe is None:
+        if cantilever is not None:
+            raise ValueError("cantilever needs probe= (as --cantilever needs --probe)")
+        return None
+    if not isinstance(probe, (str, dict)):
+        probe = os.fspath(probe)
+    return _core.probe_source(probe, cantilever)
+
+
+def _state(initial: StateLike) -> Optional[list]:
+    if initial is None:
+        return None
+    # an Attractor or an Orbit: its state at drive phase 0
+    initial = getattr(initial, "state", initial)
+    z = np.asarray(initial, dtype=np.float64)
+    if z.ndim != 1:
+        raise ValueError(
+            f"initial: expected a 1-D state (a1..aN, adot1..adotN), got shape {z.shape}"
+        )
+    return z.tolist()
+
+
+def _start_period(initial: StateLike) -> Optional[int]:
+    """The period an :class:`Attractor` start gives an orbit (its own, 1 when nonperiodic);
+    ``None`` for another start."""
+    if hasattr(initial, "basin_fraction"):
+        return getattr(initial, "period", None) or 1
+    return None
+
+
+def _param_attrs(p: Params) -> Dict[str, Any]:
+    return {k: v for k, v in p.to_dict().items() if isinstance(v, (int, float, str))}
+
+
+def _attrs(p: Params, **extra: Any) -> Dict[str, Any]:
+    a = _param_attrs(p)
+    a["units_note"] = UNITS_NOTE
+    a.update(extra)
+    return a
+
+
+_KINDS: Dict[str, Tuple[Any, str]] = {
+    "int": (numbers.Integral, "an integer"),
+    "float": (numbers.Real, "a number"),
+    "bool": ((bool, np.bool_), "True or False"),
+    "str": (str, "a string"),
+}
+
+
+_F = TypeVar("_F", bound=Callable[..., Any])
+
+
+def _typed(f: _F) -> _F:
+    """Check the keywords of the public function ``f`` against its annotations before any
+    work: ``int``/``float``/``bool``/``str`` and their ``Optional[...]``. A wrong type is a
+    ``TypeError`` naming the keyword and what it takes; an integer beyond 64 bits (or, for a
+    ``float`` keyword, beyond a double's range) a ``ValueError`` naming it (the core's
+    conversions would say neither)."""
+    sig = inspect.signature(f)
+    checks: Dict[str, Tuple[str, bool]] = {}
+    for name, prm in sig.parameters.items():
+        ann = prm.annotation if isinstance(prm.annotation, str) else ""
+        optional = ann.startswith("Optional[") and ann.endswith("]")
+        base = ann[len("Optional["):-1] if optional else ann
+        if base in _KINDS:
+            checks[name] = (base, optional)
+
+    @functools.wraps(f)
+    def checked(*args: Any, **kwargs: Any) -> Any:
+        for name, value in sig.bind_partial(*args, **kwargs).arguments.items():
+            if name not in checks:
+                continue
+            base, optional = checks[name]
+            if value is None and optional:
+                continue
+            kind, what = _KINDS[base]
+            numeric_bool = base in ("int", "float") and isinstance(value, (bool, np.bool_))
+            if numeric_bool or not isinstance(value, kind):
+                takes = what + (" or None" if optional else "")
+                raise TypeError(
+                    f"{f.__name__}(): {name} must be {takes}, got {type(value).__name__} {value!r}"
+                )
+            if base == "int" and not -(2**63) <= int(value) < 2**63:
+                raise ValueError(f"{name} = {value}: out of range (far beyond every limit)")
+            if base == "float" and isinstance(value, numbers.Integral):
+                # float(10**400) raises OverflowError: a number out of range is a ValueError
+                try:
+                    float(value)
+                except OverflowError:
+                    digits = len(str(abs(int(value))))
+                    raise ValueError(
+                        f"{name} = an integer of {digits} digits: must be a finite number "
+                        "(far beyond every limit)"
+                    ) from None
+        return f(*args, **kwargs)
+
+    return cast(_F, checked)
+
+
+_COUNTS = frozenset(
+    "samples_per_period steps_per_period max_modes periods steps starts seed threads "
+    "max_periods max_period samples period transient blocks x_steps y_steps basin_hits "
+    "discover_after stride".split()
+)
+
+
+class AfmdynWarning(UserWarning):
+    """A computed answer with a caveat the command line prints as ``afmdyn: warning: …`` on
+    stderr (a branch that ended before the end of its range, points of a sweep that failed,
+    an energy balance that did not close); the same lines are in the summary's ``warnings``."""
+
+
+def _warn(doc: Any) -> None:
+    """Issue every line of a JSON document's ``warnings`` list as an :class:`AfmdynWarning`."""
+    if isinstance(doc, str):
+        try:
+            doc = json.loads(doc)
+        except ValueError:
+            return
+    if isinstance(doc, dict):
+        for w in doc.get("warnings") or []:
+            warnings.warn(str(w), AfmdynWarning, stacklevel=5)
+
+
+_NOT_REQUEST = frozenset(("params", "progress", "model", "store", "resume"))
+
+
+def _request(names: Dict[str, Any], **given: Any) -> Dict[str, Any]:
+    """The request of an analysis: its keywords (``names``, the function's ``locals()``), but
+    the model's, ``params``, ``progress`` and a store's, with ``given`` ones replaced."""
+    r = {k: v for k, v in names.items() if k not in _NOT_REQUEST}
+    r.update(given)
+    return r
+
+
+def _start(request: Dict[str, Any]) -> Dict[str, Any]:
+    """The request of an orbit analysis (the library's ``StartRequest``): the steady-state
+    keywords ``tol``, ``max_periods``, ``max_period`` nested under ``steady``."""
+    request["steady"] = {k: request.pop(k) for k in ("tol", "max_periods", "max_period")}
+    return request
+
+
+def _run(
+    fn: Any,
+    desc: str,
+    progress: ProgressArg,
+    p: Params,
+    si: Optional[str] = None,
+    request: Optional[Dict[str, Any]] = None,
+    **extra: Any,
+) -> Dict[str, Any]:
+    """Call the compiled ``fn`` on ``request`` (the keywords of the library's request, which
+    checks them) with a progress reporter; negative counts are a ValueError naming the option
+    (the core's unsigned integers would raise OverflowError). With ``si`` (a probe file)
+    ``fn`` gets ``probe=si``, and its JSON document the command line's ``"si"`` block (added
+    by the library's request layer)."""
+    for k, v in (request or {}).items():
+        if k in _COUNTS and isinstance(v, int) and not isinstance(v, bool) and v < 0:
+            raise ValueError(f"{k} = {v}: must be >= 0")
+    if si is not None:
+        extra["probe"] = si
+    with reporter(progress, desc) as cb:
+        d = fn(p, request, progress=cb, **extra)
+    if isinstance(d, dict):
+        _warn(d.get("json"))
+    return d
+
+
+#: The defaults of every analysis' keywords: the library's requests' (``Default``).
+_DEFAULTS = {
+    name: _core.request_defaults(name)
+    for name in (
+        "simulate converge bifurcation attractors global_continuation orbit continuation "
+        "lyapunov observe approach resonance basins chart"
+    ).split()
+}
+
+
+def summary(ds: xr.Dataset) -> Dict[str, Any]:
+    """The command line's ``--json`` document stored with a dataset afmdyn returned
+    (``simulate``, ``converge``, ``continuation``, ``approach``, ``resonance``, ``observe``,
+    ``basins``, ``global_continuation``); the same as ``ds.afmdyn.to_dict()``."""
+    return json.loads(ds.attrs["summary"])
