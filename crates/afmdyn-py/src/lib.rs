@@ -73,6 +73,18 @@ fn _afmdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
             .map(|p| (p.name, p.alias.unwrap_or(p.name), p.unit, p.range, p.help))
             .collect::<Vec<_>>(),
     )?;
+    // the columns of a bifurcation sweep's records, and their numeric form (the .npy's):
+    // (name, unit, meaning)
+    let columns = |c: &[afmdyn::request::sweep::RecordColumn]| {
+        c.iter()
+            .map(|c| (c.name, c.unit, c.meaning))
+            .collect::<Vec<_>>()
+    };
+    m.add("SWEEP_COLUMNS", columns(&afmdyn::request::sweep::COLUMNS))?;
+    m.add(
+        "SWEEP_NUMERIC_COLUMNS",
+        columns(&afmdyn::request::sweep::NUMERIC_COLUMNS),
+    )?;
     // the per-point columns of a stepped curve: (name, kind of unit or None, long name)
     m.add(
         "CURVE_COLUMNS",

@@ -17,6 +17,10 @@ FORCE_SIGN: str
 #: The per-point columns of a stepped curve (``afmdyn::report::CURVE_COLUMNS``): (name, kind of
 #: unit — "length", "force", "energy", "phase" or None for a pure number — long name).
 CURVE_COLUMNS: List[Tuple[str, Optional[str], str]]
+#: The columns of a bifurcation sweep's records (``afmdyn::request::sweep::COLUMNS``, the CSV's)
+#: and their numeric form (``NUMERIC_COLUMNS``, the ``.npy``'s): (name, unit, meaning).
+SWEEP_COLUMNS: List[Tuple[str, str, str]]
+SWEEP_NUMERIC_COLUMNS: List[Tuple[str, str, str]]
 
 class SimulationError(RuntimeError):
     """A computation failed (chattering, divergence, Newton not converging, integrator

@@ -385,33 +385,24 @@ def _sweep_dataset(p: Params, d: Dict[str, Any], starts: int, seed: int) -> xr.D
     """The long-format dataset of a sweep's columns ``d`` (``bifurcation``'s, and
     ``afmdyn.dask.bifurcation``'s)."""
     n = p.modes
-    data: Dict[str, Any] = {
-        "status": ("point", np.array(d["status"], dtype=str)),
-        "period": ("point", d["period"], {"long_name": "period n (−1 nonperiodic, −2 error)"}),
-        "k": ("point", d["k"], {"long_name": "section point within the cycle"}),
-        "n_points": ("point", d["n_points"], {"long_name": "section points of the cycle"}),
-        "tau": ("point", d["tau"], {**_T, "long_name": "section time 2πk/Ω"}),
-        "v_t": ("point", d["v_t"], {**_G, "long_name": "V_T at the section"}),
-        "w_tip": ("point", d["w_tip"], {**_G, "long_name": "W(1,τ) at τ = 2πk/Ω"}),
-        "x_max": ("point", d["x_max"], {**_G, "long_name": "X_max"}),
-        "v_t_min": ("point", d["v_t_min"], {**_G, "long_name": "min V_T"}),
-        "contact_fraction": (
-            "point",
-            d["contact_fraction"],
-            {"long_name": "fraction of time in contact"},
-        ),
-        "contacts_per_period": (
-            "point",
-            d["contacts_per_period"],
-            {"long_name": "contacts per drive period"},
-        ),
-        "transient_periods": (
-            "point",
-            d["transient_periods"],
-            {"long_name": "transient (drive periods)"},
-        ),
-        "message": ("point", np.array(d["message"], dtype=str)),
-    }
+    # units and meanings as the library declares the records' columns (bifurcation.csv and
+    # .npy); the period as its numeric code
+    cols = {name: {"units": unit, "long_name": meaning} for name, unit, meaning in _core.SWEEP_COLUMNS}
+    cols["period"] = next(
+        {"units": u, "long_name": m} for name, u, m in _core.SWEEP_NUMERIC_COLUMNS if name == "period"
+    )
+    text = {"status", "message"}
+    # the dataset's name of each column (``k``, ``n_points``: the CSV's ``point``, ``points``)
+    names = {"k": "point", "n_points": "points"}
+    data: Dict[str, Any] = {}
+    for var in ("status", "period", "k", "n_points", "tau", "v_t", "w_tip", "x_max", "v_t_min",
+                "contact_fraction", "contacts_per_period", "transient_periods", "message"):
+        col = names.get(var, var)
+        attrs = {"long_name": cols[col]["long_name"]}
+        if var not in text:
+            attrs["units"] = cols[col]["units"]
+        values = np.array(d[var], dtype=str) if var in text else d[var]
+        data[var] = ("point", values, attrs)
     for j in range(n):
         data[f"a_{j + 1}"] = (
             "point",
@@ -428,7 +419,7 @@ def _sweep_dataset(p: Params, d: Dict[str, Any], starts: int, seed: int) -> xr.D
         data_vars=data,
         coords={
             "value": ("point", d["value"], {"long_name": f"{d['symbol']} ({d['param']})"}),
-            "index": ("point", d["index"], {"long_name": "index of the value"}),
+            "index": ("point", d["index"], {"long_name": cols["index"]["long_name"]}),
             "branch": ("point", np.array(d["branch"], dtype=str)),
         },
         attrs=_attrs(p, param=d["param"], values=d["values"], starts=starts, seed=seed),
