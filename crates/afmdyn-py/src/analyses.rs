@@ -261,6 +261,28 @@ pub fn simulate<'py>(
     // with a probe every array in SI (s, m, m/s, N, J, Hz; the command line's simulate
     // files), else the model's units: factors 1 (report::SeriesUnits)
     let su = report::SeriesUnits::new(&p, probe.as_ref());
+    // the units and the series' meanings as the library declares them (timeseries.csv's)
+    let names = su.names();
+    out.set(
+        "units",
+        [
+            ("time", names.time),
+            ("time_unit", names.time_unit),
+            ("length", names.length),
+            ("velocity", names.velocity),
+            ("force", names.force),
+            ("energy", names.energy),
+        ]
+        .into_iter()
+        .collect::<std::collections::BTreeMap<_, _>>(),
+    )?;
+    out.set(
+        "long_names",
+        su.columns(c.n)
+            .into_iter()
+            .map(|col| (col.name, col.long_name))
+            .collect::<std::collections::BTreeMap<_, _>>(),
+    )?;
     let by = |v: Vec<f64>, f: &dyn Fn(f64) -> f64| -> Vec<f64> { v.into_iter().map(f).collect() };
     let (t, x, v, force, energy) = (
         |a| su.t(a),

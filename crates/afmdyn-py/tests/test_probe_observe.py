@@ -136,7 +136,8 @@ def test_simulate_with_a_probe_is_in_si_as_the_command_line(cli, tmp_path):
     period = afmdyn.probe(PM)["si"]["period_s"]
     assert abs(ds.section_tau.values[1] - ds.section_tau.values[0] - period) < 1e-9 * period
     plain = afmdyn.simulate(afmdyn.Params.from_probe(PM), periods=2)
-    assert plain.contact_force.attrs["units"] == "k g0" and plain.tau.attrs["units"] == "t0"
+    # the model's units as the library names them (report::SeriesUnits, timeseries.csv's)
+    assert plain.contact_force.attrs["units"] == "k g0" and plain.tau.attrs["units"] == "τ (eq. 5)"
 
 
 RTESPA_PS = """[cantilever]

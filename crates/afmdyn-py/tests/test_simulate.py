@@ -70,7 +70,9 @@ def test_dims_dtypes_units_and_no_copies():
     assert ds.in_contact.dtype == np.bool_
     assert ds.a.dims == ("tau", "mode") and ds.a.dtype == np.float64
     assert ds.section_state.dims == ("section", "component")
-    assert ds.w_tip.attrs["units"] == "g0" and ds.tau.attrs["units"] == "t0"
+    # the units as the library names them (report::SeriesUnits, timeseries.csv's)
+    assert ds.w_tip.attrs["units"] == "g0" and ds.tau.attrs["units"] == "τ (eq. 5)"
+    assert ds.contact_force.attrs["units"] == "EI g0/L³"
     assert ds.attrs["modes"] == 2 and ds.attrs["omega"] == 2.6
     # the arrays are the buffers Rust filled, handed over without a copy
     for name in ["w_tip", "a", "event_tau"]:

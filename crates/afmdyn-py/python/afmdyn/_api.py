@@ -123,28 +123,28 @@ def simulate(
     comp = [f"a_{j}" for j in range(1, n + 1)] + [f"a_dot_{j}" for j in range(1, n + 1)]
     # with a probe the library returned every array in SI (report::SeriesUnits)
     si = bool(d["si"])
-    point_mass = p.structure == "point-mass"
-    _t = {"units": "s", "long_name": "time t"} if si else _T
-    # the time coordinate: t in s with a probe (as timeseries.csv names it), else τ
-    time = "t" if si else "tau"
-    _g = {"units": "m"} if si else _G
-    _v = {"units": "m/s"} if si else _V
-    force = "N" if si else ("k g0" if point_mass else "E I g0/L^3")
-    energy = "J" if si else ("k g0^2" if point_mass else "E I g0^2/L^3")
+    # the units and the series' meanings as the library declares them (report::SeriesUnits,
+    # timeseries.csv's columns)
+    u, long = d["units"], d["long_names"]
+    time = u["time"]
+    _t = {"units": u["time_unit"], "long_name": long[time]}
+    _g = {"units": u["length"]}
+    _v = {"units": u["velocity"]}
+    force, energy = u["force"], u["energy"]
     freq = "Hz" if si else "Ω units (1/t0)"
     ds = xr.Dataset(
         data_vars={
-            "v_t": (time, d["v_t"], {**_g, "long_name": "tip–sample distance V_T (eq. 8)"}),
+            "v_t": (time, d["v_t"], {**_g, "long_name": long["v_t"]}),
             "v_t_dot": (time, d["v_t_dot"], {**_v, "long_name": "dV_T/dτ"}),
-            "w_tip": (time, d["w_tip"], {**_g, "long_name": "tip deflection W(1,τ)"}),
-            "w_tip_dot": (time, d["w_tip_dot"], {**_v, "long_name": "∂W(1,τ)/∂τ"}),
-            "in_contact": (time, d["in_contact"], {"long_name": "tip on the sample (region II)"}),
+            "w_tip": (time, d["w_tip"], {**_g, "long_name": long["w_tip"]}),
+            "w_tip_dot": (time, d["w_tip_dot"], {**_v, "long_name": long["w_tip_dot"]}),
+            "in_contact": (time, d["in_contact"], {"long_name": long["in_contact"]}),
             "contact_force": (
                 time,
                 d["contact_force"],
                 {
                     "units": force,
-                    "long_name": "tip–sample force F_c on the tip (> 0 repulsive)",
+                    "long_name": long["contact_force"],
                     "sign_convention": _core.FORCE_SIGN,
                 },
             ),

@@ -82,12 +82,14 @@ class Model(TypedDict, total=False):
 #: Global attributes of every dataset: the scales of the dimensionless units.
 UNITS_NOTE = (
     "dimensionless (paper eq. 5): time in t0 = sqrt(m L^4/(E I)), displacements in the beam "
-    "gap g0, forces in E I g0/L^3, energies in E I g0^2/L^3"
+    "gap g0, forces in EI g0/L³, energies in EI g0²/L³"
 )
 
-_T = {"units": "t0", "long_name": "time τ"}
+# the model's units as the library names them (afmdyn::report::SeriesNames, the command
+# line's files): τ, g0, g0 per unit τ
+_T = {"units": "τ (eq. 5)", "long_name": "time τ"}
 _G = {"units": "g0"}
-_V = {"units": "g0/t0"}
+_V = {"units": "g0 per unit τ"}
 
 
 def _params(
