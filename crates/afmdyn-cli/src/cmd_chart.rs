@@ -1,8 +1,9 @@
 //! `afmdyn chart`: a behaviour chart over two parameters (issue 29). The request, its limits,
-//! its tasks, its store and its result layout are the library's
+//! its tasks, its store, its executor and its result layout are the library's
 //! ([`afmdyn::request::chart`], [`afmdyn::analysis::chart`],
-//! [`afmdyn::request::chart_store`]); this front end parses, runs the local executor with a
-//! progress bar, and writes `chart.csv`, `chart.nc` and the maps.
+//! [`afmdyn::request::chart_store`], [`afmdyn::study`]); this front end maps the flags, runs
+//! the study with a progress bar, and writes `chart.csv`, `chart.nc` (from the layout) and the
+//! maps.
 
 use crate::args::{Dim, IntegratorArgs, ModelArgs, Quantity};
 use crate::cmd_analysis::SteadyArgs;
