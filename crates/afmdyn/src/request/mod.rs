@@ -41,6 +41,7 @@ pub mod limits;
 pub mod model;
 pub mod pool;
 pub mod run;
+pub mod simulate;
 pub mod sweep;
 
 pub use analyses::{

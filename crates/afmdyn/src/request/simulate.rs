@@ -1,0 +1,161 @@
+//! The `simulate` request ([`SimulateRequest`]): one trajectory recorded after a transient,
+//! its span and its budget by where the series goes ([`SeriesStore`], [`SimulateSpan`]).
+
+use super::analyses::{check_samples_per_period, IntegratorRequest};
+use super::limits::*;
+use crate::error::SimError;
+use crate::integrate::IntegratorOptions;
+use crate::params::Params;
+use serde::{Deserialize, Serialize};
+
+/// Where a recorded time series goes, which sets its budget.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SeriesStore {
+    /// Streamed to files in chunks: [`MAX_SERIES_BYTES`] on disk.
+    Files,
+    /// Held whole in memory (a Python call): [`MAX_SERIES_MEMORY_BYTES`].
+    Memory,
+    /// Not kept (only the summary).
+    Nothing,
+}
+
+/// `simulate`: one trajectory recorded after a transient.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[serde(default, deny_unknown_fields)]
+pub struct SimulateRequest {
+    /// Drive periods recorded after the transient (> 0); default 50 when `tau_end` is not
+    /// given either.
+    pub periods: Option<f64>,
+    /// End time τ of the run, instead of `periods`.
+    pub tau_end: Option<f64>,
+    /// Drive periods discarded before recording, >= 0.
+    pub transient: f64,
+    /// The initial state (2N values); `None`: rest.
+    pub initial: Option<Vec<f64>>,
+    /// Samples per drive period, 1..=[`MAX_SAMPLES_PER_PERIOD`].
+    pub samples_per_period: usize,
+    /// The integrator.
+    #[serde(flatten)]
+    pub integrator: IntegratorRequest,
+}
+
+impl Default for SimulateRequest {
+    fn default() -> Self {
+        SimulateRequest {
+            periods: None,
+            tau_end: None,
+            transient: 0.0,
+            initial: None,
+            samples_per_period: 200,
+            integrator: IntegratorRequest::default(),
+        }
+    }
+}
+
+/// The time span of a validated [`SimulateRequest`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SimulateSpan {
+    /// τ at which recording starts (the transient).
+    pub transient_tau: f64,
+    /// Length of the recording in τ.
+    pub record_tau: f64,
+    /// Drive periods in all, transient included.
+    pub total_periods: f64,
+    /// Samples of the recorded series (ends included).
+    pub rows: f64,
+}
+
+impl SimulateRequest {
+    /// The integrator options of the recording: the samples come from the steps' dense output
+    /// ([`crate::trajectory::record`]), so the exact grid is the one the physics needs, not a
+    /// multiple of the samples per period (both front ends record with these options, so the
+    /// command line's files and Python's arrays are the same numbers).
+    pub fn integrator_options(&self) -> IntegratorOptions {
+        self.integrator.options(1)
+    }
+
+    /// Check every option for `params` and return the span; `columns` values of
+    /// `bytes_per_value` bytes per sample are kept in `store`.
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming the option, [`SimError::Budget`] for a series beyond
+    /// the store's budget.
+    pub fn validate(
+        &self,
+        params: &Params,
+        store: SeriesStore,
+        columns: usize,
+        bytes_per_value: f64,
+    ) -> Result<SimulateSpan, SimError> {
+        check_samples_per_period(self.samples_per_period)?;
+        if !(self.transient.is_finite() && self.transient >= 0.0) {
+            return Err(SimError::out_of_range(
+                "transient",
+                self.transient,
+                "must be finite and >= 0",
+            ));
+        }
+        let period = params.period();
+        let transient_tau = self.transient * period;
+        let record_tau = match (self.periods, self.tau_end) {
+            (Some(n), Some(t)) => {
+                return Err(SimError::out_of_range(
+                    "periods",
+                    format!("{n} with tau_end = {t}"),
+                    "give periods or tau_end, not both",
+                ))
+            }
+            (Some(n), None) if n.is_finite() && n > 0.0 => n * period,
+            (Some(n), None) => {
+                return Err(SimError::out_of_range(
+                    "periods",
+                    n,
+                    "must be finite and > 0",
+                ))
+            }
+            (None, Some(t)) if t.is_finite() && t > transient_tau => t - transient_tau,
+            (None, Some(t)) => {
+                return Err(SimError::out_of_range(
+                    "tau_end",
+                    format!("{t} (the transient ends at τ = {transient_tau})"),
+                    "must be finite and > the end of the transient",
+                ))
+            }
+            (None, None) => 50.0 * period,
+        };
+        let total_periods = self.transient + record_tau / period;
+        if total_periods > MAX_RUN_PERIODS {
+            return Err(SimError::out_of_range(
+                "periods",
+                format!("{total_periods:e} with the transient"),
+                "a run may span at most 1e8 drive periods (beyond, τ no longer resolves the \
+                 integration grid)",
+            ));
+        }
+        let rows = (record_tau / period * self.samples_per_period as f64).floor() + 1.0;
+        let budget = match store {
+            SeriesStore::Files => MAX_SERIES_BYTES,
+            SeriesStore::Memory => MAX_SERIES_MEMORY_BYTES,
+            SeriesStore::Nothing => f64::INFINITY,
+        };
+        let bytes = rows * columns as f64 * bytes_per_value;
+        if bytes > budget {
+            return Err(SimError::Budget {
+                what: "the time series",
+                needed: format!(
+                    "{:.1} GB ({rows:.3e} samples × {columns} columns)",
+                    bytes / 1e9
+                ),
+                budget: format!("{:.0} GiB", budget / (1024.0 * 1024.0 * 1024.0)),
+                hint: "lower periods or samples_per_period, or keep no time series",
+            });
+        }
+        Ok(SimulateSpan {
+            transient_tau,
+            record_tau,
+            total_periods,
+            rows,
+        })
+    }
+}
