@@ -654,3 +654,52 @@ fn a_budget_refusal_exits_2_in_every_analysis() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn help_shows_the_defaults_and_errors_keep_the_hint() {
+    let o = afmdyn(&["simulate", "--help"]);
+    assert!(o.status.success());
+    let help = String::from_utf8_lossy(&o.stdout)
+        .split_whitespace()
+        .collect::<Vec<_>>()
+        .join(" ");
+    let d = afmdyn::Params::default();
+    for (flag, text) in [
+        ("--modes", format!("[default: {}]", d.modes)),
+        ("--tip-mass-ratio", format!("[default: {}]", d.alpha1)),
+        ("--drive-amplitude", format!("[default: {}]", d.alpha2)),
+        ("--beam-damping", format!("[default: {}]", d.alpha3)),
+        ("--contact-stiffness", format!("[default: {}]", d.alpha4)),
+        ("--gap", format!("[default: {}]", d.alpha5)),
+        ("--contact-damping", format!("[default: {}]", d.alpha6)),
+        ("--omega", format!("[default: {}", d.omega)),
+        ("--periods", "[default: 50]".to_string()),
+    ] {
+        let at = help
+            .find(&format!("{flag} <"))
+            .unwrap_or_else(|| panic!("{flag} in {help}"));
+        let next = help[at + 2..]
+            .find(" --")
+            .map_or(help.len(), |k| at + 2 + k);
+        assert!(
+            help[at..next].contains(&text),
+            "{flag}: {}",
+            &help[at..next]
+        );
+    }
+    bad_input(&["simulate", "--omgea", "3"], "--omega");
+}
+
+#[test]
+fn toml_errors_give_the_line_and_name_a_duplicate_key() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = dir.path().join("m.toml");
+    std::fs::write(&cfg, "modes = 3\nomega = 2.0\nomega = 3.0\n").unwrap();
+    let args = ["modes", "--config", cfg.to_str().unwrap()];
+    bad_input(&args, "line 3");
+    bad_input(&args, "duplicate key `omega`");
+    std::fs::write(&cfg, "modes = 3\n\nalpha1 = = 2\n").unwrap();
+    bad_input(&args, "line 3");
+    std::fs::write(&cfg, "modes = 3\nstiffnes = 3.0\n").unwrap();
+    bad_input(&args, "line 2");
+}

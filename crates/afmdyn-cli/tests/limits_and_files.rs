@@ -733,62 +733,6 @@ fn continue_ends_a_switched_branch_at_the_period_doubling_it_returns_to() {
 }
 
 #[test]
-fn help_shows_the_defaults_and_errors_keep_the_hint() {
-    let dir = tempfile::tempdir().unwrap();
-    let o = run_in(&["simulate", "--help"], dir.path(), 10);
-    assert!(o.status.success());
-    let help = String::from_utf8_lossy(&o.stdout)
-        .split_whitespace()
-        .collect::<Vec<_>>()
-        .join(" ");
-    let d = afmdyn::Params::default();
-    for (flag, text) in [
-        ("--modes", format!("[default: {}]", d.modes)),
-        ("--tip-mass-ratio", format!("[default: {}]", d.alpha1)),
-        ("--drive-amplitude", format!("[default: {}]", d.alpha2)),
-        ("--beam-damping", format!("[default: {}]", d.alpha3)),
-        ("--contact-stiffness", format!("[default: {}]", d.alpha4)),
-        ("--gap", format!("[default: {}]", d.alpha5)),
-        ("--contact-damping", format!("[default: {}]", d.alpha6)),
-        ("--omega", format!("[default: {}", d.omega)),
-        ("--periods", "[default: 50]".to_string()),
-    ] {
-        let at = help
-            .find(&format!("{flag} <"))
-            .unwrap_or_else(|| panic!("{flag} in {help}"));
-        let next = help[at + 2..]
-            .find(" --")
-            .map_or(help.len(), |k| at + 2 + k);
-        assert!(
-            help[at..next].contains(&text),
-            "{flag}: {}",
-            &help[at..next]
-        );
-    }
-    let args = ["simulate", "--omgea", "3"];
-    refused(&run_in(&args, dir.path(), 10), &args, "--omega");
-}
-
-#[test]
-fn toml_errors_give_the_line_and_name_a_duplicate_key() {
-    let dir = tempfile::tempdir().unwrap();
-    let cfg = dir.path().join("m.toml");
-    std::fs::write(&cfg, "modes = 3\nomega = 2.0\nomega = 3.0\n").unwrap();
-    let args = ["modes", "--config", s(&cfg)];
-    let o = run_in(&args, dir.path(), 10);
-    refused(&o, &args, "line 3");
-    assert!(
-        stderr(&o).contains("duplicate key `omega`"),
-        "{}",
-        stderr(&o)
-    );
-    std::fs::write(&cfg, "modes = 3\n\nalpha1 = = 2\n").unwrap();
-    refused(&run_in(&args, dir.path(), 10), &args, "line 3");
-    std::fs::write(&cfg, "modes = 3\nstiffnes = 3.0\n").unwrap();
-    refused(&run_in(&args, dir.path(), 10), &args, "line 2");
-}
-
-#[test]
 fn a_short_lyapunov_run_says_it_is_too_short() {
     let dir = tempfile::tempdir().unwrap();
     let o = run_in(
