@@ -211,84 +211,14 @@ pub trait Integrator: Send {
         *out = self.last_step_jacobian()?;
         Ok(())
     }
-    /// Whether [`Integrator::region_transition_into`] gives the transition matrix of region `r`
-    /// (the default: no).
-    fn has_region_transition(&self, r: Region) -> bool {
-        let _ = r;
-        false
-    }
-    /// Transition matrix e^{A_r t} = ∂z(τ + t)/∂z(τ) of the flow that stays in region `r` for a
-    /// time t ≥ 0, any number of steps long, written into `out` (resized to 2N×2N): for an
-    /// affine region ż = A_r z + b_r(τ) it does not depend on τ or z, so the Jacobian of a
-    /// whole stint between two events is one matrix instead of the product of its step
-    /// Jacobians. `false`, with `out` untouched, where the integrator does not provide it (the
-    /// default; the exact propagator provides it for a region with an eigendecomposition,
-    /// [`Integrator::has_region_transition`]).
-    fn region_transition_into(&self, r: Region, t: f64, out: &mut DMatrix<f64>) -> bool {
-        let _ = (r, t, out);
-        false
-    }
-    /// ∂z(τ1)/∂p of the last step [τ0, τ1] inside its region, at fixed z(τ0), τ0 and τ1, written
-    /// into `out` (resized to `[2N]`), for a parameter p that enters the forcing only (Ω, α2,
-    /// α5; [`crate::model::CantileverModel::forcing_derivative`]). With the step Jacobians J and the event
-    /// shifts of [`crate::system::saltation_with_shift`] it gives the parameter sensitivity of
-    /// a flow, s ← J s + this (see [`crate::analysis::monodromy::flow_with_param_derivative`]).
-    /// `Ok(false)`, with `out` untouched, where the integrator does not provide it (the default;
-    /// the exact propagator provides it for Ω, α2 and α5).
-    ///
-    /// # Errors
-    /// As [`Integrator::last_step_jacobian`].
-    fn last_step_param_derivative_into(
-        &mut self,
-        param: SweepParam,
-        out: &mut DVector<f64>,
-    ) -> Result<bool, SimError> {
-        let _ = (param, out);
-        Ok(false)
-    }
-    /// ∂z_p/∂p(τ) of the periodic particular solution z_p of region `r` (eq. 10), written into
-    /// `out` (resized to `[2N]`), for a parameter p that enters the forcing only (Ω, α2, α5;
-    /// [`crate::model::CantileverModel::forcing_derivative`]). In a region with a transition matrix
-    /// ([`Integrator::has_region_transition`]) the flow is z(τ) = z_p(τ) + e^{A_r t}(z(τ0) −
-    /// z_p(τ0)) with A_r independent of p, so over a whole stint the parameter sensitivity
-    /// telescopes to s(τ) = e^{A_r t}(s(τ0) − ∂z_p/∂p(τ0)) + ∂z_p/∂p(τ) — one product per stint
-    /// instead of one per step ([`crate::analysis::monodromy::flow_with_param_derivative`]).
-    /// `Ok(false)`, with `out` untouched, where the integrator does not provide it (the
-    /// default; the exact propagator provides it for Ω, α2 and α5).
-    ///
-    /// # Errors
-    /// As [`Integrator::last_step_param_derivative_into`].
-    fn region_particular_param_derivative_into(
-        &mut self,
-        param: SweepParam,
-        r: Region,
-        tau: f64,
-        out: &mut DVector<f64>,
-    ) -> Result<bool, SimError> {
-        let _ = (param, r, tau, out);
-        Ok(false)
-    }
     /// The integrals over the last step of the energy-balance rates of
-    /// [`crate::model::CantileverModel::power`] — [base work, beam dissipation, sample dissipation] — where the
-    /// integrator has them in closed form; `None` (the default) where the caller integrates
-    /// them by quadrature of the dense output. The exact propagator has them for whole grid
-    /// steps (`integrate/exact/energy.rs`).
+    /// [`crate::model::CantileverModel::power`] — [base work, beam dissipation, sample
+    /// dissipation] — where the integrator has them in closed form; `None` (the default) where
+    /// the caller integrates them by quadrature of the dense output. The exact propagator has
+    /// them for whole grid steps (`integrate/exact/energy.rs`), the Taylor integrator from its
+    /// series.
     fn last_step_rate_integrals(&mut self) -> Option<[f64; 3]> {
         None
-    }
-    /// The last step's own smooth time over a piece [a, b] of it: τ(u) and dτ/du for
-    /// u ∈ [0, 1], τ(0) = a, τ(1) = b, along a variable in which the solution is smooth, so
-    /// that a quadrature over the piece in u converges as for a smooth integrand (∫_a^b f dτ =
-    /// ∫_0^1 f(τ(u)) τ′(u) du). The default is τ itself, a + u(b − a); the Taylor
-    /// integrator's contact steps are smooth in their regularising time σ (τ − τ_c ∝ σ² at the
-    /// contact onset, where the Hertz force ∝ (τ − τ_c)^{3/2} is not smooth in τ).
-    fn smooth_time(&mut self, a: f64, b: f64, u: f64) -> (f64, f64) {
-        (a + u * (b - a), b - a)
-    }
-    /// Whether [`Integrator::smooth_time`] is τ itself over the last step (the default; not in
-    /// the Taylor integrator's σ steps).
-    fn smooth_time_is_tau(&self) -> bool {
-        true
     }
     /// Integrate the variational equations along with the state (needed by
     /// [`Integrator::last_step_jacobian`] of the adaptive integrator; free for the exact one).
@@ -303,39 +233,99 @@ pub trait Integrator: Send {
     fn work(&self) -> u64 {
         0
     }
-    /// [W(1,τ), ∂W(1,τ)/∂τ, V_T, dV_T/dτ] at the current state. The default forms them from
-    /// [`Integrator::state`] ([`TipSampleSystem::tip_values`], where the equations are); the exact
-    /// propagator takes V_T from its switching test and W from its modal coordinates, without
-    /// forming the plain state (equal to round-off).
-    fn tip_values(&self) -> [f64; 4] {
-        self.system().tip_values(self.tau(), self.state())
+    /// The affine regions' transition matrices and parameter derivatives, where the integrator
+    /// has them ([`AffineRegions`]: the exact propagator, the split integrator's free flight);
+    /// `None` (the default) otherwise.
+    fn affine(&mut self) -> Option<&mut dyn AffineRegions> {
+        None
     }
-    /// An upper bound of Σ_j c_j |a_j| at the current state (`weights` c_j ≥ 0, shape `[N]`, a
-    /// the modal displacements), for a caller that needs to know whether the sum is below
-    /// `enough`: an integrator may return a cheaper, looser bound when it is below `enough`,
-    /// and otherwise returns its tightest (pass 0 for the tightest). The default forms the sum
-    /// from [`Integrator::state`] ([`crate::model::weighted_displacement`]); the exact
-    /// propagator bounds it from its modal coordinates without forming the plain state.
-    fn displacement_bound(&mut self, weights: &[f64], enough: f64) -> f64 {
-        let _ = enough;
-        crate::model::weighted_displacement(weights, self.state().as_slice())
+    /// Steps whose plain state is formed on demand, and spans of them ([`Spans`]: the exact
+    /// propagator's modal coordinates, the split integrator); `None` (the default) where every
+    /// step forms its state ([`Integrator::step`] is then the only way to step).
+    fn spans(&mut self) -> Option<&mut dyn Spans> {
+        None
     }
+    /// The last step's own smooth time ([`SmoothTime`]) where it is not τ itself (the Taylor
+    /// integrator's contact steps in their regularising time σ); `None` (the default) where
+    /// τ is the step's smooth time.
+    fn smooth_time(&mut self) -> Option<&mut dyn SmoothTime> {
+        None
+    }
+}
+
+/// The capability of an integrator of affine regions ż = A_r z + b_r(τ) ([`Integrator::affine`]):
+/// the transition matrix of a whole stint in a region, and the derivatives of a step and of a
+/// region's particular solution with respect to a parameter that enters the forcing only.
+pub trait AffineRegions {
+    /// Whether [`AffineRegions::region_transition_into`] gives the transition matrix of region
+    /// `r`.
+    fn has_region_transition(&self, r: Region) -> bool;
+    /// Transition matrix e^{A_r t} = ∂z(τ + t)/∂z(τ) of the flow that stays in region `r` for a
+    /// time t ≥ 0, any number of steps long, written into `out` (resized to 2N×2N): for an
+    /// affine region ż = A_r z + b_r(τ) it does not depend on τ or z, so the Jacobian of a
+    /// whole stint between two events is one matrix instead of the product of its step
+    /// Jacobians. `false`, with `out` untouched, where the integrator does not provide it for
+    /// `r` (the exact propagator provides it for a region with an eigendecomposition,
+    /// [`AffineRegions::has_region_transition`]).
+    fn region_transition_into(&self, r: Region, t: f64, out: &mut DMatrix<f64>) -> bool;
+    /// ∂z(τ1)/∂p of the last step [τ0, τ1] inside its region, at fixed z(τ0), τ0 and τ1, written
+    /// into `out` (resized to `[2N]`), for a parameter p that enters the forcing only (Ω, α2,
+    /// α5; [`crate::model::CantileverModel::forcing_derivative`]). With the step Jacobians J
+    /// and the event shifts of [`crate::system::saltation_with_shift`] it gives the parameter
+    /// sensitivity of a flow, s ← J s + this (see
+    /// [`crate::analysis::monodromy::flow_with_param_derivative`]). `Ok(false)`, with `out`
+    /// untouched, where the integrator does not provide it for this step or parameter (the
+    /// exact propagator provides it for Ω, α2 and α5).
+    ///
+    /// # Errors
+    /// As [`Integrator::last_step_jacobian`].
+    fn last_step_param_derivative_into(
+        &mut self,
+        param: SweepParam,
+        out: &mut DVector<f64>,
+    ) -> Result<bool, SimError>;
+    /// ∂z_p/∂p(τ) of the periodic particular solution z_p of region `r` (eq. 10), written into
+    /// `out` (resized to `[2N]`), for a parameter p that enters the forcing only (Ω, α2, α5;
+    /// [`crate::model::CantileverModel::forcing_derivative`]). In a region with a transition
+    /// matrix ([`AffineRegions::has_region_transition`]) the flow is z(τ) = z_p(τ) +
+    /// e^{A_r t}(z(τ0) − z_p(τ0)) with A_r independent of p, so over a whole stint the
+    /// parameter sensitivity telescopes to s(τ) = e^{A_r t}(s(τ0) − ∂z_p/∂p(τ0)) + ∂z_p/∂p(τ)
+    /// — one product per stint instead of one per step
+    /// ([`crate::analysis::monodromy::flow_with_param_derivative`]). `Ok(false)`, with `out`
+    /// untouched, where the integrator does not provide it (the exact propagator provides it
+    /// for Ω, α2 and α5).
+    ///
+    /// # Errors
+    /// As [`AffineRegions::last_step_param_derivative_into`].
+    fn region_particular_param_derivative_into(
+        &mut self,
+        param: SweepParam,
+        r: Region,
+        tau: f64,
+        out: &mut DVector<f64>,
+    ) -> Result<bool, SimError>;
+}
+
+/// The capability of an integrator that keeps its state in its own representation between
+/// steps ([`Integrator::spans`]; the exact propagator's modal coordinates): steps after which
+/// the plain state is formed on demand, spans of several steps, an unobserved advance, and the
+/// tip values and a displacement bound without the plain state. Bit for bit the steps, events
+/// and states of [`Integrator::step`]; a measured optimisation of the observed and recorded
+/// runs at large N (docs/performance.md).
+pub trait Spans {
     /// One step as [`Integrator::step`], after which the plain state may lag behind the
-    /// integrator's own representation until [`Integrator::form_state`]: [`Integrator::state`]
-    /// is then not the current state. The default is `step` (the state always formed). Called
-    /// by [`advance_observed`], whose observers see the integrator through [`Observed`], which
-    /// forms the state before handing it out.
+    /// integrator's own representation until [`Spans::form_state`]: [`Integrator::state`] is
+    /// then not the current state. Called by [`advance_observed`], whose observers see the
+    /// integrator through [`Observed`], which forms the state before handing it out.
     ///
     /// # Errors
     /// As [`Integrator::step`].
-    fn step_deferred(&mut self, tau_max: f64) -> Result<Step, SimError> {
-        self.step(tau_max)
-    }
-    /// Form the plain state after [`Integrator::step_deferred`] (the default: nothing to do).
-    fn form_state(&mut self) {}
-    /// One or more of the steps [`Integrator::step_deferred`] takes, reported as one step over
-    /// all of them, from the first one's start (a *span*): the span goes on while no step ends
-    /// at `tau_max` or at an event, and — given a body-contact check `body` — only while the
+    fn step_deferred(&mut self, tau_max: f64) -> Result<Step, SimError>;
+    /// Form the plain state after [`Spans::step_deferred`].
+    fn form_state(&mut self);
+    /// One or more of the steps [`Spans::step_deferred`] takes, reported as one step over all
+    /// of them, from the first one's start (a *span*): the span goes on while no step ends at
+    /// `tau_max` or at an event, and — given a body-contact check `body` — only while the
     /// integrator shows, without forming the state, that no station of the beam body reaches
     /// the substrate at any time of the span (so that a caller testing
     /// [`BodyContactCheck::touches`] after every step tests the span's end only). After it,
@@ -356,27 +346,91 @@ pub trait Integrator: Send {
         self.step_deferred(tau_max)
     }
     /// Advance to exactly `tau_end` without observing the steps: the same steps and events as
-    /// calling [`Integrator::step`] until `tau_end`, but an integrator may keep its state in an
-    /// internal representation in between (the exact propagator's modal coordinates).
+    /// calling [`Integrator::step`] until `tau_end`, the state kept in the integrator's own
+    /// representation in between and formed at the end.
     ///
     /// # Errors
     /// As [`Integrator::step`].
-    fn advance_to(&mut self, tau_end: f64) -> Result<(), SimError> {
-        while self.tau() < tau_end {
-            self.step(tau_end)?;
-        }
-        Ok(())
+    fn advance_to(&mut self, tau_end: f64) -> Result<(), SimError>;
+    /// [W(1,τ), ∂W(1,τ)/∂τ, V_T, dV_T/dτ] at the current state, without forming the plain
+    /// state (equal to round-off to [`TipSampleSystem::tip_values`] of the formed state; the
+    /// exact propagator takes V_T from its switching test and W from its modal coordinates).
+    fn tip_values(&self) -> [f64; 4];
+    /// An upper bound of Σ_j c_j |a_j| at the current state (`weights` c_j ≥ 0, shape `[N]`, a
+    /// the modal displacements), for a caller that needs to know whether the sum is below
+    /// `enough`: a cheaper, looser bound when it is below `enough`, and otherwise the tightest
+    /// (pass 0 for the tightest), without forming the plain state.
+    fn displacement_bound(&mut self, weights: &[f64], enough: f64) -> f64;
+}
+
+/// The capability of an integrator whose last step is smooth in another time than τ
+/// ([`Integrator::smooth_time`]; the Taylor integrator's contact steps in their regularising
+/// time σ, τ − τ_c ∝ σ² at the contact onset, where the Hertz force ∝ (τ − τ_c)^{3/2} is not
+/// smooth in τ).
+pub trait SmoothTime {
+    /// The last step's own smooth time over a piece [a, b] of it: τ(u) and dτ/du for
+    /// u ∈ [0, 1], τ(0) = a, τ(1) = b, so that a quadrature over the piece in u converges as
+    /// for a smooth integrand (∫_a^b f dτ = ∫_0^1 f(τ(u)) τ′(u) du).
+    fn tau_of(&mut self, a: f64, b: f64, u: f64) -> (f64, f64);
+}
+
+/// The last step's smooth time over a piece [a, b] of it ([`SmoothTime::tau_of`]), τ itself,
+/// a + u(b − a), where the integrator has no other ([`Integrator::smooth_time`]).
+pub fn smooth_time(integ: &mut dyn Integrator, a: f64, b: f64, u: f64) -> (f64, f64) {
+    match integ.smooth_time() {
+        Some(s) => s.tau_of(a, b, u),
+        None => (a + u * (b - a), b - a),
     }
 }
 
-/// Advance `integ` to exactly `tau_end` ([`Integrator::advance_to`]); use it instead of
+/// One step, or a span of steps where the integrator has them ([`Spans::step_span`]; otherwise
+/// [`Integrator::step`]).
+///
+/// # Errors
+/// As [`Integrator::step`].
+pub fn step_span(
+    integ: &mut dyn Integrator,
+    tau_max: f64,
+    body: Option<&BodyContactCheck>,
+) -> Result<Step, SimError> {
+    match integ.spans() {
+        Some(s) => s.step_span(tau_max, body),
+        None => integ.step(tau_max),
+    }
+}
+
+/// Form the plain state after [`Spans::step_deferred`] or [`step_span`] (nothing to do for an
+/// integrator without [`Spans`]).
+pub fn form_state(integ: &mut dyn Integrator) {
+    if let Some(s) = integ.spans() {
+        s.form_state();
+    }
+}
+
+/// [`Spans::tip_values`] where the integrator has spans, else [`TipSampleSystem::tip_values`]
+/// of its state.
+pub fn tip_values(integ: &mut dyn Integrator) -> [f64; 4] {
+    match integ.spans() {
+        Some(s) => s.tip_values(),
+        None => integ.system().tip_values(integ.tau(), integ.state()),
+    }
+}
+
+/// Advance `integ` to exactly `tau_end` ([`Spans::advance_to`] where the integrator has spans,
+/// else [`Integrator::step`] until there); use it instead of
 /// [`advance_dyn`] with an observer that does nothing.
 ///
 /// # Errors
 /// As [`Integrator::step`]; [`SimError::NotFinite`] for a non-finite `tau_end`.
 pub fn advance(integ: &mut dyn Integrator, tau_end: f64) -> Result<(), SimError> {
     crate::error::finite("tau_end", tau_end)?;
-    integ.advance_to(tau_end)
+    if let Some(s) = integ.spans() {
+        return s.advance_to(tau_end);
+    }
+    while integ.tau() < tau_end {
+        integ.step(tau_end)?;
+    }
+    Ok(())
 }
 
 /// Advance `integ` to exactly `tau_end`, calling `on_step(integ, step, z_before)` after every
@@ -425,18 +479,22 @@ impl<'a> Observed<'a> {
     pub fn region(&self) -> Region {
         self.integ.region()
     }
-    /// [W(1,τ), ∂W(1,τ)/∂τ, V_T, dV_T/dτ] at the current state ([`Integrator::tip_values`]).
-    pub fn tip_values(&self) -> [f64; 4] {
-        self.integ.tip_values()
+    /// [W(1,τ), ∂W(1,τ)/∂τ, V_T, dV_T/dτ] at the current state ([`tip_values`]).
+    pub fn tip_values(&mut self) -> [f64; 4] {
+        tip_values(self.integ)
     }
     /// An upper bound of Σ_j c_j |a_j| at the current state, possibly a looser one below
-    /// `enough` ([`Integrator::displacement_bound`]).
+    /// `enough` ([`Spans::displacement_bound`] where the integrator has spans, else the sum
+    /// formed from the state, [`crate::model::weighted_displacement`]).
     pub fn displacement_bound(&mut self, weights: &[f64], enough: f64) -> f64 {
-        self.integ.displacement_bound(weights, enough)
+        match self.integ.spans() {
+            Some(s) => s.displacement_bound(weights, enough),
+            None => crate::model::weighted_displacement(weights, self.integ.state().as_slice()),
+        }
     }
     /// The current state z = (a, ȧ), shape `[2N]`, formed if it lags behind.
     pub fn state(&mut self) -> &DVector<f64> {
-        self.integ.form_state();
+        form_state(self.integ);
         self.integ.state()
     }
     /// [`Integrator::dense_tip`] inside the last step.
@@ -515,12 +573,15 @@ pub fn advance_observed(
     let mut run = || -> Result<(), SimError> {
         obs.start(&mut Observed { integ: &mut *integ })?;
         while integ.tau() < tau_end {
-            let step = integ.step_deferred(tau_end)?;
+            let step = match integ.spans() {
+                Some(s) => s.step_deferred(tau_end)?,
+                None => integ.step(tau_end)?,
+            };
             obs.step(&mut Observed { integ: &mut *integ }, &step)?;
         }
         Ok(())
     };
     let out = run();
-    integ.form_state();
+    form_state(integ);
     out
 }
