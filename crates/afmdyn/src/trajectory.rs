@@ -291,7 +291,7 @@ pub fn record(integ: &mut dyn Integrator, spec: &RecordSpec) -> Result<Trajector
 /// [`record`] with the samples written into `rows` (cleared first) instead of
 /// [`Trajectory::samples`], which stays empty: no allocation per sample.
 ///
-/// The integrator takes its own steps, in spans ([`Integrator::step_span`]: the exact
+/// The integrator takes its own steps, in spans ([`crate::integrate::Spans::step_span`]: the exact
 /// propagator's natural grid, a span ending only at the drive-period sections, the end,
 /// switchings, and where its bound of the beam's displacement does not keep the body off the
 /// substrate), and the samples τ_i = start + i·T/S inside each span are formed from its dense
@@ -383,7 +383,7 @@ pub fn record_rows(
     while integ.tau() < end {
         let next_section = k_period as f64 * period;
         // a span proven free of body contact is checked at its end only
-        let step = integ.step_span(end.min(next_section), body.as_ref())?;
+        let step = crate::integrate::step_span(integ, end.min(next_section), body.as_ref())?;
         let closed = if spec.energy && step.tau1 > step.tau0 {
             integ.last_step_rate_integrals()
         } else {
@@ -446,7 +446,7 @@ pub fn record_rows(
             if t <= limit {
                 // at the step's end (after an event), or beyond the end by round-off: the
                 // state there
-                integ.form_state();
+                crate::integrate::form_state(integ);
                 let sc = (model.omega() * tau1).sin_cos();
                 rows.push(&model, integ.region(), tau1, sc, integ.state().as_slice());
                 i_next += 1;
@@ -471,7 +471,7 @@ pub fn record_rows(
             out.events.push(e);
         }
         if spec.energy && (tau >= next_energy_cut || (tau - next_energy_cut).abs() <= tol(tau)) {
-            integ.form_state();
+            crate::integrate::form_state(integ);
             let z = integ.state();
             acc.e_end = model.energy(step.region, tau, z);
             out.energy.push(acc);
@@ -491,11 +491,11 @@ pub fn record_rows(
             next_energy_cut += period;
         }
         if at_section(tau, k_period) {
-            integ.form_state();
+            crate::integrate::form_state(integ);
             record_section(tau, integ.state(), &mut out, &mut k_period);
         }
     }
-    integ.form_state();
+    crate::integrate::form_state(integ);
     out.tau_end = integ.tau();
     out.final_state = integ.state().clone();
     out.final_region = integ.region();

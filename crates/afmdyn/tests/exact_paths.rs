@@ -13,7 +13,8 @@ mod common;
 use afmdyn::galerkin::Region;
 use afmdyn::integrate::exact::{ExactOptions, ExactPropagator, Propagation};
 use afmdyn::integrate::{
-    advance, advance_dyn, advance_observed, Integrator, Observed, Observer, Step, SwitchEvent,
+    advance, advance_dyn, advance_observed, Integrator, Observed, Observer, Spans, Step,
+    SwitchEvent,
 };
 use afmdyn::model::weighted_displacement;
 use afmdyn::SimError;

@@ -745,28 +745,50 @@ impl afmdyn::integrate::Integrator for PerStep<'_> {
     fn last_step_jacobian(&mut self) -> Result<DMatrix<f64>, afmdyn::SimError> {
         self.0.last_step_jacobian()
     }
-    fn last_step_param_derivative_into(
-        &mut self,
-        param: SweepParam,
-        out: &mut DVector<f64>,
-    ) -> Result<bool, afmdyn::SimError> {
-        self.0.last_step_param_derivative_into(param, out)
+    fn affine(&mut self) -> Option<&mut dyn afmdyn::integrate::AffineRegions> {
+        Some(self)
     }
     fn name(&self) -> &'static str {
         "exact, per step"
     }
 }
 
+/// The per-step parameter derivative of the exact propagator, without its region transitions.
+impl afmdyn::integrate::AffineRegions for PerStep<'_> {
+    fn has_region_transition(&self, _: Region) -> bool {
+        false
+    }
+    fn region_transition_into(&self, _: Region, _: f64, _: &mut DMatrix<f64>) -> bool {
+        false
+    }
+    fn last_step_param_derivative_into(
+        &mut self,
+        param: SweepParam,
+        out: &mut DVector<f64>,
+    ) -> Result<bool, afmdyn::SimError> {
+        afmdyn::integrate::AffineRegions::last_step_param_derivative_into(self.0, param, out)
+    }
+    fn region_particular_param_derivative_into(
+        &mut self,
+        _: SweepParam,
+        _: Region,
+        _: f64,
+        _: &mut DVector<f64>,
+    ) -> Result<bool, afmdyn::SimError> {
+        Ok(false)
+    }
+}
+
 /// The monodromy matrix and the parameter sensitivity ∂Pⁿ/∂p from one transition matrix
-/// e^{A_s t} per stint between events ([`afmdyn::integrate::Integrator::region_transition_into`],
+/// e^{A_s t} per stint between events ([`afmdyn::integrate::AffineRegions::region_transition_into`],
 /// the sensitivity telescoped over the stint with
-/// [`afmdyn::integrate::Integrator::region_particular_param_derivative_into`]) equal the product
+/// [`afmdyn::integrate::AffineRegions::region_particular_param_derivative_into`]) equal the product
 /// of the step Jacobians and the per-step sensitivity terms, events included; and the region
 /// transition obeys the semigroup law e^{A(s+t)} = e^{As} e^{At} and equals the grid step's Φ_s
 /// at t = h.
 #[test]
 fn stint_transitions_equal_the_product_of_step_jacobians() {
-    use afmdyn::integrate::Integrator;
+    use afmdyn::integrate::AffineRegions;
     for (modes, omega, n) in [(3, 3.5, 1), (3, 2.6, 2), (8, 3.5, 1)] {
         let m = model(Params {
             modes,

@@ -35,8 +35,8 @@ pub struct FlowMap {
     /// of the product.
     pub log_volume: f64,
     /// ∂z(τ1)/∂p at fixed τ1, shape `[2N]`, when asked for ([`flow_with_param_derivative`]) and
-    /// the integrator provides it ([`Integrator::last_step_param_derivative_into`] per step,
-    /// [`Integrator::region_particular_param_derivative_into`] per stint); else `None`.
+    /// the integrator provides it ([`crate::integrate::AffineRegions::last_step_param_derivative_into`] per step,
+    /// [`crate::integrate::AffineRegions::region_particular_param_derivative_into`] per stint); else `None`.
     pub param_derivative: Option<DVector<f64>>,
 }
 
@@ -58,7 +58,7 @@ pub fn flow_with_jacobian(
 /// [`FlowMap::param_derivative`]: s(τ0) = 0, s ← J s + ∂z(τ_b)/∂p|_{z(τ_a)} over each step
 /// (variational equation of the parameter, Hairer, Nørsett & Wanner, *Solving ODEs I*, §I.14)
 /// — over a whole stint at once in an affine region
-/// ([`Integrator::region_particular_param_derivative_into`]) — and s⁺ = S s⁻ + w ∂g/∂p at each
+/// ([`crate::integrate::AffineRegions::region_particular_param_derivative_into`]) — and s⁺ = S s⁻ + w ∂g/∂p at each
 /// event ([`crate::system::saltation_with_shift`]). `None` there when the integrator or the law
 /// does not provide it (then ∂z/∂p needs finite differences).
 ///
@@ -122,17 +122,24 @@ fn flow(
             continue;
         }
         // a stint in a region with a transition matrix for any duration (affine,
-        // [`Integrator::region_transition_into`]) takes one Jacobian e^{A_r t} at its end
+        // [`crate::integrate::AffineRegions::region_transition_into`]) takes one Jacobian e^{A_r t} at its end
         // instead of one product per step, and the parameter sensitivity telescopes over it
-        // ([`Integrator::region_particular_param_derivative_into`]: ∂z_p/∂p at its start now)
-        if stint.is_none() && integ.has_region_transition(step.region) {
+        // ([`crate::integrate::AffineRegions::region_particular_param_derivative_into`]: ∂z_p/∂p at its start now)
+        if stint.is_none()
+            && integ
+                .affine()
+                .is_some_and(|a| a.has_region_transition(step.region))
+        {
             let open = match param {
-                Some(p) => integ.region_particular_param_derivative_into(
-                    p,
-                    step.region,
-                    step.tau0,
-                    &mut step_dp,
-                )?,
+                Some(p) => match integ.affine() {
+                    Some(a) => a.region_particular_param_derivative_into(
+                        p,
+                        step.region,
+                        step.tau0,
+                        &mut step_dp,
+                    )?,
+                    None => false,
+                },
                 None => true,
             };
             if open {
@@ -143,7 +150,11 @@ fn flow(
             integ.last_step_jacobian_into(&mut step_jac)?;
             left_mul(&step_jac, &mut jac, &mut prod);
             if let Some(p) = param {
-                if integ.last_step_param_derivative_into(p, &mut step_dp)? {
+                let given = match integ.affine() {
+                    Some(a) => a.last_step_param_derivative_into(p, &mut step_dp)?,
+                    None => false,
+                };
+                if given {
                     tmp.gemv(1.0, &step_jac, &sens, 0.0);
                     sens.copy_from(&tmp);
                     sens += &step_dp;
@@ -209,23 +220,25 @@ fn left_mul(j: &DMatrix<f64>, m: &mut DMatrix<f64>, prod: &mut DMatrix<f64>) {
 }
 
 /// M ← e^{A_r t} M for a stint of length t in region r
-/// ([`Integrator::region_transition_into`], which [`Integrator::has_region_transition`]
+/// ([`crate::integrate::AffineRegions::region_transition_into`], which [`crate::integrate::AffineRegions::has_region_transition`]
 /// promised), with `scratch` for the transition matrix.
 fn close_stint(
-    integ: &dyn Integrator,
+    integ: &mut dyn Integrator,
     r: Region,
     t: f64,
     scratch: &mut DMatrix<f64>,
     m: &mut DMatrix<f64>,
     prod: &mut DMatrix<f64>,
 ) {
-    let done = integ.region_transition_into(r, t, scratch);
+    let done = integ
+        .affine()
+        .is_some_and(|a| a.region_transition_into(r, t, scratch));
     debug_assert!(done, "has_region_transition promised the transition");
     left_mul(scratch, m, prod);
 }
 
 /// s ← e^{A_r t}(s − ∂z_p/∂p(τ0)) + ∂z_p/∂p(τ) at the end τ of a stint in region r that
-/// started at τ0 (see [`Integrator::region_particular_param_derivative_into`]): `phi` holds
+/// started at τ0 (see [`crate::integrate::AffineRegions::region_particular_param_derivative_into`]): `phi` holds
 /// e^{A_r t} (from [`close_stint`]), `dzp0` ∂z_p/∂p(τ0); `tmp` is scratch.
 #[allow(clippy::too_many_arguments)]
 fn close_stint_sensitivity(
@@ -240,7 +253,10 @@ fn close_stint_sensitivity(
 ) -> Result<(), SimError> {
     *sens -= dzp0;
     tmp.gemv(1.0, phi, sens, 0.0);
-    let done = integ.region_particular_param_derivative_into(p, r, tau, sens)?;
+    let done = match integ.affine() {
+        Some(a) => a.region_particular_param_derivative_into(p, r, tau, sens)?,
+        None => false,
+    };
     debug_assert!(done, "provided at the stint's start");
     *sens += &*tmp;
     Ok(())

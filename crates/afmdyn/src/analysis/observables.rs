@@ -10,7 +10,7 @@
 //! it errs by at most 2.2e-18 (the short steps of the adaptive integrator) — so the results are
 //! exact to round-off for the exact propagator and to the interpolant's accuracy otherwise. A
 //! Taylor contact step takes its nodes in its own regularising time σ (dτ = 2w dσ, in which the
-//! contact force is smooth up to the contact edge; [`Integrator::smooth_time`]), always with
+//! contact force is smooth up to the contact edge; [`crate::integrate::Integrator::smooth_time`]), always with
 //! the 16-point rule (the stretch dτ/dσ varies over the step, so the |c| ≤ 1 test in τ does not
 //! carry over). (For an
 //! integrand analytic in the Bernstein ellipse E_ρ, bounded by M there, the
@@ -534,7 +534,7 @@ impl Acc {
     ) {
         let half = 0.5 * (b - a);
         // (τ, dF_c/dτ, dV_T/dτ) at the ends and the GL nodes, in order; the nodes in the
-        // step's own smooth time ([`Integrator::smooth_time`]; τ itself but for the Taylor
+        // step's own smooth time ([`crate::integrate::Integrator::smooth_time`]; τ itself but for the Taylor
         // integrator's contact steps)
         let scan = &mut scratch.scan;
         scan.clear();
@@ -548,9 +548,9 @@ impl Acc {
         }
         // the short rule where a product of two factors has |c| ≤ 1 on the piece (module docs),
         // τ being the smooth time: a regularising time stretches the piece's rates unevenly
-        let short = integ.smooth_time_is_tau() && half * ctx.product_rate[r.index()] <= 1.0;
+        let short = integ.smooth_time().is_none() && half * ctx.product_rate[r.index()] <= 1.0;
         for &(x, wx) in &ctx.gl[usize::from(short)] {
-            let (tau, dtau) = integ.smooth_time(a, b, 0.5 * (x + 1.0));
+            let (tau, dtau) = crate::integrate::smooth_time(integ, a, b, 0.5 * (x + 1.0));
             let nd = ctx.node(integ, r, tau);
             self.quadrature(ctx, 0.5 * wx * dtau, &nd, &mut scratch.fi);
             self.extremes(nd.f, nd.v[0]);

@@ -180,7 +180,7 @@ impl SteadyState {
 
 /// Accumulates [`OrbitStats`] step by step ([`Observer`] of [`advance_observed`]), locating
 /// interior extrema of W(1,τ) and V_T on the integrator's dense output. The values at a step's
-/// ends are the integrator's [`Integrator::tip_values`] (the exact propagator's from its modal
+/// ends are the integrator's [`crate::integrate::Spans::tip_values`] (the exact propagator's from its modal
 /// coordinates: the plain state is formed only where the body-contact bound does not hold).
 #[derive(Debug, Clone)]
 pub struct StatsObserver {

@@ -16,14 +16,14 @@
 //! Both halves share the free flight's dead band (the model's guard tolerance), so the split
 //! integrator leaves free flight where the adaptive integrator alone would; it is its oracle
 //! in the tests. Step Jacobians: the exact transition e^{A_I t} over free steps (and over whole
-//! free stints, [`Integrator::region_transition_into`]), the variational equations in contact;
+//! free stints, [`AffineRegions::region_transition_into`]), the variational equations in contact;
 //! the saltation at the events is the analyses' ([`crate::system::saltation`]). DMT is not
 //! split: its van der Waals force acts in free flight.
 
 use super::adaptive::Adaptive;
 use super::exact::ExactPropagator;
 use super::taylor::Taylor;
-use super::{ChatterWindow, Integrator, Step};
+use super::{AffineRegions, ChatterWindow, Integrator, SmoothTime, Spans, Step};
 use crate::error::SimError;
 use crate::model::CantileverModel;
 use crate::params::SweepParam;
@@ -282,16 +282,58 @@ impl Integrator for Split {
         self.step_with(tau_max, false)
     }
 
+    fn dense_tip(&mut self, tau: f64) -> [f64; 3] {
+        self.integ_mut(self.last).dense_tip(tau)
+    }
+
+    fn dense_v_t(&mut self, tau: f64) -> [f64; 3] {
+        self.integ_mut(self.last).dense_v_t(tau)
+    }
+
+    fn dense_state(&mut self, tau: f64) -> DVector<f64> {
+        self.integ_mut(self.last).dense_state(tau)
+    }
+
+    /// The exact half's closed form over its whole grid steps of free flight (where the
+    /// model's rates are those of the linear law's region I: no tip force), the Taylor
+    /// contact's from its series.
+    fn last_step_rate_integrals(&mut self) -> Option<[f64; 3]> {
+        match self.last {
+            Half::Exact => self.exact.last_step_rate_integrals(),
+            Half::Adaptive => self.adaptive.integ_mut().last_step_rate_integrals(),
+        }
+    }
+
+    fn last_step_jacobian(&mut self) -> Result<DMatrix<f64>, SimError> {
+        self.integ_mut(self.last).last_step_jacobian()
+    }
+
+    fn last_step_jacobian_into(&mut self, out: &mut DMatrix<f64>) -> Result<(), SimError> {
+        self.integ_mut(self.last).last_step_jacobian_into(out)
+    }
+
+    fn smooth_time(&mut self) -> Option<&mut dyn SmoothTime> {
+        self.integ_mut(self.last).smooth_time()
+    }
+
+    fn affine(&mut self) -> Option<&mut dyn AffineRegions> {
+        Some(self)
+    }
+
+    fn spans(&mut self) -> Option<&mut dyn Spans> {
+        Some(self)
+    }
+}
+
+impl Spans for Split {
     fn step_deferred(&mut self, tau_max: f64) -> Result<Step, SimError> {
         self.step_with(tau_max, true)
     }
-
     fn form_state(&mut self) {
         if self.active == Half::Exact {
             self.exact.form_state();
         }
     }
-
     /// The exact half's free flight in its fast loop ([`ExactPropagator`]'s certified grid
     /// runs) until its switching, the adaptive half step by step.
     fn advance_to(&mut self, tau_end: f64) -> Result<(), SimError> {
@@ -316,76 +358,39 @@ impl Integrator for Split {
         self.form_state();
         out
     }
-
     fn tip_values(&self) -> [f64; 4] {
         match self.active {
             Half::Exact => self.exact.tip_values(),
             Half::Adaptive => self.model.tip_values(self.tau(), self.state()),
         }
     }
-
     fn displacement_bound(&mut self, weights: &[f64], enough: f64) -> f64 {
         match self.active {
             Half::Exact => self.exact.displacement_bound(weights, enough),
             Half::Adaptive => crate::model::weighted_displacement(weights, self.state().as_slice()),
         }
     }
+}
 
-    fn dense_tip(&mut self, tau: f64) -> [f64; 3] {
-        self.integ_mut(self.last).dense_tip(tau)
-    }
-
-    fn dense_v_t(&mut self, tau: f64) -> [f64; 3] {
-        self.integ_mut(self.last).dense_v_t(tau)
-    }
-
-    fn dense_state(&mut self, tau: f64) -> DVector<f64> {
-        self.integ_mut(self.last).dense_state(tau)
-    }
-
-    /// The exact half's closed form over its whole grid steps of free flight (where the
-    /// model's rates are those of the linear law's region I: no tip force), the Taylor
-    /// contact's from its series.
-    fn last_step_rate_integrals(&mut self) -> Option<[f64; 3]> {
-        match self.last {
-            Half::Exact => self.exact.last_step_rate_integrals(),
-            Half::Adaptive => self.adaptive.integ_mut().last_step_rate_integrals(),
-        }
-    }
-
-    fn smooth_time(&mut self, a: f64, b: f64, u: f64) -> (f64, f64) {
-        self.integ_mut(self.last).smooth_time(a, b, u)
-    }
-
-    fn smooth_time_is_tau(&self) -> bool {
-        self.integ(self.last).smooth_time_is_tau()
-    }
-
-    fn last_step_jacobian(&mut self) -> Result<DMatrix<f64>, SimError> {
-        self.integ_mut(self.last).last_step_jacobian()
-    }
-
-    fn last_step_jacobian_into(&mut self, out: &mut DMatrix<f64>) -> Result<(), SimError> {
-        self.integ_mut(self.last).last_step_jacobian_into(out)
-    }
-
+/// The exact half's affine free flight; the per-step parameter derivative of whichever half
+/// took the last step.
+impl AffineRegions for Split {
     fn has_region_transition(&self, r: Region) -> bool {
         r == Region::Free && self.exact.has_region_transition(Region::Free)
     }
-
     fn region_transition_into(&self, r: Region, t: f64, out: &mut DMatrix<f64>) -> bool {
         r == Region::Free && self.exact.region_transition_into(Region::Free, t, out)
     }
-
     fn last_step_param_derivative_into(
         &mut self,
         param: SweepParam,
         out: &mut DVector<f64>,
     ) -> Result<bool, SimError> {
-        self.integ_mut(self.last)
-            .last_step_param_derivative_into(param, out)
+        match self.integ_mut(self.last).affine() {
+            Some(a) => a.last_step_param_derivative_into(param, out),
+            None => Ok(false),
+        }
     }
-
     fn region_particular_param_derivative_into(
         &mut self,
         param: SweepParam,

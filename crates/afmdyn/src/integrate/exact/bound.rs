@@ -1,4 +1,4 @@
-//! The displacement bound of [`crate::integrate::Integrator::displacement_bound`] in modal
+//! The displacement bound of [`crate::integrate::Spans::displacement_bound`] in modal
 //! regions: weighted column sums per region and a bound kept over a stint; the body-contact
 //! guard of a span's steps ([`StepGuard`]).
 
@@ -7,16 +7,16 @@ use super::modal::{ModalExp, Modes};
 use super::ExactPropagator;
 use crate::model::BodyContactCheck;
 
-/// Most grid steps over which the stint's bound of [`Integrator::displacement_bound`] is kept
+/// Most grid steps over which the stint's bound of [`Spans::displacement_bound`] is kept
 /// (see there).
 ///
-/// [`Integrator::displacement_bound`]: crate::integrate::Integrator::displacement_bound
+/// [`Spans::displacement_bound`]: crate::integrate::Spans::displacement_bound
 const STINT_BOUND_STEPS: f64 = 1e5;
 
-/// The tables of [`Integrator::displacement_bound`] for weights c (per region, formed on
+/// The tables of [`Spans::displacement_bound`] for weights c (per region, formed on
 /// first use), and the bound of the current stint's homogeneous part.
 ///
-/// [`Integrator::displacement_bound`]: crate::integrate::Integrator::displacement_bound
+/// [`Spans::displacement_bound`]: crate::integrate::Spans::displacement_bound
 #[derive(Debug, Clone, Default)]
 pub(super) struct BoundCols {
     weights: Vec<f64>,

@@ -1,10 +1,10 @@
-//! [`Integrator`] for [`ExactPropagator`].
+//! [`Integrator`], [`Spans`] and [`AffineRegions`] for [`ExactPropagator`].
 
 use super::forcing::modal_tip;
 use super::step::Form;
 use super::ExactPropagator;
 use crate::error::SimError;
-use crate::integrate::{Integrator, Step};
+use crate::integrate::{AffineRegions, Integrator, Spans, Step};
 use crate::model::BodyContactCheck;
 use crate::params::SweepParam;
 use crate::system::Region;
@@ -36,67 +36,6 @@ impl Integrator for ExactPropagator {
 
     fn step(&mut self, tau_max: f64) -> Result<Step, SimError> {
         self.step_impl(tau_max, Form::All)
-    }
-
-    fn step_deferred(&mut self, tau_max: f64) -> Result<Step, SimError> {
-        self.step_impl(tau_max, Form::Events)
-    }
-
-    fn form_state(&mut self) {
-        self.materialize();
-    }
-
-    // spans and what they change: `span.rs`
-    fn step_span(
-        &mut self,
-        tau_max: f64,
-        body: Option<&BodyContactCheck>,
-    ) -> Result<Step, SimError> {
-        self.step_span_impl(tau_max, body)
-    }
-
-    /// V_T and dV_T/dτ of the switching test at the end of the last step; W and ∂W/∂τ from the
-    /// plain state, or, while it lags behind, from the modal coordinates: Σ_k Re(w_k c̃ᵀv_k q_k)
-    /// (and with λ_k; as the last step returned them, else `ModalExp::tip_of`) plus the
-    /// particular part (`modal_tip`).
-    fn tip_values(&self) -> [f64; 4] {
-        let (v, vd) = self.vt;
-        let ri = self.region.index();
-        let (w, wd) = match (&self.spec[ri].modal, self.stale) {
-            (Some(me), true) => modal_tip(
-                self.model.omega(),
-                &self.forced[ri],
-                self.tip_hom.unwrap_or_else(|| me.tip_of(&self.q)),
-                self.trig_now(),
-            ),
-            _ => (self.model.w_tip(&self.z), self.model.w_tip_dot(&self.z)),
-        };
-        [w, wd, v, vd]
-    }
-
-    // the bound and its proof: `bound.rs`
-    fn displacement_bound(&mut self, weights: &[f64], enough: f64) -> f64 {
-        self.displacement_bound_impl(weights, enough)
-    }
-
-    fn advance_to(&mut self, tau_end: f64) -> Result<(), SimError> {
-        let mut out = Ok(());
-        while self.tau < tau_end {
-            // the certified whole grid steps in one tight loop, the next step (a possible
-            // switching, or a partial step) by step_impl
-            let step = self.grid_run(tau_end).and_then(|()| {
-                if self.tau < tau_end {
-                    self.step_impl(tau_end, Form::Nothing)?;
-                }
-                Ok(())
-            });
-            if let Err(e) = step {
-                out = Err(e);
-                break;
-            }
-        }
-        self.materialize();
-        out
     }
 
     fn dense_tip(&mut self, tau: f64) -> [f64; 3] {
@@ -131,6 +70,79 @@ impl Integrator for ExactPropagator {
         Ok(self.step_transition())
     }
 
+    fn last_step_jacobian_into(&mut self, out: &mut DMatrix<f64>) -> Result<(), SimError> {
+        self.step_transition_into(out);
+        Ok(())
+    }
+
+    fn affine(&mut self) -> Option<&mut dyn AffineRegions> {
+        Some(self)
+    }
+
+    fn spans(&mut self) -> Option<&mut dyn Spans> {
+        Some(self)
+    }
+}
+
+impl Spans for ExactPropagator {
+    fn step_deferred(&mut self, tau_max: f64) -> Result<Step, SimError> {
+        self.step_impl(tau_max, Form::Events)
+    }
+    fn form_state(&mut self) {
+        self.materialize();
+    }
+    // spans and what they change: `span.rs`
+    fn step_span(
+        &mut self,
+        tau_max: f64,
+        body: Option<&BodyContactCheck>,
+    ) -> Result<Step, SimError> {
+        self.step_span_impl(tau_max, body)
+    }
+    /// V_T and dV_T/dτ of the switching test at the end of the last step; W and ∂W/∂τ from the
+    /// plain state, or, while it lags behind, from the modal coordinates: Σ_k Re(w_k c̃ᵀv_k q_k)
+    /// (and with λ_k; as the last step returned them, else `ModalExp::tip_of`) plus the
+    /// particular part (`modal_tip`).
+    fn tip_values(&self) -> [f64; 4] {
+        let (v, vd) = self.vt;
+        let ri = self.region.index();
+        let (w, wd) = match (&self.spec[ri].modal, self.stale) {
+            (Some(me), true) => modal_tip(
+                self.model.omega(),
+                &self.forced[ri],
+                self.tip_hom.unwrap_or_else(|| me.tip_of(&self.q)),
+                self.trig_now(),
+            ),
+            _ => (self.model.w_tip(&self.z), self.model.w_tip_dot(&self.z)),
+        };
+        [w, wd, v, vd]
+    }
+    // the bound and its proof: `bound.rs`
+    fn displacement_bound(&mut self, weights: &[f64], enough: f64) -> f64 {
+        self.displacement_bound_impl(weights, enough)
+    }
+    fn advance_to(&mut self, tau_end: f64) -> Result<(), SimError> {
+        let mut out = Ok(());
+        while self.tau < tau_end {
+            // the certified whole grid steps in one tight loop, the next step (a possible
+            // switching, or a partial step) by step_impl
+            let step = self.grid_run(tau_end).and_then(|()| {
+                if self.tau < tau_end {
+                    self.step_impl(tau_end, Form::Nothing)?;
+                }
+                Ok(())
+            });
+            if let Err(e) = step {
+                out = Err(e);
+                break;
+            }
+        }
+        self.materialize();
+        out
+    }
+}
+
+impl AffineRegions for ExactPropagator {
     // the derivative and its derivation: `sensitivity.rs`
     fn last_step_param_derivative_into(
         &mut self,
@@ -139,7 +151,6 @@ impl Integrator for ExactPropagator {
     ) -> Result<bool, SimError> {
         self.last_step_param_derivative_impl(param, out)
     }
-
     fn region_particular_param_derivative_into(
         &mut self,
         param: SweepParam,
@@ -155,11 +166,9 @@ impl Integrator for ExactPropagator {
         Self::zpp_into(&d[ri], &self.forced[ri], tau, sc, out.as_mut_slice());
         Ok(true)
     }
-
     fn has_region_transition(&self, r: Region) -> bool {
         self.spec[r.index()].modal.is_some()
     }
-
     /// T⁻¹ V e^{Λt} V⁻¹ T from the eigendecomposition (accurate for any t ≥ 0: Re λ_k ≤ 0 and
     /// the basis is well conditioned, [`modal::MAX_MODAL_CONDITION`]).
     ///
@@ -174,10 +183,5 @@ impl Integrator for ExactPropagator {
         }
         me.transition_plain_into(t, out);
         true
-    }
-
-    fn last_step_jacobian_into(&mut self, out: &mut DMatrix<f64>) -> Result<(), SimError> {
-        self.step_transition_into(out);
-        Ok(())
     }
 }

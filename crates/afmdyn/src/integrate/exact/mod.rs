@@ -17,7 +17,7 @@
 //! (at any N) keeps the homogeneous part in modal coordinates q = V⁻¹ T δz during a stint: a grid
 //! step multiplies q by e^{Λh} (about N complex products) and evaluates the tip from q; the
 //! plain state z = z_p + T⁻¹ V q is formed only when asked for ([`Integrator::step`] returns it
-//! after every step, [`Integrator::advance_to`] only at events and at the end). The
+//! after every step, [`Spans::advance_to`] only at events and at the end). The
 //! eigendecomposition also tightens the curvature bound below.
 //!
 //! **Switching detection** on the gap g = ±V_T (eq. 8; + in region I, − in region II) is rigorous:
@@ -45,7 +45,7 @@
 //! state), `tests.rs`.
 //!
 //! [`Integrator`]: crate::integrate::Integrator
-//! [`Integrator::advance_to`]: crate::integrate::Integrator::advance_to
+//! [`Spans::advance_to`]: crate::integrate::Spans::advance_to
 //! [`Integrator::step`]: crate::integrate::Integrator::step
 //! [`SimError::Chattering`]: crate::error::SimError::Chattering
 
@@ -154,9 +154,9 @@ pub struct ExactPropagator {
     /// `ModalExp::tip_of(q)`); `None` where q was formed otherwise (a run of grid steps, the
     /// batch, a stint entry).
     tip_hom: Option<(f64, f64)>,
-    /// z lags behind q (inside [`Integrator::advance_to`]).
+    /// z lags behind q (inside [`Spans::advance_to`]).
     ///
-    /// [`Integrator::advance_to`]: crate::integrate::Integrator::advance_to
+    /// [`Spans::advance_to`]: crate::integrate::Spans::advance_to
     stale: bool,
     /// Modal scratch: e^{λ_k t} of a partial step, the coordinates at the centre of a tip
     /// series, the step tried by a run of grid steps.
@@ -202,19 +202,19 @@ pub struct ExactPropagator {
     /// The tables of the closed-form energy integrals over grid steps (`energy.rs`), built on
     /// the first request.
     energy: Option<Arc<[energy::EnergyTable; 2]>>,
-    /// The column sums of [`Integrator::displacement_bound`] for the last weights.
+    /// The column sums of [`Spans::displacement_bound`] for the last weights.
     ///
-    /// [`Integrator::displacement_bound`]: crate::integrate::Integrator::displacement_bound
+    /// [`Spans::displacement_bound`]: crate::integrate::Spans::displacement_bound
     bound_cols: BoundCols,
     /// The body-contact guard of the span being taken: the homogeneous part's bound at its
     /// start (`span.rs`, `bound.rs`'s `StepGuard`); `None` outside a span or without a check.
     span_guard: Option<f64>,
     /// Whether the guard ended the span: the last step's end is not shown off the substrate.
     guard_stopped: bool,
-    /// The modal coordinates at the start of a span ([`Integrator::step_span`], `span.rs`); they
+    /// The modal coordinates at the start of a span ([`Spans::step_span`], `span.rs`); they
     /// trade places with the last step's start when the span becomes the last step.
     ///
-    /// [`Integrator::step_span`]: crate::integrate::Integrator::step_span
+    /// [`Spans::step_span`]: crate::integrate::Spans::step_span
     span_q0: Box<Modes>,
     /// The modal coordinates at the end of the last step that ended at a switching, in the
     /// region it left (q0 e^{Λt}, formed with the switching's state).

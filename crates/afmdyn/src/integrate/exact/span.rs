@@ -1,6 +1,6 @@
-//! Spans of steps ([`Integrator::step_span`]): in a modal region the steps of a stint up to the
+//! Spans of steps ([`Spans::step_span`]): in a modal region the steps of a stint up to the
 //! next event (or the caller's limit) in one run — the certified whole grid steps by
-//! `grid_run`, the others by `step_impl`, as [`Integrator::advance_to`] takes them, so the same
+//! `grid_run`, the others by `step_impl`, as [`Spans::advance_to`] takes them, so the same
 //! steps, events and states bit for bit — and then the span as the last step.
 //!
 //! **The span as the last step.** Along a stint the homogeneous part is δz(τ0 + t) =
@@ -16,7 +16,7 @@
 //!
 //! **The body-contact guard.** Given a body-contact check, every step of the span must end
 //! where `bound.rs`'s `StepGuard` shows without the plain state that every station is off the
-//! substrate — the displacement bound of [`Integrator::displacement_bound`] against the base at
+//! substrate — the displacement bound of [`Spans::displacement_bound`] against the base at
 //! the step's grid point, from a table per grid point and the homogeneous part's bound at the
 //! span's start (O(1) a step; |q_k| does not grow along a stint), else at the current q — the
 //! test by which `touches_observed` spares a step's end; the span ends after the first step it
@@ -24,10 +24,10 @@
 //! start's bound long (a period, at most 10⁵ grid steps: the rounding of the products can grow
 //! a computed |q_k| by a few ulp a step, which the bound's widening by 1e-10 covers).
 //!
-//! [`Integrator::displacement_bound`]: crate::integrate::Integrator::displacement_bound
+//! [`Spans::displacement_bound`]: crate::integrate::Spans::displacement_bound
 //!
-//! [`Integrator::step_span`]: crate::integrate::Integrator::step_span
-//! [`Integrator::advance_to`]: crate::integrate::Integrator::advance_to
+//! [`Spans::step_span`]: crate::integrate::Spans::step_span
+//! [`Spans::advance_to`]: crate::integrate::Spans::advance_to
 
 use super::step::Form;
 use super::ExactPropagator;

@@ -22,11 +22,11 @@ impl ExactPropagator {
     }
 
     /// z = z_p(τ) + T⁻¹ V q in a modal region, when z lags behind q (after modal steps inside
-    /// [`Integrator::advance_to`]). On a grid point z_p is the grid table's value (column k,
+    /// [`Spans::advance_to`]). On a grid point z_p is the grid table's value (column k,
     /// or m at a period end), elsewhere z_p(τ) from sin/cos Ωτ, as a materialising step of
-    /// `step_impl` forms it: [`Integrator::advance_to`] and the step loop agree bit for bit.
+    /// `step_impl` forms it: [`Spans::advance_to`] and the step loop agree bit for bit.
     ///
-    /// [`Integrator::advance_to`]: crate::integrate::Integrator::advance_to
+    /// [`Spans::advance_to`]: crate::integrate::Spans::advance_to
     pub(super) fn materialize(&mut self) {
         if !self.stale {
             return;

@@ -23,10 +23,10 @@ pub(super) enum Form {
     ///
     /// [`Integrator::step_deferred`]: crate::integrate::Integrator::step_deferred
     Events,
-    /// Neither (inside [`Integrator::advance_to`] and the batch, which read only the result's
+    /// Neither (inside [`Spans::advance_to`] and the batch, which read only the result's
     /// `Ok`/`Err`).
     ///
-    /// [`Integrator::advance_to`]: crate::integrate::Integrator::advance_to
+    /// [`Spans::advance_to`]: crate::integrate::Spans::advance_to
     Nothing,
 }
 

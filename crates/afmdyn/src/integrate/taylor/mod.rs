@@ -48,7 +48,7 @@
 mod jet;
 pub(crate) mod poly;
 
-use super::{ChatterWindow, Integrator, Step, StepBudget};
+use super::{ChatterWindow, Integrator, SmoothTime, Step, StepBudget};
 use crate::error::SimError;
 use crate::model::CantileverModel;
 use crate::roots::safeguarded_newton;
@@ -455,28 +455,12 @@ impl Integrator for Taylor {
         Some(self.jet.rate_integrals(&self.last.series, self.last.end))
     }
 
-    /// In contact the step is smooth in σ: τ(u) = τ₀ + θ(σ(u)), σ linear in u between σ(a) and
-    /// σ(b).
-    fn smooth_time_is_tau(&self) -> bool {
-        !(self.last.valid && self.last.series.sigma)
-    }
-
-    fn smooth_time(&mut self, a: f64, b: f64, u: f64) -> (f64, f64) {
-        if self.smooth_time_is_tau() {
-            return (a + u * (b - a), b - a);
+    fn smooth_time(&mut self) -> Option<&mut dyn SmoothTime> {
+        if self.last.valid && self.last.series.sigma {
+            Some(self)
+        } else {
+            None
         }
-        let (sa, sb) = match self.smooth_piece {
-            Some((pa, pb, sa, sb)) if pa == a && pb == b => (sa, sb),
-            _ => {
-                let (sa, sb) = (self.local(a), self.local(b));
-                self.smooth_piece = Some((a, b, sa, sb));
-                (sa, sb)
-            }
-        };
-        let l = &self.last;
-        let sigma = sa + u * (sb - sa);
-        let [theta, dtheta, _] = poly::eval3(&l.series.theta[..=l.series.p], sigma);
-        (l.tau0 + theta, dtheta * (sb - sa))
     }
 
     fn last_step_jacobian(&mut self) -> Result<DMatrix<f64>, SimError> {
@@ -499,5 +483,24 @@ impl Integrator for Taylor {
             }
             None => self.last_step_jacobian().map(|_| ()),
         }
+    }
+}
+
+/// In contact the step is smooth in σ: τ(u) = τ₀ + θ(σ(u)), σ linear in u between σ(a) and
+/// σ(b) ([`Integrator::smooth_time`] hands it out for the σ steps only).
+impl SmoothTime for Taylor {
+    fn tau_of(&mut self, a: f64, b: f64, u: f64) -> (f64, f64) {
+        let (sa, sb) = match self.smooth_piece {
+            Some((pa, pb, sa, sb)) if pa == a && pb == b => (sa, sb),
+            _ => {
+                let (sa, sb) = (self.local(a), self.local(b));
+                self.smooth_piece = Some((a, b, sa, sb));
+                (sa, sb)
+            }
+        };
+        let l = &self.last;
+        let sigma = sa + u * (sb - sa);
+        let [theta, dtheta, _] = poly::eval3(&l.series.theta[..=l.series.p], sigma);
+        (l.tau0 + theta, dtheta * (sb - sa))
     }
 }
