@@ -1,5 +1,7 @@
 //! Test helpers shared by the integration tests: the closed-form forced response of a region
 //! and the events of a run.
+// each test file uses some of them
+#![allow(dead_code)]
 
 use afmdyn::galerkin::Region;
 use afmdyn::integrate::{
@@ -125,5 +127,30 @@ pub fn without_attraction(law: ContactLaw) -> ContactLaw {
             intermolecular_distance,
         },
         l => l,
+    }
+}
+
+/// The impact law (restitution `r`) on `modes` modes at gap α5 = `gap` and drive Ω = `omega`.
+pub fn impact_model(r: f64, modes: usize, gap: f64, omega: f64) -> afmdyn::CantileverModel {
+    afmdyn::CantileverModel::new(&afmdyn::Params {
+        modes,
+        omega,
+        alpha5: gap,
+        contact_law: afmdyn::ContactLaw::Impact { restitution: r },
+        ..afmdyn::Params::default()
+    })
+    .unwrap()
+}
+
+/// The options of integrator `kind` at tolerance `tol` (RK4 at 4 000 steps per period).
+pub fn opts(kind: afmdyn::IntegratorKind, tol: f64) -> afmdyn::IntegratorOptions {
+    afmdyn::IntegratorOptions {
+        kind,
+        steps_per_period: if matches!(kind, afmdyn::IntegratorKind::Rk4) {
+            4000
+        } else {
+            1
+        },
+        tolerance: tol,
     }
 }
