@@ -9,7 +9,7 @@ use crate::plot::{
 };
 use afmdyn::analysis::bifurcation::Branch;
 use afmdyn::integrate::build;
-use afmdyn::request::checkpoint::{CheckpointError, SweepStudy};
+use afmdyn::request::checkpoint::CheckpointError;
 use afmdyn::request::limits::ATTRACTOR_SAMPLES_PER_PERIOD;
 use afmdyn::request::sweep::{
     branch_code, status_code, sweep_failure, COL_BRANCH, COL_INDEX, COL_MESSAGE, COL_PERIOD,
@@ -19,6 +19,7 @@ use afmdyn::request::{
     AttractorsRequest, BifurcationRequest, FileCheckpoint, GlobalContinuationRequest, SteadyRequest,
 };
 use afmdyn::request::{Document, Resolved};
+use afmdyn::study::sweep::SweepStudy;
 use afmdyn::trajectory::{record, RecordSpec};
 use afmdyn::{CantileverModel, Params, SweepParam};
 use clap::Args;

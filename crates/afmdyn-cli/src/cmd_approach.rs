@@ -12,12 +12,12 @@ use afmdyn::analysis::approach::rest_distance;
 use afmdyn::analysis::continuation::BranchEvent;
 use afmdyn::analysis::observables::Observables;
 use afmdyn::analysis::stepped::{SteppedCurve, Sweep};
+use afmdyn::layout::{Layout, Variable};
 use afmdyn::probe::Probe;
 use afmdyn::report::{curve_column_index, curve_row, CurveUnits, UnitKind, CURVE_COLUMNS};
 use afmdyn::request::{
     Analysis, ApproachRequest, CurveRequest, Document, Resolved, ResonanceRequest,
 };
-use afmdyn::study::{Layout, Variable};
 use afmdyn::Params;
 use clap::Args;
 use std::path::{Path, PathBuf};

@@ -1,7 +1,7 @@
 //! `afmdyn chart`: a behaviour chart over two parameters (issue 29). The request, its limits,
 //! its tasks, its store, its executor and its result layout are the library's
 //! ([`afmdyn::request::chart`], [`afmdyn::analysis::chart`],
-//! [`afmdyn::request::chart_store`], [`afmdyn::study`]); this front end maps the flags, runs
+//! [`afmdyn::study::chart_store`], [`afmdyn::study`]); this front end maps the flags, runs
 //! the study with a progress bar, and writes `chart.csv`, `chart.nc` (from the layout) and the
 //! maps.
 
@@ -14,9 +14,9 @@ use afmdyn::analysis::chart::ChartCell;
 use afmdyn::request::chart::{
     axis_name, axis_unit, csv_lines, document, warnings, Chart, ChartArrays, CSV_HEADER,
 };
-use afmdyn::request::chart_store::{cells, chart_store};
 use afmdyn::request::checkpoint::CheckpointError;
 use afmdyn::request::{parameter, ChartRequest};
+use afmdyn::study::chart_store::{cells, chart_store};
 use afmdyn::Params;
 use clap::Args;
 use plotters::style::RGBColor;
@@ -238,7 +238,7 @@ pub fn chart(a: &ChartArgs) -> Result<(), CliError> {
         &arrays.layout(chart.model.x, chart.model.y),
     )?;
     draw_maps(out.path(), &chart, &arrays)?;
-    if let Some(e) = Chart::every_cell_failed(&cells) {
+    if let Some(e) = afmdyn::study::chart::every_cell_failed(&cells) {
         return Err(CliError::Sim(e));
     }
     let empty = cells.iter().filter(|c| c.attractors.is_empty()).count();

@@ -60,7 +60,7 @@ struct Cli {
     /// Display units of text and plots in SI runs (--probe): afm (prefixed: nm, pN, kHz, aJ)
     /// or si (plain m, N, Hz, J). Data files and JSON are always in plain SI
     #[arg(long, value_enum, global = true, default_value = "afm")]
-    units: plot::DisplayUnits,
+    units: output::DisplayUnits,
 }
 
 #[derive(Debug, Subcommand)]
@@ -96,7 +96,7 @@ enum Command {
 }
 
 fn run(cli: Cli) -> Result<(), CliError> {
-    plot::set_display_units(cli.units);
+    output::set_display_units(cli.units);
     match cli.command {
         Command::Modes(a) => cmd_modes::modes(&a),
         Command::Units(a) => cmd_modes::units(&a),

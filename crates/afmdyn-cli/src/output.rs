@@ -145,12 +145,12 @@ where
     fs::rename(&tmp, path).map_err(|e| io_error("finish", path, e))
 }
 
-/// Write the NetCDF file of `layout` ([`afmdyn::study::netcdf`]).
+/// Write the NetCDF file of `layout` ([`afmdyn::layout::netcdf`]).
 ///
 /// # Errors
 /// [`CliError::Io`] naming the path.
-pub fn write_layout(path: &Path, layout: &afmdyn::study::Layout) -> Result<(), CliError> {
-    afmdyn::study::netcdf::write(path, layout).map_err(|e| CliError::Io(e.to_string()))
+pub fn write_layout(path: &Path, layout: &afmdyn::layout::Layout) -> Result<(), CliError> {
+    afmdyn::layout::netcdf::write(path, layout).map_err(|e| CliError::Io(e.to_string()))
 }
 
 /// Write bytes atomically.
@@ -471,7 +471,7 @@ pub fn si_value(v: f64, unit: &str) -> String {
     if v == 0.0 || !v.is_finite() {
         return format!("{v} {unit}");
     }
-    let (e, p) = crate::plot::si_prefix(v.abs());
+    let (e, p) = si_prefix(v.abs());
     let m = v / 10f64.powi(e);
     if !(1e-3..1e4).contains(&m.abs()) {
         // plain SI (--units si): 8.033740e-9 m
@@ -603,6 +603,53 @@ pub fn csv_lines(s: &mut CsvStream, bytes: &[u8]) -> Result<(), CliError> {
     file.write_all(bytes).map_err(|e| s.err(e))?;
     s.inner = Some(csv::Writer::from_writer(file));
     Ok(())
+}
+
+/// How SI quantities are displayed in text and on plot axes (`--units`): prefixed as AFM
+/// papers write them (nm, pN, kHz, aJ) or in plain SI units.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum DisplayUnits {
+    /// Prefixed units (the default): 8.03 nm, 6.9 nN, 300 kHz, 2.4 aJ.
+    Afm,
+    /// Plain SI units: 8.03e-9 m.
+    Si,
+}
+
+static PLAIN_SI: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Set the process's display units (once, from the command line).
+pub fn set_display_units(u: DisplayUnits) {
+    PLAIN_SI.store(u == DisplayUnits::Si, std::sync::atomic::Ordering::Relaxed);
+}
+
+/// The SI prefix (a … G) for a magnitude: (its power of ten, the prefix), the one that puts
+/// the magnitude's mantissa in [1, 1000) within the range of prefixes; no prefix with
+/// `--units si`.
+pub fn si_prefix(mag: f64) -> (i32, &'static str) {
+    if PLAIN_SI.load(std::sync::atomic::Ordering::Relaxed) {
+        return (0, "");
+    }
+    const PREFIXES: [(i32, &str); 10] = [
+        (-18, "a"),
+        (-15, "f"),
+        (-12, "p"),
+        (-9, "n"),
+        (-6, "µ"),
+        (-3, "m"),
+        (0, ""),
+        (3, "k"),
+        (6, "M"),
+        (9, "G"),
+    ];
+    if !(mag > 0.0 && mag.is_finite()) {
+        return (0, "");
+    }
+    let e = (mag.log10().floor() as i32).div_euclid(3) * 3;
+    PREFIXES
+        .iter()
+        .copied()
+        .min_by_key(|(x, _)| (x - e).abs())
+        .unwrap_or((0, ""))
 }
 
 #[cfg(test)]

@@ -14,7 +14,7 @@ use afmdyn::analysis::spectrum::{amplitude_spectrum, SPECTRUM_SAMPLES};
 use afmdyn::analysis::steady::SteadyState;
 use afmdyn::integrate::{build, IntegratorOptions};
 use afmdyn::probe::Probe;
-use afmdyn::request::checkpoint::{self, CheckpointError, SweepStudy};
+use afmdyn::request::checkpoint::{self, CheckpointError};
 use afmdyn::request::{self, Analysis, Document, ModesRequest, Resolved};
 use afmdyn::request::{
     AttractorsRequest, BifurcationRequest, ContinuationRequest, ConvergeRequest,
@@ -22,6 +22,7 @@ use afmdyn::request::{
     SeriesStore, SimulateRequest,
 };
 use afmdyn::request::{DirLock, FileCheckpoint, LockError, MemoryCheckpoint, SweepRecord};
+use afmdyn::study::sweep::SweepStudy;
 use afmdyn::study::{execute, StudyError};
 use afmdyn::trajectory::{record, RecordSpec};
 use afmdyn::{report, CantileverModel, Params, Region};
@@ -29,7 +30,6 @@ use nalgebra::DVector;
 use numpy::Complex64;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
-use std::path::PathBuf;
 
 type Dict<'py> = Bound<'py, PyDict>;
 
@@ -797,7 +797,7 @@ pub fn lyapunov<'py>(
     Ok(out.finish())
 }
 
-/// A probe (SI units, `afmdyn … --probe FILE`; its TOML text from [`probe_source`]): its
+/// A probe (SI units, `afmdyn … --probe FILE`; its TOML text from [`crate::params::probe_source`]): its
 /// dimensionless parameters and the `"si"` block of the command line's JSON (scales,
 /// calibration, drive, A₀, z_c).
 #[pyfunction]
@@ -805,44 +805,6 @@ pub fn probe(text: &str) -> PyResult<(PyParams, String)> {
     let pr = Probe::parse(text, "probe").map_err(probe_error)?;
     let si = report::si(&pr, &pr.params, &serde_json::json!({}));
     Ok((PyParams { inner: pr.params }, si.to_string()))
-}
-
-/// The TOML text of a probe given as Python's `probe=` takes it — a file's path (`str` or
-/// `os.PathLike`), TOML text (a `str` with a line break or `=`) or a `dict` of its sections —
-/// with `[cantilever].name` set from `cantilever` (the command line's `--cantilever`), checked:
-/// [`Probe::source_text`]. What the analyses then take as `probe`.
-///
-/// # Errors
-/// `ValueError` naming the source and every problem; `TypeError` for another type.
-#[pyfunction]
-#[pyo3(signature = (probe, cantilever=None))]
-pub fn probe_source(probe: &Bound<'_, PyAny>, cantilever: Option<String>) -> PyResult<String> {
-    use afmdyn::probe::ProbeSource;
-    let name = cantilever.as_deref();
-    let r = if let Ok(d) = probe.cast::<pyo3::types::PyDict>() {
-        let json: String = probe
-            .py()
-            .import("json")?
-            .call_method1("dumps", (d,))?
-            .extract()?;
-        let table: toml::Table = serde_json::from_str(&json).map_err(|e| {
-            value_error(format!(
-                "probe <table>: not a probe table ({e}): sections cantilever, tip, sample, \
-                 drive as dicts of numbers and strings"
-            ))
-        })?;
-        Probe::source_text(ProbeSource::Table(&table), name)
-    } else if let Ok(s) = probe.extract::<String>() {
-        Probe::source_text(ProbeSource::of_str(&s), name)
-    } else if let Ok(p) = probe.extract::<PathBuf>() {
-        Probe::source_text(ProbeSource::Path(&p), name)
-    } else {
-        return Err(pyo3::exceptions::PyTypeError::new_err(format!(
-            "probe: expected a path, TOML text or a dict, got {}",
-            probe.get_type().name()?
-        )));
-    };
-    r.map(|(text, _)| text).map_err(probe_error)
 }
 
 /// Observables of the steady state reached from `initial` (default: rest): the steady state is

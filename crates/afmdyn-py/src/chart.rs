@@ -10,8 +10,8 @@ use crate::run::{run, Job, Stop};
 use afmdyn::analysis::chart::{ChartCell, ChartPlan};
 use afmdyn::probe::Probe;
 use afmdyn::request::chart::Chart;
-use afmdyn::request::chart_store::{cells, chart_store};
 use afmdyn::request::{ChartArrays, ChartRequest, DirLock, ModelSpec};
+use afmdyn::study::chart_store::{cells, chart_store};
 use afmdyn::study::{execute, MemoryStore};
 use afmdyn::Params;
 use pyo3::prelude::*;
@@ -253,13 +253,13 @@ impl ChartStudy {
                     None => {
                         let mut s = MemoryStore::default();
                         execute(&chart, &mut s, false, threads, progress).map_err(study_error)?;
-                        Ok(Chart::cells_of(s.records))
+                        Ok(afmdyn::study::chart::cells_of(s.records))
                     }
                 }
             },
         )??;
         let this = slf.get();
-        if let Some(e) = Chart::every_cell_failed(&cells) {
+        if let Some(e) = afmdyn::study::chart::every_cell_failed(&cells) {
             return Err(sim_error(e));
         }
         let doc = afmdyn::request::chart::document(&this.chart, &cells).to_string();

@@ -59,15 +59,15 @@ impl<'py> Out<'py> {
     }
 }
 
-/// A result's [`afmdyn::study::Layout`] for the Python layer (`afmdyn._layout.dataset`):
+/// A result's [`afmdyn::layout::Layout`] for the Python layer (`afmdyn._layout.dataset`):
 /// `{"title": str, "dims": [(name, length)], "variables": [(name, dims, units, long_name,
 /// values, attrs)]}`, values as flat NumPy arrays (float64, or int64 for integer variables)
 /// that the Python layer reshapes to the dims.
 pub fn layout_dict<'py>(
     py: Python<'py>,
-    layout: afmdyn::study::Layout,
+    layout: afmdyn::layout::Layout,
 ) -> PyResult<Bound<'py, PyDict>> {
-    use afmdyn::study::layout::{Attr, Values};
+    use afmdyn::layout::{Attr, Values};
     let out = PyDict::new(py);
     out.set_item("title", layout.title)?;
     out.set_item("dims", layout.dims)?;

@@ -60,7 +60,7 @@ fn _afmdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(curves::approach, m)?)?;
     m.add_function(wrap_pyfunction!(curves::resonance, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::probe, m)?)?;
-    m.add_function(wrap_pyfunction!(analyses::probe_source, m)?)?;
+    m.add_function(wrap_pyfunction!(params::probe_source, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::observe, m)?)?;
     m.add("POLL_SECONDS", run::POLL.as_secs_f64())?;
     m.add_function(wrap_pyfunction!(run::cancel_running, m)?)?;

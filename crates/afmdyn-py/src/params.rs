@@ -271,7 +271,7 @@ impl PyParams {
     #[staticmethod]
     #[pyo3(signature = (path, **model))]
     fn from_probe(path: &Bound<'_, PyAny>, model: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
-        let text = crate::analyses::probe_source(path, None)?;
+        let text = probe_source(path, None)?;
         let pr = afmdyn::probe::Probe::parse(&text, "probe").map_err(crate::errors::probe_error)?;
         Ok(PyParams {
             inner: model_spec(model)?
@@ -429,4 +429,44 @@ impl PyParams {
         inner.validate().map_err(param_error)?;
         Ok(PyParams { inner })
     }
+}
+
+/// The TOML text of a probe given as Python's `probe=` takes it — a file's path (`str` or
+/// `os.PathLike`), TOML text (a `str` with a line break or `=`) or a `dict` of its sections —
+/// with `[cantilever].name` set from `cantilever` (the command line's `--cantilever`), checked:
+/// [`Probe::source_text`]. What the analyses then take as `probe`.
+///
+/// # Errors
+/// `ValueError` naming the source and every problem; `TypeError` for another type.
+#[pyfunction]
+#[pyo3(signature = (probe, cantilever=None))]
+pub fn probe_source(probe: &Bound<'_, PyAny>, cantilever: Option<String>) -> PyResult<String> {
+    use crate::errors::{probe_error, value_error};
+    use afmdyn::probe::{Probe, ProbeSource};
+    use std::path::PathBuf;
+    let name = cantilever.as_deref();
+    let r = if let Ok(d) = probe.cast::<pyo3::types::PyDict>() {
+        let json: String = probe
+            .py()
+            .import("json")?
+            .call_method1("dumps", (d,))?
+            .extract()?;
+        let table: toml::Table = serde_json::from_str(&json).map_err(|e| {
+            value_error(format!(
+                "probe <table>: not a probe table ({e}): sections cantilever, tip, sample, \
+                 drive as dicts of numbers and strings"
+            ))
+        })?;
+        Probe::source_text(ProbeSource::Table(&table), name)
+    } else if let Ok(s) = probe.extract::<String>() {
+        Probe::source_text(ProbeSource::of_str(&s), name)
+    } else if let Ok(p) = probe.extract::<PathBuf>() {
+        Probe::source_text(ProbeSource::Path(&p), name)
+    } else {
+        return Err(pyo3::exceptions::PyTypeError::new_err(format!(
+            "probe: expected a path, TOML text or a dict, got {}",
+            probe.get_type().name()?
+        )));
+    };
+    r.map(|(text, _)| text).map_err(probe_error)
 }

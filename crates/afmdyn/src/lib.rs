@@ -15,8 +15,8 @@
 //! [`analysis`] (steady states, periods, bifurcation sweeps, attractors, mode convergence);
 //! [`request`] is what every front end hands the library (parameters by name, defaults, limits);
 //! [`report`] builds the JSON result documents shared by the command line and Python;
-//! [`study`] runs the analyses made of many tasks (one executor, one kind of store, result
-//! layouts declared once).
+//! [`study`] runs the analyses made of many tasks (one executor, one kind of store);
+//! [`layout`] declares every result's variables once (NetCDF, Python datasets, Zarr).
 //!
 //! Time is the dimensionless τ of eq. 5 and displacements are in units of the beam gap g₀.
 //! States are `z: [f64; 2N]` = (a, ȧ), modal coordinates and their τ-derivatives.
@@ -47,7 +47,7 @@
 //! * `files` — the library's I/O: reading probe files (`Probe::load(path)`; [`probe::Probe::parse`]
 //!   takes the TOML text and is always there), the studies' stores in locked directories
 //!   (`request::checkpoint_file`, `request::chart_store`, `request::dir_lock`) and NetCDF
-//!   writing (`study::netcdf`).
+//!   writing (`layout::netcdf`).
 //! * `schema` — JSON Schemas of the requests (`schemars::JsonSchema` on [`request`]'s types;
 //!   `docs/schema/` holds them).
 //!
@@ -63,6 +63,7 @@ pub mod eigen;
 pub mod error;
 pub mod galerkin;
 pub mod integrate;
+pub mod layout;
 mod linalg;
 pub mod model;
 pub mod params;

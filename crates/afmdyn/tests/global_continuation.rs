@@ -124,7 +124,7 @@ fn fractions_count_the_random_starts_only() {
         .flat_map(|row| row.as_array().unwrap().iter().map(|v| v.as_f64().unwrap()))
         .collect();
     match &layout.variable("basin_fraction").unwrap().values {
-        afmdyn::study::Values::F64(v) => assert_eq!(v, &table),
+        afmdyn::layout::Values::F64(v) => assert_eq!(v, &table),
         v => panic!("basin_fraction: {v:?}"),
     }
 }

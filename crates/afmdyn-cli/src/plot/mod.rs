@@ -9,7 +9,7 @@
 //! * Legends sit in a panel right of the data area, never over the data.
 
 use crate::error::CliError;
-use crate::output::write_bytes;
+use crate::output::{si_prefix, write_bytes};
 use plotters::coord::ranged1d::{DefaultFormatting, KeyPointHint, Ranged};
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
@@ -522,53 +522,6 @@ fn si_axis(label: &str, lo: f64, hi: f64) -> (String, f64) {
     }
     let (e, p) = si_prefix(mag);
     (format!("{head} ({p}{u})"), 10f64.powi(e))
-}
-
-/// How SI quantities are displayed in text and on plot axes (`--units`): prefixed as AFM
-/// papers write them (nm, pN, kHz, aJ) or in plain SI units.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum DisplayUnits {
-    /// Prefixed units (the default): 8.03 nm, 6.9 nN, 300 kHz, 2.4 aJ.
-    Afm,
-    /// Plain SI units: 8.03e-9 m.
-    Si,
-}
-
-static PLAIN_SI: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
-
-/// Set the process's display units (once, from the command line).
-pub fn set_display_units(u: DisplayUnits) {
-    PLAIN_SI.store(u == DisplayUnits::Si, std::sync::atomic::Ordering::Relaxed);
-}
-
-/// The SI prefix (a … G) for a magnitude: (its power of ten, the prefix), the one that puts
-/// the magnitude's mantissa in [1, 1000) within the range of prefixes; no prefix with
-/// `--units si`.
-pub fn si_prefix(mag: f64) -> (i32, &'static str) {
-    if PLAIN_SI.load(std::sync::atomic::Ordering::Relaxed) {
-        return (0, "");
-    }
-    const PREFIXES: [(i32, &str); 10] = [
-        (-18, "a"),
-        (-15, "f"),
-        (-12, "p"),
-        (-9, "n"),
-        (-6, "µ"),
-        (-3, "m"),
-        (0, ""),
-        (3, "k"),
-        (6, "M"),
-        (9, "G"),
-    ];
-    if !(mag > 0.0 && mag.is_finite()) {
-        return (0, "");
-    }
-    let e = (mag.log10().floor() as i32).div_euclid(3) * 3;
-    PREFIXES
-        .iter()
-        .copied()
-        .min_by_key(|(x, _)| (x - e).abs())
-        .unwrap_or((0, ""))
 }
 
 /// The chart of a data area with its axes, mesh and labels over (x0, x1, y0, y1).

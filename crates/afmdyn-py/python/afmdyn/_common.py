@@ -14,11 +14,11 @@ import os
 import warnings
 from typing import (
     Literal,
-    TYPE_CHECKING,
     Any,
     Callable,
     Dict,
     Optional,
+    Protocol,
     Sequence,
     Tuple,
     TypedDict,
@@ -34,12 +34,17 @@ from . import _afmdyn as _core
 from ._afmdyn import Params
 from ._progress import ProgressArg, reporter
 
-if TYPE_CHECKING:
-    from ._attractors import Attractor
-    from ._results import Orbit
+
+class HasState(Protocol):
+    """A start given by its state at drive phase 0: an :class:`Attractor` or an
+    :class:`Orbit` (structurally, so that this module imports neither)."""
+
+    @property
+    def state(self) -> np.ndarray: ...
+
 
 #: An initial state: 2N values, or an :class:`Attractor` / :class:`Orbit` (its ``state``).
-StateLike = Union[None, Sequence[float], np.ndarray, "Attractor", "Orbit"]
+StateLike = Union[None, Sequence[float], np.ndarray, HasState]
 
 
 class Model(TypedDict, total=False):

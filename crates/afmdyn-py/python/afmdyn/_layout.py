@@ -1,4 +1,4 @@
-"""Results as the library lays them out (``afmdyn::study::Layout``): every variable's name,
+"""Results as the library lays them out (``afmdyn::layout::Layout``): every variable's name,
 dimensions, units and long name are declared once in the library, which also writes the
 command line's NetCDF files from the same declaration; this module turns a layout into an
 ``xarray.Dataset`` and gives the Dask Zarr writer its per-cell variables."""

@@ -100,8 +100,8 @@ impl Attractor {
 }
 
 /// Drive periods of the λ₁ estimate of a census's nonperiodic ends: a basin map's
-/// ([`super::basins::LYAPUNOV_PERIODS`], as a chart's default).
-pub const CENSUS_LYAPUNOV_PERIODS: usize = super::basins::LYAPUNOV_PERIODS;
+/// (as the basin map's, [`super::basins::LYAPUNOV_PERIODS`], and a chart's default).
+pub const CENSUS_LYAPUNOV_PERIODS: usize = 500;
 
 /// The result of an attractor search.
 #[derive(Debug, Clone, PartialEq)]

@@ -361,7 +361,7 @@ pub struct BasinMap {
 }
 
 /// Drive periods of the λ₁ estimate of a nonperiodic attractor of a basin map.
-pub const LYAPUNOV_PERIODS: usize = 500;
+pub const LYAPUNOV_PERIODS: usize = super::attractors::CENSUS_LYAPUNOV_PERIODS;
 
 impl BasinMap {
     /// The labels, row-major.

@@ -13,9 +13,9 @@ use crate::analysis::basins::{
 use crate::analysis::bifurcation::SweepSpec;
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
+use crate::layout::{Attr, Layout, Variable};
 use crate::model::CantileverModel;
 use crate::params::Params;
-use crate::study::layout::{Attr, Layout, Variable};
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 

@@ -13,15 +13,13 @@
 use super::analyses::{IntegratorRequest, SteadyRequest};
 use super::model::{parameter, ModelSpec, ValueKind};
 use crate::analysis::bifurcation::SweepSpec;
-use crate::analysis::chart::{run_chart, CellParams, ChartCell, ChartPlan, ChartSpec};
+use crate::analysis::chart::{CellParams, ChartCell, ChartSpec};
 use crate::error::SimError;
+use crate::layout::{Layout, Variable};
 use crate::params::Params;
 use crate::probe::Probe;
-use crate::study::{Layout, Study, Variable};
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
-use std::collections::HashSet;
-use std::sync::atomic::AtomicBool;
 
 /// Largest number of cells of a chart (x_steps × y_steps).
 pub const MAX_CHART_CELLS: usize = 1_000_000;
@@ -236,66 +234,6 @@ pub struct Chart {
     pub model: ChartModel,
     /// What a resumed chart must match ([`fingerprint`]).
     pub fingerprint: Value,
-}
-
-impl Study for Chart {
-    /// A task's number and its cells.
-    type Record = (usize, Vec<ChartCell>);
-    /// The tasks stored.
-    type Done = HashSet<usize>;
-
-    fn fingerprint(&self) -> &Value {
-        &self.fingerprint
-    }
-
-    fn units(&self) -> u64 {
-        (self.spec.x.len() * self.spec.y.len()) as u64
-    }
-
-    fn done_units(&self, done: &HashSet<usize>) -> u64 {
-        let plan = ChartPlan::new(&self.spec, &self.model);
-        done.iter().map(|&t| plan.tile(t).1.len() as u64).sum()
-    }
-
-    fn record_units(&self, record: &(usize, Vec<ChartCell>)) -> u64 {
-        record.1.len() as u64
-    }
-
-    fn run(
-        &self,
-        done: &HashSet<usize>,
-        sink: &(dyn Fn((usize, Vec<ChartCell>)) + Sync),
-        cancel: &AtomicBool,
-    ) {
-        let plan = ChartPlan::new(&self.spec, &self.model);
-        run_chart(&plan, done, &|t, cells| sink((t, cells)), cancel);
-    }
-}
-
-impl Chart {
-    /// The cells of the tasks `records` (a [`crate::study::MemoryStore`]'s, in any order), row
-    /// by row, x increasing.
-    pub fn cells_of(records: Vec<(usize, Vec<ChartCell>)>) -> Vec<ChartCell> {
-        let mut cells: Vec<ChartCell> = records.into_iter().flat_map(|(_, c)| c).collect();
-        cells.sort_by_key(|c| (c.iy, c.ix));
-        cells
-    }
-
-    /// The chart's failure when no cell found any attractor: the one rule of every front end
-    /// (with the first cell's message).
-    pub fn every_cell_failed(cells: &[ChartCell]) -> Option<SimError> {
-        if !cells.iter().all(|c| c.attractors.is_empty()) {
-            return None;
-        }
-        Some(SimError::EveryRunFailed {
-            what: "chart cells",
-            runs: cells.len(),
-            first: cells
-                .iter()
-                .find_map(|c| c.message.clone())
-                .unwrap_or_default(),
-        })
-    }
 }
 
 impl ChartRequest {

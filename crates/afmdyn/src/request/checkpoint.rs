@@ -6,18 +6,16 @@
 //! with the `files` feature [`super::checkpoint_file::FileCheckpoint`] keeps them in a
 //! directory (the command line's `--out` with `--resume`, Python's `store=`).
 //!
-//! [`open`] decides where a sweep stands in its store; the sweep is a [`Study`]
-//! ([`SweepStudy`]) that [`crate::study::execute`] computes into it, and
+//! [`open`] decides where a sweep stands in its store; the sweep is a study
+//! ([`crate::study::sweep::SweepStudy`]) that [`crate::study::execute`] computes into it, and
 //! [`Checkpoint::finish`] puts the rows in the one order ([`super::sweep::order_key`]).
 //!
 //! [`fingerprint`]: super::sweep::fingerprint
 
-use super::sweep::{first_difference, records, SweepRecord};
-use crate::analysis::bifurcation::{run_sweep_cancellable, Branch, Resume, SweepPoint, SweepSpec};
-use crate::study::{Opened, Store, Study};
+use super::sweep::{first_difference, SweepRecord};
+use crate::analysis::bifurcation::{Branch, Resume, SweepSpec};
 use nalgebra::DVector;
 use serde_json::Value;
-use std::sync::atomic::AtomicBool;
 use thiserror::Error;
 
 /// What can go wrong with a checkpoint.
@@ -191,87 +189,6 @@ pub fn open<C: Checkpoint + ?Sized>(
     Ok(Some(Resume::default()))
 }
 
-/// A bifurcation sweep as a [`Study`]: its spec and fingerprint. A task is one point (a
-/// value reached one way), stored as its records; a resume skips the stored points and goes on
-/// along each chain from its last stored state.
-#[derive(Debug, Clone)]
-pub struct SweepStudy {
-    /// The validated sweep.
-    pub spec: SweepSpec,
-    /// What a resumed sweep must match ([`super::sweep::fingerprint`]).
-    pub fingerprint: Value,
-}
-
-impl SweepStudy {
-    /// The study of `spec`, validated from `request`.
-    pub fn new(request: &super::BifurcationRequest, spec: SweepSpec) -> SweepStudy {
-        let fingerprint = super::sweep::fingerprint(request, &spec);
-        SweepStudy { spec, fingerprint }
-    }
-}
-
-impl Study for SweepStudy {
-    type Record = Vec<SweepRecord>;
-    type Done = Resume;
-
-    fn fingerprint(&self) -> &Value {
-        &self.fingerprint
-    }
-
-    fn units(&self) -> u64 {
-        point_count(&self.spec) as u64
-    }
-
-    fn done_units(&self, done: &Resume) -> u64 {
-        done.done.len() as u64
-    }
-
-    fn record_units(&self, _: &Vec<SweepRecord>) -> u64 {
-        1
-    }
-
-    fn run(&self, done: &Resume, sink: &(dyn Fn(Vec<SweepRecord>) + Sync), cancel: &AtomicBool) {
-        let param = self.spec.param;
-        run_sweep_cancellable(
-            &self.spec,
-            done,
-            &|p: SweepPoint| sink(records(param, &p)),
-            cancel,
-        );
-    }
-}
-
-/// [`Store`] of a sweep for a [`Checkpoint`]: [`open`], [`Checkpoint::append`],
-/// [`Checkpoint::finish`].
-macro_rules! sweep_store {
-    ($t:ty) => {
-        impl Store<SweepStudy> for $t {
-            fn open(
-                &mut self,
-                study: &SweepStudy,
-                resume: bool,
-            ) -> Result<Opened<Resume>, CheckpointError> {
-                Ok(match open(self, &study.fingerprint, resume)? {
-                    Some(r) => Opened::Run(r),
-                    None => Opened::Finished,
-                })
-            }
-
-            fn append(&mut self, record: Vec<SweepRecord>) -> Result<(), CheckpointError> {
-                Checkpoint::append(self, &record)
-            }
-
-            fn finish(&mut self, study: &SweepStudy) -> Result<(), CheckpointError> {
-                Checkpoint::finish(self, &study.fingerprint)
-            }
-        }
-    };
-}
-
-sweep_store!(MemoryCheckpoint);
-#[cfg(feature = "files")]
-sweep_store!(super::checkpoint_file::FileCheckpoint<'_>);
-
 /// The number of points of a sweep: values × (2 with continuation + random starts).
 pub fn point_count(spec: &SweepSpec) -> usize {
     spec.values.len() * (usize::from(spec.continuation) * 2 + spec.starts as usize)
@@ -351,7 +268,3 @@ impl Checkpoint for MemoryCheckpoint {
         Ok(())
     }
 }
-
-#[cfg(test)]
-#[path = "checkpoint_tests.rs"]
-mod tests;

@@ -9,7 +9,8 @@
 //!   `attractors`, `orbit`, `continuation`, `lyapunov`, `observe`) with `validate`, and `run`
 //!   where the analysis is one library call.
 //! - [`chart`](mod@chart): the two-parameter behaviour chart ([`ChartRequest`]), its limits,
-//!   fingerprint and result layout; [`chart_store`] its resumable directory (feature `files`).
+//!   fingerprint and result layout (its study and store: [`crate::study::chart`],
+//!   `crate::study::chart_store`).
 //! - [`curves`]: the stepped curves (`approach`, `resonance`).
 //! - [`run`](mod@run): [`run()`]`(analysis, model, progress)` → [`Document`], the typed result and
 //!   its JSON document, for every analysis whose result is one value ([`Analysis`]).
@@ -29,8 +30,6 @@
 pub mod analyses;
 pub mod basins;
 pub mod chart;
-#[cfg(feature = "files")]
-pub mod chart_store;
 pub mod checkpoint;
 #[cfg(feature = "files")]
 pub mod checkpoint_file;

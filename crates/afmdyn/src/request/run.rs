@@ -8,7 +8,7 @@
 //! [`Progress`]: `simulate` records in chunks to a sink
 //! ([`crate::trajectory::chunked::record_chunked`], budgets by
 //! [`crate::request::analyses::SimulateSpan`]) and `bifurcation` is a study
-//! ([`crate::request::checkpoint::SweepStudy`]) that [`crate::study::execute`] runs into a
+//! ([`crate::study::sweep::SweepStudy`]) that [`crate::study::execute`] runs into a
 //! [`crate::request::Checkpoint`].
 //!
 //! [`Progress`] is the sink of the run's progress and its cancel flag: the analyses count

@@ -10,28 +10,30 @@
 //!   stores lock their directory for one run at a time
 //!   ([`crate::request::checkpoint_file::FileCheckpoint`] for sweeps; `task_store::TaskStore`,
 //!   feature `files`, for any study of numbered tasks whose records serialize — the chart's
-//!   `request::chart_store`); [`MemoryStore`] keeps the tasks in memory.
+//!   `chart_store`); [`MemoryStore`] keeps the tasks in memory.
 //! - [`execute`]: the one executor — opens the store (refusing a resume of another request),
 //!   builds the worker pool (the request's thread count, checked once by
 //!   [`crate::request::limits::check_threads`]), runs the study, appends each finished task
 //!   under one lock, reports progress to an [`Observer`], and finishes the store.
-//! - [`layout`]: a result's variables (name, dimensions, units, long name) declared once, from
-//!   which the NetCDF file ([`netcdf`], feature `files`), the Python `xarray.Dataset` and the
-//!   Dask Zarr store are written.
+//! - the studies: [`chart`] (a behaviour chart's tiles, its store [`chart_store`]) and [`sweep`]
+//!   (a bifurcation sweep's points, stored by the request layer's checkpoints).
+//!
+//! The results' variables are declared once in [`crate::layout`], from which the NetCDF file,
+//! the Python `xarray.Dataset` and the Dask Zarr store are written.
 //!
 //! Results never depend on the thread count or on the order tasks finish in: every seed comes
 //! from the request and the task, and a store puts its records in the one order when it
 //! finishes. Dask (`afmdyn.dask`) is another executor of the same tasks: it ships them to
 //! workers and writes through the same layout.
 
-pub mod layout;
-mod memory;
+pub mod chart;
 #[cfg(feature = "files")]
-pub mod netcdf;
+pub mod chart_store;
+mod memory;
+pub mod sweep;
 #[cfg(feature = "files")]
 pub mod task_store;
 
-pub use layout::{Layout, Values, Variable};
 pub use memory::MemoryStore;
 
 use crate::analysis::progress::Progress;

@@ -15,7 +15,7 @@
 //!
 //! A resumed study computes only the tasks not stored, and only for the request that made the
 //! store (its fingerprint); a finished one computes nothing. The command line's
-//! `afmdyn chart --out DIR` keeps its store there ([`crate::request::chart_store`]); the files
+//! `afmdyn chart --out DIR` keeps its store there ([`super::chart_store`]); the files
 //! a user reads (`chart.csv`, `chart.nc`, the maps) are written from it.
 
 use crate::request::checkpoint::{CheckpointError, Ledger};

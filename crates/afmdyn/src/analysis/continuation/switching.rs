@@ -86,7 +86,7 @@ pub fn period_doubling_starts(
 /// being the one of `spec`.
 ///
 /// # Errors
-/// As [`continue_branch`] for the first branch; a sub-branch that fails is skipped.
+/// As [`super::continue_branch`] for the first branch; a sub-branch that fails is skipped.
 pub fn continue_with_switching(
     spec: &ContinuationSpec,
     guess: &DVector<f64>,

@@ -1,12 +1,12 @@
 //! The resumable store of a chart (feature `files`): a [`TaskStore`] of tiles in the directory
 //! `afmdyn chart --out DIR` names — `.chart.run.json` (the ledger) and `.chart.tiles.jsonl`
 //! (one checksummed line per finished tile, its cells under `"cells"`), as
-//! [`crate::study::task_store`] describes.
+//! [`super::task_store`] describes.
 
+use super::task_store::{TaskFiles, TaskStore};
 use crate::analysis::chart::ChartCell;
 use crate::request::checkpoint::CheckpointError;
 use crate::request::dir_lock::DirLock;
-use crate::study::task_store::{TaskFiles, TaskStore};
 
 /// The chart's files.
 pub const CHART_FILES: TaskFiles = TaskFiles {

@@ -8,7 +8,7 @@
 //! attractor) is left out with the variables over it, which hold no value, and the global
 //! attribute `empty_dimensions` names it.
 
-use super::layout::{Attr, Layout, Values};
+use super::{Attr, Layout, Values};
 use std::path::Path;
 use thiserror::Error;
 
@@ -99,7 +99,7 @@ pub fn write(path: &Path, layout: &Layout) -> Result<(), WriteError> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::study::layout::Variable;
+    use crate::layout::Variable;
 
     /// The file read back by the `netcdf3` reader holds the layout's values and attributes.
     #[test]

@@ -1,9 +1,12 @@
 //! A result's layout: its dimensions and variables, each with its units and long name (CF
 //! conventions), declared once by the library for every writer — the command line's NetCDF
-//! file ([`super::netcdf`]), the Python `xarray.Dataset` and the Dask Zarr store.
+//! file ([`netcdf`], feature `files`), the Python `xarray.Dataset` and the Dask Zarr store.
 //!
 //! Values are row-major over the variable's dimensions (the last one fastest), as NetCDF,
 //! NumPy and xarray store them.
+
+#[cfg(feature = "files")]
+pub mod netcdf;
 
 /// The values of a variable, row-major over its dimensions.
 #[derive(Debug, Clone, PartialEq)]

@@ -2,12 +2,16 @@
 //! ends with the rows of an uninterrupted sweep; another request is refused naming the field.
 
 use super::*;
+use crate::analysis::bifurcation::Branch;
 use crate::analysis::bifurcation::SweepSpec;
 use crate::analysis::progress::Progress;
 use crate::params::Params;
+use crate::request::checkpoint::*;
+use crate::request::sweep::SweepRecord;
 use crate::request::sweep::{fingerprint, order_key, PointStatus, HEADER};
 use crate::request::BifurcationRequest;
-use crate::study::{execute, StudyError};
+use crate::study::execute;
+use crate::study::StudyError;
 use std::collections::HashSet;
 use std::sync::Mutex;
 
@@ -130,7 +134,7 @@ fn a_failed_point_is_one_row_with_its_message_and_codes() {
         "omega,2.5,3,start-2,error,,0,1,,,,,,,,,no convergence  after 300 periods,"
     );
     assert_eq!(rows[0].status.code(), -2);
-    assert_eq!(super::super::sweep::branch_code(p.branch), 4.0);
+    assert_eq!(crate::request::sweep::branch_code(p.branch), 4.0);
     let back = SweepRecord::parse_csv(&rows[0].csv_line()).unwrap();
     assert_eq!(back.status, PointStatus::Error);
     assert!(back.w_tip.is_nan() && back.transient_periods.is_none());

@@ -1,0 +1,69 @@
+//! A behaviour chart ([`crate::request::chart::Chart`]) as a [`Study`]: its tasks are the
+//! tiles of [`ChartPlan`] (cells of one row, continued along x), its record a tile's cells
+//! with the task's number, what a resume skips the stored tasks ([`super::chart_store`]).
+
+use super::Study;
+use crate::analysis::chart::{run_chart, ChartCell, ChartPlan};
+use crate::error::SimError;
+use crate::request::chart::Chart;
+use serde_json::Value;
+use std::collections::HashSet;
+use std::sync::atomic::AtomicBool;
+
+impl Study for Chart {
+    /// A task's number and its cells.
+    type Record = (usize, Vec<ChartCell>);
+    /// The tasks stored.
+    type Done = HashSet<usize>;
+
+    fn fingerprint(&self) -> &Value {
+        &self.fingerprint
+    }
+
+    fn units(&self) -> u64 {
+        (self.spec.x.len() * self.spec.y.len()) as u64
+    }
+
+    fn done_units(&self, done: &HashSet<usize>) -> u64 {
+        let plan = ChartPlan::new(&self.spec, &self.model);
+        done.iter().map(|&t| plan.tile(t).1.len() as u64).sum()
+    }
+
+    fn record_units(&self, record: &(usize, Vec<ChartCell>)) -> u64 {
+        record.1.len() as u64
+    }
+
+    fn run(
+        &self,
+        done: &HashSet<usize>,
+        sink: &(dyn Fn((usize, Vec<ChartCell>)) + Sync),
+        cancel: &AtomicBool,
+    ) {
+        let plan = ChartPlan::new(&self.spec, &self.model);
+        run_chart(&plan, done, &|t, cells| sink((t, cells)), cancel);
+    }
+}
+
+/// The cells of the tasks `records` (a [`super::MemoryStore`]'s, in any order), row
+/// by row, x increasing.
+pub fn cells_of(records: Vec<(usize, Vec<ChartCell>)>) -> Vec<ChartCell> {
+    let mut cells: Vec<ChartCell> = records.into_iter().flat_map(|(_, c)| c).collect();
+    cells.sort_by_key(|c| (c.iy, c.ix));
+    cells
+}
+
+/// The chart's failure when no cell found any attractor: the one rule of every front end
+/// (with the first cell's message).
+pub fn every_cell_failed(cells: &[ChartCell]) -> Option<SimError> {
+    if !cells.iter().all(|c| c.attractors.is_empty()) {
+        return None;
+    }
+    Some(SimError::EveryRunFailed {
+        what: "chart cells",
+        runs: cells.len(),
+        first: cells
+            .iter()
+            .find_map(|c| c.message.clone())
+            .unwrap_or_default(),
+    })
+}
