@@ -11,8 +11,10 @@
 //! (eqs. 5, 7) → [`contact`] (tip–sample laws) → [`system`] (the hybrid-system interface,
 //! saltation) → [`model`] (the cantilever–sample system) → [`tip_sample`] (what integrators and
 //! analyses need of a probe over a sample) → [`integrate`] (exact propagation, RK4, the
-//! adaptive DOP853 oracle, Taylor series, split) → [`trajectory`] (observables, stroboscopic Poincaré section) →
-//! [`analysis`] (steady states, periods, bifurcation sweeps, attractors, mode convergence);
+//! adaptive DOP853 oracle, Taylor series, split) → [`maps`] (the flow map with its Jacobian and
+//! saltation, the stroboscopic map) and [`trajectory`] (observables, stroboscopic Poincaré
+//! section) → [`analysis`] (steady states, periods, bifurcation sweeps, attractors, mode
+//! convergence);
 //! [`request`] is what every front end hands the library (parameters by name, defaults, limits);
 //! [`report`] builds the JSON result documents shared by the command line and Python;
 //! [`study`] runs the analyses made of many tasks (one executor, one kind of store);
@@ -65,6 +67,7 @@ pub mod galerkin;
 pub mod integrate;
 pub mod layout;
 mod linalg;
+pub mod maps;
 pub mod model;
 pub mod params;
 pub mod probe;

@@ -13,13 +13,18 @@
 //! integrators and analyses on a second one (a forced oscillator against a rigid wall) and
 //! checks them against its closed forms.
 //!
-//! Analyses that need the cantilever's Galerkin structure — the AFM observables (energy
-//! balance, virial over the modes), the recorded trajectory with its energy quadrature, the
-//! check that the beam's body touches the sample — ask for it with
-//! [`TipSampleSystem::cantilever`] and refuse another system with [`SimError::NotCantilever`].
+//! What the steady-state searches need beyond the flow is asked of the trait by purpose: the
+//! slowest free decay rate for their transient caps ([`TipSampleSystem::free_decay_rate`]) and
+//! the check that the probe's body touches the sample
+//! ([`TipSampleSystem::body_contact_check`]); a system without them gets the floors and no
+//! check. The two analyses that need the cantilever's Galerkin structure itself — the AFM
+//! observables (energy balance, virial over the modes, SI scales) and the recorded trajectory
+//! with its energy quadrature — ask for it with [`require_cantilever`] and refuse another
+//! system with [`SimError::NotCantilever`].
 
+use crate::eigen::damped_eigenvalues;
 use crate::error::SimError;
-use crate::model::CantileverModel;
+use crate::model::{BodyContactCheck, CantileverModel};
 use crate::params::SweepParam;
 use crate::system::{HybridSystem, Region};
 use nalgebra::{DMatrix, DVector};
@@ -90,13 +95,27 @@ pub trait TipSampleSystem: HybridSystem {
     /// ∂g/∂p of the guard of `mode` at fixed (τ, z) for a parameter p of the forcing (Ω, α2,
     /// α5), or `None` where the system does not provide it (the default): the parameter
     /// sensitivity of a flow then is not available
-    /// ([`crate::analysis::monodromy::flow_with_param_derivative`]).
+    /// ([`crate::maps::flow::flow_with_param_derivative`]).
     fn guard_param_derivative(&self, mode: Region, param: SweepParam, tau: f64) -> Option<f64> {
         let _ = (mode, param, tau);
         None
     }
     /// Name of the tip–sample law ("linear", "hertz", "dmt", "impact", or the system's own).
     fn law_name(&self) -> &'static str;
+    /// The slowest decay rate of free motion, min |Re λ| over the damped eigenvalues λ of the
+    /// free region (eqs. 20–21 for the cantilever), per unit τ: what the derived transient caps
+    /// of the steady-state searches scale with
+    /// ([`crate::analysis::steady::decay_periods`]). `None` (the default) for a system
+    /// without one; the caps then take their floors.
+    fn free_decay_rate(&self) -> Option<f64> {
+        None
+    }
+    /// The check that the probe's body (beam stations away from the tip, sampled at `points`
+    /// stations) touches the sample; `None` (the default) for a system without a body.
+    fn body_contact_check(&self, points: usize) -> Option<BodyContactCheck> {
+        let _ = points;
+        None
+    }
     /// The cantilever model, for the analyses that need its Galerkin structure (see the module
     /// docs); `None` for another system (the default).
     fn cantilever(&self) -> Option<&CantileverModel> {
@@ -152,6 +171,15 @@ impl TipSampleSystem for CantileverModel {
     }
     fn law_name(&self) -> &'static str {
         self.law().name()
+    }
+    fn free_decay_rate(&self) -> Option<f64> {
+        damped_eigenvalues(self.galerkin().region(Region::Free))
+            .iter()
+            .map(|e| e.re.abs())
+            .reduce(f64::min)
+    }
+    fn body_contact_check(&self, points: usize) -> Option<BodyContactCheck> {
+        Some(BodyContactCheck::new(self, points))
     }
     fn cantilever(&self) -> Option<&CantileverModel> {
         Some(self)

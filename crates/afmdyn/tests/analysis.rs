@@ -225,7 +225,8 @@ fn attractor_census_reports_polished_orbits_with_multipliers() {
             "an attractor reached from random starts is stable"
         );
         for pt in &a.steady.poincare {
-            let back = afmdyn::analysis::monodromy::stroboscopic(it.as_mut(), &pt.state, n)
+            let back = afmdyn::maps::StroboscopicMap::new(it.as_mut(), n)
+                .apply(&pt.state)
                 .unwrap()
                 .state;
             let res = (&back - &pt.state).amax();

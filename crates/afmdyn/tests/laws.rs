@@ -7,11 +7,12 @@
 
 use afmdyn::analysis::continuation::{continue_branch, BranchEnd, ContinuationSpec};
 use afmdyn::analysis::lyapunov::{lyapunov_spectrum, LyapunovOptions};
-use afmdyn::analysis::monodromy::{flow_with_jacobian, stroboscopic};
 use afmdyn::analysis::shooting::{floquet_multipliers, shoot, shoot_with, ShootingOptions};
 use afmdyn::analysis::steady::{steady_state, Motion, SteadyOptions};
 use afmdyn::galerkin::Region;
 use afmdyn::integrate::{advance_dyn, build, IntegratorKind, IntegratorOptions, SwitchEvent};
+use afmdyn::maps::flow::flow_with_jacobian;
+use afmdyn::maps::StroboscopicMap;
 use afmdyn::request::analyses::OrbitRequest;
 use afmdyn::{CantileverModel, ContactLaw, EventKind, HybridSystem, Params, SimError, SweepParam};
 use nalgebra::{Complex, DMatrix, DVector};
@@ -526,8 +527,14 @@ fn dmt_kelvin_voigt_monodromy_matches_finite_differences() {
         let (mut zp, mut zm) = (o.state.clone(), o.state.clone());
         zp[k] += eps;
         zm[k] -= eps;
-        let a = stroboscopic(it.as_mut(), &zp, 1).unwrap().state;
-        let b = stroboscopic(it.as_mut(), &zm, 1).unwrap().state;
+        let a = StroboscopicMap::new(it.as_mut(), 1)
+            .apply(&zp)
+            .unwrap()
+            .state;
+        let b = StroboscopicMap::new(it.as_mut(), 1)
+            .apply(&zm)
+            .unwrap()
+            .state;
         fd.set_column(k, &((a - b) / (2.0 * eps)));
     }
     let err = (&fd - &o.monodromy).amax();
@@ -675,8 +682,14 @@ fn every_analysis_on_every_law() {
             let (mut zp, mut zm) = (o.state.clone(), o.state.clone());
             zp[k] += eps;
             zm[k] -= eps;
-            let a = stroboscopic(it.as_mut(), &zp, c.period).unwrap().state;
-            let b = stroboscopic(it.as_mut(), &zm, c.period).unwrap().state;
+            let a = StroboscopicMap::new(it.as_mut(), c.period)
+                .apply(&zp)
+                .unwrap()
+                .state;
+            let b = StroboscopicMap::new(it.as_mut(), c.period)
+                .apply(&zm)
+                .unwrap()
+                .state;
             fd.set_column(k, &((a - b) / (2.0 * eps)));
         }
         let mu_fd = floquet_multipliers(&fd);
@@ -703,7 +716,8 @@ fn every_analysis_on_every_law() {
         for bp in &branch {
             let mb = CantileverModel::new(&p.with(SweepParam::Omega, bp.value)).unwrap();
             let mut ib = build(&mb, IntegratorOptions::default(), 0.0, &mb.rest()).unwrap();
-            let back = stroboscopic(ib.as_mut(), &bp.section[0], c.period)
+            let back = StroboscopicMap::new(ib.as_mut(), c.period)
+                .apply(&bp.section[0])
                 .unwrap()
                 .state;
             assert!(

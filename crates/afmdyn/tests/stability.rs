@@ -5,12 +5,12 @@ use afmdyn::analysis::continuation::{
     continue_branch, continue_with_switching, BranchEvent, ContinuationSpec,
 };
 use afmdyn::analysis::lyapunov::{lyapunov_spectrum, zero_one_test, LyapunovOptions, Verdict};
-use afmdyn::analysis::monodromy::{stroboscopic, stroboscopic_with_param_derivative};
 use afmdyn::analysis::shooting::{shoot, shoot_broyden, Instability, ShootingOptions};
 use afmdyn::analysis::steady::{steady_state, SteadyOptions};
 use afmdyn::galerkin::Region;
 use afmdyn::integrate::exact::ExactPropagator;
 use afmdyn::integrate::{build, IntegratorKind, IntegratorOptions};
+use afmdyn::maps::StroboscopicMap;
 use afmdyn::{CantileverModel, ContactLaw, Params, SweepParam};
 use nalgebra::{Complex, DMatrix, DVector};
 use proptest::prelude::*;
@@ -48,7 +48,7 @@ proptest! {
         let m = model(Params { omega, alpha4, alpha6, alpha1, ..Params::default() });
         let z0 = DVector::from_vec(vec![a1, a2, 0.0, v1, v2, 0.0]);
         let mut prop = ExactPropagator::new(&m, 1);
-        let map = stroboscopic(&mut prop, &z0, 1).unwrap();
+        let map = StroboscopicMap::new(&mut prop, 1).apply(&z0).unwrap();
         // near-grazing switchings make the map non-differentiable at finite size: skip them
         prop_assume!(map.grazing_distance > 1e-3);
         let h = 1e-6;
@@ -58,8 +58,8 @@ proptest! {
             let mut zm = z0.clone();
             zp[j] += h;
             zm[j] -= h;
-            let a = stroboscopic(&mut prop, &zp, 1).unwrap();
-            let b = stroboscopic(&mut prop, &zm, 1).unwrap();
+            let a = StroboscopicMap::new(&mut prop, 1).apply(&zp).unwrap();
+            let b = StroboscopicMap::new(&mut prop, 1).apply(&zm).unwrap();
             prop_assume!(a.switchings == map.switchings && b.switchings == map.switchings);
             fd.set_column(j, &((a.state - b.state) / (2.0 * h)));
         }
@@ -267,7 +267,7 @@ fn shooting_converges_quadratically_to_the_period_two_orbit() {
     // the Newton iterates skip the grazing searches; the orbit's distance is the one the full
     // map gives at the converged point
     let mut it = ExactPropagator::try_new(&m, 1).unwrap();
-    let map = stroboscopic(&mut it, &o.state, 2).unwrap();
+    let map = StroboscopicMap::new(&mut it, 2).apply(&o.state).unwrap();
     assert!(map.grazing_distance.is_finite() && map.grazing_distance > 0.0);
     assert_eq!(o.grazing_distance, map.grazing_distance);
     assert_eq!(o.monodromy, map.jacobian);
@@ -288,7 +288,7 @@ fn multipliers_predict_the_decay_of_a_perturbation() {
     let mut w = &o.state + DVector::from_element(6, 1e-7);
     let mut d = Vec::new();
     for _ in 0..60 {
-        w = stroboscopic(&mut prop, &w, 1).unwrap().state;
+        w = StroboscopicMap::new(&mut prop, 1).apply(&w).unwrap().state;
         d.push((&w - &o.state).norm());
     }
     let rate = (d[59] / d[39]).powf(1.0 / 20.0);
@@ -505,7 +505,9 @@ fn continuation_locates_the_period_doubling_near_omega_2_91() {
             ..base
         });
         let mut integ = build(&m, spec.integrator, 0.0, &m.rest()).unwrap();
-        let map = stroboscopic(integ.as_mut(), &b.section[0], 1).unwrap();
+        let map = StroboscopicMap::new(integ.as_mut(), 1)
+            .apply(&b.section[0])
+            .unwrap();
         assert_eq!(
             map.grazing_distance, b.grazing_distance,
             "at Ω = {}",
@@ -654,7 +656,7 @@ fn parameter_derivative_of_the_map_equals_central_differences() {
         let map_at = |p: Params| {
             let m = model(p);
             let mut it = ExactPropagator::try_new(&m, 1).unwrap();
-            stroboscopic(&mut it, &z, n).unwrap().state
+            StroboscopicMap::new(&mut it, n).apply(&z).unwrap().state
         };
         for (param, value) in [
             (SweepParam::Omega, base.omega),
@@ -662,7 +664,10 @@ fn parameter_derivative_of_the_map_equals_central_differences() {
             (SweepParam::Alpha5, base.alpha5),
         ] {
             let mut it = ExactPropagator::try_new(&m, 1).unwrap();
-            let map = stroboscopic_with_param_derivative(&mut it, &z, n, param).unwrap();
+            let map = StroboscopicMap::new(&mut it, n)
+                .with_param_derivative(param)
+                .apply(&z)
+                .unwrap();
             assert!(map.contacts >= 1, "N = {modes}, Ω = {omega}: no contact");
             let d = map.param_derivative.expect("exact propagator: Ω, α2, α5");
             // central differences with steps h and h/2, Richardson-extrapolated (error O(h⁴))
@@ -698,14 +703,20 @@ fn parameter_derivative_is_none_where_unsupported() {
     });
     let (z, _) = attractor(&m);
     let mut it = ExactPropagator::try_new(&m, 1).unwrap();
-    let map = stroboscopic_with_param_derivative(&mut it, &z, 1, SweepParam::Alpha3).unwrap();
+    let map = StroboscopicMap::new(&mut it, 1)
+        .with_param_derivative(SweepParam::Alpha3)
+        .apply(&z)
+        .unwrap();
     assert!(map.param_derivative.is_none());
     let opts = IntegratorOptions {
         kind: IntegratorKind::Adaptive,
         ..IntegratorOptions::default()
     };
     let mut it = build(&m, opts, 0.0, &z).unwrap();
-    let map = stroboscopic_with_param_derivative(it.as_mut(), &z, 1, SweepParam::Omega).unwrap();
+    let map = StroboscopicMap::new(it.as_mut(), 1)
+        .with_param_derivative(SweepParam::Omega)
+        .apply(&z)
+        .unwrap();
     assert!(map.param_derivative.is_none());
 }
 
@@ -801,10 +812,15 @@ fn stint_transitions_equal_the_product_of_step_jacobians() {
             it.has_region_transition(Region::Free) && it.has_region_transition(Region::Contact)
         );
         for param in [SweepParam::Omega, SweepParam::Alpha2, SweepParam::Alpha5] {
-            let stints = stroboscopic_with_param_derivative(&mut it, &z, n, param).unwrap();
-            let steps =
-                stroboscopic_with_param_derivative(&mut PerStep(&mut it), &z, n, param).unwrap();
-            let plain = stroboscopic(&mut it, &z, n).unwrap();
+            let stints = StroboscopicMap::new(&mut it, n)
+                .with_param_derivative(param)
+                .apply(&z)
+                .unwrap();
+            let steps = StroboscopicMap::new(&mut PerStep(&mut it), n)
+                .with_param_derivative(param)
+                .apply(&z)
+                .unwrap();
+            let plain = StroboscopicMap::new(&mut it, n).apply(&z).unwrap();
             assert!(stints.contacts >= 1, "N = {modes}, Ω = {omega}: no contact");
             assert_eq!(stints.state, steps.state);
             assert_eq!(plain.jacobian, stints.jacobian);
@@ -875,7 +891,9 @@ fn orbit_request_finds_the_unstable_period_1_orbit_of_a_chaotic_impact_attractor
     let o = OrbitRequest::default().run(&p).unwrap();
     assert_eq!(o.period, 1);
     let mut it = build(&m, IntegratorOptions::default(), 0.0, &m.rest()).unwrap();
-    let map = stroboscopic(it.as_mut(), &o.state, 1).unwrap();
+    let map = StroboscopicMap::new(it.as_mut(), 1)
+        .apply(&o.state)
+        .unwrap();
     let tol = ShootingOptions::default().tol;
     let res = (&map.state - &o.state).norm();
     assert!(res <= tol * (1.0 + o.state.norm()), "‖P(z) − z‖ = {res:e}");
@@ -889,8 +907,8 @@ fn orbit_request_finds_the_unstable_period_1_orbit_of_a_chaotic_impact_attractor
         let (mut zp, mut zm) = (o.state.clone(), o.state.clone());
         zp[j] += h;
         zm[j] -= h;
-        let a = stroboscopic(it.as_mut(), &zp, 1).unwrap();
-        let b = stroboscopic(it.as_mut(), &zm, 1).unwrap();
+        let a = StroboscopicMap::new(it.as_mut(), 1).apply(&zp).unwrap();
+        let b = StroboscopicMap::new(it.as_mut(), 1).apply(&zm).unwrap();
         assert_eq!(
             (a.switchings, b.switchings),
             (map.switchings, map.switchings)

@@ -125,6 +125,10 @@ impl TipSampleSystem for SoftImpact {
     fn law_name(&self) -> &'static str {
         "soft impact"
     }
+    /// |Re λ| = ζ of λ = −ζ ± i√(1−ζ²); none for the undamped oscillator.
+    fn free_decay_rate(&self) -> Option<f64> {
+        (self.zeta > 0.0).then_some(self.zeta)
+    }
 }
 
 /// The adaptive DOP853 and the located-event RK4 of the system, both at rest at τ = 0.
@@ -223,6 +227,75 @@ fn an_orbit_that_touches_the_sample_keeps_liouvilles_volume_law() {
         ends[0],
         ends[1]
     );
+}
+
+/// The stroboscopic map is a layer over any system: on the oscillator's touching orbit, P² is
+/// P applied twice, its monodromy matrix is the product of the two period-1 matrices (chain
+/// rule, saltation included) with Liouville's determinant e^{−2ζ·2T}, the map without the
+/// Jacobian gives the same image, and the grazing distance alone equals the watched map's.
+/// (The exact propagator's are equal bit for bit: `tests/stability.rs`.)
+#[test]
+fn the_stroboscopic_map_composes_on_another_system() {
+    use afmdyn::maps::StroboscopicMap;
+    let sys = SoftImpact::new(0.3);
+    let mut it = Adaptive::new(&sys, 1e-12);
+    it.reset(0.0, &DVector::zeros(2)).unwrap();
+    let ss = steady_state(&mut it, &SteadyOptions::default()).unwrap();
+    // a start off the orbit, so that the two iterates differ
+    let z = ss.end_state() + DVector::from_vec(vec![0.05, -0.02]);
+    let one = StroboscopicMap::new(&mut it, 1).apply(&z).unwrap();
+    let again = StroboscopicMap::new(&mut it, 1).apply(&one.state).unwrap();
+    let two = StroboscopicMap::new(&mut it, 2).apply(&z).unwrap();
+    assert!(one.contacts >= 1 && two.contacts == one.contacts + again.contacts);
+    assert!((&two.state - &again.state).amax() < 1e-9, "P² vs P∘P");
+    let chain = &again.jacobian * &one.jacobian;
+    assert!(
+        (&two.jacobian - &chain).amax() < 1e-7,
+        "M₂ vs M₁(P z) M₁(z)"
+    );
+    let want = (-2.0 * sys.zeta * 2.0 * sys.period()).exp();
+    let det = two.jacobian.determinant();
+    assert!((det / want - 1.0).abs() < 1e-8, "det M₂ = {det} vs {want}");
+    let image = StroboscopicMap::new(&mut it, 2).image(&z).unwrap();
+    assert!((&image - &two.state).amax() < 1e-9);
+    // the adaptive integrator starts each flow with its last step size (a warm start), so a
+    // replay agrees to round-off, not bit for bit
+    let grazing = StroboscopicMap::new(&mut it, 2)
+        .grazing_distance(&z)
+        .unwrap();
+    assert!((grazing - two.grazing_distance).abs() < 1e-12, "{grazing}");
+    let unwatched = StroboscopicMap::new(&mut it, 2)
+        .watch_grazing(false)
+        .apply(&z)
+        .unwrap();
+    assert!(unwatched.grazing_distance.is_nan());
+    assert!((&unwatched.state - &two.state).amax() < 1e-12);
+}
+
+/// The transient caps of the steady-state searches come from the system's free decay rate,
+/// whatever the system: ln(1/tol)/(ζT) drive periods for the oscillator (λ = −ζ ± i√(1−ζ²)),
+/// and the floor for the undamped one, which has none.
+#[test]
+fn the_transient_cap_follows_any_systems_decay_rate() {
+    use afmdyn::analysis::steady::{decay_periods, default_transient_cap, MIN_TRANSIENT_PERIODS};
+    let sys = SoftImpact::new(0.3);
+    let closed = (1e8f64).ln() / (sys.zeta * 2.0 * PI / sys.omega);
+    let decay = decay_periods(&sys, 1e-8).unwrap();
+    assert!(
+        (decay - closed).abs() <= 1e-12 * closed,
+        "{decay} vs {closed}"
+    );
+    let undamped = SoftImpact {
+        zeta: 0.0,
+        ..SoftImpact::new(0.3)
+    };
+    assert_eq!(decay_periods(&undamped, 1e-8), None);
+    assert_eq!(
+        default_transient_cap(&undamped, 1e-8),
+        MIN_TRANSIENT_PERIODS
+    );
+    // the body check is the cantilever's: the oscillator has no body
+    assert!(sys.body_contact_check(32).is_none());
 }
 
 #[test]

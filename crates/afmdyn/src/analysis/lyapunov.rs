@@ -11,11 +11,11 @@
 //! method) is computed on V_T at the stroboscopic section: K ≈ 0 for regular, ≈ 1 for chaotic
 //! motion. It uses no derivative information, so it checks the exponents independently.
 
-use super::monodromy::flow_with_jacobian;
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
 use crate::integrate::Integrator;
 use crate::integrate::{advance, build, IntegratorOptions};
+use crate::maps::flow::flow_with_jacobian;
 use crate::model::CantileverModel;
 use nalgebra::{DMatrix, DVector};
 use rand::{RngExt, SeedableRng};

@@ -1,6 +1,6 @@
-//! Analyses on the stroboscopic Poincaré map: steady states and their periods, parameter
+//! Analyses on the stroboscopic Poincaré map ([`crate::maps`]): steady states and their periods, parameter
 //! sweeps (bifurcation diagrams), coexisting attractors and basins, mode convergence (Fig. 4);
-//! beyond the paper: monodromy matrices with saltation, Newton shooting, Floquet multipliers,
+//! beyond the paper: Newton shooting, Floquet multipliers,
 //! pseudo-arclength continuation, Lyapunov exponents and the 0–1 test for chaos; the observables
 //! of a steady state (harmonics and phase, forces, sample dissipation, virial, energy balances);
 //! the amplitude spectrum of a time series.
@@ -15,7 +15,6 @@ pub mod continuation;
 pub mod converge;
 pub mod global_continuation;
 pub mod lyapunov;
-pub mod monodromy;
 pub mod observables;
 pub mod period;
 pub mod progress;

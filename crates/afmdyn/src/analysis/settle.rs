@@ -23,10 +23,10 @@
 //! stepped sweep, whose transient starts on the previous value's orbit, keeps [`SETTLED`] and
 //! the rate test.
 
-use super::monodromy::flow_state;
 use super::shooting::{shoot_undamped, ShootingOptions};
 use crate::error::SimError;
 use crate::integrate::{advance, Integrator};
+use crate::maps::StroboscopicMap;
 use nalgebra::{Complex, DMatrix, DVector};
 
 /// Chunks of [`SettleOptions::chunk_periods`] during which Newton is retried before the
@@ -264,9 +264,8 @@ fn settled(found: Found, state: DVector<f64>, periods: usize) -> Settling {
 /// of the orbit's period finds the orbit all the same. `n` when no divisor does, or a flow
 /// fails.
 pub fn minimal_period(integ: &mut dyn Integrator, z: &DVector<f64>, n: usize, tol: f64) -> usize {
-    let drive = integ.system().period();
     for d in (1..n).filter(|d| n.is_multiple_of(*d)) {
-        let Ok(state) = flow_state(integ, 0.0, z, d as f64 * drive) else {
+        let Ok(state) = StroboscopicMap::new(&mut *integ, d).image(z) else {
             return n;
         };
         if (&state - z).norm() <= tol * (1.0 + z.norm()) {

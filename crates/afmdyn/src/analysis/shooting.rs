@@ -4,11 +4,10 @@
 //! monodromy matrix of Pⁿ ([`super::monodromy`]); it converges quadratically to stable and
 //! unstable orbits alike. The Floquet multipliers are the eigenvalues of M.
 
-use super::monodromy::{
-    flow_state, grazing_distance, stroboscopic, stroboscopic_unwatched, FlowMap,
-};
 use crate::error::SimError;
 use crate::integrate::{build, Integrator, IntegratorKind, IntegratorOptions};
+use crate::maps::flow::FlowMap;
+use crate::maps::StroboscopicMap;
 use crate::model::CantileverModel;
 use nalgebra::{Complex, DMatrix, DVector};
 use serde::Serialize;
@@ -260,7 +259,7 @@ pub fn shoot_undamped(
 
 /// [`shoot_undamped`] with `m0`, an estimate of the monodromy matrix (the previous orbit's
 /// along a sweep), for the first Jacobian: the iterates take flows without the variational
-/// equations ([`flow_state`]; for the adaptive integrator at N = 3 a seventh of a variational
+/// equations ([`StroboscopicMap::image`]; for the adaptive integrator at N = 3 a seventh of a variational
 /// flow's work), the Jacobian M − I of F updated after each step δ by Broyden's rank-one secant
 /// update J ← J + (ΔF − J δ) δᵀ/(δᵀδ) (Broyden, *Math. Comp.* 19 (1965) 577; Dennis & Schnabel,
 /// *Numerical Methods for Unconstrained Optimization and Nonlinear Equations*, SIAM 1996,
@@ -291,9 +290,8 @@ pub fn shoot_broyden(
             "must be 2N x 2N, N the model's mode count",
         ));
     }
-    let t = n as f64 * integ.system().period();
     let mut z = guess.clone();
-    let mut f = flow_state(integ, 0.0, &z, t)? - &z;
+    let mut f = StroboscopicMap::new(&mut *integ, n).image(&z)? - &z;
     let mut jac = m0 - DMatrix::identity(dim, dim);
     let mut residuals = Vec::new();
     let mut res = f.norm();
@@ -312,7 +310,7 @@ pub fn shoot_broyden(
                 residual: res,
             })?;
         let trial = &z + &delta;
-        let f_new = flow_state(integ, 0.0, &trial, t)? - &trial;
+        let f_new = StroboscopicMap::new(&mut *integ, n).image(&trial)? - &trial;
         let res_new = f_new.norm();
         // a NaN residual fails too
         if res_new.partial_cmp(&res) != Some(std::cmp::Ordering::Less) {
@@ -339,7 +337,9 @@ pub fn shoot_broyden(
     // the converged orbit's monodromy matrix, from a flow whose map differs from the plain
     // flows' by the integration error (their steps differ): a residual within
     // VARIATIONAL_SLACK tolerances is that error, a larger one calls for Newton steps
-    let map = stroboscopic_unwatched(integ, &z, n)?;
+    let map = StroboscopicMap::new(&mut *integ, n)
+        .watch_grazing(false)
+        .apply(&z)?;
     let res_var = (&map.state - &z).norm();
     if res_var <= VARIATIONAL_SLACK * opts.tol * (1.0 + z.norm()) {
         residuals.push(res_var);
@@ -413,7 +413,10 @@ fn line_search(
     let mut lambda = 1.0_f64;
     while lambda >= LINE_SEARCH_MIN_STEP {
         let trial = z + delta * lambda;
-        let f_trial = match stroboscopic_unwatched(integ, &trial, n) {
+        let f_trial = match StroboscopicMap::new(&mut *integ, n)
+            .watch_grazing(false)
+            .apply(&trial)
+        {
             Ok(tmap) => {
                 let tres = (&tmap.state - &trial).norm();
                 let f1 = 0.5 * tres * tres;
@@ -456,7 +459,9 @@ fn newton(
     let mut residuals = Vec::new();
     // the iterates without the grazing searches (`shoot_with`'s `finish` gives the converged
     // orbit its distance to grazing)
-    let mut map = stroboscopic_unwatched(integ, &z, n)?;
+    let mut map = StroboscopicMap::new(&mut *integ, n)
+        .watch_grazing(false)
+        .apply(&z)?;
     let mut res = (&map.state - &z).norm();
     for _ in 0..opts.max_iter {
         residuals.push(res);
@@ -496,7 +501,10 @@ fn newton(
             let trial = &z + &delta * lambda;
             // a trial the map cannot start from (e.g. inside a rigid sample) is a failed trial
             let last = lambda < 1e-3 || damping == Damping::Stop;
-            match stroboscopic_unwatched(integ, &trial, n) {
+            match StroboscopicMap::new(&mut *integ, n)
+                .watch_grazing(false)
+                .apply(&trial)
+            {
                 Ok(tmap) => {
                     let tres = (&tmap.state - &trial).norm();
                     if tres < res || lambda < 1e-3 {
@@ -541,7 +549,9 @@ pub fn section_points(
 ) -> Result<Vec<DVector<f64>>, SimError> {
     let mut section = vec![z.clone()];
     for _ in 1..n {
-        let next = stroboscopic(integ, section.last().expect("non-empty"), 1)?.state;
+        let next = StroboscopicMap::new(&mut *integ, 1)
+            .apply(section.last().expect("non-empty"))?
+            .state;
         section.push(next);
     }
     Ok(section)
@@ -563,8 +573,7 @@ fn finish(
     residuals: Vec<f64>,
 ) -> Result<PeriodicOrbit, SimError> {
     let section = section_points(integ, &z, n)?;
-    let period = integ.system().period();
-    let grazing_distance = grazing_distance(integ, 0.0, &z, n as f64 * period)?;
+    let grazing_distance = StroboscopicMap::new(&mut *integ, n).grazing_distance(&z)?;
     let (multipliers, stable, critical) = floquet_stability(&map.jacobian);
     Ok(PeriodicOrbit {
         period: n,

@@ -3,7 +3,6 @@
 use super::period::{detect_period, minimal_divisor, MAX_PERIOD, MERGE_FACTOR};
 use super::settle::{minimal_period, newton_from_transient, SettleOptions, CENSUS_SETTLED};
 use super::shooting::{shoot_with, ShootingOptions};
-use crate::eigen::damped_eigenvalues;
 use crate::error::SimError;
 use crate::galerkin::Region;
 use crate::integrate::{advance, advance_observed, Integrator, Observed, Observer, Step};
@@ -66,15 +65,11 @@ pub const TRANSIENT_DECAY_TIMES: f64 = 6.0;
 /// Drive periods the slowest free mode of the cantilever takes to decay by the factor `tol`:
 /// ln(1/tol)/(|Re λ| T), λ the damped eigenvalue with the smallest |Re λ| (eqs. 20–21) and T
 /// the drive period — ≈ Q ln(1/tol)/π for a lever of quality factor Q driven at resonance.
-/// `None` for a system that is not the cantilever model or an undamped one.
+/// `None` for a system without a free decay rate ([`TipSampleSystem::free_decay_rate`]) or an
+/// undamped one.
 pub fn decay_periods(system: &dyn TipSampleSystem, tol: f64) -> Option<f64> {
-    let model = system.cantilever()?;
-    let g = model.galerkin().region(Region::Free);
-    let slowest = damped_eigenvalues(g)
-        .iter()
-        .map(|e| e.re.abs())
-        .fold(f64::INFINITY, f64::min);
-    let decay = (1.0 / tol).ln() / (slowest * model.period());
+    let slowest = system.free_decay_rate()?;
+    let decay = (1.0 / tol).ln() / (slowest * system.period());
     (decay.is_finite() && decay > 0.0).then_some(decay)
 }
 
@@ -258,11 +253,9 @@ impl Observer for StatsObserver {
             self.contacts += 1;
         }
         // the beam's body: of the cantilever only (another system has no body to check)
-        let body = self.body.get_or_insert_with(|| {
-            it.system()
-                .cantilever()
-                .map(|m| BodyContactCheck::new(m, 32))
-        });
+        let body = self
+            .body
+            .get_or_insert_with(|| it.system().body_contact_check(32));
         let e1 = match &step.event {
             Some(e) => {
                 if let Some(body) = body {

@@ -162,7 +162,9 @@ pub trait Integrator: Send {
     fn state(&self) -> &DVector<f64>;
     /// Region in force at the current state.
     fn region(&self) -> Region;
-    /// Restart from (τ, z); the region is taken from the sign of V_T (eq. 8).
+    /// Restart from (τ, z); the region is taken from the sign of V_T (eq. 8). An adaptive
+    /// integrator keeps its last step size as the first guess (a warm start), so its replay of
+    /// a flow agrees to round-off rather than bit for bit; a fixed-step one replays exactly.
     ///
     /// # Errors
     /// [`SimError`] for a non-finite τ or a state of the wrong length or with non-finite entries.
@@ -273,7 +275,7 @@ pub trait AffineRegions {
     /// α5; [`crate::model::CantileverModel::forcing_derivative`]). With the step Jacobians J
     /// and the event shifts of [`crate::system::saltation_with_shift`] it gives the parameter
     /// sensitivity of a flow, s ← J s + this (see
-    /// [`crate::analysis::monodromy::flow_with_param_derivative`]). `Ok(false)`, with `out`
+    /// [`crate::maps::flow::flow_with_param_derivative`]). `Ok(false)`, with `out`
     /// untouched, where the integrator does not provide it for this step or parameter (the
     /// exact propagator provides it for Ω, α2 and α5).
     ///
@@ -291,7 +293,7 @@ pub trait AffineRegions {
     /// e^{A_r t}(z(τ0) − z_p(τ0)) with A_r independent of p, so over a whole stint the
     /// parameter sensitivity telescopes to s(τ) = e^{A_r t}(s(τ0) − ∂z_p/∂p(τ0)) + ∂z_p/∂p(τ)
     /// — one product per stint instead of one per step
-    /// ([`crate::analysis::monodromy::flow_with_param_derivative`]). `Ok(false)`, with `out`
+    /// ([`crate::maps::flow::flow_with_param_derivative`]). `Ok(false)`, with `out`
     /// untouched, where the integrator does not provide it (the exact propagator provides it
     /// for Ω, α2 and α5).
     ///

@@ -6,23 +6,21 @@
 //! condition tᵀ(y − y_pred) = 0 (Keller 1977; Seydel, *Practical Bifurcation and Stability
 //! Analysis*, 3rd ed., Springer 2010, ch. 4). ∂F/∂z = M − I with M the monodromy matrix;
 //! ∂F/∂p from the parameter sensitivity along the same flow where the integrator provides it
-//! (the exact propagator for Ω, α2, α5: [`stroboscopic_with_param_derivative`]), else by central
+//! (the exact propagator for Ω, α2, α5: [`StroboscopicMap::with_param_derivative`]), else by central
 //! differences of the map, by flows without the variational equations. Test functions
 //! between accepted points: dp/ds (fold), det(M + I) (period doubling), the number of complex
 //! multipliers outside the unit circle (Neimark–Sacker) and the number of switchings per cycle
 //! (grazing); each sign change is located on the arclength step, by bisection for the counts
 //! and by the Illinois secant for the two smooth test functions.
 
-use crate::analysis::monodromy::{
-    flow_state, grazing_distance, stroboscopic_with_param_derivative,
-    stroboscopic_with_param_derivative_unwatched, FlowMap,
-};
 use crate::analysis::progress::Progress;
 use crate::analysis::shooting::{
     floquet_stability, section_points, shoot_with, Instability, ShootingOptions,
 };
 use crate::error::SimError;
 use crate::integrate::{build, Integrator, IntegratorOptions};
+use crate::maps::flow::FlowMap;
+use crate::maps::StroboscopicMap;
 use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
 use nalgebra::{Complex, DMatrix, DVector};
@@ -299,21 +297,17 @@ impl Solver {
     /// distance to grazing only when `watched` (else NaN).
     fn map(&mut self, z: &DVector<f64>, p: f64, watched: bool) -> Result<FlowMap, SimError> {
         let (n, param) = (self.spec.period, self.spec.param);
-        let integ = self.at(p)?;
-        if watched {
-            stroboscopic_with_param_derivative(integ, z, n, param)
-        } else {
-            stroboscopic_with_param_derivative_unwatched(integ, z, n, param)
-        }
+        StroboscopicMap::new(self.at(p)?, n)
+            .with_param_derivative(param)
+            .watch_grazing(watched)
+            .apply(z)
     }
 
     /// The distance to grazing of Pⁿ(z) (as the watched [`Solver::map`] reports it: the same
     /// steps and searches).
     fn grazing(&mut self, z: &DVector<f64>, p: f64) -> Result<f64, SimError> {
-        let n = self.spec.period as f64;
-        let integ = self.at(p)?;
-        let t = n * integ.system().period();
-        grazing_distance(integ, 0.0, z, t)
+        let n = self.spec.period;
+        StroboscopicMap::new(self.at(p)?, n).grazing_distance(z)
     }
 
     /// ∂Pⁿ/∂p at (z, p): that of `map` when known, else central differences.
@@ -324,12 +318,11 @@ impl Solver {
         }
     }
 
-    /// Pⁿ(z) alone, by a flow without the variational equations ([`flow_state`]).
+    /// Pⁿ(z) alone, by a flow without the variational equations
+    /// ([`StroboscopicMap::image`]).
     fn map_state(&mut self, z: &DVector<f64>, p: f64) -> Result<DVector<f64>, SimError> {
-        let t = self.spec.period as f64;
-        let integ = self.at(p)?;
-        let t = t * integ.system().period();
-        flow_state(integ, 0.0, z, t)
+        let n = self.spec.period;
+        StroboscopicMap::new(self.at(p)?, n).image(z)
     }
 
     /// ∂Pⁿ/∂p by central differences of flows without the variational equations (two flows

@@ -3,11 +3,11 @@
 //! Shapes, units and sources as in [`super`].
 
 use super::{continue_branch_with, Branch, BranchEvent, BranchPoint, ContinuationSpec};
-use crate::analysis::monodromy::stroboscopic;
 use crate::analysis::progress::Progress;
 use crate::analysis::shooting::shoot_with;
 use crate::error::SimError;
 use crate::integrate::build;
+use crate::maps::StroboscopicMap;
 use crate::model::CantileverModel;
 use nalgebra::{DMatrix, DVector};
 
@@ -34,7 +34,10 @@ pub fn period_doubling_starts(
     let Some(v) = (|| {
         let model = CantileverModel::new(&spec.base.with(spec.param, pd.value)).ok()?;
         let mut integ = build(&model, spec.integrator, 0.0, &model.rest()).ok()?;
-        let m = stroboscopic(integ.as_mut(), &z, pd.period).ok()?.jacobian;
+        let m = StroboscopicMap::new(integ.as_mut(), pd.period)
+            .apply(&z)
+            .ok()?
+            .jacobian;
         // eigenvector of μ ≈ −1 by inverse iteration on M + (1 − 1e-8) I
         let lu = (&m + DMatrix::identity(dim, dim) * (1.0 - 1e-8)).lu();
         let mut v = DVector::from_element(dim, 1.0);
@@ -66,7 +69,8 @@ pub fn period_doubling_starts(
                 let Ok(o) = shoot_with(integ.as_mut(), &guess, 2 * pd.period, &spec.newton) else {
                     continue;
                 };
-                let Ok(half) = stroboscopic(integ.as_mut(), &o.state, pd.period) else {
+                let Ok(half) = StroboscopicMap::new(integ.as_mut(), pd.period).apply(&o.state)
+                else {
                     continue;
                 };
                 if (&half.state - &o.state).norm() > 1e-6 * (1.0 + o.state.norm()) {

@@ -31,7 +31,6 @@
 
 use crate::analysis::bifurcation::SweepSpec;
 use crate::analysis::continuation::{BranchEvent, BranchPoint};
-use crate::analysis::monodromy::stroboscopic;
 use crate::analysis::observables::{observe, ObservableOptions, Observables};
 use crate::analysis::progress::Progress;
 pub use crate::analysis::settle::Found;
@@ -42,6 +41,7 @@ use crate::analysis::shooting::{
 use crate::analysis::steady::{decay_periods, steady_state, SteadyOptions};
 use crate::error::SimError;
 use crate::integrate::{build, Integrator, IntegratorOptions};
+use crate::maps::StroboscopicMap;
 use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
 use crate::tip_sample::TipSampleSystem;
@@ -321,7 +321,7 @@ pub const POINT_DECAY_TIMES: f64 = 9.0;
 /// the slowest free mode of the cantilever (damped eigenvalue λ with the smallest |Re λ|,
 /// eqs. 20–21) takes to decay by the period search's tolerance, ln(1/tol)/(|Re λ| T), within
 /// [[`POINT_MIN_PERIODS`], `spec.steady.max_periods`]; `spec.steady.max_periods` for a
-/// system that is not the cantilever model. At Q = 400 (ln(1e8) Q/π = 2 345 periods) it is
+/// system without a free decay rate ([`TipSampleSystem::free_decay_rate`]). At Q = 400 (ln(1e8) Q/π = 2 345 periods) it is
 /// `max_periods` (20 000 by default), as before; a model with strong damping, whose transients
 /// onto an orbit take a few hundred periods (the default beam, Q ≈ 42: 248), has the floor.
 /// A motion still unsettled after the cap is classified nonperiodic: near the edge of a
@@ -798,7 +798,7 @@ pub fn is_fixed_point(
     tol: f64,
 ) -> Result<bool, SimError> {
     let mut integ = integrator_at(spec, value, z)?;
-    let m = stroboscopic(integ.as_mut(), z, n)?;
+    let m = StroboscopicMap::new(integ.as_mut(), n).apply(z)?;
     Ok((&m.state - z).norm() <= tol * (1.0 + z.norm()))
 }
 

@@ -1,7 +1,8 @@
-//! The stroboscopic map P(z) = z(τ0 + nT) and its Jacobian (the monodromy matrix of the
-//! period-n map): the product of the step Jacobians of any integrator that provides them (the
-//! exact transition matrices e^{A_s t}, or the adaptive integrator's variational equations) and
-//! the saltation matrix of every event ([`crate::system::saltation`]).
+//! The flow map z(τ0) ↦ z(τ1) and its Jacobian (over τ1 − τ0 = nT, the monodromy matrix of
+//! the period-n stroboscopic map, which [`crate::maps::StroboscopicMap`] applies): the product
+//! of the step Jacobians of any integrator that provides them (the exact transition matrices
+//! e^{A_s t}, or the adaptive integrator's variational equations) and the saltation matrix of
+//! every event ([`crate::system::saltation`]; Leine & Nijmeijer 2004, ch. 7).
 
 use crate::error::SimError;
 use crate::galerkin::Region;
@@ -24,9 +25,8 @@ pub struct FlowMap {
     /// Contacts: entries into region II and impacts.
     pub contacts: usize,
     /// Smallest |V_T| at a local extremum of V_T, and smallest |dV_T/dτ| at an event (scaled by
-    /// 1/Ω): how close the trajectory is to grazing the sample. NaN from
-    /// [`stroboscopic_unwatched`] and [`stroboscopic_with_param_derivative_unwatched`], which
-    /// do not search.
+    /// 1/Ω): how close the trajectory is to grazing the sample. NaN from a map that does not
+    /// watch it ([`crate::maps::StroboscopicMap::watch_grazing`]).
     pub grazing_distance: f64,
     /// Time spent in region II (contact, or sticking for the impact law).
     pub contact_time: f64,
@@ -74,7 +74,10 @@ pub fn flow_with_param_derivative(
     flow(integ, tau0, z0, tau1, Some(param), true)
 }
 
-fn flow(
+/// The flow from (τ0, z0) to τ1 with its Jacobian, the parameter sensitivity for `param` and
+/// the distance to grazing when `grazing` (else NaN): the one loop of [`flow_with_jacobian`],
+/// [`flow_with_param_derivative`] and [`crate::maps::StroboscopicMap::apply`].
+pub(crate) fn flow(
     integ: &mut dyn Integrator,
     tau0: f64,
     z0: &DVector<f64>,
@@ -306,35 +309,6 @@ fn farther(va: f64, vb: f64, d0: f64, nearest: f64) -> bool {
     (sigma * va).max(sigma * vb) >= nearest
 }
 
-/// The period-n stroboscopic map from drive phase 0 (τ = 0 → nT) with its monodromy matrix.
-///
-/// # Errors
-/// As [`flow_with_jacobian`].
-pub fn stroboscopic(
-    integ: &mut dyn Integrator,
-    z0: &DVector<f64>,
-    n: usize,
-) -> Result<FlowMap, SimError> {
-    let t = n as f64 * integ.system().period();
-    flow_with_jacobian(integ, 0.0, z0, t)
-}
-
-/// [`stroboscopic`] without the distance to grazing ([`FlowMap::grazing_distance`] is NaN):
-/// the state and the monodromy matrix for the iterates of a Newton solve, whose converged point
-/// then takes [`grazing_distance`] once (the local-extremum searches of V_T are a sixth of a
-/// period-1 shooting solve at N = 3).
-///
-/// # Errors
-/// As [`flow_with_jacobian`].
-pub fn stroboscopic_unwatched(
-    integ: &mut dyn Integrator,
-    z0: &DVector<f64>,
-    n: usize,
-) -> Result<FlowMap, SimError> {
-    let t = n as f64 * integ.system().period();
-    flow(integ, 0.0, z0, t, None, false)
-}
-
 /// The distance to grazing of the flow from (τ0, z0) to τ1 ([`FlowMap::grazing_distance`]),
 /// without the Jacobian: the same steps as [`flow_with_jacobian`] (variational equations
 /// switched on as there) and the same searches, so the same value.
@@ -360,54 +334,6 @@ pub fn grazing_distance(
         watch_grazing(integ, &step, &before, &mut nearest);
     }
     Ok(nearest)
-}
-
-/// [`stroboscopic`] with ∂Pⁿ/∂p in [`FlowMap::param_derivative`] (see
-/// [`flow_with_param_derivative`]): for p = Ω the end time nT = 2πn/Ω moves too, which adds
-/// ż(nT) d(nT)/dΩ = −ż(nT) nT/Ω.
-///
-/// # Errors
-/// As [`flow_with_jacobian`].
-pub fn stroboscopic_with_param_derivative(
-    integ: &mut dyn Integrator,
-    z0: &DVector<f64>,
-    n: usize,
-    param: SweepParam,
-) -> Result<FlowMap, SimError> {
-    param_map(integ, z0, n, param, true)
-}
-
-/// [`stroboscopic_with_param_derivative`] without the distance to grazing
-/// ([`FlowMap::grazing_distance`] is NaN), for the iterates of a Newton corrector (as
-/// [`stroboscopic_unwatched`]).
-///
-/// # Errors
-/// As [`flow_with_jacobian`].
-pub fn stroboscopic_with_param_derivative_unwatched(
-    integ: &mut dyn Integrator,
-    z0: &DVector<f64>,
-    n: usize,
-    param: SweepParam,
-) -> Result<FlowMap, SimError> {
-    param_map(integ, z0, n, param, false)
-}
-
-fn param_map(
-    integ: &mut dyn Integrator,
-    z0: &DVector<f64>,
-    n: usize,
-    param: SweepParam,
-    grazing: bool,
-) -> Result<FlowMap, SimError> {
-    let t = n as f64 * integ.system().period();
-    let mut map = flow(integ, 0.0, z0, t, Some(param), grazing)?;
-    if let (Some(d), SweepParam::Omega) = (&mut map.param_derivative, param) {
-        let mut f = DVector::zeros(z0.len());
-        let m = integ.system();
-        m.rhs(integ.region(), t, map.state.as_slice(), f.as_mut_slice());
-        d.axpy(-t / m.omega(), &f, 1.0);
-    }
-    Ok(map)
 }
 
 /// The state z(τ1) of the flow from (τ0, z0) alone, with the variational equations switched
