@@ -9,7 +9,6 @@ use crate::errors::{probe_error, sim_error, value_error};
 use crate::params::PyParams;
 use crate::run::{run, run_abandonable, Job, Stop};
 use afmdyn::analysis::bifurcation::SweepSpec;
-use afmdyn::analysis::continuation::BranchEvent;
 use afmdyn::analysis::spectrum::{amplitude_spectrum, SPECTRUM_SAMPLES};
 use afmdyn::analysis::steady::SteadyState;
 use afmdyn::integrate::{build, IntegratorOptions};
@@ -679,14 +678,8 @@ pub fn orbit<'py>(
     Ok(out.finish())
 }
 
-fn event_name(e: BranchEvent) -> String {
-    serde_json::to_value(e)
-        .ok()
-        .and_then(|v| v.as_str().map(String::from))
-        .unwrap_or_default()
-}
-
-/// Pseudo-arclength continuation of a period-n branch, with located bifurcations.
+/// Pseudo-arclength continuation of a period-n branch, with located bifurcations: the JSON
+/// document and the branch points' layout ([`report::continuation_layout`]).
 #[pyfunction]
 #[pyo3(signature = (params, request=None, progress=None, probe=None))]
 pub fn continuation<'py>(
@@ -701,79 +694,12 @@ pub fn continuation<'py>(
     let param = request.param;
     let p0 = base.with(param, request.from);
     let doc = analysis(py, request, base, probe, progress.as_ref(), true)?;
-    let branches = doc.output;
     let model = model_of(&p0)?;
-    let dim = 2 * base.modes;
-    let rows: usize = branches.iter().map(|b| b.len()).sum();
-    let width = branches
-        .iter()
-        .flatten()
-        .map(|b| b.section.len())
-        .max()
-        .unwrap_or(1);
-    let mut id = Vec::with_capacity(rows);
-    let mut per = Vec::with_capacity(rows);
-    let mut s = Vec::with_capacity(rows);
-    let mut value = Vec::with_capacity(rows);
-    let mut stable = Vec::with_capacity(rows);
-    let mut max_mult = Vec::with_capacity(rows);
-    let mut critical = Vec::with_capacity(rows);
-    let mut switchings = Vec::with_capacity(rows);
-    let mut grazing = Vec::with_capacity(rows);
-    let mut event = Vec::with_capacity(rows);
-    let mut w_section = Vec::with_capacity(rows * width);
-    let mut mult = Vec::with_capacity(rows * dim);
-    let mut state = Vec::with_capacity(rows * dim);
-    for (i, br) in branches.iter().enumerate() {
-        for b in br {
-            id.push(i as i64);
-            per.push(b.period as i64);
-            s.push(b.s);
-            value.push(b.value);
-            stable.push(b.stable);
-            max_mult.push(b.multipliers[0].norm());
-            critical.push(
-                serde_json::to_value(b.critical)
-                    .ok()
-                    .and_then(|v| v.as_str().map(String::from))
-                    .unwrap_or_default(),
-            );
-            switchings.push(b.switchings as i64);
-            grazing.push(b.grazing_distance);
-            event.push(b.event.map_or(String::new(), event_name));
-            for j in 0..width {
-                w_section.push(b.section.get(j).map_or(f64::NAN, |z| model.w_tip(z)));
-            }
-            for j in 0..dim {
-                mult.push(
-                    b.multipliers
-                        .get(j)
-                        .map_or(Complex64::new(f64::NAN, f64::NAN), |m| {
-                            Complex64::new(m.re, m.im)
-                        }),
-                );
-            }
-            state.extend(b.section[0].iter());
-        }
-    }
     let out = Out::new(py);
     out.json(&doc.json)?;
     out.set("param", param.name())?;
-    out.set("symbol", param.symbol())?;
-    out.i64s("branch", id)?;
-    out.i64s("period", per)?;
-    out.f64s("s", s)?;
-    out.f64s("value", value)?;
-    out.bools("stable", stable)?;
-    out.f64s("max_multiplier", max_mult)?;
-    out.set("critical", PyList::new(py, critical)?)?;
-    out.i64s("switchings", switchings)?;
-    out.f64s("grazing_distance", grazing)?;
-    out.set("event", PyList::new(py, event)?)?;
-    out.matrix("w_tip_section", rows, width, w_section)?;
-    let m = numpy::ndarray::Array2::from_shape_vec((rows, dim), mult).expect("rows × 2N");
-    out.set("multipliers", numpy::IntoPyArray::into_pyarray(m, py))?;
-    out.matrix("state", rows, dim, state)?;
+    let layout = report::continuation_layout(param, &model, &doc.output);
+    out.set("layout", crate::convert::layout_dict(py, layout)?)?;
     Ok(out.finish())
 }
 

@@ -81,6 +81,14 @@ pub fn layout_dict<'py>(
                 .collect::<Vec<_>>()
                 .into_pyarray(py)
                 .into_any(),
+            Values::Bool(x) => x.into_pyarray(py).into_any(),
+            Values::Text(x) => pyo3::types::PyList::new(py, x)?.into_any(),
+            Values::C64(x) => x
+                .into_iter()
+                .map(|(re, im)| numpy::Complex64::new(re, im))
+                .collect::<Vec<_>>()
+                .into_pyarray(py)
+                .into_any(),
         };
         let attrs = PyDict::new(py);
         for (k, a) in v.attrs {

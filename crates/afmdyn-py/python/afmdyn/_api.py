@@ -44,6 +44,7 @@ from ._common import (  # noqa: F401 (_params, _probe_text, _typed, _warn: used 
     _warn,
     summary,
 )
+from . import _layout
 from ._curves import curve_dataset, observe_dataset
 from ._progress import ProgressArg
 from ._results import RegionSpectrum, Spectrum
@@ -465,40 +466,8 @@ def continuation(
     req = _start(_request(locals(), initial=_state(initial)))
     p, probe = _params(params, model)
     d = _run(_core.continuation, "continuation", progress, p, si=probe, request=req)
-    return xr.Dataset(
-        data_vars={
-            "branch": ("point", d["branch"], {"long_name": "branch (0: the continued one)"}),
-            "period": ("point", d["period"]),
-            "s": ("point", d["s"], {"long_name": "arclength"}),
-            "stable": ("point", d["stable"]),
-            "max_multiplier": (
-                "point",
-                d["max_multiplier"],
-                {"long_name": "largest |Floquet multiplier|"},
-            ),
-            "critical": ("point", np.array(d["critical"], dtype=str)),
-            "switchings": ("point", d["switchings"], {"long_name": "switchings per cycle"}),
-            "grazing_distance": (
-                "point",
-                d["grazing_distance"],
-                {**_G, "long_name": "distance to grazing"},
-            ),
-            "event": ("point", np.array(d["event"], dtype=str)),
-            "w_tip_section": (
-                ("point", "k"),
-                d["w_tip_section"],
-                {**_G, "long_name": "W(1,τ) at the section points"},
-            ),
-            "multipliers": (
-                ("point", "multiplier"),
-                d["multipliers"],
-                {"long_name": "Floquet multipliers"},
-            ),
-            "state": (("point", "component"), d["state"], {"long_name": "state at τ = 0"}),
-        },
-        coords={"value": ("point", d["value"], {"long_name": f"{d['symbol']} ({d['param']})"})},
-        attrs=_attrs(p, param=d["param"], summary=d["json"]),
-    )
+    ds = _layout.dataset(d["layout"], _attrs(p, param=d["param"], summary=d["json"]))
+    return ds.set_coords("value")
 
 
 def probe(

@@ -15,6 +15,13 @@ pub enum Values {
     F64(Vec<f64>),
     /// 32-bit integers (codes, counts, periods).
     I32(Vec<i32>),
+    /// Flags (NetCDF: bytes 0/1).
+    Bool(Vec<bool>),
+    /// Words, one per entry (event names); not written to NetCDF 3 ([`netcdf::write`] refuses
+    /// them).
+    Text(Vec<String>),
+    /// Complex numbers (re, im): Floquet multipliers; not written to NetCDF 3.
+    C64(Vec<(f64, f64)>),
 }
 
 impl Values {
@@ -23,6 +30,9 @@ impl Values {
         match self {
             Values::F64(v) => v.len(),
             Values::I32(v) => v.len(),
+            Values::Bool(v) => v.len(),
+            Values::Text(v) => v.len(),
+            Values::C64(v) => v.len(),
         }
     }
 

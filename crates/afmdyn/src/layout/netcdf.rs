@@ -55,6 +55,13 @@ pub fn write(path: &Path, layout: &Layout) -> Result<(), WriteError> {
         match v.values {
             Values::F64(_) => d(ds.add_var_f64(&v.name, &dims))?,
             Values::I32(_) => d(ds.add_var_i32(&v.name, &dims))?,
+            Values::Bool(_) => d(ds.add_var_i8(&v.name, &dims))?,
+            Values::Text(_) | Values::C64(_) => {
+                return Err(e(format!(
+                    "variable {}: words and complex numbers are not written to NetCDF 3",
+                    v.name
+                )))
+            }
         }
         d(ds.add_var_attr_string(&v.name, "units", v.units.as_str()))?;
         d(ds.add_var_attr_string(&v.name, "long_name", v.long_name.as_str()))?;
@@ -85,6 +92,12 @@ pub fn write(path: &Path, layout: &Layout) -> Result<(), WriteError> {
             match &v.values {
                 Values::F64(x) => f.write_var_f64(&v.name, x).map_err(w)?,
                 Values::I32(x) => f.write_var_i32(&v.name, x).map_err(w)?,
+                Values::Bool(x) => {
+                    let bytes: Vec<i8> = x.iter().map(|&b| i8::from(b)).collect();
+                    f.write_var_i8(&v.name, &bytes).map_err(w)?
+                }
+                // refused when the variables were defined
+                Values::Text(_) | Values::C64(_) => {}
             }
         }
         f.close().map_err(w)
@@ -156,6 +169,28 @@ mod tests {
         );
         assert!(r.data_set().get_var("fraction").is_none());
         assert_eq!(r.read_var_f64("value").unwrap(), vec![1.0, 2.0]);
+        // flags are bytes 0/1; words are refused naming the variable
+        let flags = Variable::new(
+            "stable",
+            &["value"],
+            "1",
+            "s",
+            Values::Bool(vec![true, false]),
+        );
+        write(
+            &path,
+            &Layout::new("b", &[("value", 2)], vec![flags.clone()]),
+        )
+        .unwrap();
+        let mut r = netcdf3::FileReader::open(&path).unwrap();
+        assert_eq!(r.read_var_i8("stable").unwrap(), vec![1, 0]);
+        let words = Values::Text(vec!["fold".into(), String::new()]);
+        let words = Variable::new("event", &["value"], "1", "e", words);
+        let err = write(
+            &path,
+            &Layout::new("w", &[("value", 2)], vec![flags, words]),
+        );
+        assert!(err.unwrap_err().message.contains("variable event"));
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

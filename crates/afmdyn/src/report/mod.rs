@@ -381,8 +381,10 @@ pub fn continuation_warnings(param: SweepParam, branches: &[Branch]) -> Vec<Stri
         .collect()
 }
 
+mod branches;
 mod curves;
 mod units;
+pub use branches::*;
 pub use curves::*;
 pub use units::*;
 
