@@ -483,77 +483,18 @@ pub fn bifurcation<'py>(
     sweep_dict(py, &spec, records)
 }
 
-/// The dict of a sweep's records, in their order (the columns `bifurcation` returns).
+/// A sweep's records, in their order, as `bifurcation` returns them: the swept parameter,
+/// its values and the records' layout ([`afmdyn::request::sweep::layout`]).
 pub(crate) fn sweep_dict<'py>(
     py: Python<'py>,
     spec: &SweepSpec,
     records: Vec<SweepRecord>,
 ) -> PyResult<Dict<'py>> {
-    let param = spec.param;
-    let n = spec.base.modes;
-    let rows = records.len();
-    let mut value = Vec::with_capacity(rows);
-    let mut index = Vec::with_capacity(rows);
-    let mut branch = Vec::with_capacity(rows);
-    let mut status = Vec::with_capacity(rows);
-    let mut period = Vec::with_capacity(rows);
-    let mut k = Vec::with_capacity(rows);
-    let mut n_points = Vec::with_capacity(rows);
-    let mut cols: [Vec<f64>; 7] = Default::default();
-    let mut transient = Vec::with_capacity(rows);
-    let mut message = Vec::with_capacity(rows);
-    let mut state = vec![Vec::with_capacity(rows); 2 * n];
-    for r in records {
-        value.push(r.value);
-        index.push(r.index as i64);
-        branch.push(r.branch.to_string());
-        status.push(r.status.name());
-        period.push(r.status.code());
-        k.push(r.point as i64);
-        n_points.push(r.points as i64);
-        for (c, v) in cols.iter_mut().zip([
-            r.tau,
-            r.v_t,
-            r.w_tip,
-            r.x_max,
-            r.v_t_min,
-            r.contact_fraction,
-            r.contacts_per_period,
-        ]) {
-            c.push(v);
-        }
-        transient.push(r.transient_periods.map_or(-1, |t| t as i64));
-        for (j, c) in state.iter_mut().enumerate() {
-            c.push(r.state.get(j).copied().unwrap_or(f64::NAN));
-        }
-        message.push(r.message);
-    }
     let out = Out::new(py);
-    out.set("param", param.name())?;
-    out.set("symbol", param.symbol())?;
+    out.set("param", spec.param.name())?;
     out.f64s("values", spec.values.clone())?;
-    out.f64s("value", value)?;
-    out.i64s("index", index)?;
-    out.set("branch", PyList::new(py, branch)?)?;
-    out.set("status", PyList::new(py, status)?)?;
-    out.i64s("period", period)?;
-    out.i64s("k", k)?;
-    out.i64s("n_points", n_points)?;
-    let [tau, v_t, w_tip, x_max, v_t_min, contact_fraction, contacts_per_period] = cols;
-    out.f64s("tau", tau)?;
-    out.f64s("v_t", v_t)?;
-    out.f64s("w_tip", w_tip)?;
-    out.f64s("x_max", x_max)?;
-    out.f64s("v_t_min", v_t_min)?;
-    out.f64s("contact_fraction", contact_fraction)?;
-    out.f64s("contacts_per_period", contacts_per_period)?;
-    out.i64s("transient_periods", transient)?;
-    out.set("message", PyList::new(py, message)?)?;
-    let state_list = PyList::empty(py);
-    for c in state {
-        state_list.append(numpy::IntoPyArray::into_pyarray(c, py))?;
-    }
-    out.set("state", state_list)?;
+    let layout = afmdyn::request::sweep::layout(spec, &records);
+    out.set("layout", crate::convert::layout_dict(py, layout)?)?;
     Ok(out.finish())
 }
 

@@ -30,7 +30,6 @@ from ._common import (  # noqa: F401 (_params, _probe_text, _typed, _warn: used 
     _DEFAULTS,
     _G,
     _T,
-    _V,
     Model,
     StateLike,
     _attrs,
@@ -383,48 +382,10 @@ def bifurcation(
 
 
 def _sweep_dataset(p: Params, d: Dict[str, Any], starts: int, seed: int) -> xr.Dataset:
-    """The long-format dataset of a sweep's columns ``d`` (``bifurcation``'s, and
-    ``afmdyn.dask.bifurcation``'s)."""
-    n = p.modes
-    # units and meanings as the library declares the records' columns (bifurcation.csv and
-    # .npy); the period as its numeric code
-    cols = {name: {"units": unit, "long_name": meaning} for name, unit, meaning in _core.SWEEP_COLUMNS}
-    cols["period"] = next(
-        {"units": u, "long_name": m} for name, u, m in _core.SWEEP_NUMERIC_COLUMNS if name == "period"
-    )
-    text = {"status", "message"}
-    # the dataset's name of each column (``k``, ``n_points``: the CSV's ``point``, ``points``)
-    names = {"k": "point", "n_points": "points"}
-    data: Dict[str, Any] = {}
-    for var in ("status", "period", "k", "n_points", "tau", "v_t", "w_tip", "x_max", "v_t_min",
-                "contact_fraction", "contacts_per_period", "transient_periods", "message"):
-        col = names.get(var, var)
-        attrs = {"long_name": cols[col]["long_name"]}
-        if var not in text:
-            attrs["units"] = cols[col]["units"]
-        values = np.array(d[var], dtype=str) if var in text else d[var]
-        data[var] = ("point", values, attrs)
-    for j in range(n):
-        data[f"a_{j + 1}"] = (
-            "point",
-            d["state"][j],
-            {**_G, "long_name": f"a_{j + 1} at the section"},
-        )
-    for j in range(n):
-        data[f"a_dot_{j + 1}"] = (
-            "point",
-            d["state"][n + j],
-            {**_V, "long_name": f"da_{j + 1}/dτ at the section"},
-        )
-    return xr.Dataset(
-        data_vars=data,
-        coords={
-            "value": ("point", d["value"], {"long_name": f"{d['symbol']} ({d['param']})"}),
-            "index": ("point", d["index"], {"long_name": cols["index"]["long_name"]}),
-            "branch": ("point", np.array(d["branch"], dtype=str)),
-        },
-        attrs=_attrs(p, param=d["param"], values=d["values"], starts=starts, seed=seed),
-    )
+    """The long-format dataset of a sweep's records ``d`` (``bifurcation``'s, and
+    ``afmdyn.dask.bifurcation``'s), laid out by the library."""
+    attrs = _attrs(p, param=d["param"], values=d["values"], starts=starts, seed=seed)
+    return _layout.dataset(d["layout"], attrs).set_coords(["value", "index", "branch"])
 
 
 @_typed

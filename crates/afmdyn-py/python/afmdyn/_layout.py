@@ -22,7 +22,8 @@ def variables(
     out = {}
     for name, vdims, units, long_name, values, extra in layout["variables"]:
         shape = tuple(dims[d] for d in vdims)
-        attrs = {"long_name": long_name, "units": units, **extra}
+        # words have no units (CF): an empty unit is left out
+        attrs = {"long_name": long_name, **({"units": units} if units else {}), **extra}
         out[name] = (tuple(vdims), np.asarray(values).reshape(shape), attrs)
     return out
 

@@ -10,6 +10,7 @@
 
 use super::analyses::BifurcationRequest;
 use crate::analysis::bifurcation::{Branch, SweepPoint, SweepSpec};
+use crate::layout::{Layout, Values, Variable};
 use crate::params::SweepParam;
 use serde_json::{json, Value};
 
@@ -334,6 +335,100 @@ pub fn records(param: SweepParam, p: &SweepPoint) -> Vec<SweepRecord> {
                 .collect()
         }
     }
+}
+
+/// The records of a sweep as a layout over the dimension `point` (one per record, in their
+/// order), for the Python `xarray.Dataset` (`bifurcation`, `afmdyn.dask.bifurcation`): the
+/// columns of [`COLUMNS`] with their units and meanings — `value` (of `spec.param`), `index`,
+/// `branch` and `status` (words), `period` (its code, [`PointStatus::code`]), `k` (the CSV's
+/// `point`), `n_points` (`points`), `tau` … `contacts_per_period`, `transient_periods` (−1 for
+/// a failed point), `message` — and the state as `a_1` … `a_N`, `a_dot_1` … `a_dot_N` (NaN
+/// for a failed point).
+pub fn layout(spec: &SweepSpec, records: &[SweepRecord]) -> Layout {
+    // a number's unit and meaning as the numeric columns give them (`period` as its code),
+    // a word's as the CSV's
+    let meaning = |name: &str, numeric: bool| {
+        let table: &[RecordColumn] = if numeric { &NUMERIC_COLUMNS } else { &COLUMNS };
+        table
+            .iter()
+            .chain(&COLUMNS)
+            .find(|c| c.name == name)
+            .map_or(("1", ""), |c| (c.unit, c.meaning))
+    };
+    let point: &[&str] = &["point"];
+    let num = |var: &str, col: &str, get: &dyn Fn(&SweepRecord) -> f64| {
+        let (unit, long_name) = meaning(col, true);
+        let values: Vec<f64> = records.iter().map(get).collect();
+        Variable::f64(var, point, unit, long_name, &values)
+    };
+    let int = |var: &str, col: &str, get: &dyn Fn(&SweepRecord) -> i64| {
+        let (unit, long_name) = meaning(col, true);
+        let values = records
+            .iter()
+            .map(|r| i32::try_from(get(r)).unwrap_or(i32::MAX))
+            .collect::<Vec<_>>();
+        Variable::i32(var, point, unit, long_name, &values)
+    };
+    let text = |var: &str, get: &dyn Fn(&SweepRecord) -> String| {
+        let values = Values::Text(records.iter().map(get).collect());
+        Variable::new(var, point, "", meaning(var, false).1, values)
+    };
+    let (param, n) = (spec.param, spec.base.modes);
+    let mut variables = vec![
+        Variable::f64(
+            "value",
+            point,
+            "1",
+            format!("{} ({})", param.symbol(), param.name()),
+            &records.iter().map(|r| r.value).collect::<Vec<_>>(),
+        ),
+        int("index", "index", &|r| r.index as i64),
+        text("branch", &|r| r.branch.to_string()),
+        text("status", &|r| r.status.name().to_string()),
+        int("period", "period", &|r| r.status.code()),
+        int("k", "point", &|r| r.point as i64),
+        int("n_points", "points", &|r| r.points as i64),
+        num("tau", "tau", &|r| r.tau),
+        num("v_t", "v_t", &|r| r.v_t),
+        num("w_tip", "w_tip", &|r| r.w_tip),
+        num("x_max", "x_max", &|r| r.x_max),
+        num("v_t_min", "v_t_min", &|r| r.v_t_min),
+        num("contact_fraction", "contact_fraction", &|r| {
+            r.contact_fraction
+        }),
+        num("contacts_per_period", "contacts_per_period", &|r| {
+            r.contacts_per_period
+        }),
+        int("transient_periods", "transient_periods", &|r| {
+            r.transient_periods.map_or(-1, |t| t as i64)
+        }),
+        text("message", &|r| r.message.clone()),
+    ];
+    for (j, name, unit, what) in (0..2 * n).map(|j| match j < n {
+        true => (
+            j,
+            format!("a_{}", j + 1),
+            "g0",
+            format!("a_{} at the section", j + 1),
+        ),
+        false => (
+            j,
+            format!("a_dot_{}", j - n + 1),
+            "g0 per unit τ",
+            format!("da_{}/dτ at the section", j - n + 1),
+        ),
+    }) {
+        let values: Vec<f64> = records
+            .iter()
+            .map(|r| r.state.get(j).copied().unwrap_or(f64::NAN))
+            .collect();
+        variables.push(Variable::f64(&name, point, unit, what, &values));
+    }
+    Layout::new(
+        format!("afmdyn bifurcation sweep over {}", param.name()),
+        &[("point", records.len())],
+        variables,
+    )
 }
 
 /// The position of a record in the one row order: (value index, branch, Poincaré point).
