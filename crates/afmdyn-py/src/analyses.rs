@@ -9,9 +9,8 @@ use crate::errors::{probe_error, sim_error, value_error};
 use crate::params::PyParams;
 use crate::run::{run, run_abandonable, Job, Stop};
 use afmdyn::analysis::bifurcation::SweepSpec;
-use afmdyn::analysis::spectrum::{amplitude_spectrum, SPECTRUM_SAMPLES};
 use afmdyn::analysis::steady::SteadyState;
-use afmdyn::integrate::{build, IntegratorOptions};
+use afmdyn::integrate::build;
 use afmdyn::probe::Probe;
 use afmdyn::request::checkpoint::{self, CheckpointError};
 use afmdyn::request::{self, Analysis, Document, ModesRequest, Resolved};
@@ -24,7 +23,7 @@ use afmdyn::request::{DirLock, FileCheckpoint, LockError, MemoryCheckpoint, Swee
 use afmdyn::study::sweep::SweepStudy;
 use afmdyn::study::{execute, StudyError};
 use afmdyn::trajectory::{record, RecordSpec};
-use afmdyn::{report, CantileverModel, Params, Region};
+use afmdyn::{report, CantileverModel, Params};
 use nalgebra::DVector;
 use numpy::Complex64;
 use pyo3::prelude::*;
@@ -129,99 +128,9 @@ pub fn modes<'py>(
     Ok(out.finish())
 }
 
-/// The columns of a recorded run, built on the worker thread.
-struct SimColumns {
-    doc: serde_json::Value,
-    n: usize,
-    tau: Vec<f64>,
-    v_t: Vec<f64>,
-    v_t_dot: Vec<f64>,
-    w_tip: Vec<f64>,
-    w_tip_dot: Vec<f64>,
-    in_contact: Vec<bool>,
-    contact_force: Vec<f64>,
-    a: Vec<f64>,
-    a_dot: Vec<f64>,
-    event_tau: Vec<f64>,
-    event_to_contact: Vec<bool>,
-    event_v_t_dot: Vec<f64>,
-    section_tau: Vec<f64>,
-    section_v_t: Vec<f64>,
-    section_w_tip: Vec<f64>,
-    section_w_tip_dot: Vec<f64>,
-    section_state: Vec<f64>,
-    energy: [Vec<f64>; 7],
-    tau_end: f64,
-    switchings: usize,
-    body_contact: bool,
-    integrator: &'static str,
-}
-
-fn simulate_columns(
-    p: Params,
-    z0: Option<Vec<f64>>,
-    opts: IntegratorOptions,
-    spec: RecordSpec,
-) -> PyResult<SimColumns> {
-    let model = model_of(&p)?;
-    let z0 = initial_state(&model, z0)?;
-    let mut integ = build(&model, opts, 0.0, &z0).map_err(sim_error)?;
-    let tr = record(integ.as_mut(), &spec).map_err(sim_error)?;
-    let n = model.modes();
-    let len = tr.samples.len();
-    let mut c = SimColumns {
-        doc: report::simulate(&model, &tr),
-        n,
-        tau: Vec::with_capacity(len),
-        v_t: Vec::with_capacity(len),
-        v_t_dot: Vec::with_capacity(len),
-        w_tip: Vec::with_capacity(len),
-        w_tip_dot: Vec::with_capacity(len),
-        in_contact: Vec::with_capacity(len),
-        contact_force: Vec::with_capacity(len),
-        a: Vec::with_capacity(len * n),
-        a_dot: Vec::with_capacity(len * n),
-        event_tau: tr.events.iter().map(|e| e.tau).collect(),
-        event_to_contact: tr.events.iter().map(|e| e.to == Region::Contact).collect(),
-        event_v_t_dot: tr.events.iter().map(|e| e.v_t_dot).collect(),
-        section_tau: tr.poincare.iter().map(|(t, _)| *t).collect(),
-        section_v_t: tr.poincare.iter().map(|(t, z)| model.v_t(*t, z)).collect(),
-        section_w_tip: tr.poincare.iter().map(|(_, z)| model.w_tip(z)).collect(),
-        section_w_tip_dot: tr
-            .poincare
-            .iter()
-            .map(|(_, z)| model.w_tip_dot(z))
-            .collect(),
-        section_state: flatten(tr.poincare.iter().map(|(_, z)| z.clone())),
-        energy: [
-            tr.energy.iter().map(|e| e.tau0).collect(),
-            tr.energy.iter().map(|e| e.e_start).collect(),
-            tr.energy.iter().map(|e| e.e_end).collect(),
-            tr.energy.iter().map(|e| e.base_work).collect(),
-            tr.energy.iter().map(|e| e.beam_dissipation).collect(),
-            tr.energy.iter().map(|e| e.contact_dissipation).collect(),
-            tr.energy.iter().map(|e| e.residual()).collect(),
-        ],
-        tau_end: tr.tau_end,
-        switchings: tr.events.len(),
-        body_contact: tr.body_contact,
-        integrator: integ.name(),
-    };
-    for s in &tr.samples {
-        c.tau.push(s.tau);
-        c.v_t.push(s.v_t);
-        c.v_t_dot.push(model.v_t_dot(s.tau, &s.state));
-        c.w_tip.push(s.w_tip);
-        c.w_tip_dot.push(s.w_tip_dot);
-        c.in_contact.push(s.region == Region::Contact);
-        c.contact_force.push(s.contact_force);
-        c.a.extend(s.state.rows(0, n).iter());
-        c.a_dot.extend(s.state.rows(n, n).iter());
-    }
-    Ok(c)
-}
-
-/// One trajectory: time series, switchings, stroboscopic section and energy balance.
+/// One trajectory: time series, switchings, stroboscopic section and energy balance, laid out
+/// by the library ([`report::simulate_layout`]; with a probe every array in SI, as the command
+/// line's simulate files), with the JSON document and the run's scalars.
 #[pyfunction]
 #[pyo3(signature = (params, request=None, progress=None, probe=None))]
 pub fn simulate<'py>(
@@ -241,106 +150,38 @@ pub fn simulate<'py>(
     let span = request
         .validate(&p, SeriesStore::Memory, 7 + 2 * p.modes, 8.0)
         .map_err(sim_error)?;
-    let t_transient = span.transient_tau;
+    let su = report::SeriesUnits::new(&p, probe.as_ref());
     let opts = request.integrator_options();
-    let samples_per_period = request.samples_per_period;
+    let spp = request.samples_per_period;
     let spec = RecordSpec {
         transient_periods: request.transient,
         record_tau: span.record_tau,
-        samples_per_period,
+        samples_per_period: spp,
         energy: true,
         body_contact: true,
     };
     let initial = request.initial;
-    let c = run_abandonable(py, progress.as_ref(), move || {
-        simulate_columns(p, initial, opts, spec)
-    })??;
+    let worker_su = su;
+    let (doc, layout, tau_end, switchings, body_contact, integrator) =
+        run_abandonable(py, progress.as_ref(), move || -> PyResult<_> {
+            let model = model_of(&p)?;
+            let z0 = initial_state(&model, initial)?;
+            let mut integ = build(&model, opts, 0.0, &z0).map_err(sim_error)?;
+            let tr = record(integ.as_mut(), &spec).map_err(sim_error)?;
+            let layout = report::simulate_layout(&model, &tr, &worker_su, spp);
+            let doc = report::simulate(&model, &tr);
+            let (events, body) = (tr.events.len(), tr.body_contact);
+            Ok((doc, layout, tr.tau_end, events, body, integ.name()))
+        })??;
     let out = Out::new(py);
-    out.json(&report::with_si(c.doc.clone(), probe.as_ref(), &p))?;
-    // with a probe every array in SI (s, m, m/s, N, J, Hz; the command line's simulate
-    // files), else the model's units: factors 1 (report::SeriesUnits)
-    let su = report::SeriesUnits::new(&p, probe.as_ref());
-    // the units and the series' meanings as the library declares them (timeseries.csv's)
-    let names = su.names();
-    out.set(
-        "units",
-        [
-            ("time", names.time),
-            ("time_unit", names.time_unit),
-            ("length", names.length),
-            ("velocity", names.velocity),
-            ("force", names.force),
-            ("energy", names.energy),
-        ]
-        .into_iter()
-        .collect::<std::collections::BTreeMap<_, _>>(),
-    )?;
-    out.set(
-        "long_names",
-        su.columns(c.n)
-            .into_iter()
-            .map(|col| (col.name, col.long_name))
-            .collect::<std::collections::BTreeMap<_, _>>(),
-    )?;
-    let by = |v: Vec<f64>, f: &dyn Fn(f64) -> f64| -> Vec<f64> { v.into_iter().map(f).collect() };
-    let (t, x, v, force, energy) = (
-        |a| su.t(a),
-        |a| su.x(a),
-        |a| su.v(a),
-        |a| su.force(a),
-        |a| su.energy(a),
-    );
-    let s = c.tau.len();
-    let n = c.n;
-    // the amplitude spectrum of W(1,τ) over the last samples, as the command line's
-    // spectrum.csv
-    let tail = &c.w_tip[c.w_tip.len().saturating_sub(SPECTRUM_SAMPLES)..];
-    let hz = su.u.hz_per_omega.unwrap_or(1.0);
-    let (freq, amp): (Vec<f64>, Vec<f64>) = amplitude_spectrum(tail, samples_per_period, p.omega)
-        .into_iter()
-        .map(|(w, a)| (w * hz, x(a)))
-        .unzip();
-    out.f64s("tau", by(c.tau, &t))?;
-    out.f64s("v_t", by(c.v_t, &x))?;
-    out.f64s("v_t_dot", by(c.v_t_dot, &v))?;
-    out.f64s("spectrum_frequency", freq)?;
-    out.f64s("spectrum", amp)?;
-    out.f64s("w_tip", by(c.w_tip, &x))?;
-    out.f64s("w_tip_dot", by(c.w_tip_dot, &v))?;
-    out.bools("in_contact", c.in_contact)?;
-    out.f64s("contact_force", by(c.contact_force, &force))?;
-    out.matrix("a", s, n, by(c.a, &x))?;
-    out.matrix("a_dot", s, n, by(c.a_dot, &v))?;
-    out.f64s("event_tau", by(c.event_tau, &t))?;
-    out.bools("event_to_contact", c.event_to_contact)?;
-    out.f64s("event_v_t_dot", by(c.event_v_t_dot, &v))?;
-    let ps = c.section_tau.len();
-    out.f64s("section_tau", by(c.section_tau, &t))?;
-    out.f64s("section_v_t", by(c.section_v_t, &x))?;
-    out.f64s("section_w_tip", by(c.section_w_tip, &x))?;
-    out.f64s("section_w_tip_dot", by(c.section_w_tip_dot, &v))?;
-    // rows of (a, ȧ): the first N of each row lengths, the rest velocities
-    let state: Vec<f64> = c
-        .section_state
-        .into_iter()
-        .enumerate()
-        .map(|(i, a)| if i % (2 * n) < n { x(a) } else { v(a) })
-        .collect();
-    out.matrix("section_state", ps, 2 * n, state)?;
-    let [tau0, e_start, e_end, base, beam, contact, residual] = c.energy;
-    out.f64s("energy_tau0", by(tau0, &t))?;
-    out.f64s("energy_start", by(e_start, &energy))?;
-    out.f64s("energy_end", by(e_end, &energy))?;
-    out.f64s("base_work", by(base, &energy))?;
-    out.f64s("beam_dissipation", by(beam, &energy))?;
-    out.f64s("contact_dissipation", by(contact, &energy))?;
-    out.f64s("energy_residual", by(residual, &energy))?;
-    out.set("tau_end", t(c.tau_end))?;
-    out.set("switchings", c.switchings)?;
-    out.set("body_contact", c.body_contact)?;
-    out.set("integrator", c.integrator)?;
-    out.set("transient_tau", t(t_transient))?;
-    out.set("si", su.u.si)?;
+    out.json(&report::with_si(doc, probe.as_ref(), &p))?;
+    out.set("layout", crate::convert::layout_dict(py, layout)?)?;
+    out.set("time", su.names().time)?;
+    out.set("tau_end", su.t(tau_end))?;
+    out.set("switchings", switchings)?;
+    out.set("body_contact", body_contact)?;
+    out.set("integrator", integrator)?;
+    out.set("transient_tau", su.t(span.transient_tau))?;
     Ok(out.finish())
 }
 

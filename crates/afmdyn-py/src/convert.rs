@@ -33,10 +33,6 @@ impl<'py> Out<'py> {
     pub fn i64s(&self, key: &str, v: Vec<i64>) -> PyResult<()> {
         self.dict.set_item(key, v.into_pyarray(self.py))
     }
-    /// A 1-D bool array.
-    pub fn bools(&self, key: &str, v: Vec<bool>) -> PyResult<()> {
-        self.dict.set_item(key, v.into_pyarray(self.py))
-    }
     /// A 1-D complex128 array.
     pub fn complex(&self, key: &str, v: Vec<Complex64>) -> PyResult<()> {
         self.dict.set_item(key, v.into_pyarray(self.py))

@@ -119,127 +119,18 @@ def simulate(
     req = _request(locals(), initial=_state(initial))
     p, probe = _params(params, model)
     d = _run(_core.simulate, "simulate", progress, p, si=probe, request=req)
-    n = p.modes
-    comp = [f"a_{j}" for j in range(1, n + 1)] + [f"a_dot_{j}" for j in range(1, n + 1)]
-    # with a probe the library returned every array in SI (report::SeriesUnits)
-    si = bool(d["si"])
-    # the units and the series' meanings as the library declares them (report::SeriesUnits,
-    # timeseries.csv's columns)
-    u, long = d["units"], d["long_names"]
-    time = u["time"]
-    _t = {"units": u["time_unit"], "long_name": long[time]}
-    _g = {"units": u["length"]}
-    _v = {"units": u["velocity"]}
-    force, energy = u["force"], u["energy"]
-    freq = "Hz" if si else "Ω units (1/t0)"
-    ds = xr.Dataset(
-        data_vars={
-            "v_t": (time, d["v_t"], {**_g, "long_name": long["v_t"]}),
-            "v_t_dot": (time, d["v_t_dot"], {**_v, "long_name": "dV_T/dτ"}),
-            "w_tip": (time, d["w_tip"], {**_g, "long_name": long["w_tip"]}),
-            "w_tip_dot": (time, d["w_tip_dot"], {**_v, "long_name": long["w_tip_dot"]}),
-            "in_contact": (time, d["in_contact"], {"long_name": long["in_contact"]}),
-            "contact_force": (
-                time,
-                d["contact_force"],
-                {
-                    "units": force,
-                    "long_name": long["contact_force"],
-                    "sign_convention": _core.FORCE_SIGN,
-                },
-            ),
-            "a": ((time, "mode"), d["a"], {**_g, "long_name": "modal displacement a_i"}),
-            "a_dot": ((time, "mode"), d["a_dot"], {**_v, "long_name": "modal velocity da_i/dτ"}),
-            "event_tau": ("event", d["event_tau"], {**_t, "long_name": "switching time"}),
-            "event_to_contact": (
-                "event",
-                d["event_to_contact"],
-                {"long_name": "switching into contact (else out of it)"},
-            ),
-            "event_v_t_dot": (
-                "event",
-                d["event_v_t_dot"],
-                {**_v, "long_name": "dV_T/dτ at the switching (impact velocity)"},
-            ),
-            "section_tau": ("section", d["section_tau"], {**_t, "long_name": "section time 2πk/Ω"}),
-            "section_v_t": ("section", d["section_v_t"], {**_g, "long_name": "V_T at the section"}),
-            "section_w_tip": (
-                "section",
-                d["section_w_tip"],
-                {**_g, "long_name": "W(1,τ) at the section"},
-            ),
-            "section_w_tip_dot": (
-                "section",
-                d["section_w_tip_dot"],
-                {**_v, "long_name": "∂W(1,τ)/∂τ at the section"},
-            ),
-            "section_state": (
-                ("section", "component"),
-                d["section_state"],
-                {"long_name": "state (a, da/dτ) at the section"},
-            ),
-            "energy_tau0": ("cycle", d["energy_tau0"], {**_t, "long_name": "start of the period"}),
-            "energy_start": (
-                "cycle",
-                d["energy_start"],
-                {"units": energy, "long_name": "stored energy at the start"},
-            ),
-            "energy_end": (
-                "cycle",
-                d["energy_end"],
-                {"units": energy, "long_name": "stored energy at the end"},
-            ),
-            "base_work": (
-                "cycle",
-                d["base_work"],
-                {"units": energy, "long_name": "work of the base drive"},
-            ),
-            "beam_dissipation": (
-                "cycle",
-                d["beam_dissipation"],
-                {"units": energy, "long_name": "beam damping loss"},
-            ),
-            "contact_dissipation": (
-                "cycle",
-                d["contact_dissipation"],
-                {
-                    "units": energy,
-                    "long_name": "dissipation in the sample (contact damping, impacts)",
-                },
-            ),
-            "energy_residual": (
-                "cycle",
-                d["energy_residual"],
-                {"units": energy, "long_name": "ΔE − (work − losses)"},
-            ),
-            "spectrum": (
-                "frequency",
-                d["spectrum"],
-                {**_g, "long_name": "amplitude spectrum of W(1,τ) (spectrum.csv)"},
-            ),
-        },
-        coords={
-            "frequency": (
-                "frequency",
-                d["spectrum_frequency"],
-                {"units": freq, "long_name": "frequency"},
-            ),
-            time: (time, d["tau"], _t),
-            "mode": ("mode", np.arange(1, n + 1), {"long_name": "Galerkin mode i"}),
-            "component": ("component", comp),
-        },
-        attrs=_attrs(
-            p,
-            summary=d["json"],
-            tau_end=d["tau_end"],
-            switchings=d["switchings"],
-            body_contact=int(d["body_contact"]),
-            integrator=d["integrator"],
-            transient_tau=d["transient_tau"],
-            samples_per_period=samples_per_period,
-        ),
+    attrs = _attrs(
+        p,
+        summary=d["json"],
+        tau_end=d["tau_end"],
+        switchings=d["switchings"],
+        body_contact=int(d["body_contact"]),
+        integrator=d["integrator"],
+        transient_tau=d["transient_tau"],
+        samples_per_period=samples_per_period,
     )
-    return ds
+    # with a probe the library laid every array out in SI (report::simulate_layout)
+    return _layout.dataset(d["layout"], attrs)
 
 
 @_typed

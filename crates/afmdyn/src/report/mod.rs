@@ -383,9 +383,11 @@ pub fn continuation_warnings(param: SweepParam, branches: &[Branch]) -> Vec<Stri
 
 mod branches;
 mod curves;
+mod series;
 mod units;
 pub use branches::*;
 pub use curves::*;
+pub use series::*;
 pub use units::*;
 
 /// `afmdyn lyapunov --json`: the Lyapunov spectrum and the 0–1 test at `params` (every field of
