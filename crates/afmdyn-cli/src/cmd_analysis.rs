@@ -402,7 +402,7 @@ fn write_bifurcation_npy(csv_path: &Path, npy: &Path, param: &str) -> Result<(),
             num(14),
         ])?;
     }
-    s.finish()
+    Ok(s.finish()?)
 }
 
 /// `afmdyn attractors` flags.

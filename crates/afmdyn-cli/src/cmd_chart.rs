@@ -163,7 +163,7 @@ fn write_csv(path: &Path, chart: &Chart, cells: &[ChartCell]) -> Result<(), CliE
             text.push('\n');
         }
     }
-    write_bytes(path, text.as_bytes())
+    Ok(write_bytes(path, text.as_bytes())?)
 }
 
 /// The value of `--FLAG` on the axis `axis`: a unit (5nm, 299kHz) must be the axis' SI unit

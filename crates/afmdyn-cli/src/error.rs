@@ -96,3 +96,9 @@ impl From<afmdyn::UnitsError> for CliError {
         CliError::Input(e.to_string())
     }
 }
+
+impl From<afmdyn::layout::files::FileError> for CliError {
+    fn from(e: afmdyn::layout::files::FileError) -> Self {
+        CliError::Io(e.0)
+    }
+}

@@ -48,8 +48,8 @@
 //!   one after another; every seed comes from the run's index, so the results are the same.
 //! * `files` — the library's I/O: reading probe files (`Probe::load(path)`; [`probe::Probe::parse`]
 //!   takes the TOML text and is always there), the studies' stores in locked directories
-//!   (`request::checkpoint_file`, `request::chart_store`, `request::dir_lock`) and NetCDF
-//!   writing (`layout::netcdf`).
+//!   (`request::checkpoint_file`, `study::chart_store`, `request::dir_lock`) and the result
+//!   files: NetCDF (`layout::netcdf`), streamed CSV and NPY (`layout::files`).
 //! * `schema` — JSON Schemas of the requests (`schemars::JsonSchema` on [`request`]'s types;
 //!   `docs/schema/` holds them).
 //!

@@ -145,7 +145,10 @@ fn write_both<P: Painter>(dir: &Path, stem: &str, size: (u32, u32), p: &P) -> Re
     let bytes = png(size, p).map_err(|e| fail("png", e))?;
     write_bytes(&dir.join(format!("{stem}.png")), &bytes)?;
     let text = svg(size, p).map_err(|e| fail("svg", e))?;
-    write_bytes(&dir.join(format!("{stem}.svg")), text.as_bytes())
+    Ok(write_bytes(
+        &dir.join(format!("{stem}.svg")),
+        text.as_bytes(),
+    )?)
 }
 
 /// Break a legend label into lines of at most ~26 characters.

@@ -1,7 +1,7 @@
 //! Periodic orbits of the stroboscopic map by Newton shooting, with Floquet multipliers.
 //!
 //! A period-n orbit is a zero of F(z) = Pⁿ(z) − z. Newton's step solves (M − I) δ = −F with M the
-//! monodromy matrix of Pⁿ ([`super::monodromy`]); it converges quadratically to stable and
+//! monodromy matrix of Pⁿ ([`crate::maps::flow`]); it converges quadratically to stable and
 //! unstable orbits alike. The Floquet multipliers are the eigenvalues of M.
 
 use crate::error::SimError;

@@ -6,6 +6,8 @@
 //! NumPy and xarray store them.
 
 #[cfg(feature = "files")]
+pub mod files;
+#[cfg(feature = "files")]
 pub mod netcdf;
 
 /// The values of a variable, row-major over its dimensions.
