@@ -2,14 +2,12 @@
 
 use crate::args::{IntegratorArgs, ModelArgs};
 use crate::error::CliError;
-use crate::output::{
-    csv_finish, csv_line, csv_lines, csv_stream, f, write_csv, write_csv_numbers, Column,
-    CsvStream, Field, NpyStream, OutDir,
-};
+use crate::output::{f, write_csv, write_csv_numbers, OutDir};
 use crate::plot::{save, Figure, PixelColumns, Series, Style};
 use afmdyn::analysis::spectrum::{amplitude_spectrum, SPECTRUM_SAMPLES};
 use afmdyn::integrate::build;
 use afmdyn::report::SeriesUnits;
+use afmdyn::request::simulate_files::{SeriesFiles, SERIES_FILES};
 use afmdyn::request::{ConvergeRequest, SeriesStore, SimulateRequest};
 use afmdyn::request::{Document, Resolved};
 use afmdyn::trajectory::chunked::{record_chunked, Chunk, ChunkedSpec};
@@ -33,12 +31,6 @@ pub enum Files {
 /// Every file `simulate` writes in its `--out` directory: a run removes their stale temporary
 /// siblings (`.NAME.partial.EXT`), which a run killed outright (a second Ctrl-C) leaves.
 const SIMULATE_OUTPUTS: &[&str] = &[
-    "timeseries.npy",
-    "timeseries.npy.json",
-    "timeseries.csv",
-    "events.csv",
-    "poincare.csv",
-    "energy.csv",
     "spectrum.csv",
     "tip.png",
     "tip.svg",
@@ -230,42 +222,6 @@ impl PlotData {
     }
 }
 
-/// The writers of a run's data files.
-struct DataFiles {
-    npy: NpyStream,
-    csv: Option<CsvStream>,
-    events: CsvStream,
-    poincare: CsvStream,
-    energy: CsvStream,
-}
-
-fn series_columns(n: usize, su: &SeriesUnits) -> Vec<Column> {
-    su.columns(n)
-        .into_iter()
-        .map(|c| Column::new(c.name, c.unit, c.long_name))
-        .collect()
-}
-
-/// The rows of samples (the library's [`afmdyn::trajectory::SampleRows`] layout, which is
-/// that of [`series_columns`]) in `su`'s units, appended to `out`.
-fn convert_rows(rows: &[f64], width: usize, su: &SeriesUnits, out: &mut Vec<f64>) {
-    let n = (width - 6) / 2;
-    out.clear();
-    out.reserve(rows.len());
-    for r in rows.chunks_exact(width) {
-        out.extend([
-            su.t(r[0]),
-            su.x(r[1]),
-            su.x(r[2]),
-            su.v(r[3]),
-            r[4],
-            su.force(r[5]),
-        ]);
-        out.extend(r[6..6 + n].iter().map(|&a| su.x(a)));
-        out.extend(r[6 + n..].iter().map(|&a| su.v(a)));
-    }
-}
-
 /// Run `afmdyn simulate`: the run is recorded in chunks of whole periods and every chunk is
 /// streamed to the files, so memory does not grow with the length of the run.
 pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
@@ -282,19 +238,15 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
     let z0 = afmdyn::request::analyses::initial_state(&model, request.initial.as_deref())?;
     let n = p.modes;
     let su = SeriesUnits::new(&p, probe.as_ref());
-    let columns = series_columns(n, &su);
     let (store, bytes_per_value) = match a.files {
         Files::None => (SeriesStore::Nothing, 0.0),
         // NPY 8 bytes a value, CSV up to 24 more
         _ => (SeriesStore::Files, if a.csv { 8.0 + 24.0 } else { 8.0 }),
     };
-    let span = request.validate(&p, store, columns.len(), bytes_per_value)?;
-    let (period, t_transient, record_tau, total_periods) = (
-        p.period(),
-        span.transient_tau,
-        span.record_tau,
-        span.total_periods,
-    );
+    // τ, V_T, W, Ẇ, contact, force and the 2N modal coordinates per sample
+    let span = request.validate(&p, store, 6 + 2 * n, bytes_per_value)?;
+    let (t_transient, record_tau, total_periods) =
+        (span.transient_tau, span.record_tau, span.total_periods);
     let spp = a.samples_per_period;
     let opts = request.integrator_options();
     let mut integ = build(&model, opts, 0.0, &z0)?;
@@ -304,43 +256,14 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
         Files::None => None,
         _ => {
             let o = OutDir::lock(&a.out)?;
+            o.remove_partials(&SERIES_FILES)?;
             o.remove_partials(SIMULATE_OUTPUTS)?;
             Some(o)
         }
     };
     let mut files = match &out {
         None => None,
-        Some(o) => Some(DataFiles {
-            npy: NpyStream::create(&o.join("timeseries.npy"), columns.clone())?,
-            csv: match a.csv {
-                true => {
-                    let hdr: Vec<&str> = columns.iter().map(|c| c.name.as_str()).collect();
-                    Some(csv_stream(&o.join("timeseries.csv"), &hdr)?)
-                }
-                false => None,
-            },
-            events: csv_stream(
-                &o.join("events.csv"),
-                &[su.names().time, "from", "to", "v_t_dot"],
-            )?,
-            poincare: csv_stream(
-                &o.join("poincare.csv"),
-                &[su.names().time, "v_t", "w_tip", "w_tip_dot"],
-            )?,
-            energy: csv_stream(
-                &o.join("energy.csv"),
-                &[
-                    if su.u.si { "t0" } else { "tau0" },
-                    "e_start",
-                    "e_end",
-                    "base_work",
-                    "beam_dissipation",
-                    "contact_dissipation",
-                    "residual",
-                    if su.u.si { "t1" } else { "tau1" },
-                ],
-            )?,
-        }),
+        Some(o) => Some(SeriesFiles::create(o.path(), n, su, a.csv)?),
     };
     let start = t_transient;
     let end = start + record_tau;
@@ -378,85 +301,17 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
         chunk_periods: a.chunk_periods,
     };
     crate::error::stop_on_signal();
-    let mut converted = Vec::new();
-    let mut lines = Vec::new();
-    // dimensionless units: the rows as they are (the conversion would multiply by 1)
-    let identity = [su.u.time, su.u.length, su.u.force] == [1.0; 3];
     let each = |c: &Chunk<'_>| -> Result<(), CliError> {
         // SIGINT/SIGTERM: end here; the streams' partial files are removed as they are dropped
         crate::error::interrupted()?;
         if let Some(fl) = files.as_mut() {
-            let rows = if identity {
-                c.rows
-            } else {
-                convert_rows(c.rows, c.width, &su, &mut converted);
-                &converted
-            };
-            fl.npy.push_rows(rows)?;
-            if let Some(csv) = fl.csv.as_mut() {
-                lines.clear();
-                for row in rows.chunks_exact(c.width) {
-                    csv_line(&mut lines, row.iter().map(|&v| Field::Num(v)));
-                }
-                csv_lines(csv, &lines)?;
-            }
+            fl.push(&model, c)?;
             // the spectrum's window: the last SPECTRUM_SAMPLES values of W(1,τ)
             let new = c.samples().len();
             let keep = new.min(SPECTRUM_SAMPLES);
             let drop = (spectrum.len() + keep).saturating_sub(SPECTRUM_SAMPLES);
             spectrum.drain(..drop);
             spectrum.extend(c.samples().skip(new - keep).map(|s| s[2]));
-            let region = |r: Region| match r {
-                Region::Free => "free",
-                Region::Contact => "contact",
-            };
-            lines.clear();
-            for e in c.events() {
-                csv_line(
-                    &mut lines,
-                    [
-                        Field::Num(su.t(e.tau)),
-                        Field::Word(region(e.from)),
-                        Field::Word(region(e.to)),
-                        Field::Num(su.v(e.v_t_dot)),
-                    ],
-                );
-            }
-            csv_lines(&mut fl.events, &lines)?;
-            lines.clear();
-            for (t, z) in &c.sections {
-                csv_line(
-                    &mut lines,
-                    [
-                        su.t(*t),
-                        su.x(model.v_t(*t, z)),
-                        su.x(model.w_tip(z)),
-                        su.v(model.w_tip_dot(z)),
-                    ]
-                    .map(Field::Num),
-                );
-            }
-            csv_lines(&mut fl.poincare, &lines)?;
-            lines.clear();
-            for e in c.energy() {
-                // each interval ends at the first stroboscopic section after its start
-                let tau1 = ((e.tau0 / period + 1e-9).floor() + 1.0) * period;
-                csv_line(
-                    &mut lines,
-                    [
-                        su.t(e.tau0),
-                        su.energy(e.e_start),
-                        su.energy(e.e_end),
-                        su.energy(e.base_work),
-                        su.energy(e.beam_dissipation),
-                        su.energy(e.contact_dissipation),
-                        su.energy(e.residual()),
-                        su.t(tau1),
-                    ]
-                    .map(Field::Num),
-                );
-            }
-            csv_lines(&mut fl.energy, &lines)?;
         }
         if let Some(pd) = plots.as_mut() {
             let new = c.samples().len();
@@ -499,13 +354,7 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
     })?;
     bar.finish_and_clear();
     if let Some(fl) = files {
-        fl.npy.finish()?;
-        if let Some(c) = fl.csv {
-            csv_finish(c)?;
-        }
-        csv_finish(fl.events)?;
-        csv_finish(fl.poincare)?;
-        csv_finish(fl.energy)?;
+        fl.finish()?;
     }
     if let Some(o) = &out {
         write_spectrum_and_plots(o, &p, &su, spp, spectrum, plots, summary.tau_end)?;

@@ -41,6 +41,8 @@ pub mod model;
 pub mod pool;
 pub mod run;
 pub mod simulate;
+#[cfg(feature = "files")]
+pub mod simulate_files;
 pub mod sweep;
 
 pub use analyses::{
