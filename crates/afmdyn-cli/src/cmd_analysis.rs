@@ -2,18 +2,17 @@
 
 use crate::args::{IntegratorArgs, ModelArgs};
 use crate::error::CliError;
-use crate::output::{f, io_error, write_bytes, write_csv, Column, NpyStream, OutDir, TextUnits};
+use crate::output::{f, io_error, write_bytes, write_csv, OutDir, TextUnits};
 use crate::plot::{
     save, save_scatter_stream, save_stacked, ChunkSink, Figure, IdSeries, LegendEntry, Series,
     StackedFractions, Style,
 };
-use afmdyn::analysis::bifurcation::Branch;
 use afmdyn::integrate::build;
 use afmdyn::request::checkpoint::CheckpointError;
 use afmdyn::request::limits::ATTRACTOR_SAMPLES_PER_PERIOD;
 use afmdyn::request::sweep::{
-    branch_code, status_code, sweep_failure, COL_BRANCH, COL_INDEX, COL_MESSAGE, COL_PERIOD,
-    COL_POINT, COL_STATUS, COL_TAU, COL_X_MAX, NUMERIC_COLUMNS,
+    status_code, sweep_failure, COL_BRANCH, COL_MESSAGE, COL_PERIOD, COL_POINT, COL_STATUS,
+    COL_X_MAX,
 };
 use afmdyn::request::{
     AttractorsRequest, BifurcationRequest, FileCheckpoint, GlobalContinuationRequest, SteadyRequest,
@@ -229,7 +228,7 @@ pub fn bifurcation(a: &BifurcationArgs) -> Result<(), CliError> {
         }
         Ok(())
     })?;
-    write_bifurcation_npy(&final_csv, &out.join("bifurcation.npy"), a.param.name())?;
+    let npy = store.write_npy(a.param)?;
     let sym = a.param.symbol();
     let legend: Vec<LegendEntry> = [
         ("period 1", 1.0),
@@ -334,7 +333,7 @@ pub fn bifurcation(a: &BifurcationArgs) -> Result<(), CliError> {
         "nonperiodic": nonperiodic,
         "errors": errors,
         "csv": final_csv,
-        "npy": out.join("bifurcation.npy"),
+        "npy": npy,
     });
     summary = afmdyn::report::with_si(summary, probe.as_ref(), &base);
     // the exit-code rule (docs/outputs.md): failed points are reported on stderr too, and a
@@ -366,43 +365,6 @@ pub fn bifurcation(a: &BifurcationArgs) -> Result<(), CliError> {
         );
     }
     Ok(())
-}
-
-/// Columns of `bifurcation.npy` (the library's numeric records; the value names `param`).
-fn bifurcation_npy_columns(param: &str) -> Vec<Column> {
-    NUMERIC_COLUMNS
-        .iter()
-        .map(|c| match c.name {
-            "value" => Column::new(c.name, c.unit, format!("{} ({param})", c.meaning)),
-            _ => Column::new(c.name, c.unit, c.meaning),
-        })
-        .collect()
-}
-
-fn write_bifurcation_npy(csv_path: &Path, npy: &Path, param: &str) -> Result<(), CliError> {
-    let rd = |e| io_error("read", csv_path, e);
-    let mut reader = csv::Reader::from_path(csv_path).map_err(rd)?;
-    let mut s = NpyStream::create(npy, bifurcation_npy_columns(param))?;
-    for r in reader.records() {
-        let r = r.map_err(rd)?;
-        let num = |i: usize| r[i].parse::<f64>().unwrap_or(f64::NAN);
-        let branch: Branch = r[COL_BRANCH].parse().unwrap_or(Branch::Start(u32::MAX));
-        s.push(&[
-            num(COL_VALUE),
-            num(COL_INDEX),
-            branch_code(branch),
-            status_code(&r[COL_STATUS], &r[COL_PERIOD]),
-            num(COL_POINT),
-            num(COL_TAU),
-            num(9),
-            num(COL_W_TIP),
-            num(COL_X_MAX),
-            num(12),
-            num(13),
-            num(14),
-        ])?;
-    }
-    Ok(s.finish()?)
 }
 
 /// `afmdyn attractors` flags.

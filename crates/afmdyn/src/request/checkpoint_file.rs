@@ -17,8 +17,12 @@
 
 use super::checkpoint::{end_state, Checkpoint, CheckpointError, DonePoint, Ledger, StoreStatus};
 use super::dir_lock::{partial_path, DirLock};
-use super::sweep::{SweepRecord, COL_INDEX, COL_POINT, COL_POINTS, HEADER};
+use super::sweep::{branch_code, status_code, SweepRecord, HEADER, NUMERIC_COLUMNS};
+use super::sweep::{COL_BRANCH, COL_INDEX, COL_PERIOD, COL_POINT, COL_POINTS, COL_STATUS};
+use super::sweep::{COL_TAU, COL_VALUE, COL_W_TIP, COL_X_MAX};
 use crate::analysis::bifurcation::Branch;
+use crate::layout::files::{io_error, Column, FileError, NpyStream};
+use crate::params::SweepParam;
 use serde_json::{json, Value};
 use std::collections::HashSet;
 use std::fs::{self, File, OpenOptions};
@@ -223,6 +227,48 @@ impl<'a> FileCheckpoint<'a> {
 
     fn partial(&self) -> PathBuf {
         self.dir.join(PARTIAL_CSV)
+    }
+
+    /// Write `DIR/bifurcation.npy` and its `.npy.json` from the finished rows
+    /// ([`Self::final_csv`], streamed): the columns [`NUMERIC_COLUMNS`], the branch and the
+    /// status as their codes ([`branch_code`], [`status_code`]), an empty cell (a failed
+    /// point's numbers) as NaN; `param` names the value's column. Returns the path.
+    ///
+    /// # Errors
+    /// [`FileError`] naming the file that cannot be read or written.
+    pub fn write_npy(&self, param: SweepParam) -> Result<PathBuf, FileError> {
+        let (csv_path, npy) = (self.final_csv(), self.dir.join("bifurcation.npy"));
+        let rd = |e: csv::Error| io_error("read", &csv_path, e);
+        let mut reader = csv::Reader::from_path(&csv_path).map_err(rd)?;
+        let columns = NUMERIC_COLUMNS
+            .iter()
+            .map(|c| match c.name {
+                "value" => Column::new(c.name, c.unit, format!("{} ({})", c.meaning, param.name())),
+                _ => Column::new(c.name, c.unit, c.meaning),
+            })
+            .collect();
+        let mut s = NpyStream::create(&npy, columns)?;
+        for r in reader.records() {
+            let r = r.map_err(rd)?;
+            let num = |i: usize| r[i].parse::<f64>().unwrap_or(f64::NAN);
+            let branch: Branch = r[COL_BRANCH].parse().unwrap_or(Branch::Start(u32::MAX));
+            s.push(&[
+                num(COL_VALUE),
+                num(COL_INDEX),
+                branch_code(branch),
+                status_code(&r[COL_STATUS], &r[COL_PERIOD]),
+                num(COL_POINT),
+                num(COL_TAU),
+                num(COL_TAU + 1),
+                num(COL_W_TIP),
+                num(COL_X_MAX),
+                num(COL_X_MAX + 1),
+                num(COL_X_MAX + 2),
+                num(COL_X_MAX + 3),
+            ])?;
+        }
+        s.finish()?;
+        Ok(npy)
     }
 
     fn ledger_path(&self) -> PathBuf {
