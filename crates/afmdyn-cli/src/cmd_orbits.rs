@@ -157,7 +157,7 @@ fn branch_rows(model: &CantileverModel, id: usize, br: &[BranchPoint]) -> Vec<Ve
                 f(b.value),
                 b.stable.to_string(),
                 f(b.multipliers[0].norm()),
-                format!("{:?}", b.critical),
+                b.critical.name().to_string(),
                 b.section
                     .iter()
                     .map(|z| format!("{}", model.w_tip(z)))
@@ -165,7 +165,7 @@ fn branch_rows(model: &CantileverModel, id: usize, br: &[BranchPoint]) -> Vec<Ve
                     .join(" "),
                 b.switchings.to_string(),
                 f(b.grazing_distance),
-                b.event.map_or(String::new(), |e| format!("{e:?}")),
+                b.event.map_or(String::new(), |e| e.name().to_string()),
             ]
         })
         .collect()

@@ -46,6 +46,18 @@ pub enum Instability {
     NeimarkSacker,
 }
 
+impl Instability {
+    /// Its name in every output (JSON, CSV, Python): `fold`, `period-doubling`,
+    /// `neimark-sacker`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Instability::Fold => "fold",
+            Instability::PeriodDoubling => "period-doubling",
+            Instability::NeimarkSacker => "neimark-sacker",
+        }
+    }
+}
+
 /// The critical multiplier: the one of largest modulus, and its type.
 pub fn critical_multiplier(mu: &[Complex<f64>]) -> (Complex<f64>, Instability) {
     let m = *mu

@@ -7,15 +7,6 @@ use crate::layout::{Layout, Values, Variable};
 use crate::model::CantileverModel;
 use crate::params::SweepParam;
 
-/// The serde name of an enum value (`"fold"`, `"period-doubling"`, …), as the JSON documents
-/// spell it.
-fn word(v: impl serde::Serialize) -> String {
-    serde_json::to_value(v)
-        .ok()
-        .and_then(|v| v.as_str().map(String::from))
-        .unwrap_or_default()
-}
-
 /// The branches of `afmdyn continue` as a layout over the dimensions `point` (every branch
 /// point, branch by branch), `k` (the section points of the longest period, NaN-padded) and
 /// `multiplier` / `component` (2N): `branch` (0 the continued one), `period`, `s`
@@ -113,7 +104,12 @@ pub fn continuation_layout(
                 point,
                 "1",
                 "how the orbit is or would become unstable",
-                Values::Text(points.iter().map(|(_, b)| word(b.critical)).collect()),
+                Values::Text(
+                    points
+                        .iter()
+                        .map(|(_, b)| b.critical.name().into())
+                        .collect(),
+                ),
             ),
             Variable::i32(
                 "switchings",
@@ -137,7 +133,7 @@ pub fn continuation_layout(
                 Values::Text(
                     points
                         .iter()
-                        .map(|(_, b)| b.event.map_or(String::new(), word))
+                        .map(|(_, b)| b.event.map_or(String::new(), |e| e.name().into()))
                         .collect(),
                 ),
             ),
@@ -164,4 +160,30 @@ pub fn continuation_layout(
             ),
         ],
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::analysis::continuation::BranchEvent;
+    use crate::analysis::shooting::Instability;
+
+    /// The names of the CSV and the dataset are the JSON document's (serde's).
+    #[test]
+    fn names_are_the_json_names() {
+        for e in [
+            BranchEvent::Fold,
+            BranchEvent::PeriodDoubling,
+            BranchEvent::NeimarkSacker,
+            BranchEvent::Grazing,
+        ] {
+            assert_eq!(serde_json::to_value(e).unwrap(), e.name());
+        }
+        for i in [
+            Instability::Fold,
+            Instability::PeriodDoubling,
+            Instability::NeimarkSacker,
+        ] {
+            assert_eq!(serde_json::to_value(i).unwrap(), i.name());
+        }
+    }
 }

@@ -230,6 +230,19 @@ pub enum BranchEvent {
     Grazing,
 }
 
+impl BranchEvent {
+    /// Its name in every output (JSON, CSV, Python): `fold`, `period-doubling`,
+    /// `neimark-sacker`, `grazing`.
+    pub fn name(self) -> &'static str {
+        match self {
+            BranchEvent::Fold => "fold",
+            BranchEvent::PeriodDoubling => "period-doubling",
+            BranchEvent::NeimarkSacker => "neimark-sacker",
+            BranchEvent::Grazing => "grazing",
+        }
+    }
+}
+
 /// One point of a branch.
 #[derive(Debug, Clone, PartialEq)]
 pub struct BranchPoint {
