@@ -68,15 +68,9 @@ def test_continuation_with_branch_switching_equals_the_command_line(switched):
         got = ds.w_tip_section.values[i]
         np.testing.assert_array_equal(got[: len(row)], row)
         assert np.isnan(got[len(row) :]).all()
-    # event names: the JSON's kebab-case; the CSV spells the Rust names
-    debug = {
-        "": "",
-        "fold": "Fold",
-        "period-doubling": "PeriodDoubling",
-        "neimark-sacker": "NeimarkSacker",
-        "grazing": "Grazing",
-    }
-    assert [debug[e] for e in ds.event.values] == csv.event.tolist()
+    # event and instability names: the JSON's kebab-case in the CSV and the dataset alike
+    assert ds.event.values.tolist() == csv.event.fillna("").tolist()
+    assert ds.critical.values.tolist() == csv.critical.fillna("").tolist()
     # the period-doubling cascade: periods 1, 2, 4 and 8
     assert set(ds.branch.values.tolist()) == set(csv.branch.tolist())
     assert {1, 2, 4, 8} <= set(ds.period.values.tolist())
