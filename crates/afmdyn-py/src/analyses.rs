@@ -16,8 +16,8 @@ use afmdyn::request::checkpoint::{self, CheckpointError};
 use afmdyn::request::{self, Analysis, Document, ModesRequest, Resolved};
 use afmdyn::request::{
     AttractorsRequest, BifurcationRequest, ContinuationRequest, ConvergeRequest,
-    GlobalContinuationRequest, IntegratorRequest, LyapunovRequest, ObserveRequest, OrbitRequest,
-    SeriesStore, SimulateRequest,
+    GlobalContinuationRequest, LyapunovRequest, ObserveRequest, OrbitRequest, SeriesStore,
+    SimulateRequest,
 };
 use afmdyn::request::{DirLock, FileCheckpoint, LockError, MemoryCheckpoint, SweepRecord};
 use afmdyn::study::sweep::SweepStudy;
@@ -30,24 +30,6 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
 type Dict<'py> = Bound<'py, PyDict>;
-
-/// The integrator request of the keywords (`None`: the request's default integrator and
-/// tolerance).
-pub(crate) fn integrator_request(
-    kind: Option<&str>,
-    steps_per_period: Option<usize>,
-    tolerance: Option<f64>,
-) -> PyResult<IntegratorRequest> {
-    let d = IntegratorRequest::default();
-    Ok(IntegratorRequest {
-        integrator: match kind {
-            Some(k) => k.parse().map_err(value_error)?,
-            None => d.integrator,
-        },
-        steps_per_period,
-        tolerance: tolerance.unwrap_or(d.tolerance),
-    })
-}
 
 /// The initial state: `None` is rest, else 2N values (a₁…a_N, ȧ₁…ȧ_N).
 fn initial_state(model: &CantileverModel, initial: Option<Vec<f64>>) -> PyResult<DVector<f64>> {

@@ -75,27 +75,18 @@ impl ChartStudy {
         })
     }
 
-    /// The chart of `request` (the chart options as JSON text, but the integrator's; unknown
-    /// keys are refused) over `params` (or the probe's set, or the paper's) with the `model`
-    /// keywords; `probe` is the probe file's text; the integrator's options as every analysis
-    /// takes them.
+    /// The chart of `request` (the keywords of the library's `ChartRequest`, through serde:
+    /// an unknown key is a `TypeError`, a bad value a `ValueError`) over `params` (or the
+    /// probe's set, or the paper's) with the `model` keywords; `probe` is the probe file's text.
     #[staticmethod]
-    #[pyo3(signature = (request, params=None, probe=None, model=None, integrator=None,
-        steps_per_period=None, tolerance=None))]
+    #[pyo3(signature = (request=None, params=None, probe=None, model=None))]
     fn build(
-        request: &str,
+        request: Option<&Bound<'_, PyDict>>,
         params: Option<PyRef<'_, PyParams>>,
         probe: Option<String>,
         model: Option<&Bound<'_, PyDict>>,
-        integrator: Option<&str>,
-        steps_per_period: Option<usize>,
-        tolerance: Option<f64>,
     ) -> PyResult<Self> {
-        let mut request: ChartRequest = serde_json::from_str(request)
-            .map_err(|e| pyo3::exceptions::PyTypeError::new_err(format!("chart options: {e}")))?;
-        // the integrator as every analysis reads it (a ValueError naming a bad kind)
-        request.integrator =
-            crate::analyses::integrator_request(integrator, steps_per_period, tolerance)?;
+        let request: ChartRequest = crate::convert::request("chart", request)?;
         let parsed = probe
             .as_deref()
             .map(|t| Probe::parse(t, "probe").map_err(probe_error))
@@ -206,6 +197,16 @@ impl ChartStudy {
             &self.chart,
             ChartArrays::region(&self.chart, origin, size, &cells),
         )
+    }
+
+    /// Raise `SimulationError` when no cell found any attractor (`attractors`: the cells'
+    /// counts, from a store that keeps no messages): the library's rule
+    /// ([`afmdyn::study::chart::every_count_zero`]).
+    fn check(&self, attractors: Vec<usize>) -> PyResult<()> {
+        match afmdyn::study::chart::every_count_zero(attractors, None) {
+            Some(e) => Err(sim_error(e)),
+            None => Ok(()),
+        }
     }
 
     /// The `--json` document of the cells in `tasks`, as JSON text.

@@ -66,23 +66,13 @@ impl SweepStudy {
         SweepStudy::of(r)
     }
 
-    /// The sweep of `request` (the options of `afmdyn.bifurcation` as JSON text; unknown keys
-    /// are refused) over `params`.
+    /// The sweep of `request` (the keywords of `afmdyn.bifurcation`, through serde into the
+    /// library's `BifurcationRequest`: an unknown key is a `TypeError`, a bad value a
+    /// `ValueError`) over `params`.
     #[staticmethod]
-    #[pyo3(signature = (request, params, integrator=None, steps_per_period=None,
-        tolerance=None))]
-    fn build(
-        request: &str,
-        params: PyRef<'_, PyParams>,
-        integrator: Option<&str>,
-        steps_per_period: Option<usize>,
-        tolerance: Option<f64>,
-    ) -> PyResult<Self> {
-        let mut request: BifurcationRequest = serde_json::from_str(request).map_err(|e| {
-            pyo3::exceptions::PyTypeError::new_err(format!("bifurcation options: {e}"))
-        })?;
-        request.integrator =
-            crate::analyses::integrator_request(integrator, steps_per_period, tolerance)?;
+    #[pyo3(signature = (request, params))]
+    fn build(request: Option<&Bound<'_, PyDict>>, params: PyRef<'_, PyParams>) -> PyResult<Self> {
+        let request: BifurcationRequest = crate::convert::request("bifurcation", request)?;
         SweepStudy::of(Recipe {
             request,
             params: params.inner,

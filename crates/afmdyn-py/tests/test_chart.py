@@ -266,3 +266,13 @@ def test_netcdf_files_open_with_the_packages_own_dependencies(cli, tmp_path):
     ds.to_netcdf(tmp_path / "python.nc", engine="scipy")
     back = xr.open_dataset(tmp_path / "python.nc", engine="scipy").load()
     np.testing.assert_array_equal(back.period.values, ds.period.values)
+
+
+def test_a_chart_without_any_attractor_fails_by_the_librarys_rule():
+    # the Dask store keeps counts only: the rule of every front end on the counts
+    from afmdyn import _chart
+
+    s = _chart.study(None, {}, x_steps=2, y_steps=1)
+    s.check([0, 1])
+    with pytest.raises(afmdyn.SimulationError, match="every one of the 2 chart cells failed"):
+        s.check([0, 0])

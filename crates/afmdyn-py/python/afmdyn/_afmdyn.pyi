@@ -483,13 +483,10 @@ class ChartStudy:
     def __init__(self, recipe: str) -> None: ...
     @staticmethod
     def build(
-        request: str,
+        request: Optional[Dict[str, Any]] = None,
         params: Optional[Params] = None,
         probe: Optional[str] = None,
         model: Optional[Dict[str, Any]] = None,
-        integrator: Optional[str] = None,
-        steps_per_period: Optional[int] = None,
-        tolerance: Optional[float] = None,
     ) -> ChartStudy: ...
     @property
     def recipe(self) -> str: ...
@@ -505,6 +502,7 @@ class ChartStudy:
         origin: Optional[Tuple[int, int]] = None,
         size: Optional[Tuple[int, int]] = None,
     ) -> Dict[str, Any]: ...
+    def check(self, attractors: List[int]) -> None: ...
     def document(self, tasks: List[str]) -> str: ...
     def run(
         self,
@@ -526,13 +524,7 @@ class SweepStudy:
 
     def __init__(self, recipe: str) -> None: ...
     @staticmethod
-    def build(
-        request: str,
-        params: Params,
-        integrator: Optional[str] = None,
-        steps_per_period: Optional[int] = None,
-        tolerance: Optional[float] = None,
-    ) -> SweepStudy: ...
+    def build(request: Optional[Dict[str, Any]], params: Params) -> SweepStudy: ...
     @property
     def recipe(self) -> str: ...
     def tasks(self, stage: int) -> int: ...

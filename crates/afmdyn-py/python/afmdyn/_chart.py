@@ -15,7 +15,7 @@ import xarray as xr
 from . import _afmdyn as _core
 from . import _layout
 from ._afmdyn import Params
-from ._common import _DEFAULTS, Model, _probe_text, _typed, _warn
+from ._common import _DEFAULTS, Model, _check_counts, _probe_text, _typed, _warn
 from ._progress import ProgressArg, reporter
 
 if TYPE_CHECKING:
@@ -32,18 +32,8 @@ def study(
         raise TypeError(f"params: expected afmdyn.Params or None, got {type(params).__name__}")
     model = dict(model)
     text = _probe_text(model)
-    for k in ("x_steps", "y_steps", "starts", "seed", "tile", "lyapunov_periods",
-              "max_attractors", "threads", "max_periods", "max_period"):
-        v = request.get(k)
-        if isinstance(v, int) and not isinstance(v, bool) and v < 0:
-            raise ValueError(f"{k} = {v}: must be >= 0")
-    integrator = request.pop("integrator", None)
-    steps_per_period = request.pop("steps_per_period", None)
-    tolerance = request.pop("tolerance", 1e-12)
-    request = {k: v for k, v in request.items() if v is not None}
-    return _core.ChartStudy.build(
-        json.dumps(request), params, text, model, integrator, steps_per_period, tolerance
-    )
+    _check_counts(request)
+    return _core.ChartStudy.build(request, params, text, model)
 
 
 def dataset(s: "_core.ChartStudy", d: Dict[str, Any]) -> xr.Dataset:

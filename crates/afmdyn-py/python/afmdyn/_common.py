@@ -220,7 +220,7 @@ def _typed(f: _F) -> _F:
 _COUNTS = frozenset(
     "samples_per_period steps_per_period max_modes periods steps starts seed threads "
     "max_periods max_period samples period transient blocks x_steps y_steps basin_hits "
-    "discover_after stride".split()
+    "discover_after stride tile lyapunov_periods max_attractors".split()
 )
 
 
@@ -260,6 +260,14 @@ def _start(request: Dict[str, Any]) -> Dict[str, Any]:
     return request
 
 
+def _check_counts(request: Dict[str, Any]) -> None:
+    """Negative counts are a ValueError naming the option (the core's unsigned integers would
+    raise OverflowError)."""
+    for k, v in request.items():
+        if k in _COUNTS and isinstance(v, int) and not isinstance(v, bool) and v < 0:
+            raise ValueError(f"{k} = {v}: must be >= 0")
+
+
 def _run(
     fn: Any,
     desc: str,
@@ -274,9 +282,7 @@ def _run(
     (the core's unsigned integers would raise OverflowError). With ``si`` (a probe file)
     ``fn`` gets ``probe=si``, and its JSON document the command line's ``"si"`` block (added
     by the library's request layer)."""
-    for k, v in (request or {}).items():
-        if k in _COUNTS and isinstance(v, int) and not isinstance(v, bool) and v < 0:
-            raise ValueError(f"{k} = {v}: must be >= 0")
+    _check_counts(request or {})
     if si is not None:
         extra["probe"] = si
     with reporter(progress, desc) as cb:

@@ -19,7 +19,6 @@ the task's region is written: a killed driver loses at most the task it was writ
 from __future__ import annotations
 
 import functools
-import json
 import os
 import time
 from typing import TYPE_CHECKING, Any, Dict, Iterable, List, Optional, Sequence, Set, Union
@@ -293,10 +292,7 @@ def chart(
             client.close()
             if cluster is not None:
                 cluster.close()
-    if (ds["attractors"].values == 0).all():
-        raise _core.SimulationError(
-            f"every chart cell failed ({ds['attractors'].size} cells): no attractor found"
-        )
+    s.check(ds["attractors"].values.ravel().tolist())
     return ds
 
 
@@ -357,12 +353,9 @@ def bifurcation(
     arguments, bit for bit.
     """
     from ._api import _params, _sweep_dataset
+    from ._common import _check_counts
 
     p, _probe = _params(params, model)
-    for k, v in dict(steps=steps, starts=starts, seed=seed, max_periods=max_periods,
-                     max_period=max_period).items():
-        if isinstance(v, int) and not isinstance(v, bool) and v < 0:
-            raise ValueError(f"{k} = {v}: must be >= 0")
     request: Dict[str, Any] = dict(
         param=param,
         values=None if values is None else np.asarray(values, dtype=np.float64).ravel().tolist(),
@@ -374,9 +367,13 @@ def bifurcation(
         tol=tol,
         max_periods=max_periods,
         max_period=max_period,
+        integrator=integrator,
+        steps_per_period=steps_per_period,
+        tolerance=tolerance,
     )
     request["from"] = from_
-    s = _core.SweepStudy.build(json.dumps(request), p, integrator, steps_per_period, tolerance)
+    _check_counts(request)
+    s = _core.SweepStudy.build(request, p)
     own = client is None
     cluster = None
     if own:

@@ -55,15 +55,44 @@ pub fn cells_of(records: Vec<(usize, Vec<ChartCell>)>) -> Vec<ChartCell> {
 /// The chart's failure when no cell found any attractor: the one rule of every front end
 /// (with the first cell's message).
 pub fn every_cell_failed(cells: &[ChartCell]) -> Option<SimError> {
-    if !cells.iter().all(|c| c.attractors.is_empty()) {
-        return None;
+    every_count_zero(
+        cells.iter().map(|c| c.attractors.len()),
+        cells.iter().find_map(|c| c.message.clone()),
+    )
+}
+
+/// [`every_cell_failed`] from the cells' attractor counts and the first failure's message
+/// (`None`: a store that keeps no messages, such as the Dask Zarr store).
+pub fn every_count_zero(
+    counts: impl IntoIterator<Item = usize>,
+    first: Option<String>,
+) -> Option<SimError> {
+    let mut runs = 0;
+    for n in counts {
+        if n > 0 {
+            return None;
+        }
+        runs += 1;
     }
     Some(SimError::EveryRunFailed {
         what: "chart cells",
-        runs: cells.len(),
-        first: cells
-            .iter()
-            .find_map(|c| c.message.clone())
-            .unwrap_or_default(),
+        runs,
+        first: first.unwrap_or_else(|| "no attractor found (the store keeps no messages)".into()),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::every_count_zero;
+
+    /// One cell with an attractor is an answer; none is the failure naming the count.
+    #[test]
+    fn a_chart_fails_only_when_no_cell_found_an_attractor() {
+        assert!(every_count_zero([0, 2, 0], None).is_none());
+        let e = every_count_zero([0, 0, 0], Some("diverged".into())).unwrap();
+        assert_eq!(
+            e.to_string(),
+            "every one of the 3 chart cells failed; the first: diverged"
+        );
+    }
 }
