@@ -209,9 +209,9 @@ pub struct IntegratorArgs {
     /// Time integrator: auto (exact for the linear law, split for Hertz and impact, taylor for
     /// DMT; default), exact (piecewise-exact), split (exact free flight; Taylor series in a
     /// Hertz contact, adaptive while sticking), taylor (Taylor series of high order, the
-    /// contact's edges in its regularising time: Hertz and DMT), exponential (adaptive DOP853 of the deviation
-    /// from the exact free flight: Lawson), rk4 (located switchings), rk4-naive (region per
-    /// stage, as in the paper) or adaptive (DOP853 with events and variational equations)
+    /// contact's edges in its regularising time: Hertz and DMT), rk4 (located switchings),
+    /// rk4-naive (region per stage, as in the paper) or adaptive (DOP853 with events and
+    /// variational equations)
     #[arg(long, default_value = "auto", value_parser = parse_integrator)]
     pub integrator: IntegratorKind,
     /// Fixed steps per drive period of rk4 / rk4-naive (default 2000)

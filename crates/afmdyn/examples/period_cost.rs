@@ -11,7 +11,7 @@
 //! propagator's path ([`Propagation`]).
 //!
 //! `... -- probe <FILE.toml> [periods] [...]`: the same for the model of a probe file. With
-//! `INTEGRATOR=<kind>` in the environment (auto, adaptive, exponential, split, ...) the
+//! `INTEGRATOR=<kind>` in the environment (auto, adaptive, split, taylor, ...) the
 //! integrator is that kind instead of `auto`.
 //!
 //! `... -- build <N> [reps]`: time of one exact-propagator build at the default parameters,

@@ -171,11 +171,6 @@ impl CantileverModel {
     pub fn params(&self) -> &Params {
         &self.params
     }
-    /// The tip–sample law with its stiffness α4 and damping α6 (what [`Self::rhs`] evaluates).
-    pub(crate) fn tip_sample(&self) -> &TipSample {
-        &self.law
-    }
-
     /// The tip–sample law.
     pub fn law(&self) -> &ContactLaw {
         &self.params.contact_law

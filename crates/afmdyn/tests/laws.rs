@@ -19,7 +19,7 @@ use nalgebra::{Complex, DMatrix, DVector};
 use proptest::prelude::*;
 
 mod common;
-use common::{against_adaptive_oracle, events_until, harmonic_response, impact_model, opts};
+use common::{events_until, harmonic_response, impact_model, opts};
 
 const DMT: ContactLaw = ContactLaw::Dmt {
     hamaker: 1e-5,
@@ -115,55 +115,6 @@ fn conformance_every_law_and_integrator() {
 /// adaptive integrator at the default tolerance 1e-12 does, and for at least 8 events. Then the
 /// period-1 orbits' Floquet multipliers (variational equations in contact, e^{A_I t} over the
 /// free stints, saltation at the events) agree to 1e-7.
-/// The exponential (Lawson) frame for DMT against the plain DOP853 oracle at a tighter
-/// tolerance: the same switchings to 1e-8 in τ and the same state after 30 periods from the
-/// steady state (point mass as in examples/probe-point-mass-dmt.toml, and the beam with N = 3),
-/// and the same period-1
-/// orbit by shooting (the variational steps of both integrate the state).
-#[test]
-fn exponential_frame_agrees_with_the_adaptive_oracle() {
-    let probe = afmdyn::probe::Probe::parse(
-        include_str!("../../../examples/probe-point-mass-dmt.toml"),
-        "examples/probe-point-mass-dmt.toml",
-    )
-    .unwrap();
-    let point_mass = CantileverModel::new(&probe.params).unwrap();
-    for m in [point_mass.clone(), law_model(DMT, 3, 2.6).1] {
-        // from the steady state the orbit command starts at (the point mass at Q = 400 needs
-        // hundreds of periods from rest to reach the sample)
-        let c = against_adaptive_oracle(&m, IntegratorKind::Exponential, 1e-12);
-        assert!(c.events >= 20, "N = {}: {} events", m.modes(), c.events);
-        assert!(c.worst_event < 1e-8, "events differ by {:e}", c.worst_event);
-        let d = c.state;
-        assert!(d < 1e-8, "N = {}: final state differs by {d:e}", m.modes());
-        // fewer DOP853 steps than the plain integrator at the same tolerance
-        let (w1, w3) = c.work;
-        assert!(w1 < w3, "N = {}: {w1} vs {w3} steps", m.modes());
-    }
-    let (guess, _) = OrbitRequest::default().start.guess(&point_mass).unwrap();
-    let orbit = |kind, tol| {
-        let mut it = build(&point_mass, opts(kind, tol), 0.0, &point_mass.rest()).unwrap();
-        shoot_with(it.as_mut(), &guess, 1, &ShootingOptions::default()).unwrap()
-    };
-    let (a, b) = (
-        orbit(IntegratorKind::Exponential, 1e-12),
-        orbit(IntegratorKind::Adaptive, 1e-14),
-    );
-    let d = (&a.state - &b.state).amax();
-    assert!(d < 1e-8, "orbit states differ by {d:e}");
-    // the monodromy from the frame's variational equations (Y′ = e^{−Λs} β ∂F/∂z Φ) against the
-    // plain ones, saltation at the contact switchings included
-    let m = (&a.monodromy - &b.monodromy).amax() / b.monodromy.amax();
-    assert!(m < 1e-7, "monodromies differ by {m:e} relative");
-    // the frame integrates a force law: the impact law's jumps and the (exactly propagated)
-    // linear law are refused
-    for law in [ContactLaw::Impact { restitution: 0.6 }, ContactLaw::Linear] {
-        let (_, m) = law_model(law, 3, 2.6);
-        let e = build(&m, opts(IntegratorKind::Exponential, 1e-12), 0.0, &m.rest());
-        assert!(common::is_refusal(&e, "exponential", None), "{law}");
-    }
-}
-
 #[test]
 fn split_integrator_agrees_with_the_adaptive_oracle() {
     let events = |m: &CantileverModel, kind, tol, t_end| {

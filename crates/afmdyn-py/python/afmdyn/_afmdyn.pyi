@@ -161,7 +161,7 @@ SimulateRequest = TypedDict(
     "SimulateRequest",
     {
         "initial": Optional[List[float]],  # default null
-        "integrator": Literal["auto", "exact", "rk4", "rk4-naive", "adaptive", "split", "exponential", "taylor"],  # default "auto"
+        "integrator": Literal["auto", "exact", "rk4", "rk4-naive", "adaptive", "split", "taylor"],  # default "auto"
         "periods": Optional[float],  # default null
         "samples_per_period": int,  # default 200
         "steps_per_period": Optional[int],  # default null
@@ -175,7 +175,7 @@ SimulateRequest = TypedDict(
 ConvergeRequest = TypedDict(
     "ConvergeRequest",
     {
-        "integrator": Literal["auto", "exact", "rk4", "rk4-naive", "adaptive", "split", "exponential", "taylor"],  # default "auto"
+        "integrator": Literal["auto", "exact", "rk4", "rk4-naive", "adaptive", "split", "taylor"],  # default "auto"
         "max_modes": int,  # default 4
         "periods": int,  # default 1
         "samples_per_period": int,  # default 200
@@ -190,7 +190,7 @@ BifurcationRequest = TypedDict(
     {
         "continuation": bool,  # default true
         "from": float,  # default 1.0
-        "integrator": Literal["auto", "exact", "rk4", "rk4-naive", "adaptive", "split", "exponential", "taylor"],  # default "auto"
+        "integrator": Literal["auto", "exact", "rk4", "rk4-naive", "adaptive", "split", "taylor"],  # default "auto"
         "max_period": int,  # default 64
         "max_periods": Optional[int],  # default null
         "param": Literal["omega", "alpha1", "alpha2", "alpha3", "alpha4", "alpha5", "alpha6"],  # default "omega"
@@ -211,7 +211,7 @@ AttractorsRequest = TypedDict(
     "AttractorsRequest",
     {
         "cluster_tol": float,  # default 1e-05
-        "integrator": Literal["auto", "exact", "rk4", "rk4-naive", "adaptive", "split", "exponential", "taylor"],  # default "auto"
+        "integrator": Literal["auto", "exact", "rk4", "rk4-naive", "adaptive", "split", "taylor"],  # default "auto"
         "max_period": int,  # default 64
         "max_periods": Optional[int],  # default null
         "samples": int,  # default 64
@@ -228,7 +228,7 @@ GlobalContinuationRequest = TypedDict(
     {
         "cluster_tol": float,  # default 1e-05
         "from": float,  # default 1.5
-        "integrator": Literal["auto", "exact", "rk4", "rk4-naive", "adaptive", "split", "exponential", "taylor"],  # default "auto"
+        "integrator": Literal["auto", "exact", "rk4", "rk4-naive", "adaptive", "split", "taylor"],  # default "auto"
         "match_tol": float,  # default 0.1
         "max_period": int,  # default 64
         "max_periods": Optional[int],  # default null
@@ -329,7 +329,7 @@ BasinsRequest = TypedDict(
         "cell": float,  # default 0.01
         "cluster_tol": float,  # default 1e-05
         "discover_after": int,  # default 200
-        "integrator": Literal["auto", "exact", "rk4", "rk4-naive", "adaptive", "split", "exponential", "taylor"],  # default "auto"
+        "integrator": Literal["auto", "exact", "rk4", "rk4-naive", "adaptive", "split", "taylor"],  # default "auto"
         "max_period": int,  # default 64
         "max_periods": Optional[int],  # default null
         "near_tol": float,  # default 0.02
@@ -354,7 +354,7 @@ ChartRequest = TypedDict(
     "ChartRequest",
     {
         "cluster_tol": float,  # default 1e-05
-        "integrator": Literal["auto", "exact", "rk4", "rk4-naive", "adaptive", "split", "exponential", "taylor"],  # default "auto"
+        "integrator": Literal["auto", "exact", "rk4", "rk4-naive", "adaptive", "split", "taylor"],  # default "auto"
         "lyapunov_periods": int,  # default 500
         "max_attractors": int,  # default 8
         "max_period": int,  # default 64

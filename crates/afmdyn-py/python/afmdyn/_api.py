@@ -94,7 +94,7 @@ def simulate(
         initial: initial state (a₁…a_N, ȧ₁…ȧ_N), ``[2N]``, or an :class:`Attractor` /
             :class:`Orbit` (its state at drive phase 0); default: rest.
         samples_per_period: samples per drive period (1..=100000).
-        integrator: ``"exact"``, ``"split"``, ``"taylor"``, ``"exponential"``, ``"rk4"``,
+        integrator: ``"exact"``, ``"split"``, ``"taylor"``, ``"rk4"``,
             ``"rk4-naive"`` or ``"adaptive"``; default (``None``) the command line's default
             (exact for the linear law, split for Hertz and impact, taylor for DMT);
             steps_per_period: rk4's fixed steps (default 2000); tolerance: the adaptive one's.

@@ -350,7 +350,6 @@ pub(crate) fn polish_steady(
         IntegratorKind::Exact
             | IntegratorKind::Adaptive
             | IntegratorKind::Split
-            | IntegratorKind::Exponential
             | IntegratorKind::Taylor
     ) {
         return None;

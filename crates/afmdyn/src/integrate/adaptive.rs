@@ -23,7 +23,6 @@
 //! is applied by the analyses ([`crate::system::saltation`]).
 
 use super::dop853::{Dop853, Field};
-use super::exact::{Anchor, LinearFrame};
 use super::{ChatterWindow, HermiteStep, Integrator, Step, StepBudget};
 use crate::error::SimError;
 use crate::model::CantileverModel;
@@ -33,12 +32,6 @@ use crate::system::Region;
 use crate::tip_sample::TipSampleSystem;
 use nalgebra::{DMatrix, DVector};
 use std::cell::RefCell;
-use std::sync::Arc;
-
-/// The start of a stepper in the exponential frame: y = 0 and Y = 0 (2r(1 + 2N) ≤ 4·MAX_MODES
-/// (1 + 2·MAX_MODES) values).
-static FRAME_ZERO: [f64; 4 * crate::params::MAX_MODES * (1 + 2 * crate::params::MAX_MODES)] =
-    [0.0; 4 * crate::params::MAX_MODES * (1 + 2 * crate::params::MAX_MODES)];
 
 /// Events within this many drive periods' ten-millionth that count as chattering.
 const CHATTER_COUNT: usize = 4096;
@@ -50,17 +43,10 @@ struct ModeOde<'a, S: HybridSystem + ?Sized> {
     mode: Region,
     variational: bool,
     jac: &'a RefCell<DMatrix<f64>>,
-    /// The exponential frame and the stepper's anchor when the stepper integrates the deviation
-    /// from the exact free flight ([`LinearFrame`]) instead of the state.
-    lawson: Option<(&'a LinearFrame, &'a Anchor)>,
 }
 
 impl<S: HybridSystem + ?Sized> Field for ModeOde<'_, S> {
     fn eval(&self, t: f64, y: &[f64], dydt: &mut [f64]) {
-        if let Some((frame, anchor)) = self.lawson {
-            frame.field(self.mode, anchor).eval(t, y, dydt);
-            return;
-        }
         let d = self.sys.dim();
         self.sys.rhs(self.mode, t, &y[..d], &mut dydt[..d]);
         if self.variational {
@@ -72,12 +58,10 @@ impl<S: HybridSystem + ?Sized> Field for ModeOde<'_, S> {
     }
 }
 
-/// A DOP853 stepper and, in the exponential frame, its anchor (the stepper's state is then the
-/// deviation y of [`LinearFrame`], not z).
+/// A DOP853 stepper.
 #[derive(Clone)]
 struct Stepper {
     dop: Dop853,
-    anchor: Option<Box<Anchor>>,
 }
 
 impl std::ops::Deref for Stepper {
@@ -136,11 +120,6 @@ pub struct Adaptive<S: TipSampleSystem + Clone = CantileverModel> {
     /// A stepper no longer in use, re-initialised by the next [`Adaptive::new_stepper`] of the
     /// same dimension (with the variational equations every step starts one).
     spare: RefCell<Option<Box<Stepper>>>,
-    /// The exponential frame ([`Adaptive::exponential`]): steps without the variational
-    /// equations integrate the deviation from the exact free flight.
-    frame: Option<Arc<LinearFrame>>,
-    /// The plain augmented state [z; Φ] at the end of a step in the exponential frame.
-    plain: RefCell<Vec<f64>>,
 }
 
 impl<S: TipSampleSystem + Clone> std::fmt::Debug for Adaptive<S> {
@@ -155,25 +134,6 @@ impl<S: TipSampleSystem + Clone> std::fmt::Debug for Adaptive<S> {
 
 /// Backwards-compatible name of [`Adaptive`] (the linear law's independent oracle).
 pub type AdaptiveOracle = Adaptive;
-
-impl Adaptive<CantileverModel> {
-    /// The adaptive integrator of `model` in the exponential frame (`LinearFrame`, Lawson's
-    /// transformation): steps without the variational equations integrate only the deviation
-    /// that the tip force causes from the exact free flight, so that their size is set by the
-    /// force's variation, not the modes' oscillation; steps with the variational equations
-    /// integrate the state as [`Adaptive::new`] does. Events, dense output and tolerances as
-    /// there. `None` when the free flight has no well-conditioned modal basis.
-    ///
-    /// # Errors
-    /// Ω at an undamped resonance of the free beam ([`SimError::OutOfRange`]) and the free
-    /// flight's grid budget ([`SimError::Budget`]), as the exact propagator's.
-    pub fn exponential(model: &CantileverModel, tol: f64) -> Result<Option<Self>, SimError> {
-        Ok(LinearFrame::new(model)?.map(|frame| Adaptive {
-            frame: Some(Arc::new(frame)),
-            ..Adaptive::new(model, tol)
-        }))
-    }
-}
 
 impl<S: TipSampleSystem + Clone> Adaptive<S> {
     /// An integrator of `model` with relative and absolute tolerance `tol` of the DOP853 error
@@ -193,8 +153,6 @@ impl<S: TipSampleSystem + Clone> Adaptive<S> {
             chatter: ChatterWindow::new(CHATTER_COUNT, 1e-7 * model.period()),
             budget: StepBudget::new("adaptive integrator", model.period()),
             spare: RefCell::new(None),
-            frame: None,
-            plain: RefCell::new(Vec::new()),
             start: Vec::new(),
             jac: RefCell::new(DMatrix::zeros(d, d)),
             last: LastStep {
@@ -238,46 +196,28 @@ impl<S: TipSampleSystem + Clone> Adaptive<S> {
         self.last.region = region;
     }
 
-    /// The vector field of `mode` (with the variational equations when `variational`), in the
-    /// exponential frame from `anchor` when given.
-    fn field<'a>(
-        &'a self,
-        mode: Region,
-        variational: bool,
-        anchor: Option<&'a Anchor>,
-    ) -> ModeOde<'a, S> {
+    /// The vector field of `mode` (with the variational equations when `variational`).
+    fn field(&self, mode: Region, variational: bool) -> ModeOde<'_, S> {
         ModeOde {
             sys: &self.model,
             mode,
             variational,
             jac: &self.jac,
-            lawson: self.frame.as_deref().zip(anchor),
         }
     }
 
-    /// The plain state z at τ on the last accepted step of `s` into `out` (d): its end points
-    /// exactly, else its dense output; in the exponential frame formed from the deviation.
+    /// The state z at τ on the last accepted step of `s` into `out` (d): its end points
+    /// exactly, else its dense output.
     fn state_on(&self, s: &mut Stepper, mode: Region, tau: f64, out: &mut [f64]) {
         let d = self.dim();
-        let mut buf = [0.0; 4 * crate::params::MAX_MODES];
-        let n = match (&self.frame, &s.anchor) {
-            (Some(frame), Some(_)) => frame.dim(),
-            _ => d,
-        };
-        let y = &mut buf[..n];
         if tau == s.t() {
-            y.copy_from_slice(&s.y()[..n]);
+            out.copy_from_slice(&s.y()[..d]);
         } else if tau == s.t_prev() {
-            y.copy_from_slice(&s.y_prev()[..n]);
+            out.copy_from_slice(&s.y_prev()[..d]);
         } else {
-            let variational = s.y().len() > n;
-            let Stepper { dop, anchor } = s;
-            let ode = self.field(mode, variational, anchor.as_deref());
-            dop.interpolate(&ode, tau, y);
-        }
-        match (&self.frame, &s.anchor) {
-            (Some(frame), Some(a)) => frame.state_into(a, tau, y, out),
-            _ => out.copy_from_slice(y),
+            let variational = s.y().len() > d;
+            let ode = self.field(mode, variational);
+            s.dop.interpolate(&ode, tau, out);
         }
     }
 
@@ -325,8 +265,6 @@ impl<S: TipSampleSystem + Clone> Adaptive<S> {
 
     /// A DOP853 stepper started at (τ, y) in `mode` with step `h` (> 0), or the starting step
     /// of [`Dop853::init`]; `y` is the augmented plain state (z, then Ψ when `variational`).
-    /// Without the variational equations and with the exponential frame, the stepper
-    /// integrates the deviation from the exact free flight, anchored at (τ, z).
     fn new_stepper(
         &self,
         mode: Region,
@@ -335,31 +273,14 @@ impl<S: TipSampleSystem + Clone> Adaptive<S> {
         variational: bool,
         h: f64,
     ) -> Result<Box<Stepper>, SimError> {
-        let d = self.dim();
-        let anchor = match &self.frame {
-            Some(frame) if !variational || frame.variational_in(mode) => {
-                Some(Box::new(frame.anchor(tau, &y[..d])))
-            }
-            _ => None,
-        };
-        // the deviation (and its Jacobian Y) start at 0
-        let y = match (&self.frame, &anchor) {
-            (Some(frame), Some(_)) => {
-                &FRAME_ZERO[..frame.dim() * (1 + usize::from(variational) * d)]
-            }
-            _ => y,
-        };
         let mut s = match self.spare.take() {
             Some(s) if s.y().len() == y.len() => s,
             _ => Box::new(Stepper {
                 dop: Dop853::new(y.len(), self.tol, self.tol, self.model.period() / 8.0),
-                anchor: None,
             }),
         };
-        s.anchor = anchor;
-        let Stepper { dop, anchor } = &mut *s;
-        let ode = self.field(mode, variational, anchor.as_deref());
-        dop.init(&ode, tau, y, h);
+        let ode = self.field(mode, variational);
+        s.dop.init(&ode, tau, y, h);
         if s.h().is_nan() || s.h() <= 0.0 {
             return Err(SimError::Adaptive {
                 tau,
@@ -385,27 +306,16 @@ impl<S: TipSampleSystem + Clone> Adaptive<S> {
         variational: bool,
         t_end: f64,
     ) -> Result<f64, SimError> {
-        let Stepper {
-            dop: stepper,
-            anchor,
-        } = stepper;
+        let stepper = &mut stepper.dop;
         let t0 = stepper.t();
-        // the exponential frame: step sizes on its ladder, with the stage table of the size
-        let mut frame = self.frame.as_deref().zip(anchor.as_deref_mut());
-        let ladder_of = self.frame.as_deref().filter(|_| frame.is_some());
-        let ladder = |h: f64| ladder_of.map_or(h, |f| f.ladder(h));
-        let h_nat = ladder(stepper.h());
-        stepper.set_h(h_nat);
+        let h_nat = stepper.h();
         let clamped = t0 + h_nat >= t_end;
         if clamped {
             stepper.set_h(t_end - t0);
         }
         for _ in 0..1000 {
             self.budget.count(t0)?;
-            if let Some((f, a)) = frame.as_mut() {
-                f.use_step(a, stepper.h());
-            }
-            let ode = self.field(mode, variational, frame.as_ref().map(|(_, a)| &**a));
+            let ode = self.field(mode, variational);
             stepper.step(&ode).map_err(|e| SimError::Adaptive {
                 tau: t0,
                 message: e.to_string(),
@@ -420,8 +330,6 @@ impl<S: TipSampleSystem + Clone> Adaptive<S> {
             }
             if clamped && stepper.h() > t_end - t0 {
                 stepper.set_h(t_end - t0);
-            } else {
-                stepper.set_h(ladder(stepper.h()));
             }
         }
         Err(SimError::Adaptive {
@@ -448,19 +356,7 @@ impl<S: TipSampleSystem + Clone> Adaptive<S> {
         while t < t1 {
             t = self.advance(&mut s, mode, variational, t1)?;
         }
-        let y = match (&self.frame, &s.anchor) {
-            (Some(frame), Some(a)) => {
-                let d = self.dim();
-                let mut z = vec![0.0; if variational { d + d * d } else { d }];
-                if variational {
-                    frame.plain_into(a, t, s.y(), &mut z);
-                } else {
-                    frame.state_into(a, t, s.y(), &mut z);
-                }
-                z
-            }
-            _ => s.y().to_vec(),
-        };
+        let y = s.y().to_vec();
         self.recycle(Some(s));
         Ok(y)
     }
@@ -629,9 +525,8 @@ impl<S: TipSampleSystem + Clone + 'static> Integrator for Adaptive<S> {
         let mut y0 = std::mem::take(&mut self.start);
         self.augmented_into(region, tau0, self.z.as_slice(), var, &mut y0);
         // a fresh stepper per step with the variational equations (Φ(τ0) = I), else one per stint
-        // (in the exponential frame a fresh anchor per step: its stages are then at c_i h)
         let mut stepper = match self.last.dense.take() {
-            Some(s) if self.stint_open && !var && s.anchor.is_none() => s,
+            Some(s) if self.stint_open && !var => s,
             old => {
                 self.recycle(old);
                 self.new_stepper(region, tau0, &y0, var, self.h)?
@@ -666,7 +561,7 @@ impl<S: TipSampleSystem + Clone + 'static> Integrator for Adaptive<S> {
         }
         let t1 = self.advance(&mut stepper, region, var, tau_max)?;
         self.h = stepper.h();
-        // the state at the step's end, formed once (in the exponential frame from the deviation)
+        // the state at the step's end, formed once
         let mut end = [0.0; 2 * crate::params::MAX_MODES];
         let end = &mut end[..d];
         self.state_on(&mut stepper, region, t1, end);
@@ -684,16 +579,7 @@ impl<S: TipSampleSystem + Clone + 'static> Integrator for Adaptive<S> {
             self.last.region = region;
             if var {
                 let mut jac = self.last.jacobian.take();
-                match (&self.frame, &stepper.anchor) {
-                    (Some(frame), Some(a)) => {
-                        let mut plain = std::mem::take(&mut *self.plain.borrow_mut());
-                        plain.resize(d + d * d, 0.0);
-                        frame.plain_into(a, t1, stepper.y(), &mut plain);
-                        self.step_jacobian_into(region, t1, &plain, &mut jac);
-                        *self.plain.borrow_mut() = plain;
-                    }
-                    _ => self.step_jacobian_into(region, t1, stepper.y(), &mut jac),
-                }
+                self.step_jacobian_into(region, t1, stepper.y(), &mut jac);
                 self.last.jacobian = jac;
             } else {
                 self.last.jacobian = None;

@@ -32,11 +32,6 @@ pub enum IntegratorKind {
     /// Exact free flight; in contact the Taylor integrator (Hertz) or adaptive DOP853 (the
     /// linear law, the impact law's sticking) ([`split::Split`]; every law but DMT).
     Split,
-    /// Adaptive DOP853 of the deviation from the exact free flight (Lawson's exponential frame,
-    /// [`adaptive::Adaptive::exponential`]): for DMT, whose van der Waals force acts in free
-    /// flight. Opt-in: fewer steps, but its dense output costs an exponential and two sines per
-    /// evaluation, so recorded runs are slower (docs/performance.md).
-    Exponential,
     /// A Taylor series method of high order ([`taylor::Taylor`]): DMT's free flight in τ, the
     /// Hertz and DMT contact in a regularising time σ (dτ = 2√δ dσ) in which the δ^{3/2} force
     /// is a polynomial; Hertz and DMT only.
@@ -53,11 +48,10 @@ impl FromStr for IntegratorKind {
             "rk4-naive" | "rk4_naive" => Ok(IntegratorKind::Rk4Naive),
             "adaptive" | "dop853" => Ok(IntegratorKind::Adaptive),
             "split" => Ok(IntegratorKind::Split),
-            "exponential" | "lawson" => Ok(IntegratorKind::Exponential),
             "taylor" => Ok(IntegratorKind::Taylor),
             _ => Err(format!(
-                "integrator '{s}': expected auto, exact, rk4, rk4-naive, adaptive, split, \
-                 exponential or taylor"
+                "integrator '{s}': expected auto, exact, rk4, rk4-naive, adaptive, split or \
+                 taylor"
             )),
         }
     }
@@ -187,10 +181,7 @@ pub fn build(
     let kind = opts.kind.resolve(model);
     if matches!(
         kind,
-        IntegratorKind::Adaptive
-            | IntegratorKind::Split
-            | IntegratorKind::Exponential
-            | IntegratorKind::Taylor
+        IntegratorKind::Adaptive | IntegratorKind::Split | IntegratorKind::Taylor
     ) {
         let rate = [Region::Free, Region::Contact]
             .iter()
@@ -227,7 +218,7 @@ pub fn build(
         IntegratorKind::Rk4 => Box::new(rk4::Rk4::new(model, opts.steps_per_period, true)),
         IntegratorKind::Rk4Naive => Box::new(rk4::Rk4::new(model, opts.steps_per_period, false)),
         IntegratorKind::Taylor => Box::new(taylor::Taylor::new(model, opts.tolerance)?),
-        IntegratorKind::Adaptive | IntegratorKind::Split | IntegratorKind::Exponential => {
+        IntegratorKind::Adaptive | IntegratorKind::Split => {
             if !(opts.tolerance.is_finite() && opts.tolerance > 0.0 && opts.tolerance < 1.0) {
                 return Err(SimError::out_of_range(
                     "tolerance",
@@ -238,35 +229,6 @@ pub fn build(
             let adaptive = || Box::new(adaptive::Adaptive::new(model, opts.tolerance));
             if kind == IntegratorKind::Adaptive {
                 adaptive()
-            } else if kind == IntegratorKind::Exponential {
-                // the frame's field is the law's force F_c(δ, δ̇) on the velocity rows: not the
-                // impact law's sticking constraint
-                let unsupported = |hint| SimError::Unsupported {
-                    integrator: "exponential",
-                    law: model.law().name(),
-                    hint,
-                };
-                if model.law().restitution().is_some() {
-                    return Err(unsupported(
-                        "impacts need the jump map of the adaptive or split integrator: use \
-                         integrator = \"auto\"",
-                    ));
-                }
-                if model.law().is_affine() {
-                    return Err(unsupported(
-                        "the linear law is propagated exactly: use integrator = \"exact\" (or \
-                         \"auto\")",
-                    ));
-                }
-                match adaptive::Adaptive::exponential(model, opts.tolerance)? {
-                    Some(e) => Box::new(e),
-                    None => {
-                        return Err(unsupported(
-                            "the free flight has no well-conditioned modal basis here: use \
-                             integrator = \"adaptive\" (or \"auto\")",
-                        ))
-                    }
-                }
             } else {
                 match split::Split::try_new(model, opts.steps_per_period, opts.tolerance) {
                     Ok(s) => Box::new(s),

@@ -13,10 +13,7 @@
 //!   [`crate::system::HybridSystem`]: any contact law, located events with jumps (impacts,
 //!   sticking), and the variational equations for step Jacobians. The default for the plastic
 //!   impact law (r = 0) and where the split integrator's exact free flight cannot be built,
-//!   and the independent oracle of every other integrator; in the exponential frame
-//!   ([`adaptive::Adaptive::exponential`], Lawson's transformation, `exact/lawson.rs`; opt-in,
-//!   see docs/performance.md for why it is not the default) it integrates only the deviation
-//!   from the exact free flight.
+//!   and the independent oracle of every other integrator.
 //! * [`split::Split`] — the exact free flight, and in contact the Taylor integrator (Hertz) or
 //!   the adaptive one (the impact law's sticking): the default for Hertz and for impact with
 //!   r > 0.

@@ -85,7 +85,7 @@ pub struct IntegratorRequest {
     /// `auto` (the exact propagator for the linear law, the split integrator for Hertz and the
     /// impact law with r > 0, adaptive DOP853 for the plastic impact law r = 0, the Taylor
     /// integrator for DMT; split falls back to adaptive where its exact free flight cannot be
-    /// built), `exact`, `rk4`, `rk4-naive`, `adaptive`, `split`, `exponential` or `taylor`.
+    /// built), `exact`, `rk4`, `rk4-naive`, `adaptive`, `split` or `taylor`.
     pub integrator: IntegratorKind,
     /// Fixed steps per drive period of `rk4` / `rk4-naive` (default 2000).
     pub steps_per_period: Option<usize>,
@@ -113,7 +113,7 @@ impl IntegratorRequest {
                 samples_per_period.max(1)
             }
             IntegratorKind::Rk4 | IntegratorKind::Rk4Naive => self.steps_per_period.unwrap_or(2000),
-            IntegratorKind::Adaptive | IntegratorKind::Exponential | IntegratorKind::Taylor => 1,
+            IntegratorKind::Adaptive | IntegratorKind::Taylor => 1,
         };
         IntegratorOptions {
             kind: self.integrator,

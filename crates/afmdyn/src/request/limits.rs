@@ -25,9 +25,8 @@ pub const MAX_INPUT_TEXT_BYTES: u64 = 1024 * 1024;
 /// Largest CSV input file (`afmdyn continue --overlay bifurcation.csv`) read, in bytes:
 /// 256 MiB, about a million rows of a bifurcation sweep.
 pub const MAX_INPUT_CSV_BYTES: u64 = 256 * 1024 * 1024;
-/// The range of every integrator tolerance (relative and absolute; the adaptive, split, Taylor
-/// and exponential integrators use it, the exact propagator and RK4 ignore it but it is checked
-/// alike): below 1e-16 it is beneath the double's resolution, above 1e-3 no longer an accuracy.
+/// The range of every integrator tolerance (relative and absolute; the adaptive, split and
+/// Taylor integrators use it, the exact propagator and RK4 ignore it but it is checked alike): below 1e-16 it is beneath the double's resolution, above 1e-3 no longer an accuracy.
 pub const TOLERANCE_RANGE: (f64, f64) = crate::integrate::TOLERANCE_RANGE;
 /// Largest number of samples per drive period of a time series.
 pub const MAX_SAMPLES_PER_PERIOD: usize = 100_000;

@@ -55,7 +55,6 @@ mod energy;
 mod forcing;
 mod handoff;
 mod integrator;
-mod lawson;
 mod modal;
 mod run;
 mod sample;
@@ -72,7 +71,6 @@ mod tip;
 
 pub(crate) use crate::linalg::matmul_into;
 pub use build::{ExactOptions, Propagation};
-pub(crate) use lawson::{Anchor, LinearFrame};
 pub use modal::MAX_MODAL_CONDITION;
 
 use super::grid::PeriodGrid;
