@@ -1,6 +1,7 @@
-//! Trajectory engine: a conformance suite every integrator passes, the exact propagator against
-//! independent references (closed-form harmonic response, matrix exponential + bisection, the
-//! DOP853 oracle), grazing detection, no re-trigger, energy balance, RK4 order, bad input.
+//! Trajectory engine (the conformance suite of every integrator × law is tests/conformance.rs):
+//! the exact propagator against independent references (closed-form harmonic response, matrix
+//! exponential + bisection, the DOP853 oracle), grazing detection, no re-trigger, energy
+//! balance, RK4 order, bad input.
 
 use afmdyn::galerkin::Region;
 use afmdyn::integrate::exact::ExactPropagator;
@@ -28,91 +29,7 @@ fn max_diff(a: &DVector<f64>, b: &DVector<f64>) -> f64 {
     (a - b).amax()
 }
 
-// ---------------------------------------------------------------- conformance suite
-
-fn conformance(kind: IntegratorKind, tol: f64) {
-    // (a) a never-contacting system started on its periodic orbit stays on it
-    let p = Params {
-        alpha5: 5.0,
-        ..Params::default()
-    };
-    let m = CantileverModel::new(&p).unwrap();
-    let z0 = harmonic_response(&m, Region::Free, 0.0);
-    let mut it = build(&m, options(kind), 0.0, &z0).unwrap();
-    assert!(
-        events_until(it.as_mut(), 7.3).is_empty(),
-        "{kind:?}: no switching"
-    );
-    // (b) lands exactly on the requested time
-    assert_eq!(it.tau(), 7.3, "{kind:?}");
-    let want = harmonic_response(&m, Region::Free, 7.3);
-    assert!(
-        max_diff(it.state(), &want) < tol,
-        "{kind:?}: {}",
-        max_diff(it.state(), &want)
-    );
-    // (c) with contact, switchings alternate between the regions and are not re-triggered
-    let m = CantileverModel::new(&Params::default()).unwrap();
-    let mut it = build(&m, options(kind), 0.0, &m.rest()).unwrap();
-    let ev = events_until(it.as_mut(), 30.0);
-    assert!(ev.len() > 10, "{kind:?}: {} switchings", ev.len());
-    for w in ev.windows(2) {
-        assert_eq!(w[0].to, w[1].from, "{kind:?}: alternate");
-        assert!(
-            w[1].tau - w[0].tau > 1e-6,
-            "{kind:?}: re-triggered at {}",
-            w[1].tau
-        );
-    }
-    for e in &ev {
-        if kind != IntegratorKind::Rk4Naive {
-            assert!(
-                m.v_t(e.tau, &e.state).abs() < 1e-10,
-                "{kind:?}: V_T at switching {}",
-                m.v_t(e.tau, &e.state)
-            );
-        }
-    }
-    // (d) bad initial states are rejected with their error
-    let mut nan = m.rest();
-    nan[1] = f64::NAN;
-    assert!(
-        matches!(it.reset(0.0, &nan), Err(SimError::NotFinite { .. })),
-        "{kind:?}"
-    );
-    assert!(matches!(
-        it.reset(0.0, &DVector::zeros(3)),
-        Err(SimError::StateLength {
-            expected: 6,
-            got: 3,
-            ..
-        })
-    ));
-    assert!(matches!(
-        it.reset(f64::NAN, &m.rest()),
-        Err(SimError::NotFinite { .. })
-    ));
-}
-
-#[test]
-fn conformance_exact() {
-    conformance(IntegratorKind::Exact, 1e-12);
-}
-
-#[test]
-fn conformance_rk4() {
-    conformance(IntegratorKind::Rk4, 1e-9);
-}
-
-#[test]
-fn conformance_adaptive() {
-    conformance(IntegratorKind::Adaptive, 1e-9);
-}
-
-#[test]
-fn conformance_rk4_naive() {
-    conformance(IntegratorKind::Rk4Naive, 1e-9);
-}
+// The conformance checks of every integrator × law: tests/conformance.rs.
 
 // ---------------------------------------------------------------- exact propagator
 

@@ -14,96 +14,19 @@ use afmdyn::integrate::{advance_dyn, build, IntegratorKind, IntegratorOptions, S
 use afmdyn::maps::flow::flow_with_jacobian;
 use afmdyn::maps::StroboscopicMap;
 use afmdyn::request::analyses::OrbitRequest;
-use afmdyn::{CantileverModel, ContactLaw, EventKind, HybridSystem, Params, SimError, SweepParam};
+use afmdyn::{CantileverModel, ContactLaw, EventKind, Params, SweepParam};
 use nalgebra::{Complex, DMatrix, DVector};
 use proptest::prelude::*;
 
 mod common;
-use common::{events_until, harmonic_response, impact_model, opts};
+use common::{events_until, impact_model, opts};
 
 const DMT: ContactLaw = ContactLaw::Dmt {
     hamaker: 1e-5,
     intermolecular_distance: 0.01,
 };
 
-// ------------------------------------------------------------ conformance: law × integrator
-
-fn conformance(law: ContactLaw, kind: IntegratorKind, tol: f64) {
-    let far = common::without_attraction(law);
-    // (a) a sample out of reach: no event, the closed-form free response, exact landing
-    let p = Params {
-        alpha5: 5.0,
-        contact_law: far,
-        ..Params::default()
-    };
-    let m = CantileverModel::new(&p).unwrap();
-    let mut it = build(
-        &m,
-        opts(kind, 1e-13),
-        0.0,
-        &harmonic_response(&m, Region::Free, 0.0),
-    )
-    .unwrap();
-    assert!(events_until(it.as_mut(), 7.3).is_empty(), "{law} {kind:?}");
-    assert_eq!(it.tau(), 7.3, "{law} {kind:?}");
-    let err = (it.state() - harmonic_response(&m, Region::Free, 7.3)).amax();
-    assert!(err < tol, "{law} {kind:?}: {err:e}");
-    // (b) with the sample: events chain region to region, sit on their guard, do not re-trigger
-    let p = Params {
-        contact_law: law,
-        ..Params::default()
-    };
-    let m = CantileverModel::new(&p).unwrap();
-    let mut it = build(&m, opts(kind, 1e-12), 0.0, &m.rest()).unwrap();
-    let ev = events_until(it.as_mut(), 30.0);
-    assert!(ev.len() > 5, "{law} {kind:?}: {} events", ev.len());
-    for w in ev.windows(2) {
-        assert_eq!(w[0].to, w[1].from, "{law} {kind:?}: chained");
-        if law.restitution().is_none() {
-            assert!(w[1].tau - w[0].tau > 1e-6, "{law} {kind:?}: re-triggered");
-        }
-    }
-    for e in &ev {
-        let g = m.guard(e.from, e.tau, e.state.as_slice()).value;
-        let scale = if e.from == Region::Contact && law.restitution().is_some() {
-            1e-7
-        } else {
-            1e-10
-        };
-        assert!(
-            g.abs() < scale,
-            "{law} {kind:?}: guard {g:e} at {:?}",
-            e.kind
-        );
-    }
-    // (c) bad starts are rejected with their error
-    let mut nan = m.rest();
-    nan[1] = f64::NAN;
-    assert!(matches!(
-        it.reset(0.0, &nan),
-        Err(SimError::NotFinite { .. })
-    ));
-    assert!(matches!(
-        it.reset(0.0, &DVector::zeros(3)),
-        Err(SimError::StateLength { .. })
-    ));
-}
-
-#[test]
-fn conformance_every_law_and_integrator() {
-    for law in [ContactLaw::Linear, ContactLaw::Hertz, DMT] {
-        conformance(law, IntegratorKind::Adaptive, 1e-9);
-        conformance(law, IntegratorKind::Rk4, 1e-9);
-        conformance(law, IntegratorKind::Auto, 1e-9);
-    }
-    conformance(ContactLaw::Linear, IntegratorKind::Exact, 1e-11);
-    let impact = ContactLaw::Impact { restitution: 0.6 };
-    conformance(impact, IntegratorKind::Adaptive, 1e-9);
-    conformance(impact, IntegratorKind::Auto, 1e-9);
-    for law in [ContactLaw::Linear, ContactLaw::Hertz, impact] {
-        conformance(law, IntegratorKind::Split, 1e-11);
-    }
-}
+// One conformance suite over every law × integrator pair: tests/conformance.rs.
 
 /// The split integrator (exact free flight, adaptive contact) against the adaptive integrator
 /// alone at a tight tolerance (1e-14), from rest over 30 drive periods of time (N = 3). Linear and
