@@ -450,7 +450,7 @@ pub fn attractors(a: &AttractorsArgs) -> Result<(), CliError> {
         let periods = att.steady.period().unwrap_or(8).max(2);
         let z0 = att.steady.end_state().clone();
         let tau0 = att.steady.poincare.last().map_or(0.0, |q| q.tau);
-        let mut integ = build(&model, spec.integrator, tau0, &z0)?;
+        let mut integ = build(&model, spec.integrator.clone(), tau0, &z0)?;
         let tr = record(
             integ.as_mut(),
             &RecordSpec {

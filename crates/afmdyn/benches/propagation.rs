@@ -34,6 +34,7 @@ fn exact() -> IntegratorOptions {
         kind: IntegratorKind::Exact,
         steps_per_period: 1,
         tolerance: 1e-12, // ignored here, but every tolerance is in [1e-16, 1e-3]
+        ..IntegratorOptions::default()
     }
 }
 
@@ -108,6 +109,7 @@ fn matched_accuracy(c: &mut Criterion) {
         kind: IntegratorKind::Rk4,
         steps_per_period: s,
         tolerance: 1e-12, // ignored here, but every tolerance is in [1e-16, 1e-3]
+        ..IntegratorOptions::default()
     };
     while (run(&m, rk4(steps), &z0, 40.0) - &reference).amax() > 1e-8 {
         steps = steps * 5 / 4;
@@ -133,6 +135,7 @@ fn nonlinear_laws(c: &mut Criterion) {
         kind: IntegratorKind::Adaptive,
         steps_per_period: 1,
         tolerance: 1e-12,
+        ..IntegratorOptions::default()
     };
     for (name, law) in [
         ("hertz", ContactLaw::Hertz),
@@ -152,8 +155,8 @@ fn nonlinear_laws(c: &mut Criterion) {
             };
             let m = CantileverModel::new(&p).unwrap();
             let t0 = 50.0 * p.period();
-            let z0 = run(&m, adaptive, &m.rest(), t0);
-            let mut it = build(&m, adaptive, t0, &z0).unwrap();
+            let z0 = run(&m, adaptive.clone(), &m.rest(), t0);
+            let mut it = build(&m, adaptive.clone(), t0, &z0).unwrap();
             g.bench_with_input(BenchmarkId::new(name, n), &n, |b, _| {
                 b.iter(|| {
                     it.reset(t0, &z0).unwrap();

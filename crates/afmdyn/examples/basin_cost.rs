@@ -92,7 +92,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let mut z0 = spec.base.clone();
             spec.x.set(&model, &mut z0, spec.xs[ix]);
             spec.y.set(&model, &mut z0, spec.ys[iy]);
-            let mut it = build(&model, spec.integrator, 0.0, &z0)?;
+            let mut it = build(&model, spec.integrator.clone(), 0.0, &z0)?;
             brute.push(steady_state(it.as_mut(), &spec.steady).ok());
         }
     }

@@ -150,7 +150,7 @@ fn basin_map(steps: usize, stride: usize) -> Result<(), Box<dyn std::error::Erro
             let mut z0 = spec.base.clone();
             spec.x.set(&model, &mut z0, spec.xs[ix]);
             spec.y.set(&model, &mut z0, spec.ys[iy]);
-            let s = build(&model, spec.integrator, 0.0, &z0)
+            let s = build(&model, spec.integrator.clone(), 0.0, &z0)
                 .and_then(|mut it| steady_state(it.as_mut(), &reference()));
             s.ok()
                 .and_then(|s| {

@@ -27,6 +27,7 @@ fn exact() -> IntegratorOptions {
         kind: IntegratorKind::Exact,
         steps_per_period: 1,
         tolerance: 0.0,
+        ..IntegratorOptions::default()
     }
 }
 

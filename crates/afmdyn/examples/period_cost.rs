@@ -74,8 +74,9 @@ fn builds(modes: usize, reps: usize) -> Result<(), Box<dyn std::error::Error>> {
         ..Params::default()
     };
     let m = CantileverModel::new(&p)?;
-    let opts = |reuse| ExactOptions {
-        reuse,
+    let cache = afmdyn::integrate::PropagatorCache::new();
+    let opts = |reuse: bool| ExactOptions {
+        cache: reuse.then(|| cache.clone()),
         ..ExactOptions::default()
     };
     let cold = best_of(reps, || {

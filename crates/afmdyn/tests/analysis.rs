@@ -93,6 +93,7 @@ fn period_two_orbit_at_omega_2_8_is_confirmed_by_the_oracle() {
         kind: IntegratorKind::Adaptive,
         steps_per_period: 1,
         tolerance: 1e-13,
+        ..IntegratorOptions::default()
     };
     let mut ad = build(&m, oracle, t0, &z).unwrap();
     advance_dyn(ad.as_mut(), t0 + p.period(), &mut |_, _, _| Ok(())).unwrap();
@@ -267,7 +268,7 @@ fn the_parallel_census_equals_the_census_one_by_one() {
     )> = Vec::new();
     for i in 0..spec.samples {
         let z0 = random_state(&m, spec.seed, i as u64);
-        let mut it = build(&m, spec.integrator, 0.0, &z0).unwrap();
+        let mut it = build(&m, spec.integrator.clone(), 0.0, &z0).unwrap();
         let s = steady_state(it.as_mut(), &spec.steady).unwrap();
         match alone
             .iter_mut()

@@ -272,7 +272,7 @@ fn setpoint_points_are_orbits_with_the_setpoint_amplitude() {
         let p = spec.base.with(SweepParam::Alpha5, k.value);
         let model = CantileverModel::new(&p).unwrap();
         let integ = IntegratorOptions::default();
-        let mut it = build(&model, integ, 0.0, &z).unwrap();
+        let mut it = build(&model, integ.clone(), 0.0, &z).unwrap();
         let orbit = shoot_with(it.as_mut(), &z, 1, &ShootingOptions::default()).unwrap();
         assert!(orbit.stable);
         let o = observe_orbit(&model, integ, &orbit, 4).unwrap();
@@ -303,7 +303,14 @@ fn traces_are_the_steady_cycles_of_the_curve() {
         .iter()
         .map(|p| (p.value, &p.state, p.period))
         .collect();
-    let t = traces(&spec.base, spec.param, spec.integrator, &points, 400).unwrap();
+    let t = traces(
+        &spec.base,
+        spec.param,
+        spec.integrator.clone(),
+        &points,
+        400,
+    )
+    .unwrap();
     let n = t.time.len();
     assert_eq!(t.values.len(), c.first.len());
     assert_eq!(n, t.periods * 400);

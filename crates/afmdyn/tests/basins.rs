@@ -85,7 +85,7 @@ fn agree_with_brute_force(s: &BasinSpec) -> afmdyn::analysis::basins::BasinMap {
         let mut z0 = s.base.clone();
         s.x.set(&model, &mut z0, s.xs[ix]);
         s.y.set(&model, &mut z0, s.ys[iy]);
-        let mut it = build(&model, s.integrator, 0.0, &z0).unwrap();
+        let mut it = build(&model, s.integrator.clone(), 0.0, &z0).unwrap();
         let brute = steady_state(it.as_mut(), &SteadyOptions::default())
             .ok()
             .and_then(|st| {
@@ -213,7 +213,7 @@ fn interior_labels_agree_with_1500_period_runs() {
         let mut z0 = s.base.clone();
         s.x.set(&model, &mut z0, s.xs[ix]);
         s.y.set(&model, &mut z0, s.ys[iy]);
-        let mut it = build(&model, s.integrator, 0.0, &z0).unwrap();
+        let mut it = build(&model, s.integrator.clone(), 0.0, &z0).unwrap();
         afmdyn::integrate::advance(it.as_mut(), 1500.0 * model.period()).unwrap();
         let z = &it.state().clone();
         let (id, d) = map

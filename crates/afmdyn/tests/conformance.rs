@@ -79,6 +79,7 @@ fn opts(kind: IntegratorKind, tol: f64) -> IntegratorOptions {
             1
         },
         tolerance: tol,
+        ..Default::default()
     }
 }
 

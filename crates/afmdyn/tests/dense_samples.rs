@@ -176,7 +176,7 @@ fn adaptive_dense_samples_equal_its_steps_and_the_exact_samples() {
         tolerance: 1e-12,
         ..IntegratorOptions::default()
     };
-    let mut a = build(&m, opts, 0.0, &m.rest()).unwrap();
+    let mut a = build(&m, opts.clone(), 0.0, &m.rest()).unwrap();
     let tr = record(a.as_mut(), &spec).unwrap();
     let mut b = build(&m, opts, 0.0, &m.rest()).unwrap();
     let reference = samples_by_ending_steps(b.as_mut(), &m, 1.0, 50, 250);

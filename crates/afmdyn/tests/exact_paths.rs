@@ -11,7 +11,7 @@
 mod common;
 
 use afmdyn::galerkin::Region;
-use afmdyn::integrate::exact::{ExactOptions, ExactPropagator, Propagation};
+use afmdyn::integrate::exact::{ExactOptions, ExactPropagator, Propagation, PropagatorCache};
 use afmdyn::integrate::{
     advance, advance_dyn, advance_observed, Integrator, Observed, Observer, Spans, Step,
     SwitchEvent,
@@ -22,12 +22,16 @@ use afmdyn::{CantileverModel, Params};
 use common::{events_until, harmonic_response};
 use nalgebra::DVector;
 
-fn prop(m: &CantileverModel, propagation: Propagation, reuse: bool) -> ExactPropagator {
+fn prop(
+    m: &CantileverModel,
+    propagation: Propagation,
+    cache: Option<&PropagatorCache>,
+) -> ExactPropagator {
     ExactPropagator::try_with(
         m,
         ExactOptions {
             propagation,
-            reuse,
+            cache: cache.cloned(),
             ..ExactOptions::default()
         },
     )
@@ -95,8 +99,8 @@ fn modal_path_agrees_with_the_dense_path() {
             ..Params::default()
         };
         let m = CantileverModel::new(&p).unwrap();
-        let mut dense = prop(&m, Propagation::Dense, false);
-        let mut modal = prop(&m, Propagation::Auto, false);
+        let mut dense = prop(&m, Propagation::Dense, None);
+        let mut modal = prop(&m, Propagation::Auto, None);
         assert_eq!(dense.modal_regions(), [false, false]);
         assert_eq!(modal.modal_regions(), [true, true], "N = {modes}");
         let events = compare_runs(&mut dense, &mut modal, &m.rest(), 40.0 * p.period(), 1e-12);
@@ -132,8 +136,8 @@ fn modal_path_finds_the_same_grazing_contact() {
         };
         let m = CantileverModel::new(&p).unwrap();
         let z0 = harmonic_response(&m, Region::Free, 0.0);
-        let mut dense = prop(&m, Propagation::Dense, false);
-        let mut modal = prop(&m, Propagation::Auto, false);
+        let mut dense = prop(&m, Propagation::Dense, None);
+        let mut modal = prop(&m, Propagation::Auto, None);
         assert!(modal.modal_regions()[0]);
         let events = compare_runs(&mut dense, &mut modal, &z0, 3.0 * p.period(), 1e-12);
         assert!(events >= 2, "N = {modes}: grazing contact missed");
@@ -152,7 +156,7 @@ fn ill_conditioned_basis_falls_back_to_dense() {
     };
     let m0 = CantileverModel::new(&p0).unwrap();
     assert_eq!(
-        prop(&m0, Propagation::Auto, false).modal_regions(),
+        prop(&m0, Propagation::Auto, None).modal_regions(),
         [true, true]
     );
     let g = m0.galerkin().region(Region::Free);
@@ -167,9 +171,9 @@ fn ill_conditioned_basis_falls_back_to_dense() {
     let a = &m.dynamics(Region::Free).a;
     let disc = (a[(1, 1)] * a[(1, 1)] + 4.0 * a[(1, 0)]) / (a[(1, 1)] * a[(1, 1)]);
     assert!(disc.abs() < 1e-12, "not critically damped: {disc:e}");
-    let mut modal = prop(&m, Propagation::Auto, false);
+    let mut modal = prop(&m, Propagation::Auto, None);
     assert_eq!(modal.modal_regions(), [false, true]);
-    let mut dense = prop(&m, Propagation::Dense, false);
+    let mut dense = prop(&m, Propagation::Dense, None);
     compare_runs(&mut dense, &mut modal, &m.rest(), 20.0 * p.period(), 1e-12);
 }
 
@@ -183,10 +187,10 @@ fn ill_conditioned_basis_falls_back_to_dense() {
 fn advance_equals_the_step_loop() {
     for (modes, path) in PATHS {
         let (p, m) = default_model(modes);
-        let steps = prop(&m, path, true).steps_per_period() as f64;
+        let steps = prop(&m, path, None).steps_per_period() as f64;
         for periods in [30.5, 30.0 + 7.0 / steps, 30.0] {
-            let mut a = prop(&m, path, true);
-            let mut b = prop(&m, path, true);
+            let mut a = prop(&m, path, None);
+            let mut b = prop(&m, path, None);
             assert_eq!(a.modal_regions()[0], path == Propagation::Auto);
             a.reset(0.0, &m.rest()).unwrap();
             b.reset(0.0, &m.rest()).unwrap();
@@ -284,7 +288,7 @@ fn observed_steps_read_the_modal_coordinates_soundly() {
             ..Params::default()
         };
         let m = CantileverModel::new(&p).unwrap();
-        let (mut a, mut b) = (prop(&m, path, true), prop(&m, path, true));
+        let (mut a, mut b) = (prop(&m, path, None), prop(&m, path, None));
         for x in [&mut a, &mut b] {
             x.reset(0.0, &m.rest()).unwrap();
             advance(x, 40.0 * p.period()).unwrap();
@@ -335,15 +339,14 @@ fn observed_steps_read_the_modal_coordinates_soundly() {
 /// α5 redoes the forcing data only, a change of α4 redoes all three.
 #[test]
 fn reused_builds_propagate_as_fresh_ones() {
-    // a parameter set of this test only (α1 = 0.137), so that the other tests' builds in the
-    // shared cache cannot be the ones reused
     let p = Params {
         alpha1: 0.137,
         ..Params::default()
     };
+    let cache = PropagatorCache::new();
     let reused = |q: Params| {
         let m = CantileverModel::new(&q).unwrap();
-        prop(&m, Propagation::Auto, true).reused()
+        prop(&m, Propagation::Auto, Some(&cache)).reused()
     };
     assert_eq!(reused(p), (false, false, false));
     assert_eq!(reused(p), (true, true, true));
@@ -355,9 +358,10 @@ fn reused_builds_propagate_as_fresh_ones() {
     let big = CantileverModel::new(&Params { modes: 20, ..p }).unwrap();
     let opts = ExactOptions {
         min_steps_per_period: 7000,
+        cache: Some(cache.clone()),
         ..ExactOptions::default()
     };
-    let _ = ExactPropagator::try_with(&big, opts).unwrap();
+    let _ = ExactPropagator::try_with(&big, opts.clone()).unwrap();
     let again = ExactPropagator::try_with(&big, opts).unwrap();
     assert_eq!(again.steps_per_period(), 7000);
     assert_eq!(again.reused(), (true, true, false));
@@ -372,9 +376,9 @@ fn reused_builds_propagate_as_fresh_ones() {
         },
     ] {
         let m = CantileverModel::new(&q).unwrap();
-        let mut fresh = prop(&m, Propagation::Auto, false);
-        let _ = prop(&m, Propagation::Auto, true);
-        let mut reused = prop(&m, Propagation::Auto, true);
+        let mut fresh = prop(&m, Propagation::Auto, None);
+        let _ = prop(&m, Propagation::Auto, Some(&cache));
+        let mut reused = prop(&m, Propagation::Auto, Some(&cache));
         for it in [&mut fresh, &mut reused] {
             it.reset(0.0, &m.rest()).unwrap();
             advance(it, 20.0 * q.period()).unwrap();
@@ -398,7 +402,7 @@ fn reused_builds_propagate_as_fresh_ones() {
 fn dense_tip_is_the_tip_of_the_dense_state() {
     for (modes, path) in PATHS {
         let (p, m) = default_model(modes);
-        let mut a = prop(&m, path, true);
+        let mut a = prop(&m, path, None);
         a.reset(0.0, &m.rest()).unwrap();
         let at = format!("N = {modes}, {path:?}");
         let mut worst = 0.0f64;
@@ -447,7 +451,7 @@ fn dense_output_ends_at_the_step_end_values() {
             ..Params::default()
         };
         let m = CantileverModel::new(&p).unwrap();
-        let mut a = prop(&m, Propagation::Auto, true);
+        let mut a = prop(&m, Propagation::Auto, None);
         a.reset(0.0, &m.rest()).unwrap();
         advance(&mut a, periods as f64 * p.period()).unwrap();
         let (mut worst_w, mut worst_v, mut steps) = (0.0f64, 0.0f64, 0);
@@ -504,8 +508,8 @@ fn spans_are_the_steps_of_step_deferred() {
             (m.rest(), 40.0 * period, 10.0)
         };
         let (mut a, mut b) = (
-            prop(&m, Propagation::Auto, true),
-            prop(&m, Propagation::Auto, true),
+            prop(&m, Propagation::Auto, None),
+            prop(&m, Propagation::Auto, None),
         );
         for x in [&mut a, &mut b] {
             x.reset(0.0, &z0).unwrap();

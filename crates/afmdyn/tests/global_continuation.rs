@@ -99,7 +99,7 @@ fn fractions_count_the_random_starts_only() {
         let mut counts = vec![0usize; step.attractors.len()];
         for k in 0..s.census.samples {
             let z0 = start_state(&model, s.census.seed, step.value, k as u32);
-            let mut it = build(&model, s.census.integrator, 0.0, &z0).unwrap();
+            let mut it = build(&model, s.census.integrator.clone(), 0.0, &z0).unwrap();
             let st = steady_state(it.as_mut(), &s.census.steady).unwrap();
             let i = step
                 .attractors

@@ -59,6 +59,7 @@ fn every_integrator_checks_its_tolerance() {
                 kind,
                 steps_per_period: 200,
                 tolerance: tol,
+                ..Default::default()
             };
             let e = check_buildable(&p, opts).unwrap_err();
             assert!(
@@ -77,6 +78,7 @@ fn every_integrator_checks_its_tolerance() {
                 kind,
                 steps_per_period: 200,
                 tolerance: tol,
+                ..Default::default()
             };
             check_buildable(&p, opts).unwrap_or_else(|e| panic!("{kind:?} {tol}: {e}"));
         }

@@ -22,6 +22,7 @@ fn options(kind: IntegratorKind) -> IntegratorOptions {
             1
         },
         tolerance: 1e-13,
+        ..Default::default()
     }
 }
 
@@ -238,6 +239,7 @@ fn rk4_error_falls_as_h_to_the_fourth_without_contact() {
                 kind: IntegratorKind::Rk4,
                 steps_per_period: steps,
                 tolerance: 1e-12, // ignored by RK4, but in range (issue 42)
+                ..Default::default()
             },
             0.0,
             &z0,

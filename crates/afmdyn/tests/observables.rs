@@ -37,16 +37,19 @@ fn point_mass(law: ContactLaw, omega: f64, alpha5: f64) -> Params {
 /// The integrator of the tests: the exact propagator for the linear law, the adaptive one at
 /// tolerance 1e-14 otherwise (its dense output then accurate well below the 1e-8 of the
 /// balances).
-const INTEG: IntegratorOptions = IntegratorOptions {
-    kind: afmdyn::IntegratorKind::Auto,
-    steps_per_period: 1,
-    tolerance: 1e-14,
-};
+fn integ() -> IntegratorOptions {
+    IntegratorOptions {
+        kind: afmdyn::IntegratorKind::Auto,
+        steps_per_period: 1,
+        tolerance: 1e-14,
+        ..Default::default()
+    }
+}
 
 /// A period-n orbit of `model` at τ = 0: a transient from rest, then Newton shooting; checked
 /// periodic by one more run of n periods.
 fn orbit(model: &CantileverModel, n: usize) -> DVector<f64> {
-    let mut it = build(model, INTEG, 0.0, &model.rest()).unwrap();
+    let mut it = build(model, integ(), 0.0, &model.rest()).unwrap();
     advance_dyn(it.as_mut(), 60.0 * model.period(), &mut |_, _, _| Ok(())).unwrap();
     let guess = it.state().clone();
     let opts = ShootingOptions {
@@ -69,7 +72,7 @@ fn orbit(model: &CantileverModel, n: usize) -> DVector<f64> {
     o.state
 }
 
-/// Observables from (0, z) with [`INTEG`].
+/// Observables from (0, z) with [`integ`].
 fn observe(
     model: &CantileverModel,
     z: &DVector<f64>,
@@ -78,7 +81,7 @@ fn observe(
 ) -> Observables {
     observe_from(
         model,
-        INTEG,
+        integ(),
         0.0,
         z,
         &ObservableOptions { periods, harmonics },
@@ -130,7 +133,7 @@ fn free_oscillation_matches_the_harmonic_response() {
         // a window that starts inside a period gives the same harmonics
         let tau0 = 0.37 * model.period();
         let z1 = harmonic_response(&model, Region::Free, tau0);
-        let o1 = observe_from(&model, INTEG, tau0, &z1, &ObservableOptions::default()).unwrap();
+        let o1 = observe_from(&model, integ(), tau0, &z1, &ObservableOptions::default()).unwrap();
         assert_free_response(&o1, a, phi, omega);
         assert!(o.thd <= 1e-6, "harmonic response: THD {}", o.thd);
         assert!(o.mean_deflection.abs() <= 1e-9 * a);
@@ -368,7 +371,7 @@ fn beam_mode_balance(law: ContactLaw) {
         ..Params::default()
     };
     let model = CantileverModel::new(&p).unwrap();
-    let mut it = build(&model, INTEG, 0.0, &model.rest()).unwrap();
+    let mut it = build(&model, integ(), 0.0, &model.rest()).unwrap();
     let s = steady_state(it.as_mut(), &SteadyOptions::default()).unwrap();
     let Motion::Periodic { period: n } = s.motion else {
         panic!("expected a periodic orbit, got {:?}", s.motion)
@@ -376,7 +379,7 @@ fn beam_mode_balance(law: ContactLaw) {
     let guess = s.end_state().clone();
     let orbit = shoot_with(it.as_mut(), &guess, n, &ShootingOptions::default()).unwrap();
     let z0 = orbit.state.clone();
-    let o = observe_orbit(&model, INTEG, &orbit, 10).unwrap();
+    let o = observe_orbit(&model, integ(), &orbit, 10).unwrap();
     assert_eq!(o.periods, n);
     let big = o
         .mode_balance
@@ -408,7 +411,7 @@ fn beam_mode_balance(law: ContactLaw) {
     assert!(coupling.abs() <= 1e-9 * big, "{law}: coupling {coupling:e}");
     assert!(o.contact_fraction > 0.0);
     // trajectory::record from the same start over the same window
-    let mut it = build(&model, INTEG, 0.0, &z0).unwrap();
+    let mut it = build(&model, integ(), 0.0, &z0).unwrap();
     let spec = RecordSpec {
         transient_periods: 0.0,
         record_tau: n as f64 * model.period(),
@@ -451,11 +454,11 @@ fn thd_mean_and_contact_fraction_agree_with_independent_checks() {
     let events = events_until(it.as_mut(), t);
     // the same window started inside the period (τ₀ = 0.37 T on the orbit) sees the same orbit
     let tau0 = 0.37 * t;
-    let mut it2 = build(&model, INTEG, 0.0, &z0).unwrap();
+    let mut it2 = build(&model, integ(), 0.0, &z0).unwrap();
     advance_dyn(it2.as_mut(), tau0, &mut |_, _, _| Ok(())).unwrap();
     let shifted = observe_from(
         &model,
-        INTEG,
+        integ(),
         tau0,
         it2.state(),
         &ObservableOptions::default(),

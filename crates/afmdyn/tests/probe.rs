@@ -370,11 +370,12 @@ fn beam_n1_matches_point_mass_within_the_base_drive() {
         kind: IntegratorKind::Adaptive,
         steps_per_period: 1,
         tolerance: 1e-13,
+        ..Default::default()
     };
     let steady = |text: &str| {
         let p = Probe::parse(text, "test").unwrap();
         let model = CantileverModel::new(&p.params).unwrap();
-        let mut it = build(&model, opts, 0.0, &model.rest()).unwrap();
+        let mut it = build(&model, opts.clone(), 0.0, &model.rest()).unwrap();
         advance_dyn(it.as_mut(), 3000.0 * model.period(), &mut |_, _, _| Ok(())).unwrap();
         let guess = it.state().clone();
         let o = shoot_with(

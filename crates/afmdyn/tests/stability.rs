@@ -504,7 +504,7 @@ fn continuation_locates_the_period_doubling_near_omega_2_91() {
             omega: b.value,
             ..base
         });
-        let mut integ = build(&m, spec.integrator, 0.0, &m.rest()).unwrap();
+        let mut integ = build(&m, spec.integrator.clone(), 0.0, &m.rest()).unwrap();
         let map = StroboscopicMap::new(integ.as_mut(), 1)
             .apply(&b.section[0])
             .unwrap();

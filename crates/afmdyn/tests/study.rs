@@ -99,7 +99,7 @@ fn segments_follow_the_sequential_chain_on_a_periodic_branch() {
     let mut compared = 0;
     for (i, &v) in values.iter().enumerate() {
         let m = CantileverModel::new(&spec.base.with(SweepParam::Omega, v)).unwrap();
-        let mut it = build(&m, spec.integrator, 0.0, &z).unwrap();
+        let mut it = build(&m, spec.integrator.clone(), 0.0, &z).unwrap();
         let s = steady_state(it.as_mut(), &spec.steady).unwrap();
         z = s.end_state().clone();
         let t = segmented[i].result.as_ref().unwrap();

@@ -24,6 +24,7 @@ fn opts(kind: IntegratorKind, tol: f64) -> IntegratorOptions {
         kind,
         steps_per_period: 1,
         tolerance: tol,
+        ..IntegratorOptions::default()
     }
 }
 

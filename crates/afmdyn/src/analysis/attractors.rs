@@ -65,7 +65,7 @@ impl AttractorSpec {
             ));
         }
         self.steady.validate()?;
-        crate::integrate::check_buildable(&self.params, self.integrator)
+        crate::integrate::check_buildable(&self.params, self.integrator.clone())
     }
 }
 
@@ -206,7 +206,7 @@ pub(crate) fn census(
     attractors
         .par_iter_mut()
         .with_max_len(1)
-        .for_each(|a| polish(model, spec.integrator, a));
+        .for_each(|a| polish(model, spec.integrator.clone(), a));
     let (unsettled, attractors): (Vec<Attractor>, Vec<Attractor>) =
         merge_polished(attractors, spec.cluster_tol)
             .into_iter()
@@ -310,7 +310,7 @@ fn steady_states_of_starts(
         .with_max_len(1)
         .map(|z0| {
             let r = progress.check().and_then(|()| {
-                build(model, spec.integrator, 0.0, &z0)
+                build(model, spec.integrator.clone(), 0.0, &z0)
                     .and_then(|mut it| steady_state(it.as_mut(), &spec.steady))
             });
             progress.tick();
@@ -324,7 +324,7 @@ fn steady_states_of_starts(
 /// recorded is the first).
 /// A nonperiodic one gets its λ₁ estimate instead ([`Attractor::lyapunov`]).
 fn polish(model: &CantileverModel, integrator: IntegratorOptions, a: &mut Attractor) {
-    a.orbit = polish_steady(model, integrator, &mut a.steady);
+    a.orbit = polish_steady(model, integrator.clone(), &mut a.steady);
     if a.steady.period().is_none() {
         a.lyapunov = largest_exponent(
             model,

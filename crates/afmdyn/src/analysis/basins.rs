@@ -257,7 +257,7 @@ impl BasinSpec {
             ));
         }
         self.steady.validate()?;
-        crate::integrate::check_buildable(&self.params, self.integrator)
+        crate::integrate::check_buildable(&self.params, self.integrator.clone())
     }
 
     /// The stride of the first pass: `stride`, or when 0 the largest power of two that leaves
@@ -505,7 +505,7 @@ fn run_row(
                     it.reset(0.0, &z0)?;
                     it
                 }
-                None => integrator.insert(build(model, spec.integrator, 0.0, &z0)?),
+                None => integrator.insert(build(model, spec.integrator.clone(), 0.0, &z0)?),
             };
             let (mut near_run, mut cell_run) = ((usize::MAX, 0), (usize::MAX, 0));
             let mut grid_run = (usize::MAX, 0);
@@ -711,11 +711,18 @@ pub fn basins_with(spec: &BasinSpec, progress: &Progress) -> Result<BasinMap, Si
         .into_par_iter()
         .with_max_len(1)
         .map(|mut s| {
-            let orbit = polish_steady(&model, spec.integrator, &mut s);
+            let orbit = polish_steady(&model, spec.integrator.clone(), &mut s);
             let lyapunov = s
                 .period()
                 .is_none()
-                .then(|| largest_exponent(&model, s.end_state(), LYAPUNOV_PERIODS, spec.integrator))
+                .then(|| {
+                    largest_exponent(
+                        &model,
+                        s.end_state(),
+                        LYAPUNOV_PERIODS,
+                        spec.integrator.clone(),
+                    )
+                })
                 .flatten()
                 .map(|l| l.0);
             (s, orbit, lyapunov)

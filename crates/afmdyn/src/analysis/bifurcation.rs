@@ -161,7 +161,7 @@ impl SweepSpec {
                 &self.base,
                 self.param,
                 &self.values,
-                self.integrator,
+                self.integrator.clone(),
             ),
             _ => Err(SimError::out_of_range(
                 "sweep points",
@@ -207,7 +207,7 @@ pub struct Resume {
 fn solve_point(spec: &SweepSpec, value: f64, z0: &DVector<f64>) -> Result<SteadyState, SimError> {
     let p = spec.base.with(spec.param, value);
     let model = CantileverModel::new(&p)?;
-    let mut integ = build(&model, spec.integrator, 0.0, z0)?;
+    let mut integ = build(&model, spec.integrator.clone(), 0.0, z0)?;
     steady_state(integ.as_mut(), &spec.steady)
 }
 

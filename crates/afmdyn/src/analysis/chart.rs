@@ -263,7 +263,7 @@ impl<'a> ChartPlan<'a> {
 
     fn run(&self, w: &mut Work, z0: &DVector<f64>, origin: Origin) {
         let Some(model) = &w.model else { return };
-        let r = build(model, self.spec.integrator, 0.0, z0)
+        let r = build(model, self.spec.integrator.clone(), 0.0, z0)
             .and_then(|mut it| steady_state(it.as_mut(), &self.spec.steady));
         match r {
             Err(e) => {
@@ -376,9 +376,12 @@ impl<'a> ChartPlan<'a> {
             .map(|(s, count, origin)| {
                 let period = s.period();
                 let lyapunov = match (&w.model, period) {
-                    (Some(m), None) if spec.lyapunov_periods > 0 => {
-                        largest_exponent(m, s.end_state(), spec.lyapunov_periods, spec.integrator)
-                    }
+                    (Some(m), None) if spec.lyapunov_periods > 0 => largest_exponent(
+                        m,
+                        s.end_state(),
+                        spec.lyapunov_periods,
+                        spec.integrator.clone(),
+                    ),
                     _ => None,
                 };
                 ChartAttractor {

@@ -83,7 +83,7 @@ pub fn mode_convergence_with(
             &model,
             IntegratorOptions {
                 steps_per_period: samples_per_period,
-                ..integrator
+                ..integrator.clone()
             },
             0.0,
             &model.rest(),

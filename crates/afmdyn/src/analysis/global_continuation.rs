@@ -95,7 +95,7 @@ impl GlobalContinuationSpec {
             &self.census.params,
             self.param,
             &self.values,
-            self.census.integrator,
+            self.census.integrator.clone(),
         )
     }
 }

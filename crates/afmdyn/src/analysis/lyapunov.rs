@@ -23,7 +23,7 @@ use rand_chacha::ChaCha8Rng;
 use serde::Serialize;
 
 /// Options of the Lyapunov computation.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct LyapunovOptions {
     /// Drive periods discarded first.
     pub transient_periods: usize,
@@ -137,7 +137,7 @@ pub fn lyapunov_spectrum(
     opts: &LyapunovOptions,
 ) -> Result<LyapunovSpectrum, SimError> {
     opts.validate()?;
-    let mut integ = build(model, opts.integrator, 0.0, z0)?;
+    let mut integ = build(model, opts.integrator.clone(), 0.0, z0)?;
     lyapunov_spectrum_with(integ.as_mut(), opts, &Progress::new())
 }
 

@@ -84,7 +84,7 @@ pub fn traces(
     };
     for &(value, state, _) in points {
         let model = CantileverModel::new(&base.with(param, value))?;
-        let mut integ = build(&model, integrator, 0.0, state)?;
+        let mut integ = build(&model, integrator.clone(), 0.0, state)?;
         let tr = record(
             integ.as_mut(),
             &RecordSpec {

@@ -8,6 +8,7 @@ use crate::error::SimError;
 use crate::model::CantileverModel;
 use crate::params::SweepParam;
 use crate::system::Region;
+use exact::PropagatorCache;
 use nalgebra::DVector;
 use serde::{Deserialize, Serialize};
 use std::str::FromStr;
@@ -80,7 +81,7 @@ pub fn check_tolerance(tol: f64) -> Result<(), SimError> {
 }
 
 /// Options shared by the integrators.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct IntegratorOptions {
     /// Which integrator.
     pub kind: IntegratorKind,
@@ -89,6 +90,11 @@ pub struct IntegratorOptions {
     pub steps_per_period: usize,
     /// Relative and absolute tolerance of the adaptive oracle.
     pub tolerance: f64,
+    /// The exact propagator's cache every build with these options shares (the exact and the
+    /// split integrator's free flight; [`PropagatorCache`]): options cloned for the tasks of one
+    /// request share it; [`IntegratorOptions::default`] starts a new one. Results do not depend
+    /// on it.
+    pub cache: PropagatorCache,
 }
 
 impl IntegratorKind {
@@ -121,6 +127,7 @@ impl Default for IntegratorOptions {
             kind: IntegratorKind::Auto,
             steps_per_period: 1,
             tolerance: 1e-12,
+            cache: PropagatorCache::new(),
         }
     }
 }
@@ -154,7 +161,7 @@ pub fn check_buildable_over(
     let hi = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     for v in [lo, hi] {
         if v.is_finite() {
-            check_buildable(&base.with(param, v), opts)?;
+            check_buildable(&base.with(param, v), opts.clone())?;
         }
     }
     Ok(())
@@ -211,9 +218,13 @@ pub fn build(
         });
     }
     let mut integ: Box<dyn Integrator> = match kind {
-        IntegratorKind::Auto | IntegratorKind::Exact => Box::new(exact::ExactPropagator::try_new(
+        IntegratorKind::Auto | IntegratorKind::Exact => Box::new(exact::ExactPropagator::try_with(
             model,
-            opts.steps_per_period,
+            exact::ExactOptions {
+                min_steps_per_period: opts.steps_per_period,
+                cache: Some(opts.cache.clone()),
+                ..exact::ExactOptions::default()
+            },
         )?),
         IntegratorKind::Rk4 => Box::new(rk4::Rk4::new(model, opts.steps_per_period, true)),
         IntegratorKind::Rk4Naive => Box::new(rk4::Rk4::new(model, opts.steps_per_period, false)),
@@ -230,7 +241,8 @@ pub fn build(
             if kind == IntegratorKind::Adaptive {
                 adaptive()
             } else {
-                match split::Split::try_new(model, opts.steps_per_period, opts.tolerance) {
+                let cache = Some(opts.cache.clone());
+                match split::Split::try_with(model, opts.steps_per_period, opts.tolerance, cache) {
                     Ok(s) => Box::new(s),
                     Err(SimError::OutOfRange { .. } | SimError::Budget { .. })
                         if opts.kind == IntegratorKind::Auto =>

@@ -42,6 +42,7 @@ pub mod split;
 mod support;
 pub mod taylor;
 
+pub use exact::PropagatorCache;
 pub use factory::{
     build, check_buildable, check_buildable_over, check_start, check_tolerance, IntegratorKind,
     IntegratorOptions, TOLERANCE_RANGE,

@@ -115,6 +115,20 @@ impl Split {
         min_steps_per_period: usize,
         tol: f64,
     ) -> Result<Self, SimError> {
+        Self::try_with(model, min_steps_per_period, tol, None)
+    }
+
+    /// [`Split::try_new`] with the free flight built through `cache` (the exact propagator's
+    /// [`crate::integrate::PropagatorCache`]; `None`: computed afresh).
+    ///
+    /// # Errors
+    /// As [`Split::try_new`].
+    pub fn try_with(
+        model: &CantileverModel,
+        min_steps_per_period: usize,
+        tol: f64,
+        cache: Option<crate::integrate::PropagatorCache>,
+    ) -> Result<Self, SimError> {
         if !Self::applies(model) {
             return Err(SimError::Unsupported {
                 integrator: "split",
@@ -125,7 +139,7 @@ impl Split {
         }
         Ok(Split {
             model: model.clone(),
-            exact: ExactPropagator::free_flight(model, min_steps_per_period)?,
+            exact: ExactPropagator::free_flight(model, min_steps_per_period, cache)?,
             adaptive: ContactHalf::new(model, tol)?,
             active: Half::Exact,
             last: Half::Exact,

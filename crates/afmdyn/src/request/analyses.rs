@@ -106,7 +106,8 @@ impl Default for IntegratorRequest {
 impl IntegratorRequest {
     /// The options: `exact` (and `auto`, which picks it for the linear law) refines its own
     /// grid from `samples_per_period` so that samples land on grid points; `rk4` takes
-    /// `steps_per_period` (default 2000); `adaptive` chooses its steps.
+    /// `steps_per_period` (default 2000); `adaptive` chooses its steps. With a new exact
+    /// propagator's cache, which every build of the request shares.
     pub fn options(&self, samples_per_period: usize) -> IntegratorOptions {
         let steps = match self.integrator {
             IntegratorKind::Auto | IntegratorKind::Exact | IntegratorKind::Split => {
@@ -119,6 +120,7 @@ impl IntegratorRequest {
             kind: self.integrator,
             steps_per_period: steps,
             tolerance: self.tolerance,
+            ..IntegratorOptions::default()
         }
     }
 }
@@ -435,7 +437,7 @@ impl LyapunovRequest {
         let model = CantileverModel::new(params)?;
         let z0 = initial_state(&model, self.initial.as_deref())?;
         let opts = self.options(default_transient_cap(&model, SteadyOptions::default().tol));
-        let mut integ = build(&model, opts.integrator, 0.0, &z0)?;
+        let mut integ = build(&model, opts.integrator.clone(), 0.0, &z0)?;
         lyapunov_spectrum_with(integ.as_mut(), &opts, progress)
     }
 }

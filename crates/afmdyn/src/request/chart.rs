@@ -391,7 +391,7 @@ impl ChartRequest {
             (xs[0], ys[ys.len() - 1]),
             (xs[xs.len() - 1], ys[ys.len() - 1]),
         ] {
-            crate::integrate::check_buildable(&model.params(xv, yv)?, spec.integrator)?;
+            crate::integrate::check_buildable(&model.params(xv, yv)?, spec.integrator.clone())?;
         }
         let fingerprint = fingerprint(self, &model);
         Ok(Chart {

@@ -217,7 +217,7 @@ mod tests {
             ..IntegratorOptions::default()
         };
         let whole = {
-            let mut integ = build(&model, opts, 0.0, &model.rest()).unwrap();
+            let mut integ = build(&model, opts.clone(), 0.0, &model.rest()).unwrap();
             record(
                 integ.as_mut(),
                 &RecordSpec {
@@ -231,7 +231,7 @@ mod tests {
             .unwrap()
         };
         for chunk_periods in [1, 3, 7, 50] {
-            let mut integ = build(&model, opts, 0.0, &model.rest()).unwrap();
+            let mut integ = build(&model, opts.clone(), 0.0, &model.rest()).unwrap();
             let (mut taus, mut sections, mut chunks) = (vec![], vec![], 0);
             let summary = record_chunked::<SimError>(
                 integ.as_mut(),

@@ -80,6 +80,7 @@ pub fn against_adaptive_oracle(
             kind,
             steps_per_period: 1,
             tolerance: tol,
+            ..IntegratorOptions::default()
         };
         let mut it = build(m, opts, 0.0, &start).unwrap();
         let ev = events_until(it.as_mut(), t_end);
@@ -152,5 +153,6 @@ pub fn opts(kind: afmdyn::IntegratorKind, tol: f64) -> afmdyn::IntegratorOptions
             1
         },
         tolerance: tol,
+        ..Default::default()
     }
 }

@@ -298,7 +298,7 @@ impl Solver {
                 if self.cache.len() == 6 {
                     self.retired += self.cache.remove(0).1.work();
                 }
-                let integ = build(&model, self.spec.integrator, 0.0, &model.rest())?;
+                let integ = build(&model, self.spec.integrator.clone(), 0.0, &model.rest())?;
                 self.cache.push((p, integ));
                 self.cache.len() - 1
             }

@@ -33,7 +33,7 @@ pub fn period_doubling_starts(
     let dim = z.len();
     let Some(v) = (|| {
         let model = CantileverModel::new(&spec.base.with(spec.param, pd.value)).ok()?;
-        let mut integ = build(&model, spec.integrator, 0.0, &model.rest()).ok()?;
+        let mut integ = build(&model, spec.integrator.clone(), 0.0, &model.rest()).ok()?;
         let m = StroboscopicMap::new(integ.as_mut(), pd.period)
             .apply(&z)
             .ok()?
@@ -61,7 +61,7 @@ pub fn period_doubling_starts(
             let Ok(model) = CantileverModel::new(&spec.base.with(spec.param, p)) else {
                 continue;
             };
-            let Ok(mut integ) = build(&model, spec.integrator, 0.0, &model.rest()) else {
+            let Ok(mut integ) = build(&model, spec.integrator.clone(), 0.0, &model.rest()) else {
                 continue;
             };
             for sign_v in [1.0, -1.0] {

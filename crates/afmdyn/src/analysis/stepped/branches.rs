@@ -34,7 +34,7 @@ pub(super) fn branch(
             (l.min(v), h.max(v))
         });
     let mut cs = ContinuationSpec::new(spec.base, spec.param, from.value, to, n);
-    cs.integrator = spec.integrator;
+    cs.integrator = spec.integrator.clone();
     cs.max_points = spec.max_branch_points;
     cs.range = Some((lo, hi));
     // arclength runs in (z, p): scale the steps by the larger of the range and the orbit

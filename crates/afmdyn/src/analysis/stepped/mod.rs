@@ -405,7 +405,7 @@ fn integrator_at(
     z: &DVector<f64>,
 ) -> Result<Box<dyn Integrator>, SimError> {
     let model = CantileverModel::new(&spec.base.with(spec.param, value))?;
-    build(&model, spec.integrator, 0.0, z)
+    build(&model, spec.integrator.clone(), 0.0, z)
 }
 
 /// Halvings of a grid step tried by the sweep's orbit continuation (quasi-static sub-steps, see
@@ -439,9 +439,9 @@ fn continue_orbit(
     whole: Option<(f64, usize)>,
 ) -> Result<Option<ShotOrbit>, SimError> {
     let model = CantileverModel::new(&spec.base.with(spec.param, v1))?;
-    let mut integ = build(&model, spec.integrator, 0.0, z0)?;
+    let mut integ = build(&model, spec.integrator.clone(), 0.0, z0)?;
     let m1 = m0
-        .filter(|_| broyden_pays(spec.integrator, &model))
+        .filter(|_| broyden_pays(spec.integrator.clone(), &model))
         .map(|t| t.at(v1 - v0));
     let mut guesses = Vec::with_capacity(2);
     if let Some(s) = slope {
@@ -587,7 +587,7 @@ fn step_point(
     let model = CantileverModel::new(&spec.base.with(spec.param, value))?;
     let last = prev.map_or_else(|| model.rest(), |p| p.state.clone());
     let n = prev.and_then(|p| p.period).unwrap_or(1);
-    let mut integ = build(&model, spec.integrator, 0.0, &last)?;
+    let mut integ = build(&model, spec.integrator.clone(), 0.0, &last)?;
     let slope = prediction_slope(history, value);
     let continued = match prev {
         Some(p) => continue_orbit(
@@ -766,7 +766,7 @@ pub fn stepped_sweep_with(
             Some(super::traces::traces(
                 &spec.base,
                 spec.param,
-                spec.integrator,
+                spec.integrator.clone(),
                 &points,
                 n,
             )?)
@@ -824,7 +824,7 @@ mod tests {
             };
             let spec = SteppedSpec::new(p, SweepParam::Alpha5, vec![0.0, 0.1]);
             let model = CantileverModel::new(&p).unwrap();
-            let integ = build(&model, spec.integrator, 0.0, &model.rest()).unwrap();
+            let integ = build(&model, spec.integrator.clone(), 0.0, &model.rest()).unwrap();
             let decay = (1e8f64).ln() / (0.5 / q * std::f64::consts::TAU / omega);
             let want = (9.0 * decay).ceil().clamp(5000.0, 20_000.0);
             let got = transient_cap(integ.system(), &spec) as f64;

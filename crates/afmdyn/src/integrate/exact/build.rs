@@ -2,7 +2,8 @@
 //! spectral, grid-exponential and forcing data (each from its cache when the inputs match).
 
 use super::bound::BoundCols;
-use super::forcing::{forced, forcing_key, FORCING, FORCING_KEEP_BYTES};
+use super::cache::{cached, PropagatorCache};
+use super::forcing::{forced, forcing_key, FORCING_KEEP_BYTES};
 use super::modal::Modes;
 use super::search::TipPoly;
 use super::series::LastStep;
@@ -31,15 +32,16 @@ pub enum Propagation {
 }
 
 /// Build options of [`ExactPropagator::try_with`].
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct ExactOptions {
     /// The grid has a multiple of this many sub-steps per period (≥ 1).
     pub min_steps_per_period: usize,
     /// Propagation of the grid steps.
     pub propagation: Propagation,
-    /// Reuse the spectral data and grid exponentials of earlier builds with bit-identical
-    /// region matrices (and grid step) — the same values a rebuild computes.
-    pub reuse: bool,
+    /// The cache whose spectral data, grid exponentials and forcing data of earlier builds
+    /// with bit-identical inputs this build reuses and adds to — the same values a rebuild
+    /// computes ([`PropagatorCache`]); `None`: everything computed afresh, nothing kept.
+    pub cache: Option<PropagatorCache>,
 }
 
 impl Default for ExactOptions {
@@ -47,7 +49,7 @@ impl Default for ExactOptions {
         ExactOptions {
             min_steps_per_period: 1,
             propagation: Propagation::Auto,
-            reuse: true,
+            cache: None,
         }
     }
 }
@@ -103,7 +105,8 @@ impl ExactPropagator {
         let omega = model.omega();
         let period = model.period();
         let key = spectral::matrix_key(model);
-        let (spec, spec_reused) = spectral::spectral(model, &key, opts.reuse)?;
+        let cache = opts.cache.as_ref();
+        let (spec, spec_reused) = spectral::spectral(model, &key, cache)?;
         let rho = spec[0].rho.max(spec[1].rho);
         let base = opts.min_steps_per_period.max(1);
         // budget: the grid of one period, (2N + 2)(m + 1) values, must fit in
@@ -126,14 +129,13 @@ impl ExactPropagator {
         let need = need_f as usize;
         let m = base * need.div_ceil(base);
         let h = period / m as f64;
-        let (phi, phi_reused) = spectral::grid_exp(&spec, &key, h, opts.reuse)?;
+        let (phi, phi_reused) = spectral::grid_exp(&spec, &key, h, cache)?;
         // kept only while small: a cache entry outlives the propagators that use it, and the
         // grid of a stiff, large-N build may take up to params::GRID_BUDGET_BYTES
         let keep = (2 * dim + 2) as f64 * (m as f64 + 1.0) * 8.0 <= FORCING_KEEP_BYTES;
-        let (forcing, forcing_reused) = spectral::cached(
-            &FORCING,
+        let (forcing, forcing_reused) = cached(
+            cache.filter(|_| keep).map(|c| &c.tables().forcing),
             &forcing_key(model, &key, h),
-            opts.reuse && keep,
             || {
                 let trig: Vec<(f64, f64)> = (0..=m)
                     .map(|k| (omega * (k as f64 * h)).sin_cos())
@@ -220,7 +222,7 @@ impl ExactPropagator {
         self.grid.m
     }
 
-    /// Whether this build reused earlier builds ([`ExactOptions::reuse`]): (the spectral data —
+    /// Whether this build reused earlier builds (through [`ExactOptions::cache`]): (the spectral data —
     /// energy transforms, Ã_s, eigendecomposition —, the grid exponentials Φ_s, the forcing
     /// data — particular solutions, their grid values, sin/cos on the grid).
     pub fn reused(&self) -> (bool, bool, bool) {

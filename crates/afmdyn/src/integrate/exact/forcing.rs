@@ -1,10 +1,10 @@
 //! The forcing data of a build: each region's particular solution z_p (eq. 10 with harmonic
 //! forcing), its values on the grid, the V_T of the particular part there (and V_T in a modal
-//! region from it and the homogeneous tip), and the process-wide cache [`FORCING`] that shares
-//! them between builds.
+//! region from it and the homogeneous tip), shared between the builds of one
+//! [`super::PropagatorCache`].
 
 use super::modal::Modes;
-use super::spectral::{self, Spectral};
+use super::spectral::Spectral;
 use super::tip::base_amp;
 use super::{INV_FACT, K};
 use crate::error::SimError;
@@ -82,26 +82,9 @@ pub(super) fn grid_v_t(fr: &Forced, k: usize, (w, wd): (f64, f64)) -> (f64, f64)
 /// steps (k + 1/2, k < m).
 pub(super) type Forcing = (Arc<[Forced; 2]>, Arc<[(f64, f64)]>, Arc<[(f64, f64)]>);
 
-/// The forcing data ([`Forcing`]) of recent builds.
-///
-/// - **Key**: [`forcing_key`], the bits of everything [`forced`] and the grid's sin/cos read
-///   (the number of grid steps m is the period 2π/Ω over h, both in the key).
-/// - **Bound**: 8 entries as the [`spectral`] caches, the least recently used dropped first,
-///   and a build stores its data only while (4N + 2)(m + 1) numbers fit
-///   [`FORCING_KEEP_BYTES`] = 2 MiB. The grid tables of an entry are at most (4N + 8)(m + 1)
-///   numbers (z_p and the particular V_T of both regions, sin/cos on the grid and at its
-///   middles), so at most 2 MiB · (4N + 8)/(4N + 2), 4 MiB at N = 1; besides them the 4N×4N LU
-///   and a few vectors per region and the key, 0.14 MiB at N = 20. So at most about 4 MiB an
-///   entry and 32 MiB in all.
-/// - **Results do not depend on it**: the data is computed from the keyed bits alone, by the
-///   same operations in the same order, so a hit returns the very bits a miss computes
-///   ([`spectral::cached`]; the test `forcing_cache_tells_gaps_apart` holds two builds that
-///   differ only in α5 to it).
-pub(super) static FORCING: spectral::Cache<Forcing> = std::sync::Mutex::new(Vec::new());
-
-/// Largest forcing data kept in [`FORCING`], counted as (4N + 2)(m + 1) numbers (both regions'
-/// grid values of z_p and the grid's sin/cos): 2 MiB (N = 20 at the default parameters:
-/// 1.4 MiB). The bytes an entry really holds: [`FORCING`].
+/// Largest forcing data kept in a [`super::PropagatorCache`], counted as (4N + 2)(m + 1)
+/// numbers (both regions' grid values of z_p and the grid's sin/cos): 2 MiB (N = 20 at the
+/// default parameters: 1.4 MiB). The bytes an entry really holds: [`super::cache`].
 pub(super) const FORCING_KEEP_BYTES: f64 = 2.0 * 1024.0 * 1024.0;
 
 /// Everything [`forced`] and the grid's sin/cos read: the spectral key (A_s, M, K_s), h, Ω,

@@ -25,6 +25,7 @@ impl ExactPropagator {
     pub(crate) fn free_flight(
         model: &CantileverModel,
         min_steps_per_period: usize,
+        cache: Option<super::PropagatorCache>,
     ) -> Result<Self, SimError> {
         let p = Params {
             contact_law: ContactLaw::Linear,
@@ -33,7 +34,12 @@ impl ExactPropagator {
             ..*model.params()
         };
         let twin = CantileverModel::new(&p).map_err(SimError::from)?;
-        Self::try_new(&twin, min_steps_per_period)
+        let opts = super::ExactOptions {
+            min_steps_per_period,
+            cache,
+            ..super::ExactOptions::default()
+        };
+        Self::try_with(&twin, opts)
     }
 
     /// Restart at (τ, z) in `region`, as [`crate::integrate::Integrator::reset`] but with the

@@ -51,6 +51,7 @@
 
 mod bound;
 mod build;
+pub mod cache;
 mod energy;
 mod forcing;
 mod handoff;
@@ -71,6 +72,7 @@ mod tip;
 
 pub(crate) use crate::linalg::matmul_into;
 pub use build::{ExactOptions, Propagation};
+pub use cache::PropagatorCache;
 pub use modal::MAX_MODAL_CONDITION;
 
 use super::grid::PeriodGrid;

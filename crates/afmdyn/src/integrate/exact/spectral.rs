@@ -2,14 +2,14 @@
 //!
 //! The energy transforms, Ã_s, ‖Ã_s‖₂, the eigendecomposition, the tip moment rows and the LU
 //! factorization of A_s depend on A_s, M and K_s only — not on Ω, α2 or α5 — and the grid
-//! exponential Φ_s = e^{A_s h} on those and h. Both are kept in small process-wide caches keyed
-//! by the exact bits of the matrices (and of h), so the repeated builds of shooting at one
-//! parameter set reuse everything and a continuation step in Ω reuses the spectral data and
-//! redoes only Φ_s and the particular solution. A hit returns the very values a rebuild would
-//! compute (the build is deterministic). Each of the three process-wide caches states its key,
-//! its bound and why results do not depend on it where it is defined: [`SPECTRAL`],
-//! [`GRID_EXP`] and [`FORCING`](super::forcing::FORCING).
+//! exponential Φ_s = e^{A_s h} on those and h. Both are kept in the caller's
+//! [`PropagatorCache`] (when it gives one) keyed by the exact bits of the matrices (and of h),
+//! so the repeated builds of shooting at one parameter set reuse everything and a continuation
+//! step in Ω reuses the spectral data and redoes only Φ_s and the particular solution. A hit
+//! returns the very values a rebuild would compute (the build is deterministic); the cache
+//! states its keys and bounds ([`super::cache`]).
 
+use super::cache::{cached, PropagatorCache};
 use super::modal::ModalExp;
 use super::K;
 use crate::error::SimError;
@@ -18,7 +18,7 @@ use crate::model::CantileverModel;
 use crate::system::Region;
 use nalgebra::linalg::LU;
 use nalgebra::{DMatrix, DVector, Dyn};
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 /// Build-time data of one region that depends on A_s, M and K_s only.
 #[derive(Debug, Clone)]
@@ -42,70 +42,8 @@ pub(super) struct Spectral {
     pub(super) a_lu: LU<f64, Dyn, Dyn>,
 }
 
-/// Entries kept per cache (least recently used dropped first).
-const CAPACITY: usize = 8;
-
-/// A process-wide cache: (key, value) entries, the most recently used last ([`cached`]).
-pub(super) type Cache<V> = Mutex<Vec<(Vec<u64>, Arc<V>)>>;
-
-/// The spectral data of both regions ([`Spectral`]) of recent builds ([`spectral`]).
-///
-/// - **Key**: [`matrix_key`], the state dimension and the exact bits of A_s, M and K_s of both
-///   regions. They fix everything [`region_spectral`] reads: the tip row φ(1) of the moment
-///   rows is fixed by N and the structure, which K_s tells apart (the point mass's K = 1, the
-///   beam's β_j⁴).
-/// - **Bound**: [`CAPACITY`] = 8 entries, the least recently used dropped first. An entry holds
-///   at most 12 d² + 132 d + 160 numbers per region (d = 2N: T, T⁻¹, Ã, the LU of A_s, the
-///   moment rows, the eigendecomposition) and a key of 2(d² + 2N²) + 1 words: 0.42 MiB at
-///   N = 20 ([`crate::params::MAX_MODES`]), so at most 3.4 MiB in all.
-/// - **Results do not depend on it**: the data is computed from the keyed bits alone, by the
-///   same operations in the same order on one thread, so a hit returns the very bits a miss
-///   computes ([`cached`]: a poisoned lock counts as a miss; `reuse = false` bypasses it).
-static SPECTRAL: Cache<[Spectral; 2]> = Mutex::new(Vec::new());
-
-/// The grid exponentials Φ_s = T⁻¹ e^{Ã_s h} T of both regions ([`GridExp`]) of recent builds
-/// ([`grid_exp`]).
-///
-/// - **Key**: [`matrix_key`] and the bits of the grid step h (Φ_s is computed from the
-///   spectral data, fixed by that key as in [`SPECTRAL`], and h).
-/// - **Bound**: [`CAPACITY`] = 8 entries, the least recently used dropped first; an entry is
-///   2 d² numbers and a key of 2(d² + 2N²) + 2 words: 63 KiB at N = 20, 0.5 MiB in all.
-/// - **Results do not depend on it**: as for [`SPECTRAL`], a hit returns the bits a miss
-///   computes.
-static GRID_EXP: Cache<GridExp> = Mutex::new(Vec::new());
-
 /// Φ_s of the free and the contact region.
 pub(super) type GridExp = [DMatrix<f64>; 2];
-
-/// The cached value for `key`, or `make()` (stored when `reuse`), and whether it was cached. A
-/// poisoned lock is a miss.
-pub(super) fn cached<V>(
-    cache: &Cache<V>,
-    key: &[u64],
-    reuse: bool,
-    make: impl FnOnce() -> Result<V, SimError>,
-) -> Result<(Arc<V>, bool), SimError> {
-    if reuse {
-        if let Ok(mut entries) = cache.lock() {
-            if let Some(i) = entries.iter().position(|(k, _)| k.as_slice() == key) {
-                let entry = entries.remove(i);
-                let value = entry.1.clone();
-                entries.push(entry);
-                return Ok((value, true));
-            }
-        }
-    }
-    let value = Arc::new(make()?);
-    if reuse {
-        if let Ok(mut entries) = cache.lock() {
-            if entries.len() >= CAPACITY {
-                entries.remove(0);
-            }
-            entries.push((key.to_vec(), value.clone()));
-        }
-    }
-    Ok((value, false))
-}
 
 /// The exact bits of A_s, M and K_s of both regions: the key of the spectral data.
 pub(super) fn matrix_key(model: &CantileverModel) -> Vec<u64> {
@@ -119,17 +57,17 @@ pub(super) fn matrix_key(model: &CantileverModel) -> Vec<u64> {
     key
 }
 
-/// The spectral data of both regions (cached under `key` when `reuse`) and whether it was
-/// reused.
+/// The spectral data of both regions (cached under `key` in `cache` when given) and whether it
+/// was reused.
 ///
 /// # Errors
 /// [`SimError::OutOfRange`] when M or K_s is not positive definite.
 pub(super) fn spectral(
     model: &CantileverModel,
     key: &[u64],
-    reuse: bool,
+    cache: Option<&PropagatorCache>,
 ) -> Result<(Arc<[Spectral; 2]>, bool), SimError> {
-    cached(&SPECTRAL, key, reuse, || {
+    cached(cache.map(|c| &c.tables().spectral), key, || {
         Ok([
             region_spectral(model, Region::Free)?,
             region_spectral(model, Region::Contact)?,
@@ -188,17 +126,17 @@ pub(super) fn expm(at: &DMatrix<f64>, h: f64, rho: f64) -> DMatrix<f64> {
     p
 }
 
-/// Φ_s = T⁻¹ e^{Ã_s h} T of both regions ([`expm`]; cached under `key` and h when `reuse`) and
-/// whether it was reused.
+/// Φ_s = T⁻¹ e^{Ã_s h} T of both regions ([`expm`]; cached under `key` and h in `cache` when
+/// given) and whether it was reused.
 pub(super) fn grid_exp(
     spec: &[Spectral; 2],
     key: &[u64],
     h: f64,
-    reuse: bool,
+    cache: Option<&PropagatorCache>,
 ) -> Result<(Arc<GridExp>, bool), SimError> {
     let mut key = key.to_vec();
     key.push(h.to_bits());
-    cached(&GRID_EXP, &key, reuse, || {
+    cached(cache.map(|c| &c.tables().grid_exp), &key, || {
         Ok(std::array::from_fn(|i| {
             let s = &spec[i];
             matmul(&matmul(&s.tinv, &expm(&s.at, h, s.rho)), &s.t)

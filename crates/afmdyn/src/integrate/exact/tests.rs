@@ -5,7 +5,7 @@ use super::modal::{ModalExp, Modes};
 use super::search::TipPoly;
 use super::series::SeriesStart;
 use super::tip::base_amp;
-use super::{ExactOptions, ExactPropagator};
+use super::{ExactOptions, ExactPropagator, PropagatorCache};
 use crate::model::CantileverModel;
 use crate::params::Params;
 use crate::system::Region;
@@ -157,16 +157,15 @@ fn forcing_cache_tells_gaps_apart() {
         CantileverModel::new(&p).unwrap(),
         CantileverModel::new(&q).unwrap(),
     );
-    let _cached = ExactPropagator::try_new(&mp, 1).unwrap();
-    let reused = ExactPropagator::try_new(&mq, 1).unwrap();
-    let fresh = ExactPropagator::try_with(
-        &mq,
-        ExactOptions {
-            reuse: false,
-            ..ExactOptions::default()
-        },
-    )
-    .unwrap();
+    let cached = ExactOptions {
+        cache: Some(PropagatorCache::new()),
+        ..ExactOptions::default()
+    };
+    let _first = ExactPropagator::try_with(&mp, cached.clone()).unwrap();
+    let reused = ExactPropagator::try_with(&mq, cached).unwrap();
+    // α5 is in the forcing key only: the spectral data and the grid exponential are reused
+    assert_eq!(reused.reused(), (true, true, false));
+    let fresh = ExactPropagator::try_with(&mq, ExactOptions::default()).unwrap();
     for ri in 0..2 {
         assert_eq!(
             reused.forced[ri].vp_grid, fresh.forced[ri].vp_grid,
@@ -273,4 +272,58 @@ fn closed_form_rate_integrals_equal_quadrature_of_the_dense_output() {
             }
         }
     }
+}
+
+/// A cache is shared by the clones of its handle only: a build through a clone reuses what an
+/// earlier one stored (bit-identical propagation), a build through another cache or none
+/// computes afresh; each table holds at most `CAPACITY` entries, the least recently used
+/// dropped first.
+#[test]
+fn a_cache_is_shared_by_its_clones_only() {
+    use super::cache::CAPACITY;
+    use crate::integrate::Integrator;
+    let m = CantileverModel::new(&Params::default()).unwrap();
+    let with = |cache: Option<PropagatorCache>| {
+        let opts = ExactOptions {
+            cache,
+            ..ExactOptions::default()
+        };
+        ExactPropagator::try_with(&m, opts).unwrap()
+    };
+    let cache = PropagatorCache::new();
+    assert!(cache.is_empty());
+    assert_eq!(with(Some(cache.clone())).reused(), (false, false, false));
+    assert_eq!(cache.len(), (1, 1, 1));
+    let mut again = with(Some(cache.clone()));
+    assert_eq!(again.reused(), (true, true, true));
+    assert_eq!(
+        with(Some(PropagatorCache::new())).reused(),
+        (false, false, false)
+    );
+    assert_eq!(with(None).reused(), (false, false, false));
+    assert_ne!(cache, PropagatorCache::new());
+    assert_eq!(cache, cache.clone());
+    // the reused build propagates as a fresh one, bit for bit
+    let mut fresh = with(None);
+    for it in [&mut again, &mut fresh] {
+        it.reset(0.0, &m.rest()).unwrap();
+        crate::integrate::advance(it, 20.0).unwrap();
+    }
+    assert_eq!(again.state(), fresh.state());
+    // bounded: CAPACITY + 2 values of Ω keep the spectral data once and CAPACITY grids
+    for k in 0..CAPACITY + 2 {
+        let p = Params {
+            omega: 2.0 + 0.01 * k as f64,
+            ..Params::default()
+        };
+        let mk = CantileverModel::new(&p).unwrap();
+        let opts = ExactOptions {
+            cache: Some(cache.clone()),
+            ..ExactOptions::default()
+        };
+        ExactPropagator::try_with(&mk, opts).unwrap();
+    }
+    let (s, g, f) = cache.len();
+    assert_eq!(s, 1);
+    assert!(g <= CAPACITY && f <= CAPACITY, "{g} {f}");
 }
