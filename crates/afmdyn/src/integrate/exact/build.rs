@@ -106,7 +106,10 @@ impl ExactPropagator {
         let period = model.period();
         let key = spectral::matrix_key(model);
         let cache = opts.cache.as_ref();
-        let (spec, spec_reused) = spectral::spectral(model, &key, cache)?;
+        let tables = cache.map(PropagatorCache::tables);
+        let (spec, spec_reused) = cached(tables.map(|t| &t.spectral), &key, || {
+            spectral::spectral(model)
+        })?;
         let rho = spec[0].rho.max(spec[1].rho);
         let base = opts.min_steps_per_period.max(1);
         // budget: the grid of one period, (2N + 2)(m + 1) values, must fit in
@@ -129,12 +132,16 @@ impl ExactPropagator {
         let need = need_f as usize;
         let m = base * need.div_ceil(base);
         let h = period / m as f64;
-        let (phi, phi_reused) = spectral::grid_exp(&spec, &key, h, cache)?;
+        let mut grid_key = key.clone();
+        grid_key.push(h.to_bits());
+        let (phi, phi_reused) = cached(tables.map(|t| &t.grid_exp), &grid_key, || {
+            Ok(spectral::grid_exp(&spec, h))
+        })?;
         // kept only while small: a cache entry outlives the propagators that use it, and the
         // grid of a stiff, large-N build may take up to params::GRID_BUDGET_BYTES
         let keep = (2 * dim + 2) as f64 * (m as f64 + 1.0) * 8.0 <= FORCING_KEEP_BYTES;
         let (forcing, forcing_reused) = cached(
-            cache.filter(|_| keep).map(|c| &c.tables().forcing),
+            tables.filter(|_| keep).map(|t| &t.forcing),
             &forcing_key(model, &key, h),
             || {
                 let trig: Vec<(f64, f64)> = (0..=m)

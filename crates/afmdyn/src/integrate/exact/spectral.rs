@@ -9,7 +9,6 @@
 //! returns the very values a rebuild would compute (the build is deterministic); the cache
 //! states its keys and bounds ([`super::cache`]).
 
-use super::cache::{cached, PropagatorCache};
 use super::modal::ModalExp;
 use super::K;
 use crate::error::SimError;
@@ -18,7 +17,6 @@ use crate::model::CantileverModel;
 use crate::system::Region;
 use nalgebra::linalg::LU;
 use nalgebra::{DMatrix, DVector, Dyn};
-use std::sync::Arc;
 
 /// Build-time data of one region that depends on A_s, M and K_s only.
 #[derive(Debug, Clone)]
@@ -57,22 +55,16 @@ pub(super) fn matrix_key(model: &CantileverModel) -> Vec<u64> {
     key
 }
 
-/// The spectral data of both regions (cached under `key` in `cache` when given) and whether it
-/// was reused.
+/// The spectral data of both regions (what a [`super::PropagatorCache`] keeps under
+/// [`matrix_key`]).
 ///
 /// # Errors
 /// [`SimError::OutOfRange`] when M or K_s is not positive definite.
-pub(super) fn spectral(
-    model: &CantileverModel,
-    key: &[u64],
-    cache: Option<&PropagatorCache>,
-) -> Result<(Arc<[Spectral; 2]>, bool), SimError> {
-    cached(cache.map(|c| &c.tables().spectral), key, || {
-        Ok([
-            region_spectral(model, Region::Free)?,
-            region_spectral(model, Region::Contact)?,
-        ])
-    })
+pub(super) fn spectral(model: &CantileverModel) -> Result<[Spectral; 2], SimError> {
+    Ok([
+        region_spectral(model, Region::Free)?,
+        region_spectral(model, Region::Contact)?,
+    ])
 }
 
 /// e^{X}, X = Ã h with ‖Ã‖₂ = ρ, by scaling and squaring with a truncated Taylor series
@@ -126,21 +118,12 @@ pub(super) fn expm(at: &DMatrix<f64>, h: f64, rho: f64) -> DMatrix<f64> {
     p
 }
 
-/// Φ_s = T⁻¹ e^{Ã_s h} T of both regions ([`expm`]; cached under `key` and h in `cache` when
-/// given) and whether it was reused.
-pub(super) fn grid_exp(
-    spec: &[Spectral; 2],
-    key: &[u64],
-    h: f64,
-    cache: Option<&PropagatorCache>,
-) -> Result<(Arc<GridExp>, bool), SimError> {
-    let mut key = key.to_vec();
-    key.push(h.to_bits());
-    cached(cache.map(|c| &c.tables().grid_exp), &key, || {
-        Ok(std::array::from_fn(|i| {
-            let s = &spec[i];
-            matmul(&matmul(&s.tinv, &expm(&s.at, h, s.rho)), &s.t)
-        }))
+/// Φ_s = T⁻¹ e^{Ã_s h} T of both regions ([`expm`]; what a [`super::PropagatorCache`] keeps
+/// under [`matrix_key`] and the bits of h).
+pub(super) fn grid_exp(spec: &[Spectral; 2], h: f64) -> GridExp {
+    std::array::from_fn(|i| {
+        let s = &spec[i];
+        matmul(&matmul(&s.tinv, &expm(&s.at, h, s.rho)), &s.t)
     })
 }
 
