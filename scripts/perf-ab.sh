@@ -7,12 +7,13 @@
 # release examples directory of the B build: target/release/examples of that tree, with
 # period_cost and basin_cost built) also the engine cases of scripts/perf-stability.sh
 # (`period_cost`) and scripts/perf-basins.sh (`basin_cost`), A's from this tree.
-#   [B_EXAMPLES=DIR] bash scripts/perf-ab.sh B_BIN [A_BIN] [RUNS]
+#   [B_EXAMPLES=DIR] [ONLY_ENGINE=1] bash scripts/perf-ab.sh B_BIN [A_BIN] [RUNS]
 set -uo pipefail
+ROOT=$(realpath "$(dirname "$0")/..")
 B=$(realpath "${1:?usage: perf-ab.sh B_BIN [A_BIN] [RUNS]}")
-A=$(realpath "${2:-$(dirname "$0")/../target/release/afmdyn}")
+A=$(realpath "${2:-$ROOT/target/release/afmdyn}")
 N=${3:-5}
-E=$(realpath "$(dirname "$0")/../examples")
+E=$ROOT/examples
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 cd "$tmp" || exit 1
@@ -31,6 +32,7 @@ cases=(
 )
 printf '| case | A median (s) | B median (s) | A/B (median of pairs) |\n|---|---|---|---|\n'
 for c in "${cases[@]}"; do
+  [ -n "${ONLY_ENGINE:-}" ] && break
   name=${c%%|*}; args=${c#*|}
   # shellcheck disable=SC2086
   farm-bench -n "$N" --timeout 900 --vs "$B $args" -- $A $args >"$tmp/out.txt" 2>&1
@@ -40,8 +42,8 @@ for c in "${cases[@]}"; do
 done
 if [ -n "${B_EXAMPLES:-}" ]; then
   BX=$(realpath "$B_EXAMPLES")
-  (cd "$(dirname "$0")/.." && cargo build --release -q -p afmdyn --example period_cost --example basin_cost)
-  AX=$(realpath "$(dirname "$0")/../target/release/examples")
+  (cd "$ROOT" && cargo build --release -q -p afmdyn --example period_cost --example basin_cost)
+  AX=$ROOT/target/release/examples
   engine=(
     "period_cost shoot 3 200 (Newton shooting, N = 3)|period_cost shoot 3 200"
     "period_cost continuation 3 3 (period-1 branch, Ω 5 → 1)|period_cost continuation 3 3"

@@ -602,7 +602,9 @@ fn finish(
     })
 }
 
-/// Find a period-n orbit of `model` near `guess`.
+/// Find a period-n orbit of `model` near `guess`, on an integrator built for this solve
+/// alone (its own propagator cache): for repeated solves build the integrator once, or share
+/// one [`IntegratorOptions`] (and so its cache), and call [`shoot_with`].
 ///
 /// # Errors
 /// As [`shoot_with`].
