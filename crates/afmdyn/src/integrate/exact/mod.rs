@@ -35,8 +35,9 @@
 //! starts where the lower parabola g'(0)s − Bs²/2 is largest, so the same event cannot fire twice.
 //! Many switchings in a vanishing time window are reported as [`SimError::Chattering`].
 //!
-//! **Parts.** `build.rs` (the options, the grid, the cached data), `forcing.rs` (the particular
-//! solutions, their grid tables and their cache), `state.rs` (the state between steps),
+//! **Parts.** `build.rs` (the options, the grid, the cached data), `cache.rs` (the caller's
+//! [`PropagatorCache`]), `forcing.rs` (the particular solutions and their grid tables),
+//! `state.rs` (the state between steps),
 //! `step.rs` (one step and the switching test; the search in `search.rs`), `run.rs` (runs of
 //! certified whole grid steps), `series.rs` (the last step, dense output, tip series), `span.rs` (spans of steps),
 //! `sensitivity.rs` (step Jacobians and ∂z/∂p), `bound.rs` (the displacement bound),
