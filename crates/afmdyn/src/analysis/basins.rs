@@ -49,6 +49,7 @@ use rayon::prelude::*;
 use std::collections::HashMap;
 use std::fmt;
 use std::str::FromStr;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Consecutive returns near a known periodic attractor that decide a start.
 pub const NEAR_HITS: usize = 3;
@@ -379,11 +380,19 @@ impl BasinMap {
     }
 }
 
-/// The cells of one row of a pass and the attractors found there beyond those the pass began
-/// with (a cell's label indexes the initial ones, then these).
-struct Row {
-    cells: Vec<(usize, BasinCell)>,
-    attractors: Vec<SteadyState>,
+/// One finished row of a pass: its cells and the attractors found there beyond those the pass
+/// began with (a cell's label indexes the pass's initial ones, then these): what a run hands
+/// on row by row ([`run_passes`]) and what the map is assembled from ([`basin_map`]).
+#[derive(Debug, Clone)]
+pub struct BasinRow {
+    /// The pass (0 the coarsest; one pass where the plane is not the whole section).
+    pub pass: usize,
+    /// The row index iy.
+    pub iy: usize,
+    /// (ix, cell) of the cells run in this pass.
+    pub cells: Vec<(usize, BasinCell)>,
+    /// The attractors found beyond the pass's initial ones.
+    pub attractors: Vec<SteadyState>,
 }
 
 /// A state-space cell of the recurrence test: the box indices ⌊z_i / side_i⌋ hashed into 128
@@ -472,6 +481,9 @@ fn plane_is_the_section(spec: &BasinSpec) -> bool {
     spec.params.modes == 1 && position(spec.x) != position(spec.y)
 }
 
+/// A row's (ix, cell) pairs and the attractors found beyond the initial ones.
+type RowCells = (Vec<(usize, BasinCell)>, Vec<SteadyState>);
+
 /// Run the cells `columns` of row `iy`, knowing the attractors `initial` (their labels are
 /// their indices) and, in the second pass, the first pass's `grid`.
 fn run_row(
@@ -481,8 +493,8 @@ fn run_row(
     columns: &[usize],
     initial: &[SteadyState],
     grid: Option<&CoarseGrid>,
-    progress: &Progress,
-) -> Result<Row, SimError> {
+    cancel: &AtomicBool,
+) -> Result<RowCells, SimError> {
     let n = model.modes();
     let (h, omega, period) = (spec.cell, spec.params.omega, model.period());
     let mut known: Vec<SteadyState> = initial.to_vec();
@@ -493,7 +505,9 @@ fn run_row(
     let mut integrator: Option<Box<dyn Integrator>> = None;
     let cap = spec.steady.cap(model);
     for &ix in columns {
-        progress.check()?;
+        if cancel.load(Ordering::Relaxed) {
+            return Err(SimError::Cancelled);
+        }
         let xv = spec.xs[ix];
         let mut z0 = spec.base.clone();
         spec.x.set(model, &mut z0, xv);
@@ -583,81 +597,51 @@ fn run_row(
             },
         };
         cells.push((ix, cell));
-        progress.tick();
     }
-    Ok(Row {
-        cells,
-        attractors: known.split_off(initial.len()),
-    })
+    Ok((cells, known.split_off(initial.len())))
 }
 
-/// Run `rows` (row index and its columns) in parallel and match their new attractors in row
-/// order into `attractors`; the cells, with global labels, go to `cells` (row-major, nx wide).
-fn run_pass(
+/// Match the new attractors of a pass's `rows` (in row order) into `attractors` and put their
+/// cells, with global labels, into `slots` (row-major, nx wide): the one merge of a pass, for
+/// the run ([`run_passes`]) and for the map made from its rows ([`basin_map`]).
+fn merge_pass<'a>(
     spec: &BasinSpec,
-    model: &CantileverModel,
-    rows: &[(usize, Vec<usize>)],
+    rows: impl Iterator<Item = &'a BasinRow>,
     attractors: &mut Vec<SteadyState>,
-    grid: Option<&CoarseGrid>,
-    cells: &mut [Option<BasinCell>],
-    progress: &Progress,
-) -> Result<(), SimError> {
-    let initial: &[SteadyState] = attractors;
-    let done: Vec<Row> = rows
-        .into_par_iter()
-        .with_max_len(1)
-        .map(|(iy, columns)| run_row(spec, model, *iy, columns, initial, grid, progress))
-        .collect::<Result<_, _>>()?;
+    slots: &mut [Option<BasinCell>],
+) {
     let nx = spec.xs.len();
     let first = attractors.len();
-    for ((iy, _), row) in rows.iter().zip(done) {
+    for row in rows {
         let ids: Vec<i64> = row
             .attractors
-            .into_iter()
+            .iter()
             .map(|a| {
                 match attractors
                     .iter()
-                    .position(|b| same_attractor(b, &a, spec.cluster_tol))
+                    .position(|b| same_attractor(b, a, spec.cluster_tol))
                 {
                     Some(i) => i as i64,
                     None => {
-                        attractors.push(a);
+                        attractors.push(a.clone());
                         attractors.len() as i64 - 1
                     }
                 }
             })
             .collect();
-        for (ix, mut c) in row.cells {
+        for (ix, c) in &row.cells {
+            let mut c = c.clone();
             if c.label >= first as i64 {
                 c.label = ids[c.label as usize - first];
             }
-            cells[iy * nx + ix] = Some(c);
+            slots[row.iy * nx + ix] = Some(c);
         }
     }
-    Ok(())
 }
 
-/// The basin map of `spec`: rows in parallel (rayon), their attractors matched in row order.
-///
-/// # Errors
-/// [`SimError`] for invalid parameters or coordinates outside N modes.
-pub fn basins(spec: &BasinSpec) -> Result<BasinMap, SimError> {
-    basins_with(spec, &Progress::new())
-}
-
-/// [`basins`] counting the cells done in `progress` (its total grows by nx × ny) and stopping
-/// when it is cancelled.
-///
-/// # Errors
-/// As [`basins`]; [`SimError::Cancelled`] once `progress` is cancelled.
-pub fn basins_with(spec: &BasinSpec, progress: &Progress) -> Result<BasinMap, SimError> {
-    spec.validate()?;
-    let model = CantileverModel::new(&spec.params)?;
-    let (nx, ny) = (spec.xs.len(), spec.ys.len());
-    progress.add_total(nx * ny);
-    let mut attractors: Vec<SteadyState> = Vec::new();
-    let mut slots: Vec<Option<BasinCell>> = vec![None; nx * ny];
-    // the passes' strides: the coarsest, halved pass by pass, then every cell
+/// The passes' strides: the coarsest, halved pass by pass, then every cell (one pass where the
+/// plane is not the whole section).
+fn strides(spec: &BasinSpec) -> Vec<usize> {
     let mut strides = Vec::new();
     if plane_is_the_section(spec) {
         let mut s = spec.first_stride();
@@ -667,8 +651,41 @@ pub fn basins_with(spec: &BasinSpec, progress: &Progress) -> Result<BasinMap, Si
         }
     }
     strides.push(1);
+    strides
+}
+
+/// The labels of a pass's coarse grid (−2 where no cell was run).
+fn coarse_grid(nx: usize, ny: usize, stride: usize, slots: &[Option<BasinCell>]) -> CoarseGrid {
+    let (cx, cy) = (coarse_indices(nx, stride), coarse_indices(ny, stride));
+    let labels = cy
+        .iter()
+        .flat_map(|&iy| cx.iter().map(move |&ix| (iy, ix)))
+        .map(|(iy, ix)| slots[iy * nx + ix].as_ref().map_or(-2, |c| c.label))
+        .collect();
+    CoarseGrid {
+        xs: cx,
+        ys: cy,
+        labels,
+    }
+}
+
+/// Run every pass of `spec` (rows in parallel on the current rayon pool), handing each finished
+/// row to `sink` from the worker threads; each pass begins with the attractors and the coarse
+/// grid of the ones before it. Stops starting rows once `cancel` is set.
+///
+/// # Errors
+/// [`SimError::Cancelled`] once `cancel` is set.
+pub fn run_passes(
+    spec: &BasinSpec,
+    model: &CantileverModel,
+    sink: &(dyn Fn(BasinRow) + Sync),
+    cancel: &AtomicBool,
+) -> Result<(), SimError> {
+    let (nx, ny) = (spec.xs.len(), spec.ys.len());
+    let mut attractors: Vec<SteadyState> = Vec::new();
+    let mut slots: Vec<Option<BasinCell>> = vec![None; nx * ny];
     let mut grid: Option<CoarseGrid> = None;
-    for stride in strides {
+    for (pass, stride) in strides(spec).into_iter().enumerate() {
         let (cx, cy) = (coarse_indices(nx, stride), coarse_indices(ny, stride));
         let rows: Vec<(usize, Vec<usize>)> = cy
             .iter()
@@ -682,30 +699,78 @@ pub fn basins_with(spec: &BasinSpec, progress: &Progress) -> Result<BasinMap, Si
             })
             .filter(|(_, todo): &(usize, Vec<usize>)| !todo.is_empty())
             .collect();
-        run_pass(
-            spec,
-            &model,
-            &rows,
-            &mut attractors,
-            grid.as_ref(),
-            &mut slots,
-            progress,
-        )?;
-        let labels = cy
-            .iter()
-            .flat_map(|&iy| cx.iter().map(move |&ix| (iy, ix)))
-            .map(|(iy, ix)| slots[iy * nx + ix].as_ref().map_or(-2, |c| c.label))
-            .collect();
-        grid = Some(CoarseGrid {
-            xs: cx,
-            ys: cy,
-            labels,
-        });
+        let initial: &[SteadyState] = &attractors;
+        let done: Vec<BasinRow> = rows
+            .into_par_iter()
+            .with_max_len(1)
+            .map(|(iy, columns)| {
+                let (cells, found) =
+                    run_row(spec, model, iy, &columns, initial, grid.as_ref(), cancel)?;
+                let row = BasinRow {
+                    pass,
+                    iy,
+                    cells,
+                    attractors: found,
+                };
+                sink(row.clone());
+                Ok(row)
+            })
+            .collect::<Result<_, SimError>>()?;
+        merge_pass(spec, done.iter(), &mut attractors, &mut slots);
+        grid = Some(coarse_grid(nx, ny, stride, &slots));
     }
-    let cells: Vec<BasinCell> = slots
-        .into_iter()
-        .map(|c| c.expect("every cell run in one pass"))
-        .collect();
+    Ok(())
+}
+
+/// The basin map of `spec`: rows in parallel (rayon, the current pool), their attractors
+/// matched in row order.
+///
+/// # Errors
+/// [`SimError`] for invalid parameters or coordinates outside N modes.
+pub fn basins(spec: &BasinSpec) -> Result<BasinMap, SimError> {
+    basins_with(spec, &Progress::new())
+}
+
+/// [`basins`] counting the cells done in `progress` (its total grows by nx × ny, a row's cells
+/// counted when the row is done) and stopping when it is cancelled.
+///
+/// # Errors
+/// As [`basins`]; [`SimError::Cancelled`] once `progress` is cancelled.
+pub fn basins_with(spec: &BasinSpec, progress: &Progress) -> Result<BasinMap, SimError> {
+    spec.validate()?;
+    let model = CantileverModel::new(&spec.params)?;
+    progress.add_total(spec.xs.len() * spec.ys.len());
+    let rows = std::sync::Mutex::new(Vec::new());
+    let sink = |r: BasinRow| {
+        progress.advance(r.cells.len());
+        rows.lock().unwrap_or_else(|e| e.into_inner()).push(r);
+    };
+    run_passes(spec, &model, &sink, progress.cancel_flag())?;
+    basin_map(spec, rows.into_inner().unwrap_or_else(|e| e.into_inner()))
+}
+
+/// The basin map of `spec` from the rows of every pass (in any order; a run's [`run_passes`]):
+/// the rows matched pass by pass in row order, then the attractors polished (shooting for the
+/// periodic ones, λ₁ for the others, in parallel on the current rayon pool) and merged where
+/// their polished orbits coincide.
+///
+/// # Errors
+/// [`SimError`] for invalid parameters; [`SimError::Cancelled`] when a cell is missing (a run
+/// that was cut short).
+pub fn basin_map(spec: &BasinSpec, mut rows: Vec<BasinRow>) -> Result<BasinMap, SimError> {
+    let model = CantileverModel::new(&spec.params)?;
+    let (nx, ny) = (spec.xs.len(), spec.ys.len());
+    rows.sort_by_key(|r| (r.pass, r.iy));
+    let mut attractors: Vec<SteadyState> = Vec::new();
+    let mut slots: Vec<Option<BasinCell>> = vec![None; nx * ny];
+    for pass in 0..strides(spec).len() {
+        let of_pass = rows.iter().filter(|r| r.pass == pass);
+        merge_pass(spec, of_pass, &mut attractors, &mut slots);
+    }
+    if slots.iter().any(Option::is_none) {
+        return Err(SimError::Cancelled);
+    }
+    let cells: Vec<BasinCell> = slots.into_iter().flatten().collect();
     // polish: shooting for the periodic attractors, λ₁ for the others
     let polished: Vec<(SteadyState, Option<PeriodicOrbit>, Option<f64>)> = attractors
         .into_par_iter()
