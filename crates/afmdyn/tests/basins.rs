@@ -232,3 +232,39 @@ fn interior_labels_agree_with_1500_period_runs() {
     }
     assert!(seen[0] && seen[1], "both basins sampled");
 }
+
+/// The map assembled from the rows a run showed, handed over in any order (as a store would
+/// give them back), is the run's own map: the same labels, decisions and attractors, in two
+/// passes (the automatic stride at 60 × 60). Rows missing (a run cut short) are refused.
+#[test]
+fn the_map_of_stored_rows_is_the_runs_map() {
+    use afmdyn::analysis::basins::{basin_map, basins, run_passes};
+    use std::sync::atomic::AtomicBool;
+    use std::sync::Mutex;
+    let s = spec(impact(), 60);
+    let model = CantileverModel::new(&s.params).unwrap();
+    let rows = Mutex::new(Vec::new());
+    run_passes(
+        &s,
+        &model,
+        &|r| rows.lock().unwrap().push(r.clone()),
+        &AtomicBool::new(false),
+    )
+    .unwrap();
+    let mut rows = rows.into_inner().unwrap();
+    assert!(rows.iter().any(|r| r.pass > 0), "two passes");
+    rows.reverse();
+    let stored = basin_map(&s, rows.clone()).unwrap();
+    let run = basins(&s).unwrap();
+    assert_eq!(stored.cells, run.cells);
+    assert_eq!(stored.attractors.len(), run.attractors.len());
+    for (a, b) in stored.attractors.iter().zip(&run.attractors) {
+        assert_eq!(a.poincare.len(), b.poincare.len());
+        assert_eq!(a.end_state(), b.end_state());
+    }
+    rows.pop();
+    assert!(matches!(
+        basin_map(&s, rows),
+        Err(afmdyn::SimError::Cancelled)
+    ));
+}

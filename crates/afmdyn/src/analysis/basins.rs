@@ -381,8 +381,8 @@ impl BasinMap {
 }
 
 /// One finished row of a pass: its cells and the attractors found there beyond those the pass
-/// began with (a cell's label indexes the pass's initial ones, then these): what a run hands
-/// on row by row ([`run_passes`]) and what the map is assembled from ([`basin_map`]).
+/// began with (a cell's label indexes the pass's initial ones, then these): what a run shows
+/// row by row ([`run_passes`]) and what a stored run's map is assembled from ([`basin_map`]).
 #[derive(Debug, Clone)]
 pub struct BasinRow {
     /// The pass (0 the coarsest; one pass where the plane is not the whole section).
@@ -604,9 +604,9 @@ fn run_row(
 /// Match the new attractors of a pass's `rows` (in row order) into `attractors` and put their
 /// cells, with global labels, into `slots` (row-major, nx wide): the one merge of a pass, for
 /// the run ([`run_passes`]) and for the map made from its rows ([`basin_map`]).
-fn merge_pass<'a>(
+fn merge_pass(
     spec: &BasinSpec,
-    rows: impl Iterator<Item = &'a BasinRow>,
+    rows: impl Iterator<Item = BasinRow>,
     attractors: &mut Vec<SteadyState>,
     slots: &mut [Option<BasinCell>],
 ) {
@@ -615,22 +615,21 @@ fn merge_pass<'a>(
     for row in rows {
         let ids: Vec<i64> = row
             .attractors
-            .iter()
+            .into_iter()
             .map(|a| {
                 match attractors
                     .iter()
-                    .position(|b| same_attractor(b, a, spec.cluster_tol))
+                    .position(|b| same_attractor(b, &a, spec.cluster_tol))
                 {
                     Some(i) => i as i64,
                     None => {
-                        attractors.push(a.clone());
+                        attractors.push(a);
                         attractors.len() as i64 - 1
                     }
                 }
             })
             .collect();
-        for (ix, c) in &row.cells {
-            let mut c = c.clone();
+        for (ix, mut c) in row.cells {
             if c.label >= first as i64 {
                 c.label = ids[c.label as usize - first];
             }
@@ -669,18 +668,23 @@ fn coarse_grid(nx: usize, ny: usize, stride: usize, slots: &[Option<BasinCell>])
     }
 }
 
-/// Run every pass of `spec` (rows in parallel on the current rayon pool), handing each finished
+/// The attractors of a run in the order first found and its cells (row-major, `None` where
+/// no pass ran the cell: a run cut short).
+type Merged = (Vec<SteadyState>, Vec<Option<BasinCell>>);
+
+/// Run every pass of `spec` (rows in parallel on the current rayon pool), showing each finished
 /// row to `sink` from the worker threads; each pass begins with the attractors and the coarse
-/// grid of the ones before it. Stops starting rows once `cancel` is set.
+/// grid of the ones before it. Stops starting rows once `cancel` is set. Returns the passes
+/// merged ([`basin_map_of`] makes the map of them).
 ///
 /// # Errors
 /// [`SimError::Cancelled`] once `cancel` is set.
 pub fn run_passes(
     spec: &BasinSpec,
     model: &CantileverModel,
-    sink: &(dyn Fn(BasinRow) + Sync),
+    sink: &(dyn Fn(&BasinRow) + Sync),
     cancel: &AtomicBool,
-) -> Result<(), SimError> {
+) -> Result<Merged, SimError> {
     let (nx, ny) = (spec.xs.len(), spec.ys.len());
     let mut attractors: Vec<SteadyState> = Vec::new();
     let mut slots: Vec<Option<BasinCell>> = vec![None; nx * ny];
@@ -712,14 +716,14 @@ pub fn run_passes(
                     cells,
                     attractors: found,
                 };
-                sink(row.clone());
+                sink(&row);
                 Ok(row)
             })
             .collect::<Result<_, SimError>>()?;
-        merge_pass(spec, done.iter(), &mut attractors, &mut slots);
+        merge_pass(spec, done.into_iter(), &mut attractors, &mut slots);
         grid = Some(coarse_grid(nx, ny, stride, &slots));
     }
-    Ok(())
+    Ok((attractors, slots))
 }
 
 /// The basin map of `spec`: rows in parallel (rayon, the current pool), their attractors
@@ -740,19 +744,14 @@ pub fn basins_with(spec: &BasinSpec, progress: &Progress) -> Result<BasinMap, Si
     spec.validate()?;
     let model = CantileverModel::new(&spec.params)?;
     progress.add_total(spec.xs.len() * spec.ys.len());
-    let rows = std::sync::Mutex::new(Vec::new());
-    let sink = |r: BasinRow| {
-        progress.advance(r.cells.len());
-        rows.lock().unwrap_or_else(|e| e.into_inner()).push(r);
-    };
-    run_passes(spec, &model, &sink, progress.cancel_flag())?;
-    basin_map(spec, rows.into_inner().unwrap_or_else(|e| e.into_inner()))
+    let count = |r: &BasinRow| progress.advance(r.cells.len());
+    let merged = run_passes(spec, &model, &count, progress.cancel_flag())?;
+    basin_map_of(spec, &model, merged)
 }
 
-/// The basin map of `spec` from the rows of every pass (in any order; a run's [`run_passes`]):
-/// the rows matched pass by pass in row order, then the attractors polished (shooting for the
-/// periodic ones, λ₁ for the others, in parallel on the current rayon pool) and merged where
-/// their polished orbits coincide.
+/// The basin map of `spec` from the stored rows of every pass (in any order, as a run's
+/// [`run_passes`] showed them): the rows matched pass by pass in row order — the run's own
+/// merge — then as [`basin_map_of`].
 ///
 /// # Errors
 /// [`SimError`] for invalid parameters; [`SimError::Cancelled`] when a cell is missing (a run
@@ -763,10 +762,28 @@ pub fn basin_map(spec: &BasinSpec, mut rows: Vec<BasinRow>) -> Result<BasinMap, 
     rows.sort_by_key(|r| (r.pass, r.iy));
     let mut attractors: Vec<SteadyState> = Vec::new();
     let mut slots: Vec<Option<BasinCell>> = vec![None; nx * ny];
+    let mut rows = rows.into_iter().peekable();
     for pass in 0..strides(spec).len() {
-        let of_pass = rows.iter().filter(|r| r.pass == pass);
-        merge_pass(spec, of_pass, &mut attractors, &mut slots);
+        let mut of_pass = Vec::new();
+        while let Some(r) = rows.next_if(|r| r.pass == pass) {
+            of_pass.push(r);
+        }
+        merge_pass(spec, of_pass.into_iter(), &mut attractors, &mut slots);
     }
+    basin_map_of(spec, &model, (attractors, slots))
+}
+
+/// The map of merged passes: the attractors polished (shooting for the periodic ones, λ₁ for
+/// the others, in parallel on the current rayon pool) and merged where their polished orbits
+/// coincide, the cells relabelled.
+///
+/// # Errors
+/// [`SimError::Cancelled`] when a cell is missing (a run that was cut short).
+fn basin_map_of(
+    spec: &BasinSpec,
+    model: &CantileverModel,
+    (attractors, slots): Merged,
+) -> Result<BasinMap, SimError> {
     if slots.iter().any(Option::is_none) {
         return Err(SimError::Cancelled);
     }
@@ -776,13 +793,13 @@ pub fn basin_map(spec: &BasinSpec, mut rows: Vec<BasinRow>) -> Result<BasinMap, 
         .into_par_iter()
         .with_max_len(1)
         .map(|mut s| {
-            let orbit = polish_steady(&model, spec.integrator.clone(), &mut s);
+            let orbit = polish_steady(model, spec.integrator.clone(), &mut s);
             let lyapunov = s
                 .period()
                 .is_none()
                 .then(|| {
                     largest_exponent(
-                        &model,
+                        model,
                         s.end_state(),
                         LYAPUNOV_PERIODS,
                         spec.integrator.clone(),

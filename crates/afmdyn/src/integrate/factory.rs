@@ -242,7 +242,7 @@ pub fn build(
                 adaptive()
             } else {
                 let cache = Some(opts.cache.clone());
-                match split::Split::try_with(model, opts.steps_per_period, opts.tolerance, cache) {
+                match split::Split::try_new(model, opts.steps_per_period, opts.tolerance, cache) {
                     Ok(s) => Box::new(s),
                     Err(SimError::OutOfRange { .. } | SimError::Budget { .. })
                         if opts.kind == IntegratorKind::Auto =>

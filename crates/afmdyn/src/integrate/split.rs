@@ -103,7 +103,9 @@ pub struct Split {
 impl Split {
     /// The split integrator of `model`: the exact free flight on a grid with a multiple of
     /// `min_steps_per_period` sub-steps per period, the adaptive integrator with tolerance
-    /// `tol` in contact. Start with [`Integrator::reset`].
+    /// `tol` in contact, the free flight built through `cache` (the exact propagator's
+    /// [`crate::integrate::PropagatorCache`]; `None`: computed afresh). Start with
+    /// [`Integrator::reset`].
     ///
     /// # Errors
     /// [`SimError::Unsupported`] for the DMT law (a force in free flight);
@@ -111,19 +113,6 @@ impl Split {
     /// [`SimError::Budget`] for a free-flight grid beyond its budget (as
     /// [`ExactPropagator::try_new`]).
     pub fn try_new(
-        model: &CantileverModel,
-        min_steps_per_period: usize,
-        tol: f64,
-    ) -> Result<Self, SimError> {
-        Self::try_with(model, min_steps_per_period, tol, None)
-    }
-
-    /// [`Split::try_new`] with the free flight built through `cache` (the exact propagator's
-    /// [`crate::integrate::PropagatorCache`]; `None`: computed afresh).
-    ///
-    /// # Errors
-    /// As [`Split::try_new`].
-    pub fn try_with(
         model: &CantileverModel,
         min_steps_per_period: usize,
         tol: f64,

@@ -229,7 +229,7 @@ impl ExactPropagator {
         self.grid.m
     }
 
-    /// Whether this build reused earlier builds (through [`ExactOptions::cache`]): (the spectral data —
+    /// Whether this build reused earlier builds ([`ExactOptions::cache`]): (the spectral data —
     /// energy transforms, Ã_s, eigendecomposition —, the grid exponentials Φ_s, the forcing
     /// data — particular solutions, their grid values, sin/cos on the grid).
     pub fn reused(&self) -> (bool, bool, bool) {
