@@ -670,12 +670,12 @@ fn coarse_grid(nx: usize, ny: usize, stride: usize, slots: &[Option<BasinCell>])
 
 /// The attractors of a run in the order first found and its cells (row-major, `None` where
 /// no pass ran the cell: a run cut short).
-type Merged = (Vec<SteadyState>, Vec<Option<BasinCell>>);
+pub type Merged = (Vec<SteadyState>, Vec<Option<BasinCell>>);
 
 /// Run every pass of `spec` (rows in parallel on the current rayon pool), showing each finished
 /// row to `sink` from the worker threads; each pass begins with the attractors and the coarse
 /// grid of the ones before it. Stops starting rows once `cancel` is set. Returns the passes
-/// merged ([`basin_map_of`] makes the map of them).
+/// passes merged, from which [`basins_with`] makes the map.
 ///
 /// # Errors
 /// [`SimError::Cancelled`] once `cancel` is set.
@@ -751,7 +751,7 @@ pub fn basins_with(spec: &BasinSpec, progress: &Progress) -> Result<BasinMap, Si
 
 /// The basin map of `spec` from the stored rows of every pass (in any order, as a run's
 /// [`run_passes`] showed them): the rows matched pass by pass in row order — the run's own
-/// merge — then as [`basin_map_of`].
+/// merge — then polished and relabelled as [`basins`] does.
 ///
 /// # Errors
 /// [`SimError`] for invalid parameters; [`SimError::Cancelled`] when a cell is missing (a run
