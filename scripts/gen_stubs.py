@@ -37,7 +37,11 @@ FUNCTIONS = [
     ("observe", "observe", ["probe: Optional[str] = None"]),
     ("approach", "approach", ["probe: Optional[str] = None"]),
     ("resonance", "resonance", ["probe: Optional[str] = None"]),
-    ("basins", "basins", ["probe: Optional[str] = None"]),
+    (
+        "basins",
+        "basins",
+        ["probe: Optional[str] = None", "store: Optional[str] = None", "resume: bool = False"],
+    ),
 ]
 #: requests with a stub but no compiled function of their own (the chart's study takes JSON)
 OTHERS = ["chart"]

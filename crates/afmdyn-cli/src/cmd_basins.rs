@@ -10,8 +10,10 @@ use crate::error::CliError;
 use crate::output::{write_bytes, OutDir};
 use crate::plot::{color, save_map, CellMap};
 use afmdyn::analysis::basins::BasinSpec;
-use afmdyn::request::{BasinArrays, BasinsRequest, Document, Resolved};
-use afmdyn::{CantileverModel, Params};
+use afmdyn::request::basins::csv_text;
+use afmdyn::request::{BasinArrays, BasinsRequest, Resolved};
+use afmdyn::study::basins::{basin_store, BasinStudy};
+use afmdyn::Params;
 use clap::Args;
 use plotters::style::RGBColor;
 use std::path::PathBuf;
@@ -77,9 +79,16 @@ pub struct BasinsArgs {
     /// Worker threads (default: all cores)
     #[arg(long)]
     threads: Option<usize>,
+    /// Continue an interrupted map; refused unless the other arguments are those of the
+    /// interrupted run (recorded in OUT/.basins.run.json)
+    #[arg(long)]
+    resume: bool,
     /// Output directory (locked during the run)
     #[arg(long, default_value = "afmdyn-out")]
     out: PathBuf,
+    /// Testing: abort the process, as if killed, after this many rows are stored
+    #[arg(long, hide = true)]
+    abort_after: Option<usize>,
     /// Print one JSON document
     #[arg(long)]
     json: bool,
@@ -108,33 +117,30 @@ pub fn basins_cmd(a: &BasinsArgs) -> Result<(), CliError> {
         steady: a.steady.request(),
         integrator: a.integrator.request(),
     };
-    let spec = request.spec(&p)?;
-    let model = CantileverModel::new(&p)?;
+    let study = BasinStudy::new(&request, &p)?;
     let out = OutDir::lock(&a.out)?;
-    let Document {
-        output: map,
-        json: mut doc,
-    } = crate::progress::run(&request, &Resolved { params: p, probe }, "starts")?;
+    let mut store = basin_store(out.dir_lock());
+    let failed = |e| crate::cmd_analysis::study_error(e, "basins");
+    crate::progress::study(
+        &study,
+        &mut store,
+        a.resume,
+        a.threads,
+        "starts",
+        a.abort_after,
+    )
+    .map_err(failed)?;
+    let rows = store
+        .records()
+        .map_err(|e| crate::cmd_analysis::store_error(e, "basins"))?;
+    let map = afmdyn::request::in_pool(a.threads, || study.map(rows.into_iter().map(|(_, r)| r)))?;
+    let (spec, model) = (&study.spec, &study.model);
+    let resolved = Resolved { params: p, probe };
+    let mut doc = afmdyn::request::run::document(&request, &resolved, &map)?;
     let (nx, ny) = (spec.xs.len(), spec.ys.len());
     let labels = map.labels();
-    // basins.csv
-    let mut text = String::from("ix,iy,x,y,label,decided,periods\n");
-    for (k, c) in map.cells.iter().enumerate() {
-        let (ix, iy) = (k % nx, k / nx);
-        text.push_str(&format!(
-            "{ix},{iy},{},{},{},{},{}\n",
-            spec.xs[ix],
-            spec.ys[iy],
-            c.label,
-            c.decided.name(),
-            c.periods
-        ));
-    }
-    write_bytes(&out.join("basins.csv"), text.as_bytes())?;
-    crate::output::write_layout(
-        &out.join("basins.nc"),
-        &BasinArrays::new(&map).layout(&spec),
-    )?;
+    write_bytes(&out.join("basins.csv"), csv_text(spec, &map).as_bytes())?;
+    crate::output::write_layout(&out.join("basins.nc"), &BasinArrays::new(&map).layout(spec))?;
     // the map, the attractors' section points on it
     let colour = |l: i64| -> RGBColor {
         if l < 0 {
@@ -164,8 +170,8 @@ pub fn basins_cmd(a: &BasinsArgs) -> Result<(), CliError> {
         .flat_map(|s| s.poincare.iter())
         .map(|q| {
             (
-                BasinSpec::coordinate(&model, spec.x, &q.state),
-                BasinSpec::coordinate(&model, spec.y, &q.state),
+                BasinSpec::coordinate(model, spec.x, &q.state),
+                BasinSpec::coordinate(model, spec.y, &q.state),
             )
         })
         .collect();

@@ -122,6 +122,105 @@ fn a_killed_chart_resumes_to_the_uninterrupted_files() {
     );
 }
 
+/// A basin map of two passes (the impact oscillator's plane is its whole section: 50 × 50 at
+/// the automatic stride 2) on `dir`, with `extra` flags.
+fn two_pass_basins(dir: &std::path::Path, extra: &[&str]) -> std::process::Output {
+    let mut args = vec![
+        "basins",
+        "--contact-law",
+        "impact",
+        "--restitution",
+        "0.8",
+        "--modes",
+        "1",
+        "--omega",
+        "2.0",
+        "--x-steps",
+        "50",
+        "--y-steps",
+        "50",
+        "--out",
+        dir.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    afmdyn(&args)
+}
+
+/// A basin map killed in its first pass (or in its second) resumes, pass by pass from the
+/// stored rows, to the files of the uninterrupted map (byte for byte); no row is lost or run
+/// twice; a finished store computes nothing; another request is refused naming the field.
+#[test]
+fn a_killed_basin_map_resumes_to_the_uninterrupted_files() {
+    let full = tempfile::tempdir().unwrap();
+    let cut = tempfile::tempdir().unwrap();
+    assert!(two_pass_basins(full.path(), &[]).status.success());
+    let killed = two_pass_basins(cut.path(), &["--threads", "1", "--abort-after", "3"]);
+    assert!(!killed.status.success(), "the run was killed");
+    let rows = cut.path().join(".basins.rows.jsonl");
+    let text = std::fs::read_to_string(&rows).unwrap();
+    assert_eq!(text.lines().count(), 3, "three rows stored");
+    // a line cut as a kill during a write would leave it
+    std::fs::write(&rows, text + "{\"row\": {\"pass\": 0, \"iy\"").unwrap();
+    let resumed = two_pass_basins(cut.path(), &["--resume"]);
+    assert!(
+        resumed.status.success(),
+        "{}",
+        String::from_utf8_lossy(&resumed.stderr)
+    );
+    for f in ["basins.csv", "basins.nc"] {
+        assert!(
+            std::fs::read(full.path().join(f)).unwrap()
+                == std::fs::read(cut.path().join(f)).unwrap(),
+            "{f}: the resumed map equals the uninterrupted one"
+        );
+    }
+    // the document too, but for the files' paths
+    let doc = |d: &std::path::Path| {
+        let mut v: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(d.join("basins.json")).unwrap()).unwrap();
+        let m = v.as_object_mut().unwrap();
+        m.remove("csv");
+        m.remove("netcdf");
+        v
+    };
+    assert!(doc(full.path()) == doc(cut.path()), "basins.json");
+    let stored = std::fs::read_to_string(&rows).unwrap();
+    let mut tasks: Vec<u64> = stored
+        .lines()
+        .map(|l| {
+            serde_json::from_str::<serde_json::Value>(l).unwrap()["task"]
+                .as_u64()
+                .unwrap()
+        })
+        .collect();
+    let n = tasks.len();
+    tasks.sort_unstable();
+    tasks.dedup();
+    assert_eq!(tasks.len(), n, "no row stored twice");
+    // both passes: the coarse grid's 26 rows, then every row's remaining cells
+    assert_eq!(n, 26 + 50, "no row lost");
+    // killed in the second pass: resumed from both passes' stored rows
+    let late = tempfile::tempdir().unwrap();
+    let killed = two_pass_basins(late.path(), &["--threads", "1", "--abort-after", "30"]);
+    assert!(!killed.status.success(), "the run was killed");
+    assert!(two_pass_basins(late.path(), &["--resume"]).status.success());
+    assert!(
+        std::fs::read(full.path().join("basins.csv")).unwrap()
+            == std::fs::read(late.path().join("basins.csv")).unwrap(),
+        "a map resumed in its second pass equals the uninterrupted one"
+    );
+    let again = two_pass_basins(cut.path(), &["--resume"]);
+    assert!(again.status.success());
+    assert_eq!(std::fs::read_to_string(&rows).unwrap(), stored);
+    let other = two_pass_basins(cut.path(), &["--resume", "--near-tol", "0.03"]);
+    assert_eq!(other.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&other.stderr);
+    assert!(
+        err.contains("near-tol = 0.02 in the interrupted run, 0.03 now"),
+        "{err}"
+    );
+}
+
 #[test]
 fn a_locked_directory_is_refused_at_once() {
     let dir = tempfile::tempdir().unwrap();

@@ -57,6 +57,30 @@ def test_two_passes_and_a_base_state():
         afmdyn.basins(modes=2, base=[0.0, 0.1], x_steps=2, y_steps=2)
 
 
+def test_a_map_killed_on_the_command_line_resumes_in_python(cli, tmp_path):
+    # one store for both front ends: the command line is killed in the first pass (26 rows of
+    # the coarse grid at 50 x 50), Python resumes it to the map of an uninterrupted run
+    size = ["--x-steps", 50, "--y-steps", 50]
+    killed = cli("basins", *FLAGS, *size, "--threads", 1, "--abort-after", 5, "--out", tmp_path)
+    assert killed.returncode != 0
+    rows = (tmp_path / ".basins.rows.jsonl").read_text().splitlines()
+    assert len(rows) == 5
+    ds = afmdyn.basins(**IMPACT, x_steps=50, y_steps=50, store=tmp_path, resume=True)
+    ref = afmdyn.basins(**IMPACT, x_steps=50, y_steps=50)
+    np.testing.assert_array_equal(ds.label.values, ref.label.values)
+    np.testing.assert_array_equal(ds.decided.values, ref.decided.values)
+    np.testing.assert_array_equal(ds.periods.values, ref.periods.values)
+    assert ds.attrs["summary"] == ref.attrs["summary"]
+    stored = (tmp_path / ".basins.rows.jsonl").read_text().splitlines()
+    assert stored[:5] == rows and len(stored) == 26 + 50
+    # another request's store is refused naming the option; resume needs a store
+    with pytest.raises(ValueError, match="near_tol"):
+        afmdyn.basins(**IMPACT, x_steps=50, y_steps=50, near_tol=0.03, store=tmp_path,
+                      resume=True)
+    with pytest.raises(ValueError, match="resume=True needs store="):
+        afmdyn.basins(**IMPACT, x_steps=4, y_steps=4, resume=True)
+
+
 def test_bad_basins_are_refused():
     with pytest.raises(ValueError, match="x = b1"):
         afmdyn.basins(x="b1")

@@ -247,6 +247,7 @@ fn the_map_of_stored_rows_is_the_runs_map() {
     run_passes(
         &s,
         &model,
+        &[],
         &|r| rows.lock().unwrap().push(r.clone()),
         &AtomicBool::new(false),
     )

@@ -461,6 +461,8 @@ def basins(
     request: Optional[BasinsRequest] = None,
     progress: Optional[ProgressCallback] = None,
     probe: Optional[str] = None,
+    store: Optional[str] = None,
+    resume: bool = False,
 ) -> Dict[str, Any]: ...
 
 # --- end of the generated block ---

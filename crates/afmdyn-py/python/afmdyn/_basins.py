@@ -4,7 +4,8 @@ map and measures, as an ``xarray.Dataset``."""
 from __future__ import annotations
 
 import json
-from typing import TYPE_CHECKING, Any, List, Optional
+import os
+from typing import TYPE_CHECKING, Any, List, Optional, Union
 
 import numpy as np
 import xarray as xr
@@ -46,6 +47,8 @@ def basins(
     steps_per_period: Optional[int] = None,
     tolerance: float = _DEFAULTS["basins"]["tolerance"],
     threads: Optional[int] = None,
+    store: Union[str, "os.PathLike[str]", None] = None,
+    resume: bool = False,
     progress: ProgressArg = None,
     **model: Unpack[Model],
 ) -> xr.Dataset:
@@ -57,6 +60,9 @@ def basins(
     steady-state search decides. Where the plane is the whole section (N = 1, a position and a
     velocity) the map is made in passes from a coarse grid (``stride``; 0 automatic, 1 one
     pass): a later start stops when a return lands inside a coarse cell of one basin.
+    ``store`` keeps the command line's resumable store of rows there (``afmdyn basins --out
+    DIR``), ``resume=True`` continues an interrupted map of the same request (refused, naming
+    the option, for another request's store).
 
     Returns:
         ``xarray.Dataset`` with dims ``(y, x)``: ``label`` (attractor id, −2 failed),
@@ -70,7 +76,16 @@ def basins(
     """
     req = _request(locals())
     p, probe = _params(params, model)
-    d = _run(_core.basins, "starts", progress, p, si=probe, request=req)
+    d = _run(
+        _core.basins,
+        "starts",
+        progress,
+        p,
+        si=probe,
+        request=req,
+        store=None if store is None else os.fspath(store),
+        resume=resume,
+    )
     doc = json.loads(d["json"])
 
     def num(v: Any) -> float:

@@ -46,6 +46,7 @@ use crate::params::Params;
 use nalgebra::DVector;
 #[cfg(feature = "parallel")]
 use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
 use std::fmt;
 use std::str::FromStr;
@@ -288,7 +289,8 @@ impl BasinSpec {
 }
 
 /// How a cell was decided.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum Decided {
     /// Near a known periodic attractor.
     Near,
@@ -334,7 +336,7 @@ impl Decided {
 }
 
 /// One cell of a basin map.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct BasinCell {
     /// Attractor id (index into [`BasinMap::attractors`]); −2 failed (diverged, chattering, a
     /// budget).
@@ -383,7 +385,7 @@ impl BasinMap {
 /// One finished row of a pass: its cells and the attractors found there beyond those the pass
 /// began with (a cell's label indexes the pass's initial ones, then these): what a run shows
 /// row by row ([`run_passes`]) and what a stored run's map is assembled from ([`basin_map`]).
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct BasinRow {
     /// The pass (0 the coarsest; one pass where the plane is not the whole section).
     pub pass: usize,
@@ -674,14 +676,17 @@ pub type Merged = (Vec<SteadyState>, Vec<Option<BasinCell>>);
 
 /// Run every pass of `spec` (rows in parallel on the current rayon pool), showing each finished
 /// row to `sink` from the worker threads; each pass begins with the attractors and the coarse
-/// grid of the ones before it. Stops starting rows once `cancel` is set. Returns the passes
-/// passes merged, from which [`basins_with`] makes the map.
+/// grid of the ones before it. The rows in `stored` (a resumed run's, as `sink` saw them) are
+/// not run again but merged in their place, so a resumed run makes the map an uninterrupted
+/// one makes. Stops starting rows once `cancel` is set. Returns the passes merged, from which
+/// [`basins_with`] makes the map.
 ///
 /// # Errors
 /// [`SimError::Cancelled`] once `cancel` is set.
 pub fn run_passes(
     spec: &BasinSpec,
     model: &CantileverModel,
+    stored: &[BasinRow],
     sink: &(dyn Fn(&BasinRow) + Sync),
     cancel: &AtomicBool,
 ) -> Result<Merged, SimError> {
@@ -691,8 +696,10 @@ pub fn run_passes(
     let mut grid: Option<CoarseGrid> = None;
     for (pass, stride) in strides(spec).into_iter().enumerate() {
         let (cx, cy) = (coarse_indices(nx, stride), coarse_indices(ny, stride));
+        let kept: Vec<&BasinRow> = stored.iter().filter(|r| r.pass == pass).collect();
         let rows: Vec<(usize, Vec<usize>)> = cy
             .iter()
+            .filter(|&&iy| !kept.iter().any(|r| r.iy == iy))
             .map(|&iy| {
                 let todo = cx
                     .iter()
@@ -704,7 +711,7 @@ pub fn run_passes(
             .filter(|(_, todo): &(usize, Vec<usize>)| !todo.is_empty())
             .collect();
         let initial: &[SteadyState] = &attractors;
-        let done: Vec<BasinRow> = rows
+        let mut done: Vec<BasinRow> = rows
             .into_par_iter()
             .with_max_len(1)
             .map(|(iy, columns)| {
@@ -720,6 +727,8 @@ pub fn run_passes(
                 Ok(row)
             })
             .collect::<Result<_, SimError>>()?;
+        done.extend(kept.into_iter().cloned());
+        done.sort_by_key(|r| r.iy);
         merge_pass(spec, done.into_iter(), &mut attractors, &mut slots);
         grid = Some(coarse_grid(nx, ny, stride, &slots));
     }
@@ -745,7 +754,7 @@ pub fn basins_with(spec: &BasinSpec, progress: &Progress) -> Result<BasinMap, Si
     let model = CantileverModel::new(&spec.params)?;
     progress.add_total(spec.xs.len() * spec.ys.len());
     let count = |r: &BasinRow| progress.advance(r.cells.len());
-    let merged = run_passes(spec, &model, &count, progress.cancel_flag())?;
+    let merged = run_passes(spec, &model, &[], &count, progress.cancel_flag())?;
     basin_map_of(spec, &model, merged)
 }
 

@@ -11,7 +11,7 @@ use crate::roots::extremum;
 use crate::system::EventKind;
 use crate::tip_sample::TipSampleSystem;
 use nalgebra::DVector;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::collections::VecDeque;
 
 /// Options of the steady-state search.
@@ -102,7 +102,7 @@ impl SteadyOptions {
 }
 
 /// Classification of a steady state.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase", tag = "kind")]
 pub enum Motion {
     /// Period-n orbit of the stroboscopic map.
@@ -115,7 +115,7 @@ pub enum Motion {
 }
 
 /// One point of the stroboscopic section.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PoincarePoint {
     /// τ = 2πk/Ω.
     pub tau: f64,
@@ -128,7 +128,7 @@ pub struct PoincarePoint {
 }
 
 /// Statistics of the recorded steady-state periods.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
 pub struct OrbitStats {
     /// X_max: the largest tip displacement W(1,τ).
     pub x_max: f64,
@@ -146,8 +146,9 @@ pub struct OrbitStats {
     pub body_contact: bool,
 }
 
-/// A steady state reached from one initial condition.
-#[derive(Debug, Clone, PartialEq)]
+/// A steady state reached from one initial condition (serialized for the stores of the studies
+/// whose later tasks start from it: a basin map's passes).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SteadyState {
     /// Period-n or nonperiodic.
     pub motion: Motion,

@@ -1,17 +1,16 @@
 //! `basins`: the request of a basin map ([`crate::analysis::basins`]) that the command line
 //! and Python share — its options with their limits, the worker threads, the JSON document
 //! (`afmdyn basins --json`, Python's `summary`) and the per-cell arrays of `basins.nc` and
-//! Python's dataset ([`BasinArrays`]).
+//! Python's dataset ([`BasinArrays`]). It runs as a study (`crate::study::basins`, which
+//! holds its `Analysis`).
 
 use super::analyses::{initial_state, IntegratorRequest, SteadyRequest};
-use super::run::{Analysis, Resolved};
 use crate::analysis::basin_entropy::{basin_entropy, uncertainty_exponent};
 use crate::analysis::basins::{
-    basins_with, BasinMap, BasinSpec, Decided, StateCoord, DEFAULT_BASIN_HITS, DEFAULT_CELL,
+    BasinMap, BasinSpec, Decided, StateCoord, DEFAULT_BASIN_HITS, DEFAULT_CELL,
     DEFAULT_DISCOVER_AFTER, DEFAULT_NEAR_TOL, DEFAULT_STRIDE,
 };
 use crate::analysis::bifurcation::SweepSpec;
-use crate::analysis::progress::Progress;
 use crate::error::SimError;
 use crate::layout::{Attr, Layout, Variable};
 use crate::model::CantileverModel;
@@ -168,21 +167,6 @@ fn rename(e: SimError, [from, to, steps]: [&'static str; 3]) -> SimError {
     }
 }
 
-impl Analysis for BasinsRequest {
-    type Output = BasinMap;
-    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
-        self.spec(&model.params).map(|_| ())
-    }
-    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<BasinMap, SimError> {
-        let spec = self.spec(&model.params)?;
-        super::pool::in_pool(self.threads, || basins_with(&spec, progress))
-    }
-    fn report(&self, model: &Resolved, map: &BasinMap) -> Result<Value, SimError> {
-        let spec = self.spec(&model.params)?;
-        Ok(document(&spec, map))
-    }
-}
-
 /// The document of a basin map (`afmdyn basins --json`): axes, labels (ny rows of nx ids),
 /// attractors (period, multipliers, stability, λ₁, Poincaré states, X_max, min V_T, contacts),
 /// basin fractions, failed cells, how the cells were decided, the drive periods run, basin
@@ -229,6 +213,25 @@ pub fn document(spec: &BasinSpec, map: &BasinMap) -> Value {
         "uncertainty_exponent": uncertainty_exponent(&labels, nx).map(|u| u.0),
         "warnings": warnings(spec, map),
     })
+}
+
+/// `basins.csv`: a header and one line per cell, row by row (`ix,iy,x,y,label,decided,periods`;
+/// `decided` as [`Decided::name`]).
+pub fn csv_text(spec: &BasinSpec, map: &BasinMap) -> String {
+    let nx = spec.xs.len();
+    let mut text = String::from("ix,iy,x,y,label,decided,periods\n");
+    for (k, c) in map.cells.iter().enumerate() {
+        let (ix, iy) = (k % nx, k / nx);
+        text.push_str(&format!(
+            "{ix},{iy},{},{},{},{},{}\n",
+            spec.xs[ix],
+            spec.ys[iy],
+            c.label,
+            c.decided.name(),
+            c.periods
+        ));
+    }
+    text
 }
 
 /// The caveats of a basin map (the `warnings` of its document): attractors that are

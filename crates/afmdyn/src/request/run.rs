@@ -113,11 +113,29 @@ pub fn run<A: Analysis + ?Sized>(
     progress.check()?;
     analysis.validate(model)?;
     let output = analysis.execute(model, progress)?;
-    let doc = analysis.report(model, &output)?;
     Ok(Document {
-        json: report::with_si(doc, model.probe.as_ref(), &analysis.computed_at(model)?),
+        json: document(analysis, model, &output)?,
         output,
     })
+}
+
+/// The document of `analysis`'s `output` on `model`: [`Analysis::report`] with the SI block of
+/// the probe ([`report::with_si`]) — [`run`]'s, and a front end's for a study it ran into a
+/// store of its own.
+///
+/// # Errors
+/// As [`Analysis::report`] and [`Analysis::computed_at`].
+pub fn document<A: Analysis + ?Sized>(
+    analysis: &A,
+    model: &Resolved,
+    output: &A::Output,
+) -> Result<Value, SimError> {
+    let doc = analysis.report(model, output)?;
+    Ok(report::with_si(
+        doc,
+        model.probe.as_ref(),
+        &analysis.computed_at(model)?,
+    ))
 }
 
 /// `modes`: natural frequencies and damped eigenvalues of the free and contact systems

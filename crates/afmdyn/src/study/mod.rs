@@ -15,8 +15,9 @@
 //!   builds the worker pool (the request's thread count, checked once by
 //!   [`crate::request::limits::check_threads`]), runs the study, appends each finished task
 //!   under one lock, reports progress to an [`Observer`], and finishes the store.
-//! - the studies: [`chart`] (a behaviour chart's tiles, its store [`chart_store`]) and [`sweep`]
-//!   (a bifurcation sweep's points, stored by the request layer's checkpoints).
+//! - the studies: [`chart`] (a behaviour chart's tiles, its store [`chart_store`]), [`sweep`]
+//!   (a bifurcation sweep's points, stored by the request layer's checkpoints) and [`basins`]
+//!   (a basin map's rows, pass by pass, its store `basins::basin_store`).
 //!
 //! The results' variables are declared once in [`crate::layout`], from which the NetCDF file,
 //! the Python `xarray.Dataset` and the Dask Zarr store are written.
@@ -26,6 +27,7 @@
 //! finishes. Dask (`afmdyn.dask`) is another executor of the same tasks: it ships them to
 //! workers and writes through the same layout.
 
+pub mod basins;
 pub mod chart;
 #[cfg(feature = "files")]
 pub mod chart_store;
@@ -206,4 +208,24 @@ pub fn execute<S: Study + ?Sized, St: Store<S>>(
     }
     store.finish(study)?;
     Ok(Outcome::Finished)
+}
+
+/// Run `study` into a [`MemoryStore`] (a run that writes no files, as [`execute`] on
+/// `threads` workers reporting to `observer`): its records in the order they finished.
+///
+/// # Errors
+/// [`SimError::Cancelled`] when the observer's flag stopped the run; the pool's errors.
+pub fn execute_in_memory<S: Study + ?Sized>(
+    study: &S,
+    threads: Option<usize>,
+    observer: &dyn Observer,
+) -> Result<Vec<S::Record>, SimError> {
+    let mut store = MemoryStore::default();
+    match execute(study, &mut store, false, threads, observer) {
+        Ok(Outcome::Cancelled) => Err(SimError::Cancelled),
+        Ok(Outcome::Finished | Outcome::AlreadyFinished) => Ok(store.records),
+        Err(StudyError::Sim(e)) => Err(e),
+        // a memory store opens, appends and finishes without fail
+        Err(StudyError::Store(e)) => unreachable!("memory store: {e}"),
+    }
 }

@@ -325,17 +325,43 @@ impl<'a, R: Serialize + DeserializeOwned> TaskStore<'a, R> {
     }
 }
 
+/// What a study resumed from a [`TaskStore`] skips, read back from it: the tasks stored
+/// (`HashSet<usize>`: their records stay in the file, memory does not grow with the study) or
+/// the records themselves in the order of the tasks (`Vec<R>`: a study whose later tasks start
+/// from the earlier ones' results, as a basin map's passes do).
+pub trait StoredTasks<R>: Sized {
+    /// Read from `store`, just opened, whose stored tasks are `tasks`.
+    ///
+    /// # Errors
+    /// As [`TaskStore::records`].
+    fn stored(store: &mut TaskStore<'_, R>, tasks: HashSet<usize>)
+        -> Result<Self, CheckpointError>;
+}
+
+impl<R> StoredTasks<R> for HashSet<usize> {
+    fn stored(_: &mut TaskStore<'_, R>, tasks: HashSet<usize>) -> Result<Self, CheckpointError> {
+        Ok(tasks)
+    }
+}
+
+impl<R: Serialize + DeserializeOwned> StoredTasks<R> for Vec<R> {
+    fn stored(store: &mut TaskStore<'_, R>, _: HashSet<usize>) -> Result<Self, CheckpointError> {
+        Ok(store.records()?.into_iter().map(|(_, r)| r).collect())
+    }
+}
+
 impl<S, R> Store<S> for TaskStore<'_, R>
 where
-    S: Study<Record = (usize, R), Done = HashSet<usize>> + ?Sized,
+    S: Study<Record = (usize, R)> + ?Sized,
+    S::Done: StoredTasks<R>,
     R: Serialize + DeserializeOwned + Send,
 {
-    fn open(&mut self, study: &S, resume: bool) -> Result<Opened<HashSet<usize>>, CheckpointError> {
+    fn open(&mut self, study: &S, resume: bool) -> Result<Opened<S::Done>, CheckpointError> {
         let done = TaskStore::open(self, study.fingerprint(), resume)?;
         if resume && self.finished()? {
             return Ok(Opened::Finished);
         }
-        Ok(Opened::Run(done))
+        Ok(Opened::Run(S::Done::stored(self, done)?))
     }
 
     fn append(&mut self, (task, record): (usize, R)) -> Result<(), CheckpointError> {

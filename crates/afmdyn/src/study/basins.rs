@@ -1,0 +1,165 @@
+//! A basin map ([`crate::analysis::basins`]) as a [`Study`] ([`BasinStudy`]): a task is one
+//! row of one pass, numbered `pass × ny + iy`; its record the finished row ([`BasinRow`]: its
+//! cells and the attractors found there); what a resume skips the stored rows themselves, since
+//! each pass begins with the attractors and the coarse grid of the passes before it
+//! ([`run_passes`] merges the stored rows in their place, so a resumed map is the
+//! uninterrupted one). The map is assembled from the records by [`basin_map`], whatever store
+//! kept them: [`MemoryStore`](super::MemoryStore) for a run that writes no files, the
+//! directory store [`basin_store`] (feature `files`) for `afmdyn basins --out DIR`, resumable.
+//!
+//! The request's [`Analysis`] (`request::run`, Python's `afmdyn.basins`) runs this study in
+//! memory.
+
+use super::{execute_in_memory, Study};
+use crate::analysis::basins::{basin_map, run_passes, BasinMap, BasinRow, BasinSpec};
+use crate::analysis::progress::Progress;
+use crate::error::SimError;
+use crate::model::CantileverModel;
+use crate::params::Params;
+use crate::request::basins::document;
+use crate::request::run::{Analysis, Resolved};
+use crate::request::BasinsRequest;
+use serde_json::{json, Value};
+use std::sync::atomic::AtomicBool;
+
+/// A basin map as a [`Study`] (see the module doc): its validated spec, its model and its
+/// fingerprint.
+#[derive(Debug, Clone)]
+pub struct BasinStudy {
+    /// The validated map.
+    pub spec: BasinSpec,
+    /// The cantilever of `spec.params`.
+    pub model: CantileverModel,
+    /// What a resumed map must match ([`fingerprint`]).
+    pub fingerprint: Value,
+}
+
+/// The fingerprint of a basin map: everything that determines its cells (the library's
+/// version, the model values, every option of the request but the threads).
+pub fn fingerprint(request: &BasinsRequest, params: &Params) -> Value {
+    let mut r = serde_json::to_value(request).unwrap_or(Value::Null);
+    if let Some(map) = r.as_object_mut() {
+        map.remove("threads");
+    }
+    json!({
+        "afmdyn": env!("CARGO_PKG_VERSION"),
+        "basins": r,
+        "params": params,
+    })
+}
+
+impl BasinStudy {
+    /// The study of `request` over `params`.
+    ///
+    /// # Errors
+    /// As [`BasinsRequest::spec`].
+    pub fn new(request: &BasinsRequest, params: &Params) -> Result<BasinStudy, SimError> {
+        let spec = request.spec(params)?;
+        let model = CantileverModel::new(params)?;
+        Ok(BasinStudy {
+            spec,
+            model,
+            fingerprint: fingerprint(request, params),
+        })
+    }
+
+    /// The number of task `row` (its pass and row index).
+    pub fn task(&self, row: &BasinRow) -> usize {
+        row.pass * self.spec.ys.len() + row.iy
+    }
+
+    /// The map of a finished study's records (in any order), as [`basin_map`].
+    ///
+    /// # Errors
+    /// As [`basin_map`]: [`SimError::Cancelled`] when a row is missing.
+    pub fn map(&self, records: impl IntoIterator<Item = BasinRow>) -> Result<BasinMap, SimError> {
+        basin_map(&self.spec, records.into_iter().collect())
+    }
+}
+
+impl Study for BasinStudy {
+    /// The task's number and its row.
+    type Record = (usize, BasinRow);
+    /// The stored rows.
+    type Done = Vec<BasinRow>;
+
+    fn fingerprint(&self) -> &Value {
+        &self.fingerprint
+    }
+
+    fn units(&self) -> u64 {
+        (self.spec.xs.len() * self.spec.ys.len()) as u64
+    }
+
+    fn done_units(&self, done: &Vec<BasinRow>) -> u64 {
+        done.iter().map(|r| r.cells.len() as u64).sum()
+    }
+
+    fn record_units(&self, record: &(usize, BasinRow)) -> u64 {
+        record.1.cells.len() as u64
+    }
+
+    fn run(
+        &self,
+        done: &Vec<BasinRow>,
+        sink: &(dyn Fn((usize, BasinRow)) + Sync),
+        cancel: &AtomicBool,
+    ) {
+        // a cancelled run ends here: the rows stored so far are the store's
+        let _ = run_passes(
+            &self.spec,
+            &self.model,
+            done,
+            &|row| sink((self.task(row), row.clone())),
+            cancel,
+        );
+    }
+}
+
+impl Analysis for BasinsRequest {
+    type Output = BasinMap;
+    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
+        self.spec(&model.params).map(|_| ())
+    }
+    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<BasinMap, SimError> {
+        let study = BasinStudy::new(self, &model.params)?;
+        let records = execute_in_memory(&study, self.threads, progress)?;
+        crate::request::in_pool(self.threads, || {
+            study.map(records.into_iter().map(|(_, r)| r))
+        })
+    }
+    fn report(&self, model: &Resolved, map: &BasinMap) -> Result<Value, SimError> {
+        let spec = self.spec(&model.params)?;
+        Ok(document(&spec, map))
+    }
+}
+
+/// The resumable store of a basin map (feature `files`): a [`TaskStore`](crate::study::task_store::TaskStore) of rows in the
+/// directory `afmdyn basins --out DIR` names — `.basins.run.json` (the ledger) and
+/// `.basins.rows.jsonl` (one checksummed line per finished row, under `"row"`), as
+/// [`crate::study::task_store`] describes.
+#[cfg(feature = "files")]
+pub mod store {
+    use super::super::task_store::{TaskFiles, TaskStore};
+    use crate::analysis::basins::BasinRow;
+    use crate::request::dir_lock::DirLock;
+
+    /// The basin map's files.
+    pub const BASIN_FILES: TaskFiles = TaskFiles {
+        ledger: ".basins.run.json",
+        records: ".basins.rows.jsonl",
+        key: "row",
+        prefix: "basins.",
+    };
+
+    /// A basin map's store: its rows by task.
+    pub type BasinStore<'a> = TaskStore<'a, BasinRow>;
+
+    /// The basin store of the directory `lock` holds.
+    pub fn basin_store(lock: &DirLock) -> BasinStore<'_> {
+        TaskStore::new(lock, BASIN_FILES)
+    }
+}
+
+#[cfg(feature = "files")]
+pub use store::{basin_store, BasinStore, BASIN_FILES};
