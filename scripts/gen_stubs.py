@@ -30,7 +30,11 @@ FUNCTIONS = [
     ("converge", "converge", ["probe: Optional[str] = None"]),
     ("bifurcation", "bifurcation", ["store: Optional[str] = None", "resume: bool = False"]),
     ("attractors", "attractors", ["probe: Optional[str] = None"]),
-    ("global_continuation", "global_continuation", ["probe: Optional[str] = None"]),
+    (
+        "global_continuation",
+        "global_continuation",
+        ["probe: Optional[str] = None", "store: Optional[str] = None", "resume: bool = False"],
+    ),
     ("orbit", "orbit", ["probe: Optional[str] = None"]),
     ("continuation", "continuation", ["probe: Optional[str] = None"]),
     ("lyapunov", "lyapunov", ["probe: Optional[str] = None"]),

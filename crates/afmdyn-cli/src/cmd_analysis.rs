@@ -18,6 +18,7 @@ use afmdyn::request::{
     AttractorsRequest, BifurcationRequest, FileCheckpoint, GlobalContinuationRequest, SteadyRequest,
 };
 use afmdyn::request::{Document, Resolved};
+use afmdyn::study::global_continuation::{continuation_store, ContinuationStudy};
 use afmdyn::study::sweep::SweepStudy;
 use afmdyn::trajectory::{record, RecordSpec};
 use afmdyn::{CantileverModel, Params, SweepParam};
@@ -403,6 +404,13 @@ pub struct AttractorsArgs {
     /// consecutive values of --sweep that are one attractor
     #[arg(long, default_value_t = GlobalContinuationRequest::default().match_tol, requires = "sweep")]
     match_tol: f64,
+    /// Continue an interrupted --sweep; refused unless the other arguments are those of the
+    /// interrupted run (recorded in OUT/.continuation.run.json)
+    #[arg(long, requires = "sweep")]
+    resume: bool,
+    /// Testing: abort the process, as if killed, after this many values of --sweep are stored
+    #[arg(long, hide = true, requires = "sweep")]
+    abort_after: Option<usize>,
     /// Output directory
     #[arg(long, default_value = "afmdyn-out/attractors")]
     out: PathBuf,
@@ -605,13 +613,16 @@ fn attractors_sweep(
     request: &GlobalContinuationRequest,
     model: Resolved,
 ) -> Result<(), CliError> {
-    let p = model.params;
-    request.spec(&p)?;
+    let study = ContinuationStudy::new(request, &model.params)?;
     let out = OutDir::lock(&a.out)?;
-    let Document {
-        output: steps,
-        json: doc,
-    } = crate::progress::run(request, &model, "starts")?;
+    let mut store = continuation_store(out.dir_lock());
+    crate::progress::study(&study, &mut store, a.resume, None, "starts", a.abort_after)
+        .map_err(|e| study_error(e, "attractors --sweep"))?;
+    let records = store
+        .records()
+        .map_err(|e| store_error(e, "attractors --sweep"))?;
+    let steps = study.steps(records)?;
+    let doc = afmdyn::request::run::document(request, &model, &steps)?;
     let name = request.param.name();
     let mut rows = Vec::new();
     for s in &steps {

@@ -122,28 +122,32 @@ fn a_killed_chart_resumes_to_the_uninterrupted_files() {
     );
 }
 
-/// A basin map of two passes (the impact oscillator's plane is its whole section: 50 × 50 at
-/// the automatic stride 2) on `dir`, with `extra` flags.
-fn two_pass_basins(dir: &std::path::Path, extra: &[&str]) -> std::process::Output {
-    let mut args = vec![
-        "basins",
-        "--contact-law",
-        "impact",
-        "--restitution",
-        "0.8",
-        "--modes",
-        "1",
-        "--omega",
-        "2.0",
-        "--x-steps",
-        "50",
-        "--y-steps",
-        "50",
-        "--out",
-        dir.to_str().unwrap(),
-    ];
-    args.extend_from_slice(extra);
-    afmdyn(&args)
+/// The impact oscillator N = 1, r = 0.8 near Ω = 2 (two coexisting period-1 orbits).
+const IMPACT: [&str; 8] = [
+    "--contact-law",
+    "impact",
+    "--restitution",
+    "0.8",
+    "--modes",
+    "1",
+    "--omega",
+    "2.0",
+];
+
+/// `afmdyn COMMAND` on the impact oscillator with `args`, its outputs in `dir`, then `extra`.
+fn on_impact(command: &[&str], dir: &Path, extra: &[&str]) -> Output {
+    let out = ["--out", dir.to_str().unwrap()];
+    afmdyn(&[command, &IMPACT[..], &out, extra].concat())
+}
+
+/// A basin map of two passes (the plane is the whole section: 50 × 50 at the automatic
+/// stride 2) on `dir`, with `extra` flags.
+fn two_pass_basins(dir: &Path, extra: &[&str]) -> Output {
+    on_impact(
+        &["basins", "--x-steps", "50", "--y-steps", "50"],
+        dir,
+        extra,
+    )
 }
 
 /// A basin map killed in its first pass (or in its second) resumes, pass by pass from the
@@ -175,7 +179,7 @@ fn a_killed_basin_map_resumes_to_the_uninterrupted_files() {
         );
     }
     // the document too, but for the files' paths
-    let doc = |d: &std::path::Path| {
+    let doc = |d: &Path| {
         let mut v: serde_json::Value =
             serde_json::from_slice(&std::fs::read(d.join("basins.json")).unwrap()).unwrap();
         let m = v.as_object_mut().unwrap();
@@ -217,6 +221,64 @@ fn a_killed_basin_map_resumes_to_the_uninterrupted_files() {
     let err = String::from_utf8_lossy(&other.stderr);
     assert!(
         err.contains("near-tol = 0.02 in the interrupted run, 0.03 now"),
+        "{err}"
+    );
+}
+
+/// A global continuation over Ω (the impact oscillator's two period-1 orbits) on `dir`.
+fn continuation(dir: &Path, extra: &[&str]) -> Output {
+    let sweep = [
+        "attractors",
+        "--samples",
+        "12",
+        "--sweep",
+        "omega",
+        "--from",
+        "1.98",
+        "--to",
+        "2.06",
+        "--steps",
+        "9",
+    ];
+    on_impact(&sweep, dir, extra)
+}
+
+/// A global continuation killed after three values resumes from the last stored value's
+/// attractors (its seeds and ids) to the files of the uninterrupted run; each value is stored
+/// once; another request is refused naming the field.
+#[test]
+fn a_killed_global_continuation_resumes_to_the_uninterrupted_files() {
+    let full = tempfile::tempdir().unwrap();
+    let cut = tempfile::tempdir().unwrap();
+    let run = continuation(full.path(), &[]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let killed = continuation(cut.path(), &["--abort-after", "3"]);
+    assert!(!killed.status.success(), "the run was killed");
+    let values = cut.path().join(".continuation.values.jsonl");
+    assert_eq!(std::fs::read_to_string(&values).unwrap().lines().count(), 3);
+    let resumed = continuation(cut.path(), &["--resume"]);
+    assert!(
+        resumed.status.success(),
+        "{}",
+        String::from_utf8_lossy(&resumed.stderr)
+    );
+    for f in ["attractors-sweep.csv", "attractors-sweep.nc"] {
+        assert!(
+            std::fs::read(full.path().join(f)).unwrap()
+                == std::fs::read(cut.path().join(f)).unwrap(),
+            "{f}: the resumed continuation equals the uninterrupted one"
+        );
+    }
+    assert_eq!(std::fs::read_to_string(&values).unwrap().lines().count(), 9);
+    let other = continuation(cut.path(), &["--resume", "--match-tol", "0.2"]);
+    assert_eq!(other.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&other.stderr);
+    assert!(
+        err.contains("match-tol = 0.1 in the interrupted run, 0.2 now"),
         "{err}"
     );
 }

@@ -15,9 +15,8 @@ use afmdyn::probe::Probe;
 use afmdyn::request::checkpoint::{self, CheckpointError};
 use afmdyn::request::{self, Analysis, Document, ModesRequest, Resolved};
 use afmdyn::request::{
-    AttractorsRequest, BifurcationRequest, ContinuationRequest, ConvergeRequest,
-    GlobalContinuationRequest, LyapunovRequest, ObserveRequest, OrbitRequest, SeriesStore,
-    SimulateRequest,
+    AttractorsRequest, BifurcationRequest, ContinuationRequest, ConvergeRequest, LyapunovRequest,
+    ObserveRequest, OrbitRequest, SeriesStore, SimulateRequest,
 };
 use afmdyn::request::{DirLock, FileCheckpoint, LockError, MemoryCheckpoint, SweepRecord};
 use afmdyn::study::sweep::SweepStudy;
@@ -376,33 +375,6 @@ pub fn attractors<'py>(
     }
     out.set("attractors", list)?;
     out.set("failures", PyList::new(py, &report_.failures)?)?;
-    Ok(out.finish())
-}
-
-/// Attractors continued over a parameter (global continuation): the JSON document of
-/// `afmdyn attractors --sweep --json` (the Python layer builds the dataset from it).
-#[pyfunction]
-#[pyo3(signature = (params, request=None, progress=None, probe=None))]
-pub fn global_continuation<'py>(
-    py: Python<'py>,
-    params: PyRef<'_, PyParams>,
-    request: Option<&Dict<'py>>,
-    progress: Option<Bound<'py, PyAny>>,
-    probe: Option<String>,
-) -> PyResult<Dict<'py>> {
-    let request: GlobalContinuationRequest =
-        crate::convert::request("global_continuation", request)?;
-    let param = request.param;
-    let doc = analysis(py, request, params.inner, probe, progress.as_ref(), true)?;
-    let out = Out::new(py);
-    out.json(&doc.json)?;
-    out.set(
-        "layout",
-        crate::convert::layout_dict(
-            py,
-            afmdyn::report::global_continuation_layout(param, &doc.output),
-        )?,
-    )?;
     Ok(out.finish())
 }
 

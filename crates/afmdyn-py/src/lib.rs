@@ -6,13 +6,13 @@
 //! datasets and result objects.
 
 mod analyses;
-mod basins;
 mod chart;
 mod convert;
 mod curves;
 mod errors;
 mod params;
 mod run;
+mod studies;
 mod sweep;
 
 use pyo3::prelude::*;
@@ -50,8 +50,8 @@ fn _afmdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(analyses::converge, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::bifurcation, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::attractors, m)?)?;
-    m.add_function(wrap_pyfunction!(analyses::global_continuation, m)?)?;
-    m.add_function(wrap_pyfunction!(basins::basins, m)?)?;
+    m.add_function(wrap_pyfunction!(studies::global_continuation, m)?)?;
+    m.add_function(wrap_pyfunction!(studies::basins, m)?)?;
     m.add_function(wrap_pyfunction!(cantilevers, m)?)?;
     m.add_function(wrap_pyfunction!(request_defaults, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::orbit, m)?)?;

@@ -50,6 +50,24 @@ def test_fractions_add_up_and_ids_follow_the_orbits():
         assert np.all(steps[np.isfinite(steps)] < 0.01)
 
 
+def test_a_continuation_killed_on_the_command_line_resumes_in_python(cli, tmp_path):
+    # one store for both front ends: killed after 2 of 5 values, resumed from the second
+    # value's attractors (seeds and ids) to the continuation of an uninterrupted run
+    killed = cli("attractors", *FLAGS, "--sweep", "omega", "--from", 1.98, "--to", 2.06,
+                 "--steps", 5, "--samples", 16, "--abort-after", 2, "--out", tmp_path)
+    assert killed.returncode != 0
+    values = tmp_path / ".continuation.values.jsonl"
+    assert len(values.read_text().splitlines()) == 2
+    ds = afmdyn.global_continuation(**IMPACT, **SWEEP, store=tmp_path, resume=True)
+    ref = afmdyn.global_continuation(**IMPACT, **SWEEP)
+    assert afmdyn.summary(ds) == afmdyn.summary(ref)
+    np.testing.assert_array_equal(ds.basin_fraction.values, ref.basin_fraction.values)
+    assert len(values.read_text().splitlines()) == 5
+    with pytest.raises(ValueError, match="samples"):
+        afmdyn.global_continuation(**IMPACT, **{**SWEEP, "samples": 8}, store=tmp_path,
+                                   resume=True)
+
+
 def test_bad_global_continuations_are_refused():
     with pytest.raises(ValueError, match="unknown"):
         afmdyn.global_continuation(param="beta", **IMPACT)

@@ -412,6 +412,8 @@ def global_continuation(
     request: Optional[GlobalContinuationRequest] = None,
     progress: Optional[ProgressCallback] = None,
     probe: Optional[str] = None,
+    store: Optional[str] = None,
+    resume: bool = False,
 ) -> Dict[str, Any]: ...
 
 def orbit(

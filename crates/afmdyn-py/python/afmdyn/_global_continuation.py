@@ -4,7 +4,8 @@
 from __future__ import annotations
 
 import json
-from typing import TYPE_CHECKING, List, Optional
+import os
+from typing import TYPE_CHECKING, List, Optional, Union
 
 import xarray as xr
 
@@ -38,6 +39,8 @@ def global_continuation(
     integrator: Optional[str] = None,
     steps_per_period: Optional[int] = None,
     tolerance: float = _DEFAULTS["global_continuation"]["tolerance"],
+    store: Union[str, "os.PathLike[str]", None] = None,
+    resume: bool = False,
     progress: ProgressArg = None,
     **model: Unpack[Model],
 ) -> xr.Dataset:
@@ -47,7 +50,10 @@ def global_continuation(
     each attractor of the previous value; the attractors are matched to the previous value's
     by the distance between their Poincaré point sets (``match_tol``, relative), so an id is
     one attractor followed over the parameter. The basin fractions count the random starts
-    only (an attractor found only from the previous value has fraction 0).
+    only (an attractor found only from the previous value has fraction 0). ``store`` keeps the
+    command line's resumable store of values there (``afmdyn attractors --sweep --out DIR``),
+    ``resume=True`` continues an interrupted continuation of the same request from its last
+    stored value (refused, naming the option, for another request's store).
 
     Returns:
         ``xarray.Dataset`` with dims ``(value, id)``: ``basin_fraction`` (0 where the id has no
@@ -58,7 +64,16 @@ def global_continuation(
     """
     req = _request(locals())
     p, probe = _params(params, model)
-    d = _run(_core.global_continuation, "starts", progress, p, si=probe, request=req)
+    d = _run(
+        _core.global_continuation,
+        "starts",
+        progress,
+        p,
+        si=probe,
+        request=req,
+        store=None if store is None else os.fspath(store),
+        resume=resume,
+    )
     doc = json.loads(d["json"])
     # the library's layout (the command line's attractors-sweep.nc)
     return _layout.dataset(

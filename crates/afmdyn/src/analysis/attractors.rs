@@ -19,6 +19,7 @@ use crate::params::Params;
 use nalgebra::DVector;
 #[cfg(feature = "parallel")]
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// An attractor search.
 #[derive(Debug, Clone, PartialEq)]
@@ -70,7 +71,7 @@ impl AttractorSpec {
 }
 
 /// One attractor with its basin estimate.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Attractor {
     /// The steady state found from the first member start.
     pub steady: SteadyState,
@@ -157,30 +158,35 @@ pub fn find_attractors_with(
     let starts: Vec<DVector<f64>> = (0..spec.samples)
         .map(|i| random_state(&model, spec.seed, i as u64))
         .collect();
-    census(&model, spec, starts, &[], progress)
+    progress.add_total(starts.len());
+    census(&model, spec, starts, &[], progress.cancel_flag(), &|| {
+        progress.tick()
+    })
 }
 
 /// The attractors reached from the random `starts` and from `seeds` (states not counted in the
 /// basin fractions: the previous value's attractors of a global continuation), every run in
 /// parallel, clustered with [`same_attractor`] in the order starts then seeds, the periodic
-/// ones polished by shooting. Counts every run in `progress` (its total grows by their number).
+/// ones polished by shooting. Calls `tick` as each run ends; starts no run once `cancel` is set.
 ///
 /// # Errors
-/// [`SimError::Cancelled`] once `progress` is cancelled (failing runs are reported in
+/// [`SimError::Cancelled`] once `cancel` is set (failing runs are reported in
 /// [`AttractorReport::failures`]: the failures of seeds among them).
 pub(crate) fn census(
     model: &CantileverModel,
     spec: &AttractorSpec,
     starts: Vec<DVector<f64>>,
     seeds: &[DVector<f64>],
-    progress: &Progress,
+    cancel: &AtomicBool,
+    tick: &(dyn Fn() + Sync),
 ) -> Result<AttractorReport, SimError> {
     let random = starts.len();
     let mut all = starts;
     all.extend(seeds.iter().cloned());
-    progress.add_total(all.len());
-    let results = steady_states_of_starts(model, spec, all, progress);
-    progress.check()?;
+    let results = steady_states_of_starts(model, spec, all, cancel, tick);
+    if cancel.load(Ordering::Relaxed) {
+        return Err(SimError::Cancelled);
+    }
     let mut attractors: Vec<Attractor> = Vec::new();
     let mut failures = Vec::new();
     for (k, (z0, r)) in results.into_iter().enumerate() {
@@ -303,17 +309,20 @@ fn steady_states_of_starts(
     model: &CantileverModel,
     spec: &AttractorSpec,
     starts: Vec<DVector<f64>>,
-    progress: &Progress,
+    cancel: &AtomicBool,
+    tick: &(dyn Fn() + Sync),
 ) -> Vec<StartResult> {
     starts
         .into_par_iter()
         .with_max_len(1)
         .map(|z0| {
-            let r = progress.check().and_then(|()| {
+            let r = if cancel.load(Ordering::Relaxed) {
+                Err(SimError::Cancelled)
+            } else {
                 build(model, spec.integrator.clone(), 0.0, &z0)
                     .and_then(|mut it| steady_state(it.as_mut(), &spec.steady))
-            });
-            progress.tick();
+            };
+            tick();
             (z0, r)
         })
         .collect()

@@ -31,6 +31,7 @@ use crate::error::SimError;
 use crate::model::CantileverModel;
 use crate::params::SweepParam;
 use nalgebra::DVector;
+use std::sync::atomic::AtomicBool;
 
 /// Largest number of parameter values of a global continuation.
 pub const MAX_CONTINUATION_VALUES: usize = 10_000;
@@ -100,8 +101,9 @@ impl GlobalContinuationSpec {
     }
 }
 
-/// One value of a global continuation.
-#[derive(Debug, Clone, PartialEq)]
+/// One value of a global continuation (serialized for its study's store: the next value
+/// starts from it).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ContinuationStep {
     /// The parameter's value.
     pub value: f64,
@@ -169,8 +171,8 @@ fn match_ids(
 }
 
 /// The global continuation of `spec`: one census per value, in order (its runs in parallel),
-/// seeded from the previous value's attractors and matched to them. Counts every run in
-/// `progress`.
+/// seeded from the previous value's attractors and matched to them. Counts the random starts
+/// of each value in `progress` as the value is done.
 ///
 /// # Errors
 /// As [`GlobalContinuationSpec::validate`]; [`SimError::Cancelled`] once `progress` is
@@ -180,9 +182,35 @@ pub fn global_continuation(
     progress: &Progress,
 ) -> Result<Vec<ContinuationStep>, SimError> {
     spec.validate()?;
-    let mut steps: Vec<ContinuationStep> = Vec::with_capacity(spec.values.len());
-    let mut next_id = 0;
-    for &value in &spec.values {
+    progress.add_total(spec.values.len() * spec.census.samples);
+    let count = |_: &ContinuationStep| progress.advance(spec.census.samples);
+    continue_values(spec, &[], progress.cancel_flag(), &count)
+}
+
+/// The global continuation of `spec` going on after the steps `stored` (the first values', as
+/// a run that was cut short handed them to `sink`; none for a new run): each further value's
+/// census (its runs in parallel) is seeded from the last step's
+/// attractors, its ids matched to them and continued after the largest id so far — so that
+/// the steps are those of an uninterrupted run — and handed to `sink` as it is done. Starts no
+/// run once `cancel` is set. Returns every step, `stored` first.
+///
+/// # Errors
+/// [`SimError::Cancelled`] once `cancel` is set; [`SimError::Params`] for a value's invalid
+/// parameters.
+pub fn continue_values(
+    spec: &GlobalContinuationSpec,
+    stored: &[ContinuationStep],
+    cancel: &AtomicBool,
+    sink: &dyn Fn(&ContinuationStep),
+) -> Result<Vec<ContinuationStep>, SimError> {
+    let mut steps: Vec<ContinuationStep> = stored.to_vec();
+    // ids are never reused: the next one follows the largest given so far
+    let mut next_id = steps
+        .iter()
+        .flat_map(|s| s.attractors.iter().map(|(id, _)| id + 1))
+        .max()
+        .unwrap_or(0);
+    for &value in spec.values.iter().skip(stored.len()) {
         let params = spec.census.params.with(spec.param, value);
         let model = CantileverModel::new(&params)?;
         let starts: Vec<DVector<f64>> = (0..spec.census.samples)
@@ -197,15 +225,17 @@ pub fn global_continuation(
             params,
             ..spec.census.clone()
         };
-        let found = census(&model, &census_spec, starts, &seeds, progress)?;
+        let found = census(&model, &census_spec, starts, &seeds, cancel, &|| {})?;
         let ids = match_ids(previous, &found.attractors, spec.match_tol, &mut next_id);
         let warnings = found.warnings();
-        steps.push(ContinuationStep {
+        let step = ContinuationStep {
             value,
             attractors: ids.into_iter().zip(found.attractors).collect(),
             failures: found.failures,
             warnings,
-        });
+        };
+        sink(&step);
+        steps.push(step);
     }
     Ok(steps)
 }

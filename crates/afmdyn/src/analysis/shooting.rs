@@ -10,7 +10,7 @@ use crate::maps::flow::FlowMap;
 use crate::maps::StroboscopicMap;
 use crate::model::CantileverModel;
 use nalgebra::{Complex, DMatrix, DVector};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// Newton options.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -35,7 +35,7 @@ impl Default for ShootingOptions {
 pub const GRAZING_TOL: f64 = 1e-3;
 
 /// How an orbit is (or would become) unstable, from the multiplier of largest modulus.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Instability {
     /// A real multiplier through +1 (fold / saddle-node).
@@ -75,7 +75,7 @@ pub fn critical_multiplier(mu: &[Complex<f64>]) -> (Complex<f64>, Instability) {
 }
 
 /// A period-n orbit of the stroboscopic map.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PeriodicOrbit {
     /// n.
     pub period: usize,

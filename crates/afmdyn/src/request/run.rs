@@ -3,7 +3,10 @@
 //! Python's `to_dict()` returns (with the `"si"` block when the model came from a probe file).
 //!
 //! Every analysis whose result is one value implements [`Analysis`]: `modes`, `orbit`,
-//! `continuation`, `lyapunov`, `attractors`, `observe`, `converge`, `approach`, `resonance`.
+//! `continuation`, `lyapunov`, `attractors`, `observe`, `converge`, `approach`, `resonance`,
+//! and the two studies that run in memory here and resumably in a front end's store — `basins`
+//! and `attractors --sweep` (their `Analysis` is in `crate::study::basins` and
+//! `crate::study::global_continuation`, beside the study).
 //! The two whose results are streams run through their own entry points, which take the same
 //! [`Progress`]: `simulate` records in chunks to a sink
 //! ([`crate::trajectory::chunked::record_chunked`], budgets by
@@ -17,14 +20,13 @@
 //! `observe` are one short computation each and neither count nor check it.
 
 use super::analyses::{
-    AttractorsRequest, ContinuationRequest, ConvergeRequest, GlobalContinuationRequest,
-    LyapunovRequest, ObserveRequest, ObserveResult, OrbitRequest,
+    AttractorsRequest, ContinuationRequest, ConvergeRequest, LyapunovRequest, ObserveRequest,
+    ObserveResult, OrbitRequest,
 };
 use super::curves::{approach_request, free_resonance_base, resonance_request, CurveRequest};
 use crate::analysis::attractors::AttractorReport;
 use crate::analysis::continuation::Branch;
 use crate::analysis::converge::ConvergenceRun;
-use crate::analysis::global_continuation::{global_continuation, ContinuationStep};
 use crate::analysis::lyapunov::LyapunovSpectrum;
 use crate::analysis::progress::Progress;
 use crate::analysis::shooting::PeriodicOrbit;
@@ -207,24 +209,6 @@ impl Analysis for AttractorsRequest {
     }
     fn report(&self, model: &Resolved, r: &Self::Output) -> Result<Value, SimError> {
         Ok(report::attractors(&model.params, self.samples, r))
-    }
-}
-
-impl Analysis for GlobalContinuationRequest {
-    type Output = Vec<ContinuationStep>;
-    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
-        self.spec(&model.params).map(|_| ())
-    }
-    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
-        global_continuation(&self.spec(&model.params)?, progress)
-    }
-    fn report(&self, model: &Resolved, steps: &Self::Output) -> Result<Value, SimError> {
-        Ok(report::global_continuation(
-            &model.params,
-            self.param,
-            self.samples,
-            steps,
-        ))
     }
 }
 

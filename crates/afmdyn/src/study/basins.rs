@@ -140,7 +140,7 @@ impl Analysis for BasinsRequest {
 /// [`crate::study::task_store`] describes.
 #[cfg(feature = "files")]
 pub mod store {
-    use super::super::task_store::{TaskFiles, TaskStore};
+    use super::super::task_store::{Encoding, TaskFiles, TaskStore};
     use crate::analysis::basins::BasinRow;
     use crate::request::dir_lock::DirLock;
 
@@ -150,6 +150,7 @@ pub mod store {
         records: ".basins.rows.jsonl",
         key: "row",
         prefix: "basins.",
+        encoding: Encoding::Cbor,
     };
 
     /// A basin map's store: its rows by task.

@@ -3,7 +3,7 @@
 //! (one checksummed line per finished tile, its cells under `"cells"`), as
 //! [`super::task_store`] describes.
 
-use super::task_store::{TaskFiles, TaskStore};
+use super::task_store::{Encoding, TaskFiles, TaskStore};
 use crate::analysis::chart::ChartCell;
 use crate::request::checkpoint::CheckpointError;
 use crate::request::dir_lock::DirLock;
@@ -14,6 +14,7 @@ pub const CHART_FILES: TaskFiles = TaskFiles {
     records: ".chart.tiles.jsonl",
     key: "cells",
     prefix: "chart.",
+    encoding: Encoding::Json,
 };
 
 /// A chart's store: its tiles' cells by task.

@@ -16,8 +16,10 @@
 //!   [`crate::request::limits::check_threads`]), runs the study, appends each finished task
 //!   under one lock, reports progress to an [`Observer`], and finishes the store.
 //! - the studies: [`chart`] (a behaviour chart's tiles, its store [`chart_store`]), [`sweep`]
-//!   (a bifurcation sweep's points, stored by the request layer's checkpoints) and [`basins`]
-//!   (a basin map's rows, pass by pass, its store `basins::basin_store`).
+//!   (a bifurcation sweep's points, stored by the request layer's checkpoints), [`basins`]
+//!   (a basin map's rows, pass by pass, its store `basins::basin_store`) and
+//!   [`global_continuation`] (a global continuation's values, one chain, its store
+//!   `global_continuation::continuation_store`).
 //!
 //! The results' variables are declared once in [`crate::layout`], from which the NetCDF file,
 //! the Python `xarray.Dataset` and the Dask Zarr store are written.
@@ -31,6 +33,7 @@ pub mod basins;
 pub mod chart;
 #[cfg(feature = "files")]
 pub mod chart_store;
+pub mod global_continuation;
 mod memory;
 pub mod sweep;
 #[cfg(feature = "files")]

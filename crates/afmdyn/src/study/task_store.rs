@@ -5,8 +5,10 @@
 //! - the ledger (`.chart.run.json`): `{"args": fingerprint, "finished": bool, "format": 2}`;
 //! - the records (`.chart.tiles.jsonl`), one line per finished task, appended and flushed as
 //!   each finishes: `{"cells": record, "task": t, "crc32": "89abcdef"}` (the record under the
-//!   study's key; a killed run leaves at most a cut last line, dropped on resume). `crc32` is
-//!   the CRC-32 (zlib's) of the line's text before `,"crc32":`, 8 lowercase hex digits.
+//!   study's key, as JSON or, for records whose floats may be NaN or ±∞, which JSON cannot
+//!   hold, as a string of its CBOR encoding in base64 — [`Encoding`]; a killed run leaves at
+//!   most a cut last line, dropped on resume). `crc32` is the CRC-32 (zlib's) of the line's
+//!   text before `,"crc32":`, 8 lowercase hex digits.
 //!
 //! Reading the records (a resume, the files written from the store) refuses, naming the file
 //! and the line, a complete line whose checksum does not match or that cannot be read — a
@@ -22,6 +24,8 @@ use crate::request::checkpoint::{CheckpointError, Ledger};
 use crate::request::checkpoint_file::{crc_hex, write_atomic, START_OVER};
 use crate::request::dir_lock::DirLock;
 use crate::request::sweep::first_difference;
+use base64::engine::general_purpose::STANDARD as BASE64;
+use base64::Engine;
 use serde::de::DeserializeOwned;
 use serde::Serialize;
 use serde_json::{json, Value};
@@ -50,6 +54,19 @@ pub struct TaskFiles {
     /// The prefix of the fingerprint's fields that a mismatch's message leaves out
     /// (`"chart."`), if any.
     pub prefix: &'static str,
+    /// How a line holds its record.
+    pub encoding: Encoding,
+}
+
+/// How a store's line holds its record.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Encoding {
+    /// JSON (readable; for records whose floats are all finite: JSON has no NaN or ±∞).
+    Json,
+    /// A string: the record's CBOR encoding (RFC 8949, by `ciborium`) in standard base64 —
+    /// every f64 bit for bit, NaN and ±∞ included (a periodic orbit's grazing distance is +∞
+    /// when it never comes near the sample).
+    Cbor,
 }
 
 fn io<'p>(
@@ -241,11 +258,33 @@ impl<'a, R: Serialize + DeserializeOwned> TaskStore<'a, R> {
     }
 
     /// A line's task and record.
-    fn parse(&self, text: &str) -> Result<(usize, R), serde_json::Error> {
-        let mut v: serde_json::Map<String, Value> = serde_json::from_str(text)?;
-        let task = serde_json::from_value(v.remove("task").unwrap_or(Value::Null))?;
-        let record = serde_json::from_value(v.remove(self.files.key).unwrap_or(Value::Null))?;
+    fn parse(&self, text: &str) -> Result<(usize, R), String> {
+        let mut v: serde_json::Map<String, Value> =
+            serde_json::from_str(text).map_err(|e| e.to_string())?;
+        let task = serde_json::from_value(v.remove("task").unwrap_or(Value::Null))
+            .map_err(|e| e.to_string())?;
+        let record = v.remove(self.files.key).unwrap_or(Value::Null);
+        let record = match self.files.encoding {
+            Encoding::Json => serde_json::from_value(record).map_err(|e| e.to_string())?,
+            Encoding::Cbor => {
+                let text = record.as_str().ok_or("the record is not a string")?;
+                let bytes = BASE64.decode(text).map_err(|e| e.to_string())?;
+                ciborium::from_reader(bytes.as_slice()).map_err(|e| e.to_string())?
+            }
+        };
         Ok((task, record))
+    }
+
+    /// The record as a line holds it ([`Encoding`]).
+    fn encode(&self, record: &R) -> Result<Value, String> {
+        match self.files.encoding {
+            Encoding::Json => serde_json::to_value(record).map_err(|e| e.to_string()),
+            Encoding::Cbor => {
+                let mut bytes = Vec::new();
+                ciborium::into_writer(record, &mut bytes).map_err(|e| e.to_string())?;
+                Ok(Value::String(BASE64.encode(bytes)))
+            }
+        }
     }
 
     fn reopen_writer(&mut self) -> Result<(), CheckpointError> {
@@ -269,10 +308,10 @@ impl<'a, R: Serialize + DeserializeOwned> TaskStore<'a, R> {
         line.insert("task".into(), json!(task));
         line.insert(
             self.files.key.into(),
-            serde_json::to_value(record).map_err(|e| CheckpointError::Io {
+            self.encode(record).map_err(|message| CheckpointError::Io {
                 action: "write",
                 path: path.display().to_string(),
-                message: e.to_string(),
+                message,
             })?,
         );
         let line = Value::Object(line).to_string();
@@ -382,6 +421,7 @@ mod tests {
         records: ".t.jsonl",
         key: "lines",
         prefix: "t.",
+        encoding: Encoding::Json,
     };
 
     /// Records read back as stored, in task order; a resume keeps them and names the tasks
@@ -431,6 +471,39 @@ mod tests {
             matches!(&err, CheckpointError::Corrupt { message, .. } if message.starts_with("line 1: checksum")),
             "{err}"
         );
+        drop(lock);
+        fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// A CBOR store keeps every float bit for bit, NaN and ±∞ included (which JSON cannot),
+    /// and a resume reads the records back.
+    #[test]
+    fn cbor_records_keep_non_finite_floats_bit_for_bit() {
+        let dir = std::env::temp_dir().join(format!("afmdyn-task-cbor-{}", std::process::id()));
+        let _ = fs::remove_dir_all(&dir);
+        let lock = DirLock::acquire(&dir).unwrap();
+        let files = TaskFiles {
+            encoding: Encoding::Cbor,
+            ..FILES
+        };
+        let fp = json!({"t": 1});
+        let record = vec![
+            f64::NAN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            -0.0,
+            0.1 + 0.2,
+            5e-324,
+        ];
+        let mut s: TaskStore<'_, Vec<f64>> = TaskStore::new(&lock, files);
+        s.open(&fp, false).unwrap();
+        s.append(0, &record).unwrap();
+        let mut r: TaskStore<'_, Vec<f64>> = TaskStore::new(&lock, files);
+        r.open(&fp, true).unwrap();
+        let back = r.records().unwrap();
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(back.len(), 1);
+        assert_eq!(bits(&back[0].1), bits(&record));
         drop(lock);
         fs::remove_dir_all(&dir).unwrap();
     }

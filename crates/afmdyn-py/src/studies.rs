@@ -1,0 +1,190 @@
+//! The studies that Python runs resumably in the command line's store (`store=`, `resume=`):
+//! a basin map ([`BasinStudy`]) and a global continuation ([`ContinuationStudy`]); in memory
+//! (no `store`) they run through the request layer as every analysis does.
+
+use crate::analyses::{analysis, checkpoint_error, lock_store, study_error};
+use crate::convert::Out;
+use crate::errors::{probe_error, sim_error, value_error};
+use crate::params::PyParams;
+use crate::run::{run, Job, Stop};
+use afmdyn::probe::Probe;
+use afmdyn::request::{Analysis, BasinArrays, BasinsRequest, GlobalContinuationRequest, Resolved};
+use afmdyn::study::basins::{basin_store, BasinStudy};
+use afmdyn::study::global_continuation::{continuation_store, ContinuationStudy};
+use afmdyn::study::task_store::{StoredTasks, TaskStore};
+use afmdyn::study::{execute, Study};
+use afmdyn::Params;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use serde::de::DeserializeOwned;
+use serde::Serialize;
+use std::path::PathBuf;
+
+/// Where a study runs: in memory, or in the store of a directory.
+struct Place<'py> {
+    params: Params,
+    store: Option<PathBuf>,
+    resume: bool,
+    progress: Option<Bound<'py, PyAny>>,
+    probe: Option<String>,
+}
+
+impl<'py> Place<'py> {
+    fn new(
+        params: Params,
+        store: Option<PathBuf>,
+        resume: bool,
+        progress: Option<Bound<'py, PyAny>>,
+        probe: Option<String>,
+    ) -> PyResult<Self> {
+        if resume && store.is_none() {
+            return Err(value_error(
+                "resume=True needs store= (the directory of the interrupted run)",
+            ));
+        }
+        Ok(Place {
+            params,
+            store,
+            resume,
+            progress,
+            probe,
+        })
+    }
+
+    /// The output of `request` on the place's parameters and its document: through the request layer in
+    /// memory, or `study` run into the store `open` makes of the directory's lock (resumed
+    /// with `resume`) and its output `finish`ed from the stored records (on `threads`).
+    fn output<A, S, R>(
+        self,
+        py: Python<'py>,
+        request: A,
+        study: S,
+        threads: Option<usize>,
+        open: fn(&afmdyn::request::DirLock) -> TaskStore<'_, R>,
+        finish: impl FnOnce(&S, Vec<(usize, R)>) -> Result<A::Output, afmdyn::SimError> + Send + 'static,
+    ) -> PyResult<(A::Output, serde_json::Value)>
+    where
+        A: Analysis + Send + 'static,
+        A::Output: Send + 'static,
+        S: Study<Record = (usize, R)> + Send + 'static,
+        S::Done: StoredTasks<R>,
+        R: Serialize + DeserializeOwned + Send + 'static,
+    {
+        let Some(dir) = self.store else {
+            let doc = analysis(
+                py,
+                request,
+                self.params,
+                self.probe,
+                self.progress.as_ref(),
+                true,
+            )?;
+            return Ok((doc.output, doc.json));
+        };
+        let probe = self
+            .probe
+            .map(|text| Probe::parse(&text, "probe"))
+            .transpose()
+            .map_err(probe_error)?;
+        let lock = lock_store(&dir)?;
+        let resume = self.resume;
+        let job = Job::default();
+        let worker = job.clone();
+        let output = run(
+            py,
+            &job,
+            None,
+            self.progress.as_ref(),
+            Stop::Cancellable,
+            move || -> PyResult<A::Output> {
+                let mut s = open(&lock);
+                execute(&study, &mut s, resume, threads, &*worker.progress).map_err(study_error)?;
+                let records = s.records().map_err(checkpoint_error)?;
+                afmdyn::request::in_pool(threads, || finish(&study, records)).map_err(sim_error)
+            },
+        )??;
+        let model = Resolved {
+            params: self.params,
+            probe,
+        };
+        let json = afmdyn::request::run::document(&request, &model, &output).map_err(sim_error)?;
+        Ok((output, json))
+    }
+}
+
+/// A basin map over two coordinates of the initial state (see `afmdyn.basins`); with `store`
+/// (a directory) its rows are kept there as `afmdyn basins --out DIR` keeps them, and
+/// `resume` continues an interrupted map of the same request.
+#[pyfunction]
+#[pyo3(signature = (params, request=None, progress=None, probe=None, store=None, resume=false))]
+pub fn basins<'py>(
+    py: Python<'py>,
+    params: PyRef<'_, PyParams>,
+    request: Option<&Bound<'py, PyDict>>,
+    progress: Option<Bound<'py, PyAny>>,
+    probe: Option<String>,
+    store: Option<PathBuf>,
+    resume: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let request: BasinsRequest = crate::convert::request("basins", request)?;
+    let place = Place::new(params.inner, store, resume, progress, probe)?;
+    let study = BasinStudy::new(&request, &params.inner).map_err(sim_error)?;
+    let spec = study.spec.clone();
+    let threads = request.threads;
+    let (map, json) = place.output(
+        py,
+        request,
+        study,
+        threads,
+        basin_store,
+        |s: &BasinStudy, records| s.map(records.into_iter().map(|(_, r)| r)),
+    )?;
+    let out = Out::new(py);
+    out.json(&json)?;
+    out.set(
+        "layout",
+        crate::convert::layout_dict(py, BasinArrays::new(&map).layout(&spec))?,
+    )?;
+    Ok(out.finish())
+}
+
+/// Attractors continued over a parameter (global continuation): the JSON document of
+/// `afmdyn attractors --sweep --json` and its layout (the Python layer builds the dataset from
+/// it); with `store` (a directory) its values are kept there as `afmdyn attractors --sweep
+/// --out DIR` keeps them, and `resume` continues an interrupted continuation of the same
+/// request.
+#[pyfunction]
+#[pyo3(signature = (params, request=None, progress=None, probe=None, store=None, resume=false))]
+pub fn global_continuation<'py>(
+    py: Python<'py>,
+    params: PyRef<'_, PyParams>,
+    request: Option<&Bound<'py, PyDict>>,
+    progress: Option<Bound<'py, PyAny>>,
+    probe: Option<String>,
+    store: Option<PathBuf>,
+    resume: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let request: GlobalContinuationRequest =
+        crate::convert::request("global_continuation", request)?;
+    let place = Place::new(params.inner, store, resume, progress, probe)?;
+    let param = request.param;
+    let study = ContinuationStudy::new(&request, &params.inner).map_err(sim_error)?;
+    let (steps, json) = place.output(
+        py,
+        request,
+        study,
+        None,
+        continuation_store,
+        |s: &ContinuationStudy, records| s.steps(records),
+    )?;
+    let out = Out::new(py);
+    out.json(&json)?;
+    out.set(
+        "layout",
+        crate::convert::layout_dict(
+            py,
+            afmdyn::report::global_continuation_layout(param, &steps),
+        )?,
+    )?;
+    Ok(out.finish())
+}

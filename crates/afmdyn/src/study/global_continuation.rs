@@ -1,0 +1,169 @@
+//! A global continuation ([`crate::analysis::global_continuation`]) as a [`Study`]
+//! ([`ContinuationStudy`]): a task is one value of the parameter, numbered by its place in the
+//! values; its record the value's step (its attractors with their ids); the tasks form one
+//! chain — each value's census is seeded from the previous value's attractors and its ids
+//! matched to them — so what a resume skips is the stored steps themselves, and the chain goes
+//! on after the last ([`continue_values`]), to the steps of an uninterrupted run. Stored by
+//! [`MemoryStore`](super::MemoryStore) for a run that writes no files, by the directory store
+//! [`continuation_store`] (feature `files`) for `afmdyn attractors --sweep --out DIR`,
+//! resumable.
+//!
+//! The request's [`Analysis`] (`request::run`, Python's `afmdyn.global_continuation`) runs
+//! this study in memory.
+
+use super::{execute_in_memory, Study};
+use crate::analysis::global_continuation::{
+    continue_values, ContinuationStep, GlobalContinuationSpec,
+};
+use crate::analysis::progress::Progress;
+use crate::error::SimError;
+use crate::params::Params;
+use crate::report;
+use crate::request::run::{Analysis, Resolved};
+use crate::request::GlobalContinuationRequest;
+use serde_json::{json, Value};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+
+/// A global continuation as a [`Study`] (see the module doc): its validated spec and its
+/// fingerprint.
+#[derive(Debug, Clone)]
+pub struct ContinuationStudy {
+    /// The validated continuation.
+    pub spec: GlobalContinuationSpec,
+    /// What a resumed continuation must match ([`fingerprint`]).
+    pub fingerprint: Value,
+}
+
+/// The fingerprint of a global continuation: everything that determines its steps (the
+/// library's version, the model values, every option of the request).
+pub fn fingerprint(request: &GlobalContinuationRequest, params: &Params) -> Value {
+    json!({
+        "afmdyn": env!("CARGO_PKG_VERSION"),
+        "global_continuation": request,
+        "params": params,
+    })
+}
+
+impl ContinuationStudy {
+    /// The study of `request` over `params`.
+    ///
+    /// # Errors
+    /// As [`GlobalContinuationRequest::spec`].
+    pub fn new(
+        request: &GlobalContinuationRequest,
+        params: &Params,
+    ) -> Result<ContinuationStudy, SimError> {
+        Ok(ContinuationStudy {
+            spec: request.spec(params)?,
+            fingerprint: fingerprint(request, params),
+        })
+    }
+
+    /// The steps of a finished study's records (in any order), in the order of the values.
+    ///
+    /// # Errors
+    /// [`SimError::Cancelled`] when a value is missing (a run that was cut short).
+    pub fn steps(
+        &self,
+        records: impl IntoIterator<Item = (usize, ContinuationStep)>,
+    ) -> Result<Vec<ContinuationStep>, SimError> {
+        let mut records: Vec<(usize, ContinuationStep)> = records.into_iter().collect();
+        records.sort_by_key(|(t, _)| *t);
+        if records.len() != self.spec.values.len()
+            || records.iter().enumerate().any(|(i, (t, _))| *t != i)
+        {
+            return Err(SimError::Cancelled);
+        }
+        Ok(records.into_iter().map(|(_, s)| s).collect())
+    }
+}
+
+impl Study for ContinuationStudy {
+    /// The value's place and its step.
+    type Record = (usize, ContinuationStep);
+    /// The stored steps, in the order of the values.
+    type Done = Vec<ContinuationStep>;
+
+    fn fingerprint(&self) -> &Value {
+        &self.fingerprint
+    }
+
+    /// The random starts of every value.
+    fn units(&self) -> u64 {
+        (self.spec.values.len() * self.spec.census.samples) as u64
+    }
+
+    fn done_units(&self, done: &Vec<ContinuationStep>) -> u64 {
+        (done.len() * self.spec.census.samples) as u64
+    }
+
+    fn record_units(&self, _: &(usize, ContinuationStep)) -> u64 {
+        self.spec.census.samples as u64
+    }
+
+    fn run(
+        &self,
+        done: &Vec<ContinuationStep>,
+        sink: &(dyn Fn((usize, ContinuationStep)) + Sync),
+        cancel: &AtomicBool,
+    ) {
+        // the chain of values: a store holds its first values (a stored step after a missing
+        // one cannot be: each is stored once the one before it is)
+        let first = done.len();
+        let index = AtomicUsize::new(first);
+        let store = |s: &ContinuationStep| sink((index.fetch_add(1, Ordering::SeqCst), s.clone()));
+        // a cancelled run ends here: the steps stored so far are the store's
+        let _ = continue_values(&self.spec, done, cancel, &store);
+    }
+}
+
+impl Analysis for GlobalContinuationRequest {
+    type Output = Vec<ContinuationStep>;
+    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
+        self.spec(&model.params).map(|_| ())
+    }
+    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
+        let study = ContinuationStudy::new(self, &model.params)?;
+        study.steps(execute_in_memory(&study, None, progress)?)
+    }
+    fn report(&self, model: &Resolved, steps: &Self::Output) -> Result<Value, SimError> {
+        Ok(report::global_continuation(
+            &model.params,
+            self.param,
+            self.samples,
+            steps,
+        ))
+    }
+}
+
+/// The resumable store of a global continuation (feature `files`): a
+/// [`TaskStore`](crate::study::task_store::TaskStore) of steps in the directory
+/// `afmdyn attractors --sweep --out DIR` names — `.continuation.run.json` (the ledger) and
+/// `.continuation.values.jsonl` (one checksummed line per value, its step in CBOR under
+/// `"step"`), as [`crate::study::task_store`] describes.
+#[cfg(feature = "files")]
+pub mod store {
+    use super::super::task_store::{Encoding, TaskFiles, TaskStore};
+    use crate::analysis::global_continuation::ContinuationStep;
+    use crate::request::dir_lock::DirLock;
+
+    /// The global continuation's files.
+    pub const CONTINUATION_FILES: TaskFiles = TaskFiles {
+        ledger: ".continuation.run.json",
+        records: ".continuation.values.jsonl",
+        key: "step",
+        prefix: "global_continuation.",
+        encoding: Encoding::Cbor,
+    };
+
+    /// A global continuation's store: its steps by value.
+    pub type ContinuationStore<'a> = TaskStore<'a, ContinuationStep>;
+
+    /// The continuation store of the directory `lock` holds.
+    pub fn continuation_store(lock: &DirLock) -> ContinuationStore<'_> {
+        TaskStore::new(lock, CONTINUATION_FILES)
+    }
+}
+
+#[cfg(feature = "files")]
+pub use store::{continuation_store, ContinuationStore, CONTINUATION_FILES};
