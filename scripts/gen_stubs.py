@@ -39,8 +39,16 @@ FUNCTIONS = [
     ("continuation", "continuation", ["probe: Optional[str] = None"]),
     ("lyapunov", "lyapunov", ["probe: Optional[str] = None"]),
     ("observe", "observe", ["probe: Optional[str] = None"]),
-    ("approach", "approach", ["probe: Optional[str] = None"]),
-    ("resonance", "resonance", ["probe: Optional[str] = None"]),
+    (
+        "approach",
+        "approach",
+        ["probe: Optional[str] = None", "store: Optional[str] = None", "resume: bool = False"],
+    ),
+    (
+        "resonance",
+        "resonance",
+        ["probe: Optional[str] = None", "store: Optional[str] = None", "resume: bool = False"],
+    ),
     (
         "basins",
         "basins",

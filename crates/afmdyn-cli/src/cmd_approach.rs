@@ -15,9 +15,8 @@ use afmdyn::analysis::stepped::{SteppedCurve, Sweep};
 use afmdyn::layout::{Layout, Variable};
 use afmdyn::probe::Probe;
 use afmdyn::report::{curve_column_index, curve_row, CurveUnits, UnitKind, CURVE_COLUMNS};
-use afmdyn::request::{
-    Analysis, ApproachRequest, CurveRequest, Document, Resolved, ResonanceRequest,
-};
+use afmdyn::request::{Analysis, ApproachRequest, CurveRequest, Resolved, ResonanceRequest};
+use afmdyn::study::stepped::{curve_store, CurveStudy};
 use afmdyn::Params;
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -53,6 +52,13 @@ pub struct CurveArgs {
     /// Print one JSON document
     #[arg(long)]
     json: bool,
+    /// Continue an interrupted curve from its last stored point; refused unless the other
+    /// arguments are those of the interrupted run (recorded in OUT/.curve.run.json)
+    #[arg(long)]
+    resume: bool,
+    /// Testing: abort the process, as if killed, after this many points are stored
+    #[arg(long, hide = true)]
+    abort_after: Option<usize>,
 }
 
 impl CurveArgs {
@@ -648,12 +654,46 @@ impl Run<'_> {
         &self,
         request: &A,
         model: &Resolved,
+        study: impl FnOnce() -> Result<CurveStudy, afmdyn::SimError>,
     ) -> Result<(), CliError> {
         request.validate(model)?;
         let out = (self.args.files != Files::None)
             .then(|| OutDir::lock(self.out))
             .transpose()?;
-        let Document { output: c, json } = crate::progress::run(request, model, "points")?;
+        let (c, json) = match &out {
+            // no files: nothing to resume from
+            None if self.args.resume => {
+                return Err(CliError::Input(
+                    "--resume: --files none keeps no store to resume; use --files data or all"
+                        .into(),
+                ))
+            }
+            None => {
+                let d = crate::progress::run(request, model, "points")?;
+                (d.output, d.json)
+            }
+            Some(o) => {
+                // the points in the directory's store, resumable; the branches after them
+                let study = study()?;
+                let what = self.labels.stem;
+                let mut store = curve_store(o.dir_lock());
+                crate::progress::study(
+                    &study,
+                    &mut store,
+                    self.args.resume,
+                    None,
+                    "points",
+                    self.args.abort_after,
+                )
+                .map_err(|e| crate::cmd_analysis::study_error(e, what))?;
+                let records = store
+                    .records()
+                    .map_err(|e| crate::cmd_analysis::store_error(e, what))?;
+                let c = crate::progress::with_bar("branch points", |p| study.curve(records, p))?;
+                let json = afmdyn::request::run::document(request, model, &c)?;
+                (c, json)
+            }
+        };
         if let Some(o) = &out {
             write_files(
                 o,
@@ -905,13 +945,11 @@ pub fn approach(a: &ApproachArgs) -> Result<(), CliError> {
         labels: &labels,
         x: &x,
     };
-    run.go(
-        &request,
-        &Resolved {
-            params: base,
-            probe,
-        },
-    )
+    let model = Resolved {
+        params: base,
+        probe,
+    };
+    run.go(&request, &model, || CurveStudy::approach(&request, &model))
 }
 
 /// Run `afmdyn resonance`.
@@ -954,11 +992,9 @@ pub fn resonance(a: &ResonanceArgs) -> Result<(), CliError> {
         labels: &labels,
         x: &x,
     };
-    run.go(
-        &request,
-        &Resolved {
-            params: base,
-            probe,
-        },
-    )
+    let model = Resolved {
+        params: base,
+        probe,
+    };
+    run.go(&request, &model, || CurveStudy::resonance(&request, &model))
 }

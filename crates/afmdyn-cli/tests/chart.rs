@@ -283,6 +283,54 @@ fn a_killed_global_continuation_resumes_to_the_uninterrupted_files() {
     );
 }
 
+/// An approach curve on the point-mass DMT probe (SI) on `dir`.
+fn approach_curve(dir: &Path, extra: &[&str]) -> Output {
+    let probe = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../examples/probe-point-mass-dmt.toml"
+    );
+    let out = ["--out", dir.to_str().unwrap()];
+    afmdyn(&[&["approach", "--probe", probe][..], &out, extra].concat())
+}
+
+/// An approach curve killed during the approach resumes from its last stored point (the
+/// predictor through the points before it, the monodromy trend) to the files of the
+/// uninterrupted curve; `--files none` has no store to resume.
+#[test]
+fn a_killed_approach_curve_resumes_to_the_uninterrupted_files() {
+    let full = tempfile::tempdir().unwrap();
+    let cut = tempfile::tempdir().unwrap();
+    let run = approach_curve(full.path(), &[]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let killed = approach_curve(cut.path(), &["--abort-after", "50"]);
+    assert!(!killed.status.success(), "the run was killed");
+    let points = cut.path().join(".curve.points.jsonl");
+    assert_eq!(
+        std::fs::read_to_string(&points).unwrap().lines().count(),
+        50
+    );
+    let resumed = approach_curve(cut.path(), &["--resume"]);
+    assert!(
+        resumed.status.success(),
+        "{}",
+        String::from_utf8_lossy(&resumed.stderr)
+    );
+    for f in ["approach.csv", "approach.npy"] {
+        assert!(
+            std::fs::read(full.path().join(f)).unwrap()
+                == std::fs::read(cut.path().join(f)).unwrap(),
+            "{f}: the resumed curve equals the uninterrupted one"
+        );
+    }
+    let none = approach_curve(cut.path(), &["--resume", "--files", "none"]);
+    assert_eq!(none.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&none.stderr).contains("--files none keeps no store"));
+}
+
 #[test]
 fn a_locked_directory_is_refused_at_once() {
     let dir = tempfile::tempdir().unwrap();

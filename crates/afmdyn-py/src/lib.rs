@@ -8,7 +8,6 @@
 mod analyses;
 mod chart;
 mod convert;
-mod curves;
 mod errors;
 mod params;
 mod run;
@@ -57,8 +56,8 @@ fn _afmdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(analyses::orbit, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::continuation, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::lyapunov, m)?)?;
-    m.add_function(wrap_pyfunction!(curves::approach, m)?)?;
-    m.add_function(wrap_pyfunction!(curves::resonance, m)?)?;
+    m.add_function(wrap_pyfunction!(studies::approach, m)?)?;
+    m.add_function(wrap_pyfunction!(studies::resonance, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::probe, m)?)?;
     m.add_function(wrap_pyfunction!(params::probe_source, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::observe, m)?)?;

@@ -1,5 +1,7 @@
 //! The studies that Python runs resumably in the command line's store (`store=`, `resume=`):
-//! a basin map ([`BasinStudy`]) and a global continuation ([`ContinuationStudy`]); in memory
+//! a basin map ([`BasinStudy`]), a global continuation ([`ContinuationStudy`]) and the
+//! approach and resonance curves ([`CurveStudy`]: the stepped sweeps with branch continuation
+//! of [`afmdyn::analysis::stepped`], returning the command line's JSON documents); in memory
 //! (no `store`) they run through the request layer as every analysis does.
 
 use crate::analyses::{analysis, checkpoint_error, lock_store, study_error};
@@ -7,13 +9,19 @@ use crate::convert::Out;
 use crate::errors::{probe_error, sim_error, value_error};
 use crate::params::PyParams;
 use crate::run::{run, Job, Stop};
+use afmdyn::analysis::progress::Progress;
+use afmdyn::analysis::stepped::SteppedCurve;
 use afmdyn::probe::Probe;
-use afmdyn::request::{Analysis, BasinArrays, BasinsRequest, GlobalContinuationRequest, Resolved};
+use afmdyn::request::{
+    Analysis, ApproachRequest, BasinArrays, BasinsRequest, GlobalContinuationRequest, Resolved,
+    ResonanceRequest,
+};
 use afmdyn::study::basins::{basin_store, BasinStudy};
 use afmdyn::study::global_continuation::{continuation_store, ContinuationStudy};
+use afmdyn::study::stepped::{curve_store, CurveStudy};
 use afmdyn::study::task_store::{StoredTasks, TaskStore};
 use afmdyn::study::{execute, Study};
-use afmdyn::Params;
+use afmdyn::{Params, SimError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use serde::de::DeserializeOwned;
@@ -51,17 +59,20 @@ impl<'py> Place<'py> {
         })
     }
 
-    /// The output of `request` on the place's parameters and its document: through the request layer in
-    /// memory, or `study` run into the store `open` makes of the directory's lock (resumed
-    /// with `resume`) and its output `finish`ed from the stored records (on `threads`).
+    /// The output of `request` on the place's parameters and its document: through the
+    /// request layer in memory, or the study `of` the request and the model run into the store
+    /// `open` makes of the directory's lock (resumed with `resume`) and its output `finish`ed
+    /// from the stored records (on `threads`, counting in the run's progress).
     fn output<A, S, R>(
         self,
         py: Python<'py>,
         request: A,
-        study: S,
+        of: impl FnOnce(&A, &Resolved) -> Result<S, SimError>,
         threads: Option<usize>,
         open: fn(&afmdyn::request::DirLock) -> TaskStore<'_, R>,
-        finish: impl FnOnce(&S, Vec<(usize, R)>) -> Result<A::Output, afmdyn::SimError> + Send + 'static,
+        finish: impl FnOnce(&S, Vec<(usize, R)>, &Progress) -> Result<A::Output, SimError>
+            + Send
+            + 'static,
     ) -> PyResult<(A::Output, serde_json::Value)>
     where
         A: Analysis + Send + 'static,
@@ -86,6 +97,11 @@ impl<'py> Place<'py> {
             .map(|text| Probe::parse(&text, "probe"))
             .transpose()
             .map_err(probe_error)?;
+        let model = Resolved {
+            params: self.params,
+            probe,
+        };
+        let study = of(&request, &model).map_err(sim_error)?;
         let lock = lock_store(&dir)?;
         let resume = self.resume;
         let job = Job::default();
@@ -100,13 +116,11 @@ impl<'py> Place<'py> {
                 let mut s = open(&lock);
                 execute(&study, &mut s, resume, threads, &*worker.progress).map_err(study_error)?;
                 let records = s.records().map_err(checkpoint_error)?;
-                afmdyn::request::in_pool(threads, || finish(&study, records)).map_err(sim_error)
+                let progress = &*worker.progress;
+                afmdyn::request::in_pool(threads, || finish(&study, records, progress))
+                    .map_err(sim_error)
             },
         )??;
-        let model = Resolved {
-            params: self.params,
-            probe,
-        };
         let json = afmdyn::request::run::document(&request, &model, &output).map_err(sim_error)?;
         Ok((output, json))
     }
@@ -128,16 +142,15 @@ pub fn basins<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let request: BasinsRequest = crate::convert::request("basins", request)?;
     let place = Place::new(params.inner, store, resume, progress, probe)?;
-    let study = BasinStudy::new(&request, &params.inner).map_err(sim_error)?;
-    let spec = study.spec.clone();
+    let spec = request.spec(&params.inner).map_err(sim_error)?;
     let threads = request.threads;
     let (map, json) = place.output(
         py,
         request,
-        study,
+        |r, m| BasinStudy::new(r, &m.params),
         threads,
         basin_store,
-        |s: &BasinStudy, records| s.map(records.into_iter().map(|(_, r)| r)),
+        |s: &BasinStudy, records, _| s.map(records.into_iter().map(|(_, r)| r)),
     )?;
     let out = Out::new(py);
     out.json(&json)?;
@@ -168,14 +181,13 @@ pub fn global_continuation<'py>(
         crate::convert::request("global_continuation", request)?;
     let place = Place::new(params.inner, store, resume, progress, probe)?;
     let param = request.param;
-    let study = ContinuationStudy::new(&request, &params.inner).map_err(sim_error)?;
     let (steps, json) = place.output(
         py,
         request,
-        study,
+        |r, m| ContinuationStudy::new(r, &m.params),
         None,
         continuation_store,
-        |s: &ContinuationStudy, records| s.steps(records),
+        |s: &ContinuationStudy, records, _| s.steps(records),
     )?;
     let out = Out::new(py);
     out.json(&json)?;
@@ -187,4 +199,65 @@ pub fn global_continuation<'py>(
         )?,
     )?;
     Ok(out.finish())
+}
+
+/// A stepped curve's document: the request `R` named `name` on `params`, through
+/// [`Place::output`] with the study `of` it.
+fn curve<'py, R>(
+    py: Python<'py>,
+    name: &str,
+    request: Option<&Bound<'py, PyDict>>,
+    place: Place<'py>,
+    of: fn(&R, &Resolved) -> Result<CurveStudy, SimError>,
+) -> PyResult<Bound<'py, PyDict>>
+where
+    R: Analysis<Output = SteppedCurve> + DeserializeOwned + Send + 'static,
+{
+    let request: R = crate::convert::request(name, request)?;
+    let (_, json) = place.output(
+        py,
+        request,
+        of,
+        None,
+        curve_store,
+        |s: &CurveStudy, records, progress| s.curve(records, progress),
+    )?;
+    let out = Out::new(py);
+    out.json(&json)?;
+    Ok(out.finish())
+}
+
+/// The approach–retract curve over the rest distance z_c (`afmdyn approach`); with `store` (a
+/// directory) its points are kept there as `afmdyn approach --out DIR` keeps them, and
+/// `resume` continues an interrupted curve of the same request from its last stored point.
+#[pyfunction]
+#[pyo3(signature = (params, request=None, probe=None, progress=None, store=None, resume=false))]
+pub fn approach<'py>(
+    py: Python<'py>,
+    params: PyRef<'_, PyParams>,
+    request: Option<&Bound<'py, PyDict>>,
+    probe: Option<String>,
+    progress: Option<Bound<'py, PyAny>>,
+    store: Option<PathBuf>,
+    resume: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let place = Place::new(params.inner, store, resume, progress, probe)?;
+    curve::<ApproachRequest>(py, "approach", request, place, CurveStudy::approach)
+}
+
+/// The resonance curve near mode `mode` (`afmdyn resonance`); `store` and `resume` as
+/// [`approach`]'s.
+#[pyfunction]
+#[pyo3(signature = (params, request=None, probe=None, progress=None, store=None, resume=false))]
+pub fn resonance<'py>(
+    py: Python<'py>,
+    params: PyRef<'_, PyParams>,
+    request: Option<&Bound<'py, PyDict>>,
+    probe: Option<String>,
+    progress: Option<Bound<'py, PyAny>>,
+    store: Option<PathBuf>,
+    resume: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let place = Place::new(params.inner, store, resume, progress, probe)?;
+    curve::<ResonanceRequest>(py, "resonance", request, place, CurveStudy::resonance)
 }

@@ -46,6 +46,22 @@ def test_resonance_equals_the_command_line(cli_json):
     assert ds.amplitude.attrs["units"] == "g0" and ds.sizes["branch_point"] == 0
 
 
+def test_a_curve_killed_on_the_command_line_resumes_in_python(cli, tmp_path):
+    # one store for both front ends: the command line is killed during the approach, Python
+    # resumes the chain of points from the last stored one to the uninterrupted curve
+    killed = cli("approach", "--probe", PROBE, "--abort-after", 40, "--out", tmp_path)
+    assert killed.returncode != 0
+    points = tmp_path / ".curve.points.jsonl"
+    assert len(points.read_text().splitlines()) == 40
+    p = afmdyn.Params.from_probe(PROBE)
+    ds = afmdyn.approach(p, probe=PROBE, store=tmp_path, resume=True)
+    ref = afmdyn.approach(p, probe=PROBE)
+    assert ds.afmdyn.to_dict() == ref.afmdyn.to_dict()
+    assert len(points.read_text().splitlines()) == 2 * ds.sizes["z_c"]
+    with pytest.raises(ValueError, match="tolerance"):
+        afmdyn.approach(p, probe=PROBE, tolerance=1e-9, store=tmp_path, resume=True)
+
+
 def test_bad_grids_raise_value_error():
     with pytest.raises(ValueError, match="points"):
         afmdyn.approach(points=1)

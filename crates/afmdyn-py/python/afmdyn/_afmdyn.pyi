@@ -449,6 +449,8 @@ def approach(
     request: Optional[ApproachRequest] = None,
     progress: Optional[ProgressCallback] = None,
     probe: Optional[str] = None,
+    store: Optional[str] = None,
+    resume: bool = False,
 ) -> Dict[str, Any]: ...
 
 def resonance(
@@ -456,6 +458,8 @@ def resonance(
     request: Optional[ResonanceRequest] = None,
     progress: Optional[ProgressCallback] = None,
     probe: Optional[str] = None,
+    store: Optional[str] = None,
+    resume: bool = False,
 ) -> Dict[str, Any]: ...
 
 def basins(

@@ -392,11 +392,15 @@ def _curve(
     params: Optional[Params],
     model: Any,
     request: Dict[str, Any],
+    store: Union[str, "os.PathLike[str]", None] = None,
+    resume: bool = False,
 ) -> xr.Dataset:
-    """Run a stepped-curve analysis (:func:`approach`, :func:`resonance`) and return its
-    dataset (:func:`afmdyn._curves.curve_dataset`; in SI with a probe)."""
+    """Run a stepped-curve analysis (:func:`approach`, :func:`resonance`) — in the command
+    line's resumable store ``store`` when given — and return its dataset
+    (:func:`afmdyn._curves.curve_dataset`; in SI with a probe)."""
     p, probe = _params(params, model)
-    d = _run(fn, desc, progress, p, si=probe, request=request)
+    d = _run(fn, desc, progress, p, si=probe, request=request,
+             store=None if store is None else os.fspath(store), resume=resume)
     return curve_dataset(desc, json.loads(d["json"]))
 
 
@@ -413,6 +417,8 @@ def approach(
     tolerance: float = _DEFAULTS["approach"]["tolerance"],
     setpoint: Optional[float] = None,
     traces: Optional[int] = None,
+    store: Union[str, "os.PathLike[str]", None] = None,
+    resume: bool = False,
     progress: ProgressArg = None,
     **model: Unpack[Model],
 ) -> xr.Dataset:
@@ -436,6 +442,10 @@ def approach(
             ``z_c``, ``regime`` (attractive/repulsive), phase, peak force, indentation, E_dis…).
         probe: a probe file (a model keyword, as ``--probe``): it sets the model, and its
             scales give SI inputs (``from_``, ``to``, ``step`` in m) and outputs.
+        store: a directory for the command line's resumable store of the curve's points
+            (``afmdyn approach --out DIR``); ``resume=True`` continues an interrupted curve of
+            the same request from its last stored point (refused, naming the option, for
+            another request's store).
 
     Returns:
         An ``xarray.Dataset`` (SI with a probe: m, N, J, degrees; ``units`` in each variable's
@@ -450,7 +460,8 @@ def approach(
         (``folds``, ``bistable``, ``jumps``, ``setpoint``, ``warnings``;
         ``docs/outputs.md``).
     """
-    return _curve(_core.approach, "approach", progress, params, model, _request(locals()))
+    return _curve(_core.approach, "approach", progress, params, model, _request(locals()),
+                  store, resume)
 
 
 @_typed
@@ -466,6 +477,8 @@ def resonance(
     branches: bool = _DEFAULTS["resonance"]["branches"],
     tolerance: float = _DEFAULTS["resonance"]["tolerance"],
     traces: Optional[int] = None,
+    store: Union[str, "os.PathLike[str]", None] = None,
+    resume: bool = False,
     progress: ProgressArg = None,
     **model: Unpack[Model],
 ) -> xr.Dataset:
@@ -476,13 +489,14 @@ def resonance(
 
     Args:
         from_, to: the band (default ω_k (1 ∓ max(6/Q_k, 0.02))), in Hz with ``probe``, else Ω.
-        step, points, branches, tolerance, traces: as :func:`approach` (traces per frequency
-            of the up-sweep); ``probe`` (a model keyword)
-            sets the model and gives frequencies in Hz.
+        step, points, branches, tolerance, traces, store, resume: as :func:`approach`
+            (traces per frequency of the up-sweep; the store of ``afmdyn resonance --out
+            DIR``); ``probe`` (a model keyword) sets the model and gives frequencies in Hz.
 
     Returns:
         An ``xarray.Dataset`` as :func:`approach`'s over ``frequency_hz`` (with a probe) or
         ``omega`` and ``sweep`` = ``up``/``down``; ``ds.afmdyn.to_dict()`` is the
         ``afmdyn resonance --json`` document.
     """
-    return _curve(_core.resonance, "resonance", progress, params, model, _request(locals()))
+    return _curve(_core.resonance, "resonance", progress, params, model, _request(locals()),
+                  store, resume)

@@ -86,7 +86,7 @@ use crate::roots::{extremum, safeguarded_newton};
 use crate::system::EventKind;
 use gauss_quad::legendre::GaussLegendre;
 use nalgebra::{DMatrix, DVector};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::f64::consts::{PI, TAU};
 use std::num::NonZeroUsize;
 
@@ -100,7 +100,7 @@ const GL_NODES: usize = 16;
 const GL_NODES_SHORT: usize = 8;
 
 /// What to compute.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub struct ObservableOptions {
     /// Number of drive periods T = 2π/Ω to integrate over, in 1..=[`MAX_PERIODS`] (a multiple of
     /// the orbit's period for a period-n orbit).
@@ -120,7 +120,7 @@ impl Default for ObservableOptions {
 }
 
 /// One harmonic of the tip deflection: A_n sin(n(Ωτ + ψ) − φ_n).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Harmonic {
     /// Order n ≥ 1 (multiple of the drive frequency Ω).
     pub n: usize,
@@ -132,7 +132,7 @@ pub struct Harmonic {
 
 /// Energy balance of one mode, per drive period (energies F̃·g₀; module docs):
 /// energy_change = drive − beam_damping − sample − coupling + residual.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct ModeBalance {
     /// Mode index j (0-based).
     pub mode: usize,
@@ -151,7 +151,7 @@ pub struct ModeBalance {
 }
 
 /// The free linear response of the tip at the drive frequency: W = A₀ sin(Ωτ + ψ − φ₀).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct FreeResponse {
     /// Free amplitude A₀ = |φᵀ(K − Ω²M + iΩC)⁻¹(F_s + iF_c)| (units of g₀).
     pub amplitude: f64,
@@ -162,7 +162,7 @@ pub struct FreeResponse {
 /// The closed forms of the AFM literature from (A, φ, A₀, Q, k), evaluated for the
 /// mode-1 equivalent point mass (module docs). Exact balances only for the point-mass model at
 /// ω = ω₀; elsewhere an approximation, reported to show how far it is off.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct ClosedForms {
     /// A₀: free tip amplitude at Ω from the linear free response ([`free_response`]), g₀.
     pub free_amplitude: f64,
@@ -187,7 +187,7 @@ pub struct ClosedForms {
 
 /// Observables of a steady state over an integer number of drive periods. Lengths in g₀, time
 /// τ, forces F̃, energies F̃·g₀ (module docs for conventions and sources).
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Observables {
     /// Number of drive periods integrated over.
     pub periods: usize,

@@ -4,9 +4,9 @@
 //!
 //! Every analysis whose result is one value implements [`Analysis`]: `modes`, `orbit`,
 //! `continuation`, `lyapunov`, `attractors`, `observe`, `converge`, `approach`, `resonance`,
-//! and the two studies that run in memory here and resumably in a front end's store — `basins`
-//! and `attractors --sweep` (their `Analysis` is in `crate::study::basins` and
-//! `crate::study::global_continuation`, beside the study).
+//! and the studies that run in memory here and resumably in a front end's store — `basins`,
+//! `attractors --sweep`, `approach` and `resonance` (their `Analysis` is beside the study, in
+//! `crate::study::basins`, `crate::study::global_continuation` and `crate::study::stepped`).
 //! The two whose results are streams run through their own entry points, which take the same
 //! [`Progress`]: `simulate` records in chunks to a sink
 //! ([`crate::trajectory::chunked::record_chunked`], budgets by
@@ -23,14 +23,14 @@ use super::analyses::{
     AttractorsRequest, ContinuationRequest, ConvergeRequest, LyapunovRequest, ObserveRequest,
     ObserveResult, OrbitRequest,
 };
-use super::curves::{approach_request, free_resonance_base, resonance_request, CurveRequest};
+use super::curves::{approach_request, resonance_request, CurveRequest};
 use crate::analysis::attractors::AttractorReport;
 use crate::analysis::continuation::Branch;
 use crate::analysis::converge::ConvergenceRun;
 use crate::analysis::lyapunov::LyapunovSpectrum;
 use crate::analysis::progress::Progress;
 use crate::analysis::shooting::PeriodicOrbit;
-use crate::analysis::stepped::{stepped_sweep_with, SteppedCurve, SteppedSpec};
+use crate::analysis::stepped::SteppedSpec;
 use crate::eigen::{spectrum, RegionSpectrum};
 use crate::error::SimError;
 use crate::model::CantileverModel;
@@ -288,24 +288,6 @@ impl ApproachRequest {
     }
 }
 
-impl Analysis for ApproachRequest {
-    type Output = SteppedCurve;
-    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
-        self.spec(model).map(|_| ())
-    }
-    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
-        stepped_sweep_with(&self.spec(model)?, progress)
-    }
-    fn report(&self, model: &Resolved, c: &Self::Output) -> Result<Value, SimError> {
-        let u = Self::units(model);
-        let mut doc = report::approach(&model.params, c, &u);
-        if let Some(s) = self.setpoint {
-            doc["setpoint"] = report::setpoint(&model.params, c, s, &u);
-        }
-        Ok(doc)
-    }
-}
-
 /// `resonance`: the resonance curve near mode `mode` with its branches
 /// ([`crate::analysis::resonance`]); `from`/`to`/`step` in Hz with a probe, else in Ω.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -346,26 +328,6 @@ impl ResonanceRequest {
     pub fn spec(&self, model: &Resolved) -> Result<SteppedSpec, SimError> {
         let hz = Self::units(model).hz_per_omega.unwrap_or(1.0);
         resonance_request(self.computed_at(model)?, self.mode, &self.curve, hz)
-    }
-}
-
-impl Analysis for ResonanceRequest {
-    type Output = SteppedCurve;
-    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
-        self.spec(model).map(|_| ())
-    }
-    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
-        stepped_sweep_with(&self.spec(model)?, progress)
-    }
-    fn report(&self, model: &Resolved, c: &Self::Output) -> Result<Value, SimError> {
-        Ok(report::resonance(
-            &self.computed_at(model)?,
-            c,
-            &Self::units(model),
-        ))
-    }
-    fn computed_at(&self, model: &Resolved) -> Result<Params, SimError> {
-        free_resonance_base(model.params, model.probe.as_ref(), self.mode)
     }
 }
 

@@ -104,15 +104,15 @@ impl Study for BasinStudy {
         done: &Vec<BasinRow>,
         sink: &(dyn Fn((usize, BasinRow)) + Sync),
         cancel: &AtomicBool,
-    ) {
-        // a cancelled run ends here: the rows stored so far are the store's
-        let _ = run_passes(
+    ) -> Result<(), SimError> {
+        run_passes(
             &self.spec,
             &self.model,
             done,
             &|row| sink((self.task(row), row.clone())),
             cancel,
-        );
+        )
+        .map(|_| ())
     }
 }
 

@@ -38,9 +38,11 @@ impl Study for Chart {
         done: &HashSet<usize>,
         sink: &(dyn Fn((usize, Vec<ChartCell>)) + Sync),
         cancel: &AtomicBool,
-    ) {
+    ) -> Result<(), SimError> {
+        // a cell that fails is a cell without attractors, with its message: no task fails
         let plan = ChartPlan::new(&self.spec, &self.model);
         run_chart(&plan, done, &|t, cells| sink((t, cells)), cancel);
+        Ok(())
     }
 }
 

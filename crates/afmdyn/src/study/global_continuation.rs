@@ -106,14 +106,13 @@ impl Study for ContinuationStudy {
         done: &Vec<ContinuationStep>,
         sink: &(dyn Fn((usize, ContinuationStep)) + Sync),
         cancel: &AtomicBool,
-    ) {
+    ) -> Result<(), SimError> {
         // the chain of values: a store holds its first values (a stored step after a missing
         // one cannot be: each is stored once the one before it is)
         let first = done.len();
         let index = AtomicUsize::new(first);
         let store = |s: &ContinuationStep| sink((index.fetch_add(1, Ordering::SeqCst), s.clone()));
-        // a cancelled run ends here: the steps stored so far are the store's
-        let _ = continue_values(&self.spec, done, cancel, &store);
+        continue_values(&self.spec, done, cancel, &store).map(|_| ())
     }
 }
 

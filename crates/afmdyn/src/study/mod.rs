@@ -19,7 +19,8 @@
 //!   (a bifurcation sweep's points, stored by the request layer's checkpoints), [`basins`]
 //!   (a basin map's rows, pass by pass, its store `basins::basin_store`) and
 //!   [`global_continuation`] (a global continuation's values, one chain, its store
-//!   `global_continuation::continuation_store`).
+//!   `global_continuation::continuation_store`) and [`stepped`] (an approach or resonance
+//!   curve's points, one chain through both sweeps, its store `stepped::curve_store`).
 //!
 //! The results' variables are declared once in [`crate::layout`], from which the NetCDF file,
 //! the Python `xarray.Dataset` and the Dask Zarr store are written.
@@ -35,6 +36,7 @@ pub mod chart;
 pub mod chart_store;
 pub mod global_continuation;
 mod memory;
+pub mod stepped;
 pub mod sweep;
 #[cfg(feature = "files")]
 pub mod task_store;
@@ -72,7 +74,16 @@ pub trait Study: Sync {
     /// Compute every task not in `done` (on the current rayon pool with the `parallel`
     /// feature), handing each finished task to `sink` from the worker threads; start no
     /// further task once `cancel` is set (a task cut short is not sent).
-    fn run(&self, done: &Self::Done, sink: &(dyn Fn(Self::Record) + Sync), cancel: &AtomicBool);
+    ///
+    /// # Errors
+    /// The error that stopped the study (a task of a chain that failed: the tasks after it
+    /// cannot run); [`SimError::Cancelled`] once `cancel` is set, or `Ok`.
+    fn run(
+        &self,
+        done: &Self::Done,
+        sink: &(dyn Fn(Self::Record) + Sync),
+        cancel: &AtomicBool,
+    ) -> Result<(), SimError>;
 }
 
 /// Where a store stands when a run opens it.
@@ -163,7 +174,8 @@ pub enum StudyError {
 /// cancels the run (the tasks already stored are kept) and is returned.
 ///
 /// # Errors
-/// [`StudyError::Store`] from the store, [`StudyError::Sim`] when the pool cannot start.
+/// [`StudyError::Store`] from the store; [`StudyError::Sim`] when the pool cannot start or
+/// the study failed (the tasks stored so far are kept, the store unfinished).
 pub fn execute<S: Study + ?Sized, St: Store<S>>(
     study: &S,
     store: &mut St,
@@ -198,10 +210,7 @@ pub fn execute<S: Study + ?Sized, St: Store<S>>(
         drop(guard);
         observer.stored(units, count.fetch_add(1, Ordering::SeqCst) + 1);
     };
-    crate::request::in_pool(threads, || {
-        study.run(&done, &sink, cancel);
-        Ok(())
-    })?;
+    let ran = crate::request::in_pool(threads, || study.run(&done, &sink, cancel));
     let (_, failed) = shared.into_inner().unwrap_or_else(|e| e.into_inner());
     if let Some(e) = failed {
         return Err(e.into());
@@ -209,6 +218,8 @@ pub fn execute<S: Study + ?Sized, St: Store<S>>(
     if cancel.load(Ordering::Relaxed) {
         return Ok(Outcome::Cancelled);
     }
+    // a study that failed keeps the tasks stored so far, unfinished
+    ran?;
     store.finish(study)?;
     Ok(Outcome::Finished)
 }

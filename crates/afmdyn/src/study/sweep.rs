@@ -51,7 +51,13 @@ impl Study for SweepStudy {
         1
     }
 
-    fn run(&self, done: &Resume, sink: &(dyn Fn(Vec<SweepRecord>) + Sync), cancel: &AtomicBool) {
+    fn run(
+        &self,
+        done: &Resume,
+        sink: &(dyn Fn(Vec<SweepRecord>) + Sync),
+        cancel: &AtomicBool,
+    ) -> Result<(), crate::error::SimError> {
+        // a point that fails is a row with its status and message: no task fails
         let param = self.spec.param;
         run_sweep_cancellable(
             &self.spec,
@@ -59,6 +65,7 @@ impl Study for SweepStudy {
             &|p: SweepPoint| sink(records(param, &p)),
             cancel,
         );
+        Ok(())
     }
 }
 

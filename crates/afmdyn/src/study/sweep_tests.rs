@@ -86,7 +86,8 @@ fn uninterrupted(r: &BifurcationRequest) -> (MemoryCheckpoint, Vec<SweepRecord>)
         &resume,
         &|rec| sink.lock().unwrap().push(rec),
         &AtomicBool::new(false),
-    );
+    )
+    .unwrap();
     for rec in sink.into_inner().unwrap() {
         Store::append(&mut store, rec).unwrap();
     }

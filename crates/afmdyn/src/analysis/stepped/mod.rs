@@ -46,7 +46,8 @@ use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
 use crate::tip_sample::TipSampleSystem;
 use nalgebra::{Complex, DMatrix, DVector};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
+use std::sync::atomic::{AtomicBool, Ordering};
 
 mod branches;
 use branches::{branch, branch_starts, jumps_of, on_branch, unstable_between_folds};
@@ -191,7 +192,7 @@ impl SteppedSpec {
 }
 
 /// How the steady state of a sweep point was reached.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Reached {
     /// The first point: Newton from rest (or from the transient from rest).
@@ -202,8 +203,9 @@ pub enum Reached {
     Settled,
 }
 
-/// One point of a stepped sweep.
-#[derive(Debug, Clone, PartialEq)]
+/// One point of a stepped sweep (serialized for its study's store: the next point starts from
+/// it).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CurvePoint {
     /// Value of the swept parameter.
     pub value: f64,
@@ -646,28 +648,69 @@ fn step_point(
     })
 }
 
-/// One sweep through `values`, starting from `start` (the previous sweep's last point, at
-/// `values[0]`) or from rest.
-fn sweep(
+/// The points of both sweeps after the `stored` ones (a run that was cut short handed them to
+/// `sink`, in order: the first sweep's through `spec.values`, then the sweep back's; none for
+/// a new run), each stepped from the points before it as an uninterrupted run steps them, and
+/// handed to `sink` with its place (0..2n) as it is done. Starts no point once `cancel` is
+/// set. Returns the two sweeps ([`SteppedCurve::first`], [`SteppedCurve::second`]).
+///
+/// # Errors
+/// [`SimError::Cancelled`] once `cancel` is set; [`SimError`] from the model or the
+/// integrator.
+pub fn sweep_points(
     spec: &SteppedSpec,
-    values: &[f64],
-    start: Option<&CurvePoint>,
-    progress: &Progress,
-) -> Result<Vec<CurvePoint>, SimError> {
-    let mut out: Vec<CurvePoint> = Vec::with_capacity(values.len());
-    for (i, &v) in values.iter().enumerate() {
-        progress.check()?;
-        let p = match (i, start) {
-            (0, Some(s)) => s.clone(),
-            _ => {
-                let k = out.len();
-                step_point(spec, v, &out[k.saturating_sub(3)..])?
-            }
+    stored: &[CurvePoint],
+    cancel: &AtomicBool,
+    sink: &dyn Fn(usize, &CurvePoint),
+) -> Result<(Vec<CurvePoint>, Vec<CurvePoint>), SimError> {
+    let n = spec.values.len();
+    let back: Vec<f64> = spec.values.iter().rev().copied().collect();
+    let mut first: Vec<CurvePoint> = stored.iter().take(n).cloned().collect();
+    let mut second: Vec<CurvePoint> = stored.iter().skip(n).take(n).cloned().collect();
+    for k in stored.len().min(2 * n)..2 * n {
+        if cancel.load(Ordering::Relaxed) {
+            return Err(SimError::Cancelled);
+        }
+        let p = if k < n {
+            let m = first.len();
+            step_point(spec, spec.values[k], &first[m.saturating_sub(3)..])?
+        } else if k == n {
+            // the sweep back starts where the first sweep ended
+            first[n - 1].clone()
+        } else {
+            let m = second.len();
+            step_point(spec, back[k - n], &second[m.saturating_sub(3)..])?
         };
-        out.push(p);
-        progress.tick();
+        sink(k, &p);
+        if k < n {
+            first.push(p);
+        } else {
+            second.push(p);
+        }
     }
-    Ok(out)
+    Ok((first, second))
+}
+
+/// Check the values of a stepped sweep: 2..=[`MAX_CURVE_POINTS`] of them, finite, the ends'
+/// parameters valid.
+///
+/// # Errors
+/// [`SimError::OutOfRange`], [`SimError::NotFinite`], [`SimError::Params`].
+pub fn check_values(spec: &SteppedSpec) -> Result<(), SimError> {
+    if !(2..=MAX_CURVE_POINTS).contains(&spec.values.len()) {
+        return Err(SimError::out_of_range(
+            "points",
+            spec.values.len(),
+            "a stepped sweep needs 2..=100000 values",
+        ));
+    }
+    for &v in &spec.values {
+        crate::error::finite("sweep value", v)?;
+    }
+    for &v in [spec.values[0], spec.values[spec.values.len() - 1]].iter() {
+        spec.base.with(spec.param, v).validate()?;
+    }
+    Ok(())
 }
 
 /// Run the stepped sweep through `spec.values` and back, then (with `spec.branches`) continue
@@ -691,23 +734,26 @@ pub fn stepped_sweep_with(
     spec: &SteppedSpec,
     progress: &Progress,
 ) -> Result<SteppedCurve, SimError> {
-    if !(2..=MAX_CURVE_POINTS).contains(&spec.values.len()) {
-        return Err(SimError::out_of_range(
-            "points",
-            spec.values.len(),
-            "a stepped sweep needs 2..=100000 values",
-        ));
-    }
-    for &v in &spec.values {
-        crate::error::finite("sweep value", v)?;
-    }
-    for &v in [spec.values[0], spec.values[spec.values.len() - 1]].iter() {
-        spec.base.with(spec.param, v).validate()?;
-    }
+    check_values(spec)?;
     progress.add_total(2 * spec.values.len());
-    let first = sweep(spec, &spec.values, None, progress)?;
-    let back: Vec<f64> = spec.values.iter().rev().copied().collect();
-    let second = sweep(spec, &back, first.last(), progress)?;
+    let count = |_: usize, _: &CurvePoint| progress.tick();
+    let (first, second) = sweep_points(spec, &[], progress.cancel_flag(), &count)?;
+    finish_curve(spec, first, second, progress)
+}
+
+/// The curve of the two sweeps ([`sweep_points`]): with `spec.branches` the periodic-orbit
+/// branches through both sweeps' first points continued (their points counted in
+/// `progress`), the folds, bistable ranges and jumps, and the traces.
+///
+/// # Errors
+/// [`SimError::Cancelled`] once `progress` is cancelled; [`SimError`] from the traces' model
+/// or integrator. A branch that cannot be continued is a warning.
+pub fn finish_curve(
+    spec: &SteppedSpec,
+    first: Vec<CurvePoint>,
+    second: Vec<CurvePoint>,
+    progress: &Progress,
+) -> Result<SteppedCurve, SimError> {
     let mut warnings = Vec::new();
     let mut branches: Vec<Vec<BranchSample>> = Vec::new();
     if spec.branches {

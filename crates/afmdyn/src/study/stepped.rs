@@ -1,0 +1,211 @@
+//! A stepped approach–retract or resonance curve ([`crate::analysis::stepped`]) as a
+//! [`Study`] ([`CurveStudy`]): a task is one point of the two sweeps, numbered 0..n along the
+//! first sweep (approach, up-sweep) and n..2n along the sweep back; the points form one chain
+//! — each is stepped from the orbit before it (its state, the secant or quadratic predictor
+//! through the points before, the monodromy trend) — so what a resume skips is the stored
+//! points themselves, and the chain goes on after the last ([`sweep_points`]), to the points
+//! of an uninterrupted run. The branches, folds, jumps and traces are computed from the two
+//! sweeps when the curve is assembled ([`CurveStudy::curve`], [`finish_curve`]): they are not
+//! tasks. Stored by [`MemoryStore`](super::MemoryStore) for a run that writes no files, by the
+//! directory store [`curve_store`] (feature `files`) for `afmdyn approach|resonance --out
+//! DIR`, resumable.
+//!
+//! The requests' [`Analysis`] (`request::run`, Python's `afmdyn.approach` and
+//! `afmdyn.resonance`) run this study in memory.
+
+use super::{execute_in_memory, Study};
+use crate::analysis::progress::Progress;
+use crate::analysis::stepped::{
+    check_values, finish_curve, sweep_points, CurvePoint, SteppedCurve, SteppedSpec,
+};
+use crate::error::SimError;
+use crate::params::Params;
+use crate::report;
+use crate::request::run::{Analysis, ApproachRequest, Resolved, ResonanceRequest};
+use serde::Serialize;
+use serde_json::{json, Value};
+use std::sync::atomic::AtomicBool;
+
+/// A stepped curve as a [`Study`] (see the module doc): its validated spec and its
+/// fingerprint.
+#[derive(Debug, Clone)]
+pub struct CurveStudy {
+    /// The validated sweep.
+    pub spec: SteppedSpec,
+    /// What a resumed curve must match ([`fingerprint`]).
+    pub fingerprint: Value,
+}
+
+/// The fingerprint of a stepped curve: everything that determines its points (the library's
+/// version, the kind of curve and its request, the model values and the probe).
+pub fn fingerprint(kind: &str, request: &impl Serialize, model: &Resolved) -> Value {
+    json!({
+        "afmdyn": env!("CARGO_PKG_VERSION"),
+        kind: request,
+        "params": model.params,
+        "probe": model.probe,
+        "z_c_in_file": model.probe.as_ref().map(|p| p.z_c_in_file),
+    })
+}
+
+impl CurveStudy {
+    /// The study of the approach curve `request` on `model`.
+    ///
+    /// # Errors
+    /// As [`ApproachRequest::spec`] and [`check_values`].
+    pub fn approach(request: &ApproachRequest, model: &Resolved) -> Result<CurveStudy, SimError> {
+        CurveStudy::new(
+            request.spec(model)?,
+            fingerprint("approach", request, model),
+        )
+    }
+
+    /// The study of the resonance curve `request` on `model`.
+    ///
+    /// # Errors
+    /// As [`ResonanceRequest::spec`] and [`check_values`].
+    pub fn resonance(request: &ResonanceRequest, model: &Resolved) -> Result<CurveStudy, SimError> {
+        CurveStudy::new(
+            request.spec(model)?,
+            fingerprint("resonance", request, model),
+        )
+    }
+
+    fn new(spec: SteppedSpec, fingerprint: Value) -> Result<CurveStudy, SimError> {
+        check_values(&spec)?;
+        Ok(CurveStudy { spec, fingerprint })
+    }
+
+    /// The curve of a finished study's records (in any order): the two sweeps, then the
+    /// branches (their points counted in `progress`), folds, jumps and traces
+    /// ([`finish_curve`]).
+    ///
+    /// # Errors
+    /// [`SimError::Cancelled`] when a point is missing (a run that was cut short) or once
+    /// `progress` is cancelled; as [`finish_curve`].
+    pub fn curve(
+        &self,
+        records: impl IntoIterator<Item = (usize, CurvePoint)>,
+        progress: &Progress,
+    ) -> Result<SteppedCurve, SimError> {
+        let n = self.spec.values.len();
+        let mut records: Vec<(usize, CurvePoint)> = records.into_iter().collect();
+        records.sort_by_key(|(k, _)| *k);
+        if records.len() != 2 * n || records.iter().enumerate().any(|(i, (k, _))| *k != i) {
+            return Err(SimError::Cancelled);
+        }
+        let mut points: Vec<CurvePoint> = records.into_iter().map(|(_, p)| p).collect();
+        let second = points.split_off(n);
+        finish_curve(&self.spec, points, second, progress)
+    }
+
+    /// Run the study in memory and assemble its curve.
+    fn run_in_memory(&self, progress: &Progress) -> Result<SteppedCurve, SimError> {
+        let records = execute_in_memory(self, None, progress)?;
+        self.curve(records, progress)
+    }
+}
+
+impl Study for CurveStudy {
+    /// The point's place (0..2n) and the point.
+    type Record = (usize, CurvePoint);
+    /// The stored points, in order.
+    type Done = Vec<CurvePoint>;
+
+    fn fingerprint(&self) -> &Value {
+        &self.fingerprint
+    }
+
+    /// The points of both sweeps.
+    fn units(&self) -> u64 {
+        2 * self.spec.values.len() as u64
+    }
+
+    fn done_units(&self, done: &Vec<CurvePoint>) -> u64 {
+        done.len() as u64
+    }
+
+    fn record_units(&self, _: &(usize, CurvePoint)) -> u64 {
+        1
+    }
+
+    fn run(
+        &self,
+        done: &Vec<CurvePoint>,
+        sink: &(dyn Fn((usize, CurvePoint)) + Sync),
+        cancel: &AtomicBool,
+    ) -> Result<(), SimError> {
+        let store = |k: usize, p: &CurvePoint| sink((k, p.clone()));
+        sweep_points(&self.spec, done, cancel, &store).map(|_| ())
+    }
+}
+
+impl Analysis for ApproachRequest {
+    type Output = SteppedCurve;
+    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
+        self.spec(model).map(|_| ())
+    }
+    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
+        CurveStudy::approach(self, model)?.run_in_memory(progress)
+    }
+    fn report(&self, model: &Resolved, c: &Self::Output) -> Result<Value, SimError> {
+        let u = Self::units(model);
+        let mut doc = report::approach(&model.params, c, &u);
+        if let Some(s) = self.setpoint {
+            doc["setpoint"] = report::setpoint(&model.params, c, s, &u);
+        }
+        Ok(doc)
+    }
+}
+
+impl Analysis for ResonanceRequest {
+    type Output = SteppedCurve;
+    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
+        self.spec(model).map(|_| ())
+    }
+    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
+        CurveStudy::resonance(self, model)?.run_in_memory(progress)
+    }
+    fn report(&self, model: &Resolved, c: &Self::Output) -> Result<Value, SimError> {
+        Ok(report::resonance(
+            &self.computed_at(model)?,
+            c,
+            &Self::units(model),
+        ))
+    }
+    fn computed_at(&self, model: &Resolved) -> Result<Params, SimError> {
+        crate::request::curves::free_resonance_base(model.params, model.probe.as_ref(), self.mode)
+    }
+}
+
+/// The resumable store of a stepped curve (feature `files`): a
+/// [`TaskStore`](crate::study::task_store::TaskStore) of points in the directory
+/// `afmdyn approach|resonance --out DIR` names — `.curve.run.json` (the ledger) and
+/// `.curve.points.jsonl` (one checksummed line per point, in CBOR under `"point"`), as
+/// [`crate::study::task_store`] describes.
+#[cfg(feature = "files")]
+pub mod store {
+    use super::super::task_store::{Encoding, TaskFiles, TaskStore};
+    use crate::analysis::stepped::CurvePoint;
+    use crate::request::dir_lock::DirLock;
+
+    /// A stepped curve's files.
+    pub const CURVE_FILES: TaskFiles = TaskFiles {
+        ledger: ".curve.run.json",
+        records: ".curve.points.jsonl",
+        key: "point",
+        prefix: "",
+        encoding: Encoding::Cbor,
+    };
+
+    /// A stepped curve's store: its points by place.
+    pub type CurveStore<'a> = TaskStore<'a, CurvePoint>;
+
+    /// The curve store of the directory `lock` holds.
+    pub fn curve_store(lock: &DirLock) -> CurveStore<'_> {
+        TaskStore::new(lock, CURVE_FILES)
+    }
+}
+
+#[cfg(feature = "files")]
+pub use store::{curve_store, CurveStore, CURVE_FILES};
