@@ -6,7 +6,7 @@ use crate::args::{quantity, Dim, ModelArgs, Quantity};
 use crate::cmd_simulate::Files;
 use crate::error::CliError;
 use crate::output::si_value;
-use crate::output::{f, write_csv, Column, NpyStream, OutDir};
+use crate::output::{f, write_csv, NpyStream, OutDir};
 use crate::plot::{save, Figure, Series, Style};
 use afmdyn::analysis::approach::rest_distance;
 use afmdyn::analysis::continuation::BranchEvent;
@@ -14,7 +14,7 @@ use afmdyn::analysis::observables::Observables;
 use afmdyn::analysis::stepped::{SteppedCurve, Sweep};
 use afmdyn::layout::{Layout, Variable};
 use afmdyn::probe::Probe;
-use afmdyn::report::{curve_column_index, curve_row, CurveUnits, UnitKind, CURVE_COLUMNS};
+use afmdyn::report::{curve_column_index, curve_row, curve_table, CurveAxis, CurveUnits};
 use afmdyn::request::{Analysis, ApproachRequest, CurveRequest, Resolved, ResonanceRequest};
 use afmdyn::study::stepped::{curve_store, CurveStudy};
 use afmdyn::Params;
@@ -155,225 +155,6 @@ impl Labels {
     }
 }
 
-fn event_code(e: Option<BranchEvent>) -> f64 {
-    match e {
-        None => 0.0,
-        Some(BranchEvent::Fold) => 1.0,
-        Some(BranchEvent::Grazing) => 2.0,
-        Some(BranchEvent::PeriodDoubling) => 3.0,
-        Some(BranchEvent::NeimarkSacker) => 4.0,
-    }
-}
-
-/// The leading columns of the table: dForce 2.0's `zcdom` table (Gisbert & Garcia, *Soft
-/// Matter* 19 (2023) 5857; the header of its `zcdom*.csv`), in its order, with afmdyn's
-/// definitions and SI units (dForce writes nm, pN, 1e-20 J).
-const DFORCE: [&str; 9] = [
-    "Amplitude",
-    "Phase",
-    "Distance_min",
-    "Force_max",
-    "Energy_diss",
-    "Virial1",
-    "Deflection",
-    "Contact_time",
-    "Power_diss",
-];
-
-/// One numeric row per sweep point and branch point, in the order of [`columns`].
-#[allow(clippy::too_many_arguments)]
-fn row(
-    x: f64,
-    o: &Observables,
-    omega: f64,
-    u: &CurveUnits,
-    code: f64,
-    stable: bool,
-    period: Option<usize>,
-    event: Option<BranchEvent>,
-) -> Vec<f64> {
-    let period_s = std::f64::consts::TAU / omega * u.time;
-    // the library's values of the observables in u's units (one derivation: curve_row), in
-    // the order of this file's columns
-    let c = curve_row(o, u);
-    let at = |name: &str| c[curve_column_index(name).expect("a curve column")];
-    let mut r = vec![
-        x,
-        at("amplitude"),
-        at("phase_deg"),
-        at("min_distance"),
-        at("peak_force").max(-at("min_force")),
-        at("energy_dissipated"),
-        at("virial"),
-        at("mean_deflection"),
-        o.contact_time * u.time,
-        at("energy_dissipated") / period_s,
-        code,
-        at("amplitude_ratio"),
-        at("peak_force"),
-        at("min_force"),
-        at("indentation"),
-        at("contact_fraction"),
-        at("harmonic_distortion"),
-    ];
-    r.push(if stable { 1.0 } else { 0.0 });
-    r.push(period.map_or(f64::NAN, |n| n as f64));
-    r.push(event_code(event));
-    r
-}
-
-fn rows(c: &SteppedCurve, x: &dyn Fn(f64) -> f64, u: &CurveUnits, base: &Params) -> Vec<Vec<f64>> {
-    let omega = |v: f64| base.with(c.param, v).omega;
-    let mut out = Vec::new();
-    for (code, sweep) in [(0.0, &c.first), (1.0, &c.second)] {
-        for p in sweep {
-            out.push(row(
-                x(p.value),
-                &p.observables,
-                omega(p.value),
-                u,
-                code,
-                p.stable,
-                p.period,
-                None,
-            ));
-        }
-    }
-    for (k, b) in c.branches.iter().enumerate() {
-        for s in b {
-            let bp = &s.point;
-            out.push(row(
-                x(bp.value),
-                &s.observables,
-                omega(bp.value),
-                u,
-                2.0 + k as f64,
-                bp.stable,
-                Some(bp.period),
-                bp.event,
-            ));
-        }
-    }
-    out
-}
-
-fn columns(l: &Labels, u: &CurveUnits) -> Vec<Column> {
-    // the library's columns (name, unit, meaning: report::CURVE_COLUMNS) by name
-    let lib = |name: &str| {
-        let c = CURVE_COLUMNS[curve_column_index(name).expect("a curve column")];
-        (u.unit(c.kind), c.long_name)
-    };
-    let force = u.unit(UnitKind::Force);
-    let (time, power) = if u.si {
-        ("s", "W")
-    } else {
-        ("tau", "F~ g0 / tau")
-    };
-    let x_unit = match (l.x_name, u.si, u.hz_per_omega.is_some()) {
-        ("z_c", true, _) => "m",
-        ("z_c", false, _) => "g0",
-        (_, _, true) => "Hz",
-        _ => "1",
-    };
-    let meaning = [
-        lib("amplitude"),
-        lib("phase_deg"),
-        lib("min_distance"),
-        (
-            force,
-            "largest |tip–sample force| (dForce's definition; see peak_force)",
-        ),
-        lib("energy_dissipated"),
-        lib("virial"),
-        lib("mean_deflection"),
-        (time, "time in contact per period"),
-        (power, "dissipated power: Energy_diss per period / period"),
-    ];
-    let x_name = if l.x_name == "z_c" { "zc" } else { l.x_name };
-    let mut cols = vec![Column::new(x_name, x_unit, l.x_label.clone())];
-    for (name, (unit, what)) in DFORCE.iter().zip(meaning) {
-        cols.push(Column::new(*name, unit, what));
-    }
-    cols.push(Column::new(
-        "sweep",
-        "1",
-        format!("0 {}, 1 {}, 2 + k branch k", l.sweeps.0, l.sweeps.1),
-    ));
-    for name in [
-        "amplitude_ratio",
-        "peak_force",
-        "min_force",
-        "indentation",
-        "contact_fraction",
-        "harmonic_distortion",
-    ] {
-        let (unit, what) = lib(name);
-        cols.push(Column::new(name, unit, what));
-    }
-    cols.extend([
-        Column::new("stable", "1", "1 stable (Floquet), 0 unstable"),
-        Column::new(
-            "period",
-            "drive periods",
-            "period n of the orbit (NaN: not period-n)",
-        ),
-        Column::new(
-            "event",
-            "1",
-            "0 none, 1 fold, 2 grazing, 3 period doubling, 4 Neimark–Sacker",
-        ),
-    ]);
-    cols
-}
-
-/// The table's columns named and ordered as the JSON document ([`CURVE_COLUMNS`] after the
-/// abscissa), then afmdyn's own: (name, index in the dForce layout of [`row`]/[`columns`]).
-const JSON_LAYOUT: [(&str, usize); 19] = [
-    ("amplitude", 1),
-    ("amplitude_ratio", 11),
-    ("phase_deg", 2),
-    ("mean_deflection", 7),
-    ("peak_force", 12),
-    ("min_force", 13),
-    ("indentation", 14),
-    ("contact_fraction", 15),
-    ("min_distance", 3),
-    ("energy_dissipated", 5),
-    ("virial", 6),
-    ("harmonic_distortion", 16),
-    ("stable", 17),
-    ("period", 18),
-    ("sweep", 10),
-    ("event", 19),
-    ("contact_time", 8),
-    ("max_abs_force", 4),
-    ("power_dissipated", 9),
-];
-
-/// `table` and `cols` (dForce's layout) in the JSON layout ([`JSON_LAYOUT`]; the abscissa
-/// keeps its place and takes the JSON's name `x_json`).
-fn json_layout(
-    table: Vec<Vec<f64>>,
-    cols: Vec<Column>,
-    x_json: &str,
-) -> (Vec<Vec<f64>>, Vec<Column>) {
-    let mut named = vec![Column::new(x_json, cols[0].unit, cols[0].meaning.clone())];
-    named.extend(
-        JSON_LAYOUT
-            .iter()
-            .map(|(name, k)| Column::new(*name, cols[*k].unit, cols[*k].meaning.clone())),
-    );
-    let rows = table
-        .into_iter()
-        .map(|r| {
-            std::iter::once(r[0])
-                .chain(JSON_LAYOUT.iter().map(|(_, k)| r[*k]))
-                .collect()
-        })
-        .collect();
-    (rows, named)
-}
-
 /// The CSV (the same numeric columns as the NPY: named as the JSON document, or dForce's
 /// `zcdom` columns first with `dforce`), NPY and plots of one curve in `out`.
 #[allow(clippy::too_many_arguments)]
@@ -387,11 +168,12 @@ fn write_files(
     l: &Labels,
     base: &Params,
 ) -> Result<(), CliError> {
-    let (table, cols) = if dforce {
-        (rows(c, x, u, base), columns(l, u))
-    } else {
-        json_layout(rows(c, x, u, base), columns(l, u), l.x_name)
+    let axis = CurveAxis {
+        name: l.x_name,
+        label: l.x_label.clone(),
+        sweeps: l.sweeps,
     };
+    let (table, cols) = curve_table(c, x, u, base, &axis, dforce);
     let header: Vec<&str> = cols.iter().map(|c| c.name.as_str()).collect();
     write_csv(
         &out.join(format!("{}.csv", l.stem)),

@@ -6,6 +6,7 @@
 //! datasets and result objects.
 
 mod analyses;
+mod basin_tasks;
 mod chart;
 mod convert;
 mod errors;
@@ -36,6 +37,7 @@ fn request_defaults<'py>(py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyA
 fn _afmdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<params::PyParams>()?;
     m.add_class::<chart::ChartStudy>()?;
+    m.add_class::<basin_tasks::BasinMapStudy>()?;
     m.add_class::<chart::StoreLock>()?;
     m.add_class::<sweep::SweepStudy>()?;
     m.add_class::<sweep::SweepStore>()?;

@@ -81,6 +81,30 @@ def test_a_map_killed_on_the_command_line_resumes_in_python(cli, tmp_path):
         afmdyn.basins(**IMPACT, x_steps=4, y_steps=4, resume=True)
 
 
+def test_dask_basins_equal_the_local_map():
+    # two passes (50 x 50 on N = 1) on a LocalCluster of two worker processes: the recipe,
+    # the starts of the passes and the rows pickle to the workers and back
+    distributed = pytest.importorskip("distributed")
+    import afmdyn.dask
+
+    cluster = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                       dashboard_address=None)
+    client = distributed.Client(cluster)
+    try:
+        ds = afmdyn.dask.basins(**IMPACT, x_steps=50, y_steps=50, client=client)
+    finally:
+        client.close()
+        cluster.close()
+    ref = afmdyn.basins(**IMPACT, x_steps=50, y_steps=50)
+    assert json.loads(ref.attrs["summary"])["first_stride"] == 2
+    xr.testing.assert_identical(ds, ref)
+    # a misspelt keyword is refused as afmdyn.basins refuses it, before any work
+    with pytest.raises(TypeError, match="unknown model parameter 'x_step'"):
+        afmdyn.dask.basins(**IMPACT, x_step=5, client=client)
+    with pytest.raises(ValueError, match="near_tol"):
+        afmdyn.dask.basins(**IMPACT, near_tol=0.0, client=client)
+
+
 def test_bad_basins_are_refused():
     with pytest.raises(ValueError, match="x = b1"):
         afmdyn.basins(x="b1")

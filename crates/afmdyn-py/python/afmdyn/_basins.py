@@ -86,14 +86,18 @@ def basins(
         store=None if store is None else os.fspath(store),
         resume=resume,
     )
-    doc = json.loads(d["json"])
+    return _dataset(d["layout"], json.loads(d["json"]), p)
+
+
+def _dataset(layout: Any, doc: Any, p: Params) -> xr.Dataset:
+    """The dataset of a basin map from its layout and document (as the core returns them)."""
 
     def num(v: Any) -> float:
         return float("nan") if v is None else float(v)
 
     # the variables as the library lays them out (basins.nc's), `decided` given by its meanings
     ds = _layout.dataset(
-        d["layout"],
+        layout,
         {
             "basin_entropy": num(doc["basin_entropy"]),
             "boundary_basin_entropy": num(doc["boundary_basin_entropy"]),
@@ -108,4 +112,3 @@ def basins(
     attrs = {k: v for k, v in decided.attrs.items() if not k.startswith("flag_")}
     ds["decided"] = (decided.dims, names.reshape(decided.shape), attrs)
     return ds.assign_coords(attractor=("attractor", np.arange(ds.sizes["attractor"])))
-

@@ -19,6 +19,7 @@ the task's region is written: a killed driver loses at most the task it was writ
 from __future__ import annotations
 
 import functools
+import json
 import os
 import time
 from typing import TYPE_CHECKING, Any, Dict, Iterable, List, Optional, Sequence, Set, Union
@@ -422,11 +423,77 @@ def bifurcation(
     return _sweep_dataset(p, d, starts, seed)
 
 
+def run_basin_row(recipe: str, start: str, iy: int) -> str:
+    """Row ``iy`` of the pass of the basin map of ``recipe`` that begins at ``start`` (the
+    attractors and coarse grid of the passes before it): the finished row, as text."""
+    return _core.BasinMapStudy(recipe).run_row(start, iy)
+
+
+def basins(
+    params: Optional[Params] = None,
+    /,
+    *,
+    client: Optional["distributed.Client"] = None,
+    progress: ProgressArg = None,
+    **keywords: Any,
+) -> xr.Dataset:
+    """:func:`afmdyn.basins` (the same keywords but ``store``, ``resume`` and ``threads``)
+    with the rows of each pass mapped over a Dask cluster (``client``; default a
+    ``LocalCluster`` of this machine's cores, closed at the end). The passes run in turn: the
+    start of a pass — the attractors and the coarse grid of the passes before it, made by the
+    library from their finished rows — is sent to the workers once, and each row is a task.
+
+    Returns the same ``xarray.Dataset`` as :func:`afmdyn.basins` with the same arguments, bit
+    for bit (a row is a pure function of its pass's start).
+    """
+    import inspect
+
+    from ._basins import _dataset
+    from ._basins import basins as local
+    from ._common import _check_counts, _params
+
+    # the map's keywords are those of afmdyn.basins; the others are the model's (as there)
+    own_keywords = set(inspect.signature(local).parameters) - {
+        "params", "model", "store", "resume", "threads", "progress"}
+    model = {k: keywords.pop(k) for k in list(keywords) if k not in own_keywords}
+    p, probe = _params(params, model)
+    _check_counts(keywords)
+    s = _core.BasinMapStudy.build(p, keywords, probe)
+    own = client is None
+    cluster = None
+    if own:
+        cluster = distributed.LocalCluster(threads_per_worker=1, dashboard_address=None)
+        client = distributed.Client(cluster)
+    assert client is not None
+    rows: List[str] = []
+    try:
+        with reporter(progress, "basins (dask)", unit="row") as cb:
+            for k in range(s.passes()):
+                start = s.start(k, rows)
+                iys = s.rows(start)
+                shared = client.scatter(start, broadcast=True)
+                futures = client.map(run_basin_row, [s.recipe] * len(iys), [shared] * len(iys),
+                                     iys, pure=False, retries=3)
+                for fut in distributed.as_completed(futures):
+                    rows.append(fut.result())
+                    if cb is not None:
+                        cb(len(rows), None)
+        layout, doc = s.result(rows)
+    finally:
+        if own:
+            client.close()
+            if cluster is not None:
+                cluster.close()
+    return _dataset(layout, json.loads(doc), p)
+
+
 __all__ = [
     "DONE",
+    "basins",
     "bifurcation",
     "chart",
     "ledger_dir",
+    "run_basin_row",
     "run_chart_task",
     "run_coarse_task",
     "run_sweep_task",

@@ -425,6 +425,7 @@ fn near(spec: &BasinSpec, known: &[SteadyState], z: &DVector<f64>) -> Option<usi
 
 /// The first pass's labels on its coarse grid (rows `ys`, columns `xs`: indices into the
 /// map's values), for the second pass's lookup.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 struct CoarseGrid {
     xs: Vec<usize>,
     ys: Vec<usize>,
@@ -672,14 +673,98 @@ fn coarse_grid(nx: usize, ny: usize, stride: usize, slots: &[Option<BasinCell>])
 
 /// The attractors of a run in the order first found and its cells (row-major, `None` where
 /// no pass ran the cell: a run cut short).
-pub type Merged = (Vec<SteadyState>, Vec<Option<BasinCell>>);
+type Merged = (Vec<SteadyState>, Vec<Option<BasinCell>>);
+
+/// Where a pass of a basin map starts: the attractors the passes before it found (in the
+/// order first found: a cell's label indexes them) and the coarse grid of the last of them,
+/// and the rows it runs — what each row of the pass needs, and all of it (a row is a pure
+/// function of it: any executor gives the same map).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PassStart {
+    /// The pass (0 the coarsest).
+    pub pass: usize,
+    /// The attractors found by the passes before.
+    initial: Vec<SteadyState>,
+    /// The coarse grid of the pass before (`None` for the first).
+    grid: Option<CoarseGrid>,
+    /// The rows to run: (iy, the columns not yet run), rows stored already left out.
+    pub rows: Vec<(usize, Vec<usize>)>,
+}
+
+/// The number of passes of `spec` (one where the plane is not the whole section).
+pub fn passes(spec: &BasinSpec) -> usize {
+    strides(spec).len()
+}
+
+/// The start of pass `pass` of `spec` from the finished rows `rows` (in any order; those of
+/// later passes are ignored, those of this pass are not run again): the passes before merged
+/// in their order — the merge of [`basin_map`] —, the last one's coarse grid, and the rows
+/// left to run.
+pub fn pass_start(spec: &BasinSpec, rows: &[BasinRow], pass: usize) -> PassStart {
+    let (nx, ny) = (spec.xs.len(), spec.ys.len());
+    let strides = strides(spec);
+    let (attractors, slots) = merge_passes(spec, rows.iter().filter(|r| r.pass < pass).cloned());
+    let grid = pass
+        .checked_sub(1)
+        .map(|before| coarse_grid(nx, ny, strides[before], &slots));
+    let stride = strides.get(pass).copied().unwrap_or(1);
+    let (cx, cy) = (coarse_indices(nx, stride), coarse_indices(ny, stride));
+    let todo = cy
+        .iter()
+        .filter(|&&iy| !rows.iter().any(|r| r.pass == pass && r.iy == iy))
+        .map(|&iy| {
+            let columns = cx
+                .iter()
+                .copied()
+                .filter(|&ix| slots[iy * nx + ix].is_none())
+                .collect();
+            (iy, columns)
+        })
+        .filter(|(_, columns): &(usize, Vec<usize>)| !columns.is_empty())
+        .collect();
+    PassStart {
+        pass,
+        initial: attractors,
+        grid,
+        rows: todo,
+    }
+}
+
+/// Run row `iy` of the pass that `start` begins, its cells `columns`.
+///
+/// # Errors
+/// [`SimError::Cancelled`] once `cancel` is set.
+pub fn run_pass_row(
+    spec: &BasinSpec,
+    model: &CantileverModel,
+    start: &PassStart,
+    iy: usize,
+    columns: &[usize],
+    cancel: &AtomicBool,
+) -> Result<BasinRow, SimError> {
+    let (cells, found) = run_row(
+        spec,
+        model,
+        iy,
+        columns,
+        &start.initial,
+        start.grid.as_ref(),
+        cancel,
+    )?;
+    Ok(BasinRow {
+        pass: start.pass,
+        iy,
+        cells,
+        attractors: found,
+    })
+}
 
 /// Run every pass of `spec` (rows in parallel on the current rayon pool), showing each finished
 /// row to `sink` from the worker threads; each pass begins with the attractors and the coarse
-/// grid of the ones before it. The rows in `stored` (a resumed run's, as `sink` saw them) are
-/// not run again but merged in their place, so a resumed run makes the map an uninterrupted
-/// one makes. Stops starting rows once `cancel` is set. Returns the passes merged, from which
-/// [`basins_with`] makes the map.
+/// grid of the ones before it ([`pass_start`]). The rows in `stored` (a resumed run's, as
+/// `sink` saw them) are not run again but merged in their place, so a resumed run makes the
+/// map an uninterrupted one makes. Stops starting rows once `cancel` is set. Returns every
+/// row, `stored` first, from which [`basin_map`] makes the map.
 ///
 /// # Errors
 /// [`SimError::Cancelled`] once `cancel` is set.
@@ -689,50 +774,22 @@ pub fn run_passes(
     stored: &[BasinRow],
     sink: &(dyn Fn(&BasinRow) + Sync),
     cancel: &AtomicBool,
-) -> Result<Merged, SimError> {
-    let (nx, ny) = (spec.xs.len(), spec.ys.len());
-    let mut attractors: Vec<SteadyState> = Vec::new();
-    let mut slots: Vec<Option<BasinCell>> = vec![None; nx * ny];
-    let mut grid: Option<CoarseGrid> = None;
-    for (pass, stride) in strides(spec).into_iter().enumerate() {
-        let (cx, cy) = (coarse_indices(nx, stride), coarse_indices(ny, stride));
-        let kept: Vec<&BasinRow> = stored.iter().filter(|r| r.pass == pass).collect();
-        let rows: Vec<(usize, Vec<usize>)> = cy
-            .iter()
-            .filter(|&&iy| !kept.iter().any(|r| r.iy == iy))
-            .map(|&iy| {
-                let todo = cx
-                    .iter()
-                    .copied()
-                    .filter(|&ix| slots[iy * nx + ix].is_none())
-                    .collect();
-                (iy, todo)
-            })
-            .filter(|(_, todo): &(usize, Vec<usize>)| !todo.is_empty())
-            .collect();
-        let initial: &[SteadyState] = &attractors;
-        let mut done: Vec<BasinRow> = rows
+) -> Result<Vec<BasinRow>, SimError> {
+    let mut rows = stored.to_vec();
+    for pass in 0..passes(spec) {
+        let start = pass_start(spec, &rows, pass);
+        let done: Vec<BasinRow> = (&start.rows)
             .into_par_iter()
             .with_max_len(1)
             .map(|(iy, columns)| {
-                let (cells, found) =
-                    run_row(spec, model, iy, &columns, initial, grid.as_ref(), cancel)?;
-                let row = BasinRow {
-                    pass,
-                    iy,
-                    cells,
-                    attractors: found,
-                };
+                let row = run_pass_row(spec, model, &start, *iy, columns, cancel)?;
                 sink(&row);
                 Ok(row)
             })
             .collect::<Result<_, SimError>>()?;
-        done.extend(kept.into_iter().cloned());
-        done.sort_by_key(|r| r.iy);
-        merge_pass(spec, done.into_iter(), &mut attractors, &mut slots);
-        grid = Some(coarse_grid(nx, ny, stride, &slots));
+        rows.extend(done);
     }
-    Ok((attractors, slots))
+    Ok(rows)
 }
 
 /// The basin map of `spec`: rows in parallel (rayon, the current pool), their attractors
@@ -754,8 +811,8 @@ pub fn basins_with(spec: &BasinSpec, progress: &Progress) -> Result<BasinMap, Si
     let model = CantileverModel::new(&spec.params)?;
     progress.add_total(spec.xs.len() * spec.ys.len());
     let count = |r: &BasinRow| progress.advance(r.cells.len());
-    let merged = run_passes(spec, &model, &[], &count, progress.cancel_flag())?;
-    basin_map_of(spec, &model, merged)
+    let rows = run_passes(spec, &model, &[], &count, progress.cancel_flag())?;
+    basin_map(spec, rows)
 }
 
 /// The basin map of `spec` from the stored rows of every pass (in any order, as a run's
@@ -765,21 +822,28 @@ pub fn basins_with(spec: &BasinSpec, progress: &Progress) -> Result<BasinMap, Si
 /// # Errors
 /// [`SimError`] for invalid parameters; [`SimError::Cancelled`] when a cell is missing (a run
 /// that was cut short).
-pub fn basin_map(spec: &BasinSpec, mut rows: Vec<BasinRow>) -> Result<BasinMap, SimError> {
+pub fn basin_map(spec: &BasinSpec, rows: Vec<BasinRow>) -> Result<BasinMap, SimError> {
     let model = CantileverModel::new(&spec.params)?;
+    basin_map_of(spec, &model, merge_passes(spec, rows.into_iter()))
+}
+
+/// The rows of the passes (in any order) merged pass by pass in row order ([`merge_pass`]):
+/// the attractors in the order first found and the cells.
+fn merge_passes(spec: &BasinSpec, rows: impl Iterator<Item = BasinRow>) -> Merged {
     let (nx, ny) = (spec.xs.len(), spec.ys.len());
+    let mut rows: Vec<BasinRow> = rows.collect();
     rows.sort_by_key(|r| (r.pass, r.iy));
     let mut attractors: Vec<SteadyState> = Vec::new();
     let mut slots: Vec<Option<BasinCell>> = vec![None; nx * ny];
     let mut rows = rows.into_iter().peekable();
-    for pass in 0..strides(spec).len() {
+    for pass in 0..passes(spec) {
         let mut of_pass = Vec::new();
         while let Some(r) = rows.next_if(|r| r.pass == pass) {
             of_pass.push(r);
         }
         merge_pass(spec, of_pass.into_iter(), &mut attractors, &mut slots);
     }
-    basin_map_of(spec, &model, (attractors, slots))
+    (attractors, slots)
 }
 
 /// The map of merged passes: the attractors polished (shooting for the periodic ones, λ₁ for

@@ -382,10 +382,14 @@ pub fn continuation_warnings(param: SweepParam, branches: &[Branch]) -> Vec<Stri
 }
 
 mod branches;
+#[cfg(feature = "files")]
+mod curve_table;
 mod curves;
 mod series;
 mod units;
 pub use branches::*;
+#[cfg(feature = "files")]
+pub use curve_table::*;
 pub use curves::*;
 pub use series::*;
 pub use units::*;

@@ -16,7 +16,9 @@ pub fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, SimError
         .map_err(|e| SimError::out_of_range("threads", e, "cannot start the worker threads"))
 }
 
-/// Run `f` on a [`thread_pool`] of `threads`.
+/// Run `f` on a [`thread_pool`] of `threads`; `None` on the current pool (rayon's global pool
+/// of one thread per core, or the pool the caller runs in), which saves starting threads for
+/// a short run.
 ///
 /// # Errors
 /// As [`thread_pool`]; `f`'s errors.
@@ -25,7 +27,10 @@ pub fn in_pool<T: Send>(
     threads: Option<usize>,
     f: impl FnOnce() -> Result<T, SimError> + Send,
 ) -> Result<T, SimError> {
-    thread_pool(threads)?.install(f)
+    match threads {
+        None => f(),
+        Some(_) => thread_pool(threads)?.install(f),
+    }
 }
 
 /// Without the `parallel` feature: `f` on the calling thread.

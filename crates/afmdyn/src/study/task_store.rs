@@ -266,11 +266,7 @@ impl<'a, R: Serialize + DeserializeOwned> TaskStore<'a, R> {
         let record = v.remove(self.files.key).unwrap_or(Value::Null);
         let record = match self.files.encoding {
             Encoding::Json => serde_json::from_value(record).map_err(|e| e.to_string())?,
-            Encoding::Cbor => {
-                let text = record.as_str().ok_or("the record is not a string")?;
-                let bytes = BASE64.decode(text).map_err(|e| e.to_string())?;
-                ciborium::from_reader(bytes.as_slice()).map_err(|e| e.to_string())?
-            }
+            Encoding::Cbor => from_cbor_text(record.as_str().ok_or("the record is not a string")?)?,
         };
         Ok((task, record))
     }
@@ -279,11 +275,7 @@ impl<'a, R: Serialize + DeserializeOwned> TaskStore<'a, R> {
     fn encode(&self, record: &R) -> Result<Value, String> {
         match self.files.encoding {
             Encoding::Json => serde_json::to_value(record).map_err(|e| e.to_string()),
-            Encoding::Cbor => {
-                let mut bytes = Vec::new();
-                ciborium::into_writer(record, &mut bytes).map_err(|e| e.to_string())?;
-                Ok(Value::String(BASE64.encode(bytes)))
-            }
+            Encoding::Cbor => Ok(Value::String(to_cbor_text(record)?)),
         }
     }
 
@@ -362,6 +354,26 @@ impl<'a, R: Serialize + DeserializeOwned> TaskStore<'a, R> {
         })?;
         Ok(records.into_iter().collect())
     }
+}
+
+/// `value` as [`Encoding::Cbor`] text: its CBOR encoding in standard base64 (every f64 bit for
+/// bit) — also how a task's input and result travel to and from a Dask worker.
+///
+/// # Errors
+/// The encoder's message.
+pub fn to_cbor_text<T: Serialize + ?Sized>(value: &T) -> Result<String, String> {
+    let mut bytes = Vec::new();
+    ciborium::into_writer(value, &mut bytes).map_err(|e| e.to_string())?;
+    Ok(BASE64.encode(bytes))
+}
+
+/// The value of [`to_cbor_text`]'s `text`.
+///
+/// # Errors
+/// The decoder's message (not base64, not CBOR, not a `T`).
+pub fn from_cbor_text<T: DeserializeOwned>(text: &str) -> Result<T, String> {
+    let bytes = BASE64.decode(text).map_err(|e| e.to_string())?;
+    ciborium::from_reader(bytes.as_slice()).map_err(|e| e.to_string())
 }
 
 /// What a study resumed from a [`TaskStore`] skips, read back from it: the tasks stored
