@@ -79,7 +79,7 @@ impl<'py> Place<'py> {
         A::Output: Send + 'static,
         S: Study<Record = (usize, R)> + Send + 'static,
         S::Done: StoredTasks<R>,
-        R: Serialize + DeserializeOwned + Send + 'static,
+        R: Serialize + DeserializeOwned + Clone + Send + 'static,
     {
         let Some(dir) = self.store else {
             let doc = analysis(

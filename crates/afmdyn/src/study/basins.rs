@@ -158,7 +158,7 @@ pub mod store {
 
     /// The basin store of the directory `lock` holds.
     pub fn basin_store(lock: &DirLock) -> BasinStore<'_> {
-        TaskStore::new(lock, BASIN_FILES)
+        TaskStore::new(lock, BASIN_FILES).keeping()
     }
 }
 

@@ -160,7 +160,7 @@ pub mod store {
 
     /// The continuation store of the directory `lock` holds.
     pub fn continuation_store(lock: &DirLock) -> ContinuationStore<'_> {
-        TaskStore::new(lock, CONTINUATION_FILES)
+        TaskStore::new(lock, CONTINUATION_FILES).keeping()
     }
 }
 

@@ -203,7 +203,7 @@ pub mod store {
 
     /// The curve store of the directory `lock` holds.
     pub fn curve_store(lock: &DirLock) -> CurveStore<'_> {
-        TaskStore::new(lock, CURVE_FILES)
+        TaskStore::new(lock, CURVE_FILES).keeping()
     }
 }
 

@@ -88,10 +88,13 @@ pub struct TaskStore<'a, R> {
     writer: Option<BufWriter<File>>,
     /// The tasks stored (their records stay in the file: memory does not grow with the study).
     tasks: BTreeSet<usize>,
+    /// With [`TaskStore::keeping`]: a copy of the stored records, and whether it holds every
+    /// one (after a new run's start, or once a resumed store's records were read).
+    kept: Option<(BTreeMap<usize, R>, bool)>,
     record: PhantomData<fn() -> R>,
 }
 
-impl<'a, R: Serialize + DeserializeOwned> TaskStore<'a, R> {
+impl<'a, R: Serialize + DeserializeOwned + Clone> TaskStore<'a, R> {
     /// The store of the directory `lock` holds, in `files`.
     pub fn new(lock: &'a DirLock, files: TaskFiles) -> TaskStore<'a, R> {
         TaskStore {
@@ -99,8 +102,18 @@ impl<'a, R: Serialize + DeserializeOwned> TaskStore<'a, R> {
             lock,
             writer: None,
             tasks: BTreeSet::new(),
+            kept: None,
             record: PhantomData,
         }
+    }
+
+    /// The store keeping a copy of its records in memory, so that [`TaskStore::records`]
+    /// hands them back without reading and decoding the file again — for a study whose
+    /// records a resume reads anyway (a chain's: [`StoredTasks`] for `Vec<R>`), not for one
+    /// whose records must stay on disk.
+    pub fn keeping(mut self) -> TaskStore<'a, R> {
+        self.kept = Some((BTreeMap::new(), false));
+        self
     }
 
     fn path(&self, name: &str) -> PathBuf {
@@ -176,12 +189,18 @@ impl<'a, R: Serialize + DeserializeOwned> TaskStore<'a, R> {
                         return Err(CheckpointError::Mismatch { field, then, now });
                     }
                     self.tasks = self.read_records(|_, _| {})?;
+                    if let Some(k) = self.kept.as_mut() {
+                        *k = (BTreeMap::new(), false);
+                    }
                     self.reopen_writer()?;
                     return Ok(self.tasks.iter().copied().collect());
                 }
             }
         }
         self.tasks.clear();
+        if let Some(k) = self.kept.as_mut() {
+            *k = (BTreeMap::new(), true);
+        }
         match fs::remove_file(&tiles_path) {
             Ok(()) => {}
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
@@ -316,6 +335,9 @@ impl<'a, R: Serialize + DeserializeOwned> TaskStore<'a, R> {
                 .map_err(io("write", &path))?;
         }
         self.tasks.insert(task);
+        if let Some((kept, _)) = self.kept.as_mut() {
+            kept.entry(task).or_insert_with(|| record.clone());
+        }
         Ok(())
     }
 
@@ -348,10 +370,16 @@ impl<'a, R: Serialize + DeserializeOwned> TaskStore<'a, R> {
             let path = self.lock.path().join(self.files.records);
             w.flush().map_err(io("write", &path))?;
         }
+        if let Some((kept, true)) = &self.kept {
+            return Ok(kept.iter().map(|(t, r)| (*t, r.clone())).collect());
+        }
         let mut records = BTreeMap::new();
         self.read_records(|t, r| {
             records.insert(t, r);
         })?;
+        if let Some(k) = self.kept.as_mut() {
+            *k = (records.clone(), true);
+        }
         Ok(records.into_iter().collect())
     }
 }
@@ -395,7 +423,7 @@ impl<R> StoredTasks<R> for HashSet<usize> {
     }
 }
 
-impl<R: Serialize + DeserializeOwned> StoredTasks<R> for Vec<R> {
+impl<R: Serialize + DeserializeOwned + Clone> StoredTasks<R> for Vec<R> {
     fn stored(store: &mut TaskStore<'_, R>, _: HashSet<usize>) -> Result<Self, CheckpointError> {
         Ok(store.records()?.into_iter().map(|(_, r)| r).collect())
     }
@@ -405,7 +433,7 @@ impl<S, R> Store<S> for TaskStore<'_, R>
 where
     S: Study<Record = (usize, R)> + ?Sized,
     S::Done: StoredTasks<R>,
-    R: Serialize + DeserializeOwned + Send,
+    R: Serialize + DeserializeOwned + Clone + Send,
 {
     fn open(&mut self, study: &S, resume: bool) -> Result<Opened<S::Done>, CheckpointError> {
         let done = TaskStore::open(self, study.fingerprint(), resume)?;
@@ -516,6 +544,33 @@ mod tests {
         let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
         assert_eq!(back.len(), 1);
         assert_eq!(bits(&back[0].1), bits(&record));
+        drop(lock);
+        fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// A keeping store hands back the records the file holds (what a store that reads the file
+    /// gives), on a new run and after a resume, without a second copy of any task.
+    #[test]
+    fn a_keeping_store_hands_back_what_the_file_holds() {
+        let dir = std::env::temp_dir().join(format!("afmdyn-task-keep-{}", std::process::id()));
+        let _ = fs::remove_dir_all(&dir);
+        let lock = DirLock::acquire(&dir).unwrap();
+        let fp = json!({"t": 2});
+        let mut s: TaskStore<'_, Vec<String>> = TaskStore::new(&lock, FILES).keeping();
+        s.open(&fp, false).unwrap();
+        s.append(1, &vec!["b".into()]).unwrap();
+        s.append(0, &vec!["a".into()]).unwrap();
+        let reading = |lock| -> Vec<(usize, Vec<String>)> {
+            let mut r: TaskStore<'_, Vec<String>> = TaskStore::new(lock, FILES);
+            r.records().unwrap()
+        };
+        assert_eq!(s.records().unwrap(), reading(&lock));
+        let mut again: TaskStore<'_, Vec<String>> = TaskStore::new(&lock, FILES).keeping();
+        again.open(&fp, true).unwrap();
+        again.append(2, &vec!["c".into()]).unwrap();
+        let got = again.records().unwrap();
+        assert_eq!(got.len(), 3);
+        assert_eq!(got, reading(&lock));
         drop(lock);
         fs::remove_dir_all(&dir).unwrap();
     }
