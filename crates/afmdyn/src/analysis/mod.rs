@@ -3,7 +3,8 @@
 //! beyond the paper: Newton shooting, Floquet multipliers,
 //! pseudo-arclength continuation, Lyapunov exponents and the 0–1 test for chaos; the observables
 //! of a steady state (harmonics and phase, forces, sample dissipation, virial, energy balances);
-//! the amplitude spectrum of a time series.
+//! the amplitude spectrum of a time series; force reconstruction from FM-AFM frequency shifts
+//! ([`reconstruct`]: Sader–Jarvis).
 
 pub mod approach;
 pub mod attractors;
@@ -18,6 +19,7 @@ pub mod lyapunov;
 pub mod observables;
 pub mod period;
 pub mod progress;
+pub mod reconstruct;
 pub mod resonance;
 pub mod setpoint;
 pub mod settle;
