@@ -17,10 +17,12 @@
 //!   under one lock, reports progress to an [`Observer`], and finishes the store.
 //! - the studies: [`chart`] (a behaviour chart's tiles, its store [`chart_store`]), [`sweep`]
 //!   (a bifurcation sweep's points, stored by the request layer's checkpoints), [`basins`]
-//!   (a basin map's rows, pass by pass, its store `basins::basin_store`) and
+//!   (a basin map's rows, pass by pass, its store `basins::basin_store`),
 //!   [`global_continuation`] (a global continuation's values, one chain, its store
 //!   `global_continuation::continuation_store`) and [`stepped`] (an approach or resonance
-//!   curve's points, one chain through both sweeps, its store `stepped::curve_store`).
+//!   curve's points, one chain through both sweeps, its store `stepped::curve_store`). A
+//!   chain's resume reads its stored records back (its next task starts from them: `Done` is
+//!   the records); a study of independent tasks reads only their numbers.
 //!
 //! The results' variables are declared once in [`crate::layout`], from which the NetCDF file,
 //! the Python `xarray.Dataset` and the Dask Zarr store are written.
@@ -228,7 +230,8 @@ pub fn execute<S: Study + ?Sized, St: Store<S>>(
 /// `threads` workers reporting to `observer`): its records in the order they finished.
 ///
 /// # Errors
-/// [`SimError::Cancelled`] when the observer's flag stopped the run; the pool's errors.
+/// [`SimError::Cancelled`] when the observer's flag stopped the run; the pool's errors and the
+/// study's ([`Study::run`]).
 pub fn execute_in_memory<S: Study + ?Sized>(
     study: &S,
     threads: Option<usize>,
