@@ -56,7 +56,7 @@ FUNCTIONS = [
     ),
 ]
 #: requests with a stub but no compiled function of their own (the chart's study takes JSON)
-OTHERS = ["chart"]
+OTHERS = ["chart", "reconstruct"]
 
 
 def py_type(prop: dict, defs: dict) -> str:

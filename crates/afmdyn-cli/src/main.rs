@@ -34,6 +34,7 @@ mod cmd_basins;
 mod cmd_chart;
 mod cmd_modes;
 mod cmd_orbits;
+mod cmd_reconstruct;
 mod cmd_simulate;
 mod error;
 mod output;
@@ -93,6 +94,8 @@ enum Command {
     Approach(cmd_approach::ApproachArgs),
     /// Resonance curve near a mode: up- and down-sweep in frequency, branches, folds
     Resonance(cmd_approach::ResonanceArgs),
+    /// Tip–sample force and potential from an FM-AFM frequency-shift curve (Sader–Jarvis)
+    Reconstruct(cmd_reconstruct::ReconstructArgs),
 }
 
 fn run(cli: Cli) -> Result<(), CliError> {
@@ -112,6 +115,7 @@ fn run(cli: Cli) -> Result<(), CliError> {
         Command::Lyapunov(a) => cmd_orbits::lyapunov(&a),
         Command::Approach(a) => cmd_approach::approach(&a),
         Command::Resonance(a) => cmd_approach::resonance(&a),
+        Command::Reconstruct(a) => cmd_reconstruct::reconstruct(&a),
     }
 }
 

@@ -459,6 +459,30 @@ pub fn lyapunov<'py>(
     Ok(out.finish())
 }
 
+/// The force and potential behind a frequency-modulation curve (`afmdyn reconstruct`): the
+/// JSON document (the Python layer builds the dataset from it).
+#[pyfunction]
+#[pyo3(signature = (request=None, progress=None))]
+pub fn reconstruct<'py>(
+    py: Python<'py>,
+    request: Option<&Dict<'py>>,
+    progress: Option<Bound<'py, PyAny>>,
+) -> PyResult<Dict<'py>> {
+    let request: afmdyn::request::ReconstructRequest =
+        crate::convert::request("reconstruct", request)?;
+    let doc = analysis(
+        py,
+        request,
+        Params::default(),
+        None,
+        progress.as_ref(),
+        false,
+    )?;
+    let out = Out::new(py);
+    out.json(&doc.json)?;
+    Ok(out.finish())
+}
+
 /// A probe (SI units, `afmdyn … --probe FILE`; its TOML text from [`crate::params::probe_source`]): its
 /// dimensionless parameters and the `"si"` block of the command line's JSON (scales,
 /// calibration, drive, A₀, z_c).

@@ -309,6 +309,7 @@ pub fn request_default(name: &str) -> Option<serde_json::Value> {
         "resonance" => v::<ResonanceRequest>(),
         "basins" => v::<BasinsRequest>(),
         "chart" => v::<ChartRequest>(),
+        "reconstruct" => v::<ReconstructRequest>(),
         _ => None,
     }
 }

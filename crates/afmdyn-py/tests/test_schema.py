@@ -28,7 +28,10 @@ IMPACT_PY = dict(contact_law="impact", restitution=0.5, modes=1, gap=0.05, omega
 SHORT = ["--max-periods", 300]
 
 COMMANDS = ["modes", "units", "simulate", "converge", "bifurcation", "attractors", "orbit",
-            "continue", "lyapunov", "approach", "resonance", "chart", "basins"]
+            "continue", "lyapunov", "approach", "resonance", "chart", "basins", "reconstruct"]
+FM = str(EXAMPLES / "fm-vdw.csv")
+FM_ARGS = ["--fm", FM, "--spring-constant", 40, "--resonance-frequency", "300kHz",
+           "--amplitude", "10nm"]
 SHARED = ["params", "si"]
 PYTHON_ONLY = ["observe"]
 
@@ -112,12 +115,14 @@ CLI_CASES: List[Tuple[str, List[Any]]] = [
     ("chart", ["--x-steps", 2, "--y-steps", 1, "--starts", 1, "--lyapunov-periods", 20, *SHORT]),
     ("basins", ["--x-steps", 3, "--y-steps", 2, *SHORT, *IMPACT]),
     ("basins", ["--x-steps", 2, "--y-steps", 1, *SHORT, "--probe", P1]),
+    ("reconstruct", FM_ARGS),
     # (a probe refuses the dimensionless omega axis: the drive frequency in Hz, 0.99 f0)
     ("chart", ["--x", "z-c", "--x-from", 6e-9, "--x-to", 8e-9, "--x-steps", 2, "--y",
                "drive-frequency", "--y-from", "297kHz", "--y-to", "297kHz", "--y-steps", 1,
                "--starts", 1, *SHORT, "--probe", P1]),
 ]
-WRITES = {"simulate", "converge", "bifurcation", "attractors", "continue", "chart", "basins"}
+WRITES = {"simulate", "converge", "bifurcation", "attractors", "continue", "chart", "basins",
+          "reconstruct"}
 
 
 @pytest.fixture(scope="module")
@@ -188,7 +193,17 @@ def _python_docs() -> List[Tuple[str, str, Callable[[], Any]]]:
         ("observe", "observe", lambda: afmdyn.summary(afmdyn.observe())),
         ("observe", "observe probe", lambda: afmdyn.summary(afmdyn.observe(probe=P1))),
         ("observe", "observe impact", lambda: afmdyn.summary(afmdyn.observe(**IMPACT_PY))),
+        ("reconstruct", "reconstruct", lambda: afmdyn.summary(afmdyn.reconstruct(
+            **_fm_curve(), spring_constant=40.0, resonance_frequency=3e5, amplitude=1e-8))),
     ]
+
+
+def _fm_curve() -> Dict[str, Any]:
+    import csv
+
+    with open(FM, newline="", encoding="utf-8") as f:
+        rows = list(csv.DictReader(f))
+    return {k: [float(r[k]) for r in rows] for k in ("distance", "frequency_shift")}
 
 
 PY_CASES = _python_docs()
@@ -293,7 +308,7 @@ def test_every_request_has_a_schema() -> None:
     assert REQUEST_NAMES == sorted(
         ["model", "steady", "integrator", "start", "orbit", "continuation", "lyapunov",
          "attractors", "observe", "converge", "simulate", "bifurcation", "curve", "modes",
-         "approach", "resonance", "chart", "global_continuation", "basins"]
+         "approach", "resonance", "chart", "global_continuation", "basins", "reconstruct"]
     )
 
 

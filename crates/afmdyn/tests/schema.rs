@@ -7,7 +7,8 @@
 #![cfg(feature = "schema")]
 
 use afmdyn::request::{
-    ApproachRequest, BasinsRequest, ChartRequest, ModesRequest, ResonanceRequest,
+    ApproachRequest, BasinsRequest, ChartRequest, ModesRequest, ReconstructRequest,
+    ResonanceRequest,
 };
 use afmdyn::request::{
     AttractorsRequest, BifurcationRequest, ContinuationRequest, ConvergeRequest, CurveRequest,
@@ -71,6 +72,7 @@ fn schemas() -> Vec<(&'static str, Value)> {
         ("resonance", schema::<ResonanceRequest>("resonance")),
         ("chart", schema::<ChartRequest>("chart")),
         ("basins", schema::<BasinsRequest>("basins")),
+        ("reconstruct", schema::<ReconstructRequest>("reconstruct")),
     ]
 }
 

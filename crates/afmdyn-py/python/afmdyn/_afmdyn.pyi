@@ -378,6 +378,19 @@ ChartRequest = TypedDict(
     total=False,
 )
 
+ReconstructRequest = TypedDict(
+    "ReconstructRequest",
+    {
+        "amplitude": float,  # default 0.0
+        "distance": Optional[List[float]],  # default null
+        "frequency_shift": List[float],  # default []
+        "resonance_frequency": float,  # default 0.0
+        "spring_constant": float,  # default 0.0
+        "z_c": Optional[List[float]],  # default null
+    },
+    total=False,
+)
+
 def simulate(
     params: Params,
     request: Optional[SimulateRequest] = None,
@@ -473,6 +486,10 @@ def basins(
 
 # --- end of the generated block ---
 
+def reconstruct(
+    request: Optional[ReconstructRequest] = None,
+    progress: Optional[ProgressCallback] = None,
+) -> Dict[str, Any]: ...
 def cantilevers() -> str: ...
 def probe(text: str) -> Tuple[Params, str]: ...
 def probe_source(

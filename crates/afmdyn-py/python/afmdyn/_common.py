@@ -305,5 +305,6 @@ _DEFAULTS = {
 def summary(ds: xr.Dataset) -> Dict[str, Any]:
     """The command line's ``--json`` document stored with a dataset afmdyn returned
     (``simulate``, ``converge``, ``continuation``, ``approach``, ``resonance``, ``observe``,
-    ``basins``, ``global_continuation``); the same as ``ds.afmdyn.to_dict()``."""
+    ``basins``, ``global_continuation``, ``reconstruct``); the same as
+    ``ds.afmdyn.to_dict()``."""
     return json.loads(ds.attrs["summary"])

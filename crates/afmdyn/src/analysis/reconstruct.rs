@@ -215,7 +215,10 @@ mod tests {
             // (an offset of the force adds only round-off, amplified by f0/(k A))
             let linear = |d: f64| -1e-9 + 0.5 * d;
             let got = giessibl_shift(&linear, 5e-10, k, f0, a, 8);
-            assert!((got / (-f0 * 0.5 / (2.0 * k)) - 1.0).abs() < 1e-9, "A = {a}: {got}");
+            assert!(
+                (got / (-f0 * 0.5 / (2.0 * k)) - 1.0).abs() < 1e-9,
+                "A = {a}: {got}"
+            );
             let (f_0, lambda) = (-2e-9, 3e-10);
             let exp = |d: f64| f_0 * (-d / lambda).exp();
             let d = 4e-10;

@@ -39,6 +39,7 @@ pub mod dir_lock;
 pub mod limits;
 pub mod model;
 pub mod pool;
+pub mod reconstruct;
 pub mod run;
 pub mod simulate;
 #[cfg(feature = "files")]
@@ -62,6 +63,7 @@ pub use model::{parameter, ModelSpec, ParamInfo, MODEL_PARAMETERS};
 pub use pool::in_pool;
 #[cfg(feature = "parallel")]
 pub use pool::thread_pool;
+pub use reconstruct::ReconstructRequest;
 pub use run::{run, Analysis, ApproachRequest, Document, ModesRequest, Resolved, ResonanceRequest};
 pub use sweep::{fingerprint, SweepRecord};
 

@@ -1,0 +1,163 @@
+//! `afmdyn reconstruct`: the tip–sample force and potential behind a frequency-modulation
+//! curve by the Sader–Jarvis inversion. The request, the inversion and the document are the
+//! library's ([`afmdyn::request::ReconstructRequest`], [`afmdyn::analysis::reconstruct`]);
+//! this front end reads the curve's CSV, maps the flags, and writes `reconstruct.csv`, the
+//! force plot and the JSON document.
+
+use crate::args::{quantity, Dim, Quantity};
+use crate::error::CliError;
+use crate::output::{write_bytes, write_csv_numbers, OutDir};
+use crate::plot::{save, Figure, Series, Style};
+use afmdyn::request::{self, ReconstructRequest, Resolved};
+use clap::Args;
+use std::path::{Path, PathBuf};
+
+/// `afmdyn reconstruct` flags.
+#[derive(Debug, Args)]
+pub struct ReconstructArgs {
+    /// The frequency-shift curve: a CSV with a header naming `frequency_shift` (Hz) and
+    /// `distance` (m, closest approach) or `z_c` (m, rest distance: d = z_c − A)
+    #[arg(long, value_name = "FILE")]
+    fm: PathBuf,
+    /// Spring constant k (N/m)
+    #[arg(long)]
+    spring_constant: f64,
+    /// Free resonance frequency f0 (Hz; a unit may follow: 300kHz)
+    #[arg(long)]
+    resonance_frequency: Quantity,
+    /// Oscillation amplitude A (m; a unit may follow: 10nm)
+    #[arg(long)]
+    amplitude: Quantity,
+    /// Output directory (locked during the run)
+    #[arg(long, default_value = "afmdyn-out/reconstruct")]
+    out: PathBuf,
+    /// Print one JSON document
+    #[arg(long)]
+    json: bool,
+}
+
+/// The curve's columns by name from the CSV `path`.
+fn read_curve(path: &Path) -> Result<(Vec<String>, Vec<Vec<f64>>), CliError> {
+    let bad = |what: String| CliError::Input(format!("--fm {}: {what}", path.display()));
+    let mut reader = csv::Reader::from_path(path).map_err(|e| bad(e.to_string()))?;
+    let names: Vec<String> = reader
+        .headers()
+        .map_err(|e| bad(e.to_string()))?
+        .iter()
+        .map(|h| h.trim().to_string())
+        .collect();
+    let mut columns = vec![Vec::new(); names.len()];
+    for (line, record) in reader.records().enumerate() {
+        let record = record.map_err(|e| bad(e.to_string()))?;
+        for (k, field) in record.iter().enumerate().take(names.len()) {
+            let v: f64 = field.trim().parse().map_err(|_| {
+                bad(format!(
+                    "line {}: {} = {field:?} is not a number",
+                    line + 2,
+                    names[k]
+                ))
+            })?;
+            columns[k].push(v);
+        }
+    }
+    Ok((names, columns))
+}
+
+/// Run `afmdyn reconstruct`.
+pub fn reconstruct(a: &ReconstructArgs) -> Result<(), CliError> {
+    let (names, mut columns) = read_curve(&a.fm)?;
+    let mut take = |name: &str| {
+        names
+            .iter()
+            .position(|n| n == name)
+            .map(|k| std::mem::take(&mut columns[k]))
+    };
+    let frequency_shift = take("frequency_shift").ok_or_else(|| {
+        CliError::Input(format!(
+            "--fm {}: no frequency_shift column (the header has {})",
+            a.fm.display(),
+            names.join(", ")
+        ))
+    })?;
+    let request = ReconstructRequest {
+        distance: take("distance"),
+        z_c: take("z_c"),
+        frequency_shift,
+        spring_constant: a.spring_constant,
+        resonance_frequency: quantity(
+            Some(a.resonance_frequency),
+            "resonance-frequency",
+            Dim::Frequency,
+            true,
+        )?
+        .unwrap_or(f64::NAN),
+        amplitude: quantity(Some(a.amplitude), "amplitude", Dim::Length, true)?.unwrap_or(f64::NAN),
+    };
+    let model = Resolved::plain(afmdyn::Params::default());
+    request::Analysis::validate(&request, &model)?;
+    let out = OutDir::lock(&a.out)?;
+    let doc = request::run(
+        &request,
+        &model,
+        &afmdyn::analysis::progress::Progress::new(),
+    )?;
+    let r = &doc.output;
+    write_csv_numbers(
+        &out.join("reconstruct.csv"),
+        &["distance", "force", "potential"],
+        r.distance
+            .iter()
+            .zip(&r.force)
+            .zip(&r.potential)
+            .map(|((d, f), u)| [*d, *f, *u]),
+    )?;
+    let points = |ys: &[f64]| r.distance.iter().copied().zip(ys.iter().copied()).collect();
+    save(
+        out.path(),
+        "reconstruct-force",
+        &Figure {
+            title: "Tip–sample force by the Sader–Jarvis inversion".into(),
+            x_label: "distance of closest approach d (m)".into(),
+            y_label: "force F (N)".into(),
+            series: vec![Series {
+                label: String::new(),
+                points: points(&r.force),
+                style: Style::Line,
+                color: 0,
+            }],
+            shade: Vec::new(),
+            y_min_span: 0.0,
+        },
+    )?;
+    let mut json = doc.json;
+    json["csv"] = serde_json::json!(out.join("reconstruct.csv"));
+    write_bytes(
+        &out.join("reconstruct.json"),
+        serde_json::to_string_pretty(&json)
+            .expect("json")
+            .as_bytes(),
+    )?;
+    for w in json["warnings"].as_array().into_iter().flatten() {
+        errln!("afmdyn: warning: {}", w.as_str().unwrap_or_default());
+    }
+    if a.json {
+        outln!("{json}");
+    } else {
+        let (k, f) = r
+            .force
+            .iter()
+            .enumerate()
+            .min_by(|x, y| x.1.total_cmp(y.1))
+            .map_or((0, f64::NAN), |(k, f)| (k, *f));
+        outln!(
+            "{} distances from {:e} m to {:e} m: most attractive force {f:e} N at d = {:e} m; \
+             outputs in {}",
+            r.distance.len(),
+            r.distance[0],
+            r.distance[r.distance.len() - 1],
+            r.distance.get(k).copied().unwrap_or(f64::NAN),
+            out.path().display()
+        );
+    }
+    Ok(())
+}

@@ -1,0 +1,82 @@
+"""The tip–sample force behind a frequency-modulation curve (``afmdyn reconstruct``): the
+library's Sader–Jarvis inversion as an ``xarray.Dataset`` in SI."""
+
+from __future__ import annotations
+
+import json
+from typing import Any, Optional, Sequence
+
+import numpy as np
+import xarray as xr
+
+from . import _afmdyn as _core
+from ._progress import ProgressArg, reporter
+
+
+def _values(v: Optional[Any]) -> Optional[list]:
+    return None if v is None else np.asarray(v, dtype=np.float64).ravel().tolist()
+
+
+def reconstruct(
+    *,
+    frequency_shift: Sequence[float],
+    spring_constant: float,
+    resonance_frequency: float,
+    amplitude: float,
+    distance: Optional[Sequence[float]] = None,
+    z_c: Optional[Sequence[float]] = None,
+    progress: ProgressArg = None,
+) -> xr.Dataset:
+    """The tip–sample force F(d) and potential U(d) behind a frequency-modulation curve, by
+    the Sader–Jarvis inversion (J. E. Sader and S. P. Jarvis, Appl. Phys. Lett. 84, 1801
+    (2004); ``afmdyn reconstruct``).
+
+    Args:
+        frequency_shift: Δf = f − f0 (Hz) at each distance.
+        distance: the distances of closest approach d (m), monotonic; or
+        z_c: the rest distances (m), d = z_c − A.
+        spring_constant: k (N/m). resonance_frequency: f0 (Hz). amplitude: A (m).
+
+    Returns:
+        ``xarray.Dataset`` over ``distance`` (m, increasing): ``force`` (N, attractive < 0),
+        ``potential`` (J, ∫_d^{d_max} F); attributes ``spring_constant``,
+        ``resonance_frequency``, ``amplitude`` and ``summary`` (the command line's JSON
+        document). The force near the largest distance is not reconstructed (the inversion
+        integrates the shift beyond each distance): take data out to where Δf has decayed.
+
+    Raises:
+        ValueError: naming the field — fewer than 3 points, distances not monotonic, lengths
+            that differ, constants not > 0, neither or both of ``distance`` and ``z_c``.
+    """
+    request = dict(
+        frequency_shift=_values(frequency_shift),
+        distance=_values(distance),
+        z_c=_values(z_c),
+        spring_constant=float(spring_constant),
+        resonance_frequency=float(resonance_frequency),
+        amplitude=float(amplitude),
+    )
+    with reporter(progress, "reconstruct") as cb:
+        d = _core.reconstruct(request, progress=cb)
+    doc = json.loads(d["json"])
+    f = doc["force"]
+    units = doc["units"]
+    return xr.Dataset(
+        {
+            "force": ("distance", np.asarray(f["force"]),
+                      {"units": units["force"], "long_name": "tip–sample force F(d)"}),
+            "potential": ("distance", np.asarray(f["potential"]),
+                          {"units": units["potential"],
+                           "long_name": "potential U(d), integral of F from d to the last distance"}),
+        },
+        coords={"distance": ("distance", np.asarray(f["distance"]),
+                             {"units": units["distance"],
+                              "long_name": "distance of closest approach d"})},
+        attrs={
+            "spring_constant": doc["spring_constant"],
+            "resonance_frequency": doc["resonance_frequency"],
+            "amplitude": doc["amplitude"],
+            "method": doc["method"],
+            "summary": json.dumps(doc),
+        },
+    )
