@@ -17,7 +17,10 @@
 //! F(d) = 2k ∫_d^∞ [ (1 + A^{1/2} / (8 √(π (t − d)))) Ω(t) − A^{3/2} / √(2 (t − d)) Ω′(t) ] dt
 //!
 //! (J. E. Sader and S. P. Jarvis, Appl. Phys. Lett. 84, 1801 (2004), eq. 9: accurate to a few
-//! per cent at any amplitude, exact in the small- and large-amplitude limits). Discretised as
+//! per cent at any amplitude, exact in the small- and large-amplitude limits; its error
+//! against the amplitude over the force's decay length, with two minima and a maximum
+//! between them: J. Welker, E. Illek and F. J. Giessibl, Beilstein J. Nanotechnol. 3, 238
+//! (2012)). Discretised as
 //! the paper's authors do (and the published implementations after them): the trapezoidal rule
 //! on the grid beyond the next point, and on the first interval [d_j, d_{j+1}] the integral
 //! taken exactly with Ω and Ω′ held at their values at d_j — which removes the integrable
