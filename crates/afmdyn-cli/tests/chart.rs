@@ -11,6 +11,29 @@ fn afmdyn(args: &[&str]) -> Output {
         .expect("run afmdyn")
 }
 
+/// `out` succeeded (its stderr shown when not).
+fn succeeded(out: &Output) {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+/// `files` of the directories `a` and `b` are byte for byte the same.
+fn same_files(a: &Path, b: &Path, files: &[&str]) {
+    for f in files {
+        let (x, y) = (
+            std::fs::read(a.join(f)).unwrap(),
+            std::fs::read(b.join(f)).unwrap(),
+        );
+        assert!(
+            x == y,
+            "{f}: the resumed run's differs from the uninterrupted one's"
+        );
+    }
+}
+
 const SMALL: [&str; 12] = [
     "chart",
     "--x-steps",
@@ -37,11 +60,7 @@ fn small(out: &Path, extra: &[&str]) -> Output {
 fn chart_json_lists_every_cell_and_its_attractors() {
     let dir = tempfile::tempdir().unwrap();
     let out = small(dir.path(), &[]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    succeeded(&out);
     let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(doc["x"]["name"], "omega");
     assert_eq!(doc["y"]["name"], "drive_amplitude");
@@ -94,18 +113,8 @@ fn a_killed_chart_resumes_to_the_uninterrupted_files() {
     // a line cut as a kill during a write would leave it
     std::fs::write(&tiles, text + "{\"task\": 3, \"cells\": [{\"ix\"").unwrap();
     let resumed = small(cut.path(), &["--resume"]);
-    assert!(
-        resumed.status.success(),
-        "{}",
-        String::from_utf8_lossy(&resumed.stderr)
-    );
-    for f in ["chart.csv", "chart.nc"] {
-        assert_eq!(
-            std::fs::read(full.path().join(f)).unwrap(),
-            std::fs::read(cut.path().join(f)).unwrap(),
-            "{f}: the resumed chart equals the uninterrupted one"
-        );
-    }
+    succeeded(&resumed);
+    same_files(full.path(), cut.path(), &["chart.csv", "chart.nc"]);
     let stored = std::fs::read_to_string(&tiles).unwrap();
     assert_eq!(stored.lines().count(), 4, "no lost or duplicated task");
     // a finished store computes nothing on --resume; another request is refused
@@ -166,18 +175,8 @@ fn a_killed_basin_map_resumes_to_the_uninterrupted_files() {
     // a line cut as a kill during a write would leave it
     std::fs::write(&rows, text + "{\"row\": {\"pass\": 0, \"iy\"").unwrap();
     let resumed = two_pass_basins(cut.path(), &["--resume"]);
-    assert!(
-        resumed.status.success(),
-        "{}",
-        String::from_utf8_lossy(&resumed.stderr)
-    );
-    for f in ["basins.csv", "basins.nc"] {
-        assert!(
-            std::fs::read(full.path().join(f)).unwrap()
-                == std::fs::read(cut.path().join(f)).unwrap(),
-            "{f}: the resumed map equals the uninterrupted one"
-        );
-    }
+    succeeded(&resumed);
+    same_files(full.path(), cut.path(), &["basins.csv", "basins.nc"]);
     // the document too, but for the files' paths
     let doc = |d: &Path| {
         let mut v: serde_json::Value =
@@ -208,11 +207,7 @@ fn a_killed_basin_map_resumes_to_the_uninterrupted_files() {
     let killed = two_pass_basins(late.path(), &["--threads", "1", "--abort-after", "30"]);
     assert!(!killed.status.success(), "the run was killed");
     assert!(two_pass_basins(late.path(), &["--resume"]).status.success());
-    assert!(
-        std::fs::read(full.path().join("basins.csv")).unwrap()
-            == std::fs::read(late.path().join("basins.csv")).unwrap(),
-        "a map resumed in its second pass equals the uninterrupted one"
-    );
+    same_files(full.path(), late.path(), &["basins.csv"]);
     let again = two_pass_basins(cut.path(), &["--resume"]);
     assert!(again.status.success());
     assert_eq!(std::fs::read_to_string(&rows).unwrap(), stored);
@@ -251,28 +246,18 @@ fn a_killed_global_continuation_resumes_to_the_uninterrupted_files() {
     let full = tempfile::tempdir().unwrap();
     let cut = tempfile::tempdir().unwrap();
     let run = continuation(full.path(), &[]);
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
+    succeeded(&run);
     let killed = continuation(cut.path(), &["--abort-after", "3"]);
     assert!(!killed.status.success(), "the run was killed");
     let values = cut.path().join(".continuation.values.jsonl");
     assert_eq!(std::fs::read_to_string(&values).unwrap().lines().count(), 3);
     let resumed = continuation(cut.path(), &["--resume"]);
-    assert!(
-        resumed.status.success(),
-        "{}",
-        String::from_utf8_lossy(&resumed.stderr)
+    succeeded(&resumed);
+    same_files(
+        full.path(),
+        cut.path(),
+        &["attractors-sweep.csv", "attractors-sweep.nc"],
     );
-    for f in ["attractors-sweep.csv", "attractors-sweep.nc"] {
-        assert!(
-            std::fs::read(full.path().join(f)).unwrap()
-                == std::fs::read(cut.path().join(f)).unwrap(),
-            "{f}: the resumed continuation equals the uninterrupted one"
-        );
-    }
     assert_eq!(std::fs::read_to_string(&values).unwrap().lines().count(), 9);
     let other = continuation(cut.path(), &["--resume", "--match-tol", "0.2"]);
     assert_eq!(other.status.code(), Some(2));
@@ -301,11 +286,7 @@ fn a_killed_approach_curve_resumes_to_the_uninterrupted_files() {
     let full = tempfile::tempdir().unwrap();
     let cut = tempfile::tempdir().unwrap();
     let run = approach_curve(full.path(), &[]);
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
+    succeeded(&run);
     let killed = approach_curve(cut.path(), &["--abort-after", "50"]);
     assert!(!killed.status.success(), "the run was killed");
     let points = cut.path().join(".curve.points.jsonl");
@@ -314,18 +295,8 @@ fn a_killed_approach_curve_resumes_to_the_uninterrupted_files() {
         50
     );
     let resumed = approach_curve(cut.path(), &["--resume"]);
-    assert!(
-        resumed.status.success(),
-        "{}",
-        String::from_utf8_lossy(&resumed.stderr)
-    );
-    for f in ["approach.csv", "approach.npy"] {
-        assert!(
-            std::fs::read(full.path().join(f)).unwrap()
-                == std::fs::read(cut.path().join(f)).unwrap(),
-            "{f}: the resumed curve equals the uninterrupted one"
-        );
-    }
+    succeeded(&resumed);
+    same_files(full.path(), cut.path(), &["approach.csv", "approach.npy"]);
     let none = approach_curve(cut.path(), &["--resume", "--files", "none"]);
     assert_eq!(none.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&none.stderr).contains("--files none keeps no store"));
@@ -393,11 +364,7 @@ fn basins_json_has_the_labels_attractors_and_measures() {
         "--out",
         dir.path().to_str().unwrap(),
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    succeeded(&out);
     let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(doc["x"]["name"], "a1");
     assert_eq!(doc["y"]["name"], "adot1");

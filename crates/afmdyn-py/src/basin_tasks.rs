@@ -97,15 +97,7 @@ impl BasinMapStudy {
     }
 
     fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
-        let py = slf.py();
-        let cls = py.get_type::<BasinMapStudy>();
-        PyTuple::new(
-            py,
-            [
-                cls.into_any(),
-                PyTuple::new(py, [slf.get().text.clone()])?.into_any(),
-            ],
-        )
+        crate::convert::rebuilt_from::<BasinMapStudy>(slf.py(), &slf.get().text)
     }
 
     /// The number of passes (one where the plane is not the whole section).

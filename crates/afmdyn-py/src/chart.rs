@@ -116,15 +116,7 @@ impl ChartStudy {
     }
 
     fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
-        let py = slf.py();
-        let cls = py.get_type::<ChartStudy>();
-        PyTuple::new(
-            py,
-            [
-                cls.into_any(),
-                PyTuple::new(py, [slf.get().recipe.clone()])?.into_any(),
-            ],
-        )
+        crate::convert::rebuilt_from::<ChartStudy>(slf.py(), &slf.get().recipe)
     }
 
     /// The fingerprint (JSON text): what a stored chart must match to be resumed.

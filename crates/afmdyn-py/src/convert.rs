@@ -313,3 +313,22 @@ pub fn request_default(name: &str) -> Option<serde_json::Value> {
         _ => None,
     }
 }
+
+/// The `__reduce__` of a study class that any process rebuilds from its recipe (a JSON text):
+/// `(cls, (recipe,))`, so that it pickles to Dask workers as its recipe.
+///
+/// # Errors
+/// Python's, building the tuples.
+pub fn rebuilt_from<'py, T: pyo3::PyTypeInfo>(
+    py: Python<'py>,
+    recipe: &str,
+) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
+    use pyo3::types::PyTuple;
+    PyTuple::new(
+        py,
+        [
+            py.get_type::<T>().into_any(),
+            PyTuple::new(py, [recipe])?.into_any(),
+        ],
+    )
+}

@@ -126,6 +126,21 @@ impl<'py> Place<'py> {
     }
 }
 
+/// What a study's function returns to the Python layer: `json` (the document) and, when the
+/// result has one, `layout` (its arrays, [`crate::convert::layout_dict`]).
+fn returned<'py>(
+    py: Python<'py>,
+    json: &serde_json::Value,
+    layout: Option<afmdyn::layout::Layout>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let out = Out::new(py);
+    out.json(json)?;
+    if let Some(l) = layout {
+        out.set("layout", crate::convert::layout_dict(py, l)?)?;
+    }
+    Ok(out.finish())
+}
+
 /// A basin map over two coordinates of the initial state (see `afmdyn.basins`); with `store`
 /// (a directory) its rows are kept there as `afmdyn basins --out DIR` keeps them, and
 /// `resume` continues an interrupted map of the same request.
@@ -152,13 +167,7 @@ pub fn basins<'py>(
         basin_store,
         |s: &BasinStudy, records, _| s.map(records.into_iter().map(|(_, r)| r)),
     )?;
-    let out = Out::new(py);
-    out.json(&json)?;
-    out.set(
-        "layout",
-        crate::convert::layout_dict(py, BasinArrays::new(&map).layout(&spec))?,
-    )?;
-    Ok(out.finish())
+    returned(py, &json, Some(BasinArrays::new(&map).layout(&spec)))
 }
 
 /// Attractors continued over a parameter (global continuation): the JSON document of
@@ -189,16 +198,8 @@ pub fn global_continuation<'py>(
         continuation_store,
         |s: &ContinuationStudy, records, _| s.steps(records),
     )?;
-    let out = Out::new(py);
-    out.json(&json)?;
-    out.set(
-        "layout",
-        crate::convert::layout_dict(
-            py,
-            afmdyn::report::global_continuation_layout(param, &steps),
-        )?,
-    )?;
-    Ok(out.finish())
+    let layout = afmdyn::report::global_continuation_layout(param, &steps);
+    returned(py, &json, Some(layout))
 }
 
 /// A stepped curve's document: the request `R` named `name` on `params`, through
@@ -222,9 +223,7 @@ where
         curve_store,
         |s: &CurveStudy, records, progress| s.curve(records, progress),
     )?;
-    let out = Out::new(py);
-    out.json(&json)?;
-    Ok(out.finish())
+    returned(py, &json, None)
 }
 
 /// The approach–retract curve over the rest distance z_c (`afmdyn approach`); with `store` (a

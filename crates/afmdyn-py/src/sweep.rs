@@ -86,14 +86,7 @@ impl SweepStudy {
     }
 
     fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
-        let py = slf.py();
-        PyTuple::new(
-            py,
-            [
-                py.get_type::<SweepStudy>().into_any(),
-                PyTuple::new(py, [slf.get().recipe.clone()])?.into_any(),
-            ],
-        )
+        crate::convert::rebuilt_from::<SweepStudy>(slf.py(), &slf.get().recipe)
     }
 
     /// The number of tasks of `stage` (0: the coarse passes, 1: segments and random starts).

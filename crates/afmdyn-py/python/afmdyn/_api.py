@@ -266,7 +266,7 @@ def bifurcation(
         progress,
         p,
         request=req,
-        store=None if store is None else os.fspath(store),
+        store=store,
         resume=resume,
     )
     return _sweep_dataset(p, d, starts, seed)
@@ -400,7 +400,7 @@ def _curve(
     (:func:`afmdyn._curves.curve_dataset`; in SI with a probe)."""
     p, probe = _params(params, model)
     d = _run(fn, desc, progress, p, si=probe, request=request,
-             store=None if store is None else os.fspath(store), resume=resume)
+             store=store, resume=resume)
     return curve_dataset(desc, json.loads(d["json"]))
 
 

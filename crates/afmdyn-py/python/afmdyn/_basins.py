@@ -83,7 +83,7 @@ def basins(
         p,
         si=probe,
         request=req,
-        store=None if store is None else os.fspath(store),
+        store=store,
         resume=resume,
     )
     return _dataset(d["layout"], json.loads(d["json"]), p)

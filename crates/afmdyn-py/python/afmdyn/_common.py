@@ -281,10 +281,12 @@ def _run(
     checks them) with a progress reporter; negative counts are a ValueError naming the option
     (the core's unsigned integers would raise OverflowError). With ``si`` (a probe file)
     ``fn`` gets ``probe=si``, and its JSON document the command line's ``"si"`` block (added
-    by the library's request layer)."""
+    by the library's request layer); a ``store`` directory may be any path-like."""
     _check_counts(request or {})
     if si is not None:
         extra["probe"] = si
+    if extra.get("store") is not None:
+        extra["store"] = os.fspath(extra["store"])
     with reporter(progress, desc) as cb:
         d = fn(p, request, progress=cb, **extra)
     if isinstance(d, dict):

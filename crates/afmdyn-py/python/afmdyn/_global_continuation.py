@@ -71,7 +71,7 @@ def global_continuation(
         p,
         si=probe,
         request=req,
-        store=None if store is None else os.fspath(store),
+        store=store,
         resume=resume,
     )
     doc = json.loads(d["json"])

@@ -18,11 +18,13 @@ the task's region is written: a killed driver loses at most the task it was writ
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import json
 import os
 import time
-from typing import TYPE_CHECKING, Any, Dict, Iterable, List, Optional, Sequence, Set, Union
+from typing import (TYPE_CHECKING, Any, Dict, Iterable, Iterator, List, Optional, Sequence,
+                    Set, Union)
 
 import numpy as np
 import xarray as xr
@@ -48,6 +50,22 @@ if TYPE_CHECKING:
 
 #: The file of finished tasks, in the store's ledger directory ``STORE.afmdyn``.
 DONE = "done"
+
+
+@contextlib.contextmanager
+def _cluster(client: Optional["distributed.Client"]) -> Iterator["distributed.Client"]:
+    """``client``, or a ``LocalCluster`` of this machine's cores (one thread per worker)
+    started for the study and closed at its end."""
+    if client is not None:
+        yield client
+        return
+    cluster = distributed.LocalCluster(threads_per_worker=1, dashboard_address=None)
+    own = distributed.Client(cluster)
+    try:
+        yield own
+    finally:
+        own.close()
+        cluster.close()
 
 
 def ledger_dir(store: str) -> str:
@@ -255,44 +273,35 @@ def chart(
         tolerance=tolerance,
     )
     n = s.tasks()
-    own = client is None
-    cluster = None
     if not (checkpoint_seconds >= 0 and np.isfinite(checkpoint_seconds)):
         raise ValueError(f"checkpoint_seconds = {checkpoint_seconds}: must be finite and >= 0")
-    if own:
-        cluster = distributed.LocalCluster(threads_per_worker=1, dashboard_address=None)
-        client = distributed.Client(cluster)
-    assert client is not None
-    lock = None
-    try:
-        with reporter(progress, "chart (dask)") as cb:
-            if store is None:
-                results: Dict[int, str] = {}
-                _map(client, s, range(n), results.__setitem__, cb, n, 0)
-                ds = dataset(s, s.arrays([results[t] for t in range(n)]))
-            else:
-                import zarr
+    with _cluster(client) as client:
+        lock = None
+        try:
+            with reporter(progress, "chart (dask)") as cb:
+                if store is None:
+                    results: Dict[int, str] = {}
+                    _map(client, s, range(n), results.__setitem__, cb, n, 0)
+                    ds = dataset(s, s.arrays([results[t] for t in range(n)]))
+                else:
+                    import zarr
 
-                path = os.fspath(store)
-                lock = _core.StoreLock(ledger_dir(path))
-                done = _open_store(s, path, resume)
-                todo = [t for t in range(n) if t not in done]
-                writer = _Writer(path, s, seconds=checkpoint_seconds)
-                _map(client, s, todo, writer.add, cb, n, n - len(todo))
-                writer.flush()
-                zarr.consolidate_metadata(path)
-                ds = xr.open_zarr(path).load()
-                ds.attrs = {
-                    **_template(s).attrs,
-                    "failed_runs": int(ds["failures"].values.sum()),
-                }
-    finally:
-        if lock is not None:
-            lock.release()
-        if own:
-            client.close()
-            if cluster is not None:
-                cluster.close()
+                    path = os.fspath(store)
+                    lock = _core.StoreLock(ledger_dir(path))
+                    done = _open_store(s, path, resume)
+                    todo = [t for t in range(n) if t not in done]
+                    writer = _Writer(path, s, seconds=checkpoint_seconds)
+                    _map(client, s, todo, writer.add, cb, n, n - len(todo))
+                    writer.flush()
+                    zarr.consolidate_metadata(path)
+                    ds = xr.open_zarr(path).load()
+                    ds.attrs = {
+                        **_template(s).attrs,
+                        "failed_runs": int(ds["failures"].values.sum()),
+                    }
+        finally:
+            if lock is not None:
+                lock.release()
     s.check(ds["attractors"].values.ravel().tolist())
     return ds
 
@@ -375,51 +384,42 @@ def bifurcation(
     request["from"] = from_
     _check_counts(request)
     s = _core.SweepStudy.build(request, p)
-    own = client is None
-    cluster = None
-    if own:
-        cluster = distributed.LocalCluster(threads_per_worker=1, dashboard_address=None)
-        client = distributed.Client(cluster)
-    assert client is not None
-    sweep_store = None
-    try:
-        if store is not None:
-            sweep_store = _core.SweepStore(os.fspath(store))
-        todo: Optional[List[int]] = list(range(s.tasks(1)))
-        if sweep_store is not None:
-            todo = sweep_store.open(s, resume)
-        rows: List[str] = []
-        if todo:
-            with reporter(progress, "bifurcation (dask)") as cb:
-                recipe = s.recipe
-                coarse = client.map(run_coarse_task, [recipe] * s.tasks(0),
-                                    range(s.tasks(0)), pure=False, retries=3)
-                fwd, bwd = (coarse[0], coarse[1]) if coarse else (None, None)
-                futures = [
-                    client.submit(run_sweep_task, recipe, k, fwd, bwd, pure=False, retries=3)
-                    for k in todo
-                ]
-                for i, fut in enumerate(distributed.as_completed(futures)):
-                    task_rows = fut.result()
-                    if sweep_store is not None:
-                        sweep_store.append(task_rows)
-                    else:
-                        rows.extend(task_rows)
-                    if cb is not None:
-                        cb(i + 1, len(todo))
-        if sweep_store is not None:
-            if todo is not None:
-                sweep_store.finish(s)
-            d = sweep_store.records(s)
-        else:
-            d = s.records(rows)
-    finally:
-        if sweep_store is not None:
-            sweep_store.release()
-        if own:
-            client.close()
-            if cluster is not None:
-                cluster.close()
+    with _cluster(client) as client:
+        sweep_store = None
+        try:
+            if store is not None:
+                sweep_store = _core.SweepStore(os.fspath(store))
+            todo: Optional[List[int]] = list(range(s.tasks(1)))
+            if sweep_store is not None:
+                todo = sweep_store.open(s, resume)
+            rows: List[str] = []
+            if todo:
+                with reporter(progress, "bifurcation (dask)") as cb:
+                    recipe = s.recipe
+                    coarse = client.map(run_coarse_task, [recipe] * s.tasks(0),
+                                        range(s.tasks(0)), pure=False, retries=3)
+                    fwd, bwd = (coarse[0], coarse[1]) if coarse else (None, None)
+                    futures = [
+                        client.submit(run_sweep_task, recipe, k, fwd, bwd, pure=False, retries=3)
+                        for k in todo
+                    ]
+                    for i, fut in enumerate(distributed.as_completed(futures)):
+                        task_rows = fut.result()
+                        if sweep_store is not None:
+                            sweep_store.append(task_rows)
+                        else:
+                            rows.extend(task_rows)
+                        if cb is not None:
+                            cb(i + 1, len(todo))
+            if sweep_store is not None:
+                if todo is not None:
+                    sweep_store.finish(s)
+                d = sweep_store.records(s)
+            else:
+                d = s.records(rows)
+        finally:
+            if sweep_store is not None:
+                sweep_store.release()
     return _sweep_dataset(p, d, starts, seed)
 
 
@@ -459,14 +459,8 @@ def basins(
     p, probe = _params(params, model)
     _check_counts(keywords)
     s = _core.BasinMapStudy.build(p, keywords, probe)
-    own = client is None
-    cluster = None
-    if own:
-        cluster = distributed.LocalCluster(threads_per_worker=1, dashboard_address=None)
-        client = distributed.Client(cluster)
-    assert client is not None
-    rows: List[str] = []
-    try:
+    with _cluster(client) as client:
+        rows: List[str] = []
         with reporter(progress, "basins (dask)", unit="row") as cb:
             for k in range(s.passes()):
                 start = s.start(k, rows)
@@ -479,11 +473,6 @@ def basins(
                     if cb is not None:
                         cb(len(rows), None)
         layout, doc = s.result(rows)
-    finally:
-        if own:
-            client.close()
-            if cluster is not None:
-                cluster.close()
     return _dataset(layout, json.loads(doc), p)
 
 
