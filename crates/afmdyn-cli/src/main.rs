@@ -32,6 +32,7 @@ mod cmd_analysis;
 mod cmd_approach;
 mod cmd_basins;
 mod cmd_chart;
+mod cmd_fm;
 mod cmd_modes;
 mod cmd_orbits;
 mod cmd_reconstruct;
@@ -94,6 +95,8 @@ enum Command {
     Approach(cmd_approach::ApproachArgs),
     /// Resonance curve near a mode: up- and down-sweep in frequency, branches, folds
     Resonance(cmd_approach::ResonanceArgs),
+    /// FM-AFM at constant amplitude: frequency shift and excitation over z_c (ideal PLL)
+    Fm(cmd_fm::FmArgs),
     /// Tip–sample force and potential from an FM-AFM frequency-shift curve (Sader–Jarvis)
     Reconstruct(cmd_reconstruct::ReconstructArgs),
 }
@@ -115,6 +118,7 @@ fn run(cli: Cli) -> Result<(), CliError> {
         Command::Lyapunov(a) => cmd_orbits::lyapunov(&a),
         Command::Approach(a) => cmd_approach::approach(&a),
         Command::Resonance(a) => cmd_approach::resonance(&a),
+        Command::Fm(a) => cmd_fm::fm(&a),
         Command::Reconstruct(a) => cmd_reconstruct::reconstruct(&a),
     }
 }

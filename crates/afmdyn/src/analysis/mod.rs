@@ -14,6 +14,7 @@ pub mod bifurcation;
 pub mod chart;
 pub mod continuation;
 pub mod converge;
+pub mod fm;
 pub mod global_continuation;
 pub mod lyapunov;
 pub mod observables;

@@ -276,7 +276,7 @@ pub fn free_resonance_base(
 /// An error of the grid ([`crate::analysis::stepped::grid`], in dimensionless units) about
 /// `from`, `to` or `step` with the value in the request's units (`unit` per dimensionless
 /// unit: m per g₀ or Hz per unit Ω with a probe), as the user wrote it.
-fn in_units(e: SimError, unit: f64) -> SimError {
+pub(crate) fn in_units(e: SimError, unit: f64) -> SimError {
     match e {
         SimError::OutOfRange {
             name: name @ ("from" | "to" | "step"),

@@ -36,6 +36,7 @@ pub mod checkpoint_file;
 pub mod curves;
 #[cfg(feature = "files")]
 pub mod dir_lock;
+pub mod fm;
 pub mod limits;
 pub mod model;
 pub mod pool;
@@ -59,6 +60,7 @@ pub use checkpoint_file::FileCheckpoint;
 pub use curves::{approach_request, resonance_request, CurveRequest};
 #[cfg(feature = "files")]
 pub use dir_lock::{DirLock, LockError};
+pub use fm::FmRequest;
 pub use model::{parameter, ModelSpec, ParamInfo, MODEL_PARAMETERS};
 pub use pool::in_pool;
 #[cfg(feature = "parallel")]

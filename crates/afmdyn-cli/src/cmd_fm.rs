@@ -1,0 +1,132 @@
+//! `afmdyn fm`: the frequency-modulation curve at constant amplitude over the rest distance
+//! z_c — the drive frequency an ideal PLL locks at and the excitation an ideal amplitude
+//! controller sets, as exact periodic orbits. The request, the analysis and the document are
+//! the library's ([`afmdyn::request::FmRequest`], [`afmdyn::analysis::fm`]); this front end
+//! maps the flags and writes `fm.csv`, `fm.json` and the frequency-shift plot.
+
+use crate::args::{quantity, Dim, ModelArgs, Quantity};
+use crate::error::CliError;
+use crate::output::{f, write_bytes, write_csv, OutDir};
+use crate::plot::{save, Figure, Series, Style};
+use afmdyn::request::fm::{rows, COLUMNS};
+use afmdyn::request::{self, FmRequest, Resolved};
+use afmdyn::Params;
+use clap::Args;
+use std::path::PathBuf;
+
+/// `afmdyn fm` flags.
+#[derive(Debug, Args)]
+pub struct FmArgs {
+    #[command(flatten)]
+    model: ModelArgs,
+    /// Oscillation amplitude A the amplitude controller holds (m with --probe, else g0; a unit
+    /// may follow: 10nm) [default: the probe's free amplitude A0]
+    #[arg(long)]
+    amplitude: Option<Quantity>,
+    /// Mode K the PLL tracks (1..=N)
+    #[arg(long, default_value_t = 1)]
+    mode: usize,
+    /// Rest distance z_c where the approach starts [default: 2A + a0, the lower turning point
+    /// at A from the sample]
+    #[arg(long, allow_hyphen_values = true)]
+    from: Option<Quantity>,
+    /// Rest distance z_c where it ends [default: A + a0, the lower turning point at the contact
+    /// distance a0]
+    #[arg(long, allow_hyphen_values = true)]
+    to: Option<Quantity>,
+    /// Step of z_c (in the units of --from/--to); conflicts with --points
+    #[arg(long, conflicts_with = "points", allow_hyphen_values = true)]
+    step: Option<Quantity>,
+    /// Number of z_c values, ends included [default: 120]
+    #[arg(long)]
+    points: Option<usize>,
+    /// Tolerance of the loop conditions: |A1/A − 1| and the phase error (rad)
+    #[arg(long, default_value_t = FmRequest::default().tolerance)]
+    tolerance: f64,
+    /// Output directory (locked during the run)
+    #[arg(long, default_value = "afmdyn-out/fm")]
+    out: PathBuf,
+    /// Print one JSON document
+    #[arg(long)]
+    json: bool,
+}
+
+/// Run `afmdyn fm`.
+pub fn fm(a: &FmArgs) -> Result<(), CliError> {
+    let si = a.model.probe.is_some();
+    let (params, probe) = a.model.resolve(Params::default())?;
+    let request = FmRequest {
+        amplitude: quantity(a.amplitude, "amplitude", Dim::Length, si)?,
+        mode: a.mode,
+        from: quantity(a.from, "from", Dim::Length, si)?,
+        to: quantity(a.to, "to", Dim::Length, si)?,
+        step: quantity(a.step, "step", Dim::Length, si)?,
+        points: a.points,
+        tolerance: a.tolerance,
+    };
+    let model = Resolved { params, probe };
+    request::Analysis::validate(&request, &model)?;
+    let out = OutDir::lock(&a.out)?;
+    let doc = crate::progress::run(&request, &model, "z_c values")?;
+    let mut json = doc.json;
+    let table = rows(&json);
+    write_csv(
+        &out.join("fm.csv"),
+        &COLUMNS,
+        table.iter().map(|r| r.iter().map(|v| f(*v)).collect()),
+    )?;
+    let (x_unit, y_unit) = if si {
+        (" (m)", " (Hz)")
+    } else {
+        (" (g0)", " (Ω)")
+    };
+    let points: Vec<(f64, f64)> = table.iter().map(|r| (r[0], r[1])).collect();
+    save(
+        out.path(),
+        "fm-frequency-shift",
+        &Figure {
+            title: "FM-AFM: frequency shift at constant amplitude".into(),
+            x_label: format!("rest distance z_c{x_unit}"),
+            y_label: format!("frequency shift Δf{y_unit}"),
+            series: vec![Series {
+                label: String::new(),
+                points,
+                style: Style::Line,
+                color: 0,
+            }],
+            shade: Vec::new(),
+            y_min_span: 0.0,
+        },
+    )?;
+    json["csv"] = serde_json::json!(out.join("fm.csv"));
+    write_bytes(
+        &out.join("fm.json"),
+        serde_json::to_string_pretty(&json)
+            .expect("json")
+            .as_bytes(),
+    )?;
+    for w in json["warnings"].as_array().into_iter().flatten() {
+        errln!("afmdyn: warning: {}", w.as_str().unwrap_or_default());
+    }
+    if a.json {
+        outln!("{json}");
+    } else {
+        let last = table.last();
+        outln!(
+            "{} z_c values from {:e} to {:e}{}: Δf from {:e} to {:e}{}, excitation up to {:.4} × \
+             the free one; {} unstable, {} folds; outputs in {}",
+            table.len(),
+            table.first().map_or(f64::NAN, |r| r[0]),
+            last.map_or(f64::NAN, |r| r[0]),
+            x_unit,
+            table.first().map_or(f64::NAN, |r| r[1]),
+            last.map_or(f64::NAN, |r| r[1]),
+            y_unit,
+            table.iter().map(|r| r[3]).fold(f64::NAN, f64::max),
+            table.iter().filter(|r| r[14] == 0.0).count(),
+            json["folds"].as_array().map_or(0, |v| v.len()),
+            out.path().display()
+        );
+    }
+    Ok(())
+}

@@ -1,0 +1,270 @@
+//! `fm`: the frequency-modulation (FM-AFM) curve at constant amplitude over the rest distance
+//! z_c ([`crate::analysis::fm`]: ideal PLL and amplitude controller, exact periodic orbits) —
+//! the request the command line (`afmdyn fm`) and Python (`afmdyn.fm`) share, and its
+//! document. With a probe everything is SI (z_c and A in m, Δf in Hz, E_dis in J, forces in N);
+//! without one the model's units (g₀, Ω, F̃).
+
+use super::curves::CurveRequest;
+use super::run::{Analysis, Resolved};
+use crate::analysis::approach::approach_spec;
+use crate::analysis::fm::{fm_curve, FmCurve, FmSpec, DEFAULT_LOOP_TOLERANCE};
+use crate::analysis::progress::Progress;
+use crate::error::SimError;
+use crate::report::CurveUnits;
+use serde::{Deserialize, Serialize};
+use serde_json::{json, Value};
+
+/// `fm`: an FM curve from `from` to `to` (z_c; m with a probe, else g₀) at the oscillation
+/// amplitude `amplitude`, tracking mode `mode`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[serde(default, deny_unknown_fields)]
+pub struct FmRequest {
+    /// The first-harmonic amplitude A the amplitude controller holds (m with a probe, else g₀),
+    /// > 0; default the probe's free amplitude A₀ (1 g₀).
+    pub amplitude: Option<f64>,
+    /// The mode K (1-based) the PLL tracks; default 1.
+    pub mode: usize,
+    /// First z_c of the approach (default 2A + a₀: the lower turning point at A).
+    pub from: Option<f64>,
+    /// Last z_c (default A + a₀: the lower turning point at the contact distance a₀, 0 for
+    /// the laws without attraction).
+    pub to: Option<f64>,
+    /// Step of z_c; excludes `points`.
+    pub step: Option<f64>,
+    /// Number of z_c values, ends included (default 120).
+    pub points: Option<usize>,
+    /// Tolerance of the loop conditions, |A₁/A − 1| and |φ₁ − φ_set| (rad), in (0, 1e-3).
+    pub tolerance: f64,
+}
+
+impl Default for FmRequest {
+    fn default() -> Self {
+        FmRequest {
+            amplitude: None,
+            mode: 1,
+            from: None,
+            to: None,
+            step: None,
+            points: None,
+            tolerance: DEFAULT_LOOP_TOLERANCE,
+        }
+    }
+}
+
+impl FmRequest {
+    /// The units of the document: SI with a probe (frequencies in Hz), else the model's.
+    pub fn units(model: &Resolved) -> CurveUnits {
+        match &model.probe {
+            Some(p) => CurveUnits::from_scales(&p.scales, true),
+            None => CurveUnits::dimensionless(),
+        }
+    }
+
+    /// The analysis' spec on `model`: the z_c grid (α5 values, from the far end), the amplitude
+    /// in g₀, the mode and the tolerance.
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming `amplitude`, `mode`, `tolerance`, `from`, `to`, `step`
+    /// or `points` (as an approach curve's); [`SimError::Params`] for a model invalid at an
+    /// end of the grid.
+    pub fn spec(&self, model: &Resolved) -> Result<FmSpec, SimError> {
+        let length = Self::units(model).length;
+        let range = CurveRequest {
+            from: self.from,
+            to: self.to,
+            step: self.step,
+            points: self.points,
+            ..CurveRequest::default()
+        };
+        range.check_finite()?;
+        if let Some(a) = self.amplitude {
+            crate::error::finite("amplitude", a)?;
+            if length != 1.0 {
+                super::limits::si_distance("amplitude", a)?;
+            }
+            if a <= 0.0 {
+                return Err(SimError::out_of_range(
+                    "amplitude",
+                    a,
+                    "must be > 0: the oscillation amplitude the controller holds",
+                ));
+            }
+        }
+        if length != 1.0 {
+            for (name, v) in [("from", self.from), ("to", self.to), ("step", self.step)] {
+                if let Some(v) = v {
+                    super::limits::si_distance(name, v)?;
+                }
+            }
+        }
+        let base = model.params;
+        if self.mode == 0 || self.mode > base.modes {
+            return Err(SimError::out_of_range(
+                "mode",
+                self.mode,
+                "must be in 1..=N, the number of modes of the model (1 for the point mass)",
+            ));
+        }
+        let tol = self.tolerance;
+        if !(tol.is_finite() && tol > 0.0 && tol < 1e-3) {
+            return Err(SimError::out_of_range(
+                "tolerance",
+                tol,
+                "must be in (0, 1e-3)",
+            ));
+        }
+        let a = self.amplitude.map_or(1.0, |a| a / length);
+        let offset = base.contact_law.distance_offset();
+        let (from, to) = range.ends((2.0 * a + offset, a + offset), length);
+        let values = approach_spec(base, from, to, range.spacing(length)?)
+            .map_err(|e| super::curves::in_units(e, length))?
+            .values;
+        for v in [values[0], values[values.len() - 1]] {
+            base.with(crate::params::SweepParam::Alpha5, v).validate()?;
+        }
+        let mut spec = FmSpec::new(base, values, a);
+        spec.mode = self.mode;
+        spec.tolerance = tol;
+        Ok(spec)
+    }
+}
+
+impl Analysis for FmRequest {
+    type Output = FmCurve;
+    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
+        self.spec(model).map(|_| ())
+    }
+    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<FmCurve, SimError> {
+        fm_curve(&self.spec(model)?, progress)
+    }
+    fn report(&self, model: &Resolved, curve: &FmCurve) -> Result<Value, SimError> {
+        Ok(document(self, model, curve))
+    }
+}
+
+/// The document of an FM curve (`afmdyn fm --json`, Python's `to_dict()`): `curve` (one array
+/// per quantity, one entry per z_c reached), `folds`, `reference` (the free lever's operating
+/// point), the cantilever's constants that [`super::reconstruct`] needs (`spring_constant`,
+/// `resonance_frequency`, `amplitude`), `units`, `method`, `warnings`.
+pub fn document(request: &FmRequest, model: &Resolved, curve: &FmCurve) -> Value {
+    let u = FmRequest::units(model);
+    let hz = u.hz_per_omega.unwrap_or(1.0);
+    let p = &curve.points;
+    let col = |f: &dyn Fn(&crate::analysis::fm::FmPoint) -> f64| -> Vec<f64> {
+        p.iter().map(f).collect()
+    };
+    let base = model.params;
+    let z_c = |a5: f64| {
+        base.with(crate::params::SweepParam::Alpha5, a5)
+            .rest_distance()
+    };
+    let r = &curve.reference;
+    let max_mult =
+        |q: &crate::analysis::fm::FmPoint| q.multipliers.first().map_or(f64::NAN, |m| m.norm());
+    // the stiffness of the tracked mode at the tip is the probe's k for mode 1 only
+    let spring_constant = match (&model.probe, request.mode) {
+        (Some(probe), 1) => json!(probe.calibration.spring_constant),
+        (None, 1) if base.structure == crate::params::Structure::PointMass => json!(1.0),
+        _ => Value::Null,
+    };
+    let mut warnings: Vec<String> = curve.warnings.clone();
+    if spring_constant.is_null() {
+        warnings.push(format!(
+            "no spring constant is given for mode {}: give it to reconstruct the force",
+            request.mode
+        ));
+    }
+    json!({
+        "curve": {
+            "z_c": col(&|q| z_c(q.alpha5) * u.length),
+            "frequency_shift": col(&|q| (q.omega - r.omega) * hz),
+            "frequency": col(&|q| q.omega * hz),
+            "excitation": col(&|q| q.alpha2 / r.excitation),
+            "amplitude": col(&|q| q.observables.amplitude * u.length),
+            "phase_deg": col(&|q| q.observables.phase.to_degrees()),
+            "energy_dissipated": col(&|q| q.observables.energy_dissipated * u.energy),
+            "virial": col(&|q| q.observables.virial * u.energy),
+            "mean_deflection": col(&|q| q.observables.mean_deflection * u.length),
+            "min_distance": col(&|q| q.observables.min_distance * u.length),
+            "peak_force": col(&|q| q.observables.peak_force * u.force),
+            "mean_force": col(&|q| q.observables.mean_force * u.force),
+            "indentation": col(&|q| q.observables.indentation * u.length),
+            "max_multiplier": col(&max_mult),
+            "stable": p.iter().map(|q| q.stable).collect::<Vec<bool>>(),
+            "loop_residual": col(&|q| q.loop_residual),
+            "iterations": p.iter().map(|q| q.iterations).collect::<Vec<usize>>(),
+        },
+        "folds": curve.folds.iter().map(|f| json!({"index": f.index, "z_c": z_c(f.alpha5) * u.length})).collect::<Vec<_>>(),
+        "reference": {
+            "resonance_frequency": r.omega * hz,
+            "quality_factor": r.quality_factor,
+            "phase_deg": r.phase.to_degrees(),
+            "excitation": r.excitation,
+        },
+        "mode": request.mode,
+        "amplitude": curve.amplitude * u.length,
+        "spring_constant": spring_constant,
+        "resonance_frequency": r.omega * hz,
+        "units": if u.si {
+            json!({"z_c": "m", "frequency_shift": "Hz", "frequency": "Hz", "excitation": "1 (relative to the free lever's at its resonance)",
+                   "amplitude": "m", "energy_dissipated": "J", "virial": "J", "min_distance": "m", "peak_force": "N", "spring_constant": "N/m"})
+        } else {
+            json!({"z_c": "g0", "frequency_shift": "Ω (units of the τ scale)", "frequency": "Ω", "excitation": "1 (relative)",
+                   "amplitude": "g0", "energy_dissipated": "F·g0", "virial": "F·g0", "min_distance": "g0", "peak_force": "F"})
+        },
+        "method": "ideal PLL (the first harmonic locked at the free lever's phase at its resonance) and ideal amplitude controller: exact periodic orbits by shooting, the drive frequency and excitation by Newton's method on the two loop conditions (docs/afm-workflow.md)",
+        "warnings": warnings,
+    })
+}
+
+/// The columns of an FM curve's table (`fm.csv`, Python's Dataset variables), in order: the
+/// numeric arrays of the document's `curve` (`stable` as 1/0).
+pub const COLUMNS: [&str; 17] = [
+    "z_c",
+    "frequency_shift",
+    "frequency",
+    "excitation",
+    "amplitude",
+    "phase_deg",
+    "energy_dissipated",
+    "virial",
+    "mean_deflection",
+    "min_distance",
+    "peak_force",
+    "mean_force",
+    "indentation",
+    "max_multiplier",
+    "stable",
+    "loop_residual",
+    "iterations",
+];
+
+/// The rows of the table of an FM document ([`document`]), one per point, in [`COLUMNS`]
+/// order.
+pub fn rows(doc: &Value) -> Vec<Vec<f64>> {
+    let curve = &doc["curve"];
+    let column = |name: &str| -> Vec<f64> {
+        curve[name]
+            .as_array()
+            .map(|a| {
+                a.iter()
+                    .map(|v| match v {
+                        Value::Bool(b) => f64::from(u8::from(*b)),
+                        v => v.as_f64().unwrap_or(f64::NAN),
+                    })
+                    .collect()
+            })
+            .unwrap_or_default()
+    };
+    let columns: Vec<Vec<f64>> = COLUMNS.iter().map(|c| column(c)).collect();
+    let n = columns[0].len();
+    (0..n)
+        .map(|i| {
+            columns
+                .iter()
+                .map(|c| c.get(i).copied().unwrap_or(f64::NAN))
+                .collect()
+        })
+        .collect()
+}
