@@ -15,19 +15,23 @@ use std::path::{Path, PathBuf};
 /// `afmdyn reconstruct` flags.
 #[derive(Debug, Args)]
 pub struct ReconstructArgs {
-    /// The frequency-shift curve: a CSV with a header naming `frequency_shift` (Hz) and
-    /// `distance` (m, closest approach) or `z_c` (m, rest distance: d = z_c − A)
+    /// The frequency-shift curve: the JSON document of `afmdyn fm --probe` (fm.json: its
+    /// distances of closest approach, shifts, k, f0 and A), or a CSV with a header naming
+    /// `frequency_shift` (Hz) and `distance` (m, closest approach) or `z_c` (m, rest distance:
+    /// d = z_c − A)
     #[arg(long, value_name = "FILE")]
     fm: PathBuf,
-    /// Spring constant k (N/m)
+    /// Spring constant k (N/m); required with a CSV, replaces the document's
     #[arg(long)]
-    spring_constant: f64,
-    /// Free resonance frequency f0 (Hz; a unit may follow: 300kHz)
+    spring_constant: Option<f64>,
+    /// Free resonance frequency f0 (Hz; a unit may follow: 300kHz); required with a CSV,
+    /// replaces the document's
     #[arg(long)]
-    resonance_frequency: Quantity,
-    /// Oscillation amplitude A (m; a unit may follow: 10nm)
+    resonance_frequency: Option<Quantity>,
+    /// Oscillation amplitude A (m; a unit may follow: 10nm); required with a CSV, replaces
+    /// the document's
     #[arg(long)]
-    amplitude: Quantity,
+    amplitude: Option<Quantity>,
     /// Output directory (locked during the run)
     #[arg(long, default_value = "afmdyn-out/reconstruct")]
     out: PathBuf,
@@ -63,8 +67,29 @@ fn read_curve(path: &Path) -> Result<(Vec<String>, Vec<Vec<f64>>), CliError> {
     Ok((names, columns))
 }
 
-/// Run `afmdyn reconstruct`.
-pub fn reconstruct(a: &ReconstructArgs) -> Result<(), CliError> {
+/// The request of the flags: from an `fm` JSON document, or from a CSV with k, f0 and A.
+fn request_of(a: &ReconstructArgs) -> Result<ReconstructRequest, CliError> {
+    let k = a.spring_constant;
+    let f0 = quantity(
+        a.resonance_frequency,
+        "resonance-frequency",
+        Dim::Frequency,
+        true,
+    )?;
+    let amp = quantity(a.amplitude, "amplitude", Dim::Length, true)?;
+    let text = std::fs::read(&a.fm)
+        .map_err(|e| CliError::Input(format!("--fm {}: {e}", a.fm.display())))?;
+    if text.iter().find(|b| !b.is_ascii_whitespace()) == Some(&b'{') {
+        let doc: serde_json::Value = serde_json::from_slice(&text).map_err(|e| {
+            CliError::Input(format!("--fm {}: not a JSON document: {e}", a.fm.display()))
+        })?;
+        return Ok(ReconstructRequest::from_fm_document(&doc, k, f0, amp)?);
+    }
+    let missing = |flag: &str| {
+        CliError::Input(format!(
+            "--{flag} is required with a CSV curve (an afmdyn fm document carries it)"
+        ))
+    };
     let (names, mut columns) = read_curve(&a.fm)?;
     let mut take = |name: &str| {
         names
@@ -79,20 +104,19 @@ pub fn reconstruct(a: &ReconstructArgs) -> Result<(), CliError> {
             names.join(", ")
         ))
     })?;
-    let request = ReconstructRequest {
+    Ok(ReconstructRequest {
         distance: take("distance"),
         z_c: take("z_c"),
         frequency_shift,
-        spring_constant: a.spring_constant,
-        resonance_frequency: quantity(
-            Some(a.resonance_frequency),
-            "resonance-frequency",
-            Dim::Frequency,
-            true,
-        )?
-        .unwrap_or(f64::NAN),
-        amplitude: quantity(Some(a.amplitude), "amplitude", Dim::Length, true)?.unwrap_or(f64::NAN),
-    };
+        spring_constant: k.ok_or_else(|| missing("spring-constant"))?,
+        resonance_frequency: f0.ok_or_else(|| missing("resonance-frequency"))?,
+        amplitude: amp.ok_or_else(|| missing("amplitude"))?,
+    })
+}
+
+/// Run `afmdyn reconstruct`.
+pub fn reconstruct(a: &ReconstructArgs) -> Result<(), CliError> {
+    let request = request_of(a)?;
     let model = Resolved::plain(afmdyn::Params::default());
     request::Analysis::validate(&request, &model)?;
     let out = OutDir::lock(&a.out)?;

@@ -459,6 +459,24 @@ pub fn lyapunov<'py>(
     Ok(out.finish())
 }
 
+/// The constant-amplitude FM-AFM curve over z_c (`afmdyn fm`): the JSON document (the
+/// Python layer builds the dataset from it).
+#[pyfunction]
+#[pyo3(signature = (params, request=None, progress=None, probe=None))]
+pub fn fm<'py>(
+    py: Python<'py>,
+    params: PyRef<'_, PyParams>,
+    request: Option<&Dict<'py>>,
+    progress: Option<Bound<'py, PyAny>>,
+    probe: Option<String>,
+) -> PyResult<Dict<'py>> {
+    let request: afmdyn::request::FmRequest = crate::convert::request("fm", request)?;
+    let doc = analysis(py, request, params.inner, probe, progress.as_ref(), true)?;
+    let out = Out::new(py);
+    out.json(&doc.json)?;
+    Ok(out.finish())
+}
+
 /// The force and potential behind a frequency-modulation curve (`afmdyn reconstruct`): the
 /// JSON document (the Python layer builds the dataset from it).
 #[pyfunction]

@@ -310,6 +310,7 @@ pub fn request_default(name: &str) -> Option<serde_json::Value> {
         "basins" => v::<BasinsRequest>(),
         "chart" => v::<ChartRequest>(),
         "reconstruct" => v::<ReconstructRequest>(),
+        "fm" => v::<FmRequest>(),
         _ => None,
     }
 }

@@ -57,7 +57,6 @@ fn giessibl(centre: f64, a: f64, k: f64, f0: f64) -> f64 {
 fn fm_shift_matches_giessibl_first_order_formula() {
     let probe = Probe::parse(PROBE, "test").unwrap();
     let g0 = probe.scales.length_m;
-    let offset = probe.params.contact_law.distance_offset();
     // z_c from 20 nm to 10.8 nm: lower turning points from 10 nm to 0.8 nm
     let z_c: Vec<f64> = (0..24).map(|i| 20e-9 - i as f64 * 0.4e-9).collect();
     let values = z_c
@@ -65,14 +64,15 @@ fn fm_shift_matches_giessibl_first_order_formula() {
         .map(|z| probe.params.alpha5_for_rest_distance(z / g0))
         .collect();
     let spec = FmSpec::new(probe.params, values, 1.0);
-    let t = std::time::Instant::now();
     let curve = fm_curve(&spec, &Progress::new()).unwrap();
-    eprintln!("{} points in {:?}", curve.points.len(), t.elapsed());
-    assert!(curve.warnings.is_empty(), "{:?}", curve.warnings);
+    assert!(curve.unreached.is_none(), "{:?}", curve.unreached);
     assert_eq!(curve.points.len(), z_c.len());
+    // the point mass: ω0 = 1, the free lag at resonance 90°, the free excitation A/Q
+    assert!((curve.reference.omega - 1.0).abs() < 1e-12);
+    assert!((curve.reference.phase - PI / 2.0).abs() < 1e-12);
+    assert!((curve.reference.excitation - probe.params.alpha3).abs() < 1e-12);
     let (k, f0) = (40.0, 300e3);
     let a = g0;
-    let mut worst: f64 = 0.0;
     for (p, &zc) in curve.points.iter().zip(&z_c) {
         let df = probe.scales.frequency_hz(p.omega - curve.reference.omega);
         // the centre of the oscillation: z_c plus the static deflection
@@ -82,12 +82,9 @@ fn fm_shift_matches_giessibl_first_order_formula() {
         // first-order error O(max|F|/(kA))
         let bound = vdw(d_min).abs() / (k * a);
         let rel = (df - expected).abs() / expected.abs();
-        worst = worst.max(rel / bound);
-        eprintln!("z_c {zc:e} d {d_min:e} df {df:.6} giessibl {expected:.6} rel {rel:.2e} bound {bound:.2e} it {}", p.iterations);
         assert!(rel <= 3.0 * bound + 1e-6, "z_c {zc}: {df} vs {expected}");
-        let _ = offset;
+        assert!(p.stable && p.loop_residual <= 1e-6);
     }
-    eprintln!("worst rel/bound {worst}");
 }
 
 fn beam_probe() -> Probe {
@@ -95,36 +92,128 @@ fn beam_probe() -> Probe {
     Probe::parse(&text, "beam").unwrap()
 }
 
+/// The Galerkin beam (N = 3, base drive) with the same calibrated k, f0 and Q: its first mode
+/// follows Giessibl's formula with the calibrated k (the higher modes, 6× and 17× stiffer in
+/// frequency, take part only at second order).
 #[test]
-fn beam_experiment() {
+fn beam_fm_shift_matches_giessibl_with_the_first_modes_stiffness() {
     let probe = beam_probe();
     let g0 = probe.scales.length_m;
-    let z_c: Vec<f64> = (0..24).map(|i| 20e-9 - i as f64 * 0.4e-9).collect();
+    let z_c: Vec<f64> = (0..12).map(|i| 20e-9 - i as f64 * 0.8e-9).collect();
     let values = z_c
         .iter()
         .map(|z| probe.params.alpha5_for_rest_distance(z / g0))
         .collect();
-    let spec = FmSpec::new(probe.params, values, 1.0);
-    let t = std::time::Instant::now();
-    let curve = fm_curve(&spec, &Progress::new()).unwrap();
-    eprintln!(
-        "{} points in {:?} {:?}",
-        curve.points.len(),
-        t.elapsed(),
-        curve.reference
+    let curve = fm_curve(&FmSpec::new(probe.params, values, 1.0), &Progress::new()).unwrap();
+    assert_eq!(curve.points.len(), z_c.len());
+    // the free base-driven beam's lag at its first natural frequency is not exactly 90°
+    assert!((curve.reference.phase - PI / 2.0).abs() < 1e-3);
+    let (k, f0) = (
+        probe.calibration.spring_constant,
+        probe.calibration.resonance_frequency,
     );
-    let k = probe.calibration.spring_constant;
-    let f0 = probe.calibration.resonance_frequency;
     for (p, &zc) in curve.points.iter().zip(&z_c) {
         let df = probe.scales.frequency_hz(p.omega - curve.reference.omega);
         let centre = zc + p.observables.mean_deflection * g0;
         let d_min = p.observables.min_distance * g0;
         let expected = giessibl(centre, g0, k, f0);
-        eprintln!(
-            "z_c {zc:e} d {d_min:e} df {df:.6} giessibl {expected:.6} rel {:.2e} it {} res {:.1e}",
-            (df - expected) / expected,
-            p.iterations,
-            p.loop_residual
+        let bound = vdw(d_min).abs() / (k * g0);
+        let rel = (df - expected).abs() / expected.abs();
+        assert!(rel <= 3.0 * bound + 1e-6, "z_c {zc}: {df} vs {expected}");
+        assert!(p.stable);
+        assert!(p.loop_residual < 1e-7);
+    }
+}
+
+/// Small amplitude: Δf → −f0 F′(d)/(2k) (the force gradient acts as a spring; Giessibl,
+/// Rev. Mod. Phys. 75, 949 (2003), eq. 15), with relative corrections O((A/d)²).
+#[test]
+fn small_amplitude_shift_is_the_force_gradient() {
+    let probe = Probe::parse(PROBE, "test").unwrap();
+    let g0 = probe.scales.length_m;
+    let a = 0.05e-9;
+    let z_c: Vec<f64> = vec![4e-9, 3e-9, 2e-9];
+    let values = z_c
+        .iter()
+        .map(|z| probe.params.alpha5_for_rest_distance(z / g0))
+        .collect();
+    let curve = fm_curve(&FmSpec::new(probe.params, values, a / g0), &Progress::new()).unwrap();
+    let (k, f0) = (40.0, 300e3);
+    for (p, &zc) in curve.points.iter().zip(&z_c) {
+        let df = probe.scales.frequency_hz(p.omega - curve.reference.omega);
+        let d = zc + p.observables.mean_deflection * g0;
+        // F = −HR/(6d²): F′ = HR/(3d³)
+        let gradient = 6.6e-20 * 10e-9 / (3.0 * d * d * d);
+        let expected = -f0 * gradient / (2.0 * k);
+        let rel = (df - expected).abs() / expected.abs();
+        assert!(
+            rel < 2.0 * (a / d).powi(2) + 1e-6,
+            "z_c {zc}: {df} vs {expected} ({rel:e})"
         );
+    }
+}
+
+/// Dissipation: the excitation the controller needs is the free one plus what the sample and
+/// the higher harmonics take. For the point mass at φ₁ = 90° the period balance is
+/// π α2 A = (π/Q) Ω (A² + Σ n²Aₙ²) + E_dis (module docs of `observables`), here with the
+/// tip–sample energy E_dis of a viscous DMT contact, to 1e-8 of the drive's energy.
+#[test]
+fn excitation_grows_by_the_energy_dissipated() {
+    let text = PROBE
+        .replace("viscosity = 0.0", "viscosity = 50.0")
+        .replace("quality_factor = 1e4", "quality_factor = 400");
+    let probe = Probe::parse(&text, "viscous").unwrap();
+    let g0 = probe.scales.length_m;
+    let z_c: Vec<f64> = (0..12).map(|i| 11e-9 - i as f64 * 0.15e-9).collect();
+    let values = z_c
+        .iter()
+        .map(|z| probe.params.alpha5_for_rest_distance(z / g0))
+        .collect();
+    let curve = fm_curve(&FmSpec::new(probe.params, values, 1.0), &Progress::new()).unwrap();
+    assert!(curve.unreached.is_none(), "{:?}", curve.unreached);
+    let q_inv = probe.params.alpha3;
+    let mut dissipated = 0.0f64;
+    for p in &curve.points {
+        let o = &p.observables;
+        let drive = PI * p.alpha2 * o.amplitude * o.phase.sin();
+        let damping = PI * q_inv * p.omega * (o.amplitude.powi(2) + o.higher_n2_sq);
+        assert!(
+            (drive - damping - o.energy_dissipated).abs() <= 1e-8 * drive,
+            "{drive} vs {damping} + {}",
+            o.energy_dissipated
+        );
+        // the excitation relative to the free one (A/Q at ω0)
+        let relative = p.alpha2 / curve.reference.excitation;
+        let expected = p.omega * (1.0 + o.higher_n2_sq / o.amplitude.powi(2))
+            + o.energy_dissipated / (PI * q_inv * o.amplitude.powi(2));
+        assert!(
+            (relative - expected).abs() < 1e-7,
+            "{relative} vs {expected}"
+        );
+        dissipated = dissipated.max(o.energy_dissipated);
+    }
+    // the curve reaches the contact, where the viscous sample takes energy
+    assert!(dissipated > 1e-5, "E_dis up to {dissipated}");
+}
+
+/// Bad requests are refused naming the field.
+#[test]
+fn bad_spec_is_refused_naming_the_field() {
+    let probe = Probe::parse(PROBE, "test").unwrap();
+    let one = vec![probe.params.alpha5];
+    for (spec, field) in [
+        (FmSpec::new(probe.params, one.clone(), 0.0), "amplitude"),
+        (FmSpec::new(probe.params, vec![], 1.0), "values"),
+        (FmSpec::new(probe.params, vec![f64::NAN], 1.0), "z_c"),
+        (
+            FmSpec {
+                mode: 2,
+                ..FmSpec::new(probe.params, one.clone(), 1.0)
+            },
+            "mode",
+        ),
+    ] {
+        let e = fm_curve(&spec, &Progress::new()).unwrap_err().to_string();
+        assert!(e.contains(field), "{e}");
     }
 }

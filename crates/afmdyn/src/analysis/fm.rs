@@ -42,7 +42,7 @@
 use super::observables::{free_response, observe_orbit, Observables};
 use super::progress::Progress;
 use super::resonance::mode_resonance;
-use super::shooting::{shoot_with, PeriodicOrbit, ShootingOptions};
+use super::shooting::{shoot_globalised, shoot_with, PeriodicOrbit, ShootingOptions};
 use crate::error::SimError;
 use crate::integrate::{build, IntegratorOptions};
 use crate::model::CantileverModel;
@@ -58,12 +58,24 @@ pub const DEFAULT_ORBIT_TOLERANCE: f64 = 1e-13;
 /// (module docs, [`FmSpec::new`]), to this many times Q_K × the integrator's tolerance once
 /// Newton stops gaining.
 pub const NOISE_FLOOR_FACTOR: f64 = 1e3;
+/// A shooting that stops above its tolerance at a residual r ≤ [`ROUND_OFF_LIMIT`] (the map's
+/// round-off floor) is taken again to this many times r.
+pub const ROUND_OFF_RETRY: f64 = 4.0;
+/// The largest fixed-point residual taken as the map's round-off.
+pub const ROUND_OFF_LIMIT: f64 = 1e-7;
+/// … plus this many times Q_K × the orbit's fixed-point residual (an orbit error δz moves
+/// the first harmonic by up to Q δz/π).
+pub const ORBIT_FLOOR_FACTOR: f64 = 10.0;
 /// Most Newton iterations on (Ω, α2) per value.
 pub const MAX_LOOP_ITERATIONS: usize = 30;
 /// Most halvings of the step in z_c towards a value that does not converge.
 pub const MAX_HALVINGS: usize = 6;
-/// Relative step of the forward differences of the loop Jacobian.
-const DIFFERENCE_STEP: f64 = 1e-6;
+/// Step of the forward differences of the loop Jacobian: relative in α2; in Ω relative to the
+/// half linewidth ω_K/(2Q_K) (across which the phase turns by about 1 rad), so that the phase
+/// moves by about this many rad, well above its round-off and well inside its linear range.
+const DIFFERENCE_STEP: f64 = 1e-5;
+/// Most halvings of a Newton step on (Ω, α2) that does not lower the loop residual.
+const BACKTRACKS: usize = 10;
 
 /// What to compute: an FM curve over the gap values `values` (α5, approach order).
 #[derive(Debug, Clone, PartialEq)]
@@ -86,14 +98,18 @@ pub struct FmSpec {
 
 impl FmSpec {
     /// Defaults: mode 1, tolerance [`DEFAULT_LOOP_TOLERANCE`], the integrator's tolerance
-    /// [`DEFAULT_ORBIT_TOLERANCE`], shooting to 1e-12.
+    /// [`DEFAULT_ORBIT_TOLERANCE`], shooting to 1e-12 in at most 20 Newton
+    /// iterations, or, where the map's round-off is above that (a viscous √δ δ̇ contact: near
+    /// 1e-10), to [`ROUND_OFF_RETRY`] × the residual reached
     ///
     /// The orbit must be tighter than an AM curve's: near resonance the fixed point of the
     /// stroboscopic map amplifies an error ε of the map by ‖(I − M)⁻¹‖ ≈ Q/π, and the phase
     /// condition sees it (measured at Q = 10⁴: a loop residual floor of 6e-8 at ε = 1e-11).
     pub fn new(base: Params, values: Vec<f64>, amplitude: f64) -> Self {
-        let mut integrator = IntegratorOptions::default();
-        integrator.tolerance = DEFAULT_ORBIT_TOLERANCE;
+        let integrator = IntegratorOptions {
+            tolerance: DEFAULT_ORBIT_TOLERANCE,
+            ..IntegratorOptions::default()
+        };
         FmSpec {
             base,
             values,
@@ -186,8 +202,9 @@ pub struct FmPoint {
     pub multipliers: Vec<Complex<f64>>,
     /// All multipliers inside the unit circle (module docs, **Stability**).
     pub stable: bool,
-    /// det ∂(A₁/A, φ₁)/∂(Ω, α2) at the solution (its secant estimate): a sign change between two
-    /// values is a fold.
+    /// det ∂(A₁/A, φ₁)/∂(Ω, α2) at the solution (its secant estimate; NaN where the bracketing
+    /// fallback found the point): a sign change between two values, confirmed by forward
+    /// differences, is a fold.
     pub loop_determinant: f64,
     /// Newton iterations on (Ω, α2).
     pub iterations: usize,
@@ -217,13 +234,24 @@ pub struct FmCurve {
     pub points: Vec<FmPoint>,
     /// Where the loop Jacobian's determinant changes sign.
     pub folds: Vec<FmFold>,
-    /// Values not reached and why.
-    pub warnings: Vec<String>,
+    /// The first value not reached, where the curve ends (the values after it are not tried).
+    pub unreached: Option<Unreached>,
+}
+
+/// The value where an FM curve ends early.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Unreached {
+    /// α5 of the value.
+    pub alpha5: f64,
+    /// Why: the error of the last attempt.
+    pub reason: String,
 }
 
 /// An orbit at one (α5, Ω, α2) with its loop residual.
 struct Locked {
     x: Vector2<f64>,
+    /// ‖P(z) − z‖ of the orbit.
+    fixed_point: f64,
     orbit: PeriodicOrbit,
     observables: Observables,
     residual: Vector2<f64>,
@@ -251,7 +279,27 @@ impl Solver<'_> {
         p.validate()?;
         let model = CantileverModel::new(&p)?;
         let mut integ = build(&model, self.spec.integrator.clone(), 0.0, guess)?;
-        let orbit = shoot_with(integ.as_mut(), guess, 1, &self.spec.newton)?;
+        // Newton's full steps; where they stall (near a grazing orbit, whose map has a
+        // square-root singularity) Newton with a line search; at the map's round-off floor a
+        // looser tolerance
+        let orbit = match shoot_with(integ.as_mut(), guess, 1, &self.spec.newton) {
+            Err(SimError::NoConvergence { .. }) => {
+                match shoot_globalised(integ.as_mut(), guess, 1, &self.spec.newton) {
+                    Err(SimError::NoConvergence { residual, .. })
+                        if residual <= ROUND_OFF_LIMIT =>
+                    {
+                        let looser = ShootingOptions {
+                            tol: ROUND_OFF_RETRY * residual,
+                            ..self.spec.newton
+                        };
+                        shoot_globalised(integ.as_mut(), guess, 1, &looser)?
+                    }
+                    r => r?,
+                }
+            }
+            r => r?,
+        };
+        let fixed_point = orbit.residuals.last().copied().unwrap_or(0.0);
         let observables = observe_orbit(&model, self.spec.integrator.clone(), &orbit, 1)?;
         let residual = Vector2::new(
             observables.amplitude / self.spec.amplitude - 1.0,
@@ -259,6 +307,7 @@ impl Solver<'_> {
         );
         Ok(Locked {
             x,
+            fixed_point,
             orbit,
             observables,
             residual,
@@ -268,14 +317,148 @@ impl Solver<'_> {
     /// The forward-difference Jacobian of g at `at`.
     fn jacobian(&self, alpha5: f64, at: &Locked) -> Result<Matrix2<f64>, SimError> {
         let mut j = Matrix2::zeros();
-        for c in 0..2 {
-            let h = DIFFERENCE_STEP * at.x[c].abs().max(1e-12);
+        let r = &self.reference;
+        let steps = [
+            DIFFERENCE_STEP * r.omega * (0.5 / r.quality_factor).min(1.0),
+            DIFFERENCE_STEP * at.x[1].abs().max(1e-12),
+        ];
+        for (c, h) in steps.into_iter().enumerate() {
             let mut x = at.x;
             x[c] += h;
             let moved = self.orbit(alpha5, x, &at.orbit.state)?;
             j.set_column(c, &((moved.residual - at.residual) / h));
         }
         Ok(j)
+    }
+
+    /// The orbit at (α5, Ω) with α2 set so that A₁ = A: α2 ← α2 A/A₁ (A₁ is nearly linear in
+    /// α2 at fixed Ω, exactly so without a sample), from `alpha2` and `guess`.
+    fn hold_amplitude(
+        &self,
+        alpha5: f64,
+        omega: f64,
+        alpha2: f64,
+        guess: &DVector<f64>,
+        evaluations: &mut usize,
+    ) -> Result<Locked, SimError> {
+        let mut cur = self.orbit(alpha5, Vector2::new(omega, alpha2), guess)?;
+        *evaluations += 1;
+        for _ in 0..MAX_LOOP_ITERATIONS {
+            let r = cur.residual[0].abs();
+            if r <= self.spec.tolerance {
+                break;
+            }
+            let next = self.orbit(
+                alpha5,
+                Vector2::new(omega, cur.x[1] / (1.0 + cur.residual[0])),
+                &cur.orbit.state,
+            )?;
+            *evaluations += 1;
+            if next.residual[0].abs() >= r {
+                break;
+            }
+            cur = next;
+        }
+        Ok(cur)
+    }
+
+    /// The loop conditions met by bracketing, where Newton's method fails (a kink of A₁ and
+    /// φ₁ in (Ω, α2) where the lower turning point crosses the edge of a contact law whose
+    /// force gradient jumps there, as DMT's at d = a₀): at each Ω the amplitude is held
+    /// ([`Self::hold_amplitude`]), and φ₁(Ω) − φ_set, increasing in Ω (the lag grows through
+    /// a resonance), is bracketed from `x0` by steps growing from 10⁻³ of the half linewidth,
+    /// then reduced by the Illinois variant of regula falsi (Dowell & Jarratt, *BIT* 11 (1971)
+    /// 168), which converges superlinearly on a smooth function and never leaves the bracket.
+    fn lock_bracketed(
+        &self,
+        alpha5: f64,
+        x0: Vector2<f64>,
+        guess: &DVector<f64>,
+    ) -> Result<(Locked, usize), SimError> {
+        let mut n = 0;
+        let at = |omega: f64, alpha2: f64, guess: &DVector<f64>, n: &mut usize| {
+            self.hold_amplitude(alpha5, omega, alpha2, guess, n)
+        };
+        let done = |l: &Locked| {
+            let r = l.residual.amax();
+            r <= self.spec.tolerance
+        };
+        let mut a = at(x0[0], x0[1], guess, &mut n)?;
+        if done(&a) {
+            return Ok((a, n));
+        }
+        let r = &self.reference;
+        let mut h = 1e-3 * r.omega * (0.5 / r.quality_factor).min(1.0);
+        let dir = if a.residual[1] > 0.0 { -1.0 } else { 1.0 };
+        let mut b = loop {
+            let state = a.orbit.state.clone();
+            let next = at(a.x[0] + dir * h, a.x[1], &state, &mut n)?;
+            if next.residual[1].signum() != a.residual[1].signum() || done(&next) {
+                break next;
+            }
+            a = next;
+            h *= 2.0;
+            if h > 0.5 * r.omega {
+                return Err(SimError::NoConvergence {
+                    what: "bracketing the FM phase condition in Ω",
+                    iterations: n,
+                    residual: a.residual.amax(),
+                });
+            }
+        };
+        // Illinois: (a, b) bracket the zero of the phase residual
+        let mut side = 0i8;
+        for _ in 0..4 * MAX_LOOP_ITERATIONS {
+            if done(&b) {
+                return Ok((b, n));
+            }
+            let (fa, fb) = (a.residual[1], b.residual[1]);
+            let mut wa = 1.0;
+            let mut wb = 1.0;
+            if side == 1 {
+                wa = 0.5;
+            } else if side == -1 {
+                wb = 0.5;
+            }
+            let (fa_w, fb_w) = (wa * fa, wb * fb);
+            let omega = (a.x[0] * fb_w - b.x[0] * fa_w) / (fb_w - fa_w);
+            let width = (b.x[0] - a.x[0]).abs();
+            if !(omega.is_finite()) || width <= 4.0 * f64::EPSILON * r.omega {
+                break;
+            }
+            let alpha2 = 0.5 * (a.x[1] + b.x[1]);
+            let state = b.orbit.state.clone();
+            let c = at(omega, alpha2, &state, &mut n)?;
+            if c.residual[1].signum() == fb.signum() {
+                b = c;
+                side = if side == 1 { 2 } else { 1 };
+            } else {
+                a = b;
+                b = c;
+                side = -1;
+            }
+            if side == 2 {
+                side = 1;
+            }
+        }
+        let best = if a.residual.amax() < b.residual.amax() {
+            a
+        } else {
+            b
+        };
+        let floor = self.spec.tolerance.max(
+            r.quality_factor.min(1e12)
+                * (NOISE_FLOOR_FACTOR * self.spec.integrator.tolerance
+                    + ORBIT_FLOOR_FACTOR * best.fixed_point),
+        );
+        if best.residual.amax() <= floor {
+            return Ok((best, n));
+        }
+        Err(SimError::NoConvergence {
+            what: "the FM loop conditions by bracketing in Ω",
+            iterations: n,
+            residual: best.residual.amax(),
+        })
     }
 
     /// Newton on (Ω, α2) at α5 from `x0` with the orbit guess `guess` and a Jacobian estimate.
@@ -287,11 +470,13 @@ impl Solver<'_> {
         jac: &mut Option<Matrix2<f64>>,
     ) -> Result<(Locked, usize), SimError> {
         let tol = self.spec.tolerance;
-        let floor = tol.max(
-            NOISE_FLOOR_FACTOR
-                * self.reference.quality_factor.min(1e12)
-                * self.spec.integrator.tolerance,
-        );
+        let q = self.reference.quality_factor.min(1e12);
+        let floor = |at: &Locked| {
+            tol.max(
+                q * (NOISE_FLOOR_FACTOR * self.spec.integrator.tolerance
+                    + ORBIT_FLOOR_FACTOR * at.fixed_point),
+            )
+        };
         let mut stalled = 0;
         let mut cur = self.orbit(alpha5, x0, guess)?;
         let mut j = match jac {
@@ -301,7 +486,7 @@ impl Solver<'_> {
         let mut fresh = jac.is_none();
         for it in 0..MAX_LOOP_ITERATIONS {
             let r = cur.residual.amax();
-            if r <= tol || (r <= floor && stalled >= 2) {
+            if r <= tol || (r <= floor(&cur) && stalled >= 2) {
                 *jac = Some(j);
                 return Ok((cur, it));
             }
@@ -322,13 +507,18 @@ impl Solver<'_> {
             if cur.x[1] + dx[1] <= 0.0 {
                 dx *= 0.5 * cur.x[1] / dx[1].abs();
             }
-            let mut next = None;
+            // backtrack on the loop residual (and on orbits that are not found)
+            let mut next: Option<Locked> = None;
             let mut step = dx;
-            for _ in 0..8 {
+            for _ in 0..BACKTRACKS {
                 match self.orbit(alpha5, cur.x + step, &cur.orbit.state) {
-                    Ok(n) => {
+                    Ok(n) if n.residual.amax() < cur.residual.amax() => {
                         next = Some(n);
                         break;
+                    }
+                    Ok(n) => {
+                        next.get_or_insert(n);
+                        step *= 0.5;
                     }
                     Err(SimError::Cancelled) => return Err(SimError::Cancelled),
                     Err(_) => step *= 0.5,
@@ -337,6 +527,22 @@ impl Solver<'_> {
             let Some(next) = next else {
                 break;
             };
+            if next.residual.amax() >= cur.residual.amax() {
+                // no decrease along the step: at the orbit's round-off floor the point is
+                // found; else a fresh Jacobian, unless it is one already
+                if cur.residual.amax() <= floor(&cur) {
+                    *jac = Some(j);
+                    return Ok((cur, it));
+                }
+                if fresh {
+                    break;
+                }
+                j = self.jacobian(alpha5, &cur)?;
+                fresh = true;
+                stalled += 1;
+                continue;
+            }
+            let step = next.x - cur.x;
             let dg = next.residual - cur.residual;
             let good = next.residual.amax() < 0.5 * cur.residual.amax();
             // Broyden: J ← J + (Δg − J δ) δᵀ / (δᵀδ)
@@ -374,7 +580,7 @@ pub fn fm_curve(spec: &FmSpec, progress: &Progress) -> Result<FmCurve, SimError>
     let solver = Solver { spec, reference };
     progress.add_total(spec.values.len());
     let mut points: Vec<FmPoint> = Vec::with_capacity(spec.values.len());
-    let mut warnings = Vec::new();
+    let mut unreached = None;
     let mut jac: Option<Matrix2<f64>> = None;
     // the free orbit at the reference from rest (Newton on the free flight's affine map)
     let start = CantileverModel::new(&spec.base.with(SweepParam::Alpha5, spec.values[0]))?.rest();
@@ -395,7 +601,15 @@ pub fn fm_curve(spec: &FmSpec, progress: &Progress) -> Result<FmCurve, SimError>
                     _ => target,
                 };
                 let (x0, guess) = predict(&from, &prev, value, &reference, &start);
-                match solver.lock(value, x0, &guess, &mut trial_jac) {
+                let locked = match solver.lock(value, x0, &guess, &mut trial_jac) {
+                    Err(SimError::Cancelled) => Err(SimError::Cancelled),
+                    Err(_) => {
+                        trial_jac = None;
+                        solver.lock_bracketed(value, x0, &guess)
+                    }
+                    ok => ok,
+                };
+                match locked {
                     Ok((locked, it)) => {
                         prev = from;
                         from = Some((value, locked.x, locked.orbit.state.clone()));
@@ -424,10 +638,10 @@ pub fn fm_curve(spec: &FmSpec, progress: &Progress) -> Result<FmCurve, SimError>
             if points.is_empty() {
                 return Err(e);
             }
-            warnings.push(format!(
-                "the FM steady state was not found at α5 = {target} and beyond ({e}); the \
-                 curve ends at the previous value"
-            ));
+            unreached = Some(Unreached {
+                alpha5: target,
+                reason: e.to_string(),
+            });
             break;
         };
         let p = spec
@@ -452,21 +666,29 @@ pub fn fm_curve(spec: &FmSpec, progress: &Progress) -> Result<FmCurve, SimError>
         });
         progress.tick();
     }
-    let folds = points
-        .windows(2)
-        .enumerate()
-        .filter(|(_, w)| w[0].loop_determinant * w[1].loop_determinant < 0.0)
-        .map(|(index, w)| FmFold {
-            index,
-            alpha5: w[0].alpha5,
-        })
-        .collect();
+    // a sign change of the secant estimates is confirmed by forward differences at both ends
+    let mut folds = Vec::new();
+    for index in 0..points.len().saturating_sub(1) {
+        let (a, b) = (&points[index], &points[index + 1]);
+        if a.loop_determinant * b.loop_determinant < 0.0 {
+            let fresh = |q: &FmPoint| -> Result<f64, SimError> {
+                let at = solver.orbit(q.alpha5, Vector2::new(q.omega, q.alpha2), &q.state)?;
+                Ok(solver.jacobian(q.alpha5, &at)?.determinant())
+            };
+            if fresh(a)? * fresh(b)? < 0.0 {
+                folds.push(FmFold {
+                    index,
+                    alpha5: a.alpha5,
+                });
+            }
+        }
+    }
     Ok(FmCurve {
         reference,
         amplitude: spec.amplitude,
         points,
         folds,
-        warnings,
+        unreached,
     })
 }
 

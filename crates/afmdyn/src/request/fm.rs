@@ -159,6 +159,7 @@ pub fn document(request: &FmRequest, model: &Resolved, curve: &FmCurve) -> Value
         base.with(crate::params::SweepParam::Alpha5, a5)
             .rest_distance()
     };
+    let u_len = u.length;
     let r = &curve.reference;
     let max_mult =
         |q: &crate::analysis::fm::FmPoint| q.multipliers.first().map_or(f64::NAN, |m| m.norm());
@@ -168,7 +169,16 @@ pub fn document(request: &FmRequest, model: &Resolved, curve: &FmCurve) -> Value
         (None, 1) if base.structure == crate::params::Structure::PointMass => json!(1.0),
         _ => Value::Null,
     };
-    let mut warnings: Vec<String> = curve.warnings.clone();
+    let mut warnings: Vec<String> = Vec::new();
+    if let Some(u) = &curve.unreached {
+        warnings.push(format!(
+            "the FM steady state was not found at z_c = {:e}{} and beyond ({}); the curve ends at \
+             the previous value",
+            z_c(u.alpha5) * u_len,
+            if model.probe.is_some() { " m" } else { " g0" },
+            u.reason
+        ));
+    }
     if spring_constant.is_null() {
         warnings.push(format!(
             "no spring constant is given for mode {}: give it to reconstruct the force",

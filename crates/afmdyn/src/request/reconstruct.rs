@@ -70,6 +70,66 @@ impl ReconstructRequest {
     }
 }
 
+impl ReconstructRequest {
+    /// The request of an `afmdyn fm` document in SI ([`super::fm::document`]): the distances
+    /// of closest approach `curve.min_distance` (the lower turning points, static deflection
+    /// included), `curve.frequency_shift`, and the document's `spring_constant`,
+    /// `resonance_frequency` and `amplitude` — each of the three replaced by the value given.
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming `fm` for a document that is not an SI `fm` document (no
+    /// `curve`, or the model's units: run `fm` with a probe), naming `spring_constant` when the
+    /// document has none (a mode other than 1) and none is given.
+    pub fn from_fm_document(
+        doc: &Value,
+        spring_constant: Option<f64>,
+        resonance_frequency: Option<f64>,
+        amplitude: Option<f64>,
+    ) -> Result<Self, SimError> {
+        let numbers = |name: &str| -> Option<Vec<f64>> {
+            doc["curve"][name]
+                .as_array()?
+                .iter()
+                .map(Value::as_f64)
+                .collect()
+        };
+        let (Some(distance), Some(frequency_shift)) =
+            (numbers("min_distance"), numbers("frequency_shift"))
+        else {
+            return Err(SimError::out_of_range(
+                "fm",
+                "a document without curve.min_distance and curve.frequency_shift",
+                "must be the JSON document of afmdyn fm (fm.json, or --json's output)",
+            ));
+        };
+        if doc["units"]["z_c"].as_str() != Some("m") {
+            return Err(SimError::out_of_range(
+                "fm",
+                "a document in the model's units",
+                "must be in SI: run afmdyn fm with --probe (or give the curve as a CSV with \
+                 k, f0 and A)",
+            ));
+        }
+        let constant = |given: Option<f64>, key: &'static str| -> Result<f64, SimError> {
+            given.or_else(|| doc[key].as_f64()).ok_or_else(|| {
+                SimError::out_of_range(
+                    key,
+                    "missing",
+                    "the fm document has none (a higher mode's stiffness is not known): give it",
+                )
+            })
+        };
+        Ok(ReconstructRequest {
+            distance: Some(distance),
+            z_c: None,
+            frequency_shift,
+            spring_constant: constant(spring_constant, "spring_constant")?,
+            resonance_frequency: constant(resonance_frequency, "resonance_frequency")?,
+            amplitude: constant(amplitude, "amplitude")?,
+        })
+    }
+}
+
 impl Analysis for ReconstructRequest {
     type Output = Reconstruction;
     fn validate(&self, _: &Resolved) -> Result<(), SimError> {
