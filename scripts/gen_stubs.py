@@ -54,6 +54,7 @@ FUNCTIONS = [
         "basins",
         ["probe: Optional[str] = None", "store: Optional[str] = None", "resume: bool = False"],
     ),
+    ("fm", "fm", ["probe: Optional[str] = None"]),
 ]
 #: requests with a stub but no compiled function of their own (the chart's study takes JSON)
 OTHERS = ["chart", "reconstruct"]

@@ -21,7 +21,7 @@ pub struct FmArgs {
     model: ModelArgs,
     /// Oscillation amplitude A the amplitude controller holds (m with --probe, else g0; a unit
     /// may follow: 10nm) [default: the probe's free amplitude A0]
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     amplitude: Option<Quantity>,
     /// Mode K the PLL tracks (1..=N)
     #[arg(long, default_value_t = 1)]

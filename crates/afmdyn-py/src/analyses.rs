@@ -501,6 +501,42 @@ pub fn reconstruct<'py>(
     Ok(out.finish())
 }
 
+/// The force and potential behind an `fm` document (`afmdyn reconstruct --fm fm.json`): the
+/// request from the document ([`afmdyn::request::ReconstructRequest::from_fm_document`], its
+/// k, f0 and A replaced by those given), and its JSON document.
+#[pyfunction]
+#[pyo3(signature = (document, spring_constant=None, resonance_frequency=None, amplitude=None, progress=None))]
+pub fn reconstruct_fm<'py>(
+    py: Python<'py>,
+    document: &str,
+    spring_constant: Option<f64>,
+    resonance_frequency: Option<f64>,
+    amplitude: Option<f64>,
+    progress: Option<Bound<'py, PyAny>>,
+) -> PyResult<Dict<'py>> {
+    let doc: serde_json::Value = serde_json::from_str(document).map_err(|e| {
+        pyo3::exceptions::PyValueError::new_err(format!("fm: not a JSON document: {e}"))
+    })?;
+    let request = afmdyn::request::ReconstructRequest::from_fm_document(
+        &doc,
+        spring_constant,
+        resonance_frequency,
+        amplitude,
+    )
+    .map_err(sim_error)?;
+    let doc = analysis(
+        py,
+        request,
+        Params::default(),
+        None,
+        progress.as_ref(),
+        false,
+    )?;
+    let out = Out::new(py);
+    out.json(&doc.json)?;
+    Ok(out.finish())
+}
+
 /// A probe (SI units, `afmdyn … --probe FILE`; its TOML text from [`crate::params::probe_source`]): its
 /// dimensionless parameters and the `"si"` block of the command line's JSON (scales,
 /// calibration, drive, A₀, z_c).

@@ -28,7 +28,8 @@ IMPACT_PY = dict(contact_law="impact", restitution=0.5, modes=1, gap=0.05, omega
 SHORT = ["--max-periods", 300]
 
 COMMANDS = ["modes", "units", "simulate", "converge", "bifurcation", "attractors", "orbit",
-            "continue", "lyapunov", "approach", "resonance", "chart", "basins", "reconstruct"]
+            "continue", "lyapunov", "approach", "resonance", "chart", "basins", "reconstruct",
+            "fm"]
 FM = str(EXAMPLES / "fm-vdw.csv")
 FM_ARGS = ["--fm", FM, "--spring-constant", 40, "--resonance-frequency", "300kHz",
            "--amplitude", "10nm"]
@@ -116,13 +117,15 @@ CLI_CASES: List[Tuple[str, List[Any]]] = [
     ("basins", ["--x-steps", 3, "--y-steps", 2, *SHORT, *IMPACT]),
     ("basins", ["--x-steps", 2, "--y-steps", 1, *SHORT, "--probe", P1]),
     ("reconstruct", FM_ARGS),
+    ("fm", ["--points", 4]),
+    ("fm", ["--points", 4, "--probe", P1]),
     # (a probe refuses the dimensionless omega axis: the drive frequency in Hz, 0.99 f0)
     ("chart", ["--x", "z-c", "--x-from", 6e-9, "--x-to", 8e-9, "--x-steps", 2, "--y",
                "drive-frequency", "--y-from", "297kHz", "--y-to", "297kHz", "--y-steps", 1,
                "--starts", 1, *SHORT, "--probe", P1]),
 ]
 WRITES = {"simulate", "converge", "bifurcation", "attractors", "continue", "chart", "basins",
-          "reconstruct"}
+          "reconstruct", "fm"}
 
 
 @pytest.fixture(scope="module")
@@ -195,6 +198,8 @@ def _python_docs() -> List[Tuple[str, str, Callable[[], Any]]]:
         ("observe", "observe impact", lambda: afmdyn.summary(afmdyn.observe(**IMPACT_PY))),
         ("reconstruct", "reconstruct", lambda: afmdyn.summary(afmdyn.reconstruct(
             **_fm_curve(), spring_constant=40.0, resonance_frequency=3e5, amplitude=1e-8))),
+        ("fm", "fm", lambda: afmdyn.summary(afmdyn.fm(points=4))),
+        ("fm", "fm probe", lambda: afmdyn.summary(afmdyn.fm(points=4, probe=P1))),
     ]
 
 
@@ -308,7 +313,8 @@ def test_every_request_has_a_schema() -> None:
     assert REQUEST_NAMES == sorted(
         ["model", "steady", "integrator", "start", "orbit", "continuation", "lyapunov",
          "attractors", "observe", "converge", "simulate", "bifurcation", "curve", "modes",
-         "approach", "resonance", "chart", "global_continuation", "basins", "reconstruct"]
+         "approach", "resonance", "chart", "global_continuation", "basins", "reconstruct",
+         "fm"]
     )
 
 

@@ -7,7 +7,7 @@
 #![cfg(feature = "schema")]
 
 use afmdyn::request::{
-    ApproachRequest, BasinsRequest, ChartRequest, ModesRequest, ReconstructRequest,
+    ApproachRequest, BasinsRequest, ChartRequest, FmRequest, ModesRequest, ReconstructRequest,
     ResonanceRequest,
 };
 use afmdyn::request::{
@@ -73,6 +73,7 @@ fn schemas() -> Vec<(&'static str, Value)> {
         ("chart", schema::<ChartRequest>("chart")),
         ("basins", schema::<BasinsRequest>("basins")),
         ("reconstruct", schema::<ReconstructRequest>("reconstruct")),
+        ("fm", schema::<FmRequest>("fm")),
     ]
 }
 

@@ -43,6 +43,7 @@ from ._common import AfmdynWarning, Model, summary
 from ._interrupt import cancel_running
 from ._interrupt import install as _install_sigint
 from ._orbits import lyapunov, orbit
+from ._fm import fm
 from ._reconstruct import reconstruct
 from ._results import Lyapunov, Orbit, RegionSpectrum, Spectrum
 
@@ -83,6 +84,7 @@ __all__ = [
     "orbit",
     "probe",
     "reconstruct",
+    "fm",
     "resonance",
     "simulate",
     "summary",

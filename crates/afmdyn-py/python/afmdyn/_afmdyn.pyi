@@ -350,6 +350,20 @@ BasinsRequest = TypedDict(
     total=False,
 )
 
+FmRequest = TypedDict(
+    "FmRequest",
+    {
+        "amplitude": Optional[float],  # default null
+        "from": Optional[float],  # default null
+        "mode": int,  # default 1
+        "points": Optional[int],  # default null
+        "step": Optional[float],  # default null
+        "to": Optional[float],  # default null
+        "tolerance": float,  # default 1e-09
+    },
+    total=False,
+)
+
 ChartRequest = TypedDict(
     "ChartRequest",
     {
@@ -484,10 +498,24 @@ def basins(
     resume: bool = False,
 ) -> Dict[str, Any]: ...
 
+def fm(
+    params: Params,
+    request: Optional[FmRequest] = None,
+    progress: Optional[ProgressCallback] = None,
+    probe: Optional[str] = None,
+) -> Dict[str, Any]: ...
+
 # --- end of the generated block ---
 
 def reconstruct(
     request: Optional[ReconstructRequest] = None,
+    progress: Optional[ProgressCallback] = None,
+) -> Dict[str, Any]: ...
+def reconstruct_fm(
+    document: str,
+    spring_constant: Optional[float] = None,
+    resonance_frequency: Optional[float] = None,
+    amplitude: Optional[float] = None,
     progress: Optional[ProgressCallback] = None,
 ) -> Dict[str, Any]: ...
 def cantilevers() -> str: ...

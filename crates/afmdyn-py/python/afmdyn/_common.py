@@ -299,7 +299,7 @@ _DEFAULTS = {
     name: _core.request_defaults(name)
     for name in (
         "simulate converge bifurcation attractors global_continuation orbit continuation "
-        "lyapunov observe approach resonance basins chart"
+        "lyapunov observe approach resonance basins chart fm"
     ).split()
 }
 

@@ -4,7 +4,7 @@ library's Sader–Jarvis inversion as an ``xarray.Dataset`` in SI."""
 from __future__ import annotations
 
 import json
-from typing import Any, Optional, Sequence
+from typing import Any, Dict, Optional, Sequence, Union
 
 import numpy as np
 import xarray as xr
@@ -19,12 +19,13 @@ def _values(v: Optional[Any]) -> Optional[list]:
 
 def reconstruct(
     *,
-    frequency_shift: Sequence[float],
-    spring_constant: float,
-    resonance_frequency: float,
-    amplitude: float,
+    frequency_shift: Optional[Sequence[float]] = None,
+    spring_constant: Optional[float] = None,
+    resonance_frequency: Optional[float] = None,
+    amplitude: Optional[float] = None,
     distance: Optional[Sequence[float]] = None,
     z_c: Optional[Sequence[float]] = None,
+    fm: Optional[Union[xr.Dataset, Dict[str, Any]]] = None,
     progress: ProgressArg = None,
 ) -> xr.Dataset:
     """The tip–sample force F(d) and potential U(d) behind a frequency-modulation curve, by
@@ -36,6 +37,10 @@ def reconstruct(
         distance: the distances of closest approach d (m), monotonic; or
         z_c: the rest distances (m), d = z_c − A.
         spring_constant: k (N/m). resonance_frequency: f0 (Hz). amplitude: A (m).
+        fm: instead of the curve, the dataset of :func:`afmdyn.fm` with a probe (or its
+            document, ``afmdyn.summary(ds)``): its distances of closest approach
+            (``min_distance``), shifts, k, f0 and A; ``spring_constant``,
+            ``resonance_frequency``, ``amplitude`` given replace the document's.
 
     Returns:
         ``xarray.Dataset`` over ``distance`` (m, increasing): ``force`` (N, attractive < 0),
@@ -46,8 +51,26 @@ def reconstruct(
 
     Raises:
         ValueError: naming the field — fewer than 3 points, distances not monotonic, lengths
-            that differ, constants not > 0, neither or both of ``distance`` and ``z_c``.
+            that differ, constants not > 0 or missing, neither or both of ``distance`` and
+            ``z_c``; ``fm`` not an SI ``fm`` document.
     """
+    if fm is not None:
+        if frequency_shift is not None or distance is not None or z_c is not None:
+            raise ValueError("fm: give the fm curve or frequency_shift with distance/z_c, not both")
+        document = fm.attrs["summary"] if isinstance(fm, xr.Dataset) else json.dumps(fm)
+        with reporter(progress, "reconstruct") as cb:
+            d = _core.reconstruct_fm(
+                document,
+                None if spring_constant is None else float(spring_constant),
+                None if resonance_frequency is None else float(resonance_frequency),
+                None if amplitude is None else float(amplitude),
+                progress=cb,
+            )
+        return _dataset(json.loads(d["json"]))
+    for name, v in (("frequency_shift", frequency_shift), ("spring_constant", spring_constant),
+                    ("resonance_frequency", resonance_frequency), ("amplitude", amplitude)):
+        if v is None:
+            raise ValueError(f"{name}: missing (give the curve and k, f0, A, or fm=)")
     request = dict(
         frequency_shift=_values(frequency_shift),
         distance=_values(distance),
@@ -58,7 +81,11 @@ def reconstruct(
     )
     with reporter(progress, "reconstruct") as cb:
         d = _core.reconstruct(request, progress=cb)
-    doc = json.loads(d["json"])
+    return _dataset(json.loads(d["json"]))
+
+
+def _dataset(doc: Dict[str, Any]) -> xr.Dataset:
+    """The dataset of a reconstruction document."""
     f = doc["force"]
     units = doc["units"]
     return xr.Dataset(

@@ -68,7 +68,7 @@ pub const ROUND_OFF_LIMIT: f64 = 1e-7;
 pub const ORBIT_FLOOR_FACTOR: f64 = 10.0;
 /// Most Newton iterations on (Ω, α2) per value.
 pub const MAX_LOOP_ITERATIONS: usize = 30;
-/// Most halvings of the step in z_c towards a value that does not converge.
+/// Most failures (each halving the step in z_c) on the way to one value.
 pub const MAX_HALVINGS: usize = 6;
 /// Step of the forward differences of the loop Jacobian: relative in α2; in Ω relative to the
 /// half linewidth ω_K/(2Q_K) (across which the phase turns by about 1 rad), so that the phase
@@ -588,46 +588,51 @@ pub fn fm_curve(spec: &FmSpec, progress: &Progress) -> Result<FmCurve, SimError>
     let mut before: Option<(f64, Vector2<f64>, DVector<f64>)> = None;
     for &target in &spec.values {
         progress.check()?;
+        // the step from the last value reached towards the target: halved after a failure
+        // (at most MAX_HALVINGS times for this target), doubled back after a success; the
+        // first value has no earlier point to step from
         let mut reached: Option<(Locked, usize)> = None;
         let mut failure: Option<SimError> = None;
-        // the first value has no earlier point to halve from
-        let most = if last.is_some() { MAX_HALVINGS } else { 0 };
-        for halvings in 0..=most {
-            let pieces = 1usize << halvings;
-            let (mut from, mut prev, mut trial_jac) = (last.clone(), before.clone(), jac);
-            for k in 1..=pieces {
-                let value = match &from {
-                    Some((a, ..)) if k < pieces => a + (target - a) / (pieces + 1 - k) as f64,
-                    _ => target,
-                };
-                let (x0, guess) = predict(&from, &prev, value, &reference, &start);
-                let locked = match solver.lock(value, x0, &guess, &mut trial_jac) {
-                    Err(SimError::Cancelled) => Err(SimError::Cancelled),
-                    Err(_) => {
-                        trial_jac = None;
-                        solver.lock_bracketed(value, x0, &guess)
-                    }
-                    ok => ok,
-                };
-                match locked {
-                    Ok((locked, it)) => {
-                        prev = from;
-                        from = Some((value, locked.x, locked.orbit.state.clone()));
-                        if k == pieces {
-                            reached = Some((locked, it));
-                        }
-                    }
-                    Err(SimError::Cancelled) => return Err(SimError::Cancelled),
-                    Err(e) => {
-                        failure = Some(e);
+        let (mut from, mut prev, mut trial_jac) = (last.clone(), before.clone(), jac);
+        let (mut fraction, mut failures) = (1.0f64, 0);
+        loop {
+            let value = match &from {
+                Some((a, ..)) if fraction < 1.0 => a + (target - a) * fraction,
+                _ => target,
+            };
+            let (x0, guess) = predict(&from, &prev, value, &reference, &start);
+            let locked = match solver.lock(value, x0, &guess, &mut trial_jac) {
+                Err(SimError::Cancelled) => Err(SimError::Cancelled),
+                Err(_) => {
+                    trial_jac = None;
+                    solver.lock_bracketed(value, x0, &guess)
+                }
+                ok => ok,
+            };
+            match locked {
+                Ok((locked, it)) => {
+                    prev = from;
+                    from = Some((value, locked.x, locked.orbit.state.clone()));
+                    if value == target {
+                        reached = Some((locked, it));
                         break;
                     }
+                    fraction = (2.0 * fraction).min(1.0);
+                }
+                Err(SimError::Cancelled) => return Err(SimError::Cancelled),
+                Err(e) => {
+                    failure = Some(e);
+                    failures += 1;
+                    if from.is_none() || failures > MAX_HALVINGS {
+                        break;
+                    }
+                    fraction *= 0.5;
                 }
             }
-            if reached.is_some() {
-                (jac, before, last) = (trial_jac, prev, from);
-                break;
-            }
+            progress.check()?;
+        }
+        if reached.is_some() {
+            (jac, before, last) = (trial_jac, prev, from);
         }
         let Some((locked, iterations)) = reached else {
             let e = failure.unwrap_or(SimError::NoConvergence {

@@ -179,7 +179,7 @@ pub fn document(request: &FmRequest, model: &Resolved, curve: &FmCurve) -> Value
             u.reason
         ));
     }
-    if spring_constant.is_null() {
+    if spring_constant.is_null() && model.probe.is_some() {
         warnings.push(format!(
             "no spring constant is given for mode {}: give it to reconstruct the force",
             request.mode

@@ -1,0 +1,136 @@
+//! `afmdyn fm` end to end: the Sader–Jarvis round trip (J. E. Sader and S. P. Jarvis, Appl.
+//! Phys. Lett. 84, 1801 (2004)) — the DMT probe's van der Waals force −HR/(6d²) → Δf(z_c) by
+//! `afmdyn fm` → `afmdyn reconstruct --fm fm.json` → the force again within 2 % outside contact
+//! (d from 3a₀ to A/2, where the inversion's own error is below 1 % on this grid); the files;
+//! bad input exits 2 with one line naming the flag.
+
+use std::process::{Command, Output};
+
+fn afmdyn(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_afmdyn"))
+        .args(args)
+        .output()
+        .expect("run afmdyn")
+}
+
+const PROBE: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../../examples/probe-point-mass-dmt.toml"
+);
+
+fn column(doc: &serde_json::Value, block: &str, k: &str) -> Vec<f64> {
+    doc[block][k]
+        .as_array()
+        .unwrap_or_else(|| panic!("{block}.{k}"))
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect()
+}
+
+#[test]
+fn fm_then_reconstruct_gives_back_the_van_der_waals_force() {
+    let dir = tempfile::tempdir().unwrap();
+    let fm_dir = dir.path().join("fm");
+    let out = afmdyn(&[
+        "fm",
+        "--probe",
+        PROBE,
+        "--from",
+        "60nm",
+        "--to",
+        "10.5nm",
+        "--step",
+        "0.02nm",
+        "--json",
+        "--out",
+        fm_dir.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(doc["units"]["frequency_shift"], "Hz");
+    assert_eq!(doc["spring_constant"], 40.0);
+    assert_eq!(
+        doc["warnings"].as_array().unwrap().len(),
+        0,
+        "{}",
+        doc["warnings"]
+    );
+    let shift = column(&doc, "curve", "frequency_shift");
+    assert_eq!(shift.len(), 2476);
+    // attractive: the shift is negative and grows towards the sample
+    assert!(shift.windows(2).all(|w| w[1] < w[0] && w[1] < 0.0));
+    for file in ["fm.csv", "fm.json", "fm-frequency-shift.png"] {
+        assert!(fm_dir.join(file).metadata().unwrap().len() > 0, "{file}");
+    }
+    let rec = dir.path().join("rec");
+    let out = afmdyn(&[
+        "reconstruct",
+        "--fm",
+        fm_dir.join("fm.json").to_str().unwrap(),
+        "--json",
+        "--out",
+        rec.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let (d, force) = (
+        column(&doc, "force", "distance"),
+        column(&doc, "force", "force"),
+    );
+    let hr = 6.6e-20 * 10e-9;
+    let a0 = 0.165e-9;
+    let mut checked = 0;
+    for (d, f) in d
+        .iter()
+        .zip(&force)
+        .filter(|(d, _)| **d >= 3.0 * a0 && **d <= 5e-9)
+    {
+        let want = -hr / (6.0 * d * d);
+        assert!((f / want - 1.0).abs() < 0.02, "d = {d}: {f} vs {want}");
+        checked += 1;
+    }
+    assert!(checked > 200, "{checked}");
+}
+
+#[test]
+fn bad_fm_requests_exit_2_with_one_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("o");
+    for (extra, needle) in [
+        (&["--amplitude", "-1nm"][..], "amplitude"),
+        (&["--mode", "2"][..], "mode"),
+        (&["--tolerance", "0"][..], "tolerance"),
+        (&["--from", "1"][..], "from = 1 m"),
+        (&["--points", "1"][..], "points"),
+    ] {
+        let mut args = vec!["fm", "--probe", PROBE, "--out", out.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        let o = afmdyn(&args);
+        assert_eq!(o.status.code(), Some(2), "{extra:?}");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+        assert!(err.contains(needle), "{needle}: {err}");
+    }
+    // a document in the model's units cannot be inverted
+    let plain = dir.path().join("plain");
+    let o = afmdyn(&["fm", "--points", "3", "--out", plain.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = afmdyn(&[
+        "reconstruct",
+        "--fm",
+        plain.join("fm.json").to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("fm") && err.contains("SI"), "{err}");
+}
