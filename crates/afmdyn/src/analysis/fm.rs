@@ -20,8 +20,13 @@
 //! (Ω, α2) ([`super::shooting`]), and (Ω, α2) by Newton's method on the two conditions, its
 //! 2×2 Jacobian by forward differences and then Broyden's secant update (Broyden, *Math.
 //! Comp.* 19 (1965) 577) — the orbit's own accuracy is the shooting's, the conditions are met
-//! to [`FmSpec::tolerance`]. The curve is followed in z_c by natural-parameter continuation
-//! with a secant predictor; a value that does not converge is approached in halved steps.
+//! to [`FmSpec::tolerance`]. Where that nested solve fails — the forced orbit at the locked
+//! drive near a fold of its resonance curve (bent past the vertical by the interaction at high
+//! Q), so that M − I is singular — the orbit and the conditions are solved together by Newton's
+//! method on the augmented system in (z, Ω, α2) (`Solver::lock_augmented`), and as a last
+//! resort the phase condition is bracketed in Ω (`Solver::lock_bracketed`). The curve is
+//! followed in z_c by natural-parameter continuation with a secant predictor; a value that does
+//! not converge is approached in halved steps.
 //!
 //! **Reported.** The frequency shift Δω = Ω − ω_K, the excitation relative to the free one
 //! (α2 over the α2 that holds amplitude A at ω_K without a sample), and the observables of the
@@ -39,7 +44,7 @@
 //! The curve cannot be continued through a fold by natural-parameter continuation; it ends
 //! there with a warning.
 
-use super::observables::{free_response, observe_orbit, Observables};
+use super::observables::{free_response, observe, observe_orbit, ObservableOptions, Observables};
 use super::progress::Progress;
 use super::resonance::mode_resonance;
 use super::shooting::{shoot_globalised, shoot_with, PeriodicOrbit, ShootingOptions};
@@ -66,6 +71,9 @@ pub const ROUND_OFF_LIMIT: f64 = 1e-7;
 /// … plus this many times Q_K × the orbit's fixed-point residual (an orbit error δz moves
 /// the first harmonic by up to Q δz/π).
 pub const ORBIT_FLOOR_FACTOR: f64 = 10.0;
+/// The largest loop residual accepted at the orbit's round-off floor (1e-6 rad of phase: at
+/// Q = 10⁴ and f0 = 300 kHz, 2e-5 Hz of frequency shift).
+pub const MAX_LOOP_RESIDUAL: f64 = 1e-6;
 /// Most Newton iterations on (Ω, α2) per value.
 pub const MAX_LOOP_ITERATIONS: usize = 30;
 /// Most failures (each halving the step in z_c) on the way to one value.
@@ -74,6 +82,8 @@ pub const MAX_HALVINGS: usize = 6;
 /// half linewidth ω_K/(2Q_K) (across which the phase turns by about 1 rad), so that the phase
 /// moves by about this many rad, well above its round-off and well inside its linear range.
 const DIFFERENCE_STEP: f64 = 1e-5;
+/// Step of the forward differences in the state of the augmented Newton, times 1 + max|z|.
+const AUGMENTED_STATE_STEP: f64 = 1e-7;
 /// Most halvings of a Newton step on (Ω, α2) that does not lower the loop residual.
 const BACKTRACKS: usize = 10;
 
@@ -263,6 +273,18 @@ struct Solver<'a> {
 }
 
 impl Solver<'_> {
+    /// The loop residual accepted for the orbit `at` once Newton stops gaining: the
+    /// tolerance, or the orbit's own error Q_K (10³ × the integrator's tolerance + 10 × its
+    /// fixed-point residual) ([`NOISE_FLOOR_FACTOR`], [`ORBIT_FLOOR_FACTOR`]), never above
+    /// [`MAX_LOOP_RESIDUAL`].
+    fn floor(&self, at: &Locked) -> f64 {
+        let q = self.reference.quality_factor.min(1e12);
+        let noise = q
+            * (NOISE_FLOOR_FACTOR * self.spec.integrator.tolerance
+                + ORBIT_FLOOR_FACTOR * at.fixed_point);
+        self.spec.tolerance.max(noise.min(MAX_LOOP_RESIDUAL))
+    }
+
     /// The periodic orbit at (α5, x = (Ω, α2)) from `guess`, and g = (A₁/A − 1, φ₁ − φ_set).
     fn orbit(
         &self,
@@ -329,6 +351,140 @@ impl Solver<'_> {
             j.set_column(c, &((moved.residual - at.residual) / h));
         }
         Ok(j)
+    }
+
+    /// The residual of the augmented system at y = (z, Ω, α2): (P(z) − z, A₁/A − 1,
+    /// φ₁ − φ_set), with A₁ and φ₁ demodulated over the period from z (one flow gives both:
+    /// the observables' window ends at P(z)).
+    fn augmented_residual(&self, alpha5: f64, y: &DVector<f64>) -> Result<DVector<f64>, SimError> {
+        let d = y.len() - 2;
+        let z = y.rows(0, d).into_owned();
+        let p = self
+            .spec
+            .base
+            .with(SweepParam::Alpha5, alpha5)
+            .with(SweepParam::Omega, y[d])
+            .with(SweepParam::Alpha2, y[d + 1]);
+        p.validate()?;
+        let model = CantileverModel::new(&p)?;
+        let mut integ = build(&model, self.spec.integrator.clone(), 0.0, &z)?;
+        let o = observe(
+            integ.as_mut(),
+            &ObservableOptions {
+                periods: 1,
+                harmonics: 1,
+            },
+        )?;
+        let mut r = DVector::zeros(d + 2);
+        r.rows_mut(0, d).copy_from(&(integ.state() - &z));
+        r[d] = o.amplitude / self.spec.amplitude - 1.0;
+        r[d + 1] = o.phase - self.reference.phase;
+        Ok(r)
+    }
+
+    /// The orbit and the loop conditions solved together: Newton's method on the augmented
+    /// system (P(z) − z, A₁/A − 1, φ₁ − φ_set) = 0 in y = (z, Ω, α2) (the shooting of an
+    /// orbit of unknown frequency and forcing: Seydel, *Practical Bifurcation and Stability
+    /// Analysis*, Springer 2010, §7.3), its (d + 2)-square Jacobian by forward differences
+    /// (z on the state's scale, Ω on the linewidth's, α2 relative), each step backtracked on
+    /// the largest residual. Where the forced response at the locked drive is at a fold — its
+    /// resonance curve bent past the vertical by the interaction, at high Q, so that the
+    /// orbit's M − I is singular and the nested solve ([`Self::lock`]) cannot shoot it — the
+    /// augmented Jacobian is still regular: the loop conditions fix the direction M − I leaves
+    /// free.
+    fn lock_augmented(
+        &self,
+        alpha5: f64,
+        x0: Vector2<f64>,
+        guess: &DVector<f64>,
+    ) -> Result<(Locked, usize), SimError> {
+        let d = guess.len();
+        let mut y = DVector::zeros(d + 2);
+        y.rows_mut(0, d).copy_from(guess);
+        y[d] = x0[0];
+        y[d + 1] = x0[1];
+        let mut r = self.augmented_residual(alpha5, &y)?;
+        let r_ = &self.reference;
+        let fixed_tol = |y: &DVector<f64>| self.spec.newton.tol * (1.0 + y.rows(0, d).norm());
+        let met = |r: &DVector<f64>, y: &DVector<f64>| {
+            r.rows(0, d).norm() <= fixed_tol(y)
+                && r[d].abs().max(r[d + 1].abs()) <= self.spec.tolerance
+        };
+        let mut it = 0;
+        while !met(&r, &y) {
+            if it == MAX_LOOP_ITERATIONS {
+                return Err(SimError::NoConvergence {
+                    what: "the FM orbit and loop conditions together (augmented Newton)",
+                    iterations: it,
+                    residual: r.amax(),
+                });
+            }
+            it += 1;
+            let mut jac = nalgebra::DMatrix::zeros(d + 2, d + 2);
+            for c in 0..d + 2 {
+                let h = if c < d {
+                    AUGMENTED_STATE_STEP * (1.0 + y.rows(0, d).amax())
+                } else if c == d {
+                    DIFFERENCE_STEP * r_.omega * (0.5 / r_.quality_factor).min(1.0)
+                } else {
+                    DIFFERENCE_STEP * y[d + 1].abs().max(1e-12)
+                };
+                let mut yh = y.clone();
+                yh[c] += h;
+                let rh = self.augmented_residual(alpha5, &yh)?;
+                jac.set_column(c, &((rh - &r) / h));
+            }
+            let step = jac.lu().solve(&(-&r)).ok_or(SimError::NoConvergence {
+                what: "the FM orbit and loop conditions together (singular Jacobian)",
+                iterations: it,
+                residual: r.amax(),
+            })?;
+            let mut t = 1.0;
+            let mut accepted = None;
+            for _ in 0..BACKTRACKS {
+                let trial = &y + &step * t;
+                if let Ok(rt) = self.augmented_residual(alpha5, &trial) {
+                    if rt.amax() < r.amax() {
+                        accepted = Some((trial, rt));
+                        break;
+                    }
+                }
+                t *= 0.5;
+            }
+            let Some((ny, nr)) = accepted else {
+                break;
+            };
+            y = ny;
+            r = nr;
+        }
+        // the orbit at the solution, for its monodromy matrix and multipliers: shooting from a
+        // fixed point returns it at once
+        let x = Vector2::new(y[d], y[d + 1]);
+        let z = y.rows(0, d).into_owned();
+        let spec = self.spec;
+        let loose = Solver {
+            spec: &FmSpec {
+                newton: ShootingOptions {
+                    tol: spec
+                        .newton
+                        .tol
+                        .max(2.0 * r.rows(0, d).norm() / (1.0 + z.norm())),
+                    ..spec.newton
+                },
+                ..spec.clone()
+            },
+            reference: self.reference,
+        };
+        let locked = loose.orbit(alpha5, x, &z)?;
+        if locked.residual.amax() <= self.floor(&locked) {
+            Ok((locked, it))
+        } else {
+            Err(SimError::NoConvergence {
+                what: "the FM orbit and loop conditions together (augmented Newton)",
+                iterations: it,
+                residual: locked.residual.amax(),
+            })
+        }
     }
 
     /// The orbit at (α5, Ω) with α2 set so that A₁ = A: α2 ← α2 A/A₁ (A₁ is nearly linear in
@@ -446,12 +602,7 @@ impl Solver<'_> {
         } else {
             b
         };
-        let floor = self.spec.tolerance.max(
-            r.quality_factor.min(1e12)
-                * (NOISE_FLOOR_FACTOR * self.spec.integrator.tolerance
-                    + ORBIT_FLOOR_FACTOR * best.fixed_point),
-        );
-        if best.residual.amax() <= floor {
+        if best.residual.amax() <= self.floor(&best) {
             return Ok((best, n));
         }
         Err(SimError::NoConvergence {
@@ -470,13 +621,7 @@ impl Solver<'_> {
         jac: &mut Option<Matrix2<f64>>,
     ) -> Result<(Locked, usize), SimError> {
         let tol = self.spec.tolerance;
-        let q = self.reference.quality_factor.min(1e12);
-        let floor = |at: &Locked| {
-            tol.max(
-                q * (NOISE_FLOOR_FACTOR * self.spec.integrator.tolerance
-                    + ORBIT_FLOOR_FACTOR * at.fixed_point),
-            )
-        };
+        let floor = |at: &Locked| self.floor(at);
         let mut stalled = 0;
         let mut cur = self.orbit(alpha5, x0, guess)?;
         let mut j = match jac {
@@ -605,7 +750,9 @@ pub fn fm_curve(spec: &FmSpec, progress: &Progress) -> Result<FmCurve, SimError>
                 Err(SimError::Cancelled) => Err(SimError::Cancelled),
                 Err(_) => {
                     trial_jac = None;
-                    solver.lock_bracketed(value, x0, &guess)
+                    solver
+                        .lock_augmented(value, x0, &guess)
+                        .or_else(|_| solver.lock_bracketed(value, x0, &guess))
                 }
                 ok => ok,
             };
