@@ -240,3 +240,31 @@ fn high_q_curve_reaches_the_contact_edge() {
     assert!(curve.points.iter().all(|p| p.loop_residual <= 1e-6));
     assert!(curve.points.windows(2).all(|w| w[1].omega < w[0].omega));
 }
+
+/// The time-domain loop (`analysis::fm_loop`: the cantilever integrated cycle after cycle, a
+/// PLL and an amplitude controller correcting the drive once per cycle) settles on the exact
+/// steady state: the same frequency shift within what the settling tolerance allows.
+#[test]
+fn the_time_domain_loop_settles_on_the_exact_steady_state() {
+    use afmdyn::analysis::fm_loop::{fm_loop, LoopSpec};
+    let text = PROBE.replace("quality_factor = 1e4", "quality_factor = 400");
+    let probe = Probe::parse(&text, "q400").unwrap();
+    let g0 = probe.scales.length_m;
+    let z_c: Vec<f64> = (0..5).map(|i| 14e-9 - i as f64 * 0.8e-9).collect();
+    let values = z_c
+        .iter()
+        .map(|z| probe.params.alpha5_for_rest_distance(z / g0))
+        .collect();
+    let spec = FmSpec::new(probe.params, values, 1.0);
+    let exact = fm_curve(&spec, &Progress::new()).unwrap();
+    let looped = fm_loop(&spec, &LoopSpec::new(400.0), &Progress::new()).unwrap();
+    for (e, l) in exact.points.iter().zip(&looped) {
+        assert!(l.settled);
+        assert!((e.alpha2 - l.alpha2).abs() <= 1e-5 * e.alpha2);
+        let (de, dl) = (
+            e.omega - exact.reference.omega,
+            l.omega - exact.reference.omega,
+        );
+        assert!((de - dl).abs() <= 1e-3 * de.abs(), "{de} vs {dl}");
+    }
+}

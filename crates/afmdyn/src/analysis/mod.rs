@@ -15,6 +15,7 @@ pub mod chart;
 pub mod continuation;
 pub mod converge;
 pub mod fm;
+pub mod fm_loop;
 pub mod global_continuation;
 pub mod lyapunov;
 pub mod observables;
