@@ -105,6 +105,7 @@ fn request_of(a: &ReconstructArgs) -> Result<ReconstructRequest, CliError> {
         ))
     })?;
     Ok(ReconstructRequest {
+        law_force: None,
         distance: take("distance"),
         z_c: take("z_c"),
         frequency_shift,
@@ -143,12 +144,19 @@ pub fn reconstruct(a: &ReconstructArgs) -> Result<(), CliError> {
             title: "Tip–sample force by the Sader–Jarvis inversion".into(),
             x_label: "distance of closest approach d (m)".into(),
             y_label: "force F (N)".into(),
-            series: vec![Series {
-                label: String::new(),
+            series: std::iter::once(Series {
+                label: "reconstructed".into(),
                 points: points(&r.force),
                 style: Style::Line,
                 color: 0,
-            }],
+            })
+            .chain(request.law_in_order().map(|law| Series {
+                label: "the model's force law".into(),
+                points: points(&law),
+                style: Style::Dashed,
+                color: 1,
+            }))
+            .collect(),
             shade: Vec::new(),
             y_min_span: 0.0,
         },

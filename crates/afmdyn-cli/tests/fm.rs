@@ -98,6 +98,13 @@ fn fm_then_reconstruct_gives_back_the_van_der_waals_force() {
         checked += 1;
     }
     assert!(checked > 200, "{checked}");
+    // the model's force beside it: the law's van der Waals force outside contact, exactly
+    let law = column(&doc, "force", "law");
+    assert_eq!(law.len(), d.len());
+    for (d, l) in d.iter().zip(&law).filter(|(d, _)| **d > a0) {
+        let want = -hr / (6.0 * d * d);
+        assert!((l / want - 1.0).abs() < 1e-12, "d = {d}: {l} vs {want}");
+    }
 }
 
 #[test]

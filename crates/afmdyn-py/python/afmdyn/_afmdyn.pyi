@@ -398,6 +398,7 @@ ReconstructRequest = TypedDict(
         "amplitude": float,  # default 0.0
         "distance": Optional[List[float]],  # default null
         "frequency_shift": List[float],  # default []
+        "law_force": Optional[List[float]],  # default null
         "resonance_frequency": float,  # default 0.0
         "spring_constant": float,  # default 0.0
         "z_c": Optional[List[float]],  # default null

@@ -31,6 +31,7 @@ _LONG = {
     "min_distance": "tip–sample distance at the lower turning point",
     "peak_force": "largest tip–sample force",
     "mean_force": "mean tip–sample force",
+    "law_force": "the law's conservative force at the lower turning point",
     "indentation": "largest indentation",
     "max_multiplier": "largest Floquet multiplier modulus under the locked drive",
     "stable": "Floquet-stable under the locked drive",

@@ -44,7 +44,7 @@ def reconstruct(
 
     Returns:
         ``xarray.Dataset`` over ``distance`` (m, increasing): ``force`` (N, attractive < 0),
-        ``potential`` (J, ∫_d^{d_max} F); attributes ``spring_constant``,
+        ``potential`` (J, ∫_d^{d_max} F), and from ``fm=`` ``law`` (N, the model's force at d); attributes ``spring_constant``,
         ``resonance_frequency``, ``amplitude`` and ``summary`` (the command line's JSON
         document). The force near the largest distance is not reconstructed (the inversion
         integrates the shift beyond each distance): take data out to where Δf has decayed.
@@ -88,8 +88,14 @@ def _dataset(doc: Dict[str, Any]) -> xr.Dataset:
     """The dataset of a reconstruction document."""
     f = doc["force"]
     units = doc["units"]
+    law = {}
+    if "law" in f:
+        law["law"] = ("distance", np.asarray(f["law"]),
+                      {"units": units["force"],
+                       "long_name": "the model's force at d (a curve from afmdyn.fm)"})
     return xr.Dataset(
         {
+            **law,
             "force": ("distance", np.asarray(f["force"]),
                       {"units": units["force"], "long_name": "tip–sample force F(d)"}),
             "potential": ("distance", np.asarray(f["potential"]),

@@ -48,6 +48,7 @@ use super::observables::{free_response, observe, observe_orbit, ObservableOption
 use super::progress::Progress;
 use super::resonance::mode_resonance;
 use super::shooting::{shoot_globalised, shoot_with, PeriodicOrbit, ShootingOptions};
+use crate::contact::{TipSample, TipSampleLaw};
 use crate::error::SimError;
 use crate::integrate::{build, IntegratorOptions};
 use crate::model::CantileverModel;
@@ -220,6 +221,9 @@ pub struct FmPoint {
     pub iterations: usize,
     /// max(|A₁/A − 1|, |φ₁ − φ_set|) reached.
     pub loop_residual: f64,
+    /// The law's conservative force at the lower turning point's distance (F̃; at rest, the
+    /// damping off): the force a reconstruction from this curve should give back there.
+    pub law_force: f64,
     /// The orbit's observables (harmonics, forces, E_dis, virial, …).
     pub observables: Observables,
 }
@@ -814,6 +818,7 @@ pub fn fm_curve(spec: &FmSpec, progress: &Progress) -> Result<FmCurve, SimError>
             loop_determinant: jac.map_or(f64::NAN, |j| j.determinant()),
             iterations,
             loop_residual: locked.residual.amax(),
+            law_force: law_force(&p, observables.min_distance),
             observables,
         });
         progress.tick();
@@ -842,6 +847,18 @@ pub fn fm_curve(spec: &FmSpec, progress: &Progress) -> Result<FmCurve, SimError>
         folds,
         unreached,
     })
+}
+
+/// The conservative tip–sample force F̃ of `params`' law at the tip–sample distance `d` (units
+/// of g₀; d = V_T + [`crate::ContactLaw::distance_offset`], contact where V_T ≤ 0), at rest.
+pub fn law_force(params: &Params, d: f64) -> f64 {
+    let law = TipSample {
+        law: params.contact_law,
+        stiffness: params.alpha4,
+        damping: params.alpha6,
+    };
+    let delta = params.contact_law.distance_offset() - d;
+    law.force(delta >= 0.0, delta, 0.0).force
 }
 
 /// The start of the loop's Newton iteration at `value`: the secant through the last two points

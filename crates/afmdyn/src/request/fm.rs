@@ -199,6 +199,7 @@ pub fn document(request: &FmRequest, model: &Resolved, curve: &FmCurve) -> Value
             "min_distance": col(&|q| q.observables.min_distance * u.length),
             "peak_force": col(&|q| q.observables.peak_force * u.force),
             "mean_force": col(&|q| q.observables.mean_force * u.force),
+            "law_force": col(&|q| q.law_force * u.force),
             "indentation": col(&|q| q.observables.indentation * u.length),
             "max_multiplier": col(&max_mult),
             "stable": p.iter().map(|q| q.stable).collect::<Vec<bool>>(),
@@ -230,7 +231,7 @@ pub fn document(request: &FmRequest, model: &Resolved, curve: &FmCurve) -> Value
 
 /// The columns of an FM curve's table (`fm.csv`, Python's Dataset variables), in order: the
 /// numeric arrays of the document's `curve` (`stable` as 1/0).
-pub const COLUMNS: [&str; 17] = [
+pub const COLUMNS: [&str; 18] = [
     "z_c",
     "frequency_shift",
     "frequency",
@@ -243,6 +244,7 @@ pub const COLUMNS: [&str; 17] = [
     "min_distance",
     "peak_force",
     "mean_force",
+    "law_force",
     "indentation",
     "max_multiplier",
     "stable",

@@ -30,6 +30,10 @@ pub struct ReconstructRequest {
     pub resonance_frequency: f64,
     /// Oscillation amplitude A (m), > 0.
     pub amplitude: f64,
+    /// The model's force at each distance (N), when the curve came from a model (an `fm`
+    /// document's `curve.law_force`): reported beside the reconstruction for comparison.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub law_force: Option<Vec<f64>>,
 }
 
 impl ReconstructRequest {
@@ -66,7 +70,26 @@ impl ReconstructRequest {
             curve.frequency_shift.reverse();
         }
         curve.validate()?;
+        if let Some(l) = &self.law_force {
+            if l.len() != self.frequency_shift.len() {
+                return Err(SimError::out_of_range(
+                    "law_force",
+                    format!("{} values", l.len()),
+                    "must hold one force per frequency shift",
+                ));
+            }
+        }
         Ok(curve)
+    }
+
+    /// `law_force` in the order of [`Self::curve`] (increasing distance).
+    pub fn law_in_order(&self) -> Option<Vec<f64>> {
+        let mut law = self.law_force.clone()?;
+        let d = self.distance.as_ref().or(self.z_c.as_ref())?;
+        if d.len() >= 2 && d[0] > d[1] {
+            law.reverse();
+        }
+        Some(law)
     }
 }
 
@@ -122,6 +145,7 @@ impl ReconstructRequest {
         Ok(ReconstructRequest {
             distance: Some(distance),
             z_c: None,
+            law_force: numbers("law_force"),
             frequency_shift,
             spring_constant: constant(spring_constant, "spring_constant")?,
             resonance_frequency: constant(resonance_frequency, "resonance_frequency")?,
@@ -144,11 +168,16 @@ impl Analysis for ReconstructRequest {
 }
 
 /// The document of a reconstruction (`afmdyn reconstruct --json`): `force` (`distance` (m),
-/// `force` (N), `potential` (J), increasing distance), the cantilever's constants, `method`,
+/// `force` (N), `potential` (J), increasing distance; `law` (N), the model's force there, for a
+/// curve from an `fm` document), the cantilever's constants, `method`,
 /// `units`, `warnings` (the far end of the data, where the inversion has no data beyond).
 pub fn document(request: &ReconstructRequest, r: &Reconstruction) -> Value {
+    let mut force = json!({"distance": r.distance, "force": r.force, "potential": r.potential});
+    if let Some(law) = request.law_in_order() {
+        force["law"] = json!(law);
+    }
     json!({
-        "force": {"distance": r.distance, "force": r.force, "potential": r.potential},
+        "force": force,
         "spring_constant": request.spring_constant,
         "resonance_frequency": request.resonance_frequency,
         "amplitude": request.amplitude,
