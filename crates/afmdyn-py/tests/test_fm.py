@@ -59,3 +59,16 @@ def test_bad_fm_options_name_them():
     with pytest.raises(ValueError, match="spring_constant"):
         afmdyn.reconstruct(frequency_shift=[1.0, 2.0, 3.0], distance=[1.0, 2.0, 3.0])
     assert json.loads(plain.attrs["summary"])["mode"] == 1
+
+
+def test_reconstruct_of_fm_carries_the_model_force_law():
+    ds = afmdyn.fm(probe=P1, from_=30e-9, to=10.5e-9, step=0.1e-9)
+    back = afmdyn.reconstruct(fm=ds)
+    assert back.law.attrs["units"] == "N"
+    d = back.distance.values
+    outside = d > 0.165e-9
+    # the law's force outside contact is the probe's van der Waals force, exactly
+    np.testing.assert_allclose(back.law.values[outside], -6.6e-20 * 10e-9 / (6.0 * d[outside] ** 2),
+                               rtol=1e-12)
+    # and it is the fm dataset's law_force at its lower turning points, in increasing distance
+    np.testing.assert_allclose(np.sort(ds.law_force.values), np.sort(back.law.values), rtol=0)

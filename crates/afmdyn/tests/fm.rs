@@ -157,8 +157,8 @@ fn small_amplitude_shift_is_the_force_gradient() {
 /// the higher harmonics take. For the point mass at φ₁ = 90° the period balance is
 /// π α2 A = (π/Q) Ω (A² + Σ n²Aₙ²) + E_dis (module docs of `observables`), here with the
 /// tip–sample energy E_dis of a viscous DMT contact at Q = 10⁴, to 1e-8 of the drive's
-/// energy. The curve crosses the contact edge, where the forced response at the locked drive
-/// is near a fold (the augmented Newton's case).
+/// energy. The curve crosses the contact edge, where the nested solve stalls at this Q (the
+/// augmented Newton's case).
 #[test]
 fn excitation_grows_by_the_energy_dissipated() {
     let text = PROBE.replace("viscosity = 0.0", "viscosity = 50.0");
@@ -219,9 +219,9 @@ fn bad_spec_is_refused_naming_the_field() {
 }
 
 /// At Q = 10⁴ the default range ends where the lower turning point reaches the DMT contact
-/// edge, whose force gradient jumps: the resonance curve at the locked drive is bent past the
-/// vertical, its M − I nearly singular. Every value is reached (the nested solve falls back to
-/// the augmented Newton), the loop conditions met to 1e-6, the shift monotonic.
+/// edge, whose force gradient jumps, while M − I is nearly singular (multipliers within π/Q of
+/// 1). Every value is reached (the nested solve falls back to the augmented Newton), the loop
+/// conditions met to 1e-6, the shift monotonic, every orbit stable under the locked drive.
 #[test]
 fn high_q_curve_reaches_the_contact_edge() {
     let probe = Probe::parse(PROBE, "test").unwrap();
@@ -239,6 +239,7 @@ fn high_q_curve_reaches_the_contact_edge() {
     assert_eq!(curve.points.len(), 100);
     assert!(curve.points.iter().all(|p| p.loop_residual <= 1e-6));
     assert!(curve.points.windows(2).all(|w| w[1].omega < w[0].omega));
+    assert!(curve.points.iter().all(|p| p.stable));
 }
 
 /// The time-domain loop (`analysis::fm_loop`: the cantilever integrated cycle after cycle, a
