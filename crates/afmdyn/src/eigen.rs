@@ -53,11 +53,21 @@ pub fn natural_modes(m: &RegionMatrices) -> NaturalModes {
 /// beam against the static 3EI/L³. One place for the calibration of probes and the closed forms
 /// of the observables.
 pub fn first_mode_at_tip(m: &RegionMatrices, tip: &DVector<f64>) -> (f64, DVector<f64>, f64) {
+    mode_at_tip(m, tip, 0)
+}
+
+/// [`first_mode_at_tip`] for mode `k` (0-based, k < N): ω̃_k, the mass-normalised undamped
+/// mode x_k and the stiffness k̃_k = ω̃_k²/(φᵀx_k)² of the equivalent point mass of that mode
+/// at the tip (Melcher, Hu & Raman, *Appl. Phys. Lett.* 91 (2007) 053101).
+///
+/// # Panics
+/// For k ≥ N.
+pub fn mode_at_tip(m: &RegionMatrices, tip: &DVector<f64>, k: usize) -> (f64, DVector<f64>, f64) {
     let modes = natural_modes(m);
-    let x1: DVector<f64> = modes.vectors.column(0).into_owned();
-    let w1 = modes.omega[0];
-    let t = tip.dot(&x1);
-    (w1, x1, w1 * w1 / (t * t))
+    let x: DVector<f64> = modes.vectors.column(k).into_owned();
+    let w = modes.omega[k];
+    let t = tip.dot(&x);
+    (w, x, w * w / (t * t))
 }
 
 /// The first-order state matrix of eqs. 20–21: with Q = (Ẋ, X), M* Q̇ + K* Q = 0 where

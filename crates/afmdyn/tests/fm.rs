@@ -269,3 +269,40 @@ fn the_time_domain_loop_settles_on_the_exact_steady_state() {
         assert!((de - dl).abs() <= 1e-3 * de.abs(), "{de} vs {dl}");
     }
 }
+
+/// The beam's second mode tracked (`mode = 2`, as the second channel of bimodal AM-FM
+/// imaging): Giessibl's formula holds with that mode's frequency f₂ and its stiffness at the
+/// tip k̃₂ (Melcher, Hu & Raman 2007; 39.3 k for a uniform beam, (β₂/β₁)⁴).
+#[test]
+fn the_second_mode_follows_giessibl_with_its_own_stiffness() {
+    let probe = beam_probe();
+    let g0 = probe.scales.length_m;
+    let z_c: Vec<f64> = (0..8).map(|i| 14e-9 - i as f64 * 0.4e-9).collect();
+    let values = z_c
+        .iter()
+        .map(|z| probe.params.alpha5_for_rest_distance(z / g0))
+        .collect();
+    let spec = FmSpec {
+        mode: 2,
+        ..FmSpec::new(probe.params, values, 1.0)
+    };
+    let curve = fm_curve(&spec, &Progress::new()).unwrap();
+    assert!(curve.unreached.is_none(), "{:?}", curve.unreached);
+    let s = &probe.scales;
+    let k2 = curve.reference.stiffness * s.force_n / s.length_m;
+    let f2 = s.frequency_hz(curve.reference.omega);
+    assert!((k2 / 40.0 - 39.3).abs() < 0.5, "k2 = {k2}");
+    assert!((f2 / 300e3 - 6.27).abs() < 0.05, "f2 = {f2}");
+    for (p, &zc) in curve.points.iter().zip(&z_c) {
+        let df = s.frequency_hz(p.omega - curve.reference.omega);
+        let centre = zc + p.observables.mean_deflection * g0;
+        let d_min = p.observables.min_distance * g0;
+        let expected = giessibl(centre, g0, k2, f2);
+        let bound = vdw(d_min).abs() / (k2 * g0);
+        let rel = (df - expected).abs() / expected.abs();
+        assert!(
+            rel <= 3.0 * bound + 1e-5,
+            "z_c {zc}: {df} vs {expected} ({rel:e})"
+        );
+    }
+}

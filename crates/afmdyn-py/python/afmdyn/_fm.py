@@ -62,8 +62,7 @@ def fm_dataset(doc: Dict[str, Any]) -> xr.Dataset:
             "mode": doc["mode"],
             "amplitude": doc["amplitude"],
             "resonance_frequency": doc["resonance_frequency"],
-            "spring_constant": doc["spring_constant"] if doc["spring_constant"] is not None
-            else float("nan"),
+            "spring_constant": doc["spring_constant"],
             "folds_z_c": [f["z_c"] for f in doc["folds"]],
             "method": doc["method"],
             "summary": json.dumps(doc),

@@ -180,6 +180,9 @@ pub struct FmReference {
     pub phase: f64,
     /// α2 that holds the first-harmonic amplitude at A at ω_K without a sample.
     pub excitation: f64,
+    /// k̃_K: the tracked mode's stiffness at the tip (F̃/g₀; [`crate::eigen::mode_at_tip`], 1
+    /// for the point mass): the k of Giessibl's and Sader–Jarvis's formulas for this mode.
+    pub stiffness: f64,
 }
 
 /// The reference of `base` for the tracked mode `mode` at amplitude `amplitude` (g₀): ω_K,
@@ -190,12 +193,17 @@ pub struct FmReference {
 pub fn fm_reference(base: &Params, mode: usize, amplitude: f64) -> Result<FmReference, SimError> {
     let (omega, q) = mode_resonance(base, mode)?;
     let at = base.with(SweepParam::Omega, omega);
-    let free = free_response(&CantileverModel::new(&at)?)?;
+    let model = CantileverModel::new(&at)?;
+    let free = free_response(&model)?;
+    let g = model.galerkin();
+    let (_, _, stiffness) =
+        crate::eigen::mode_at_tip(g.region(crate::galerkin::Region::Free), g.tip(), mode - 1);
     Ok(FmReference {
         omega,
         quality_factor: q,
         phase: free.phase,
         excitation: at.alpha2 * amplitude / free.amplitude,
+        stiffness,
     })
 }
 
@@ -330,7 +338,7 @@ impl Solver<'_> {
         let observables = observe_orbit(&model, self.spec.integrator.clone(), &orbit, 1)?;
         let residual = Vector2::new(
             observables.amplitude / self.spec.amplitude - 1.0,
-            observables.phase - self.reference.phase,
+            phase_error(observables.phase, self.reference.phase),
         );
         Ok(Locked {
             x,
@@ -383,7 +391,7 @@ impl Solver<'_> {
         let mut r = DVector::zeros(d + 2);
         r.rows_mut(0, d).copy_from(&(integ.state() - &z));
         r[d] = o.amplitude / self.spec.amplitude - 1.0;
-        r[d + 1] = o.phase - self.reference.phase;
+        r[d + 1] = phase_error(o.phase, self.reference.phase);
         Ok(r)
     }
 
@@ -848,6 +856,17 @@ pub fn fm_curve(spec: &FmSpec, progress: &Progress) -> Result<FmCurve, SimError>
         folds,
         unreached,
     })
+}
+
+/// The lag error φ₁ − φ_set wrapped into (−π, π] (the lags are reported in (−π/2, 3π/2]: a
+/// higher mode's free lag, near 270°, sits at the wrap).
+pub fn phase_error(phase: f64, set: f64) -> f64 {
+    let e = (phase - set).rem_euclid(std::f64::consts::TAU);
+    if e > std::f64::consts::PI {
+        e - std::f64::consts::TAU
+    } else {
+        e
+    }
 }
 
 /// The conservative tip–sample force F̃ of `params`' law at the tip–sample distance `d` (units

@@ -17,7 +17,7 @@
 //! the loop stable ([`LoopSpec::new`]). A value is settled when both errors stay below the
 //! tolerance for [`SETTLED_CYCLES`] cycles in a row.
 
-use super::fm::{fm_reference, FmSpec};
+use super::fm::{fm_reference, phase_error, FmSpec};
 use super::observables::{observe, ObservableOptions};
 use super::progress::Progress;
 use crate::error::SimError;
@@ -106,7 +106,10 @@ pub fn fm_loop(
             let mut integ = build(&model, spec.integrator.clone(), 0.0, &z)?;
             let o = observe(integ.as_mut(), &opts)?;
             z = integ.state().clone();
-            let (ea, ep) = (o.amplitude / spec.amplitude - 1.0, o.phase - r.phase);
+            let (ea, ep) = (
+                o.amplitude / spec.amplitude - 1.0,
+                phase_error(o.phase, r.phase),
+            );
             calm = if ea.abs().max(ep.abs()) <= gains.tolerance {
                 calm + 1
             } else {

@@ -163,12 +163,8 @@ pub fn document(request: &FmRequest, model: &Resolved, curve: &FmCurve) -> Value
     let r = &curve.reference;
     let max_mult =
         |q: &crate::analysis::fm::FmPoint| q.multipliers.first().map_or(f64::NAN, |m| m.norm());
-    // the stiffness of the tracked mode at the tip is the probe's k for mode 1 only
-    let spring_constant = match (&model.probe, request.mode) {
-        (Some(probe), 1) => json!(probe.calibration.spring_constant),
-        (None, 1) if base.structure == crate::params::Structure::PointMass => json!(1.0),
-        _ => Value::Null,
-    };
+    // the tracked mode's stiffness at the tip (the probe's calibrated k for mode 1)
+    let spring_constant = r.stiffness * u.force / u.length;
     let mut warnings: Vec<String> = Vec::new();
     if let Some(u) = &curve.unreached {
         warnings.push(format!(
@@ -177,12 +173,6 @@ pub fn document(request: &FmRequest, model: &Resolved, curve: &FmCurve) -> Value
             z_c(u.alpha5) * u_len,
             if model.probe.is_some() { " m" } else { " g0" },
             u.reason
-        ));
-    }
-    if spring_constant.is_null() && model.probe.is_some() {
-        warnings.push(format!(
-            "no spring constant is given for mode {}: give it to reconstruct the force",
-            request.mode
         ));
     }
     json!({
@@ -212,6 +202,7 @@ pub fn document(request: &FmRequest, model: &Resolved, curve: &FmCurve) -> Value
             "quality_factor": r.quality_factor,
             "phase_deg": r.phase.to_degrees(),
             "excitation": r.excitation,
+            "stiffness": spring_constant,
         },
         "mode": request.mode,
         "amplitude": curve.amplitude * u.length,

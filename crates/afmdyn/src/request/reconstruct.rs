@@ -135,11 +135,7 @@ impl ReconstructRequest {
         }
         let constant = |given: Option<f64>, key: &'static str| -> Result<f64, SimError> {
             given.or_else(|| doc[key].as_f64()).ok_or_else(|| {
-                SimError::out_of_range(
-                    key,
-                    "missing",
-                    "the fm document has none (a higher mode's stiffness is not known): give it",
-                )
+                SimError::out_of_range(key, "missing", "the fm document has none: give it")
             })
         };
         Ok(ReconstructRequest {
