@@ -23,6 +23,7 @@ DOCUMENTS = SCHEMA / "documents"
 REQUESTS = SCHEMA / "requests"
 P1 = str(EXAMPLES / "probe-point-mass-dmt.toml")
 P2 = str(EXAMPLES / "probe-geometry-hertz.toml")
+EIG = str(EXAMPLES / "probe-eigenmodes-dmt.toml")
 IMPACT = "--contact-law impact --restitution 0.5 --modes 1 --gap 0.05 --omega 3".split()
 IMPACT_PY = dict(contact_law="impact", restitution=0.5, modes=1, gap=0.05, omega=3.0)
 SHORT = ["--max-periods", 300]
@@ -119,6 +120,8 @@ CLI_CASES: List[Tuple[str, List[Any]]] = [
     ("reconstruct", FM_ARGS),
     ("fm", ["--points", 4]),
     ("fm", ["--points", 4, "--probe", P1]),
+    ("fm", ["--points", 4, "--mode", 2, "--probe", EIG]),
+    ("approach", ["--points", 4, "--no-branches", "--files", "none", "--probe", EIG]),
     # (a probe refuses the dimensionless omega axis: the drive frequency in Hz, 0.99 f0)
     ("chart", ["--x", "z-c", "--x-from", 6e-9, "--x-to", 8e-9, "--x-steps", 2, "--y",
                "drive-frequency", "--y-from", "297kHz", "--y-to", "297kHz", "--y-steps", 1,

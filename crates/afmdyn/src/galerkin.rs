@@ -69,18 +69,28 @@ impl Galerkin {
         let shapes = ModeShapes::new(n);
         // the point-mass model (params::Structure): one coordinate z = V_T − α5 with φ(1) = 1,
         // unit mass and stiffness, no distributed inertia (∫φ = 0) and a force drive
-        let point_mass = params.structure == Structure::PointMass;
-        let (tip, integrals, k_diag) = if point_mass {
-            (DVector::from_element(1, 1.0), DVector::zeros(1), vec![1.0])
-        } else {
-            (
+        // the eigenmode model: N such coordinates z_j (V_T = Σ z_j + α5, φ_j(1) = 1), stiffness
+        // k_j/k_1 and mass (k_j/k_1)/(ω_j/ω_1)², each driven by the tip force
+        let (tip, integrals, k_diag) = match (params.structure, &params.eigenmodes) {
+            (Structure::PointMass, _) => {
+                (DVector::from_element(1, 1.0), DVector::zeros(1), vec![1.0])
+            }
+            (Structure::Eigenmodes, Some(e)) => (
+                DVector::from_element(n, 1.0),
+                DVector::zeros(n),
+                e.stiffness[..n].to_vec(),
+            ),
+            _ => (
                 DVector::from_vec(shapes.tip()),
                 DVector::from_vec(shapes.integrals()),
                 shapes.beta4(),
-            )
+            ),
         };
         let outer = &tip * tip.transpose();
-        let mass = mass_matrix(params, &outer);
+        let mass = match &params.eigenmodes {
+            Some(e) => DMatrix::from_diagonal(&DVector::from_fn(n, |j, _| e.mass(j))),
+            None => mass_matrix(params, &outer),
+        };
         let k_free = DMatrix::from_diagonal(&DVector::from_vec(k_diag));
         let free = RegionMatrices {
             mass: mass.clone(),
@@ -197,10 +207,11 @@ fn stiffness_contact(p: &Params, k_free: &DMatrix<f64>, outer: &DMatrix<f64>) ->
 }
 
 /// Eq. 14: F^I_i = α2 Ω² [α1 φ_i(1) + ∫φ_i] sin Ωτ − α2 α3 s_i ∫φ_i cos Ωτ (s_i of the damping
-/// profile, 1 in the paper). The point-mass model has the force drive F^I = α2 cos Ωτ instead.
+/// profile, 1 in the paper). The point-mass and eigenmode models have the force drive
+/// F^I_j = α2 cos Ωτ at the tip instead (every mode's tip value is 1).
 fn forcing_free(p: &Params, tip: &DVector<f64>, integrals: &DVector<f64>) -> Forcing {
     let n = tip.len();
-    if p.structure == Structure::PointMass {
+    if p.structure.is_lumped() {
         return Forcing {
             constant: DVector::zeros(n),
             sin: DVector::zeros(n),

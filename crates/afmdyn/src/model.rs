@@ -448,10 +448,10 @@ impl CantileverModel {
         Region::of_v_t(self.v_t(tau, z))
     }
     /// Beam deflection W(ξ,τ) = Σ a_j φ_j(ξ) (eq. 9).
-    /// For the point-mass model, the tip deflection z at every ξ.
+    /// For the point-mass and eigenmode models, the tip deflection Σ z_j at every ξ.
     pub fn deflection(&self, xi: f64, z: &DVector<f64>) -> f64 {
-        if self.params.structure == crate::params::Structure::PointMass {
-            return z[0];
+        if self.params.structure.is_lumped() {
+            return z.rows(0, self.modes()).sum();
         }
         let phi = self.galerkin.shapes().values(xi);
         phi.iter().zip(z.iter()).map(|(p, a)| p * a).sum()

@@ -104,6 +104,28 @@ pub struct Params {
     // 20 = MAX_MODES, written as a literal: with the named constant, clippy-driver 1.95 stops
     // with an internal compiler error on closures that capture a Params (tests/stability.rs)
     pub damping_profile: Option<[f64; 20]>,
+    /// The eigenmode model's modes ([`Structure::Eigenmodes`]; `None` for the other models).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub eigenmodes: Option<Eigenmodes>,
+}
+
+/// The modes of the eigenmode model ([`Structure::Eigenmodes`]): stiffness at the tip and
+/// natural frequency of each mode relative to mode 1's (k_j/k_1, ω_j/ω_1; entry 0 is 1, only
+/// the first N entries are used). Their quality factors are the damping profile's
+/// ([`Params::damping_profile`], set by [`crate::probe`]).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Eigenmodes {
+    /// k_j/k_1.
+    pub stiffness: [f64; 20],
+    /// ω_j/ω_1.
+    pub frequency: [f64; 20],
+}
+
+impl Eigenmodes {
+    /// The modal mass of mode j in the model's units (k_1 and ω_1 of 1): (k_j/k_1)/(ω_j/ω_1)².
+    pub fn mass(&self, j: usize) -> f64 {
+        self.stiffness[j] / (self.frequency[j] * self.frequency[j])
+    }
 }
 
 /// The structural model of the cantilever.
@@ -124,6 +146,13 @@ pub enum Structure {
     Beam,
     /// One eigenmode with a force drive (the point-mass model).
     PointMass,
+    /// N eigenmodes with a force drive, each with its own stiffness k_j, frequency ω_j and
+    /// quality factor Q_j at the tip, the tip displacement their sum: the model of the bimodal
+    /// AFM literature (Lozano & García, *Phys. Rev. Lett.* 100 (2008) 076102; García & Proksch,
+    /// *Eur. Polym. J.* 49 (2013) 1897, eq. 1): (k_j/ω_j²) z_j'' + (k_j/(ω_j Q_j)) z_j' + k_j z_j
+    /// = F_drive + F_ts, V_T = Σ z_j + α5. In the units of the point mass (k_1, ω_1 of 1) the
+    /// modal masses are (k_j/k_1)/(ω_j/ω_1)² ([`Eigenmodes`]).
+    Eigenmodes,
 }
 
 impl Structure {
@@ -132,6 +161,16 @@ impl Structure {
         match self {
             Structure::Beam => "beam",
             Structure::PointMass => "point-mass",
+            Structure::Eigenmodes => "eigenmodes",
+        }
+    }
+
+    /// Whether the model is lumped at the tip (the point mass and the eigenmode model): a force
+    /// drive, no beam body, the deflection the tip's everywhere.
+    pub fn is_lumped(self) -> bool {
+        match self {
+            Structure::Beam => false,
+            Structure::PointMass | Structure::Eigenmodes => true,
         }
     }
 }
@@ -142,7 +181,10 @@ impl FromStr for Structure {
         match s.trim().to_ascii_lowercase().replace('_', "-").as_str() {
             "beam" => Ok(Structure::Beam),
             "point-mass" | "pointmass" => Ok(Structure::PointMass),
-            _ => Err(format!("model '{s}': expected beam or point-mass")),
+            "eigenmodes" => Ok(Structure::Eigenmodes),
+            _ => Err(format!(
+                "model '{s}': expected beam, point-mass or eigenmodes"
+            )),
         }
     }
 }
@@ -162,6 +204,7 @@ impl Default for Params {
             contact_law: ContactLaw::Linear,
             structure: Structure::Beam,
             damping_profile: None,
+            eigenmodes: None,
         }
     }
 }
@@ -312,6 +355,45 @@ impl Params {
                 }
             }
         }
+        match (self.structure, &self.eigenmodes) {
+            (Structure::Eigenmodes, None) => {
+                return Err(ParamError::Structure {
+                    name: "eigenmodes (eigenmode model: the modes' stiffnesses and frequencies)",
+                    value: f64::NAN,
+                })
+            }
+            (Structure::Eigenmodes, Some(e)) => {
+                if self.alpha1 != 0.0 {
+                    return Err(ParamError::Structure {
+                        name: "alpha1 (eigenmode model: no tip mass, 0)",
+                        value: self.alpha1,
+                    });
+                }
+                for j in 0..self.modes {
+                    let (k, w) = (e.stiffness[j], e.frequency[j]);
+                    let first = j == 0 && (k != 1.0 || w != 1.0);
+                    if first || !(k.is_finite() && k > 0.0 && k <= 1e12) {
+                        return Err(ParamError::Structure {
+                            name: "eigenmodes.stiffness (k_j/k_1: 1 for mode 1, in (0, 1e12])",
+                            value: k,
+                        });
+                    }
+                    if !(w.is_finite() && w > 0.0 && w <= 1e4) {
+                        return Err(ParamError::Structure {
+                            name: "eigenmodes.frequency (ω_j/ω_1: 1 for mode 1, in (0, 1e4])",
+                            value: w,
+                        });
+                    }
+                }
+            }
+            (_, Some(_)) => {
+                return Err(ParamError::Structure {
+                    name: "eigenmodes (only for the eigenmode model)",
+                    value: f64::NAN,
+                })
+            }
+            _ => {}
+        }
         if self.structure == Structure::PointMass {
             for (name, bad, value) in [
                 (
@@ -344,7 +426,7 @@ impl Params {
     pub fn base_amplitude(&self) -> f64 {
         match self.structure {
             Structure::Beam => self.alpha2,
-            Structure::PointMass => 0.0,
+            Structure::PointMass | Structure::Eigenmodes => 0.0,
         }
     }
 
@@ -354,7 +436,7 @@ impl Params {
     pub fn drive_phase(&self) -> f64 {
         match self.structure {
             Structure::Beam => 0.0,
-            Structure::PointMass => std::f64::consts::FRAC_PI_2,
+            Structure::PointMass | Structure::Eigenmodes => std::f64::consts::FRAC_PI_2,
         }
     }
 

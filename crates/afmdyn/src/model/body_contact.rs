@@ -20,8 +20,8 @@ impl BodyContactCheck {
     pub fn new(model: &CantileverModel, points: usize) -> Self {
         let n = model.modes();
         let shapes = model.galerkin().shapes();
-        // the point-mass model has no beam body
-        let points = if model.params().structure == crate::params::Structure::PointMass {
+        // the point-mass and eigenmode models have no beam body
+        let points = if model.params().structure.is_lumped() {
             0
         } else {
             points

@@ -2,7 +2,8 @@
 //! dimensionless set (α1 … α6, Ω and the law's groups) and the scales back to SI.
 //!
 //! ```toml
-//! model = "beam"                 # "beam" (N Galerkin modes, the paper) or "point-mass"
+//! model = "beam"                 # "beam" (N Galerkin modes, the paper), "point-mass" or
+//!                                # "eigenmodes" (per-mode k, f0, Q as arrays: see below)
 //! modes = 3                      # beam only
 //! [cantilever]                   # calibrated values ...
 //! spring_constant = 40.0         # k (N/m), first-mode equivalent stiffness at the tip
@@ -407,7 +408,7 @@ impl Probe {
         let structure = match r.string(root, "", "model") {
             None if !root.contains_key("model") => {
                 r.problems
-                    .push("missing key model (\"beam\" or \"point-mass\")".into());
+                    .push("missing key model (\"beam\", \"point-mass\" or \"eigenmodes\")".into());
                 None
             }
             None => None,
@@ -438,6 +439,31 @@ impl Probe {
                 None
             }
             (Some(Structure::PointMass), _) => Some(1),
+            // the eigenmode model: one mode per entry of the cantilever's arrays
+            (Some(Structure::Eigenmodes), n) => {
+                let len = root
+                    .get("cantilever")
+                    .and_then(|c| c.get("spring_constant"))
+                    .and_then(toml::Value::as_array)
+                    .map(Vec::len);
+                match (n, len) {
+                    (Some(n), Some(len)) if n != len => {
+                        r.problems.push(format!(
+                            "modes = {n}: the eigenmode model has one mode per entry of \
+                             [cantilever].spring_constant ({len}; omit modes)"
+                        ));
+                        None
+                    }
+                    (_, Some(len)) if (1..=MAX_MODES).contains(&len) => Some(len),
+                    (_, Some(len)) => {
+                        r.problems.push(format!(
+                            "[cantilever].spring_constant has {len} values: give 1..=20"
+                        ));
+                        None
+                    }
+                    (_, None) => None,
+                }
+            }
             // (a modes key that is present but invalid was reported above)
             (Some(Structure::Beam), None) if !root.contains_key("modes") => {
                 r.problems
@@ -449,9 +475,23 @@ impl Probe {
 
         // [cantilever]
         let cant = r.table(root, "cantilever", true);
-        let (beam, q1, qs) = match cant {
-            Some(c) => Self::read_cantilever(&mut r, c),
-            None => (None, None, None),
+        let mut eigen = None;
+        let (beam, q1, qs) = match (cant, structure) {
+            (Some(c), Some(Structure::Eigenmodes)) => match Self::read_eigenmodes(&mut r, c) {
+                Some((k, f, q)) => {
+                    let beam = Beam::Calibrated {
+                        k: k[0],
+                        f0: f[0],
+                        alpha1: 0.0,
+                    };
+                    let q1 = q[0];
+                    eigen = Some((k, f));
+                    (Some(beam), Some(q1), Some(q))
+                }
+                None => (None, None, None),
+            },
+            (Some(c), _) => Self::read_cantilever(&mut r, c),
+            (None, _) => (None, None, None),
         };
         // [tip]
         let tip = r.table(root, "tip", false);
@@ -524,13 +564,73 @@ impl Probe {
         }
         let (structure, modes, beam, q1, sample, a0) =
             (structure?, modes?, beam?, q1?, sample?, a0?);
-        match Self::resolve(structure, modes, beam, q1, qs, sample, a0, freq) {
+        match Self::resolve(structure, modes, beam, q1, qs, eigen, sample, a0, freq) {
             Ok(p) => Some(p),
             Err(e) => {
                 r.problems.push(e);
                 None
             }
         }
+    }
+
+    /// The eigenmode model's `[cantilever]`: `spring_constant`, `resonance_frequency` and
+    /// `quality_factor` as arrays of equal length, one entry per mode (N/m, Hz, 1), the
+    /// frequencies increasing.
+    #[allow(clippy::type_complexity)]
+    fn read_eigenmodes(
+        r: &mut Reader<'_>,
+        c: &toml::Table,
+    ) -> Option<(Vec<f64>, Vec<f64>, Vec<f64>)> {
+        const S: &str = "cantilever";
+        r.unknown(
+            c,
+            S,
+            &["spring_constant", "resonance_frequency", "quality_factor"],
+        );
+        let mut array = |key: &str, max: f64| -> Option<Vec<f64>> {
+            let Some(toml::Value::Array(a)) = c.get(key) else {
+                r.problems.push(format!(
+                    "[cantilever].{key} must be an array, one value per mode (the eigenmode \
+                     model)"
+                ));
+                return None;
+            };
+            let mut v = Vec::with_capacity(a.len());
+            for (i, x) in a.iter().enumerate() {
+                match x.as_float().or(x.as_integer().map(|i| i as f64)) {
+                    Some(y) if y.is_finite() && y > 0.0 && y <= max => v.push(y),
+                    _ => r.problems.push(format!(
+                        "[cantilever].{key}[{i}] = {x}: must be a number in (0, {max:e}]"
+                    )),
+                }
+            }
+            (v.len() == a.len()).then_some(v)
+        };
+        let k = array("spring_constant", 1e6);
+        let f = array("resonance_frequency", 1e10);
+        let q = array("quality_factor", MAX_QUALITY_FACTOR);
+        let (k, f, q) = (k?, f?, q?);
+        if k.len() != f.len() || k.len() != q.len() {
+            r.problems.push(format!(
+                "[cantilever]: spring_constant, resonance_frequency and quality_factor have \
+                 {}, {} and {} values: give one of each per mode",
+                k.len(),
+                f.len(),
+                q.len()
+            ));
+            return None;
+        }
+        if k.is_empty() {
+            r.problems
+                .push("[cantilever].spring_constant is empty: give one value per mode".into());
+            return None;
+        }
+        if f.windows(2).any(|w| w[1] <= w[0]) {
+            r.problems
+                .push("[cantilever].resonance_frequency must increase from mode to mode".into());
+            return None;
+        }
+        Some((k, f, q))
     }
 
     #[allow(clippy::type_complexity)]
@@ -744,6 +844,7 @@ impl Probe {
         beam: Beam,
         q1: f64,
         qs: Option<Vec<f64>>,
+        eigen: Option<(Vec<f64>, Vec<f64>)>,
         sample: Sample,
         a0: f64,
         freq: Option<f64>,
@@ -765,8 +866,20 @@ impl Probe {
         };
         let alpha1 = match structure {
             Structure::Beam => beam_alpha1,
-            Structure::PointMass => 0.0,
+            Structure::PointMass | Structure::Eigenmodes => 0.0,
         };
+        // the eigenmode model's modes relative to mode 1
+        let eigenmodes = eigen.map(|(k, f)| {
+            let mut e = crate::params::Eigenmodes {
+                stiffness: [1.0; MAX_MODES],
+                frequency: [1.0; MAX_MODES],
+            };
+            for j in 0..k.len() {
+                e.stiffness[j] = k[j] / k[0];
+                e.frequency[j] = f[j] / f[0];
+            }
+            e
+        });
         // undamped structure without drive or sample: ω̃₁ and k̃₁
         let bare = Params {
             modes,
@@ -780,6 +893,7 @@ impl Probe {
             contact_law: ContactLaw::Linear,
             structure,
             damping_profile: None,
+            eigenmodes,
         };
         let (w1, x1, k1) = first_mode(&bare).map_err(|e| e.to_string())?;
         // k and f0, given or from the geometry (first mode of the beam with its tip mass; the
@@ -806,6 +920,12 @@ impl Probe {
         // it was reported as 0 whenever k was given)
         let static_k = match structure {
             Structure::PointMass => k,
+            // the modes' springs in series at the tip (each takes the static force)
+            Structure::Eigenmodes => {
+                let compliance: f64 =
+                    eigenmodes.map_or(1.0, |e| (0..modes).map(|j| 1.0 / e.stiffness[j]).sum());
+                k / compliance
+            }
             Structure::Beam if geometry.is_ok() => static_k,
             Structure::Beam => 3.0 * k / k1,
         };
@@ -820,6 +940,14 @@ impl Probe {
         let omega = scales.omega(drive_hz);
         // damping: profile from per-mode Q, then α3 from Q1
         let profile = match (&qs, structure) {
+            // C_jj = m_j ω_j / Q_j = α3 s_j with α3 = 1/Q₁ (mode 1's m and ω are 1)
+            (Some(q), Structure::Eigenmodes) => eigenmodes.map(|e| {
+                let mut s = [1.0; MAX_MODES];
+                for (j, qj) in q.iter().enumerate() {
+                    s[j] = e.mass(j) * e.frequency[j] * q1 / qj;
+                }
+                s
+            }),
             (Some(q), Structure::Beam) => {
                 let mut s = [1.0; MAX_MODES];
                 for (j, qj) in q.iter().enumerate() {

@@ -84,7 +84,7 @@ impl CurveUnits {
 pub struct SeriesUnits {
     /// The factors (time, length, force, energy, Hz per unit Ω for a spectrum; `si`).
     pub u: CurveUnits,
-    /// The point-mass model (force unit k g₀ rather than EI g₀/L³).
+    /// A lumped model, point mass or eigenmodes (force unit k g₀ rather than EI g₀/L³).
     pub point_mass: bool,
 }
 
@@ -112,7 +112,7 @@ impl SeriesUnits {
             u: probe.map_or_else(CurveUnits::dimensionless, |pr| {
                 CurveUnits::from_scales(&pr.scales, true)
             }),
-            point_mass: params.structure == crate::Structure::PointMass,
+            point_mass: params.structure.is_lumped(),
         }
     }
     /// A time τ in the reported unit.
