@@ -73,20 +73,23 @@ fn two_modes_of(beam: &Probe) -> Probe {
     ))
 }
 
+/// The AM approach's first-harmonic amplitudes (g₀) from z_c = `from` to `to` (g₀).
+fn amplitudes(p: &Probe, from: f64, to: f64, points: usize) -> Vec<f64> {
+    let spec = approach_spec(p.params, from, to, Spacing::Points(points)).unwrap();
+    approach_retract(&spec)
+        .unwrap()
+        .first
+        .iter()
+        .map(|q| q.observables.amplitude)
+        .collect()
+}
+
 #[test]
 fn one_eigenmode_is_the_point_mass() {
     let (pm, e1) = (probe(POINT_MASS), probe(ONE_MODE));
     assert_eq!(pm.scales, e1.scales);
-    let amplitude = |p: &Probe| -> Vec<f64> {
-        let spec = approach_spec(p.params, 1.2, 0.3, Spacing::Points(15)).unwrap();
-        approach_retract(&spec)
-            .unwrap()
-            .first
-            .iter()
-            .map(|q| q.observables.amplitude)
-            .collect()
-    };
-    for (x, y) in amplitude(&e1).iter().zip(&amplitude(&pm)) {
+    let (a, b) = (amplitudes(&e1, 1.2, 0.3, 15), amplitudes(&pm, 1.2, 0.3, 15));
+    for (x, y) in a.iter().zip(&b) {
         assert!((x - y).abs() <= 1e-12, "{x} vs {y}");
     }
 }
@@ -159,16 +162,11 @@ fn two_eigenmodes_follow_the_beam_in_the_attractive_regime() {
             );
         }
     }
-    let amplitude = |p: &Probe| -> Vec<f64> {
-        let spec = approach_spec(p.params, 1.6, 1.1, Spacing::Points(10)).unwrap();
-        approach_retract(&spec)
-            .unwrap()
-            .first
-            .iter()
-            .map(|q| q.observables.amplitude)
-            .collect()
-    };
-    for (x, y) in amplitude(&beam).iter().zip(&amplitude(&eig)) {
+    let (a, b) = (
+        amplitudes(&beam, 1.6, 1.1, 10),
+        amplitudes(&eig, 1.6, 1.1, 10),
+    );
+    for (x, y) in a.iter().zip(&b) {
         assert!(
             (x - y).abs() <= 2e-3,
             "AM amplitude: beam {x}, eigenmodes {y}"
