@@ -6,7 +6,7 @@
 
 use crate::args::{quantity, Dim, ModelArgs, Quantity};
 use crate::error::CliError;
-use crate::output::{f, write_bytes, write_csv, OutDir};
+use crate::output::{f, write_csv, write_document, OutDir};
 use crate::plot::{save, Figure, Series, Style};
 use afmdyn::request::fm::{rows, COLUMNS};
 use afmdyn::request::{self, FmRequest, Resolved};
@@ -99,15 +99,7 @@ pub fn fm(a: &FmArgs) -> Result<(), CliError> {
         },
     )?;
     json["csv"] = serde_json::json!(out.join("fm.csv"));
-    write_bytes(
-        &out.join("fm.json"),
-        serde_json::to_string_pretty(&json)
-            .expect("json")
-            .as_bytes(),
-    )?;
-    for w in json["warnings"].as_array().into_iter().flatten() {
-        errln!("afmdyn: warning: {}", w.as_str().unwrap_or_default());
-    }
+    write_document(&out, "fm.json", &json)?;
     if a.json {
         outln!("{json}");
     } else {

@@ -6,7 +6,7 @@
 
 use crate::args::{quantity, Dim, Quantity};
 use crate::error::CliError;
-use crate::output::{write_bytes, write_csv_numbers, OutDir};
+use crate::output::{write_csv_numbers, write_document, OutDir};
 use crate::plot::{save, Figure, Series, Style};
 use afmdyn::request::{self, ReconstructRequest, Resolved};
 use clap::Args;
@@ -163,15 +163,7 @@ pub fn reconstruct(a: &ReconstructArgs) -> Result<(), CliError> {
     )?;
     let mut json = doc.json;
     json["csv"] = serde_json::json!(out.join("reconstruct.csv"));
-    write_bytes(
-        &out.join("reconstruct.json"),
-        serde_json::to_string_pretty(&json)
-            .expect("json")
-            .as_bytes(),
-    )?;
-    for w in json["warnings"].as_array().into_iter().flatten() {
-        errln!("afmdyn: warning: {}", w.as_str().unwrap_or_default());
-    }
+    write_document(&out, "reconstruct.json", &json)?;
     if a.json {
         outln!("{json}");
     } else {

@@ -116,6 +116,22 @@ impl OutDir {
 ///
 /// # Errors
 /// [`CliError::Io`] naming the path.
+/// The JSON document `json` written (pretty, atomically) as `name` in `out`, and its
+/// `warnings` printed on stderr as `afmdyn: warning: …`.
+///
+/// # Errors
+/// As [`write_bytes`].
+pub fn write_document(out: &OutDir, name: &str, json: &serde_json::Value) -> Result<(), CliError> {
+    write_bytes(
+        &out.join(name),
+        serde_json::to_string_pretty(json).expect("json").as_bytes(),
+    )?;
+    for w in json["warnings"].as_array().into_iter().flatten() {
+        errln!("afmdyn: warning: {}", w.as_str().unwrap_or_default());
+    }
+    Ok(())
+}
+
 pub fn write_layout(path: &Path, layout: &afmdyn::layout::Layout) -> Result<(), CliError> {
     afmdyn::layout::netcdf::write(path, layout).map_err(|e| CliError::Io(e.to_string()))
 }

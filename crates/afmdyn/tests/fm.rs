@@ -33,6 +33,17 @@ free_amplitude = 10e-9
 frequency = 300e3
 "#;
 
+/// The gap values α5 of the rest distances `z_c` (m) under `probe`.
+fn gaps(probe: &Probe, z_c: &[f64]) -> Vec<f64> {
+    z_c.iter()
+        .map(|z| {
+            probe
+                .params
+                .alpha5_for_rest_distance(z / probe.scales.length_m)
+        })
+        .collect()
+}
+
 /// The van der Waals force of a sphere over a plane, −HR/(6d²) (N), d in m.
 fn vdw(d: f64) -> f64 {
     -6.6e-20 * 10e-9 / (6.0 * d * d)
@@ -59,10 +70,7 @@ fn fm_shift_matches_giessibl_first_order_formula() {
     let g0 = probe.scales.length_m;
     // z_c from 20 nm to 10.8 nm: lower turning points from 10 nm to 0.8 nm
     let z_c: Vec<f64> = (0..24).map(|i| 20e-9 - i as f64 * 0.4e-9).collect();
-    let values = z_c
-        .iter()
-        .map(|z| probe.params.alpha5_for_rest_distance(z / g0))
-        .collect();
+    let values = gaps(&probe, &z_c);
     let spec = FmSpec::new(probe.params, values, 1.0);
     let curve = fm_curve(&spec, &Progress::new()).unwrap();
     assert!(curve.unreached.is_none(), "{:?}", curve.unreached);
@@ -100,10 +108,7 @@ fn beam_fm_shift_matches_giessibl_with_the_first_modes_stiffness() {
     let probe = beam_probe();
     let g0 = probe.scales.length_m;
     let z_c: Vec<f64> = (0..12).map(|i| 20e-9 - i as f64 * 0.8e-9).collect();
-    let values = z_c
-        .iter()
-        .map(|z| probe.params.alpha5_for_rest_distance(z / g0))
-        .collect();
+    let values = gaps(&probe, &z_c);
     let curve = fm_curve(&FmSpec::new(probe.params, values, 1.0), &Progress::new()).unwrap();
     assert_eq!(curve.points.len(), z_c.len());
     // the free base-driven beam's lag at its first natural frequency is not exactly 90°
@@ -133,10 +138,7 @@ fn small_amplitude_shift_is_the_force_gradient() {
     let g0 = probe.scales.length_m;
     let a = 0.05e-9;
     let z_c: Vec<f64> = vec![4e-9, 3e-9, 2e-9];
-    let values = z_c
-        .iter()
-        .map(|z| probe.params.alpha5_for_rest_distance(z / g0))
-        .collect();
+    let values = gaps(&probe, &z_c);
     let curve = fm_curve(&FmSpec::new(probe.params, values, a / g0), &Progress::new()).unwrap();
     let (k, f0) = (40.0, 300e3);
     for (p, &zc) in curve.points.iter().zip(&z_c) {
@@ -163,12 +165,8 @@ fn small_amplitude_shift_is_the_force_gradient() {
 fn excitation_grows_by_the_energy_dissipated() {
     let text = PROBE.replace("viscosity = 0.0", "viscosity = 50.0");
     let probe = Probe::parse(&text, "viscous").unwrap();
-    let g0 = probe.scales.length_m;
     let z_c: Vec<f64> = (0..30).map(|i| 11e-9 - i as f64 * 0.05e-9).collect();
-    let values = z_c
-        .iter()
-        .map(|z| probe.params.alpha5_for_rest_distance(z / g0))
-        .collect();
+    let values = gaps(&probe, &z_c);
     let curve = fm_curve(&FmSpec::new(probe.params, values, 1.0), &Progress::new()).unwrap();
     assert!(curve.unreached.is_none(), "{:?}", curve.unreached);
     let q_inv = probe.params.alpha3;
@@ -225,15 +223,11 @@ fn bad_spec_is_refused_naming_the_field() {
 #[test]
 fn high_q_curve_reaches_the_contact_edge() {
     let probe = Probe::parse(PROBE, "test").unwrap();
-    let g0 = probe.scales.length_m;
     let a0 = 0.165e-9;
     let z_c: Vec<f64> = (0..100)
         .map(|i| 20e-9 + a0 - i as f64 * 10e-9 / 99.0)
         .collect();
-    let values = z_c
-        .iter()
-        .map(|z| probe.params.alpha5_for_rest_distance(z / g0))
-        .collect();
+    let values = gaps(&probe, &z_c);
     let curve = fm_curve(&FmSpec::new(probe.params, values, 1.0), &Progress::new()).unwrap();
     assert!(curve.unreached.is_none(), "{:?}", curve.unreached);
     assert_eq!(curve.points.len(), 100);
@@ -250,12 +244,8 @@ fn the_time_domain_loop_settles_on_the_exact_steady_state() {
     use afmdyn::analysis::fm_loop::{fm_loop, LoopSpec};
     let text = PROBE.replace("quality_factor = 1e4", "quality_factor = 400");
     let probe = Probe::parse(&text, "q400").unwrap();
-    let g0 = probe.scales.length_m;
     let z_c: Vec<f64> = (0..5).map(|i| 14e-9 - i as f64 * 0.8e-9).collect();
-    let values = z_c
-        .iter()
-        .map(|z| probe.params.alpha5_for_rest_distance(z / g0))
-        .collect();
+    let values = gaps(&probe, &z_c);
     let spec = FmSpec::new(probe.params, values, 1.0);
     let exact = fm_curve(&spec, &Progress::new()).unwrap();
     let looped = fm_loop(&spec, &LoopSpec::new(400.0), &Progress::new()).unwrap();
@@ -278,10 +268,7 @@ fn the_second_mode_follows_giessibl_with_its_own_stiffness() {
     let probe = beam_probe();
     let g0 = probe.scales.length_m;
     let z_c: Vec<f64> = (0..8).map(|i| 14e-9 - i as f64 * 0.4e-9).collect();
-    let values = z_c
-        .iter()
-        .map(|z| probe.params.alpha5_for_rest_distance(z / g0))
-        .collect();
+    let values = gaps(&probe, &z_c);
     let spec = FmSpec {
         mode: 2,
         ..FmSpec::new(probe.params, values, 1.0)

@@ -157,13 +157,7 @@ impl FmSpec {
                 "must be a positive, finite oscillation amplitude",
             ));
         }
-        if !(self.tolerance.is_finite() && self.tolerance > 0.0 && self.tolerance < 1e-3) {
-            return Err(SimError::out_of_range(
-                "tolerance",
-                self.tolerance,
-                "must be in (0, 1e-3)",
-            ));
-        }
+        crate::request::limits::tolerance("tolerance", self.tolerance)?;
         self.base.validate()?;
         Ok(())
     }

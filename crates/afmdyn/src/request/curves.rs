@@ -106,13 +106,7 @@ impl CurveRequest {
     /// [`SimError::Params`] for parameters invalid at an end of the grid.
     pub fn configure(&self, mut spec: SteppedSpec) -> Result<SteppedSpec, SimError> {
         let tol = self.tolerance;
-        if !(tol.is_finite() && tol > 0.0 && tol < 1e-3) {
-            return Err(SimError::out_of_range(
-                "tolerance",
-                tol,
-                "must be in (0, 1e-3)",
-            ));
-        }
+        super::limits::tolerance("tolerance", tol)?;
         for v in [spec.values[0], spec.values[spec.values.len() - 1]] {
             spec.base.with(spec.param, v).validate()?;
         }

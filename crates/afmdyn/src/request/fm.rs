@@ -107,13 +107,7 @@ impl FmRequest {
             ));
         }
         let tol = self.tolerance;
-        if !(tol.is_finite() && tol > 0.0 && tol < 1e-3) {
-            return Err(SimError::out_of_range(
-                "tolerance",
-                tol,
-                "must be in (0, 1e-3)",
-            ));
-        }
+        super::limits::tolerance("tolerance", tol)?;
         let a = self.amplitude.map_or(1.0, |a| a / length);
         let offset = base.contact_law.distance_offset();
         let (from, to) = range.ends((2.0 * a + offset, a + offset), length);

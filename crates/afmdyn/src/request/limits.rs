@@ -80,6 +80,22 @@ pub const MAX_SI_DISTANCE: f64 = 1e-4;
 /// MHz but written in Hz (1e3 or 1e6 too small).
 pub const SI_FREQUENCY_RATIO: (f64, f64) = (1e-2, 1e4);
 
+/// Check a relative tolerance `v` (an integrator's, a curve's loop conditions) in (0, 1e-3):
+/// beyond 1e-3 a steady state is not resolved, and 0 or less is never met.
+///
+/// # Errors
+/// [`crate::SimError::OutOfRange`] naming `name`.
+pub fn tolerance(name: &'static str, v: f64) -> Result<(), crate::SimError> {
+    if !(v.is_finite() && v > 0.0 && v < 1e-3) {
+        return Err(crate::SimError::out_of_range(
+            name,
+            v,
+            "must be in (0, 1e-3)",
+        ));
+    }
+    Ok(())
+}
+
 /// Check an SI distance `v` (m) against [`MAX_SI_DISTANCE`].
 ///
 /// # Errors
