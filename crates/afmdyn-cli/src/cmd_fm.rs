@@ -6,7 +6,7 @@
 
 use crate::args::{quantity, Dim, ModelArgs, Quantity};
 use crate::error::CliError;
-use crate::output::{f, write_csv, write_document, OutDir};
+use crate::output::{f, si_value, write_csv, write_document, OutDir};
 use crate::plot::{save, Figure, Series, Style};
 use afmdyn::request::fm::{rows, COLUMNS};
 use afmdyn::request::{self, FmRequest, Resolved};
@@ -70,6 +70,7 @@ pub fn fm(a: &FmArgs) -> Result<(), CliError> {
     let doc = crate::progress::run(&request, &model, "z_c values")?;
     let mut json = doc.json;
     let table = rows(&json);
+    let column = |name: &str| COLUMNS.iter().position(|c| *c == name).unwrap_or(0);
     write_csv(
         &out.join("fm.csv"),
         &COLUMNS,
@@ -80,7 +81,8 @@ pub fn fm(a: &FmArgs) -> Result<(), CliError> {
     } else {
         (" (g0)", " (Ω)")
     };
-    let points: Vec<(f64, f64)> = table.iter().map(|r| (r[0], r[1])).collect();
+    let (x, y) = (column("z_c"), column("frequency_shift"));
+    let points: Vec<(f64, f64)> = table.iter().map(|r| (r[x], r[y])).collect();
     save(
         out.path(),
         "fm-frequency-shift",
@@ -103,19 +105,29 @@ pub fn fm(a: &FmArgs) -> Result<(), CliError> {
     if a.json {
         outln!("{json}");
     } else {
-        let last = table.last();
+        let value = |v: f64, si_unit: &str, model_unit: &str| {
+            if si {
+                si_value(v, si_unit)
+            } else {
+                format!("{v:e} {model_unit}")
+            }
+        };
+        let (first, last) = (table.first(), table.last());
+        let k = |name: &str| COLUMNS.iter().position(|c| *c == name).unwrap_or(0);
+        let at = |r: Option<&Vec<f64>>, k: usize| r.map_or(f64::NAN, |r| r[k]);
         outln!(
-            "{} z_c values from {:e} to {:e}{}: Δf from {:e} to {:e}{}, excitation up to {:.4} × \
-             the free one; {} unstable, {} folds; outputs in {}",
+            "{} z_c values from {} to {}: Δf from {} to {}, excitation up to {:.4} × the free \
+             one; {} unstable, {} folds; outputs in {}",
             table.len(),
-            table.first().map_or(f64::NAN, |r| r[0]),
-            last.map_or(f64::NAN, |r| r[0]),
-            x_unit,
-            table.first().map_or(f64::NAN, |r| r[1]),
-            last.map_or(f64::NAN, |r| r[1]),
-            y_unit,
-            table.iter().map(|r| r[3]).fold(f64::NAN, f64::max),
-            table.iter().filter(|r| r[14] == 0.0).count(),
+            value(at(first, k("z_c")), "m", "g0"),
+            value(at(last, k("z_c")), "m", "g0"),
+            value(at(first, k("frequency_shift")), "Hz", "Ω"),
+            value(at(last, k("frequency_shift")), "Hz", "Ω"),
+            table
+                .iter()
+                .map(|r| r[k("excitation")])
+                .fold(f64::NAN, f64::max),
+            table.iter().filter(|r| r[k("stable")] == 0.0).count(),
             json["folds"].as_array().map_or(0, |v| v.len()),
             out.path().display()
         );
