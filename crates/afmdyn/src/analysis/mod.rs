@@ -3,8 +3,10 @@
 //! beyond the paper: Newton shooting, Floquet multipliers,
 //! pseudo-arclength continuation, Lyapunov exponents and the 0–1 test for chaos; the observables
 //! of a steady state (harmonics and phase, forces, sample dissipation, virial, energy balances);
-//! the amplitude spectrum of a time series; force reconstruction from FM-AFM frequency shifts
-//! ([`reconstruct`]: Sader–Jarvis).
+//! the amplitude spectrum of a time series; frequency-modulation AFM at constant amplitude as
+//! exact periodic orbits ([`fm`]; its time-domain loop for comparison, [`fm_loop`]); force
+//! reconstruction from FM-AFM frequency shifts ([`reconstruct`]: Sader–Jarvis) and from AM
+//! amplitude and phase ([`reconstruct_am`]: the matrix method at each point's amplitude).
 
 pub mod approach;
 pub mod attractors;
@@ -22,6 +24,7 @@ pub mod observables;
 pub mod period;
 pub mod progress;
 pub mod reconstruct;
+pub mod reconstruct_am;
 pub mod resonance;
 pub mod setpoint;
 pub mod settle;

@@ -90,19 +90,11 @@ impl ShiftCurve {
     /// [`SimError::OutOfRange`] naming the field: fewer than 3 points, lengths that differ,
     /// distances not strictly increasing, a value not finite, constants not > 0.
     pub fn validate(&self) -> Result<(), SimError> {
-        for (name, v) in [
+        positive_constants(&[
             ("spring_constant", self.spring_constant),
             ("resonance_frequency", self.resonance_frequency),
             ("amplitude", self.amplitude),
-        ] {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(SimError::out_of_range(
-                    name,
-                    v,
-                    "must be a finite number > 0",
-                ));
-            }
-        }
+        ])?;
         let n = self.distance.len();
         if n < 3 {
             return Err(SimError::out_of_range(
@@ -179,15 +171,39 @@ pub fn sader_jarvis(curve: &ShiftCurve) -> Result<Reconstruction, SimError> {
     }
     // the last point has no interval beyond it: its force is the end of the data
     force[n - 1] = 0.0;
-    let mut potential = vec![0.0; n];
-    for j in (0..n - 1).rev() {
-        potential[j] = potential[j + 1] + 0.5 * (force[j] + force[j + 1]) * (d[j + 1] - d[j]);
-    }
     Ok(Reconstruction {
         distance: d.clone(),
+        potential: potential_of(d, &force),
         force,
-        potential,
     })
+}
+
+/// U(d_j) = ∫_{d_j}^{d_max} F dt by the trapezoidal rule on the increasing distances `d`
+/// (U(d_max) = 0): the potential of every reconstruction.
+pub fn potential_of(d: &[f64], force: &[f64]) -> Vec<f64> {
+    let n = d.len();
+    let mut potential = vec![0.0; n];
+    for j in (0..n.saturating_sub(1)).rev() {
+        potential[j] = potential[j + 1] + 0.5 * (force[j] + force[j + 1]) * (d[j + 1] - d[j]);
+    }
+    potential
+}
+
+/// Each named constant finite and > 0.
+///
+/// # Errors
+/// [`SimError::OutOfRange`] naming the first that is not.
+pub fn positive_constants(constants: &[(&'static str, f64)]) -> Result<(), SimError> {
+    for &(name, v) in constants {
+        if !(v.is_finite() && v > 0.0) {
+            return Err(SimError::out_of_range(
+                name,
+                v,
+                "must be a finite number > 0",
+            ));
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]
