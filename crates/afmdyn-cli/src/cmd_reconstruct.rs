@@ -8,6 +8,7 @@ use crate::args::{quantity, Dim, Quantity};
 use crate::error::CliError;
 use crate::output::{write_csv_numbers, write_document, OutDir};
 use crate::plot::{save, Figure, Series, Style};
+use afmdyn::analysis::reconstruct::Reconstruction;
 use afmdyn::request::{self, ReconstructRequest, Resolved};
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -19,18 +20,28 @@ pub struct ReconstructArgs {
     /// distances of closest approach, shifts, k, f0 and A), or a CSV with a header naming
     /// `frequency_shift` (Hz) and `distance` (m, closest approach) or `z_c` (m, rest distance:
     /// d = z_c − A)
+    #[arg(
+        long,
+        value_name = "FILE",
+        required_unless_present = "am",
+        conflicts_with = "am"
+    )]
+    fm: Option<PathBuf>,
+    /// Instead of an FM curve, an AM curve: the JSON document of `afmdyn approach --probe` on
+    /// the point-mass model (approach.json); its attractive run (phase lag above 90°) is
+    /// inverted at each point's amplitude (the matrix method)
     #[arg(long, value_name = "FILE")]
-    fm: PathBuf,
+    am: Option<PathBuf>,
     /// Spring constant k (N/m); required with a CSV, replaces the document's
-    #[arg(long)]
+    #[arg(long, conflicts_with = "am")]
     spring_constant: Option<f64>,
     /// Free resonance frequency f0 (Hz; a unit may follow: 300kHz); required with a CSV,
     /// replaces the document's
-    #[arg(long)]
+    #[arg(long, conflicts_with = "am")]
     resonance_frequency: Option<Quantity>,
     /// Oscillation amplitude A (m; a unit may follow: 10nm); required with a CSV, replaces
     /// the document's
-    #[arg(long)]
+    #[arg(long, conflicts_with = "am")]
     amplitude: Option<Quantity>,
     /// Output directory (locked during the run)
     #[arg(long, default_value = "afmdyn-out/reconstruct")]
@@ -68,7 +79,7 @@ fn read_curve(path: &Path) -> Result<(Vec<String>, Vec<Vec<f64>>), CliError> {
 }
 
 /// The request of the flags: from an `fm` JSON document, or from a CSV with k, f0 and A.
-fn request_of(a: &ReconstructArgs) -> Result<ReconstructRequest, CliError> {
+fn request_of(a: &ReconstructArgs, fm: &Path) -> Result<ReconstructRequest, CliError> {
     let k = a.spring_constant;
     let f0 = quantity(
         a.resonance_frequency,
@@ -77,11 +88,11 @@ fn request_of(a: &ReconstructArgs) -> Result<ReconstructRequest, CliError> {
         true,
     )?;
     let amp = quantity(a.amplitude, "amplitude", Dim::Length, true)?;
-    let text = std::fs::read(&a.fm)
-        .map_err(|e| CliError::Input(format!("--fm {}: {e}", a.fm.display())))?;
+    let text =
+        std::fs::read(fm).map_err(|e| CliError::Input(format!("--fm {}: {e}", fm.display())))?;
     if text.iter().find(|b| !b.is_ascii_whitespace()) == Some(&b'{') {
         let doc: serde_json::Value = serde_json::from_slice(&text).map_err(|e| {
-            CliError::Input(format!("--fm {}: not a JSON document: {e}", a.fm.display()))
+            CliError::Input(format!("--fm {}: not a JSON document: {e}", fm.display()))
         })?;
         return Ok(ReconstructRequest::from_fm_document(&doc, k, f0, amp)?);
     }
@@ -90,7 +101,7 @@ fn request_of(a: &ReconstructArgs) -> Result<ReconstructRequest, CliError> {
             "--{flag} is required with a CSV curve (an afmdyn fm document carries it)"
         ))
     };
-    let (names, mut columns) = read_curve(&a.fm)?;
+    let (names, mut columns) = read_curve(fm)?;
     let mut take = |name: &str| {
         names
             .iter()
@@ -100,7 +111,7 @@ fn request_of(a: &ReconstructArgs) -> Result<ReconstructRequest, CliError> {
     let frequency_shift = take("frequency_shift").ok_or_else(|| {
         CliError::Input(format!(
             "--fm {}: no frequency_shift column (the header has {})",
-            a.fm.display(),
+            fm.display(),
             names.join(", ")
         ))
     })?;
@@ -115,18 +126,55 @@ fn request_of(a: &ReconstructArgs) -> Result<ReconstructRequest, CliError> {
     })
 }
 
+/// The reconstruction of an AM document (`--am FILE`) and its JSON document.
+fn am_reconstruction(path: &Path) -> Result<(Reconstruction, serde_json::Value), CliError> {
+    let text = std::fs::read(path)
+        .map_err(|e| CliError::Input(format!("--am {}: {e}", path.display())))?;
+    let doc: serde_json::Value = serde_json::from_slice(&text).map_err(|e| {
+        CliError::Input(format!("--am {}: not a JSON document: {e}", path.display()))
+    })?;
+    let curve = request::reconstruct::am_curve_from_approach(&doc)?;
+    let r = afmdyn::analysis::reconstruct_am::matrix_inversion(&curve)?;
+    let json = request::reconstruct::am_document(&curve, &r);
+    Ok((r, json))
+}
+
 /// Run `afmdyn reconstruct`.
 pub fn reconstruct(a: &ReconstructArgs) -> Result<(), CliError> {
-    let request = request_of(a)?;
-    let model = Resolved::plain(afmdyn::Params::default());
-    request::Analysis::validate(&request, &model)?;
+    let (r, json, law) = match (&a.am, &a.fm) {
+        (Some(path), _) => {
+            let (r, json) = am_reconstruction(path)?;
+            (r, json, None)
+        }
+        (None, Some(fm)) => {
+            let request = request_of(a, fm)?;
+            let model = Resolved::plain(afmdyn::Params::default());
+            request::Analysis::validate(&request, &model)?;
+            let doc = request::run(
+                &request,
+                &model,
+                &afmdyn::analysis::progress::Progress::new(),
+            )?;
+            (doc.output, doc.json, request.law_in_order())
+        }
+        (None, None) => {
+            return Err(CliError::Input(
+                "give --fm FILE or --am FILE (the curve to invert)".into(),
+            ))
+        }
+    };
     let out = OutDir::lock(&a.out)?;
-    let doc = request::run(
-        &request,
-        &model,
-        &afmdyn::analysis::progress::Progress::new(),
-    )?;
-    let r = &doc.output;
+    finish(a, &out, &r, json, law)
+}
+
+/// Write the outputs of reconstruction `r` and print its document or summary.
+fn finish(
+    a: &ReconstructArgs,
+    out: &OutDir,
+    r: &Reconstruction,
+    mut json: serde_json::Value,
+    law: Option<Vec<f64>>,
+) -> Result<(), CliError> {
     write_csv_numbers(
         &out.join("reconstruct.csv"),
         &["distance", "force", "potential"],
@@ -141,7 +189,11 @@ pub fn reconstruct(a: &ReconstructArgs) -> Result<(), CliError> {
         out.path(),
         "reconstruct-force",
         &Figure {
-            title: "Tip–sample force by the Sader–Jarvis inversion".into(),
+            title: if a.am.is_some() {
+                "Tip–sample force from the AM curve (matrix method)".into()
+            } else {
+                "Tip–sample force by the Sader–Jarvis inversion".into()
+            },
             x_label: "distance of closest approach d (m)".into(),
             y_label: "force F (N)".into(),
             series: std::iter::once(Series {
@@ -150,7 +202,7 @@ pub fn reconstruct(a: &ReconstructArgs) -> Result<(), CliError> {
                 style: Style::Line,
                 color: 0,
             })
-            .chain(request.law_in_order().map(|law| Series {
+            .chain(law.map(|law| Series {
                 label: "the model's force law".into(),
                 points: points(&law),
                 style: Style::Dashed,
@@ -161,9 +213,8 @@ pub fn reconstruct(a: &ReconstructArgs) -> Result<(), CliError> {
             y_min_span: 0.0,
         },
     )?;
-    let mut json = doc.json;
     json["csv"] = serde_json::json!(out.join("reconstruct.csv"));
-    write_document(&out, "reconstruct.json", &json)?;
+    write_document(out, "reconstruct.json", &json)?;
     if a.json {
         outln!("{json}");
     } else {

@@ -537,6 +537,21 @@ pub fn reconstruct_fm<'py>(
     Ok(out.finish())
 }
 
+/// The conservative force behind an AM approach document of the point mass (`afmdyn
+/// reconstruct --am approach.json`: [`afmdyn::request::reconstruct::am_curve_from_approach`],
+/// [`afmdyn::analysis::reconstruct_am::matrix_inversion`]): its JSON document.
+#[pyfunction]
+pub fn reconstruct_am<'py>(py: Python<'py>, document: &str) -> PyResult<Dict<'py>> {
+    let doc: serde_json::Value = serde_json::from_str(document).map_err(|e| {
+        pyo3::exceptions::PyValueError::new_err(format!("am: not a JSON document: {e}"))
+    })?;
+    let curve = afmdyn::request::reconstruct::am_curve_from_approach(&doc).map_err(sim_error)?;
+    let r = afmdyn::analysis::reconstruct_am::matrix_inversion(&curve).map_err(sim_error)?;
+    let out = Out::new(py);
+    out.json(&afmdyn::request::reconstruct::am_document(&curve, &r))?;
+    Ok(out.finish())
+}
+
 /// A probe (SI units, `afmdyn … --probe FILE`; its TOML text from [`crate::params::probe_source`]): its
 /// dimensionless parameters and the `"si"` block of the command line's JSON (scales,
 /// calibration, drive, A₀, z_c).

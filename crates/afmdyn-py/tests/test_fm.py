@@ -72,3 +72,17 @@ def test_reconstruct_of_fm_carries_the_model_force_law():
                                rtol=1e-12)
     # and it is the fm dataset's law_force at its lower turning points, in increasing distance
     np.testing.assert_allclose(np.sort(ds.law_force.values), np.sort(back.law.values), rtol=0)
+
+
+def test_reconstruct_of_an_am_approach_gives_the_force():
+    ds = afmdyn.approach(probe=P1, from_=60e-9, to=3e-9, step=0.02e-9, branches=False)
+    back = afmdyn.reconstruct(am=ds)
+    doc = json.loads(back.attrs["summary"])
+    assert doc["points"] > 2000 and "matrix method" in doc["method"]
+    d = back.distance.values
+    inside = (d >= 0.5e-9) & (d <= 5e-9)
+    assert inside.sum() > 200
+    want = -6.6e-20 * 10e-9 / (6.0 * d[inside] ** 2)
+    np.testing.assert_allclose(back.force.values[inside], want, rtol=0.01)
+    with pytest.raises(ValueError, match="constants"):
+        afmdyn.reconstruct(am=ds, spring_constant=40.0)

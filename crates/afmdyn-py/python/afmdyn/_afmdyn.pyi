@@ -512,6 +512,7 @@ def reconstruct(
     request: Optional[ReconstructRequest] = None,
     progress: Optional[ProgressCallback] = None,
 ) -> Dict[str, Any]: ...
+def reconstruct_am(document: str) -> Dict[str, Any]: ...
 def reconstruct_fm(
     document: str,
     spring_constant: Optional[float] = None,

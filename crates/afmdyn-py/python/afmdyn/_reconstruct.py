@@ -26,6 +26,7 @@ def reconstruct(
     distance: Optional[Sequence[float]] = None,
     z_c: Optional[Sequence[float]] = None,
     fm: Optional[Union[xr.Dataset, Dict[str, Any]]] = None,
+    am: Optional[Union[xr.Dataset, Dict[str, Any]]] = None,
     progress: ProgressArg = None,
 ) -> xr.Dataset:
     """The tip–sample force F(d) and potential U(d) behind a frequency-modulation curve, by
@@ -41,6 +42,10 @@ def reconstruct(
             document, ``afmdyn.summary(ds)``): its distances of closest approach
             (``min_distance``), shifts, k, f0 and A; ``spring_constant``,
             ``resonance_frequency``, ``amplitude`` given replace the document's.
+        am: instead, the dataset of :func:`afmdyn.approach` with a point-mass probe (or its
+            document): its attractive run (phase lag above 90°) inverted at each point's
+            amplitude by the matrix method (``afmdyn reconstruct --am``); the constants are
+            the probe's.
 
     Returns:
         ``xarray.Dataset`` over ``distance`` (m, increasing): ``force`` (N, attractive < 0),
@@ -54,6 +59,14 @@ def reconstruct(
             that differ, constants not > 0 or missing, neither or both of ``distance`` and
             ``z_c``; ``fm`` not an SI ``fm`` document.
     """
+    if am is not None:
+        given = [n for n, v in (("fm", fm), ("frequency_shift", frequency_shift),
+                                ("spring_constant", spring_constant), ("amplitude", amplitude),
+                                ("resonance_frequency", resonance_frequency)) if v is not None]
+        if given:
+            raise ValueError(f"am: the approach curve carries its constants; {given[0]} not taken")
+        document = am.attrs["summary"] if isinstance(am, xr.Dataset) else json.dumps(am)
+        return _dataset(json.loads(_core.reconstruct_am(document)["json"]))
     if fm is not None:
         if frequency_shift is not None or distance is not None or z_c is not None:
             raise ValueError("fm: give the fm curve or frequency_shift with distance/z_c, not both")

@@ -7,6 +7,7 @@
 use super::run::{Analysis, Resolved};
 use crate::analysis::progress::Progress;
 use crate::analysis::reconstruct::{sader_jarvis, Reconstruction, ShiftCurve};
+use crate::analysis::reconstruct_am::AmCurve;
 use crate::error::SimError;
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
@@ -184,6 +185,113 @@ pub fn document(request: &ReconstructRequest, r: &Reconstruction) -> Value {
             "the force near the largest distance is not reconstructed: the inversion integrates \
              the frequency shift beyond each distance, and the data end there (take data out to \
              where the shift has decayed)"
+        ],
+    })
+}
+
+/// The AM curve of an `afmdyn approach --probe` document of the point-mass model (`reconstruct
+/// --am`, [`crate::analysis::reconstruct_am`]): the approach sweep's leading attractive run —
+/// from its first point while the phase lag stays above 90° (the repulsive regime, where the
+/// first-harmonic balance still holds but the branch jumps, is left out) — with k, f₀ and Q of
+/// `si.calibration`, the drive frequency `si.drive_frequency_hz` and the free amplitude
+/// `si.free_amplitude_m`.
+///
+/// # Errors
+/// [`SimError::OutOfRange`] naming `am` for a document that is not such a document (no
+/// `approach` or `si`, another model: the inversion's balance is the point mass's, force-driven
+/// equation), or with fewer than 3 attractive points.
+pub fn am_curve_from_approach(doc: &Value) -> Result<AmCurve, SimError> {
+    let bad = |what: &'static str| {
+        SimError::out_of_range(
+            "am",
+            what,
+            "must be the JSON document of afmdyn approach --probe on the point-mass model \
+             (approach.json, or --json's output)",
+        )
+    };
+    if doc["params"]["structure"].as_str() != Some("point-mass") {
+        return Err(bad("a document of another model than the point mass"));
+    }
+    let column = |name: &str| -> Option<Vec<Option<f64>>> {
+        Some(
+            doc["approach"][name]
+                .as_array()?
+                .iter()
+                .map(Value::as_f64)
+                .collect(),
+        )
+    };
+    let (Some(z), Some(a), Some(p), Some(m)) = (
+        column("z_c"),
+        column("amplitude"),
+        column("phase_deg"),
+        column("mean_deflection"),
+    ) else {
+        return Err(bad(
+            "a document without the approach's z_c, amplitude, phase_deg, mean_deflection",
+        ));
+    };
+    let si = &doc["si"];
+    let number = |v: &Value| {
+        v.as_f64()
+            .ok_or_else(|| bad("a document without its si block"))
+    };
+    let mut curve = AmCurve {
+        z_c: Vec::new(),
+        amplitude: Vec::new(),
+        phase: Vec::new(),
+        mean_deflection: Some(Vec::new()),
+        spring_constant: number(&si["calibration"]["spring_constant"])?,
+        resonance_frequency: number(&si["calibration"]["resonance_frequency"])?,
+        quality_factor: number(&si["calibration"]["quality_factor"])?,
+        drive_frequency: number(&si["drive_frequency_hz"])?,
+        free_amplitude: number(&si["free_amplitude_m"])?,
+    };
+    for i in 0..z.len() {
+        let (Some(z), Some(a), Some(p), Some(m)) = (z[i], a[i], p[i], m[i]) else {
+            break;
+        };
+        if p <= 90.0 {
+            break;
+        }
+        curve.z_c.push(z);
+        curve.amplitude.push(a);
+        curve.phase.push(p.to_radians());
+        if let Some(md) = &mut curve.mean_deflection {
+            md.push(m);
+        }
+    }
+    if curve.z_c.len() < 3 {
+        return Err(SimError::out_of_range(
+            "am",
+            format!("{} attractive points", curve.z_c.len()),
+            "needs at least 3 points of the approach with the phase lag above 90°",
+        ));
+    }
+    Ok(curve)
+}
+
+/// The document of an AM reconstruction (`afmdyn reconstruct --am`): as [`document`]'s, with
+/// `amplitude` the free amplitude A₀, `quality_factor`, `drive_frequency` and the points used.
+pub fn am_document(curve: &AmCurve, r: &Reconstruction) -> Value {
+    json!({
+        "force": {"distance": r.distance, "force": r.force, "potential": r.potential},
+        "spring_constant": curve.spring_constant,
+        "resonance_frequency": curve.resonance_frequency,
+        "amplitude": curve.free_amplitude,
+        "quality_factor": curve.quality_factor,
+        "drive_frequency": curve.drive_frequency,
+        "points": curve.z_c.len(),
+        "method": "AM inversion: the first-harmonic balance kA(1 - w^2/w0^2) - F0 cos(phi) = \
+                   (1/pi) integral of F cos(theta), inverted by Giessibl's matrix method (Appl. \
+                   Phys. Lett. 78, 123 (2001)) with hat functions at each point's lower turning \
+                   point and amplitude (analysis::reconstruct_am); the approach's attractive run \
+                   (phase lag above 90 degrees)",
+        "units": {"distance": "m", "force": "N", "potential": "J"},
+        "warnings": [
+            "the force near the largest distance is not reconstructed: the inversion integrates \
+             the curve beyond each distance, and the data end there (start the approach where \
+             the amplitude and phase are the free ones)"
         ],
     })
 }
