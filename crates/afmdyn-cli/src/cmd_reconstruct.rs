@@ -133,10 +133,8 @@ fn am_reconstruction(path: &Path) -> Result<(Reconstruction, serde_json::Value),
     let doc: serde_json::Value = serde_json::from_slice(&text).map_err(|e| {
         CliError::Input(format!("--am {}: not a JSON document: {e}", path.display()))
     })?;
-    let curve = request::reconstruct::am_curve_from_approach(&doc)?;
-    let r = afmdyn::analysis::reconstruct_am::matrix_inversion(&curve)?;
-    let json = request::reconstruct::am_document(&curve, &r);
-    Ok((r, json))
+    let d = request::reconstruct::am_reconstruction(&doc)?;
+    Ok((d.output, d.json))
 }
 
 /// Run `afmdyn reconstruct`.

@@ -488,6 +488,15 @@ pub fn reconstruct<'py>(
 ) -> PyResult<Dict<'py>> {
     let request: afmdyn::request::ReconstructRequest =
         crate::convert::request("reconstruct", request)?;
+    reconstruction(py, request, progress)
+}
+
+/// The JSON document of a reconstruction request, run as every analysis is ([`analysis`]).
+fn reconstruction<'py>(
+    py: Python<'py>,
+    request: afmdyn::request::ReconstructRequest,
+    progress: Option<Bound<'py, PyAny>>,
+) -> PyResult<Dict<'py>> {
     let doc = analysis(
         py,
         request,
@@ -499,6 +508,13 @@ pub fn reconstruct<'py>(
     let out = Out::new(py);
     out.json(&doc.json)?;
     Ok(out.finish())
+}
+
+/// A JSON document passed as text (`name` the keyword, for the error).
+fn json_document(name: &str, text: &str) -> PyResult<serde_json::Value> {
+    serde_json::from_str(text).map_err(|e| {
+        pyo3::exceptions::PyValueError::new_err(format!("{name}: not a JSON document: {e}"))
+    })
 }
 
 /// The force and potential behind an `fm` document (`afmdyn reconstruct --fm fm.json`): the
@@ -514,41 +530,25 @@ pub fn reconstruct_fm<'py>(
     amplitude: Option<f64>,
     progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Dict<'py>> {
-    let doc: serde_json::Value = serde_json::from_str(document).map_err(|e| {
-        pyo3::exceptions::PyValueError::new_err(format!("fm: not a JSON document: {e}"))
-    })?;
     let request = afmdyn::request::ReconstructRequest::from_fm_document(
-        &doc,
+        &json_document("fm", document)?,
         spring_constant,
         resonance_frequency,
         amplitude,
     )
     .map_err(sim_error)?;
-    let doc = analysis(
-        py,
-        request,
-        Params::default(),
-        None,
-        progress.as_ref(),
-        false,
-    )?;
-    let out = Out::new(py);
-    out.json(&doc.json)?;
-    Ok(out.finish())
+    reconstruction(py, request, progress)
 }
 
 /// The conservative force behind an AM approach document of the point mass (`afmdyn
-/// reconstruct --am approach.json`: [`afmdyn::request::reconstruct::am_curve_from_approach`],
-/// [`afmdyn::analysis::reconstruct_am::matrix_inversion`]): its JSON document.
+/// reconstruct --am approach.json`: [`afmdyn::request::reconstruct::am_reconstruction`]): its
+/// JSON document.
 #[pyfunction]
 pub fn reconstruct_am<'py>(py: Python<'py>, document: &str) -> PyResult<Dict<'py>> {
-    let doc: serde_json::Value = serde_json::from_str(document).map_err(|e| {
-        pyo3::exceptions::PyValueError::new_err(format!("am: not a JSON document: {e}"))
-    })?;
-    let curve = afmdyn::request::reconstruct::am_curve_from_approach(&doc).map_err(sim_error)?;
-    let r = afmdyn::analysis::reconstruct_am::matrix_inversion(&curve).map_err(sim_error)?;
+    let doc = afmdyn::request::reconstruct::am_reconstruction(&json_document("am", document)?)
+        .map_err(sim_error)?;
     let out = Out::new(py);
-    out.json(&afmdyn::request::reconstruct::am_document(&curve, &r))?;
+    out.json(&doc.json)?;
     Ok(out.finish())
 }
 

@@ -270,7 +270,6 @@ struct Locked {
     /// ‖P(z) − z‖ of the orbit.
     fixed_point: f64,
     orbit: PeriodicOrbit,
-    observables: Observables,
     residual: Vector2<f64>,
 }
 
@@ -338,7 +337,6 @@ impl Solver<'_> {
             x,
             fixed_point,
             orbit,
-            observables,
             residual,
         })
     }
@@ -810,7 +808,6 @@ pub fn fm_curve(spec: &FmSpec, progress: &Progress) -> Result<FmCurve, SimError>
             .with(SweepParam::Alpha2, locked.x[1]);
         let model = CantileverModel::new(&p)?;
         let observables = observe_orbit(&model, spec.integrator.clone(), &locked.orbit, 10)?;
-        debug_assert!((observables.amplitude - locked.observables.amplitude).abs() < 1e-9);
         points.push(FmPoint {
             alpha5: target,
             omega: locked.x[0],

@@ -332,22 +332,11 @@ mod end_to_end {
     use crate::analysis::stepped::Spacing;
     use crate::params::SweepParam;
 
-    const PROBE: &str = r#"
-model = "point-mass"
-[cantilever]
-spring_constant = 40.0
-resonance_frequency = 300e3
-quality_factor = 400
-[tip]
-radius = 10e-9
-[sample]
-law = "dmt"
-youngs_modulus = 4e9
-poisson_ratio = 0.33
-hamaker = 6.6e-20
-[drive]
-free_amplitude = 10e-9
-"#;
+    /// The example probe of the point mass (its `z_c` is the approach's, not used here).
+    const PROBE: &str = include_str!(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../examples/probe-point-mass-dmt.toml"
+    ));
 
     /// The force comes back within 1 % from d = 1 nm to A/2 (measured 0.09 % at 1 nm, 0.76 % at
     /// 5 nm, growing with d as the data's end at z_c = 60 nm truncates the integrals): the

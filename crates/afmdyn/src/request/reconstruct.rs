@@ -295,3 +295,20 @@ pub fn am_document(curve: &AmCurve, r: &Reconstruction) -> Value {
         ],
     })
 }
+
+/// The reconstruction of an `afmdyn approach --probe` document of the point mass and its JSON
+/// document ([`am_curve_from_approach`], [`crate::analysis::reconstruct_am::matrix_inversion`],
+/// [`am_document`]): `reconstruct --am` of every front end.
+///
+/// # Errors
+/// As [`am_curve_from_approach`] and the inversion.
+pub fn am_reconstruction(
+    approach: &Value,
+) -> Result<super::run::Document<Reconstruction>, SimError> {
+    let curve = am_curve_from_approach(approach)?;
+    let r = crate::analysis::reconstruct_am::matrix_inversion(&curve)?;
+    Ok(super::run::Document {
+        json: am_document(&curve, &r),
+        output: r,
+    })
+}
