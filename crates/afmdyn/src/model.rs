@@ -229,10 +229,21 @@ impl CantileverModel {
             *o = d.b_const[i] + s * d.b_sin[i] + c * d.b_cos[i];
         }
         crate::linalg::matvec(&d.a, z, dz, 1.0, true);
-        if linear {
+        // the further components of a multifrequency drive: a force at the tip
+        let fd = if self.params.is_multifrequency() {
+            self.params.component_force(tau)
+        } else {
+            0.0
+        };
+        if linear && fd == 0.0 {
             return;
         }
-        let f = self.tip_force_with(r, tau, (s, c), z);
+        let f = fd
+            + if linear {
+                0.0
+            } else {
+                self.tip_force_with(r, tau, (s, c), z)
+            };
         let acc = &mut dz[n..];
         if f != 0.0 {
             for (o, m) in acc.iter_mut().zip(self.mphi.iter()) {
@@ -478,7 +489,8 @@ impl CantileverModel {
 
     /// The rates of the energy balance at (τ, z) in region r. Multiplying the equation of
     /// motion by Ȧᵀ gives dE/dτ = P_base − D_beam − D_contact exactly, with
-    /// P_base = ȦᵀF^I(τ) − α2 Ω cos Ωτ · F_c and D_contact = F_d δ̇ (F_d the dissipative part
+    /// P_base = ȦᵀF^I(τ) − α2 Ω cos Ωτ · F_c (plus the power F̃(τ) Ẇ(1,τ) of the further
+    /// components of a multifrequency drive, [`Params::component_force`]) and D_contact = F_d δ̇ (F_d the dissipative part
     /// of the law).
     pub fn power(&self, r: Region, tau: f64, z: &DVector<f64>) -> PowerTerms {
         let n = self.modes();
@@ -486,7 +498,9 @@ impl CantileverModel {
         let g = self.galerkin.region(Region::Free);
         let v = z.rows(n, n);
         let (s, c) = (p.omega * tau).sin_cos();
-        let drive = g.forcing.sin.dot(&v) * s + g.forcing.cos.dot(&v) * c;
+        let drive = g.forcing.sin.dot(&v) * s
+            + g.forcing.cos.dot(&v) * c
+            + p.component_force(tau) * self.tip().dot(&v);
         let beam = p.alpha3 * v.dot(&v);
         let fc = self.contact_force(r, tau, z);
         let rate = -self.v_t_dot(tau, z);
@@ -623,7 +637,8 @@ impl CantileverModel {
                 * (p.base_amplitude() * om * om * om * c
                     - om * (fs * c - fc * s)
                     - 2.0 * beta * dvd_tau
-                    - beta * beta * dv_tau),
+                    - beta * beta * dv_tau)
+                - p.component_force_rate(tau),
         }
     }
 
@@ -638,7 +653,36 @@ impl CantileverModel {
         let acc =
             self.tip_acc.iter().zip(z).map(|(a, b)| a * b).sum::<f64>() + f0 + fs * s + fc * c;
         let (v, vd) = self.v_t_pair(tau, z);
+        // the further drive components' tip force F̃ adds F̃/m_eff to the free tip acceleration
         self.m_eff * (p.base_amplitude() * om * om * s - acc - 2.0 * beta * vd - beta * beta * v)
+            - p.component_force(tau)
+    }
+
+    /// Complex amplitude H of the free tip deflection's response to a unit force cos(ωτ) at the
+    /// tip: W(1,τ) = Re(H e^{iωτ}), so F̃|H| is a force component's free amplitude and −arg H
+    /// its phase lag ([`Params::drive_components`]); H = φ(1)ᵀ(K − ω²M + iωC)⁻¹φ(1), the
+    /// harmonic balance of the free system as in [`CantileverModel::free_tip_response`].
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] when ω is at an undamped natural frequency.
+    pub fn free_force_response(&self, omega: f64) -> Result<nalgebra::Complex<f64>, SimError> {
+        use nalgebra::Complex;
+        let g = self.galerkin.region(Region::Free);
+        let dyn_stiff = DMatrix::from_fn(self.modes(), self.modes(), |i, j| {
+            Complex::new(
+                g.stiffness[(i, j)] - omega * omega * g.mass[(i, j)],
+                omega * g.damping[(i, j)],
+            )
+        });
+        let f = self.tip().map(|v| Complex::new(v, 0.0));
+        let x = dyn_stiff.lu().solve(&f).ok_or_else(|| {
+            SimError::out_of_range(
+                "drive frequency",
+                omega,
+                "the free system has no steady state at an undamped natural frequency",
+            )
+        })?;
+        Ok(self.tip().iter().zip(x.iter()).map(|(p, xi)| xi * *p).sum())
     }
 
     /// Impact law, start inside the sample (V_T < 0): the plastic contact that places it on the

@@ -107,6 +107,67 @@ pub struct Params {
     /// The eigenmode model's modes ([`Structure::Eigenmodes`]; `None` for the other models).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub eigenmodes: Option<Eigenmodes>,
+    /// Further components of a multifrequency drive ([`DriveComponent`]; multifrequency AFM,
+    /// García & Proksch, *Eur. Polym. J.* 49 (2013) 1897): forces at the tip beside the
+    /// primary drive (α2 at Ω). `None` entries are absent; the default has none.
+    // 3 = MAX_DRIVE_COMPONENTS as a literal (the named constant in a field's array length
+    // makes rustc 1.95 stop with an internal compiler error, as for damping_profile)
+    #[serde(default, skip_serializing_if = "no_components")]
+    pub drive_components: [Option<DriveComponent>; 3],
+}
+
+/// Most further drive components beside the primary one ([`Params::drive_components`]).
+pub const MAX_DRIVE_COMPONENTS: usize = 3;
+/// Largest common period of a multifrequency drive, in periods 2π/Ω of the primary drive:
+/// the orbit, the stroboscopic map and the observables' window span this many periods.
+pub const MAX_COMMON_PERIODS: u64 = 1000;
+
+const _: () = assert!(
+    MAX_DRIVE_COMPONENTS == 3,
+    "Params::drive_components has MAX_DRIVE_COMPONENTS entries"
+);
+
+fn no_components(c: &[Option<DriveComponent>; 3]) -> bool {
+    c.iter().all(Option::is_none)
+}
+
+/// One further component of a multifrequency drive: the force F̃ cos(p/q Ω τ + θ) at the tip,
+/// in the model's force unit (that of the contact force F_c: k g₀ for the lumped models, the
+/// unit of α4 V_T for the beam). It enters every model as the tip force does, through
+/// φ(1)F̃ (paper eq. 8 with F_c → F_c + F̃ cos(…)): for the eigenmode model each mode is
+/// driven by every component (García & Proksch 2013, eq. 1); for the beam it is a force drive
+/// at the tip (magnetic or photothermal) beside the base drive, which does not move V_T.
+/// The frequency ratio p/q is rational, so the drive is periodic with the common period
+/// 2πq/Ω for p/q in lowest terms ([`Params::common_periods`]).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct DriveComponent {
+    /// F̃ ≥ 0, the force amplitude at the tip (model units, above).
+    pub force: f64,
+    /// [p, q], both in 1..=1000: the frequency is p/q times Ω.
+    pub ratio: [u32; 2],
+    /// θ, the phase of the component (rad).
+    pub phase: f64,
+}
+
+impl DriveComponent {
+    /// The component's frequency ratio p/q to Ω.
+    pub fn ratio(&self) -> f64 {
+        f64::from(self.ratio[0]) / f64::from(self.ratio[1])
+    }
+    /// The component's period in periods 2π/Ω: q/gcd(p, q).
+    pub fn periods(&self) -> u64 {
+        let [p, q] = self.ratio.map(u64::from);
+        q / gcd(p, q)
+    }
+}
+
+/// Greatest common divisor (Euclid).
+pub(crate) fn gcd(a: u64, b: u64) -> u64 {
+    if b == 0 {
+        a
+    } else {
+        gcd(b, a % b)
+    }
 }
 
 /// The modes of the eigenmode model ([`Structure::Eigenmodes`]): stiffness at the tip and
@@ -205,6 +266,7 @@ impl Default for Params {
             structure: Structure::Beam,
             damping_profile: None,
             eigenmodes: None,
+            drive_components: [None; MAX_DRIVE_COMPONENTS],
         }
     }
 }
@@ -394,6 +456,32 @@ impl Params {
             }
             _ => {}
         }
+        for c in self.components() {
+            if !(c.force.is_finite() && (0.0..=DISPLACEMENT_MAX).contains(&c.force)) {
+                return Err(ParamError::Structure {
+                    name: "drive_components.force (the component's force at the tip, in [0, 1e6])",
+                    value: c.force,
+                });
+            }
+            if c.ratio.iter().any(|&v| !(1..=1000).contains(&v)) {
+                return Err(ParamError::Structure {
+                    name: "drive_components.ratio ([p, q], each in 1..=1000)",
+                    value: f64::from(c.ratio[0]) / f64::from(c.ratio[1].max(1)),
+                });
+            }
+            if !c.phase.is_finite() {
+                return Err(ParamError::Structure {
+                    name: "drive_components.phase (rad, finite)",
+                    value: c.phase,
+                });
+            }
+        }
+        if self.common_periods() > MAX_COMMON_PERIODS {
+            return Err(ParamError::Structure {
+                name: "drive_components.ratio (the common period, lcm of the q's, at most 1000 drive periods)",
+                value: f64::NAN,
+            });
+        }
         if self.structure == Structure::PointMass {
             for (name, bad, value) in [
                 (
@@ -452,9 +540,47 @@ impl Params {
         z_c - self.contact_law.distance_offset()
     }
 
-    /// The drive period T = 2π/Ω.
+    /// The drive period T = 2π/Ω, or for a multifrequency drive its common period
+    /// 2π/Ω × [`Params::common_periods`]: the period of the forced system, of its stroboscopic
+    /// map and of its periodic orbits.
     pub fn period(&self) -> f64 {
-        std::f64::consts::TAU / self.omega
+        std::f64::consts::TAU / self.omega * self.common_periods() as f64
+    }
+
+    /// The further drive components present ([`Params::drive_components`]).
+    pub fn components(&self) -> impl Iterator<Item = &DriveComponent> {
+        self.drive_components.iter().flatten()
+    }
+
+    /// Whether the drive has further components ([`Params::drive_components`]).
+    pub fn is_multifrequency(&self) -> bool {
+        self.components().next().is_some()
+    }
+
+    /// The drive's common period in periods 2π/Ω: the least common multiple of the
+    /// components' [`DriveComponent::periods`] (1 for a single-frequency drive).
+    pub fn common_periods(&self) -> u64 {
+        self.components().fold(1, |l, c| {
+            let q = c.periods();
+            l / gcd(l, q) * q
+        })
+    }
+
+    /// Σ F̃_i cos(p_i/q_i Ω τ + θ_i), the further components' tip force at τ (0 without them).
+    pub fn component_force(&self, tau: f64) -> f64 {
+        self.components()
+            .map(|c| c.force * (c.ratio() * self.omega * tau + c.phase).cos())
+            .sum()
+    }
+
+    /// d/dτ of [`Params::component_force`].
+    pub fn component_force_rate(&self, tau: f64) -> f64 {
+        self.components()
+            .map(|c| {
+                let w = c.ratio() * self.omega;
+                -c.force * w * (w * tau + c.phase).sin()
+            })
+            .sum()
     }
 
     /// Value of one sweepable parameter.

@@ -235,6 +235,47 @@ pub struct Observables {
     pub mode_balance: Vec<ModeBalance>,
     /// The closed forms from (A, φ, A₀, Q, k).
     pub closed_form: ClosedForms,
+    /// Per drive component of a multifrequency drive, the primary first (empty for a
+    /// single-frequency drive; [`crate::params::Params::drive_components`]).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub components: Vec<ComponentObservables>,
+}
+
+/// The observables of one component of a multifrequency drive (frequency ω_c = r Ω, drive
+/// ∝ sin(ω_c τ + ψ_c): ψ_c = ψ for the primary, θ + π/2 for a further component's
+/// F̃ cos(ω_c τ + θ)). The tip's motion at ω_c, demodulated over the window (an integer number
+/// of periods of every component), is z_c(τ) = A_c sin(ω_c τ + ψ_c − φ_c); the component's
+/// virial and dissipated energy are those of the tip–sample force on that motion,
+/// V_c = ⟨F_c z_c⟩ and E_c = −∮F_c ż_c dτ per cycle of the component — the per-mode virial
+/// and dissipation of bimodal AFM (Lozano & García, *Phys. Rev. Lett.* 100 (2008) 076102;
+/// García & Proksch, *Eur. Polym. J.* 49 (2013) 1897), each mode moving at its own drive
+/// frequency. Their closed forms, from the equivalent point mass of the mode whose natural
+/// frequency is nearest ω_c (k̃, Q, ω₀) and the component's free amplitude A₀c:
+/// E_cf = (π k̃ A_c²/Q)[(A₀c/A_c) sin φ_c − ω_c/ω₀], V_cf = −(k̃ A_c A₀c/(2Q)) cos φ_c, which
+/// for the point mass at ω_c = ω₀ are exact balances (projecting z'' + z'/Q + z = F + F_c on
+/// ż_c and z_c), elsewhere approximations reported beside the direct integrals.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ComponentObservables {
+    /// ω_c/Ω (p/q; 1 for the primary).
+    pub ratio: f64,
+    /// A_c (g₀).
+    pub amplitude: f64,
+    /// φ_c, the lag behind the component's drive, rad, in (−π/2, 3π/2].
+    pub phase: f64,
+    /// A₀c, the free amplitude at ω_c (g₀).
+    pub free_amplitude: f64,
+    /// The free response's lag at ω_c, rad.
+    pub free_phase: f64,
+    /// V_c = ⟨F_c z_c⟩ (F̃·g₀), impulses included.
+    pub virial: f64,
+    /// E_c = −∮F_c ż_c per cycle of the component (F̃·g₀), impulses included.
+    pub energy_dissipated: f64,
+    /// The mode (0-based) whose equivalent point mass the closed forms use.
+    pub mode: usize,
+    /// V_cf = −(k̃ A_c A₀c/(2Q)) cos φ_c.
+    pub closed_virial: f64,
+    /// E_cf = (π k̃ A_c²/Q)[(A₀c/A_c) sin φ_c − ω_c/ω₀] per cycle.
+    pub closed_energy_dissipated: f64,
 }
 
 /// The free linear response of the tip at the drive frequency Ω, from the model's complex
@@ -288,6 +329,8 @@ fn wrap_phase(p: f64) -> f64 {
 
 /// Values of the dense output at one τ of a smooth piece.
 struct Node {
+    /// τ.
+    tau: f64,
     /// State (a, ȧ), shape `[2N]`.
     z: DVector<f64>,
     /// Its vector field (ȧ, ä), shape `[2N]`.
@@ -312,6 +355,9 @@ struct Ctx {
     omega: f64,
     /// (sin ψ, cos ψ) of the drive phase ψ.
     psi: (f64, f64),
+    /// The drive components of a multifrequency drive, the primary first: (ω_c, ψ_c) (empty
+    /// for one frequency; [`ComponentObservables`]).
+    components: Vec<(f64, f64)>,
     /// Gauss–Legendre nodes and weights on [−1, 1], ascending: [`GL_NODES`] of them, and
     /// [`GL_NODES_SHORT`].
     gl: [Vec<(f64, f64)>; 2],
@@ -336,8 +382,21 @@ impl Ctx {
                 .iter()
                 .fold(0.0f64, |m, l| m.max(l.norm()))
         });
-        let h_max = rho.map(|rho| (model.period() / harmonics as f64).min(TAU / rho.max(1e-300)));
-        let top = harmonics as f64 * p.omega;
+        let components: Vec<(f64, f64)> = if p.is_multifrequency() {
+            std::iter::once((p.omega, p.drive_phase()))
+                .chain(
+                    p.components()
+                        .map(|c| (c.ratio() * p.omega, c.phase + std::f64::consts::FRAC_PI_2)),
+                )
+                .collect()
+        } else {
+            Vec::new()
+        };
+        // the highest frequency: the highest harmonic of Ω, or a faster drive component
+        let top = components
+            .iter()
+            .fold(harmonics as f64 * p.omega, |m, c| m.max(c.0));
+        let h_max = rho.map(|rho| (TAU / top).min(TAU / rho.max(1e-300)));
         let product_rate = rho.map(|rho| rho + rho.max(top));
         let gl = [GL_NODES, GL_NODES_SHORT].map(|n| {
             let mut gl: Vec<(f64, f64)> = GaussLegendre::new(NonZeroUsize::new(n).expect("> 0"))
@@ -358,6 +417,7 @@ impl Ctx {
             tip: model.tip().clone(),
             omega: p.omega,
             psi: p.drive_phase().sin_cos(),
+            components,
             gl,
             h_max,
             product_rate,
@@ -376,6 +436,7 @@ impl Ctx {
         let wdd = self.tip.dot(&dz.rows(n, n));
         let v = self.model.v_t_at(sc, [w, wd, wdd]);
         Node {
+            tau,
             z,
             dz,
             w,
@@ -440,6 +501,9 @@ struct Acc {
     f_max: f64,
     f_min: f64,
     v_min: f64,
+    /// Per drive component: ∫W sin θ_c, ∫W cos θ_c, ∫F_c sin θ_c, ∫F_c cos θ_c with
+    /// θ_c = ω_c τ + ψ_c (impulses P sin θ_c, P cos θ_c in the force's).
+    comp: Vec<[f64; 4]>,
 }
 
 impl Acc {
@@ -463,6 +527,7 @@ impl Acc {
             f_max: f64::NEG_INFINITY,
             f_min: f64::INFINITY,
             v_min: f64::INFINITY,
+            comp: Vec::new(),
         }
     }
 
@@ -492,10 +557,22 @@ impl Acc {
         self.e_dis -= wq * nd.f * nd.v[1];
         self.virial += wq * nd.f * nd.w;
         self.force += wq * nd.f;
-        // the drive F^I(τ) (eq. 14) from the node's sin and cos of Ωτ
+        for (acc, &(om, psi)) in self.comp.iter_mut().zip(&ctx.components) {
+            let (st, ct) = (om * nd.tau + psi).sin_cos();
+            acc[0] += wq * nd.w * st;
+            acc[1] += wq * nd.w * ct;
+            acc[2] += wq * nd.f * st;
+            acc[3] += wq * nd.f * ct;
+        }
+        // the drive F^I(τ) (eq. 14) from the node's sin and cos of Ωτ, and the further drive
+        // components' force at the tip
         let forcing = &ctx.free.forcing;
+        let tip_force = ctx.model.params().component_force(nd.tau);
         for (j, o) in fi.iter_mut().enumerate() {
-            *o = forcing.constant[j] + s * forcing.sin[j] + c * forcing.cos[j];
+            *o = forcing.constant[j]
+                + s * forcing.sin[j]
+                + c * forcing.cos[j]
+                + tip_force * ctx.tip[j];
         }
         let (a, ad, add) = (
             &nd.z.as_slice()[..n],
@@ -606,6 +683,11 @@ impl Acc {
         let imp = -(1.0 + rc) * model.effective_mass() * e.v_t_dot;
         self.virial += imp * model.w_tip(&e.state);
         self.force += imp;
+        for (acc, &(om, psi)) in self.comp.iter_mut().zip(&ctx.components) {
+            let (st, ct) = (om * e.tau + psi).sin_cos();
+            acc[2] += imp * st;
+            acc[3] += imp * ct;
+        }
         let jump: Vec<f64> = (0..n).map(|k| after[n + k] - e.state[n + k]).collect();
         for j in 0..n {
             // the impulse's work on mode j and on the others, at the mean velocity
@@ -650,6 +732,7 @@ pub fn observe(
     let end = tau_start + opts.periods as f64 * model.period();
     let z_start = integ.state().clone();
     let mut acc = Acc::new(n, nh);
+    acc.comp = vec![[0.0; 4]; ctx.components.len()];
     let mut scratch = Scratch {
         fi: DVector::zeros(n),
         scan: Vec::with_capacity(GL_NODES + 2),
@@ -682,7 +765,8 @@ pub fn observe(
     }
     let z_end = integ.state().clone();
     let t_tot = integ.tau() - tau_start;
-    let per = opts.periods as f64;
+    // per drive period 2π/Ω (a multifrequency drive's common period spans several)
+    let per = opts.periods as f64 * p.common_periods() as f64;
     let harmonics: Vec<Harmonic> = (0..nh)
         .map(|h| {
             let s = 2.0 * acc.sin[h] / t_tot;
@@ -718,6 +802,13 @@ pub fn observe(
         .collect();
     let phase = harmonics[0].phase;
     let closed_form = closed_forms(model, a1, phase)?;
+    let components = ctx
+        .components
+        .iter()
+        .zip(&acc.comp)
+        .enumerate()
+        .map(|(i, (&(om, _), sums))| component(model, i, om, sums, t_tot))
+        .collect::<Result<Vec<_>, _>>()?;
     Ok(Observables {
         periods: opts.periods,
         amplitude: a1,
@@ -740,6 +831,65 @@ pub fn observe(
         virial: acc.virial / t_tot,
         mode_balance,
         closed_form,
+        components,
+    })
+}
+
+/// [`ComponentObservables`] of component `i` (0: the primary) at ω_c = `om` from its window
+/// sums (`sums`: ∫W sin θ, ∫W cos θ, ∫F_c sin θ, ∫F_c cos θ over `t_tot`, θ = ω_c τ + ψ_c).
+/// With z_c = A sin(θ − φ): V_c = (A/T)(Fs cos φ − Fc sin φ) and
+/// ∮F_c ż_c = Aω_c(Fc cos φ + Fs sin φ).
+fn component(
+    model: &CantileverModel,
+    i: usize,
+    om: f64,
+    sums: &[f64; 4],
+    t_tot: f64,
+) -> Result<ComponentObservables, SimError> {
+    let [ws, wc, fs, fc] = *sums;
+    let (s, c) = (2.0 * ws / t_tot, 2.0 * wc / t_tot);
+    let a = s.hypot(c);
+    let phase = wrap_phase((-c).atan2(s));
+    let (sp, cp) = phase.sin_cos();
+    let virial = a * (fs * cp - fc * sp) / t_tot;
+    let cycles = om * t_tot / TAU;
+    let e_dis = -a * om * (fc * cp + fs * sp) / cycles;
+    let p = model.params();
+    let (free_amplitude, free_phase) = if i == 0 {
+        let f = free_response(model)?;
+        (f.amplitude, f.phase)
+    } else {
+        let d = p.components().nth(i - 1).expect("component i exists");
+        let h = model.free_force_response(om)?;
+        (d.force * h.norm(), wrap_phase(-h.arg()))
+    };
+    // the equivalent point mass of the mode nearest ω_c
+    let g = model.galerkin().region(Region::Free);
+    let natural = crate::eigen::natural_modes(g);
+    let mode = (0..model.modes())
+        .min_by(|&x, &y| {
+            (natural.omega[x] - om)
+                .abs()
+                .total_cmp(&(natural.omega[y] - om).abs())
+        })
+        .unwrap_or(0);
+    let (w0, _, k) = crate::eigen::mode_at_tip(g, model.tip(), mode);
+    let under: Vec<_> = damped_eigenvalues(g)
+        .into_iter()
+        .filter(|e| e.im > 0.0)
+        .collect();
+    let q = under.get(mode).map_or(f64::INFINITY, |e| 0.5 / e.zeta);
+    Ok(ComponentObservables {
+        ratio: om / p.omega,
+        amplitude: a,
+        phase,
+        free_amplitude,
+        free_phase,
+        virial,
+        energy_dissipated: e_dis,
+        mode,
+        closed_virial: -k * a * free_amplitude / (2.0 * q) * phase.cos(),
+        closed_energy_dissipated: PI * k / q * (a * free_amplitude * phase.sin() - om / w0 * a * a),
     })
 }
 

@@ -99,7 +99,8 @@ pub struct IntegratorOptions {
 
 impl IntegratorKind {
     /// The concrete integrator for `model`: [`IntegratorKind::Auto`] resolves to `Exact` for an
-    /// affine (linear-law) model, to `Split` for a law without force in free flight (Hertz,
+    /// affine (linear-law) model (to `Adaptive` for every law under a multifrequency drive,
+    /// [`crate::params::Params::drive_components`]), to `Split` for a law without force in free flight (Hertz,
     /// impact with r > 0), to `Adaptive` for the plastic impact law r = 0 (whose free flights
     /// all start tangentially) and to `Taylor` for DMT; other kinds are returned as given.
     /// ([`build`] falls back from `Split` to `Adaptive` for `Auto` where the exact free flight
@@ -107,6 +108,8 @@ impl IntegratorKind {
     /// budget.)
     pub fn resolve(self, model: &CantileverModel) -> IntegratorKind {
         match self {
+            // the exact, split and Taylor integrators propagate one harmonic drive
+            IntegratorKind::Auto if model.params().is_multifrequency() => IntegratorKind::Adaptive,
             IntegratorKind::Auto if model.law().is_affine() => IntegratorKind::Exact,
             // a plastic impact law (r = 0): every free flight starts tangentially (V̇_T⁺ = 0),
             // which the split integrator hands to the adaptive half anyway
@@ -207,6 +210,19 @@ pub fn build(
                 hint: "use the exact integrator, or a larger Ω or softer contact",
             });
         }
+    }
+    if model.params().is_multifrequency()
+        && matches!(
+            kind,
+            IntegratorKind::Exact | IntegratorKind::Split | IntegratorKind::Taylor
+        )
+    {
+        return Err(SimError::out_of_range(
+            "integrator",
+            format!("{kind:?}").to_lowercase(),
+            "must be adaptive, auto or rk4 under a multifrequency drive: the exact, split and \
+             Taylor integrators propagate one harmonic drive",
+        ));
     }
     if matches!(kind, IntegratorKind::Rk4 | IntegratorKind::Rk4Naive)
         && model.law().restitution().is_some()

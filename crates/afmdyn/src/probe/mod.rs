@@ -80,7 +80,7 @@ pub const DEFAULT_INTERMOLECULAR_DISTANCE: f64 = 0.165e-9;
 use crate::contact::ContactLaw;
 use crate::galerkin::{Galerkin, Region};
 use crate::model::CantileverModel;
-use crate::params::{Params, Structure, MAX_MODES};
+use crate::params::{DriveComponent, Params, Structure, MAX_DRIVE_COMPONENTS, MAX_MODES};
 use serde::Serialize;
 use std::f64::consts::TAU;
 #[cfg(feature = "files")]
@@ -217,12 +217,39 @@ pub struct Probe {
     pub free_amplitude: f64,
     /// Drive frequency f (Hz).
     pub drive_frequency: f64,
+    /// The further components of a multifrequency drive, in SI (empty for one frequency).
+    pub components: Vec<DriveComponentSi>,
     /// Rest tip–sample distance z_c (m).
     pub z_c: f64,
     /// Whether the file gives `[sample] z_c` (else z_c is its default A₀; a resonance curve
     /// then defaults to the free resonance, [`crate::request::curves::free_resonance_base`]).
     #[serde(skip)]
     pub z_c_in_file: bool,
+}
+
+/// A further drive component of a probe ([`Params::drive_components`]) in SI.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct DriveComponentSi {
+    /// A₀ᵢ (m), the free amplitude of the tip at this component's frequency.
+    pub free_amplitude: f64,
+    /// fᵢ (Hz), the frequency used: the first component's times p/q.
+    pub frequency: f64,
+    /// [p, q], the ratio to the first component's frequency.
+    pub ratio: [u32; 2],
+}
+
+/// The fraction p/q with the smallest q ≤ 1000 within 1e-6 (relative) of `r` > 0, `None`
+/// when there is none. A frequency moved by 1e-6 of itself moves the response of a mode of
+/// quality factor Q by 2Q·1e-6 rad in phase (2e-3 rad at Q = 1000); the frequency used is
+/// reported ([`DriveComponentSi::frequency`]).
+pub fn rational_ratio(r: f64) -> Option<(u32, u32)> {
+    if !(r.is_finite() && r > 0.0 && r < 1e6) {
+        return None;
+    }
+    (1..=1000u32).find_map(|q| {
+        let p = (r * f64::from(q)).round();
+        (p >= 1.0 && ((p / f64::from(q)) - r).abs() <= 1e-6 * r).then(|| (p as u32, q))
+    })
 }
 
 /// The cantilever section, before the model is known.
@@ -238,6 +265,14 @@ enum Beam {
         mass_per_length: f64,
         tip_mass: f64,
     },
+}
+
+/// The drive section in SI: the first component's A₀ (m) and f (Hz, `None`: f₀), and the
+/// further components' (A₀ᵢ, fᵢ) (fᵢ NaN: the mode's free resonance).
+struct Drive {
+    free_amplitude: f64,
+    frequency: Option<f64>,
+    components: Vec<(f64, f64)>,
 }
 
 /// The sample section in SI.
@@ -518,18 +553,22 @@ impl Probe {
             .and_then(|s| Self::read_sample(&mut r, s, tip, radius, tip_e, tip_nu));
         // [drive]
         let drive = r.table(root, "drive", true);
-        let (a0, freq) = match drive {
+        let (a0, freq, extra) = match drive {
             Some(d) => {
                 r.unknown(d, "drive", &["free_amplitude", "frequency"]);
-                (
-                    r.required(d, "drive", "free_amplitude", "m", POSITIVE),
-                    r.optional(d, "drive", "frequency", "Hz", POSITIVE),
-                )
+                Self::read_drive(&mut r, d)
             }
-            None => (None, None),
+            None => (None, None, Vec::new()),
         };
         // lengths are in units of A₀: an amplitude of metres makes every other length vanish
         // and the motion unresolvable (a probe with A₀ = 1 m ran for minutes; issue 27)
+        if extra.iter().any(|&(a, _)| a > MAX_FREE_AMPLITUDE) {
+            r.problems.push(
+                "[drive].free_amplitude: each component must be ≤ 1e-5 m (10 µm; tapping-mode \
+                 amplitudes are nanometres)"
+                    .into(),
+            );
+        }
         let a0 = match a0 {
             Some(a) if a > MAX_FREE_AMPLITUDE => {
                 r.problems.push(format!(
@@ -564,13 +603,107 @@ impl Probe {
         }
         let (structure, modes, beam, q1, sample, a0) =
             (structure?, modes?, beam?, q1?, sample?, a0?);
-        match Self::resolve(structure, modes, beam, q1, qs, eigen, sample, a0, freq) {
+        let drive = Drive {
+            free_amplitude: a0,
+            frequency: freq,
+            components: extra,
+        };
+        match Self::resolve(structure, modes, beam, q1, qs, eigen, sample, drive) {
             Ok(p) => Some(p),
             Err(e) => {
                 r.problems.push(e);
                 None
             }
         }
+    }
+
+    /// `[drive]`: `free_amplitude` (m) and `frequency` (Hz) as numbers (one component), or as
+    /// arrays of equal length (a multifrequency drive, at most 1 + [`MAX_DRIVE_COMPONENTS`]
+    /// components; `frequency` may be omitted, each component then at its mode's free
+    /// resonance). Returns A₀ and f of the first component and (A₀ᵢ, fᵢ) of the others (fᵢ NaN
+    /// where omitted).
+    #[allow(clippy::type_complexity)]
+    fn read_drive(
+        r: &mut Reader<'_>,
+        d: &toml::Table,
+    ) -> (Option<f64>, Option<f64>, Vec<(f64, f64)>) {
+        const S: &str = "drive";
+        let arrays = matches!(d.get("free_amplitude"), Some(toml::Value::Array(_)))
+            || matches!(d.get("frequency"), Some(toml::Value::Array(_)));
+        if !arrays {
+            return (
+                r.required(d, S, "free_amplitude", "m", POSITIVE),
+                r.optional(d, S, "frequency", "Hz", POSITIVE),
+                Vec::new(),
+            );
+        }
+        let mut array = |key: &str, unit: &str| -> Option<Vec<f64>> {
+            let a = match d.get(key) {
+                Some(toml::Value::Array(a)) => a,
+                _ => {
+                    r.problems.push(format!(
+                        "[drive].{key} must be an array ({unit}), one value per component, \
+                         when the other key is"
+                    ));
+                    return None;
+                }
+            };
+            if a.is_empty() || a.len() > 1 + MAX_DRIVE_COMPONENTS {
+                r.problems.push(format!(
+                    "[drive].{key} has {} values: give 1 to {} components",
+                    a.len(),
+                    1 + MAX_DRIVE_COMPONENTS
+                ));
+                return None;
+            }
+            let mut v = Vec::with_capacity(a.len());
+            for (i, x) in a.iter().enumerate() {
+                match x.as_float().or(x.as_integer().map(|i| i as f64)) {
+                    Some(y) if y.is_finite() && y > 0.0 => {
+                        let key_i = format!("{key}[{i}]");
+                        if let Some(hint) = scale_hint(S, key, y) {
+                            r.problems
+                                .push(format!("[drive].{key_i} = {y} ({unit}): {hint}"));
+                        } else {
+                            v.push(y);
+                        }
+                    }
+                    _ => r.problems.push(format!(
+                        "[drive].{key}[{i}] = {x} ({unit}): must be finite and > 0"
+                    )),
+                }
+            }
+            (v.len() == a.len()).then_some(v)
+        };
+        let amplitudes = array("free_amplitude", "m");
+        let frequencies = if d.contains_key("frequency") {
+            array("frequency", "Hz").map(Some)
+        } else {
+            Some(None)
+        };
+        let (Some(amplitudes), Some(frequencies)) = (amplitudes, frequencies) else {
+            return (None, None, Vec::new());
+        };
+        if let Some(f) = &frequencies {
+            if f.len() != amplitudes.len() {
+                r.problems.push(format!(
+                    "[drive]: free_amplitude and frequency have {} and {} values: give one of \
+                     each per component",
+                    amplitudes.len(),
+                    f.len()
+                ));
+                return (None, None, Vec::new());
+            }
+        }
+        let f = |i: usize| frequencies.as_ref().map_or(f64::NAN, |f| f[i]);
+        let extra = (1..amplitudes.len())
+            .map(|i| (amplitudes[i], f(i)))
+            .collect();
+        (
+            Some(amplitudes[0]),
+            frequencies.as_ref().map(|f| f[0]),
+            extra,
+        )
     }
 
     /// The eigenmode model's `[cantilever]`: `spring_constant`, `resonance_frequency` and
@@ -846,9 +979,9 @@ impl Probe {
         qs: Option<Vec<f64>>,
         eigen: Option<(Vec<f64>, Vec<f64>)>,
         sample: Sample,
-        a0: f64,
-        freq: Option<f64>,
+        drive: Drive,
     ) -> Result<Probe, String> {
+        let (a0, freq) = (drive.free_amplitude, drive.frequency);
         let g0 = a0;
         // tip-mass ratio α1 of the beam, and for the geometry the time scale t = τ √(mL⁴/EI)
         // (eq. 5), the force unit EI/L³ and the static stiffness 3EI/L³
@@ -894,6 +1027,7 @@ impl Probe {
             structure,
             damping_profile: None,
             eigenmodes,
+            drive_components: [None; MAX_DRIVE_COMPONENTS],
         };
         let (w1, x1, k1) = first_mode(&bare).map_err(|e| e.to_string())?;
         // k and f0, given or from the geometry (first mode of the beam with its tip mass; the
@@ -1019,6 +1153,8 @@ impl Probe {
             .map_err(|e| derived(e.to_string()))?
             .norm();
         params.alpha2 = 1.0 / unit_response;
+        let components =
+            Self::resolve_components(&mut params, &drive.components, drive_hz, &scales)?;
         params.validate().map_err(|e| derived(e.to_string()))?;
         Ok(Probe {
             params,
@@ -1033,9 +1169,79 @@ impl Probe {
             },
             free_amplitude: a0,
             drive_frequency: drive_hz,
+            components,
             z_c,
             z_c_in_file,
         })
+    }
+
+    /// The further components of a multifrequency drive ([`Params::drive_components`]): each
+    /// at the frequency given, or at its mode's free resonance (mode i + 1 for component i,
+    /// the undamped natural frequency of the free structure), its ratio to the first
+    /// component's frequency the rational p/q ([`rational_ratio`]), its force F̃ᵢ = A₀ᵢ/|Hᵢ|
+    /// from the free amplitude through the free response Hᵢ to a tip force at that frequency
+    /// ([`CantileverModel::free_force_response`]), phase θ = 0.
+    fn resolve_components(
+        params: &mut Params,
+        given: &[(f64, f64)],
+        drive_hz: f64,
+        scales: &Scales,
+    ) -> Result<Vec<DriveComponentSi>, String> {
+        if given.is_empty() {
+            return Ok(Vec::new());
+        }
+        let model = CantileverModel::new(params).map_err(|e| derived(e.to_string()))?;
+        let natural = crate::eigen::natural_modes(model.galerkin().region(Region::Free));
+        let mut out = Vec::new();
+        for (i, &(amp, f)) in given.iter().enumerate() {
+            let f = if f.is_nan() {
+                let k = i + 1;
+                let w = *natural.omega.get(k).ok_or_else(|| {
+                    format!(
+                        "[drive].frequency: component {} has no mode {} to default to (modes = \
+                         {}): give the frequencies",
+                        k + 1,
+                        k + 1,
+                        params.modes
+                    )
+                })?;
+                scales.frequency_hz(w)
+            } else {
+                f
+            };
+            let (p, q) = rational_ratio(f / drive_hz).ok_or_else(|| {
+                format!(
+                    "[drive].frequency[{}] = {f} Hz: its ratio to the first component's \
+                     {drive_hz} Hz, {}, is not within 1e-6 of a fraction p/q with q ≤ 1000; \
+                     an incommensurate drive has no periodic steady state: give a frequency \
+                     whose ratio is such a fraction",
+                    i + 1,
+                    f / drive_hz
+                )
+            })?;
+            let ratio = f64::from(p) / f64::from(q);
+            let h = model
+                .free_force_response(ratio * params.omega)
+                .map_err(|e| derived(e.to_string()))?;
+            let force = amp / scales.length_m / h.norm();
+            params.drive_components[i] = Some(DriveComponent {
+                force,
+                ratio: [p, q],
+                phase: 0.0,
+            });
+            out.push(DriveComponentSi {
+                free_amplitude: amp,
+                frequency: drive_hz * ratio,
+                ratio: [p, q],
+            });
+        }
+        if out.len() > MAX_DRIVE_COMPONENTS {
+            return Err(format!(
+                "[drive]: at most {} components",
+                1 + MAX_DRIVE_COMPONENTS
+            ));
+        }
+        Ok(out)
     }
 
     /// The rest distance z_c (m) of a parameter set under these scales.
