@@ -14,7 +14,10 @@ use afmdyn::analysis::observables::Observables;
 use afmdyn::analysis::stepped::{SteppedCurve, Sweep};
 use afmdyn::layout::{Layout, Variable};
 use afmdyn::probe::Probe;
-use afmdyn::report::{curve_column_index, curve_row, curve_table, CurveAxis, CurveUnits};
+use afmdyn::report::{
+    component_columns, component_row, curve_column_index, curve_row, curve_table, CurveAxis,
+    CurveUnits,
+};
 use afmdyn::request::{Analysis, ApproachRequest, CurveRequest, Resolved, ResonanceRequest};
 use afmdyn::study::stepped::{curve_store, CurveStudy};
 use afmdyn::Params;
@@ -108,6 +111,28 @@ pub struct ApproachArgs {
     out: PathBuf,
 }
 
+/// `afmdyn bimodal` flags: those of `approach` without the setpoint; the probe's `[drive]`
+/// gives two or more components (`free_amplitude = [A01, A02]`, `frequency = [f1, f2]`).
+#[derive(Debug, Args)]
+pub struct BimodalArgs {
+    #[command(flatten)]
+    model: ModelArgs,
+    /// Rest distance z_c where the approach starts (m with --probe, else units of g0)
+    /// [default: 1.2 × the sum of the components' free amplitudes from the sample]; a unit may
+    /// follow (20nm)
+    #[arg(long, allow_hyphen_values = true)]
+    from: Option<Quantity>,
+    /// Rest distance z_c where the approach ends and the retract starts [default: 0.1 × that
+    /// sum]
+    #[arg(long, allow_hyphen_values = true)]
+    to: Option<Quantity>,
+    #[command(flatten)]
+    curve: CurveArgs,
+    /// Output directory (locked during the run)
+    #[arg(long, default_value = "afmdyn-out/bimodal")]
+    out: PathBuf,
+}
+
 /// `afmdyn resonance` flags.
 #[derive(Debug, Args)]
 pub struct ResonanceArgs {
@@ -191,9 +216,20 @@ fn write_files(
     Ok(())
 }
 
-/// One value of the observables, by CURVE_COLUMNS index.
-fn col(o: &Observables, u: &CurveUnits, k: usize) -> f64 {
-    curve_row(o, u)[k]
+/// Where a plotted value comes from: a CURVE_COLUMNS index, or an index into the drive
+/// components' columns (`component_row`).
+#[derive(Clone, Copy)]
+enum Key {
+    Curve(usize),
+    Component(usize),
+}
+
+/// One value of the observables.
+fn col(o: &Observables, u: &CurveUnits, k: Key) -> f64 {
+    match k {
+        Key::Curve(k) => curve_row(o, u)[k],
+        Key::Component(k) => component_row(o, u).get(k).copied().unwrap_or(f64::NAN),
+    }
 }
 
 fn plots(
@@ -210,8 +246,8 @@ fn plots(
             String::new()
         }
     };
-    let idx = |name: &str| curve_column_index(name).expect("column");
-    let panels = [
+    let idx = |name: &str| Key::Curve(curve_column_index(name).expect("column"));
+    let mut panels = vec![
         if l.x_name == "z_c" {
             ("amplitude_ratio", "A/A0".to_string(), "amplitude")
         } else {
@@ -233,9 +269,35 @@ fn plots(
             format!("peak force {}", unit("(N)")),
             "peak-force",
         ),
-    ];
-    for (name, y_label, suffix) in panels {
-        let k = idx(name);
+    ]
+    .into_iter()
+    .map(|(name, y, suffix)| (idx(name), name.to_string(), y, suffix.to_string()))
+    .collect::<Vec<_>>();
+    // a multifrequency drive: A_i and φ_i of each component
+    let count = c
+        .first
+        .first()
+        .map_or(0, |p| p.observables.components.len());
+    for (k, (name, _, _)) in component_columns(count).into_iter().enumerate() {
+        let i = k / 4 + 1;
+        match k % 4 {
+            0 => panels.push((
+                Key::Component(k),
+                name,
+                format!("amplitude A{i} {}", unit("(m)")),
+                format!("amplitude-{i}"),
+            )),
+            1 => panels.push((
+                Key::Component(k),
+                name,
+                format!("phase lag φ{i} (deg)"),
+                format!("phase-{i}"),
+            )),
+            _ => {}
+        }
+    }
+    for (k, name, y_label, suffix) in panels {
+        let name = name.as_str();
         let mut series = Vec::new();
         // branches first (underneath): each unstable stretch a dotted line, stable points as
         // small dots
@@ -707,9 +769,37 @@ pub fn approach(a: &ApproachArgs) -> Result<(), CliError> {
         curve: a.curve.request(from, to, Dim::Length, si)?,
         setpoint: a.setpoint,
     };
+    approach_run(&a.curve, &a.out, "approach", &request, base, units, probe)
+}
+
+/// Run `afmdyn bimodal`: the approach curve of a multifrequency drive
+/// ([`afmdyn::request::curves::check_bimodal`]), its files `bimodal.*`.
+pub fn bimodal(a: &BimodalArgs) -> Result<(), CliError> {
+    let si = a.model.probe.is_some();
+    let from = quantity(a.from, "from", Dim::Length, si)?;
+    let to = quantity(a.to, "to", Dim::Length, si)?;
+    let (base, units, probe) = setup(&a.model, from, to, false)?;
+    afmdyn::request::curves::check_bimodal(&base)?;
+    let request = ApproachRequest {
+        curve: a.curve.request(from, to, Dim::Length, si)?,
+        setpoint: None,
+    };
+    approach_run(&a.curve, &a.out, "bimodal", &request, base, units, probe)
+}
+
+/// An approach curve's run with the files named `stem`.
+fn approach_run(
+    args: &CurveArgs,
+    out: &Path,
+    stem: &'static str,
+    request: &ApproachRequest,
+    base: Params,
+    units: CurveUnits,
+    probe: Option<Probe>,
+) -> Result<(), CliError> {
     let x = |v: f64| rest_distance(&base, v) * units.length;
     let labels = Labels {
-        stem: "approach",
+        stem,
         sweeps: ("approach", "retract"),
         x_name: "z_c",
         x_label: format!(
@@ -720,9 +810,9 @@ pub fn approach(a: &ApproachArgs) -> Result<(), CliError> {
         x_unit: units.si.then_some("m"),
     };
     let run = Run {
-        args: &a.curve,
+        args,
         base: &base,
-        out: &a.out,
+        out,
         units: &units,
         labels: &labels,
         x: &x,
@@ -731,7 +821,7 @@ pub fn approach(a: &ApproachArgs) -> Result<(), CliError> {
         params: base,
         probe,
     };
-    run.go(&request, &model, || CurveStudy::approach(&request, &model))
+    run.go(request, &model, || CurveStudy::approach(request, &model))
 }
 
 /// Run `afmdyn resonance`.

@@ -93,6 +93,8 @@ enum Command {
     Lyapunov(cmd_orbits::LyapunovArgs),
     /// Approach–retract curve over the rest distance z_c: stepped both ways, branches, folds
     Approach(cmd_approach::ApproachArgs),
+    /// Bimodal (multifrequency) AM approach curve: per drive component A_i, φ_i, virial_i, E_dis,i
+    Bimodal(cmd_approach::BimodalArgs),
     /// Resonance curve near a mode: up- and down-sweep in frequency, branches, folds
     Resonance(cmd_approach::ResonanceArgs),
     /// FM-AFM at constant amplitude: frequency shift and excitation over z_c (ideal PLL)
@@ -117,6 +119,7 @@ fn run(cli: Cli) -> Result<(), CliError> {
         Command::Continue(a) => cmd_orbits::continuation(&a),
         Command::Lyapunov(a) => cmd_orbits::lyapunov(&a),
         Command::Approach(a) => cmd_approach::approach(&a),
+        Command::Bimodal(a) => cmd_approach::bimodal(&a),
         Command::Resonance(a) => cmd_approach::resonance(&a),
         Command::Fm(a) => cmd_fm::fm(&a),
         Command::Reconstruct(a) => cmd_reconstruct::reconstruct(&a),

@@ -65,3 +65,139 @@ fn far_from_the_sample_each_component_is_free() {
     assert!((o.components[0].free_amplitude - 1.0).abs() < 1e-12);
     assert!((o.components[1].free_amplitude - 0.1).abs() < 1e-12);
 }
+
+/// The point mass driven at its resonance and at 25/4 of it, over a conservative DMT sample:
+/// projecting z'' + z'/Q + z = F₁ cos τ + F₂ cos(25τ/4) + F_c on ż_c and z_c makes the
+/// closed forms of the primary component exact (module docs of the observables:
+/// E₁ = (πA₁²/Q)[(A₀₁/A₁) sin φ₁ − 1], V₁ = −A₁A₀₁ cos φ₁/(2Q)); each mode's energy balance
+/// (drive − damping − sample, the further component's work included) closes; the total
+/// dissipation of a conservative law is zero.
+#[test]
+fn point_mass_component_balances_are_exact() {
+    let probe = Probe::parse(
+        r#"
+model = "point-mass"
+[cantilever]
+spring_constant = 40.0
+resonance_frequency = 300e3
+quality_factor = 400
+[tip]
+radius = 10e-9
+[sample]
+law = "dmt"
+youngs_modulus = 4e9
+poisson_ratio = 0.33
+hamaker = 6.6e-20
+[drive]
+free_amplitude = [10e-9, 0.5e-9]
+frequency = [300e3, 1.875e6]
+"#,
+        "test",
+    )
+    .unwrap();
+    assert_eq!(probe.components[0].ratio, [25, 4]);
+    let g0 = probe.scales.length_m;
+    let mut checked = 0;
+    for z_c in [9.0e-9, 6.0e-9, 3.0e-9] {
+        let mut p = probe.params;
+        p.alpha5 = p.alpha5_for_rest_distance(z_c / g0);
+        let model = CantileverModel::new(&p).unwrap();
+        // settle from rest, then the periodic orbit of the common period
+        let mut it = afmdyn::integrate::build(&model, integ(), 0.0, &model.rest()).unwrap();
+        let settled = afmdyn::analysis::steady::steady_state(
+            it.as_mut(),
+            &afmdyn::analysis::steady::SteadyOptions::default(),
+        )
+        .unwrap();
+        let start = settled.end_state().clone();
+        let Ok(orbit) = shoot(&model, &start, 1, &ShootingOptions::default()) else {
+            continue;
+        };
+        let o = observe_orbit(&model, integ(), &orbit, 3).unwrap();
+        let c1 = &o.components[0];
+        let scale = PI_OVER_Q * c1.free_amplitude * c1.free_amplitude;
+        assert!(
+            (c1.energy_dissipated - c1.closed_energy_dissipated).abs() < 1e-7 * scale,
+            "E1 {} vs {}",
+            c1.energy_dissipated,
+            c1.closed_energy_dissipated
+        );
+        assert!(
+            (c1.virial - c1.closed_virial).abs() < 1e-7 * scale,
+            "V1 {} vs {}",
+            c1.virial,
+            c1.closed_virial
+        );
+        for b in &o.mode_balance {
+            assert!(b.residual.abs() < 1e-8 * scale, "mode balance {b:?}");
+        }
+        assert!(o.energy_dissipated.abs() < 1e-8 * scale);
+        checked += 1;
+    }
+    assert_eq!(checked, 3);
+}
+
+const PI_OVER_Q: f64 = std::f64::consts::PI / 400.0;
+
+/// The eigenmode model's approach curve (two modes, each driven at its resonance): the
+/// closed forms of each component (Lozano & García 2008) agree with the direct integrals to
+/// within the terms they neglect (the other mode's response at the component's frequency,
+/// here ≤ 1e-3 of π k A₀²/Q), both sweeps give one curve away from the bistable range, and
+/// the single-harmonic integrators are refused naming the integrator.
+#[test]
+fn eigenmode_approach_components_match_their_closed_forms() {
+    use afmdyn::analysis::approach::{approach_retract, approach_spec};
+    use afmdyn::analysis::stepped::Spacing;
+    let text = EIGENMODES.replace("1.88e6", "1.875e6");
+    let probe = Probe::parse(&text, "test").unwrap();
+    assert_eq!(probe.components[0].ratio, [25, 4]);
+    let g0 = probe.scales.length_m;
+    let mut spec = approach_spec(probe.params, 10e-9 / g0, 3e-9 / g0, Spacing::Points(15)).unwrap();
+    spec.branches = false;
+    let c = approach_retract(&spec).unwrap();
+    let mut reduced = false;
+    for p in &c.first {
+        let o = &p.observables;
+        assert_eq!(o.components.len(), 2);
+        for (i, k) in o.components.iter().enumerate() {
+            assert_eq!(k.mode, i);
+            let (stiff, q) = if i == 0 {
+                (1.0, 400.0)
+            } else {
+                (1571.0 / 40.0, 2500.0)
+            };
+            let scale = std::f64::consts::PI * stiff * k.free_amplitude.powi(2) / q;
+            assert!(
+                (k.energy_dissipated - k.closed_energy_dissipated).abs() < 1e-3 * scale,
+                "component {i} at {}: E {} vs {}",
+                p.value,
+                k.energy_dissipated,
+                k.closed_energy_dissipated
+            );
+            assert!(
+                (k.virial - k.closed_virial).abs() < 1e-3 * scale,
+                "component {i} at {}: V {} vs {}",
+                p.value,
+                k.virial,
+                k.closed_virial
+            );
+        }
+        reduced |= o.components[0].amplitude < 0.9 * o.components[0].free_amplitude;
+    }
+    assert!(reduced, "the curve reaches the sample");
+    let model = CantileverModel::new(&probe.params).unwrap();
+    for kind in [
+        IntegratorKind::Exact,
+        IntegratorKind::Taylor,
+        IntegratorKind::Split,
+    ] {
+        let opts = IntegratorOptions {
+            kind,
+            ..IntegratorOptions::default()
+        };
+        let e = afmdyn::integrate::build(&model, opts, 0.0, &model.rest())
+            .err()
+            .expect("refused");
+        assert!(e.to_string().contains("integrator"), "{e}");
+    }
+}

@@ -14,13 +14,19 @@ use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
 
 /// The default z_c range of an approach (units of g₀): from 1.2 A₀ to 0.1 A₀ above the contact
-/// threshold, A₀ the free amplitude of `base` ([`free_response`]): from where the sample is out
+/// threshold, A₀ the free amplitude of `base` ([`free_response`]; under a multifrequency drive
+/// the sum of the components' free amplitudes): from where the sample is out
 /// of reach to deep in the repulsive regime.
 ///
 /// # Errors
 /// [`SimError`] for invalid parameters or an undamped drive at resonance (no finite A₀).
 pub fn default_range(base: &Params) -> Result<(f64, f64), SimError> {
-    let a0 = free_response(&CantileverModel::new(base)?)?.amplitude;
+    let model = CantileverModel::new(base)?;
+    // a multifrequency drive: the free amplitudes of all components add up at the sample
+    let mut a0 = free_response(&model)?.amplitude;
+    for c in base.components() {
+        a0 += c.force * model.free_force_response(c.ratio() * base.omega)?.norm();
+    }
     let offset = base.contact_law.distance_offset();
     Ok((1.2 * a0 + offset, 0.1 * a0 + offset))
 }

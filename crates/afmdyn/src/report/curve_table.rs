@@ -4,7 +4,10 @@
 //! request, first as dForce 2.0's `zcdom` table — declared here once, for every front end that
 //! writes the table.
 
-use super::{curve_column_index, curve_row, CurveUnits, UnitKind, CURVE_COLUMNS};
+use super::{
+    component_columns, component_row, curve_column_index, curve_row, CurveUnits, UnitKind,
+    CURVE_COLUMNS,
+};
 use crate::analysis::continuation::BranchEvent;
 use crate::analysis::observables::Observables;
 use crate::analysis::stepped::SteppedCurve;
@@ -33,10 +36,19 @@ pub fn curve_table(
     axis: &CurveAxis,
     dforce: bool,
 ) -> (Vec<Vec<f64>>, Vec<Column>) {
+    let mut cols = columns(axis, u);
+    // the per-component columns of a multifrequency drive, last in either layout
+    let count = c
+        .first
+        .first()
+        .map_or(0, |p| p.observables.components.len());
+    for (name, kind, what) in component_columns(count) {
+        cols.push(Column::new(name, u.unit(kind), what));
+    }
     if dforce {
-        (rows(c, x, u, base), columns(axis, u))
+        (rows(c, x, u, base), cols)
     } else {
-        json_layout(rows(c, x, u, base), columns(axis, u), axis.name)
+        json_layout(rows(c, x, u, base), cols, axis.name)
     }
 }
 
@@ -105,6 +117,7 @@ fn row(
     r.push(if stable { 1.0 } else { 0.0 });
     r.push(period.map_or(f64::NAN, |n| n as f64));
     r.push(event_code(event));
+    r.extend(component_row(o, u));
     r
 }
 
@@ -251,11 +264,16 @@ fn json_layout(
             .iter()
             .map(|(name, k)| Column::new(*name, cols[*k].unit, cols[*k].meaning.clone())),
     );
+    // columns past the dForce layout's (the drive components') keep their order, last
+    let extra = JSON_LAYOUT.len() + 1;
+    named.extend(cols.into_iter().skip(extra));
     let rows = table
         .into_iter()
         .map(|r| {
+            let tail = r[extra..].to_vec();
             std::iter::once(r[0])
                 .chain(JSON_LAYOUT.iter().map(|(_, k)| r[*k]))
+                .chain(tail)
                 .collect()
         })
         .collect();

@@ -79,10 +79,17 @@ fn columns<'a>(
 ) -> serde_json::Map<String, Value> {
     let mut xs = Vec::new();
     let mut cols: Vec<Vec<f64>> = vec![Vec::new(); CURVE_COLUMNS.len()];
+    // the per-component columns of a multifrequency drive (as many on every point)
+    let mut comp: Vec<Vec<f64>> = Vec::new();
     let mut stable = Vec::new();
     for (v, o, s) in rows {
         xs.push((x.1)(v));
         for (c, val) in cols.iter_mut().zip(curve_row(o, u)) {
+            c.push(val);
+        }
+        let row = component_row(o, u);
+        comp.resize(row.len().max(comp.len()), Vec::new());
+        for (c, val) in comp.iter_mut().zip(row) {
             c.push(val);
         }
         stable.push(s);
@@ -91,6 +98,9 @@ fn columns<'a>(
     m.insert(x.0.into(), json!(xs));
     for (col, c) in CURVE_COLUMNS.iter().zip(cols) {
         m.insert(col.name.into(), json!(c));
+    }
+    for ((name, _, _), c) in component_columns(comp.len() / 4).into_iter().zip(comp) {
+        m.insert(name, json!(c));
     }
     m.insert("stable".into(), json!(stable));
     m
@@ -179,7 +189,7 @@ fn curve_doc(
             "force": rows(&t.force, u.force),
         })
     });
-    json!({
+    let mut doc = json!({
         "params": params,
         "units": u.names(),
         "scales": {"length": u.length, "force": u.force, "energy": u.energy, "time": u.time,
@@ -196,7 +206,40 @@ fn curve_doc(
         "free_amplitude": free,
         "warnings": c.warnings,
         "traces": traces,
-    })
+    });
+    if let Some(d) = drive_components(params, c, u) {
+        doc["drive_components"] = d;
+    }
+    doc
+}
+
+/// The `"drive_components"` block of a curve under a multifrequency drive (`None` for one
+/// frequency): per component (the primary first) `ratio` (ω_c/Ω at the curve's first point),
+/// `frequency` (Hz with a probe's scales, else Ω units), `free_amplitude` (`u`'s length) and
+/// the `columns` [name, kind of unit or null, meaning] of [`component_columns`].
+fn drive_components(params: &Params, c: &SteppedCurve, u: &CurveUnits) -> Option<Value> {
+    let o = &c.first.first()?.observables;
+    if o.components.is_empty() {
+        return None;
+    }
+    let omega = params.with(c.param, c.first[0].value).omega;
+    let freq = |r: f64| u.hz_per_omega.map_or(r * omega, |h| h * r * omega);
+    let kind = |k: UnitKind| match k {
+        UnitKind::Length => Some("length"),
+        UnitKind::Force => Some("force"),
+        UnitKind::Energy => Some("energy"),
+        UnitKind::Phase => Some("phase"),
+        UnitKind::One => None,
+    };
+    Some(json!({
+        "ratio": o.components.iter().map(|c| c.ratio).collect::<Vec<_>>(),
+        "frequency": o.components.iter().map(|c| freq(c.ratio)).collect::<Vec<_>>(),
+        "free_amplitude": o.components.iter().map(|c| c.free_amplitude * u.length).collect::<Vec<_>>(),
+        "columns": component_columns(o.components.len())
+            .into_iter()
+            .map(|(n, k, l)| json!([n, kind(k), l]))
+            .collect::<Vec<_>>(),
+    }))
 }
 
 /// `doc` with the [`si`] block of `probe` added (built from `doc` itself, so its headline values

@@ -342,3 +342,55 @@ pub const CURVE_COLUMNS: [CurveColumn; 12] = [
 pub fn curve_column_index(name: &str) -> Option<usize> {
     CURVE_COLUMNS.iter().position(|c| c.name == name)
 }
+
+/// The per-component columns of a curve under a multifrequency drive
+/// ([`crate::analysis::observables::ComponentObservables`]), for components 1..=`count` (1 the
+/// primary): `amplitude_i`, `phase_i_deg`, `virial_i`, `energy_dissipated_i` (per cycle of
+/// component i), each with its kind of unit and meaning. [`component_row`] gives the values in
+/// this order.
+pub fn component_columns(count: usize) -> Vec<(String, UnitKind, String)> {
+    (1..=count)
+        .flat_map(|i| {
+            [
+                (
+                    format!("amplitude_{i}"),
+                    UnitKind::Length,
+                    format!("amplitude of the tip deflection at drive component {i}'s frequency"),
+                ),
+                (
+                    format!("phase_{i}_deg"),
+                    UnitKind::Phase,
+                    format!("phase lag of the deflection behind drive component {i}"),
+                ),
+                (
+                    format!("virial_{i}"),
+                    UnitKind::Energy,
+                    format!(
+                        "virial of component {i}: <F_ts z_{i}>, z_{i} the motion at its frequency"
+                    ),
+                ),
+                (
+                    format!("energy_dissipated_{i}"),
+                    UnitKind::Energy,
+                    format!("energy dissipated by component {i}'s motion, per cycle of it"),
+                ),
+            ]
+        })
+        .collect()
+}
+
+/// The values of [`component_columns`] of one orbit's observables in `u`'s units (empty for a
+/// single-frequency drive).
+pub fn component_row(o: &crate::analysis::observables::Observables, u: &CurveUnits) -> Vec<f64> {
+    o.components
+        .iter()
+        .flat_map(|c| {
+            [
+                c.amplitude * u.length,
+                c.phase.to_degrees(),
+                c.virial * u.energy,
+                c.energy_dissipated * u.energy,
+            ]
+        })
+        .collect()
+}

@@ -170,6 +170,27 @@ pub fn approach_request(
     request.configure(spec.map_err(|e| in_units(e, length))?)
 }
 
+/// The check of a bimodal (multifrequency) approach curve (`afmdyn bimodal`, Python's
+/// `bimodal`): the drive must have at least two components
+/// ([`Params::drive_components`]); the curve is then the approach curve of that model, its
+/// document with the per-component columns ([`crate::report::component_columns`]).
+///
+/// # Errors
+/// [`SimError::OutOfRange`] naming the probe's `[drive]` arrays for a single-frequency drive.
+pub fn check_bimodal(base: &Params) -> Result<(), SimError> {
+    if base.is_multifrequency() {
+        Ok(())
+    } else {
+        Err(SimError::out_of_range(
+            "[drive].free_amplitude",
+            "one drive component",
+            "must be an array of two or more free amplitudes (with frequency = [f1, f2, …] or \
+             each at its mode's resonance) for a multifrequency drive, e.g. free_amplitude = \
+             [10e-9, 1e-9]",
+        ))
+    }
+}
+
 /// The resonance spec of a front end's request near mode `mode`, Ω in units of `hz` (Hz per
 /// unit Ω, or 1): [`mode_band`] for missing ends, [`resonance_spec`], then
 /// [`CurveRequest::configure`].
