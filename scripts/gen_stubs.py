@@ -45,6 +45,11 @@ FUNCTIONS = [
         ["probe: Optional[str] = None", "store: Optional[str] = None", "resume: bool = False"],
     ),
     (
+        "bimodal",
+        "approach",
+        ["probe: Optional[str] = None", "store: Optional[str] = None", "resume: bool = False"],
+    ),
+    (
         "resonance",
         "resonance",
         ["probe: Optional[str] = None", "store: Optional[str] = None", "resume: bool = False"],

@@ -51,6 +51,8 @@ pub fn interrupted() -> Result<(), CliError> {
 pub fn spell(e: &afmdyn::SimError) -> String {
     let msg = e.spelled(|name| match name {
         "initial" => "--initial-modal".to_string(),
+        // a probe file's key ([section].key) keeps its TOML spelling
+        _ if name.starts_with('[') => name.to_string(),
         _ => name.replace('_', "-"),
     });
     match e {

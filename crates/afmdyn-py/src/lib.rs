@@ -59,6 +59,7 @@ fn _afmdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(analyses::continuation, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::lyapunov, m)?)?;
     m.add_function(wrap_pyfunction!(studies::approach, m)?)?;
+    m.add_function(wrap_pyfunction!(studies::bimodal, m)?)?;
     m.add_function(wrap_pyfunction!(studies::resonance, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::reconstruct, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::fm, m)?)?;

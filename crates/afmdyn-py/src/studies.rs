@@ -244,6 +244,25 @@ pub fn approach<'py>(
     curve::<ApproachRequest>(py, "approach", request, place, CurveStudy::approach)
 }
 
+/// The bimodal (multifrequency) approach curve (`afmdyn bimodal`): the approach curve of a
+/// drive with two or more components ([`afmdyn::request::curves::check_bimodal`]), its
+/// document with the per-component columns; `store` and `resume` as [`approach`]'s.
+#[pyfunction]
+#[pyo3(signature = (params, request=None, probe=None, progress=None, store=None, resume=false))]
+pub fn bimodal<'py>(
+    py: Python<'py>,
+    params: PyRef<'_, PyParams>,
+    request: Option<&Bound<'py, PyDict>>,
+    probe: Option<String>,
+    progress: Option<Bound<'py, PyAny>>,
+    store: Option<PathBuf>,
+    resume: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    afmdyn::request::curves::check_bimodal(&params.inner).map_err(crate::errors::sim_error)?;
+    let place = Place::new(params.inner, store, resume, progress, probe)?;
+    curve::<ApproachRequest>(py, "approach", request, place, CurveStudy::approach)
+}
+
 /// The resonance curve near mode `mode` (`afmdyn resonance`); `store` and `resume` as
 /// [`approach`]'s.
 #[pyfunction]

@@ -24,13 +24,14 @@ REQUESTS = SCHEMA / "requests"
 P1 = str(EXAMPLES / "probe-point-mass-dmt.toml")
 P2 = str(EXAMPLES / "probe-geometry-hertz.toml")
 EIG = str(EXAMPLES / "probe-eigenmodes-dmt.toml")
+BIM = str(EXAMPLES / "probe-bimodal.toml")
 IMPACT = "--contact-law impact --restitution 0.5 --modes 1 --gap 0.05 --omega 3".split()
 IMPACT_PY = dict(contact_law="impact", restitution=0.5, modes=1, gap=0.05, omega=3.0)
 SHORT = ["--max-periods", 300]
 
 COMMANDS = ["modes", "units", "simulate", "converge", "bifurcation", "attractors", "orbit",
             "continue", "lyapunov", "approach", "resonance", "chart", "basins", "reconstruct",
-            "fm"]
+            "fm", "bimodal"]
 FM = str(EXAMPLES / "fm-vdw.csv")
 FM_ARGS = ["--fm", FM, "--spring-constant", 40, "--resonance-frequency", "300kHz",
            "--amplitude", "10nm"]
@@ -122,6 +123,7 @@ CLI_CASES: List[Tuple[str, List[Any]]] = [
     ("fm", ["--points", 4, "--probe", P1]),
     ("fm", ["--points", 4, "--mode", 2, "--probe", EIG]),
     ("approach", ["--points", 4, "--no-branches", "--files", "none", "--probe", EIG]),
+    ("bimodal", ["--points", 4, "--files", "none", "--probe", BIM]),
     # (a probe refuses the dimensionless omega axis: the drive frequency in Hz, 0.99 f0)
     ("chart", ["--x", "z-c", "--x-from", 6e-9, "--x-to", 8e-9, "--x-steps", 2, "--y",
                "drive-frequency", "--y-from", "297kHz", "--y-to", "297kHz", "--y-steps", 1,
@@ -203,6 +205,7 @@ def _python_docs() -> List[Tuple[str, str, Callable[[], Any]]]:
             **_fm_curve(), spring_constant=40.0, resonance_frequency=3e5, amplitude=1e-8))),
         ("fm", "fm", lambda: afmdyn.summary(afmdyn.fm(points=4))),
         ("fm", "fm probe", lambda: afmdyn.summary(afmdyn.fm(points=4, probe=P1))),
+        ("bimodal", "bimodal probe", lambda: afmdyn.summary(afmdyn.bimodal(probe=BIM, **curve))),
     ]
 
 

@@ -25,6 +25,7 @@ file in SI (:func:`probe`, ``Params.from_probe``) sets every parameter. Tip–sa
 from ._afmdyn import Params, SimulationError
 from ._api import (
     approach,
+    bimodal,
     bifurcation,
     continuation,
     converge,
@@ -69,6 +70,7 @@ __all__ = [
     "SimulationError",
     "Spectrum",
     "approach",
+    "bimodal",
     "attractors",
     "basins",
     "bifurcation",

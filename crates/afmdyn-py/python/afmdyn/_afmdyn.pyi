@@ -306,6 +306,21 @@ ApproachRequest = TypedDict(
     total=False,
 )
 
+ApproachRequest = TypedDict(
+    "ApproachRequest",
+    {
+        "branches": bool,  # default true
+        "from": Optional[float],  # default null
+        "points": Optional[int],  # default null
+        "setpoint": Optional[float],  # default null
+        "step": Optional[float],  # default null
+        "to": Optional[float],  # default null
+        "tolerance": float,  # default 1e-10
+        "traces": Optional[int],  # default null
+    },
+    total=False,
+)
+
 ResonanceRequest = TypedDict(
     "ResonanceRequest",
     {
@@ -473,6 +488,15 @@ def observe(
 ) -> Dict[str, Any]: ...
 
 def approach(
+    params: Params,
+    request: Optional[ApproachRequest] = None,
+    progress: Optional[ProgressCallback] = None,
+    probe: Optional[str] = None,
+    store: Optional[str] = None,
+    resume: bool = False,
+) -> Dict[str, Any]: ...
+
+def bimodal(
     params: Params,
     request: Optional[ApproachRequest] = None,
     progress: Optional[ProgressCallback] = None,

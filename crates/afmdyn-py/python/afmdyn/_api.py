@@ -465,6 +465,53 @@ def approach(
 
 
 @_typed
+def bimodal(
+    params: Optional[Params] = None,
+    /,
+    *,
+    from_: Optional[float] = None,
+    to: Optional[float] = None,
+    step: Optional[float] = None,
+    points: Optional[int] = None,
+    branches: bool = _DEFAULTS["approach"]["branches"],
+    tolerance: float = _DEFAULTS["approach"]["tolerance"],
+    traces: Optional[int] = None,
+    store: Union[str, "os.PathLike[str]", None] = None,
+    resume: bool = False,
+    progress: ProgressArg = None,
+    **model: Unpack[Model],
+) -> xr.Dataset:
+    """The bimodal (multifrequency) AM approach–retract curve (``afmdyn bimodal``): the
+    approach curve of a drive with two or more components — a probe whose ``[drive]`` gives
+    ``free_amplitude = [A01, A02]`` and ``frequency = [f1, f2]`` (or each component at its
+    mode's resonance), on the eigenmode model (``model = "eigenmodes"``), the beam or the point
+    mass. The frequency ratio is taken as a fraction p/q (within 1e-6), the steady state is the
+    periodic orbit of the common period q/f1, and each component's amplitude, phase, virial
+    and dissipated energy come from demodulation over it (Lozano & García, Phys. Rev. Lett.
+    100, 076102 (2008); García & Proksch, Eur. Polym. J. 49, 1897 (2013)).
+
+    Args:
+        from_, to, step, points, branches, tolerance, traces, store, resume: as
+            :func:`approach` (the default range from 1.2 to 0.1 times the sum of the free
+            amplitudes).
+        probe: the probe file with the multifrequency ``[drive]`` (a model keyword).
+
+    Raises:
+        ValueError: for a single-frequency drive (naming ``[drive].free_amplitude``), and as
+            :func:`approach`.
+
+    Returns:
+        The dataset of :func:`approach` plus, over (``sweep``, ``z_c``), ``amplitude_i``,
+        ``phase_i_deg``, ``virial_i`` and ``energy_dissipated_i`` (per cycle of component i)
+        for each component i = 1, 2, … (1 the primary; SI with a probe); the branches' as
+        ``branch_amplitude_2`` …; the frequencies, ratios and free amplitudes in
+        ``ds.afmdyn.to_dict()["drive_components"]``.
+    """
+    return _curve(_core.bimodal, "bimodal", progress, params, model, _request(locals()),
+                  store, resume)
+
+
+@_typed
 def resonance(
     params: Optional[Params] = None,
     /,

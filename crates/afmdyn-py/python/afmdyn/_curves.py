@@ -22,6 +22,7 @@ COLUMNS: Dict[str, tuple] = {name: (kind, long) for name, kind, long in _core.CU
 # the stepped curves: command → (abscissa keys in order of preference, the two sweeps)
 SWEEPS = {
     "approach": (("z_c",), ("approach", "retract")),
+    "bimodal": (("z_c",), ("approach", "retract")),
     "resonance": (("frequency_hz", "omega"), ("up", "down")),
 }
 
@@ -82,7 +83,12 @@ def curve_dataset(command: str, doc: Dict[str, Any]) -> xr.Dataset:
                 out[index[at]] = fill if v is None else v
         return out
 
-    for col, (k, long_name) in COLUMNS.items():
+    # the curve's columns, then under a multifrequency drive each component's
+    # (``drive_components.columns``: amplitude_i, phase_i_deg, virial_i, energy_dissipated_i)
+    columns = dict(COLUMNS)
+    for name, k, long_name in (doc.get("drive_components") or {}).get("columns", []):
+        columns[name] = (k, long_name)
+    for col, (k, long_name) in columns.items():
         rows = [grid_of(doc[s][col], doc[s][x], np.nan, np.float64) for s in sweeps]
         data[col] = (("sweep", x), np.stack(rows), _attrs(units, k, long_name))
     data["stable"] = (
@@ -108,7 +114,7 @@ def curve_dataset(command: str, doc: Dict[str, Any]) -> xr.Dataset:
         _floats([v for b in branches for v in b[x]]),
         _attrs(units, kind, name),
     )
-    for col, (k, long_name) in COLUMNS.items():
+    for col, (k, long_name) in columns.items():
         data[f"branch_{col}"] = (
             "branch_point",
             _floats([v for b in branches for v in b[col]]),

@@ -223,7 +223,14 @@ fn drive_components(params: &Params, c: &SteppedCurve, u: &CurveUnits) -> Option
         return None;
     }
     let omega = params.with(c.param, c.first[0].value).omega;
-    let freq = |r: f64| u.hz_per_omega.map_or(r * omega, |h| h * r * omega);
+    // Hz in SI (τ = t / u.time), else Ω units
+    let freq = |r: f64| {
+        if u.si {
+            r * omega / (std::f64::consts::TAU * u.time)
+        } else {
+            r * omega
+        }
+    };
     let kind = |k: UnitKind| match k {
         UnitKind::Length => Some("length"),
         UnitKind::Force => Some("force"),

@@ -427,6 +427,9 @@ pub fn si(probe: &crate::probe::Probe, params: &Params, doc: &Value) -> Value {
         "free_amplitude_m": probe.free_amplitude,
         "z_c_m": probe.z_c_of(params),
     });
+    if !probe.components.is_empty() {
+        out["drive_components"] = json!(probe.components);
+    }
     let map_array = |v: &Value, f: &dyn Fn(&Value) -> Option<f64>| -> Value {
         v.as_array()
             .map(|a| Value::from(a.iter().map(f).collect::<Vec<_>>()))

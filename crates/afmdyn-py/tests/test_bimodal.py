@@ -1,0 +1,41 @@
+"""bimodal(): the dataset equals the command line's ``afmdyn bimodal --json`` (the same library
+request and document) and carries each drive component's amplitude, phase, virial and
+dissipated energy over (sweep, z_c) in SI; far from the sample each component's amplitude is
+its free amplitude (the probe's 10 nm and 1 nm, to 1e-4); a single-frequency probe is refused
+naming ``[drive].free_amplitude``."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import afmdyn
+from conftest import EXAMPLES
+
+BIM = str(EXAMPLES / "probe-bimodal.toml")
+SINGLE = str(EXAMPLES / "probe-eigenmodes-dmt.toml")
+
+
+def test_bimodal_equals_the_command_line_and_reports_each_component(cli_json):
+    doc = cli_json("bimodal", "--probe", BIM, "--points", "8", "--no-branches", "--files",
+                   "none")
+    ds = afmdyn.bimodal(probe=BIM, points=8, branches=False)
+    assert afmdyn.summary(ds) == doc
+    for i in (1, 2):
+        for name, unit in ((f"amplitude_{i}", "m"), (f"phase_{i}_deg", "degree"),
+                           (f"virial_{i}", "J"), (f"energy_dissipated_{i}", "J")):
+            assert ds[name].dims == ("sweep", "z_c")
+            assert ds[name].attrs["units"] == unit, name
+            assert ds[name].sel(sweep="approach").values.tolist() == doc["approach"][name]
+    far = ds.sel(sweep="approach").isel(z_c=0)
+    assert float(far.amplitude_1) == pytest.approx(10e-9, rel=1e-4)
+    assert float(far.amplitude_2) == pytest.approx(1e-9, rel=1e-4)
+    near = ds.sel(sweep="approach").isel(z_c=-1)
+    assert float(near.amplitude_2) < 0.5e-9
+    assert doc["drive_components"]["frequency"] == pytest.approx([300e3, 1.875e6], rel=1e-12)
+    assert np.isfinite(ds.energy_dissipated_2.values).all()
+
+
+def test_bimodal_refuses_a_single_frequency_drive():
+    with pytest.raises(ValueError, match=r"\[drive\]\.free_amplitude"):
+        afmdyn.bimodal(probe=SINGLE, points=3, branches=False)
