@@ -249,6 +249,9 @@ def test_one_attractor_conforms() -> None:
 
 def _required_paths(schema: Dict[str, Any], doc: Dict[str, Any]) -> List[str]:
     """The required keys of ``doc`` (of the form it has, for ``modes`` and ``units``)."""
+    if "allOf" in schema:  # a document that extends another (bimodal: approach's)
+        (ref,) = [s["$ref"] for s in schema["allOf"]]
+        return _required_paths(_load(DOCUMENTS / ref), doc) + list(schema["required"])
     forms = schema.get("oneOf", [schema])
     (form,) = [f for f in forms if set(f["required"]) <= set(doc) <= set(f["properties"])]
     return list(form["required"])
@@ -266,7 +269,7 @@ def test_each_schema_refuses_a_missing_key_and_an_unknown_one(
             del broken[key]
             with pytest.raises(ValidationError):
                 v.validate(broken)
-        if schema.get("additionalProperties") is False or "oneOf" in schema:
+        if schema.get("additionalProperties") is False or "oneOf" in schema or "allOf" in schema:
             broken = dict(doc, unexpected_key=1)
             with pytest.raises(ValidationError):
                 v.validate(broken)
