@@ -103,7 +103,7 @@ def test_every_flag_the_docs_name_exists(cli):
 
 
 def test_the_docs_code_block_commands_run(cli, tmp_path):
-    """The docs' code-block commands run as written, in short variants: approach and
+    """The docs' code-block commands run as written, in short variants: approach, bimodal and
     resonance with 6 points, no branches and no files (the grid and the model are the
     docs'); redirections dropped; a command the docs show failing (``bad.toml``) skipped."""
     (tmp_path / "examples").symlink_to(REPO / "examples")
@@ -113,7 +113,7 @@ def test_the_docs_code_block_commands_run(cli, tmp_path):
             continue
         if ">" in args:
             args = args[: args.index(">")]
-        if args[0] in ("approach", "resonance"):
+        if args[0] in ("approach", "resonance", "bimodal"):
             drop = {"--points", "--step"}
             short = []
             skip = False

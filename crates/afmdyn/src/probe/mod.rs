@@ -27,6 +27,9 @@
 //! [drive]
 //! free_amplitude = 10e-9         # A₀ (m) at the drive frequency, far from the sample
 //! frequency = 300e3              # f (Hz), default f₀
+//! # multifrequency (bimodal): arrays, one entry per component, at most 4
+//! # free_amplitude = [10e-9, 1e-9]   # A₀ᵢ (m)
+//! # frequency = [300e3, 1.875e6]     # fᵢ (Hz), default each at its mode's free resonance
 //! ```
 //!
 //! **Scales.** Lengths are measured in g₀ = A₀, so the dimensionless free amplitude is 1 and
@@ -53,6 +56,11 @@
 //! amplitude at Ω is A₀: α2 = 1/|H(Ω)|, H the tip response per unit α2 of the linear free system
 //! ([`crate::CantileverModel::free_tip_response`]). The point mass is force-driven:
 //! α2 = F₀/(k A₀) = √((1 − Ω²)² + (Ω/Q)²) (the harmonic oscillator's response).
+//! A multifrequency drive (`[drive]` arrays) adds, for every model, components F̃ᵢ cos(ωᵢτ) at
+//! the tip ([`crate::params::DriveComponent`]): ωᵢ/Ω is the fraction p/q with the smallest
+//! q ≤ 1000 within 1e-6 of fᵢ/f₁ ([`rational_ratio`]; the frequency used is reported), and
+//! F̃ᵢ = A₀ᵢ/(g₀|Hᵢ|) from the free tip response Hᵢ to a unit tip force at ωᵢ
+//! ([`crate::CantileverModel::free_force_response`]).
 //!
 //! **Sample** (force unit F_s, length g₀, time t_s; E* from 1/E* = (1 − ν_t²)/E_t +
 //! (1 − ν_s²)/E_s, Johnson, *Contact Mechanics*, CUP 1985, eq. 4.22):
