@@ -2,7 +2,8 @@
 //! components each at its mode's resonance, f₂/f₁ = 25/4): far from the sample each
 //! component's amplitude is its free amplitude (the probe's 10 nm and 1 nm, to 1e-4 at
 //! 1.2 × their sum), near it both fall; the CSV carries the per-component columns in the
-//! document's names; a single-frequency probe and a bad `[drive]` array exit 2 with one line.
+//! document's names; a single-frequency probe and a bad `[drive]` array exit 2 with one line,
+//! as do `resonance` and `fm`, which move the drive frequency, on a multifrequency probe.
 
 use std::process::{Command, Output};
 
@@ -104,6 +105,20 @@ fn bimodal_refuses_a_single_frequency_drive_and_bad_arrays() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(err.trim().lines().count(), 1, "{err}");
     assert!(err.contains("[drive].free_amplitude"), "{err}");
+    // analyses that move the drive frequency refuse a multifrequency drive
+    let tmp = tempfile::tempdir().unwrap();
+    let fm_out = tmp.path().join("fm");
+    for args in [
+        vec!["resonance", "--files", "none"],
+        vec!["fm", "--out", fm_out.to_str().unwrap()],
+    ] {
+        let cmd = args[0];
+        let out = afmdyn(&[&args[..], &["--probe", PROBE, "--points", "4"]].concat());
+        assert_eq!(out.status.code(), Some(2), "{cmd}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(err.trim().lines().count(), 1, "{err}");
+        assert!(err.contains("[drive].frequency"), "{cmd}: {err}");
+    }
     let dir = tempfile::tempdir().unwrap();
     let text = std::fs::read_to_string(PROBE).unwrap();
     for (bad, says) in [

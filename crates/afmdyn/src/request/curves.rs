@@ -191,6 +191,36 @@ pub fn check_bimodal(base: &Params) -> Result<(), SimError> {
     }
 }
 
+/// Refuse a multifrequency drive in an analysis that moves the drive frequency (`what`: the
+/// resonance curve, FM-AFM): the further components' frequencies are fixed fractions of Ω
+/// ([`crate::params::DriveComponent`]), so they would move with it — not what an instrument
+/// does, and not what the analysis means.
+///
+/// # Errors
+/// [`SimError::OutOfRange`] naming the probe's `[drive].frequency`.
+pub fn check_single_frequency(base: &Params, what: &'static str) -> Result<(), SimError> {
+    if base.is_multifrequency() {
+        Err(SimError::out_of_range(
+            "[drive].frequency",
+            format!("{} components", 1 + base.components().count()),
+            match what {
+                "fm" => {
+                    "must be one frequency for fm: the further components' frequencies are \
+                         fixed fractions of the first and would follow the PLL (use bimodal for \
+                         a multifrequency AM curve)"
+                }
+                _ => {
+                    "must be one frequency for resonance: the further components' \
+                      frequencies are fixed fractions of the first and would sweep with it \
+                      (use bimodal for a multifrequency AM curve)"
+                }
+            },
+        ))
+    } else {
+        Ok(())
+    }
+}
+
 /// The resonance spec of a front end's request near mode `mode`, Ω in units of `hz` (Hz per
 /// unit Ω, or 1): [`mode_band`] for missing ends, [`resonance_spec`], then
 /// [`CurveRequest::configure`].
@@ -207,6 +237,7 @@ pub fn resonance_request(
     request: &CurveRequest,
     hz: f64,
 ) -> Result<SteppedSpec, SimError> {
+    check_single_frequency(&base, "resonance")?;
     request.check_finite()?;
     if hz != 1.0 {
         for (name, v) in [("from", request.from), ("to", request.to)] {

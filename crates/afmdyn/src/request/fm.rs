@@ -127,9 +127,11 @@ impl FmRequest {
 impl Analysis for FmRequest {
     type Output = FmCurve;
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
+        super::curves::check_single_frequency(&model.params, "fm")?;
         self.spec(model).map(|_| ())
     }
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<FmCurve, SimError> {
+        super::curves::check_single_frequency(&model.params, "fm")?;
         fm_curve(&self.spec(model)?, progress)
     }
     fn report(&self, model: &Resolved, curve: &FmCurve) -> Result<Value, SimError> {
