@@ -78,7 +78,8 @@ pub struct PowerTerms {
     /// Power of the base motion: ȦᵀF^I(τ) (inertial drive in the clamped frame, eq. 14) minus
     /// α2 Ω cos Ωτ · F_c (the sample is fixed while the clamped frame moves).
     pub base: f64,
-    /// Beam damping dissipation α3 ȦᵀȦ (eq. 12).
+    /// Beam damping dissipation ȦᵀC^IȦ (eq. 12: α3 ȦᵀȦ, or α3 Σ s_j ȧ_j² with a damping
+    /// profile).
     pub beam_dissipation: f64,
     /// Sample dissipation F_d δ̇ (α6 V̇_T² for the linear law in contact).
     pub contact_dissipation: f64,
@@ -501,7 +502,9 @@ impl CantileverModel {
         let drive = g.forcing.sin.dot(&v) * s
             + g.forcing.cos.dot(&v) * c
             + p.component_force(tau) * self.tip().dot(&v);
-        let beam = p.alpha3 * v.dot(&v);
+        // ȦᵀC^IȦ with the damping matrix of eq. 12 (α3 diag(s) with a per-mode damping profile:
+        // the beam's per-mode Q, the eigenmode model)
+        let beam = (&g.damping * v).dot(&v);
         let fc = self.contact_force(r, tau, z);
         let rate = -self.v_t_dot(tau, z);
         let delta = -self.v_t(tau, z);

@@ -67,7 +67,8 @@ impl CantileverModel {
     /// The rates [base power, beam dissipation, sample dissipation] of region `r` as quadratic
     /// forms (module docs), or `None` for a law that is not affine (only the linear law is).
     pub fn rate_forms(&self, r: Region) -> Option<[RateForm; 3]> {
-        if !matches!(self.law(), ContactLaw::Linear) {
+        // the forms hold one harmonic drive (a multifrequency drive's power is not in them)
+        if !matches!(self.law(), ContactLaw::Linear) || self.params().is_multifrequency() {
             return None;
         }
         let p = self.params();
@@ -80,7 +81,9 @@ impl CantileverModel {
         base.l[1].rows_mut(n, n).copy_from(&forcing.sin);
         base.l[2].rows_mut(n, n).copy_from(&forcing.cos);
         let mut beam = RateForm::zero(dim);
-        beam.q.view_mut((n, n), (n, n)).fill_diagonal(p.alpha3);
+        beam.q
+            .view_mut((n, n), (n, n))
+            .copy_from(&self.galerkin().region(Region::Free).damping);
         let mut sample = RateForm::zero(dim);
         if r == Region::Contact {
             let (a4, a6) = (p.alpha4, p.alpha6);
@@ -109,11 +112,20 @@ mod tests {
     use crate::{CantileverModel, Params, Region, Structure};
 
     /// The quadratic forms equal [`CantileverModel::power`] at random states and times, in both
-    /// regions, for the beam and the point mass (whose base does not move), to round-off.
+    /// regions, for the beam (with and without a per-mode damping profile) and the point mass
+    /// (whose base does not move), to round-off.
     #[test]
     fn rate_forms_equal_the_power_terms() {
-        for structure in [Structure::Beam, Structure::PointMass] {
+        for (structure, profile) in [
+            (Structure::Beam, false),
+            (Structure::Beam, true),
+            (Structure::PointMass, false),
+        ] {
+            let mut s = [1.0; 20];
+            s[1] = 0.3;
+            s[2] = 2.5;
             let p = Params {
+                damping_profile: profile.then_some(s),
                 modes: if structure == Structure::Beam { 3 } else { 1 },
                 alpha1: if structure == Structure::Beam {
                     0.1

@@ -93,10 +93,10 @@ pub(crate) struct Jet {
     /// Ωᵏ/k!, k ≤ MAX_ORDER.
     trig_factor: Vec<f64>,
     /// The energy balance's rates ([`CantileverModel::power`]): the Galerkin forcing f_s, f_c
-    /// (not M⁻¹-scaled), α3.
+    /// (not M⁻¹-scaled), and the damping C^I_ii (α3 s_i, eq. 12; C^I is diagonal).
     power_sin: Vec<f64>,
     power_cos: Vec<f64>,
-    alpha3: f64,
+    damping: Vec<f64>,
     /// Gauss–Legendre nodes and weights on [−1, 1] of [`Jet::rate_integrals`].
     rate_rule: [(f64, f64); RATE_NODES],
 }
@@ -488,7 +488,10 @@ impl Jet {
                 .cos
                 .as_slice()
                 .to_vec(),
-            alpha3: p.alpha3,
+            damping: {
+                let c = &model.galerkin().region(Region::Free).damping;
+                (0..c.nrows()).map(|i| c[(i, i)]).collect()
+            },
             rate_rule: {
                 let rule = gauss_quad::legendre::GaussLegendre::new(
                     std::num::NonZeroUsize::new(RATE_NODES).expect("nonzero"),
@@ -528,7 +531,7 @@ impl Jet {
         };
         let (sn, cs, f) = (at(&|k| s.s[k]), at(&|k| s.c[k]), at(&|k| s.f[k]));
         let bo = self.base * self.omega;
-        // Σ_i f_s,i ȧ_i sin Ωτ + (Σ_i f_c,i ȧ_i − α2_b Ω F_c) cos Ωτ, and α3 Σ_i ȧ_i²
+        // Σ_i f_s,i ȧ_i sin Ωτ + (Σ_i f_c,i ȧ_i − α2_b Ω F_c) cos Ωτ, and Σ_i C_ii ȧ_i²
         let mut base = [0.0; RATE_NODES];
         let mut beam = [0.0; RATE_NODES];
         for g in 0..RATE_NODES {
@@ -538,7 +541,7 @@ impl Jet {
             let ad = at(&|k| s.z[k * d + n + i]);
             for g in 0..RATE_NODES {
                 base[g] += ad[g] * (self.power_sin[i] * sn[g] + self.power_cos[i] * cs[g]);
-                beam[g] += self.alpha3 * ad[g] * ad[g];
+                beam[g] += self.damping[i] * ad[g] * ad[g];
             }
         }
         let mut sample = [0.0; RATE_NODES];
