@@ -63,9 +63,10 @@ section=$(mktemp)
     echo
     echo "Goal (issue 44): ≤ 2 s for 100 z_c values on the eigenmode model. The steady state is a"
     echo "periodic orbit of the common period q/f1, so a point costs about q times a single-frequency"
-    echo "point on the adaptive integrator (the Taylor and exact integrators propagate one harmonic"
-    echo "drive). \`bash scripts/perf-bimodal.sh\` on this machine (2 cores; one curve is one chain,"
-    echo "so one core)."
+    echo "point; the Taylor integrator carries every drive component in its series (auto's choice for"
+    echo "Hertz and DMT; it replaced the adaptive DOP853 for such drives, the curves equal to 1e-7)."
+    echo "\`bash scripts/perf-bimodal.sh\` on this machine"
+    echo "(2 cores; one curve is one chain, so one core)."
     echo "<!-- bimodal:end -->"
 } > "$section"
 python3 scripts/doc_section.py bimodal "$section" "Bimodal AM curves (issue 44)"

@@ -4,6 +4,7 @@
 //! [`build`], the one place that imports every integrator.
 
 use super::{adaptive, exact, rk4, split, taylor, Integrator};
+use crate::contact::ContactLaw;
 use crate::error::SimError;
 use crate::model::CantileverModel;
 use crate::params::SweepParam;
@@ -99,8 +100,9 @@ pub struct IntegratorOptions {
 
 impl IntegratorKind {
     /// The concrete integrator for `model`: [`IntegratorKind::Auto`] resolves to `Exact` for an
-    /// affine (linear-law) model (to `Adaptive` for every law under a multifrequency drive,
-    /// [`crate::params::Params::drive_components`]), to `Split` for a law without force in free flight (Hertz,
+    /// affine (linear-law) model (under a multifrequency drive,
+    /// [`crate::params::Params::drive_components`], to `Taylor` for Hertz and DMT and to
+    /// `Adaptive` for the others), to `Split` for a law without force in free flight (Hertz,
     /// impact with r > 0), to `Adaptive` for the plastic impact law r = 0 (whose free flights
     /// all start tangentially) and to `Taylor` for DMT; other kinds are returned as given.
     /// ([`build`] falls back from `Split` to `Adaptive` for `Auto` where the exact free flight
@@ -108,8 +110,16 @@ impl IntegratorKind {
     /// budget.)
     pub fn resolve(self, model: &CantileverModel) -> IntegratorKind {
         match self {
-            // the exact, split and Taylor integrators propagate one harmonic drive
-            IntegratorKind::Auto if model.params().is_multifrequency() => IntegratorKind::Adaptive,
+            // a multifrequency drive: the Taylor integrator for Hertz and DMT (its series carry
+            // every component), else adaptive (the exact and split integrators propagate one
+            // harmonic drive)
+            IntegratorKind::Auto if model.params().is_multifrequency() => {
+                if matches!(model.law(), ContactLaw::Hertz | ContactLaw::Dmt { .. }) {
+                    IntegratorKind::Taylor
+                } else {
+                    IntegratorKind::Adaptive
+                }
+            }
             IntegratorKind::Auto if model.law().is_affine() => IntegratorKind::Exact,
             // a plastic impact law (r = 0): every free flight starts tangentially (V̇_T⁺ = 0),
             // which the split integrator hands to the adaptive half anyway
@@ -212,16 +222,13 @@ pub fn build(
         }
     }
     if model.params().is_multifrequency()
-        && matches!(
-            kind,
-            IntegratorKind::Exact | IntegratorKind::Split | IntegratorKind::Taylor
-        )
+        && matches!(kind, IntegratorKind::Exact | IntegratorKind::Split)
     {
         return Err(SimError::out_of_range(
             "integrator",
             format!("{kind:?}").to_lowercase(),
-            "must be adaptive, auto or rk4 under a multifrequency drive: the exact, split and \
-             Taylor integrators propagate one harmonic drive",
+            "must be adaptive, taylor, auto or rk4 under a multifrequency drive: the exact and \
+             split integrators propagate one harmonic drive",
         ));
     }
     if matches!(kind, IntegratorKind::Rk4 | IntegratorKind::Rk4Naive)

@@ -80,6 +80,9 @@ struct LastStep {
 #[derive(Debug, Clone)]
 pub struct Taylor {
     model: CantileverModel,
+    /// The shortest drive period 2π/max(Ω, ω_c) (a multifrequency drive's fastest component
+    /// included): a free step spans at most a quarter of it ([`rule`]).
+    drive_period: f64,
     jet: Jet,
     tol: f64,
     order: usize,
@@ -163,7 +166,12 @@ impl Taylor {
             });
         };
         let d = model.dim();
+        let p = model.params();
+        let fastest = p
+            .components()
+            .fold(p.omega, |m, c| m.max(c.ratio() * p.omega));
         Ok(Taylor {
+            drive_period: std::f64::consts::TAU / fastest,
             jet,
             tol,
             order: poly::order_for(tol),
@@ -314,7 +322,7 @@ impl Integrator for Taylor {
         let (end, tau1, hit) = match region {
             Region::Free => {
                 self.jet.free(s, tau0, self.z.as_slice(), var, p);
-                let h = rule(s, self.model.period(), self.tol).min(remaining);
+                let h = rule(s, self.drive_period, self.tol).min(remaining);
                 let hit = poly::leftmost_crossing(s.guard(), h, dead, self.just_switched);
                 match hit {
                     Some(e) => (e, tau0 + e, true),
@@ -335,7 +343,7 @@ impl Integrator for Taylor {
                     // the contact's interior in τ (module docs)
                     self.jet
                         .contact_interior(s, tau0, self.z.as_slice(), w0, var, p);
-                    let h = rule(s, self.model.period(), self.tol);
+                    let h = rule(s, self.drive_period, self.tol);
                     if h >= it.advance
                         && poly::leftmost_crossing(s.depth(), h.min(remaining), 0.0, false)
                             .is_none()
@@ -353,7 +361,7 @@ impl Integrator for Taylor {
                     }
                 }
                 self.jet.contact(s, tau0, self.z.as_slice(), w0, var, p);
-                let h = rule(s, self.model.period(), self.tol);
+                let h = rule(s, self.drive_period, self.tol);
                 let hit = poly::leftmost_crossing(s.guard(), h, dead, self.just_switched);
                 let e = hit.unwrap_or(h);
                 let theta = &s.theta[..=p];

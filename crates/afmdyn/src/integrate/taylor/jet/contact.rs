@@ -149,6 +149,7 @@ impl Jet {
         let (sn, cs) = s.start(p, d, variational, Region::Contact, t0, z0, self.omega);
         s.s[0] = sn;
         s.c[0] = cs;
+        self.component_sigma_start(s);
         s.theta[0] = 0.0;
         s.w[0] = w0;
         s.wrev[M - 1] = w0;
@@ -192,7 +193,7 @@ impl Jet {
             {
                 let mut lower = [0.0; crate::params::MAX_MODES];
                 let zs = &s.z[k * d..(k + 1) * d];
-                self.lower_field(wd, zs, k, s.s[k], s.c[k], f, &mut lower[..n]);
+                self.lower_field(wd, zs, k, s.s[k], s.c[k], f + s.fd[k], &mut lower[..n]);
                 for i in 0..n {
                     s.g[i * M + k] = zs[n + i];
                     s.g[(n + i) * M + k] = lower[i];
@@ -211,6 +212,9 @@ impl Jet {
             // sin and cos of Ωτ(σ): S′ = Ω C τ′, C′ = −Ω S τ′, τ′ = 2w
             s.s[k + 1] = 2.0 * om * cauchy_rev(&s.c, &s.wrev, k) * inv;
             s.c[k + 1] = -2.0 * om * cauchy_rev(&s.s, &s.wrev, k) * inv;
+            if !self.components.is_empty() {
+                self.component_sigma_next(s, k);
+            }
             if variational {
                 {
                     let phik = &s.phi[k * dd..(k + 1) * dd];

@@ -92,6 +92,10 @@ pub(crate) struct Jet {
     law: Law,
     /// Ωᵏ/k!, k ≤ MAX_ORDER.
     trig_factor: Vec<f64>,
+    /// The further components of a multifrequency drive ([`crate::params::DriveComponent`]):
+    /// (F̃, ω, θ) of F̃ cos(ωτ + θ) at the tip, and ωᵏ/k! per component (M each).
+    components: Vec<(f64, f64, f64)>,
+    component_factor: Vec<f64>,
     /// The energy balance's rates ([`CantileverModel::power`]): the Galerkin forcing f_s, f_c
     /// (not M⁻¹-scaled), and the damping C^I_ii (α3 s_i, eq. 12; C^I is diagonal).
     power_sin: Vec<f64>,
@@ -137,6 +141,11 @@ pub(crate) struct Series {
     pub v: [f64; M],
     /// The tip force F_c.
     pub f: [f64; M],
+    /// The further drive components' tip force F̃(τ) = Σ F̃ cos(ωτ + θ) (0 without them).
+    pub fd: [f64; M],
+    /// Contact in σ: sin and cos of each component's ωτ(σ) + θ, M per component.
+    comp_s: Vec<f64>,
+    comp_c: Vec<f64>,
     // scratch series of the recurrences
     /// u and w backwards (`urev[M − 1 − j] = u_j`), so that every product of series is a dot
     /// product of two contiguous slices ([`dot`]).
@@ -175,6 +184,9 @@ impl Default for Series {
             w: [0.0; M],
             v: [0.0; M],
             f: [0.0; M],
+            fd: [0.0; M],
+            comp_s: vec![0.0; crate::params::MAX_DRIVE_COMPONENTS * M],
+            comp_c: vec![0.0; crate::params::MAX_DRIVE_COMPONENTS * M],
             urev: [0.0; M],
             wrev: [0.0; M],
             s: [0.0; M],
@@ -460,7 +472,19 @@ impl Jet {
         for k in 1..=MAX_ORDER {
             trig_factor[k] = trig_factor[k - 1] * omega / k as f64;
         }
+        let components: Vec<(f64, f64, f64)> = p
+            .components()
+            .map(|c| (c.force, c.ratio() * omega, c.phase))
+            .collect();
+        let mut component_factor = vec![1.0; components.len() * M];
+        for (j, c) in components.iter().enumerate() {
+            for k in 1..=MAX_ORDER {
+                component_factor[j * M + k] = component_factor[j * M + k - 1] * c.1 / k as f64;
+            }
+        }
         Some(Jet {
+            components,
+            component_factor,
             n,
             ak,
             ac,
@@ -530,6 +554,12 @@ impl Jet {
             acc
         };
         let (sn, cs, f) = (at(&|k| s.s[k]), at(&|k| s.c[k]), at(&|k| s.f[k]));
+        // the further drive components' power F̃(τ) Ẇ(1,τ)
+        let fd = if self.components.is_empty() {
+            [0.0; RATE_NODES]
+        } else {
+            at(&|k| s.fd[k])
+        };
         let bo = self.base * self.omega;
         // Σ_i f_s,i ȧ_i sin Ωτ + (Σ_i f_c,i ȧ_i − α2_b Ω F_c) cos Ωτ, and Σ_i C_ii ȧ_i²
         let mut base = [0.0; RATE_NODES];
@@ -540,7 +570,8 @@ impl Jet {
         for i in 0..n {
             let ad = at(&|k| s.z[k * d + n + i]);
             for g in 0..RATE_NODES {
-                base[g] += ad[g] * (self.power_sin[i] * sn[g] + self.power_cos[i] * cs[g]);
+                base[g] += ad[g]
+                    * (self.power_sin[i] * sn[g] + self.power_cos[i] * cs[g] + self.phi[i] * fd[g]);
                 beam[g] += self.damping[i] * ad[g] * ad[g];
             }
         }
@@ -641,6 +672,42 @@ impl Jet {
             s.s[k] = f * a;
             s.c[k] = f * b;
         }
+        // the further drive components' F̃ cos(ω(τ₀ + t) + θ) in t: F̃ ωᵏ/k! cos(φ₀ + kπ/2)
+        s.fd[..=p].fill(0.0);
+        for (j, &(force, om, theta)) in self.components.iter().enumerate() {
+            let (sp, cp) = (om * s.t0 + theta).sin_cos();
+            let quarter = [cp, -sp, -cp, sp];
+            for k in 0..=p {
+                s.fd[k] += force * self.component_factor[j * M + k] * quarter[k & 3];
+            }
+        }
+    }
+
+    /// The components' series in the regularising time σ (a contact step at its edges) at
+    /// order 0, from τ₀: sin and cos of ωτ₀ + θ, and F̃(τ₀).
+    fn component_sigma_start(&self, s: &mut Series) {
+        s.fd[0] = 0.0;
+        for (j, &(force, om, theta)) in self.components.iter().enumerate() {
+            let (sp, cp) = (om * s.t0 + theta).sin_cos();
+            s.comp_s[j * M] = sp;
+            s.comp_c[j * M] = cp;
+            s.fd[0] += force * cp;
+        }
+    }
+
+    /// Order k + 1 of the components' series in σ from orders ≤ k and w up to order k
+    /// (`wrev`): S′ = ω C τ′, C′ = −ω S τ′ with τ′ = 2w, and F̃ = Σ F̃ C.
+    fn component_sigma_next(&self, s: &mut Series, k: usize) {
+        let inv = 1.0 / (k + 1) as f64;
+        s.fd[k + 1] = 0.0;
+        for (j, &(force, om, _)) in self.components.iter().enumerate() {
+            let wk = &s.wrev[M - 1 - k..];
+            let sn = 2.0 * om * dot(&s.comp_c[j * M..=j * M + k], wk) * inv;
+            let cn = -2.0 * om * dot(&s.comp_s[j * M..=j * M + k], wk) * inv;
+            s.comp_s[j * M + k + 1] = sn;
+            s.comp_c[j * M + k + 1] = cn;
+            s.fd[k + 1] += force * cn;
+        }
     }
 
     /// The state's coefficient of order k + 1 in τ from that of order k (`cur`, d, replaced
@@ -652,7 +719,7 @@ impl Jet {
         let inv = 1.0 / (k + 1) as f64;
         let mut lower = [0.0; crate::params::MAX_MODES];
         let lower = &mut lower[..n];
-        self.lower_field(w, cur, k, s.s[k], s.c[k], f, lower);
+        self.lower_field(w, cur, k, s.s[k], s.c[k], f + s.fd[k], lower);
         let mut nxt = [0.0; 2 * crate::params::MAX_MODES];
         let nxt = &mut nxt[..d];
         for i in 0..n {
@@ -755,7 +822,10 @@ impl Jet {
             s.f[k] = f;
             let inv = 1.0 / (k + 1) as f64;
             let forcing = if k == 0 { b0 } else { 0.0 } + bs * s.s[k] + bc * s.c[k];
-            let (xn, vn) = (v * inv, (ak * x + ac * v + forcing + m * f) * inv);
+            let (xn, vn) = (
+                v * inv,
+                (ak * x + ac * v + forcing + m * (f + s.fd[k])) * inv,
+            );
             s.z[2 * k + 2] = xn;
             s.z[2 * k + 3] = vn;
             (x, v) = (xn, vn);
