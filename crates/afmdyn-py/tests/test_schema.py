@@ -201,6 +201,8 @@ def _python_docs() -> List[Tuple[str, str, Callable[[], Any]]]:
         ("observe", "observe", lambda: afmdyn.summary(afmdyn.observe())),
         ("observe", "observe probe", lambda: afmdyn.summary(afmdyn.observe(probe=P1))),
         ("observe", "observe impact", lambda: afmdyn.summary(afmdyn.observe(**IMPACT_PY))),
+        ("observe", "observe probe bimodal", lambda: afmdyn.summary(
+            afmdyn.observe(probe=BIM, z_c=9e-9))),
         ("reconstruct", "reconstruct", lambda: afmdyn.summary(afmdyn.reconstruct(
             **_fm_curve(), spring_constant=40.0, resonance_frequency=3e5, amplitude=1e-8))),
         ("fm", "fm", lambda: afmdyn.summary(afmdyn.fm(points=4))),

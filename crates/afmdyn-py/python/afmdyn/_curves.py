@@ -164,7 +164,10 @@ def observe_dataset(doc: Dict[str, Any]) -> xr.Dataset:
     in degrees) as scalar variables, ``harmonic_amplitude`` and ``harmonic_phase_deg`` over
     ``harmonic`` (n), the per-mode energy balance ``mode_drive``, ``mode_beam_damping``,
     ``mode_sample``, ``mode_coupling``, ``mode_energy_change``, ``mode_residual`` over ``mode``,
-    ``state`` (the start, ``[2N]`` as (a, ȧ)) and ``period`` (NaN when not periodic)."""
+    ``state`` (the start, ``[2N]`` as (a, ȧ)) and ``period`` (NaN when not periodic); under a
+    multifrequency drive ``component_amplitude``, ``component_phase_deg``, ``component_virial``,
+    ``component_energy_dissipated`` (with their closed forms and free values) over
+    ``component`` (1, 2, …)."""
     r: Dict[str, Any] = doc["reported"]
     units: Dict[str, str] = r["units"]
     data: Dict[str, Any] = {}
@@ -189,6 +192,23 @@ def observe_dataset(doc: Dict[str, Any]) -> xr.Dataset:
             "mode", _floats(b[term]),
             _attrs(units, "energy", f"energy balance of the mode per drive period: {term}"),
         )
+    comp = r.get("components")
+    if comp:  # a multifrequency drive: per component (the first first)
+        for key, k, long_name in (
+            ("amplitude", "length", "tip amplitude at the component's frequency"),
+            ("phase_deg", "phase", "phase lag behind the component's drive"),
+            ("free_amplitude", "length", "free amplitude at the component's frequency"),
+            ("free_phase_deg", "phase", "the free response's lag"),
+            ("virial", "energy", "<F_ts z_i>, z_i the motion at the component's frequency"),
+            ("energy_dissipated", "energy", "energy dissipated per cycle of the component"),
+            ("closed_virial", "energy", "closed form -(k A A0/(2Q)) cos(phase)"),
+            ("closed_energy_dissipated", "energy",
+             "closed form (pi k A^2/Q)[(A0/A) sin(phase) - f/f0]"),
+        ):
+            data[f"component_{key}"] = ("component", _floats(comp[key]),
+                                        _attrs(units, k, long_name))
+        data["component_ratio"] = ("component", _floats(comp["ratio"]),
+                                   {"units": "1", "long_name": "frequency over the first's"})
     data["state"] = ("state_index", np.asarray(doc["state"], dtype=np.float64),
                      {"long_name": "state (a, da/dtau) at tau = 0 the observables start from"})
     period = doc.get("period")
@@ -198,6 +218,8 @@ def observe_dataset(doc: Dict[str, Any]) -> xr.Dataset:
         "harmonic": ("harmonic", np.array(h["n"], dtype=np.int64)),
         "mode": ("mode", np.array(b["mode"], dtype=np.int64)),
     }
+    if comp:
+        coords["component"] = ("component", np.arange(1, len(comp["ratio"]) + 1))
     summary = dict(doc)
     summary["state"] = [float(v) for v in doc["state"]]
     return xr.Dataset(

@@ -28,8 +28,13 @@ pub fn curve_row(o: &Observables, u: &CurveUnits) -> [f64; 12] {
 /// (as [`curve_row`]), then `contact_time`, `mean_force`, `impacts_per_period`, `impact_loss`,
 /// `harmonics` (arrays `n`, `amplitude`, `phase_deg`), `mode_balance` (arrays `mode`, `drive`,
 /// `beam_damping`, `sample`, `coupling`, `energy_change`, `residual`; energies per drive period)
-/// and `units` (the names). The `"reported"` block of `observe`'s document, which Python's
-/// dataset is built from.
+/// `units` (the names) and, under a multifrequency drive, `components` (arrays over the drive
+/// components, the first first: `ratio`, `amplitude`, `phase_deg`, `free_amplitude`,
+/// `free_phase_deg`, `virial`, `energy_dissipated` per cycle of the component, their closed
+/// forms `closed_virial`, `closed_energy_dissipated`, and the `mode` those use (0-based, as
+/// `mode_balance`);
+/// [`crate::analysis::observables::ComponentObservables`]). The `"reported"` block of
+/// `observe`'s document, which Python's dataset is built from.
 pub fn observed(o: &Observables, u: &CurveUnits) -> Value {
     let mut m = serde_json::Map::new();
     for (c, v) in CURVE_COLUMNS.iter().zip(curve_row(o, u)) {
@@ -63,6 +68,26 @@ pub fn observed(o: &Observables, u: &CurveUnits) -> Value {
             "residual": energies(|x| x.residual),
         }),
     );
+    if !o.components.is_empty() {
+        let c = &o.components;
+        let list =
+            |f: &dyn Fn(&ComponentObservables) -> f64| -> Vec<f64> { c.iter().map(f).collect() };
+        m.insert(
+            "components".into(),
+            json!({
+                "ratio": list(&|x| x.ratio),
+                "amplitude": list(&|x| x.amplitude * u.length),
+                "phase_deg": list(&|x| x.phase.to_degrees()),
+                "free_amplitude": list(&|x| x.free_amplitude * u.length),
+                "free_phase_deg": list(&|x| x.free_phase.to_degrees()),
+                "virial": list(&|x| x.virial * u.energy),
+                "energy_dissipated": list(&|x| x.energy_dissipated * u.energy),
+                "closed_virial": list(&|x| x.closed_virial * u.energy),
+                "closed_energy_dissipated": list(&|x| x.closed_energy_dissipated * u.energy),
+                "mode": c.iter().map(|x| x.mode).collect::<Vec<_>>(),
+            }),
+        );
+    }
     let mut units = u.names();
     units["time"] = json!(if u.si { "s" } else { "τ" });
     m.insert("units".into(), units);

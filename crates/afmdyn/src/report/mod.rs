@@ -10,7 +10,7 @@ use crate::analysis::continuation::Branch;
 use crate::analysis::converge::ConvergenceRun;
 use crate::analysis::global_continuation::ContinuationStep;
 use crate::analysis::lyapunov::LyapunovSpectrum;
-use crate::analysis::observables::{ModeBalance, Observables};
+use crate::analysis::observables::{ComponentObservables, ModeBalance, Observables};
 use crate::analysis::shooting::PeriodicOrbit;
 use crate::analysis::steady::SteadyState;
 use crate::analysis::stepped::{CurvePoint, SteppedCurve, Sweep};
