@@ -66,9 +66,18 @@ pub fn orbit(a: &OrbitArgs) -> Result<(), CliError> {
         return Ok(());
     }
     outln!(
-        "period-{} orbit at {}{} ({}), {} switchings per cycle",
+        "period-{} orbit at {}{}{} ({}), {} switchings per cycle",
         n,
         u.drive(p.omega),
+        if p.is_multifrequency() {
+            format!(
+                " (a multifrequency drive: periods of its common period, {} of the first \
+                 component's)",
+                p.common_periods()
+            )
+        } else {
+            String::new()
+        },
         if u.si() {
             format!(", z_c = {}", u.length(p.rest_distance()))
         } else {
