@@ -143,7 +143,8 @@ fn no_components(c: &[Option<DriveComponent>; 3]) -> bool {
 pub struct DriveComponent {
     /// F̃ ≥ 0, the force amplitude at the tip (model units, above).
     pub force: f64,
-    /// [p, q], both in 1..=1000: the frequency is p/q times Ω.
+    /// [p, q], p in 1..=1000000 and q in 1..=1000: the frequency is p/q times Ω (q sets the
+    /// common period, [`Params::common_periods`]).
     pub ratio: [u32; 2],
     /// θ, the phase of the component (rad).
     pub phase: f64,
@@ -463,9 +464,9 @@ impl Params {
                     value: c.force,
                 });
             }
-            if c.ratio.iter().any(|&v| !(1..=1000).contains(&v)) {
+            if !(1..=1_000_000).contains(&c.ratio[0]) || !(1..=1000).contains(&c.ratio[1]) {
                 return Err(ParamError::Structure {
-                    name: "drive_components.ratio ([p, q], each in 1..=1000)",
+                    name: "drive_components.ratio ([p, q], p in 1..=1000000, q in 1..=1000)",
                     value: f64::from(c.ratio[0]) / f64::from(c.ratio[1].max(1)),
                 });
             }

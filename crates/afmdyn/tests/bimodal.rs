@@ -421,3 +421,49 @@ fn taylor_agrees_with_dop853_under_a_bimodal_drive() {
     }
     assert!(contact >= 2, "the orbits reach the contact");
 }
+
+/// A ratio that needs a long common period (201/64: 64 drive periods per orbit) gives a curve
+/// with a warning naming it; the beam's own f₂/f₁ (each component at its mode's resonance,
+/// the default) is taken within 1e-6 as 1855/296.
+#[test]
+fn a_long_common_period_is_warned_of() {
+    use afmdyn::analysis::approach::{approach_retract, approach_spec};
+    use afmdyn::analysis::stepped::Spacing;
+    let text = EIGENMODES
+        .replace("model = \"eigenmodes\"", "model = \"point-mass\"")
+        .replace("[40.0, 1571.0]", "40.0")
+        .replace(
+            "[300e3, 1.88e6]\nquality_factor = [400, 2507]",
+            "300e3\nquality_factor = 400",
+        )
+        .replace(
+            "frequency = [300e3, 1.88e6]",
+            "frequency = [300e3, 942187.5]",
+        );
+    let probe = Probe::parse(&text, "test").unwrap();
+    assert_eq!(probe.components[0].ratio, [201, 64]);
+    let g0 = probe.scales.length_m;
+    let mut spec = approach_spec(probe.params, 12e-9 / g0, 11e-9 / g0, Spacing::Points(2)).unwrap();
+    spec.branches = false;
+    let c = approach_retract(&spec).unwrap();
+    assert!(
+        c.warnings
+            .iter()
+            .any(|w| w.contains("every 64 drive periods") && w.contains("201/64")),
+        "{:?}",
+        c.warnings
+    );
+    let beam = Probe::parse(
+        &format!(
+            "{BEAM_HEAD}{}",
+            BEAM_TAIL.replace("frequency = [300e3, 1.875e6]\n", "")
+        ),
+        "test",
+    )
+    .unwrap();
+    assert_eq!(beam.components[0].ratio, [1855, 296]);
+    let f2 = beam.components[0].frequency;
+    let (free, _) = afmdyn::eigen::spectrum(&beam.params).unwrap();
+    let natural = beam.scales.frequency_hz(free.omega[1]);
+    assert!((f2 / natural - 1.0).abs() <= 1e-6, "{f2} vs {natural}");
+}

@@ -246,7 +246,7 @@ pub struct DriveComponentSi {
     pub ratio: [u32; 2],
 }
 
-/// The fraction p/q (p ≤ 1000) with the smallest q ≤ 1000 within 1e-6 (relative) of `r` > 0, `None`
+/// The fraction p/q (p ≤ 10⁶) with the smallest q ≤ 1000 within 1e-6 (relative) of `r` > 0, `None`
 /// when there is none. A frequency moved by 1e-6 of itself moves the response of a mode of
 /// quality factor Q by 2Q·1e-6 rad in phase (2e-3 rad at Q = 1000); the frequency used is
 /// reported ([`DriveComponentSi::frequency`]).
@@ -256,7 +256,7 @@ pub fn rational_ratio(r: f64) -> Option<(u32, u32)> {
     }
     (1..=1000u32).find_map(|q| {
         let p = (r * f64::from(q)).round();
-        let close = (1.0..=1000.0).contains(&p) && ((p / f64::from(q)) - r).abs() <= 1e-6 * r;
+        let close = (1.0..=1e6).contains(&p) && ((p / f64::from(q)) - r).abs() <= 1e-6 * r;
         close.then_some((p as u32, q))
     })
 }
@@ -1221,7 +1221,7 @@ impl Probe {
             let (p, q) = rational_ratio(f / drive_hz).ok_or_else(|| {
                 format!(
                     "[drive].frequency[{}] = {f} Hz: its ratio to the first component's \
-                     {drive_hz} Hz, {}, is not within 1e-6 of a fraction p/q with p, q ≤ 1000; \
+                     {drive_hz} Hz, {}, is not within 1e-6 of a fraction p/q with q ≤ 1000; \
                      an incommensurate drive has no periodic steady state: give a frequency \
                      whose ratio is such a fraction",
                     i + 1,

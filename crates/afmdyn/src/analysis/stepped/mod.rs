@@ -71,6 +71,10 @@ pub enum Spacing {
     Points(usize),
 }
 
+/// A multifrequency drive whose common period spans more drive periods than this gets a
+/// warning on its curves: each orbit costs that many periods (the example's 25/4 takes 4).
+pub const SLOW_COMMON_PERIODS: u64 = 32;
+
 /// Grid points of a curve request that gives neither a step nor a count.
 pub const DEFAULT_CURVE_POINTS: usize = 120;
 
@@ -755,6 +759,19 @@ pub fn finish_curve(
     progress: &Progress,
 ) -> Result<SteppedCurve, SimError> {
     let mut warnings = Vec::new();
+    let q = spec.base.common_periods();
+    if q > SLOW_COMMON_PERIODS {
+        warnings.push(format!(
+            "the multifrequency drive repeats only every {q} drive periods (its frequency ratio \
+             {}): every orbit spans them all; a ratio p/q with a small q (e.g. f2 = 6.25 f1) \
+             is as many times faster",
+            spec.base
+                .components()
+                .map(|c| format!("{}/{}", c.ratio[0], c.ratio[1]))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ));
+    }
     let mut branches: Vec<Vec<BranchSample>> = Vec::new();
     if spec.branches {
         for start in branch_starts(spec, &first, &second) {
