@@ -673,6 +673,10 @@ impl Jet {
             s.c[k] = f * b;
         }
         // the further drive components' F̃ cos(ω(τ₀ + t) + θ) in t: F̃ ωᵏ/k! cos(φ₀ + kπ/2)
+        // (without them `fd` keeps its zeros: one jet per integrator)
+        if self.components.is_empty() {
+            return;
+        }
         s.fd[..=p].fill(0.0);
         for (j, &(force, om, theta)) in self.components.iter().enumerate() {
             let (sp, cp) = (om * s.t0 + theta).sin_cos();
