@@ -20,17 +20,7 @@ sed 's/1.875e6/1.88e6/g' $P > "$tmp/ratio-94-15.toml"
 sed -e 's/^free_amplitude = .*/free_amplitude = 10e-9/' -e 's/^frequency = .*/frequency = 300e3/' \
     $P > "$tmp/single.toml"
 
-best_of() {  # best wall time (s) of 3 runs of "$@"
-    local best=""
-    for _ in 1 2 3; do
-        local t0 t1
-        t0=$(date +%s.%N)
-        "$@" > "$tmp/doc.json"
-        t1=$(date +%s.%N)
-        best=$(python3 -c "print(min(float(x) for x in '$best $(python3 -c "print($t1 - $t0)")'.split()))")
-    done
-    echo "$best"
-}
+source scripts/best-of.sh
 
 rows=""
 for case in "eigenmodes, f2/f1 = 25/4, branches|bimodal|$P|" \
@@ -39,7 +29,7 @@ for case in "eigenmodes, f2/f1 = 25/4, branches|bimodal|$P|" \
             "one component (approach, Taylor integrator), --no-branches|approach|$tmp/single.toml|--no-branches"; do
     IFS='|' read -r name cmd probe extra <<< "$case"
     # shellcheck disable=SC2086
-    t=$(best_of $B $cmd --probe "$probe" --points 100 $extra --json --out "$tmp/out")
+    t=$(best_of 3 "$tmp/doc.json" $B $cmd --probe "$probe" --points 100 $extra --json --out "$tmp/out")
     stats=$(python3 - "$tmp/doc.json" <<'PY'
 import json, sys
 d = json.load(open(sys.argv[1]))

@@ -14,17 +14,7 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 sed 's/^quality_factor = 400 .*/quality_factor = 1e4/' examples/probe-point-mass-dmt.toml > "$tmp/q1e4.toml"
 
-best_of() {  # best wall time (s) of 5 runs of "$@"
-    local best=""
-    for _ in 1 2 3 4 5; do
-        local t0 t1
-        t0=$(date +%s.%N)
-        "$@" > "$tmp/doc.json"
-        t1=$(date +%s.%N)
-        best=$(python3 -c "print(min(float(x) for x in '$best $(python3 -c "print($t1 - $t0)")'.split()))")
-    done
-    echo "$best"
-}
+source scripts/best-of.sh
 
 rows=""
 for case in "point mass, Q = 400|examples/probe-point-mass-dmt.toml" \
@@ -32,7 +22,7 @@ for case in "point mass, Q = 400|examples/probe-point-mass-dmt.toml" \
             "point mass, Q = 10⁴|$tmp/q1e4.toml"; do
     name=${case%%|*}
     probe=${case#*|}
-    t=$(best_of $B fm --probe "$probe" --points 100 --json --out "$tmp/out")
+    t=$(best_of 5 "$tmp/doc.json" $B fm --probe "$probe" --points 100 --json --out "$tmp/out")
     stats=$(python3 - "$tmp/doc.json" <<'PY'
 import json, sys
 d = json.load(open(sys.argv[1]))

@@ -86,19 +86,36 @@ impl CurveArgs {
     }
 }
 
-/// `afmdyn approach` flags.
+/// The z_c range of `approach` and `bimodal`.
 #[derive(Debug, Args)]
-pub struct ApproachArgs {
-    #[command(flatten)]
-    model: ModelArgs,
+struct ZcRange {
     /// Rest distance z_c where the approach starts (m with --probe, else units of g0)
-    /// [default: 1.2 × the free amplitude A0 from the sample]; with --probe a unit may follow
-    /// (20nm)
+    /// [default: 1.2 × the free amplitude A0 from the sample, the sum of the components' under
+    /// a multifrequency drive]; with --probe a unit may follow (20nm)
     #[arg(long, allow_hyphen_values = true)]
     from: Option<Quantity>,
     /// Rest distance z_c where the approach ends and the retract starts [default: 0.1 × A0]
     #[arg(long, allow_hyphen_values = true)]
     to: Option<Quantity>,
+}
+
+impl ZcRange {
+    /// The ends in the model's or SI lengths (a probe: `si`).
+    fn ends(&self, si: bool) -> Result<(Option<f64>, Option<f64>), CliError> {
+        Ok((
+            quantity(self.from, "from", Dim::Length, si)?,
+            quantity(self.to, "to", Dim::Length, si)?,
+        ))
+    }
+}
+
+/// `afmdyn approach` flags.
+#[derive(Debug, Args)]
+pub struct ApproachArgs {
+    #[command(flatten)]
+    model: ModelArgs,
+    #[command(flatten)]
+    range: ZcRange,
     #[command(flatten)]
     curve: CurveArgs,
     /// Amplitude setpoint A_sp/A0 in (0, 1]: the operating points where the curve's amplitude
@@ -117,15 +134,8 @@ pub struct ApproachArgs {
 pub struct BimodalArgs {
     #[command(flatten)]
     model: ModelArgs,
-    /// Rest distance z_c where the approach starts (m with --probe, else units of g0)
-    /// [default: 1.2 × the sum of the components' free amplitudes from the sample]; a unit may
-    /// follow (20nm)
-    #[arg(long, allow_hyphen_values = true)]
-    from: Option<Quantity>,
-    /// Rest distance z_c where the approach ends and the retract starts [default: 0.1 × that
-    /// sum]
-    #[arg(long, allow_hyphen_values = true)]
-    to: Option<Quantity>,
+    #[command(flatten)]
+    range: ZcRange,
     #[command(flatten)]
     curve: CurveArgs,
     /// Output directory (locked during the run)
@@ -762,8 +772,7 @@ fn check_finite(name: &str, v: Option<f64>) -> Result<(), CliError> {
 /// Run `afmdyn approach`.
 pub fn approach(a: &ApproachArgs) -> Result<(), CliError> {
     let si = a.model.probe.is_some();
-    let from = quantity(a.from, "from", Dim::Length, si)?;
-    let to = quantity(a.to, "to", Dim::Length, si)?;
+    let (from, to) = a.range.ends(si)?;
     let (base, units, probe) = setup(&a.model, from, to, false)?;
     let request = ApproachRequest {
         curve: a.curve.request(from, to, Dim::Length, si)?,
@@ -776,8 +785,7 @@ pub fn approach(a: &ApproachArgs) -> Result<(), CliError> {
 /// ([`afmdyn::request::curves::check_bimodal`]), its files `bimodal.*`.
 pub fn bimodal(a: &BimodalArgs) -> Result<(), CliError> {
     let si = a.model.probe.is_some();
-    let from = quantity(a.from, "from", Dim::Length, si)?;
-    let to = quantity(a.to, "to", Dim::Length, si)?;
+    let (from, to) = a.range.ends(si)?;
     let (base, units, probe) = setup(&a.model, from, to, false)?;
     afmdyn::request::curves::check_bimodal(&base)?;
     let request = ApproachRequest {

@@ -5,14 +5,8 @@
 //! document's names; a single-frequency probe and a bad `[drive]` array exit 2 with one line,
 //! as do `resonance` and `fm`, which move the drive frequency, on a multifrequency probe.
 
-use std::process::{Command, Output};
-
-fn afmdyn(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_afmdyn"))
-        .args(args)
-        .output()
-        .expect("run afmdyn")
-}
+mod common;
+use common::{column, run as afmdyn};
 
 const PROBE: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
@@ -22,15 +16,6 @@ const SINGLE: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
     "/../../examples/probe-eigenmodes-dmt.toml"
 );
-
-fn column(doc: &serde_json::Value, block: &str, k: &str) -> Vec<f64> {
-    doc[block][k]
-        .as_array()
-        .unwrap_or_else(|| panic!("{block}.{k}"))
-        .iter()
-        .map(|v| v.as_f64().unwrap())
-        .collect()
-}
 
 #[test]
 fn bimodal_curve_reports_each_component() {

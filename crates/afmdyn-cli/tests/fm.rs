@@ -4,14 +4,9 @@
 //! (d from 3a₀ to A/2, where the inversion's own error is below 1 % on this grid); the files;
 //! bad input exits 2 with one line naming the flag.
 
-use std::process::{Command, Output};
-
-fn afmdyn(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_afmdyn"))
-        .args(args)
-        .output()
-        .expect("run afmdyn")
-}
+mod common;
+use common::{column, run as afmdyn};
+use std::process::Output;
 
 const PROBE: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
@@ -27,15 +22,6 @@ fn succeeded(args: &[&str]) -> Output {
         String::from_utf8_lossy(&out.stderr)
     );
     out
-}
-
-fn column(doc: &serde_json::Value, block: &str, k: &str) -> Vec<f64> {
-    doc[block][k]
-        .as_array()
-        .unwrap_or_else(|| panic!("{block}.{k}"))
-        .iter()
-        .map(|v| v.as_f64().unwrap())
-        .collect()
 }
 
 #[test]

@@ -96,17 +96,7 @@ fn _afmdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
         "CURVE_COLUMNS",
         afmdyn::report::CURVE_COLUMNS
             .iter()
-            .map(|c| {
-                use afmdyn::report::UnitKind;
-                let kind = match c.kind {
-                    UnitKind::Length => Some("length"),
-                    UnitKind::Force => Some("force"),
-                    UnitKind::Energy => Some("energy"),
-                    UnitKind::Phase => Some("phase"),
-                    UnitKind::One => None,
-                };
-                (c.name, kind, c.long_name)
-            })
+            .map(|c| (c.name, c.kind.key(), c.long_name))
             .collect::<Vec<_>>(),
     )?;
     Ok(())

@@ -499,9 +499,10 @@ impl CantileverModel {
         let g = self.galerkin.region(Region::Free);
         let v = z.rows(n, n);
         let (s, c) = (p.omega * tau).sin_cos();
-        let drive = g.forcing.sin.dot(&v) * s
-            + g.forcing.cos.dot(&v) * c
-            + p.component_force(tau) * self.tip().dot(&v);
+        let mut drive = g.forcing.sin.dot(&v) * s + g.forcing.cos.dot(&v) * c;
+        if p.is_multifrequency() {
+            drive += p.component_force(tau) * self.tip().dot(&v);
+        }
         // ȦᵀC^IȦ with the damping matrix of eq. 12 (α3 diag(s) with a per-mode damping profile:
         // the beam's per-mode Q, the eigenmode model)
         let beam = (&g.damping * v).dot(&v);

@@ -29,12 +29,12 @@ free_amplitude = [10e-9, 1e-9]
 frequency = [300e3, 1.88e6]
 "#;
 
+mod common;
+use common::opts;
+
+/// The integrator of the checks: auto (Taylor for DMT) at 1e-12.
 fn integ() -> IntegratorOptions {
-    IntegratorOptions {
-        kind: IntegratorKind::Auto,
-        tolerance: 1e-12,
-        ..IntegratorOptions::default()
-    }
+    opts(IntegratorKind::Auto, 1e-12)
 }
 
 /// Far from the sample each component's amplitude is its free amplitude and its phase the
@@ -213,39 +213,6 @@ free_amplitude = [10e-9, 1e-9]
 frequency = [300e3, 1.875e6]
 "#;
 
-/// The eigenmode model with the beam's first two modes (k̃_j, f_j, Q_j as the beam gives them).
-fn two_modes_of(beam: &Probe) -> Probe {
-    let (free, _) = afmdyn::eigen::spectrum(&beam.params).unwrap();
-    let g = afmdyn::galerkin::Galerkin::new(&beam.params).unwrap();
-    let s = &beam.scales;
-    let (mut k, mut f, mut q) = (Vec::new(), Vec::new(), Vec::new());
-    for j in 0..2 {
-        let (w, _, kt) =
-            afmdyn::eigen::mode_at_tip(g.region(afmdyn::galerkin::Region::Free), g.tip(), j);
-        k.push(format!("{:e}", kt * s.force_n / s.length_m));
-        f.push(format!("{:e}", s.frequency_hz(w)));
-        let zeta = free
-            .eigenvalues
-            .iter()
-            .filter(|e| e.im > 0.0)
-            .nth(j)
-            .unwrap()
-            .zeta;
-        q.push(format!("{:e}", 0.5 / zeta));
-    }
-    Probe::parse(
-        &format!(
-            "model = \"eigenmodes\"\n[cantilever]\nspring_constant = [{}]\n\
-             resonance_frequency = [{}]\nquality_factor = [{}]\n{BEAM_TAIL}",
-            k.join(", "),
-            f.join(", "),
-            q.join(", ")
-        ),
-        "test",
-    )
-    .unwrap()
-}
-
 /// The two-mode eigenmode model with the Galerkin beam's k̃_j, f_j, Q_j (N = 3, base drive
 /// for component 1, a tip force for component 2 at 6.25 f₁) follows the beam in the attractive
 /// regime under the same bimodal drive: each component's amplitude within 0.5 % of its free
@@ -257,7 +224,7 @@ fn two_eigenmodes_follow_the_beam_under_a_bimodal_drive() {
     use afmdyn::analysis::approach::{approach_retract, approach_spec};
     use afmdyn::analysis::stepped::Spacing;
     let beam = Probe::parse(&format!("{BEAM_HEAD}{BEAM_TAIL}"), "test").unwrap();
-    let eig = two_modes_of(&beam);
+    let eig = common::two_modes_of(&beam, BEAM_TAIL);
     let g0 = beam.scales.length_m;
     assert_eq!(beam.scales.length_m, eig.scales.length_m);
     let run = |p: &Probe| {
@@ -305,12 +272,8 @@ fn the_energy_balance_closes_with_each_modes_damping() {
     p.alpha5 = 10.0;
     let m = CantileverModel::new(&p).unwrap();
     let z0 = nalgebra::DVector::zeros(4);
-    let opts = IntegratorOptions {
-        kind: IntegratorKind::Adaptive,
-        tolerance: 1e-13,
-        ..IntegratorOptions::default()
-    };
-    let mut it = afmdyn::integrate::build(&m, opts, 0.0, &z0).unwrap();
+    let mut it =
+        afmdyn::integrate::build(&m, opts(IntegratorKind::Adaptive, 1e-13), 0.0, &z0).unwrap();
     let t_end = m.period();
     let n = 200_000;
     let h = t_end / n as f64;
@@ -355,11 +318,6 @@ fn taylor_agrees_with_dop853_under_a_bimodal_drive() {
         .replace("z_c = 8e-9", "z_c = 8e-9\nviscosity = 50.0");
     let probe = Probe::parse(&text, "test").unwrap();
     let g0 = probe.scales.length_m;
-    let opts = |kind, tolerance| IntegratorOptions {
-        kind,
-        tolerance,
-        ..IntegratorOptions::default()
-    };
     let mut contact = 0;
     for z_c in [20e-9, 10.5e-9, 6e-9, 3e-9] {
         let mut p = probe.params;

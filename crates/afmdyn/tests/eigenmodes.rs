@@ -10,6 +10,8 @@ use afmdyn::analysis::fm::{fm_curve, FmSpec};
 use afmdyn::analysis::progress::Progress;
 use afmdyn::analysis::stepped::Spacing;
 use afmdyn::eigen::spectrum;
+
+mod common;
 use afmdyn::probe::Probe;
 
 const SAMPLE: &str = r#"
@@ -35,43 +37,6 @@ const ONE_MODE: &str = "model = \"eigenmodes\"\n[cantilever]\nspring_constant = 
                         resonance_frequency = [300e3]\nquality_factor = [400]\n";
 const BEAM: &str = "model = \"beam\"\nmodes = 3\n[cantilever]\nspring_constant = 40.0\n\
                     resonance_frequency = 300e3\nquality_factor = 400\n";
-
-/// The eigenmode model with the beam's first two modes (k̃_j, f_j, Q_j as the beam gives them).
-fn two_modes_of(beam: &Probe) -> Probe {
-    let (free, _) = spectrum(&beam.params).unwrap();
-    let g = afmdyn::galerkin::Galerkin::new(&beam.params).unwrap();
-    let s = &beam.scales;
-    let mut k = Vec::new();
-    let mut f = Vec::new();
-    let mut q = Vec::new();
-    for j in 0..2 {
-        let (w, _, kt) =
-            afmdyn::eigen::mode_at_tip(g.region(afmdyn::galerkin::Region::Free), g.tip(), j);
-        k.push(kt * s.force_n / s.length_m);
-        f.push(s.frequency_hz(w));
-        let zeta = free
-            .eigenvalues
-            .iter()
-            .filter(|e| e.im > 0.0)
-            .nth(j)
-            .unwrap()
-            .zeta;
-        q.push(0.5 / zeta);
-    }
-    let list = |v: &[f64]| {
-        v.iter()
-            .map(|x| format!("{x:e}"))
-            .collect::<Vec<_>>()
-            .join(", ")
-    };
-    probe(&format!(
-        "model = \"eigenmodes\"\n[cantilever]\nspring_constant = [{}]\nresonance_frequency = \
-         [{}]\nquality_factor = [{}]\n",
-        list(&k),
-        list(&f),
-        list(&q)
-    ))
-}
 
 /// The AM approach's first-harmonic amplitudes (g₀) from z_c = `from` to `to` (g₀).
 fn amplitudes(p: &Probe, from: f64, to: f64, points: usize) -> Vec<f64> {
@@ -132,7 +97,7 @@ fn the_modes_are_the_given_ones() {
 #[test]
 fn two_eigenmodes_follow_the_beam_in_the_attractive_regime() {
     let beam = probe(BEAM);
-    let eig = two_modes_of(&beam);
+    let eig = common::two_modes_of(&beam, SAMPLE);
     assert_eq!(eig.params.modes, 2);
     let g0 = beam.scales.length_m;
     for mode in [1, 2] {

@@ -39,3 +39,13 @@ pub fn text(args: &[&str]) -> String {
     );
     String::from_utf8(out.stdout).unwrap()
 }
+
+/// The numbers of `doc[block][k]` (an array of a curve document).
+pub fn column(doc: &serde_json::Value, block: &str, k: &str) -> Vec<f64> {
+    doc[block][k]
+        .as_array()
+        .unwrap_or_else(|| panic!("{block}.{k}"))
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect()
+}

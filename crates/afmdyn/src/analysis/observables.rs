@@ -76,7 +76,7 @@
 
 use super::shooting::PeriodicOrbit;
 use crate::contact::{TipSample, TipSampleLaw};
-use crate::eigen::{damped_eigenvalues, first_mode_at_tip};
+use crate::eigen::damped_eigenvalues;
 use crate::error::SimError;
 use crate::galerkin::{Region, RegionMatrices};
 use crate::integrate::{build, Integrator, IntegratorOptions, SwitchEvent};
@@ -299,23 +299,61 @@ pub fn free_response(model: &CantileverModel) -> Result<FreeResponse, SimError> 
 /// As [`free_response`].
 pub fn closed_forms(model: &CantileverModel, a: f64, phase: f64) -> Result<ClosedForms, SimError> {
     let free = free_response(model)?;
-    let g = model.galerkin().region(Region::Free);
-    let (w0, _, k) = first_mode_at_tip(g, model.tip());
-    let eig = damped_eigenvalues(g);
-    let first = eig.iter().find(|e| e.im > 0.0).or(eig.first());
-    let q = first.map_or(f64::INFINITY, |e| 0.5 / e.zeta);
-    let r = model.omega() / w0;
+    let m = EquivalentMode::of(model, 0);
+    let (k, q) = (m.stiffness, m.quality_factor);
+    let r = model.omega() / m.natural_frequency;
     let a0 = free.amplitude;
     Ok(ClosedForms {
         free_amplitude: a0,
         free_phase: free.phase,
         quality_factor: q,
-        natural_frequency: w0,
+        natural_frequency: m.natural_frequency,
         stiffness: k,
         drive_force: k * a0 * ((1.0 - r * r).powi(2) + (r / q).powi(2)).sqrt(),
-        energy_dissipated: PI * k / q * (a * a0 * phase.sin() - r * a * a),
-        virial: -k * a * a0 / (2.0 * q) * phase.cos(),
+        energy_dissipated: m.energy_dissipated(a, a0, phase, model.omega()),
+        virial: m.virial(a, a0, phase),
     })
+}
+
+/// The equivalent point mass of one mode at the tip: ω₀, k̃ ([`crate::eigen::mode_at_tip`]) and
+/// Q = 1/(2ζ) of its damped eigenvalue — what the closed forms of the AFM literature take.
+struct EquivalentMode {
+    natural_frequency: f64,
+    stiffness: f64,
+    quality_factor: f64,
+}
+
+impl EquivalentMode {
+    /// Mode `mode` (0-based) of `model`; Q from the mode-th underdamped eigenvalue (for mode 1
+    /// the first eigenvalue when none is underdamped; ∞ without one).
+    fn of(model: &CantileverModel, mode: usize) -> Self {
+        let g = model.galerkin().region(Region::Free);
+        let (w0, _, k) = crate::eigen::mode_at_tip(g, model.tip(), mode);
+        let eig = damped_eigenvalues(g);
+        let under = eig.iter().filter(|e| e.im > 0.0).nth(mode);
+        let e = if mode == 0 {
+            under.or(eig.first())
+        } else {
+            under
+        };
+        EquivalentMode {
+            natural_frequency: w0,
+            stiffness: k,
+            quality_factor: e.map_or(f64::INFINITY, |e| 0.5 / e.zeta),
+        }
+    }
+
+    /// Cleveland/Anczykowski E_cf = (π k A²/Q)[(A₀/A) sin φ − ω/ω₀] per cycle at frequency ω
+    /// (module docs).
+    fn energy_dissipated(&self, a: f64, a0: f64, phase: f64, omega: f64) -> f64 {
+        let r = omega / self.natural_frequency;
+        PI * self.stiffness / self.quality_factor * (a * a0 * phase.sin() - r * a * a)
+    }
+
+    /// San Paulo & García V_cf = −(k A A₀/(2Q)) cos φ (module docs).
+    fn virial(&self, a: f64, a0: f64, phase: f64) -> f64 {
+        -self.stiffness * a * a0 / (2.0 * self.quality_factor) * phase.cos()
+    }
 }
 
 /// A phase in (−π/2, 3π/2].
@@ -864,8 +902,7 @@ fn component(
         (d.force * h.norm(), wrap_phase(-h.arg()))
     };
     // the equivalent point mass of the mode nearest ω_c
-    let g = model.galerkin().region(Region::Free);
-    let natural = crate::eigen::natural_modes(g);
+    let natural = crate::eigen::natural_modes(model.galerkin().region(Region::Free));
     let mode = (0..model.modes())
         .min_by(|&x, &y| {
             (natural.omega[x] - om)
@@ -873,12 +910,7 @@ fn component(
                 .total_cmp(&(natural.omega[y] - om).abs())
         })
         .unwrap_or(0);
-    let (w0, _, k) = crate::eigen::mode_at_tip(g, model.tip(), mode);
-    let under: Vec<_> = damped_eigenvalues(g)
-        .into_iter()
-        .filter(|e| e.im > 0.0)
-        .collect();
-    let q = under.get(mode).map_or(f64::INFINITY, |e| 0.5 / e.zeta);
+    let m = EquivalentMode::of(model, mode);
     Ok(ComponentObservables {
         ratio: om / p.omega,
         amplitude: a,
@@ -888,8 +920,8 @@ fn component(
         virial,
         energy_dissipated: e_dis,
         mode,
-        closed_virial: -k * a * free_amplitude / (2.0 * q) * phase.cos(),
-        closed_energy_dissipated: PI * k / q * (a * free_amplitude * phase.sin() - om / w0 * a * a),
+        closed_virial: m.virial(a, free_amplitude, phase),
+        closed_energy_dissipated: m.energy_dissipated(a, free_amplitude, phase, om),
     })
 }
 

@@ -256,20 +256,13 @@ fn drive_components(params: &Params, c: &SteppedCurve, u: &CurveUnits) -> Option
             r * omega
         }
     };
-    let kind = |k: UnitKind| match k {
-        UnitKind::Length => Some("length"),
-        UnitKind::Force => Some("force"),
-        UnitKind::Energy => Some("energy"),
-        UnitKind::Phase => Some("phase"),
-        UnitKind::One => None,
-    };
     Some(json!({
         "ratio": o.components.iter().map(|c| c.ratio).collect::<Vec<_>>(),
         "frequency": o.components.iter().map(|c| freq(c.ratio)).collect::<Vec<_>>(),
         "free_amplitude": o.components.iter().map(|c| c.free_amplitude * u.length).collect::<Vec<_>>(),
         "columns": component_columns(o.components.len())
             .into_iter()
-            .map(|(n, k, l)| json!([n, kind(k), l]))
+            .map(|(n, k, l)| json!([n, k.key(), l]))
             .collect::<Vec<_>>(),
     }))
 }

@@ -253,6 +253,20 @@ pub enum UnitKind {
     One,
 }
 
+impl UnitKind {
+    /// The kind's key in a document's `units` block (`length`, `force`, `energy`, `phase`;
+    /// `None` for a pure number): how Python's datasets and a document's column lists name it.
+    pub fn key(self) -> Option<&'static str> {
+        match self {
+            UnitKind::Length => Some("length"),
+            UnitKind::Force => Some("force"),
+            UnitKind::Energy => Some("energy"),
+            UnitKind::Phase => Some("phase"),
+            UnitKind::One => None,
+        }
+    }
+}
+
 /// A per-point column of a stepped curve: its name, its kind of unit and its meaning — the
 /// one declaration of the JSON document's keys, the command line's `.npy.json` meanings and
 /// Python's dataset attributes.

@@ -156,3 +156,38 @@ pub fn opts(kind: afmdyn::IntegratorKind, tol: f64) -> afmdyn::IntegratorOptions
         ..Default::default()
     }
 }
+
+/// The eigenmode model with the first two modes of `beam` (a probe): each mode's stiffness at
+/// the tip k̃_j (Melcher, Hu & Raman 2007, [`afmdyn::eigen::mode_at_tip`]), natural frequency f_j
+/// and quality factor Q_j = 1/(2ζ_j) as the beam gives them, over the sections `tail` (tip,
+/// sample, drive).
+pub fn two_modes_of(beam: &afmdyn::probe::Probe, tail: &str) -> afmdyn::probe::Probe {
+    let (free, _) = afmdyn::eigen::spectrum(&beam.params).unwrap();
+    let g = afmdyn::galerkin::Galerkin::new(&beam.params).unwrap();
+    let s = &beam.scales;
+    let (mut k, mut f, mut q) = (Vec::new(), Vec::new(), Vec::new());
+    for j in 0..2 {
+        let (w, _, kt) = afmdyn::eigen::mode_at_tip(g.region(Region::Free), g.tip(), j);
+        k.push(format!("{:e}", kt * s.force_n / s.length_m));
+        f.push(format!("{:e}", s.frequency_hz(w)));
+        let zeta = free
+            .eigenvalues
+            .iter()
+            .filter(|e| e.im > 0.0)
+            .nth(j)
+            .unwrap()
+            .zeta;
+        q.push(format!("{:e}", 0.5 / zeta));
+    }
+    afmdyn::probe::Probe::parse(
+        &format!(
+            "model = \"eigenmodes\"\n[cantilever]\nspring_constant = [{}]\n\
+             resonance_frequency = [{}]\nquality_factor = [{}]\n{tail}",
+            k.join(", "),
+            f.join(", "),
+            q.join(", ")
+        ),
+        "test",
+    )
+    .unwrap()
+}
