@@ -62,9 +62,10 @@ impl Galerkin {
     /// Assemble both regions' matrices.
     ///
     /// # Errors
-    /// [`ParamError`] if `params` fails validation.
+    /// [`ParamError`] if `params` fails validation ([`Params::validate_fields`]: the matrices do
+    /// not depend on the drive's common period).
     pub fn new(params: &Params) -> Result<Self, ParamError> {
-        params.validate()?;
+        params.validate_fields()?;
         let n = params.modes;
         let shapes = ModeShapes::new(n);
         // the point-mass model (params::Structure): one coordinate z = V_T − α5 with φ(1) = 1,

@@ -102,14 +102,35 @@ pub struct CantileverModel {
     tip_acc: DVector<f64>,
     /// φᵀM⁻¹F^I: constant, sin and cos coefficients of the free tip acceleration.
     tip_acc_forcing: [f64; 3],
+    /// The system's period: [`Params::period`], or 2π/Ω for a quasi-periodic drive
+    /// ([`CantileverModel::quasiperiodic`]).
+    period: f64,
 }
 
 impl CantileverModel {
     /// Assemble the model.
     ///
     /// # Errors
-    /// [`ParamError`] if `params` is invalid.
+    /// [`ParamError`] if `params` is invalid ([`Params::validate`]: a quasi-periodic drive is
+    /// refused, it has no period).
     pub fn new(params: &Params) -> Result<Self, ParamError> {
+        params.validate()?;
+        Self::assemble(params, params.period())
+    }
+
+    /// The model of a quasi-periodic drive ([`Params::is_quasiperiodic`]; any drive is
+    /// accepted) for the time average ([`crate::analysis::stepped::average`]), the only analysis
+    /// that does not need the system's period: its [`HybridSystem::period`] is the primary
+    /// drive period 2π/Ω, the scale of the integrators' step budgets, not a period of the
+    /// system. Crate-private so that no periodic analysis receives it.
+    ///
+    /// # Errors
+    /// [`ParamError`] if a field is invalid ([`Params::validate_fields`]).
+    pub(crate) fn quasiperiodic(params: &Params) -> Result<Self, ParamError> {
+        Self::assemble(params, std::f64::consts::TAU / params.omega)
+    }
+
+    fn assemble(params: &Params, period: f64) -> Result<Self, ParamError> {
         let galerkin = Galerkin::new(params)?;
         let n = params.modes;
         let minv = galerkin
@@ -165,6 +186,7 @@ impl CantileverModel {
             m_eff,
             tip_acc,
             tip_acc_forcing,
+            period,
         })
     }
 
@@ -188,9 +210,10 @@ impl CantileverModel {
     pub fn omega(&self) -> f64 {
         self.params.omega
     }
-    /// Drive period T = 2π/Ω.
+    /// The system's period: the drive period T = 2π/Ω, or a multifrequency drive's common
+    /// period ([`Params::period`]); 2π/Ω for the model of a quasi-periodic drive.
     pub fn period(&self) -> f64 {
-        self.params.period()
+        self.period
     }
     /// The Galerkin matrices.
     pub fn galerkin(&self) -> &Galerkin {
@@ -759,7 +782,7 @@ impl HybridSystem for CantileverModel {
         2 * self.params.modes
     }
     fn period(&self) -> f64 {
-        self.params.period()
+        self.period
     }
 
     /// Contact when V_T < 0, or V_T = 0 moving inwards (dV_T/dτ ≤ 0); free otherwise. For the

@@ -121,6 +121,12 @@ pub const MAX_DRIVE_COMPONENTS: usize = 3;
 /// Largest common period of a multifrequency drive, in periods 2π/Ω of the primary drive:
 /// the orbit, the stroboscopic map and the observables' window span this many periods.
 pub const MAX_COMMON_PERIODS: u64 = 1000;
+/// Largest q of a component's ratio p/q: with q up to 10⁶ every frequency ratio is given to
+/// about 1e-12 (a continued fraction's convergent), so an incommensurate ratio is represented
+/// to round-off of a window's phase; such a drive is quasi-periodic ([`Params::is_quasiperiodic`]).
+pub const MAX_RATIO_DENOMINATOR: u32 = 1_000_000;
+/// Largest p of a component's ratio p/q.
+pub const MAX_RATIO_NUMERATOR: u32 = 1_000_000_000;
 
 const _: () = assert!(
     MAX_DRIVE_COMPONENTS == 3,
@@ -138,13 +144,15 @@ fn no_components(c: &[Option<DriveComponent>; 3]) -> bool {
 /// driven by every component (García & Proksch 2013, eq. 1); for the beam it is a force drive
 /// at the tip (magnetic or photothermal) beside the base drive, which does not move V_T.
 /// The frequency ratio p/q is rational, so the drive is periodic with the common period
-/// 2πq/Ω for p/q in lowest terms ([`Params::common_periods`]).
+/// 2πq/Ω for p/q in lowest terms ([`Params::common_periods`]); a common period beyond
+/// [`MAX_COMMON_PERIODS`] makes the drive quasi-periodic ([`Params::is_quasiperiodic`]).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct DriveComponent {
     /// F̃ ≥ 0, the force amplitude at the tip (model units, above).
     pub force: f64,
-    /// [p, q], p in 1..=1000000 and q in 1..=1000: the frequency is p/q times Ω (q sets the
-    /// common period, [`Params::common_periods`]).
+    /// [p, q], p in 1..=[`MAX_RATIO_NUMERATOR`] and q in 1..=[`MAX_RATIO_DENOMINATOR`]: the
+    /// frequency is p/q times Ω (q sets the common period, [`Params::common_periods`]; above
+    /// [`MAX_COMMON_PERIODS`] the drive is quasi-periodic).
     pub ratio: [u32; 2],
     /// θ, the phase of the component (rad).
     pub phase: f64,
@@ -313,11 +321,38 @@ impl Params {
         }
     }
 
-    /// Check every field against its allowed range.
+    /// Check every field against its allowed range, and that the drive is periodic with a
+    /// common period of at most [`MAX_COMMON_PERIODS`] drive periods (what periodic orbits,
+    /// stroboscopic maps and every analysis but the time average need).
     ///
     /// # Errors
     /// [`ParamError`] naming the first field out of range.
     pub fn validate(&self) -> Result<(), ParamError> {
+        self.validate_fields()?;
+        if self.is_quasiperiodic() {
+            return Err(ParamError::Structure {
+                name: "drive_components.ratio (the common period, lcm of the q's, at most 1000 \
+                       drive periods: a drive this close to incommensurate is averaged in time by \
+                       bimodal, not shot as an orbit)",
+                value: self.common_periods() as f64,
+            });
+        }
+        Ok(())
+    }
+
+    /// Whether the drive's common period exceeds [`MAX_COMMON_PERIODS`]: a ratio p/q given to
+    /// within 1e-12 by a q up to 10⁶, incommensurate in all but name, whose response is
+    /// measured by the time average ([`crate::analysis::stepped::average`]).
+    pub fn is_quasiperiodic(&self) -> bool {
+        self.common_periods() > MAX_COMMON_PERIODS
+    }
+
+    /// [`Params::validate`] without the limit on the common period: the fields a model needs,
+    /// for the time average of a quasi-periodic drive ([`crate::analysis::stepped::average`]).
+    ///
+    /// # Errors
+    /// [`ParamError`] naming the first field out of range.
+    pub fn validate_fields(&self) -> Result<(), ParamError> {
         if !(1..=MAX_MODES).contains(&self.modes) {
             return Err(ParamError::Modes(self.modes));
         }
@@ -464,9 +499,11 @@ impl Params {
                     value: c.force,
                 });
             }
-            if !(1..=1_000_000).contains(&c.ratio[0]) || !(1..=1000).contains(&c.ratio[1]) {
+            if !(1..=MAX_RATIO_NUMERATOR).contains(&c.ratio[0])
+                || !(1..=MAX_RATIO_DENOMINATOR).contains(&c.ratio[1])
+            {
                 return Err(ParamError::Structure {
-                    name: "drive_components.ratio ([p, q], p in 1..=1000000, q in 1..=1000)",
+                    name: "drive_components.ratio ([p, q], p in 1..=1000000000, q in 1..=1000000)",
                     value: f64::from(c.ratio[0]) / f64::from(c.ratio[1].max(1)),
                 });
             }
@@ -476,12 +513,6 @@ impl Params {
                     value: c.phase,
                 });
             }
-        }
-        if self.common_periods() > MAX_COMMON_PERIODS {
-            return Err(ParamError::Structure {
-                name: "drive_components.ratio (the common period, lcm of the q's, at most 1000 drive periods)",
-                value: f64::NAN,
-            });
         }
         if self.structure == Structure::PointMass {
             for (name, bad, value) in [

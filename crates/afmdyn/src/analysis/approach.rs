@@ -21,7 +21,8 @@ use crate::params::{Params, SweepParam};
 /// # Errors
 /// [`SimError`] for invalid parameters or an undamped drive at resonance (no finite A₀).
 pub fn default_range(base: &Params) -> Result<(f64, f64), SimError> {
-    let model = CantileverModel::new(base)?;
+    // the free responses only: any drive, quasi-periodic ones too
+    let model = CantileverModel::quasiperiodic(base)?;
     // a multifrequency drive: the free amplitudes of all components add up at the sample
     let mut a0 = free_response(&model)?.amplitude;
     for c in base.components() {

@@ -58,7 +58,9 @@
 //! α2 = F₀/(k A₀) = √((1 − Ω²)² + (Ω/Q)²) (the harmonic oscillator's response).
 //! A multifrequency drive (`[drive]` arrays) adds, for every model, components F̃ᵢ cos(ωᵢτ) at
 //! the tip ([`crate::params::DriveComponent`]): ωᵢ/Ω is the fraction p/q with the smallest
-//! q ≤ 1000 within 1e-6 of fᵢ/f₁ ([`rational_ratio`]; the frequency used is reported), and
+//! q ≤ 1000 within 1e-6 of fᵢ/f₁ ([`rational_ratio`]: a periodic drive), else the convergent
+//! of fᵢ/f₁ with q ≤ 10⁶ ([`convergent`]: a quasi-periodic drive, within about 1e-12, whose
+//! response the time average measures); the frequency used is reported; and
 //! F̃ᵢ = A₀ᵢ/(g₀|Hᵢ|) from the free tip response Hᵢ to a unit tip force at ωᵢ
 //! ([`crate::CantileverModel::free_force_response`]).
 //!
@@ -88,7 +90,10 @@ pub const DEFAULT_INTERMOLECULAR_DISTANCE: f64 = 0.165e-9;
 use crate::contact::ContactLaw;
 use crate::galerkin::{Galerkin, Region};
 use crate::model::CantileverModel;
-use crate::params::{DriveComponent, Params, Structure, MAX_DRIVE_COMPONENTS, MAX_MODES};
+use crate::params::{
+    DriveComponent, Params, Structure, MAX_DRIVE_COMPONENTS, MAX_MODES, MAX_RATIO_DENOMINATOR,
+    MAX_RATIO_NUMERATOR,
+};
 use serde::Serialize;
 use std::f64::consts::TAU;
 #[cfg(feature = "files")]
@@ -259,6 +264,46 @@ pub fn rational_ratio(r: f64) -> Option<(u32, u32)> {
         let close = (1.0..=1e6).contains(&p) && ((p / f64::from(q)) - r).abs() <= 1e-6 * r;
         close.then_some((p as u32, q))
     })
+}
+
+/// The convergent p/q of the continued fraction of `r` > 0 with the largest q ≤
+/// [`MAX_RATIO_DENOMINATOR`] (and p ≤ [`MAX_RATIO_NUMERATOR`]): the best rational approximation
+/// with such a denominator, |r − p/q| < 1/(q q′) with q′ > 10⁶ the next convergent's
+/// denominator (Khinchin, *Continued Fractions*, 1964, Thm. 9), so within about 1e-12 of r
+/// unless r itself has a small denominator. `None` for r outside (0, 10⁶) or not finite.
+pub fn convergent(r: f64) -> Option<(u32, u32)> {
+    convergent_within(r, MAX_RATIO_DENOMINATOR)
+}
+
+/// The convergent p/q of the continued fraction of `r` > 0 with the largest q ≤ `max_q` (and
+/// p ≤ [`MAX_RATIO_NUMERATOR`]), as [`convergent`]: the best rational approximation of `r`
+/// with a denominator that small. `None` for r outside (0, 10⁶) or not finite.
+pub fn convergent_within(r: f64, max_q: u32) -> Option<(u32, u32)> {
+    if !(r.is_finite() && r > 0.0 && r < 1e6) {
+        return None;
+    }
+    let (max_p, max_q) = (f64::from(MAX_RATIO_NUMERATOR), f64::from(max_q));
+    // h_n/k_n from the partial quotients a_n: h_n = a_n h_{n−1} + h_{n−2}, likewise k_n
+    let (mut h, mut h1, mut k, mut k1) = (1.0f64, 0.0f64, 0.0f64, 1.0f64);
+    let mut x = r;
+    let mut best = None;
+    for _ in 0..64 {
+        let a = x.floor();
+        let (hn, kn) = (a * h + h1, a * k + k1);
+        if hn > max_p || kn > max_q {
+            break;
+        }
+        if hn >= 1.0 {
+            best = Some((hn as u32, kn as u32));
+        }
+        (h1, h, k1, k) = (h, hn, k, kn);
+        let frac = x - a;
+        if frac <= 1e-15 * x.max(1.0) {
+            break;
+        }
+        x = 1.0 / frac;
+    }
+    best
 }
 
 /// The cantilever section, before the model is known.
@@ -1164,7 +1209,9 @@ impl Probe {
         params.alpha2 = 1.0 / unit_response;
         let components =
             Self::resolve_components(&mut params, &drive.components, drive_hz, &scales)?;
-        params.validate().map_err(|e| derived(e.to_string()))?;
+        params
+            .validate_fields()
+            .map_err(|e| derived(e.to_string()))?;
         Ok(Probe {
             params,
             scales,
@@ -1218,14 +1265,12 @@ impl Probe {
             } else {
                 f
             };
-            let (p, q) = rational_ratio(f / drive_hz).ok_or_else(|| {
+            let r = f / drive_hz;
+            let (p, q) = rational_ratio(r).or_else(|| convergent(r)).ok_or_else(|| {
                 format!(
                     "[drive].frequency[{}] = {f} Hz: its ratio to the first component's \
-                     {drive_hz} Hz, {}, is not within 1e-6 of a fraction p/q with q ≤ 1000; \
-                     an incommensurate drive has no periodic steady state: give a frequency \
-                     whose ratio is such a fraction",
+                     {drive_hz} Hz, {r}, must be in (0, 1e6)",
                     i + 1,
-                    f / drive_hz
                 )
             })?;
             let ratio = f64::from(p) / f64::from(q);

@@ -423,7 +423,12 @@ pub fn si(probe: &crate::probe::Probe, params: &Params, doc: &Value) -> Value {
         },
         "calibration": probe.calibration,
         "drive_frequency_hz": s.frequency_hz(params.omega),
-        "period_s": params.period() * s.time_s,
+        // a quasi-periodic drive has no common period: its primary period 2π/Ω
+        "period_s": if params.is_quasiperiodic() {
+            std::f64::consts::TAU / params.omega
+        } else {
+            params.period()
+        } * s.time_s,
         "free_amplitude_m": probe.free_amplitude,
         "z_c_m": probe.z_c_of(params),
     });

@@ -439,7 +439,7 @@ impl ModelSpec {
             }
             p.omega = probe.scales.omega(f);
         }
-        p.validate().map_err(SimError::from)?;
+        p.validate_fields().map_err(SimError::from)?;
         Ok(p)
     }
 }
