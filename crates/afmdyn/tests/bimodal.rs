@@ -10,24 +10,10 @@ use afmdyn::integrate::{IntegratorKind, IntegratorOptions};
 use afmdyn::probe::Probe;
 use afmdyn::CantileverModel;
 
-const EIGENMODES: &str = r#"
-model = "eigenmodes"
-[cantilever]
-spring_constant = [40.0, 1571.0]
-resonance_frequency = [300e3, 1.88e6]
-quality_factor = [400, 2507]
-[tip]
-radius = 10e-9
-[sample]
-law = "dmt"
-youngs_modulus = 4e9
-poisson_ratio = 0.33
-hamaker = 6.6e-20
-z_c = 8e-9
-[drive]
-free_amplitude = [10e-9, 1e-9]
-frequency = [300e3, 1.88e6]
-"#;
+/// The eigenmode model of the checks: mode 2 at 1.88 MHz, Q = [400, 2507], driven there.
+fn eigenmodes() -> String {
+    common::bimodal_lever("1.88e6", "400, 2507", "1.88e6")
+}
 
 mod common;
 use common::opts;
@@ -41,7 +27,7 @@ fn integ() -> IntegratorOptions {
 /// free response's (≤ 1e-6), the primary's 90° at resonance.
 #[test]
 fn far_from_the_sample_each_component_is_free() {
-    let probe = Probe::parse(EIGENMODES, "test").unwrap();
+    let probe = Probe::parse(&eigenmodes(), "test").unwrap();
     assert_eq!(probe.components.len(), 1);
     assert_eq!(probe.components[0].ratio, [94, 15]);
     let mut p = probe.params;
@@ -148,7 +134,7 @@ const PI_OVER_Q: f64 = std::f64::consts::PI / 400.0;
 fn eigenmode_approach_components_match_their_closed_forms() {
     use afmdyn::analysis::approach::{approach_retract, approach_spec};
     use afmdyn::analysis::stepped::Spacing;
-    let text = EIGENMODES.replace("1.88e6", "1.875e6");
+    let text = eigenmodes().replace("1.88e6", "1.875e6");
     let probe = Probe::parse(&text, "test").unwrap();
     assert_eq!(probe.components[0].ratio, [25, 4]);
     let g0 = probe.scales.length_m;
@@ -266,7 +252,7 @@ fn two_eigenmodes_follow_the_beam_under_a_bimodal_drive() {
 /// integrator's dense output, to 1e-9 of the work.
 #[test]
 fn the_energy_balance_closes_with_each_modes_damping() {
-    let text = EIGENMODES.replace("1.88e6", "1.875e6");
+    let text = eigenmodes().replace("1.88e6", "1.875e6");
     let probe = Probe::parse(&text, "test").unwrap();
     let mut p = probe.params;
     p.alpha5 = 10.0;
@@ -313,7 +299,7 @@ fn the_energy_balance_closes_with_each_modes_damping() {
 /// (an independent integrator) to 1e-8, and its per-step energy integrals close the balance.
 #[test]
 fn taylor_agrees_with_dop853_under_a_bimodal_drive() {
-    let text = EIGENMODES
+    let text = eigenmodes()
         .replace("1.88e6", "1.875e6")
         .replace("z_c = 8e-9", "z_c = 8e-9\nviscosity = 50.0");
     let probe = Probe::parse(&text, "test").unwrap();
@@ -387,7 +373,7 @@ fn taylor_agrees_with_dop853_under_a_bimodal_drive() {
 fn a_long_common_period_is_warned_of() {
     use afmdyn::analysis::approach::{approach_retract, approach_spec};
     use afmdyn::analysis::stepped::Spacing;
-    let text = EIGENMODES
+    let text = eigenmodes()
         .replace("model = \"eigenmodes\"", "model = \"point-mass\"")
         .replace("[40.0, 1571.0]", "40.0")
         .replace(

@@ -14,21 +14,16 @@ use afmdyn::eigen::spectrum;
 mod common;
 use afmdyn::probe::Probe;
 
-const SAMPLE: &str = r#"
-[tip]
-radius = 10e-9
-[sample]
-law = "dmt"
-youngs_modulus = 4e9
-poisson_ratio = 0.33
-hamaker = 6.6e-20
-z_c = 8e-9
-[drive]
-free_amplitude = 10e-9
-"#;
+/// The tip, sample and single-frequency drive of the checks.
+fn sample() -> String {
+    format!(
+        "{}[drive]\nfree_amplitude = 10e-9\n",
+        common::TIP_OVER_POLYSTYRENE
+    )
+}
 
 fn probe(head: &str) -> Probe {
-    Probe::parse(&format!("{head}{SAMPLE}"), "test").unwrap()
+    Probe::parse(&format!("{head}{}", sample()), "test").unwrap()
 }
 
 const POINT_MASS: &str = "model = \"point-mass\"\n[cantilever]\nspring_constant = 40.0\n\
@@ -97,7 +92,7 @@ fn the_modes_are_the_given_ones() {
 #[test]
 fn two_eigenmodes_follow_the_beam_in_the_attractive_regime() {
     let beam = probe(BEAM);
-    let eig = common::two_modes_of(&beam, SAMPLE);
+    let eig = common::two_modes_of(&beam, &sample());
     assert_eq!(eig.params.modes, 2);
     let g0 = beam.scales.length_m;
     for mode in [1, 2] {
@@ -163,13 +158,17 @@ fn bad_eigenmode_arrays_are_refused_naming_the_key() {
             "unknown key [cantilever].length",
         ),
     ] {
-        let text = format!("model = \"eigenmodes\"\n[cantilever]\n{cant}\n{SAMPLE}");
+        let text = format!(
+            "model = \"eigenmodes\"\n[cantilever]\n{cant}\n{}",
+            sample()
+        );
         let e = Probe::parse(&text, "p.toml").unwrap_err().to_string();
         assert!(e.contains(needle), "{needle}: {e}");
     }
     let text = format!(
         "model = \"eigenmodes\"\nmodes = 3\n[cantilever]\nspring_constant = [40.0]\n\
-         resonance_frequency = [300e3]\nquality_factor = [400]\n{SAMPLE}"
+         resonance_frequency = [300e3]\nquality_factor = [400]\n{}",
+        sample()
     );
     let e = Probe::parse(&text, "p.toml").unwrap_err().to_string();
     assert!(e.contains("modes = 3"), "{e}");

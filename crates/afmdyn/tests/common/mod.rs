@@ -191,3 +191,21 @@ pub fn two_modes_of(beam: &afmdyn::probe::Probe, tail: &str) -> afmdyn::probe::P
     )
     .unwrap()
 }
+
+/// The tip and sample of the eigenmode-model checks: a 10 nm tip over polystyrene (DMT,
+/// E = 4 GPa, H = 6.6e-20 J), z_c = 8 nm.
+pub const TIP_OVER_POLYSTYRENE: &str = "[tip]\nradius = 10e-9\n[sample]\nlaw = \"dmt\"\n\
+     youngs_modulus = 4e9\npoisson_ratio = 0.33\nhamaker = 6.6e-20\nz_c = 8e-9\n";
+
+/// The bimodal probe of the checks: the eigenmode model of a 40 N/m lever (as
+/// `examples/probe-bimodal.toml`: k = [40, 1571] N/m, f₁ = 300 kHz) with mode 2 at `f2_mode`
+/// (Hz) and quality factors `q` ("Q1, Q2"), over [`TIP_OVER_POLYSTYRENE`], driven with
+/// free amplitudes [10 nm, 1 nm] at [300 kHz, `f2`].
+pub fn bimodal_lever(f2_mode: &str, q: &str, f2: &str) -> String {
+    format!(
+        "model = \"eigenmodes\"\n[cantilever]\nspring_constant = [40.0, 1571.0]\n\
+         resonance_frequency = [300e3, {f2_mode}]\nquality_factor = [{q}]\n\
+         {TIP_OVER_POLYSTYRENE}[drive]\nfree_amplitude = [10e-9, 1e-9]\n\
+         frequency = [300e3, {f2}]\n"
+    )
+}
