@@ -138,6 +138,12 @@ pub struct BimodalArgs {
     range: ZcRange,
     #[command(flatten)]
     curve: CurveArgs,
+    /// Measure every point by the time average (Hann-windowed demodulation until successive
+    /// windows agree, with an error estimate per component) instead of the exact periodic
+    /// orbit of the common period; always so for an incommensurate ratio (common period beyond
+    /// 1000 drive periods). No branches
+    #[arg(long)]
+    average: bool,
     /// Output directory (locked during the run)
     #[arg(long, default_value = "afmdyn-out/bimodal")]
     out: PathBuf,
@@ -777,6 +783,7 @@ pub fn approach(a: &ApproachArgs) -> Result<(), CliError> {
     let request = ApproachRequest {
         curve: a.curve.request(from, to, Dim::Length, si)?,
         setpoint: a.setpoint,
+        average: false,
     };
     approach_run(&a.curve, &a.out, "approach", &request, base, units, probe)
 }
@@ -791,6 +798,7 @@ pub fn bimodal(a: &BimodalArgs) -> Result<(), CliError> {
     let request = ApproachRequest {
         curve: a.curve.request(from, to, Dim::Length, si)?,
         setpoint: None,
+        average: a.average,
     };
     approach_run(&a.curve, &a.out, "bimodal", &request, base, units, probe)
 }

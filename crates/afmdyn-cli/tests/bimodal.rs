@@ -4,6 +4,8 @@
 //! 1.2 × their sum), near it both fall; the CSV carries the per-component columns in the
 //! document's names; a single-frequency probe and a bad `[drive]` array exit 2 with one line,
 //! as do `resonance` and `fm`, which move the drive frequency, on a multifrequency probe.
+//! `--average` measures the same points by the time average, within its error estimates of
+//! the orbits; an incommensurate ratio is averaged without being asked, and says so.
 
 mod common;
 use common::{column, run as afmdyn};
@@ -114,7 +116,7 @@ fn bimodal_refuses_a_single_frequency_drive_and_bad_arrays() {
         ),
         (
             "frequency = [300e3, 1.875e6]",
-            "frequency = [300e3, 1876058.4]",
+            "frequency = [300e3, -1.875e6]",
         ),
     ] {
         let p = dir.path().join("p.toml");
@@ -125,4 +127,103 @@ fn bimodal_refuses_a_single_frequency_drive_and_bad_arrays() {
         assert_eq!(err.trim().lines().count(), 1, "{err}");
         assert!(err.contains("[drive]"), "{says}: {err}");
     }
+}
+
+/// The doc's `time_average.<sweep>.<k>` as rows of numbers (one per point).
+fn estimates(doc: &serde_json::Value, sweep: &str, k: &str) -> Vec<Vec<f64>> {
+    doc["time_average"][sweep][k]
+        .as_array()
+        .unwrap_or_else(|| panic!("time_average.{sweep}.{k}"))
+        .iter()
+        .map(|r| {
+            r.as_array()
+                .unwrap()
+                .iter()
+                .map(|v| v.as_f64().unwrap())
+                .collect()
+        })
+        .collect()
+}
+
+#[test]
+fn average_agrees_with_the_orbits_within_its_estimates() {
+    let range = ["--from", "12nm", "--to", "8nm", "--points", "4"];
+    let common = [
+        &[
+            "bimodal",
+            "--probe",
+            PROBE,
+            "--no-branches",
+            "--files",
+            "none",
+            "--json",
+        ][..],
+        &range[..],
+    ]
+    .concat();
+    let orbit = common::json(&common);
+    let avg = common::json(&[&common[..], &["--average"]].concat());
+    assert!(orbit.get("time_average").is_none());
+    let ta = &avg["time_average"];
+    assert!(ta["window_periods"].as_u64().unwrap() >= 16, "{ta}");
+    for sweep in ["approach", "retract"] {
+        let settled = ta[sweep]["settled"].as_array().unwrap();
+        assert!(settled.iter().all(|s| s == true), "{sweep}: {ta}");
+        let err = estimates(&avg, sweep, "amplitude_error");
+        for (i, a0) in [(1, 10e-9), (2, 1e-9)] {
+            let k = format!("amplitude_{i}");
+            let (x, y) = (column(&orbit, sweep, &k), column(&avg, sweep, &k));
+            for (j, (x, y)) in x.iter().zip(&y).enumerate() {
+                // the estimate, or the settling tolerance 1e-5 A0 at the least
+                let bound = err[j][i - 1].max(1e-5 * a0);
+                assert!(
+                    (x - y).abs() <= bound,
+                    "{sweep} {k}[{j}]: orbit {x}, average {y}, bound {bound}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn an_incommensurate_ratio_is_averaged_and_says_so() {
+    // f2/f1 = 6.25 + √2·1e-2: no fraction with a common period of ≤ 1000 drive periods
+    let dir = tempfile::tempdir().unwrap();
+    let f2 = 300e3 * (6.25 + std::f64::consts::SQRT_2 * 1e-2);
+    let text = std::fs::read_to_string(PROBE)
+        .unwrap()
+        .replace(
+            "frequency = [300e3, 1.875e6]  ",
+            &format!("frequency = [300e3, {f2}]"),
+        )
+        .replace("quality_factor = [400, 2500]", "quality_factor = [60, 300]");
+    let p = dir.path().join("p.toml");
+    std::fs::write(&p, text).unwrap();
+    let doc = common::json(&[
+        "bimodal",
+        "--probe",
+        p.to_str().unwrap(),
+        "--from",
+        "11nm",
+        "--to",
+        "9nm",
+        "--points",
+        "3",
+        "--files",
+        "none",
+        "--json",
+    ]);
+    let warnings = doc["warnings"].to_string();
+    assert!(warnings.contains("quasi-periodic"), "{warnings}");
+    let r = doc["drive_components"]["ratio"][1].as_f64().unwrap();
+    assert!((r / (f2 / 300e3) - 1.0).abs() < 1e-9, "ratio {r}");
+    let settled = doc["time_average"]["approach"]["settled"]
+        .as_array()
+        .unwrap();
+    assert_eq!(settled.len(), 3);
+    let a2 = column(&doc, "approach", "amplitude_2");
+    assert!(
+        a2.iter().all(|a| a.is_finite() && *a > 0.0 && *a < 1.5e-9),
+        "{a2:?}"
+    );
 }

@@ -55,3 +55,22 @@ def test_observe_reports_each_component():
         scale = np.pi * k * a0 ** 2 / q
         assert abs(float(ds.component_energy_dissipated[i] - ds.component_closed_energy_dissipated[i])) < 1e-3 * scale
         assert abs(float(ds.component_virial[i] - ds.component_closed_virial[i])) < 1e-3 * scale
+
+
+def test_bimodal_average_agrees_with_the_orbits_within_its_estimates():
+    """``average=True`` measures the same points by the time average: within each point's
+    error estimate (or the settling tolerance 1e-5 A0) of the periodic orbits, with the
+    estimates in ``to_dict()["time_average"]``."""
+    curve = dict(from_=12e-9, to=8e-9, points=3, branches=False)
+    orbit = afmdyn.bimodal(probe=BIM, **curve)
+    avg = afmdyn.bimodal(probe=BIM, average=True, **curve)
+    ta = avg.afmdyn.to_dict()["time_average"]
+    assert "time_average" not in orbit.afmdyn.to_dict()
+    for sweep in ("approach", "retract"):
+        assert all(ta[sweep]["settled"]), ta
+        err = np.asarray(ta[sweep]["amplitude_error"])
+        for i, a0 in ((1, 10e-9), (2, 1e-9)):
+            x = orbit[f"amplitude_{i}"].sel(sweep=sweep).values
+            y = avg[f"amplitude_{i}"].sel(sweep=sweep).values
+            bound = np.maximum(err[:, i - 1], 1e-5 * a0)
+            assert (np.abs(x - y) <= bound).all(), (sweep, i, x, y, bound)

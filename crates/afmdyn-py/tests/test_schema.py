@@ -124,6 +124,7 @@ CLI_CASES: List[Tuple[str, List[Any]]] = [
     ("fm", ["--points", 4, "--mode", 2, "--probe", EIG]),
     ("approach", ["--points", 4, "--no-branches", "--files", "none", "--probe", EIG]),
     ("bimodal", ["--points", 4, "--files", "none", "--probe", BIM]),
+    ("bimodal", ["--points", 2, "--files", "none", "--average", "--probe", BIM]),
     # (a probe refuses the dimensionless omega axis: the drive frequency in Hz, 0.99 f0)
     ("chart", ["--x", "z-c", "--x-from", 6e-9, "--x-to", 8e-9, "--x-steps", 2, "--y",
                "drive-frequency", "--y-from", "297kHz", "--y-to", "297kHz", "--y-steps", 1,
@@ -343,3 +344,24 @@ def test_request_schema_accepts_the_default_and_refuses_unknown_keys(name: str) 
     key = next(iter(schema["properties"]))
     with pytest.raises(ValidationError):
         v.validate(dict(default, **{key: {"wrong": "type"}}))
+
+
+def test_quasiperiodic_bimodal_document_conforms(tmp_path: Path) -> None:
+    """A quasi-periodic drive (f2/f1 = 6.25 + √2·1e-2: no fraction with q ≤ 1000 within 1e-6)
+    through Python: its ratio [p, q] has p beyond 1e6, its points are time averages with the
+    ``time_average`` block, and the document conforms to bimodal.json; the warning names it."""
+    f2 = 300e3 * (6.25 + 2 ** 0.5 * 1e-2)
+    text = _bim_text().replace("frequency = [300e3, 1.875e6]  ", f"frequency = [300e3, {f2!r}]")
+    text = text.replace("quality_factor = [400, 2500]", "quality_factor = [60, 300]")
+    probe = tmp_path / "quasi.toml"
+    probe.write_text(text, encoding="utf-8")
+    with pytest.warns(afmdyn.AfmdynWarning, match="quasi-periodic"):
+        ds = afmdyn.bimodal(probe=str(probe), from_=11e-9, to=10e-9, points=2)
+    doc = afmdyn.summary(ds)
+    assert doc["si"]["drive_components"][0]["ratio"][1] > 1000
+    assert len(doc["time_average"]["approach"]["settled"]) == 2
+    check("bimodal", plain(doc))
+
+
+def _bim_text() -> str:
+    return Path(BIM).read_text(encoding="utf-8")

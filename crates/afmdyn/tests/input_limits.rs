@@ -140,11 +140,11 @@ fn traces_have_a_memory_budget() {
         traces: Some(traces),
         ..CurveRequest::default()
     };
-    let e = approach_request(Params::default(), &req(1000, 10000), 1.0).unwrap_err();
+    let e = approach_request(Params::default(), &req(1000, 10000), 1.0, false).unwrap_err();
     assert!(matches!(e, SimError::Budget { what: "traces", .. }), "{e}");
     assert!(e.to_string().contains("up to 3.6 GiB"), "{e}");
     assert!(e.is_input_error());
-    approach_request(Params::default(), &req(200, 200), 1.0).expect("within the budget");
+    approach_request(Params::default(), &req(200, 200), 1.0, false).expect("within the budget");
 }
 
 /// The contact law's name in any case, in a config file as on the command line.

@@ -294,6 +294,7 @@ ObserveRequest = TypedDict(
 ApproachRequest = TypedDict(
     "ApproachRequest",
     {
+        "average": bool,  # default false
         "branches": bool,  # default true
         "from": Optional[float],  # default null
         "points": Optional[int],  # default null
@@ -309,6 +310,7 @@ ApproachRequest = TypedDict(
 ApproachRequest = TypedDict(
     "ApproachRequest",
     {
+        "average": bool,  # default false
         "branches": bool,  # default true
         "from": Optional[float],  # default null
         "points": Optional[int],  # default null

@@ -476,6 +476,7 @@ def bimodal(
     branches: bool = _DEFAULTS["approach"]["branches"],
     tolerance: float = _DEFAULTS["approach"]["tolerance"],
     traces: Optional[int] = None,
+    average: bool = False,
     store: Union[str, "os.PathLike[str]", None] = None,
     resume: bool = False,
     progress: ProgressArg = None,
@@ -488,12 +489,16 @@ def bimodal(
     mass. The frequency ratio is taken as a fraction p/q (within 1e-6), the steady state is the
     periodic orbit of the common period q/f1, and each component's amplitude, phase, virial
     and dissipated energy come from demodulation over it (Lozano & García, Phys. Rev. Lett.
-    100, 076102 (2008); García & Proksch, Eur. Polym. J. 49, 1897 (2013)).
+    100, 076102 (2008); García & Proksch, Eur. Polym. J. 49, 1897 (2013)). A ratio whose
+    common period exceeds 1000 primary periods (incommensurate) is averaged in time instead.
 
     Args:
         from_, to, step, points, branches, tolerance, traces, store, resume: as
             :func:`approach` (the default range from 1.2 to 0.1 times the sum of the free
             amplitudes).
+        average: demodulate a time average (a Hann² window over many primary periods, after
+            the transient has settled) instead of the periodic orbit — what an incommensurate
+            ratio always gets; branches and traces are then off.
         probe: the probe file with the multifrequency ``[drive]`` (a model keyword).
 
     Raises:
@@ -505,7 +510,9 @@ def bimodal(
         ``phase_i_deg``, ``virial_i`` and ``energy_dissipated_i`` (per cycle of component i)
         for each component i = 1, 2, … (1 the primary; SI with a probe); the branches' as
         ``branch_amplitude_2`` …; the frequencies, ratios and free amplitudes in
-        ``ds.afmdyn.to_dict()["drive_components"]``.
+        ``ds.afmdyn.to_dict()["drive_components"]``; for a time average, each point's periods,
+        whether it settled, and its amplitude and phase error estimates per component in
+        ``ds.afmdyn.to_dict()["time_average"]`` (an unsettled point also in the warnings).
     """
     return _curve(_core.bimodal, "bimodal", progress, params, model, _request(locals()),
                   store, resume)

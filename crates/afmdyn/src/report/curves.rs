@@ -235,7 +235,44 @@ fn curve_doc(
     if let Some(d) = drive_components(params, c, u) {
         doc["drive_components"] = d;
     }
+    if let Some(a) = &c.average {
+        doc["time_average"] = time_average(a, names, c, u);
+    }
     doc
+}
+
+/// The `"time_average"` block of a curve measured by the time average
+/// ([`crate::analysis::stepped::average`]): its options, and per sweep and point the periods
+/// integrated, whether it settled, and per component (the primary first) the error estimates
+/// of the amplitude (`u`'s length) and of the phase (degrees).
+fn time_average(
+    a: &crate::analysis::stepped::average::AverageOptions,
+    names: (&str, &str),
+    c: &SteppedCurve,
+    u: &CurveUnits,
+) -> Value {
+    let sweep = |points: &[CurvePoint]| {
+        let est: Vec<_> = points.iter().filter_map(|p| p.average.as_ref()).collect();
+        json!({
+            "periods": est.iter().map(|e| e.periods).collect::<Vec<_>>(),
+            "settled": est.iter().map(|e| e.settled).collect::<Vec<_>>(),
+            "amplitude_error": est
+                .iter()
+                .map(|e| e.amplitude_error.iter().map(|x| x * u.length).collect::<Vec<_>>())
+                .collect::<Vec<_>>(),
+            "phase_error_deg": est
+                .iter()
+                .map(|e| e.phase_error.iter().map(|x| x.to_degrees()).collect::<Vec<_>>())
+                .collect::<Vec<_>>(),
+        })
+    };
+    json!({
+        "window_periods": a.window_periods,
+        "windows": a.windows,
+        "tolerance": a.tol,
+        names.0: sweep(&c.first),
+        names.1: sweep(&c.second),
+    })
 }
 
 /// The `"drive_components"` block of a curve under a multifrequency drive (`None` for one

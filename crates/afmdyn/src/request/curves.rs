@@ -5,6 +5,7 @@
 use crate::analysis::approach::{approach_spec, default_range};
 use crate::analysis::observables::free_response;
 use crate::analysis::resonance::{mode_band, mode_resonance, resonance_spec};
+use crate::analysis::stepped::average::AverageOptions;
 use crate::analysis::stepped::{
     Spacing, SteppedSpec, DEFAULT_CURVE_POINTS, DEFAULT_TOLERANCE, MAX_CURVE_POINTS,
 };
@@ -108,10 +109,15 @@ impl CurveRequest {
         let tol = self.tolerance;
         super::limits::tolerance("tolerance", tol)?;
         for v in [spec.values[0], spec.values[spec.values.len() - 1]] {
-            spec.base.with(spec.param, v).validate()?;
+            let p = spec.base.with(spec.param, v);
+            match spec.average {
+                Some(_) => p.validate_fields()?,
+                None => p.validate()?,
+            }
         }
         spec.integrator.tolerance = tol;
-        spec.branches = self.branches;
+        // the time average follows the motion in time: no periodic orbits to continue
+        spec.branches = self.branches && spec.average.is_none();
         if let Some(n) = self.traces {
             if !(2..=crate::analysis::traces::MAX_TRACE_SAMPLES).contains(&n) {
                 return Err(SimError::out_of_range(
@@ -144,7 +150,8 @@ impl CurveRequest {
 }
 
 /// The approach spec of a front end's request, z_c in units of `length` (m per g₀, or 1):
-/// [`default_range`] for missing ends, [`approach_spec`], then [`CurveRequest::configure`].
+/// [`default_range`] for missing ends, [`approach_spec`], with `average` the time average of
+/// every point ([`AverageOptions::for_model`]), then [`CurveRequest::configure`].
 ///
 /// # Errors
 /// As those three.
@@ -152,6 +159,7 @@ pub fn approach_request(
     base: Params,
     request: &CurveRequest,
     length: f64,
+    average: bool,
 ) -> Result<SteppedSpec, SimError> {
     request.check_finite()?;
     if length != 1.0 {
@@ -166,8 +174,14 @@ pub fn approach_request(
         }
     }
     let (from, to) = request.ends(default_range(&base)?, length);
-    let spec = approach_spec(base, from, to, request.spacing(length)?);
-    request.configure(spec.map_err(|e| in_units(e, length))?)
+    let mut spec =
+        approach_spec(base, from, to, request.spacing(length)?).map_err(|e| in_units(e, length))?;
+    if average {
+        spec.average = Some(AverageOptions::for_model(&CantileverModel::quasiperiodic(
+            &base,
+        )?));
+    }
+    request.configure(spec)
 }
 
 /// The check of a bimodal (multifrequency) approach curve (`afmdyn bimodal`, Python's

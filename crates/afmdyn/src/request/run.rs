@@ -150,7 +150,7 @@ pub struct ModesRequest {}
 impl Analysis for ModesRequest {
     type Output = (RegionSpectrum, RegionSpectrum);
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
-        Ok(model.params.validate()?)
+        Ok(model.params.validate_fields()?)
     }
     fn execute(&self, model: &Resolved, _: &Progress) -> Result<Self::Output, SimError> {
         Ok(spectrum(&model.params)?)
@@ -257,6 +257,12 @@ pub struct ApproachRequest {
     /// the operating points where the curve's amplitude equals it
     /// ([`crate::analysis::setpoint`]).
     pub setpoint: Option<f64>,
+    /// Measure every point by the time average of a multifrequency drive
+    /// ([`crate::analysis::stepped::average`]) instead of its periodic orbit; always so for a
+    /// quasi-periodic drive ([`Params::is_quasiperiodic`]). No branches then.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    #[cfg_attr(feature = "schema", schemars(extend("default" = false)))]
+    pub average: bool,
 }
 
 impl ApproachRequest {
@@ -284,7 +290,13 @@ impl ApproachRequest {
                 ));
             }
         }
-        approach_request(model.params, &self.curve, Self::units(model).length)
+        let average = self.average || model.params.is_quasiperiodic();
+        approach_request(
+            model.params,
+            &self.curve,
+            Self::units(model).length,
+            average,
+        )
     }
 }
 

@@ -12,7 +12,7 @@ use crate::analysis::continuation::{
 use crate::analysis::progress::Progress;
 use crate::analysis::shooting::shoot_with;
 use crate::error::SimError;
-use nalgebra::DVector;
+use nalgebra::{Complex, DVector};
 
 /// Continue the branch through `from` (a stable orbit of a sweep) towards `to`, with
 /// observables at every point.
@@ -119,6 +119,8 @@ pub(super) fn branch_starts(
             monodromy: Some(o.monodromy),
             reached: Reached::Start,
             observables,
+            tau: 0.0,
+            average: None,
         });
     }
     starts
@@ -151,6 +153,25 @@ pub(super) fn unstable_between_folds(br: &[BranchSample]) -> Vec<(f64, f64)> {
     out
 }
 
+/// How far apart two successive points of a sweep are: their states' relative gap, or for
+/// time-averaged points (whose states are at different τ) the largest change of a component's
+/// phasor A_i e^{iφ_i} relative to its free amplitude.
+fn point_gap(a: &CurvePoint, b: &CurvePoint) -> f64 {
+    if a.average.is_none() || b.average.is_none() {
+        return relative_gap(&b.state, &a.state);
+    }
+    a.observables
+        .components
+        .iter()
+        .zip(&b.observables.components)
+        .map(|(x, y)| {
+            let d = Complex::from_polar(x.amplitude, x.phase)
+                - Complex::from_polar(y.amplitude, y.phase);
+            d.norm() / x.free_amplitude
+        })
+        .fold(0.0, f64::max)
+}
+
 /// Jumps of one sweep: points reached by settling on an orbit away from the previous one.
 pub(super) fn jumps_of(
     which: Sweep,
@@ -159,10 +180,28 @@ pub(super) fn jumps_of(
     jump_tol: f64,
 ) -> Vec<Jump> {
     let mut out = Vec::new();
+    let gaps: Vec<f64> = (1..points.len())
+        .map(|i| point_gap(&points[i - 1], &points[i]))
+        .collect();
     for i in 1..points.len() {
         let (a, b) = (&points[i - 1], &points[i]);
-        if b.reached != Reached::Settled || relative_gap(&b.state, &a.state) <= jump_tol {
+        let gap = gaps[i - 1];
+        if b.reached != Reached::Settled || gap <= jump_tol {
             continue;
+        }
+        // every time-averaged point is reached by settling: a jump is a step that stands out
+        // from its neighbours' (the motion's smooth change over one grid step is not; a sweep
+        // of two points has no neighbour to tell them apart)
+        if b.average.is_some() {
+            let next = gaps.get(i).copied();
+            let before = (i >= 2).then(|| gaps[i - 2]);
+            let neighbour = next
+                .into_iter()
+                .chain(before)
+                .fold(None, |m: Option<f64>, g| Some(m.map_or(g, |m| m.max(g))));
+            if neighbour.is_none_or(|n| gap <= 2.0 * n) {
+                continue;
+            }
         }
         let step = (b.value - a.value).abs();
         let (lo, hi) = (a.value.min(b.value) - step, a.value.max(b.value) + step);

@@ -49,7 +49,9 @@ use nalgebra::{Complex, DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 use std::sync::atomic::{AtomicBool, Ordering};
 
+pub mod average;
 mod branches;
+use average::{average_point, AverageEstimate, AverageOptions};
 use branches::{branch, branch_starts, jumps_of, on_branch, unstable_between_folds};
 
 /// Largest number of values of a stepped sweep (each is a steady-state computation, twice).
@@ -161,6 +163,10 @@ pub struct SteppedSpec {
     /// Samples per drive period of the per-point traces of the first sweep
     /// ([`super::traces`]); 0: none.
     pub trace_samples: usize,
+    /// Measure every point by the time average ([`average`]) instead of the periodic orbit:
+    /// what a quasi-periodic drive needs ([`Params::is_quasiperiodic`]); no branches, traces
+    /// or Floquet multipliers then.
+    pub average: Option<AverageOptions>,
 }
 
 impl SteppedSpec {
@@ -191,6 +197,7 @@ impl SteppedSpec {
             branches: true,
             max_branch_points: 2000,
             trace_samples: 0,
+            average: None,
         }
     }
 }
@@ -228,8 +235,20 @@ pub struct CurvePoint {
     pub stable: bool,
     /// How it was reached.
     pub reached: Reached,
-    /// Observables over one cycle (n periods; `steady.nonperiodic_record` periods otherwise).
+    /// Observables over one cycle (n periods; `steady.nonperiodic_record` periods otherwise;
+    /// the measured Hann window of a time-averaged point).
     pub observables: Observables,
+    /// τ of `state`: 0 but for a time-averaged point, whose state is where its window ended
+    /// (the next point goes on from it).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub tau: f64,
+    /// The convergence estimate of a time-averaged point ([`average`]); `None` for an orbit.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub average: Option<AverageEstimate>,
+}
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
 }
 
 /// One point of a continued branch with its observables.
@@ -292,6 +311,28 @@ pub struct SteppedCurve {
     /// One steady-state cycle per point of the first sweep, when
     /// [`SteppedSpec::trace_samples`] > 0.
     pub traces: Option<super::traces::Traces>,
+    /// The time average's options when the points were measured by it ([`average`]; each
+    /// point's estimate is its [`CurvePoint::average`]).
+    pub average: Option<AverageOptions>,
+}
+
+/// Why a time average may not settle ([`average::slowest_beat`]): the clause for the
+/// warning when the slowest beat of the combination tones is longer than the settling window,
+/// or empty.
+fn slow_beat(base: &Params, window_periods: usize) -> String {
+    match average::slowest_beat(base) {
+        Some((p, q, r, beat)) if average::BEATS_PER_WINDOW * beat > window_periods as f64 => {
+            format!(
+                "; f/f1 = {} lies {:.1e} from {p}/{q}: the motion beats every {beat:.0} drive \
+                 periods, and the settling window of {window_periods} holds fewer than {} beats \
+                 (a frequency ratio of exactly {p}/{q} gives the periodic orbit)",
+                crate::error::number(r),
+                (r - f64::from(p) / f64::from(q)).abs(),
+                average::BEATS_PER_WINDOW,
+            )
+        }
+        _ => String::new(),
+    }
 }
 
 /// Observables of a period-n orbit (or `record` periods of a motion) from `z` at τ = 0.
@@ -590,6 +631,9 @@ fn step_point(
     history: &[CurvePoint],
 ) -> Result<CurvePoint, SimError> {
     let prev = history.last();
+    if let Some(opts) = &spec.average {
+        return average_point(spec, opts, value, prev);
+    }
     let model = CantileverModel::new(&spec.base.with(spec.param, value))?;
     let last = prev.map_or_else(|| model.rest(), |p| p.state.clone());
     let n = prev.and_then(|p| p.period).unwrap_or(1);
@@ -649,6 +693,8 @@ fn step_point(
         stable: found.stable,
         reached,
         observables,
+        tau: 0.0,
+        average: None,
     })
 }
 
@@ -712,7 +758,37 @@ pub fn check_values(spec: &SteppedSpec) -> Result<(), SimError> {
         crate::error::finite("sweep value", v)?;
     }
     for &v in [spec.values[0], spec.values[spec.values.len() - 1]].iter() {
-        spec.base.with(spec.param, v).validate()?;
+        let p = spec.base.with(spec.param, v);
+        match spec.average {
+            Some(_) => p.validate_fields()?,
+            None => p.validate()?,
+        }
+    }
+    if let Some(a) = &spec.average {
+        a.check()?;
+        if !spec.base.is_multifrequency() {
+            return Err(SimError::out_of_range(
+                "average",
+                "one drive component",
+                "the time average is for a multifrequency drive; a single-frequency curve is \
+                 measured on its exact periodic orbits",
+            ));
+        }
+        if spec.branches || spec.trace_samples > 0 {
+            return Err(SimError::out_of_range(
+                if spec.branches { "branches" } else { "traces" },
+                true,
+                "not with the time average, which follows the motion in time (no periodic \
+                 orbits to continue or to trace)",
+            ));
+        }
+    } else if spec.base.is_quasiperiodic() {
+        return Err(SimError::out_of_range(
+            "average",
+            false,
+            "a quasi-periodic drive (common period beyond 1000 drive periods) has no periodic \
+             orbit: measure it by the time average",
+        ));
     }
     Ok(())
 }
@@ -760,11 +836,41 @@ pub fn finish_curve(
 ) -> Result<SteppedCurve, SimError> {
     let mut warnings = Vec::new();
     let q = spec.base.common_periods();
-    if q > SLOW_COMMON_PERIODS {
+    let unsettled = first
+        .iter()
+        .chain(&second)
+        .filter(|p| p.average.as_ref().is_some_and(|a| !a.settled))
+        .count();
+    if unsettled > 0 {
+        warnings.push(format!(
+            "{unsettled} time-averaged point(s) did not settle within their transient cap (their \
+             components' windows still differed by more than the tolerance): their values and \
+             error estimates are those of the last windows{}",
+            spec.average
+                .as_ref()
+                .map(|a| slow_beat(&spec.base, a.window_periods))
+                .unwrap_or_default()
+        ));
+    }
+    if spec.average.is_some() && spec.base.is_quasiperiodic() {
+        warnings.push(format!(
+            "the drive's frequency ratio ({}) repeats only after more than {} drive periods \
+             (quasi-periodic): every point is a time average, with its error estimate in \
+             time_average",
+            spec.base
+                .components()
+                .map(|c| format!("{}/{}", c.ratio[0], c.ratio[1]))
+                .collect::<Vec<_>>()
+                .join(", "),
+            crate::params::MAX_COMMON_PERIODS
+        ));
+    }
+    if q > SLOW_COMMON_PERIODS && spec.average.is_none() {
         warnings.push(format!(
             "the multifrequency drive repeats only every {q} drive periods (its frequency ratio \
              {}): every orbit spans them all; a ratio p/q with a small q (e.g. f2 = 6.25 f1) \
-             is as many times faster",
+             is as many times faster, and the time average (bimodal --average) does not \
+             depend on q",
             spec.base
                 .components()
                 .map(|c| format!("{}/{}", c.ratio[0], c.ratio[1]))
@@ -845,6 +951,7 @@ pub fn finish_curve(
         bistable,
         warnings,
         traces,
+        average: spec.average,
     })
 }
 
