@@ -64,6 +64,7 @@ pub mod contact;
 pub mod eigen;
 pub mod error;
 pub mod galerkin;
+pub mod hydro;
 pub mod integrate;
 pub mod layout;
 mod linalg;

@@ -1,0 +1,268 @@
+//! Hydrodynamic loading of a rectangular cantilever in a viscous fluid: Sader's hydrodynamic
+//! function (J. E. Sader, *J. Appl. Phys.* 84, 64 (1998)) and the wet resonance frequency and
+//! quality factor of each flexural mode it gives.
+//!
+//! A beam of width b vibrating at angular frequency ω in a fluid of density ρ and viscosity η
+//! feels, per unit length, the force −(π/4)ρb²ω² Γ(ω) W(ω) on its deflection W: an added mass
+//! (π/4)ρb² Γ_r and a damping (π/4)ρb²ω Γ_i per unit length. Γ depends on ω only through the
+//! Reynolds number Re = ρωb²/(4η) (Sader 1998, eq. 7). For a beam of circular cross-section
+//! of diameter b it is exact (Sader 1998, eq. 19, after Rosenhead):
+//!
+//! Γ_circ(Re) = 1 + 4 K₁(z) / (z K₀(z)),  z = −i √(i Re),
+//!
+//! with K₀, K₁ the modified Bessel functions of the second kind (`complex_bessel`, Amos'
+//! algorithm, ACM TOMS 644); for the rectangular section, Γ_rect = Ω(Re) Γ_circ(Re) with the
+//! rational fits Ω_r, Ω_i in τ = log₁₀ Re of Sader 1998, eq. 21 (accurate to 0.1 % against his
+//! boundary-integral results over 1e-6 ≤ Re ≤ 1e4, the range accepted here).
+//!
+//! **Wet modes** (Sader 1998, eqs. 18 and 20, for Q ≫ 1, as used by Chon, Mulvaney & Sader,
+//! *J. Appl. Phys.* 87, 3978 (2000)): a mode of vacuum angular frequency ω_vac resonates in
+//! the fluid at ω_f with
+//!
+//! ω_f = ω_vac (1 + T Γ_r(Re(ω_f)))^{−1/2},  T = πρb / (4ρ_c h),
+//!
+//! (ρ_c, h the beam's density and thickness) and quality factor
+//! Q = (1/T + Γ_r(ω_f)) / Γ_i(ω_f). The equation for ω_f is solved by bisection in ln ω:
+//! ω²(1 + TΓ_r) grows with ω (Γ_r falls more slowly than 1/ω), so its root is unique.
+//!
+//! Status (issue 45): the hydrodynamic function and the wet modes; the medium is not yet a
+//! probe section, nor are the modes' added mass and damping in the models.
+
+use crate::error::SimError;
+use crate::units::Cantilever;
+use nalgebra::Complex;
+use serde::{Deserialize, Serialize};
+use std::f64::consts::PI;
+
+/// Smallest Reynolds number of Sader's fit Ω (1998, eq. 21).
+pub const MIN_REYNOLDS: f64 = 1e-6;
+/// Largest Reynolds number of Sader's fit Ω.
+pub const MAX_REYNOLDS: f64 = 1e4;
+
+/// A Newtonian fluid around the cantilever.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Medium {
+    /// Density ρ (kg/m³), > 0.
+    pub density: f64,
+    /// Dynamic viscosity η (Pa s), > 0.
+    pub viscosity: f64,
+}
+
+impl Medium {
+    /// Water at 25 °C: ρ = 997.05 kg/m³, η = 0.890 mPa s (CRC Handbook of Chemistry and
+    /// Physics, 97th ed., 2016, §6, "Properties of water in the range 0–100 °C" and
+    /// "Viscosity of liquids").
+    pub const WATER: Medium = Medium {
+        density: 997.05,
+        viscosity: 8.90e-4,
+    };
+    /// Dry air at 25 °C and 101.325 kPa: ρ = 1.184 kg/m³, η = 18.49 µPa s (CRC Handbook, 97th
+    /// ed., §6, "Properties of air" and "Viscosity of gases").
+    pub const AIR: Medium = Medium {
+        density: 1.184,
+        viscosity: 1.849e-5,
+    };
+
+    /// A preset by name: `"water"` or `"air"`.
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming `medium` for another name.
+    pub fn named(name: &str) -> Result<Medium, SimError> {
+        match name {
+            "water" => Ok(Medium::WATER),
+            "air" => Ok(Medium::AIR),
+            _ => Err(SimError::out_of_range(
+                "medium",
+                name,
+                "must be \"water\" or \"air\" (or give density and viscosity)",
+            )),
+        }
+    }
+
+    /// Check that density and viscosity are finite and positive.
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming the field.
+    pub fn validate(&self) -> Result<(), SimError> {
+        for (name, v, allowed) in [
+            (
+                "medium.density",
+                self.density,
+                "must be finite and > 0 (kg/m^3)",
+            ),
+            (
+                "medium.viscosity",
+                self.viscosity,
+                "must be finite and > 0 (Pa s)",
+            ),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(SimError::out_of_range(name, v, allowed));
+            }
+        }
+        Ok(())
+    }
+
+    /// The Reynolds number Re = ρωb²/(4η) of a beam of width `width` (m) vibrating at angular
+    /// frequency `omega` (rad/s) (Sader 1998, eq. 7).
+    pub fn reynolds(&self, omega: f64, width: f64) -> f64 {
+        self.density * omega * width * width / (4.0 * self.viscosity)
+    }
+}
+
+/// Check that `re` lies in Sader's range [[`MIN_REYNOLDS`], [`MAX_REYNOLDS`]].
+fn check_reynolds(re: f64) -> Result<f64, SimError> {
+    if (MIN_REYNOLDS..=MAX_REYNOLDS).contains(&re) {
+        Ok(re)
+    } else {
+        Err(SimError::out_of_range(
+            "reynolds",
+            re,
+            "must be in [1e-6, 1e4], the range of Sader's hydrodynamic function (Re = ρωb²/(4η))",
+        ))
+    }
+}
+
+/// Γ_circ(Re) = 1 + 4K₁(z)/(zK₀(z)), z = −i√(iRe): the hydrodynamic function of a circular
+/// cylinder (module docs).
+///
+/// # Errors
+/// [`SimError::OutOfRange`] for Re outside [[`MIN_REYNOLDS`], [`MAX_REYNOLDS`]] (or not
+/// finite); [`SimError::OutOfRange`] naming `bessel` should the Bessel functions fail.
+pub fn gamma_circular(re: f64) -> Result<Complex<f64>, SimError> {
+    let re = check_reynolds(re)?;
+    let i = Complex::<f64>::i();
+    let z = -i * (i * re).sqrt();
+    let k = |nu: f64| {
+        complex_bessel::besselk(nu, z)
+            .map_err(|_| SimError::out_of_range("bessel", re, "K_0, K_1 of −i√(iRe) failed"))
+    };
+    let (k0, k1) = (k(0.0)?, k(1.0)?);
+    Ok(Complex::new(1.0, 0.0) + 4.0 * k1 / (z * k0))
+}
+
+/// Ω(Re): Sader's rational fits (1998, eq. 21) of the rectangular section's correction to
+/// Γ_circ, in τ = log₁₀ Re.
+///
+/// # Errors
+/// [`SimError::OutOfRange`] for Re outside [[`MIN_REYNOLDS`], [`MAX_REYNOLDS`]].
+pub fn rectangular_correction(re: f64) -> Result<Complex<f64>, SimError> {
+    let tau = check_reynolds(re)?.log10();
+    // Horner's rule on coefficients in ascending powers of τ
+    let poly = |c: &[f64]| c.iter().rev().fold(0.0, |acc, &a| acc * tau + a);
+    let real = poly(&[
+        0.91324, -0.48274, 0.46842, -0.12886, 0.044055, -0.0035117, 0.00069085,
+    ]) / poly(&[
+        1.0, -0.56964, 0.48690, -0.13444, 0.045155, -0.0035862, 0.00069085,
+    ]);
+    let imag = poly(&[
+        -0.024134,
+        -0.029256,
+        0.016294,
+        -0.00010961,
+        0.000064577,
+        -0.000044510,
+    ]) / poly(&[
+        1.0, -0.59702, 0.55182, -0.18357, 0.079156, -0.014369, 0.0028361,
+    ]);
+    Ok(Complex::new(real, imag))
+}
+
+/// Γ_rect(Re) = Ω(Re) Γ_circ(Re): the hydrodynamic function of a thin rectangular beam
+/// (module docs). Γ_r (added mass) and Γ_i (damping) are both positive.
+///
+/// # Errors
+/// As [`gamma_circular`].
+pub fn gamma_rectangular(re: f64) -> Result<Complex<f64>, SimError> {
+    Ok(rectangular_correction(re)? * gamma_circular(re)?)
+}
+
+/// One flexural mode in the fluid (module docs).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct WetMode {
+    /// Resonance frequency in the fluid f_f = ω_f/2π (Hz).
+    pub frequency_hz: f64,
+    /// Quality factor Q = (1/T + Γ_r)/Γ_i from the fluid alone (a lever's internal and
+    /// support losses come on top).
+    pub quality_factor: f64,
+    /// The added mass relative to the beam's, T Γ_r(ω_f): f_f = f_vac/√(1 + this).
+    pub added_mass_ratio: f64,
+    /// Re at ω_f.
+    pub reynolds: f64,
+    /// Γ_rect(Re) at ω_f.
+    pub gamma: Complex<f64>,
+}
+
+/// The mode of vacuum frequency `vacuum_frequency_hz` of the rectangular beam `beam` (its
+/// width, thickness and density) in `medium`: the wet frequency, quality factor and added mass
+/// (module docs).
+///
+/// # Errors
+/// [`SimError::OutOfRange`] naming the field for an invalid beam, medium or frequency, or
+/// `reynolds` when the wet mode's Re leaves Sader's range.
+pub fn wet_mode(
+    vacuum_frequency_hz: f64,
+    beam: &Cantilever,
+    medium: &Medium,
+) -> Result<WetMode, SimError> {
+    beam.validate()
+        .map_err(|e| SimError::out_of_range("cantilever", e, "a valid rectangular beam"))?;
+    medium.validate()?;
+    if !(vacuum_frequency_hz.is_finite() && vacuum_frequency_hz > 0.0) {
+        return Err(SimError::out_of_range(
+            "vacuum_frequency_hz",
+            vacuum_frequency_hz,
+            "must be finite and > 0 (Hz)",
+        ));
+    }
+    let omega_vac = 2.0 * PI * vacuum_frequency_hz;
+    let t = PI * medium.density * beam.width / (4.0 * beam.density * beam.thickness);
+    let b = beam.width;
+    // g(ω) = ω²(1 + TΓ_r) − ω_vac², increasing in ω; g(ω_vac) ≥ 0 since Γ_r > 0
+    let g = |omega: f64| -> Result<f64, SimError> {
+        let gr = gamma_rectangular(medium.reynolds(omega, b))?.re;
+        Ok(omega * omega * (1.0 + t * gr) - omega_vac * omega_vac)
+    };
+    // the bracket: down from ω_vac by factors of 2 until g < 0 (Re stays in range or errs)
+    let mut hi = omega_vac;
+    let mut lo = 0.5 * omega_vac;
+    let mut found = false;
+    for _ in 0..60 {
+        if g(lo)? < 0.0 {
+            found = true;
+            break;
+        }
+        hi = lo;
+        lo *= 0.5;
+    }
+    if !found {
+        return Err(SimError::out_of_range(
+            "medium",
+            medium.density,
+            "no wet resonance within 60 octaves below the vacuum frequency",
+        ));
+    }
+    // bisection in ln ω to round-off
+    let (mut a, mut c) = (lo.ln(), hi.ln());
+    for _ in 0..200 {
+        let m = 0.5 * (a + c);
+        if m <= a || m >= c {
+            break;
+        }
+        if g(m.exp())? < 0.0 {
+            a = m;
+        } else {
+            c = m;
+        }
+    }
+    let omega = (0.5 * (a + c)).exp();
+    let re = medium.reynolds(omega, b);
+    let gamma = gamma_rectangular(re)?;
+    Ok(WetMode {
+        frequency_hz: omega / (2.0 * PI),
+        quality_factor: (1.0 / t + gamma.re) / gamma.im,
+        added_mass_ratio: t * gamma.re,
+        reynolds: re,
+        gamma,
+    })
+}
