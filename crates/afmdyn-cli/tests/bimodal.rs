@@ -227,3 +227,39 @@ fn an_incommensurate_ratio_is_averaged_and_says_so() {
         "{a2:?}"
     );
 }
+
+/// A time-averaged curve killed after 3 points resumes from the last stored point's end state
+/// (τ and z) to the files of the uninterrupted curve, byte for byte; resuming it without
+/// `--average` is another request, refused naming it.
+#[test]
+fn a_killed_average_resumes_to_the_uninterrupted_files() {
+    let (full, cut) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+    let curve = |dir: &std::path::Path, extra: &[&str]| {
+        let base = [
+            "bimodal", "--probe", PROBE, "--from", "12nm", "--to", "8nm", "--points", "4",
+            "--files", "data", "--out",
+        ];
+        afmdyn(&[&base[..], &[dir.to_str().unwrap()], extra].concat())
+    };
+    assert!(curve(full.path(), &["--average"]).status.success());
+    assert!(!curve(cut.path(), &["--average", "--abort-after", "3"])
+        .status
+        .success());
+    let other = curve(cut.path(), &["--resume", "--no-branches"]);
+    assert_eq!(other.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&other.stderr);
+    assert!(err.contains("average"), "{err}");
+    let resumed = curve(cut.path(), &["--average", "--resume"]);
+    assert!(
+        resumed.status.success(),
+        "{}",
+        String::from_utf8_lossy(&resumed.stderr)
+    );
+    for f in ["bimodal.csv", "bimodal.npy"] {
+        assert!(
+            std::fs::read(full.path().join(f)).unwrap()
+                == std::fs::read(cut.path().join(f)).unwrap(),
+            "{f}: the resumed curve differs"
+        );
+    }
+}
