@@ -26,13 +26,17 @@ def test_notebook_executes_and_shows_the_results():
     text = []
     figures = 0
     for cell in nb.cells:
+        # a cell's stdout and stderr each as one string: the kernel may split a stream into
+        # several outputs anywhere (under load, inside a line)
+        streams = {"stdout": "", "stderr": ""}
         for out in cell.get("outputs", []):
             assert out.output_type != "error", out
             if out.output_type == "stream":
-                text.append(out.text)
+                streams[out.name] = streams.get(out.name, "") + out.text
             data = out.get("data", {})
             text.append(data.get("text/plain", ""))
             figures += "image/png" in data
+        text.extend(streams.values())
     text = "\n".join(text)
     assert "7.79,  20.33,  55.81" in text  # paper eq. 25
     assert "Attractor(nonperiodic" in text

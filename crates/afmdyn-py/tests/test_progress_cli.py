@@ -15,10 +15,10 @@ import pytest
 
 from conftest import _binary
 
-# 96 random starts of the impact oscillator: 3–5 s on this machine, so the bar (drawn after
-# the first second) shows
+# 400 random starts of the impact oscillator: about 4 s on this machine (2 cores; 96 starts
+# had become 1 s, when the bar, drawn after the first second, may not show), so the bar shows
 SLOW = ["attractors", "--contact-law", "impact", "--restitution", "0.7", "--omega", "2.6",
-        "--samples", "96"]
+        "--samples", "400"]
 
 
 @pytest.mark.skipif(sys.platform == "win32", reason="needs a pseudo-terminal")
@@ -41,8 +41,8 @@ def test_a_slow_run_shows_a_progress_bar_on_a_terminal():
         seen += chunk
     assert proc.wait(timeout=120) == 0
     text = seen.decode("utf-8", "replace")
-    # "████░░ 23/96 starts  1s / ~3s": done/total, the unit, elapsed and the estimate
-    assert re.search(r"\d+/96 starts", text), text[-500:]
+    # "████░░ 23/400 starts  1s / ~3s": done/total, the unit, elapsed and the estimate
+    assert re.search(r"\d+/400 starts", text), text[-500:]
 
 
 def test_piped_runs_print_no_bar(cli):
