@@ -852,30 +852,27 @@ pub fn finish_curve(
                 .unwrap_or_default()
         ));
     }
+    // the components' ratios p/q, for the warnings
+    let ratios = spec
+        .base
+        .components()
+        .map(|c| format!("{}/{}", c.ratio[0], c.ratio[1]))
+        .collect::<Vec<_>>()
+        .join(", ");
     if spec.average.is_some() && spec.base.is_quasiperiodic() {
         warnings.push(format!(
-            "the drive's frequency ratio ({}) repeats only after more than {} drive periods \
-             (quasi-periodic): every point is a time average, with its error estimate in \
-             time_average",
-            spec.base
-                .components()
-                .map(|c| format!("{}/{}", c.ratio[0], c.ratio[1]))
-                .collect::<Vec<_>>()
-                .join(", "),
+            "the drive's frequency ratio ({ratios}) repeats only after more than {} drive \
+             periods (quasi-periodic): every point is a time average, with its error estimate \
+             in time_average",
             crate::params::MAX_COMMON_PERIODS
         ));
     }
     if q > SLOW_COMMON_PERIODS && spec.average.is_none() {
         warnings.push(format!(
             "the multifrequency drive repeats only every {q} drive periods (its frequency ratio \
-             {}): every orbit spans them all; a ratio p/q with a small q (e.g. f2 = 6.25 f1) \
-             is as many times faster, and the time average (bimodal --average) does not \
-             depend on q",
-            spec.base
-                .components()
-                .map(|c| format!("{}/{}", c.ratio[0], c.ratio[1]))
-                .collect::<Vec<_>>()
-                .join(", ")
+             {ratios}): every orbit spans them all; a ratio p/q with a small q (e.g. f2 = 6.25 \
+             f1) is as many times faster, and the time average (bimodal --average) does not \
+             depend on q"
         ));
     }
     let mut branches: Vec<Vec<BranchSample>> = Vec::new();
