@@ -5,17 +5,17 @@
 //! A beam of width b vibrating at angular frequency ω in a fluid of density ρ and viscosity η
 //! feels, per unit length, the force −(π/4)ρb²ω² Γ(ω) W(ω) on its deflection W: an added mass
 //! (π/4)ρb² Γ_r and a damping (π/4)ρb²ω Γ_i per unit length. Γ depends on ω only through the
-//! Reynolds number Re = ρωb²/(4η) (Sader 1998, §II). For a beam of circular cross-section of
-//! diameter b it is exact (Sader 1998, §II, after Rosenhead's oscillating cylinder):
+//! Reynolds number Re = ρωb²/(4η) (Sader 1998). For a beam of circular cross-section of
+//! diameter b it is exact (Sader 1998, after Rosenhead's oscillating cylinder):
 //!
 //! Γ_circ(Re) = 1 + 4 K₁(z) / (z K₀(z)),  z = −i √(i Re),
 //!
 //! with K₀, K₁ the modified Bessel functions of the second kind (`complex_bessel`, Amos'
 //! algorithm, ACM TOMS 644); for the rectangular section, Γ_rect = Ω(Re) Γ_circ(Re) with the
-//! rational fits Ω_r, Ω_i in τ = log₁₀ Re of Sader 1998, §II (accurate to 0.1 % against his
+//! rational fits Ω_r, Ω_i in τ = log₁₀ Re of Sader 1998 (accurate to 0.1 % against his
 //! boundary-integral results over 1e-6 ≤ Re ≤ 1e4, the range accepted here).
 //!
-//! **Wet modes** (Sader 1998, §III, for Q ≫ 1, as used by Chon, Mulvaney & Sader,
+//! **Wet modes** (Sader 1998, for Q ≫ 1, as used by Chon, Mulvaney & Sader,
 //! *J. Appl. Phys.* 87, 3978 (2000)): a mode of vacuum angular frequency ω_vac resonates in
 //! the fluid at ω_f with
 //!
