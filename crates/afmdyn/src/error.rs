@@ -181,6 +181,9 @@ pub enum SimError {
     /// Invalid model parameters.
     #[error(transparent)]
     Params(#[from] ParamError),
+    /// A physical (SI) input out of range ([`crate::units`], [`crate::hydro`]).
+    #[error(transparent)]
+    Units(#[from] UnitsError),
     /// A state vector has the wrong length.
     #[error("{name}: expected {expected} values, got {got}")]
     StateLength {
@@ -326,6 +329,7 @@ impl SimError {
         matches!(
             self,
             SimError::Params(_)
+                | SimError::Units(_)
                 | SimError::Probe(_)
                 | SimError::StateLength { .. }
                 | SimError::NotFinite { .. }

@@ -28,8 +28,8 @@
 //! Status (issue 45): the hydrodynamic function and the wet modes; the medium is not yet a
 //! probe section, nor are the modes' added mass and damping in the models.
 
-use crate::error::SimError;
-use crate::units::Cantilever;
+use crate::error::{SimError, UnitsError};
+use crate::units::{positive, Cantilever};
 use nalgebra::Complex;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
@@ -63,43 +63,33 @@ impl Medium {
         viscosity: 1.849e-5,
     };
 
-    /// A preset by name: `"water"` or `"air"`.
+    /// A preset by name ([`MEDIA`], case-insensitive).
     ///
     /// # Errors
-    /// [`SimError::OutOfRange`] naming `medium` for another name.
-    pub fn named(name: &str) -> Result<Medium, SimError> {
-        match name {
-            "water" => Ok(Medium::WATER),
-            "air" => Ok(Medium::AIR),
-            _ => Err(SimError::out_of_range(
-                "medium",
-                name,
-                "must be \"water\" or \"air\" (or give density and viscosity)",
-            )),
-        }
+    /// [`UnitsError::Choice`] naming `medium` and listing the presets.
+    pub fn named(name: &str) -> Result<Medium, UnitsError> {
+        let key = name.trim().to_ascii_lowercase();
+        MEDIA
+            .iter()
+            .find(|(n, _)| *n == key)
+            .map(|(_, m)| *m)
+            .ok_or_else(|| {
+                let names: Vec<&str> = MEDIA.iter().map(|(n, _)| *n).collect();
+                UnitsError::Choice(format!(
+                    "medium = '{name}': unknown, expected one of {} (or give density and \
+                     viscosity)",
+                    names.join(", ")
+                ))
+            })
     }
 
     /// Check that density and viscosity are finite and positive.
     ///
     /// # Errors
-    /// [`SimError::OutOfRange`] naming the field.
-    pub fn validate(&self) -> Result<(), SimError> {
-        for (name, v, allowed) in [
-            (
-                "medium.density",
-                self.density,
-                "must be finite and > 0 (kg/m^3)",
-            ),
-            (
-                "medium.viscosity",
-                self.viscosity,
-                "must be finite and > 0 (Pa s)",
-            ),
-        ] {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(SimError::out_of_range(name, v, allowed));
-            }
-        }
+    /// [`UnitsError::Positive`] naming the field.
+    pub fn validate(&self) -> Result<(), UnitsError> {
+        positive("medium.density", self.density, "kg/m^3")?;
+        positive("medium.viscosity", self.viscosity, "Pa s")?;
         Ok(())
     }
 
@@ -109,6 +99,9 @@ impl Medium {
         self.density * omega * width * width / (4.0 * self.viscosity)
     }
 }
+
+/// The media by name: `water`, `air` ([`Medium::WATER`], [`Medium::AIR`]).
+pub const MEDIA: [(&str, Medium); 2] = [("water", Medium::WATER), ("air", Medium::AIR)];
 
 /// Check that `re` lies in Sader's range [[`MIN_REYNOLDS`], [`MAX_REYNOLDS`]].
 fn check_reynolds(re: f64) -> Result<f64, SimError> {
@@ -198,23 +191,16 @@ pub struct WetMode {
 /// (module docs).
 ///
 /// # Errors
-/// [`SimError::OutOfRange`] naming the field for an invalid beam, medium or frequency, or
-/// `reynolds` when the wet mode's Re leaves Sader's range.
+/// [`SimError::Units`] naming the field for an invalid beam, medium or frequency;
+/// [`SimError::OutOfRange`] naming `reynolds` when the wet mode's Re leaves Sader's range.
 pub fn wet_mode(
     vacuum_frequency_hz: f64,
     beam: &Cantilever,
     medium: &Medium,
 ) -> Result<WetMode, SimError> {
-    beam.validate()
-        .map_err(|e| SimError::out_of_range("cantilever", e, "a valid rectangular beam"))?;
+    beam.validate()?;
     medium.validate()?;
-    if !(vacuum_frequency_hz.is_finite() && vacuum_frequency_hz > 0.0) {
-        return Err(SimError::out_of_range(
-            "vacuum_frequency_hz",
-            vacuum_frequency_hz,
-            "must be finite and > 0 (Hz)",
-        ));
-    }
+    positive("vacuum_frequency_hz", vacuum_frequency_hz, "Hz")?;
     let omega_vac = 2.0 * PI * vacuum_frequency_hz;
     let t = PI * medium.density * beam.width / (4.0 * beam.density * beam.thickness);
     let b = beam.width;

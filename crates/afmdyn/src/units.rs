@@ -389,7 +389,12 @@ pub fn contact_stiffness(k: ContactStiffness) -> Result<f64, UnitsError> {
     }
 }
 
-fn positive(name: &'static str, value: f64, unit: &'static str) -> Result<f64, UnitsError> {
+/// `value` if finite and > 0, else [`UnitsError::Positive`] naming `name` and its `unit`.
+pub(crate) fn positive(
+    name: &'static str,
+    value: f64,
+    unit: &'static str,
+) -> Result<f64, UnitsError> {
     if value.is_finite() && value > 0.0 {
         Ok(value)
     } else {
