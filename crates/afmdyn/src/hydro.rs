@@ -29,7 +29,7 @@
 //! probe section, nor are the modes' added mass and damping in the models.
 
 use crate::error::{SimError, UnitsError};
-use crate::units::{positive, Cantilever};
+use crate::units::{positive, preset, Cantilever};
 use nalgebra::Complex;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
@@ -68,19 +68,7 @@ impl Medium {
     /// # Errors
     /// [`UnitsError::Choice`] naming `medium` and listing the presets.
     pub fn named(name: &str) -> Result<Medium, UnitsError> {
-        let key = name.trim().to_ascii_lowercase();
-        MEDIA
-            .iter()
-            .find(|(n, _)| *n == key)
-            .map(|(_, m)| *m)
-            .ok_or_else(|| {
-                let names: Vec<&str> = MEDIA.iter().map(|(n, _)| *n).collect();
-                UnitsError::Choice(format!(
-                    "medium = '{name}': unknown, expected one of {} (or give density and \
-                     viscosity)",
-                    names.join(", ")
-                ))
-            })
+        preset(&MEDIA, name, "medium", "medium")
     }
 
     /// Check that density and viscosity are finite and positive.

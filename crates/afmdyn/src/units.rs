@@ -73,15 +73,26 @@ pub const SAMPLE_MATERIALS: &[(&str, Material)] = &[
 /// # Errors
 /// [`UnitsError::Choice`] listing the known names.
 pub fn material(name: &str) -> Result<Material, UnitsError> {
-    let key = name.trim().to_ascii_lowercase();
-    SAMPLE_MATERIALS
+    preset(SAMPLE_MATERIALS, name, "sample", "material")
+}
+
+/// The entry of `table` named `name` (case-insensitive, trimmed); else [`UnitsError::Choice`]
+/// "`key` = 'name': unknown `what`, expected one of …" listing the names.
+pub(crate) fn preset<T: Copy>(
+    table: &[(&str, T)],
+    name: &str,
+    key: &str,
+    what: &str,
+) -> Result<T, UnitsError> {
+    let wanted = name.trim().to_ascii_lowercase();
+    table
         .iter()
-        .find(|(n, _)| *n == key)
+        .find(|(n, _)| *n == wanted)
         .map(|(_, m)| *m)
         .ok_or_else(|| {
-            let names: Vec<&str> = SAMPLE_MATERIALS.iter().map(|(n, _)| *n).collect();
+            let names: Vec<&str> = table.iter().map(|(n, _)| *n).collect();
             UnitsError::Choice(format!(
-                "sample = '{name}': unknown material, expected one of {}",
+                "{key} = '{name}': unknown {what}, expected one of {}",
                 names.join(", ")
             ))
         })
