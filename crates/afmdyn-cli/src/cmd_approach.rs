@@ -312,6 +312,19 @@ fn plots(
             _ => {}
         }
     }
+    // more than one mode: the higher modes' share of the motion (in liquid, every tap rings them)
+    let modes = c
+        .first
+        .first()
+        .map_or(0, |p| p.observables.mode_amplitudes.len());
+    if modes > 1 {
+        panels.push((
+            idx("higher_mode_fraction"),
+            "higher_mode_fraction".to_string(),
+            "higher modes' RMS tip amplitude / mode 1's".to_string(),
+            "higher-modes".to_string(),
+        ));
+    }
     for (k, name, y_label, suffix) in panels {
         let name = name.as_str();
         let mut series = Vec::new();

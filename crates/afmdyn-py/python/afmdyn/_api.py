@@ -323,20 +323,26 @@ def continuation(
 
 
 def probe(
-    path: Union[str, "os.PathLike[str]", Dict[str, Any]], cantilever: Optional[str] = None
+    path: Union[str, "os.PathLike[str]", Dict[str, Any]],
+    cantilever: Optional[str] = None,
+    medium: Optional[str] = None,
 ) -> Dict[str, Any]:
     """Read a probe in SI units (the command line's ``--probe FILE``; format and mapping in
     ``docs/afm-workflow.md``): a file's path, its TOML text or a dict of its sections, with
-    ``cantilever`` as ``--cantilever``.
+    ``cantilever`` as ``--cantilever`` and ``medium`` (``"water"``, ``"air"``, ``"none"``) as
+    ``--medium``.
 
     Returns:
         ``{"params": Params, "si": dict}``: the dimensionless set, and the ``"si"`` block of the
         command line's JSON documents — ``scales`` (``length_m`` = A₀, ``time_s`` per unit τ,
         ``force_n``, ``energy_j``, ``power_w``), ``calibration`` (k, f₀, Q), the drive in Hz, the
-        period in s, ``free_amplitude_m`` and ``z_c_m``. Raises ``ValueError`` listing every
-        problem of the file.
+        period in s, ``free_amplitude_m`` and ``z_c_m``, and with a fluid ``medium`` (the
+        lever's vacuum values, each mode's wet frequency, Q and added mass; Sader 1998).
+        Raises ``ValueError`` listing every problem of the file.
     """
-    p, si = _core.probe(_probe_text({"probe": path, "cantilever": cantilever}))
+    p, si = _core.probe(
+        _probe_text({"probe": path, "cantilever": cantilever, "medium": medium})
+    )
     return {"params": p, "si": json.loads(si)}
 
 
@@ -368,7 +374,7 @@ def observe(
         τ otherwise; ``units`` in each variable's attrs), phases in degrees: scalars
         ``amplitude``, ``amplitude_ratio``, ``phase_deg``, ``mean_deflection``,
         ``peak_force``, ``min_force``, ``indentation``, ``contact_fraction``,
-        ``min_distance``, ``energy_dissipated``, ``virial``, ``harmonic_distortion``,
+        ``min_distance``, ``energy_dissipated``, ``virial``, ``harmonic_distortion``, ``higher_mode_fraction``,
         ``contact_time``, ``mean_force``, ``impacts_per_period``, ``impact_loss``, ``period``
         (NaN when not periodic); ``harmonic_amplitude``/``harmonic_phase_deg`` over
         ``harmonic``; the energy balance ``mode_drive``, ``mode_sample``, … over ``mode``;
@@ -452,7 +458,7 @@ def approach(
         attrs) over ``z_c`` (the approach's grid) and ``sweep`` = ``approach``/``retract``:
         ``amplitude``, ``amplitude_ratio``, ``phase_deg``, ``mean_deflection``,
         ``peak_force``, ``min_force``, ``indentation``, ``contact_fraction``,
-        ``min_distance``, ``energy_dissipated``, ``virial``, ``harmonic_distortion``,
+        ``min_distance``, ``energy_dissipated``, ``virial``, ``harmonic_distortion``, ``higher_mode_fraction``,
         ``stable``, ``period``, ``reached``; the branches along ``branch_point``
         (``branch``, ``branch_z_c``, ``branch_amplitude``, …, ``branch_event``); with
         ``traces``, ``trace_deflection``/``trace_distance``/``trace_force`` over (``trace``,

@@ -235,6 +235,13 @@ pub struct Observables {
     pub virial: f64,
     /// Per-mode energy balance, per period, one entry per mode.
     pub mode_balance: Vec<ModeBalance>,
+    /// Per eigenmode k of the free cantilever (ascending frequency), the amplitude of the tip
+    /// deflection it carries, w_k = (φᵀx_k) x_kᵀM a (x_k mass-normalised, Σ_k w_k = W): the
+    /// RMS amplitude √(2(⟨w_k²⟩ − ⟨w_k⟩²)), which is A for w_k = A sin(…). The participation
+    /// of the higher modes in tapping, strongest in liquid where every tap excites them
+    /// (Basak & Raman, *Appl. Phys. Lett.* 91 (2007) 064107); one entry per mode.
+    #[serde(default)]
+    pub mode_amplitudes: Vec<f64>,
     /// The closed forms from (A, φ, A₀, Q, k).
     pub closed_form: ClosedForms,
     /// Per drive component of a multifrequency drive, the primary first (empty for a
@@ -392,6 +399,10 @@ struct Ctx {
     law: TipSample,
     free: RegionMatrices,
     tip: DVector<f64>,
+    /// Row k: (φᵀx_k) x_kᵀM, the tip deflection carried by eigenmode k of the free region
+    /// (x_k mass-normalised, [`crate::eigen::natural_modes`]) at modal coordinates a; the rows
+    /// sum to φᵀ (Σ_k x_k x_kᵀ M = I).
+    participation: DMatrix<f64>,
     omega: f64,
     /// (sin ψ, cos ψ) of the drive phase ψ.
     psi: (f64, f64),
@@ -458,6 +469,12 @@ impl Ctx {
             },
             free: model.galerkin().region(Region::Free).clone(),
             tip: model.tip().clone(),
+            participation: {
+                let free = model.galerkin().region(Region::Free);
+                let x = crate::eigen::natural_modes(free).vectors;
+                let scale = model.tip().transpose() * &x;
+                DMatrix::from_diagonal(&scale.transpose()) * x.transpose() * &free.mass
+            },
             omega: p.omega,
             psi: p.drive_phase().sin_cos(),
             components,
@@ -587,6 +604,9 @@ struct Acc {
     comp: Vec<[f64; 4]>,
     /// Per mode, ∫w′E_j dτ under a window (E_j of [`ModeBalance::energy_change`]).
     energy_rate: Vec<f64>,
+    /// Per eigenmode k, ∫w_k and ∫w_k² (w_k its tip deflection, `Ctx::participation`).
+    eigen_mean: Vec<f64>,
+    eigen_sq: Vec<f64>,
 }
 
 impl Acc {
@@ -612,6 +632,8 @@ impl Acc {
             v_min: f64::INFINITY,
             comp: Vec::new(),
             energy_rate: vec![0.0; modes],
+            eigen_mean: vec![0.0; modes],
+            eigen_sq: vec![0.0; modes],
         }
     }
 
@@ -648,6 +670,12 @@ impl Acc {
             *sin += wq * nd.w * sh;
             *cos += wq * nd.w * ch;
             (sh, ch) = (sh * c1 + ch * s1, ch * c1 - sh * s1);
+        }
+        let a_now = nd.z.rows(0, n);
+        for k in 0..n {
+            let wk = ctx.participation.row(k).dot(&a_now.transpose());
+            self.eigen_mean[k] += wq * wk;
+            self.eigen_sq[k] += wq * wk * wk;
         }
         self.e_dis -= wq * nd.f * nd.v[1];
         self.virial += wq * nd.f * nd.w;
@@ -946,6 +974,12 @@ fn observe_window(
             }
         })
         .collect();
+    let mode_amplitudes = (0..n)
+        .map(|k| {
+            let m = acc.eigen_mean[k] / t_tot;
+            (2.0 * (acc.eigen_sq[k] / t_tot - m * m)).max(0.0).sqrt()
+        })
+        .collect();
     let phase = harmonics[0].phase;
     let closed_form = closed_forms(model, a1, phase)?;
     let components = ctx
@@ -976,6 +1010,7 @@ fn observe_window(
         impact_loss: acc.impact_loss / per,
         virial: acc.virial / t_tot,
         mode_balance,
+        mode_amplitudes,
         closed_form,
         components,
     })

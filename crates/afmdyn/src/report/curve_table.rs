@@ -113,6 +113,7 @@ fn row(
         at("indentation"),
         at("contact_fraction"),
         at("harmonic_distortion"),
+        at("higher_mode_fraction"),
     ];
     r.push(if stable { 1.0 } else { 0.0 });
     r.push(period.map_or(f64::NAN, |n| n as f64));
@@ -207,6 +208,7 @@ fn columns(l: &CurveAxis, u: &CurveUnits) -> Vec<Column> {
         "indentation",
         "contact_fraction",
         "harmonic_distortion",
+        "higher_mode_fraction",
     ] {
         let (unit, what) = lib(name);
         cols.push(Column::new(name, unit, what));
@@ -229,7 +231,7 @@ fn columns(l: &CurveAxis, u: &CurveUnits) -> Vec<Column> {
 
 /// The table's columns named and ordered as the JSON document ([`CURVE_COLUMNS`] after the
 /// abscissa), then afmdyn's own: (name, index in the dForce layout of [`row`]/[`columns`]).
-const JSON_LAYOUT: [(&str, usize); 19] = [
+const JSON_LAYOUT: [(&str, usize); 20] = [
     ("amplitude", 1),
     ("amplitude_ratio", 11),
     ("phase_deg", 2),
@@ -242,10 +244,11 @@ const JSON_LAYOUT: [(&str, usize); 19] = [
     ("energy_dissipated", 5),
     ("virial", 6),
     ("harmonic_distortion", 16),
-    ("stable", 17),
-    ("period", 18),
+    ("higher_mode_fraction", 17),
+    ("stable", 18),
+    ("period", 19),
     ("sweep", 10),
-    ("event", 19),
+    ("event", 20),
     ("contact_time", 8),
     ("max_abs_force", 4),
     ("power_dissipated", 9),

@@ -5,8 +5,9 @@ use super::*;
 
 /// The [`CURVE_COLUMNS`] of one orbit's observables in `u`'s units: A, A/A₀ (A₀ the free
 /// amplitude at the same drive), φ in degrees, ⟨W⟩, max F_c, min F_c, indentation, contact
-/// fraction, min distance, E_dis, virial, THD.
-pub fn curve_row(o: &Observables, u: &CurveUnits) -> [f64; 12] {
+/// fraction, min distance, E_dis, virial, THD, the higher modes' participation
+/// √(Σ_{k≥2} A_k²)/A_1 from [`Observables::mode_amplitudes`].
+pub fn curve_row(o: &Observables, u: &CurveUnits) -> [f64; 13] {
     [
         o.amplitude * u.length,
         o.amplitude / o.closed_form.free_amplitude,
@@ -20,13 +21,22 @@ pub fn curve_row(o: &Observables, u: &CurveUnits) -> [f64; 12] {
         o.energy_dissipated * u.energy,
         o.virial * u.energy,
         o.thd,
+        higher_mode_fraction(&o.mode_amplitudes),
     ]
+}
+
+/// √(Σ_{k≥2} A_k²)/A_1 of the eigenmodes' amplitudes A_k (0 for one mode; NaN without any).
+pub fn higher_mode_fraction(amplitudes: &[f64]) -> f64 {
+    match amplitudes.split_first() {
+        Some((a1, rest)) => rest.iter().fold(0.0, |s, a| s + a * a).sqrt() / a1,
+        None => f64::NAN,
+    }
 }
 
 /// The observables of one steady state in `u`'s units — SI for a probe's model (m, N, J, s),
 /// the model's own otherwise (g₀, F̃, F̃·g₀, τ) — with phases in degrees: the [`CURVE_COLUMNS`]
 /// (as [`curve_row`]), then `contact_time`, `mean_force`, `impacts_per_period`, `impact_loss`,
-/// `harmonics` (arrays `n`, `amplitude`, `phase_deg`), `mode_balance` (arrays `mode`, `drive`,
+/// `mode_amplitudes` (per eigenmode, [`Observables::mode_amplitudes`]), `harmonics` (arrays `n`, `amplitude`, `phase_deg`), `mode_balance` (arrays `mode`, `drive`,
 /// `beam_damping`, `sample`, `coupling`, `energy_change`, `residual`; energies per drive period)
 /// `units` (the names) and, under a multifrequency drive, `components` (arrays over the drive
 /// components, the first first: `ratio`, `amplitude`, `phase_deg`, `free_amplitude`,
@@ -44,6 +54,14 @@ pub fn observed(o: &Observables, u: &CurveUnits) -> Value {
     m.insert("mean_force".into(), json!(o.mean_force * u.force));
     m.insert("impacts_per_period".into(), json!(o.impacts_per_period));
     m.insert("impact_loss".into(), json!(o.impact_loss * u.energy));
+    m.insert(
+        "mode_amplitudes".into(),
+        json!(o
+            .mode_amplitudes
+            .iter()
+            .map(|a| a * u.length)
+            .collect::<Vec<_>>()),
+    );
     let h = &o.harmonics;
     m.insert(
         "harmonics".into(),

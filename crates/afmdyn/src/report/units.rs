@@ -289,7 +289,7 @@ const fn curve_column(name: &'static str, kind: UnitKind, long_name: &'static st
 }
 
 /// The per-point columns of a stepped-curve document, in this order after the abscissa.
-pub const CURVE_COLUMNS: [CurveColumn; 12] = [
+pub const CURVE_COLUMNS: [CurveColumn; 13] = [
     curve_column(
         "amplitude",
         UnitKind::Length,
@@ -349,6 +349,12 @@ pub const CURVE_COLUMNS: [CurveColumn; 12] = [
         "harmonic_distortion",
         UnitKind::One,
         "total harmonic distortion of the deflection",
+    ),
+    curve_column(
+        "higher_mode_fraction",
+        UnitKind::One,
+        "participation of the higher eigenmodes: RMS amplitude of the tip deflection of modes \
+         2..N relative to mode 1's (0 for one mode)",
     ),
 ];
 
