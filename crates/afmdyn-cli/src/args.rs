@@ -27,6 +27,11 @@ pub struct ModelArgs {
     #[allow(rustdoc::broken_intra_doc_links)]
     #[arg(long, value_name = "NAME", requires = "probe")]
     pub cantilever: Option<String>,
+    /// The fluid around the lever, over the probe file's [medium]: water or air (Sader's
+    /// hydrodynamic loading of every mode; docs/afm-workflow.md §6e), or none (no fluid)
+    #[allow(rustdoc::broken_intra_doc_links)]
+    #[arg(long, value_name = "NAME", requires = "probe")]
+    pub medium: Option<String>,
     // The help of the model flags comes from the library's table (afmdyn::request::
     // MODEL_PARAMETERS), set in main.rs.
     #[arg(
@@ -164,17 +169,23 @@ impl ModelArgs {
             .map_err(CliError::from)
     }
 
-    /// The probe file's text, with `[cantilever].name` set from `--cantilever`.
+    /// The probe file's text, with `[cantilever].name` set from `--cantilever` and the fluid
+    /// from `--medium`.
     pub fn probe_text(&self) -> Result<Option<String>, CliError> {
         let Some(path) = &self.probe else {
             return Ok(None);
         };
         let text = read_text(path).map_err(|e| CliError::Input(format!("probe {e}")))?;
-        match &self.cantilever {
+        let bad = |e: String| CliError::Input(format!("{}: {e}", path.display()));
+        let text = match &self.cantilever {
+            None => text,
+            Some(name) => afmdyn::cantilevers::with_name(&text, name).map_err(bad)?,
+        };
+        match &self.medium {
             None => Ok(Some(text)),
-            Some(name) => afmdyn::cantilevers::with_name(&text, name)
+            Some(name) => afmdyn::hydro::with_medium(&text, name)
                 .map(Some)
-                .map_err(|e| CliError::Input(format!("{}: {e}", path.display()))),
+                .map_err(bad),
         }
     }
 

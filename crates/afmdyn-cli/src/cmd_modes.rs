@@ -200,6 +200,11 @@ pub struct UnitsArgs {
     /// A cantilever of the library for the probe file (as every command's --cantilever)
     #[arg(long, value_name = "NAME", requires = "probe")]
     cantilever: Option<String>,
+    /// The fluid around the lever, over the probe's [medium]: water, air or none (as every
+    /// command's --medium)
+    #[allow(rustdoc::broken_intra_doc_links)]
+    #[arg(long, value_name = "NAME", requires = "probe")]
+    medium: Option<String>,
     /// Print one JSON document
     #[arg(long)]
     json: bool,
@@ -208,15 +213,11 @@ pub struct UnitsArgs {
 /// Run `afmdyn units`.
 pub fn units(a: &UnitsArgs) -> Result<(), CliError> {
     if let Some(path) = &a.probe {
-        let origin = path.display().to_string();
-        let text =
-            crate::args::read_text(path).map_err(|e| CliError::Input(format!("probe {e}")))?;
-        let text = match &a.cantilever {
-            Some(name) => afmdyn::cantilevers::with_name(&text, name)
-                .map_err(|e| CliError::Input(format!("{origin}: {e}")))?,
-            None => text,
-        };
-        let pr = afmdyn::probe::Probe::parse(&text, &origin)?;
+        let (_, pr) = afmdyn::probe::Probe::source_text(
+            afmdyn::probe::ProbeSource::Path(path),
+            a.cantilever.as_deref(),
+            a.medium.as_deref(),
+        )?;
         let p = pr.params;
         let doc = json!({ "params": p, "si": afmdyn::report::si(&pr, &p, &json!({})) });
         if a.json {

@@ -271,7 +271,7 @@ impl PyParams {
     #[staticmethod]
     #[pyo3(signature = (path, **model))]
     fn from_probe(path: &Bound<'_, PyAny>, model: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
-        let text = probe_source(path, None)?;
+        let text = probe_source(path, None, None)?;
         let pr = afmdyn::probe::Probe::parse(&text, "probe").map_err(crate::errors::probe_error)?;
         Ok(PyParams {
             inner: model_spec(model)?
@@ -439,12 +439,16 @@ impl PyParams {
 /// # Errors
 /// `ValueError` naming the source and every problem; `TypeError` for another type.
 #[pyfunction]
-#[pyo3(signature = (probe, cantilever=None))]
-pub fn probe_source(probe: &Bound<'_, PyAny>, cantilever: Option<String>) -> PyResult<String> {
+#[pyo3(signature = (probe, cantilever=None, medium=None))]
+pub fn probe_source(
+    probe: &Bound<'_, PyAny>,
+    cantilever: Option<String>,
+    medium: Option<String>,
+) -> PyResult<String> {
     use crate::errors::{probe_error, value_error};
     use afmdyn::probe::{Probe, ProbeSource};
     use std::path::PathBuf;
-    let name = cantilever.as_deref();
+    let (name, medium) = (cantilever.as_deref(), medium.as_deref());
     let r = if let Ok(d) = probe.cast::<pyo3::types::PyDict>() {
         let json: String = probe
             .py()
@@ -457,11 +461,11 @@ pub fn probe_source(probe: &Bound<'_, PyAny>, cantilever: Option<String>) -> PyR
                  drive as dicts of numbers and strings"
             ))
         })?;
-        Probe::source_text(ProbeSource::Table(&table), name)
+        Probe::source_text(ProbeSource::Table(&table), name, medium)
     } else if let Ok(s) = probe.extract::<String>() {
-        Probe::source_text(ProbeSource::of_str(&s), name)
+        Probe::source_text(ProbeSource::of_str(&s), name, medium)
     } else if let Ok(p) = probe.extract::<PathBuf>() {
-        Probe::source_text(ProbeSource::Path(&p), name)
+        Probe::source_text(ProbeSource::Path(&p), name, medium)
     } else {
         return Err(pyo3::exceptions::PyTypeError::new_err(format!(
             "probe: expected a path, TOML text or a dict, got {}",

@@ -216,16 +216,16 @@ def test_the_same_bad_value_gets_the_same_message(
 
 def test_the_table_of_model_parameters_is_every_front_ends() -> None:
     """The one table (``afmdyn::request::MODEL_PARAMETERS``) names exactly the keywords of the
-    ``Model`` TypedDict (the stubs' keywords) beside ``probe`` and ``cantilever`` (the command
-    line's ``--probe`` and ``--cantilever``), and every row is a flag of every command line
-    subcommand with its help."""
+    ``Model`` TypedDict (the stubs' keywords) beside ``probe``, ``cantilever`` and ``medium``
+    (the command line's ``--probe``, ``--cantilever`` and ``--medium``), and every row is a flag
+    of every command line subcommand with its help."""
     from afmdyn import _afmdyn as core
     from afmdyn._api import Model
 
     names = set()
     for name, alias, _unit, _range, _help in core.MODEL_PARAMETERS:
         names.update({name, alias})
-    assert names | {"probe", "cantilever"} == set(Model.__annotations__)
+    assert names | {"probe", "cantilever", "medium"} == set(Model.__annotations__)
 
 
 def test_the_stubs_and_docstrings_follow_the_table() -> None:

@@ -88,10 +88,15 @@ impl Galerkin {
             ),
         };
         let outer = &tip * tip.transpose();
-        let mass = match &params.eigenmodes {
+        let mut mass = match &params.eigenmodes {
             Some(e) => DMatrix::from_diagonal(&DVector::from_fn(n, |j, _| e.mass(j))),
             None => mass_matrix(params, &outer),
         };
+        if let Some(h) = &params.hydrodynamic {
+            for j in 0..n {
+                mass[(j, j)] += h.added_mass[j];
+            }
+        }
         let k_free = DMatrix::from_diagonal(&DVector::from_vec(k_diag));
         let free = RegionMatrices {
             mass: mass.clone(),
@@ -188,8 +193,17 @@ fn mass_matrix(p: &Params, outer: &DMatrix<f64>) -> DMatrix<f64> {
 /// Eq. 12: C^I_ij = δ_ij α3 ∫φ_i φ_j dξ = α3 δ_ij, generalised to modal damping
 /// C^I = α3 diag(s_1 … s_N) with the profile s_j of [`Params::damping_profile`] (s_j = 1 in the
 /// paper); s_j = (β_j²/β_1²)(Q_1/Q_j) gives mode j of the bare beam the quality factor Q_j.
+/// A fluid adds its hydrodynamic damping c_j on the diagonal ([`crate::params::Hydrodynamic`]).
 fn damping_free(p: &Params, n: usize) -> DMatrix<f64> {
-    DMatrix::from_diagonal(&DVector::from_fn(n, |j, _| p.alpha3 * profile(p, j)))
+    DMatrix::from_diagonal(&DVector::from_fn(n, |j, _| {
+        p.alpha3 * profile(p, j) + fluid(p, j).1
+    }))
+}
+
+/// The fluid's added mass m_a,j and damping c_j of mode j ((0, 0) without a fluid).
+fn fluid(p: &Params, j: usize) -> (f64, f64) {
+    p.hydrodynamic
+        .map_or((0.0, 0.0), |h| (h.added_mass[j], h.damping[j]))
 }
 
 /// s_j of the damping profile (1 without one).
@@ -208,22 +222,30 @@ fn stiffness_contact(p: &Params, k_free: &DMatrix<f64>, outer: &DMatrix<f64>) ->
 }
 
 /// Eq. 14: F^I_i = α2 Ω² [α1 φ_i(1) + ∫φ_i] sin Ωτ − α2 α3 s_i ∫φ_i cos Ωτ (s_i of the damping
-/// profile, 1 in the paper). The point-mass and eigenmode models have the force drive
-/// F^I_j = α2 cos Ωτ at the tip instead (every mode's tip value is 1).
+/// profile, 1 in the paper). A fluid at rest acts on the absolute motion, so its added mass
+/// m_a,i and damping c_i add α2 Ω² m_a,i ∫φ_i sin Ωτ − α2 Ω c_i ∫φ_i cos Ωτ (the base's
+/// acceleration −α2Ω² sin Ωτ and velocity α2Ω cos Ωτ; [`crate::params::Hydrodynamic`]).
+/// (Eq. 14 as printed has α2 α3 without the Ω of the base velocity that eq. 6 carries; afmdyn
+/// keeps eq. 14 for the paper's α3, whose term is ~1/Q of the drive for a real lever.)
+/// A force drive ([`Params::is_force_driven`]: the point-mass and eigenmode models, every
+/// mode's tip value 1, and the beam with [`crate::params::Excitation::Tip`]) has
+/// F^I_i = α2 φ_i(1) cos Ωτ instead.
 fn forcing_free(p: &Params, tip: &DVector<f64>, integrals: &DVector<f64>) -> Forcing {
     let n = tip.len();
-    if p.structure.is_lumped() {
+    if p.is_force_driven() {
         return Forcing {
             constant: DVector::zeros(n),
             sin: DVector::zeros(n),
-            cos: DVector::from_element(n, p.alpha2),
+            cos: tip * p.alpha2,
         };
     }
+    let added: DVector<f64> = DVector::from_fn(n, |i, _| fluid(p, i).0 * integrals[i]);
     Forcing {
         constant: DVector::zeros(n),
-        sin: (tip * p.alpha1 + integrals) * (p.alpha2 * p.omega * p.omega),
+        sin: (tip * p.alpha1 + integrals + added) * (p.alpha2 * p.omega * p.omega),
         cos: DVector::from_fn(n, |i, _| {
             -p.alpha2 * p.alpha3 * profile(p, i) * integrals[i]
+                - p.alpha2 * p.omega * fluid(p, i).1 * integrals[i]
         }),
     }
 }

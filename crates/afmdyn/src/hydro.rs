@@ -25,8 +25,10 @@
 //! Q = (1/T + Γ_r(ω_f)) / Γ_i(ω_f). The equation for ω_f is solved by bisection in ln ω:
 //! ω²(1 + TΓ_r) grows with ω (Γ_r falls more slowly than 1/ω), so its root is unique.
 //!
-//! Status (issue 45): the hydrodynamic function and the wet modes; the medium is not yet a
-//! probe section, nor are the modes' added mass and damping in the models.
+//! A probe's `[medium]` loads every mode of the model with its added mass and damping at its
+//! own wet frequency ([`crate::params::Hydrodynamic`], set by the probe reader's `medium`
+//! part); [`Section::mode_at`] inverts the wet mode in closed form, which brings a lever's
+//! values measured in air back to vacuum.
 
 use crate::error::{SimError, UnitsError};
 use crate::units::{positive, preset, Cantilever};
@@ -86,6 +88,32 @@ impl Medium {
     pub fn reynolds(&self, omega: f64, width: f64) -> f64 {
         self.density * omega * width * width / (4.0 * self.viscosity)
     }
+}
+
+/// A probe's TOML text with its `[medium]` set to the preset `name` (the command line's
+/// `--medium NAME`, Python's `medium=`, which win over the file's fluid: its `density` and
+/// `viscosity` go, `calibrated_in` stays), or without `[medium]` for `name = "none"` (the lever
+/// as in the paper, no fluid). The name is checked when the probe is read.
+///
+/// # Errors
+/// The TOML parser's message, or `medium must be a table`.
+pub fn with_medium(text: &str, name: &str) -> Result<String, String> {
+    let mut root: toml::Table = text
+        .parse()
+        .map_err(|e: toml::de::Error| e.to_string().replace('\n', " "))?;
+    if name.trim().eq_ignore_ascii_case("none") {
+        root.remove("medium");
+    } else {
+        let m = root
+            .entry("medium")
+            .or_insert_with(|| toml::Value::Table(toml::Table::new()))
+            .as_table_mut()
+            .ok_or("medium must be a table ([medium])")?;
+        m.remove("density");
+        m.remove("viscosity");
+        m.insert("name".into(), toml::Value::String(name.into()));
+    }
+    Ok(toml::to_string(&root).expect("a TOML table serialises"))
 }
 
 /// The media by name: `water`, `air` ([`Medium::WATER`], [`Medium::AIR`]).
@@ -174,9 +202,69 @@ pub struct WetMode {
     pub gamma: Complex<f64>,
 }
 
+/// The cross-section of a beam as the fluid sees it: its width b (m) and mass per unit length
+/// μ = ρ_c b h (kg/m). T = πρb²/(4μ) is the mass of fluid in the cylinder of diameter b per
+/// beam mass (module docs).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Section {
+    /// Width b (m), > 0.
+    pub width: f64,
+    /// Mass per unit length μ (kg/m), > 0.
+    pub mass_per_length: f64,
+}
+
+impl Section {
+    /// The section of a rectangular beam (its width, thickness and density).
+    pub fn of(beam: &Cantilever) -> Section {
+        Section {
+            width: beam.width,
+            mass_per_length: beam.mass_per_length(),
+        }
+    }
+
+    /// Check that width and mass per length are finite and positive.
+    ///
+    /// # Errors
+    /// [`UnitsError::Positive`] naming the field.
+    pub fn validate(&self) -> Result<(), UnitsError> {
+        positive("cantilever.width", self.width, "m")?;
+        positive("cantilever.mass_per_length", self.mass_per_length, "kg/m")?;
+        Ok(())
+    }
+
+    /// T = πρb²/(4μ) in `medium`.
+    pub fn mass_ratio(&self, medium: &Medium) -> f64 {
+        PI * medium.density * self.width * self.width / (4.0 * self.mass_per_length)
+    }
+
+    /// The mode of this section resonating at `frequency_hz` in `medium`: its quality factor
+    /// Q = (1/T + Γ_r)/Γ_i and added mass TΓ_r at that frequency, and the vacuum frequency
+    /// f_vac = f √(1 + TΓ_r) it comes from (the inverse of [`wet_mode_of`], closed form).
+    ///
+    /// # Errors
+    /// As [`wet_mode_of`].
+    pub fn mode_at(&self, frequency_hz: f64, medium: &Medium) -> Result<(WetMode, f64), SimError> {
+        self.validate()?;
+        medium.validate()?;
+        positive("frequency_hz", frequency_hz, "Hz")?;
+        let omega = 2.0 * PI * frequency_hz;
+        let t = self.mass_ratio(medium);
+        let re = medium.reynolds(omega, self.width);
+        let gamma = gamma_rectangular(re)?;
+        let mode = WetMode {
+            frequency_hz,
+            quality_factor: (1.0 / t + gamma.re) / gamma.im,
+            added_mass_ratio: t * gamma.re,
+            reynolds: re,
+            gamma,
+        };
+        Ok((mode, frequency_hz * (1.0 + t * gamma.re).sqrt()))
+    }
+}
+
 /// The mode of vacuum frequency `vacuum_frequency_hz` of the rectangular beam `beam` (its
 /// width, thickness and density) in `medium`: the wet frequency, quality factor and added mass
-/// (module docs).
+/// (module docs). [`wet_mode_of`] of its [`Section`].
 ///
 /// # Errors
 /// [`SimError::Units`] naming the field for an invalid beam, medium or frequency;
@@ -187,11 +275,26 @@ pub fn wet_mode(
     medium: &Medium,
 ) -> Result<WetMode, SimError> {
     beam.validate()?;
+    wet_mode_of(vacuum_frequency_hz, &Section::of(beam), medium)
+}
+
+/// The mode of vacuum frequency `vacuum_frequency_hz` of a beam of cross-section `section` in
+/// `medium`: ω_f from ω_f²(1 + TΓ_r(Re(ω_f))) = ω_vac² by bisection in ln ω (module docs).
+///
+/// # Errors
+/// [`SimError::Units`] naming the field for an invalid section, medium or frequency;
+/// [`SimError::OutOfRange`] naming `reynolds` when the wet mode's Re leaves Sader's range.
+pub fn wet_mode_of(
+    vacuum_frequency_hz: f64,
+    section: &Section,
+    medium: &Medium,
+) -> Result<WetMode, SimError> {
+    section.validate()?;
     medium.validate()?;
     positive("vacuum_frequency_hz", vacuum_frequency_hz, "Hz")?;
     let omega_vac = 2.0 * PI * vacuum_frequency_hz;
-    let t = PI * medium.density * beam.width / (4.0 * beam.density * beam.thickness);
-    let b = beam.width;
+    let t = section.mass_ratio(medium);
+    let b = section.width;
     // g(ω) = ω²(1 + TΓ_r) − ω_vac², increasing in ω; g(ω_vac) ≥ 0 since Γ_r > 0
     let g = |omega: f64| -> Result<f64, SimError> {
         let gr = gamma_rectangular(medium.reynolds(omega, b))?.re;

@@ -85,6 +85,6 @@ pub use contact::{ContactLaw, LawKind};
 pub use error::{ParamError, SimError, UnitsError};
 pub use integrate::{Integrator, IntegratorKind, IntegratorOptions};
 pub use model::CantileverModel;
-pub use params::{Params, Structure, SweepParam};
+pub use params::{Excitation, Hydrodynamic, Params, Structure, SweepParam};
 pub use system::{EventKind, HybridSystem, Region};
 pub use tip_sample::TipSampleSystem;

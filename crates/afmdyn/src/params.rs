@@ -114,6 +114,108 @@ pub struct Params {
     // makes rustc 1.95 stop with an internal compiler error, as for damping_profile)
     #[serde(default, skip_serializing_if = "no_components")]
     pub drive_components: [Option<DriveComponent>; 3],
+    /// Where the primary drive α2 acts ([`Excitation`]): at the base (the paper, the default
+    /// for the beam) or as a force at the tip. The lumped models are always force-driven.
+    #[serde(default, skip_serializing_if = "Excitation::is_base")]
+    pub excitation: Excitation,
+    /// Each mode's hydrodynamic loading in a liquid or gas ([`Hydrodynamic`], set from a
+    /// probe's `[medium]` by [`crate::probe`]; `None`: none, as in the paper).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub hydrodynamic: Option<Hydrodynamic>,
+}
+
+/// Where the primary drive acts on the beam.
+///
+/// * `Base` — the paper's base displacement α2 sin Ωτ (acoustic or piezo excitation at the
+///   chip, eq. 6): V_T moves with the base (eq. 8).
+/// * `Tip` — a force α2 cos Ωτ at the tip (magnetic excitation of a coated lever, or
+///   photothermal excitation modelled at the tip; Xu, Melcher, Basak & Raman, *Phys. Rev.
+///   Lett.* 102 (2009) 060801 drive magnetically in liquid): modal forcing φ_j(1) α2 cos Ωτ,
+///   the base does not move, V_T = W(1,τ) + α5, in the force unit of α4 V_T.
+///
+/// The lumped models ([`Structure::is_lumped`]) are force-driven whatever this says. The
+/// fluid-borne excitation of an acoustic drive in liquid (the "forest of peaks", Schäffer,
+/// Cleveland, Ohnesorge, Walters & Hansma, *Ultramicroscopy* 63 (1996) 149) is not modelled:
+/// the liquid is at rest far from the lever.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum Excitation {
+    /// Base displacement α2 sin Ωτ (the paper).
+    #[default]
+    Base,
+    /// Force α2 cos Ωτ at the tip.
+    Tip,
+}
+
+impl Excitation {
+    /// Whether this is the base drive (the default).
+    pub fn is_base(&self) -> bool {
+        *self == Excitation::Base
+    }
+    /// `base` or `tip`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Excitation::Base => "base",
+            Excitation::Tip => "tip",
+        }
+    }
+}
+
+impl FromStr for Excitation {
+    type Err = String;
+    /// `base` (or `acoustic`, `piezo`), `tip` (or `magnetic`, `photothermal`), in any case.
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "base" | "acoustic" | "piezo" => Ok(Excitation::Base),
+            "tip" | "magnetic" | "photothermal" => Ok(Excitation::Tip),
+            _ => Err(format!(
+                "excitation '{s}': expected base (acoustic, piezo) or tip (magnetic, \
+                 photothermal)"
+            )),
+        }
+    }
+}
+
+/// The hydrodynamic loading of each mode by the surrounding fluid, in the model's units
+/// (mass of the bare beam mL = 1, or mode 1's modal mass for the lumped models; time τ):
+/// mode j gains the added mass `added_mass[j]` on the diagonal of M and the damping
+/// `damping[j]` on the diagonal of C^I (and of C^II). For the beam base drive the fluid acts
+/// on the absolute motion, so the forcing gains α2Ω² m_a,j ∫φ_j sin Ωτ − α2Ω c_j ∫φ_j cos Ωτ.
+///
+/// From Sader's hydrodynamic function evaluated at each mode's frequency in the fluid
+/// ([`crate::hydro`]; Sader, *J. Appl. Phys.* 84 (1998) 64): m_a,j = m_j T Γ_r(ω_j),
+/// c_j = m_j T Γ_i(ω_j) ω_j, with T = πρb²/(4μ) and m_j the mode's mass (1 for the beam's
+/// orthonormal modes). Evaluating Γ at each mode's own frequency keeps M and C diagonal in
+/// the modes (the approximation of Basak, Raman & Garoff, *J. Appl. Phys.* 99 (2006) 114906
+/// and of VEDA's liquid model); only the first N entries are used.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Hydrodynamic {
+    /// m_a,j ≥ 0, the added modal mass of mode j.
+    pub added_mass: [f64; 20],
+    /// c_j ≥ 0, the hydrodynamic modal damping of mode j (per unit τ).
+    pub damping: [f64; 20],
+}
+
+/// Check a coefficient that must be finite, ≥ 0 and ≤ `max` (`range` as written, `reason` why).
+fn bounded(
+    name: &'static str,
+    value: f64,
+    max: f64,
+    range: &'static str,
+    reason: &'static str,
+) -> Result<(), ParamError> {
+    if !(value.is_finite() && value >= 0.0) {
+        return Err(ParamError::NonNegative { name, value });
+    }
+    if value > max {
+        return Err(ParamError::Magnitude {
+            name,
+            value,
+            range,
+            reason,
+        });
+    }
+    Ok(())
 }
 
 /// Most further drive components beside the primary one ([`Params::drive_components`]).
@@ -276,6 +378,8 @@ impl Default for Params {
             damping_profile: None,
             eigenmodes: None,
             drive_components: [None; MAX_DRIVE_COMPONENTS],
+            excitation: Excitation::Base,
+            hydrodynamic: None,
         }
     }
 }
@@ -396,17 +500,7 @@ impl Params {
                 DAMPING,
             ),
         ] {
-            if !(value.is_finite() && value >= 0.0) {
-                return Err(ParamError::NonNegative { name, value });
-            }
-            if value > max {
-                return Err(ParamError::Magnitude {
-                    name,
-                    value,
-                    range,
-                    reason,
-                });
-            }
+            bounded(name, value, max, range, reason)?;
         }
         if !self.alpha5.is_finite() {
             return Err(ParamError::Gap(self.alpha5));
@@ -514,6 +608,24 @@ impl Params {
                 });
             }
         }
+        if let Some(h) = &self.hydrodynamic {
+            for j in 0..self.modes {
+                bounded(
+                    "hydrodynamic.added_mass (mode's added mass)",
+                    h.added_mass[j],
+                    ALPHA1_MAX,
+                    "[0, 1e4]",
+                    TIP_MASS,
+                )?;
+                bounded(
+                    "hydrodynamic.damping (mode's hydrodynamic damping)",
+                    h.damping[j],
+                    DAMPING_MAX,
+                    "[0, 1e4]",
+                    DAMPING,
+                )?;
+            }
+        }
         if self.structure == Structure::PointMass {
             for (name, bad, value) in [
                 (
@@ -541,22 +653,31 @@ impl Params {
         Ok(())
     }
 
-    /// Amplitude of the base displacement in V_T (eq. 8): α2 for the beam, 0 for the point-mass
-    /// model, whose drive is a force and whose base does not move. Every V_T formula uses this.
+    /// Amplitude of the base displacement in V_T (eq. 8): α2 for the base-driven beam, 0 for a
+    /// force drive ([`Params::is_force_driven`]: the lumped models, the beam with
+    /// [`Excitation::Tip`]), whose base does not move. Every V_T formula uses this.
     pub fn base_amplitude(&self) -> f64 {
-        match self.structure {
-            Structure::Beam => self.alpha2,
-            Structure::PointMass | Structure::Eigenmodes => 0.0,
+        if self.is_force_driven() {
+            0.0
+        } else {
+            self.alpha2
         }
     }
 
-    /// Phase ψ of the drive: the drive is ∝ sin(Ωτ + ψ), ψ = 0 for the beam (base displacement
-    /// α2 sin Ωτ) and π/2 for the point-mass model (force α2 cos Ωτ). Phases of the response
+    /// Whether the primary drive is a force at the tip: the lumped models, and the beam with
+    /// [`Excitation::Tip`].
+    pub fn is_force_driven(&self) -> bool {
+        self.structure.is_lumped() || self.excitation == Excitation::Tip
+    }
+
+    /// Phase ψ of the drive: the drive is ∝ sin(Ωτ + ψ), ψ = 0 for the base drive (base
+    /// displacement α2 sin Ωτ) and π/2 for a force drive (force α2 cos Ωτ). Phases of the response
     /// are measured as lags behind it.
     pub fn drive_phase(&self) -> f64 {
-        match self.structure {
-            Structure::Beam => 0.0,
-            Structure::PointMass | Structure::Eigenmodes => std::f64::consts::FRAC_PI_2,
+        if self.is_force_driven() {
+            std::f64::consts::FRAC_PI_2
+        } else {
+            0.0
         }
     }
 

@@ -549,7 +549,9 @@ def reconstruct_fm(
 def cantilevers() -> str: ...
 def probe(text: str) -> Tuple[Params, str]: ...
 def probe_source(
-    probe: Union[str, "os.PathLike[str]", Dict[str, Any]], cantilever: Optional[str] = None
+    probe: Union[str, "os.PathLike[str]", Dict[str, Any]],
+    cantilever: Optional[str] = None,
+    medium: Optional[str] = None,
 ) -> str: ...
 def resolve(
     params: Optional[Params] = None,

@@ -82,6 +82,7 @@ class Model(TypedDict, total=False):
     drive_frequency: float
     probe: Union[str, "os.PathLike[str]", Dict[str, Any]]
     cantilever: str
+    medium: str
 
 
 #: Global attributes of every dataset: the scales of the dimensionless units.
@@ -112,19 +113,23 @@ def _params(
 
 
 def _probe_text(model: Dict[str, Any]) -> Optional[str]:
-    """Pop ``probe`` and ``cantilever`` from the model keywords: the probe's TOML text with the
-    cantilever's name set (the library's ``Probe::source_text``), checked, or ``None``."""
+    """Pop ``probe``, ``cantilever`` and ``medium`` from the model keywords: the probe's TOML
+    text with the cantilever's name and the fluid (``"water"``, ``"air"`` or ``"none"``) set
+    (the library's ``Probe::source_text``), checked, or ``None``."""
     probe = model.pop("probe", None)
     cantilever = model.pop("cantilever", None)
-    if cantilever is not None and not isinstance(cantilever, str):
-        raise TypeError(f"cantilever: expected a name (str), got {type(cantilever).__name__}")
+    medium = model.pop("medium", None)
+    for key, value in (("cantilever", cantilever), ("medium", medium)):
+        if value is not None and not isinstance(value, str):
+            raise TypeError(f"{key}: expected a name (str), got {type(value).__name__}")
     if probe is None:
-        if cantilever is not None:
-            raise ValueError("cantilever needs probe= (as --cantilever needs --probe)")
+        for key, value in (("cantilever", cantilever), ("medium", medium)):
+            if value is not None:
+                raise ValueError(f"{key} needs probe= (as --{key} needs --probe)")
         return None
     if not isinstance(probe, (str, dict)):
         probe = os.fspath(probe)
-    return _core.probe_source(probe, cantilever)
+    return _core.probe_source(probe, cantilever, medium)
 
 
 def _state(initial: StateLike) -> Optional[list]:

@@ -30,7 +30,15 @@
 //! # multifrequency (bimodal): arrays, one entry per component, at most 4
 //! # free_amplitude = [10e-9, 1e-9]   # A₀ᵢ (m)
 //! # frequency = [300e3, 1.875e6]     # fᵢ (Hz), default each at its mode's free resonance
+//! excitation = "base"            # base (acoustic, piezo: eq. 6) | tip (magnetic, photothermal)
+//! [medium]                       # optional: the lever in a fluid (module `medium`)
+//! name = "water"                 # water | air, or density (kg/m³) and viscosity (Pa s)
+//! calibrated_in = "air"          # where f₀ and Q were measured: air (default) | vacuum
 //! ```
+//!
+//! With `[medium]` and calibrated values, `[cantilever]` also takes the lever's `length` and
+//! `width` (m), which the fluid loading needs; the drive frequency then defaults to the first
+//! mode's natural frequency in the fluid.
 //!
 //! **Scales.** Lengths are measured in g₀ = A₀, so the dimensionless free amplitude is 1 and
 //! A/A₀ is read directly. Time: τ = ω̃₁ · 2πf₀ t, where ω̃₁ is the dimensionless first natural
@@ -52,7 +60,8 @@
 //! ratio is α3 s_j/(2β_j²); with a tip mass the modes mix and the achieved Q_j (reported by
 //! `afmdyn modes`) differ slightly.
 //!
-//! **Drive.** The beam is base-driven (eq. 14); α2 is chosen so that the free tip deflection
+//! **Drive.** The beam is base-driven (eq. 14), or with `excitation = "tip"` driven by a force
+//! at the tip ([`crate::params::Excitation`]); α2 is chosen so that the free tip deflection
 //! amplitude at Ω is A₀: α2 = 1/|H(Ω)|, H the tip response per unit α2 of the linear free system
 //! ([`crate::CantileverModel::free_tip_response`]). The point mass is force-driven:
 //! α2 = F₀/(k A₀) = √((1 − Ω²)² + (Ω/Q)²) (the harmonic oscillator's response).
@@ -80,7 +89,9 @@
 //! a modulus of 4 Pa, a resonance at 300 Hz: read as a unit slip, with the reading meant), all
 //! listed in one [`ProbeError::Invalid`].
 
+mod medium;
 mod reader;
+pub use medium::{CalibratedIn, FluidMode, MediumReport};
 use reader::*;
 
 /// The intermolecular distance a₀ of the DMT law when a probe file omits it, m
@@ -91,8 +102,8 @@ use crate::contact::ContactLaw;
 use crate::galerkin::{Galerkin, Region};
 use crate::model::CantileverModel;
 use crate::params::{
-    DriveComponent, Params, Structure, MAX_DRIVE_COMPONENTS, MAX_MODES, MAX_RATIO_DENOMINATOR,
-    MAX_RATIO_NUMERATOR,
+    DriveComponent, Excitation, Params, Structure, MAX_DRIVE_COMPONENTS, MAX_MODES,
+    MAX_RATIO_DENOMINATOR, MAX_RATIO_NUMERATOR,
 };
 use serde::Serialize;
 use std::f64::consts::TAU;
@@ -238,6 +249,9 @@ pub struct Probe {
     /// then defaults to the free resonance, [`crate::request::curves::free_resonance_base`]).
     #[serde(skip)]
     pub z_c_in_file: bool,
+    /// The fluid of `[medium]` and each mode's loading (`None` without the section).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub medium: Option<MediumReport>,
 }
 
 /// A further drive component of a probe ([`Params::drive_components`]) in SI.
@@ -307,14 +321,18 @@ pub fn convergent_within(r: f64, max_q: u32) -> Option<(u32, u32)> {
 }
 
 /// The cantilever section, before the model is known.
+#[derive(Debug, Clone, Copy)]
 enum Beam {
     Calibrated {
         k: f64,
         f0: f64,
         alpha1: f64,
+        /// Length and width (m) when given (what `[medium]` needs).
+        plan: Option<(f64, f64)>,
     },
     Geometry {
         length: f64,
+        width: f64,
         ei: f64,
         mass_per_length: f64,
         tip_mass: f64,
@@ -327,6 +345,7 @@ struct Drive {
     free_amplitude: f64,
     frequency: Option<f64>,
     components: Vec<(f64, f64)>,
+    excitation: Excitation,
 }
 
 /// The sample section in SI.
@@ -382,8 +401,9 @@ impl<'a> ProbeSource<'a> {
 impl Probe {
     /// The TOML text of the probe `source` with `[cantilever].name` set to `cantilever` when
     /// given (the command line's `--cantilever NAME`, Python's `cantilever=`, which win over a
-    /// name in the probe: [`crate::cantilevers::with_name`]), checked by resolving it, so that
-    /// every later [`Probe::parse`] of the text succeeds; with the resolved probe.
+    /// name in the probe: [`crate::cantilevers::with_name`]) and its fluid set to `medium`
+    /// (`--medium NAME`, `medium=`: [`crate::hydro::with_medium`]), checked by resolving it,
+    /// so that every later [`Probe::parse`] of the text succeeds; with the resolved probe.
     ///
     /// # Errors
     /// [`ProbeError::Io`] for a file that cannot be read; as [`Probe::parse`], naming the
@@ -392,6 +412,7 @@ impl Probe {
     pub fn source_text(
         source: ProbeSource<'_>,
         cantilever: Option<&str>,
+        medium: Option<&str>,
     ) -> Result<(String, Probe), ProbeError> {
         let origin = source.origin();
         let text = match source {
@@ -411,6 +432,15 @@ impl Probe {
                     message,
                 }
             })?,
+        };
+        let text = match medium {
+            None => text,
+            Some(name) => {
+                crate::hydro::with_medium(&text, name).map_err(|message| ProbeError::Syntax {
+                    path: origin.clone(),
+                    message,
+                })?
+            }
         };
         let probe = Self::parse(&text, &origin)?;
         Ok((text, probe))
@@ -492,7 +522,15 @@ impl Probe {
         r.unknown(
             root,
             "",
-            &["model", "modes", "cantilever", "tip", "sample", "drive"],
+            &[
+                "model",
+                "modes",
+                "cantilever",
+                "tip",
+                "sample",
+                "drive",
+                "medium",
+            ],
         );
         let structure = match r.string(root, "", "model") {
             None if !root.contains_key("model") => {
@@ -572,6 +610,7 @@ impl Probe {
                         k: k[0],
                         f0: f[0],
                         alpha1: 0.0,
+                        plan: None,
                     };
                     let q1 = q[0];
                     eigen = Some((k, f));
@@ -607,13 +646,32 @@ impl Probe {
             .and_then(|s| Self::read_sample(&mut r, s, tip, radius, tip_e, tip_nu));
         // [drive]
         let drive = r.table(root, "drive", true);
+        let mut excitation = Excitation::Base;
         let (a0, freq, extra) = match drive {
             Some(d) => {
-                r.unknown(d, "drive", &["free_amplitude", "frequency"]);
+                r.unknown(d, "drive", &["free_amplitude", "frequency", "excitation"]);
+                if let Some(e) = r.string(d, "drive", "excitation") {
+                    match e.parse::<Excitation>() {
+                        Ok(x) => excitation = x,
+                        Err(m) => r.problems.push(format!("[drive].{m}")),
+                    }
+                }
                 Self::read_drive(&mut r, d)
             }
             None => (None, None, Vec::new()),
         };
+        if excitation == Excitation::Tip && structure.is_some_and(Structure::is_lumped) {
+            r.problems.push(
+                "[drive].excitation = \"tip\": the point-mass and eigenmode models are always \
+                 driven by a force at the tip (omit excitation)"
+                    .into(),
+            );
+        }
+        // [medium]
+        let medium = r
+            .table(root, "medium", false)
+            .and_then(|t| medium::read(&mut r, t));
+        let medium_given = root.contains_key("medium");
         // lengths are in units of A₀: an amplitude of metres makes every other length vanish
         // and the motion unresolvable (a probe with A₀ = 1 m ran for minutes; issue 27)
         if extra.iter().any(|&(a, _)| a > MAX_FREE_AMPLITUDE) {
@@ -652,7 +710,7 @@ impl Probe {
                 ));
             }
         }
-        if !r.problems.is_empty() {
+        if !r.problems.is_empty() || (medium_given && medium.is_none()) {
             return None;
         }
         let (structure, modes, beam, q1, sample, a0) =
@@ -661,8 +719,9 @@ impl Probe {
             free_amplitude: a0,
             frequency: freq,
             components: extra,
+            excitation,
         };
-        match Self::resolve(structure, modes, beam, q1, qs, eigen, sample, drive) {
+        match Self::resolve(structure, modes, beam, q1, qs, eigen, sample, drive, medium) {
             Ok(p) => Some(p),
             Err(e) => {
                 r.problems.push(e);
@@ -839,7 +898,10 @@ impl Probe {
         known.extend(["quality_factor", "quality_factors"]);
         r.unknown(c, S, &known);
         let has_cal = CAL[..2].iter().any(|k| c.contains_key(*k));
-        let has_geo = GEO.iter().any(|k| c.contains_key(*k));
+        // length and width may come with calibrated values: the plan `[medium]` needs
+        let has_geo = GEO
+            .iter()
+            .any(|k| c.contains_key(*k) && !(has_cal && matches!(*k, "length" | "width")));
         let beam = match (has_cal, has_geo) {
             (true, true) => {
                 r.problems.push(
@@ -860,6 +922,7 @@ impl Probe {
                 match (length, width, thickness, e, rho) {
                     (Some(l), Some(b), Some(h), Some(e), Some(rho)) => Some(Beam::Geometry {
                         length: l,
+                        width: b,
                         ei: e * b * h.powi(3) / 12.0,
                         mass_per_length: rho * b * h,
                         tip_mass: tip_mass.unwrap_or(0.0),
@@ -873,8 +936,22 @@ impl Probe {
                 let alpha1 = r
                     .optional(c, S, "tip_mass_ratio", "1", NON_NEGATIVE)
                     .unwrap_or(0.0);
+                let length = r.optional(c, S, "length", "m", POSITIVE);
+                let width = r.optional(c, S, "width", "m", POSITIVE);
+                if length.is_some() != width.is_some() {
+                    r.problems.push(
+                        "[cantilever]: give both length and width (m, the lever's plan) or \
+                         neither"
+                            .into(),
+                    );
+                }
                 match (k, f0) {
-                    (Some(k), Some(f0)) => Some(Beam::Calibrated { k, f0, alpha1 }),
+                    (Some(k), Some(f0)) => Some(Beam::Calibrated {
+                        k,
+                        f0,
+                        alpha1,
+                        plan: length.zip(width),
+                    }),
                     _ => None,
                 }
             }
@@ -1034,18 +1111,21 @@ impl Probe {
         eigen: Option<(Vec<f64>, Vec<f64>)>,
         sample: Sample,
         drive: Drive,
+        medium: Option<medium::MediumSpec>,
     ) -> Result<Probe, String> {
         let (a0, freq) = (drive.free_amplitude, drive.frequency);
+        let q1_file = q1;
         let g0 = a0;
         // tip-mass ratio α1 of the beam, and for the geometry the time scale t = τ √(mL⁴/EI)
         // (eq. 5), the force unit EI/L³ and the static stiffness 3EI/L³
         let (beam_alpha1, geometry) = match beam {
-            Beam::Calibrated { alpha1, k, f0 } => (alpha1, Err((k, f0))),
+            Beam::Calibrated { alpha1, k, f0, .. } => (alpha1, Err((k, f0))),
             Beam::Geometry {
                 length: l,
                 ei,
                 mass_per_length: m,
                 tip_mass,
+                ..
             } => (
                 tip_mass / (m * l),
                 Ok(((m * l.powi(4) / ei).sqrt(), ei / l.powi(3))),
@@ -1056,7 +1136,7 @@ impl Probe {
             Structure::PointMass | Structure::Eigenmodes => 0.0,
         };
         // the eigenmode model's modes relative to mode 1
-        let eigenmodes = eigen.map(|(k, f)| {
+        let eigenmodes = eigen.as_ref().map(|(k, f)| {
             let mut e = crate::params::Eigenmodes {
                 stiffness: [1.0; MAX_MODES],
                 frequency: [1.0; MAX_MODES],
@@ -1082,6 +1162,8 @@ impl Probe {
             damping_profile: None,
             eigenmodes,
             drive_components: [None; MAX_DRIVE_COMPONENTS],
+            excitation: drive.excitation,
+            hydrodynamic: None,
         };
         let (w1, x1, k1) = first_mode(&bare).map_err(|e| e.to_string())?;
         // k and f0, given or from the geometry (first mode of the beam with its tip mass; the
@@ -1117,17 +1199,51 @@ impl Probe {
             Structure::Beam if geometry.is_ok() => static_k,
             Structure::Beam => 3.0 * k / k1,
         };
-        let time_s = w1 / (TAU * f0);
+        // [medium]: the lever's f₀ and Q in vacuum (medium.rs); the eigenmode model's
+        // frequency ratios with them
+        let (f0_model, q1_model, qs_model, eigenmodes, vacuum) = match &medium {
+            None => (f0, q1, qs.clone(), eigenmodes, None),
+            Some(spec) => {
+                let (w1_k1, ratios) = if structure == Structure::Beam {
+                    let g = Galerkin::new(&bare).map_err(|e| e.to_string())?;
+                    let om = crate::eigen::natural_modes(g.region(Region::Free)).omega;
+                    (w1 * w1 / k1, om.iter().map(|w| w / om[0]).collect())
+                } else {
+                    (4.0, vec![1.0])
+                };
+                let eigen_f = eigen.as_ref().map(|(_, f)| f.as_slice());
+                let v = medium::to_vacuum(
+                    spec,
+                    &beam,
+                    k,
+                    f0,
+                    q1,
+                    qs.as_deref(),
+                    eigen_f,
+                    w1_k1,
+                    &ratios,
+                )?;
+                let eigenmodes = eigenmodes.map(|mut e| {
+                    if let Some(fv) = &v.eigen_frequencies {
+                        for (j, f) in fv.iter().enumerate() {
+                            e.frequency[j] = f / fv[0];
+                        }
+                    }
+                    e
+                });
+                (v.f0, v.q1, v.qs.clone(), eigenmodes, Some(v))
+            }
+        };
+        let time_s = w1 / (TAU * f0_model);
         let force_n = k * g0 / k1;
         let scales = Scales {
             length_m: g0,
             time_s,
             force_n,
         };
-        let drive_hz = freq.unwrap_or(f0);
-        let omega = scales.omega(drive_hz);
         // damping: profile from per-mode Q, then α3 from Q1
-        let profile = match (&qs, structure) {
+        let (q1, qs_given) = (q1_model, qs);
+        let profile = match (&qs_model, structure) {
             // C_jj = m_j ω_j / Q_j = α3 s_j with α3 = 1/Q₁ (mode 1's m and ω are 1)
             (Some(q), Structure::Eigenmodes) => eigenmodes.map(|e| {
                 let mut s = [1.0; MAX_MODES];
@@ -1149,6 +1265,7 @@ impl Probe {
         };
         let with_profile = Params {
             damping_profile: profile,
+            eigenmodes,
             ..bare
         };
         // x₁ is mass-normalised (x₁ᵀMx₁ = 1): α3 = ω̃₁/(Q₁ x₁ᵀ diag(s) x₁)
@@ -1194,11 +1311,18 @@ impl Probe {
             alpha3,
             alpha4,
             alpha6,
-            omega,
             contact_law: law,
             alpha2: 1.0,
             ..with_profile
         };
+        // the fluid's loading of every mode; the drive then defaults to the first mode's
+        // natural frequency in the fluid (f₀ without one)
+        let medium_report = match (&medium, &vacuum) {
+            (Some(spec), Some(v)) => Some(medium::load(spec, v, &mut params, time_s)?),
+            _ => None,
+        };
+        let drive_hz = freq.unwrap_or(medium_report.as_ref().map_or(f0, |m| m.resonance_frequency));
+        params.omega = scales.omega(drive_hz);
         params.alpha5 = params.alpha5_for_rest_distance(z_c / g0);
         // drive amplitude: free tip amplitude A0 (= 1 in units of g0) at Ω
         let unit_response = CantileverModel::new(&params)
@@ -1218,8 +1342,8 @@ impl Probe {
             calibration: Calibration {
                 spring_constant: k,
                 resonance_frequency: f0,
-                quality_factor: q1,
-                quality_factors: qs,
+                quality_factor: q1_file,
+                quality_factors: qs_given,
                 tip_mass_ratio: alpha1,
                 static_spring_constant: static_k,
             },
@@ -1228,6 +1352,7 @@ impl Probe {
             components,
             z_c,
             z_c_in_file,
+            medium: medium_report,
         })
     }
 

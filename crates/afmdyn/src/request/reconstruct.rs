@@ -192,8 +192,9 @@ pub fn document(request: &ReconstructRequest, r: &Reconstruction) -> Value {
 /// The AM curve of an `afmdyn approach --probe` document of the point-mass model (`reconstruct
 /// --am`, [`crate::analysis::reconstruct_am`]): the approach sweep's leading attractive run —
 /// from its first point while the phase lag stays above 90° (the repulsive regime, where the
-/// first-harmonic balance still holds but the branch jumps, is left out) — with k, f₀ and Q of
-/// `si.calibration`, the drive frequency `si.drive_frequency_hz` and the free amplitude
+/// first-harmonic balance still holds but the branch jumps, is left out) — with k of
+/// `si.calibration`, f₀ and Q of `si.medium` for a lever in a fluid (else of
+/// `si.calibration`), the drive frequency `si.drive_frequency_hz` and the free amplitude
 /// `si.free_amplitude_m`.
 ///
 /// # Errors
@@ -232,6 +233,12 @@ pub fn am_curve_from_approach(doc: &Value) -> Result<AmCurve, SimError> {
         ));
     };
     let si = &doc["si"];
+    fn resonance<'v>(si: &'v Value, key: &str) -> &'v Value {
+        match si.get("medium") {
+            Some(m) if m.is_object() => &m[key],
+            _ => &si["calibration"][key],
+        }
+    }
     let number = |v: &Value| {
         v.as_f64()
             .ok_or_else(|| bad("a document without its si block"))
@@ -242,8 +249,9 @@ pub fn am_curve_from_approach(doc: &Value) -> Result<AmCurve, SimError> {
         phase: Vec::new(),
         mean_deflection: Some(Vec::new()),
         spring_constant: number(&si["calibration"]["spring_constant"])?,
-        resonance_frequency: number(&si["calibration"]["resonance_frequency"])?,
-        quality_factor: number(&si["calibration"]["quality_factor"])?,
+        // in a fluid the lever's resonance and Q are the medium's, not the calibration's (air)
+        resonance_frequency: number(resonance(si, "resonance_frequency"))?,
+        quality_factor: number(resonance(si, "quality_factor"))?,
         drive_frequency: number(&si["drive_frequency_hz"])?,
         free_amplitude: number(&si["free_amplitude_m"])?,
     };

@@ -11,10 +11,9 @@ use afmdyn::request::analyses::OrbitRequest;
 use afmdyn::{CantileverModel, ContactLaw, HybridSystem, SimError};
 use nalgebra::{Complex, DMatrix, DVector};
 
-/// Closed-form periodic forced response of region `r` from the second-order equations
-/// M Ẍ + C Ẋ + K X = F(τ) (eq. 10): K X₀ = F_const and (K − Ω²M + iΩC) X̂ = F_cos − i F_sin.
-/// Independent of the first-order solve inside the propagator. Returns z_p(τ) = (X, Ẋ).
-pub fn harmonic_response(model: &CantileverModel, r: Region, tau: f64) -> DVector<f64> {
+/// The complex amplitude â of region `r`'s linear response a = Re(â e^{iΩτ}) to its harmonic
+/// forcing: (K − Ω²M + iΩC) â = F_cos − i F_sin (eq. 10, shape `[N]`).
+pub fn complex_response(model: &CantileverModel, r: Region) -> DVector<Complex<f64>> {
     let g = model.galerkin().region(r);
     let w = model.omega();
     let c = |m: &DMatrix<f64>| m.map(|v| Complex::new(v, 0.0));
@@ -22,7 +21,16 @@ pub fn harmonic_response(model: &CantileverModel, r: Region, tau: f64) -> DVecto
         + c(&g.damping) * Complex::new(0.0, w);
     let rhs =
         g.forcing.cos.map(|v| Complex::new(v, 0.0)) - g.forcing.sin.map(|v| Complex::new(0.0, v));
-    let xh = dyn_stiff.lu().solve(&rhs).unwrap();
+    dyn_stiff.lu().solve(&rhs).unwrap()
+}
+
+/// Closed-form periodic forced response of region `r` from the second-order equations
+/// M Ẍ + C Ẋ + K X = F(τ) (eq. 10): K X₀ = F_const and (K − Ω²M + iΩC) X̂ = F_cos − i F_sin.
+/// Independent of the first-order solve inside the propagator. Returns z_p(τ) = (X, Ẋ).
+pub fn harmonic_response(model: &CantileverModel, r: Region, tau: f64) -> DVector<f64> {
+    let g = model.galerkin().region(r);
+    let w = model.omega();
+    let xh = complex_response(model, r);
     let x0 = g.stiffness.clone().lu().solve(&g.forcing.constant).unwrap();
     let e = Complex::new((w * tau).cos(), (w * tau).sin());
     let n = model.modes();

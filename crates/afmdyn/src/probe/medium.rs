@@ -1,0 +1,371 @@
+//! The probe's `[medium]`: the fluid around the lever, the lever's values brought to vacuum,
+//! and each mode's hydrodynamic loading ([`crate::params::Hydrodynamic`]) from Sader's
+//! hydrodynamic function ([`crate::hydro`]).
+//!
+//! ```toml
+//! [medium]
+//! name = "water"             # water | air (presets), or give density and viscosity
+//! density = 997.05           # ρ (kg/m³), overrides the preset's
+//! viscosity = 8.9e-4         # η (Pa s), overrides the preset's
+//! calibrated_in = "air"      # where [cantilever]'s f₀ and Q were measured: air (default) | vacuum
+//! ```
+//!
+//! The fluid needs the lever's width b and its mass per unit length μ: from the geometry, or
+//! with calibrated values from `[cantilever] length` and `width` (m) through
+//! μ = k ω̃₁²/(k̃₁ ω₁² L) (the modal stiffness k = k̃₁ EI/L³ and ω₁ = ω̃₁ √(EI/(μL⁴)), module docs
+//! of [`crate::probe`]; for the lumped models the uniform beam's ω̃₁²/k̃₁ = 4).
+//!
+//! **Calibrated in air.** A datasheet's or a thermal tune's f₀ and Q are the lever's in air.
+//! The vacuum frequency is f_vac = f_air √(1 + T Γ_r(f_air)) (Sader 1998; the inverse of the
+//! wet mode, closed form), and the lever's own loss (support, material) is kept as a damping
+//! coefficient: 1/Q_air = 1/(Q_int √(1 + TΓ_r)) + 1/Q_fluid,air, so
+//! Q_int = 1/((1/Q_air − 1/Q_fluid,air) √(1 + TΓ_r)), refused when Q_air exceeds what air alone
+//! allows. With a calibrated k, μ depends on f_vac: the two are iterated to a fixed point (T
+//! in air is ~1e-3, so 8 iterations reach round-off).
+//!
+//! **The loading.** Each mode j of the model (its vacuum natural frequency) is put in the
+//! fluid by [`crate::hydro::wet_mode_of`]: m_a,j = m_j TΓ_r(ω_j), c_j = m_j TΓ_i(ω_j) ω_j at its
+//! wet frequency ω_j, m_j = 1 for the beam's orthonormal modes and the point mass, the modal
+//! mass for the eigenmode model.
+
+use super::reader::Reader;
+use super::Beam;
+use crate::eigen::{damped_eigenvalues, natural_modes};
+use crate::galerkin::{Galerkin, Region};
+use crate::hydro::{wet_mode_of, Medium, Section};
+use crate::params::{Hydrodynamic, Params, Structure};
+use serde::Serialize;
+use std::f64::consts::TAU;
+
+/// Where a probe's f₀ and Q were measured.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum CalibratedIn {
+    /// In air (datasheets, a thermal tune in air): the default.
+    Air,
+    /// In vacuum (or the lever's own values).
+    Vacuum,
+}
+
+/// The `[medium]` section as read.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct MediumSpec {
+    name: Option<String>,
+    medium: Medium,
+    calibrated_in: CalibratedIn,
+}
+
+/// One mode in the medium.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FluidMode {
+    /// The mode's vacuum natural frequency (Hz).
+    pub vacuum_frequency_hz: f64,
+    /// Its frequency in the fluid by Sader's wet-mode equation (Hz; the model's own natural
+    /// frequency, with the tip mass, is in `free_frequencies_hz`).
+    pub frequency_hz: f64,
+    /// Re = ρωb²/(4η) at that frequency.
+    pub reynolds: f64,
+    /// Γ_rect(Re) as [Γ_r, Γ_i].
+    pub gamma: [f64; 2],
+    /// The added mass per beam mass, TΓ_r.
+    pub added_mass_ratio: f64,
+    /// Q from the fluid alone, (1/T + Γ_r)/Γ_i.
+    pub fluid_quality_factor: f64,
+}
+
+/// What a probe's `[medium]` did (the `"medium"` of the `"si"` block).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct MediumReport {
+    /// The preset's name, when one was named.
+    pub name: Option<String>,
+    /// ρ (kg/m³).
+    pub density: f64,
+    /// η (Pa s).
+    pub viscosity: f64,
+    /// Where the file's f₀ and Q were measured.
+    pub calibrated_in: CalibratedIn,
+    /// The lever's width b (m).
+    pub width: f64,
+    /// Its mass per unit length μ (kg/m).
+    pub mass_per_length: f64,
+    /// T = πρb²/(4μ).
+    pub mass_ratio: f64,
+    /// The lever's first vacuum frequency (Hz).
+    pub vacuum_resonance_frequency: f64,
+    /// Its own quality factor per mode (support and material losses, in vacuum): mode 1's, or
+    /// one per mode where the file gives quality_factors.
+    pub intrinsic_quality_factors: Vec<f64>,
+    /// The first mode's natural frequency in the medium (Hz), as the model has it.
+    pub resonance_frequency: f64,
+    /// The first mode's quality factor in the medium, 1/(2ζ) of the model's damped eigenvalue.
+    pub quality_factor: f64,
+    /// Each mode of the model in the fluid.
+    pub modes: Vec<FluidMode>,
+}
+
+/// Read `[medium]`.
+pub(super) fn read(r: &mut Reader<'_>, t: &toml::Table) -> Option<MediumSpec> {
+    const S: &str = "medium";
+    r.unknown(t, S, &["name", "density", "viscosity", "calibrated_in"]);
+    let preset = match r.string(t, S, "name") {
+        Some(n) => match crate::units::preset(&crate::hydro::MEDIA, n, "name", "medium") {
+            Ok(m) => Some((n.trim().to_ascii_lowercase(), m)),
+            Err(e) => {
+                r.problems.push(format!("[medium].{e}"));
+                return None;
+            }
+        },
+        None => None,
+    };
+    let density = r.optional(t, S, "density", "kg/m^3", super::POSITIVE);
+    let viscosity = r.optional(t, S, "viscosity", "Pa s", super::POSITIVE);
+    let calibrated_in = match r.string(t, S, "calibrated_in") {
+        None => CalibratedIn::Air,
+        Some(s) => match s.trim().to_ascii_lowercase().as_str() {
+            "air" => CalibratedIn::Air,
+            "vacuum" => CalibratedIn::Vacuum,
+            _ => {
+                r.problems.push(format!(
+                    "[medium].calibrated_in = '{s}': expected air or vacuum (where \
+                     [cantilever]'s resonance_frequency and quality_factor were measured)"
+                ));
+                return None;
+            }
+        },
+    };
+    let (name, medium) = match (preset, density, viscosity) {
+        (Some((n, m)), d, v) => (
+            Some(n),
+            Medium {
+                density: d.unwrap_or(m.density),
+                viscosity: v.unwrap_or(m.viscosity),
+            },
+        ),
+        (None, Some(d), Some(v)) => (
+            None,
+            Medium {
+                density: d,
+                viscosity: v,
+            },
+        ),
+        (None, _, _) => {
+            if !(t.contains_key("density") && t.contains_key("viscosity")) {
+                r.problems.push(
+                    "[medium]: give name = \"water\" or \"air\", or density (kg/m^3) and \
+                     viscosity (Pa s)"
+                        .into(),
+                );
+            }
+            return None;
+        }
+    };
+    Some(MediumSpec {
+        name,
+        medium,
+        calibrated_in,
+    })
+}
+
+/// The cantilever's values brought to vacuum, and what the loading needs.
+pub(super) struct Vacuum {
+    /// f₀ in vacuum (Hz).
+    pub f0: f64,
+    /// Q₁ and the per-mode Q_j (when given), intrinsic.
+    pub q1: f64,
+    pub qs: Option<Vec<f64>>,
+    /// The eigenmode model's frequencies in vacuum (Hz).
+    pub eigen_frequencies: Option<Vec<f64>>,
+    section: Section,
+}
+
+/// `1/(1/Q − 1/Q_f)/√(1 + TΓ_r)` (module docs), or the error naming `key`.
+fn intrinsic(q: f64, mode: &crate::hydro::WetMode, key: &str) -> Result<f64, String> {
+    let inv = 1.0 / q - 1.0 / mode.quality_factor;
+    if inv <= 0.0 {
+        return Err(format!(
+            "[cantilever].{key} = {q}: exceeds {:.4}, the quality factor air damping alone \
+             allows this lever at {:.6e} Hz (Sader 1998; width and thickness as given): give \
+             [medium] calibrated_in = \"vacuum\" for a lever's own Q, or check the dimensions",
+            mode.quality_factor, mode.frequency_hz
+        ));
+    }
+    Ok(1.0 / (inv * (1.0 + mode.added_mass_ratio).sqrt()))
+}
+
+/// The lever's values in vacuum (module docs). `w1_k1` is ω̃₁²/k̃₁ of the structure's bare
+/// first mode (4 for the lumped models: the uniform beam's); `beam_frequencies` the vacuum
+/// frequencies of the beam's modes per unit f₀ (for per-mode Q of the beam).
+#[allow(clippy::too_many_arguments)]
+pub(super) fn to_vacuum(
+    spec: &MediumSpec,
+    beam: &Beam,
+    k: f64,
+    f0: f64,
+    q1: f64,
+    qs: Option<&[f64]>,
+    eigen_f: Option<&[f64]>,
+    w1_k1: f64,
+    beam_frequencies: &[f64],
+) -> Result<Vacuum, String> {
+    let air = Medium::AIR;
+    let e = |x: crate::error::SimError| format!("[medium]: {x}");
+    // the section, and f₀ in vacuum
+    let (section, f_vac) = match *beam {
+        Beam::Geometry {
+            width,
+            mass_per_length,
+            ..
+        } => (
+            Section {
+                width,
+                mass_per_length,
+            },
+            f0,
+        ),
+        Beam::Calibrated { plan, .. } => {
+            let Some((length, width)) = plan else {
+                return Err(
+                    "[medium] needs the lever's plan: give [cantilever] length and \
+                            width (m)"
+                        .into(),
+                );
+            };
+            let mu = |f: f64| k * w1_k1 / ((TAU * f).powi(2) * length);
+            let mut f = f0;
+            if spec.calibrated_in == CalibratedIn::Air {
+                for _ in 0..8 {
+                    let s = Section {
+                        width,
+                        mass_per_length: mu(f),
+                    };
+                    f = s.mode_at(f0, &air).map_err(e)?.1;
+                }
+            }
+            (
+                Section {
+                    width,
+                    mass_per_length: mu(f),
+                },
+                f,
+            )
+        }
+    };
+    let vacuum = |f_air: f64| -> Result<(crate::hydro::WetMode, f64), String> {
+        section.mode_at(f_air, &air).map_err(e)
+    };
+    if spec.calibrated_in == CalibratedIn::Vacuum {
+        return Ok(Vacuum {
+            f0: f_vac,
+            q1,
+            qs: qs.map(<[f64]>::to_vec),
+            eigen_frequencies: eigen_f.map(<[f64]>::to_vec),
+            section,
+        });
+    }
+    // the geometry's f₀ is a vacuum frequency: its mode in air from the wet-mode equation
+    let air_mode = |f_vacuum: f64| wet_mode_of(f_vacuum, &section, &air).map_err(e);
+    let (f_air1, f_vac1) = match beam {
+        Beam::Geometry { .. } => (air_mode(f0)?.frequency_hz, f0),
+        Beam::Calibrated { .. } => (f0, f_vac),
+    };
+    let eigen_frequencies = match eigen_f {
+        Some(f) => Some(
+            f.iter()
+                .map(|&x| vacuum(x).map(|m| m.1))
+                .collect::<Result<Vec<_>, _>>()?,
+        ),
+        None => None,
+    };
+    // mode j's frequency in air: the eigenmode model's as given; the beam's from its vacuum
+    // frequency (f₀ times the Galerkin ratio)
+    let air_frequency = |j: usize| -> Result<f64, String> {
+        match (eigen_f, beam) {
+            (Some(f), _) => Ok(f[j]),
+            (None, _) if j == 0 => Ok(f_air1),
+            (None, _) => Ok(air_mode(f_vac1 * beam_frequencies[j])?.frequency_hz),
+        }
+    };
+    let q1_int = intrinsic(q1, &vacuum(air_frequency(0)?)?.0, "quality_factor")?;
+    let qs = match qs {
+        Some(q) => Some(
+            q.iter()
+                .enumerate()
+                .map(|(j, &qj)| intrinsic(qj, &vacuum(air_frequency(j)?)?.0, "quality_factors"))
+                .collect::<Result<Vec<_>, _>>()?,
+        ),
+        None => None,
+    };
+    Ok(Vacuum {
+        f0: f_vac1,
+        q1: q1_int,
+        qs,
+        eigen_frequencies,
+        section,
+    })
+}
+
+/// Load every mode of `params` (vacuum values, time scale `time_s`) with the fluid: sets
+/// [`Params::hydrodynamic`] and returns the report. `qs_int` are the intrinsic Q's reported.
+pub(super) fn load(
+    spec: &MediumSpec,
+    vacuum: &Vacuum,
+    params: &mut Params,
+    time_s: f64,
+) -> Result<MediumReport, String> {
+    let e = |x: crate::error::SimError| format!("[medium]: {x}");
+    let derived = |x: crate::error::ParamError| format!("[medium]: {x}");
+    let bare = Galerkin::new(params).map_err(derived)?;
+    let free = bare.region(Region::Free);
+    let natural = natural_modes(free);
+    let n = params.modes;
+    let mut h = Hydrodynamic {
+        added_mass: [0.0; 20],
+        damping: [0.0; 20],
+    };
+    let mut modes = Vec::with_capacity(n);
+    let t = vacuum.section.mass_ratio(&spec.medium);
+    for j in 0..n {
+        // the eigenmode model's modal mass; 1 for the orthonormal beam modes and the point mass
+        let m_j = match (&params.eigenmodes, params.structure) {
+            (Some(em), Structure::Eigenmodes) => em.mass(j),
+            _ => 1.0,
+        };
+        let f_vac = natural.omega[j] / (TAU * time_s);
+        let wet = wet_mode_of(f_vac, &vacuum.section, &spec.medium).map_err(e)?;
+        h.added_mass[j] = m_j * wet.added_mass_ratio;
+        h.damping[j] = m_j * t * wet.gamma.im * TAU * wet.frequency_hz * time_s;
+        modes.push(FluidMode {
+            vacuum_frequency_hz: f_vac,
+            frequency_hz: wet.frequency_hz,
+            reynolds: wet.reynolds,
+            gamma: [wet.gamma.re, wet.gamma.im],
+            added_mass_ratio: wet.added_mass_ratio,
+            fluid_quality_factor: wet.quality_factor,
+        });
+    }
+    params.hydrodynamic = Some(h);
+    let loaded = Galerkin::new(params).map_err(derived)?;
+    let region = loaded.region(Region::Free);
+    let w1 = natural_modes(region).omega[0];
+    // mode 1's damped eigenvalue: the one whose |λ| is nearest ω̃₁ (an overdamped mode's
+    // real pair gives ζ = 1, Q = 0.5)
+    let modulus = |l: &crate::eigen::DampedEigenvalue| l.re.hypot(l.im);
+    let zeta = damped_eigenvalues(region)
+        .iter()
+        .min_by(|a, b| (modulus(a) - w1).abs().total_cmp(&(modulus(b) - w1).abs()))
+        .map_or(f64::NAN, |l| l.zeta);
+    Ok(MediumReport {
+        name: spec.name.clone(),
+        density: spec.medium.density,
+        viscosity: spec.medium.viscosity,
+        calibrated_in: spec.calibrated_in,
+        width: vacuum.section.width,
+        mass_per_length: vacuum.section.mass_per_length,
+        mass_ratio: t,
+        vacuum_resonance_frequency: vacuum.f0,
+        intrinsic_quality_factors: vacuum.qs.clone().unwrap_or_else(|| vec![vacuum.q1]),
+        resonance_frequency: w1 / (TAU * time_s),
+        quality_factor: 1.0 / (2.0 * zeta),
+        modes,
+    })
+}
