@@ -87,6 +87,54 @@ fn calibrated_in_air_and_put_in_air_gives_back_the_calibration() {
     assert!(m.intrinsic_quality_factors[0] > 120.0);
 }
 
+/// The eigenmode model (per-mode k, f, Q at the tip, a 125 × 30 µm plan): calibrated in air
+/// and put in air, both modes have the file's f and Q; in water both drop, mode 1 more; a Q
+/// above air's limit is refused naming its entry.
+#[test]
+fn eigenmode_model_in_a_fluid() {
+    let text = |q2: f64, medium: &str| {
+        format!(
+            "model = \"eigenmodes\"\n[cantilever]\nspring_constant = [40.0, 1571.0]\n\
+             resonance_frequency = [300e3, 1.88e6]\nquality_factor = [400, {q2}]\n\
+             length = 125e-6\nwidth = 30e-6\n[tip]\nradius = 10e-9\n[sample]\n\
+             law = \"hertz\"\nyoungs_modulus = 4e9\npoisson_ratio = 0.33\n[drive]\n\
+             free_amplitude = 10e-9\n[medium]\nname = \"{medium}\"\n"
+        )
+    };
+    let q = |p: &Probe| {
+        let model = CantileverModel::new(&p.params).unwrap();
+        let free = model.galerkin().region(Region::Free);
+        let w = afmdyn::eigen::natural_modes(free).omega;
+        let f: Vec<f64> = w.iter().map(|&w| p.scales.frequency_hz(w)).collect();
+        let q: Vec<f64> = afmdyn::eigen::damped_eigenvalues(free)
+            .iter()
+            .map(|l| 1.0 / (2.0 * l.zeta))
+            .collect();
+        (f, q)
+    };
+    let air = Probe::parse(&text(1500.0, "air"), "<test>").unwrap_or_else(|e| panic!("{e}"));
+    let (f, qs) = q(&air);
+    assert!(
+        (f[0] / 300e3 - 1.0).abs() < 1e-12 && (f[1] / 1.88e6 - 1.0).abs() < 1e-12,
+        "{f:?}"
+    );
+    assert!(
+        (qs[0] - 400.0).abs() < 1e-8 && (qs[1] - 1500.0).abs() < 1e-6,
+        "{qs:?}"
+    );
+    let water = Probe::parse(&text(1500.0, "water"), "<test>").unwrap();
+    let (fw, qw) = q(&water);
+    assert!(fw[0] / f[0] < fw[1] / f[1] && fw[1] < f[1], "{fw:?}");
+    assert!(qw[0] < 20.0 && qw[1] < 50.0, "{qw:?}");
+    let err = Probe::parse(&text(2507.0, "water"), "<test>")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("[cantilever].quality_factor[1] = 2507"),
+        "{err}"
+    );
+}
+
 /// Sader's method (1999, eq. 1) from the model's own first mode in the fluid: a lever with
 /// negligible intrinsic loss (calibrated in vacuum, Q = 1e7), so that its Q is the fluid's,
 /// k = 0.1906 ρ b² L Q Γ_i(ω_f) ω_f² equals the lever's 3EI/L³ — exactly as 0.1906 ≈ 3π/(4β₁⁴)

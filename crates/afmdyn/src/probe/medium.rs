@@ -290,7 +290,14 @@ pub(super) fn to_vacuum(
         Some(q) => Some(
             q.iter()
                 .enumerate()
-                .map(|(j, &qj)| intrinsic(qj, &vacuum(air_frequency(j)?)?.0, "quality_factors"))
+                .map(|(j, &qj)| {
+                    // the eigenmode model's array is quality_factor, the beam's quality_factors
+                    let key = match eigen_f {
+                        Some(_) => format!("quality_factor[{j}]"),
+                        None => format!("quality_factors[{j}]"),
+                    };
+                    intrinsic(qj, &vacuum(air_frequency(j)?)?.0, &key)
+                })
                 .collect::<Result<Vec<_>, _>>()?,
         ),
         None => None,

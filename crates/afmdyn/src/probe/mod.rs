@@ -610,7 +610,7 @@ impl Probe {
                         k: k[0],
                         f0: f[0],
                         alpha1: 0.0,
-                        plan: None,
+                        plan: Self::read_plan(&mut r, c),
                     };
                     let q1 = q[0];
                     eigen = Some((k, f));
@@ -831,7 +831,13 @@ impl Probe {
         r.unknown(
             c,
             S,
-            &["spring_constant", "resonance_frequency", "quality_factor"],
+            &[
+                "spring_constant",
+                "resonance_frequency",
+                "quality_factor",
+                "length",
+                "width",
+            ],
         );
         let mut array = |key: &str, max: f64| -> Option<Vec<f64>> {
             let Some(toml::Value::Array(a)) = c.get(key) else {
@@ -877,6 +883,20 @@ impl Probe {
             return None;
         }
         Some((k, f, q))
+    }
+
+    /// A calibrated lever's plan, `[cantilever] length` and `width` (m), both or neither: what
+    /// `[medium]` needs.
+    fn read_plan(r: &mut Reader<'_>, c: &toml::Table) -> Option<(f64, f64)> {
+        const S: &str = "cantilever";
+        let length = r.optional(c, S, "length", "m", POSITIVE);
+        let width = r.optional(c, S, "width", "m", POSITIVE);
+        if c.contains_key("length") != c.contains_key("width") {
+            r.problems.push(
+                "[cantilever]: give both length and width (m, the lever's plan) or neither".into(),
+            );
+        }
+        length.zip(width)
     }
 
     #[allow(clippy::type_complexity)]
@@ -936,21 +956,13 @@ impl Probe {
                 let alpha1 = r
                     .optional(c, S, "tip_mass_ratio", "1", NON_NEGATIVE)
                     .unwrap_or(0.0);
-                let length = r.optional(c, S, "length", "m", POSITIVE);
-                let width = r.optional(c, S, "width", "m", POSITIVE);
-                if length.is_some() != width.is_some() {
-                    r.problems.push(
-                        "[cantilever]: give both length and width (m, the lever's plan) or \
-                         neither"
-                            .into(),
-                    );
-                }
+                let plan = Self::read_plan(r, c);
                 match (k, f0) {
                     (Some(k), Some(f0)) => Some(Beam::Calibrated {
                         k,
                         f0,
                         alpha1,
-                        plan: length.zip(width),
+                        plan,
                     }),
                     _ => None,
                 }
