@@ -135,6 +135,37 @@ fn eigenmode_model_in_a_fluid() {
     );
 }
 
+/// `--modes` over a probe in water: the request layer loads every mode, the added ones at
+/// their own wet frequencies (not left dry), the probe's modes as the probe had them.
+#[test]
+fn more_modes_over_a_probe_in_water_are_loaded_too() {
+    let p = probe("beam", "[medium]\nname = \"water\"\n");
+    let six = afmdyn::request::ModelSpec {
+        modes: Some(6),
+        ..Default::default()
+    }
+    .resolve(afmdyn::Params::default(), Some(&p))
+    .unwrap();
+    let (h3, h6) = (p.params.hydrodynamic.unwrap(), six.hydrodynamic.unwrap());
+    for j in 0..3 {
+        assert!(
+            (h6.added_mass[j] / h3.added_mass[j] - 1.0).abs() < 1e-12,
+            "mode {j}"
+        );
+        assert!(
+            (h6.damping[j] / h3.damping[j] - 1.0).abs() < 1e-12,
+            "mode {j}"
+        );
+    }
+    // modes 4–6 loaded, their added mass falling with Re (Γ_r decreases) but not to 0
+    for j in 3..6 {
+        assert!(
+            h6.added_mass[j] > 0.5 * h6.added_mass[2] && h6.added_mass[j] < h6.added_mass[j - 1]
+        );
+        assert!(h6.damping[j] > h6.damping[j - 1]);
+    }
+}
+
 /// Sader's method (1999, eq. 1) from the model's own first mode in the fluid: a lever with
 /// negligible intrinsic loss (calibrated in vacuum, Q = 1e7), so that its Q is the fluid's,
 /// k = 0.1906 ρ b² L Q Γ_i(ω_f) ω_f² equals the lever's 3EI/L³ — exactly as 0.1906 ≈ 3π/(4β₁⁴)

@@ -312,45 +312,16 @@ pub(super) fn to_vacuum(
 }
 
 /// Load every mode of `params` (vacuum values, time scale `time_s`) with the fluid: sets
-/// [`Params::hydrodynamic`] and returns the report. `qs_int` are the intrinsic Q's reported.
+/// [`Params::hydrodynamic`] and returns the report.
 pub(super) fn load(
     spec: &MediumSpec,
     vacuum: &Vacuum,
     params: &mut Params,
     time_s: f64,
 ) -> Result<MediumReport, String> {
-    let e = |x: crate::error::SimError| format!("[medium]: {x}");
     let derived = |x: crate::error::ParamError| format!("[medium]: {x}");
-    let bare = Galerkin::new(params).map_err(derived)?;
-    let free = bare.region(Region::Free);
-    let natural = natural_modes(free);
-    let n = params.modes;
-    let mut h = Hydrodynamic {
-        added_mass: [0.0; 20],
-        damping: [0.0; 20],
-    };
-    let mut modes = Vec::with_capacity(n);
+    let modes = loading(&spec.medium, &vacuum.section, params, time_s)?;
     let t = vacuum.section.mass_ratio(&spec.medium);
-    for j in 0..n {
-        // the eigenmode model's modal mass; 1 for the orthonormal beam modes and the point mass
-        let m_j = match (&params.eigenmodes, params.structure) {
-            (Some(em), Structure::Eigenmodes) => em.mass(j),
-            _ => 1.0,
-        };
-        let f_vac = natural.omega[j] / (TAU * time_s);
-        let wet = wet_mode_of(f_vac, &vacuum.section, &spec.medium).map_err(e)?;
-        h.added_mass[j] = m_j * wet.added_mass_ratio;
-        h.damping[j] = m_j * t * wet.gamma.im * TAU * wet.frequency_hz * time_s;
-        modes.push(FluidMode {
-            vacuum_frequency_hz: f_vac,
-            frequency_hz: wet.frequency_hz,
-            reynolds: wet.reynolds,
-            gamma: [wet.gamma.re, wet.gamma.im],
-            added_mass_ratio: wet.added_mass_ratio,
-            fluid_quality_factor: wet.quality_factor,
-        });
-    }
-    params.hydrodynamic = Some(h);
     let loaded = Galerkin::new(params).map_err(derived)?;
     let region = loaded.region(Region::Free);
     let w1 = natural_modes(region).omega[0];
@@ -375,4 +346,77 @@ pub(super) fn load(
         quality_factor: 1.0 / (2.0 * zeta),
         modes,
     })
+}
+
+/// Set [`Params::hydrodynamic`] of `params` (the lever's vacuum values, time scale `time_s`
+/// seconds per unit τ): every mode of the model put in `medium` at its own wet frequency
+/// (module docs); with what each mode gets.
+fn loading(
+    medium: &Medium,
+    section: &Section,
+    params: &mut Params,
+    time_s: f64,
+) -> Result<Vec<FluidMode>, String> {
+    let derived = |x: crate::error::ParamError| format!("[medium]: {x}");
+    let bare = Galerkin::new(&Params {
+        hydrodynamic: None,
+        ..*params
+    })
+    .map_err(derived)?;
+    let natural = natural_modes(bare.region(Region::Free));
+    let n = params.modes;
+    let mut h = Hydrodynamic {
+        added_mass: [0.0; 20],
+        damping: [0.0; 20],
+    };
+    let mut modes = Vec::with_capacity(n);
+    let t = section.mass_ratio(medium);
+    for j in 0..n {
+        // the eigenmode model's modal mass; 1 for the orthonormal beam modes and the point mass
+        let m_j = match (&params.eigenmodes, params.structure) {
+            (Some(em), Structure::Eigenmodes) => em.mass(j),
+            _ => 1.0,
+        };
+        let f_vac = natural.omega[j] / (TAU * time_s);
+        let wet = wet_mode_of(f_vac, section, medium).map_err(|x| {
+            format!(
+                "[medium]: mode {} ({} Hz in vacuum): {x} (fewer modes keep within it)",
+                j + 1,
+                crate::error::number(f_vac)
+            )
+        })?;
+        h.added_mass[j] = m_j * wet.added_mass_ratio;
+        h.damping[j] = m_j * t * wet.gamma.im * TAU * wet.frequency_hz * time_s;
+        modes.push(FluidMode {
+            vacuum_frequency_hz: f_vac,
+            frequency_hz: wet.frequency_hz,
+            reynolds: wet.reynolds,
+            gamma: [wet.gamma.re, wet.gamma.im],
+            added_mass_ratio: wet.added_mass_ratio,
+            fluid_quality_factor: wet.quality_factor,
+        });
+    }
+    params.hydrodynamic = Some(h);
+    Ok(modes)
+}
+
+impl MediumReport {
+    /// Load `params` — the probe's set with another number of modes N (`--modes`, Python's
+    /// `modes=`) — with this medium, every mode at its own wet frequency as the probe's were:
+    /// without it the modes beyond the probe's N would be left dry.
+    ///
+    /// # Errors
+    /// A message naming `[medium]` when a mode's Reynolds number leaves Sader's range or the
+    /// set is invalid.
+    pub fn reload(&self, params: &mut Params, time_s: f64) -> Result<(), String> {
+        let medium = Medium {
+            density: self.density,
+            viscosity: self.viscosity,
+        };
+        let section = Section {
+            width: self.width,
+            mass_per_length: self.mass_per_length,
+        };
+        loading(&medium, &section, params, time_s).map(|_| ())
+    }
 }

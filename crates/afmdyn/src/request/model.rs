@@ -376,6 +376,13 @@ impl ModelSpec {
             omega: self.omega.unwrap_or(base.omega),
             ..base
         };
+        // a lever in a fluid with another N: every mode loaded as the probe's were
+        if let Some(pr) = probe {
+            if let (Some(m), true) = (&pr.medium, p.modes != pr.params.modes) {
+                m.reload(&mut p, pr.scales.time_s)
+                    .map_err(SimError::Probe)?;
+            }
+        }
         if let Some(z) = self.z_c {
             let probe = probe.ok_or_else(|| {
                 SimError::out_of_range("z_c", z, "needs a probe file (z_c is in m, SI)")
