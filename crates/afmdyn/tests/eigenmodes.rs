@@ -154,8 +154,8 @@ fn bad_eigenmode_arrays_are_refused_naming_the_key() {
             "spring_constant[1]",
         ),
         (
-            "spring_constant = [40.0]\nresonance_frequency = [300e3]\nquality_factor = [400]\nlength = 1e-4",
-            "unknown key [cantilever].length",
+            "spring_constant = [40.0]\nresonance_frequency = [300e3]\nquality_factor = [400]\nthickness = 4e-6",
+            "unknown key [cantilever].thickness",
         ),
     ] {
         let text = format!(
