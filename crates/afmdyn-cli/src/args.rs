@@ -104,6 +104,10 @@ pub struct ModelArgs {
     pub hamaker: Option<f64>,
     #[arg(long, value_name = "ã0", allow_negative_numbers = true)]
     pub intermolecular_distance: Option<f64>,
+    #[arg(long, value_name = "Ẽ", allow_negative_numbers = true)]
+    pub electrostatic: Option<f64>,
+    #[arg(long, value_name = "R̃", allow_negative_numbers = true)]
+    pub tip_radius: Option<f64>,
 }
 
 fn parse_law(s: &str) -> Result<LawKind, String> {
@@ -149,6 +153,8 @@ impl ModelArgs {
             restitution: self.restitution,
             hamaker: self.hamaker,
             intermolecular_distance: self.intermolecular_distance,
+            electrostatic: self.electrostatic,
+            tip_radius: self.tip_radius,
             z_c: quantity(self.z_c, "z-c", Dim::Length, true)?,
             drive_frequency: quantity(
                 self.drive_frequency,

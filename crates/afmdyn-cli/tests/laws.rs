@@ -25,7 +25,7 @@ fn json(args: &[&str]) -> serde_json::Value {
 }
 
 /// (law flags, model flags giving a periodic orbit at the chosen Ω, Ω).
-const LAWS: [(&[&str], &[&str], &str); 4] = [
+const LAWS: [(&[&str], &[&str], &str); 5] = [
     (&["--contact-law", "linear"], &["--modes", "2"], "2.8"),
     (&["--contact-law", "hertz"], &["--modes", "2"], "2.8"),
     (
@@ -44,6 +44,12 @@ const LAWS: [(&[&str], &[&str], &str); 4] = [
         &["--contact-law", "impact", "--restitution", "0.5"],
         &["--modes", "1", "--gap", "0.05"],
         "3.0",
+    ),
+    // the documented defaults: `--contact-law electrostatic` runs as it stands
+    (
+        &["--contact-law", "electrostatic"],
+        &["--modes", "2"],
+        "2.8",
     ),
 ];
 
@@ -145,6 +151,30 @@ fn law_flags_are_checked() {
         (
             vec!["orbit", "--contact-law", "dmt", "--hamaker", "-1"],
             "hamaker",
+        ),
+        (
+            vec!["orbit", "--contact-law", "dmt", "--electrostatic", "1e-3"],
+            "electrostatic",
+        ),
+        (
+            vec![
+                "orbit",
+                "--contact-law",
+                "electrostatic",
+                "--tip-radius",
+                "0",
+            ],
+            "tip_radius",
+        ),
+        (
+            vec![
+                "simulate",
+                "--contact-law",
+                "electrostatic",
+                "--integrator",
+                "taylor",
+            ],
+            "taylor",
         ),
         (
             vec![

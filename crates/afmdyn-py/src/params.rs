@@ -123,12 +123,14 @@ pub fn model_spec(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<ModelSpec> {
             "restitution" => m.restitution = x()?,
             "hamaker" => m.hamaker = x()?,
             "intermolecular_distance" => m.intermolecular_distance = x()?,
+            "electrostatic" => m.electrostatic = x()?,
+            "tip_radius" => m.tip_radius = x()?,
             "z_c" => m.z_c = x()?,
             "drive_frequency" => m.drive_frequency = x()?,
             "contact_law" => {
                 let name: String = v.extract().map_err(|_| {
                     PyTypeError::new_err(format!(
-                        "{key}: expected a string (linear, hertz, dmt or impact)"
+                        "{key}: expected a string (linear, hertz, dmt, electrostatic or impact)"
                     ))
                 })?;
                 m.contact_law = Some(
@@ -196,9 +198,10 @@ pub fn resolve(
 /// ``tip_mass_ratio``/``alpha1`` (α1 ≥ 0), ``drive_amplitude``/``alpha2`` (α2 ≥ 0),
 /// ``beam_damping``/``alpha3`` (α3 ≥ 0), ``contact_stiffness``/``alpha4`` (α4 ≥ 0),
 /// ``gap``/``alpha5`` (α5, finite), ``contact_damping``/``alpha6`` (α6 ≥ 0), ``omega``
-/// (Ω > 0), ``contact_law`` (``"linear"``, ``"hertz"``, ``"dmt"``, ``"impact"``) with its groups
-/// ``restitution`` (0..=1, impact), ``hamaker`` (≥ 0) and ``intermolecular_distance`` (> 0,
-/// DMT). Missing ones take the paper's Figs. 5–14 set (N = 3, α1 = α2 = α3 = 0.1, α4 = 20,
+/// (Ω > 0), ``contact_law`` (``"linear"``, ``"hertz"``, ``"dmt"``, ``"electrostatic"``,
+/// ``"impact"``) with its groups ``restitution`` (0..=1, impact), ``hamaker`` (≥ 0) and
+/// ``intermolecular_distance`` (> 0, DMT and electrostatic), ``electrostatic`` (Ẽ ≥ 0) and
+/// ``tip_radius`` (R̃ > 0, electrostatic). Missing ones take the paper's Figs. 5–14 set (N = 3, α1 = α2 = α3 = 0.1, α4 = 20,
 /// α5 = 0, α6 = 0.2, Ω = 2.6). The names, ranges and help are the library's one table
 /// (``afmdyn._afmdyn.MODEL_PARAMETERS``).
 ///
@@ -336,22 +339,38 @@ impl PyParams {
     fn restitution(&self) -> Option<f64> {
         self.inner.contact_law.restitution()
     }
-    /// DMT van der Waals group H̃ (``None`` for the other laws).
+    /// DMT (and electrostatic law) van der Waals group H̃ (``None`` for the other laws).
     #[getter]
     fn hamaker(&self) -> Option<f64> {
         match self.inner.contact_law {
-            afmdyn::ContactLaw::Dmt { hamaker, .. } => Some(hamaker),
+            afmdyn::ContactLaw::Dmt { hamaker, .. }
+            | afmdyn::ContactLaw::Electrostatic { hamaker, .. } => Some(hamaker),
             _ => None,
         }
     }
-    /// DMT intermolecular distance ã0 (``None`` for the other laws).
+    /// DMT (and electrostatic law) intermolecular distance ã0 (``None`` for the other laws).
     #[getter]
     fn intermolecular_distance(&self) -> Option<f64> {
         match self.inner.contact_law {
-            afmdyn::ContactLaw::Dmt {
-                intermolecular_distance,
-                ..
-            } => Some(intermolecular_distance),
+            afmdyn::ContactLaw::Dmt { .. } | afmdyn::ContactLaw::Electrostatic { .. } => {
+                Some(self.inner.contact_law.distance_offset())
+            }
+            _ => None,
+        }
+    }
+    /// Electrostatic law: the group Ẽ (``None`` for the other laws).
+    #[getter]
+    fn electrostatic(&self) -> Option<f64> {
+        match self.inner.contact_law {
+            afmdyn::ContactLaw::Electrostatic { electrostatic, .. } => Some(electrostatic),
+            _ => None,
+        }
+    }
+    /// Electrostatic law: the tip radius R̃ = R/g0 (``None`` for the other laws).
+    #[getter]
+    fn tip_radius(&self) -> Option<f64> {
+        match self.inner.contact_law {
+            afmdyn::ContactLaw::Electrostatic { tip_radius, .. } => Some(tip_radius),
             _ => None,
         }
     }

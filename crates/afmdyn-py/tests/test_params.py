@@ -177,11 +177,24 @@ def test_contact_law_keywords_resolve_as_on_the_command_line(cli_json):
         Params(contact_law="elastic")
     with pytest.raises(TypeError, match="contact_law"):
         Params(contact_law=1)
+    # the electrostatic law: DMT's groups and its own, with their defaults
+    e = Params(contact_law="electrostatic")
+    assert (e.electrostatic, e.tip_radius, e.hamaker) == (1e-3, 1.0, 1e-5)
+    assert e.to_dict() == cli_json("modes", "--contact-law", "electrostatic")["params"]
+    with pytest.raises(ValueError, match="electrostatic is a group of the electrostatic law"):
+        Params(contact_law="dmt", electrostatic=1e-3)
+    with pytest.raises(ValueError, match="tip_radius"):
+        Params(contact_law="electrostatic", tip_radius=-1.0)
 
 
 def test_every_law_runs_from_python_as_on_the_command_line(cli_json):
     # the orbit document of each law equals the command line's for the same keywords
-    for law, extra in [("hertz", {}), ("dmt", {}), ("impact", {"restitution": 0.5})]:
+    for law, extra in [
+        ("hertz", {}),
+        ("dmt", {}),
+        ("electrostatic", {"electrostatic": 2e-3, "tip_radius": 0.5}),
+        ("impact", {"restitution": 0.5}),
+    ]:
         model = {"contact_law": law, "modes": 1, "omega": 3.0, "gap": 0.05, **extra}
         args = ["orbit"]
         for k, v in model.items():

@@ -22,6 +22,12 @@
 //!   Kelvin–Voigt damping ∝ contact radius √(Rδ); see García & San Paulo, *Phys. Rev. B* 60
 //!   (1999) 4961 and Garcia, *Amplitude Modulation AFM*, Wiley 2010, ch. 3). The force is
 //!   continuous at δ = 0, so the free flight is nonlinear but the switching has no force jump.
+//! * `electrostatic` — DMT with the electrostatic attraction of a biased tip: the sphere–plane
+//!   capacitor force F_es = −πε₀V²R²/(d(d + R)) (Hudlet, Saint Jean, Guthmann & Berger,
+//!   *Eur. Phys. J. B* 2 (1998) 5, the sphere's term; −πε₀V²R/d for d ≪ R), V the bias minus
+//!   the contact potential difference, in units Ẽ = πε₀V²/F̃-unit and R̃ = R/g₀:
+//!   F_c = −H/d² − ẼR̃²/(d(d + R̃)) outside contact, and both long-range forces at d = a₀ plus
+//!   Hertz and Kelvin–Voigt in contact, as DMT (continuous at δ = 0).
 //! * `impact` — the impact oscillator of the paper's Fig. 1b: a rigid sample at V_T = 0 with
 //!   Newton's coefficient of restitution r: dV_T/dτ⁺ = −r dV_T/dτ⁻ (Shaw & Holmes, *J. Sound Vib.*
 //!   90 (1983) 129; Nordmark, *J. Sound Vib.* 145 (1991) 279). No force acts in free flight; the
@@ -56,6 +62,17 @@ pub enum ContactLaw {
         /// ã₀ = a₀/g₀ > 0: intermolecular distance, the contact threshold.
         intermolecular_distance: f64,
     },
+    /// DMT plus the electrostatic force of a biased spherical tip (Hudlet et al. 1998).
+    Electrostatic {
+        /// H̃ ≥ 0, as DMT's.
+        hamaker: f64,
+        /// ã₀ > 0, as DMT's: the contact threshold.
+        intermolecular_distance: f64,
+        /// Ẽ = πε₀(V_bias − V_cpd)²/F_unit ≥ 0: F_es = −ẼR̃²/(d(d + R̃)).
+        electrostatic: f64,
+        /// R̃ = R/g₀ > 0: the tip radius.
+        tip_radius: f64,
+    },
     /// Rigid sample with coefficient of restitution r ∈ [0, 1] (impact oscillator, Fig. 1b).
     Impact {
         /// Newton's coefficient of restitution r.
@@ -71,17 +88,22 @@ impl ContactLaw {
             ContactLaw::Dmt {
                 intermolecular_distance,
                 ..
+            }
+            | ContactLaw::Electrostatic {
+                intermolecular_distance,
+                ..
             } => *intermolecular_distance,
             _ => 0.0,
         }
     }
 
-    /// The law's name: `linear`, `hertz`, `dmt` or `impact`.
+    /// The law's name: `linear`, `hertz`, `dmt`, `electrostatic` or `impact`.
     pub fn name(&self) -> &'static str {
         match self {
             ContactLaw::Linear => "linear",
             ContactLaw::Hertz => "hertz",
             ContactLaw::Dmt { .. } => "dmt",
+            ContactLaw::Electrostatic { .. } => "electrostatic",
             ContactLaw::Impact { .. } => "impact",
         }
     }
@@ -99,7 +121,8 @@ impl ContactLaw {
         }
     }
 
-    /// Check the law's own groups: DMT H̃ ≥ 0 finite, 0 < ã₀ ≤ 1e6; impact 0 ≤ r ≤ 1.
+    /// Check the law's own groups: DMT H̃ ≥ 0 finite, 0 < ã₀ ≤ 1e6; electrostatic those and
+    /// 0 ≤ Ẽ ≤ 1e12, 0 < R̃ ≤ 1e6; impact 0 ≤ r ≤ 1.
     ///
     /// # Errors
     /// [`crate::ParamError::Law`] naming the group and its allowed range.
@@ -109,6 +132,34 @@ impl ContactLaw {
         };
         match *self {
             ContactLaw::Linear | ContactLaw::Hertz => Ok(()),
+            ContactLaw::Electrostatic {
+                hamaker,
+                intermolecular_distance,
+                electrostatic,
+                tip_radius,
+            } => {
+                ContactLaw::Dmt {
+                    hamaker,
+                    intermolecular_distance,
+                }
+                .validate()?;
+                if !(electrostatic.is_finite() && (0.0..=1e12).contains(&electrostatic)) {
+                    return bad("electrostatic (group Ẽ)", electrostatic, "0 ≤ Ẽ ≤ 1e12");
+                }
+                if !(tip_radius.is_finite() && tip_radius > 0.0 && tip_radius <= 1e6) {
+                    return bad("tip_radius (R̃ = R/g₀)", tip_radius, "0 < R̃ ≤ 1e6");
+                }
+                let a0 = intermolecular_distance;
+                let at_contact = electrostatic * tip_radius * tip_radius / (a0 * (a0 + tip_radius));
+                if !(at_contact.is_finite() && at_contact <= 1e12) {
+                    return bad(
+                        "electrostatic (group Ẽ)",
+                        electrostatic,
+                        "ẼR̃²/(ã₀(ã₀ + R̃)) ≤ 1e12 (the electrostatic force at contact)",
+                    );
+                }
+                Ok(())
+            }
             ContactLaw::Dmt {
                 hamaker,
                 intermolecular_distance,
@@ -154,7 +205,7 @@ impl fmt::Display for ContactLaw {
     }
 }
 
-/// The kind of a law without its groups, parsed from `linear|hertz|dmt|impact`.
+/// The kind of a law without its groups, parsed from `linear|hertz|dmt|electrostatic|impact`.
 ///
 /// One parser for every front end: the name is taken in any case (`"HERTZ"`, `"DMT"` as the
 /// literature writes it) on the command line, in a `--config` file, a probe file and from
@@ -170,6 +221,8 @@ pub enum LawKind {
     Hertz,
     /// [`ContactLaw::Dmt`].
     Dmt,
+    /// [`ContactLaw::Electrostatic`].
+    Electrostatic,
     /// [`ContactLaw::Impact`].
     Impact,
 }
@@ -181,9 +234,10 @@ impl FromStr for LawKind {
             "linear" => Ok(LawKind::Linear),
             "hertz" => Ok(LawKind::Hertz),
             "dmt" => Ok(LawKind::Dmt),
+            "electrostatic" => Ok(LawKind::Electrostatic),
             "impact" => Ok(LawKind::Impact),
             _ => Err(format!(
-                "contact law '{s}': expected linear, hertz, dmt or impact"
+                "contact law '{s}': expected linear, hertz, dmt, electrostatic or impact"
             )),
         }
     }
@@ -202,6 +256,12 @@ impl<'de> Deserialize<'de> for LawKind {
 pub const DMT_DEFAULT_HAMAKER: f64 = 1e-5;
 /// Default DMT intermolecular distance ã₀.
 pub const DMT_DEFAULT_A0: f64 = 0.01;
+/// Default electrostatic group Ẽ: with R̃ = 1 and ã₀ = 0.01 the electrostatic force at contact
+/// is ẼR̃²/(ã₀(ã₀ + R̃)) ≈ 0.099, about DMT's default adhesion (a few volts on a 10 nm tip give
+/// nanonewtons, as van der Waals does), and it decays as 1/d, not 1/d².
+pub const ELECTROSTATIC_DEFAULT: f64 = 1e-3;
+/// Default tip radius R̃ = R/g₀ of the electrostatic law.
+pub const ELECTROSTATIC_DEFAULT_RADIUS: f64 = 1.0;
 /// Default coefficient of restitution of the impact law.
 pub const IMPACT_DEFAULT_RESTITUTION: f64 = 0.8;
 
@@ -212,6 +272,8 @@ impl LawKind {
         hamaker: Option<f64>,
         intermolecular_distance: Option<f64>,
         restitution: Option<f64>,
+        electrostatic: Option<f64>,
+        tip_radius: Option<f64>,
     ) -> ContactLaw {
         match self {
             LawKind::Linear => ContactLaw::Linear,
@@ -219,6 +281,12 @@ impl LawKind {
             LawKind::Dmt => ContactLaw::Dmt {
                 hamaker: hamaker.unwrap_or(DMT_DEFAULT_HAMAKER),
                 intermolecular_distance: intermolecular_distance.unwrap_or(DMT_DEFAULT_A0),
+            },
+            LawKind::Electrostatic => ContactLaw::Electrostatic {
+                hamaker: hamaker.unwrap_or(DMT_DEFAULT_HAMAKER),
+                intermolecular_distance: intermolecular_distance.unwrap_or(DMT_DEFAULT_A0),
+                electrostatic: electrostatic.unwrap_or(ELECTROSTATIC_DEFAULT),
+                tip_radius: tip_radius.unwrap_or(ELECTROSTATIC_DEFAULT_RADIUS),
             },
             LawKind::Impact => ContactLaw::Impact {
                 restitution: restitution.unwrap_or(IMPACT_DEFAULT_RESTITUTION),
@@ -235,60 +303,105 @@ impl ContactLaw {
     /// # Errors
     /// [`crate::ParamError::Group`] for a group of another law (e.g. `restitution` with
     /// `contact_law = hertz`); the groups' ranges are checked by [`ContactLaw::validate`].
+    #[allow(clippy::too_many_arguments)]
     pub fn from_parts(
         kind: Option<LawKind>,
         hamaker: Option<f64>,
         intermolecular_distance: Option<f64>,
         restitution: Option<f64>,
+        electrostatic: Option<f64>,
+        tip_radius: Option<f64>,
         base: ContactLaw,
     ) -> Result<ContactLaw, crate::ParamError> {
-        let kind = kind.unwrap_or(match base {
-            ContactLaw::Linear => LawKind::Linear,
-            ContactLaw::Hertz => LawKind::Hertz,
-            ContactLaw::Dmt { .. } => LawKind::Dmt,
-            ContactLaw::Impact { .. } => LawKind::Impact,
-        });
-        for (given, group, owner) in [
-            (restitution.is_some(), "restitution", LawKind::Impact),
-            (hamaker.is_some(), "hamaker", LawKind::Dmt),
+        let kind = kind.unwrap_or(base.kind());
+        const DMT: &[LawKind] = &[LawKind::Dmt, LawKind::Electrostatic];
+        const ES: &[LawKind] = &[LawKind::Electrostatic];
+        for (given, group, owners, owner) in [
+            (
+                restitution.is_some(),
+                "restitution",
+                &[LawKind::Impact][..],
+                "impact",
+            ),
+            (hamaker.is_some(), "hamaker", DMT, "dmt or electrostatic"),
             (
                 intermolecular_distance.is_some(),
                 "intermolecular_distance",
-                LawKind::Dmt,
+                DMT,
+                "dmt or electrostatic",
             ),
+            (
+                electrostatic.is_some(),
+                "electrostatic",
+                ES,
+                "electrostatic",
+            ),
+            (tip_radius.is_some(), "tip_radius", ES, "electrostatic"),
         ] {
-            if given && kind != owner {
+            if given && !owners.contains(&kind) {
                 return Err(crate::ParamError::Group {
                     group,
-                    owner: owner.name(),
+                    owner,
                     law: kind.name(),
                 });
             }
         }
-        // groups not given keep base's when base is of the same kind
-        let (h0, a0, r0) = match base {
+        // groups not given keep base's when base has them
+        let (h0, a0, r0, e0, t0) = match base {
             ContactLaw::Dmt {
                 hamaker,
                 intermolecular_distance,
-            } => (Some(hamaker), Some(intermolecular_distance), None),
-            ContactLaw::Impact { restitution } => (None, None, Some(restitution)),
-            _ => (None, None, None),
+            } => (
+                Some(hamaker),
+                Some(intermolecular_distance),
+                None,
+                None,
+                None,
+            ),
+            ContactLaw::Electrostatic {
+                hamaker,
+                intermolecular_distance,
+                electrostatic,
+                tip_radius,
+            } => (
+                Some(hamaker),
+                Some(intermolecular_distance),
+                None,
+                Some(electrostatic),
+                Some(tip_radius),
+            ),
+            ContactLaw::Impact { restitution } => (None, None, Some(restitution), None, None),
+            _ => (None, None, None, None, None),
         };
         Ok(kind.with_groups(
             hamaker.or(h0),
             intermolecular_distance.or(a0),
             restitution.or(r0),
+            electrostatic.or(e0),
+            tip_radius.or(t0),
         ))
+    }
+
+    /// The law's kind without its groups.
+    pub fn kind(&self) -> LawKind {
+        match self {
+            ContactLaw::Linear => LawKind::Linear,
+            ContactLaw::Hertz => LawKind::Hertz,
+            ContactLaw::Dmt { .. } => LawKind::Dmt,
+            ContactLaw::Electrostatic { .. } => LawKind::Electrostatic,
+            ContactLaw::Impact { .. } => LawKind::Impact,
+        }
     }
 }
 
 impl LawKind {
-    /// The kind's name: `linear`, `hertz`, `dmt` or `impact`.
+    /// The kind's name: `linear`, `hertz`, `dmt`, `electrostatic` or `impact`.
     pub fn name(self) -> &'static str {
         match self {
             LawKind::Linear => "linear",
             LawKind::Hertz => "hertz",
             LawKind::Dmt => "dmt",
+            LawKind::Electrostatic => "electrostatic",
             LawKind::Impact => "impact",
         }
     }
@@ -348,26 +461,24 @@ impl TipSampleLaw for TipSample {
                     d_rate: c,
                 }
             }
-            ContactLaw::Dmt {
-                hamaker,
-                intermolecular_distance: a0,
-            } => {
+            ContactLaw::Dmt { .. } | ContactLaw::Electrostatic { .. } => {
+                let a0 = self.law.distance_offset();
                 if contact {
                     let d = delta.max(0.0);
                     let s = d.sqrt();
                     // ∂(√δ δ̇)/∂δ = δ̇/(2√δ): integrable singularity at δ = 0, 0 there
                     let visc_d = if s > 0.0 { 0.5 * c * rate / s } else { 0.0 };
                     ForceEval {
-                        force: -hamaker / (a0 * a0) + k * d * s + c * s * rate,
+                        force: self.long_range(a0)[0] + k * d * s + c * s * rate,
                         d_delta: 1.5 * k * s + visc_d,
                         d_rate: c * s,
                     }
                 } else {
-                    // d = a₀ + V_T = a₀ − δ > a₀
-                    let d = a0 - delta;
+                    // d = a₀ + V_T = a₀ − δ > a₀; ∂/∂δ = −∂/∂d
+                    let [force, d_d, _] = self.long_range(a0 - delta);
                     ForceEval {
-                        force: -hamaker / (d * d),
-                        d_delta: -2.0 * hamaker / (d * d * d),
+                        force,
+                        d_delta: -d_d,
                         d_rate: 0.0,
                     }
                 }
@@ -381,14 +492,13 @@ impl TipSampleLaw for TipSample {
         match self.law {
             ContactLaw::Linear if contact => 0.5 * k * delta * delta,
             ContactLaw::Hertz if contact => 0.4 * k * delta.max(0.0).powf(2.5),
-            ContactLaw::Dmt {
-                hamaker,
-                intermolecular_distance: a0,
-            } => {
+            ContactLaw::Dmt { .. } | ContactLaw::Electrostatic { .. } => {
+                let a0 = self.law.distance_offset();
                 if contact {
-                    -hamaker / a0 - hamaker * delta / (a0 * a0) + 0.4 * k * delta.max(0.0).powf(2.5)
+                    let [f0, _, u0] = self.long_range(a0);
+                    u0 + f0 * delta + 0.4 * k * delta.max(0.0).powf(2.5)
                 } else {
-                    -hamaker / (a0 - delta)
+                    self.long_range(a0 - delta)[2]
                 }
             }
             _ => 0.0,
@@ -401,13 +511,45 @@ impl TipSampleLaw for TipSample {
         }
         match self.law {
             ContactLaw::Linear | ContactLaw::Hertz => self.damping * rate,
-            ContactLaw::Dmt { .. } => self.damping * delta.max(0.0).sqrt() * rate,
+            ContactLaw::Dmt { .. } | ContactLaw::Electrostatic { .. } => {
+                self.damping * delta.max(0.0).sqrt() * rate
+            }
             ContactLaw::Impact { .. } => 0.0,
         }
     }
 
     fn acts_outside(&self) -> bool {
-        matches!(self.law, ContactLaw::Dmt { .. })
+        matches!(
+            self.law,
+            ContactLaw::Dmt { .. } | ContactLaw::Electrostatic { .. }
+        )
+    }
+}
+
+impl TipSample {
+    /// The long-range attraction at tip–sample distance d > 0: [F(d), dF/dd, U(d)] with
+    /// F = −dU/dd — DMT's van der Waals −H̃/d² (U = −H̃/d), and for the electrostatic law also
+    /// the biased sphere over the plane −ẼR̃²/(d(d + R̃)) (Hudlet et al. 1998;
+    /// U = −ẼR̃ ln((d + R̃)/d)); zeros for the other laws.
+    pub fn long_range(&self, d: f64) -> [f64; 3] {
+        let (h, es) = match self.law {
+            ContactLaw::Dmt { hamaker, .. } => (hamaker, None),
+            ContactLaw::Electrostatic {
+                hamaker,
+                electrostatic,
+                tip_radius,
+                ..
+            } => (hamaker, Some((electrostatic, tip_radius))),
+            _ => return [0.0; 3],
+        };
+        let mut out = [-h / (d * d), 2.0 * h / (d * d * d), -h / d];
+        if let Some((e, r)) = es {
+            let dr = d + r;
+            out[0] -= e * r * r / (d * dr);
+            out[1] += e * r * r * (2.0 * d + r) / (d * d * dr * dr);
+            out[2] -= e * r * (dr / d).ln();
+        }
+        out
     }
 }
 
@@ -422,6 +564,12 @@ mod tests {
             ContactLaw::Dmt {
                 hamaker: 0.3,
                 intermolecular_distance: 0.02,
+            },
+            ContactLaw::Electrostatic {
+                hamaker: 0.3,
+                intermolecular_distance: 0.02,
+                electrostatic: 0.05,
+                tip_radius: 0.7,
             },
         ]
         .into_iter()
@@ -463,13 +611,42 @@ mod tests {
     }
 
     /// DMT is continuous at the contact threshold (force and potential), the DMT adhesion
-    /// force is H̃/ã₀² there.
+    /// force is H̃/ã₀² there; the electrostatic law too, with the sphere–plane force
+    /// ẼR̃²/(ã₀(ã₀ + R̃)) added.
     #[test]
     fn dmt_is_continuous_at_contact() {
-        let ts = laws()[2];
-        let (inside, outside) = (ts.force(true, 0.0, 0.0), ts.force(false, 0.0, 0.0));
-        assert!((inside.force - outside.force).abs() < 1e-12);
-        assert!((inside.force + 0.3 / (0.02 * 0.02)).abs() < 1e-9);
-        assert!((ts.potential(true, 0.0) - ts.potential(false, 0.0)).abs() < 1e-12);
+        for (ts, adhesion) in [
+            (laws()[2], 0.3 / (0.02 * 0.02)),
+            (
+                laws()[3],
+                0.3 / (0.02 * 0.02) + 0.05 * 0.7 * 0.7 / (0.02 * 0.72),
+            ),
+        ] {
+            let (inside, outside) = (ts.force(true, 0.0, 0.0), ts.force(false, 0.0, 0.0));
+            assert!((inside.force - outside.force).abs() < 1e-12);
+            assert!((inside.force + adhesion).abs() < 1e-9 * adhesion);
+            assert!((ts.potential(true, 0.0) - ts.potential(false, 0.0)).abs() < 1e-12);
+        }
+    }
+
+    /// The electrostatic force is Hudlet's sphere term: −πε₀V²R/d for d ≪ R (the parallel
+    /// plate limit of the sphere, Hudlet et al. 1998) and −πε₀V²R²/d² for d ≫ R (a point
+    /// charge's image force), in the law's units Ẽ = πε₀V², R̃.
+    #[test]
+    fn electrostatic_force_has_its_limits() {
+        let ts = TipSample {
+            law: ContactLaw::Electrostatic {
+                hamaker: 0.0,
+                intermolecular_distance: 1e-3,
+                electrostatic: 2.0,
+                tip_radius: 5.0,
+            },
+            stiffness: 0.0,
+            damping: 0.0,
+        };
+        let near = ts.long_range(1e-4)[0];
+        assert!((near / (-2.0 * 5.0 / 1e-4) - 1.0).abs() < 1e-4, "{near}");
+        let far = ts.long_range(1e5)[0];
+        assert!((far / (-2.0 * 25.0 / 1e10) - 1.0).abs() < 1e-4, "{far}");
     }
 }

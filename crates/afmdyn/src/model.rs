@@ -349,7 +349,7 @@ impl CantileverModel {
         self.jacobian_parts(r, tau, self.base_trig(tau), z, jac, true);
     }
 
-    /// The Kelvin–Voigt weight w = α6 √δ of DMT in contact (0 elsewhere): its τ-derivative
+    /// The Kelvin–Voigt weight w = α6 √δ of DMT (and the electrostatic law) in contact (0 elsewhere): its τ-derivative
     /// α6 δ̇/(2√δ) is the singular part of ∂F_c/∂δ at contact onset.
     fn kelvin_voigt_weight(&self, r: Region, tau: f64, z: &[f64]) -> f64 {
         self.kelvin_voigt_weight_at(r, self.base_trig(tau), z)
@@ -357,7 +357,12 @@ impl CantileverModel {
 
     /// [`Self::kelvin_voigt_weight`] given (sin Ωτ, cos Ωτ) = `sc` ([`Self::base_trig`]).
     fn kelvin_voigt_weight_at(&self, r: Region, sc: (f64, f64), z: &[f64]) -> f64 {
-        if r != Region::Contact || !matches!(self.law.law, ContactLaw::Dmt { .. }) {
+        if r != Region::Contact
+            || !matches!(
+                self.law.law,
+                ContactLaw::Dmt { .. } | ContactLaw::Electrostatic { .. }
+            )
+        {
             return 0.0;
         }
         let [v, _, _] = self.v_t_at(sc, [self.w_tip_slice(z, 0), 0.0, 0.0]);

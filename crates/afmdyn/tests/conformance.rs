@@ -30,8 +30,14 @@ const DMT: ContactLaw = ContactLaw::Dmt {
     intermolecular_distance: 0.01,
 };
 const IMPACT: ContactLaw = ContactLaw::Impact { restitution: 0.6 };
+const ES: ContactLaw = ContactLaw::Electrostatic {
+    hamaker: 1e-5,
+    intermolecular_distance: 0.01,
+    electrostatic: 1e-3,
+    tip_radius: 1.0,
+};
 
-const LAWS: [ContactLaw; 4] = [ContactLaw::Linear, ContactLaw::Hertz, DMT, IMPACT];
+const LAWS: [ContactLaw; 5] = [ContactLaw::Linear, ContactLaw::Hertz, DMT, ES, IMPACT];
 
 const KINDS: [IntegratorKind; 6] = [
     IntegratorKind::Exact,
@@ -56,17 +62,19 @@ fn name(kind: IntegratorKind) -> &'static str {
 
 /// The support table: which integrator carries which law.
 fn supported(kind: IntegratorKind, law: ContactLaw) -> bool {
-    let (linear, impact, dmt) = (
+    let (linear, impact, dmt, es) = (
         law == ContactLaw::Linear,
         law.restitution().is_some(),
         matches!(law, ContactLaw::Dmt { .. }),
+        matches!(law, ContactLaw::Electrostatic { .. }),
     );
     match kind {
         IntegratorKind::Auto | IntegratorKind::Adaptive => true,
         IntegratorKind::Exact => linear,
         IntegratorKind::Rk4 | IntegratorKind::Rk4Naive => !impact,
-        IntegratorKind::Split => !dmt,
-        IntegratorKind::Taylor => !linear && !impact,
+        // the electrostatic force acts in free flight, and is not in the Taylor recurrences
+        IntegratorKind::Split => !dmt && !es,
+        IntegratorKind::Taylor => !linear && !impact && !es,
     }
 }
 

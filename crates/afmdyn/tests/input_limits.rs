@@ -154,7 +154,10 @@ fn contact_law_in_any_case() {
     let spec: ModelSpec = afmdyn::request::model::parse_toml("contact_law = \"HERTZ\"").unwrap();
     assert_eq!(spec.contact_law, Some(afmdyn::contact::LawKind::Hertz));
     let e = afmdyn::request::model::parse_toml::<ModelSpec>("contact_law = \"hooke\"").unwrap_err();
-    assert!(e.contains("expected linear, hertz, dmt or impact"), "{e}");
+    assert!(
+        e.contains("expected linear, hertz, dmt, electrostatic or impact"),
+        "{e}"
+    );
 }
 
 /// Numbers in messages: at most 6 significant digits, 1e300 not as 301 digits.

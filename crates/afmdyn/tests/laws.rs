@@ -25,6 +25,13 @@ const DMT: ContactLaw = ContactLaw::Dmt {
     hamaker: 1e-5,
     intermolecular_distance: 0.01,
 };
+/// The electrostatic law at its defaults (DMT's groups, Ẽ = 1e-3, R̃ = 1).
+const ES: ContactLaw = ContactLaw::Electrostatic {
+    hamaker: 1e-5,
+    intermolecular_distance: 0.01,
+    electrostatic: 1e-3,
+    tip_radius: 1.0,
+};
 
 // One conformance suite over every law × integrator pair: tests/conformance.rs.
 
@@ -259,6 +266,21 @@ impl Independent {
                     -h / ((a0 + v) * (a0 + v))
                 }
             }
+            // Hudlet et al. 1998: the biased sphere over the plane, −ẼR̃²/(d(d + R̃)), added to
+            // DMT's van der Waals force and saturated at d = a₀ in contact
+            ContactLaw::Electrostatic {
+                hamaker: h,
+                intermolecular_distance: a0,
+                electrostatic: e,
+                tip_radius: r,
+            } => {
+                let attraction = |dist: f64| -h / (dist * dist) - e * r * r / (dist * (dist + r));
+                if contact {
+                    attraction(a0) + k * d.max(0.0).powf(1.5) + c * d.max(0.0).sqrt() * dd
+                } else {
+                    attraction(a0 + v)
+                }
+            }
             _ => 0.0,
         }
     }
@@ -353,7 +375,8 @@ fn law_model(law: ContactLaw, modes: usize, omega: f64) -> (Params, CantileverMo
     (p, CantileverModel::new(&p).unwrap())
 }
 
-/// Hertz and DMT period-1 orbits at Ω = 2.8 (N = 2): state and Floquet multipliers from the
+/// Hertz, DMT and electrostatic period-1 orbits at Ω = 2.8 (N = 2): state and Floquet
+/// multipliers from the
 /// adaptive integrator (variational equations + saltation) against the independent integrator
 /// (RK4, 40 000 steps per period, finite-difference monodromy) to 1e-7. DMT is compared without
 /// its Kelvin–Voigt term: α6 √δ δ̇ has an unbounded derivative at contact onset, where fixed-step
@@ -361,7 +384,7 @@ fn law_model(law: ContactLaw, modes: usize, omega: f64) -> (Params, CantileverMo
 /// finite differences of the map in `dmt_kelvin_voigt_monodromy_matches_finite_differences`.
 #[test]
 fn hertz_and_dmt_orbits_agree_with_an_independent_integrator() {
-    for (law, alpha6) in [(ContactLaw::Hertz, 0.2), (DMT, 0.0)] {
+    for (law, alpha6) in [(ContactLaw::Hertz, 0.2), (DMT, 0.0), (ES, 0.0)] {
         let p = Params {
             modes: 2,
             omega: 2.8,
@@ -445,7 +468,7 @@ proptest! {
     /// and the impact law, from random starts.
     #[test]
     fn variational_jacobian_matches_finite_differences(
-        law_ix in 0usize..3,
+        law_ix in 0usize..4,
         a1 in -0.05f64..0.05,
         v1 in -0.3f64..0.3,
         a2 in -0.003f64..0.003,
@@ -453,6 +476,7 @@ proptest! {
         let (law, modes, omega, gap) = match law_ix {
             0 => (ContactLaw::Hertz, 2, 2.8, 0.0),
             1 => (DMT, 2, 2.8, 0.0),
+            2 => (ES, 2, 2.8, 0.0),
             _ => (ContactLaw::Impact { restitution: 0.5 }, 1, 3.0, 0.05),
         };
         let p = Params { modes, omega, alpha5: gap, contact_law: law, ..Params::default() };
@@ -505,6 +529,13 @@ fn every_analysis_on_every_law() {
         },
         Case {
             law: DMT,
+            modes: 2,
+            omega: 2.8,
+            gap: 0.0,
+            period: 1,
+        },
+        Case {
+            law: ES,
             modes: 2,
             omega: 2.8,
             gap: 0.0,

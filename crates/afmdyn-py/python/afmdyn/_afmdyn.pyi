@@ -33,8 +33,10 @@ class Params:
     ``drive_amplitude``/``alpha2`` (≥ 0), ``beam_damping``/``alpha3`` (≥ 0),
     ``contact_stiffness``/``alpha4`` (≥ 0), ``gap``/``alpha5`` (finite),
     ``contact_damping``/``alpha6`` (≥ 0), ``omega`` (Ω > 0), ``contact_law`` (``"linear"``,
-    ``"hertz"``, ``"dmt"``, ``"impact"``) with its groups ``restitution`` (0..=1, impact),
-    ``hamaker`` (≥ 0) and ``intermolecular_distance`` (> 0, DMT); the others keep the paper's
+    ``"hertz"``, ``"dmt"``, ``"electrostatic"``, ``"impact"``) with its groups ``restitution``
+    (0..=1, impact), ``hamaker`` (≥ 0) and ``intermolecular_distance`` (> 0, DMT and
+    electrostatic), ``electrostatic`` (Ẽ ≥ 0) and ``tip_radius`` (R̃ > 0, electrostatic); the
+    others keep the paper's
     Figs. 5–14 set. Raises ``ValueError`` (field and range) or ``TypeError`` (unknown keyword,
     wrong type).
     """
@@ -56,10 +58,12 @@ class Params:
         contact_damping: float = ...,
         alpha6: float = ...,
         omega: float = ...,
-        contact_law: Literal["linear", "hertz", "dmt", "impact"] = ...,
+        contact_law: Literal["linear", "hertz", "dmt", "electrostatic", "impact"] = ...,
         restitution: float = ...,
         hamaker: float = ...,
         intermolecular_distance: float = ...,
+        electrostatic: float = ...,
+        tip_radius: float = ...,
     ) -> None: ...
     def replace(
         self,
@@ -78,10 +82,12 @@ class Params:
         contact_damping: float = ...,
         alpha6: float = ...,
         omega: float = ...,
-        contact_law: Literal["linear", "hertz", "dmt", "impact"] = ...,
+        contact_law: Literal["linear", "hertz", "dmt", "electrostatic", "impact"] = ...,
         restitution: float = ...,
         hamaker: float = ...,
         intermolecular_distance: float = ...,
+        electrostatic: float = ...,
+        tip_radius: float = ...,
     ) -> "Params":
         """A validated copy with the given keywords changed."""
     @staticmethod
@@ -114,13 +120,17 @@ class Params:
     @property
     def omega(self) -> float: ...
     @property
-    def contact_law(self) -> Literal["linear", "hertz", "dmt", "impact"]: ...
+    def contact_law(self) -> Literal["linear", "hertz", "dmt", "electrostatic", "impact"]: ...
     @property
     def restitution(self) -> Optional[float]: ...
     @property
     def hamaker(self) -> Optional[float]: ...
     @property
     def intermolecular_distance(self) -> Optional[float]: ...
+    @property
+    def electrostatic(self) -> Optional[float]: ...
+    @property
+    def tip_radius(self) -> Optional[float]: ...
     @property
     def tip_mass_ratio(self) -> float: ...
     @property

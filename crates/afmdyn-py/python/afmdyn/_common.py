@@ -74,10 +74,12 @@ class Model(TypedDict, total=False):
     contact_damping: float
     alpha6: float
     omega: float
-    contact_law: Literal["linear", "hertz", "dmt", "impact"]
+    contact_law: Literal["linear", "hertz", "dmt", "electrostatic", "impact"]
     restitution: float
     hamaker: float
     intermolecular_distance: float
+    electrostatic: float
+    tip_radius: float
     z_c: float
     drive_frequency: float
     probe: Union[str, "os.PathLike[str]", Dict[str, Any]]

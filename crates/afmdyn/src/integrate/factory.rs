@@ -104,7 +104,8 @@ impl IntegratorKind {
     /// [`crate::params::Params::drive_components`], to `Taylor` for Hertz and DMT and to
     /// `Adaptive` for the others), to `Split` for a law without force in free flight (Hertz,
     /// impact with r > 0), to `Adaptive` for the plastic impact law r = 0 (whose free flights
-    /// all start tangentially) and to `Taylor` for DMT; other kinds are returned as given.
+    /// all start tangentially) and for the electrostatic law, and to `Taylor` for DMT; other
+    /// kinds are returned as given.
     /// ([`build`] falls back from `Split` to `Adaptive` for `Auto` where the exact free flight
     /// cannot be built: Ω at an undamped resonance of the free beam, or a grid beyond its
     /// budget.)
@@ -127,6 +128,11 @@ impl IntegratorKind {
                 IntegratorKind::Adaptive
             }
             IntegratorKind::Auto if split::Split::applies(model) => IntegratorKind::Split,
+            // the electrostatic law: its 1/(d(d + R)) force is not in the Taylor integrator's
+            // recurrences; the adaptive DOP853 integrates it with events
+            IntegratorKind::Auto if matches!(model.law(), ContactLaw::Electrostatic { .. }) => {
+                IntegratorKind::Adaptive
+            }
             // DMT: its van der Waals force acts in free flight
             IntegratorKind::Auto => IntegratorKind::Taylor,
             k => k,

@@ -16,7 +16,7 @@
 //! youngs_modulus = 130e9         # E_t (Pa), default 130e9 (silicon, Hopcroft et al. 2010)
 //! poisson_ratio = 0.27           # ν_t, default 0.28 (silicon)
 //! [sample]
-//! law = "dmt"                    # linear | hertz | dmt | impact
+//! law = "dmt"                    # linear | hertz | dmt | electrostatic | impact
 //! youngs_modulus = 4e9           # E_s (Pa)            (hertz, dmt)
 //! poisson_ratio = 0.33           # ν_s                 (hertz, dmt)
 //! hamaker = 6.6e-20              # H (J)               (dmt)
@@ -80,6 +80,9 @@
 //! * dmt (Derjaguin, Muller & Toporov 1975; García & San Paulo, *Phys. Rev. B* 60 (1999) 4961):
 //!   α4 as hertz, H̃ = H R/(6 g₀² F_s), ã₀ = a₀/g₀, α6 = η √(R g₀) g₀/(t_s F_s) (the
 //!   Kelvin–Voigt term η√(Rδ) δ̇);
+//! * electrostatic (DMT plus a biased tip, Hudlet et al., *Eur. Phys. J. B* 2 (1998) 5): the
+//!   DMT groups, and from `bias_voltage` V_b and `contact_potential` V_cpd (default 0) the group
+//!   Ẽ = πε₀(V_b − V_cpd)²/F_s and R̃ = R/g₀ of F_es = −πε₀V²R²/(d(d + R));
 //! * impact: the restitution r.
 //!
 //! The rest distance z_c sets α5 = z_c/g₀ − ã₀ (DMT) or z_c/g₀ ([`crate::Params::rest_distance`]).
@@ -93,6 +96,9 @@ mod medium;
 mod reader;
 pub use medium::{CalibratedIn, FluidMode, MediumReport};
 use reader::*;
+
+/// ε₀, the vacuum permittivity (F/m; CODATA 2018).
+pub const VACUUM_PERMITTIVITY: f64 = 8.854_187_812_8e-12;
 
 /// The intermolecular distance a₀ of the DMT law when a probe file omits it, m
 /// (Israelachvili 2011, §13.6).
@@ -359,6 +365,8 @@ struct Sample {
     stiffness: Option<f64>,
     damping: Option<f64>,
     restitution: Option<f64>,
+    /// The electrostatic law's voltage across the gap, bias − contact potential (V).
+    voltage: Option<f64>,
     z_c: Option<f64>,
 }
 
@@ -1023,33 +1031,50 @@ impl Probe {
             .string(s, S, "law")
             .map(|l| (l, l.trim().to_ascii_lowercase()))
         {
-            Some((_, l)) if matches!(l.as_str(), "linear" | "hertz" | "dmt" | "impact") => Some(l),
+            Some((_, l))
+                if matches!(
+                    l.as_str(),
+                    "linear" | "hertz" | "dmt" | "electrostatic" | "impact"
+                ) =>
+            {
+                Some(l)
+            }
             Some((l, _)) => {
                 r.problems.push(format!(
-                    "[sample].law = '{l}': expected linear, hertz, dmt or impact"
+                    "[sample].law = '{l}': expected linear, hertz, dmt, electrostatic or impact"
                 ));
                 None
             }
             None => {
                 if !s.contains_key("law") {
-                    r.problems
-                        .push("missing key [sample].law (linear, hertz, dmt or impact)".into());
+                    r.problems.push(
+                        "missing key [sample].law (linear, hertz, dmt, electrostatic or impact)"
+                            .into(),
+                    );
                 }
                 None
             }
         }?;
+        // the electrostatic law's keys are DMT's and the voltages
+        const DMT: [&str; 7] = [
+            "law",
+            "youngs_modulus",
+            "poisson_ratio",
+            "hamaker",
+            "intermolecular_distance",
+            "viscosity",
+            "z_c",
+        ];
+        let electrostatic: Vec<&str> = DMT
+            .iter()
+            .copied()
+            .chain(["bias_voltage", "contact_potential"])
+            .collect();
         let keys: &[&str] = match law.as_str() {
             "linear" => &["law", "stiffness", "damping", "z_c"],
             "hertz" => &["law", "youngs_modulus", "poisson_ratio", "damping", "z_c"],
-            "dmt" => &[
-                "law",
-                "youngs_modulus",
-                "poisson_ratio",
-                "hamaker",
-                "intermolecular_distance",
-                "viscosity",
-                "z_c",
-            ],
+            "dmt" => &DMT,
+            "electrostatic" => &electrostatic,
             _ => &["law", "restitution", "z_c"],
         };
         r.unknown(s, S, keys);
@@ -1064,6 +1089,7 @@ impl Probe {
             stiffness: None,
             damping: None,
             restitution: None,
+            voltage: None,
             z_c,
         };
         match law.as_str() {
@@ -1108,6 +1134,15 @@ impl Probe {
                 Some(DEFAULT_INTERMOLECULAR_DISTANCE)
             };
             out.viscosity = r.optional(s, S, "viscosity", "Pa s", NON_NEGATIVE);
+        }
+        if law == "electrostatic" {
+            // the voltage across the gap: the bias less the contact potential difference
+            let bias = r.required(s, S, "bias_voltage", "V", ANY);
+            let cpd = r
+                .optional(s, S, "contact_potential", "V", ANY)
+                .unwrap_or(0.0);
+            out.voltage = bias.map(|b| b - cpd);
+            out.voltage?;
         }
         out.e_star.and(out.radius).map(|_| out)
     }
@@ -1296,16 +1331,28 @@ impl Probe {
                 alpha4 = sample.stiffness.unwrap_or(0.0) * g0 / force_n;
                 alpha6 = sample.damping.unwrap_or(0.0) * g0 / (t_s * force_n);
             }
-            "hertz" | "dmt" => {
+            "hertz" | "dmt" | "electrostatic" => {
                 let (e, rr) = (sample.e_star.unwrap_or(0.0), sample.radius.unwrap_or(0.0));
                 alpha4 = 4.0 / 3.0 * e * rr.sqrt() * g0.powf(1.5) / force_n;
                 if sample.law == "hertz" {
                     law = ContactLaw::Hertz;
                     alpha6 = sample.damping.unwrap_or(0.0) * g0 / (t_s * force_n);
                 } else {
-                    law = ContactLaw::Dmt {
-                        hamaker: sample.hamaker.unwrap_or(0.0) * rr / (6.0 * g0 * g0 * force_n),
-                        intermolecular_distance: sample.a0.unwrap_or(0.0) / g0,
+                    let hamaker = sample.hamaker.unwrap_or(0.0) * rr / (6.0 * g0 * g0 * force_n);
+                    let intermolecular_distance = sample.a0.unwrap_or(0.0) / g0;
+                    law = match sample.voltage {
+                        // Hudlet et al. 1998: F = −πε₀V²R²/(d(d + R)), Ẽ = πε₀V²/F_s, R̃ = R/g₀
+                        Some(v) => ContactLaw::Electrostatic {
+                            hamaker,
+                            intermolecular_distance,
+                            electrostatic: std::f64::consts::PI * VACUUM_PERMITTIVITY * v * v
+                                / force_n,
+                            tip_radius: rr / g0,
+                        },
+                        None => ContactLaw::Dmt {
+                            hamaker,
+                            intermolecular_distance,
+                        },
                     };
                     alpha6 =
                         sample.viscosity.unwrap_or(0.0) * (rr * g0).sqrt() * g0 / (t_s * force_n);

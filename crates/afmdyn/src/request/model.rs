@@ -74,7 +74,7 @@ const fn info(
 /// Every model parameter a request takes, in the order the front ends list them. The ranges
 /// are those [`Params::validate`] and [`ContactLaw::validate`] enforce; `z_c` and
 /// `drive_frequency` are SI values that need a probe file.
-pub const MODEL_PARAMETERS: [ParamInfo; 14] = [
+pub const MODEL_PARAMETERS: [ParamInfo; 16] = [
     info(
         "modes",
         None,
@@ -160,7 +160,7 @@ pub const MODEL_PARAMETERS: [ParamInfo; 14] = [
         None,
         "F_c",
         "1",
-        "linear, hertz, dmt or impact",
+        "linear, hertz, dmt, electrostatic or impact",
         "linear",
         "tip–sample law: linear (α4 δ + α6 δ̇), hertz (α4 δ^1.5 + α6 δ̇), dmt (van der Waals + \
          adhesion + Hertz + α6 √δ δ̇) or impact (rigid sample, restitution r)",
@@ -194,6 +194,26 @@ pub const MODEL_PARAMETERS: [ParamInfo; 14] = [
         "> 0",
         "0.01",
         "DMT: intermolecular distance ã0 = a0/g0, the contact threshold",
+        ValueKind::Real,
+    ),
+    info(
+        "electrostatic",
+        None,
+        "Ẽ",
+        "1",
+        ">= 0",
+        "1e-3",
+        "electrostatic law: group Ẽ = πε0 V²/F of the biased tip, F_es = -Ẽ R̃²/(d(d + R̃))",
+        ValueKind::Real,
+    ),
+    info(
+        "tip_radius",
+        None,
+        "R̃",
+        "1",
+        "> 0",
+        "1",
+        "electrostatic law: tip radius R̃ = R/g0",
         ValueKind::Real,
     ),
     info(
@@ -282,6 +302,12 @@ pub struct ModelSpec {
     /// DMT: ã0.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub intermolecular_distance: Option<f64>,
+    /// Electrostatic law: Ẽ.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub electrostatic: Option<f64>,
+    /// Electrostatic law: R̃.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tip_radius: Option<f64>,
     /// With a probe: z_c in m.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub z_c: Option<f64>,
@@ -308,6 +334,8 @@ impl ModelSpec {
             intermolecular_distance: self
                 .intermolecular_distance
                 .or(lower.intermolecular_distance),
+            electrostatic: self.electrostatic.or(lower.electrostatic),
+            tip_radius: self.tip_radius.or(lower.tip_radius),
             z_c: self.z_c.or(lower.z_c),
             drive_frequency: self.drive_frequency.or(lower.drive_frequency),
         }
@@ -332,6 +360,8 @@ impl ModelSpec {
             ("restitution", self.restitution),
             ("hamaker", self.hamaker),
             ("intermolecular_distance", self.intermolecular_distance),
+            ("electrostatic", self.electrostatic),
+            ("tip_radius", self.tip_radius),
             ("z_c", self.z_c),
             ("drive_frequency", self.drive_frequency),
         ];
@@ -362,6 +392,8 @@ impl ModelSpec {
             self.hamaker,
             self.intermolecular_distance,
             self.restitution,
+            self.electrostatic,
+            self.tip_radius,
             base.contact_law,
         )?;
         let mut p = Params {
@@ -456,7 +488,7 @@ impl ModelSpec {
 /// Hamaker constant in J): the value's name and what to give instead. `modes` and
 /// `restitution` (pure numbers, the same in SI) and the SI values `z_c` and `drive_frequency`
 /// are taken with a probe.
-pub const PROBE_SETS: [(&str, &str); 10] = [
+pub const PROBE_SETS: [(&str, &str); 12] = [
     (
         "tip_mass_ratio",
         "is the dimensionless α1 and a probe sets it: give it in the probe file's [cantilever] \
@@ -507,6 +539,16 @@ pub const PROBE_SETS: [(&str, &str); 10] = [
         "is the dimensionless ã0 and a probe sets it: give a0 in the probe file's [sample] \
          intermolecular_distance (m)",
     ),
+    (
+        "electrostatic",
+        "is the dimensionless Ẽ and a probe sets it: give the voltage in the probe file's \
+         [sample] bias_voltage (V, law = \"electrostatic\")",
+    ),
+    (
+        "tip_radius",
+        "is the dimensionless R̃ and a probe sets it: give the radius in the probe file's \
+         [tip] radius (m)",
+    ),
 ];
 
 impl ModelSpec {
@@ -523,6 +565,8 @@ impl ModelSpec {
             ("contact_law", None),
             ("hamaker", self.hamaker),
             ("intermolecular_distance", self.intermolecular_distance),
+            ("electrostatic", self.electrostatic),
+            ("tip_radius", self.tip_radius),
         ];
         for ((name, value), (key, allowed)) in given.into_iter().zip(PROBE_SETS) {
             debug_assert_eq!(name, key);
@@ -602,6 +646,8 @@ mod tests {
             restitution: Some(0.5),
             hamaker: Some(0.0),
             intermolecular_distance: Some(1.0),
+            electrostatic: Some(0.0),
+            tip_radius: Some(1.0),
             z_c: Some(0.0),
             drive_frequency: Some(1.0),
         };

@@ -135,6 +135,16 @@ pub fn without_attraction(law: ContactLaw) -> ContactLaw {
             hamaker: 0.0,
             intermolecular_distance,
         },
+        ContactLaw::Electrostatic {
+            intermolecular_distance,
+            tip_radius,
+            ..
+        } => ContactLaw::Electrostatic {
+            hamaker: 0.0,
+            intermolecular_distance,
+            electrostatic: 0.0,
+            tip_radius,
+        },
         l => l,
     }
 }

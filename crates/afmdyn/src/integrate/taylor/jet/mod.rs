@@ -454,7 +454,9 @@ impl Jet {
                 k: p.alpha4,
                 c: p.alpha6,
             },
-            ContactLaw::Linear | ContactLaw::Impact { .. } => return None,
+            ContactLaw::Linear | ContactLaw::Impact { .. } | ContactLaw::Electrostatic { .. } => {
+                return None
+            }
         };
         let n = model.modes();
         let free = model.dynamics(Region::Free);
