@@ -149,3 +149,37 @@ fn probe_keys_of_the_electrostatic_law() {
         ContactLaw::Electrostatic { electrostatic, .. } if electrostatic == 0.0
     ));
 }
+
+/// The Tabor parameter μ = (R W²/(E*² z₀³))^{1/3}, W = H/(12πz₀²) (Tabor 1977; Johnson &
+/// Greenwood 1997; Israelachvili 2011 §13.6), in `si` and as a warning in JKR's regime (μ > 5):
+/// the issue's case — a 2 N/m lever over a 50 MPa adhesive polymer (H = 6.6e-20 J, R = 10 nm)
+/// — gets it; polystyrene (4 GPa) does not.
+#[test]
+fn the_tabor_parameter_warns_where_dmt_does_not_apply() {
+    let text = |e: f64| {
+        format!(
+            "model = \"point-mass\"\n[cantilever]\nspring_constant = 2.0\n\
+             resonance_frequency = 70e3\nquality_factor = 150\n[tip]\nradius = 10e-9\n\
+             youngs_modulus = 130e9\npoisson_ratio = 0.28\n[sample]\nlaw = \"dmt\"\n\
+             youngs_modulus = {e}\npoisson_ratio = 0.4\nhamaker = 6.6e-20\n\
+             intermolecular_distance = 0.165e-9\n[drive]\nfree_amplitude = 10e-9\n"
+        )
+    };
+    for (e, jkr) in [(50e6, true), (4e9, false)] {
+        let p = Probe::parse(&text(e), "p").unwrap();
+        // by hand: E* from 1/E* = (1 − ν_t²)/E_t + (1 − ν_s²)/E_s
+        let e_star = 1.0 / ((1.0 - 0.28 * 0.28) / 130e9 + (1.0 - 0.4 * 0.4) / e);
+        let z0: f64 = 0.165e-9;
+        let w = 6.6e-20 / (12.0 * PI * z0 * z0);
+        let mu = (10e-9 * w * w / (e_star * e_star * z0.powi(3))).cbrt();
+        let got = p.tabor_parameter.unwrap();
+        assert!((got / mu - 1.0).abs() < 1e-12, "{got} vs {mu}");
+        assert_eq!(got > 5.0, jkr, "μ = {got}");
+        let doc = afmdyn::report::with_si(serde_json::json!({"warnings": []}), Some(&p), &p.params);
+        assert_eq!(doc["si"]["tabor_parameter"], serde_json::json!(got));
+        let warned = doc["warnings"][0]
+            .as_str()
+            .is_some_and(|w| w.contains("JKR's regime"));
+        assert_eq!(warned, jkr, "{doc}");
+    }
+}

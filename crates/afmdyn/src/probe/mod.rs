@@ -258,6 +258,44 @@ pub struct Probe {
     /// The fluid of `[medium]` and each mode's loading (`None` without the section).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub medium: Option<MediumReport>,
+    /// The Tabor parameter μ of a DMT or electrostatic sample ([`tabor_parameter`]; `None`
+    /// for the other laws).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tabor_parameter: Option<f64>,
+}
+
+/// Above this Tabor parameter the contact is JKR's (Johnson & Greenwood, *J. Colloid Interface
+/// Sci.* 192 (1997) 326, adhesion map: DMT below 0.1, the transition between, JKR above 5).
+pub const TABOR_JKR: f64 = 5.0;
+
+/// The Tabor parameter μ = (R W²/(E*² z₀³))^{1/3} (Tabor, *J. Colloid Interface Sci.* 58 (1977)
+/// 2; Johnson & Greenwood 1997) of a sphere of radius R (m) on a sample with reduced modulus
+/// E* (Pa), the work of adhesion W = H/(12πz₀²) (J/m²) from the Hamaker constant H (J) at the
+/// equilibrium separation z₀ (m) (Israelachvili, *Intermolecular and Surface Forces*, 3rd ed.
+/// 2011, §13.6): which contact model applies — DMT (stiff, weakly adhesive, small tips) below
+/// 0.1, JKR (compliant, adhesive, large tips) above [`TABOR_JKR`].
+pub fn tabor_parameter(radius: f64, e_star: f64, hamaker: f64, z0: f64) -> f64 {
+    let w = hamaker / (12.0 * std::f64::consts::PI * z0 * z0);
+    (radius * w * w / (e_star * e_star * z0 * z0 * z0)).cbrt()
+}
+
+impl Probe {
+    /// The probe's own warnings, which every document of it carries
+    /// ([`crate::report::with_si`]): a DMT or electrostatic sample in JKR's regime (Tabor
+    /// parameter above [`TABOR_JKR`]), where DMT misses the contact's neck and the adhesion
+    /// hysteresis.
+    pub fn warnings(&self) -> Vec<String> {
+        let mut w = Vec::new();
+        if let Some(mu) = self.tabor_parameter.filter(|&mu| mu > TABOR_JKR) {
+            w.push(format!(
+                "the sample's Tabor parameter is {mu:.3} (> {TABOR_JKR}: a compliant, adhesive \
+                 contact, JKR's regime; Johnson & Greenwood 1997): DMT misses the contact's neck \
+                 and the adhesion hysteresis of each tap, so adhesion and dissipation are \
+                 underestimated"
+            ));
+        }
+        w
+    }
 }
 
 /// A further drive component of a probe ([`Params::drive_components`]) in SI.
@@ -1364,6 +1402,15 @@ impl Probe {
                 };
             }
         }
+        let tabor_parameter = match (sample.law.as_str(), sample.hamaker, sample.a0) {
+            ("dmt" | "electrostatic", Some(h), Some(z0)) if h > 0.0 => Some(tabor_parameter(
+                sample.radius.unwrap_or(0.0),
+                sample.e_star.unwrap_or(f64::NAN),
+                h,
+                z0,
+            )),
+            _ => None,
+        };
         let z_c_in_file = sample.z_c.is_some();
         let z_c = sample.z_c.unwrap_or(a0);
         let mut params = Params {
@@ -1412,6 +1459,7 @@ impl Probe {
             z_c,
             z_c_in_file,
             medium: medium_report,
+            tabor_parameter,
         })
     }
 

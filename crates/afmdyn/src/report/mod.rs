@@ -486,6 +486,9 @@ pub fn si(probe: &crate::probe::Probe, params: &Params, doc: &Value) -> Value {
     if let Some(m) = &probe.medium {
         out["medium"] = json!(m);
     }
+    if let Some(mu) = probe.tabor_parameter {
+        out["tabor_parameter"] = json!(mu);
+    }
     if let Some(x) = doc.get("x_max") {
         out["x_max_m"] = json!(metres(x));
     }
