@@ -126,6 +126,28 @@ pub fn damped_eigenvalues(m: &RegionMatrices) -> Vec<DampedEigenvalue> {
     out
 }
 
+/// Each mode's quality factor Q_k = 1/(2ζ_k) in region `m`, shape `[N]`: for the natural
+/// frequency ω̃_k ([`natural_modes`]) the underdamped damped eigenvalue λ (eqs. 20–21) whose
+/// modulus is nearest it (|λ| = ω̃_k for modal damping); `None` for an overdamped mode (Q < 1/2:
+/// no underdamped eigenvalue within ω̃_k/2 of it).
+pub fn quality_factors(m: &RegionMatrices) -> Vec<Option<f64>> {
+    let eig: Vec<DampedEigenvalue> = damped_eigenvalues(m)
+        .into_iter()
+        .filter(|e| e.im > 0.0)
+        .collect();
+    let modulus = |e: &DampedEigenvalue| e.re.hypot(e.im);
+    natural_modes(m)
+        .omega
+        .iter()
+        .map(|&w| {
+            let e = eig
+                .iter()
+                .min_by(|a, b| (modulus(a) - w).abs().total_cmp(&(modulus(b) - w).abs()))?;
+            ((modulus(e) - w).abs() <= 0.5 * w && e.zeta > 0.0).then(|| 0.5 / e.zeta)
+        })
+        .collect()
+}
+
 /// Natural frequencies and damped eigenvalues of one region.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RegionSpectrum {

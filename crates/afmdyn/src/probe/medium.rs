@@ -30,7 +30,7 @@
 
 use super::reader::Reader;
 use super::Beam;
-use crate::eigen::{damped_eigenvalues, natural_modes};
+use crate::eigen::natural_modes;
 use crate::galerkin::{Galerkin, Region};
 use crate::hydro::{wet_mode_of, Medium, Section};
 use crate::params::{Hydrodynamic, Params, Structure};
@@ -97,8 +97,9 @@ pub struct MediumReport {
     pub intrinsic_quality_factors: Vec<f64>,
     /// The first mode's natural frequency in the medium (Hz), as the model has it.
     pub resonance_frequency: f64,
-    /// The first mode's quality factor in the medium, 1/(2ζ) of the model's damped eigenvalue.
-    pub quality_factor: f64,
+    /// The first mode's quality factor in the medium, 1/(2ζ) of the model's damped eigenvalue
+    /// ([`crate::eigen::quality_factors`]; `None` when it is overdamped).
+    pub quality_factor: Option<f64>,
     /// Each mode of the model in the fluid.
     pub modes: Vec<FluidMode>,
 }
@@ -325,13 +326,6 @@ pub(super) fn load(
     let loaded = Galerkin::new(params).map_err(derived)?;
     let region = loaded.region(Region::Free);
     let w1 = natural_modes(region).omega[0];
-    // mode 1's damped eigenvalue: the one whose |λ| is nearest ω̃₁ (an overdamped mode's
-    // real pair gives ζ = 1, Q = 0.5)
-    let modulus = |l: &crate::eigen::DampedEigenvalue| l.re.hypot(l.im);
-    let zeta = damped_eigenvalues(region)
-        .iter()
-        .min_by(|a, b| (modulus(a) - w1).abs().total_cmp(&(modulus(b) - w1).abs()))
-        .map_or(f64::NAN, |l| l.zeta);
     Ok(MediumReport {
         name: spec.name.clone(),
         density: spec.medium.density,
@@ -343,7 +337,7 @@ pub(super) fn load(
         vacuum_resonance_frequency: vacuum.f0,
         intrinsic_quality_factors: vacuum.qs.clone().unwrap_or_else(|| vec![vacuum.q1]),
         resonance_frequency: w1 / (TAU * time_s),
-        quality_factor: 1.0 / (2.0 * zeta),
+        quality_factor: crate::eigen::quality_factors(region)[0],
         modes,
     })
 }

@@ -402,41 +402,6 @@ pub fn lyapunov(params: &Params, l: &LyapunovSpectrum) -> Value {
     doc
 }
 
-/// Each mode's quality factor Q_j = |λ_j|/(−2 Re λ_j) = 1/(2ζ_j) from the damped eigenvalues
-/// [re, im] of a `modes` document's region (`{"omega": [...], "eigenvalues": [...]}`): for the
-/// natural frequency ω_j the underdamped eigenvalue of modulus nearest it; `null` for an
-/// overdamped mode (Q < 1/2, no oscillation).
-fn quality_factors(region: &Value) -> Value {
-    let pair = |v: &Value| Some((v.get(0)?.as_f64()?, v.get(1)?.as_f64()?));
-    let eig: Vec<(f64, f64)> = region
-        .get("eigenvalues")
-        .and_then(Value::as_array)
-        .map(|a| {
-            a.iter()
-                .filter_map(pair)
-                .filter(|&(_, im)| im > 0.0)
-                .collect()
-        })
-        .unwrap_or_default();
-    let omega = region.get("omega").and_then(Value::as_array);
-    let q = omega.map(|om| {
-        om.iter()
-            .map(|w| {
-                let w = w.as_f64()?;
-                let (re, im) = eig.iter().min_by(|a, b| {
-                    (a.0.hypot(a.1) - w)
-                        .abs()
-                        .total_cmp(&(b.0.hypot(b.1) - w).abs())
-                })?;
-                // the nearest underdamped eigenvalue must belong to this mode
-                let modulus = re.hypot(*im);
-                ((modulus - w).abs() <= 0.5 * w && *re < 0.0).then(|| modulus / (-2.0 * re))
-            })
-            .collect::<Vec<_>>()
-    });
-    json!(q)
-}
-
 /// The `"si"` block a front end adds to any document when the model came from a probe file
 /// ([`crate::probe`]): the scales back to SI (every dimensionless value of the document converts
 /// with them: lengths × `length_m`, τ × `time_s`, forces × `force_n`, energies × `energy_j`,
@@ -480,8 +445,12 @@ pub fn si(probe: &crate::probe::Probe, params: &Params, doc: &Value) -> Value {
             out[format!("{region}_frequencies_hz")] = map_array(om, &hz);
         }
     }
-    if let Some(free) = doc.get("free") {
-        out["quality_factors"] = quality_factors(free);
+    if doc.get("free").is_some() {
+        if let Ok(g) = crate::galerkin::Galerkin::new(params) {
+            out["quality_factors"] = json!(crate::eigen::quality_factors(
+                g.region(crate::galerkin::Region::Free)
+            ));
+        }
     }
     if let Some(m) = &probe.medium {
         out["medium"] = json!(m);
