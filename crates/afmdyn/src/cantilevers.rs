@@ -138,8 +138,9 @@ pub fn fill(root: &toml::Table) -> Result<toml::Table, String> {
     };
     let mut cantilever = section(&mut out, "cantilever");
     cantilever.remove("name");
-    // a geometry in the file replaces the calibrated values
-    let geometry = ["length", "width", "thickness", "density"]
+    // a geometry in the file replaces the calibrated values; length and width alone are the
+    // plan of a calibrated lever, which [medium] needs
+    let geometry = ["thickness", "density", "youngs_modulus"]
         .iter()
         .any(|k| cantilever.contains_key(*k));
     if !geometry {

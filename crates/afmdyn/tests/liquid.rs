@@ -166,6 +166,35 @@ fn more_modes_over_a_probe_in_water_are_loaded_too() {
     }
 }
 
+/// A lever of the library (RTESPA-300: k = 40 N/m, f₀ = 300 kHz, Q = 500 in air) with its plan
+/// (125 × 40 µm) given in the file: the library fills the calibrated values (the plan is not a
+/// geometry), and in water the first mode drops to under half with Q ≈ 9, Q₁ in air kept.
+#[test]
+fn a_library_lever_with_its_plan_goes_into_water() {
+    let text = |medium: &str| {
+        format!(
+            "model = \"beam\"\nmodes = 3\n[cantilever]\nname = \"RTESPA-300\"\n\
+             length = 125e-6\nwidth = 40e-6\n[sample]\nlaw = \"hertz\"\n\
+             youngs_modulus = 2.5e9\npoisson_ratio = 0.33\n[drive]\nfree_amplitude = 15e-9\n\
+             [medium]\nname = \"{medium}\"\n"
+        )
+    };
+    let air = Probe::parse(&text("air"), "<test>").unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(air.calibration.spring_constant, 40.0);
+    let m = air.medium.as_ref().unwrap();
+    assert!((m.resonance_frequency / 300e3 - 1.0).abs() < 1e-9);
+    assert!((m.quality_factor.unwrap() - 500.0).abs() < 1e-6);
+    let water = Probe::parse(&text("water"), "<test>").unwrap();
+    let w = water.medium.as_ref().unwrap();
+    println!(
+        "RTESPA-300 in water: {:.1} kHz, Q {:.2}",
+        w.resonance_frequency / 1e3,
+        w.quality_factor.unwrap()
+    );
+    assert!(w.resonance_frequency < 0.5 * 300e3);
+    assert!((5.0..15.0).contains(&w.quality_factor.unwrap()));
+}
+
 /// Sader's method (1999, eq. 1) from the model's own first mode in the fluid: a lever with
 /// negligible intrinsic loss (calibrated in vacuum, Q = 1e7), so that its Q is the fluid's,
 /// k = 0.1906 ρ b² L Q Γ_i(ω_f) ω_f² equals the lever's 3EI/L³ — exactly as 0.1906 ≈ 3π/(4β₁⁴)
