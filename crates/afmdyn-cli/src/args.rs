@@ -98,6 +98,8 @@ pub struct ModelArgs {
     pub omega: Option<f64>,
     #[arg(long, value_name = "LAW", value_parser = parse_law)]
     pub contact_law: Option<LawKind>,
+    #[arg(long, value_name = "WHERE", value_parser = parse_excitation)]
+    pub excitation: Option<afmdyn::Excitation>,
     #[arg(long, value_name = "r", allow_negative_numbers = true)]
     pub restitution: Option<f64>,
     #[arg(long, value_name = "H̃", allow_negative_numbers = true)]
@@ -111,6 +113,10 @@ pub struct ModelArgs {
 }
 
 fn parse_law(s: &str) -> Result<LawKind, String> {
+    s.parse()
+}
+
+fn parse_excitation(s: &str) -> Result<afmdyn::Excitation, String> {
     s.parse()
 }
 
@@ -150,6 +156,7 @@ impl ModelArgs {
             contact_damping: self.alpha6,
             omega: self.omega,
             contact_law: self.contact_law,
+            excitation: self.excitation,
             restitution: self.restitution,
             hamaker: self.hamaker,
             intermolecular_distance: self.intermolecular_distance,

@@ -156,6 +156,20 @@ fn law_flags_are_checked() {
             vec!["orbit", "--contact-law", "dmt", "--electrostatic", "1e-3"],
             "electrostatic",
         ),
+        (vec!["orbit", "--excitation", "laser"], "excitation 'laser'"),
+        (
+            vec![
+                "orbit",
+                "--probe",
+                concat!(
+                    env!("CARGO_MANIFEST_DIR"),
+                    "/../../examples/probe-beam-dmt.toml"
+                ),
+                "--excitation",
+                "tip",
+            ],
+            "[drive] excitation",
+        ),
         (
             vec![
                 "orbit",

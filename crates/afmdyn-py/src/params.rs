@@ -127,6 +127,15 @@ pub fn model_spec(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<ModelSpec> {
             "tip_radius" => m.tip_radius = x()?,
             "z_c" => m.z_c = x()?,
             "drive_frequency" => m.drive_frequency = x()?,
+            "excitation" => {
+                let name: String = v.extract().map_err(|_| {
+                    PyTypeError::new_err(format!("{key}: expected a string (base or tip)"))
+                })?;
+                m.excitation = Some(
+                    name.parse::<afmdyn::Excitation>()
+                        .map_err(PyValueError::new_err)?,
+                );
+            }
             "contact_law" => {
                 let name: String = v.extract().map_err(|_| {
                     PyTypeError::new_err(format!(
@@ -201,7 +210,8 @@ pub fn resolve(
 /// (Ω > 0), ``contact_law`` (``"linear"``, ``"hertz"``, ``"dmt"``, ``"electrostatic"``,
 /// ``"impact"``) with its groups ``restitution`` (0..=1, impact), ``hamaker`` (≥ 0) and
 /// ``intermolecular_distance`` (> 0, DMT and electrostatic), ``electrostatic`` (Ẽ ≥ 0) and
-/// ``tip_radius`` (R̃ > 0, electrostatic). Missing ones take the paper's Figs. 5–14 set (N = 3, α1 = α2 = α3 = 0.1, α4 = 20,
+/// ``tip_radius`` (R̃ > 0, electrostatic), ``excitation`` (``"base"``, ``"tip"``: where the
+/// drive acts on the beam). Missing ones take the paper's Figs. 5–14 set (N = 3, α1 = α2 = α3 = 0.1, α4 = 20,
 /// α5 = 0, α6 = 0.2, Ω = 2.6). The names, ranges and help are the library's one table
 /// (``afmdyn._afmdyn.MODEL_PARAMETERS``).
 ///
@@ -357,6 +367,11 @@ impl PyParams {
             }
             _ => None,
         }
+    }
+    /// Where the drive acts: ``"base"`` (the paper) or ``"tip"`` (a force at the tip).
+    #[getter]
+    fn excitation(&self) -> &'static str {
+        self.inner.excitation.name()
     }
     /// Electrostatic law: the group Ẽ (``None`` for the other laws).
     #[getter]

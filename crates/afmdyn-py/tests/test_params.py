@@ -177,6 +177,12 @@ def test_contact_law_keywords_resolve_as_on_the_command_line(cli_json):
         Params(contact_law="elastic")
     with pytest.raises(TypeError, match="contact_law"):
         Params(contact_law=1)
+    # the tip-force drive of the beam, as --excitation
+    t = Params(excitation="magnetic")
+    assert t.excitation == "tip" and Params().excitation == "base"
+    assert t.to_dict() == cli_json("modes", "--excitation", "tip")["params"]
+    with pytest.raises(ValueError, match="excitation 'laser'"):
+        Params(excitation="laser")
     # the electrostatic law: DMT's groups and its own, with their defaults
     e = Params(contact_law="electrostatic")
     assert (e.electrostatic, e.tip_radius, e.hamaker) == (1e-3, 1.0, 1e-5)

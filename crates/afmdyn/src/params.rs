@@ -138,6 +138,7 @@ pub struct Params {
 /// Cleveland, Ohnesorge, Walters & Hansma, *Ultramicroscopy* 63 (1996) 149) is not modelled:
 /// the liquid is at rest far from the lever.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(rename_all = "lowercase")]
 pub enum Excitation {
     /// Base displacement α2 sin Ωτ (the paper).

@@ -35,8 +35,9 @@ class Params:
     ``contact_damping``/``alpha6`` (≥ 0), ``omega`` (Ω > 0), ``contact_law`` (``"linear"``,
     ``"hertz"``, ``"dmt"``, ``"electrostatic"``, ``"impact"``) with its groups ``restitution``
     (0..=1, impact), ``hamaker`` (≥ 0) and ``intermolecular_distance`` (> 0, DMT and
-    electrostatic), ``electrostatic`` (Ẽ ≥ 0) and ``tip_radius`` (R̃ > 0, electrostatic); the
-    others keep the paper's
+    electrostatic), ``electrostatic`` (Ẽ ≥ 0) and ``tip_radius`` (R̃ > 0, electrostatic),
+    ``excitation`` (``"base"``, ``"tip"``: where the drive acts on the beam); the others keep
+    the paper's
     Figs. 5–14 set. Raises ``ValueError`` (field and range) or ``TypeError`` (unknown keyword,
     wrong type).
     """
@@ -59,6 +60,7 @@ class Params:
         alpha6: float = ...,
         omega: float = ...,
         contact_law: Literal["linear", "hertz", "dmt", "electrostatic", "impact"] = ...,
+        excitation: Literal["base", "tip"] = ...,
         restitution: float = ...,
         hamaker: float = ...,
         intermolecular_distance: float = ...,
@@ -83,6 +85,7 @@ class Params:
         alpha6: float = ...,
         omega: float = ...,
         contact_law: Literal["linear", "hertz", "dmt", "electrostatic", "impact"] = ...,
+        excitation: Literal["base", "tip"] = ...,
         restitution: float = ...,
         hamaker: float = ...,
         intermolecular_distance: float = ...,
@@ -127,6 +130,8 @@ class Params:
     def hamaker(self) -> Optional[float]: ...
     @property
     def intermolecular_distance(self) -> Optional[float]: ...
+    @property
+    def excitation(self) -> Literal["base", "tip"]: ...
     @property
     def electrostatic(self) -> Optional[float]: ...
     @property

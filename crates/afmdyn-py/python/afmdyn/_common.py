@@ -75,6 +75,7 @@ class Model(TypedDict, total=False):
     alpha6: float
     omega: float
     contact_law: Literal["linear", "hertz", "dmt", "electrostatic", "impact"]
+    excitation: Literal["base", "tip"]
     restitution: float
     hamaker: float
     intermolecular_distance: float

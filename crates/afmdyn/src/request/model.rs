@@ -9,7 +9,7 @@
 
 use crate::contact::{ContactLaw, LawKind};
 use crate::error::SimError;
-use crate::params::Params;
+use crate::params::{Excitation, Params};
 use crate::probe::Probe;
 use serde::{Deserialize, Serialize};
 
@@ -21,8 +21,10 @@ pub enum ValueKind {
     Integer,
     /// A real number.
     Real,
-    /// One of `linear`, `hertz`, `dmt`, `impact`.
+    /// One of `linear`, `hertz`, `dmt`, `electrostatic`, `impact`.
     Law,
+    /// One of `base`, `tip`.
+    Excitation,
 }
 
 /// One model parameter: its library name, the paper's alias, symbol, unit, range and help.
@@ -74,7 +76,7 @@ const fn info(
 /// Every model parameter a request takes, in the order the front ends list them. The ranges
 /// are those [`Params::validate`] and [`ContactLaw::validate`] enforce; `z_c` and
 /// `drive_frequency` are SI values that need a probe file.
-pub const MODEL_PARAMETERS: [ParamInfo; 16] = [
+pub const MODEL_PARAMETERS: [ParamInfo; 17] = [
     info(
         "modes",
         None,
@@ -163,8 +165,20 @@ pub const MODEL_PARAMETERS: [ParamInfo; 16] = [
         "linear, hertz, dmt, electrostatic or impact",
         "linear",
         "tip–sample law: linear (α4 δ + α6 δ̇), hertz (α4 δ^1.5 + α6 δ̇), dmt (van der Waals + \
-         adhesion + Hertz + α6 √δ δ̇) or impact (rigid sample, restitution r)",
+         adhesion + Hertz + α6 √δ δ̇), electrostatic (dmt + a biased tip) or impact (rigid \
+         sample, restitution r)",
         ValueKind::Law,
+    ),
+    info(
+        "excitation",
+        None,
+        "—",
+        "1",
+        "base or tip",
+        "base",
+        "where the drive acts on the beam: base (α2 sin Ωτ, the paper; acoustic) or tip (a \
+         force α2 cos Ωτ at the tip: magnetic, photothermal)",
+        ValueKind::Excitation,
     ),
     info(
         "restitution",
@@ -293,6 +307,9 @@ pub struct ModelSpec {
     /// The tip–sample law.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub contact_law: Option<LawKind>,
+    /// Where the drive acts (beam).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub excitation: Option<Excitation>,
     /// Impact law: r.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub restitution: Option<f64>,
@@ -329,6 +346,7 @@ impl ModelSpec {
             contact_damping: self.contact_damping.or(lower.contact_damping),
             omega: self.omega.or(lower.omega),
             contact_law: self.contact_law.or(lower.contact_law),
+            excitation: self.excitation.or(lower.excitation),
             restitution: self.restitution.or(lower.restitution),
             hamaker: self.hamaker.or(lower.hamaker),
             intermolecular_distance: self
@@ -406,6 +424,7 @@ impl ModelSpec {
             alpha5: self.gap.unwrap_or(base.alpha5),
             alpha6: self.contact_damping.unwrap_or(base.alpha6),
             omega: self.omega.unwrap_or(base.omega),
+            excitation: self.excitation.unwrap_or(base.excitation),
             ..base
         };
         // a lever in a fluid with another N: every mode loaded as the probe's were
@@ -488,7 +507,7 @@ impl ModelSpec {
 /// Hamaker constant in J): the value's name and what to give instead. `modes` and
 /// `restitution` (pure numbers, the same in SI) and the SI values `z_c` and `drive_frequency`
 /// are taken with a probe.
-pub const PROBE_SETS: [(&str, &str); 12] = [
+pub const PROBE_SETS: [(&str, &str); 13] = [
     (
         "tip_mass_ratio",
         "is the dimensionless α1 and a probe sets it: give it in the probe file's [cantilever] \
@@ -549,6 +568,11 @@ pub const PROBE_SETS: [(&str, &str); 12] = [
         "is the dimensionless R̃ and a probe sets it: give the radius in the probe file's \
          [tip] radius (m)",
     ),
+    (
+        "excitation",
+        "is set by the probe file's [drive] excitation (its drive amplitude is calibrated for \
+         it): change it there",
+    ),
 ];
 
 impl ModelSpec {
@@ -567,6 +591,7 @@ impl ModelSpec {
             ("intermolecular_distance", self.intermolecular_distance),
             ("electrostatic", self.electrostatic),
             ("tip_radius", self.tip_radius),
+            ("excitation", None),
         ];
         for ((name, value), (key, allowed)) in given.into_iter().zip(PROBE_SETS) {
             debug_assert_eq!(name, key);
@@ -583,6 +608,13 @@ impl ModelSpec {
                 "contact_law",
                 law.name(),
                 PROBE_SETS[7].1,
+            ));
+        }
+        if let Some(e) = self.excitation {
+            return Err(SimError::out_of_range(
+                "excitation",
+                e.name(),
+                PROBE_SETS[12].1,
             ));
         }
         Ok(())
@@ -643,6 +675,7 @@ mod tests {
             contact_damping: Some(0.0),
             omega: Some(1.0),
             contact_law: Some(LawKind::Linear),
+            excitation: Some(Excitation::Tip),
             restitution: Some(0.5),
             hamaker: Some(0.0),
             intermolecular_distance: Some(1.0),
