@@ -110,6 +110,8 @@ pub struct ModelArgs {
     pub electrostatic: Option<f64>,
     #[arg(long, value_name = "R̃", allow_negative_numbers = true)]
     pub tip_radius: Option<f64>,
+    #[arg(long, value_name = "P̃", allow_negative_numbers = true)]
+    pub adhesion: Option<f64>,
 }
 
 fn parse_law(s: &str) -> Result<LawKind, String> {
@@ -162,6 +164,7 @@ impl ModelArgs {
             intermolecular_distance: self.intermolecular_distance,
             electrostatic: self.electrostatic,
             tip_radius: self.tip_radius,
+            adhesion: self.adhesion,
             z_c: quantity(self.z_c, "z-c", Dim::Length, true)?,
             drive_frequency: quantity(
                 self.drive_frequency,

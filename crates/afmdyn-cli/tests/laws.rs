@@ -25,7 +25,7 @@ fn json(args: &[&str]) -> serde_json::Value {
 }
 
 /// (law flags, model flags giving a periodic orbit at the chosen Ω, Ω).
-const LAWS: [(&[&str], &[&str], &str); 5] = [
+const LAWS: [(&[&str], &[&str], &str); 6] = [
     (&["--contact-law", "linear"], &["--modes", "2"], "2.8"),
     (&["--contact-law", "hertz"], &["--modes", "2"], "2.8"),
     (
@@ -51,6 +51,8 @@ const LAWS: [(&[&str], &[&str], &str); 5] = [
         &["--modes", "2"],
         "2.8",
     ),
+    // and `--contact-law jkr`: a hysteretic contact (the neck) through every subcommand
+    (&["--contact-law", "jkr"], &["--modes", "2"], "2.8"),
 ];
 
 fn as_refs(v: Vec<String>) -> Output {
@@ -155,6 +157,26 @@ fn law_flags_are_checked() {
         (
             vec!["orbit", "--contact-law", "dmt", "--electrostatic", "1e-3"],
             "electrostatic",
+        ),
+        (
+            vec!["orbit", "--contact-law", "hertz", "--adhesion", "0.1"],
+            "adhesion",
+        ),
+        (
+            vec!["orbit", "--contact-law", "jkr", "--adhesion", "0"],
+            "adhesion",
+        ),
+        (
+            vec!["orbit", "--contact-law", "jkr", "--contact-stiffness", "0"],
+            "alpha4",
+        ),
+        (
+            vec!["simulate", "--contact-law", "jkr", "--integrator", "rk4"],
+            "neck",
+        ),
+        (
+            vec!["simulate", "--contact-law", "jkr", "--integrator", "taylor"],
+            "taylor",
         ),
         (vec!["orbit", "--excitation", "laser"], "excitation 'laser'"),
         (

@@ -125,6 +125,7 @@ pub fn model_spec(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<ModelSpec> {
             "intermolecular_distance" => m.intermolecular_distance = x()?,
             "electrostatic" => m.electrostatic = x()?,
             "tip_radius" => m.tip_radius = x()?,
+            "adhesion" => m.adhesion = x()?,
             "z_c" => m.z_c = x()?,
             "drive_frequency" => m.drive_frequency = x()?,
             "excitation" => {
@@ -139,7 +140,7 @@ pub fn model_spec(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<ModelSpec> {
             "contact_law" => {
                 let name: String = v.extract().map_err(|_| {
                     PyTypeError::new_err(format!(
-                        "{key}: expected a string (linear, hertz, dmt, electrostatic or impact)"
+                        "{key}: expected a string (linear, hertz, dmt, electrostatic, jkr or impact)"
                     ))
                 })?;
                 m.contact_law = Some(
@@ -208,9 +209,10 @@ pub fn resolve(
 /// ``beam_damping``/``alpha3`` (α3 ≥ 0), ``contact_stiffness``/``alpha4`` (α4 ≥ 0),
 /// ``gap``/``alpha5`` (α5, finite), ``contact_damping``/``alpha6`` (α6 ≥ 0), ``omega``
 /// (Ω > 0), ``contact_law`` (``"linear"``, ``"hertz"``, ``"dmt"``, ``"electrostatic"``,
-/// ``"impact"``) with its groups ``restitution`` (0..=1, impact), ``hamaker`` (≥ 0) and
-/// ``intermolecular_distance`` (> 0, DMT and electrostatic), ``electrostatic`` (Ẽ ≥ 0) and
-/// ``tip_radius`` (R̃ > 0, electrostatic), ``excitation`` (``"base"``, ``"tip"``: where the
+/// ``"jkr"``, ``"impact"``) with its groups ``restitution`` (0..=1, impact), ``hamaker``
+/// (≥ 0) and ``intermolecular_distance`` (> 0, DMT and electrostatic), ``electrostatic``
+/// (Ẽ ≥ 0) and ``tip_radius`` (R̃ > 0, electrostatic), ``adhesion`` (P̃ > 0, JKR),
+/// ``excitation`` (``"base"``, ``"tip"``: where the
 /// drive acts on the beam). Missing ones take the paper's Figs. 5–14 set (N = 3, α1 = α2 = α3 = 0.1, α4 = 20,
 /// α5 = 0, α6 = 0.2, Ω = 2.6). The names, ranges and help are the library's one table
 /// (``afmdyn._afmdyn.MODEL_PARAMETERS``).
@@ -339,7 +341,8 @@ impl PyParams {
     fn omega(&self) -> f64 {
         self.inner.omega
     }
-    /// The tip–sample law: ``"linear"``, ``"hertz"``, ``"dmt"`` or ``"impact"``.
+    /// The tip–sample law: ``"linear"``, ``"hertz"``, ``"dmt"``, ``"electrostatic"``,
+    /// ``"jkr"`` or ``"impact"``.
     #[getter]
     fn contact_law(&self) -> &'static str {
         self.inner.contact_law.name()
@@ -386,6 +389,14 @@ impl PyParams {
     fn tip_radius(&self) -> Option<f64> {
         match self.inner.contact_law {
             afmdyn::ContactLaw::Electrostatic { tip_radius, .. } => Some(tip_radius),
+            _ => None,
+        }
+    }
+    /// JKR law: the adhesion group P̃ = πWR/F (``None`` for the other laws).
+    #[getter]
+    fn adhesion(&self) -> Option<f64> {
+        match self.inner.contact_law {
+            afmdyn::ContactLaw::Jkr { adhesion } => Some(adhesion),
             _ => None,
         }
     }

@@ -191,6 +191,18 @@ def test_contact_law_keywords_resolve_as_on_the_command_line(cli_json):
         Params(contact_law="dmt", electrostatic=1e-3)
     with pytest.raises(ValueError, match="tip_radius"):
         Params(contact_law="electrostatic", tip_radius=-1.0)
+    # the JKR law: its adhesion group P̃ with its default, as --contact-law jkr --adhesion
+    j = Params(contact_law="jkr")
+    assert j.adhesion == 0.05 and j.hamaker is None and Params().adhesion is None
+    assert j.to_dict() == cli_json("modes", "--contact-law", "jkr")["params"]
+    assert (
+        Params(contact_law="jkr", adhesion=0.2).to_dict()
+        == cli_json("modes", "--contact-law", "jkr", "--adhesion", "0.2")["params"]
+    )
+    with pytest.raises(ValueError, match="adhesion is a group of the jkr law"):
+        Params(contact_law="hertz", adhesion=0.1)
+    with pytest.raises(ValueError, match="adhesion"):
+        Params(contact_law="jkr", adhesion=0.0)
 
 
 def test_every_law_runs_from_python_as_on_the_command_line(cli_json):
@@ -199,6 +211,7 @@ def test_every_law_runs_from_python_as_on_the_command_line(cli_json):
         ("hertz", {}),
         ("dmt", {}),
         ("electrostatic", {"electrostatic": 2e-3, "tip_radius": 0.5}),
+        ("jkr", {"adhesion": 0.02}),
         ("impact", {"restitution": 0.5}),
     ]:
         model = {"contact_law": law, "modes": 1, "omega": 3.0, "gap": 0.05, **extra}

@@ -195,7 +195,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let law: LawKind = first.parse()?;
         Params {
             modes,
-            contact_law: law.with_groups(None, None, None, None, None),
+            contact_law: law.with_groups(Default::default()),
             ..Params::default()
         }
     };

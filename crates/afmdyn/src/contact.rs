@@ -28,6 +28,21 @@
 //!   the contact potential difference, in units Ẽ = πε₀V²/F̃-unit and R̃ = R/g₀:
 //!   F_c = −H/d² − ẼR̃²/(d(d + R̃)) outside contact, and both long-range forces at d = a₀ plus
 //!   Hertz and Kelvin–Voigt in contact, as DMT (continuous at δ = 0).
+//! * `jkr` — Johnson, Kendall & Roberts, *Proc. R. Soc. Lond. A* 324 (1971) 301: a compliant,
+//!   adhesive sphere–flat contact with a neck. No force outside contact. In contact the contact
+//!   radius a sets both the force and the indentation (Johnson, *Contact Mechanics*, CUP 1985,
+//!   §5.5): F = 4E*a³/(3R) − √(8πWE*a³), δ = a²/R − √(2πWa/E*). With h = a²/R (the Hertz
+//!   indentation of that radius), q = h^{1/4}, the Hertz group α4 = (4/3)E*√(R g₀) L³/(EI) and
+//!   the adhesion group P̃ = πWR/F̃-unit this is, exactly,
+//!   F_c = α4 q⁶ − √(6P̃α4) q³ + α6 q² δ̇,  δ = q⁴ − c q,  c = √(8P̃/(3α4)),
+//!   the damper α6 q² δ̇ = α6 √h δ̇ being Kelvin–Voigt's ∝ the contact radius a = √(Rh), as
+//!   DMT's. The contact forms at δ = 0 on approach (the force jumps to −(4/3)P̃, a₀³ = 2πWR²/E*),
+//!   and breaks on retraction where the branch ends, dδ/da = 0: δ_f = −3 q_f⁴, q_f³ = c/4
+//!   (−(3/4)(π²W²R/E*²)^{1/3} in SI, the pull-off under fixed grips, force −(5/6)P̃). The
+//!   load-controlled pull-off, min F = −(3/2)P̃ = −(3/2)πWR, lies on the branch. Each tap loses
+//!   the hysteresis E_hys = ∫_{δ_f}^0 |F| dδ = (3/5 + 4^{−1/3}/10) P̃ c^{4/3}
+//!   = (3/5 + 4^{−1/3}/10) 2^{2/3} π^{5/3} (W⁵R⁴/E*²)^{1/3} ≈ 7.09 (W⁵R⁴/E*²)^{1/3} (from
+//!   the potential below). The region is hysteretic: contact persists while δ > δ_f.
 //! * `impact` — the impact oscillator of the paper's Fig. 1b: a rigid sample at V_T = 0 with
 //!   Newton's coefficient of restitution r: dV_T/dτ⁺ = −r dV_T/dτ⁻ (Shaw & Holmes, *J. Sound Vib.*
 //!   90 (1983) 129; Nordmark, *J. Sound Vib.* 145 (1991) 279). No force acts in free flight; the
@@ -73,6 +88,13 @@ pub enum ContactLaw {
         /// R̃ = R/g₀ > 0: the tip radius.
         tip_radius: f64,
     },
+    /// JKR: adhesive Hertz contact with a neck, formed at δ = 0, broken at δ_f < 0
+    /// (Johnson, Kendall & Roberts 1971; module docs).
+    Jkr {
+        /// P̃ = πWR/F̃-unit > 0 (W the work of adhesion): the load-controlled pull-off force is
+        /// (3/2)P̃.
+        adhesion: f64,
+    },
     /// Rigid sample with coefficient of restitution r ∈ [0, 1] (impact oscillator, Fig. 1b).
     Impact {
         /// Newton's coefficient of restitution r.
@@ -97,14 +119,21 @@ impl ContactLaw {
         }
     }
 
-    /// The law's name: `linear`, `hertz`, `dmt`, `electrostatic` or `impact`.
+    /// The law's name: `linear`, `hertz`, `dmt`, `electrostatic`, `jkr` or `impact`.
     pub fn name(&self) -> &'static str {
-        match self {
-            ContactLaw::Linear => "linear",
-            ContactLaw::Hertz => "hertz",
-            ContactLaw::Dmt { .. } => "dmt",
-            ContactLaw::Electrostatic { .. } => "electrostatic",
-            ContactLaw::Impact { .. } => "impact",
+        self.kind().name()
+    }
+
+    /// How far beyond the contact threshold (V_T = 0) the contact persists on retraction: the
+    /// contact region is left where V_T rises to this value. |δ_f| = 3q_f⁴ for JKR (the neck,
+    /// [`Jkr::release`]), 0 for the other laws. A law with a positive value is **hysteretic**:
+    /// for 0 < V_T < |δ_f| the region depends on the history, and [`crate::CantileverModel`]
+    /// takes a start there as in contact when the tip moves away from the sample (leaving
+    /// through its neck) and free when it moves towards it (approaching).
+    pub fn release_distance(&self, alpha4: f64) -> f64 {
+        match *self {
+            ContactLaw::Jkr { adhesion } => -Jkr::new(alpha4, adhesion).release(),
+            _ => 0.0,
         }
     }
 
@@ -122,7 +151,7 @@ impl ContactLaw {
     }
 
     /// Check the law's own groups: DMT H̃ ≥ 0 finite, 0 < ã₀ ≤ 1e6; electrostatic those and
-    /// 0 ≤ Ẽ ≤ 1e12, 0 < R̃ ≤ 1e6; impact 0 ≤ r ≤ 1.
+    /// 0 ≤ Ẽ ≤ 1e12, 0 < R̃ ≤ 1e6; JKR 0 < P̃ ≤ 1e12; impact 0 ≤ r ≤ 1.
     ///
     /// # Errors
     /// [`crate::ParamError::Law`] naming the group and its allowed range.
@@ -132,6 +161,13 @@ impl ContactLaw {
         };
         match *self {
             ContactLaw::Linear | ContactLaw::Hertz => Ok(()),
+            ContactLaw::Jkr { adhesion } => {
+                // P̃ = 0 is Hertz (use `hertz`); the neck's scale P̃/α4 must stay resolvable
+                if !(adhesion.is_finite() && adhesion > 0.0 && adhesion <= 1e12) {
+                    return bad("adhesion (JKR group P̃ = πWR)", adhesion, "0 < P̃ ≤ 1e12");
+                }
+                Ok(())
+            }
             ContactLaw::Electrostatic {
                 hamaker,
                 intermolecular_distance,
@@ -205,7 +241,8 @@ impl fmt::Display for ContactLaw {
     }
 }
 
-/// The kind of a law without its groups, parsed from `linear|hertz|dmt|electrostatic|impact`.
+/// The kind of a law without its groups, parsed from
+/// `linear|hertz|dmt|electrostatic|jkr|impact`.
 ///
 /// One parser for every front end: the name is taken in any case (`"HERTZ"`, `"DMT"` as the
 /// literature writes it) on the command line, in a `--config` file, a probe file and from
@@ -223,6 +260,8 @@ pub enum LawKind {
     Dmt,
     /// [`ContactLaw::Electrostatic`].
     Electrostatic,
+    /// [`ContactLaw::Jkr`].
+    Jkr,
     /// [`ContactLaw::Impact`].
     Impact,
 }
@@ -235,10 +274,9 @@ impl FromStr for LawKind {
             "hertz" => Ok(LawKind::Hertz),
             "dmt" => Ok(LawKind::Dmt),
             "electrostatic" => Ok(LawKind::Electrostatic),
+            "jkr" => Ok(LawKind::Jkr),
             "impact" => Ok(LawKind::Impact),
-            _ => Err(format!(
-                "contact law '{s}': expected linear, hertz, dmt, electrostatic or impact"
-            )),
+            _ => Err(format!("contact law '{s}': expected {}", LawKind::EXPECTED)),
         }
     }
 }
@@ -262,19 +300,24 @@ pub const DMT_DEFAULT_A0: f64 = 0.01;
 pub const ELECTROSTATIC_DEFAULT: f64 = 1e-3;
 /// Default tip radius R̃ = R/g₀ of the electrostatic law.
 pub const ELECTROSTATIC_DEFAULT_RADIUS: f64 = 1.0;
+/// Default JKR adhesion group P̃ = πWR = 0.05: the work of adhesion of DMT's defaults (whose
+/// pull-off 2πRW is H̃/ã₀² = 0.1), so the JKR pull-off (3/2)P̃ = 0.075 is ¾ of DMT's, as the
+/// two theories give for one W.
+pub const JKR_DEFAULT_ADHESION: f64 = 0.05;
 /// Default coefficient of restitution of the impact law.
 pub const IMPACT_DEFAULT_RESTITUTION: f64 = 0.8;
 
 impl LawKind {
     /// Build the law, filling groups that are not given with the defaults above.
-    pub fn with_groups(
-        self,
-        hamaker: Option<f64>,
-        intermolecular_distance: Option<f64>,
-        restitution: Option<f64>,
-        electrostatic: Option<f64>,
-        tip_radius: Option<f64>,
-    ) -> ContactLaw {
+    pub fn with_groups(self, groups: LawGroups) -> ContactLaw {
+        let LawGroups {
+            hamaker,
+            intermolecular_distance,
+            restitution,
+            electrostatic,
+            tip_radius,
+            adhesion,
+        } = groups;
         match self {
             LawKind::Linear => ContactLaw::Linear,
             LawKind::Hertz => ContactLaw::Hertz,
@@ -288,9 +331,81 @@ impl LawKind {
                 electrostatic: electrostatic.unwrap_or(ELECTROSTATIC_DEFAULT),
                 tip_radius: tip_radius.unwrap_or(ELECTROSTATIC_DEFAULT_RADIUS),
             },
+            LawKind::Jkr => ContactLaw::Jkr {
+                adhesion: adhesion.unwrap_or(JKR_DEFAULT_ADHESION),
+            },
             LawKind::Impact => ContactLaw::Impact {
                 restitution: restitution.unwrap_or(IMPACT_DEFAULT_RESTITUTION),
             },
+        }
+    }
+}
+
+/// The law groups a front end may give (each `None` when not given): the one argument of
+/// [`LawKind::with_groups`] and [`ContactLaw::from_parts`].
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct LawGroups {
+    /// DMT and electrostatic: H̃.
+    pub hamaker: Option<f64>,
+    /// DMT and electrostatic: ã₀.
+    pub intermolecular_distance: Option<f64>,
+    /// Impact: r.
+    pub restitution: Option<f64>,
+    /// Electrostatic: Ẽ.
+    pub electrostatic: Option<f64>,
+    /// Electrostatic: R̃.
+    pub tip_radius: Option<f64>,
+    /// JKR: P̃.
+    pub adhesion: Option<f64>,
+}
+
+impl LawGroups {
+    /// The groups of `law` (those it has), e.g. to keep them when another group is changed.
+    pub fn of(law: ContactLaw) -> LawGroups {
+        match law {
+            ContactLaw::Dmt {
+                hamaker,
+                intermolecular_distance,
+            } => LawGroups {
+                hamaker: Some(hamaker),
+                intermolecular_distance: Some(intermolecular_distance),
+                ..LawGroups::default()
+            },
+            ContactLaw::Electrostatic {
+                hamaker,
+                intermolecular_distance,
+                electrostatic,
+                tip_radius,
+            } => LawGroups {
+                hamaker: Some(hamaker),
+                intermolecular_distance: Some(intermolecular_distance),
+                electrostatic: Some(electrostatic),
+                tip_radius: Some(tip_radius),
+                ..LawGroups::default()
+            },
+            ContactLaw::Jkr { adhesion } => LawGroups {
+                adhesion: Some(adhesion),
+                ..LawGroups::default()
+            },
+            ContactLaw::Impact { restitution } => LawGroups {
+                restitution: Some(restitution),
+                ..LawGroups::default()
+            },
+            ContactLaw::Linear | ContactLaw::Hertz => LawGroups::default(),
+        }
+    }
+
+    /// Each group of `self`, or `other`'s where `self` has none.
+    pub fn or(self, other: LawGroups) -> LawGroups {
+        LawGroups {
+            hamaker: self.hamaker.or(other.hamaker),
+            intermolecular_distance: self
+                .intermolecular_distance
+                .or(other.intermolecular_distance),
+            restitution: self.restitution.or(other.restitution),
+            electrostatic: self.electrostatic.or(other.electrostatic),
+            tip_radius: self.tip_radius.or(other.tip_radius),
+            adhesion: self.adhesion.or(other.adhesion),
         }
     }
 }
@@ -303,14 +418,9 @@ impl ContactLaw {
     /// # Errors
     /// [`crate::ParamError::Group`] for a group of another law (e.g. `restitution` with
     /// `contact_law = hertz`); the groups' ranges are checked by [`ContactLaw::validate`].
-    #[allow(clippy::too_many_arguments)]
     pub fn from_parts(
         kind: Option<LawKind>,
-        hamaker: Option<f64>,
-        intermolecular_distance: Option<f64>,
-        restitution: Option<f64>,
-        electrostatic: Option<f64>,
-        tip_radius: Option<f64>,
+        groups: LawGroups,
         base: ContactLaw,
     ) -> Result<ContactLaw, crate::ParamError> {
         let kind = kind.unwrap_or(base.kind());
@@ -318,25 +428,41 @@ impl ContactLaw {
         const ES: &[LawKind] = &[LawKind::Electrostatic];
         for (given, group, owners, owner) in [
             (
-                restitution.is_some(),
+                groups.restitution.is_some(),
                 "restitution",
                 &[LawKind::Impact][..],
                 "impact",
             ),
-            (hamaker.is_some(), "hamaker", DMT, "dmt or electrostatic"),
             (
-                intermolecular_distance.is_some(),
+                groups.hamaker.is_some(),
+                "hamaker",
+                DMT,
+                "dmt or electrostatic",
+            ),
+            (
+                groups.intermolecular_distance.is_some(),
                 "intermolecular_distance",
                 DMT,
                 "dmt or electrostatic",
             ),
             (
-                electrostatic.is_some(),
+                groups.electrostatic.is_some(),
                 "electrostatic",
                 ES,
                 "electrostatic",
             ),
-            (tip_radius.is_some(), "tip_radius", ES, "electrostatic"),
+            (
+                groups.tip_radius.is_some(),
+                "tip_radius",
+                ES,
+                "electrostatic",
+            ),
+            (
+                groups.adhesion.is_some(),
+                "adhesion",
+                &[LawKind::Jkr][..],
+                "jkr",
+            ),
         ] {
             if given && !owners.contains(&kind) {
                 return Err(crate::ParamError::Group {
@@ -347,39 +473,7 @@ impl ContactLaw {
             }
         }
         // groups not given keep base's when base has them
-        let (h0, a0, r0, e0, t0) = match base {
-            ContactLaw::Dmt {
-                hamaker,
-                intermolecular_distance,
-            } => (
-                Some(hamaker),
-                Some(intermolecular_distance),
-                None,
-                None,
-                None,
-            ),
-            ContactLaw::Electrostatic {
-                hamaker,
-                intermolecular_distance,
-                electrostatic,
-                tip_radius,
-            } => (
-                Some(hamaker),
-                Some(intermolecular_distance),
-                None,
-                Some(electrostatic),
-                Some(tip_radius),
-            ),
-            ContactLaw::Impact { restitution } => (None, None, Some(restitution), None, None),
-            _ => (None, None, None, None, None),
-        };
-        Ok(kind.with_groups(
-            hamaker.or(h0),
-            intermolecular_distance.or(a0),
-            restitution.or(r0),
-            electrostatic.or(e0),
-            tip_radius.or(t0),
-        ))
+        Ok(kind.with_groups(groups.or(LawGroups::of(base))))
     }
 
     /// The law's kind without its groups.
@@ -389,19 +483,24 @@ impl ContactLaw {
             ContactLaw::Hertz => LawKind::Hertz,
             ContactLaw::Dmt { .. } => LawKind::Dmt,
             ContactLaw::Electrostatic { .. } => LawKind::Electrostatic,
+            ContactLaw::Jkr { .. } => LawKind::Jkr,
             ContactLaw::Impact { .. } => LawKind::Impact,
         }
     }
 }
 
 impl LawKind {
-    /// The kind's name: `linear`, `hertz`, `dmt`, `electrostatic` or `impact`.
+    /// The names a front end accepts, for messages.
+    pub const EXPECTED: &'static str = "linear, hertz, dmt, electrostatic, jkr or impact";
+
+    /// The kind's name: `linear`, `hertz`, `dmt`, `electrostatic`, `jkr` or `impact`.
     pub fn name(self) -> &'static str {
         match self {
             LawKind::Linear => "linear",
             LawKind::Hertz => "hertz",
             LawKind::Dmt => "dmt",
             LawKind::Electrostatic => "electrostatic",
+            LawKind::Jkr => "jkr",
             LawKind::Impact => "impact",
         }
     }
@@ -461,6 +560,25 @@ impl TipSampleLaw for TipSample {
                     d_rate: c,
                 }
             }
+            ContactLaw::Jkr { adhesion } if contact => {
+                let jkr = Jkr::new(k, adhesion);
+                let q = jkr.radius_variable(delta);
+                let (f, df_dq) = jkr.elastic(q);
+                let q2 = q * q;
+                // dq/dδ = 1/(4q³ − c), large but finite at the break q_b ([`JKR_BREAK_CUT`]);
+                // beyond it, where an integrator's stage may look across the guard, q stays at
+                // q_b and the force at its break value
+                let dq = if delta > jkr.release() {
+                    1.0 / (4.0 * q2 * q - jkr.c)
+                } else {
+                    0.0
+                };
+                ForceEval {
+                    force: f + c * q2 * rate,
+                    d_delta: (df_dq + 2.0 * c * q * rate) * dq,
+                    d_rate: c * q2,
+                }
+            }
             ContactLaw::Dmt { .. } | ContactLaw::Electrostatic { .. } => {
                 let a0 = self.law.distance_offset();
                 if contact {
@@ -492,6 +610,10 @@ impl TipSampleLaw for TipSample {
         match self.law {
             ContactLaw::Linear if contact => 0.5 * k * delta * delta,
             ContactLaw::Hertz if contact => 0.4 * k * delta.max(0.0).powf(2.5),
+            ContactLaw::Jkr { adhesion } if contact => {
+                let jkr = Jkr::new(k, adhesion);
+                jkr.potential(jkr.radius_variable(delta))
+            }
             ContactLaw::Dmt { .. } | ContactLaw::Electrostatic { .. } => {
                 let a0 = self.law.distance_offset();
                 if contact {
@@ -514,6 +636,10 @@ impl TipSampleLaw for TipSample {
             ContactLaw::Dmt { .. } | ContactLaw::Electrostatic { .. } => {
                 self.damping * delta.max(0.0).sqrt() * rate
             }
+            ContactLaw::Jkr { adhesion } => {
+                let q = Jkr::new(self.stiffness, adhesion).radius_variable(delta);
+                self.damping * q * q * rate
+            }
             ContactLaw::Impact { .. } => 0.0,
         }
     }
@@ -523,6 +649,138 @@ impl TipSampleLaw for TipSample {
             self.law,
             ContactLaw::Dmt { .. } | ContactLaw::Electrostatic { .. }
         )
+    }
+}
+
+/// The JKR contact in the law's units (module docs): Hertz group α4, adhesion P̃ = πWR, and
+/// the contact-radius variable q = h^{1/4} = (a²/R)^{1/4} on the stable branch q ≥ q_f.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Jkr {
+    /// α4.
+    pub alpha4: f64,
+    /// P̃.
+    pub adhesion: f64,
+    /// c = √(8P̃/(3α4)): δ = q⁴ − c q.
+    pub c: f64,
+    /// b = √(6P̃α4): F = α4 q⁶ − b q³.
+    pub b: f64,
+    /// q_f = (c/4)^{1/3}: the end of the branch (dδ/dq = 0).
+    pub q_end: f64,
+    /// q_b = (1 + [`JKR_BREAK_CUT`]) q_f, where the contact breaks, just before the end of the
+    /// branch.
+    pub q_break: f64,
+}
+
+/// The JKR branch is cut just before its end: the contact breaks at q_b = (1 + 1e-3) q_f,
+/// δ_b = δ_f (1 − 2.0e-6). At the end dF/dδ ∝ 1/√(δ − δ_f) is unbounded, and the variational
+/// equations (orbits, multipliers, shooting) stall on it (steps of 1e-17 measured); at the cut
+/// it is finite (1/(4q_b³ − c) = 1/(3.0e-3 c)). The break force is (5/6)P̃(1 + 2.4e-3) and
+/// E_hys is 1.2e-6 lower, relatively ([`Jkr::hysteresis`] is that of the cut branch,
+/// [`Jkr::hysteresis_uncut`] the closed form).
+pub const JKR_BREAK_CUT: f64 = 1e-3;
+
+impl Jkr {
+    /// The contact of Hertz group `alpha4` > 0 and adhesion `adhesion` = P̃ > 0.
+    pub fn new(alpha4: f64, adhesion: f64) -> Jkr {
+        let c = (8.0 * adhesion / (3.0 * alpha4)).sqrt();
+        let q_end = (0.25 * c).cbrt();
+        Jkr {
+            alpha4,
+            adhesion,
+            c,
+            b: (6.0 * adhesion * alpha4).sqrt(),
+            q_end,
+            q_break: (1.0 + JKR_BREAK_CUT) * q_end,
+        }
+    }
+
+    /// δ(q) = q⁴ − c q.
+    pub fn indentation(&self, q: f64) -> f64 {
+        let q2 = q * q;
+        q2 * q2 - self.c * q
+    }
+
+    /// The indentation where the contact breaks, δ_b = δ(q_b) < 0 ([`JKR_BREAK_CUT`]), with
+    /// δ_f = −3q_f⁴ the end of the branch (the fixed-grips pull-off, −(3/4)(π²W²R/E*²)^{1/3}
+    /// in SI).
+    pub fn release(&self) -> f64 {
+        self.indentation(self.q_break)
+    }
+
+    /// q = c^{1/3} where the contact forms on approach (δ = 0).
+    pub fn q_contact(&self) -> f64 {
+        self.c.cbrt()
+    }
+
+    /// The elastic–adhesive force F(q) = α4 q⁶ − b q³ and dF/dq.
+    pub fn elastic(&self, q: f64) -> (f64, f64) {
+        let q3 = q * q * q;
+        (
+            self.alpha4 * q3 * q3 - self.b * q3,
+            6.0 * self.alpha4 * q3 * q * q - 3.0 * self.b * q * q,
+        )
+    }
+
+    /// U(q) = ∫_{δ_b}^{δ(q)} F dδ = G(q) − G(q_b), with
+    /// G(q) = (2/5)α4 q¹⁰ − ((α4c + 4b)/7) q⁷ + (bc/4) q⁴ the integral of
+    /// F(q) δ′(q) = (α4q⁶ − bq³)(4q³ − c): 0 at the break, so the potential is continuous there
+    /// and drops by E_hys = −U(q_contact) where the contact forms.
+    pub fn potential(&self, q: f64) -> f64 {
+        let g = |q: f64| {
+            let q2 = q * q;
+            let q4 = q2 * q2;
+            let q7 = q4 * q2 * q;
+            0.4 * self.alpha4 * q7 * q2 * q - (self.alpha4 * self.c + 4.0 * self.b) / 7.0 * q7
+                + 0.25 * self.b * self.c * q4
+        };
+        g(q) - g(self.q_break)
+    }
+
+    /// The energy lost per contact cycle (formed at δ = 0, broken at δ_b) by the
+    /// elastic–adhesive force alone: E_hys = −U(q_contact).
+    pub fn hysteresis(&self) -> f64 {
+        -self.potential(self.q_contact())
+    }
+
+    /// The closed form of the uncut branch (broken at δ_f): E_hys = (3/5 + 4^{−1/3}/10) P̃
+    /// c^{4/3} (module docs), 1.2e-6 above [`Jkr::hysteresis`] relatively.
+    pub fn hysteresis_uncut(&self) -> f64 {
+        (0.6 + 0.1 / 4f64.cbrt()) * self.adhesion * self.c.powf(4.0 / 3.0)
+    }
+
+    /// q(δ) on the stable branch: the root q ≥ q_f of q⁴ − c q = δ (q_b for δ ≤ δ_b: beyond
+    /// the break, where an integrator's stage may look across the guard). Newton's
+    /// iteration on the convex, increasing δ(q) from a start right of the root converges
+    /// monotonically; the start is the smaller of two upper bounds, max((2δ)^{1/4}, (2c)^{1/3})
+    /// (where q⁴/2 bounds both δ and c q) and q_f + √((δ − δ_f)/(6q_f²)) (δ(q) − δ_f ≥
+    /// 6q_f²(q − q_f)²), the second exact to leading order at the break, where δ′(q_f) = 0.
+    pub fn radius_variable(&self, delta: f64) -> f64 {
+        if delta.is_nan() || delta <= self.indentation(self.q_break) {
+            return self.q_break;
+        }
+        let qf = self.q_end;
+        let above = delta - self.indentation(qf);
+        let far = (2.0 * delta.max(0.0))
+            .sqrt()
+            .sqrt()
+            .max((2.0 * self.c).cbrt());
+        let near = qf + (above / (6.0 * qf * qf)).sqrt();
+        let mut q = far.min(near).max(qf);
+        for _ in 0..100 {
+            let q2 = q * q;
+            let f = q2 * q2 - self.c * q - delta;
+            let d = 4.0 * q2 * q - self.c;
+            if !(f > 0.0 && d > 0.0) {
+                break;
+            }
+            let next = q - f / d;
+            if next.is_nan() || next >= q || next <= qf {
+                q = next.max(qf);
+                break;
+            }
+            q = next;
+        }
+        q
     }
 }
 

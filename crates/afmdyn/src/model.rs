@@ -105,6 +105,9 @@ pub struct CantileverModel {
     /// The system's period: [`Params::period`], or 2π/Ω for a quasi-periodic drive
     /// ([`CantileverModel::quasiperiodic`]).
     period: f64,
+    /// V_T where the contact region is left on retraction ([`ContactLaw::release_distance`]):
+    /// the JKR neck's |δ_f|, 0 for the other laws.
+    release: f64,
 }
 
 impl CantileverModel {
@@ -187,7 +190,37 @@ impl CantileverModel {
             tip_acc,
             tip_acc_forcing,
             period,
+            release: params.contact_law.release_distance(params.alpha4),
         })
+    }
+
+    /// The constant of the guard of `mode`: |δ_f| in a hysteretic law's contact, else 0.
+    fn guard_offset(&self, mode: Region) -> f64 {
+        if mode == Region::Contact {
+            self.release
+        } else {
+            0.0
+        }
+    }
+
+    /// V_T at which the contact region is left on retraction: |δ_f| > 0 for a hysteretic law
+    /// (JKR's neck, [`ContactLaw::release_distance`]), 0 otherwise. The contact guard is
+    /// g = release − V_T.
+    pub fn release_distance(&self) -> f64 {
+        self.release
+    }
+
+    /// The energy the sample takes at an event from `from` to `to` at (τ, z) where the state
+    /// is continuous: the drop of the tip–sample potential U_from − U_to (F̃·g₀). 0 for the laws
+    /// whose potential is continuous across the switching; for JKR E_hys where the contact
+    /// forms (the adhesive neck snaps in) and 0 where it breaks (U = 0 at δ_f).
+    pub fn switching_loss(&self, from: Region, to: Region, tau: f64, z: &DVector<f64>) -> f64 {
+        if self.release == 0.0 || from == to {
+            return 0.0;
+        }
+        let delta = -self.v_t(tau, z);
+        self.law.potential(from == Region::Contact, delta)
+            - self.law.potential(to == Region::Contact, delta)
     }
 
     /// Parameters.
@@ -791,7 +824,9 @@ impl HybridSystem for CantileverModel {
     }
 
     /// Contact when V_T < 0, or V_T = 0 moving inwards (dV_T/dτ ≤ 0); free otherwise. For the
-    /// impact law: sticking when V_T = 0, dV_T/dτ = 0 and the constraint force λ > 0.
+    /// impact law: sticking when V_T = 0, dV_T/dτ = 0 and the constraint force λ > 0. For a
+    /// hysteretic law (JKR) also contact for 0 ≤ V_T < |δ_f| moving away (dV_T/dτ > 0: the
+    /// neck), the region being history-dependent there.
     fn mode_at(&self, tau: f64, z: &[f64]) -> Region {
         let (v, vd) = self.v_t_pair(tau, z);
         if self.law.law.restitution().is_some() {
@@ -800,7 +835,9 @@ impl HybridSystem for CantileverModel {
             } else {
                 Region::Free
             }
-        } else if v < 0.0 || (v == 0.0 && vd <= 0.0) {
+        } else if v < 0.0 || (v == 0.0 && vd <= 0.0) || (v < self.release && vd > 0.0) {
+            // a hysteretic law's band 0 ≤ V_T < |δ_f|: in contact when leaving through the
+            // neck, free when approaching ([`ContactLaw::release_distance`])
             Region::Contact
         } else {
             Region::Free
@@ -815,7 +852,8 @@ impl HybridSystem for CantileverModel {
         self.jacobian_into(mode, tau, z, jac);
     }
 
-    /// Free flight: g = V_T; contact: g = −V_T; sticking (impact law): g = λ.
+    /// Free flight: g = V_T; contact: g = −V_T, or |δ_f| − V_T for a hysteretic law (JKR's
+    /// neck); sticking (impact law): g = λ.
     fn guard(&self, mode: Region, tau: f64, z: &[f64]) -> Guard {
         if mode == Region::Contact && self.law.law.restitution().is_some() {
             return self.sticking_force(tau, z);
@@ -826,7 +864,7 @@ impl HybridSystem for CantileverModel {
         let mut grad = DVector::zeros(2 * n);
         grad.rows_mut(0, n).copy_from(&(sigma * self.tip()));
         Guard {
-            value: sigma * self.v_t_pair(tau, z).0,
+            value: sigma * self.v_t_pair(tau, z).0 + self.guard_offset(mode),
             grad,
             d_tau: sigma * p.base_amplitude() * p.omega * (p.omega * tau).cos(),
         }
@@ -836,7 +874,7 @@ impl HybridSystem for CantileverModel {
         if mode == Region::Contact && self.law.law.restitution().is_some() {
             return self.sticking_force_value(tau, z);
         }
-        mode.guard_sign() * self.v_t_pair(tau, z).0
+        mode.guard_sign() * self.v_t_pair(tau, z).0 + self.guard_offset(mode)
     }
 
     /// Switchings are the identity; the impact law's free-flight guard is an impact (module

@@ -530,6 +530,18 @@ impl Params {
             });
         }
         self.contact_law.validate()?;
+        if let crate::contact::ContactLaw::Jkr { adhesion } = self.contact_law {
+            // the JKR branch scales with P̃/α4 (δ_f = −3(P̃/(6α4))^{2/3}): α4 = 0 has no
+            // elastic contact, and beyond 1e12 the neck is below resolution or the whole gap
+            let ratio = adhesion / self.alpha4;
+            if !(self.alpha4 > 0.0 && (1e-12..=1e12).contains(&ratio)) {
+                return Err(ParamError::Law {
+                    name: "alpha4 (contact stiffness α4, the JKR Hertz group)",
+                    value: self.alpha4,
+                    range: "α4 > 0 with 1e-12 ≤ P̃/α4 ≤ 1e12 (the neck's scale)",
+                });
+            }
+        }
         if let Some(profile) = &self.damping_profile {
             for &s in &profile[..self.modes] {
                 if !(s.is_finite() && s >= 0.0) {

@@ -102,6 +102,14 @@ pub trait TipSampleSystem: HybridSystem {
     }
     /// Name of the tip–sample law ("linear", "hertz", "dmt", "impact", or the system's own).
     fn law_name(&self) -> &'static str;
+    /// Whether the region of a state depends on its history as well (a hysteretic law: JKR's
+    /// neck, [`crate::contact::ContactLaw::release_distance`]), so that [`HybridSystem::mode_at`]
+    /// decides a start in the band by a rule and a periodic orbit must be checked to end in the
+    /// region it starts in ([`crate::analysis::shooting`]). `false` (the default) for a system
+    /// whose region follows from the state.
+    fn is_hysteretic(&self) -> bool {
+        false
+    }
     /// The slowest decay rate of free motion, min |Re λ| over the damped eigenvalues λ of the
     /// free region (eqs. 20–21 for the cantilever), per unit τ: what the derived transient caps
     /// of the steady-state searches scale with
@@ -171,6 +179,9 @@ impl TipSampleSystem for CantileverModel {
     }
     fn law_name(&self) -> &'static str {
         self.law().name()
+    }
+    fn is_hysteretic(&self) -> bool {
+        self.release_distance() > 0.0
     }
     fn free_decay_rate(&self) -> Option<f64> {
         damped_eigenvalues(self.galerkin().region(Region::Free))

@@ -468,6 +468,10 @@ pub fn record_rows(
                 acc.contact_dissipation += loss;
                 acc.base_work += base;
             }
+            // a hysteretic law's potential drops where the contact forms (JKR's neck)
+            if spec.energy && e.kind == EventKind::Switching {
+                acc.contact_dissipation += model.switching_loss(e.from, e.to, e.tau, &e.state);
+            }
             out.events.push(e);
         }
         if spec.energy && (tau >= next_energy_cut || (tau - next_energy_cut).abs() <= tol(tau)) {

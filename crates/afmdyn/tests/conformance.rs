@@ -1,5 +1,6 @@
 //! One conformance suite over every integrator × contact law pair (exact, rk4, rk4-naive,
-//! adaptive, split, taylor × linear, Hertz, DMT, impact): the support table (every
+//! adaptive, split, taylor × linear, Hertz, DMT, electrostatic, JKR, impact): the support
+//! table (every
 //! unsupported pair is refused with [`SimError::Unsupported`] naming the integrator), and for
 //! every supported pair the identities an integrator of the switched model must satisfy:
 //!
@@ -37,7 +38,10 @@ const ES: ContactLaw = ContactLaw::Electrostatic {
     tip_radius: 1.0,
 };
 
-const LAWS: [ContactLaw; 5] = [ContactLaw::Linear, ContactLaw::Hertz, DMT, ES, IMPACT];
+/// JKR at its default adhesion: a hysteretic region (the neck, left at V_T = |δ_b|).
+const JKR: ContactLaw = ContactLaw::Jkr { adhesion: 0.05 };
+
+const LAWS: [ContactLaw; 6] = [ContactLaw::Linear, ContactLaw::Hertz, DMT, ES, JKR, IMPACT];
 
 const KINDS: [IntegratorKind; 6] = [
     IntegratorKind::Exact,
@@ -62,19 +66,22 @@ fn name(kind: IntegratorKind) -> &'static str {
 
 /// The support table: which integrator carries which law.
 fn supported(kind: IntegratorKind, law: ContactLaw) -> bool {
-    let (linear, impact, dmt, es) = (
+    let (linear, impact, dmt, es, jkr) = (
         law == ContactLaw::Linear,
         law.restitution().is_some(),
         matches!(law, ContactLaw::Dmt { .. }),
         matches!(law, ContactLaw::Electrostatic { .. }),
+        matches!(law, ContactLaw::Jkr { .. }),
     );
     match kind {
         IntegratorKind::Auto | IntegratorKind::Adaptive => true,
         IntegratorKind::Exact => linear,
-        IntegratorKind::Rk4 | IntegratorKind::Rk4Naive => !impact,
-        // the electrostatic force acts in free flight, and is not in the Taylor recurrences
+        // JKR's region depends on the history (the neck), not on the sign of V_T alone
+        IntegratorKind::Rk4 | IntegratorKind::Rk4Naive => !impact && !jkr,
+        // the electrostatic force acts in free flight, and is not in the Taylor recurrences,
+        // nor is JKR's implicit contact radius
         IntegratorKind::Split => !dmt && !es,
-        IntegratorKind::Taylor => !linear && !impact && !es,
+        IntegratorKind::Taylor => !linear && !impact && !es && !jkr,
     }
 }
 

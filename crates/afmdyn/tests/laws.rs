@@ -33,6 +33,9 @@ const ES: ContactLaw = ContactLaw::Electrostatic {
     tip_radius: 1.0,
 };
 
+/// JKR at its default adhesion P̃ = 0.05.
+const JKR: ContactLaw = ContactLaw::Jkr { adhesion: 0.05 };
+
 // One conformance suite over every law × integrator pair: tests/conformance.rs.
 
 /// The split integrator (exact free flight, adaptive contact) against the adaptive integrator
@@ -464,11 +467,12 @@ fn fd_flow_jacobian(m: &CantileverModel, z0: &DVector<f64>, t1: f64) -> DMatrix<
 proptest! {
     #![proptest_config(ProptestConfig { cases: 6, ..ProptestConfig::default() })]
     /// The Jacobian of the flow over one period (variational equations × saltation matrices)
-    /// equals central differences of the flow, for Hertz, DMT (Kelvin–Voigt tangent coordinates)
-    /// and the impact law, from random starts.
+    /// equals central differences of the flow, for Hertz, DMT (Kelvin–Voigt tangent coordinates),
+    /// the electrostatic law, JKR (the force jumps where the neck forms and breaks) and the
+    /// impact law, from random starts.
     #[test]
     fn variational_jacobian_matches_finite_differences(
-        law_ix in 0usize..4,
+        law_ix in 0usize..5,
         a1 in -0.05f64..0.05,
         v1 in -0.3f64..0.3,
         a2 in -0.003f64..0.003,
@@ -477,6 +481,7 @@ proptest! {
             0 => (ContactLaw::Hertz, 2, 2.8, 0.0),
             1 => (DMT, 2, 2.8, 0.0),
             2 => (ES, 2, 2.8, 0.0),
+            3 => (JKR, 2, 2.8, 0.0),
             _ => (ContactLaw::Impact { restitution: 0.5 }, 1, 3.0, 0.05),
         };
         let p = Params { modes, omega, alpha5: gap, contact_law: law, ..Params::default() };
@@ -536,6 +541,13 @@ fn every_analysis_on_every_law() {
         },
         Case {
             law: ES,
+            modes: 2,
+            omega: 2.8,
+            gap: 0.0,
+            period: 1,
+        },
+        Case {
+            law: JKR,
             modes: 2,
             omega: 2.8,
             gap: 0.0,

@@ -33,9 +33,10 @@ class Params:
     ``drive_amplitude``/``alpha2`` (≥ 0), ``beam_damping``/``alpha3`` (≥ 0),
     ``contact_stiffness``/``alpha4`` (≥ 0), ``gap``/``alpha5`` (finite),
     ``contact_damping``/``alpha6`` (≥ 0), ``omega`` (Ω > 0), ``contact_law`` (``"linear"``,
-    ``"hertz"``, ``"dmt"``, ``"electrostatic"``, ``"impact"``) with its groups ``restitution``
-    (0..=1, impact), ``hamaker`` (≥ 0) and ``intermolecular_distance`` (> 0, DMT and
-    electrostatic), ``electrostatic`` (Ẽ ≥ 0) and ``tip_radius`` (R̃ > 0, electrostatic),
+    ``"hertz"``, ``"dmt"``, ``"electrostatic"``, ``"jkr"``, ``"impact"``) with its groups
+    ``restitution`` (0..=1, impact), ``hamaker`` (≥ 0) and ``intermolecular_distance`` (> 0,
+    DMT and electrostatic), ``electrostatic`` (Ẽ ≥ 0) and ``tip_radius`` (R̃ > 0,
+    electrostatic), ``adhesion`` (P̃ = πWR > 0, JKR),
     ``excitation`` (``"base"``, ``"tip"``: where the drive acts on the beam); the others keep
     the paper's
     Figs. 5–14 set. Raises ``ValueError`` (field and range) or ``TypeError`` (unknown keyword,
@@ -59,13 +60,14 @@ class Params:
         contact_damping: float = ...,
         alpha6: float = ...,
         omega: float = ...,
-        contact_law: Literal["linear", "hertz", "dmt", "electrostatic", "impact"] = ...,
+        contact_law: Literal["linear", "hertz", "dmt", "electrostatic", "jkr", "impact"] = ...,
         excitation: Literal["base", "tip"] = ...,
         restitution: float = ...,
         hamaker: float = ...,
         intermolecular_distance: float = ...,
         electrostatic: float = ...,
         tip_radius: float = ...,
+        adhesion: float = ...,
     ) -> None: ...
     def replace(
         self,
@@ -84,13 +86,14 @@ class Params:
         contact_damping: float = ...,
         alpha6: float = ...,
         omega: float = ...,
-        contact_law: Literal["linear", "hertz", "dmt", "electrostatic", "impact"] = ...,
+        contact_law: Literal["linear", "hertz", "dmt", "electrostatic", "jkr", "impact"] = ...,
         excitation: Literal["base", "tip"] = ...,
         restitution: float = ...,
         hamaker: float = ...,
         intermolecular_distance: float = ...,
         electrostatic: float = ...,
         tip_radius: float = ...,
+        adhesion: float = ...,
     ) -> "Params":
         """A validated copy with the given keywords changed."""
     @staticmethod
@@ -123,7 +126,7 @@ class Params:
     @property
     def omega(self) -> float: ...
     @property
-    def contact_law(self) -> Literal["linear", "hertz", "dmt", "electrostatic", "impact"]: ...
+    def contact_law(self) -> Literal["linear", "hertz", "dmt", "electrostatic", "jkr", "impact"]: ...
     @property
     def restitution(self) -> Optional[float]: ...
     @property
@@ -136,6 +139,8 @@ class Params:
     def electrostatic(self) -> Optional[float]: ...
     @property
     def tip_radius(self) -> Optional[float]: ...
+    @property
+    def adhesion(self) -> Optional[float]: ...
     @property
     def tip_mass_ratio(self) -> float: ...
     @property

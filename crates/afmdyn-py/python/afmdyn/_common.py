@@ -74,13 +74,14 @@ class Model(TypedDict, total=False):
     contact_damping: float
     alpha6: float
     omega: float
-    contact_law: Literal["linear", "hertz", "dmt", "electrostatic", "impact"]
+    contact_law: Literal["linear", "hertz", "dmt", "electrostatic", "jkr", "impact"]
     excitation: Literal["base", "tip"]
     restitution: float
     hamaker: float
     intermolecular_distance: float
     electrostatic: float
     tip_radius: float
+    adhesion: float
     z_c: float
     drive_frequency: float
     probe: Union[str, "os.PathLike[str]", Dict[str, Any]]

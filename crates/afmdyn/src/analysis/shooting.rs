@@ -266,7 +266,39 @@ pub fn shoot_undamped(
     opts: &ShootingOptions,
 ) -> Result<ShotOrbit, SimError> {
     let (state, map, residuals) = newton(integ, guess, n, opts, Damping::Stop)?;
+    closes_in_its_region(integ, &state, n, &residuals)?;
     Ok(ShotOrbit::new(state, map.jacobian, residuals))
+}
+
+/// For a hysteretic system ([`crate::tip_sample::TipSampleSystem::is_hysteretic`]): the
+/// fixed point z = Pⁿ(z) is an orbit only if the flow ends in the region a start at z is given
+/// ([`crate::system::HybridSystem::mode_at`]'s rule in the neck's band). Where it does not, the
+/// map restarts in the other region than the motion is in: the point is no orbit of the hybrid
+/// system, and it is refused rather than reported (one extra flow, for such systems only).
+///
+/// # Errors
+/// [`SimError::NoConvergence`] naming the mismatch; the integrator's errors.
+fn closes_in_its_region(
+    integ: &mut dyn Integrator,
+    z: &DVector<f64>,
+    n: usize,
+    residuals: &[f64],
+) -> Result<(), SimError> {
+    if !integ.system().is_hysteretic() {
+        return Ok(());
+    }
+    let start = integ.system().mode_at(0.0, z.as_slice());
+    StroboscopicMap::new(&mut *integ, n).image(z)?;
+    if integ.region() == start {
+        return Ok(());
+    }
+    Err(SimError::NoConvergence {
+        what: "shooting (the fixed point crosses the section in the contact's neck, 0 < V_T < \
+               |δ_b|, in the other region than a start there is given: no orbit of the \
+               hysteretic law)",
+        iterations: residuals.len(),
+        residual: residuals.last().copied().unwrap_or(f64::NAN),
+    })
 }
 
 /// [`shoot_undamped`] with `m0`, an estimate of the monodromy matrix (the previous orbit's
@@ -355,10 +387,12 @@ pub fn shoot_broyden(
     let res_var = (&map.state - &z).norm();
     if res_var <= VARIATIONAL_SLACK * opts.tol * (1.0 + z.norm()) {
         residuals.push(res_var);
+        closes_in_its_region(integ, &z, n, &residuals)?;
         return Ok(ShotOrbit::new(z, map.jacobian, residuals));
     }
     let (state, map, more) = newton(integ, &z, n, opts, Damping::Stop)?;
     residuals.extend(more);
+    closes_in_its_region(integ, &state, n, &residuals)?;
     Ok(ShotOrbit::new(state, map.jacobian, residuals))
 }
 
@@ -584,6 +618,7 @@ fn finish(
     map: FlowMap,
     residuals: Vec<f64>,
 ) -> Result<PeriodicOrbit, SimError> {
+    closes_in_its_region(integ, &z, n, &residuals)?;
     let section = section_points(integ, &z, n)?;
     let grazing_distance = StroboscopicMap::new(&mut *integ, n).grazing_distance(&z)?;
     let (multipliers, stable, critical) = floquet_stability(&map.jacobian);

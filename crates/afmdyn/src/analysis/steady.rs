@@ -621,7 +621,7 @@ mod tests {
             let law: LawKind = law.parse().unwrap();
             let p = Params {
                 modes,
-                contact_law: law.with_groups(None, None, None, None, None),
+                contact_law: law.with_groups(Default::default()),
                 ..Params::default()
             };
             let model = CantileverModel::new(&p).unwrap();

@@ -103,7 +103,7 @@ impl IntegratorKind {
     /// affine (linear-law) model (under a multifrequency drive,
     /// [`crate::params::Params::drive_components`], to `Taylor` for Hertz and DMT and to
     /// `Adaptive` for the others), to `Split` for a law without force in free flight (Hertz,
-    /// impact with r > 0), to `Adaptive` for the plastic impact law r = 0 (whose free flights
+    /// JKR, impact with r > 0), to `Adaptive` for the plastic impact law r = 0 (whose free flights
     /// all start tangentially) and for the electrostatic law, and to `Taylor` for DMT; other
     /// kinds are returned as given.
     /// ([`build`] falls back from `Split` to `Adaptive` for `Auto` where the exact free flight
@@ -236,6 +236,17 @@ pub fn build(
             "must be adaptive, taylor, auto or rk4 under a multifrequency drive: the exact and \
              split integrators propagate one harmonic drive",
         ));
+    }
+    if matches!(kind, IntegratorKind::Rk4 | IntegratorKind::Rk4Naive)
+        && model.release_distance() > 0.0
+    {
+        return Err(SimError::Unsupported {
+            integrator: "rk4",
+            law: model.law().name(),
+            hint: "the contact's neck makes the region depend on the history, which RK4's \
+                   region from the sign of V_T cannot follow: use integrator = \"auto\" (or \
+                   \"adaptive\")",
+        });
     }
     if matches!(kind, IntegratorKind::Rk4 | IntegratorKind::Rk4Naive)
         && model.law().restitution().is_some()

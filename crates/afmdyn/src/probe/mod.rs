@@ -16,10 +16,12 @@
 //! youngs_modulus = 130e9         # E_t (Pa), default 130e9 (silicon, Hopcroft et al. 2010)
 //! poisson_ratio = 0.27           # ν_t, default 0.28 (silicon)
 //! [sample]
-//! law = "dmt"                    # linear | hertz | dmt | electrostatic | impact
+//! law = "dmt"                    # linear | hertz | dmt | electrostatic | jkr | impact
 //! youngs_modulus = 4e9           # E_s (Pa)            (hertz, dmt)
 //! poisson_ratio = 0.33           # ν_s                 (hertz, dmt)
-//! hamaker = 6.6e-20              # H (J)               (dmt)
+//! hamaker = 6.6e-20              # H (J)               (dmt; jkr: W = H/(12πa₀²) if no
+//!                                #                      adhesion_energy)
+//! # adhesion_energy = 0.05       # W (J/m²), work of adhesion (jkr)
 //! intermolecular_distance = 0.165e-9  # a₀ (m), default 0.165e-9 (Israelachvili) (dmt)
 //! viscosity = 0.0                # η (Pa·s), Kelvin–Voigt −η√(R(a₀ − d))·ḋ (dmt)
 //! # hertz: damping (N·s/m); linear: stiffness (N/m), damping (N·s/m); impact: restitution
@@ -83,6 +85,10 @@
 //! * electrostatic (DMT plus a biased tip, Hudlet et al., *Eur. Phys. J. B* 2 (1998) 5): the
 //!   DMT groups, and from `bias_voltage` V_b and `contact_potential` V_cpd (default 0) the group
 //!   Ẽ = πε₀(V_b − V_cpd)²/F_s and R̃ = R/g₀ of F_es = −πε₀V²R²/(d(d + R));
+//! * jkr (Johnson, Kendall & Roberts, *Proc. R. Soc. Lond. A* 324 (1971) 301): α4 as hertz,
+//!   P̃ = πWR/F_s from the work of adhesion W (`adhesion_energy`, or H/(12πa₀²) from `hamaker`
+//!   and `intermolecular_distance`, Israelachvili 2011 §13.6), α6 as DMT's (the Kelvin–Voigt
+//!   term η a δ̇ with the contact radius a);
 //! * impact: the restitution r.
 //!
 //! The rest distance z_c sets α5 = z_c/g₀ − ã₀ (DMT) or z_c/g₀ ([`crate::Params::rest_distance`]).
@@ -258,7 +264,7 @@ pub struct Probe {
     /// The fluid of `[medium]` and each mode's loading (`None` without the section).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub medium: Option<MediumReport>,
-    /// The Tabor parameter μ of a DMT or electrostatic sample ([`tabor_parameter`]; `None`
+    /// The Tabor parameter μ of a DMT, electrostatic or JKR sample ([`tabor_parameter`]; `None`
     /// for the other laws).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub tabor_parameter: Option<f64>,
@@ -268,15 +274,23 @@ pub struct Probe {
 /// Sci.* 192 (1997) 326, adhesion map: DMT below 0.1, the transition between, JKR above 5).
 pub const TABOR_JKR: f64 = 5.0;
 
+/// Below this Tabor parameter the contact is DMT's (Johnson & Greenwood 1997).
+pub const TABOR_DMT: f64 = 0.1;
+
+/// The work of adhesion W = H/(12πz₀²) (J/m²) from the Hamaker constant H (J) at the
+/// equilibrium separation z₀ (m) (Israelachvili, *Intermolecular and Surface Forces*, 3rd ed.
+/// 2011, §13.6).
+pub fn work_of_adhesion(hamaker: f64, z0: f64) -> f64 {
+    hamaker / (12.0 * std::f64::consts::PI * z0 * z0)
+}
+
 /// The Tabor parameter μ = (R W²/(E*² z₀³))^{1/3} (Tabor, *J. Colloid Interface Sci.* 58 (1977)
 /// 2; Johnson & Greenwood 1997) of a sphere of radius R (m) on a sample with reduced modulus
-/// E* (Pa), the work of adhesion W = H/(12πz₀²) (J/m²) from the Hamaker constant H (J) at the
-/// equilibrium separation z₀ (m) (Israelachvili, *Intermolecular and Surface Forces*, 3rd ed.
-/// 2011, §13.6): which contact model applies — DMT (stiff, weakly adhesive, small tips) below
-/// 0.1, JKR (compliant, adhesive, large tips) above [`TABOR_JKR`].
-pub fn tabor_parameter(radius: f64, e_star: f64, hamaker: f64, z0: f64) -> f64 {
-    let w = hamaker / (12.0 * std::f64::consts::PI * z0 * z0);
-    (radius * w * w / (e_star * e_star * z0 * z0 * z0)).cbrt()
+/// E* (Pa) and work of adhesion W (J/m², e.g. [`work_of_adhesion`]) at the equilibrium
+/// separation z₀ (m): which contact model applies — DMT (stiff, weakly adhesive, small tips)
+/// below [`TABOR_DMT`], JKR (compliant, adhesive, large tips) above [`TABOR_JKR`].
+pub fn tabor_parameter(radius: f64, e_star: f64, work: f64, z0: f64) -> f64 {
+    (radius * work * work / (e_star * e_star * z0 * z0 * z0)).cbrt()
 }
 
 impl Probe {
@@ -286,12 +300,20 @@ impl Probe {
     /// hysteresis.
     pub fn warnings(&self) -> Vec<String> {
         let mut w = Vec::new();
-        if let Some(mu) = self.tabor_parameter.filter(|&mu| mu > TABOR_JKR) {
+        let jkr = matches!(self.params.contact_law, ContactLaw::Jkr { .. });
+        if let Some(mu) = self.tabor_parameter.filter(|&mu| jkr && mu < TABOR_DMT) {
+            w.push(format!(
+                "the sample's Tabor parameter is {mu:.3} (< {TABOR_DMT}: a stiff, weakly \
+                 adhesive contact, DMT's regime; Johnson & Greenwood 1997): JKR's neck is then an \
+                 overestimate, law = \"dmt\" applies"
+            ));
+        }
+        if let Some(mu) = self.tabor_parameter.filter(|&mu| !jkr && mu > TABOR_JKR) {
             w.push(format!(
                 "the sample's Tabor parameter is {mu:.3} (> {TABOR_JKR}: a compliant, adhesive \
                  contact, JKR's regime; Johnson & Greenwood 1997): DMT misses the contact's neck \
                  and the adhesion hysteresis of each tap, so adhesion and dissipation are \
-                 underestimated"
+                 underestimated; law = \"jkr\" applies"
             ));
         }
         w
@@ -405,6 +427,8 @@ struct Sample {
     restitution: Option<f64>,
     /// The electrostatic law's voltage across the gap, bias − contact potential (V).
     voltage: Option<f64>,
+    /// JKR's work of adhesion W (J/m²).
+    adhesion_energy: Option<f64>,
     z_c: Option<f64>,
 }
 
@@ -1072,23 +1096,24 @@ impl Probe {
             Some((_, l))
                 if matches!(
                     l.as_str(),
-                    "linear" | "hertz" | "dmt" | "electrostatic" | "impact"
+                    "linear" | "hertz" | "dmt" | "electrostatic" | "jkr" | "impact"
                 ) =>
             {
                 Some(l)
             }
             Some((l, _)) => {
                 r.problems.push(format!(
-                    "[sample].law = '{l}': expected linear, hertz, dmt, electrostatic or impact"
+                    "[sample].law = '{l}': expected {}",
+                    crate::contact::LawKind::EXPECTED
                 ));
                 None
             }
             None => {
                 if !s.contains_key("law") {
-                    r.problems.push(
-                        "missing key [sample].law (linear, hertz, dmt, electrostatic or impact)"
-                            .into(),
-                    );
+                    r.problems.push(format!(
+                        "missing key [sample].law ({})",
+                        crate::contact::LawKind::EXPECTED
+                    ));
                 }
                 None
             }
@@ -1108,11 +1133,13 @@ impl Probe {
             .copied()
             .chain(["bias_voltage", "contact_potential"])
             .collect();
+        let jkr: Vec<&str> = DMT.iter().copied().chain(["adhesion_energy"]).collect();
         let keys: &[&str] = match law.as_str() {
             "linear" => &["law", "stiffness", "damping", "z_c"],
             "hertz" => &["law", "youngs_modulus", "poisson_ratio", "damping", "z_c"],
             "dmt" => &DMT,
             "electrostatic" => &electrostatic,
+            "jkr" => &jkr,
             _ => &["law", "restitution", "z_c"],
         };
         r.unknown(s, S, keys);
@@ -1128,6 +1155,7 @@ impl Probe {
             damping: None,
             restitution: None,
             voltage: None,
+            adhesion_energy: None,
             z_c,
         };
         match law.as_str() {
@@ -1162,7 +1190,24 @@ impl Probe {
         if law == "hertz" {
             out.damping = r.optional(s, S, "damping", "N s/m", NON_NEGATIVE);
         } else {
-            out.hamaker = r.required(s, S, "hamaker", "J", NON_NEGATIVE);
+            // JKR: the work of adhesion W, or H/(12πa₀²) from the Hamaker constant
+            out.hamaker = if law == "jkr" {
+                out.adhesion_energy = r.optional(s, S, "adhesion_energy", "J/m^2", POSITIVE);
+                match (out.adhesion_energy.is_some(), s.contains_key("hamaker")) {
+                    (_, true) => r.optional(s, S, "hamaker", "J", POSITIVE),
+                    (true, false) => None,
+                    (false, false) => {
+                        r.problems.push(
+                            "missing key [sample].adhesion_energy (W, J/m², the jkr law's work \
+                             of adhesion; or hamaker, J, for W = H/(12πa₀²))"
+                                .into(),
+                        );
+                        None
+                    }
+                }
+            } else {
+                r.required(s, S, "hamaker", "J", NON_NEGATIVE)
+            };
             // a₀ = 0.165 nm when omitted (Israelachvili, Intermolecular and Surface Forces,
             // 3rd ed., Academic Press 2011, §13.6: the contact separation D₀ that gives
             // surface energies from Hamaker constants; García & San Paulo 1999 use it)
@@ -1181,6 +1226,20 @@ impl Probe {
                 .unwrap_or(0.0);
             out.voltage = bias.map(|b| b - cpd);
             out.voltage?;
+        }
+        if law == "jkr" {
+            if out.adhesion_energy.is_some() && out.hamaker.is_some() {
+                r.problems.push(
+                    "[sample] gives both adhesion_energy and hamaker: the jkr law takes one work \
+                     of adhesion (W, or H/(12πa₀²))"
+                        .into(),
+                );
+                return None;
+            }
+            if let (None, Some(h), Some(a0)) = (out.adhesion_energy, out.hamaker, out.a0) {
+                out.adhesion_energy = Some(work_of_adhesion(h, a0));
+            }
+            out.adhesion_energy?;
         }
         out.e_star.and(out.radius).map(|_| out)
     }
@@ -1369,12 +1428,20 @@ impl Probe {
                 alpha4 = sample.stiffness.unwrap_or(0.0) * g0 / force_n;
                 alpha6 = sample.damping.unwrap_or(0.0) * g0 / (t_s * force_n);
             }
-            "hertz" | "dmt" | "electrostatic" => {
+            "hertz" | "dmt" | "electrostatic" | "jkr" => {
                 let (e, rr) = (sample.e_star.unwrap_or(0.0), sample.radius.unwrap_or(0.0));
                 alpha4 = 4.0 / 3.0 * e * rr.sqrt() * g0.powf(1.5) / force_n;
                 if sample.law == "hertz" {
                     law = ContactLaw::Hertz;
                     alpha6 = sample.damping.unwrap_or(0.0) * g0 / (t_s * force_n);
+                } else if sample.law == "jkr" {
+                    // P̃ = πWR/F_s; the Kelvin–Voigt term η a δ̇ = η √(Rh) δ̇ as DMT's
+                    law = ContactLaw::Jkr {
+                        adhesion: std::f64::consts::PI * sample.adhesion_energy.unwrap_or(0.0) * rr
+                            / force_n,
+                    };
+                    alpha6 =
+                        sample.viscosity.unwrap_or(0.0) * (rr * g0).sqrt() * g0 / (t_s * force_n);
                 } else {
                     let hamaker = sample.hamaker.unwrap_or(0.0) * rr / (6.0 * g0 * g0 * force_n);
                     let intermolecular_distance = sample.a0.unwrap_or(0.0) / g0;
@@ -1402,15 +1469,21 @@ impl Probe {
                 };
             }
         }
-        let tabor_parameter = match (sample.law.as_str(), sample.hamaker, sample.a0) {
-            ("dmt" | "electrostatic", Some(h), Some(z0)) if h > 0.0 => Some(tabor_parameter(
-                sample.radius.unwrap_or(0.0),
-                sample.e_star.unwrap_or(f64::NAN),
-                h,
-                z0,
-            )),
+        let work = match (sample.law.as_str(), sample.adhesion_energy, sample.hamaker) {
+            ("jkr", Some(w), _) => Some(w),
+            ("dmt" | "electrostatic", _, Some(h)) if h > 0.0 => {
+                Some(work_of_adhesion(h, sample.a0.unwrap_or(f64::NAN)))
+            }
             _ => None,
         };
+        let tabor_parameter = work.map(|w| {
+            tabor_parameter(
+                sample.radius.unwrap_or(0.0),
+                sample.e_star.unwrap_or(f64::NAN),
+                w,
+                sample.a0.unwrap_or(DEFAULT_INTERMOLECULAR_DISTANCE),
+            )
+        });
         let z_c_in_file = sample.z_c.is_some();
         let z_c = sample.z_c.unwrap_or(a0);
         let mut params = Params {

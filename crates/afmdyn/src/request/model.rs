@@ -7,7 +7,7 @@
 //! single values of [`ModelSpec`] ← the SI overrides `z_c` (sets α5) and `drive_frequency`
 //! (sets Ω), which need the probe's scales.
 
-use crate::contact::{ContactLaw, LawKind};
+use crate::contact::{ContactLaw, LawGroups, LawKind};
 use crate::error::SimError;
 use crate::params::{Excitation, Params};
 use crate::probe::Probe;
@@ -76,7 +76,7 @@ const fn info(
 /// Every model parameter a request takes, in the order the front ends list them. The ranges
 /// are those [`Params::validate`] and [`ContactLaw::validate`] enforce; `z_c` and
 /// `drive_frequency` are SI values that need a probe file.
-pub const MODEL_PARAMETERS: [ParamInfo; 17] = [
+pub const MODEL_PARAMETERS: [ParamInfo; 18] = [
     info(
         "modes",
         None,
@@ -162,11 +162,12 @@ pub const MODEL_PARAMETERS: [ParamInfo; 17] = [
         None,
         "F_c",
         "1",
-        "linear, hertz, dmt, electrostatic or impact",
+        "linear, hertz, dmt, electrostatic, jkr or impact",
         "linear",
         "tip–sample law: linear (α4 δ + α6 δ̇), hertz (α4 δ^1.5 + α6 δ̇), dmt (van der Waals + \
-         adhesion + Hertz + α6 √δ δ̇), electrostatic (dmt + a biased tip) or impact (rigid \
-         sample, restitution r)",
+         adhesion + Hertz + α6 √δ δ̇), electrostatic (dmt + a biased tip), jkr (adhesive Hertz \
+         contact with a neck, formed at δ = 0, broken at δ_f < 0) or impact (rigid sample, \
+         restitution r)",
         ValueKind::Law,
     ),
     info(
@@ -228,6 +229,16 @@ pub const MODEL_PARAMETERS: [ParamInfo; 17] = [
         "> 0",
         "1",
         "electrostatic law: tip radius R̃ = R/g0",
+        ValueKind::Real,
+    ),
+    info(
+        "adhesion",
+        None,
+        "P̃",
+        "1",
+        "> 0",
+        "0.05",
+        "jkr law: adhesion group P̃ = πWR/F (W the work of adhesion): pull-off (3/2)P̃",
         ValueKind::Real,
     ),
     info(
@@ -325,6 +336,9 @@ pub struct ModelSpec {
     /// Electrostatic law: R̃.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub tip_radius: Option<f64>,
+    /// JKR law: P̃.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub adhesion: Option<f64>,
     /// With a probe: z_c in m.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub z_c: Option<f64>,
@@ -354,6 +368,7 @@ impl ModelSpec {
                 .or(lower.intermolecular_distance),
             electrostatic: self.electrostatic.or(lower.electrostatic),
             tip_radius: self.tip_radius.or(lower.tip_radius),
+            adhesion: self.adhesion.or(lower.adhesion),
             z_c: self.z_c.or(lower.z_c),
             drive_frequency: self.drive_frequency.or(lower.drive_frequency),
         }
@@ -380,6 +395,7 @@ impl ModelSpec {
             ("intermolecular_distance", self.intermolecular_distance),
             ("electrostatic", self.electrostatic),
             ("tip_radius", self.tip_radius),
+            ("adhesion", self.adhesion),
             ("z_c", self.z_c),
             ("drive_frequency", self.drive_frequency),
         ];
@@ -407,11 +423,14 @@ impl ModelSpec {
         let base = probe.map_or(defaults, |p| p.params);
         let contact_law = ContactLaw::from_parts(
             self.contact_law,
-            self.hamaker,
-            self.intermolecular_distance,
-            self.restitution,
-            self.electrostatic,
-            self.tip_radius,
+            LawGroups {
+                hamaker: self.hamaker,
+                intermolecular_distance: self.intermolecular_distance,
+                restitution: self.restitution,
+                electrostatic: self.electrostatic,
+                tip_radius: self.tip_radius,
+                adhesion: self.adhesion,
+            },
             base.contact_law,
         )?;
         let mut p = Params {
@@ -507,7 +526,7 @@ impl ModelSpec {
 /// Hamaker constant in J): the value's name and what to give instead. `modes` and
 /// `restitution` (pure numbers, the same in SI) and the SI values `z_c` and `drive_frequency`
 /// are taken with a probe.
-pub const PROBE_SETS: [(&str, &str); 13] = [
+pub const PROBE_SETS: [(&str, &str); 14] = [
     (
         "tip_mass_ratio",
         "is the dimensionless α1 and a probe sets it: give it in the probe file's [cantilever] \
@@ -573,6 +592,11 @@ pub const PROBE_SETS: [(&str, &str); 13] = [
         "is set by the probe file's [drive] excitation (its drive amplitude is calibrated for \
          it): change it there",
     ),
+    (
+        "adhesion",
+        "is the dimensionless P̃ and a probe sets it: give the work of adhesion in the probe \
+         file's [sample] adhesion_energy (J/m², law = \"jkr\")",
+    ),
 ];
 
 impl ModelSpec {
@@ -592,6 +616,7 @@ impl ModelSpec {
             ("electrostatic", self.electrostatic),
             ("tip_radius", self.tip_radius),
             ("excitation", None),
+            ("adhesion", self.adhesion),
         ];
         for ((name, value), (key, allowed)) in given.into_iter().zip(PROBE_SETS) {
             debug_assert_eq!(name, key);
@@ -681,6 +706,7 @@ mod tests {
             intermolecular_distance: Some(1.0),
             electrostatic: Some(0.0),
             tip_radius: Some(1.0),
+            adhesion: Some(1.0),
             z_c: Some(0.0),
             drive_frequency: Some(1.0),
         };

@@ -49,6 +49,7 @@ mod jet;
 pub(crate) mod poly;
 
 use super::{ChatterWindow, Integrator, SmoothTime, Step, StepBudget};
+use crate::contact::ContactLaw;
 use crate::error::SimError;
 use crate::model::CantileverModel;
 use crate::roots::safeguarded_newton;
@@ -156,12 +157,20 @@ impl Taylor {
             return Err(SimError::Unsupported {
                 integrator: "taylor",
                 law: model.law().name(),
-                hint: if model.law().is_affine() {
-                    "the linear law is propagated exactly: use integrator = \"exact\" (or \
-                     \"auto\")"
-                } else {
-                    "impacts need the jump map of the adaptive or split integrator: use \
-                     integrator = \"auto\""
+                hint: match model.law() {
+                    ContactLaw::Linear => {
+                        "the linear law is propagated exactly: use integrator = \"exact\" (or \
+                         \"auto\")"
+                    }
+                    ContactLaw::Impact { .. } => {
+                        "impacts need the jump map of the adaptive or split integrator: use \
+                         integrator = \"auto\""
+                    }
+                    _ => {
+                        "this law's force is not in the Taylor recurrences (the electrostatic \
+                         1/(d(d + R)), JKR's implicit contact radius): use integrator = \
+                         \"auto\" (or \"adaptive\")"
+                    }
                 },
             });
         };

@@ -454,9 +454,10 @@ impl Jet {
                 k: p.alpha4,
                 c: p.alpha6,
             },
-            ContactLaw::Linear | ContactLaw::Impact { .. } | ContactLaw::Electrostatic { .. } => {
-                return None
-            }
+            ContactLaw::Linear
+            | ContactLaw::Impact { .. }
+            | ContactLaw::Electrostatic { .. }
+            | ContactLaw::Jkr { .. } => return None,
         };
         let n = model.modes();
         let free = model.dynamics(Region::Free);
