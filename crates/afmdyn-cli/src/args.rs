@@ -112,6 +112,12 @@ pub struct ModelArgs {
     pub tip_radius: Option<f64>,
     #[arg(long, value_name = "P̃", allow_negative_numbers = true)]
     pub adhesion: Option<f64>,
+    #[arg(long, value_name = "F̃_cap", allow_negative_numbers = true)]
+    pub capillary: Option<f64>,
+    #[arg(long, value_name = "h̃", allow_negative_numbers = true)]
+    pub meniscus: Option<f64>,
+    #[arg(long, value_name = "D̃_r", allow_negative_numbers = true)]
+    pub rupture: Option<f64>,
 }
 
 fn parse_law(s: &str) -> Result<LawKind, String> {
@@ -165,6 +171,9 @@ impl ModelArgs {
             electrostatic: self.electrostatic,
             tip_radius: self.tip_radius,
             adhesion: self.adhesion,
+            capillary: self.capillary,
+            meniscus: self.meniscus,
+            rupture: self.rupture,
             z_c: quantity(self.z_c, "z-c", Dim::Length, true)?,
             drive_frequency: quantity(
                 self.drive_frequency,

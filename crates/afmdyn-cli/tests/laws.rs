@@ -25,7 +25,7 @@ fn json(args: &[&str]) -> serde_json::Value {
 }
 
 /// (law flags, model flags giving a periodic orbit at the chosen Ω, Ω).
-const LAWS: [(&[&str], &[&str], &str); 6] = [
+const LAWS: [(&[&str], &[&str], &str); 7] = [
     (&["--contact-law", "linear"], &["--modes", "2"], "2.8"),
     (&["--contact-law", "hertz"], &["--modes", "2"], "2.8"),
     (
@@ -53,6 +53,12 @@ const LAWS: [(&[&str], &[&str], &str); 6] = [
     ),
     // and `--contact-law jkr`: a hysteretic contact (the neck) through every subcommand
     (&["--contact-law", "jkr"], &["--modes", "2"], "2.8"),
+    // and `--contact-law capillary`: a meniscus formed at contact, ruptured at V_T = D̃_r
+    (
+        &["--contact-law", "capillary", "--rupture", "0.04"],
+        &["--modes", "2"],
+        "2.8",
+    ),
 ];
 
 fn as_refs(v: Vec<String>) -> Output {
@@ -169,6 +175,18 @@ fn law_flags_are_checked() {
         (
             vec!["orbit", "--contact-law", "jkr", "--contact-stiffness", "0"],
             "alpha4",
+        ),
+        (
+            vec!["orbit", "--contact-law", "dmt", "--meniscus", "0.01"],
+            "meniscus is a group of the capillary law",
+        ),
+        (
+            vec!["orbit", "--contact-law", "capillary", "--rupture", "0"],
+            "rupture",
+        ),
+        (
+            vec!["orbit", "--contact-law", "capillary", "--capillary", "-1"],
+            "capillary",
         ),
         (
             vec!["simulate", "--contact-law", "jkr", "--integrator", "rk4"],

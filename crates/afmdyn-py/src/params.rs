@@ -126,6 +126,9 @@ pub fn model_spec(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<ModelSpec> {
             "electrostatic" => m.electrostatic = x()?,
             "tip_radius" => m.tip_radius = x()?,
             "adhesion" => m.adhesion = x()?,
+            "capillary" => m.capillary = x()?,
+            "meniscus" => m.meniscus = x()?,
+            "rupture" => m.rupture = x()?,
             "z_c" => m.z_c = x()?,
             "drive_frequency" => m.drive_frequency = x()?,
             "excitation" => {
@@ -140,7 +143,8 @@ pub fn model_spec(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<ModelSpec> {
             "contact_law" => {
                 let name: String = v.extract().map_err(|_| {
                     PyTypeError::new_err(format!(
-                        "{key}: expected a string (linear, hertz, dmt, electrostatic, jkr or impact)"
+                        "{key}: expected a string ({})",
+                        afmdyn::contact::LawKind::EXPECTED
                     ))
                 })?;
                 m.contact_law = Some(
@@ -209,9 +213,10 @@ pub fn resolve(
 /// ``beam_damping``/``alpha3`` (α3 ≥ 0), ``contact_stiffness``/``alpha4`` (α4 ≥ 0),
 /// ``gap``/``alpha5`` (α5, finite), ``contact_damping``/``alpha6`` (α6 ≥ 0), ``omega``
 /// (Ω > 0), ``contact_law`` (``"linear"``, ``"hertz"``, ``"dmt"``, ``"electrostatic"``,
-/// ``"jkr"``, ``"impact"``) with its groups ``restitution`` (0..=1, impact), ``hamaker``
+/// ``"jkr"``, ``"capillary"``, ``"impact"``) with its groups ``restitution`` (0..=1, impact), ``hamaker``
 /// (≥ 0) and ``intermolecular_distance`` (> 0, DMT and electrostatic), ``electrostatic``
 /// (Ẽ ≥ 0) and ``tip_radius`` (R̃ > 0, electrostatic), ``adhesion`` (P̃ > 0, JKR),
+/// ``capillary`` (F̃_cap > 0), ``meniscus`` (h̃) and ``rupture`` (D̃_r, capillary),
 /// ``excitation`` (``"base"``, ``"tip"``: where the
 /// drive acts on the beam). Missing ones take the paper's Figs. 5–14 set (N = 3, α1 = α2 = α3 = 0.1, α4 = 20,
 /// α5 = 0, α6 = 0.2, Ω = 2.6). The names, ranges and help are the library's one table
@@ -342,7 +347,7 @@ impl PyParams {
         self.inner.omega
     }
     /// The tip–sample law: ``"linear"``, ``"hertz"``, ``"dmt"``, ``"electrostatic"``,
-    /// ``"jkr"`` or ``"impact"``.
+    /// ``"jkr"``, ``"capillary"`` or ``"impact"``.
     #[getter]
     fn contact_law(&self) -> &'static str {
         self.inner.contact_law.name()
@@ -397,6 +402,33 @@ impl PyParams {
     fn adhesion(&self) -> Option<f64> {
         match self.inner.contact_law {
             afmdyn::ContactLaw::Jkr { adhesion } => Some(adhesion),
+            _ => None,
+        }
+    }
+    /// Capillary law: the meniscus's force at contact F̃_cap = 4πRγcosθ/F (``None`` for the
+    /// other laws).
+    #[getter]
+    fn capillary(&self) -> Option<f64> {
+        match self.inner.contact_law {
+            afmdyn::ContactLaw::Capillary { capillary, .. } => Some(capillary),
+            _ => None,
+        }
+    }
+    /// Capillary law: the meniscus's immersion at contact h̃ = √(V/(πR))/g₀ (``None`` for the
+    /// other laws).
+    #[getter]
+    fn meniscus(&self) -> Option<f64> {
+        match self.inner.contact_law {
+            afmdyn::ContactLaw::Capillary { meniscus, .. } => Some(meniscus),
+            _ => None,
+        }
+    }
+    /// Capillary law: the rupture distance D̃_r = (1 + θ/2)V^{1/3}/g₀ (``None`` for the other
+    /// laws).
+    #[getter]
+    fn rupture(&self) -> Option<f64> {
+        match self.inner.contact_law {
+            afmdyn::ContactLaw::Capillary { rupture, .. } => Some(rupture),
             _ => None,
         }
     }

@@ -203,6 +203,14 @@ def test_contact_law_keywords_resolve_as_on_the_command_line(cli_json):
         Params(contact_law="hertz", adhesion=0.1)
     with pytest.raises(ValueError, match="adhesion"):
         Params(contact_law="jkr", adhesion=0.0)
+    # the capillary meniscus: its three groups with their defaults, as on the command line
+    c = Params(contact_law="capillary", rupture=0.04)
+    assert (c.capillary, c.meniscus, c.rupture) == (0.1, 0.01, 0.04)
+    assert c.to_dict() == cli_json("modes", "--contact-law", "capillary", "--rupture", "0.04")[
+        "params"
+    ]
+    with pytest.raises(ValueError, match="meniscus is a group of the capillary law"):
+        Params(contact_law="dmt", meniscus=0.01)
 
 
 def test_every_law_runs_from_python_as_on_the_command_line(cli_json):
@@ -212,6 +220,7 @@ def test_every_law_runs_from_python_as_on_the_command_line(cli_json):
         ("dmt", {}),
         ("electrostatic", {"electrostatic": 2e-3, "tip_radius": 0.5}),
         ("jkr", {"adhesion": 0.02}),
+        ("capillary", {"capillary": 0.05, "rupture": 0.04}),
         ("impact", {"restitution": 0.5}),
     ]:
         model = {"contact_law": law, "modes": 1, "omega": 3.0, "gap": 0.05, **extra}

@@ -382,7 +382,8 @@ impl CantileverModel {
         self.jacobian_parts(r, tau, self.base_trig(tau), z, jac, true);
     }
 
-    /// The Kelvin–Voigt weight w = α6 √δ of DMT (and the electrostatic law) in contact (0 elsewhere): its τ-derivative
+    /// The Kelvin–Voigt weight w = α6 √δ of DMT (and the electrostatic and capillary laws) in
+    /// contact (0 elsewhere): its τ-derivative
     /// α6 δ̇/(2√δ) is the singular part of ∂F_c/∂δ at contact onset.
     fn kelvin_voigt_weight(&self, r: Region, tau: f64, z: &[f64]) -> f64 {
         self.kelvin_voigt_weight_at(r, self.base_trig(tau), z)
@@ -393,7 +394,9 @@ impl CantileverModel {
         if r != Region::Contact
             || !matches!(
                 self.law.law,
-                ContactLaw::Dmt { .. } | ContactLaw::Electrostatic { .. }
+                ContactLaw::Dmt { .. }
+                    | ContactLaw::Electrostatic { .. }
+                    | ContactLaw::Capillary { .. }
             )
         {
             return 0.0;

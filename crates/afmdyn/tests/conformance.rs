@@ -1,6 +1,6 @@
 //! One conformance suite over every integrator × contact law pair (exact, rk4, rk4-naive,
-//! adaptive, split, taylor × linear, Hertz, DMT, electrostatic, JKR, impact): the support
-//! table (every
+//! adaptive, split, taylor × linear, Hertz, DMT, electrostatic, JKR, capillary, impact): the
+//! support table (every
 //! unsupported pair is refused with [`SimError::Unsupported`] naming the integrator), and for
 //! every supported pair the identities an integrator of the switched model must satisfy:
 //!
@@ -41,7 +41,23 @@ const ES: ContactLaw = ContactLaw::Electrostatic {
 /// JKR at its default adhesion: a hysteretic region (the neck, left at V_T = |δ_b|).
 const JKR: ContactLaw = ContactLaw::Jkr { adhesion: 0.05 };
 
-const LAWS: [ContactLaw; 6] = [ContactLaw::Linear, ContactLaw::Hertz, DMT, ES, JKR, IMPACT];
+/// The capillary meniscus at its defaults: hysteretic too (left at V_T = D̃_r), with a kink
+/// in the force inside its region (at V_T = 0).
+const CAP: ContactLaw = ContactLaw::Capillary {
+    capillary: 0.1,
+    meniscus: 0.01,
+    rupture: 0.05,
+};
+
+const LAWS: [ContactLaw; 7] = [
+    ContactLaw::Linear,
+    ContactLaw::Hertz,
+    DMT,
+    ES,
+    JKR,
+    CAP,
+    IMPACT,
+];
 
 const KINDS: [IntegratorKind; 6] = [
     IntegratorKind::Exact,
@@ -71,15 +87,16 @@ fn supported(kind: IntegratorKind, law: ContactLaw) -> bool {
         law.restitution().is_some(),
         matches!(law, ContactLaw::Dmt { .. }),
         matches!(law, ContactLaw::Electrostatic { .. }),
-        matches!(law, ContactLaw::Jkr { .. }),
+        matches!(law, ContactLaw::Jkr { .. } | ContactLaw::Capillary { .. }),
     );
     match kind {
         IntegratorKind::Auto | IntegratorKind::Adaptive => true,
         IntegratorKind::Exact => linear,
-        // JKR's region depends on the history (the neck), not on the sign of V_T alone
+        // JKR's and the meniscus's region depends on the history (the neck, the meniscus), not
+        // on the sign of V_T alone
         IntegratorKind::Rk4 | IntegratorKind::Rk4Naive => !impact && !jkr,
         // the electrostatic force acts in free flight, and is not in the Taylor recurrences,
-        // nor is JKR's implicit contact radius
+        // nor are JKR's implicit contact radius and the meniscus's √(D² + h²)
         IntegratorKind::Split => !dmt && !es,
         IntegratorKind::Taylor => !linear && !impact && !es && !jkr,
     }

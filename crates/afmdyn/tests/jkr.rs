@@ -14,15 +14,14 @@
 //! * the region's hysteresis: the contact forms at V_T = 0 and breaks at V_T = |δ_b|;
 //! * the Tabor parameter names JKR's regime, and a JKR probe in DMT's regime is warned.
 
-use afmdyn::analysis::observables::{observe, ObservableOptions};
-use afmdyn::analysis::shooting::{shoot, ShootingOptions};
 use afmdyn::contact::{Jkr, TipSample, TipSampleLaw, JKR_BREAK_CUT};
-use afmdyn::integrate::{build, IntegratorOptions};
 use afmdyn::probe::Probe;
-use afmdyn::trajectory::{record, RecordSpec};
-use afmdyn::{CantileverModel, ContactLaw, EventKind, Params, Region};
+use afmdyn::{CantileverModel, ContactLaw, Params, Region};
 use nalgebra::DVector;
 use std::f64::consts::PI;
+
+mod common;
+use common::{gauss_legendre, hysteretic_tap};
 
 /// A soft lever over a compliant, adhesive polymer: R = 10 nm, E_s = 50 MPa, W = 0.05 J/m².
 const R: f64 = 10e-9;
@@ -187,31 +186,6 @@ fn hysteresis_energy_is_the_closed_form() {
     assert!((si / want - 1.0).abs() < 1e-12, "{si} vs {want}");
 }
 
-/// Gauss–Legendre nodes and weights on [−1, 1] (Newton on P_n from Chebyshev guesses).
-fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
-    (0..n)
-        .map(|i| {
-            let mut x = (PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
-            let mut dp = 0.0;
-            for _ in 0..100 {
-                let (mut p0, mut p1) = (1.0, x);
-                for k in 2..=n {
-                    let p2 = ((2 * k - 1) as f64 * x * p1 - (k - 1) as f64 * p0) / k as f64;
-                    p0 = p1;
-                    p1 = p2;
-                }
-                dp = n as f64 * (x * p1 - p0) / (x * x - 1.0);
-                let dx = p1 / dp;
-                x -= dx;
-                if dx.abs() < 1e-16 {
-                    break;
-                }
-            }
-            (x, 2.0 / ((1.0 - x * x) * dp * dp))
-        })
-        .collect()
-}
-
 /// The dimensionless beam (N = 2, Ω = 2.8, the default JKR adhesion) without the sample's
 /// viscous damping: a period-1 orbit with one tap.
 fn tapping_model() -> CantileverModel {
@@ -232,61 +206,7 @@ fn tapping_model() -> CantileverModel {
 #[test]
 fn a_tap_dissipates_the_hysteresis_energy() {
     let m = tapping_model();
-    let jkr = Jkr::new(20.0, 0.05);
-    let mut it = build(&m, IntegratorOptions::default(), 0.0, &m.rest()).unwrap();
-    let warm = record(
-        it.as_mut(),
-        &RecordSpec {
-            transient_periods: 300.0,
-            record_tau: 0.0,
-            samples_per_period: 0,
-            energy: false,
-            body_contact: false,
-        },
-    )
-    .unwrap();
-    let o = shoot(&m, &warm.final_state, 1, &ShootingOptions::default()).unwrap();
-    assert!(o.stable);
-    let mut it = build(&m, IntegratorOptions::default(), 0.0, &o.state).unwrap();
-    let obs = observe(it.as_mut(), &ObservableOptions::default()).unwrap();
-    let e = jkr.hysteresis();
-    assert!(
-        (obs.energy_dissipated / e - 1.0).abs() < 1e-8,
-        "E_dis {} vs E_hys {e}",
-        obs.energy_dissipated
-    );
-    // the events of 5 periods: contact formed at V_T = 0, broken at V_T = |δ_b|
-    let mut it = build(&m, IntegratorOptions::default(), 0.0, &o.state).unwrap();
-    let tr = record(
-        it.as_mut(),
-        &RecordSpec {
-            transient_periods: 0.0,
-            record_tau: 5.0 * m.period(),
-            samples_per_period: 16,
-            energy: true,
-            body_contact: false,
-        },
-    )
-    .unwrap();
-    assert_eq!(tr.events.len(), 10);
-    for ev in &tr.events {
-        assert_eq!(ev.kind, EventKind::Switching);
-        let v = m.v_t(ev.tau, &ev.state);
-        let want = if ev.to == Region::Contact {
-            0.0
-        } else {
-            -jkr.release()
-        };
-        assert!((v - want).abs() < 1e-10, "{:?}: V_T {v} vs {want}", ev.to);
-    }
-    for b in &tr.energy {
-        assert!(b.residual().abs() < 1e-9 * e, "residual {}", b.residual());
-        assert!(
-            (b.contact_dissipation / e - 1.0).abs() < 1e-7,
-            "{} vs {e}",
-            b.contact_dissipation
-        );
-    }
+    hysteretic_tap(&m, Jkr::new(20.0, 0.05).hysteresis());
 }
 
 /// A start in the band 0 < V_T < |δ_b| is in contact when the tip leaves the sample (through its

@@ -33,10 +33,12 @@ class Params:
     ``drive_amplitude``/``alpha2`` (≥ 0), ``beam_damping``/``alpha3`` (≥ 0),
     ``contact_stiffness``/``alpha4`` (≥ 0), ``gap``/``alpha5`` (finite),
     ``contact_damping``/``alpha6`` (≥ 0), ``omega`` (Ω > 0), ``contact_law`` (``"linear"``,
-    ``"hertz"``, ``"dmt"``, ``"electrostatic"``, ``"jkr"``, ``"impact"``) with its groups
+    ``"hertz"``, ``"dmt"``, ``"electrostatic"``, ``"jkr"``, ``"capillary"``, ``"impact"``) with
+    its groups
     ``restitution`` (0..=1, impact), ``hamaker`` (≥ 0) and ``intermolecular_distance`` (> 0,
     DMT and electrostatic), ``electrostatic`` (Ẽ ≥ 0) and ``tip_radius`` (R̃ > 0,
-    electrostatic), ``adhesion`` (P̃ = πWR > 0, JKR),
+    electrostatic), ``adhesion`` (P̃ = πWR > 0, JKR), ``capillary`` (F̃_cap > 0), ``meniscus``
+    (h̃) and ``rupture`` (D̃_r, capillary),
     ``excitation`` (``"base"``, ``"tip"``: where the drive acts on the beam); the others keep
     the paper's
     Figs. 5–14 set. Raises ``ValueError`` (field and range) or ``TypeError`` (unknown keyword,
@@ -60,7 +62,7 @@ class Params:
         contact_damping: float = ...,
         alpha6: float = ...,
         omega: float = ...,
-        contact_law: Literal["linear", "hertz", "dmt", "electrostatic", "jkr", "impact"] = ...,
+        contact_law: Literal["linear", "hertz", "dmt", "electrostatic", "jkr", "capillary", "impact"] = ...,
         excitation: Literal["base", "tip"] = ...,
         restitution: float = ...,
         hamaker: float = ...,
@@ -68,6 +70,9 @@ class Params:
         electrostatic: float = ...,
         tip_radius: float = ...,
         adhesion: float = ...,
+        capillary: float = ...,
+        meniscus: float = ...,
+        rupture: float = ...,
     ) -> None: ...
     def replace(
         self,
@@ -86,7 +91,7 @@ class Params:
         contact_damping: float = ...,
         alpha6: float = ...,
         omega: float = ...,
-        contact_law: Literal["linear", "hertz", "dmt", "electrostatic", "jkr", "impact"] = ...,
+        contact_law: Literal["linear", "hertz", "dmt", "electrostatic", "jkr", "capillary", "impact"] = ...,
         excitation: Literal["base", "tip"] = ...,
         restitution: float = ...,
         hamaker: float = ...,
@@ -94,6 +99,9 @@ class Params:
         electrostatic: float = ...,
         tip_radius: float = ...,
         adhesion: float = ...,
+        capillary: float = ...,
+        meniscus: float = ...,
+        rupture: float = ...,
     ) -> "Params":
         """A validated copy with the given keywords changed."""
     @staticmethod
@@ -126,7 +134,7 @@ class Params:
     @property
     def omega(self) -> float: ...
     @property
-    def contact_law(self) -> Literal["linear", "hertz", "dmt", "electrostatic", "jkr", "impact"]: ...
+    def contact_law(self) -> Literal["linear", "hertz", "dmt", "electrostatic", "jkr", "capillary", "impact"]: ...
     @property
     def restitution(self) -> Optional[float]: ...
     @property
@@ -141,6 +149,12 @@ class Params:
     def tip_radius(self) -> Optional[float]: ...
     @property
     def adhesion(self) -> Optional[float]: ...
+    @property
+    def capillary(self) -> Optional[float]: ...
+    @property
+    def meniscus(self) -> Optional[float]: ...
+    @property
+    def rupture(self) -> Optional[float]: ...
     @property
     def tip_mass_ratio(self) -> float: ...
     @property

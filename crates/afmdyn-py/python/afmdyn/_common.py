@@ -74,7 +74,7 @@ class Model(TypedDict, total=False):
     contact_damping: float
     alpha6: float
     omega: float
-    contact_law: Literal["linear", "hertz", "dmt", "electrostatic", "jkr", "impact"]
+    contact_law: Literal["linear", "hertz", "dmt", "electrostatic", "jkr", "capillary", "impact"]
     excitation: Literal["base", "tip"]
     restitution: float
     hamaker: float
@@ -82,6 +82,9 @@ class Model(TypedDict, total=False):
     electrostatic: float
     tip_radius: float
     adhesion: float
+    capillary: float
+    meniscus: float
+    rupture: float
     z_c: float
     drive_frequency: float
     probe: Union[str, "os.PathLike[str]", Dict[str, Any]]

@@ -103,7 +103,7 @@ impl IntegratorKind {
     /// affine (linear-law) model (under a multifrequency drive,
     /// [`crate::params::Params::drive_components`], to `Taylor` for Hertz and DMT and to
     /// `Adaptive` for the others), to `Split` for a law without force in free flight (Hertz,
-    /// JKR, impact with r > 0), to `Adaptive` for the plastic impact law r = 0 (whose free flights
+    /// JKR, capillary, impact with r > 0), to `Adaptive` for the plastic impact law r = 0 (whose free flights
     /// all start tangentially) and for the electrostatic law, and to `Taylor` for DMT; other
     /// kinds are returned as given.
     /// ([`build`] falls back from `Split` to `Adaptive` for `Auto` where the exact free flight

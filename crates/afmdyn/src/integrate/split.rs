@@ -1,5 +1,6 @@
 //! The split integrator: exact propagation of the free flight, the adaptive integrator only in
-//! contact — for the laws that exert no force outside contact (linear, Hertz, JKR, impact).
+//! contact — for the laws that exert no force outside contact (linear, Hertz, JKR, capillary,
+//! impact).
 //!
 //! While V_T > 0 the Hertz and impact laws, like the linear one, exert no force, so the free
 //! flight is region I of eq. 10, ż = A_I z + b_I(τ), and [`ExactPropagator`] propagates it
@@ -10,7 +11,8 @@
 //! [`crate::model`]). The contact flow is integrated until it ends in a switching or release,
 //! where the exact free flight takes over again: the Hertz force α4 δ^{3/2} + α6 δ̇ by the
 //! Taylor integrator ([`Taylor`], in the regularising time of the contact, where the force is a
-//! polynomial), the linear law's and JKR's contact (left at the neck's break, V_T = |δ_f|) and
+//! polynomial), the linear law's, JKR's (left at the neck's break, V_T = |δ_f|) and the
+//! capillary meniscus's contact (left where it ruptures, V_T = D̃_r) and
 //! the impact law's sticking by [`Adaptive`] (DOP853 with events and the variational
 //! equations).
 //!

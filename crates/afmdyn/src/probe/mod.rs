@@ -16,12 +16,15 @@
 //! youngs_modulus = 130e9         # E_t (Pa), default 130e9 (silicon, Hopcroft et al. 2010)
 //! poisson_ratio = 0.27           # ν_t, default 0.28 (silicon)
 //! [sample]
-//! law = "dmt"                    # linear | hertz | dmt | electrostatic | jkr | impact
+//! law = "dmt"                    # linear | hertz | dmt | electrostatic | jkr | capillary | impact
 //! youngs_modulus = 4e9           # E_s (Pa)            (hertz, dmt)
 //! poisson_ratio = 0.33           # ν_s                 (hertz, dmt)
 //! hamaker = 6.6e-20              # H (J)               (dmt; jkr: W = H/(12πa₀²) if no
 //!                                #                      adhesion_energy)
 //! # adhesion_energy = 0.05       # W (J/m²), work of adhesion (jkr)
+//! # meniscus_volume = 1e-25      # V (m³), the water meniscus (capillary; with
+//! # surface_tension = 0.072      #   γ (N/m), default water's, and
+//! # contact_angle = 20           #   θ (degrees), default 0)
 //! intermolecular_distance = 0.165e-9  # a₀ (m), default 0.165e-9 (Israelachvili) (dmt)
 //! viscosity = 0.0                # η (Pa·s), Kelvin–Voigt −η√(R(a₀ − d))·ḋ (dmt)
 //! # hertz: damping (N·s/m); linear: stiffness (N/m), damping (N·s/m); impact: restitution
@@ -89,6 +92,11 @@
 //!   P̃ = πWR/F_s from the work of adhesion W (`adhesion_energy`, or H/(12πa₀²) from `hamaker`
 //!   and `intermolecular_distance`, Israelachvili 2011 §13.6), α6 as DMT's (the Kelvin–Voigt
 //!   term η a δ̇ with the contact radius a);
+//! * capillary (a meniscus formed at contact, ruptured at D_r; Zitzler, Herminghaus & Mugele,
+//!   *Phys. Rev. B* 66 (2002) 155436; [`crate::contact`]): α4 and α6 as DMT's, from
+//!   `meniscus_volume` V, `surface_tension` γ (default 0.072 N/m, water at 25 °C) and
+//!   `contact_angle` θ (degrees, default 0) F̃_cap = 4πRγcosθ/F_s, h̃ = √(V/(πR))/g₀ and
+//!   D̃_r = (1 + θ/2)V^{1/3}/g₀ (Lian, Thornton & Adams 1993);
 //! * impact: the restitution r.
 //!
 //! The rest distance z_c sets α5 = z_c/g₀ − ã₀ (DMT) or z_c/g₀ ([`crate::Params::rest_distance`]).
@@ -277,6 +285,10 @@ pub const TABOR_JKR: f64 = 5.0;
 /// Below this Tabor parameter the contact is DMT's (Johnson & Greenwood 1997).
 pub const TABOR_DMT: f64 = 0.1;
 
+/// The surface tension of water at 25 °C, 0.07197 N/m (CRC Handbook of Chemistry and Physics,
+/// 97th ed. 2016, "Surface tension of common liquids"): the capillary law's default.
+pub const WATER_SURFACE_TENSION: f64 = 0.07197;
+
 /// The work of adhesion W = H/(12πz₀²) (J/m²) from the Hamaker constant H (J) at the
 /// equilibrium separation z₀ (m) (Israelachvili, *Intermolecular and Surface Forces*, 3rd ed.
 /// 2011, §13.6).
@@ -429,6 +441,8 @@ struct Sample {
     voltage: Option<f64>,
     /// JKR's work of adhesion W (J/m²).
     adhesion_energy: Option<f64>,
+    /// The capillary meniscus: volume V (m³), surface tension γ (N/m), contact angle θ (rad).
+    meniscus: Option<(f64, f64, f64)>,
     z_c: Option<f64>,
 }
 
@@ -1096,7 +1110,7 @@ impl Probe {
             Some((_, l))
                 if matches!(
                     l.as_str(),
-                    "linear" | "hertz" | "dmt" | "electrostatic" | "jkr" | "impact"
+                    "linear" | "hertz" | "dmt" | "electrostatic" | "jkr" | "capillary" | "impact"
                 ) =>
             {
                 Some(l)
@@ -1134,12 +1148,23 @@ impl Probe {
             .chain(["bias_voltage", "contact_potential"])
             .collect();
         let jkr: Vec<&str> = DMT.iter().copied().chain(["adhesion_energy"]).collect();
+        const CAPILLARY: [&str; 8] = [
+            "law",
+            "youngs_modulus",
+            "poisson_ratio",
+            "viscosity",
+            "meniscus_volume",
+            "surface_tension",
+            "contact_angle",
+            "z_c",
+        ];
         let keys: &[&str] = match law.as_str() {
             "linear" => &["law", "stiffness", "damping", "z_c"],
             "hertz" => &["law", "youngs_modulus", "poisson_ratio", "damping", "z_c"],
             "dmt" => &DMT,
             "electrostatic" => &electrostatic,
             "jkr" => &jkr,
+            "capillary" => &CAPILLARY,
             _ => &["law", "restitution", "z_c"],
         };
         r.unknown(s, S, keys);
@@ -1156,6 +1181,7 @@ impl Probe {
             restitution: None,
             voltage: None,
             adhesion_energy: None,
+            meniscus: None,
             z_c,
         };
         match law.as_str() {
@@ -1189,6 +1215,19 @@ impl Probe {
         }
         if law == "hertz" {
             out.damping = r.optional(s, S, "damping", "N s/m", NON_NEGATIVE);
+        } else if law == "capillary" {
+            let volume = r.required(s, S, "meniscus_volume", "m^3", POSITIVE);
+            let gamma = r
+                .optional(s, S, "surface_tension", "N/m", POSITIVE)
+                .or(Some(WATER_SURFACE_TENSION));
+            let theta = r
+                .optional(s, S, "contact_angle", "degree", WETTING_ANGLE)
+                .or(Some(0.0));
+            out.viscosity = r.optional(s, S, "viscosity", "Pa s", NON_NEGATIVE);
+            if let (Some(v), Some(g), Some(t)) = (volume, gamma, theta) {
+                out.meniscus = Some((v, g, t.to_radians()));
+            }
+            out.meniscus?;
         } else {
             // JKR: the work of adhesion W, or H/(12πa₀²) from the Hamaker constant
             out.hamaker = if law == "jkr" {
@@ -1428,12 +1467,32 @@ impl Probe {
                 alpha4 = sample.stiffness.unwrap_or(0.0) * g0 / force_n;
                 alpha6 = sample.damping.unwrap_or(0.0) * g0 / (t_s * force_n);
             }
-            "hertz" | "dmt" | "electrostatic" | "jkr" => {
+            "hertz" | "dmt" | "electrostatic" | "jkr" | "capillary" => {
                 let (e, rr) = (sample.e_star.unwrap_or(0.0), sample.radius.unwrap_or(0.0));
                 alpha4 = 4.0 / 3.0 * e * rr.sqrt() * g0.powf(1.5) / force_n;
                 if sample.law == "hertz" {
                     law = ContactLaw::Hertz;
                     alpha6 = sample.damping.unwrap_or(0.0) * g0 / (t_s * force_n);
+                } else if let Some((v, gamma, theta)) = sample.meniscus {
+                    // the meniscus reaches r₁² = 2Rh on the sphere: within its cap, h ≤ R/2
+                    let h = (v / (std::f64::consts::PI * rr)).sqrt();
+                    if h > 0.5 * rr {
+                        return Err(format!(
+                            "[sample].meniscus_volume = {v:e} m^3 wets the tip beyond its apex \
+                             (immersion √(V/(πR)) = {h:.3e} m > R/2 = {:.3e} m): the sphere–flat \
+                             meniscus needs V ≤ πR³/4 = {:.3e} m^3",
+                            0.5 * rr,
+                            0.25 * std::f64::consts::PI * rr.powi(3)
+                        ));
+                    }
+                    // F̃_cap = 4πRγcosθ/F_s, h̃ = √(V/(πR))/g₀, D̃_r = (1 + θ/2)V^{1/3}/g₀
+                    law = ContactLaw::Capillary {
+                        capillary: 4.0 * std::f64::consts::PI * rr * gamma * theta.cos() / force_n,
+                        meniscus: h / g0,
+                        rupture: (1.0 + 0.5 * theta) * v.cbrt() / g0,
+                    };
+                    alpha6 =
+                        sample.viscosity.unwrap_or(0.0) * (rr * g0).sqrt() * g0 / (t_s * force_n);
                 } else if sample.law == "jkr" {
                     // P̃ = πWR/F_s; the Kelvin–Voigt term η a δ̇ = η √(Rh) δ̇ as DMT's
                     law = ContactLaw::Jkr {

@@ -194,3 +194,8 @@ pub(super) const QUALITY: (&str, fn(f64) -> bool) =
 pub(super) const UNIT_INTERVAL: (&str, fn(f64) -> bool) =
     ("in [0, 1]", |x| (0.0..=1.0).contains(&x));
 pub(super) const ANY: (&str, fn(f64) -> bool) = ("finite", |_| true);
+/// A contact angle of a wetting liquid (degrees): cos θ > 0.
+pub(super) const WETTING_ANGLE: (&str, fn(f64) -> bool) =
+    ("in [0, 90) degrees (a wetting meniscus)", |x| {
+        (0.0..90.0).contains(&x)
+    });

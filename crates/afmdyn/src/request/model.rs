@@ -76,7 +76,7 @@ const fn info(
 /// Every model parameter a request takes, in the order the front ends list them. The ranges
 /// are those [`Params::validate`] and [`ContactLaw::validate`] enforce; `z_c` and
 /// `drive_frequency` are SI values that need a probe file.
-pub const MODEL_PARAMETERS: [ParamInfo; 18] = [
+pub const MODEL_PARAMETERS: [ParamInfo; 21] = [
     info(
         "modes",
         None,
@@ -162,11 +162,12 @@ pub const MODEL_PARAMETERS: [ParamInfo; 18] = [
         None,
         "F_c",
         "1",
-        "linear, hertz, dmt, electrostatic, jkr or impact",
+        "linear, hertz, dmt, electrostatic, jkr, capillary or impact",
         "linear",
         "tip–sample law: linear (α4 δ + α6 δ̇), hertz (α4 δ^1.5 + α6 δ̇), dmt (van der Waals + \
          adhesion + Hertz + α6 √δ δ̇), electrostatic (dmt + a biased tip), jkr (adhesive Hertz \
-         contact with a neck, formed at δ = 0, broken at δ_f < 0) or impact (rigid sample, \
+         contact with a neck, formed at δ = 0, broken at δ_f < 0), capillary (a meniscus formed \
+         at contact, ruptured at V_T = D_r, over a Hertz sample) or impact (rigid sample, \
          restitution r)",
         ValueKind::Law,
     ),
@@ -239,6 +240,36 @@ pub const MODEL_PARAMETERS: [ParamInfo; 18] = [
         "> 0",
         "0.05",
         "jkr law: adhesion group P̃ = πWR/F (W the work of adhesion): pull-off (3/2)P̃",
+        ValueKind::Real,
+    ),
+    info(
+        "capillary",
+        None,
+        "F̃_cap",
+        "1",
+        "> 0",
+        "0.1",
+        "capillary law: the meniscus's force at contact F̃_cap = 4πRγcosθ/F",
+        ValueKind::Real,
+    ),
+    info(
+        "meniscus",
+        None,
+        "h̃",
+        "1",
+        "1e-9..=1e6",
+        "0.01",
+        "capillary law: the meniscus's immersion at contact h̃ = √(V/(πR))/g0 (V its volume)",
+        ValueKind::Real,
+    ),
+    info(
+        "rupture",
+        None,
+        "D̃_r",
+        "1",
+        "1e-9..=1e6",
+        "0.05",
+        "capillary law: the rupture distance D̃_r = (1 + θ/2)V^(1/3)/g0 (Lian et al. 1993)",
         ValueKind::Real,
     ),
     info(
@@ -339,6 +370,15 @@ pub struct ModelSpec {
     /// JKR law: P̃.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub adhesion: Option<f64>,
+    /// Capillary law: F̃_cap.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub capillary: Option<f64>,
+    /// Capillary law: h̃.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub meniscus: Option<f64>,
+    /// Capillary law: D̃_r.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rupture: Option<f64>,
     /// With a probe: z_c in m.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub z_c: Option<f64>,
@@ -369,6 +409,9 @@ impl ModelSpec {
             electrostatic: self.electrostatic.or(lower.electrostatic),
             tip_radius: self.tip_radius.or(lower.tip_radius),
             adhesion: self.adhesion.or(lower.adhesion),
+            capillary: self.capillary.or(lower.capillary),
+            meniscus: self.meniscus.or(lower.meniscus),
+            rupture: self.rupture.or(lower.rupture),
             z_c: self.z_c.or(lower.z_c),
             drive_frequency: self.drive_frequency.or(lower.drive_frequency),
         }
@@ -396,6 +439,9 @@ impl ModelSpec {
             ("electrostatic", self.electrostatic),
             ("tip_radius", self.tip_radius),
             ("adhesion", self.adhesion),
+            ("capillary", self.capillary),
+            ("meniscus", self.meniscus),
+            ("rupture", self.rupture),
             ("z_c", self.z_c),
             ("drive_frequency", self.drive_frequency),
         ];
@@ -430,6 +476,9 @@ impl ModelSpec {
                 electrostatic: self.electrostatic,
                 tip_radius: self.tip_radius,
                 adhesion: self.adhesion,
+                capillary: self.capillary,
+                meniscus: self.meniscus,
+                rupture: self.rupture,
             },
             base.contact_law,
         )?;
@@ -526,7 +575,7 @@ impl ModelSpec {
 /// Hamaker constant in J): the value's name and what to give instead. `modes` and
 /// `restitution` (pure numbers, the same in SI) and the SI values `z_c` and `drive_frequency`
 /// are taken with a probe.
-pub const PROBE_SETS: [(&str, &str); 14] = [
+pub const PROBE_SETS: [(&str, &str); 17] = [
     (
         "tip_mass_ratio",
         "is the dimensionless α1 and a probe sets it: give it in the probe file's [cantilever] \
@@ -597,6 +646,21 @@ pub const PROBE_SETS: [(&str, &str); 14] = [
         "is the dimensionless P̃ and a probe sets it: give the work of adhesion in the probe \
          file's [sample] adhesion_energy (J/m², law = \"jkr\")",
     ),
+    (
+        "capillary",
+        "is the dimensionless F̃_cap and a probe sets it: give the probe file's [sample] \
+         surface_tension (N/m) and contact_angle (degrees) (law = \"capillary\")",
+    ),
+    (
+        "meniscus",
+        "is the dimensionless h̃ and a probe sets it: give the probe file's [sample] \
+         meniscus_volume (m³, law = \"capillary\")",
+    ),
+    (
+        "rupture",
+        "is the dimensionless D̃_r and a probe sets it: give the probe file's [sample] \
+         meniscus_volume (m³) and contact_angle (degrees) (law = \"capillary\")",
+    ),
 ];
 
 impl ModelSpec {
@@ -617,6 +681,9 @@ impl ModelSpec {
             ("tip_radius", self.tip_radius),
             ("excitation", None),
             ("adhesion", self.adhesion),
+            ("capillary", self.capillary),
+            ("meniscus", self.meniscus),
+            ("rupture", self.rupture),
         ];
         for ((name, value), (key, allowed)) in given.into_iter().zip(PROBE_SETS) {
             debug_assert_eq!(name, key);
@@ -707,6 +774,9 @@ mod tests {
             electrostatic: Some(0.0),
             tip_radius: Some(1.0),
             adhesion: Some(1.0),
+            capillary: Some(1.0),
+            meniscus: Some(1.0),
+            rupture: Some(1.0),
             z_c: Some(0.0),
             drive_frequency: Some(1.0),
         };

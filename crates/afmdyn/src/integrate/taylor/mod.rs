@@ -168,8 +168,8 @@ impl Taylor {
                     }
                     _ => {
                         "this law's force is not in the Taylor recurrences (the electrostatic \
-                         1/(d(d + R)), JKR's implicit contact radius): use integrator = \
-                         \"auto\" (or \"adaptive\")"
+                         1/(d(d + R)), JKR's implicit contact radius, the capillary meniscus's \
+                         √(D² + h²)): use integrator = \"auto\" (or \"adaptive\")"
                     }
                 },
             });

@@ -457,7 +457,8 @@ impl Jet {
             ContactLaw::Linear
             | ContactLaw::Impact { .. }
             | ContactLaw::Electrostatic { .. }
-            | ContactLaw::Jkr { .. } => return None,
+            | ContactLaw::Jkr { .. }
+            | ContactLaw::Capillary { .. } => return None,
         };
         let n = model.modes();
         let free = model.dynamics(Region::Free);
