@@ -820,3 +820,64 @@ fn contact_force_sign_in_data_matches_its_documentation() {
     assert!(!row.contains("F_c < 0 pushes"), "{row}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Every example probe file (`examples/probe-*.toml`) loads, and the adhesive-hysteresis examples run an approach curve
+/// from the file as they stand: the JKR polymer and the capillary meniscus lose energy on the
+/// taps (E_dis > 0 somewhere) and pull with their closed-form forces (the JKR pull-off
+/// (3/2)πWR = 2.36 nN, the meniscus's 4πRγcosθ = 8.50 nN as the most attractive force).
+#[test]
+fn every_example_probe_loads_and_the_hysteretic_ones_approach() {
+    let mut n = 0;
+    for entry in std::fs::read_dir(repo().join("examples")).unwrap() {
+        let path = entry.unwrap().path();
+        let name = path.file_name().unwrap().to_string_lossy().to_string();
+        // (examples/probe.toml is the `units --config` format, not a probe file)
+        if name.starts_with("probe-") && name.ends_with(".toml") {
+            afmdyn::probe::Probe::load(&path).unwrap_or_else(|e| panic!("{name}: {e}"));
+            n += 1;
+        }
+    }
+    assert!(n >= 9, "{n} probe files");
+    let pi = std::f64::consts::PI;
+    for (file, law, pull) in [
+        (
+            "examples/probe-jkr-polymer.toml",
+            "jkr",
+            1.5 * pi * 0.05 * 10e-9,
+        ),
+        (
+            "examples/probe-capillary-humid.toml",
+            "capillary",
+            4.0 * pi * 10e-9 * 0.072 * 20f64.to_radians().cos(),
+        ),
+    ] {
+        let doc = json(&[
+            "approach",
+            "--probe",
+            file,
+            "--points",
+            "16",
+            "--no-branches",
+            "--json",
+        ]);
+        assert_eq!(doc["params"]["contact_law"]["law"], law);
+        let a = &doc["approach"];
+        let col = |k: &str| -> Vec<f64> {
+            a[k].as_array()
+                .unwrap()
+                .iter()
+                .map(|v| v.as_f64().unwrap())
+                .collect()
+        };
+        assert!(
+            col("energy_dissipated").iter().any(|&e| e > 1e-19),
+            "{file}"
+        );
+        let most = col("min_force").into_iter().fold(0.0f64, f64::min);
+        assert!(
+            (most / -pull - 1.0).abs() < 1e-3,
+            "{file}: {most} vs {}",
+            -pull
+        );
+    }
+}
