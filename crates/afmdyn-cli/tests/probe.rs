@@ -824,7 +824,8 @@ fn contact_force_sign_in_data_matches_its_documentation() {
 /// Every example probe file (`examples/probe-*.toml`) loads, and the adhesive-hysteresis examples run an approach curve
 /// from the file as they stand: the JKR polymer and the capillary meniscus lose energy on the
 /// taps (E_dis > 0 somewhere) and pull with their closed-form forces (the JKR pull-off
-/// (3/2)πWR = 2.36 nN, the meniscus's 4πRγcosθ = 8.50 nN as the most attractive force).
+/// (3/2)πWR = 2.36 nN, the meniscus's 4πRγcosθ = 8.50 nN as the most attractive force), and
+/// `si.contact_hysteresis` reports their cycles as the closed forms give them.
 #[test]
 fn every_example_probe_loads_and_the_hysteretic_ones_approach() {
     let mut n = 0;
@@ -879,5 +880,38 @@ fn every_example_probe_loads_and_the_hysteretic_ones_approach() {
             "{file}: {most} vs {}",
             -pull
         );
+        let h = &doc["si"]["contact_hysteresis"];
+        let got = h["pull_off_force_n"].as_f64().unwrap();
+        assert!((got / pull - 1.0).abs() < 1e-12, "{file}: {got} vs {pull}");
     }
+    // the cycles in SI against the closed forms: JKR (Johnson 1985 §5.5) δ_f =
+    // (3/4)(π²W²R/E*²)^{1/3}, E_hys ≈ 7.09 (W⁵R⁴/E*²)^{1/3} (the branch cut 1e-3 short of its
+    // end: 2e-6 less); the meniscus D_r = (1 + θ/2)V^{1/3}, E_cap = F(D_r + h − √(D_r² + h²))
+    let (w, r) = (0.05, 10e-9);
+    let e_star = 1.0 / ((1.0 - 0.27f64.powi(2)) / 130e9 + (1.0 - 0.4f64.powi(2)) / 50e6);
+    let jkr = &json(&[
+        "units",
+        "--probe",
+        "examples/probe-jkr-polymer.toml",
+        "--json",
+    ])["si"]["contact_hysteresis"];
+    let rel = |v: &serde_json::Value, want: f64| (v.as_f64().unwrap() / want - 1.0).abs();
+    let release = 0.75 * (pi * pi * w * w * r / (e_star * e_star)).cbrt();
+    assert!(rel(&jkr["release_distance_m"], release) < 3e-6, "{jkr}");
+    let coeff = (0.6 + 0.1 / 4f64.cbrt()) * 2f64.powf(2.0 / 3.0) * pi.powf(5.0 / 3.0);
+    let e_hys = coeff * (w.powi(5) * r.powi(4) / (e_star * e_star)).cbrt();
+    assert!(rel(&jkr["energy_per_tap_j"], e_hys) < 3e-6, "{jkr}");
+    let cap = &json(&[
+        "units",
+        "--probe",
+        "examples/probe-capillary-humid.toml",
+        "--json",
+    ])["si"]["contact_hysteresis"];
+    let (v, theta) = (1e-25f64, 20f64.to_radians());
+    let d_r = (1.0 + 0.5 * theta) * v.cbrt();
+    assert!(rel(&cap["release_distance_m"], d_r) < 1e-12, "{cap}");
+    let h = (v / (pi * r)).sqrt();
+    let f = 4.0 * pi * r * 0.072 * theta.cos();
+    let e_cap = f * (d_r + h - d_r.hypot(h));
+    assert!(rel(&cap["energy_per_tap_j"], e_cap) < 1e-12, "{cap}");
 }

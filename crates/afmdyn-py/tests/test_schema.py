@@ -87,6 +87,9 @@ CLI_CASES: List[Tuple[str, List[Any]]] = [
     ("modes", ["--sweep", "fig3"]),
     ("units", ["--probe", P1]),
     ("units", ["--config", EXAMPLES / "probe.toml"]),
+    # the hysteretic laws' si.contact_hysteresis
+    ("units", ["--probe", EXAMPLES / "probe-jkr-polymer.toml"]),
+    ("units", ["--probe", EXAMPLES / "probe-capillary-humid.toml"]),
     ("simulate", ["--periods", 3, "--files", "none"]),
     ("simulate", ["--periods", 3, "--files", "data"]),
     ("simulate", ["--periods", 3, "--files", "none", "--probe", P1]),

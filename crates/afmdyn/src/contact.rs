@@ -169,6 +169,33 @@ impl ContactLaw {
         }
     }
 
+    /// A hysteretic law's cycle ([`ContactLaw::release_distance`] > 0) in the law's units, with
+    /// Hertz group `alpha4`: where the contact is left, the largest pull and the energy each tap
+    /// loses to the hysteresis; `None` for the other laws.
+    pub fn hysteresis(&self, alpha4: f64) -> Option<Hysteresis> {
+        match *self {
+            ContactLaw::Jkr { adhesion } => {
+                let jkr = Jkr::new(alpha4, adhesion);
+                Some(Hysteresis {
+                    release_distance: -jkr.release(),
+                    // the load-controlled pull-off, min F = −(3/2)P̃, on the branch
+                    pull_off_force: 1.5 * adhesion,
+                    energy_per_tap: jkr.hysteresis(),
+                })
+            }
+            ContactLaw::Capillary {
+                capillary,
+                meniscus,
+                rupture,
+            } => Some(Hysteresis {
+                release_distance: rupture,
+                pull_off_force: capillary,
+                energy_per_tap: Meniscus::new(capillary, meniscus, rupture).hysteresis(),
+            }),
+            _ => None,
+        }
+    }
+
     /// Whether each region is affine in the state (the exact propagator applies).
     pub fn is_affine(&self) -> bool {
         matches!(self, ContactLaw::Linear)
@@ -784,6 +811,20 @@ impl TipSampleLaw for TipSample {
             ContactLaw::Dmt { .. } | ContactLaw::Electrostatic { .. }
         )
     }
+}
+
+/// A hysteretic law's cycle ([`ContactLaw::hysteresis`]), in the law's units (lengths in g₀,
+/// forces in F̃, energies in F̃·g₀).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Hysteresis {
+    /// V_T where the contact is left on retraction: JKR's |δ_b|, the meniscus's D̃_r.
+    pub release_distance: f64,
+    /// The largest pull of the contact (a positive magnitude): JKR's load-controlled pull-off
+    /// (3/2)P̃ = (3/2)πWR, the meniscus's F̃_cap = 4πRγcosθ.
+    pub pull_off_force: f64,
+    /// The energy each tap loses to the hysteresis (formed, then left): JKR's E_hys, the
+    /// meniscus's E_cap.
+    pub energy_per_tap: f64,
 }
 
 /// The JKR contact in the law's units (module docs): Hertz group α4, adhesion P̃ = πWR, and

@@ -458,6 +458,13 @@ pub fn si(probe: &crate::probe::Probe, params: &Params, doc: &Value) -> Value {
     if let Some(mu) = probe.tabor_parameter {
         out["tabor_parameter"] = json!(mu);
     }
+    if let Some(h) = params.contact_law.hysteresis(params.alpha4) {
+        out["contact_hysteresis"] = json!({
+            "release_distance_m": h.release_distance * s.length_m,
+            "pull_off_force_n": h.pull_off_force * s.force_n,
+            "energy_per_tap_j": h.energy_per_tap * s.energy_j(),
+        });
+    }
     if let Some(x) = doc.get("x_max") {
         out["x_max_m"] = json!(metres(x));
     }
