@@ -50,6 +50,9 @@ pub struct Medium {
     pub viscosity: f64,
 }
 
+/// The density (kg/m³) from which a medium counts as a liquid ([`Medium::is_liquid`]).
+pub const LIQUID_DENSITY: f64 = 100.0;
+
 impl Medium {
     /// Water at 25 °C: ρ = 997.05 kg/m³, η = 0.890 mPa s (CRC Handbook of Chemistry and
     /// Physics, 97th ed., 2016, §6, "Properties of water in the range 0–100 °C" and
@@ -64,6 +67,12 @@ impl Medium {
         density: 1.184,
         viscosity: 1.849e-5,
     };
+
+    /// Whether the medium is a liquid: a density of [`LIQUID_DENSITY`] or more (gases at
+    /// ambient conditions are below 10 kg/m³, liquids above 500).
+    pub fn is_liquid(&self) -> bool {
+        self.density >= LIQUID_DENSITY
+    }
 
     /// A preset by name ([`MEDIA`], case-insensitive).
     ///

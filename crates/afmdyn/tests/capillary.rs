@@ -252,3 +252,35 @@ fn bad_meniscus_input_is_refused_naming_the_key() {
     let want = 4.0 * PI * R * afmdyn::probe::WATER_SURFACE_TENSION / p.scales.force_n;
     assert!((capillary / want - 1.0).abs() < 1e-12);
 }
+
+/// Laws of a gas are refused in a liquid `[medium]`: the capillary meniscus (it does not form
+/// under water) and the electrostatic force across ε₀; in air both load.
+#[test]
+fn gas_laws_are_refused_in_a_liquid() {
+    let water = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../examples/probe-water-beam.toml"
+    ))
+    .unwrap();
+    let dmt = "law = \"dmt\"\nyoungs_modulus = 50e6          # a soft polymer (Pa)\n\
+               poisson_ratio = 0.45\nhamaker = 1e-20";
+    assert!(water.contains(dmt), "the example's [sample] changed");
+    for (sample, law) in [
+        (
+            "law = \"capillary\"\nyoungs_modulus = 50e6\npoisson_ratio = 0.45\n\
+             meniscus_volume = 1e-25",
+            "capillary",
+        ),
+        (
+            "law = \"electrostatic\"\nyoungs_modulus = 50e6\npoisson_ratio = 0.45\n\
+             hamaker = 1e-20\nbias_voltage = 1.0",
+            "electrostatic",
+        ),
+    ] {
+        let text = water.replace(dmt, sample);
+        let e = Probe::parse(&text, "<test>").unwrap_err().to_string();
+        assert!(e.contains(law) && e.contains("liquid [medium]"), "{e}");
+        let air = text.replace("name = \"water\"", "name = \"air\"");
+        Probe::parse(&air, "<test>").unwrap_or_else(|e| panic!("{law} in air: {e}"));
+    }
+}

@@ -55,6 +55,13 @@ pub(super) struct MediumSpec {
     calibrated_in: CalibratedIn,
 }
 
+impl MediumSpec {
+    /// Whether the medium is a liquid ([`Medium::is_liquid`]).
+    pub(super) fn is_liquid(&self) -> bool {
+        self.medium.is_liquid()
+    }
+}
+
 /// One mode in the medium.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FluidMode {

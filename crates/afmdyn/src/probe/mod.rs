@@ -1555,6 +1555,27 @@ impl Probe {
         };
         // the fluid's loading of every mode; the drive then defaults to the first mode's
         // natural frequency in the fluid (f₀ without one)
+        // laws of a gas: a meniscus does not form under a liquid, and the electrostatic law is
+        // the force across vacuum (ε₀), not across a polar, screening liquid
+        let liquid = medium.as_ref().is_some_and(|m| m.is_liquid());
+        if liquid
+            && matches!(
+                law,
+                ContactLaw::Capillary { .. } | ContactLaw::Electrostatic { .. }
+            )
+        {
+            let why = if matches!(law, ContactLaw::Capillary { .. }) {
+                "the meniscus of humid air does not form under a liquid"
+            } else {
+                "the sphere–plane force across vacuum (ε₀) ignores the liquid's permittivity and \
+                 ionic screening"
+            };
+            return Err(format!(
+                "[sample].law = \"{}\" in a liquid [medium]: {why} (use it in air, or another \
+                 law)",
+                law.name()
+            ));
+        }
         let medium_report = match (&medium, &vacuum) {
             (Some(spec), Some(v)) => Some(medium::load(spec, v, &mut params, time_s)?),
             _ => None,
