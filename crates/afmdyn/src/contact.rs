@@ -162,11 +162,7 @@ impl ContactLaw {
     /// takes a start there as in contact when the tip moves away from the sample (leaving
     /// through its neck) and free when it moves towards it (approaching).
     pub fn release_distance(&self, alpha4: f64) -> f64 {
-        match *self {
-            ContactLaw::Jkr { adhesion } => -Jkr::new(alpha4, adhesion).release(),
-            ContactLaw::Capillary { rupture, .. } => rupture,
-            _ => 0.0,
-        }
+        self.hysteresis(alpha4).map_or(0.0, |h| h.release_distance)
     }
 
     /// A hysteretic law's cycle ([`ContactLaw::release_distance`] > 0) in the law's units, with
