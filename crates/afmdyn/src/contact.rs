@@ -931,10 +931,8 @@ impl Jkr {
         }
         let qf = self.q_end;
         let above = delta - self.indentation(qf);
-        let far = (2.0 * delta.max(0.0))
-            .sqrt()
-            .sqrt()
-            .max((2.0 * self.c).cbrt());
+        // (2c)^{1/3} = 2 q_f, since q_f³ = c/4
+        let far = (2.0 * delta.max(0.0)).sqrt().sqrt().max(2.0 * qf);
         let near = qf + (above / (6.0 * qf * qf)).sqrt();
         let mut q = far.min(near).max(qf);
         for _ in 0..100 {

@@ -24,30 +24,10 @@ use afmdyn::{CantileverModel, ContactLaw, HybridSystem, Params, SimError};
 use nalgebra::{DMatrix, DVector};
 
 mod common;
+use common::laws::{CAP, DMT, ES, JKR};
 use common::{events_until, harmonic_response};
 
-const DMT: ContactLaw = ContactLaw::Dmt {
-    hamaker: 1e-5,
-    intermolecular_distance: 0.01,
-};
 const IMPACT: ContactLaw = ContactLaw::Impact { restitution: 0.6 };
-const ES: ContactLaw = ContactLaw::Electrostatic {
-    hamaker: 1e-5,
-    intermolecular_distance: 0.01,
-    electrostatic: 1e-3,
-    tip_radius: 1.0,
-};
-
-/// JKR at its default adhesion: a hysteretic region (the neck, left at V_T = |δ_b|).
-const JKR: ContactLaw = ContactLaw::Jkr { adhesion: 0.05 };
-
-/// The capillary meniscus at its defaults: hysteretic too (left at V_T = D̃_r), with a kink
-/// in the force inside its region (at V_T = 0).
-const CAP: ContactLaw = ContactLaw::Capillary {
-    capillary: 0.1,
-    meniscus: 0.01,
-    rupture: 0.05,
-};
 
 const LAWS: [ContactLaw; 7] = [
     ContactLaw::Linear,

@@ -19,29 +19,8 @@ use nalgebra::{Complex, DMatrix, DVector};
 use proptest::prelude::*;
 
 mod common;
+use common::laws::{CAP, DMT, ES, JKR};
 use common::{events_until, impact_model, opts};
-
-const DMT: ContactLaw = ContactLaw::Dmt {
-    hamaker: 1e-5,
-    intermolecular_distance: 0.01,
-};
-/// The electrostatic law at its defaults (DMT's groups, Ẽ = 1e-3, R̃ = 1).
-const ES: ContactLaw = ContactLaw::Electrostatic {
-    hamaker: 1e-5,
-    intermolecular_distance: 0.01,
-    electrostatic: 1e-3,
-    tip_radius: 1.0,
-};
-
-/// JKR at its default adhesion P̃ = 0.05.
-const JKR: ContactLaw = ContactLaw::Jkr { adhesion: 0.05 };
-
-/// The capillary meniscus at its defaults.
-const CAP: ContactLaw = ContactLaw::Capillary {
-    capillary: 0.1,
-    meniscus: 0.01,
-    rupture: 0.05,
-};
 
 // One conformance suite over every law × integrator pair: tests/conformance.rs.
 

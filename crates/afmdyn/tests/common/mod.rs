@@ -300,3 +300,34 @@ pub fn hysteretic_tap(m: &CantileverModel, e: f64) -> DVector<f64> {
     }
     o.state
 }
+
+/// The laws with groups, at the library's defaults ([`afmdyn::contact`]'s `*_DEFAULT*`): the
+/// law sets of the conformance and law suites.
+pub mod laws {
+    use afmdyn::contact::*;
+    use afmdyn::ContactLaw;
+
+    /// DMT (H̃ = 1e-5, ã₀ = 0.01).
+    pub const DMT: ContactLaw = ContactLaw::Dmt {
+        hamaker: DMT_DEFAULT_HAMAKER,
+        intermolecular_distance: DMT_DEFAULT_A0,
+    };
+    /// The electrostatic law (DMT's groups, Ẽ = 1e-3, R̃ = 1).
+    pub const ES: ContactLaw = ContactLaw::Electrostatic {
+        hamaker: DMT_DEFAULT_HAMAKER,
+        intermolecular_distance: DMT_DEFAULT_A0,
+        electrostatic: ELECTROSTATIC_DEFAULT,
+        tip_radius: ELECTROSTATIC_DEFAULT_RADIUS,
+    };
+    /// JKR (P̃ = 0.05): a hysteretic region (the neck, left at V_T = |δ_b|).
+    pub const JKR: ContactLaw = ContactLaw::Jkr {
+        adhesion: JKR_DEFAULT_ADHESION,
+    };
+    /// The capillary meniscus (F̃_cap = 0.1, h̃ = 0.01, D̃_r = 0.05): hysteretic too (left at
+    /// V_T = D̃_r), with a kink in the force inside its region (at V_T = 0).
+    pub const CAP: ContactLaw = ContactLaw::Capillary {
+        capillary: CAPILLARY_DEFAULT_FORCE,
+        meniscus: CAPILLARY_DEFAULT_MENISCUS,
+        rupture: CAPILLARY_DEFAULT_RUPTURE,
+    };
+}
