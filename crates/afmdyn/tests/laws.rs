@@ -431,7 +431,7 @@ fn dmt_kelvin_voigt_monodromy_matches_finite_differences() {
 
 // ----------------------------------------------- variational equations: finite differences
 
-fn fd_flow_jacobian(m: &CantileverModel, z0: &DVector<f64>, t1: f64) -> DMatrix<f64> {
+fn fd_flow_jacobian(m: &CantileverModel, z0: &DVector<f64>, t1: f64, eps: f64) -> DMatrix<f64> {
     let mut it = build(m, opts(IntegratorKind::Adaptive, 1e-13), 0.0, z0).unwrap();
     let mut flow = |z: &DVector<f64>| {
         it.reset(0.0, z).unwrap();
@@ -439,7 +439,6 @@ fn fd_flow_jacobian(m: &CantileverModel, z0: &DVector<f64>, t1: f64) -> DMatrix<
         it.state().clone()
     };
     let dim = z0.len();
-    let eps = 1e-6;
     let mut j = DMatrix::zeros(dim, dim);
     for k in 0..dim {
         let (mut zp, mut zm) = (z0.clone(), z0.clone());
@@ -486,7 +485,11 @@ proptest! {
             if map.grazing_distance <= 1e-2 {
                 continue;
             }
-            let fd = fd_flow_jacobian(&m, &z0, t1);
+            // the capillary force's kink at V_T = 0 lies inside a step: the flow's error at
+            // the tolerance then varies unevenly with the start (~1e-11), which differences
+            // of 1e-6 magnify to 1e-5; differences of 1e-5 stay below 3e-6 (150 random starts)
+            let eps = if matches!(law, ContactLaw::Capillary { .. }) { 1e-5 } else { 1e-6 };
+            let fd = fd_flow_jacobian(&m, &z0, t1, eps);
             let err = (&map.jacobian - &fd).amax() / (1.0 + fd.amax());
             prop_assert!(err < 1e-5, "{law}: relative error {err:e}, {} events", map.switchings);
         }
