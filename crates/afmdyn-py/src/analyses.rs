@@ -127,9 +127,9 @@ pub fn simulate<'py>(
         .transpose()
         .map_err(probe_error)?;
     let request: SimulateRequest = crate::convert::request("simulate", request)?;
-    // held in memory: τ, V_T, V̇_T, W, Ẇ, contact, force and the 2N modal coordinates
+    // held in memory: τ, V_T, V̇_T, W, Ẇ, contact, force and the 2N + m state entries
     let span = request
-        .validate(&p, SeriesStore::Memory, 7 + 2 * p.modes, 8.0)
+        .validate(&p, SeriesStore::Memory, 7 + p.state_dim(), 8.0)
         .map_err(sim_error)?;
     let su = report::SeriesUnits::new(&p, probe.as_ref());
     let opts = request.integrator_options();

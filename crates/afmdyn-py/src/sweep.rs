@@ -128,7 +128,7 @@ impl SweepStudy {
                 Some(t) => serde_json::from_str::<Vec<Vec<f64>>>(t)
                     .map(vectors)
                     .map_err(|e| value_error(format!("coarse pass: {e}"))),
-                None => Ok(vec![DVector::zeros(2 * self.spec.base.modes); n]),
+                None => Ok(vec![DVector::zeros(self.spec.base.state_dim()); n]),
             }
         };
         let seeds = Seeds::new(parse(forward)?, parse(backward)?);

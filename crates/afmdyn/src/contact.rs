@@ -62,6 +62,22 @@
 //!   E_cap = F̃_cap(D̃_r + h̃ − √(D̃_r² + h̃²)). The force is continuous at D = 0 with a kink
 //!   (dF/dD = F̃_cap/h̃ on the meniscus side, 0 on the contact side), inside the region
 //!   ([`Meniscus`]).
+//! * `sls` — the standard linear solid (Zener) sample with surface memory (López-Guerra &
+//!   Solares, *Beilstein J. Nanotechnol.* 5 (2014) 2149, §2; Zener, *Elasticity and Anelasticity
+//!   of Metals*, Chicago 1948): the relaxed spring α4 in parallel with a Maxwell arm, the spring
+//!   κ in series with the dashpot α6. Its internal state is the dashpot's extension u (units of
+//!   g₀, the state's last entry). In contact the sample's surface follows the tip, δ = −V_T, and
+//!   F_c = α4 δ + κ(δ − u), u̇ = (κ/α6)(δ − u); the force never pulls: the tip leaves the
+//!   surface where F_c falls to 0. Free of the tip, the massless surface sits where its springs
+//!   balance, at the depression s(u) = κu/(α4 + κ), and recovers as u̇ = −α4κ u/(α6(α4 + κ));
+//!   the tip touches it again where V_T = −s(u). Both guards are therefore σ(V_T + s(u)), the
+//!   contact's being F_c/(α4 + κ). The energy stored in the sample is
+//!   U = ½α4 δ_s² + ½κ(δ_s − u)² (δ_s the surface's depression), continuous at the switchings,
+//!   and the dashpot dissipates α6 u̇² in and out of contact. Under a prescribed indentation
+//!   δ₀ sin ωτ held in contact it dissipates πκωτ_r δ₀²/(1 + ω²τ_r²) per cycle, τ_r = α6/κ
+//!   (the loss of a Maxwell element, e.g. Lakes, *Viscoelastic Materials*, CUP 2009, §2.7). κ → 0
+//!   is the linear law without damper; κ → ∞ a Kelvin–Voigt solid α4, α6 whose surface lags
+//!   the tip. ([`Zener`]; the model carries u, [`crate::CantileverModel`].)
 //! * `impact` — the impact oscillator of the paper's Fig. 1b: a rigid sample at V_T = 0 with
 //!   Newton's coefficient of restitution r: dV_T/dτ⁺ = −r dV_T/dτ⁻ (Shaw & Holmes, *J. Sound Vib.*
 //!   90 (1983) 129; Nordmark, *J. Sound Vib.* 145 (1991) 279). No force acts in free flight; the
@@ -124,6 +140,13 @@ pub enum ContactLaw {
         /// D̃_r = (1 + θ/2)V^{1/3}/g₀ > 0: the rupture distance.
         rupture: f64,
     },
+    /// Standard linear solid (Zener) sample with surface memory: the relaxed spring α4 in
+    /// parallel with a Maxwell arm (spring κ, dashpot α6), one internal state (module docs).
+    Sls {
+        /// κ ≥ 0: the Maxwell arm's spring (units of α4); the instantaneous stiffness is α4 + κ
+        /// and the relaxation time α6/κ.
+        maxwell_stiffness: f64,
+    },
     /// Rigid sample with coefficient of restitution r ∈ [0, 1] (impact oscillator, Fig. 1b).
     Impact {
         /// Newton's coefficient of restitution r.
@@ -148,7 +171,7 @@ impl ContactLaw {
         }
     }
 
-    /// The law's name: `linear`, `hertz`, `dmt`, `electrostatic`, `jkr`, `capillary` or
+    /// The law's name: `linear`, `hertz`, `dmt`, `electrostatic`, `jkr`, `capillary`, `sls` or
     /// `impact`.
     pub fn name(&self) -> &'static str {
         self.kind().name()
@@ -192,6 +215,12 @@ impl ContactLaw {
         }
     }
 
+    /// The number m of internal states the law adds to the state `z: [f64; 2N + m]` after
+    /// (a, ȧ): 1 for SLS (the dashpot's extension u, [`Zener`]), 0 for the other laws.
+    pub fn internal_states(&self) -> usize {
+        usize::from(matches!(self, ContactLaw::Sls { .. }))
+    }
+
     /// Whether each region is affine in the state (the exact propagator applies).
     pub fn is_affine(&self) -> bool {
         matches!(self, ContactLaw::Linear)
@@ -217,6 +246,21 @@ impl ContactLaw {
         };
         match *self {
             ContactLaw::Linear | ContactLaw::Hertz => Ok(()),
+            ContactLaw::Sls { maxwell_stiffness } => {
+                // κ = 0 leaves u without dynamics (a neutral direction of every monodromy):
+                // that sample is the linear law with α6 = 0
+                if !(maxwell_stiffness.is_finite()
+                    && maxwell_stiffness > 0.0
+                    && maxwell_stiffness <= 1e12)
+                {
+                    return bad(
+                        "maxwell_stiffness (SLS Maxwell arm κ)",
+                        maxwell_stiffness,
+                        "0 < κ ≤ 1e12 (κ = 0 is the linear law with α6 = 0)",
+                    );
+                }
+                Ok(())
+            }
             ContactLaw::Jkr { adhesion } => {
                 // P̃ = 0 is Hertz (use `hertz`); the neck's scale P̃/α4 must stay resolvable
                 if !(adhesion.is_finite() && adhesion > 0.0 && adhesion <= 1e12) {
@@ -327,7 +371,7 @@ impl fmt::Display for ContactLaw {
 }
 
 /// The kind of a law without its groups, parsed from
-/// `linear|hertz|dmt|electrostatic|jkr|capillary|impact`.
+/// `linear|hertz|dmt|electrostatic|jkr|capillary|sls|impact`.
 ///
 /// One parser for every front end: the name is taken in any case (`"HERTZ"`, `"DMT"` as the
 /// literature writes it) on the command line, in a `--config` file, a probe file and from
@@ -349,6 +393,8 @@ pub enum LawKind {
     Jkr,
     /// [`ContactLaw::Capillary`].
     Capillary,
+    /// [`ContactLaw::Sls`].
+    Sls,
     /// [`ContactLaw::Impact`].
     Impact,
 }
@@ -363,6 +409,7 @@ impl FromStr for LawKind {
             "electrostatic" => Ok(LawKind::Electrostatic),
             "jkr" => Ok(LawKind::Jkr),
             "capillary" => Ok(LawKind::Capillary),
+            "sls" | "zener" => Ok(LawKind::Sls),
             "impact" => Ok(LawKind::Impact),
             _ => Err(format!("contact law '{s}': expected {}", LawKind::EXPECTED)),
         }
@@ -400,6 +447,11 @@ pub const CAPILLARY_DEFAULT_MENISCUS: f64 = 0.01;
 /// Default rupture distance D̃_r = 0.05: a few nanometres under the default tapping amplitude,
 /// as Zitzler et al. (2002) find for the menisci of humid air.
 pub const CAPILLARY_DEFAULT_RUPTURE: f64 = 0.05;
+/// Default Maxwell arm κ = 20 of the SLS law: the sample twice as stiff at the onset of a tap
+/// (α4 + κ = 40 with the default α4 = 20) as at rest, with a relaxation time α6/κ = 0.01 (the
+/// default α6 = 0.2) between the contact's time scale 1/√(α4 + κ) and the drive period, so the
+/// Maxwell arm both stiffens and damps the tap.
+pub const SLS_DEFAULT_MAXWELL: f64 = 20.0;
 /// Default coefficient of restitution of the impact law.
 pub const IMPACT_DEFAULT_RESTITUTION: f64 = 0.8;
 
@@ -416,6 +468,7 @@ impl LawKind {
             capillary,
             meniscus,
             rupture,
+            maxwell_stiffness,
         } = groups;
         match self {
             LawKind::Linear => ContactLaw::Linear,
@@ -437,6 +490,9 @@ impl LawKind {
                 capillary: capillary.unwrap_or(CAPILLARY_DEFAULT_FORCE),
                 meniscus: meniscus.unwrap_or(CAPILLARY_DEFAULT_MENISCUS),
                 rupture: rupture.unwrap_or(CAPILLARY_DEFAULT_RUPTURE),
+            },
+            LawKind::Sls => ContactLaw::Sls {
+                maxwell_stiffness: maxwell_stiffness.unwrap_or(SLS_DEFAULT_MAXWELL),
             },
             LawKind::Impact => ContactLaw::Impact {
                 restitution: restitution.unwrap_or(IMPACT_DEFAULT_RESTITUTION),
@@ -467,6 +523,8 @@ pub struct LawGroups {
     pub meniscus: Option<f64>,
     /// Capillary: D̃_r.
     pub rupture: Option<f64>,
+    /// SLS: κ.
+    pub maxwell_stiffness: Option<f64>,
 }
 
 impl LawGroups {
@@ -511,6 +569,10 @@ impl LawGroups {
                 restitution: Some(restitution),
                 ..LawGroups::default()
             },
+            ContactLaw::Sls { maxwell_stiffness } => LawGroups {
+                maxwell_stiffness: Some(maxwell_stiffness),
+                ..LawGroups::default()
+            },
             ContactLaw::Linear | ContactLaw::Hertz => LawGroups::default(),
         }
     }
@@ -529,6 +591,7 @@ impl LawGroups {
             capillary: self.capillary.or(other.capillary),
             meniscus: self.meniscus.or(other.meniscus),
             rupture: self.rupture.or(other.rupture),
+            maxwell_stiffness: self.maxwell_stiffness.or(other.maxwell_stiffness),
         }
     }
 }
@@ -590,6 +653,12 @@ impl ContactLaw {
             (groups.capillary.is_some(), "capillary", CAP, "capillary"),
             (groups.meniscus.is_some(), "meniscus", CAP, "capillary"),
             (groups.rupture.is_some(), "rupture", CAP, "capillary"),
+            (
+                groups.maxwell_stiffness.is_some(),
+                "maxwell_stiffness",
+                &[LawKind::Sls][..],
+                "sls",
+            ),
         ] {
             if given && !owners.contains(&kind) {
                 return Err(crate::ParamError::Group {
@@ -612,6 +681,7 @@ impl ContactLaw {
             ContactLaw::Electrostatic { .. } => LawKind::Electrostatic,
             ContactLaw::Jkr { .. } => LawKind::Jkr,
             ContactLaw::Capillary { .. } => LawKind::Capillary,
+            ContactLaw::Sls { .. } => LawKind::Sls,
             ContactLaw::Impact { .. } => LawKind::Impact,
         }
     }
@@ -620,9 +690,9 @@ impl ContactLaw {
 impl LawKind {
     /// The names a front end accepts, for messages.
     pub const EXPECTED: &'static str =
-        "linear, hertz, dmt, electrostatic, jkr, capillary or impact";
+        "linear, hertz, dmt, electrostatic, jkr, capillary, sls or impact";
 
-    /// The kind's name: `linear`, `hertz`, `dmt`, `electrostatic`, `jkr`, `capillary` or
+    /// The kind's name: `linear`, `hertz`, `dmt`, `electrostatic`, `jkr`, `capillary`, `sls` or
     /// `impact`.
     pub fn name(self) -> &'static str {
         match self {
@@ -632,6 +702,7 @@ impl LawKind {
             LawKind::Electrostatic => "electrostatic",
             LawKind::Jkr => "jkr",
             LawKind::Capillary => "capillary",
+            LawKind::Sls => "sls",
             LawKind::Impact => "impact",
         }
     }
@@ -681,6 +752,13 @@ impl TipSampleLaw for TipSample {
                 force: k * delta + c * rate,
                 d_delta: k,
                 d_rate: c,
+            },
+            // the relaxed (equilibrium) force: the Maxwell arm's force depends on the state u,
+            // which the model evaluates ([`Zener`]); this is the quasi-static law
+            ContactLaw::Sls { .. } if contact => ForceEval {
+                force: k * delta,
+                d_delta: k,
+                d_rate: 0.0,
             },
             ContactLaw::Hertz if contact => {
                 let d = delta.max(0.0);
@@ -756,7 +834,7 @@ impl TipSampleLaw for TipSample {
     fn potential(&self, contact: bool, delta: f64) -> f64 {
         let k = self.stiffness;
         match self.law {
-            ContactLaw::Linear if contact => 0.5 * k * delta * delta,
+            ContactLaw::Linear | ContactLaw::Sls { .. } if contact => 0.5 * k * delta * delta,
             ContactLaw::Hertz if contact => 0.4 * k * delta.max(0.0).powf(2.5),
             ContactLaw::Jkr { adhesion } if contact => {
                 let jkr = Jkr::new(k, adhesion);
@@ -797,7 +875,7 @@ impl TipSampleLaw for TipSample {
                 let q = Jkr::new(self.stiffness, adhesion).radius_variable(delta);
                 self.damping * q * q * rate
             }
-            ContactLaw::Impact { .. } => 0.0,
+            ContactLaw::Impact { .. } | ContactLaw::Sls { .. } => 0.0,
         }
     }
 
@@ -821,6 +899,94 @@ pub struct Hysteresis {
     /// The energy each tap loses to the hysteresis (formed, then left): JKR's E_hys, the
     /// meniscus's E_cap.
     pub energy_per_tap: f64,
+}
+
+/// The standard linear solid with surface memory ([`ContactLaw::Sls`], module docs): the
+/// relaxed spring α4, the Maxwell arm's spring κ and dashpot α6, in the law's units. The state u
+/// is the dashpot's extension (g₀), δ = −V_T the tip's indentation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Zener {
+    /// α4: the relaxed spring.
+    pub relaxed: f64,
+    /// κ: the Maxwell arm's spring.
+    pub maxwell: f64,
+    /// α6: the Maxwell arm's dashpot.
+    pub dashpot: f64,
+}
+
+impl Zener {
+    /// The SLS of the model's α4, α6 and the law's κ.
+    pub fn new(alpha4: f64, maxwell: f64, alpha6: f64) -> Zener {
+        Zener {
+            relaxed: alpha4,
+            maxwell,
+            dashpot: alpha6,
+        }
+    }
+    /// κ/(α4 + κ): the free surface's depression per unit u (0 for κ = 0, 1 for α4 = 0).
+    pub fn surface_gain(&self) -> f64 {
+        let k = self.relaxed + self.maxwell;
+        if k > 0.0 {
+            self.maxwell / k
+        } else {
+            0.0
+        }
+    }
+    /// s(u) = κu/(α4 + κ): where the free surface sits (a depression, g₀), balanced between
+    /// its springs. The switching function is V_T + s(u) in both regions.
+    pub fn surface(&self, u: f64) -> f64 {
+        self.surface_gain() * u
+    }
+    /// The surface's depression δ_s: the indentation δ in contact, s(u) free.
+    pub fn depression(&self, contact: bool, delta: f64, u: f64) -> f64 {
+        if contact {
+            delta
+        } else {
+            self.surface(u)
+        }
+    }
+    /// κ/α6: the Maxwell arm's relaxation rate 1/τ_r (0 for κ = 0).
+    pub fn relaxation_rate(&self) -> f64 {
+        if self.maxwell == 0.0 {
+            0.0
+        } else {
+            self.maxwell / self.dashpot
+        }
+    }
+    /// F_c = α4 δ + κ(δ − u) in contact (repulsive positive), 0 free.
+    pub fn force(&self, contact: bool, delta: f64, u: f64) -> f64 {
+        if contact {
+            self.relaxed * delta + self.maxwell * (delta - u)
+        } else {
+            0.0
+        }
+    }
+    /// u̇ = (κ/α6)(δ_s − u): the dashpot's rate, in contact and free.
+    pub fn rate(&self, contact: bool, delta: f64, u: f64) -> f64 {
+        self.relaxation_rate() * (self.depression(contact, delta, u) - u)
+    }
+    /// U = ½α4 δ_s² + ½κ(δ_s − u)²: the energy stored in the sample's springs.
+    pub fn potential(&self, contact: bool, delta: f64, u: f64) -> f64 {
+        let ds = self.depression(contact, delta, u);
+        0.5 * self.relaxed * ds * ds + 0.5 * self.maxwell * (ds - u) * (ds - u)
+    }
+    /// α6 u̇²: the dashpot's dissipation rate (≥ 0).
+    pub fn dissipation(&self, contact: bool, delta: f64, u: f64) -> f64 {
+        let r = self.rate(contact, delta, u);
+        self.dashpot * r * r
+    }
+    /// The energy the Maxwell arm dissipates per cycle of a prescribed harmonic indentation
+    /// δ = δ̄ + δ₀ sin ωτ held in contact, at the periodic steady state:
+    /// πκ ωτ_r δ₀²/(1 + ω²τ_r²), τ_r = α6/κ (the loss modulus of a Maxwell element, e.g.
+    /// Lakes, *Viscoelastic Materials*, CUP 2009, §2.7; the relaxed spring stores only).
+    pub fn cycle_dissipation(&self, omega: f64, amplitude: f64) -> f64 {
+        let rate = self.relaxation_rate();
+        if rate == 0.0 {
+            return 0.0;
+        }
+        let wt = omega / rate;
+        std::f64::consts::PI * self.maxwell * wt * amplitude * amplitude / (1.0 + wt * wt)
+    }
 }
 
 /// The JKR contact in the law's units (module docs): Hertz group α4, adhesion P̃ = πWR, and

@@ -1,6 +1,8 @@
 //! The cantilever–sample model (paper eqs. 8–18) in first-order form, for any tip–sample law.
 //!
-//! State `z: [f64; 2N]` = (a, ȧ): modal coordinates a_j and their τ-derivatives. In both regions
+//! State `z: [f64; 2N + m]` = (a, ȧ, internal): modal coordinates a_j, their τ-derivatives,
+//! and the m internal states of the law ([`ContactLaw::internal_states`]: the SLS sample's
+//! dashpot extension u, m = 1; m = 0 for every other law). In both regions
 //!
 //! M ä + C ȧ + K a = F^I(τ) + φ(1) F_c(δ, δ̇),  δ = −V_T (eq. 8),
 //!
@@ -19,7 +21,7 @@
 //! A chattering sequence (impact velocities decaying as rᵏ) ends in sticking once the next bounce
 //! would rise less than [`STICK_HEIGHT_TOLERANCES`] guard tolerances while λ > 0.
 
-use crate::contact::{ContactLaw, TipSample, TipSampleLaw};
+use crate::contact::{ContactLaw, TipSample, TipSampleLaw, Zener};
 use crate::error::{ParamError, SimError};
 use crate::galerkin::Galerkin;
 use crate::params::{Params, SweepParam};
@@ -108,6 +110,9 @@ pub struct CantileverModel {
     /// V_T where the contact region is left on retraction ([`ContactLaw::release_distance`]):
     /// the JKR neck's |δ_f|, 0 for the other laws.
     release: f64,
+    /// The SLS sample (α4, κ, α6) whose dashpot extension u is the state's entry 2N; `None`
+    /// for the laws without an internal state.
+    zener: Option<Zener>,
 }
 
 impl CantileverModel {
@@ -191,6 +196,12 @@ impl CantileverModel {
             tip_acc_forcing,
             period,
             release: params.contact_law.release_distance(params.alpha4),
+            zener: match params.contact_law {
+                ContactLaw::Sls { maxwell_stiffness } => {
+                    Some(Zener::new(params.alpha4, maxwell_stiffness, params.alpha6))
+                }
+                _ => None,
+            },
         })
     }
 
@@ -235,9 +246,26 @@ impl CantileverModel {
     pub fn modes(&self) -> usize {
         self.params.modes
     }
-    /// State dimension 2N.
+    /// State dimension 2N + m (m the law's internal states, [`ContactLaw::internal_states`]).
     pub fn dim(&self) -> usize {
-        2 * self.params.modes
+        self.params.state_dim()
+    }
+    /// The SLS sample whose dashpot extension u is the state's entry 2N (`None` for the other
+    /// laws).
+    pub fn zener(&self) -> Option<&Zener> {
+        self.zener.as_ref()
+    }
+    /// The SLS sample's (zener, u) at z, `None` for the other laws.
+    fn zener_state(&self, z: &[f64]) -> Option<(&Zener, f64)> {
+        self.zener.as_ref().map(|zn| (zn, z[2 * self.modes()]))
+    }
+    /// The switching function σ-free: V_T + s(u) for the SLS sample (the tip's height above
+    /// the recovering surface, [`Zener::surface`]), V_T for the other laws, given V_T.
+    fn switching(&self, v_t: f64, z: &[f64]) -> f64 {
+        match self.zener_state(z) {
+            Some((zn, u)) => v_t + zn.surface(u),
+            None => v_t,
+        }
     }
     /// Drive frequency Ω.
     pub fn omega(&self) -> f64 {
@@ -282,10 +310,16 @@ impl CantileverModel {
         let (s, c) = (self.params.omega * tau).sin_cos();
         let linear = self.law.law.is_affine();
         let d = &self.regions[if linear { r.index() } else { 0 }];
-        for (i, o) in dz.iter_mut().enumerate() {
+        let (zb, dzb) = (&z[..2 * n], &mut dz[..2 * n]);
+        for (i, o) in dzb.iter_mut().enumerate() {
             *o = d.b_const[i] + s * d.b_sin[i] + c * d.b_cos[i];
         }
-        crate::linalg::matvec(&d.a, z, dz, 1.0, true);
+        crate::linalg::matvec(&d.a, zb, dzb, 1.0, true);
+        if let Some((zn, u)) = self.zener_state(z) {
+            // the dashpot's rate u̇ (the state's last entry)
+            let [v, _, _] = self.v_t_at((s, c), [self.w_tip_slice(z, 0), 0.0, 0.0]);
+            dz[2 * n] = zn.rate(r == Region::Contact, -v, u);
+        }
         // the further components of a multifrequency drive: a force at the tip
         let fd = if self.params.is_multifrequency() {
             self.params.component_force(tau)
@@ -360,6 +394,10 @@ impl CantileverModel {
     ) -> f64 {
         let contact = r == Region::Contact;
         match self.law.law {
+            ContactLaw::Sls { .. } => match self.zener_state(z) {
+                Some((zn, u)) if contact => zn.force(true, -v_t().0, u),
+                _ => 0.0,
+            },
             ContactLaw::Impact { .. } => {
                 if contact {
                     self.sticking_force_value(tau, z)
@@ -418,15 +456,43 @@ impl CantileverModel {
     ) {
         let n = self.modes();
         let linear = self.law.law.is_affine();
-        jac.copy_from(&self.regions[if linear { r.index() } else { 0 }].a);
+        let a = &self.regions[if linear { r.index() } else { 0 }].a;
+        if jac.nrows() == a.nrows() {
+            jac.copy_from(a);
+        } else {
+            // a law with internal states: A_I in the top-left block, their rows below
+            jac.fill(0.0);
+            jac.view_mut((0, 0), (2 * n, 2 * n)).copy_from(a);
+        }
         if linear {
             return;
         }
         // the gradient row of the tip force (on the stack), then the rank-one term M⁻¹φ rowᵀ
         // added to the velocity rows
-        let mut buf = [0.0; 2 * crate::params::MAX_MODES];
-        let row = &mut buf[..2 * n];
+        let mut buf = [0.0; 2 * crate::params::MAX_MODES + 1];
+        let row = &mut buf[..self.dim()];
         match self.law.law {
+            ContactLaw::Sls { .. } => {
+                let Some((zn, _)) = self.zener_state(z) else {
+                    return;
+                };
+                // u̇ = (κ/α6)(δ_s − u): δ_s = δ = −φᵀa − … in contact, s(u) free
+                let rate = zn.relaxation_rate();
+                if r == Region::Contact {
+                    for (j, t) in self.tip().iter().enumerate() {
+                        jac[(2 * n, j)] = -rate * t;
+                    }
+                    jac[(2 * n, 2 * n)] = -rate;
+                    // F = (α4 + κ)δ − κu
+                    for (j, t) in self.tip().iter().enumerate() {
+                        row[j] = -(zn.relaxed + zn.maxwell) * t;
+                    }
+                    row[2 * n] = -zn.maxwell;
+                } else {
+                    jac[(2 * n, 2 * n)] = rate * (zn.surface_gain() - 1.0);
+                    return;
+                }
+            }
             ContactLaw::Impact { .. } => {
                 if r != Region::Contact {
                     return;
@@ -518,10 +584,11 @@ impl CantileverModel {
     pub fn v_t_dot(&self, tau: f64, z: &DVector<f64>) -> f64 {
         self.v_t_from_tip(tau, [0.0, self.w_tip_dot(z), 0.0])[1]
     }
-    /// Region by the sign of V_T: contact when V_T ≤ 0 (eq. 10). (For the impact law, sticking
-    /// is tracked by the integrators; see [`HybridSystem::mode_at`].)
+    /// Region by the sign of V_T: contact when V_T ≤ 0 (eq. 10; V_T + s(u) ≤ 0 over the SLS
+    /// sample's recovering surface). (For the impact law, sticking is tracked by the
+    /// integrators; see [`HybridSystem::mode_at`].)
     pub fn region_at(&self, tau: f64, z: &DVector<f64>) -> Region {
-        Region::of_v_t(self.v_t(tau, z))
+        Region::of_v_t(self.switching(self.v_t(tau, z), z.as_slice()))
     }
     /// Beam deflection W(ξ,τ) = Σ a_j φ_j(ξ) (eq. 9).
     /// For the point-mass and eigenmode models, the tip deflection Σ z_j at every ξ.
@@ -534,7 +601,8 @@ impl CantileverModel {
     }
 
     /// Stored energy E = ½ȦᵀMȦ + ½XᵀK^I X + U(δ), U the potential of the law's conservative
-    /// part (½α4 V_T² for the linear law in contact; continuous across a switching).
+    /// part (½α4 V_T² for the linear law in contact; continuous across a switching; the energy
+    /// in the SLS sample's springs, [`Zener::potential`], in and out of contact).
     pub fn energy(&self, r: Region, tau: f64, z: &DVector<f64>) -> f64 {
         let n = self.modes();
         let g = self.galerkin.region(Region::Free);
@@ -549,7 +617,13 @@ impl CantileverModel {
         };
         let kinetic = 0.5 * quad(&g.mass, v);
         let bending = 0.5 * quad(&g.stiffness, x);
-        kinetic + bending + self.law.potential(r == Region::Contact, -self.v_t(tau, z))
+        let contact = r == Region::Contact;
+        let delta = -self.v_t(tau, z);
+        let sample = match self.zener_state(z.as_slice()) {
+            Some((zn, u)) => zn.potential(contact, delta, u),
+            None => self.law.potential(contact, delta),
+        };
+        kinetic + bending + sample
     }
 
     /// The rates of the energy balance at (τ, z) in region r. Multiplying the equation of
@@ -576,7 +650,11 @@ impl CantileverModel {
         PowerTerms {
             base: drive - p.base_amplitude() * p.omega * c * fc,
             beam_dissipation: beam,
-            contact_dissipation: self.law.dissipative(r == Region::Contact, delta, rate) * rate,
+            contact_dissipation: match self.zener_state(z.as_slice()) {
+                // the SLS dashpot, also while the surface recovers after the tip left
+                Some((zn, u)) => zn.dissipation(r == Region::Contact, delta, u),
+                None => self.law.dissipative(r == Region::Contact, delta, rate) * rate,
+            },
         }
     }
 
@@ -634,7 +712,7 @@ impl CantileverModel {
         let n = self.modes();
         let chol = self.galerkin.region(Region::Free).mass.clone().cholesky()?;
         let lift = |f: &DVector<f64>| {
-            let mut v = DVector::zeros(2 * n);
+            let mut v = DVector::zeros(self.dim());
             v.rows_mut(n, n).copy_from(&chol.solve(f));
             v
         };
@@ -787,7 +865,8 @@ impl CantileverModel {
         DVector::zeros(self.dim())
     }
 
-    /// Build a state from modal displacements `a` and velocities `a_dot` (each of length N).
+    /// Build a state from modal displacements `a` and velocities `a_dot` (each of length N), the
+    /// law's internal states at rest (an SLS sample relaxed, u = 0).
     ///
     /// # Errors
     /// [`SimError::StateLength`] / [`SimError::NotFinite`].
@@ -805,7 +884,10 @@ impl CantileverModel {
                 });
             }
         }
-        let z = DVector::from_iterator(2 * n, a.iter().chain(a_dot).copied());
+        // the law's internal states at rest (the SLS sample relaxed)
+        let mut z = DVector::zeros(self.dim());
+        z.rows_mut(0, n).copy_from_slice(a);
+        z.rows_mut(n, n).copy_from_slice(a_dot);
         crate::system::check_state("initial state", self.dim(), &z)?;
         Ok(z)
     }
@@ -820,7 +902,7 @@ impl CantileverModel {
 
 impl HybridSystem for CantileverModel {
     fn dim(&self) -> usize {
-        2 * self.params.modes
+        CantileverModel::dim(self)
     }
     fn period(&self) -> f64 {
         self.period
@@ -831,7 +913,12 @@ impl HybridSystem for CantileverModel {
     /// hysteretic law (JKR) also contact for 0 ≤ V_T < |δ_f| moving away (dV_T/dτ > 0: the
     /// neck), the region being history-dependent there.
     fn mode_at(&self, tau: f64, z: &[f64]) -> Region {
-        let (v, vd) = self.v_t_pair(tau, z);
+        let (mut v, mut vd) = self.v_t_pair(tau, z);
+        if let Some((zn, u)) = self.zener_state(z) {
+            // over the SLS surface: g = V_T + s(u), ġ = V̇_T + s′u̇ (u̇ is continuous at g = 0)
+            v += zn.surface(u);
+            vd += zn.surface_gain() * zn.rate(false, -v, u);
+        }
         if self.law.law.restitution().is_some() {
             if v <= 0.0 && vd == 0.0 && self.sticking_force_value(tau, z) > 0.0 {
                 Region::Contact
@@ -856,7 +943,8 @@ impl HybridSystem for CantileverModel {
     }
 
     /// Free flight: g = V_T; contact: g = −V_T, or |δ_f| − V_T for a hysteretic law (JKR's
-    /// neck); sticking (impact law): g = λ.
+    /// neck); sticking (impact law): g = λ; over the SLS sample σ(V_T + s(u)) (the contact's
+    /// being F_c/(α4 + κ): the tip leaves where the sample's force falls to 0).
     fn guard(&self, mode: Region, tau: f64, z: &[f64]) -> Guard {
         if mode == Region::Contact && self.law.law.restitution().is_some() {
             return self.sticking_force(tau, z);
@@ -864,10 +952,13 @@ impl HybridSystem for CantileverModel {
         let n = self.modes();
         let p = &self.params;
         let sigma = mode.guard_sign();
-        let mut grad = DVector::zeros(2 * n);
+        let mut grad = DVector::zeros(self.dim());
         grad.rows_mut(0, n).copy_from(&(sigma * self.tip()));
+        if let Some((zn, _)) = self.zener_state(z) {
+            grad[2 * n] = sigma * zn.surface_gain();
+        }
         Guard {
-            value: sigma * self.v_t_pair(tau, z).0 + self.guard_offset(mode),
+            value: sigma * self.switching(self.v_t_pair(tau, z).0, z) + self.guard_offset(mode),
             grad,
             d_tau: sigma * p.base_amplitude() * p.omega * (p.omega * tau).cos(),
         }
@@ -877,7 +968,7 @@ impl HybridSystem for CantileverModel {
         if mode == Region::Contact && self.law.law.restitution().is_some() {
             return self.sticking_force_value(tau, z);
         }
-        mode.guard_sign() * self.v_t_pair(tau, z).0 + self.guard_offset(mode)
+        mode.guard_sign() * self.switching(self.v_t_pair(tau, z).0, z) + self.guard_offset(mode)
     }
 
     /// Switchings are the identity; the impact law's free-flight guard is an impact (module
@@ -962,7 +1053,10 @@ impl HybridSystem for CantileverModel {
             .zip(&f[..n])
             .map(|(a, b)| a * b)
             .sum();
-        mode.guard_sign() * (wd + p.base_amplitude() * p.omega * (p.omega * tau).cos())
+        let surface = self
+            .zener_state(z)
+            .map_or(0.0, |(zn, _)| zn.surface_gain() * f[2 * n]);
+        mode.guard_sign() * (wd + p.base_amplitude() * p.omega * (p.omega * tau).cos() + surface)
     }
 
     /// 1e-12 of the guard's scale: of V_T, 1 + α2 + |α5|; of the constraint force of sticking,
@@ -996,6 +1090,11 @@ impl HybridSystem for CantileverModel {
         let sc = self.base_trig(tau);
         let w = self.kelvin_voigt_weight_at(mode, sc, z);
         self.jacobian_parts(mode, tau, sc, z, jac, w == 0.0);
+        if d != 2 * n {
+            // internal states: J is not of the second-order form
+            crate::system::jacobian_product(jac, psi, dpsi);
+            return;
+        }
         if w == 0.0 {
             second_order_product(jac, n, psi, dpsi);
             return;

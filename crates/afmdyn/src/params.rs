@@ -9,6 +9,10 @@ use std::str::FromStr;
 /// Largest number of Galerkin modes supported (the mode shapes are accurate to ~1e-13 up to i = 20).
 pub const MAX_MODES: usize = 20;
 
+/// Largest state dimension 2N + m: [`MAX_MODES`] modes and the internal states of a law
+/// ([`crate::ContactLaw::internal_states`], at most 1).
+pub const MAX_STATE: usize = 2 * MAX_MODES + 1;
+
 const _: () = assert!(
     MAX_MODES == 20,
     "Params::damping_profile has MAX_MODES entries"
@@ -542,6 +546,27 @@ impl Params {
                 });
             }
         }
+        if let crate::contact::ContactLaw::Sls { maxwell_stiffness } = self.contact_law {
+            // the Maxwell arm relaxes at κ/α6: a dashpot is needed (α6 = 0 would relax it
+            // instantly), and its rate must stay within the integrators' reach
+            let rate = maxwell_stiffness / self.alpha6;
+            if !(self.alpha6 > 0.0 && rate <= 1e12) {
+                return Err(ParamError::Law {
+                    name: "alpha6 (the SLS Maxwell arm's dashpot α6)",
+                    value: self.alpha6,
+                    range: "α6 > 0 with κ/α6 ≤ 1e12 (the relaxation rate)",
+                });
+            }
+            // the relaxed spring brings the surface back after a tap (α4 = 0, a Maxwell
+            // fluid, keeps every dent)
+            if self.alpha4 <= 0.0 || self.alpha4.is_nan() {
+                return Err(ParamError::Law {
+                    name: "alpha4 (the SLS relaxed spring α4)",
+                    value: self.alpha4,
+                    range: "α4 > 0 (the spring that brings the surface back after a tap)",
+                });
+            }
+        }
         if let Some(profile) = &self.damping_profile {
             for &s in &profile[..self.modes] {
                 if !(s.is_finite() && s >= 0.0) {
@@ -704,6 +729,12 @@ impl Params {
     /// α5 that gives the rest distance `z_c` (inverse of [`Params::rest_distance`]).
     pub fn alpha5_for_rest_distance(&self, z_c: f64) -> f64 {
         z_c - self.contact_law.distance_offset()
+    }
+
+    /// The state dimension 2N + m of the model of these parameters: N modes and the law's m
+    /// internal states ([`crate::ContactLaw::internal_states`]).
+    pub fn state_dim(&self) -> usize {
+        2 * self.modes + self.contact_law.internal_states()
     }
 
     /// The drive period T = 2π/Ω, or for a multifrequency drive its common period

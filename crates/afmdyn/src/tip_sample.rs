@@ -184,9 +184,14 @@ impl TipSampleSystem for CantileverModel {
         self.release_distance() > 0.0
     }
     fn free_decay_rate(&self) -> Option<f64> {
+        // the SLS surface's recovery, α4κ/(α6(α4 + κ)), is a free decay too
+        let surface = self
+            .zener()
+            .map(|zn| zn.relaxation_rate() * (1.0 - zn.surface_gain()));
         damped_eigenvalues(self.galerkin().region(Region::Free))
             .iter()
             .map(|e| e.re.abs())
+            .chain(surface)
             .reduce(f64::min)
     }
     fn body_contact_check(&self, points: usize) -> Option<BodyContactCheck> {

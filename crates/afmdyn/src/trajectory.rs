@@ -28,7 +28,7 @@ pub struct Sample {
     pub region: Region,
     /// Tip–sample force F_c (repulsive positive; α4 δ + α6 δ̇ for the linear law in contact).
     pub contact_force: f64,
-    /// State (a, ȧ), shape `[2N]`.
+    /// State (a, ȧ) and the law's internal states, shape `[2N + m]`.
     pub state: DVector<f64>,
 }
 

@@ -1,5 +1,5 @@
 //! One conformance suite over every integrator × contact law pair (exact, rk4, rk4-naive,
-//! adaptive, split, taylor × linear, Hertz, DMT, electrostatic, JKR, capillary, impact): the
+//! adaptive, split, taylor × linear, Hertz, DMT, electrostatic, JKR, capillary, SLS, impact): the
 //! support table (every
 //! unsupported pair is refused with [`SimError::Unsupported`] naming the integrator), and for
 //! every supported pair the identities an integrator of the switched model must satisfy:
@@ -24,18 +24,19 @@ use afmdyn::{CantileverModel, ContactLaw, HybridSystem, Params, SimError};
 use nalgebra::{DMatrix, DVector};
 
 mod common;
-use common::laws::{CAP, DMT, ES, JKR};
+use common::laws::{CAP, DMT, ES, JKR, SLS};
 use common::{events_until, harmonic_response};
 
 const IMPACT: ContactLaw = ContactLaw::Impact { restitution: 0.6 };
 
-const LAWS: [ContactLaw; 7] = [
+const LAWS: [ContactLaw; 8] = [
     ContactLaw::Linear,
     ContactLaw::Hertz,
     DMT,
     ES,
     JKR,
     CAP,
+    SLS,
     IMPACT,
 ];
 
@@ -69,6 +70,10 @@ fn supported(kind: IntegratorKind, law: ContactLaw) -> bool {
         matches!(law, ContactLaw::Electrostatic { .. }),
         matches!(law, ContactLaw::Jkr { .. } | ContactLaw::Capillary { .. }),
     );
+    // the SLS sample's internal state: the adaptive integrator only
+    if law.internal_states() > 0 {
+        return matches!(kind, IntegratorKind::Auto | IntegratorKind::Adaptive);
+    }
     match kind {
         IntegratorKind::Auto | IntegratorKind::Adaptive => true,
         IntegratorKind::Exact => linear,

@@ -155,7 +155,7 @@ fn contact_law_in_any_case() {
     assert_eq!(spec.contact_law, Some(afmdyn::contact::LawKind::Hertz));
     let e = afmdyn::request::model::parse_toml::<ModelSpec>("contact_law = \"hooke\"").unwrap_err();
     assert!(
-        e.contains("expected linear, hertz, dmt, electrostatic, jkr, capillary or impact"),
+        e.contains("expected linear, hertz, dmt, electrostatic, jkr, capillary, sls or impact"),
         "{e}"
     );
 }

@@ -194,7 +194,8 @@ impl BasinSpec {
     ///
     /// # Errors
     /// [`SimError::OutOfRange`] naming the option (`x`, `y` for a coordinate outside the N
-    /// modes); [`SimError::StateLength`] for a base state of another length than 2N.
+    /// modes); [`SimError::StateLength`] for a base state of another length than 2N + m (m the
+    /// law's internal states).
     pub fn validate(&self) -> Result<(), SimError> {
         let n = self.params.modes;
         for (name, c) in [("x", self.x), ("y", self.y)] {
@@ -206,10 +207,12 @@ impl BasinSpec {
                 ));
             }
         }
-        if self.base.len() != 2 * n {
+        // (a, ȧ) and the law's internal states
+        let dim = self.params.state_dim();
+        if self.base.len() != dim {
             return Err(SimError::StateLength {
                 name: "base",
-                expected: 2 * n,
+                expected: dim,
                 got: self.base.len(),
             });
         }

@@ -34,7 +34,8 @@ pub fn random_state(model: &CantileverModel, seed: u64, index: u64) -> DVector<f
     let n = model.modes();
     let shapes = model.galerkin().shapes();
     let b1 = shapes.modes()[0].beta.powi(2);
-    let mut z = DVector::zeros(2 * n);
+    // the law's internal states at rest
+    let mut z = model.rest();
     for (j, m) in shapes.modes().iter().enumerate() {
         let scale = b1 / m.beta.powi(2);
         z[j] = rng.random_range(-RANDOM_AMPLITUDE..RANDOM_AMPLITUDE) * scale;
@@ -337,7 +338,7 @@ impl<'a> SweepPlan<'a> {
     /// from rest; returns the seed of every chunk. Stops early (with rest for the chunks not
     /// reached) once `cancel` is set.
     pub fn coarse(&self, branch: Branch, cancel: &AtomicBool) -> Vec<DVector<f64>> {
-        let dim = 2 * self.spec.base.modes;
+        let dim = self.spec.base.state_dim();
         let mut z = DVector::zeros(dim);
         let mut seeds = vec![DVector::zeros(dim); self.chunks()];
         for (k, seed) in seeds.iter_mut().enumerate() {
@@ -372,7 +373,7 @@ impl<'a> SweepPlan<'a> {
                         .any(|&i| !resume.done.contains(&(i, b)))
             })
         };
-        let dim = 2 * self.spec.base.modes;
+        let dim = self.spec.base.state_dim();
         let pass = |b: Branch| {
             if needs(b) {
                 self.coarse(b, cancel)
@@ -403,7 +404,7 @@ impl<'a> SweepPlan<'a> {
                     .of(branch)
                     .get(k)
                     .cloned()
-                    .unwrap_or_else(|| DVector::zeros(2 * spec.base.modes));
+                    .unwrap_or_else(|| DVector::zeros(spec.base.state_dim()));
                 for i in self.chunk_indices(branch, k) {
                     if cancel.load(Ordering::Relaxed) {
                         return;

@@ -527,7 +527,7 @@ impl Ctx {
     fn node(&self, integ: &mut dyn Integrator, r: Region, tau: f64) -> Node {
         let n = self.model.modes();
         let z = integ.dense_state(tau);
-        let mut dz = DVector::zeros(2 * n);
+        let mut dz = DVector::zeros(z.len());
         self.model.rhs(r, tau, &z, &mut dz);
         let sc = (self.omega * tau).sin_cos();
         let [_, w, wd, f] = self.model.sample_values(r, tau, sc, z.as_slice());
@@ -546,8 +546,9 @@ impl Ctx {
     }
 
     /// dF_c/dτ at `nd` (τ = `t` in the piece [lo, hi]): analytic for the smooth laws
-    /// ([`force_rate`]), a central difference inside the piece for the sticking force of the
-    /// impact law (only the extremum's location depends on it, its value to second order).
+    /// ([`force_rate`]) and the SLS sample ((α4 + κ)δ̇ − κu̇ in contact), a central difference
+    /// inside the piece for the sticking force of the impact law (only the extremum's location
+    /// depends on it, its value to second order).
     fn rate(
         &self,
         integ: &mut dyn Integrator,
@@ -557,6 +558,15 @@ impl Ctx {
         lo: f64,
         hi: f64,
     ) -> f64 {
+        if let Some(zn) = self.model.zener() {
+            // F = (α4 + κ)δ − κu: its rate from δ̇ = −V̇_T and u̇ (the state's last rate)
+            return if r == Region::Contact {
+                let u_dot = nd.dz[nd.dz.len() - 1];
+                -(zn.relaxed + zn.maxwell) * nd.v[1] - zn.maxwell * u_dot
+            } else {
+                0.0
+            };
+        }
         if r != Region::Contact || self.law.law.restitution().is_none() {
             return force_rate(&self.law, r, nd);
         }
@@ -699,8 +709,8 @@ impl Acc {
         }
         let (a, ad, add) = (
             &nd.z.as_slice()[..n],
-            &nd.z.as_slice()[n..],
-            &nd.dz.as_slice()[n..],
+            &nd.z.as_slice()[n..2 * n],
+            &nd.dz.as_slice()[n..2 * n],
         );
         for j in 0..n {
             let aj = ad[j];

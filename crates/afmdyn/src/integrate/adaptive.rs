@@ -365,7 +365,7 @@ impl<S: TipSampleSystem + Clone> Adaptive<S> {
 
     /// (g, dg/dτ) at (τ, z) in `mode`.
     fn guard_at(&self, mode: Region, tau: f64, z: &[f64]) -> (f64, f64) {
-        let mut buf = [0.0; 2 * crate::params::MAX_MODES];
+        let mut buf = [0.0; crate::params::MAX_STATE];
         let mut heap = Vec::new();
         let f = if z.len() <= buf.len() {
             &mut buf[..z.len()]
@@ -382,7 +382,7 @@ impl<S: TipSampleSystem + Clone> Adaptive<S> {
 
     /// (g, dg/dτ) along the dense output of `stepper` at τ (its end points exactly).
     fn guard_on(&self, stepper: &mut Stepper, mode: Region, tau: f64) -> (f64, f64) {
-        let mut buf = [0.0; 2 * crate::params::MAX_MODES];
+        let mut buf = [0.0; crate::params::MAX_STATE];
         let z = &mut buf[..self.dim()];
         self.state_on(stepper, mode, tau, z);
         self.guard_at(mode, tau, z)
@@ -564,7 +564,7 @@ impl<S: TipSampleSystem + Clone + 'static> Integrator for Adaptive<S> {
         let t1 = self.advance(&mut stepper, region, var, tau_max)?;
         self.h = stepper.h();
         // the state at the step's end, formed once
-        let mut end = [0.0; 2 * crate::params::MAX_MODES];
+        let mut end = [0.0; crate::params::MAX_STATE];
         let end = &mut end[..d];
         self.state_on(&mut stepper, region, t1, end);
         let zero = self.find_zero(&mut stepper, region, (tau0, self.z.as_slice()), (t1, end));
@@ -660,11 +660,11 @@ impl<S: TipSampleSystem + Clone + 'static> Integrator for Adaptive<S> {
             return self.last.hermite.tip(&self.model, tau);
         }
         let z = self.dense_state(tau);
-        let mut f = vec![0.0; 2 * n];
+        let mut f = vec![0.0; z.len()];
         self.model.rhs(self.last.region, tau, z.as_slice(), &mut f);
         let tip = self.model.tip();
         let dot = |x: &[f64]| tip.iter().zip(x).map(|(a, b)| a * b).sum::<f64>();
-        [dot(&z.as_slice()[..n]), dot(&f[..n]), dot(&f[n..])]
+        [dot(&z.as_slice()[..n]), dot(&f[..n]), dot(&f[n..2 * n])]
     }
 
     fn last_step_jacobian(&mut self) -> Result<DMatrix<f64>, SimError> {

@@ -104,13 +104,16 @@ impl IntegratorKind {
     /// [`crate::params::Params::drive_components`], to `Taylor` for Hertz and DMT and to
     /// `Adaptive` for the others), to `Split` for a law without force in free flight (Hertz,
     /// JKR, capillary, impact with r > 0), to `Adaptive` for the plastic impact law r = 0 (whose free flights
-    /// all start tangentially) and for the electrostatic law, and to `Taylor` for DMT; other
-    /// kinds are returned as given.
+    /// all start tangentially), for the electrostatic law and for a law with internal states
+    /// (SLS), and to `Taylor` for DMT; other kinds are returned as given.
     /// ([`build`] falls back from `Split` to `Adaptive` for `Auto` where the exact free flight
     /// cannot be built: Ω at an undamped resonance of the free beam, or a grid beyond its
     /// budget.)
     pub fn resolve(self, model: &CantileverModel) -> IntegratorKind {
         match self {
+            // a law with internal states (the SLS sample): only the adaptive integrator carries
+            // them
+            IntegratorKind::Auto if model.law().internal_states() > 0 => IntegratorKind::Adaptive,
             // a multifrequency drive: the Taylor integrator for Hertz and DMT (its series carry
             // every component), else adaptive (the exact and split integrators propagate one
             // harmonic drive)
@@ -161,7 +164,7 @@ impl Default for IntegratorOptions {
 /// As [`CantileverModel::new`] and [`build`].
 pub fn check_buildable(params: &crate::Params, opts: IntegratorOptions) -> Result<(), SimError> {
     let model = CantileverModel::new(params)?;
-    build(&model, opts, 0.0, &DVector::zeros(2 * params.modes)).map(|_| ())
+    build(&model, opts, 0.0, &model.rest()).map(|_| ())
 }
 
 /// [`check_buildable`] at the smallest and the largest of `values` of `param` over `base` (the
@@ -212,7 +215,11 @@ pub fn build(
         let rate = [Region::Free, Region::Contact]
             .iter()
             .map(|&r| model.dynamics(r).a.norm())
-            .fold(0.0, f64::max);
+            .fold(0.0, f64::max)
+            // the SLS Maxwell arm: its relaxation rate and its spring at the tip
+            .max(model.zener().map_or(0.0, |zn| {
+                zn.relaxation_rate() + zn.maxwell * model.tip_mobility().norm()
+            }));
         let steps = rate * model.period();
         if steps.is_nan() || steps > crate::params::ADAPTIVE_STEPS_BUDGET {
             return Err(SimError::Budget {
@@ -236,6 +243,20 @@ pub fn build(
             "must be adaptive, taylor, auto or rk4 under a multifrequency drive: the exact and \
              split integrators propagate one harmonic drive",
         ));
+    }
+    if kind != IntegratorKind::Adaptive && model.law().internal_states() > 0 {
+        return Err(SimError::Unsupported {
+            integrator: match kind {
+                IntegratorKind::Exact => "exact",
+                IntegratorKind::Split => "split",
+                IntegratorKind::Taylor => "taylor",
+                _ => "rk4",
+            },
+            law: model.law().name(),
+            hint: "the sample's internal state (the SLS dashpot's extension) and its surface's \
+                   recovery are carried by the adaptive integrator only: use integrator = \
+                   \"auto\" (or \"adaptive\")",
+        });
     }
     if matches!(kind, IntegratorKind::Rk4 | IntegratorKind::Rk4Naive)
         && model.release_distance() > 0.0

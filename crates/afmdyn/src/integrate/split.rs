@@ -142,11 +142,12 @@ impl Split {
     /// Whether `model`'s law exerts no force in free flight (linear, Hertz, impact; not DMT or
     /// the electrostatic law).
     pub fn applies(model: &CantileverModel) -> bool {
-        !matches!(
-            model.law(),
-            crate::contact::ContactLaw::Dmt { .. }
-                | crate::contact::ContactLaw::Electrostatic { .. }
-        )
+        model.law().internal_states() == 0
+            && !matches!(
+                model.law(),
+                crate::contact::ContactLaw::Dmt { .. }
+                    | crate::contact::ContactLaw::Electrostatic { .. }
+            )
     }
 
     fn integ(&self, h: Half) -> &dyn Integrator {

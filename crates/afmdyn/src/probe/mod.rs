@@ -16,7 +16,8 @@
 //! youngs_modulus = 130e9         # E_t (Pa), default 130e9 (silicon, Hopcroft et al. 2010)
 //! poisson_ratio = 0.27           # ν_t, default 0.28 (silicon)
 //! [sample]
-//! law = "dmt"                    # linear | hertz | dmt | electrostatic | jkr | capillary | impact
+//! law = "dmt"                    # linear | hertz | dmt | electrostatic | jkr | capillary | sls
+//!                                # | impact
 //! youngs_modulus = 4e9           # E_s (Pa)            (hertz, dmt)
 //! poisson_ratio = 0.33           # ν_s                 (hertz, dmt)
 //! hamaker = 6.6e-20              # H (J)               (dmt; jkr: W = H/(12πa₀²) if no
@@ -28,6 +29,8 @@
 //! intermolecular_distance = 0.165e-9  # a₀ (m), default 0.165e-9 (Israelachvili) (dmt)
 //! viscosity = 0.0                # η (Pa·s), Kelvin–Voigt −η√(R(a₀ − d))·ḋ (dmt)
 //! # hertz: damping (N·s/m); linear: stiffness (N/m), damping (N·s/m); impact: restitution
+//! # sls: stiffness (N/m, the relaxed spring k₁), maxwell_stiffness (N/m, k₂) and
+//! #      relaxation_time (s, τ_r = η/k₂ of the Maxwell arm)
 //! z_c = 8e-9                     # optional rest tip–sample distance (m), default A₀
 //! [drive]
 //! free_amplitude = 10e-9         # A₀ (m) at the drive frequency, far from the sample
@@ -443,6 +446,8 @@ struct Sample {
     adhesion_energy: Option<f64>,
     /// The capillary meniscus: volume V (m³), surface tension γ (N/m), contact angle θ (rad).
     meniscus: Option<(f64, f64, f64)>,
+    /// The SLS sample's Maxwell arm: spring k₂ (N/m) and relaxation time τ_r = η/k₂ (s).
+    maxwell: Option<(f64, f64)>,
     z_c: Option<f64>,
 }
 
@@ -1110,7 +1115,14 @@ impl Probe {
             Some((_, l))
                 if matches!(
                     l.as_str(),
-                    "linear" | "hertz" | "dmt" | "electrostatic" | "jkr" | "capillary" | "impact"
+                    "linear"
+                        | "hertz"
+                        | "dmt"
+                        | "electrostatic"
+                        | "jkr"
+                        | "capillary"
+                        | "sls"
+                        | "impact"
                 ) =>
             {
                 Some(l)
@@ -1160,6 +1172,13 @@ impl Probe {
         ];
         let keys: &[&str] = match law.as_str() {
             "linear" => &["law", "stiffness", "damping", "z_c"],
+            "sls" => &[
+                "law",
+                "stiffness",
+                "maxwell_stiffness",
+                "relaxation_time",
+                "z_c",
+            ],
             "hertz" => &["law", "youngs_modulus", "poisson_ratio", "damping", "z_c"],
             "dmt" => &DMT,
             "electrostatic" => &electrostatic,
@@ -1182,6 +1201,7 @@ impl Probe {
             voltage: None,
             adhesion_energy: None,
             meniscus: None,
+            maxwell: None,
             z_c,
         };
         match law.as_str() {
@@ -1189,6 +1209,13 @@ impl Probe {
                 out.stiffness = r.required(s, S, "stiffness", "N/m", NON_NEGATIVE);
                 out.damping = r.optional(s, S, "damping", "N s/m", NON_NEGATIVE);
                 return out.stiffness.map(|_| out);
+            }
+            "sls" => {
+                out.stiffness = r.required(s, S, "stiffness", "N/m", POSITIVE);
+                let k2 = r.required(s, S, "maxwell_stiffness", "N/m", POSITIVE);
+                let tau = r.required(s, S, "relaxation_time", "s", POSITIVE);
+                out.maxwell = k2.zip(tau);
+                return out.stiffness.and(out.maxwell).map(|_| out);
             }
             "impact" => {
                 out.restitution = r.required(s, S, "restitution", "1", UNIT_INTERVAL);
@@ -1466,6 +1493,15 @@ impl Probe {
             "linear" => {
                 alpha4 = sample.stiffness.unwrap_or(0.0) * g0 / force_n;
                 alpha6 = sample.damping.unwrap_or(0.0) * g0 / (t_s * force_n);
+            }
+            "sls" => {
+                // springs in units of F_s/g₀; the dashpot η = k₂τ_r (N·s/m) as the linear
+                // law's damper: α6 = η g₀/(t_s F_s) = κ τ_r/t_s
+                let (k2, tau_r) = sample.maxwell.unwrap_or((0.0, 0.0));
+                alpha4 = sample.stiffness.unwrap_or(0.0) * g0 / force_n;
+                let maxwell_stiffness = k2 * g0 / force_n;
+                alpha6 = maxwell_stiffness * tau_r / t_s;
+                law = ContactLaw::Sls { maxwell_stiffness };
             }
             "hertz" | "dmt" | "electrostatic" | "jkr" | "capillary" => {
                 let (e, rr) = (sample.e_star.unwrap_or(0.0), sample.radius.unwrap_or(0.0));

@@ -26,7 +26,10 @@ pub fn continuation_layout(
         .flat_map(|(i, b)| b.iter().map(move |p| (i, p)))
         .collect();
     let rows = points.len();
+    // the state's modal part (a, ȧ) (a law's internal states are not listed); every Floquet
+    // multiplier, one per state entry
     let dim = 2 * model.modes();
+    let mults = model.dim();
     let width = points
         .iter()
         .map(|(_, b)| b.section.len())
@@ -42,16 +45,16 @@ pub fn continuation_layout(
             .collect::<Vec<i32>>()
     };
     let mut w_section = Vec::with_capacity(rows * width);
-    let mut multipliers = Vec::with_capacity(rows * dim);
+    let mut multipliers = Vec::with_capacity(rows * mults);
     let mut state = Vec::with_capacity(rows * dim);
     for (_, b) in &points {
         w_section.extend((0..width).map(|j| b.section.get(j).map_or(f64::NAN, |z| model.w_tip(z))));
-        multipliers.extend((0..dim).map(|j| {
+        multipliers.extend((0..mults).map(|j| {
             b.multipliers
                 .get(j)
                 .map_or((f64::NAN, f64::NAN), |m| (m.re, m.im))
         }));
-        state.extend(b.section[0].iter());
+        state.extend(b.section[0].iter().take(dim));
     }
     let point: &[&str] = &["point"];
     Layout::new(
@@ -59,7 +62,7 @@ pub fn continuation_layout(
         &[
             ("point", rows),
             ("k", width),
-            ("multiplier", dim),
+            ("multiplier", mults),
             ("component", dim),
         ],
         vec![

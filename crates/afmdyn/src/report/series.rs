@@ -61,7 +61,9 @@ pub fn simulate_layout(
     let state: Vec<f64> = sections
         .iter()
         .flat_map(|(_, z)| {
+            // the modal state (a, ȧ); a law's internal states are not listed
             z.iter()
+                .take(2 * n)
                 .enumerate()
                 .map(|(i, &v)| if i < n { su.x(v) } else { su.v(v) })
         })

@@ -138,7 +138,8 @@ pub fn initial_state(
         return Ok(model.rest());
     };
     let n = model.modes();
-    if z.len() != 2 * n {
+    // (a, ȧ) with the law's internal states at rest, or the whole state (an orbit's, fed back)
+    if z.len() != 2 * n && z.len() != model.dim() {
         return Err(SimError::StateLength {
             name: "initial (a1..aN, adot1..adotN)",
             expected: 2 * n,
@@ -162,7 +163,9 @@ pub fn initial_state(
             "every entry must be finite and below 1e11 (states of norm 1e12 count as diverged)",
         ));
     }
-    model.state_from(&z[..n], &z[n..])
+    let mut state = model.state_from(&z[..n], &z[n..2 * n])?;
+    state.as_mut_slice()[2 * n..].copy_from_slice(&z[2 * n..]);
+    Ok(state)
 }
 
 /// [`StartRequest::guess_with_section`]: the guess, the period found, the recorded section

@@ -76,7 +76,7 @@ const fn info(
 /// Every model parameter a request takes, in the order the front ends list them. The ranges
 /// are those [`Params::validate`] and [`ContactLaw::validate`] enforce; `z_c` and
 /// `drive_frequency` are SI values that need a probe file.
-pub const MODEL_PARAMETERS: [ParamInfo; 21] = [
+pub const MODEL_PARAMETERS: [ParamInfo; 22] = [
     info(
         "modes",
         None,
@@ -162,13 +162,14 @@ pub const MODEL_PARAMETERS: [ParamInfo; 21] = [
         None,
         "F_c",
         "1",
-        "linear, hertz, dmt, electrostatic, jkr, capillary or impact",
+        "linear, hertz, dmt, electrostatic, jkr, capillary, sls or impact",
         "linear",
         "tip–sample law: linear (α4 δ + α6 δ̇), hertz (α4 δ^1.5 + α6 δ̇), dmt (van der Waals + \
          adhesion + Hertz + α6 √δ δ̇), electrostatic (dmt + a biased tip), jkr (adhesive Hertz \
          contact with a neck, formed at δ = 0, broken at δ_f < 0), capillary (a meniscus formed \
-         at contact, ruptured at V_T = D_r, over a Hertz sample) or impact (rigid sample, \
-         restitution r)",
+         at contact, ruptured at V_T = D_r, over a Hertz sample), sls (standard linear solid: \
+         α4 in parallel with a Maxwell arm κ, α6, whose surface recovers after the tip leaves) \
+         or impact (rigid sample, restitution r)",
         ValueKind::Law,
     ),
     info(
@@ -270,6 +271,17 @@ pub const MODEL_PARAMETERS: [ParamInfo; 21] = [
         "1e-9..=1e6",
         "0.05",
         "capillary law: the rupture distance D̃_r = (1 + θ/2)V^(1/3)/g0 (Lian et al. 1993)",
+        ValueKind::Real,
+    ),
+    info(
+        "maxwell_stiffness",
+        None,
+        "κ",
+        "1",
+        "(0, 1e12]",
+        "20",
+        "sls law: the Maxwell arm's spring κ (in series with the dashpot α6; relaxation time \
+         α6/κ, instantaneous stiffness α4 + κ)",
         ValueKind::Real,
     ),
     info(
@@ -379,6 +391,9 @@ pub struct ModelSpec {
     /// Capillary law: D̃_r.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub rupture: Option<f64>,
+    /// SLS law: κ.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub maxwell_stiffness: Option<f64>,
     /// With a probe: z_c in m.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub z_c: Option<f64>,
@@ -412,6 +427,7 @@ impl ModelSpec {
             capillary: self.capillary.or(lower.capillary),
             meniscus: self.meniscus.or(lower.meniscus),
             rupture: self.rupture.or(lower.rupture),
+            maxwell_stiffness: self.maxwell_stiffness.or(lower.maxwell_stiffness),
             z_c: self.z_c.or(lower.z_c),
             drive_frequency: self.drive_frequency.or(lower.drive_frequency),
         }
@@ -442,6 +458,7 @@ impl ModelSpec {
             ("capillary", self.capillary),
             ("meniscus", self.meniscus),
             ("rupture", self.rupture),
+            ("maxwell_stiffness", self.maxwell_stiffness),
             ("z_c", self.z_c),
             ("drive_frequency", self.drive_frequency),
         ];
@@ -479,6 +496,7 @@ impl ModelSpec {
                 capillary: self.capillary,
                 meniscus: self.meniscus,
                 rupture: self.rupture,
+                maxwell_stiffness: self.maxwell_stiffness,
             },
             base.contact_law,
         )?;
@@ -575,7 +593,7 @@ impl ModelSpec {
 /// Hamaker constant in J): the value's name and what to give instead. `modes` and
 /// `restitution` (pure numbers, the same in SI) and the SI values `z_c` and `drive_frequency`
 /// are taken with a probe.
-pub const PROBE_SETS: [(&str, &str); 17] = [
+pub const PROBE_SETS: [(&str, &str); 18] = [
     (
         "tip_mass_ratio",
         "is the dimensionless α1 and a probe sets it: give it in the probe file's [cantilever] \
@@ -661,6 +679,11 @@ pub const PROBE_SETS: [(&str, &str); 17] = [
         "is the dimensionless D̃_r and a probe sets it: give the probe file's [sample] \
          meniscus_volume (m³) and contact_angle (degrees) (law = \"capillary\")",
     ),
+    (
+        "maxwell_stiffness",
+        "is the dimensionless κ and a probe sets it: give the probe file's [sample] \
+         maxwell_stiffness (N/m, law = \"sls\")",
+    ),
 ];
 
 impl ModelSpec {
@@ -684,6 +707,7 @@ impl ModelSpec {
             ("capillary", self.capillary),
             ("meniscus", self.meniscus),
             ("rupture", self.rupture),
+            ("maxwell_stiffness", self.maxwell_stiffness),
         ];
         for ((name, value), (key, allowed)) in given.into_iter().zip(PROBE_SETS) {
             debug_assert_eq!(name, key);
@@ -777,6 +801,7 @@ mod tests {
             capillary: Some(1.0),
             meniscus: Some(1.0),
             rupture: Some(1.0),
+            maxwell_stiffness: Some(1.0),
             z_c: Some(0.0),
             drive_frequency: Some(1.0),
         };

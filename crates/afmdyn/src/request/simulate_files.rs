@@ -56,6 +56,8 @@ pub fn series_columns(n: usize, su: &SeriesUnits) -> Vec<Column> {
 /// The rows of samples ([`crate::trajectory::SampleRows`]' layout, that of
 /// [`series_columns`]) in `su`'s units, written over `out`.
 fn convert_rows(rows: &[f64], width: usize, su: &SeriesUnits, out: &mut Vec<f64>) {
+    // the modal state (a, ȧ) of each row; a law's internal states (an SLS sample's u, the
+    // row's last entry) are not written
     let n = (width - 6) / 2;
     out.clear();
     out.reserve(rows.len());
@@ -69,7 +71,7 @@ fn convert_rows(rows: &[f64], width: usize, su: &SeriesUnits, out: &mut Vec<f64>
             su.force(r[5]),
         ]);
         out.extend(r[6..6 + n].iter().map(|&a| su.x(a)));
-        out.extend(r[6 + n..].iter().map(|&a| su.v(a)));
+        out.extend(r[6 + n..6 + 2 * n].iter().map(|&a| su.v(a)));
     }
 }
 
@@ -136,8 +138,11 @@ impl SeriesFiles {
     /// [`FileError`] naming a file that cannot be written.
     pub fn push(&mut self, model: &CantileverModel, c: &Chunk<'_>) -> Result<(), FileError> {
         let su = &self.su;
-        // dimensionless units: the rows as they are (the conversion would multiply by 1)
-        let rows = if [su.u.time, su.u.length, su.u.force] == [1.0; 3] {
+        // dimensionless units and no internal state: the rows as they are (the conversion
+        // would multiply by 1)
+        let n = model.modes();
+        let width = 6 + 2 * n;
+        let rows = if [su.u.time, su.u.length, su.u.force] == [1.0; 3] && c.width == width {
             c.rows
         } else {
             convert_rows(c.rows, c.width, su, &mut self.converted);
@@ -147,7 +152,7 @@ impl SeriesFiles {
         let lines = &mut self.lines;
         if let Some(csv) = self.csv.as_mut() {
             lines.clear();
-            for row in rows.chunks_exact(c.width) {
+            for row in rows.chunks_exact(width) {
                 csv_line(lines, row.iter().map(|&v| Field::Num(v)));
             }
             csv_lines(csv, lines)?;

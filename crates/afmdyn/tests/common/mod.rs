@@ -26,7 +26,8 @@ pub fn complex_response(model: &CantileverModel, r: Region) -> DVector<Complex<f
 
 /// Closed-form periodic forced response of region `r` from the second-order equations
 /// M Ẍ + C Ẋ + K X = F(τ) (eq. 10): K X₀ = F_const and (K − Ω²M + iΩC) X̂ = F_cos − i F_sin.
-/// Independent of the first-order solve inside the propagator. Returns z_p(τ) = (X, Ẋ).
+/// Independent of the first-order solve inside the propagator. Returns z_p(τ) = (X, Ẋ) (and a
+/// law's internal states at rest).
 pub fn harmonic_response(model: &CantileverModel, r: Region, tau: f64) -> DVector<f64> {
     let g = model.galerkin().region(r);
     let w = model.omega();
@@ -34,7 +35,8 @@ pub fn harmonic_response(model: &CantileverModel, r: Region, tau: f64) -> DVecto
     let x0 = g.stiffness.clone().lu().solve(&g.forcing.constant).unwrap();
     let e = Complex::new((w * tau).cos(), (w * tau).sin());
     let n = model.modes();
-    let mut z = DVector::zeros(2 * n);
+    // a law's internal states at rest (an SLS sample out of reach stays relaxed)
+    let mut z = DVector::zeros(model.dim());
     for j in 0..n {
         z[j] = x0[j] + (xh[j] * e).re;
         z[n + j] = (xh[j] * e * Complex::new(0.0, w)).re;
@@ -330,4 +332,58 @@ pub mod laws {
         meniscus: CAPILLARY_DEFAULT_MENISCUS,
         rupture: CAPILLARY_DEFAULT_RUPTURE,
     };
+    /// The standard linear solid (κ = 20): one internal state (the dashpot's extension u, the
+    /// state's last entry), a guard over the recovering surface.
+    pub const SLS: ContactLaw = ContactLaw::Sls {
+        maxwell_stiffness: SLS_DEFAULT_MAXWELL,
+    };
+}
+
+/// A region's vector field ż = f(contact, τ, z).
+pub type RegionField<'a> = &'a dyn Fn(bool, f64, &DVector<f64>) -> DVector<f64>;
+
+/// An independent integrator of a two-region switched system, for the tests: fixed-step RK4
+/// of `rhs(contact, τ, z)` from z(0) = `z0` to `t1` with steps of `h`; the region starts as
+/// `below(0, z0)` (in contact when the switching function is negative) and a change of sign of
+/// the switching function inside a step, `below(τ, z) != contact`, is located by bisection on
+/// the step length (60 halvings) and the region switched there.
+pub fn rk4_switched_flow(
+    rhs: RegionField<'_>,
+    below: &dyn Fn(f64, &DVector<f64>) -> bool,
+    z0: &DVector<f64>,
+    t1: f64,
+    h: f64,
+) -> DVector<f64> {
+    let rk4 = |contact: bool, tau: f64, z: &DVector<f64>, h: f64| {
+        let k1 = rhs(contact, tau, z);
+        let k2 = rhs(contact, tau + h / 2.0, &(z + &k1 * (h / 2.0)));
+        let k3 = rhs(contact, tau + h / 2.0, &(z + &k2 * (h / 2.0)));
+        let k4 = rhs(contact, tau + h, &(z + &k3 * h));
+        z + (k1 + k2 * 2.0 + k3 * 2.0 + k4) * (h / 6.0)
+    };
+    let (mut tau, mut z) = (0.0, z0.clone());
+    let mut contact = below(0.0, z0);
+    while tau < t1 - 1e-14 {
+        let step = h.min(t1 - tau);
+        let inside = |zz: &DVector<f64>, t: f64| below(t, zz) == contact;
+        let zb = rk4(contact, tau, &z, step);
+        if inside(&zb, tau + step) {
+            z = zb;
+            tau += step;
+            continue;
+        }
+        let (mut lo, mut hi) = (0.0, step);
+        for _ in 0..60 {
+            let mid = 0.5 * (lo + hi);
+            if inside(&rk4(contact, tau, &z, mid), tau + mid) {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        z = rk4(contact, tau, &z, hi);
+        tau += hi;
+        contact = !contact;
+    }
+    z
 }

@@ -458,7 +458,8 @@ impl Jet {
             | ContactLaw::Impact { .. }
             | ContactLaw::Electrostatic { .. }
             | ContactLaw::Jkr { .. }
-            | ContactLaw::Capillary { .. } => return None,
+            | ContactLaw::Capillary { .. }
+            | ContactLaw::Sls { .. } => return None,
         };
         let n = model.modes();
         let free = model.dynamics(Region::Free);
