@@ -118,6 +118,8 @@ pub struct ModelArgs {
     pub meniscus: Option<f64>,
     #[arg(long, value_name = "D̃_r", allow_negative_numbers = true)]
     pub rupture: Option<f64>,
+    #[arg(long, value_name = "κ", allow_negative_numbers = true)]
+    pub maxwell_stiffness: Option<f64>,
 }
 
 fn parse_law(s: &str) -> Result<LawKind, String> {
@@ -174,6 +176,7 @@ impl ModelArgs {
             capillary: self.capillary,
             meniscus: self.meniscus,
             rupture: self.rupture,
+            maxwell_stiffness: self.maxwell_stiffness,
             z_c: quantity(self.z_c, "z-c", Dim::Length, true)?,
             drive_frequency: quantity(
                 self.drive_frequency,

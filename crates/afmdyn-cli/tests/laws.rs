@@ -25,7 +25,7 @@ fn json(args: &[&str]) -> serde_json::Value {
 }
 
 /// (law flags, model flags giving a periodic orbit at the chosen Ω, Ω).
-const LAWS: [(&[&str], &[&str], &str); 7] = [
+const LAWS: [(&[&str], &[&str], &str); 8] = [
     (&["--contact-law", "linear"], &["--modes", "2"], "2.8"),
     (&["--contact-law", "hertz"], &["--modes", "2"], "2.8"),
     (
@@ -59,6 +59,8 @@ const LAWS: [(&[&str], &[&str], &str); 7] = [
         &["--modes", "2"],
         "2.8",
     ),
+    // and `--contact-law sls`: an internal state (the Maxwell dashpot) and a recovering surface
+    (&["--contact-law", "sls"], &["--modes", "2"], "3.0"),
 ];
 
 fn as_refs(v: Vec<String>) -> Output {
@@ -195,6 +197,18 @@ fn law_flags_are_checked() {
         (
             vec!["simulate", "--contact-law", "jkr", "--integrator", "taylor"],
             "taylor",
+        ),
+        (
+            vec!["orbit", "--contact-law", "sls", "--maxwell-stiffness", "0"],
+            "maxwell_stiffness",
+        ),
+        (
+            vec!["orbit", "--contact-law", "sls", "--contact-damping", "0"],
+            "alpha6",
+        ),
+        (
+            vec!["simulate", "--contact-law", "sls", "--integrator", "split"],
+            "split",
         ),
         (vec!["orbit", "--excitation", "laser"], "excitation 'laser'"),
         (

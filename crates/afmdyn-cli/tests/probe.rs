@@ -915,3 +915,43 @@ fn every_example_probe_loads_and_the_hysteretic_ones_approach() {
     let e_cap = f * (d_r + h - d_r.hypot(h));
     assert!(rel(&cap["energy_per_tap_j"], e_cap) < 1e-12, "{cap}");
 }
+
+/// The standard linear solid in water (`examples/probe-water-sls.toml`, a beam of three modes
+/// at Q₁ ≈ 2.4) runs an approach curve from the file as it stands: the taps dissipate energy in
+/// the sample's dashpot, the sample never pulls the tip (its force vanishes where the tip leaves;
+/// round-off allowed), and the higher modes' share of the motion grows from its free value as
+/// the tip taps harder (Basak & Raman, APL 91 (2007) 064107: the higher modes are excited at
+/// every tap in liquid).
+#[test]
+fn a_viscoelastic_sample_in_water_approaches_from_its_probe_file() {
+    let doc = json(&[
+        "approach",
+        "--probe",
+        "examples/probe-water-sls.toml",
+        "--points",
+        "24",
+        "--no-branches",
+        "--json",
+    ]);
+    assert_eq!(doc["params"]["contact_law"]["law"], "sls");
+    let a = &doc["approach"];
+    let col = |k: &str| -> Vec<f64> {
+        a[k].as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect()
+    };
+    let (e, fmin, fmax, share) = (
+        col("energy_dissipated"),
+        col("min_force"),
+        col("peak_force"),
+        col("higher_mode_fraction"),
+    );
+    assert!(e.iter().any(|&x| x > 1e-19), "{e:?}");
+    let peak = fmax.iter().copied().fold(0.0, f64::max);
+    assert!(peak > 1e-10, "{peak}");
+    assert!(fmin.iter().all(|&f| f > -1e-8 * peak), "{fmin:?}");
+    let (free, tapping) = (share[0], share.iter().copied().fold(0.0, f64::max));
+    assert!(tapping > 3.0 * free, "{free} → {tapping}");
+}

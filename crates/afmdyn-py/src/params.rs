@@ -129,6 +129,7 @@ pub fn model_spec(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<ModelSpec> {
             "capillary" => m.capillary = x()?,
             "meniscus" => m.meniscus = x()?,
             "rupture" => m.rupture = x()?,
+            "maxwell_stiffness" => m.maxwell_stiffness = x()?,
             "z_c" => m.z_c = x()?,
             "drive_frequency" => m.drive_frequency = x()?,
             "excitation" => {
@@ -213,10 +214,11 @@ pub fn resolve(
 /// ``beam_damping``/``alpha3`` (α3 ≥ 0), ``contact_stiffness``/``alpha4`` (α4 ≥ 0),
 /// ``gap``/``alpha5`` (α5, finite), ``contact_damping``/``alpha6`` (α6 ≥ 0), ``omega``
 /// (Ω > 0), ``contact_law`` (``"linear"``, ``"hertz"``, ``"dmt"``, ``"electrostatic"``,
-/// ``"jkr"``, ``"capillary"``, ``"impact"``) with its groups ``restitution`` (0..=1, impact), ``hamaker``
+/// ``"jkr"``, ``"capillary"``, ``"sls"``, ``"impact"``) with its groups ``restitution`` (0..=1, impact), ``hamaker``
 /// (≥ 0) and ``intermolecular_distance`` (> 0, DMT and electrostatic), ``electrostatic``
 /// (Ẽ ≥ 0) and ``tip_radius`` (R̃ > 0, electrostatic), ``adhesion`` (P̃ > 0, JKR),
 /// ``capillary`` (F̃_cap > 0), ``meniscus`` (h̃) and ``rupture`` (D̃_r, capillary),
+/// ``maxwell_stiffness`` (κ > 0, the SLS sample's Maxwell arm; its dashpot is α6),
 /// ``excitation`` (``"base"``, ``"tip"``: where the
 /// drive acts on the beam). Missing ones take the paper's Figs. 5–14 set (N = 3, α1 = α2 = α3 = 0.1, α4 = 20,
 /// α5 = 0, α6 = 0.2, Ω = 2.6). The names, ranges and help are the library's one table
@@ -429,6 +431,14 @@ impl PyParams {
     fn rupture(&self) -> Option<f64> {
         match self.inner.contact_law {
             afmdyn::ContactLaw::Capillary { rupture, .. } => Some(rupture),
+            _ => None,
+        }
+    }
+    /// SLS law: the Maxwell arm's spring κ (its dashpot is α6; ``None`` for the other laws).
+    #[getter]
+    fn maxwell_stiffness(&self) -> Option<f64> {
+        match self.inner.contact_law {
+            afmdyn::ContactLaw::Sls { maxwell_stiffness } => Some(maxwell_stiffness),
             _ => None,
         }
     }

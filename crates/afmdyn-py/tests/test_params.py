@@ -211,6 +211,16 @@ def test_contact_law_keywords_resolve_as_on_the_command_line(cli_json):
     ]
     with pytest.raises(ValueError, match="meniscus is a group of the capillary law"):
         Params(contact_law="dmt", meniscus=0.01)
+    # the standard linear solid: its Maxwell arm κ with its default, the dashpot α6
+    s = Params(contact_law="sls")
+    assert s.maxwell_stiffness == 20.0 and Params().maxwell_stiffness is None
+    assert s.to_dict() == cli_json("modes", "--contact-law", "sls")["params"]
+    with pytest.raises(ValueError, match="maxwell_stiffness is a group of the sls law"):
+        Params(contact_law="linear", maxwell_stiffness=1.0)
+    with pytest.raises(ValueError, match="maxwell_stiffness"):
+        Params(contact_law="sls", maxwell_stiffness=0.0)
+    with pytest.raises(ValueError, match="alpha6"):
+        Params(contact_law="sls", contact_damping=0.0)
 
 
 def test_every_law_runs_from_python_as_on_the_command_line(cli_json):
@@ -221,6 +231,7 @@ def test_every_law_runs_from_python_as_on_the_command_line(cli_json):
         ("electrostatic", {"electrostatic": 2e-3, "tip_radius": 0.5}),
         ("jkr", {"adhesion": 0.02}),
         ("capillary", {"capillary": 0.05, "rupture": 0.04}),
+        ("sls", {"maxwell_stiffness": 5.0}),
         ("impact", {"restitution": 0.5}),
     ]:
         model = {"contact_law": law, "modes": 1, "omega": 3.0, "gap": 0.05, **extra}

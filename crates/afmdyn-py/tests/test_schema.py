@@ -90,6 +90,7 @@ CLI_CASES: List[Tuple[str, List[Any]]] = [
     # the hysteretic laws' si.contact_hysteresis
     ("units", ["--probe", EXAMPLES / "probe-jkr-polymer.toml"]),
     ("units", ["--probe", EXAMPLES / "probe-capillary-humid.toml"]),
+    ("units", ["--probe", EXAMPLES / "probe-water-sls.toml"]),
     ("simulate", ["--periods", 3, "--files", "none"]),
     ("simulate", ["--periods", 3, "--files", "data"]),
     ("simulate", ["--periods", 3, "--files", "none", "--probe", P1]),

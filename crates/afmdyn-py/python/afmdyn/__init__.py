@@ -18,10 +18,11 @@ with :func:`afmdyn.dask.chart`), :func:`orbit`, :func:`continuation`, :func:`lya
 (approach–retract curves) and :func:`resonance` (resonance curves), both with branches and
 folds. Physical units: a probe
 file in SI (:func:`probe`, ``Params.from_probe``) sets every parameter. Tip–sample laws:
-``contact_law="linear" | "hertz" | "dmt" | "electrostatic" | "jkr" | "capillary" | "impact"``
+``contact_law="linear" | "hertz" | "dmt" | "electrostatic" | "jkr" | "capillary" | "sls" | "impact"``
 with ``restitution`` (impact), ``hamaker`` and ``intermolecular_distance`` (DMT,
 electrostatic), ``electrostatic`` and ``tip_radius`` (electrostatic), ``adhesion`` (JKR),
-``capillary``, ``meniscus`` and ``rupture`` (capillary) among the model keywords.
+``capillary``, ``meniscus`` and ``rupture`` (capillary), ``maxwell_stiffness`` (sls) among the
+model keywords.
 """
 
 from ._afmdyn import Params, SimulationError

@@ -33,12 +33,12 @@ class Params:
     ``drive_amplitude``/``alpha2`` (≥ 0), ``beam_damping``/``alpha3`` (≥ 0),
     ``contact_stiffness``/``alpha4`` (≥ 0), ``gap``/``alpha5`` (finite),
     ``contact_damping``/``alpha6`` (≥ 0), ``omega`` (Ω > 0), ``contact_law`` (``"linear"``,
-    ``"hertz"``, ``"dmt"``, ``"electrostatic"``, ``"jkr"``, ``"capillary"``, ``"impact"``) with
+    ``"hertz"``, ``"dmt"``, ``"electrostatic"``, ``"jkr"``, ``"capillary"``, ``"sls"``, ``"impact"``) with
     its groups
     ``restitution`` (0..=1, impact), ``hamaker`` (≥ 0) and ``intermolecular_distance`` (> 0,
     DMT and electrostatic), ``electrostatic`` (Ẽ ≥ 0) and ``tip_radius`` (R̃ > 0,
     electrostatic), ``adhesion`` (P̃ = πWR > 0, JKR), ``capillary`` (F̃_cap > 0), ``meniscus``
-    (h̃) and ``rupture`` (D̃_r, capillary),
+    (h̃) and ``rupture`` (D̃_r, capillary), ``maxwell_stiffness`` (κ > 0, sls),
     ``excitation`` (``"base"``, ``"tip"``: where the drive acts on the beam); the others keep
     the paper's
     Figs. 5–14 set. Raises ``ValueError`` (field and range) or ``TypeError`` (unknown keyword,
@@ -62,7 +62,7 @@ class Params:
         contact_damping: float = ...,
         alpha6: float = ...,
         omega: float = ...,
-        contact_law: Literal["linear", "hertz", "dmt", "electrostatic", "jkr", "capillary", "impact"] = ...,
+        contact_law: Literal["linear", "hertz", "dmt", "electrostatic", "jkr", "capillary", "sls", "impact"] = ...,
         excitation: Literal["base", "tip"] = ...,
         restitution: float = ...,
         hamaker: float = ...,
@@ -73,6 +73,7 @@ class Params:
         capillary: float = ...,
         meniscus: float = ...,
         rupture: float = ...,
+        maxwell_stiffness: float = ...,
     ) -> None: ...
     def replace(
         self,
@@ -91,7 +92,7 @@ class Params:
         contact_damping: float = ...,
         alpha6: float = ...,
         omega: float = ...,
-        contact_law: Literal["linear", "hertz", "dmt", "electrostatic", "jkr", "capillary", "impact"] = ...,
+        contact_law: Literal["linear", "hertz", "dmt", "electrostatic", "jkr", "capillary", "sls", "impact"] = ...,
         excitation: Literal["base", "tip"] = ...,
         restitution: float = ...,
         hamaker: float = ...,
@@ -102,6 +103,7 @@ class Params:
         capillary: float = ...,
         meniscus: float = ...,
         rupture: float = ...,
+        maxwell_stiffness: float = ...,
     ) -> "Params":
         """A validated copy with the given keywords changed."""
     @staticmethod
@@ -134,7 +136,7 @@ class Params:
     @property
     def omega(self) -> float: ...
     @property
-    def contact_law(self) -> Literal["linear", "hertz", "dmt", "electrostatic", "jkr", "capillary", "impact"]: ...
+    def contact_law(self) -> Literal["linear", "hertz", "dmt", "electrostatic", "jkr", "capillary", "sls", "impact"]: ...
     @property
     def restitution(self) -> Optional[float]: ...
     @property
@@ -155,6 +157,8 @@ class Params:
     def meniscus(self) -> Optional[float]: ...
     @property
     def rupture(self) -> Optional[float]: ...
+    @property
+    def maxwell_stiffness(self) -> Optional[float]: ...
     @property
     def tip_mass_ratio(self) -> float: ...
     @property

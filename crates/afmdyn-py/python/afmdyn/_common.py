@@ -74,7 +74,7 @@ class Model(TypedDict, total=False):
     contact_damping: float
     alpha6: float
     omega: float
-    contact_law: Literal["linear", "hertz", "dmt", "electrostatic", "jkr", "capillary", "impact"]
+    contact_law: Literal["linear", "hertz", "dmt", "electrostatic", "jkr", "capillary", "sls", "impact"]
     excitation: Literal["base", "tip"]
     restitution: float
     hamaker: float
@@ -85,6 +85,7 @@ class Model(TypedDict, total=False):
     capillary: float
     meniscus: float
     rupture: float
+    maxwell_stiffness: float
     z_c: float
     drive_frequency: float
     probe: Union[str, "os.PathLike[str]", Dict[str, Any]]
