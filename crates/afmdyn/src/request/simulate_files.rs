@@ -53,12 +53,11 @@ pub fn series_columns(n: usize, su: &SeriesUnits) -> Vec<Column> {
         .collect()
 }
 
-/// The rows of samples ([`crate::trajectory::SampleRows`]' layout, that of
-/// [`series_columns`]) in `su`'s units, written over `out`.
-fn convert_rows(rows: &[f64], width: usize, su: &SeriesUnits, out: &mut Vec<f64>) {
-    // the modal state (a, ȧ) of each row; a law's internal states (an SLS sample's u, the
-    // row's last entry) are not written
-    let n = (width - 6) / 2;
+/// The rows of samples of an `n`-mode run ([`crate::trajectory::SampleRows`]' layout, rows of
+/// `width` = 6 + 2N + m) as [`series_columns`] has them, in `su`'s units, written over `out`:
+/// the modal state (a, ȧ) of each row; a law's m internal states (an SLS sample's u, the row's
+/// last entries) are not written.
+fn convert_rows(rows: &[f64], width: usize, n: usize, su: &SeriesUnits, out: &mut Vec<f64>) {
     out.clear();
     out.reserve(rows.len());
     for r in rows.chunks_exact(width) {
@@ -145,7 +144,7 @@ impl SeriesFiles {
         let rows = if [su.u.time, su.u.length, su.u.force] == [1.0; 3] && c.width == width {
             c.rows
         } else {
-            convert_rows(c.rows, c.width, su, &mut self.converted);
+            convert_rows(c.rows, c.width, n, su, &mut self.converted);
             &self.converted
         };
         self.npy.push_rows(rows)?;
