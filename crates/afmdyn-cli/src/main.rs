@@ -33,6 +33,7 @@ mod cmd_approach;
 mod cmd_basins;
 mod cmd_chart;
 mod cmd_fm;
+mod cmd_image;
 mod cmd_modes;
 mod cmd_orbits;
 mod cmd_reconstruct;
@@ -101,6 +102,8 @@ enum Command {
     Fm(cmd_fm::FmArgs),
     /// Tip–sample force and potential from an FM-AFM frequency-shift curve (Sader–Jarvis)
     Reconstruct(cmd_reconstruct::ReconstructArgs),
+    /// AM-AFM image of a heterogeneous sample (ideal feedback): apparent height, phase, E_dis maps
+    Image(cmd_image::ImageArgs),
 }
 
 fn run(cli: Cli) -> Result<(), CliError> {
@@ -123,6 +126,7 @@ fn run(cli: Cli) -> Result<(), CliError> {
         Command::Resonance(a) => cmd_approach::resonance(&a),
         Command::Fm(a) => cmd_fm::fm(&a),
         Command::Reconstruct(a) => cmd_reconstruct::reconstruct(&a),
+        Command::Image(a) => cmd_image::image_cmd(&a),
     }
 }
 

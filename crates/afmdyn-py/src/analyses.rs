@@ -582,3 +582,35 @@ pub fn observe<'py>(
     out.set("period", doc.output.period)?;
     Ok(out.finish())
 }
+
+/// The ideal-feedback image of a sample map under a probe (`afmdyn image`:
+/// [`afmdyn::request::image::image`]): its JSON document. `probe` is the probe's TOML text
+/// ([`crate::params::probe_source`]), `sample` the map's TOML text or path
+/// ([`afmdyn::request::image::SampleMap::read`]); `None` takes the request's defaults
+/// ([`afmdyn::request::image::ImageRequest::at`]).
+#[pyfunction]
+#[pyo3(signature = (probe, sample, setpoint, pixels=None, lines=None, curve_points=None))]
+pub fn image(
+    py: Python<'_>,
+    probe: &str,
+    sample: &str,
+    setpoint: f64,
+    pixels: Option<usize>,
+    lines: Option<usize>,
+    curve_points: Option<usize>,
+) -> PyResult<String> {
+    use afmdyn::request::image::{image, ImageRequest, SampleMap};
+    let table: toml::Table = probe
+        .parse()
+        .map_err(|e: toml::de::Error| crate::errors::value_error(format!("probe: {e}")))?;
+    let map = SampleMap::read(sample).map_err(sim_error)?;
+    let d = ImageRequest::at(setpoint);
+    let req = ImageRequest {
+        pixels: pixels.unwrap_or(d.pixels),
+        lines,
+        curve_points: curve_points.unwrap_or(d.curve_points),
+        ..d
+    };
+    let img = py.detach(|| image(&table, &map, &req)).map_err(sim_error)?;
+    Ok(img.document(setpoint).to_string())
+}

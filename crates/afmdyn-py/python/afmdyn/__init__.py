@@ -48,6 +48,7 @@ from ._interrupt import cancel_running
 from ._interrupt import install as _install_sigint
 from ._orbits import lyapunov, orbit
 from ._fm import fm
+from ._image import image
 from ._reconstruct import reconstruct
 from ._results import Lyapunov, Orbit, RegionSpectrum, Spectrum
 
@@ -89,6 +90,7 @@ __all__ = [
     "orbit",
     "probe",
     "reconstruct",
+    "image",
     "fm",
     "resonance",
     "simulate",

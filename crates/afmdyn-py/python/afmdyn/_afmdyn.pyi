@@ -584,6 +584,14 @@ def reconstruct_fm(
     amplitude: Optional[float] = None,
     progress: Optional[ProgressCallback] = None,
 ) -> Dict[str, Any]: ...
+def image(
+    probe: str,
+    sample: str,
+    setpoint: float,
+    pixels: Optional[int] = None,
+    lines: Optional[int] = None,
+    curve_points: Optional[int] = None,
+) -> str: ...
 def cantilevers() -> str: ...
 def probe(text: str) -> Tuple[Params, str]: ...
 def probe_source(

@@ -37,6 +37,7 @@ pub mod curves;
 #[cfg(feature = "files")]
 pub mod dir_lock;
 pub mod fm;
+pub mod image;
 pub mod limits;
 pub mod model;
 pub mod pool;

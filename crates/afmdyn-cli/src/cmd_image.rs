@@ -1,0 +1,245 @@
+//! `afmdyn image`: the AM-AFM image of a heterogeneous sample under an ideal amplitude feedback.
+//! The sample map, the operating points and the scan are the library's
+//! ([`afmdyn::request::image`]); this front end reads the two files, maps the flags, and writes
+//! `image.json`, the maps (height, phase, E_dis) and the line profile.
+
+use crate::args::read_text;
+use crate::error::CliError;
+use crate::output::{si_value, write_document, OutDir};
+use crate::plot::{save, save_map, CellMap, Figure, Series, Style};
+use afmdyn::request::image::{image, Image, ImageRequest, SampleMap};
+use clap::Args;
+use plotters::style::RGBColor;
+use std::path::PathBuf;
+
+/// `afmdyn image` flags.
+#[derive(Debug, Args)]
+pub struct ImageArgs {
+    /// The probe file (SI): the lever, tip, drive and the background sample
+    #[arg(long, value_name = "PROBE.toml")]
+    probe: PathBuf,
+    /// The sample map: size = [Lx, Ly] (m) and [[domain]] entries (name, x, y, height,
+    /// [domain.sample])
+    #[arg(long, value_name = "S.toml")]
+    sample: PathBuf,
+    /// Amplitude setpoint A_sp/A0 in (0, 1)
+    #[arg(long)]
+    setpoint: f64,
+    /// Feedback: ideal (an operating point of the local material at every pixel). The
+    /// time-domain PI loop is not built yet
+    #[arg(long, default_value = "ideal")]
+    feedback: String,
+    /// Pixels per line [default: 64]
+    #[arg(long)]
+    pixels: Option<usize>,
+    /// Lines (default: as many as pixels, 1 for a line map with Ly = 0)
+    #[arg(long)]
+    lines: Option<usize>,
+    /// Points of each material's approach curve (the probe's default z_c range) [default: 120]
+    #[arg(long)]
+    curve_points: Option<usize>,
+    /// Output directory (locked during the run)
+    #[arg(long, default_value = "afmdyn-out/image")]
+    out: PathBuf,
+    /// Print one JSON document
+    #[arg(long)]
+    json: bool,
+}
+
+/// A white-to-blue ramp at t ∈ [0, 1] (missing values are left white by the map).
+fn ramp(t: f64) -> RGBColor {
+    let t = if t.is_finite() {
+        t.clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let mix = |a: u8, b: u8| (f64::from(a) + (f64::from(b) - f64::from(a)) * t) as u8;
+    RGBColor(mix(253, 8), mix(231, 48), mix(37, 107))
+}
+
+/// The map of one field over the image, coloured from its smallest to its largest value, with a
+/// legend of five levels in SI.
+fn map_of(
+    out: &OutDir,
+    img: &Image,
+    stem: &str,
+    title: &str,
+    unit: &str,
+    value: &dyn Fn(usize, usize) -> f64,
+) -> Result<(), CliError> {
+    let (nx, ny) = (img.x.len(), img.y.len());
+    let values: Vec<f64> = (0..ny)
+        .flat_map(|j| (0..nx).map(move |i| (j, i)))
+        .map(|(j, i)| value(j, i))
+        .collect();
+    let finite = values.iter().copied().filter(|v| v.is_finite());
+    let lo = finite.clone().fold(f64::INFINITY, f64::min);
+    let hi = finite.fold(f64::NEG_INFINITY, f64::max);
+    let span = if hi > lo { hi - lo } else { 1.0 };
+    let cells: Vec<Option<RGBColor>> = values
+        .iter()
+        .map(|&v| v.is_finite().then(|| ramp((v - lo) / span)))
+        .collect();
+    let legend: Vec<(String, RGBColor)> = if lo.is_finite() {
+        [0.0, 0.25, 0.5, 0.75, 1.0]
+            .iter()
+            .map(|&t| (si_value(lo + t * (hi - lo), unit), ramp(t)))
+            .collect()
+    } else {
+        Vec::new()
+    };
+    save_map(
+        out.path(),
+        stem,
+        &CellMap {
+            title,
+            labels: ("x (m)", "y (m)"),
+            x: &img.x,
+            y: &img.y,
+            cells: &cells,
+            legend: &legend,
+            points: &[],
+        },
+    )
+}
+
+/// Run `afmdyn image`.
+pub fn image_cmd(a: &ImageArgs) -> Result<(), CliError> {
+    if a.feedback != "ideal" {
+        return Err(CliError::Input(format!(
+            "feedback = {}: must be ideal (the time-domain PI scan is not available yet)",
+            a.feedback
+        )));
+    }
+    let text = read_text(&a.probe).map_err(|e| CliError::Input(format!("probe {e}")))?;
+    let table: toml::Table = text.parse().map_err(|e: toml::de::Error| {
+        CliError::Input(format!(
+            "probe {}: {}",
+            a.probe.display(),
+            e.to_string().replace('\n', " ")
+        ))
+    })?;
+    let map = SampleMap::load(&a.sample)?;
+    let d = ImageRequest::at(a.setpoint);
+    let req = ImageRequest {
+        pixels: a.pixels.unwrap_or(d.pixels),
+        lines: a.lines,
+        curve_points: a.curve_points.unwrap_or(d.curve_points),
+        ..d
+    };
+    req.validate(&map)?;
+    let out = OutDir::lock(&a.out)?;
+    let img = image(&table, &map, &req)?;
+    let json = img.document(a.setpoint);
+    write_document(&out, "image.json", &json)?;
+    let img = &img;
+    let field = |get: fn(&afmdyn::request::image::OperatingPoint) -> f64| {
+        move |j: usize, i: usize| img.point(j, i).map_or(f64::NAN, get)
+    };
+    map_of(
+        &out,
+        img,
+        "image-height",
+        "Apparent height (ideal feedback)",
+        "m",
+        &|j, i| img.apparent_height(j, i),
+    )?;
+    map_of(
+        &out,
+        img,
+        "image-phase",
+        "Phase lag",
+        "°",
+        &field(|o| o.phase_deg),
+    )?;
+    map_of(
+        &out,
+        img,
+        "image-dissipation",
+        "Energy dissipated per period",
+        "J",
+        &field(|o| o.energy_dissipated),
+    )?;
+    // the first line's profile: apparent and true height
+    let profile = |f: &dyn Fn(usize) -> f64| -> Vec<(f64, f64)> {
+        (0..img.x.len())
+            .map(|i| (img.x[i], f(i)))
+            .filter(|p| p.1.is_finite())
+            .collect()
+    };
+    save(
+        out.path(),
+        "image-profile",
+        &Figure {
+            title: format!(
+                "Line profile at y = {} (setpoint A/A0 = {})",
+                si_value(img.y[0], "m"),
+                a.setpoint
+            ),
+            x_label: "x (m)".into(),
+            y_label: "height (m)".into(),
+            series: vec![
+                Series {
+                    label: "apparent height".into(),
+                    points: profile(&|i| img.apparent_height(0, i)),
+                    style: Style::Line,
+                    color: 0,
+                },
+                Series {
+                    label: "true height".into(),
+                    points: profile(&|i| img.pixels[0][i].height),
+                    style: Style::Dashed,
+                    color: 1,
+                },
+            ],
+            shade: Vec::new(),
+            y_min_span: 1e-12,
+        },
+    )?;
+    if a.json {
+        outln!("{json}");
+        return Ok(());
+    }
+    outln!(
+        "ideal-feedback image, {} × {} pixels, setpoint A/A0 = {}; z_c,ref = {} on the background",
+        img.x.len(),
+        img.y.len(),
+        a.setpoint,
+        si_value(img.reference, "m")
+    );
+    let names: Vec<(Option<usize>, &str)> = std::iter::once((None, "background"))
+        .chain(
+            img.domain_names
+                .iter()
+                .enumerate()
+                .map(|(k, n)| (Some(k), n.as_str())),
+        )
+        .collect();
+    for (d, name) in names {
+        // where this domain is first met in the image, its operating point there
+        let first = img.pixels.iter().enumerate().find_map(|(j, line)| {
+            line.iter()
+                .position(|p| p.domain == d && p.point.is_some())
+                .map(|i| (j, i))
+        });
+        match first {
+            Some((j, i)) => {
+                let o = img.point(j, i).expect("a point");
+                outln!(
+                    "  {}: z_c {} ({:?}), apparent height {} over true {}, phase {:.2}°, E_dis {}, peak force {}",
+                    name,
+                    si_value(o.z_c, "m"),
+                    o.regime,
+                    si_value(img.apparent_height(j, i), "m"),
+                    si_value(img.pixels[j][i].height, "m"),
+                    o.phase_deg,
+                    si_value(o.energy_dissipated, "J"),
+                    si_value(o.peak_force, "N")
+                );
+            }
+            None => outln!("  {name}: not imaged (no operating point, or not in the map)"),
+        }
+    }
+    outln!("outputs in {}", out.path().display());
+    Ok(())
+}

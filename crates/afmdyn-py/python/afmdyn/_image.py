@@ -1,0 +1,92 @@
+"""AM-AFM images of a heterogeneous sample (``afmdyn image``): the library's ideal-feedback
+image as an ``xarray.Dataset`` in SI."""
+
+from __future__ import annotations
+
+import json
+import os
+from typing import Any, Dict, Optional, Union
+
+import numpy as np
+import xarray as xr
+
+from . import _afmdyn as _core
+from ._common import _typed, _warn
+
+#: The numeric maps of an image, their units and meanings (the document's ``image`` block).
+_FIELDS = {
+    "height": ("m", "apparent height h + z_c − z_c,ref (ideal feedback)"),
+    "true_height": ("m", "true height of the sample map"),
+    "z_c": ("m", "rest distance z_c the feedback holds"),
+    "amplitude": ("m", "amplitude (the setpoint where reached)"),
+    "phase_deg": ("degree", "phase lag behind the drive"),
+    "energy_dissipated": ("J", "energy dissipated per drive period"),
+    "virial": ("J", "virial of the tip–sample force"),
+    "peak_force": ("N", "largest tip–sample force"),
+    "indentation": ("m", "largest indentation"),
+}
+
+
+@_typed
+def image(
+    probe: Union[str, "os.PathLike[str]", Dict[str, Any]],
+    sample: Union[str, "os.PathLike[str]"],
+    setpoint: float,
+    *,
+    pixels: Optional[int] = None,
+    lines: Optional[int] = None,
+    curve_points: Optional[int] = None,
+) -> xr.Dataset:
+    """The image an ideal amplitude feedback records over a heterogeneous sample
+    (``afmdyn image --feedback ideal``): at every pixel the operating point of the local
+    material where the amplitude equals the setpoint, the regime kept from the previous pixel
+    where the material allows it, each line engaged from far.
+
+    Args:
+        probe: the probe (path, TOML text or dict, as ``afmdyn.probe``): the lever, tip,
+            drive and the background sample.
+        sample: the sample map (path or TOML text): ``size = [Lx, Ly]`` (m) and ``[[domain]]``
+            entries with ``name``, ``x``, ``y``, ``height`` (m) and ``[domain.sample]``.
+        setpoint: A_sp/A0 in (0, 1).
+        pixels: pixels per line (default 64). lines: lines (default: as many as pixels, 1 for
+            a line map). curve_points: points of each material's approach curve (default 120).
+
+    Returns:
+        ``xarray.Dataset`` over ``y`` and ``x`` (m): ``height``, ``true_height``, ``z_c``,
+        ``amplitude``, ``phase_deg``, ``energy_dissipated``, ``virial``, ``peak_force``,
+        ``indentation`` (NaN where the setpoint is not reached), ``regime``, ``material`` and
+        ``domain`` (strings); attributes ``setpoint``, ``reference_z_c`` (m) and ``summary``
+        (the command line's JSON document, with each material's operating points).
+
+    Raises:
+        ValueError: naming the field — a setpoint outside (0, 1), pixels or lines outside
+            1..=4096 (lines = 1 for a line map), a sample map's key.
+    """
+    text = _core.probe_source(probe)
+    source = os.fspath(sample) if isinstance(sample, os.PathLike) else sample
+    doc = json.loads(_core.image(text, source, setpoint, pixels, lines, curve_points))
+    _warn(doc)
+    img = doc["image"]
+    dims = ("y", "x")
+    data: Dict[str, Any] = {}
+    for name, (unit, meaning) in _FIELDS.items():
+        values = np.array(
+            [[np.nan if v is None else v for v in row] for row in img[name]], dtype=np.float64
+        )
+        data[name] = (dims, values, {"units": unit, "long_name": meaning})
+    for name in ("regime", "material", "domain"):
+        values = np.array([["" if v is None else v for v in row] for row in img[name]])
+        data[name] = (dims, values)
+    return xr.Dataset(
+        data,
+        coords={
+            "x": ("x", np.asarray(img["x"], dtype=np.float64), {"units": "m"}),
+            "y": ("y", np.asarray(img["y"], dtype=np.float64), {"units": "m"}),
+        },
+        attrs={
+            "setpoint": setpoint,
+            "reference_z_c": doc["reference_z_c"],
+            "feedback": doc["feedback"],
+            "summary": json.dumps(doc),
+        },
+    )

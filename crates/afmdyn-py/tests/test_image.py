@@ -1,0 +1,53 @@
+"""afmdyn.image: the ideal-feedback image as an xarray.Dataset, the same document as
+``afmdyn image --json``; the line's domains at their operating points; refusals named."""
+
+import json
+
+import numpy as np
+import pytest
+
+import afmdyn
+
+from conftest import EXAMPLES
+
+PROBE = EXAMPLES / "probe-point-mass-dmt.toml"
+STRIPE = EXAMPLES / "sample-stripe.toml"
+
+
+def test_image_is_the_command_lines_document(cli_json, tmp_path):
+    with pytest.warns(afmdyn.AfmdynWarning, match="switch regime"):
+        ds = afmdyn.image(PROBE, STRIPE, 0.7, pixels=40)
+    doc = cli_json(
+        "image", "--probe", PROBE, "--sample", STRIPE, "--setpoint", "0.7", "--pixels", "40",
+        "--out", tmp_path,
+    )
+    assert afmdyn.summary(ds) == doc
+    assert ds.height.dims == ("y", "x") and ds.height.shape == (1, 40)
+    assert ds.height.attrs["units"] == "m"
+    # the step of the background material is at its true height; the background at 0
+    step = ds.domain.values[0] == "step"
+    background = ds.domain.values[0] == "background"
+    assert np.allclose(ds.height.values[0][step], 5e-9, rtol=0, atol=1e-18)
+    assert np.all(ds.height.values[0][background] == 0.0)
+    # the rubber stripe: one operating point for all its pixels, its own phase
+    rubber = ds.domain.values[0] == "rubber"
+    assert rubber.any() and len(set(ds.phase_deg.values[0][rubber])) == 1
+    points = {m["name"]: m["points"] for m in doc["materials"]}
+    assert ds.phase_deg.values[0][rubber][0] in [p["phase_deg"] for p in points["rubber"]]
+
+
+def test_the_sample_map_may_be_text_and_refusals_name_their_field():
+    text = STRIPE.read_text()
+    with pytest.warns(afmdyn.AfmdynWarning):
+        a = afmdyn.image(PROBE, text, 0.7, pixels=16)
+    with pytest.warns(afmdyn.AfmdynWarning):
+        b = afmdyn.image(str(PROBE), str(STRIPE), 0.7, pixels=16)
+    assert json.loads(a.attrs["summary"]) == json.loads(b.attrs["summary"])
+    with pytest.raises(ValueError, match="setpoint"):
+        afmdyn.image(PROBE, STRIPE, 1.5)
+    with pytest.raises(ValueError, match="lines"):
+        afmdyn.image(PROBE, STRIPE, 0.7, lines=3)
+    with pytest.raises(ValueError, match="size"):
+        afmdyn.image(PROBE, "size = [1e-6]", 0.7)
+    with pytest.raises(TypeError, match="pixels"):
+        afmdyn.image(PROBE, STRIPE, 0.7, pixels=2.5)

@@ -1,0 +1,698 @@
+//! AM-AFM images of a heterogeneous sample (issue 46): a sample map ([`SampleMap`], the
+//! `--sample S.toml` of `afmdyn image`) and the image an **ideal** amplitude feedback records
+//! over it ([`image`]).
+//!
+//! **Sample map.** `size = [Lx, Ly]` (m; Ly = 0 for a line), then `[[domain]]` entries with a
+//! `name`, `x = [x0, x1]` (m), optional `y = [y0, y1]` (m; the whole width when left out), an
+//! optional true `height` (m, default 0) and an optional `[domain.sample]` table with the keys of
+//! a probe's `[sample]` (law, moduli, Hamaker constant, viscosity, …); the probe's own
+//! `[sample]` is the background (height 0). Where domains overlap, the later one lies on top.
+//!
+//! **Ideal feedback.** A feedback loop infinitely faster than the scan holds the amplitude at
+//! the setpoint A_sp = r A₀ at every pixel, so a pixel's operating point is a point of its
+//! material's approach curve where A(z_c) = A_sp ([`crate::analysis::setpoint`]), and the z
+//! piezo records the true height plus the rest distance z_c there. Which of the material's
+//! operating points (in the bistable range one attractive, one repulsive: García & San Paulo,
+//! *Phys. Rev. B* 61 (2000) R13381) is the history's: each line is engaged from far, as an
+//! instrument engages, on the operating point the approach sweep meets first (its largest z_c);
+//! along the line the regime (attractive or repulsive) is kept from pixel to pixel while the new
+//! material has an operating point in it, and otherwise the nearest z_c of the other regime is
+//! taken and the switch reported. The apparent height is h + z_c − z_c,ref, z_c,ref the engaged
+//! rest distance on the background, so a soft domain of the background's true height shows its
+//! difference in z_c (García & San Paulo 2000; the height artefacts of Kühle, Sørensen & Bohr,
+//! *J. Appl. Phys.* 81 (1997) 6562). The operating points of each material are computed once
+//! (an approach curve per material, [`crate::analysis::approach::approach_retract`]), so the
+//! image costs one approach curve per material however many pixels it has.
+
+use crate::analysis::approach::approach_retract;
+use crate::error::SimError;
+use crate::params::Params;
+use crate::probe::Probe;
+use crate::report::CurveUnits;
+use serde::Serialize;
+use serde_json::Value;
+
+use super::curves::{approach_request, CurveRequest};
+
+/// Largest number of pixels per line and of lines.
+pub const MAX_PIXELS: usize = 4096;
+
+/// Largest number of domains of a sample map.
+pub const MAX_DOMAINS: usize = 1000;
+
+/// One domain of a [`SampleMap`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Domain {
+    /// Its name.
+    pub name: String,
+    /// [x0, x1] (m).
+    pub x: (f64, f64),
+    /// [y0, y1] (m); `None`: the map's whole width in y.
+    pub y: Option<(f64, f64)>,
+    /// True height (m).
+    pub height: f64,
+    /// Its `[domain.sample]` table (a probe's `[sample]` keys); `None`: the background's
+    /// material.
+    pub sample: Option<toml::Table>,
+}
+
+/// A heterogeneous sample (module docs).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SampleMap {
+    /// [Lx, Ly] (m).
+    pub size: (f64, f64),
+    /// The domains, the later on top.
+    pub domains: Vec<Domain>,
+}
+
+/// A refusal of a sample map's key: `name = value: allowed` ([`SimError::Probe`], an input
+/// error; [`SampleMap::parse`] names the file).
+fn bad(name: String, value: impl std::fmt::Display, allowed: &str) -> SimError {
+    SimError::Probe(format!("{name} = {value}: {allowed}"))
+}
+
+/// A length of the map (m): finite, |v| ≤ 1 m.
+fn length(v: &toml::Value, name: &str) -> Result<f64, SimError> {
+    let x = v
+        .as_float()
+        .or_else(|| v.as_integer().map(|i| i as f64))
+        .ok_or_else(|| bad(name.into(), v, "must be a number (m)"))?;
+    if !(x.is_finite() && x.abs() <= 1.0) {
+        return Err(bad(
+            name.into(),
+            x,
+            "must be a finite length in m, at most 1 m",
+        ));
+    }
+    Ok(x)
+}
+
+/// A pair [a, b] of lengths with a < b (or a ≤ b when `allow_equal`).
+fn pair(v: &toml::Value, name: &str) -> Result<(f64, f64), SimError> {
+    let a = v.as_array().filter(|a| a.len() == 2).ok_or_else(|| {
+        bad(
+            name.into(),
+            v,
+            "must be an array of two lengths [from, to] (m)",
+        )
+    })?;
+    let (x0, x1) = (length(&a[0], name)?, length(&a[1], name)?);
+    if x0 >= x1 {
+        return Err(bad(
+            name.into(),
+            format!("[{x0:e}, {x1:e}]"),
+            "must be [from, to] with from < to",
+        ));
+    }
+    Ok((x0, x1))
+}
+
+impl SampleMap {
+    /// Parse a sample map from TOML text; `origin` names it in errors.
+    ///
+    /// # Errors
+    /// [`SimError::Probe`] naming the file and the key (`size`, `domain 'soft' x`, …) and what
+    /// it must be: an unknown key, a missing `size` or `x`, a range that is empty or outside the
+    /// map, more than [`MAX_DOMAINS`] domains; the syntax error of invalid TOML.
+    pub fn parse(text: &str, origin: &str) -> Result<SampleMap, SimError> {
+        Self::parse_text(text).map_err(|e| SimError::Probe(format!("sample map {origin}: {e}")))
+    }
+
+    fn parse_text(text: &str) -> Result<SampleMap, SimError> {
+        let root: toml::Table = text.parse().map_err(|e: toml::de::Error| {
+            SimError::Probe(format!(
+                "invalid TOML: {}",
+                e.to_string().replace('\n', " ")
+            ))
+        })?;
+        for k in root.keys() {
+            if !matches!(k.as_str(), "size" | "domain") {
+                return Err(bad(
+                    format!("sample map key '{k}'"),
+                    "given",
+                    "unknown: expected size and [[domain]] entries",
+                ));
+            }
+        }
+        let size = root.get("size").ok_or_else(|| {
+            bad(
+                "size".into(),
+                "missing",
+                "[Lx, Ly] in m (Ly = 0 for a line)",
+            )
+        })?;
+        let s = size.as_array().filter(|a| a.len() == 2).ok_or_else(|| {
+            bad(
+                "size".into(),
+                size,
+                "must be [Lx, Ly] in m (Ly = 0 for a line)",
+            )
+        })?;
+        let (lx, ly) = (length(&s[0], "size")?, length(&s[1], "size")?);
+        if !(lx > 0.0 && ly >= 0.0) {
+            return Err(bad(
+                "size".into(),
+                format!("[{lx:e}, {ly:e}]"),
+                "must be [Lx, Ly] with Lx > 0 and Ly ≥ 0 (m)",
+            ));
+        }
+        let entries = match root.get("domain") {
+            None => Vec::new(),
+            Some(v) => v
+                .as_array()
+                .ok_or_else(|| bad("domain".into(), v, "must be [[domain]] tables"))?
+                .clone(),
+        };
+        if entries.len() > MAX_DOMAINS {
+            return Err(bad("domain".into(), entries.len(), "at most 1000 domains"));
+        }
+        let mut domains = Vec::with_capacity(entries.len());
+        for (i, e) in entries.iter().enumerate() {
+            let t = e
+                .as_table()
+                .ok_or_else(|| bad(format!("domain {}", i + 1), e, "must be a table"))?;
+            let name = match t.get("name") {
+                Some(n) => n
+                    .as_str()
+                    .ok_or_else(|| bad(format!("domain {} name", i + 1), n, "must be a string"))?
+                    .to_string(),
+                None => format!("domain {}", i + 1),
+            };
+            let key = |k: &str| format!("domain '{name}' {k}");
+            for k in t.keys() {
+                if !matches!(k.as_str(), "name" | "x" | "y" | "height" | "sample") {
+                    return Err(bad(
+                        key(k),
+                        "given",
+                        "unknown: expected name, x, y, height and [domain.sample]",
+                    ));
+                }
+            }
+            let x = pair(
+                t.get("x")
+                    .ok_or_else(|| bad(key("x"), "missing", "[x0, x1] in m"))?,
+                &key("x"),
+            )?;
+            let y = t.get("y").map(|v| pair(v, &key("y"))).transpose()?;
+            if x.1 <= 0.0 || x.0 >= lx || y.is_some_and(|y| y.1 <= 0.0 || y.0 >= ly.max(0.0)) {
+                return Err(bad(
+                    key("x, y"),
+                    "outside the map",
+                    "must overlap the map [0, Lx] × [0, Ly]",
+                ));
+            }
+            let height = t
+                .get("height")
+                .map(|v| length(v, &key("height")))
+                .transpose()?
+                .unwrap_or(0.0);
+            if height.abs() > 1e-5 {
+                return Err(bad(
+                    key("height"),
+                    height,
+                    "must be within ±10 µm (a topography the z piezo follows)",
+                ));
+            }
+            let sample = match t.get("sample") {
+                None => None,
+                Some(v) => {
+                    let s = v.as_table().ok_or_else(|| {
+                        bad(key("sample"), v, "must be a table ([domain.sample])")
+                    })?;
+                    if s.contains_key("z_c") {
+                        return Err(bad(
+                            key("sample.z_c"),
+                            "given",
+                            "is set by the feedback, not by the sample",
+                        ));
+                    }
+                    Some(s.clone())
+                }
+            };
+            domains.push(Domain {
+                name,
+                x,
+                y,
+                height,
+                sample,
+            });
+        }
+        Ok(SampleMap {
+            size: (lx, ly),
+            domains,
+        })
+    }
+
+    /// A sample map from a front end's string: TOML text when it holds a line break or `=`
+    /// (every map has a `size = …` line), else the path of a file ([`SampleMap::load`]).
+    ///
+    /// # Errors
+    /// As [`SampleMap::load`] and [`SampleMap::parse`].
+    #[cfg(feature = "files")]
+    pub fn read(source: &str) -> Result<SampleMap, SimError> {
+        if source.contains(['\n', '=']) {
+            Self::parse(source, "<text>")
+        } else {
+            Self::load(std::path::Path::new(source))
+        }
+    }
+
+    /// Read a sample map file.
+    ///
+    /// # Errors
+    /// [`SimError::Probe`] naming the file when it cannot be read (or is larger than
+    /// [`super::limits::MAX_INPUT_TEXT_BYTES`]); as [`SampleMap::parse`].
+    #[cfg(feature = "files")]
+    pub fn load(path: &std::path::Path) -> Result<SampleMap, SimError> {
+        let text = super::limits::read_input(path, super::limits::MAX_INPUT_TEXT_BYTES)
+            .map_err(|e| SimError::Probe(format!("sample map: {e}")))?;
+        Self::parse(&text, &path.display().to_string())
+    }
+
+    /// The domain at (x, y) (m): the last listed that contains it, `None` for the background.
+    pub fn domain_at(&self, x: f64, y: f64) -> Option<usize> {
+        self.domains.iter().rposition(|d| {
+            (d.x.0..=d.x.1).contains(&x) && d.y.is_none_or(|(y0, y1)| (y0..=y1).contains(&y))
+        })
+    }
+}
+
+/// An image request (`afmdyn image`, Python's `afmdyn.image`; module docs).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ImageRequest {
+    /// Setpoint ratio A_sp/A₀ in (0, 1).
+    pub setpoint: f64,
+    /// Pixels per line (default 64).
+    pub pixels: usize,
+    /// Lines; `None`: as many as pixels, 1 for a line map (Ly = 0) ([`ImageRequest::lines`]).
+    pub lines: Option<usize>,
+    /// Points of each material's approach curve (its z_c grid, the probe's default range;
+    /// default 120, the approach's [`crate::analysis::stepped::DEFAULT_CURVE_POINTS`]).
+    pub curve_points: usize,
+}
+
+impl ImageRequest {
+    /// The request at `setpoint` with the defaults: 64 pixels, the default lines, the
+    /// approach curve's default points.
+    pub fn at(setpoint: f64) -> ImageRequest {
+        ImageRequest {
+            setpoint,
+            pixels: 64,
+            lines: None,
+            curve_points: crate::analysis::stepped::DEFAULT_CURVE_POINTS,
+        }
+    }
+
+    /// The number of lines over `map`: as given, else as many as pixels (1 for a line map).
+    pub fn lines(&self, map: &SampleMap) -> usize {
+        self.lines
+            .unwrap_or(if map.size.1 == 0.0 { 1 } else { self.pixels })
+    }
+}
+
+/// Regime of an operating point (García & San Paulo 2000): the mean tip–sample force is
+/// attractive (negative) or repulsive.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Regime {
+    /// Net attractive force.
+    Attractive,
+    /// Net repulsive force.
+    Repulsive,
+}
+
+/// One operating point of a material at the setpoint, in SI: the rest distance and the
+/// observables interpolated there ([`crate::report::setpoint`]).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct OperatingPoint {
+    /// `approach` or `retract`: the sweep it lies on.
+    pub source: String,
+    /// Rest distance z_c (m).
+    pub z_c: f64,
+    /// Regime.
+    pub regime: Regime,
+    /// Amplitude (m).
+    pub amplitude: f64,
+    /// Phase lag (degrees).
+    pub phase_deg: f64,
+    /// Energy dissipated per drive period (J).
+    pub energy_dissipated: f64,
+    /// Virial (J).
+    pub virial: f64,
+    /// Peak force (N).
+    pub peak_force: f64,
+    /// Indentation (m).
+    pub indentation: f64,
+}
+
+/// A material of the image: the background or a domain's sample, with its operating points.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Material {
+    /// `background` or the domain's name.
+    pub name: String,
+    /// Its operating points at the setpoint (none: the setpoint is not reached on it).
+    pub points: Vec<OperatingPoint>,
+    /// The warnings of its approach curve.
+    pub warnings: Vec<String>,
+}
+
+/// A pixel: its domain, material and operating point (`None`: the setpoint is not reached
+/// there).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Pixel {
+    /// Index into the map's domains, `None` for the background.
+    pub domain: Option<usize>,
+    /// Index into [`Image::materials`].
+    pub material: usize,
+    /// True height (m).
+    pub height: f64,
+    /// Index into the material's points.
+    pub point: Option<usize>,
+    /// Whether the regime changed at this pixel because the material had no operating point
+    /// in the previous one.
+    pub switched: bool,
+}
+
+/// An ideal-feedback image ([`image`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Image {
+    /// Pixel centres x (m).
+    pub x: Vec<f64>,
+    /// Line positions y (m).
+    pub y: Vec<f64>,
+    /// The materials: 0 the background, then one per domain with its own sample.
+    pub materials: Vec<Material>,
+    /// The pixels, `[line][pixel]`.
+    pub pixels: Vec<Vec<Pixel>>,
+    /// z_c,ref (m): the engaged rest distance on the background, the zero of the apparent
+    /// height.
+    pub reference: f64,
+    /// The map's domain names, in its order.
+    pub domain_names: Vec<String>,
+    /// What the image cannot show as asked.
+    pub warnings: Vec<String>,
+}
+
+impl ImageRequest {
+    /// Check the request against the map.
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming `setpoint` (in (0, 1)), `pixels`, `lines` (1..=4096;
+    /// 1 for a line map) or `curve_points` (8..=2000).
+    pub fn validate(&self, map: &SampleMap) -> Result<(), SimError> {
+        if !(self.setpoint > 0.0 && self.setpoint < 1.0) {
+            return Err(SimError::out_of_range(
+                "setpoint",
+                crate::error::number(self.setpoint),
+                "must be a ratio A_sp/A0 in (0, 1)",
+            ));
+        }
+        if !(1..=MAX_PIXELS).contains(&self.pixels) {
+            return Err(SimError::out_of_range(
+                "pixels",
+                self.pixels,
+                "must be in 1..=4096",
+            ));
+        }
+        let lines = self.lines(map);
+        if !(1..=MAX_PIXELS).contains(&lines) {
+            return Err(SimError::out_of_range(
+                "lines",
+                lines,
+                "must be in 1..=4096",
+            ));
+        }
+        if map.size.1 == 0.0 && lines != 1 {
+            return Err(SimError::out_of_range(
+                "lines",
+                lines,
+                "must be 1 for a line map (size = [Lx, 0])",
+            ));
+        }
+        if !(8..=2000).contains(&self.curve_points) {
+            return Err(SimError::out_of_range(
+                "curve_points",
+                self.curve_points,
+                "must be in 8..=2000",
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The operating points of `params`' approach curve at the setpoint, in SI (`units`).
+fn operating_points(
+    params: Params,
+    units: &CurveUnits,
+    req: &ImageRequest,
+) -> Result<(Vec<OperatingPoint>, Vec<String>), SimError> {
+    let curve_req = CurveRequest {
+        points: Some(req.curve_points),
+        branches: false,
+        ..CurveRequest::default()
+    };
+    let spec = approach_request(params, &curve_req, units.length, false)?;
+    let curve = approach_retract(&spec)?;
+    let doc = crate::report::setpoint(&params, &curve, req.setpoint, units);
+    let num = |p: &Value, k: &str| p[k].as_f64().unwrap_or(f64::NAN);
+    let points = doc["points"]
+        .as_array()
+        .map(|a| {
+            a.iter()
+                .map(|p| OperatingPoint {
+                    source: p["source"].as_str().unwrap_or("").to_string(),
+                    z_c: num(p, "z_c"),
+                    regime: if p["regime"] == "attractive" {
+                        Regime::Attractive
+                    } else {
+                        Regime::Repulsive
+                    },
+                    amplitude: num(p, "amplitude"),
+                    phase_deg: num(p, "phase_deg"),
+                    energy_dissipated: num(p, "energy_dissipated"),
+                    virial: num(p, "virial"),
+                    peak_force: num(p, "peak_force"),
+                    indentation: num(p, "indentation"),
+                })
+                .collect()
+        })
+        .unwrap_or_default();
+    Ok((points, curve.warnings))
+}
+
+/// The operating point a line engages on: the approach sweep's first (largest z_c), else the
+/// largest z_c of any.
+fn engage(points: &[OperatingPoint]) -> Option<usize> {
+    let best = |approach_only: bool| {
+        (0..points.len())
+            .filter(|&i| !approach_only || points[i].source == "approach")
+            .max_by(|&a, &b| points[a].z_c.total_cmp(&points[b].z_c))
+    };
+    best(true).or_else(|| best(false))
+}
+
+/// The operating point of a material continued from the previous pixel's (regime, z_c): the
+/// same regime, nearest z_c; else the nearest z_c of the other regime (switched = true).
+fn continue_from(points: &[OperatingPoint], regime: Regime, z_c: f64) -> Option<(usize, bool)> {
+    let nearest = |same: bool| {
+        (0..points.len())
+            .filter(|&i| (points[i].regime == regime) == same)
+            .min_by(|&a, &b| {
+                (points[a].z_c - z_c)
+                    .abs()
+                    .total_cmp(&(points[b].z_c - z_c).abs())
+            })
+    };
+    nearest(true)
+        .map(|i| (i, false))
+        .or_else(|| nearest(false).map(|i| (i, true)))
+}
+
+/// The ideal-feedback image of `map` under `probe` (module docs): the operating points of each
+/// material, then the scan line by line.
+///
+/// # Errors
+/// As [`ImageRequest::validate`]; [`SimError::Probe`] for a domain's sample the probe format
+/// refuses (named by the domain); as the approach curves.
+pub fn image(
+    probe_table: &toml::Table,
+    map: &SampleMap,
+    req: &ImageRequest,
+) -> Result<Image, SimError> {
+    req.validate(map)?;
+    let background =
+        Probe::from_table(probe_table, "probe").map_err(|e| SimError::Probe(e.to_string()))?;
+    if background.components.len() > 1 {
+        return Err(SimError::out_of_range(
+            "probe",
+            "a multifrequency drive",
+            "an image is recorded with one drive frequency",
+        ));
+    }
+    let units = CurveUnits::from_scales(&background.scales, false);
+    // materials: the background, then each domain with its own sample
+    let mut materials = Vec::new();
+    let mut of_domain = Vec::with_capacity(map.domains.len());
+    let (points, warnings) = operating_points(background.params, &units, req)?;
+    materials.push(Material {
+        name: "background".into(),
+        points,
+        warnings,
+    });
+    for d in &map.domains {
+        let Some(sample) = &d.sample else {
+            of_domain.push(0);
+            continue;
+        };
+        let mut root = probe_table.clone();
+        root.insert("sample".into(), toml::Value::Table(sample.clone()));
+        let origin = format!("domain '{}'", d.name);
+        let probe =
+            Probe::from_table(&root, &origin).map_err(|e| SimError::Probe(e.to_string()))?;
+        // the same lever, drive and units: only the sample differs
+        let (points, warnings) = operating_points(probe.params, &units, req)?;
+        of_domain.push(materials.len());
+        materials.push(Material {
+            name: d.name.clone(),
+            points,
+            warnings,
+        });
+    }
+    let (lx, ly) = map.size;
+    let x: Vec<f64> = (0..req.pixels)
+        .map(|i| (i as f64 + 0.5) * lx / req.pixels as f64)
+        .collect();
+    let n_lines = req.lines(map);
+    let y: Vec<f64> = (0..n_lines)
+        .map(|j| (j as f64 + 0.5) * ly / n_lines as f64)
+        .collect();
+    let mut warnings = Vec::new();
+    for m in &materials {
+        if m.points.is_empty() {
+            warnings.push(format!(
+                "{}: the setpoint A/A0 = {} is not reached on its approach curve: its pixels \
+                 are empty (NaN)",
+                m.name, req.setpoint
+            ));
+        }
+    }
+    let reference = engage(&materials[0].points)
+        .map(|i| materials[0].points[i].z_c)
+        .unwrap_or(f64::NAN);
+    let mut pixels = Vec::with_capacity(n_lines);
+    let mut switches = 0usize;
+    for &yj in &y {
+        let mut line = Vec::with_capacity(req.pixels);
+        let mut prev: Option<(Regime, f64)> = None;
+        for &xi in &x {
+            let d = map.domain_at(xi, yj);
+            let (material, height) = d.map_or((0, 0.0), |k| (of_domain[k], map.domains[k].height));
+            let pts = &materials[material].points;
+            let (point, switched) = match prev {
+                None => (engage(pts), false),
+                Some((regime, z)) => match continue_from(pts, regime, z) {
+                    Some((i, s)) => (Some(i), s),
+                    None => (None, false),
+                },
+            };
+            if let Some(i) = point {
+                prev = Some((pts[i].regime, pts[i].z_c));
+            }
+            switches += usize::from(switched);
+            line.push(Pixel {
+                domain: d,
+                material,
+                height,
+                point,
+                switched,
+            });
+        }
+        pixels.push(line);
+    }
+    if switches > 0 {
+        warnings.push(format!(
+            "{switches} pixel(s) switch regime (attractive ↔ repulsive) where a material has no \
+             operating point in the previous one's: the image's contrast changes there"
+        ));
+    }
+    Ok(Image {
+        x,
+        y,
+        materials,
+        pixels,
+        reference,
+        domain_names: map.domains.iter().map(|d| d.name.clone()).collect(),
+        warnings,
+    })
+}
+
+impl Image {
+    /// The operating point of pixel (line, pixel), `None` where the setpoint is not reached.
+    pub fn point(&self, line: usize, pixel: usize) -> Option<&OperatingPoint> {
+        let p = &self.pixels[line][pixel];
+        p.point.map(|i| &self.materials[p.material].points[i])
+    }
+
+    /// Apparent height of a pixel (m): h + z_c − z_c,ref (NaN where not reached).
+    pub fn apparent_height(&self, line: usize, pixel: usize) -> f64 {
+        let p = &self.pixels[line][pixel];
+        self.point(line, pixel)
+            .map_or(f64::NAN, |o| p.height + o.z_c - self.reference)
+    }
+
+    /// The image document (`afmdyn image --json`): `image` with `x`, `y` (m) and per
+    /// `[line][pixel]` `height` (apparent, m), `true_height` (m), `amplitude` (m), `phase_deg`,
+    /// `energy_dissipated` (J), `virial` (J), `peak_force` (N), `indentation` (m), `z_c` (m),
+    /// `regime`, `material` and `domain` (their names); `materials` with their operating points;
+    /// `reference_z_c` (m), `setpoint`, `warnings`.
+    pub fn document(&self, setpoint: f64) -> Value {
+        let grid = |f: &dyn Fn(usize, usize) -> Value| -> Value {
+            Value::Array(
+                (0..self.y.len())
+                    .map(|j| Value::Array((0..self.x.len()).map(|i| f(j, i)).collect()))
+                    .collect(),
+            )
+        };
+        let num = |v: f64| {
+            if v.is_finite() {
+                serde_json::json!(v)
+            } else {
+                Value::Null
+            }
+        };
+        let field = |get: fn(&OperatingPoint) -> f64| {
+            grid(&|j, i| num(self.point(j, i).map_or(f64::NAN, get)))
+        };
+        serde_json::json!({
+            "image": {
+                "x": self.x,
+                "y": self.y,
+                "height": grid(&|j, i| num(self.apparent_height(j, i))),
+                "true_height": grid(&|j, i| num(self.pixels[j][i].height)),
+                "z_c": field(|o| o.z_c),
+                "amplitude": field(|o| o.amplitude),
+                "phase_deg": field(|o| o.phase_deg),
+                "energy_dissipated": field(|o| o.energy_dissipated),
+                "virial": field(|o| o.virial),
+                "peak_force": field(|o| o.peak_force),
+                "indentation": field(|o| o.indentation),
+                "regime": grid(&|j, i| {
+                    self.point(j, i).map_or(Value::Null, |o| serde_json::json!(o.regime))
+                }),
+                "material": grid(&|j, i| {
+                    serde_json::json!(self.materials[self.pixels[j][i].material].name)
+                }),
+                "domain": grid(&|j, i| {
+                    serde_json::json!(self.pixels[j][i].domain.map_or("background", |k| {
+                        self.domain_names[k].as_str()
+                    }))
+                }),
+            },
+            "feedback": "ideal",
+            "setpoint": setpoint,
+            "reference_z_c": num(self.reference),
+            "materials": self.materials,
+            "warnings": self.warnings,
+        })
+    }
+}

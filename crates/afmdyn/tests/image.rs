@@ -1,0 +1,262 @@
+//! Ideal-feedback images (issue 46, [`afmdyn::request::image`]): every domain of a line
+//! PS | rubber | PS | step shows the operating point `approach --setpoint` finds on its
+//! material alone (its apparent height the difference of the rest distances, its phase the
+//! same); a true step of the background material shows at its true height; a line engages on
+//! the approach sweep's first operating point and keeps its regime across materials where it
+//! can; the sample map's refusals name their key.
+
+use afmdyn::analysis::approach::approach_retract;
+use afmdyn::probe::Probe;
+use afmdyn::report::{setpoint, CurveUnits};
+use afmdyn::request::curves::{approach_request, CurveRequest};
+use afmdyn::request::image::{image, ImageRequest, Regime, SampleMap};
+
+fn repo(path: &str) -> String {
+    std::fs::read_to_string(format!("{}/../../{path}", env!("CARGO_MANIFEST_DIR"))).unwrap()
+}
+
+/// The probe text with its `[sample]` table replaced by `sample` (the domain's keys), written
+/// out as a probe file a user would write for that material alone.
+fn probe_with_sample(probe: &str, sample: &str) -> String {
+    let mut out = String::new();
+    let mut skip = false;
+    for line in probe.lines() {
+        if line.trim_start().starts_with('[') {
+            skip = line.trim() == "[sample]";
+            if skip {
+                out.push_str("[sample]\n");
+                out.push_str(sample);
+                out.push('\n');
+                continue;
+            }
+        }
+        if !skip {
+            out.push_str(line);
+            out.push('\n');
+        }
+    }
+    out
+}
+
+/// `approach --setpoint r --no-branches` on one probe: its operating points (z_c, regime,
+/// phase), in SI.
+fn operating_points(probe_text: &str, r: f64, points: usize) -> Vec<(f64, String, f64, String)> {
+    let p = Probe::parse(probe_text, "<test>").unwrap();
+    let u = CurveUnits::from_scales(&p.scales, false);
+    let req = CurveRequest {
+        points: Some(points),
+        branches: false,
+        ..CurveRequest::default()
+    };
+    let spec = approach_request(p.params, &req, u.length, false).unwrap();
+    let c = approach_retract(&spec).unwrap();
+    let doc = setpoint(&p.params, &c, r, &u);
+    doc["points"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|q| {
+            (
+                q["z_c"].as_f64().unwrap(),
+                q["regime"].as_str().unwrap().to_string(),
+                q["phase_deg"].as_f64().unwrap(),
+                q["source"].as_str().unwrap().to_string(),
+            )
+        })
+        .collect()
+}
+
+const RUBBER: &str = "law = \"dmt\"\nyoungs_modulus = 50e6\npoisson_ratio = 0.45\nhamaker = \
+                      6.6e-20\nintermolecular_distance = 0.165e-9\nviscosity = 5.0";
+
+/// The line of `examples/sample-stripe.toml` over `examples/probe-point-mass-dmt.toml` at the
+/// setpoint 0.7: the background (polystyrene) is imaged on its repulsive operating point, the
+/// rubber stripe on its own attractive one (it has no other at this setpoint: a regime switch,
+/// reported), the step of polystyrene 5 nm higher at exactly 5 nm; each as `approach
+/// --setpoint` locates it on that material alone, from a probe file with that sample.
+#[test]
+fn each_domain_shows_its_own_operating_point() {
+    let probe = repo("examples/probe-point-mass-dmt.toml");
+    let table: toml::Table = probe.parse().unwrap();
+    let map = SampleMap::parse(&repo("examples/sample-stripe.toml"), "<test>").unwrap();
+    let req = ImageRequest {
+        setpoint: 0.7,
+        pixels: 50,
+        ..ImageRequest::at(0.7)
+    };
+    let img = image(&table, &map, &req).unwrap();
+    let bg = operating_points(&probe, 0.7, 120);
+    let rubber = operating_points(&probe_with_sample(&probe, RUBBER), 0.7, 120);
+    // engaged from far: the approach sweep's operating point of largest z_c
+    let engaged = bg
+        .iter()
+        .filter(|p| p.3 == "approach")
+        .max_by(|a, b| a.0.total_cmp(&b.0))
+        .unwrap();
+    assert!(
+        (img.reference - engaged.0).abs() < 1e-18,
+        "{} vs {engaged:?}",
+        img.reference
+    );
+    let mut seen = [false; 3];
+    for (i, &x) in img.x.iter().enumerate() {
+        let p = img.pixels[0][i];
+        let o = img.point(0, i).unwrap();
+        let h = img.apparent_height(0, i);
+        match p.domain {
+            None => {
+                // polystyrene at the reference: height 0, the engaged phase
+                assert_eq!(h, 0.0, "x = {x}");
+                assert_eq!(o.phase_deg, engaged.2);
+                assert_eq!(o.regime, Regime::Repulsive);
+                seen[0] = true;
+            }
+            Some(0) => {
+                // the rubber: attractive only (on both sweeps), so the line switches to the
+                // operating point nearest the background's z_c; the height its z_c's
+                // difference from polystyrene's
+                assert!(rubber.iter().all(|p| p.1 == "attractive"), "{rubber:?}");
+                let want = rubber
+                    .iter()
+                    .min_by(|a, b| (a.0 - engaged.0).abs().total_cmp(&(b.0 - engaged.0).abs()))
+                    .unwrap();
+                assert!((h - (want.0 - engaged.0)).abs() < 1e-18, "{h}");
+                assert!((o.phase_deg - want.2).abs() < 1e-12);
+                seen[1] = true;
+            }
+            Some(_) => {
+                // the step: the background's point, 5 nm up
+                assert!((h - 5e-9).abs() < 1e-18, "{h}");
+                assert_eq!(o.phase_deg, engaged.2);
+                seen[2] = true;
+            }
+        }
+    }
+    assert_eq!(seen, [true; 3]);
+    // entering and leaving the stripe switch regime, and the document says so
+    let switched: usize = img.pixels[0].iter().map(|p| usize::from(p.switched)).sum();
+    assert_eq!(switched, 2);
+    assert!(img
+        .warnings
+        .iter()
+        .any(|w| w.contains("2 pixel(s) switch regime")));
+    let doc = img.document(0.7);
+    assert_eq!(doc["image"]["height"][0].as_array().unwrap().len(), 50);
+    assert_eq!(doc["image"]["domain"][0][20], "rubber");
+}
+
+/// Where the setpoint has an attractive and a repulsive operating point (the RTESPA-300 over
+/// polystyrene at A/A0 = 0.95, bistable), the line engages on the attractive one the approach
+/// meets first, and a domain of a softer polymer that has both keeps the line attractive.
+#[test]
+fn a_line_engages_from_far_and_keeps_its_regime() {
+    let probe = repo("examples/probe-rtespa300-polystyrene.toml");
+    let bg = operating_points(&probe, 0.95, 120);
+    let regimes: Vec<&str> = bg.iter().map(|p| p.1.as_str()).collect();
+    assert!(
+        regimes.contains(&"attractive") && regimes.contains(&"repulsive"),
+        "{bg:?}"
+    );
+    let map = SampleMap::parse(
+        "size = [1e-6, 0]\n[[domain]]\nname = \"soft\"\nx = [0.4e-6, 0.6e-6]\n\
+         [domain.sample]\nlaw = \"dmt\"\nyoungs_modulus = 1e9\npoisson_ratio = 0.4\n\
+         hamaker = 6.6e-20\nviscosity = 10.0\n",
+        "<test>",
+    )
+    .unwrap();
+    let req = ImageRequest {
+        setpoint: 0.95,
+        pixels: 20,
+        ..ImageRequest::at(0.95)
+    };
+    let img = image(&probe.parse().unwrap(), &map, &req).unwrap();
+    assert_eq!(img.point(0, 0).unwrap().regime, Regime::Attractive);
+    // the softer polymer has both regimes at this setpoint too: the line stays attractive
+    let soft = &img.materials[1].points;
+    for r in [Regime::Attractive, Regime::Repulsive] {
+        assert!(soft.iter().any(|p| p.regime == r), "{soft:?}");
+    }
+    for i in 0..20 {
+        assert_eq!(
+            img.point(0, i).unwrap().regime,
+            Regime::Attractive,
+            "pixel {i}"
+        );
+        assert!(!img.pixels[0][i].switched);
+    }
+}
+
+/// A 2D map: where domains overlap the later one lies on top; the request's and the map's
+/// refusals name their key.
+#[test]
+fn sample_maps_and_their_refusals() {
+    let map = SampleMap::parse(
+        "size = [1e-6, 1e-6]\n[[domain]]\nname = \"a\"\nx = [0, 0.6e-6]\n\
+         [[domain]]\nname = \"b\"\nx = [0.4e-6, 1e-6]\ny = [0, 0.5e-6]\nheight = 2e-9\n",
+        "<test>",
+    )
+    .unwrap();
+    assert_eq!(map.domain_at(0.5e-6, 0.2e-6), Some(1));
+    assert_eq!(map.domain_at(0.5e-6, 0.8e-6), Some(0));
+    assert_eq!(map.domain_at(0.8e-6, 0.8e-6), None);
+    let refused = |text: &str, key: &str| {
+        let e = SampleMap::parse(text, "s.toml").unwrap_err().to_string();
+        assert!(e.contains(key) && e.contains("s.toml"), "{key}: {e}");
+    };
+    refused("size = [1e-6]", "size");
+    refused("size = [0, 0]", "size");
+    refused("size = [1e-6, 0]\ncolour = 1", "colour");
+    refused("size = [1e-6, 0]\n[[domain]]\nname = \"d\"", "domain 'd' x");
+    refused(
+        "size = [1e-6, 0]\n[[domain]]\nname = \"d\"\nx = [2e-7, 1e-7]",
+        "domain 'd' x",
+    );
+    refused(
+        "size = [1e-6, 0]\n[[domain]]\nx = [2e-6, 3e-6]",
+        "outside the map",
+    );
+    refused(
+        "size = [1e-6, 0]\n[[domain]]\nname = \"d\"\nx = [0, 1e-7]\nheight = 1e-3",
+        "domain 'd' height",
+    );
+    refused(
+        "size = [1e-6, 0]\n[[domain]]\nname = \"d\"\nx = [0, 1e-7]\n[domain.sample]\nz_c = 1e-9",
+        "sample.z_c",
+    );
+    refused("size = [1e-6, 0", "invalid TOML");
+    let line = SampleMap::parse("size = [1e-6, 0]", "<test>").unwrap();
+    let req = |setpoint: f64, lines: usize| ImageRequest {
+        setpoint,
+        pixels: 8,
+        lines: Some(lines),
+        curve_points: 40,
+    };
+    for (r, key) in [
+        (req(1.0, 1), "setpoint"),
+        (req(0.0, 1), "setpoint"),
+        (req(0.5, 2), "lines"),
+        (
+            ImageRequest {
+                pixels: 0,
+                ..req(0.5, 1)
+            },
+            "pixels",
+        ),
+    ] {
+        let e = r.validate(&line).unwrap_err().to_string();
+        assert!(e.contains(key), "{e}");
+    }
+    // a domain's sample that the probe format refuses is named by its domain
+    let probe: toml::Table = repo("examples/probe-point-mass-dmt.toml").parse().unwrap();
+    let bad = SampleMap::parse(
+        "size = [1e-6, 0]\n[[domain]]\nname = \"glass\"\nx = [0, 1e-7]\n[domain.sample]\n\
+         law = \"dmt\"\nyoungs_modulus = -1\npoisson_ratio = 0.2\nhamaker = 1e-20\n",
+        "<test>",
+    )
+    .unwrap();
+    let e = image(&probe, &bad, &req(0.7, 1)).unwrap_err().to_string();
+    assert!(
+        e.contains("domain 'glass'") && e.contains("youngs_modulus"),
+        "{e}"
+    );
+}
