@@ -7,7 +7,9 @@ use crate::args::read_text;
 use crate::error::CliError;
 use crate::output::{si_value, write_document, OutDir};
 use crate::plot::{save, save_map, CellMap, Figure, Series, Style};
-use afmdyn::request::image::{image, Image, ImageRequest, SampleMap};
+use afmdyn::request::image::{
+    image, setpoint_study, study_ratios, Image, ImageRequest, SampleMap, SetpointStudy,
+};
 use clap::Args;
 use plotters::style::RGBColor;
 use std::path::PathBuf;
@@ -38,6 +40,11 @@ pub struct ImageArgs {
     /// Points of each material's approach curve (the probe's default z_c range) [default: 120]
     #[arg(long)]
     curve_points: Option<usize>,
+    /// Also the setpoint study FROM:TO:N (e.g. 0.2:0.95:16): every domain's apparent height,
+    /// phase and E_dis at N setpoints, as a line engaged on the background meets it (the
+    /// contrast inversion); "setpoint_study" in the document and two plots
+    #[arg(long, value_name = "FROM:TO:N")]
+    setpoint_study: Option<String>,
     /// Output directory (locked during the run)
     #[arg(long, default_value = "afmdyn-out/image")]
     out: PathBuf,
@@ -103,6 +110,55 @@ fn map_of(
     )
 }
 
+/// The setpoint study's plots: each domain's apparent height and phase lag against A/A0.
+fn study_plots(out: &OutDir, s: &SetpointStudy) -> Result<(), CliError> {
+    for (stem, title, label, get) in [
+        (
+            "image-setpoint-height",
+            "Apparent height of each domain against the setpoint (ideal feedback)",
+            "apparent height (m)",
+            (|d: &afmdyn::request::image::DomainContrast| d.apparent_height.clone())
+                as fn(&afmdyn::request::image::DomainContrast) -> Vec<f64>,
+        ),
+        (
+            "image-setpoint-phase",
+            "Phase lag of each domain against the setpoint (ideal feedback)",
+            "phase lag (°)",
+            |d| d.phase_deg.clone(),
+        ),
+    ] {
+        save(
+            out.path(),
+            stem,
+            &Figure {
+                title: title.into(),
+                x_label: "setpoint A/A0".into(),
+                y_label: label.into(),
+                series: s
+                    .domains
+                    .iter()
+                    .enumerate()
+                    .map(|(k, d)| Series {
+                        label: d.name.clone(),
+                        points: s
+                            .ratio
+                            .iter()
+                            .copied()
+                            .zip(get(d))
+                            .filter(|p| p.1.is_finite())
+                            .collect(),
+                        style: Style::Line,
+                        color: k,
+                    })
+                    .collect(),
+                shade: Vec::new(),
+                y_min_span: 0.0,
+            },
+        )?;
+    }
+    Ok(())
+}
+
 /// Run `afmdyn image`.
 pub fn image_cmd(a: &ImageArgs) -> Result<(), CliError> {
     if a.feedback != "ideal" {
@@ -128,9 +184,18 @@ pub fn image_cmd(a: &ImageArgs) -> Result<(), CliError> {
         ..d
     };
     req.validate(&map)?;
+    let ratios = a.setpoint_study.as_deref().map(study_ratios).transpose()?;
     let out = OutDir::lock(&a.out)?;
     let img = image(&table, &map, &req)?;
-    let json = img.document(a.setpoint);
+    let mut json = img.document(a.setpoint);
+    let study = match &ratios {
+        Some(r) => Some(setpoint_study(&table, &map, r, req.curve_points)?),
+        None => None,
+    };
+    if let Some(s) = &study {
+        json["setpoint_study"] = serde_json::to_value(s).expect("a study serialises");
+        study_plots(&out, s)?;
+    }
     write_document(&out, "image.json", &json)?;
     let img = &img;
     let field = |get: fn(&afmdyn::request::image::OperatingPoint) -> f64| {
@@ -238,6 +303,24 @@ pub fn image_cmd(a: &ImageArgs) -> Result<(), CliError> {
                 );
             }
             None => outln!("  {name}: not imaged (no operating point, or not in the map)"),
+        }
+    }
+    if let Some(s) = &study {
+        outln!("setpoint study (apparent height, phase; a line engaged on the background):");
+        for (k, r) in s.ratio.iter().enumerate() {
+            let cells: Vec<String> = s
+                .domains
+                .iter()
+                .map(|d| {
+                    format!(
+                        "{} {}, {:.1}°",
+                        d.name,
+                        si_value(d.apparent_height[k], "m"),
+                        d.phase_deg[k]
+                    )
+                })
+                .collect();
+            outln!("  A/A0 = {r:.3}: {}", cells.join("; "));
         }
     }
     outln!("outputs in {}", out.path().display());

@@ -614,3 +614,27 @@ pub fn image(
     let img = py.detach(|| image(&table, &map, &req)).map_err(sim_error)?;
     Ok(img.document(setpoint).to_string())
 }
+
+/// The setpoint study of a sample map under a probe (`afmdyn image --setpoint-study`:
+/// [`afmdyn::request::image::setpoint_study`]): its JSON (`ratio`, `domains`). Arguments as
+/// [`image`]'s.
+#[pyfunction]
+#[pyo3(signature = (probe, sample, ratios, curve_points=None))]
+pub fn setpoint_study(
+    py: Python<'_>,
+    probe: &str,
+    sample: &str,
+    ratios: Vec<f64>,
+    curve_points: Option<usize>,
+) -> PyResult<String> {
+    use afmdyn::request::image::{setpoint_study, ImageRequest, SampleMap};
+    let table: toml::Table = probe
+        .parse()
+        .map_err(|e: toml::de::Error| crate::errors::value_error(format!("probe: {e}")))?;
+    let map = SampleMap::read(sample).map_err(sim_error)?;
+    let points = curve_points.unwrap_or(ImageRequest::at(0.5).curve_points);
+    let study = py
+        .detach(|| setpoint_study(&table, &map, &ratios, points))
+        .map_err(sim_error)?;
+    Ok(serde_json::to_string(&study).expect("a study serialises"))
+}

@@ -51,3 +51,20 @@ def test_the_sample_map_may_be_text_and_refusals_name_their_field():
         afmdyn.image(PROBE, "size = [1e-6]", 0.7)
     with pytest.raises(TypeError, match="pixels"):
         afmdyn.image(PROBE, STRIPE, 0.7, pixels=2.5)
+
+
+def test_the_setpoint_study_is_the_command_lines(cli_json, tmp_path):
+    ds = afmdyn.setpoint_study(PROBE, STRIPE, [0.3, 0.6, 0.9])
+    assert ds.apparent_height.dims == ("domain", "setpoint")
+    assert list(ds.domain.values) == ["background", "rubber", "step"]
+    doc = cli_json(
+        "image", "--probe", PROBE, "--sample", STRIPE, "--setpoint", "0.7",
+        "--setpoint-study", "0.3:0.9:3", "--pixels", "8", "--out", tmp_path,
+    )
+    study = doc["setpoint_study"]
+    assert json.loads(ds.attrs["summary"]) == study
+    # the step is the background 5 nm up at every setpoint; the background at 0
+    assert np.allclose(ds.apparent_height.sel(domain="step"), 5e-9, rtol=0, atol=1e-18)
+    assert np.all(ds.apparent_height.sel(domain="background") == 0.0)
+    with pytest.raises(ValueError, match="setpoint_study"):
+        afmdyn.setpoint_study(PROBE, STRIPE, [0.5, 1.2])

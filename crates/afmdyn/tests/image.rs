@@ -9,7 +9,9 @@ use afmdyn::analysis::approach::approach_retract;
 use afmdyn::probe::Probe;
 use afmdyn::report::{setpoint, CurveUnits};
 use afmdyn::request::curves::{approach_request, CurveRequest};
-use afmdyn::request::image::{image, ImageRequest, Regime, SampleMap};
+use afmdyn::request::image::{
+    image, setpoint_study, study_ratios, ImageRequest, Regime, SampleMap,
+};
 
 fn repo(path: &str) -> String {
     std::fs::read_to_string(format!("{}/../../{path}", env!("CARGO_MANIFEST_DIR"))).unwrap()
@@ -259,4 +261,43 @@ fn sample_maps_and_their_refusals() {
         e.contains("domain 'glass'") && e.contains("youngs_modulus"),
         "{e}"
     );
+}
+
+/// The setpoint study is the image's operating points ratio by ratio: at each of 6 setpoints
+/// every domain's apparent height and phase equal those of the stripe line imaged at that
+/// setpoint (the line engages on the background and crosses onto the rubber, then the step);
+/// its ratios parse from FROM:TO:N, and other forms are refused naming setpoint_study.
+#[test]
+fn the_setpoint_study_is_the_image_at_each_setpoint() {
+    let probe: toml::Table = repo("examples/probe-point-mass-dmt.toml").parse().unwrap();
+    let map = SampleMap::parse(&repo("examples/sample-stripe.toml"), "<test>").unwrap();
+    let ratios = study_ratios("0.3:0.9:6").unwrap();
+    assert_eq!(ratios.len(), 6);
+    assert!((ratios[1] - 0.42).abs() < 1e-15 && ratios[5] == 0.9);
+    let study = setpoint_study(&probe, &map, &ratios, 120).unwrap();
+    let names: Vec<&str> = study.domains.iter().map(|d| d.name.as_str()).collect();
+    assert_eq!(names, ["background", "rubber", "step"]);
+    for (k, &r) in ratios.iter().enumerate() {
+        let img = image(
+            &probe,
+            &map,
+            &ImageRequest {
+                pixels: 40,
+                ..ImageRequest::at(r)
+            },
+        )
+        .unwrap();
+        for (d, series) in study.domains.iter().enumerate() {
+            let want = if d == 0 { None } else { Some(d - 1) };
+            let i = img.pixels[0].iter().position(|p| p.domain == want).unwrap();
+            let (h, o) = (img.apparent_height(0, i), img.point(0, i).unwrap());
+            assert_eq!(series.apparent_height[k], h, "{} at {r}", series.name);
+            assert_eq!(series.phase_deg[k], o.phase_deg, "{} at {r}", series.name);
+            assert_eq!(series.regime[k], Some(o.regime));
+        }
+    }
+    for bad in ["0.2:0.9", "0:0.9:5", "0.2:1.0:5", "0.2:0.9:1", "a:b:c"] {
+        let e = study_ratios(bad).unwrap_err().to_string();
+        assert!(e.contains("setpoint_study"), "{bad}: {e}");
+    }
 }

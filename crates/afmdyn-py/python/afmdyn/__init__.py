@@ -48,7 +48,7 @@ from ._interrupt import cancel_running
 from ._interrupt import install as _install_sigint
 from ._orbits import lyapunov, orbit
 from ._fm import fm
-from ._image import image
+from ._image import image, setpoint_study
 from ._reconstruct import reconstruct
 from ._results import Lyapunov, Orbit, RegionSpectrum, Spectrum
 
@@ -91,6 +91,7 @@ __all__ = [
     "probe",
     "reconstruct",
     "image",
+    "setpoint_study",
     "fm",
     "resonance",
     "simulate",

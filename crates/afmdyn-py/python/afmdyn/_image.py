@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import json
 import os
-from typing import Any, Dict, Optional, Union
+from typing import Any, Dict, Optional, Sequence, Union
 
 import numpy as np
 import xarray as xr
@@ -89,4 +89,52 @@ def image(
             "feedback": doc["feedback"],
             "summary": json.dumps(doc),
         },
+    )
+
+
+def setpoint_study(
+    probe: Union[str, "os.PathLike[str]", Dict[str, Any]],
+    sample: Union[str, "os.PathLike[str]"],
+    ratios: Sequence[float],
+    *,
+    curve_points: Optional[int] = None,
+) -> xr.Dataset:
+    """Every domain's apparent height, phase lag and dissipated energy against the setpoint
+    under an ideal feedback (``afmdyn image --setpoint-study``): at each ratio a line engaged
+    on the background crosses onto each domain — the contrast inversion of AM-AFM (García &
+    San Paulo, Phys. Rev. B 61, R13381 (2000)). Arguments as :func:`image`'s; ``ratios`` the
+    setpoints A_sp/A0 in (0, 1).
+
+    Returns:
+        ``xarray.Dataset`` over ``domain`` (``background`` first) and ``setpoint``:
+        ``apparent_height`` (m), ``phase_deg``, ``energy_dissipated`` (J) (NaN where a
+        material has no operating point) and ``regime``; attribute ``summary`` (the JSON).
+    """
+    if isinstance(curve_points, bool) or not (
+        curve_points is None or isinstance(curve_points, int)
+    ):
+        raise TypeError(f"setpoint_study(): curve_points must be int or None, got {curve_points!r}")
+    text = _core.probe_source(probe)
+    source = os.fspath(sample) if isinstance(sample, os.PathLike) else sample
+    values = [float(r) for r in np.asarray(ratios, dtype=np.float64).ravel()]
+    doc = json.loads(_core.setpoint_study(text, source, values, curve_points))
+    dims = ("domain", "setpoint")
+    num = lambda key: np.array(  # noqa: E731
+        [[np.nan if v is None else v for v in d[key]] for d in doc["domains"]], dtype=np.float64
+    )
+    return xr.Dataset(
+        {
+            "apparent_height": (dims, num("apparent_height"), {"units": "m"}),
+            "phase_deg": (dims, num("phase_deg"), {"units": "degree"}),
+            "energy_dissipated": (dims, num("energy_dissipated"), {"units": "J"}),
+            "regime": (
+                dims,
+                np.array([["" if v is None else v for v in d["regime"]] for d in doc["domains"]]),
+            ),
+        },
+        coords={
+            "domain": [d["name"] for d in doc["domains"]],
+            "setpoint": np.asarray(doc["ratio"], dtype=np.float64),
+        },
+        attrs={"summary": json.dumps(doc)},
     )

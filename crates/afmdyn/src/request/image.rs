@@ -22,7 +22,9 @@
 //! difference in z_c (García & San Paulo 2000; the height artefacts of Kühle, Sørensen & Bohr,
 //! *J. Appl. Phys.* 81 (1997) 6562). The operating points of each material are computed once
 //! (an approach curve per material, [`crate::analysis::approach::approach_retract`]), so the
-//! image costs one approach curve per material however many pixels it has.
+//! image costs one approach curve per material however many pixels it has, and the
+//! [`setpoint_study`] (every domain's contrast against the setpoint) as many however many
+//! setpoints.
 
 use crate::analysis::approach::approach_retract;
 use crate::error::SimError;
@@ -440,22 +442,81 @@ impl ImageRequest {
     }
 }
 
-/// The operating points of `params`' approach curve at the setpoint, in SI (`units`).
-fn operating_points(
+/// One material's approach curve: the background or a domain's sample under the probe's lever
+/// and drive.
+struct MaterialCurve {
+    name: String,
+    params: Params,
+    curve: crate::analysis::stepped::SteppedCurve,
+}
+
+/// The approach curve of `params` (`curve_points` z_c values each way over the probe's default
+/// range, no branches).
+fn approach_curve(
     params: Params,
     units: &CurveUnits,
-    req: &ImageRequest,
-) -> Result<(Vec<OperatingPoint>, Vec<String>), SimError> {
+    curve_points: usize,
+) -> Result<crate::analysis::stepped::SteppedCurve, SimError> {
     let curve_req = CurveRequest {
-        points: Some(req.curve_points),
+        points: Some(curve_points),
         branches: false,
         ..CurveRequest::default()
     };
     let spec = approach_request(params, &curve_req, units.length, false)?;
-    let curve = approach_retract(&spec)?;
-    let doc = crate::report::setpoint(&params, &curve, req.setpoint, units);
+    approach_retract(&spec)
+}
+
+/// The materials of `map` under the probe `probe_table`: the background, then one per domain
+/// with its own sample, each with its approach curve; the material of each domain; the SI
+/// units.
+fn material_curves(
+    probe_table: &toml::Table,
+    map: &SampleMap,
+    curve_points: usize,
+) -> Result<(Vec<MaterialCurve>, Vec<usize>, CurveUnits), SimError> {
+    let background =
+        Probe::from_table(probe_table, "probe").map_err(|e| SimError::Probe(e.to_string()))?;
+    if background.components.len() > 1 {
+        return Err(SimError::out_of_range(
+            "probe",
+            "a multifrequency drive",
+            "an image is recorded with one drive frequency",
+        ));
+    }
+    let units = CurveUnits::from_scales(&background.scales, false);
+    let mut materials = vec![MaterialCurve {
+        name: "background".into(),
+        params: background.params,
+        curve: approach_curve(background.params, &units, curve_points)?,
+    }];
+    let mut of_domain = Vec::with_capacity(map.domains.len());
+    for d in &map.domains {
+        let Some(sample) = &d.sample else {
+            of_domain.push(0);
+            continue;
+        };
+        let mut root = probe_table.clone();
+        root.insert("sample".into(), toml::Value::Table(sample.clone()));
+        let origin = format!("domain '{}'", d.name);
+        let probe =
+            Probe::from_table(&root, &origin).map_err(|e| SimError::Probe(e.to_string()))?;
+        // the same lever, drive and units: only the sample differs
+        of_domain.push(materials.len());
+        materials.push(MaterialCurve {
+            name: d.name.clone(),
+            params: probe.params,
+            curve: approach_curve(probe.params, &units, curve_points)?,
+        });
+    }
+    Ok((materials, of_domain, units))
+}
+
+/// The operating points of a material's curve at the setpoint `ratio`, in SI (`units`;
+/// [`crate::report::setpoint`]).
+fn points_at(m: &MaterialCurve, ratio: f64, units: &CurveUnits) -> Vec<OperatingPoint> {
+    let doc = crate::report::setpoint(&m.params, &m.curve, ratio, units);
     let num = |p: &Value, k: &str| p[k].as_f64().unwrap_or(f64::NAN);
-    let points = doc["points"]
+    doc["points"]
         .as_array()
         .map(|a| {
             a.iter()
@@ -476,8 +537,7 @@ fn operating_points(
                 })
                 .collect()
         })
-        .unwrap_or_default();
-    Ok((points, curve.warnings))
+        .unwrap_or_default()
 }
 
 /// The operating point a line engages on: the approach sweep's first (largest z_c), else the
@@ -520,44 +580,15 @@ pub fn image(
     req: &ImageRequest,
 ) -> Result<Image, SimError> {
     req.validate(map)?;
-    let background =
-        Probe::from_table(probe_table, "probe").map_err(|e| SimError::Probe(e.to_string()))?;
-    if background.components.len() > 1 {
-        return Err(SimError::out_of_range(
-            "probe",
-            "a multifrequency drive",
-            "an image is recorded with one drive frequency",
-        ));
-    }
-    let units = CurveUnits::from_scales(&background.scales, false);
-    // materials: the background, then each domain with its own sample
-    let mut materials = Vec::new();
-    let mut of_domain = Vec::with_capacity(map.domains.len());
-    let (points, warnings) = operating_points(background.params, &units, req)?;
-    materials.push(Material {
-        name: "background".into(),
-        points,
-        warnings,
-    });
-    for d in &map.domains {
-        let Some(sample) = &d.sample else {
-            of_domain.push(0);
-            continue;
-        };
-        let mut root = probe_table.clone();
-        root.insert("sample".into(), toml::Value::Table(sample.clone()));
-        let origin = format!("domain '{}'", d.name);
-        let probe =
-            Probe::from_table(&root, &origin).map_err(|e| SimError::Probe(e.to_string()))?;
-        // the same lever, drive and units: only the sample differs
-        let (points, warnings) = operating_points(probe.params, &units, req)?;
-        of_domain.push(materials.len());
-        materials.push(Material {
-            name: d.name.clone(),
-            points,
-            warnings,
-        });
-    }
+    let (curves, of_domain, units) = material_curves(probe_table, map, req.curve_points)?;
+    let materials: Vec<Material> = curves
+        .iter()
+        .map(|m| Material {
+            name: m.name.clone(),
+            points: points_at(m, req.setpoint, &units),
+            warnings: m.curve.warnings.clone(),
+        })
+        .collect();
     let (lx, ly) = map.size;
     let x: Vec<f64> = (0..req.pixels)
         .map(|i| (i as f64 + 0.5) * lx / req.pixels as f64)
@@ -695,4 +726,141 @@ impl Image {
             "warnings": self.warnings,
         })
     }
+}
+
+/// The apparent height and phase of every domain against the setpoint (issue 46's setpoint
+/// study: the contrast inversion of AM-AFM, García & San Paulo 2000): at each ratio a line
+/// engaged on the background ([`image`]'s rule) crosses onto each domain, whose operating point
+/// is the one the regime rule takes there. The materials' approach curves are computed once
+/// for all ratios.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SetpointStudy {
+    /// The setpoint ratios A_sp/A₀.
+    pub ratio: Vec<f64>,
+    /// The background first, then every domain of the map.
+    pub domains: Vec<DomainContrast>,
+}
+
+/// One domain's series of a [`SetpointStudy`]: per ratio its apparent height (m), phase lag
+/// (degrees) and regime, `None`/NaN where its material has no operating point there.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct DomainContrast {
+    /// `background` or the domain's name.
+    pub name: String,
+    /// Apparent height h + z_c − z_c,ref (m).
+    pub apparent_height: Vec<f64>,
+    /// Phase lag (degrees).
+    pub phase_deg: Vec<f64>,
+    /// Energy dissipated per period (J).
+    pub energy_dissipated: Vec<f64>,
+    /// Regime.
+    pub regime: Vec<Option<Regime>>,
+}
+
+/// Parse a setpoint study's ratios `FROM:TO:N` (N evenly spaced ratios in (0, 1), ends
+/// included).
+///
+/// # Errors
+/// [`SimError::OutOfRange`] naming `setpoint_study` for another form, ratios outside (0, 1)
+/// or N outside 2..=1000.
+pub fn study_ratios(spec: &str) -> Result<Vec<f64>, SimError> {
+    let bad = || {
+        SimError::out_of_range(
+            "setpoint_study",
+            spec.to_string(),
+            "must be FROM:TO:N, ratios A_sp/A0 in (0, 1) and N in 2..=1000 (e.g. 0.2:0.95:16)",
+        )
+    };
+    let parts: Vec<&str> = spec.split(':').collect();
+    let [from, to, n] = parts[..] else {
+        return Err(bad());
+    };
+    let (from, to): (f64, f64) = (
+        from.trim().parse().map_err(|_| bad())?,
+        to.trim().parse().map_err(|_| bad())?,
+    );
+    let n: usize = n.trim().parse().map_err(|_| bad())?;
+    let inside = |r: f64| r > 0.0 && r < 1.0;
+    if !(inside(from) && inside(to) && (2..=1000).contains(&n)) {
+        return Err(bad());
+    }
+    // (1 − t)·from + t·to: both ends exactly
+    Ok((0..n)
+        .map(|k| {
+            let t = k as f64 / (n - 1) as f64;
+            (1.0 - t) * from + t * to
+        })
+        .collect())
+}
+
+/// The setpoint study of `map` under the probe at the `ratios` ([`SetpointStudy`]).
+///
+/// # Errors
+/// [`SimError::OutOfRange`] naming `setpoint_study` for a ratio outside (0, 1) or no ratios;
+/// as [`image`]'s materials.
+pub fn setpoint_study(
+    probe_table: &toml::Table,
+    map: &SampleMap,
+    ratios: &[f64],
+    curve_points: usize,
+) -> Result<SetpointStudy, SimError> {
+    if ratios.is_empty() || ratios.iter().any(|&r| !(r > 0.0 && r < 1.0)) {
+        return Err(SimError::out_of_range(
+            "setpoint_study",
+            format!("{ratios:?}"),
+            "must be one or more ratios A_sp/A0 in (0, 1)",
+        ));
+    }
+    ImageRequest {
+        curve_points,
+        ..ImageRequest::at(ratios[0])
+    }
+    .validate(map)?;
+    let (curves, of_domain, units) = material_curves(probe_table, map, curve_points)?;
+    let names = std::iter::once(("background".to_string(), 0, 0.0)).chain(
+        map.domains
+            .iter()
+            .zip(&of_domain)
+            .map(|(d, &m)| (d.name.clone(), m, d.height)),
+    );
+    let mut domains: Vec<DomainContrast> = names
+        .clone()
+        .map(|(name, _, _)| DomainContrast {
+            name,
+            apparent_height: Vec::with_capacity(ratios.len()),
+            phase_deg: Vec::with_capacity(ratios.len()),
+            energy_dissipated: Vec::with_capacity(ratios.len()),
+            regime: Vec::with_capacity(ratios.len()),
+        })
+        .collect();
+    for &r in ratios {
+        let points: Vec<Vec<OperatingPoint>> =
+            curves.iter().map(|m| points_at(m, r, &units)).collect();
+        let engaged = engage(&points[0]).map(|i| &points[0][i]);
+        for ((_, material, height), series) in names.clone().zip(domains.iter_mut()) {
+            let pts = &points[material];
+            let point = engaged.and_then(|e| {
+                if material == 0 {
+                    Some(e)
+                } else {
+                    continue_from(pts, e.regime, e.z_c).map(|(i, _)| &pts[i])
+                }
+            });
+            let reference = engaged.map_or(f64::NAN, |e| e.z_c);
+            series
+                .apparent_height
+                .push(point.map_or(f64::NAN, |o| height + o.z_c - reference));
+            series
+                .phase_deg
+                .push(point.map_or(f64::NAN, |o| o.phase_deg));
+            series
+                .energy_dissipated
+                .push(point.map_or(f64::NAN, |o| o.energy_dissipated));
+            series.regime.push(point.map(|o| o.regime));
+        }
+    }
+    Ok(SetpointStudy {
+        ratio: ratios.to_vec(),
+        domains,
+    })
 }
