@@ -583,6 +583,18 @@ pub fn observe<'py>(
     Ok(out.finish())
 }
 
+/// The probe's table (from its TOML text) and the sample map (TOML text or path) of an image.
+fn image_inputs(
+    probe: &str,
+    sample: &str,
+) -> PyResult<(toml::Table, afmdyn::request::image::SampleMap)> {
+    let table: toml::Table = probe
+        .parse()
+        .map_err(|e: toml::de::Error| crate::errors::value_error(format!("probe: {e}")))?;
+    let map = afmdyn::request::image::SampleMap::read(sample).map_err(sim_error)?;
+    Ok((table, map))
+}
+
 /// The ideal-feedback image of a sample map under a probe (`afmdyn image`:
 /// [`afmdyn::request::image::image`]): its JSON document. `probe` is the probe's TOML text
 /// ([`crate::params::probe_source`]), `sample` the map's TOML text or path
@@ -599,11 +611,8 @@ pub fn image(
     lines: Option<usize>,
     curve_points: Option<usize>,
 ) -> PyResult<String> {
-    use afmdyn::request::image::{image, ImageRequest, SampleMap};
-    let table: toml::Table = probe
-        .parse()
-        .map_err(|e: toml::de::Error| crate::errors::value_error(format!("probe: {e}")))?;
-    let map = SampleMap::read(sample).map_err(sim_error)?;
+    use afmdyn::request::image::{image, ImageRequest};
+    let (table, map) = image_inputs(probe, sample)?;
     let d = ImageRequest::at(setpoint);
     let req = ImageRequest {
         pixels: pixels.unwrap_or(d.pixels),
@@ -627,11 +636,8 @@ pub fn setpoint_study(
     ratios: Vec<f64>,
     curve_points: Option<usize>,
 ) -> PyResult<String> {
-    use afmdyn::request::image::{setpoint_study, ImageRequest, SampleMap};
-    let table: toml::Table = probe
-        .parse()
-        .map_err(|e: toml::de::Error| crate::errors::value_error(format!("probe: {e}")))?;
-    let map = SampleMap::read(sample).map_err(sim_error)?;
+    use afmdyn::request::image::{setpoint_study, ImageRequest};
+    let (table, map) = image_inputs(probe, sample)?;
     let points = curve_points.unwrap_or(ImageRequest::at(0.5).curve_points);
     let study = py
         .detach(|| setpoint_study(&table, &map, &ratios, points))

@@ -259,7 +259,7 @@ impl CantileverModel {
     fn zener_state(&self, z: &[f64]) -> Option<(&Zener, f64)> {
         self.zener.as_ref().map(|zn| (zn, z[2 * self.modes()]))
     }
-    /// The switching function σ-free: V_T + s(u) for the SLS sample (the tip's height above
+    /// The switching function without the guard's sign σ: V_T + s(u) for the SLS sample (the tip's height above
     /// the recovering surface, [`Zener::surface`]), V_T for the other laws, given V_T.
     fn switching(&self, v_t: f64, z: &[f64]) -> f64 {
         match self.zener_state(z) {
@@ -469,7 +469,7 @@ impl CantileverModel {
         }
         // the gradient row of the tip force (on the stack), then the rank-one term M⁻¹φ rowᵀ
         // added to the velocity rows
-        let mut buf = [0.0; 2 * crate::params::MAX_MODES + 1];
+        let mut buf = [0.0; crate::params::MAX_STATE];
         let row = &mut buf[..self.dim()];
         match self.law.law {
             ContactLaw::Sls { .. } => {
