@@ -259,8 +259,9 @@ impl CantileverModel {
     fn zener_state(&self, z: &[f64]) -> Option<(&Zener, f64)> {
         self.zener.as_ref().map(|zn| (zn, z[2 * self.modes()]))
     }
-    /// The switching function without the guard's sign σ: V_T + s(u) for the SLS sample (the tip's height above
-    /// the recovering surface, [`Zener::surface`]), V_T for the other laws, given V_T.
+    /// The switching function without the guard's sign σ, given V_T: V_T + s(u) for the SLS
+    /// sample (the tip's height above the recovering surface, [`Zener::surface`]), V_T for the
+    /// other laws.
     fn switching(&self, v_t: f64, z: &[f64]) -> f64 {
         match self.zener_state(z) {
             Some((zn, u)) => v_t + zn.surface(u),
