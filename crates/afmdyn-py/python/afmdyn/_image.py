@@ -118,6 +118,7 @@ def setpoint_study(
     source = os.fspath(sample) if isinstance(sample, os.PathLike) else sample
     values = [float(r) for r in np.asarray(ratios, dtype=np.float64).ravel()]
     doc = json.loads(_core.setpoint_study(text, source, values, curve_points))
+    _warn(doc)
     dims = ("domain", "setpoint")
     num = lambda key: np.array(  # noqa: E731
         [[np.nan if v is None else v for v in d[key]] for d in doc["domains"]], dtype=np.float64

@@ -511,6 +511,19 @@ fn material_curves(
     Ok((materials, of_domain, units))
 }
 
+/// The warnings of the materials' approach curves, each named by its material.
+fn curve_warnings(curves: &[MaterialCurve]) -> Vec<String> {
+    curves
+        .iter()
+        .flat_map(|m| {
+            m.curve
+                .warnings
+                .iter()
+                .map(move |w| format!("{} (its approach curve): {w}", m.name))
+        })
+        .collect()
+}
+
 /// The operating points of a material's curve at the setpoint `ratio`, in SI (`units`;
 /// [`crate::report::setpoint`]).
 fn points_at(m: &MaterialCurve, ratio: f64, units: &CurveUnits) -> Vec<OperatingPoint> {
@@ -597,7 +610,8 @@ pub fn image(
     let y: Vec<f64> = (0..n_lines)
         .map(|j| (j as f64 + 0.5) * ly / n_lines as f64)
         .collect();
-    let mut warnings = Vec::new();
+    // the approach curves' own warnings (an unsettled point, a failed one), named by material
+    let mut warnings = curve_warnings(&curves);
     for m in &materials {
         if m.points.is_empty() {
             warnings.push(format!(
@@ -739,6 +753,8 @@ pub struct SetpointStudy {
     pub ratio: Vec<f64>,
     /// The background first, then every domain of the map.
     pub domains: Vec<DomainContrast>,
+    /// The materials' approach curves' warnings, named by material.
+    pub warnings: Vec<String>,
 }
 
 /// One domain's series of a [`SetpointStudy`]: per ratio its apparent height (m), phase lag
@@ -862,5 +878,6 @@ pub fn setpoint_study(
     Ok(SetpointStudy {
         ratio: ratios.to_vec(),
         domains,
+        warnings: curve_warnings(&curves),
     })
 }
