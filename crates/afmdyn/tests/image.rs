@@ -301,3 +301,59 @@ fn the_setpoint_study_is_the_image_at_each_setpoint() {
         assert!(e.contains("setpoint_study"), "{bad}: {e}");
     }
 }
+
+/// A smooth step (a domain's `width`) rises as the smoothstep 3t² − 2t³ of the distance to its
+/// edge over the width — half its height at half the width — and a height map is interpolated
+/// bilinearly (its nodes exactly, midpoints the mean); over one material the ideal feedback
+/// records that true topography exactly (apparent = true height).
+#[test]
+fn smooth_steps_and_height_maps_are_recorded_as_they_are() {
+    let map = SampleMap::parse(
+        "size = [1e-6, 1e-6]\nheight_map = [[0, 1e-9, 2e-9], [4e-9, 5e-9, 6e-9]]\n\
+         [[domain]]\nname = \"terrace\"\nx = [0.5e-6, 1e-6]\nheight = 4e-9\nwidth = 0.2e-6\n",
+        "<test>",
+    )
+    .unwrap();
+    let h = |x: f64, y: f64| map.height_at(x, y);
+    // the height map alone left of the terrace: nodes at x = 0, 0.5 µm, 1 µm and y = 0, 1 µm
+    assert_eq!(h(0.0, 0.0), 0.0);
+    assert!((h(0.25e-6, 0.5e-6) - (0.5e-9 + 4.5e-9) / 2.0).abs() < 1e-20);
+    // the terrace: half its height at half its width from the edge x = 0.5 µm, all of it beyond
+    let step = |x: f64| h(x, 0.0) - (x / 0.5e-6) * 1e-9;
+    assert!((step(0.6e-6) - 2e-9).abs() < 1e-20, "{}", step(0.6e-6));
+    assert!((step(0.8e-6) - 4e-9).abs() < 1e-20);
+    // the map's own edge (x = 1 µm) is no step
+    assert!((step(1e-6) - 4e-9).abs() < 1e-20);
+    let probe: toml::Table = repo("examples/probe-point-mass-dmt.toml").parse().unwrap();
+    let img = image(
+        &probe,
+        &map,
+        &ImageRequest {
+            pixels: 10,
+            lines: Some(3),
+            ..ImageRequest::at(0.7)
+        },
+    )
+    .unwrap();
+    for (j, &y) in img.y.iter().enumerate() {
+        for (i, &x) in img.x.iter().enumerate() {
+            assert_eq!(img.pixels[j][i].height, h(x, y));
+            assert!((img.apparent_height(j, i) - h(x, y)).abs() < 1e-20);
+        }
+    }
+    for (text, key) in [
+        (
+            "size = [1e-6, 0]\nheight_map = [[0, 1e-9], [0]]",
+            "height_map",
+        ),
+        ("size = [1e-6, 0]\nheight_map = [[0, 1]]", "height_map"),
+        ("size = [1e-6, 0]\nheight_map = 3", "height_map"),
+        (
+            "size = [1e-6, 0]\n[[domain]]\nname = \"d\"\nx = [0, 1e-7]\nwidth = -1e-9",
+            "domain 'd' width",
+        ),
+    ] {
+        let e = SampleMap::parse(text, "<test>").unwrap_err().to_string();
+        assert!(e.contains(key), "{e}");
+    }
+}

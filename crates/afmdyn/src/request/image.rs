@@ -4,9 +4,14 @@
 //!
 //! **Sample map.** `size = [Lx, Ly]` (m; Ly = 0 for a line), then `[[domain]]` entries with a
 //! `name`, `x = [x0, x1]` (m), optional `y = [y0, y1]` (m; the whole width when left out), an
-//! optional true `height` (m, default 0) and an optional `[domain.sample]` table with the keys of
+//! optional true `height` (m, default 0) reached over an optional `width` (m, default 0: a sharp
+//! step; the height rises inside the domain's edges as the smoothstep 3t² − 2t³, t the distance
+//! to the nearest edge over `width`) and an optional `[domain.sample]` table with the keys of
 //! a probe's `[sample]` (law, moduli, Hamaker constant, viscosity, …); the probe's own
-//! `[sample]` is the background (height 0). Where domains overlap, the later one lies on top.
+//! `[sample]` is the background (height 0). Where domains overlap, the later one lies on top. A
+//! top-level `height_map = [[…], …]` (m; rows from y = 0 to Ly, columns from x = 0 to Lx, each
+//! row as long) adds a topography sampled bilinearly at each pixel (a measured or generated
+//! height map, e.g. from a NumPy array).
 //!
 //! **Ideal feedback.** A feedback loop infinitely faster than the scan holds the amplitude at
 //! the setpoint A_sp = r A₀ at every pixel, so a pixel's operating point is a point of its
@@ -53,6 +58,8 @@ pub struct Domain {
     pub y: Option<(f64, f64)>,
     /// True height (m).
     pub height: f64,
+    /// Width (m) over which the height rises inside the domain's edges (0: a sharp step).
+    pub width: f64,
     /// Its `[domain.sample]` table (a probe's `[sample]` keys); `None`: the background's
     /// material.
     pub sample: Option<toml::Table>,
@@ -65,6 +72,8 @@ pub struct SampleMap {
     pub size: (f64, f64),
     /// The domains, the later on top.
     pub domains: Vec<Domain>,
+    /// A topography added everywhere (m), `[row][column]` over y then x (empty: none).
+    pub height_map: Vec<Vec<f64>>,
 }
 
 /// A refusal of a sample map's key: `name = value: allowed` ([`SimError::Probe`], an input
@@ -109,6 +118,37 @@ fn pair(v: &toml::Value, name: &str) -> Result<(f64, f64), SimError> {
     Ok((x0, x1))
 }
 
+/// A height map `[[h, …], …]` (m): at most 4096 × 4096 values, rows of one length, each a
+/// finite height within ±10 µm.
+fn height_map(v: &toml::Value) -> Result<Vec<Vec<f64>>, SimError> {
+    let what = "must be an array of rows [[h, …], …] of heights in m (rows from y = 0, each as \
+                long, at most 4096 × 4096)";
+    let rows = v
+        .as_array()
+        .filter(|r| !r.is_empty() && r.len() <= MAX_PIXELS)
+        .ok_or_else(|| bad("height_map".into(), "given", what))?;
+    let mut out = Vec::with_capacity(rows.len());
+    for r in rows {
+        let row = r
+            .as_array()
+            .filter(|c| !c.is_empty() && c.len() <= MAX_PIXELS)
+            .ok_or_else(|| bad("height_map".into(), "a row", what))?;
+        let mut hs = Vec::with_capacity(row.len());
+        for h in row {
+            let h = length(h, "height_map")?;
+            if h.abs() > 1e-5 {
+                return Err(bad("height_map".into(), h, "heights must be within ±10 µm"));
+            }
+            hs.push(h);
+        }
+        out.push(hs);
+    }
+    if out.iter().any(|r| r.len() != out[0].len()) {
+        return Err(bad("height_map".into(), "rows of different lengths", what));
+    }
+    Ok(out)
+}
+
 impl SampleMap {
     /// Parse a sample map from TOML text; `origin` names it in errors.
     ///
@@ -128,11 +168,11 @@ impl SampleMap {
             ))
         })?;
         for k in root.keys() {
-            if !matches!(k.as_str(), "size" | "domain") {
+            if !matches!(k.as_str(), "size" | "domain" | "height_map") {
                 return Err(bad(
                     format!("sample map key '{k}'"),
                     "given",
-                    "unknown: expected size and [[domain]] entries",
+                    "unknown: expected size, height_map and [[domain]] entries",
                 ));
             }
         }
@@ -182,11 +222,14 @@ impl SampleMap {
             };
             let key = |k: &str| format!("domain '{name}' {k}");
             for k in t.keys() {
-                if !matches!(k.as_str(), "name" | "x" | "y" | "height" | "sample") {
+                if !matches!(
+                    k.as_str(),
+                    "name" | "x" | "y" | "height" | "width" | "sample"
+                ) {
                     return Err(bad(
                         key(k),
                         "given",
-                        "unknown: expected name, x, y, height and [domain.sample]",
+                        "unknown: expected name, x, y, height, width and [domain.sample]",
                     ));
                 }
             }
@@ -215,6 +258,14 @@ impl SampleMap {
                     "must be within ±10 µm (a topography the z piezo follows)",
                 ));
             }
+            let width = t
+                .get("width")
+                .map(|v| length(v, &key("width")))
+                .transpose()?
+                .unwrap_or(0.0);
+            if width < 0.0 {
+                return Err(bad(key("width"), width, "must be ≥ 0 (m)"));
+            }
             let sample = match t.get("sample") {
                 None => None,
                 Some(v) => {
@@ -236,12 +287,18 @@ impl SampleMap {
                 x,
                 y,
                 height,
+                width,
                 sample,
             });
         }
+        let height_map = match root.get("height_map") {
+            None => Vec::new(),
+            Some(v) => height_map(v)?,
+        };
         Ok(SampleMap {
             size: (lx, ly),
             domains,
+            height_map,
         })
     }
 
@@ -269,6 +326,61 @@ impl SampleMap {
         let text = super::limits::read_input(path, super::limits::MAX_INPUT_TEXT_BYTES)
             .map_err(|e| SimError::Probe(format!("sample map: {e}")))?;
         Self::parse(&text, &path.display().to_string())
+    }
+
+    /// The true height at (x, y) (m): the top domain's height, risen over its `width` inside its
+    /// edges (smoothstep), plus the height map's bilinear interpolation there.
+    pub fn height_at(&self, x: f64, y: f64) -> f64 {
+        let domain = self.domain_at(x, y).map_or(0.0, |k| {
+            let d = &self.domains[k];
+            if d.width <= 0.0 {
+                return d.height;
+            }
+            // the distance to the nearest edge inside the map (the map's own edges are not
+            // steps)
+            let (lx, ly) = self.size;
+            let mut edge = f64::INFINITY;
+            for (e, lo, hi, v) in [(d.x.0, 0.0, lx, x), (d.x.1, 0.0, lx, x)] {
+                if e > lo && e < hi {
+                    edge = edge.min((v - e).abs());
+                }
+            }
+            if let Some((y0, y1)) = d.y {
+                for e in [y0, y1] {
+                    if e > 0.0 && e < ly {
+                        edge = edge.min((y - e).abs());
+                    }
+                }
+            }
+            let t = (edge / d.width).min(1.0);
+            d.height * t * t * (3.0 - 2.0 * t)
+        });
+        domain + self.map_height(x, y)
+    }
+
+    /// The height map's bilinear interpolation at (x, y) (0 without a map).
+    fn map_height(&self, x: f64, y: f64) -> f64 {
+        let rows = self.height_map.len();
+        if rows == 0 {
+            return 0.0;
+        }
+        let cols = self.height_map[0].len();
+        // grid position: column i at x = i Lx/(cols − 1), row j at y = j Ly/(rows − 1)
+        let pos = |v: f64, len: f64, n: usize| {
+            if n < 2 || len <= 0.0 {
+                (0, 0.0)
+            } else {
+                let p = (v / len * (n - 1) as f64).clamp(0.0, (n - 1) as f64);
+                let k = (p.floor() as usize).min(n - 2);
+                (k, p - k as f64)
+            }
+        };
+        let (i, fx) = pos(x, self.size.0, cols);
+        let (j, fy) = pos(y, self.size.1, rows);
+        let at = |jj: usize, ii: usize| self.height_map[jj.min(rows - 1)][ii.min(cols - 1)];
+        let top = at(j, i) * (1.0 - fx) + at(j, i + 1) * fx;
+        let bottom = at(j + 1, i) * (1.0 - fx) + at(j + 1, i + 1) * fx;
+        top * (1.0 - fy) + bottom * fy
     }
 
     /// The domain at (x, y) (m): the last listed that contains it, `None` for the background.
@@ -631,7 +743,8 @@ pub fn image(
         let mut prev: Option<(Regime, f64)> = None;
         for &xi in &x {
             let d = map.domain_at(xi, yj);
-            let (material, height) = d.map_or((0, 0.0), |k| (of_domain[k], map.domains[k].height));
+            let material = d.map_or(0, |k| of_domain[k]);
+            let height = map.height_at(xi, yj);
             let pts = &materials[material].points;
             let (point, switched) = match prev {
                 None => (engage(pts), false),
