@@ -584,14 +584,19 @@ pub fn observe<'py>(
 }
 
 /// The probe's table (from its TOML text) and the sample map (TOML text or path) of an image.
+/// With `height_map`, the map's height map replaced by it.
 fn image_inputs(
     probe: &str,
     sample: &str,
+    height_map: Option<Vec<Vec<f64>>>,
 ) -> PyResult<(toml::Table, afmdyn::request::image::SampleMap)> {
     let table: toml::Table = probe
         .parse()
         .map_err(|e: toml::de::Error| crate::errors::value_error(format!("probe: {e}")))?;
-    let map = afmdyn::request::image::SampleMap::read(sample).map_err(sim_error)?;
+    let mut map = afmdyn::request::image::SampleMap::read(sample).map_err(sim_error)?;
+    if let Some(rows) = height_map {
+        map = map.with_height_map(rows).map_err(sim_error)?;
+    }
     Ok((table, map))
 }
 
@@ -601,7 +606,8 @@ fn image_inputs(
 /// ([`afmdyn::request::image::SampleMap::read`]); `None` takes the request's defaults
 /// ([`afmdyn::request::image::ImageRequest::at`]).
 #[pyfunction]
-#[pyo3(signature = (probe, sample, setpoint, pixels=None, lines=None, curve_points=None))]
+#[pyo3(signature = (probe, sample, setpoint, pixels=None, lines=None, curve_points=None, height_map=None))]
+#[allow(clippy::too_many_arguments)]
 pub fn image(
     py: Python<'_>,
     probe: &str,
@@ -610,9 +616,10 @@ pub fn image(
     pixels: Option<usize>,
     lines: Option<usize>,
     curve_points: Option<usize>,
+    height_map: Option<Vec<Vec<f64>>>,
 ) -> PyResult<String> {
     use afmdyn::request::image::{image, ImageRequest};
-    let (table, map) = image_inputs(probe, sample)?;
+    let (table, map) = image_inputs(probe, sample, height_map)?;
     let d = ImageRequest::at(setpoint);
     let req = ImageRequest {
         pixels: pixels.unwrap_or(d.pixels),
@@ -637,7 +644,7 @@ pub fn setpoint_study(
     curve_points: Option<usize>,
 ) -> PyResult<String> {
     use afmdyn::request::image::{setpoint_study, ImageRequest};
-    let (table, map) = image_inputs(probe, sample)?;
+    let (table, map) = image_inputs(probe, sample, None)?;
     let points = curve_points.unwrap_or(ImageRequest::at(0.5).curve_points);
     let study = py
         .detach(|| setpoint_study(&table, &map, &ratios, points))

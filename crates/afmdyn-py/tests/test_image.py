@@ -68,3 +68,17 @@ def test_the_setpoint_study_is_the_command_lines(cli_json, tmp_path):
     assert np.all(ds.apparent_height.sel(domain="background") == 0.0)
     with pytest.raises(ValueError, match="setpoint_study"):
         afmdyn.setpoint_study(PROBE, STRIPE, [0.5, 1.2])
+
+
+def test_a_height_map_from_numpy_is_the_recorded_topography():
+    # one material (no domains): the ideal feedback records the true topography exactly
+    grid = np.array([[0.0, 1e-9, 2e-9], [4e-9, 5e-9, 6e-9]])
+    ds = afmdyn.image(PROBE, "size = [1e-6, 1e-6]", 0.7, pixels=5, lines=3, height_map=grid)
+    assert np.allclose(ds.height.values, ds.true_height.values, rtol=0, atol=1e-20)
+    # bilinear: at (x, y) the plane through the nodes (x/0.5 µm · 1 nm + y/1 µm · 4 nm)
+    x, y = np.meshgrid(ds.x.values, ds.y.values)
+    assert np.allclose(ds.true_height.values, x / 0.5e-6 * 1e-9 + y / 1e-6 * 4e-9, atol=1e-20)
+    with pytest.raises(ValueError, match="height_map"):
+        afmdyn.image(PROBE, "size = [1e-6, 1e-6]", 0.7, height_map=np.ones(3))
+    with pytest.raises(ValueError, match="height_map"):
+        afmdyn.image(PROBE, "size = [1e-6, 1e-6]", 0.7, height_map=[[0.0, np.nan]])

@@ -591,6 +591,7 @@ def image(
     pixels: Optional[int] = None,
     lines: Optional[int] = None,
     curve_points: Optional[int] = None,
+    height_map: Optional[List[List[float]]] = None,
 ) -> str: ...
 def setpoint_study(
     probe: str,

@@ -36,6 +36,7 @@ def image(
     pixels: Optional[int] = None,
     lines: Optional[int] = None,
     curve_points: Optional[int] = None,
+    height_map: Optional[Any] = None,
 ) -> xr.Dataset:
     """The image an ideal amplitude feedback records over a heterogeneous sample
     (``afmdyn image --feedback ideal``): at every pixel the operating point of the local
@@ -50,6 +51,9 @@ def image(
         setpoint: A_sp/A0 in (0, 1).
         pixels: pixels per line (default 64). lines: lines (default: as many as pixels, 1 for
             a line map). curve_points: points of each material's approach curve (default 120).
+        height_map: a 2D array of heights (m), rows from y = 0 to Ly and columns from x = 0 to
+            Lx, interpolated bilinearly and added to the map's topography (replaces the map's
+            own ``height_map``).
 
     Returns:
         ``xarray.Dataset`` over ``y`` and ``x`` (m): ``height``, ``true_height``, ``z_c``,
@@ -64,7 +68,13 @@ def image(
     """
     text = _core.probe_source(probe)
     source = os.fspath(sample) if isinstance(sample, os.PathLike) else sample
-    doc = json.loads(_core.image(text, source, setpoint, pixels, lines, curve_points))
+    rows = None
+    if height_map is not None:
+        grid = np.asarray(height_map, dtype=np.float64)
+        if grid.ndim != 2:
+            raise ValueError(f"height_map: must be a 2D array of heights (m), got {grid.ndim}D")
+        rows = grid.tolist()
+    doc = json.loads(_core.image(text, source, setpoint, pixels, lines, curve_points, rows))
     _warn(doc)
     img = doc["image"]
     dims = ("y", "x")

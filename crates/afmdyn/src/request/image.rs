@@ -328,6 +328,22 @@ impl SampleMap {
         Self::parse(&text, &path.display().to_string())
     }
 
+    /// The map with `rows` as its height map (m, `[row][column]`, rows from y = 0), replacing any
+    /// it had: a front end's array (Python's `height_map=`), checked as the TOML key is.
+    ///
+    /// # Errors
+    /// [`SimError::Probe`] naming `height_map`: empty, rows of different lengths, more than
+    /// 4096 × 4096 values, a height not finite or beyond ±10 µm.
+    pub fn with_height_map(mut self, rows: Vec<Vec<f64>>) -> Result<SampleMap, SimError> {
+        let v = toml::Value::Array(
+            rows.into_iter()
+                .map(|r| toml::Value::Array(r.into_iter().map(toml::Value::Float).collect()))
+                .collect(),
+        );
+        self.height_map = height_map(&v)?;
+        Ok(self)
+    }
+
     /// The true height at (x, y) (m): the top domain's height, risen over its `width` inside its
     /// edges (smoothstep), plus the height map's bilinear interpolation there.
     pub fn height_at(&self, x: f64, y: f64) -> f64 {
