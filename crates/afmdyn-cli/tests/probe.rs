@@ -4,7 +4,7 @@
 use std::path::Path;
 
 mod common;
-use common::{json, repo, run};
+use common::{column, json, repo, run};
 
 /// The probe's parameters reach the model: `modes` reports the first free frequency f₀ of the
 /// probe in Hz (the calibration it was built from), and `orbit` the probe's α's.
@@ -862,14 +862,7 @@ fn every_example_probe_loads_and_the_hysteretic_ones_approach() {
             "--json",
         ]);
         assert_eq!(doc["params"]["contact_law"]["law"], law);
-        let a = &doc["approach"];
-        let col = |k: &str| -> Vec<f64> {
-            a[k].as_array()
-                .unwrap()
-                .iter()
-                .map(|v| v.as_f64().unwrap())
-                .collect()
-        };
+        let col = |k: &str| column(&doc, "approach", k);
         assert!(
             col("energy_dissipated").iter().any(|&e| e > 1e-19),
             "{file}"
@@ -934,14 +927,7 @@ fn a_viscoelastic_sample_in_water_approaches_from_its_probe_file() {
         "--json",
     ]);
     assert_eq!(doc["params"]["contact_law"]["law"], "sls");
-    let a = &doc["approach"];
-    let col = |k: &str| -> Vec<f64> {
-        a[k].as_array()
-            .unwrap()
-            .iter()
-            .map(|v| v.as_f64().unwrap())
-            .collect()
-    };
+    let col = |k: &str| column(&doc, "approach", k);
     let (e, fmin, fmax, share) = (
         col("energy_dissipated"),
         col("min_force"),

@@ -205,39 +205,23 @@ fn linear_law_adaptive_reproduces_exact() {
 
 // ---------------------------------------- an independent integrator for Hertz and DMT
 
-/// The model written again from the Galerkin matrices (eqs. 11–14) with its own force laws:
-/// M ä + C ȧ + K a = F(τ) + φ F_c, F_c from the formulas of Johnson (Hertz) and DMT.
+/// The model written again from the Galerkin matrices (eqs. 11–14, `common::FreeBeam`) with its
+/// own force laws: M ä + C ȧ + K a = F(τ) + φ F_c, F_c from the formulas of Johnson (Hertz) and
+/// DMT.
 struct Independent {
-    minv: DMatrix<f64>,
-    c: DMatrix<f64>,
-    k: DMatrix<f64>,
-    fs: DVector<f64>,
-    fc: DVector<f64>,
-    tip: DVector<f64>,
+    beam: common::FreeBeam,
     p: Params,
 }
 
 impl Independent {
     fn new(p: &Params) -> Self {
-        let m = CantileverModel::new(p).unwrap();
-        let g = m.galerkin().region(Region::Free);
         Independent {
-            minv: g.mass.clone().try_inverse().unwrap(),
-            c: g.damping.clone(),
-            k: g.stiffness.clone(),
-            fs: g.forcing.sin.clone(),
-            fc: g.forcing.cos.clone(),
-            tip: m.tip().clone(),
+            beam: common::FreeBeam::of(&CantileverModel::new(p).unwrap()),
             p: *p,
         }
     }
     fn v_t(&self, tau: f64, z: &DVector<f64>) -> (f64, f64) {
-        let n = self.p.modes;
-        let (s, c) = (self.p.omega * tau).sin_cos();
-        (
-            self.tip.dot(&z.rows(0, n)) + self.p.alpha2 * s + self.p.alpha5,
-            self.tip.dot(&z.rows(n, n)) + self.p.alpha2 * self.p.omega * c,
-        )
+        self.beam.v_t(tau, z)
     }
     fn force(&self, contact: bool, tau: f64, z: &DVector<f64>) -> f64 {
         let (v, vd) = self.v_t(tau, z);
@@ -274,15 +258,8 @@ impl Independent {
         }
     }
     fn rhs(&self, contact: bool, tau: f64, z: &DVector<f64>) -> DVector<f64> {
-        let n = self.p.modes;
-        let (s, c) = (self.p.omega * tau).sin_cos();
-        let (a, ad) = (z.rows(0, n), z.rows(n, n));
-        let f = &self.fs * s + &self.fc * c - &self.c * ad - &self.k * a
-            + &self.tip * self.force(contact, tau, z);
-        let mut out = DVector::zeros(2 * n);
-        out.rows_mut(0, n).copy_from(&ad);
-        out.rows_mut(n, n).copy_from(&(&self.minv * f));
-        out
+        let f = self.force(contact, tau, z);
+        self.beam.rhs(tau, z, f, 2 * self.p.modes)
     }
     /// z(t1) from z(0) = z0 with `m` RK4 steps per period; a sign change of V_T inside a step is
     /// located by bisection on the step length and the region switched there

@@ -15,7 +15,7 @@ use afmdyn::integrate::{advance, build, IntegratorKind, IntegratorOptions};
 use afmdyn::probe::Probe;
 use afmdyn::trajectory::{record, RecordSpec};
 use afmdyn::{CantileverModel, ContactLaw, Params, SimError};
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DVector;
 use std::f64::consts::PI;
 
 mod common;
@@ -212,36 +212,24 @@ fn an_orbit_loses_to_the_dashpot_what_the_tip_loses() {
     }
 }
 
-/// The model written again here for N modes (eqs. 11–14 with the SLS force at the tip and the
-/// dashpot's extension u), integrated by `common::rk4_switched_flow`.
+/// The model written again here for N modes (eqs. 11–14, `common::FreeBeam`, with the SLS force
+/// at the tip and the dashpot's extension u), integrated by `common::rk4_switched_flow`.
 struct Independent {
-    minv: DMatrix<f64>,
-    c: DMatrix<f64>,
-    k: DMatrix<f64>,
-    fs: DVector<f64>,
-    fc: DVector<f64>,
-    tip: DVector<f64>,
+    beam: common::FreeBeam,
     p: Params,
     kappa: f64,
 }
 
 impl Independent {
     fn new(m: &CantileverModel, kappa: f64) -> Self {
-        let g = m.galerkin().region(Region::Free);
         Independent {
-            minv: g.mass.clone().try_inverse().unwrap(),
-            c: g.damping.clone(),
-            k: g.stiffness.clone(),
-            fs: g.forcing.sin.clone(),
-            fc: g.forcing.cos.clone(),
-            tip: m.tip().clone(),
+            beam: common::FreeBeam::of(m),
             p: *m.params(),
             kappa,
         }
     }
     fn v_t(&self, tau: f64, z: &DVector<f64>) -> f64 {
-        let n = self.p.modes;
-        self.tip.dot(&z.rows(0, n)) + self.p.alpha2 * (self.p.omega * tau).sin() + self.p.alpha5
+        self.beam.v_t(tau, z).0
     }
     /// V_T + κu/(α4 + κ): the tip's height over the (recovering) surface.
     fn gap(&self, tau: f64, z: &DVector<f64>) -> f64 {
@@ -251,7 +239,6 @@ impl Independent {
     fn rhs(&self, contact: bool, tau: f64, z: &DVector<f64>) -> DVector<f64> {
         let n = self.p.modes;
         let (k1, k2, eta) = (self.p.alpha4, self.kappa, self.p.alpha6);
-        let (s, c) = (self.p.omega * tau).sin_cos();
         let u = z[2 * n];
         let delta = -self.v_t(tau, z);
         let (force, surface) = if contact {
@@ -259,11 +246,7 @@ impl Independent {
         } else {
             (0.0, k2 * u / (k1 + k2))
         };
-        let (a, ad) = (z.rows(0, n), z.rows(n, n));
-        let f = &self.fs * s + &self.fc * c - &self.c * ad - &self.k * a + &self.tip * force;
-        let mut out = DVector::zeros(2 * n + 1);
-        out.rows_mut(0, n).copy_from(&ad);
-        out.rows_mut(n, n).copy_from(&(&self.minv * f));
+        let mut out = self.beam.rhs(tau, z, force, 2 * n + 1);
         out[2 * n] = k2 / eta * (surface - u);
         out
     }

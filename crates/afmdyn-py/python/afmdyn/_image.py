@@ -102,6 +102,7 @@ def image(
     )
 
 
+@_typed
 def setpoint_study(
     probe: Union[str, "os.PathLike[str]", Dict[str, Any]],
     sample: Union[str, "os.PathLike[str]"],
@@ -120,10 +121,6 @@ def setpoint_study(
         ``apparent_height`` (m), ``phase_deg``, ``energy_dissipated`` (J) (NaN where a
         material has no operating point) and ``regime``; attribute ``summary`` (the JSON).
     """
-    if isinstance(curve_points, bool) or not (
-        curve_points is None or isinstance(curve_points, int)
-    ):
-        raise TypeError(f"setpoint_study(): curve_points must be int or None, got {curve_points!r}")
     text = _core.probe_source(probe)
     source = os.fspath(sample) if isinstance(sample, os.PathLike) else sample
     values = [float(r) for r in np.asarray(ratios, dtype=np.float64).ravel()]

@@ -387,3 +387,56 @@ pub fn rk4_switched_flow(
     }
     z
 }
+
+/// The free region of a model written again from its Galerkin matrices (eqs. 11–14), for the
+/// tests' independent integrators: M ä + C ȧ + K a = F_s sin Ωτ + F_c cos Ωτ + φ F_tip.
+pub struct FreeBeam {
+    minv: DMatrix<f64>,
+    c: DMatrix<f64>,
+    k: DMatrix<f64>,
+    fs: DVector<f64>,
+    fc: DVector<f64>,
+    /// φ(1), shape `[N]`.
+    pub tip: DVector<f64>,
+    /// The parameters.
+    pub p: afmdyn::Params,
+}
+
+impl FreeBeam {
+    /// The matrices of `model`'s free region.
+    pub fn of(model: &CantileverModel) -> Self {
+        let g = model.galerkin().region(Region::Free);
+        FreeBeam {
+            minv: g.mass.clone().try_inverse().unwrap(),
+            c: g.damping.clone(),
+            k: g.stiffness.clone(),
+            fs: g.forcing.sin.clone(),
+            fc: g.forcing.cos.clone(),
+            tip: model.tip().clone(),
+            p: *model.params(),
+        }
+    }
+
+    /// (V_T, dV_T/dτ) at (τ, z) (eq. 8 for the beam: φᵀa + α2 sin Ωτ + α5).
+    pub fn v_t(&self, tau: f64, z: &DVector<f64>) -> (f64, f64) {
+        let n = self.p.modes;
+        let (s, c) = (self.p.omega * tau).sin_cos();
+        (
+            self.tip.dot(&z.rows(0, n)) + self.p.alpha2 * s + self.p.alpha5,
+            self.tip.dot(&z.rows(n, n)) + self.p.alpha2 * self.p.omega * c,
+        )
+    }
+
+    /// ż = (ȧ, M⁻¹(F(τ) − Cȧ − Ka + φ F_tip)) of the first 2N entries of z, in a vector of
+    /// `dim` entries (the rest 0, for a law's internal states to fill).
+    pub fn rhs(&self, tau: f64, z: &DVector<f64>, tip_force: f64, dim: usize) -> DVector<f64> {
+        let n = self.p.modes;
+        let (s, c) = (self.p.omega * tau).sin_cos();
+        let (a, ad) = (z.rows(0, n), z.rows(n, n));
+        let f = &self.fs * s + &self.fc * c - &self.c * ad - &self.k * a + &self.tip * tip_force;
+        let mut out = DVector::zeros(dim);
+        out.rows_mut(0, n).copy_from(&ad);
+        out.rows_mut(n, n).copy_from(&(&self.minv * f));
+        out
+    }
+}
