@@ -1,7 +1,9 @@
-//! `afmdyn image`: the AM-AFM image of a heterogeneous sample under an ideal amplitude feedback.
+//! `afmdyn image`: the AM-AFM image of a heterogeneous sample under an ideal amplitude feedback,
+//! or scanned in the time domain under a lock-in and a PI z controller (`--feedback pi`).
 //! The sample map, the operating points and the scan are the library's
-//! ([`afmdyn::request::image`]); this front end reads the two files, maps the flags, and writes
-//! `image.json`, the maps (height, phase, E_dis) and the line profile.
+//! ([`afmdyn::request::image`], [`afmdyn::request::image_scan`]); this front end reads the two
+//! files, maps the flags, and writes `image.json`, the maps (height, phase, E_dis; the error
+//! image of a PI scan) and the line profile.
 
 use crate::args::read_text;
 use crate::error::CliError;
@@ -10,6 +12,7 @@ use crate::plot::{save, save_map, CellMap, Figure, Series, Style};
 use afmdyn::request::image::{
     image, setpoint_study, study_ratios, Image, ImageRequest, SampleMap, SetpointStudy,
 };
+use afmdyn::request::image_scan::{PiImage, PiScan, ScanStudy};
 use clap::Args;
 use plotters::style::RGBColor;
 use std::path::PathBuf;
@@ -27,10 +30,29 @@ pub struct ImageArgs {
     /// Amplitude setpoint A_sp/A0 in (0, 1)
     #[arg(long)]
     setpoint: f64,
-    /// Feedback: ideal (an operating point of the local material at every pixel). The
-    /// time-domain PI loop is not built yet
+    /// Feedback: ideal (an operating point of the local material at every pixel) or pi (a
+    /// time-domain scan, trace and retrace, under a lock-in and a PI z controller)
     #[arg(long, default_value = "ideal")]
     feedback: String,
+    /// PI scan: lines (trace and retrace) per second, Hz (default: a pixel lasts 5 loop time
+    /// constants 1/K_I)
+    #[arg(long, value_name = "HZ")]
+    scan_rate: Option<f64>,
+    /// PI scan: the gains K_P (m/m) and K_I (1/s) (default: K_P = 0, K_I = 1/(4(τ_c + τ_L)),
+    /// τ_c = 2Q/ω0)
+    #[arg(
+        long,
+        value_name = "P,I",
+        value_delimiter = ',',
+        allow_hyphen_values = true
+    )]
+    gains: Option<Vec<f64>>,
+    /// PI scan: the lock-in's low-pass time constant, s (default: τ_c/4)
+    #[arg(long, value_name = "S")]
+    time_constant: Option<f64>,
+    /// PI scan: worker threads, one line per task (default: all cores)
+    #[arg(long)]
+    threads: Option<usize>,
     /// Pixels per line [default: 64]
     #[arg(long)]
     pixels: Option<usize>,
@@ -161,12 +183,50 @@ fn study_plots(out: &OutDir, s: &SetpointStudy) -> Result<(), CliError> {
 
 /// Run `afmdyn image`.
 pub fn image_cmd(a: &ImageArgs) -> Result<(), CliError> {
-    if a.feedback != "ideal" {
-        return Err(CliError::Input(format!(
-            "feedback = {}: must be ideal (the time-domain PI scan is not available yet)",
-            a.feedback
-        )));
-    }
+    let pi = match a.feedback.as_str() {
+        "ideal" => {
+            for (set, flag) in [
+                (a.scan_rate.is_some(), "--scan-rate"),
+                (a.gains.is_some(), "--gains"),
+                (a.time_constant.is_some(), "--time-constant"),
+                (a.threads.is_some(), "--threads"),
+            ] {
+                if set {
+                    return Err(CliError::Input(format!(
+                        "{flag}: only with --feedback pi (the ideal feedback has no loop)"
+                    )));
+                }
+            }
+            None
+        }
+        "pi" => {
+            if a.setpoint_study.is_some() {
+                return Err(CliError::Input(
+                    "--setpoint-study: only with --feedback ideal (a study of exact operating \
+                     points)"
+                        .into(),
+                ));
+            }
+            Some(PiScan {
+                scan_rate: a.scan_rate,
+                gains: match a.gains.as_deref() {
+                    None => None,
+                    Some([p, i]) => Some((*p, *i)),
+                    Some(g) => {
+                        return Err(CliError::Input(format!(
+                            "--gains {g:?}: must be two numbers P,I (K_P in m/m, K_I in 1/s)"
+                        )))
+                    }
+                },
+                time_constant: a.time_constant,
+            })
+        }
+        other => {
+            return Err(CliError::Input(format!(
+                "feedback = {other}: must be ideal or pi"
+            )))
+        }
+    };
     let text = read_text(&a.probe).map_err(|e| CliError::Input(format!("probe {e}")))?;
     let table: toml::Table = text.parse().map_err(|e: toml::de::Error| {
         CliError::Input(format!(
@@ -185,6 +245,9 @@ pub fn image_cmd(a: &ImageArgs) -> Result<(), CliError> {
     };
     req.validate(&map)?;
     let ratios = a.setpoint_study.as_deref().map(study_ratios).transpose()?;
+    if let Some(scan) = pi {
+        return pi_cmd(a, &table, &map, &req, &scan);
+    }
     let out = OutDir::lock(&a.out)?;
     let img = image(&table, &map, &req)?;
     let mut json = img.document(a.setpoint);
@@ -325,4 +388,140 @@ pub fn image_cmd(a: &ImageArgs) -> Result<(), CliError> {
     }
     outln!("outputs in {}", out.path().display());
     Ok(())
+}
+
+/// `afmdyn image --feedback pi`: the scan's lines as a study on the worker threads, then the
+/// document, the maps (recorded height, error image, phase, E_dis) and the first line's profile
+/// (trace, retrace, ideal and true height).
+fn pi_cmd(
+    a: &ImageArgs,
+    table: &toml::Table,
+    map: &SampleMap,
+    req: &ImageRequest,
+    scan: &PiScan,
+) -> Result<(), CliError> {
+    let study = ScanStudy::new(table, map, req, scan)?;
+    let out = OutDir::lock(&a.out)?;
+    let mut store = afmdyn::study::MemoryStore::default();
+    crate::progress::study(&study, &mut store, false, a.threads, "lines", None)
+        .map_err(|e| crate::cmd_analysis::study_error(e, "image"))?;
+    let img = study.assemble(store.records)?;
+    let json = img.document(a.setpoint);
+    write_document(&out, "image.json", &json)?;
+    let grid = &img.ideal;
+    let pixel = |j: usize, i: usize| &img.lines[j].trace[i];
+    map_of(
+        &out,
+        grid,
+        "image-height",
+        "Recorded height (PI feedback, trace)",
+        "m",
+        &|j, i| img.height(0, j, i),
+    )?;
+    map_of(
+        &out,
+        grid,
+        "image-error",
+        "Amplitude error A_sp - A (PI feedback, trace)",
+        "m",
+        &|j, i| pixel(j, i).tracking_error * img.length(),
+    )?;
+    map_of(
+        &out,
+        grid,
+        "image-phase",
+        "Phase lag (PI feedback, trace)",
+        "°",
+        &|j, i| pixel(j, i).phase.to_degrees(),
+    )?;
+    map_of(
+        &out,
+        grid,
+        "image-dissipation",
+        "Energy dissipated per period (PI feedback, trace)",
+        "J",
+        &|j, i| pixel(j, i).energy_dissipated * img.energy(),
+    )?;
+    pi_profile(&out, &img, a.setpoint)?;
+    if a.json {
+        outln!("{json}");
+        return Ok(());
+    }
+    let s = img.settings;
+    outln!(
+        "PI-feedback image, {} × {} pixels, setpoint A/A0 = {}: scan rate {}, K_P {}, K_I {}, \
+         lock-in time constant {}; {} drive periods per pixel ({}), {} to engage each line",
+        grid.x.len(),
+        grid.y.len(),
+        a.setpoint,
+        si_value(s.scan_rate, "Hz"),
+        s.proportional_gain,
+        si_value(s.integral_gain, "1/s"),
+        si_value(s.time_constant, "s"),
+        s.periods_per_pixel,
+        si_value(s.pixel_time, "s"),
+        s.engage_periods
+    );
+    for (name, art) in ["trace", "retrace"].iter().zip(img.artefacts) {
+        outln!(
+            "  {name}: height error against the ideal image RMS {}, largest {}; overshoot {}; \
+             error image RMS {}; {} pixel(s) lost contact; {} period(s) at the output limit",
+            si_value(art.height_rms_error, "m"),
+            si_value(art.height_max_error, "m"),
+            si_value(art.overshoot, "m"),
+            si_value(art.tracking_error_rms, "m"),
+            art.lost_contact_pixels,
+            art.saturated_periods
+        );
+    }
+    outln!("outputs in {}", out.path().display());
+    Ok(())
+}
+
+/// The first line of a PI scan: trace, retrace, the ideal image's apparent height and the true
+/// height.
+fn pi_profile(out: &OutDir, img: &PiImage, setpoint: f64) -> Result<(), CliError> {
+    let g = &img.ideal;
+    let profile = |f: &dyn Fn(usize) -> f64| -> Vec<(f64, f64)> {
+        (0..g.x.len())
+            .map(|i| (g.x[i], f(i)))
+            .filter(|p| p.1.is_finite())
+            .collect()
+    };
+    let series = [
+        (
+            "trace",
+            Style::Line,
+            &(|i| img.height(0, 0, i)) as &dyn Fn(usize) -> f64,
+        ),
+        ("retrace", Style::Line, &|i| img.height(1, 0, i)),
+        ("ideal feedback", Style::Dashed, &|i| {
+            g.apparent_height(0, i)
+        }),
+        ("true height", Style::Dashed, &|i| g.pixels[0][i].height),
+    ];
+    save(
+        out.path(),
+        "image-profile",
+        &Figure {
+            title: format!(
+                "Line profile at y = {} (PI feedback, setpoint A/A0 = {setpoint})",
+                si_value(g.y[0], "m"),
+            ),
+            x_label: "x (m)".into(),
+            y_label: "height (m)".into(),
+            series: series
+                .iter()
+                .enumerate()
+                .map(|(k, (label, style, f))| Series {
+                    label: (*label).into(),
+                    points: profile(f),
+                    style: *style,
+                    color: k,
+                })
+                .collect(),
+            shade: Vec::new(),
+            y_min_span: 1e-12,
+        },
+    )
 }

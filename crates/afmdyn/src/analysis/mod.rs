@@ -8,6 +8,7 @@
 //! reconstruction from FM-AFM frequency shifts ([`reconstruct`]: Sader–Jarvis) and from AM
 //! amplitude and phase ([`reconstruct_am`]: the matrix method at each point's amplitude).
 
+pub mod am_loop;
 pub mod approach;
 pub mod attractors;
 pub mod basin_entropy;

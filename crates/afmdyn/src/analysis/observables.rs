@@ -366,7 +366,7 @@ impl EquivalentMode {
 }
 
 /// A phase in (−π/2, 3π/2].
-fn wrap_phase(p: f64) -> f64 {
+pub(crate) fn wrap_phase(p: f64) -> f64 {
     let mut x = p.rem_euclid(TAU);
     if x > 1.5 * PI {
         x -= TAU;

@@ -357,6 +357,17 @@ fn z_c_of<'a>(params: &'a Params, u: &'a CurveUnits) -> impl Fn(f64) -> f64 + 'a
     move |a5| crate::analysis::approach::rest_distance(params, a5) * u.length
 }
 
+/// The regime of a steady state from its mean deflection ⟨W⟩ (any length unit):
+/// `"attractive"` where the mean tip–sample force, k⟨W⟩ for the point mass, is negative, else
+/// `"repulsive"` (García & San Paulo, *Phys. Rev. B* 61 (2000) R13381).
+pub fn regime(mean_deflection: f64) -> &'static str {
+    if mean_deflection < 0.0 {
+        "attractive"
+    } else {
+        "repulsive"
+    }
+}
+
 /// The `"setpoint"` block of `afmdyn approach --setpoint S --json`: the ratio A_sp/A₀, the
 /// amplitude it means (in `u`'s length), and per crossing of the curve
 /// ([`crate::analysis::setpoint::setpoint_crossings`]) its `source` (`"branch k"`,
@@ -401,15 +412,7 @@ pub fn setpoint(params: &Params, c: &SteppedCurve, ratio: f64, u: &CurveUnits) -
                 .zip(rb)
                 .map(|(p, q)| (1.0 - k.t) * p + k.t * q)
                 .collect();
-            let mean = row[3];
-            m.insert(
-                "regime".into(),
-                json!(if mean < 0.0 {
-                    "attractive"
-                } else {
-                    "repulsive"
-                }),
-            );
+            m.insert("regime".into(), json!(regime(row[3])));
             for (c, v) in CURVE_COLUMNS.iter().zip(row) {
                 m.insert(c.name.into(), json!(v));
             }

@@ -572,10 +572,10 @@ impl ImageRequest {
 
 /// One material's approach curve: the background or a domain's sample under the probe's lever
 /// and drive.
-struct MaterialCurve {
-    name: String,
-    params: Params,
-    curve: crate::analysis::stepped::SteppedCurve,
+pub(crate) struct MaterialCurve {
+    pub(crate) name: String,
+    pub(crate) params: Params,
+    pub(crate) curve: crate::analysis::stepped::SteppedCurve,
 }
 
 /// The approach curve of `params` (`curve_points` z_c values each way over the probe's default
@@ -597,7 +597,7 @@ fn approach_curve(
 /// The materials of `map` under the probe `probe_table`: the background, then one per domain
 /// with its own sample, each with its approach curve; the material of each domain; the SI
 /// units.
-fn material_curves(
+pub(crate) fn material_curves(
     probe_table: &toml::Table,
     map: &SampleMap,
     curve_points: usize,
@@ -722,11 +722,22 @@ pub fn image(
 ) -> Result<Image, SimError> {
     req.validate(map)?;
     let (curves, of_domain, units) = material_curves(probe_table, map, req.curve_points)?;
+    Ok(image_of(&curves, &of_domain, &units, map, req))
+}
+
+/// [`image`] from the materials' curves ([`material_curves`]).
+pub(crate) fn image_of(
+    curves: &[MaterialCurve],
+    of_domain: &[usize],
+    units: &CurveUnits,
+    map: &SampleMap,
+    req: &ImageRequest,
+) -> Image {
     let materials: Vec<Material> = curves
         .iter()
         .map(|m| Material {
             name: m.name.clone(),
-            points: points_at(m, req.setpoint, &units),
+            points: points_at(m, req.setpoint, units),
             warnings: m.curve.warnings.clone(),
         })
         .collect();
@@ -739,7 +750,7 @@ pub fn image(
         .map(|j| (j as f64 + 0.5) * ly / n_lines as f64)
         .collect();
     // the approach curves' own warnings (an unsettled point, a failed one), named by material
-    let mut warnings = curve_warnings(&curves);
+    let mut warnings = curve_warnings(curves);
     for m in &materials {
         if m.points.is_empty() {
             warnings.push(format!(
@@ -789,7 +800,7 @@ pub fn image(
              operating point in the previous one's: the image's contrast changes there"
         ));
     }
-    Ok(Image {
+    Image {
         x,
         y,
         materials,
@@ -797,7 +808,7 @@ pub fn image(
         reference,
         domain_names: map.domains.iter().map(|d| d.name.clone()).collect(),
         warnings,
-    })
+    }
 }
 
 impl Image {

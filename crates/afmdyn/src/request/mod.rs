@@ -38,6 +38,7 @@ pub mod curves;
 pub mod dir_lock;
 pub mod fm;
 pub mod image;
+pub mod image_scan;
 pub mod limits;
 pub mod model;
 pub mod pool;

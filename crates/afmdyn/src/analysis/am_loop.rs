@@ -1,0 +1,438 @@
+//! AM-AFM's amplitude feedback in the time domain: the cantilever integrated drive period after
+//! drive period while the sample under the tip changes (a scan line), a lock-in amplifier
+//! measuring the tip's first harmonic and a PI controller moving the z piezo to hold it at the
+//! setpoint, as an instrument's digital loops do once per drive period — the scanning AM-AFM of
+//! VEDA (Kiracofe, Melcher & Raman, *Rev. Sci. Instrum.* 83 (2012) 013702, with continuous-time
+//! loops) and of the control model of Stirling (*Beilstein J. Nanotechnol.* 5 (2014) 337).
+//! [`crate::request::image_scan`] builds an image from its lines.
+//!
+//! Units are the model's: τ (eq. 5) and lengths in g₀.
+//!
+//! **Lock-in** ([`LockIn`]). Over drive period k the deflection W(1,τ) is sampled at the ends of
+//! M equal parts (θ_j = Ωτ_j + ψ, ψ the drive's phase) and demodulated by the rectangle rule,
+//! X_k = (2/M) Σ_j W_j sin θ_j = A cos φ, Y_k = −(2/M) Σ_j W_j cos θ_j = A sin φ for
+//! W = ⟨W⟩ + A sin(θ − φ): exact for a periodic motion but for the harmonics M ± 1, 2M ± 1, …
+//! that alias onto the first (a digital lock-in sampling at M times the drive frequency). The
+//! output low-pass is first order with time constant τ_L, sampled exactly for an input held
+//! over the period T: X̄_k = X̄_{k−1} + β (X_k − X̄_{k−1}), β = 1 − e^{−T/τ_L} (β = 1 for
+//! τ_L = 0: the period's own boxcar average); A = |(X̄, Ȳ)|, φ = arg(X̄ + iȲ).
+//!
+//! **PI controller** ([`PiController`]). With the error e_k = A_sp − A_k (positive when the tip
+//! presses too hard and the amplitude drops) the piezo's rest distance for the next period is
+//! z_{k+1} = z_origin + K_P e_k + K_I T Σ_{j≤k} e_j (position form; K_P dimensionless, K_I per
+//! unit time), held within the output range given; a period at a limit counts as saturated and
+//! does not integrate an error that drives the output further out (conditional integration
+//! against wind-up).
+//!
+//! **Default gains** ([`FeedbackGains::for_lever`]). The amplitude answers a step of z within
+//! τ_c = 2Q/ω₀ (the lever's amplitude decay time) and, in both regimes, by about the step
+//! (dA/dz_c ≈ 1 on an approach curve), so with the lock-in's delay the loop is an integrator
+//! over a first-order lag τ_c + τ_L: K_I = 1/(4(τ_c + τ_L)) damps it critically
+//! (s²(τ_c + τ_L) + s + K_I = 0 has a double root). The lock-in's default time constant is
+//! τ_c/4, K_P = 0.
+
+use super::observables::{observe, wrap_phase, ObservableOptions};
+#[cfg(not(feature = "parallel"))]
+use super::sequential::*;
+use crate::error::SimError;
+use crate::integrate::{advance, build, Integrator, IntegratorOptions};
+use crate::model::CantileverModel;
+use crate::params::{Params, SweepParam};
+use nalgebra::DVector;
+#[cfg(feature = "parallel")]
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// Samples per drive period of the lock-in's demodulation.
+pub const LOCK_IN_SAMPLES: usize = 32;
+
+/// The feedback's gains and the lock-in's time constant (model units: τ, g₀).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct FeedbackGains {
+    /// K_P: rest-distance change per unit amplitude error (dimensionless), ≥ 0.
+    pub proportional: f64,
+    /// K_I: rest-distance rate per unit amplitude error (per unit τ), > 0.
+    pub integral: f64,
+    /// τ_L: the lock-in's low-pass time constant (units of τ), ≥ 0.
+    pub time_constant: f64,
+}
+
+impl FeedbackGains {
+    /// The defaults of a lever of quality factor `q` and first free resonance `omega0` (rad
+    /// per unit τ) (module docs): τ_L = τ_c/4, K_P = 0, K_I = 1/(4(τ_c + τ_L)), τ_c = 2Q/ω₀.
+    pub fn for_lever(q: f64, omega0: f64) -> Self {
+        let tau_c = 2.0 * q / omega0;
+        let time_constant = tau_c / 4.0;
+        FeedbackGains {
+            proportional: 0.0,
+            integral: 1.0 / (4.0 * (tau_c + time_constant)),
+            time_constant,
+        }
+    }
+}
+
+/// The lock-in amplifier (module docs).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LockIn {
+    /// β = 1 − e^{−T/τ_L}.
+    beta: f64,
+    /// X̄, Ȳ.
+    x: f64,
+    y: f64,
+}
+
+impl LockIn {
+    /// A lock-in of time constant `time_constant` (τ_L ≥ 0) updated once per `period`, its
+    /// output preloaded with (`amplitude`, `phase`).
+    pub fn new(time_constant: f64, period: f64, amplitude: f64, phase: f64) -> Self {
+        let beta = if time_constant > 0.0 {
+            -(-period / time_constant).exp_m1()
+        } else {
+            1.0
+        };
+        LockIn {
+            beta,
+            x: amplitude * phase.cos(),
+            y: amplitude * phase.sin(),
+        }
+    }
+
+    /// Feed one period's demodulated first harmonic (A_k, φ_k).
+    pub fn update(&mut self, amplitude: f64, phase: f64) {
+        self.x += self.beta * (amplitude * phase.cos() - self.x);
+        self.y += self.beta * (amplitude * phase.sin() - self.y);
+    }
+
+    /// The output amplitude A = |(X̄, Ȳ)|.
+    pub fn amplitude(&self) -> f64 {
+        self.x.hypot(self.y)
+    }
+
+    /// The output phase lag φ = arg(X̄ + iȲ), in (−π/2, 3π/2].
+    pub fn phase(&self) -> f64 {
+        wrap_phase(self.y.atan2(self.x))
+    }
+}
+
+/// The first harmonic (A, φ) of W(1,τ) over the drive period from the integrator's current τ,
+/// sampled `samples` times (module docs), the integrator advanced to the period's end.
+///
+/// # Errors
+/// As the integrator.
+pub fn demodulate_period(
+    integ: &mut dyn Integrator,
+    model: &CantileverModel,
+    samples: usize,
+) -> Result<(f64, f64), SimError> {
+    let p = model.params();
+    let (t0, period) = (integ.tau(), model.period());
+    let psi = p.drive_phase();
+    let (mut x, mut y) = (0.0, 0.0);
+    for j in 1..=samples {
+        let tau = t0 + period * j as f64 / samples as f64;
+        advance(integ, tau)?;
+        let w = model.tip_values(tau, integ.state())[0];
+        let (s, c) = (p.omega * tau + psi).sin_cos();
+        x += w * s;
+        y -= w * c;
+    }
+    let k = 2.0 / samples as f64;
+    Ok(((k * x).hypot(k * y), wrap_phase((k * y).atan2(k * x))))
+}
+
+/// The PI controller (module docs).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PiController {
+    proportional: f64,
+    /// K_I T.
+    integral_step: f64,
+    origin: f64,
+    /// Σ e_j.
+    sum: f64,
+}
+
+impl PiController {
+    /// A controller of `gains` updated once per `period`, its output `origin` at zero error.
+    pub fn new(gains: &FeedbackGains, period: f64, origin: f64) -> Self {
+        PiController {
+            proportional: gains.proportional,
+            integral_step: gains.integral * period,
+            origin,
+            sum: 0.0,
+        }
+    }
+
+    /// The output after the error `e`, held within `range` = (lowest, highest): the output and
+    /// whether it saturated. An error that drives a saturated output further out is not
+    /// integrated (conditional integration); one that drives it back is.
+    pub fn output(&mut self, e: f64, range: (f64, f64)) -> (f64, bool) {
+        let z = self.origin + self.proportional * e + self.integral_step * (self.sum + e);
+        let (low, high) = (z < range.0, z > range.1);
+        if !((low && e < 0.0) || (high && e > 0.0)) {
+            self.sum += e;
+        }
+        (z.clamp(range.0, range.1), low || high)
+    }
+}
+
+/// One scanned pixel (model units): means over its drive periods and the observables of its
+/// last period.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ScanPixel {
+    /// Mean piezo position (rest distance over the sample's zero height), g₀.
+    pub z: f64,
+    /// Mean lock-in amplitude, g₀.
+    pub amplitude: f64,
+    /// Mean lock-in phase lag, rad.
+    pub phase: f64,
+    /// Mean error A_sp − A, g₀ (the error image).
+    pub tracking_error: f64,
+    /// The material under the tip at the pixel's last period.
+    pub material: usize,
+    /// Energy dissipated over the last period (F̃·g₀; [`observe`]).
+    pub energy_dissipated: f64,
+    /// Virial over the last period (F̃·g₀).
+    pub virial: f64,
+    /// Peak force over the last period (F̃).
+    pub peak_force: f64,
+    /// Indentation over the last period (g₀).
+    pub indentation: f64,
+    /// Mean deflection ⟨W⟩ over the last period (g₀; its sign is the regime's, as the
+    /// setpoint report's).
+    pub mean_deflection: f64,
+    /// Whether the controller lost contact ("parachuting"): in the last period the tip did not
+    /// reach the sample and the lock-in amplitude was nearer to the free amplitude than to
+    /// the setpoint.
+    pub lost_contact: bool,
+    /// Periods at the controller's output limit.
+    pub saturated: usize,
+}
+
+/// What a scan line needs (model units).
+#[derive(Debug, Clone)]
+pub struct LineSpec {
+    /// The materials under the tip: the same lever and drive, only the sample differs (their
+    /// α5 is set per period).
+    pub materials: Vec<Params>,
+    /// The amplitude setpoint A_sp (g₀).
+    pub setpoint: f64,
+    /// The free amplitude A₀ (g₀): a pixel whose amplitude is nearer to it than to the
+    /// setpoint, with the tip off the sample, lost contact.
+    pub free_amplitude: f64,
+    /// Gains and the lock-in's time constant.
+    pub gains: FeedbackGains,
+    /// Samples per period of the lock-in ([`LOCK_IN_SAMPLES`]).
+    pub samples: usize,
+    /// Pixels per line.
+    pub pixels: usize,
+    /// Drive periods per pixel.
+    pub periods_per_pixel: usize,
+    /// Drive periods of the engage at the line's start, before the trace.
+    pub engage_periods: usize,
+    /// The rest-distance range of the controller above the local surface (lowest, highest).
+    pub range: (f64, f64),
+    /// The integrator.
+    pub integrator: IntegratorOptions,
+}
+
+/// Where a line engages: far above its first pixel's material, on the steady state there.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Engage {
+    /// The steady state at the start (τ = 0 of a period), shape `[dim]` of its material.
+    pub state: DVector<f64>,
+    /// Its rest distance z_c (g₀).
+    pub z_c: f64,
+    /// Its first harmonic (A, φ): the lock-in's preload.
+    pub amplitude: f64,
+    /// Phase lag, rad.
+    pub phase: f64,
+}
+
+/// The trace and the retrace of one line, each in x order.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ScanLine {
+    /// Trace (x increasing).
+    pub trace: Vec<ScanPixel>,
+    /// Retrace (scanned x decreasing, stored in x order).
+    pub retrace: Vec<ScanPixel>,
+}
+
+/// `z` for a state of dimension `dim`: the modal part kept, a law's internal states at rest
+/// where the material under the tip has them (a fresh, relaxed SLS surface), dropped where it
+/// has none.
+fn fit_state(z: &DVector<f64>, dim: usize) -> DVector<f64> {
+    if z.len() == dim {
+        return z.clone();
+    }
+    DVector::from_fn(dim, |i, _| if i < z.len() { z[i] } else { 0.0 })
+}
+
+/// Accumulates a pixel's means.
+#[derive(Default)]
+struct Sums {
+    z: f64,
+    amplitude: f64,
+    phase: f64,
+    error: f64,
+    saturated: usize,
+    n: usize,
+    /// The lock-in amplitude after the last period.
+    last: f64,
+}
+
+/// Scan one line (module docs): engage at the line's start for `engage_periods` from `engage`,
+/// then the trace over `pixels` × `periods_per_pixel` drive periods and the retrace back.
+/// `under_tip(s)` is the material and the true height (g₀) at the position s ∈ [0, pixels]
+/// along the line (in pixels, x increasing).
+///
+/// # Errors
+/// [`SimError::Cancelled`] once `cancel` is set; the model's and the integrator's errors.
+pub fn scan_line(
+    spec: &LineSpec,
+    engage: &Engage,
+    under_tip: &dyn Fn(f64) -> (usize, f64),
+    cancel: &AtomicBool,
+) -> Result<ScanLine, SimError> {
+    let base = &spec.materials[0];
+    let period = base.period();
+    let h0 = under_tip(0.0).1;
+    let mut z = engage.state.clone();
+    let mut lock = LockIn::new(
+        spec.gains.time_constant,
+        period,
+        engage.amplitude,
+        engage.phase,
+    );
+    let mut pi = PiController::new(&spec.gains, period, engage.z_c + h0);
+    let mut piezo = engage.z_c + h0;
+    let opts = ObservableOptions {
+        periods: 1,
+        harmonics: 1,
+    };
+    // one period at position s: returns the observables when `observe_it`
+    let mut period_at =
+        |s: f64,
+         observe_it: bool,
+         piezo: &mut f64,
+         sums: &mut Sums|
+         -> Result<Option<(usize, crate::analysis::observables::Observables)>, SimError> {
+            let (m, h) = under_tip(s);
+            let mat = &spec.materials[m];
+            let p = mat.with(SweepParam::Alpha5, mat.alpha5_for_rest_distance(*piezo - h));
+            let model = CantileverModel::new(&p)?;
+            let start = fit_state(&z, model.dim());
+            let mut integ = build(&model, spec.integrator.clone(), 0.0, &start)?;
+            let (raw, o) = if observe_it {
+                let o = observe(integ.as_mut(), &opts)?;
+                ((o.amplitude, o.phase), Some((m, o)))
+            } else {
+                (
+                    demodulate_period(integ.as_mut(), &model, spec.samples)?,
+                    None,
+                )
+            };
+            z = integ.state().clone();
+            lock.update(raw.0, raw.1);
+            sums.z += *piezo;
+            sums.amplitude += lock.amplitude();
+            sums.last = lock.amplitude();
+            sums.phase += lock.phase();
+            let e = spec.setpoint - lock.amplitude();
+            sums.error += e;
+            let (next, sat) = pi.output(e, (h + spec.range.0, h + spec.range.1));
+            sums.saturated += usize::from(sat);
+            sums.n += 1;
+            *piezo = next;
+            Ok(o)
+        };
+    let mut scratch = Sums::default();
+    for _ in 0..spec.engage_periods {
+        if cancel.load(Ordering::Relaxed) {
+            return Err(SimError::Cancelled);
+        }
+        period_at(0.0, false, &mut piezo, &mut scratch)?;
+    }
+    let n_c = spec.periods_per_pixel;
+    let mut lines = [Vec::new(), Vec::new()];
+    for (dir, out) in lines.iter_mut().enumerate() {
+        for i in 0..spec.pixels {
+            if cancel.load(Ordering::Relaxed) {
+                return Err(SimError::Cancelled);
+            }
+            let mut sums = Sums::default();
+            let mut last = None;
+            for c in 0..n_c {
+                let along = i as f64 + (c as f64 + 0.5) / n_c as f64;
+                let s = if dir == 0 {
+                    along
+                } else {
+                    spec.pixels as f64 - along
+                };
+                if let Some(o) = period_at(s, c + 1 == n_c, &mut piezo, &mut sums)? {
+                    last = Some(o);
+                }
+            }
+            let (material, o) = last.expect("a pixel has at least one period");
+            let n = sums.n as f64;
+            out.push(ScanPixel {
+                z: sums.z / n,
+                amplitude: sums.amplitude / n,
+                phase: sums.phase / n,
+                tracking_error: sums.error / n,
+                material,
+                energy_dissipated: o.energy_dissipated,
+                virial: o.virial,
+                peak_force: o.peak_force,
+                indentation: o.indentation,
+                mean_deflection: o.mean_deflection,
+                lost_contact: o.contact_fraction == 0.0
+                    && o.impacts_per_period == 0.0
+                    && 2.0 * sums.last > spec.setpoint + spec.free_amplitude,
+                saturated: sums.saturated,
+            });
+        }
+    }
+    let [trace, mut retrace] = lines;
+    retrace.reverse();
+    Ok(ScanLine { trace, retrace })
+}
+
+/// Scan the lines `0..lines` not in `done` (on the current rayon pool with the `parallel`
+/// feature, one line per task), handing each finished one to `sink`; start no line once
+/// `cancel` is set. Each line depends only on its number, so the result does not depend on
+/// the thread count.
+///
+/// # Errors
+/// The error of the lowest-numbered line that failed (the others finished are sent).
+pub fn scan_lines(
+    lines: usize,
+    done: &std::collections::HashSet<usize>,
+    line: &(dyn Fn(usize) -> Result<ScanLine, SimError> + Sync),
+    sink: &(dyn Fn(usize, ScanLine) + Sync),
+    cancel: &AtomicBool,
+) -> Result<(), SimError> {
+    let failed = std::sync::Mutex::new(None::<(usize, SimError)>);
+    (0..lines)
+        .into_par_iter()
+        .with_max_len(1)
+        .filter(|t| !done.contains(t))
+        .for_each(|t| {
+            if cancel.load(Ordering::Relaxed) {
+                return;
+            }
+            match line(t) {
+                Ok(l) => sink(t, l),
+                Err(e) => {
+                    let mut f = failed.lock().unwrap_or_else(|p| p.into_inner());
+                    if f.as_ref().is_none_or(|(k, _)| t < *k) {
+                        *f = Some((t, e));
+                    }
+                }
+            }
+        });
+    match failed.into_inner().unwrap_or_else(|p| p.into_inner()) {
+        Some((_, e)) => Err(e),
+        None => Ok(()),
+    }
+}
