@@ -631,6 +631,65 @@ pub fn image(
     Ok(img.document(setpoint).to_string())
 }
 
+/// The PI-scanned image of a sample map under a probe (`afmdyn image --feedback pi`:
+/// [`afmdyn::request::image_scan::pi_image`]): its JSON document, the lines on `threads` worker
+/// threads (`None`: all cores), with progress (lines) and Ctrl-C. Arguments as [`image`]'s;
+/// `scan_rate` (Hz), `gains` (K_P, K_I in 1/s) and `time_constant` (s), `None` for the lever's
+/// defaults.
+#[pyfunction]
+#[pyo3(signature = (probe, sample, setpoint, pixels=None, lines=None, curve_points=None, height_map=None, scan_rate=None, gains=None, time_constant=None, threads=None, progress=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn pi_image<'py>(
+    py: Python<'py>,
+    probe: &str,
+    sample: &str,
+    setpoint: f64,
+    pixels: Option<usize>,
+    lines: Option<usize>,
+    curve_points: Option<usize>,
+    height_map: Option<Vec<Vec<f64>>>,
+    scan_rate: Option<f64>,
+    gains: Option<(f64, f64)>,
+    time_constant: Option<f64>,
+    threads: Option<usize>,
+    progress: Option<Bound<'py, PyAny>>,
+) -> PyResult<String> {
+    use afmdyn::request::image::ImageRequest;
+    use afmdyn::request::image_scan::{PiScan, ScanStudy};
+    let (table, map) = image_inputs(probe, sample, height_map)?;
+    afmdyn::request::limits::check_threads(threads).map_err(sim_error)?;
+    let d = ImageRequest::at(setpoint);
+    let req = ImageRequest {
+        pixels: pixels.unwrap_or(d.pixels),
+        lines,
+        curve_points: curve_points.unwrap_or(d.curve_points),
+        ..d
+    };
+    let scan = PiScan {
+        scan_rate,
+        gains,
+        time_constant,
+    };
+    // the settings are checked before the approach curves are run
+    let job = Job::default();
+    let worker = job.clone();
+    let doc = run(
+        py,
+        &job,
+        Some(req.lines(&map)),
+        progress.as_ref(),
+        Stop::Cancellable,
+        move || -> PyResult<String> {
+            let study = ScanStudy::new(&table, &map, &req, &scan).map_err(sim_error)?;
+            let mut store = afmdyn::study::MemoryStore::default();
+            execute(&study, &mut store, false, threads, &*worker.progress).map_err(study_error)?;
+            let img = study.assemble(store.records).map_err(sim_error)?;
+            Ok(img.document(setpoint).to_string())
+        },
+    )??;
+    Ok(doc)
+}
+
 /// The setpoint study of a sample map under a probe (`afmdyn image --setpoint-study`:
 /// [`afmdyn::request::image::setpoint_study`]): its JSON (`ratio`, `domains`). Arguments as
 /// [`image`]'s.

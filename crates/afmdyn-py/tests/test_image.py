@@ -82,3 +82,49 @@ def test_a_height_map_from_numpy_is_the_recorded_topography():
         afmdyn.image(PROBE, "size = [1e-6, 1e-6]", 0.7, height_map=np.ones(3))
     with pytest.raises(ValueError, match="height_map"):
         afmdyn.image(PROBE, "size = [1e-6, 1e-6]", 0.7, height_map=[[0.0, np.nan]])
+
+
+def _lever_q100(tmp_path):
+    """The point-mass probe with Q = 100 (a short loop time: a quick scan)."""
+    text = PROBE.read_text().replace("quality_factor = 400", "quality_factor = 100")
+    path = tmp_path / "probe.toml"
+    path.write_text(text)
+    return path
+
+
+def test_the_pi_scan_is_the_command_lines_document(cli_json, tmp_path):
+    probe = _lever_q100(tmp_path)
+    # the rubber has no operating point at 0.5 with this lever: the controller presses to its
+    # range's limit there, and says so
+    with pytest.warns(afmdyn.AfmdynWarning, match="sat at a limit"):
+        ds = afmdyn.image(
+            probe, STRIPE, 0.5, pixels=8, feedback="pi", scan_rate=40.0, gains=(0.1, 2000.0),
+            time_constant=20e-6, threads=2, progress=False,
+        )
+    doc = cli_json(
+        "image", "--probe", probe, "--sample", STRIPE, "--setpoint", "0.5", "--pixels", "8",
+        "--feedback", "pi", "--scan-rate", "40", "--gains", "0.1,2000", "--time-constant",
+        "20e-6", "--threads", "1", "--out", tmp_path / "out",
+    )
+    assert afmdyn.summary(ds) == doc
+    assert ds.attrs["feedback"] == "pi"
+    assert ds.height.shape == (1, 8) and ds.height_retrace.shape == (1, 8)
+    assert json.loads(ds.attrs["scan"])["proportional_gain"] == 0.1
+    assert ds.tracking_error.attrs["units"] == "m"
+    assert ds.lost_contact.dtype == bool
+    # the recorded trace is the document's, in m
+    assert np.array_equal(ds.height.values[0], np.array(doc["image"]["height"][0], dtype=float))
+
+
+def test_pi_settings_are_refused_by_name(tmp_path):
+    probe = _lever_q100(tmp_path)
+    with pytest.raises(ValueError, match="gains"):
+        afmdyn.image(probe, STRIPE, 0.5, pixels=8, feedback="pi", gains=(-1.0, 10.0))
+    with pytest.raises(ValueError, match="scan_rate"):
+        afmdyn.image(probe, STRIPE, 0.5, pixels=8, feedback="pi", scan_rate=1e9)
+    with pytest.raises(ValueError, match="time_constant"):
+        afmdyn.image(probe, STRIPE, 0.5, pixels=8, feedback="pi", time_constant=-1.0)
+    with pytest.raises(ValueError, match="feedback"):
+        afmdyn.image(probe, STRIPE, 0.5, feedback="pid")
+    with pytest.raises(ValueError, match="only with feedback='pi'"):
+        afmdyn.image(probe, STRIPE, 0.5, scan_rate=2.0)

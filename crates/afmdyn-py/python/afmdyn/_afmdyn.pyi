@@ -593,6 +593,20 @@ def image(
     curve_points: Optional[int] = None,
     height_map: Optional[List[List[float]]] = None,
 ) -> str: ...
+def pi_image(
+    probe: str,
+    sample: str,
+    setpoint: float,
+    pixels: Optional[int] = None,
+    lines: Optional[int] = None,
+    curve_points: Optional[int] = None,
+    height_map: Optional[List[List[float]]] = None,
+    scan_rate: Optional[float] = None,
+    gains: Optional[Tuple[float, float]] = None,
+    time_constant: Optional[float] = None,
+    threads: Optional[int] = None,
+    progress: Optional[Callable[[int, Optional[int]], object]] = None,
+) -> str: ...
 def setpoint_study(
     probe: str,
     sample: str,

@@ -5,13 +5,14 @@ from __future__ import annotations
 
 import json
 import os
-from typing import Any, Dict, Optional, Sequence, Union
+from typing import Any, Dict, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import xarray as xr
 
 from . import _afmdyn as _core
 from ._common import _typed, _warn
+from ._progress import ProgressArg, reporter
 
 #: The numeric maps of an image, their units and meanings (the document's ``image`` block).
 _FIELDS = {
@@ -26,6 +27,18 @@ _FIELDS = {
     "indentation": ("m", "largest indentation"),
 }
 
+#: The recorded maps of a PI scan (``feedback="pi"``), trace and ``_retrace``.
+_SCAN_FIELDS = {
+    "height": ("m", "recorded height: mean piezo position less the ideal reference z_c,ref"),
+    "amplitude": ("m", "mean lock-in amplitude"),
+    "phase_deg": ("degree", "mean lock-in phase lag behind the drive"),
+    "tracking_error": ("m", "mean amplitude error A_sp - A (the error image)"),
+    "energy_dissipated": ("J", "energy dissipated over the pixel's last drive period"),
+    "virial": ("J", "virial over the pixel's last drive period"),
+    "peak_force": ("N", "largest tip-sample force over the pixel's last drive period"),
+    "indentation": ("m", "largest indentation over the pixel's last drive period"),
+}
+
 
 @_typed
 def image(
@@ -37,11 +50,21 @@ def image(
     lines: Optional[int] = None,
     curve_points: Optional[int] = None,
     height_map: Optional[Any] = None,
+    feedback: str = "ideal",
+    scan_rate: Optional[float] = None,
+    gains: Optional[Tuple[float, float]] = None,
+    time_constant: Optional[float] = None,
+    threads: Optional[int] = None,
+    progress: ProgressArg = None,
 ) -> xr.Dataset:
-    """The image an ideal amplitude feedback records over a heterogeneous sample
-    (``afmdyn image --feedback ideal``): at every pixel the operating point of the local
+    """The image an amplitude feedback records over a heterogeneous sample
+    (``afmdyn image``). ``feedback="ideal"``: at every pixel the operating point of the local
     material where the amplitude equals the setpoint, the regime kept from the previous pixel
-    where the material allows it, each line engaged from far.
+    where the material allows it, each line engaged from far. ``feedback="pi"``: each line
+    scanned in the time domain, trace and retrace, under a lock-in and a PI z controller
+    updating once per drive period (``scan_rate`` in Hz, ``gains`` = (K_P, K_I in 1/s),
+    ``time_constant`` of the lock-in in s; ``None`` for the lever's defaults), its lines on
+    ``threads`` cores with ``progress``; Ctrl-C stops it.
 
     Args:
         probe: the probe (path, TOML text or dict, as ``afmdyn.probe``): the lever, tip,
@@ -62,10 +85,27 @@ def image(
         ``domain`` (strings); attributes ``setpoint``, ``reference_z_c`` (m) and ``summary``
         (the command line's JSON document, with each material's operating points).
 
+        With ``feedback="pi"``: the recorded trace ``height``, ``amplitude``, ``phase_deg``,
+        ``tracking_error``, ``energy_dissipated``, ``virial``, ``peak_force``, ``indentation``
+        and ``lost_contact``, the same with ``_retrace``, ``ideal_height`` and
+        ``true_height`` (m); attributes ``scan`` (the settings) and ``artefacts`` (JSON: per
+        direction the height error against the ideal image, the overshoot, the error image's
+        RMS, the pixels that lost contact).
+
     Raises:
         ValueError: naming the field — a setpoint outside (0, 1), pixels or lines outside
-            1..=4096 (lines = 1 for a line map), a sample map's key.
+            1..=4096 (lines = 1 for a line map), a sample map's key, a scan setting
+            (scan_rate, gains, time_constant).
     """
+    if feedback not in ("ideal", "pi"):
+        raise ValueError(f"feedback = {feedback!r}: must be 'ideal' or 'pi'")
+    if feedback == "ideal" and any(
+        v is not None for v in (scan_rate, gains, time_constant, threads)
+    ):
+        raise ValueError(
+            "scan_rate, gains, time_constant, threads: only with feedback='pi' "
+            "(the ideal feedback has no loop)"
+        )
     text = _core.probe_source(probe)
     source = os.fspath(sample) if isinstance(sample, os.PathLike) else sample
     rows = None
@@ -74,6 +114,19 @@ def image(
         if grid.ndim != 2:
             raise ValueError(f"height_map: must be a 2D array of heights (m), got {grid.ndim}D")
         rows = grid.tolist()
+    if feedback == "pi":
+        pair = None if gains is None else (float(gains[0]), float(gains[1]))
+        if gains is not None and len(gains) != 2:
+            raise ValueError("gains: must be two numbers (K_P, K_I in 1/s)")
+        with reporter(progress, "image", unit="line") as cb:
+            doc = json.loads(
+                _core.pi_image(
+                    text, source, setpoint, pixels, lines, curve_points, rows,
+                    scan_rate, pair, time_constant, threads, cb,
+                )
+            )
+        _warn(doc)
+        return _scan_dataset(doc, setpoint)
     doc = json.loads(_core.image(text, source, setpoint, pixels, lines, curve_points, rows))
     _warn(doc)
     img = doc["image"]
@@ -97,6 +150,42 @@ def image(
             "setpoint": setpoint,
             "reference_z_c": doc["reference_z_c"],
             "feedback": doc["feedback"],
+            "summary": json.dumps(doc),
+        },
+    )
+
+
+def _grid(rows: Any, dtype: Any = np.float64) -> Any:
+    """A ``[line][pixel]`` block of the document as an array (None → NaN)."""
+    return np.array([[np.nan if v is None else v for v in row] for row in rows], dtype=dtype)
+
+
+def _scan_dataset(doc: Dict[str, Any], setpoint: float) -> xr.Dataset:
+    """The Dataset of a PI scan's document."""
+    img = doc["image"]
+    dims = ("y", "x")
+    data: Dict[str, Any] = {}
+    for suffix, block in (("", img), ("_retrace", img["retrace"])):
+        for name, (unit, meaning) in _SCAN_FIELDS.items():
+            data[name + suffix] = (dims, _grid(block[name]), {"units": unit, "long_name": meaning})
+        data["lost_contact" + suffix] = (dims, np.array(block["lost_contact"], dtype=bool))
+        data["regime" + suffix] = (dims, np.array(block["regime"]))
+        data["material" + suffix] = (dims, np.array(block["material"]))
+    data["ideal_height"] = (dims, _grid(img["ideal_height"]), {"units": "m"})
+    data["true_height"] = (dims, _grid(img["true_height"]), {"units": "m"})
+    data["domain"] = (dims, np.array(img["domain"]))
+    return xr.Dataset(
+        data,
+        coords={
+            "x": ("x", np.asarray(img["x"], dtype=np.float64), {"units": "m"}),
+            "y": ("y", np.asarray(img["y"], dtype=np.float64), {"units": "m"}),
+        },
+        attrs={
+            "setpoint": setpoint,
+            "reference_z_c": doc["reference_z_c"],
+            "feedback": doc["feedback"],
+            "scan": json.dumps(doc["scan"]),
+            "artefacts": json.dumps(doc["artefacts"]),
             "summary": json.dumps(doc),
         },
     )
