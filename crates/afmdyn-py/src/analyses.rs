@@ -585,7 +585,7 @@ pub fn observe<'py>(
 
 /// The probe's table (from its TOML text) and the sample map (TOML text or path) of an image.
 /// With `height_map`, the map's height map replaced by it.
-fn image_inputs(
+pub(crate) fn image_inputs(
     probe: &str,
     sample: &str,
     height_map: Option<Vec<Vec<f64>>>,

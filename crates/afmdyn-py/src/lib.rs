@@ -10,6 +10,7 @@ mod basin_tasks;
 mod chart;
 mod convert;
 mod errors;
+mod image_tasks;
 mod params;
 mod run;
 mod studies;
@@ -38,6 +39,7 @@ fn _afmdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<params::PyParams>()?;
     m.add_class::<chart::ChartStudy>()?;
     m.add_class::<basin_tasks::BasinMapStudy>()?;
+    m.add_class::<image_tasks::ScanStudy>()?;
     m.add_class::<chart::StoreLock>()?;
     m.add_class::<sweep::SweepStudy>()?;
     m.add_class::<sweep::SweepStore>()?;

@@ -128,3 +128,27 @@ def test_pi_settings_are_refused_by_name(tmp_path):
         afmdyn.image(probe, STRIPE, 0.5, feedback="pid")
     with pytest.raises(ValueError, match="only with feedback='pi'"):
         afmdyn.image(probe, STRIPE, 0.5, scan_rate=2.0)
+
+
+def test_the_dask_scan_equals_the_local_scan(tmp_path):
+    # two lines on a LocalCluster of two worker processes: the recipe pickles to the workers,
+    # each line comes back as text, and the image is the local one bit for bit
+    distributed = pytest.importorskip("distributed")
+    import afmdyn.dask
+    import xarray as xr
+
+    probe = _lever_q100(tmp_path)
+    two = STRIPE.read_text().replace("size = [1.0e-6, 0.0]", "size = [1.0e-6, 0.2e-6]")
+    keywords = dict(pixels=8, lines=2, scan_rate=40.0)
+    cluster = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                       dashboard_address=None)
+    client = distributed.Client(cluster)
+    try:
+        with pytest.warns(afmdyn.AfmdynWarning):
+            ds = afmdyn.dask.image(probe, two, 0.5, client=client, progress=False, **keywords)
+    finally:
+        client.close()
+        cluster.close()
+    with pytest.warns(afmdyn.AfmdynWarning):
+        ref = afmdyn.image(probe, two, 0.5, feedback="pi", progress=False, **keywords)
+    xr.testing.assert_identical(ds, ref)

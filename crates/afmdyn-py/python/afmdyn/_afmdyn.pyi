@@ -607,6 +607,27 @@ def pi_image(
     threads: Optional[int] = None,
     progress: Optional[Callable[[int, Optional[int]], object]] = None,
 ) -> str: ...
+class ScanStudy:
+    """A PI-scanned image planned as lines (``afmdyn.dask.image``)."""
+    def __init__(self, recipe: str) -> None: ...
+    @staticmethod
+    def build(
+        probe: str,
+        sample: str,
+        setpoint: float,
+        pixels: Optional[int] = None,
+        lines: Optional[int] = None,
+        curve_points: Optional[int] = None,
+        height_map: Optional[List[List[float]]] = None,
+        scan_rate: Optional[float] = None,
+        gains: Optional[Tuple[float, float]] = None,
+        time_constant: Optional[float] = None,
+    ) -> "ScanStudy": ...
+    @property
+    def recipe(self) -> str: ...
+    def lines(self) -> int: ...
+    def run_line(self, t: int) -> str: ...
+    def document(self, lines: List[str]) -> str: ...
 def setpoint_study(
     probe: str,
     sample: str,

@@ -40,6 +40,19 @@ _SCAN_FIELDS = {
 }
 
 
+def _inputs(probe: Any, sample: Any, height_map: Any) -> Tuple[str, str, Any]:
+    """The probe's TOML text, the sample map's text or path, the height map's rows (or None)."""
+    text = _core.probe_source(probe)
+    source = os.fspath(sample) if isinstance(sample, os.PathLike) else sample
+    rows = None
+    if height_map is not None:
+        grid = np.asarray(height_map, dtype=np.float64)
+        if grid.ndim != 2:
+            raise ValueError(f"height_map: must be a 2D array of heights (m), got {grid.ndim}D")
+        rows = grid.tolist()
+    return text, source, rows
+
+
 @_typed
 def image(
     probe: Union[str, "os.PathLike[str]", Dict[str, Any]],
@@ -106,14 +119,7 @@ def image(
             "scan_rate, gains, time_constant, threads: only with feedback='pi' "
             "(the ideal feedback has no loop)"
         )
-    text = _core.probe_source(probe)
-    source = os.fspath(sample) if isinstance(sample, os.PathLike) else sample
-    rows = None
-    if height_map is not None:
-        grid = np.asarray(height_map, dtype=np.float64)
-        if grid.ndim != 2:
-            raise ValueError(f"height_map: must be a 2D array of heights (m), got {grid.ndim}D")
-        rows = grid.tolist()
+    text, source, rows = _inputs(probe, sample, height_map)
     if feedback == "pi":
         pair = None if gains is None else (float(gains[0]), float(gains[1]))
         if gains is not None and len(gains) != 2:

@@ -476,14 +476,73 @@ def basins(
     return _dataset(layout, json.loads(doc), p)
 
 
+def run_image_line(recipe: str, line: int) -> str:
+    """Line ``line`` of the PI scan of ``recipe`` (what a worker runs): its trace and retrace,
+    as text. The scan (its materials' approach curves) is built once per worker process and
+    recipe."""
+    return _scan_of(recipe).run_line(line)
+
+
+@functools.lru_cache(maxsize=8)
+def _scan_of(recipe: str) -> "_core.ScanStudy":
+    return _core.ScanStudy(recipe)
+
+
+def image(
+    probe: Any,
+    sample: Any,
+    setpoint: float,
+    *,
+    client: Optional["distributed.Client"] = None,
+    progress: ProgressArg = None,
+    pixels: Optional[int] = None,
+    lines: Optional[int] = None,
+    curve_points: Optional[int] = None,
+    height_map: Any = None,
+    scan_rate: Optional[float] = None,
+    gains: Optional[Sequence[float]] = None,
+    time_constant: Optional[float] = None,
+) -> xr.Dataset:
+    """:func:`afmdyn.image` with ``feedback="pi"`` (the same keywords but ``threads``) with
+    its lines mapped over a Dask cluster (``client``; default a ``LocalCluster`` of this
+    machine's cores, closed at the end): each line is a task, a pure function of the request
+    and its number, so the Dataset equals :func:`afmdyn.image`'s bit for bit.
+    """
+    from ._image import _inputs, _scan_dataset
+
+    text, source, rows = _inputs(probe, sample, height_map)
+    pair = None if gains is None else (float(gains[0]), float(gains[1]))
+    if gains is not None and len(gains) != 2:
+        raise ValueError("gains: must be two numbers (K_P, K_I in 1/s)")
+    s = _core.ScanStudy.build(text, source, setpoint, pixels, lines, curve_points, rows,
+                              scan_rate, pair, time_constant)
+    n = s.lines()
+    with _cluster(client) as client:
+        texts: List[str] = []
+        with reporter(progress, "image (dask)", unit="line") as cb:
+            futures = client.map(run_image_line, [s.recipe] * n, list(range(n)), pure=False,
+                                 retries=3)
+            for fut in distributed.as_completed(futures):
+                texts.append(fut.result())
+                if cb is not None:
+                    cb(len(texts), n)
+        doc = json.loads(s.document(texts))
+    from ._common import _warn
+
+    _warn(doc)
+    return _scan_dataset(doc, setpoint)
+
+
 __all__ = [
     "DONE",
     "basins",
     "bifurcation",
     "chart",
+    "image",
     "ledger_dir",
     "run_basin_row",
     "run_chart_task",
     "run_coarse_task",
+    "run_image_line",
     "run_sweep_task",
 ]

@@ -36,7 +36,7 @@ use crate::error::SimError;
 use crate::params::Params;
 use crate::probe::Probe;
 use crate::report::CurveUnits;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
 use super::curves::{approach_request, CurveRequest};
@@ -48,7 +48,7 @@ pub const MAX_PIXELS: usize = 4096;
 pub const MAX_DOMAINS: usize = 1000;
 
 /// One domain of a [`SampleMap`].
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Domain {
     /// Its name.
     pub name: String,
@@ -66,7 +66,7 @@ pub struct Domain {
 }
 
 /// A heterogeneous sample (module docs).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SampleMap {
     /// [Lx, Ly] (m).
     pub size: (f64, f64),
@@ -408,7 +408,7 @@ impl SampleMap {
 }
 
 /// An image request (`afmdyn image`, Python's `afmdyn.image`; module docs).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct ImageRequest {
     /// Setpoint ratio A_sp/A₀ in (0, 1).
     pub setpoint: f64,

@@ -127,11 +127,26 @@ pub struct PiImage {
     pub warnings: Vec<String>,
 }
 
+/// What rebuilds a [`ScanStudy`] in any process (a Dask worker): the probe's table, the
+/// sample map (height maps read already), the request and the settings as given.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ScanRecipe {
+    /// The probe file's table.
+    pub probe: toml::Table,
+    /// The sample map.
+    pub map: SampleMap,
+    /// The image request.
+    pub request: ImageRequest,
+    /// The PI settings as given (`None`: the lever's defaults).
+    pub scan: PiScan,
+}
+
 /// The study of a PI scan: one task per line ([module docs](self)).
 pub struct ScanStudy {
     fingerprint: Value,
+    recipe: ScanRecipe,
     ideal: Image,
-    map: SampleMap,
     of_domain: Vec<usize>,
     spec: LineSpec,
     /// Per material: where a line starting on it engages.
@@ -288,8 +303,13 @@ impl ScanStudy {
         });
         Ok(ScanStudy {
             fingerprint,
+            recipe: ScanRecipe {
+                probe: probe_table.clone(),
+                map: map.clone(),
+                request: *req,
+                scan: *scan,
+            },
             ideal,
-            map: map.clone(),
             of_domain,
             spec,
             engage,
@@ -297,6 +317,19 @@ impl ScanStudy {
             settings,
             pixels,
         })
+    }
+
+    /// The study of a recipe ([`ScanStudy::recipe`]).
+    ///
+    /// # Errors
+    /// As [`ScanStudy::new`].
+    pub fn from_recipe(r: &ScanRecipe) -> Result<ScanStudy, SimError> {
+        ScanStudy::new(&r.probe, &r.map, &r.request, &r.scan)
+    }
+
+    /// What rebuilds this study elsewhere.
+    pub fn recipe(&self) -> &ScanRecipe {
+        &self.recipe
     }
 
     /// The number of lines.
@@ -323,13 +356,14 @@ impl ScanStudy {
             ));
         }
         let y = self.ideal.y[t];
-        let (lx, g0) = (self.map.size.0, self.units.length);
+        let map = &self.recipe.map;
+        let (lx, g0) = (map.size.0, self.units.length);
         let dx = lx / self.pixels as f64;
         let under_tip = |s: f64| {
             // a position on an edge belongs to the pixel it begins
             let x = (s * dx).clamp(0.0, lx);
-            let m = self.map.domain_at(x, y).map_or(0, |k| self.of_domain[k]);
-            (m, self.map.height_at(x, y) / g0)
+            let m = map.domain_at(x, y).map_or(0, |k| self.of_domain[k]);
+            (m, map.height_at(x, y) / g0)
         };
         let first = under_tip(0.5 / self.spec.periods_per_pixel as f64).0;
         scan_line(&self.spec, &self.engage[first], &under_tip, cancel)
