@@ -1,11 +1,12 @@
 //! `afmdyn image`: the AM-AFM image of a heterogeneous sample under an ideal amplitude feedback.
 //! The sample map, the operating points and the scan are the library's
 //! ([`afmdyn::request::image`]); this front end reads the two files, maps the flags, and writes
-//! `image.json`, the maps (height, phase, E_dis) and the line profile.
+//! `image.json`, `image.nc` (the library's layout, [`afmdyn::layout::image`]), the maps
+//! (height, phase, E_dis) and the line profile.
 
 use crate::args::read_text;
 use crate::error::CliError;
-use crate::output::{si_value, write_document, OutDir};
+use crate::output::{si_value, write_document, write_layout, OutDir};
 use crate::plot::{save, save_map, CellMap, Figure, Series, Style};
 use afmdyn::request::image::{
     image, setpoint_study, study_ratios, Image, ImageRequest, SampleMap, SetpointStudy,
@@ -197,6 +198,10 @@ pub fn image_cmd(a: &ImageArgs) -> Result<(), CliError> {
         study_plots(&out, s)?;
     }
     write_document(&out, "image.json", &json)?;
+    write_layout(
+        &out.join("image.nc"),
+        &afmdyn::layout::image::layout(&img, a.setpoint),
+    )?;
     let img = &img;
     let field = |get: fn(&afmdyn::request::image::OperatingPoint) -> f64| {
         move |j: usize, i: usize| img.point(j, i).map_or(f64::NAN, get)
