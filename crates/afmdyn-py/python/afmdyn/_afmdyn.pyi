@@ -592,7 +592,7 @@ def image(
     lines: Optional[int] = None,
     curve_points: Optional[int] = None,
     height_map: Optional[List[List[float]]] = None,
-) -> str: ...
+) -> Dict[str, Any]: ...
 def setpoint_study(
     probe: str,
     sample: str,
