@@ -600,6 +600,14 @@ fn image_inputs(
     Ok((table, map))
 }
 
+/// The heights of a height map file (`.csv` or `.npy`, a relative path from the current
+/// directory; [`afmdyn::request::height_map_file::read`]), `[row][column]` in m: Python's
+/// `afmdyn.image(…, height_map="h.npy")`.
+#[pyfunction]
+pub fn read_height_map(path: &str) -> PyResult<Vec<Vec<f64>>> {
+    afmdyn::request::height_map_file::read(path, None).map_err(sim_error)
+}
+
 /// The ideal-feedback image of a sample map under a probe (`afmdyn image`:
 /// [`afmdyn::request::image::image`]): `json` (its document) and `layout` (its arrays,
 /// [`afmdyn::layout::image::layout`], as `image.nc` holds them). `probe` is the probe's TOML text

@@ -109,13 +109,22 @@ def test_a_height_map_file_in_the_sample_map_is_the_array_keyword(tmp_path, monk
         xr.testing.assert_identical(
             afmdyn.image(PROBE, str(sample), 0.7, pixels=5, lines=3), want
         )
+    # the keyword takes the file too (a path, absolute or from the current directory)
+    for path in (tmp_path / "h.npy", str(tmp_path / "h.csv")):
+        got = afmdyn.image(PROBE, size, 0.7, pixels=5, lines=3, height_map=path)
+        xr.testing.assert_identical(got, want)
     monkeypatch.chdir(tmp_path)
     text = size + 'height_map = "h.npy"\n'
     xr.testing.assert_identical(afmdyn.image(PROBE, text, 0.7, pixels=5, lines=3), want)
+    xr.testing.assert_identical(
+        afmdyn.image(PROBE, size, 0.7, pixels=5, lines=3, height_map="h.csv"), want
+    )
     # the array keyword replaces the file's map; a bad file is refused naming it
     np.save(tmp_path / "f32.npy", grid.astype(np.float32))
     with pytest.raises(ValueError, match=r'height_map = "f32.npy".*must be float64'):
         afmdyn.image(PROBE, size + 'height_map = "f32.npy"\n', 0.7)
+    with pytest.raises(ValueError, match=r'height_map = "f32.npy".*must be float64'):
+        afmdyn.image(PROBE, size, 0.7, height_map="f32.npy")
 
 
 def test_the_dataset_is_image_nc(cli, tmp_path):

@@ -514,7 +514,24 @@ mod height_map_files {
         );
         let bytes = std::fs::read(dir.join("cut.npy")).unwrap();
         std::fs::write(dir.join("cut.npy"), &bytes[..bytes.len() - 5]).unwrap();
+        // larger than the limits (sparse files: nothing is written, nothing is read)
+        use afmdyn::request::height_map_file::{MAX_CSV_BYTES, MAX_NPY_BYTES};
+        for (name, len) in [("big.csv", MAX_CSV_BYTES), ("big.npy", MAX_NPY_BYTES)] {
+            let f = std::fs::File::create(dir.join(name)).unwrap();
+            f.set_len(len + 1).unwrap();
+        }
+        // an NPY header that says it is a megabyte long
+        let mut huge = b"\x93NUMPY\x02\x00".to_vec();
+        huge.extend(1_000_000u32.to_le_bytes());
+        huge.extend(b"{'descr': '<f8'");
+        std::fs::write(dir.join("header.npy"), huge).unwrap();
         for (file, problem) in [
+            ("big.csv", "larger than 536870912 bytes"),
+            ("big.npy", "the limit of an NPY height map"),
+            (
+                "header.npy",
+                "an NPY header of 1000000 bytes: at most 65536",
+            ),
             ("ragged.csv", "row 2 has 2 values, row 1 has 3"),
             ("word.csv", "row 2, column 3: 'abc' is not a number"),
             (

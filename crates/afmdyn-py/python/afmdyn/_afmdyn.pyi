@@ -593,6 +593,7 @@ def image(
     curve_points: Optional[int] = None,
     height_map: Optional[List[List[float]]] = None,
 ) -> Dict[str, Any]: ...
+def read_height_map(path: str) -> List[List[float]]: ...
 def setpoint_study(
     probe: str,
     sample: str,

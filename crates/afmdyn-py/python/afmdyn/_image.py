@@ -43,7 +43,7 @@ def image(
             a line map). curve_points: points of each material's approach curve (default 120).
         height_map: a 2D array of heights (m), rows from y = 0 to Ly and columns from x = 0 to
             Lx, interpolated bilinearly and added to the map's topography (replaces the map's
-            own ``height_map``).
+            own ``height_map``); or the path of a ``.csv`` or ``.npy`` file holding them.
 
     Returns:
         ``xarray.Dataset`` over ``y`` and ``x`` (m): ``height``, ``true_height``, ``z_c``,
@@ -60,7 +60,10 @@ def image(
     text = _core.probe_source(probe)
     source = os.fspath(sample) if isinstance(sample, os.PathLike) else sample
     rows = None
-    if height_map is not None:
+    if isinstance(height_map, (str, os.PathLike)):
+        # a .csv or .npy file, read and checked by the library as the TOML key's file is
+        rows = _core.read_height_map(os.fspath(height_map))
+    elif height_map is not None:
         grid = np.asarray(height_map, dtype=np.float64)
         if grid.ndim != 2:
             raise ValueError(f"height_map: must be a 2D array of heights (m), got {grid.ndim}D")

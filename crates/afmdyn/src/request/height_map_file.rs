@@ -3,10 +3,11 @@
 //!
 //! - **CSV** (`.csv`): rows of comma-separated heights in m, no header, rows from y = 0 to
 //!   Ly and columns from x = 0 to Lx (the `csv` crate; spaces around a value are ignored, blank
-//!   lines skipped). At most [`MAX_CSV_BYTES`] bytes are read.
+//!   lines skipped). A file larger than [`MAX_CSV_BYTES`] is refused, and no more is read.
 //! - **NPY** (`.npy`, NumPy's `np.save`): a 2-D float64 array (`<f8` or `>f8`, C or Fortran
-//!   order), `[row][column]` as the CSV (the `npyz` crate). The header is at most
-//!   [`MAX_NPY_HEADER_BYTES`] and the shape is checked before the values are read.
+//!   order), `[row][column]` as the CSV (the `npyz` crate). The file is at most
+//!   [`MAX_NPY_BYTES`], its header at most [`MAX_NPY_HEADER_BYTES`], and the dtype and shape
+//!   are checked before the values are read.
 //!
 //! Both: at most [`MAX_PIXELS`] × [`MAX_PIXELS`] values, rows of one length, each finite and
 //! within ±[`MAX_HEIGHT`] (10 µm). Errors are [`SimError::Probe`] naming `height_map`, the
@@ -23,6 +24,10 @@ pub const MAX_CSV_BYTES: u64 = (MAX_PIXELS * MAX_PIXELS * 32) as u64;
 
 /// Largest NPY header read, in bytes (NumPy's own `np.load` allows 10 000).
 pub const MAX_NPY_HEADER_BYTES: usize = 65_536;
+
+/// Largest NPY height map file read, in bytes: 4096 × 4096 float64 values and the largest
+/// header.
+pub const MAX_NPY_BYTES: u64 = (MAX_PIXELS * MAX_PIXELS * 8 + MAX_NPY_HEADER_BYTES + 12) as u64;
 
 /// The heights of the file `file` (the value of `height_map`), a relative path taken from
 /// `base` (the sample file's directory; `None`: the current directory), `[row][column]`.
@@ -45,9 +50,21 @@ pub fn read(file: &str, base: Option<&Path>) -> Result<Vec<Vec<f64>>, SimError> 
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase);
     let open = || std::fs::File::open(&path).map_err(|e| err(crate::error::io_message(&e)));
+    // a regular file larger than the format's limit is refused before any of it is read
+    let sized = |limit: u64, what: &str| -> Result<std::fs::File, SimError> {
+        let file = open()?;
+        match file.metadata() {
+            Ok(m) if m.is_file() && m.len() > limit => Err(err(format!(
+                "{} bytes: larger than {limit} bytes, the limit of {what} height map (4096 × \
+                 4096 heights)",
+                m.len()
+            ))),
+            _ => Ok(file),
+        }
+    };
     let rows = match ext.as_deref() {
-        Some("csv") => csv_rows(open()?).map_err(err)?,
-        Some("npy") => npy_rows(open()?).map_err(err)?,
+        Some("csv") => csv_rows(sized(MAX_CSV_BYTES, "a CSV")?).map_err(err)?,
+        Some("npy") => npy_rows(sized(MAX_NPY_BYTES, "an NPY")?).map_err(err)?,
         _ => {
             return Err(err(
                 "must be a .csv file (rows of heights in m) or a .npy file (a 2-D float64 \
@@ -170,8 +187,7 @@ fn npy_rows(file: std::fs::File) -> Result<Vec<Vec<f64>>, String> {
             "an NPY header of {header_len} bytes: at most {MAX_NPY_HEADER_BYTES}"
         ));
     }
-    let data_limit = (MAX_PIXELS * MAX_PIXELS * 8 + MAX_NPY_HEADER_BYTES) as u64;
-    let reader = std::io::Cursor::new(pre[..got].to_vec()).chain(file.take(data_limit));
+    let reader = std::io::Cursor::new(pre[..got].to_vec()).chain(file.take(MAX_NPY_BYTES));
     let npy = npyz::NpyFile::new(std::io::BufReader::new(reader)).map_err(io)?;
     let shape = npy.shape().to_vec();
     let [rows, cols] = shape[..] else {
