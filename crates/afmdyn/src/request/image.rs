@@ -128,7 +128,7 @@ fn pair(v: &toml::Value, name: &str) -> Result<(f64, f64), SimError> {
 /// finite height within ±10 µm.
 fn height_map(v: &toml::Value) -> Result<Vec<Vec<f64>>, SimError> {
     let what = "must be an array of rows [[h, …], …] of heights in m (rows from y = 0, each as \
-                long, at most 4096 × 4096)";
+                long, at most 4096 × 4096) or the path of a .csv or .npy file of them";
     let rows = v
         .as_array()
         .filter(|r| !r.is_empty() && r.len() <= MAX_PIXELS)
