@@ -2,12 +2,13 @@
 //! or scanned in the time domain under a lock-in and a PI z controller (`--feedback pi`).
 //! The sample map, the operating points and the scan are the library's
 //! ([`afmdyn::request::image`], [`afmdyn::request::image_scan`]); this front end reads the two
-//! files, maps the flags, and writes `image.json`, the maps (height, phase, E_dis; the error
-//! image of a PI scan) and the line profile.
+//! files, maps the flags, and writes `image.json`, `image.nc` of an ideal image (the library's
+//! layout, [`afmdyn::layout::image`]), the maps (height, phase, E_dis; the error image of a PI
+//! scan) and the line profile.
 
 use crate::args::read_text;
 use crate::error::CliError;
-use crate::output::{si_value, write_document, OutDir};
+use crate::output::{si_value, write_document, write_layout, OutDir};
 use crate::plot::{save, save_map, CellMap, Figure, Series, Style};
 use afmdyn::request::image::{
     image, setpoint_study, study_ratios, Image, ImageRequest, SampleMap, SetpointStudy,
@@ -260,6 +261,10 @@ pub fn image_cmd(a: &ImageArgs) -> Result<(), CliError> {
         study_plots(&out, s)?;
     }
     write_document(&out, "image.json", &json)?;
+    write_layout(
+        &out.join("image.nc"),
+        &afmdyn::layout::image::layout(&img, a.setpoint),
+    )?;
     let img = &img;
     let field = |get: fn(&afmdyn::request::image::OperatingPoint) -> f64| {
         move |j: usize, i: usize| img.point(j, i).map_or(f64::NAN, get)

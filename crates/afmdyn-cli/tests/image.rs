@@ -1,8 +1,8 @@
 //! `afmdyn image` end to end: the 2D blend example (`examples/sample-blend.toml` over
 //! `examples/probe-point-mass-dmt.toml`) writes its document and maps, with the terrace 5 nm
 //! up at its true height and the rubber domain at its own operating point; bad input exits 2
-//! with one line naming the field; `--feedback pi` writes the library's scan document and its
-//! maps.
+//! with one line naming the field; `--out` writes `image.nc`; `--feedback pi` writes the library's
+//! scan document and its maps.
 
 use std::process::{Command, Output};
 
@@ -57,6 +57,7 @@ fn the_blend_example_images_at_a_setpoint() {
     }
     for f in [
         "image.json",
+        "image.nc",
         "image-height.png",
         "image-phase.png",
         "image-dissipation.png",
@@ -133,6 +134,179 @@ fn bad_input_exits_2_naming_the_field() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(err.contains("domain 'd' x"), "{err}");
+}
+
+/// A `[line][pixel]` grid of the JSON document as row-major values, null as NaN.
+fn flat(grid: &serde_json::Value) -> Vec<f64> {
+    grid.as_array()
+        .unwrap()
+        .iter()
+        .flat_map(|row| row.as_array().unwrap().iter())
+        .map(|v| v.as_f64().unwrap_or(f64::NAN))
+        .collect()
+}
+
+/// Equal as values, NaN equal to NaN (a pixel where the setpoint is not reached).
+fn same(a: &[f64], b: &[f64]) -> bool {
+    a.len() == b.len()
+        && a.iter()
+            .zip(b)
+            .all(|(x, y)| x == y || (x.is_nan() && y.is_nan()))
+}
+
+/// `image.nc` holds the document's maps: every numeric field of `image.json` over (y, x) with
+/// its units, and the regime, material and domain as codes whose CF flag meanings are the
+/// document's words.
+#[test]
+fn image_nc_holds_the_documents_maps() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = afmdyn(&[
+        "image",
+        "--probe",
+        "examples/probe-point-mass-dmt.toml",
+        "--sample",
+        "examples/sample-blend.toml",
+        "--setpoint",
+        "0.7",
+        "--pixels",
+        "12",
+        "--lines",
+        "9",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let doc: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("image.json")).unwrap()).unwrap();
+    let img = &doc["image"];
+    let path = dir.path().join("image.nc");
+    // the header (dimensions, attributes) from one reader, the values from another
+    let (ds, _) = netcdf3::FileReader::open(&path).unwrap().close();
+    let mut nc = netcdf3::FileReader::open(&path).unwrap();
+    assert_eq!(ds.dim_size("y"), Some(9));
+    assert_eq!(ds.dim_size("x"), Some(12));
+    let xs: Vec<f64> = serde_json::from_value(img["x"].clone()).unwrap();
+    assert_eq!(nc.read_var_f64("x").unwrap(), xs);
+    let ys: Vec<f64> = serde_json::from_value(img["y"].clone()).unwrap();
+    assert_eq!(nc.read_var_f64("y").unwrap(), ys);
+    for (name, units) in [
+        ("height", "m"),
+        ("true_height", "m"),
+        ("z_c", "m"),
+        ("amplitude", "m"),
+        ("phase_deg", "degree"),
+        ("energy_dissipated", "J"),
+        ("virial", "J"),
+        ("peak_force", "N"),
+        ("indentation", "m"),
+    ] {
+        let var = ds.get_var(name).unwrap();
+        assert_eq!(var.dim_names(), vec!["y", "x"], "{name}");
+        assert_eq!(var.get_attr_as_string("units").as_deref(), Some(units));
+        let values = nc.read_var_f64(name).unwrap();
+        assert!(same(&values, &flat(&img[name])), "{name}");
+    }
+    // the apparent height: 0 on the background, the terrace's 5 nm, the rubber's z_c shift
+    let height = nc.read_var_f64("height").unwrap();
+    assert!(height.contains(&0.0) && height.iter().any(|h| (h - 5e-9).abs() < 1e-18));
+    // codes, their meanings the document's words
+    let meanings = |name: &str| -> Vec<String> {
+        let v = ds.get_var(name).unwrap();
+        let words = v.get_attr_as_string("flag_meanings").unwrap();
+        let codes = v.get_attr_i32("flag_values").unwrap().to_vec();
+        assert_eq!(codes, (0..codes.len() as i32).collect::<Vec<_>>(), "{name}");
+        words.split(' ').map(str::to_string).collect()
+    };
+    let words = |name: &str| -> Vec<String> {
+        img[name]
+            .as_array()
+            .unwrap()
+            .iter()
+            .flat_map(|r| r.as_array().unwrap().iter())
+            .map(|v| v.as_str().unwrap_or("not_reached").to_string())
+            .collect()
+    };
+    for name in ["regime", "material", "domain"] {
+        let names = meanings(name);
+        let coded: Vec<String> = nc
+            .read_var_i32(name)
+            .unwrap()
+            .iter()
+            .map(|&c| names[c as usize].clone())
+            .collect();
+        assert_eq!(coded, words(name), "{name}");
+    }
+    assert_eq!(meanings("material"), ["background", "rubber"]);
+    assert_eq!(meanings("domain"), ["background", "rubber", "terrace"]);
+    assert_eq!(nc.read_var_f64("setpoint").unwrap(), vec![0.7]);
+    assert_eq!(
+        nc.read_var_f64("reference_z_c").unwrap(),
+        vec![doc["reference_z_c"].as_f64().unwrap()]
+    );
+}
+
+/// A sample map's `height_map = "h.csv"` is read from the sample file's directory (the command
+/// runs elsewhere); over one material the image records it exactly: with two columns the true
+/// height is the straight line between them, h(x) = h₀ + (h₁ − h₀) x / Lx, on every line.
+#[test]
+fn a_height_map_csv_beside_the_sample_file_is_imaged() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("h.csv"), "0, 4e-9\n0, 4e-9\n").unwrap();
+    let sample = dir.path().join("s.toml");
+    std::fs::write(&sample, "size = [1e-6, 1e-6]\nheight_map = \"h.csv\"\n").unwrap();
+    let out_dir = dir.path().join("out");
+    let out = afmdyn(&[
+        "image",
+        "--probe",
+        "examples/probe-point-mass-dmt.toml",
+        "--sample",
+        sample.to_str().unwrap(),
+        "--setpoint",
+        "0.7",
+        "--pixels",
+        "8",
+        "--lines",
+        "2",
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let mut nc = netcdf3::FileReader::open(out_dir.join("image.nc")).unwrap();
+    let x = nc.read_var_f64("x").unwrap();
+    let truth = nc.read_var_f64("true_height").unwrap();
+    let height = nc.read_var_f64("height").unwrap();
+    for (k, (&t, &h)) in truth.iter().zip(&height).enumerate() {
+        let want = 4e-9 * x[k % 8] / 1e-6;
+        assert!((t - want).abs() < 1e-20, "pixel {k}: {t} against {want}");
+        assert!((h - t).abs() < 1e-20, "pixel {k}: apparent {h}, true {t}");
+    }
+    // a missing file is refused naming height_map and the file, exit 2
+    std::fs::write(&sample, "size = [1e-6, 1e-6]\nheight_map = \"gone.npy\"\n").unwrap();
+    let out = afmdyn(&[
+        "image",
+        "--probe",
+        "examples/probe-point-mass-dmt.toml",
+        "--sample",
+        sample.to_str().unwrap(),
+        "--setpoint",
+        "0.7",
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("height_map = \"gone.npy\"") && err.contains("gone.npy)"),
+        "{err}"
+    );
 }
 
 /// `--feedback pi --json` prints the library's document of the same scan (lines on 2 threads

@@ -600,16 +600,25 @@ pub(crate) fn image_inputs(
     Ok((table, map))
 }
 
+/// The heights of a height map file (`.csv` or `.npy`, a relative path from the current
+/// directory; [`afmdyn::request::height_map_file::read`]), `[row][column]` in m: Python's
+/// `afmdyn.image(…, height_map="h.npy")`.
+#[pyfunction]
+pub fn read_height_map(path: &str) -> PyResult<Vec<Vec<f64>>> {
+    afmdyn::request::height_map_file::read(path, None).map_err(sim_error)
+}
+
 /// The ideal-feedback image of a sample map under a probe (`afmdyn image`:
-/// [`afmdyn::request::image::image`]): its JSON document. `probe` is the probe's TOML text
+/// [`afmdyn::request::image::image`]): `json` (its document) and `layout` (its arrays,
+/// [`afmdyn::layout::image::layout`], as `image.nc` holds them). `probe` is the probe's TOML text
 /// ([`crate::params::probe_source`]), `sample` the map's TOML text or path
 /// ([`afmdyn::request::image::SampleMap::read`]); `None` takes the request's defaults
 /// ([`afmdyn::request::image::ImageRequest::at`]).
 #[pyfunction]
 #[pyo3(signature = (probe, sample, setpoint, pixels=None, lines=None, curve_points=None, height_map=None))]
 #[allow(clippy::too_many_arguments)]
-pub fn image(
-    py: Python<'_>,
+pub fn image<'py>(
+    py: Python<'py>,
     probe: &str,
     sample: &str,
     setpoint: f64,
@@ -617,7 +626,7 @@ pub fn image(
     lines: Option<usize>,
     curve_points: Option<usize>,
     height_map: Option<Vec<Vec<f64>>>,
-) -> PyResult<String> {
+) -> PyResult<Dict<'py>> {
     use afmdyn::request::image::{image, ImageRequest};
     let (table, map) = image_inputs(probe, sample, height_map)?;
     let d = ImageRequest::at(setpoint);
@@ -628,7 +637,11 @@ pub fn image(
         ..d
     };
     let img = py.detach(|| image(&table, &map, &req)).map_err(sim_error)?;
-    Ok(img.document(setpoint).to_string())
+    let out = Out::new(py);
+    out.json(&img.document(setpoint))?;
+    let layout = afmdyn::layout::image::layout(&img, setpoint);
+    out.set("layout", crate::convert::layout_dict(py, layout)?)?;
+    Ok(out.finish())
 }
 
 /// The PI-scanned image of a sample map under a probe (`afmdyn image --feedback pi`:

@@ -69,6 +69,7 @@ fn _afmdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(analyses::reconstruct_am, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::image, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::pi_image, m)?)?;
+    m.add_function(wrap_pyfunction!(analyses::read_height_map, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::setpoint_study, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::probe, m)?)?;
     m.add_function(wrap_pyfunction!(params::probe_source, m)?)?;

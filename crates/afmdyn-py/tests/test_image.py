@@ -5,6 +5,7 @@ import json
 
 import numpy as np
 import pytest
+import xarray as xr
 
 import afmdyn
 
@@ -82,6 +83,72 @@ def test_a_height_map_from_numpy_is_the_recorded_topography():
         afmdyn.image(PROBE, "size = [1e-6, 1e-6]", 0.7, height_map=np.ones(3))
     with pytest.raises(ValueError, match="height_map"):
         afmdyn.image(PROBE, "size = [1e-6, 1e-6]", 0.7, height_map=[[0.0, np.nan]])
+
+
+def test_a_height_map_file_in_the_sample_map_is_the_array_keyword(tmp_path, monkeypatch):
+    """``height_map = "h.npy"`` (``np.save``) or ``"h.csv"`` in the sample TOML gives the
+    Dataset of the same array passed as ``height_map=``: relative to the sample file's
+    directory for a path, to the current directory for TOML text."""
+    grid = np.array([[0.0, 1.25e-9, 2.5e-9], [3e-9, -1e-9, 7.123456789e-10]])
+    np.save(tmp_path / "h.npy", grid)
+    np.savetxt(tmp_path / "h.csv", grid, delimiter=",", fmt="%.17g")
+    size = "size = [1e-6, 1e-6]\n"
+    want = afmdyn.image(PROBE, size, 0.7, pixels=5, lines=3, height_map=grid)
+    # the true height is the array's bilinear interpolation (SciPy's, nodes at x = 0, Lx/2, Lx
+    # and y = 0, Ly) at the pixel centres
+    from scipy.interpolate import RegularGridInterpolator
+
+    bilinear = RegularGridInterpolator(([0.0, 1e-6], [0.0, 0.5e-6, 1e-6]), grid)
+    yy, xx = np.meshgrid(want.y.values, want.x.values, indexing="ij")
+    expected = bilinear(np.stack([yy.ravel(), xx.ravel()], axis=-1)).reshape(3, 5)
+    np.testing.assert_allclose(want.true_height.values, expected, rtol=0, atol=1e-24)
+    for name in ("h.npy", "h.csv"):
+        sample = tmp_path / f"s-{name}.toml"
+        sample.write_text(size + f'height_map = "{name}"\n')
+        xr.testing.assert_identical(afmdyn.image(PROBE, sample, 0.7, pixels=5, lines=3), want)
+        xr.testing.assert_identical(
+            afmdyn.image(PROBE, str(sample), 0.7, pixels=5, lines=3), want
+        )
+    # the keyword takes the file too (a path, absolute or from the current directory)
+    for path in (tmp_path / "h.npy", str(tmp_path / "h.csv")):
+        got = afmdyn.image(PROBE, size, 0.7, pixels=5, lines=3, height_map=path)
+        xr.testing.assert_identical(got, want)
+    monkeypatch.chdir(tmp_path)
+    text = size + 'height_map = "h.npy"\n'
+    xr.testing.assert_identical(afmdyn.image(PROBE, text, 0.7, pixels=5, lines=3), want)
+    xr.testing.assert_identical(
+        afmdyn.image(PROBE, size, 0.7, pixels=5, lines=3, height_map="h.csv"), want
+    )
+    # the array keyword replaces the file's map; a bad file is refused naming it
+    np.save(tmp_path / "f32.npy", grid.astype(np.float32))
+    with pytest.raises(ValueError, match=r'height_map = "f32.npy".*must be float64'):
+        afmdyn.image(PROBE, size + 'height_map = "f32.npy"\n', 0.7)
+    with pytest.raises(ValueError, match=r'height_map = "f32.npy".*must be float64'):
+        afmdyn.image(PROBE, size, 0.7, height_map="f32.npy")
+
+
+def test_the_dataset_is_image_nc(cli, tmp_path):
+    """The Dataset's numeric maps are the command line's ``image.nc`` variables: values,
+    units and long names (both from the library's one layout)."""
+    with pytest.warns(afmdyn.AfmdynWarning):
+        ds = afmdyn.image(PROBE, STRIPE, 0.7, pixels=24)
+    run = cli(
+        "image", "--probe", PROBE, "--sample", STRIPE, "--setpoint", "0.7", "--pixels", "24",
+        "--out", tmp_path,
+    )
+    assert run.returncode == 0, run.stderr
+    nc = xr.open_dataset(tmp_path / "image.nc").load()
+    numeric = [k for k in ds.data_vars if ds[k].dtype.kind == "f"]
+    assert len(numeric) == 9 and "height" in numeric and "indentation" in numeric
+    for k in numeric + ["x", "y"]:
+        np.testing.assert_array_equal(ds[k].values, nc[k].values, err_msg=k)
+        assert ds[k].attrs == nc[k].attrs, k
+    # the codes of the file are the Dataset's words
+    regimes = nc.regime.attrs["flag_meanings"].split()
+    words = np.array([regimes[c] for c in nc.regime.values.ravel()]).reshape(nc.regime.shape)
+    named = np.where(ds.regime.values == "", "not_reached", ds.regime.values)
+    np.testing.assert_array_equal(named, words)
+    assert float(nc.reference_z_c) == ds.attrs["reference_z_c"]
 
 
 def _lever_q100(tmp_path):

@@ -48,8 +48,9 @@
 //!   one after another; every seed comes from the run's index, so the results are the same.
 //! * `files` — the library's I/O: reading probe files (`Probe::load(path)`; [`probe::Probe::parse`]
 //!   takes the TOML text and is always there), the studies' stores in locked directories
-//!   (`request::checkpoint_file`, `study::chart_store`, `request::dir_lock`) and the result
-//!   files: NetCDF (`layout::netcdf`), streamed CSV and NPY (`layout::files`).
+//!   (`request::checkpoint_file`, `study::chart_store`, `request::dir_lock`), the sample maps'
+//!   height map files (`request::height_map_file`: CSV and NPY) and the result files: NetCDF
+//!   (`layout::netcdf`), streamed CSV and NPY (`layout::files`).
 //! * `schema` — JSON Schemas of the requests (`schemars::JsonSchema` on [`request`]'s types;
 //!   `docs/schema/` holds them).
 //!

@@ -357,3 +357,235 @@ fn smooth_steps_and_height_maps_are_recorded_as_they_are() {
         assert!(e.contains(key), "{e}");
     }
 }
+
+/// Height maps read from files (feature `files`): a CSV and an NPY file hold the same heights
+/// as the rows given inline, and their refusals name `height_map` and the file.
+#[cfg(feature = "files")]
+mod height_map_files {
+    use afmdyn::request::image::SampleMap;
+    use std::path::{Path, PathBuf};
+
+    /// Rows of heights (m) that are not round numbers: the files must give them bit for bit.
+    fn rows() -> Vec<Vec<f64>> {
+        vec![
+            vec![0.0, 1.234_567_890_123_456_7e-9, -2.5e-9, 3e-10],
+            vec![4.1e-9, 5.000_000_000_000_001e-9, 6.02e-9, -7.7e-9],
+            vec![9.999e-6, -1e-5, 1e-12, 2.718_281_828_459_045e-9],
+        ]
+    }
+
+    /// A fresh directory under the system's temporary one.
+    fn temp_dir(name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("afmdyn-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    /// `rows` as CSV: each height in Rust's shortest round-trip form.
+    fn write_csv(path: &Path, rows: &[Vec<f64>]) {
+        let text: String = rows
+            .iter()
+            .map(|r| {
+                let cells: Vec<String> = r.iter().map(|h| format!("{h:e}")).collect();
+                cells.join(", ") + "\n"
+            })
+            .collect();
+        std::fs::write(path, text).unwrap();
+    }
+
+    /// `values` (row-major over `shape`, or column-major with `fortran`) as an NPY file of the
+    /// default dtype of `T`.
+    fn write_npy<T: npyz::AutoSerialize + Copy>(
+        path: &Path,
+        shape: &[u64],
+        values: &[T],
+        fortran: bool,
+    ) {
+        use npyz::WriterBuilder;
+        let order = if fortran {
+            npyz::Order::Fortran
+        } else {
+            npyz::Order::C
+        };
+        let file = std::io::BufWriter::new(std::fs::File::create(path).unwrap());
+        let mut w = npyz::WriteOptions::<T>::new()
+            .default_dtype()
+            .order(order)
+            .shape(shape)
+            .writer(file)
+            .begin_nd()
+            .unwrap();
+        w.extend(values.iter().copied()).unwrap();
+        w.finish().unwrap();
+    }
+
+    fn map_text(height_map: &str) -> String {
+        format!(
+            "size = [1e-6, 2e-6]\nheight_map = {height_map}\n[[domain]]\nname = \"t\"\n\
+             x = [0.5e-6, 1e-6]\nheight = 2e-9\nwidth = 0.1e-6\n"
+        )
+    }
+
+    /// The inline map's heights at a grid of points, nodes and between them, against `map`'s:
+    /// exactly equal.
+    fn same_heights(map: &SampleMap, inline: &SampleMap) {
+        assert_eq!(map.height_map, inline.height_map);
+        for j in 0..=12 {
+            for i in 0..=15 {
+                let (x, y) = (i as f64 * 1e-6 / 15.0, j as f64 * 2e-6 / 12.0);
+                assert_eq!(map.height_at(x, y), inline.height_at(x, y), "({x}, {y})");
+            }
+        }
+    }
+
+    #[test]
+    fn csv_and_npy_files_give_the_inline_heights() {
+        let dir = temp_dir("hmap-ok");
+        let rows = rows();
+        let inline = SampleMap::parse(
+            &map_text(&serde_json::to_string(&rows).unwrap()),
+            "<inline>",
+        )
+        .unwrap();
+        assert_eq!(inline.height_map, rows);
+        write_csv(&dir.join("h.csv"), &rows);
+        let flat: Vec<f64> = rows.concat();
+        write_npy(&dir.join("h.npy"), &[3, 4], &flat, false);
+        // the same array in Fortran order (np.save of a transposed view)
+        let column_major: Vec<f64> = (0..4)
+            .flat_map(|i| rows.iter().map(move |r| r[i]))
+            .collect();
+        write_npy(&dir.join("hf.npy"), &[3, 4], &column_major, true);
+        // relative to the sample file's directory when loaded from a file
+        for file in ["h.csv", "h.npy", "hf.npy"] {
+            let sample = dir.join(format!("s-{file}.toml"));
+            std::fs::write(&sample, map_text(&format!("\"{file}\""))).unwrap();
+            let map = SampleMap::load(&sample).unwrap();
+            same_heights(&map, &inline);
+            assert_eq!(map.domains, inline.domains);
+            // and from text, relative to the current directory (here an absolute path)
+            let abs = dir.join(file).display().to_string();
+            let map = SampleMap::parse(&map_text(&format!("{abs:?}")), "<text>").unwrap();
+            same_heights(&map, &inline);
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn bad_height_map_files_are_refused_naming_the_file_and_the_problem() {
+        let dir = temp_dir("hmap-bad");
+        let w = |name: &str, text: &str| std::fs::write(dir.join(name), text).unwrap();
+        w("ragged.csv", "0, 1e-9, 2e-9\n0, 1e-9\n");
+        w("word.csv", "0, 1e-9, 2e-9\n0, 1e-9, abc\n");
+        w("high.csv", "0, 1e-9\n0, 2e-5\n");
+        w("nan.csv", "0, NaN\n");
+        w("empty.csv", "");
+        w("h.txt", "0, 1e-9\n");
+        w("junk.npy", "not an npy file at all");
+        write_npy(
+            &dir.join("f32.npy"),
+            &[2, 2],
+            &[0f32, 1e-9, 2e-9, 3e-9],
+            false,
+        );
+        write_npy(&dir.join("i64.npy"), &[2, 2], &[0i64, 1, 2, 3], false);
+        write_npy(&dir.join("1d.npy"), &[4], &[0.0, 1e-9, 2e-9, 3e-9], false);
+        write_npy(
+            &dir.join("3d.npy"),
+            &[1, 2, 2],
+            &[0.0, 1e-9, 2e-9, 3e-9],
+            false,
+        );
+        write_npy(
+            &dir.join("high.npy"),
+            &[2, 2],
+            &[0.0, 1e-9, 1e-4, 3e-9],
+            false,
+        );
+        write_npy(&dir.join("inf.npy"), &[1, 2], &[0.0, f64::INFINITY], false);
+        write_npy(&dir.join("wide.npy"), &[1, 4097], &vec![0.0; 4097], false);
+        // a truncated file: its header promises more values than it holds
+        write_npy(
+            &dir.join("cut.npy"),
+            &[2, 2],
+            &[0.0, 1e-9, 2e-9, 3e-9],
+            false,
+        );
+        let bytes = std::fs::read(dir.join("cut.npy")).unwrap();
+        std::fs::write(dir.join("cut.npy"), &bytes[..bytes.len() - 5]).unwrap();
+        // larger than the limits (sparse files: nothing is written, nothing is read)
+        use afmdyn::request::height_map_file::{MAX_CSV_BYTES, MAX_NPY_BYTES};
+        for (name, len) in [("big.csv", MAX_CSV_BYTES), ("big.npy", MAX_NPY_BYTES)] {
+            let f = std::fs::File::create(dir.join(name)).unwrap();
+            f.set_len(len + 1).unwrap();
+        }
+        // an NPY header that says it is a megabyte long
+        let mut huge = b"\x93NUMPY\x02\x00".to_vec();
+        huge.extend(1_000_000u32.to_le_bytes());
+        huge.extend(b"{'descr': '<f8'");
+        std::fs::write(dir.join("header.npy"), huge).unwrap();
+        for (file, problem) in [
+            ("big.csv", "larger than 536870912 bytes"),
+            ("big.npy", "the limit of an NPY height map"),
+            (
+                "header.npy",
+                "an NPY header of 1000000 bytes: at most 65536",
+            ),
+            ("ragged.csv", "row 2 has 2 values, row 1 has 3"),
+            ("word.csv", "row 2, column 3: 'abc' is not a number"),
+            (
+                "high.csv",
+                "row 2, column 2: 2e-5 m: heights must be within ±10 µm",
+            ),
+            ("nan.csv", "row 1, column 2: NaN is not a finite height"),
+            ("empty.csv", "holds no heights"),
+            ("h.txt", "must be a .csv file"),
+            ("missing.csv", "No such file"),
+            ("missing.npy", "No such file"),
+            ("junk.npy", "not an NPY file"),
+            ("f32.npy", "dtype '<f4': must be float64"),
+            ("i64.npy", "dtype '<i8': must be float64"),
+            ("1d.npy", "a 1-D array of shape [4]: must be 2-D"),
+            ("3d.npy", "a 3-D array"),
+            (
+                "high.npy",
+                "row 2, column 1: 1e-4 m: heights must be within ±10 µm",
+            ),
+            ("inf.npy", "row 1, column 2: inf is not a finite height"),
+            ("wide.npy", "shape (1, 4097): at most 4096 × 4096"),
+            ("cut.npy", "cannot be read (a truncated file?)"),
+        ] {
+            let sample = dir.join("s.toml");
+            std::fs::write(&sample, map_text(&format!("\"{file}\""))).unwrap();
+            let e = SampleMap::load(&sample).unwrap_err();
+            let msg = e.to_string();
+            assert!(
+                matches!(e, afmdyn::SimError::Probe(_)),
+                "{file}: not a sample map error: {e:?}"
+            );
+            assert!(
+                msg.contains(&format!("height_map = \"{file}\""))
+                    && msg.contains(&dir.join(file).display().to_string())
+                    && msg.contains(&sample.display().to_string()),
+                "{file}: {msg}"
+            );
+            assert!(msg.contains(problem), "{file}: {msg}");
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
+
+/// Without the `files` feature (the WebAssembly build) a height map file is refused, naming
+/// `height_map` and the feature.
+#[cfg(not(feature = "files"))]
+#[test]
+fn without_files_a_height_map_file_is_refused() {
+    let e = SampleMap::parse("size = [1e-6, 0]\nheight_map = \"h.csv\"", "<test>").unwrap_err();
+    let msg = e.to_string();
+    assert!(matches!(e, afmdyn::SimError::Probe(_)), "{e:?}");
+    assert!(
+        msg.contains("height_map = \"h.csv\"") && msg.contains("`files` feature"),
+        "{msg}"
+    );
+}

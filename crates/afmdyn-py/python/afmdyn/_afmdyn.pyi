@@ -592,7 +592,8 @@ def image(
     lines: Optional[int] = None,
     curve_points: Optional[int] = None,
     height_map: Optional[List[List[float]]] = None,
-) -> str: ...
+) -> Dict[str, Any]: ...
+def read_height_map(path: str) -> List[List[float]]: ...
 def pi_image(
     probe: str,
     sample: str,

@@ -11,21 +11,9 @@ import numpy as np
 import xarray as xr
 
 from . import _afmdyn as _core
+from . import _layout
 from ._common import _typed, _warn
 from ._progress import ProgressArg, reporter
-
-#: The numeric maps of an image, their units and meanings (the document's ``image`` block).
-_FIELDS = {
-    "height": ("m", "apparent height h + z_c − z_c,ref (ideal feedback)"),
-    "true_height": ("m", "true height of the sample map"),
-    "z_c": ("m", "rest distance z_c the feedback holds"),
-    "amplitude": ("m", "amplitude (the setpoint where reached)"),
-    "phase_deg": ("degree", "phase lag behind the drive"),
-    "energy_dissipated": ("J", "energy dissipated per drive period"),
-    "virial": ("J", "virial of the tip–sample force"),
-    "peak_force": ("N", "largest tip–sample force"),
-    "indentation": ("m", "largest indentation"),
-}
 
 #: The recorded maps of a PI scan (``feedback="pi"``), trace and ``_retrace``.
 _SCAN_FIELDS = {
@@ -45,7 +33,10 @@ def _inputs(probe: Any, sample: Any, height_map: Any) -> Tuple[str, str, Any]:
     text = _core.probe_source(probe)
     source = os.fspath(sample) if isinstance(sample, os.PathLike) else sample
     rows = None
-    if height_map is not None:
+    if isinstance(height_map, (str, os.PathLike)):
+        # a .csv or .npy file, read and checked by the library as the TOML key's file is
+        rows = _core.read_height_map(os.fspath(height_map))
+    elif height_map is not None:
         grid = np.asarray(height_map, dtype=np.float64)
         if grid.ndim != 2:
             raise ValueError(f"height_map: must be a 2D array of heights (m), got {grid.ndim}D")
@@ -83,19 +74,22 @@ def image(
         probe: the probe (path, TOML text or dict, as ``afmdyn.probe``): the lever, tip,
             drive and the background sample.
         sample: the sample map (path or TOML text): ``size = [Lx, Ly]`` (m) and ``[[domain]]``
-            entries with ``name``, ``x``, ``y``, ``height`` (m) and ``[domain.sample]``.
+            entries with ``name``, ``x``, ``y``, ``height`` (m) and ``[domain.sample]``; its
+            ``height_map`` the rows inline or a ``.csv`` / ``.npy`` file (a relative path from
+            the sample file's directory, or from the current one for TOML text).
         setpoint: A_sp/A0 in (0, 1).
         pixels: pixels per line (default 64). lines: lines (default: as many as pixels, 1 for
             a line map). curve_points: points of each material's approach curve (default 120).
         height_map: a 2D array of heights (m), rows from y = 0 to Ly and columns from x = 0 to
             Lx, interpolated bilinearly and added to the map's topography (replaces the map's
-            own ``height_map``).
+            own ``height_map``); or the path of a ``.csv`` or ``.npy`` file holding them.
 
     Returns:
         ``xarray.Dataset`` over ``y`` and ``x`` (m): ``height``, ``true_height``, ``z_c``,
         ``amplitude``, ``phase_deg``, ``energy_dissipated``, ``virial``, ``peak_force``,
-        ``indentation`` (NaN where the setpoint is not reached), ``regime``, ``material`` and
-        ``domain`` (strings); attributes ``setpoint``, ``reference_z_c`` (m) and ``summary``
+        ``indentation`` (NaN where the setpoint is not reached; units and long names as the
+        library lays them out, the variables of ``afmdyn image``'s ``image.nc``), ``regime``,
+        ``material`` and ``domain`` (strings); attributes ``setpoint``, ``reference_z_c`` (m) and ``summary``
         (the command line's JSON document, with each material's operating points).
 
         With ``feedback="pi"``: the recorded trace ``height``, ``amplitude``, ``phase_deg``,
@@ -133,25 +127,24 @@ def image(
             )
         _warn(doc)
         return _scan_dataset(doc, setpoint)
-    doc = json.loads(_core.image(text, source, setpoint, pixels, lines, curve_points, rows))
+    out = _core.image(text, source, setpoint, pixels, lines, curve_points, rows)
+    doc = json.loads(out["json"])
     _warn(doc)
     img = doc["image"]
     dims = ("y", "x")
+    # the numeric maps and the coordinates as the library lays them out (image.nc's variables,
+    # units and long names); the codes of regime, material and domain as the document's words
+    layout = _layout.variables(out["layout"])
     data: Dict[str, Any] = {}
-    for name, (unit, meaning) in _FIELDS.items():
-        values = np.array(
-            [[np.nan if v is None else v for v in row] for row in img[name]], dtype=np.float64
-        )
-        data[name] = (dims, values, {"units": unit, "long_name": meaning})
+    for name, (vdims, values, attrs) in layout.items():
+        if vdims == dims and values.dtype.kind == "f":
+            data[name] = (vdims, values, attrs)
     for name in ("regime", "material", "domain"):
         values = np.array([["" if v is None else v for v in row] for row in img[name]])
-        data[name] = (dims, values)
+        data[name] = (dims, values, {"long_name": layout[name][2]["long_name"]})
     return xr.Dataset(
         data,
-        coords={
-            "x": ("x", np.asarray(img["x"], dtype=np.float64), {"units": "m"}),
-            "y": ("y", np.asarray(img["y"], dtype=np.float64), {"units": "m"}),
-        },
+        coords={name: layout[name] for name in ("x", "y")},
         attrs={
             "setpoint": setpoint,
             "reference_z_c": doc["reference_z_c"],

@@ -11,7 +11,9 @@
 //! `[sample]` is the background (height 0). Where domains overlap, the later one lies on top. A
 //! top-level `height_map = [[…], …]` (m; rows from y = 0 to Ly, columns from x = 0 to Lx, each
 //! row as long) adds a topography sampled bilinearly at each pixel (a measured or generated
-//! height map, e.g. from a NumPy array).
+//! height map, e.g. from a NumPy array); `height_map = "h.csv"` or `"h.npy"` reads it from a
+//! file (feature `files`: [`super::height_map_file`]), a relative path taken from the sample
+//! file's directory ([`SampleMap::load`]) or else the current directory ([`SampleMap::parse`]).
 //!
 //! **Ideal feedback.** A feedback loop infinitely faster than the scan holds the amplitude at
 //! the setpoint A_sp = r A₀ at every pixel, so a pixel's operating point is a point of its
@@ -46,6 +48,10 @@ pub const MAX_PIXELS: usize = 4096;
 
 /// Largest number of domains of a sample map.
 pub const MAX_DOMAINS: usize = 1000;
+
+/// Largest true height of a domain or a height map's value, either sign (m): 10 µm, a
+/// topography the z piezo follows.
+pub const MAX_HEIGHT: f64 = 1e-5;
 
 /// One domain of a [`SampleMap`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -122,7 +128,7 @@ fn pair(v: &toml::Value, name: &str) -> Result<(f64, f64), SimError> {
 /// finite height within ±10 µm.
 fn height_map(v: &toml::Value) -> Result<Vec<Vec<f64>>, SimError> {
     let what = "must be an array of rows [[h, …], …] of heights in m (rows from y = 0, each as \
-                long, at most 4096 × 4096)";
+                long, at most 4096 × 4096) or the path of a .csv or .npy file of them";
     let rows = v
         .as_array()
         .filter(|r| !r.is_empty() && r.len() <= MAX_PIXELS)
@@ -136,7 +142,7 @@ fn height_map(v: &toml::Value) -> Result<Vec<Vec<f64>>, SimError> {
         let mut hs = Vec::with_capacity(row.len());
         for h in row {
             let h = length(h, "height_map")?;
-            if h.abs() > 1e-5 {
+            if h.abs() > MAX_HEIGHT {
                 return Err(bad("height_map".into(), h, "heights must be within ±10 µm"));
             }
             hs.push(h);
@@ -149,18 +155,49 @@ fn height_map(v: &toml::Value) -> Result<Vec<Vec<f64>>, SimError> {
     Ok(out)
 }
 
+/// A height map file `height_map = "…"` ([`super::height_map_file::read`]), a relative path
+/// taken from `dir`.
+#[cfg(feature = "files")]
+fn height_map_file(file: &str, dir: Option<&std::path::Path>) -> Result<Vec<Vec<f64>>, SimError> {
+    super::height_map_file::read(file, dir)
+}
+
+/// Without the `files` feature a height map file is refused.
+#[cfg(not(feature = "files"))]
+fn height_map_file(file: &str, _dir: Option<&std::path::Path>) -> Result<Vec<Vec<f64>>, SimError> {
+    Err(bad(
+        "height_map".into(),
+        format!("\"{file}\""),
+        "a height map file needs afmdyn's `files` feature: give the rows inline [[h, …], …]",
+    ))
+}
+
 impl SampleMap {
-    /// Parse a sample map from TOML text; `origin` names it in errors.
+    /// Parse a sample map from TOML text; `origin` names it in errors. A height map file
+    /// (`height_map = "h.csv"`) is read from the current directory when its path is relative.
     ///
     /// # Errors
     /// [`SimError::Probe`] naming the file and the key (`size`, `domain 'soft' x`, …) and what
     /// it must be: an unknown key, a missing `size` or `x`, a range that is empty or outside the
-    /// map, more than [`MAX_DOMAINS`] domains; the syntax error of invalid TOML.
+    /// map, more than [`MAX_DOMAINS`] domains; the syntax error of invalid TOML; a height map
+    /// file's refusals ([`super::height_map_file::read`]), or, without the `files` feature, any
+    /// height map file.
     pub fn parse(text: &str, origin: &str) -> Result<SampleMap, SimError> {
-        Self::parse_text(text).map_err(|e| SimError::Probe(format!("sample map {origin}: {e}")))
+        Self::parse_in(text, origin, None)
     }
 
-    fn parse_text(text: &str) -> Result<SampleMap, SimError> {
+    /// [`SampleMap::parse`] with a relative height map file taken from `dir` (`None`: the
+    /// current directory).
+    fn parse_in(
+        text: &str,
+        origin: &str,
+        dir: Option<&std::path::Path>,
+    ) -> Result<SampleMap, SimError> {
+        Self::parse_text(text, dir)
+            .map_err(|e| SimError::Probe(format!("sample map {origin}: {e}")))
+    }
+
+    fn parse_text(text: &str, dir: Option<&std::path::Path>) -> Result<SampleMap, SimError> {
         let root: toml::Table = text.parse().map_err(|e: toml::de::Error| {
             SimError::Probe(format!(
                 "invalid TOML: {}",
@@ -251,7 +288,7 @@ impl SampleMap {
                 .map(|v| length(v, &key("height")))
                 .transpose()?
                 .unwrap_or(0.0);
-            if height.abs() > 1e-5 {
+            if height.abs() > MAX_HEIGHT {
                 return Err(bad(
                     key("height"),
                     height,
@@ -293,6 +330,7 @@ impl SampleMap {
         }
         let height_map = match root.get("height_map") {
             None => Vec::new(),
+            Some(toml::Value::String(file)) => height_map_file(file, dir)?,
             Some(v) => height_map(v)?,
         };
         Ok(SampleMap {
@@ -316,7 +354,8 @@ impl SampleMap {
         }
     }
 
-    /// Read a sample map file.
+    /// Read a sample map file; a relative height map file (`height_map = "h.csv"`) is taken
+    /// from its directory.
     ///
     /// # Errors
     /// [`SimError::Probe`] naming the file when it cannot be read (or is larger than
@@ -325,7 +364,7 @@ impl SampleMap {
     pub fn load(path: &std::path::Path) -> Result<SampleMap, SimError> {
         let text = super::limits::read_input(path, super::limits::MAX_INPUT_TEXT_BYTES)
             .map_err(|e| SimError::Probe(format!("sample map: {e}")))?;
-        Self::parse(&text, &path.display().to_string())
+        Self::parse_in(&text, &path.display().to_string(), path.parent())
     }
 
     /// The map with `rows` as its height map (m, `[row][column]`, rows from y = 0), replacing any

@@ -37,6 +37,8 @@ pub mod curves;
 #[cfg(feature = "files")]
 pub mod dir_lock;
 pub mod fm;
+#[cfg(feature = "files")]
+pub mod height_map_file;
 pub mod image;
 pub mod image_scan;
 pub mod limits;
