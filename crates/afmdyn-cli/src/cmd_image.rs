@@ -2,8 +2,8 @@
 //! or scanned in the time domain under a lock-in and a PI z controller (`--feedback pi`).
 //! The sample map, the operating points and the scan are the library's
 //! ([`afmdyn::request::image`], [`afmdyn::request::image_scan`]); this front end reads the two
-//! files, maps the flags, and writes `image.json`, `image.nc` of an ideal image (the library's
-//! layout, [`afmdyn::layout::image`]), the maps (height, phase, E_dis; the error image of a PI
+//! files, maps the flags, and writes `image.json`, `image.nc` (the library's layouts,
+//! [`afmdyn::layout::image`]), the maps (height, phase, E_dis; the error image of a PI
 //! scan) and the line profile.
 
 use crate::args::read_text;
@@ -413,6 +413,10 @@ fn pi_cmd(
     let img = study.assemble(store.records)?;
     let json = img.document(a.setpoint);
     write_document(&out, "image.json", &json)?;
+    write_layout(
+        &out.join("image.nc"),
+        &afmdyn::layout::image::scan_layout(&img, a.setpoint),
+    )?;
     let grid = &img.ideal;
     let pixel = |j: usize, i: usize| &img.lines[j].trace[i];
     map_of(

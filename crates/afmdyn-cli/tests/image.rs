@@ -376,6 +376,7 @@ fn the_pi_scan_writes_the_libraries_document_and_maps() {
     assert_eq!(doc["scan"]["proportional_gain"], 0.1);
     for f in [
         "image.json",
+        "image.nc",
         "image-height.png",
         "image-error.png",
         "image-phase.png",

@@ -645,7 +645,7 @@ pub fn image<'py>(
 }
 
 /// The PI-scanned image of a sample map under a probe (`afmdyn image --feedback pi`:
-/// [`afmdyn::request::image_scan::pi_image`]): its JSON document, the lines on `threads` worker
+/// [`afmdyn::request::image_scan::pi_image`]): its JSON document and layout, the lines on `threads` worker
 /// threads (`None`: all cores), with progress (lines) and Ctrl-C. Arguments as [`image`]'s;
 /// `scan_rate` (Hz), `gains` (K_P, K_I in 1/s) and `time_constant` (s), `None` for the lever's
 /// defaults.
@@ -666,7 +666,7 @@ pub fn pi_image<'py>(
     time_constant: Option<f64>,
     threads: Option<usize>,
     progress: Option<Bound<'py, PyAny>>,
-) -> PyResult<String> {
+) -> PyResult<Bound<'py, PyDict>> {
     use afmdyn::request::image::ImageRequest;
     use afmdyn::request::image_scan::{PiScan, ScanStudy};
     let (table, map) = image_inputs(probe, sample, height_map)?;
@@ -686,21 +686,34 @@ pub fn pi_image<'py>(
     // the settings are checked before the approach curves are run
     let job = Job::default();
     let worker = job.clone();
-    let doc = run(
+    let img = run(
         py,
         &job,
         Some(req.lines(&map)),
         progress.as_ref(),
         Stop::Cancellable,
-        move || -> PyResult<String> {
+        move || -> PyResult<afmdyn::request::image_scan::PiImage> {
             let study = ScanStudy::new(&table, &map, &req, &scan).map_err(sim_error)?;
             let mut store = afmdyn::study::MemoryStore::default();
             execute(&study, &mut store, false, threads, &*worker.progress).map_err(study_error)?;
-            let img = study.assemble(store.records).map_err(sim_error)?;
-            Ok(img.document(setpoint).to_string())
+            study.assemble(store.records).map_err(sim_error)
         },
     )??;
-    Ok(doc)
+    scan_out(py, &img, setpoint)
+}
+
+/// A PI scan's document and layout ([`afmdyn::layout::image::scan_layout`]) as Python takes
+/// them: `{"json": text, "layout": …}`.
+pub(crate) fn scan_out<'py>(
+    py: Python<'py>,
+    img: &afmdyn::request::image_scan::PiImage,
+    setpoint: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    let out = Out::new(py);
+    out.json(&img.document(setpoint))?;
+    let layout = afmdyn::layout::image::scan_layout(img, setpoint);
+    out.set("layout", crate::convert::layout_dict(py, layout)?)?;
+    Ok(out.finish())
 }
 
 /// The setpoint study of a sample map under a probe (`afmdyn image --setpoint-study`:

@@ -92,8 +92,13 @@ impl ScanStudy {
         to_cbor_text(&(t, line)).map_err(value_error)
     }
 
-    /// The image document (JSON) of the finished lines (their texts, any order).
-    fn document(&self, lines: Vec<String>) -> PyResult<String> {
+    /// The image's document and layout (`{"json": text, "layout": …}`) of the finished lines
+    /// (their texts, any order).
+    fn document<'py>(
+        &self,
+        py: Python<'py>,
+        lines: Vec<String>,
+    ) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
         let records = lines
             .iter()
             .map(|t| {
@@ -102,8 +107,6 @@ impl ScanStudy {
             })
             .collect::<PyResult<Vec<_>>>()?;
         let img = self.study.assemble(records).map_err(sim_error)?;
-        Ok(img
-            .document(self.study.recipe().request.setpoint)
-            .to_string())
+        crate::analyses::scan_out(py, &img, self.study.recipe().request.setpoint)
     }
 }

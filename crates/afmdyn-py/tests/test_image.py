@@ -181,6 +181,11 @@ def test_the_pi_scan_is_the_command_lines_document(cli_json, tmp_path):
     assert ds.lost_contact.dtype == bool
     # the recorded trace is the document's, in m
     assert np.array_equal(ds.height.values[0], np.array(doc["image"]["height"][0], dtype=float))
+    # and image.nc's (the one layout): every recorded map, its units
+    nc = xr.open_dataset(tmp_path / "out" / "image.nc")
+    for name in ("height", "height_retrace", "tracking_error", "phase_deg", "ideal_height"):
+        assert np.array_equal(nc[name].values, ds[name].values, equal_nan=True), name
+        assert nc[name].attrs["units"] == ds[name].attrs["units"]
 
 
 def test_pi_settings_are_refused_by_name(tmp_path):

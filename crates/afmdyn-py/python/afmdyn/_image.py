@@ -15,19 +15,6 @@ from . import _layout
 from ._common import _typed, _warn
 from ._progress import ProgressArg, reporter
 
-#: The recorded maps of a PI scan (``feedback="pi"``), trace and ``_retrace``.
-_SCAN_FIELDS = {
-    "height": ("m", "recorded height: mean piezo position less the ideal reference z_c,ref"),
-    "amplitude": ("m", "mean lock-in amplitude"),
-    "phase_deg": ("degree", "mean lock-in phase lag behind the drive"),
-    "tracking_error": ("m", "mean amplitude error A_sp - A (the error image)"),
-    "energy_dissipated": ("J", "energy dissipated over the pixel's last drive period"),
-    "virial": ("J", "virial over the pixel's last drive period"),
-    "peak_force": ("N", "largest tip-sample force over the pixel's last drive period"),
-    "indentation": ("m", "largest indentation over the pixel's last drive period"),
-}
-
-
 def _inputs(probe: Any, sample: Any, height_map: Any) -> Tuple[str, str, Any]:
     """The probe's TOML text, the sample map's text or path, the height map's rows (or None)."""
     text = _core.probe_source(probe)
@@ -119,14 +106,11 @@ def image(
         if gains is not None and len(gains) != 2:
             raise ValueError("gains: must be two numbers (K_P, K_I in 1/s)")
         with reporter(progress, "image", unit="line") as cb:
-            doc = json.loads(
-                _core.pi_image(
-                    text, source, setpoint, pixels, lines, curve_points, rows,
-                    scan_rate, pair, time_constant, threads, cb,
-                )
+            out = _core.pi_image(
+                text, source, setpoint, pixels, lines, curve_points, rows,
+                scan_rate, pair, time_constant, threads, cb,
             )
-        _warn(doc)
-        return _scan_dataset(doc, setpoint)
+        return _scan_dataset(out, setpoint)
     out = _core.image(text, source, setpoint, pixels, lines, curve_points, rows)
     doc = json.loads(out["json"])
     _warn(doc)
@@ -154,31 +138,26 @@ def image(
     )
 
 
-def _grid(rows: Any, dtype: Any = np.float64) -> Any:
-    """A ``[line][pixel]`` block of the document as an array (None → NaN)."""
-    return np.array([[np.nan if v is None else v for v in row] for row in rows], dtype=dtype)
-
-
-def _scan_dataset(doc: Dict[str, Any], setpoint: float) -> xr.Dataset:
-    """The Dataset of a PI scan's document."""
+def _scan_dataset(out: Dict[str, Any], setpoint: float) -> xr.Dataset:
+    """The Dataset of a PI scan (``{"json", "layout"}``): its variables as the library lays
+    them out (``image.nc``'s), the regime and material codes as the document's words."""
+    doc = json.loads(out["json"])
+    _warn(doc)
     img = doc["image"]
+    layout = _layout.variables(out["layout"])
     dims = ("y", "x")
     data: Dict[str, Any] = {}
+    for name, (vdims, values, attrs) in layout.items():
+        if vdims == dims and values.dtype.kind in "fb":
+            data[name] = (vdims, values, attrs)
     for suffix, block in (("", img), ("_retrace", img["retrace"])):
-        for name, (unit, meaning) in _SCAN_FIELDS.items():
-            data[name + suffix] = (dims, _grid(block[name]), {"units": unit, "long_name": meaning})
-        data["lost_contact" + suffix] = (dims, np.array(block["lost_contact"], dtype=bool))
-        data["regime" + suffix] = (dims, np.array(block["regime"]))
-        data["material" + suffix] = (dims, np.array(block["material"]))
-    data["ideal_height"] = (dims, _grid(img["ideal_height"]), {"units": "m"})
-    data["true_height"] = (dims, _grid(img["true_height"]), {"units": "m"})
-    data["domain"] = (dims, np.array(img["domain"]))
+        for name in ("regime", "material"):
+            words = np.array(block[name])
+            data[name + suffix] = (dims, words, {"long_name": layout[name + suffix][2]["long_name"]})
+    data["domain"] = (dims, np.array(img["domain"]), {"long_name": layout["domain"][2]["long_name"]})
     return xr.Dataset(
         data,
-        coords={
-            "x": ("x", np.asarray(img["x"], dtype=np.float64), {"units": "m"}),
-            "y": ("y", np.asarray(img["y"], dtype=np.float64), {"units": "m"}),
-        },
+        coords={name: layout[name] for name in ("x", "y")},
         attrs={
             "setpoint": setpoint,
             "reference_z_c": doc["reference_z_c"],

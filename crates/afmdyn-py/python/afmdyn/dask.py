@@ -526,11 +526,8 @@ def image(
                 texts.append(fut.result())
                 if cb is not None:
                     cb(len(texts), n)
-        doc = json.loads(s.document(texts))
-    from ._common import _warn
-
-    _warn(doc)
-    return _scan_dataset(doc, setpoint)
+        out = s.document(texts)
+    return _scan_dataset(out, setpoint)
 
 
 __all__ = [

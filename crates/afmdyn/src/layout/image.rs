@@ -1,9 +1,11 @@
-//! The layout of an ideal-feedback image ([`crate::request::image::Image`]): `image.nc` of
-//! `afmdyn image --out DIR` ([`super::netcdf::write`]) and the variables' units and long
-//! names of Python's `afmdyn.image` Dataset.
+//! The layouts of an image: `image.nc` of `afmdyn image --out DIR` ([`super::netcdf::write`])
+//! and the variables' units and long names of Python's `afmdyn.image` Dataset — the
+//! ideal-feedback image ([`crate::request::image::Image`], [`layout`]) and the PI scan
+//! ([`crate::request::image_scan::PiImage`], [`scan_layout`]).
 
-use super::{Attr, Layout, Variable};
+use super::{Attr, Layout, Values, Variable};
 use crate::request::image::{Image, OperatingPoint, Regime};
+use crate::request::image_scan::PiImage;
 
 /// The numeric maps of an image over (y, x): name, units, long name, as the JSON document's
 /// `image` block names them ([`Image::document`]).
@@ -35,6 +37,56 @@ pub const REGIME_FLAGS: [(i32, &str); 3] =
 /// A name as one word of a CF `flag_meanings` list (blanks become `_`).
 fn word(name: &str) -> String {
     name.split_whitespace().collect::<Vec<_>>().join("_")
+}
+
+/// `v` with the CF `flag_values` 0, 1, … and `flag_meanings` `names`.
+fn flags(v: Variable, names: Vec<String>) -> Variable {
+    let codes = (0..names.len() as i32).collect();
+    v.with("flag_values", Attr::I32(codes))
+        .with("flag_meanings", Attr::Text(names.join(" ")))
+}
+
+/// The regime codes [`REGIME_FLAGS`] over (y, x).
+fn regime_variable(name: &str, codes: &[i32]) -> Variable {
+    flags(
+        Variable::i32(
+            name,
+            &["y", "x"],
+            "1",
+            "regime of the operating point (mean tip–sample force attractive or repulsive)",
+            codes,
+        ),
+        REGIME_FLAGS.iter().map(|(_, n)| n.to_string()).collect(),
+    )
+}
+
+/// The material codes (indices into the image's materials, 0 the background) over (y, x).
+fn material_variable(img: &Image, name: &str, codes: &[i32]) -> Variable {
+    flags(
+        Variable::i32(name, &["y", "x"], "1", "material of the pixel", codes),
+        img.materials.iter().map(|m| word(&m.name)).collect(),
+    )
+}
+
+/// The domain codes over (y, x): 0 the background, k the map's k-th domain.
+fn domain_variable(img: &Image) -> Variable {
+    let (nx, ny) = (img.x.len(), img.y.len());
+    let domain: Vec<i32> = (0..ny)
+        .flat_map(|j| (0..nx).map(move |i| (j, i)))
+        .map(|(j, i)| img.pixels[j][i].domain.map_or(0, |k| k as i32 + 1))
+        .collect();
+    flags(
+        Variable::i32(
+            "domain",
+            &["y", "x"],
+            "1",
+            "domain of the sample map on top at the pixel",
+            &domain,
+        ),
+        std::iter::once("background".to_string())
+            .chain(img.domain_names.iter().map(|n| word(n)))
+            .collect(),
+    )
 }
 
 /// The image's layout: coordinates `x`, `y` (m: pixel centres and line positions); over
@@ -70,11 +122,6 @@ pub fn layout(img: &Image, setpoint: f64) -> Layout {
         };
         variables.push(Variable::f64(name, grid, units, long_name, &values));
     }
-    let flags = |v: Variable, names: Vec<String>| {
-        let codes = (0..names.len() as i32).collect();
-        v.with("flag_values", Attr::I32(codes))
-            .with("flag_meanings", Attr::Text(names.join(" ")))
-    };
     let regime: Vec<i32> = cells()
         .map(|(j, i)| match img.point(j, i).map(|o| o.regime) {
             None => REGIME_FLAGS[0].0,
@@ -82,38 +129,12 @@ pub fn layout(img: &Image, setpoint: f64) -> Layout {
             Some(Regime::Repulsive) => REGIME_FLAGS[2].0,
         })
         .collect();
-    variables.push(flags(
-        Variable::i32(
-            "regime",
-            grid,
-            "1",
-            "regime of the operating point (mean tip–sample force attractive or repulsive)",
-            &regime,
-        ),
-        REGIME_FLAGS.iter().map(|(_, n)| n.to_string()).collect(),
-    ));
+    variables.push(regime_variable("regime", &regime));
     let material: Vec<i32> = cells()
         .map(|(j, i)| img.pixels[j][i].material as i32)
         .collect();
-    variables.push(flags(
-        Variable::i32("material", grid, "1", "material of the pixel", &material),
-        img.materials.iter().map(|m| word(&m.name)).collect(),
-    ));
-    let domain: Vec<i32> = cells()
-        .map(|(j, i)| img.pixels[j][i].domain.map_or(0, |k| k as i32 + 1))
-        .collect();
-    variables.push(flags(
-        Variable::i32(
-            "domain",
-            grid,
-            "1",
-            "domain of the sample map on top at the pixel",
-            &domain,
-        ),
-        std::iter::once("background".to_string())
-            .chain(img.domain_names.iter().map(|n| word(n)))
-            .collect(),
-    ));
+    variables.push(material_variable(img, "material", &material));
+    variables.push(domain_variable(img));
     variables.push(Variable::f64(
         "setpoint",
         &[],
@@ -130,6 +151,177 @@ pub fn layout(img: &Image, setpoint: f64) -> Layout {
     ));
     Layout::new(
         format!("afmdyn ideal-feedback AM-AFM image at the setpoint A/A0 = {setpoint}"),
+        &[("y", ny), ("x", nx)],
+        variables,
+    )
+}
+
+/// The recorded maps of a PI scan over (y, x), trace and `_retrace`: name, units, long name,
+/// as the document's `image` block names them ([`PiImage::document`]).
+pub const SCAN_FIELDS: [(&str, &str, &str); 8] = [
+    (
+        "height",
+        "m",
+        "recorded height: the mean piezo position less the ideal reference z_c,ref",
+    ),
+    ("amplitude", "m", "mean lock-in amplitude"),
+    (
+        "phase_deg",
+        "degree",
+        "mean lock-in phase lag behind the drive",
+    ),
+    (
+        "tracking_error",
+        "m",
+        "mean amplitude error A_sp − A (the error image)",
+    ),
+    (
+        "energy_dissipated",
+        "J",
+        "energy dissipated over the pixel's last drive period",
+    ),
+    ("virial", "J", "virial over the pixel's last drive period"),
+    (
+        "peak_force",
+        "N",
+        "largest tip–sample force over the pixel's last drive period",
+    ),
+    (
+        "indentation",
+        "m",
+        "largest indentation over the pixel's last drive period",
+    ),
+];
+
+/// The PI scan's layout: coordinates `x`, `y` (m); over (y, x) the [`SCAN_FIELDS`] of the
+/// trace and, suffixed `_retrace`, of the retrace (64-bit floats in SI), `lost_contact` and
+/// `lost_contact_retrace` (flags), `regime` and `material` of each direction (codes as in
+/// [`layout`]), `ideal_height` (m, the ideal image's apparent height), `true_height` (m) and
+/// `domain`; the scalars `setpoint`, `reference_z_c` (m), `scan_rate` (Hz),
+/// `proportional_gain` (1), `integral_gain` (1/s) and `time_constant` (s).
+pub fn scan_layout(img: &PiImage, setpoint: f64) -> Layout {
+    let g = &img.ideal;
+    let (nx, ny) = (g.x.len(), g.y.len());
+    let cells = || (0..ny).flat_map(move |j| (0..nx).map(move |i| (j, i)));
+    let grid: &[&str] = &["y", "x"];
+    let (m, e, f) = (img.length(), img.energy(), img.force());
+    let mut variables = vec![
+        Variable::f64("x", &["x"], "m", "pixel centre x", &g.x),
+        Variable::f64("y", &["y"], "m", "line position y", &g.y),
+    ];
+    for (d, suffix) in [(0, ""), (1, "_retrace")] {
+        let pixel = |j: usize, i: usize| {
+            if d == 0 {
+                &img.lines[j].trace[i]
+            } else {
+                &img.lines[j].retrace[i]
+            }
+        };
+        for (name, units, long_name) in SCAN_FIELDS {
+            let values: Vec<f64> = cells()
+                .map(|(j, i)| {
+                    let p = pixel(j, i);
+                    match name {
+                        "height" => img.height(d, j, i),
+                        "amplitude" => p.amplitude * m,
+                        "phase_deg" => p.phase.to_degrees(),
+                        "tracking_error" => p.tracking_error * m,
+                        "energy_dissipated" => p.energy_dissipated * e,
+                        "virial" => p.virial * e,
+                        "peak_force" => p.peak_force * f,
+                        _ => p.indentation * m,
+                    }
+                })
+                .collect();
+            variables.push(Variable::f64(
+                &format!("{name}{suffix}"),
+                grid,
+                units,
+                long_name,
+                &values,
+            ));
+        }
+        let lost: Vec<bool> = cells().map(|(j, i)| pixel(j, i).lost_contact).collect();
+        variables.push(Variable::new(
+            &format!("lost_contact{suffix}"),
+            grid,
+            "1",
+            "the controller lost contact (parachuting) in the pixel's last drive period",
+            Values::Bool(lost),
+        ));
+        let regime: Vec<i32> = cells()
+            .map(|(j, i)| {
+                if crate::report::regime(pixel(j, i).mean_deflection) == "attractive" {
+                    REGIME_FLAGS[1].0
+                } else {
+                    REGIME_FLAGS[2].0
+                }
+            })
+            .collect();
+        variables.push(regime_variable(&format!("regime{suffix}"), &regime));
+        let material: Vec<i32> = cells().map(|(j, i)| pixel(j, i).material as i32).collect();
+        variables.push(material_variable(
+            g,
+            &format!("material{suffix}"),
+            &material,
+        ));
+    }
+    let ideal: Vec<f64> = cells().map(|(j, i)| g.apparent_height(j, i)).collect();
+    variables.push(Variable::f64(
+        "ideal_height",
+        grid,
+        "m",
+        "apparent height under the ideal feedback h + z_c − z_c,ref",
+        &ideal,
+    ));
+    let truth: Vec<f64> = cells().map(|(j, i)| g.pixels[j][i].height).collect();
+    variables.push(Variable::f64(
+        "true_height",
+        grid,
+        "m",
+        "true height of the sample map",
+        &truth,
+    ));
+    variables.push(domain_variable(g));
+    let s = &img.settings;
+    for (name, units, long_name, v) in [
+        ("setpoint", "1", "amplitude setpoint A_sp/A0", setpoint),
+        (
+            "reference_z_c",
+            "m",
+            "rest distance z_c,ref engaged on the background under the ideal feedback (the \
+             zero of the heights)",
+            g.reference,
+        ),
+        (
+            "scan_rate",
+            "Hz",
+            "lines (trace and retrace) per second",
+            s.scan_rate,
+        ),
+        (
+            "proportional_gain",
+            "1",
+            "K_P of the z controller",
+            s.proportional_gain,
+        ),
+        (
+            "integral_gain",
+            "1/s",
+            "K_I of the z controller",
+            s.integral_gain,
+        ),
+        (
+            "time_constant",
+            "s",
+            "time constant of the lock-in's low-pass",
+            s.time_constant,
+        ),
+    ] {
+        variables.push(Variable::f64(name, &[], units, long_name, &[v]));
+    }
+    Layout::new(
+        format!("afmdyn PI-feedback AM-AFM scan at the setpoint A/A0 = {setpoint}"),
         &[("y", ny), ("x", nx)],
         variables,
     )

@@ -483,6 +483,11 @@ impl PiImage {
         self.units.length
     }
 
+    /// Newtons per model force unit (the records' forces).
+    pub fn force(&self) -> f64 {
+        self.units.force
+    }
+
     /// Joules per model energy unit (the records' energies).
     pub fn energy(&self) -> f64 {
         self.units.energy
