@@ -102,7 +102,7 @@ enum Command {
     Fm(cmd_fm::FmArgs),
     /// Tip–sample force and potential from an FM-AFM frequency-shift curve (Sader–Jarvis)
     Reconstruct(cmd_reconstruct::ReconstructArgs),
-    /// AM-AFM image of a heterogeneous sample (ideal feedback): apparent height, phase, E_dis maps
+    /// AM-AFM image of a heterogeneous sample (ideal or PI feedback): height, phase, E_dis maps
     Image(cmd_image::ImageArgs),
 }
 
