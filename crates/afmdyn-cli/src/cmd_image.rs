@@ -54,6 +54,13 @@ pub struct ImageArgs {
     /// PI scan: worker threads, one line per task (default: all cores)
     #[arg(long)]
     threads: Option<usize>,
+    /// PI scan: continue an interrupted scan; refused unless the other arguments are those of
+    /// the interrupted run (recorded in OUT/.image.run.json)
+    #[arg(long)]
+    resume: bool,
+    /// Testing: abort the process, as if killed, after this many lines are stored
+    #[arg(long, hide = true)]
+    abort_after: Option<usize>,
     /// Pixels per line [default: 64]
     #[arg(long)]
     pixels: Option<usize>,
@@ -191,6 +198,7 @@ pub fn image_cmd(a: &ImageArgs) -> Result<(), CliError> {
                 (a.gains.is_some(), "--gains"),
                 (a.time_constant.is_some(), "--time-constant"),
                 (a.threads.is_some(), "--threads"),
+                (a.resume, "--resume"),
             ] {
                 if set {
                     return Err(CliError::Input(format!(
@@ -407,10 +415,20 @@ fn pi_cmd(
 ) -> Result<(), CliError> {
     let study = ScanStudy::new(table, map, req, scan)?;
     let out = OutDir::lock(&a.out)?;
-    let mut store = afmdyn::study::MemoryStore::default();
-    crate::progress::study(&study, &mut store, false, a.threads, "lines", None)
-        .map_err(|e| crate::cmd_analysis::study_error(e, "image"))?;
-    let img = study.assemble(store.records)?;
+    let mut store = afmdyn::study::scan_store::scan_store(out.dir_lock());
+    crate::progress::study(
+        &study,
+        &mut store,
+        a.resume,
+        a.threads,
+        "lines",
+        a.abort_after,
+    )
+    .map_err(|e| crate::cmd_analysis::study_error(e, "image"))?;
+    let records = store
+        .records()
+        .map_err(|e| crate::cmd_analysis::store_error(e, "image"))?;
+    let img = study.assemble(records)?;
     let json = img.document(a.setpoint);
     write_document(&out, "image.json", &json)?;
     write_layout(

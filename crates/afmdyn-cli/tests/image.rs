@@ -386,3 +386,82 @@ fn the_pi_scan_writes_the_libraries_document_and_maps() {
         assert!(dir.path().join("out").join(f).exists(), "{f}");
     }
 }
+
+/// `afmdyn image --feedback pi` of a 2-line map under the Q = 100 point mass, in `dir`.
+fn two_line_scan(dir: &std::path::Path, extra: &[&str]) -> Output {
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../../");
+    let text = std::fs::read_to_string(format!("{root}examples/probe-point-mass-dmt.toml"))
+        .unwrap()
+        .replace("quality_factor = 400", "quality_factor = 100");
+    let probe = dir.join("probe.toml");
+    std::fs::write(&probe, &text).unwrap();
+    let map = std::fs::read_to_string(format!("{root}examples/sample-stripe.toml"))
+        .unwrap()
+        .replace("size = [1.0e-6, 0.0]", "size = [1.0e-6, 0.2e-6]");
+    let sample = dir.join("sample.toml");
+    std::fs::write(&sample, map).unwrap();
+    let out = dir.join("out");
+    let mut args = vec![
+        "image",
+        "--probe",
+        probe.to_str().unwrap(),
+        "--sample",
+        sample.to_str().unwrap(),
+        "--setpoint",
+        "0.5",
+        "--feedback",
+        "pi",
+        "--pixels",
+        "6",
+        "--lines",
+        "2",
+        "--scan-rate",
+        "50",
+        "--threads",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    afmdyn(&args)
+}
+
+/// A PI scan killed after its first line resumes to the uninterrupted run's files (the stored
+/// line read back bit for bit); a finished store computes nothing on `--resume`; another
+/// request is refused naming the first field that differs.
+#[test]
+fn a_killed_pi_scan_resumes_to_the_uninterrupted_files() {
+    let full = tempfile::tempdir().unwrap();
+    let cut = tempfile::tempdir().unwrap();
+    let ok = two_line_scan(full.path(), &[]);
+    assert!(
+        ok.status.success(),
+        "{}",
+        String::from_utf8_lossy(&ok.stderr)
+    );
+    let killed = two_line_scan(cut.path(), &["--abort-after", "1"]);
+    assert!(!killed.status.success(), "the run was killed");
+    let lines = cut.path().join("out/.image.lines.jsonl");
+    assert_eq!(std::fs::read_to_string(&lines).unwrap().lines().count(), 1);
+    let resumed = two_line_scan(cut.path(), &["--resume"]);
+    assert!(
+        resumed.status.success(),
+        "{}",
+        String::from_utf8_lossy(&resumed.stderr)
+    );
+    for f in ["image.json", "image.nc"] {
+        assert_eq!(
+            std::fs::read(full.path().join("out").join(f)).unwrap(),
+            std::fs::read(cut.path().join("out").join(f)).unwrap(),
+            "{f}"
+        );
+    }
+    let stored = std::fs::read_to_string(&lines).unwrap();
+    assert_eq!(stored.lines().count(), 2);
+    assert!(two_line_scan(cut.path(), &["--resume"]).status.success());
+    assert_eq!(std::fs::read_to_string(&lines).unwrap(), stored);
+    let other = two_line_scan(cut.path(), &["--resume", "--gains", "0,3000"]);
+    assert_eq!(other.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&other.stderr);
+    assert!(err.contains("gains") && err.contains("3000"), "{err}");
+}

@@ -296,8 +296,12 @@ impl ScanStudy {
             range: (lo, hi),
             integrator: IntegratorOptions::default(),
         };
+        // what a resumed scan must match: everything its lines depend on (the settings as
+        // given under "feedback", named first when a resume differs; then as resolved)
         let fingerprint = json!({
+            "feedback": scan,
             "probe": probe_table,
+            "map": map,
             "request": req,
             "scan": settings,
         });

@@ -10,7 +10,8 @@
 //!   stores lock their directory for one run at a time
 //!   ([`crate::request::checkpoint_file::FileCheckpoint`] for sweeps; `task_store::TaskStore`,
 //!   feature `files`, for any study of numbered tasks whose records serialize — the chart's
-//!   `chart_store`); [`MemoryStore`] keeps the tasks in memory.
+//!   `chart_store`; a PI-scanned image's lines, `scan_store`); [`MemoryStore`] keeps the tasks
+//!   in memory.
 //! - [`execute`]: the one executor — opens the store (refusing a resume of another request),
 //!   builds the worker pool (the request's thread count, checked once by
 //!   [`crate::request::limits::check_threads`]), runs the study, appends each finished task
@@ -38,6 +39,8 @@ pub mod chart;
 pub mod chart_store;
 pub mod global_continuation;
 mod memory;
+#[cfg(feature = "files")]
+pub mod scan_store;
 pub mod stepped;
 pub mod sweep;
 #[cfg(feature = "files")]
