@@ -207,6 +207,11 @@ pub struct ScanPixel {
     pub lost_contact: bool,
     /// Periods at the controller's output limit.
     pub saturated: usize,
+    /// The per-mode energy balance of the last period ([`observe`]'s
+    /// [`crate::analysis::observables::ModeBalance`]): the largest |residual| relative to the
+    /// drive's work on its mode — the balance ΔE_j = drive − damping − sample − coupling holds
+    /// over any window, settled or not.
+    pub energy_residual: f64,
 }
 
 /// What a scan line needs (model units).
@@ -390,6 +395,11 @@ pub fn scan_line(
                     && o.impacts_per_period == 0.0
                     && 2.0 * sums.last > spec.setpoint + spec.free_amplitude,
                 saturated: sums.saturated,
+                energy_residual: o
+                    .mode_balance
+                    .iter()
+                    .map(|b| b.residual.abs() / b.drive.abs().max(f64::MIN_POSITIVE))
+                    .fold(0.0, f64::max),
             });
         }
     }

@@ -30,8 +30,8 @@
 //! height from the ideal image's apparent height; the overshoot, how far a recorded height goes
 //! beyond the ideal heights of its pixel and its two neighbours (a lag stays between them; an
 //! overshoot does not; pixels beside one without an ideal height are left out); the pixels that
-//! lost contact; the periods at the controller's output
-//! limit (an unstable loop).
+//! lost contact; the periods at the controller's output limit (an unstable loop); the largest
+//! energy-balance residual of a pixel's last period.
 
 use super::image::{image_of, material_curves, Image, ImageRequest, SampleMap};
 use crate::analysis::am_loop::{
@@ -108,6 +108,9 @@ pub struct Artefacts {
     pub lost_contact_pixels: usize,
     /// Drive periods at the controller's output limit.
     pub saturated_periods: usize,
+    /// The largest per-mode energy-balance residual of a pixel's last period, relative to the
+    /// drive's work ([`ScanPixel::energy_residual`]).
+    pub energy_residual_max: f64,
 }
 
 /// A scanned image: the ideal image of the same map, the lines, the settings.
@@ -440,6 +443,7 @@ fn empty_artefacts() -> Artefacts {
         tracking_error_rms: f64::NAN,
         lost_contact_pixels: 0,
         saturated_periods: 0,
+        energy_residual_max: f64::NAN,
     }
 }
 
@@ -515,6 +519,7 @@ impl PiImage {
     fn artefacts_of(&self, d: usize) -> Artefacts {
         let (mut sq, mut n, mut worst, mut over, mut err_sq, mut lost, mut sat) =
             (0.0, 0usize, 0.0f64, 0.0f64, 0.0, 0, 0);
+        let mut residual = 0.0f64;
         let px = self.ideal.x.len();
         for j in 0..self.lines.len() {
             for i in 0..px {
@@ -523,6 +528,7 @@ impl PiImage {
                 err_sq += e * e;
                 lost += usize::from(p.lost_contact);
                 sat += p.saturated;
+                residual = residual.max(p.energy_residual);
                 let h = self.height(d, j, i);
                 let ideal = self.ideal.apparent_height(j, i);
                 if !ideal.is_finite() {
@@ -554,6 +560,7 @@ impl PiImage {
             tracking_error_rms: (err_sq / all).sqrt(),
             lost_contact_pixels: lost,
             saturated_periods: sat,
+            energy_residual_max: residual,
         }
     }
 
