@@ -5,8 +5,10 @@
 #      $AFMDYN_TEST_VENV chooses another),
 #      `pip install ./crates/afmdyn-py[test]` (maturin builds the extension into it), then
 #      pytest crates/afmdyn-py/tests, which also executes the example notebook and script.
+#   3. the WebAssembly engine: bash scripts/test-wasm.sh (crates/afmdyn-wasm built for wasm32,
+#      its JavaScript glue by wasm-bindgen-cli, checked under Node.js against the command line).
 # Needs a Rust toolchain and Python >= 3.9 with network access to crates.io and PyPI.
-# The last line is "N passed, N failed", Rust and Python together; the exit status is 0 only
+# The last line is "N passed, N failed", Rust, Python and wasm together; the exit status is 0 only
 # when everything ran and passed.
 set -uo pipefail
 cd "$(dirname "$0")/.."
@@ -69,6 +71,17 @@ else
     extra_failed=$((extra_failed + 1))
 fi
 
-echo "Rust: ${rust_passed} passed, ${rust_failed} failed; Python: ${py_passed} passed, ${py_failed} failed"
-echo "$((rust_passed + py_passed)) passed, $((rust_failed + py_failed + extra_failed)) failed"
+echo "== WebAssembly: bash scripts/test-wasm.sh (the browser engine under Node.js)"
+bash scripts/test-wasm.sh 2>&1 | tee "$logs/wasm.log"
+wasm_code=${PIPESTATUS[0]}
+wasm_line=$(grep -E '^wasm: [0-9]+ passed, [0-9]+ failed' "$logs/wasm.log" | tail -1)
+wasm_passed=$(echo "$wasm_line" | awk '{print $2 + 0}')
+wasm_failed=$(echo "$wasm_line" | awk '{print $4 + 0}')
+if [ "$wasm_code" -ne 0 ]; then
+    status=1
+    [ "${wasm_failed:-0}" -gt 0 ] || extra_failed=$((extra_failed + 1))
+fi
+
+echo "Rust: ${rust_passed} passed, ${rust_failed} failed; Python: ${py_passed} passed, ${py_failed} failed; wasm: ${wasm_passed:-0} passed, ${wasm_failed:-0} failed"
+echo "$((rust_passed + py_passed + ${wasm_passed:-0})) passed, $((rust_failed + py_failed + ${wasm_failed:-0} + extra_failed)) failed"
 exit "$status"

@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# The browser front end's engine under a real WebAssembly runtime (issue 47, part of the README's
+# test command): builds crates/afmdyn-wasm for wasm32-unknown-unknown (no threads, no files),
+# generates its JavaScript glue with wasm-bindgen-cli at the version of the wasm-bindgen crate in
+# Cargo.lock (installed from crates.io into target/tools if missing), and runs
+# scripts/wasm-check.mjs under Node.js (Debian's nodejs, installed with apt-get if missing): the
+# wasm documents of `orbit` (the paper's Ω = 2.8) and of an approach curve from a probe file
+# must equal the native command line's `--json` ones, and a bad value must give its message.
+# Prints "wasm: N passed, M failed" last; exit status 0 only when all passed.
+set -uo pipefail
+cd "$(dirname "$0")/.."
+TARGET=${CARGO_TARGET_DIR:-target}
+fail() { echo "wasm: 0 passed, 1 failed ($1)"; exit 1; }
+
+command -v node > /dev/null || {
+    echo "== installing Node.js (Debian nodejs)"
+    if [ "$(id -u)" = 0 ]; then apt-get update -qq && apt-get install -y -qq nodejs > /dev/null;
+    else sudo apt-get update -qq && sudo apt-get install -y -qq nodejs > /dev/null; fi
+} || fail "no Node.js"
+rustup target list --installed 2>/dev/null | grep -q wasm32-unknown-unknown ||
+    rustup target add wasm32-unknown-unknown || fail "no wasm32 target"
+version=$(awk '/^name = "wasm-bindgen"$/ {getline; gsub(/"/, "", $3); print $3; exit}' Cargo.lock)
+[ -n "$version" ] || fail "no wasm-bindgen in Cargo.lock"
+tools=$TARGET/tools
+bindgen=$tools/bin/wasm-bindgen
+if ! { [ -x "$bindgen" ] && "$bindgen" --version | grep -q " $version"; }; then
+    echo "== installing wasm-bindgen-cli $version into $tools"
+    # --locked first (the release's own lock file); a registry mirror that lacks one of its
+    # pinned versions resolves the newest compatible ones instead
+    cargo install -q wasm-bindgen-cli --version "=$version" --locked --root "$tools" 2>/dev/null ||
+        cargo install -q wasm-bindgen-cli --version "=$version" --root "$tools" ||
+        fail "cargo install wasm-bindgen-cli $version"
+fi
+echo "== afmdyn-wasm for wasm32-unknown-unknown"
+cargo build -q --release -p afmdyn-wasm --target wasm32-unknown-unknown || fail "wasm build"
+cargo build -q --release -p afmdyn-cli || fail "native build"
+out=$TARGET/wasm-node
+"$bindgen" --target nodejs --out-dir "$out" \
+    "$TARGET/wasm32-unknown-unknown/release/afmdyn_wasm.wasm" || fail "wasm-bindgen"
+node scripts/wasm-check.mjs "$out/afmdyn_wasm.js" "$TARGET/release/afmdyn"

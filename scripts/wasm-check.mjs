@@ -1,0 +1,82 @@
+// The wasm engine (crates/afmdyn-wasm, built by scripts/test-wasm.sh) against the native command
+// line: node scripts/wasm-check.mjs PKG.js AFMDYN_BIN. Each check compares the wasm document
+// with `afmdyn … --json` (the same keys, words and flags; every number within 1e-9 of
+// 1 + |native|: wasm's libm is not the platform's) or the error message;
+// prints each result, the wasm and native wall times of the approach curve, and
+// "wasm: N passed, M failed" last.
+import { createRequire } from "node:module";
+import { execFileSync } from "node:child_process";
+import { readFileSync } from "node:fs";
+import { isDeepStrictEqual } from "node:util";
+import path from "node:path";
+
+const require = createRequire(import.meta.url);
+const [pkg, bin] = process.argv.slice(2);
+const wasm = require(path.resolve(pkg));
+const root = path.resolve(path.dirname(new URL(import.meta.url).pathname), "..");
+let passed = 0, failed = 0;
+
+function native(args) {
+  return JSON.parse(execFileSync(bin, [...args, "--json"], { cwd: root, encoding: "utf8" }));
+}
+// the largest difference of two documents' numbers relative to 1 + |native| (Infinity where
+// their shapes, keys, strings or flags differ): wasm's libm (sin, exp, pow) is not the
+// platform's, so their last bits may differ
+function worst(a, b, at = "") {
+  if (typeof a === "number" && typeof b === "number") {
+    if (Number.isNaN(a) && Number.isNaN(b)) return [0, at];
+    return [Math.abs(a - b) / (1 + Math.abs(b)), at];
+  }
+  if (Array.isArray(a) && Array.isArray(b) && a.length === b.length) {
+    return a.reduce((m, x, i) => { const w = worst(x, b[i], `${at}[${i}]`); return w[0] > m[0] ? w : m; }, [0, at]);
+  }
+  if (a && b && typeof a === "object" && typeof b === "object" && !Array.isArray(a) && !Array.isArray(b)) {
+    const ka = Object.keys(a).sort(), kb = Object.keys(b).sort();
+    if (!isDeepStrictEqual(ka, kb)) return [Infinity, `${at} keys`];
+    return ka.reduce((m, k) => { const w = worst(a[k], b[k], `${at}.${k}`); return w[0] > m[0] ? w : m; }, [0, at]);
+  }
+  return [isDeepStrictEqual(a, b) ? 0 : Infinity, at];
+}
+
+function check(name, ok, detail = "") {
+  if (ok) { passed += 1; console.log(`ok   ${name}`); }
+  else { failed += 1; console.log(`FAIL ${name} ${detail}`); }
+}
+
+const orbit = JSON.parse(wasm.run("orbit", JSON.stringify({ model: { omega: 2.8 } })));
+let [w, at] = worst(orbit, native(["orbit", "--omega", "2.8"]));
+check("orbit Ω = 2.8 is `afmdyn orbit --omega 2.8 --json` (numbers to 1e-9)", w <= 1e-9,
+  `${w} at ${at}`);
+console.log(`     largest difference ${w.toExponential(1)} at ${at}`);
+
+const probe = "examples/probe-point-mass-dmt.toml";
+const text = readFileSync(path.join(root, probe), "utf8");
+let t0 = performance.now();
+const curve = JSON.parse(wasm.run("approach",
+  JSON.stringify({ probe: text, request: { points: 60, setpoint: 0.7 } })));
+const tWasm = (performance.now() - t0) / 1000;
+t0 = performance.now();
+const ref = native(["approach", "--probe", probe, "--points", "60", "--setpoint", "0.7"]);
+const tNative = (performance.now() - t0) / 1000;
+// the two sweeps and the setpoint's operating points to 1e-9; the continued branches, whose
+// adaptive arclength steps carry last-bit differences into the points they land on, to 1e-6
+const sweeps = (d) => ({ ...d, branches: null, folds: null, bistable: null, jumps: null });
+[w, at] = worst(sweeps(curve), sweeps(ref));
+check("approach from a probe: sweeps and setpoint are `afmdyn approach --probe … --json`'s " +
+  "(numbers to 1e-9)", w <= 1e-9, `${w} at ${at}`);
+console.log(`     largest difference ${w.toExponential(1)} at ${at}`);
+const branches = (d) => ({ branches: d.branches, folds: d.folds, bistable: d.bistable, jumps: d.jumps });
+[w, at] = worst(branches(curve), branches(ref));
+check("approach from a probe: its branches, folds and jumps are the command line's (to 1e-6)",
+  w <= 1e-6, `${w} at ${at}`);
+console.log(`     largest difference ${w.toExponential(1)} at ${at}`);
+
+let message = "";
+try { wasm.run("orbit", JSON.stringify({ model: { omega: -1 } })); }
+catch (e) { message = String(e.message); }
+check("a bad Ω is refused naming omega", message.includes("omega"), message);
+
+console.log(`approach curve (60 z_c each way, branches): wasm ${tWasm.toFixed(2)} s, ` +
+  `native ${tNative.toFixed(2)} s (whole command), ratio ${(tWasm / tNative).toFixed(2)}`);
+console.log(`wasm: ${passed} passed, ${failed} failed`);
+process.exit(failed === 0 ? 0 : 1);
