@@ -71,6 +71,49 @@ check("approach from a probe: its branches, folds and jumps are the command line
   w <= 1e-6, `${w} at ${at}`);
 console.log(`     largest difference ${w.toExponential(1)} at ${at}`);
 
+// a bifurcation diagram in chunks of 5 points, as the page draws it, against bifurcation.csv
+const tmp = execFileSync("mktemp", ["-d"], { encoding: "utf8" }).trim();
+execFileSync(bin, ["bifurcation", "--from", "2.4", "--to", "3.2", "--steps", "12", "--out", tmp],
+  { cwd: root });
+const csv = readFileSync(path.join(tmp, "bifurcation.csv"), "utf8").trim().split("\n");
+const head = csv[0].split(",");
+const session = new wasm.Bifurcation(JSON.stringify({ request: { from: 2.4, to: 3.2, steps: 12 } }));
+let rows = [];
+while (!session.finished()) rows = rows.concat(JSON.parse(session.next(5)));
+rows.sort((a, b) => a.index - b.index || (a.branch !== "forward") - (b.branch !== "forward") ||
+  a.point - b.point);
+// the same rows (branch, status, Poincaré points); a periodic point's values to 1e-6 (a steady
+// state is reached when its returns repeat to 1e-8, which wasm's last bits may reach a period
+// earlier or later: a period-n cycle may start at another of its points, so each point's cycle
+// is compared as a set); a nonperiodic motion's points are not comparable point by point
+// (last-bit differences grow at the Lyapunov rate)
+let bad = rows.length === csv.length - 1 ? "" : `${rows.length} rows, ${csv.length - 1} in the file`;
+const groups = new Map();
+for (let i = 0; !bad && i < rows.length; i++) {
+  const cells = csv[i + 1].split(",");
+  const cell = (name) => cells[head.indexOf(name)];
+  if (cell("branch") !== rows[i].branch || cell("status") !== rows[i].status ||
+      cell("points") !== String(rows[i].points) || Number(cell("value")) !== rows[i].value) {
+    bad = `row ${i}: ${cells.slice(0, 8).join(",")}`;
+  }
+  if (rows[i].status !== "periodic") continue;
+  const key = `${rows[i].index} ${rows[i].branch}`;
+  const g = groups.get(key) || { file: [], wasm: [] };
+  g.file.push(Number(cell("w_tip")));
+  g.wasm.push(rows[i].w_tip);
+  groups.set(key, g);
+}
+let far = 0;
+for (const g of groups.values()) {
+  g.file.sort((a, b) => a - b);
+  g.wasm.sort((a, b) => a - b);
+  g.file.forEach((v, k) => { far = Math.max(far, Math.abs(v - g.wasm[k]) / (1 + Math.abs(v))); });
+}
+check("a bifurcation in chunks of 5 is `afmdyn bifurcation`'s bifurcation.csv (rows; periodic " +
+  "cycles to 1e-6)", !bad && far <= 1e-6, bad || `${far}`);
+console.log(`     ${rows.length} rows, ${groups.size} periodic points; their largest difference ` +
+  `${far.toExponential(1)}`);
+
 let message = "";
 try { wasm.run("orbit", JSON.stringify({ model: { omega: -1 } })); }
 catch (e) { message = String(e.message); }

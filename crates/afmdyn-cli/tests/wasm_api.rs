@@ -94,3 +94,57 @@ fn errors_are_the_command_lines_messages() {
     let e = run_json("orbitt", "{}").unwrap_err();
     assert!(e.contains("orbitt") && e.contains("modes"), "{e}");
 }
+
+/// The bifurcation diagram in chunks of 5 points (a page drawing as they come) is the command
+/// line's uninterrupted sweep: every row of `bifurcation.csv` (value, branch, status, period,
+/// W(1,τ) at each Poincaré point) in the same order, the chains continued across the chunks.
+#[test]
+fn a_bifurcation_in_chunks_is_the_command_lines_sweep() {
+    use afmdyn_wasm::bifurcation::BifurcationSession;
+    let dir = tempfile::tempdir().unwrap();
+    let (code, _, err) = cli(&[
+        "bifurcation",
+        "--from",
+        "2.4",
+        "--to",
+        "3.2",
+        "--steps",
+        "12",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    assert_eq!(code, Some(0), "{err}");
+    let input = json!({"request": {"from": 2.4, "to": 3.2, "steps": 12}}).to_string();
+    let mut s = BifurcationSession::new(&input).unwrap();
+    assert_eq!(s.total(), 24);
+    let mut rows: Vec<Value> = Vec::new();
+    let mut chunks = 0;
+    while !s.finished() {
+        let chunk: Vec<Value> = serde_json::from_str(&s.next(5).unwrap()).unwrap();
+        rows.extend(chunk);
+        chunks += 1;
+        assert!(chunks <= 24, "the sweep ends");
+    }
+    assert!(chunks >= 5, "{chunks} chunks");
+    // the one order of the file: by value index, then forward, backward
+    rows.sort_by_key(|r| {
+        (
+            r["index"].as_u64().unwrap(),
+            r["branch"].as_str().unwrap() != "forward",
+            r["point"].as_u64().unwrap(),
+        )
+    });
+    let mut csv = csv::Reader::from_path(dir.path().join("bifurcation.csv")).unwrap();
+    let header = csv.headers().unwrap().clone();
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let records: Vec<csv::StringRecord> = csv.records().map(|r| r.unwrap()).collect();
+    assert_eq!(records.len(), rows.len());
+    for (r, w) in records.iter().zip(&rows) {
+        assert_eq!(&r[col("branch")], w["branch"].as_str().unwrap());
+        assert_eq!(&r[col("status")], w["status"].as_str().unwrap());
+        let num = |name: &str| r[col(name)].parse::<f64>().unwrap();
+        assert_eq!(num("value"), w["value"].as_f64().unwrap());
+        assert_eq!(num("w_tip"), w["w_tip"].as_f64().unwrap(), "{r:?}");
+        assert_eq!(num("tau"), w["tau"].as_f64().unwrap());
+    }
+}

@@ -12,9 +12,12 @@
 //! text beside the field.
 //!
 //! The analyses: `modes`, `orbit`, `observe`, `lyapunov`, `continuation`, `attractors`,
-//! `converge`, `approach`, `resonance` and `fm` ([`ANALYSES`]).
+//! `converge`, `approach`, `resonance` and `fm` ([`ANALYSES`]); the bifurcation diagram in
+//! chunks ([`Bifurcation`], [`bifurcation::BifurcationSession`]).
 
 #![warn(missing_docs)]
+
+pub mod bifurcation;
 
 use afmdyn::analysis::progress::Progress;
 use afmdyn::probe::Probe;
@@ -53,7 +56,7 @@ struct Input {
 
 /// The model of `input` (the command line's defaults, or the probe's, then the `model` keys)
 /// and its `request`.
-fn resolve(input: &str) -> Result<(Resolved, Option<Value>), String> {
+pub(crate) fn resolve(input: &str) -> Result<(Resolved, Option<Value>), String> {
     let inp: Input = if input.trim().is_empty() {
         Input::default()
     } else {
@@ -163,4 +166,44 @@ pub fn run(analysis: &str, input: &str) -> Result<String, JsError> {
 #[wasm_bindgen]
 pub fn version() -> String {
     env!("CARGO_PKG_VERSION").to_string()
+}
+
+/// A bifurcation diagram computed in chunks for JavaScript
+/// ([`bifurcation::BifurcationSession`]): `new Bifurcation(input)`, then `next(points)` until
+/// `finished()`, each call returning the new rows as JSON text.
+#[wasm_bindgen]
+pub struct Bifurcation {
+    inner: bifurcation::BifurcationSession,
+}
+
+#[wasm_bindgen]
+impl Bifurcation {
+    /// The sweep of `input` (as [`run`]'s, the request `afmdyn bifurcation`'s keywords).
+    ///
+    /// # Errors
+    /// As [`bifurcation::BifurcationSession::new`].
+    #[wasm_bindgen(constructor)]
+    pub fn new(input: &str) -> Result<Bifurcation, JsError> {
+        bifurcation::BifurcationSession::new(input)
+            .map(|inner| Bifurcation { inner })
+            .map_err(|e| JsError::new(&e))
+    }
+
+    /// The sweep's points.
+    pub fn total(&self) -> usize {
+        self.inner.total()
+    }
+
+    /// Whether every point has been handed out.
+    pub fn finished(&self) -> bool {
+        self.inner.finished()
+    }
+
+    /// At least `points` further points: their rows, JSON text.
+    ///
+    /// # Errors
+    /// As [`bifurcation::BifurcationSession::next`].
+    pub fn next(&mut self, points: usize) -> Result<String, JsError> {
+        self.inner.next(points).map_err(|e| JsError::new(&e))
+    }
 }
