@@ -33,7 +33,7 @@ done
 # the page's two figures: the default Fig. 5 diagram (400 Ω values, forward and backward) and
 # one orbit (a click on the diagram), wasm against the native command on one thread
 fig5_native=$(best_of 1 /dev/null "$TARGET/release/afmdyn" bifurcation --threads 1 --out "$(mktemp -d)")
-read -r fig5_wasm orbit_wasm rows <<< "$(node -e '
+read -r fig5_wasm orbit_wasm nrows <<< "$(node -e '
 const w = require(process.argv[1]);
 let t = performance.now();
 const s = new w.Bifurcation("{}");
@@ -53,7 +53,7 @@ section=$(mktemp)
     echo
     echo "| the page's figures | wasm32 in V8 | native command, 1 thread (whole process) |"
     echo "|---|---|---|"
-    echo "| default Fig. 5 diagram (400 Ω values each way, chunks of 20 points; $rows rows) | $fig5_wasm s | $(python3 -c "print(f'{$fig5_native:.2f}')") s |"
+    echo "| default Fig. 5 diagram (400 Ω values each way, chunks of 20 points; $nrows rows) | $fig5_wasm s | $(python3 -c "print(f'{$fig5_native:.2f}')") s |"
     echo "| one orbit (Ω = 2.8: a click on the diagram) | $orbit_wasm ms | $(python3 -c "print(f'{$orbit_native * 1000:.1f}')") ms |"
     echo
     echo "The same Rust call (\`afmdyn_wasm::advance_periods\`), best of 3, compiled natively and to"
