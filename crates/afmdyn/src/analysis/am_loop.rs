@@ -286,22 +286,41 @@ struct Sums {
     last: f64,
 }
 
+/// Where a line engages, in pixels along it: the trace's first drive period,
+/// 0.5/`periods_per_pixel` (its material is the one [`Engage`] must be of).
+pub fn engage_position(spec: &LineSpec) -> f64 {
+    0.5 / spec.periods_per_pixel as f64
+}
+
 /// Scan one line (module docs): engage at the line's start for `engage_periods` from `engage`,
 /// then the trace over `pixels` × `periods_per_pixel` drive periods and the retrace back.
 /// `under_tip(s)` is the material and the true height (g₀) at the position s ∈ [0, pixels]
 /// along the line (in pixels, x increasing).
 ///
 /// # Errors
-/// [`SimError::Cancelled`] once `cancel` is set; the model's and the integrator's errors.
+/// [`SimError::OutOfRange`] naming `periods_per_pixel`, `samples` or `materials` when 0;
+/// [`SimError::Cancelled`] once `cancel` is set; `material` when `under_tip` names none of
+/// `spec.materials`; the model's and the integrator's errors.
 pub fn scan_line(
     spec: &LineSpec,
     engage: &Engage,
     under_tip: &dyn Fn(f64) -> (usize, f64),
     cancel: &AtomicBool,
 ) -> Result<ScanLine, SimError> {
+    for (name, n) in [
+        ("periods_per_pixel", spec.periods_per_pixel),
+        ("samples", spec.samples),
+        ("materials", spec.materials.len()),
+    ] {
+        if n == 0 {
+            return Err(SimError::out_of_range(name, n, "must be at least 1"));
+        }
+    }
     let base = &spec.materials[0];
     let period = base.period();
-    let h0 = under_tip(0.0).1;
+    // the engage holds the tip where the trace's first period is
+    let s0 = engage_position(spec);
+    let h0 = under_tip(s0).1;
     let mut z = engage.state.clone();
     let mut lock = LockIn::new(
         spec.gains.time_constant,
@@ -323,7 +342,9 @@ pub fn scan_line(
          sums: &mut Sums|
          -> Result<Option<(usize, crate::analysis::observables::Observables)>, SimError> {
             let (m, h) = under_tip(s);
-            let mat = &spec.materials[m];
+            let mat = spec.materials.get(m).ok_or_else(|| {
+                SimError::out_of_range("material", m, "must be one of the spec's materials")
+            })?;
             let p = mat.with(SweepParam::Alpha5, mat.alpha5_for_rest_distance(*piezo - h));
             let model = CantileverModel::new(&p)?;
             let start = fit_state(&z, model.dim());
@@ -356,7 +377,7 @@ pub fn scan_line(
         if cancel.load(Ordering::Relaxed) {
             return Err(SimError::Cancelled);
         }
-        period_at(0.0, false, &mut piezo, &mut scratch)?;
+        period_at(s0, false, &mut piezo, &mut scratch)?;
     }
     let n_c = spec.periods_per_pixel;
     let mut lines = [Vec::new(), Vec::new()];

@@ -35,7 +35,8 @@
 
 use super::image::{image_of, material_curves, Image, ImageRequest, SampleMap};
 use crate::analysis::am_loop::{
-    scan_line, scan_lines, Engage, FeedbackGains, LineSpec, ScanLine, ScanPixel, LOCK_IN_SAMPLES,
+    engage_position, scan_line, scan_lines, Engage, FeedbackGains, LineSpec, ScanLine, ScanPixel,
+    LOCK_IN_SAMPLES,
 };
 use crate::analysis::approach::rest_distance;
 use crate::error::SimError;
@@ -372,7 +373,7 @@ impl ScanStudy {
             let m = map.domain_at(x, y).map_or(0, |k| self.of_domain[k]);
             (m, map.height_at(x, y) / g0)
         };
-        let first = under_tip(0.5 / self.spec.periods_per_pixel as f64).0;
+        let first = under_tip(engage_position(&self.spec)).0;
         scan_line(&self.spec, &self.engage[first], &under_tip, cancel)
     }
 
