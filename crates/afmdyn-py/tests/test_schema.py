@@ -25,13 +25,15 @@ P1 = str(EXAMPLES / "probe-point-mass-dmt.toml")
 P2 = str(EXAMPLES / "probe-geometry-hertz.toml")
 EIG = str(EXAMPLES / "probe-eigenmodes-dmt.toml")
 BIM = str(EXAMPLES / "probe-bimodal.toml")
+STRIPE = str(EXAMPLES / "sample-stripe.toml")
+IMAGE = ["--probe", P1, "--sample", STRIPE, "--setpoint", 0.7, "--pixels", 4]
 IMPACT = "--contact-law impact --restitution 0.5 --modes 1 --gap 0.05 --omega 3".split()
 IMPACT_PY = dict(contact_law="impact", restitution=0.5, modes=1, gap=0.05, omega=3.0)
 SHORT = ["--max-periods", 300]
 
 COMMANDS = ["modes", "units", "simulate", "converge", "bifurcation", "attractors", "orbit",
             "continue", "lyapunov", "approach", "resonance", "chart", "basins", "reconstruct",
-            "fm", "bimodal"]
+            "fm", "bimodal", "image"]
 FM = str(EXAMPLES / "fm-vdw.csv")
 FM_ARGS = ["--fm", FM, "--spring-constant", 40, "--resonance-frequency", "300kHz",
            "--amplitude", "10nm"]
@@ -129,13 +131,16 @@ CLI_CASES: List[Tuple[str, List[Any]]] = [
     ("approach", ["--points", 4, "--no-branches", "--files", "none", "--probe", EIG]),
     ("bimodal", ["--points", 4, "--files", "none", "--probe", BIM]),
     ("bimodal", ["--points", 2, "--files", "none", "--average", "--probe", BIM]),
+    ("image", IMAGE),
+    ("image", [*IMAGE, "--setpoint-study", "0.3:0.9:3"]),
+    ("image", [*IMAGE, "--feedback", "pi", "--scan-rate", 20]),
     # (a probe refuses the dimensionless omega axis: the drive frequency in Hz, 0.99 f0)
     ("chart", ["--x", "z-c", "--x-from", 6e-9, "--x-to", 8e-9, "--x-steps", 2, "--y",
                "drive-frequency", "--y-from", "297kHz", "--y-to", "297kHz", "--y-steps", 1,
                "--starts", 1, *SHORT, "--probe", P1]),
 ]
 WRITES = {"simulate", "converge", "bifurcation", "attractors", "continue", "chart", "basins",
-          "reconstruct", "fm"}
+          "reconstruct", "fm", "image"}
 
 
 @pytest.fixture(scope="module")
@@ -160,7 +165,8 @@ def test_every_command_has_a_case() -> None:
 def test_cli_documents_conform(cli_docs: List[Tuple[str, List[Any], Dict[str, Any]]], k: int) -> None:
     name, args, doc = cli_docs[k]
     check(name, doc)
-    assert ("si" in doc) == ("--probe" in args), "an si block exactly with a probe"
+    # (an image is in SI throughout: no si block of scales)
+    assert ("si" in doc) == ("--probe" in args and name != "image"), "an si block exactly with a probe"
 
 
 # ------------------------------------------------------------------------ Python
@@ -213,7 +219,21 @@ def _python_docs() -> List[Tuple[str, str, Callable[[], Any]]]:
         ("fm", "fm", lambda: afmdyn.summary(afmdyn.fm(points=4))),
         ("fm", "fm probe", lambda: afmdyn.summary(afmdyn.fm(points=4, probe=P1))),
         ("bimodal", "bimodal probe", lambda: afmdyn.summary(afmdyn.bimodal(probe=BIM, **curve))),
+        # an image is in SI throughout (its label names no probe: no si block)
+        ("image", "image", lambda: _quiet(lambda: afmdyn.summary(
+            afmdyn.image(P1, STRIPE, 0.7, pixels=4)))),
+        ("image", "image pi", lambda: _quiet(lambda: afmdyn.summary(afmdyn.image(
+            P1, STRIPE, 0.7, pixels=4, feedback="pi", scan_rate=20.0, progress=False)))),
     ]
+
+
+def _quiet(run: Callable[[], Any]) -> Any:
+    """``run()`` with afmdyn's warnings (an image's regime switches) silenced."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", afmdyn.AfmdynWarning)
+        return run()
 
 
 def _fm_curve() -> Dict[str, Any]:
