@@ -38,8 +38,8 @@ PY
 "
 }
 run "point mass Q = 400, stripe" examples/probe-point-mass-dmt.toml examples/sample-stripe.toml 64 1 1
-run "RTESPA-300 Q = 400, blend" examples/probe-rtespa300-polystyrene.toml examples/sample-blend.toml 64 4 1
-run "RTESPA-300 Q = 400, blend" examples/probe-rtespa300-polystyrene.toml examples/sample-blend.toml 64 4 2
+run "RTESPA-300 Q = 500, blend" examples/probe-rtespa300-polystyrene.toml examples/sample-blend.toml 64 4 1
+run "RTESPA-300 Q = 500, blend" examples/probe-rtespa300-polystyrene.toml examples/sample-blend.toml 64 4 2
 run "beam N = 3, stripe" examples/probe-beam-dmt.toml examples/sample-stripe.toml 32 1 1
 section=$(mktemp)
 {

@@ -245,13 +245,7 @@ pub fn image_cmd(a: &ImageArgs) -> Result<(), CliError> {
         ))
     })?;
     let map = SampleMap::load(&a.sample)?;
-    let d = ImageRequest::at(a.setpoint);
-    let req = ImageRequest {
-        pixels: a.pixels.unwrap_or(d.pixels),
-        lines: a.lines,
-        curve_points: a.curve_points.unwrap_or(d.curve_points),
-        ..d
-    };
+    let req = ImageRequest::with(a.setpoint, a.pixels, a.lines, a.curve_points);
     req.validate(&map)?;
     let ratios = a.setpoint_study.as_deref().map(study_ratios).transpose()?;
     if let Some(scan) = pi {

@@ -309,6 +309,22 @@ fn a_height_map_csv_beside_the_sample_file_is_imaged() {
     );
 }
 
+/// `examples/probe-point-mass-dmt.toml` with Q = 100 (a short loop time: a quick scan),
+/// written into `dir`: its path and text.
+fn q100_probe(dir: &std::path::Path) -> (std::path::PathBuf, String) {
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../../");
+    let text = std::fs::read_to_string(format!("{root}examples/probe-point-mass-dmt.toml"))
+        .unwrap()
+        .replace("quality_factor = 400", "quality_factor = 100");
+    assert!(
+        text.contains("quality_factor = 100"),
+        "the example's Q changed"
+    );
+    let probe = dir.join("probe.toml");
+    std::fs::write(&probe, &text).unwrap();
+    (probe, text)
+}
+
 /// `--feedback pi --json` prints the library's document of the same scan (lines on 2 threads
 /// here, 1 in the library) and writes the maps of the recorded height, the error image, the
 /// phase and E_dis, and the profile.
@@ -319,11 +335,7 @@ fn the_pi_scan_writes_the_libraries_document_and_maps() {
     use afmdyn::request::image_scan::{pi_image, PiScan};
     let dir = tempfile::tempdir().unwrap();
     let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../../");
-    let text = std::fs::read_to_string(format!("{root}examples/probe-point-mass-dmt.toml"))
-        .unwrap()
-        .replace("quality_factor = 400", "quality_factor = 100");
-    let probe = dir.path().join("probe.toml");
-    std::fs::write(&probe, &text).unwrap();
+    let (probe, text) = q100_probe(dir.path());
     let out = afmdyn(&[
         "image",
         "--probe",
@@ -390,11 +402,7 @@ fn the_pi_scan_writes_the_libraries_document_and_maps() {
 /// `afmdyn image --feedback pi` of a 2-line map under the Q = 100 point mass, in `dir`.
 fn two_line_scan(dir: &std::path::Path, extra: &[&str]) -> Output {
     let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../../");
-    let text = std::fs::read_to_string(format!("{root}examples/probe-point-mass-dmt.toml"))
-        .unwrap()
-        .replace("quality_factor = 400", "quality_factor = 100");
-    let probe = dir.join("probe.toml");
-    std::fs::write(&probe, &text).unwrap();
+    let (probe, _) = q100_probe(dir);
     let map = std::fs::read_to_string(format!("{root}examples/sample-stripe.toml"))
         .unwrap()
         .replace("size = [1.0e-6, 0.0]", "size = [1.0e-6, 0.2e-6]");

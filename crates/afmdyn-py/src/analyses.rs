@@ -629,13 +629,7 @@ pub fn image<'py>(
 ) -> PyResult<Dict<'py>> {
     use afmdyn::request::image::{image, ImageRequest};
     let (table, map) = image_inputs(probe, sample, height_map)?;
-    let d = ImageRequest::at(setpoint);
-    let req = ImageRequest {
-        pixels: pixels.unwrap_or(d.pixels),
-        lines,
-        curve_points: curve_points.unwrap_or(d.curve_points),
-        ..d
-    };
+    let req = ImageRequest::with(setpoint, pixels, lines, curve_points);
     let img = py.detach(|| image(&table, &map, &req)).map_err(sim_error)?;
     let out = Out::new(py);
     out.json(&img.document(setpoint))?;
@@ -667,33 +661,30 @@ pub fn pi_image<'py>(
     threads: Option<usize>,
     progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    use afmdyn::request::image::ImageRequest;
-    use afmdyn::request::image_scan::{PiScan, ScanStudy};
-    let (table, map) = image_inputs(probe, sample, height_map)?;
-    afmdyn::request::limits::check_threads(threads).map_err(sim_error)?;
-    let d = ImageRequest::at(setpoint);
-    let req = ImageRequest {
-        pixels: pixels.unwrap_or(d.pixels),
+    use afmdyn::request::image_scan::ScanStudy;
+    let recipe = crate::image_tasks::recipe(
+        probe,
+        sample,
+        setpoint,
+        pixels,
         lines,
-        curve_points: curve_points.unwrap_or(d.curve_points),
-        ..d
-    };
-    let scan = PiScan {
+        curve_points,
+        height_map,
         scan_rate,
         gains,
         time_constant,
-    };
-    // the settings are checked before the approach curves are run
+    )?;
+    afmdyn::request::limits::check_threads(threads).map_err(sim_error)?;
     let job = Job::default();
     let worker = job.clone();
     let img = run(
         py,
         &job,
-        Some(req.lines(&map)),
+        Some(recipe.request.lines(&recipe.map)),
         progress.as_ref(),
         Stop::Cancellable,
         move || -> PyResult<afmdyn::request::image_scan::PiImage> {
-            let study = ScanStudy::new(&table, &map, &req, &scan).map_err(sim_error)?;
+            let study = ScanStudy::from_recipe(&recipe).map_err(sim_error)?;
             let mut store = afmdyn::study::MemoryStore::default();
             execute(&study, &mut store, false, threads, &*worker.progress).map_err(study_error)?;
             study.assemble(store.records).map_err(sim_error)

@@ -19,6 +19,37 @@ pub struct ScanStudy {
     text: String,
 }
 
+/// The recipe of a PI scan from the arguments of `afmdyn.image(feedback="pi")` (`None`: the
+/// defaults): the probe's TOML text, the sample map's text or path, its height map.
+///
+/// # Errors
+/// `ValueError` for a probe or sample map the library refuses.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn recipe(
+    probe: &str,
+    sample: &str,
+    setpoint: f64,
+    pixels: Option<usize>,
+    lines: Option<usize>,
+    curve_points: Option<usize>,
+    height_map: Option<Vec<Vec<f64>>>,
+    scan_rate: Option<f64>,
+    gains: Option<(f64, f64)>,
+    time_constant: Option<f64>,
+) -> PyResult<ScanRecipe> {
+    let (probe, map) = crate::analyses::image_inputs(probe, sample, height_map)?;
+    Ok(ScanRecipe {
+        probe,
+        map,
+        request: ImageRequest::with(setpoint, pixels, lines, curve_points),
+        scan: PiScan {
+            scan_rate,
+            gains,
+            time_constant,
+        },
+    })
+}
+
 impl ScanStudy {
     fn of(recipe: &ScanRecipe) -> PyResult<Self> {
         let study = Study::from_recipe(recipe).map_err(sim_error)?;
@@ -54,23 +85,18 @@ impl ScanStudy {
         gains: Option<(f64, f64)>,
         time_constant: Option<f64>,
     ) -> PyResult<Self> {
-        let (table, map) = crate::analyses::image_inputs(probe, sample, height_map)?;
-        let d = ImageRequest::at(setpoint);
-        ScanStudy::of(&ScanRecipe {
-            probe: table,
-            map,
-            request: ImageRequest {
-                pixels: pixels.unwrap_or(d.pixels),
-                lines,
-                curve_points: curve_points.unwrap_or(d.curve_points),
-                ..d
-            },
-            scan: PiScan {
-                scan_rate,
-                gains,
-                time_constant,
-            },
-        })
+        ScanStudy::of(&recipe(
+            probe,
+            sample,
+            setpoint,
+            pixels,
+            lines,
+            curve_points,
+            height_map,
+            scan_rate,
+            gains,
+            time_constant,
+        )?)
     }
 
     /// The recipe: JSON text that rebuilds this scan in any process.

@@ -320,9 +320,9 @@ fn the_scan_does_not_depend_on_the_thread_count() {
     assert_eq!(h[0], h[1]);
 }
 
-/// A real lever (RTESPA-300 over polystyrene, Q = 400 at 300 kHz; `examples/
-/// probe-rtespa300-polystyrene.toml`) at the default settings (a pixel 5/K_I long, K_I from
-/// its τ_c = 2Q/ω₀): the settled pixels record the ideal heights within 0.05 nm.
+/// A real lever (RTESPA-300 from the cantilever library over polystyrene, Q = 500 at 300 kHz;
+/// `examples/probe-rtespa300-polystyrene.toml`) at the default settings (a pixel 5/K_I long,
+/// K_I from its τ_c = 2Q/ω₀): the settled pixels record the ideal heights within 0.05 nm.
 #[test]
 fn real_lever_at_the_default_settings_records_the_ideal_heights() {
     let p: toml::Table = repo("examples/probe-rtespa300-polystyrene.toml")

@@ -102,30 +102,46 @@ def image(
         )
     text, source, rows = _inputs(probe, sample, height_map)
     if feedback == "pi":
-        pair = None if gains is None else (float(gains[0]), float(gains[1]))
-        if gains is not None and len(gains) != 2:
-            raise ValueError("gains: must be two numbers (K_P, K_I in 1/s)")
         with reporter(progress, "image", unit="line") as cb:
             out = _core.pi_image(
                 text, source, setpoint, pixels, lines, curve_points, rows,
-                scan_rate, pair, time_constant, threads, cb,
+                scan_rate, _gains(gains), time_constant, threads, cb,
             )
-        return _scan_dataset(out, setpoint)
-    out = _core.image(text, source, setpoint, pixels, lines, curve_points, rows)
+    else:
+        out = _core.image(text, source, setpoint, pixels, lines, curve_points, rows)
+    return _dataset(out, setpoint)
+
+
+def _gains(gains: Optional[Sequence[float]]) -> Optional[Tuple[float, float]]:
+    """``gains`` as the pair (K_P, K_I) the core takes."""
+    if gains is None:
+        return None
+    if len(gains) != 2:
+        raise ValueError("gains: must be two numbers (K_P, K_I in 1/s)")
+    return (float(gains[0]), float(gains[1]))
+
+
+def _dataset(out: Dict[str, Any], setpoint: float) -> xr.Dataset:
+    """The Dataset of an image (``{"json", "layout"}``), ideal or PI: its maps and flags as the
+    library lays them out (``image.nc``'s variables, units and long names), its integer codes
+    (regime, material, domain; a PI scan's ``_retrace`` ones) as the document's words."""
     doc = json.loads(out["json"])
     _warn(doc)
     img = doc["image"]
     dims = ("y", "x")
-    # the numeric maps and the coordinates as the library lays them out (image.nc's variables,
-    # units and long names); the codes of regime, material and domain as the document's words
     layout = _layout.variables(out["layout"])
     data: Dict[str, Any] = {}
     for name, (vdims, values, attrs) in layout.items():
-        if vdims == dims and values.dtype.kind == "f":
+        if vdims != dims:
+            continue
+        if values.dtype.kind in "fb":
             data[name] = (vdims, values, attrs)
-    for name in ("regime", "material", "domain"):
-        values = np.array([["" if v is None else v for v in row] for row in img[name]])
-        data[name] = (dims, values, {"long_name": layout[name][2]["long_name"]})
+        else:
+            base, retrace, _ = name.partition("_retrace")
+            block = img["retrace"] if retrace else img
+            words = np.array([["" if v is None else v for v in row] for row in block[base]])
+            data[name] = (dims, words, {"long_name": attrs["long_name"]})
+    extra = {k: json.dumps(doc[k]) for k in ("scan", "artefacts") if k in doc}
     return xr.Dataset(
         data,
         coords={name: layout[name] for name in ("x", "y")},
@@ -133,37 +149,7 @@ def image(
             "setpoint": setpoint,
             "reference_z_c": doc["reference_z_c"],
             "feedback": doc["feedback"],
-            "summary": json.dumps(doc),
-        },
-    )
-
-
-def _scan_dataset(out: Dict[str, Any], setpoint: float) -> xr.Dataset:
-    """The Dataset of a PI scan (``{"json", "layout"}``): its variables as the library lays
-    them out (``image.nc``'s), the regime and material codes as the document's words."""
-    doc = json.loads(out["json"])
-    _warn(doc)
-    img = doc["image"]
-    layout = _layout.variables(out["layout"])
-    dims = ("y", "x")
-    data: Dict[str, Any] = {}
-    for name, (vdims, values, attrs) in layout.items():
-        if vdims == dims and values.dtype.kind in "fb":
-            data[name] = (vdims, values, attrs)
-    for suffix, block in (("", img), ("_retrace", img["retrace"])):
-        for name in ("regime", "material"):
-            words = np.array(block[name])
-            data[name + suffix] = (dims, words, {"long_name": layout[name + suffix][2]["long_name"]})
-    data["domain"] = (dims, np.array(img["domain"]), {"long_name": layout["domain"][2]["long_name"]})
-    return xr.Dataset(
-        data,
-        coords={name: layout[name] for name in ("x", "y")},
-        attrs={
-            "setpoint": setpoint,
-            "reference_z_c": doc["reference_z_c"],
-            "feedback": doc["feedback"],
-            "scan": json.dumps(doc["scan"]),
-            "artefacts": json.dumps(doc["artefacts"]),
+            **extra,
             "summary": json.dumps(doc),
         },
     )

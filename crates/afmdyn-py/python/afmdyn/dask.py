@@ -508,14 +508,11 @@ def image(
     machine's cores, closed at the end): each line is a task, a pure function of the request
     and its number, so the Dataset equals :func:`afmdyn.image`'s bit for bit.
     """
-    from ._image import _inputs, _scan_dataset
+    from ._image import _dataset, _gains, _inputs
 
     text, source, rows = _inputs(probe, sample, height_map)
-    pair = None if gains is None else (float(gains[0]), float(gains[1]))
-    if gains is not None and len(gains) != 2:
-        raise ValueError("gains: must be two numbers (K_P, K_I in 1/s)")
     s = _core.ScanStudy.build(text, source, setpoint, pixels, lines, curve_points, rows,
-                              scan_rate, pair, time_constant)
+                              scan_rate, _gains(gains), time_constant)
     n = s.lines()
     with _cluster(client) as client:
         texts: List[str] = []
@@ -527,7 +524,7 @@ def image(
                 if cb is not None:
                     cb(len(texts), n)
         out = s.document(texts)
-    return _scan_dataset(out, setpoint)
+    return _dataset(out, setpoint)
 
 
 __all__ = [

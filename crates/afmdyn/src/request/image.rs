@@ -472,6 +472,23 @@ impl ImageRequest {
         }
     }
 
+    /// The request at `setpoint` with the options a front end was given (`None`: the
+    /// defaults of [`ImageRequest::at`]).
+    pub fn with(
+        setpoint: f64,
+        pixels: Option<usize>,
+        lines: Option<usize>,
+        curve_points: Option<usize>,
+    ) -> ImageRequest {
+        let d = ImageRequest::at(setpoint);
+        ImageRequest {
+            pixels: pixels.unwrap_or(d.pixels),
+            lines,
+            curve_points: curve_points.unwrap_or(d.curve_points),
+            ..d
+        }
+    }
+
     /// The number of lines over `map`: as given, else as many as pixels (1 for a line map).
     pub fn lines(&self, map: &SampleMap) -> usize {
         self.lines
