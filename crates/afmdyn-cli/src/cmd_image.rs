@@ -237,13 +237,7 @@ pub fn image_cmd(a: &ImageArgs) -> Result<(), CliError> {
         }
     };
     let text = read_text(&a.probe).map_err(|e| CliError::Input(format!("probe {e}")))?;
-    let table: toml::Table = text.parse().map_err(|e: toml::de::Error| {
-        CliError::Input(format!(
-            "probe {}: {}",
-            a.probe.display(),
-            e.to_string().replace('\n', " ")
-        ))
-    })?;
+    let table = afmdyn::probe::Probe::table(&text, &a.probe.display().to_string())?;
     let map = SampleMap::load(&a.sample)?;
     let req = ImageRequest::with(a.setpoint, a.pixels, a.lines, a.curve_points);
     req.validate(&map)?;

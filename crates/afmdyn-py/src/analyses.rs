@@ -10,18 +10,16 @@ use crate::params::PyParams;
 use crate::run::{run, run_abandonable, Job, Stop};
 use afmdyn::analysis::bifurcation::SweepSpec;
 use afmdyn::analysis::steady::SteadyState;
-use afmdyn::integrate::build;
 use afmdyn::probe::Probe;
 use afmdyn::request::checkpoint::{self, CheckpointError};
 use afmdyn::request::{self, Analysis, Document, ModesRequest, Resolved};
 use afmdyn::request::{
     AttractorsRequest, BifurcationRequest, ContinuationRequest, ConvergeRequest, LyapunovRequest,
-    ObserveRequest, OrbitRequest, SeriesStore, SimulateRequest,
+    ObserveRequest, OrbitRequest, SimulateRequest,
 };
 use afmdyn::request::{DirLock, FileCheckpoint, LockError, MemoryCheckpoint, SweepRecord};
 use afmdyn::study::sweep::SweepStudy;
 use afmdyn::study::{execute, StudyError};
-use afmdyn::trajectory::{record, RecordSpec};
 use afmdyn::{report, CantileverModel, Params};
 use nalgebra::DVector;
 use numpy::Complex64;
@@ -29,11 +27,6 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
 type Dict<'py> = Bound<'py, PyDict>;
-
-/// The initial state: `None` is rest, else 2N values (a₁…a_N, ȧ₁…ȧ_N).
-fn initial_state(model: &CantileverModel, initial: Option<Vec<f64>>) -> PyResult<DVector<f64>> {
-    afmdyn::request::analyses::initial_state(model, initial.as_deref()).map_err(sim_error)
-}
 
 /// The library's [`request::run`] of `request` on `params` (with the probe file's SI block in
 /// the document) on a worker thread without the GIL: validated first, here; a `counted`
@@ -127,32 +120,18 @@ pub fn simulate<'py>(
         .transpose()
         .map_err(probe_error)?;
     let request: SimulateRequest = crate::convert::request("simulate", request)?;
-    // held in memory: τ, V_T, V̇_T, W, Ẇ, contact, force and the 2N + m state entries
-    let span = request
-        .validate(&p, SeriesStore::Memory, 7 + p.state_dim(), 8.0)
-        .map_err(sim_error)?;
+    let span = request.validate_in_memory(&p).map_err(sim_error)?;
     let su = report::SeriesUnits::new(&p, probe.as_ref());
-    let opts = request.integrator_options();
     let spp = request.samples_per_period;
-    let spec = RecordSpec {
-        transient_periods: request.transient,
-        record_tau: span.record_tau,
-        samples_per_period: spp,
-        energy: true,
-        body_contact: true,
-    };
-    let initial = request.initial;
     let worker_su = su;
     let (doc, layout, tau_end, switchings, body_contact, integrator) =
         run_abandonable(py, progress.as_ref(), move || -> PyResult<_> {
             let model = model_of(&p)?;
-            let z0 = initial_state(&model, initial)?;
-            let mut integ = build(&model, opts, 0.0, &z0).map_err(sim_error)?;
-            let tr = record(integ.as_mut(), &spec).map_err(sim_error)?;
+            let (tr, integrator) = request.record_whole(&model, &span).map_err(sim_error)?;
             let layout = report::simulate_layout(&model, &tr, &worker_su, spp);
             let doc = report::simulate(&model, &tr);
             let (events, body) = (tr.events.len(), tr.body_contact);
-            Ok((doc, layout, tr.tau_end, events, body, integ.name()))
+            Ok((doc, layout, tr.tau_end, events, body, integrator))
         })??;
     let out = Out::new(py);
     out.json(&report::with_si(doc, probe.as_ref(), &p))?;
@@ -590,9 +569,7 @@ pub(crate) fn image_inputs(
     sample: &str,
     height_map: Option<Vec<Vec<f64>>>,
 ) -> PyResult<(toml::Table, afmdyn::request::image::SampleMap)> {
-    let table: toml::Table = probe
-        .parse()
-        .map_err(|e: toml::de::Error| crate::errors::value_error(format!("probe: {e}")))?;
+    let table = Probe::table(probe, "probe").map_err(probe_error)?;
     let mut map = afmdyn::request::image::SampleMap::read(sample).map_err(sim_error)?;
     if let Some(rows) = height_map {
         map = map.with_height_map(rows).map_err(sim_error)?;

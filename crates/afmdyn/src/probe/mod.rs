@@ -570,13 +570,20 @@ impl Probe {
     /// [`ProbeError::Syntax`] for invalid TOML, [`ProbeError::Invalid`] listing every unknown,
     /// missing or out-of-range key.
     pub fn parse(text: &str, origin: &str) -> Result<Probe, ProbeError> {
-        let root: toml::Table = text
-            .parse()
+        Self::from_table(&Self::table(text, origin)?, origin)
+    }
+
+    /// A probe file's TOML text as its table, unresolved (an image reads each domain's sample
+    /// over it, [`crate::request::image::image`]); `origin` names it in errors.
+    ///
+    /// # Errors
+    /// [`ProbeError::Syntax`] for invalid TOML (the parser's message on one line).
+    pub fn table(text: &str, origin: &str) -> Result<toml::Table, ProbeError> {
+        text.parse()
             .map_err(|e: toml::de::Error| ProbeError::Syntax {
                 path: origin.to_string(),
                 message: e.to_string().replace('\n', " "),
-            })?;
-        Self::from_table(&root, origin)
+            })
     }
 
     /// Resolve a probe from its parsed TOML table (a chart sets one of its values per cell,
