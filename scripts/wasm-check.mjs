@@ -14,7 +14,7 @@ const require = createRequire(import.meta.url);
 const [pkg, bin] = process.argv.slice(2);
 const wasm = require(path.resolve(pkg));
 const root = path.resolve(path.dirname(new URL(import.meta.url).pathname), "..");
-let passed = 0, failed = 0;
+let passed = 0, failed = 0, message = "";
 
 function native(args) {
   return JSON.parse(execFileSync(bin, [...args, "--json"], { cwd: root, encoding: "utf8" }));
@@ -114,7 +114,57 @@ check("a bifurcation in chunks of 5 is `afmdyn bifurcation`'s bifurcation.csv (r
 console.log(`     ${rows.length} rows, ${groups.size} periodic points; their largest difference ` +
   `${far.toExponential(1)}`);
 
-let message = "";
+// simulate from the native period-2 orbit's state at Ω = 2.8 (the page's time series and phase
+// portrait of a clicked orbit): the summary is `afmdyn simulate --json`'s, the series
+// periods × samples_per_period + 1 samples, W(1,τ) and V_T those of its timeseries.npy
+const z = native(["orbit", "--omega", "2.8"]).state;
+const half = z.length / 2;
+const simDir = execFileSync("mktemp", ["-d"], { encoding: "utf8" }).trim();
+const simRef = native(["simulate", "--omega", "2.8", "--periods", "4", "--samples-per-period",
+  "50", `--initial-modal=${z.slice(0, half).join(",")};${z.slice(half).join(",")}`,
+  "--files", "data", "--out", simDir]);
+const sim = JSON.parse(wasm.run("simulate", JSON.stringify({ model: { omega: 2.8 },
+  request: { initial: z, periods: 4, samples_per_period: 50 } })));
+// timeseries.npy: float64 rows after its header (magic, version 1, header length, dict)
+const npy = readFileSync(path.join(simDir, "timeseries.npy"));
+const body = 10 + npy.readUInt16LE(8);
+const [rowsN, cols] = /'shape': \((\d+), (\d+)\)/.exec(npy.toString("latin1", 10, body)).slice(1).map(Number);
+const column = (k) => Array.from({ length: rowsN }, (_, i) => npy.readDoubleLE(body + 8 * (i * cols + k)));
+[w, at] = worst({ ...sim.summary, files: simRef.files }, simRef);
+const [ws, ats] = worst([sim.series.v_t.values, sim.series.w_tip.values], [column(1), column(2)]);
+const length = sim.series.tau.values.length;
+check("simulate from the orbit's state: summary is `afmdyn simulate --json`'s (to 1e-9), " +
+  "201 samples, W(1,τ) and V_T its timeseries.npy's (to 1e-9)",
+  w <= 1e-9 && ws <= 1e-9 && length === 201 && rowsN === 201 && sim.summary.files === "none",
+  `summary ${w} at ${at}, series ${ws} at ${ats}, ${length} samples`);
+console.log(`     largest difference: summary ${w.toExponential(1)} at ${at}, series ` +
+  `${ws.toExponential(1)} at ${ats}`);
+
+const lib = JSON.parse(wasm.cantilevers());
+check("cantilevers() is `afmdyn cantilevers --json`", isDeepStrictEqual(lib, native(["cantilevers"])));
+
+// the ideal-feedback image of the stripe sample, as `afmdyn image … --json`
+const sampleFile = "examples/sample-stripe.toml";
+const sampleText = readFileSync(path.join(root, sampleFile), "utf8");
+const imgDir = execFileSync("mktemp", ["-d"], { encoding: "utf8" }).trim();
+const img = JSON.parse(wasm.run("image", JSON.stringify({ probe: text, sample: sampleText,
+  request: { setpoint: 0.7, pixels: 16 } })));
+[w, at] = worst(img, native(["image", "--probe", probe, "--sample", sampleFile, "--setpoint",
+  "0.7", "--pixels", "16", "--out", imgDir]));
+check("image of the stripe sample is `afmdyn image --setpoint 0.7 --pixels 16 --json`'s " +
+  "(numbers to 1e-9)", w <= 1e-9, `${w} at ${at}`);
+console.log(`     largest difference ${w.toExponential(1)} at ${at}`);
+
+// wasm has no files: a height map file is refused with the library's message
+message = "";
+try {
+  wasm.run("image", JSON.stringify({ probe: text, request: { setpoint: 0.7 },
+    sample: 'size = [1.0e-6, 0.0]\nheight_map = "h.csv"\n' }));
+} catch (e) { message = String(e.message); }
+check("a height map file is refused in wasm, naming height_map",
+  message.includes("height_map") && message.includes("h.csv") && !message.includes("\n"), message);
+
+message = "";
 try { wasm.run("orbit", JSON.stringify({ model: { omega: -1 } })); }
 catch (e) { message = String(e.message); }
 check("a bad Ω is refused naming omega", message.includes("omega"), message);

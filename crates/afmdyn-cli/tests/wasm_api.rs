@@ -148,3 +148,262 @@ fn a_bifurcation_in_chunks_is_the_command_lines_sweep() {
         assert_eq!(num("tau"), w["tau"].as_f64().unwrap());
     }
 }
+
+/// The repository's file `path` as text (a probe or sample map the page would send).
+fn example(path: &str) -> String {
+    std::fs::read_to_string(format!("{}/../../{path}", env!("CARGO_MANIFEST_DIR"))).unwrap()
+}
+
+/// `simulate` of `input` (its request `{"periods", "samples_per_period", …}`) and
+/// `afmdyn simulate ARGS --files data --json` (the same run): the wasm output, after checking
+/// that its summary is the command line's (but for `"files": "none"`, nothing being written),
+/// and the shape and rows of the command line's `timeseries.npy` (columns t/τ, V_T, W, Ẇ,
+/// contact, force, a, ȧ).
+fn simulated(input: Value, args: &[&str]) -> (Value, Vec<u64>, Vec<f64>) {
+    let dir = tempfile::tempdir().unwrap();
+    let out_dir = dir.path().to_str().unwrap();
+    let mut cli_args = vec!["simulate"];
+    cli_args.extend(args);
+    cli_args.extend(["--files", "data", "--out", out_dir, "--json"]);
+    let mut cli_doc = cli_json(&cli_args);
+    let out = wasm("simulate", input);
+    assert_eq!(out["summary"]["files"], "none");
+    cli_doc["files"] = json!("none");
+    assert_eq!(out["summary"], cli_doc);
+    let bytes = std::fs::read(dir.path().join("timeseries.npy")).unwrap();
+    let npy = npyz::NpyFile::new(&bytes[..]).unwrap();
+    let shape = npy.shape().to_vec();
+    (out, shape, npy.into_vec().unwrap())
+}
+
+/// The numbers of a series variable (null as NaN).
+fn values(series: &Value, name: &str) -> Vec<f64> {
+    series[name]["values"]
+        .as_array()
+        .unwrap_or_else(|| panic!("{name}"))
+        .iter()
+        .map(|v| match v {
+            Value::Bool(b) => f64::from(u8::from(*b)),
+            v => v.as_f64().unwrap_or(f64::NAN),
+        })
+        .collect()
+}
+
+/// `simulate` from the period-2 orbit's state at Ω = 2.8 (the page's phase portrait of a
+/// clicked orbit): its summary is `afmdyn simulate --json`'s with the same periods, samples and
+/// initial state, and its series are the numbers of the command line's `timeseries.npy`
+/// exactly, periods × samples_per_period + 1 of them, starting at the given state.
+#[test]
+fn simulate_is_the_command_lines_run_and_time_series() {
+    let orbit = wasm("orbit", json!({"model": {"omega": 2.8}}));
+    let z: Vec<f64> = serde_json::from_value(orbit["state"].clone()).unwrap();
+    let n = z.len() / 2;
+    let initial = afmdyn::report::initial_modal(Some(&nalgebra::DVector::from_vec(z.clone())));
+    let (out, shape, rows) = simulated(
+        json!({"model": {"omega": 2.8},
+               "request": {"initial": z, "periods": 4, "samples_per_period": 50}}),
+        &[
+            "--omega",
+            "2.8",
+            "--periods",
+            "4",
+            "--samples-per-period",
+            "50",
+            &format!("--initial-modal={initial}"),
+        ],
+    );
+    let series = &out["series"];
+    assert_eq!(series["tau"]["dims"], json!(["tau"]));
+    assert_eq!(series["a"]["dims"], json!(["tau", "mode"]));
+    assert_eq!(series["a"]["shape"], json!([201, n]));
+    assert_eq!(shape, [4 * 50 + 1, 6 + 2 * n as u64]);
+    let width = shape[1] as usize;
+    let column = |k: usize| -> Vec<f64> { rows.chunks(width).map(|r| r[k]).collect() };
+    for (k, name) in [
+        "tau",
+        "v_t",
+        "w_tip",
+        "w_tip_dot",
+        "in_contact",
+        "contact_force",
+    ]
+    .iter()
+    .enumerate()
+    {
+        assert_eq!(values(series, name), column(k), "{name}");
+    }
+    let (a, a_dot) = (values(series, "a"), values(series, "a_dot"));
+    for j in 0..n {
+        let of = |v: &[f64]| v.chunks(n).map(|r| r[j]).collect::<Vec<_>>();
+        assert_eq!(of(&a), column(6 + j), "a_{}", j + 1);
+        assert_eq!(of(&a_dot), column(6 + n + j), "a_dot_{}", j + 1);
+    }
+    // the first sample is the given state, at τ = 0
+    assert_eq!(values(series, "tau")[0], 0.0);
+    assert_eq!(&a[..n], &z[..n]);
+    assert_eq!(&a_dot[..n], &z[n..]);
+    assert_eq!(values(series, "v_t_dot").len(), 201);
+    assert!(series["contact_force"]["attrs"]["sign_convention"].is_string());
+}
+
+/// `simulate` from a probe file is in SI, as `afmdyn simulate --probe`: the time is `t` (s),
+/// lengths in m, the summary with its `si` block.
+#[test]
+fn simulate_from_a_probe_is_in_si_as_the_command_line() {
+    let path = "examples/probe-point-mass-dmt.toml";
+    let (out, shape, rows) = simulated(
+        json!({"probe": example(path), "request": {"periods": 3, "samples_per_period": 40}}),
+        &[
+            "--probe",
+            path,
+            "--periods",
+            "3",
+            "--samples-per-period",
+            "40",
+        ],
+    );
+    let series = &out["series"];
+    assert!(out["summary"]["si"].is_object());
+    assert!(series.get("tau").is_none());
+    assert_eq!(series["t"]["units"], "s");
+    assert_eq!(series["w_tip"]["units"], "m");
+    let width = shape[1] as usize;
+    for (k, name) in ["t", "v_t", "w_tip", "w_tip_dot"].iter().enumerate() {
+        let col: Vec<f64> = rows.chunks(width).map(|r| r[k]).collect();
+        assert_eq!(values(series, name), col, "{name}");
+    }
+}
+
+/// The cantilever library is `afmdyn cantilevers --json`.
+#[test]
+fn cantilevers_are_the_command_lines() {
+    let doc: Value = serde_json::from_str(&afmdyn_wasm::cantilevers()).unwrap();
+    assert_eq!(doc, cli_json(&["cantilevers", "--json"]));
+}
+
+/// The bimodal approach curve from examples/probe-bimodal.toml is `afmdyn bimodal --json`'s;
+/// a single-frequency drive is refused as there.
+#[test]
+fn bimodal_is_the_command_lines_curve() {
+    let path = "examples/probe-bimodal.toml";
+    assert_eq!(
+        wasm(
+            "bimodal",
+            json!({"probe": example(path), "request": {"points": 12, "branches": false}})
+        ),
+        cli_json(&[
+            "bimodal",
+            "--probe",
+            path,
+            "--points",
+            "12",
+            "--no-branches",
+            "--files",
+            "none",
+            "--json"
+        ])
+    );
+    let probe = example("examples/probe-point-mass-dmt.toml");
+    let e = run_json("bimodal", &json!({"probe": probe}).to_string()).unwrap_err();
+    assert!(e.contains("free_amplitude"), "{e}");
+}
+
+/// The ideal-feedback image of the stripe sample is `afmdyn image --json`'s, with its setpoint
+/// study; the PI feedback, missing inputs and model keys are refused.
+#[test]
+fn image_is_the_command_lines_document() {
+    let dir = tempfile::tempdir().unwrap();
+    let (probe, sample) = (
+        "examples/probe-point-mass-dmt.toml",
+        "examples/sample-stripe.toml",
+    );
+    let input = |request: Value| json!({"probe": example(probe), "sample": example(sample), "request": request});
+    assert_eq!(
+        wasm(
+            "image",
+            input(json!({"setpoint": 0.7, "pixels": 16, "setpoint_study": "0.3:0.9:4"}))
+        ),
+        cli_json(&[
+            "image",
+            "--probe",
+            probe,
+            "--sample",
+            sample,
+            "--setpoint",
+            "0.7",
+            "--pixels",
+            "16",
+            "--setpoint-study",
+            "0.3:0.9:4",
+            "--out",
+            dir.path().to_str().unwrap(),
+            "--json"
+        ])
+    );
+    let refused = |input: Value, words: &[&str]| {
+        let e = run_json("image", &input.to_string()).unwrap_err();
+        assert!(words.iter().all(|w| e.contains(w)), "{e}");
+        assert!(!e.contains('\n'), "{e}");
+    };
+    refused(
+        input(json!({"setpoint": 0.7, "feedback": "pi"})),
+        &["feedback", "ideal"],
+    );
+    refused(input(json!({"pixels": 8})), &["setpoint", "(0, 1)"]);
+    refused(input(json!({"setpoint": 1.5})), &["setpoint", "(0, 1)"]);
+    refused(input(json!({"setpoint": 0.7, "pixel": 8})), &["pixel"]);
+    refused(
+        json!({"probe": example(probe), "sample": "size = [1.0e-6, 1.0e-6]",
+               "request": {"setpoint": 0.7, "pixels": 600}}),
+        &["pixels", "262144"],
+    );
+    refused(
+        json!({"probe": example(probe), "request": {"setpoint": 0.7}}),
+        &["sample"],
+    );
+    refused(
+        json!({"model": {"omega": 2.0}, "probe": example(probe), "sample": example(sample),
+               "request": {"setpoint": 0.7}}),
+        &["model"],
+    );
+}
+
+/// Refusals: a sample map given to another analysis; a series beyond the browser's samples; a
+/// height map file (in wasm, without files: the library's message; natively the file is not
+/// there); each one line naming the key.
+#[test]
+fn refusals_name_the_key() {
+    let one_line = |e: String, words: &[&str]| {
+        assert!(words.iter().all(|w| e.contains(w)), "{e}");
+        assert!(!e.contains('\n'), "{e}");
+    };
+    let e = run_json("orbit", &json!({"sample": "size = [1e-6, 0]"}).to_string()).unwrap_err();
+    one_line(e, &["sample", "image", "orbit"]);
+    let e = run_json(
+        "simulate",
+        &json!({"request": {"periods": 20000, "samples_per_period": 200}}).to_string(),
+    )
+    .unwrap_err();
+    one_line(e, &["periods", "samples_per_period", "2000000"]);
+    let e = run_json(
+        "simulate",
+        &json!({"request": {"samples_per_period": 0}}).to_string(),
+    )
+    .unwrap_err();
+    one_line(e, &["samples_per_period"]);
+    let e = run_json(
+        "simulate",
+        &json!({"request": {"initial": [1.0, 2.0]}}).to_string(),
+    )
+    .unwrap_err();
+    one_line(e, &["initial"]);
+    let sample = "size = [1.0e-6, 0.0]\nheight_map = \"no-such-map.csv\"\n";
+    let e = run_json(
+        "image",
+        &json!({"probe": example("examples/probe-point-mass-dmt.toml"), "sample": sample,
+                "request": {"setpoint": 0.7}})
+        .to_string(),
+    )
+    .unwrap_err();
+    one_line(e, &["height_map", "no-such-map.csv"]);
+}

@@ -75,11 +75,8 @@ impl BifurcationSession {
     /// # Errors
     /// As [`crate::run_json`]'s model; the request's validation errors.
     pub fn new(input: &str) -> Result<BifurcationSession, String> {
-        let (model, request) = crate::resolve(input)?;
-        let request: BifurcationRequest = match request {
-            Some(v) => serde_json::from_value(v).map_err(|e| format!("request: {e}"))?,
-            None => BifurcationRequest::default(),
-        };
+        let (model, request) = crate::resolve(input, "bifurcation")?;
+        let request: BifurcationRequest = crate::request(request)?;
         let spec = request.spec(&model.params).map_err(|e| e.to_string())?;
         let total = afmdyn::request::checkpoint::point_count(&spec);
         Ok(BifurcationSession {

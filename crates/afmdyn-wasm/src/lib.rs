@@ -7,17 +7,33 @@
 //! [`afmdyn::request::ModelSpec`]), `probe` the text of a probe file (SI), `request` the
 //! analysis's keywords as the library's request types name them (their JSON Schemas in
 //! `docs/schema/requests/`) — resolves the model as the command line does (the paper's
-//! defaults, or the probe's), and runs [`afmdyn::request::run()`]. Errors are the command line's
-//! one-line messages (the library's, naming the field and its range), so a page shows the same
-//! text beside the field.
+//! defaults, or the probe's), and runs [`afmdyn::request::run()`]. `image` also takes
+//! `"sample"`, the text of a sample map; the other analyses refuse it. Errors are the command
+//! line's one-line messages (the library's, naming the field and its range), so a page shows
+//! the same text beside the field.
 //!
-//! The analyses: `modes`, `orbit`, `observe`, `lyapunov`, `continuation`, `attractors`,
-//! `converge`, `approach`, `resonance` and `fm` ([`ANALYSES`]); the bifurcation diagram in
-//! chunks ([`Bifurcation`], [`bifurcation::BifurcationSession`]).
+//! The analyses ([`ANALYSES`]) and what each returns:
+//!
+//! * `modes`, `orbit`, `observe`, `lyapunov`, `continuation`, `attractors`, `converge`,
+//!   `approach`, `resonance`, `fm`: the document of `afmdyn <analysis> --json`;
+//! * `bimodal`: the multifrequency approach curve of `afmdyn bimodal --json` (the request
+//!   `approach`'s keys; the probe's `[drive]` must have two or more components);
+//! * `simulate`: `{"summary": <afmdyn simulate --files none --json>, "series": {name: {"dims",
+//!   "shape", "units", "long_name", "values"}, …}}`, the run's time series by the library's
+//!   layout ([`simulate`]: `tau` or `t`, `v_t`, `w_tip`, `w_tip_dot`, `v_t_dot`, `in_contact`,
+//!   `contact_force`, `a`, `a_dot`, …);
+//! * `image`: the ideal-feedback image of `afmdyn image --json` ([`image`]).
+//!
+//! Besides: [`cantilevers()`] (the cantilever library, `afmdyn cantilevers --json`), the
+//! bifurcation diagram in chunks ([`Bifurcation`], [`bifurcation::BifurcationSession`]),
+//! [`periods()`] (the cost per drive period) and [`version()`].
 
 #![warn(missing_docs)]
 
 pub mod bifurcation;
+pub mod image;
+pub mod series;
+pub mod simulate;
 
 use afmdyn::analysis::progress::Progress;
 use afmdyn::probe::Probe;
@@ -29,7 +45,7 @@ use serde_json::Value;
 use wasm_bindgen::prelude::*;
 
 /// The analyses [`run_json`] runs, by the command line's names.
-pub const ANALYSES: [&str; 10] = [
+pub const ANALYSES: [&str; 13] = [
     "modes",
     "orbit",
     "observe",
@@ -40,28 +56,45 @@ pub const ANALYSES: [&str; 10] = [
     "approach",
     "resonance",
     "fm",
+    "bimodal",
+    "simulate",
+    "image",
 ];
 
 /// What a page sends.
 #[derive(Debug, Default, Deserialize)]
 #[serde(default, deny_unknown_fields)]
-struct Input {
+pub(crate) struct Input {
     /// The model's values (a `--config` file's keys).
-    model: ModelSpec,
+    pub(crate) model: ModelSpec,
     /// A probe file's text (SI).
-    probe: Option<String>,
+    pub(crate) probe: Option<String>,
+    /// A sample map's text (`image` only).
+    pub(crate) sample: Option<String>,
     /// The analysis's keywords.
-    request: Option<Value>,
+    pub(crate) request: Option<Value>,
+}
+
+impl Input {
+    /// `input` read (empty: no keys).
+    pub(crate) fn read(input: &str) -> Result<Input, String> {
+        if input.trim().is_empty() {
+            Ok(Input::default())
+        } else {
+            serde_json::from_str(input).map_err(|e| format!("input: {e}"))
+        }
+    }
 }
 
 /// The model of `input` (the command line's defaults, or the probe's, then the `model` keys)
-/// and its `request`.
-pub(crate) fn resolve(input: &str) -> Result<(Resolved, Option<Value>), String> {
-    let inp: Input = if input.trim().is_empty() {
-        Input::default()
-    } else {
-        serde_json::from_str(input).map_err(|e| format!("input: {e}"))?
-    };
+/// and its `request`, for `analysis` (which takes no sample map).
+pub(crate) fn resolve(input: &str, analysis: &str) -> Result<(Resolved, Option<Value>), String> {
+    let inp = Input::read(input)?;
+    if inp.sample.is_some() {
+        return Err(format!(
+            "sample: only image takes a sample map, not {analysis}"
+        ));
+    }
     let probe = inp
         .probe
         .as_deref()
@@ -75,15 +108,20 @@ pub(crate) fn resolve(input: &str) -> Result<(Resolved, Option<Value>), String> 
     Ok((Resolved { params, probe }, inp.request))
 }
 
+/// A request read from `request` (`None`: its defaults).
+pub(crate) fn request<R: DeserializeOwned + Default>(request: Option<Value>) -> Result<R, String> {
+    match request {
+        Some(v) => serde_json::from_value(v).map_err(|e| format!("request: {e}")),
+        None => Ok(R::default()),
+    }
+}
+
 /// Run `A` read from `request` on `model`: its JSON document as text.
 fn document<A: Analysis + DeserializeOwned + Default>(
-    request: Option<Value>,
+    r: Option<Value>,
     model: &Resolved,
 ) -> Result<String, String> {
-    let a: A = match request {
-        Some(v) => serde_json::from_value(v).map_err(|e| format!("request: {e}"))?,
-        None => A::default(),
-    };
+    let a: A = request(r)?;
     let doc = request::run(&a, model, &Progress::new()).map_err(|e| e.to_string())?;
     Ok(doc.json.to_string())
 }
@@ -96,7 +134,18 @@ fn document<A: Analysis + DeserializeOwned + Default>(
 /// the probe format refuses; the model's and the request's validation errors (naming the field
 /// and its range) and the analysis's.
 pub fn run_json(analysis: &str, input: &str) -> Result<String, String> {
-    let (model, r) = resolve(input)?;
+    if !ANALYSES.contains(&analysis) {
+        return Err(format!(
+            "analysis = {analysis}: must be one of {}",
+            ANALYSES.join(", ")
+        ));
+    }
+    match analysis {
+        "simulate" => return simulate::simulate(input),
+        "image" => return image::image(input),
+        _ => {}
+    }
+    let (model, r) = resolve(input, analysis)?;
     match analysis {
         "modes" => document::<request::ModesRequest>(r, &model),
         "orbit" => document::<request::OrbitRequest>(r, &model),
@@ -108,10 +157,11 @@ pub fn run_json(analysis: &str, input: &str) -> Result<String, String> {
         "approach" => document::<request::ApproachRequest>(r, &model),
         "resonance" => document::<request::ResonanceRequest>(r, &model),
         "fm" => document::<request::fm::FmRequest>(r, &model),
-        other => Err(format!(
-            "analysis = {other}: must be one of {}",
-            ANALYSES.join(", ")
-        )),
+        // afmdyn bimodal: the approach curve of a drive of two or more components
+        _ => {
+            request::curves::check_bimodal(&model.params).map_err(|e| e.to_string())?;
+            document::<request::ApproachRequest>(r, &model)
+        }
     }
 }
 
@@ -129,7 +179,7 @@ pub fn advance_periods(input: &str, periods: usize) -> Result<String, String> {
     if !(1..=MAX_PERIODS).contains(&periods) {
         return Err(format!("periods = {periods}: must be in 1..=1000000"));
     }
-    let (model, _) = resolve(input)?;
+    let (model, _) = resolve(input, "periods")?;
     let m = afmdyn::CantileverModel::new(&model.params).map_err(|e| e.to_string())?;
     let mut integ = afmdyn::integrate::build(
         &m,
@@ -160,6 +210,13 @@ pub fn periods(input: &str, periods: usize) -> Result<String, JsError> {
 #[wasm_bindgen]
 pub fn run(analysis: &str, input: &str) -> Result<String, JsError> {
     run_json(analysis, input).map_err(|e| JsError::new(&e))
+}
+
+/// The cantilever library (nominal k, f₀, Q and tip radius of common cantilevers, SI): the
+/// document of `afmdyn cantilevers --json` ([`afmdyn::cantilevers::document`]), JSON text.
+#[wasm_bindgen]
+pub fn cantilevers() -> String {
+    afmdyn::cantilevers::document().to_string()
 }
 
 /// The library's version (the page shows it).
