@@ -17,20 +17,7 @@ command -v node > /dev/null || {
     if [ "$(id -u)" = 0 ]; then apt-get update -qq && apt-get install -y -qq nodejs > /dev/null;
     else sudo apt-get update -qq && sudo apt-get install -y -qq nodejs > /dev/null; fi
 } || fail "no Node.js"
-rustup target list --installed 2>/dev/null | grep -q wasm32-unknown-unknown ||
-    rustup target add wasm32-unknown-unknown || fail "no wasm32 target"
-version=$(awk '/^name = "wasm-bindgen"$/ {getline; gsub(/"/, "", $3); print $3; exit}' Cargo.lock)
-[ -n "$version" ] || fail "no wasm-bindgen in Cargo.lock"
-tools=$TARGET/tools
-bindgen=$tools/bin/wasm-bindgen
-if ! { [ -x "$bindgen" ] && "$bindgen" --version | grep -q " $version"; }; then
-    echo "== installing wasm-bindgen-cli $version into $tools"
-    # --locked first (the release's own lock file); a registry mirror that lacks one of its
-    # pinned versions resolves the newest compatible ones instead
-    cargo install -q wasm-bindgen-cli --version "=$version" --locked --root "$tools" 2>/dev/null ||
-        cargo install -q wasm-bindgen-cli --version "=$version" --root "$tools" ||
-        fail "cargo install wasm-bindgen-cli $version"
-fi
+bindgen=$(bash scripts/wasm-bindgen.sh) || fail "wasm-bindgen-cli"
 echo "== afmdyn-wasm for wasm32-unknown-unknown"
 cargo build -q --release -p afmdyn-wasm --target wasm32-unknown-unknown || fail "wasm build"
 cargo build -q --release -p afmdyn-cli || fail "native build"

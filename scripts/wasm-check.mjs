@@ -9,6 +9,7 @@ import { execFileSync } from "node:child_process";
 import { readFileSync } from "node:fs";
 import { isDeepStrictEqual } from "node:util";
 import path from "node:path";
+import { worst, approachSweeps, approachBranches, compareBifurcation } from "./compare-docs.mjs";
 
 const require = createRequire(import.meta.url);
 const [pkg, bin] = process.argv.slice(2);
@@ -18,24 +19,6 @@ let passed = 0, failed = 0, message = "";
 
 function native(args) {
   return JSON.parse(execFileSync(bin, [...args, "--json"], { cwd: root, encoding: "utf8" }));
-}
-// the largest difference of two documents' numbers relative to 1 + |native| (Infinity where
-// their shapes, keys, strings or flags differ): wasm's libm (sin, exp, pow) is not the
-// platform's, so their last bits may differ
-function worst(a, b, at = "") {
-  if (typeof a === "number" && typeof b === "number") {
-    if (Number.isNaN(a) && Number.isNaN(b)) return [0, at];
-    return [Math.abs(a - b) / (1 + Math.abs(b)), at];
-  }
-  if (Array.isArray(a) && Array.isArray(b) && a.length === b.length) {
-    return a.reduce((m, x, i) => { const w = worst(x, b[i], `${at}[${i}]`); return w[0] > m[0] ? w : m; }, [0, at]);
-  }
-  if (a && b && typeof a === "object" && typeof b === "object" && !Array.isArray(a) && !Array.isArray(b)) {
-    const ka = Object.keys(a).sort(), kb = Object.keys(b).sort();
-    if (!isDeepStrictEqual(ka, kb)) return [Infinity, `${at} keys`];
-    return ka.reduce((m, k) => { const w = worst(a[k], b[k], `${at}.${k}`); return w[0] > m[0] ? w : m; }, [0, at]);
-  }
-  return [isDeepStrictEqual(a, b) ? 0 : Infinity, at];
 }
 
 function check(name, ok, detail = "") {
@@ -60,13 +43,11 @@ const ref = native(["approach", "--probe", probe, "--points", "60", "--setpoint"
 const tNative = (performance.now() - t0) / 1000;
 // the two sweeps and the setpoint's operating points to 1e-9; the continued branches, whose
 // adaptive arclength steps carry last-bit differences into the points they land on, to 1e-6
-const sweeps = (d) => ({ ...d, branches: null, folds: null, bistable: null, jumps: null });
-[w, at] = worst(sweeps(curve), sweeps(ref));
+[w, at] = worst(approachSweeps(curve), approachSweeps(ref));
 check("approach from a probe: sweeps and setpoint are `afmdyn approach --probe … --json`'s " +
   "(numbers to 1e-9)", w <= 1e-9, `${w} at ${at}`);
 console.log(`     largest difference ${w.toExponential(1)} at ${at}`);
-const branches = (d) => ({ branches: d.branches, folds: d.folds, bistable: d.bistable, jumps: d.jumps });
-[w, at] = worst(branches(curve), branches(ref));
+[w, at] = worst(approachBranches(curve), approachBranches(ref));
 check("approach from a probe: its branches, folds and jumps are the command line's (to 1e-6)",
   w <= 1e-6, `${w} at ${at}`);
 console.log(`     largest difference ${w.toExponential(1)} at ${at}`);
@@ -75,43 +56,13 @@ console.log(`     largest difference ${w.toExponential(1)} at ${at}`);
 const tmp = execFileSync("mktemp", ["-d"], { encoding: "utf8" }).trim();
 execFileSync(bin, ["bifurcation", "--from", "2.4", "--to", "3.2", "--steps", "12", "--out", tmp],
   { cwd: root });
-const csv = readFileSync(path.join(tmp, "bifurcation.csv"), "utf8").trim().split("\n");
-const head = csv[0].split(",");
 const session = new wasm.Bifurcation(JSON.stringify({ request: { from: 2.4, to: 3.2, steps: 12 } }));
 let rows = [];
 while (!session.finished()) rows = rows.concat(JSON.parse(session.next(5)));
-rows.sort((a, b) => a.index - b.index || (a.branch !== "forward") - (b.branch !== "forward") ||
-  a.point - b.point);
-// the same rows (branch, status, Poincaré points); a periodic point's values to 1e-6 (a steady
-// state is reached when its returns repeat to 1e-8, which wasm's last bits may reach a period
-// earlier or later: a period-n cycle may start at another of its points, so each point's cycle
-// is compared as a set); a nonperiodic motion's points are not comparable point by point
-// (last-bit differences grow at the Lyapunov rate)
-let bad = rows.length === csv.length - 1 ? "" : `${rows.length} rows, ${csv.length - 1} in the file`;
-const groups = new Map();
-for (let i = 0; !bad && i < rows.length; i++) {
-  const cells = csv[i + 1].split(",");
-  const cell = (name) => cells[head.indexOf(name)];
-  if (cell("branch") !== rows[i].branch || cell("status") !== rows[i].status ||
-      cell("points") !== String(rows[i].points) || Number(cell("value")) !== rows[i].value) {
-    bad = `row ${i}: ${cells.slice(0, 8).join(",")}`;
-  }
-  if (rows[i].status !== "periodic") continue;
-  const key = `${rows[i].index} ${rows[i].branch}`;
-  const g = groups.get(key) || { file: [], wasm: [] };
-  g.file.push(Number(cell("w_tip")));
-  g.wasm.push(rows[i].w_tip);
-  groups.set(key, g);
-}
-let far = 0;
-for (const g of groups.values()) {
-  g.file.sort((a, b) => a - b);
-  g.wasm.sort((a, b) => a - b);
-  g.file.forEach((v, k) => { far = Math.max(far, Math.abs(v - g.wasm[k]) / (1 + Math.abs(v))); });
-}
+const { bad, far, periodic } = compareBifurcation(rows, readFileSync(path.join(tmp, "bifurcation.csv"), "utf8"));
 check("a bifurcation in chunks of 5 is `afmdyn bifurcation`'s bifurcation.csv (rows; periodic " +
   "cycles to 1e-6)", !bad && far <= 1e-6, bad || `${far}`);
-console.log(`     ${rows.length} rows, ${groups.size} periodic points; their largest difference ` +
+console.log(`     ${rows.length} rows, ${periodic} periodic points; their largest difference ` +
   `${far.toExponential(1)}`);
 
 // simulate from the native period-2 orbit's state at Ω = 2.8 (the page's time series and phase
