@@ -7,6 +7,9 @@
 #      pytest crates/afmdyn-py/tests, which also executes the example notebook and script.
 #   3. the WebAssembly engine: bash scripts/test-wasm.sh (crates/afmdyn-wasm built for wasm32,
 #      its JavaScript glue by wasm-bindgen-cli, checked under Node.js against the command line).
+#   4. the explorer in a real browser: bash scripts/test-explorer.sh (the static page built with
+#      its npm packages, served on 127.0.0.1, driven in Debian's headless Chromium, installed with
+#      apt-get when missing, by playwright-core, against the command line).
 # Needs a Rust toolchain and Python >= 3.9 with network access to crates.io and PyPI.
 # The last line is "N passed, N failed", Rust, Python and wasm together; the exit status is 0 only
 # when everything ran and passed.
@@ -71,17 +74,28 @@ else
     extra_failed=$((extra_failed + 1))
 fi
 
-echo "== WebAssembly: bash scripts/test-wasm.sh (the browser engine under Node.js)"
-bash scripts/test-wasm.sh 2>&1 | tee "$logs/wasm.log"
-wasm_code=${PIPESTATUS[0]}
-wasm_line=$(grep -E '^wasm: [0-9]+ passed, [0-9]+ failed' "$logs/wasm.log" | tail -1)
-wasm_passed=$(echo "$wasm_line" | awk '{print $2 + 0}')
-wasm_failed=$(echo "$wasm_line" | awk '{print $4 + 0}')
-if [ "$wasm_code" -ne 0 ]; then
-    status=1
-    [ "${wasm_failed:-0}" -gt 0 ] || extra_failed=$((extra_failed + 1))
-fi
+# a suite whose script prints "NAME: N passed, M failed" last: its counts into NAME_passed and
+# NAME_failed; a non-zero exit without a counted failure counts as one
+suite() {
+    local name=$1 script=$2 code line
+    bash "$script" 2>&1 | tee "$logs/$name.log"
+    code=${PIPESTATUS[0]}
+    line=$(grep -E "^$name: [0-9]+ passed, [0-9]+ failed" "$logs/$name.log" | tail -1)
+    printf -v "${name}_passed" '%s' "$(echo "$line" | awk '{print $2 + 0}')"
+    printf -v "${name}_failed" '%s' "$(echo "$line" | awk '{print $4 + 0}')"
+    if [ "$code" -ne 0 ]; then
+        status=1
+        local f="${name}_failed"
+        [ "${!f:-0}" -gt 0 ] || extra_failed=$((extra_failed + 1))
+    fi
+}
 
-echo "Rust: ${rust_passed} passed, ${rust_failed} failed; Python: ${py_passed} passed, ${py_failed} failed; wasm: ${wasm_passed:-0} passed, ${wasm_failed:-0} failed"
-echo "$((rust_passed + py_passed + ${wasm_passed:-0})) passed, $((rust_failed + py_failed + ${wasm_failed:-0} + extra_failed)) failed"
+echo "== WebAssembly: bash scripts/test-wasm.sh (the browser engine under Node.js)"
+suite wasm scripts/test-wasm.sh
+
+echo "== Explorer: bash scripts/test-explorer.sh (the page in headless Chromium)"
+suite explorer scripts/test-explorer.sh
+
+echo "Rust: ${rust_passed} passed, ${rust_failed} failed; Python: ${py_passed} passed, ${py_failed} failed; wasm: ${wasm_passed:-0} passed, ${wasm_failed:-0} failed; explorer: ${explorer_passed:-0} passed, ${explorer_failed:-0} failed"
+echo "$((rust_passed + py_passed + ${wasm_passed:-0} + ${explorer_passed:-0})) passed, $((rust_failed + py_failed + ${wasm_failed:-0} + ${explorer_failed:-0} + extra_failed)) failed"
 exit "$status"

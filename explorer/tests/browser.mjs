@@ -1,0 +1,285 @@
+// The explorer in a real browser (issue 47; run by scripts/test-explorer.sh, part of the README's
+// test command): headless Debian Chromium driven by playwright-core against the built site served
+// on 127.0.0.1. Every number the page shows is checked against the native command line's
+// (`afmdyn … --json`, the binary given) at the same parameters.
+//   node explorer/tests/browser.mjs --url URL --bin AFMDYN --chromium PATH --out DIR
+// Prints each check, the timings (diagram, click to orbit, approach curve) and
+// "explorer: N passed, M failed" last; saves DIR/screenshot.png (and screenshot-afm.png).
+import { chromium } from "playwright-core";
+import { execFileSync, spawnSync } from "node:child_process";
+import { mkdtempSync, readFileSync, writeFileSync } from "node:fs";
+import { tmpdir } from "node:os";
+import path from "node:path";
+import { fileURLToPath } from "node:url";
+import { worst, approachSweeps, approachBranches, branchesScaled, compareBifurcation } from "../../scripts/compare-docs.mjs";
+
+const root = path.resolve(path.dirname(fileURLToPath(import.meta.url)), "../..");
+const arg = (name) => {
+  const i = process.argv.indexOf(name);
+  if (i < 0) throw new Error(`missing ${name}`);
+  return process.argv[i + 1];
+};
+const url = arg("--url");
+const bin = path.resolve(arg("--bin"));
+const out = path.resolve(arg("--out"));
+let passed = 0, failed = 0;
+const timings = {};
+
+function check(name, ok, detail = "") {
+  if (ok) { passed += 1; console.log(`ok   ${name}`); }
+  else { failed += 1; console.log(`FAIL ${name} ${detail}`); }
+}
+function native(args) {
+  return JSON.parse(execFileSync(bin, [...args, "--json"], { cwd: root, encoding: "utf8", stdio: ["ignore", "pipe", "pipe"] }));
+}
+/** The command line's one-line message for `args` (stderr without the "afmdyn: " prefix). */
+function nativeError(args) {
+  const r = spawnSync(bin, args, { cwd: root, encoding: "utf8" });
+  return r.stderr.trim().replace(/^afmdyn: /, "");
+}
+
+const browser = await chromium.launch({
+  executablePath: arg("--chromium"),
+  headless: true,
+  // the machine's network is closed: no background connections, no component updates
+  args: ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+    "--disable-background-networking", "--disable-component-update", "--disable-sync"],
+});
+const browserVersion = browser.version();
+const errors = [];
+try {
+  const context = await browser.newContext({ viewport: { width: 1440, height: 900 }, acceptDownloads: true });
+  const page = await context.newPage();
+  page.on("pageerror", (e) => errors.push(`page error: ${e.message}`));
+  page.on("console", (m) => { if (m.type() === "error") errors.push(`console: ${m.text()}`); });
+  page.setDefaultTimeout(120_000);
+
+  // ------------------------------------------------------------------ the default diagram
+  const t0 = Date.now();
+  await page.goto(url);
+  await page.waitForFunction(() => window.explorer?.ready);
+  check("the page loads and shows the library's version",
+    /Library version \d+\.\d+\.\d+/.test(await page.textContent("#version")));
+  // the page starts the default Fig. 5 diagram itself
+  await page.waitForFunction(() => window.explorer.timings.diagram_ms !== undefined);
+  timings.diagram = await page.evaluate(() => window.explorer.timings.diagram_ms);
+  timings.load_and_diagram = Date.now() - t0;
+  const rows = await page.evaluate(() => window.explorer.rows);
+  const tmp = mkdtempSync(path.join(tmpdir(), "afmdyn-explorer-"));
+  execFileSync(bin, ["bifurcation", "--out", tmp], { cwd: root });
+  const csvText = readFileSync(path.join(tmp, "bifurcation.csv"), "utf8");
+  const cmp = compareBifurcation(rows, csvText);
+  // each run stops its transient when two returns repeat to 1e-8, which leaves it up to
+  // 1e-8 |μ|/(1 − |μ|) from the cycle; the sweep passes points with |μ| = 0.988 (Ω = 2.504,
+  // backward: 5.5e-7 from the shot orbit), and wasm's last bits may stop a period earlier or
+  // later: the cycles agree to 1e-5, not to the 1e-6 of a short sweep
+  check("the default diagram (Fig. 5, 400 Ω values each way) is `afmdyn bifurcation`'s " +
+    "bifurcation.csv (rows, statuses; periodic cycles to 1e-5)", !cmp.bad && cmp.far <= 1e-5,
+  cmp.bad || `${cmp.far}`);
+  console.log(`     ${cmp.rows} rows, ${cmp.periodic} periodic points; largest difference ${cmp.far.toExponential(1)} (value index, branch: ${cmp.farAt})`);
+  const drawn = await page.evaluate(() => {
+    const gd = document.getElementById("bif-plot");
+    return { n: gd.data.slice(0, 2).reduce((s, t) => s + t.x.length, 0), x: gd.layout.xaxis.title.text };
+  });
+  check("every Poincaré point is drawn, the Ω axis labelled", drawn.n === rows.filter((r) => r.x_max !== null).length && /Ω/.test(drawn.x),
+    JSON.stringify(drawn));
+
+  // ------------------------------------------------------------------ click a point → orbit
+  // a periodic point on the forward branch near Ω = 2.8: its pixel from the plot's own axes
+  const target = rows.findIndex((r) => r.branch === "forward" && r.status === "periodic" && r.value >= 2.8);
+  const at = await page.evaluate((i) => {
+    const gd = document.getElementById("bif-plot");
+    const r = window.explorer.rows[i];
+    const L = gd._fullLayout;
+    const box = gd.querySelector(".nsewdrag").getBoundingClientRect();
+    const y = document.getElementById("bif-y").value;
+    return { x: box.left + L.xaxis.l2p(r.value), y: box.top + L.yaxis.l2p(r[y]) };
+  }, target);
+  const before = await page.evaluate(() => window.explorer.timings.orbit_view_ms);
+  await page.mouse.move(at.x, at.y);
+  await page.mouse.click(at.x, at.y);
+  await page.waitForFunction((b) => window.explorer.timings.orbit_view_ms !== b && !window.explorer.busy.orbit, before);
+  const shown = await page.evaluate(() => ({
+    selected: window.explorer.selected, orbit: window.explorer.orbit, series: window.explorer.series,
+    summary: document.getElementById("orbit-summary").textContent, t: window.explorer.timings,
+  }));
+  timings.click_to_orbit = shown.t.orbit_ms;
+  timings.click_to_orbit_view = shown.t.orbit_view_ms;
+  timings.orbit_engine = shown.t.orbit_engine_ms;
+  check("a click on the diagram selects a point", shown.selected >= 0, String(shown.selected));
+  const row = rows[shown.selected] ?? rows[target];
+  const n = row.state.length / 2;
+  const modal = `${row.state.slice(0, n).join(",")};${row.state.slice(n).join(",")}`;
+  const ref = native(["orbit", "--omega", String(row.value), "--initial-modal", modal,
+    ...(row.period ? ["--period", String(row.period)] : [])]);
+  check(`the clicked point's orbit (Ω = ${row.value}) has the period of \`afmdyn orbit --json\` there`,
+    shown.orbit.period === ref.period, `${shown.orbit.period} vs ${ref.period}`);
+  const [wp, atp] = worst(shown.orbit.poincare, ref.poincare);
+  check("… and its Poincaré points (to 1e-9)", wp <= 1e-9, `${wp} at ${atp}`);
+  const [wm] = worst(shown.orbit.multipliers, ref.multipliers);
+  check("… and its Floquet multipliers (to 1e-9) and stability", wm <= 1e-9 && shown.orbit.stable === ref.stable, `${wm}`);
+  console.log(`     Poincaré points differ by ${wp.toExponential(1)}, multipliers by ${wm.toExponential(1)}`);
+  check("the orbit's period and stability are shown", shown.summary.includes(`${ref.period} drive period`) &&
+    shown.summary.includes(ref.stable ? "yes" : "no"), shown.summary.slice(0, 120));
+  const series = await page.evaluate(() => {
+    const s = document.getElementById("orbit-series");
+    const p = document.getElementById("orbit-phase");
+    return { s: s.data?.[0]?.x.length ?? 0, p: p.data?.length ?? 0, xs: s.layout?.xaxis.title.text ?? "" };
+  });
+  const spp = shown.series.samples_per_period;
+  check("its time series W(1, τ) over the period and its phase portrait are drawn",
+    series.s === ref.period * spp + 1 && series.p === 2, JSON.stringify(series));
+  // the series starts at the orbit's own state: W(1, 0) is its first Poincaré point
+  const w0 = shown.series.series.w_tip?.values?.[0] ?? shown.series.series.w?.values?.[0];
+  check("the time series starts on the orbit's first Poincaré point (to 1e-9)",
+    Math.abs(w0 - ref.poincare.w_tip[0]) <= 1e-9 * (1 + Math.abs(ref.poincare.w_tip[0])), `${w0} vs ${ref.poincare.w_tip[0]}`);
+  await page.screenshot({ path: path.join(out, "screenshot.png"), fullPage: true });
+
+  // keyboard: the diagram takes focus, → moves the selection, Enter shows that orbit
+  await page.focus("#bif-plot");
+  const sel0 = await page.evaluate(() => window.explorer.selected);
+  await page.keyboard.press("ArrowRight");
+  const sel1 = await page.evaluate(() => window.explorer.selected);
+  const before2 = await page.evaluate(() => window.explorer.timings.orbit_view_ms);
+  await page.keyboard.press("Enter");
+  await page.waitForFunction((b) => window.explorer.timings.orbit_view_ms !== b && !window.explorer.busy.orbit, before2);
+  const kb = await page.evaluate(() => ({ r: window.explorer.rows[window.explorer.selected], o: window.explorer.orbitRequest }));
+  check("keyboard: → moves the selected point and Enter shows its orbit",
+    sel1 !== sel0 && kb.o.model.omega === kb.r.value, `${sel0} → ${sel1}`);
+
+  // ------------------------------------------------------------------ export
+  const [dl] = await Promise.all([page.waitForEvent("download"), page.click("[data-export=csv][data-what=dyn]")]);
+  const exported = readFileSync(await dl.path(), "utf8").split("\n");
+  const cliHead = csvText.split("\n")[0].split(",");
+  const pageHead = exported[0].split(",");
+  check("the diagram's CSV export has bifurcation.csv's columns and one line per point",
+    pageHead.join(",") === cliHead.join(",") && exported.length - 2 === rows.length,
+    `${pageHead.join(",")} vs ${cliHead.join(",")}; ${exported.length - 2} lines`);
+  const [png] = await Promise.all([page.waitForEvent("download"), page.click("[data-export=png][data-what=bif-plot]")]);
+  const pngBytes = readFileSync(await png.path());
+  check("the diagram exports as PNG", pngBytes.subarray(1, 4).toString() === "PNG", String(pngBytes.length));
+  const [svg] = await Promise.all([page.waitForEvent("download"), page.click("[data-export=svg][data-what=bif-plot]")]);
+  check("the diagram exports as SVG", readFileSync(await svg.path(), "utf8").includes("<svg"));
+
+  // ------------------------------------------------------------------ bad input
+  await page.fill("#alpha1", "-1");
+  await page.click("#dyn-run");
+  await page.waitForFunction(() => document.getElementById("err-alpha1").textContent !== "");
+  const msg = await page.textContent("#err-alpha1");
+  const cliMsg = nativeError(["orbit", "--tip-mass-ratio", "-1"]);
+  check("a bad α1 is refused beside its field with the command line's message",
+    msg === cliMsg && await page.getAttribute("#alpha1", "aria-invalid") === "true", `"${msg}" vs "${cliMsg}"`);
+  await page.fill("#alpha1", "0.1");
+
+  // ------------------------------------------------------------------ AFM: approach from a preset
+  await page.click("#tab-afm");
+  await page.selectOption("#probe-preset", "probe-point-mass-dmt.toml");
+  await page.fill("#points", "60");
+  await page.fill("#setpoint", "0.7");
+  const tA = await page.evaluate(() => window.explorer.timings.afm_ms);
+  await page.click("#afm-run");
+  await page.waitForFunction((b) => window.explorer.timings.afm_ms !== b && !window.explorer.busy.afm, tA);
+  timings.approach = await page.evaluate(() => window.explorer.timings.afm_ms);
+  const curve = await page.evaluate(() => window.explorer.afm.doc);
+  const refCurve = native(["approach", "--probe", "examples/probe-point-mass-dmt.toml", "--points", "60", "--setpoint", "0.7"]);
+  let [w, where] = worst(approachSweeps(curve), approachSweeps(refCurve));
+  check("the approach curve from the preset probe is `afmdyn approach --probe … --json`'s " +
+    "(sweeps and setpoint to 1e-9)", w <= 1e-9, `${w} at ${where}`);
+  console.log(`     largest difference ${w.toExponential(1)} at ${where}`);
+  [w, where] = worst(approachBranches(curve), approachBranches(refCurve));
+  check("… and its branches, folds and jumps (to 1e-6)", w <= 1e-6, `${w} at ${where}`);
+  const axes = await page.evaluate(() => ["afm-plot-a", "afm-plot-b"].map((id) => {
+    const gd = document.getElementById(id);
+    return [gd.layout.xaxis.title.text, gd.layout.yaxis.title.text, gd.data.length];
+  }));
+  check("the curves are drawn with labelled SI axes (z_c in m, amplitude in m, phase in °)",
+    axes[0][0].includes("(m)") && axes[0][1].includes("(m)") && axes[1][1].includes("(°)") && axes[0][2] >= 3,
+    JSON.stringify(axes));
+  const sumText = await page.textContent("#afm-summary");
+  const op = refCurve.setpoint.points[0];
+  check("the setpoint's operating point is shown (z_c, regime)", sumText.includes(op.z_c.toExponential(4)) && sumText.includes(op.regime),
+    sumText.slice(0, 200));
+  await page.screenshot({ path: path.join(out, "screenshot-afm.png"), fullPage: true });
+
+  // bimodal: the two-mode probe preset against `afmdyn bimodal --json`
+  const afmRun = async () => {
+    const b = await page.evaluate(() => window.explorer.timings.afm_ms);
+    await page.click("#afm-run");
+    await page.waitForFunction((t) => window.explorer.timings.afm_ms !== t && !window.explorer.busy.afm, b);
+    return page.evaluate(() => window.explorer.afm.doc);
+  };
+  await page.selectOption("#probe-preset", "probe-bimodal.toml");
+  await page.selectOption("#afm-analysis", "bimodal");
+  await page.fill("#points", "16");
+  const bimodal = await afmRun();
+  const refBimodal = native(["bimodal", "--probe", "examples/probe-bimodal.toml", "--points", "16", "--out", tmp]);
+  [w, where] = worst(approachSweeps(bimodal), approachSweeps(refBimodal));
+  const [wb, wbAt] = branchesScaled(bimodal.branches, refBimodal.branches);
+  const [wf, wfAt] = worst({ ...approachBranches(bimodal), branches: null }, { ...approachBranches(refBimodal), branches: null });
+  check("the bimodal curve of the preset probe-bimodal.toml is `afmdyn bimodal --json`'s " +
+    "(sweeps to 1e-9; branches to 1e-6, 1e-4 at their grazing and fold events; folds to 1e-6); both modes drawn",
+  w <= 1e-9 && wb <= 1 && wf <= 1e-6 &&
+    await page.evaluate(() => document.getElementById("afm-plot-a").data.length === 4), `${w} at ${where}; ${wb} of the tolerance at ${wbAt}; ${wf} at ${wfAt}`);
+
+  // an image: the stripe (one line) and the blend (a map) against `afmdyn image --json`
+  await page.selectOption("#probe-preset", "probe-point-mass-dmt.toml");
+  await page.selectOption("#afm-analysis", "image");
+  await page.fill("#pixels", "16");
+  for (const sample of ["sample-stripe.toml", "sample-blend.toml"]) {
+    await page.selectOption("#sample-preset", sample);
+    const image = await afmRun();
+    const refImage = native(["image", "--probe", "examples/probe-point-mass-dmt.toml", "--sample", `examples/${sample}`,
+      "--setpoint", "0.7", "--pixels", "16", "--out", tmp]);
+    [w, where] = worst(image, refImage);
+    const kind = await page.evaluate(() => document.getElementById("afm-plot-a").data[0].type);
+    const listed = await page.$$eval("#afm-warnings li", (li) => li.map((x) => x.textContent));
+    check(`… and its ${refImage.warnings.length} warning(s) are listed under the plots`,
+      listed.length === refImage.warnings.length && refImage.warnings.every((m, i) => listed[i].includes(typeof m === "string" ? m : m.message ?? "")),
+      JSON.stringify(listed));
+    check(`the image of ${sample} is \`afmdyn image --setpoint 0.7 --pixels 16 --json\`'s (to 1e-9), drawn as ` +
+      (refImage.image.y.length === 1 ? "a line profile" : "maps"),
+    w <= 1e-9 && kind === (refImage.image.y.length === 1 ? "scatter" : "heatmap"), `${w} at ${where}; ${kind}`);
+  }
+  await page.screenshot({ path: path.join(out, "screenshot-image.png"), fullPage: true });
+  await page.selectOption("#afm-analysis", "approach");
+
+  // a bad probe value: beside its field, the command line's message for that key
+  await page.fill("#p-spring_constant", "-40");
+  await page.dispatchEvent("#p-spring_constant", "change");
+  await page.click("#afm-run");
+  await page.waitForFunction(() => document.querySelector("#p-spring_constant + .error").textContent !== "");
+  const kMsg = await page.textContent("#p-spring_constant + .error");
+  check("a bad k is refused beside its field, naming [cantilever].spring_constant and the range",
+    kMsg.startsWith("[cantilever].spring_constant = -40 (N/m): must be"), kMsg);
+
+  // ------------------------------------------------------------------ the URL holds the view
+  const shared = page.url();
+  check("the URL holds the parameters", shared.includes("ws=afm") && shared.includes("spring_constant") && shared.includes("setpoint=0.7"));
+  const page2 = await context.newPage();
+  await page2.goto(`${url}#ws=dyn&modes=2&alpha1=0.2&from=2.5&to=3&steps=12&omega=2.7`);
+  await page2.waitForFunction(() => window.explorer?.timings.diagram_ms !== undefined);
+  const restored = await page2.evaluate(() => ({
+    modes: document.getElementById("modes").value, a1: document.getElementById("alpha1").value,
+    rows: window.explorer.rows.length, om: document.getElementById("orbit-omega").value,
+  }));
+  const tmp2 = mkdtempSync(path.join(tmpdir(), "afmdyn-explorer-"));
+  execFileSync(bin, ["bifurcation", "--modes", "2", "--tip-mass-ratio", "0.2", "--from", "2.5", "--to", "3", "--steps", "12", "--out", tmp2], { cwd: root });
+  const cmp2 = compareBifurcation(await page2.evaluate(() => window.explorer.rows), readFileSync(path.join(tmp2, "bifurcation.csv"), "utf8"));
+  check("a shared link restores the view and recomputes it (N = 2, α1 = 0.2: the command line's diagram)",
+    restored.modes === "2" && restored.a1 === "0.2" && restored.om === "2.7" && !cmp2.bad && cmp2.far <= 1e-6,
+    JSON.stringify(restored) + cmp2.bad);
+
+  check("no error in the page's console", errors.length === 0, errors.join(" | "));
+} catch (e) {
+  check("the browser session ran to its end", false, e.stack);
+} finally {
+  await browser.close();
+}
+
+console.log(`timings in the browser: default Fig. 5 diagram ${(timings.diagram / 1000).toFixed(2)} s ` +
+  `(goal 3 s; page load included ${(timings.load_and_diagram / 1000).toFixed(2)} s), click to orbit ` +
+  `${timings.click_to_orbit?.toFixed(0)} ms (goal 100 ms; the engine's shooting ${timings.orbit_engine?.toFixed(0)} ms; with its time series ${timings.click_to_orbit_view?.toFixed(0)} ms), ` +
+  `approach curve (60 z_c each way, branches) ${(timings.approach / 1000).toFixed(2)} s (goal 2 s)`);
+writeFileSync(path.join(out, "timings.json"), JSON.stringify({ ...timings, chromium: browserVersion }, null, 1));
+console.log(`explorer: ${passed} passed, ${failed} failed`);
+process.exit(failed === 0 ? 0 : 1);
