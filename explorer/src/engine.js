@@ -42,6 +42,9 @@ export class Engine {
   cancel(name) {
     const lane = this.lanes.get(name);
     if (lane && lane.pending) {
+      // no message of the old request may arrive after this (one already queued included)
+      lane.worker.onmessage = null;
+      lane.worker.onerror = null;
       lane.worker.terminate();
       lane.worker = null;
       const p = lane.pending;

@@ -32,6 +32,8 @@ const state = {
 window.explorer = state;
 
 let engine;
+// each workspace's newest request: a cancelled one leaves the shared state alone
+const generation = { diagram: 0, orbit: 0, afm: 0 };
 
 // ---------------------------------------------------------------------------- the URL
 
@@ -182,6 +184,8 @@ async function runDiagram() {
     return;
   }
   writeHash();
+  // a newer diagram cancels this one: only the newest resets the state it shares
+  const gen = ++generation.diagram;
   state.rows = [];
   state.selected = -1;
   state.diagram = { param: "omega", input };
@@ -208,7 +212,7 @@ async function runDiagram() {
     reportError(e, dynErrorPlaces("diagram"), $("err-dyn"));
     if (!(e instanceof Cancelled)) status($("dyn-status"), "");
   } finally {
-    state.busy.diagram = false;
+    if (gen === generation.diagram) state.busy.diagram = false;
   }
 }
 
@@ -313,6 +317,7 @@ async function showOrbit(rowIndex) {
     return;
   }
   const model = dynModel(v);
+  const gen = ++generation.orbit;
   state.busy.orbit = true;
   status($("dyn-status"), "shooting the orbit…");
   try {
@@ -339,7 +344,7 @@ async function showOrbit(rowIndex) {
   } catch (e) {
     reportError(e, dynErrorPlaces("orbit"), $("err-orbit"));
   } finally {
-    state.busy.orbit = false;
+    if (gen === generation.orbit) state.busy.orbit = false;
   }
 }
 
@@ -680,6 +685,7 @@ async function runAfm() {
   }
   writeHash();
   const input = { probe: $("probe-text").value, request: req.request };
+  const gen = ++generation.afm;
   if (req.analysis === "image") input.sample = $("sample-text").value;
   state.busy.afm = true;
   status($("afm-status"), `computing the ${req.analysis} curve…`);
@@ -696,7 +702,7 @@ async function runAfm() {
     reportError(e, afmErrorPlaces, $("err-afm"));
     if (!(e instanceof Cancelled)) status($("afm-status"), "");
   } finally {
-    state.busy.afm = false;
+    if (gen === generation.afm) state.busy.afm = false;
   }
 }
 

@@ -269,6 +269,19 @@ try {
     restored.modes === "2" && restored.a1 === "0.2" && restored.om === "2.7" && !cmp2.bad && cmp2.far <= 1e-6,
     JSON.stringify(restored) + cmp2.bad);
 
+  // a new request cancels the old: a 400-value diagram started, then the 12-value one while
+  // it runs; only the second's rows are shown (the command line's diagram)
+  await page2.fill("#steps", "400");
+  await page2.click("#dyn-run");
+  await page2.waitForFunction(() => window.explorer.rows.length > 0);
+  await page2.fill("#steps", "12");
+  const [t12, running] = await page2.evaluate(() => [window.explorer.timings.diagram_ms, window.explorer.busy.diagram]);
+  await page2.click("#dyn-run");
+  await page2.waitForFunction((t) => window.explorer.timings.diagram_ms !== t && !window.explorer.busy.diagram, t12);
+  const cmp3 = compareBifurcation(await page2.evaluate(() => window.explorer.rows), readFileSync(path.join(tmp2, "bifurcation.csv"), "utf8"));
+  check("a new diagram cancels the one running: only its rows are shown (the command line's)",
+    running && !cmp3.bad && cmp3.far <= 1e-6, `${running ? "" : "the first had finished; "}${cmp3.bad}`);
+
   check("no error in the page's console", errors.length === 0, errors.join(" | "));
 } catch (e) {
   check("the browser session ran to its end", false, e.stack);
