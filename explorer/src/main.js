@@ -151,7 +151,7 @@ function drawDiagram() {
       hovertemplate: "Ω = %{x:.4f}<br>%{y:.5g}<extra>%{fullData.name}</extra>",
     };
   });
-  const label = $("bif-y").selectedOptions[0].textContent;
+  const label = { x_max: "X_max, tip amplitude", v_t: "V_T at the section", w_tip: "W(1, τ) at the section" }[y];
   const param = state.diagram?.param ?? "omega";
   Plotly.react("bif-plot", traces, {
     margin: { l: 70, r: 10, t: 30, b: 50 },

@@ -147,6 +147,15 @@ try {
   check("keyboard: → moves the selected point and Enter shows its orbit",
     sel1 !== sel0 && kb.o.model.omega === kb.r.value, `${sel0} → ${sel1}`);
 
+  // the eigenfrequency view: the command line's natural frequencies (eqs. 19–23)
+  await page.click("#modes-run");
+  await page.waitForFunction(() => window.explorer.modes && !document.getElementById("modes-panel").hidden);
+  const modes = await page.evaluate(() => ({ doc: window.explorer.modes, rows: document.querySelectorAll("#modes-table tr").length }));
+  const refModes = native(["modes"]);
+  const [wq] = worst(modes.doc, refModes);
+  check("the eigenfrequency view is `afmdyn modes --json`'s (to 1e-9), a table row per mode",
+    wq <= 1e-9 && modes.rows === refModes.free.omega.length + 1, `${wq}; ${modes.rows} rows`);
+
   // ------------------------------------------------------------------ export
   const [dl] = await Promise.all([page.waitForEvent("download"), page.click("[data-export=csv][data-what=dyn]")]);
   const exported = readFileSync(await dl.path(), "utf8").split("\n");
@@ -201,13 +210,37 @@ try {
     sumText.slice(0, 200));
   await page.screenshot({ path: path.join(out, "screenshot-afm.png"), fullPage: true });
 
-  // bimodal: the two-mode probe preset against `afmdyn bimodal --json`
+  // a curve computed: its document
   const afmRun = async () => {
     const b = await page.evaluate(() => window.explorer.timings.afm_ms);
     await page.click("#afm-run");
     await page.waitForFunction((t) => window.explorer.timings.afm_ms !== t && !window.explorer.busy.afm, b);
     return page.evaluate(() => window.explorer.afm.doc);
   };
+  // resonance and FM curves of the same probe against the command line's
+  await page.selectOption("#afm-analysis", "resonance");
+  await page.fill("#points", "40");
+  const resonance = await afmRun();
+  const refRes = native(["resonance", "--probe", "examples/probe-point-mass-dmt.toml", "--points", "40", "--out", tmp]);
+  [w, where] = worst(approachSweeps(resonance), approachSweeps(refRes));
+  const [wr, wrAt] = branchesScaled(resonance.branches, refRes.branches);
+  // a sweep's steady state settles to the curve's tolerance (1e-10) at the free lever's decay
+  // per period e^(−π/Q): near resonance the last-bit differences of wasm stop it up to
+  // 1e-10 Q/π = 1.3e-8 (Q = 400) apart, so the sweeps agree to 1e-7 (measured: 5e-9)
+  check("the resonance curve is `afmdyn resonance --json`'s (sweeps to 1e-7, branches to 1e-6, 1e-4 at events)",
+    w <= 1e-7 && wr <= 1, `${w} at ${where}; ${wr} of the tolerance at ${wrAt}`);
+  console.log(`     largest difference ${w.toExponential(1)} at ${where}`);
+  await page.selectOption("#afm-analysis", "fm");
+  await page.fill("#points", "20");
+  const fm = await afmRun();
+  const refFm = native(["fm", "--probe", "examples/probe-point-mass-dmt.toml", "--points", "20", "--out", tmp]);
+  [w, where] = worst(fm.curve, refFm.curve);
+  // the two loop conditions are solved by Newton's method to the request's tolerance, 1e-9
+  check("the FM curve Δf(z_c) is `afmdyn fm --json`'s (to 1e-8: its loop solved to 1e-9), drawn against z_c",
+    w <= 1e-8 && await page.evaluate(() => document.getElementById("afm-plot-a").layout.yaxis.title.text.includes("(Hz)")), `${w} at ${where}`);
+  console.log(`     largest difference ${w.toExponential(1)} at ${where}`);
+
+  // bimodal: the two-mode probe preset against `afmdyn bimodal --json`
   await page.selectOption("#probe-preset", "probe-bimodal.toml");
   await page.selectOption("#afm-analysis", "bimodal");
   await page.fill("#points", "16");
