@@ -53,6 +53,14 @@ export class Engine {
     }
   }
 
+  /** End the lane's worker (cancelling its request, if any). */
+  close(name) {
+    this.cancel(name);
+    const lane = this.lanes.get(name);
+    if (lane?.worker) lane.worker.terminate();
+    this.lanes.delete(name);
+  }
+
   request(name, msg, onChunk) {
     this.cancel(name);
     const lane = this.lane(name);

@@ -10,9 +10,6 @@ import { DYN_PRESETS, DYN_FIELDS, dynModel, dynRequest } from "./dynamics.js";
 import { toCsv, download } from "./export.js";
 
 const $ = (id) => document.getElementById(id);
-const BIFURCATION_COLUMNS = ["param", "value", "index", "branch", "status", "period", "point",
-  "points", "tau", "v_t", "w_tip", "x_max", "v_t_min", "contact_fraction", "contacts_per_period",
-  "transient_periods", "message", "state"];
 const COLOURS = { forward: "#1f5fbf", backward: "#c0392b", selected: "#f39c12" };
 const PLOT_CONFIG = { responsive: true, displaylogo: false };
 
@@ -712,7 +709,7 @@ function exportData(format, what) {
   if (what === "dyn") {
     if (format === "csv") {
       // bifurcation.csv's columns (afmdyn::request::sweep::COLUMNS), the state space-separated
-      const rows = state.rows.map((r) => Object.fromEntries(BIFURCATION_COLUMNS.map((c) =>
+      const rows = state.rows.map((r) => Object.fromEntries(state.columns.map(({ name: c }) =>
         [c, c === "state" ? r.state.join(" ") : r[c]])));
       download("bifurcation.csv", toCsv(rows), "text/csv");
     } else {
@@ -789,8 +786,13 @@ function applyHash(p) {
 async function main() {
   for (const p of DYN_PRESETS) $("dyn-preset").add(new Option(p.label, p.id));
   engine = await Engine.load("pkg/afmdyn_wasm_bg.wasm", "worker.js");
-  const [{ doc: version }, { doc: levers }] = await Promise.all([
-    engine.run("meta", "version", {}), engine.run("meta2", "cantilevers", {}), loadPresets()]);
+  const presets = loadPresets();
+  // the engine's data, one after the other on one worker, which then ends
+  const { doc: version } = await engine.run("meta", "version", {});
+  const { doc: levers } = await engine.run("meta", "cantilevers", {});
+  state.columns = (await engine.run("meta", "bifurcation_columns", {})).doc;
+  engine.close("meta");
+  await presets;
   $("version").textContent = `Library version ${version}.`;
   state.cantilevers = levers.cantilevers;
   for (const c of state.cantilevers) $("cantilever").add(new Option(`${c.name} (${c.maker}: k = ${c.spring_constant} N/m, f₀ = ${c.resonance_frequency / 1e3} kHz, Q = ${c.quality_factor})`, c.name));

@@ -19,9 +19,11 @@ async function handle(msg) {
   const t0 = performance.now();
   try {
     if (msg.kind === "run") {
-      const text = msg.analysis === "cantilevers" ? wasm.cantilevers()
-        : msg.analysis === "version" ? JSON.stringify(wasm.version())
-          : wasm.run(msg.analysis, msg.input);
+      // the engine's data besides its analyses: the cantilever library, bifurcation.csv's
+      // columns, the version
+      const data = { cantilevers: wasm.cantilevers, bifurcation_columns: wasm.bifurcation_columns,
+        version: () => JSON.stringify(wasm.version()) }[msg.analysis];
+      const text = data ? data() : wasm.run(msg.analysis, msg.input);
       reply({ id: msg.id, ok: true, text, ms: performance.now() - t0 });
     } else if (msg.kind === "bifurcation") {
       const b = new wasm.Bifurcation(msg.input);

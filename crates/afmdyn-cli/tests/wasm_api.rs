@@ -139,6 +139,22 @@ fn a_bifurcation_in_chunks_is_the_command_lines_sweep() {
     let col = |name: &str| header.iter().position(|h| h == name).unwrap();
     let records: Vec<csv::StringRecord> = csv.records().map(|r| r.unwrap()).collect();
     assert_eq!(records.len(), rows.len());
+    // the columns the page writes its CSV with: the file's header, in its order, and the keys
+    // of every row
+    let columns: Vec<String> = afmdyn_wasm::bifurcation::columns()
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["name"].as_str().unwrap().to_string())
+        .collect();
+    assert_eq!(columns, header.iter().collect::<Vec<_>>());
+    let mut sorted = columns.clone();
+    sorted.sort();
+    for w in &rows {
+        let mut keys: Vec<&String> = w.as_object().unwrap().keys().collect();
+        keys.sort();
+        assert_eq!(keys, sorted.iter().collect::<Vec<_>>());
+    }
     for (r, w) in records.iter().zip(&rows) {
         assert_eq!(&r[col("branch")], w["branch"].as_str().unwrap());
         assert_eq!(&r[col("status")], w["status"].as_str().unwrap());

@@ -58,6 +58,18 @@ fn row(r: &SweepRecord) -> Value {
     })
 }
 
+/// The columns of `bifurcation.csv` ([`afmdyn::request::sweep::COLUMNS`]), in its order, as a
+/// JSON array of `{"name", "unit", "meaning"}`: the keys of [`BifurcationSession::next`]'s
+/// rows, for a page that writes them as the command line does.
+pub fn columns() -> Value {
+    Value::Array(
+        afmdyn::request::sweep::COLUMNS
+            .iter()
+            .map(|c| json!({"name": c.name, "unit": c.unit, "meaning": c.meaning}))
+            .collect(),
+    )
+}
+
 /// A bifurcation sweep computed chunk by chunk (module docs).
 pub struct BifurcationSession {
     study: SweepStudy,

@@ -219,6 +219,13 @@ pub fn cantilevers() -> String {
     afmdyn::cantilevers::document().to_string()
 }
 
+/// The columns of `bifurcation.csv`, in its order ([`bifurcation::columns`]): JSON text of
+/// `[{"name", "unit", "meaning"}, …]`, the keys of [`Bifurcation::next`]'s rows.
+#[wasm_bindgen]
+pub fn bifurcation_columns() -> String {
+    bifurcation::columns().to_string()
+}
+
 /// The library's version (the page shows it).
 #[wasm_bindgen]
 pub fn version() -> String {
