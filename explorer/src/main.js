@@ -84,11 +84,13 @@ function status(el, text) {
 
 // ---------------------------------------------------------------------------- Dynamics
 
-function numberField(id) {
+/** The number in field `id` (undefined when blank); `name` is the request's key, which a
+ * message names. */
+function numberField(id, name = id) {
   const v = $(id).value.trim();
   if (v === "") return undefined;
   const x = Number(v);
-  if (!Number.isFinite(x)) throw new FieldError(id, `${id} = ${v}: not a number`);
+  if (!Number.isFinite(x)) throw new FieldError(name, `${name} = ${v}: must be a number`);
   return x;
 }
 
@@ -305,10 +307,10 @@ async function showOrbit(rowIndex) {
       request = { initial: r.state };
       if (r.period) request.period = r.period;
     } else {
-      const period = numberField("orbit-period");
+      const period = numberField("orbit-period", "period");
       if (period !== undefined) request.period = period;
     }
-    v.omega = numberField("orbit-omega");
+    v.omega = numberField("orbit-omega", "omega");
   } catch (e) {
     reportError(e, dynErrorPlaces("orbit"), $("err-orbit"));
     return;

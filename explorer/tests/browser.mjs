@@ -179,6 +179,12 @@ try {
   check("a bad α1 is refused beside its field with the command line's message",
     msg === cliMsg && await page.getAttribute("#alpha1", "aria-invalid") === "true", `"${msg}" vs "${cliMsg}"`);
   await page.fill("#alpha1", "0.1");
+  await page.fill("#orbit-omega", "two");
+  await page.click("#orbit-run");
+  await page.waitForFunction(() => document.getElementById("err-omega").textContent !== "");
+  check("text that is no number is refused beside its field, naming the key",
+    await page.textContent("#err-omega") === "omega = two: must be a number", await page.textContent("#err-omega"));
+  await page.fill("#orbit-omega", "2.8");
 
   // ------------------------------------------------------------------ AFM: approach from a preset
   await page.click("#tab-afm");
