@@ -11,13 +11,17 @@ export function fieldErrors(message, locate) {
 }
 
 /** [[element, part]] for each `; `-separated part of a probe message naming a key `locate`
- * knows (`[section].key` → "section.key"); nothing when no part is placed. */
-export function probeErrors(message, locate) {
+ * knows (`[section].key` → "section.key"), the other parts together beside `rest`; nothing
+ * when no part is placed. */
+export function probeErrors(message, locate, rest) {
   const out = [];
+  const left = [];
   for (const part of message.replace(/^probe[^:]*: /, "").split("; ")) {
     const m = /\[([a-z_]+)\]\.([a-z_0-9]+)/.exec(part);
     const el = m ? locate(`${m[1]}.${m[2]}`) : null;
     if (el) out.push([el, part]);
+    else left.push(part);
   }
+  if (out.length && left.length) out.push([rest, `probe: ${left.join("; ")}`]);
   return out;
 }

@@ -503,7 +503,7 @@ function showAnalysisFields() {
 
 function afmErrorPlaces(message) {
   const placed = probeErrors(message, (key) =>
-    document.querySelector(`#afm-form [data-key="${key}"]`)?.parentElement.querySelector(".error"));
+    document.querySelector(`#afm-form [data-key="${key}"]`)?.parentElement.querySelector(".error"), $("err-probe"));
   if (placed.length) return placed;
   return fieldErrors(message, (name) => $(`err-${name}`));
 }

@@ -290,6 +290,22 @@ try {
   const kMsg = await page.textContent("#p-spring_constant + .error");
   check("a bad k is refused beside its field, naming [cantilever].spring_constant and the range",
     kMsg.startsWith("[cantilever].spring_constant = -40 (N/m): must be"), kMsg);
+  // a key with no field of its own: its part of the message beside the probe file
+  await page.fill("#p-spring_constant", "40");
+  await page.dispatchEvent("#p-spring_constant", "change");
+  await page.fill("#p-youngs_modulus", "-4e9");
+  await page.dispatchEvent("#p-youngs_modulus", "change");
+  await page.click("details:has(#probe-text) > summary");
+  const text = await page.inputValue("#probe-text");
+  await page.fill("#probe-text", text.replace(/poisson_ratio = 0\.33/, "poisson_ratio = 0.7"));
+  await page.dispatchEvent("#probe-text", "change");
+  await page.click("#afm-run");
+  await page.waitForFunction(() => document.getElementById("err-probe").textContent !== "");
+  const eMsg = await page.textContent("#p-youngs_modulus + .error");
+  const rest = await page.textContent("#err-probe");
+  check("every part of a probe's message is shown: E beside its field, the Poisson ratio (no field) beside the file",
+    eMsg.startsWith("[sample].youngs_modulus = -4000000000") && rest.startsWith("probe: ") && rest.includes("[sample].poisson_ratio"),
+    `${eMsg} | ${rest}`);
 
   // ------------------------------------------------------------------ the URL holds the view
   const shared = page.url();
