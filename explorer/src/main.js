@@ -175,8 +175,9 @@ async function runDiagram() {
   const form = $("dyn-form");
   clearErrors(form);
   let input;
+  let v;
   try {
-    const v = dynValues();
+    v = dynValues();
     input = { model: dynModel(v), request: dynRequest(v) };
   } catch (e) {
     reportError(e, dynErrorPlaces("diagram"), $("err-dyn"));
@@ -187,7 +188,7 @@ async function runDiagram() {
   const gen = ++generation.diagram;
   state.rows = [];
   state.selected = -1;
-  state.diagram = { param: "omega", input };
+  state.diagram = { param: "omega", input, values: v };
   state.busy.diagram = true;
   const t0 = performance.now();
   status($("dyn-status"), "computing the diagram…");
@@ -298,7 +299,8 @@ async function showOrbit(rowIndex) {
   let v;
   let request = {};
   try {
-    v = dynValues();
+    // a diagram point's orbit is of the diagram's model, whatever the fields say since
+    v = rowIndex !== undefined && rowIndex >= 0 ? { ...state.diagram.values } : dynValues();
     if (rowIndex !== undefined && rowIndex >= 0) {
       const r = state.rows[rowIndex];
       state.selected = rowIndex;

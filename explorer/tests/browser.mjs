@@ -136,6 +136,8 @@ try {
   await page.screenshot({ path: path.join(out, "screenshot.png"), fullPage: true });
 
   // keyboard: the diagram takes focus, → moves the selection, Enter shows that orbit
+  // a field changed since the diagram was computed does not change its points' orbits
+  await page.fill("#alpha1", "0.2");
   await page.focus("#bif-plot");
   const sel0 = await page.evaluate(() => window.explorer.selected);
   await page.keyboard.press("ArrowRight");
@@ -144,8 +146,9 @@ try {
   await page.keyboard.press("Enter");
   await page.waitForFunction((b) => window.explorer.timings.orbit_view_ms !== b && !window.explorer.busy.orbit, before2);
   const kb = await page.evaluate(() => ({ r: window.explorer.rows[window.explorer.selected], o: window.explorer.orbitRequest }));
-  check("keyboard: → moves the selected point and Enter shows its orbit",
-    sel1 !== sel0 && kb.o.model.omega === kb.r.value, `${sel0} → ${sel1}`);
+  check("keyboard: → moves the selected point and Enter shows its orbit, of the diagram's model",
+    sel1 !== sel0 && kb.o.model.omega === kb.r.value && kb.o.model.alpha1 === 0.1, `${sel0} → ${sel1}; α1 = ${kb.o.model.alpha1}`);
+  await page.fill("#alpha1", "0.1");
 
   // the eigenfrequency view: the command line's natural frequencies (eqs. 19–23)
   await page.click("#modes-run");
