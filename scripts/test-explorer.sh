@@ -32,5 +32,9 @@ for _ in $(seq 50); do
     python3 -c "import urllib.request; urllib.request.urlopen('http://127.0.0.1:$port/')" 2> /dev/null && break
     sleep 0.1
 done
-node explorer/tests/browser.mjs --url "http://127.0.0.1:$port/" --bin "$TARGET/release/afmdyn" \
-    --chromium "$chromium" --out "$TARGET/explorer"
+# each wait in the test is bounded (120 s); the whole run too
+timeout 900 node explorer/tests/browser.mjs --url "http://127.0.0.1:$port/" \
+    --bin "$TARGET/release/afmdyn" --chromium "$chromium" --out "$TARGET/explorer"
+code=$?
+[ "$code" -ne 124 ] || fail "the browser test ran past 900 s"
+exit "$code"

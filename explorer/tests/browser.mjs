@@ -7,7 +7,7 @@
 // "explorer: N passed, M failed" last; saves DIR/screenshot.png (and screenshot-afm.png).
 import { chromium } from "playwright-core";
 import { execFileSync, spawnSync } from "node:child_process";
-import { mkdtempSync, readFileSync, writeFileSync } from "node:fs";
+import { mkdtempSync, readFileSync, rmSync, writeFileSync } from "node:fs";
 import { tmpdir } from "node:os";
 import path from "node:path";
 import { fileURLToPath } from "node:url";
@@ -47,6 +47,13 @@ const browser = await chromium.launch({
 });
 const browserVersion = browser.version();
 const errors = [];
+// the command line's output directories, removed at the end
+const scratch = [];
+const scratchDir = () => {
+  const d = mkdtempSync(path.join(tmpdir(), "afmdyn-explorer-"));
+  scratch.push(d);
+  return d;
+};
 try {
   const context = await browser.newContext({ viewport: { width: 1440, height: 900 }, acceptDownloads: true });
   const page = await context.newPage();
@@ -65,7 +72,7 @@ try {
   timings.diagram = await page.evaluate(() => window.explorer.timings.diagram_ms);
   timings.load_and_diagram = Date.now() - t0;
   const rows = await page.evaluate(() => window.explorer.rows);
-  const tmp = mkdtempSync(path.join(tmpdir(), "afmdyn-explorer-"));
+  const tmp = scratchDir();
   execFileSync(bin, ["bifurcation", "--out", tmp], { cwd: root });
   const csvText = readFileSync(path.join(tmp, "bifurcation.csv"), "utf8");
   const cmp = compareBifurcation(rows, csvText);
@@ -320,7 +327,7 @@ try {
     modes: document.getElementById("modes").value, a1: document.getElementById("alpha1").value,
     rows: window.explorer.rows.length, om: document.getElementById("orbit-omega").value,
   }));
-  const tmp2 = mkdtempSync(path.join(tmpdir(), "afmdyn-explorer-"));
+  const tmp2 = scratchDir();
   execFileSync(bin, ["bifurcation", "--modes", "2", "--tip-mass-ratio", "0.2", "--from", "2.5", "--to", "3", "--steps", "12", "--out", tmp2], { cwd: root });
   const cmp2 = compareBifurcation(await page2.evaluate(() => window.explorer.rows), readFileSync(path.join(tmp2, "bifurcation.csv"), "utf8"));
   check("a shared link restores the view and recomputes it (N = 2, α1 = 0.2: the command line's diagram)",
@@ -345,6 +352,7 @@ try {
   check("the browser session ran to its end", false, e.stack);
 } finally {
   await browser.close();
+  for (const d of scratch) rmSync(d, { recursive: true, force: true });
 }
 
 console.log(`timings in the browser: default Fig. 5 diagram ${(timings.diagram / 1000).toFixed(2)} s ` +
