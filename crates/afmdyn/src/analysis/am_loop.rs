@@ -32,15 +32,11 @@
 //! τ_c/4, K_P = 0.
 
 use super::observables::{observe, wrap_phase, ObservableOptions};
-#[cfg(not(feature = "parallel"))]
-use super::sequential::*;
 use crate::error::SimError;
 use crate::integrate::{advance, build, Integrator, IntegratorOptions};
 use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
 use nalgebra::DVector;
-#[cfg(feature = "parallel")]
-use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -443,27 +439,5 @@ pub fn scan_lines(
     sink: &(dyn Fn(usize, ScanLine) + Sync),
     cancel: &AtomicBool,
 ) -> Result<(), SimError> {
-    let failed = std::sync::Mutex::new(None::<(usize, SimError)>);
-    (0..lines)
-        .into_par_iter()
-        .with_max_len(1)
-        .filter(|t| !done.contains(t))
-        .for_each(|t| {
-            if cancel.load(Ordering::Relaxed) {
-                return;
-            }
-            match line(t) {
-                Ok(l) => sink(t, l),
-                Err(e) => {
-                    let mut f = failed.lock().unwrap_or_else(|p| p.into_inner());
-                    if f.as_ref().is_none_or(|(k, _)| t < *k) {
-                        *f = Some((t, e));
-                    }
-                }
-            }
-        });
-    match failed.into_inner().unwrap_or_else(|p| p.into_inner()) {
-        Some((_, e)) => Err(e),
-        None => Ok(()),
-    }
+    super::tasks::run_independent(lines, done, &|t| line(t).map(Some), sink, cancel)
 }

@@ -22,16 +22,12 @@
 use super::attractors::same_attractor;
 use super::bifurcation::{mix64, random_state};
 use super::lyapunov::largest_exponent;
-#[cfg(not(feature = "parallel"))]
-use super::sequential::*;
 use super::steady::{steady_state, SteadyOptions, SteadyState};
 use crate::error::SimError;
 use crate::integrate::{build, IntegratorOptions};
 use crate::model::CantileverModel;
 use crate::params::Params;
 use nalgebra::DVector;
-#[cfg(feature = "parallel")]
-use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::collections::HashSet;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -421,16 +417,15 @@ pub fn run_chart(
     sink: &(dyn Fn(usize, Vec<ChartCell>) + Sync),
     cancel: &AtomicBool,
 ) {
-    (0..plan.tasks())
-        .into_par_iter()
-        .with_max_len(1)
-        .filter(|t| !done.contains(t))
-        .for_each(|t| {
-            if cancel.load(Ordering::Relaxed) {
-                return;
-            }
-            if let Some(cells) = plan.run_task(t, cancel) {
-                sink(t, cells);
-            }
-        });
+    let never: Result<(), std::convert::Infallible> = super::tasks::run_independent(
+        plan.tasks(),
+        done,
+        &|t| Ok(plan.run_task(t, cancel)),
+        sink,
+        cancel,
+    );
+    match never {
+        Ok(()) => {}
+        Err(e) => match e {},
+    }
 }

@@ -33,6 +33,7 @@ pub mod shooting;
 pub mod spectrum;
 pub mod steady;
 pub mod stepped;
+pub mod tasks;
 pub mod traces;
 
 /// Without the `parallel` feature: the few rayon adaptors the analyses call, on plain
