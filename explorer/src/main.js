@@ -204,10 +204,12 @@ async function runDiagram() {
     state.timings.diagram_ms = wall;
     state.timings.diagram_engine_ms = ms;
     drawDiagram();
-    const failed = state.rows.filter((r) => r.status === "failed").length;
+    // a point that failed is a row of status "error" with its message (the library's
+    // PointStatus): said here, as the command line says it
+    const failed = state.rows.filter((r) => r.status === "error");
     status($("dyn-status"),
       `diagram: ${state.rows.length} Poincaré points in ${(wall / 1000).toFixed(2)} s` +
-      (failed ? ` — ${failed} points failed (see the CSV's message column)` : ""));
+      (failed.length ? ` — ${failed.length} point(s) failed, e.g. Ω = ${failed[0].value}: ${failed[0].message}` : ""));
   } catch (e) {
     reportError(e, dynErrorPlaces("diagram"), $("err-dyn"));
     if (!(e instanceof Cancelled)) status($("dyn-status"), "");
