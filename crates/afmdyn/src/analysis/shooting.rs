@@ -4,6 +4,7 @@
 //! monodromy matrix of Pⁿ ([`crate::maps::flow`]); it converges quadratically to stable and
 //! unstable orbits alike. The Floquet multipliers are the eigenvalues of M.
 
+use super::period::{close, MERGE_FACTOR};
 use crate::error::SimError;
 use crate::integrate::{build, Integrator, IntegratorKind, IntegratorOptions};
 use crate::maps::flow::FlowMap;
@@ -119,7 +120,7 @@ pub fn shoot_with(
     opts: &ShootingOptions,
 ) -> Result<PeriodicOrbit, SimError> {
     let (z, map, residuals) = newton(integ, guess, n, opts, Damping::Halve)?;
-    finish(integ, z, n, map, residuals)
+    finish(integ, z, n, map, residuals, opts)
 }
 
 /// [`shoot_with`] globalised: each Newton step is backtracked by a line search on ½‖F‖²
@@ -140,7 +141,7 @@ pub fn shoot_globalised(
     opts: &ShootingOptions,
 ) -> Result<PeriodicOrbit, SimError> {
     let (z, map, residuals) = newton(integ, guess, n, opts, Damping::LineSearch)?;
-    finish(integ, z, n, map, residuals)
+    finish(integ, z, n, map, residuals, opts)
 }
 
 /// How many section points of an attractor [`shoot_from_section`] tries as starts at most.
@@ -611,15 +612,69 @@ pub fn floquet_stability(m: &DMatrix<f64>) -> (Vec<Complex<f64>>, bool, Instabil
     (multipliers, crit.norm() < 1.0, critical)
 }
 
+/// The smallest proper divisor d of n = `section.len()` whose return P^d(z) comes back to the
+/// orbit's start z = `section[0]` within [`MERGE_FACTOR`] × `tol` (1 + ‖z‖): the candidate
+/// minimal period of a period-n orbit. A period-1 orbit is a fixed point of Pⁿ too, and a
+/// Newton solve for Pⁿ(z) = z from a guess (a period carried along a sweep, a transient's
+/// guess) converges to it as readily as to a true period-n orbit; the orbit's own returns tell
+/// them apart. `None` when no proper divisor returns (n is the minimal period).
+pub fn proper_period(section: &[DVector<f64>], tol: f64) -> Option<usize> {
+    let n = section.len();
+    (1..n)
+        .filter(|&d| n.is_multiple_of(d))
+        .find(|&d| close(&section[d], &section[0], MERGE_FACTOR * tol))
+}
+
+/// The period-n orbit through `z` (converged to `opts.tol`) reduced to its minimal period:
+/// the orbit shot again at the [`proper_period`] of its section, which must converge there
+/// (else n stands). `Ok(None)` when n is minimal (costs n − 1 plain flows of one period).
+///
+/// # Errors
+/// [`SimError`] from the propagator.
+pub fn reduce_period(
+    integ: &mut dyn Integrator,
+    z: &DVector<f64>,
+    n: usize,
+    opts: &ShootingOptions,
+) -> Result<Option<PeriodicOrbit>, SimError> {
+    if n < 2 {
+        return Ok(None);
+    }
+    let section = section_points(integ, z, n)?;
+    minimal(integ, &section, opts)
+}
+
+/// [`reduce_period`] on the orbit's section points.
+fn minimal(
+    integ: &mut dyn Integrator,
+    section: &[DVector<f64>],
+    opts: &ShootingOptions,
+) -> Result<Option<PeriodicOrbit>, SimError> {
+    let Some(d) = proper_period(section, opts.tol) else {
+        return Ok(None);
+    };
+    match newton(integ, &section[0], d, opts, Damping::Stop) {
+        Ok((z, map, residuals)) => finish(integ, z, d, map, residuals, opts).map(Some),
+        Err(SimError::Cancelled) => Err(SimError::Cancelled),
+        // not an orbit of period d after all: n stands
+        Err(_) => Ok(None),
+    }
+}
+
 fn finish(
     integ: &mut dyn Integrator,
     z: DVector<f64>,
     n: usize,
     map: FlowMap,
     residuals: Vec<f64>,
+    opts: &ShootingOptions,
 ) -> Result<PeriodicOrbit, SimError> {
     closes_in_its_region(integ, &z, n, &residuals)?;
     let section = section_points(integ, &z, n)?;
+    // the minimal period: an orbit found as period n may repeat after a divisor of n
+    if let Some(o) = minimal(integ, &section, opts)? {
+        return Ok(o);
+    }
     let grazing_distance = StroboscopicMap::new(&mut *integ, n).grazing_distance(&z)?;
     let (multipliers, stable, critical) = floquet_stability(&map.jacobian);
     Ok(PeriodicOrbit {

@@ -316,6 +316,19 @@ pub struct SteppedCurve {
     pub average: Option<AverageOptions>,
 }
 
+impl SteppedCurve {
+    /// The largest indentation max(−V_T, 0) of the curve's operating points, both sweeps (in
+    /// the model's length unit; 0 for a curve that never touches).
+    pub fn largest_indentation(&self) -> f64 {
+        self.first
+            .iter()
+            .chain(&self.second)
+            .map(|p| p.observables.indentation)
+            .filter(|d| d.is_finite())
+            .fold(0.0, f64::max)
+    }
+}
+
 /// Why a time average may not settle ([`average::slowest_beat`]): the clause for the
 /// warning when the slowest beat of the combination tones is longer than the settling window,
 /// or empty.
@@ -681,6 +694,28 @@ fn step_point(
                 Reached::Start
             },
         ),
+    };
+    // the minimal period: a period carried along the sweep (or a transient's guess) finds a
+    // period-1 orbit as a fixed point of Pⁿ as readily as a period-n one
+    let found = match found.period {
+        Some(n) if n > 1 => {
+            match crate::analysis::shooting::reduce_period(
+                integ.as_mut(),
+                &found.state,
+                n,
+                &spec.newton,
+            )? {
+                Some(o) => Found {
+                    period: Some(o.period),
+                    state: o.state,
+                    multipliers: o.multipliers,
+                    monodromy: Some(o.monodromy),
+                    stable: o.stable,
+                },
+                None => found,
+            }
+        }
+        _ => found,
     };
     let periods = found.period.unwrap_or(spec.steady.nonperiodic_record);
     let observables = measure(integ.as_mut(), &found.state, periods, &spec.observables)?;
