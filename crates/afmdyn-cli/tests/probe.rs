@@ -140,7 +140,7 @@ fn cantilever_library_composes_with_a_sample_file() {
     let full = format!(
         "model = \"point-mass\"\n[cantilever]\nspring_constant = 26.0\n\
          resonance_frequency = 300e3\nquality_factor = 500\n[tip]\nradius = 7e-9\n\
-         youngs_modulus = 130e9\npoisson_ratio = 0.28\n{sample}"
+         youngs_modulus = 130e9\npoisson_ratio = 0.27\n{sample}"
     );
     let (s, f) = (dir.path().join("sample.toml"), dir.path().join("full.toml"));
     std::fs::write(&s, sample).unwrap();

@@ -83,7 +83,7 @@ def test_cantilever_library(tmp_path):
     full = tmp_path / "full.toml"
     full.write_text('model = "point-mass"\n[cantilever]\nspring_constant = 40.0\n'
                     "resonance_frequency = 300e3\nquality_factor = 500\n[tip]\nradius = 8e-9\n"
-                    "youngs_modulus = 130e9\npoisson_ratio = 0.28\n" + sample)
+                    "youngs_modulus = 130e9\npoisson_ratio = 0.27\n" + sample)
     assert afmdyn.Params.from_probe(str(named)).to_dict() == afmdyn.Params.from_probe(str(full)).to_dict()
     bad = tmp_path / "bad.toml"
     bad.write_text('[cantilever]\nname = "rtespa"\n' + sample)

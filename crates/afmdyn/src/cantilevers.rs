@@ -8,12 +8,14 @@
 
 use std::sync::OnceLock;
 
-/// Young's modulus of a silicon tip (Pa): 130 GPa along ⟨100⟩, the lower end of 130–188 GPa over
-/// orientations (Hopcroft, Nix & Kenny, "What is the Young's modulus of silicon?", J.
+/// Young's modulus of a silicon tip (Pa), from the one materials table
+/// ([`crate::units::SILICON_TIP`]: 130 GPa along ⟨100⟩, the lower end of 130–188 GPa over
+/// orientations; Hopcroft, Nix & Kenny, "What is the Young's modulus of silicon?", J.
 /// Microelectromech. Syst. 19, 229 (2010)).
-pub const SILICON_YOUNGS_MODULUS: f64 = 130e9;
-/// Poisson's ratio of a silicon tip: 0.28 (Hopcroft, Nix & Kenny 2010, ⟨100⟩ in-plane).
-pub const SILICON_POISSON_RATIO: f64 = 0.28;
+pub const SILICON_YOUNGS_MODULUS: f64 = crate::units::SILICON_TIP.youngs_modulus;
+/// Poisson's ratio of a silicon tip, from the one materials table
+/// ([`crate::units::SILICON_TIP`]: 0.27, the paper's).
+pub const SILICON_POISSON_RATIO: f64 = crate::units::SILICON_TIP.poisson_ratio;
 
 /// One cantilever of the library (SI units).
 #[derive(Debug, Clone, PartialEq)]
@@ -250,7 +252,7 @@ mod tests {
         let same = crate::probe::Probe::parse(
             "model = \"point-mass\"\n[cantilever]\nspring_constant = 26.0\n\
              resonance_frequency = 300e3\nquality_factor = 500\n[tip]\nradius = 7e-9\n\
-             youngs_modulus = 130e9\npoisson_ratio = 0.28\n[sample]\nlaw = \"hertz\"\n\
+             youngs_modulus = 130e9\npoisson_ratio = 0.27\n[sample]\nlaw = \"hertz\"\n\
              youngs_modulus = 1e9\npoisson_ratio = 0.3\nz_c = 8e-9\n[drive]\n\
              free_amplitude = 10e-9\n",
             "written out",

@@ -56,6 +56,21 @@ pub fn first_mode_at_tip(m: &RegionMatrices, tip: &DVector<f64>) -> (f64, DVecto
     mode_at_tip(m, tip, 0)
 }
 
+/// The paper's beam damping α3 (C^I = α3·I, eq. 12; per mode α3 s_j with a damping profile
+/// s) that gives the first mode the quality factor `q1`: the first mode's modal damping
+/// x₁ᵀ C x₁ = α3 x₁ᵀ diag(s) x₁ equals 2ζ₁ω̃₁ = ω̃₁/Q₁ for the mass-normalised undamped mode
+/// x₁ (x₁ᵀMx₁ = 1) of frequency ω̃₁ (modal damping of a lightly damped mode, Q = 1/(2ζ);
+/// Meirovitch, *Fundamentals of Vibrations*, 2001, §7.15). The one place α3 is derived from Q;
+/// `profile` is s (None: uniform).
+pub fn beam_damping_for_q(omega1: f64, x1: &DVector<f64>, q1: f64, profile: Option<&[f64]>) -> f64 {
+    let s_x1: f64 = x1
+        .iter()
+        .enumerate()
+        .map(|(j, x)| x * x * profile.map_or(1.0, |s| s[j]))
+        .sum();
+    omega1 / (q1 * s_x1)
+}
+
 /// [`first_mode_at_tip`] for mode `k` (0-based, k < N): ω̃_k, the mass-normalised undamped
 /// mode x_k and the stiffness k̃_k = ω̃_k²/(φᵀx_k)² of the equivalent point mass of that mode
 /// at the tip (Melcher, Hu & Raman, *Appl. Phys. Lett.* 91 (2007) 053101).

@@ -353,8 +353,8 @@ pub fn beam_damping_from_q(model: &PhysicalModel, q1: f64) -> Result<f64, UnitsE
     let p = undamped.to_params()?;
     let g = Galerkin::new(&p)?;
     let modes = natural_modes(g.region(Region::Free));
-    let x1 = modes.vectors.column(0);
-    let alpha3 = modes.omega[0] / (q1 * x1.dot(&x1));
+    let x1 = modes.vectors.column(0).into_owned();
+    let alpha3 = crate::eigen::beam_damping_for_q(modes.omega[0], &x1, q1, None);
     let c = &model.cantilever;
     Ok(alpha3 * (c.bending_stiffness() * c.mass_per_length()).sqrt() / c.length.powi(2))
 }
