@@ -13,10 +13,15 @@ use crate::error::SimError;
 use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
 
-/// The default z_c range of an approach (units of g₀): from 1.2 A₀ to 0.1 A₀ above the contact
+/// The default z_c range of an approach (units of g₀): from 1.2 A₀ above the contact
 /// threshold, A₀ the free amplitude of `base` ([`free_response`]; under a multifrequency drive
-/// the sum of the components' free amplitudes): from where the sample is out
-/// of reach to deep in the repulsive regime.
+/// the sum of the components' free amplitudes), where the sample is out of reach, down to
+/// 0.1 A₀ above it — deep in the repulsive regime of a stiff sample — or, on a soft sample,
+/// to 0.4 A₀ − δ_k ([`soft_indentation`]): a rigid sample holds the amplitude at A/A₀ = 0.5
+/// near z_c = 0.5 A₀, and a compliant one lets the tip sink by about the indentation δ_k at
+/// which it pushes back with the lever's force at its free amplitude, so the curve reaches
+/// A/A₀ ≤ 0.5 (issue 60 item 12: a 0.09 N/m lever on 1 MPa never got below A/A₀ = 0.995 on
+/// 0.1 A₀). The two agree while δ_k ≤ 0.3 A₀.
 ///
 /// # Errors
 /// [`SimError`] for invalid parameters or an undamped drive at resonance (no finite A₀).
@@ -29,7 +34,55 @@ pub fn default_range(base: &Params) -> Result<(f64, f64), SimError> {
         a0 += c.force * model.free_force_response(c.ratio() * base.omega)?.norm();
     }
     let offset = base.contact_law.distance_offset();
-    Ok((1.2 * a0 + offset, 0.1 * a0 + offset))
+    let near = (0.1 * a0).min(0.4 * a0 - soft_indentation(&model, a0));
+    Ok((1.2 * a0 + offset, near + offset))
+}
+
+/// The quasi-static indentation δ_k (units of g₀) at which the sample's contact force (its
+/// relaxed law, no rate) reaches k_s A₀, the lever's static stiffness at the tip k_s =
+/// 1/(φᵀK⁻¹φ) (K the free stiffness matrix, φ the tip's mode shapes: 1 for the point mass,
+/// 1/Σ(1/k_j) for the eigenmode model) times its free amplitude `a0`: how far the tip sinks into
+/// the sample before it is stopped. At most 3 A₀ (a sample that never pushes back so hard, or a
+/// rigid one whose law has no force of its own, gives its bound or 0).
+pub fn soft_indentation(model: &CantileverModel, a0: f64) -> f64 {
+    use crate::contact::{TipSample, TipSampleLaw};
+    use crate::galerkin::Region;
+    let p = model.params();
+    if matches!(p.contact_law, crate::contact::ContactLaw::Impact { .. }) || a0.is_nan() || a0 <= 0.0 {
+        return 0.0;
+    }
+    let free = model.galerkin().region(Region::Free);
+    let tip = model.tip();
+    let Some(k_inv) = free.stiffness.clone().try_inverse() else {
+        return 0.0;
+    };
+    let k_s = 1.0 / tip.dot(&(&k_inv * tip));
+    let law = TipSample {
+        law: p.contact_law,
+        stiffness: p.alpha4,
+        damping: 0.0,
+    };
+    let target = k_s * a0;
+    let pushes = |d: f64| law.force(true, d, 0.0).force >= target;
+    let cap = 3.0 * a0;
+    if !pushes(cap) {
+        return cap;
+    }
+    // the first doubling of 1e-6 A₀ that pushes back hard enough, then bisection
+    let (mut lo, mut hi) = (0.0, 1e-6 * a0);
+    while !pushes(hi) {
+        lo = hi;
+        hi *= 2.0;
+    }
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        if pushes(mid) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    hi
 }
 
 /// The stepped-sweep spec of an approach from the larger to the smaller of `z_from` and `z_to`

@@ -184,20 +184,29 @@ pub(super) struct Vacuum {
     /// The eigenmode model's frequencies in vacuum (Hz).
     pub eigen_frequencies: Option<Vec<f64>>,
     section: Section,
+    /// What the conversion assumed ([`intrinsic`]), for the probe's warnings.
+    pub warnings: Vec<String>,
 }
 
-/// `1/(1/Q − 1/Q_f)/√(1 + TΓ_r)` (module docs), or the error naming `key`.
-fn intrinsic(q: f64, mode: &crate::hydro::WetMode, key: &str) -> Result<f64, String> {
+/// `1/(1/Q − 1/Q_f)/√(1 + TΓ_r)` (module docs). A calibrated Q at or above what air damping
+/// alone allows for the lever's plan (Sader's estimate, which assumes a long lever, L ≫ b) is
+/// data, not an error: the lever's own loss is then taken as nil (Q_int =
+/// [`super::MAX_QUALITY_FACTOR`]), its fluid loading from the plan, and `warnings` says so.
+fn intrinsic(q: f64, mode: &crate::hydro::WetMode, key: &str, warnings: &mut Vec<String>) -> f64 {
     let inv = 1.0 / q - 1.0 / mode.quality_factor;
     if inv <= 0.0 {
-        return Err(format!(
-            "[cantilever].{key} = {q}: exceeds {:.4}, the quality factor air damping alone \
-             allows this lever at {:.6e} Hz (Sader 1998; width and thickness as given): give \
-             [medium] calibrated_in = \"vacuum\" for a lever's own Q, or check the dimensions",
-            mode.quality_factor, mode.frequency_hz
+        warnings.push(format!(
+            "[cantilever].{key} = {}: at or above {}, the quality factor air damping alone \
+             allows this lever's plan at {} Hz (Sader 1998, for a long lever, L ≫ b): the \
+             lever's own loss is taken as nil and its fluid loading from the plan (a short or \
+             wide lever, or a Q measured in vacuum: give [medium] calibrated_in = \"vacuum\")",
+            crate::error::number(q),
+            crate::error::number(mode.quality_factor),
+            crate::error::number(mode.frequency_hz)
         ));
+        return super::MAX_QUALITY_FACTOR;
     }
-    Ok(1.0 / (inv * (1.0 + mode.added_mass_ratio).sqrt()))
+    1.0 / (inv * (1.0 + mode.added_mass_ratio).sqrt())
 }
 
 /// The lever's values in vacuum (module docs). `w1_k1` is ω̃₁²/k̃₁ of the structure's bare
@@ -268,6 +277,7 @@ pub(super) fn to_vacuum(
             qs: qs.map(<[f64]>::to_vec),
             eigen_frequencies: eigen_f.map(<[f64]>::to_vec),
             section,
+            warnings: Vec::new(),
         });
     }
     // the geometry's f₀ is a vacuum frequency: its mode in air from the wet-mode equation
@@ -293,7 +303,13 @@ pub(super) fn to_vacuum(
             (None, _) => Ok(air_mode(f_vac1 * beam_frequencies[j])?.frequency_hz),
         }
     };
-    let q1_int = intrinsic(q1, &vacuum(air_frequency(0)?)?.0, "quality_factor")?;
+    let mut warnings = Vec::new();
+    let q1_int = intrinsic(
+        q1,
+        &vacuum(air_frequency(0)?)?.0,
+        "quality_factor",
+        &mut warnings,
+    );
     let qs = match qs {
         Some(q) => Some(
             q.iter()
@@ -304,7 +320,12 @@ pub(super) fn to_vacuum(
                         Some(_) => format!("quality_factor[{j}]"),
                         None => format!("quality_factors[{j}]"),
                     };
-                    intrinsic(qj, &vacuum(air_frequency(j)?)?.0, &key)
+                    Ok::<f64, String>(intrinsic(
+                        qj,
+                        &vacuum(air_frequency(j)?)?.0,
+                        &key,
+                        &mut warnings,
+                    ))
                 })
                 .collect::<Result<Vec<_>, _>>()?,
         ),
@@ -316,6 +337,7 @@ pub(super) fn to_vacuum(
         qs,
         eigen_frequencies,
         section,
+        warnings,
     })
 }
 

@@ -14,7 +14,7 @@
 //! [tip]
 //! radius = 10e-9                 # R (m)
 //! youngs_modulus = 130e9         # E_t (Pa), default 130e9 (silicon, Hopcroft et al. 2010)
-//! poisson_ratio = 0.27           # ν_t, default 0.28 (silicon)
+//! poisson_ratio = 0.27           # ν_t, default 0.27 (silicon, units::SILICON_TIP)
 //! [sample]
 //! law = "dmt"                    # linear | hertz | dmt | electrostatic | jkr | capillary | sls
 //!                                # | impact
@@ -191,7 +191,14 @@ fn derived(message: String) -> String {
              [cantilever] spring_constant and [drive] free_amplitude"
         }
         "alpha5" => "[sample] z_c and [drive] free_amplitude, lengths in units of A₀",
-        "alpha6" => "[sample] damping or viscosity and [cantilever] resonance_frequency",
+        "alpha6" => {
+            "[sample] damping or viscosity (sls: maxwell_stiffness × relaxation_time, the \
+             dashpot) and [cantilever] resonance_frequency"
+        }
+        "maxwell_stiffness" => {
+            "[sample] maxwell_stiffness (sls), [cantilever] spring_constant and [drive] \
+             free_amplitude"
+        }
         "omega" => "[drive] frequency and [cantilever] resonance_frequency",
         "hamaker" => "[sample] hamaker, [tip] radius and [drive] free_amplitude",
         "intermolecular_distance" => {
@@ -279,7 +286,23 @@ pub struct Probe {
     /// for the other laws).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub tabor_parameter: Option<f64>,
+    /// Values of the file outside the range AFM probes and samples typically take (inside
+    /// their physical range, which the reader enforces): each a warning naming the likely
+    /// unit slip, carried by [`Probe::warnings`].
+    #[serde(skip)]
+    pub input_warnings: Vec<String>,
+    /// The tip radius R (m) of a law whose contact is Hertz's paraboloid (hertz, dmt,
+    /// electrostatic, jkr, capillary, sls; `None` for the others): what
+    /// [`Probe::indentation_warnings`] holds an indentation against.
+    #[serde(skip)]
+    pub tip_radius: Option<f64>,
 }
+
+/// The indentation, as a fraction of the tip radius, beyond which the paraboloid contact of
+/// Hertz, DMT and JKR no longer describes a spherical tip: the paraboloid approximates the
+/// sphere for contact radii a = √(Rδ) ≪ R (Johnson, *Contact Mechanics*, 1985, §4.2), and at
+/// δ = R/2 the contact radius is already 0.7 R (and a real tip's apex turns conical).
+pub const INDENTATION_VALIDITY: f64 = 0.5;
 
 /// Above this Tabor parameter the contact is JKR's (Johnson & Greenwood, *J. Colloid Interface
 /// Sci.* 192 (1997) 326, adhesion map: DMT below 0.1, the transition between, JKR above 5).
@@ -309,12 +332,31 @@ pub fn tabor_parameter(radius: f64, e_star: f64, work: f64, z0: f64) -> f64 {
 }
 
 impl Probe {
+    /// A result's validity against the contact law's assumptions: a warning when its largest
+    /// indentation `indentation` (m) exceeds [`INDENTATION_VALIDITY`] × the tip radius of a
+    /// paraboloid (Hertz-family) contact.
+    pub fn indentation_warnings(&self, indentation: f64) -> Vec<String> {
+        match self.tip_radius {
+            Some(r) if indentation > INDENTATION_VALIDITY * r => vec![format!(
+                "the largest indentation, {} m, exceeds half the tip radius R = {} m: the \
+                 {} law's paraboloid contact holds for indentations well below R (contact \
+                 radius √(Rδ) ≪ R; Johnson 1985, §4.2), so forces and indentations there are \
+                 outside the law's validity (a stiffer sample, a smaller amplitude or a larger \
+                 setpoint keeps the tip shallower)",
+                crate::error::number(indentation),
+                crate::error::number(r),
+                self.params.contact_law.name()
+            )],
+            _ => Vec::new(),
+        }
+    }
+
     /// The probe's own warnings, which every document of it carries
     /// ([`crate::report::with_si`]): a DMT or electrostatic sample in JKR's regime (Tabor
     /// parameter above [`TABOR_JKR`]), where DMT misses the contact's neck and the adhesion
     /// hysteresis.
     pub fn warnings(&self) -> Vec<String> {
-        let mut w = Vec::new();
+        let mut w = self.input_warnings.clone();
         let jkr = matches!(self.params.contact_law, ContactLaw::Jkr { .. });
         if let Some(mu) = self.tabor_parameter.filter(|&mu| jkr && mu < TABOR_DMT) {
             w.push(format!(
@@ -614,7 +656,10 @@ impl Probe {
     }
 
     fn read(root: &toml::Table, problems: &mut Vec<String>) -> Option<Probe> {
-        let mut r = Reader { problems };
+        let mut r = Reader {
+            problems,
+            warnings: Vec::new(),
+        };
         r.unknown(
             root,
             "",
@@ -727,8 +772,8 @@ impl Probe {
             radius = r.optional(t, "tip", "radius", "m", POSITIVE);
             tip_e = r.optional(t, "tip", "youngs_modulus", "Pa", POSITIVE);
             tip_nu = r.optional(t, "tip", "poisson_ratio", "1", POISSON);
-            // a silicon tip where the section omits its elastic constants (Hopcroft, Nix &
-            // Kenny, J. Microelectromech. Syst. 19 (2010) 229: E = 130 GPa, ν = 0.28)
+            // a silicon tip where the section omits its elastic constants (the one materials
+            // table, crate::units::SILICON_TIP)
             if !t.contains_key("youngs_modulus") {
                 tip_e = Some(crate::cantilevers::SILICON_YOUNGS_MODULUS);
             }
@@ -818,7 +863,11 @@ impl Probe {
             excitation,
         };
         match Self::resolve(structure, modes, beam, q1, qs, eigen, sample, drive, medium) {
-            Ok(p) => Some(p),
+            Ok(p) => Some(Probe {
+                input_warnings: [std::mem::take(&mut r.warnings), p.input_warnings.clone()]
+                    .concat(),
+                ..p
+            }),
             Err(e) => {
                 r.problems.push(e);
                 None
@@ -1097,7 +1146,8 @@ impl Probe {
         if let (Some(q1), Some(q)) = (q1, &qs) {
             if q.first().is_some_and(|&f| f != q1) {
                 r.problems.push(format!(
-                    "[cantilever].quality_factor = {q1} differs from quality_factors[0] = {}",
+                    "[cantilever].quality_factor = {} differs from quality_factors[0] = {}",
+                    crate::error::number(q1),
                     q[0]
                 ));
             }
@@ -1266,7 +1316,9 @@ impl Probe {
             // JKR: the work of adhesion W, or H/(12πa₀²) from the Hamaker constant
             out.hamaker = if law == "jkr" {
                 out.adhesion_energy = r.optional(s, S, "adhesion_energy", "J/m^2", POSITIVE);
-                match (out.adhesion_energy.is_some(), s.contains_key("hamaker")) {
+                // (a given but invalid adhesion_energy is reported by its own check, not
+                // as missing)
+                match (s.contains_key("adhesion_energy"), s.contains_key("hamaker")) {
                     (_, true) => r.optional(s, S, "hamaker", "J", POSITIVE),
                     (true, false) => None,
                     (false, false) => {
@@ -1485,13 +1537,8 @@ impl Probe {
             eigenmodes,
             ..bare
         };
-        // x₁ is mass-normalised (x₁ᵀMx₁ = 1): α3 = ω̃₁/(Q₁ x₁ᵀ diag(s) x₁)
-        let s_x1: f64 = x1
-            .iter()
-            .enumerate()
-            .map(|(j, x)| x * x * profile.map_or(1.0, |s| s[j]))
-            .sum();
-        let alpha3 = w1 / (q1 * s_x1);
+        let alpha3 =
+            crate::eigen::beam_damping_for_q(w1, &x1, q1, profile.as_ref().map(|s| &s[..]));
         // sample groups
         let t_s = time_s;
         let mut law = ContactLaw::Linear;
@@ -1656,6 +1703,13 @@ impl Probe {
             z_c_in_file,
             medium: medium_report,
             tabor_parameter,
+            input_warnings: vacuum.as_ref().map_or(Vec::new(), |v| v.warnings.clone()),
+            tip_radius: sample.radius.filter(|_| {
+                matches!(
+                    sample.law.as_str(),
+                    "hertz" | "dmt" | "electrostatic" | "jkr" | "capillary" | "sls"
+                )
+            }),
         })
     }
 
@@ -1696,11 +1750,29 @@ impl Probe {
             let r = f / drive_hz;
             let (p, q) = rational_ratio(r).or_else(|| convergent(r)).ok_or_else(|| {
                 format!(
-                    "[drive].frequency[{}] = {f} Hz: its ratio to the first component's \
-                     {drive_hz} Hz, {r}, must be in (0, 1e6)",
+                    "[drive].frequency[{}] = {} Hz: its ratio to the first component's \
+                     {} Hz, {}, must be in (0, 1e6)",
                     i + 1,
+                    crate::error::number(f),
+                    crate::error::number(drive_hz),
+                    crate::error::number(r),
                 )
             })?;
+            // a lock-in at one frequency measures the sum of every component there: two
+            // components at one frequency would each be reported with their total amplitude
+            let same = (p, q) == (1, 1)
+                || out.iter().any(|c: &DriveComponentSi| {
+                    u64::from(c.ratio[0]) * u64::from(q) == u64::from(p) * u64::from(c.ratio[1])
+                });
+            if same {
+                return Err(format!(
+                    "[drive].frequency[{}] = {} Hz: another component is at this frequency; \
+                     a lock-in cannot tell components at one frequency apart, so give them as \
+                     one component (their amplitudes added)",
+                    i + 1,
+                    crate::error::number(f),
+                ));
+            }
             let ratio = f64::from(p) / f64::from(q);
             let h = model
                 .free_force_response(ratio * params.omega)

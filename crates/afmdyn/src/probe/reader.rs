@@ -7,6 +7,9 @@ use super::*;
 /// A TOML table walker that collects every problem instead of stopping at the first.
 pub(super) struct Reader<'a> {
     pub(super) problems: &'a mut Vec<String>,
+    /// Values inside their physical range but outside the range any AFM probe or sample
+    /// typically takes ([`typical_hint`]): warnings, with the likely unit slip named.
+    pub(super) warnings: Vec<String>,
 }
 
 impl Reader<'_> {
@@ -111,6 +114,13 @@ impl Reader<'_> {
                 ));
                 return None;
             }
+            if let Some(hint) = typical_hint(section, key, x) {
+                self.warnings.push(format!(
+                    "{}{key} = {} ({unit}) is {hint}",
+                    prefix(section),
+                    crate::error::number(x)
+                ));
+            }
             Some(x)
         } else {
             self.problems.push(format!(
@@ -173,6 +183,65 @@ pub(super) fn scale_hint(section: &str, key: &str, x: f64) -> Option<String> {
         ("sample", "hamaker") if x > 1e-17 => Some(format!(
             "above 1e-17 J (Hamaker constants are ~1e-20 J); in J: {x}e-20"
         )),
+        // the highest surface tension of a liquid at room temperature is mercury's, 0.485 N/m
+        // (CRC Handbook, 97th ed., "Surface tension of common liquids")
+        ("sample", "surface_tension") if x > 1.0 => Some(format!(
+            "above 1 N/m, beyond any liquid (water 0.072 N/m, mercury 0.485 N/m); surface \
+             tensions are in N/m: {x} mN/m is {x}e-3"
+        )),
+        // works of adhesion: polymers 0.03–0.1 J/m², water on silica 0.14 J/m², clean metals
+        // up to ~3 J/m² (Israelachvili 2011, ch. 13 and 17)
+        ("sample", "adhesion_energy") if x > 10.0 => Some(format!(
+            "above 10 J/m², beyond any solid's work of adhesion (polymers 0.03–0.1 J/m², \
+             metals up to ~3 J/m²); in J/m²: {x} mJ/m² is {x}e-3"
+        )),
+        _ => None,
+    }
+}
+
+/// A value inside its physical range but outside the range AFM probes and samples typically
+/// take, with the unit slip it may be: a warning, not an error (a colloidal probe's radius of
+/// 20 µm is real). `None` inside the typical range. The ranges: tip radii 1 nm–50 µm (sharp
+/// tips to colloidal probes), free amplitudes 10 pm–1 µm (FM at small amplitude to large
+/// tapping), spring constants 0.005–1e4 N/m (soft contact levers to qPlus sensors at
+/// 1.8 kN/m), resonances up to 10 MHz, Hamaker constants 1e-21–5e-19 J (Israelachvili 2011,
+/// table 13.2: 0.4e-20 for hydrocarbons in water to 40e-20 for metals), surface tensions
+/// 0.01–0.6 N/m, works of adhesion 1e-3–1 J/m², lever lengths 5 µm–1 mm.
+pub(super) fn typical_hint(section: &str, key: &str, x: f64) -> Option<String> {
+    let hint = |range: &str, slip: &str| Some(format!("outside the typical {range}: {slip}"));
+    match (section, key) {
+        ("tip", "radius") if !(1e-9..=5e-5).contains(&x) => hint(
+            "1 nm–50 µm of tips and colloidal probes",
+            "radii are in m (10 nm is 10e-9)",
+        ),
+        ("drive", "free_amplitude") if !(1e-11..=1e-6).contains(&x) => hint(
+            "10 pm–1 µm of dynamic AFM",
+            "amplitudes are in m (10 nm is 10e-9)",
+        ),
+        ("cantilever", "spring_constant") if !(5e-3..=1e4).contains(&x) => hint(
+            "0.005–1e4 N/m of AFM levers and qPlus sensors",
+            "stiffnesses are in N/m (40 N/m is 40.0)",
+        ),
+        ("cantilever", "resonance_frequency") | ("drive", "frequency") if x > 1e7 => hint(
+            "1 kHz–10 MHz of AFM levers",
+            "frequencies are in Hz (300 kHz is 300e3)",
+        ),
+        ("sample", "hamaker") if x != 0.0 && !(1e-21..=5e-19).contains(&x) => hint(
+            "1e-21–5e-19 J of Hamaker constants",
+            "they are in J (6.6e-20 J for polystyrene)",
+        ),
+        ("sample", "surface_tension") if !(0.01..=0.6).contains(&x) => hint(
+            "0.01–0.6 N/m of liquids",
+            "surface tensions are in N/m (water 0.072 N/m is 72e-3)",
+        ),
+        ("sample", "adhesion_energy") if !(1e-3..=1.0).contains(&x) => hint(
+            "1e-3–1 J/m² of works of adhesion",
+            "they are in J/m² (50 mJ/m² is 50e-3)",
+        ),
+        ("cantilever", "length") if !(5e-6..=1e-3).contains(&x) => hint(
+            "5 µm–1 mm of AFM levers",
+            "lengths are in m (125 µm is 125e-6)",
+        ),
         _ => None,
     }
 }

@@ -325,14 +325,18 @@ fn drive_components(params: &Params, c: &SteppedCurve, u: &CurveUnits) -> Option
 /// `doc` with the [`si`] block of `probe` added (built from `doc` itself, so its headline values
 /// appear in SI), when the model came from a probe file; `doc` unchanged otherwise. Every front
 /// end adds the block through this one function. The probe's own warnings
-/// ([`crate::probe::Probe::warnings`]) join the document's `warnings` when it has them.
+/// ([`crate::probe::Probe::warnings`]) join the document's `warnings` (made for them when the
+/// document has none).
 pub fn with_si(mut doc: Value, probe: Option<&crate::probe::Probe>, params: &Params) -> Value {
     if let Some(p) = probe {
         doc["si"] = si(p, params, &doc);
-        // the probe's own warnings (a sample outside its law's regime) in every document
-        // that carries warnings
+        // the probe's own warnings (a sample outside its law's regime, a value outside its
+        // typical range) in every document: joined to its warnings, or as its warnings
+        let own = p.warnings();
         if let Some(w) = doc.get_mut("warnings").and_then(Value::as_array_mut) {
-            w.extend(p.warnings().into_iter().map(Value::from));
+            w.extend(own.into_iter().map(Value::from));
+        } else if !own.is_empty() && doc.is_object() {
+            doc["warnings"] = Value::from(own);
         }
     }
     doc

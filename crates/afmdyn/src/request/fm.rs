@@ -52,6 +52,14 @@ impl Default for FmRequest {
     }
 }
 
+/// The FM amplitude's range in the model's length unit (g₀ = A₀ of a probe): outside it the
+/// request is refused, naming `amplitude`.
+pub const FM_AMPLITUDE_RANGE: (f64, f64) = (1e-8, 1e4);
+
+/// The FM amplitude's typical range in SI (m): 10 pm (qPlus sensors at small amplitude) to
+/// 1 µm; outside it the document warns of a unit slip.
+pub const FM_AMPLITUDE_TYPICAL: (f64, f64) = (1e-11, 1e-6);
+
 impl FmRequest {
     /// The units of the document: SI with a probe (frequencies in Hz), else the model's.
     pub fn units(model: &Resolved) -> CurveUnits {
@@ -88,6 +96,17 @@ impl FmRequest {
                     "amplitude",
                     a,
                     "must be > 0: the oscillation amplitude the controller holds",
+                ));
+            }
+            // the model's lengths are in units of its A₀ (g₀): an amplitude 1e8 times smaller
+            // or 1e4 times larger leaves nothing of the other length scales
+            if !(FM_AMPLITUDE_RANGE.0..=FM_AMPLITUDE_RANGE.1).contains(&(a / length)) {
+                return Err(SimError::out_of_range(
+                    "amplitude",
+                    a,
+                    "must be within [1e-8, 1e4] × the model's length unit (A₀ of a probe's \
+                     [drive] free_amplitude): amplitudes are in m with a probe (100 pm is \
+                     100e-12, or 100pm on the command line)",
                 ));
             }
         }
@@ -137,6 +156,10 @@ impl Analysis for FmRequest {
     fn report(&self, model: &Resolved, curve: &FmCurve) -> Result<Value, SimError> {
         Ok(document(self, model, curve))
     }
+    fn largest_indentation(&self, curve: &FmCurve) -> Option<f64> {
+        let d = curve.points.iter().map(|q| q.observables.indentation);
+        Some(d.filter(|d| d.is_finite()).fold(0.0, f64::max))
+    }
 }
 
 /// The document of an FM curve (`afmdyn fm --json`, Python's `to_dict()`): `curve` (one array
@@ -162,11 +185,34 @@ pub fn document(request: &FmRequest, model: &Resolved, curve: &FmCurve) -> Value
     // the tracked mode's stiffness at the tip (the probe's calibrated k for mode 1)
     let spring_constant = r.stiffness * u.force / u.length;
     let mut warnings: Vec<String> = Vec::new();
+    let unit = if model.probe.is_some() { "m" } else { "g0" };
+    if let (Some(a), Some(_)) = (request.amplitude, &model.probe) {
+        if !(FM_AMPLITUDE_TYPICAL.0..=FM_AMPLITUDE_TYPICAL.1).contains(&a) {
+            warnings.push(format!(
+                "amplitude = {} m is outside the typical 10 pm–1 µm of FM-AFM: amplitudes are \
+                 in m (100 pm is 100e-12)",
+                crate::error::number(a)
+            ));
+        }
+    }
+    if let (Some(from), Some(to)) = (request.from, request.to) {
+        if from < to {
+            warnings.push(format!(
+                "from = {} {unit} is nearer the sample than to = {} {unit}: an FM curve is \
+                 taken approaching, so it runs from z_c = {} {unit} down to {} {unit} (give \
+                 from > to to say so)",
+                crate::error::number(from),
+                crate::error::number(to),
+                crate::error::number(to),
+                crate::error::number(from),
+            ));
+        }
+    }
     if let Some(u) = &curve.unreached {
         warnings.push(format!(
-            "the FM steady state was not found at z_c = {:e}{} and beyond ({}); the curve ends at \
+            "the FM steady state was not found at z_c = {}{} and beyond ({}); the curve ends at \
              the previous value",
-            z_c(u.alpha5) * u_len,
+            crate::error::number(z_c(u.alpha5) * u_len),
             if model.probe.is_some() { " m" } else { " g0" },
             u.reason
         ));

@@ -480,8 +480,26 @@ impl ModelSpec {
     /// not finite (not positive); [`SimError::Params`] for a law group of another law or a
     /// value out of range ([`Params::validate`]).
     pub fn resolve(&self, defaults: Params, probe: Option<&Probe>) -> Result<Params, SimError> {
-        if probe.is_some() {
+        if let Some(pr) = probe {
             self.refuse_dimensionless_under_probe()?;
+            // one meaning of N everywhere: a lumped model's modes are the probe's (the point
+            // mass has one, the eigenmode model one per entry of [cantilever].spring_constant),
+            // as the probe file's own `modes` key is checked; a larger N would repeat mode 1
+            if let (Some(n), true) = (self.modes, pr.params.structure.is_lumped()) {
+                if n != pr.params.modes {
+                    return Err(SimError::out_of_range(
+                        "modes",
+                        format!(
+                            "{n} (this probe's {} model has {} mode(s))",
+                            pr.params.structure.name(),
+                            pr.params.modes
+                        ),
+                        "must equal the probe's number of modes: the point-mass model has \
+                         one mode and the eigenmode model one per entry of [cantilever] \
+                         spring_constant (omit modes, or edit the probe's arrays)",
+                    ));
+                }
+            }
         }
         let base = probe.map_or(defaults, |p| p.params);
         let contact_law = ContactLaw::from_parts(

@@ -99,6 +99,13 @@ pub trait Analysis {
     fn computed_at(&self, model: &Resolved) -> Result<Params, SimError> {
         Ok(model.params)
     }
+    /// The largest indentation max(−V_T, 0) of a result that has operating points in contact
+    /// (in the model's length unit), which [`document`] holds against the contact law's
+    /// validity under a probe ([`crate::probe::Probe::indentation_warnings`]); `None` (the
+    /// default) for a result without one.
+    fn largest_indentation(&self, _output: &Self::Output) -> Option<f64> {
+        None
+    }
 }
 
 /// Run `analysis` on `model`: [`Analysis::validate`], [`Analysis::execute`], then its document with the SI block of
@@ -133,11 +140,15 @@ pub fn document<A: Analysis + ?Sized>(
     output: &A::Output,
 ) -> Result<Value, SimError> {
     let doc = analysis.report(model, output)?;
-    Ok(report::with_si(
-        doc,
-        model.probe.as_ref(),
-        &analysis.computed_at(model)?,
-    ))
+    let mut doc = report::with_si(doc, model.probe.as_ref(), &analysis.computed_at(model)?);
+    // the result's validity against the law's assumptions, in every document of a probe
+    if let (Some(p), Some(d)) = (&model.probe, analysis.largest_indentation(output)) {
+        if let Some(w) = doc.get_mut("warnings").and_then(Value::as_array_mut) {
+            let warnings = p.indentation_warnings(d * p.scales.length_m);
+            w.extend(warnings.into_iter().map(Value::from));
+        }
+    }
+    Ok(doc)
 }
 
 /// `modes`: natural frequencies and damped eigenvalues of the free and contact systems

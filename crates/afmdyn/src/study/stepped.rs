@@ -154,7 +154,19 @@ impl Analysis for ApproachRequest {
         if let Some(s) = self.setpoint {
             doc["setpoint"] = report::setpoint(&model.params, c, s, &u);
         }
+        // the default range ends at the soft sample's force bound (default_range): say so when
+        // the amplitude has not come down to half the free one by then
+        if self.curve.to.is_none() && self.curve.from.is_none() {
+            if let Some(w) = soft_sample_warning(&model.params, c, &u) {
+                if let Some(ws) = doc["warnings"].as_array_mut() {
+                    ws.push(w.into());
+                }
+            }
+        }
         Ok(doc)
+    }
+    fn largest_indentation(&self, c: &Self::Output) -> Option<f64> {
+        Some(c.largest_indentation())
     }
 }
 
@@ -175,6 +187,9 @@ impl Analysis for ResonanceRequest {
     }
     fn computed_at(&self, model: &Resolved) -> Result<Params, SimError> {
         crate::request::curves::free_resonance_base(model.params, model.probe.as_ref(), self.mode)
+    }
+    fn largest_indentation(&self, c: &Self::Output) -> Option<f64> {
+        Some(c.largest_indentation())
     }
 }
 
@@ -209,3 +224,33 @@ pub mod store {
 
 #[cfg(feature = "files")]
 pub use store::{curve_store, CurveStore, CURVE_FILES};
+
+/// A warning when an approach over the default range ([`crate::analysis::approach::
+/// default_range`]) never brought the amplitude down to 0.5 A₀: on a sample so soft that it
+/// pushes back with the lever's force at its free amplitude only deep inside it, the range ends
+/// there (a peak-force bound) and the setpoints a user would image at are not on the curve.
+fn soft_sample_warning(
+    params: &crate::params::Params,
+    c: &crate::analysis::stepped::SteppedCurve,
+    u: &report::CurveUnits,
+) -> Option<String> {
+    let ratio = |p: &crate::analysis::stepped::CurvePoint| {
+        p.observables.amplitude / p.observables.closed_form.free_amplitude
+    };
+    let lowest = c.first.iter().map(ratio).fold(f64::INFINITY, f64::min);
+    let last = c.first.last()?;
+    if lowest.is_nan() || lowest <= 0.5 {
+        return None;
+    }
+    let z = crate::analysis::approach::rest_distance(params, last.value) * u.length;
+    Some(format!(
+        "the amplitude stays above {} A0 down to the default range's end, z_c = {} {}, where \
+         the sample already pushes back with the lever's force at its free amplitude (k A0): \
+         the sample is too compliant for this lever to reach the usual setpoints (A/A0 ≤ 0.5) \
+         within its contact law's validity; a softer lever or a smaller A0 would (or a deeper \
+         `to` for the range)",
+        crate::error::number((lowest * 1e3).floor() / 1e3),
+        crate::error::number(z),
+        if u.si { "m" } else { "g0" },
+    ))
+}
