@@ -484,9 +484,6 @@ fn summary(
                 .map_or(String::new(), |fv| format!(" (fold at {})", l.show(x(fv))))
         );
     }
-    for w in &c.warnings {
-        errln!("afmdyn: warning: {w}");
-    }
     if let Some(o) = out {
         outln!("outputs in {}", o.path().display());
     }
@@ -582,6 +579,7 @@ impl Run<'_> {
                 write_traces(o, self.args.files, t, self.x, self.units, self.labels)?;
             }
         }
+        crate::output::print_warnings(&json)?;
         if self.args.json {
             outln!("{json}");
         } else {

@@ -44,6 +44,7 @@ pub fn modes(a: &ModesArgs) -> Result<(), CliError> {
         &Resolved { params: p, probe },
         &Progress::new(),
     )?;
+    crate::output::print_warnings(&json)?;
     if a.json {
         outln!("{json}");
         return Ok(());
@@ -72,47 +73,61 @@ pub fn modes(a: &ModesArgs) -> Result<(), CliError> {
         if u.si() {
             // SI: the natural frequency and the damped one Im λ/2π, the decay rate Re λ in 1/s
             outln!(
-                "{:>4} {:>16} {:>16} {:>18} {:>10}",
+                "{:>4} {:>16} {:>16} {:>18} {:>10} {:>10}",
                 "i",
                 "f (undamped)",
                 "Im λ/2π",
                 "Re λ",
-                "ζ"
+                "ζ",
+                "Q"
             );
             for (i, w) in r.omega.iter().enumerate() {
                 let e = r.eigenvalues.get(i);
                 outln!(
-                    "{:>4} {:>16} {:>16} {:>18} {:>10.5}",
+                    "{:>4} {:>16} {:>16} {:>18} {:>10.5} {:>10}",
                     i + 1,
                     u.frequency(*w),
                     e.map_or("-".into(), |e| u.frequency(e.im)),
                     e.map_or("-".into(), |e| u.rate(e.re)),
-                    e.map_or(f64::NAN, |e| e.zeta)
+                    e.map_or(f64::NAN, |e| e.zeta),
+                    quality_factor(e.map(|e| e.zeta))
                 );
             }
             continue;
         }
         outln!(
-            "{:>4} {:>14} {:>14} {:>14} {:>10}",
+            "{:>4} {:>14} {:>14} {:>14} {:>10} {:>10}",
             "i",
             "ω (undamped)",
             "Re λ",
             "Im λ",
-            "ζ"
+            "ζ",
+            "Q"
         );
         for (i, w) in r.omega.iter().enumerate() {
             let e = r.eigenvalues.get(i);
             outln!(
-                "{:>4} {:>14.6} {:>14.6} {:>14.6} {:>10.5}",
+                "{:>4} {:>14.6} {:>14.6} {:>14.6} {:>10.5} {:>10}",
                 i + 1,
                 w,
                 e.map_or(f64::NAN, |e| e.re),
                 e.map_or(f64::NAN, |e| e.im),
-                e.map_or(f64::NAN, |e| e.zeta)
+                e.map_or(f64::NAN, |e| e.zeta),
+                quality_factor(e.map(|e| e.zeta))
             );
         }
     }
     Ok(())
+}
+
+/// A mode's quality factor Q = 1/(2ζ) from its damping ratio, 6 significant digits ("∞"
+/// undamped, "-" where the mode has no eigenvalue).
+fn quality_factor(zeta: Option<f64>) -> String {
+    match zeta {
+        Some(z) if z > 0.0 => afmdyn::error::number(0.5 / z),
+        Some(_) => "∞".into(),
+        None => "-".into(),
+    }
 }
 
 fn fig3(a: &ModesArgs, p: &Params) -> Result<(), CliError> {

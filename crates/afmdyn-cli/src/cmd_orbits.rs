@@ -61,6 +61,7 @@ pub fn orbit(a: &OrbitArgs) -> Result<(), CliError> {
     let Document { output: o, json } =
         request::run(&request, &Resolved { params: p, probe }, &Progress::new())?;
     let n = o.period;
+    crate::output::print_warnings(&json)?;
     if a.json {
         outln!("{json}");
         return Ok(());

@@ -126,7 +126,17 @@ pub fn write_document(out: &OutDir, name: &str, json: &serde_json::Value) -> Res
         &out.join(name),
         serde_json::to_string_pretty(json).expect("json").as_bytes(),
     )?;
-    for w in json["warnings"].as_array().into_iter().flatten() {
+    print_warnings(json)
+}
+
+/// Every warning of a document (its `warnings` array) on stderr as `afmdyn: warning: …`, the
+/// one place the command line prints a document's warnings (with `--json` too: stdout holds
+/// the document, stderr its warnings).
+///
+/// # Errors
+/// [`CliError`] when stderr cannot be written.
+pub fn print_warnings(doc: &serde_json::Value) -> Result<(), CliError> {
+    for w in doc["warnings"].as_array().into_iter().flatten() {
         errln!("afmdyn: warning: {}", w.as_str().unwrap_or_default());
     }
     Ok(())
