@@ -157,6 +157,9 @@ def converge(
         section point; ``period`` ``[n_modes]`` (−1: nonperiodic); ``rms_change``
         ``[n_modes]`` (RMS of W_tip(N) − W_tip(N−1), NaN for N = 1); coordinate
         ``tau_from_section`` ``[K]``.
+
+    ``progress``: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a
+    log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.
     """
     req = _request(locals())
     p, probe = _params(params, model, default=Params(omega=4.1))
@@ -254,6 +257,9 @@ def bifurcation(
         ``v_t``, ``w_tip``, ``x_max``, ``v_t_min``, ``contact_fraction``,
         ``contacts_per_period``, ``transient_periods``, ``message``, ``a_1``…``a_N``,
         ``a_dot_1``…``a_dot_N``. ``.to_dataframe()`` gives the tidy table.
+
+    ``progress``: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a
+    log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.
     """
     req = _request(locals())
     if values is not None:
@@ -314,6 +320,9 @@ def continuation(
         ``w_tip_section`` ``[point, k]`` (W(1,τ) at the section points, NaN-padded),
         ``multipliers`` ``[point, 2N]`` complex128, ``state`` ``[point, 2N]``.
         ``attrs["summary"]`` is ``afmdyn continue --json``.
+
+    ``progress``: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a
+    log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.
     """
     req = _start(_request(locals(), initial=_state(initial)))
     p, probe = _params(params, model)
@@ -381,6 +390,9 @@ def observe(
         ``state`` ``[2N]`` (a, ȧ). ``ds.afmdyn.to_dict()`` is the library's document
         (dimensionless, phases in radians, the closed forms; its ``reported`` block holds the
         dataset's values).
+
+    ``progress``: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a
+    log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.
     """
     req = _start(_request(locals(), initial=_state(initial)))
     p, probe = _params(params, model)
@@ -465,6 +477,9 @@ def approach(
         ``trace_time``). ``ds.afmdyn.to_dict()`` is the ``afmdyn approach --json`` document
         (``folds``, ``bistable``, ``jumps``, ``setpoint``, ``warnings``;
         ``docs/outputs.md``).
+
+    ``progress``: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a
+    log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.
     """
     return _curve(_core.approach, "approach", progress, params, model, _request(locals()),
                   store, resume)
@@ -519,6 +534,9 @@ def bimodal(
         ``ds.afmdyn.to_dict()["drive_components"]``; for a time average, each point's periods,
         whether it settled, and its amplitude and phase error estimates per component in
         ``ds.afmdyn.to_dict()["time_average"]`` (an unsettled point also in the warnings).
+
+    ``progress``: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a
+    log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.
     """
     return _curve(_core.bimodal, "bimodal", progress, params, model, _request(locals()),
                   store, resume)
@@ -557,6 +575,9 @@ def resonance(
         An ``xarray.Dataset`` as :func:`approach`'s over ``frequency_hz`` (with a probe) or
         ``omega`` and ``sweep`` = ``up``/``down``; ``ds.afmdyn.to_dict()`` is the
         ``afmdyn resonance --json`` document.
+
+    ``progress``: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a
+    log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.
     """
     return _curve(_core.resonance, "resonance", progress, params, model, _request(locals()),
                   store, resume)

@@ -187,6 +187,9 @@ def attractors(
     Returns:
         :class:`Attractors`, a sequence of :class:`Attractor` (most frequent first);
         ``to_dict()`` is ``afmdyn attractors --json``, ``to_dataframe()`` a summary table.
+
+    ``progress``: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a
+    log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.
     """
     req = _request(locals())
     p, probe = _params(params, model)

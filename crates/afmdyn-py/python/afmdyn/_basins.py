@@ -73,6 +73,9 @@ def basins(
         attributes ``basin_entropy``, ``boundary_basin_entropy`` (Daza et al. 2016; NaN when
         undefined), ``uncertainty_exponent`` (Grebogi et al. 1983) and ``summary`` (the
         command line's JSON document).
+
+    ``progress``: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a
+    log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.
     """
     req = _request(locals())
     p, probe = _params(params, model)

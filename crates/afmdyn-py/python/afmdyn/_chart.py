@@ -111,6 +111,9 @@ def chart(
         ``lyapunov`` (λ₁ per unit τ of a nonperiodic attractor), ``lyapunov_error``, ``x_max``,
         ``v_t_min`` (g0), ``contacts_per_period``, ``contact_fraction``, ``fraction``
         (basin fraction among the random starts). The same values as ``chart.nc``.
+
+    ``progress``: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a
+    log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.
     """
     s = study(
         params,

@@ -114,6 +114,9 @@ def fm(
     Raises:
         ValueError: naming the option (``amplitude``, ``mode``, ``tolerance``, ``from``, ``to``,
             ``step``, ``points``) or the model parameter.
+
+    ``progress``: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a
+    log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.
     """
     request = _request(locals())
     p, probe = _params(params, model)

@@ -61,6 +61,9 @@ def global_continuation(
         absent), ``stable`` (1/0 from the Floquet multipliers of the orbit polished by shooting,
         NaN otherwise); dim ``value``: ``failures`` (runs that failed). Attribute ``summary``:
         the command line's JSON document (Poincaré points, multipliers of every attractor).
+
+    ``progress``: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a
+    log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.
     """
     req = _request(locals())
     p, probe = _params(params, model)

@@ -54,6 +54,9 @@ def orbit(
     Returns:
         :class:`Orbit`; ``to_dict()`` is ``afmdyn orbit --json``. Raises
         :class:`SimulationError` when Newton's method does not converge.
+
+    ``progress``: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a
+    log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.
     """
     names = dict(locals())
     p, probe = _params(params, model)
@@ -99,6 +102,9 @@ def lyapunov(
 
     Returns:
         :class:`Lyapunov`; ``to_dict()`` is ``afmdyn lyapunov --json``.
+
+    ``progress``: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a
+    log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.
     """
     req = _request(locals(), initial=_state(initial))
     p, probe = _params(params, model)

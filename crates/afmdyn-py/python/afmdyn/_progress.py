@@ -17,17 +17,36 @@ ProgressArg = Union[None, bool, Callable[[int, Optional[int]], object]]
 DELAY = 1.0
 
 
-def _tqdm_class():
+def _in_jupyter() -> bool:
     # a Jupyter kernel has IPython imported already; do not import it otherwise (slow)
     ipython = sys.modules.get("IPython")
-    if ipython is not None:
-        try:
-            shell = ipython.get_ipython()
-            if shell is not None and "IPKernelApp" in shell.config:
-                import ipywidgets  # noqa: F401  (the widget bar needs it)
-                from tqdm.notebook import tqdm as notebook_tqdm
+    if ipython is None:
+        return False
+    try:
+        shell = ipython.get_ipython()
+        return shell is not None and "IPKernelApp" in shell.config
+    except Exception:
+        return False
 
-                return notebook_tqdm
+
+def _interactive() -> bool:
+    """Whether a default bar (``progress=None``) is shown: in Jupyter, or when stderr is a
+    terminal. In a log file or a pipe tqdm would write a line per update."""
+    if _in_jupyter():
+        return True
+    try:
+        return sys.stderr is not None and sys.stderr.isatty()
+    except (AttributeError, ValueError):  # a replaced or closed stderr
+        return False
+
+
+def _tqdm_class():
+    if _in_jupyter():
+        try:
+            import ipywidgets  # noqa: F401  (the widget bar needs it)
+            from tqdm.notebook import tqdm as notebook_tqdm
+
+            return notebook_tqdm
         except Exception:  # no widgets: the text bar works everywhere
             pass
     from tqdm import tqdm as text_tqdm
@@ -66,9 +85,11 @@ class _Bar:
 def reporter(
     progress: ProgressArg, desc: str, unit: str = "point"
 ) -> Iterator[Optional[Callable[[int, Optional[int]], object]]]:
-    """The callback to hand to the core for ``progress``: ``None``/``True`` a tqdm bar
-    (``True`` shows it at once), ``False`` nothing, a callable is called as is."""
-    if progress is False:
+    """The callback to hand to the core for ``progress``: ``None`` a tqdm bar after
+    ``DELAY`` seconds when stderr is a terminal or in Jupyter (nothing in a log or a pipe),
+    ``True`` a bar at once wherever stderr goes, ``False`` nothing, a callable is called as
+    is."""
+    if progress is False or (progress is None and not _interactive()):
         yield None
     elif progress is None or progress is True:
         bar = _Bar(desc, unit, 0.0 if progress is True else DELAY)

@@ -361,6 +361,9 @@ def bifurcation(
 
     Returns the same ``xarray.Dataset`` as :func:`afmdyn.bifurcation` with the same
     arguments, bit for bit.
+
+    ``progress``: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a
+    log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.
     """
     from ._api import _params, _sweep_dataset
     from ._common import _check_counts
@@ -445,6 +448,9 @@ def basins(
 
     Returns the same ``xarray.Dataset`` as :func:`afmdyn.basins` with the same arguments, bit
     for bit (a row is a pure function of its pass's start).
+
+    ``progress``: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a
+    log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.
     """
     import inspect
 
