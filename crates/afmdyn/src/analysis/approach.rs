@@ -19,9 +19,10 @@ use crate::params::{Params, SweepParam};
 /// 0.1 A₀ above it — deep in the repulsive regime of a stiff sample — or, on a soft sample,
 /// to 0.4 A₀ − δ_k ([`soft_indentation`]): a rigid sample holds the amplitude at A/A₀ = 0.5
 /// near z_c = 0.5 A₀, and a compliant one lets the tip sink by about the indentation δ_k at
-/// which it pushes back with the lever's force at its free amplitude, so the curve reaches
-/// A/A₀ ≤ 0.5 (issue 60 item 12: a 0.09 N/m lever on 1 MPa never got below A/A₀ = 0.995 on
-/// 0.1 A₀). The two agree while δ_k ≤ 0.3 A₀.
+/// which it pushes back with the peak force of tapping at that setpoint, so the curve reaches
+/// A/A₀ ≤ 0.5 (issue 60 item 12: a 0.09 N/m lever on 1 MPa in water never got below
+/// A/A₀ = 0.995 on 0.1 A₀). The two agree while δ_k ≤ 0.3 A₀: on every sample stiff for its
+/// lever and Q.
 ///
 /// # Errors
 /// [`SimError`] for invalid parameters or an undamped drive at resonance (no finite A₀).
@@ -39,16 +40,24 @@ pub fn default_range(base: &Params) -> Result<(f64, f64), SimError> {
 }
 
 /// The quasi-static indentation δ_k (units of g₀) at which the sample's contact force (its
-/// relaxed law, no rate) reaches k_s A₀, the lever's static stiffness at the tip k_s =
-/// 1/(φᵀK⁻¹φ) (K the free stiffness matrix, φ the tip's mode shapes: 1 for the point mass,
-/// 1/Σ(1/k_j) for the eigenmode model) times its free amplitude `a0`: how far the tip sinks into
-/// the sample before it is stopped. At most 3 A₀ (a sample that never pushes back so hard, or a
-/// rigid one whose law has no force of its own, gives its bound or 0).
+/// relaxed law, no rate) reaches F_k = min(1, 3/Q₁) k_s A₀: an estimate of the peak force of
+/// tapping at A/A₀ = 0.5. The virial of a tapping lever is at most k A A₀/(2Q) in magnitude
+/// (San Paulo & García, *Phys. Rev. B* 64 (2001) 193411; García & Pérez, *Surf. Sci. Rep.* 47
+/// (2002) 197, eq. 27), and a force acting over about a sixth of the cycle near the lower
+/// turning point reaches it with F ≈ 3kA₀/Q; it never exceeds the lever's force at its free
+/// amplitude k_s A₀. k_s = 1/(φᵀK⁻¹φ) is the lever's static stiffness at the tip (K the free
+/// stiffness matrix, φ the tip's mode shapes: 1 for the point mass, 1/Σ(1/k_j) for the
+/// eigenmode model), Q₁ = 1/(2ζ₁) of its first damped free mode. At most 3 A₀ (a sample that
+/// never pushes back so hard gives that bound; a rigid one, whose law has no force of its
+/// own, 0).
 pub fn soft_indentation(model: &CantileverModel, a0: f64) -> f64 {
     use crate::contact::{TipSample, TipSampleLaw};
     use crate::galerkin::Region;
     let p = model.params();
-    if matches!(p.contact_law, crate::contact::ContactLaw::Impact { .. }) || a0.is_nan() || a0 <= 0.0 {
+    if matches!(p.contact_law, crate::contact::ContactLaw::Impact { .. })
+        || a0.is_nan()
+        || a0 <= 0.0
+    {
         return 0.0;
     }
     let free = model.galerkin().region(Region::Free);
@@ -62,7 +71,10 @@ pub fn soft_indentation(model: &CantileverModel, a0: f64) -> f64 {
         stiffness: p.alpha4,
         damping: 0.0,
     };
-    let target = k_s * a0;
+    let q1 = crate::eigen::damped_eigenvalues(free)
+        .first()
+        .map_or(f64::INFINITY, |e| 0.5 / e.zeta);
+    let target = (3.0 / q1).min(1.0) * k_s * a0;
     let pushes = |d: f64| law.force(true, d, 0.0).force >= target;
     let cap = 3.0 * a0;
     if !pushes(cap) {
