@@ -139,15 +139,13 @@ pub fn read_toml<T: for<'de> Deserialize<'de>>(path: &std::path::Path) -> Result
 }
 
 /// The text of an input file (a probe or `--config` file), at most
-/// [`afmdyn::request::limits::MAX_INPUT_TEXT_BYTES`] bytes of UTF-8
-/// ([`afmdyn::request::limits::read_input`]).
+/// [`afmdyn::io::MAX_INPUT_TEXT_BYTES`] bytes of UTF-8
+/// ([`afmdyn::io::read_input`]).
 ///
 /// # Errors
-/// The library's [`afmdyn::request::limits::InputFileError`] naming the file.
-pub fn read_text(
-    path: &std::path::Path,
-) -> Result<String, afmdyn::request::limits::InputFileError> {
-    afmdyn::request::limits::read_input(path, afmdyn::request::limits::MAX_INPUT_TEXT_BYTES)
+/// The library's [`afmdyn::io::InputFileError`] naming the file.
+pub fn read_text(path: &std::path::Path) -> Result<String, afmdyn::io::InputFileError> {
+    afmdyn::io::read_input(path, afmdyn::io::MAX_INPUT_TEXT_BYTES)
 }
 
 impl ModelArgs {

@@ -3,7 +3,7 @@
 //! The sample map, the operating points and the scan are the library's
 //! ([`afmdyn::request::image`], [`afmdyn::request::image_scan`]); this front end reads the two
 //! files, maps the flags, and writes `image.json`, `image.nc` (the library's layouts,
-//! [`afmdyn::layout::image`]), the maps (height, phase, E_dis; the error image of a PI
+//! [`afmdyn::request::image_layout`]), the maps (height, phase, E_dis; the error image of a PI
 //! scan) and the line profile.
 
 use crate::args::read_text;
@@ -259,7 +259,7 @@ pub fn image_cmd(a: &ImageArgs) -> Result<(), CliError> {
     write_document(&out, "image.json", &json)?;
     write_layout(
         &out.join("image.nc"),
-        &afmdyn::layout::image::layout(&img, a.setpoint),
+        &afmdyn::request::image_layout::layout(&img, a.setpoint),
     )?;
     let img = &img;
     let field = |get: fn(&afmdyn::request::image::OperatingPoint) -> f64| {
@@ -421,7 +421,7 @@ fn pi_cmd(
     write_document(&out, "image.json", &json)?;
     write_layout(
         &out.join("image.nc"),
-        &afmdyn::layout::image::scan_layout(&img, a.setpoint),
+        &afmdyn::request::image_layout::scan_layout(&img, a.setpoint),
     )?;
     let grid = &img.ideal;
     let pixel = |j: usize, i: usize| &img.lines[j].trace[i];

@@ -1,5 +1,5 @@
 //! Height maps read from files (feature `files`): a sample map's `height_map = "h.csv"` or
-//! `"h.npy"` ([`super::image::SampleMap`]), with the limits and refusals of the inline array.
+//! `"h.npy"` ([`crate::request::image::SampleMap`]), with the limits and refusals of the inline array.
 //!
 //! - **CSV** (`.csv`): rows of comma-separated heights in m, no header, rows from y = 0 to
 //!   Ly and columns from x = 0 to Lx (the `csv` crate; spaces around a value are ignored, blank
@@ -13,10 +13,20 @@
 //! within ±[`MAX_HEIGHT`] (10 µm). Errors are [`SimError::Probe`] naming `height_map`, the
 //! file and the problem (the row and column of a bad value).
 
-use super::image::{MAX_HEIGHT, MAX_PIXELS};
+#[cfg(feature = "files")]
 use crate::error::SimError;
+#[cfg(feature = "files")]
 use std::io::Read;
+#[cfg(feature = "files")]
 use std::path::{Path, PathBuf};
+
+/// Largest number of rows and of columns of a height map, and of pixels per line and of lines
+/// of an image ([`crate::request::image`]).
+pub const MAX_PIXELS: usize = 4096;
+
+/// Largest true height of a domain or a height map's value, either sign (m): 10 µm, a
+/// topography the z piezo follows.
+pub const MAX_HEIGHT: f64 = 1e-5;
 
 /// Largest height map CSV file read, in bytes: 512 MiB, 32 bytes for each of 4096 × 4096
 /// values (a full-precision height and its comma take 24).
@@ -37,6 +47,7 @@ pub const MAX_NPY_BYTES: u64 = (MAX_PIXELS * MAX_PIXELS * 8 + MAX_NPY_HEADER_BYT
 /// `.npy`; a file that cannot be read, is too large or is not CSV/NPY; more than 4096 rows or
 /// columns, no values, rows of different lengths; a value that is not a number, not finite or
 /// beyond ±10 µm (with its row and column); an NPY array that is not 2-D float64.
+#[cfg(feature = "files")]
 pub fn read(file: &str, base: Option<&Path>) -> Result<Vec<Vec<f64>>, SimError> {
     let path = base.map_or_else(|| PathBuf::from(file), |b| b.join(file));
     let err = |problem: String| {
@@ -80,6 +91,7 @@ pub fn read(file: &str, base: Option<&Path>) -> Result<Vec<Vec<f64>>, SimError> 
 }
 
 /// A height at (row, column), both from 1: finite and within ±10 µm.
+#[cfg(feature = "files")]
 fn check(h: f64, row: usize, col: usize) -> Result<f64, String> {
     if !h.is_finite() {
         return Err(format!(
@@ -96,6 +108,7 @@ fn check(h: f64, row: usize, col: usize) -> Result<f64, String> {
 
 /// The rows of a CSV height map, streamed: at most [`MAX_CSV_BYTES`], 4096 rows of 4096
 /// values, each row as long as the first.
+#[cfg(feature = "files")]
 fn csv_rows(file: std::fs::File) -> Result<Vec<Vec<f64>>, String> {
     let too_large = || format!("larger than {MAX_CSV_BYTES} bytes (4096 × 4096 heights)");
     let mut reader = csv::ReaderBuilder::new()
@@ -158,6 +171,7 @@ fn csv_rows(file: std::fs::File) -> Result<Vec<Vec<f64>>, String> {
 
 /// The rows of an NPY height map: the header's length, then its dtype and shape, checked
 /// before the values are read.
+#[cfg(feature = "files")]
 fn npy_rows(file: std::fs::File) -> Result<Vec<Vec<f64>>, String> {
     let not_npy = || "not an NPY file (NumPy's np.save)".to_string();
     let io = |e: std::io::Error| format!("not a readable NPY file: {e}");
