@@ -236,9 +236,14 @@ pub fn image_cmd(a: &ImageArgs) -> Result<(), CliError> {
             )))
         }
     };
-    let text = read_text(&a.probe).map_err(|e| CliError::Input(format!("probe {e}")))?;
+    let text = read_text(&a.probe, afmdyn::io::InputKind::Probe)
+        .map_err(|e| CliError::Input(format!("--probe {e}")))?;
     let table = afmdyn::probe::Probe::table(&text, &a.probe.display().to_string())?;
-    let map = SampleMap::load(&a.sample)?;
+    // a sample map's refusals (its file, its height map's) name the option
+    let map = SampleMap::load(&a.sample).map_err(|e| match e {
+        afmdyn::SimError::Probe(m) => CliError::Input(format!("--sample {m}")),
+        e => e.into(),
+    })?;
     let req = ImageRequest::with(a.setpoint, a.pixels, a.lines, a.curve_points);
     req.validate(&map)?;
     let ratios = a.setpoint_study.as_deref().map(study_ratios).transpose()?;

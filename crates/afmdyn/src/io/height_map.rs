@@ -3,7 +3,8 @@
 //!
 //! - **CSV** (`.csv`): rows of comma-separated heights in m, no header, rows from y = 0 to
 //!   Ly and columns from x = 0 to Lx (the `csv` crate; spaces around a value are ignored, blank
-//!   lines skipped). A file larger than [`MAX_CSV_BYTES`] is refused, and no more is read.
+//!   lines skipped). A file larger than [`MAX_CSV_BYTES`], or with a line longer than
+//!   [`super::input::MAX_CSV_LINE_BYTES`] (`/dev/zero`), is refused, and no more is read.
 //! - **NPY** (`.npy`, NumPy's `np.save`): a 2-D float64 array (`<f8` or `>f8`, C or Fortran
 //!   order), `[row][column]` as the CSV (the `npyz` crate). The file is at most
 //!   [`MAX_NPY_BYTES`], its header at most [`MAX_NPY_HEADER_BYTES`], and the dtype and shape
@@ -13,6 +14,8 @@
 //! within ±[`MAX_HEIGHT`] (10 µm). Errors are [`SimError::Probe`] naming `height_map`, the
 //! file and the problem (the row and column of a bad value).
 
+#[cfg(feature = "files")]
+use super::input::{Bounded, InputFileError, InputKind};
 #[cfg(feature = "files")]
 use crate::error::SimError;
 #[cfg(feature = "files")]
@@ -74,8 +77,18 @@ pub fn read(file: &str, base: Option<&Path>) -> Result<Vec<Vec<f64>>, SimError> 
         }
     };
     let rows = match ext.as_deref() {
-        Some("csv") => csv_rows(sized(MAX_CSV_BYTES, "a CSV")?).map_err(err)?,
-        Some("npy") => npy_rows(sized(MAX_NPY_BYTES, "an NPY")?).map_err(err)?,
+        Some("csv") => csv_rows(Bounded::new(
+            sized(MAX_CSV_BYTES, "a CSV")?,
+            &path,
+            InputKind::HeightMapCsv,
+        ))
+        .map_err(err)?,
+        Some("npy") => npy_rows(Bounded::new(
+            sized(MAX_NPY_BYTES, "an NPY")?,
+            &path,
+            InputKind::HeightMapNpy,
+        ))
+        .map_err(err)?,
         _ => {
             return Err(err(
                 "must be a .csv file (rows of heights in m) or a .npy file (a 2-D float64 \
@@ -109,13 +122,13 @@ fn check(h: f64, row: usize, col: usize) -> Result<f64, String> {
 /// The rows of a CSV height map, streamed: at most [`MAX_CSV_BYTES`], 4096 rows of 4096
 /// values, each row as long as the first.
 #[cfg(feature = "files")]
-fn csv_rows(file: std::fs::File) -> Result<Vec<Vec<f64>>, String> {
+fn csv_rows(file: Bounded) -> Result<Vec<Vec<f64>>, String> {
     let too_large = || format!("larger than {MAX_CSV_BYTES} bytes (4096 × 4096 heights)");
     let mut reader = csv::ReaderBuilder::new()
         .has_headers(false)
         .flexible(true)
         .trim(csv::Trim::All)
-        .from_reader(file.take(MAX_CSV_BYTES + 1));
+        .from_reader(file);
     let mut rows: Vec<Vec<f64>> = Vec::new();
     let mut record = csv::StringRecord::new();
     loop {
@@ -124,6 +137,14 @@ fn csv_rows(file: std::fs::File) -> Result<Vec<Vec<f64>>, String> {
             Ok(true) => {}
             Err(e) => {
                 return Err(match e.kind() {
+                    csv::ErrorKind::Io(io) => match super::input::refusal(io) {
+                        Some(InputFileError::LineTooLong { limit, .. }) => format!(
+                            "a line longer than {limit} bytes: not a CSV height map (a row of \
+                             4096 heights is far shorter)"
+                        ),
+                        Some(_) => too_large(),
+                        None => format!("cannot be read: {e}"),
+                    },
                     csv::ErrorKind::Utf8 { .. } => format!("not UTF-8 text: {e}"),
                     _ => format!("cannot be read: {e}"),
                 })
@@ -172,7 +193,7 @@ fn csv_rows(file: std::fs::File) -> Result<Vec<Vec<f64>>, String> {
 /// The rows of an NPY height map: the header's length, then its dtype and shape, checked
 /// before the values are read.
 #[cfg(feature = "files")]
-fn npy_rows(file: std::fs::File) -> Result<Vec<Vec<f64>>, String> {
+fn npy_rows(file: Bounded) -> Result<Vec<Vec<f64>>, String> {
     let not_npy = || "not an NPY file (NumPy's np.save)".to_string();
     let io = |e: std::io::Error| format!("not a readable NPY file: {e}");
     // the magic, the version and the header's length: npyz allocates the header as its length

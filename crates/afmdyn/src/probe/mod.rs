@@ -529,8 +529,8 @@ impl Probe {
     /// As [`Probe::load`].
     #[cfg(feature = "files")]
     fn read_file(path: &Path) -> Result<String, ProbeError> {
-        use crate::io::{read_input, InputFileError, MAX_INPUT_TEXT_BYTES};
-        read_input(path, MAX_INPUT_TEXT_BYTES).map_err(|e| match e {
+        use crate::io::{read_text, InputFileError, InputKind};
+        read_text(path, InputKind::Probe).map_err(|e| match e {
             InputFileError::Io { path, message } => ProbeError::Io { path, message },
             e => ProbeError::File(e),
         })

@@ -357,7 +357,7 @@ impl SampleMap {
     /// [`super::limits::MAX_INPUT_TEXT_BYTES`]); as [`SampleMap::parse`].
     #[cfg(feature = "files")]
     pub fn load(path: &std::path::Path) -> Result<SampleMap, SimError> {
-        let text = crate::io::read_input(path, crate::io::MAX_INPUT_TEXT_BYTES)
+        let text = crate::io::read_text(path, crate::io::InputKind::SampleMap)
             .map_err(|e| SimError::Probe(format!("sample map: {e}")))?;
         Self::parse_in(&text, &path.display().to_string(), path.parent())
     }
