@@ -23,24 +23,11 @@ use std::io::Read;
 #[cfg(feature = "files")]
 use std::path::{Path, PathBuf};
 
-/// Largest number of rows and of columns of a height map, and of pixels per line and of lines
-/// of an image ([`crate::request::image`]).
-pub const MAX_PIXELS: usize = 4096;
+pub use super::caps::{MAX_CSV_BYTES, MAX_NPY_BYTES, MAX_NPY_HEADER_BYTES, MAX_PIXELS};
 
 /// Largest true height of a domain or a height map's value, either sign (m): 10 µm, a
 /// topography the z piezo follows.
 pub const MAX_HEIGHT: f64 = 1e-5;
-
-/// Largest height map CSV file read, in bytes: 512 MiB, 32 bytes for each of 4096 × 4096
-/// values (a full-precision height and its comma take 24).
-pub const MAX_CSV_BYTES: u64 = (MAX_PIXELS * MAX_PIXELS * 32) as u64;
-
-/// Largest NPY header read, in bytes (NumPy's own `np.load` allows 10 000).
-pub const MAX_NPY_HEADER_BYTES: usize = 65_536;
-
-/// Largest NPY height map file read, in bytes: 4096 × 4096 float64 values and the largest
-/// header.
-pub const MAX_NPY_BYTES: u64 = (MAX_PIXELS * MAX_PIXELS * 8 + MAX_NPY_HEADER_BYTES + 12) as u64;
 
 /// The heights of the file `file` (the value of `height_map`), a relative path taken from
 /// `base` (the sample file's directory; `None`: the current directory), `[row][column]`.

@@ -6,6 +6,7 @@
 //! passes [`MAX_CSV_LINE_BYTES`] (a CSV parser holds a line whole). Every refusal names the
 //! file, the cap and the kind.
 
+#[cfg(feature = "files")]
 use std::io::Read;
 
 /// Largest text input file (a probe file, a `--config` file) read, in bytes: 1 MiB, a
@@ -55,8 +56,8 @@ impl InputKind {
         match self {
             InputKind::Probe | InputKind::Config | InputKind::SampleMap => MAX_INPUT_TEXT_BYTES,
             InputKind::Overlay | InputKind::CurveCsv => MAX_INPUT_CSV_BYTES,
-            InputKind::HeightMapCsv => super::height_map::MAX_CSV_BYTES,
-            InputKind::HeightMapNpy => super::height_map::MAX_NPY_BYTES,
+            InputKind::HeightMapCsv => super::caps::MAX_CSV_BYTES,
+            InputKind::HeightMapNpy => super::caps::MAX_NPY_BYTES,
             InputKind::CurveDocument => MAX_INPUT_DOCUMENT_BYTES,
             InputKind::Store => MAX_STORE_BYTES,
         }

@@ -6,6 +6,7 @@
 //! file is read by [`input::read_text`], a study's store is locked by [`dir_lock::DirLock`]),
 //! never the other way round.
 
+pub mod caps;
 #[cfg(feature = "files")]
 pub mod dir_lock;
 pub mod height_map;
