@@ -3,6 +3,7 @@
 
 use crate::error::CliError;
 use afmdyn::integrate::IntegratorKind;
+use afmdyn::io::InputKind;
 use afmdyn::request::{IntegratorRequest, ModelSpec};
 use afmdyn::{LawKind, Params};
 use clap::Args;
@@ -133,21 +134,22 @@ fn parse_excitation(s: &str) -> Result<afmdyn::Excitation, String> {
 /// Read and parse a TOML file. Errors name the file, the line and column, and for a duplicate
 /// key the key ([`afmdyn::request::model::parse_toml`]).
 pub fn read_toml<T: for<'de> Deserialize<'de>>(path: &std::path::Path) -> Result<T, CliError> {
-    let text = read_text(path).map_err(|e| CliError::Input(format!("config {e}")))?;
+    let text =
+        read_text(path, InputKind::Config).map_err(|e| CliError::Input(format!("--config {e}")))?;
     afmdyn::request::model::parse_toml(&text)
         .map_err(|msg| CliError::Input(format!("config {}: {msg}", path.display())))
 }
 
-/// The text of an input file (a probe or `--config` file), at most
-/// [`afmdyn::request::limits::MAX_INPUT_TEXT_BYTES`] bytes of UTF-8
-/// ([`afmdyn::request::limits::read_input`]).
+/// The text of an input file (a probe or `--config` file) of kind `kind`, at most its cap
+/// ([`afmdyn::io::read_text`]).
 ///
 /// # Errors
-/// The library's [`afmdyn::request::limits::InputFileError`] naming the file.
+/// The library's [`afmdyn::io::InputFileError`] naming the file, the cap and the kind.
 pub fn read_text(
     path: &std::path::Path,
-) -> Result<String, afmdyn::request::limits::InputFileError> {
-    afmdyn::request::limits::read_input(path, afmdyn::request::limits::MAX_INPUT_TEXT_BYTES)
+    kind: InputKind,
+) -> Result<String, afmdyn::io::InputFileError> {
+    afmdyn::io::read_text(path, kind)
 }
 
 impl ModelArgs {
@@ -203,7 +205,8 @@ impl ModelArgs {
         let Some(path) = &self.probe else {
             return Ok(None);
         };
-        let text = read_text(path).map_err(|e| CliError::Input(format!("probe {e}")))?;
+        let text = read_text(path, InputKind::Probe)
+            .map_err(|e| CliError::Input(format!("--probe {e}")))?;
         let bad = |e: String| CliError::Input(format!("{}: {e}", path.display()));
         let text = match &self.cantilever {
             None => text,

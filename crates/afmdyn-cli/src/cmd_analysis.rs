@@ -146,8 +146,13 @@ fn read_rows(
     path: &Path,
     each: &mut dyn FnMut(&csv::StringRecord) -> Result<(), String>,
 ) -> Result<(), CliError> {
-    let rd = |e| io_error("read", path, e);
-    let mut rd_csv = csv::Reader::from_path(path).map_err(rd)?;
+    let rd = |e: csv::Error| io_error("read", path, e);
+    // the sweep's own output, read back through the bounded reader as a store file
+    let file = afmdyn::io::open(path, afmdyn::io::InputKind::Store).map_err(|e| match e {
+        afmdyn::io::InputFileError::Io { message, .. } => io_error("read", path, message),
+        e => io_error("read", path, e),
+    })?;
+    let mut rd_csv = csv::Reader::from_reader(file);
     for r in rd_csv.records() {
         let r = r.map_err(rd)?;
         each(&r).map_err(CliError::Io)?;

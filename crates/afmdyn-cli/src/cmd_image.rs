@@ -3,7 +3,7 @@
 //! The sample map, the operating points and the scan are the library's
 //! ([`afmdyn::request::image`], [`afmdyn::request::image_scan`]); this front end reads the two
 //! files, maps the flags, and writes `image.json`, `image.nc` (the library's layouts,
-//! [`afmdyn::layout::image`]), the maps (height, phase, E_dis; the error image of a PI
+//! [`afmdyn::request::image_layout`]), the maps (height, phase, E_dis; the error image of a PI
 //! scan) and the line profile.
 
 use crate::args::read_text;
@@ -236,9 +236,14 @@ pub fn image_cmd(a: &ImageArgs) -> Result<(), CliError> {
             )))
         }
     };
-    let text = read_text(&a.probe).map_err(|e| CliError::Input(format!("probe {e}")))?;
+    let text = read_text(&a.probe, afmdyn::io::InputKind::Probe)
+        .map_err(|e| CliError::Input(format!("--probe {e}")))?;
     let table = afmdyn::probe::Probe::table(&text, &a.probe.display().to_string())?;
-    let map = SampleMap::load(&a.sample)?;
+    // a sample map's refusals (its file, its height map's) name the option
+    let map = SampleMap::load(&a.sample).map_err(|e| match e {
+        afmdyn::SimError::Probe(m) => CliError::Input(format!("--sample {m}")),
+        e => e.into(),
+    })?;
     let req = ImageRequest::with(a.setpoint, a.pixels, a.lines, a.curve_points);
     req.validate(&map)?;
     let ratios = a.setpoint_study.as_deref().map(study_ratios).transpose()?;
@@ -259,7 +264,7 @@ pub fn image_cmd(a: &ImageArgs) -> Result<(), CliError> {
     write_document(&out, "image.json", &json)?;
     write_layout(
         &out.join("image.nc"),
-        &afmdyn::layout::image::layout(&img, a.setpoint),
+        &afmdyn::request::image_layout::layout(&img, a.setpoint),
     )?;
     let img = &img;
     let field = |get: fn(&afmdyn::request::image::OperatingPoint) -> f64| {
@@ -421,7 +426,7 @@ fn pi_cmd(
     write_document(&out, "image.json", &json)?;
     write_layout(
         &out.join("image.nc"),
-        &afmdyn::layout::image::scan_layout(&img, a.setpoint),
+        &afmdyn::request::image_layout::scan_layout(&img, a.setpoint),
     )?;
     let grid = &img.ideal;
     let pixel = |j: usize, i: usize| &img.lines[j].trace[i];

@@ -182,13 +182,13 @@ fn branch_rows(model: &CantileverModel, id: usize, br: &[BranchPoint]) -> Vec<Ve
 }
 
 /// The overlay CSV read and checked before any computation: readable, at most
-/// [`afmdyn::request::limits::MAX_INPUT_CSV_BYTES`] of UTF-8, with `value` and `w_tip`
+/// [`afmdyn::io::MAX_INPUT_CSV_BYTES`] of UTF-8 in lines of at most
+/// [`afmdyn::io::input::MAX_CSV_LINE_BYTES`], with `value` and `w_tip`
 /// columns; its (value, w_tip) pairs. Every failure is bad input (exit code 2) naming the file.
 fn read_overlay(path: &Path) -> Result<Vec<(f64, f64)>, CliError> {
     let bad = |m: String| CliError::Input(format!("--overlay {m}"));
-    let text =
-        afmdyn::request::limits::read_input(path, afmdyn::request::limits::MAX_INPUT_CSV_BYTES)
-            .map_err(|e| bad(e.to_string()))?;
+    let text = afmdyn::io::read_text(path, afmdyn::io::InputKind::Overlay)
+        .map_err(|e| bad(e.to_string()))?;
     let csv_error = |e: csv::Error| {
         bad(format!(
             "{}: {}",

@@ -9,6 +9,7 @@ use crate::error::CliError;
 use crate::output::{write_csv_numbers, write_document, OutDir};
 use crate::plot::{save, Figure, Series, Style};
 use afmdyn::analysis::reconstruct::Reconstruction;
+use afmdyn::io::{InputFileError, InputKind};
 use afmdyn::request::{self, ReconstructRequest, Resolved};
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -51,19 +52,33 @@ pub struct ReconstructArgs {
     json: bool,
 }
 
-/// The curve's columns by name from the CSV `path`.
+/// An input file's refusal as bad input naming the option (`--fm FILE: …`).
+fn input(option: &str, e: InputFileError) -> CliError {
+    CliError::Input(format!("{option} {e}"))
+}
+
+/// The curve's columns by name from the CSV `path`, read through the bounded reader
+/// ([`InputKind::CurveCsv`]).
 fn read_curve(path: &Path) -> Result<(Vec<String>, Vec<Vec<f64>>), CliError> {
     let bad = |what: String| CliError::Input(format!("--fm {}: {what}", path.display()));
-    let mut reader = csv::Reader::from_path(path).map_err(|e| bad(e.to_string()))?;
+    let csv_error = |e: csv::Error| match e.kind() {
+        csv::ErrorKind::Io(io) => match afmdyn::io::refusal(io) {
+            Some(r) => input("--fm", r.clone()),
+            None => bad(e.to_string()),
+        },
+        _ => bad(e.to_string()),
+    };
+    let file = afmdyn::io::open(path, InputKind::CurveCsv).map_err(|e| input("--fm", e))?;
+    let mut reader = csv::Reader::from_reader(file);
     let names: Vec<String> = reader
         .headers()
-        .map_err(|e| bad(e.to_string()))?
+        .map_err(csv_error)?
         .iter()
         .map(|h| h.trim().to_string())
         .collect();
     let mut columns = vec![Vec::new(); names.len()];
     for (line, record) in reader.records().enumerate() {
-        let record = record.map_err(|e| bad(e.to_string()))?;
+        let record = record.map_err(csv_error)?;
         for (k, field) in record.iter().enumerate().take(names.len()) {
             let v: f64 = field.trim().parse().map_err(|_| {
                 bad(format!(
@@ -78,6 +93,65 @@ fn read_curve(path: &Path) -> Result<(Vec<String>, Vec<Vec<f64>>), CliError> {
     Ok((names, columns))
 }
 
+/// A JSON document (`--fm fm.json`, `--am approach.json`) parsed as it is read through the
+/// bounded reader ([`InputKind::CurveDocument`]), from `reader` that has read none of it yet
+/// beyond the whitespace [`first_byte`] skipped.
+fn read_document(
+    option: &str,
+    path: &Path,
+    reader: impl std::io::Read,
+) -> Result<serde_json::Value, CliError> {
+    serde_json::from_reader(reader).map_err(|e| {
+        if e.is_io() {
+            let io = std::io::Error::from(e);
+            return match afmdyn::io::refusal(&io) {
+                Some(r) => input(option, r.clone()),
+                None => CliError::Input(format!("{option} {}: {io}", path.display())),
+            };
+        }
+        CliError::Input(format!(
+            "{option} {}: not a JSON document: {e}",
+            path.display()
+        ))
+    })
+}
+
+/// The first byte of `reader` that is not ASCII whitespace, the whitespace before it consumed
+/// (`None` at the end).
+fn first_byte(reader: &mut impl std::io::BufRead) -> std::io::Result<Option<u8>> {
+    loop {
+        let buf = reader.fill_buf()?;
+        if buf.is_empty() {
+            return Ok(None);
+        }
+        match buf.iter().position(|b| !b.is_ascii_whitespace()) {
+            Some(i) => {
+                let b = buf[i];
+                reader.consume(i);
+                return Ok(Some(b));
+            }
+            None => {
+                let n = buf.len();
+                reader.consume(n);
+            }
+        }
+    }
+}
+
+/// The bounded reader of `path` as `kind` and its first byte that is not whitespace.
+fn open_document(
+    option: &str,
+    path: &Path,
+) -> Result<(std::io::BufReader<afmdyn::io::Bounded>, Option<u8>), CliError> {
+    let file = afmdyn::io::open(path, InputKind::CurveDocument).map_err(|e| input(option, e))?;
+    let mut reader = std::io::BufReader::new(file);
+    let first = first_byte(&mut reader).map_err(|e| match afmdyn::io::refusal(&e) {
+        Some(r) => input(option, r.clone()),
+        None => CliError::Input(format!("{option} {}: {e}", path.display())),
+    })?;
+    Ok((reader, first))
+}
+
 /// The request of the flags: from an `fm` JSON document, or from a CSV with k, f0 and A.
 fn request_of(a: &ReconstructArgs, fm: &Path) -> Result<ReconstructRequest, CliError> {
     let k = a.spring_constant;
@@ -88,14 +162,12 @@ fn request_of(a: &ReconstructArgs, fm: &Path) -> Result<ReconstructRequest, CliE
         true,
     )?;
     let amp = quantity(a.amplitude, "amplitude", Dim::Length, true)?;
-    let text =
-        std::fs::read(fm).map_err(|e| CliError::Input(format!("--fm {}: {e}", fm.display())))?;
-    if text.iter().find(|b| !b.is_ascii_whitespace()) == Some(&b'{') {
-        let doc: serde_json::Value = serde_json::from_slice(&text).map_err(|e| {
-            CliError::Input(format!("--fm {}: not a JSON document: {e}", fm.display()))
-        })?;
+    let (reader, first) = open_document("--fm", fm)?;
+    if first == Some(b'{') {
+        let doc = read_document("--fm", fm, reader)?;
         return Ok(ReconstructRequest::from_fm_document(&doc, k, f0, amp)?);
     }
+    drop(reader);
     let missing = |flag: &str| {
         CliError::Input(format!(
             "--{flag} is required with a CSV curve (an afmdyn fm document carries it)"
@@ -128,11 +200,8 @@ fn request_of(a: &ReconstructArgs, fm: &Path) -> Result<ReconstructRequest, CliE
 
 /// The reconstruction of an AM document (`--am FILE`) and its JSON document.
 fn am_reconstruction(path: &Path) -> Result<(Reconstruction, serde_json::Value), CliError> {
-    let text = std::fs::read(path)
-        .map_err(|e| CliError::Input(format!("--am {}: {e}", path.display())))?;
-    let doc: serde_json::Value = serde_json::from_slice(&text).map_err(|e| {
-        CliError::Input(format!("--am {}: not a JSON document: {e}", path.display()))
-    })?;
+    let (reader, _) = open_document("--am", path)?;
+    let doc = read_document("--am", path, reader)?;
     let d = request::reconstruct::am_reconstruction(&doc)?;
     Ok((d.output, d.json))
 }

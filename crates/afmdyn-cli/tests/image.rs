@@ -332,7 +332,8 @@ fn q100_probe(dir: &std::path::Path) -> (std::path::PathBuf, String) {
 fn the_pi_scan_writes_the_libraries_document_and_maps() {
     use afmdyn::analysis::progress::Progress;
     use afmdyn::request::image::{ImageRequest, SampleMap};
-    use afmdyn::request::image_scan::{pi_image, PiScan};
+    use afmdyn::request::image_scan::PiScan;
+    use afmdyn::study::scan::pi_image;
     let dir = tempfile::tempdir().unwrap();
     let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../../");
     let (probe, text) = q100_probe(dir.path());

@@ -6,6 +6,7 @@
 
 use crate::convert::Out;
 use crate::errors::{probe_error, sim_error, value_error};
+use crate::image_tasks::{image_inputs, scan_out};
 use crate::params::PyParams;
 use crate::run::{run, run_abandonable, Job, Stop};
 use afmdyn::analysis::bifurcation::SweepSpec;
@@ -562,32 +563,17 @@ pub fn observe<'py>(
     Ok(out.finish())
 }
 
-/// The probe's table (from its TOML text) and the sample map (TOML text or path) of an image.
-/// With `height_map`, the map's height map replaced by it.
-pub(crate) fn image_inputs(
-    probe: &str,
-    sample: &str,
-    height_map: Option<Vec<Vec<f64>>>,
-) -> PyResult<(toml::Table, afmdyn::request::image::SampleMap)> {
-    let table = Probe::table(probe, "probe").map_err(probe_error)?;
-    let mut map = afmdyn::request::image::SampleMap::read(sample).map_err(sim_error)?;
-    if let Some(rows) = height_map {
-        map = map.with_height_map(rows).map_err(sim_error)?;
-    }
-    Ok((table, map))
-}
-
 /// The heights of a height map file (`.csv` or `.npy`, a relative path from the current
-/// directory; [`afmdyn::request::height_map_file::read`]), `[row][column]` in m: Python's
+/// directory; [`afmdyn::io::height_map::read`]), `[row][column]` in m: Python's
 /// `afmdyn.image(…, height_map="h.npy")`.
 #[pyfunction]
 pub fn read_height_map(path: &str) -> PyResult<Vec<Vec<f64>>> {
-    afmdyn::request::height_map_file::read(path, None).map_err(sim_error)
+    afmdyn::io::height_map::read(path, None).map_err(sim_error)
 }
 
 /// The ideal-feedback image of a sample map under a probe (`afmdyn image`:
 /// [`afmdyn::request::image::image`]): `json` (its document) and `layout` (its arrays,
-/// [`afmdyn::layout::image::layout`], as `image.nc` holds them). `probe` is the probe's TOML text
+/// [`afmdyn::request::image_layout::layout`], as `image.nc` holds them). `probe` is the probe's TOML text
 /// ([`crate::params::probe_source`]), `sample` the map's TOML text or path
 /// ([`afmdyn::request::image::SampleMap::read`]); `None` takes the request's defaults
 /// ([`afmdyn::request::image::ImageRequest::at`]).
@@ -610,13 +596,13 @@ pub fn image<'py>(
     let img = py.detach(|| image(&table, &map, &req)).map_err(sim_error)?;
     let out = Out::new(py);
     out.json(&img.document(setpoint))?;
-    let layout = afmdyn::layout::image::layout(&img, setpoint);
+    let layout = afmdyn::request::image_layout::layout(&img, setpoint);
     out.set("layout", crate::convert::layout_dict(py, layout)?)?;
     Ok(out.finish())
 }
 
 /// The PI-scanned image of a sample map under a probe (`afmdyn image --feedback pi`:
-/// [`afmdyn::request::image_scan::pi_image`]): its JSON document and layout, the lines on `threads` worker
+/// [`afmdyn::study::scan::pi_image`]): its JSON document and layout, the lines on `threads` worker
 /// threads (`None`: all cores), with progress (lines) and Ctrl-C. Arguments as [`image`]'s;
 /// `scan_rate` (Hz), `gains` (K_P, K_I in 1/s) and `time_constant` (s), `None` for the lever's
 /// defaults.
@@ -668,20 +654,6 @@ pub fn pi_image<'py>(
         },
     )??;
     scan_out(py, &img, setpoint)
-}
-
-/// A PI scan's document and layout ([`afmdyn::layout::image::scan_layout`]) as Python takes
-/// them: `{"json": text, "layout": …}`.
-pub(crate) fn scan_out<'py>(
-    py: Python<'py>,
-    img: &afmdyn::request::image_scan::PiImage,
-    setpoint: f64,
-) -> PyResult<Bound<'py, PyDict>> {
-    let out = Out::new(py);
-    out.json(&img.document(setpoint))?;
-    let layout = afmdyn::layout::image::scan_layout(img, setpoint);
-    out.set("layout", crate::convert::layout_dict(py, layout)?)?;
-    Ok(out.finish())
 }
 
 /// The setpoint study of a sample map under a probe (`afmdyn image --setpoint-study`:

@@ -4,12 +4,15 @@
 //! finished line travels as CBOR text (every float bit for bit), so an image scanned on a
 //! cluster is the local image bit for bit.
 
-use crate::errors::{sim_error, value_error};
+use crate::convert::Out;
+use crate::errors::{probe_error, sim_error, value_error};
 use afmdyn::analysis::am_loop::ScanLine;
+use afmdyn::probe::Probe;
 use afmdyn::request::image::ImageRequest;
 use afmdyn::request::image_scan::{PiScan, ScanRecipe, ScanStudy as Study};
 use afmdyn::study::task_store::{from_cbor_text, to_cbor_text};
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 use std::sync::atomic::AtomicBool;
 
 /// A PI scan planned as lines.
@@ -37,7 +40,7 @@ pub(crate) fn recipe(
     gains: Option<(f64, f64)>,
     time_constant: Option<f64>,
 ) -> PyResult<ScanRecipe> {
-    let (probe, map) = crate::analyses::image_inputs(probe, sample, height_map)?;
+    let (probe, map) = image_inputs(probe, sample, height_map)?;
     Ok(ScanRecipe {
         probe,
         map,
@@ -133,6 +136,35 @@ impl ScanStudy {
             })
             .collect::<PyResult<Vec<_>>>()?;
         let img = self.study.assemble(records).map_err(sim_error)?;
-        crate::analyses::scan_out(py, &img, self.study.recipe().request.setpoint)
+        scan_out(py, &img, self.study.recipe().request.setpoint)
     }
+}
+
+/// The probe's table (from its TOML text) and the sample map (TOML text or path) of an image.
+/// With `height_map`, the map's height map replaced by it.
+pub(crate) fn image_inputs(
+    probe: &str,
+    sample: &str,
+    height_map: Option<Vec<Vec<f64>>>,
+) -> PyResult<(toml::Table, afmdyn::request::image::SampleMap)> {
+    let table = Probe::table(probe, "probe").map_err(probe_error)?;
+    let mut map = afmdyn::request::image::SampleMap::read(sample).map_err(sim_error)?;
+    if let Some(rows) = height_map {
+        map = map.with_height_map(rows).map_err(sim_error)?;
+    }
+    Ok((table, map))
+}
+
+/// A PI scan's document and layout ([`afmdyn::request::image_layout::scan_layout`]) as Python takes
+/// them: `{"json": text, "layout": …}`.
+pub(crate) fn scan_out<'py>(
+    py: Python<'py>,
+    img: &afmdyn::request::image_scan::PiImage,
+    setpoint: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    let out = Out::new(py);
+    out.json(&img.document(setpoint))?;
+    let layout = afmdyn::request::image_layout::scan_layout(img, setpoint);
+    out.set("layout", crate::convert::layout_dict(py, layout)?)?;
+    Ok(out.finish())
 }

@@ -239,10 +239,10 @@ impl ContactLaw {
     /// 1e-9 ≤ h̃ ≤ 1e6, 1e-9 ≤ D̃_r ≤ 1e6; impact 0 ≤ r ≤ 1.
     ///
     /// # Errors
-    /// [`crate::ParamError::Law`] naming the group and its allowed range.
-    pub fn validate(&self) -> Result<(), crate::ParamError> {
+    /// [`crate::error::ParamError::Law`] naming the group and its allowed range.
+    pub fn validate(&self) -> Result<(), crate::error::ParamError> {
         let bad = |name: &'static str, value: f64, range: &'static str| {
-            Err(crate::ParamError::Law { name, value, range })
+            Err(crate::error::ParamError::Law { name, value, range })
         };
         match *self {
             ContactLaw::Linear | ContactLaw::Hertz => Ok(()),
@@ -602,13 +602,13 @@ impl ContactLaw {
     /// for the CLI flags, the TOML keys and the Python keywords.
     ///
     /// # Errors
-    /// [`crate::ParamError::Group`] for a group of another law (e.g. `restitution` with
+    /// [`crate::error::ParamError::Group`] for a group of another law (e.g. `restitution` with
     /// `contact_law = hertz`); the groups' ranges are checked by [`ContactLaw::validate`].
     pub fn from_parts(
         kind: Option<LawKind>,
         groups: LawGroups,
         base: ContactLaw,
-    ) -> Result<ContactLaw, crate::ParamError> {
+    ) -> Result<ContactLaw, crate::error::ParamError> {
         let kind = kind.unwrap_or(base.kind());
         const DMT: &[LawKind] = &[LawKind::Dmt, LawKind::Electrostatic];
         const ES: &[LawKind] = &[LawKind::Electrostatic];
@@ -661,7 +661,7 @@ impl ContactLaw {
             ),
         ] {
             if given && !owners.contains(&kind) {
-                return Err(crate::ParamError::Group {
+                return Err(crate::error::ParamError::Group {
                     group,
                     owner,
                     law: kind.name(),

@@ -235,6 +235,38 @@ pub const MAX_RATIO_DENOMINATOR: u32 = 1_000_000;
 /// Largest p of a component's ratio p/q.
 pub const MAX_RATIO_NUMERATOR: u32 = 1_000_000_000;
 
+/// The convergent p/q of the continued fraction of `r` > 0 with the largest q ≤ `max_q` (and
+/// p ≤ [`MAX_RATIO_NUMERATOR`]), as [`crate::probe::convergent`]: the best rational
+/// approximation of `r` with a denominator that small. `None` for r outside (0, 10⁶) or not
+/// finite.
+pub fn convergent_within(r: f64, max_q: u32) -> Option<(u32, u32)> {
+    if !(r.is_finite() && r > 0.0 && r < 1e6) {
+        return None;
+    }
+    let (max_p, max_q) = (f64::from(MAX_RATIO_NUMERATOR), f64::from(max_q));
+    // h_n/k_n from the partial quotients a_n: h_n = a_n h_{n−1} + h_{n−2}, likewise k_n
+    let (mut h, mut h1, mut k, mut k1) = (1.0f64, 0.0f64, 0.0f64, 1.0f64);
+    let mut x = r;
+    let mut best = None;
+    for _ in 0..64 {
+        let a = x.floor();
+        let (hn, kn) = (a * h + h1, a * k + k1);
+        if hn > max_p || kn > max_q {
+            break;
+        }
+        if hn >= 1.0 {
+            best = Some((hn as u32, kn as u32));
+        }
+        (h1, h, k1, k) = (h, hn, k, kn);
+        let frac = x - a;
+        if frac <= 1e-15 * x.max(1.0) {
+            break;
+        }
+        x = 1.0 / frac;
+    }
+    best
+}
+
 const _: () = assert!(
     MAX_DRIVE_COMPONENTS == 3,
     "Params::drive_components has MAX_DRIVE_COMPONENTS entries"

@@ -157,7 +157,7 @@ impl FmSpec {
                 "must be a positive, finite oscillation amplitude",
             ));
         }
-        crate::request::limits::tolerance("tolerance", self.tolerance)?;
+        super::tolerance("tolerance", self.tolerance)?;
         self.base.validate()?;
         Ok(())
     }

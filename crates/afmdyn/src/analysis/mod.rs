@@ -36,6 +36,22 @@ pub mod stepped;
 pub mod tasks;
 pub mod traces;
 
+/// Check a relative tolerance `v` (an integrator's, a curve's loop conditions) in (0, 1e-3):
+/// beyond 1e-3 a steady state is not resolved, and 0 or less is never met.
+///
+/// # Errors
+/// [`crate::SimError::OutOfRange`] naming `name`.
+pub fn tolerance(name: &'static str, v: f64) -> Result<(), crate::SimError> {
+    if !(v.is_finite() && v > 0.0 && v < 1e-3) {
+        return Err(crate::SimError::out_of_range(
+            name,
+            v,
+            "must be in (0, 1e-3)",
+        ));
+    }
+    Ok(())
+}
+
 /// Without the `parallel` feature: the few rayon adaptors the analyses call, on plain
 /// iterators, so the same code runs its independent tasks one after another (each task's seed
 /// comes from its index, so the results do not depend on the feature).

@@ -39,9 +39,9 @@ fn without_errno(text: &str) -> &str {
 }
 
 /// Temporary sibling of `path` keeping its extension (plotters picks the format from it):
-/// [`crate::request::dir_lock::partial_path`].
+/// [`crate::io::dir_lock::partial_path`].
 pub fn temp_path(path: &Path) -> PathBuf {
-    crate::request::dir_lock::partial_path(path)
+    crate::io::dir_lock::partial_path(path)
 }
 
 /// Write `path` atomically with `write` filling a temporary file. On failure the temporary

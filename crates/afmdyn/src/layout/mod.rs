@@ -3,14 +3,13 @@
 //! file ([`netcdf`], feature `files`), the Python `xarray.Dataset` and the Dask Zarr store.
 //!
 //! The layouts of the results are declared beside them (a chart's, a basin map's, a sweep's);
-//! the ideal-feedback image's is [`image`].
+//! the ideal-feedback image's is `crate::request::image_layout`.
 //!
 //! Values are row-major over the variable's dimensions (the last one fastest), as NetCDF,
 //! NumPy and xarray store them.
 
 #[cfg(feature = "files")]
 pub mod files;
-pub mod image;
 #[cfg(feature = "files")]
 pub mod netcdf;
 

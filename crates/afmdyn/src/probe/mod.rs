@@ -124,9 +124,12 @@ pub const DEFAULT_INTERMOLECULAR_DISTANCE: f64 = 0.165e-9;
 use crate::contact::ContactLaw;
 use crate::galerkin::{Galerkin, Region};
 use crate::model::CantileverModel;
+/// The convergent of `r` with the largest denominator ≤ `max_q` (defined with the ratio limits in
+/// [`crate::params`], where the time average of a stepped curve also finds it).
+pub use crate::params::convergent_within;
 use crate::params::{
     DriveComponent, Excitation, Params, Structure, MAX_DRIVE_COMPONENTS, MAX_MODES,
-    MAX_RATIO_DENOMINATOR, MAX_RATIO_NUMERATOR,
+    MAX_RATIO_DENOMINATOR,
 };
 use serde::Serialize;
 use std::f64::consts::TAU;
@@ -146,9 +149,9 @@ pub enum ProbeError {
         message: String,
     },
     /// The file could not be read, is larger than
-    /// [`crate::request::limits::MAX_INPUT_TEXT_BYTES`] or is not UTF-8 text.
+    /// [`crate::io::MAX_INPUT_TEXT_BYTES`] or is not UTF-8 text.
     #[error(transparent)]
-    File(crate::request::limits::InputFileError),
+    File(crate::io::InputFileError),
     /// Not TOML (with line and column from the parser).
     #[error("{path}: {message}")]
     Syntax {
@@ -404,43 +407,12 @@ pub fn rational_ratio(r: f64) -> Option<(u32, u32)> {
 }
 
 /// The convergent p/q of the continued fraction of `r` > 0 with the largest q ≤
-/// [`MAX_RATIO_DENOMINATOR`] (and p ≤ [`MAX_RATIO_NUMERATOR`]): the best rational approximation
+/// [`MAX_RATIO_DENOMINATOR`] (and p ≤ [`crate::params::MAX_RATIO_NUMERATOR`]): the best rational approximation
 /// with such a denominator, |r − p/q| < 1/(q q′) with q′ > 10⁶ the next convergent's
 /// denominator (Khinchin, *Continued Fractions*, 1964, Thm. 9), so within about 1e-12 of r
 /// unless r itself has a small denominator. `None` for r outside (0, 10⁶) or not finite.
 pub fn convergent(r: f64) -> Option<(u32, u32)> {
     convergent_within(r, MAX_RATIO_DENOMINATOR)
-}
-
-/// The convergent p/q of the continued fraction of `r` > 0 with the largest q ≤ `max_q` (and
-/// p ≤ [`MAX_RATIO_NUMERATOR`]), as [`convergent`]: the best rational approximation of `r`
-/// with a denominator that small. `None` for r outside (0, 10⁶) or not finite.
-pub fn convergent_within(r: f64, max_q: u32) -> Option<(u32, u32)> {
-    if !(r.is_finite() && r > 0.0 && r < 1e6) {
-        return None;
-    }
-    let (max_p, max_q) = (f64::from(MAX_RATIO_NUMERATOR), f64::from(max_q));
-    // h_n/k_n from the partial quotients a_n: h_n = a_n h_{n−1} + h_{n−2}, likewise k_n
-    let (mut h, mut h1, mut k, mut k1) = (1.0f64, 0.0f64, 0.0f64, 1.0f64);
-    let mut x = r;
-    let mut best = None;
-    for _ in 0..64 {
-        let a = x.floor();
-        let (hn, kn) = (a * h + h1, a * k + k1);
-        if hn > max_p || kn > max_q {
-            break;
-        }
-        if hn >= 1.0 {
-            best = Some((hn as u32, kn as u32));
-        }
-        (h1, h, k1, k) = (h, hn, k, kn);
-        let frac = x - a;
-        if frac <= 1e-15 * x.max(1.0) {
-            break;
-        }
-        x = 1.0 / frac;
-    }
-    best
 }
 
 /// The cantilever section, before the model is known.
@@ -583,7 +555,7 @@ impl Probe {
     ///
     /// # Errors
     /// [`ProbeError`] naming the path and every problem; [`ProbeError::File`] for a file that
-    /// cannot be read, is larger than [`crate::request::limits::MAX_INPUT_TEXT_BYTES`] or is
+    /// cannot be read, is larger than [`crate::io::MAX_INPUT_TEXT_BYTES`] or is
     /// not UTF-8 text.
     #[cfg(feature = "files")]
     pub fn load(path: &Path) -> Result<Probe, ProbeError> {
@@ -593,14 +565,14 @@ impl Probe {
 
     /// The text of a probe file, bounded: the one reader of [`Probe::load`] and
     /// [`Probe::source_text`] (a `/dev/zero` is refused after
-    /// [`crate::request::limits::MAX_INPUT_TEXT_BYTES`], not read until memory runs out).
+    /// [`crate::io::MAX_INPUT_TEXT_BYTES`], not read until memory runs out).
     ///
     /// # Errors
     /// As [`Probe::load`].
     #[cfg(feature = "files")]
     fn read_file(path: &Path) -> Result<String, ProbeError> {
-        use crate::request::limits::{read_input, InputFileError, MAX_INPUT_TEXT_BYTES};
-        read_input(path, MAX_INPUT_TEXT_BYTES).map_err(|e| match e {
+        use crate::io::{read_text, InputFileError, InputKind};
+        read_text(path, InputKind::Probe).map_err(|e| match e {
             InputFileError::Io { path, message } => ProbeError::Io { path, message },
             e => ProbeError::File(e),
         })

@@ -12,7 +12,7 @@
 //! top-level `height_map = [[…], …]` (m; rows from y = 0 to Ly, columns from x = 0 to Lx, each
 //! row as long) adds a topography sampled bilinearly at each pixel (a measured or generated
 //! height map, e.g. from a NumPy array); `height_map = "h.csv"` or `"h.npy"` reads it from a
-//! file (feature `files`: [`super::height_map_file`]), a relative path taken from the sample
+//! file (feature `files`: [`crate::io::height_map`]), a relative path taken from the sample
 //! file's directory ([`SampleMap::load`]) or else the current directory ([`SampleMap::parse`]).
 //!
 //! **Ideal feedback.** A feedback loop infinitely faster than the scan holds the amplitude at
@@ -43,15 +43,10 @@ use serde_json::Value;
 
 use super::curves::{approach_request, CurveRequest};
 
-/// Largest number of pixels per line and of lines.
-pub const MAX_PIXELS: usize = 4096;
+pub use crate::io::height_map::{MAX_HEIGHT, MAX_PIXELS};
 
 /// Largest number of domains of a sample map.
 pub const MAX_DOMAINS: usize = 1000;
-
-/// Largest true height of a domain or a height map's value, either sign (m): 10 µm, a
-/// topography the z piezo follows.
-pub const MAX_HEIGHT: f64 = 1e-5;
 
 /// One domain of a [`SampleMap`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -155,11 +150,11 @@ fn height_map(v: &toml::Value) -> Result<Vec<Vec<f64>>, SimError> {
     Ok(out)
 }
 
-/// A height map file `height_map = "…"` ([`super::height_map_file::read`]), a relative path
+/// A height map file `height_map = "…"` ([`crate::io::height_map::read`]), a relative path
 /// taken from `dir`.
 #[cfg(feature = "files")]
 fn height_map_file(file: &str, dir: Option<&std::path::Path>) -> Result<Vec<Vec<f64>>, SimError> {
-    super::height_map_file::read(file, dir)
+    crate::io::height_map::read(file, dir)
 }
 
 /// Without the `files` feature a height map file is refused.
@@ -180,7 +175,7 @@ impl SampleMap {
     /// [`SimError::Probe`] naming the file and the key (`size`, `domain 'soft' x`, …) and what
     /// it must be: an unknown key, a missing `size` or `x`, a range that is empty or outside the
     /// map, more than [`MAX_DOMAINS`] domains; the syntax error of invalid TOML; a height map
-    /// file's refusals ([`super::height_map_file::read`]), or, without the `files` feature, any
+    /// file's refusals ([`crate::io::height_map::read`]), or, without the `files` feature, any
     /// height map file.
     pub fn parse(text: &str, origin: &str) -> Result<SampleMap, SimError> {
         Self::parse_in(text, origin, None)
@@ -362,7 +357,7 @@ impl SampleMap {
     /// [`super::limits::MAX_INPUT_TEXT_BYTES`]); as [`SampleMap::parse`].
     #[cfg(feature = "files")]
     pub fn load(path: &std::path::Path) -> Result<SampleMap, SimError> {
-        let text = super::limits::read_input(path, super::limits::MAX_INPUT_TEXT_BYTES)
+        let text = crate::io::read_text(path, crate::io::InputKind::SampleMap)
             .map_err(|e| SimError::Probe(format!("sample map: {e}")))?;
         Self::parse_in(&text, &path.display().to_string(), path.parent())
     }

@@ -35,7 +35,7 @@
 
 use super::image::{image_of, material_curves, Image, ImageRequest, SampleMap};
 use crate::analysis::am_loop::{
-    engage_position, scan_line, scan_lines, Engage, FeedbackGains, LineSpec, ScanLine, ScanPixel,
+    engage_position, scan_line, Engage, FeedbackGains, LineSpec, ScanLine, ScanPixel,
     LOCK_IN_SAMPLES,
 };
 use crate::analysis::approach::rest_distance;
@@ -43,10 +43,8 @@ use crate::error::SimError;
 use crate::integrate::IntegratorOptions;
 use crate::probe::Probe;
 use crate::report::CurveUnits;
-use crate::study::Study;
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
-use std::collections::HashSet;
 use std::sync::atomic::AtomicBool;
 
 /// Most drive periods a scan may integrate (lines × (engage + 2 × pixels × periods per pixel)).
@@ -148,7 +146,7 @@ pub struct ScanRecipe {
 
 /// The study of a PI scan: one task per line ([module docs](self)).
 pub struct ScanStudy {
-    fingerprint: Value,
+    pub(crate) fingerprint: Value,
     recipe: ScanRecipe,
     ideal: Image,
     of_domain: Vec<usize>,
@@ -448,44 +446,6 @@ fn empty_artefacts() -> Artefacts {
     }
 }
 
-impl Study for ScanStudy {
-    /// A line's number and its trace and retrace.
-    type Record = (usize, ScanLine);
-    /// The lines stored.
-    type Done = HashSet<usize>;
-
-    fn fingerprint(&self) -> &Value {
-        &self.fingerprint
-    }
-
-    fn units(&self) -> u64 {
-        self.lines() as u64
-    }
-
-    fn done_units(&self, done: &HashSet<usize>) -> u64 {
-        done.len() as u64
-    }
-
-    fn record_units(&self, _: &(usize, ScanLine)) -> u64 {
-        1
-    }
-
-    fn run(
-        &self,
-        done: &HashSet<usize>,
-        sink: &(dyn Fn((usize, ScanLine)) + Sync),
-        cancel: &AtomicBool,
-    ) -> Result<(), SimError> {
-        scan_lines(
-            self.lines(),
-            done,
-            &|t| self.line(t, cancel),
-            &|t, l| sink((t, l)),
-            cancel,
-        )
-    }
-}
-
 impl PiImage {
     /// Metres per model length unit g₀ (the records' lengths).
     pub fn length(&self) -> f64 {
@@ -619,30 +579,4 @@ impl PiImage {
             "warnings": self.warnings,
         })
     }
-}
-
-/// The PI-scanned image of `map` under `probe_table` ([module docs](self)), its lines on
-/// `threads` worker threads (`None`: all cores) with progress and cancellation in `observer`.
-///
-/// # Errors
-/// As [`ScanStudy::new`] and the lines; [`SimError::Cancelled`].
-pub fn pi_image(
-    probe_table: &toml::Table,
-    map: &SampleMap,
-    req: &ImageRequest,
-    scan: &PiScan,
-    threads: Option<usize>,
-    observer: &dyn crate::study::Observer,
-) -> Result<PiImage, SimError> {
-    let study = ScanStudy::new(probe_table, map, req, scan)?;
-    let mut store = crate::study::MemoryStore::default();
-    match crate::study::execute(&study, &mut store, false, threads, observer) {
-        Ok(crate::study::Outcome::Cancelled) => return Err(SimError::Cancelled),
-        Ok(_) => {}
-        Err(crate::study::StudyError::Sim(e)) => return Err(e),
-        Err(crate::study::StudyError::Store(e)) => {
-            return Err(SimError::Probe(format!("the scan's store: {e}")))
-        }
-    }
-    study.assemble(store.records)
 }

@@ -19,12 +19,7 @@ pub const MAX_SERIES_MEMORY_BYTES: f64 = 4.0 * 1024.0 * 1024.0 * 1024.0;
 pub const MAX_TRACE_BYTES: f64 = 1024.0 * 1024.0 * 1024.0;
 /// Bytes of one trace sample: deflection, distance and force, 8 bytes each.
 pub const TRACE_BYTES_PER_SAMPLE: f64 = 24.0;
-/// Largest text input file (a probe file, a `--config` file) read, in bytes: 1 MiB, a
-/// thousand times a probe file; larger input (`/dev/zero`) is refused after reading this much.
-pub const MAX_INPUT_TEXT_BYTES: u64 = 1024 * 1024;
-/// Largest CSV input file (`afmdyn continue --overlay bifurcation.csv`) read, in bytes:
-/// 256 MiB, about a million rows of a bifurcation sweep.
-pub const MAX_INPUT_CSV_BYTES: u64 = 256 * 1024 * 1024;
+pub use crate::io::input::{MAX_INPUT_CSV_BYTES, MAX_INPUT_TEXT_BYTES};
 /// The range of every integrator tolerance (relative and absolute; the adaptive, split and
 /// Taylor integrators use it, the exact propagator and RK4 ignore it but it is checked alike): below 1e-16 it is beneath the double's resolution, above 1e-3 no longer an accuracy.
 pub const TOLERANCE_RANGE: (f64, f64) = crate::integrate::TOLERANCE_RANGE;
@@ -80,21 +75,7 @@ pub const MAX_SI_DISTANCE: f64 = 1e-4;
 /// MHz but written in Hz (1e3 or 1e6 too small).
 pub const SI_FREQUENCY_RATIO: (f64, f64) = (1e-2, 1e4);
 
-/// Check a relative tolerance `v` (an integrator's, a curve's loop conditions) in (0, 1e-3):
-/// beyond 1e-3 a steady state is not resolved, and 0 or less is never met.
-///
-/// # Errors
-/// [`crate::SimError::OutOfRange`] naming `name`.
-pub fn tolerance(name: &'static str, v: f64) -> Result<(), crate::SimError> {
-    if !(v.is_finite() && v > 0.0 && v < 1e-3) {
-        return Err(crate::SimError::out_of_range(
-            name,
-            v,
-            "must be in (0, 1e-3)",
-        ));
-    }
-    Ok(())
-}
+pub use crate::analysis::tolerance;
 
 /// Check an SI distance `v` (m) against [`MAX_SI_DISTANCE`].
 ///
@@ -112,60 +93,6 @@ pub fn si_distance(name: &'static str, v: f64) -> Result<(), crate::SimError> {
     Ok(())
 }
 
-/// The text of the input file `path`, read with at most `limit` bytes kept in memory
-/// ([`MAX_INPUT_TEXT_BYTES`], [`MAX_INPUT_CSV_BYTES`]; `Read::take`, so `/dev/zero` is refused
-/// after `limit` bytes, not read on).
-///
-/// # Errors
-/// [`InputFileError`] naming the file: unreadable, larger than `limit`, or not UTF-8 text.
 #[cfg(feature = "files")]
-pub fn read_input(path: &std::path::Path, limit: u64) -> Result<String, InputFileError> {
-    use std::io::Read;
-    let name = || path.display().to_string();
-    let io = |e: std::io::Error| InputFileError::Io {
-        path: name(),
-        message: crate::error::io_message(&e),
-    };
-    let file = std::fs::File::open(path).map_err(io)?;
-    let mut bytes = Vec::new();
-    file.take(limit + 1).read_to_end(&mut bytes).map_err(io)?;
-    if bytes.len() as u64 > limit {
-        return Err(InputFileError::TooLarge {
-            path: name(),
-            limit,
-        });
-    }
-    String::from_utf8(bytes).map_err(|e| InputFileError::NotText {
-        path: name(),
-        offset: e.utf8_error().valid_up_to(),
-    })
-}
-
-/// An input file that cannot be used ([`read_input`]); every message names the file.
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-pub enum InputFileError {
-    /// The file cannot be opened or read.
-    #[error("{path}: {message}")]
-    Io {
-        /// The file.
-        path: String,
-        /// The operating system's reason.
-        message: String,
-    },
-    /// The file is larger than the limit.
-    #[error("{path}: larger than {limit} bytes, the limit of this input (is it the right file?)")]
-    TooLarge {
-        /// The file.
-        path: String,
-        /// The limit in bytes.
-        limit: u64,
-    },
-    /// The file is not UTF-8 text.
-    #[error("{path}: not UTF-8 text (invalid byte after {offset} bytes)")]
-    NotText {
-        /// The file.
-        path: String,
-        /// Bytes of valid text before the first invalid one.
-        offset: usize,
-    },
-}
+pub use crate::io::input::read_input;
+pub use crate::io::input::InputFileError;

@@ -19,7 +19,7 @@
 //!   fingerprint of its request.
 //! - [`checkpoint`]: resumable sweeps: the [`Checkpoint`] a store implements, in memory or
 //!   (feature `files`) in a directory ([`checkpoint_file`]), locked for one run at a time
-//!   ([`dir_lock`]).
+//!   ([`crate::io::dir_lock`]).
 //!
 //! A front end maps its spelling of a name to a request field and nothing else; errors name
 //! the library's parameter (`samples_per_period`) and a front end respells them
@@ -35,11 +35,12 @@ pub mod checkpoint;
 pub mod checkpoint_file;
 pub mod curves;
 #[cfg(feature = "files")]
-pub mod dir_lock;
+pub use crate::io::dir_lock;
 pub mod fm;
 #[cfg(feature = "files")]
-pub mod height_map_file;
+pub use crate::io::height_map as height_map_file;
 pub mod image;
+pub mod image_layout;
 pub mod image_scan;
 pub mod limits;
 pub mod model;

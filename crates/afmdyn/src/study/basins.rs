@@ -142,7 +142,7 @@ impl Analysis for BasinsRequest {
 pub mod store {
     use super::super::task_store::{Encoding, TaskFiles, TaskStore};
     use crate::analysis::basins::BasinRow;
-    use crate::request::dir_lock::DirLock;
+    use crate::io::dir_lock::DirLock;
 
     /// The basin map's files.
     pub const BASIN_FILES: TaskFiles = TaskFiles {

@@ -5,8 +5,8 @@
 
 use super::task_store::{Encoding, TaskFiles, TaskStore};
 use crate::analysis::chart::ChartCell;
+use crate::io::dir_lock::DirLock;
 use crate::request::checkpoint::CheckpointError;
-use crate::request::dir_lock::DirLock;
 
 /// The chart's files.
 pub const CHART_FILES: TaskFiles = TaskFiles {

@@ -144,7 +144,7 @@ impl Analysis for GlobalContinuationRequest {
 pub mod store {
     use super::super::task_store::{Encoding, TaskFiles, TaskStore};
     use crate::analysis::global_continuation::ContinuationStep;
-    use crate::request::dir_lock::DirLock;
+    use crate::io::dir_lock::DirLock;
 
     /// The global continuation's files.
     pub const CONTINUATION_FILES: TaskFiles = TaskFiles {

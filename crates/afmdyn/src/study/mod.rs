@@ -39,6 +39,7 @@ pub mod chart;
 pub mod chart_store;
 pub mod global_continuation;
 mod memory;
+pub mod scan;
 #[cfg(feature = "files")]
 pub mod scan_store;
 pub mod stepped;

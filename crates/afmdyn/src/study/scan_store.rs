@@ -7,7 +7,7 @@
 
 use super::task_store::{Encoding, TaskFiles, TaskStore};
 use crate::analysis::am_loop::ScanLine;
-use crate::request::dir_lock::DirLock;
+use crate::io::dir_lock::DirLock;
 
 /// The scan's files.
 pub const SCAN_FILES: TaskFiles = TaskFiles {

@@ -202,7 +202,7 @@ impl Analysis for ResonanceRequest {
 pub mod store {
     use super::super::task_store::{Encoding, TaskFiles, TaskStore};
     use crate::analysis::stepped::CurvePoint;
-    use crate::request::dir_lock::DirLock;
+    use crate::io::dir_lock::DirLock;
 
     /// A stepped curve's files.
     pub const CURVE_FILES: TaskFiles = TaskFiles {

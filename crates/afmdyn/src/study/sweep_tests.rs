@@ -250,8 +250,8 @@ fn records_without_a_ledger_are_not_resumed() {
 #[cfg(feature = "files")]
 #[test]
 fn the_file_store_resumes_a_killed_sweep_and_drops_a_cut_row() {
+    use crate::io::dir_lock::DirLock;
     use crate::request::checkpoint_file::{FileCheckpoint, LEDGER, PARTIAL_CSV};
-    use crate::request::dir_lock::DirLock;
     let r = request();
     let (unfinished, reference) = uninterrupted(&r);
     let dir = std::env::temp_dir().join(format!("afmdyn-checkpoint-{}", std::process::id()));

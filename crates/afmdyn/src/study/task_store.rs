@@ -20,9 +20,9 @@
 //! `afmdyn chart --out DIR` keeps its store there ([`super::chart_store`]); the files
 //! a user reads (`chart.csv`, `chart.nc`, the maps) are written from it.
 
+use crate::io::dir_lock::DirLock;
 use crate::request::checkpoint::{CheckpointError, Ledger};
 use crate::request::checkpoint_file::{crc_hex, write_atomic, START_OVER};
-use crate::request::dir_lock::DirLock;
 use crate::request::sweep::first_difference;
 use base64::engine::general_purpose::STANDARD as BASE64;
 use base64::Engine;

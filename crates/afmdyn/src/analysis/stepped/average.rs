@@ -51,7 +51,7 @@ pub const MAX_DEFAULT_WINDOW: usize = 4096;
 
 /// The slowest beat of a multifrequency drive's combination tones: for each component's ratio
 /// r = f_i/f₁ its best rational approximation p/q with q ≤ [`BEAT_DENOMINATOR`]
-/// ([`crate::probe::convergent_within`]), whose tone q f_i − p f₁ = q f₁ (r − p/q) a tapping
+/// ([`crate::params::convergent_within`]), whose tone q f_i − p f₁ = q f₁ (r − p/q) a tapping
 /// tip's nonlinearity makes: the motion's averages over windows shorter than its period
 /// 1/(q |r − p/q|) primary periods follow the beat instead of settling (at f₂ = 1761/281 f₁,
 /// 94/15: the beat is the common period, 281 periods). The slowest over the components as
@@ -60,7 +60,7 @@ pub fn slowest_beat(p: &crate::params::Params) -> Option<(u32, u32, f64, f64)> {
     p.components()
         .filter_map(|c| {
             let r = c.ratio();
-            let (a, b) = crate::probe::convergent_within(r, BEAT_DENOMINATOR)?;
+            let (a, b) = crate::params::convergent_within(r, BEAT_DENOMINATOR)?;
             let off = (r - f64::from(a) / f64::from(b)).abs();
             (off > 0.0).then(|| (a, b, r, 1.0 / (f64::from(b) * off)))
         })

@@ -1,9 +1,10 @@
 //! Height maps read from files (feature `files`): a sample map's `height_map = "h.csv"` or
-//! `"h.npy"` ([`super::image::SampleMap`]), with the limits and refusals of the inline array.
+//! `"h.npy"` ([`crate::request::image::SampleMap`]), with the limits and refusals of the inline array.
 //!
 //! - **CSV** (`.csv`): rows of comma-separated heights in m, no header, rows from y = 0 to
 //!   Ly and columns from x = 0 to Lx (the `csv` crate; spaces around a value are ignored, blank
-//!   lines skipped). A file larger than [`MAX_CSV_BYTES`] is refused, and no more is read.
+//!   lines skipped). A file larger than [`MAX_CSV_BYTES`], or with a line longer than
+//!   [`super::input::MAX_CSV_LINE_BYTES`] (`/dev/zero`), is refused, and no more is read.
 //! - **NPY** (`.npy`, NumPy's `np.save`): a 2-D float64 array (`<f8` or `>f8`, C or Fortran
 //!   order), `[row][column]` as the CSV (the `npyz` crate). The file is at most
 //!   [`MAX_NPY_BYTES`], its header at most [`MAX_NPY_HEADER_BYTES`], and the dtype and shape
@@ -13,21 +14,20 @@
 //! within ±[`MAX_HEIGHT`] (10 µm). Errors are [`SimError::Probe`] naming `height_map`, the
 //! file and the problem (the row and column of a bad value).
 
-use super::image::{MAX_HEIGHT, MAX_PIXELS};
+#[cfg(feature = "files")]
+use super::input::{Bounded, InputFileError, InputKind};
+#[cfg(feature = "files")]
 use crate::error::SimError;
+#[cfg(feature = "files")]
 use std::io::Read;
+#[cfg(feature = "files")]
 use std::path::{Path, PathBuf};
 
-/// Largest height map CSV file read, in bytes: 512 MiB, 32 bytes for each of 4096 × 4096
-/// values (a full-precision height and its comma take 24).
-pub const MAX_CSV_BYTES: u64 = (MAX_PIXELS * MAX_PIXELS * 32) as u64;
+pub use super::caps::{MAX_CSV_BYTES, MAX_NPY_BYTES, MAX_NPY_HEADER_BYTES, MAX_PIXELS};
 
-/// Largest NPY header read, in bytes (NumPy's own `np.load` allows 10 000).
-pub const MAX_NPY_HEADER_BYTES: usize = 65_536;
-
-/// Largest NPY height map file read, in bytes: 4096 × 4096 float64 values and the largest
-/// header.
-pub const MAX_NPY_BYTES: u64 = (MAX_PIXELS * MAX_PIXELS * 8 + MAX_NPY_HEADER_BYTES + 12) as u64;
+/// Largest true height of a domain or a height map's value, either sign (m): 10 µm, a
+/// topography the z piezo follows.
+pub const MAX_HEIGHT: f64 = 1e-5;
 
 /// The heights of the file `file` (the value of `height_map`), a relative path taken from
 /// `base` (the sample file's directory; `None`: the current directory), `[row][column]`.
@@ -37,6 +37,7 @@ pub const MAX_NPY_BYTES: u64 = (MAX_PIXELS * MAX_PIXELS * 8 + MAX_NPY_HEADER_BYT
 /// `.npy`; a file that cannot be read, is too large or is not CSV/NPY; more than 4096 rows or
 /// columns, no values, rows of different lengths; a value that is not a number, not finite or
 /// beyond ±10 µm (with its row and column); an NPY array that is not 2-D float64.
+#[cfg(feature = "files")]
 pub fn read(file: &str, base: Option<&Path>) -> Result<Vec<Vec<f64>>, SimError> {
     let path = base.map_or_else(|| PathBuf::from(file), |b| b.join(file));
     let err = |problem: String| {
@@ -63,8 +64,18 @@ pub fn read(file: &str, base: Option<&Path>) -> Result<Vec<Vec<f64>>, SimError> 
         }
     };
     let rows = match ext.as_deref() {
-        Some("csv") => csv_rows(sized(MAX_CSV_BYTES, "a CSV")?).map_err(err)?,
-        Some("npy") => npy_rows(sized(MAX_NPY_BYTES, "an NPY")?).map_err(err)?,
+        Some("csv") => csv_rows(Bounded::new(
+            sized(MAX_CSV_BYTES, "a CSV")?,
+            &path,
+            InputKind::HeightMapCsv,
+        ))
+        .map_err(err)?,
+        Some("npy") => npy_rows(Bounded::new(
+            sized(MAX_NPY_BYTES, "an NPY")?,
+            &path,
+            InputKind::HeightMapNpy,
+        ))
+        .map_err(err)?,
         _ => {
             return Err(err(
                 "must be a .csv file (rows of heights in m) or a .npy file (a 2-D float64 \
@@ -80,6 +91,7 @@ pub fn read(file: &str, base: Option<&Path>) -> Result<Vec<Vec<f64>>, SimError> 
 }
 
 /// A height at (row, column), both from 1: finite and within ±10 µm.
+#[cfg(feature = "files")]
 fn check(h: f64, row: usize, col: usize) -> Result<f64, String> {
     if !h.is_finite() {
         return Err(format!(
@@ -96,13 +108,14 @@ fn check(h: f64, row: usize, col: usize) -> Result<f64, String> {
 
 /// The rows of a CSV height map, streamed: at most [`MAX_CSV_BYTES`], 4096 rows of 4096
 /// values, each row as long as the first.
-fn csv_rows(file: std::fs::File) -> Result<Vec<Vec<f64>>, String> {
+#[cfg(feature = "files")]
+fn csv_rows(file: Bounded) -> Result<Vec<Vec<f64>>, String> {
     let too_large = || format!("larger than {MAX_CSV_BYTES} bytes (4096 × 4096 heights)");
     let mut reader = csv::ReaderBuilder::new()
         .has_headers(false)
         .flexible(true)
         .trim(csv::Trim::All)
-        .from_reader(file.take(MAX_CSV_BYTES + 1));
+        .from_reader(file);
     let mut rows: Vec<Vec<f64>> = Vec::new();
     let mut record = csv::StringRecord::new();
     loop {
@@ -111,6 +124,14 @@ fn csv_rows(file: std::fs::File) -> Result<Vec<Vec<f64>>, String> {
             Ok(true) => {}
             Err(e) => {
                 return Err(match e.kind() {
+                    csv::ErrorKind::Io(io) => match super::input::refusal(io) {
+                        Some(InputFileError::LineTooLong { limit, .. }) => format!(
+                            "a line longer than {limit} bytes: not a CSV height map (a row of \
+                             4096 heights is far shorter)"
+                        ),
+                        Some(_) => too_large(),
+                        None => format!("cannot be read: {e}"),
+                    },
                     csv::ErrorKind::Utf8 { .. } => format!("not UTF-8 text: {e}"),
                     _ => format!("cannot be read: {e}"),
                 })
@@ -158,7 +179,8 @@ fn csv_rows(file: std::fs::File) -> Result<Vec<Vec<f64>>, String> {
 
 /// The rows of an NPY height map: the header's length, then its dtype and shape, checked
 /// before the values are read.
-fn npy_rows(file: std::fs::File) -> Result<Vec<Vec<f64>>, String> {
+#[cfg(feature = "files")]
+fn npy_rows(file: Bounded) -> Result<Vec<Vec<f64>>, String> {
     let not_npy = || "not an NPY file (NumPy's np.save)".to_string();
     let io = |e: std::io::Error| format!("not a readable NPY file: {e}");
     // the magic, the version and the header's length: npyz allocates the header as its length

@@ -1,11 +1,12 @@
-//! The layouts of an image: `image.nc` of `afmdyn image --out DIR` ([`super::netcdf::write`])
+//! The layouts of an image, declared beside the image's types as a chart's beside the chart
+//! (a layout module knows no request): `image.nc` of `afmdyn image --out DIR` ([`crate::layout::netcdf::write`])
 //! and the variables' units and long names of Python's `afmdyn.image` Dataset — the
 //! ideal-feedback image ([`crate::request::image::Image`], [`layout`]) and the PI scan
 //! ([`crate::request::image_scan::PiImage`], [`scan_layout`]).
 
-use super::{Attr, Layout, Values, Variable};
-use crate::request::image::{Image, OperatingPoint, Regime};
-use crate::request::image_scan::PiImage;
+use super::image::{Image, OperatingPoint, Regime};
+use super::image_scan::PiImage;
+use crate::layout::{Attr, Layout, Values, Variable};
 
 /// The numeric maps of an image over (y, x): name, units, long name, as the JSON document's
 /// `image` block names them ([`Image::document`]).

@@ -1,0 +1,206 @@
+//! Every file a command line option names is read through the library's one bounded reader
+//! (`afmdyn::io::input`, a cap per kind): `/dev/zero` (no end, no line end) and a 2 GiB sparse
+//! file (a regular file larger than every cap, refused from its length) are refused with exit
+//! code 2 and one line naming the option, the file and the cap, for `--probe`, `--config`,
+//! `--overlay`, `--sample` and a sample map's `height_map` (CSV and NPY), and `reconstruct
+//! --fm` and `--am`. (How long a refusal takes is measured by hand, not asserted: a loaded
+//! machine would make such an assertion race.)
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn afmdyn(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_afmdyn"))
+        .args(args)
+        .current_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
+        .output()
+        .expect("run afmdyn")
+}
+
+/// `args` exit 2 with one line on stderr mentioning every one of `needles`, and no stdout.
+fn refused(args: &[&str], needles: &[&str]) {
+    let out = afmdyn(args);
+    let err = String::from_utf8_lossy(&out.stderr).to_string();
+    assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+    assert_eq!(
+        err.trim_end().lines().count(),
+        1,
+        "{args:?}: one line: {err}"
+    );
+    for needle in needles {
+        assert!(
+            err.contains(needle),
+            "{args:?}: '{err}' should mention '{needle}'"
+        );
+    }
+    assert!(
+        out.stdout.is_empty(),
+        "{args:?}: no output presented as a result"
+    );
+}
+
+/// A sparse file of 2 GiB (no blocks written) named `name` in `dir`.
+fn sparse(dir: &Path, name: &str) -> PathBuf {
+    let path = dir.join(name);
+    let f = std::fs::File::create(&path).unwrap();
+    f.set_len(2 << 30).unwrap();
+    assert_eq!(std::fs::metadata(&path).unwrap().len(), 2 << 30);
+    path
+}
+
+/// `/dev/zero` under the name `name` in `dir` (a symbolic link: a height map's kind is its
+/// extension).
+fn zero(dir: &Path, name: &str) -> PathBuf {
+    let path = dir.join(name);
+    std::os::unix::fs::symlink("/dev/zero", &path).unwrap();
+    path
+}
+
+const PROBE: &str = "examples/probe-point-mass-dmt.toml";
+const TEXT_CAP: &str = "larger than 1048576 bytes";
+const CSV_CAP: &str = "larger than 268435456 bytes";
+const LINE_CAP: &str = "larger than 1048576 bytes in one line";
+
+#[test]
+fn probe_and_config_files_are_refused_past_their_cap() {
+    let dir = tempfile::tempdir().unwrap();
+    let big = sparse(dir.path(), "big.toml");
+    for file in ["/dev/zero", big.to_str().unwrap()] {
+        refused(
+            &["modes", "--probe", file],
+            &["--probe", file, TEXT_CAP, "a probe file"],
+        );
+        refused(
+            &["modes", "--config", file],
+            &["--config", file, TEXT_CAP, "a config file"],
+        );
+        refused(
+            &["units", "--config", file],
+            &["--config", file, TEXT_CAP, "a config file"],
+        );
+        refused(
+            &["units", "--probe", file],
+            &["probe", file, TEXT_CAP, "a probe file"],
+        );
+        refused(
+            &[
+                "image",
+                "--probe",
+                file,
+                "--sample",
+                "examples/sample-blend.toml",
+                "--setpoint",
+                "0.7",
+            ],
+            &["--probe", file, TEXT_CAP, "a probe file"],
+        );
+    }
+}
+
+#[test]
+fn an_overlay_is_refused_past_its_cap_or_its_line_cap() {
+    let dir = tempfile::tempdir().unwrap();
+    let big = sparse(dir.path(), "big.csv");
+    let out = dir.path().join("out");
+    let o = out.to_str().unwrap();
+    let continuation = |file: &str| {
+        [
+            "continue",
+            "--from",
+            "3",
+            "--to",
+            "2.9",
+            "--overlay",
+            file,
+            "--out",
+            o,
+        ]
+        .map(String::from)
+    };
+    let run = |file: &str, needles: &[&str]| {
+        let args = continuation(file);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        refused(&args, needles);
+    };
+    run(
+        "/dev/zero",
+        &["--overlay", "/dev/zero", LINE_CAP, "an overlay CSV"],
+    );
+    let b = big.to_str().unwrap();
+    run(b, &["--overlay", b, CSV_CAP, "an overlay CSV"]);
+}
+
+#[test]
+fn a_sample_map_and_its_height_maps_are_refused_past_their_caps() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let image = |sample: &Path| {
+        [
+            "image",
+            "--probe",
+            PROBE,
+            "--sample",
+            sample.to_str().unwrap(),
+            "--setpoint",
+            "0.7",
+        ]
+        .map(String::from)
+    };
+    let run = |sample: &Path, needles: &[&str]| {
+        let args = image(sample);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        refused(&args, needles);
+    };
+    for sample in [PathBuf::from("/dev/zero"), sparse(d, "big.toml")] {
+        let s = sample.to_str().unwrap().to_string();
+        run(&sample, &["--sample", &s, TEXT_CAP, "a sample map"]);
+    }
+    // the height map files beside a sample map: /dev/zero as CSV and as NPY, and sparse files
+    // larger than the caps of both formats
+    zero(d, "zero.csv");
+    zero(d, "zero.npy");
+    sparse(d, "big.csv");
+    sparse(d, "big.npy");
+    let cases = [
+        (
+            "zero.csv",
+            "a line longer than 1048576 bytes: not a CSV height map",
+        ),
+        ("zero.npy", "not an NPY file"),
+        ("big.csv", "larger than 536870912 bytes"),
+        ("big.npy", "larger than 134283276 bytes"),
+    ];
+    for (file, needle) in cases {
+        let sample = d.join(format!("{file}.toml"));
+        std::fs::write(
+            &sample,
+            format!("size = [1e-6, 0]\nheight_map = \"{file}\"\n"),
+        )
+        .unwrap();
+        run(&sample, &["--sample", "height_map", file, needle]);
+    }
+}
+
+#[test]
+fn reconstruct_curves_are_refused_past_their_caps() {
+    let dir = tempfile::tempdir().unwrap();
+    let big = sparse(dir.path(), "big.json");
+    let b = big.to_str().unwrap();
+    let out = dir.path().join("out");
+    let o = out.to_str().unwrap();
+    // /dev/zero is not JSON (its first byte is 0), so --fm reads it as a CSV: its line cap
+    refused(
+        &["reconstruct", "--fm", "/dev/zero", "--out", o],
+        &["--fm", "/dev/zero", LINE_CAP, "a curve CSV"],
+    );
+    refused(
+        &["reconstruct", "--am", "/dev/zero", "--out", o],
+        &["--am", "/dev/zero", "not a JSON document"],
+    );
+    for option in ["--fm", "--am"] {
+        refused(
+            &["reconstruct", option, b, "--out", o],
+            &[option, b, CSV_CAP, "a curve document"],
+        );
+    }
+}
