@@ -165,7 +165,7 @@ def test_ctrl_c_stops_a_reconstruction():
     the cancel flag between chunks of rows and the call waits for it to stop. Gated on the
     computation itself, not on a delay: the progress callback sends SIGINT to its own process
     once the inversion has counted some rows but not all (an uneven grid at the direct sum's
-    limit, 50 000 points: some seconds of work), and once the call has raised no worker thread
+    limit, 20 000 points: some seconds of work), and once the call has raised no worker thread
     is left computing."""
     code, out, err = _run_script(
         """
@@ -173,7 +173,7 @@ def test_ctrl_c_stops_a_reconstruction():
         import numpy as np
         import afmdyn
 
-        d = np.geomspace(3e-10, 6e-8, 50_000)
+        d = np.geomspace(3e-10, 6e-8, 20_000)
         sent = []
 
         def progress(done, total):

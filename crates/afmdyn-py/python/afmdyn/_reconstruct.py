@@ -56,7 +56,7 @@ def reconstruct(
         integrates the shift beyond each distance): take data out to where Δf has decayed.
         On an evenly spaced grid (every distance within 1e-9 of a spacing of d0 + i h) the
         inversion takes O(N log N) by FFT, up to 2 000 000 points; on another grid O(N²), up
-        to 50 000 points. Ctrl-C stops it.
+        to 20 000 points. Ctrl-C stops it.
 
     Warns:
         AfmdynWarning: a constant outside its typical range (A 10 pm–1 µm, f0 1 kHz–10 MHz,

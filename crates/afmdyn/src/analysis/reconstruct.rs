@@ -30,7 +30,7 @@
 //! reconstructed well). The potential is U(d) = ∫_d^{d_max} F(t) dt (trapezoidal, U(d_max) = 0).
 //!
 //! **Cost.** The sum is over every pair of points, O(N²) ([`sader_jarvis_direct`], the
-//! reference: 26 s for 10⁵ points before it was restructured). With the integrand written
+//! reference: 26 to 70 s for 10⁵ points as it was written before the FFT). With the integrand written
 //! Ω(t) + g(t)/√(t − d), g = (A^{1/2}/(8√π)) Ω − (A^{3/2}/√2) Ω′, the Ω part of the trapezoid
 //! beyond the first interval is a suffix sum (O(N)), and the g part Σ_i w_i g_i / √(d_i − d_j)
 //! depends on d_i − d_j only: on a uniform grid it is a correlation with the kernel 1/√(m h),
@@ -43,7 +43,7 @@
 //! The size is bounded before the run ([`ShiftCurve::method`]): at most [`MAX_UNIFORM_POINTS`]
 //! points on a uniform grid (the FFT's buffers: three of 16 bytes × the next power of two ≥
 //! 2N, 200 MB at the limit), at most [`MAX_DIRECT_POINTS`] on another grid (the direct sum's
-//! N²/2 pairs, 1.25·10⁹ at the limit: about 4 s on one core). Both check their
+//! N²/2 pairs, 2·10⁸ at the limit: some 3 s on one core). Both check their
 //! [`Progress`]'s cancel flag between chunks of rows.
 //!
 //! Units: any consistent set (SI: d and A in m, Δf and f0 in Hz, k in N/m → F in N, U in J).
@@ -159,9 +159,10 @@ pub const UNIFORM_TOLERANCE: f64 = 1e-9;
 /// front ends some 100 bytes a point).
 pub const MAX_UNIFORM_POINTS: usize = 2_000_000;
 
-/// The most points of a grid that is not uniform: the direct sum's N²/2 pairs, 1.25·10⁹ at
-/// 50 000 points, take about 4 s on one core.
-pub const MAX_DIRECT_POINTS: usize = 50_000;
+/// The most points of a grid that is not uniform: the direct sum's N²/2 pairs, 2·10⁸ at
+/// 20 000 points, take some 3 s on one core (measured: 0.66 s for 10⁴ points,
+/// scripts/perf-reconstruct.sh).
+pub const MAX_DIRECT_POINTS: usize = 20_000;
 
 /// The terms of the g part with i − j ≤ `NEAR_FIELD` are summed directly with the grid's own
 /// distances, the rest by FFT with the kernel at (i − j) h (module doc).
@@ -217,7 +218,7 @@ impl ShiftCurve {
             None => Err(SimError::out_of_range(
                 "distance",
                 format!("{n} values, not evenly spaced"),
-                "must hold at most 50000 values when not evenly spaced (the direct sum's cost \
+                "must hold at most 20000 values when not evenly spaced (the direct sum's cost \
                  grows as N²): resample the curve onto an even grid (every distance within \
                  1e-9 of a spacing of d0 + i h), which is inverted by FFT up to 2000000 values",
             )),
