@@ -6,7 +6,7 @@
 
 use crate::args::{quantity, Dim, Quantity};
 use crate::error::CliError;
-use crate::output::{write_csv_numbers, write_document, OutDir};
+use crate::output::{si_value, write_csv_numbers, write_document, OutDir};
 use crate::plot::{save, Figure, Series, Style};
 use afmdyn::analysis::reconstruct::Reconstruction;
 use afmdyn::io::{InputFileError, InputKind};
@@ -33,16 +33,17 @@ pub struct ReconstructArgs {
     /// inverted at each point's amplitude (the matrix method)
     #[arg(long, value_name = "FILE")]
     am: Option<PathBuf>,
-    /// Spring constant k (N/m); required with a CSV, replaces the document's
-    #[arg(long, conflicts_with = "am")]
+    /// Spring constant k (N/m; typical 0.01–1e6, refused outside 1e-6–1e9); required with a
+    /// CSV, replaces the document's
+    #[arg(long, conflicts_with = "am", allow_hyphen_values = true)]
     spring_constant: Option<f64>,
-    /// Free resonance frequency f0 (Hz; a unit may follow: 300kHz); required with a CSV,
-    /// replaces the document's
-    #[arg(long, conflicts_with = "am")]
+    /// Free resonance frequency f0 (Hz; a unit may follow: 300kHz; typical 1 kHz–10 MHz,
+    /// refused outside 1 Hz–10 GHz); required with a CSV, replaces the document's
+    #[arg(long, conflicts_with = "am", allow_hyphen_values = true)]
     resonance_frequency: Option<Quantity>,
-    /// Oscillation amplitude A (m; a unit may follow: 10nm); required with a CSV, replaces
-    /// the document's
-    #[arg(long, conflicts_with = "am")]
+    /// Oscillation amplitude A (m; a unit may follow: 10nm; typical 10 pm–1 µm, refused
+    /// outside 1 fm–1 mm); required with a CSV, replaces the document's
+    #[arg(long, conflicts_with = "am", allow_hyphen_values = true)]
     amplitude: Option<Quantity>,
     /// Output directory (locked during the run)
     #[arg(long, default_value = "afmdyn-out/reconstruct")]
@@ -162,6 +163,19 @@ fn request_of(a: &ReconstructArgs, fm: &Path) -> Result<ReconstructRequest, CliE
         true,
     )?;
     let amp = quantity(a.amplitude, "amplitude", Dim::Length, true)?;
+    // a constant ≤ 0 is refused here naming its flag (the library's ranges name the field)
+    for (flag, v) in [
+        ("spring-constant", k),
+        ("resonance-frequency", f0),
+        ("amplitude", amp),
+    ] {
+        if let Some(v) = v.filter(|v| *v <= 0.0) {
+            return Err(CliError::Input(format!(
+                "--{flag} = {}: must be > 0",
+                afmdyn::error::number(v)
+            )));
+        }
+    }
     let (reader, first) = open_document("--fm", fm)?;
     if first == Some(b'{') {
         let doc = read_document("--fm", fm, reader)?;
@@ -202,8 +216,24 @@ fn request_of(a: &ReconstructArgs, fm: &Path) -> Result<ReconstructRequest, CliE
 fn am_reconstruction(path: &Path) -> Result<(Reconstruction, serde_json::Value), CliError> {
     let (reader, _) = open_document("--am", path)?;
     let doc = read_document("--am", path, reader)?;
-    let d = request::reconstruct::am_reconstruction(&doc)?;
+    let d = request::reconstruct::am_reconstruction(
+        &doc,
+        &afmdyn::analysis::progress::Progress::new(),
+    )?;
     Ok((d.output, d.json))
+}
+
+/// A library error with the cantilever's constants spelled as their flags
+/// (`--amplitude = 10: must be …`).
+fn flagged(e: afmdyn::SimError) -> CliError {
+    match &e {
+        afmdyn::SimError::OutOfRange { name, .. }
+            if ["amplitude", "resonance_frequency", "spring_constant"].contains(name) =>
+        {
+            CliError::Input(format!("--{}", crate::error::spell(&e)))
+        }
+        _ => e.into(),
+    }
 }
 
 /// Run `afmdyn reconstruct`.
@@ -216,7 +246,7 @@ pub fn reconstruct(a: &ReconstructArgs) -> Result<(), CliError> {
         (None, Some(fm)) => {
             let request = request_of(a, fm)?;
             let model = Resolved::plain(afmdyn::Params::default());
-            request::Analysis::validate(&request, &model)?;
+            request::Analysis::validate(&request, &model).map_err(flagged)?;
             let doc = request::run(
                 &request,
                 &model,
@@ -292,12 +322,12 @@ fn finish(
             .min_by(|x, y| x.1.total_cmp(y.1))
             .map_or((0, f64::NAN), |(k, f)| (k, *f));
         outln!(
-            "{} distances from {:e} m to {:e} m: most attractive force {f:e} N at d = {:e} m; \
-             outputs in {}",
+            "{} distances from {} to {}: most attractive force {} at d = {}; outputs in {}",
             r.distance.len(),
-            r.distance[0],
-            r.distance[r.distance.len() - 1],
-            r.distance.get(k).copied().unwrap_or(f64::NAN),
+            si_value(r.distance[0], "m"),
+            si_value(r.distance[r.distance.len() - 1], "m"),
+            si_value(f, "N"),
+            si_value(r.distance.get(k).copied().unwrap_or(f64::NAN), "m"),
             out.path().display()
         );
     }

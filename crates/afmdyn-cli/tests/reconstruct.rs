@@ -130,3 +130,169 @@ fn bad_curves_exit_2_with_one_line() {
         assert!(err.contains(needle), "{needle}: {err}");
     }
 }
+
+/// The example's flags with `extra` replacing or adding some, on `csv`: (exit code, stdout,
+/// stderr).
+fn run_example(csv: &str, extra: &[&str]) -> (Option<i32>, String, String) {
+    let dir = tempfile::tempdir().unwrap();
+    let mut args = vec![
+        "reconstruct",
+        "--fm",
+        csv,
+        "--out",
+        dir.path().to_str().unwrap(),
+    ];
+    for (flag, default) in [
+        ("--spring-constant", "40"),
+        ("--resonance-frequency", "300kHz"),
+        ("--amplitude", "10nm"),
+    ] {
+        if !extra.contains(&flag) {
+            args.extend([flag, default]);
+        }
+    }
+    args.extend_from_slice(extra);
+    let o = afmdyn(&args);
+    (
+        o.status.code(),
+        String::from_utf8_lossy(&o.stdout).into_owned(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+/// Constants outside their physical range are refused naming the flag and the range (1e300 m
+/// was "distance must increase"; -10nm was clap's "unexpected argument '-1'"; 10 m ran).
+#[test]
+fn constants_out_of_their_physical_range_are_refused_naming_the_flag() {
+    for (extra, needle) in [
+        (
+            &["--amplitude", "1e300"][..],
+            "--amplitude = 1e300: must be an amplitude between 1e-15 and 1e-3 m",
+        ),
+        (
+            &["--amplitude", "-10nm"][..],
+            "--amplitude = -1e-8: must be > 0",
+        ),
+        (
+            &["--amplitude", "10"][..],
+            "--amplitude = 10: must be an amplitude between",
+        ),
+        (
+            &["--resonance-frequency", "-300kHz"][..],
+            "--resonance-frequency = -300000: must be > 0",
+        ),
+        (
+            &["--resonance-frequency", "1e12"][..],
+            "--resonance-frequency = 1000000000000: must be a resonance frequency between",
+        ),
+        (
+            &["--spring-constant", "1e12"][..],
+            "--spring-constant = 1000000000000: must be a spring constant between",
+        ),
+    ] {
+        let (code, _, err) = run_example(FM, extra);
+        assert_eq!(code, Some(2), "{extra:?}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+        assert!(err.contains(needle), "{needle}: {err}");
+    }
+}
+
+/// A constant outside its typical range runs with a warning naming the likely unit slip, on
+/// stderr and in the document: 300 (Hz, meant kHz) gives forces 1000 times too large.
+#[test]
+fn a_likely_unit_slip_is_warned_of() {
+    for (extra, needle) in [
+        (
+            &["--resonance-frequency", "300"][..],
+            "resonance_frequency = 300 Hz is outside the typical 1 kHz to 10 MHz: was it meant \
+             in kHz? (300 kHz is 300000 Hz",
+        ),
+        (
+            &["--amplitude", "5e-4"][..],
+            "amplitude = 0.0005 m is outside the typical 10 pm to 1 µm: was it meant in µm? \
+             (0.0005 µm is 5e-10 m",
+        ),
+        (
+            &["--spring-constant", "4e7", "--json"][..],
+            "spring_constant = 40000000 N/m is outside the typical 0.01 to 1e6 N/m: was it meant \
+             in mN/m? (40000000 mN/m is 40000 N/m",
+        ),
+    ] {
+        let (code, out, err) = run_example(FM, extra);
+        assert_eq!(code, Some(0), "{extra:?}: {err}");
+        assert!(err.contains(&format!("afmdyn: warning: {needle}")), "{err}");
+        if extra.contains(&"--json") {
+            let doc: serde_json::Value = serde_json::from_str(&out).unwrap();
+            assert!(
+                doc["warnings"][0].as_str().unwrap().contains(needle),
+                "{doc}"
+            );
+        }
+    }
+}
+
+/// The summary's numbers have at most 6 significant digits; the example (out to 60 nm, where
+/// |Δf| is 5e-5 of its extreme) has no truncation warning, the same curve cut at 2 nm has one.
+#[test]
+fn the_summary_is_short_and_the_truncation_warning_depends_on_the_decay() {
+    let (code, out, err) = run_example(FM, &[]);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(err.is_empty(), "{err}");
+    for word in out.split_whitespace() {
+        let digits: String = word
+            .trim_end_matches([';', ':', ','])
+            .split(['e', 'E'])
+            .next()
+            .unwrap()
+            .chars()
+            .filter(char::is_ascii_digit)
+            .collect();
+        let significant = digits.trim_start_matches('0').len();
+        if word.contains('.') {
+            assert!(significant <= 6, "{word} in {out}");
+        }
+    }
+    assert!(
+        out.starts_with("400 distances from 300.000 pm to 60.0000 nm"),
+        "{out}"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let cut = dir.path().join("cut.csv");
+    let text = std::fs::read_to_string(FM).unwrap();
+    let kept: Vec<&str> = text
+        .lines()
+        .take_while(|l| {
+            l.starts_with('d') || l.split(',').next().unwrap().parse::<f64>().unwrap() <= 2e-9
+        })
+        .collect();
+    std::fs::write(&cut, kept.join("\n")).unwrap();
+    let (code, _, err) = run_example(cut.to_str().unwrap(), &[]);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(
+        err.contains("afmdyn: warning: the frequency shift at the largest distance")
+            && err.contains("take data out to where the shift has decayed below 1 %"),
+        "{err}"
+    );
+}
+
+/// More points than the direct sum's limit on an uneven grid are refused before the run,
+/// naming distance, the size and the limit.
+#[test]
+fn an_uneven_grid_beyond_the_limit_is_refused_before_the_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("big.csv");
+    let n = 20_001;
+    let mut text = String::from("distance,frequency_shift\n");
+    for i in 0..n {
+        let d = 3e-10 * 200f64.powf(i as f64 / (n - 1) as f64);
+        text += &format!("{d:e},{}\n", -1e-27 / (d * d));
+    }
+    std::fs::write(&csv, text).unwrap();
+    let (code, _, err) = run_example(csv.to_str().unwrap(), &[]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(
+        err.contains("distance = 20001 values, not evenly spaced: must hold at most 20000")
+            && err.contains("resample"),
+        "{err}"
+    );
+}

@@ -471,7 +471,8 @@ pub fn reconstruct<'py>(
     reconstruction(py, request, progress)
 }
 
-/// The JSON document of a reconstruction request, run as every analysis is ([`analysis`]).
+/// The JSON document of a reconstruction request, run as every analysis is ([`analysis`]):
+/// cancellable (the inversion checks the cancel flag between chunks of rows; Ctrl-C stops it).
 fn reconstruction<'py>(
     py: Python<'py>,
     request: afmdyn::request::ReconstructRequest,
@@ -483,7 +484,7 @@ fn reconstruction<'py>(
         Params::default(),
         None,
         progress.as_ref(),
-        false,
+        true,
     )?;
     let out = Out::new(py);
     out.json(&doc.json)?;
@@ -522,11 +523,26 @@ pub fn reconstruct_fm<'py>(
 
 /// The conservative force behind an AM approach document of the point mass (`afmdyn
 /// reconstruct --am approach.json`: [`afmdyn::request::reconstruct::am_reconstruction`]): its
-/// JSON document.
+/// JSON document; without the GIL and cancellable, as [`reconstruction`].
 #[pyfunction]
-pub fn reconstruct_am<'py>(py: Python<'py>, document: &str) -> PyResult<Dict<'py>> {
-    let doc = afmdyn::request::reconstruct::am_reconstruction(&json_document("am", document)?)
-        .map_err(sim_error)?;
+#[pyo3(signature = (document, progress=None))]
+pub fn reconstruct_am<'py>(
+    py: Python<'py>,
+    document: &str,
+    progress: Option<Bound<'py, PyAny>>,
+) -> PyResult<Dict<'py>> {
+    let approach = json_document("am", document)?;
+    let job = Job::default();
+    let worker = job.clone();
+    let doc = run(
+        py,
+        &job,
+        None,
+        progress.as_ref(),
+        Stop::Cancellable,
+        move || afmdyn::request::reconstruct::am_reconstruction(&approach, &worker.progress),
+    )?
+    .map_err(sim_error)?;
     let out = Out::new(py);
     out.json(&doc.json)?;
     Ok(out.finish())

@@ -158,3 +158,61 @@ def test_an_interrupted_simulate_leaves_no_partial_files(cli, tmp_path, sig):
     assert err.strip() == "afmdyn: interrupted; the partial files of this run were removed"
     left = sorted(f.name for f in out.iterdir())
     assert left == [".afmdyn.lock"], left
+
+
+def test_ctrl_c_stops_a_reconstruction():
+    """``afmdyn.reconstruct`` ran on for 24 s after Ctrl-C (issue 60): the inversion now checks
+    the cancel flag between chunks of rows and the call waits for it to stop. Gated on the
+    computation itself, not on a delay: the progress callback sends SIGINT to its own process
+    once the inversion has counted some rows but not all (an uneven grid at the direct sum's
+    limit, 20 000 points: some seconds of work), and once the call has raised no worker thread
+    is left computing."""
+    code, out, err = _run_script(
+        """
+        import os, signal
+        import numpy as np
+        import afmdyn
+
+        d = np.geomspace(3e-10, 6e-8, 20_000)
+        sent = []
+
+        def progress(done, total):
+            if not sent and total and 0 < done < total:
+                sent.append(done)
+                os.kill(os.getpid(), signal.SIGINT)
+
+        def workers():
+            return sum(open(f"/proc/self/task/{t}/comm").read().strip() == "afmdyn-worker"
+                       for t in os.listdir("/proc/self/task"))
+
+        try:
+            afmdyn.reconstruct(distance=d, frequency_shift=-(3e-10 / d) ** 1.5,
+                               spring_constant=40.0, resonance_frequency=3e5, amplitude=1e-8,
+                               progress=progress)
+            print("finished", flush=True)
+        except KeyboardInterrupt:
+            print("interrupted", flush=True)
+        # the worker ended with the call (it sends its result, then returns); allow it to exit
+        for _ in range(100):
+            if workers() == 0:
+                break
+            import time; time.sleep(0.01)
+        print("workers", workers(), flush=True)
+        ds = afmdyn.reconstruct(distance=d[:100], frequency_shift=-(3e-10 / d[:100]) ** 1.5,
+                                spring_constant=40.0, resonance_frequency=3e5, amplitude=1e-8)
+        print("after", ds.sizes["distance"], flush=True)
+        """
+    )
+    assert code == 0, err
+    assert out == ["interrupted", "workers", "0", "after", "100"], (out, err)
+    assert "panicked" not in err, err
+
+
+def _run_script(script: str, timeout: float = 120):
+    p = subprocess.run(
+        [sys.executable, "-c", textwrap.dedent(script)],
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+    )
+    return p.returncode, p.stdout.split(), p.stderr

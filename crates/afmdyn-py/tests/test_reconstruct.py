@@ -54,4 +54,39 @@ def test_bad_curves_name_the_field():
         afmdyn.reconstruct(**c, z_c=c["distance"], **CONSTANTS)
     with pytest.raises(TypeError):
         afmdyn.reconstruct(**c, **CONSTANTS, spring=1.0)  # type: ignore[call-arg]
-    assert json.loads(afmdyn.reconstruct(**c, **CONSTANTS).attrs["summary"])["warnings"]
+    # the example reaches 60 nm, where |Δf| is 5e-5 of its extreme: no truncation warning
+    assert json.loads(afmdyn.reconstruct(**c, **CONSTANTS).attrs["summary"])["warnings"] == []
+    # constants outside their physical range (10 m: nm given as m; 1e300), named
+    for bad in (10.0, 1e300, -1e-8):
+        with pytest.raises(ValueError, match="amplitude = .*: must be"):
+            afmdyn.reconstruct(**c, **{**CONSTANTS, "amplitude": bad})
+
+
+def test_a_likely_unit_slip_and_a_truncated_curve_warn():
+    """f0 = 300 (Hz, meant kHz) runs with an AfmdynWarning naming the slip, in the summary
+    too; a curve that ends at 2 nm, where |Δf| is still a tenth of its extreme, warns of the
+    truncation."""
+    c = _curve()
+    with pytest.warns(afmdyn.AfmdynWarning, match=r"resonance_frequency = 300 Hz .* kHz"):
+        ds = afmdyn.reconstruct(**c, **{**CONSTANTS, "resonance_frequency": 300.0})
+    assert "kHz" in json.loads(ds.attrs["summary"])["warnings"][0]
+    near = c["distance"] <= 2e-9
+    with pytest.warns(afmdyn.AfmdynWarning, match="frequency shift at the largest distance"):
+        afmdyn.reconstruct(distance=c["distance"][near],
+                           frequency_shift=c["frequency_shift"][near], **CONSTANTS)
+
+
+def test_a_uniform_grid_is_inverted_as_the_uneven_one_would_be():
+    """The example interpolated onto an even grid of 10^5 points (inverted by FFT) gives
+    −HR/(6d²) back within 2 % from 0.4 to 5 nm (A >= 2d); an uneven grid of more than 20 000
+    points is refused, naming distance and the limit."""
+    c = _curve()
+    d = np.linspace(c["distance"][0], c["distance"][-1], 100_000)
+    df = np.interp(np.log(d), np.log(c["distance"]), c["frequency_shift"])
+    ds = afmdyn.reconstruct(distance=d, frequency_shift=df, **CONSTANTS)
+    near = (d <= 5e-9) & (d >= 4e-10)
+    want = -1e-19 * 1e-8 / (6.0 * d[near] ** 2)
+    np.testing.assert_allclose(ds.force.values[near], want, rtol=0.02)
+    uneven = np.geomspace(3e-10, 6e-8, 20_001)
+    with pytest.raises(ValueError, match="distance = 20001 values.*at most 20000"):
+        afmdyn.reconstruct(distance=uneven, frequency_shift=-1.0 / uneven, **CONSTANTS)

@@ -576,7 +576,9 @@ def reconstruct(
     request: Optional[ReconstructRequest] = None,
     progress: Optional[ProgressCallback] = None,
 ) -> Dict[str, Any]: ...
-def reconstruct_am(document: str) -> Dict[str, Any]: ...
+def reconstruct_am(
+    document: str, progress: Optional[ProgressCallback] = None
+) -> Dict[str, Any]: ...
 def reconstruct_fm(
     document: str,
     spring_constant: Optional[float] = None,

@@ -10,6 +10,7 @@ import numpy as np
 import xarray as xr
 
 from . import _afmdyn as _core
+from ._common import _warn
 from ._progress import ProgressArg, reporter
 
 
@@ -53,11 +54,21 @@ def reconstruct(
         ``resonance_frequency``, ``amplitude`` and ``summary`` (the command line's JSON
         document). The force near the largest distance is not reconstructed (the inversion
         integrates the shift beyond each distance): take data out to where Δf has decayed.
+        On an evenly spaced grid (every distance within 1e-9 of a spacing of d0 + i h) the
+        inversion takes O(N log N) by FFT, up to 2 000 000 points; on another grid O(N²), up
+        to 20 000 points. Ctrl-C stops it.
+
+    Warns:
+        AfmdynWarning: a constant outside its typical range (A 10 pm–1 µm, f0 1 kHz–10 MHz,
+            k 0.01–1e6 N/m: a likely unit slip, named); data that end while |Δf| is still
+            above 1 % of its extreme.
 
     Raises:
         ValueError: naming the field — fewer than 3 points, distances not monotonic, lengths
-            that differ, constants not > 0 or missing, neither or both of ``distance`` and
-            ``z_c``; ``fm`` not an SI ``fm`` document.
+            that differ, constants missing or outside their physical range (A 1e-15–1e-3 m,
+            f0 1–1e10 Hz, k 1e-6–1e9 N/m), neither or both of ``distance`` and ``z_c``, more
+            points than the limits above; ``fm`` not an SI ``fm`` document.
+        KeyboardInterrupt: on Ctrl-C.
     """
     if am is not None:
         given = [n for n, v in (("fm", fm), ("frequency_shift", frequency_shift),
@@ -66,7 +77,9 @@ def reconstruct(
         if given:
             raise ValueError(f"am: the approach curve carries its constants; {given[0]} not taken")
         document = am.attrs["summary"] if isinstance(am, xr.Dataset) else json.dumps(am)
-        return _dataset(json.loads(_core.reconstruct_am(document)["json"]))
+        with reporter(progress, "reconstruct") as cb:
+            d = _core.reconstruct_am(document, progress=cb)
+        return _dataset(json.loads(d["json"]))
     if fm is not None:
         if frequency_shift is not None or distance is not None or z_c is not None:
             raise ValueError("fm: give the fm curve or frequency_shift with distance/z_c, not both")
@@ -98,7 +111,9 @@ def reconstruct(
 
 
 def _dataset(doc: Dict[str, Any]) -> xr.Dataset:
-    """The dataset of a reconstruction document."""
+    """The dataset of a reconstruction document, its warnings issued as
+    :class:`afmdyn.AfmdynWarning`."""
+    _warn(doc)
     f = doc["force"]
     units = doc["units"]
     law = {}

@@ -29,8 +29,26 @@
 //! the data must reach where Δf has decayed (the force at the far end of the grid is not
 //! reconstructed well). The potential is U(d) = ∫_d^{d_max} F(t) dt (trapezoidal, U(d_max) = 0).
 //!
+//! **Cost.** The sum is over every pair of points, O(N²) ([`sader_jarvis_direct`], the
+//! reference: 26 to 70 s for 10⁵ points as it was written before the FFT). With the integrand written
+//! Ω(t) + g(t)/√(t − d), g = (A^{1/2}/(8√π)) Ω − (A^{3/2}/√2) Ω′, the Ω part of the trapezoid
+//! beyond the first interval is a suffix sum (O(N)), and the g part Σ_i w_i g_i / √(d_i − d_j)
+//! depends on d_i − d_j only: on a uniform grid it is a correlation with the kernel 1/√(m h),
+//! taken by FFT ([`sader_jarvis`] on a grid that [`uniform_spacing`] accepts: O(N log N)). The
+//! FFT takes the kernel at m h for m > [`NEAR_FIELD`] only; the nearer terms, where a grid's
+//! round-off moves the kernel most, are summed directly with the grid's own distances, and the
+//! trapezoid weights and the first interval use the grid's own spacings: the result is the
+//! direct sum's, to round-off (on an exactly even grid) or to the grid's unevenness (≤
+//! [`UNIFORM_TOLERANCE`] of a spacing, divided by [`NEAR_FIELD`]) — tests/reconstruct.rs.
+//! The size is bounded before the run ([`ShiftCurve::method`]): at most [`MAX_UNIFORM_POINTS`]
+//! points on a uniform grid (the FFT's buffers: three of 16 bytes × the next power of two ≥
+//! 2N, 200 MB at the limit), at most [`MAX_DIRECT_POINTS`] on another grid (the direct sum's
+//! N²/2 pairs, 2·10⁸ at the limit: some 3 s on one core). Both check their
+//! [`Progress`]'s cancel flag between chunks of rows.
+//!
 //! Units: any consistent set (SI: d and A in m, Δf and f0 in Hz, k in N/m → F in N, U in J).
 
+use crate::analysis::progress::Progress;
 use crate::error::SimError;
 use gauss_quad::chebyshev::GaussChebyshevFirstKind;
 use std::num::NonZeroUsize;
@@ -129,15 +147,89 @@ impl ShiftCurve {
     }
 }
 
-/// The force and potential of `curve` by the Sader–Jarvis inversion (module doc).
-///
-/// # Errors
-/// As [`ShiftCurve::validate`].
-pub fn sader_jarvis(curve: &ShiftCurve) -> Result<Reconstruction, SimError> {
-    curve.validate()?;
+/// A grid is uniform when every distance lies within this fraction of a spacing of its place
+/// on the even grid d_0 + i h, h = (d_max − d_0)/(N − 1): a grid written as d_0 + i h in
+/// floating point (numpy's `linspace`, `arange`) is off by about 10⁻¹⁶ N d_max/(d_max − d_0)
+/// spacings, 2·10⁻¹⁰ at the [`MAX_UNIFORM_POINTS`] limit; a grid printed to fewer digits than
+/// its spacing needs is not.
+pub const UNIFORM_TOLERANCE: f64 = 1e-9;
+
+/// The most points of a uniform grid ([`UNIFORM_TOLERANCE`]): the FFT's three buffers of 16
+/// bytes × the next power of two ≥ 2N take 200 MB at 2·10⁶ points (and the documents of the
+/// front ends some 100 bytes a point).
+pub const MAX_UNIFORM_POINTS: usize = 2_000_000;
+
+/// The most points of a grid that is not uniform: the direct sum's N²/2 pairs, 2·10⁸ at
+/// 20 000 points, take some 3 s on one core (measured: 0.66 s for 10⁴ points,
+/// scripts/perf-reconstruct.sh).
+pub const MAX_DIRECT_POINTS: usize = 20_000;
+
+/// The terms of the g part with i − j ≤ `NEAR_FIELD` are summed directly with the grid's own
+/// distances, the rest by FFT with the kernel at (i − j) h (module doc).
+pub const NEAR_FIELD: usize = 32;
+
+/// Rows of the direct sum between two checks of the cancel flag.
+const CHUNK: usize = 256;
+
+/// How [`sader_jarvis`] sums a curve.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Method {
+    /// The g part by FFT on a uniform grid of spacing `h` (module doc).
+    Fft {
+        /// The spacing (d_max − d_0)/(N − 1).
+        h: f64,
+    },
+    /// The direct O(N²) sum ([`sader_jarvis_direct`]).
+    Direct,
+}
+
+/// The spacing of `d` (increasing, ≥ 2 values) when it is uniform to [`UNIFORM_TOLERANCE`].
+pub fn uniform_spacing(d: &[f64]) -> Option<f64> {
+    let n = d.len();
+    if n < 2 {
+        return None;
+    }
+    let h = (d[n - 1] - d[0]) / (n - 1) as f64;
+    let uniform = d
+        .iter()
+        .enumerate()
+        .all(|(i, &x)| (x - (d[0] + i as f64 * h)).abs() <= UNIFORM_TOLERANCE * h);
+    (h > 0.0 && uniform).then_some(h)
+}
+
+impl ShiftCurve {
+    /// How [`sader_jarvis`] will sum the curve (checked before it runs: the size limits).
+    ///
+    /// # Errors
+    /// As [`ShiftCurve::validate`]; [`SimError::OutOfRange`] naming `distance` for more than
+    /// [`MAX_UNIFORM_POINTS`] points on a uniform grid or [`MAX_DIRECT_POINTS`] on another.
+    pub fn method(&self) -> Result<Method, SimError> {
+        self.validate()?;
+        let n = self.distance.len();
+        match uniform_spacing(&self.distance) {
+            Some(h) if n <= MAX_UNIFORM_POINTS => Ok(Method::Fft { h }),
+            Some(_) => Err(SimError::out_of_range(
+                "distance",
+                format!("{n} values (an evenly spaced grid)"),
+                "must hold at most 2000000 values (the FFT's memory): take every other point \
+                 or a shorter range",
+            )),
+            None if n <= MAX_DIRECT_POINTS => Ok(Method::Direct),
+            None => Err(SimError::out_of_range(
+                "distance",
+                format!("{n} values, not evenly spaced"),
+                "must hold at most 20000 values when not evenly spaced (the direct sum's cost \
+                 grows as N²): resample the curve onto an even grid (every distance within \
+                 1e-9 of a spacing of d0 + i h), which is inverted by FFT up to 2000000 values",
+            )),
+        }
+    }
+}
+
+/// Ω = Δf/f0 and Ω′ by central differences (one-sided at the ends) on the curve's grid.
+fn omega_and_slope(curve: &ShiftCurve) -> (Vec<f64>, Vec<f64>) {
     let d = &curve.distance;
     let n = d.len();
-    let (k, a) = (curve.spring_constant, curve.amplitude);
     let omega: Vec<f64> = curve
         .frequency_shift
         .iter()
@@ -150,27 +242,185 @@ pub fn sader_jarvis(curve: &ShiftCurve) -> Result<Reconstruction, SimError> {
             (omega[hi] - omega[lo]) / (d[hi] - d[lo])
         })
         .collect();
+    (omega, slope)
+}
+
+/// The integral over the first interval [d_j, d_j + `step`], exactly with Ω, Ω′ held at d_j
+/// (the 1/√(t − d) singularity; module doc).
+fn first_interval(omega: f64, slope: f64, step: f64, a: f64) -> f64 {
     let (sa, a32) = (a.sqrt(), a.powf(1.5));
     let pi_sqrt = std::f64::consts::PI.sqrt();
+    omega * step + sa / (4.0 * pi_sqrt) * omega * step.sqrt()
+        - std::f64::consts::SQRT_2 * a32 * slope * step.sqrt()
+}
+
+/// The force and potential of `curve` by the Sader–Jarvis inversion (module doc): by FFT on a
+/// uniform grid, else by the direct sum ([`ShiftCurve::method`]).
+///
+/// # Errors
+/// As [`ShiftCurve::method`].
+pub fn sader_jarvis(curve: &ShiftCurve) -> Result<Reconstruction, SimError> {
+    sader_jarvis_with(curve, &Progress::new())
+}
+
+/// [`sader_jarvis`] counting the curve's points in `progress` and checking its cancel flag
+/// between chunks of rows.
+///
+/// # Errors
+/// As [`ShiftCurve::method`]; [`SimError::Cancelled`] once `progress` is cancelled.
+pub fn sader_jarvis_with(
+    curve: &ShiftCurve,
+    progress: &Progress,
+) -> Result<Reconstruction, SimError> {
+    match curve.method()? {
+        Method::Fft { h } => sader_jarvis_fft(curve, h, progress),
+        Method::Direct => sader_jarvis_direct(curve, progress),
+    }
+}
+
+/// The Sader–Jarvis inversion by the direct O(N²) sum, term by term as the module doc writes
+/// it: the reference of the FFT, and the method on a grid that is not uniform. No size limit
+/// (the caller's: [`ShiftCurve::method`]).
+///
+/// # Errors
+/// As [`ShiftCurve::validate`]; [`SimError::Cancelled`] once `progress` is cancelled.
+pub fn sader_jarvis_direct(
+    curve: &ShiftCurve,
+    progress: &Progress,
+) -> Result<Reconstruction, SimError> {
+    curve.validate()?;
+    let d = &curve.distance;
+    let n = d.len();
+    progress.add_total(n);
+    let (k, a) = (curve.spring_constant, curve.amplitude);
+    let (omega, slope) = omega_and_slope(curve);
+    let (sa, a32) = (a.sqrt(), a.powf(1.5));
     let mut force = vec![0.0; n];
     for j in 0..n - 1 {
+        if j % CHUNK == 0 {
+            progress.check()?;
+            progress.advance(CHUNK.min(n - 1 - j));
+        }
         let z = d[j];
-        let step = d[j + 1] - z;
-        // the first interval, exactly with Ω, Ω′ at d_j (the 1/√(t − d) singularity)
-        let first = omega[j] * step + sa / (4.0 * pi_sqrt) * omega[j] * step.sqrt()
-            - std::f64::consts::SQRT_2 * a32 * slope[j] * step.sqrt();
+        let first = first_interval(omega[j], slope[j], d[j + 1] - z, a);
         let integrand = |i: usize| {
             let s = d[i] - z;
             (1.0 + sa / (8.0 * (std::f64::consts::PI * s).sqrt())) * omega[i]
                 - a32 / (2.0 * s).sqrt() * slope[i]
         };
-        let rest: f64 = (j + 1..n - 1)
-            .map(|i| 0.5 * (integrand(i) + integrand(i + 1)) * (d[i + 1] - d[i]))
-            .sum();
+        // the trapezoid beyond the first interval, each integrand value computed once
+        let mut rest = 0.0;
+        if j + 2 < n {
+            let mut previous = integrand(j + 1);
+            for i in j + 1..n - 1 {
+                let next = integrand(i + 1);
+                rest += 0.5 * (previous + next) * (d[i + 1] - d[i]);
+                previous = next;
+            }
+        }
         force[j] = 2.0 * k * (first + rest);
     }
     // the last point has no interval beyond it: its force is the end of the data
     force[n - 1] = 0.0;
+    progress.advance(1);
+    Ok(Reconstruction {
+        distance: d.clone(),
+        potential: potential_of(d, &force),
+        force,
+    })
+}
+
+/// The Sader–Jarvis inversion on a uniform grid of spacing `h` (module doc: the Ω part by a
+/// suffix sum, the g part near the diagonal directly and beyond it by FFT).
+///
+/// # Errors
+/// [`SimError::Cancelled`] once `progress` is cancelled.
+fn sader_jarvis_fft(
+    curve: &ShiftCurve,
+    h: f64,
+    progress: &Progress,
+) -> Result<Reconstruction, SimError> {
+    use rustfft::{num_complex::Complex, FftPlanner};
+    let d = &curve.distance;
+    let n = d.len();
+    progress.add_total(n);
+    progress.check()?;
+    let (k, a) = (curve.spring_constant, curve.amplitude);
+    let (omega, slope) = omega_and_slope(curve);
+    let (sa, a32) = (a.sqrt(), a.powf(1.5));
+    // the integrand beyond the first interval is Ω_i + g_i / √(d_i − d_j)
+    let g: Vec<f64> = (0..n)
+        .map(|i| {
+            sa / (8.0 * std::f64::consts::PI.sqrt()) * omega[i]
+                - a32 / std::f64::consts::SQRT_2 * slope[i]
+        })
+        .collect();
+    let step = |i: usize| if i + 1 < n { d[i + 1] - d[i] } else { 0.0 };
+    // trapezoid weights of point i when it is not the first beyond the first interval
+    let w: Vec<f64> = (0..n)
+        .map(|i| 0.5 * (if i > 0 { step(i - 1) } else { 0.0 } + step(i)))
+        .collect();
+    // the Ω part: suffix sums of the trapezoid segments, tail[i] = Σ_{i' ≥ i} segments
+    let mut tail = vec![0.0; n];
+    for i in (0..n - 1).rev() {
+        tail[i] = tail[i + 1] + 0.5 * (omega[i] + omega[i + 1]) * step(i);
+    }
+    // the g part beyond the near field: far[j] = Σ_{m > NEAR_FIELD} w g_{j+m} / √(m h), the
+    // correlation of u = w g with the kernel, as the convolution of the kernel with u reversed
+    let far: Vec<f64> = if n > NEAR_FIELD + 1 {
+        let len = (2 * n - 1).next_power_of_two();
+        let mut kernel = vec![Complex::new(0.0, 0.0); len];
+        for (m, v) in kernel.iter_mut().enumerate().take(n).skip(NEAR_FIELD + 1) {
+            v.re = 1.0 / (m as f64 * h).sqrt();
+        }
+        let mut data = vec![Complex::new(0.0, 0.0); len];
+        for (p, v) in data.iter_mut().enumerate().take(n) {
+            let i = n - 1 - p;
+            v.re = w[i] * g[i];
+        }
+        let mut planner = FftPlanner::new();
+        let forward = planner.plan_fft_forward(len);
+        let mut scratch = vec![Complex::new(0.0, 0.0); forward.get_inplace_scratch_len()];
+        forward.process_with_scratch(&mut kernel, &mut scratch);
+        progress.check()?;
+        forward.process_with_scratch(&mut data, &mut scratch);
+        progress.check()?;
+        for (x, y) in data.iter_mut().zip(&kernel) {
+            *x *= y;
+        }
+        drop(kernel);
+        let inverse = planner.plan_fft_inverse(len);
+        scratch.resize(inverse.get_inplace_scratch_len(), Complex::new(0.0, 0.0));
+        inverse.process_with_scratch(&mut data, &mut scratch);
+        progress.check()?;
+        (0..n).map(|j| data[n - 1 - j].re / len as f64).collect()
+    } else {
+        vec![0.0; n]
+    };
+    let mut force = vec![0.0; n];
+    for j in 0..n - 1 {
+        if j % (16 * CHUNK) == 0 {
+            progress.check()?;
+            progress.advance((16 * CHUNK).min(n - 1 - j));
+        }
+        let first = first_interval(omega[j], slope[j], step(j), a);
+        let mut rest = 0.0;
+        if j + 2 < n {
+            // the first point beyond the first interval has half its following step only
+            let s = d[j + 1] - d[j];
+            rest += 0.5 * step(j + 1) * g[j + 1] / s.sqrt();
+            for i in j + 2..n.min(j + NEAR_FIELD + 1) {
+                rest += w[i] * g[i] / (d[i] - d[j]).sqrt();
+            }
+            if j + NEAR_FIELD + 1 < n {
+                rest += far[j];
+            }
+            rest += tail[j + 1];
+        }
+        force[j] = 2.0 * k * (first + rest);
+    }
+    force[n - 1] = 0.0;
+    progress.advance(1);
     Ok(Reconstruction {
         distance: d.clone(),
         potential: potential_of(d, &force),

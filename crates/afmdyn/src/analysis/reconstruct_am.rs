@@ -37,8 +37,15 @@
 //! approximation's error included) the force comes back within 1 % from 1 to 5 nm (test
 //! `end_to_end`). The inversion is in the library only, not yet a front-end command.
 //!
+//! **Cost.** A row sees only the nodes within its cycle, [d_k, d_k + 2A_k]: the inversion
+//! computes the weights of those (found by bisection), Σ_k (nodes within cycle k) of them —
+//! O(N · 2A/Δd), quadratic only when the cycles span the whole curve. The count is checked
+//! before the run against [`MAX_AM_WEIGHTS`], and the cancel flag between chunks of rows
+//! ([`matrix_inversion_with`]).
+//!
 //! Units: any consistent set (SI: lengths in m, k in N/m → F in N).
 
+use super::progress::Progress;
 use super::reconstruct::{positive_constants, potential_of, Reconstruction};
 use crate::error::SimError;
 use std::f64::consts::PI;
@@ -194,13 +201,33 @@ fn weight(d: &[f64], j: usize, c: f64, a: f64) -> f64 {
     w
 }
 
+/// The most hat weights [`matrix_inversion`] computes: 2·10⁷ ≈ 10⁴ points whose cycles each
+/// span 2000 of them, four times the 5·10⁶ of the synthetic test below (5070 points at 0.02 nm
+/// spacing, cycles of 16 to 20 nm).
+pub const MAX_AM_WEIGHTS: usize = 20_000_000;
+
+/// Rows between two checks of the cancel flag.
+const AM_CHUNK: usize = 64;
+
+/// The nodes of `d` (increasing) whose hats can meet the cycle [c − a, c + a]: those from the
+/// one before the first node above c − a to the one after the last node below c + a.
+fn nodes_within(d: &[f64], c: f64, a: f64) -> std::ops::Range<usize> {
+    let lo = d.partition_point(|x| *x <= c - a).saturating_sub(1);
+    let hi = (d.partition_point(|x| *x < c + a) + 1).min(d.len());
+    lo..hi.max(lo)
+}
+
 /// The forward model: the integrals I_k of the piecewise-linear force with values `force` at
 /// the nodes `d` (increasing; F = 0 beyond the last) for cycles about `centre` of `amplitude`.
 pub fn force_integrals_of(d: &[f64], force: &[f64], centre: &[f64], amplitude: &[f64]) -> Vec<f64> {
     centre
         .iter()
         .zip(amplitude)
-        .map(|(&c, &a)| (0..d.len()).map(|j| weight(d, j, c, a) * force[j]).sum())
+        .map(|(&c, &a)| {
+            nodes_within(d, c, a)
+                .map(|j| weight(d, j, c, a) * force[j])
+                .sum()
+        })
         .collect()
 }
 
@@ -209,9 +236,23 @@ pub fn force_integrals_of(d: &[f64], force: &[f64], centre: &[f64], amplitude: &
 /// the force at the largest distance is 0 (the end of the data).
 ///
 /// # Errors
-/// As [`AmCurve::validate`]; [`SimError::NoConvergence`] for a singular diagonal (a cycle
-/// that does not reach beyond its own turning point: never for A > 0).
+/// As [`matrix_inversion_with`].
 pub fn matrix_inversion(curve: &AmCurve) -> Result<Reconstruction, SimError> {
+    matrix_inversion_with(curve, &Progress::new())
+}
+
+/// [`matrix_inversion`] counting the rows in `progress` and checking its cancel flag between
+/// chunks of them.
+///
+/// # Errors
+/// As [`AmCurve::validate`]; [`SimError::OutOfRange`] naming `z_c` for more than
+/// [`MAX_AM_WEIGHTS`] weights (checked before the run); [`SimError::NoConvergence`] for a
+/// singular diagonal (a cycle that does not reach beyond its own turning point: never for
+/// A > 0); [`SimError::Cancelled`] once `progress` is cancelled.
+pub fn matrix_inversion_with(
+    curve: &AmCurve,
+    progress: &Progress,
+) -> Result<Reconstruction, SimError> {
     curve.validate()?;
     let mut order: Vec<usize> = (0..curve.z_c.len()).collect();
     let d_all = curve.turning_points();
@@ -225,9 +266,28 @@ pub fn matrix_inversion(curve: &AmCurve) -> Result<Reconstruction, SimError> {
         order.iter().map(|&i| integrals[i]).collect(),
     );
     let n = d.len();
+    // the nodes each row sees (beyond its own), and their count checked before the run
+    let seen: Vec<std::ops::Range<usize>> = (0..n)
+        .map(|k| (k + 1).max(nodes_within(&d, c[k], a[k]).start)..nodes_within(&d, c[k], a[k]).end)
+        .collect();
+    let weights: usize = seen.iter().map(|r| r.len() + 1).sum();
+    if weights > MAX_AM_WEIGHTS {
+        return Err(SimError::out_of_range(
+            "z_c",
+            format!("{n} points whose cycles span {weights} hat weights"),
+            "must need at most 20000000 weights (each point's cycle spans 2A of the curve): take \
+             fewer points (every other one) or a smaller amplitude range",
+        ));
+    }
+    progress.add_total(n);
     let mut force = vec![0.0; n];
     for k in (0..n - 1).rev() {
-        let rest: f64 = (k + 1..n)
+        if (n - 1 - k).is_multiple_of(AM_CHUNK) {
+            progress.check()?;
+            progress.advance(AM_CHUNK.min(k + 1));
+        }
+        let rest: f64 = seen[k]
+            .clone()
             .map(|j| weight(&d, j, c[k], a[k]) * force[j])
             .sum();
         let diag = weight(&d, k, c[k], a[k]);
@@ -240,6 +300,7 @@ pub fn matrix_inversion(curve: &AmCurve) -> Result<Reconstruction, SimError> {
         }
         force[k] = (y[k] - rest) / diag;
     }
+    progress.advance(1);
     Ok(Reconstruction {
         potential: potential_of(&d, &force),
         distance: d,

@@ -3,12 +3,32 @@
 //! command line (`afmdyn reconstruct --fm FILE`) and Python (`afmdyn.reconstruct`) share, and
 //! its JSON document. SI throughout: distances and the amplitude in m, frequencies in Hz, the
 //! spring constant in N/m; the force in N, the potential in J.
+//!
+//! **Ranges.** Each constant has a physical range outside which it is refused and a typical
+//! range outside which the document warns of a likely unit slip ([`RANGES`]):
+//!
+//! | constant | refused outside | typical (else a warning) |
+//! |---|---|---|
+//! | `amplitude` A | 1 fm – 1 mm | 10 pm – 1 µm |
+//! | `resonance_frequency` f0 | 1 Hz – 10 GHz | 1 kHz – 10 MHz |
+//! | `spring_constant` k | 10⁻⁶ – 10⁹ N/m | 0.01 – 10⁶ N/m |
+//!
+//! Typical: FM-AFM amplitudes run from the ~20 pm of qPlus sensors at sub-Ångström
+//! resolution to the tens of nm of Si cantilevers in ultra-high vacuum (1 µm leaves room for
+//! large-amplitude work); resonances from the few kHz of soft levers in liquid and the ~30 kHz
+//! of a qPlus sensor to the 1 MHz of a length-extension resonator (10 MHz for the
+//! high-frequency levers); spring constants from the 0.01 N/m of soft contact levers through
+//! 40 N/m (tapping levers) and 1.8 kN/m (qPlus) to the 540 kN/m of a length-extension
+//! resonator. A value a factor 10³ off (nm given as m, kHz as Hz) falls outside. Physical: no
+//! lever oscillates by more than its length (~1 mm) or by less than a femtometre (far below its
+//! thermal motion), resonates below 1 Hz or above 10 GHz, or has a stiffness outside
+//! 10⁻⁶–10⁹ N/m.
 
 use super::run::{Analysis, Resolved};
 use crate::analysis::progress::Progress;
-use crate::analysis::reconstruct::{sader_jarvis, Reconstruction, ShiftCurve};
+use crate::analysis::reconstruct::{sader_jarvis_with, Reconstruction, ShiftCurve};
 use crate::analysis::reconstruct_am::AmCurve;
-use crate::error::SimError;
+use crate::error::{number, SimError};
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 
@@ -37,13 +57,113 @@ pub struct ReconstructRequest {
     pub law_force: Option<Vec<f64>>,
 }
 
+/// The range of one SI constant of a reconstruction (module doc).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Range {
+    /// The request's field.
+    pub name: &'static str,
+    /// Its SI unit.
+    pub unit: &'static str,
+    /// Refused outside [lo, hi].
+    pub physical: (f64, f64),
+    /// A warning outside [lo, hi].
+    pub typical: (f64, f64),
+    /// The typical range in words.
+    pub typical_text: &'static str,
+    /// The error's words.
+    pub refused: &'static str,
+    /// The unit slips to suggest: the prefix and its factor.
+    pub slips: &'static [(&'static str, f64)],
+}
+
+/// The ranges of `amplitude`, `resonance_frequency` and `spring_constant` (module doc).
+pub const RANGES: [Range; 3] = [
+    Range {
+        name: "amplitude",
+        unit: "m",
+        physical: (1e-15, 1e-3),
+        typical: (1e-11, 1e-6),
+        typical_text: "10 pm to 1 µm",
+        refused: "must be an amplitude between 1e-15 and 1e-3 m (in metres: 10 nm is 1e-8)",
+        slips: &[("n", 1e-9), ("p", 1e-12), ("µ", 1e-6)],
+    },
+    Range {
+        name: "resonance_frequency",
+        unit: "Hz",
+        physical: (1.0, 1e10),
+        typical: (1e3, 1e7),
+        typical_text: "1 kHz to 10 MHz",
+        refused: "must be a resonance frequency between 1 Hz and 1e10 Hz (in Hz: 300 kHz is 3e5)",
+        slips: &[("k", 1e3), ("M", 1e6)],
+    },
+    Range {
+        name: "spring_constant",
+        unit: "N/m",
+        physical: (1e-6, 1e9),
+        typical: (1e-2, 1e6),
+        typical_text: "0.01 to 1e6 N/m",
+        refused: "must be a spring constant between 1e-6 and 1e9 N/m",
+        slips: &[("m", 1e-3), ("k", 1e3)],
+    },
+];
+
+impl Range {
+    /// `v` refused outside the physical range.
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming the field.
+    pub fn check(&self, v: f64) -> Result<(), SimError> {
+        if v.is_finite() && v >= self.physical.0 && v <= self.physical.1 {
+            Ok(())
+        } else {
+            Err(SimError::out_of_range(self.name, v, self.refused))
+        }
+    }
+
+    /// The warning for `v` outside the typical range (a likely unit slip), if it is.
+    pub fn warning(&self, v: f64) -> Option<String> {
+        let (lo, hi) = self.typical;
+        if v >= lo && v <= hi {
+            return None;
+        }
+        let mut text = format!(
+            "{} = {} {} is outside the typical {}",
+            self.name,
+            number(v),
+            self.unit,
+            self.typical_text
+        );
+        if let Some((prefix, f)) = self.slips.iter().find(|(_, f)| v * f >= lo && v * f <= hi) {
+            text += &format!(
+                ": was it meant in {prefix}{unit}? ({} {prefix}{unit} is {} {unit}; the forces \
+                 scale with it)",
+                number(v),
+                number(v * f),
+                unit = self.unit
+            );
+        } else {
+            text += ": check its unit (SI)";
+        }
+        Some(text)
+    }
+}
+
+/// The share of its extreme that |Δf| may keep at the largest distance without the truncation
+/// warning: the inversion integrates Δf beyond each distance and stops at the data's end.
+pub const DECAYED: f64 = 0.01;
+
 impl ReconstructRequest {
     /// The curve to invert, in increasing distance.
     ///
     /// # Errors
-    /// [`SimError::OutOfRange`] naming the field: neither or both of `distance` and `z_c`,
-    /// and as [`ShiftCurve::validate`] (distances not monotonic among them).
+    /// [`SimError::OutOfRange`] naming the field: a constant outside its physical range
+    /// ([`RANGES`]), neither or both of `distance` and `z_c`, and as [`ShiftCurve::validate`]
+    /// (distances not monotonic among them).
     pub fn curve(&self) -> Result<ShiftCurve, SimError> {
+        // the constants first: a wrong unit would otherwise show as distances out of order
+        for (range, v) in RANGES.iter().zip(self.constants()) {
+            range.check(v)?;
+        }
         let distance: Vec<f64> =
             match (&self.distance, &self.z_c) {
                 (Some(d), None) => d.clone(),
@@ -81,6 +201,51 @@ impl ReconstructRequest {
             }
         }
         Ok(curve)
+    }
+
+    /// `amplitude`, `resonance_frequency`, `spring_constant` (the order of [`RANGES`]).
+    fn constants(&self) -> [f64; 3] {
+        [
+            self.amplitude,
+            self.resonance_frequency,
+            self.spring_constant,
+        ]
+    }
+
+    /// The document's warnings on the request: a constant outside its typical range (a likely
+    /// unit slip, [`RANGES`]); data that end before the shift has decayed (|Δf| at the largest
+    /// distance above [`DECAYED`] of its extreme).
+    pub fn warnings(&self) -> Vec<String> {
+        let mut warnings: Vec<String> = RANGES
+            .iter()
+            .zip(self.constants())
+            .filter_map(|(r, v)| r.warning(v))
+            .collect();
+        if let Ok(c) = self.curve() {
+            let n = c.distance.len();
+            let far = c.frequency_shift[n - 1];
+            let (at, extreme) = c
+                .frequency_shift
+                .iter()
+                .enumerate()
+                .max_by(|x, y| x.1.abs().total_cmp(&y.1.abs()))
+                .map_or((0, 0.0), |(i, v)| (i, *v));
+            if far.abs() > DECAYED * extreme.abs() {
+                warnings.push(format!(
+                    "the frequency shift at the largest distance (d = {} m) is still {} % of its \
+                     extreme ({} Hz at d = {} m): the force there and within about an amplitude \
+                     of it is not reconstructed (the inversion integrates the shift beyond each \
+                     distance, and the data end there); take data out to where the shift has \
+                     decayed below {} % of its extreme",
+                    number(c.distance[n - 1]),
+                    number(100.0 * far.abs() / extreme.abs()),
+                    number(extreme),
+                    number(c.distance[at]),
+                    number(100.0 * DECAYED),
+                ));
+            }
+        }
+        warnings
     }
 
     /// `law_force` in the order of [`Self::curve`] (increasing distance).
@@ -154,10 +319,10 @@ impl ReconstructRequest {
 impl Analysis for ReconstructRequest {
     type Output = Reconstruction;
     fn validate(&self, _: &Resolved) -> Result<(), SimError> {
-        self.curve().map(|_| ())
+        self.curve()?.method().map(|_| ())
     }
-    fn execute(&self, _: &Resolved, _: &Progress) -> Result<Reconstruction, SimError> {
-        sader_jarvis(&self.curve()?)
+    fn execute(&self, _: &Resolved, progress: &Progress) -> Result<Reconstruction, SimError> {
+        sader_jarvis_with(&self.curve()?, progress)
     }
     fn report(&self, _: &Resolved, r: &Reconstruction) -> Result<Value, SimError> {
         Ok(document(self, r))
@@ -167,7 +332,8 @@ impl Analysis for ReconstructRequest {
 /// The document of a reconstruction (`afmdyn reconstruct --json`): `force` (`distance` (m),
 /// `force` (N), `potential` (J), increasing distance; `law` (N), the model's force there, for a
 /// curve from an `fm` document), the cantilever's constants, `method`,
-/// `units`, `warnings` (the far end of the data, where the inversion has no data beyond).
+/// `units`, `warnings` ([`ReconstructRequest::warnings`]: constants outside their typical
+/// ranges, data that end before the shift has decayed).
 pub fn document(request: &ReconstructRequest, r: &Reconstruction) -> Value {
     let mut force = json!({"distance": r.distance, "force": r.force, "potential": r.potential});
     if let Some(law) = request.law_in_order() {
@@ -181,11 +347,7 @@ pub fn document(request: &ReconstructRequest, r: &Reconstruction) -> Value {
         "method": "Sader-Jarvis inversion (Appl. Phys. Lett. 84, 1801 (2004)); potential by \
                    integrating the force from the last distance",
         "units": {"distance": "m", "force": "N", "potential": "J"},
-        "warnings": [
-            "the force near the largest distance is not reconstructed: the inversion integrates \
-             the frequency shift beyond each distance, and the data end there (take data out to \
-             where the shift has decayed)"
-        ],
+        "warnings": request.warnings(),
     })
 }
 
@@ -308,13 +470,17 @@ pub fn am_document(curve: &AmCurve, r: &Reconstruction) -> Value {
 /// document ([`am_curve_from_approach`], [`crate::analysis::reconstruct_am::matrix_inversion`],
 /// [`am_document`]): `reconstruct --am` of every front end.
 ///
+/// Counts the rows in `progress` and stops at its cancel flag.
+///
 /// # Errors
-/// As [`am_curve_from_approach`] and the inversion.
+/// As [`am_curve_from_approach`] and the inversion
+/// ([`crate::analysis::reconstruct_am::matrix_inversion_with`]).
 pub fn am_reconstruction(
     approach: &Value,
+    progress: &Progress,
 ) -> Result<super::run::Document<Reconstruction>, SimError> {
     let curve = am_curve_from_approach(approach)?;
-    let r = crate::analysis::reconstruct_am::matrix_inversion(&curve)?;
+    let r = crate::analysis::reconstruct_am::matrix_inversion_with(&curve, progress)?;
     Ok(super::run::Document {
         json: am_document(&curve, &r),
         output: r,
