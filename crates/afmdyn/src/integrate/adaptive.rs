@@ -321,10 +321,31 @@ impl<S: TipSampleSystem + Clone> Adaptive<S> {
             }
             self.budget.count(t0)?;
             let ode = self.field(mode, variational);
-            stepper.step(&ode).map_err(|e| SimError::Adaptive {
+            let fail = |e: super::dop853::StepFailure| SimError::Adaptive {
                 tau: t0,
                 message: e.to_string(),
-            })?;
+            };
+            stepper.step(&ode).map_err(fail)?;
+            if variational && clamped && stepper.t() == t0 && t0 + stepper.h() >= t_end - near {
+                // the remainder to t_end, within round-off of τ, was rejected and its retry
+                // would be clamped to the very same step: rejected again, forever (the failure
+                // "1000 rejected steps in a row"). The variational field may jump inside it: at
+                // a guard where the Jacobian changes, as at JKR's neck break (∂F/∂δ of the cut
+                // branch before δ_b, none beyond, where a stage of the polished event's last
+                // step looks). Measured on the issue-60 probe at z_c = 8 nm: a Ψ′ entry 9.09
+                // before, −1.00 beyond, over a remainder of 5.5e-12 (3 ulps at τ ≈ 1.1e4), an
+                // error estimate 1.25 × its scale 1e-12 (the absolute tolerance of a Ψ entry
+                // near 0): an error of the order of |ΔΨ′| times the remainder, the round-off of
+                // the event time itself, which no step can reduce. The state alone judges this
+                // step, as CVODES may leave sensitivities out of the error test
+                // (`CVodeSetSensErrCon`); a step it rejects still fails.
+                self.budget.count(t0)?;
+                stepper.set_h(t_end - t0);
+                stepper.set_controlled(self.dim());
+                let taken = stepper.step(&ode);
+                stepper.set_controlled(usize::MAX);
+                taken.map_err(fail)?;
+            }
             if stepper.t() > t0 {
                 if clamped && stepper.t() >= t_end - near {
                     // landed on t_end; keep the step size the method chose before clamping

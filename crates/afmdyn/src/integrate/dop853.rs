@@ -189,6 +189,9 @@ pub(crate) struct Dop853 {
     dense_ready: bool,
     /// The last attempt was rejected (the next step may not grow).
     rejected: bool,
+    /// The leading components under error control (n, all of them, unless
+    /// [`Dop853::set_controlled`] narrowed it for an attempt).
+    controlled: usize,
 }
 
 impl Dop853 {
@@ -197,7 +200,9 @@ impl Dop853 {
     /// Every component is under error control, the variational equations appended to a state
     /// included: with the Hertz and DMT laws the Jacobian has a √δ singularity at the contact
     /// onset that the state's error does not see (controlling the state alone moved Floquet
-    /// multipliers by 5e-7 against an independent integrator).
+    /// multipliers by 5e-7 against an independent integrator). The one exception is the
+    /// adaptive integrator's remainder step of a few ulps that it could not otherwise take
+    /// ([`Dop853::set_controlled`]).
     pub(crate) fn new(n: usize, rtol: f64, atol: f64, h_max: f64) -> Self {
         Dop853 {
             n,
@@ -218,6 +223,7 @@ impl Dop853 {
             cont: vec![0.0; 8 * n],
             dense_ready: false,
             rejected: false,
+            controlled: n,
         }
     }
 
@@ -232,6 +238,7 @@ impl Dop853 {
         f.eval(t, y, &mut self.work[..n]);
         self.rejected = false;
         self.dense_ready = false;
+        self.controlled = n;
         self.h = if h0 > 0.0 { h0 } else { self.initial_step(f) };
         self.h = self.h.min(self.h_max);
         self.h_prev = self.h;
@@ -301,6 +308,15 @@ impl Dop853 {
         self.h = h.min(self.h_max);
     }
 
+    /// Put only the first `m` (≤ n) components under error control from the next attempt on;
+    /// `m` = n (the default) controls every component. The adaptive integrator narrows it to the
+    /// state for the one step it cannot otherwise take (`integrate/adaptive.rs`, `advance`), as
+    /// CVODES lets sensitivities out of the error test (`CVodeSetSensErrCon`; Hindmarsh et al.,
+    /// *ACM TOMS* 31 (2005) 363, §3.2).
+    pub(crate) fn set_controlled(&mut self, m: usize) {
+        self.controlled = m.min(self.n);
+    }
+
     /// One attempt with the current step size: `Ok(true)` when accepted (t, y advance; the
     /// interpolant covers the step), `Ok(false)` when rejected (h shrinks). 11 evaluations of
     /// `f` (12 with the derivative at an accepted end), nothing allocated.
@@ -333,6 +349,9 @@ impl Dop853 {
             let bk = self.tmp[m];
             let y1 = self.y[m] + h * bk;
             self.y_new[m] = y1;
+            if m >= self.controlled {
+                continue;
+            }
             let sk = self.atol + self.rtol * self.y[m].abs().max(y1.abs());
             let err3 = bk - BH.iter().map(|&(j, c)| c * k[j * n + m]).sum::<f64>();
             e5 += (self.err[m] / sk).powi(2);
@@ -342,7 +361,7 @@ impl Dop853 {
         if deno <= 0.0 {
             deno = 1.0;
         }
-        let err = h.abs() * e5 * (1.0 / (deno * n as f64)).sqrt();
+        let err = h.abs() * e5 * (1.0 / (deno * self.controlled as f64)).sqrt();
         let mut scale = if err.is_finite() {
             (SAFETY * err.powf(-1.0 / 8.0)).clamp(MIN_SCALE, MAX_SCALE)
         } else {
