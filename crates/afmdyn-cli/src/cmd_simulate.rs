@@ -248,7 +248,7 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
     let (t_transient, record_tau, total_periods) =
         (span.transient_tau, span.record_tau, span.total_periods);
     let spp = a.samples_per_period;
-    let opts = request.integrator_options();
+    let opts = request.integrator_options()?;
     let mut integ = build(&model, opts, 0.0, &z0)?;
     // inputs are valid: lock the output directory (removing what a run killed outright left
     // of these files) and open the files

@@ -108,7 +108,25 @@ impl IntegratorRequest {
     /// grid from `samples_per_period` so that samples land on grid points; `rk4` takes
     /// `steps_per_period` (default 2000); `adaptive` chooses its steps. With a new exact
     /// propagator's cache, which every build of the request shares.
-    pub fn options(&self, samples_per_period: usize) -> IntegratorOptions {
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming `steps_per_period` when it is given to an integrator
+    /// that chooses its own steps (only `rk4` and `rk4-naive` take it: it was ignored).
+    pub fn options(&self, samples_per_period: usize) -> Result<IntegratorOptions, SimError> {
+        if let (Some(n), false) = (
+            self.steps_per_period,
+            matches!(
+                self.integrator,
+                IntegratorKind::Rk4 | IntegratorKind::Rk4Naive
+            ),
+        ) {
+            return Err(SimError::out_of_range(
+                "steps_per_period",
+                n,
+                "is taken by the fixed-step integrators rk4 and rk4-naive only (the others \
+                 choose their own steps): give integrator = rk4, or omit it",
+            ));
+        }
         let steps = match self.integrator {
             IntegratorKind::Auto | IntegratorKind::Exact | IntegratorKind::Split => {
                 samples_per_period.max(1)
@@ -116,12 +134,12 @@ impl IntegratorRequest {
             IntegratorKind::Rk4 | IntegratorKind::Rk4Naive => self.steps_per_period.unwrap_or(2000),
             IntegratorKind::Adaptive | IntegratorKind::Taylor => 1,
         };
-        IntegratorOptions {
+        Ok(IntegratorOptions {
             kind: self.integrator,
             steps_per_period: steps,
             tolerance: self.tolerance,
             ..IntegratorOptions::default()
-        }
+        })
     }
 }
 
@@ -489,7 +507,7 @@ impl AttractorsRequest {
             seed: self.seed,
             cluster_tol: self.cluster_tol,
             steady: self.steady.options()?,
-            integrator: self.integrator.options(ATTRACTOR_SAMPLES_PER_PERIOD),
+            integrator: self.integrator.options(ATTRACTOR_SAMPLES_PER_PERIOD)?,
         };
         spec.validate()?;
         Ok(spec)
@@ -776,7 +794,7 @@ impl ConvergeRequest {
             self.periods,
             self.samples_per_period,
             &SteadyOptions::default(),
-            self.integrator.options(self.samples_per_period),
+            self.integrator.options(self.samples_per_period)?,
             progress,
         )
     }
@@ -870,7 +888,7 @@ impl BifurcationRequest {
             starts: self.starts,
             seed: self.seed,
             steady: self.steady.options()?,
-            integrator: self.integrator.options(1),
+            integrator: self.integrator.options(1)?,
         };
         spec.validate()?;
         Ok(spec)

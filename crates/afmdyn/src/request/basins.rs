@@ -135,7 +135,7 @@ impl BasinsRequest {
             stride: self.stride,
             steady: self.steady.options()?,
             cluster_tol: self.cluster_tol,
-            integrator: self.integrator.options(1),
+            integrator: self.integrator.options(1)?,
         };
         spec.validate()?;
         Ok(spec)

@@ -379,7 +379,7 @@ impl ChartRequest {
             cluster_tol: self.cluster_tol,
             lyapunov_periods: self.lyapunov_periods,
             steady: self.steady.options()?,
-            integrator: self.integrator.options(1),
+            integrator: self.integrator.options(1)?,
         };
         // the integrator's up-front budgets (steps per period, support of the law) at the
         // corners, as the attractor census checks them: an input error before any cell runs,

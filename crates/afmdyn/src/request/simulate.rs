@@ -73,7 +73,10 @@ impl SimulateRequest {
     /// ([`crate::trajectory::record`]), so the exact grid is the one the physics needs, not a
     /// multiple of the samples per period (both front ends record with these options, so the
     /// command line's files and Python's arrays are the same numbers).
-    pub fn integrator_options(&self) -> IntegratorOptions {
+    ///
+    /// # Errors
+    /// As [`super::analyses::IntegratorRequest::options`].
+    pub fn integrator_options(&self) -> Result<IntegratorOptions, SimError> {
         self.integrator.options(1)
     }
 
@@ -186,7 +189,7 @@ impl SimulateRequest {
         span: &SimulateSpan,
     ) -> Result<(Trajectory, &'static str), SimError> {
         let z0 = initial_state(model, self.initial.as_deref())?;
-        let mut integ = build(model, self.integrator_options(), 0.0, &z0)?;
+        let mut integ = build(model, self.integrator_options()?, 0.0, &z0)?;
         let spec = RecordSpec {
             transient_periods: self.transient,
             record_tau: span.record_tau,

@@ -189,6 +189,8 @@ pub fn execute<S: Study + ?Sized, St: Store<S>>(
     threads: Option<usize>,
     observer: &dyn Observer,
 ) -> Result<Outcome, StudyError> {
+    // the one executor checks the thread count of every study (before its store is opened)
+    crate::request::limits::check_threads(threads).map_err(StudyError::Sim)?;
     let done = match store.open(study, resume)? {
         Opened::Finished => {
             observer.start(study.units(), study.units());
