@@ -101,6 +101,15 @@ fn bad_input_exits_2_naming_the_field() {
             "scan",
         ),
         (vec!["--setpoint", "0.7", "--lines", "4"], "lines"),
+        // the one executor's thread rule (issue 60 D: 0 and 1025 were accepted here)
+        (
+            vec!["--setpoint", "0.7", "--feedback", "pi", "--threads", "0"],
+            "threads",
+        ),
+        (
+            vec!["--setpoint", "0.7", "--feedback", "pi", "--threads", "1025"],
+            "threads",
+        ),
     ] {
         let mut args = vec![
             "image",
@@ -134,6 +143,27 @@ fn bad_input_exits_2_naming_the_field() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(err.contains("domain 'd' x"), "{err}");
+    // issue 60 item 6: 2048 × 2048 pixels (4.2e6 at about 1 kB each) aborted on allocation;
+    // the image's memory is checked against its budget before any work
+    let out = afmdyn(&[
+        "image",
+        "--probe",
+        "examples/probe-point-mass-dmt.toml",
+        "--sample",
+        "examples/sample-blend.toml",
+        "--setpoint",
+        "0.7",
+        "--pixels",
+        "2048",
+        "--out",
+        d,
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("image") && err.contains("2048 × 2048 pixels") && err.contains("3.9 GiB"),
+        "{err}"
+    );
 }
 
 /// A `[line][pixel]` grid of the JSON document as row-major values, null as NaN.

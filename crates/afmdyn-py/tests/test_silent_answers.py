@@ -34,3 +34,14 @@ def test_a_typical_range_slip_warns_and_a_physical_one_is_refused(tmp_path: path
     odd.write_text(text.replace("surface_tension = 0.072", "surface_tension = 0.8"))
     with pytest.warns(afmdyn.AfmdynWarning, match=r"surface_tension = 0\.8 \(N/m\) is outside"):
         afmdyn.approach(probe=str(odd), points=6)
+
+
+def test_an_image_beyond_its_memory_budget_is_refused_before_any_work() -> None:
+    # issue 60 item 6: 2048 x 2048 pixels aborted with a PanicException on allocation
+    with pytest.raises(ValueError, match=r"2048 × 2048 pixels.*GiB"):
+        afmdyn.image(
+            probe=str(EXAMPLES / "probe-point-mass-dmt.toml"),
+            sample=str(EXAMPLES / "sample-blend.toml"),
+            setpoint=0.7,
+            pixels=2048,
+        )

@@ -126,12 +126,14 @@ fn eigenmode_model_in_a_fluid() {
     let (fw, qw) = q(&water);
     assert!(fw[0] / f[0] < fw[1] / f[1] && fw[1] < f[1], "{fw:?}");
     assert!(qw[0] < 20.0 && qw[1] < 50.0, "{qw:?}");
-    let err = Probe::parse(&text(2507.0, "water"), "<test>")
-        .unwrap_err()
-        .to_string();
+    // a Q₂ above what air alone allows the plan is data (issue 60 item 14): accepted, with
+    // the lever's own loss of mode 2 taken as nil, and said
+    let high = Probe::parse(&text(2507.0, "water"), "<test>").unwrap();
+    let w = high.warnings();
     assert!(
-        err.contains("[cantilever].quality_factor[1] = 2507"),
-        "{err}"
+        w.iter()
+            .any(|w| w.contains("[cantilever].quality_factor[1] = 2507")),
+        "{w:?}"
     );
 }
 
