@@ -225,10 +225,11 @@ pub mod store {
 #[cfg(feature = "files")]
 pub use store::{curve_store, CurveStore, CURVE_FILES};
 
-/// A warning when an approach over the default range ([`crate::analysis::approach::
-/// default_range`]) never brought the amplitude down to 0.5 A₀: on a sample so soft that it
-/// pushes back with the lever's force at its free amplitude only deep inside it, the range ends
-/// there (a peak-force bound) and the setpoints a user would image at are not on the curve.
+/// A warning when an approach over the default range
+/// ([`crate::analysis::approach::default_range`]) never brought the amplitude down to 0.5 A₀:
+/// on a sample so soft that it pushes back with the peak force of tapping only deep inside it
+/// ([`crate::analysis::approach::soft_indentation`]), the range ends there (a peak-force
+/// bound) and the setpoints a user would image at are not on the curve.
 fn soft_sample_warning(
     params: &crate::params::Params,
     c: &crate::analysis::stepped::SteppedCurve,
@@ -245,8 +246,8 @@ fn soft_sample_warning(
     let z = crate::analysis::approach::rest_distance(params, last.value) * u.length;
     Some(format!(
         "the amplitude stays above {} A0 down to the default range's end, z_c = {} {}, where \
-         the sample already pushes back with the lever's force at its free amplitude (k A0): \
-         the sample is too compliant for this lever to reach the usual setpoints (A/A0 ≤ 0.5) \
+         the sample already pushes back with the peak force of tapping at A/A0 = 0.5 (about \
+         min(1, 3/Q) k A0): the sample is too compliant for this lever to reach the usual setpoints (A/A0 ≤ 0.5) \
          within its contact law's validity; a softer lever or a smaller A0 would (or a deeper \
          `to` for the range)",
         crate::error::number((lowest * 1e3).floor() / 1e3),
