@@ -69,6 +69,9 @@ def reconstruct(
             f0 1–1e10 Hz, k 1e-6–1e9 N/m), neither or both of ``distance`` and ``z_c``, more
             points than the limits above; ``fm`` not an SI ``fm`` document.
         KeyboardInterrupt: on Ctrl-C.
+
+    ``progress``: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a
+    log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.
     """
     if am is not None:
         given = [n for n, v in (("fm", fm), ("frequency_shift", frequency_shift),
