@@ -295,8 +295,8 @@ pub struct Probe {
     #[serde(skip)]
     pub input_warnings: Vec<String>,
     /// The tip radius R (m) of a law whose contact is Hertz's paraboloid (hertz, dmt,
-    /// electrostatic, jkr, capillary, sls; `None` for the others): what
-    /// [`Probe::indentation_warnings`] holds an indentation against.
+    /// electrostatic, jkr, capillary; `None` for the others: linear and SLS springs, impact):
+    /// what [`Probe::indentation_warnings`] holds an indentation against.
     #[serde(skip)]
     pub tip_radius: Option<f64>,
 }
@@ -1679,7 +1679,7 @@ impl Probe {
             tip_radius: sample.radius.filter(|_| {
                 matches!(
                     sample.law.as_str(),
-                    "hertz" | "dmt" | "electrostatic" | "jkr" | "capillary" | "sls"
+                    "hertz" | "dmt" | "electrostatic" | "jkr" | "capillary"
                 )
             }),
         })
