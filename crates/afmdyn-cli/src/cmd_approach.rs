@@ -703,7 +703,8 @@ fn write_traces(
             series,
             shade: vec![],
         },
-    )
+    )?;
+    Ok(())
 }
 
 /// Below this fraction of the model's force and energy units (F̃ and F̃·g₀: kA₀ and kA₀² for

@@ -8,6 +8,7 @@ use crate::cmd_analysis::SteadyArgs;
 use crate::cmd_simulate::parse_modal_state;
 use crate::error::CliError;
 use crate::output::{write_bytes, OutDir};
+use crate::plot::RGBColor;
 use crate::plot::{color, save_map, CellMap};
 use afmdyn::analysis::basins::BasinSpec;
 use afmdyn::request::basins::csv_text;
@@ -15,7 +16,6 @@ use afmdyn::request::{BasinArrays, BasinsRequest, Resolved};
 use afmdyn::study::basins::{basin_store, BasinStudy};
 use afmdyn::Params;
 use clap::Args;
-use plotters::style::RGBColor;
 use std::path::PathBuf;
 
 /// `afmdyn basins` flags.

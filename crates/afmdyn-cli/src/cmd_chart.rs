@@ -9,6 +9,7 @@ use crate::args::{Dim, IntegratorArgs, ModelArgs, Quantity};
 use crate::cmd_analysis::SteadyArgs;
 use crate::error::CliError;
 use crate::output::{write_bytes, OutDir};
+use crate::plot::RGBColor;
 use crate::plot::{color, save_map, CellMap};
 use afmdyn::analysis::chart::ChartCell;
 use afmdyn::request::chart::{
@@ -19,7 +20,6 @@ use afmdyn::request::{parameter, ChartRequest};
 use afmdyn::study::chart_store::{cells, chart_store};
 use afmdyn::Params;
 use clap::Args;
-use plotters::style::RGBColor;
 use std::path::{Path, PathBuf};
 
 /// `afmdyn chart` flags.

@@ -9,13 +9,13 @@
 use crate::args::read_text;
 use crate::error::CliError;
 use crate::output::{si_value, write_document, write_layout, OutDir};
+use crate::plot::RGBColor;
 use crate::plot::{save, save_map, CellMap, Figure, Series, Style};
 use afmdyn::request::image::{
     image, setpoint_study, study_ratios, Image, ImageRequest, SampleMap, SetpointStudy,
 };
 use afmdyn::request::image_scan::{PiImage, PiScan, ScanStudy};
 use clap::Args;
-use plotters::style::RGBColor;
 use std::path::PathBuf;
 
 /// `afmdyn image` flags.
@@ -137,7 +137,8 @@ fn map_of(
             legend: &legend,
             points: &[],
         },
-    )
+    )?;
+    Ok(())
 }
 
 /// The setpoint study's plots: each domain's apparent height and phase lag against A/A0.
@@ -543,5 +544,6 @@ fn pi_profile(out: &OutDir, img: &PiImage, setpoint: f64) -> Result<(), CliError
             shade: Vec::new(),
             y_min_span: 1e-12,
         },
-    )
+    )?;
+    Ok(())
 }

@@ -608,7 +608,8 @@ fn write_spectrum_and_plots(
             }],
             shade: vec![],
         },
-    )
+    )?;
+    Ok(())
 }
 
 /// How far below the spectrum's peak its log-scale plot reaches: 1e-10 of the peak, where the

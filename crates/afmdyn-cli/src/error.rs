@@ -104,3 +104,12 @@ impl From<afmdyn::layout::files::FileError> for CliError {
         CliError::Io(e.0)
     }
 }
+
+impl From<crate::plot::PlotError> for CliError {
+    fn from(e: crate::plot::PlotError) -> Self {
+        match e {
+            crate::plot::PlotError::File(e) => e.into(),
+            e => CliError::Io(e.to_string()),
+        }
+    }
+}

@@ -40,7 +40,7 @@ mod cmd_reconstruct;
 mod cmd_simulate;
 mod error;
 mod output;
-mod plot;
+use afmdyn_plot as plot;
 mod progress;
 
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};

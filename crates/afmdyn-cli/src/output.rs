@@ -217,42 +217,12 @@ pub enum DisplayUnits {
     Si,
 }
 
-static PLAIN_SI: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
-
-/// Set the process's display units (once, from the command line).
+/// Set the process's display units (once, from the command line): the plots' and the text's.
 pub fn set_display_units(u: DisplayUnits) {
-    PLAIN_SI.store(u == DisplayUnits::Si, std::sync::atomic::Ordering::Relaxed);
+    crate::plot::set_plain_si(u == DisplayUnits::Si);
 }
 
-/// The SI prefix (a … G) for a magnitude: (its power of ten, the prefix), the one that puts
-/// the magnitude's mantissa in [1, 1000) within the range of prefixes; no prefix with
-/// `--units si`.
-pub fn si_prefix(mag: f64) -> (i32, &'static str) {
-    if PLAIN_SI.load(std::sync::atomic::Ordering::Relaxed) {
-        return (0, "");
-    }
-    const PREFIXES: [(i32, &str); 10] = [
-        (-18, "a"),
-        (-15, "f"),
-        (-12, "p"),
-        (-9, "n"),
-        (-6, "µ"),
-        (-3, "m"),
-        (0, ""),
-        (3, "k"),
-        (6, "M"),
-        (9, "G"),
-    ];
-    if !(mag > 0.0 && mag.is_finite()) {
-        return (0, "");
-    }
-    let e = (mag.log10().floor() as i32).div_euclid(3) * 3;
-    PREFIXES
-        .iter()
-        .copied()
-        .min_by_key(|(x, _)| (x - e).abs())
-        .unwrap_or((0, ""))
-}
+pub use crate::plot::si_prefix;
 
 #[cfg(test)]
 mod tests {

@@ -86,7 +86,7 @@ impl Painter for CellMap<'_> {
 }
 
 /// Write `stem.png` and `stem.svg` of a cell map in `dir`, each atomically.
-pub fn save_map(dir: &Path, stem: &str, map: &CellMap<'_>) -> Result<(), CliError> {
+pub fn save_map(dir: &Path, stem: &str, map: &CellMap<'_>) -> Result<(), PlotError> {
     write_both(dir, stem, (1100, 700), map)
 }
 
@@ -208,6 +208,6 @@ impl Painter for StackedFractions {
 }
 
 /// Write `stem.png` and `stem.svg` of a [`StackedFractions`] figure in `dir`, each atomically.
-pub fn save_stacked(dir: &Path, stem: &str, fig: &StackedFractions) -> Result<(), CliError> {
+pub fn save_stacked(dir: &Path, stem: &str, fig: &StackedFractions) -> Result<(), PlotError> {
     write_both(dir, stem, (1100, 850), fig)
 }

@@ -1,22 +1,82 @@
 //! Plots (PNG and SVG) with plotters, using the bundled DejaVu Sans font (no system libraries).
 //!
-//! * Every figure is rendered in memory and written by [`crate::output`], so a failed write
-//!   names its file and never surfaces a backend's debug text.
+//! The one plotting module of the front ends: the command line renders every figure with it.
+//!
+//! * Every figure is rendered in memory and written atomically
+//!   ([`afmdyn::layout::files::write_bytes`]), so a failed write names its file and never
+//!   surfaces a backend's debug text ([`PlotError`]).
 //! * Series are decimated to the canvas before drawing: a monotone series (a time series, a
 //!   spectrum) keeps per pixel column its first, lowest, highest and last point, which draws the
 //!   same picture as all points; any other line drops repeated pixels and already drawn
 //!   segments; markers keep one per pixel. Files stay small whatever the number of points.
 //! * Legends sit in a panel right of the data area, never over the data.
 
-use crate::error::CliError;
-use crate::output::{si_prefix, write_bytes};
+#![warn(missing_docs)]
+
+use afmdyn::layout::files::{write_bytes, FileError};
 use plotters::coord::ranged1d::{DefaultFormatting, KeyPointHint, Ranged};
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
+/// The colour type of the figures' palettes, re-exported for the front ends' cell maps.
+pub use plotters::style::RGBColor;
 use std::collections::HashSet;
 use std::path::Path;
 use std::sync::Once;
+
+/// Why a figure was not written.
+#[derive(Debug, thiserror::Error)]
+pub enum PlotError {
+    /// The backend failed to draw (its message, with the file it was drawing).
+    #[error("cannot draw {path}: {message}")]
+    Draw {
+        /// The file being drawn.
+        path: String,
+        /// The backend's message.
+        message: String,
+    },
+    /// The file could not be written.
+    #[error(transparent)]
+    File(#[from] FileError),
+}
+
+static PLAIN_SI: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Label axes and values in plain SI units (m, N, Hz) instead of prefixed ones (nm, pN, kHz):
+/// the process's display units, set once by the front end.
+pub fn set_plain_si(plain: bool) {
+    PLAIN_SI.store(plain, std::sync::atomic::Ordering::Relaxed);
+}
+
+/// The SI prefix (a … G) for a magnitude: (its power of ten, the prefix), the one that puts
+/// the magnitude's mantissa in [1, 1000) within the range of prefixes; no prefix when
+/// [`set_plain_si`] asked for plain SI.
+pub fn si_prefix(mag: f64) -> (i32, &'static str) {
+    if PLAIN_SI.load(std::sync::atomic::Ordering::Relaxed) {
+        return (0, "");
+    }
+    const PREFIXES: [(i32, &str); 10] = [
+        (-18, "a"),
+        (-15, "f"),
+        (-12, "p"),
+        (-9, "n"),
+        (-6, "µ"),
+        (-3, "m"),
+        (0, ""),
+        (3, "k"),
+        (6, "M"),
+        (9, "G"),
+    ];
+    if !(mag > 0.0 && mag.is_finite()) {
+        return (0, "");
+    }
+    let e = (mag.log10().floor() as i32).div_euclid(3) * 3;
+    PREFIXES
+        .iter()
+        .copied()
+        .min_by_key(|(x, _)| (x - e).abs())
+        .unwrap_or((0, ""))
+}
 
 static FONT: Once = Once::new();
 
@@ -25,7 +85,7 @@ fn register_font() {
         let _ = plotters::style::register_font(
             "sans-serif",
             FontStyle::Normal,
-            include_bytes!("../../assets/DejaVuSans.ttf"),
+            include_bytes!("../assets/DejaVuSans.ttf"),
         );
     });
 }
@@ -136,11 +196,16 @@ fn svg<P: Painter>(size: (u32, u32), p: &P) -> Result<String, String> {
 }
 
 /// Write `stem.png` and `stem.svg` of `p` in `dir`, each atomically.
-fn write_both<P: Painter>(dir: &Path, stem: &str, size: (u32, u32), p: &P) -> Result<(), CliError> {
+fn write_both<P: Painter>(
+    dir: &Path,
+    stem: &str,
+    size: (u32, u32),
+    p: &P,
+) -> Result<(), PlotError> {
     register_font();
-    let fail = |ext: &str, e: String| {
-        let path = dir.join(format!("{stem}.{ext}"));
-        CliError::Io(format!("cannot draw {}: {e}", path.display()))
+    let fail = |ext: &str, message: String| PlotError::Draw {
+        path: dir.join(format!("{stem}.{ext}")).display().to_string(),
+        message,
     };
     let bytes = png(size, p).map_err(|e| fail("png", e))?;
     write_bytes(&dir.join(format!("{stem}.png")), &bytes)?;
@@ -652,25 +717,26 @@ impl Painter for Figure {
 }
 
 /// Write `stem.png` and `stem.svg` in `dir`, each atomically.
-pub fn save(dir: &Path, stem: &str, fig: &Figure) -> Result<(), CliError> {
+pub fn save(dir: &Path, stem: &str, fig: &Figure) -> Result<(), PlotError> {
     write_both(dir, stem, (1000, 650), fig)
 }
 
 /// Draws one chunk of (x, y, palette index) points.
 pub type ChunkSink<'a> = dyn FnMut(&[(f64, f64, usize)]) -> Result<(), String> + 'a;
-/// Streams all chunks of a scatter plot into a [`ChunkSink`].
-pub type ChunkFeed<'a> = dyn Fn(&mut ChunkSink<'_>) -> Result<(), CliError> + 'a;
+/// Streams all chunks of a scatter plot into a [`ChunkSink`], failing with the caller's error
+/// `E`.
+pub type ChunkFeed<'a, E> = dyn Fn(&mut ChunkSink<'_>) -> Result<(), E> + 'a;
 
-struct Scatter<'a> {
+struct Scatter<'a, E> {
     title: &'a str,
     labels: (&'a str, &'a str),
     bounds: (f64, f64, f64, f64),
     legend: &'a [LegendEntry],
-    feed: &'a ChunkFeed<'a>,
-    failure: std::cell::RefCell<Option<CliError>>,
+    feed: &'a ChunkFeed<'a, E>,
+    failure: std::cell::RefCell<Option<E>>,
 }
 
-impl Painter for Scatter<'_> {
+impl<E: std::fmt::Display> Painter for Scatter<'_, E> {
     fn paint<DB: DrawingBackend>(
         &self,
         root: DrawingArea<DB, Shift>,
@@ -725,15 +791,15 @@ impl Painter for Scatter<'_> {
 /// A scatter plot drawn from a stream of points in chunks (the bifurcation diagram), so that the
 /// points are never all in memory. `bounds` = (x0, x1, y0, y1); `feed` is called once per
 /// backend and hands chunks of (x, y, palette index) to its callback.
-pub fn save_scatter_stream(
+pub fn save_scatter_stream<E: std::fmt::Display + From<PlotError>>(
     dir: &Path,
     stem: &str,
     title: &str,
     labels: (&str, &str),
     bounds: (f64, f64, f64, f64),
     legend: &[LegendEntry],
-    feed: &ChunkFeed<'_>,
-) -> Result<(), CliError> {
+    feed: &ChunkFeed<'_, E>,
+) -> Result<(), E> {
     let s = Scatter {
         title,
         labels,
@@ -742,7 +808,7 @@ pub fn save_scatter_stream(
         feed,
         failure: std::cell::RefCell::new(None),
     };
-    write_both(dir, stem, (1200, 750), &s).map_err(|e| s.failure.take().unwrap_or(e))
+    write_both(dir, stem, (1200, 750), &s).map_err(|e| s.failure.take().unwrap_or(E::from(e)))
 }
 
 mod cells;
