@@ -202,22 +202,10 @@ impl ModelArgs {
     /// The probe file's text, with `[cantilever].name` set from `--cantilever` and the fluid
     /// from `--medium`.
     pub fn probe_text(&self) -> Result<Option<String>, CliError> {
-        let Some(path) = &self.probe else {
-            return Ok(None);
-        };
-        let text = read_text(path, InputKind::Probe)
-            .map_err(|e| CliError::Input(format!("--probe {e}")))?;
-        let bad = |e: String| CliError::Input(format!("{}: {e}", path.display()));
-        let text = match &self.cantilever {
-            None => text,
-            Some(name) => afmdyn::cantilevers::with_name(&text, name).map_err(bad)?,
-        };
-        match &self.medium {
-            None => Ok(Some(text)),
-            Some(name) => afmdyn::hydro::with_medium(&text, name)
-                .map(Some)
-                .map_err(bad),
-        }
+        self.probe
+            .as_deref()
+            .map(|path| probe_text(path, self.cantilever.as_deref(), self.medium.as_deref()))
+            .transpose()
     }
 
     /// The model values of the flags over the config file, and the probe (unresolved: a
@@ -399,6 +387,27 @@ pub fn quantity(
     si: bool,
 ) -> Result<Option<f64>, CliError> {
     q.map(|q| q.value(flag, want, si)).transpose()
+}
+
+/// The text of the probe file `path` (read through the bounded reader, its refusals naming
+/// `--probe`) with `[cantilever].name` set to `cantilever` and the fluid to `medium` when given
+/// (`--cantilever`, `--medium`): every command's probe, `image`'s included.
+pub fn probe_text(
+    path: &std::path::Path,
+    cantilever: Option<&str>,
+    medium: Option<&str>,
+) -> Result<String, CliError> {
+    let text =
+        read_text(path, InputKind::Probe).map_err(|e| CliError::Input(format!("--probe {e}")))?;
+    let bad = |e: String| CliError::Input(format!("{}: {e}", path.display()));
+    let text = match cantilever {
+        None => text,
+        Some(name) => afmdyn::cantilevers::with_name(&text, name).map_err(bad)?,
+    };
+    match medium {
+        None => Ok(text),
+        Some(name) => afmdyn::hydro::with_medium(&text, name).map_err(bad),
+    }
 }
 
 #[cfg(test)]

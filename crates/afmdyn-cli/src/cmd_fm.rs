@@ -5,6 +5,7 @@
 //! maps the flags and writes `fm.csv`, `fm.json` and the frequency-shift plot.
 
 use crate::args::{quantity, Dim, ModelArgs, Quantity};
+use crate::cmd_simulate::Files;
 use crate::error::CliError;
 use crate::output::{f, si_value, write_csv, write_document, OutDir};
 use crate::plot::{save, Figure, Series, Style};
@@ -46,6 +47,9 @@ pub struct FmArgs {
     /// Output directory (locked during the run)
     #[arg(long, default_value = "afmdyn-out/fm")]
     out: PathBuf,
+    /// Files written: all (data and plots), data (no plots) or none (only the summary)
+    #[arg(long, value_enum, default_value = "all")]
+    files: Files,
     /// Print one JSON document
     #[arg(long)]
     json: bool,
@@ -66,16 +70,21 @@ pub fn fm(a: &FmArgs) -> Result<(), CliError> {
     };
     let model = Resolved { params, probe };
     request::Analysis::validate(&request, &model)?;
-    let out = OutDir::lock(&a.out)?;
+    let out = match a.files {
+        Files::None => None,
+        _ => Some(OutDir::lock(&a.out)?),
+    };
     let doc = crate::progress::run(&request, &model, "z_c values")?;
     let mut json = doc.json;
     let table = rows(&json);
     let column = |name: &str| COLUMNS.iter().position(|c| *c == name).unwrap_or(0);
-    write_csv(
-        &out.join("fm.csv"),
-        &COLUMNS,
-        table.iter().map(|r| r.iter().map(|v| f(*v)).collect()),
-    )?;
+    if let Some(out) = &out {
+        write_csv(
+            &out.join("fm.csv"),
+            &COLUMNS,
+            table.iter().map(|r| r.iter().map(|v| f(*v)).collect()),
+        )?;
+    }
     let (x_unit, y_unit) = if si {
         (" (m)", " (Hz)")
     } else {
@@ -83,25 +92,29 @@ pub fn fm(a: &FmArgs) -> Result<(), CliError> {
     };
     let (x, y) = (column("z_c"), column("frequency_shift"));
     let points: Vec<(f64, f64)> = table.iter().map(|r| (r[x], r[y])).collect();
-    save(
-        out.path(),
-        "fm-frequency-shift",
-        &Figure {
-            title: "FM-AFM: frequency shift at constant amplitude".into(),
-            x_label: format!("rest distance z_c{x_unit}"),
-            y_label: format!("frequency shift Δf{y_unit}"),
-            series: vec![Series {
-                label: String::new(),
-                points,
-                style: Style::Line,
-                color: 0,
-            }],
-            shade: Vec::new(),
-            y_min_span: 0.0,
-        },
-    )?;
-    json["csv"] = serde_json::json!(out.join("fm.csv"));
-    write_document(&out, "fm.json", &json)?;
+    if let (Some(out), Files::All) = (&out, a.files) {
+        save(
+            out.path(),
+            "fm-frequency-shift",
+            &Figure {
+                title: "FM-AFM: frequency shift at constant amplitude".into(),
+                x_label: format!("rest distance z_c{x_unit}"),
+                y_label: format!("frequency shift Δf{y_unit}"),
+                series: vec![Series {
+                    label: String::new(),
+                    points,
+                    style: Style::Line,
+                    color: 0,
+                }],
+                shade: Vec::new(),
+                y_min_span: 0.0,
+            },
+        )?;
+    }
+    if let Some(out) = &out {
+        json["csv"] = serde_json::json!(out.join("fm.csv"));
+        write_document(out, "fm.json", &json)?;
+    }
     if a.json {
         outln!("{json}");
     } else {
@@ -117,7 +130,7 @@ pub fn fm(a: &FmArgs) -> Result<(), CliError> {
         let at = |r: Option<&Vec<f64>>, k: usize| r.map_or(f64::NAN, |r| r[k]);
         outln!(
             "{} z_c values from {} to {}: Δf from {} to {}, excitation up to {:.4} × the free \
-             one; {} unstable, {} folds; outputs in {}",
+             one; {} unstable, {} folds; {}",
             table.len(),
             value(at(first, k("z_c")), "m", "g0"),
             value(at(last, k("z_c")), "m", "g0"),
@@ -129,7 +142,10 @@ pub fn fm(a: &FmArgs) -> Result<(), CliError> {
                 .fold(f64::NAN, f64::max),
             table.iter().filter(|r| r[k("stable")] == 0.0).count(),
             json["folds"].as_array().map_or(0, |v| v.len()),
-            out.path().display()
+            out.as_ref().map_or("no files written".into(), |o| format!(
+                "outputs in {}",
+                o.path().display()
+            ))
         );
     }
     Ok(())

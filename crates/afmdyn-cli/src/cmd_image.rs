@@ -6,7 +6,6 @@
 //! [`afmdyn::request::image_layout`]), the maps (height, phase, E_dis; the error image of a PI
 //! scan) and the line profile.
 
-use crate::args::read_text;
 use crate::error::CliError;
 use crate::output::{si_value, write_document, write_layout, OutDir};
 use crate::plot::RGBColor;
@@ -24,6 +23,15 @@ pub struct ImageArgs {
     /// The probe file (SI): the lever, tip, drive and the background sample
     #[arg(long, value_name = "PROBE.toml")]
     probe: PathBuf,
+    /// A cantilever of the library (`afmdyn cantilevers` lists them) for the probe file, as for
+    /// every command taking --probe
+    #[arg(long, value_name = "NAME")]
+    cantilever: Option<String>,
+    /// The fluid around the lever, over the probe file's [medium]: water, air or none, as for
+    /// every command taking --probe
+    #[allow(rustdoc::broken_intra_doc_links)]
+    #[arg(long, value_name = "NAME")]
+    medium: Option<String>,
     /// The sample map: size = [Lx, Ly] (m) and [[domain]] entries (name, x, y, height,
     /// [domain.sample])
     #[arg(long, value_name = "S.toml")]
@@ -237,8 +245,7 @@ pub fn image_cmd(a: &ImageArgs) -> Result<(), CliError> {
             )))
         }
     };
-    let text = read_text(&a.probe, afmdyn::io::InputKind::Probe)
-        .map_err(|e| CliError::Input(format!("--probe {e}")))?;
+    let text = crate::args::probe_text(&a.probe, a.cantilever.as_deref(), a.medium.as_deref())?;
     let table = afmdyn::probe::Probe::table(&text, &a.probe.display().to_string())?;
     // a sample map's refusals (its file, its height map's) name the option
     let map = SampleMap::load(&a.sample).map_err(|e| match e {

@@ -5,6 +5,7 @@
 //! force plot and the JSON document.
 
 use crate::args::{quantity, Dim, Quantity};
+use crate::cmd_simulate::Files;
 use crate::error::CliError;
 use crate::output::{si_value, write_csv_numbers, write_document, OutDir};
 use crate::plot::{save, Figure, Series, Style};
@@ -48,6 +49,9 @@ pub struct ReconstructArgs {
     /// Output directory (locked during the run)
     #[arg(long, default_value = "afmdyn-out/reconstruct")]
     out: PathBuf,
+    /// Files written: all (data and plots), data (no plots) or none (only the summary)
+    #[arg(long, value_enum, default_value = "all")]
+    files: Files,
     /// Print one JSON document
     #[arg(long)]
     json: bool,
@@ -260,58 +264,70 @@ pub fn reconstruct(a: &ReconstructArgs) -> Result<(), CliError> {
             ))
         }
     };
-    let out = OutDir::lock(&a.out)?;
-    finish(a, &out, &r, json, law)
+    let out = match a.files {
+        Files::None => None,
+        _ => Some(OutDir::lock(&a.out)?),
+    };
+    finish(a, out.as_ref(), &r, json, law)
 }
 
 /// Write the outputs of reconstruction `r` and print its document or summary.
 fn finish(
     a: &ReconstructArgs,
-    out: &OutDir,
+    out: Option<&OutDir>,
     r: &Reconstruction,
     mut json: serde_json::Value,
     law: Option<Vec<f64>>,
 ) -> Result<(), CliError> {
-    write_csv_numbers(
-        &out.join("reconstruct.csv"),
-        &["distance", "force", "potential"],
-        r.distance
-            .iter()
-            .zip(&r.force)
-            .zip(&r.potential)
-            .map(|((d, f), u)| [*d, *f, *u]),
-    )?;
-    let points = |ys: &[f64]| r.distance.iter().copied().zip(ys.iter().copied()).collect();
-    save(
-        out.path(),
-        "reconstruct-force",
-        &Figure {
-            title: if a.am.is_some() {
-                "Tip–sample force from the AM curve (matrix method)".into()
-            } else {
-                "Tip–sample force by the Sader–Jarvis inversion".into()
-            },
-            x_label: "distance of closest approach d (m)".into(),
-            y_label: "force F (N)".into(),
-            series: std::iter::once(Series {
-                label: "reconstructed".into(),
-                points: points(&r.force),
-                style: Style::Line,
-                color: 0,
-            })
-            .chain(law.map(|law| Series {
-                label: "the model's force law".into(),
-                points: points(&law),
-                style: Style::Dashed,
-                color: 1,
-            }))
-            .collect(),
-            shade: Vec::new(),
-            y_min_span: 0.0,
-        },
-    )?;
-    json["csv"] = serde_json::json!(out.join("reconstruct.csv"));
-    write_document(out, "reconstruct.json", &json)?;
+    if let Some(out) = out {
+        let write = || -> Result<(), CliError> {
+            write_csv_numbers(
+                &out.join("reconstruct.csv"),
+                &["distance", "force", "potential"],
+                r.distance
+                    .iter()
+                    .zip(&r.force)
+                    .zip(&r.potential)
+                    .map(|((d, f), u)| [*d, *f, *u]),
+            )?;
+            let points = |ys: &[f64]| r.distance.iter().copied().zip(ys.iter().copied()).collect();
+            if a.files != Files::All {
+                return Ok(());
+            }
+            save(
+                out.path(),
+                "reconstruct-force",
+                &Figure {
+                    title: if a.am.is_some() {
+                        "Tip–sample force from the AM curve (matrix method)".into()
+                    } else {
+                        "Tip–sample force by the Sader–Jarvis inversion".into()
+                    },
+                    x_label: "distance of closest approach d (m)".into(),
+                    y_label: "force F (N)".into(),
+                    series: std::iter::once(Series {
+                        label: "reconstructed".into(),
+                        points: points(&r.force),
+                        style: Style::Line,
+                        color: 0,
+                    })
+                    .chain(law.map(|law| Series {
+                        label: "the model's force law".into(),
+                        points: points(&law),
+                        style: Style::Dashed,
+                        color: 1,
+                    }))
+                    .collect(),
+                    shade: Vec::new(),
+                    y_min_span: 0.0,
+                },
+            )?;
+            Ok(())
+        };
+        write()?;
+        json["csv"] = serde_json::json!(out.join("reconstruct.csv"));
+        write_document(out, "reconstruct.json", &json)?;
+    }
     if a.json {
         outln!("{json}");
     } else {
@@ -322,13 +338,16 @@ fn finish(
             .min_by(|x, y| x.1.total_cmp(y.1))
             .map_or((0, f64::NAN), |(k, f)| (k, *f));
         outln!(
-            "{} distances from {} to {}: most attractive force {} at d = {}; outputs in {}",
+            "{} distances from {} to {}: most attractive force {} at d = {}; {}",
             r.distance.len(),
             si_value(r.distance[0], "m"),
             si_value(r.distance[r.distance.len() - 1], "m"),
             si_value(f, "N"),
             si_value(r.distance.get(k).copied().unwrap_or(f64::NAN), "m"),
-            out.path().display()
+            out.map_or("no files written".into(), |o| format!(
+                "outputs in {}",
+                o.path().display()
+            ))
         );
     }
     Ok(())

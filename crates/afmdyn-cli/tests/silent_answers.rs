@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 
 mod common;
-use common::{json, run};
+use common::{json, refused, run};
 
 /// A probe file written into a fresh temporary directory.
 fn probe_file(name: &str, text: &str) -> PathBuf {
@@ -20,17 +20,6 @@ fn out_dir(name: &str) -> String {
     let dir = std::env::temp_dir().join(format!("afmdyn-silent-{}-out-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     dir.to_str().unwrap().to_string()
-}
-
-/// `afmdyn ARGS` must fail with exit 2 and one stderr line holding every `needles`.
-fn refused(args: &[&str], needles: &[&str]) {
-    let out = run(args);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
-    assert_eq!(err.trim().lines().count(), 1, "{args:?}: {err}");
-    for n in needles {
-        assert!(err.contains(n), "{args:?}: {n:?} not in {err}");
-    }
 }
 
 /// A point-mass lever (40 N/m, 300 kHz, Q 400, A₀ 10 nm) over the JKR sample of the issue (R

@@ -189,6 +189,39 @@ impl<'de> serde::Deserializer<'de> for Val {
     }
 }
 
+/// A probe given as a dict of sections, as the TOML table the probe reader takes: numbers
+/// (NaN and ±∞ kept, so that the reader's own checks name the key), strings, booleans, lists
+/// and sub-dicts; `None` entries left out.
+///
+/// # Errors
+/// `TypeError` naming the key of a value that is none of these.
+pub fn toml_table(d: &Bound<'_, PyDict>) -> PyResult<toml::Table> {
+    fn toml_of(v: Val) -> Option<toml::Value> {
+        Some(match v {
+            Val::Null => return None,
+            Val::Bool(b) => toml::Value::Boolean(b),
+            Val::Int(i) => toml::Value::Integer(i),
+            Val::Float(x) => toml::Value::Float(x),
+            Val::Str(s) => toml::Value::String(s),
+            Val::Seq(items) => toml::Value::Array(items.into_iter().filter_map(toml_of).collect()),
+            Val::Map(entries) => toml::Value::Table(
+                entries
+                    .into_iter()
+                    .filter_map(|(k, v)| toml_of(v).map(|v| (k, v)))
+                    .collect(),
+            ),
+        })
+    }
+    let mut table = toml::Table::new();
+    for (k, v) in d.iter() {
+        let key: String = k.extract()?;
+        if let Some(v) = toml_of(val(&key, &v)?) {
+            table.insert(key, v);
+        }
+    }
+    Ok(table)
+}
+
 /// `v` as a [`Val`]; `key` names it in a `TypeError` for a type serde cannot take.
 fn val(key: &str, v: &Bound<'_, PyAny>) -> PyResult<Val> {
     use pyo3::types::{PyBool, PyFloat, PyInt, PyList, PyString, PyTuple};
@@ -278,8 +311,20 @@ pub fn request<R: serde::de::DeserializeOwned>(
         Some(d) => entries(d)?,
         None => Vec::new(),
     };
-    R::deserialize(Val::Map(map)).map_err(|e| {
-        let msg = format!("{what}: {e}");
+    serde_path_to_error::deserialize(Val::Map(map)).map_err(|e| {
+        // the keyword's name (serde_path_to_error's path) and the kind of number in words
+        let path = e.path().to_string();
+        let e = e.into_inner();
+        let text = ["usize", "u64", "u32", "u16", "u8"]
+            .iter()
+            .fold(e.to_string(), |t, ty| {
+                t.replace(&format!("expected {ty}"), "expected a non-negative integer")
+            });
+        let msg = if e.unknown || path == "." {
+            format!("{what}: {text}")
+        } else {
+            format!("{what}: {path}: {text}")
+        };
         if e.unknown {
             pyo3::exceptions::PyTypeError::new_err(msg)
         } else {

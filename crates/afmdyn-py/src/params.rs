@@ -532,22 +532,12 @@ pub fn probe_source(
     cantilever: Option<String>,
     medium: Option<String>,
 ) -> PyResult<String> {
-    use crate::errors::{probe_error, value_error};
+    use crate::errors::probe_error;
     use afmdyn::probe::{Probe, ProbeSource};
     use std::path::PathBuf;
     let (name, medium) = (cantilever.as_deref(), medium.as_deref());
     let r = if let Ok(d) = probe.cast::<pyo3::types::PyDict>() {
-        let json: String = probe
-            .py()
-            .import("json")?
-            .call_method1("dumps", (d,))?
-            .extract()?;
-        let table: toml::Table = serde_json::from_str(&json).map_err(|e| {
-            value_error(format!(
-                "probe <table>: not a probe table ({e}): sections cantilever, tip, sample, \
-                 drive as dicts of numbers and strings"
-            ))
-        })?;
+        let table = crate::convert::toml_table(d)?;
         Probe::source_text(ProbeSource::Table(&table), name, medium)
     } else if let Ok(s) = probe.extract::<String>() {
         Probe::source_text(ProbeSource::of_str(&s), name, medium)

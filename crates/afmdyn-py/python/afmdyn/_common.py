@@ -106,6 +106,21 @@ _G = {"units": "g0"}
 _V = {"units": "g0 per unit τ"}
 
 
+def _real_array(name: str, v: Any, ndim: int) -> np.ndarray:
+    """``v`` as a float64 array of ``ndim`` dimensions, or a ``ValueError`` naming ``name``: a
+    complex array (whose imaginary part NumPy would drop with a mere warning) or one of other
+    dimensions is refused, not flattened."""
+    a = np.asarray(v)
+    if np.iscomplexobj(a):
+        raise ValueError(f"{name}: must be real numbers, got a complex array")
+    if a.ndim != ndim:
+        raise ValueError(f"{name}: must be a {ndim}D array, got {a.ndim}D (shape {a.shape})")
+    try:
+        return a.astype(np.float64)
+    except (TypeError, ValueError) as e:
+        raise ValueError(f"{name}: must be numbers ({e})") from None
+
+
 def _params(
     params: Optional[Params], model: Any, default: Optional[Params] = None
 ) -> Tuple[Params, Optional[str]]:

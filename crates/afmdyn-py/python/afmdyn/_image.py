@@ -12,7 +12,7 @@ import xarray as xr
 
 from . import _afmdyn as _core
 from . import _layout
-from ._common import _typed, _warn
+from ._common import _real_array, _typed, _warn
 from ._progress import ProgressArg, reporter
 
 def _inputs(probe: Any, sample: Any, height_map: Any) -> Tuple[str, str, Any]:
@@ -24,10 +24,7 @@ def _inputs(probe: Any, sample: Any, height_map: Any) -> Tuple[str, str, Any]:
         # a .csv or .npy file, read and checked by the library as the TOML key's file is
         rows = _core.read_height_map(os.fspath(height_map))
     elif height_map is not None:
-        grid = np.asarray(height_map, dtype=np.float64)
-        if grid.ndim != 2:
-            raise ValueError(f"height_map: must be a 2D array of heights (m), got {grid.ndim}D")
-        rows = grid.tolist()
+        rows = _real_array("height_map", height_map, 2).tolist()
     return text, source, rows
 
 
@@ -176,7 +173,7 @@ def setpoint_study(
     """
     text = _core.probe_source(probe)
     source = os.fspath(sample) if isinstance(sample, os.PathLike) else sample
-    values = [float(r) for r in np.asarray(ratios, dtype=np.float64).ravel()]
+    values = _real_array("ratios", ratios, 1).tolist()
     doc = json.loads(_core.setpoint_study(text, source, values, curve_points))
     _warn(doc)
     dims = ("domain", "setpoint")

@@ -10,12 +10,12 @@ import numpy as np
 import xarray as xr
 
 from . import _afmdyn as _core
-from ._common import _warn
+from ._common import _real_array, _warn
 from ._progress import ProgressArg, reporter
 
 
-def _values(v: Optional[Any]) -> Optional[list]:
-    return None if v is None else np.asarray(v, dtype=np.float64).ravel().tolist()
+def _values(name: str, v: Optional[Any]) -> Optional[list]:
+    return None if v is None else _real_array(name, v, 1).tolist()
 
 
 def reconstruct(
@@ -101,9 +101,9 @@ def reconstruct(
         if v is None:
             raise ValueError(f"{name}: missing (give the curve and k, f0, A, or fm=)")
     request = dict(
-        frequency_shift=_values(frequency_shift),
-        distance=_values(distance),
-        z_c=_values(z_c),
+        frequency_shift=_values("frequency_shift", frequency_shift),
+        distance=_values("distance", distance),
+        z_c=_values("z_c", z_c),
         spring_constant=float(spring_constant),
         resonance_frequency=float(resonance_frequency),
         amplitude=float(amplitude),

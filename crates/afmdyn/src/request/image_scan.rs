@@ -228,6 +228,18 @@ impl ScanStudy {
             )?,
             None => ki / (2.0 * pixels as f64 * PIXEL_LOOP_TIMES),
         };
+        if scan_rate > fastest && scan.scan_rate.is_none() {
+            // the rate was not given: it follows K_I, which is then what to change
+            return Err(SimError::out_of_range(
+                "gains",
+                format!(
+                    "K_I = {ki:e} 1/s (at most {:.6e} here)",
+                    fastest * 2.0 * pixels as f64 * PIXEL_LOOP_TIMES
+                ),
+                "sets the default scan rate (a pixel lasts 5 loop times 1/K_I) above the drive \
+                 frequency over 2 × pixels: give a smaller K_I, or scan_rate",
+            ));
+        }
         if scan_rate > fastest {
             return Err(SimError::out_of_range(
                 "scan_rate",

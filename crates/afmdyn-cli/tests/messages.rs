@@ -1,0 +1,177 @@
+//! Issue 60, part D: a refusal names what the user gave and can change, and a damaged store is
+//! recovered, not reported as a cancellation.
+
+mod common;
+use common::{refused, run};
+
+/// `image --feedback pi --gains 0,1e12` without `--scan-rate` blamed "scan-rate = 1.25e10",
+/// a flag never given: the default scan rate follows K_I (a pixel lasts 5/K_I), so K_I is what
+/// to change, and its largest value here is named: the fastest scan, 300 kHz over 2 × 8
+/// pixels, times 2 × 8 pixels × 5 loop times, 1.5e6 1/s.
+#[test]
+fn a_pi_gain_that_sets_too_fast_a_scan_blames_the_gain() {
+    refused(
+        &[
+            "image",
+            "--probe",
+            "examples/probe-point-mass-dmt.toml",
+            "--sample",
+            "examples/sample-stripe.toml",
+            "--feedback",
+            "pi",
+            "--gains",
+            "0,1e12",
+            "--pixels",
+            "8",
+            "--lines",
+            "1",
+            "--setpoint",
+            "0.8",
+            "--files",
+            "none",
+        ],
+        &["gains", "K_I = 1e12", "at most 1.500000e6", "scan"],
+    );
+}
+
+/// A fresh temporary directory for one test.
+fn temp_dir(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("afmdyn-messages-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// A probe with only its sample and drive: the lever comes from `--cantilever`.
+const SAMPLE_ONLY: &str = r#"
+model = "point-mass"
+[sample]
+law = "dmt"
+youngs_modulus = 4e9
+poisson_ratio = 0.33
+hamaker = 6.6e-20
+intermolecular_distance = 0.165e-9
+z_c = 8e-9
+[drive]
+free_amplitude = 10e-9
+"#;
+
+/// Issue 59: `image` refused `--cantilever`, which every other command taking `--probe` takes.
+/// Now the library's ARROW-NCR (k 42 N/m, f0 285 kHz, Q 450, R 10 nm: `afmdyn cantilevers`)
+/// fills the probe's lever, and the image equals the one of the same constants written into
+/// the file.
+#[test]
+fn image_takes_the_cantilever_library_as_every_command_does() {
+    let dir = temp_dir("image-cantilever");
+    let named = dir.join("named.toml");
+    let written = dir.join("written.toml");
+    std::fs::write(&named, SAMPLE_ONLY).unwrap();
+    std::fs::write(
+        &written,
+        format!(
+            "{SAMPLE_ONLY}[cantilever]\nspring_constant = 42.0\nresonance_frequency = 285e3\n\
+             quality_factor = 450\n[tip]\nradius = 10e-9\n"
+        ),
+    )
+    .unwrap();
+    let image = |probe: &std::path::Path, extra: &[&str], out: &str| {
+        let out = dir.join(out);
+        let mut args = vec![
+            "image",
+            "--probe",
+            probe.to_str().unwrap(),
+            "--sample",
+            "examples/sample-stripe.toml",
+            "--setpoint",
+            "0.8",
+            "--pixels",
+            "4",
+            "--lines",
+            "1",
+            "--curve-points",
+            "20",
+            "--json",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let o = run(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        serde_json::from_slice::<serde_json::Value>(&o.stdout).unwrap()
+    };
+    let a = image(&named, &["--cantilever", "ARROW-NCR"], "a");
+    let b = image(&written, &[], "b");
+    assert_eq!(a["image"], b["image"]);
+    assert_eq!(a["materials"], b["materials"]);
+    // a fluid needs the lever's plan, which neither probe has: the medium reaches the probe
+    let o = run(&[
+        "image",
+        "--probe",
+        named.to_str().unwrap(),
+        "--cantilever",
+        "ARROW-NCR",
+        "--medium",
+        "water",
+        "--sample",
+        "examples/sample-stripe.toml",
+        "--setpoint",
+        "0.8",
+        "--out",
+        dir.join("c").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("[medium]"));
+}
+
+/// Issue 60 item 17: `fm` and `reconstruct` refused `--files`, which the other curve commands
+/// take. With `--files none` they write nothing (not even the locked directory) and print the
+/// summary; with `--files data` the data without the plots.
+#[test]
+fn fm_and_reconstruct_take_files() {
+    let dir = temp_dir("files");
+    let none = dir.join("none");
+    let o = run(&[
+        "fm",
+        "--points",
+        "6",
+        "--files",
+        "none",
+        "--out",
+        none.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("no files written"));
+    assert!(!none.exists());
+    let data = dir.join("data");
+    let o = run(&[
+        "fm",
+        "--points",
+        "6",
+        "--files",
+        "data",
+        "--out",
+        data.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(data.join("fm.csv").exists() && data.join("fm.json").exists());
+    assert!(!data.join("fm-frequency-shift.png").exists());
+    let rec = dir.join("rec");
+    let o = run(&[
+        "reconstruct",
+        "--fm",
+        "examples/fm-vdw.csv",
+        "--spring-constant",
+        "40",
+        "--resonance-frequency",
+        "3e5",
+        "--amplitude",
+        "10nm",
+        "--files",
+        "none",
+        "--out",
+        rec.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("no files written"));
+    assert!(!rec.exists());
+}
