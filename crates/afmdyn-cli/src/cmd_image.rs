@@ -8,8 +8,7 @@
 
 use crate::error::CliError;
 use crate::output::{si_value, write_document, write_layout, OutDir};
-use crate::plot::RGBColor;
-use crate::plot::{save, save_map, CellMap, Figure, Series, Style};
+use crate::plot::{save, save_image, AfmImage, Figure, Series, Style};
 use afmdyn::request::image::{
     image, setpoint_study, study_ratios, Image, ImageRequest, SampleMap, SetpointStudy,
 };
@@ -91,19 +90,8 @@ pub struct ImageArgs {
     json: bool,
 }
 
-/// A white-to-blue ramp at t ∈ [0, 1] (missing values are left white by the map).
-fn ramp(t: f64) -> RGBColor {
-    let t = if t.is_finite() {
-        t.clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    let mix = |a: u8, b: u8| (f64::from(a) + (f64::from(b) - f64::from(a)) * t) as u8;
-    RGBColor(mix(253, 8), mix(231, 48), mix(37, 107))
-}
-
-/// The map of one field over the image, coloured from its smallest to its largest value, with a
-/// legend of five levels in SI.
+/// The map of one field over the image as AFM software draws it (dark = low, a colour bar in
+/// `unit`, the scan's aspect ratio: [`crate::plot::AfmImage`]).
 fn map_of(
     out: &OutDir,
     img: &Image,
@@ -117,33 +105,22 @@ fn map_of(
         .flat_map(|j| (0..nx).map(move |i| (j, i)))
         .map(|(j, i)| value(j, i))
         .collect();
-    let finite = values.iter().copied().filter(|v| v.is_finite());
-    let lo = finite.clone().fold(f64::INFINITY, f64::min);
-    let hi = finite.fold(f64::NEG_INFINITY, f64::max);
-    let span = if hi > lo { hi - lo } else { 1.0 };
-    let cells: Vec<Option<RGBColor>> = values
-        .iter()
-        .map(|&v| v.is_finite().then(|| ramp((v - lo) / span)))
-        .collect();
-    let legend: Vec<(String, RGBColor)> = if lo.is_finite() {
-        [0.0, 0.25, 0.5, 0.75, 1.0]
-            .iter()
-            .map(|&t| (si_value(lo + t * (hi - lo), unit), ramp(t)))
-            .collect()
-    } else {
-        Vec::new()
-    };
-    save_map(
+    // the bar's description: the title's quantity (before any parenthesis) and the unit
+    let quantity = title.split(" (").next().unwrap_or(title);
+    let mut chars = quantity.chars();
+    let quantity: String = chars
+        .next()
+        .map(|c| c.to_lowercase().chain(chars).collect())
+        .unwrap_or_default();
+    save_image(
         out.path(),
         stem,
-        &CellMap {
+        &AfmImage {
             title,
-            labels: ("x (m)", "y (m)"),
             x: &img.x,
             y: &img.y,
-            cells: &cells,
-            legend: &legend,
-            points: &[],
+            values: &values,
+            label: &format!("{quantity} ({unit})"),
         },
     )?;
     Ok(())

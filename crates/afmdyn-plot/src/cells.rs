@@ -25,7 +25,7 @@ pub struct CellMap<'a> {
 
 /// The edges of the cells of an axis: midpoints between values, half a spacing beyond the
 /// ends (a single value gets ±0.5 of its magnitude's order, at least ±0.5).
-fn cell_edges(v: &[f64]) -> Vec<f64> {
+pub(crate) fn cell_edges(v: &[f64]) -> Vec<f64> {
     let n = v.len();
     if n == 1 {
         let h = if v[0] != 0.0 { 0.05 * v[0].abs() } else { 0.5 };

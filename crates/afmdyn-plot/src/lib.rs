@@ -592,6 +592,19 @@ fn si_axis(label: &str, lo: f64, hi: f64) -> (String, f64) {
     (format!("{head} ({p}{u})"), 10f64.powi(e))
 }
 
+/// The width in pixels of a y axis's labels over [y0, y1] described by `label`: room for the
+/// widest tick label beside the axis description (never overprinted).
+fn y_label_width(y0: f64, y1: f64, label: &str) -> u32 {
+    let (_, fy) = si_axis(label, y0, y1);
+    let ys = (y1 - y0) / fy;
+    let widest = [y0, y1, 0.5 * (y0 + y1), 0.25 * y0 + 0.75 * y1]
+        .iter()
+        .map(|v| tick(*v / fy, ys).chars().count())
+        .max()
+        .unwrap_or(4) as u32;
+    (widest * 9 + 34).max(70)
+}
+
 /// The chart of a data area with its axes, mesh and labels over (x0, x1, y0, y1).
 fn chart<'a, DB: DrawingBackend>(
     area: &'a DrawingArea<DB, Shift>,
@@ -604,16 +617,10 @@ where
     // an axis in an SI unit reads in the prefixed unit of its magnitude (nm, kHz, aJ)
     let ((xd, fx), (yd, fy)) = (si_axis(labels.0, x0, x1), si_axis(labels.1, y0, y1));
     let (xs, ys) = ((x1 - x0) / fx, (y1 - y0) / fy);
-    // room for the widest y tick label beside the axis description (never overprinted)
-    let widest = [y0, y1, 0.5 * (y0 + y1), 0.25 * y0 + 0.75 * y1]
-        .iter()
-        .map(|v| tick(*v / fy, ys).chars().count())
-        .max()
-        .unwrap_or(4) as u32;
     let mut chart = ChartBuilder::on(area)
         .margin(12)
         .x_label_area_size(45)
-        .y_label_area_size((widest * 9 + 34).max(70))
+        .y_label_area_size(y_label_width(y0, y1, labels.1))
         .build_cartesian_2d(Axis::new(x0, x1), Axis::new(y0, y1))
         .map_err(|x| x.to_string())?;
     chart
@@ -813,6 +820,8 @@ pub fn save_scatter_stream<E: std::fmt::Display + From<PlotError>>(
 
 mod cells;
 pub use cells::*;
+mod afm_image;
+pub use afm_image::*;
 
 #[cfg(test)]
 mod tests;

@@ -226,3 +226,55 @@ fn legend_labels_wrap() {
         "{w:?}"
     );
 }
+
+/// Issue 60 item 18: an AFM image follows the instrument's habit — the colour map is dark for
+/// low values and monotone in lightness (Rec. 601 luma of matplotlib's `afmhot`).
+#[test]
+fn the_afm_colour_map_is_dark_for_low_values() {
+    let luma =
+        |c: RGBColor| 0.299 * f64::from(c.0) + 0.587 * f64::from(c.1) + 0.114 * f64::from(c.2);
+    assert_eq!(afmhot(0.0), RGBColor(0, 0, 0));
+    assert_eq!(afmhot(1.0), RGBColor(255, 255, 255));
+    let l: Vec<f64> = (0..=100)
+        .map(|k| luma(afmhot(f64::from(k) / 100.0)))
+        .collect();
+    assert!(l.windows(2).all(|w| w[1] > w[0]), "{l:?}");
+}
+
+/// An image's data area has the scan's aspect ratio, and its high line (largest y, drawn at
+/// the top) is bright, its low line dark: a 2 × 3 scan of 1 µm × 0.6 µm whose lines at
+/// y = 0.1, 0.3, 0.5 µm are 0, 2.5 and 5 nm high (black, afmhot(½) and white).
+#[test]
+fn an_afm_image_keeps_its_aspect_and_draws_high_bright() {
+    let (x, y) = ([0.25e-6, 0.75e-6], [0.1e-6, 0.3e-6, 0.5e-6]);
+    let values = [0.0, 0.0, 2.5e-9, 2.5e-9, 5e-9, 5e-9];
+    let map = AfmImage {
+        title: "t",
+        x: &x,
+        y: &y,
+        values: &values,
+        label: "height (m)",
+    };
+    let (w, h) = map.canvas();
+    register_font();
+    let img = image::load_from_memory(&png((w, h), &map).unwrap())
+        .unwrap()
+        .to_rgb8();
+    // the middle line's band, in the colour no axis or text has
+    let mid = afmhot(0.5);
+    let (mut x0, mut x1, mut y0, mut y1) = (u32::MAX, 0, u32::MAX, 0);
+    for py in 0..h {
+        for px in 0..w - 190 {
+            if img.get_pixel(px, py).0 == [mid.0, mid.1, mid.2] {
+                (x0, x1, y0, y1) = (x0.min(px), x1.max(px), y0.min(py), y1.max(py));
+            }
+        }
+    }
+    let (band_w, band_h) = (f64::from(x1 - x0 + 1), f64::from(y1 - y0 + 1));
+    // the band spans 0.2 µm of y over 1 µm of x, to a few pixels of 700
+    assert!((band_h / band_w - 0.2).abs() < 0.01, "{band_h} / {band_w}");
+    // above it the high line (white), below it the low one (black)
+    let cx = (x0 + x1) / 2;
+    assert_eq!(img.get_pixel(cx, y0 - 10).0, [255, 255, 255]);
+    assert_eq!(img.get_pixel(cx, y1 + 10).0, [0, 0, 0]);
+}
