@@ -53,6 +53,23 @@ export class Engine {
     }
   }
 
+  /**
+   * Testing: while `on`, every request's last message (its result) is held back, so that the
+   * request is certainly still running when a test starts a newer one (a gate, not a race);
+   * `hold(false)` delivers the held results.
+   */
+  hold(on) {
+    this.holding = on;
+    if (on) return;
+    for (const lane of this.lanes.values()) {
+      const p = lane.pending;
+      if (p?.held) {
+        lane.pending = null;
+        p.deliver(p.held);
+      }
+    }
+  }
+
   /** End the lane's worker (cancelling its request, if any). */
   close(name) {
     this.cancel(name);
@@ -66,7 +83,8 @@ export class Engine {
     const lane = this.lane(name);
     const id = this.nextId++;
     return new Promise((resolve, reject) => {
-      lane.pending = { id, reject };
+      const deliver = (m) => (m.ok ? resolve(m) : reject(new Error(m.error)));
+      lane.pending = { id, reject, deliver, held: null };
       lane.worker.onmessage = (ev) => {
         const m = ev.data;
         if (m.id !== id) return;
@@ -74,9 +92,12 @@ export class Engine {
           onChunk?.(JSON.parse(m.rows), m.total);
           return;
         }
+        if (this.holding) {
+          lane.pending.held = m;
+          return;
+        }
         lane.pending = null;
-        if (m.ok) resolve(m);
-        else reject(new Error(m.error));
+        deliver(m);
       };
       lane.worker.onerror = (ev) => {
         lane.pending = null;

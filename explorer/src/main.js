@@ -792,6 +792,8 @@ function applyHash(p) {
 async function main() {
   for (const p of DYN_PRESETS) $("dyn-preset").add(new Option(p.label, p.id));
   engine = await Engine.load("pkg/afmdyn_wasm_bg.wasm", "worker.js");
+  // testing: hold results back so that a request is certainly running (Engine.hold)
+  window.explorer.hold = (on) => engine.hold(on);
   const presets = loadPresets();
   // the engine's data, one after the other on one worker, which then ends
   const { doc: version } = await engine.run("meta", "version", {});

@@ -335,14 +335,19 @@ try {
     restored.modes === "2" && restored.a1 === "0.2" && restored.om === "2.7" && !cmp2.bad && cmp2.far <= 1e-6,
     JSON.stringify(restored) + cmp2.bad);
 
-  // a new request cancels the old: a 400-value diagram started, then the 12-value one while
-  // it runs; only the second's rows are shown (the command line's diagram)
-  await page2.fill("#steps", "400");
+  // a new request cancels the old: a 40-value diagram started and held back by the engine's
+  // gate (its result is not delivered: it is certainly still running), then the 12-value one;
+  // only the second's rows are shown (the command line's diagram)
+  await page2.evaluate(() => window.explorer.hold(true));
+  await page2.fill("#steps", "40");
   await page2.click("#dyn-run");
   await page2.waitForFunction(() => window.explorer.rows.length > 0);
   await page2.fill("#steps", "12");
   const [t12, running] = await page2.evaluate(() => [window.explorer.timings.diagram_ms, window.explorer.busy.diagram]);
+  // the click cancels the held request at once (Engine.request); then the gate opens for
+  // the new one
   await page2.click("#dyn-run");
+  await page2.evaluate(() => window.explorer.hold(false));
   await page2.waitForFunction((t) => window.explorer.timings.diagram_ms !== t && !window.explorer.busy.diagram, t12);
   const cmp3 = compareBifurcation(await page2.evaluate(() => window.explorer.rows), readFileSync(path.join(tmp2, "bifurcation.csv"), "utf8"));
   check("a new diagram cancels the one running: only its rows are shown (the command line's)",
