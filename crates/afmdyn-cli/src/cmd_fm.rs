@@ -27,8 +27,9 @@ pub struct FmArgs {
     /// Mode K the PLL tracks (1..=N)
     #[arg(long, default_value_t = 1)]
     mode: usize,
-    /// Rest distance z_c where the approach starts [default: 2A + a0, the lower turning point
-    /// at A from the sample]
+    /// Rest distance z_c where the approach starts [default: where the frequency shift has
+    /// decayed to 1 % of its value at --to (Giessibl's first-order shift of the law's force);
+    /// 2A + a0 for a law without a force before contact]
     #[arg(long, allow_hyphen_values = true)]
     from: Option<Quantity>,
     /// Rest distance z_c where it ends [default: A + a0, the lower turning point at the contact

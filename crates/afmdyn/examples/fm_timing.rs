@@ -1,8 +1,8 @@
 //! Cost of an FM-AFM curve: the exact steady states ([`afmdyn::analysis::fm`]) against the
 //! time-domain loop ([`afmdyn::analysis::fm_loop`], a PLL and an amplitude controller updating
 //! the drive once per cycle, integrated until settled), on the point mass of
-//! `examples/probe-point-mass-dmt.toml` (Q = 400) over 100 z_c values of the default range
-//! (2A + a0 down to A + a0):
+//! `examples/probe-point-mass-dmt.toml` (Q = 400) over 100 z_c values from 2A + a0 down to A + a0 (the
+//! request's default range before it followed the decay of the shift, kept for comparison):
 //!
 //! ```sh
 //! cargo run --release -p afmdyn --example fm_timing

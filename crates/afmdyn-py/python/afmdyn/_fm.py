@@ -95,8 +95,10 @@ def fm(
         amplitude: the oscillation amplitude A (m with ``probe``, else g₀; default the probe's
             free amplitude A₀).
         mode: the mode K the PLL tracks (1..N).
-        from_, to: the z_c range (default 2A + a₀ down to A + a₀: the lower turning point from
-            A to the contact distance a₀), m with ``probe``, else g₀.
+        from_, to: the z_c range, m with ``probe``, else g₀ (default: from where the frequency
+            shift has decayed to 1 % of its value at ``to`` — Giessibl's first-order shift of
+            the law's force; 2A + a₀ for a law without a force before contact — down to
+            A + a₀, the lower turning point at the contact distance a₀).
         step, points: the grid (a step in the same unit, or the number of values; default 120).
         tolerance: of the loop conditions, |A₁/A − 1| and the phase error (rad).
         probe: a probe file (a model keyword, as ``--probe``): SI inputs and outputs.

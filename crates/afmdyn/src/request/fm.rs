@@ -25,7 +25,9 @@ pub struct FmRequest {
     pub amplitude: Option<f64>,
     /// The mode K (1-based) the PLL tracks; default 1.
     pub mode: usize,
-    /// First z_c of the approach (default 2A + a₀: the lower turning point at A).
+    /// First z_c of the approach (default: where the frequency shift has decayed to 1 % of
+    /// its value at `to`, [`default_from`]; 2A + a₀, the lower turning point at A, for the
+    /// laws without a force before contact).
     pub from: Option<f64>,
     /// Last z_c (default A + a₀: the lower turning point at the contact distance a₀, 0 for
     /// the laws without attraction).
@@ -59,6 +61,65 @@ pub const FM_AMPLITUDE_RANGE: (f64, f64) = (1e-8, 1e4);
 /// The FM amplitude's typical range in SI (m): 10 pm (qPlus sensors at small amplitude) to
 /// 1 µm; outside it the document warns of a unit slip.
 pub const FM_AMPLITUDE_TYPICAL: (f64, f64) = (1e-11, 1e-6);
+
+/// The share of the frequency shift at the curve's end (`to`) below which the default FM curve
+/// starts: the range runs from where |Δf| has decayed to it down to contact, which is also the
+/// range a Sader–Jarvis reconstruction needs (its integrals run to where the shift vanishes).
+pub const FM_DEFAULT_DECAY: f64 = 0.01;
+
+/// The default first z_c of an FM curve at amplitude `a` ending at `to` (units of g₀): the
+/// largest z_c whose estimated frequency shift is still [`FM_DEFAULT_DECAY`] of its value at
+/// `to` (by bisection to round-off), from Giessibl's first-order shift, which is
+/// proportional to the cosine-weighted mean force over a cycle,
+/// Δf ∝ −⟨F(z_c + A cos θ) cos θ⟩_θ (Giessibl, *Phys. Rev. B* 56, 16010 (1997), eq. 11;
+/// [`crate::analysis::fm::law_force`] the law's conservative force at distance d, the mean by
+/// the midpoint rule over enough phases to resolve the closest approach, 40 across its
+/// width √(2 d_min/A)). `None` when the law has no force before contact (the
+/// shift at `to` is 0) or it does not decay within 10⁶ g₀.
+pub fn default_from(base: &crate::Params, a: f64, to: f64) -> Option<f64> {
+    // the integrand peaks at the closest distance d_min = to − A within |θ − π| ≈ √(2 d_min/A):
+    // 40 phases across that width (at least 1024, at most 2²⁰ over the cycle)
+    let d_min = (to - a)
+        .max(base.contact_law.distance_offset())
+        .max(1e-9 * a);
+    let width = (2.0 * d_min / a).sqrt().min(1.0);
+    let phases = ((40.0 * std::f64::consts::TAU / width).ceil() as usize).clamp(1024, 1 << 20);
+    let shift = |z: f64| {
+        (0..phases)
+            .map(|k| {
+                let theta = std::f64::consts::TAU * (k as f64 + 0.5) / phases as f64;
+                crate::analysis::fm::law_force(base, z + a * theta.cos()) * theta.cos()
+            })
+            .sum::<f64>()
+            / phases as f64
+    };
+    let target = FM_DEFAULT_DECAY * shift(to).abs();
+    if !(target > 0.0 && target.is_finite()) {
+        return None;
+    }
+    // out from `to` by doubling steps until the shift is below the target, then bisect
+    let (mut lo, mut step) = (to, 1e-3 * a.max(1e-6));
+    while shift(to + step).abs() > target {
+        lo = to + step;
+        step *= 2.0;
+        if step > 1e6 {
+            return None;
+        }
+    }
+    let mut hi = to + step;
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if mid <= lo || mid >= hi {
+            break;
+        }
+        if shift(mid).abs() > target {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    Some(hi)
+}
 
 impl FmRequest {
     /// The units of the document: SI with a probe (frequencies in Hz), else the model's.
@@ -129,7 +190,12 @@ impl FmRequest {
         super::limits::tolerance("tolerance", tol)?;
         let a = self.amplitude.map_or(1.0, |a| a / length);
         let offset = base.contact_law.distance_offset();
-        let (from, to) = range.ends((2.0 * a + offset, a + offset), length);
+        let from_default = match range.from {
+            Some(_) => 2.0 * a + offset, // not used
+            None => default_from(&base, a, range.to.map_or(a + offset, |t| t / length))
+                .unwrap_or(2.0 * a + offset),
+        };
+        let (from, to) = range.ends((from_default, a + offset), length);
         let values = approach_spec(base, from, to, range.spacing(length)?)
             .map_err(|e| super::curves::in_units(e, length))?
             .values;
