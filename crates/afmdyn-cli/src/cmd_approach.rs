@@ -128,8 +128,8 @@ pub struct ApproachArgs {
     out: PathBuf,
 }
 
-/// `afmdyn bimodal` flags: those of `approach` without the setpoint; the probe's `[drive]`
-/// gives two or more components (`free_amplitude = [A01, A02]`, `frequency = [f1, f2]`).
+/// `afmdyn bimodal` flags: those of `approach`; the probe's `[drive]` gives two or more
+/// components (`free_amplitude = [A01, A02]`, `frequency = [f1, f2]`).
 #[derive(Debug, Args)]
 pub struct BimodalArgs {
     #[command(flatten)]
@@ -144,6 +144,11 @@ pub struct BimodalArgs {
     /// 1000 drive periods). No branches
     #[arg(long)]
     average: bool,
+    /// Setpoint A1/A01 in (0, 1] of the first component's amplitude (the one the feedback
+    /// holds): the operating points where the curve reaches it, with every component's
+    /// amplitude, phase, virial and dissipated energy there ("setpoint" in --json)
+    #[arg(long, value_name = "RATIO")]
+    setpoint: Option<f64>,
     /// Output directory (locked during the run)
     #[arg(long, default_value = "afmdyn-out/bimodal")]
     out: PathBuf,
@@ -774,6 +779,19 @@ fn print_setpoint(sp: &serde_json::Value, labels: &Labels, u: &CurveUnits) -> Re
             num(p, "phase_deg"),
             length(num(p, "indentation")),
         );
+        // a multifrequency drive: each component's amplitude and phase there
+        for i in 1.. {
+            let Some(amp) = p.get(format!("amplitude_{i}")).and_then(|v| v.as_f64()) else {
+                break;
+            };
+            outln!(
+                "    component {i}: A{i} = {}, phase {:.2}°, virial {}, E_dis {}",
+                length(amp),
+                num(p, &format!("phase_{i}_deg")),
+                resolved(num(p, &format!("virial_{i}")), u.energy, si("J")),
+                resolved(num(p, &format!("energy_dissipated_{i}")), u.energy, si("J")),
+            );
+        }
     }
     Ok(())
 }
@@ -809,7 +827,7 @@ pub fn bimodal(a: &BimodalArgs) -> Result<(), CliError> {
     afmdyn::request::curves::check_bimodal(&base)?;
     let request = ApproachRequest {
         curve: a.curve.request(from, to, Dim::Length, si)?,
-        setpoint: None,
+        setpoint: a.setpoint,
         average: a.average,
     };
     approach_run(&a.curve, &a.out, "bimodal", &request, base, units, probe)

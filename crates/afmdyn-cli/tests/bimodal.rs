@@ -263,3 +263,70 @@ fn a_killed_average_resumes_to_the_uninterrupted_files() {
         );
     }
 }
+
+/// Issue 60 item 15: `bimodal --setpoint` gives the operating point where the first
+/// component's amplitude — the one the feedback holds — is the setpoint times its free
+/// amplitude (a defining identity: A1 = 0.7 × 10 nm), with every component's amplitude, phase,
+/// virial and E_dis there, each between its values at the two curve points around it.
+#[test]
+fn bimodal_setpoint_gives_every_component() {
+    let out = afmdyn(&[
+        "bimodal",
+        "--probe",
+        PROBE,
+        "--points",
+        "20",
+        "--setpoint",
+        "0.7",
+        "--files",
+        "none",
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let a01 = doc["drive_components"]["free_amplitude"][0]
+        .as_f64()
+        .unwrap();
+    let points = doc["setpoint"]["points"].as_array().unwrap();
+    assert!(!points.is_empty());
+    for p in points {
+        let a1 = p["amplitude_1"].as_f64().unwrap();
+        assert!((a1 - 0.7 * a01).abs() < 1e-9 * a01, "{a1} vs {}", 0.7 * a01);
+        for key in [
+            "amplitude_2",
+            "phase_2_deg",
+            "virial_2",
+            "energy_dissipated_2",
+        ] {
+            assert!(p[key].as_f64().is_some_and(f64::is_finite), "{key}: {p}");
+        }
+        // the same row of the curve's own columns brackets each component's value
+        let z = p["z_c"].as_f64().unwrap();
+        let source = p["source"].as_str().unwrap();
+        if let Some(j) = source.strip_prefix("branch ") {
+            let b = &doc["branches"][j.parse::<usize>().unwrap()];
+            let zs: Vec<f64> = b["z_c"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|v| v.as_f64().unwrap())
+                .collect();
+            let k = zs
+                .windows(2)
+                .position(|w| (w[0] - z) * (w[1] - z) <= 0.0)
+                .expect("the setpoint lies on its branch");
+            for key in ["amplitude_2", "phase_2_deg"] {
+                let (lo, hi) = (b[key][k].as_f64().unwrap(), b[key][k + 1].as_f64().unwrap());
+                let v = p[key].as_f64().unwrap();
+                assert!(
+                    v >= lo.min(hi) - 1e-12 && v <= lo.max(hi) + 1e-12,
+                    "{key}: {v} not in [{lo}, {hi}]"
+                );
+            }
+        }
+    }
+}

@@ -27,8 +27,8 @@ fn a_pi_gain_that_sets_too_fast_a_scan_blames_the_gain() {
             "1",
             "--setpoint",
             "0.8",
-            "--files",
-            "none",
+            "--out",
+            temp_dir("pi-gain").join("out").to_str().unwrap(),
         ],
         &["gains", "K_I = 1e12", "at most 1.500000e6", "scan"],
     );

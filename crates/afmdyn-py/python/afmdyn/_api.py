@@ -498,6 +498,7 @@ def bimodal(
     tolerance: float = _DEFAULTS["approach"]["tolerance"],
     traces: Optional[int] = None,
     average: bool = False,
+    setpoint: Optional[float] = None,
     store: Union[str, "os.PathLike[str]", None] = None,
     resume: bool = False,
     progress: ProgressArg = None,
@@ -520,6 +521,10 @@ def bimodal(
         average: demodulate a time average (a Hann² window over many primary periods, after
             the transient has settled) instead of the periodic orbit — what an incommensurate
             ratio always gets; branches and traces are then off.
+        setpoint: A1/A01 in (0, 1] of the first component, the amplitude the feedback holds:
+            ``ds.afmdyn.to_dict()["setpoint"]["points"]`` gives the operating points where the
+            curve reaches it, with every component's ``amplitude_i``, ``phase_i_deg``,
+            ``virial_i`` and ``energy_dissipated_i`` there (as :func:`approach`'s).
         probe: the probe file with the multifrequency ``[drive]`` (a model keyword).
 
     Raises:

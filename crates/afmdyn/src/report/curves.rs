@@ -420,6 +420,12 @@ pub fn setpoint(params: &Params, c: &SteppedCurve, ratio: f64, u: &CurveUnits) -
             for (c, v) in CURVE_COLUMNS.iter().zip(row) {
                 m.insert(c.name.into(), json!(v));
             }
+            // a multifrequency drive: each component's amplitude, phase, virial and E_dis there
+            let (ca, cb) = (component_row(a, u), component_row(b, u));
+            let names = component_columns(ca.len() / 4);
+            for ((name, _, _), (p, q)) in names.into_iter().zip(ca.iter().zip(&cb)) {
+                m.insert(name, json!((1.0 - k.t) * p + k.t * q));
+            }
             Value::Object(m)
         })
         .collect();
