@@ -52,6 +52,11 @@ run resonance resonance --probe "$B" --out o --json
 run orbit-probe orbit --probe "$B" --z-c 6e-9 --json
 run attr-highq attractors --probe "$H" --samples 4 --json
 run bad-input orbit --omega -1
+run fm-probe fm --probe "$P" --points 12 --out o --json
+run fm-model fm --contact-law dmt --hamaker 1e-5 --intermolecular-distance 0.01 --points 12 --out o --json
+run bimodal bimodal --probe "$EX/probe-bimodal.toml" --points 10 --setpoint 0.7 --out o --json
+run reconstruct reconstruct --fm "$EX/fm-vdw.csv" --spring-constant 40 --resonance-frequency 300kHz --amplitude 10nm --out o --json
+run image image --probe "$P" --sample "$EX/sample-stripe.toml" --setpoint 0.8 --pixels 8 --curve-points 30 --out o --json
 # the Python datasets: every variable's dims, attrs and bytes
 if [ "$PY" != none ] && [ -x "$PY" ]; then
     mkdir -p "$OUT/python"
@@ -79,7 +84,12 @@ PYEOF
     echo $? >exit.txt)
 fi
 # the manifest: every file's sum (absolute paths of this run are replaced before summing)
+# (a store's records, .jsonl, are summed in sorted order: threads append them as they finish)
 (cd "$OUT" && find . -type f ! -name manifest.txt ! -name "*.lock" ! -name ".chart.tiles.jsonl" ! -path ./python/stderr.txt | LC_ALL=C sort | while read -r f; do
-    printf '%s  %s\n' "$(sed "s#$OUT#OUT#g; s#$EX#EX#g" "$f" | sha256sum | cut -c1-16)" "$f"
+    case "$f" in
+        *.jsonl) sum=$(sed "s#$OUT#OUT#g; s#$EX#EX#g" "$f" | LC_ALL=C sort | sha256sum | cut -c1-16) ;;
+        *) sum=$(sed "s#$OUT#OUT#g; s#$EX#EX#g" "$f" | sha256sum | cut -c1-16) ;;
+    esac
+    printf '%s  %s\n' "$sum" "$f"
 done) >"$OUT/manifest.txt"
 echo "$(wc -l <"$OUT/manifest.txt") files in $OUT/manifest.txt"
