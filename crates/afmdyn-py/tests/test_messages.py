@@ -40,9 +40,9 @@ def test_a_complex_height_map_is_refused() -> None:
     probe = str(EXAMPLES / "probe-point-mass-dmt.toml")
     sample = str(EXAMPLES / "sample-stripe.toml")
     with pytest.raises(ValueError, match="height_map: must be real numbers"):
-        afmdyn.image(probe=probe, sample=sample, height_map=np.ones((4, 4)) * (1 + 1j) * 1e-9)
+        afmdyn.image(probe=probe, sample=sample, setpoint=0.8, height_map=np.ones((4, 4)) * (1 + 1j) * 1e-9)
     with pytest.raises(ValueError, match="height_map: must be a 2D array"):
-        afmdyn.image(probe=probe, sample=sample, height_map=np.ones(4) * 1e-9)
+        afmdyn.image(probe=probe, sample=sample, setpoint=0.8, height_map=np.ones(4) * 1e-9)
 
 
 def test_reconstruct_refuses_arrays_that_are_not_curves() -> None:
