@@ -3,6 +3,7 @@
 //! and the corrector itself (module docs of [`super`]).
 
 use super::*;
+use crate::maps::DiscreteMap;
 
 pub(super) struct Solver {
     pub(super) spec: ContinuationSpec,
@@ -42,6 +43,13 @@ impl Solver {
         Ok(self.cache[i].1.as_mut())
     }
 
+    /// The branch's map at `p`: the period-n stroboscopic map (n the branch's period) with
+    /// ∂Pⁿ/∂p asked for, one iterate of which the corrector evaluates through [`DiscreteMap`].
+    fn map_at(&mut self, p: f64) -> Result<StroboscopicMap<'_>, SimError> {
+        let (n, param) = (self.spec.period, self.spec.param);
+        Ok(StroboscopicMap::new(self.at(p)?, n).with_param_derivative(param))
+    }
+
     /// Pⁿ(z) with its monodromy matrix and, where the integrator provides it, ∂Pⁿ/∂p; the
     /// distance to grazing only when `watched` (else NaN).
     pub(super) fn map(
@@ -50,18 +58,13 @@ impl Solver {
         p: f64,
         watched: bool,
     ) -> Result<FlowMap, SimError> {
-        let (n, param) = (self.spec.period, self.spec.param);
-        StroboscopicMap::new(self.at(p)?, n)
-            .with_param_derivative(param)
-            .watch_grazing(watched)
-            .apply(z)
+        self.map_at(p)?.linearise(z, 1, watched)
     }
 
     /// The distance to grazing of Pⁿ(z) (as the watched [`Solver::map`] reports it: the same
     /// steps and searches).
     pub(super) fn grazing(&mut self, z: &DVector<f64>, p: f64) -> Result<f64, SimError> {
-        let n = self.spec.period;
-        StroboscopicMap::new(self.at(p)?, n).grazing_distance(z)
+        DiscreteMap::grazing_distance(&mut self.map_at(p)?, z, 1)
     }
 
     /// ∂Pⁿ/∂p at (z, p): that of `map` when known, else central differences.
@@ -78,10 +81,9 @@ impl Solver {
     }
 
     /// Pⁿ(z) alone, by a flow without the variational equations
-    /// ([`StroboscopicMap::image`]).
+    /// ([`DiscreteMap::iterate`]).
     pub(super) fn map_state(&mut self, z: &DVector<f64>, p: f64) -> Result<DVector<f64>, SimError> {
-        let n = self.spec.period;
-        StroboscopicMap::new(self.at(p)?, n).image(z)
+        self.map_at(p)?.iterate(z, 1)
     }
 
     /// ∂Pⁿ/∂p by central differences of flows without the variational equations (two flows
