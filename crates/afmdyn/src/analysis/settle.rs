@@ -26,7 +26,7 @@
 use super::shooting::{shoot_undamped, ShootingOptions};
 use crate::error::SimError;
 use crate::integrate::{advance, Integrator};
-use crate::maps::StroboscopicMap;
+use crate::maps::DiscreteMap;
 use nalgebra::{Complex, DMatrix, DVector};
 
 /// Chunks of [`SettleOptions::chunk_periods`] during which Newton is retried before the
@@ -262,10 +262,11 @@ fn settled(found: Found, state: DVector<f64>, periods: usize) -> Settling {
 /// The smallest divisor d of an orbit's period n whose d-fold map already returns its state
 /// (Pᵈ(z*) = z* to `tol` relative to 1 + ‖z*‖): Newton from a transient tried at a multiple
 /// of the orbit's period finds the orbit all the same. `n` when no divisor does, or a flow
-/// fails.
-pub fn minimal_period(integ: &mut dyn Integrator, z: &DVector<f64>, n: usize, tol: f64) -> usize {
+/// fails. On any [`DiscreteMap`] (Pᵈ by [`DiscreteMap::iterate`]; the steady-state search
+/// gives the period-1 stroboscopic map of its integrator).
+pub fn minimal_period(dmap: &mut dyn DiscreteMap, z: &DVector<f64>, n: usize, tol: f64) -> usize {
     for d in (1..n).filter(|d| n.is_multiple_of(*d)) {
-        let Ok(state) = StroboscopicMap::new(&mut *integ, d).image(z) else {
+        let Ok(state) = dmap.iterate(z, d) else {
             return n;
         };
         if (&state - z).norm() <= tol * (1.0 + z.norm()) {

@@ -6,6 +6,7 @@ use super::shooting::{shoot_with, ShootingOptions};
 use crate::error::SimError;
 use crate::galerkin::Region;
 use crate::integrate::{advance, advance_observed, Integrator, Observed, Observer, Step};
+use crate::maps::StroboscopicMap;
 use crate::model::BodyContactCheck;
 use crate::roots::extremum;
 use crate::system::EventKind;
@@ -517,7 +518,12 @@ pub fn steady_state(
             integ.set_variational(false);
             if let Some(orbit) = s.found {
                 let n = orbit.period.unwrap_or(1);
-                let n = minimal_period(integ, &orbit.state, n, opts.tol);
+                let n = minimal_period(
+                    &mut StroboscopicMap::new(&mut *integ, 1),
+                    &orbit.state,
+                    n,
+                    opts.tol,
+                );
                 integ.reset(tau0 + spent as f64 * period, &orbit.state)?;
                 return record(integ, Some(n), spent, opts);
             }

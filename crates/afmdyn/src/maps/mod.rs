@@ -8,6 +8,8 @@
 //! events), the parameter derivative ∂P/∂p (`[2N]`) and the distance to grazing
 //! ([`flow::FlowMap`]). Errors are the integrator's [`SimError`]s.
 //!
+//! - [`discrete`]: the trait [`DiscreteMap`] (image, Jacobian, parameter derivative, distance
+//!   to grazing of the n-th iterate), which the map-only analyses take;
 //! - [`flow`]: the flow map z(τ0) ↦ z(τ1) of any integrator with its Jacobian (step Jacobians
 //!   times saltation matrices), its parameter derivative and the distance to grazing — the one
 //!   loop every map and the Lyapunov spectrum use;
@@ -19,7 +21,9 @@
 //! [`Integrator`]: crate::integrate::Integrator
 //! [`SimError`]: crate::error::SimError
 
+pub mod discrete;
 pub mod flow;
 pub mod stroboscopic;
 
+pub use discrete::DiscreteMap;
 pub use stroboscopic::StroboscopicMap;

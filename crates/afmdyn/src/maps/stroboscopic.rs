@@ -6,6 +6,7 @@
 
 use crate::error::SimError;
 use crate::integrate::Integrator;
+use crate::maps::discrete::DiscreteMap;
 use crate::maps::flow::{flow, flow_state, grazing_distance, FlowMap};
 use crate::params::SweepParam;
 use nalgebra::DVector;
@@ -68,7 +69,7 @@ impl<'a> StroboscopicMap<'a> {
 
     /// The duration nT of one iterate (dimensionless τ).
     pub fn duration(&self) -> f64 {
-        self.periods as f64 * self.integ.system().period()
+        self.duration_of(self.periods)
     }
 
     /// The integrator the map runs on (its state after a call is the last image's).
@@ -83,8 +84,23 @@ impl<'a> StroboscopicMap<'a> {
     /// [`SimError`] from the integrator, [`SimError::Unsupported`] for one without step
     /// Jacobians.
     pub fn apply(&mut self, z: &DVector<f64>) -> Result<FlowMap, SimError> {
-        let t = self.duration();
-        let mut map = flow(&mut *self.integ, 0.0, z, t, self.param, self.grazing)?;
+        self.apply_over(z, self.periods, self.grazing)
+    }
+
+    /// The duration of `periods` drive periods (dimensionless τ).
+    fn duration_of(&self, periods: usize) -> f64 {
+        periods as f64 * self.integ.system().period()
+    }
+
+    /// [`Self::apply`] over `periods` drive periods, the distance to grazing when `grazing`.
+    fn apply_over(
+        &mut self,
+        z: &DVector<f64>,
+        periods: usize,
+        grazing: bool,
+    ) -> Result<FlowMap, SimError> {
+        let t = self.duration_of(periods);
+        let mut map = flow(&mut *self.integ, 0.0, z, t, self.param, grazing)?;
         if let (Some(d), Some(SweepParam::Omega)) = (&mut map.param_derivative, self.param) {
             let mut f = DVector::zeros(z.len());
             let m = self.integ.system();
@@ -119,5 +135,59 @@ impl<'a> StroboscopicMap<'a> {
     pub fn grazing_distance(&mut self, z: &DVector<f64>) -> Result<f64, SimError> {
         let t = self.duration();
         grazing_distance(&mut *self.integ, 0.0, z, t)
+    }
+}
+
+/// The period-n map as a [`DiscreteMap`]: one iterate spans [`StroboscopicMap::periods`] drive
+/// periods, and Pᵏ is one flow over k·n periods (the same flow as the inherent methods of a map
+/// of k·n periods, so the same numbers); the parameter derivative as set by
+/// [`StroboscopicMap::with_param_derivative`].
+impl DiscreteMap for StroboscopicMap<'_> {
+    fn dim(&self) -> usize {
+        self.integ.system().dim()
+    }
+
+    fn periods(&self) -> usize {
+        self.periods
+    }
+
+    fn duration(&self) -> f64 {
+        StroboscopicMap::duration(self)
+    }
+
+    fn iterate(&mut self, z: &DVector<f64>, n: usize) -> Result<DVector<f64>, SimError> {
+        let t = self.duration_of(self.periods * n);
+        flow_state(&mut *self.integ, 0.0, z, t)
+    }
+
+    fn linearise(
+        &mut self,
+        z: &DVector<f64>,
+        n: usize,
+        grazing: bool,
+    ) -> Result<FlowMap, SimError> {
+        self.apply_over(z, self.periods * n, grazing)
+    }
+
+    fn grazing_distance(&mut self, z: &DVector<f64>, n: usize) -> Result<f64, SimError> {
+        let t = self.duration_of(self.periods * n);
+        grazing_distance(&mut *self.integ, 0.0, z, t)
+    }
+
+    fn check_state(&self, name: &'static str, z: &DVector<f64>) -> Result<(), SimError> {
+        self.integ.system().check_state(name, z)
+    }
+
+    /// For a hysteretic system ([`crate::tip_sample::TipSampleSystem::is_hysteretic`]): whether
+    /// the flow from z ends in the region a start at z is given
+    /// ([`crate::system::HybridSystem::mode_at`]'s rule in the neck's band): one extra flow,
+    /// for such systems only; `true` for every other system.
+    fn closes(&mut self, z: &DVector<f64>, n: usize) -> Result<bool, SimError> {
+        if !self.integ.system().is_hysteretic() {
+            return Ok(true);
+        }
+        let start = self.integ.system().mode_at(0.0, z.as_slice());
+        self.iterate(z, n)?;
+        Ok(self.integ.region() == start)
     }
 }

@@ -1,0 +1,337 @@
+//! One point of a stepped sweep: the transient settled from the previous value's state
+//! ([`settle`]), the orbit continued by a predicted Newton solve with substeps where it fails,
+//! and the trend of the branch the predictor follows (module docs of [`super`]).
+
+use super::*;
+
+/// Integrate from `z0` (τ = 0) at the integrator's parameters until the motion settles:
+/// Newton shooting for a period-`n` orbit from the transient every `spec.chunk_periods`
+/// periods, for at most [`NEWTON_CHUNKS`] chunks, until the trajectory is seen to go to a
+/// stable orbit ([`newton_from_transient`]); otherwise the motion is classified by
+/// [`steady_state`] within `spec.steady` (a period-m orbit is then polished by Newton), over
+/// the periods of the point's [`transient_cap`] not yet spent.
+///
+/// # Errors
+/// [`SimError`] from the integrator.
+pub fn settle(
+    integ: &mut dyn Integrator,
+    z0: &DVector<f64>,
+    n: usize,
+    spec: &SteppedSpec,
+) -> Result<Found, SimError> {
+    let cap = transient_cap(integ.system(), spec);
+    let chunk = spec.chunk_periods.max(1);
+    let opts = SettleOptions {
+        newton: spec.newton,
+        chunk_periods: chunk,
+        max_period: spec.steady.max_period,
+        max_wait: usize::MAX,
+        settled: SETTLED,
+        linear: true,
+    };
+    let budget = cap.min(NEWTON_CHUNKS * chunk);
+    let s = newton_from_transient(integ, z0, Some(n), &opts, budget, &mut |_| false)?;
+    if let Some(found) = s.found {
+        return Ok(found);
+    }
+    // no settling on a period-n orbit: classify the motion
+    integ.set_variational(false);
+    integ.reset(0.0, &s.state)?;
+    let steady = SteadyOptions {
+        max_periods: Some(cap.saturating_sub(s.periods).max(1)),
+        newton: false,
+        ..spec.steady
+    };
+    let s = steady_state(integ, &steady)?;
+    if let Some(m) = s.period() {
+        if let Ok(o) = shoot_with(integ, s.end_state(), m, &spec.newton) {
+            if o.stable {
+                return Ok(Found {
+                    period: Some(m),
+                    state: o.state,
+                    multipliers: o.multipliers,
+                    monodromy: Some(o.monodromy),
+                    stable: true,
+                });
+            }
+        }
+    }
+    Ok(Found {
+        period: None,
+        state: s.end_state().clone(),
+        multipliers: Vec::new(),
+        monodromy: None,
+        stable: true,
+    })
+}
+
+/// The integrator at one parameter value, started at `z` (τ = 0).
+pub(super) fn integrator_at(
+    spec: &SteppedSpec,
+    value: f64,
+    z: &DVector<f64>,
+) -> Result<Box<dyn Integrator>, SimError> {
+    let model = CantileverModel::new(&spec.base.with(spec.param, value))?;
+    build(&model, spec.integrator.clone(), 0.0, z)
+}
+
+/// Follow the stable period-n orbit `z0` at `v0` (its monodromy matrix and trend `m0`) to `v1`
+/// by Newton
+/// (from the secant prediction `z0 + slope (v1 − v0)`, then from `z0`; undamped,
+/// [`shoot_undamped`]: a full step that does not lower the residual means the orbit is not
+/// near, and halving the parameter step is the remedy; where the integrator integrates the
+/// variational equations step by step ([`broyden_pays`]), first [`shoot_broyden`] with the
+/// trend's estimate at `v1` as the first Jacobian): accepted when stable and within `jump_tol`
+/// of `z0`.
+/// Otherwise the step is halved (up to `depth` times) and each half continued in turn — a
+/// quasi-static sweep — unless three halvings in a row did not shrink the distance to the stable
+/// orbit Newton found below 0.95 of the distance over the longer step (`whole`: that distance
+/// and the halvings so far without shrinking): a jump, not a steep piece of branch (across a
+/// resonance much sharper than the step the distance shrinks slowly, but it shrinks). `None` when the orbit cannot be followed (it vanished or lost
+/// stability).
+#[allow(clippy::type_complexity, clippy::too_many_arguments)]
+pub(super) fn continue_orbit(
+    spec: &SteppedSpec,
+    v0: f64,
+    z0: &DVector<f64>,
+    slope: Option<&DVector<f64>>,
+    v1: f64,
+    m0: Option<&Trend>,
+    n: usize,
+    depth: usize,
+    whole: Option<(f64, usize)>,
+) -> Result<Option<ShotOrbit>, SimError> {
+    let model = CantileverModel::new(&spec.base.with(spec.param, v1))?;
+    let mut integ = build(&model, spec.integrator.clone(), 0.0, z0)?;
+    let m1 = m0
+        .filter(|_| broyden_pays(spec.integrator.clone(), &model))
+        .map(|t| t.at(v1 - v0));
+    let mut guesses = Vec::with_capacity(2);
+    if let Some(s) = slope {
+        guesses.push(z0 + s * (v1 - v0));
+    }
+    guesses.push(z0.clone());
+    let mut gap: Option<f64> = None;
+    for g in &guesses {
+        let shot = match &m1 {
+            Some(m) => shoot_broyden(integ.as_mut(), g, n, &spec.newton, m)
+                .or_else(|_| shoot_undamped(integ.as_mut(), g, n, &spec.newton)),
+            None => shoot_undamped(integ.as_mut(), g, n, &spec.newton),
+        };
+        if let Ok(o) = shot {
+            if o.stable {
+                let d = relative_gap(&o.state, z0);
+                if d <= spec.jump_tol {
+                    return Ok(Some(o));
+                }
+                gap = Some(gap.map_or(d, |x: f64| x.min(d)));
+            }
+        }
+    }
+    // halvings in a row that did not shrink the distance
+    let stuck = match (gap, whole) {
+        (Some(g), Some((w, k))) if g > 0.95 * w => k + 1,
+        _ => 0,
+    };
+    if depth == 0 || stuck >= 3 {
+        return Ok(None);
+    }
+    let mid = 0.5 * (v0 + v1);
+    let first = gap.map(|g| (g, stuck));
+    let Some(om) = continue_orbit(spec, v0, z0, slope, mid, m0, n, depth - 1, first)? else {
+        return Ok(None);
+    };
+    let half_slope = (&om.state - z0) / (mid - v0);
+    let trend = m0.map(|t| Trend::through(&t.m, &om.monodromy, mid - v0));
+    let mm = trend.as_ref();
+    continue_orbit(
+        spec,
+        mid,
+        &om.state,
+        Some(&half_slope),
+        v1,
+        mm,
+        n,
+        depth - 1,
+        None,
+    )
+}
+
+/// The monodromy matrix M of the orbit followed at v0 and, when the orbit before it is on the
+/// same branch, its rate of change along the sweep: the first Jacobian of [`shoot_broyden`] at
+/// v is M + (v − v0) dM/dv (linear extrapolation, the monodromy's counterpart of
+/// [`prediction_slope`]).
+#[derive(Debug, Clone)]
+pub(super) struct Trend {
+    m: DMatrix<f64>,
+    rate: Option<DMatrix<f64>>,
+}
+
+impl Trend {
+    /// From M(v0 − dv) = `before` to M(v0) = `m`.
+    pub(super) fn through(before: &DMatrix<f64>, m: &DMatrix<f64>, dv: f64) -> Self {
+        Trend {
+            m: m.clone(),
+            rate: Some((m - before) / dv),
+        }
+    }
+
+    /// The estimate dv after v0.
+    pub(super) fn at(&self, dv: f64) -> DMatrix<f64> {
+        match &self.rate {
+            Some(r) => &self.m + r * dv,
+            None => self.m.clone(),
+        }
+    }
+
+    /// The trend of the last point of `history`: its monodromy matrix, with the secant through
+    /// the point before when both are on one branch (the same period, the last not reached by
+    /// settling, distinct values).
+    pub(super) fn of(history: &[CurvePoint]) -> Option<Self> {
+        let k = history.len();
+        let last = history.last()?;
+        let m = last.monodromy.as_ref()?;
+        let before = (k >= 2)
+            .then(|| &history[k - 2])
+            .filter(|b| {
+                b.period == last.period && last.reached != Reached::Settled && b.value != last.value
+            })
+            .and_then(|b| b.monodromy.as_ref().map(|mb| (mb, last.value - b.value)));
+        Some(match before {
+            Some((mb, dv)) => Trend::through(mb, m, dv),
+            None => Trend {
+                m: m.clone(),
+                rate: None,
+            },
+        })
+    }
+}
+
+/// The slope s with which `z_last + s (value − v_last)` predicts the orbit at `value` from the
+/// previous points of the same branch (same period, none reached by settling after the first):
+/// the quadratic (Lagrange) extrapolation through the last three, else the secant through the
+/// last two, else none.
+pub(super) fn prediction_slope(history: &[CurvePoint], value: f64) -> Option<DVector<f64>> {
+    let k = history.len();
+    let last = history.last()?;
+    // the longest tail of the same branch, at most three points
+    let mut m = 1;
+    while m < k.min(3) {
+        let (a, b) = (&history[k - m - 1], &history[k - m]);
+        if a.period != b.period || b.reached == Reached::Settled || a.value == b.value {
+            break;
+        }
+        m += 1;
+    }
+    let pts = &history[k - m..];
+    let dv = value - last.value;
+    match pts {
+        [b, a] => Some((&a.state - &b.state) / (a.value - b.value)),
+        [c, b, a] if c.value != a.value => {
+            let (x0, x1, x2) = (c.value, b.value, a.value);
+            let l0 = (value - x1) * (value - x2) / ((x0 - x1) * (x0 - x2));
+            let l1 = (value - x0) * (value - x2) / ((x1 - x0) * (x1 - x2));
+            let l2 = (value - x0) * (value - x1) / ((x2 - x0) * (x2 - x1));
+            let pred = &c.state * l0 + &b.state * l1 + &a.state * l2;
+            (dv != 0.0).then(|| (pred - &a.state) / dv)
+        }
+        _ => None,
+    }
+}
+
+/// The steady state at `value` reached from the last point of `history` (or from rest), the
+/// previous points of its branch giving the predictor ([`prediction_slope`]).
+pub(super) fn step_point(
+    spec: &SteppedSpec,
+    value: f64,
+    history: &[CurvePoint],
+) -> Result<CurvePoint, SimError> {
+    let prev = history.last();
+    if let Some(opts) = &spec.average {
+        return average_point(spec, opts, value, prev);
+    }
+    let model = CantileverModel::new(&spec.base.with(spec.param, value))?;
+    let last = prev.map_or_else(|| model.rest(), |p| p.state.clone());
+    let n = prev.and_then(|p| p.period).unwrap_or(1);
+    let mut integ = build(&model, spec.integrator.clone(), 0.0, &last)?;
+    let slope = prediction_slope(history, value);
+    let continued = match prev {
+        Some(p) => continue_orbit(
+            spec,
+            p.value,
+            &last,
+            slope.as_ref(),
+            value,
+            Trend::of(history).as_ref(),
+            n,
+            SUBSTEP_DEPTH,
+            None,
+        )?
+        .map(|o| (o.state, o.multipliers, o.monodromy)),
+        None => shoot_with(integ.as_mut(), &last, n, &spec.newton)
+            .ok()
+            .filter(|o| o.stable)
+            .map(|o| (o.state, o.multipliers, o.monodromy)),
+    };
+    let first = if prev.is_some() {
+        Reached::Continued
+    } else {
+        Reached::Start
+    };
+    let (found, reached) = match continued {
+        Some((state, multipliers, monodromy)) => (
+            Found {
+                period: Some(n),
+                state,
+                multipliers,
+                monodromy: Some(monodromy),
+                stable: true,
+            },
+            first,
+        ),
+        None => (
+            settle(integ.as_mut(), &last, n, spec)?,
+            if prev.is_some() {
+                Reached::Settled
+            } else {
+                Reached::Start
+            },
+        ),
+    };
+    // the minimal period: a period carried along the sweep (or a transient's guess) finds a
+    // period-1 orbit as a fixed point of Pⁿ as readily as a period-n one
+    let found = match found.period {
+        Some(n) if n > 1 => {
+            match crate::analysis::shooting::reduce_period(
+                integ.as_mut(),
+                &found.state,
+                n,
+                &spec.newton,
+            )? {
+                Some(o) => Found {
+                    period: Some(o.period),
+                    state: o.state,
+                    multipliers: o.multipliers,
+                    monodromy: Some(o.monodromy),
+                    stable: o.stable,
+                },
+                None => found,
+            }
+        }
+        _ => found,
+    };
+    let periods = found.period.unwrap_or(spec.steady.nonperiodic_record);
+    let observables = measure(integ.as_mut(), &found.state, periods, &spec.observables)?;
+    Ok(CurvePoint {
+        value,
+        period: found.period,
+        state: found.state,
+        multipliers: found.multipliers,
+        monodromy: found.monodromy,
+        stable: found.stable,
+        reached,
+        observables,
+        tau: 0.0,
+        average: None,
+    })
+}

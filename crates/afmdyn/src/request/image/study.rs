@@ -1,0 +1,144 @@
+//! The setpoint study of an image ([`super::setpoint_study`]): the domain contrast of
+//! height, phase and dissipation over a range of amplitude ratios.
+
+use super::*;
+
+/// The apparent height and phase of every domain against the setpoint (issue 46's setpoint
+/// study: the contrast inversion of AM-AFM, García & San Paulo 2000): at each ratio a line
+/// engaged on the background ([`image`]'s rule) crosses onto each domain, whose operating point
+/// is the one the regime rule takes there. The materials' approach curves are computed once
+/// for all ratios.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SetpointStudy {
+    /// The setpoint ratios A_sp/A₀.
+    pub ratio: Vec<f64>,
+    /// The background first, then every domain of the map.
+    pub domains: Vec<DomainContrast>,
+    /// The materials' approach curves' warnings, named by material.
+    pub warnings: Vec<String>,
+}
+
+/// One domain's series of a [`SetpointStudy`]: per ratio its apparent height (m), phase lag
+/// (degrees) and regime, `None`/NaN where its material has no operating point there.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct DomainContrast {
+    /// `background` or the domain's name.
+    pub name: String,
+    /// Apparent height h + z_c − z_c,ref (m).
+    pub apparent_height: Vec<f64>,
+    /// Phase lag (degrees).
+    pub phase_deg: Vec<f64>,
+    /// Energy dissipated per period (J).
+    pub energy_dissipated: Vec<f64>,
+    /// Regime.
+    pub regime: Vec<Option<Regime>>,
+}
+
+/// Parse a setpoint study's ratios `FROM:TO:N` (N evenly spaced ratios in (0, 1), ends
+/// included).
+///
+/// # Errors
+/// [`SimError::OutOfRange`] naming `setpoint_study` for another form, ratios outside (0, 1)
+/// or N outside 2..=1000.
+pub fn study_ratios(spec: &str) -> Result<Vec<f64>, SimError> {
+    let bad = || {
+        SimError::out_of_range(
+            "setpoint_study",
+            spec.to_string(),
+            "must be FROM:TO:N, ratios A_sp/A0 in (0, 1) and N in 2..=1000 (e.g. 0.2:0.95:16)",
+        )
+    };
+    let parts: Vec<&str> = spec.split(':').collect();
+    let [from, to, n] = parts[..] else {
+        return Err(bad());
+    };
+    let (from, to): (f64, f64) = (
+        from.trim().parse().map_err(|_| bad())?,
+        to.trim().parse().map_err(|_| bad())?,
+    );
+    let n: usize = n.trim().parse().map_err(|_| bad())?;
+    let inside = |r: f64| r > 0.0 && r < 1.0;
+    if !(inside(from) && inside(to) && (2..=1000).contains(&n)) {
+        return Err(bad());
+    }
+    // (1 − t)·from + t·to: both ends exactly
+    Ok((0..n)
+        .map(|k| {
+            let t = k as f64 / (n - 1) as f64;
+            (1.0 - t) * from + t * to
+        })
+        .collect())
+}
+
+/// The setpoint study of `map` under the probe at the `ratios` ([`SetpointStudy`]).
+///
+/// # Errors
+/// [`SimError::OutOfRange`] naming `setpoint_study` for a ratio outside (0, 1) or no ratios;
+/// as [`image`]'s materials.
+pub fn setpoint_study(
+    probe_table: &toml::Table,
+    map: &SampleMap,
+    ratios: &[f64],
+    curve_points: usize,
+) -> Result<SetpointStudy, SimError> {
+    if ratios.is_empty() || ratios.iter().any(|&r| !(r > 0.0 && r < 1.0)) {
+        return Err(SimError::out_of_range(
+            "setpoint_study",
+            format!("{ratios:?}"),
+            "must be one or more ratios A_sp/A0 in (0, 1)",
+        ));
+    }
+    ImageRequest {
+        curve_points,
+        ..ImageRequest::at(ratios[0])
+    }
+    .validate(map)?;
+    let (curves, of_domain, units) = material_curves(probe_table, map, curve_points)?;
+    let names = std::iter::once(("background".to_string(), 0, 0.0)).chain(
+        map.domains
+            .iter()
+            .zip(&of_domain)
+            .map(|(d, &m)| (d.name.clone(), m, d.height)),
+    );
+    let mut domains: Vec<DomainContrast> = names
+        .clone()
+        .map(|(name, _, _)| DomainContrast {
+            name,
+            apparent_height: Vec::with_capacity(ratios.len()),
+            phase_deg: Vec::with_capacity(ratios.len()),
+            energy_dissipated: Vec::with_capacity(ratios.len()),
+            regime: Vec::with_capacity(ratios.len()),
+        })
+        .collect();
+    for &r in ratios {
+        let points: Vec<Vec<OperatingPoint>> =
+            curves.iter().map(|m| points_at(m, r, &units)).collect();
+        let engaged = engage(&points[0]).map(|i| &points[0][i]);
+        for ((_, material, height), series) in names.clone().zip(domains.iter_mut()) {
+            let pts = &points[material];
+            let point = engaged.and_then(|e| {
+                if material == 0 {
+                    Some(e)
+                } else {
+                    continue_from(pts, e.regime, e.z_c).map(|(i, _)| &pts[i])
+                }
+            });
+            let reference = engaged.map_or(f64::NAN, |e| e.z_c);
+            series
+                .apparent_height
+                .push(point.map_or(f64::NAN, |o| height + o.z_c - reference));
+            series
+                .phase_deg
+                .push(point.map_or(f64::NAN, |o| o.phase_deg));
+            series
+                .energy_dissipated
+                .push(point.map_or(f64::NAN, |o| o.energy_dissipated));
+            series.regime.push(point.map(|o| o.regime));
+        }
+    }
+    Ok(SetpointStudy {
+        ratio: ratios.to_vec(),
+        domains,
+        warnings: curve_warnings(&curves),
+    })
+}
