@@ -145,7 +145,7 @@ pub fn model_spec(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<ModelSpec> {
                 let name: String = v.extract().map_err(|_| {
                     PyTypeError::new_err(format!(
                         "{key}: expected a string ({})",
-                        afmdyn::contact::LawKind::EXPECTED
+                        afmdyn::contact::LawKind::expected()
                     ))
                 })?;
                 m.contact_law = Some(

@@ -196,12 +196,7 @@ impl CantileverModel {
             tip_acc_forcing,
             period,
             release: params.contact_law.release_distance(params.alpha4),
-            zener: match params.contact_law {
-                ContactLaw::Sls { maxwell_stiffness } => {
-                    Some(Zener::new(params.alpha4, maxwell_stiffness, params.alpha6))
-                }
-                _ => None,
-            },
+            zener: params.contact_law.zener(params.alpha4, params.alpha6),
         })
     }
 
@@ -394,23 +389,23 @@ impl CantileverModel {
         v_t: impl FnOnce() -> (f64, f64),
     ) -> f64 {
         let contact = r == Region::Contact;
-        match self.law.law {
-            ContactLaw::Sls { .. } => match self.zener_state(z) {
+        // a law with an internal state (SLS), a rigid constraint (impact), or a force law
+        if self.zener.is_some() {
+            match self.zener_state(z) {
                 Some((zn, u)) if contact => zn.force(true, -v_t().0, u),
                 _ => 0.0,
-            },
-            ContactLaw::Impact { .. } => {
-                if contact {
-                    self.sticking_force_value(tau, z)
-                } else {
-                    0.0
-                }
             }
-            _ if !contact && !self.law.acts_outside() => 0.0,
-            _ => {
-                let (v, vd) = v_t();
-                self.law.force(contact, -v, -vd).force
+        } else if self.law.law.restitution().is_some() {
+            if contact {
+                self.sticking_force_value(tau, z)
+            } else {
+                0.0
             }
+        } else if !contact && !self.law.acts_outside() {
+            0.0
+        } else {
+            let (v, vd) = v_t();
+            self.law.force(contact, -v, -vd).force
         }
     }
 
@@ -430,14 +425,7 @@ impl CantileverModel {
 
     /// [`Self::kelvin_voigt_weight`] given (sin Ωτ, cos Ωτ) = `sc` ([`Self::base_trig`]).
     fn kelvin_voigt_weight_at(&self, r: Region, sc: (f64, f64), z: &[f64]) -> f64 {
-        if r != Region::Contact
-            || !matches!(
-                self.law.law,
-                ContactLaw::Dmt { .. }
-                    | ContactLaw::Electrostatic { .. }
-                    | ContactLaw::Capillary { .. }
-            )
-        {
+        if r != Region::Contact || !self.law.law.kelvin_voigt() {
             return 0.0;
         }
         let [v, _, _] = self.v_t_at(sc, [self.w_tip_slice(z, 0), 0.0, 0.0]);
@@ -472,52 +460,45 @@ impl CantileverModel {
         // added to the velocity rows
         let mut buf = [0.0; crate::params::MAX_STATE];
         let row = &mut buf[..self.dim()];
-        match self.law.law {
-            ContactLaw::Sls { .. } => {
-                let Some((zn, _)) = self.zener_state(z) else {
-                    return;
-                };
-                // u̇ = (κ/α6)(δ_s − u): δ_s = δ = −φᵀa − … in contact, s(u) free
-                let rate = zn.relaxation_rate();
-                if r == Region::Contact {
-                    for (j, t) in self.tip().iter().enumerate() {
-                        jac[(2 * n, j)] = -rate * t;
-                    }
-                    jac[(2 * n, 2 * n)] = -rate;
-                    // F = (α4 + κ)δ − κu
-                    for (j, t) in self.tip().iter().enumerate() {
-                        row[j] = -(zn.relaxed + zn.maxwell) * t;
-                    }
-                    row[2 * n] = -zn.maxwell;
-                } else {
-                    jac[(2 * n, 2 * n)] = rate * (zn.surface_gain() - 1.0);
-                    return;
-                }
-            }
-            ContactLaw::Impact { .. } => {
-                if r != Region::Contact {
-                    return;
-                }
-                row.copy_from_slice(self.sticking_force(tau, z).grad.as_slice());
-            }
-            _ => {
-                if r != Region::Contact && !self.law.acts_outside() {
-                    return;
-                }
-                let [v, vd, _] =
-                    self.v_t_at(sc, [self.w_tip_slice(z, 0), self.w_tip_slice(z, n), 0.0]);
-                let f = self.law.force(r == Region::Contact, -v, -vd);
-                let w = self.kelvin_voigt_weight_at(r, sc, z);
-                let d_delta = if singular || w == 0.0 {
-                    f.d_delta
-                } else {
-                    // remove α6 δ̇/(2√δ) = α6² δ̇/(2w)
-                    f.d_delta - 0.5 * self.law.damping * self.law.damping * (-vd) / w
-                };
+        // a law with an internal state (SLS), a rigid constraint (impact), or a force law
+        if let Some((zn, _)) = self.zener_state(z) {
+            // u̇ = (κ/α6)(δ_s − u): δ_s = δ = −φᵀa − … in contact, s(u) free
+            let rate = zn.relaxation_rate();
+            if r == Region::Contact {
                 for (j, t) in self.tip().iter().enumerate() {
-                    row[j] = -d_delta * t;
-                    row[n + j] = -f.d_rate * t;
+                    jac[(2 * n, j)] = -rate * t;
                 }
+                jac[(2 * n, 2 * n)] = -rate;
+                // F = (α4 + κ)δ − κu
+                for (j, t) in self.tip().iter().enumerate() {
+                    row[j] = -(zn.relaxed + zn.maxwell) * t;
+                }
+                row[2 * n] = -zn.maxwell;
+            } else {
+                jac[(2 * n, 2 * n)] = rate * (zn.surface_gain() - 1.0);
+                return;
+            }
+        } else if self.law.law.restitution().is_some() {
+            if r != Region::Contact {
+                return;
+            }
+            row.copy_from_slice(self.sticking_force(tau, z).grad.as_slice());
+        } else {
+            if r != Region::Contact && !self.law.acts_outside() {
+                return;
+            }
+            let [v, vd, _] = self.v_t_at(sc, [self.w_tip_slice(z, 0), self.w_tip_slice(z, n), 0.0]);
+            let f = self.law.force(r == Region::Contact, -v, -vd);
+            let w = self.kelvin_voigt_weight_at(r, sc, z);
+            let d_delta = if singular || w == 0.0 {
+                f.d_delta
+            } else {
+                // remove α6 δ̇/(2√δ) = α6² δ̇/(2w)
+                f.d_delta - 0.5 * self.law.damping * self.law.damping * (-vd) / w
+            };
+            for (j, t) in self.tip().iter().enumerate() {
+                row[j] = -d_delta * t;
+                row[n + j] = -f.d_rate * t;
             }
         }
         for (c, &rc) in row.iter().enumerate() {

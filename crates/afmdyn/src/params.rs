@@ -566,39 +566,9 @@ impl Params {
             });
         }
         self.contact_law.validate()?;
-        if let crate::contact::ContactLaw::Jkr { adhesion } = self.contact_law {
-            // the JKR branch scales with P̃/α4 (δ_f = −3(P̃/(6α4))^{2/3}): α4 = 0 has no
-            // elastic contact, and beyond 1e12 the neck is below resolution or the whole gap
-            let ratio = adhesion / self.alpha4;
-            if !(self.alpha4 > 0.0 && (1e-12..=1e12).contains(&ratio)) {
-                return Err(ParamError::Law {
-                    name: "alpha4 (contact stiffness α4, the JKR Hertz group)",
-                    value: self.alpha4,
-                    range: "α4 > 0 with 1e-12 ≤ P̃/α4 ≤ 1e12 (the neck's scale)",
-                });
-            }
-        }
-        if let crate::contact::ContactLaw::Sls { maxwell_stiffness } = self.contact_law {
-            // the Maxwell arm relaxes at κ/α6: a dashpot is needed (α6 = 0 would relax it
-            // instantly), and its rate must stay within the integrators' reach
-            let rate = maxwell_stiffness / self.alpha6;
-            if !(self.alpha6 > 0.0 && rate <= 1e12) {
-                return Err(ParamError::Law {
-                    name: "alpha6 (the SLS Maxwell arm's dashpot α6)",
-                    value: self.alpha6,
-                    range: "α6 > 0 with κ/α6 ≤ 1e12 (the relaxation rate)",
-                });
-            }
-            // the relaxed spring brings the surface back after a tap (α4 = 0, a Maxwell
-            // fluid, keeps every dent)
-            if self.alpha4 <= 0.0 || self.alpha4.is_nan() {
-                return Err(ParamError::Law {
-                    name: "alpha4 (the SLS relaxed spring α4)",
-                    value: self.alpha4,
-                    range: "α4 > 0 (the spring that brings the surface back after a tap)",
-                });
-            }
-        }
+        // the law's groups against the shared α4, α6 (JKR's neck scale P̃/α4, the SLS
+        // relaxation rate κ/α6)
+        self.contact_law.validate_shared(self.alpha4, self.alpha6)?;
         if let Some(profile) = &self.damping_profile {
             for &s in &profile[..self.modes] {
                 if !(s.is_finite() && s >= 0.0) {

@@ -1141,25 +1141,12 @@ impl Probe {
             .string(s, S, "law")
             .map(|l| (l, l.trim().to_ascii_lowercase()))
         {
-            Some((_, l))
-                if matches!(
-                    l.as_str(),
-                    "linear"
-                        | "hertz"
-                        | "dmt"
-                        | "electrostatic"
-                        | "jkr"
-                        | "capillary"
-                        | "sls"
-                        | "impact"
-                ) =>
-            {
-                Some(l)
-            }
+            // a registered law's name ([`crate::contact::LAWS`])
+            Some((_, l)) if crate::contact::LAWS.iter().any(|law| law.name == l) => Some(l),
             Some((l, _)) => {
                 r.problems.push(format!(
                     "[sample].law = '{l}': expected {}",
-                    crate::contact::LawKind::EXPECTED
+                    crate::contact::LawKind::expected()
                 ));
                 None
             }
@@ -1167,7 +1154,7 @@ impl Probe {
                 if !s.contains_key("law") {
                     r.problems.push(format!(
                         "missing key [sample].law ({})",
-                        crate::contact::LawKind::EXPECTED
+                        crate::contact::LawKind::expected()
                     ));
                 }
                 None
@@ -1584,10 +1571,16 @@ impl Probe {
                         sample.viscosity.unwrap_or(0.0) * (rr * g0).sqrt() * g0 / (t_s * force_n);
                 }
             }
-            _ => {
+            "impact" => {
                 law = ContactLaw::Impact {
                     restitution: sample.restitution.unwrap_or(0.0),
                 };
+            }
+            other => {
+                return Err(format!(
+                    "[sample].law = \"{other}\": a probe file cannot give this law (it has no \
+                     conversion from SI keys)"
+                ))
             }
         }
         let work = match (sample.law.as_str(), sample.adhesion_energy, sample.hamaker) {

@@ -53,21 +53,12 @@
 // the recurrences index several series by the order k and by k − j at once
 #![allow(clippy::needless_range_loop)]
 
-use crate::contact::ContactLaw;
+use crate::contact::JetLaw as Law;
 use crate::model::CantileverModel;
 use crate::system::Region;
 
 /// Highest order the series are formed to (tolerances down to 1e-18 need order 22).
 pub(crate) const MAX_ORDER: usize = 40;
-
-/// The tip-force law as the recurrences need it.
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum Law {
-    /// α4 δ^{3/2} + α6 δ̇ in contact, no force in free flight.
-    Hertz { k: f64, c: f64 },
-    /// −H̃/d² in free flight; −H̃/ã₀² + α4 δ^{3/2} + α6 √δ δ̇ in contact.
-    Dmt { h: f64, a0: f64, k: f64, c: f64 },
-}
 
 /// The model's data the recurrences read (see the module docs).
 #[derive(Debug, Clone)]
@@ -440,27 +431,9 @@ impl Jet {
     /// propagated exactly, and the impact law, whose contact is a constraint).
     pub(crate) fn new(model: &CantileverModel) -> Option<Self> {
         let p = model.params();
-        let law = match *model.law() {
-            ContactLaw::Hertz => Law::Hertz {
-                k: p.alpha4,
-                c: p.alpha6,
-            },
-            ContactLaw::Dmt {
-                hamaker,
-                intermolecular_distance,
-            } => Law::Dmt {
-                h: hamaker,
-                a0: intermolecular_distance,
-                k: p.alpha4,
-                c: p.alpha6,
-            },
-            ContactLaw::Linear
-            | ContactLaw::Impact { .. }
-            | ContactLaw::Electrostatic { .. }
-            | ContactLaw::Jkr { .. }
-            | ContactLaw::Capillary { .. }
-            | ContactLaw::Sls { .. } => return None,
-        };
+        // the law's piece of the jet ([`crate::contact::Law::jet`]): the tip force as the
+        // recurrences carry it
+        let law = model.law().jet(p.alpha4, p.alpha6)?;
         let n = model.modes();
         let free = model.dynamics(Region::Free);
         let mut ak = vec![0.0; n * n];
