@@ -18,7 +18,7 @@
 //! (dF/dD = F̃_cap/h̃ on the meniscus side, 0 on the contact side), inside the region
 //! ([`Meniscus`]).
 
-use super::{ForceEval, Hysteresis, Law, LawGroups, Param};
+use super::{ForceEval, Hysteresis, Law, LawGroups, Param, SampleSi};
 use crate::error::ParamError;
 
 /// Default capillary force at contact F̃_cap = 0.1: DMT's default adhesion (a water meniscus
@@ -49,6 +49,7 @@ impl CapillaryLaw {
 
 impl Law for CapillaryLaw {
     const DOC: &'static str = "capillary meniscus over a Hertz sample: formed at contact, ruptured at V_T = D̃_r (Zitzler, Herminghaus & Mugele 2002)";
+    const SAMPLE_KEYS: &'static [&'static str] = &["law", "youngs_modulus", "poisson_ratio", "viscosity", "meniscus_volume", "surface_tension", "contact_angle", "z_c"];
     const PARAMS: &'static [Param] = &[
         Param {
             name: "capillary",
@@ -122,6 +123,31 @@ impl Law for CapillaryLaw {
             );
         }
         Ok(())
+    }
+    fn from_si(si: &SampleSi) -> Result<(Self, f64, f64), String> {
+        let (rr, g0) = (si.radius.unwrap_or(0.0), si.g0);
+        let (v, gamma, theta) = si.meniscus.unwrap_or((0.0, 0.0, 0.0));
+        // the meniscus reaches r₁² = 2Rh on the sphere: within its cap, h ≤ R/2
+        let h = (v / (std::f64::consts::PI * rr)).sqrt();
+        if h > 0.5 * rr {
+            return Err(format!(
+                "[sample].meniscus_volume = {v:e} m^3 wets the tip beyond its apex \
+                 (immersion √(V/(πR)) = {h:.3e} m > R/2 = {:.3e} m): the sphere–flat \
+                 meniscus needs V ≤ πR³/4 = {:.3e} m^3",
+                0.5 * rr,
+                0.25 * std::f64::consts::PI * rr.powi(3)
+            ));
+        }
+        // F̃_cap = 4πRγcosθ/F_s, h̃ = √(V/(πR))/g₀, D̃_r = (1 + θ/2)V^{1/3}/g₀
+        let law = CapillaryLaw {
+            capillary: 4.0 * std::f64::consts::PI * rr * gamma * theta.cos() / si.force,
+            meniscus: h / g0,
+            rupture: (1.0 + 0.5 * theta) * v.cbrt() / g0,
+        };
+        Ok((law, si.hertz_alpha4(), si.kelvin_voigt_alpha6()))
+    }
+    fn not_in_liquid(&self) -> Option<&'static str> {
+        Some("the meniscus of humid air does not form under a liquid")
     }
     fn force(&self, k: f64, c: f64, contact: bool, delta: f64, rate: f64) -> ForceEval {
         if !contact {

@@ -7,7 +7,7 @@
 //! (1999) 4961 and Garcia, *Amplitude Modulation AFM*, Wiley 2010, ch. 3). The force is
 //! continuous at δ = 0, so the free flight is nonlinear but the switching has no force jump.
 
-use super::{ForceEval, JetLaw, Law, LawGroups, Param};
+use super::{ForceEval, JetLaw, Law, LawGroups, Param, SampleSi};
 use crate::error::ParamError;
 
 /// Default DMT groups: H̃ = 1e-5, ã₀ = 0.01, an adhesion force H̃/ã₀² = 0.1, about 5 % of the
@@ -131,6 +131,7 @@ impl Law for DmtLaw {
     const DOC: &'static str =
         "DMT: van der Waals attraction outside contact, adhesion + Hertz + Kelvin–Voigt inside";
     const PARAMS: &'static [Param] = &PARAMS;
+    const SAMPLE_KEYS: &'static [&'static str] = &["law", "youngs_modulus", "poisson_ratio", "hamaker", "intermolecular_distance", "viscosity", "z_c"];
 
     fn with_groups(g: &LawGroups) -> Self {
         DmtLaw {
@@ -174,6 +175,14 @@ impl Law for DmtLaw {
             );
         }
         Ok(())
+    }
+    fn from_si(si: &SampleSi) -> Result<(Self, f64, f64), String> {
+        let (rr, g0) = (si.radius.unwrap_or(0.0), si.g0);
+        let law = DmtLaw {
+            hamaker: si.hamaker.unwrap_or(0.0) * rr / (6.0 * g0 * g0 * si.force),
+            intermolecular_distance: si.a0.unwrap_or(0.0) / g0,
+        };
+        Ok((law, si.hertz_alpha4(), si.kelvin_voigt_alpha6()))
     }
     dmt_family!();
     fn long_range(&self, d: f64) -> [f64; 3] {

@@ -7,7 +7,7 @@
 
 use super::dmt::{
     dmt_family,dmt_force, dmt_potential, van_der_waals, DmtLaw, DMT_DEFAULT_A0, DMT_DEFAULT_HAMAKER};
-use super::{ForceEval, Law, LawGroups, Param};
+use super::{ForceEval, Law, LawGroups, Param, SampleSi};
 use crate::error::ParamError;
 
 /// Default electrostatic group Ẽ: with R̃ = 1 and ã₀ = 0.01 the electrostatic force at contact
@@ -33,6 +33,7 @@ pub struct ElectrostaticLaw {
 impl Law for ElectrostaticLaw {
     const DOC: &'static str =
         "DMT plus the electrostatic force of a biased spherical tip (Hudlet et al. 1998)";
+    const SAMPLE_KEYS: &'static [&'static str] = &["law", "youngs_modulus", "poisson_ratio", "hamaker", "intermolecular_distance", "viscosity", "z_c", "bias_voltage", "contact_potential"];
     const PARAMS: &'static [Param] = &[
         super::dmt::PARAMS[0],
         super::dmt::PARAMS[1],
@@ -99,6 +100,25 @@ impl Law for ElectrostaticLaw {
             );
         }
         Ok(())
+    }
+    fn from_si(si: &SampleSi) -> Result<(Self, f64, f64), String> {
+        let (dmt, alpha4, alpha6) = DmtLaw::from_si(si)?;
+        let (rr, v) = (si.radius.unwrap_or(0.0), si.voltage.unwrap_or(0.0));
+        // Hudlet et al. 1998: F = −πε₀V²R²/(d(d + R)), Ẽ = πε₀V²/F_s, R̃ = R/g₀
+        let law = ElectrostaticLaw {
+            hamaker: dmt.hamaker,
+            intermolecular_distance: dmt.intermolecular_distance,
+            electrostatic: std::f64::consts::PI * crate::probe::VACUUM_PERMITTIVITY * v * v
+                / si.force,
+            tip_radius: rr / si.g0,
+        };
+        Ok((law, alpha4, alpha6))
+    }
+    fn not_in_liquid(&self) -> Option<&'static str> {
+        Some(
+            "the sphere–plane force across vacuum (ε₀) ignores the liquid's permittivity and \
+             ionic screening",
+        )
     }
     dmt_family!();
     /// DMT's van der Waals and the biased sphere over the plane −ẼR̃²/(d(d + R̃))

@@ -4,7 +4,7 @@
 //! impulse and the sticking phase are handled by the model ([`crate::model`]).
 
 
-use super::{Law, LawGroups, Param};
+use super::{Law, LawGroups, Param, SampleSi};
 use crate::error::ParamError;
 
 /// Default coefficient of restitution of the impact law.
@@ -20,6 +20,7 @@ pub struct ImpactLaw {
 impl Law for ImpactLaw {
     const DOC: &'static str =
         "rigid sample with coefficient of restitution r ∈ [0, 1] (impact oscillator, Fig. 1b)";
+    const SAMPLE_KEYS: &'static [&'static str] = &["law", "restitution", "z_c"];
     const PARAMS: &'static [Param] = &[Param {
         name: "restitution",
         symbol: "r",
@@ -51,6 +52,12 @@ impl Law for ImpactLaw {
             });
         }
         Ok(())
+    }
+    fn from_si(si: &SampleSi) -> Result<(Self, f64, f64), String> {
+        let law = ImpactLaw {
+            restitution: si.restitution.unwrap_or(0.0),
+        };
+        Ok((law, 0.0, 0.0))
     }
     fn restitution(&self) -> Option<f64> {
         Some(self.restitution)

@@ -14,7 +14,7 @@
 //! = (3/5 + 4^{−1/3}/10) 2^{2/3} π^{5/3} (W⁵R⁴/E*²)^{1/3} ≈ 7.09 (W⁵R⁴/E*²)^{1/3} (from
 //! the potential below). The region is hysteretic: contact persists while δ > δ_f.
 
-use super::{ForceEval, Hysteresis, Law, LawGroups, Param};
+use super::{ForceEval, Hysteresis, Law, LawGroups, Param, SampleSi};
 use crate::error::ParamError;
 
 /// Default JKR adhesion group P̃ = πWR = 0.05: the work of adhesion of DMT's defaults (whose
@@ -32,6 +32,7 @@ pub struct JkrLaw {
 
 impl Law for JkrLaw {
     const DOC: &'static str = "JKR: adhesive Hertz contact with a neck, formed at δ = 0, broken at δ_f < 0 (Johnson, Kendall & Roberts 1971)";
+    const SAMPLE_KEYS: &'static [&'static str] = &["law", "youngs_modulus", "poisson_ratio", "hamaker", "intermolecular_distance", "viscosity", "z_c", "adhesion_energy"];
     const PARAMS: &'static [Param] = &[Param {
         name: "adhesion",
         symbol: "P̃",
@@ -77,6 +78,14 @@ impl Law for JkrLaw {
             });
         }
         Ok(())
+    }
+    fn from_si(si: &SampleSi) -> Result<(Self, f64, f64), String> {
+        // P̃ = πWR/F_s; the Kelvin–Voigt term η a δ̇ = η √(Rh) δ̇ as DMT's
+        let rr = si.radius.unwrap_or(0.0);
+        let law = JkrLaw {
+            adhesion: std::f64::consts::PI * si.adhesion_energy.unwrap_or(0.0) * rr / si.force,
+        };
+        Ok((law, si.hertz_alpha4(), si.kelvin_voigt_alpha6()))
     }
     fn force(&self, k: f64, c: f64, contact: bool, delta: f64, rate: f64) -> ForceEval {
         if !contact {

@@ -21,7 +21,7 @@ pub struct Param {
     pub default: f64,
     /// One line of documentation.
     pub doc: &'static str,
-    /// The probe file's SI keys ([sample] table) the group is derived from.
+    /// The probe file's SI keys (`[sample]` table) the group is derived from.
     pub si_keys: &'static [&'static str],
 }
 
@@ -36,6 +36,63 @@ pub struct LawInfo {
     pub doc: &'static str,
     /// Its own groups (the shared α4, α6 are [`crate::Params`]').
     pub params: &'static [Param],
+    /// The keys a probe file's `[sample]` table may hold for it ([`Law::SAMPLE_KEYS`]).
+    pub sample_keys: &'static [&'static str],
+}
+
+/// A probe file's sample in SI (`[sample]` and `[tip]`, read by [`crate::probe`]) and the probe's
+/// scales: what a law's [`Law::from_si`] converts into its groups and α4, α6. A value the law
+/// does not read is `None`.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct SampleSi {
+    /// The length scale g₀ (m).
+    pub g0: f64,
+    /// The force scale F_s (N): the unit of the scaled force.
+    pub force: f64,
+    /// The time scale t_s (s).
+    pub time: f64,
+    /// The effective modulus E* (Pa) of tip and sample (Johnson, eq. 4.22).
+    pub e_star: Option<f64>,
+    /// The tip radius R (m).
+    pub radius: Option<f64>,
+    /// The Hamaker constant H (J).
+    pub hamaker: Option<f64>,
+    /// The intermolecular distance a₀ (m).
+    pub a0: Option<f64>,
+    /// The sample's viscosity η (Pa s).
+    pub viscosity: Option<f64>,
+    /// A linear sample's stiffness (N/m).
+    pub stiffness: Option<f64>,
+    /// A linear or Hertz sample's damper (N s/m).
+    pub damping: Option<f64>,
+    /// The coefficient of restitution.
+    pub restitution: Option<f64>,
+    /// The voltage across the gap, bias − contact potential (V).
+    pub voltage: Option<f64>,
+    /// The work of adhesion W (J/m²).
+    pub adhesion_energy: Option<f64>,
+    /// The capillary meniscus: volume V (m³), surface tension γ (N/m), contact angle θ (rad).
+    pub meniscus: Option<(f64, f64, f64)>,
+    /// The SLS sample's Maxwell arm: spring k₂ (N/m) and relaxation time τ_r = η/k₂ (s).
+    pub maxwell: Option<(f64, f64)>,
+}
+
+impl SampleSi {
+    /// The Hertz group α4 = (4/3) E* √R g₀^{3/2}/F_s (Johnson, *Contact Mechanics*, §4.2).
+    pub fn hertz_alpha4(&self) -> f64 {
+        let (e, rr) = (self.e_star.unwrap_or(0.0), self.radius.unwrap_or(0.0));
+        4.0 / 3.0 * e * rr.sqrt() * self.g0.powf(1.5) / self.force
+    }
+    /// The Kelvin–Voigt group α6 = η √(R g₀) g₀/(t_s F_s): the damper η a δ̇ with the contact
+    /// radius a = √(Rδ).
+    pub fn kelvin_voigt_alpha6(&self) -> f64 {
+        let rr = self.radius.unwrap_or(0.0);
+        self.viscosity.unwrap_or(0.0) * (rr * self.g0).sqrt() * self.g0 / (self.time * self.force)
+    }
+    /// A viscous damper's α6 = c g₀/(t_s F_s) of `damping` c (N s/m).
+    pub fn damper_alpha6(&self) -> f64 {
+        self.damping.unwrap_or(0.0) * self.g0 / (self.time * self.force)
+    }
 }
 
 /// A tip–sample law: a struct of its dimensionless groups (all `f64`, named as its
@@ -51,6 +108,8 @@ pub trait Law: Copy + Sized {
     const ALIASES: &'static [&'static str] = &[];
     /// The law's own groups, in the order of its fields.
     const PARAMS: &'static [Param] = &[];
+    /// The keys a probe file's `[sample]` table may hold for the law ([`crate::probe`]).
+    const SAMPLE_KEYS: &'static [&'static str] = &["law", "z_c"];
 
     /// The law from the groups a front end gives, the missing ones at their defaults.
     fn with_groups(groups: &LawGroups) -> Self;
@@ -123,6 +182,18 @@ pub trait Law: Copy + Sized {
     }
     /// The law's piece of the Taylor jet: its force as the recurrences carry it, or `None`.
     fn jet(&self, _k: f64, _c: f64) -> Option<super::JetLaw> {
+        None
+    }
+    /// The law's groups and α4, α6 from a probe file's sample in SI.
+    ///
+    /// # Errors
+    /// A message naming the `[sample]` key whose value the law cannot take; for a law a probe
+    /// file cannot give (the default), a message saying so.
+    fn from_si(_si: &SampleSi) -> Result<(Self, f64, f64), String> {
+        Err("a probe file cannot give this law (it has no conversion from SI keys)".into())
+    }
+    /// Why the law does not apply in a liquid medium, if it does not.
+    fn not_in_liquid(&self) -> Option<&'static str> {
         None
     }
     /// Why the Taylor integrator refuses the law (when [`Law::jet`] is `None`).

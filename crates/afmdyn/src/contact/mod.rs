@@ -86,6 +86,7 @@ macro_rules! laws {
                 aliases: <$Law as Law>::ALIASES,
                 doc: <$Law as Law>::DOC,
                 params: <$Law as Law>::PARAMS,
+                sample_keys: <$Law as Law>::SAMPLE_KEYS,
             },
         )*];
 
@@ -97,6 +98,24 @@ macro_rules! laws {
             pub fn name(self) -> &'static str {
                 match self {
                     $( $(#[cfg($cfg)])? LawKind::$Variant => stringify!($name), )*
+                }
+            }
+
+            /// The law of this kind from a probe file's sample in SI ([`Law::from_si`]), with
+            /// α4 and α6.
+            ///
+            /// # Errors
+            /// The law's message: a value it cannot take, or that a probe file cannot give it.
+            pub fn from_si(self, si: &SampleSi) -> Result<(ContactLaw, f64, f64), String> {
+                match self {
+                    $(
+                        $(#[cfg($cfg)])?
+                        LawKind::$Variant => {
+                            #[allow(unused_variables)]
+                            let (law, alpha4, alpha6) = <$Law as Law>::from_si(si)?;
+                            Ok((ContactLaw::$Variant $({ $($field: law.$field),* })?, alpha4, alpha6))
+                        }
+                    )*
                 }
             }
 
@@ -174,6 +193,9 @@ macro_rules! laws {
             fn jet(k: f64, c: f64) -> Option<JetLaw>;
             /// Why the Taylor integrator refuses the law ([`Law::taylor_hint`]).
             fn taylor_hint() -> &'static str;
+            /// Why the law does not apply in a liquid medium, if it does not
+            /// ([`Law::not_in_liquid`]: the capillary meniscus, the electrostatic force).
+            fn not_in_liquid() -> Option<&'static str>;
         }
     };
 }
@@ -235,7 +257,7 @@ pub use dmt::{DMT_DEFAULT_A0, DMT_DEFAULT_HAMAKER};
 pub use electrostatic::{ELECTROSTATIC_DEFAULT, ELECTROSTATIC_DEFAULT_RADIUS};
 pub use impact::IMPACT_DEFAULT_RESTITUTION;
 pub use jkr::{Jkr, JKR_BREAK_CUT, JKR_DEFAULT_ADHESION};
-pub use law::{Law, LawInfo, Param};
+pub use law::{Law, LawInfo, Param, SampleSi};
 pub use sls::{Zener, SLS_DEFAULT_MAXWELL};
 
 impl Default for ContactLaw {
@@ -313,7 +335,7 @@ impl FromStr for LawKind {
             .iter()
             .copied()
             .find(|k| k.name() == key || k.info().aliases.contains(&key.as_str()))
-            .ok_or_else(|| format!("contact law '{s}': expected {}", LawKind::expected()))
+            .ok_or_else(|| format!("contact law '{s}': expected {}", LawKind::EXPECTED))
     }
 }
 
@@ -324,16 +346,57 @@ impl<'de> Deserialize<'de> for LawKind {
     }
 }
 
-impl LawKind {
-    /// The names a front end accepts, for messages: `linear, hertz, … or impact`.
-    pub fn expected() -> String {
-        let names: Vec<&str> = LAWS.iter().map(|l| l.name).collect();
-        match names.split_last() {
-            Some((last, [])) => (*last).to_string(),
-            Some((last, rest)) => format!("{} or {last}", rest.join(", ")),
-            None => String::new(),
-        }
+/// The separator before the `i`-th of `n` names in [`LawKind::EXPECTED`].
+const fn separator(i: usize, n: usize) -> &'static [u8] {
+    if i == 0 {
+        b""
+    } else if i + 1 == n {
+        b" or "
+    } else {
+        b", "
     }
+}
+
+/// The length of [`LawKind::EXPECTED`].
+const fn expected_len() -> usize {
+    let mut len = 0;
+    let mut i = 0;
+    while i < LAWS.len() {
+        len += separator(i, LAWS.len()).len() + LAWS[i].name.len();
+        i += 1;
+    }
+    len
+}
+
+/// The bytes of [`LawKind::EXPECTED`]: the names joined by `, ` and a last ` or `.
+const EXPECTED_BYTES: [u8; expected_len()] = {
+    let mut out = [0u8; expected_len()];
+    let mut at = 0;
+    let mut i = 0;
+    while i < LAWS.len() {
+        let parts = [separator(i, LAWS.len()), LAWS[i].name.as_bytes()];
+        let mut p = 0;
+        while p < parts.len() {
+            let mut j = 0;
+            while j < parts[p].len() {
+                out[at] = parts[p][j];
+                at += 1;
+                j += 1;
+            }
+            p += 1;
+        }
+        i += 1;
+    }
+    out
+};
+
+impl LawKind {
+    /// The names a front end accepts, for messages and help: `linear, hertz, … or impact`, the
+    /// registry's names ([`LAWS`]) joined at compile time.
+    pub const EXPECTED: &'static str = match std::str::from_utf8(&EXPECTED_BYTES) {
+        Ok(s) => s,
+        Err(_) => panic!("the laws' names are UTF-8"),
+    };
 
     /// The kind's descriptor in [`LAWS`].
     pub fn info(self) -> &'static LawInfo {

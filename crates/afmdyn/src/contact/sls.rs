@@ -15,7 +15,7 @@
 //! is the linear law without damper; κ → ∞ a Kelvin–Voigt solid α4, α6 whose surface lags
 //! the tip. ([`Zener`]; the model carries u, [`crate::CantileverModel`].)
 
-use super::{ForceEval, Law, LawGroups, Param};
+use super::{ForceEval, Law, LawGroups, Param, SampleSi};
 use crate::error::ParamError;
 
 /// Default Maxwell arm κ = 20 of the SLS law: the sample twice as stiff at the onset of a tap
@@ -35,6 +35,7 @@ pub struct SlsLaw {
 impl Law for SlsLaw {
     const DOC: &'static str = "standard linear solid (Zener) sample with surface memory: the relaxed spring α4 in parallel with a Maxwell arm (spring κ, dashpot α6), one internal state";
     const ALIASES: &'static [&'static str] = &["zener"];
+    const SAMPLE_KEYS: &'static [&'static str] = &["law", "stiffness", "maxwell_stiffness", "relaxation_time", "z_c"];
     const PARAMS: &'static [Param] = &[Param {
         name: "maxwell_stiffness",
         symbol: "κ",
@@ -91,6 +92,15 @@ impl Law for SlsLaw {
             });
         }
         Ok(())
+    }
+    fn from_si(si: &SampleSi) -> Result<(Self, f64, f64), String> {
+        // springs in units of F_s/g₀; the dashpot η = k₂τ_r (N·s/m) as the linear
+        // law's damper: α6 = η g₀/(t_s F_s) = κ τ_r/t_s
+        let (k2, tau_r) = si.maxwell.unwrap_or((0.0, 0.0));
+        let alpha4 = si.stiffness.unwrap_or(0.0) * si.g0 / si.force;
+        let maxwell_stiffness = k2 * si.g0 / si.force;
+        let alpha6 = maxwell_stiffness * tau_r / si.time;
+        Ok((SlsLaw { maxwell_stiffness }, alpha4, alpha6))
     }
     /// The relaxed (equilibrium) force: the Maxwell arm's force depends on the state u,
     /// which the model evaluates ([`Zener`]); this is the quasi-static law.

@@ -115,3 +115,39 @@ fn electrostatic_force_has_its_limits() {
     let far = ts.long_range(1e5)[0];
     assert!((far / (-2.0 * 25.0 / 1e10) - 1.0).abs() < 1e-4, "{far}");
 }
+
+/// The registry agrees with itself: names, serde tags and the parser; each law's defaults
+/// validate and are its descriptors' defaults; each group is a `LawGroups` field and a
+/// request key; [`LawKind::EXPECTED`] lists the names.
+#[test]
+fn the_registry_is_consistent() {
+    assert_eq!(LawKind::ALL.len(), LAWS.len());
+    for (&kind, info) in LawKind::ALL.iter().zip(LAWS) {
+        assert_eq!(kind.name(), info.name);
+        assert_eq!(kind.info(), info);
+        let law = kind.with_groups(LawGroups::default());
+        assert_eq!(law.kind(), kind);
+        let json = serde_json::to_value(law).unwrap();
+        assert_eq!(json["law"], info.name);
+        assert_eq!(serde_json::from_value::<ContactLaw>(json).unwrap(), law);
+        assert_eq!(serde_json::to_value(kind).unwrap(), info.name);
+        assert_eq!(info.name.to_uppercase().parse::<LawKind>().unwrap(), kind);
+        for a in info.aliases {
+            assert_eq!(a.parse::<LawKind>().unwrap(), kind);
+        }
+        law.validate().unwrap();
+        let groups = law.groups().entries();
+        for p in info.params {
+            let (_, v) = groups
+                .iter()
+                .find(|(n, _)| *n == p.name)
+                .expect("a LawGroups field");
+            assert_eq!(*v, Some(p.default), "{}.{}", info.name, p.name);
+            assert!(crate::request::parameter(p.name).is_some(), "{}", p.name);
+        }
+        let given = groups.iter().filter(|(_, v)| v.is_some()).count();
+        assert_eq!(given, info.params.len(), "{}", info.name);
+        assert!(LawKind::EXPECTED.contains(info.name));
+    }
+    assert!(LawKind::EXPECTED.starts_with("linear, hertz, dmt"));
+}

@@ -174,90 +174,26 @@ impl Probe {
         let alpha3 =
             crate::eigen::beam_damping_for_q(w1, &x1, q1, profile.as_ref().map(|s| &s[..]));
         // sample groups
-        let t_s = time_s;
-        let mut law = ContactLaw::Linear;
-        let (mut alpha4, mut alpha6) = (0.0, 0.0);
-        match sample.law.as_str() {
-            "linear" => {
-                alpha4 = sample.stiffness.unwrap_or(0.0) * g0 / force_n;
-                alpha6 = sample.damping.unwrap_or(0.0) * g0 / (t_s * force_n);
-            }
-            "sls" => {
-                // springs in units of F_s/g₀; the dashpot η = k₂τ_r (N·s/m) as the linear
-                // law's damper: α6 = η g₀/(t_s F_s) = κ τ_r/t_s
-                let (k2, tau_r) = sample.maxwell.unwrap_or((0.0, 0.0));
-                alpha4 = sample.stiffness.unwrap_or(0.0) * g0 / force_n;
-                let maxwell_stiffness = k2 * g0 / force_n;
-                alpha6 = maxwell_stiffness * tau_r / t_s;
-                law = ContactLaw::Sls { maxwell_stiffness };
-            }
-            "hertz" | "dmt" | "electrostatic" | "jkr" | "capillary" => {
-                let (e, rr) = (sample.e_star.unwrap_or(0.0), sample.radius.unwrap_or(0.0));
-                alpha4 = 4.0 / 3.0 * e * rr.sqrt() * g0.powf(1.5) / force_n;
-                if sample.law == "hertz" {
-                    law = ContactLaw::Hertz;
-                    alpha6 = sample.damping.unwrap_or(0.0) * g0 / (t_s * force_n);
-                } else if let Some((v, gamma, theta)) = sample.meniscus {
-                    // the meniscus reaches r₁² = 2Rh on the sphere: within its cap, h ≤ R/2
-                    let h = (v / (std::f64::consts::PI * rr)).sqrt();
-                    if h > 0.5 * rr {
-                        return Err(format!(
-                            "[sample].meniscus_volume = {v:e} m^3 wets the tip beyond its apex \
-                             (immersion √(V/(πR)) = {h:.3e} m > R/2 = {:.3e} m): the sphere–flat \
-                             meniscus needs V ≤ πR³/4 = {:.3e} m^3",
-                            0.5 * rr,
-                            0.25 * std::f64::consts::PI * rr.powi(3)
-                        ));
-                    }
-                    // F̃_cap = 4πRγcosθ/F_s, h̃ = √(V/(πR))/g₀, D̃_r = (1 + θ/2)V^{1/3}/g₀
-                    law = ContactLaw::Capillary {
-                        capillary: 4.0 * std::f64::consts::PI * rr * gamma * theta.cos() / force_n,
-                        meniscus: h / g0,
-                        rupture: (1.0 + 0.5 * theta) * v.cbrt() / g0,
-                    };
-                    alpha6 =
-                        sample.viscosity.unwrap_or(0.0) * (rr * g0).sqrt() * g0 / (t_s * force_n);
-                } else if sample.law == "jkr" {
-                    // P̃ = πWR/F_s; the Kelvin–Voigt term η a δ̇ = η √(Rh) δ̇ as DMT's
-                    law = ContactLaw::Jkr {
-                        adhesion: std::f64::consts::PI * sample.adhesion_energy.unwrap_or(0.0) * rr
-                            / force_n,
-                    };
-                    alpha6 =
-                        sample.viscosity.unwrap_or(0.0) * (rr * g0).sqrt() * g0 / (t_s * force_n);
-                } else {
-                    let hamaker = sample.hamaker.unwrap_or(0.0) * rr / (6.0 * g0 * g0 * force_n);
-                    let intermolecular_distance = sample.a0.unwrap_or(0.0) / g0;
-                    law = match sample.voltage {
-                        // Hudlet et al. 1998: F = −πε₀V²R²/(d(d + R)), Ẽ = πε₀V²/F_s, R̃ = R/g₀
-                        Some(v) => ContactLaw::Electrostatic {
-                            hamaker,
-                            intermolecular_distance,
-                            electrostatic: std::f64::consts::PI * VACUUM_PERMITTIVITY * v * v
-                                / force_n,
-                            tip_radius: rr / g0,
-                        },
-                        None => ContactLaw::Dmt {
-                            hamaker,
-                            intermolecular_distance,
-                        },
-                    };
-                    alpha6 =
-                        sample.viscosity.unwrap_or(0.0) * (rr * g0).sqrt() * g0 / (t_s * force_n);
-                }
-            }
-            "impact" => {
-                law = ContactLaw::Impact {
-                    restitution: sample.restitution.unwrap_or(0.0),
-                };
-            }
-            other => {
-                return Err(format!(
-                    "[sample].law = \"{other}\": a probe file cannot give this law (it has no \
-                     conversion from SI keys)"
-                ))
-            }
-        }
+        // the law's groups and α4, α6 from the sample's SI values ([`Law::from_si`])
+        let kind: crate::contact::LawKind = sample.law.parse()?;
+        let si = crate::contact::SampleSi {
+            g0,
+            force: force_n,
+            time: time_s,
+            e_star: sample.e_star,
+            radius: sample.radius,
+            hamaker: sample.hamaker,
+            a0: sample.a0,
+            viscosity: sample.viscosity,
+            stiffness: sample.stiffness,
+            damping: sample.damping,
+            restitution: sample.restitution,
+            voltage: sample.voltage,
+            adhesion_energy: sample.adhesion_energy,
+            meniscus: sample.meniscus,
+            maxwell: sample.maxwell,
+        };
+        let (law, alpha4, alpha6) = kind.from_si(&si)?;
         let work = match (sample.law.as_str(), sample.adhesion_energy, sample.hamaker) {
             ("jkr", Some(w), _) => Some(w),
             ("dmt" | "electrostatic", _, Some(h)) if h > 0.0 => {
@@ -288,18 +224,7 @@ impl Probe {
         // laws of a gas: a meniscus does not form under a liquid, and the electrostatic law is
         // the force across vacuum (ε₀), not across a polar, screening liquid
         let liquid = medium.as_ref().is_some_and(|m| m.is_liquid());
-        if liquid
-            && matches!(
-                law,
-                ContactLaw::Capillary { .. } | ContactLaw::Electrostatic { .. }
-            )
-        {
-            let why = if matches!(law, ContactLaw::Capillary { .. }) {
-                "the meniscus of humid air does not form under a liquid"
-            } else {
-                "the sphere–plane force across vacuum (ε₀) ignores the liquid's permittivity and \
-                 ionic screening"
-            };
+        if let Some(why) = law.not_in_liquid().filter(|_| liquid) {
             return Err(format!(
                 "[sample].law = \"{}\" in a liquid [medium]: {why} (use it in air, or another \
                  law)",

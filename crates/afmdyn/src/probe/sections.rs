@@ -522,7 +522,7 @@ impl Probe {
             Some((l, _)) => {
                 r.problems.push(format!(
                     "[sample].law = '{l}': expected {}",
-                    crate::contact::LawKind::expected()
+                    crate::contact::LawKind::EXPECTED
                 ));
                 None
             }
@@ -530,54 +530,16 @@ impl Probe {
                 if !s.contains_key("law") {
                     r.problems.push(format!(
                         "missing key [sample].law ({})",
-                        crate::contact::LawKind::expected()
+                        crate::contact::LawKind::EXPECTED
                     ));
                 }
                 None
             }
         }?;
-        // the electrostatic law's keys are DMT's and the voltages
-        const DMT: [&str; 7] = [
-            "law",
-            "youngs_modulus",
-            "poisson_ratio",
-            "hamaker",
-            "intermolecular_distance",
-            "viscosity",
-            "z_c",
-        ];
-        let electrostatic: Vec<&str> = DMT
-            .iter()
-            .copied()
-            .chain(["bias_voltage", "contact_potential"])
-            .collect();
-        let jkr: Vec<&str> = DMT.iter().copied().chain(["adhesion_energy"]).collect();
-        const CAPILLARY: [&str; 8] = [
-            "law",
-            "youngs_modulus",
-            "poisson_ratio",
-            "viscosity",
-            "meniscus_volume",
-            "surface_tension",
-            "contact_angle",
-            "z_c",
-        ];
-        let keys: &[&str] = match law.as_str() {
-            "linear" => &["law", "stiffness", "damping", "z_c"],
-            "sls" => &[
-                "law",
-                "stiffness",
-                "maxwell_stiffness",
-                "relaxation_time",
-                "z_c",
-            ],
-            "hertz" => &["law", "youngs_modulus", "poisson_ratio", "damping", "z_c"],
-            "dmt" => &DMT,
-            "electrostatic" => &electrostatic,
-            "jkr" => &jkr,
-            "capillary" => &CAPILLARY,
-            _ => &["law", "restitution", "z_c"],
-        };
+        // the keys the law takes ([`crate::contact::Law::SAMPLE_KEYS`])
+        let keys = law
+            .parse::<crate::contact::LawKind>()
+            .map_or(&[][..], |kind| kind.info().sample_keys);
         r.unknown(s, S, keys);
         let z_c = r.optional(s, S, "z_c", "m", ANY);
         let mut out = Sample {

@@ -162,7 +162,7 @@ pub const MODEL_PARAMETERS: [ParamInfo; 22] = [
         None,
         "F_c",
         "1",
-        "linear, hertz, dmt, electrostatic, jkr, capillary, sls or impact",
+        crate::contact::LawKind::EXPECTED,
         "linear",
         "tip–sample law: linear (α4 δ + α6 δ̇), hertz (α4 δ^1.5 + α6 δ̇), dmt (van der Waals + \
          adhesion + Hertz + α6 √δ δ̇), electrostatic (dmt + a biased tip), jkr (adhesive Hertz \
