@@ -150,4 +150,9 @@ fn the_registry_is_consistent() {
         assert!(LawKind::EXPECTED.contains(info.name));
     }
     assert!(LawKind::EXPECTED.starts_with("linear, hertz, dmt"));
+    #[cfg(not(feature = "toy-law"))]
+    assert_eq!(
+        LawKind::EXPECTED,
+        "linear, hertz, dmt, electrostatic, jkr, capillary, sls or impact"
+    );
 }
