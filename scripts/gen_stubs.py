@@ -15,6 +15,7 @@ and defaults) and the compiled functions that take it.
 from __future__ import annotations
 
 import json
+import re
 import sys
 from pathlib import Path
 
@@ -123,6 +124,23 @@ def generate() -> str:
     return "\n\n".join(out) + "\n"
 
 
+#: the Python files whose ``contact_law`` annotations list the laws
+LAW_LISTS = [STUB, ROOT / "crates" / "afmdyn-py" / "python" / "afmdyn" / "_common.py"]
+
+
+def law_literal() -> str:
+    """``Literal[...]`` of the registry's law names (the model schema's ``LawKind``)."""
+    schema = json.loads((SCHEMAS / "model.json").read_text())
+    kinds = schema["$defs"]["LawKind"]["oneOf"]
+    return "Literal[" + ", ".join(json.dumps(k["const"]) for k in kinds) + "]"
+
+
+def with_laws(text: str) -> str:
+    """``text`` with every ``contact_law`` annotation's ``Literal[...]`` the registry's."""
+    return re.sub(r'(contact_law(?:\(self\) ->|:) )Literal\["linear"[^]]*\]',
+                  lambda m: m.group(1) + law_literal(), text)
+
+
 def main() -> int:
     text = STUB.read_text()
     head, sep, rest = text.partition(BEGIN)
@@ -130,14 +148,17 @@ def main() -> int:
         print(f"{STUB}: no line '{BEGIN}'", file=sys.stderr)
         return 2
     _, sep, tail = rest.partition(END + "\n")
-    new = head + generate() + tail
+    new = {STUB: with_laws(head + generate() + tail)}
+    for path in LAW_LISTS[1:]:
+        new[path] = with_laws(path.read_text())
     if "--check" in sys.argv[1:]:
-        if new != text:
-            print(f"{STUB.relative_to(ROOT)} is stale: run python3 scripts/gen_stubs.py",
+        stale = [p for p, t in new.items() if t != p.read_text()]
+        for p in stale:
+            print(f"{p.relative_to(ROOT)} is stale: run python3 scripts/gen_stubs.py",
                   file=sys.stderr)
-            return 1
-        return 0
-    STUB.write_text(new)
+        return 1 if stale else 0
+    for path, t in new.items():
+        path.write_text(t)
     return 0
 
 

@@ -362,21 +362,12 @@ impl PyParams {
     /// DMT (and electrostatic law) van der Waals group H̃ (``None`` for the other laws).
     #[getter]
     fn hamaker(&self) -> Option<f64> {
-        match self.inner.contact_law {
-            afmdyn::ContactLaw::Dmt { hamaker, .. }
-            | afmdyn::ContactLaw::Electrostatic { hamaker, .. } => Some(hamaker),
-            _ => None,
-        }
+        self.inner.contact_law.groups().hamaker
     }
     /// DMT (and electrostatic law) intermolecular distance ã0 (``None`` for the other laws).
     #[getter]
     fn intermolecular_distance(&self) -> Option<f64> {
-        match self.inner.contact_law {
-            afmdyn::ContactLaw::Dmt { .. } | afmdyn::ContactLaw::Electrostatic { .. } => {
-                Some(self.inner.contact_law.distance_offset())
-            }
-            _ => None,
-        }
+        self.inner.contact_law.groups().intermolecular_distance
     }
     /// Where the drive acts: ``"base"`` (the paper) or ``"tip"`` (a force at the tip).
     #[getter]
@@ -386,61 +377,40 @@ impl PyParams {
     /// Electrostatic law: the group Ẽ (``None`` for the other laws).
     #[getter]
     fn electrostatic(&self) -> Option<f64> {
-        match self.inner.contact_law {
-            afmdyn::ContactLaw::Electrostatic { electrostatic, .. } => Some(electrostatic),
-            _ => None,
-        }
+        self.inner.contact_law.groups().electrostatic
     }
     /// Electrostatic law: the tip radius R̃ = R/g0 (``None`` for the other laws).
     #[getter]
     fn tip_radius(&self) -> Option<f64> {
-        match self.inner.contact_law {
-            afmdyn::ContactLaw::Electrostatic { tip_radius, .. } => Some(tip_radius),
-            _ => None,
-        }
+        self.inner.contact_law.groups().tip_radius
     }
     /// JKR law: the adhesion group P̃ = πWR/F (``None`` for the other laws).
     #[getter]
     fn adhesion(&self) -> Option<f64> {
-        match self.inner.contact_law {
-            afmdyn::ContactLaw::Jkr { adhesion } => Some(adhesion),
-            _ => None,
-        }
+        self.inner.contact_law.groups().adhesion
     }
     /// Capillary law: the meniscus's force at contact F̃_cap = 4πRγcosθ/F (``None`` for the
     /// other laws).
     #[getter]
     fn capillary(&self) -> Option<f64> {
-        match self.inner.contact_law {
-            afmdyn::ContactLaw::Capillary { capillary, .. } => Some(capillary),
-            _ => None,
-        }
+        self.inner.contact_law.groups().capillary
     }
     /// Capillary law: the meniscus's immersion at contact h̃ = √(V/(πR))/g₀ (``None`` for the
     /// other laws).
     #[getter]
     fn meniscus(&self) -> Option<f64> {
-        match self.inner.contact_law {
-            afmdyn::ContactLaw::Capillary { meniscus, .. } => Some(meniscus),
-            _ => None,
-        }
+        self.inner.contact_law.groups().meniscus
     }
     /// Capillary law: the rupture distance D̃_r = (1 + θ/2)V^{1/3}/g₀ (``None`` for the other
     /// laws).
     #[getter]
     fn rupture(&self) -> Option<f64> {
-        match self.inner.contact_law {
-            afmdyn::ContactLaw::Capillary { rupture, .. } => Some(rupture),
-            _ => None,
-        }
+        self.inner.contact_law.groups().rupture
     }
     /// SLS law: the Maxwell arm's spring κ (its dashpot is α6; ``None`` for the other laws).
     #[getter]
     fn maxwell_stiffness(&self) -> Option<f64> {
-        match self.inner.contact_law {
-            afmdyn::ContactLaw::Sls { maxwell_stiffness } => Some(maxwell_stiffness),
-            _ => None,
-        }
+        self.inner.contact_law.groups().maxwell_stiffness
     }
     /// α1 (alias).
     #[getter]

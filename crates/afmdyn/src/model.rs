@@ -196,12 +196,7 @@ impl CantileverModel {
             tip_acc_forcing,
             period,
             release: params.contact_law.release_distance(params.alpha4),
-            zener: match params.contact_law {
-                ContactLaw::Sls { maxwell_stiffness } => {
-                    Some(Zener::new(params.alpha4, maxwell_stiffness, params.alpha6))
-                }
-                _ => None,
-            },
+            zener: params.contact_law.zener(params.alpha4, params.alpha6),
         })
     }
 
@@ -394,23 +389,23 @@ impl CantileverModel {
         v_t: impl FnOnce() -> (f64, f64),
     ) -> f64 {
         let contact = r == Region::Contact;
-        match self.law.law {
-            ContactLaw::Sls { .. } => match self.zener_state(z) {
+        // a law with an internal state (SLS), a rigid constraint (impact), or a force law
+        if self.zener.is_some() {
+            match self.zener_state(z) {
                 Some((zn, u)) if contact => zn.force(true, -v_t().0, u),
                 _ => 0.0,
-            },
-            ContactLaw::Impact { .. } => {
-                if contact {
-                    self.sticking_force_value(tau, z)
-                } else {
-                    0.0
-                }
             }
-            _ if !contact && !self.law.acts_outside() => 0.0,
-            _ => {
-                let (v, vd) = v_t();
-                self.law.force(contact, -v, -vd).force
+        } else if self.law.law.restitution().is_some() {
+            if contact {
+                self.sticking_force_value(tau, z)
+            } else {
+                0.0
             }
+        } else if !contact && !self.law.acts_outside() {
+            0.0
+        } else {
+            let (v, vd) = v_t();
+            self.law.force(contact, -v, -vd).force
         }
     }
 
@@ -430,14 +425,7 @@ impl CantileverModel {
 
     /// [`Self::kelvin_voigt_weight`] given (sin Ωτ, cos Ωτ) = `sc` ([`Self::base_trig`]).
     fn kelvin_voigt_weight_at(&self, r: Region, sc: (f64, f64), z: &[f64]) -> f64 {
-        if r != Region::Contact
-            || !matches!(
-                self.law.law,
-                ContactLaw::Dmt { .. }
-                    | ContactLaw::Electrostatic { .. }
-                    | ContactLaw::Capillary { .. }
-            )
-        {
+        if r != Region::Contact || !self.law.law.kelvin_voigt() {
             return 0.0;
         }
         let [v, _, _] = self.v_t_at(sc, [self.w_tip_slice(z, 0), 0.0, 0.0]);
@@ -472,52 +460,45 @@ impl CantileverModel {
         // added to the velocity rows
         let mut buf = [0.0; crate::params::MAX_STATE];
         let row = &mut buf[..self.dim()];
-        match self.law.law {
-            ContactLaw::Sls { .. } => {
-                let Some((zn, _)) = self.zener_state(z) else {
-                    return;
-                };
-                // u̇ = (κ/α6)(δ_s − u): δ_s = δ = −φᵀa − … in contact, s(u) free
-                let rate = zn.relaxation_rate();
-                if r == Region::Contact {
-                    for (j, t) in self.tip().iter().enumerate() {
-                        jac[(2 * n, j)] = -rate * t;
-                    }
-                    jac[(2 * n, 2 * n)] = -rate;
-                    // F = (α4 + κ)δ − κu
-                    for (j, t) in self.tip().iter().enumerate() {
-                        row[j] = -(zn.relaxed + zn.maxwell) * t;
-                    }
-                    row[2 * n] = -zn.maxwell;
-                } else {
-                    jac[(2 * n, 2 * n)] = rate * (zn.surface_gain() - 1.0);
-                    return;
-                }
-            }
-            ContactLaw::Impact { .. } => {
-                if r != Region::Contact {
-                    return;
-                }
-                row.copy_from_slice(self.sticking_force(tau, z).grad.as_slice());
-            }
-            _ => {
-                if r != Region::Contact && !self.law.acts_outside() {
-                    return;
-                }
-                let [v, vd, _] =
-                    self.v_t_at(sc, [self.w_tip_slice(z, 0), self.w_tip_slice(z, n), 0.0]);
-                let f = self.law.force(r == Region::Contact, -v, -vd);
-                let w = self.kelvin_voigt_weight_at(r, sc, z);
-                let d_delta = if singular || w == 0.0 {
-                    f.d_delta
-                } else {
-                    // remove α6 δ̇/(2√δ) = α6² δ̇/(2w)
-                    f.d_delta - 0.5 * self.law.damping * self.law.damping * (-vd) / w
-                };
+        // a law with an internal state (SLS), a rigid constraint (impact), or a force law
+        if let Some((zn, _)) = self.zener_state(z) {
+            // u̇ = (κ/α6)(δ_s − u): δ_s = δ = −φᵀa − … in contact, s(u) free
+            let rate = zn.relaxation_rate();
+            if r == Region::Contact {
                 for (j, t) in self.tip().iter().enumerate() {
-                    row[j] = -d_delta * t;
-                    row[n + j] = -f.d_rate * t;
+                    jac[(2 * n, j)] = -rate * t;
                 }
+                jac[(2 * n, 2 * n)] = -rate;
+                // F = (α4 + κ)δ − κu
+                for (j, t) in self.tip().iter().enumerate() {
+                    row[j] = -(zn.relaxed + zn.maxwell) * t;
+                }
+                row[2 * n] = -zn.maxwell;
+            } else {
+                jac[(2 * n, 2 * n)] = rate * (zn.surface_gain() - 1.0);
+                return;
+            }
+        } else if self.law.law.restitution().is_some() {
+            if r != Region::Contact {
+                return;
+            }
+            row.copy_from_slice(self.sticking_force(tau, z).grad.as_slice());
+        } else {
+            if r != Region::Contact && !self.law.acts_outside() {
+                return;
+            }
+            let [v, vd, _] = self.v_t_at(sc, [self.w_tip_slice(z, 0), self.w_tip_slice(z, n), 0.0]);
+            let f = self.law.force(r == Region::Contact, -v, -vd);
+            let w = self.kelvin_voigt_weight_at(r, sc, z);
+            let d_delta = if singular || w == 0.0 {
+                f.d_delta
+            } else {
+                // remove α6 δ̇/(2√δ) = α6² δ̇/(2w)
+                f.d_delta - 0.5 * self.law.damping * self.law.damping * (-vd) / w
+            };
+            for (j, t) in self.tip().iter().enumerate() {
+                row[j] = -d_delta * t;
+                row[n + j] = -f.d_rate * t;
             }
         }
         for (c, &rc) in row.iter().enumerate() {
@@ -599,163 +580,6 @@ impl CantileverModel {
         }
         let phi = self.galerkin.shapes().values(xi);
         phi.iter().zip(z.iter()).map(|(p, a)| p * a).sum()
-    }
-
-    /// Stored energy E = ½ȦᵀMȦ + ½XᵀK^I X + U(δ), U the potential of the law's conservative
-    /// part (½α4 V_T² for the linear law in contact; continuous across a switching; the energy
-    /// in the SLS sample's springs, [`Zener::potential`], in and out of contact).
-    pub fn energy(&self, r: Region, tau: f64, z: &DVector<f64>) -> f64 {
-        let n = self.modes();
-        let g = self.galerkin.region(Region::Free);
-        let x = z.rows(0, n);
-        let v = z.rows(n, n);
-        // the products into a buffer on the stack (the same gemv, no allocation)
-        let mut buf = [0.0; crate::params::MAX_MODES];
-        let mut quad = |m: &DMatrix<f64>, y| {
-            let mut out = nalgebra::DVectorViewMut::from_slice(&mut buf[..n], n);
-            m.mul_to(&y, &mut out);
-            out.dot(&y)
-        };
-        let kinetic = 0.5 * quad(&g.mass, v);
-        let bending = 0.5 * quad(&g.stiffness, x);
-        let contact = r == Region::Contact;
-        let delta = -self.v_t(tau, z);
-        let sample = match self.zener_state(z.as_slice()) {
-            Some((zn, u)) => zn.potential(contact, delta, u),
-            None => self.law.potential(contact, delta),
-        };
-        kinetic + bending + sample
-    }
-
-    /// The rates of the energy balance at (τ, z) in region r. Multiplying the equation of
-    /// motion by Ȧᵀ gives dE/dτ = P_base − D_beam − D_contact exactly, with
-    /// P_base = ȦᵀF^I(τ) − α2 Ω cos Ωτ · F_c (plus the power F̃(τ) Ẇ(1,τ) of the further
-    /// components of a multifrequency drive, [`Params::component_force`]) and D_contact = F_d δ̇ (F_d the dissipative part
-    /// of the law).
-    pub fn power(&self, r: Region, tau: f64, z: &DVector<f64>) -> PowerTerms {
-        let n = self.modes();
-        let p = &self.params;
-        let g = self.galerkin.region(Region::Free);
-        let v = z.rows(n, n);
-        let (s, c) = (p.omega * tau).sin_cos();
-        let mut drive = g.forcing.sin.dot(&v) * s + g.forcing.cos.dot(&v) * c;
-        if p.is_multifrequency() {
-            drive += p.component_force(tau) * self.tip().dot(&v);
-        }
-        // ȦᵀC^IȦ with the damping matrix of eq. 12 (α3 diag(s) with a per-mode damping profile:
-        // the beam's per-mode Q, the eigenmode model)
-        let beam = (&g.damping * v).dot(&v);
-        let fc = self.contact_force(r, tau, z);
-        let rate = -self.v_t_dot(tau, z);
-        let delta = -self.v_t(tau, z);
-        PowerTerms {
-            base: drive - p.base_amplitude() * p.omega * c * fc,
-            beam_dissipation: beam,
-            contact_dissipation: match self.zener_state(z.as_slice()) {
-                // the SLS dashpot, also while the surface recovers after the tip left
-                Some((zn, u)) => zn.dissipation(r == Region::Contact, delta, u),
-                None => self.law.dissipative(r == Region::Contact, delta, rate) * rate,
-            },
-        }
-    }
-
-    /// Energy bookkeeping of an impact at τ with pre-impact rate V̇_T⁻ = `v_minus` and
-    /// restitution r: (loss in the sample, work of the impulse on the clamped frame). The
-    /// kinetic energy of the motion relative to the sample changes by −(1 − r²) ½ m_eff (V̇_T⁻)²;
-    /// the impulse P = −(1 + r) m_eff V̇_T⁻ at the tip also does the work −P α2 Ω cos Ωτ, so
-    /// ΔE = −loss + base (derivation in `docs/contact-laws.md`).
-    pub fn impact_energy(&self, tau: f64, v_minus: f64, restitution: f64) -> (f64, f64) {
-        let p = &self.params;
-        let base_velocity = p.base_amplitude() * p.omega * (p.omega * tau).cos();
-        let loss = 0.5 * (1.0 - restitution * restitution) * self.m_eff * v_minus * v_minus;
-        let base = (1.0 + restitution) * self.m_eff * v_minus * base_velocity;
-        (loss, base)
-    }
-
-    /// Complex amplitude H of the free steady response of the tip deflection (no sample force,
-    /// the linear free system of eqs. 11–14): W(1,τ) = Im(H e^{i(Ωτ + ψ)}) with ψ the drive
-    /// phase ([`Params::drive_phase`]), so |H| is the free amplitude A₀ (units of g₀) and
-    /// −arg H the phase lag behind the drive. From (K − Ω²M + iΩC) X = F_s + i F_c for the
-    /// forcing F_s sin Ωτ + F_c cos Ωτ, H = φ(1)ᵀX e^{−iψ} (the harmonic-balance solution of a
-    /// linear system, e.g. Meirovitch, *Fundamentals of Vibrations*, McGraw-Hill 2001, §7.15).
-    ///
-    /// # Errors
-    /// [`SimError::OutOfRange`] when Ω is at an undamped natural frequency (no steady state).
-    pub fn free_tip_response(&self) -> Result<nalgebra::Complex<f64>, SimError> {
-        use nalgebra::Complex;
-        let g = self.galerkin.region(Region::Free);
-        let om = self.params.omega;
-        let dyn_stiff = DMatrix::from_fn(self.modes(), self.modes(), |i, j| {
-            Complex::new(
-                g.stiffness[(i, j)] - om * om * g.mass[(i, j)],
-                om * g.damping[(i, j)],
-            )
-        });
-        let f = DVector::from_fn(self.modes(), |i, _| {
-            Complex::new(g.forcing.sin[i], g.forcing.cos[i])
-        });
-        let x = dyn_stiff.lu().solve(&f).ok_or_else(|| {
-            SimError::out_of_range(
-                "omega",
-                om,
-                "the free system has no steady state at an undamped natural frequency",
-            )
-        })?;
-        let tip: Complex<f64> = self.tip().iter().zip(x.iter()).map(|(p, xi)| xi * *p).sum();
-        Ok(tip * Complex::from_polar(1.0, -self.params.drive_phase()))
-    }
-
-    /// ∂b/∂p of the free and the contact region (in that order) for a parameter p that enters
-    /// the forcing only: b = (0, M⁻¹F) lifted from [`Galerkin::forcing_derivative`] (Ω, α2,
-    /// α5); `None` for α1, α3, α4, α6, on which A_s depends.
-    pub fn forcing_derivative(&self, param: SweepParam) -> Option<[ForcingDerivative; 2]> {
-        let df = self.galerkin.forcing_derivative(param)?;
-        let n = self.modes();
-        let chol = self.galerkin.region(Region::Free).mass.clone().cholesky()?;
-        let lift = |f: &DVector<f64>| {
-            let mut v = DVector::zeros(self.dim());
-            v.rows_mut(n, n).copy_from(&chol.solve(f));
-            v
-        };
-        let d_omega = f64::from(u8::from(param == SweepParam::Omega));
-        let region = |f: &crate::galerkin::Forcing| ForcingDerivative {
-            b_const: lift(&f.constant),
-            b_sin: lift(&f.sin),
-            b_cos: lift(&f.cos),
-            d_omega,
-        };
-        Some([region(&df[0]), region(&df[1])])
-    }
-
-    /// ∂g/∂p of the guard of `mode` at fixed (τ, z) for the guards σ V_T (eq. 8: V_T = W(1,τ) +
-    /// α2 sin Ωτ + α5, so ∂V_T/∂Ω = α2 τ cos Ωτ, ∂V_T/∂α2 = sin Ωτ for the beam and 0 for the
-    /// point mass, ∂V_T/∂α5 = 1, and 0 for the parameters that enter only the dynamics).
-    /// `None` for laws with restitution, whose guards and jump maps depend on the parameters
-    /// in other ways (sticking force, impact).
-    pub fn guard_param_derivative(&self, mode: Region, param: SweepParam, tau: f64) -> Option<f64> {
-        if self.law.law.restitution().is_some() {
-            return None;
-        }
-        let p = &self.params;
-        let (s, c) = (p.omega * tau).sin_cos();
-        // base_amplitude() is α2 or 0: linear in α2, so its value at α2 = 1 is its derivative
-        let unit = p.with(SweepParam::Alpha2, 1.0).base_amplitude();
-        let dv = match param {
-            SweepParam::Omega => p.base_amplitude() * tau * c,
-            SweepParam::Alpha2 => unit * s,
-            SweepParam::Alpha5 => 1.0,
-            SweepParam::Alpha1 | SweepParam::Alpha3 | SweepParam::Alpha4 | SweepParam::Alpha6 => {
-                0.0
-            }
-        };
-        Some(mode.guard_sign() * dv)
-    }
-
-    /// Saltation matrix (2N×2N) at an event of region `from` at (τ, z⁻): the generic
-    /// [`crate::system::saltation`] of this system. For the linear law on V_T = 0 only the
-    /// damper term α6 V̇_T jumps, so S ≠ I whenever α6 > 0.
-    pub fn saltation(&self, from: Region, tau: f64, z: &DVector<f64>) -> DMatrix<f64> {
-        crate::system::saltation(self, from, tau, z.as_slice()).0
     }
 
     /// Constraint force λ of sticking (impact law) at (τ, z), with its gradient and τ-rate:
@@ -901,258 +725,5 @@ impl CantileverModel {
     }
 }
 
-impl HybridSystem for CantileverModel {
-    fn dim(&self) -> usize {
-        CantileverModel::dim(self)
-    }
-    fn period(&self) -> f64 {
-        self.period
-    }
-
-    /// Contact when V_T < 0, or V_T = 0 moving inwards (dV_T/dτ ≤ 0); free otherwise. For the
-    /// impact law: sticking when V_T = 0, dV_T/dτ = 0 and the constraint force λ > 0. For a
-    /// hysteretic law (JKR) also contact for 0 ≤ V_T < |δ_f| moving away (dV_T/dτ > 0: the
-    /// neck), the region being history-dependent there.
-    fn mode_at(&self, tau: f64, z: &[f64]) -> Region {
-        let (mut v, mut vd) = self.v_t_pair(tau, z);
-        if let Some((zn, u)) = self.zener_state(z) {
-            // over the SLS surface: g = V_T + s(u), ġ = V̇_T + s′u̇ (u̇ is continuous at g = 0)
-            v += zn.surface(u);
-            vd += zn.surface_gain() * zn.rate(false, -v, u);
-        }
-        if self.law.law.restitution().is_some() {
-            if v <= 0.0 && vd == 0.0 && self.sticking_force_value(tau, z) > 0.0 {
-                Region::Contact
-            } else {
-                Region::Free
-            }
-        } else if v < 0.0 || (v == 0.0 && vd <= 0.0) || (v < self.release && vd > 0.0) {
-            // a hysteretic law's band 0 ≤ V_T < |δ_f|: in contact when leaving through the
-            // neck, free when approaching ([`ContactLaw::release_distance`])
-            Region::Contact
-        } else {
-            Region::Free
-        }
-    }
-
-    fn rhs(&self, mode: Region, tau: f64, z: &[f64], dz: &mut [f64]) {
-        self.rhs_slice(mode, tau, z, dz);
-    }
-
-    fn jacobian(&self, mode: Region, tau: f64, z: &[f64], jac: &mut DMatrix<f64>) {
-        self.jacobian_into(mode, tau, z, jac);
-    }
-
-    /// Free flight: g = V_T; contact: g = −V_T, or |δ_f| − V_T for a hysteretic law (JKR's
-    /// neck); sticking (impact law): g = λ; over the SLS sample σ(V_T + s(u)) (the contact's
-    /// being F_c/(α4 + κ): the tip leaves where the sample's force falls to 0).
-    fn guard(&self, mode: Region, tau: f64, z: &[f64]) -> Guard {
-        if mode == Region::Contact && self.law.law.restitution().is_some() {
-            return self.sticking_force(tau, z);
-        }
-        let n = self.modes();
-        let p = &self.params;
-        let sigma = mode.guard_sign();
-        let mut grad = DVector::zeros(self.dim());
-        grad.rows_mut(0, n).copy_from(&(sigma * self.tip()));
-        if let Some((zn, _)) = self.zener_state(z) {
-            grad[2 * n] = sigma * zn.surface_gain();
-        }
-        Guard {
-            value: sigma * self.switching(self.v_t_pair(tau, z).0, z) + self.guard_offset(mode),
-            grad,
-            d_tau: sigma * p.base_amplitude() * p.omega * (p.omega * tau).cos(),
-        }
-    }
-
-    fn guard_value(&self, mode: Region, tau: f64, z: &[f64]) -> f64 {
-        if mode == Region::Contact && self.law.law.restitution().is_some() {
-            return self.sticking_force_value(tau, z);
-        }
-        mode.guard_sign() * self.switching(self.v_t_pair(tau, z).0, z) + self.guard_offset(mode)
-    }
-
-    /// Switchings are the identity; the impact law's free-flight guard is an impact (module
-    /// docs), ending in sticking (a plastic impact) when the bounce would rise less than
-    /// [`STICK_HEIGHT_TOLERANCES`] guard tolerances against λ > 0; sticking ends in a release
-    /// (identity).
-    fn jump(&self, from: Region, tau: f64, z: &[f64]) -> Jump {
-        let Some(r) = self.law.law.restitution() else {
-            return Jump::switching(from.other(), z);
-        };
-        if from == Region::Contact {
-            let mut j = Jump::switching(Region::Free, z);
-            j.kind = EventKind::Release;
-            return j;
-        }
-        let n = self.modes();
-        let p = &self.params;
-        let (_, v_minus) = self.v_t_pair(tau, z);
-        // ȧ⁺ = ȧ⁻ − (1 + r) m_eff V̇_T⁻ M⁻¹φ; the plastic impact (r = 0) first when sticking
-        let apply = |r: f64| {
-            let mut state = DVector::from_column_slice(z);
-            let k = (1.0 + r) * self.m_eff * v_minus;
-            for (o, m) in state.rows_mut(n, n).iter_mut().zip(self.mphi.iter()) {
-                *o -= k * m;
-            }
-            state
-        };
-        let plastic = apply(0.0);
-        // stick when λ is compressive (or within its dead band of 0: about to become so) and the
-        // bounce would rise less than the resolvable height
-        let lambda = self.sticking_force_value(tau, plastic.as_slice());
-        let bounce = r * v_minus;
-        let h_stick =
-            STICK_HEIGHT_TOLERANCES * self.guard_tolerance(Region::Free, tau, plastic.as_slice());
-        let sticks = lambda > -self.guard_tolerance(Region::Contact, tau, plastic.as_slice())
-            && self.m_eff * bounce * bounce <= 2.0 * h_stick * lambda.max(0.0);
-        let r_eff = if sticks { 0.0 } else { r };
-        let state = if sticks { plastic } else { apply(r) };
-        // R = I − (1 + r) m_eff [0 0; M⁻¹φ φᵀ 0] on the velocity block (V̇_T⁻ = φᵀȧ + α2Ω cos Ωτ)
-        let mut jacobian = DMatrix::identity(2 * n, 2 * n);
-        let k = (1.0 + r_eff) * self.m_eff;
-        let mut block = jacobian.view_mut((n, n), (n, n));
-        block.ger(-k, &self.mphi, self.tip(), 1.0);
-        // ∂ȧ⁺/∂τ = −(1 + r) m_eff M⁻¹φ ∂V̇_T⁻/∂τ, ∂V̇_T⁻/∂τ = −α2 Ω² sin Ωτ
-        let mut d_tau = DVector::zeros(2 * n);
-        let dv = -p.base_amplitude() * p.omega * p.omega * (p.omega * tau).sin();
-        d_tau.rows_mut(n, n).copy_from(&(-k * dv * &self.mphi));
-        Jump {
-            to: if sticks {
-                Region::Contact
-            } else {
-                Region::Free
-            },
-            kind: if sticks {
-                EventKind::Stick
-            } else {
-                EventKind::Impact
-            },
-            state,
-            jacobian,
-            d_tau,
-        }
-    }
-
-    fn is_affine(&self) -> bool {
-        self.law.law.is_affine()
-    }
-
-    /// σ dV_T/dτ = σ(φ·ȧ + α2 Ω cos Ωτ) for the V_T guards (ȧ = f's top half), without
-    /// allocating; the sticking guard through [`HybridSystem::guard`].
-    fn guard_rate(&self, mode: Region, tau: f64, z: &[f64], f: &[f64]) -> f64 {
-        if mode == Region::Contact && self.law.law.restitution().is_some() {
-            let g = self.sticking_force(tau, z);
-            return g.grad.iter().zip(f).map(|(a, b)| a * b).sum::<f64>() + g.d_tau;
-        }
-        let p = &self.params;
-        let n = p.modes;
-        let wd: f64 = self
-            .tip()
-            .as_slice()
-            .iter()
-            .zip(&f[..n])
-            .map(|(a, b)| a * b)
-            .sum();
-        let surface = self
-            .zener_state(z)
-            .map_or(0.0, |(zn, _)| zn.surface_gain() * f[2 * n]);
-        mode.guard_sign() * (wd + p.base_amplitude() * p.omega * (p.omega * tau).cos() + surface)
-    }
-
-    /// 1e-12 of the guard's scale: of V_T, 1 + α2 + |α5|; of the constraint force of sticking,
-    /// m_eff (1 + α2 Ω²).
-    fn guard_tolerance(&self, mode: Region, _tau: f64, _z: &[f64]) -> f64 {
-        let p = &self.params;
-        if mode == Region::Contact && self.law.law.restitution().is_some() {
-            1e-12 * self.m_eff * (1.0 + p.base_amplitude() * p.omega * p.omega)
-        } else {
-            1e-12 * (1.0 + p.base_amplitude() + p.alpha5.abs())
-        }
-    }
-
-    /// For DMT in contact the Kelvin–Voigt term makes ∂F_c/∂δ ∋ α6 δ̇/(2√δ), unbounded at contact
-    /// onset (integrable: the tangent flow stays finite). With the rank-one nilpotent
-    /// E = [0; M⁻¹φ] w [φᵀ 0], w = α6√δ, and Ψ = (I + E)Φ, the singular part cancels against
-    /// E′: Ψ′ = (J_reg + [0; M⁻¹φ] w [0 φᵀ]) (I − E) Ψ, all terms bounded (J_reg: the Jacobian
-    /// without the singular term; (I + E)⁻¹ = I − E since [φᵀ 0][0; M⁻¹φ] = 0).
-    fn variational_rhs(
-        &self,
-        mode: Region,
-        tau: f64,
-        z: &[f64],
-        psi: &[f64],
-        dpsi: &mut [f64],
-        jac: &mut DMatrix<f64>,
-    ) {
-        let d = self.dim();
-        let n = self.modes();
-        // sin, cos Ωτ once for V_T in the weight and the Jacobian
-        let sc = self.base_trig(tau);
-        let w = self.kelvin_voigt_weight_at(mode, sc, z);
-        self.jacobian_parts(mode, tau, sc, z, jac, w == 0.0);
-        if d != 2 * n {
-            // internal states: J is not of the second-order form
-            crate::system::jacobian_product(jac, psi, dpsi);
-            return;
-        }
-        if w == 0.0 {
-            second_order_product(jac, n, psi, dpsi);
-            return;
-        }
-        // J = J_reg + [0; M⁻¹φ] w [0 φᵀ] (velocity rows, velocity columns)
-        let tip = self.tip();
-        for j in 0..n {
-            let wt = w * tip[j];
-            for i in 0..n {
-                jac[(n + i, n + j)] += self.mphi[i] * wt;
-            }
-        }
-        // J (I − E) Ψ = J Ψ − (J u) vᵀ with E Ψ = u vᵀ, u = [0; M⁻¹φ], v_c = w φᵀ Ψ_top[:, c]
-        second_order_product(jac, n, psi, dpsi);
-        let mut ju = [0.0; 2 * crate::params::MAX_MODES];
-        ju[..n].copy_from_slice(self.mphi.as_slice());
-        for i in 0..n {
-            ju[n + i] = (0..n).map(|j| jac[(n + i, n + j)] * self.mphi[j]).sum();
-        }
-        for (out, col) in dpsi.chunks_exact_mut(d).zip(psi.chunks_exact(d)) {
-            let v = w * (0..n).map(|j| tip[j] * col[j]).sum::<f64>();
-            if v != 0.0 {
-                for (o, u) in out.iter_mut().zip(&ju[..d]) {
-                    *o -= u * v;
-                }
-            }
-        }
-    }
-
-    /// Ψ = (I + E)Φ (forward) or Φ = (I − E)Ψ, E as in [`HybridSystem::variational_rhs`].
-    fn to_tangent_coords(&self, mode: Region, tau: f64, z: &[f64], m: &mut [f64], forward: bool) {
-        let w = self.kelvin_voigt_weight(mode, tau, z);
-        if w == 0.0 {
-            return;
-        }
-        let d = self.dim();
-        let n = self.modes();
-        let sign = if forward { w } else { -w };
-        let tip = self.tip();
-        // velocity rows ± M⁻¹φ w (φᵀ M_top), column by column
-        for col in m.chunks_exact_mut(d) {
-            let top = sign * (0..n).map(|j| tip[j] * col[j]).sum::<f64>();
-            if top != 0.0 {
-                for (o, u) in col[n..].iter_mut().zip(self.mphi.iter()) {
-                    *o += u * top;
-                }
-            }
-        }
-    }
-}
-
-/// J Ψ for the Jacobian of a second-order system in z = (a, ȧ), J = [[0, I], [L]] (`jac`'s top
-/// rows are not read): the top rows are Ψ's lower rows, the lower rows L Ψ
-/// ([`crate::system::jacobian_rows_product`]). Ψ and the output are 2n × 2n column-major.
-fn second_order_product(jac: &DMatrix<f64>, n: usize, psi: &[f64], dpsi: &mut [f64]) {
-    for (out, col) in dpsi.chunks_exact_mut(2 * n).zip(psi.chunks_exact(2 * n)) {
-        out[..n].copy_from_slice(&col[n..]);
-    }
-    crate::system::jacobian_rows_product(jac, n, psi, dpsi);
-}
+mod hybrid;
+mod response;

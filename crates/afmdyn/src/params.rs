@@ -318,86 +318,6 @@ pub(crate) fn gcd(a: u64, b: u64) -> u64 {
     }
 }
 
-/// The modes of the eigenmode model ([`Structure::Eigenmodes`]): stiffness at the tip and
-/// natural frequency of each mode relative to mode 1's (k_j/k_1, ω_j/ω_1; entry 0 is 1, only
-/// the first N entries are used). Their quality factors are the damping profile's
-/// ([`Params::damping_profile`], set by [`crate::probe`]).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct Eigenmodes {
-    /// k_j/k_1.
-    pub stiffness: [f64; 20],
-    /// ω_j/ω_1.
-    pub frequency: [f64; 20],
-}
-
-impl Eigenmodes {
-    /// The modal mass of mode j in the model's units (k_1 and ω_1 of 1): (k_j/k_1)/(ω_j/ω_1)².
-    pub fn mass(&self, j: usize) -> f64 {
-        self.stiffness[j] / (self.frequency[j] * self.frequency[j])
-    }
-}
-
-/// The structural model of the cantilever.
-///
-/// * `Beam` — the paper: N clamped–free Galerkin modes with a tip mass α1, driven by the base
-///   displacement α2 sin Ωτ (eqs. 8–18); V_T = W(1,τ) + α2 sin Ωτ + α5.
-/// * `PointMass` — the standard model of the AFM literature (García & Pérez, *Surf. Sci. Rep.*
-///   47 (2002) 197, eq. 6; García & San Paulo, *Phys. Rev. B* 60 (1999) 4961): one eigenmode
-///   driven by a force at the tip, m z̈ + (m ω₀/Q) ż + k z = F₀ cos ωt + F_ts(d, ḋ), d = z_c + z.
-///   In the units τ = ω₀ t and lengths of g₀ (forces of k g₀) it reads
-///   z'' + α3 z' + z = α2 cos Ωτ + F_c with α3 = 1/Q, α2 = F₀/(k g₀), Ω = ω/ω₀, and
-///   V_T = z + α5 (the base does not move): N = 1, φ(1) = 1, M = 1, K = 1, α1 = 0.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "kebab-case")]
-pub enum Structure {
-    /// The paper's Euler–Bernoulli beam in N Galerkin modes, base-driven.
-    #[default]
-    Beam,
-    /// One eigenmode with a force drive (the point-mass model).
-    PointMass,
-    /// N eigenmodes with a force drive, each with its own stiffness k_j, frequency ω_j and
-    /// quality factor Q_j at the tip, the tip displacement their sum: the model of the bimodal
-    /// AFM literature (Lozano & García, *Phys. Rev. Lett.* 100 (2008) 076102; García & Proksch,
-    /// *Eur. Polym. J.* 49 (2013) 1897, eq. 1): (k_j/ω_j²) z_j'' + (k_j/(ω_j Q_j)) z_j' + k_j z_j
-    /// = F_drive + F_ts, V_T = Σ z_j + α5. In the units of the point mass (k_1, ω_1 of 1) the
-    /// modal masses are (k_j/k_1)/(ω_j/ω_1)² ([`Eigenmodes`]).
-    Eigenmodes,
-}
-
-impl Structure {
-    /// `beam` or `point-mass`.
-    pub fn name(self) -> &'static str {
-        match self {
-            Structure::Beam => "beam",
-            Structure::PointMass => "point-mass",
-            Structure::Eigenmodes => "eigenmodes",
-        }
-    }
-
-    /// Whether the model is lumped at the tip (the point mass and the eigenmode model): a force
-    /// drive, no beam body, the deflection the tip's everywhere.
-    pub fn is_lumped(self) -> bool {
-        match self {
-            Structure::Beam => false,
-            Structure::PointMass | Structure::Eigenmodes => true,
-        }
-    }
-}
-
-impl FromStr for Structure {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s.trim().to_ascii_lowercase().replace('_', "-").as_str() {
-            "beam" => Ok(Structure::Beam),
-            "point-mass" | "pointmass" => Ok(Structure::PointMass),
-            "eigenmodes" => Ok(Structure::Eigenmodes),
-            _ => Err(format!(
-                "model '{s}': expected beam, point-mass or eigenmodes"
-            )),
-        }
-    }
-}
-
 impl Default for Params {
     /// The paper's set for Figs. 5–14 (eq. 26 with α1 = 0.1, N = 3) at Ω = 2.6.
     fn default() -> Self {
@@ -566,39 +486,9 @@ impl Params {
             });
         }
         self.contact_law.validate()?;
-        if let crate::contact::ContactLaw::Jkr { adhesion } = self.contact_law {
-            // the JKR branch scales with P̃/α4 (δ_f = −3(P̃/(6α4))^{2/3}): α4 = 0 has no
-            // elastic contact, and beyond 1e12 the neck is below resolution or the whole gap
-            let ratio = adhesion / self.alpha4;
-            if !(self.alpha4 > 0.0 && (1e-12..=1e12).contains(&ratio)) {
-                return Err(ParamError::Law {
-                    name: "alpha4 (contact stiffness α4, the JKR Hertz group)",
-                    value: self.alpha4,
-                    range: "α4 > 0 with 1e-12 ≤ P̃/α4 ≤ 1e12 (the neck's scale)",
-                });
-            }
-        }
-        if let crate::contact::ContactLaw::Sls { maxwell_stiffness } = self.contact_law {
-            // the Maxwell arm relaxes at κ/α6: a dashpot is needed (α6 = 0 would relax it
-            // instantly), and its rate must stay within the integrators' reach
-            let rate = maxwell_stiffness / self.alpha6;
-            if !(self.alpha6 > 0.0 && rate <= 1e12) {
-                return Err(ParamError::Law {
-                    name: "alpha6 (the SLS Maxwell arm's dashpot α6)",
-                    value: self.alpha6,
-                    range: "α6 > 0 with κ/α6 ≤ 1e12 (the relaxation rate)",
-                });
-            }
-            // the relaxed spring brings the surface back after a tap (α4 = 0, a Maxwell
-            // fluid, keeps every dent)
-            if self.alpha4 <= 0.0 || self.alpha4.is_nan() {
-                return Err(ParamError::Law {
-                    name: "alpha4 (the SLS relaxed spring α4)",
-                    value: self.alpha4,
-                    range: "α4 > 0 (the spring that brings the surface back after a tap)",
-                });
-            }
-        }
+        // the law's groups against the shared α4, α6 (JKR's neck scale P̃/α4, the SLS
+        // relaxation rate κ/α6)
+        self.contact_law.validate_shared(self.alpha4, self.alpha6)?;
         if let Some(profile) = &self.damping_profile {
             for &s in &profile[..self.modes] {
                 if !(s.is_finite() && s >= 0.0) {
@@ -841,81 +731,7 @@ impl Params {
     }
 }
 
-/// A continuous parameter that sweeps and continuation can vary.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
-#[serde(rename_all = "lowercase")]
-pub enum SweepParam {
-    /// Ω, drive frequency.
-    Omega,
-    /// α1, tip-mass ratio.
-    Alpha1,
-    /// α2, drive amplitude.
-    Alpha2,
-    /// α3, beam damping.
-    Alpha3,
-    /// α4, contact stiffness.
-    Alpha4,
-    /// α5, gap.
-    Alpha5,
-    /// α6, contact damping.
-    Alpha6,
-}
-
-impl SweepParam {
-    /// Canonical name (`omega`, `alpha1` … `alpha6`).
-    pub fn name(self) -> &'static str {
-        match self {
-            SweepParam::Omega => "omega",
-            SweepParam::Alpha1 => "alpha1",
-            SweepParam::Alpha2 => "alpha2",
-            SweepParam::Alpha3 => "alpha3",
-            SweepParam::Alpha4 => "alpha4",
-            SweepParam::Alpha5 => "alpha5",
-            SweepParam::Alpha6 => "alpha6",
-        }
-    }
-
-    /// Paper symbol (Ω, α1 … α6).
-    pub fn symbol(self) -> &'static str {
-        match self {
-            SweepParam::Omega => "Ω",
-            SweepParam::Alpha1 => "α1",
-            SweepParam::Alpha2 => "α2",
-            SweepParam::Alpha3 => "α3",
-            SweepParam::Alpha4 => "α4",
-            SweepParam::Alpha5 => "α5",
-            SweepParam::Alpha6 => "α6",
-        }
-    }
-}
-
-impl fmt::Display for SweepParam {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl FromStr for SweepParam {
-    type Err = String;
-    /// Accepts `omega`, `alpha1`…`alpha6` and the descriptive names (`tip-mass-ratio`,
-    /// `drive-amplitude`, `beam-damping`, `contact-stiffness`, `gap`, `contact-damping`), with `-` or `_`.
-    fn from_str(s: &str) -> Result<Self, String> {
-        let k = s.trim().to_ascii_lowercase().replace('_', "-");
-        Ok(match k.as_str() {
-            "omega" | "Ω" => SweepParam::Omega,
-            "alpha1" | "tip-mass-ratio" => SweepParam::Alpha1,
-            "alpha2" | "drive-amplitude" => SweepParam::Alpha2,
-            "alpha3" | "beam-damping" => SweepParam::Alpha3,
-            "alpha4" | "contact-stiffness" => SweepParam::Alpha4,
-            "alpha5" | "gap" => SweepParam::Alpha5,
-            "alpha6" | "contact-damping" => SweepParam::Alpha6,
-            _ => {
-                return Err(format!(
-                    "unknown parameter '{s}': expected omega, alpha1..alpha6 or tip-mass-ratio, \
-                     drive-amplitude, beam-damping, contact-stiffness, gap, contact-damping"
-                ))
-            }
-        })
-    }
-}
+mod structure;
+mod sweep;
+pub use structure::{Eigenmodes, Structure};
+pub use sweep::SweepParam;

@@ -1,8 +1,9 @@
 //! One conformance suite over every integrator × contact law pair (exact, rk4, rk4-naive,
-//! adaptive, split, taylor × linear, Hertz, DMT, electrostatic, JKR, capillary, SLS, impact): the
-//! support table (every
-//! unsupported pair is refused with [`SimError::Unsupported`] naming the integrator), and for
-//! every supported pair the identities an integrator of the switched model must satisfy:
+//! adaptive, split, taylor × every law of the registry, [`afmdyn::contact::LAWS`]: linear,
+//! Hertz, DMT, electrostatic, JKR, capillary, SLS, impact, and the toy law with the `toy-law`
+//! feature): the support table from the laws' capabilities (every unsupported pair is refused
+//! with [`SimError::Unsupported`] naming the integrator), and for every supported pair the
+//! identities an integrator of the switched model must satisfy:
 //!
 //! * a sample out of reach: no event, the closed-form harmonic response of the free flight
 //!   (`common::harmonic_response`), landing exactly on the end time;
@@ -18,9 +19,10 @@
 //! * the capability accessors ([`Integrator::affine`], [`Integrator::spans`]) are offered by
 //!   the integrators that have them only.
 
+use afmdyn::contact::LawGroups;
 use afmdyn::galerkin::Region;
 use afmdyn::integrate::{advance, build, Integrator, IntegratorKind, IntegratorOptions, Step};
-use afmdyn::{CantileverModel, ContactLaw, HybridSystem, Params, SimError};
+use afmdyn::{CantileverModel, ContactLaw, HybridSystem, LawKind, Params, SimError};
 use nalgebra::{DMatrix, DVector};
 
 mod common;
@@ -29,16 +31,28 @@ use common::{events_until, harmonic_response};
 
 const IMPACT: ContactLaw = ContactLaw::Impact { restitution: 0.6 };
 
-const LAWS: [ContactLaw; 8] = [
-    ContactLaw::Linear,
-    ContactLaw::Hertz,
-    DMT,
-    ES,
-    JKR,
-    CAP,
-    SLS,
-    IMPACT,
-];
+/// The cases: every registered law, with these groups where given, else its defaults.
+fn laws() -> Vec<ContactLaw> {
+    let chosen = [
+        ContactLaw::Linear,
+        ContactLaw::Hertz,
+        DMT,
+        ES,
+        JKR,
+        CAP,
+        SLS,
+        IMPACT,
+    ];
+    LawKind::ALL
+        .iter()
+        .map(|&kind| {
+            chosen
+                .into_iter()
+                .find(|law| law.kind() == kind)
+                .unwrap_or_else(|| kind.with_groups(LawGroups::default()))
+        })
+        .collect()
+}
 
 const KINDS: [IntegratorKind; 6] = [
     IntegratorKind::Exact,
@@ -61,14 +75,15 @@ fn name(kind: IntegratorKind) -> &'static str {
     }
 }
 
-/// The support table: which integrator carries which law.
+/// The support table: which integrator carries which law, by the law's capabilities.
 fn supported(kind: IntegratorKind, law: ContactLaw) -> bool {
-    let (linear, impact, dmt, es, jkr) = (
-        law == ContactLaw::Linear,
+    let p = Params::default();
+    let (affine, impact, outside, jet, hysteretic) = (
+        law.is_affine(),
         law.restitution().is_some(),
-        matches!(law, ContactLaw::Dmt { .. }),
-        matches!(law, ContactLaw::Electrostatic { .. }),
-        matches!(law, ContactLaw::Jkr { .. } | ContactLaw::Capillary { .. }),
+        law.acts_outside(),
+        law.jet(p.alpha4, p.alpha6).is_some(),
+        law.hysteresis(p.alpha4).is_some(),
     );
     // the SLS sample's internal state: the adaptive integrator only
     if law.internal_states() > 0 {
@@ -76,14 +91,14 @@ fn supported(kind: IntegratorKind, law: ContactLaw) -> bool {
     }
     match kind {
         IntegratorKind::Auto | IntegratorKind::Adaptive => true,
-        IntegratorKind::Exact => linear,
+        IntegratorKind::Exact => affine,
         // JKR's and the meniscus's region depends on the history (the neck, the meniscus), not
         // on the sign of V_T alone
-        IntegratorKind::Rk4 | IntegratorKind::Rk4Naive => !impact && !jkr,
-        // the electrostatic force acts in free flight, and is not in the Taylor recurrences,
-        // nor are JKR's implicit contact radius and the meniscus's √(D² + h²)
-        IntegratorKind::Split => !dmt && !es,
-        IntegratorKind::Taylor => !linear && !impact && !es && !jkr,
+        IntegratorKind::Rk4 | IntegratorKind::Rk4Naive => !impact && !hysteretic,
+        // DMT's and the electrostatic force act in free flight; the Taylor recurrences carry
+        // the laws with a piece of the jet (Hertz, DMT)
+        IntegratorKind::Split => !outside,
+        IntegratorKind::Taylor => jet,
     }
 }
 
@@ -135,7 +150,7 @@ fn free_accuracy(kind: IntegratorKind) -> f64 {
 /// Unsupported pairs are typed refusals naming the integrator; supported ones build.
 #[test]
 fn the_support_table() {
-    for law in LAWS {
+    for law in laws() {
         let m = model(law, None);
         for kind in KINDS {
             let built = build(&m, opts(kind, 1e-12), 0.0, &m.rest());
@@ -155,7 +170,7 @@ fn the_support_table() {
 /// Free flight with the sample out of reach, events with it, bad starts.
 #[test]
 fn free_flight_events_and_bad_starts() {
-    for law in LAWS {
+    for law in laws() {
         for kind in KINDS.into_iter().filter(|&k| supported(k, law)) {
             // (a) a sample out of reach: no event, the closed-form free response, exact landing
             let m = model(common::without_attraction(law), Some(5.0));
@@ -220,7 +235,7 @@ fn free_flight_events_and_bad_starts() {
 /// The stroboscopic state after 3 drive periods from rest against DOP853 at 1e-14.
 #[test]
 fn stroboscopic_state_agrees_with_the_oracle() {
-    for law in LAWS {
+    for law in laws() {
         let m = model(law, None);
         let t = 3.0 * m.period();
         let mut oracle = build(&m, opts(IntegratorKind::Adaptive, 1e-14), 0.0, &m.rest()).unwrap();
@@ -261,7 +276,7 @@ fn steps(it: &mut dyn Integrator, t_end: f64) -> Vec<(Step, DVector<f64>, DVecto
 /// same integrator after a reset the same end state.
 #[test]
 fn dense_output_and_replay() {
-    for law in LAWS {
+    for law in laws() {
         let m = model(law, None);
         let t = 2.0 * m.period();
         for kind in KINDS.into_iter().filter(|&k| supported(k, law)) {
@@ -305,7 +320,7 @@ fn dense_output_and_replay() {
 /// refused with [`SimError::Unsupported`]).
 #[test]
 fn step_jacobians_match_finite_differences() {
-    for law in LAWS {
+    for law in laws() {
         let m = model(law, None);
         let t = 2.0 * m.period();
         for kind in KINDS.into_iter().filter(|&k| supported(k, law)) {
@@ -371,7 +386,7 @@ fn step_jacobians_match_finite_differences() {
 /// own representation of the state (exact, split), none for the others.
 #[test]
 fn capabilities_where_they_are() {
-    for law in LAWS {
+    for law in laws() {
         let m = model(law, None);
         for kind in KINDS.into_iter().filter(|&k| supported(k, law)) {
             let mut it = build(&m, opts(kind, 1e-12), 0.0, &m.rest()).unwrap();

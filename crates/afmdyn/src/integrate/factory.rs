@@ -4,7 +4,6 @@
 //! [`build`], the one place that imports every integrator.
 
 use super::{adaptive, exact, rk4, split, taylor, Integrator};
-use crate::contact::ContactLaw;
 use crate::error::SimError;
 use crate::model::CantileverModel;
 use crate::params::SweepParam;
@@ -118,7 +117,8 @@ impl IntegratorKind {
             // every component), else adaptive (the exact and split integrators propagate one
             // harmonic drive)
             IntegratorKind::Auto if model.params().is_multifrequency() => {
-                if matches!(model.law(), ContactLaw::Hertz | ContactLaw::Dmt { .. }) {
+                let p = model.params();
+                if model.law().jet(p.alpha4, p.alpha6).is_some() {
                     IntegratorKind::Taylor
                 } else {
                     IntegratorKind::Adaptive
@@ -133,7 +133,12 @@ impl IntegratorKind {
             IntegratorKind::Auto if split::Split::applies(model) => IntegratorKind::Split,
             // the electrostatic law: its 1/(d(d + R)) force is not in the Taylor integrator's
             // recurrences; the adaptive DOP853 integrates it with events
-            IntegratorKind::Auto if matches!(model.law(), ContactLaw::Electrostatic { .. }) => {
+            IntegratorKind::Auto
+                if model
+                    .law()
+                    .jet(model.params().alpha4, model.params().alpha6)
+                    .is_none() =>
+            {
                 IntegratorKind::Adaptive
             }
             // DMT: its van der Waals force acts in free flight

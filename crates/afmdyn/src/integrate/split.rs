@@ -57,11 +57,13 @@ enum ContactHalf {
 
 impl ContactHalf {
     fn new(model: &CantileverModel, tol: f64) -> Result<Self, SimError> {
-        Ok(match model.law() {
-            crate::contact::ContactLaw::Hertz => {
-                ContactHalf::Taylor(Box::new(Taylor::new(model, tol)?))
-            }
-            _ => ContactHalf::Adaptive(Box::new(Adaptive::new(model, tol))),
+        // a law with a piece of the Taylor jet (Hertz: DMT's force acts in free flight, where
+        // the split does not apply)
+        let p = model.params();
+        Ok(if model.law().jet(p.alpha4, p.alpha6).is_some() {
+            ContactHalf::Taylor(Box::new(Taylor::new(model, tol)?))
+        } else {
+            ContactHalf::Adaptive(Box::new(Adaptive::new(model, tol)))
         })
     }
     fn integ(&self) -> &dyn Integrator {
@@ -142,12 +144,7 @@ impl Split {
     /// Whether `model`'s law exerts no force in free flight (linear, Hertz, impact; not DMT or
     /// the electrostatic law).
     pub fn applies(model: &CantileverModel) -> bool {
-        model.law().internal_states() == 0
-            && !matches!(
-                model.law(),
-                crate::contact::ContactLaw::Dmt { .. }
-                    | crate::contact::ContactLaw::Electrostatic { .. }
-            )
+        model.law().internal_states() == 0 && !model.law().acts_outside()
     }
 
     fn integ(&self, h: Half) -> &dyn Integrator {

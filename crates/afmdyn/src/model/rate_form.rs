@@ -13,7 +13,6 @@
 //! degree 2 in (sin Ωτ, cos Ωτ) ([`RateForm`]); `tests` check them against `power` pointwise.
 
 use super::CantileverModel;
-use crate::contact::ContactLaw;
 use crate::system::Region;
 use nalgebra::{DMatrix, DVector};
 
@@ -68,7 +67,7 @@ impl CantileverModel {
     /// forms (module docs), or `None` for a law that is not affine (only the linear law is).
     pub fn rate_forms(&self, r: Region) -> Option<[RateForm; 3]> {
         // the forms hold one harmonic drive (a multifrequency drive's power is not in them)
-        if !matches!(self.law(), ContactLaw::Linear) || self.params().is_multifrequency() {
+        if !self.law().is_affine() || self.params().is_multifrequency() {
             return None;
         }
         let p = self.params();

@@ -49,7 +49,6 @@ mod jet;
 pub(crate) mod poly;
 
 use super::{ChatterWindow, Integrator, SmoothTime, Step, StepBudget};
-use crate::contact::ContactLaw;
 use crate::error::SimError;
 use crate::model::CantileverModel;
 use crate::roots::safeguarded_newton;
@@ -157,21 +156,7 @@ impl Taylor {
             return Err(SimError::Unsupported {
                 integrator: "taylor",
                 law: model.law().name(),
-                hint: match model.law() {
-                    ContactLaw::Linear => {
-                        "the linear law is propagated exactly: use integrator = \"exact\" (or \
-                         \"auto\")"
-                    }
-                    ContactLaw::Impact { .. } => {
-                        "impacts need the jump map of the adaptive or split integrator: use \
-                         integrator = \"auto\""
-                    }
-                    _ => {
-                        "this law's force is not in the Taylor recurrences (the electrostatic \
-                         1/(d(d + R)), JKR's implicit contact radius, the capillary meniscus's \
-                         √(D² + h²)): use integrator = \"auto\" (or \"adaptive\")"
-                    }
-                },
+                hint: model.law().taylor_hint(),
             });
         };
         let d = model.dim();

@@ -1,4 +1,5 @@
 use super::*;
+use crate::contact::ContactLaw;
 
 /// The products of series (a dot product with one factor backwards) are the Cauchy products
 /// written out, at every order.

@@ -1,0 +1,158 @@
+use super::*;
+
+fn laws() -> Vec<TipSample> {
+    [
+        ContactLaw::Linear,
+        ContactLaw::Hertz,
+        ContactLaw::Dmt {
+            hamaker: 0.3,
+            intermolecular_distance: 0.02,
+        },
+        ContactLaw::Electrostatic {
+            hamaker: 0.3,
+            intermolecular_distance: 0.02,
+            electrostatic: 0.05,
+            tip_radius: 0.7,
+        },
+        ContactLaw::Jkr { adhesion: 0.05 },
+        ContactLaw::Capillary {
+            capillary: 0.1,
+            meniscus: 0.02,
+            rupture: 0.06,
+        },
+    ]
+    .into_iter()
+    .map(|law| TipSample {
+        law,
+        stiffness: 20.0,
+        damping: 0.2,
+    })
+    .collect()
+}
+
+/// The partial derivatives are those of the force (central differences), and the
+/// conservative part is −dU/dV_T = dU/dδ (definition of the potential).
+#[test]
+fn partials_and_potential_are_consistent() {
+    for ts in laws() {
+        // and a hysteretic law's contact region beyond V_T = 0: JKR's neck (δ_b = −0.0167
+        // here), the capillary meniscus (D̃_r = 0.06)
+        let band: &[(bool, f64, f64)] = match ts.law {
+            ContactLaw::Jkr { .. } => &[(true, -0.01, 0.3), (true, -0.002, -0.5)],
+            // and next to the kink at D = 0, on both sides
+            ContactLaw::Capillary { .. } => &[
+                (true, -0.03, 0.3),
+                (true, -0.055, -0.5),
+                (true, -1e-5, 0.0),
+                (true, 1.2e-5, 0.0),
+            ],
+            _ => &[],
+        };
+        for &(contact, delta, rate) in [
+            (true, 0.07, 0.3),
+            (true, 0.5, -1.2),
+            (false, -0.05, 0.4),
+            (false, -0.8, -2.0),
+        ]
+        .iter()
+        .chain(band)
+        {
+            let f = ts.force(contact, delta, rate);
+            // a step that stays on the kink's side where δ is that small
+            let h = 1e-6f64.min(1e-3 * delta.abs());
+            let fd = (ts.force(contact, delta + h, rate).force
+                - ts.force(contact, delta - h, rate).force)
+                / (2.0 * h);
+            let fr = (ts.force(contact, delta, rate + h).force
+                - ts.force(contact, delta, rate - h).force)
+                / (2.0 * h);
+            assert!((f.d_delta - fd).abs() < 1e-6 * (1.0 + fd.abs()), "{ts:?}");
+            assert!((f.d_rate - fr).abs() < 1e-6 * (1.0 + fr.abs()), "{ts:?}");
+            let du =
+                (ts.potential(contact, delta + h) - ts.potential(contact, delta - h)) / (2.0 * h);
+            let cons = f.force - ts.dissipative(contact, delta, rate);
+            assert!((du - cons).abs() < 1e-6 * (1.0 + du.abs()), "{ts:?}");
+        }
+    }
+}
+
+/// DMT is continuous at the contact threshold (force and potential), the DMT adhesion
+/// force is H̃/ã₀² there; the electrostatic law too, with the sphere–plane force
+/// ẼR̃²/(ã₀(ã₀ + R̃)) added.
+#[test]
+fn dmt_is_continuous_at_contact() {
+    for (ts, adhesion) in [
+        (laws()[2], 0.3 / (0.02 * 0.02)),
+        (
+            laws()[3],
+            0.3 / (0.02 * 0.02) + 0.05 * 0.7 * 0.7 / (0.02 * 0.72),
+        ),
+    ] {
+        let (inside, outside) = (ts.force(true, 0.0, 0.0), ts.force(false, 0.0, 0.0));
+        assert!((inside.force - outside.force).abs() < 1e-12);
+        assert!((inside.force + adhesion).abs() < 1e-9 * adhesion);
+        assert!((ts.potential(true, 0.0) - ts.potential(false, 0.0)).abs() < 1e-12);
+    }
+}
+
+/// The electrostatic force is Hudlet's sphere term: −πε₀V²R/d for d ≪ R (the parallel
+/// plate limit of the sphere, Hudlet et al. 1998) and −πε₀V²R²/d² for d ≫ R (a point
+/// charge's image force), in the law's units Ẽ = πε₀V², R̃.
+#[test]
+fn electrostatic_force_has_its_limits() {
+    let ts = TipSample {
+        law: ContactLaw::Electrostatic {
+            hamaker: 0.0,
+            intermolecular_distance: 1e-3,
+            electrostatic: 2.0,
+            tip_radius: 5.0,
+        },
+        stiffness: 0.0,
+        damping: 0.0,
+    };
+    let near = ts.long_range(1e-4)[0];
+    assert!((near / (-2.0 * 5.0 / 1e-4) - 1.0).abs() < 1e-4, "{near}");
+    let far = ts.long_range(1e5)[0];
+    assert!((far / (-2.0 * 25.0 / 1e10) - 1.0).abs() < 1e-4, "{far}");
+}
+
+/// The registry agrees with itself: names, serde tags and the parser; each law's defaults
+/// validate and are its descriptors' defaults; each group is a `LawGroups` field and a
+/// request key; [`LawKind::EXPECTED`] lists the names.
+#[test]
+fn the_registry_is_consistent() {
+    assert_eq!(LawKind::ALL.len(), LAWS.len());
+    for (&kind, info) in LawKind::ALL.iter().zip(LAWS) {
+        assert_eq!(kind.name(), info.name);
+        assert_eq!(kind.info(), info);
+        let law = kind.with_groups(LawGroups::default());
+        assert_eq!(law.kind(), kind);
+        let json = serde_json::to_value(law).unwrap();
+        assert_eq!(json["law"], info.name);
+        assert_eq!(serde_json::from_value::<ContactLaw>(json).unwrap(), law);
+        assert_eq!(serde_json::to_value(kind).unwrap(), info.name);
+        assert_eq!(info.name.to_uppercase().parse::<LawKind>().unwrap(), kind);
+        for a in info.aliases {
+            assert_eq!(a.parse::<LawKind>().unwrap(), kind);
+        }
+        law.validate().unwrap();
+        let groups = law.groups().entries();
+        for p in info.params {
+            let (_, v) = groups
+                .iter()
+                .find(|(n, _)| *n == p.name)
+                .expect("a LawGroups field");
+            assert_eq!(*v, Some(p.default), "{}.{}", info.name, p.name);
+            assert!(crate::request::parameter(p.name).is_some(), "{}", p.name);
+        }
+        let given = groups.iter().filter(|(_, v)| v.is_some()).count();
+        assert_eq!(given, info.params.len(), "{}", info.name);
+        assert!(LawKind::EXPECTED.contains(info.name));
+    }
+    assert!(LawKind::EXPECTED.starts_with("linear, hertz, dmt"));
+    #[cfg(not(feature = "toy-law"))]
+    assert_eq!(
+        LawKind::EXPECTED,
+        "linear, hertz, dmt, electrostatic, jkr, capillary, sls or impact"
+    );
+}

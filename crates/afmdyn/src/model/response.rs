@@ -1,0 +1,162 @@
+//! The model's energy balance, responses and parameter derivatives.
+
+use super::*;
+
+impl CantileverModel {
+    /// Stored energy E = ½ȦᵀMȦ + ½XᵀK^I X + U(δ), U the potential of the law's conservative
+    /// part (½α4 V_T² for the linear law in contact; continuous across a switching; the energy
+    /// in the SLS sample's springs, [`Zener::potential`], in and out of contact).
+    pub fn energy(&self, r: Region, tau: f64, z: &DVector<f64>) -> f64 {
+        let n = self.modes();
+        let g = self.galerkin.region(Region::Free);
+        let x = z.rows(0, n);
+        let v = z.rows(n, n);
+        // the products into a buffer on the stack (the same gemv, no allocation)
+        let mut buf = [0.0; crate::params::MAX_MODES];
+        let mut quad = |m: &DMatrix<f64>, y| {
+            let mut out = nalgebra::DVectorViewMut::from_slice(&mut buf[..n], n);
+            m.mul_to(&y, &mut out);
+            out.dot(&y)
+        };
+        let kinetic = 0.5 * quad(&g.mass, v);
+        let bending = 0.5 * quad(&g.stiffness, x);
+        let contact = r == Region::Contact;
+        let delta = -self.v_t(tau, z);
+        let sample = match self.zener_state(z.as_slice()) {
+            Some((zn, u)) => zn.potential(contact, delta, u),
+            None => self.law.potential(contact, delta),
+        };
+        kinetic + bending + sample
+    }
+
+    /// The rates of the energy balance at (τ, z) in region r. Multiplying the equation of
+    /// motion by Ȧᵀ gives dE/dτ = P_base − D_beam − D_contact exactly, with
+    /// P_base = ȦᵀF^I(τ) − α2 Ω cos Ωτ · F_c (plus the power F̃(τ) Ẇ(1,τ) of the further
+    /// components of a multifrequency drive, [`Params::component_force`]) and D_contact = F_d δ̇ (F_d the dissipative part
+    /// of the law).
+    pub fn power(&self, r: Region, tau: f64, z: &DVector<f64>) -> PowerTerms {
+        let n = self.modes();
+        let p = &self.params;
+        let g = self.galerkin.region(Region::Free);
+        let v = z.rows(n, n);
+        let (s, c) = (p.omega * tau).sin_cos();
+        let mut drive = g.forcing.sin.dot(&v) * s + g.forcing.cos.dot(&v) * c;
+        if p.is_multifrequency() {
+            drive += p.component_force(tau) * self.tip().dot(&v);
+        }
+        // ȦᵀC^IȦ with the damping matrix of eq. 12 (α3 diag(s) with a per-mode damping profile:
+        // the beam's per-mode Q, the eigenmode model)
+        let beam = (&g.damping * v).dot(&v);
+        let fc = self.contact_force(r, tau, z);
+        let rate = -self.v_t_dot(tau, z);
+        let delta = -self.v_t(tau, z);
+        PowerTerms {
+            base: drive - p.base_amplitude() * p.omega * c * fc,
+            beam_dissipation: beam,
+            contact_dissipation: match self.zener_state(z.as_slice()) {
+                // the SLS dashpot, also while the surface recovers after the tip left
+                Some((zn, u)) => zn.dissipation(r == Region::Contact, delta, u),
+                None => self.law.dissipative(r == Region::Contact, delta, rate) * rate,
+            },
+        }
+    }
+
+    /// Energy bookkeeping of an impact at τ with pre-impact rate V̇_T⁻ = `v_minus` and
+    /// restitution r: (loss in the sample, work of the impulse on the clamped frame). The
+    /// kinetic energy of the motion relative to the sample changes by −(1 − r²) ½ m_eff (V̇_T⁻)²;
+    /// the impulse P = −(1 + r) m_eff V̇_T⁻ at the tip also does the work −P α2 Ω cos Ωτ, so
+    /// ΔE = −loss + base (derivation in `docs/contact-laws.md`).
+    pub fn impact_energy(&self, tau: f64, v_minus: f64, restitution: f64) -> (f64, f64) {
+        let p = &self.params;
+        let base_velocity = p.base_amplitude() * p.omega * (p.omega * tau).cos();
+        let loss = 0.5 * (1.0 - restitution * restitution) * self.m_eff * v_minus * v_minus;
+        let base = (1.0 + restitution) * self.m_eff * v_minus * base_velocity;
+        (loss, base)
+    }
+
+    /// Complex amplitude H of the free steady response of the tip deflection (no sample force,
+    /// the linear free system of eqs. 11–14): W(1,τ) = Im(H e^{i(Ωτ + ψ)}) with ψ the drive
+    /// phase ([`Params::drive_phase`]), so |H| is the free amplitude A₀ (units of g₀) and
+    /// −arg H the phase lag behind the drive. From (K − Ω²M + iΩC) X = F_s + i F_c for the
+    /// forcing F_s sin Ωτ + F_c cos Ωτ, H = φ(1)ᵀX e^{−iψ} (the harmonic-balance solution of a
+    /// linear system, e.g. Meirovitch, *Fundamentals of Vibrations*, McGraw-Hill 2001, §7.15).
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] when Ω is at an undamped natural frequency (no steady state).
+    pub fn free_tip_response(&self) -> Result<nalgebra::Complex<f64>, SimError> {
+        use nalgebra::Complex;
+        let g = self.galerkin.region(Region::Free);
+        let om = self.params.omega;
+        let dyn_stiff = DMatrix::from_fn(self.modes(), self.modes(), |i, j| {
+            Complex::new(
+                g.stiffness[(i, j)] - om * om * g.mass[(i, j)],
+                om * g.damping[(i, j)],
+            )
+        });
+        let f = DVector::from_fn(self.modes(), |i, _| {
+            Complex::new(g.forcing.sin[i], g.forcing.cos[i])
+        });
+        let x = dyn_stiff.lu().solve(&f).ok_or_else(|| {
+            SimError::out_of_range(
+                "omega",
+                om,
+                "the free system has no steady state at an undamped natural frequency",
+            )
+        })?;
+        let tip: Complex<f64> = self.tip().iter().zip(x.iter()).map(|(p, xi)| xi * *p).sum();
+        Ok(tip * Complex::from_polar(1.0, -self.params.drive_phase()))
+    }
+
+    /// ∂b/∂p of the free and the contact region (in that order) for a parameter p that enters
+    /// the forcing only: b = (0, M⁻¹F) lifted from [`Galerkin::forcing_derivative`] (Ω, α2,
+    /// α5); `None` for α1, α3, α4, α6, on which A_s depends.
+    pub fn forcing_derivative(&self, param: SweepParam) -> Option<[ForcingDerivative; 2]> {
+        let df = self.galerkin.forcing_derivative(param)?;
+        let n = self.modes();
+        let chol = self.galerkin.region(Region::Free).mass.clone().cholesky()?;
+        let lift = |f: &DVector<f64>| {
+            let mut v = DVector::zeros(self.dim());
+            v.rows_mut(n, n).copy_from(&chol.solve(f));
+            v
+        };
+        let d_omega = f64::from(u8::from(param == SweepParam::Omega));
+        let region = |f: &crate::galerkin::Forcing| ForcingDerivative {
+            b_const: lift(&f.constant),
+            b_sin: lift(&f.sin),
+            b_cos: lift(&f.cos),
+            d_omega,
+        };
+        Some([region(&df[0]), region(&df[1])])
+    }
+
+    /// ∂g/∂p of the guard of `mode` at fixed (τ, z) for the guards σ V_T (eq. 8: V_T = W(1,τ) +
+    /// α2 sin Ωτ + α5, so ∂V_T/∂Ω = α2 τ cos Ωτ, ∂V_T/∂α2 = sin Ωτ for the beam and 0 for the
+    /// point mass, ∂V_T/∂α5 = 1, and 0 for the parameters that enter only the dynamics).
+    /// `None` for laws with restitution, whose guards and jump maps depend on the parameters
+    /// in other ways (sticking force, impact).
+    pub fn guard_param_derivative(&self, mode: Region, param: SweepParam, tau: f64) -> Option<f64> {
+        if self.law.law.restitution().is_some() {
+            return None;
+        }
+        let p = &self.params;
+        let (s, c) = (p.omega * tau).sin_cos();
+        // base_amplitude() is α2 or 0: linear in α2, so its value at α2 = 1 is its derivative
+        let unit = p.with(SweepParam::Alpha2, 1.0).base_amplitude();
+        let dv = match param {
+            SweepParam::Omega => p.base_amplitude() * tau * c,
+            SweepParam::Alpha2 => unit * s,
+            SweepParam::Alpha5 => 1.0,
+            SweepParam::Alpha1 | SweepParam::Alpha3 | SweepParam::Alpha4 | SweepParam::Alpha6 => {
+                0.0
+            }
+        };
+        Some(mode.guard_sign() * dv)
+    }
+
+    /// Saltation matrix (2N×2N) at an event of region `from` at (τ, z⁻): the generic
+    /// [`crate::system::saltation`] of this system. For the linear law on V_T = 0 only the
+    /// damper term α6 V̇_T jumps, so S ≠ I whenever α6 > 0.
+    pub fn saltation(&self, from: Region, tau: f64, z: &DVector<f64>) -> DMatrix<f64> {
+        crate::system::saltation(self, from, tau, z.as_slice()).0
+    }
+}
