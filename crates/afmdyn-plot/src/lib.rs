@@ -327,143 +327,6 @@ fn bounds(fig: &Figure) -> (f64, f64, f64, f64) {
 /// position of each in the input.
 type PixelColumn = (i32, [(f64, f64); 4], [usize; 4]);
 
-/// The pixel columns of a line monotone in x, point by point: per column its first, lowest,
-/// highest and last point, written out (in their order, each once) when the next column
-/// starts — the monotone case of [`decimate_line`], also streamed by a caller that gathers a
-/// long line (`afmdyn simulate`'s plots).
-#[derive(Debug, Clone, Default)]
-pub struct PixelColumns {
-    /// The open column; (first, min, max, last) as positions among the points pushed.
-    col: Option<PixelColumn>,
-    k: usize,
-}
-
-impl PixelColumns {
-    /// Add the finite point `q` of pixel column `cx` (columns non-decreasing), writing the
-    /// column before into `out` when `cx` starts a new one.
-    #[inline]
-    pub fn push(&mut self, cx: i32, q: (f64, f64), out: &mut Vec<(f64, f64)>) {
-        self.k += 1;
-        let k = self.k;
-        match &mut self.col {
-            Some((c, p, order)) if *c == cx => {
-                if q.1 < p[1].1 {
-                    (p[1], order[1]) = (q, k);
-                }
-                if q.1 > p[2].1 {
-                    (p[2], order[2]) = (q, k);
-                }
-                (p[3], order[3]) = (q, k);
-            }
-            _ => {
-                self.flush(out);
-                self.col = Some((cx, [q; 4], [k; 4]));
-            }
-        }
-    }
-
-    /// Write the open column into `out`.
-    pub fn flush(&mut self, out: &mut Vec<(f64, f64)>) {
-        if let Some((_, p, order)) = self.col.take() {
-            let mut idx = [0usize, 1, 2, 3];
-            idx.sort_by_key(|&i| order[i]);
-            let mut last = None;
-            for i in idx {
-                if last != Some(order[i]) {
-                    out.push(p[i]);
-                    last = Some(order[i]);
-                }
-            }
-        }
-    }
-}
-
-/// Decimate a line to the pixel grid `px` maps to. A series monotone in x keeps per pixel
-/// column its first, lowest, highest and last point (in their order), which draws the same
-/// picture; any other line drops points on the pixel of the previous one and segments already
-/// drawn, splitting into runs. Non-finite points split runs too.
-pub fn decimate_line(
-    points: &[(f64, f64)],
-    px: impl Fn(f64, f64) -> (i32, i32),
-) -> Vec<Vec<(f64, f64)>> {
-    let finite = |p: &(f64, f64)| p.0.is_finite() && p.1.is_finite();
-    let monotone = points
-        .iter()
-        .filter(|p| finite(p))
-        .collect::<Vec<_>>()
-        .windows(2)
-        .all(|w| w[0].0 <= w[1].0);
-    let mut runs: Vec<Vec<(f64, f64)>> = vec![];
-    let mut run: Vec<(f64, f64)> = vec![];
-    if monotone {
-        let mut cols = PixelColumns::default();
-        for &q in points {
-            if !finite(&q) {
-                cols.flush(&mut run);
-                if !run.is_empty() {
-                    runs.push(std::mem::take(&mut run));
-                }
-                continue;
-            }
-            cols.push(px(q.0, q.1).0, q, &mut run);
-        }
-        cols.flush(&mut run);
-    } else {
-        let mut drawn: HashSet<(i32, i32, i32, i32)> = HashSet::new();
-        let mut last_px: Option<(i32, i32)> = None;
-        for &q in points {
-            if !finite(&q) {
-                if run.len() > 1 {
-                    runs.push(std::mem::take(&mut run));
-                }
-                run.clear();
-                last_px = None;
-                continue;
-            }
-            let p = px(q.0, q.1);
-            match last_px {
-                Some(l) if l == p => continue,
-                Some(l) => {
-                    let key = if l <= p {
-                        (l.0, l.1, p.0, p.1)
-                    } else {
-                        (p.0, p.1, l.0, l.1)
-                    };
-                    if drawn.insert(key) {
-                        run.push(q);
-                    } else {
-                        // a segment already drawn: end the run, restart from here
-                        if run.len() > 1 {
-                            runs.push(std::mem::take(&mut run));
-                        }
-                        run.clear();
-                        run.push(q);
-                    }
-                }
-                None => run.push(q),
-            }
-            last_px = Some(p);
-        }
-    }
-    if !run.is_empty() {
-        runs.push(run);
-    }
-    runs
-}
-
-/// One marker per pixel.
-pub fn decimate_points(
-    points: &[(f64, f64)],
-    px: impl Fn(f64, f64) -> (i32, i32),
-) -> Vec<(f64, f64)> {
-    let mut seen = HashSet::new();
-    points
-        .iter()
-        .copied()
-        .filter(|q| q.0.is_finite() && q.1.is_finite() && seen.insert(px(q.0, q.1)))
-        .collect()
-}
-
 /// Merge shaded x-intervals whose pixel columns touch.
 fn merge_shade(shade: &[(f64, f64)], px: impl Fn(f64) -> i32) -> Vec<(f64, f64)> {
     let mut out: Vec<(f64, f64, i32)> = Vec::new();
@@ -820,6 +683,8 @@ pub fn save_scatter_stream<E: std::fmt::Display + From<PlotError>>(
 
 mod cells;
 pub use cells::*;
+mod decimate;
+pub use decimate::*;
 mod afm_image;
 pub use afm_image::*;
 

@@ -10,6 +10,9 @@ use super::dmt::{
 use super::{ForceEval, Law, LawGroups, Param, SampleSi};
 use crate::error::ParamError;
 
+/// ε₀, the vacuum permittivity (F/m; CODATA 2018).
+pub const VACUUM_PERMITTIVITY: f64 = 8.854_187_812_8e-12;
+
 /// Default electrostatic group Ẽ: with R̃ = 1 and ã₀ = 0.01 the electrostatic force at contact
 /// is ẼR̃²/(ã₀(ã₀ + R̃)) ≈ 0.099, about DMT's default adhesion (a few volts on a 10 nm tip give
 /// nanonewtons, as van der Waals does), and it decays as 1/d, not 1/d².
@@ -108,7 +111,7 @@ impl Law for ElectrostaticLaw {
         let law = ElectrostaticLaw {
             hamaker: dmt.hamaker,
             intermolecular_distance: dmt.intermolecular_distance,
-            electrostatic: std::f64::consts::PI * crate::probe::VACUUM_PERMITTIVITY * v * v
+            electrostatic: std::f64::consts::PI * VACUUM_PERMITTIVITY * v * v
                 / si.force,
             tip_radius: rr / si.g0,
         };

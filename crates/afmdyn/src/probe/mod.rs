@@ -114,8 +114,7 @@ mod reader;
 pub use medium::{CalibratedIn, FluidMode, MediumReport};
 use reader::*;
 
-/// ε₀, the vacuum permittivity (F/m; CODATA 2018).
-pub const VACUUM_PERMITTIVITY: f64 = 8.854_187_812_8e-12;
+pub use crate::contact::VACUUM_PERMITTIVITY;
 
 /// The intermolecular distance a₀ of the DMT law when a probe file omits it, m
 /// (Israelachvili 2011, §13.6).
