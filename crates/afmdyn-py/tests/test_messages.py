@@ -56,3 +56,11 @@ def test_reconstruct_refuses_arrays_that_are_not_curves() -> None:
     # the same curve as 1-D arrays is reconstructed
     ds = afmdyn.reconstruct(frequency_shift=shift, distance=d, **common)
     assert ds.sizes["distance"] > 0
+
+
+def test_a_setpoint_study_is_capped_as_on_the_command_line() -> None:
+    # the command line capped FROM:TO:N at 1000 ratios; Python took 1001
+    probe = str(EXAMPLES / "probe-point-mass-dmt.toml")
+    sample = str(EXAMPLES / "sample-stripe.toml")
+    with pytest.raises(ValueError, match="at most 1000 ratios"):
+        afmdyn.setpoint_study(probe, sample, np.linspace(0.2, 0.9, 1001))

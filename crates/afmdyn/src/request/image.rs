@@ -45,7 +45,7 @@ use super::curves::{approach_request, CurveRequest};
 
 mod sample;
 mod study;
-pub use study::{setpoint_study, study_ratios, DomainContrast, SetpointStudy};
+pub use study::{setpoint_study, study_ratios, DomainContrast, SetpointStudy, MAX_STUDY_RATIOS};
 
 pub use crate::io::height_map::{MAX_HEIGHT, MAX_PIXELS};
 

@@ -3,6 +3,10 @@
 
 use super::*;
 
+/// The most setpoints of a setpoint study, on every front end: each is a line engaged on
+/// the background that crosses every domain.
+pub const MAX_STUDY_RATIOS: usize = 1000;
+
 /// The apparent height and phase of every domain against the setpoint (issue 46's setpoint
 /// study: the contrast inversion of AM-AFM, García & San Paulo 2000): at each ratio a line
 /// engaged on the background ([`image`]'s rule) crosses onto each domain, whose operating point
@@ -45,7 +49,8 @@ pub fn study_ratios(spec: &str) -> Result<Vec<f64>, SimError> {
         SimError::out_of_range(
             "setpoint_study",
             spec.to_string(),
-            "must be FROM:TO:N, ratios A_sp/A0 in (0, 1) and N in 2..=1000 (e.g. 0.2:0.95:16)",
+            "must be FROM:TO:N, ratios A_sp/A0 in (0, 1) and N in 2..=1000 (MAX_STUDY_RATIOS; \
+             e.g. 0.2:0.95:16)",
         )
     };
     let parts: Vec<&str> = spec.split(':').collect();
@@ -58,7 +63,7 @@ pub fn study_ratios(spec: &str) -> Result<Vec<f64>, SimError> {
     );
     let n: usize = n.trim().parse().map_err(|_| bad())?;
     let inside = |r: f64| r > 0.0 && r < 1.0;
-    if !(inside(from) && inside(to) && (2..=1000).contains(&n)) {
+    if !(inside(from) && inside(to) && (2..=MAX_STUDY_RATIOS).contains(&n)) {
         return Err(bad());
     }
     // (1 − t)·from + t·to: both ends exactly
@@ -81,6 +86,13 @@ pub fn setpoint_study(
     ratios: &[f64],
     curve_points: usize,
 ) -> Result<SetpointStudy, SimError> {
+    if ratios.len() > MAX_STUDY_RATIOS {
+        return Err(SimError::out_of_range(
+            "setpoint_study",
+            format!("{} ratios", ratios.len()),
+            "must be at most 1000 ratios (MAX_STUDY_RATIOS), as the command line's FROM:TO:N",
+        ));
+    }
     if ratios.is_empty() || ratios.iter().any(|&r| !(r > 0.0 && r < 1.0)) {
         return Err(SimError::out_of_range(
             "setpoint_study",
