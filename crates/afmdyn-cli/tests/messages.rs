@@ -175,3 +175,31 @@ fn fm_and_reconstruct_take_files() {
     assert!(String::from_utf8_lossy(&o.stdout).contains("no files written"));
     assert!(!rec.exists());
 }
+
+/// Issue 60 part D: an SLS sample whose dashpot is out of reach blamed "[medium]: alpha6
+/// (contact damping α6)", a group the user never wrote, under a section that was not at
+/// fault; now the two `[sample]` keys that make it are named, with their units.
+#[test]
+fn an_sls_dashpot_out_of_reach_names_its_sample_keys() {
+    let dir = temp_dir("sls");
+    let text =
+        std::fs::read_to_string(common::repo().join("examples/probe-water-sls.toml")).unwrap();
+    assert!(text.contains("relaxation_time = 20e-6"));
+    let probe = dir.join("sls.toml");
+    std::fs::write(
+        &probe,
+        text.replace("relaxation_time = 20e-6", "relaxation_time = 1e30"),
+    )
+    .unwrap();
+    refused(
+        &["orbit", "--probe", probe.to_str().unwrap()],
+        &[
+            "[sample].maxwell_stiffness = 1.5e0 N/m",
+            "relaxation_time = 1e30 s",
+            "α6",
+        ],
+    );
+    let err = String::from_utf8_lossy(&run(&["orbit", "--probe", probe.to_str().unwrap()]).stderr)
+        .to_string();
+    assert!(!err.contains("[medium]"), "{err}");
+}
