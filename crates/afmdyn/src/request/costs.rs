@@ -68,7 +68,8 @@ pub fn newton_work(params: &Params, period: usize, newton: &ShootingOptions) -> 
 /// [`SimError::Budget`] naming the request, its cost and the budget.
 pub fn check_cost(what: &'static str, cost: Cost) -> Result<(), SimError> {
     const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
-    if !(cost.bytes <= MAX_REQUEST_BYTES) {
+    // NaN (an estimate that overflowed) is refused too
+    if cost.bytes.is_nan() || cost.bytes > MAX_REQUEST_BYTES {
         return Err(SimError::Budget {
             what,
             needed: format!("a peak memory of {:.2} GiB", cost.bytes / GIB),
@@ -76,7 +77,7 @@ pub fn check_cost(what: &'static str, cost: Cost) -> Result<(), SimError> {
             hint: "ask for fewer points, samples, cells or periods",
         });
     }
-    if !(cost.work <= MAX_REQUEST_WORK) {
+    if cost.work.is_nan() || cost.work > MAX_REQUEST_WORK {
         return Err(SimError::Budget {
             what,
             needed: format!(
