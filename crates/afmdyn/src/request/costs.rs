@@ -1,5 +1,5 @@
 //! What a request costs before it runs ([`super::Analysis::cost`]): its peak memory and its
-//! work, estimated for the worst case its options allow, and held by [`super::run`] against
+//! work, estimated for the worst case its options allow, and held by [`super::run()`] against
 //! the budgets of [`super::limits`] ([`check_cost`]), so that a request too large is refused
 //! naming its cost and the budget — before any allocation or integration — instead of
 //! aborting on allocation or running for weeks.
