@@ -146,12 +146,22 @@ fn read_rows(
     path: &Path,
     each: &mut dyn FnMut(&csv::StringRecord) -> Result<(), String>,
 ) -> Result<(), CliError> {
-    let rd = |e: csv::Error| io_error("read", path, e);
-    // the sweep's own output, read back through the bounded reader as a store file
-    let file = afmdyn::io::open(path, afmdyn::io::InputKind::Store).map_err(|e| match e {
+    // a refusal of the bounded reader (past the cap, not a store's CSV) is the input's fault:
+    // exit code 2, the store left as it is
+    let refused = |e: afmdyn::io::InputFileError| match e {
         afmdyn::io::InputFileError::Io { message, .. } => io_error("read", path, message),
-        e => io_error("read", path, e),
-    })?;
+        e => CliError::Input(format!("{e}; rerun without --resume to start over")),
+    };
+    let rd = |e: csv::Error| {
+        if let csv::ErrorKind::Io(io) = e.kind() {
+            if let Some(r) = afmdyn::io::refusal(io) {
+                return refused(r.clone());
+            }
+        }
+        io_error("read", path, e)
+    };
+    // the sweep's own output, read back through the bounded reader as a store file
+    let file = afmdyn::io::open(path, afmdyn::io::InputKind::Store).map_err(refused)?;
     let mut rd_csv = csv::Reader::from_reader(file);
     for r in rd_csv.records() {
         let r = r.map_err(rd)?;

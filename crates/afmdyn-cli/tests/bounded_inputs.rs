@@ -3,7 +3,9 @@
 //! file (a regular file larger than every cap, refused from its length) are refused with exit
 //! code 2 and one line naming the option, the file and the cap, for `--probe`, `--config`,
 //! `--overlay`, `--sample` and a sample map's `height_map` (CSV and NPY), and `reconstruct
-//! --fm` and `--am`. (How long a refusal takes is measured by hand, not asserted: a loaded
+//! --fm` and `--am`; and a `--resume` whose store's ledger, rows or records are `/dev/zero` or
+//! a 2 GiB sparse file is refused naming the file and the cap, the store left as it was. (How
+//! long a refusal takes is measured by `scripts/bounded-inputs.sh`, not asserted: a loaded
 //! machine would make such an assertion race.)
 
 use std::path::{Path, PathBuf};
@@ -203,4 +205,125 @@ fn reconstruct_curves_are_refused_past_their_caps() {
             &[option, b, CSV_CAP, "a curve document"],
         );
     }
+}
+
+/// Every file of `dir` but its lock (which a run rewrites with its process id): name, and the
+/// target of a symbolic link or the length and bytes of a small file (a sparse one by its
+/// length alone).
+fn snapshot(dir: &Path) -> Vec<(String, String)> {
+    let mut files: Vec<(String, String)> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| !p.ends_with(".afmdyn.lock"))
+        .map(|p| {
+            let name = p.file_name().unwrap().to_string_lossy().to_string();
+            let meta = std::fs::symlink_metadata(&p).unwrap();
+            let what = if meta.file_type().is_symlink() {
+                format!("-> {}", std::fs::read_link(&p).unwrap().display())
+            } else if meta.len() > 1 << 20 {
+                format!("{} bytes", meta.len())
+            } else if meta.is_dir() {
+                "dir".to_string()
+            } else {
+                format!("{:?}", std::fs::read(&p).unwrap())
+            };
+            (name, what)
+        })
+        .collect();
+    files.sort();
+    files
+}
+
+/// Replace the store file `name` in `store` by /dev/zero and then by a 2 GiB sparse file: each
+/// time `resume` (the run's arguments with `--resume`) exits 2 with one line naming the file
+/// and `cap`, and leaves every file of the store as it was.
+fn refused_resumes(store: &Path, name: &str, cap: &str, resume: &[&str]) {
+    let path = store.join(name);
+    let _ = std::fs::remove_file(&path);
+    for sparse_file in [false, true] {
+        if sparse_file {
+            std::fs::remove_file(&path).unwrap();
+            sparse(store, name);
+        } else {
+            zero(store, name);
+        }
+        let before = snapshot(store);
+        let p = path.to_str().unwrap();
+        refused(resume, &[p, cap]);
+        assert_eq!(
+            snapshot(store),
+            before,
+            "{p}: the refused resume changed the store"
+        );
+    }
+    std::fs::remove_file(&path).unwrap();
+}
+
+const LEDGER_CAP: &str = "537919488 bytes";
+const STORE_CAP: &str = "137438953472 bytes";
+
+#[test]
+fn a_sweeps_store_is_refused_past_its_caps_and_left_as_it_was() {
+    let dir = tempfile::tempdir().unwrap();
+    let store = dir.path().join("sweep");
+    let s = store.to_str().unwrap();
+    let args = [
+        "bifurcation",
+        "--from",
+        "2.4",
+        "--to",
+        "2.9",
+        "--steps",
+        "2",
+        "--starts",
+        "0",
+        "--max-periods",
+        "100",
+        "--threads",
+        "1",
+        "--out",
+        s,
+    ];
+    let made = afmdyn(&args);
+    assert!(made.status.success(), "{made:?}");
+    let mut resume = args.to_vec();
+    resume.push("--resume");
+    // the finished rows, their ledger, and an unfinished sweep's rows
+    let ledger = std::fs::read(store.join(".bifurcation.run.json")).unwrap();
+    refused_resumes(&store, ".bifurcation.run.json", LEDGER_CAP, &resume);
+    std::fs::write(store.join(".bifurcation.run.json"), &ledger).unwrap();
+    let rows = std::fs::read(store.join("bifurcation.csv")).unwrap();
+    refused_resumes(&store, "bifurcation.csv", STORE_CAP, &resume);
+    std::fs::write(store.join("bifurcation.csv"), &rows).unwrap();
+    refused_resumes(&store, ".bifurcation.partial.csv", STORE_CAP, &resume);
+}
+
+#[test]
+fn a_studys_store_is_refused_past_its_caps_and_left_as_it_was() {
+    let dir = tempfile::tempdir().unwrap();
+    let store = dir.path().join("chart");
+    let s = store.to_str().unwrap();
+    let args = [
+        "chart",
+        "--x-steps",
+        "2",
+        "--y-steps",
+        "1",
+        "--starts",
+        "1",
+        "--tile",
+        "1",
+        "--lyapunov-periods",
+        "20",
+        "--out",
+        s,
+    ];
+    let made = afmdyn(&args);
+    assert!(made.status.success(), "{made:?}");
+    let mut resume = args.to_vec();
+    resume.push("--resume");
+    let ledger = std::fs::read(store.join(".chart.run.json")).unwrap();
+    refused_resumes(&store, ".chart.run.json", LEDGER_CAP, &resume);
+    std::fs::write(store.join(".chart.run.json"), &ledger).unwrap();
+    refused_resumes(&store, ".chart.tiles.jsonl", STORE_CAP, &resume);
 }

@@ -2,6 +2,9 @@
 //! (per thread, so that other tests of this binary do not interfere) sees no allocation in a
 //! step that ends without an event, with and without the variational equations, for every
 //! nonlinear tip–sample law. (A located event allocates: its record carries the state.)
+//!
+//! The same allocator also keeps the live heap bytes and their peak (over all threads), against
+//! which a request's declared memory ([`afmdyn::request::Analysis::cost`]) is checked.
 
 use afmdyn::integrate::adaptive::Adaptive;
 use afmdyn::integrate::taylor::Taylor;
@@ -9,8 +12,29 @@ use afmdyn::integrate::Integrator;
 use afmdyn::{CantileverModel, ContactLaw, Params};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 struct Counting;
+
+/// Live heap bytes and their peak since [`reset_peak`], over all threads.
+static LIVE: AtomicUsize = AtomicUsize::new(0);
+static PEAK: AtomicUsize = AtomicUsize::new(0);
+
+fn grow(bytes: usize) {
+    let now = LIVE.fetch_add(bytes, Ordering::Relaxed) + bytes;
+    PEAK.fetch_max(now, Ordering::Relaxed);
+}
+
+fn shrink(bytes: usize) {
+    LIVE.fetch_sub(bytes, Ordering::Relaxed);
+}
+
+/// Start a peak measurement: the live bytes now.
+fn reset_peak() -> usize {
+    let now = LIVE.load(Ordering::Relaxed);
+    PEAK.store(now, Ordering::Relaxed);
+    now
+}
 
 thread_local! {
     static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
@@ -25,17 +49,23 @@ fn count() {
 unsafe impl GlobalAlloc for Counting {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
         count();
+        grow(layout.size());
         unsafe { System.alloc(layout) }
     }
     unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
         count();
+        grow(layout.size());
         unsafe { System.alloc_zeroed(layout) }
     }
     unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        shrink(layout.size());
         unsafe { System.dealloc(ptr, layout) }
     }
     unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
         count();
+        // the old block and the new one may both be live while it is copied
+        grow(new_size);
+        shrink(layout.size());
         unsafe { System.realloc(ptr, layout, new_size) }
     }
 }
@@ -106,4 +136,56 @@ fn event_free_steps_allocate_nothing() {
             }
         }
     }
+}
+
+/// The peak heap bytes of `f` above what was live before it, and its result.
+fn peak_of<T>(f: impl FnOnce() -> T) -> (f64, T) {
+    static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let base = reset_peak();
+    let out = f();
+    (
+        PEAK.load(Ordering::Relaxed).saturating_sub(base) as f64,
+        out,
+    )
+}
+
+/// A request's declared memory bounds what it allocates, and is not far above it where the
+/// request's memory is its result: `converge` (every run's samples) and `approach` with traces.
+#[test]
+fn declared_memory_bounds_the_measured_peak() {
+    use afmdyn::analysis::progress::Progress;
+    use afmdyn::request::{
+        run, Analysis, ApproachRequest, ConvergeRequest, CurveRequest, Resolved,
+    };
+    let model = Resolved::plain(Params::default());
+    let converge = ConvergeRequest {
+        max_modes: 3,
+        periods: 200,
+        samples_per_period: 1000,
+        ..ConvergeRequest::default()
+    };
+    let declared = converge.cost(&model).unwrap().bytes;
+    let (peak, out) = peak_of(|| run(&converge, &model, &Progress::new()));
+    out.unwrap();
+    assert!(
+        peak <= declared && peak >= declared / 3.0,
+        "converge: peak {peak:.3e} B, declared {declared:.3e} B"
+    );
+    let approach = ApproachRequest {
+        curve: CurveRequest {
+            points: Some(60),
+            branches: false,
+            traces: Some(2000),
+            ..CurveRequest::default()
+        },
+        ..ApproachRequest::default()
+    };
+    let declared = approach.cost(&model).unwrap().bytes;
+    let (peak, out) = peak_of(|| run(&approach, &model, &Progress::new()));
+    out.unwrap();
+    assert!(
+        peak <= declared && peak >= declared / 3.0,
+        "approach: peak {peak:.3e} B, declared {declared:.3e} B"
+    );
 }

@@ -173,3 +173,185 @@ proptest! {
         prop_assert!(t.elapsed() < Duration::from_secs(20), "took {:?} for {p:?}", t.elapsed());
     }
 }
+
+/// Issue 59 (Deliver 2): every request declares its cost (peak memory, work in mode-periods)
+/// before it runs, and `run` refuses it beyond the budgets of `request::limits`.
+mod costs {
+    use afmdyn::analysis::progress::Progress;
+    use afmdyn::request::limits::{Cost, MAX_REQUEST_BYTES, MAX_REQUEST_WORK};
+    use afmdyn::request::{
+        run, Analysis, ApproachRequest, AttractorsRequest, BasinsRequest, ContinuationRequest,
+        ConvergeRequest, FmRequest, GlobalContinuationRequest, LyapunovRequest, ModesRequest,
+        ObserveRequest, OrbitRequest, ReconstructRequest, Resolved, ResonanceRequest,
+        SteadyRequest,
+    };
+    use afmdyn::{Params, SimError};
+
+    fn model() -> Resolved {
+        Resolved::plain(Params::default())
+    }
+
+    fn within(what: &str, c: Cost) {
+        assert!(
+            c.bytes <= MAX_REQUEST_BYTES && c.work <= MAX_REQUEST_WORK,
+            "{what}: {c:?} should be within the budgets"
+        );
+        assert!(c.bytes > 0.0 && c.work >= 0.0, "{what}: {c:?}");
+    }
+
+    /// `a` is refused by `run` naming the request and the budget, before any work (nothing
+    /// counted in its progress).
+    fn refused<A: Analysis>(a: &A, budget: &str) {
+        refused_on(a, &model(), budget)
+    }
+
+    /// [`refused`] on `m`.
+    fn refused_on<A: Analysis>(a: &A, m: &Resolved, budget: &str) {
+        let progress = Progress::new();
+        let e = run(a, m, &progress)
+            .err()
+            .unwrap_or_else(|| panic!("{}: {:?} should be over the budgets", a.name(), a.cost(m)));
+        assert!(matches!(e, SimError::Budget { .. }), "{}: {e}", a.name());
+        let text = e.to_string();
+        assert!(text.starts_with(a.name()), "{text}");
+        assert!(text.contains(budget), "{text}");
+        assert_eq!(progress.done(), 0, "{}: refused before any work", a.name());
+    }
+
+    fn steady(max_periods: usize) -> SteadyRequest {
+        SteadyRequest {
+            max_periods: Some(max_periods),
+            ..SteadyRequest::default()
+        }
+    }
+
+    #[test]
+    fn default_requests_cost_within_the_budgets() {
+        let m = model();
+        within("modes", ModesRequest::default().cost(&m).unwrap());
+        within("orbit", OrbitRequest::default().cost(&m).unwrap());
+        within(
+            "continuation",
+            ContinuationRequest::default().cost(&m).unwrap(),
+        );
+        within("lyapunov", LyapunovRequest::default().cost(&m).unwrap());
+        within("attractors", AttractorsRequest::default().cost(&m).unwrap());
+        within("observe", ObserveRequest::default().cost(&m).unwrap());
+        within("converge", ConvergeRequest::default().cost(&m).unwrap());
+        within("approach", ApproachRequest::default().cost(&m).unwrap());
+        within("resonance", ResonanceRequest::default().cost(&m).unwrap());
+        within("basins", BasinsRequest::default().cost(&m).unwrap());
+        within(
+            "attractors --sweep",
+            GlobalContinuationRequest::default().cost(&m).unwrap(),
+        );
+        within("fm", FmRequest::default().cost(&m).unwrap());
+        let curve = ReconstructRequest {
+            distance: Some((0..1000).map(|i| 1e-10 * (1.0 + i as f64)).collect()),
+            z_c: None,
+            frequency_shift: (0..1000).map(|i| -100.0 / (1.0 + i as f64)).collect(),
+            spring_constant: 40.0,
+            resonance_frequency: 300e3,
+            amplitude: 1e-9,
+            law_force: None,
+        };
+        within("reconstruct", curve.cost(&m).unwrap());
+    }
+
+    /// The requests whose options bound their cost one by one stay within the budgets at the
+    /// options' limits: the orbit, its continuation and the observables at the largest period
+    /// and transient, an FM curve of the most points.
+    #[test]
+    fn requests_bounded_option_by_option_stay_within_the_budgets_at_their_limits() {
+        let m = model();
+        let start = afmdyn::request::StartRequest {
+            initial: None,
+            steady: SteadyRequest {
+                max_period: 64,
+                ..steady(10_000_000)
+            },
+        };
+        let orbit = OrbitRequest {
+            period: Some(64),
+            start: start.clone(),
+        };
+        within("orbit", orbit.cost(&m).unwrap());
+        let observe = ObserveRequest {
+            periods: 1_000_000,
+            harmonics: 10_000,
+            start,
+        };
+        within("observe", observe.cost(&m).unwrap());
+        let lyapunov = LyapunovRequest {
+            transient: Some(10_000_000),
+            periods: 90_000_000,
+            blocks: 1000,
+            ..LyapunovRequest::default()
+        };
+        within("lyapunov", lyapunov.cost(&m).unwrap());
+    }
+
+    #[test]
+    fn requests_just_over_their_budget_are_refused_before_any_work() {
+        // work = starts × transient cap × 3 modes: 50 000 × 666 667 × 3 just over 1e11, and
+        // one period less just within
+        let census = |max_periods| AttractorsRequest {
+            samples: 50_000,
+            steady: steady(max_periods),
+            ..AttractorsRequest::default()
+        };
+        within("attractors", census(666_666).cost(&model()).unwrap());
+        refused(&census(666_667), "1e11 mode-periods");
+        let sweep = |max_periods| GlobalContinuationRequest {
+            steps: 10,
+            samples: 5_000,
+            steady: steady(max_periods),
+            ..GlobalContinuationRequest::default()
+        };
+        within("attractors --sweep", sweep(666_666).cost(&model()).unwrap());
+        refused(&sweep(666_667), "1e11 mode-periods");
+        let basins = |max_periods| BasinsRequest {
+            x_steps: 500,
+            y_steps: 100,
+            steady: steady(max_periods),
+            ..BasinsRequest::default()
+        };
+        within("basins", basins(666_666).cost(&model()).unwrap());
+        refused(&basins(666_667), "1e11 mode-periods");
+        // a curve's traces: 1000 points × 16 periods × 24 bytes × samples per period, 2.5
+        // times while they are recorded: 1000 samples take 0.96 GB, 2000 1.9 GB (and 0.77 GB
+        // by the traces' own budget of 1 GiB, which lets them through)
+        let traced = |samples| afmdyn::request::CurveRequest {
+            points: Some(1000),
+            branches: false,
+            traces: Some(samples),
+            ..afmdyn::request::CurveRequest::default()
+        };
+        let approach = ApproachRequest {
+            curve: traced(1000),
+            ..ApproachRequest::default()
+        };
+        within("approach", approach.cost(&model()).unwrap());
+        let approach = ApproachRequest {
+            curve: traced(2000),
+            ..ApproachRequest::default()
+        };
+        refused(&approach, "1.1 GiB");
+        let resonance = ResonanceRequest {
+            curve: traced(2000),
+            ..ResonanceRequest::default()
+        };
+        refused(&resonance, "1.1 GiB");
+        // memory: converge keeps every run's samples (24 bytes each) and records the last
+        // run's trajectory whole (some 250 bytes a sample at N = 3): 3 × 2·10^6 samples take
+        // about 0.6 GB, 3 × 4·10^6 about 1.3 GB
+        let converge = |periods| ConvergeRequest {
+            max_modes: 3,
+            periods,
+            samples_per_period: 1_000,
+            ..ConvergeRequest::default()
+        };
+        within("converge", converge(2_000).cost(&model()).unwrap());
+        refused(&converge(4_000), "1.1 GiB");
+    }
+}

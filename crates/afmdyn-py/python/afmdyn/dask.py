@@ -90,14 +90,26 @@ def _template(s: "_core.ChartStudy") -> xr.Dataset:
     return dataset(s, d)
 
 
+#: Largest ledger of finished tasks read back, in bytes: 16 MiB, a line of at most 16 bytes for
+#: each of the 10^6 tasks of the largest chart (one cell a task).
+MAX_DONE_BYTES = 16 * 1024 * 1024
+
+
 def _done(store: str) -> Set[int]:
     """The finished tasks: every complete line of the ledger (a cut last line is dropped)."""
     path = os.path.join(ledger_dir(store), DONE)
     try:
         with open(path, "rb") as f:
-            text = f.read()
+            # bounded: one short line per task of the largest chart (1e6 cells), never /dev/zero
+            # read on or a sparse file held whole
+            text = f.read(MAX_DONE_BYTES + 1)
     except FileNotFoundError:
         return set()
+    if len(text) > MAX_DONE_BYTES or b"\0" in text:
+        raise ValueError(
+            f"resume: {path} is not this store's ledger (text of at most {MAX_DONE_BYTES} "
+            "bytes); call with resume=False to start over"
+        )
     lines = text.split(b"\n")
     return {int(x) for x in lines[:-1] if x.strip()}
 

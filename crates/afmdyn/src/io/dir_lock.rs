@@ -91,7 +91,10 @@ impl DirLock {
         let locked = match file.try_lock() {
             Ok(()) => true,
             Err(fs::TryLockError::WouldBlock) => {
-                let holder = fs::read_to_string(&path).unwrap_or_default();
+                // the holder's line, read through the bounded reader (a lock file that is
+                // not one names no process)
+                let holder = super::input::read_text(&path, super::input::InputKind::Lock)
+                    .unwrap_or_default();
                 let holder = holder
                     .split_whitespace()
                     .next()

@@ -2,9 +2,11 @@
 //! sample map and its height map, an overlay, a curve to invert, a store read back) is read
 //! here, with a cap per [`InputKind`]. A regular file larger than its cap is refused from its
 //! length before any of it is read; anything else (`/dev/zero`, a pipe) is read through
-//! `Read::take(cap + 1)` and refused once it passes the cap, and a CSV kind also once a line
-//! passes [`MAX_CSV_LINE_BYTES`] (a CSV parser holds a line whole). Every refusal names the
-//! file, the cap and the kind.
+//! `Read::take(cap + 1)` and refused once it passes the cap, a kind read line by line also once
+//! a line passes its [`InputKind::line_cap`] (a CSV parser holds a line whole), and a store's
+//! file at its first NUL byte ([`InputKind::refuses_nul`]: `/dev/zero` and a sparse file are
+//! refused at once, before any memory is taken). Every refusal names the file, the cap and the
+//! kind.
 
 #[cfg(feature = "files")]
 use std::io::Read;
@@ -18,10 +20,28 @@ pub const MAX_INPUT_CSV_BYTES: u64 = 256 * 1024 * 1024;
 /// Largest JSON document read back (`afmdyn reconstruct --fm fm.json`, `--am approach.json`), in
 /// bytes: 256 MiB, parsed as it is read (never held as text).
 pub const MAX_INPUT_DOCUMENT_BYTES: u64 = 256 * 1024 * 1024;
-/// Largest store file read back (`--resume`: a sweep's partial CSV, a study's records), in
-/// bytes: 16 GiB, the largest time series a run may write; stores are streamed, never held
-/// whole.
-pub const MAX_STORE_BYTES: u64 = 16 * 1024 * 1024 * 1024;
+/// Largest file of records of a store read back (`--resume`: a sweep's partial and finished
+/// CSV, a study's records), in bytes: 128 GiB, above the largest store a request may make — a
+/// sweep of [`crate::analysis::bifurcation::MAX_SWEEP_POINTS`] (10⁶) points of up to
+/// [`crate::analysis::period::MAX_PERIOD`] (64) rows of at most 2 KiB (a 20-mode state in full
+/// precision) is 128 GiB at most, a chart of 10⁶ cells with 64 attractors of 2 KiB 128 GiB.
+/// Stores are streamed line by line, never held whole.
+pub const MAX_STORE_BYTES: u64 = 128 * 1024 * 1024 * 1024;
+/// Largest line of a study's records (`.chart.tiles.jsonl`, `.image.lines.jsonl`, …), in
+/// bytes: 1 GiB, above the largest record — a chart tile of
+/// [`crate::request::chart::MAX_CHART_TILE`] (10⁴) cells with
+/// [`crate::request::chart::MAX_CHART_SLOTS`] (64) attractors of at most 1.5 KiB of JSON each,
+/// 0.9 GiB (a PI scan's line of 2 × 4096 pixels takes a few MiB).
+pub const MAX_STORE_LINE_BYTES: u64 = 1024 * 1024 * 1024;
+/// Largest ledger of a store read back (`.bifurcation.run.json`, `.chart.run.json`, …), in
+/// bytes: 513 MiB, the largest fingerprint a request stores — a PI scan's holds its sample map,
+/// whose height map of 4096 × 4096 values takes at most the 512 MiB of its CSV
+/// ([`super::caps::MAX_CSV_BYTES`]), and 1 MiB ([`MAX_INPUT_TEXT_BYTES`]) for the probe and
+/// the request. Parsed as it is read (never held as text).
+pub const MAX_LEDGER_BYTES: u64 = super::caps::MAX_CSV_BYTES + MAX_INPUT_TEXT_BYTES;
+/// Largest lock file of a store read (its holder's process id, when a run finds the store
+/// locked), in bytes: 4 KiB (the lock holds one short line, `12345 afmdyn`).
+pub const MAX_LOCK_BYTES: u64 = 4096;
 /// Longest line of a CSV input, in bytes: 1 MiB, eight times a row of 4096 full-precision
 /// heights; a CSV parser holds a line whole, so a file without line ends (`/dev/zero`) is
 /// refused after this much.
@@ -46,8 +66,17 @@ pub enum InputKind {
     CurveCsv,
     /// A curve's JSON document (`afmdyn reconstruct --fm fm.json`, `--am approach.json`).
     CurveDocument,
-    /// A file of a study's store read back (`--resume`).
+    /// A CSV file of a sweep's store read back (`--resume`: `.bifurcation.partial.csv`, and
+    /// `bifurcation.csv` when the sweep finished).
     Store,
+    /// A study's records read back (`--resume`: `.chart.tiles.jsonl`, `.image.lines.jsonl`,
+    /// …: one JSON line per finished task).
+    StoreRecords,
+    /// A store's ledger read back (`--resume`: `.bifurcation.run.json`, `.chart.run.json`,
+    /// …: the fingerprint of the request that made the store).
+    StoreLedger,
+    /// A store's lock file, read for the process holding it.
+    Lock,
 }
 
 impl InputKind {
@@ -59,8 +88,32 @@ impl InputKind {
             InputKind::HeightMapCsv => super::caps::MAX_CSV_BYTES,
             InputKind::HeightMapNpy => super::caps::MAX_NPY_BYTES,
             InputKind::CurveDocument => MAX_INPUT_DOCUMENT_BYTES,
-            InputKind::Store => MAX_STORE_BYTES,
+            InputKind::Store | InputKind::StoreRecords => MAX_STORE_BYTES,
+            InputKind::StoreLedger => MAX_LEDGER_BYTES,
+            InputKind::Lock => MAX_LOCK_BYTES,
         }
+    }
+
+    /// The longest line read, in bytes, for a kind read line by line (CSV:
+    /// [`MAX_CSV_LINE_BYTES`]; a study's records: [`MAX_STORE_LINE_BYTES`]).
+    pub const fn line_cap(self) -> Option<u64> {
+        match self {
+            InputKind::Overlay
+            | InputKind::HeightMapCsv
+            | InputKind::CurveCsv
+            | InputKind::Store => Some(MAX_CSV_LINE_BYTES),
+            InputKind::StoreRecords => Some(MAX_STORE_LINE_BYTES),
+            _ => None,
+        }
+    }
+
+    /// Whether a NUL byte refuses the file at once: a store afmdyn wrote is text (CSV, JSON)
+    /// and never holds one, while `/dev/zero` and a sparse file are nothing else.
+    pub const fn refuses_nul(self) -> bool {
+        matches!(
+            self,
+            InputKind::Store | InputKind::StoreRecords | InputKind::StoreLedger | InputKind::Lock
+        )
     }
 
     /// The kind as its refusals name it ("a probe file").
@@ -74,7 +127,10 @@ impl InputKind {
             InputKind::HeightMapNpy => "a height map NPY",
             InputKind::CurveCsv => "a curve CSV",
             InputKind::CurveDocument => "a curve document",
-            InputKind::Store => "a store file",
+            InputKind::Store => "a store's CSV",
+            InputKind::StoreRecords => "a store's records",
+            InputKind::StoreLedger => "a store's ledger",
+            InputKind::Lock => "a store's lock",
         }
     }
 
@@ -82,13 +138,14 @@ impl InputKind {
     pub const fn is_csv(self) -> bool {
         matches!(
             self,
-            InputKind::Overlay | InputKind::HeightMapCsv | InputKind::CurveCsv
+            InputKind::Overlay | InputKind::HeightMapCsv | InputKind::CurveCsv | InputKind::Store
         )
     }
 }
 
-/// An input file opened by [`open`]: its bytes, at most the kind's cap (and, for CSV kinds,
-/// lines of at most [`MAX_CSV_LINE_BYTES`]); past either, a read fails with an
+/// An input file opened by [`open`]: its bytes, at most the kind's cap (and, for kinds read
+/// line by line, lines of at most [`InputKind::line_cap`]; for a store, no NUL byte:
+/// [`InputKind::refuses_nul`]); past either, a read fails with an
 /// [`std::io::Error`] carrying the [`InputFileError`] ([`refusal`] finds it).
 #[cfg(feature = "files")]
 #[derive(Debug)]
@@ -131,15 +188,28 @@ impl Read for Bounded {
                 },
             ));
         }
-        if self.kind.is_csv() {
+        if self.kind.refuses_nul() {
+            if let Some(at) = buf[..n].iter().position(|&b| b == 0) {
+                return Err(std::io::Error::new(
+                    std::io::ErrorKind::InvalidData,
+                    InputFileError::Binary {
+                        path: self.path.clone(),
+                        offset: self.read - n as u64 + at as u64,
+                        limit: cap,
+                        kind: self.kind.name(),
+                    },
+                ));
+            }
+        }
+        if let Some(limit) = self.kind.line_cap() {
             for &b in &buf[..n] {
                 self.line = if b == b'\n' { 0 } else { self.line + 1 };
-                if self.line > MAX_CSV_LINE_BYTES {
+                if self.line > limit {
                     return Err(std::io::Error::new(
                         std::io::ErrorKind::InvalidData,
                         InputFileError::LineTooLong {
                             path: self.path.clone(),
-                            limit: MAX_CSV_LINE_BYTES,
+                            limit,
                             kind: self.kind.name(),
                         },
                     ));
@@ -181,6 +251,21 @@ pub fn open(path: &std::path::Path, kind: InputKind) -> Result<Bounded, InputFil
         }
     }
     Ok(Bounded::new(file, path, kind))
+}
+
+/// [`open`], or `None` when `path` does not exist (a store's file not yet written).
+///
+/// # Errors
+/// As [`open`].
+#[cfg(feature = "files")]
+pub fn open_existing(
+    path: &std::path::Path,
+    kind: InputKind,
+) -> Result<Option<Bounded>, InputFileError> {
+    match std::fs::metadata(path) {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
+        _ => open(path, kind).map(Some),
+    }
 }
 
 /// The bytes of the input file `path` of kind `kind`, at most its cap ([`open`]).
@@ -276,7 +361,7 @@ pub enum InputFileError {
         /// What the file was read as ([`InputKind::name`], or "this input").
         kind: &'static str,
     },
-    /// A line of a CSV file is longer than [`MAX_CSV_LINE_BYTES`].
+    /// A line of a file read line by line is longer than its kind's [`InputKind::line_cap`].
     #[error(
         "{path}: larger than {limit} bytes in one line, the line limit of {kind} (is it the right \
          file?)"
@@ -285,6 +370,22 @@ pub enum InputFileError {
         /// The file.
         path: String,
         /// The limit in bytes.
+        limit: u64,
+        /// What the file was read as ([`InputKind::name`]).
+        kind: &'static str,
+    },
+    /// A store's file holds a NUL byte ([`InputKind::refuses_nul`]): it is not what afmdyn
+    /// wrote (`/dev/zero`, a sparse or binary file).
+    #[error(
+        "{path}: a NUL byte after {offset} bytes: not {kind} (text of at most {limit} bytes; is \
+         it the right file?)"
+    )]
+    Binary {
+        /// The file.
+        path: String,
+        /// Bytes before the NUL byte.
+        offset: u64,
+        /// The kind's cap in bytes.
         limit: u64,
         /// What the file was read as ([`InputKind::name`]).
         kind: &'static str,

@@ -13,5 +13,5 @@ pub mod height_map;
 pub mod input;
 
 #[cfg(feature = "files")]
-pub use input::{open, read_bytes, read_input, read_text, Bounded};
+pub use input::{open, open_existing, read_bytes, read_input, read_text, Bounded};
 pub use input::{refusal, InputFileError, InputKind, MAX_INPUT_CSV_BYTES, MAX_INPUT_TEXT_BYTES};

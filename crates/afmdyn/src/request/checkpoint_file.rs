@@ -21,6 +21,7 @@ use super::sweep::{branch_code, status_code, SweepRecord, HEADER, NUMERIC_COLUMN
 use super::sweep::{COL_BRANCH, COL_INDEX, COL_PERIOD, COL_POINT, COL_POINTS, COL_STATUS};
 use super::sweep::{COL_TAU, COL_VALUE, COL_W_TIP, COL_X_MAX};
 use crate::analysis::bifurcation::Branch;
+use crate::io::input::{open_existing, refusal, Bounded, InputFileError, InputKind};
 use crate::layout::files::{io_error, Column, FileError, NpyStream};
 use crate::params::SweepParam;
 use serde_json::{json, Value};
@@ -61,6 +62,72 @@ pub fn sealed(row: &str) -> String {
 pub fn unsealed(line: &str) -> Option<&str> {
     let (row, crc) = line.rsplit_once(',')?;
     (crc_hex(row) == crc).then_some(row)
+}
+
+/// A refusal of the bounded reader ([`crate::io::input`]) as the store's error: the file is
+/// not what the store wrote, or larger than the cap of its kind ([`CheckpointError::Corrupt`]
+/// naming the file and the cap); the store is left as it is.
+pub(crate) fn refused(path: &Path, e: InputFileError) -> CheckpointError {
+    match e {
+        InputFileError::Io { message, .. } => CheckpointError::Io {
+            action: "read",
+            path: path.display().to_string(),
+            message,
+        },
+        e => {
+            let name = path.display().to_string();
+            let text = e.to_string();
+            let message = text
+                .strip_prefix(&format!("{name}: "))
+                .unwrap_or(&text)
+                .to_string();
+            corrupt(path, format!("{message}; {START_OVER}"))
+        }
+    }
+}
+
+/// A read error of a [`Bounded`] store file: its refusal ([`refused`]), or the system's.
+pub(crate) fn read_failed(path: &Path, e: std::io::Error) -> CheckpointError {
+    match refusal(&e) {
+        Some(r) => refused(path, r.clone()),
+        None => io("read", path)(e),
+    }
+}
+
+/// The store file `path` of `kind` opened through the bounded reader, `None` when it does not
+/// exist.
+///
+/// # Errors
+/// [`refused`]: larger than the kind's cap, or unreadable.
+pub(crate) fn open_store(path: &Path, kind: InputKind) -> Result<Option<Bounded>, CheckpointError> {
+    open_existing(path, kind).map_err(|e| refused(path, e))
+}
+
+/// The ledger `path` of a store, parsed as it is read through the bounded reader
+/// ([`InputKind::StoreLedger`]); `None` when there is none.
+///
+/// # Errors
+/// [`CheckpointError::Corrupt`] naming the file and the cap: larger than the cap, or not a
+/// ledger (not JSON, a NUL byte); [`CheckpointError::Io`].
+pub(crate) fn read_ledger(path: &Path) -> Result<Option<Value>, CheckpointError> {
+    let Some(file) = open_store(path, InputKind::StoreLedger)? else {
+        return Ok(None);
+    };
+    serde_json::from_reader(BufReader::new(file))
+        .map(Some)
+        .map_err(|e| {
+            if e.is_io() {
+                return read_failed(path, e.into());
+            }
+            corrupt(
+                path,
+                format!(
+                    "not {} (JSON of at most {} bytes): {e}; {START_OVER}",
+                    InputKind::StoreLedger.name(),
+                    InputKind::StoreLedger.cap()
+                ),
+            )
+        })
 }
 
 fn corrupt(path: &Path, message: String) -> CheckpointError {
@@ -133,7 +200,12 @@ fn complete(g: &[String]) -> bool {
 /// [`partial_header`] (a store written before the checksums, or a removed or changed
 /// header), a complete line whose checksum does not match, a point stored twice.
 fn groups(path: &Path) -> Result<Vec<Group>, CheckpointError> {
-    let mut reader = BufReader::new(File::open(path).map_err(io("read", path))?);
+    let file = open_store(path, InputKind::Store)?.ok_or_else(|| CheckpointError::Io {
+        action: "read",
+        path: path.display().to_string(),
+        message: "No such file or directory".into(),
+    })?;
+    let mut reader = BufReader::new(file);
     let (mut groups, mut group) = (Vec::new(), Vec::<String>::new());
     let mut seen = HashSet::new();
     let mut close = |group: &mut Vec<String>, line: usize| -> Result<(), CheckpointError> {
@@ -160,7 +232,7 @@ fn groups(path: &Path) -> Result<Vec<Group>, CheckpointError> {
         buf.clear();
         let n = reader
             .read_until(b'\n', &mut buf)
-            .map_err(io("read", path))?;
+            .map_err(|e| read_failed(path, e))?;
         if n == 0 || buf.last() != Some(&b'\n') {
             break; // the end, or a cut row without its newline
         }
@@ -239,7 +311,9 @@ impl<'a> FileCheckpoint<'a> {
     pub fn write_npy(&self, param: SweepParam) -> Result<PathBuf, FileError> {
         let (csv_path, npy) = (self.final_csv(), self.dir.join("bifurcation.npy"));
         let rd = |e: csv::Error| io_error("read", &csv_path, e);
-        let mut reader = csv::Reader::from_path(&csv_path).map_err(rd)?;
+        let file = crate::io::open(&csv_path, InputKind::Store)
+            .map_err(|e| io_error("read", &csv_path, e))?;
+        let mut reader = csv::Reader::from_reader(file);
         let columns = NUMERIC_COLUMNS
             .iter()
             .map(|c| match c.name {
@@ -288,12 +362,18 @@ impl<'a> FileCheckpoint<'a> {
     /// be read.
     pub fn records(&self) -> Result<Vec<SweepRecord>, CheckpointError> {
         let path = self.final_csv();
-        let text = fs::read_to_string(&path).map_err(io("read", &path))?;
-        text.lines()
+        let file = open_store(&path, InputKind::Store)?.ok_or_else(|| CheckpointError::Io {
+            action: "read",
+            path: path.display().to_string(),
+            message: "No such file or directory".into(),
+        })?;
+        BufReader::new(file)
+            .lines()
             .enumerate()
             .skip(1)
             .map(|(i, l)| {
-                SweepRecord::parse_csv(l).map_err(|message| CheckpointError::Corrupt {
+                let l = l.map_err(|e| read_failed(&path, e))?;
+                SweepRecord::parse_csv(&l).map_err(|message| CheckpointError::Corrupt {
                     path: path.display().to_string(),
                     message: format!("line {}: {message}", i + 1),
                 })
@@ -304,22 +384,10 @@ impl<'a> FileCheckpoint<'a> {
 
 impl Checkpoint for FileCheckpoint<'_> {
     fn status(&mut self) -> Result<StoreStatus, CheckpointError> {
-        let path = self.ledger_path();
-        let ledger = match fs::read_to_string(&path) {
-            Ok(t) => {
-                let doc: Value =
-                    serde_json::from_str(&t).map_err(|e| CheckpointError::Corrupt {
-                        path: path.display().to_string(),
-                        message: e.to_string(),
-                    })?;
-                Some(Ledger {
-                    fingerprint: doc["args"].clone(),
-                    finished: doc["finished"] == json!(true),
-                })
-            }
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => None,
-            Err(e) => return Err(io("read", &path)(e)),
-        };
+        let ledger = read_ledger(&self.ledger_path())?.map(|doc| Ledger {
+            fingerprint: doc["args"].clone(),
+            finished: doc["finished"] == json!(true),
+        });
         Ok(StoreStatus {
             ledger,
             partial: self.partial().exists(),

@@ -60,6 +60,17 @@ impl Default for CurveRequest {
 /// Bytes in a GiB.
 const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
 
+/// The worst-case memory of the traces of a curve of `points` points at `samples` samples per
+/// drive period, in bytes: every trace over
+/// [`crate::analysis::traces::MAX_TRACE_PERIODS`] periods of
+/// [`super::limits::TRACE_BYTES_PER_SAMPLE`] bytes a sample (held against
+/// [`super::limits::MAX_TRACE_BYTES`], and part of the curve's [`super::limits::Cost`]).
+pub fn trace_bytes(points: usize, samples: usize) -> f64 {
+    points as f64
+        * (crate::analysis::traces::MAX_TRACE_PERIODS * samples) as f64
+        * super::limits::TRACE_BYTES_PER_SAMPLE
+}
+
 impl CurveRequest {
     /// The given ends and step are finite numbers (a NaN end was reported as the other one).
     ///
@@ -127,9 +138,7 @@ impl CurveRequest {
                 ));
             }
             // the worst case up front: every trace over MAX_TRACE_PERIODS periods
-            let bytes = spec.values.len() as f64
-                * (crate::analysis::traces::MAX_TRACE_PERIODS * n) as f64
-                * super::limits::TRACE_BYTES_PER_SAMPLE;
+            let bytes = trace_bytes(spec.values.len(), n);
             if bytes > super::limits::MAX_TRACE_BYTES {
                 return Err(SimError::Budget {
                     what: "traces",

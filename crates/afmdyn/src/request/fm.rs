@@ -4,10 +4,13 @@
 //! document. With a probe everything is SI (z_c and A in m, Δf in Hz, E_dis in J, forces in N);
 //! without one the model's units (g₀, Ω, F̃).
 
+use super::costs::{newton_work, state_bytes, MODEL_BYTES};
 use super::curves::CurveRequest;
+use super::limits::Cost;
 use super::run::{Analysis, Resolved};
 use crate::analysis::approach::approach_spec;
 use crate::analysis::fm::{fm_curve, FmCurve, FmSpec, DEFAULT_LOOP_TOLERANCE};
+use crate::analysis::fm::{MAX_HALVINGS, MAX_LOOP_ITERATIONS};
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
 use crate::report::CurveUnits;
@@ -218,6 +221,21 @@ impl Analysis for FmRequest {
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<FmCurve, SimError> {
         super::curves::check_single_frequency(&model.params, "fm")?;
         fm_curve(&self.spec(model)?, progress)
+    }
+    fn name(&self) -> &'static str {
+        "fm"
+    }
+    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
+        // every z_c: up to MAX_LOOP_ITERATIONS × MAX_HALVINGS steps of the phase loop, each a
+        // Newton solve of the period-1 orbit; a point's orbit and observables kept
+        let spec = self.spec(model)?;
+        let p = &spec.base;
+        let points = spec.values.len() as f64;
+        let steps = (MAX_LOOP_ITERATIONS * MAX_HALVINGS) as f64;
+        Ok(Cost {
+            bytes: MODEL_BYTES + points * (4.0 * state_bytes(p) + 512.0),
+            work: points * steps * newton_work(p, 1, &spec.newton),
+        })
     }
     fn report(&self, model: &Resolved, curve: &FmCurve) -> Result<Value, SimError> {
         Ok(document(self, model, curve))

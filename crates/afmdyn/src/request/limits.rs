@@ -51,6 +51,30 @@ pub fn check_threads(threads: Option<usize>) -> Result<(), crate::SimError> {
         _ => Ok(()),
     }
 }
+/// What a request costs ([`crate::request::Analysis::cost`]), estimated before it runs for the
+/// worst case its options allow ([`crate::request::costs`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Cost {
+    /// Peak memory, in bytes.
+    pub bytes: f64,
+    /// Work, in mode-periods: drive periods integrated × the model's modes.
+    pub work: f64,
+}
+
+/// Largest peak memory of a request, estimated before it runs, in bytes: 1.1 GiB, the budget
+/// of an image (`MAX_IMAGE_BYTES` of `crate::request::image`, where 2048 × 2048 pixels aborted
+/// on allocation) and about that of a curve's traces ([`MAX_TRACE_BYTES`]): what a request and
+/// the copies a front end makes of its result (files, NumPy arrays) hold within a few GiB.
+pub const MAX_REQUEST_BYTES: f64 = 1.1 * 1024.0 * 1024.0 * 1024.0;
+
+/// Largest work of a request, estimated before it runs, in mode-periods (drive periods
+/// integrated × modes): 1e11, about four days on one core at N = 20 (59 µs a drive period,
+/// 3 µs a mode-period, `docs/performance.md`) and one at N = 3 (2.3 µs a period; a nonlinear
+/// law 6–37 µs). Above every request whose factors the options bound one by one
+/// ([`MAX_RUN_PERIODS`] × 20 modes × the 41 columns of a Lyapunov spectrum is 8.2e10), below
+/// their products (random starts × transient cap × cells, which reach 1e18).
+pub const MAX_REQUEST_WORK: f64 = 1e11;
+
 /// Depth of a period-doubling cascade followed by branch switching: periods n, 2n, 4n and 8n.
 pub const CASCADE_FACTOR: usize = 8;
 /// Largest number of drive periods compared by the mode-convergence study (Fig. 4), and the

@@ -14,7 +14,8 @@
 //! - [`curves`]: the stepped curves (`approach`, `resonance`).
 //! - [`run`](mod@run): [`run()`]`(analysis, model, progress)` → [`Document`], the typed result and
 //!   its JSON document, for every analysis whose result is one value ([`Analysis`]).
-//! - [`limits`]: the limits beyond the model's ranges, each with its reason.
+//! - [`limits`]: the limits beyond the model's ranges, each with its reason, and the budgets of
+//!   a request's cost ([`limits::Cost`]), which [`costs`] estimates before it runs.
 //! - [`sweep`]: the records of a bifurcation sweep (columns, codes, the one row order) and the
 //!   fingerprint of its request.
 //! - [`checkpoint`]: resumable sweeps: the [`Checkpoint`] a store implements, in memory or
@@ -33,6 +34,7 @@ pub mod chart;
 pub mod checkpoint;
 #[cfg(feature = "files")]
 pub mod checkpoint_file;
+pub mod costs;
 pub mod curves;
 #[cfg(feature = "files")]
 pub use crate::io::dir_lock;

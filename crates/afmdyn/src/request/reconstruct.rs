@@ -24,9 +24,11 @@
 //! thermal motion), resonates below 1 Hz or above 10 GHz, or has a stiffness outside
 //! 10⁻⁶–10⁹ N/m.
 
+use super::costs::MODEL_BYTES;
+use super::limits::Cost;
 use super::run::{Analysis, Resolved};
 use crate::analysis::progress::Progress;
-use crate::analysis::reconstruct::{sader_jarvis_with, Reconstruction, ShiftCurve};
+use crate::analysis::reconstruct::{sader_jarvis_with, Method, Reconstruction, ShiftCurve};
 use crate::analysis::reconstruct_am::AmCurve;
 use crate::error::{number, SimError};
 use serde::{Deserialize, Serialize};
@@ -323,6 +325,23 @@ impl Analysis for ReconstructRequest {
     }
     fn execute(&self, _: &Resolved, progress: &Progress) -> Result<Reconstruction, SimError> {
         sader_jarvis_with(&self.curve()?, progress)
+    }
+    fn name(&self) -> &'static str {
+        "reconstruct"
+    }
+    fn cost(&self, _: &Resolved) -> Result<Cost, SimError> {
+        // no integration; memory bounded by the method's own limit (ShiftCurve::method): the
+        // FFT's three buffers of 16 bytes × the next power of two ≥ 2n, or the direct sum's
+        // O(n) rows; and the curve's columns (distance, shift, force, potential, law)
+        let n = self.frequency_shift.len();
+        let work_bytes = match self.curve()?.method()? {
+            Method::Fft { .. } => 3.0 * 16.0 * (2 * n).next_power_of_two() as f64,
+            Method::Direct => 8.0 * n as f64,
+        };
+        Ok(Cost {
+            bytes: MODEL_BYTES + work_bytes + 5.0 * 8.0 * n as f64,
+            work: 0.0,
+        })
     }
     fn report(&self, _: &Resolved, r: &Reconstruction) -> Result<Value, SimError> {
         Ok(document(self, r))

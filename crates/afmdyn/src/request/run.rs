@@ -23,13 +23,20 @@ use super::analyses::{
     AttractorsRequest, ContinuationRequest, ConvergeRequest, LyapunovRequest, ObserveRequest,
     ObserveResult, OrbitRequest,
 };
+use super::costs::{census_cost, converge_cost};
+use super::costs::{check_cost, newton_work, start_work, state_bytes, steady_periods, MODEL_BYTES};
 use super::curves::{approach_request, resonance_request, CurveRequest};
+use super::limits::Cost;
+use super::limits::CASCADE_FACTOR;
 use crate::analysis::attractors::AttractorReport;
 use crate::analysis::continuation::Branch;
+use crate::analysis::continuation::ContinuationSpec;
 use crate::analysis::converge::ConvergenceRun;
 use crate::analysis::lyapunov::LyapunovSpectrum;
 use crate::analysis::progress::Progress;
 use crate::analysis::shooting::PeriodicOrbit;
+use crate::analysis::shooting::ShootingOptions;
+use crate::analysis::steady::SteadyOptions;
 use crate::analysis::stepped::SteppedSpec;
 use crate::eigen::{spectrum, RegionSpectrum};
 use crate::error::SimError;
@@ -90,6 +97,16 @@ pub trait Analysis {
     /// # Errors
     /// [`SimError`] where the document needs the model built again (an invalid `params`).
     fn report(&self, model: &Resolved, output: &Self::Output) -> Result<Value, SimError>;
+    /// The request's name in its refusals (`"attractors"`).
+    fn name(&self) -> &'static str;
+    /// What the request costs on `model` — peak memory and work in mode-periods
+    /// ([`super::costs`]) — estimated for the worst case its options allow, before any work;
+    /// [`run`] refuses it beyond [`super::limits::MAX_REQUEST_BYTES`] or
+    /// [`super::limits::MAX_REQUEST_WORK`]. Called after [`Analysis::validate`].
+    ///
+    /// # Errors
+    /// As the analysis' validation.
+    fn cost(&self, model: &Resolved) -> Result<Cost, SimError>;
     /// The parameters the result was computed at, for the SI block: `model.params`, unless
     /// the analysis moves them (a resonance curve under a probe is the free resonance,
     /// [`super::curves::free_resonance_base`]).
@@ -108,12 +125,14 @@ pub trait Analysis {
     }
 }
 
-/// Run `analysis` on `model`: [`Analysis::validate`], [`Analysis::execute`], then its document with the SI block of
-/// the probe ([`report::with_si`]).
+/// Run `analysis` on `model`: [`Analysis::validate`], its [`Analysis::cost`] held against the
+/// budgets ([`check_cost`]), [`Analysis::execute`], then its document with the SI block of the
+/// probe ([`report::with_si`]).
 ///
 /// # Errors
-/// As [`Analysis::execute`] and [`Analysis::report`]; [`SimError::Cancelled`] when `progress`
-/// is cancelled before the start.
+/// As [`Analysis::execute`] and [`Analysis::report`]; [`SimError::Budget`] naming the request,
+/// its cost and the budget, before any work; [`SimError::Cancelled`] when `progress` is
+/// cancelled before the start.
 pub fn run<A: Analysis + ?Sized>(
     analysis: &A,
     model: &Resolved,
@@ -121,6 +140,7 @@ pub fn run<A: Analysis + ?Sized>(
 ) -> Result<Document<A::Output>, SimError> {
     progress.check()?;
     analysis.validate(model)?;
+    check_cost(analysis.name(), analysis.cost(model)?)?;
     let output = analysis.execute(model, progress)?;
     Ok(Document {
         json: document(analysis, model, &output)?,
@@ -166,6 +186,16 @@ impl Analysis for ModesRequest {
     fn execute(&self, model: &Resolved, _: &Progress) -> Result<Self::Output, SimError> {
         Ok(spectrum(&model.params)?)
     }
+    fn name(&self) -> &'static str {
+        "modes"
+    }
+    fn cost(&self, _: &Resolved) -> Result<Cost, SimError> {
+        // two eigenproblems of 2N × 2N: no integration
+        Ok(Cost {
+            bytes: MODEL_BYTES,
+            work: 0.0,
+        })
+    }
     fn report(&self, model: &Resolved, (free, contact): &Self::Output) -> Result<Value, SimError> {
         Ok(report::modes(&model.params, free, contact))
     }
@@ -178,6 +208,20 @@ impl Analysis for OrbitRequest {
     }
     fn execute(&self, model: &Resolved, _: &Progress) -> Result<PeriodicOrbit, SimError> {
         self.run(&model.params)
+    }
+    fn name(&self) -> &'static str {
+        "orbit"
+    }
+    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
+        // the steady state from rest (without an initial state), then Newton on the period
+        // asked for or the largest one searched
+        let p = &model.params;
+        let (search, steady) = start_work(&self.start, p)?;
+        let period = self.period.unwrap_or(steady.max_period);
+        Ok(Cost {
+            bytes: MODEL_BYTES,
+            work: search + newton_work(p, period, &ShootingOptions::default()),
+        })
     }
     fn report(&self, model: &Resolved, o: &PeriodicOrbit) -> Result<Value, SimError> {
         Ok(report::orbit(&CantileverModel::new(&model.params)?, o))
@@ -192,6 +236,28 @@ impl Analysis for ContinuationRequest {
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
         self.run(&model.params, progress)
     }
+    fn name(&self) -> &'static str {
+        "continuation"
+    }
+    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
+        // the start's steady state, then up to max_points Newton solves per branch (the
+        // cascade: branches of periods n, 2n, 4n, 8n with switching), each point's state and
+        // monodromy kept
+        let p = &model.params;
+        let (search, steady) = start_work(&self.start, &p.with(self.param, self.from))?;
+        let n = self.period.unwrap_or(steady.max_period);
+        let points = ContinuationSpec::new(*p, self.param, self.from, self.to, n).max_points;
+        let (branches, top) = match self.switch {
+            true => (4.0, CASCADE_FACTOR * n),
+            false => (1.0, n),
+        };
+        let point = (p.state_dim() * (p.state_dim() + 4)) as f64 * 8.0;
+        Ok(Cost {
+            bytes: MODEL_BYTES + branches * points as f64 * point,
+            work: search
+                + branches * points as f64 * newton_work(p, top, &ShootingOptions::default()),
+        })
+    }
     fn report(&self, model: &Resolved, branches: &Self::Output) -> Result<Value, SimError> {
         Ok(report::continuation(&model.params, self.param, branches))
     }
@@ -204,6 +270,23 @@ impl Analysis for LyapunovRequest {
     }
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
         self.run(&model.params, progress)
+    }
+    fn name(&self) -> &'static str {
+        "lyapunov"
+    }
+    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
+        // the transient and the averaged periods of the state and its tangent space (one
+        // column per state dimension); one value per block and exponent kept
+        let p = &model.params;
+        let transient = match self.transient {
+            Some(t) => t as f64,
+            None => steady_periods(&SteadyOptions::default(), p)?,
+        };
+        let dim = p.state_dim() as f64;
+        Ok(Cost {
+            bytes: MODEL_BYTES + self.blocks as f64 * state_bytes(p),
+            work: (transient + self.periods as f64) * (dim + 1.0) * p.modes as f64,
+        })
     }
     fn report(&self, model: &Resolved, l: &Self::Output) -> Result<Value, SimError> {
         Ok(report::lyapunov(&model.params, l))
@@ -218,6 +301,13 @@ impl Analysis for AttractorsRequest {
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
         self.run(&model.params, progress)
     }
+    fn name(&self) -> &'static str {
+        "attractors"
+    }
+    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
+        let spec = self.spec(&model.params)?;
+        census_cost(&spec, 1)
+    }
     fn report(&self, model: &Resolved, r: &Self::Output) -> Result<Value, SimError> {
         Ok(report::attractors(&model.params, self.samples, r))
     }
@@ -230,6 +320,24 @@ impl Analysis for ObserveRequest {
     }
     fn execute(&self, model: &Resolved, _: &Progress) -> Result<Self::Output, SimError> {
         self.run(&model.params)
+    }
+    fn name(&self) -> &'static str {
+        "observe"
+    }
+    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
+        // the start's steady state, Newton on its period (at most the largest searched), then
+        // `periods` of that period; the harmonics' amplitudes and phases kept
+        let p = &model.params;
+        let (search, steady) = start_work(&self.start, p)?;
+        let n = steady.max_period;
+        let newton = ShootingOptions {
+            tol: 1e-12,
+            ..ShootingOptions::default()
+        };
+        Ok(Cost {
+            bytes: MODEL_BYTES + self.harmonics as f64 * 32.0,
+            work: search + newton_work(p, n, &newton) + (self.periods * n) as f64 * p.modes as f64,
+        })
     }
     fn report(&self, model: &Resolved, o: &Self::Output) -> Result<Value, SimError> {
         let units = match &model.probe {
@@ -249,6 +357,12 @@ impl Analysis for ConvergeRequest {
     }
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
         self.run(&model.params, progress)
+    }
+    fn name(&self) -> &'static str {
+        "converge"
+    }
+    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
+        converge_cost(self, &model.params)
     }
     fn report(&self, model: &Resolved, runs: &Self::Output) -> Result<Value, SimError> {
         Ok(report::converge(&model.params, runs))

@@ -17,6 +17,8 @@ use crate::error::SimError;
 use crate::model::CantileverModel;
 use crate::params::Params;
 use crate::request::basins::document;
+use crate::request::costs::{basins_cost, check_cost};
+use crate::request::limits::Cost;
 use crate::request::run::{Analysis, Resolved};
 use crate::request::BasinsRequest;
 use serde_json::{json, Value};
@@ -52,9 +54,13 @@ impl BasinStudy {
     /// The study of `request` over `params`.
     ///
     /// # Errors
-    /// As [`BasinsRequest::spec`].
+    /// As [`BasinsRequest::spec`]; [`SimError::Budget`] beyond the budgets of a request
+    /// ([`check_cost`]).
     pub fn new(request: &BasinsRequest, params: &Params) -> Result<BasinStudy, SimError> {
         let spec = request.spec(params)?;
+        // held to the budgets here too: a front end runs the study into its store without
+        // `run`
+        check_cost("basins", basins_cost(&spec)?)?;
         let model = CantileverModel::new(params)?;
         Ok(BasinStudy {
             spec,
@@ -127,6 +133,12 @@ impl Analysis for BasinsRequest {
         crate::request::in_pool(self.threads, || {
             study.map(records.into_iter().map(|(_, r)| r))
         })
+    }
+    fn name(&self) -> &'static str {
+        "basins"
+    }
+    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
+        basins_cost(&self.spec(&model.params)?)
     }
     fn report(&self, model: &Resolved, map: &BasinMap) -> Result<Value, SimError> {
         let spec = self.spec(&model.params)?;

@@ -19,6 +19,8 @@ use crate::analysis::progress::Progress;
 use crate::error::SimError;
 use crate::params::Params;
 use crate::report;
+use crate::request::costs::{census_cost, check_cost};
+use crate::request::limits::Cost;
 use crate::request::run::{Analysis, Resolved};
 use crate::request::GlobalContinuationRequest;
 use serde_json::{json, Value};
@@ -48,13 +50,21 @@ impl ContinuationStudy {
     /// The study of `request` over `params`.
     ///
     /// # Errors
-    /// As [`GlobalContinuationRequest::spec`].
+    /// As [`GlobalContinuationRequest::spec`]; [`SimError::Budget`] beyond the budgets of a request
+    /// ([`check_cost`]).
     pub fn new(
         request: &GlobalContinuationRequest,
         params: &Params,
     ) -> Result<ContinuationStudy, SimError> {
+        let spec = request.spec(params)?;
+        // held to the budgets here too: a front end runs the study into its store without
+        // `run`
+        check_cost(
+            "attractors --sweep",
+            census_cost(&spec.census, spec.values.len())?,
+        )?;
         Ok(ContinuationStudy {
-            spec: request.spec(params)?,
+            spec,
             fingerprint: fingerprint(request, params),
         })
     }
@@ -124,6 +134,14 @@ impl Analysis for GlobalContinuationRequest {
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
         let study = ContinuationStudy::new(self, &model.params)?;
         study.steps(execute_in_memory(&study, None, progress)?)
+    }
+    fn name(&self) -> &'static str {
+        "attractors --sweep"
+    }
+    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
+        // one census per value
+        let spec = self.spec(&model.params)?;
+        census_cost(&spec.census, spec.values.len())
     }
     fn report(&self, model: &Resolved, steps: &Self::Output) -> Result<Value, SimError> {
         Ok(report::global_continuation(

@@ -21,6 +21,8 @@ use crate::analysis::stepped::{
 use crate::error::SimError;
 use crate::params::Params;
 use crate::report;
+use crate::request::costs::{check_cost, stepped_cost};
+use crate::request::limits::Cost;
 use crate::request::run::{Analysis, ApproachRequest, Resolved, ResonanceRequest};
 use serde::Serialize;
 use serde_json::{json, Value};
@@ -52,9 +54,11 @@ impl CurveStudy {
     /// The study of the approach curve `request` on `model`.
     ///
     /// # Errors
-    /// As [`ApproachRequest::spec`] and [`check_values`].
+    /// As [`ApproachRequest::spec`] and [`check_values`]; [`SimError::Budget`] beyond the
+    /// budgets of a request ([`check_cost`]).
     pub fn approach(request: &ApproachRequest, model: &Resolved) -> Result<CurveStudy, SimError> {
         CurveStudy::new(
+            "approach",
             request.spec(model)?,
             fingerprint("approach", request, model),
         )
@@ -63,16 +67,25 @@ impl CurveStudy {
     /// The study of the resonance curve `request` on `model`.
     ///
     /// # Errors
-    /// As [`ResonanceRequest::spec`] and [`check_values`].
+    /// As [`ResonanceRequest::spec`] and [`check_values`]; [`SimError::Budget`] beyond the
+    /// budgets of a request ([`check_cost`]).
     pub fn resonance(request: &ResonanceRequest, model: &Resolved) -> Result<CurveStudy, SimError> {
         CurveStudy::new(
+            "resonance",
             request.spec(model)?,
             fingerprint("resonance", request, model),
         )
     }
 
-    fn new(spec: SteppedSpec, fingerprint: Value) -> Result<CurveStudy, SimError> {
+    fn new(
+        what: &'static str,
+        spec: SteppedSpec,
+        fingerprint: Value,
+    ) -> Result<CurveStudy, SimError> {
         check_values(&spec)?;
+        // held to the budgets here too: a front end runs the study into its store without
+        // `run`
+        check_cost(what, stepped_cost(&spec)?)?;
         Ok(CurveStudy { spec, fingerprint })
     }
 
@@ -148,6 +161,12 @@ impl Analysis for ApproachRequest {
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
         CurveStudy::approach(self, model)?.run_in_memory(progress)
     }
+    fn name(&self) -> &'static str {
+        "approach"
+    }
+    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
+        stepped_cost(&self.spec(model)?)
+    }
     fn report(&self, model: &Resolved, c: &Self::Output) -> Result<Value, SimError> {
         let u = Self::units(model);
         let mut doc = report::approach(&model.params, c, &u);
@@ -177,6 +196,12 @@ impl Analysis for ResonanceRequest {
     }
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
         CurveStudy::resonance(self, model)?.run_in_memory(progress)
+    }
+    fn name(&self) -> &'static str {
+        "resonance"
+    }
+    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
+        stepped_cost(&self.spec(model)?)
     }
     fn report(&self, model: &Resolved, c: &Self::Output) -> Result<Value, SimError> {
         Ok(report::resonance(

@@ -21,8 +21,10 @@
 //! a user reads (`chart.csv`, `chart.nc`, the maps) are written from it.
 
 use crate::io::dir_lock::DirLock;
+use crate::io::input::InputKind;
 use crate::request::checkpoint::{CheckpointError, Ledger};
-use crate::request::checkpoint_file::{crc_hex, write_atomic, START_OVER};
+use crate::request::checkpoint_file::{crc_hex, open_store, read_failed, read_ledger};
+use crate::request::checkpoint_file::{write_atomic, START_OVER};
 use crate::request::sweep::first_difference;
 use base64::engine::general_purpose::STANDARD as BASE64;
 use base64::Engine;
@@ -121,16 +123,9 @@ impl<'a, R: Serialize + DeserializeOwned + Clone> TaskStore<'a, R> {
     }
 
     fn ledger(&self) -> Result<Option<Ledger>, CheckpointError> {
-        let path = self.path(self.files.ledger);
-        let text = match fs::read_to_string(&path) {
-            Ok(t) => t,
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
-            Err(e) => return Err(io("read", &path)(e)),
+        let Some(v) = read_ledger(&self.path(self.files.ledger))? else {
+            return Ok(None);
         };
-        let v: Value = serde_json::from_str(&text).map_err(|e| CheckpointError::Corrupt {
-            path: path.display().to_string(),
-            message: e.to_string(),
-        })?;
         if v.get("format").and_then(Value::as_u64) != Some(FORMAT)
             && self.path(self.files.records).exists()
         {
@@ -224,10 +219,8 @@ impl<'a, R: Serialize + DeserializeOwned + Clone> TaskStore<'a, R> {
     ) -> Result<BTreeSet<usize>, CheckpointError> {
         let path = self.path(self.files.records);
         let mut tasks = BTreeSet::new();
-        let file = match File::open(&path) {
-            Ok(f) => f,
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(tasks),
-            Err(e) => return Err(io("read", &path)(e)),
+        let Some(file) = open_store(&path, InputKind::StoreRecords)? else {
+            return Ok(tasks);
         };
         let mut reader = BufReader::new(file);
         let (mut good, mut buf, mut number) = (0u64, Vec::new(), 0usize);
@@ -239,7 +232,7 @@ impl<'a, R: Serialize + DeserializeOwned + Clone> TaskStore<'a, R> {
             buf.clear();
             let n = reader
                 .read_until(b'\n', &mut buf)
-                .map_err(io("read", &path))?;
+                .map_err(|e| read_failed(&path, e))?;
             if n == 0 || buf.last() != Some(&b'\n') {
                 break;
             }

@@ -1,0 +1,188 @@
+//! What a request costs before it runs ([`super::Analysis::cost`]): its peak memory and its
+//! work, estimated for the worst case its options allow, and held by [`super::run()`] against
+//! the budgets of [`super::limits`] ([`check_cost`]), so that a request too large is refused
+//! naming its cost and the budget — before any allocation or integration — instead of
+//! aborting on allocation or running for weeks.
+//!
+//! Work is counted in mode-periods: drive periods integrated × the model's modes N (a drive
+//! period's cost grows about linearly with N at N ≥ 3: 2.3 µs at N = 3, 11 µs at N = 10, 59 µs at
+//! N = 20 for the exact propagator, `docs/performance.md`). A steady-state search counts its
+//! transient cap ([`crate::analysis::steady::SteadyOptions::cap`]), a Newton solve on an orbit of
+//! period n its [`crate::analysis::shooting::ShootingOptions::max_iter`] iterations of n
+//! periods of the state and its 2N-column variational system, `(2N + 1) n`.
+
+use super::analyses::{ConvergeRequest, StartRequest};
+use super::limits::{Cost, MAX_REQUEST_BYTES, MAX_REQUEST_WORK};
+use crate::analysis::attractors::AttractorSpec;
+use crate::analysis::basins::BasinSpec;
+use crate::analysis::shooting::ShootingOptions;
+use crate::analysis::steady::SteadyOptions;
+use crate::analysis::stepped::SteppedSpec;
+use crate::error::SimError;
+use crate::model::CantileverModel;
+use crate::params::Params;
+
+/// Memory of a model and its propagators, held by every request, in bytes: 1 MiB (N ≤ 20:
+/// a few dozen 2N × 2N matrices per contact region).
+pub const MODEL_BYTES: f64 = 1024.0 * 1024.0;
+
+/// Memory of a state (2N values and the law's internal ones), in bytes.
+pub fn state_bytes(params: &Params) -> f64 {
+    params.state_dim() as f64 * 8.0
+}
+
+/// The drive periods of a steady-state search on `params` (its transient cap: `max_periods`,
+/// else the one derived from the model's slowest decay).
+///
+/// # Errors
+/// [`SimError::Params`] when the model cannot be built.
+pub fn steady_periods(steady: &SteadyOptions, params: &Params) -> Result<f64, SimError> {
+    Ok(steady.cap(&CantileverModel::new(params)?) as f64)
+}
+
+/// The mode-periods of the steady-state search of a start on `params` (none when it gives its
+/// initial state), and the search's options.
+///
+/// # Errors
+/// As [`super::SteadyRequest::options`]; [`SimError::Params`] when the model cannot be built.
+pub fn start_work(start: &StartRequest, params: &Params) -> Result<(f64, SteadyOptions), SimError> {
+    let steady = start.steady.options()?;
+    let search = match start.initial {
+        Some(_) => 0.0,
+        None => steady_periods(&steady, params)? * params.modes as f64,
+    };
+    Ok((search, steady))
+}
+
+/// The mode-periods of a Newton solve of an orbit of `period` drive periods on `params`
+/// (`max_iter` iterations of the state and its variational system: see the module).
+pub fn newton_work(params: &Params, period: usize, newton: &ShootingOptions) -> f64 {
+    let columns = 2.0 * params.modes as f64 + 1.0;
+    newton.max_iter as f64 * period as f64 * columns * params.modes as f64
+}
+
+/// Check `cost`, the cost of the request `what`, against [`MAX_REQUEST_BYTES`] and
+/// [`MAX_REQUEST_WORK`].
+///
+/// # Errors
+/// [`SimError::Budget`] naming the request, its cost and the budget.
+pub fn check_cost(what: &'static str, cost: Cost) -> Result<(), SimError> {
+    const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
+    // NaN (an estimate that overflowed) is refused too
+    if cost.bytes.is_nan() || cost.bytes > MAX_REQUEST_BYTES {
+        return Err(SimError::Budget {
+            what,
+            needed: format!("a peak memory of {:.2} GiB", cost.bytes / GIB),
+            budget: format!("{:.1} GiB", MAX_REQUEST_BYTES / GIB),
+            hint: "ask for fewer points, samples, cells or periods",
+        });
+    }
+    if cost.work.is_nan() || cost.work > MAX_REQUEST_WORK {
+        return Err(SimError::Budget {
+            what,
+            needed: format!(
+                "{:.3e} mode-periods (drive periods integrated × modes)",
+                cost.work
+            ),
+            budget: format!("{MAX_REQUEST_WORK:.0e} mode-periods"),
+            hint: "ask for fewer points, samples, cells or periods, or a shorter transient \
+                   (max_periods)",
+        });
+    }
+    Ok(())
+}
+
+/// The cost of `values` censuses of attractors ([`AttractorSpec`]: `attractors`, and one per
+/// value of `attractors --sweep`): every random start searched to its transient cap; each
+/// start's end state and Poincaré points (at most `max_period` states) kept.
+///
+/// # Errors
+/// [`SimError::Params`] when the model cannot be built.
+pub fn census_cost(spec: &AttractorSpec, values: usize) -> Result<Cost, SimError> {
+    let p = &spec.params;
+    let starts = values as f64 * spec.samples as f64;
+    let per_start = (spec.steady.max_period as f64 + 2.0) * state_bytes(p) + 128.0;
+    Ok(Cost {
+        bytes: MODEL_BYTES + starts * per_start,
+        work: starts * steady_periods(&spec.steady, p)? * p.modes as f64,
+    })
+}
+
+/// The memory of a trajectory's sample as [`crate::trajectory::record`] holds it, for a state
+/// of `params`, in bytes: the sample and its state's heap block, twice (a growing vector's old
+/// and new blocks are both live while it is copied).
+pub fn recorded_sample_bytes(params: &Params) -> f64 {
+    2.0 * (std::mem::size_of::<crate::trajectory::Sample>() as f64 + state_bytes(params))
+}
+
+/// The cost of `converge` on `params`: for N = 1..=`max_modes`, the steady state (the default
+/// search, its cap at `max_modes` modes) and `periods` sampled; every run's samples kept (τ,
+/// W_tip and V_T: 24 bytes a sample) and the last run's trajectory recorded whole
+/// ([`recorded_sample_bytes`]) while they are taken from it.
+///
+/// # Errors
+/// [`SimError::Params`] when the model cannot be built.
+pub fn converge_cost(req: &ConvergeRequest, params: &Params) -> Result<Cost, SimError> {
+    let top = Params {
+        modes: req.max_modes,
+        ..*params
+    };
+    let cap = steady_periods(&SteadyOptions::default(), &top)?;
+    // Σ N over N = 1..=max_modes
+    let modes = (req.max_modes * (req.max_modes + 1) / 2) as f64;
+    let run = req.periods as f64 * req.samples_per_period as f64;
+    Ok(Cost {
+        bytes: MODEL_BYTES + req.max_modes as f64 * run * 24.0 + run * recorded_sample_bytes(&top),
+        work: modes * (cap + req.periods as f64),
+    })
+}
+
+/// What the traces of a curve take at their peak for the bytes of their samples
+/// ([`super::curves::trace_bytes`]): 2.5, measured 2.27 (872 bytes per point and sample per
+/// period at 2000 samples, 60 and 120 points, 1 and 2 threads, against 384 for 16 periods of 24
+/// bytes: the vectors grow by doubling while a trace is recorded).
+pub const TRACE_GROWTH: f64 = 2.5;
+
+/// The cost of a stepped curve (`approach`, `resonance`): every point's steady state (one way,
+/// and back with branches: each value twice), up to `max_branch_points` Newton solves of the
+/// largest period per branch, and the traces' worst case ([`super::curves::trace_bytes`] ×
+/// [`TRACE_GROWTH`]).
+///
+/// # Errors
+/// [`SimError::Params`] when the model cannot be built.
+pub fn stepped_cost(spec: &SteppedSpec) -> Result<Cost, SimError> {
+    let p = &spec.base;
+    let points = spec.values.len() as f64;
+    let ways = if spec.branches { 2.0 } else { 1.0 };
+    let search = steady_periods(&spec.steady, p)? * p.modes as f64;
+    let branch = match spec.branches {
+        true => {
+            spec.max_branch_points as f64 * newton_work(p, spec.steady.max_period, &spec.newton)
+        }
+        false => 0.0,
+    };
+    let traces = match spec.trace_samples {
+        0 => 0.0,
+        n => TRACE_GROWTH * super::curves::trace_bytes(spec.values.len(), n),
+    };
+    // a point: its state, observables and orbit (a few hundred bytes)
+    let point = 4.0 * state_bytes(p) + 512.0;
+    Ok(Cost {
+        bytes: MODEL_BYTES + ways * points * point + traces,
+        work: ways * points * search + branch,
+    })
+}
+
+/// The cost of a basin map: every cell integrated up to its transient cap; a cell's class
+/// kept (64 bytes) and each attractor's Poincaré points.
+///
+/// # Errors
+/// [`SimError::Params`] when the model cannot be built.
+pub fn basins_cost(spec: &BasinSpec) -> Result<Cost, SimError> {
+    let p = &spec.params;
+    let cells = spec.xs.len() as f64 * spec.ys.len() as f64;
+    Ok(Cost {
+        bytes: MODEL_BYTES + cells * 64.0,
+        work: cells * steady_periods(&spec.steady, p)? * p.modes as f64,
+    })
+}
