@@ -203,3 +203,50 @@ fn an_sls_dashpot_out_of_reach_names_its_sample_keys() {
         .to_string();
     assert!(!err.contains("[medium]"), "{err}");
 }
+
+/// Issue 60 part D: resuming a finished curve store with one point's line removed exited 1
+/// with "cancelled". The points from the gap on are run again (each starts from the one
+/// before it), and the curve equals the uninterrupted one, byte for byte.
+#[test]
+fn a_finished_store_with_a_line_removed_is_completed_on_resume() {
+    let dir = temp_dir("resume-gap");
+    let (whole, cut) = (dir.join("whole"), dir.join("cut"));
+    let approach = |out: &std::path::Path, resume: bool| {
+        let mut args = vec![
+            "approach",
+            "--probe",
+            "examples/probe-point-mass-dmt.toml",
+            "--points",
+            "30",
+            "--files",
+            "data",
+            "--json",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        if resume {
+            args.push("--resume");
+        }
+        let o = run(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        o.stdout
+    };
+    let first = approach(&whole, false);
+    std::fs::create_dir_all(&cut).unwrap();
+    let records = std::fs::read_to_string(whole.join(".curve.points.jsonl")).unwrap();
+    let lines: Vec<&str> = records.lines().collect();
+    assert_eq!(lines.len(), 60);
+    let gap: String = lines
+        .iter()
+        .enumerate()
+        .filter(|(k, _)| *k != 20)
+        .map(|(_, l)| format!("{l}\n"))
+        .collect();
+    std::fs::write(cut.join(".curve.points.jsonl"), gap).unwrap();
+    std::fs::copy(whole.join(".curve.run.json"), cut.join(".curve.run.json")).unwrap();
+    let again = approach(&cut, true);
+    assert_eq!(
+        String::from_utf8_lossy(&first),
+        String::from_utf8_lossy(&again).replace(cut.to_str().unwrap(), whole.to_str().unwrap())
+    );
+}

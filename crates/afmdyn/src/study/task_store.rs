@@ -417,8 +417,17 @@ impl<R> StoredTasks<R> for HashSet<usize> {
 }
 
 impl<R: Serialize + DeserializeOwned + Clone> StoredTasks<R> for Vec<R> {
+    /// The records of tasks 0, 1, 2, … up to the first task missing: a later task starts from
+    /// the earlier ones' results, so the tasks after a gap (a store with a line removed) are
+    /// run again rather than shifted into its place.
     fn stored(store: &mut TaskStore<'_, R>, _: HashSet<usize>) -> Result<Self, CheckpointError> {
-        Ok(store.records()?.into_iter().map(|(_, r)| r).collect())
+        Ok(store
+            .records()?
+            .into_iter()
+            .enumerate()
+            .take_while(|(k, (task, _))| k == task)
+            .map(|(_, (_, r))| r)
+            .collect())
     }
 }
 
@@ -429,11 +438,15 @@ where
     R: Serialize + DeserializeOwned + Clone + Send,
 {
     fn open(&mut self, study: &S, resume: bool) -> Result<Opened<S::Done>, CheckpointError> {
-        let done = TaskStore::open(self, study.fingerprint(), resume)?;
-        if resume && self.finished()? {
+        let tasks = TaskStore::open(self, study.fingerprint(), resume)?;
+        let finished = resume && self.finished()?;
+        let done = S::Done::stored(self, tasks)?;
+        // a finished store that lost records (a line removed) runs them again: it loses
+        // nothing, where the finished flag alone would hand on an incomplete result
+        if finished && study.done_units(&done) >= study.units() {
             return Ok(Opened::Finished);
         }
-        Ok(Opened::Run(S::Done::stored(self, done)?))
+        Ok(Opened::Run(done))
     }
 
     fn append(&mut self, (task, record): (usize, R)) -> Result<(), CheckpointError> {
