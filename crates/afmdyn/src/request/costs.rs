@@ -154,7 +154,15 @@ pub fn stepped_cost(spec: &SteppedSpec) -> Result<Cost, SimError> {
     let p = &spec.base;
     let points = spec.values.len() as f64;
     let ways = if spec.branches { 2.0 } else { 1.0 };
-    let search = steady_periods(&spec.steady, p)? * p.modes as f64;
+    // a time-averaged curve (a quasi-periodic drive, or asked for) runs its quasi-periodic
+    // model to its transient cap and then its measured windows
+    let search = match &spec.average {
+        Some(avg) => {
+            let model = CantileverModel::quasiperiodic(p)?;
+            (spec.steady.cap(&model) + avg.windows * avg.window_periods) as f64 * p.modes as f64
+        }
+        None => steady_periods(&spec.steady, p)? * p.modes as f64,
+    };
     let branch = match spec.branches {
         true => {
             spec.max_branch_points as f64 * newton_work(p, spec.steady.max_period, &spec.newton)

@@ -57,6 +57,18 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Mutex;
 use thiserror::Error;
 
+/// The stored records of tasks 0, 1, 2, … up to the first task missing, in order: what a chain
+/// resumes from, whose every task starts from the one before it (a stepped curve). The tasks
+/// after a gap (a store with a line removed) are run again rather than shifted into its place.
+#[derive(Debug, Clone)]
+pub struct Prefix<R>(pub Vec<R>);
+
+impl<R> Default for Prefix<R> {
+    fn default() -> Self {
+        Prefix(Vec::new())
+    }
+}
+
 /// A study: independent tasks whose results a [`Store`] keeps (see the module doc).
 pub trait Study: Sync {
     /// One finished task, as a store keeps it.

@@ -13,7 +13,7 @@
 //! The requests' [`Analysis`] (`request::run`, Python's `afmdyn.approach` and
 //! `afmdyn.resonance`) run this study in memory.
 
-use super::{execute_in_memory, Study};
+use super::{execute_in_memory, Prefix, Study};
 use crate::analysis::progress::Progress;
 use crate::analysis::stepped::{
     check_values, finish_curve, sweep_points, CurvePoint, SteppedCurve, SteppedSpec,
@@ -122,8 +122,8 @@ impl CurveStudy {
 impl Study for CurveStudy {
     /// The point's place (0..2n) and the point.
     type Record = (usize, CurvePoint);
-    /// The stored points, in order.
-    type Done = Vec<CurvePoint>;
+    /// The stored points up to the first one missing, in order ([`Prefix`]).
+    type Done = Prefix<CurvePoint>;
 
     fn fingerprint(&self) -> &Value {
         &self.fingerprint
@@ -134,8 +134,8 @@ impl Study for CurveStudy {
         2 * self.spec.values.len() as u64
     }
 
-    fn done_units(&self, done: &Vec<CurvePoint>) -> u64 {
-        done.len() as u64
+    fn done_units(&self, done: &Prefix<CurvePoint>) -> u64 {
+        done.0.len() as u64
     }
 
     fn record_units(&self, _: &(usize, CurvePoint)) -> u64 {
@@ -144,12 +144,12 @@ impl Study for CurveStudy {
 
     fn run(
         &self,
-        done: &Vec<CurvePoint>,
+        done: &Prefix<CurvePoint>,
         sink: &(dyn Fn((usize, CurvePoint)) + Sync),
         cancel: &AtomicBool,
     ) -> Result<(), SimError> {
         let store = |k: usize, p: &CurvePoint| sink((k, p.clone()));
-        sweep_points(&self.spec, done, cancel, &store).map(|_| ())
+        sweep_points(&self.spec, &done.0, cancel, &store).map(|_| ())
     }
 }
 

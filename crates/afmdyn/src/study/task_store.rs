@@ -417,17 +417,22 @@ impl<R> StoredTasks<R> for HashSet<usize> {
 }
 
 impl<R: Serialize + DeserializeOwned + Clone> StoredTasks<R> for Vec<R> {
-    /// The records of tasks 0, 1, 2, … up to the first task missing: a later task starts from
-    /// the earlier ones' results, so the tasks after a gap (a store with a line removed) are
-    /// run again rather than shifted into its place.
     fn stored(store: &mut TaskStore<'_, R>, _: HashSet<usize>) -> Result<Self, CheckpointError> {
-        Ok(store
-            .records()?
-            .into_iter()
-            .enumerate()
-            .take_while(|(k, (task, _))| k == task)
-            .map(|(_, (_, r))| r)
-            .collect())
+        Ok(store.records()?.into_iter().map(|(_, r)| r).collect())
+    }
+}
+
+impl<R: Serialize + DeserializeOwned + Clone> StoredTasks<R> for super::Prefix<R> {
+    fn stored(store: &mut TaskStore<'_, R>, _: HashSet<usize>) -> Result<Self, CheckpointError> {
+        Ok(super::Prefix(
+            store
+                .records()?
+                .into_iter()
+                .enumerate()
+                .take_while(|(k, (task, _))| k == task)
+                .map(|(_, (_, r))| r)
+                .collect(),
+        ))
     }
 }
 
