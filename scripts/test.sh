@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The test command (README "Tests"; .ci/run calls it):
-#   1. the Rust tests: cargo test --workspace --release
+#   1. the Rust tests: cargo test --workspace --release --no-fail-fast (every test binary runs,
+#      so one failure does not hide the others)
 #   2. the Python package: a virtual environment in target/venv-test (created once, reused;
 #      $AFMDYN_TEST_VENV chooses another),
 #      `pip install ./crates/afmdyn-py[test]` (maturin builds the extension into it), then
@@ -24,8 +25,8 @@ trap 'rm -rf "$logs"' EXIT
 status=0
 extra_failed=0
 
-echo "== Rust: cargo test --workspace --release"
-cargo test --workspace --release 2>&1 | tee "$logs/rust.log"
+echo "== Rust: cargo test --workspace --release --no-fail-fast"
+cargo test --workspace --release --no-fail-fast 2>&1 | tee "$logs/rust.log"
 rust_code=${PIPESTATUS[0]}
 rust_passed=$(grep -Eo '^test result: [a-zA-Z]+\. [0-9]+ passed' "$logs/rust.log" | awk '{s += $4} END {print s + 0}')
 rust_failed=$(grep -Eo '[0-9]+ failed;' "$logs/rust.log" | awk '{s += $1} END {print s + 0}')
