@@ -58,17 +58,15 @@ impl AfmImage<'_> {
     /// The canvas (width, height) in pixels whose data area has the scan's aspect ratio
     /// (Ly/Lx of the pixel edges, kept within [0.08, 1.5]: a single line is drawn as a strip).
     pub(crate) fn canvas(&self) -> (u32, u32) {
-        let span = |e: &[f64]| (e[e.len() - 1] - e[0]).abs();
-        let (ex, ey) = (cell_edges(self.x), cell_edges(self.y));
+        let (_, _, (x0, x1, y0, y1)) = cell_grid(self.x, self.y);
         let aspect = if self.y.len() < 2 {
             0.08
         } else {
-            (span(&ey) / span(&ex)).clamp(0.08, 1.5)
+            ((y1 - y0) / (x1 - x0)).clamp(0.08, 1.5)
         };
         // the data area is the canvas less the colour bar, the y labels and the margins
         // (chart's: 12 each side); the height adds the title (about 40), the x labels (45)
         // and the margins
-        let (y0, y1) = (ey[0].min(ey[ey.len() - 1]), ey[0].max(ey[ey.len() - 1]));
         let labels = y_label_width(y0, y1, "y (m)");
         let data_w = 700u32;
         (
@@ -92,12 +90,7 @@ impl Painter for AfmImage<'_> {
         let (w, _) = body.dim_in_pixel();
         let (plot, bar) = body.split_horizontally(w.saturating_sub(BAR_PANEL));
         let (lo, hi) = self.range();
-        let (ex, ey) = (cell_edges(self.x), cell_edges(self.y));
-        let lo_hi = |e: &[f64]| {
-            let (a, b) = (e[0], e[e.len() - 1]);
-            (a.min(b), a.max(b))
-        };
-        let ((x0, x1), (y0, y1)) = (lo_hi(&ex), lo_hi(&ey));
+        let (ex, ey, (x0, x1, y0, y1)) = cell_grid(self.x, self.y);
         let mut chart = chart(&plot, (x0, x1, y0, y1), ("x (m)", "y (m)"))?;
         let nx = self.x.len();
         let missing = RGBColor(190, 190, 190);

@@ -40,6 +40,18 @@ pub(crate) fn cell_edges(v: &[f64]) -> Vec<f64> {
     e
 }
 
+/// The cell edges of both axes ([`cell_edges`]) and the extent they span, (x0, x1, y0, y1)
+/// with x0 < x1 and y0 < y1 whatever the axes' order.
+pub(crate) fn cell_grid(x: &[f64], y: &[f64]) -> (Vec<f64>, Vec<f64>, (f64, f64, f64, f64)) {
+    let (ex, ey) = (cell_edges(x), cell_edges(y));
+    let lo_hi = |e: &[f64]| {
+        let (a, b) = (e[0], e[e.len() - 1]);
+        (a.min(b), a.max(b))
+    };
+    let ((x0, x1), (y0, y1)) = (lo_hi(&ex), lo_hi(&ey));
+    (ex, ey, (x0, x1, y0, y1))
+}
+
 impl Painter for CellMap<'_> {
     fn paint<DB: DrawingBackend>(
         &self,
@@ -55,12 +67,7 @@ impl Painter for CellMap<'_> {
             .map(|(l, c)| (l.clone(), *c, false))
             .collect();
         let area = layout_rgb(root, self.title, &entries)?;
-        let (ex, ey) = (cell_edges(self.x), cell_edges(self.y));
-        let lo_hi = |e: &[f64]| {
-            let (a, b) = (e[0], e[e.len() - 1]);
-            (a.min(b), a.max(b))
-        };
-        let ((x0, x1), (y0, y1)) = (lo_hi(&ex), lo_hi(&ey));
+        let (ex, ey, (x0, x1, y0, y1)) = cell_grid(self.x, self.y);
         let mut chart = chart(&area, (x0, x1, y0, y1), self.labels)?;
         let nx = self.x.len();
         let rects = self.cells.iter().enumerate().filter_map(|(i, c)| {

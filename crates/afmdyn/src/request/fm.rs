@@ -193,12 +193,11 @@ impl FmRequest {
         super::limits::tolerance("tolerance", tol)?;
         let a = self.amplitude.map_or(1.0, |a| a / length);
         let offset = base.contact_law.distance_offset();
-        let from_default = match range.from {
-            Some(_) => 2.0 * a + offset, // not used
-            None => default_from(&base, a, range.to.map_or(a + offset, |t| t / length))
-                .unwrap_or(2.0 * a + offset),
+        let to = range.to.map_or(a + offset, |t| t / length);
+        let from = match range.from {
+            Some(f) => f / length,
+            None => default_from(&base, a, to).unwrap_or(2.0 * a + offset),
         };
-        let (from, to) = range.ends((from_default, a + offset), length);
         let values = approach_spec(base, from, to, range.spacing(length)?)
             .map_err(|e| super::curves::in_units(e, length))?
             .values;
