@@ -2,7 +2,7 @@
 
 use crate::args::{IntegratorArgs, ModelArgs};
 use crate::error::CliError;
-use crate::output::{f, io_error, write_bytes, write_csv, OutDir, TextUnits};
+use crate::output::{f, io_error, write_bytes, write_csv, OutDir};
 use crate::plot::{
     save, save_scatter_stream, save_stacked, ChunkSink, Figure, IdSeries, LegendEntry, Series,
     StackedFractions, Style,
@@ -463,7 +463,7 @@ pub fn attractors(a: &AttractorsArgs) -> Result<(), CliError> {
     }
     let spec = request.spec(&p)?;
     let out = OutDir::lock(&a.out)?;
-    let u = TextUnits::of(probe.as_ref());
+    let u = crate::output::units_of(probe.as_ref());
     let Document {
         output: report,
         json: doc,

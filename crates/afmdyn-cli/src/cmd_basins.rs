@@ -8,9 +8,10 @@ use crate::cmd_analysis::SteadyArgs;
 use crate::cmd_simulate::parse_modal_state;
 use crate::error::CliError;
 use crate::output::{write_bytes, OutDir};
-use crate::plot::RGBColor;
-use crate::plot::{color, save_map, CellMap};
+use crate::plot::{save_map, CellMap};
 use afmdyn::analysis::basins::BasinSpec;
+use afmdyn::layout::figure::palette as color;
+use afmdyn::layout::figure::Rgb as RGBColor;
 use afmdyn::request::basins::csv_text;
 use afmdyn::request::{BasinArrays, BasinsRequest, Resolved};
 use afmdyn::study::basins::{basin_store, BasinStudy};
@@ -183,13 +184,13 @@ pub fn basins_cmd(a: &BasinsArgs) -> Result<(), CliError> {
         out.path(),
         "basins",
         &CellMap {
-            title: "Basins of attraction (section points of the attractors: white rings)",
-            labels: (&xl, &yl),
-            x: &spec.xs,
-            y: &spec.ys,
-            cells: &cells,
-            legend: &legend,
-            points: &points,
+            title: "Basins of attraction (section points of the attractors: white rings)".into(),
+            labels: (xl.clone(), yl.clone()),
+            x: spec.xs.clone(),
+            y: spec.ys.clone(),
+            cells: cells.clone(),
+            legend: legend.clone(),
+            points: points.clone(),
         },
     )?;
     doc["csv"] = serde_json::json!(out.join("basins.csv"));

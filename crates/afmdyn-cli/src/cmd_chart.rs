@@ -9,9 +9,10 @@ use crate::args::{Dim, IntegratorArgs, ModelArgs, Quantity};
 use crate::cmd_analysis::SteadyArgs;
 use crate::error::CliError;
 use crate::output::{write_bytes, OutDir};
-use crate::plot::RGBColor;
-use crate::plot::{color, save_map, CellMap};
+use crate::plot::{save_map, CellMap};
 use afmdyn::analysis::chart::ChartCell;
+use afmdyn::layout::figure::palette as color;
+use afmdyn::layout::figure::Rgb as RGBColor;
 use afmdyn::request::chart::{
     axis_name, axis_unit, csv_lines, document, warnings, Chart, ChartArrays, CSV_HEADER,
 };
@@ -295,13 +296,13 @@ fn draw_maps(dir: &Path, chart: &afmdyn::request::Chart, a: &ChartArrays) -> Res
         dir,
         "chart-period",
         &CellMap {
-            title: "Period of the attractor most starts reach",
-            labels,
-            x: &a.x,
-            y: &a.y,
-            cells: &cells,
-            legend: &legend,
-            points: &[],
+            title: "Period of the attractor most starts reach".into(),
+            labels: (labels.0.to_string(), labels.1.to_string()),
+            x: a.x.clone(),
+            y: a.y.clone(),
+            cells: cells.clone(),
+            legend: legend.clone(),
+            points: vec![],
         },
     )?;
     // λ₁ of the dominant attractor, where it is nonperiodic
@@ -336,13 +337,13 @@ fn draw_maps(dir: &Path, chart: &afmdyn::request::Chart, a: &ChartArrays) -> Res
         dir,
         "chart-lyapunov",
         &CellMap {
-            title: "Largest Lyapunov exponent λ₁ of the nonperiodic attractors",
-            labels,
-            x: &a.x,
-            y: &a.y,
-            cells: &cells,
-            legend: &legend,
-            points: &[],
+            title: "Largest Lyapunov exponent λ₁ of the nonperiodic attractors".into(),
+            labels: (labels.0.to_string(), labels.1.to_string()),
+            x: a.x.clone(),
+            y: a.y.clone(),
+            cells: cells.clone(),
+            legend: legend.clone(),
+            points: vec![],
         },
     )?;
     // coexisting attractors
@@ -364,13 +365,13 @@ fn draw_maps(dir: &Path, chart: &afmdyn::request::Chart, a: &ChartArrays) -> Res
         dir,
         "chart-attractors",
         &CellMap {
-            title: "Coexisting attractors per cell",
-            labels,
-            x: &a.x,
-            y: &a.y,
-            cells: &cells,
-            legend: &legend,
-            points: &[],
+            title: "Coexisting attractors per cell".into(),
+            labels: (labels.0.to_string(), labels.1.to_string()),
+            x: a.x.clone(),
+            y: a.y.clone(),
+            cells: cells.clone(),
+            legend: legend.clone(),
+            points: vec![],
         },
     )?;
     Ok(())

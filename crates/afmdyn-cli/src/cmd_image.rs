@@ -116,11 +116,11 @@ fn map_of(
         out.path(),
         stem,
         &AfmImage {
-            title,
-            x: &img.x,
-            y: &img.y,
-            values: &values,
-            label: &format!("{quantity} ({unit})"),
+            title: title.to_string(),
+            x: img.x.clone(),
+            y: img.y.clone(),
+            values,
+            label: format!("{quantity} ({unit})"),
         },
     )?;
     Ok(())

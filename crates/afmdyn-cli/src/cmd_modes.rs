@@ -2,7 +2,7 @@
 
 use crate::args::{read_toml, ModelArgs};
 use crate::error::CliError;
-use crate::output::{f, write_csv, OutDir, TextUnits};
+use crate::output::{f, write_csv, OutDir};
 use crate::plot::{save, Figure, Series, Style};
 use afmdyn::analysis::progress::Progress;
 use afmdyn::eigen::fig3_sweep;
@@ -35,7 +35,7 @@ pub fn modes(a: &ModesArgs) -> Result<(), CliError> {
     if a.sweep.is_some() {
         return fig3(a, &p);
     }
-    let u = TextUnits::of(probe.as_ref());
+    let u = crate::output::units_of(probe.as_ref());
     let Document {
         output: (free, contact),
         json,

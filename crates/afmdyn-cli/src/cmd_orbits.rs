@@ -3,13 +3,13 @@
 use crate::args::ModelArgs;
 use crate::cmd_analysis::{SteadyArgs, COL_VALUE, COL_W_TIP};
 use crate::cmd_simulate::parse_initial;
+use crate::door::{self, Exit};
 use crate::error::CliError;
-use crate::output::{f, write_csv, OutDir, TextUnits};
+use crate::output::{f, write_csv, OutDir};
 use crate::plot::{save, Figure, Series, Style};
 use crate::progress;
 use afmdyn::analysis::continuation::BranchPoint;
-use afmdyn::analysis::progress::Progress;
-use afmdyn::request::{self, Document, Resolved};
+use afmdyn::request::{Document, Resolved};
 use afmdyn::request::{ContinuationRequest, LyapunovRequest, OrbitRequest, StartRequest};
 use afmdyn::{CantileverModel, Params, SweepParam};
 use clap::Args;
@@ -52,75 +52,17 @@ pub struct OrbitArgs {
 
 /// Run `afmdyn orbit`.
 pub fn orbit(a: &OrbitArgs) -> Result<(), CliError> {
-    let (p, probe) = a.model.resolve(Params::default())?;
+    let (params, probe) = a.model.resolve(Params::default())?;
     let request = OrbitRequest {
         period: a.period,
-        start: a.start.request(p.modes)?,
+        start: a.start.request(params.modes)?,
     };
-    let u = TextUnits::of(probe.as_ref());
-    let Document { output: o, json } =
-        request::run(&request, &Resolved { params: p, probe }, &Progress::new())?;
-    let n = o.period;
-    crate::output::print_warnings(&json)?;
-    if a.json {
-        outln!("{json}");
-        return Ok(());
-    }
-    outln!(
-        "period-{} orbit at {}{}{} ({}), {} switchings per cycle",
-        n,
-        u.drive(p.omega),
-        if p.is_multifrequency() {
-            format!(
-                " (a multifrequency drive: periods of its common period, {} of the first \
-                 component's)",
-                p.common_periods()
-            )
-        } else {
-            String::new()
-        },
-        if u.si() {
-            format!(", z_c = {}", u.length(p.rest_distance()))
-        } else {
-            String::new()
-        },
-        if o.stable { "stable" } else { "unstable" },
-        o.switchings
-    );
-    outln!(
-        "Newton residuals: {}",
-        o.residuals
-            .iter()
-            .map(|r| format!("{r:.2e}"))
-            .collect::<Vec<_>>()
-            .join(" → ")
-    );
-    outln!("Floquet multipliers (|μ|):");
-    for m in &o.multipliers {
-        outln!("  {:+.8} {:+.8}i   {:.8}", m.re, m.im, m.norm());
-    }
-    outln!(
-        "critical multiplier type: {:?}; distance to grazing {}{}",
-        o.critical,
-        if u.si() {
-            u.length(o.grazing_distance)
-        } else {
-            format!("{:.3e}", o.grazing_distance)
-        },
-        if o.grazing { " (grazing)" } else { "" }
-    );
-    let model = CantileverModel::new(&p)?;
-    for (k, z) in o.section.iter().enumerate() {
-        if u.si() {
-            outln!(
-                "  section {k}: tip deflection = {}",
-                u.length(model.w_tip(z))
-            );
-        } else {
-            outln!("  section {k}: W(1,τ) = {:.9}", model.w_tip(z));
-        }
-    }
-    Ok(())
+    let exit = Exit {
+        json: a.json,
+        out: None,
+        unit: "orbits",
+    };
+    door::run(&request, &Resolved { params, probe }, exit).map(drop)
 }
 
 /// `afmdyn continue` flags.
@@ -236,7 +178,7 @@ pub fn continuation(a: &ContinueArgs) -> Result<(), CliError> {
         None => Vec::new(),
     };
     let out = OutDir::lock(&a.out)?;
-    let u = TextUnits::of(probe.as_ref());
+    let u = crate::output::units_of(probe.as_ref());
     let model = Resolved {
         params: base,
         probe,
@@ -427,43 +369,17 @@ pub struct LyapunovArgs {
 
 /// Run `afmdyn lyapunov`.
 pub fn lyapunov(a: &LyapunovArgs) -> Result<(), CliError> {
-    let (p, probe) = a.model.resolve(Params::default())?;
+    let (params, probe) = a.model.resolve(Params::default())?;
     let request = LyapunovRequest {
-        initial: parse_initial(&a.initial_modal, p.modes)?,
+        initial: parse_initial(&a.initial_modal, params.modes)?,
         transient: a.transient,
         periods: a.periods,
         blocks: a.blocks,
     };
-    let u = TextUnits::of(probe.as_ref());
-    let Document { output: l, json } =
-        progress::run(&request, &Resolved { params: p, probe }, "periods")?;
-    let warnings = &l.warnings;
-    for w in warnings {
-        errln!("afmdyn: warning: {w}");
-    }
-    if a.json {
-        outln!("{json}");
-        return Ok(());
-    }
-    outln!(
-        "Lyapunov exponents ({}) over {} periods at {}:",
-        if u.si() { "1/s" } else { "per unit τ" },
-        l.periods,
-        u.drive(p.omega)
-    );
-    for ((e, s), c) in l.exponents.iter().zip(&l.uncertainty).zip(&l.convergence) {
-        outln!(
-            "  {} ± {} (statistical) ± {} (convergence, |λ(T) − λ(T/2)|)",
-            u.rate(*e),
-            u.rate(*s).trim_start_matches('+'),
-            u.rate(*c).trim_start_matches('+')
-        );
-    }
-    outln!(
-        "sum {}; mean phase-volume contraction {}",
-        u.rate(l.exponents.iter().sum::<f64>()),
-        u.rate(l.volume_rate)
-    );
-    outln!("0–1 test K = {:.3}; verdict: {:?}", l.zero_one, l.verdict);
-    Ok(())
+    let exit = Exit {
+        json: a.json,
+        out: None,
+        unit: "periods",
+    };
+    door::run(&request, &Resolved { params, probe }, exit).map(drop)
 }

@@ -38,6 +38,7 @@ mod cmd_modes;
 mod cmd_orbits;
 mod cmd_reconstruct;
 mod cmd_simulate;
+mod door;
 mod error;
 mod output;
 use afmdyn_plot as plot;

@@ -146,65 +146,16 @@ pub fn write_layout(path: &Path, layout: &afmdyn::layout::Layout) -> Result<(), 
     afmdyn::layout::netcdf::write(path, layout).map_err(|e| CliError::Io(e.to_string()))
 }
 
-/// `v` in `unit` with the SI prefix that puts its mantissa in [1, 1000), 6 significant digits
-/// (13.4747 nm, 300.000 kHz), or plain SI with `--units si` (8.033740e-9 m): the one format of
-/// SI values in every text summary.
+/// `v` in `unit` in the process's display units ([`afmdyn::report::si_value`]).
 pub fn si_value(v: f64, unit: &str) -> String {
-    if v == 0.0 || !v.is_finite() {
-        return format!("{v} {unit}");
-    }
-    let (e, p) = si_prefix(v.abs());
-    let m = v / 10f64.powi(e);
-    if !(1e-3..1e4).contains(&m.abs()) {
-        // plain SI (--units si): 8.033740e-9 m
-        return format!("{m:.6e} {p}{unit}");
-    }
-    let digits = (5 - m.abs().log10().floor() as i32).clamp(0, 5) as usize;
-    format!("{m:.digits$} {p}{unit}")
+    afmdyn::report::si_value(v, unit, crate::plot::plain_si())
 }
 
-/// The units of a text summary: SI with a probe (lengths, frequencies and rates through its
-/// scales, printed by [`si_value`]), else the model's (g₀, Ω, per unit τ).
-#[derive(Debug, Clone, Copy)]
-pub struct TextUnits(pub Option<afmdyn::probe::Scales>);
+pub use afmdyn::report::TextUnits;
 
-impl TextUnits {
-    /// The units of a run on `probe` (SI) or without one.
-    pub fn of(probe: Option<&afmdyn::probe::Probe>) -> Self {
-        TextUnits(probe.map(|p| p.scales))
-    }
-    /// The drive: `f = 300.000 kHz` or `Ω = 2.6`.
-    pub fn drive(self, omega: f64) -> String {
-        match self.0 {
-            Some(s) => format!("f = {}", si_value(s.frequency_hz(omega), "Hz")),
-            None => format!("Ω = {omega}"),
-        }
-    }
-    /// An angular frequency ω (per unit τ) as a frequency: Hz, or ω itself.
-    pub fn frequency(self, omega: f64) -> String {
-        match self.0 {
-            Some(s) => si_value(s.frequency_hz(omega), "Hz"),
-            None => format!("{omega:.6}"),
-        }
-    }
-    /// A length in g₀: m, or g₀.
-    pub fn length(self, v: f64) -> String {
-        match self.0 {
-            Some(s) => si_value(v * s.length_m, "m"),
-            None => format!("{v:.9}"),
-        }
-    }
-    /// A rate per unit τ (a Lyapunov exponent, Re λ): 1/s, or per unit τ.
-    pub fn rate(self, v: f64) -> String {
-        match self.0 {
-            Some(s) => format!("{:+.6e} 1/s", v / s.time_s),
-            None => format!("{v:+.6}"),
-        }
-    }
-    /// Whether the summary speaks SI.
-    pub fn si(self) -> bool {
-        self.0.is_some()
-    }
+/// The text units of a run on `probe` (SI) or without one, in the process's display units.
+pub fn units_of(probe: Option<&afmdyn::probe::Probe>) -> TextUnits {
+    TextUnits::of(probe, crate::plot::plain_si())
 }
 
 /// How SI quantities are displayed in text and on plot axes (`--units`): prefixed as AFM
@@ -220,21 +171,4 @@ pub enum DisplayUnits {
 /// Set the process's display units (once, from the command line): the plots' and the text's.
 pub fn set_display_units(u: DisplayUnits) {
     crate::plot::set_plain_si(u == DisplayUnits::Si);
-}
-
-pub use crate::plot::si_prefix;
-
-#[cfg(test)]
-mod tests {
-    use super::si_value;
-
-    /// SI prefixes with 6 significant digits.
-    #[test]
-    fn values_print_with_si_prefixes() {
-        assert_eq!(si_value(1.347465e-8, "m"), "13.4747 nm");
-        assert_eq!(si_value(3.0e5, "Hz"), "300.000 kHz");
-        assert_eq!(si_value(-2.5e-10, "m"), "-250.000 pm");
-        assert_eq!(si_value(1.0, "m"), "1.00000 m");
-        assert_eq!(si_value(0.0, "m"), "0 m");
-    }
 }

@@ -18,27 +18,16 @@ pub fn afmhot(t: f64) -> RGBColor {
     RGBColor(c(2.0 * t), c(2.0 * t - 0.5), c(2.0 * t - 1.0))
 }
 
-/// An image over a scan: pixel (i, j) centred on (`x[i]`, `y[j]`), reaching halfway to its
-/// neighbours, coloured by [`afmhot`] from the smallest to the largest finite value; NaN
-/// pixels (no operating point) are left grey.
-pub struct AfmImage<'a> {
-    /// Title.
-    pub title: &'a str,
-    /// Pixel centres along the fast axis x (m).
-    pub x: &'a [f64],
-    /// Line positions y (m).
-    pub y: &'a [f64],
-    /// The values, row-major (y slowest): `values[j * x.len() + i]`.
-    pub values: &'a [f64],
-    /// The colour bar's description with its unit in parentheses, e.g. `"height (m)"` (an SI
-    /// unit gets the prefix of the values' magnitude, as every axis).
-    pub label: &'a str,
-}
-
 /// Width of the colour bar's panel, pixels.
 const BAR_PANEL: u32 = 190;
 
-impl AfmImage<'_> {
+/// Sizing of an AFM image's canvas.
+pub(crate) trait ImageExt {
+    fn range(&self) -> (f64, f64);
+    fn canvas(&self) -> (u32, u32);
+}
+
+impl ImageExt for AfmImage {
     /// The finite range of the values (lo, hi), hi > lo (a flat image gets ±½ of its level's
     /// magnitude, or ±½).
     fn range(&self) -> (f64, f64) {
@@ -57,8 +46,8 @@ impl AfmImage<'_> {
 
     /// The canvas (width, height) in pixels whose data area has the scan's aspect ratio
     /// (Ly/Lx of the pixel edges, kept within [0.08, 1.5]: a single line is drawn as a strip).
-    pub(crate) fn canvas(&self) -> (u32, u32) {
-        let (_, _, (x0, x1, y0, y1)) = cell_grid(self.x, self.y);
+    fn canvas(&self) -> (u32, u32) {
+        let (_, _, (x0, x1, y0, y1)) = cell_grid(&self.x, &self.y);
         let aspect = if self.y.len() < 2 {
             0.08
         } else {
@@ -76,7 +65,7 @@ impl AfmImage<'_> {
     }
 }
 
-impl Painter for AfmImage<'_> {
+impl Painter for AfmImage {
     fn paint<DB: DrawingBackend>(
         &self,
         root: DrawingArea<DB, Shift>,
@@ -86,11 +75,11 @@ impl Painter for AfmImage<'_> {
         DB::ErrorType: 'static,
     {
         let s = |x: &dyn std::fmt::Display| x.to_string();
-        let body = layout_rgb(root, self.title, &[])?;
+        let body = layout_rgb(root, &self.title, &[])?;
         let (w, _) = body.dim_in_pixel();
         let (plot, bar) = body.split_horizontally(w.saturating_sub(BAR_PANEL));
         let (lo, hi) = self.range();
-        let (ex, ey, (x0, x1, y0, y1)) = cell_grid(self.x, self.y);
+        let (ex, ey, (x0, x1, y0, y1)) = cell_grid(&self.x, &self.y);
         let mut chart = chart(&plot, (x0, x1, y0, y1), ("x (m)", "y (m)"))?;
         let nx = self.x.len();
         let missing = RGBColor(190, 190, 190);
@@ -105,7 +94,7 @@ impl Painter for AfmImage<'_> {
         });
         chart.draw_series(rects).map_err(|x| s(&x))?;
         // the colour bar: 256 bands from lo to hi, its axis in the quantity's unit
-        let mut scale = chart_on_bar(&bar, lo, hi, self.label)?;
+        let mut scale = chart_on_bar(&bar, lo, hi, &self.label)?;
         let bands = 256;
         let step = (hi - lo) / f64::from(bands);
         scale
@@ -156,6 +145,6 @@ where
 
 /// Write `stem.png` and `stem.svg` of an AFM image in `dir`, each atomically, on a canvas of
 /// the scan's aspect ratio.
-pub fn save_image(dir: &Path, stem: &str, image: &AfmImage<'_>) -> Result<(), PlotError> {
+pub fn save_image(dir: &Path, stem: &str, image: &AfmImage) -> Result<(), PlotError> {
     write_both(dir, stem, image.canvas(), image)
 }

@@ -3,26 +3,6 @@
 
 use super::*;
 
-/// A map over a grid of cells (a behaviour chart): cell (ix, iy) is a rectangle centred on
-/// (`x[ix]`, `y[iy]`) reaching halfway to its neighbours, filled with its colour (`None`: left
-/// white); the legend (colours given) sits right of the data.
-pub struct CellMap<'a> {
-    /// Title.
-    pub title: &'a str,
-    /// Axis labels.
-    pub labels: (&'a str, &'a str),
-    /// x values (columns).
-    pub x: &'a [f64],
-    /// y values (rows).
-    pub y: &'a [f64],
-    /// Colour of each cell, row-major (y slowest).
-    pub cells: &'a [Option<RGBColor>],
-    /// Legend: label, colour.
-    pub legend: &'a [(String, RGBColor)],
-    /// Points drawn over the cells (x, y): white rings.
-    pub points: &'a [(f64, f64)],
-}
-
 /// The edges of the cells of an axis: midpoints between values, half a spacing beyond the
 /// ends (a single value gets ±0.5 of its magnitude's order, at least ±0.5).
 pub(crate) fn cell_edges(v: &[f64]) -> Vec<f64> {
@@ -52,7 +32,7 @@ pub(crate) fn cell_grid(x: &[f64], y: &[f64]) -> (Vec<f64>, Vec<f64>, (f64, f64,
     (ex, ey, (x0, x1, y0, y1))
 }
 
-impl Painter for CellMap<'_> {
+impl Painter for CellMap {
     fn paint<DB: DrawingBackend>(
         &self,
         root: DrawingArea<DB, Shift>,
@@ -64,18 +44,19 @@ impl Painter for CellMap<'_> {
         let entries: Vec<(String, RGBColor, bool)> = self
             .legend
             .iter()
-            .map(|(l, c)| (l.clone(), *c, false))
+            .map(|(l, c)| (l.clone(), rgb(*c), false))
             .collect();
-        let area = layout_rgb(root, self.title, &entries)?;
-        let (ex, ey, (x0, x1, y0, y1)) = cell_grid(self.x, self.y);
-        let mut chart = chart(&area, (x0, x1, y0, y1), self.labels)?;
+        let area = layout_rgb(root, &self.title, &entries)?;
+        let (ex, ey, (x0, x1, y0, y1)) = cell_grid(&self.x, &self.y);
+        let labels = (self.labels.0.as_str(), self.labels.1.as_str());
+        let mut chart = chart(&area, (x0, x1, y0, y1), labels)?;
         let nx = self.x.len();
         let rects = self.cells.iter().enumerate().filter_map(|(i, c)| {
             let (ix, iy) = (i % nx, i / nx);
             let c = (*c)?;
             Some(Rectangle::new(
                 [(ex[ix], ey[iy]), (ex[ix + 1], ey[iy + 1])],
-                c.filled(),
+                rgb(c).filled(),
             ))
         });
         chart.draw_series(rects).map_err(|x| x.to_string())?;
@@ -93,27 +74,8 @@ impl Painter for CellMap<'_> {
 }
 
 /// Write `stem.png` and `stem.svg` of a cell map in `dir`, each atomically.
-pub fn save_map(dir: &Path, stem: &str, map: &CellMap<'_>) -> Result<(), PlotError> {
+pub fn save_map(dir: &Path, stem: &str, map: &CellMap) -> Result<(), PlotError> {
     write_both(dir, stem, (1100, 700), map)
-}
-
-/// One id of a [`StackedFractions`] figure: its legend label and, per value, (basin fraction,
-/// X_max) where it has an attractor.
-pub type IdSeries = (String, Vec<Option<(f64, f64)>>);
-
-/// A global continuation's figure: on top, the basin fractions of the attractors stacked over
-/// the parameter (each id a band, in id order); below, each attractor's X_max over the
-/// parameter (markers joined where consecutive values have the id).
-pub struct StackedFractions {
-    /// Title.
-    pub title: String,
-    /// The parameter's axis label.
-    pub x_label: String,
-    /// The parameter's values.
-    pub values: Vec<f64>,
-    /// Per id: legend label and, per value, (basin fraction, X_max) where the id has an
-    /// attractor.
-    pub ids: Vec<IdSeries>,
 }
 
 impl Painter for StackedFractions {

@@ -48,34 +48,15 @@ pub fn set_plain_si(plain: bool) {
     PLAIN_SI.store(plain, std::sync::atomic::Ordering::Relaxed);
 }
 
-/// The SI prefix (a … G) for a magnitude: (its power of ten, the prefix), the one that puts
-/// the magnitude's mantissa in [1, 1000) within the range of prefixes; no prefix when
-/// [`set_plain_si`] asked for plain SI.
+/// Whether the process displays plain SI units ([`set_plain_si`]).
+pub fn plain_si() -> bool {
+    PLAIN_SI.load(std::sync::atomic::Ordering::Relaxed)
+}
+
+/// The SI prefix for a magnitude in the process's display units
+/// ([`afmdyn::report::si_prefix`]; none when [`set_plain_si`] asked for plain SI).
 pub fn si_prefix(mag: f64) -> (i32, &'static str) {
-    if PLAIN_SI.load(std::sync::atomic::Ordering::Relaxed) {
-        return (0, "");
-    }
-    const PREFIXES: [(i32, &str); 10] = [
-        (-18, "a"),
-        (-15, "f"),
-        (-12, "p"),
-        (-9, "n"),
-        (-6, "µ"),
-        (-3, "m"),
-        (0, ""),
-        (3, "k"),
-        (6, "M"),
-        (9, "G"),
-    ];
-    if !(mag > 0.0 && mag.is_finite()) {
-        return (0, "");
-    }
-    let e = (mag.log10().floor() as i32).div_euclid(3) * 3;
-    PREFIXES
-        .iter()
-        .copied()
-        .min_by_key(|(x, _)| (x - e).abs())
-        .unwrap_or((0, ""))
+    afmdyn::report::si_prefix(mag, plain_si())
 }
 
 static FONT: Once = Once::new();
@@ -90,71 +71,18 @@ fn register_font() {
     });
 }
 
-/// How a series is drawn.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Style {
-    /// Solid line.
-    Line,
-    /// Large dots (markers).
-    Points,
-    /// Small dots (a background cloud).
-    Dots,
-    /// Dashed line.
-    Dashed,
-    /// Dotted line (dots of 2 px, gaps of 4 px: e.g. an unstable branch).
-    Dotted,
-}
+pub use afmdyn::layout::figure::{
+    AfmImage, CellMap, Figure, IdSeries, Plot, Rgb, Series, StackedFractions, Style,
+};
 
-/// One plotted series.
-#[derive(Debug, Clone)]
-pub struct Series {
-    /// Legend label (empty: no legend entry).
-    pub label: String,
-    /// (x, y) points.
-    pub points: Vec<(f64, f64)>,
-    /// Style.
-    pub style: Style,
-    /// Palette index.
-    pub color: usize,
-}
-
-/// A 2-D figure.
-#[derive(Debug, Clone)]
-pub struct Figure {
-    /// Title.
-    pub title: String,
-    /// x-axis label.
-    pub x_label: String,
-    /// y-axis label.
-    pub y_label: String,
-    /// Series.
-    pub series: Vec<Series>,
-    /// Shaded x-intervals (e.g. contact intervals).
-    pub shade: Vec<(f64, f64)>,
-    /// The smallest extent of the y-axis (0: the data's own, padded): a physical scale below
-    /// which variations are round-off — a conservative law's E_dis of 1e-27 J on a problem
-    /// whose energies are 1e-15 J is drawn as the zero it is, not as noise filling the axis.
-    pub y_min_span: f64,
-}
-
-/// Number of palette colours.
-const PALETTE: usize = 10;
-
-/// Palette colour `i`.
+/// Palette colour `i` ([`afmdyn::layout::figure::palette`]).
 pub fn color(i: usize) -> RGBColor {
-    const P: [RGBColor; PALETTE] = [
-        RGBColor(31, 119, 180),
-        RGBColor(214, 39, 40),
-        RGBColor(44, 160, 44),
-        RGBColor(255, 127, 14),
-        RGBColor(148, 103, 189),
-        RGBColor(140, 86, 75),
-        RGBColor(227, 119, 194),
-        RGBColor(127, 127, 127),
-        RGBColor(188, 189, 34),
-        RGBColor(23, 190, 207),
-    ];
-    P[i % P.len()]
+    rgb(afmdyn::layout::figure::palette(i))
+}
+
+/// A figure's colour as the backend's.
+pub fn rgb(c: Rgb) -> RGBColor {
+    RGBColor(c.0, c.1, c.2)
 }
 
 /// A legend entry: label, palette index, marker (true) or line swatch.
@@ -591,6 +519,16 @@ pub fn save(dir: &Path, stem: &str, fig: &Figure) -> Result<(), PlotError> {
     write_both(dir, stem, (1000, 650), fig)
 }
 
+/// Write `stem.png` and `stem.svg` of a figure of any kind in `dir`, each atomically.
+pub fn save_plot(dir: &Path, stem: &str, plot: &Plot) -> Result<(), PlotError> {
+    match plot {
+        Plot::Lines(f) => save(dir, stem, f),
+        Plot::Cells(m) => save_map(dir, stem, m),
+        Plot::Stacked(s) => save_stacked(dir, stem, s),
+        Plot::Image(i) => save_image(dir, stem, i),
+    }
+}
+
 /// Draws one chunk of (x, y, palette index) points.
 pub type ChunkSink<'a> = dyn FnMut(&[(f64, f64, usize)]) -> Result<(), String> + 'a;
 /// Streams all chunks of a scatter plot into a [`ChunkSink`], failing with the caller's error
@@ -622,7 +560,7 @@ impl<E: std::fmt::Display> Painter for Scatter<'_, E> {
         // not by the number of points (an SVG would otherwise grow with the sweep)
         let (w, h) = area.dim_in_pixel();
         let (w, h) = (w as usize + 1, h as usize + 1);
-        let mut seen = vec![0u64; (w * h * PALETTE).div_ceil(64)];
+        let mut seen = vec![0u64; (w * h * afmdyn::layout::figure::PALETTE_LEN).div_ceil(64)];
         let fed = (self.feed)(&mut |chunk| {
             let fresh: Vec<(f64, f64, usize)> = chunk
                 .iter()
@@ -632,7 +570,8 @@ impl<E: std::fmt::Display> Painter for Scatter<'_, E> {
                     if px < 0 || py < 0 || px as usize >= w || py as usize >= h {
                         return false;
                     }
-                    let bit = (py as usize * w + px as usize) * PALETTE + c % PALETTE;
+                    let bit = (py as usize * w + px as usize) * afmdyn::layout::figure::PALETTE_LEN
+                        + c % afmdyn::layout::figure::PALETTE_LEN;
                     let (word, mask) = (bit / 64, 1u64 << (bit % 64));
                     let new = seen[word] & mask == 0;
                     seen[word] |= mask;

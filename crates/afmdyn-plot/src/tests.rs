@@ -249,11 +249,11 @@ fn an_afm_image_keeps_its_aspect_and_draws_high_bright() {
     let (x, y) = ([0.25e-6, 0.75e-6], [0.1e-6, 0.3e-6, 0.5e-6]);
     let values = [0.0, 0.0, 2.5e-9, 2.5e-9, 5e-9, 5e-9];
     let map = AfmImage {
-        title: "t",
-        x: &x,
-        y: &y,
-        values: &values,
-        label: "height (m)",
+        title: "t".into(),
+        x: x.to_vec(),
+        y: y.to_vec(),
+        values: values.to_vec(),
+        label: "height (m)".into(),
     };
     let (w, h) = map.canvas();
     register_font();

@@ -385,12 +385,14 @@ mod branches;
 #[cfg(feature = "files")]
 mod curve_table;
 mod curves;
+mod present;
 mod series;
 mod units;
 pub use branches::*;
 #[cfg(feature = "files")]
 pub use curve_table::*;
 pub use curves::*;
+pub use present::*;
 pub use series::*;
 pub use units::*;
 

@@ -123,6 +123,21 @@ pub trait Analysis {
     fn largest_indentation(&self, _output: &Self::Output) -> Option<f64> {
         None
     }
+    /// What the result shows besides its document ([`report::Presentation`]): the text
+    /// summary in `units`, its tables, datasets and figures as data, for every front end to
+    /// write; `document` is the result's JSON ([`run`]'s). Empty by default.
+    ///
+    /// # Errors
+    /// [`SimError`] where the presentation needs the model built again (an invalid `params`).
+    fn present(
+        &self,
+        _model: &Resolved,
+        _output: &Self::Output,
+        _document: &Value,
+        _units: report::TextUnits,
+    ) -> Result<report::Presentation, SimError> {
+        Ok(report::Presentation::default())
+    }
 }
 
 /// Run `analysis` on `model`: [`Analysis::validate`], its [`Analysis::cost`] held against the
@@ -226,6 +241,15 @@ impl Analysis for OrbitRequest {
     fn report(&self, model: &Resolved, o: &PeriodicOrbit) -> Result<Value, SimError> {
         Ok(report::orbit(&CantileverModel::new(&model.params)?, o))
     }
+    fn present(
+        &self,
+        model: &Resolved,
+        output: &Self::Output,
+        _: &Value,
+        units: report::TextUnits,
+    ) -> Result<report::Presentation, SimError> {
+        super::present::orbits::orbit(&model.params, output, units)
+    }
 }
 
 impl Analysis for ContinuationRequest {
@@ -290,6 +314,19 @@ impl Analysis for LyapunovRequest {
     }
     fn report(&self, model: &Resolved, l: &Self::Output) -> Result<Value, SimError> {
         Ok(report::lyapunov(&model.params, l))
+    }
+    fn present(
+        &self,
+        model: &Resolved,
+        output: &Self::Output,
+        _: &Value,
+        units: report::TextUnits,
+    ) -> Result<report::Presentation, SimError> {
+        Ok(super::present::orbits::lyapunov(
+            &model.params,
+            output,
+            units,
+        ))
     }
 }
 

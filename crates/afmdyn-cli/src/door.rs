@@ -1,0 +1,104 @@
+//! The one door of the command line: a request is validated, its `--out` directory locked, it
+//! runs with a progress bar ([`progress::run`]), and its presentation
+//! ([`afmdyn::report::Presentation`], built by the library) is written: the document's
+//! warnings on stderr, every file into the directory (CSV, NetCDF, JSON, figures through the
+//! one plotting module), then the JSON document (`--json`) or the text summary on stdout.
+
+use crate::error::CliError;
+use crate::output::{print_warnings, units_of, write_layout, OutDir};
+use crate::progress;
+use afmdyn::layout::files::{write_bytes, write_csv};
+use afmdyn::report::{OutputFile, Presentation};
+use afmdyn::request::{Analysis, Document, Resolved};
+use serde_json::Value;
+use std::path::Path;
+
+/// How a command's results leave: the JSON document on stdout instead of the summary, and the
+/// output directory of its files (none: a command that writes none).
+#[derive(Debug, Clone, Copy)]
+pub struct Exit<'a> {
+    /// Print the JSON document.
+    pub json: bool,
+    /// The output directory.
+    pub out: Option<&'a Path>,
+    /// What the progress bar counts ("points", "starts").
+    pub unit: &'static str,
+}
+
+/// Run `request` on `model` through the door and write its presentation; the typed result
+/// and its document are returned for a command that adds to them.
+///
+/// # Errors
+/// The request's validation and run errors; [`CliError::Input`] when `--out` is held by
+/// another run; [`CliError::Io`] naming a file that cannot be written.
+pub fn run<A: Analysis>(
+    request: &A,
+    model: &Resolved,
+    exit: Exit<'_>,
+) -> Result<Document<A::Output>, CliError> {
+    request.validate(model)?;
+    let out = exit.out.map(OutDir::lock).transpose()?;
+    let doc = progress::run(request, model, exit.unit)?;
+    let shown = request.present(
+        model,
+        &doc.output,
+        &doc.json,
+        units_of(model.probe.as_ref()),
+    )?;
+    emit(out.as_ref(), &shown, &doc.json, exit.json)?;
+    Ok(doc)
+}
+
+/// Write a presentation: `document`'s warnings on stderr, the files into `out`, then the
+/// document (`json`) or the summary and where the outputs are on stdout.
+///
+/// # Errors
+/// [`CliError::Io`] naming a file or stream that cannot be written.
+pub fn emit(
+    out: Option<&OutDir>,
+    shown: &Presentation,
+    document: &Value,
+    json: bool,
+) -> Result<(), CliError> {
+    print_warnings(document)?;
+    if let Some(out) = out {
+        let names = shown.file_names();
+        out.remove_partials(&names.iter().map(String::as_str).collect::<Vec<_>>())?;
+        for file in &shown.files {
+            write_file(out, file)?;
+        }
+    }
+    if json {
+        outln!("{document}");
+    } else {
+        for line in &shown.summary {
+            outln!("{line}");
+        }
+        if let Some(out) = out.filter(|_| !shown.files.is_empty()) {
+            outln!("outputs in {}", out.path().display());
+        }
+    }
+    Ok(())
+}
+
+/// One output file written atomically into `out`.
+///
+/// # Errors
+/// [`CliError::Io`] naming the file.
+pub fn write_file(out: &OutDir, file: &OutputFile) -> Result<(), CliError> {
+    match file {
+        OutputFile::Csv { name, header, rows } => {
+            let header: Vec<&str> = header.iter().map(String::as_str).collect();
+            write_csv(&out.join(name), &header, rows.iter().cloned())?;
+        }
+        OutputFile::Dataset { name, layout } => write_layout(&out.join(name), layout)?,
+        OutputFile::Figure { stem, plot } => crate::plot::save_plot(out.path(), stem, plot)?,
+        OutputFile::Json { name, value } => write_bytes(
+            &out.join(name),
+            serde_json::to_string_pretty(value)
+                .expect("a JSON value serialises")
+                .as_bytes(),
+        )?,
+    }
+    Ok(())
+}

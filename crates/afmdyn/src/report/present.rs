@@ -1,0 +1,216 @@
+//! What a result shows besides its JSON document: a text summary, tables (CSV), datasets
+//! (a [`Layout`]: the NetCDF file and the Python `xarray.Dataset`) and figures as data
+//! ([`Plot`]), built once here for every front end ([`Presentation`]). A front end only
+//! writes them: the command line prints the summary (unless `--json`) and writes each file
+//! into its `--out` directory, rendering figures with its one plotting module.
+//!
+//! The text speaks SI with a probe ([`TextUnits`]: prefixed values such as 13.4747 nm, or
+//! plain SI with `--units si`), else the model's dimensionless units (g₀, Ω, τ).
+
+use crate::layout::figure::Plot;
+use crate::layout::Layout;
+use serde_json::Value;
+
+/// A result's presentation: summary lines and output files, in the order they are written.
+#[derive(Debug, Clone, Default)]
+pub struct Presentation {
+    /// The text summary, one entry a line (without a trailing newline).
+    pub summary: Vec<String>,
+    /// The files, written in this order.
+    pub files: Vec<OutputFile>,
+}
+
+/// One output file of a result (its name relative to the output directory).
+#[derive(Debug, Clone)]
+pub enum OutputFile {
+    /// A CSV table: header and rows of already formatted fields.
+    Csv {
+        /// File name (`orbit.csv`).
+        name: String,
+        /// Column names.
+        header: Vec<String>,
+        /// Rows, each as many fields as the header.
+        rows: Vec<Vec<String>>,
+    },
+    /// A dataset: a NetCDF file from the command line, an `xarray.Dataset` in Python.
+    Dataset {
+        /// File name (`chart.nc`).
+        name: String,
+        /// Dimensions and variables.
+        layout: Layout,
+    },
+    /// A figure: `stem.png` and `stem.svg`.
+    Figure {
+        /// File stem (`amplitude`).
+        stem: String,
+        /// The figure as data.
+        plot: Plot,
+    },
+    /// A JSON document written pretty (`image.json`).
+    Json {
+        /// File name.
+        name: String,
+        /// The document.
+        value: Value,
+    },
+}
+
+impl Presentation {
+    /// Add a summary line.
+    pub fn line(&mut self, line: impl Into<String>) {
+        self.summary.push(line.into());
+    }
+    /// Add a CSV table.
+    pub fn csv(&mut self, name: &str, header: &[&str], rows: Vec<Vec<String>>) {
+        self.files.push(OutputFile::Csv {
+            name: name.to_string(),
+            header: header.iter().map(|h| h.to_string()).collect(),
+            rows,
+        });
+    }
+    /// Add a dataset.
+    pub fn dataset(&mut self, name: &str, layout: Layout) {
+        self.files.push(OutputFile::Dataset {
+            name: name.to_string(),
+            layout,
+        });
+    }
+    /// Add a figure.
+    pub fn figure(&mut self, stem: &str, plot: Plot) {
+        self.files.push(OutputFile::Figure {
+            stem: stem.to_string(),
+            plot,
+        });
+    }
+    /// The names of the files, figures as `stem.png` and `stem.svg` (to clear their stale
+    /// temporary files before writing).
+    pub fn file_names(&self) -> Vec<String> {
+        self.files
+            .iter()
+            .flat_map(|f| match f {
+                OutputFile::Csv { name, .. }
+                | OutputFile::Dataset { name, .. }
+                | OutputFile::Json { name, .. } => vec![name.clone()],
+                OutputFile::Figure { stem, .. } => {
+                    vec![format!("{stem}.png"), format!("{stem}.svg")]
+                }
+            })
+            .collect()
+    }
+}
+
+/// The SI prefix (a … G) for a magnitude: (its power of ten, the prefix), the one that puts
+/// the magnitude's mantissa in [1, 1000) within the range of prefixes; none when `plain`
+/// (plain SI units) or for zero and non-finite magnitudes.
+pub fn si_prefix(mag: f64, plain: bool) -> (i32, &'static str) {
+    const PREFIXES: [(i32, &str); 10] = [
+        (-18, "a"),
+        (-15, "f"),
+        (-12, "p"),
+        (-9, "n"),
+        (-6, "µ"),
+        (-3, "m"),
+        (0, ""),
+        (3, "k"),
+        (6, "M"),
+        (9, "G"),
+    ];
+    if plain || !(mag > 0.0 && mag.is_finite()) {
+        return (0, "");
+    }
+    let e = (mag.log10().floor() as i32).div_euclid(3) * 3;
+    PREFIXES
+        .iter()
+        .copied()
+        .min_by_key(|(x, _)| (x - e).abs())
+        .unwrap_or((0, ""))
+}
+
+/// `v` in `unit` with the SI prefix that puts its mantissa in [1, 1000), 6 significant digits
+/// (13.4747 nm, 300.000 kHz), or plain SI when `plain` (8.033740e-9 m): the one format of SI
+/// values in every text summary.
+pub fn si_value(v: f64, unit: &str, plain: bool) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return format!("{v} {unit}");
+    }
+    let (e, p) = si_prefix(v.abs(), plain);
+    let m = v / 10f64.powi(e);
+    if !(1e-3..1e4).contains(&m.abs()) {
+        // plain SI: 8.033740e-9 m
+        return format!("{m:.6e} {p}{unit}");
+    }
+    let digits = (5 - m.abs().log10().floor() as i32).clamp(0, 5) as usize;
+    format!("{m:.digits$} {p}{unit}")
+}
+
+/// The units of a text summary: SI with a probe (lengths, frequencies and rates through its
+/// scales, printed by [`si_value`]), else the model's (g₀, Ω, per unit τ).
+#[derive(Debug, Clone, Copy)]
+pub struct TextUnits {
+    /// The probe's scales (SI), or none (dimensionless).
+    pub scales: Option<crate::probe::Scales>,
+    /// Plain SI units (no prefixes).
+    pub plain: bool,
+}
+
+impl TextUnits {
+    /// The units of a run on `probe` (SI) or without one; `plain` for unprefixed SI.
+    pub fn of(probe: Option<&crate::probe::Probe>, plain: bool) -> Self {
+        TextUnits {
+            scales: probe.map(|p| p.scales),
+            plain,
+        }
+    }
+    /// `v` in `unit` ([`si_value`] with these units' prefix choice).
+    pub fn value(self, v: f64, unit: &str) -> String {
+        si_value(v, unit, self.plain)
+    }
+    /// The drive: `f = 300.000 kHz` or `Ω = 2.6`.
+    pub fn drive(self, omega: f64) -> String {
+        match self.scales {
+            Some(s) => format!("f = {}", self.value(s.frequency_hz(omega), "Hz")),
+            None => format!("Ω = {omega}"),
+        }
+    }
+    /// An angular frequency ω (per unit τ) as a frequency: Hz, or ω itself.
+    pub fn frequency(self, omega: f64) -> String {
+        match self.scales {
+            Some(s) => self.value(s.frequency_hz(omega), "Hz"),
+            None => format!("{omega:.6}"),
+        }
+    }
+    /// A length in g₀: m, or g₀.
+    pub fn length(self, v: f64) -> String {
+        match self.scales {
+            Some(s) => self.value(v * s.length_m, "m"),
+            None => format!("{v:.9}"),
+        }
+    }
+    /// A rate per unit τ (a Lyapunov exponent, Re λ): 1/s, or per unit τ.
+    pub fn rate(self, v: f64) -> String {
+        match self.scales {
+            Some(s) => format!("{:+.6e} 1/s", v / s.time_s),
+            None => format!("{v:+.6}"),
+        }
+    }
+    /// Whether the summary speaks SI.
+    pub fn si(self) -> bool {
+        self.scales.is_some()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::si_value;
+
+    /// SI prefixes with 6 significant digits; plain SI without.
+    #[test]
+    fn values_print_with_si_prefixes() {
+        assert_eq!(si_value(1.347465e-8, "m", false), "13.4747 nm");
+        assert_eq!(si_value(3.0e5, "Hz", false), "300.000 kHz");
+        assert_eq!(si_value(-2.5e-10, "m", false), "-250.000 pm");
+        assert_eq!(si_value(1.0, "m", false), "1.00000 m");
+        assert_eq!(si_value(0.0, "m", false), "0 m");
+        assert_eq!(si_value(8.03374e-9, "m", true), "8.033740e-9 m");
+    }
+}
