@@ -798,10 +798,13 @@ async function main() {
   // the engine's data, one after the other on one worker, which then ends
   const { doc: version } = await engine.run("meta", "version", {});
   const { doc: levers } = await engine.run("meta", "cantilevers", {});
+  const { doc: laws } = await engine.run("meta", "laws", {});
   state.columns = (await engine.run("meta", "bifurcation_columns", {})).doc;
   engine.close("meta");
   await presets;
   $("version").textContent = `Library version ${version}.`;
+  // both law lists from the library's registry (the model's and the probe's sample)
+  for (const id of ["contact_law", "p-law"]) for (const l of laws) $(id).add(Object.assign(new Option(l.name, l.name), { title: l.doc }));
   state.cantilevers = levers.cantilevers;
   for (const c of state.cantilevers) $("cantilever").add(new Option(`${c.name} (${c.maker}: k = ${c.spring_constant} N/m, f₀ = ${c.resonance_frequency / 1e3} kHz, Q = ${c.quality_factor})`, c.name));
   const defaultProbe = state.presets.find((x) => x.file === "probe-point-mass-dmt.toml") ?? state.presets[0];

@@ -20,8 +20,9 @@ async function handle(msg) {
   try {
     if (msg.kind === "run") {
       // the engine's data besides its analyses: the cantilever library, bifurcation.csv's
-      // columns, the version
+      // columns, the contact laws' registry, the version
       const data = { cantilevers: wasm.cantilevers, bifurcation_columns: wasm.bifurcation_columns,
+        laws: wasm.laws,
         version: () => JSON.stringify(wasm.version()) }[msg.analysis];
       const text = data ? data() : wasm.run(msg.analysis, msg.input);
       reply({ id: msg.id, ok: true, text, ms: performance.now() - t0 });

@@ -219,6 +219,14 @@ pub fn cantilevers() -> String {
     afmdyn::cantilevers::document().to_string()
 }
 
+/// The registered contact laws ([`afmdyn::contact::LAWS`]), in registry order: JSON text of
+/// `[{"name", "aliases", "doc", "params", "sample_keys"}, …]`; the explorer's law lists are
+/// filled from it, so a law added to the registry appears there without an edit.
+#[wasm_bindgen]
+pub fn laws() -> String {
+    serde_json::to_string(afmdyn::contact::LAWS).expect("the law descriptors serialise")
+}
+
 /// The columns of `bifurcation.csv`, in its order ([`bifurcation::columns`]): JSON text of
 /// `[{"name", "unit", "meaning"}, …]`, the keys of [`Bifurcation::next`]'s rows.
 #[wasm_bindgen]
