@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The test command (README "Tests"; .ci/run calls it):
 #   1. the Rust tests: cargo test --workspace --release --no-fail-fast (every test binary runs,
-#      so one failure does not hide the others)
+#      so one failure does not hide the others), and the toy contact law's test (feature toy-law)
 #   2. the Python package: a virtual environment in target/venv-test (created once, reused;
 #      $AFMDYN_TEST_VENV chooses another),
 #      `pip install ./crates/afmdyn-py[test]` (maturin builds the extension into it), then
@@ -28,6 +28,10 @@ extra_failed=0
 echo "== Rust: cargo test --workspace --release --no-fail-fast"
 cargo test --workspace --release --no-fail-fast 2>&1 | tee "$logs/rust.log"
 rust_code=${PIPESTATUS[0]}
+# the toy contact law (feature toy-law, not shipped): a law is one file plus one registry line
+echo "== Rust: cargo test --release -p afmdyn --features toy-law --test toy_law"
+cargo test --release -p afmdyn --features toy-law --test toy_law 2>&1 | tee -a "$logs/rust.log"
+[ "${PIPESTATUS[0]}" -eq 0 ] || rust_code=1
 rust_passed=$(grep -Eo '^test result: [a-zA-Z]+\. [0-9]+ passed' "$logs/rust.log" | awk '{s += $4} END {print s + 0}')
 rust_failed=$(grep -Eo '[0-9]+ failed;' "$logs/rust.log" | awk '{s += $1} END {print s + 0}')
 if [ "$rust_code" -ne 0 ]; then

@@ -167,7 +167,7 @@ fn constants_out_of_their_physical_range_are_refused_naming_the_flag() {
     for (extra, needle) in [
         (
             &["--amplitude", "1e300"][..],
-            "--amplitude = 1e300: must be an amplitude between 1e-15 and 1e-3 m",
+            "--amplitude = 1e300: must be ≤ 1e-5 m",
         ),
         (
             &["--amplitude", "-10nm"][..],
@@ -175,7 +175,7 @@ fn constants_out_of_their_physical_range_are_refused_naming_the_flag() {
         ),
         (
             &["--amplitude", "10"][..],
-            "--amplitude = 10: must be an amplitude between",
+            "--amplitude = 10: must be ≤ 1e-5 m",
         ),
         (
             &["--resonance-frequency", "-300kHz"][..],
@@ -183,11 +183,16 @@ fn constants_out_of_their_physical_range_are_refused_naming_the_flag() {
         ),
         (
             &["--resonance-frequency", "1e12"][..],
-            "--resonance-frequency = 1000000000000: must be a resonance frequency between",
+            "--resonance-frequency = 1000000000000: above 10 GHz",
+        ),
+        (
+            &["--resonance-frequency", "300"][..],
+            "--resonance-frequency = 300: below 1 kHz for a cantilever; frequencies are in Hz: \
+             300 kHz is 300e3",
         ),
         (
             &["--spring-constant", "1e12"][..],
-            "--spring-constant = 1000000000000: must be a spring constant between",
+            "--spring-constant = 1000000000000: above 1e9 N/m",
         ),
     ] {
         let (code, _, err) = run_example(FM, extra);
@@ -198,24 +203,25 @@ fn constants_out_of_their_physical_range_are_refused_naming_the_flag() {
 }
 
 /// A constant outside its typical range runs with a warning naming the likely unit slip, on
-/// stderr and in the document: 300 (Hz, meant kHz) gives forces 1000 times too large.
+/// stderr and in the document (300 Hz, meant kHz, is below any lever and refused above).
 #[test]
 fn a_likely_unit_slip_is_warned_of() {
     for (extra, needle) in [
         (
-            &["--resonance-frequency", "300"][..],
-            "resonance_frequency = 300 Hz is outside the typical 1 kHz to 10 MHz: was it meant \
-             in kHz? (300 kHz is 300000 Hz",
+            &["--resonance-frequency", "2e7"][..],
+            "resonance_frequency = 20000000 Hz is outside the typical 1 kHz–10 MHz of AFM \
+             levers: frequencies are in Hz",
         ),
         (
-            &["--amplitude", "5e-4"][..],
-            "amplitude = 0.0005 m is outside the typical 10 pm to 1 µm: was it meant in µm? \
-             (0.0005 µm is 5e-10 m",
+            &["--amplitude", "5e-6"][..],
+            "m is outside the typical 10 pm–1 µm of dynamic AFM: amplitudes are in m (10 nm \
+             is 10e-9)",
         ),
         (
             &["--spring-constant", "4e7", "--json"][..],
-            "spring_constant = 40000000 N/m is outside the typical 0.01 to 1e6 N/m: was it meant \
-             in mN/m? (40000000 mN/m is 40000 N/m",
+            "spring_constant = 40000000 N/m is outside the typical 0.005–1e6 N/m of AFM \
+             levers, qPlus sensors and length-extension resonators: was it meant in mN/m? \
+             (40000000 mN/m is 40000 N/m)",
         ),
     ] {
         let (code, out, err) = run_example(FM, extra);

@@ -214,7 +214,7 @@ pub enum SimError {
         /// Rejected value (as text, it may be an integer).
         value: String,
         /// The allowed range in words.
-        allowed: &'static str,
+        allowed: std::borrow::Cow<'static, str>,
     },
     /// Repeated switchings with vanishing intervals (chattering / sliding).
     #[error(
@@ -340,11 +340,15 @@ impl SimError {
     }
 
     /// Shorthand for [`SimError::OutOfRange`].
-    pub fn out_of_range(name: &'static str, value: impl ToString, allowed: &'static str) -> Self {
+    pub fn out_of_range(
+        name: &'static str,
+        value: impl ToString,
+        allowed: impl Into<std::borrow::Cow<'static, str>>,
+    ) -> Self {
         SimError::OutOfRange {
             name,
             value: value.to_string(),
-            allowed,
+            allowed: allowed.into(),
         }
     }
 }

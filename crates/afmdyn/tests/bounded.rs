@@ -195,7 +195,8 @@ fn probe_refusals_name_the_keys_written() {
         ),
         (
             with(pm, "resonance_frequency", "resonance_frequency = 1e15"),
-            "from [drive] frequency and [cantilever] resonance_frequency",
+            // refused as written, outside its physical range (probe::ranges)
+            "[cantilever].resonance_frequency = 1000000000000000 (Hz): above 10 GHz",
         ),
     ];
     for (msg, needle) in &cases {
@@ -203,7 +204,7 @@ fn probe_refusals_name_the_keys_written() {
     }
     let msg = with(pm, "free_amplitude", "free_amplitude = 1.0");
     assert!(
-        msg.ends_with("[drive].free_amplitude = 1 m: must be ≤ 1e-5 m (10 µm; tapping-mode amplitudes are nanometres)"),
+        msg.ends_with("[drive].free_amplitude = 1 (m): must be ≤ 1e-5 m (10 µm; tapping-mode amplitudes are nanometres)"),
         "{msg}"
     );
     let msg = with(beam, "modes", "modes = 0");

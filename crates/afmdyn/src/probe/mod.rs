@@ -110,6 +110,7 @@
 //! listed in one [`ProbeError::Invalid`].
 
 mod medium;
+pub mod ranges;
 mod reader;
 pub use medium::{CalibratedIn, FluidMode, MediumReport};
 use reader::*;
@@ -173,11 +174,6 @@ pub enum ProbeError {
 /// sensors in vacuum (1e4–1e6); a larger one leaves the beam's damping α3 and the drive
 /// amplitude α2 = A₀/Q-scaled below the double's resolution (Q = 1e308 made α2 NaN).
 pub const MAX_QUALITY_FACTOR: f64 = 1e7;
-
-/// The largest free amplitude A₀ a probe may give (m): 10 µm, a thousand times the tapping-mode
-/// amplitudes (1–100 nm). Lengths are in units of A₀, so beyond it the tip–sample lengths
-/// vanish against it.
-pub const MAX_FREE_AMPLITUDE: f64 = 1e-5;
 
 /// A refusal of a dimensionless group derived from the probe's keys, with the keys it was
 /// derived from: the user wrote those, not the group (a tiny `free_amplitude` was refused as

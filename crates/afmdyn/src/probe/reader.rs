@@ -151,99 +151,18 @@ impl Reader<'_> {
 }
 
 /// A value that is a unit slip rather than a measurement — a tip radius of 10 m written for
-/// 10 nm, a modulus of 4 Pa for 4 GPa, a resonance at 300 Hz for 300 kHz (below 1 kHz), a Hamaker constant
-/// of 6.6 J for 6.6e-20 J: values 1e3–1e12 off the range any AFM probe or sample takes, refused
-/// with the reading that was probably meant. `None` for a plausible value.
+/// 10 nm, a modulus of 4 Pa for 4 GPa, a resonance at 300 Hz for 300 kHz: outside its physical
+/// range ([`super::ranges`]), refused with the reading that was probably meant. `None` for a
+/// plausible value.
 pub(super) fn scale_hint(section: &str, key: &str, x: f64) -> Option<String> {
-    let nano = |what: &str| {
-        format!("longer than 100 µm for {what}; probe files are in metres: {x} nm is {x}e-9")
-    };
-    match (section, key) {
-        ("tip", "radius") if x > 1e-4 => Some(nano("a tip radius")),
-        ("drive", "free_amplitude") if x < 1e-12 => Some(
-            "below 1 pm, under the lever's thermal motion (probe files are in metres: 10 nm is \
-             10e-9)"
-                .into(),
-        ),
-        ("sample", "intermolecular_distance") if x > 1e-6 => Some(nano("a₀ (0.165e-9 m typical)")),
-        ("sample", "z_c") if x.abs() > 1e-4 => Some(nano("a rest distance")),
-        ("cantilever", "length" | "width" | "thickness") if x > 1e-2 => Some(format!(
-            "longer than 1 cm for a cantilever; probe files are in metres: {x} µm is {x}e-6"
-        )),
-        ("tip", "youngs_modulus") if x < 1e6 => Some(format!(
-            "below 1 MPa for a tip; moduli are in Pa: {x} GPa is {x}e9"
-        )),
-        ("sample", "youngs_modulus") if x < 100.0 => Some(format!(
-            "below 100 Pa (softer than any cell); moduli are in Pa: {x} MPa is {x}e6, {x} GPa \
-             is {x}e9"
-        )),
-        ("cantilever", "resonance_frequency") | ("drive", "frequency") if x < 1e3 => Some(format!(
-            "below 1 kHz for a cantilever; frequencies are in Hz: {x} kHz is {x}e3"
-        )),
-        ("sample", "hamaker") if x > 1e-17 => Some(format!(
-            "above 1e-17 J (Hamaker constants are ~1e-20 J); in J: {x}e-20"
-        )),
-        // the highest surface tension of a liquid at room temperature is mercury's, 0.485 N/m
-        // (CRC Handbook, 97th ed., "Surface tension of common liquids")
-        ("sample", "surface_tension") if x > 1.0 => Some(format!(
-            "above 1 N/m, beyond any liquid (water 0.072 N/m, mercury 0.485 N/m); surface \
-             tensions are in N/m: {x} mN/m is {x}e-3"
-        )),
-        // works of adhesion: polymers 0.03–0.1 J/m², water on silica 0.14 J/m², clean metals
-        // up to ~3 J/m² (Israelachvili 2011, ch. 13 and 17)
-        ("sample", "adhesion_energy") if x > 10.0 => Some(format!(
-            "above 10 J/m², beyond any solid's work of adhesion (polymers 0.03–0.1 J/m², \
-             metals up to ~3 J/m²); in J/m²: {x} mJ/m² is {x}e-3"
-        )),
-        _ => None,
-    }
+    super::ranges::refusal(section, key, x)
 }
 
 /// A value inside its physical range but outside the range AFM probes and samples typically
-/// take, with the unit slip it may be: a warning, not an error (a colloidal probe's radius of
-/// 20 µm is real). `None` inside the typical range. The ranges: tip radii 1 nm–50 µm (sharp
-/// tips to colloidal probes), free amplitudes 10 pm–1 µm (FM at small amplitude to large
-/// tapping), spring constants 0.005–1e4 N/m (soft contact levers to qPlus sensors at
-/// 1.8 kN/m), resonances up to 10 MHz, Hamaker constants 1e-21–5e-19 J (Israelachvili 2011,
-/// table 13.2: 0.4e-20 for hydrocarbons in water to 40e-20 for metals), surface tensions
-/// 0.01–0.6 N/m, works of adhesion 1e-3–1 J/m², lever lengths 5 µm–1 mm.
+/// take, with the unit slip it may be ([`super::ranges`]): a warning, not an error (a
+/// colloidal probe's radius of 20 µm is real). `None` inside the typical range.
 pub(super) fn typical_hint(section: &str, key: &str, x: f64) -> Option<String> {
-    let hint = |range: &str, slip: &str| Some(format!("outside the typical {range}: {slip}"));
-    match (section, key) {
-        ("tip", "radius") if !(1e-9..=5e-5).contains(&x) => hint(
-            "1 nm–50 µm of tips and colloidal probes",
-            "radii are in m (10 nm is 10e-9)",
-        ),
-        ("drive", "free_amplitude") if !(1e-11..=1e-6).contains(&x) => hint(
-            "10 pm–1 µm of dynamic AFM",
-            "amplitudes are in m (10 nm is 10e-9)",
-        ),
-        ("cantilever", "spring_constant") if !(5e-3..=1e4).contains(&x) => hint(
-            "0.005–1e4 N/m of AFM levers and qPlus sensors",
-            "stiffnesses are in N/m (40 N/m is 40.0)",
-        ),
-        ("cantilever", "resonance_frequency") | ("drive", "frequency") if x > 1e7 => hint(
-            "1 kHz–10 MHz of AFM levers",
-            "frequencies are in Hz (300 kHz is 300e3)",
-        ),
-        ("sample", "hamaker") if x != 0.0 && !(1e-21..=5e-19).contains(&x) => hint(
-            "1e-21–5e-19 J of Hamaker constants",
-            "they are in J (6.6e-20 J for polystyrene)",
-        ),
-        ("sample", "surface_tension") if !(0.01..=0.6).contains(&x) => hint(
-            "0.01–0.6 N/m of liquids",
-            "surface tensions are in N/m (water 0.072 N/m is 72e-3)",
-        ),
-        ("sample", "adhesion_energy") if !(1e-3..=1.0).contains(&x) => hint(
-            "1e-3–1 J/m² of works of adhesion",
-            "they are in J/m² (50 mJ/m² is 50e-3)",
-        ),
-        ("cantilever", "length") if !(5e-6..=1e-3).contains(&x) => hint(
-            "5 µm–1 mm of AFM levers",
-            "lengths are in m (125 µm is 125e-6)",
-        ),
-        _ => None,
-    }
+    super::ranges::warning(section, key, x)
 }
 
 pub(super) fn prefix(section: &str) -> String {

@@ -161,26 +161,6 @@ impl Probe {
             .table(root, "medium", false)
             .and_then(|t| medium::read(&mut r, t));
         let medium_given = root.contains_key("medium");
-        // lengths are in units of A₀: an amplitude of metres makes every other length vanish
-        // and the motion unresolvable (a probe with A₀ = 1 m ran for minutes; issue 27)
-        if extra.iter().any(|&(a, _)| a > MAX_FREE_AMPLITUDE) {
-            r.problems.push(
-                "[drive].free_amplitude: each component must be ≤ 1e-5 m (10 µm; tapping-mode \
-                 amplitudes are nanometres)"
-                    .into(),
-            );
-        }
-        let a0 = match a0 {
-            Some(a) if a > MAX_FREE_AMPLITUDE => {
-                r.problems.push(format!(
-                    "[drive].free_amplitude = {} m: must be ≤ 1e-5 m (10 µm; tapping-mode \
-                     amplitudes are nanometres)",
-                    crate::error::number(a)
-                ));
-                None
-            }
-            a => a,
-        };
         if let (Some(Structure::PointMass), Some(_)) = (structure, &qs) {
             r.problems.push(
                 "[cantilever].quality_factors: the point-mass model has one mode (use quality_factor)"

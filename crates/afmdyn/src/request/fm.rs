@@ -61,10 +61,6 @@ impl Default for FmRequest {
 /// request is refused, naming `amplitude`.
 pub const FM_AMPLITUDE_RANGE: (f64, f64) = (1e-8, 1e4);
 
-/// The FM amplitude's typical range in SI (m): 10 pm (qPlus sensors at small amplitude) to
-/// 1 µm; outside it the document warns of a unit slip.
-pub const FM_AMPLITUDE_TYPICAL: (f64, f64) = (1e-11, 1e-6);
-
 /// The share of the frequency shift at the curve's end (`to`) below which the default FM curve
 /// starts: the range runs from where |Δf| has decayed to it down to contact, which is also the
 /// range a Sader–Jarvis reconstruction needs (its integrals run to where the shift vanishes).
@@ -270,10 +266,10 @@ pub fn document(request: &FmRequest, model: &Resolved, curve: &FmCurve) -> Value
     let mut warnings: Vec<String> = Vec::new();
     let unit = if model.probe.is_some() { "m" } else { "g0" };
     if let (Some(a), Some(_)) = (request.amplitude, &model.probe) {
-        if !(FM_AMPLITUDE_TYPICAL.0..=FM_AMPLITUDE_TYPICAL.1).contains(&a) {
+        // the amplitude's typical range is the probe's ([`crate::probe::ranges`])
+        if let Some(why) = crate::probe::ranges::warning("drive", "free_amplitude", a) {
             warnings.push(format!(
-                "amplitude = {} m is outside the typical 10 pm–1 µm of FM-AFM: amplitudes are \
-                 in m (100 pm is 100e-12)",
+                "amplitude = {} m is {why}",
                 crate::error::number(a)
             ));
         }

@@ -5,13 +5,17 @@
 //! spring constant in N/m; the force in N, the potential in J.
 //!
 //! **Ranges.** Each constant has a physical range outside which it is refused and a typical
-//! range outside which the document warns of a likely unit slip ([`RANGES`]):
+//! range outside which the document warns of a likely unit slip ([`CONSTANTS`]):
 //!
 //! | constant | refused outside | typical (else a warning) |
 //! |---|---|---|
-//! | `amplitude` A | 1 fm – 1 mm | 10 pm – 1 µm |
-//! | `resonance_frequency` f0 | 1 Hz – 10 GHz | 1 kHz – 10 MHz |
-//! | `spring_constant` k | 10⁻⁶ – 10⁹ N/m | 0.01 – 10⁶ N/m |
+//! | `amplitude` A | 1 pm – 10 µm | 10 pm – 1 µm |
+//! | `resonance_frequency` f0 | 1 kHz – 10 GHz | 1 kHz – 10 MHz |
+//! | `spring_constant` k | 10⁻⁶ – 10⁹ N/m | 0.005 – 10⁶ N/m |
+//!
+//! They are the probe's ranges of the same quantities (`[drive] free_amplitude`,
+//! `[cantilever] resonance_frequency`, `spring_constant`), declared once in
+//! [`crate::probe::ranges`].
 //!
 //! Typical: FM-AFM amplitudes run from the ~20 pm of qPlus sensors at sub-Ångström
 //! resolution to the tens of nm of Si cantilevers in ultra-high vacuum (1 µm leaves room for
@@ -20,9 +24,8 @@
 //! high-frequency levers); spring constants from the 0.01 N/m of soft contact levers through
 //! 40 N/m (tapping levers) and 1.8 kN/m (qPlus) to the 540 kN/m of a length-extension
 //! resonator. A value a factor 10³ off (nm given as m, kHz as Hz) falls outside. Physical: no
-//! lever oscillates by more than its length (~1 mm) or by less than a femtometre (far below its
-//! thermal motion), resonates below 1 Hz or above 10 GHz, or has a stiffness outside
-//! 10⁻⁶–10⁹ N/m.
+//! lever oscillates by more than 10 µm (a thousand times the tapping amplitudes) or by less
+//! than a picometre (its thermal motion), resonates below 1 kHz or above 10 GHz, or has a stiffness outside 10⁻⁶–10⁹ N/m.
 
 use super::costs::MODEL_BYTES;
 use super::limits::Cost;
@@ -59,95 +62,18 @@ pub struct ReconstructRequest {
     pub law_force: Option<Vec<f64>>,
 }
 
-/// The range of one SI constant of a reconstruction (module doc).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Range {
-    /// The request's field.
-    pub name: &'static str,
-    /// Its SI unit.
-    pub unit: &'static str,
-    /// Refused outside [lo, hi].
-    pub physical: (f64, f64),
-    /// A warning outside [lo, hi].
-    pub typical: (f64, f64),
-    /// The typical range in words.
-    pub typical_text: &'static str,
-    /// The error's words.
-    pub refused: &'static str,
-    /// The unit slips to suggest: the prefix and its factor.
-    pub slips: &'static [(&'static str, f64)],
-}
-
-/// The ranges of `amplitude`, `resonance_frequency` and `spring_constant` (module doc).
-pub const RANGES: [Range; 3] = [
-    Range {
-        name: "amplitude",
-        unit: "m",
-        physical: (1e-15, 1e-3),
-        typical: (1e-11, 1e-6),
-        typical_text: "10 pm to 1 µm",
-        refused: "must be an amplitude between 1e-15 and 1e-3 m (in metres: 10 nm is 1e-8)",
-        slips: &[("n", 1e-9), ("p", 1e-12), ("µ", 1e-6)],
-    },
-    Range {
-        name: "resonance_frequency",
-        unit: "Hz",
-        physical: (1.0, 1e10),
-        typical: (1e3, 1e7),
-        typical_text: "1 kHz to 10 MHz",
-        refused: "must be a resonance frequency between 1 Hz and 1e10 Hz (in Hz: 300 kHz is 3e5)",
-        slips: &[("k", 1e3), ("M", 1e6)],
-    },
-    Range {
-        name: "spring_constant",
-        unit: "N/m",
-        physical: (1e-6, 1e9),
-        typical: (1e-2, 1e6),
-        typical_text: "0.01 to 1e6 N/m",
-        refused: "must be a spring constant between 1e-6 and 1e9 N/m",
-        slips: &[("m", 1e-3), ("k", 1e3)],
-    },
+/// The probe quantities of the constants `amplitude`, `resonance_frequency`,
+/// `spring_constant` (in that order): their ranges are the probe's, declared once in
+/// [`crate::probe::ranges`].
+pub const CONSTANTS: [(&str, &str, &str); 3] = [
+    ("amplitude", "drive", "free_amplitude"),
+    ("resonance_frequency", "cantilever", "resonance_frequency"),
+    ("spring_constant", "cantilever", "spring_constant"),
 ];
 
-impl Range {
-    /// `v` refused outside the physical range.
-    ///
-    /// # Errors
-    /// [`SimError::OutOfRange`] naming the field.
-    pub fn check(&self, v: f64) -> Result<(), SimError> {
-        if v.is_finite() && v >= self.physical.0 && v <= self.physical.1 {
-            Ok(())
-        } else {
-            Err(SimError::out_of_range(self.name, v, self.refused))
-        }
-    }
-
-    /// The warning for `v` outside the typical range (a likely unit slip), if it is.
-    pub fn warning(&self, v: f64) -> Option<String> {
-        let (lo, hi) = self.typical;
-        if v >= lo && v <= hi {
-            return None;
-        }
-        let mut text = format!(
-            "{} = {} {} is outside the typical {}",
-            self.name,
-            number(v),
-            self.unit,
-            self.typical_text
-        );
-        if let Some((prefix, f)) = self.slips.iter().find(|(_, f)| v * f >= lo && v * f <= hi) {
-            text += &format!(
-                ": was it meant in {prefix}{unit}? ({} {prefix}{unit} is {} {unit}; the forces \
-                 scale with it)",
-                number(v),
-                number(v * f),
-                unit = self.unit
-            );
-        } else {
-            text += ": check its unit (SI)";
-        }
-        Some(text)
-    }
+/// The ranges of a constant ([`CONSTANTS`]).
+fn range_of(section: &str, key: &str) -> &'static crate::probe::ranges::SiRange {
+    crate::probe::ranges::si_range(section, key).expect("the constants' ranges are declared")
 }
 
 /// The share of its extreme that |Δf| may keep at the largest distance without the truncation
@@ -159,12 +85,14 @@ impl ReconstructRequest {
     ///
     /// # Errors
     /// [`SimError::OutOfRange`] naming the field: a constant outside its physical range
-    /// ([`RANGES`]), neither or both of `distance` and `z_c`, and as [`ShiftCurve::validate`]
+    /// ([`CONSTANTS`]), neither or both of `distance` and `z_c`, and as [`ShiftCurve::validate`]
     /// (distances not monotonic among them).
     pub fn curve(&self) -> Result<ShiftCurve, SimError> {
         // the constants first: a wrong unit would otherwise show as distances out of order
-        for (range, v) in RANGES.iter().zip(self.constants()) {
-            range.check(v)?;
+        for ((name, section, key), v) in CONSTANTS.iter().zip(self.constants()) {
+            if let Some(why) = range_of(section, key).refusal(v) {
+                return Err(SimError::out_of_range(name, v, why));
+            }
         }
         let distance: Vec<f64> =
             match (&self.distance, &self.z_c) {
@@ -205,7 +133,7 @@ impl ReconstructRequest {
         Ok(curve)
     }
 
-    /// `amplitude`, `resonance_frequency`, `spring_constant` (the order of [`RANGES`]).
+    /// `amplitude`, `resonance_frequency`, `spring_constant` (the order of [`CONSTANTS`]).
     fn constants(&self) -> [f64; 3] {
         [
             self.amplitude,
@@ -215,13 +143,17 @@ impl ReconstructRequest {
     }
 
     /// The document's warnings on the request: a constant outside its typical range (a likely
-    /// unit slip, [`RANGES`]); data that end before the shift has decayed (|Δf| at the largest
+    /// unit slip, [`CONSTANTS`]); data that end before the shift has decayed (|Δf| at the largest
     /// distance above [`DECAYED`] of its extreme).
     pub fn warnings(&self) -> Vec<String> {
-        let mut warnings: Vec<String> = RANGES
+        let mut warnings: Vec<String> = CONSTANTS
             .iter()
             .zip(self.constants())
-            .filter_map(|(r, v)| r.warning(v))
+            .filter_map(|((name, section, key), v)| {
+                let r = range_of(section, key);
+                let why = r.warning(v)?;
+                Some(format!("{name} = {} {} is {why}", number(v), r.unit))
+            })
             .collect();
         if let Ok(c) = self.curve() {
             let n = c.distance.len();

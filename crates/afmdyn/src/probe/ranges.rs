@@ -1,0 +1,298 @@
+//! The one declaration of every SI input's ranges ([`SI_RANGES`]), by its probe key: the
+//! physical range, outside which a value is refused, and the typical range of AFM probes and
+//! samples, outside which it is accepted with a warning naming the likely unit slip. The probe
+//! reader, the FM request and the Sader–Jarvis reconstruction (whose constants are the probe's
+//! quantities: amplitude, resonance frequency, spring constant) all read it, so a range is
+//! written once and means the same on every front end.
+//!
+//! Sources of the typical ranges: tip radii 1 nm–50 µm (sharp tips to colloidal probes); free
+//! amplitudes 10 pm–1 µm (qPlus FM at small amplitude to large tapping); spring constants
+//! 0.005–1e6 N/m (soft contact levers, qPlus sensors at 1.8 kN/m, length-extension
+//! resonators at 540 kN/m); resonances 1 kHz–10 MHz;
+//! Hamaker constants 1e-21–5e-19 J (Israelachvili, *Intermolecular and Surface Forces*, 3rd ed.
+//! 2011, table 13.2: 0.4e-20 J for hydrocarbons in water to 40e-20 J for metals); surface
+//! tensions 0.01–0.6 N/m (CRC Handbook, 97th ed.: the highest liquid at room temperature is
+//! mercury, 0.485 N/m); works of adhesion 1e-3–1 J/m² (polymers 0.03–0.1 J/m², water on silica
+//! 0.14 J/m², clean metals up to ~3 J/m²: Israelachvili 2011, ch. 13 and 17); lever lengths
+//! 5 µm–1 mm.
+
+/// A bound of a physical range: the value beyond which a value is refused, and the refusal's
+/// words (`{x}` stands for the value as given).
+pub type Bound = (f64, &'static str);
+
+/// The ranges of one SI input (module doc).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SiRange {
+    /// The probe file's `[section]`.
+    pub section: &'static str,
+    /// Its keys in the section (more than one where they share the ranges).
+    pub keys: &'static [&'static str],
+    /// Its SI unit.
+    pub unit: &'static str,
+    /// The prefixes a value outside the typical range may have been meant in, with their
+    /// factors (`("k", 1e3)`): the warning names the one that brings it into the range.
+    pub slips: &'static [(&'static str, f64)],
+    /// Refused below this.
+    pub below: Option<Bound>,
+    /// Refused above this.
+    pub above: Option<Bound>,
+    /// The range compares |x| (a signed distance).
+    pub magnitude: bool,
+    /// The typical range [lo, hi] (a warning outside it), its words and the unit reminder;
+    /// zero counts as typical when `zero_typical` (no Hamaker attraction at all).
+    pub typical: Option<(f64, f64, &'static str, &'static str)>,
+    /// Zero is typical (a term switched off).
+    pub zero_typical: bool,
+}
+
+/// Every SI input with a physical or typical range beyond its sign (module doc).
+pub const SI_RANGES: &[SiRange] = &[
+    SiRange {
+        section: "tip",
+        keys: &["radius"],
+        unit: "m",
+        slips: &[("n", 1e-9), ("µ", 1e-6)],
+        below: None,
+        above: Some((1e-4, "longer than 100 µm for a tip radius; probe files are in metres: {x} nm is {x}e-9")),
+        magnitude: false,
+        typical: Some((1e-9, 5e-5, "1 nm–50 µm of tips and colloidal probes", "radii are in m (10 nm is 10e-9)")),
+        zero_typical: false,
+    },
+    SiRange {
+        section: "drive",
+        keys: &["free_amplitude"],
+        unit: "m",
+        slips: &[("n", 1e-9), ("p", 1e-12), ("µ", 1e-6)],
+        below: Some((1e-12, "below 1 pm, under the lever's thermal motion (probe files are in metres: 10 nm is 10e-9)")),
+        // lengths are in units of A₀: beyond 10 µm (a thousand times the tapping-mode amplitudes)
+        // every tip–sample length vanishes against it (A₀ = 1 m ran for minutes; issue 27)
+        above: Some((1e-5, "must be ≤ 1e-5 m (10 µm; tapping-mode amplitudes are nanometres)")),
+        magnitude: false,
+        typical: Some((1e-11, 1e-6, "10 pm–1 µm of dynamic AFM", "amplitudes are in m (10 nm is 10e-9)")),
+        zero_typical: false,
+    },
+    SiRange {
+        section: "sample",
+        keys: &["intermolecular_distance"],
+        unit: "m",
+        slips: &[],
+        below: None,
+        above: Some((1e-6, "longer than 100 µm for a₀ (0.165e-9 m typical); probe files are in metres: {x} nm is {x}e-9")),
+        magnitude: false,
+        typical: None,
+        zero_typical: false,
+    },
+    SiRange {
+        section: "sample",
+        keys: &["z_c"],
+        unit: "m",
+        slips: &[],
+        below: None,
+        above: Some((1e-4, "longer than 100 µm for a rest distance; probe files are in metres: {x} nm is {x}e-9")),
+        magnitude: true,
+        typical: None,
+        zero_typical: false,
+    },
+    SiRange {
+        section: "cantilever",
+        keys: &["length"],
+        unit: "m",
+        slips: &[("µ", 1e-6), ("m", 1e-3)],
+        below: None,
+        above: Some((1e-2, "longer than 1 cm for a cantilever; probe files are in metres: {x} µm is {x}e-6")),
+        magnitude: false,
+        typical: Some((5e-6, 1e-3, "5 µm–1 mm of AFM levers", "lengths are in m (125 µm is 125e-6)")),
+        zero_typical: false,
+    },
+    SiRange {
+        section: "cantilever",
+        keys: &["width", "thickness"],
+        unit: "m",
+        slips: &[],
+        below: None,
+        above: Some((1e-2, "longer than 1 cm for a cantilever; probe files are in metres: {x} µm is {x}e-6")),
+        magnitude: false,
+        typical: None,
+        zero_typical: false,
+    },
+    SiRange {
+        section: "tip",
+        keys: &["youngs_modulus"],
+        unit: "Pa",
+        slips: &[],
+        below: Some((1e6, "below 1 MPa for a tip; moduli are in Pa: {x} GPa is {x}e9")),
+        above: None,
+        magnitude: false,
+        typical: None,
+        zero_typical: false,
+    },
+    SiRange {
+        section: "sample",
+        keys: &["youngs_modulus"],
+        unit: "Pa",
+        slips: &[],
+        below: Some((100.0, "below 100 Pa (softer than any cell); moduli are in Pa: {x} MPa is {x}e6, {x} GPa is {x}e9")),
+        above: None,
+        magnitude: false,
+        typical: None,
+        zero_typical: false,
+    },
+    SiRange {
+        section: "cantilever",
+        keys: &["resonance_frequency"],
+        unit: "Hz",
+        slips: &[("k", 1e3), ("M", 1e6)],
+        below: Some((1e3, "below 1 kHz for a cantilever; frequencies are in Hz: {x} kHz is {x}e3")),
+        above: Some((1e10, "above 10 GHz, beyond any cantilever; frequencies are in Hz")),
+        magnitude: false,
+        typical: Some((1e3, 1e7, "1 kHz–10 MHz of AFM levers", "frequencies are in Hz (300 kHz is 300e3)")),
+        zero_typical: false,
+    },
+    SiRange {
+        section: "drive",
+        keys: &["frequency"],
+        unit: "Hz",
+        slips: &[("k", 1e3), ("M", 1e6)],
+        below: Some((1e3, "below 1 kHz for a cantilever; frequencies are in Hz: {x} kHz is {x}e3")),
+        above: Some((1e10, "above 10 GHz, beyond any cantilever; frequencies are in Hz")),
+        magnitude: false,
+        typical: Some((1e3, 1e7, "1 kHz–10 MHz of AFM levers", "frequencies are in Hz (300 kHz is 300e3)")),
+        zero_typical: false,
+    },
+    SiRange {
+        section: "cantilever",
+        keys: &["spring_constant"],
+        unit: "N/m",
+        slips: &[("m", 1e-3), ("k", 1e3)],
+        below: Some((1e-6, "below 1 µN/m, softer than any lever; spring constants are in N/m")),
+        above: Some((1e9, "above 1e9 N/m, stiffer than any sensor; spring constants are in N/m: {x} mN/m is {x}e-3")),
+        magnitude: false,
+        typical: Some((5e-3, 1e6, "0.005–1e6 N/m of AFM levers, qPlus sensors and length-extension resonators", "stiffnesses are in N/m (40 N/m is 40.0)")),
+        zero_typical: false,
+    },
+    SiRange {
+        section: "sample",
+        keys: &["hamaker"],
+        unit: "J",
+        slips: &[],
+        below: None,
+        above: Some((1e-17, "above 1e-17 J (Hamaker constants are ~1e-20 J); in J: {x}e-20")),
+        magnitude: false,
+        typical: Some((1e-21, 5e-19, "1e-21–5e-19 J of Hamaker constants", "they are in J (6.6e-20 J for polystyrene)")),
+        zero_typical: true,
+    },
+    SiRange {
+        section: "sample",
+        keys: &["surface_tension"],
+        unit: "N/m",
+        slips: &[("m", 1e-3)],
+        below: None,
+        above: Some((1.0, "above 1 N/m, beyond any liquid (water 0.072 N/m, mercury 0.485 N/m); surface tensions are in N/m: {x} mN/m is {x}e-3")),
+        magnitude: false,
+        typical: Some((0.01, 0.6, "0.01–0.6 N/m of liquids", "surface tensions are in N/m (water 0.072 N/m is 72e-3)")),
+        zero_typical: false,
+    },
+    SiRange {
+        section: "sample",
+        keys: &["adhesion_energy"],
+        unit: "J/m²",
+        slips: &[("m", 1e-3)],
+        below: None,
+        above: Some((10.0, "above 10 J/m², beyond any solid's work of adhesion (polymers 0.03–0.1 J/m², metals up to ~3 J/m²); in J/m²: {x} mJ/m² is {x}e-3")),
+        magnitude: false,
+        typical: Some((1e-3, 1.0, "1e-3–1 J/m² of works of adhesion", "they are in J/m² (50 mJ/m² is 50e-3)")),
+        zero_typical: false,
+    },
+];
+
+/// The ranges of `[section].key`, if it has any beyond its sign.
+pub fn si_range(section: &str, key: &str) -> Option<&'static SiRange> {
+    SI_RANGES
+        .iter()
+        .find(|r| r.section == section && r.keys.contains(&key))
+}
+
+impl SiRange {
+    /// Why `x` is refused (outside the physical range: a unit slip rather than a measurement),
+    /// or `None`.
+    pub fn refusal(&self, x: f64) -> Option<String> {
+        let v = if self.magnitude { x.abs() } else { x };
+        let words = match (self.below, self.above) {
+            (Some((lo, w)), _) if v < lo => w,
+            (_, Some((hi, w))) if v > hi => w,
+            _ => return None,
+        };
+        Some(words.replace("{x}", &x.to_string()))
+    }
+
+    /// The warning's words for `x` outside the typical range (`outside the typical …: …`):
+    /// the prefix it was likely meant in, when one of [`SiRange::slips`] brings it into the
+    /// range (`was it meant in kHz? (300 kHz is 300000 Hz)`), else the unit reminder; `None`
+    /// inside the typical range.
+    pub fn warning(&self, x: f64) -> Option<String> {
+        let (lo, hi, range, reminder) = self.typical?;
+        if (self.zero_typical && x == 0.0) || (lo..=hi).contains(&x) {
+            return None;
+        }
+        let unit = self.unit;
+        let meant = self
+            .slips
+            .iter()
+            .find(|(_, f)| (lo..=hi).contains(&(x * f)));
+        Some(match meant {
+            Some((prefix, f)) => format!(
+                "outside the typical {range}: was it meant in {prefix}{unit}? ({} {prefix}{unit} \
+                 is {} {unit})",
+                crate::error::number(x),
+                crate::error::number(x * f)
+            ),
+            None => format!("outside the typical {range}: {reminder}"),
+        })
+    }
+}
+
+/// Why `[section].key = x` is refused ([`SiRange::refusal`]), if it is.
+pub fn refusal(section: &str, key: &str, x: f64) -> Option<String> {
+    si_range(section, key)?.refusal(x)
+}
+
+/// The typical-range warning of `[section].key = x` ([`SiRange::warning`]), if any.
+pub fn warning(section: &str, key: &str, x: f64) -> Option<String> {
+    si_range(section, key)?.warning(x)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every declared range is a range: lo < hi, typical inside physical.
+    #[test]
+    fn ranges_are_ordered_and_nested() {
+        for r in SI_RANGES {
+            let lo = r.below.map_or(f64::NEG_INFINITY, |b| b.0);
+            let hi = r.above.map_or(f64::INFINITY, |b| b.0);
+            assert!(lo < hi, "{}.{:?}", r.section, r.keys);
+            if let Some((tl, th, _, _)) = r.typical {
+                assert!(
+                    lo <= tl && tl < th && th <= hi,
+                    "{}.{:?}",
+                    r.section,
+                    r.keys
+                );
+            }
+        }
+    }
+
+    /// The slips of issue 60 §A2: a 10 m amplitude and a 300 Hz resonance are refused, 72 N/m
+    /// of surface tension is refused, 0.5 N/m is typical and 0.9 N/m warned.
+    #[test]
+    fn the_unit_slips_are_refused_or_warned() {
+        assert!(refusal("drive", "free_amplitude", 10.0).is_some());
+        assert!(refusal("cantilever", "resonance_frequency", 300.0).is_some());
+        assert!(refusal("sample", "surface_tension", 72.0).is_some());
+        assert!(warning("sample", "surface_tension", 0.5).is_none());
+        assert!(warning("sample", "surface_tension", 0.9).is_some());
+        assert!(warning("sample", "hamaker", 0.0).is_none());
+        assert!(refusal("sample", "z_c", -2e-4).is_some());
+    }
+}
