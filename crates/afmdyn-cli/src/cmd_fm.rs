@@ -1,15 +1,17 @@
 //! `afmdyn fm`: the frequency-modulation curve at constant amplitude over the rest distance
 //! z_c — the drive frequency an ideal PLL locks at and the excitation an ideal amplitude
 //! controller sets, as exact periodic orbits. The request, the analysis and the document are
-//! the library's ([`afmdyn::request::FmRequest`], [`afmdyn::analysis::fm`]); this front end
-//! maps the flags and writes `fm.csv`, `fm.json` and the frequency-shift plot.
+//! the library's ([`afmdyn::request::FmRequest`], [`afmdyn::analysis::fm`]), and so are its
+//! summary, `fm.csv`, `fm.json` and the frequency-shift figure
+//! ([`afmdyn::request::present::fm`]); this front end maps the flags.
 
 use crate::args::{quantity, Dim, ModelArgs, Quantity};
+use crate::cmd_approach::files;
 use crate::cmd_simulate::Files;
+use crate::door;
 use crate::error::CliError;
-use crate::output::{f, si_value, write_csv, write_document, OutDir};
-use crate::plot::{save, Figure, Series, Style};
-use afmdyn::request::fm::{rows, COLUMNS};
+use crate::output::{units_of, OutDir};
+use afmdyn::request::present;
 use afmdyn::request::{self, FmRequest, Resolved};
 use afmdyn::Params;
 use clap::Args;
@@ -71,83 +73,12 @@ pub fn fm(a: &FmArgs) -> Result<(), CliError> {
     };
     let model = Resolved { params, probe };
     request::Analysis::validate(&request, &model)?;
-    let out = match a.files {
-        Files::None => None,
-        _ => Some(OutDir::lock(&a.out)?),
-    };
-    let doc = crate::progress::run(&request, &model, "z_c values")?;
-    let mut json = doc.json;
-    let table = rows(&json);
-    let column = |name: &str| COLUMNS.iter().position(|c| *c == name).unwrap_or(0);
-    if let Some(out) = &out {
-        write_csv(
-            &out.join("fm.csv"),
-            &COLUMNS,
-            table.iter().map(|r| r.iter().map(|v| f(*v)).collect()),
-        )?;
-    }
-    let (x_unit, y_unit) = if si {
-        (" (m)", " (Hz)")
-    } else {
-        (" (g0)", " (Ω)")
-    };
-    let (x, y) = (column("z_c"), column("frequency_shift"));
-    let points: Vec<(f64, f64)> = table.iter().map(|r| (r[x], r[y])).collect();
-    if let (Some(out), Files::All) = (&out, a.files) {
-        save(
-            out.path(),
-            "fm-frequency-shift",
-            &Figure {
-                title: "FM-AFM: frequency shift at constant amplitude".into(),
-                x_label: format!("rest distance z_c{x_unit}"),
-                y_label: format!("frequency shift Δf{y_unit}"),
-                series: vec![Series {
-                    label: String::new(),
-                    points,
-                    style: Style::Line,
-                    color: 0,
-                }],
-                shade: Vec::new(),
-                y_min_span: 0.0,
-            },
-        )?;
-    }
-    if let Some(out) = &out {
-        json["csv"] = serde_json::json!(out.join("fm.csv"));
-        write_document(out, "fm.json", &json)?;
-    }
-    if a.json {
-        outln!("{json}");
-    } else {
-        let value = |v: f64, si_unit: &str, model_unit: &str| {
-            if si {
-                si_value(v, si_unit)
-            } else {
-                format!("{v:e} {model_unit}")
-            }
-        };
-        let (first, last) = (table.first(), table.last());
-        let k = |name: &str| COLUMNS.iter().position(|c| *c == name).unwrap_or(0);
-        let at = |r: Option<&Vec<f64>>, k: usize| r.map_or(f64::NAN, |r| r[k]);
-        outln!(
-            "{} z_c values from {} to {}: Δf from {} to {}, excitation up to {:.4} × the free \
-             one; {} unstable, {} folds; {}",
-            table.len(),
-            value(at(first, k("z_c")), "m", "g0"),
-            value(at(last, k("z_c")), "m", "g0"),
-            value(at(first, k("frequency_shift")), "Hz", "Ω"),
-            value(at(last, k("frequency_shift")), "Hz", "Ω"),
-            table
-                .iter()
-                .map(|r| r[k("excitation")])
-                .fold(f64::NAN, f64::max),
-            table.iter().filter(|r| r[k("stable")] == 0.0).count(),
-            json["folds"].as_array().map_or(0, |v| v.len()),
-            out.as_ref().map_or("no files written".into(), |o| format!(
-                "outputs in {}",
-                o.path().display()
-            ))
-        );
-    }
-    Ok(())
+    let out = (a.files != Files::None)
+        .then(|| OutDir::lock(&a.out))
+        .transpose()?;
+    let mut doc = crate::progress::run(&request, &model, "z_c values")?.json;
+    let units = units_of(model.probe.as_ref());
+    let dir = out.as_ref().map(OutDir::path);
+    let shown = present::fm::fm(&mut doc, units, files(a.files), dir);
+    door::emit(out.as_ref(), &shown, &doc, a.json)
 }

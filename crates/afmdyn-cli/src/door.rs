@@ -7,7 +7,7 @@
 use crate::error::CliError;
 use crate::output::{print_warnings, units_of, write_layout, OutDir};
 use crate::progress;
-use afmdyn::layout::files::{write_bytes, write_csv};
+use afmdyn::layout::files::{write_bytes, write_csv, NpyStream};
 use afmdyn::report::{OutputFile, Presentation};
 use afmdyn::request::{Analysis, Document, Resolved};
 use serde_json::Value;
@@ -71,11 +71,9 @@ pub fn emit(
     if json {
         outln!("{document}");
     } else {
-        for line in &shown.summary {
+        let dir = out.filter(|_| !shown.files.is_empty()).map(OutDir::path);
+        for line in shown.summary_with(dir) {
             outln!("{line}");
-        }
-        if let Some(out) = out.filter(|_| !shown.files.is_empty()) {
-            outln!("outputs in {}", out.path().display());
         }
     }
     Ok(())
@@ -93,6 +91,17 @@ pub fn write_file(out: &OutDir, file: &OutputFile) -> Result<(), CliError> {
         }
         OutputFile::Dataset { name, layout } => write_layout(&out.join(name), layout)?,
         OutputFile::Figure { stem, plot } => crate::plot::save_plot(out.path(), stem, plot)?,
+        OutputFile::Npy {
+            name,
+            columns,
+            rows,
+        } => {
+            let mut npy = NpyStream::create(&out.join(name), columns.clone())?;
+            for r in rows {
+                npy.push(r)?;
+            }
+            npy.finish()?;
+        }
         OutputFile::Json { name, value } => write_bytes(
             &out.join(name),
             serde_json::to_string_pretty(value)

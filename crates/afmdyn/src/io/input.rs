@@ -390,6 +390,15 @@ pub enum InputFileError {
         /// What the file was read as ([`InputKind::name`]).
         kind: &'static str,
     },
+    /// The file's content is not what its kind holds (a curve CSV's field that is not a
+    /// number, a curve document that is not JSON).
+    #[error("{path}: {message}")]
+    Invalid {
+        /// The file.
+        path: String,
+        /// What is wrong with it.
+        message: String,
+    },
     /// The file is not UTF-8 text.
     #[error("{path}: not UTF-8 text (invalid byte after {offset} bytes)")]
     NotText {

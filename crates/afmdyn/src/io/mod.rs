@@ -8,6 +8,8 @@
 
 pub mod caps;
 #[cfg(feature = "files")]
+pub mod curve_file;
+#[cfg(feature = "files")]
 pub mod dir_lock;
 pub mod height_map;
 pub mod input;

@@ -18,6 +18,21 @@ pub struct Presentation {
     pub summary: Vec<String>,
     /// The files, written in this order.
     pub files: Vec<OutputFile>,
+    /// Where a front end that writes the files into a directory says so in the summary.
+    pub outputs_note: OutputsNote,
+}
+
+/// Where the summary of a front end that writes files into a directory names it
+/// ([`Presentation::summary_with`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum OutputsNote {
+    /// `outputs in DIR` on a line of its own after the summary (the default).
+    #[default]
+    End,
+    /// `outputs in DIR` on a line of its own after the first `n` summary lines.
+    After(usize),
+    /// At the end of the last summary line: `; outputs in DIR`, or `; no files written`.
+    Tail,
 }
 
 /// One output file of a result (its name relative to the output directory).
@@ -45,6 +60,17 @@ pub enum OutputFile {
         stem: String,
         /// The figure as data.
         plot: Plot,
+    },
+    /// A 2-D float64 NPY array (`approach.npy`) and its header file (`approach.npy.json`:
+    /// shape, dtype, each column's name, unit and meaning).
+    #[cfg(feature = "files")]
+    Npy {
+        /// File name.
+        name: String,
+        /// The columns.
+        columns: Vec<crate::layout::files::Column>,
+        /// Rows, each as many values as the columns.
+        rows: Vec<Vec<f64>>,
     },
     /// A JSON document written pretty (`image.json`).
     Json {
@@ -94,8 +120,29 @@ impl Presentation {
                 OutputFile::Figure { stem, .. } => {
                     vec![format!("{stem}.png"), format!("{stem}.svg")]
                 }
+                #[cfg(feature = "files")]
+                OutputFile::Npy { name, .. } => vec![name.clone(), format!("{name}.json")],
             })
             .collect()
+    }
+    /// The summary as a front end prints it that wrote the files into `dir` (none: no files
+    /// written), naming the directory where [`Presentation::outputs_note`] says.
+    pub fn summary_with(&self, dir: Option<&std::path::Path>) -> Vec<String> {
+        let mut lines = self.summary.clone();
+        let named = dir.map(|d| format!("outputs in {}", d.display()));
+        match (self.outputs_note, named) {
+            (OutputsNote::Tail, named) => {
+                let tail = named.unwrap_or_else(|| "no files written".into());
+                match lines.last_mut() {
+                    Some(last) => *last = format!("{last}; {tail}"),
+                    None => lines.push(tail),
+                }
+            }
+            (OutputsNote::End, Some(named)) => lines.push(named),
+            (OutputsNote::After(n), Some(named)) => lines.insert(n.min(lines.len()), named),
+            (_, None) => {}
+        }
+        lines
     }
 }
 
@@ -201,7 +248,25 @@ impl TextUnits {
 
 #[cfg(test)]
 mod tests {
-    use super::si_value;
+    use super::{si_value, OutputsNote, Presentation};
+
+    /// The output directory is named where the presentation says: on its own line at the end
+    /// or after a number of lines, or at the end of the last line ("no files written" without
+    /// a directory).
+    #[test]
+    fn the_summary_names_the_directory_where_asked() {
+        let dir = std::path::Path::new("out");
+        let mut p = Presentation::default();
+        p.line("a");
+        p.line("b");
+        assert_eq!(p.summary_with(Some(dir)), ["a", "b", "outputs in out"]);
+        assert_eq!(p.summary_with(None), ["a", "b"]);
+        p.outputs_note = OutputsNote::After(1);
+        assert_eq!(p.summary_with(Some(dir)), ["a", "outputs in out", "b"]);
+        p.outputs_note = OutputsNote::Tail;
+        assert_eq!(p.summary_with(Some(dir)), ["a", "b; outputs in out"]);
+        assert_eq!(p.summary_with(None), ["a", "b; no files written"]);
+    }
 
     /// SI prefixes with 6 significant digits; plain SI without.
     #[test]

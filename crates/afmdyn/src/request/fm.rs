@@ -235,6 +235,17 @@ impl Analysis for FmRequest {
     fn report(&self, model: &Resolved, curve: &FmCurve) -> Result<Value, SimError> {
         Ok(document(self, model, curve))
     }
+    fn present(
+        &self,
+        _: &Resolved,
+        _: &FmCurve,
+        document: &Value,
+        units: crate::report::TextUnits,
+    ) -> Result<crate::report::Presentation, SimError> {
+        let mut document = document.clone();
+        let files = super::present::Files::All;
+        Ok(super::present::fm::fm(&mut document, units, files, None))
+    }
     fn largest_indentation(&self, curve: &FmCurve) -> Option<f64> {
         let d = curve.points.iter().map(|q| q.observables.indentation);
         Some(d.filter(|d| d.is_finite()).fold(0.0, f64::max))

@@ -278,6 +278,20 @@ impl Analysis for ReconstructRequest {
     fn report(&self, _: &Resolved, r: &Reconstruction) -> Result<Value, SimError> {
         Ok(document(self, r))
     }
+    fn present(
+        &self,
+        _: &Resolved,
+        r: &Reconstruction,
+        document: &Value,
+        units: crate::report::TextUnits,
+    ) -> Result<crate::report::Presentation, SimError> {
+        use super::present::reconstruct::{reconstruction, Inversion};
+        let files = (super::present::Files::All, None);
+        let law = self.law_in_order();
+        let mut document = document.clone();
+        let how = Inversion::SaderJarvis;
+        Ok(reconstruction(r, how, law, &mut document, units, files))
+    }
 }
 
 /// The document of a reconstruction (`afmdyn reconstruct --json`): `force` (`distance` (m),

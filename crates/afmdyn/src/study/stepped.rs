@@ -23,6 +23,7 @@ use crate::params::Params;
 use crate::report;
 use crate::request::costs::{check_cost, stepped_cost};
 use crate::request::limits::Cost;
+use crate::request::present::curves::{stepped, CurveKind, CurveOptions};
 use crate::request::run::{Analysis, ApproachRequest, Resolved, ResonanceRequest};
 use serde::Serialize;
 use serde_json::{json, Value};
@@ -153,6 +154,23 @@ impl Study for CurveStudy {
     }
 }
 
+/// [`Analysis::present`] of a stepped curve of kind `$kind`: its presentation
+/// ([`crate::request::present::curves::stepped`]) with every file, named as the request.
+macro_rules! present_curve {
+    ($kind:expr) => {
+        fn present(
+            &self,
+            model: &Resolved,
+            c: &Self::Output,
+            document: &Value,
+            units: report::TextUnits,
+        ) -> Result<report::Presentation, SimError> {
+            let options = CurveOptions::all(self.name());
+            Ok(stepped($kind, model, c, document, units, &options))
+        }
+    };
+}
+
 impl Analysis for ApproachRequest {
     type Output = SteppedCurve;
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
@@ -187,6 +205,7 @@ impl Analysis for ApproachRequest {
     fn largest_indentation(&self, c: &Self::Output) -> Option<f64> {
         Some(c.largest_indentation())
     }
+    present_curve!(CurveKind::Approach);
 }
 
 impl Analysis for ResonanceRequest {
@@ -216,6 +235,7 @@ impl Analysis for ResonanceRequest {
     fn largest_indentation(&self, c: &Self::Output) -> Option<f64> {
         Some(c.largest_indentation())
     }
+    present_curve!(CurveKind::Resonance);
 }
 
 /// The resumable store of a stepped curve (feature `files`): a

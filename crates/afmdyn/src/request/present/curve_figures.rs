@@ -1,8 +1,12 @@
 //! The figures of a stepped curve (amplitude, phase, peak force, virial, dissipation against the
-//! swept quantity, with branches and folds) and its force–distance traces
-//! (`STEM-traces.nc`, `STEM-traces` plots).
+//! swept quantity, with branches and folds) and of its force–distance traces, as data.
 
-use super::*;
+use super::curves::{Labels, Shown};
+use crate::analysis::continuation::BranchEvent;
+use crate::analysis::observables::Observables;
+use crate::analysis::stepped::Sweep;
+use crate::layout::figure::{Figure, Plot, Series, Style};
+use crate::report::{component_columns, component_row, curve_column_index, curve_row, CurveUnits};
 
 /// Where a plotted value comes from: a CURVE_COLUMNS index, or an index into the drive
 /// components' columns (`component_row`).
@@ -20,13 +24,13 @@ fn col(o: &Observables, u: &CurveUnits, k: Key) -> f64 {
     }
 }
 
-pub(super) fn plots(
-    out: &OutDir,
-    c: &SteppedCurve,
-    x: &dyn Fn(f64) -> f64,
-    u: &CurveUnits,
-    l: &Labels,
-) -> Result<(), CliError> {
+/// The figures of a curve against its swept quantity, each with its stem: amplitude, phase,
+/// dissipation, virial, peak force, each drive component's amplitude and phase, the higher
+/// modes' share; the sweeps, the continued branches (unstable dotted), jumps and folds, the
+/// bistable ranges shaded.
+pub(crate) fn panels(s: &Shown<'_>) -> Vec<(String, Plot)> {
+    let (c, x, u, l) = (s.c, s.x, s.u, s.l);
+    let mut figures = Vec::new();
     let unit = |base: &str| {
         if u.si {
             base.to_string()
@@ -188,10 +192,9 @@ pub(super) fn plots(
                 color: 4,
             });
         }
-        save(
-            out.path(),
-            &format!("{}-{suffix}", l.stem),
-            &Figure {
+        figures.push((
+            format!("{}-{suffix}", l.stem),
+            Plot::Lines(Figure {
                 // energies and forces below 1e-6 of the model's units are round-off (a
                 // conservative law's E_dis): drawn as zero on an axis of that extent
                 y_min_span: match name {
@@ -211,85 +214,23 @@ pub(super) fn plots(
                         (p.min(q), p.max(q))
                     })
                     .collect(),
-            },
-        )?;
+            }),
+        ));
     }
-    Ok(())
+    figures
 }
 
-/// `STEM-traces.nc` (NetCDF 3: deflection, distance, force over (point, time), the swept
-/// quantity and the time axis in drive periods) and, with plots, `STEM-traces`: the
-/// force–distance loops of up to 8 points spread over the sweep.
-pub(super) fn write_traces(
-    out: &OutDir,
-    files: Files,
-    t: &afmdyn::analysis::traces::Traces,
-    x: &dyn Fn(f64) -> f64,
-    units: &CurveUnits,
-    labels: &Labels,
-) -> Result<(), CliError> {
-    let path = out.join(format!("{}-traces.nc", labels.stem));
-    let (np, ns) = (t.values.len(), t.time.len());
-    let xs: Vec<f64> = t.values.iter().map(|&v| x(v)).collect();
-    let scale = |v: &[f64], s: f64| v.iter().map(|a| a * s).collect::<Vec<f64>>();
-    let (length, force) = if units.si { ("m", "N") } else { ("g0", "F~") };
-    let (deflection, distance, force_values) = (
-        scale(&t.deflection, units.length),
-        scale(&t.distance, units.length),
-        scale(&t.force, units.force),
-    );
-    let grid: &[&str] = &["point", "time"];
-    let vars = vec![
-        Variable::f64(
-            labels.x_name,
-            &["point"],
-            labels.x_unit.unwrap_or("1"),
-            labels.x_text,
-            &xs,
-        ),
-        Variable::f64(
-            "time",
-            &["time"],
-            "drive periods",
-            "time within the cycle",
-            &t.time,
-        ),
-        Variable::f64(
-            "deflection",
-            grid,
-            length,
-            "tip deflection W(1,tau)",
-            &deflection,
-        ),
-        Variable::f64(
-            "distance",
-            grid,
-            length,
-            "tip-sample distance V_T (<= 0 in contact)",
-            &distance,
-        ),
-        Variable::f64(
-            "force",
-            grid,
-            force,
-            "tip-sample force F_c (> 0 repulsive, < 0 attractive)",
-            &force_values,
-        ),
-    ];
-    crate::output::write_layout(
-        &path,
-        &Layout::new(
-            format!(
-                "afmdyn {} traces: one steady-state cycle per point of the {}",
-                labels.stem, labels.sweeps.0
-            ),
-            &[("point", np), ("time", ns)],
-            vars,
-        ),
-    )?;
-    if files != Files::All || np == 0 {
-        return Ok(());
-    }
+/// The force–distance loops of up to 8 of the traces' `xs` spread over the sweep (`distance`
+/// and `force` over (point, time), `ns` samples a cycle; in the units `length` and `force`).
+pub(crate) fn traces_figure(
+    l: &Labels,
+    xs: &[f64],
+    distance: &[f64],
+    force_values: &[f64],
+    ns: usize,
+    (length, force): (&str, &str),
+) -> Plot {
+    let np = xs.len();
     let picks: Vec<usize> = if np <= 8 {
         (0..np).collect()
     } else {
@@ -301,9 +242,9 @@ pub(super) fn write_traces(
         .map(|(c, &i)| Series {
             label: format!(
                 "{} = {}",
-                labels.x_text,
-                match labels.x_unit {
-                    Some(u) => si_value(xs[i], u),
+                l.x_text,
+                match l.x_unit {
+                    Some(u) => l.text.value(xs[i], u),
                     None => format!("{:.4}", xs[i]),
                 }
             ),
@@ -314,20 +255,15 @@ pub(super) fn write_traces(
             color: c,
         })
         .collect();
-    save(
-        out.path(),
-        &format!("{}-traces", labels.stem),
-        &Figure {
-            y_min_span: 0.0,
-            title: format!(
-                "Force–distance loops over one cycle ({}; the loop's area is E_dis)",
-                labels.sweeps.0
-            ),
-            x_label: format!("tip–sample distance V_T ({length})"),
-            y_label: format!("tip–sample force ({force})"),
-            series,
-            shade: vec![],
-        },
-    )?;
-    Ok(())
+    Plot::Lines(Figure {
+        y_min_span: 0.0,
+        title: format!(
+            "Force–distance loops over one cycle ({}; the loop's area is E_dis)",
+            l.sweeps.0
+        ),
+        x_label: format!("tip–sample distance V_T ({length})"),
+        y_label: format!("tip–sample force ({force})"),
+        series,
+        shade: vec![],
+    })
 }
