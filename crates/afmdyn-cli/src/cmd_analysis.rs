@@ -1,17 +1,16 @@
 //! `afmdyn bifurcation` and `afmdyn attractors`.
 
 use crate::args::{IntegratorArgs, ModelArgs};
-use crate::error::CliError;
+use crate::error::{store_error, study_error, CliError};
 use crate::output::{io_error, units_of, OutDir};
 use crate::plot::{save_scatter_stream, ChunkSink};
-use afmdyn::request::checkpoint::CheckpointError;
 use afmdyn::request::present::census::failed_starts;
 use afmdyn::request::present::sweeps::{
     branch_legend, diagram_point, SweepRow, SweepTally, BIFURCATION_FIGURES,
 };
 use afmdyn::request::Analysis;
 use afmdyn::request::{
-    AttractorsRequest, BifurcationRequest, FileCheckpoint, GlobalContinuationRequest, SteadyRequest,
+    AttractorsRequest, BifurcationRequest, FileCheckpoint, GlobalContinuationRequest,
 };
 use afmdyn::request::{Document, Resolved};
 use afmdyn::study::global_continuation::{continuation_store, ContinuationStudy};
@@ -21,32 +20,8 @@ use clap::Args;
 use serde_json::json;
 use std::path::{Path, PathBuf};
 
-/// Steady-state flags.
-#[derive(Debug, Clone, Args)]
-pub struct SteadyArgs {
-    /// Relative tolerance for returns of the stroboscopic map to coincide
-    #[arg(long, default_value_t = SteadyRequest::default().tol)]
-    tol: f64,
-    /// Cap on the transient, in drive periods [default: derived from the model's slowest free
-    /// decay: six times the periods it takes to decay by --tol, at least 1500; ≈ 1.9 Q
-    /// ln(1/tol) for a lever of quality factor Q]
-    #[arg(long)]
-    max_periods: Option<usize>,
-    /// Largest period searched (≤ 64)
-    #[arg(long, default_value_t = SteadyRequest::default().max_period)]
-    max_period: usize,
-}
-
-impl SteadyArgs {
-    /// The library's request ([`SteadyRequest::options`] validates it).
-    pub fn request(&self) -> SteadyRequest {
-        SteadyRequest {
-            tol: self.tol,
-            max_periods: self.max_periods,
-            max_period: self.max_period,
-        }
-    }
-}
+/// The steady-state flags (shared with `basins`, `chart`, `orbit`, …).
+pub use crate::args::SteadyArgs;
 
 /// `afmdyn bifurcation` flags.
 #[derive(Debug, Args)]
@@ -98,32 +73,6 @@ pub struct BifurcationArgs {
 
 /// Column positions in the library's sweep records (also read by `afmdyn continue --overlay`).
 pub(crate) use afmdyn::request::sweep::{COL_VALUE, COL_W_TIP};
-
-/// The command line's message for a checkpoint error (`--resume` names the flag) of a store of
-/// `what` (`sweep`, `chart`) results.
-pub(crate) fn store_error(e: CheckpointError, what: &str) -> CliError {
-    match e {
-        CheckpointError::Io { .. } => CliError::Io(e.to_string()),
-        CheckpointError::Mismatch { field, then, now } => CliError::Input(format!(
-            "--resume: {} = {then} in the interrupted run, {now} now; rerun with the same \
-             arguments, or without --resume to start over",
-            field.replace('_', "-")
-        )),
-        CheckpointError::Unrecorded { store, ledger } => CliError::Input(format!(
-            "--resume: {store} has {what} results but no record of the arguments that made them \
-             ({ledger} is missing); rerun without --resume to start over"
-        )),
-        CheckpointError::Corrupt { .. } => CliError::Input(e.to_string()),
-    }
-}
-
-/// The command line's message for a study that stopped ([`store_error`] for its store).
-pub(crate) fn study_error(e: afmdyn::study::StudyError, what: &str) -> CliError {
-    match e {
-        afmdyn::study::StudyError::Store(e) => store_error(e, what),
-        afmdyn::study::StudyError::Sim(e) => CliError::Sim(e),
-    }
-}
 
 /// Each row of the store's CSV `path`, read back through the bounded reader as a store file.
 fn read_rows(

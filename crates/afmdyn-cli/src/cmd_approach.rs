@@ -350,10 +350,10 @@ impl Run<'_> {
                     "points",
                     self.args.abort_after,
                 )
-                .map_err(|e| crate::cmd_analysis::study_error(e, what))?;
+                .map_err(|e| crate::error::study_error(e, what))?;
                 let records = store
                     .records()
-                    .map_err(|e| crate::cmd_analysis::store_error(e, what))?;
+                    .map_err(|e| crate::error::store_error(e, what))?;
                 let c = crate::progress::with_bar("branch points", |p| study.curve(records, p))?;
                 let json = afmdyn::request::run::document(request, model, &c)?;
                 (c, json)
