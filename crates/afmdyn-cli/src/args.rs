@@ -4,7 +4,7 @@
 use crate::error::CliError;
 use afmdyn::integrate::IntegratorKind;
 use afmdyn::io::InputKind;
-use afmdyn::request::{IntegratorRequest, ModelSpec};
+use afmdyn::request::{IntegratorRequest, ModelSpec, SteadyRequest};
 use afmdyn::{LawKind, Params};
 use clap::Args;
 use serde::Deserialize;
@@ -444,5 +444,32 @@ mod quantity_tests {
         assert_eq!(q("5µm").value, 5e-6);
         assert!("7 parsecs".parse::<Quantity>().is_err());
         assert!("nm".parse::<Quantity>().is_err());
+    }
+}
+
+/// Steady-state flags.
+#[derive(Debug, Clone, Args)]
+pub struct SteadyArgs {
+    /// Relative tolerance for returns of the stroboscopic map to coincide
+    #[arg(long, default_value_t = SteadyRequest::default().tol)]
+    tol: f64,
+    /// Cap on the transient, in drive periods [default: derived from the model's slowest free
+    /// decay: six times the periods it takes to decay by --tol, at least 1500; ≈ 1.9 Q
+    /// ln(1/tol) for a lever of quality factor Q]
+    #[arg(long)]
+    max_periods: Option<usize>,
+    /// Largest period searched (≤ 64)
+    #[arg(long, default_value_t = SteadyRequest::default().max_period)]
+    max_period: usize,
+}
+
+impl SteadyArgs {
+    /// The library's request ([`SteadyRequest::options`] validates it).
+    pub fn request(&self) -> SteadyRequest {
+        SteadyRequest {
+            tol: self.tol,
+            max_periods: self.max_periods,
+            max_period: self.max_period,
+        }
     }
 }

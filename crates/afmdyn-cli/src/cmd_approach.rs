@@ -216,10 +216,10 @@ fn go<A: Analysis<Output = SteppedCurve>>(
                 "points",
                 args.abort_after,
             )
-            .map_err(|e| crate::cmd_analysis::study_error(e, stem))?;
+            .map_err(|e| crate::error::study_error(e, stem))?;
             let records = store
                 .records()
-                .map_err(|e| crate::cmd_analysis::store_error(e, stem))?;
+                .map_err(|e| crate::error::store_error(e, stem))?;
             let c = crate::progress::with_bar("branch points", |p| study.curve(records, p))?;
             let json = afmdyn::request::run::document(request, model, &c)?;
             (c, json)

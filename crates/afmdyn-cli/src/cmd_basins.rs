@@ -121,7 +121,7 @@ pub fn basins_cmd(a: &BasinsArgs) -> Result<(), CliError> {
     let study = BasinStudy::new(&request, &p)?;
     let out = OutDir::lock(&a.out)?;
     let mut store = basin_store(out.dir_lock());
-    let failed = |e| crate::cmd_analysis::study_error(e, "basins");
+    let failed = |e| crate::error::study_error(e, "basins");
     crate::progress::study(
         &study,
         &mut store,
@@ -133,7 +133,7 @@ pub fn basins_cmd(a: &BasinsArgs) -> Result<(), CliError> {
     .map_err(failed)?;
     let rows = store
         .records()
-        .map_err(|e| crate::cmd_analysis::store_error(e, "basins"))?;
+        .map_err(|e| crate::error::store_error(e, "basins"))?;
     let map = afmdyn::request::in_pool(a.threads, || study.map(rows.into_iter().map(|(_, r)| r)))?;
     let (spec, model) = (&study.spec, &study.model);
     let resolved = Resolved { params: p, probe };

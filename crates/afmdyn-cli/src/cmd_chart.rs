@@ -97,7 +97,7 @@ pub struct ChartArgs {
 }
 
 fn store_error(e: CheckpointError) -> CliError {
-    crate::cmd_analysis::store_error(e, "chart")
+    crate::error::store_error(e, "chart")
 }
 
 /// The label of an axis: symbol, name and unit.
@@ -230,7 +230,7 @@ pub fn chart(a: &ChartArgs) -> Result<(), CliError> {
         "cells",
         a.abort_after,
     )
-    .map_err(|e| crate::cmd_analysis::study_error(e, "chart"))?;
+    .map_err(|e| crate::error::study_error(e, "chart"))?;
     let cells = cells(&mut store).map_err(store_error)?;
     let arrays = ChartArrays::new(&chart, &cells);
     write_csv(&out.join("chart.csv"), &chart, &cells)?;

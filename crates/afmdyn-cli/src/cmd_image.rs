@@ -402,10 +402,10 @@ fn pi_cmd(
         "lines",
         a.abort_after,
     )
-    .map_err(|e| crate::cmd_analysis::study_error(e, "image"))?;
+    .map_err(|e| crate::error::study_error(e, "image"))?;
     let records = store
         .records()
-        .map_err(|e| crate::cmd_analysis::store_error(e, "image"))?;
+        .map_err(|e| crate::error::store_error(e, "image"))?;
     let img = study.assemble(records)?;
     let json = img.document(a.setpoint);
     write_document(&out, "image.json", &json)?;

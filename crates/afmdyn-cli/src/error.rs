@@ -1,5 +1,6 @@
 //! CLI errors: bad input (exit code 2) or failures while running (exit code 1).
 
+use afmdyn::request::checkpoint::CheckpointError;
 use thiserror::Error;
 
 /// What can go wrong in a command.
@@ -78,6 +79,32 @@ impl CliError {
             CliError::Io(_) => 1,
             CliError::Interrupted => 130,
         }
+    }
+}
+
+/// The command line's message for a checkpoint error (`--resume` names the flag) of a store of
+/// `what` (`sweep`, `chart`) results.
+pub(crate) fn store_error(e: CheckpointError, what: &str) -> CliError {
+    match e {
+        CheckpointError::Io { .. } => CliError::Io(e.to_string()),
+        CheckpointError::Mismatch { field, then, now } => CliError::Input(format!(
+            "--resume: {} = {then} in the interrupted run, {now} now; rerun with the same \
+             arguments, or without --resume to start over",
+            field.replace('_', "-")
+        )),
+        CheckpointError::Unrecorded { store, ledger } => CliError::Input(format!(
+            "--resume: {store} has {what} results but no record of the arguments that made them \
+             ({ledger} is missing); rerun without --resume to start over"
+        )),
+        CheckpointError::Corrupt { .. } => CliError::Input(e.to_string()),
+    }
+}
+
+/// The command line's message for a study that stopped ([`store_error`] for its store).
+pub(crate) fn study_error(e: afmdyn::study::StudyError, what: &str) -> CliError {
+    match e {
+        afmdyn::study::StudyError::Store(e) => store_error(e, what),
+        afmdyn::study::StudyError::Sim(e) => CliError::Sim(e),
     }
 }
 

@@ -7,7 +7,7 @@ use afmdyn::request::{DirLock, LockError};
 use std::fmt::Display;
 use std::path::{Path, PathBuf};
 
-pub use afmdyn::layout::files::{f, write_bytes, write_csv, write_csv_numbers};
+pub use afmdyn::layout::files::{f, write_bytes, write_csv};
 
 /// An I/O failure on `path`, as one readable line ("cannot write DIR/x.csv: No space left on
 /// device"): the library's [`afmdyn::layout::files::io_error`].

@@ -36,6 +36,10 @@ fn draw(progress: &Progress, finished: &AtomicBool, unit: &'static str) {
     let mut bar: Option<(ProgressBar, bool)> = None;
     while !finished.load(Ordering::Relaxed) {
         std::thread::park_timeout(Duration::from_millis(100));
+        // a signal caught for a run that cleans up (`simulate`) cancels it
+        if crate::error::interrupted().is_err() {
+            progress.cancel();
+        }
         if start.elapsed() < Duration::from_secs(1) || finished.load(Ordering::Relaxed) {
             continue;
         }

@@ -251,10 +251,6 @@ fn bounds(fig: &Figure) -> (f64, f64, f64, f64) {
     padded(b, 0.03)
 }
 
-/// A pixel column of a monotone line: column, (first, lowest, highest, last) point, and the
-/// position of each in the input.
-type PixelColumn = (i32, [(f64, f64); 4], [usize; 4]);
-
 /// Merge shaded x-intervals whose pixel columns touch.
 fn merge_shade(shade: &[(f64, f64)], px: impl Fn(f64) -> i32) -> Vec<(f64, f64)> {
     let mut out: Vec<(f64, f64, i32)> = Vec::new();

@@ -285,6 +285,9 @@ pub enum SimError {
         /// The crate's message.
         message: String,
     },
+    /// A file of the run could not be written (the message names it).
+    #[error("{0}")]
+    File(String),
     /// A run would exceed a documented memory or work budget; refused before allocating.
     #[error("{what}: {needed} exceeds the budget of {budget} ({hint})")]
     Budget {
@@ -297,6 +300,20 @@ pub enum SimError {
         /// How to stay within it.
         hint: &'static str,
     },
+}
+
+#[cfg(feature = "files")]
+impl From<crate::layout::files::FileError> for SimError {
+    fn from(e: crate::layout::files::FileError) -> Self {
+        SimError::File(e.0)
+    }
+}
+
+#[cfg(feature = "files")]
+impl From<crate::io::dir_lock::LockError> for SimError {
+    fn from(e: crate::io::dir_lock::LockError) -> Self {
+        SimError::File(e.to_string())
+    }
 }
 
 impl SimError {

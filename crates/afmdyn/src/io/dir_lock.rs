@@ -129,16 +129,7 @@ impl DirLock {
     /// # Errors
     /// [`LockError::Io`] naming a file that exists but cannot be removed.
     pub fn remove_partials(&self, outputs: &[&str]) -> Result<Vec<PathBuf>, LockError> {
-        let mut removed = Vec::new();
-        for name in outputs {
-            let tmp = partial_path(&self.dir.join(name));
-            match fs::remove_file(&tmp) {
-                Ok(()) => removed.push(tmp),
-                Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
-                Err(e) => return Err(io("remove", &tmp)(e)),
-            }
-        }
-        Ok(removed)
+        remove_partials_in(&self.dir, outputs)
     }
 
     /// Whether the lock is held (false on a file system without advisory locks, where the
@@ -146,6 +137,24 @@ impl DirLock {
     pub fn is_locked(&self) -> bool {
         self.locked
     }
+}
+
+/// [`DirLock::remove_partials`] in `dir`, for a writer that holds no [`DirLock`] itself (its
+/// caller holds the directory's lock).
+///
+/// # Errors
+/// [`LockError::Io`] naming a file that exists but cannot be removed.
+pub fn remove_partials_in(dir: &Path, outputs: &[&str]) -> Result<Vec<PathBuf>, LockError> {
+    let mut removed = Vec::new();
+    for name in outputs {
+        let tmp = partial_path(&dir.join(name));
+        match fs::remove_file(&tmp) {
+            Ok(()) => removed.push(tmp),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+            Err(e) => return Err(io("remove", &tmp)(e)),
+        }
+    }
+    Ok(removed)
 }
 
 #[cfg(test)]

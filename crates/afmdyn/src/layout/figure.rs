@@ -148,3 +148,58 @@ pub enum Plot {
     /// An AFM image with its colour bar.
     Image(AfmImage),
 }
+
+/// A pixel column of a monotone line: column, (first, lowest, highest, last) point, and the
+/// position of each in the input.
+type PixelColumn = (i32, [(f64, f64); 4], [usize; 4]);
+
+/// The pixel columns of a line monotone in x, point by point: per column its first, lowest,
+/// highest and last point, written out (in their order, each once) when the next column
+/// starts — the monotone case of the plotting module's `decimate_line`, also streamed by a
+/// caller that gathers a long line (`simulate`'s plots, [`crate::request::simulate_stream`]).
+#[derive(Debug, Clone, Default)]
+pub struct PixelColumns {
+    /// The open column.
+    col: Option<PixelColumn>,
+    k: usize,
+}
+
+impl PixelColumns {
+    /// Add the finite point `q` of pixel column `cx` (columns non-decreasing), writing the
+    /// column before into `out` when `cx` starts a new one.
+    #[inline]
+    pub fn push(&mut self, cx: i32, q: (f64, f64), out: &mut Vec<(f64, f64)>) {
+        self.k += 1;
+        let k = self.k;
+        match &mut self.col {
+            Some((c, p, order)) if *c == cx => {
+                if q.1 < p[1].1 {
+                    (p[1], order[1]) = (q, k);
+                }
+                if q.1 > p[2].1 {
+                    (p[2], order[2]) = (q, k);
+                }
+                (p[3], order[3]) = (q, k);
+            }
+            _ => {
+                self.flush(out);
+                self.col = Some((cx, [q; 4], [k; 4]));
+            }
+        }
+    }
+
+    /// Write the open column into `out`.
+    pub fn flush(&mut self, out: &mut Vec<(f64, f64)>) {
+        if let Some((_, p, order)) = self.col.take() {
+            let mut idx = [0usize, 1, 2, 3];
+            idx.sort_by_key(|&i| order[i]);
+            let mut last = None;
+            for i in idx {
+                if last != Some(order[i]) {
+                    out.push(p[i]);
+                    last = Some(order[i]);
+                }
+            }
+        }
+    }
+}

@@ -127,3 +127,65 @@ fn initial_states() {
         );
     }
 }
+
+/// Issue 59: `simulate` (streamed to files) and `bifurcation` enter through the one door, so
+/// a request beyond the budgets is refused by its cost before any work (nothing counted),
+/// naming the request; the same requests within the budgets are admitted.
+#[cfg(feature = "files")]
+#[test]
+fn simulate_and_bifurcation_beyond_the_budget_are_refused_before_any_work() {
+    use crate::analysis::progress::Progress;
+    use crate::request::run::{admit, run, Resolved};
+    use crate::request::simulate_stream::SimulateStream;
+    let model = Resolved::plain(Params::default());
+    let refused = |e: SimError| match e {
+        SimError::Budget { what, .. } => what,
+        other => panic!("unexpected {other:?}"),
+    };
+    // a sweep of 1e6 points with a transient cap of 1e5 periods: 3e11 mode-periods
+    let sweep = BifurcationRequest {
+        values: Some(vec![2.6, 2.8]),
+        starts: 499_998,
+        steady: SteadyRequest {
+            max_periods: Some(100_000),
+            ..SteadyRequest::default()
+        },
+        ..BifurcationRequest::default()
+    };
+    let progress = Progress::new();
+    assert_eq!(
+        refused(run(&sweep, &model, &progress).unwrap_err()),
+        "bifurcation"
+    );
+    assert_eq!((progress.done(), progress.total()), (0, None));
+    let small = BifurcationRequest {
+        steps: 7,
+        ..BifurcationRequest::default()
+    };
+    assert!(admit(&small, &model).is_ok());
+    // a run held in one chunk of 1e6 periods of 100 samples: 1e8 samples in memory at once
+    // (within the files' budget on disk, 9.6 GB)
+    let long = SimulateStream {
+        request: SimulateRequest {
+            periods: Some(1e6),
+            samples_per_period: 100,
+            ..SimulateRequest::default()
+        },
+        dir: Some(std::env::temp_dir().join("afmdyn-never-written")),
+        figures: true,
+        csv: false,
+        chunk_periods: Some(1_000_000),
+    };
+    assert_eq!(
+        refused(run(&long, &model, &progress).unwrap_err()),
+        "simulate"
+    );
+    assert_eq!((progress.done(), progress.total()), (0, None));
+    assert!(!long.dir.as_ref().unwrap().exists());
+    // the same run in the default chunks is admitted (its series streamed to the files)
+    let chunked = SimulateStream {
+        chunk_periods: None,
+        ..long
+    };
+    assert!(admit(&chunked, &model).is_ok());
+}

@@ -53,6 +53,8 @@ pub mod run;
 pub mod simulate;
 #[cfg(feature = "files")]
 pub mod simulate_files;
+#[cfg(feature = "files")]
+pub mod simulate_stream;
 pub mod sweep;
 
 pub use analyses::{
@@ -74,7 +76,9 @@ pub use pool::in_pool;
 #[cfg(feature = "parallel")]
 pub use pool::thread_pool;
 pub use reconstruct::ReconstructRequest;
-pub use run::{run, Analysis, ApproachRequest, Document, ModesRequest, Resolved, ResonanceRequest};
+pub use run::{
+    admit, run, Analysis, ApproachRequest, Document, ModesRequest, Resolved, ResonanceRequest,
+};
 pub use sweep::{fingerprint, SweepRecord};
 
 /// The default relative distance within which two Poincaré point sets are one attractor

@@ -1,13 +1,19 @@
 //! The presentations of the requests' results ([`crate::report::Presentation`]): per family
 //! of commands, the text summary, the tables, datasets and figures that every front end
 //! writes as they are. Each [`super::Analysis::present`] calls its function here; a front end
-//! that chooses which files it writes (`--files`, `--dforce-columns`) calls them itself.
+//! that chooses which files it writes (`--files`, `--dforce-columns`), runs a study into its own
+//! store or streams a run to files calls them itself.
 
+#[cfg(feature = "files")]
+pub mod census;
 pub(crate) mod curve_figures;
 pub mod curves;
 pub mod fm;
 pub(crate) mod orbits;
 pub mod reconstruct;
+#[cfg(feature = "files")]
+pub mod simulate;
+pub mod sweeps;
 
 /// Which files a presentation holds (`--files`).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]

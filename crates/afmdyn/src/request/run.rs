@@ -7,12 +7,13 @@
 //! and the studies that run in memory here and resumably in a front end's store — `basins`,
 //! `attractors --sweep`, `approach` and `resonance` (their `Analysis` is beside the study, in
 //! `crate::study::basins`, `crate::study::global_continuation` and `crate::study::stepped`).
-//! The two whose results are streams run through their own entry points, which take the same
-//! [`Progress`]: `simulate` records in chunks to a sink
-//! ([`crate::trajectory::chunked::record_chunked`], budgets by
-//! [`crate::request::analyses::SimulateSpan`]) and `bifurcation` is a study
-//! ([`crate::study::sweep::SweepStudy`]) that [`crate::study::execute`] runs into a
-//! [`crate::request::Checkpoint`].
+//! The two whose results are streams enter through it too: `simulate` streamed to files
+//! ([`crate::request::simulate_stream::SimulateStream`]: recorded in chunks by
+//! [`crate::trajectory::chunked::record_chunked`], its series' bytes held against the files'
+//! budget, [`crate::request::analyses::SimulateSpan`]), and `bifurcation`, whose `execute` is
+//! the in-memory sweep; a front end that runs the sweep resumably into a store of its own
+//! ([`crate::study::sweep::SweepStudy`] into a [`crate::request::Checkpoint`]) checks its cost
+//! first by [`admit`].
 //!
 //! [`Progress`] is the sink of the run's progress and its cancel flag: the analyses count
 //! their units of work in it (random starts, curve and branch points, drive periods, mode
@@ -154,13 +155,24 @@ pub fn run<A: Analysis + ?Sized>(
     progress: &Progress,
 ) -> Result<Document<A::Output>, SimError> {
     progress.check()?;
-    analysis.validate(model)?;
-    check_cost(analysis.name(), analysis.cost(model)?)?;
+    admit(analysis, model)?;
     let output = analysis.execute(model, progress)?;
     Ok(Document {
         json: document(analysis, model, &output)?,
         output,
     })
+}
+
+/// Admit `analysis` on `model` before any work: [`Analysis::validate`], then its
+/// [`Analysis::cost`] held against the budgets ([`check_cost`]) — [`run`]'s first step, and a
+/// front end's for a request it runs itself (a study into its store, a run streamed to files).
+///
+/// # Errors
+/// The request's validation errors; [`SimError::Budget`] naming the request, its cost and the
+/// budget.
+pub fn admit<A: Analysis + ?Sized>(analysis: &A, model: &Resolved) -> Result<(), SimError> {
+    analysis.validate(model)?;
+    check_cost(analysis.name(), analysis.cost(model)?)
 }
 
 /// The document of `analysis`'s `output` on `model`: [`Analysis::report`] with the SI block of
@@ -348,6 +360,16 @@ impl Analysis for AttractorsRequest {
     fn report(&self, model: &Resolved, r: &Self::Output) -> Result<Value, SimError> {
         Ok(report::attractors(&model.params, self.samples, r))
     }
+    #[cfg(feature = "files")]
+    fn present(
+        &self,
+        model: &Resolved,
+        r: &Self::Output,
+        document: &Value,
+        units: report::TextUnits,
+    ) -> Result<report::Presentation, SimError> {
+        super::present::census::attractors(self, &model.params, r, document, units)
+    }
 }
 
 impl Analysis for ObserveRequest {
@@ -403,6 +425,16 @@ impl Analysis for ConvergeRequest {
     }
     fn report(&self, model: &Resolved, runs: &Self::Output) -> Result<Value, SimError> {
         Ok(report::converge(&model.params, runs))
+    }
+    #[cfg(feature = "files")]
+    fn present(
+        &self,
+        model: &Resolved,
+        runs: &Self::Output,
+        _: &Value,
+        _: report::TextUnits,
+    ) -> Result<report::Presentation, SimError> {
+        Ok(super::present::simulate::converge(&model.params, runs))
     }
 }
 

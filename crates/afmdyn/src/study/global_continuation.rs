@@ -151,6 +151,18 @@ impl Analysis for GlobalContinuationRequest {
             steps,
         ))
     }
+    #[cfg(feature = "files")]
+    fn present(
+        &self,
+        _: &Resolved,
+        steps: &Self::Output,
+        document: &Value,
+        _: report::TextUnits,
+    ) -> Result<report::Presentation, SimError> {
+        Ok(crate::request::present::census::global_continuation(
+            self, steps, document,
+        ))
+    }
 }
 
 /// The resumable store of a global continuation (feature `files`): a

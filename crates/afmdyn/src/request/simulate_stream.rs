@@ -1,0 +1,360 @@
+//! `simulate` streamed to files ([`SimulateStream`]): the run is recorded in chunks of whole
+//! periods ([`crate::trajectory::chunked::record_chunked`]) and every chunk is written to the
+//! data files ([`super::simulate_files::SeriesFiles`]) as it comes, while what the plots and
+//! the spectrum need is gathered in bounded memory ([`PlotData`]); memory does not grow with
+//! the length of the run. Its [`Analysis`] checks the series' bytes against the files' budget
+//! ([`SeriesStore::Files`]) and the run's cost before any work; `execute` is the run itself
+//! (it writes the data files into `dir`), `present` the spectrum, the figures and the summary
+//! ([`super::present::simulate`]).
+
+use super::analyses::{initial_state, SeriesStore, SimulateRequest, SimulateSpan};
+use super::costs::{state_bytes, MODEL_BYTES};
+use super::limits::Cost;
+use super::run::{Analysis, Resolved};
+use super::simulate_files::{SeriesFiles, SERIES_FILES};
+use crate::analysis::progress::Progress;
+use crate::analysis::spectrum::SPECTRUM_SAMPLES;
+use crate::error::SimError;
+use crate::integrate::build;
+use crate::layout::figure::PixelColumns;
+use crate::model::CantileverModel;
+use crate::report::{self, SeriesUnits, SimulateSummary};
+use crate::system::Region;
+use crate::trajectory::chunked::{record_chunked, Chunk, ChunkedSpec, CHUNK_SAMPLES};
+use serde_json::{json, Value};
+use std::collections::VecDeque;
+use std::path::PathBuf;
+
+/// Samples kept for the phase portrait (the last ones).
+pub const PHASE_SAMPLES: usize = 50_000;
+/// Drive periods `tip.png` shows (the last ones) when more were recorded; `tip-all.png` then
+/// shows every recorded period (a 50-period chaotic record drawn whole is unreadable).
+pub const TIP_WINDOW_PERIODS: usize = 10;
+/// Pixel columns of the tip plots' grid, on which their lines are decimated as they come.
+const TIP_COLUMNS: f64 = 2000.0;
+
+/// `simulate` with its series streamed to the files of `dir` (none: only the summary).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SimulateStream {
+    /// The run.
+    pub request: SimulateRequest,
+    /// The output directory (locked by the caller); `None`: no files, only the summary.
+    pub dir: Option<PathBuf>,
+    /// Draw the figures (with `dir`).
+    pub figures: bool,
+    /// Also write the time series as CSV (`timeseries.csv`; by default only the NPY file).
+    pub csv: bool,
+    /// Drive periods held in memory at once (testing the streaming; `None`: from the samples).
+    pub chunk_periods: Option<usize>,
+}
+
+/// What a streamed run leaves besides its files: the run's summary, the spectrum's window and
+/// the plots' data.
+#[derive(Debug, Clone)]
+pub struct SimulateRecording {
+    /// The integrator's name.
+    pub integrator: &'static str,
+    /// τ at which recording started.
+    pub transient_tau: f64,
+    /// The run: its end, final state, switchings, sections and energy balance.
+    pub summary: SimulateSummary,
+    /// The last [`SPECTRUM_SAMPLES`] values of W(1,τ) (with files).
+    pub spectrum: Vec<f64>,
+    /// The plots' data (with figures).
+    pub plots: Option<PlotData>,
+}
+
+impl SimulateStream {
+    /// `all` (data and figures), `data` or `none`: the files written.
+    pub fn files(&self) -> &'static str {
+        match (&self.dir, self.figures) {
+            (None, _) => "none",
+            (Some(_), false) => "data",
+            (Some(_), true) => "all",
+        }
+    }
+
+    /// The request validated on `params` for its store: τ, V_T, W, Ẇ, contact, force and the
+    /// 2N modal coordinates per sample, 8 bytes each in the NPY file and up to 24 more in the
+    /// CSV one.
+    fn span(&self, params: &crate::params::Params) -> Result<SimulateSpan, SimError> {
+        let (store, bytes_per_value) = match (&self.dir, self.csv) {
+            (None, _) => (SeriesStore::Nothing, 0.0),
+            (Some(_), true) => (SeriesStore::Files, 8.0 + 24.0),
+            (Some(_), false) => (SeriesStore::Files, 8.0),
+        };
+        self.request
+            .validate(params, store, 6 + 2 * params.modes, bytes_per_value)
+    }
+}
+
+impl Analysis for SimulateStream {
+    type Output = SimulateRecording;
+    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
+        self.span(&model.params)?;
+        self.request.integrator_options()?;
+        let m = CantileverModel::new(&model.params)?;
+        initial_state(&m, self.request.initial.as_deref()).map(|_| ())
+    }
+    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
+        let p = &model.params;
+        let span = self.span(p)?;
+        let m = CantileverModel::new(p)?;
+        let z0 = initial_state(&m, self.request.initial.as_deref())?;
+        let mut integ = build(&m, self.request.integrator_options()?, 0.0, &z0)?;
+        let su = SeriesUnits::new(p, model.probe.as_ref());
+        let mut files = match &self.dir {
+            Some(dir) => {
+                // what a run killed outright left of these files
+                crate::io::dir_lock::remove_partials_in(dir, &SERIES_FILES)?;
+                Some(SeriesFiles::create(dir, p.modes, su, self.csv)?)
+            }
+            None => None,
+        };
+        let spp = self.request.samples_per_period;
+        let (start, end) = (span.transient_tau, span.transient_tau + span.record_tau);
+        let mut plots = (self.figures && files.is_some()).then(|| PlotData::new(start, end, spp));
+        let mut spectrum: VecDeque<f64> = VecDeque::new();
+        let spec = ChunkedSpec {
+            transient_periods: self.request.transient,
+            record_tau: span.record_tau,
+            samples_per_period: if files.is_some() { spp } else { 0 },
+            chunk_periods: self.chunk_periods,
+        };
+        progress.add_total(span.total_periods.ceil() as usize);
+        let each = |c: &Chunk<'_>| -> Result<(), SimError> {
+            // a cancel ends here; the streams' partial files are removed as they are dropped
+            progress.check()?;
+            if let Some(fl) = files.as_mut() {
+                fl.push(&m, c)?;
+                // the spectrum's window: the last SPECTRUM_SAMPLES values of W(1,τ)
+                keep_last(&mut spectrum, SPECTRUM_SAMPLES, c, |s| s[2]);
+            }
+            if let Some(pd) = plots.as_mut() {
+                pd.push(c);
+            }
+            Ok(())
+        };
+        let mut counted = 0;
+        let summary = record_chunked(integ.as_mut(), &spec, each, |done| {
+            let done = done as usize;
+            progress.advance(done.saturating_sub(counted));
+            counted = counted.max(done);
+        })?;
+        if let Some(fl) = files {
+            fl.finish()?;
+        }
+        if let Some(pd) = plots.as_mut() {
+            pd.finish(summary.tau_end);
+        }
+        Ok(SimulateRecording {
+            integrator: integ.name(),
+            transient_tau: span.transient_tau,
+            summary: SimulateSummary {
+                tau_end: summary.tau_end,
+                final_state: summary.final_state.clone().unwrap_or(z0),
+                switchings: summary.switchings,
+                body_contact: summary.body_contact,
+                poincare_points: summary.sections,
+                energy_residual: (summary.residual, summary.relative),
+            },
+            spectrum: spectrum.into(),
+            plots,
+        })
+    }
+    fn name(&self) -> &'static str {
+        "simulate"
+    }
+    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
+        // every period integrated, transient included; in memory one chunk of samples (its
+        // rows and the converted copy, at most CHUNK_SAMPLES of 6 + 2N + m values, or one
+        // period of them) and the plots' windows (the last TIP_WINDOW_PERIODS periods, the
+        // phase portrait's and the spectrum's samples, the decimated lines)
+        let p = &model.params;
+        let span = self.span(p)?;
+        let spp = self.request.samples_per_period as f64;
+        let row = 6.0 * 8.0 + state_bytes(p);
+        let chunk = match self.chunk_periods {
+            Some(n) => n as f64 * spp,
+            None => (CHUNK_SAMPLES as f64).max(spp),
+        };
+        let plots = (TIP_WINDOW_PERIODS as f64 * spp + 1.0) * 32.0
+            + PHASE_SAMPLES as f64 * 24.0
+            + 2.0 * 9.0 * TIP_COLUMNS * 16.0;
+        let kept = match self.dir {
+            Some(_) => 2.0 * chunk * row + SPECTRUM_SAMPLES as f64 * 8.0 + plots,
+            None => 0.0,
+        };
+        Ok(Cost {
+            bytes: MODEL_BYTES + kept,
+            work: span.total_periods * p.modes as f64,
+        })
+    }
+    fn report(&self, model: &Resolved, r: &Self::Output) -> Result<Value, SimError> {
+        let mut doc = report::simulate_summary(&CantileverModel::new(&model.params)?, &r.summary);
+        doc["files"] = json!(self.files());
+        Ok(doc)
+    }
+    fn present(
+        &self,
+        model: &Resolved,
+        r: &Self::Output,
+        _: &Value,
+        _: report::TextUnits,
+    ) -> Result<report::Presentation, SimError> {
+        super::present::simulate::simulate(self, model, r)
+    }
+}
+
+/// Keep in `window` the last `cap` values `of` the samples of chunk `c`.
+fn keep_last<T>(window: &mut VecDeque<T>, cap: usize, c: &Chunk<'_>, of: impl Fn(&[f64]) -> T) {
+    let new = c.samples().len();
+    let keep = new.min(cap);
+    let drop = (window.len() + keep).saturating_sub(cap);
+    window.drain(..drop);
+    window.extend(c.samples().skip(new - keep).map(of));
+}
+
+/// Contact intervals for shading, merged when closer than `min_gap` (bounded memory).
+#[derive(Debug, Clone)]
+pub struct Shade {
+    /// The intervals (τ).
+    pub intervals: Vec<(f64, f64)>,
+    open: Option<f64>,
+    min_gap: f64,
+}
+
+impl Shade {
+    fn push(&mut self, a: f64, b: f64) {
+        match self.intervals.last_mut() {
+            Some(last) if a - last.1 <= self.min_gap => last.1 = last.1.max(b),
+            _ => self.intervals.push((a, b)),
+        }
+    }
+}
+
+/// What the plots need, gathered chunk by chunk in bounded memory.
+#[derive(Debug, Clone)]
+pub struct PlotData {
+    /// The tip line (τ, W(1,τ)), decimated to the pixel columns once long.
+    pub tip: Vec<(f64, f64)>,
+    /// The line (τ, V_T), likewise.
+    pub vt: Vec<(f64, f64)>,
+    /// The open pixel columns of `tip` and `vt` once they are decimated as they come
+    /// (`streaming`: from the first chunk after which they hold more than 8 points a column).
+    tip_cols: PixelColumns,
+    vt_cols: PixelColumns,
+    streaming: bool,
+    /// The recorded span (τ).
+    pub t0: f64,
+    /// See `t0`.
+    pub t1: f64,
+    /// The contact intervals.
+    pub shade: Shade,
+    /// The last [`PHASE_SAMPLES`]: τ, V_T, ∂W(1,τ)/∂τ (dV_T/dτ formed at the end).
+    pub phase: VecDeque<(f64, f64, f64)>,
+    /// The last [`TIP_WINDOW_PERIODS`] periods: τ, W(1,τ), V_T, in contact.
+    pub recent: VecDeque<(f64, f64, f64, bool)>,
+    /// Its capacity (samples).
+    recent_cap: usize,
+}
+
+impl PlotData {
+    fn new(t0: f64, t1: f64, spp: usize) -> Self {
+        PlotData {
+            tip: vec![],
+            vt: vec![],
+            tip_cols: PixelColumns::default(),
+            vt_cols: PixelColumns::default(),
+            streaming: false,
+            t0,
+            t1,
+            shade: Shade {
+                intervals: vec![],
+                open: None,
+                min_gap: (t1 - t0) / 4000.0,
+            },
+            phase: VecDeque::new(),
+            recent: VecDeque::new(),
+            recent_cap: TIP_WINDOW_PERIODS * spp + 1,
+        }
+    }
+
+    /// The pixel column of τ on the tip plots' grid.
+    fn column(&self, x: f64) -> i32 {
+        (((x - self.t0) / (self.t1 - self.t0).max(1e-300)) * TIP_COLUMNS) as i32
+    }
+
+    /// Add a sample (τ, W, V_T) to the tip plots' lines: as it is, or into its pixel column
+    /// once the lines are decimated as they come (the first, lowest, highest and last point
+    /// of every column, [`PixelColumns`]: what decimating the whole line keeps; a non-finite
+    /// value closes the column and is dropped, as there).
+    fn add(&mut self, t: f64, w: f64, v: f64) {
+        if !self.streaming {
+            self.tip.push((t, w));
+            self.vt.push((t, v));
+            return;
+        }
+        let cx = self.column(t);
+        for (q, cols, out) in [
+            ((t, w), &mut self.tip_cols, &mut self.tip),
+            ((t, v), &mut self.vt_cols, &mut self.vt),
+        ] {
+            if q.0.is_finite() && q.1.is_finite() {
+                cols.push(cx, q, out);
+            } else {
+                cols.flush(out);
+            }
+        }
+    }
+
+    /// Gather a chunk: its samples on the lines, the last ones of the phase portrait and the
+    /// tip window, its contact intervals.
+    fn push(&mut self, c: &Chunk<'_>) {
+        for s in c.samples() {
+            self.add(s[0], s[2], s[1]);
+        }
+        // the phase portrait's and the tip window's last samples (only those kept)
+        keep_last(&mut self.phase, PHASE_SAMPLES, c, |s| (s[0], s[1], s[3]));
+        let cap = self.recent_cap;
+        keep_last(&mut self.recent, cap, c, |s| {
+            (s[0], s[2], s[1], s[4] != 0.0)
+        });
+        if let Some(s) = c.samples().next().filter(|s| c.first && s[4] != 0.0) {
+            self.shade.open = Some(s[0]);
+        }
+        for e in c.events() {
+            match e.to {
+                Region::Contact => self.shade.open = Some(e.tau),
+                Region::Free => {
+                    if let Some(t0) = self.shade.open.take() {
+                        self.shade.push(t0, e.tau);
+                    }
+                }
+            }
+        }
+        self.redecimate();
+    }
+
+    /// After a chunk: once the lines hold more than 8 points a pixel column, decimate them
+    /// from then on as the samples come ([`PlotData::add`]).
+    fn redecimate(&mut self) {
+        if self.streaming || self.tip.len() <= 8 * TIP_COLUMNS as usize {
+            return;
+        }
+        self.streaming = true;
+        let (tip, vt) = (std::mem::take(&mut self.tip), std::mem::take(&mut self.vt));
+        for (&(t, w), &(_, v)) in tip.iter().zip(&vt) {
+            self.add(t, w, v);
+        }
+    }
+
+    /// Close the open pixel columns, and a contact interval open at the end `tau_end`.
+    fn finish(&mut self, tau_end: f64) {
+        self.tip_cols.flush(&mut self.tip);
+        self.vt_cols.flush(&mut self.vt);
+        if let Some(t0) = self.shade.open.take() {
+            self.shade.push(t0, tau_end);
+        }
+    }
+}
