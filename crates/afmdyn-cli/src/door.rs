@@ -36,15 +36,30 @@ pub fn run<A: Analysis>(
     model: &Resolved,
     exit: Exit<'_>,
 ) -> Result<Document<A::Output>, CliError> {
+    run_with(request, model, exit, |_| {})
+}
+
+/// [`run`], with `decorate` adding to the presentation before it is written (a front end's
+/// own underlay in a figure).
+///
+/// # Errors
+/// As [`run`].
+pub fn run_with<A: Analysis>(
+    request: &A,
+    model: &Resolved,
+    exit: Exit<'_>,
+    decorate: impl FnOnce(&mut Presentation),
+) -> Result<Document<A::Output>, CliError> {
     request.validate(model)?;
     let out = exit.out.map(OutDir::lock).transpose()?;
     let doc = progress::run(request, model, exit.unit)?;
-    let shown = request.present(
+    let mut shown = request.present(
         model,
         &doc.output,
         &doc.json,
         units_of(model.probe.as_ref()),
     )?;
+    decorate(&mut shown);
     emit(out.as_ref(), &shown, &doc.json, exit.json)?;
     Ok(doc)
 }
@@ -60,23 +75,55 @@ pub fn emit(
     document: &Value,
     json: bool,
 ) -> Result<(), CliError> {
+    emit_as(out, shown, document, json, false)
+}
+
+/// [`emit`]; `inline`: the summary's last line ends with `; outputs in DIR` instead of a line
+/// of its own (the one-line summaries of `chart` and `basins`).
+///
+/// # Errors
+/// As [`emit`].
+pub fn emit_as(
+    out: Option<&OutDir>,
+    shown: &Presentation,
+    document: &Value,
+    json: bool,
+    inline: bool,
+) -> Result<(), CliError> {
     print_warnings(document)?;
     if let Some(out) = out {
-        let names = shown.file_names();
-        out.remove_partials(&names.iter().map(String::as_str).collect::<Vec<_>>())?;
-        for file in &shown.files {
-            write_file(out, file)?;
-        }
+        write_files(out, shown)?;
     }
     if json {
         outln!("{document}");
-    } else {
-        for line in &shown.summary {
-            outln!("{line}");
+        return Ok(());
+    }
+    let outputs = out
+        .filter(|_| !shown.files.is_empty())
+        .map(|o| format!("outputs in {}", o.path().display()));
+    let last = shown.summary.len().saturating_sub(1);
+    for (k, line) in shown.summary.iter().enumerate() {
+        match &outputs {
+            Some(o) if inline && k == last => outln!("{line}; {o}"),
+            _ => outln!("{line}"),
         }
-        if let Some(out) = out.filter(|_| !shown.files.is_empty()) {
-            outln!("outputs in {}", out.path().display());
-        }
+    }
+    if let Some(o) = outputs.filter(|_| !inline) {
+        outln!("{o}");
+    }
+    Ok(())
+}
+
+/// Every file of a presentation written atomically into `out` (their stale temporary files
+/// removed first).
+///
+/// # Errors
+/// [`CliError::Io`] naming a file.
+pub fn write_files(out: &OutDir, shown: &Presentation) -> Result<(), CliError> {
+    let names = shown.file_names();
+    out.remove_partials(&names.iter().map(String::as_str).collect::<Vec<_>>())?;
+    for file in &shown.files {
+        write_file(out, file)?;
     }
     Ok(())
 }
@@ -92,6 +139,7 @@ pub fn write_file(out: &OutDir, file: &OutputFile) -> Result<(), CliError> {
             write_csv(&out.join(name), &header, rows.iter().cloned())?;
         }
         OutputFile::Dataset { name, layout } => write_layout(&out.join(name), layout)?,
+        OutputFile::Text { name, text } => write_bytes(&out.join(name), text.as_bytes())?,
         OutputFile::Figure { stem, plot } => crate::plot::save_plot(out.path(), stem, plot)?,
         OutputFile::Json { name, value } => write_bytes(
             &out.join(name),

@@ -47,7 +47,7 @@ pub mod image_scan;
 pub mod limits;
 pub mod model;
 pub mod pool;
-mod present;
+pub mod present;
 pub mod reconstruct;
 pub mod run;
 pub mod simulate;
