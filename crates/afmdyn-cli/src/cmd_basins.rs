@@ -7,13 +7,8 @@ use crate::args::{IntegratorArgs, ModelArgs};
 use crate::cmd_analysis::SteadyArgs;
 use crate::cmd_simulate::parse_modal_state;
 use crate::error::CliError;
-use crate::output::{write_bytes, OutDir};
-use crate::plot::{save_map, CellMap};
-use afmdyn::analysis::basins::BasinSpec;
-use afmdyn::layout::figure::palette as color;
-use afmdyn::layout::figure::Rgb as RGBColor;
-use afmdyn::request::basins::csv_text;
-use afmdyn::request::{BasinArrays, BasinsRequest, Resolved};
+use crate::output::OutDir;
+use afmdyn::request::{Analysis, BasinsRequest, Resolved};
 use afmdyn::study::basins::{basin_store, BasinStudy};
 use afmdyn::Params;
 use clap::Args;
@@ -135,87 +130,11 @@ pub fn basins_cmd(a: &BasinsArgs) -> Result<(), CliError> {
         .records()
         .map_err(|e| crate::error::store_error(e, "basins"))?;
     let map = afmdyn::request::in_pool(a.threads, || study.map(rows.into_iter().map(|(_, r)| r)))?;
-    let (spec, model) = (&study.spec, &study.model);
     let resolved = Resolved { params: p, probe };
     let mut doc = afmdyn::request::run::document(&request, &resolved, &map)?;
-    let (nx, ny) = (spec.xs.len(), spec.ys.len());
-    let labels = map.labels();
-    write_bytes(&out.join("basins.csv"), csv_text(spec, &map).as_bytes())?;
-    crate::output::write_layout(&out.join("basins.nc"), &BasinArrays::new(&map).layout(spec))?;
-    // the map, the attractors' section points on it
-    let colour = |l: i64| -> RGBColor {
-        if l < 0 {
-            RGBColor(0, 0, 0)
-        } else {
-            color(l as usize)
-        }
-    };
-    let cells: Vec<Option<RGBColor>> = labels.iter().map(|&l| Some(colour(l))).collect();
-    let mut legend: Vec<(String, RGBColor)> = map
-        .attractors
-        .iter()
-        .enumerate()
-        .map(|(i, s)| {
-            let kind = s
-                .period()
-                .map_or("nonperiodic".to_string(), |n| format!("period {n}"));
-            (format!("attractor {i}: {kind}"), colour(i as i64))
-        })
-        .collect();
-    if labels.iter().any(|&l| l < 0) {
-        legend.push(("failed".into(), colour(-2)));
-    }
-    let points: Vec<(f64, f64)> = map
-        .attractors
-        .iter()
-        .flat_map(|s| s.poincare.iter())
-        .map(|q| {
-            (
-                BasinSpec::coordinate(model, spec.x, &q.state),
-                BasinSpec::coordinate(model, spec.y, &q.state),
-            )
-        })
-        .collect();
-    let (xl, yl) = (
-        format!("{} at τ = 0", spec.x),
-        format!("{} at τ = 0", spec.y),
-    );
-    save_map(
-        out.path(),
-        "basins",
-        &CellMap {
-            title: "Basins of attraction (section points of the attractors: white rings)".into(),
-            labels: (xl.clone(), yl.clone()),
-            x: spec.xs.clone(),
-            y: spec.ys.clone(),
-            cells: cells.clone(),
-            legend: legend.clone(),
-            points: points.clone(),
-        },
-    )?;
     doc["csv"] = serde_json::json!(out.join("basins.csv"));
     doc["netcdf"] = serde_json::json!(out.join("basins.nc"));
-    write_bytes(
-        &out.join("basins.json"),
-        serde_json::to_string_pretty(&doc).expect("json").as_bytes(),
-    )?;
-    for w in doc["warnings"].as_array().into_iter().flatten() {
-        errln!("afmdyn: warning: {}", w.as_str().unwrap_or_default());
-    }
-    if a.json {
-        outln!("{doc}");
-    } else {
-        outln!(
-            "{} × {} starts: {} attractors, basin fractions {:?}; outputs in {}",
-            nx,
-            ny,
-            map.attractors.len(),
-            map.basin_fractions()
-                .iter()
-                .map(|f| (f * 1000.0).round() / 1000.0)
-                .collect::<Vec<_>>(),
-            out.path().display()
-        );
-    }
-    Ok(())
+    let units = crate::output::units_of(resolved.probe.as_ref());
+    let shown = request.present(&resolved, &map, &doc, units)?;
+    crate::door::emit_as(Some(&out), &shown, &doc, a.json, true)
 }

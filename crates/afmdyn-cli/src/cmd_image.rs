@@ -6,13 +6,12 @@
 //! [`afmdyn::request::image_layout`]), the maps (height, phase, E_dis; the error image of a PI
 //! scan) and the line profile.
 
+use crate::door;
 use crate::error::CliError;
-use crate::output::{si_value, write_document, write_layout, OutDir};
-use crate::plot::{save, save_image, AfmImage, Figure, Series, Style};
-use afmdyn::request::image::{
-    image, setpoint_study, study_ratios, Image, ImageRequest, SampleMap, SetpointStudy,
-};
-use afmdyn::request::image_scan::{PiImage, PiScan, ScanStudy};
+use crate::output::{units_of, OutDir};
+use afmdyn::request::image::{image, setpoint_study, study_ratios, ImageRequest, SampleMap};
+use afmdyn::request::image_scan::{PiScan, ScanStudy};
+use afmdyn::request::present;
 use clap::Args;
 use std::path::PathBuf;
 
@@ -90,91 +89,6 @@ pub struct ImageArgs {
     json: bool,
 }
 
-/// The map of one field over the image as AFM software draws it (dark = low, a colour bar in
-/// `unit`, the scan's aspect ratio: [`crate::plot::AfmImage`]).
-fn map_of(
-    out: &OutDir,
-    img: &Image,
-    stem: &str,
-    title: &str,
-    unit: &str,
-    value: &dyn Fn(usize, usize) -> f64,
-) -> Result<(), CliError> {
-    let (nx, ny) = (img.x.len(), img.y.len());
-    let values: Vec<f64> = (0..ny)
-        .flat_map(|j| (0..nx).map(move |i| (j, i)))
-        .map(|(j, i)| value(j, i))
-        .collect();
-    // the bar's description: the title's quantity (before any parenthesis) and the unit
-    let quantity = title.split(" (").next().unwrap_or(title);
-    let mut chars = quantity.chars();
-    let quantity: String = chars
-        .next()
-        .map(|c| c.to_lowercase().chain(chars).collect())
-        .unwrap_or_default();
-    save_image(
-        out.path(),
-        stem,
-        &AfmImage {
-            title: title.to_string(),
-            x: img.x.clone(),
-            y: img.y.clone(),
-            values,
-            label: format!("{quantity} ({unit})"),
-        },
-    )?;
-    Ok(())
-}
-
-/// The setpoint study's plots: each domain's apparent height and phase lag against A/A0.
-fn study_plots(out: &OutDir, s: &SetpointStudy) -> Result<(), CliError> {
-    for (stem, title, label, get) in [
-        (
-            "image-setpoint-height",
-            "Apparent height of each domain against the setpoint (ideal feedback)",
-            "apparent height (m)",
-            (|d: &afmdyn::request::image::DomainContrast| d.apparent_height.clone())
-                as fn(&afmdyn::request::image::DomainContrast) -> Vec<f64>,
-        ),
-        (
-            "image-setpoint-phase",
-            "Phase lag of each domain against the setpoint (ideal feedback)",
-            "phase lag (°)",
-            |d| d.phase_deg.clone(),
-        ),
-    ] {
-        save(
-            out.path(),
-            stem,
-            &Figure {
-                title: title.into(),
-                x_label: "setpoint A/A0".into(),
-                y_label: label.into(),
-                series: s
-                    .domains
-                    .iter()
-                    .enumerate()
-                    .map(|(k, d)| Series {
-                        label: d.name.clone(),
-                        points: s
-                            .ratio
-                            .iter()
-                            .copied()
-                            .zip(get(d))
-                            .filter(|p| p.1.is_finite())
-                            .collect(),
-                        style: Style::Line,
-                        color: k,
-                    })
-                    .collect(),
-                shade: Vec::new(),
-                y_min_span: 0.0,
-            },
-        )?;
-    }
-    Ok(())
-}
-
 /// Run `afmdyn image`.
 pub fn image_cmd(a: &ImageArgs) -> Result<(), CliError> {
     let pi = match a.feedback.as_str() {
@@ -237,153 +151,17 @@ pub fn image_cmd(a: &ImageArgs) -> Result<(), CliError> {
     }
     let out = OutDir::lock(&a.out)?;
     let img = image(&table, &map, &req)?;
-    let mut json = img.document(a.setpoint);
     let study = match &ratios {
         Some(r) => Some(setpoint_study(&table, &map, r, req.curve_points)?),
         None => None,
     };
-    if let Some(s) = &study {
-        json["setpoint_study"] = serde_json::to_value(s).expect("a study serialises");
-        study_plots(&out, s)?;
-    }
-    write_document(&out, "image.json", &json)?;
-    write_layout(
-        &out.join("image.nc"),
-        &afmdyn::request::image_layout::layout(&img, a.setpoint),
-    )?;
-    let img = &img;
-    let field = |get: fn(&afmdyn::request::image::OperatingPoint) -> f64| {
-        move |j: usize, i: usize| img.point(j, i).map_or(f64::NAN, get)
-    };
-    map_of(
-        &out,
-        img,
-        "image-height",
-        "Apparent height (ideal feedback)",
-        "m",
-        &|j, i| img.apparent_height(j, i),
-    )?;
-    map_of(
-        &out,
-        img,
-        "image-phase",
-        "Phase lag",
-        "°",
-        &field(|o| o.phase_deg),
-    )?;
-    map_of(
-        &out,
-        img,
-        "image-dissipation",
-        "Energy dissipated per period",
-        "J",
-        &field(|o| o.energy_dissipated),
-    )?;
-    // the first line's profile: apparent and true height
-    let profile = |f: &dyn Fn(usize) -> f64| -> Vec<(f64, f64)> {
-        (0..img.x.len())
-            .map(|i| (img.x[i], f(i)))
-            .filter(|p| p.1.is_finite())
-            .collect()
-    };
-    save(
-        out.path(),
-        "image-profile",
-        &Figure {
-            title: format!(
-                "Line profile at y = {} (setpoint A/A0 = {})",
-                si_value(img.y[0], "m"),
-                a.setpoint
-            ),
-            x_label: "x (m)".into(),
-            y_label: "height (m)".into(),
-            series: vec![
-                Series {
-                    label: "apparent height".into(),
-                    points: profile(&|i| img.apparent_height(0, i)),
-                    style: Style::Line,
-                    color: 0,
-                },
-                Series {
-                    label: "true height".into(),
-                    points: profile(&|i| img.pixels[0][i].height),
-                    style: Style::Dashed,
-                    color: 1,
-                },
-            ],
-            shade: Vec::new(),
-            y_min_span: 1e-12,
-        },
-    )?;
-    if a.json {
-        outln!("{json}");
-        return Ok(());
-    }
-    outln!(
-        "ideal-feedback image, {} × {} pixels, setpoint A/A0 = {}; z_c,ref = {} on the background",
-        img.x.len(),
-        img.y.len(),
-        a.setpoint,
-        si_value(img.reference, "m")
-    );
-    let names: Vec<(Option<usize>, &str)> = std::iter::once((None, "background"))
-        .chain(
-            img.domain_names
-                .iter()
-                .enumerate()
-                .map(|(k, n)| (Some(k), n.as_str())),
-        )
-        .collect();
-    for (d, name) in names {
-        // where this domain is first met in the image, its operating point there
-        let first = img.pixels.iter().enumerate().find_map(|(j, line)| {
-            line.iter()
-                .position(|p| p.domain == d && p.point.is_some())
-                .map(|i| (j, i))
-        });
-        match first {
-            Some((j, i)) => {
-                let o = img.point(j, i).expect("a point");
-                outln!(
-                    "  {}: z_c {} ({:?}), apparent height {} over true {}, phase {:.2}°, E_dis {}, peak force {}",
-                    name,
-                    si_value(o.z_c, "m"),
-                    o.regime,
-                    si_value(img.apparent_height(j, i), "m"),
-                    si_value(img.pixels[j][i].height, "m"),
-                    o.phase_deg,
-                    si_value(o.energy_dissipated, "J"),
-                    si_value(o.peak_force, "N")
-                );
-            }
-            None => outln!("  {name}: not imaged (no operating point, or not in the map)"),
-        }
-    }
-    if let Some(s) = &study {
-        outln!("setpoint study (apparent height, phase; a line engaged on the background):");
-        for (k, r) in s.ratio.iter().enumerate() {
-            let cells: Vec<String> = s
-                .domains
-                .iter()
-                .map(|d| {
-                    format!(
-                        "{} {}, {:.1}°",
-                        d.name,
-                        si_value(d.apparent_height[k], "m"),
-                        d.phase_deg[k]
-                    )
-                })
-                .collect();
-            outln!("  A/A0 = {r:.3}: {}", cells.join("; "));
-        }
-    }
-    outln!("outputs in {}", out.path().display());
-    Ok(())
+    let json = present::image::ideal_document(&img, a.setpoint, study.as_ref());
+    let shown = present::image::ideal(&img, a.setpoint, study.as_ref(), &json, units_of(None));
+    door::emit(Some(&out), &shown, &json, a.json)
 }
 
-/// `afmdyn image --feedback pi`: the scan's lines as a study on the worker threads, then the
-/// document, the maps (recorded height, error image, phase, E_dis) and the first line's profile
-/// (trace, retrace, ideal and true height).
+/// `afmdyn image --feedback pi`: the scan's lines as a study on the worker threads, then its
+/// presentation.
 fn pi_cmd(
     a: &ImageArgs,
     table: &toml::Table,
@@ -408,126 +186,6 @@ fn pi_cmd(
         .map_err(|e| crate::error::store_error(e, "image"))?;
     let img = study.assemble(records)?;
     let json = img.document(a.setpoint);
-    write_document(&out, "image.json", &json)?;
-    write_layout(
-        &out.join("image.nc"),
-        &afmdyn::request::image_layout::scan_layout(&img, a.setpoint),
-    )?;
-    let grid = &img.ideal;
-    let pixel = |j: usize, i: usize| &img.lines[j].trace[i];
-    map_of(
-        &out,
-        grid,
-        "image-height",
-        "Recorded height (PI feedback, trace)",
-        "m",
-        &|j, i| img.height(0, j, i),
-    )?;
-    map_of(
-        &out,
-        grid,
-        "image-error",
-        "Amplitude error A_sp - A (PI feedback, trace)",
-        "m",
-        &|j, i| pixel(j, i).tracking_error * img.length(),
-    )?;
-    map_of(
-        &out,
-        grid,
-        "image-phase",
-        "Phase lag (PI feedback, trace)",
-        "°",
-        &|j, i| pixel(j, i).phase.to_degrees(),
-    )?;
-    map_of(
-        &out,
-        grid,
-        "image-dissipation",
-        "Energy dissipated per period (PI feedback, trace)",
-        "J",
-        &|j, i| pixel(j, i).energy_dissipated * img.energy(),
-    )?;
-    pi_profile(&out, &img, a.setpoint)?;
-    if a.json {
-        outln!("{json}");
-        return Ok(());
-    }
-    let s = img.settings;
-    outln!(
-        "PI-feedback image, {} × {} pixels, setpoint A/A0 = {}: scan rate {}, K_P {}, K_I {}, \
-         lock-in time constant {}; {} drive periods per pixel ({}), {} to engage each line",
-        grid.x.len(),
-        grid.y.len(),
-        a.setpoint,
-        si_value(s.scan_rate, "Hz"),
-        s.proportional_gain,
-        si_value(s.integral_gain, "1/s"),
-        si_value(s.time_constant, "s"),
-        s.periods_per_pixel,
-        si_value(s.pixel_time, "s"),
-        s.engage_periods
-    );
-    for (name, art) in ["trace", "retrace"].iter().zip(img.artefacts) {
-        outln!(
-            "  {name}: height error against the ideal image RMS {}, largest {}; overshoot {}; \
-             error image RMS {}; {} pixel(s) lost contact; {} period(s) at the output limit",
-            si_value(art.height_rms_error, "m"),
-            si_value(art.height_max_error, "m"),
-            si_value(art.overshoot, "m"),
-            si_value(art.tracking_error_rms, "m"),
-            art.lost_contact_pixels,
-            art.saturated_periods
-        );
-    }
-    outln!("outputs in {}", out.path().display());
-    Ok(())
-}
-
-/// The first line of a PI scan: trace, retrace, the ideal image's apparent height and the true
-/// height.
-fn pi_profile(out: &OutDir, img: &PiImage, setpoint: f64) -> Result<(), CliError> {
-    let g = &img.ideal;
-    let profile = |f: &dyn Fn(usize) -> f64| -> Vec<(f64, f64)> {
-        (0..g.x.len())
-            .map(|i| (g.x[i], f(i)))
-            .filter(|p| p.1.is_finite())
-            .collect()
-    };
-    let series = [
-        (
-            "trace",
-            Style::Line,
-            &(|i| img.height(0, 0, i)) as &dyn Fn(usize) -> f64,
-        ),
-        ("retrace", Style::Line, &|i| img.height(1, 0, i)),
-        ("ideal feedback", Style::Dashed, &|i| {
-            g.apparent_height(0, i)
-        }),
-        ("true height", Style::Dashed, &|i| g.pixels[0][i].height),
-    ];
-    save(
-        out.path(),
-        "image-profile",
-        &Figure {
-            title: format!(
-                "Line profile at y = {} (PI feedback, setpoint A/A0 = {setpoint})",
-                si_value(g.y[0], "m"),
-            ),
-            x_label: "x (m)".into(),
-            y_label: "height (m)".into(),
-            series: series
-                .iter()
-                .enumerate()
-                .map(|(k, (label, style, f))| Series {
-                    label: (*label).into(),
-                    points: profile(f),
-                    style: *style,
-                    color: k,
-                })
-                .collect(),
-            shade: Vec::new(),
-            y_min_span: 1e-12,
-        },
-    )?;
-    Ok(())
+    let shown = present::image::pi(&img, a.setpoint, &json, units_of(None));
+    door::emit(Some(&out), &shown, &json, a.json)
 }

@@ -5,13 +5,10 @@ use crate::cmd_analysis::{SteadyArgs, COL_VALUE, COL_W_TIP};
 use crate::cmd_simulate::parse_initial;
 use crate::door::{self, Exit};
 use crate::error::CliError;
-use crate::output::{f, write_csv, OutDir};
-use crate::plot::{save, Figure, Series, Style};
-use crate::progress;
-use afmdyn::analysis::continuation::BranchPoint;
+use crate::plot::{Series, Style};
+use afmdyn::request::Resolved;
 use afmdyn::request::{ContinuationRequest, LyapunovRequest, OrbitRequest, StartRequest};
-use afmdyn::request::{Document, Resolved};
-use afmdyn::{CantileverModel, Params, SweepParam};
+use afmdyn::{Params, SweepParam};
 use clap::Args;
 use std::path::{Path, PathBuf};
 
@@ -99,30 +96,6 @@ pub struct ContinueArgs {
     json: bool,
 }
 
-fn branch_rows(model: &CantileverModel, id: usize, br: &[BranchPoint]) -> Vec<Vec<String>> {
-    br.iter()
-        .map(|b| {
-            vec![
-                id.to_string(),
-                b.period.to_string(),
-                f(b.s),
-                f(b.value),
-                b.stable.to_string(),
-                f(b.multipliers[0].norm()),
-                b.critical.name().to_string(),
-                b.section
-                    .iter()
-                    .map(|z| format!("{}", model.w_tip(z)))
-                    .collect::<Vec<_>>()
-                    .join(" "),
-                b.switchings.to_string(),
-                f(b.grazing_distance),
-                b.event.map_or(String::new(), |e| e.name().to_string()),
-            ]
-        })
-        .collect()
-}
-
 /// The overlay CSV read and checked before any computation: readable, at most
 /// [`afmdyn::io::MAX_INPUT_CSV_BYTES`] of UTF-8 in lines of at most
 /// [`afmdyn::io::input::MAX_CSV_LINE_BYTES`], with `value` and `w_tip`
@@ -163,185 +136,46 @@ fn read_overlay(path: &Path) -> Result<Vec<(f64, f64)>, CliError> {
 
 /// Run `afmdyn continue`.
 pub fn continuation(a: &ContinueArgs) -> Result<(), CliError> {
-    let (base, probe) = a.model.resolve(Params::default())?;
+    let (params, probe) = a.model.resolve(Params::default())?;
     let request = ContinuationRequest {
         param: a.param,
         from: a.from,
         to: a.to,
         period: a.period,
         switch: a.switch,
-        start: a.start.request(base.modes)?,
+        start: a.start.request(params.modes)?,
     };
-    request.validate(&base)?;
+    request.validate(&params)?;
     let underlay = match &a.overlay {
         Some(o) => read_overlay(o)?,
         None => Vec::new(),
     };
-    let out = OutDir::lock(&a.out)?;
-    let u = crate::output::units_of(probe.as_ref());
-    let model = Resolved {
-        params: base,
-        probe,
+    let exit = Exit {
+        json: a.json,
+        out: Some(&a.out),
+        unit: "branch points",
     };
-    let Document {
-        output: branches,
-        json,
-    } = progress::run(&request, &model, "branch points")?;
-    let model = CantileverModel::new(&base.with(a.param, a.from))?;
-    let n = branches[0].first().map_or(1, |b| b.period);
-    write_csv(
-        &out.join("continuation.csv"),
-        &[
-            "branch",
-            "period",
-            "s",
-            "value",
-            "stable",
-            "max_multiplier",
-            "critical",
-            "w_tip_section",
-            "switchings",
-            "grazing_distance",
-            "event",
-        ],
-        branches
-            .iter()
-            .enumerate()
-            .flat_map(|(i, b)| branch_rows(&model, i, b)),
-    )?;
-    // plot: section points of each branch, stable solid, unstable dashed (as dots)
-    let mut series = Vec::new();
-    // a colour per branch, avoiding the events' (3) and the sweep underlay's (7)
-    const BRANCH_COLORS: [usize; 8] = [0, 1, 2, 4, 5, 6, 8, 9];
-    for (ib, b) in branches.iter().enumerate() {
-        let i = BRANCH_COLORS[ib % BRANCH_COLORS.len()];
-        let first_series = series.len();
-        let np = b.first().map_or(0, |x| x.section.len());
-        for k in 0..np {
-            let mut run: Vec<(f64, f64)> = Vec::new();
-            let mut stable = b.first().is_some_and(|x| x.stable);
-            for x in b {
-                let pt = (x.value, model.w_tip(&x.section[k.min(x.section.len() - 1)]));
-                if x.stable != stable && !run.is_empty() {
-                    run.push(pt);
-                    series.push(Series {
-                        label: String::new(),
-                        points: std::mem::take(&mut run),
-                        style: if stable { Style::Line } else { Style::Dashed },
-                        color: i,
-                    });
-                    stable = x.stable;
-                }
-                run.push(pt);
-            }
-            if !run.is_empty() {
-                series.push(Series {
-                    label: String::new(),
-                    points: run,
-                    style: if stable { Style::Line } else { Style::Dashed },
-                    color: i,
-                });
-            }
-        }
-        if let (Some(sr), Some(x)) = (series.get_mut(first_series), b.first()) {
-            sr.label = if ib == 0 {
-                format!("period-{n} branch (solid stable, dashed unstable)")
-            } else {
-                format!(
-                    "period-{} branch from {} = {:.4}",
-                    x.period,
-                    a.param.symbol(),
-                    x.value
-                )
-            };
-        }
-    }
-    let events: Vec<(f64, f64)> = branches
-        .iter()
-        .flat_map(|b| {
-            b.iter()
-                .filter(|x| x.event.is_some())
-                .map(|x| (x.value, model.w_tip(&x.section[0])))
-        })
-        .collect();
-    series.push(Series {
-        label: "fold / period doubling / NS / grazing".into(),
-        points: events,
-        style: Style::Points,
-        color: 3,
-    });
-    if !underlay.is_empty() {
-        series.insert(
-            0,
-            Series {
-                label: "bifurcation sweep".into(),
-                points: underlay,
-                style: Style::Dots,
-                color: 7,
-            },
-        );
-    }
-    // the periods the branches have (with --switch, the doubled branches too)
-    let mut periods: Vec<usize> = branches
-        .iter()
-        .filter_map(|b| b.first().map(|x| x.period))
-        .collect();
-    periods.sort_unstable();
-    periods.dedup();
-    let title = match periods.as_slice() {
-        [p] => format!("Continuation of period-{p} orbits in {}", a.param.symbol()),
-        [] => format!("Continuation of period-{n} orbits in {}", a.param.symbol()),
-        ps => format!(
-            "Continuation of periodic orbits in {} (periods {})",
-            a.param.symbol(),
-            ps.iter()
-                .map(|p| p.to_string())
-                .collect::<Vec<_>>()
-                .join(", ")
-        ),
-    };
-    save(
-        out.path(),
-        "continuation",
-        &Figure {
-            y_min_span: 0.0,
-            title,
-            x_label: format!("{} ({})", a.param.symbol(), a.param.name()),
-            y_label: "W(1,τ) at τ = 2πk/Ω".into(),
-            series,
-            shade: vec![],
-        },
-    )?;
-    for w in afmdyn::report::continuation_warnings(a.param, &branches) {
-        errln!("afmdyn: warning: {w}");
-    }
-    if a.json {
-        outln!("{json}");
-    } else {
-        outln!(
-            "{} branch(es), {} points; located:",
-            branches.len(),
-            branches.iter().map(|b| b.len()).sum::<usize>()
-        );
-        for b in branches.iter().flatten().filter(|b| b.event.is_some()) {
-            // with a probe Ω reads as the drive frequency and α5 as the rest distance z_c
-            let at = match (u.si(), a.param) {
-                (true, SweepParam::Omega) => u.drive(b.value),
-                (true, SweepParam::Alpha5) => format!(
-                    "z_c = {}",
-                    u.length(base.with(SweepParam::Alpha5, b.value).rest_distance())
-                ),
-                _ => format!("{} = {:.6}", a.param.name(), b.value),
-            };
-            outln!(
-                "  {:<16} at {at} (period {})",
-                format!("{:?}", b.event.expect("event")),
-                b.period
+    // the sweep's points below the branches
+    let decorate = |shown: &mut afmdyn::report::Presentation| {
+        if let Some(series) = shown
+            .series_mut("continuation")
+            .filter(|_| !underlay.is_empty())
+        {
+            let points = underlay.clone();
+            let style = Style::Dots;
+            let label = "bifurcation sweep".into();
+            series.insert(
+                0,
+                Series {
+                    label,
+                    points,
+                    style,
+                    color: 7,
+                },
             );
         }
-        outln!("outputs in {}", out.path().display());
-    }
-    Ok(())
+    };
+    door::run_with(&request, &Resolved { params, probe }, exit, decorate).map(drop)
 }
 
 /// `afmdyn lyapunov` flags.

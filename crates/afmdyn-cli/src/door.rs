@@ -8,7 +8,7 @@ use crate::error::CliError;
 use crate::output::{print_warnings, units_of, write_layout, OutDir};
 use crate::progress;
 use afmdyn::layout::files::{write_bytes, write_csv, NpyStream};
-use afmdyn::report::{OutputFile, Presentation};
+use afmdyn::report::{OutputFile, OutputsNote, Presentation};
 use afmdyn::request::{Analysis, Document, Resolved};
 use serde_json::Value;
 use std::path::Path;
@@ -36,15 +36,30 @@ pub fn run<A: Analysis>(
     model: &Resolved,
     exit: Exit<'_>,
 ) -> Result<Document<A::Output>, CliError> {
+    run_with(request, model, exit, |_| {})
+}
+
+/// [`run`], with `decorate` adding to the presentation before it is written (a front end's
+/// own underlay in a figure).
+///
+/// # Errors
+/// As [`run`].
+pub fn run_with<A: Analysis>(
+    request: &A,
+    model: &Resolved,
+    exit: Exit<'_>,
+    decorate: impl FnOnce(&mut Presentation),
+) -> Result<Document<A::Output>, CliError> {
     request.validate(model)?;
     let out = exit.out.map(OutDir::lock).transpose()?;
     let doc = progress::run(request, model, exit.unit)?;
-    let shown = request.present(
+    let mut shown = request.present(
         model,
         &doc.output,
         &doc.json,
         units_of(model.probe.as_ref()),
     )?;
+    decorate(&mut shown);
     emit(out.as_ref(), &shown, &doc.json, exit.json)?;
     Ok(doc)
 }
@@ -60,21 +75,57 @@ pub fn emit(
     document: &Value,
     json: bool,
 ) -> Result<(), CliError> {
+    emit_as(out, shown, document, json, false)
+}
+
+/// [`emit`]; `inline`: the summary's last line ends with `; outputs in DIR` instead of a line
+/// of its own (the one-line summaries of `chart` and `basins`).
+///
+/// # Errors
+/// As [`emit`].
+pub fn emit_as(
+    out: Option<&OutDir>,
+    shown: &Presentation,
+    document: &Value,
+    json: bool,
+    inline: bool,
+) -> Result<(), CliError> {
     print_warnings(document)?;
     if let Some(out) = out {
-        let names = shown.file_names();
-        out.remove_partials(&names.iter().map(String::as_str).collect::<Vec<_>>())?;
-        for file in &shown.files {
-            write_file(out, file)?;
-        }
+        write_files(out, shown)?;
     }
     if json {
         outln!("{document}");
+        return Ok(());
+    }
+    let dir = out.filter(|_| !shown.files.is_empty()).map(OutDir::path);
+    let lines = if inline && dir.is_some() {
+        // the one-line summaries: `…; outputs in DIR`
+        let tail = Presentation {
+            summary: shown.summary.clone(),
+            outputs_note: OutputsNote::Tail,
+            ..Presentation::default()
+        };
+        tail.summary_with(dir)
     } else {
-        let dir = out.filter(|_| !shown.files.is_empty()).map(OutDir::path);
-        for line in shown.summary_with(dir) {
-            outln!("{line}");
-        }
+        shown.summary_with(dir)
+    };
+    for line in lines {
+        outln!("{line}");
+    }
+    Ok(())
+}
+
+/// Every file of a presentation written atomically into `out` (their stale temporary files
+/// removed first).
+///
+/// # Errors
+/// [`CliError::Io`] naming a file.
+pub fn write_files(out: &OutDir, shown: &Presentation) -> Result<(), CliError> {
+    let names = shown.file_names();
+    out.remove_partials(&names.iter().map(String::as_str).collect::<Vec<_>>())?;
+    for file in &shown.files {
+        write_file(out, file)?;
     }
     Ok(())
 }
@@ -90,6 +141,7 @@ pub fn write_file(out: &OutDir, file: &OutputFile) -> Result<(), CliError> {
             write_csv(&out.join(name), &header, rows.iter().cloned())?;
         }
         OutputFile::Dataset { name, layout } => write_layout(&out.join(name), layout)?,
+        OutputFile::Text { name, text } => write_bytes(&out.join(name), text.as_bytes())?,
         OutputFile::Figure { stem, plot } => crate::plot::save_plot(out.path(), stem, plot)?,
         OutputFile::Npy {
             name,

@@ -7,8 +7,6 @@ use afmdyn::request::{DirLock, LockError};
 use std::fmt::Display;
 use std::path::{Path, PathBuf};
 
-pub use afmdyn::layout::files::{f, write_bytes, write_csv};
-
 /// An I/O failure on `path`, as one readable line ("cannot write DIR/x.csv: No space left on
 /// device"): the library's [`afmdyn::layout::files::io_error`].
 pub fn io_error(verb: &str, path: &Path, e: impl Display) -> CliError {
@@ -116,19 +114,6 @@ impl OutDir {
 ///
 /// # Errors
 /// [`CliError::Io`] naming the path.
-/// The JSON document `json` written (pretty, atomically) as `name` in `out`, and its
-/// `warnings` printed on stderr as `afmdyn: warning: …`.
-///
-/// # Errors
-/// As [`write_bytes`].
-pub fn write_document(out: &OutDir, name: &str, json: &serde_json::Value) -> Result<(), CliError> {
-    write_bytes(
-        &out.join(name),
-        serde_json::to_string_pretty(json).expect("json").as_bytes(),
-    )?;
-    print_warnings(json)
-}
-
 /// Every warning of a document (its `warnings` array) on stderr as `afmdyn: warning: …`, the
 /// one place the command line prints a document's warnings (with `--json` too: stdout holds
 /// the document, stderr its warnings).
@@ -144,11 +129,6 @@ pub fn print_warnings(doc: &serde_json::Value) -> Result<(), CliError> {
 
 pub fn write_layout(path: &Path, layout: &afmdyn::layout::Layout) -> Result<(), CliError> {
     afmdyn::layout::netcdf::write(path, layout).map_err(|e| CliError::Io(e.to_string()))
-}
-
-/// `v` in `unit` in the process's display units ([`afmdyn::report::si_value`]).
-pub fn si_value(v: f64, unit: &str) -> String {
-    afmdyn::report::si_value(v, unit, crate::plot::plain_si())
 }
 
 pub use afmdyn::report::TextUnits;

@@ -6,6 +6,7 @@
 //! here it must deserialise back to the default.
 #![cfg(feature = "schema")]
 
+use afmdyn::request::image::ImageRequest;
 use afmdyn::request::{
     ApproachRequest, BasinsRequest, ChartRequest, FmRequest, ModesRequest, ReconstructRequest,
     ResonanceRequest,
@@ -74,6 +75,7 @@ fn schemas() -> Vec<(&'static str, Value)> {
         ("basins", schema::<BasinsRequest>("basins")),
         ("reconstruct", schema::<ReconstructRequest>("reconstruct")),
         ("fm", schema::<FmRequest>("fm")),
+        ("image", schema::<ImageRequest>("image")),
     ]
 }
 

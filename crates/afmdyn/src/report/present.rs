@@ -72,6 +72,13 @@ pub enum OutputFile {
         /// Rows, each as many values as the columns.
         rows: Vec<Vec<f64>>,
     },
+    /// A text file written as it is (a table formatted by its request: `chart.csv`).
+    Text {
+        /// File name.
+        name: String,
+        /// The file's text.
+        text: String,
+    },
     /// A JSON document written pretty (`image.json`).
     Json {
         /// File name.
@@ -108,6 +115,31 @@ impl Presentation {
             plot,
         });
     }
+    /// Add a text file written as it is.
+    pub fn text(&mut self, name: &str, text: String) {
+        self.files.push(OutputFile::Text {
+            name: name.to_string(),
+            text,
+        });
+    }
+    /// Add a JSON document, written pretty.
+    pub fn json(&mut self, name: &str, value: Value) {
+        self.files.push(OutputFile::Json {
+            name: name.to_string(),
+            value,
+        });
+    }
+    /// The figure `stem`'s series, to decorate it (a front end's underlay); `None` when the
+    /// presentation has no such figure of lines.
+    pub fn series_mut(&mut self, stem: &str) -> Option<&mut Vec<crate::layout::figure::Series>> {
+        self.files.iter_mut().find_map(|f| match f {
+            OutputFile::Figure {
+                stem: s,
+                plot: Plot::Lines(fig),
+            } if s == stem => Some(&mut fig.series),
+            _ => None,
+        })
+    }
     /// The names of the files, figures as `stem.png` and `stem.svg` (to clear their stale
     /// temporary files before writing).
     pub fn file_names(&self) -> Vec<String> {
@@ -116,6 +148,7 @@ impl Presentation {
             .flat_map(|f| match f {
                 OutputFile::Csv { name, .. }
                 | OutputFile::Dataset { name, .. }
+                | OutputFile::Text { name, .. }
                 | OutputFile::Json { name, .. } => vec![name.clone()],
                 OutputFile::Figure { stem, .. } => {
                     vec![format!("{stem}.png"), format!("{stem}.svg")]

@@ -234,6 +234,8 @@ pub struct Chart {
     pub model: ChartModel,
     /// What a resumed chart must match ([`fingerprint`]).
     pub fingerprint: Value,
+    /// Worker threads (`None`: all cores).
+    pub threads: Option<usize>,
 }
 
 impl ChartRequest {
@@ -394,12 +396,16 @@ impl ChartRequest {
             crate::integrate::check_buildable(&model.params(xv, yv)?, spec.integrator.clone())?;
         }
         let fingerprint = fingerprint(self, &model);
-        Ok(Chart {
+        let chart = Chart {
             spec,
             slots: self.max_attractors,
             model,
             fingerprint,
-        })
+            threads: self.threads,
+        };
+        // held to the budgets of a request here, where every front end builds its chart
+        super::costs::check_cost("chart", super::costs::chart_cost(&chart)?)?;
+        Ok(chart)
     }
 }
 

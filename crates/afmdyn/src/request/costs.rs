@@ -194,3 +194,142 @@ pub fn basins_cost(spec: &BasinSpec) -> Result<Cost, SimError> {
         work: cells * steady_periods(&spec.steady, p)? * p.modes as f64,
     })
 }
+
+/// Runs of a chart's cell in the worst case its options allow: its K random starts and, by
+/// continuation, the attractors of its two neighbours (about K each).
+pub const CHART_RUNS_PER_START: f64 = 3.0;
+
+/// The cost of a behaviour chart ([`crate::request::chart::Chart`]): cells × starts (and the
+/// neighbours' attractors continued into each cell, [`CHART_RUNS_PER_START`]) × the transient
+/// cap × modes, the largest cap of its four corners (the decay rates vary monotonically
+/// along each axis); a λ₁ of `lyapunov_periods` of the state and one tangent vector per
+/// attractor found; every cell's attractors kept (up to its slots: 128 bytes each and their
+/// 10 array values).
+///
+/// # Errors
+/// [`SimError`] when a corner's parameters do not build a model.
+pub fn chart_cost(chart: &crate::request::chart::Chart) -> Result<Cost, SimError> {
+    use crate::analysis::chart::CellParams;
+    let (xs, ys) = (&chart.spec.x, &chart.spec.y);
+    let mut cap: f64 = 0.0;
+    for (x, y) in [
+        (xs[0], ys[0]),
+        (xs[xs.len() - 1], ys[0]),
+        (xs[0], ys[ys.len() - 1]),
+        (xs[xs.len() - 1], ys[ys.len() - 1]),
+    ] {
+        let p = chart.model.params(x, y)?;
+        let periods =
+            steady_periods(&chart.spec.steady, &p)? + 2.0 * chart.spec.lyapunov_periods as f64;
+        cap = cap.max(periods * p.modes as f64);
+    }
+    let cells = xs.len() as f64 * ys.len() as f64;
+    let runs = cells * f64::from(chart.spec.starts) * CHART_RUNS_PER_START;
+    Ok(Cost {
+        bytes: MODEL_BYTES + cells * (128.0 + chart.slots as f64 * (128.0 + 80.0)),
+        work: runs * cap,
+    })
+}
+
+/// The cost of an image's approach curves ([`crate::request::image`]): one curve of
+/// `curve_points` each way per material (`materials`: the background and every domain with a
+/// sample of its own) on the probe's model `params` (the lever's decay, hence the transient
+/// cap, is the same for every material), in length unit `length`.
+///
+/// # Errors
+/// As the approach curve's request.
+pub fn image_curves_cost(
+    params: Params,
+    length: f64,
+    curve_points: usize,
+    materials: usize,
+) -> Result<Cost, SimError> {
+    let curve = super::curves::CurveRequest {
+        points: Some(curve_points),
+        branches: false,
+        ..super::curves::CurveRequest::default()
+    };
+    let one = stepped_cost(&super::curves::approach_request(
+        params, &curve, length, false,
+    )?)?;
+    let m = materials as f64;
+    Ok(Cost {
+        bytes: m * one.bytes,
+        work: m * one.work,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::error::SimError;
+    use crate::params::Params;
+    use crate::request::image::{image, ImageRequest, SampleMap};
+    use crate::request::image_scan::{PiScan, ScanStudy};
+    use crate::request::{ChartRequest, ModelSpec};
+
+    fn refused_as(e: SimError, what: &str) {
+        match &e {
+            SimError::Budget { what: w, .. } => assert_eq!(*w, what, "{e}"),
+            other => panic!("not a budget refusal: {other}"),
+        }
+        assert!(e.to_string().contains(what), "{e}");
+    }
+
+    /// A chart beyond the work budget (10⁶ cells × 10 starts) is refused as it is built,
+    /// before any cell runs (the refusal is immediate), naming the chart.
+    #[test]
+    fn a_chart_beyond_the_budget_is_refused_before_any_work() {
+        let request = ChartRequest {
+            x_steps: 1000,
+            y_steps: 1000,
+            starts: 10,
+            ..ChartRequest::default()
+        };
+        let e = request
+            .chart(ModelSpec::default(), Params::default(), None)
+            .unwrap_err();
+        refused_as(e, "chart");
+        // the default chart is within it
+        assert!(ChartRequest::default()
+            .chart(ModelSpec::default(), Params::default(), None)
+            .is_ok());
+    }
+
+    /// An image whose pixels fit the pixel check but not with its approach curves' memory is
+    /// refused before the first curve, ideal and PI alike, naming the image.
+    #[test]
+    fn an_image_beyond_the_budget_is_refused_before_any_work() {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../examples/probe-point-mass-dmt.toml"
+        );
+        let table: toml::Table = std::fs::read_to_string(path).unwrap().parse().unwrap();
+        let map = SampleMap {
+            size: (1e-6, 1e-6),
+            domains: vec![],
+            height_map: vec![],
+        };
+        // 1100 × 1072 pixels: 1.1792e9 B, within the pixels' own check (1.1 GiB)
+        let req = ImageRequest {
+            pixels: 1100,
+            lines: Some(1072),
+            ..ImageRequest::at(0.8)
+        };
+        req.validate(&map).unwrap();
+        let started = std::time::Instant::now();
+        refused_as(image(&table, &map, &req).unwrap_err(), "image");
+        // the fastest scan: a drive period per pixel
+        let probe = crate::probe::Probe::from_table(&table, "probe").unwrap();
+        let scan = PiScan {
+            scan_rate: Some(probe.drive_frequency / 2200.0),
+            gains: None,
+            time_constant: None,
+        };
+        match ScanStudy::new(&table, &map, &req, &scan) {
+            Err(e) => refused_as(e, "image"),
+            Ok(_) => panic!("a scan beyond the budget was accepted"),
+        }
+        // no curve ran: a curve of 120 points takes far longer in a debug build
+        assert!(started.elapsed().as_secs_f64() < 5.0);
+    }
+}

@@ -41,7 +41,9 @@ use crate::report::CurveUnits;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
+use super::costs::{check_cost, image_curves_cost, MODEL_BYTES};
 use super::curves::{approach_request, CurveRequest};
+use super::limits::Cost;
 
 mod sample;
 mod study;
@@ -81,8 +83,11 @@ pub struct SampleMap {
     pub height_map: Vec<Vec<f64>>,
 }
 
-/// An image request (`afmdyn image`, Python's `afmdyn.image`; module docs).
+/// An image request (`afmdyn image`, Python's `afmdyn.image`; module docs). Its default
+/// ([`ImageRequest::at`] 0.5) only exemplifies it: every front end asks for the setpoint.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[serde(deny_unknown_fields)]
 pub struct ImageRequest {
     /// Setpoint ratio A_sp/A₀ in (0, 1).
     pub setpoint: f64,
@@ -93,6 +98,12 @@ pub struct ImageRequest {
     /// Points of each material's approach curve (its z_c grid, the probe's default range;
     /// default 120, the approach's [`crate::analysis::stepped::DEFAULT_CURVE_POINTS`]).
     pub curve_points: usize,
+}
+
+impl Default for ImageRequest {
+    fn default() -> Self {
+        ImageRequest::at(0.5)
+    }
 }
 
 impl ImageRequest {
@@ -122,6 +133,12 @@ impl ImageRequest {
             curve_points: curve_points.unwrap_or(d.curve_points),
             ..d
         }
+    }
+
+    /// The memory of the image over `map` while it is held and written:
+    /// [`IMAGE_BYTES_PER_PIXEL`] a pixel.
+    pub fn pixel_bytes(&self, map: &SampleMap) -> f64 {
+        (self.pixels * self.lines(map)) as f64 * IMAGE_BYTES_PER_PIXEL
     }
 
     /// The number of lines over `map`: as given, else as many as pixels (1 for a line map).
@@ -259,7 +276,7 @@ impl ImageRequest {
         }
         // the image held in memory with its document: measured 920 B a pixel (RSS of a
         // 512 × 512 blend image, 241 MB), checked before any work
-        let bytes = (self.pixels * lines) as f64 * IMAGE_BYTES_PER_PIXEL;
+        let bytes = self.pixel_bytes(map);
         if bytes > MAX_IMAGE_BYTES {
             return Err(SimError::Budget {
                 what: "image",
@@ -313,10 +330,15 @@ fn approach_curve(
 /// The materials of `map` under the probe `probe_table`: the background, then one per domain
 /// with its own sample, each with its approach curve; the material of each domain; the SI
 /// units.
+///
+/// `extra` is what the caller adds to the curves' cost (the pixels' memory, a scan's drive
+/// periods): the whole is held against the budgets of a request ([`check_cost`], named
+/// `image`) before the first curve.
 pub(crate) fn material_curves(
     probe_table: &toml::Table,
     map: &SampleMap,
     curve_points: usize,
+    extra: Cost,
 ) -> Result<(Vec<MaterialCurve>, Vec<usize>, CurveUnits), SimError> {
     let background =
         Probe::from_table(probe_table, "probe").map_err(|e| SimError::Probe(e.to_string()))?;
@@ -328,6 +350,15 @@ pub(crate) fn material_curves(
         ));
     }
     let units = CurveUnits::from_scales(&background.scales, false);
+    let materials = 1 + map.domains.iter().filter(|d| d.sample.is_some()).count();
+    let curves = image_curves_cost(background.params, units.length, curve_points, materials)?;
+    check_cost(
+        "image",
+        Cost {
+            bytes: MODEL_BYTES + curves.bytes + extra.bytes,
+            work: curves.work + extra.work * background.params.modes as f64,
+        },
+    )?;
     let mut materials = vec![MaterialCurve {
         name: "background".into(),
         params: background.params,
@@ -437,7 +468,11 @@ pub fn image(
     req: &ImageRequest,
 ) -> Result<Image, SimError> {
     req.validate(map)?;
-    let (curves, of_domain, units) = material_curves(probe_table, map, req.curve_points)?;
+    let extra = Cost {
+        bytes: req.pixel_bytes(map),
+        work: 0.0,
+    };
+    let (curves, of_domain, units) = material_curves(probe_table, map, req.curve_points, extra)?;
     Ok(image_of(&curves, &of_domain, &units, map, req))
 }
 

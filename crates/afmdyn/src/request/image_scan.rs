@@ -263,7 +263,13 @@ impl ScanStudy {
                  periods per pixel)): scan faster, or with fewer pixels or lines",
             ));
         }
-        let (curves, of_domain, units) = material_curves(probe_table, map, req.curve_points)?;
+        // the lines' drive periods (× modes) and the pixels' memory, with the curves' cost
+        let extra = crate::request::limits::Cost {
+            bytes: req.pixel_bytes(map),
+            work: total,
+        };
+        let (curves, of_domain, units) =
+            material_curves(probe_table, map, req.curve_points, extra)?;
         let ideal = image_of(&curves, &of_domain, &units, map, req);
         let engage = curves
             .iter()

@@ -2,13 +2,20 @@
 //! of commands, the text summary, the tables, datasets and figures that every front end
 //! writes as they are. Each [`super::Analysis::present`] calls its function here; a front end
 //! that chooses which files it writes (`--files`, `--dforce-columns`), runs a study into its own
-//! store or streams a run to files calls them itself.
+//! store (`chart`, `image`, the stepped curves, `bifurcation`) or streams a run to files, and
+//! the commands without a computation of their own (`modes --sweep fig3`, `units`,
+//! `cantilevers`) call theirs directly.
 
 #[cfg(feature = "files")]
 pub mod census;
+#[cfg(feature = "files")]
+pub(crate) mod continuation;
 pub(crate) mod curve_figures;
 pub mod curves;
 pub mod fm;
+pub mod image;
+pub mod maps;
+pub mod modes;
 pub(crate) mod orbits;
 pub mod reconstruct;
 #[cfg(feature = "files")]

@@ -226,6 +226,20 @@ impl Analysis for ModesRequest {
     fn report(&self, model: &Resolved, (free, contact): &Self::Output) -> Result<Value, SimError> {
         Ok(report::modes(&model.params, free, contact))
     }
+    fn present(
+        &self,
+        model: &Resolved,
+        (free, contact): &Self::Output,
+        _: &Value,
+        units: report::TextUnits,
+    ) -> Result<report::Presentation, SimError> {
+        Ok(super::present::modes::modes(
+            &model.params,
+            free,
+            contact,
+            units,
+        ))
+    }
 }
 
 impl Analysis for OrbitRequest {
@@ -296,6 +310,22 @@ impl Analysis for ContinuationRequest {
     }
     fn report(&self, model: &Resolved, branches: &Self::Output) -> Result<Value, SimError> {
         Ok(report::continuation(&model.params, self.param, branches))
+    }
+    #[cfg(feature = "files")]
+    fn present(
+        &self,
+        model: &Resolved,
+        branches: &Self::Output,
+        _: &Value,
+        units: report::TextUnits,
+    ) -> Result<report::Presentation, SimError> {
+        super::present::continuation::continuation(
+            &model.params,
+            self.param,
+            self.from,
+            branches,
+            units,
+        )
     }
 }
 

@@ -144,6 +144,16 @@ impl Analysis for BasinsRequest {
         let spec = self.spec(&model.params)?;
         Ok(document(&spec, map))
     }
+    fn present(
+        &self,
+        model: &Resolved,
+        map: &BasinMap,
+        document: &Value,
+        _: crate::report::TextUnits,
+    ) -> Result<crate::report::Presentation, SimError> {
+        let spec = self.spec(&model.params)?;
+        crate::request::present::maps::basins(&spec, map, document)
+    }
 }
 
 /// The resumable store of a basin map (feature `files`): a [`TaskStore`](crate::study::task_store::TaskStore) of rows in the

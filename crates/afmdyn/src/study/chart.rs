@@ -2,10 +2,14 @@
 //! tiles of [`ChartPlan`] (cells of one row, continued along x), its record a tile's cells
 //! with the task's number, what a resume skips the stored tasks ([`super::chart_store`]).
 
-use super::Study;
+use super::{execute_in_memory, Study};
 use crate::analysis::chart::{run_chart, ChartCell, ChartPlan};
+use crate::analysis::progress::Progress;
 use crate::error::SimError;
-use crate::request::chart::Chart;
+use crate::request::chart::{document, Chart};
+use crate::request::costs::chart_cost;
+use crate::request::limits::Cost;
+use crate::request::run::{Analysis, Resolved};
 use serde_json::Value;
 use std::collections::HashSet;
 use std::sync::atomic::AtomicBool;
@@ -43,6 +47,43 @@ impl Study for Chart {
         let plan = ChartPlan::new(&self.spec, &self.model);
         run_chart(&plan, done, &|t, cells| sink((t, cells)), cancel);
         Ok(())
+    }
+}
+
+/// A validated chart runs as an analysis ([`crate::request::run`], Python's `afmdyn.chart`):
+/// its model is its own — [`ChartRequest::chart`](crate::request::ChartRequest::chart) built
+/// it from the request's model values, defaults and probe, validated every option and held
+/// its cost to the budgets — so the `model` given here is not read (pass
+/// [`Resolved::plain`] of any parameters). Its study runs in memory on its threads.
+impl Analysis for Chart {
+    type Output = Vec<ChartCell>;
+    fn validate(&self, _: &Resolved) -> Result<(), SimError> {
+        Ok(())
+    }
+    fn execute(&self, _: &Resolved, progress: &Progress) -> Result<Vec<ChartCell>, SimError> {
+        let cells = cells_of(execute_in_memory(self, self.threads, progress)?);
+        match every_cell_failed(&cells) {
+            Some(e) => Err(e),
+            None => Ok(cells),
+        }
+    }
+    fn name(&self) -> &'static str {
+        "chart"
+    }
+    fn cost(&self, _: &Resolved) -> Result<Cost, SimError> {
+        chart_cost(self)
+    }
+    fn report(&self, _: &Resolved, cells: &Vec<ChartCell>) -> Result<Value, SimError> {
+        Ok(document(self, cells))
+    }
+    fn present(
+        &self,
+        _: &Resolved,
+        cells: &Vec<ChartCell>,
+        _: &Value,
+        _: crate::report::TextUnits,
+    ) -> Result<crate::report::Presentation, SimError> {
+        Ok(crate::request::present::maps::chart(self, cells))
     }
 }
 

@@ -105,7 +105,11 @@ pub fn setpoint_study(
         ..ImageRequest::at(ratios[0])
     }
     .validate(map)?;
-    let (curves, of_domain, units) = material_curves(probe_table, map, curve_points)?;
+    let extra = crate::request::limits::Cost {
+        bytes: 0.0,
+        work: 0.0,
+    };
+    let (curves, of_domain, units) = material_curves(probe_table, map, curve_points, extra)?;
     let names = std::iter::once(("background".to_string(), 0, 0.0)).chain(
         map.domains
             .iter()
