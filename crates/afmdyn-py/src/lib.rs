@@ -9,6 +9,7 @@ mod analyses;
 mod basin_tasks;
 mod chart;
 mod convert;
+mod door;
 mod errors;
 mod image_tasks;
 mod params;
@@ -28,7 +29,7 @@ fn cantilevers() -> String {
 /// keywords: the one source of the Python functions' defaults. `KeyError` for another name.
 #[pyfunction]
 fn request_defaults<'py>(py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
-    let d = convert::request_default(name)
+    let d = afmdyn::request::named::default_request(name)
         .ok_or_else(|| pyo3::exceptions::PyKeyError::new_err(name.to_string()))?;
     convert::json_to_py(py, &d.to_string())
 }
@@ -48,23 +49,15 @@ fn _afmdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
         m.py().get_type::<errors::SimulationError>(),
     )?;
     m.add("FORCE_SIGN", afmdyn::contact::FORCE_SIGN)?;
-    m.add_function(wrap_pyfunction!(analyses::modes, m)?)?;
-    m.add_function(wrap_pyfunction!(analyses::simulate, m)?)?;
-    m.add_function(wrap_pyfunction!(analyses::converge, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::bifurcation, m)?)?;
-    m.add_function(wrap_pyfunction!(analyses::attractors, m)?)?;
     m.add_function(wrap_pyfunction!(studies::global_continuation, m)?)?;
     m.add_function(wrap_pyfunction!(studies::basins, m)?)?;
+    m.add_function(wrap_pyfunction!(door::run, m)?)?;
     m.add_function(wrap_pyfunction!(cantilevers, m)?)?;
     m.add_function(wrap_pyfunction!(request_defaults, m)?)?;
-    m.add_function(wrap_pyfunction!(analyses::orbit, m)?)?;
-    m.add_function(wrap_pyfunction!(analyses::continuation, m)?)?;
-    m.add_function(wrap_pyfunction!(analyses::lyapunov, m)?)?;
     m.add_function(wrap_pyfunction!(studies::approach, m)?)?;
     m.add_function(wrap_pyfunction!(studies::bimodal, m)?)?;
     m.add_function(wrap_pyfunction!(studies::resonance, m)?)?;
-    m.add_function(wrap_pyfunction!(analyses::reconstruct, m)?)?;
-    m.add_function(wrap_pyfunction!(analyses::fm, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::reconstruct_fm, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::reconstruct_am, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::image, m)?)?;
@@ -73,7 +66,6 @@ fn _afmdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(analyses::setpoint_study, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::probe, m)?)?;
     m.add_function(wrap_pyfunction!(params::probe_source, m)?)?;
-    m.add_function(wrap_pyfunction!(analyses::observe, m)?)?;
     m.add("POLL_SECONDS", run::POLL.as_secs_f64())?;
     m.add_function(wrap_pyfunction!(run::cancel_running, m)?)?;
     m.add_function(wrap_pyfunction!(params::resolve, m)?)?;

@@ -322,6 +322,25 @@ def _run(
     return d
 
 
+def _door(
+    name: str,
+    desc: str,
+    progress: ProgressArg,
+    p: Optional[Params] = None,
+    si: Optional[str] = None,
+    request: Optional[Dict[str, Any]] = None,
+) -> Dict[str, Any]:
+    """Run analysis ``name`` through the one door of the core (``_afmdyn.run``: the library
+    parses the request by name, runs it and lays out its arrays) with a progress reporter:
+    ``{"json": document, "datasets": {name: layout}, "facts": dict}``; negative counts are a
+    ValueError naming the option, the document's warnings are issued (as by :func:`_run`)."""
+    _check_counts(request or {})
+    with reporter(progress, desc) as cb:
+        d: Dict[str, Any] = _core.run(name, request, p, si, cb)
+    _warn(d["json"])
+    return d
+
+
 #: The defaults of every analysis' keywords: the library's requests' (``Default``).
 _DEFAULTS = {
     name: _core.request_defaults(name)
