@@ -28,8 +28,6 @@ from . import _afmdyn as _core
 from ._afmdyn import Params
 from ._common import (  # noqa: F401 (_params, _probe_text, _typed, _warn: used by _chart, dask)
     _DEFAULTS,
-    _G,
-    _T,
     Model,
     StateLike,
     _attrs,

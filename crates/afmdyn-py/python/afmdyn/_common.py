@@ -99,12 +99,6 @@ UNITS_NOTE = (
     "gap g0, forces in EI g0/L³, energies in EI g0²/L³"
 )
 
-# the model's units as the library names them (afmdyn::report::SeriesNames, the command
-# line's files): τ, g0, g0 per unit τ
-_T = {"units": "τ (eq. 5)", "long_name": "time τ"}
-_G = {"units": "g0"}
-_V = {"units": "g0 per unit τ"}
-
 
 def _real_array(name: str, v: Any, ndim: int) -> np.ndarray:
     """``v`` as a float64 array of ``ndim`` dimensions, or a ``ValueError`` naming ``name``: a
