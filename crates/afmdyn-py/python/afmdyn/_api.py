@@ -165,8 +165,8 @@ def converge(
     req = _request(locals())
     p, probe = _params(params, model, default=Params(omega=4.1))
     d = _door("converge", "converge", progress, p, probe, req)
-    ds = _layout.dataset(d["datasets"]["converge"], _attrs(p, summary=d["json"]))
-    return ds.set_coords("tau_from_section")
+    attrs = _attrs(p, summary=d["json"])
+    return _layout.dataset(d["datasets"]["converge"], attrs, coords=("tau_from_section",))
 
 
 @_typed
