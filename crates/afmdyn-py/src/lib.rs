@@ -1,9 +1,13 @@
 //! `afmdyn._afmdyn`: the compiled part of the Python package `afmdyn`.
 //!
-//! The pure-Python layer (`python/afmdyn/`) is the public API; it calls these functions, which
-//! run the library's analyses with the GIL released and return dicts of NumPy arrays (owning
-//! the Rust buffers) and the command line's JSON documents, and turns them into xarray
-//! datasets and result objects.
+//! The pure-Python layer (`python/afmdyn/`) is the public API. Every analysis enters through
+//! one door, [`door::run`]`(name, request, params, probe, progress)`: the library parses the
+//! request by name and runs it ([`afmdyn::request::named`]) with the GIL released, and the
+//! document, the result's layouts (dicts of NumPy arrays owning the Rust buffers) and its
+//! scalars come back for the Python layer to turn into xarray datasets and result objects.
+//! The studies run into a store (`store=`, `resume=`: bifurcation, basins, global
+//! continuation, the stepped curves) and the Dask tasks (chart, basin map, PI scan) keep
+//! functions and classes of their own.
 
 mod analyses;
 mod basin_tasks;
