@@ -8,24 +8,17 @@ use crate::convert::Out;
 use crate::errors::{probe_error, sim_error, value_error};
 use crate::image_tasks::{image_inputs, scan_out};
 use crate::params::PyParams;
-use crate::run::{run, run_abandonable, Job, Stop};
+use crate::run::{run, Job, Stop};
 use afmdyn::analysis::bifurcation::SweepSpec;
-use afmdyn::analysis::steady::SteadyState;
 use afmdyn::probe::Probe;
 use afmdyn::request::checkpoint::{self, CheckpointError};
-use afmdyn::request::{self, Analysis, Document, ModesRequest, Resolved};
-use afmdyn::request::{
-    AttractorsRequest, BifurcationRequest, ContinuationRequest, ConvergeRequest, LyapunovRequest,
-    ObserveRequest, OrbitRequest, SimulateRequest,
-};
+use afmdyn::request::{self, Analysis, BifurcationRequest, Document, Resolved};
 use afmdyn::request::{DirLock, FileCheckpoint, LockError, MemoryCheckpoint, SweepRecord};
 use afmdyn::study::sweep::SweepStudy;
 use afmdyn::study::{execute, StudyError};
-use afmdyn::{report, CantileverModel, Params};
-use nalgebra::DVector;
-use numpy::Complex64;
+use afmdyn::{report, Params};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList};
+use pyo3::types::PyDict;
 
 type Dict<'py> = Bound<'py, PyDict>;
 
@@ -45,11 +38,10 @@ where
     A: Analysis + Send + 'static,
     A::Output: Send + 'static,
 {
-    let probe = probe
-        .map(|text| Probe::parse(&text, "probe"))
-        .transpose()
-        .map_err(probe_error)?;
-    let model = Resolved { params, probe };
+    let model = Resolved {
+        params,
+        probe: crate::door::probe_of(probe)?,
+    };
     request.validate(&model).map_err(sim_error)?;
     let job = Job::default();
     let worker = job.clone();
@@ -62,134 +54,6 @@ where
         request::run(&request, &model, &worker.progress)
     })?
     .map_err(sim_error)
-}
-
-fn model_of(p: &Params) -> PyResult<CantileverModel> {
-    CantileverModel::new(p).map_err(crate::errors::param_error)
-}
-
-fn flatten(rows: impl IntoIterator<Item = DVector<f64>>) -> Vec<f64> {
-    rows.into_iter()
-        .flat_map(|z| z.iter().copied().collect::<Vec<_>>())
-        .collect()
-}
-
-/// Natural frequencies and damped eigenvalues of the free and contact systems (eqs. 19–23).
-#[pyfunction]
-#[pyo3(signature = (params, probe=None))]
-pub fn modes<'py>(
-    py: Python<'py>,
-    params: PyRef<'_, PyParams>,
-    probe: Option<String>,
-) -> PyResult<Dict<'py>> {
-    let doc = analysis(py, ModesRequest {}, params.inner, probe, None, false)?;
-    let (free, contact) = doc.output;
-    let out = Out::new(py);
-    out.json(&doc.json)?;
-    for (name, r) in [("free", &free), ("contact", &contact)] {
-        out.f64s(&format!("{name}_omega"), r.omega.clone())?;
-        out.complex(
-            &format!("{name}_eigenvalues"),
-            r.eigenvalues
-                .iter()
-                .map(|e| Complex64::new(e.re, e.im))
-                .collect(),
-        )?;
-        out.f64s(
-            &format!("{name}_zeta"),
-            r.eigenvalues.iter().map(|e| e.zeta).collect(),
-        )?;
-    }
-    Ok(out.finish())
-}
-
-/// One trajectory: time series, switchings, stroboscopic section and energy balance, laid out
-/// by the library ([`report::simulate_layout`]; with a probe every array in SI, as the command
-/// line's simulate files), with the JSON document and the run's scalars.
-#[pyfunction]
-#[pyo3(signature = (params, request=None, progress=None, probe=None))]
-pub fn simulate<'py>(
-    py: Python<'py>,
-    params: PyRef<'_, PyParams>,
-    request: Option<&Dict<'py>>,
-    progress: Option<Bound<'py, PyAny>>,
-    probe: Option<String>,
-) -> PyResult<Dict<'py>> {
-    let p = params.inner;
-    let probe = probe
-        .map(|text| Probe::parse(&text, "probe"))
-        .transpose()
-        .map_err(probe_error)?;
-    let request: SimulateRequest = crate::convert::request("simulate", request)?;
-    let span = request.validate_in_memory(&p).map_err(sim_error)?;
-    let su = report::SeriesUnits::new(&p, probe.as_ref());
-    let spp = request.samples_per_period;
-    let worker_su = su;
-    let (doc, layout, tau_end, switchings, body_contact, integrator) =
-        run_abandonable(py, progress.as_ref(), move || -> PyResult<_> {
-            let model = model_of(&p)?;
-            let (tr, integrator) = request.record_whole(&model, &span).map_err(sim_error)?;
-            let layout = report::simulate_layout(&model, &tr, &worker_su, spp);
-            let doc = report::simulate(&model, &tr);
-            let (events, body) = (tr.events.len(), tr.body_contact);
-            Ok((doc, layout, tr.tau_end, events, body, integrator))
-        })??;
-    let out = Out::new(py);
-    out.json(&report::with_si(doc, probe.as_ref(), &p))?;
-    out.set("layout", crate::convert::layout_dict(py, layout)?)?;
-    out.set("time", su.names().time)?;
-    out.set("tau_end", su.t(tau_end))?;
-    out.set("switchings", switchings)?;
-    out.set("body_contact", body_contact)?;
-    out.set("integrator", integrator)?;
-    out.set("transient_tau", su.t(span.transient_tau))?;
-    Ok(out.finish())
-}
-
-/// Mode-number convergence (paper Fig. 4).
-#[pyfunction]
-#[pyo3(signature = (params, request=None, progress=None, probe=None))]
-pub fn converge<'py>(
-    py: Python<'py>,
-    params: PyRef<'_, PyParams>,
-    request: Option<&Dict<'py>>,
-    progress: Option<Bound<'py, PyAny>>,
-    probe: Option<String>,
-) -> PyResult<Dict<'py>> {
-    let request: ConvergeRequest = crate::convert::request("converge", request)?;
-    let doc = analysis(py, request, params.inner, probe, progress.as_ref(), true)?;
-    let runs = doc.output;
-    let out = Out::new(py);
-    out.json(&doc.json)?;
-    let k = runs.iter().map(|r| r.w_tip.len()).min().unwrap_or(0);
-    let r = runs.len();
-    let t0 = runs[0].tau[0];
-    out.f64s(
-        "tau_from_section",
-        runs[0].tau[..k].iter().map(|t| t - t0).collect(),
-    )?;
-    let grab = |f: &dyn Fn(&afmdyn::analysis::converge::ConvergenceRun) -> &Vec<f64>| {
-        runs.iter()
-            .flat_map(|x| f(x)[..k].to_vec())
-            .collect::<Vec<f64>>()
-    };
-    out.matrix("tau", r, k, grab(&|x| &x.tau))?;
-    out.matrix("w_tip", r, k, grab(&|x| &x.w_tip))?;
-    out.matrix("v_t", r, k, grab(&|x| &x.v_t))?;
-    out.i64s("modes", runs.iter().map(|x| x.modes as i64).collect())?;
-    out.i64s(
-        "period",
-        runs.iter()
-            .map(|x| x.period.map_or(-1, |n| n as i64))
-            .collect(),
-    )?;
-    out.f64s(
-        "rms_change",
-        runs.iter()
-            .map(|x| x.rms_change.unwrap_or(f64::NAN))
-            .collect(),
-    )?;
-    Ok(out.finish())
 }
 
 /// A checkpoint error as Python sees it: a store of another request (or of none) is a
@@ -300,177 +164,6 @@ pub(crate) fn sweep_dict<'py>(
     Ok(out.finish())
 }
 
-fn steady_dict<'py>(py: Python<'py>, s: &SteadyState) -> PyResult<Dict<'py>> {
-    let out = Out::new(py);
-    out.set("period", s.period())?;
-    out.set("transient_periods", s.transient_periods)?;
-    out.f64s("section_tau", s.poincare.iter().map(|q| q.tau).collect())?;
-    out.f64s("section_v_t", s.poincare.iter().map(|q| q.v_t).collect())?;
-    out.f64s(
-        "section_w_tip",
-        s.poincare.iter().map(|q| q.w_tip).collect(),
-    )?;
-    let dim = s.poincare.first().map_or(0, |q| q.state.len());
-    out.matrix(
-        "section_state",
-        s.poincare.len(),
-        dim,
-        flatten(s.poincare.iter().map(|q| q.state.clone())),
-    )?;
-    let st = &s.stats;
-    out.set("x_max", st.x_max)?;
-    out.set("x_min", st.x_min)?;
-    out.set("v_t_min", st.v_t_min)?;
-    out.set("contact_fraction", st.contact_fraction)?;
-    out.set("contacts_per_period", st.contacts_per_period)?;
-    out.set("body_contact", st.body_contact)?;
-    Ok(out.finish())
-}
-
-/// Coexisting attractors and their basin fractions at fixed parameters.
-#[pyfunction]
-#[pyo3(signature = (params, request=None, progress=None, probe=None))]
-pub fn attractors<'py>(
-    py: Python<'py>,
-    params: PyRef<'_, PyParams>,
-    request: Option<&Dict<'py>>,
-    progress: Option<Bound<'py, PyAny>>,
-    probe: Option<String>,
-) -> PyResult<Dict<'py>> {
-    let request: AttractorsRequest = crate::convert::request("attractors", request)?;
-    let doc = analysis(py, request, params.inner, probe, progress.as_ref(), true)?;
-    let report_ = doc.output;
-    let out = Out::new(py);
-    out.json(&doc.json)?;
-    let list = PyList::empty(py);
-    for a in &report_.attractors {
-        let d = steady_dict(py, &a.steady)?;
-        d.set_item("count", a.count)?;
-        d.set_item("basin_fraction", a.basin_fraction)?;
-        d.set_item(
-            "initial",
-            numpy::IntoPyArray::into_pyarray(a.initial.as_slice().to_vec(), py),
-        )?;
-        list.append(d)?;
-    }
-    out.set("attractors", list)?;
-    out.set("failures", PyList::new(py, &report_.failures)?)?;
-    Ok(out.finish())
-}
-
-/// A period-n orbit by Newton shooting, with its Floquet multipliers.
-#[pyfunction]
-#[pyo3(signature = (params, request=None, progress=None, probe=None))]
-pub fn orbit<'py>(
-    py: Python<'py>,
-    params: PyRef<'_, PyParams>,
-    request: Option<&Dict<'py>>,
-    progress: Option<Bound<'py, PyAny>>,
-    probe: Option<String>,
-) -> PyResult<Dict<'py>> {
-    let request: OrbitRequest = crate::convert::request("orbit", request)?;
-    let doc = analysis(py, request, params.inner, probe, progress.as_ref(), false)?;
-    let o = doc.output;
-    let out = Out::new(py);
-    out.json(&doc.json)?;
-    let dim = o.state.len();
-    out.f64s("state", o.state.as_slice().to_vec())?;
-    out.matrix("section", o.section.len(), dim, flatten(o.section.clone()))?;
-    // nalgebra stores column-major: transpose into a row-major (C-ordered) buffer
-    out.matrix(
-        "monodromy",
-        dim,
-        dim,
-        o.monodromy.transpose().as_slice().to_vec(),
-    )?;
-    out.complex(
-        "multipliers",
-        o.multipliers
-            .iter()
-            .map(|m| Complex64::new(m.re, m.im))
-            .collect(),
-    )?;
-    out.f64s("newton_residuals", o.residuals.clone())?;
-    Ok(out.finish())
-}
-
-/// Pseudo-arclength continuation of a period-n branch, with located bifurcations: the JSON
-/// document and the branch points' layout ([`report::continuation_layout`]).
-#[pyfunction]
-#[pyo3(signature = (params, request=None, progress=None, probe=None))]
-pub fn continuation<'py>(
-    py: Python<'py>,
-    params: PyRef<'_, PyParams>,
-    request: Option<&Dict<'py>>,
-    progress: Option<Bound<'py, PyAny>>,
-    probe: Option<String>,
-) -> PyResult<Dict<'py>> {
-    let request: ContinuationRequest = crate::convert::request("continuation", request)?;
-    let base = params.inner;
-    let param = request.param;
-    let p0 = base.with(param, request.from);
-    let doc = analysis(py, request, base, probe, progress.as_ref(), true)?;
-    let model = model_of(&p0)?;
-    let out = Out::new(py);
-    out.json(&doc.json)?;
-    out.set("param", param.name())?;
-    let layout = report::continuation_layout(param, &model, &doc.output);
-    out.set("layout", crate::convert::layout_dict(py, layout)?)?;
-    Ok(out.finish())
-}
-
-/// Lyapunov spectrum (with saltation matrices) and the 0–1 test.
-#[pyfunction]
-#[pyo3(signature = (params, request=None, progress=None, probe=None))]
-pub fn lyapunov<'py>(
-    py: Python<'py>,
-    params: PyRef<'_, PyParams>,
-    request: Option<&Dict<'py>>,
-    progress: Option<Bound<'py, PyAny>>,
-    probe: Option<String>,
-) -> PyResult<Dict<'py>> {
-    let request: LyapunovRequest = crate::convert::request("lyapunov", request)?;
-    let doc = analysis(py, request, params.inner, probe, progress.as_ref(), true)?;
-    let l = doc.output;
-    let out = Out::new(py);
-    out.json(&doc.json)?;
-    out.f64s("exponents", l.exponents.clone())?;
-    out.f64s("uncertainty", l.uncertainty.clone())?;
-    Ok(out.finish())
-}
-
-/// The constant-amplitude FM-AFM curve over z_c (`afmdyn fm`): the JSON document (the
-/// Python layer builds the dataset from it).
-#[pyfunction]
-#[pyo3(signature = (params, request=None, progress=None, probe=None))]
-pub fn fm<'py>(
-    py: Python<'py>,
-    params: PyRef<'_, PyParams>,
-    request: Option<&Dict<'py>>,
-    progress: Option<Bound<'py, PyAny>>,
-    probe: Option<String>,
-) -> PyResult<Dict<'py>> {
-    let request: afmdyn::request::FmRequest = crate::convert::request("fm", request)?;
-    let doc = analysis(py, request, params.inner, probe, progress.as_ref(), true)?;
-    let out = Out::new(py);
-    out.json(&doc.json)?;
-    Ok(out.finish())
-}
-
-/// The force and potential behind a frequency-modulation curve (`afmdyn reconstruct`): the
-/// JSON document (the Python layer builds the dataset from it).
-#[pyfunction]
-#[pyo3(signature = (request=None, progress=None))]
-pub fn reconstruct<'py>(
-    py: Python<'py>,
-    request: Option<&Dict<'py>>,
-    progress: Option<Bound<'py, PyAny>>,
-) -> PyResult<Dict<'py>> {
-    let request: afmdyn::request::ReconstructRequest =
-        crate::convert::request("reconstruct", request)?;
-    reconstruction(py, request, progress)
-}
-
 /// The JSON document of a reconstruction request, run as every analysis is ([`analysis`]):
 /// cancellable (the inversion checks the cancel flag between chunks of rows; Ctrl-C stops it).
 fn reconstruction<'py>(
@@ -556,27 +249,6 @@ pub fn probe(text: &str) -> PyResult<(PyParams, String)> {
     let pr = Probe::parse(text, "probe").map_err(probe_error)?;
     let si = report::si(&pr, &pr.params, &serde_json::json!({}));
     Ok((PyParams { inner: pr.params }, si.to_string()))
-}
-
-/// Observables of the steady state reached from `initial` (default: rest): the steady state is
-/// found as by `orbit` (polished by Newton shooting when periodic), then
-/// [`afmdyn::analysis::observables::observe`] integrates `periods` orbit periods.
-#[pyfunction]
-#[pyo3(signature = (params, request=None, progress=None, probe=None))]
-pub fn observe<'py>(
-    py: Python<'py>,
-    params: PyRef<'_, PyParams>,
-    request: Option<&Dict<'py>>,
-    progress: Option<Bound<'py, PyAny>>,
-    probe: Option<String>,
-) -> PyResult<Dict<'py>> {
-    let request: ObserveRequest = crate::convert::request("observe", request)?;
-    let doc = analysis(py, request, params.inner, probe, progress.as_ref(), false)?;
-    let out = Out::new(py);
-    out.json(&doc.json)?;
-    out.f64s("state", doc.output.state.as_slice().to_vec())?;
-    out.set("period", doc.output.period)?;
-    Ok(out.finish())
 }
 
 /// The heights of a height map file (`.csv` or `.npy`, a relative path from the current

@@ -2,8 +2,7 @@
 //! the request is the one signature), and Rust results to Python objects: NumPy arrays that
 //! take over the Rust buffers (no copy), and JSON documents as Python dicts.
 
-use numpy::ndarray::Array2;
-use numpy::{Complex64, IntoPyArray};
+use numpy::IntoPyArray;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -28,19 +27,6 @@ impl<'py> Out<'py> {
     /// A 1-D float64 array owning `v`.
     pub fn f64s(&self, key: &str, v: Vec<f64>) -> PyResult<()> {
         self.dict.set_item(key, v.into_pyarray(self.py))
-    }
-    /// A 1-D int64 array.
-    pub fn i64s(&self, key: &str, v: Vec<i64>) -> PyResult<()> {
-        self.dict.set_item(key, v.into_pyarray(self.py))
-    }
-    /// A 1-D complex128 array.
-    pub fn complex(&self, key: &str, v: Vec<Complex64>) -> PyResult<()> {
-        self.dict.set_item(key, v.into_pyarray(self.py))
-    }
-    /// A C-ordered (rows × cols) float64 array owning the row-major `v`.
-    pub fn matrix(&self, key: &str, rows: usize, cols: usize, v: Vec<f64>) -> PyResult<()> {
-        let a = Array2::from_shape_vec((rows, cols), v).expect("rows × cols values");
-        self.dict.set_item(key, a.into_pyarray(self.py))
     }
     /// Any other value.
     pub fn set<V: IntoPyObject<'py>>(&self, key: &str, v: V) -> PyResult<()> {
@@ -307,14 +293,39 @@ pub fn request<R: serde::de::DeserializeOwned>(
     what: &str,
     kwargs: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<R> {
+    deserialize(what, kwargs, |d| R::deserialize(d))
+}
+
+/// The request of analysis `name` ([`afmdyn::request::named::parse`]) of its keywords, as
+/// [`request`]; `KeyError` for another name.
+pub fn named(
+    name: &str,
+    kwargs: Option<&Bound<'_, PyDict>>,
+) -> PyResult<Box<dyn afmdyn::request::Named>> {
+    // the curve of a multifrequency drive is the approach curve's request
+    let what = if name == "bimodal" { "approach" } else { name };
+    deserialize(what, kwargs, |d| afmdyn::request::named::parse(name, d))?
+        .ok_or_else(|| pyo3::exceptions::PyKeyError::new_err(name.to_string()))
+}
+
+/// `parse` of the keywords, its error naming the keyword (serde_path_to_error's path) and the
+/// kind of number in words: `TypeError` for an unknown keyword, else `ValueError`.
+fn deserialize<T>(
+    what: &str,
+    kwargs: Option<&Bound<'_, PyDict>>,
+    parse: impl FnOnce(serde_path_to_error::Deserializer<'_, '_, Val>) -> Result<T, DeError>,
+) -> PyResult<T> {
     let map = match kwargs {
         Some(d) => entries(d)?,
         None => Vec::new(),
     };
-    serde_path_to_error::deserialize(Val::Map(map)).map_err(|e| {
-        // the keyword's name (serde_path_to_error's path) and the kind of number in words
-        let path = e.path().to_string();
-        let e = e.into_inner();
+    let mut track = serde_path_to_error::Track::new();
+    let parsed = parse(serde_path_to_error::Deserializer::new(
+        Val::Map(map),
+        &mut track,
+    ));
+    parsed.map_err(|e| {
+        let path = track.path().to_string();
         let text = ["usize", "u64", "u32", "u16", "u8"]
             .iter()
             .fold(e.to_string(), |t, ty| {
@@ -331,33 +342,6 @@ pub fn request<R: serde::de::DeserializeOwned>(
             pyo3::exceptions::PyValueError::new_err(msg)
         }
     })
-}
-
-/// The default request of analysis `name` as a dict (`None`: no such analysis): what the
-/// Python functions' keywords default to.
-pub fn request_default(name: &str) -> Option<serde_json::Value> {
-    use afmdyn::request::*;
-    fn v<T: serde::Serialize + Default>() -> Option<serde_json::Value> {
-        serde_json::to_value(T::default()).ok()
-    }
-    match name {
-        "simulate" => v::<SimulateRequest>(),
-        "converge" => v::<ConvergeRequest>(),
-        "bifurcation" => v::<BifurcationRequest>(),
-        "attractors" => v::<AttractorsRequest>(),
-        "global_continuation" => v::<GlobalContinuationRequest>(),
-        "orbit" => v::<OrbitRequest>(),
-        "continuation" => v::<ContinuationRequest>(),
-        "lyapunov" => v::<LyapunovRequest>(),
-        "observe" => v::<ObserveRequest>(),
-        "approach" => v::<ApproachRequest>(),
-        "resonance" => v::<ResonanceRequest>(),
-        "basins" => v::<BasinsRequest>(),
-        "chart" => v::<ChartRequest>(),
-        "reconstruct" => v::<ReconstructRequest>(),
-        "fm" => v::<FmRequest>(),
-        _ => None,
-    }
 }
 
 /// The `__reduce__` of a study class that any process rebuilds from its recipe (a JSON text):

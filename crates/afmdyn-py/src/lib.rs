@@ -1,14 +1,19 @@
 //! `afmdyn._afmdyn`: the compiled part of the Python package `afmdyn`.
 //!
-//! The pure-Python layer (`python/afmdyn/`) is the public API; it calls these functions, which
-//! run the library's analyses with the GIL released and return dicts of NumPy arrays (owning
-//! the Rust buffers) and the command line's JSON documents, and turns them into xarray
-//! datasets and result objects.
+//! The pure-Python layer (`python/afmdyn/`) is the public API. Every analysis enters through
+//! one door, [`door::run`]`(name, request, params, probe, progress)`: the library parses the
+//! request by name and runs it ([`afmdyn::request::named`]) with the GIL released, and the
+//! document, the result's layouts (dicts of NumPy arrays owning the Rust buffers) and its
+//! scalars come back for the Python layer to turn into xarray datasets and result objects.
+//! The studies run into a store (`store=`, `resume=`: bifurcation, basins, global
+//! continuation, the stepped curves) and the Dask tasks (chart, basin map, PI scan) keep
+//! functions and classes of their own.
 
 mod analyses;
 mod basin_tasks;
 mod chart;
 mod convert;
+mod door;
 mod errors;
 mod image_tasks;
 mod params;
@@ -28,7 +33,7 @@ fn cantilevers() -> String {
 /// keywords: the one source of the Python functions' defaults. `KeyError` for another name.
 #[pyfunction]
 fn request_defaults<'py>(py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
-    let d = convert::request_default(name)
+    let d = afmdyn::request::named::default_request(name)
         .ok_or_else(|| pyo3::exceptions::PyKeyError::new_err(name.to_string()))?;
     convert::json_to_py(py, &d.to_string())
 }
@@ -48,23 +53,15 @@ fn _afmdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
         m.py().get_type::<errors::SimulationError>(),
     )?;
     m.add("FORCE_SIGN", afmdyn::contact::FORCE_SIGN)?;
-    m.add_function(wrap_pyfunction!(analyses::modes, m)?)?;
-    m.add_function(wrap_pyfunction!(analyses::simulate, m)?)?;
-    m.add_function(wrap_pyfunction!(analyses::converge, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::bifurcation, m)?)?;
-    m.add_function(wrap_pyfunction!(analyses::attractors, m)?)?;
     m.add_function(wrap_pyfunction!(studies::global_continuation, m)?)?;
     m.add_function(wrap_pyfunction!(studies::basins, m)?)?;
+    m.add_function(wrap_pyfunction!(door::run, m)?)?;
     m.add_function(wrap_pyfunction!(cantilevers, m)?)?;
     m.add_function(wrap_pyfunction!(request_defaults, m)?)?;
-    m.add_function(wrap_pyfunction!(analyses::orbit, m)?)?;
-    m.add_function(wrap_pyfunction!(analyses::continuation, m)?)?;
-    m.add_function(wrap_pyfunction!(analyses::lyapunov, m)?)?;
     m.add_function(wrap_pyfunction!(studies::approach, m)?)?;
     m.add_function(wrap_pyfunction!(studies::bimodal, m)?)?;
     m.add_function(wrap_pyfunction!(studies::resonance, m)?)?;
-    m.add_function(wrap_pyfunction!(analyses::reconstruct, m)?)?;
-    m.add_function(wrap_pyfunction!(analyses::fm, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::reconstruct_fm, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::reconstruct_am, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::image, m)?)?;
@@ -73,7 +70,6 @@ fn _afmdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(analyses::setpoint_study, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::probe, m)?)?;
     m.add_function(wrap_pyfunction!(params::probe_source, m)?)?;
-    m.add_function(wrap_pyfunction!(analyses::observe, m)?)?;
     m.add("POLL_SECONDS", run::POLL.as_secs_f64())?;
     m.add_function(wrap_pyfunction!(run::cancel_running, m)?)?;
     m.add_function(wrap_pyfunction!(params::resolve, m)?)?;

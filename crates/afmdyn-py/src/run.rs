@@ -151,20 +151,3 @@ where
         }
     }
 }
-
-/// [`run`] for a computation that cannot count its work or stop early: no progress count
-/// (`progress(0, None)`), abandoned on an interrupt ([`Stop::Abandon`]).
-///
-/// # Errors
-/// As [`run`].
-pub fn run_abandonable<T, F>(
-    py: Python<'_>,
-    progress: Option<&Bound<'_, PyAny>>,
-    work: F,
-) -> PyResult<T>
-where
-    T: Send + 'static,
-    F: FnOnce() -> T + Send + 'static,
-{
-    run(py, &Job::default(), None, progress, Stop::Abandon, work)
-}

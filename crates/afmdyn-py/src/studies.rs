@@ -1,20 +1,17 @@
 //! The studies that Python runs resumably in the command line's store (`store=`, `resume=`):
 //! a basin map ([`BasinStudy`]), a global continuation ([`ContinuationStudy`]) and the
 //! approach and resonance curves ([`CurveStudy`]: the stepped sweeps with branch continuation
-//! of [`afmdyn::analysis::stepped`], returning the command line's JSON documents); in memory
-//! (no `store`) they run through the request layer as every analysis does.
+//! of [`afmdyn::analysis::stepped`]), returning what the one door returns for the same request
+//! ([`crate::door::outcome_dict`]); in memory (no `store`) they go through the door.
 
-use crate::analyses::{analysis, checkpoint_error, lock_store, study_error};
-use crate::convert::Out;
-use crate::errors::{probe_error, sim_error, value_error};
+use crate::analyses::{checkpoint_error, lock_store, study_error};
+use crate::errors::{sim_error, value_error};
 use crate::params::PyParams;
 use crate::run::{run, Job, Stop};
 use afmdyn::analysis::progress::Progress;
 use afmdyn::analysis::stepped::SteppedCurve;
-use afmdyn::probe::Probe;
 use afmdyn::request::{
-    Analysis, ApproachRequest, BasinArrays, BasinsRequest, GlobalContinuationRequest, Resolved,
-    ResonanceRequest,
+    ApproachRequest, BasinsRequest, Datasets, GlobalContinuationRequest, Resolved, ResonanceRequest,
 };
 use afmdyn::study::basins::{basin_store, BasinStudy};
 use afmdyn::study::global_continuation::{continuation_store, ContinuationStudy};
@@ -28,10 +25,10 @@ use serde::de::DeserializeOwned;
 use serde::Serialize;
 use std::path::PathBuf;
 
-/// Where a study runs: in memory, or in the store of a directory.
+/// Where a study runs: the store of a directory.
 struct Place<'py> {
     params: Params,
-    store: Option<PathBuf>,
+    store: PathBuf,
     resume: bool,
     progress: Option<Bound<'py, PyAny>>,
     probe: Option<String>,
@@ -45,11 +42,11 @@ impl<'py> Place<'py> {
         progress: Option<Bound<'py, PyAny>>,
         probe: Option<String>,
     ) -> PyResult<Self> {
-        if resume && store.is_none() {
+        let Some(store) = store else {
             return Err(value_error(
                 "resume=True needs store= (the directory of the interrupted run)",
             ));
-        }
+        };
         Ok(Place {
             params,
             store,
@@ -59,10 +56,10 @@ impl<'py> Place<'py> {
         })
     }
 
-    /// The output of `request` on the place's parameters and its document: through the
-    /// request layer in memory, or the study `of` the request and the model run into the store
-    /// `open` makes of the directory's lock (resumed with `resume`) and its output `finish`ed
-    /// from the stored records (on `threads`, counting in the run's progress).
+    /// The outcome of `request` on the place's parameters: the study `of` the request and
+    /// the model run into the store `open` makes of the directory's lock (resumed with
+    /// `resume`) and its output `finish`ed from the stored records (on `threads`, counting in
+    /// the run's progress), with its document and datasets as the door's.
     fn output<A, S, R>(
         self,
         py: Python<'py>,
@@ -73,36 +70,20 @@ impl<'py> Place<'py> {
         finish: impl FnOnce(&S, Vec<(usize, R)>, &Progress) -> Result<A::Output, SimError>
             + Send
             + 'static,
-    ) -> PyResult<(A::Output, serde_json::Value)>
+    ) -> PyResult<Bound<'py, PyDict>>
     where
-        A: Analysis + Send + 'static,
+        A: Datasets + Send + 'static,
         A::Output: Send + 'static,
         S: Study<Record = (usize, R)> + Send + 'static,
         S::Done: StoredTasks<R>,
         R: Serialize + DeserializeOwned + Clone + Send + 'static,
     {
-        let Some(dir) = self.store else {
-            let doc = analysis(
-                py,
-                request,
-                self.params,
-                self.probe,
-                self.progress.as_ref(),
-                true,
-            )?;
-            return Ok((doc.output, doc.json));
-        };
-        let probe = self
-            .probe
-            .map(|text| Probe::parse(&text, "probe"))
-            .transpose()
-            .map_err(probe_error)?;
         let model = Resolved {
             params: self.params,
-            probe,
+            probe: crate::door::probe_of(self.probe)?,
         };
         let study = of(&request, &model).map_err(sim_error)?;
-        let lock = lock_store(&dir)?;
+        let lock = lock_store(&self.store)?;
         let resume = self.resume;
         let job = Job::default();
         let worker = job.clone();
@@ -121,24 +102,9 @@ impl<'py> Place<'py> {
                     .map_err(sim_error)
             },
         )??;
-        let json = afmdyn::request::run::document(&request, &model, &output).map_err(sim_error)?;
-        Ok((output, json))
+        let outcome = afmdyn::request::named::outcome(&request, &model, &output);
+        crate::door::outcome_dict(py, outcome.map_err(sim_error)?)
     }
-}
-
-/// What a study's function returns to the Python layer: `json` (the document) and, when the
-/// result has one, `layout` (its arrays, [`crate::convert::layout_dict`]).
-fn returned<'py>(
-    py: Python<'py>,
-    json: &serde_json::Value,
-    layout: Option<afmdyn::layout::Layout>,
-) -> PyResult<Bound<'py, PyDict>> {
-    let out = Out::new(py);
-    out.json(json)?;
-    if let Some(l) = layout {
-        out.set("layout", crate::convert::layout_dict(py, l)?)?;
-    }
-    Ok(out.finish())
 }
 
 /// A basin map over two coordinates of the initial state (see `afmdyn.basins`); with `store`
@@ -157,17 +123,15 @@ pub fn basins<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let request: BasinsRequest = crate::convert::request("basins", request)?;
     let place = Place::new(params.inner, store, resume, progress, probe)?;
-    let spec = request.spec(&params.inner).map_err(sim_error)?;
     let threads = request.threads;
-    let (map, json) = place.output(
+    place.output(
         py,
         request,
         |r, m| BasinStudy::new(r, &m.params),
         threads,
         basin_store,
         |s: &BasinStudy, records, _| s.map(records.into_iter().map(|(_, r)| r)),
-    )?;
-    returned(py, &json, Some(BasinArrays::new(&map).layout(&spec)))
+    )
 }
 
 /// Attractors continued over a parameter (global continuation): the JSON document of
@@ -189,17 +153,14 @@ pub fn global_continuation<'py>(
     let request: GlobalContinuationRequest =
         crate::convert::request("global_continuation", request)?;
     let place = Place::new(params.inner, store, resume, progress, probe)?;
-    let param = request.param;
-    let (steps, json) = place.output(
+    place.output(
         py,
         request,
         |r, m| ContinuationStudy::new(r, &m.params),
         None,
         continuation_store,
         |s: &ContinuationStudy, records, _| s.steps(records),
-    )?;
-    let layout = afmdyn::report::global_continuation_layout(param, &steps);
-    returned(py, &json, Some(layout))
+    )
 }
 
 /// A stepped curve's document: the request `R` named `name` on `params`, through
@@ -212,18 +173,17 @@ fn curve<'py, R>(
     of: fn(&R, &Resolved) -> Result<CurveStudy, SimError>,
 ) -> PyResult<Bound<'py, PyDict>>
 where
-    R: Analysis<Output = SteppedCurve> + DeserializeOwned + Send + 'static,
+    R: Datasets<Output = SteppedCurve> + DeserializeOwned + Send + 'static,
 {
     let request: R = crate::convert::request(name, request)?;
-    let (_, json) = place.output(
+    place.output(
         py,
         request,
         of,
         None,
         curve_store,
         |s: &CurveStudy, records, progress| s.curve(records, progress),
-    )?;
-    returned(py, &json, None)
+    )
 }
 
 /// The approach–retract curve over the rest distance z_c (`afmdyn approach`); with `store` (a

@@ -37,7 +37,7 @@ pub mod simulate;
 
 use afmdyn::analysis::progress::Progress;
 use afmdyn::probe::Probe;
-use afmdyn::request::{self, Analysis, ModelSpec, Resolved};
+use afmdyn::request::{self, ModelSpec, Resolved};
 use afmdyn::Params;
 use serde::de::DeserializeOwned;
 use serde::Deserialize;
@@ -116,16 +116,6 @@ pub(crate) fn request<R: DeserializeOwned + Default>(request: Option<Value>) -> 
     }
 }
 
-/// Run `A` read from `request` on `model`: its JSON document as text.
-fn document<A: Analysis + DeserializeOwned + Default>(
-    r: Option<Value>,
-    model: &Resolved,
-) -> Result<String, String> {
-    let a: A = request(r)?;
-    let doc = request::run(&a, model, &Progress::new()).map_err(|e| e.to_string())?;
-    Ok(doc.json.to_string())
-}
-
 /// Run the analysis `analysis` (one of [`ANALYSES`]) on `input` (module docs): the document as
 /// JSON text, or the error's one-line message.
 ///
@@ -146,23 +136,15 @@ pub fn run_json(analysis: &str, input: &str) -> Result<String, String> {
         _ => {}
     }
     let (model, r) = resolve(input, analysis)?;
-    match analysis {
-        "modes" => document::<request::ModesRequest>(r, &model),
-        "orbit" => document::<request::OrbitRequest>(r, &model),
-        "observe" => document::<request::ObserveRequest>(r, &model),
-        "lyapunov" => document::<request::LyapunovRequest>(r, &model),
-        "continuation" => document::<request::ContinuationRequest>(r, &model),
-        "attractors" => document::<request::AttractorsRequest>(r, &model),
-        "converge" => document::<request::ConvergeRequest>(r, &model),
-        "approach" => document::<request::ApproachRequest>(r, &model),
-        "resonance" => document::<request::ResonanceRequest>(r, &model),
-        "fm" => document::<request::fm::FmRequest>(r, &model),
-        // afmdyn bimodal: the approach curve of a drive of two or more components
-        _ => {
-            request::curves::check_bimodal(&model.params).map_err(|e| e.to_string())?;
-            document::<request::ApproachRequest>(r, &model)
-        }
-    }
+    // the one door: the request parsed by name, run to its outcome (its document here)
+    let r = r.unwrap_or_else(|| Value::Object(Default::default()));
+    let named = request::named::parse(analysis, r)
+        .map_err(|e| format!("request: {e}"))?
+        .ok_or_else(|| format!("analysis = {analysis}: not a named analysis"))?;
+    let outcome = named
+        .run(&model, &Progress::new())
+        .map_err(|e| e.to_string())?;
+    Ok(outcome.document.to_string())
 }
 
 /// Most drive periods [`advance_periods`] integrates.

@@ -2,7 +2,7 @@
 functions wrap these and build the datasets and result objects)."""
 
 import os
-from typing import Any, Callable, Dict, List, Literal, Optional, Tuple, TypedDict, Union
+from typing import Any, Callable, Dict, List, Literal, Optional, Tuple, TypedDict, Union, overload
 
 ProgressCallback = Callable[[int, Optional[int]], object]
 
@@ -179,7 +179,6 @@ class Params:
     def __eq__(self, other: object) -> bool: ...
     def __reduce__(self) -> Tuple[Any, Tuple[str]]: ...
 
-def modes(params: Params, probe: Optional[str] = None) -> Dict[str, Any]: ...
 def request_defaults(name: str) -> Dict[str, Any]:
     """The default request of analysis ``name`` (the library's ``Default``) as a dict."""
 
@@ -219,28 +218,6 @@ ConvergeRequest = TypedDict(
         "samples_per_period": int,  # default 200
         "steps_per_period": Optional[int],  # default null
         "tolerance": float,  # default 1e-12
-    },
-    total=False,
-)
-
-BifurcationRequest = TypedDict(
-    "BifurcationRequest",
-    {
-        "continuation": bool,  # default true
-        "from": float,  # default 1.0
-        "integrator": Literal["auto", "exact", "rk4", "rk4-naive", "adaptive", "split", "taylor"],  # default "auto"
-        "max_period": int,  # default 64
-        "max_periods": Optional[int],  # default null
-        "param": Literal["omega", "alpha1", "alpha2", "alpha3", "alpha4", "alpha5", "alpha6"],  # default "omega"
-        "seed": int,  # default 1
-        "starts": int,  # default 0
-        "steps": int,  # default 400
-        "steps_per_period": Optional[int],  # default null
-        "threads": Optional[int],  # default null
-        "to": float,  # default 5.0
-        "tol": float,  # default 1e-08
-        "tolerance": float,  # default 1e-12
-        "values": Optional[List[float]],  # default null
     },
     total=False,
 )
@@ -345,22 +322,6 @@ ApproachRequest = TypedDict(
     total=False,
 )
 
-ApproachRequest = TypedDict(
-    "ApproachRequest",
-    {
-        "average": bool,  # default false
-        "branches": bool,  # default true
-        "from": Optional[float],  # default null
-        "points": Optional[int],  # default null
-        "setpoint": Optional[float],  # default null
-        "step": Optional[float],  # default null
-        "to": Optional[float],  # default null
-        "tolerance": float,  # default 1e-10
-        "traces": Optional[int],  # default null
-    },
-    total=False,
-)
-
 ResonanceRequest = TypedDict(
     "ResonanceRequest",
     {
@@ -419,6 +380,42 @@ FmRequest = TypedDict(
     total=False,
 )
 
+ReconstructRequest = TypedDict(
+    "ReconstructRequest",
+    {
+        "amplitude": float,  # default 0.0
+        "distance": Optional[List[float]],  # default null
+        "frequency_shift": List[float],  # default []
+        "law_force": Optional[List[float]],  # default null
+        "resonance_frequency": float,  # default 0.0
+        "spring_constant": float,  # default 0.0
+        "z_c": Optional[List[float]],  # default null
+    },
+    total=False,
+)
+
+BifurcationRequest = TypedDict(
+    "BifurcationRequest",
+    {
+        "continuation": bool,  # default true
+        "from": float,  # default 1.0
+        "integrator": Literal["auto", "exact", "rk4", "rk4-naive", "adaptive", "split", "taylor"],  # default "auto"
+        "max_period": int,  # default 64
+        "max_periods": Optional[int],  # default null
+        "param": Literal["omega", "alpha1", "alpha2", "alpha3", "alpha4", "alpha5", "alpha6"],  # default "omega"
+        "seed": int,  # default 1
+        "starts": int,  # default 0
+        "steps": int,  # default 400
+        "steps_per_period": Optional[int],  # default null
+        "threads": Optional[int],  # default null
+        "to": float,  # default 5.0
+        "tol": float,  # default 1e-08
+        "tolerance": float,  # default 1e-12
+        "values": Optional[List[float]],  # default null
+    },
+    total=False,
+)
+
 ChartRequest = TypedDict(
     "ChartRequest",
     {
@@ -447,32 +444,148 @@ ChartRequest = TypedDict(
     total=False,
 )
 
-ReconstructRequest = TypedDict(
-    "ReconstructRequest",
-    {
-        "amplitude": float,  # default 0.0
-        "distance": Optional[List[float]],  # default null
-        "frequency_shift": List[float],  # default []
-        "law_force": Optional[List[float]],  # default null
-        "resonance_frequency": float,  # default 0.0
-        "spring_constant": float,  # default 0.0
-        "z_c": Optional[List[float]],  # default null
-    },
-    total=False,
-)
-
-def simulate(
-    params: Params,
-    request: Optional[SimulateRequest] = None,
-    progress: Optional[ProgressCallback] = None,
+@overload
+def run(
+    name: Literal["modes"],
+    request: Optional[Dict[str, Any]] = None,
+    params: Optional[Params] = None,
     probe: Optional[str] = None,
+    progress: Optional[ProgressCallback] = None,
 ) -> Dict[str, Any]: ...
 
-def converge(
-    params: Params,
-    request: Optional[ConvergeRequest] = None,
-    progress: Optional[ProgressCallback] = None,
+@overload
+def run(
+    name: Literal["simulate"],
+    request: Optional[SimulateRequest] = None,
+    params: Optional[Params] = None,
     probe: Optional[str] = None,
+    progress: Optional[ProgressCallback] = None,
+) -> Dict[str, Any]: ...
+
+@overload
+def run(
+    name: Literal["converge"],
+    request: Optional[ConvergeRequest] = None,
+    params: Optional[Params] = None,
+    probe: Optional[str] = None,
+    progress: Optional[ProgressCallback] = None,
+) -> Dict[str, Any]: ...
+
+@overload
+def run(
+    name: Literal["attractors"],
+    request: Optional[AttractorsRequest] = None,
+    params: Optional[Params] = None,
+    probe: Optional[str] = None,
+    progress: Optional[ProgressCallback] = None,
+) -> Dict[str, Any]: ...
+
+@overload
+def run(
+    name: Literal["global_continuation"],
+    request: Optional[GlobalContinuationRequest] = None,
+    params: Optional[Params] = None,
+    probe: Optional[str] = None,
+    progress: Optional[ProgressCallback] = None,
+) -> Dict[str, Any]: ...
+
+@overload
+def run(
+    name: Literal["orbit"],
+    request: Optional[OrbitRequest] = None,
+    params: Optional[Params] = None,
+    probe: Optional[str] = None,
+    progress: Optional[ProgressCallback] = None,
+) -> Dict[str, Any]: ...
+
+@overload
+def run(
+    name: Literal["continuation"],
+    request: Optional[ContinuationRequest] = None,
+    params: Optional[Params] = None,
+    probe: Optional[str] = None,
+    progress: Optional[ProgressCallback] = None,
+) -> Dict[str, Any]: ...
+
+@overload
+def run(
+    name: Literal["lyapunov"],
+    request: Optional[LyapunovRequest] = None,
+    params: Optional[Params] = None,
+    probe: Optional[str] = None,
+    progress: Optional[ProgressCallback] = None,
+) -> Dict[str, Any]: ...
+
+@overload
+def run(
+    name: Literal["observe"],
+    request: Optional[ObserveRequest] = None,
+    params: Optional[Params] = None,
+    probe: Optional[str] = None,
+    progress: Optional[ProgressCallback] = None,
+) -> Dict[str, Any]: ...
+
+@overload
+def run(
+    name: Literal["approach"],
+    request: Optional[ApproachRequest] = None,
+    params: Optional[Params] = None,
+    probe: Optional[str] = None,
+    progress: Optional[ProgressCallback] = None,
+) -> Dict[str, Any]: ...
+
+@overload
+def run(
+    name: Literal["bimodal"],
+    request: Optional[ApproachRequest] = None,
+    params: Optional[Params] = None,
+    probe: Optional[str] = None,
+    progress: Optional[ProgressCallback] = None,
+) -> Dict[str, Any]: ...
+
+@overload
+def run(
+    name: Literal["resonance"],
+    request: Optional[ResonanceRequest] = None,
+    params: Optional[Params] = None,
+    probe: Optional[str] = None,
+    progress: Optional[ProgressCallback] = None,
+) -> Dict[str, Any]: ...
+
+@overload
+def run(
+    name: Literal["basins"],
+    request: Optional[BasinsRequest] = None,
+    params: Optional[Params] = None,
+    probe: Optional[str] = None,
+    progress: Optional[ProgressCallback] = None,
+) -> Dict[str, Any]: ...
+
+@overload
+def run(
+    name: Literal["fm"],
+    request: Optional[FmRequest] = None,
+    params: Optional[Params] = None,
+    probe: Optional[str] = None,
+    progress: Optional[ProgressCallback] = None,
+) -> Dict[str, Any]: ...
+
+@overload
+def run(
+    name: Literal["reconstruct"],
+    request: Optional[ReconstructRequest] = None,
+    params: Optional[Params] = None,
+    probe: Optional[str] = None,
+    progress: Optional[ProgressCallback] = None,
+) -> Dict[str, Any]: ...
+
+@overload
+def run(
+    name: str,
+    request: Optional[Dict[str, Any]] = None,
+    params: Optional[Params] = None,
+    probe: Optional[str] = None,
+    progress: Optional[ProgressCallback] = None,
 ) -> Dict[str, Any]: ...
 
 def bifurcation(
@@ -483,13 +596,6 @@ def bifurcation(
     resume: bool = False,
 ) -> Dict[str, Any]: ...
 
-def attractors(
-    params: Params,
-    request: Optional[AttractorsRequest] = None,
-    progress: Optional[ProgressCallback] = None,
-    probe: Optional[str] = None,
-) -> Dict[str, Any]: ...
-
 def global_continuation(
     params: Params,
     request: Optional[GlobalContinuationRequest] = None,
@@ -497,34 +603,6 @@ def global_continuation(
     probe: Optional[str] = None,
     store: Optional[str] = None,
     resume: bool = False,
-) -> Dict[str, Any]: ...
-
-def orbit(
-    params: Params,
-    request: Optional[OrbitRequest] = None,
-    progress: Optional[ProgressCallback] = None,
-    probe: Optional[str] = None,
-) -> Dict[str, Any]: ...
-
-def continuation(
-    params: Params,
-    request: Optional[ContinuationRequest] = None,
-    progress: Optional[ProgressCallback] = None,
-    probe: Optional[str] = None,
-) -> Dict[str, Any]: ...
-
-def lyapunov(
-    params: Params,
-    request: Optional[LyapunovRequest] = None,
-    progress: Optional[ProgressCallback] = None,
-    probe: Optional[str] = None,
-) -> Dict[str, Any]: ...
-
-def observe(
-    params: Params,
-    request: Optional[ObserveRequest] = None,
-    progress: Optional[ProgressCallback] = None,
-    probe: Optional[str] = None,
 ) -> Dict[str, Any]: ...
 
 def approach(
@@ -563,19 +641,8 @@ def basins(
     resume: bool = False,
 ) -> Dict[str, Any]: ...
 
-def fm(
-    params: Params,
-    request: Optional[FmRequest] = None,
-    progress: Optional[ProgressCallback] = None,
-    probe: Optional[str] = None,
-) -> Dict[str, Any]: ...
-
 # --- end of the generated block ---
 
-def reconstruct(
-    request: Optional[ReconstructRequest] = None,
-    progress: Optional[ProgressCallback] = None,
-) -> Dict[str, Any]: ...
 def reconstruct_am(
     document: str, progress: Optional[ProgressCallback] = None
 ) -> Dict[str, Any]: ...

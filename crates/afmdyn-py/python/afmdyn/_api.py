@@ -28,11 +28,10 @@ from . import _afmdyn as _core
 from ._afmdyn import Params
 from ._common import (  # noqa: F401 (_params, _probe_text, _typed, _warn: used by _chart, dask)
     _DEFAULTS,
-    _G,
-    _T,
     Model,
     StateLike,
     _attrs,
+    _door,
     _params,
     _probe_text,
     _request,
@@ -61,10 +60,11 @@ def modes(params: Optional[Params] = None, /, **model: Unpack[Model]) -> Spectru
     complex128, ζ); ``to_dict()`` is ``afmdyn modes --json``.
     """
     p, probe = _params(params, model)
-    d = _core.modes(p, probe=probe)
+    d = _door("modes", "modes", False, p, probe)
 
     def region(name: str) -> RegionSpectrum:
-        return RegionSpectrum(d[f"{name}_omega"], d[f"{name}_eigenvalues"], d[f"{name}_zeta"])
+        v = _layout.variables(d["datasets"][name])
+        return RegionSpectrum(v["omega"][1], v["eigenvalues"][1], v["zeta"][1])
 
     return Spectrum(p, region("free"), region("contact"), d["json"])
 
@@ -118,19 +118,20 @@ def simulate(
     """
     req = _request(locals(), initial=_state(initial))
     p, probe = _params(params, model)
-    d = _run(_core.simulate, "simulate", progress, p, si=probe, request=req)
+    d = _door("simulate", "simulate", progress, p, probe, req)
+    f = d["facts"]
     attrs = _attrs(
         p,
         summary=d["json"],
-        tau_end=d["tau_end"],
-        switchings=d["switchings"],
-        body_contact=int(d["body_contact"]),
-        integrator=d["integrator"],
-        transient_tau=d["transient_tau"],
+        tau_end=f["tau_end"],
+        switchings=f["switchings"],
+        body_contact=int(f["body_contact"]),
+        integrator=f["integrator"],
+        transient_tau=f["transient_tau"],
         samples_per_period=samples_per_period,
     )
     # with a probe the library laid every array out in SI (report::simulate_layout)
-    return _layout.dataset(d["layout"], attrs)
+    return _layout.dataset(d["datasets"]["simulate"], attrs)
 
 
 @_typed
@@ -163,37 +164,9 @@ def converge(
     """
     req = _request(locals())
     p, probe = _params(params, model, default=Params(omega=4.1))
-    d = _run(_core.converge, "converge", progress, p, si=probe, request=req)
-    return xr.Dataset(
-        data_vars={
-            "w_tip": (
-                ("n_modes", "sample"),
-                d["w_tip"],
-                {**_G, "long_name": "tip deflection W(1,τ)"},
-            ),
-            "v_t": (("n_modes", "sample"), d["v_t"], {**_G, "long_name": "V_T"}),
-            "tau": (("n_modes", "sample"), d["tau"], _T),
-            "period": (
-                "n_modes",
-                d["period"],
-                {"long_name": "period of the steady state (−1: nonperiodic)"},
-            ),
-            "rms_change": (
-                "n_modes",
-                d["rms_change"],
-                {**_G, "long_name": "RMS of W_tip(N) − W_tip(N−1)"},
-            ),
-        },
-        coords={
-            "n_modes": ("n_modes", d["modes"], {"long_name": "number of Galerkin modes N"}),
-            "tau_from_section": (
-                "sample",
-                d["tau_from_section"],
-                {**_T, "long_name": "τ − τ0 from a section point"},
-            ),
-        },
-        attrs=_attrs(p, summary=d["json"]),
-    )
+    d = _door("converge", "converge", progress, p, probe, req)
+    attrs = _attrs(p, summary=d["json"])
+    return _layout.dataset(d["datasets"]["converge"], attrs, coords=("tau_from_section",))
 
 
 @_typed
@@ -326,8 +299,9 @@ def continuation(
     """
     req = _start(_request(locals(), initial=_state(initial)))
     p, probe = _params(params, model)
-    d = _run(_core.continuation, "continuation", progress, p, si=probe, request=req)
-    ds = _layout.dataset(d["layout"], _attrs(p, param=d["param"], summary=d["json"]))
+    d = _door("continuation", "continuation", progress, p, probe, req)
+    attrs = _attrs(p, param=d["facts"]["param"], summary=d["json"])
+    ds = _layout.dataset(d["datasets"]["continuation"], attrs)
     return ds.set_coords("value")
 
 
@@ -396,10 +370,10 @@ def observe(
     """
     req = _start(_request(locals(), initial=_state(initial)))
     p, probe = _params(params, model)
-    d = _run(_core.observe, "observe", progress, p, si=probe, request=req)
+    d = _door("observe", "observe", progress, p, probe, req)
     doc: Dict[str, Any] = json.loads(d["json"])
-    doc["state"] = d["state"]
-    doc["period"] = d["period"]
+    doc["state"] = _layout.variables(d["datasets"]["observe"])["state"][1]
+    doc["period"] = d["facts"]["period"]
     return observe_dataset(doc)
 
 
@@ -417,8 +391,10 @@ def _curve(
     line's resumable store ``store`` when given — and return its dataset
     (:func:`afmdyn._curves.curve_dataset`; in SI with a probe)."""
     p, probe = _params(params, model)
-    d = _run(fn, desc, progress, p, si=probe, request=request,
-             store=store, resume=resume)
+    if store is None and not resume:
+        d = _door(desc, desc, progress, p, probe, request)
+    else:
+        d = _run(fn, desc, progress, p, si=probe, request=request, store=store, resume=resume)
     return curve_dataset(desc, json.loads(d["json"]))
 
 

@@ -11,9 +11,9 @@ from typing import TYPE_CHECKING, Any, Dict, Iterator, List, Optional, Sequence,
 import numpy as np
 
 from ._afmdyn import Params
-from . import _afmdyn as _core
+from . import _layout
 from ._api import simulate
-from ._common import _DEFAULTS, Model, _params, _request, _run, _typed
+from ._common import _DEFAULTS, Model, _door, _params, _request, _typed
 from ._orbits import orbit
 from ._progress import ProgressArg
 from ._results import Orbit, _Document
@@ -193,28 +193,15 @@ def attractors(
     """
     req = _request(locals())
     p, probe = _params(params, model)
-    d = _run(_core.attractors, "attractors", progress, p, si=probe, request=req)
+    d = _door("attractors", "attractors", progress, p, probe, req)
     doc = json.loads(d["json"])
-    found = [
-        Attractor(
-            params=p,
-            period=a["period"],
-            count=a["count"],
-            basin_fraction=a["basin_fraction"],
-            section_tau=a["section_tau"],
-            section_v_t=a["section_v_t"],
-            section_w_tip=a["section_w_tip"],
-            section_state=a["section_state"],
-            initial=a["initial"],
-            x_max=a["x_max"],
-            x_min=a["x_min"],
-            v_t_min=a["v_t_min"],
-            contact_fraction=a["contact_fraction"],
-            contacts_per_period=a["contacts_per_period"],
-            body_contact=a["body_contact"],
-            transient_periods=a["transient_periods"],
-            _doc=entry,
-        )
-        for a, entry in zip(d["attractors"], doc["attractors"])
+    # each attractor's layout (attractor-1, …): its arrays, and its scalars as Python's
+    found_arrays = [
+        {k: (v[1] if v[0] else v[1].item()) for k, v in _layout.variables(a).items()}
+        for a in d["datasets"].values()
     ]
-    return Attractors(p, samples, found, list(d["failures"]), d["json"])
+    found = [
+        Attractor(params=p, period=entry["period"], _doc=entry, **a)
+        for a, entry in zip(found_arrays, doc["attractors"])
+    ]
+    return Attractors(p, samples, found, list(d["facts"]["failures"]), d["json"])

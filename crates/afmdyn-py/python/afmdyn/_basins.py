@@ -13,7 +13,7 @@ import xarray as xr
 from . import _afmdyn as _core
 from . import _layout
 from ._afmdyn import Params
-from ._common import _DEFAULTS, Model, _params, _request, _run, _typed
+from ._common import _DEFAULTS, Model, _door, _params, _request, _run, _typed
 from ._progress import ProgressArg
 
 if TYPE_CHECKING:
@@ -79,17 +79,12 @@ def basins(
     """
     req = _request(locals())
     p, probe = _params(params, model)
-    d = _run(
-        _core.basins,
-        "starts",
-        progress,
-        p,
-        si=probe,
-        request=req,
-        store=store,
-        resume=resume,
-    )
-    return _dataset(d["layout"], json.loads(d["json"]), p)
+    if store is None and not resume:
+        d = _door("basins", "starts", progress, p, probe, req)
+    else:
+        d = _run(_core.basins, "starts", progress, p, si=probe, request=req, store=store,
+                 resume=resume)
+    return _dataset(d["datasets"]["basins"], json.loads(d["json"]), p)
 
 
 def _dataset(layout: Any, doc: Any, p: Params) -> xr.Dataset:

@@ -99,12 +99,6 @@ UNITS_NOTE = (
     "gap g0, forces in EI g0/L³, energies in EI g0²/L³"
 )
 
-# the model's units as the library names them (afmdyn::report::SeriesNames, the command
-# line's files): τ, g0, g0 per unit τ
-_T = {"units": "τ (eq. 5)", "long_name": "time τ"}
-_G = {"units": "g0"}
-_V = {"units": "g0 per unit τ"}
-
 
 def _real_array(name: str, v: Any, ndim: int) -> np.ndarray:
     """``v`` as a float64 array of ``ndim`` dimensions, or a ``ValueError`` naming ``name``: a
@@ -319,6 +313,25 @@ def _run(
         d = fn(p, request, progress=cb, **extra)
     if isinstance(d, dict):
         _warn(d.get("json"))
+    return d
+
+
+def _door(
+    name: str,
+    desc: str,
+    progress: ProgressArg,
+    p: Optional[Params] = None,
+    si: Optional[str] = None,
+    request: Optional[Dict[str, Any]] = None,
+) -> Dict[str, Any]:
+    """Run analysis ``name`` through the one door of the core (``_afmdyn.run``: the library
+    parses the request by name, runs it and lays out its arrays) with a progress reporter:
+    ``{"json": document, "datasets": {name: layout}, "facts": dict}``; negative counts are a
+    ValueError naming the option, the document's warnings are issued (as by :func:`_run`)."""
+    _check_counts(request or {})
+    with reporter(progress, desc) as cb:
+        d: Dict[str, Any] = _core.run(name, request, p, si, cb)
+    _warn(d["json"])
     return d
 
 

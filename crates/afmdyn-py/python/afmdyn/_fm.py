@@ -10,9 +10,8 @@ from typing import TYPE_CHECKING, Any, Dict, Optional
 import numpy as np
 import xarray as xr
 
-from . import _afmdyn as _core
 from ._afmdyn import Params
-from ._common import _DEFAULTS, Model, _params, _request, _run, _typed
+from ._common import _DEFAULTS, Model, _door, _params, _request, _typed
 from ._progress import ProgressArg
 
 if TYPE_CHECKING:  # annotations only (PEP 692)
@@ -122,5 +121,5 @@ def fm(
     """
     request = _request(locals())
     p, probe = _params(params, model)
-    d = _run(_core.fm, "fm", progress, p, si=probe, request=request)
+    d = _door("fm", "fm", progress, p, probe, request)
     return fm_dataset(json.loads(d["json"]))

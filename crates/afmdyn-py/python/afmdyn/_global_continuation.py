@@ -12,7 +12,7 @@ import xarray as xr
 from . import _afmdyn as _core
 from . import _layout
 from ._afmdyn import Params
-from ._common import _DEFAULTS, Model, _params, _request, _run, _typed
+from ._common import _DEFAULTS, Model, _door, _params, _request, _run, _typed
 from ._progress import ProgressArg
 
 if TYPE_CHECKING:
@@ -67,20 +67,16 @@ def global_continuation(
     """
     req = _request(locals())
     p, probe = _params(params, model)
-    d = _run(
-        _core.global_continuation,
-        "starts",
-        progress,
-        p,
-        si=probe,
-        request=req,
-        store=store,
-        resume=resume,
-    )
+    if store is None and not resume:
+        d = _door("global_continuation", "starts", progress, p, probe, req)
+    else:
+        d = _run(_core.global_continuation, "starts", progress, p, si=probe, request=req,
+                 store=store, resume=resume)
+    layout = d["datasets"]["global_continuation"]
     doc = json.loads(d["json"])
     # the library's layout (the command line's attractors-sweep.nc)
     return _layout.dataset(
-        d["layout"],
+        layout,
         {"param": doc["param"], "samples": samples, "match_tol": match_tol,
          "summary": json.dumps(doc)},
     )

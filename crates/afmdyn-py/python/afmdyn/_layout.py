@@ -28,13 +28,18 @@ def variables(
     return out
 
 
-def dataset(layout: Dict[str, Any], attrs: Optional[Dict[str, Any]] = None) -> xr.Dataset:
+def dataset(
+    layout: Dict[str, Any],
+    attrs: Optional[Dict[str, Any]] = None,
+    coords: Tuple[str, ...] = (),
+) -> xr.Dataset:
     """The ``xarray.Dataset`` of ``layout``: a variable named as its one dimension is that
-    dimension's coordinate, every other one a data variable."""
-    data, coords = {}, {}
+    dimension's coordinate, and so is every one named in ``coords``; every other one a data
+    variable."""
+    data, coord = {}, {}
     for name, v in variables(layout).items():
-        (coords if v[0] == (name,) else data)[name] = v
-    return xr.Dataset(data_vars=data, coords=coords, attrs=attrs or {})
+        (coord if v[0] == (name,) or name in coords else data)[name] = v
+    return xr.Dataset(data_vars=data, coords=coord, attrs=attrs or {})
 
 
 def over(layout: Dict[str, Any], lead: Tuple[str, ...]) -> List[str]:

@@ -8,15 +8,15 @@ from typing import TYPE_CHECKING, Optional
 
 import numpy as np
 
-from . import _afmdyn as _core
+from . import _layout
 from ._afmdyn import Params
 from ._common import (
     _DEFAULTS,
     Model,
     StateLike,
+    _door,
     _params,
     _request,
-    _run,
     _start,
     _start_period,
     _state,
@@ -63,23 +63,24 @@ def orbit(
     if period is None:
         period = _start_period(initial)
     req = _start(_request(names, period=period, initial=_state(initial)))
-    d = _run(_core.orbit, "orbit", progress, p, si=probe, request=req)
+    d = _door("orbit", "orbit", progress, p, probe, req)
     doc = json.loads(d["json"])
+    v = {k: x[1] for k, x in _layout.variables(d["datasets"]["orbit"]).items()}
     return Orbit(
         params=p,
         period=doc["period"],
-        state=d["state"],
-        section=d["section"],
+        state=v["state"],
+        section=v["section"],
         poincare_v_t=np.asarray(doc["poincare"]["v_t"], dtype=np.float64),
         poincare_w_tip=np.asarray(doc["poincare"]["w_tip"], dtype=np.float64),
-        monodromy=d["monodromy"],
-        multipliers=d["multipliers"],
+        monodromy=v["monodromy"],
+        multipliers=v["multipliers"],
         stable=doc["stable"],
         critical=doc["critical"],
         grazing=doc["grazing"],
         grazing_distance=doc["grazing_distance"],
         switchings=doc["switchings"],
-        newton_residuals=d["newton_residuals"],
+        newton_residuals=v["newton_residuals"],
         _json=d["json"],
     )
 
@@ -108,12 +109,13 @@ def lyapunov(
     """
     req = _request(locals(), initial=_state(initial))
     p, probe = _params(params, model)
-    d = _run(_core.lyapunov, "lyapunov", progress, p, si=probe, request=req)
+    d = _door("lyapunov", "lyapunov", progress, p, probe, req)
     doc = json.loads(d["json"])
+    v = _layout.variables(d["datasets"]["lyapunov"])
     return Lyapunov(
         params=p,
-        exponents=d["exponents"],
-        uncertainty=d["uncertainty"],
+        exponents=v["exponents"][1],
+        uncertainty=v["uncertainty"][1],
         volume_rate=doc["volume_rate"],
         zero_one=float("nan") if doc["zero_one"] is None else doc["zero_one"],
         periods=doc["periods"],

@@ -109,7 +109,7 @@ def reconstruct(
         amplitude=float(amplitude),
     )
     with reporter(progress, "reconstruct") as cb:
-        d = _core.reconstruct(request, progress=cb)
+        d = _core.run("reconstruct", request, None, None, cb)
     return _dataset(json.loads(d["json"]))
 
 

@@ -14,6 +14,8 @@
 //! - [`curves`]: the stepped curves (`approach`, `resonance`).
 //! - [`run`](mod@run): [`run()`]`(analysis, model, progress)` → [`Document`], the typed result and
 //!   its JSON document, for every analysis whose result is one value ([`Analysis`]).
+//! - [`named`]: every analysis by its name ([`named::parse`]), run to an [`Outcome`]: its
+//!   document and its arrays as layouts ([`Datasets`]); the one door of Python and WebAssembly.
 //! - [`limits`]: the limits beyond the model's ranges, each with its reason, and the budgets of
 //!   a request's cost ([`limits::Cost`]), which [`costs`] estimates before it runs.
 //! - [`sweep`]: the records of a bifurcation sweep (columns, codes, the one row order) and the
@@ -36,6 +38,7 @@ pub mod checkpoint;
 pub mod checkpoint_file;
 pub mod costs;
 pub mod curves;
+mod datasets;
 #[cfg(feature = "files")]
 pub use crate::io::dir_lock;
 pub mod fm;
@@ -46,6 +49,7 @@ pub mod image_layout;
 pub mod image_scan;
 pub mod limits;
 pub mod model;
+pub mod named;
 pub mod pool;
 pub mod present;
 pub mod reconstruct;
@@ -72,6 +76,7 @@ pub use curves::{approach_request, resonance_request, CurveRequest};
 pub use dir_lock::{DirLock, LockError};
 pub use fm::FmRequest;
 pub use model::{parameter, ModelSpec, ParamInfo, MODEL_PARAMETERS};
+pub use named::{Datasets, Named, Outcome};
 pub use pool::in_pool;
 #[cfg(feature = "parallel")]
 pub use pool::thread_pool;

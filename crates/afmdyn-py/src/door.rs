@@ -1,0 +1,72 @@
+//! The one door of every analysis: `run(name, request, params, probe, progress)` parses the
+//! request by name in the library ([`afmdyn::request::named::parse`]), validates it, runs it
+//! without the GIL ([`crate::run`]; cancellable where it checks its progress) and returns its
+//! outcome: `json` (the document), `datasets` (each result layout as
+//! [`crate::convert::layout_dict`], which `afmdyn._layout` turns into a dataset) and `facts`
+//! (the result's scalars, a dict).
+
+use crate::convert::{json_to_py, layout_dict};
+use crate::errors::{probe_error, sim_error};
+use crate::params::PyParams;
+use crate::run::{run as run_job, Job, Stop};
+use afmdyn::probe::Probe;
+use afmdyn::request::{Outcome, Resolved};
+use afmdyn::Params;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+/// A probe file's text parsed (the command line's `--probe`).
+pub fn probe_of(probe: Option<String>) -> PyResult<Option<Probe>> {
+    probe
+        .map(|text| Probe::parse(&text, "probe"))
+        .transpose()
+        .map_err(probe_error)
+}
+
+/// Run analysis `name` (`"orbit"`, …: `afmdyn.request.named.NAMES`) with the keywords
+/// `request` on `params` (default: the paper's set) and the probe file's text `probe`:
+/// `{"json": str, "datasets": {name: layout}, "facts": dict}`. `progress(done, total)` is
+/// called at every poll.
+#[pyfunction]
+#[pyo3(signature = (name, request=None, params=None, probe=None, progress=None))]
+pub fn run<'py>(
+    py: Python<'py>,
+    name: &str,
+    request: Option<&Bound<'py, PyDict>>,
+    params: Option<PyRef<'_, PyParams>>,
+    probe: Option<String>,
+    progress: Option<Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let named = crate::convert::named(name, request)?;
+    let model = Resolved {
+        params: params.map_or_else(Params::default, |p| p.inner),
+        probe: probe_of(probe)?,
+    };
+    named.validate(&model).map_err(sim_error)?;
+    let stop = if named.checks_cancel() {
+        Stop::Cancellable
+    } else {
+        Stop::Abandon
+    };
+    let job = Job::default();
+    let worker = job.clone();
+    let outcome = run_job(py, &job, None, progress.as_ref(), stop, move || {
+        named.run(&model, &worker.progress)
+    })?
+    .map_err(sim_error)?;
+    outcome_dict(py, outcome)
+}
+
+/// An [`Outcome`] as `run` returns it.
+pub fn outcome_dict(py: Python<'_>, outcome: Outcome) -> PyResult<Bound<'_, PyDict>> {
+    let out = PyDict::new(py);
+    out.set_item("json", outcome.document.to_string())?;
+    let datasets = PyDict::new(py);
+    for (name, layout) in outcome.datasets {
+        datasets.set_item(name, layout_dict(py, layout)?)?;
+    }
+    out.set_item("datasets", datasets)?;
+    let facts = serde_json::Value::Object(outcome.facts).to_string();
+    out.set_item("facts", json_to_py(py, &facts)?)?;
+    Ok(out)
+}
