@@ -1,5 +1,5 @@
-//! The one door of the command line: a request is validated, its `--out` directory locked, it
-//! runs with a progress bar ([`progress::run`]), and its presentation
+//! The one door of the command line: a request is validated and held to the budgets, its
+//! `--out` directory locked, it runs with a progress bar ([`progress::run`]), and its presentation
 //! ([`afmdyn::report::Presentation`], built by the library) is written: the document's
 //! warnings on stderr, every file into the directory (CSV, NetCDF, JSON, figures through the
 //! one plotting module), then the JSON document (`--json`) or the text summary on stdout.
@@ -50,7 +50,8 @@ pub fn run_with<A: Analysis>(
     exit: Exit<'_>,
     decorate: impl FnOnce(&mut Presentation),
 ) -> Result<Document<A::Output>, CliError> {
-    request.validate(model)?;
+    // validated and held to the budgets before the output directory is created or locked
+    afmdyn::request::run::admit(request, model)?;
     let out = exit.out.map(OutDir::lock).transpose()?;
     let doc = progress::run(request, model, exit.unit)?;
     let mut shown = request.present(
