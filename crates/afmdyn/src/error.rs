@@ -302,20 +302,6 @@ pub enum SimError {
     },
 }
 
-#[cfg(feature = "files")]
-impl From<crate::layout::files::FileError> for SimError {
-    fn from(e: crate::layout::files::FileError) -> Self {
-        SimError::File(e.0)
-    }
-}
-
-#[cfg(feature = "files")]
-impl From<crate::io::dir_lock::LockError> for SimError {
-    fn from(e: crate::io::dir_lock::LockError) -> Self {
-        SimError::File(e.to_string())
-    }
-}
-
 impl SimError {
     /// The message with the parameter of an [`SimError::OutOfRange`] or
     /// [`SimError::NotFinite`] spelled as a front end spells it (`samples_per_period` is

@@ -157,6 +157,13 @@ pub fn remove_partials_in(dir: &Path, outputs: &[&str]) -> Result<Vec<PathBuf>, 
     Ok(removed)
 }
 
+/// A lock error as the library's error ([`crate::error::SimError::File`]).
+impl From<LockError> for crate::error::SimError {
+    fn from(e: LockError) -> Self {
+        crate::error::SimError::File(e.to_string())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -453,6 +453,13 @@ pub fn csv_lines(s: &mut CsvStream, bytes: &[u8]) -> Result<(), FileError> {
     Ok(())
 }
 
+/// A file error as the library's error ([`crate::error::SimError::File`]), naming its path.
+impl From<FileError> for crate::error::SimError {
+    fn from(e: FileError) -> Self {
+        crate::error::SimError::File(e.0)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::{f, std_format};

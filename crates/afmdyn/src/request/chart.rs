@@ -404,7 +404,7 @@ impl ChartRequest {
             threads: self.threads,
         };
         // held to the budgets of a request here, where every front end builds its chart
-        super::costs::check_cost("chart", super::costs::chart_cost(&chart)?)?;
+        super::costs::check_cost("chart", chart_cost(&chart)?)?;
         Ok(chart)
     }
 }
@@ -792,4 +792,9 @@ pub fn document(chart: &Chart, cells: &[ChartCell]) -> Value {
         Ok(p) => crate::report::with_si(doc, chart.model.probe.as_ref(), p),
         Err(_) => doc,
     }
+}
+
+/// The cost of a chart ([`super::costs::chart_cost`] of its spec, slots and cells; its errors).
+pub fn chart_cost(chart: &Chart) -> Result<super::limits::Cost, SimError> {
+    super::costs::chart_cost(&chart.spec, chart.slots, &|x, y| chart.model.params(x, y))
 }

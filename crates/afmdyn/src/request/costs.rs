@@ -199,7 +199,8 @@ pub fn basins_cost(spec: &BasinSpec) -> Result<Cost, SimError> {
 /// continuation, the attractors of its two neighbours (about K each).
 pub const CHART_RUNS_PER_START: f64 = 3.0;
 
-/// The cost of a behaviour chart ([`crate::request::chart::Chart`]): cells × starts (and the
+/// The cost of a behaviour chart of `spec` (its cells' parameters by `params(x, y)`, up to
+/// `slots` attractors a cell): cells × starts (and the
 /// neighbours' attractors continued into each cell, [`CHART_RUNS_PER_START`]) × the transient
 /// cap × modes, the largest cap of its four corners (the decay rates vary monotonically
 /// along each axis); a λ₁ of `lyapunov_periods` of the state and one tangent vector per
@@ -208,9 +209,12 @@ pub const CHART_RUNS_PER_START: f64 = 3.0;
 ///
 /// # Errors
 /// [`SimError`] when a corner's parameters do not build a model.
-pub fn chart_cost(chart: &crate::request::chart::Chart) -> Result<Cost, SimError> {
-    use crate::analysis::chart::CellParams;
-    let (xs, ys) = (&chart.spec.x, &chart.spec.y);
+pub fn chart_cost(
+    spec: &crate::analysis::chart::ChartSpec,
+    slots: usize,
+    params: &dyn Fn(f64, f64) -> Result<crate::params::Params, SimError>,
+) -> Result<Cost, SimError> {
+    let (xs, ys) = (&spec.x, &spec.y);
     let mut cap: f64 = 0.0;
     for (x, y) in [
         (xs[0], ys[0]),
@@ -218,15 +222,14 @@ pub fn chart_cost(chart: &crate::request::chart::Chart) -> Result<Cost, SimError
         (xs[0], ys[ys.len() - 1]),
         (xs[xs.len() - 1], ys[ys.len() - 1]),
     ] {
-        let p = chart.model.params(x, y)?;
-        let periods =
-            steady_periods(&chart.spec.steady, &p)? + 2.0 * chart.spec.lyapunov_periods as f64;
+        let p = params(x, y)?;
+        let periods = steady_periods(&spec.steady, &p)? + 2.0 * spec.lyapunov_periods as f64;
         cap = cap.max(periods * p.modes as f64);
     }
     let cells = xs.len() as f64 * ys.len() as f64;
-    let runs = cells * f64::from(chart.spec.starts) * CHART_RUNS_PER_START;
+    let runs = cells * f64::from(spec.starts) * CHART_RUNS_PER_START;
     Ok(Cost {
-        bytes: MODEL_BYTES + cells * (128.0 + chart.slots as f64 * (128.0 + 80.0)),
+        bytes: MODEL_BYTES + cells * (128.0 + slots as f64 * (128.0 + 80.0)),
         work: runs * cap,
     })
 }

@@ -10,6 +10,8 @@
 pub mod census;
 #[cfg(feature = "files")]
 pub(crate) mod continuation;
+#[cfg(feature = "files")]
+pub mod converge;
 pub(crate) mod curve_figures;
 pub mod curves;
 pub mod fm;
@@ -18,8 +20,6 @@ pub mod maps;
 pub mod modes;
 pub(crate) mod orbits;
 pub mod reconstruct;
-#[cfg(feature = "files")]
-pub mod simulate;
 pub mod sweeps;
 
 /// Which files a presentation holds (`--files`).

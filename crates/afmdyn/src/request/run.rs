@@ -464,7 +464,7 @@ impl Analysis for ConvergeRequest {
         _: &Value,
         _: report::TextUnits,
     ) -> Result<report::Presentation, SimError> {
-        Ok(super::present::simulate::converge(&model.params, runs))
+        Ok(super::present::converge::converge(&model.params, runs))
     }
 }
 

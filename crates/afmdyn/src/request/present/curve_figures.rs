@@ -1,12 +1,49 @@
 //! The figures of a stepped curve (amplitude, phase, peak force, virial, dissipation against the
 //! swept quantity, with branches and folds) and of its force–distance traces, as data.
 
-use super::curves::{Labels, Shown};
 use crate::analysis::continuation::BranchEvent;
 use crate::analysis::observables::Observables;
+use crate::analysis::stepped::SteppedCurve;
 use crate::analysis::stepped::Sweep;
 use crate::layout::figure::{Figure, Plot, Series, Style};
+use crate::report::TextUnits;
 use crate::report::{component_columns, component_row, curve_column_index, curve_row, CurveUnits};
+
+/// How one curve is labelled and converted.
+pub(crate) struct Labels {
+    /// File stem.
+    pub stem: &'static str,
+    /// Names of the two sweeps.
+    pub sweeps: (&'static str, &'static str),
+    /// Abscissa column name and axis label.
+    pub x_name: &'static str,
+    pub x_label: String,
+    /// The abscissa's symbol in the printed summary and its SI unit (`None`: dimensionless).
+    pub x_text: &'static str,
+    pub x_unit: Option<&'static str>,
+    /// The text's units.
+    pub text: TextUnits,
+}
+
+impl Labels {
+    /// An abscissa value as the summary prints it: with an SI prefix and the unit (13.4747 nm,
+    /// 300.000 kHz), or to 7 significant digits when dimensionless.
+    pub(super) fn show(&self, v: f64) -> String {
+        match self.x_unit {
+            Some(unit) => self.text.value(v, unit),
+            None => format!("{v:.6e}"),
+        }
+    }
+}
+
+/// One curve's presentation context: the curve, its abscissa in reported units, its units
+/// and labels.
+pub(crate) struct Shown<'a> {
+    pub c: &'a SteppedCurve,
+    pub x: &'a dyn Fn(f64) -> f64,
+    pub u: &'a CurveUnits,
+    pub l: &'a Labels,
+}
 
 /// Where a plotted value comes from: a CURVE_COLUMNS index, or an index into the drive
 /// components' columns (`component_row`).

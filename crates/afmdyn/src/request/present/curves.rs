@@ -4,7 +4,7 @@
 //! quantity ([`super::curve_figures`]) and the force–distance traces (`STEM-traces.nc` and
 //! their figure).
 
-use super::curve_figures::{panels, traces_figure};
+use super::curve_figures::{panels, traces_figure, Labels, Shown};
 use super::Files;
 use crate::analysis::approach::rest_distance;
 use crate::analysis::stepped::{SteppedCurve, Sweep};
@@ -34,42 +34,6 @@ impl CurveOptions {
             dforce_columns: false,
         }
     }
-}
-
-/// How one curve is labelled and converted.
-pub(crate) struct Labels {
-    /// File stem.
-    pub stem: &'static str,
-    /// Names of the two sweeps.
-    pub sweeps: (&'static str, &'static str),
-    /// Abscissa column name and axis label.
-    pub x_name: &'static str,
-    pub x_label: String,
-    /// The abscissa's symbol in the printed summary and its SI unit (`None`: dimensionless).
-    pub x_text: &'static str,
-    pub x_unit: Option<&'static str>,
-    /// The text's units.
-    pub text: TextUnits,
-}
-
-impl Labels {
-    /// An abscissa value as the summary prints it: with an SI prefix and the unit (13.4747 nm,
-    /// 300.000 kHz), or to 7 significant digits when dimensionless.
-    fn show(&self, v: f64) -> String {
-        match self.x_unit {
-            Some(unit) => self.text.value(v, unit),
-            None => format!("{v:.6e}"),
-        }
-    }
-}
-
-/// One curve's presentation context: the curve, its abscissa in reported units, its units
-/// and labels.
-pub(crate) struct Shown<'a> {
-    pub c: &'a SteppedCurve,
-    pub x: &'a dyn Fn(f64) -> f64,
-    pub u: &'a CurveUnits,
-    pub l: &'a Labels,
 }
 
 /// Which stepped curve is shown.

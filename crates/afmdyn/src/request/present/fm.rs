@@ -4,7 +4,6 @@
 use super::{lines, with_document, Files};
 use crate::layout::figure::{Series, Style};
 use crate::report::{OutputsNote, Presentation, TextUnits};
-use crate::request::fm::{rows, COLUMNS};
 use serde_json::Value;
 use std::path::Path;
 
@@ -79,4 +78,56 @@ pub fn fm(document: &mut Value, text: TextUnits, files: Files, dir: Option<&Path
     }
     with_document(&mut p, document, ("fm.json", "fm.csv"), dir);
     p
+}
+
+/// The columns of an FM curve's table (`fm.csv`, Python's Dataset variables), in order: the
+/// numeric arrays of the document's `curve` (`stable` as 1/0).
+pub const COLUMNS: [&str; 18] = [
+    "z_c",
+    "frequency_shift",
+    "frequency",
+    "excitation",
+    "amplitude",
+    "phase_deg",
+    "energy_dissipated",
+    "virial",
+    "mean_deflection",
+    "min_distance",
+    "peak_force",
+    "mean_force",
+    "law_force",
+    "indentation",
+    "max_multiplier",
+    "stable",
+    "loop_residual",
+    "iterations",
+];
+
+/// The rows of the table of an FM document ([`crate::request::fm::document`]), one per point, in [`COLUMNS`]
+/// order.
+pub fn rows(doc: &Value) -> Vec<Vec<f64>> {
+    let curve = &doc["curve"];
+    let column = |name: &str| -> Vec<f64> {
+        curve[name]
+            .as_array()
+            .map(|a| {
+                a.iter()
+                    .map(|v| match v {
+                        Value::Bool(b) => f64::from(u8::from(*b)),
+                        v => v.as_f64().unwrap_or(f64::NAN),
+                    })
+                    .collect()
+            })
+            .unwrap_or_default()
+    };
+    let columns: Vec<Vec<f64>> = COLUMNS.iter().map(|c| column(c)).collect();
+    let n = columns[0].len();
+    (0..n)
+        .map(|i| {
+            columns
+                .iter()
+                .map(|c| c.get(i).copied().unwrap_or(f64::NAN))
+                .collect()
+        })
+        .collect()
 }
