@@ -1,7 +1,7 @@
 //! `afmdyn._afmdyn`: the compiled part of the Python package `afmdyn`.
 //!
 //! The pure-Python layer (`python/afmdyn/`) is the public API. Every analysis enters through
-//! one door, [`door::run`]`(name, request, params, probe, progress)`: the library parses the
+//! one door, `door::run(name, request, params, probe, progress)`: the library parses the
 //! request by name and runs it ([`afmdyn::request::named`]) with the GIL released, and the
 //! document, the result's layouts (dicts of NumPy arrays owning the Rust buffers) and its
 //! scalars come back for the Python layer to turn into xarray datasets and result objects.

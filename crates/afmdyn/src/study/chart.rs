@@ -50,7 +50,7 @@ impl Study for Chart {
     }
 }
 
-/// A validated chart runs as an analysis ([`crate::request::run`], Python's `afmdyn.chart`):
+/// A validated chart runs as an analysis ([`crate::request::run()`], Python's `afmdyn.chart`):
 /// its model is its own — [`ChartRequest::chart`](crate::request::ChartRequest::chart) built
 /// it from the request's model values, defaults and probe, validated every option and held
 /// its cost to the budgets — so the `model` given here is not read (pass

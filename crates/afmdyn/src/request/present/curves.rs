@@ -1,7 +1,7 @@
 //! The stepped curves (`approach`, `bimodal`, `resonance`): the text summary (folds,
 //! bistable ranges, jumps, the setpoint's operating points), the table (`STEM.csv` and
 //! `STEM.npy`, columns named as the document or as dForce's), the figures against the swept
-//! quantity ([`super::curve_figures`]) and the force–distance traces (`STEM-traces.nc` and
+//! quantity (`curve_figures.rs`) and the force–distance traces (`STEM-traces.nc` and
 //! their figure).
 
 use super::curve_figures::{panels, traces_figure, Labels, Shown};
