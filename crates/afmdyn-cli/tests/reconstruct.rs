@@ -214,8 +214,8 @@ fn a_likely_unit_slip_is_warned_of() {
         ),
         (
             &["--amplitude", "5e-6"][..],
-            "m is outside the typical 10 pm–1 µm of dynamic AFM: amplitudes are in m (10 nm \
-             is 10e-9)",
+            "amplitude = 5e-6 m is outside the typical 10 pm–1 µm of dynamic AFM: amplitudes \
+             are in m (10 nm is 10e-9)",
         ),
         (
             &["--spring-constant", "4e7", "--json"][..],

@@ -1,7 +1,7 @@
 //! The toy contact law `spring_adhesion` (feature `toy-law`: a linear spring with a constant
 //! adhesion force, F_c = α4 δ + α6 δ̇ − F̃_ad in contact) shows that a law is one file plus one
 //! registry line: `crates/afmdyn/src/contact/spring_adhesion.rs` and the line
-//! `spring_adhesion => SpringAdhesion { adhesion } : SpringAdhesionLaw` of `contact/mod.rs`'s
+//! `spring_adhesion => SpringAdhesion { adhesion } : SpringAdhesionLaw` of `contact.rs`'s
 //! `laws!` (with its `#[cfg(feature = "toy-law")]`, because the toy law does not ship; the
 //! feature and this test's `required-features` are the only other lines, in Cargo.toml).
 //!
@@ -84,7 +84,7 @@ fn the_toy_law_is_one_file_and_one_registry_line() {
     assert_eq!(
         names,
         [
-            "crates/afmdyn/src/contact/mod.rs",
+            "crates/afmdyn/src/contact.rs",
             "crates/afmdyn/src/contact/spring_adhesion.rs"
         ]
     );
