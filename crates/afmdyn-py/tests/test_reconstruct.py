@@ -63,13 +63,15 @@ def test_bad_curves_name_the_field():
 
 
 def test_a_likely_unit_slip_and_a_truncated_curve_warn():
-    """f0 = 300 (Hz, meant kHz) runs with an AfmdynWarning naming the slip, in the summary
-    too; a curve that ends at 2 nm, where |Δf| is still a tenth of its extreme, warns of the
-    truncation."""
+    """k = 4e7 (N/m, meant mN/m) runs with an AfmdynWarning naming the slip, in the summary
+    too; f0 = 300 (Hz, meant kHz) is below any lever and refused, as in a probe file; a curve
+    that ends at 2 nm, where |Δf| is still a tenth of its extreme, warns of the truncation."""
     c = _curve()
-    with pytest.warns(afmdyn.AfmdynWarning, match=r"resonance_frequency = 300 Hz .* kHz"):
-        ds = afmdyn.reconstruct(**c, **{**CONSTANTS, "resonance_frequency": 300.0})
-    assert "kHz" in json.loads(ds.attrs["summary"])["warnings"][0]
+    with pytest.warns(afmdyn.AfmdynWarning, match=r"spring_constant = 40000000 N/m .* mN/m"):
+        ds = afmdyn.reconstruct(**c, **{**CONSTANTS, "spring_constant": 4e7})
+    assert "mN/m" in json.loads(ds.attrs["summary"])["warnings"][0]
+    with pytest.raises(ValueError, match="resonance_frequency = 300: below 1 kHz"):
+        afmdyn.reconstruct(**c, **{**CONSTANTS, "resonance_frequency": 300.0})
     near = c["distance"] <= 2e-9
     with pytest.warns(afmdyn.AfmdynWarning, match="frequency shift at the largest distance"):
         afmdyn.reconstruct(distance=c["distance"][near],
