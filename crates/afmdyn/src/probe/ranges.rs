@@ -23,8 +23,8 @@ pub type Bound = (f64, &'static str);
 /// The ranges of one SI input (module doc).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SiRange {
-    /// The probe file's `[section]`.
-    pub section: &'static str,
+    /// The probe file's `[section]`s holding the keys.
+    pub sections: &'static [&'static str],
     /// Its keys in the section (more than one where they share the ranges).
     pub keys: &'static [&'static str],
     /// Its SI unit.
@@ -48,7 +48,7 @@ pub struct SiRange {
 /// Every SI input with a physical or typical range beyond its sign (module doc).
 pub const SI_RANGES: &[SiRange] = &[
     SiRange {
-        section: "tip",
+        sections: &["tip"],
         keys: &["radius"],
         unit: "m",
         slips: &[("n", 1e-9), ("µ", 1e-6)],
@@ -59,7 +59,7 @@ pub const SI_RANGES: &[SiRange] = &[
         zero_typical: false,
     },
     SiRange {
-        section: "drive",
+        sections: &["drive"],
         keys: &["free_amplitude"],
         unit: "m",
         slips: &[("n", 1e-9), ("p", 1e-12), ("µ", 1e-6)],
@@ -72,7 +72,7 @@ pub const SI_RANGES: &[SiRange] = &[
         zero_typical: false,
     },
     SiRange {
-        section: "sample",
+        sections: &["sample"],
         keys: &["intermolecular_distance"],
         unit: "m",
         slips: &[],
@@ -83,7 +83,7 @@ pub const SI_RANGES: &[SiRange] = &[
         zero_typical: false,
     },
     SiRange {
-        section: "sample",
+        sections: &["sample"],
         keys: &["z_c"],
         unit: "m",
         slips: &[],
@@ -94,7 +94,7 @@ pub const SI_RANGES: &[SiRange] = &[
         zero_typical: false,
     },
     SiRange {
-        section: "cantilever",
+        sections: &["cantilever"],
         keys: &["length"],
         unit: "m",
         slips: &[("µ", 1e-6), ("m", 1e-3)],
@@ -105,7 +105,7 @@ pub const SI_RANGES: &[SiRange] = &[
         zero_typical: false,
     },
     SiRange {
-        section: "cantilever",
+        sections: &["cantilever"],
         keys: &["width", "thickness"],
         unit: "m",
         slips: &[],
@@ -116,7 +116,7 @@ pub const SI_RANGES: &[SiRange] = &[
         zero_typical: false,
     },
     SiRange {
-        section: "tip",
+        sections: &["tip"],
         keys: &["youngs_modulus"],
         unit: "Pa",
         slips: &[],
@@ -127,7 +127,7 @@ pub const SI_RANGES: &[SiRange] = &[
         zero_typical: false,
     },
     SiRange {
-        section: "sample",
+        sections: &["sample"],
         keys: &["youngs_modulus"],
         unit: "Pa",
         slips: &[],
@@ -138,8 +138,9 @@ pub const SI_RANGES: &[SiRange] = &[
         zero_typical: false,
     },
     SiRange {
-        section: "cantilever",
-        keys: &["resonance_frequency"],
+        // the lever's resonance and the drive's frequency: the same range
+        sections: &["cantilever", "drive"],
+        keys: &["resonance_frequency", "frequency"],
         unit: "Hz",
         slips: &[("k", 1e3), ("M", 1e6)],
         below: Some((1e3, "below 1 kHz for a cantilever; frequencies are in Hz: {x} kHz is {x}e3")),
@@ -149,18 +150,7 @@ pub const SI_RANGES: &[SiRange] = &[
         zero_typical: false,
     },
     SiRange {
-        section: "drive",
-        keys: &["frequency"],
-        unit: "Hz",
-        slips: &[("k", 1e3), ("M", 1e6)],
-        below: Some((1e3, "below 1 kHz for a cantilever; frequencies are in Hz: {x} kHz is {x}e3")),
-        above: Some((1e10, "above 10 GHz, beyond any cantilever; frequencies are in Hz")),
-        magnitude: false,
-        typical: Some((1e3, 1e7, "1 kHz–10 MHz of AFM levers", "frequencies are in Hz (300 kHz is 300e3)")),
-        zero_typical: false,
-    },
-    SiRange {
-        section: "cantilever",
+        sections: &["cantilever"],
         keys: &["spring_constant"],
         unit: "N/m",
         slips: &[("m", 1e-3), ("k", 1e3)],
@@ -171,7 +161,7 @@ pub const SI_RANGES: &[SiRange] = &[
         zero_typical: false,
     },
     SiRange {
-        section: "sample",
+        sections: &["sample"],
         keys: &["hamaker"],
         unit: "J",
         slips: &[],
@@ -182,7 +172,7 @@ pub const SI_RANGES: &[SiRange] = &[
         zero_typical: true,
     },
     SiRange {
-        section: "sample",
+        sections: &["sample"],
         keys: &["surface_tension"],
         unit: "N/m",
         slips: &[("m", 1e-3)],
@@ -193,7 +183,7 @@ pub const SI_RANGES: &[SiRange] = &[
         zero_typical: false,
     },
     SiRange {
-        section: "sample",
+        sections: &["sample"],
         keys: &["adhesion_energy"],
         unit: "J/m²",
         slips: &[("m", 1e-3)],
@@ -209,7 +199,7 @@ pub const SI_RANGES: &[SiRange] = &[
 pub fn si_range(section: &str, key: &str) -> Option<&'static SiRange> {
     SI_RANGES
         .iter()
-        .find(|r| r.section == section && r.keys.contains(&key))
+        .find(|r| r.sections.contains(&section) && r.keys.contains(&key))
 }
 
 impl SiRange {
@@ -271,12 +261,12 @@ mod tests {
         for r in SI_RANGES {
             let lo = r.below.map_or(f64::NEG_INFINITY, |b| b.0);
             let hi = r.above.map_or(f64::INFINITY, |b| b.0);
-            assert!(lo < hi, "{}.{:?}", r.section, r.keys);
+            assert!(lo < hi, "{:?}.{:?}", r.sections, r.keys);
             if let Some((tl, th, _, _)) = r.typical {
                 assert!(
                     lo <= tl && tl < th && th <= hi,
-                    "{}.{:?}",
-                    r.section,
+                    "{:?}.{:?}",
+                    r.sections,
                     r.keys
                 );
             }
