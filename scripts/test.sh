@@ -4,7 +4,8 @@
 #      so one failure does not hide the others), and the toy contact law's test (feature toy-law)
 #   2. the Python package: a virtual environment in target/venv-test (created once, reused;
 #      $AFMDYN_TEST_VENV chooses another),
-#      `pip install ./crates/afmdyn-py[test]` (maturin builds the extension into it), then
+#      `pip install ./crates/afmdyn-py[test]` (maturin builds the extension into it, reusing the
+#      library the Rust tests compiled: scripts/check-feature-unification.sh), then
 #      pytest crates/afmdyn-py/tests, which also executes the example notebook and script.
 #   3. the WebAssembly engine: bash scripts/test-wasm.sh (crates/afmdyn-wasm built for wasm32,
 #      its JavaScript glue by wasm-bindgen-cli, checked under Node.js against the command line).
