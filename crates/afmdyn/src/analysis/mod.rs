@@ -34,6 +34,7 @@ pub mod spectrum;
 pub mod steady;
 pub mod stepped;
 pub mod tasks;
+pub mod torus;
 pub mod traces;
 
 /// Check a relative tolerance `v` (an integrator's, a curve's loop conditions) in (0, 1e-3):

@@ -94,7 +94,7 @@ mod closed;
 mod window;
 use closed::EquivalentMode;
 pub use closed::{closed_forms, free_response};
-use window::observe_window;
+use window::{observe_window, Weighting};
 
 /// Largest accepted [`ObservableOptions::periods`].
 pub const MAX_PERIODS: usize = 1_000_000;
@@ -313,7 +313,7 @@ pub fn observe(
     integ: &mut dyn Integrator,
     opts: &ObservableOptions,
 ) -> Result<Observables, SimError> {
-    observe_window(integ, opts, false)
+    observe_window(integ, opts, Weighting::Flat)
 }
 
 /// Observables over `opts.periods` primary drive periods 2π/Ω from the integrator's current
@@ -337,7 +337,31 @@ pub fn observe_tapered(
     integ: &mut dyn Integrator,
     opts: &ObservableOptions,
 ) -> Result<Observables, SimError> {
-    observe_window(integ, opts, true)
+    observe_window(integ, opts, Weighting::Hann)
+}
+
+/// Observables over `opts.periods` = M primary drive periods 2π/Ω from the integrator's current
+/// (τ₀, z), the integrals over period k weighted by M·`weights[k]` (weights summing to 1): the
+/// average over an invariant circle from the M periods of its collocation segment, with the
+/// circle's quadrature weights q_k ([`crate::maps::circle::CircleNodes::quadrature`]; each
+/// integrand's average over the torus is Σ_k q_k times its average over period k, the change
+/// of variables (θ₁, θ₂) = (Ωτ, θ_k + rΩτ) having a unit Jacobian). The per-mode balance's
+/// energy change is Σ_k M q_k (E_j(end of k) − E_j(start of k)), 0 on the circle up to its
+/// quadrature's error; extremes are over the M periods, unweighted.
+///
+/// # Errors
+/// As [`observe`]; [`SimError::OutOfRange`] when `weights` is not one finite weight per period.
+pub fn observe_weighted(
+    integ: &mut dyn Integrator,
+    opts: &ObservableOptions,
+    weights: &[f64],
+) -> Result<Observables, SimError> {
+    let m = weights.len() as f64;
+    observe_window(
+        integ,
+        opts,
+        Weighting::Steps(weights.iter().map(|w| w * m).collect()),
+    )
 }
 
 /// [`observe`] from a start state: builds the integrator of `model` with `integ` at (τ₀, z₀).

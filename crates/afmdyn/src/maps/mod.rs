@@ -13,6 +13,8 @@
 //! - [`flow`]: the flow map z(τ0) ↦ z(τ1) of any integrator with its Jacobian (step Jacobians
 //!   times saltation matrices), its parameter derivative and the distance to grazing — the one
 //!   loop every map and the Lyapunov spectrum use;
+//! - [`circle`]: [`circle::CircleMap`], the invariant circle of a two-frequency drive's
+//!   stroboscopic map as the fixed point of a map (quasi-periodic steady states);
 //! - [`stroboscopic`]: [`StroboscopicMap`], the value the analyses iterate: steady states and
 //!   period detection ([`crate::analysis::steady`], [`crate::analysis::settle`]), Newton
 //!   shooting and Floquet multipliers ([`crate::analysis::shooting`]), continuation
@@ -21,6 +23,7 @@
 //! [`Integrator`]: crate::integrate::Integrator
 //! [`SimError`]: crate::error::SimError
 
+pub mod circle;
 pub mod discrete;
 pub mod flow;
 pub mod stroboscopic;

@@ -50,6 +50,9 @@ pub(super) struct Ctx {
     /// The tapered window's start τ₀ and angular rate κ = 2π/L over the window's length L
     /// ([`observe_tapered`]); `None`: every weight 1.
     taper: Option<(f64, f64)>,
+    /// Weights constant over each drive period of the window ([`observe_weighted`]): the
+    /// window's start τ₀, the period T and the weight of each period; `None`: every weight 1.
+    steps: Option<(f64, f64, Vec<f64>)>,
 }
 
 impl Ctx {
@@ -112,12 +115,17 @@ impl Ctx {
             h_max,
             product_rate,
             taper: None,
+            steps: None,
         }
     }
 
     /// The window's weight w(τ): 1, or the Hann² window (2/3)(1 − cos x)², x = κ(τ − τ₀)
     /// (mean 1 over the window; it and its first three derivatives vanish at the ends).
     pub(super) fn weight(&self, tau: f64) -> f64 {
+        if let Some((t0, t, w)) = &self.steps {
+            let k = ((tau - t0) / t).floor().clamp(0.0, (w.len() - 1) as f64) as usize;
+            return w[k];
+        }
         match self.taper {
             Some((t0, k)) => {
                 let c = 1.0 - (k * (tau - t0)).cos();
@@ -140,6 +148,10 @@ impl Ctx {
 
     /// ∫ₐᵇ w dτ, in closed form: (2/3)∫(1 − cos x)² dx = x − (4/3) sin x + (1/6) sin 2x over κ.
     pub(super) fn weighted_length(&self, a: f64, b: f64) -> f64 {
+        if self.steps.is_some() {
+            // [a, b] lies in one period: the window's steps end at the periods' ends
+            return self.weight(0.5 * (a + b)) * (b - a);
+        }
         match self.taper {
             Some((t0, k)) => {
                 let f = |t: f64| {
@@ -463,13 +475,23 @@ impl Acc {
     }
 }
 
-/// [`observe`] (`taper` false: over `opts.periods` periods of the system, unweighted) or
-/// [`observe_tapered`].
+/// The weighting of [`observe_window`]'s window.
+pub(super) enum Weighting {
+    /// Every weight 1, over `periods` periods of the system ([`observe`]).
+    Flat,
+    /// The Hann² window over `periods` primary drive periods ([`observe_tapered`]).
+    Hann,
+    /// One weight per primary drive period, `periods` of them ([`observe_weighted`]).
+    Steps(Vec<f64>),
+}
+
+/// [`observe`], [`observe_tapered`] or [`observe_weighted`], as `weighting` says.
 pub(super) fn observe_window(
     integ: &mut dyn Integrator,
     opts: &ObservableOptions,
-    taper: bool,
+    weighting: Weighting,
 ) -> Result<Observables, SimError> {
+    let taper = matches!(weighting, Weighting::Hann);
     if !(1..=MAX_PERIODS).contains(&opts.periods) {
         return Err(SimError::out_of_range(
             "periods",
@@ -490,7 +512,7 @@ pub(super) fn observe_window(
     let (n, nh, om) = (ctx.model.modes(), opts.harmonics, p.omega);
     let tau_start = integ.tau();
     // the window: periods of the system, or (tapered) primary drive periods
-    let (window, per) = if taper {
+    let (window, per) = if !matches!(weighting, Weighting::Flat) {
         (opts.periods as f64 * TAU / om, opts.periods as f64)
     } else {
         (
@@ -502,6 +524,16 @@ pub(super) fn observe_window(
     if taper {
         ctx.taper = Some((tau_start, TAU / window));
     }
+    if let Weighting::Steps(w) = weighting {
+        if w.len() != opts.periods || w.iter().any(|x| !x.is_finite()) {
+            return Err(SimError::out_of_range(
+                "weights",
+                w.len(),
+                "must be one finite weight per drive period of the window",
+            ));
+        }
+        ctx.steps = Some((tau_start, TAU / om, w));
+    }
     let (model, free) = (&ctx.model, &ctx.free);
     let end = tau_start + window;
     let z_start = integ.state().clone();
@@ -512,8 +544,34 @@ pub(super) fn observe_window(
         scan: Vec::with_capacity(GL_NODES + 2),
         start: None,
     };
+    let mode_energy = |z: &DVector<f64>, j: usize| {
+        0.5 * free.mass[(j, j)] * z[n + j] * z[n + j] + 0.5 * free.stiffness[(j, j)] * z[j] * z[j]
+    };
+    // a step-weighted window: steps end at each period's end, where the weighted energy
+    // change Σ_k W_k (E_j(end of k) − E_j(start of k)) takes each mode's energy
+    let mut boundary = 1;
+    let mut step_energy = vec![0.0; n];
+    if let Some((_, _, w)) = &ctx.steps {
+        for (j, e) in step_energy.iter_mut().enumerate() {
+            *e -= w[0] * mode_energy(&z_start, j);
+        }
+    }
     while integ.tau() < end {
-        let step = integ.step(end)?;
+        let target = match &ctx.steps {
+            Some((_, t, w)) if boundary < w.len() => tau_start + boundary as f64 * t,
+            _ => end,
+        };
+        let step = integ.step(target)?;
+        if let Some((_, _, w)) = &ctx.steps {
+            if integ.tau() >= target && boundary <= w.len() {
+                let z = integ.state();
+                for (j, e) in step_energy.iter_mut().enumerate() {
+                    let ej = mode_energy(z, j);
+                    *e += w[boundary - 1] * ej - w.get(boundary).map_or(0.0, |wb| wb * ej);
+                }
+                boundary += 1;
+            }
+        }
         let (r, t0, t1) = (step.region, step.tau0, step.tau1);
         if t1 > t0 {
             if r == Region::Contact {
@@ -554,12 +612,11 @@ pub(super) fn observe_window(
     let a1 = harmonics[0].amplitude;
     let higher_sq = 2.0 * (acc.w2 / t_tot - mean * mean) - a1 * a1;
     let higher_n2_sq = 2.0 * acc.wd2 / t_tot / (om * om) - a1 * a1;
-    let mode_energy = |z: &DVector<f64>, j: usize| {
-        0.5 * free.mass[(j, j)] * z[n + j] * z[n + j] + 0.5 * free.stiffness[(j, j)] * z[j] * z[j]
-    };
     let mode_balance = (0..n)
         .map(|j| {
-            let de = if taper {
+            let de = if ctx.steps.is_some() {
+                step_energy[j]
+            } else if taper {
                 -acc.energy_rate[j]
             } else {
                 mode_energy(&z_end, j) - mode_energy(&z_start, j)
