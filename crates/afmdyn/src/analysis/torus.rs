@@ -21,10 +21,8 @@ use crate::analysis::shooting::{shoot_map, ShootingOptions, GRAZING_TOL};
 use crate::error::SimError;
 use crate::integrate::{build, IntegratorOptions};
 use crate::maps::circle::{node_count, CircleMap, CircleNodes};
-use crate::maps::flow::flow;
 use crate::model::CantileverModel;
-use nalgebra::{DMatrix, DVector};
-use std::f64::consts::TAU;
+use nalgebra::DVector;
 
 /// A node's distance to grazing below which the circle may cross a grazing bifurcation
 /// between two nodes ([`InvariantCircle::smooth`]): on the test levers a node next to such a
@@ -123,48 +121,28 @@ pub fn invariant_circle(
     }
     let nodes = CircleNodes::new(p, q, node_count(p, q, opts.nodes))?;
     let mut it = build(model, integ, 0.0, guess)?;
-    let orbit = {
-        let mut map = CircleMap::new(it.as_mut(), nodes.clone());
-        shoot_map(&mut map, guess, 1, &opts.shooting)?
-    };
-    // the segment from the converged x_0, its monodromy matrix and distance to grazing
-    let t = TAU / model.omega();
-    let d = guess.len();
-    let mut states = Vec::with_capacity(nodes.len());
-    let mut phi = DMatrix::identity(d, d);
-    let mut x = orbit.state.clone();
-    let mut graze = f64::INFINITY;
-    let mut switchings = Vec::with_capacity(nodes.len());
-    for k in 0..nodes.len() {
-        states.push(x.clone());
-        let step = flow(
-            it.as_mut(),
-            k as f64 * t,
-            &x,
-            (k + 1) as f64 * t,
-            None,
-            true,
-        )?;
-        phi = &step.jacobian * &phi;
-        graze = graze.min(step.grazing_distance);
-        switchings.push(step.switchings);
-        x = step.state;
-    }
-    let radius = phi
+    let mut map = CircleMap::new(it.as_mut(), nodes.clone());
+    let orbit = shoot_map(&mut map, guess, 1, &opts.shooting)?;
+    // the segment from the converged x_0: its monodromy matrix and distance to grazing
+    let mut seg = map.linearised_segment(&orbit.state, true)?;
+    let m = nodes.len();
+    let radius = seg.monodromy[m]
         .complex_eigenvalues()
         .iter()
-        .fold(0.0f64, |m, l| m.max(l.norm()));
-    let contraction = radius.powf(1.0 / nodes.len() as f64);
+        .fold(0.0f64, |r, l| r.max(l.norm()));
+    let contraction = radius.powf(1.0 / m as f64);
+    let graze = seg.grazing_distance;
+    seg.states.truncate(m);
     Ok(InvariantCircle {
         nodes,
-        states,
+        states: seg.states,
         residuals: orbit.residuals,
         contraction,
         stable: contraction < 1.0,
         grazing_distance: graze,
         grazing: graze < GRAZING_TOL,
         smooth: graze >= NEAR_GRAZING,
-        switchings,
+        switchings: seg.switchings,
     })
 }
 

@@ -175,6 +175,24 @@ pub fn node_count(p: u64, q: u64, target: usize) -> usize {
     q.min(MAX_NODES as u64) as usize
 }
 
+/// One orbit segment of M drive periods from x_0 with its linearisation
+/// ([`CircleMap::linearised_segment`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Segment {
+    /// x_0 … x_M (M + 1 states `[2N]`), x_{k+1} = P(x_k).
+    pub states: Vec<DVector<f64>>,
+    /// Φ_0 = I … Φ_M, Φ_k = ∂x_k/∂x_0 (M + 1 matrices 2N×2N, saltation matrices included).
+    pub monodromy: Vec<DMatrix<f64>>,
+    /// Switchings in each period, `[M]`.
+    pub switchings: Vec<usize>,
+    /// Contacts (entries into region II and impacts) over the segment.
+    pub contacts: usize,
+    /// Time in region II over the segment (τ).
+    pub contact_time: f64,
+    /// Smallest distance to grazing over the segment (NaN when not watched).
+    pub grazing_distance: f64,
+}
+
 /// The circle's map over an integrator (module docs): G(x_0) = x_0 + x_M − Σ_j w_j x_j, whose
 /// fixed point is the circle's node at θ = 0. One iterate integrates M drive periods from
 /// τ = 0; only n = 1 iterate is defined.
@@ -212,6 +230,38 @@ impl<'a> CircleMap<'a> {
             xs.push(next);
         }
         Ok(xs)
+    }
+
+    /// The segment from x_0 with its linearisation: each period's flow with its monodromy
+    /// matrix ([`crate::maps::flow`]), the distance to grazing when `grazing` (else NaN).
+    ///
+    /// # Errors
+    /// [`SimError`] from the integrator.
+    pub fn linearised_segment(
+        &mut self,
+        x0: &DVector<f64>,
+        grazing: bool,
+    ) -> Result<Segment, SimError> {
+        let (t, m, d) = (self.period(), self.nodes.len(), x0.len());
+        let mut seg = Segment {
+            states: vec![x0.clone()],
+            monodromy: vec![DMatrix::identity(d, d)],
+            switchings: Vec::with_capacity(m),
+            contacts: 0,
+            contact_time: 0.0,
+            grazing_distance: if grazing { f64::INFINITY } else { f64::NAN },
+        };
+        for k in 0..m {
+            let (t0, t1) = (k as f64 * t, (k + 1) as f64 * t);
+            let step = flow(&mut *self.integ, t0, &seg.states[k], t1, None, grazing)?;
+            seg.monodromy.push(&step.jacobian * &seg.monodromy[k]);
+            seg.states.push(step.state);
+            seg.switchings.push(step.switchings);
+            seg.contacts += step.contacts;
+            seg.contact_time += step.contact_time;
+            seg.grazing_distance = seg.grazing_distance.min(step.grazing_distance);
+        }
+        Ok(seg)
     }
 
     /// Σ_j w_j x_j of node states `xs` (the interpolant at θ_M).
@@ -263,44 +313,24 @@ impl DiscreteMap for CircleMap<'_> {
         grazing: bool,
     ) -> Result<FlowMap, SimError> {
         Self::one_iterate(n)?;
-        let (t, m, d) = (self.period(), self.nodes.len(), z.len());
-        let mut x = z.clone();
-        let mut phi = DMatrix::identity(d, d);
-        // F = x_M − Σ w_j x_j and ∂F = Φ_M − Σ w_j Φ_j, accumulated along the segment
-        let mut f = DVector::zeros(d);
-        let mut df = DMatrix::zeros(d, d);
-        let (mut switchings, mut contacts, mut contact_time) = (0, 0, 0.0);
-        let mut graze = f64::INFINITY;
-        for k in 0..m {
-            let w = self.nodes.closure[k];
-            f.axpy(-w, &x, 1.0);
-            df -= &phi * w;
-            let step = flow(
-                &mut *self.integ,
-                k as f64 * t,
-                &x,
-                (k + 1) as f64 * t,
-                None,
-                grazing,
-            )?;
-            phi = &step.jacobian * &phi;
-            x = step.state;
-            switchings += step.switchings;
-            contacts += step.contacts;
-            contact_time += step.contact_time;
-            graze = graze.min(step.grazing_distance);
+        let seg = self.linearised_segment(z, grazing)?;
+        let (m, d) = (self.nodes.len(), z.len());
+        // F = x_M − Σ w_j x_j and ∂F = Φ_M − Σ w_j Φ_j
+        let mut f = seg.states[m].clone();
+        let mut df = seg.monodromy[m].clone();
+        for (k, w) in self.nodes.closure.iter().enumerate() {
+            f.axpy(-w, &seg.states[k], 1.0);
+            df -= &seg.monodromy[k] * *w;
         }
-        f += &x;
-        df += &phi;
         let jacobian = DMatrix::identity(d, d) + df;
         let log_volume = jacobian.determinant().abs().ln();
         Ok(FlowMap {
             state: z + f,
             jacobian,
-            switchings,
-            contacts,
-            grazing_distance: if grazing { graze } else { f64::NAN },
-            contact_time,
+            switchings: seg.switchings.iter().sum(),
+            contacts: seg.contacts,
+            grazing_distance: seg.grazing_distance,
+            contact_time: seg.contact_time,
             log_volume,
             param_derivative: None,
         })
