@@ -546,8 +546,7 @@ function showAnalysisFields() {
   // the swept range: z_c (m), or the drive frequency (Hz) of a resonance curve
   for (const end of ["from", "to"]) {
     $(`curve-${end}`).disabled = a === "image";
-    $(`curve-${end}-label`).textContent = a === "resonance"
-      ? `frequency ${end} (Hz; blank: the library's)` : `z_c ${end} (m; blank: the library's)`;
+    $(`curve-${end}-label`).textContent = a === "resonance" ? `frequency ${end} (Hz)` : `z_c ${end} (m)`;
   }
   $("fm-amplitude").disabled = a !== "fm";
 }
@@ -655,6 +654,8 @@ function drawAfm() {
   const d = state.afm.doc;
   const kind = state.afm.analysis;
   const y = $("afm-y").value;
+  // the reconstruction's plot, shown before it is drawn (a plot drawn hidden has no size)
+  $("afm-plot-c").hidden = !(kind === "fm" && state.afm.reconstruction?.force);
   const layout = (title, xk, yk) => ({
     margin: { l: 75, r: 10, t: 30, b: 50 }, title: { text: title, font: { size: 13 } },
     xaxis: axis(xk), yaxis: axis(yk), legend: { orientation: "h", y: -0.25 }, hovermode: "closest",
@@ -739,7 +740,6 @@ function drawAfm() {
         yaxis: { title: { text: "tip–sample force (N)" }, exponentformat: "SI" } });
     }
   }
-  $("afm-plot-c").hidden = !(kind === "fm" && state.afm.reconstruction?.force);
   const w = $("afm-warnings");
   w.replaceChildren();
   // the reconstruction's warnings, or its refusal, with the curve's

@@ -206,7 +206,7 @@ try {
   await page.waitForFunction((b) => window.explorer.timings.afm_ms !== b && !window.explorer.busy.afm, tA);
   timings.approach = await page.evaluate(() => window.explorer.timings.afm_ms);
   const curve = await page.evaluate(() => window.explorer.afm.doc);
-  const refCurve = native(["approach", "--probe", "examples/probe-point-mass-dmt.toml", "--points", "60", "--setpoint", "0.7"]);
+  const refCurve = native(["approach", "--probe", "examples/probe-point-mass-dmt.toml", "--points", "60", "--setpoint", "0.7", "--out", tmp]);
   let [w, where] = worst(approachSweeps(curve), approachSweeps(refCurve));
   check("the approach curve from the preset probe is `afmdyn approach --probe … --json`'s " +
     "(sweeps and setpoint to 1e-9)", w <= 1e-9, `${w} at ${where}`);
@@ -261,14 +261,17 @@ try {
   writeFileSync(fmFile, JSON.stringify(fm));
   const refRec = native(["reconstruct", "--fm", fmFile, "--files", "none"]);
   const rec = await page.evaluate(() => ({ r: window.explorer.afm.reconstruction, n: document.getElementById("afm-plot-c").data?.length ?? 0,
-    shown: !document.getElementById("afm-plot-c").hidden, warned: [...document.querySelectorAll("#afm-warnings li")].map((li) => li.textContent) }));
+    shown: !document.getElementById("afm-plot-c").hidden,
+    // drawn at its box's width (not at Plotly's default for a plot drawn while hidden)
+    fits: Math.abs(document.getElementById("afm-plot-c")._fullLayout.width - document.getElementById("afm-plot-c").clientWidth) <= 2,
+    warned: [...document.querySelectorAll("#afm-warnings li")].map((li) => li.textContent) }));
   const scale = Math.max(...refRec.force.force.map(Math.abs));
   const farF = rec.r?.force ? Math.max(...rec.r.force.force.map((f, i) => Math.abs(f - refRec.force.force[i]) / scale)) : Infinity;
   check("the FM curve's force reconstruction is `afmdyn reconstruct --fm` of the page's fm document (force to 1e-9 of its extreme; distances, law, warnings), drawn with the law",
     farF <= 1e-9 && rec.r.force.force.length === refRec.force.force.length &&
     worst(rec.r.force.distance, refRec.force.distance)[0] <= 1e-12 && JSON.stringify(rec.r.force.law) === JSON.stringify(refRec.force.law) &&
-    rec.shown && rec.n === 2 && refRec.warnings.every((m) => rec.warned.includes(`reconstruction: ${m}`)),
-  `${farF}; ${rec.n} traces; ${JSON.stringify(rec.warned)}`);
+    rec.shown && rec.fits && rec.n === 2 && refRec.warnings.every((m) => rec.warned.includes(`reconstruction: ${m}`)),
+  `${farF}; ${rec.n} traces; fits its box: ${rec.fits}; ${JSON.stringify(rec.warned)}`);
   // the phase is held at 90° by the PLL: its spread is the loop's round-off, drawn flat with
   // readable ticks rather than magnified into a scribble of 12-digit labels (issue 60 item 19)
   const phase = refFm.curve.phase_deg;
@@ -282,6 +285,7 @@ try {
     fmPhase.ticks.length >= 2 && new Set(fmPhase.ticks).size === fmPhase.ticks.length &&
     fmPhase.ticks.every((t) => t.length <= 6) && fmPhase.title.includes("constant"),
   `spread ${spread}; ${JSON.stringify(fmPhase)}`);
+  await page.screenshot({ path: path.join(out, "screenshot-fm.png"), fullPage: true });
   // the FM amplitude and the z_c range from their fields, against the command line's
   await page.fill("#fm-amplitude", "12e-9");
   await page.fill("#curve-from", "30e-9");
@@ -300,7 +304,7 @@ try {
   await page.click("#afm-run");
   await page.waitForFunction(() => document.getElementById("err-fm-amplitude").textContent !== "");
   const aMsg = await page.textContent("#err-fm-amplitude");
-  const aCli = nativeError(["fm", "--probe", "examples/probe-point-mass-dmt.toml", "--amplitude", "-1"]);
+  const aCli = nativeError(["fm", "--probe", "examples/probe-point-mass-dmt.toml", "--amplitude", "-1", "--out", tmp]);
   check("a bad FM amplitude is refused beside its field with the library's message (the command line's)",
     aMsg === aCli && await page.getAttribute("#fm-amplitude", "aria-invalid") === "true", `"${aMsg}" vs "${aCli}"`);
   await page.fill("#fm-amplitude", "");
@@ -309,7 +313,7 @@ try {
   await page.click("#afm-run");
   await page.waitForFunction(() => document.getElementById("err-curve-from").textContent !== "");
   const fMsg = await page.textContent("#err-curve-from");
-  const fCli = nativeError(["approach", "--probe", "examples/probe-point-mass-dmt.toml", "--from", "-3", "--to", "14e-9"]);
+  const fCli = nativeError(["approach", "--probe", "examples/probe-point-mass-dmt.toml", "--from", "-3", "--to", "14e-9", "--out", tmp]);
   check("a bad z_c start is refused beside its field with the library's message (the command line's)",
     fMsg === fCli, `"${fMsg}" vs "${fCli}"`);
   await page.fill("#curve-from", "");
