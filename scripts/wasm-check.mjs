@@ -6,7 +6,7 @@
 // "wasm: N passed, M failed" last.
 import { createRequire } from "node:module";
 import { execFileSync } from "node:child_process";
-import { readFileSync } from "node:fs";
+import { readFileSync, writeFileSync } from "node:fs";
 import { isDeepStrictEqual } from "node:util";
 import path from "node:path";
 import { worst, approachSweeps, approachBranches, compareBifurcation } from "./compare-docs.mjs";
@@ -26,7 +26,8 @@ function check(name, ok, detail = "") {
   else { failed += 1; console.log(`FAIL ${name} ${detail}`); }
 }
 
-const orbit = JSON.parse(wasm.run("orbit", JSON.stringify({ model: { omega: 2.8 } })));
+const orbitText = wasm.run("orbit", JSON.stringify({ model: { omega: 2.8 } }));
+const orbit = JSON.parse(orbitText);
 let [w, at] = worst(orbit, native(["orbit", "--omega", "2.8"]));
 check("orbit Ω = 2.8 is `afmdyn orbit --omega 2.8 --json` (numbers to 1e-9)", w <= 1e-9,
   `${w} at ${at}`);
@@ -114,6 +115,24 @@ try {
 } catch (e) { message = String(e.message); }
 check("a height map file is refused in wasm, naming height_map",
   message.includes("height_map") && message.includes("h.csv") && !message.includes("\n"), message);
+
+// the force behind an FM curve: wasm's fm document reconstructed in wasm and by
+// `afmdyn reconstruct --fm` from the same document (force to 1e-9 of its extreme)
+const fmDoc = wasm.run("fm", JSON.stringify({ probe: text, request: { points: 20 } }));
+const fmFile = path.join(imgDir, "fm.json");
+writeFileSync(fmFile, fmDoc);
+const rec = JSON.parse(wasm.reconstruct_fm(fmDoc));
+const refRec = native(["reconstruct", "--fm", fmFile, "--files", "none"]);
+const scale = Math.max(...refRec.force.force.map(Math.abs));
+const farF = Math.max(...rec.force.force.map((f, i) => Math.abs(f - refRec.force.force[i]) / scale));
+[w, at] = worst({ ...rec, force: null, csv: null }, { ...refRec, force: null, csv: null });
+check("reconstruct_fm of an fm document is `afmdyn reconstruct --fm` of it (force to 1e-9 of its " +
+  "extreme; distances, law, the rest to 1e-9)", farF <= 1e-9 && w <= 1e-9 &&
+  rec.force.force.length === 20 && worst(rec.force.distance, refRec.force.distance)[0] <= 1e-9 &&
+  isDeepStrictEqual(rec.force.law, refRec.force.law), `${farF}; ${w} at ${at}`);
+message = "";
+try { wasm.reconstruct_fm(orbitText); } catch (e) { message = String(e.message); }
+check("reconstruct_fm refuses a document that is no fm document, naming fm", message.startsWith("fm"), message);
 
 message = "";
 try { wasm.run("orbit", JSON.stringify({ model: { omega: -1 } })); }

@@ -38,6 +38,9 @@ function readHash() {
   return new URLSearchParams(location.hash.slice(1));
 }
 
+/** The AFM workspace's fields the URL keeps (by element id). */
+const AFM_KEPT = ["afm-analysis", "points", "setpoint", "afm-y", "pixels", "lines", "feedback", "curve-from", "curve-to", "fm-amplitude"];
+
 function writeHash() {
   const p = new URLSearchParams();
   const ws = $("tab-afm").getAttribute("aria-selected") === "true" ? "afm" : "dyn";
@@ -50,7 +53,7 @@ function writeHash() {
   if ($("cantilever").value) p.set("cantilever", $("cantilever").value);
   const preset = state.presets.find((x) => x.file === $("probe-preset").value);
   if (!preset || preset.text !== $("probe-text").value) p.set("probetext", $("probe-text").value);
-  for (const k of ["afm-analysis", "points", "setpoint", "afm-y", "pixels", "lines"]) if ($(k).value) p.set(k, $(k).value);
+  for (const k of AFM_KEPT) if ($(k).value) p.set(k, $(k).value);
   p.set("sample", $("sample-preset").value);
   const sample = state.presets.find((x) => x.file === $("sample-preset").value);
   if (!sample || sample.text !== $("sample-text").value) p.set("sampletext", $("sample-text").value);
@@ -467,6 +470,7 @@ function probeFromField(input) {
   }
   setKey(obj, input.dataset.key, value);
   $("probe-text").value = stringifyToml(obj);
+  probeChanged();
 }
 
 function chooseCantilever() {
@@ -481,6 +485,7 @@ function chooseCantilever() {
   } else if (obj.cantilever) delete obj.cantilever.name;
   $("probe-text").value = stringifyToml(obj);
   fieldsFromProbe();
+  probeChanged();
 }
 
 function choosePreset() {
@@ -496,6 +501,41 @@ function chooseSample() {
   if (p) $("sample-text").value = p.text;
 }
 
+/** The example menu of `kind` ("probe", "sample") names the example whose text the file's text
+ * is, else "(edited)": a menu never names an example the text no longer is (and choosing that
+ * example again restores it). */
+function presetOfText(kind) {
+  const text = $(`${kind}-text`).value;
+  const p = state.presets.find((x) => x.kind === kind && x.text === text);
+  $(`${kind}-preset`).value = p ? p.file : "";
+}
+
+/** The probe's text changed: the example menu follows it (presetOfText), and the engine gives
+ * its model's modes (`modes` of the probe: the document's "si" block), whose first mode's
+ * frequency and quality factor are shown under the probe — in a fluid, the wet f₀ and Q
+ * (Sader's hydrodynamic loading, the "medium" block), not the file's. */
+async function probeChanged() {
+  presetOfText("probe");
+  const text = $("probe-text").value;
+  const el = $("probe-modes");
+  el.textContent = "";
+  const g = (x, unit = "") => (typeof x === "number" ? `${x.toPrecision(6)}${unit}` : "— (overdamped)");
+  try {
+    const { doc } = await engine.run("probe", "modes", { probe: text });
+    const si = doc.si;
+    const m = si.medium;
+    state.probeModes = { text, si };
+    el.textContent = m
+      ? `In ${m.name ?? "the fluid"} (ρ = ${m.density} kg/m³, η = ${m.viscosity} Pa s), the model's first mode: ` +
+        `f₀ = ${g(m.resonance_frequency, " Hz")}, Q = ${g(m.quality_factor)} (wet; in vacuum f₀ = ${g(m.vacuum_resonance_frequency, " Hz")}; ` +
+        `the file's f₀ and Q are those measured in ${m.calibrated_in})`
+      : `The model's first mode: f₀ = ${g(si.free_frequencies_hz[0], " Hz")}, Q = ${g(si.quality_factors?.[0])}`;
+  } catch (e) {
+    // a probe the engine refuses: its message is shown beside its field when a curve is asked
+    if (!(e instanceof Cancelled)) state.probeModes = { text, error: e.message };
+  }
+}
+
 /** The fields an analysis takes: the sample map for an image, the setpoint for approach and
  * image, the points for the curves. */
 function showAnalysisFields() {
@@ -503,29 +543,44 @@ function showAnalysisFields() {
   $("sample-box").hidden = a !== "image";
   $("setpoint").disabled = !(a === "approach" || a === "image");
   $("points").disabled = a === "image";
+  // the swept range: z_c (m), or the drive frequency (Hz) of a resonance curve
+  for (const end of ["from", "to"]) {
+    $(`curve-${end}`).disabled = a === "image";
+    $(`curve-${end}-label`).textContent = a === "resonance" ? `frequency ${end} (Hz)` : `z_c ${end} (m)`;
+  }
+  $("fm-amplitude").disabled = a !== "fm";
 }
+
+/** The element of a request key's message in the AFM form. */
+const AFM_ERRORS = { from: "err-curve-from", to: "err-curve-to", amplitude: "err-fm-amplitude" };
+const afmErrorOf = (name) => $(AFM_ERRORS[name] ?? `err-${name}`);
 
 function afmErrorPlaces(message) {
   const placed = probeErrors(message, (key) =>
     document.querySelector(`#afm-form [data-key="${key}"]`)?.parentElement.querySelector(".error"), $("err-probe"));
   if (placed.length) return placed;
-  return fieldErrors(message, (name) => $(`err-${name}`));
+  return fieldErrors(message, afmErrorOf);
 }
 
 function afmRequest() {
   const analysis = $("afm-analysis").value;
   const request = {};
   const put = (key, id) => {
-    const v = numberField(id);
+    const v = numberField(id, key);
     if (v !== undefined) request[key] = v;
   };
   if (analysis === "image") {
     put("setpoint", "setpoint");
     put("pixels", "pixels");
     put("lines", "lines");
+    // the engine says why a PI scan is not run here (its message beside the field)
+    request.feedback = $("feedback").value;
   } else {
     put("points", "points");
+    put("from", "curve-from");
+    put("to", "curve-to");
     if (analysis === "approach") put("setpoint", "setpoint");
+    if (analysis === "fm") put("amplitude", "fm-amplitude");
   }
   return { analysis, request };
 }
@@ -563,10 +618,44 @@ const AXIS_UNITS = { amplitude: "m", z_c: "m", peak_force: "N", indentation: "m"
 const AXIS_NAMES = { amplitude: "amplitude A", z_c: "z_c (rest tip–sample distance)", peak_force: "peak force", indentation: "indentation", energy_dissipated: "E_dis (dissipated energy per period)", virial: "virial", phase_deg: "phase", frequency_hz: "drive frequency", frequency_shift: "frequency shift Δf" };
 const axis = (k) => ({ title: { text: `${AXIS_NAMES[k] ?? k} (${AXIS_UNITS[k] ?? ""})` }, exponentformat: "SI" });
 
+/** The share of its magnitude below which a plotted quantity's spread is round-off, not
+ * structure (a quantity held by a loop, as FM-AFM's phase at 90° to its tolerance): such an axis
+ * is drawn over ±FLAT_SHOWN of its magnitude, so that the noise is not magnified into a
+ * scribble and its ticks into overlapping 12-digit labels. Rendering only: the values (hover,
+ * export) are the engine's. */
+const FLAT_SPREAD = 1e-6;
+const FLAT_SHOWN = 1e-3;
+
+/** Plotly.react of an AFM plot, each y axis whose data spread is round-off (FLAT_SPREAD) given a
+ * fixed range about its middle and said to be constant in the plot's title. */
+function react(div, traces, layout) {
+  const flat = [];
+  for (const [name, ref] of [["yaxis", "y"], ["yaxis2", "y2"]]) {
+    const ys = traces.filter((t) => (t.yaxis ?? "y") === ref).flatMap((t) => t.y ?? [])
+      .filter((v) => typeof v === "number" && Number.isFinite(v));
+    if (!ys.length) continue;
+    const lo = Math.min(...ys);
+    const hi = Math.max(...ys);
+    const mag = Math.max(Math.abs(lo), Math.abs(hi));
+    if (mag > 0 && hi - lo <= FLAT_SPREAD * mag) {
+      const mid = (lo + hi) / 2;
+      layout[name] = { ...layout[name], range: [mid - FLAT_SHOWN * mag, mid + FLAT_SHOWN * mag], autorange: false };
+      flat.push(name);
+    }
+  }
+  if (flat.length) {
+    const text = `${layout.title?.text ?? ""} — constant to ${FLAT_SPREAD.toExponential(0)} of its size`;
+    layout.title = { ...layout.title, text };
+  }
+  Plotly.react(div, traces, layout, PLOT_CONFIG);
+}
+
 function drawAfm() {
   const d = state.afm.doc;
   const kind = state.afm.analysis;
   const y = $("afm-y").value;
+  // the reconstruction's plot, shown before it is drawn (a plot drawn hidden has no size)
+  $("afm-plot-c").hidden = !(kind === "fm" && state.afm.reconstruction?.force);
   const layout = (title, xk, yk) => ({
     margin: { l: 75, r: 10, t: 30, b: 50 }, title: { text: title, font: { size: 13 } },
     xaxis: axis(xk), yaxis: axis(yk), legend: { orientation: "h", y: -0.25 }, hovermode: "closest",
@@ -584,7 +673,7 @@ function drawAfm() {
         traces.push({ type: "scatter", mode: "markers", x: pts.map((p) => p.z_c), y: pts.map((p) => p[yk]), name: `setpoint A/A₀ = ${d.setpoint.ratio}`, marker: { size: 11, symbol: "star", color: COLOURS.selected } });
         if (yk === "amplitude") shapes.push({ type: "line", xref: "paper", yref: "y", x0: 0, x1: 1, y0: d.setpoint.amplitude, y1: d.setpoint.amplitude, line: { color: COLOURS.selected, dash: "dash", width: 1 } });
       }
-      Plotly.react(div, traces, { ...layout(title, "z_c", yk), shapes }, PLOT_CONFIG);
+      react(div, traces, { ...layout(title, "z_c", yk), shapes });
     };
     plot("afm-plot-a", "amplitude", "Approach–retract: amplitude (folds dotted)");
     plot("afm-plot-b", y, `Approach–retract: ${AXIS_NAMES[y]}`);
@@ -598,11 +687,11 @@ function drawAfm() {
       ["Tabor parameter", d.si?.tabor_parameter?.toFixed(3) ?? "—"],
     ]);
   } else if (kind === "resonance") {
-    const plot = (div, yk, title) => Plotly.react(div, [
+    const plot = (div, yk, title) => react(div, [
       lines(d.up.frequency_hz, d.up[yk], "sweep up", COLOURS.forward),
       lines(d.down.frequency_hz, d.down[yk], "sweep down", COLOURS.backward),
       ...branchTraces(d.branches, "frequency_hz", yk),
-    ], layout(title, "frequency_hz", yk), PLOT_CONFIG);
+    ], layout(title, "frequency_hz", yk));
     plot("afm-plot-a", "amplitude", "Resonance curve: amplitude");
     plot("afm-plot-b", "phase_deg", "Resonance curve: phase");
     summary($("afm-summary"), [
@@ -614,8 +703,15 @@ function drawAfm() {
       lines(d.approach.z_c, d.approach[`${key}_${m}${key === "phase" ? "_deg" : ""}`], `mode ${m}, approach`, m === 1 ? COLOURS.forward : "#16a085"),
       lines(d.retract.z_c, d.retract[`${key}_${m}${key === "phase" ? "_deg" : ""}`], `mode ${m}, retract`, m === 1 ? COLOURS.backward : "#d35400", { line: { dash: "dot", color: m === 1 ? COLOURS.backward : "#d35400" } }),
     ]).map((t) => ({ ...t, name: `${label} ${t.name}` }));
-    Plotly.react("afm-plot-a", modeTraces("amplitude", "A"), layout("Bimodal: each mode's amplitude", "z_c", "amplitude"), PLOT_CONFIG);
-    Plotly.react("afm-plot-b", modeTraces("phase", "φ"), layout("Bimodal: each mode's phase", "z_c", "phase_deg"), PLOT_CONFIG);
+    // A₂ is often a small fraction of A₁: on its own axis (right), so that it is not drawn
+    // flat along A₁'s
+    const amp = modeTraces("amplitude", "A").map((t, i) => (i >= 2 ? { ...t, yaxis: "y2" } : t));
+    const ampLayout = layout("Bimodal: each mode's amplitude (A₂ on the right axis)", "z_c", "amplitude");
+    ampLayout.margin = { ...ampLayout.margin, r: 75 };
+    ampLayout.yaxis = { ...ampLayout.yaxis, title: { text: "mode 1 amplitude A₁ (m)" } };
+    ampLayout.yaxis2 = { title: { text: "mode 2 amplitude A₂ (m)" }, exponentformat: "SI", overlaying: "y", side: "right" };
+    react("afm-plot-a", amp, ampLayout);
+    react("afm-plot-b", modeTraces("phase", "φ"), layout("Bimodal: each mode's phase", "z_c", "phase_deg"));
     summary($("afm-summary"), [
       ["drive components", JSON.stringify(d.drive_components.frequency ?? d.drive_components)],
       ["folds (z_c)", d.folds.length ? d.folds.map((z) => `${z.toExponential(4)} m`).join(", ") : "none"],
@@ -625,19 +721,31 @@ function drawAfm() {
   } else {
     const c = d.curve;
     const yk = c[y] ? y : "amplitude";
-    Plotly.react("afm-plot-a", [lines(c.z_c, c.frequency_shift, "Δf", COLOURS.forward)],
-      layout("FM-AFM: frequency shift", "z_c", "frequency_shift"), PLOT_CONFIG);
-    Plotly.react("afm-plot-b", [lines(c.z_c, c[yk], AXIS_NAMES[yk], COLOURS.backward)],
-      layout(`FM-AFM: ${AXIS_NAMES[yk]}`, "z_c", yk), PLOT_CONFIG);
+    react("afm-plot-a", [lines(c.z_c, c.frequency_shift, "Δf", COLOURS.forward)],
+      layout("FM-AFM: frequency shift", "z_c", "frequency_shift"));
+    react("afm-plot-b", [lines(c.z_c, c[yk], AXIS_NAMES[yk], COLOURS.backward)],
+      layout(`FM-AFM: ${AXIS_NAMES[yk]}${yk === "phase_deg" ? " (held by the PLL)" : ""}`, "z_c", yk));
     summary($("afm-summary"), [
       ["method", d.method],
       ["amplitude", `${d.amplitude.toExponential(4)} m`],
       ["resonance frequency", `${d.resonance_frequency.toFixed(1)} Hz`],
     ]);
+    const r = state.afm.reconstruction;
+    if (r?.force) {
+      react("afm-plot-c", [
+        lines(r.force.distance, r.force.force, "reconstructed (Sader–Jarvis)", COLOURS.forward),
+        ...(r.force.law ? [lines(r.force.distance, r.force.law, "the model's force law", "#7f8c8d", { line: { dash: "dot", color: "#7f8c8d" } })] : []),
+      ], { ...layout("The force behind Δf(d): reconstruction", "distance", "force"),
+        xaxis: { title: { text: "distance of closest approach d (m)" }, exponentformat: "SI" },
+        yaxis: { title: { text: "tip–sample force (N)" }, exponentformat: "SI" } });
+    }
   }
   const w = $("afm-warnings");
   w.replaceChildren();
-  for (const msg of d.warnings ?? []) {
+  // the reconstruction's warnings, or its refusal, with the curve's
+  const rec = kind === "fm" ? state.afm.reconstruction : null;
+  const reconstructed = (rec?.error ? [rec.error] : rec?.warnings ?? []).map((m) => `reconstruction: ${m}`);
+  for (const msg of [...(d.warnings ?? []), ...reconstructed]) {
     const li = document.createElement("li");
     li.textContent = typeof msg === "string" ? msg : JSON.stringify(msg);
     w.append(li);
@@ -651,14 +759,14 @@ function drawImage(d, channel) {
   const margin = { l: 75, r: 10, t: 30, b: 50 };
   const xTitle = { title: { text: "x (m)" }, exponentformat: "SI" };
   if (im.y.length === 1) {
-    Plotly.react("afm-plot-a", [
+    react("afm-plot-a", [
       lines(im.x, im.height[0], "apparent height", COLOURS.forward),
       lines(im.x, im.true_height[0], "true height", "#7f8c8d", { line: { dash: "dot", color: "#7f8c8d" } }),
     ], { margin, title: { text: `Line profile at A/A₀ = ${d.setpoint}`, font: { size: 13 } }, xaxis: xTitle,
-      yaxis: { title: { text: "height (m)" }, exponentformat: "SI" }, legend: { orientation: "h", y: -0.25 } }, PLOT_CONFIG);
-    Plotly.react("afm-plot-b", [lines(im.x, im[key][0], AXIS_NAMES[key], COLOURS.backward)],
+      yaxis: { title: { text: "height (m)" }, exponentformat: "SI" }, legend: { orientation: "h", y: -0.25 } });
+    react("afm-plot-b", [lines(im.x, im[key][0], AXIS_NAMES[key], COLOURS.backward)],
       { margin, title: { text: AXIS_NAMES[key], font: { size: 13 } }, xaxis: xTitle,
-        yaxis: axis(key), legend: { orientation: "h", y: -0.25 } }, PLOT_CONFIG);
+        yaxis: axis(key), legend: { orientation: "h", y: -0.25 } });
   } else {
     const heat = (div, z, name, unit) => Plotly.react(div, [{
       type: "heatmap", x: im.x, y: im.y, z, colorscale: "Viridis",
@@ -683,7 +791,7 @@ async function runAfm() {
   try {
     req = afmRequest();
   } catch (e) {
-    reportError(e, (m) => fieldErrors(m, (n) => $(`err-${n}`)), $("err-afm"));
+    reportError(e, (m) => fieldErrors(m, afmErrorOf), $("err-afm"));
     return;
   }
   writeHash();
@@ -696,6 +804,16 @@ async function runAfm() {
   try {
     const { doc, ms } = await engine.run("afm", req.analysis, input);
     state.afm = { analysis: req.analysis, doc, input };
+    if (req.analysis === "fm") {
+      // the force behind the curve: the library reads the fm document (its distances, shifts,
+      // k, f₀ and A) as `afmdyn reconstruct --fm fm.json` does
+      try {
+        state.afm.reconstruction = (await engine.run("afm", "reconstruct_fm", doc)).doc;
+      } catch (e) {
+        if (e instanceof Cancelled) throw e;
+        state.afm.reconstruction = { error: e.message };
+      }
+    }
     state.timings.afm_ms = performance.now() - t0;
     state.timings.afm_engine_ms = ms;
     drawAfm();
@@ -772,8 +890,7 @@ async function loadPresets() {
 function applyHash(p) {
   for (const f of DYN_FIELDS) if (p.has(f)) $(f).value = p.get(f);
   for (const [k, id] of [["y", "bif-y"], ["omega", "orbit-omega"], ["period", "orbit-period"],
-    ["afm-analysis", "afm-analysis"], ["points", "points"], ["setpoint", "setpoint"], ["afm-y", "afm-y"],
-    ["pixels", "pixels"], ["lines", "lines"], ["sample", "sample-preset"]]) {
+    ...AFM_KEPT.map((k) => [k, k]), ["sample", "sample-preset"]]) {
     if (p.has(k)) $(id).value = p.get(k);
   }
   if (p.has("probe")) $("probe-preset").value = p.get("probe");
@@ -787,6 +904,8 @@ function applyHash(p) {
     if (!p.has("probetext")) chooseCantilever();
   }
   fieldsFromProbe();
+  probeChanged();
+  presetOfText("sample");
 }
 
 async function main() {
@@ -840,11 +959,20 @@ async function main() {
   for (const input of document.querySelectorAll("#afm-form [data-key]")) {
     input.addEventListener("change", () => { clearErrors($("afm-form")); probeFromField(input); });
   }
-  $("probe-text").addEventListener("change", () => { clearErrors($("afm-form")); fieldsFromProbe(); });
-  $("probe-preset").addEventListener("change", () => { clearErrors($("afm-form")); choosePreset(); });
+  $("probe-text").addEventListener("change", () => { clearErrors($("afm-form")); fieldsFromProbe(); probeChanged(); });
+  $("probe-preset").addEventListener("change", () => { clearErrors($("afm-form")); choosePreset(); probeChanged(); });
+  $("sample-text").addEventListener("change", () => presetOfText("sample"));
   $("cantilever").addEventListener("change", () => { clearErrors($("afm-form")); chooseCantilever(); });
   $("afm-form").addEventListener("submit", (e) => { e.preventDefault(); runAfm(); });
-  $("afm-analysis").addEventListener("change", showAnalysisFields);
+  let swept = $("afm-analysis").value === "resonance";
+  $("afm-analysis").addEventListener("change", () => {
+    // a range in Hz is no range of z_c (m), nor the reverse: blanked when the swept quantity
+    // changes
+    const hz = $("afm-analysis").value === "resonance";
+    if (hz !== swept) for (const id of ["curve-from", "curve-to"]) $(id).value = "";
+    swept = hz;
+    showAnalysisFields();
+  });
   $("sample-preset").addEventListener("change", chooseSample);
   $("afm-y").addEventListener("change", () => { if (state.afm) drawAfm(); writeHash(); });
 
@@ -871,7 +999,7 @@ async function main() {
   }
 
   // the lanes' workers started now, so that a click finds its module instantiated
-  for (const lane of ["orbit", "afm"]) engine.lane(lane);
+  for (const lane of ["orbit", "afm", "probe"]) engine.lane(lane);
   state.ready = true;
   if (hash.get("ws") === "afm") {
     selectTab("tab-afm");

@@ -24,7 +24,9 @@ async function handle(msg) {
       const data = { cantilevers: wasm.cantilevers, bifurcation_columns: wasm.bifurcation_columns,
         laws: wasm.laws,
         version: () => JSON.stringify(wasm.version()) }[msg.analysis];
-      const text = data ? data() : wasm.run(msg.analysis, msg.input);
+      // reconstruct_fm: the force behind an fm document (the input is that document)
+      const text = data ? data() : msg.analysis === "reconstruct_fm" ? wasm.reconstruct_fm(msg.input)
+        : wasm.run(msg.analysis, msg.input);
       reply({ id: msg.id, ok: true, text, ms: performance.now() - t0 });
     } else if (msg.kind === "bifurcation") {
       const b = new wasm.Bifurcation(msg.input);

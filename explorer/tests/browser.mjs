@@ -206,7 +206,7 @@ try {
   await page.waitForFunction((b) => window.explorer.timings.afm_ms !== b && !window.explorer.busy.afm, tA);
   timings.approach = await page.evaluate(() => window.explorer.timings.afm_ms);
   const curve = await page.evaluate(() => window.explorer.afm.doc);
-  const refCurve = native(["approach", "--probe", "examples/probe-point-mass-dmt.toml", "--points", "60", "--setpoint", "0.7"]);
+  const refCurve = native(["approach", "--probe", "examples/probe-point-mass-dmt.toml", "--points", "60", "--setpoint", "0.7", "--out", tmp]);
   let [w, where] = worst(approachSweeps(curve), approachSweeps(refCurve));
   check("the approach curve from the preset probe is `afmdyn approach --probe … --json`'s " +
     "(sweeps and setpoint to 1e-9)", w <= 1e-9, `${w} at ${where}`);
@@ -256,6 +256,68 @@ try {
   check("the FM curve Δf(z_c) is `afmdyn fm --json`'s (to 1e-8: its loop solved to 1e-9), drawn against z_c",
     w <= 1e-8 && await page.evaluate(() => document.getElementById("afm-plot-a").layout.yaxis.title.text.includes("(Hz)")), `${w} at ${where}`);
   console.log(`     largest difference ${w.toExponential(1)} at ${where}`);
+  // the force behind the curve: the page's own fm document through `afmdyn reconstruct --fm`
+  const fmFile = path.join(tmp, "page-fm.json");
+  writeFileSync(fmFile, JSON.stringify(fm));
+  const refRec = native(["reconstruct", "--fm", fmFile, "--files", "none"]);
+  const rec = await page.evaluate(() => ({ r: window.explorer.afm.reconstruction, n: document.getElementById("afm-plot-c").data?.length ?? 0,
+    shown: !document.getElementById("afm-plot-c").hidden,
+    // drawn at its box's width (not at Plotly's default for a plot drawn while hidden)
+    fits: Math.abs(document.getElementById("afm-plot-c")._fullLayout.width - document.getElementById("afm-plot-c").clientWidth) <= 2,
+    warned: [...document.querySelectorAll("#afm-warnings li")].map((li) => li.textContent) }));
+  const scale = Math.max(...refRec.force.force.map(Math.abs));
+  const farF = rec.r?.force ? Math.max(...rec.r.force.force.map((f, i) => Math.abs(f - refRec.force.force[i]) / scale)) : Infinity;
+  check("the FM curve's force reconstruction is `afmdyn reconstruct --fm` of the page's fm document (force to 1e-9 of its extreme; distances, law, warnings), drawn with the law",
+    farF <= 1e-9 && rec.r.force.force.length === refRec.force.force.length &&
+    worst(rec.r.force.distance, refRec.force.distance)[0] <= 1e-12 && JSON.stringify(rec.r.force.law) === JSON.stringify(refRec.force.law) &&
+    rec.shown && rec.fits && rec.n === 2 && refRec.warnings.every((m) => rec.warned.includes(`reconstruction: ${m}`)),
+  `${farF}; ${rec.n} traces; fits its box: ${rec.fits}; ${JSON.stringify(rec.warned)}`);
+  // the phase is held at 90° by the PLL: its spread is the loop's round-off, drawn flat with
+  // readable ticks rather than magnified into a scribble of 12-digit labels (issue 60 item 19)
+  const phase = refFm.curve.phase_deg;
+  const spread = Math.max(...phase) - Math.min(...phase);
+  const fmPhase = await page.evaluate(() => {
+    const L = document.getElementById("afm-plot-b")._fullLayout;
+    return { range: L.yaxis.range, ticks: (L.yaxis._vals ?? []).map((t) => t.text), title: L.title.text };
+  });
+  check("the FM phase (held at 90° by the PLL, spread only round-off) is drawn flat over ±0.1 %, its tick labels short and distinct",
+    spread > 0 && spread <= 1e-6 * 90 && fmPhase.range[1] - fmPhase.range[0] >= 0.1 &&
+    fmPhase.ticks.length >= 2 && new Set(fmPhase.ticks).size === fmPhase.ticks.length &&
+    fmPhase.ticks.every((t) => t.length <= 6) && fmPhase.title.includes("constant"),
+  `spread ${spread}; ${JSON.stringify(fmPhase)}`);
+  await page.screenshot({ path: path.join(out, "screenshot-fm.png"), fullPage: true });
+  // the FM amplitude and the z_c range from their fields, against the command line's
+  await page.fill("#fm-amplitude", "12e-9");
+  await page.fill("#curve-from", "30e-9");
+  await page.fill("#curve-to", "14e-9");
+  await page.fill("#points", "8");
+  const fmA = await afmRun();
+  const refFmA = native(["fm", "--probe", "examples/probe-point-mass-dmt.toml", "--amplitude", "12e-9",
+    "--from", "30e-9", "--to", "14e-9", "--points", "8", "--out", tmp]);
+  [w, where] = worst(fmA.curve, refFmA.curve);
+  check("the FM amplitude and z_c range fields are the request's amplitude, from, to: " +
+    "`afmdyn fm --amplitude 12e-9 --from 30e-9 --to 14e-9 --points 8 --json`'s curve (to 1e-8)",
+  w <= 1e-8 && fmA.amplitude === 12e-9 && fmA.curve.z_c[0] === 30e-9 && fmA.curve.z_c.at(-1) === 14e-9,
+  `${w} at ${where}; A = ${fmA.amplitude}; z_c ${fmA.curve.z_c[0]}…${fmA.curve.z_c.at(-1)}`);
+  // a value the library refuses: its message beside the field (the page checks no range)
+  await page.fill("#fm-amplitude", "-1");
+  await page.click("#afm-run");
+  await page.waitForFunction(() => document.getElementById("err-fm-amplitude").textContent !== "");
+  const aMsg = await page.textContent("#err-fm-amplitude");
+  const aCli = nativeError(["fm", "--probe", "examples/probe-point-mass-dmt.toml", "--amplitude", "-1", "--out", tmp]);
+  check("a bad FM amplitude is refused beside its field with the library's message (the command line's)",
+    aMsg === aCli && await page.getAttribute("#fm-amplitude", "aria-invalid") === "true", `"${aMsg}" vs "${aCli}"`);
+  await page.fill("#fm-amplitude", "");
+  await page.fill("#curve-from", "-3");
+  await page.selectOption("#afm-analysis", "approach");
+  await page.click("#afm-run");
+  await page.waitForFunction(() => document.getElementById("err-curve-from").textContent !== "");
+  const fMsg = await page.textContent("#err-curve-from");
+  const fCli = nativeError(["approach", "--probe", "examples/probe-point-mass-dmt.toml", "--from", "-3", "--to", "14e-9", "--out", tmp]);
+  check("a bad z_c start is refused beside its field with the library's message (the command line's)",
+    fMsg === fCli, `"${fMsg}" vs "${fCli}"`);
+  await page.fill("#curve-from", "");
+  await page.fill("#curve-to", "");
 
   // bimodal: the two-mode probe preset against `afmdyn bimodal --json`
   await page.selectOption("#probe-preset", "probe-bimodal.toml");
@@ -270,6 +332,16 @@ try {
     "(sweeps to 1e-9; branches to 1e-6, 1e-4 at their grazing and fold events; folds to 1e-6); both modes drawn",
   w <= 1e-9 && wb <= 1 && wf <= 1e-6 &&
     await page.evaluate(() => document.getElementById("afm-plot-a").data.length === 4), `${w} at ${where}; ${wb} of the tolerance at ${wbAt}; ${wf} at ${wfAt}`);
+  // A₂ on its own axis: mode 2's traces on the right axis, whose range holds A₂'s values
+  const a2 = await page.evaluate(() => {
+    const gd = document.getElementById("afm-plot-a");
+    const L = gd._fullLayout;
+    return { axes: gd.data.map((t) => t.yaxis ?? "y"), title: L.yaxis2?.title.text ?? "", range: L.yaxis2?.range ?? null };
+  });
+  const amp2 = [...refBimodal.approach.amplitude_2, ...refBimodal.retract.amplitude_2];
+  check("bimodal: A₂ is drawn on its own (right) axis, A₁ on the left",
+    JSON.stringify(a2.axes) === JSON.stringify(["y", "y", "y2", "y2"]) && a2.title.includes("A₂") && a2.range &&
+    a2.range[0] <= Math.min(...amp2) && a2.range[1] >= Math.max(...amp2), JSON.stringify(a2));
 
   // an image: the stripe (one line) and the blend (a map) against `afmdyn image --json`
   await page.selectOption("#probe-preset", "probe-point-mass-dmt.toml");
@@ -291,6 +363,14 @@ try {
     w <= 1e-9 && kind === (refImage.image.y.length === 1 ? "scatter" : "heatmap"), `${w} at ${where}; ${kind}`);
   }
   await page.screenshot({ path: path.join(out, "screenshot-image.png"), fullPage: true });
+  // a PI-feedback image is the command line's only: the engine's refusal beside the field
+  await page.selectOption("#feedback", "pi");
+  await page.click("#afm-run");
+  await page.waitForFunction(() => document.getElementById("err-feedback").textContent !== "");
+  const piMsg = await page.textContent("#err-feedback");
+  check("a PI-feedback image is refused beside its field: not in the browser, the command line's --feedback pi",
+    piMsg.startsWith("feedback = pi: not in the browser") && piMsg.includes("afmdyn image --feedback pi"), piMsg);
+  await page.selectOption("#feedback", "ideal");
   await page.selectOption("#afm-analysis", "approach");
 
   // a bad probe value: beside its field, the command line's message for that key
@@ -321,6 +401,25 @@ try {
   // ------------------------------------------------------------------ the URL holds the view
   const shared = page.url();
   check("the URL holds the parameters", shared.includes("ws=afm") && shared.includes("spring_constant") && shared.includes("setpoint=0.7"));
+  // the probe's own modes: in water the wet f₀ and Q (Sader's), the command line's
+  await page.selectOption("#probe-preset", "probe-water-beam.toml");
+  const water = readFileSync(path.join(root, "examples/probe-water-beam.toml"), "utf8");
+  await page.waitForFunction((t) => window.explorer.probeModes?.text === t, water);
+  const wet = await page.evaluate(() => ({ si: window.explorer.probeModes.si, text: document.getElementById("probe-modes").textContent }));
+  const refWet = native(["modes", "--probe", "examples/probe-water-beam.toml"]).si.medium;
+  check("the probe in water shows its wet f₀ and Q (`afmdyn modes --probe … --json`'s si.medium), not the file's",
+    wet.si.medium.resonance_frequency === refWet.resonance_frequency && wet.si.medium.quality_factor === refWet.quality_factor &&
+    wet.text.includes(`f₀ = ${refWet.resonance_frequency.toPrecision(6)} Hz`) && wet.text.includes(`Q = ${refWet.quality_factor.toPrecision(6)}`),
+  `${wet.text} vs ${refWet.resonance_frequency}, ${refWet.quality_factor}`);
+  // the example menu follows the text: an edit leaves no example named, and choosing the
+  // example again restores its text
+  await page.fill("#p-quality_factor", "300");
+  await page.dispatchEvent("#p-quality_factor", "change");
+  const edited = await page.inputValue("#probe-preset");
+  await page.selectOption("#probe-preset", "probe-water-beam.toml");
+  check("the example menu names no example once the probe is edited, and choosing it again restores its text",
+    edited === "" && await page.inputValue("#probe-text") === water, `menu after the edit: "${edited}"`);
+
   const page2 = await context.newPage();
   await page2.goto(`${url}#ws=dyn&modes=2&alpha1=0.2&from=2.5&to=3&steps=12&omega=2.7`);
   await page2.waitForFunction(() => window.explorer?.timings.diagram_ms !== undefined);

@@ -24,7 +24,8 @@
 //!   `contact_force`, `a`, `a_dot`, …);
 //! * `image`: the ideal-feedback image of `afmdyn image --json` ([`image`]).
 //!
-//! Besides: [`cantilevers()`] (the cantilever library, `afmdyn cantilevers --json`), the
+//! Besides: [`reconstruct_fm()`] (the force behind an `fm` document, `afmdyn reconstruct
+//! --fm`), [`cantilevers()`] (the cantilever library, `afmdyn cantilevers --json`), the
 //! bifurcation diagram in chunks ([`Bifurcation`], [`bifurcation::BifurcationSession`]),
 //! [`periods()`] (the cost per drive period) and [`version()`].
 
@@ -145,6 +146,40 @@ pub fn run_json(analysis: &str, input: &str) -> Result<String, String> {
         .run(&model, &Progress::new())
         .map_err(|e| e.to_string())?;
     Ok(outcome.document.to_string())
+}
+
+/// The force and potential behind an FM curve (Sader–Jarvis): `fm` the JSON document `fm`
+/// returned with a probe (SI), its request read by the library
+/// ([`afmdyn::request::ReconstructRequest::from_fm_document`]: the distances of closest
+/// approach, the shifts, k, f₀ and A) and run through the named door — the document of
+/// `afmdyn reconstruct --fm fm.json --json`.
+///
+/// # Errors
+/// A text that is no JSON; a document that is no SI `fm` document; the request's validation
+/// (naming the field and its range) and the inversion's.
+pub fn reconstruct_fm_json(fm: &str) -> Result<String, String> {
+    let doc: Value = serde_json::from_str(fm).map_err(|e| format!("fm: {e}"))?;
+    let req = request::ReconstructRequest::from_fm_document(&doc, None, None, None)
+        .map_err(|e| e.to_string())?;
+    let value = serde_json::to_value(&req).map_err(|e| format!("request: {e}"))?;
+    let named = request::named::parse("reconstruct", value)
+        .map_err(|e| format!("request: {e}"))?
+        .ok_or("analysis = reconstruct: not a named analysis")?;
+    let model = Resolved::plain(Params::default());
+    named.validate(&model).map_err(|e| e.to_string())?;
+    let outcome = named
+        .run(&model, &Progress::new())
+        .map_err(|e| e.to_string())?;
+    Ok(outcome.document.to_string())
+}
+
+/// [`reconstruct_fm_json`] for JavaScript.
+///
+/// # Errors
+/// As [`reconstruct_fm_json`].
+#[wasm_bindgen]
+pub fn reconstruct_fm(fm: &str) -> Result<String, JsError> {
+    reconstruct_fm_json(fm).map_err(|e| JsError::new(&e))
 }
 
 /// Most drive periods [`advance_periods`] integrates.
