@@ -5,7 +5,9 @@
 
 use afmdyn::analysis::observables::{observe_orbit, Observables};
 use afmdyn::analysis::shooting::{shoot, ShootingOptions};
-use afmdyn::analysis::torus::{invariant_circle, observe_circle, CircleOptions, InvariantCircle};
+use afmdyn::analysis::torus::{
+    continue_circle, invariant_circle, observe_circle, CircleOptions, InvariantCircle,
+};
 use afmdyn::integrate::IntegratorKind;
 use afmdyn::maps::flow::flow_state;
 use afmdyn::probe::Probe;
@@ -199,4 +201,25 @@ fn far_from_the_sample_the_circle_is_the_free_response() {
     for m in &o.mode_balance {
         assert!(m.residual.abs() < 1e-9 * m.drive.abs().max(1e-12), "{m:?}");
     }
+}
+
+/// A step of an approach curve: the circle at z_c = 0.5 A₀₁ continued from the one at 0.51
+/// (Broyden's updates from its map's Jacobian, flows without the variational equations) is
+/// the circle a Newton solve finds there, to the solves' tolerance.
+#[test]
+fn a_continued_circle_is_the_circle() {
+    let opts = CircleOptions::default();
+    let before = CantileverModel::new(&lever_a2("1.881e6", 0.51, "0.5e-9")).unwrap();
+    let guess = settled(&before, 400);
+    let previous = invariant_circle(&before, integ(), &guess, &opts).unwrap();
+    let model = CantileverModel::new(&lever_a2("1.881e6", 0.5, "0.5e-9")).unwrap();
+    let fresh = invariant_circle(&model, integ(), &guess, &opts).unwrap();
+    let continued = continue_circle(&model, integ(), &previous, &opts).unwrap();
+    assert_eq!(fresh.nodes, continued.nodes);
+    let scale = fresh.states[0].amax();
+    for (a, b) in fresh.states.iter().zip(&continued.states) {
+        assert!((a - b).amax() < 1e-9 * scale, "{a} {b}");
+    }
+    assert!((fresh.contraction - continued.contraction).abs() < 1e-9);
+    assert_eq!(fresh.smooth, continued.smooth);
 }

@@ -17,12 +17,13 @@
 //! modulus to the power 1/M.
 
 use crate::analysis::observables::{observe_weighted, ObservableOptions, Observables};
-use crate::analysis::shooting::{shoot_map, ShootingOptions, GRAZING_TOL};
+use crate::analysis::shooting::{shoot_map, shoot_map_broyden, ShootingOptions, GRAZING_TOL};
 use crate::error::SimError;
 use crate::integrate::{build, IntegratorOptions};
 use crate::maps::circle::{node_count, CircleMap, CircleNodes};
+use crate::maps::DiscreteMap;
 use crate::model::CantileverModel;
-use nalgebra::DVector;
+use nalgebra::{DMatrix, DVector};
 
 /// A node's distance to grazing below which the circle may cross a grazing bifurcation
 /// between two nodes ([`InvariantCircle::smooth`]): on the test levers a node next to such a
@@ -60,6 +61,9 @@ pub struct InvariantCircle {
     pub nodes: CircleNodes,
     /// x_k = u(θ_k) at τ = kT, k = 0..M−1 (M states `[2N]`).
     pub states: Vec<DVector<f64>>,
+    /// ∂G at the solution (2N×2N), G the circle's map ([`CircleMap`]): Broyden's first
+    /// estimate when the circle is continued ([`continue_circle`]).
+    pub jacobian: DMatrix<f64>,
     /// ‖F‖ after each Newton iteration.
     pub residuals: Vec<f64>,
     /// ρ(Φ_M)^{1/M}: the cocycle's contraction per drive period (module docs).
@@ -103,7 +107,8 @@ pub fn rotation(model: &CantileverModel) -> Result<(u64, u64), SimError> {
 
 /// The invariant circle of `model`'s two-frequency drive near `guess` (the state at τ = 0,
 /// `[2N]`): Newton ([`shoot_map`]) on the circle's map of `opts.nodes` nodes
-/// ([`node_count`]), then its stability from one more pass over the segment.
+/// ([`node_count`]), its stability from the monodromy matrices of the last Newton
+/// linearisation, and its distance to grazing from one more pass.
 ///
 /// # Errors
 /// [`SimError::OutOfRange`] for a drive without exactly one further component or nodes
@@ -115,6 +120,39 @@ pub fn invariant_circle(
     guess: &DVector<f64>,
     opts: &CircleOptions,
 ) -> Result<InvariantCircle, SimError> {
+    solve(model, integ, guess, opts, None)
+}
+
+/// The circle of `model` continued from `previous` (the circle at a nearby parameter value,
+/// on as many nodes): Broyden's updates ([`shoot_map_broyden`]) from its state and from its
+/// map's Jacobian, by flows without the variational equations, and one linearisation at the
+/// solution — a step of an approach curve at the cost of about one Newton iteration.
+///
+/// # Errors
+/// As [`invariant_circle`]; [`SimError::OutOfRange`] when `previous` has another number of
+/// nodes than `opts.nodes` gives for `model`.
+pub fn continue_circle(
+    model: &CantileverModel,
+    integ: IntegratorOptions,
+    previous: &InvariantCircle,
+    opts: &CircleOptions,
+) -> Result<InvariantCircle, SimError> {
+    solve(
+        model,
+        integ,
+        &previous.states[0],
+        opts,
+        Some(&previous.jacobian),
+    )
+}
+
+fn solve(
+    model: &CantileverModel,
+    integ: IntegratorOptions,
+    guess: &DVector<f64>,
+    opts: &CircleOptions,
+    jacobian: Option<&DMatrix<f64>>,
+) -> Result<InvariantCircle, SimError> {
     let (p, q) = rotation(model)?;
     if opts.nodes == 0 {
         return Err(SimError::out_of_range("nodes", 0, "must be ≥ 1"));
@@ -122,21 +160,31 @@ pub fn invariant_circle(
     let nodes = CircleNodes::new(p, q, node_count(p, q, opts.nodes))?;
     let mut it = build(model, integ, 0.0, guess)?;
     let mut map = CircleMap::new(it.as_mut(), nodes.clone());
-    let orbit = shoot_map(&mut map, guess, 1, &opts.shooting)?;
-    // the segment from the converged x_0: its monodromy matrix and distance to grazing
-    let mut seg = map.linearised_segment(&orbit.state, true)?;
+    // Newton's solution (whose finish measures the distance to grazing), or Broyden's
+    let (state, jacobian, residuals, graze) = match jacobian {
+        None => {
+            let o = shoot_map(&mut map, guess, 1, &opts.shooting)?;
+            (o.state, o.monodromy, o.residuals, o.grazing_distance)
+        }
+        Some(m0) => {
+            let o = shoot_map_broyden(&mut map, guess, 1, &opts.shooting, m0)?;
+            let graze = map.grazing_distance(&o.state, 1)?;
+            (o.state, o.monodromy, o.residuals, graze)
+        }
+    };
+    let mut seg = map.segment_at(&state)?;
     let m = nodes.len();
     let radius = seg.monodromy[m]
         .complex_eigenvalues()
         .iter()
         .fold(0.0f64, |r, l| r.max(l.norm()));
     let contraction = radius.powf(1.0 / m as f64);
-    let graze = seg.grazing_distance;
     seg.states.truncate(m);
     Ok(InvariantCircle {
         nodes,
         states: seg.states,
-        residuals: orbit.residuals,
+        jacobian,
+        residuals,
         contraction,
         stable: contraction < 1.0,
         grazing_distance: graze,

@@ -31,7 +31,7 @@
 use crate::error::SimError;
 use crate::integrate::Integrator;
 use crate::maps::discrete::DiscreteMap;
-use crate::maps::flow::{flow, flow_state, FlowMap};
+use crate::maps::flow::{flow, flow_state, grazing_distance, FlowMap};
 use nalgebra::{DMatrix, DVector};
 use std::f64::consts::TAU;
 
@@ -199,13 +199,21 @@ pub struct Segment {
 pub struct CircleMap<'a> {
     integ: &'a mut dyn Integrator,
     nodes: CircleNodes,
+    /// The last linearised segment ([`DiscreteMap::linearise`] keeps it: a Newton solve ends
+    /// with a linearisation at its solution, whose monodromy matrices the circle's stability
+    /// reads).
+    last: Option<Segment>,
 }
 
 impl<'a> CircleMap<'a> {
     /// The circle's map on `nodes` over `integ` (at its system's parameters; the drive period
     /// T = 2π/Ω of the primary drive).
     pub fn new(integ: &'a mut dyn Integrator, nodes: CircleNodes) -> Self {
-        CircleMap { integ, nodes }
+        CircleMap {
+            integ,
+            nodes,
+            last: None,
+        }
     }
 
     /// The nodes.
@@ -262,6 +270,19 @@ impl<'a> CircleMap<'a> {
             seg.grazing_distance = seg.grazing_distance.min(step.grazing_distance);
         }
         Ok(seg)
+    }
+
+    /// The linearised segment from `x0`: the one the last [`DiscreteMap::linearise`] computed
+    /// when it started at `x0`, else a new one ([`Self::linearised_segment`], grazing not
+    /// watched).
+    ///
+    /// # Errors
+    /// [`SimError`] from the integrator.
+    pub fn segment_at(&mut self, x0: &DVector<f64>) -> Result<Segment, SimError> {
+        match self.last.take() {
+            Some(seg) if &seg.states[0] == x0 => Ok(seg),
+            _ => self.linearised_segment(x0, false),
+        }
     }
 
     /// Σ_j w_j x_j of node states `xs` (the interpolant at θ_M).
@@ -324,7 +345,7 @@ impl DiscreteMap for CircleMap<'_> {
         }
         let jacobian = DMatrix::identity(d, d) + df;
         let log_volume = jacobian.determinant().abs().ln();
-        Ok(FlowMap {
+        let map = FlowMap {
             state: z + f,
             jacobian,
             switchings: seg.switchings.iter().sum(),
@@ -333,7 +354,23 @@ impl DiscreteMap for CircleMap<'_> {
             contact_time: seg.contact_time,
             log_volume,
             param_derivative: None,
-        })
+        };
+        self.last = Some(seg);
+        Ok(map)
+    }
+
+    /// The smallest distance to grazing over the segment's periods
+    /// ([`crate::maps::flow::grazing_distance`] of each, without the Jacobian).
+    fn grazing_distance(&mut self, z: &DVector<f64>, n: usize) -> Result<f64, SimError> {
+        Self::one_iterate(n)?;
+        let t = self.period();
+        let xs = self.segment(z)?;
+        let mut graze = f64::INFINITY;
+        for (k, x) in xs.iter().take(self.nodes.len()).enumerate() {
+            let (t0, t1) = (k as f64 * t, (k + 1) as f64 * t);
+            graze = graze.min(grazing_distance(&mut *self.integ, t0, x, t1)?);
+        }
+        Ok(graze)
     }
 
     fn check_state(&self, name: &'static str, z: &DVector<f64>) -> Result<(), SimError> {
