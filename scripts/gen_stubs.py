@@ -6,8 +6,8 @@ JSON Schemas (``docs/schema/requests/*.json``, written by
 ``AFMDYN_WRITE_SCHEMA=1 cargo test --release -p afmdyn --test schema``) give each keyword's
 type and default. This script writes, between the markers in
 ``crates/afmdyn-py/python/afmdyn/_afmdyn.pyi``, a ``TypedDict`` per request (its keys, types
-and defaults), the overloads of the one door ``run`` (one per analysis' name) and the compiled
-functions of the studies run into a store.
+and defaults), the overloads of the one door ``run`` and of ``run_stored`` (the studies run into
+a store; one per analysis' name).
 
     python3 scripts/gen_stubs.py          # rewrite the generated block
     python3 scripts/gen_stubs.py --check  # exit 1 when it is stale (the Python tests run this)
@@ -45,16 +45,15 @@ RUN = [
     ("fm", "fm"),
     ("reconstruct", "reconstruct"),
 ]
-_STORE = ["probe: Optional[str] = None", "store: Optional[str] = None", "resume: bool = False"]
-#: compiled functions of the studies run into a store, schema file, extra parameters after
-#: ``request`` (the non-request ones)
-FUNCTIONS = [
-    ("bifurcation", "bifurcation", ["store: Optional[str] = None", "resume: bool = False"]),
-    ("global_continuation", "global_continuation", _STORE),
-    ("approach", "approach", _STORE),
-    ("bimodal", "approach", _STORE),
-    ("resonance", "resonance", _STORE),
-    ("basins", "basins", _STORE),
+#: the studies run into a store through ``_afmdyn.run_stored`` (the library's
+#: ``study::stored::parse``) and their schema files
+STORED = [
+    ("bifurcation", "bifurcation"),
+    ("basins", "basins"),
+    ("global_continuation", "global_continuation"),
+    ("approach", "approach"),
+    ("bimodal", "approach"),
+    ("resonance", "resonance"),
 ]
 #: requests with a stub but no compiled function of their own (the chart's study takes JSON)
 OTHERS = ["chart"]
@@ -105,7 +104,7 @@ def generate() -> str:
     out = [BEGIN]
     nested: dict = {}
     blocks = []
-    stems = [f[1] for f in RUN if f[1]] + [f[1] for f in FUNCTIONS] + OTHERS
+    stems = [f[1] for f in RUN if f[1]] + [f[1] for f in STORED] + OTHERS
     for stem in dict.fromkeys(stems):
         schema = json.loads((SCHEMAS / f"{stem}.json").read_text())
         defs = schema.get("$defs", {})
@@ -114,21 +113,16 @@ def generate() -> str:
                 nested[dname] = typed_dict(dname, d, defs)
         blocks.append(typed_dict(schema["title"], schema, defs))
     out += list(nested.values()) + blocks
-    for name, stem in RUN:
-        request = f"Optional[{title(stem)}]" if stem else "Optional[Dict[str, Any]]"
-        params = [f'    name: Literal["{name}"]', f"    request: {request} = None",
-                  "    params: Optional[Params] = None", "    probe: Optional[str] = None",
-                  "    progress: Optional[ProgressCallback] = None"]
-        out.append("@overload\ndef run(\n" + ",\n".join(params) + ",\n) -> Dict[str, Any]: ...")
-    # a name known only at run time (the package's own calls): any request
-    out.append("@overload\ndef run(\n    name: str,\n    request: Optional[Dict[str, Any]] = None,\n"
-               "    params: Optional[Params] = None,\n    probe: Optional[str] = None,\n"
-               "    progress: Optional[ProgressCallback] = None,\n) -> Dict[str, Any]: ...")
-    for fn, stem, extra in FUNCTIONS:
-        params = ["    params: Params", f"    request: Optional[{title(stem)}] = None",
-                  "    progress: Optional[ProgressCallback] = None"]
-        params += [f"    {e}" for e in extra]
-        out.append(f"def {fn}(\n" + ",\n".join(params) + ",\n) -> Dict[str, Any]: ...")
+    store = ["    store: Optional[str] = None", "    resume: bool = False"]
+    for fn, names, extra in (("run", RUN, []), ("run_stored", STORED, store)):
+        # each name with its request, then a name known only at run time: any request
+        for name, request in [(f'Literal["{n}"]', f"Optional[{title(stem)}]" if stem else None)
+                              for n, stem in names] + [("str", None)]:
+            params = [f"    name: {name}", f"    request: {request or 'Optional[Dict[str, Any]]'}"
+                      " = None", "    params: Optional[Params] = None",
+                      "    probe: Optional[str] = None",
+                      "    progress: Optional[ProgressCallback] = None"] + extra
+            out.append(f"@overload\ndef {fn}(\n" + ",\n".join(params) + ",\n) -> Dict[str, Any]: ...")
     out.append(END)
     return "\n\n".join(out) + "\n"
 

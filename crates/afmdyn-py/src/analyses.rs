@@ -11,10 +11,9 @@ use crate::params::PyParams;
 use crate::run::{run, Job, Stop};
 use afmdyn::analysis::bifurcation::SweepSpec;
 use afmdyn::probe::Probe;
-use afmdyn::request::checkpoint::{self, CheckpointError};
-use afmdyn::request::{self, Analysis, BifurcationRequest, Document, Resolved};
-use afmdyn::request::{DirLock, FileCheckpoint, LockError, MemoryCheckpoint, SweepRecord};
-use afmdyn::study::sweep::SweepStudy;
+use afmdyn::request::checkpoint::CheckpointError;
+use afmdyn::request::{self, Analysis, Document, Resolved};
+use afmdyn::request::{DirLock, LockError, SweepRecord};
 use afmdyn::study::{execute, StudyError};
 use afmdyn::{report, Params};
 use pyo3::prelude::*;
@@ -92,76 +91,14 @@ pub(crate) fn study_error(e: StudyError) -> PyErr {
     }
 }
 
-/// A bifurcation diagram: the steady state at each parameter value, one row per section point
-/// in the command line's order (`bifurcation.csv`: by value index, then forward, backward,
-/// start 0, 1, …). With `store`, the sweep is checkpointed in that directory (the command
-/// line's `--out` layout) and `resume` continues it.
-#[pyfunction]
-#[pyo3(signature = (params, request=None, progress=None, store=None, resume=false))]
-pub fn bifurcation<'py>(
-    py: Python<'py>,
-    params: PyRef<'_, PyParams>,
-    request: Option<&Dict<'py>>,
-    progress: Option<Bound<'py, PyAny>>,
-    store: Option<std::path::PathBuf>,
-    resume: bool,
-) -> PyResult<Dict<'py>> {
-    let request: BifurcationRequest = crate::convert::request("bifurcation", request)?;
-    let threads = request.threads;
-    let spec = request.spec(&params.inner).map_err(sim_error)?;
-    if resume && store.is_none() {
-        return Err(value_error(
-            "resume=True needs store= (the directory of the interrupted sweep)",
-        ));
-    }
-    // the store is locked here, before any work: a second run on it is refused at once
-    let lock = store.map(|dir| lock_store(&dir)).transpose()?;
-    let total = checkpoint::point_count(&spec);
-    let job = Job::default();
-    let worker_job = job.clone();
-    let worker_spec = spec.clone();
-    let records = run(
-        py,
-        &job,
-        Some(total),
-        progress.as_ref(),
-        Stop::Cancellable,
-        move || -> PyResult<Vec<SweepRecord>> {
-            let study = SweepStudy::new(&request, worker_spec);
-            let progress = &*worker_job.progress;
-            match &lock {
-                Some(lock) => {
-                    let mut s = FileCheckpoint::new(lock);
-                    execute(&study, &mut s, resume, threads, progress).map_err(study_error)?;
-                    s.records().map_err(checkpoint_error)
-                }
-                None => {
-                    let mut s = MemoryCheckpoint::default();
-                    execute(&study, &mut s, false, threads, progress).map_err(study_error)?;
-                    Ok(s.into_records())
-                }
-            }
-        },
-    )??;
-    if let Some(e) = afmdyn::request::sweep::every_point_failed(&records) {
-        return Err(sim_error(e));
-    }
-    sweep_dict(py, &spec, records)
-}
-
-/// A sweep's records, in their order, as `bifurcation` returns them: the swept parameter,
-/// its values and the records' layout ([`afmdyn::request::sweep::layout`]).
+/// A sweep's records, in their order, as the door returns them
+/// ([`afmdyn::study::stored::sweep_outcome`]).
 pub(crate) fn sweep_dict<'py>(
     py: Python<'py>,
     spec: &SweepSpec,
     records: Vec<SweepRecord>,
 ) -> PyResult<Dict<'py>> {
-    let out = Out::new(py);
-    out.set("param", spec.param.name())?;
-    out.f64s("values", spec.values.clone())?;
-    let layout = afmdyn::request::sweep::layout(spec, &records);
-    out.set("layout", crate::convert::layout_dict(py, layout)?)?;
-    Ok(out.finish())
+    crate::door::outcome_dict(py, afmdyn::study::stored::sweep_outcome(spec, &records))
 }
 
 /// The JSON document of a reconstruction request, run as every analysis is ([`analysis`]):

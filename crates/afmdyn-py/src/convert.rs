@@ -2,6 +2,7 @@
 //! the request is the one signature), and Rust results to Python objects: NumPy arrays that
 //! take over the Rust buffers (no copy), and JSON documents as Python dicts.
 
+use afmdyn::request::keywords::{canonical_name, Keyword as Val, KeywordError};
 use numpy::IntoPyArray;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -13,22 +14,16 @@ pub fn json_to_py<'py>(py: Python<'py>, text: &str) -> PyResult<Bound<'py, PyAny
 
 /// Builder of the dict a compiled function returns to the Python layer.
 pub struct Out<'py> {
-    pub py: Python<'py>,
     pub dict: Bound<'py, PyDict>,
 }
 
 impl<'py> Out<'py> {
     pub fn new(py: Python<'py>) -> Self {
         Out {
-            py,
             dict: PyDict::new(py),
         }
     }
-    /// A 1-D float64 array owning `v`.
-    pub fn f64s(&self, key: &str, v: Vec<f64>) -> PyResult<()> {
-        self.dict.set_item(key, v.into_pyarray(self.py))
-    }
-    /// Any other value.
+    /// Any value.
     pub fn set<V: IntoPyObject<'py>>(&self, key: &str, v: V) -> PyResult<()> {
         self.dict.set_item(key, v)
     }
@@ -85,96 +80,6 @@ pub fn layout_dict<'py>(
     Ok(out)
 }
 
-/// A Python value as serde sees it: the keywords of an analysis on their way into the
-/// library's request (NaN and ±∞ kept, so that the request's own checks name them).
-enum Val {
-    Null,
-    Bool(bool),
-    Int(i64),
-    Float(f64),
-    Str(String),
-    Seq(Vec<Val>),
-    Map(Vec<(String, Val)>),
-}
-
-/// A serde error of [`request`]: an unknown key is a `TypeError`, every other a `ValueError`.
-#[derive(Debug)]
-struct DeError {
-    msg: String,
-    unknown: bool,
-}
-
-impl std::fmt::Display for DeError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.msg)
-    }
-}
-
-impl std::error::Error for DeError {}
-
-impl serde::de::Error for DeError {
-    fn custom<T: std::fmt::Display>(msg: T) -> Self {
-        DeError {
-            msg: msg.to_string(),
-            unknown: false,
-        }
-    }
-    fn unknown_field(field: &str, expected: &'static [&'static str]) -> Self {
-        DeError {
-            msg: format!(
-                "unknown keyword '{field}': expected {}",
-                expected.join(", ")
-            ),
-            unknown: true,
-        }
-    }
-}
-
-impl<'de> serde::de::IntoDeserializer<'de, DeError> for Val {
-    type Deserializer = Val;
-    fn into_deserializer(self) -> Val {
-        self
-    }
-}
-
-impl<'de> serde::Deserializer<'de> for Val {
-    type Error = DeError;
-    fn deserialize_any<V: serde::de::Visitor<'de>>(self, v: V) -> Result<V::Value, DeError> {
-        use serde::de::value::{MapDeserializer, SeqDeserializer};
-        match self {
-            Val::Null => v.visit_unit(),
-            Val::Bool(b) => v.visit_bool(b),
-            Val::Int(i) => v.visit_i64(i),
-            Val::Float(x) => v.visit_f64(x),
-            Val::Str(s) => v.visit_string(s),
-            Val::Seq(items) => v.visit_seq(SeqDeserializer::new(items.into_iter())),
-            Val::Map(entries) => v.visit_map(MapDeserializer::new(entries.into_iter())),
-        }
-    }
-    fn deserialize_option<V: serde::de::Visitor<'de>>(self, v: V) -> Result<V::Value, DeError> {
-        match self {
-            Val::Null => v.visit_none(),
-            other => v.visit_some(other),
-        }
-    }
-    fn deserialize_enum<V: serde::de::Visitor<'de>>(
-        self,
-        _name: &'static str,
-        _variants: &'static [&'static str],
-        v: V,
-    ) -> Result<V::Value, DeError> {
-        match self {
-            Val::Str(s) => v.visit_enum(serde::de::value::StringDeserializer::new(s)),
-            other => other.deserialize_any(v),
-        }
-    }
-    serde::forward_to_deserialize_any! {
-        bool i8 i16 i32 i64 i128 u8 u16 u32 u64 u128 f32 f64 char str string bytes byte_buf
-        unit unit_struct newtype_struct seq tuple tuple_struct map struct identifier
-        ignored_any
-    }
-}
-
 /// A probe given as a dict of sections, as the TOML table the probe reader takes: numbers
 /// (NaN and ±∞ kept, so that the reader's own checks name the key), strings, booleans, lists
 /// and sub-dicts; `None` entries left out.
@@ -182,33 +87,17 @@ impl<'de> serde::Deserializer<'de> for Val {
 /// # Errors
 /// `TypeError` naming the key of a value that is none of these.
 pub fn toml_table(d: &Bound<'_, PyDict>) -> PyResult<toml::Table> {
-    fn toml_of(v: Val) -> Option<toml::Value> {
-        Some(match v {
-            Val::Null => return None,
-            Val::Bool(b) => toml::Value::Boolean(b),
-            Val::Int(i) => toml::Value::Integer(i),
-            Val::Float(x) => toml::Value::Float(x),
-            Val::Str(s) => toml::Value::String(s),
-            Val::Seq(items) => toml::Value::Array(items.into_iter().filter_map(toml_of).collect()),
-            Val::Map(entries) => toml::Value::Table(
-                entries
-                    .into_iter()
-                    .filter_map(|(k, v)| toml_of(v).map(|v| (k, v)))
-                    .collect(),
-            ),
-        })
-    }
     let mut table = toml::Table::new();
     for (k, v) in d.iter() {
         let key: String = k.extract()?;
-        if let Some(v) = toml_of(val(&key, &v)?) {
+        if let Some(v) = val(&key, &v)?.into_toml() {
             table.insert(key, v);
         }
     }
     Ok(table)
 }
 
-/// `v` as a [`Val`]; `key` names it in a `TypeError` for a type serde cannot take.
+/// `v` as a [`Val`] (the library's [`Keyword`]); `key` names it in a `TypeError` for a type serde cannot take.
 fn val(key: &str, v: &Bound<'_, PyAny>) -> PyResult<Val> {
     use pyo3::types::{PyBool, PyFloat, PyInt, PyList, PyString, PyTuple};
     if v.is_none() {
@@ -220,14 +109,29 @@ fn val(key: &str, v: &Bound<'_, PyAny>) -> PyResult<Val> {
     } else if v.is_instance_of::<PyFloat>() {
         Ok(Val::Float(v.extract()?))
     } else if v.is_instance_of::<PyInt>() {
-        v.extract().map(Val::Int).map_err(|_| {
-            crate::errors::value_error(format!("{key} = {v}: out of range (beyond 64 bits)"))
-        })
+        if let Ok(i) = v.extract() {
+            return Ok(Val::Int(i));
+        }
+        // beyond 64 bits: a value out of range (named with the model parameter's range), or
+        // for a real model parameter the nearest double
+        use afmdyn::request::model::ValueKind;
+        let msg = match afmdyn::request::parameter(key) {
+            Some(p) if matches!(p.kind, ValueKind::Real) => match v.extract::<f64>() {
+                Ok(x) => return Ok(Val::Float(x)),
+                Err(_) => format!(
+                    "{key} = an integer of {} digits: must be a finite number",
+                    v.str()?.to_string().trim_start_matches('-').len()
+                ),
+            },
+            Some(p) => format!("{key} = {v}: must be in {}", p.range),
+            None => format!("{key} = {v}: out of range (beyond 64 bits)"),
+        };
+        Err(crate::errors::value_error(msg))
     } else if v.is_instance_of::<PyList>() || v.is_instance_of::<PyTuple>() {
         let items: PyResult<Vec<Val>> = v.try_iter()?.map(|x| val(key, &x?)).collect();
         Ok(Val::Seq(items?))
     } else if let Ok(d) = v.cast::<PyDict>() {
-        Ok(Val::Map(entries(d)?))
+        Ok(Val::Map(entries(d, false)?))
     } else if let Ok(i) = v.extract::<i64>() {
         Ok(Val::Int(i))
     } else if let Ok(x) = v.extract::<f64>() {
@@ -243,8 +147,9 @@ fn val(key: &str, v: &Bound<'_, PyAny>) -> PyResult<Val> {
 /// The entries of a dict of keywords, `None` ones left out (they mean the request's default),
 /// a keyword with the trailing `_` of a Python keyword (`from_`) under the request's name
 /// (`from`), and the names of the integrator and the swept parameter in the request's
-/// spelling (parsed as the command line parses them: a `ValueError` names a bad one).
-fn entries(d: &Bound<'_, PyDict>) -> PyResult<Vec<(String, Val)>> {
+/// spelling (parsed as the command line parses them: a `ValueError` names a bad one). The
+/// model's keywords (`model`) keep a `None` (a value of the wrong type).
+fn entries(d: &Bound<'_, PyDict>, model: bool) -> PyResult<Vec<(String, Val)>> {
     let mut out = Vec::with_capacity(d.len());
     for (k, v) in d.iter() {
         let key: String = k.extract()?;
@@ -254,31 +159,16 @@ fn entries(d: &Bound<'_, PyDict>) -> PyResult<Vec<(String, Val)>> {
             key
         };
         let value = match (key.as_str(), val(&key, &v)?) {
+            (_, Val::Null) if model => Val::NoneGiven,
             (_, Val::Null) => continue,
-            ("integrator", Val::Str(s)) => {
-                Val::Str(canonical::<afmdyn::integrate::IntegratorKind>(&s)?)
+            (_, Val::Str(s)) => {
+                Val::Str(canonical_name(&key, s).map_err(crate::errors::value_error)?)
             }
-            ("param", Val::Str(s)) => Val::Str(canonical::<afmdyn::SweepParam>(&s)?),
             (_, other) => other,
         };
         out.push((key, value));
     }
     Ok(out)
-}
-
-/// `s` parsed by `T`'s `FromStr` (its message as the `ValueError`), in `T`'s serde spelling.
-fn canonical<T>(s: &str) -> PyResult<String>
-where
-    T: std::str::FromStr + serde::Serialize,
-    T::Err: std::fmt::Display,
-{
-    let t: T = s
-        .parse()
-        .map_err(|e: T::Err| crate::errors::value_error(e.to_string()))?;
-    match serde_json::to_value(t) {
-        Ok(serde_json::Value::String(name)) => Ok(name),
-        _ => Ok(s.to_string()),
-    }
 }
 
 /// The library's request `R` of an analysis' keywords (the request is the one signature:
@@ -308,15 +198,26 @@ pub fn named(
         .ok_or_else(|| pyo3::exceptions::PyKeyError::new_err(name.to_string()))
 }
 
-/// `parse` of the keywords, its error naming the keyword (serde_path_to_error's path) and the
-/// kind of number in words: `TypeError` for an unknown keyword, else `ValueError`.
-fn deserialize<T>(
-    what: &str,
+/// The study run into a store of analysis `name` ([`afmdyn::study::stored::parse`]) of its
+/// keywords, as [`request`]; `KeyError` for another name.
+pub fn stored(
+    name: &str,
     kwargs: Option<&Bound<'_, PyDict>>,
-    parse: impl FnOnce(serde_path_to_error::Deserializer<'_, '_, Val>) -> Result<T, DeError>,
-) -> PyResult<T> {
+) -> PyResult<Box<dyn afmdyn::study::stored::Stored>> {
+    let what = if name == "bimodal" { "approach" } else { name };
+    deserialize(what, kwargs, |d| afmdyn::study::stored::parse(name, d))?
+        .ok_or_else(|| pyo3::exceptions::PyKeyError::new_err(name.to_string()))
+}
+
+/// `parse` of the keywords (`model`: the model's, see [`entries`]): the error and the
+/// keyword's path (serde_path_to_error's).
+fn parse<T>(
+    kwargs: Option<&Bound<'_, PyDict>>,
+    model: bool,
+    parse: impl FnOnce(serde_path_to_error::Deserializer<'_, '_, Val>) -> Result<T, KeywordError>,
+) -> PyResult<Result<T, (String, KeywordError)>> {
     let map = match kwargs {
-        Some(d) => entries(d)?,
+        Some(d) => entries(d, model)?,
         None => Vec::new(),
     };
     let mut track = serde_path_to_error::Track::new();
@@ -324,24 +225,38 @@ fn deserialize<T>(
         Val::Map(map),
         &mut track,
     ));
-    parsed.map_err(|e| {
-        let path = track.path().to_string();
-        let text = ["usize", "u64", "u32", "u16", "u8"]
-            .iter()
-            .fold(e.to_string(), |t, ty| {
-                t.replace(&format!("expected {ty}"), "expected a non-negative integer")
-            });
-        let msg = if e.unknown || path == "." {
-            format!("{what}: {text}")
-        } else {
-            format!("{what}: {path}: {text}")
-        };
-        if e.unknown {
-            pyo3::exceptions::PyTypeError::new_err(msg)
-        } else {
-            pyo3::exceptions::PyValueError::new_err(msg)
-        }
+    Ok(parsed.map_err(|e| (track.path().to_string(), e)))
+}
+
+/// `parse` of the keywords, its error naming the keyword (serde_path_to_error's path) and the
+/// kind of number in words: `TypeError` for an unknown keyword, else `ValueError`.
+fn deserialize<T>(
+    what: &str,
+    kwargs: Option<&Bound<'_, PyDict>>,
+    de: impl FnOnce(serde_path_to_error::Deserializer<'_, '_, Val>) -> Result<T, KeywordError>,
+) -> PyResult<T> {
+    parse(kwargs, false, de)?.map_err(|(path, e)| raise(e.is_unknown(), e.message(what, &path)))
+}
+
+/// The model keywords in `kwargs` as the library's [`ModelSpec`](afmdyn::request::ModelSpec)
+/// (its serde names and aliases; ranges are checked when it is resolved). The errors name the
+/// keyword: `TypeError` for an unknown one (the closest name as a hint, every name listed) or
+/// a value of the wrong type (what it takes, from the one table of model parameters),
+/// `ValueError` for a value out of range or a parameter given under its name and its alias.
+pub fn model_spec(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<afmdyn::request::ModelSpec> {
+    parse(kwargs, true, |d| serde::Deserialize::deserialize(d))?.map_err(|(key, e)| {
+        let (type_error, msg) = e.model_message(&key);
+        raise(type_error, msg)
     })
+}
+
+/// A `TypeError` or a `ValueError`.
+fn raise(type_error: bool, msg: String) -> PyErr {
+    if type_error {
+        pyo3::exceptions::PyTypeError::new_err(msg)
+    } else {
+        pyo3::exceptions::PyValueError::new_err(msg)
+    }
 }
 
 /// The `__reduce__` of a study class that any process rebuilds from its recipe (a JSON text):

@@ -3,10 +3,12 @@
 //! without the GIL ([`crate::run`]; cancellable where it checks its progress) and returns its
 //! outcome: `json` (the document), `datasets` (each result layout as
 //! [`crate::convert::layout_dict`], which `afmdyn._layout` turns into a dataset) and `facts`
-//! (the result's scalars, a dict).
+//! (the result's scalars, a dict). The studies run into the command line's resumable store go
+//! through `run_stored` (the library's [`afmdyn::study::stored`]), to the same outcome.
 
+use crate::analyses::{lock_store, study_error};
 use crate::convert::{json_to_py, layout_dict};
-use crate::errors::{probe_error, sim_error};
+use crate::errors::{probe_error, sim_error, value_error};
 use crate::params::PyParams;
 use crate::run::{run as run_job, Job, Stop};
 use afmdyn::probe::Probe;
@@ -54,6 +56,49 @@ pub fn run<'py>(
         named.run(&model, &worker.progress)
     })?
     .map_err(sim_error)?;
+    outcome_dict(py, outcome)
+}
+
+/// Run study `name` (`"bifurcation"`, `"basins"`, `"global_continuation"`, `"approach"`,
+/// `"bimodal"`, `"resonance"`) as [`run`] does, into the store of the directory `store`
+/// (locked, created if needed; `resume` continues an interrupted run of the same request; no
+/// store: in memory): what `run` returns.
+#[pyfunction]
+#[pyo3(signature = (name, request=None, params=None, probe=None, progress=None, store=None, resume=false))]
+#[allow(clippy::too_many_arguments)]
+pub fn run_stored<'py>(
+    py: Python<'py>,
+    name: &str,
+    request: Option<&Bound<'py, PyDict>>,
+    params: Option<PyRef<'_, PyParams>>,
+    probe: Option<String>,
+    progress: Option<Bound<'py, PyAny>>,
+    store: Option<std::path::PathBuf>,
+    resume: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let stored = crate::convert::stored(name, request)?;
+    let model = Resolved {
+        params: params.map_or_else(Params::default, |p| p.inner),
+        probe: probe_of(probe)?,
+    };
+    let study = stored.prepare(model).map_err(sim_error)?;
+    if resume && store.is_none() {
+        let msg = "resume=True needs store= (the directory of the interrupted run)";
+        return Err(value_error(msg));
+    }
+    // locked here, before any work: a second run on the store is refused at once
+    let lock = store.map(|dir| lock_store(&dir)).transpose()?;
+    let job = Job::default();
+    let worker = job.clone();
+    let outcome = run_job(
+        py,
+        &job,
+        None,
+        progress.as_ref(),
+        Stop::Cancellable,
+        move || study.run(lock.as_ref(), resume, &worker.progress),
+    )?
+    .map_err(study_error)?;
     outcome_dict(py, outcome)
 }
 

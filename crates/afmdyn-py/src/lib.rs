@@ -6,8 +6,8 @@
 //! document, the result's layouts (dicts of NumPy arrays owning the Rust buffers) and its
 //! scalars come back for the Python layer to turn into xarray datasets and result objects.
 //! The studies run into a store (`store=`, `resume=`: bifurcation, basins, global
-//! continuation, the stepped curves) and the Dask tasks (chart, basin map, PI scan) keep
-//! functions and classes of their own.
+//! continuation, the stepped curves) go through `door::run_stored`; the Dask tasks (chart,
+//! basin map, PI scan) keep classes of their own.
 
 mod analyses;
 mod basin_tasks;
@@ -18,7 +18,6 @@ mod errors;
 mod image_tasks;
 mod params;
 mod run;
-mod studies;
 mod sweep;
 
 use pyo3::prelude::*;
@@ -53,15 +52,10 @@ fn _afmdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
         m.py().get_type::<errors::SimulationError>(),
     )?;
     m.add("FORCE_SIGN", afmdyn::contact::FORCE_SIGN)?;
-    m.add_function(wrap_pyfunction!(analyses::bifurcation, m)?)?;
-    m.add_function(wrap_pyfunction!(studies::global_continuation, m)?)?;
-    m.add_function(wrap_pyfunction!(studies::basins, m)?)?;
     m.add_function(wrap_pyfunction!(door::run, m)?)?;
+    m.add_function(wrap_pyfunction!(door::run_stored, m)?)?;
     m.add_function(wrap_pyfunction!(cantilevers, m)?)?;
     m.add_function(wrap_pyfunction!(request_defaults, m)?)?;
-    m.add_function(wrap_pyfunction!(studies::approach, m)?)?;
-    m.add_function(wrap_pyfunction!(studies::bimodal, m)?)?;
-    m.add_function(wrap_pyfunction!(studies::resonance, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::reconstruct_fm, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::reconstruct_am, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::image, m)?)?;
@@ -92,14 +86,6 @@ fn _afmdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add(
         "SWEEP_NUMERIC_COLUMNS",
         columns(&afmdyn::request::sweep::NUMERIC_COLUMNS),
-    )?;
-    // the per-point columns of a stepped curve: (name, kind of unit or None, long name)
-    m.add(
-        "CURVE_COLUMNS",
-        afmdyn::report::CURVE_COLUMNS
-            .iter()
-            .map(|c| (c.name, c.kind.key(), c.long_name))
-            .collect::<Vec<_>>(),
     )?;
     Ok(())
 }

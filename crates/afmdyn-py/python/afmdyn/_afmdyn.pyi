@@ -14,9 +14,6 @@ def cancel_running() -> None: ...
 MODEL_PARAMETERS: List[Tuple[str, str, str, str, str]]
 
 FORCE_SIGN: str
-#: The per-point columns of a stepped curve (``afmdyn::report::CURVE_COLUMNS``): (name, kind of
-#: unit — "length", "force", "energy", "phase" or None for a pure number — long name).
-CURVE_COLUMNS: List[Tuple[str, Optional[str], str]]
 #: The columns of a bifurcation sweep's records (``afmdyn::request::sweep::COLUMNS``, the CSV's)
 #: and their numeric form (``NUMERIC_COLUMNS``, the ``.npy``'s): (name, unit, meaning).
 SWEEP_COLUMNS: List[Tuple[str, str, str]]
@@ -588,55 +585,79 @@ def run(
     progress: Optional[ProgressCallback] = None,
 ) -> Dict[str, Any]: ...
 
-def bifurcation(
-    params: Params,
+@overload
+def run_stored(
+    name: Literal["bifurcation"],
     request: Optional[BifurcationRequest] = None,
-    progress: Optional[ProgressCallback] = None,
-    store: Optional[str] = None,
-    resume: bool = False,
-) -> Dict[str, Any]: ...
-
-def global_continuation(
-    params: Params,
-    request: Optional[GlobalContinuationRequest] = None,
-    progress: Optional[ProgressCallback] = None,
+    params: Optional[Params] = None,
     probe: Optional[str] = None,
-    store: Optional[str] = None,
-    resume: bool = False,
-) -> Dict[str, Any]: ...
-
-def approach(
-    params: Params,
-    request: Optional[ApproachRequest] = None,
     progress: Optional[ProgressCallback] = None,
-    probe: Optional[str] = None,
     store: Optional[str] = None,
     resume: bool = False,
 ) -> Dict[str, Any]: ...
 
-def bimodal(
-    params: Params,
-    request: Optional[ApproachRequest] = None,
-    progress: Optional[ProgressCallback] = None,
-    probe: Optional[str] = None,
-    store: Optional[str] = None,
-    resume: bool = False,
-) -> Dict[str, Any]: ...
-
-def resonance(
-    params: Params,
-    request: Optional[ResonanceRequest] = None,
-    progress: Optional[ProgressCallback] = None,
-    probe: Optional[str] = None,
-    store: Optional[str] = None,
-    resume: bool = False,
-) -> Dict[str, Any]: ...
-
-def basins(
-    params: Params,
+@overload
+def run_stored(
+    name: Literal["basins"],
     request: Optional[BasinsRequest] = None,
-    progress: Optional[ProgressCallback] = None,
+    params: Optional[Params] = None,
     probe: Optional[str] = None,
+    progress: Optional[ProgressCallback] = None,
+    store: Optional[str] = None,
+    resume: bool = False,
+) -> Dict[str, Any]: ...
+
+@overload
+def run_stored(
+    name: Literal["global_continuation"],
+    request: Optional[GlobalContinuationRequest] = None,
+    params: Optional[Params] = None,
+    probe: Optional[str] = None,
+    progress: Optional[ProgressCallback] = None,
+    store: Optional[str] = None,
+    resume: bool = False,
+) -> Dict[str, Any]: ...
+
+@overload
+def run_stored(
+    name: Literal["approach"],
+    request: Optional[ApproachRequest] = None,
+    params: Optional[Params] = None,
+    probe: Optional[str] = None,
+    progress: Optional[ProgressCallback] = None,
+    store: Optional[str] = None,
+    resume: bool = False,
+) -> Dict[str, Any]: ...
+
+@overload
+def run_stored(
+    name: Literal["bimodal"],
+    request: Optional[ApproachRequest] = None,
+    params: Optional[Params] = None,
+    probe: Optional[str] = None,
+    progress: Optional[ProgressCallback] = None,
+    store: Optional[str] = None,
+    resume: bool = False,
+) -> Dict[str, Any]: ...
+
+@overload
+def run_stored(
+    name: Literal["resonance"],
+    request: Optional[ResonanceRequest] = None,
+    params: Optional[Params] = None,
+    probe: Optional[str] = None,
+    progress: Optional[ProgressCallback] = None,
+    store: Optional[str] = None,
+    resume: bool = False,
+) -> Dict[str, Any]: ...
+
+@overload
+def run_stored(
+    name: str,
+    request: Optional[Dict[str, Any]] = None,
+    params: Optional[Params] = None,
+    probe: Optional[str] = None,
+    progress: Optional[ProgressCallback] = None,
     store: Optional[str] = None,
     resume: bool = False,
 ) -> Dict[str, Any]: ...

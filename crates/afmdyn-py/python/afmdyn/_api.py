@@ -35,7 +35,6 @@ from ._common import (  # noqa: F401 (_params, _probe_text, _typed, _warn: used 
     _params,
     _probe_text,
     _request,
-    _run,
     _start,
     _state,
     _typed,
@@ -43,7 +42,6 @@ from ._common import (  # noqa: F401 (_params, _probe_text, _typed, _warn: used 
     summary,
 )
 from . import _layout
-from ._curves import curve_dataset, observe_dataset
 from ._progress import ProgressArg
 from ._results import RegionSpectrum, Spectrum
 
@@ -239,23 +237,17 @@ def bifurcation(
         req["values"] = np.asarray(values, dtype=np.float64).ravel().tolist()
     p, probe = _params(params, model)
     # the sweep's records carry no JSON document, so no "si" block: the probe only resolved p
-    d = _run(
-        _core.bifurcation,
-        "bifurcation",
-        progress,
-        p,
-        request=req,
-        store=store,
-        resume=resume,
-    )
+    d = _door("bifurcation", "bifurcation", progress, p, None, req, store, resume, stored=True)
     return _sweep_dataset(p, d, starts, seed)
 
 
 def _sweep_dataset(p: Params, d: Dict[str, Any], starts: int, seed: int) -> xr.Dataset:
     """The long-format dataset of a sweep's records ``d`` (``bifurcation``'s, and
     ``afmdyn.dask.bifurcation``'s), laid out by the library."""
-    attrs = _attrs(p, param=d["param"], values=d["values"], starts=starts, seed=seed)
-    return _layout.dataset(d["layout"], attrs).set_coords(["value", "index", "branch"])
+    f = d["facts"]
+    attrs = _attrs(p, param=f["param"], values=f["values"], starts=starts, seed=seed)
+    ds = _layout.dataset(d["datasets"]["bifurcation"], attrs)
+    return ds.set_coords(["value", "index", "branch"])
 
 
 @_typed
@@ -371,14 +363,15 @@ def observe(
     req = _start(_request(locals(), initial=_state(initial)))
     p, probe = _params(params, model)
     d = _door("observe", "observe", progress, p, probe, req)
+    ds = _layout.dataset(d["datasets"]["observe"])
     doc: Dict[str, Any] = json.loads(d["json"])
-    doc["state"] = _layout.variables(d["datasets"]["observe"])["state"][1]
+    doc["state"] = [float(v) for v in ds["state"].values]
     doc["period"] = d["facts"]["period"]
-    return observe_dataset(doc)
+    ds.attrs = {"title": "afmdyn observe", "summary": json.dumps(doc)}
+    return ds
 
 
 def _curve(
-    fn: Any,
     desc: str,
     progress: ProgressArg,
     params: Optional[Params],
@@ -389,13 +382,16 @@ def _curve(
 ) -> xr.Dataset:
     """Run a stepped-curve analysis (:func:`approach`, :func:`resonance`) — in the command
     line's resumable store ``store`` when given — and return its dataset
-    (:func:`afmdyn._curves.curve_dataset`; in SI with a probe)."""
+    (the library's layout of its document, ``afmdyn::request::curve_layout``; in SI with a
+    probe; ``attrs["summary"]`` is the document)."""
     p, probe = _params(params, model)
-    if store is None and not resume:
-        d = _door(desc, desc, progress, p, probe, request)
-    else:
-        d = _run(fn, desc, progress, p, si=probe, request=request, store=store, resume=resume)
-    return curve_dataset(desc, json.loads(d["json"]))
+    d = _door(desc, desc, progress, p, probe, request, store, resume)
+    attrs = {"title": f"afmdyn {desc}", "summary": d["json"]}
+    free = json.loads(d["json"]).get("free_amplitude")
+    if free is not None:  # attrs must be storable in NetCDF
+        attrs["free_amplitude"] = free
+    traces = tuple(f"trace_{x}" for x in ("z_c", "frequency_hz", "omega"))
+    return _layout.dataset(d["datasets"]["curve"], attrs, coords=traces)
 
 
 @_typed
@@ -457,7 +453,7 @@ def approach(
     ``progress``: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a
     log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.
     """
-    return _curve(_core.approach, "approach", progress, params, model, _request(locals()),
+    return _curve("approach", progress, params, model, _request(locals()),
                   store, resume)
 
 
@@ -519,7 +515,7 @@ def bimodal(
     ``progress``: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a
     log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.
     """
-    return _curve(_core.bimodal, "bimodal", progress, params, model, _request(locals()),
+    return _curve("bimodal", progress, params, model, _request(locals()),
                   store, resume)
 
 
@@ -560,5 +556,5 @@ def resonance(
     ``progress``: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a
     log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.
     """
-    return _curve(_core.resonance, "resonance", progress, params, model, _request(locals()),
+    return _curve("resonance", progress, params, model, _request(locals()),
                   store, resume)

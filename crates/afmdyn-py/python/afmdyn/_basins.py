@@ -10,10 +10,9 @@ from typing import TYPE_CHECKING, Any, List, Optional, Union
 import numpy as np
 import xarray as xr
 
-from . import _afmdyn as _core
 from . import _layout
 from ._afmdyn import Params
-from ._common import _DEFAULTS, Model, _door, _params, _request, _run, _typed
+from ._common import _DEFAULTS, Model, _door, _params, _request, _typed
 from ._progress import ProgressArg
 
 if TYPE_CHECKING:
@@ -79,11 +78,7 @@ def basins(
     """
     req = _request(locals())
     p, probe = _params(params, model)
-    if store is None and not resume:
-        d = _door("basins", "starts", progress, p, probe, req)
-    else:
-        d = _run(_core.basins, "starts", progress, p, si=probe, request=req, store=store,
-                 resume=resume)
+    d = _door("basins", "starts", progress, p, probe, req, store, resume)
     return _dataset(d["datasets"]["basins"], json.loads(d["json"]), p)
 
 

@@ -15,7 +15,7 @@ import xarray as xr
 from . import _afmdyn as _core
 from . import _layout
 from ._afmdyn import Params
-from ._common import _DEFAULTS, Model, _check_counts, _probe_text, _typed, _warn
+from ._common import _DEFAULTS, Model, _probe_text, _typed, _warn
 from ._progress import ProgressArg, reporter
 
 if TYPE_CHECKING:
@@ -32,7 +32,6 @@ def study(
         raise TypeError(f"params: expected afmdyn.Params or None, got {type(params).__name__}")
     model = dict(model)
     text = _probe_text(model)
-    _check_counts(request)
     return _core.ChartStudy.build(request, params, text, model)
 
 

@@ -239,13 +239,6 @@ def _typed(f: _F) -> _F:
     return cast(_F, checked)
 
 
-_COUNTS = frozenset(
-    "samples_per_period steps_per_period max_modes periods steps starts seed threads "
-    "max_periods max_period samples period transient blocks x_steps y_steps basin_hits "
-    "discover_after stride tile lyapunov_periods max_attractors".split()
-)
-
-
 class AfmdynWarning(UserWarning):
     """A computed answer with a caveat the command line prints as ``afmdyn: warning: …`` on
     stderr (a branch that ended before the end of its range, points of a sweep that failed,
@@ -282,40 +275,6 @@ def _start(request: Dict[str, Any]) -> Dict[str, Any]:
     return request
 
 
-def _check_counts(request: Dict[str, Any]) -> None:
-    """Negative counts are a ValueError naming the option (the core's unsigned integers would
-    raise OverflowError)."""
-    for k, v in request.items():
-        if k in _COUNTS and isinstance(v, int) and not isinstance(v, bool) and v < 0:
-            raise ValueError(f"{k} = {v}: must be >= 0")
-
-
-def _run(
-    fn: Any,
-    desc: str,
-    progress: ProgressArg,
-    p: Params,
-    si: Optional[str] = None,
-    request: Optional[Dict[str, Any]] = None,
-    **extra: Any,
-) -> Dict[str, Any]:
-    """Call the compiled ``fn`` on ``request`` (the keywords of the library's request, which
-    checks them) with a progress reporter; negative counts are a ValueError naming the option
-    (the core's unsigned integers would raise OverflowError). With ``si`` (a probe file)
-    ``fn`` gets ``probe=si``, and its JSON document the command line's ``"si"`` block (added
-    by the library's request layer); a ``store`` directory may be any path-like."""
-    _check_counts(request or {})
-    if si is not None:
-        extra["probe"] = si
-    if extra.get("store") is not None:
-        extra["store"] = os.fspath(extra["store"])
-    with reporter(progress, desc) as cb:
-        d = fn(p, request, progress=cb, **extra)
-    if isinstance(d, dict):
-        _warn(d.get("json"))
-    return d
-
-
 def _door(
     name: str,
     desc: str,
@@ -323,14 +282,22 @@ def _door(
     p: Optional[Params] = None,
     si: Optional[str] = None,
     request: Optional[Dict[str, Any]] = None,
+    store: Union[str, "os.PathLike[str]", None] = None,
+    resume: bool = False,
+    stored: bool = False,
 ) -> Dict[str, Any]:
     """Run analysis ``name`` through the one door of the core (``_afmdyn.run``: the library
     parses the request by name, runs it and lays out its arrays) with a progress reporter:
-    ``{"json": document, "datasets": {name: layout}, "facts": dict}``; negative counts are a
-    ValueError naming the option, the document's warnings are issued (as by :func:`_run`)."""
-    _check_counts(request or {})
+    ``{"json": document, "datasets": {name: layout}, "facts": dict}``; the document's
+    warnings are issued. With ``store`` (or
+    ``resume``, or ``stored``: a study of no other door) a study runs through
+    ``_afmdyn.run_stored``, into the command line's resumable store there."""
     with reporter(progress, desc) as cb:
-        d: Dict[str, Any] = _core.run(name, request, p, si, cb)
+        if store is None and not resume and not stored:
+            d: Dict[str, Any] = _core.run(name, request, p, si, cb)
+        else:
+            where = None if store is None else os.fspath(store)
+            d = _core.run_stored(name, request, p, si, cb, where, resume)
     _warn(d["json"])
     return d
 

@@ -9,10 +9,9 @@ from typing import TYPE_CHECKING, List, Optional, Union
 
 import xarray as xr
 
-from . import _afmdyn as _core
 from . import _layout
 from ._afmdyn import Params
-from ._common import _DEFAULTS, Model, _door, _params, _request, _run, _typed
+from ._common import _DEFAULTS, Model, _door, _params, _request, _typed
 from ._progress import ProgressArg
 
 if TYPE_CHECKING:
@@ -67,11 +66,7 @@ def global_continuation(
     """
     req = _request(locals())
     p, probe = _params(params, model)
-    if store is None and not resume:
-        d = _door("global_continuation", "starts", progress, p, probe, req)
-    else:
-        d = _run(_core.global_continuation, "starts", progress, p, si=probe, request=req,
-                 store=store, resume=resume)
+    d = _door("global_continuation", "starts", progress, p, probe, req, store, resume)
     layout = d["datasets"]["global_continuation"]
     doc = json.loads(d["json"])
     # the library's layout (the command line's attractors-sweep.nc)

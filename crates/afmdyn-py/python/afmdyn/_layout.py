@@ -1,10 +1,12 @@
 """Results as the library lays them out (``afmdyn::layout::Layout``): every variable's name,
 dimensions, units and long name are declared once in the library, which also writes the
 command line's NetCDF files from the same declaration; this module turns a layout into an
-``xarray.Dataset`` and gives the Dask Zarr writer its per-cell variables."""
+``xarray.Dataset`` (with the accessor ``ds.afmdyn``) and gives the Dask Zarr writer its per-cell
+variables."""
 
 from __future__ import annotations
 
+import json
 from typing import Any, Dict, List, Optional, Tuple
 
 import numpy as np
@@ -24,7 +26,9 @@ def variables(
         shape = tuple(dims[d] for d in vdims)
         # words have no units (CF): an empty unit is left out
         attrs = {"long_name": long_name, **({"units": units} if units else {}), **extra}
-        out[name] = (tuple(vdims), np.asarray(values).reshape(shape), attrs)
+        # words are str, also where there are none
+        a = np.asarray(values, dtype=str) if isinstance(values, list) else np.asarray(values)
+        out[name] = (tuple(vdims), a.reshape(shape), attrs)
     return out
 
 
@@ -47,3 +51,19 @@ def over(layout: Dict[str, Any], lead: Tuple[str, ...]) -> List[str]:
     variables: ``("y", "x")``)."""
     n = len(lead)
     return [v[0] for v in layout["variables"] if tuple(v[1][:n]) == lead]
+
+
+@xr.register_dataset_accessor("afmdyn")
+class AfmdynAccessor:
+    """``ds.afmdyn``: the command line's document of a dataset afmdyn returned."""
+
+    def __init__(self, ds: xr.Dataset) -> None:
+        self._ds = ds
+
+    def to_dict(self) -> Dict[str, Any]:
+        """The ``--json`` document for the same request (a new dict; Python-only analyses
+        such as ``observe`` give the library's document). Raises KeyError for a dataset
+        afmdyn did not make."""
+        if "summary" not in self._ds.attrs:
+            raise KeyError("this dataset carries no afmdyn document (attrs['summary'])")
+        return json.loads(self._ds.attrs["summary"])

@@ -378,7 +378,6 @@ def bifurcation(
     log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.
     """
     from ._api import _params, _sweep_dataset
-    from ._common import _check_counts
 
     p, _probe = _params(params, model)
     request: Dict[str, Any] = dict(
@@ -397,7 +396,6 @@ def bifurcation(
         tolerance=tolerance,
     )
     request["from"] = from_
-    _check_counts(request)
     s = _core.SweepStudy.build(request, p)
     with _cluster(client) as client:
         sweep_store = None
@@ -468,14 +466,13 @@ def basins(
 
     from ._basins import _dataset
     from ._basins import basins as local
-    from ._common import _check_counts, _params
+    from ._common import _params
 
     # the map's keywords are those of afmdyn.basins; the others are the model's (as there)
     own_keywords = set(inspect.signature(local).parameters) - {
         "params", "model", "store", "resume", "threads", "progress"}
     model = {k: keywords.pop(k) for k in list(keywords) if k not in own_keywords}
     p, probe = _params(params, model)
-    _check_counts(keywords)
     s = _core.BasinMapStudy.build(p, keywords, probe)
     with _cluster(client) as client:
         rows: List[str] = []

@@ -1,7 +1,7 @@
 //! The arrays of each analysis' result as [`Layout`]s ([`Datasets`]): what a front end shows
 //! beside the document — Python's datasets and result objects, built from them generically.
-//! A result whose front ends build their tables from its document (`fm`, `reconstruct`, the
-//! stepped curves) has none.
+//! A result whose front ends build their tables from its document (`fm`, `reconstruct`) has
+//! none; the stepped curves' layout is laid out from their document.
 
 use super::named::Datasets;
 use super::run::{ApproachRequest, ModesRequest, Resolved, ResonanceRequest};
@@ -129,13 +129,11 @@ impl Datasets for LyapunovRequest {
 }
 
 impl Datasets for ObserveRequest {
-    fn datasets(&self, _: &Resolved, o: &Self::Output) -> Arrays {
-        let state = o.state.as_slice().to_vec();
-        let layout = Layout::new(
-            "observe",
-            &[("component", state.len())],
-            vec![f64s("state", &["component"], state)],
-        );
+    /// The observables' layout from the document ([`super::curve_layout::observe_layout`])
+    /// and the period.
+    fn datasets(&self, model: &Resolved, o: &Self::Output) -> Arrays {
+        let doc = super::run::document(self, model, o)?;
+        let layout = super::curve_layout::observe_layout(&doc, o.state.as_slice(), o.period);
         Ok((
             vec![("observe".into(), layout)],
             facts(json!({ "period": o.period })),
@@ -318,7 +316,20 @@ impl Datasets for GlobalContinuationRequest {
     }
 }
 
-impl Datasets for ApproachRequest {}
-impl Datasets for ResonanceRequest {}
+impl Datasets for ApproachRequest {
+    /// The curve's layout from its document ([`super::curve_layout::curve_layout`]).
+    fn datasets(&self, model: &Resolved, curve: &Self::Output) -> Arrays {
+        let doc = super::run::document(self, model, curve)?;
+        one("curve", super::curve_layout::curve_layout(&doc))
+    }
+}
+
+impl Datasets for ResonanceRequest {
+    /// The curve's layout from its document ([`super::curve_layout::curve_layout`]).
+    fn datasets(&self, model: &Resolved, curve: &Self::Output) -> Arrays {
+        let doc = super::run::document(self, model, curve)?;
+        one("curve", super::curve_layout::curve_layout(&doc))
+    }
+}
 impl Datasets for FmRequest {}
 impl Datasets for ReconstructRequest {}

@@ -37,6 +37,7 @@ pub mod checkpoint;
 #[cfg(feature = "files")]
 pub mod checkpoint_file;
 pub mod costs;
+pub mod curve_layout;
 pub mod curves;
 mod datasets;
 #[cfg(feature = "files")]
@@ -47,8 +48,10 @@ pub use crate::io::height_map as height_map_file;
 pub mod image;
 pub mod image_layout;
 pub mod image_scan;
+pub mod keywords;
 pub mod limits;
 pub mod model;
+mod model_of;
 pub mod named;
 pub mod pool;
 pub mod present;

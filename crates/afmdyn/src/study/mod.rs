@@ -43,6 +43,8 @@ pub mod scan;
 #[cfg(feature = "files")]
 pub mod scan_store;
 pub mod stepped;
+#[cfg(feature = "files")]
+pub mod stored;
 pub mod sweep;
 #[cfg(feature = "files")]
 pub mod task_store;
