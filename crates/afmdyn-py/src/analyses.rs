@@ -5,16 +5,15 @@
 //! one (`"json"`).
 
 use crate::convert::Out;
-use crate::errors::{probe_error, sim_error, value_error};
+use crate::errors::{probe_error, sim_error, study_error};
 use crate::image_tasks::{image_inputs, scan_out};
 use crate::params::PyParams;
 use crate::run::{run, Job, Stop};
 use afmdyn::analysis::bifurcation::SweepSpec;
 use afmdyn::probe::Probe;
-use afmdyn::request::checkpoint::CheckpointError;
 use afmdyn::request::{self, Analysis, Document, Resolved};
-use afmdyn::request::{DirLock, LockError, SweepRecord};
-use afmdyn::study::{execute, StudyError};
+use afmdyn::request::SweepRecord;
+use afmdyn::study::execute;
 use afmdyn::{report, Params};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -53,42 +52,6 @@ where
         request::run(&request, &model, &worker.progress)
     })?
     .map_err(sim_error)
-}
-
-/// A checkpoint error as Python sees it: a store of another request (or of none) is a
-/// `ValueError` naming the field, a file that cannot be read or written an `OSError`.
-/// Lock a store directory (created if needed) before any work: a second run on it is refused
-/// at once (`ValueError`), a directory that cannot be created or locked is an `OSError`.
-pub(crate) fn lock_store(dir: &std::path::Path) -> PyResult<DirLock> {
-    DirLock::acquire(dir).map_err(|e| match e {
-        LockError::InUse { .. } => value_error(format!(
-            "store: {e}; wait for it to finish or choose another store="
-        )),
-        LockError::Io { .. } => pyo3::exceptions::PyOSError::new_err(e.to_string()),
-    })
-}
-
-pub(crate) fn checkpoint_error(e: CheckpointError) -> PyErr {
-    match e {
-        CheckpointError::Io { .. } => pyo3::exceptions::PyOSError::new_err(e.to_string()),
-        CheckpointError::Mismatch { .. } => value_error(format!(
-            "resume: {e}; call with the same arguments, or with resume=False to start over"
-        )),
-        // the library's advice names the command line's flag
-        _ => value_error(format!(
-            "resume: {}",
-            e.to_string()
-                .replace("rerun without --resume", "call with resume=False")
-        )),
-    }
-}
-
-/// A study's error as Python raises it.
-pub(crate) fn study_error(e: StudyError) -> PyErr {
-    match e {
-        StudyError::Store(e) => checkpoint_error(e),
-        StudyError::Sim(e) => sim_error(e),
-    }
 }
 
 /// A sweep's records, in their order, as the door returns them

@@ -3,7 +3,7 @@
 //! the model values, the defaults and the probe file's text), so that it pickles to Dask
 //! workers as a few hundred bytes.
 
-use crate::analyses::{checkpoint_error, lock_store, study_error};
+use crate::errors::{checkpoint_error, lock_store, study_error};
 use crate::errors::{probe_error, sim_error, value_error};
 use crate::params::{model_spec, PyParams};
 use crate::run::{run, Job, Stop};

@@ -5,7 +5,7 @@
 //! Points travel as the rows of `bifurcation.csv` (numbers in shortest round-trip form), so a
 //! sweep assembled from tasks equals `afmdyn.bifurcation` bit for bit.
 
-use crate::analyses::{checkpoint_error, lock_store};
+use crate::errors::{checkpoint_error, lock_store};
 use crate::errors::{sim_error, value_error};
 use crate::params::PyParams;
 use afmdyn::analysis::bifurcation::{Branch, Seeds, SweepPlan, SweepPoint, SweepSpec, SweepTask};
