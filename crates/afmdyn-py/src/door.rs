@@ -6,8 +6,8 @@
 //! (the result's scalars, a dict). The studies run into the command line's resumable store go
 //! through `run_stored` (the library's [`afmdyn::study::stored`]), to the same outcome.
 
-use crate::errors::{lock_store, study_error};
 use crate::convert::{json_to_py, layout_dict};
+use crate::errors::{lock_store, study_error};
 use crate::errors::{probe_error, sim_error, value_error};
 use crate::params::PyParams;
 use crate::run::{run as run_job, Job, Stop};
