@@ -204,3 +204,76 @@ fn peakforce_setpoint_feedback() {
     let e = peak_force_setpoint(&p, -1.0, &SetpointOptions::default()).unwrap_err();
     assert!(e.to_string().contains("setpoint"), "{e}");
 }
+
+const AIR: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../../examples/probe-peakforce-air.toml"
+);
+
+/// The example probe resolves to a sample-modulated beam with α2 = 1 (g₀ = A_m) and
+/// Ω = f_m/f₀; a modulation frequency out of its physical range is refused naming the key.
+#[test]
+fn peakforce_probe_reads_the_modulation_and_refuses_a_bad_frequency() {
+    let text = std::fs::read_to_string(AIR).unwrap();
+    let p = afmdyn::probe::Probe::parse(&text, "air").unwrap();
+    assert!(p.off_resonance);
+    assert_eq!(p.params.excitation, Excitation::Sample);
+    assert_eq!(p.params.alpha2, 1.0);
+    assert!((p.scales.length_m - 100e-9).abs() < 1e-20);
+    assert!((p.drive_frequency - 2e3).abs() < 1e-9);
+    let bad = text.replace("modulation_frequency = 2e3", "modulation_frequency = 5e6");
+    let e = afmdyn::probe::Probe::parse(&bad, "bad")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("modulation_frequency"), "{e}");
+    let bad = text.replace("modulated = \"sample\"", "modulated = \"tip\"");
+    let e = afmdyn::probe::Probe::parse(&bad, "bad")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("modulated"), "{e}");
+}
+
+/// The request through the one door by name: the channels in SI, the cycle at ≥ 2 000
+/// points, the fitted modulus beside the true one; a model that is not modulated is refused
+/// naming `excitation`, a drive near resonance naming `omega`.
+#[test]
+fn peakforce_request_by_name_reports_si_channels() {
+    use afmdyn::request::{named, Resolved};
+    let text = std::fs::read_to_string(AIR).unwrap();
+    let mut probe = afmdyn::probe::Probe::parse(&text, "air").unwrap();
+    // the point mass of the same lever, for speed
+    let pm = text.replace("model = \"beam\"\nmodes = 3", "model = \"point-mass\"");
+    probe = afmdyn::probe::Probe::parse(&pm, "air-pm").unwrap_or(probe);
+    let model = Resolved {
+        params: probe.params,
+        probe: Some(probe),
+    };
+    let r = named::parse("peakforce", serde_json::json!({}))
+        .unwrap()
+        .unwrap();
+    let out = r.run(&model, &Default::default()).unwrap();
+    let ch = &out.document["channels"];
+    let peak = ch["peak_force"].as_f64().unwrap();
+    assert!(peak > 1e-11 && peak < 1e-7, "{ch}");
+    assert!(ch["adhesion"].as_f64().unwrap() < 0.0, "{ch}");
+    assert!(out.document["cycle"]["force"].as_array().unwrap().len() >= 2000);
+    assert_eq!(out.document["units"]["peak_force"], "N");
+    assert!(out.document["modulus"]["true"].as_f64().unwrap() > 1e9);
+    assert_eq!(out.datasets.len(), 2);
+    // a force-driven point mass (tapping near resonance) is no modulation
+    let tapping = Params {
+        excitation: Excitation::Base,
+        ..point_mass(ContactLaw::Hertz, 1.0, 100.0, 20.0, 0.95)
+    };
+    let e = r
+        .run(&Resolved::plain(tapping), &Default::default())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("excitation"), "{e}");
+    // the beam's base drive near resonance is not off resonance
+    let e = r
+        .run(&Resolved::plain(Params::default()), &Default::default())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("omega"), "{e}");
+}
