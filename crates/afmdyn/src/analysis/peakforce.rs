@@ -25,7 +25,10 @@
 //! snap-off time (the last exit from contact in the cycle, from t = 0), the ringing amplitude
 //! (after snap-off, the largest |W − c F_c| with c = φ(1)ᵀK⁻¹φ(1) the lever's static
 //! compliance at the tip: the deviation from the quasi-static deflection) and the DMT fit of
-//! the retract curve ([`fit_dmt`]).
+//! the retract curve ([`fit_dmt`]) on the force the instrument measures, W/c (k × deflection),
+//! against the distance d (the instrument's separation, z-piezo plus deflection), and the
+//! same fit on the true force F_c: the channels are the true tip–sample force's, the fit
+//! shows the instrument method's bias.
 
 mod fit;
 mod setpoint;
@@ -181,8 +184,13 @@ pub struct SteadyTap {
     pub state: DVector<f64>,
     /// The channels over the n periods (per period where a rate).
     pub channels: TapChannels,
-    /// The DMT fit of the retract curve (`None` without a retract branch in contact).
+    /// The DMT fit of the retract curve as the instrument measures it: the force k × deflection
+    /// (the deflection W over the static compliance c) against the distance (`None` without a
+    /// retract branch in contact). At f₀/f_m ≲ 20 the lever's inertia and ringing make the
+    /// measured force differ from the tip–sample force: the fit's bias.
     pub fit: Option<DmtFit>,
+    /// The same fit on the true tip–sample force F_c (the law's own curve, for comparison).
+    pub fit_tip_sample: Option<DmtFit>,
     /// The energy balance per period.
     pub balance: EnergyBalance,
     /// One period (the first of n) sampled from t = 0.
@@ -258,7 +266,9 @@ pub fn steady_tap_from(
     integ.reset(0.0, &orbit.state)?;
     let cycle = sample_cycle(model, integ.as_mut(), opts.samples)?;
     let (snap_off_time, ringing_amplitude) = after_snap_off(model, &cycle);
-    let fit = retract_fit(model, integ.as_mut(), &orbit.state, &cycle, opts.fit_band)?;
+    let (fit, fit_tip_sample) =
+        retract_fit(model, integ.as_mut(), &orbit.state, &cycle, opts.fit_band)?
+            .unwrap_or((None, None));
     Ok(SteadyTap {
         period: n,
         multipliers: orbit.multipliers,
@@ -276,6 +286,7 @@ pub fn steady_tap_from(
             taps_per_cycle: obs.impacts_per_period,
         },
         fit,
+        fit_tip_sample,
         balance,
         cycle,
     })
@@ -351,15 +362,20 @@ fn after_snap_off(model: &CantileverModel, c: &Cycle) -> (f64, f64) {
     (snap, ringing)
 }
 
-/// The DMT fit on the retract branch, resampled at [`FIT_SAMPLES`] points between the peak
-/// force's sample and the pull-off (the force minimum after it); `None` without contact.
+/// The retract branch's DMT fits: the instrument's (k × deflection) and the true force's.
+type RetractFits = (Option<DmtFit>, Option<DmtFit>);
+
+/// The DMT fits on the retract branch, resampled at [`FIT_SAMPLES`] points between the peak
+/// force's sample and the pull-off (the force minimum after it): (the instrument's, on the
+/// force it measures, the deflection over the static compliance, k × deflection; the same on
+/// the true tip–sample force); `None` without contact.
 fn retract_fit(
     model: &CantileverModel,
     integ: &mut dyn Integrator,
     z0: &DVector<f64>,
     c: &Cycle,
     band: (f64, f64),
-) -> Result<Option<DmtFit>, SimError> {
+) -> Result<Option<RetractFits>, SimError> {
     let n = c.time.len();
     let (peak, _) = c
         .force
@@ -389,16 +405,16 @@ fn retract_fit(
     let origin = time_origin(model);
     integ.reset(0.0, z0)?;
     advance(integ, origin + t0)?;
-    let (mut d, mut f) = (
-        Vec::with_capacity(FIT_SAMPLES),
-        Vec::with_capacity(FIT_SAMPLES),
-    );
+    let compliance = static_compliance(model);
+    let mut d = Vec::with_capacity(FIT_SAMPLES + 1);
+    let (mut measured, mut f) = (d.clone(), d.clone());
     for k in 0..=FIT_SAMPLES {
         let t = t0 + (t1 - t0) * k as f64 / FIT_SAMPLES as f64;
         advance(integ, origin + t)?;
-        let (_, dk, fk) = tip_sample(model, integ.tau(), integ.state());
+        let (w, dk, fk) = tip_sample(model, integ.tau(), integ.state());
         d.push(dk);
+        measured.push(w / compliance);
         f.push(fk);
     }
-    Ok(fit_dmt(&d, &f, band))
+    Ok(Some((fit_dmt(&d, &measured, band), fit_dmt(&d, &f, band))))
 }

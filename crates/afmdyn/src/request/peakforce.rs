@@ -308,6 +308,11 @@ pub fn document(request: &PeakForceRequest, model: &Resolved, r: &PeakForceResul
             "modulus_dmt": modulus_fit,
             "true": modulus_true,
             "ratio": match (fitted, has_radius) { (Some(k), true) => Some(k / p.alpha4), _ => None },
+            "tip_sample_modulus": match true_modulus(model, 1.0) {
+                Some(scale) if has_radius => tap.fit_tip_sample.map(|f| f.hertz_group * scale),
+                _ => tap.fit_tip_sample.map(|f| f.hertz_group),
+            },
+            "force_measured_as": "k × deflection (the deflection over the lever's static compliance at the tip), as the instrument does; tip_sample_modulus is the same fit on the true tip–sample force",
             "fit_band": request.fit_band,
             "fit_points": tap.fit.map(|f| f.points),
             "fit_relative_residual": tap.fit.map(|f| f.relative_residual),

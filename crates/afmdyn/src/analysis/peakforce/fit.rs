@@ -9,7 +9,9 @@
 //! squares of y = F − F_adh against x = (d₀ − d)^{3/2} through the origin, y = K x, over the
 //! retract points from the peak to the pull-off whose force lies in the band; in model units
 //! K is the Hertz group α4 of the law ([`crate::contact`]: F = α4 δ^{3/2}), so K/α4 is the
-//! fitted modulus over the true one, and E*_fit = K F̃ / ((4/3) √R g₀^{3/2}) in SI.
+//! fitted modulus over the true one, and E*_fit = K F̃ / ((4/3) √R g₀^{3/2}) in SI. The steady
+//! tap ([`super::steady_tap`]) fits the force the instrument measures, k × deflection, and
+//! the true tip–sample force beside it.
 
 use serde::Serialize;
 
