@@ -275,6 +275,8 @@ pub enum Dim {
     Length,
     /// Hz, kHz, MHz.
     Frequency,
+    /// N, mN, µN (uN), nN, pN.
+    Force,
 }
 
 impl Dim {
@@ -282,6 +284,7 @@ impl Dim {
         match self {
             Dim::Length => "a length (m)",
             Dim::Frequency => "a frequency (Hz)",
+            Dim::Force => "a force (N)",
         }
     }
 }
@@ -297,7 +300,7 @@ pub struct Quantity {
 }
 
 /// The SI units a number may carry on the command line, with their powers of ten to m or Hz.
-const UNITS: [(&str, i32, Dim); 9] = [
+const UNITS: [(&str, i32, Dim); 15] = [
     ("pm", -12, Dim::Length),
     ("nm", -9, Dim::Length),
     ("um", -6, Dim::Length),
@@ -307,6 +310,12 @@ const UNITS: [(&str, i32, Dim); 9] = [
     ("kHz", 3, Dim::Frequency),
     ("MHz", 6, Dim::Frequency),
     ("Hz", 0, Dim::Frequency),
+    ("pN", -12, Dim::Force),
+    ("nN", -9, Dim::Force),
+    ("uN", -6, Dim::Force),
+    ("µN", -6, Dim::Force),
+    ("mN", -3, Dim::Force),
+    ("N", 0, Dim::Force),
 ];
 
 impl std::str::FromStr for Quantity {
@@ -338,7 +347,7 @@ impl std::str::FromStr for Quantity {
             }
         }
         Err(format!(
-            "'{s}': expected a number, optionally with a unit (pm, nm, um, mm, m, Hz, kHz, MHz)"
+            "'{s}': expected a number, optionally with a unit (pm, nm, um, mm, m, Hz, kHz, MHz, pN, nN, uN, mN, N)"
         ))
     }
 }

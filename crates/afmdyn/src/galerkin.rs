@@ -229,9 +229,17 @@ fn stiffness_contact(p: &Params, k_free: &DMatrix<f64>, outer: &DMatrix<f64>) ->
 /// keeps eq. 14 for the paper's α3, whose term is ~1/Q of the drive for a real lever.)
 /// A force drive ([`Params::is_force_driven`]: the point-mass and eigenmode models, every
 /// mode's tip value 1, and the beam with [`crate::params::Excitation::Tip`]) has
-/// F^I_i = α2 φ_i(1) cos Ωτ instead.
+/// F^I_i = α2 φ_i(1) cos Ωτ instead. A moving sample ([`crate::params::Excitation::Sample`])
+/// has F^I = 0: the lever's frame is at rest, the drive enters through V_T only (eq. 18).
 fn forcing_free(p: &Params, tip: &DVector<f64>, integrals: &DVector<f64>) -> Forcing {
     let n = tip.len();
+    if p.is_sample_modulated() {
+        return Forcing {
+            constant: DVector::zeros(n),
+            sin: DVector::zeros(n),
+            cos: DVector::zeros(n),
+        };
+    }
     if p.is_force_driven() {
         return Forcing {
             constant: DVector::zeros(n),

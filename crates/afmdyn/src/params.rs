@@ -137,7 +137,13 @@ pub struct Params {
 ///   Lett.* 102 (2009) 060801 drive magnetically in liquid): modal forcing φ_j(1) α2 cos Ωτ,
 ///   the base does not move, V_T = W(1,τ) + α5, in the force unit of α4 V_T.
 ///
-/// The lumped models ([`Structure::is_lumped`]) are force-driven whatever this says. The
+/// * `Sample` — the sample moves by α2 sin Ωτ (off-resonance tapping, PeakForce / PF-QNM, with
+///   the z-modulation on the sample): V_T = W(1,τ) + α5 + α2 sin Ωτ as for the base drive
+///   (eq. 8, the tip–sample distance sees the same sinusoid), but the lever's frame does not
+///   move, so the modal forcing is zero (no inertial or drag term of eq. 14). It works on
+///   every structure, the lumped models included.
+///
+/// The lumped models ([`Structure::is_lumped`]) are force-driven unless this is `Sample`. The
 /// fluid-borne excitation of an acoustic drive in liquid (the "forest of peaks", Schäffer,
 /// Cleveland, Ohnesorge, Walters & Hansma, *Ultramicroscopy* 63 (1996) 149) is not modelled:
 /// the liquid is at rest far from the lever.
@@ -150,6 +156,8 @@ pub enum Excitation {
     Base,
     /// Force α2 cos Ωτ at the tip.
     Tip,
+    /// The sample moves by α2 sin Ωτ; the lever's frame is at rest (off-resonance tapping).
+    Sample,
 }
 
 impl Excitation {
@@ -162,6 +170,7 @@ impl Excitation {
         match self {
             Excitation::Base => "base",
             Excitation::Tip => "tip",
+            Excitation::Sample => "sample",
         }
     }
 }
@@ -613,9 +622,10 @@ impl Params {
         Ok(())
     }
 
-    /// Amplitude of the base displacement in V_T (eq. 8): α2 for the base-driven beam, 0 for a
-    /// force drive ([`Params::is_force_driven`]: the lumped models, the beam with
-    /// [`Excitation::Tip`]), whose base does not move. Every V_T formula uses this.
+    /// Amplitude of the base displacement in V_T (eq. 8): α2 for the base-driven beam and for a
+    /// moving sample ([`Excitation::Sample`], any structure: the tip–sample distance carries
+    /// the same sinusoid), 0 for a force drive ([`Params::is_force_driven`]: the lumped models,
+    /// the beam with [`Excitation::Tip`]), whose base does not move. Every V_T formula uses this.
     pub fn base_amplitude(&self) -> f64 {
         if self.is_force_driven() {
             0.0
@@ -625,9 +635,16 @@ impl Params {
     }
 
     /// Whether the primary drive is a force at the tip: the lumped models, and the beam with
-    /// [`Excitation::Tip`].
+    /// [`Excitation::Tip`] (never with [`Excitation::Sample`]).
     pub fn is_force_driven(&self) -> bool {
-        self.structure.is_lumped() || self.excitation == Excitation::Tip
+        self.excitation != Excitation::Sample
+            && (self.structure.is_lumped() || self.excitation == Excitation::Tip)
+    }
+
+    /// Whether the sample moves and the lever's frame is at rest ([`Excitation::Sample`]): V_T
+    /// carries α2 sin Ωτ, the modal forcing is zero.
+    pub fn is_sample_modulated(&self) -> bool {
+        self.excitation == Excitation::Sample
     }
 
     /// Phase ψ of the drive: the drive is ∝ sin(Ωτ + ψ), ψ = 0 for the base drive (base

@@ -75,6 +75,10 @@ fn schemas() -> Vec<(&'static str, Value)> {
         ("basins", schema::<BasinsRequest>("basins")),
         ("reconstruct", schema::<ReconstructRequest>("reconstruct")),
         ("fm", schema::<FmRequest>("fm")),
+        (
+            "peakforce",
+            schema::<afmdyn::request::PeakForceRequest>("peakforce"),
+        ),
         ("image", schema::<ImageRequest>("image")),
     ]
 }

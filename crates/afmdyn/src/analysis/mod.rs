@@ -22,6 +22,7 @@ pub mod fm_loop;
 pub mod global_continuation;
 pub mod lyapunov;
 pub mod observables;
+pub mod peakforce;
 pub mod period;
 pub mod progress;
 pub mod reconstruct;

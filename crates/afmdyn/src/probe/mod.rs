@@ -39,6 +39,12 @@
 //! # free_amplitude = [10e-9, 1e-9]   # A₀ᵢ (m)
 //! # frequency = [300e3, 1.875e6]     # fᵢ (Hz), default each at its mode's free resonance
 //! excitation = "base"            # base (acoustic, piezo: eq. 6) | tip (magnetic, photothermal)
+//! # off-resonance (PeakForce) tapping instead of the above:
+//! # mode = "off-resonance"
+//! # modulation_frequency = 2e3   # f_m (Hz)
+//! # modulation_amplitude = 100e-9 # A_m (m): the length unit g₀, α2 = 1
+//! # modulated = "sample"         # sample (default: the lever's frame at rest) | base (beam:
+//! #                              #   the base's inertial and drag terms of eq. 14)
 //! [medium]                       # optional: the lever in a fluid (module `medium`)
 //! name = "water"                 # water | air, or density (kg/m³) and viscosity (Pa s)
 //! calibrated_in = "air"          # where f₀ and Q were measured: air (default) | vacuum
@@ -294,6 +300,12 @@ pub struct Probe {
     /// what [`Probe::indentation_warnings`] holds an indentation against.
     #[serde(skip)]
     pub tip_radius: Option<f64>,
+    /// Whether `[drive] mode = "off-resonance"` (PeakForce tapping): then
+    /// [`Probe::free_amplitude`] is the modulation amplitude A_m (m, the length unit g₀),
+    /// [`Probe::drive_frequency`] the modulation frequency f_m (Hz), α2 = 1 and the drive is
+    /// [`Excitation::Sample`] (or, with `modulated = "base"`, the beam's base drive).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub off_resonance: bool,
 }
 
 /// The indentation, as a fraction of the tip radius, beyond which the paraboloid contact of
@@ -436,6 +448,9 @@ struct Drive {
     frequency: Option<f64>,
     components: Vec<(f64, f64)>,
     excitation: Excitation,
+    /// `[drive] mode = "off-resonance"`: A₀ is the modulation amplitude A_m, f the modulation
+    /// frequency f_m, and α2 = 1 (the modulation's amplitude in units of g₀ = A_m).
+    off_resonance: bool,
 }
 
 /// The sample section in SI.

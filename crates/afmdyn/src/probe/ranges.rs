@@ -72,6 +72,31 @@ pub const SI_RANGES: &[SiRange] = &[
         zero_typical: false,
     },
     SiRange {
+        // off-resonance (PeakForce) tapping: the z-modulation's frequency, 0.25–8 kHz on
+        // commercial instruments (Bruker PeakForce, JPK QI, Asylum FFV)
+        sections: &["drive"],
+        keys: &["modulation_frequency"],
+        unit: "Hz",
+        slips: &[("k", 1e3)],
+        below: Some((1.0, "below 1 Hz for an off-resonance modulation; frequencies are in Hz: {x} kHz is {x}e3")),
+        above: Some((1e6, "above 1 MHz, not off resonance for any lever; frequencies are in Hz")),
+        magnitude: false,
+        typical: Some((100.0, 1e4, "0.1–10 kHz of off-resonance tapping", "frequencies are in Hz (2 kHz is 2e3)")),
+        zero_typical: false,
+    },
+    SiRange {
+        // the z-modulation's amplitude, 10–300 nm on commercial instruments
+        sections: &["drive"],
+        keys: &["modulation_amplitude"],
+        unit: "m",
+        slips: &[("n", 1e-9), ("µ", 1e-6)],
+        below: Some((1e-10, "below 0.1 nm for an off-resonance modulation (probe files are in metres: 100 nm is 100e-9)")),
+        above: Some((1e-5, "must be ≤ 1e-5 m (10 µm; off-resonance modulations are 10–300 nm)")),
+        magnitude: false,
+        typical: Some((5e-9, 5e-7, "5–500 nm of off-resonance tapping", "amplitudes are in m (100 nm is 100e-9)")),
+        zero_typical: false,
+    },
+    SiRange {
         sections: &["sample"],
         keys: &["intermolecular_distance"],
         unit: "m",

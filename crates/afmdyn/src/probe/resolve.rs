@@ -238,13 +238,18 @@ impl Probe {
         let drive_hz = freq.unwrap_or(medium_report.as_ref().map_or(f0, |m| m.resonance_frequency));
         params.omega = scales.omega(drive_hz);
         params.alpha5 = params.alpha5_for_rest_distance(z_c / g0);
-        // drive amplitude: free tip amplitude A0 (= 1 in units of g0) at Ω
-        let unit_response = CantileverModel::new(&params)
-            .map_err(|e| derived(e.to_string()))?
-            .free_tip_response()
-            .map_err(|e| derived(e.to_string()))?
-            .norm();
-        params.alpha2 = 1.0 / unit_response;
+        // drive amplitude: free tip amplitude A0 (= 1 in units of g0) at Ω; off resonance the
+        // modulation amplitude A_m = g0 itself
+        params.alpha2 = if drive.off_resonance {
+            1.0
+        } else {
+            let unit_response = CantileverModel::new(&params)
+                .map_err(|e| derived(e.to_string()))?
+                .free_tip_response()
+                .map_err(|e| derived(e.to_string()))?
+                .norm();
+            1.0 / unit_response
+        };
         let components =
             Self::resolve_components(&mut params, &drive.components, drive_hz, &scales)?;
         params
@@ -275,6 +280,7 @@ impl Probe {
                     "hertz" | "dmt" | "electrostatic" | "jkr" | "capillary"
                 )
             }),
+            off_resonance: drive.off_resonance,
         })
     }
 

@@ -136,9 +136,58 @@ impl Probe {
         // [drive]
         let drive = r.table(root, "drive", true);
         let mut excitation = Excitation::Base;
+        let off_resonance = drive
+            .and_then(|d| d.get("mode"))
+            .and_then(toml::Value::as_str)
+            .is_some_and(|m| m == "off-resonance");
         let (a0, freq, extra) = match drive {
+            Some(d) if off_resonance => {
+                r.unknown(
+                    d,
+                    "drive",
+                    &[
+                        "mode",
+                        "modulation_frequency",
+                        "modulation_amplitude",
+                        "modulated",
+                    ],
+                );
+                excitation = Excitation::Sample;
+                match r.string(d, "drive", "modulated") {
+                    None | Some("sample") => {}
+                    Some("base") if structure.is_some_and(Structure::is_lumped) => r.problems.push(
+                        "[drive].modulated = \"base\": the base's inertial term is modelled \
+                             for the beam only; the point-mass and eigenmode models take \
+                             modulated = \"sample\" (at f_m ≪ f₀ the two differ by (f_m/f₀)² \
+                             of the drive)"
+                            .into(),
+                    ),
+                    Some("base") => excitation = Excitation::Base,
+                    Some(m) => r.problems.push(format!(
+                        "[drive].modulated = \"{m}\": expected sample (the sample moves, the \
+                         default) or base (the lever's base moves)"
+                    )),
+                }
+                (
+                    r.required(d, "drive", "modulation_amplitude", "m", POSITIVE),
+                    r.required(d, "drive", "modulation_frequency", "Hz", POSITIVE),
+                    Vec::new(),
+                )
+            }
             Some(d) => {
-                r.unknown(d, "drive", &["free_amplitude", "frequency", "excitation"]);
+                if let Some(m) = r.string(d, "drive", "mode") {
+                    if m != "tapping" {
+                        r.problems.push(format!(
+                            "[drive].mode = \"{m}\": expected tapping (the default: a drive \
+                             near resonance) or off-resonance (PeakForce tapping)"
+                        ));
+                    }
+                }
+                r.unknown(
+                    d,
+                    "drive",
+                    &["mode", "free_amplitude", "frequency", "excitation"],
+                );
                 if let Some(e) = r.string(d, "drive", "excitation") {
                     match e.parse::<Excitation>() {
                         Ok(x) => excitation = x,
@@ -189,6 +238,7 @@ impl Probe {
             frequency: freq,
             components: extra,
             excitation,
+            off_resonance,
         };
         match Self::resolve(structure, modes, beam, q1, qs, eigen, sample, drive, medium) {
             Ok(p) => Some(Probe {

@@ -53,6 +53,7 @@ pub mod limits;
 pub mod model;
 mod model_of;
 pub mod named;
+pub mod peakforce;
 pub mod pool;
 pub mod present;
 pub mod reconstruct;
@@ -80,6 +81,7 @@ pub use dir_lock::{DirLock, LockError};
 pub use fm::FmRequest;
 pub use model::{parameter, ModelSpec, ParamInfo, MODEL_PARAMETERS};
 pub use named::{Datasets, Named, Outcome};
+pub use peakforce::PeakForceRequest;
 pub use pool::in_pool;
 #[cfg(feature = "parallel")]
 pub use pool::thread_pool;

@@ -25,7 +25,7 @@ use serde::de::{Deserialize, Deserializer};
 use serde_json::{Map, Value};
 
 /// The names of the analyses [`parse`] knows.
-pub const NAMES: [&str; 15] = [
+pub const NAMES: [&str; 16] = [
     "modes",
     "simulate",
     "converge",
@@ -41,6 +41,7 @@ pub const NAMES: [&str; 15] = [
     "basins",
     "fm",
     "reconstruct",
+    "peakforce",
 ];
 
 /// What a named analysis returns: its document, its arrays and its scalars.
@@ -204,6 +205,7 @@ pub fn parse<'de, D: Deserializer<'de>>(
         "basins" => door::<BasinsRequest, D>(d, false),
         "fm" => door::<FmRequest, D>(d, false),
         "reconstruct" => door::<ReconstructRequest, D>(d, false),
+        "peakforce" => door::<super::PeakForceRequest, D>(d, false),
         _ => Ok(None),
     }
 }
@@ -232,6 +234,7 @@ pub fn default_request(name: &str) -> Option<Value> {
         "chart" => v::<ChartRequest>(),
         "reconstruct" => v::<ReconstructRequest>(),
         "fm" => v::<FmRequest>(),
+        "peakforce" => v::<super::PeakForceRequest>(),
         _ => None,
     }
 }

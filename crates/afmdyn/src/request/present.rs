@@ -19,6 +19,7 @@ pub mod image;
 pub mod maps;
 pub mod modes;
 pub(crate) mod orbits;
+pub mod peakforce;
 pub mod reconstruct;
 pub mod sweeps;
 

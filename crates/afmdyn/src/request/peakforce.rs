@@ -1,0 +1,440 @@
+//! `peakforce`: off-resonance (PeakForce) tapping ([`crate::analysis::peakforce`]): the steady
+//! tap at a mean rest separation z_c, or at the z_c an ideal peak-force feedback finds for a
+//! setpoint, with the instrument's channels, one cycle and the force–distance curve — the
+//! request the command line (`afmdyn peakforce`) and, by its name, Python and the browser
+//! share, and its document. With a probe everything is SI (m, N, J, s, Pa); without one the
+//! model's units (g₀, F̃, F̃·g₀, τ).
+
+use super::costs::{newton_work, state_bytes, steady_periods, MODEL_BYTES};
+use super::limits::Cost;
+use super::run::{Analysis, Resolved};
+use crate::analysis::peakforce::{
+    peak_force_setpoint, steady_tap, PeakForceOptions, SetpointOptions, SteadyTap, BRACKET_STEPS,
+    FIT_BAND, MAX_CYCLE_SAMPLES, MIN_CYCLE_SAMPLES, SETPOINT_ITERATIONS,
+};
+use crate::analysis::progress::Progress;
+use crate::error::SimError;
+use crate::model::CantileverModel;
+use crate::params::{Params, SweepParam};
+use crate::report::CurveUnits;
+use serde::{Deserialize, Serialize};
+use serde_json::{json, Value};
+
+/// Largest modulation frequency relative to the lever's first resonance, Ω = f_m/f₀ (the
+/// model's Ω): above it the drive is not off resonance (use `orbit` or `approach`).
+pub const MAX_MODULATION_RATIO: f64 = 0.5;
+
+/// `peakforce`: one steady off-resonance tap at `z_c` (m with a probe, else g₀) or at the z_c
+/// whose peak force is `setpoint` (N with a probe, else F̃).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[serde(default, deny_unknown_fields)]
+pub struct PeakForceRequest {
+    /// The mean rest separation z_c (m with a probe, else g₀): the tip–sample distance with the
+    /// lever at rest and the sample at the centre of its modulation; default the model's
+    /// (the probe's `[sample] z_c`, default A_m). Excludes `setpoint`.
+    pub z_c: Option<f64>,
+    /// The peak force the ideal feedback holds (N with a probe, else F̃), > 0: z_c is found so
+    /// that the steady tap's peak force equals it. Excludes `z_c`.
+    pub setpoint: Option<f64>,
+    /// Points of the reported cycle, in 2000..=1000000 (default 4096).
+    pub samples: usize,
+    /// The DMT fit's band: fractions [lo, hi] of the retract curve's force range from the
+    /// adhesion to the peak force (default [0.3, 0.9]).
+    pub fit_band: [f64; 2],
+}
+
+impl Default for PeakForceRequest {
+    fn default() -> Self {
+        PeakForceRequest {
+            z_c: None,
+            setpoint: None,
+            samples: 4_096,
+            fit_band: [FIT_BAND.0, FIT_BAND.1],
+        }
+    }
+}
+
+/// The result of a `peakforce` request: the tap and the α5 it was computed at.
+#[derive(Debug, Clone)]
+pub struct PeakForceResult {
+    /// α5 of the tap (the request's z_c, or the setpoint's).
+    pub alpha5: f64,
+    /// The steady tap.
+    pub tap: SteadyTap,
+    /// Steady taps the setpoint's feedback computed (1 at a given z_c).
+    pub evaluations: usize,
+}
+
+impl PeakForceRequest {
+    /// The units of the document: SI with a probe, else the model's.
+    pub fn units(model: &Resolved) -> CurveUnits {
+        match &model.probe {
+            Some(p) => CurveUnits::from_scales(&p.scales, true),
+            None => CurveUnits::dimensionless(),
+        }
+    }
+
+    /// The analysis' options.
+    pub fn options(&self) -> PeakForceOptions {
+        PeakForceOptions {
+            samples: self.samples,
+            fit_band: (self.fit_band[0], self.fit_band[1]),
+            ..PeakForceOptions::default()
+        }
+    }
+
+    /// Check the request on `model` and give the parameters of the tap (α5 from `z_c`).
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming `z_c`, `setpoint`, `samples`, `fit_band`, or the model's
+    /// drive (`excitation`, `omega`) when it is no off-resonance modulation.
+    pub fn params(&self, model: &Resolved) -> Result<Params, SimError> {
+        let p = model.params;
+        let off_resonance = match &model.probe {
+            Some(pr) => pr.off_resonance,
+            None => !p.is_force_driven() && !p.is_multifrequency(),
+        };
+        if !off_resonance {
+            return Err(SimError::out_of_range(
+                "excitation",
+                p.excitation.name(),
+                "peakforce needs a modulated sample or base: a probe with [drive] mode = \
+                 \"off-resonance\" (modulation_frequency, modulation_amplitude), or a model \
+                 with excitation = \"sample\" (or the beam's base drive) and one drive frequency",
+            ));
+        }
+        if p.omega > MAX_MODULATION_RATIO {
+            return Err(SimError::out_of_range(
+                "omega",
+                p.omega,
+                "the modulation must lie below half the lever's first resonance (f_m/f₀ ≤ \
+                 0.5) to be off resonance",
+            ));
+        }
+        if !(MIN_CYCLE_SAMPLES..=MAX_CYCLE_SAMPLES).contains(&self.samples) {
+            return Err(SimError::out_of_range(
+                "samples",
+                self.samples,
+                "must be in 2000..=1000000 (points of the reported cycle)",
+            ));
+        }
+        self.options().validate()?;
+        let length = Self::units(model).length;
+        let mut q = p;
+        match (self.z_c, self.setpoint) {
+            (Some(_), Some(_)) => {
+                return Err(SimError::out_of_range(
+                    "setpoint",
+                    "given with z_c",
+                    "give either z_c (the mean rest separation) or setpoint (the peak force \
+                     the feedback holds), not both",
+                ))
+            }
+            (Some(z), None) => {
+                crate::error::finite("z_c", z)?;
+                if model.probe.is_some() {
+                    super::limits::si_distance("z_c", z)?;
+                }
+                q = p.with(SweepParam::Alpha5, p.alpha5_for_rest_distance(z / length));
+            }
+            (None, Some(f)) => {
+                if !(f.is_finite() && f > 0.0) {
+                    return Err(SimError::out_of_range(
+                        "setpoint",
+                        f,
+                        "must be a finite peak force > 0 (N with a probe: 2 nN is 2e-9, or \
+                         2nN on the command line)",
+                    ));
+                }
+            }
+            (None, None) => {}
+        }
+        q.validate()?;
+        Ok(q)
+    }
+}
+
+impl Analysis for PeakForceRequest {
+    type Output = PeakForceResult;
+    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
+        self.params(model).map(|_| ())
+    }
+    fn execute(&self, model: &Resolved, _: &Progress) -> Result<PeakForceResult, SimError> {
+        let p = self.params(model)?;
+        match self.setpoint {
+            Some(f) => {
+                let force = Self::units(model).force;
+                let opts = SetpointOptions {
+                    tap: self.options(),
+                    ..SetpointOptions::default()
+                };
+                let s = peak_force_setpoint(&p, f / force, &opts)?;
+                Ok(PeakForceResult {
+                    alpha5: s.alpha5,
+                    tap: s.tap,
+                    evaluations: s.evaluations,
+                })
+            }
+            None => Ok(PeakForceResult {
+                alpha5: p.alpha5,
+                tap: steady_tap(&CantileverModel::new(&p)?, &self.options())?,
+                evaluations: 1,
+            }),
+        }
+    }
+    fn name(&self) -> &'static str {
+        "peakforce"
+    }
+    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
+        // every tap: the transient (at most its cap) and Newton's variational flows, each drive
+        // period spanning 1/Ω lever periods; the setpoint's bracket and iterations; the cycle
+        // and the fit's resampling kept
+        let p = self.params(model)?;
+        let opts = self.options();
+        let lever_periods = (1.0 / p.omega).max(1.0);
+        let tap = (steady_periods(&opts.steady, &p)? * p.modes as f64
+            + newton_work(&p, 1, &opts.shooting))
+            * lever_periods;
+        let taps = if self.setpoint.is_some() {
+            (2 * BRACKET_STEPS + SETPOINT_ITERATIONS) as f64
+        } else {
+            1.0
+        };
+        let samples = (self.samples + crate::analysis::peakforce::FIT_SAMPLES) as f64;
+        Ok(Cost {
+            bytes: MODEL_BYTES + 2.0 * samples * 4.0 * 8.0 + 64.0 * state_bytes(&p),
+            work: taps * tap,
+        })
+    }
+    fn computed_at(&self, model: &Resolved) -> Result<Params, SimError> {
+        self.params(model)
+    }
+    fn report(&self, model: &Resolved, r: &PeakForceResult) -> Result<Value, SimError> {
+        Ok(document(self, model, r))
+    }
+    fn present(
+        &self,
+        _: &Resolved,
+        _: &PeakForceResult,
+        document: &Value,
+        units: crate::report::TextUnits,
+    ) -> Result<crate::report::Presentation, SimError> {
+        let mut document = document.clone();
+        let files = super::present::Files::All;
+        Ok(super::present::peakforce::peakforce(
+            &mut document,
+            units,
+            files,
+            None,
+        ))
+    }
+    fn largest_indentation(&self, r: &PeakForceResult) -> Option<f64> {
+        Some(r.tap.channels.deformation)
+    }
+}
+
+/// The sample's true reduced modulus E* (Pa) of a Hertz-type law under a probe: from the
+/// Hertz group α4 = (4/3)E*√R g₀^{3/2}/F_s (module docs of [`crate::probe`]).
+fn true_modulus(model: &Resolved, alpha4: f64) -> Option<f64> {
+    let pr = model.probe.as_ref()?;
+    let r = pr.tip_radius?;
+    let s = &pr.scales;
+    Some(alpha4 * s.force_n / (4.0 / 3.0 * r.sqrt() * s.length_m.powf(1.5)))
+}
+
+/// The document of a steady tap (`afmdyn peakforce --json`, Python's `to_dict()`): `channels`
+/// (the instrument's, SI with a probe), `modulus` (the DMT fit beside the true modulus),
+/// `orbit` (period, Floquet multipliers, stability), `balance` (energy per cycle), `cycle`
+/// (time, deflection, distance, force from the largest separation) and `curve` (the
+/// force–distance curve, approach and retract), `z_c`, `units`, `method`, `warnings`.
+pub fn document(request: &PeakForceRequest, model: &Resolved, r: &PeakForceResult) -> Value {
+    let u = PeakForceRequest::units(model);
+    let tap = &r.tap;
+    let c = &tap.channels;
+    let p = model.params.with(SweepParam::Alpha5, r.alpha5);
+    let has_radius = matches!(
+        p.contact_law.name(),
+        "hertz" | "dmt" | "electrostatic" | "jkr" | "capillary"
+    );
+    // the fitted Hertz group to a modulus (SI with a probe), beside the true one
+    let fitted = tap.fit.map(|f| f.hertz_group);
+    let (modulus_fit, modulus_true) = match true_modulus(model, 1.0) {
+        Some(scale) if has_radius => (fitted.map(|k| k * scale), Some(p.alpha4 * scale)),
+        _ => (fitted, has_radius.then_some(p.alpha4)),
+    };
+    let mut warnings: Vec<String> = Vec::new();
+    if tap.period > 1 {
+        warnings.push(format!(
+            "period-{} tapping: the orbit repeats after {} modulation periods; the cycle shows \
+             the first",
+            tap.period, tap.period
+        ));
+    }
+    if c.taps_per_cycle > 1.0 + 1e-9 {
+        warnings.push(format!(
+            "{} contacts per modulation period: double taps (the lever's ringing reaches the \
+             sample again)",
+            c.taps_per_cycle
+        ));
+    }
+    if !tap.stable {
+        warnings.push(
+            "the steady tap is unstable (a Floquet multiplier outside the unit circle)".into(),
+        );
+    }
+    if c.peak_force <= 0.0 {
+        warnings.push("no repulsive contact: the sample never reaches the tip at this z_c".into());
+    }
+    let t = &tap.cycle;
+    let half = t.time.len() / 2;
+    let col = |v: &[f64], s: f64| v.iter().map(|x| x * s).collect::<Vec<f64>>();
+    let multipliers: Vec<[f64; 2]> = tap.multipliers.iter().map(|m| [m.re, m.im]).collect();
+    let time_unit = if u.si { "s" } else { "τ" };
+    let period = std::f64::consts::TAU / p.omega;
+    json!({
+        "channels": {
+            "peak_force": c.peak_force * u.force,
+            "adhesion": c.adhesion * u.force,
+            "deformation": c.deformation * u.length,
+            "dissipation": c.dissipation * u.energy,
+            "contact_time": c.contact_time * u.time,
+            "snap_off_time": c.snap_off_time * u.time,
+            "ringing_amplitude": c.ringing_amplitude * u.length,
+            "modulus_dmt": modulus_fit,
+            "taps_per_cycle": c.taps_per_cycle,
+        },
+        "modulus": {
+            "modulus_dmt": modulus_fit,
+            "true": modulus_true,
+            "ratio": match (fitted, has_radius) { (Some(k), true) => Some(k / p.alpha4), _ => None },
+            "tip_sample_modulus": match true_modulus(model, 1.0) {
+                Some(scale) if has_radius => tap.fit_tip_sample.map(|f| f.hertz_group * scale),
+                _ => tap.fit_tip_sample.map(|f| f.hertz_group),
+            },
+            "force_measured_as": "k × deflection (the deflection over the lever's static compliance at the tip), as the instrument does; tip_sample_modulus is the same fit on the true tip–sample force",
+            "fit_band": request.fit_band,
+            "fit_points": tap.fit.map(|f| f.points),
+            "fit_relative_residual": tap.fit.map(|f| f.relative_residual),
+            "contact_distance": tap.fit.map(|f| f.contact_distance * u.length),
+            "quantity": if u.si { "reduced modulus E* (Pa), 1/E* = (1 − ν_t²)/E_t + (1 − ν_s²)/E_s" } else { "Hertz group (4/3)E*√R in model units (α4)" },
+        },
+        "z_c": p.rest_distance() * u.length,
+        "setpoint": request.setpoint,
+        "feedback_evaluations": r.evaluations,
+        "modulation": {
+            "period": period * u.time,
+            "f0_over_fm": 1.0 / p.omega,
+            "amplitude": p.alpha2 * u.length,
+        },
+        "orbit": {
+            "period": tap.period,
+            "stable": tap.stable,
+            "multipliers": multipliers,
+            "transient_periods": tap.transient_periods,
+        },
+        "balance": {
+            "modulation_work": tap.balance.modulation_work * u.energy,
+            "lever_damping": tap.balance.lever_damping * u.energy,
+            "tip_sample": tap.balance.tip_sample * u.energy,
+            "base_forcing": tap.balance.base_forcing * u.energy,
+            "residual": tap.balance.residual * u.energy,
+        },
+        "cycle": {
+            "time": col(&t.time, u.time),
+            "deflection": col(&t.deflection, u.length),
+            "distance": col(&t.distance, u.length),
+            "force": col(&t.force, u.force),
+        },
+        "curve": {
+            "approach_distance": col(&t.distance[..half], u.length),
+            "approach_force": col(&t.force[..half], u.force),
+            "retract_distance": col(&t.distance[half..], u.length),
+            "retract_force": col(&t.force[half..], u.force),
+        },
+        "units": if u.si {
+            json!({"peak_force": "N", "adhesion": "N", "deformation": "m", "dissipation": "J", "contact_time": "s",
+                   "snap_off_time": "s (from the largest separation)", "ringing_amplitude": "m", "modulus_dmt": "Pa", "z_c": "m",
+                   "time": time_unit, "deflection": "m", "distance": "m", "force": "N"})
+        } else {
+            json!({"peak_force": "F", "adhesion": "F", "deformation": "g0", "dissipation": "F·g0", "contact_time": "τ",
+                   "snap_off_time": "τ (from the largest separation)", "ringing_amplitude": "g0", "modulus_dmt": "α4 (Hertz group)", "z_c": "g0",
+                   "time": time_unit, "deflection": "g0", "distance": "g0", "force": "F"})
+        },
+        "method": "the sample (or base) modulated as z_c + A_m cos 2πf_m t (t = 0 at the largest separation); the steady tap is the periodic orbit of the modulation period, settled from rest and Newton-shot with its Floquet multipliers; modulus_dmt from the DMT relation F − F_adh = (4/3)E*√R(d₀ − d)^{3/2} fitted on the retract curve between fit_band of its force range, d₀ at the force minimum (PF-QNM, Bruker AN128); adhesion is the most negative force (signed) (docs/afm-workflow.md)",
+        "warnings": warnings,
+    })
+}
+
+impl super::named::Datasets for PeakForceRequest {
+    /// `cycle` (time, deflection, distance, force over one period from the largest
+    /// separation) and `curve` (approach and retract, each over its own dimension), in the
+    /// document's units; the channels as facts.
+    fn datasets(
+        &self,
+        model: &Resolved,
+        r: &PeakForceResult,
+    ) -> Result<super::named::Arrays, SimError> {
+        use crate::layout::{Layout, Variable};
+        let doc = document(self, model, r);
+        let units = &doc["units"];
+        let unit = |k: &str| units[k].as_str().unwrap_or("").to_string();
+        let arr = |block: &str, k: &str| -> Vec<f64> {
+            doc[block][k].as_array().map_or(Vec::new(), |a| {
+                a.iter().map(|v| v.as_f64().unwrap_or(f64::NAN)).collect()
+            })
+        };
+        let n = r.tap.cycle.time.len();
+        let cycle = Layout::new(
+            "peakforce cycle",
+            &[("sample", n)],
+            ["time", "deflection", "distance", "force"]
+                .iter()
+                .map(|k| Variable::f64(k, &["sample"], &unit(k), *k, &arr("cycle", k)))
+                .collect(),
+        );
+        let (a, b) = (
+            arr("curve", "approach_distance").len(),
+            arr("curve", "retract_distance").len(),
+        );
+        let curve = Layout::new(
+            "peakforce force-distance curve",
+            &[("approach", a), ("retract", b)],
+            vec![
+                Variable::f64(
+                    "approach_distance",
+                    &["approach"],
+                    &unit("distance"),
+                    "distance, approach",
+                    &arr("curve", "approach_distance"),
+                ),
+                Variable::f64(
+                    "approach_force",
+                    &["approach"],
+                    &unit("force"),
+                    "force, approach",
+                    &arr("curve", "approach_force"),
+                ),
+                Variable::f64(
+                    "retract_distance",
+                    &["retract"],
+                    &unit("distance"),
+                    "distance, retract",
+                    &arr("curve", "retract_distance"),
+                ),
+                Variable::f64(
+                    "retract_force",
+                    &["retract"],
+                    &unit("force"),
+                    "force, retract",
+                    &arr("curve", "retract_force"),
+                ),
+            ],
+        );
+        let facts = doc["channels"].as_object().cloned().unwrap_or_default();
+        Ok((
+            vec![("cycle".into(), cycle), ("curve".into(), curve)],
+            facts,
+        ))
+    }
+}

@@ -1,0 +1,170 @@
+//! `peakforce`: the summary of a steady off-resonance tap (its channels, the DMT fit beside
+//! the true modulus, the orbit's stability), its tables `peakforce-cycle.csv` and
+//! `peakforce-curve.csv`, its document `peakforce.json` and the figures of force against
+//! distance and against time.
+
+use super::{lines, with_document, Files};
+use crate::layout::figure::{Series, Style};
+use crate::report::{OutputsNote, Presentation, TextUnits};
+use serde_json::Value;
+use std::path::Path;
+
+/// The columns of the cycle's table (`peakforce-cycle.csv`, Python's Dataset variables).
+pub const CYCLE_COLUMNS: [&str; 4] = ["time", "deflection", "distance", "force"];
+/// The columns of the force–distance curve's table (`peakforce-curve.csv`): approach and
+/// retract side by side (the retract has as many points as the approach, or one more).
+pub const CURVE_COLUMNS: [&str; 4] = [
+    "approach_distance",
+    "approach_force",
+    "retract_distance",
+    "retract_force",
+];
+
+/// A numeric array of the document at `block.name` (empty when absent).
+fn column(doc: &Value, block: &str, name: &str) -> Vec<f64> {
+    doc[block][name].as_array().map_or(Vec::new(), |a| {
+        a.iter().map(|v| v.as_f64().unwrap_or(f64::NAN)).collect()
+    })
+}
+
+/// The rows of one table of the document: `block`'s arrays in `columns` order, as long as the
+/// longest (NaN beyond a shorter one).
+pub fn rows(doc: &Value, block: &str, columns: &[&str]) -> Vec<Vec<f64>> {
+    let cols: Vec<Vec<f64>> = columns.iter().map(|c| column(doc, block, c)).collect();
+    let n = cols.iter().map(Vec::len).max().unwrap_or(0);
+    (0..n)
+        .map(|i| {
+            cols.iter()
+                .map(|c| c.get(i).copied().unwrap_or(f64::NAN))
+                .collect()
+        })
+        .collect()
+}
+
+/// The presentation of a steady tap's `document` ([`crate::request::peakforce::document`]):
+/// the summary, and with `files` the two tables, the figures (all files) and the document
+/// `peakforce.json`.
+pub fn peakforce(
+    document: &mut Value,
+    text: TextUnits,
+    files: Files,
+    dir: Option<&Path>,
+) -> Presentation {
+    let mut p = Presentation {
+        outputs_note: OutputsNote::Tail,
+        ..Presentation::default()
+    };
+    let si = text.si();
+    let ch = &document["channels"];
+    let num = |v: &Value| v.as_f64().unwrap_or(f64::NAN);
+    let value = |v: f64, si_unit: &str, model_unit: &str| {
+        if si {
+            text.value(v, si_unit)
+        } else {
+            format!("{v:e} {model_unit}")
+        }
+    };
+    p.line(format!(
+        "steady tap at z_c = {}: peak force {}, adhesion {}, deformation {}, dissipation {} per \
+         cycle",
+        value(num(&document["z_c"]), "m", "g0"),
+        value(num(&ch["peak_force"]), "N", "F"),
+        value(num(&ch["adhesion"]), "N", "F"),
+        value(num(&ch["deformation"]), "m", "g0"),
+        value(num(&ch["dissipation"]), "J", "F·g0"),
+    ));
+    p.line(format!(
+        "contact time {}, snap-off at {}, ringing {}",
+        value(num(&ch["contact_time"]), "s", "τ"),
+        value(num(&ch["snap_off_time"]), "s", "τ"),
+        value(num(&ch["ringing_amplitude"]), "m", "g0"),
+    ));
+    let m = &document["modulus"];
+    if let (Some(fit), Some(truth)) = (m["modulus_dmt"].as_f64(), m["true"].as_f64()) {
+        p.line(format!(
+            "modulus_dmt {} against the sample's {} (ratio {:.4})",
+            value(fit, "Pa", "(α4)"),
+            value(truth, "Pa", "(α4)"),
+            fit / truth
+        ));
+    }
+    let o = &document["orbit"];
+    p.line(format!(
+        "orbit: period {} modulation period(s), {}; largest Floquet multiplier |μ| = {:.3e}",
+        o["period"].as_u64().unwrap_or(0),
+        if o["stable"].as_bool().unwrap_or(false) {
+            "stable"
+        } else {
+            "unstable"
+        },
+        o["multipliers"]
+            .as_array()
+            .and_then(|a| a.first())
+            .map(|m| num(&m[0]).hypot(num(&m[1])))
+            .unwrap_or(f64::NAN),
+    ));
+    if files == Files::None {
+        return p;
+    }
+    let cycle = rows(document, "cycle", &CYCLE_COLUMNS);
+    let curve = rows(document, "curve", &CURVE_COLUMNS);
+    #[cfg(feature = "files")]
+    {
+        use crate::layout::files::f;
+        let table = |t: &[Vec<f64>]| {
+            t.iter()
+                .map(|r| r.iter().map(|v| f(*v)).collect())
+                .collect()
+        };
+        p.csv("peakforce-cycle.csv", &CYCLE_COLUMNS, table(&cycle));
+        p.csv("peakforce-curve.csv", &CURVE_COLUMNS, table(&curve));
+    }
+    if files == Files::All {
+        let (l, f, t) = if si {
+            (" (m)", " (N)", " (s)")
+        } else {
+            (" (g0)", " (F)", " (τ)")
+        };
+        let series = |label: &str, pts: Vec<(f64, f64)>, color: usize| Series {
+            label: label.into(),
+            points: pts
+                .into_iter()
+                .filter(|(x, y)| x.is_finite() && y.is_finite())
+                .collect(),
+            style: Style::Line,
+            color,
+        };
+        let approach = curve.iter().map(|r| (r[0], r[1])).collect();
+        let retract = curve.iter().map(|r| (r[2], r[3])).collect();
+        p.figure(
+            "peakforce-curve",
+            lines(
+                "PeakForce tapping: force against tip–sample distance",
+                (format!("distance{l}"), format!("force{f}")),
+                vec![
+                    series("approach", approach, 0),
+                    series("retract", retract, 1),
+                ],
+            ),
+        );
+        let time = cycle.iter().map(|r| (r[0], r[3])).collect();
+        p.figure(
+            "peakforce-force-time",
+            lines(
+                "PeakForce tapping: force over one modulation period",
+                (
+                    format!("time from the largest separation{t}"),
+                    format!("force{f}"),
+                ),
+                vec![series("", time, 0)],
+            ),
+        );
+    }
+    with_document(
+        &mut p,
+        document,
+        ("peakforce.json", "peakforce-cycle.csv"),
+        dir,
+    );
+    p
+}
