@@ -72,3 +72,30 @@ fn peakforce_refuses_z_c_with_a_setpoint() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("--setpoint"), "{err}");
 }
+
+/// The issue's own example, `--setpoint 2nN` on the air probe: the feedback's bracket starts
+/// where the sample just reaches the tip's rest position, where the tap grazes and does not
+/// settle; such points are passed over, and the tap found holds the setpoint to its tolerance
+/// (1e-6), with the double taps and the meaningless DMT fit said.
+#[test]
+fn peakforce_holds_a_setpoint_past_a_grazing_tap() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = afmdyn(&[
+        "peakforce",
+        "--probe",
+        AIR,
+        "--setpoint",
+        "2nN",
+        "--json",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let peak = doc["channels"]["peak_force"].as_f64().unwrap();
+    assert!((peak - 2e-9).abs() <= 1e-6 * 2e-9, "{peak}");
+    if doc["channels"]["taps_per_cycle"].as_f64().unwrap_or(1.0) > 1.0 {
+        assert!(err.contains("not meaningful"), "{err}");
+    }
+}

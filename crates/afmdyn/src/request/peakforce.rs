@@ -274,7 +274,8 @@ pub fn document(request: &PeakForceRequest, model: &Resolved, r: &PeakForceResul
     if c.taps_per_cycle > 1.0 + 1e-9 {
         warnings.push(format!(
             "{} contacts per modulation period: double taps (the lever's ringing reaches the \
-             sample again)",
+             sample again); modulus_dmt, fitted as PF-QNM does on the retract of one tap, is not \
+             meaningful for such a cycle",
             c.taps_per_cycle
         ));
     }

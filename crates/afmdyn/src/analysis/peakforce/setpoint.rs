@@ -18,6 +18,9 @@ use nalgebra::DVector;
 pub const SETPOINT_TOL: f64 = 1e-6;
 /// Doublings of the downward step that brackets the setpoint before it is refused.
 pub const BRACKET_STEPS: usize = 12;
+/// Points passed over at the bracket's far end whose tap does not settle (each 0.05 α2
+/// farther out).
+pub const UNSETTLED_SKIPS: usize = 4;
 /// Iterations of false position.
 pub const SETPOINT_ITERATIONS: usize = 80;
 
@@ -77,9 +80,21 @@ pub fn peak_force_setpoint(
         start.copy_from(&tap.state);
         Ok((tap.channels.peak_force - setpoint, tap))
     };
-    // the upper end: no repulsive contact (the far side of the root)
+    // the upper end: no repulsive contact (the far side of the root). At α5 = α2 the sample's
+    // highest point just reaches the tip's rest position, where the tap may graze and not
+    // settle: a point whose tap does not settle is passed over, a little farther out
     let mut hi = base.alpha2.max(1e-3);
-    let (mut g_hi, mut tap_hi) = eval(hi, &mut start)?;
+    let mut far = 0;
+    let (mut g_hi, mut tap_hi) = loop {
+        match eval(hi, &mut start) {
+            Err(SimError::NoConvergence { .. }) if far < UNSETTLED_SKIPS => {
+                far += 1;
+                hi += 0.05 * base.alpha2.max(1e-3);
+                start.fill(0.0);
+            }
+            other => break other?,
+        }
+    };
     let mut up = 0;
     while g_hi > 0.0 {
         up += 1;
@@ -112,7 +127,16 @@ pub fn peak_force_setpoint(
         tap_hi = tap_lo.clone();
         lo -= step0 * f64::from(1u32 << k);
         k += 1;
-        (g_lo, tap_lo) = eval(lo, &mut start)?;
+        // a tap that does not settle (grazing, or a motion that does not repeat) is passed
+        // over: the bracket steps on
+        match eval(lo, &mut start) {
+            Ok(v) => (g_lo, tap_lo) = v,
+            Err(SimError::NoConvergence { .. }) => {
+                lo = hi;
+                start.fill(0.0);
+            }
+            Err(e) => return Err(e),
+        }
     }
     // Illinois false position on [lo, hi]: g(lo) ≥ 0 > g(hi)
     let mut side = 0i8;
@@ -127,7 +151,16 @@ pub fn peak_force_setpoint(
         }
         let x = (lo * g_hi - hi * g_lo) / (g_hi - g_lo);
         let x = if x > lo && x < hi { x } else { 0.5 * (lo + hi) };
-        let (g, tap) = eval(x, &mut start)?;
+        let (g, tap) = match eval(x, &mut start) {
+            Ok(v) => v,
+            // a tap that does not settle grazes the sample: on the far (low-force) side
+            Err(SimError::NoConvergence { .. }) => {
+                hi = x;
+                start.copy_from(&best.2.state);
+                continue;
+            }
+            Err(e) => return Err(e),
+        };
         if g.abs() < best.1.abs() {
             best = (x, g, tap);
         }
