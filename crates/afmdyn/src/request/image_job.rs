@@ -131,9 +131,9 @@ impl Analysis for ImageJob {
         let setpoint = self.request.setpoint;
         Ok(match output {
             ImageOutput::Ideal { image, study } => {
-                super::present::image::ideal_document(image, setpoint, study.as_ref())
+                super::present::image::ideal_summary(image, setpoint, study.as_ref())
             }
-            ImageOutput::Pi(img) => img.document(setpoint),
+            ImageOutput::Pi(img) => super::present::image::pi_summary(img, setpoint),
         })
     }
 
