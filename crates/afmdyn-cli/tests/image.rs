@@ -565,3 +565,113 @@ fn a_killed_pi_scan_resumes_to_the_uninterrupted_files() {
     let err = String::from_utf8_lossy(&other.stderr);
     assert!(err.contains("gains") && err.contains("3000"), "{err}");
 }
+
+/// The refusal of `args`: exit 2, one line on stderr, nothing written to `dir`.
+fn refused(args: &[&str], dir: &std::path::Path) -> String {
+    let out = afmdyn(args);
+    let err = String::from_utf8_lossy(&out.stderr).to_string();
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(!dir.exists(), "{err}: {} was created", dir.display());
+    err
+}
+
+/// Issue 60: `image` goes through the door — held to the budgets before its directory is
+/// made (2048 × 2048 pixels refused naming the image's budget), its threads refused as
+/// every command's (0, 1025), a default scan rate's K_I blamed as gains.
+#[test]
+fn image_is_refused_before_its_directory() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let o = out.to_str().unwrap();
+    let base = [
+        "image",
+        "--probe",
+        "examples/probe-point-mass-dmt.toml",
+        "--sample",
+        "examples/sample-blend.toml",
+        "--setpoint",
+        "0.7",
+        "--out",
+        o,
+    ];
+    let with = |extra: &[&str]| -> Vec<String> {
+        base.iter().chain(extra).map(|s| s.to_string()).collect()
+    };
+    let run = |extra: &[&str]| {
+        let args = with(extra);
+        refused(&args.iter().map(String::as_str).collect::<Vec<_>>(), &out)
+    };
+    let err = run(&["--pixels", "2048"]);
+    assert!(
+        err.contains("image: 2048 × 2048 pixels") && err.contains("exceeds the budget"),
+        "{err}"
+    );
+    for t in ["0", "1025"] {
+        let err = run(&["--feedback", "pi", "--threads", t]);
+        assert!(
+            err.contains(&format!("threads = {t}: must be in 1..=1024")),
+            "{err}"
+        );
+    }
+    let err = run(&["--feedback", "pi", "--gains", "0,1e12"]);
+    assert!(
+        err.contains("gains = K_I = 1e12") && !err.contains("scan_rate ="),
+        "{err}"
+    );
+}
+
+/// `image --files`: `data` writes the document and the dataset without figures, `none`
+/// writes nothing (no directory) and prints the summary; `--resume` needs a store.
+#[test]
+fn image_takes_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let args = |files: &'static str| {
+        vec![
+            "image".to_string(),
+            "--probe".into(),
+            "examples/probe-point-mass-dmt.toml".into(),
+            "--sample".into(),
+            "examples/sample-stripe.toml".into(),
+            "--setpoint".into(),
+            "0.8".into(),
+            "--pixels".into(),
+            "6".into(),
+            "--curve-points".into(),
+            "20".into(),
+            "--files".into(),
+            files.into(),
+            "--out".into(),
+            out.to_str().unwrap().into(),
+        ]
+    };
+    let run = |a: Vec<String>| afmdyn(&a.iter().map(String::as_str).collect::<Vec<_>>());
+    let o = run(args("none"));
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(!out.exists());
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        text.starts_with("ideal-feedback image, 6 × 1 pixels"),
+        "{text}"
+    );
+    assert!(!text.contains("outputs in"), "{text}");
+    let o = run(args("data"));
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let mut names: Vec<String> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+        .filter(|n| !n.starts_with('.'))
+        .collect();
+    names.sort();
+    assert_eq!(names, ["image.json", "image.nc"]);
+    let mut a = args("none");
+    a.extend(["--feedback".into(), "pi".into(), "--resume".into()]);
+    let o = run(a);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("--resume: --files none keeps no store"),
+        "{err}"
+    );
+}

@@ -2,6 +2,7 @@
 //! draws them (height, phase, E_dis; the error image of a PI scan), the first line's profile,
 //! the setpoint study's plots and the text summary, for the ideal feedback and the PI scan.
 
+use crate::error::number;
 use crate::layout::figure::{AfmImage, Figure, Plot, Series, Style};
 use crate::report::{Presentation, TextUnits};
 use crate::request::image::{DomainContrast, Image, OperatingPoint, SetpointStudy};
@@ -218,7 +219,7 @@ pub fn ideal(
         "ideal-feedback image, {} × {} pixels, setpoint A/A0 = {}; z_c,ref = {} on the background",
         img.x.len(),
         img.y.len(),
-        setpoint,
+        number(setpoint),
         u.value(img.reference, "m")
     ));
     let names = std::iter::once((None, "background")).chain(
@@ -333,9 +334,9 @@ pub fn pi(img: &PiImage, setpoint: f64, document: &Value, u: TextUnits) -> Prese
          lock-in time constant {}; {} drive periods per pixel ({}), {} to engage each line",
         grid.x.len(),
         grid.y.len(),
-        setpoint,
+        number(setpoint),
         u.value(st.scan_rate, "Hz"),
-        st.proportional_gain,
+        number(st.proportional_gain),
         u.value(st.integral_gain, "1/s"),
         u.value(st.time_constant, "s"),
         st.periods_per_pixel,
