@@ -1,10 +1,11 @@
 //! `afmdyn image`: the AM-AFM image of a heterogeneous sample under an ideal amplitude feedback,
 //! or scanned in the time domain under a lock-in and a PI z controller (`--feedback pi`).
-//! The sample map, the operating points and the scan are the library's
-//! ([`afmdyn::request::image`], [`afmdyn::request::image_scan`]); this front end reads the two
-//! files, maps the flags, and writes `image.json`, `image.nc` (the library's layouts,
-//! [`afmdyn::request::image_layout`]), the maps (height, phase, E_dis; the error image of a PI
-//! scan) and the line profile.
+//! The request, its limits, cost, run, document and presentation are the library's
+//! ([`afmdyn::request::image_job::ImageJob`], an `Analysis`); this front end reads the two
+//! files, maps the flags, and runs it through the door ([`door::run`]) — a PI scan with files
+//! into the output directory's store (resumable), held to the budgets first
+//! ([`afmdyn::request::run::admit`]). It writes `image.json` (a summary), `image.nc` (the maps),
+//! the maps' figures and the line profile, as `--files` asks.
 
 use crate::cmd_approach::files;
 use crate::cmd_simulate::Files;
