@@ -1,17 +1,21 @@
 //! `afmdyn image`: the AM-AFM image of a heterogeneous sample under an ideal amplitude feedback,
 //! or scanned in the time domain under a lock-in and a PI z controller (`--feedback pi`).
-//! The sample map, the operating points and the scan are the library's
-//! ([`afmdyn::request::image`], [`afmdyn::request::image_scan`]); this front end reads the two
-//! files, maps the flags, and writes `image.json`, `image.nc` (the library's layouts,
-//! [`afmdyn::request::image_layout`]), the maps (height, phase, E_dis; the error image of a PI
-//! scan) and the line profile.
+//! The request, its limits, cost, run, document and presentation are the library's
+//! ([`afmdyn::request::image_job::ImageJob`], an `Analysis`); this front end reads the two
+//! files, maps the flags, and runs it through the door ([`door::run`]) — a PI scan with files
+//! into the output directory's store (resumable), held to the budgets first
+//! ([`afmdyn::request::run::admit`]). It writes `image.json` (a summary), `image.nc` (the maps),
+//! the maps' figures and the line profile, as `--files` asks.
 
-use crate::door;
+use crate::cmd_approach::files;
+use crate::cmd_simulate::Files;
+use crate::door::{self, Exit};
 use crate::error::CliError;
 use crate::output::{units_of, OutDir};
-use afmdyn::request::image::{image, setpoint_study, study_ratios, ImageRequest, SampleMap};
-use afmdyn::request::image_scan::{PiScan, ScanStudy};
-use afmdyn::request::present;
+use afmdyn::request::image::{study_ratios, ImageRequest, SampleMap};
+use afmdyn::request::image_job::ImageJob;
+use afmdyn::request::image_scan::PiScan;
+use afmdyn::request::Analysis;
 use clap::Args;
 use std::path::PathBuf;
 
@@ -84,6 +88,9 @@ pub struct ImageArgs {
     /// Output directory (locked during the run)
     #[arg(long, default_value = "afmdyn-out/image")]
     out: PathBuf,
+    /// Files written: all (data and plots), data (no plots) or none (only the summary)
+    #[arg(long, value_enum, default_value = "all")]
+    files: Files,
     /// Print one JSON document
     #[arg(long)]
     json: bool,
@@ -143,34 +150,50 @@ pub fn image_cmd(a: &ImageArgs) -> Result<(), CliError> {
         afmdyn::SimError::Probe(m) => CliError::Input(format!("--sample {m}")),
         e => e.into(),
     })?;
-    let req = ImageRequest::with(a.setpoint, a.pixels, a.lines, a.curve_points);
-    req.validate(&map)?;
-    let ratios = a.setpoint_study.as_deref().map(study_ratios).transpose()?;
-    if let Some(scan) = pi {
-        return pi_cmd(a, &table, &map, &req, &scan);
-    }
-    let out = OutDir::lock(&a.out)?;
-    let img = image(&table, &map, &req)?;
-    let study = match &ratios {
-        Some(r) => Some(setpoint_study(&table, &map, r, req.curve_points)?),
-        None => None,
+    let request = ImageRequest::with(a.setpoint, a.pixels, a.lines, a.curve_points);
+    request.validate(&map)?;
+    let study = a.setpoint_study.as_deref().map(study_ratios).transpose()?;
+    let job = ImageJob {
+        probe: table,
+        sample: map,
+        request,
+        feedback: pi,
+        study,
+        threads: a.threads,
+        files: files(a.files),
     };
-    let json = present::image::ideal_document(&img, a.setpoint, study.as_ref());
-    let shown = present::image::ideal(&img, a.setpoint, study.as_ref(), &json, units_of(None));
-    door::emit(Some(&out), &shown, &json, a.json)
+    let model = job.model()?;
+    let out = (a.files != Files::None).then_some(a.out.as_path());
+    if job.feedback.is_none() || out.is_none() {
+        if a.resume {
+            return Err(CliError::Input(
+                "--resume: --files none keeps no store to resume; use --files data or all".into(),
+            ));
+        }
+        let exit = Exit {
+            json: a.json,
+            out,
+            unit: if job.feedback.is_some() {
+                "lines"
+            } else {
+                "points"
+            },
+        };
+        return door::run(&job, &model, exit).map(|_| ());
+    }
+    pi_cmd(a, &job, &model)
 }
 
-/// `afmdyn image --feedback pi`: the scan's lines as a study on the worker threads, then its
-/// presentation.
+/// `afmdyn image --feedback pi` with files: the scan's lines as a study on the worker threads
+/// in the output directory's store (resumable), then its presentation.
 fn pi_cmd(
     a: &ImageArgs,
-    table: &toml::Table,
-    map: &SampleMap,
-    req: &ImageRequest,
-    scan: &PiScan,
+    job: &ImageJob,
+    model: &afmdyn::request::Resolved,
 ) -> Result<(), CliError> {
-    let study = ScanStudy::new(table, map, req, scan)?;
+    afmdyn::request::run::admit(job, model)?;
     let out = OutDir::lock(&a.out)?;
+    let study = job.scan_study()?.expect("a PI scan");
     let mut store = afmdyn::study::scan_store::scan_store(out.dir_lock());
     crate::progress::study(
         &study,
@@ -184,8 +207,8 @@ fn pi_cmd(
     let records = store
         .records()
         .map_err(|e| crate::error::store_error(e, "image"))?;
-    let img = study.assemble(records)?;
-    let json = img.document(a.setpoint);
-    let shown = present::image::pi(&img, a.setpoint, &json, units_of(None));
+    let output = afmdyn::request::image_job::ImageOutput::Pi(study.assemble(records)?);
+    let json = afmdyn::request::run::document(job, model, &output)?;
+    let shown = job.present(model, &output, &json, units_of(None))?;
     door::emit(Some(&out), &shown, &json, a.json)
 }

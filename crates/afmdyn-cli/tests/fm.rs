@@ -215,3 +215,82 @@ fn am_approach_reconstructs_the_van_der_waals_force() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(err.contains("am") && err.contains("point-mass"), "{err}");
 }
+
+/// The refusal of `args`: exit 2 and one line on stderr.
+fn refused(args: &[&str]) -> String {
+    let out = afmdyn(args);
+    let err = String::from_utf8_lossy(&out.stderr).to_string();
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    err
+}
+
+/// Issue 60: an SI amplitude is held against the amplitude's range of the library
+/// (`probe::ranges`, `[drive] free_amplitude`: 1 pm to 10 µm), not a rest distance's ±1e-4 m
+/// nor any range of the front end: 0.5 mm and 5e-324 m are refused naming `amplitude` and
+/// the amplitude's bound, a negative one as not > 0.
+#[test]
+fn an_si_amplitude_is_refused_by_the_amplitudes_range() {
+    let err = refused(&[
+        "fm",
+        "--probe",
+        PROBE,
+        "--amplitude",
+        "5e-4",
+        "--files",
+        "none",
+    ]);
+    assert!(
+        err.contains("amplitude = 0.0005 m: must be ≤ 1e-5 m"),
+        "{err}"
+    );
+    let err = refused(&[
+        "fm",
+        "--probe",
+        PROBE,
+        "--amplitude",
+        "0.5mm",
+        "--files",
+        "none",
+    ]);
+    assert!(
+        err.contains("amplitude = 0.0005 m: must be ≤ 1e-5 m"),
+        "{err}"
+    );
+    let err = refused(&[
+        "fm",
+        "--probe",
+        PROBE,
+        "--amplitude",
+        "5e-324",
+        "--files",
+        "none",
+    ]);
+    assert!(err.contains("amplitude = 5e-324 m: below 1 pm"), "{err}");
+    let err = refused(&[
+        "fm",
+        "--probe",
+        PROBE,
+        "--amplitude",
+        "-10nm",
+        "--files",
+        "none",
+    ]);
+    assert!(
+        err.contains("amplitude") && err.contains("must be > 0"),
+        "{err}"
+    );
+}
+
+/// Issue 60: the summary's numbers have at most 6 significant digits in their unit (a model
+/// run printed `2e0 g0`, `0e0 Ω`).
+#[test]
+fn the_model_summary_prints_plain_numbers() {
+    let out = succeeded(&["fm", "--points", "12", "--files", "none"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.starts_with("12 z_c values from 2 g0 to 1 g0: Δf from "),
+        "{text}"
+    );
+    assert!(!text.contains("e0 "), "{text}");
+}

@@ -38,21 +38,24 @@ fn the_blend_example_images_at_a_setpoint() {
         String::from_utf8_lossy(&out.stderr)
     );
     let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    let img = &doc["image"];
-    assert_eq!(img["height"].as_array().unwrap().len(), 16);
-    for j in 0..16 {
-        for i in 0..16 {
-            let h = img["height"][j][i].as_f64().unwrap();
-            match img["domain"][j][i].as_str().unwrap() {
-                "terrace" => assert!((h - 5e-9).abs() < 1e-18, "{h}"),
-                "background" => assert_eq!(h, 0.0),
-                "rubber" => {
-                    let z = img["z_c"][j][i].as_f64().unwrap();
-                    let r = doc["reference_z_c"].as_f64().unwrap();
-                    assert!((h - (z - r)).abs() < 1e-18);
-                }
-                other => panic!("{other}"),
-            }
+    // the document summarises the maps; the maps are image.nc's
+    let path = dir.path().join("image.nc");
+    summarises(&doc["image"], &path);
+    assert_eq!(doc["image"]["pixels"], 16);
+    assert_eq!(doc["image"]["lines"], 16);
+    let mut nc = netcdf3::FileReader::open(&path).unwrap();
+    let height = nc.read_var_f64("height").unwrap();
+    let z_c = nc.read_var_f64("z_c").unwrap();
+    let domain = words(&path, "domain");
+    assert_eq!(height.len(), 16 * 16);
+    let r = doc["reference_z_c"].as_f64().unwrap();
+    for k in 0..16 * 16 {
+        let h = height[k];
+        match domain[k].as_str() {
+            "terrace" => assert!((h - 5e-9).abs() < 1e-18, "{h}"),
+            "background" => assert_eq!(h, 0.0),
+            "rubber" => assert!((h - (z_c[k] - r)).abs() < 1e-18),
+            other => panic!("{other}"),
         }
     }
     for f in [
@@ -166,29 +169,99 @@ fn bad_input_exits_2_naming_the_field() {
     );
 }
 
-/// A `[line][pixel]` grid of the JSON document as row-major values, null as NaN.
-fn flat(grid: &serde_json::Value) -> Vec<f64> {
-    grid.as_array()
+/// The words of the code map `name` of the dataset `path`: each pixel's code as its CF flag
+/// meaning (the codes 0, 1, …).
+fn words(path: &std::path::Path, name: &str) -> Vec<String> {
+    let (ds, _) = netcdf3::FileReader::open(path).unwrap().close();
+    let v = ds.get_var(name).unwrap();
+    let meanings: Vec<String> = v
+        .get_attr_as_string("flag_meanings")
+        .unwrap()
+        .split(' ')
+        .map(str::to_string)
+        .collect();
+    let codes = v.get_attr_i32("flag_values").unwrap().to_vec();
+    assert_eq!(codes, (0..codes.len() as i32).collect::<Vec<_>>(), "{name}");
+    let mut nc = netcdf3::FileReader::open(path).unwrap();
+    nc.read_var_i32(name)
         .unwrap()
         .iter()
-        .flat_map(|row| row.as_array().unwrap().iter())
-        .map(|v| v.as_f64().unwrap_or(f64::NAN))
+        .map(|&c| meanings[c as usize].clone())
         .collect()
 }
 
-/// Equal as values, NaN equal to NaN (a pixel where the setpoint is not reached).
-fn same(a: &[f64], b: &[f64]) -> bool {
-    a.len() == b.len()
-        && a.iter()
-            .zip(b)
-            .all(|(x, y)| x == y || (x.is_nan() && y.is_nan()))
+/// The document's `image` block summarises every map of the dataset `path` over (y, x): a
+/// float map's units, min, max and mean over its finite values and their number, computed
+/// here from the file; a code map's pixels per meaning; the first and last x and y.
+fn summarises(img: &serde_json::Value, path: &std::path::Path) {
+    let (ds, _) = netcdf3::FileReader::open(path).unwrap().close();
+    let mut nc = netcdf3::FileReader::open(path).unwrap();
+    let maps = img["maps"].as_object().unwrap();
+    let mut seen = 0;
+    for var in ds.get_vars() {
+        if var.dim_names() != vec!["y", "x"] {
+            continue;
+        }
+        let name = var.name();
+        let m = &maps[name];
+        seen += 1;
+        if var.get_attr("flag_meanings").is_some() {
+            let mut counts = std::collections::BTreeMap::<String, u64>::new();
+            for w in words(path, name) {
+                *counts.entry(w).or_default() += 1;
+            }
+            let got: std::collections::BTreeMap<String, u64> =
+                serde_json::from_value(m["counts"].clone()).unwrap();
+            assert_eq!(got, counts, "{name}");
+            continue;
+        }
+        if let Ok(flags) = nc.read_var_i8(name) {
+            let set = flags.iter().filter(|&&b| b != 0).count();
+            assert_eq!(m["counts"]["true"], set, "{name}");
+            assert_eq!(m["counts"]["false"], flags.len() - set, "{name}");
+            continue;
+        }
+        let values: Vec<f64> = nc
+            .read_var_f64(name)
+            .unwrap()
+            .into_iter()
+            .filter(|v| v.is_finite())
+            .collect();
+        assert_eq!(
+            m["units"].as_str(),
+            var.get_attr_as_string("units").as_deref(),
+            "{name}"
+        );
+        assert_eq!(m["finite"], values.len(), "{name}");
+        if values.is_empty() {
+            assert!(m["min"].is_null() && m["max"].is_null() && m["mean"].is_null());
+            continue;
+        }
+        let min = values.iter().copied().fold(f64::INFINITY, f64::min);
+        let max = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let mean = values.iter().sum::<f64>() / values.len() as f64;
+        assert_eq!(m["min"].as_f64(), Some(min), "{name}");
+        assert_eq!(m["max"].as_f64(), Some(max), "{name}");
+        let got = m["mean"].as_f64().unwrap();
+        assert!(
+            (got - mean).abs() <= 1e-12 * mean.abs().max(1e-300),
+            "{name}: {got} {mean}"
+        );
+    }
+    assert_eq!(seen, maps.len(), "a summary for every map and no other");
+    let x = nc.read_var_f64("x").unwrap();
+    let y = nc.read_var_f64("y").unwrap();
+    assert_eq!(img["x"], serde_json::json!([x[0], x[x.len() - 1]]));
+    assert_eq!(img["y"], serde_json::json!([y[0], y[y.len() - 1]]));
+    assert_eq!(img["pixels"], x.len());
+    assert_eq!(img["lines"], y.len());
 }
 
-/// `image.nc` holds the document's maps: every numeric field of `image.json` over (y, x) with
-/// its units, and the regime, material and domain as codes whose CF flag meanings are the
-/// document's words.
+/// `image.nc` holds the maps (every numeric one over (y, x) with its units; the regime,
+/// material and domain as codes with CF flag meanings) and `image.json` their summary, not
+/// every pixel.
 #[test]
-fn image_nc_holds_the_documents_maps() {
+fn image_json_summarises_the_maps_of_image_nc() {
     let dir = tempfile::tempdir().unwrap();
     let out = afmdyn(&[
         "image",
@@ -214,15 +287,10 @@ fn image_nc_holds_the_documents_maps() {
         serde_json::from_slice(&std::fs::read(dir.path().join("image.json")).unwrap()).unwrap();
     let img = &doc["image"];
     let path = dir.path().join("image.nc");
-    // the header (dimensions, attributes) from one reader, the values from another
     let (ds, _) = netcdf3::FileReader::open(&path).unwrap().close();
     let mut nc = netcdf3::FileReader::open(&path).unwrap();
     assert_eq!(ds.dim_size("y"), Some(9));
     assert_eq!(ds.dim_size("x"), Some(12));
-    let xs: Vec<f64> = serde_json::from_value(img["x"].clone()).unwrap();
-    assert_eq!(nc.read_var_f64("x").unwrap(), xs);
-    let ys: Vec<f64> = serde_json::from_value(img["y"].clone()).unwrap();
-    assert_eq!(nc.read_var_f64("y").unwrap(), ys);
     for (name, units) in [
         ("height", "m"),
         ("true_height", "m"),
@@ -237,45 +305,38 @@ fn image_nc_holds_the_documents_maps() {
         let var = ds.get_var(name).unwrap();
         assert_eq!(var.dim_names(), vec!["y", "x"], "{name}");
         assert_eq!(var.get_attr_as_string("units").as_deref(), Some(units));
-        let values = nc.read_var_f64(name).unwrap();
-        assert!(same(&values, &flat(&img[name])), "{name}");
+        // no pixel grids in the document
+        assert!(
+            img["maps"][name]["min"].is_number() && img[name].is_null(),
+            "{name}"
+        );
     }
+    summarises(img, &path);
     // the apparent height: 0 on the background, the terrace's 5 nm, the rubber's z_c shift
     let height = nc.read_var_f64("height").unwrap();
     assert!(height.contains(&0.0) && height.iter().any(|h| (h - 5e-9).abs() < 1e-18));
-    // codes, their meanings the document's words
-    let meanings = |name: &str| -> Vec<String> {
-        let v = ds.get_var(name).unwrap();
-        let words = v.get_attr_as_string("flag_meanings").unwrap();
-        let codes = v.get_attr_i32("flag_values").unwrap().to_vec();
-        assert_eq!(codes, (0..codes.len() as i32).collect::<Vec<_>>(), "{name}");
-        words.split(' ').map(str::to_string).collect()
-    };
-    let words = |name: &str| -> Vec<String> {
-        img[name]
-            .as_array()
-            .unwrap()
+    let top = img["maps"]["height"]["max"].as_f64().unwrap();
+    assert!((top - 5e-9).abs() < 1e-18, "{top}");
+    let domains = words(&path, "domain");
+    assert!(domains.iter().any(|w| w == "rubber") && domains.iter().any(|w| w == "terrace"));
+    assert_eq!(
+        words(&path, "material")
             .iter()
-            .flat_map(|r| r.as_array().unwrap().iter())
-            .map(|v| v.as_str().unwrap_or("not_reached").to_string())
-            .collect()
-    };
-    for name in ["regime", "material", "domain"] {
-        let names = meanings(name);
-        let coded: Vec<String> = nc
-            .read_var_i32(name)
-            .unwrap()
-            .iter()
-            .map(|&c| names[c as usize].clone())
-            .collect();
-        assert_eq!(coded, words(name), "{name}");
-    }
-    assert_eq!(meanings("material"), ["background", "rubber"]);
-    assert_eq!(meanings("domain"), ["background", "rubber", "terrace"]);
+            .filter(|w| *w == "rubber")
+            .count(),
+        domains.iter().filter(|w| *w == "rubber").count()
+    );
     assert_eq!(nc.read_var_f64("setpoint").unwrap(), vec![0.7]);
     assert_eq!(
         nc.read_var_f64("reference_z_c").unwrap(),
         vec![doc["reference_z_c"].as_f64().unwrap()]
+    );
+    // the document's size stays small: a summary, not 108 pixels of 13 maps
+    assert!(
+        std::fs::metadata(dir.path().join("image.json"))
+            .unwrap()
+            .len()
+            < 20_000
     );
 }
 
@@ -411,10 +472,10 @@ fn the_pi_scan_writes_the_libraries_document_and_maps() {
         gains: Some((0.1, 2000.0)),
         time_constant: Some(20e-6),
     };
-    let lib = pi_image(&table, &map, &req, &scan, Some(1), &Progress::new())
-        .unwrap()
-        .document(0.5);
+    let lib = pi_image(&table, &map, &req, &scan, Some(1), &Progress::new()).unwrap();
+    let lib = afmdyn::request::present::image::pi_summary(&lib, 0.5);
     assert_eq!(doc, lib);
+    summarises(&doc["image"], &dir.path().join("out").join("image.nc"));
     assert_eq!(doc["feedback"], "pi");
     assert_eq!(doc["scan"]["proportional_gain"], 0.1);
     for f in [
@@ -503,4 +564,114 @@ fn a_killed_pi_scan_resumes_to_the_uninterrupted_files() {
     assert_eq!(other.status.code(), Some(2));
     let err = String::from_utf8_lossy(&other.stderr);
     assert!(err.contains("gains") && err.contains("3000"), "{err}");
+}
+
+/// The refusal of `args`: exit 2, one line on stderr, nothing written to `dir`.
+fn refused(args: &[&str], dir: &std::path::Path) -> String {
+    let out = afmdyn(args);
+    let err = String::from_utf8_lossy(&out.stderr).to_string();
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(!dir.exists(), "{err}: {} was created", dir.display());
+    err
+}
+
+/// Issue 60: `image` goes through the door — held to the budgets before its directory is
+/// made (2048 × 2048 pixels refused naming the image's budget), its threads refused as
+/// every command's (0, 1025), a default scan rate's K_I blamed as gains.
+#[test]
+fn image_is_refused_before_its_directory() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let o = out.to_str().unwrap();
+    let base = [
+        "image",
+        "--probe",
+        "examples/probe-point-mass-dmt.toml",
+        "--sample",
+        "examples/sample-blend.toml",
+        "--setpoint",
+        "0.7",
+        "--out",
+        o,
+    ];
+    let with = |extra: &[&str]| -> Vec<String> {
+        base.iter().chain(extra).map(|s| s.to_string()).collect()
+    };
+    let run = |extra: &[&str]| {
+        let args = with(extra);
+        refused(&args.iter().map(String::as_str).collect::<Vec<_>>(), &out)
+    };
+    let err = run(&["--pixels", "2048"]);
+    assert!(
+        err.contains("image: 2048 × 2048 pixels") && err.contains("exceeds the budget"),
+        "{err}"
+    );
+    for t in ["0", "1025"] {
+        let err = run(&["--feedback", "pi", "--threads", t]);
+        assert!(
+            err.contains(&format!("threads = {t}: must be in 1..=1024")),
+            "{err}"
+        );
+    }
+    let err = run(&["--feedback", "pi", "--gains", "0,1e12"]);
+    assert!(
+        err.contains("gains = K_I = 1e12") && !err.contains("scan_rate ="),
+        "{err}"
+    );
+}
+
+/// `image --files`: `data` writes the document and the dataset without figures, `none`
+/// writes nothing (no directory) and prints the summary; `--resume` needs a store.
+#[test]
+fn image_takes_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let args = |files: &'static str| {
+        vec![
+            "image".to_string(),
+            "--probe".into(),
+            "examples/probe-point-mass-dmt.toml".into(),
+            "--sample".into(),
+            "examples/sample-stripe.toml".into(),
+            "--setpoint".into(),
+            "0.8".into(),
+            "--pixels".into(),
+            "6".into(),
+            "--curve-points".into(),
+            "20".into(),
+            "--files".into(),
+            files.into(),
+            "--out".into(),
+            out.to_str().unwrap().into(),
+        ]
+    };
+    let run = |a: Vec<String>| afmdyn(&a.iter().map(String::as_str).collect::<Vec<_>>());
+    let o = run(args("none"));
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(!out.exists());
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        text.starts_with("ideal-feedback image, 6 × 1 pixels"),
+        "{text}"
+    );
+    assert!(!text.contains("outputs in"), "{text}");
+    let o = run(args("data"));
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let mut names: Vec<String> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+        .filter(|n| !n.starts_with('.'))
+        .collect();
+    names.sort();
+    assert_eq!(names, ["image.json", "image.nc"]);
+    let mut a = args("none");
+    a.extend(["--feedback".into(), "pi".into(), "--resume".into()]);
+    let o = run(a);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("--resume: --files none keeps no store"),
+        "{err}"
+    );
 }

@@ -302,3 +302,43 @@ fn an_uneven_grid_beyond_the_limit_is_refused_before_the_run() {
         "{err}"
     );
 }
+
+/// Issue 60 D: the calibration's refusals name the flag and the value briefly (a spring
+/// constant of 1e300 was written out in 301 digits; an amplitude of 1e300 was blamed on the
+/// distances; a negative one was taken for a flag).
+#[test]
+fn calibration_refusals_name_the_flag_briefly() {
+    let fm = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/fm-vdw.csv");
+    let refused = |k: &str, a: &str| {
+        let out = afmdyn(&[
+            "reconstruct",
+            "--fm",
+            fm,
+            "--spring-constant",
+            k,
+            "--resonance-frequency",
+            "300kHz",
+            "--amplitude",
+            a,
+            "--files",
+            "none",
+        ]);
+        let err = String::from_utf8_lossy(&out.stderr).to_string();
+        assert_eq!(out.status.code(), Some(2), "{err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+        assert!(err.len() < 300, "{err}");
+        err
+    };
+    let err = refused("1e300", "10nm");
+    assert!(
+        err.contains("--spring-constant = 1e300") && err.contains("1e300 mN/m"),
+        "{err}"
+    );
+    let err = refused("40", "1e300");
+    assert!(
+        err.contains("--amplitude = 1e300: must be ≤ 1e-5 m"),
+        "{err}"
+    );
+    let err = refused("40", "-10nm");
+    assert!(err.contains("--amplitude = -1e-8: must be > 0"), "{err}");
+}

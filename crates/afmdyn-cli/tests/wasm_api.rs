@@ -334,28 +334,52 @@ fn image_is_the_command_lines_document() {
         "examples/sample-stripe.toml",
     );
     let input = |request: Value| json!({"probe": example(probe), "sample": example(sample), "request": request});
-    assert_eq!(
-        wasm(
-            "image",
-            input(json!({"setpoint": 0.7, "pixels": 16, "setpoint_study": "0.3:0.9:4"}))
-        ),
-        cli_json(&[
-            "image",
-            "--probe",
-            probe,
-            "--sample",
-            sample,
-            "--setpoint",
-            "0.7",
-            "--pixels",
-            "16",
-            "--setpoint-study",
-            "0.3:0.9:4",
-            "--out",
-            dir.path().to_str().unwrap(),
-            "--json"
-        ])
+    // the browser's document holds every pixel (the explorer draws them); the command line's
+    // their summary (the maps are image.nc's): the same image, materials and study
+    let web = wasm(
+        "image",
+        input(json!({"setpoint": 0.7, "pixels": 16, "setpoint_study": "0.3:0.9:4"})),
     );
+    let cli = cli_json(&[
+        "image",
+        "--probe",
+        probe,
+        "--sample",
+        sample,
+        "--setpoint",
+        "0.7",
+        "--pixels",
+        "16",
+        "--setpoint-study",
+        "0.3:0.9:4",
+        "--out",
+        dir.path().to_str().unwrap(),
+        "--json",
+    ]);
+    for key in [
+        "feedback",
+        "setpoint",
+        "reference_z_c",
+        "materials",
+        "warnings",
+        "setpoint_study",
+    ] {
+        assert_eq!(web[key], cli[key], "{key}");
+    }
+    for name in ["height", "z_c", "phase_deg", "true_height"] {
+        let values: Vec<f64> = web["image"][name]
+            .as_array()
+            .unwrap()
+            .iter()
+            .flat_map(|row| row.as_array().unwrap().iter().filter_map(Value::as_f64))
+            .collect();
+        let m = &cli["image"]["maps"][name];
+        assert_eq!(m["finite"], values.len(), "{name}");
+        let max = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let min = values.iter().copied().fold(f64::INFINITY, f64::min);
+        assert_eq!(m["max"].as_f64(), Some(max), "{name}");
+        assert_eq!(m["min"].as_f64(), Some(min), "{name}");
+    }
     let refused = |input: Value, words: &[&str]| {
         let e = run_json("image", &input.to_string()).unwrap_err();
         assert!(words.iter().all(|w| e.contains(w)), "{e}");

@@ -237,7 +237,8 @@ impl SiRange {
             (_, Some((hi, w))) if v > hi => w,
             _ => return None,
         };
-        Some(words.replace("{x}", &x.to_string()))
+        // the value as the refusal names it: at most 6 significant digits (1e300, not 301 digits)
+        Some(words.replace("{x}", &crate::error::number(x)))
     }
 
     /// The warning's words for `x` outside the typical range (`outside the typical …: …`):
@@ -309,5 +310,15 @@ mod tests {
         assert!(warning("sample", "surface_tension", 0.9).is_some());
         assert!(warning("sample", "hamaker", 0.0).is_none());
         assert!(refusal("sample", "z_c", -2e-4).is_some());
+    }
+
+    /// Issue 60: a refusal names the value with at most 6 significant digits (1e300 was
+    /// written out in 301 digits).
+    #[test]
+    fn a_refusal_names_the_value_briefly() {
+        let why = refusal("cantilever", "spring_constant", 1e300).unwrap();
+        assert!(why.contains(": 1e300 mN/m is 1e300e-3"), "{why}");
+        let why = refusal("cantilever", "spring_constant", 1.234567891e10).unwrap();
+        assert!(why.contains(": 12345700000 mN/m"), "{why}");
     }
 }

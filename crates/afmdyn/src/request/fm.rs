@@ -148,15 +148,23 @@ impl FmRequest {
         range.check_finite()?;
         if let Some(a) = self.amplitude {
             crate::error::finite("amplitude", a)?;
-            if length != 1.0 {
-                super::limits::si_distance("amplitude", a)?;
-            }
             if a <= 0.0 {
                 return Err(SimError::out_of_range(
                     "amplitude",
                     a,
                     "must be > 0: the oscillation amplitude the controller holds",
                 ));
+            }
+            if length != 1.0 {
+                // an amplitude's range is the probe's amplitude's ([`crate::probe::ranges`]),
+                // not a rest distance's
+                if let Some(why) = crate::probe::ranges::refusal("drive", "free_amplitude", a) {
+                    return Err(SimError::out_of_range(
+                        "amplitude",
+                        format!("{} m", crate::error::number(a)),
+                        why,
+                    ));
+                }
             }
             // the model's lengths are in units of its A₀ (g₀): an amplitude 1e8 times smaller
             // or 1e4 times larger leaves nothing of the other length scales

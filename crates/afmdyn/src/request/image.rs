@@ -327,6 +327,45 @@ fn approach_curve(
     approach_retract(&spec)
 }
 
+/// The background probe of an image under the probe file's table `probe_table`.
+///
+/// # Errors
+/// [`SimError::Probe`] for a table the probe format refuses; [`SimError::OutOfRange`] naming
+/// `probe` for a multifrequency drive (an image is recorded with one drive frequency).
+pub(crate) fn background_probe(probe_table: &toml::Table) -> Result<Probe, SimError> {
+    let background =
+        Probe::from_table(probe_table, "probe").map_err(|e| SimError::Probe(e.to_string()))?;
+    if background.components.len() > 1 {
+        return Err(SimError::out_of_range(
+            "probe",
+            "a multifrequency drive",
+            "an image is recorded with one drive frequency",
+        ));
+    }
+    Ok(background)
+}
+
+/// What the materials' approach curves of `map` under `background` cost, with `extra` (the
+/// pixels' memory, a scan's drive periods, × the modes) added: the cost [`material_curves`]
+/// holds against the budgets before the first curve.
+///
+/// # Errors
+/// As the approach curves' cost ([`image_curves_cost`]).
+pub(crate) fn curves_cost(
+    background: &Probe,
+    map: &SampleMap,
+    curve_points: usize,
+    extra: Cost,
+) -> Result<Cost, SimError> {
+    let units = CurveUnits::from_scales(&background.scales, false);
+    let materials = 1 + map.domains.iter().filter(|d| d.sample.is_some()).count();
+    let curves = image_curves_cost(background.params, units.length, curve_points, materials)?;
+    Ok(Cost {
+        bytes: MODEL_BYTES + curves.bytes + extra.bytes,
+        work: curves.work + extra.work * background.params.modes as f64,
+    })
+}
+
 /// The materials of `map` under the probe `probe_table`: the background, then one per domain
 /// with its own sample, each with its approach curve; the material of each domain; the SI
 /// units.
@@ -340,25 +379,9 @@ pub(crate) fn material_curves(
     curve_points: usize,
     extra: Cost,
 ) -> Result<(Vec<MaterialCurve>, Vec<usize>, CurveUnits), SimError> {
-    let background =
-        Probe::from_table(probe_table, "probe").map_err(|e| SimError::Probe(e.to_string()))?;
-    if background.components.len() > 1 {
-        return Err(SimError::out_of_range(
-            "probe",
-            "a multifrequency drive",
-            "an image is recorded with one drive frequency",
-        ));
-    }
+    let background = background_probe(probe_table)?;
     let units = CurveUnits::from_scales(&background.scales, false);
-    let materials = 1 + map.domains.iter().filter(|d| d.sample.is_some()).count();
-    let curves = image_curves_cost(background.params, units.length, curve_points, materials)?;
-    check_cost(
-        "image",
-        Cost {
-            bytes: MODEL_BYTES + curves.bytes + extra.bytes,
-            work: curves.work + extra.work * background.params.modes as f64,
-        },
-    )?;
+    check_cost("image", curves_cost(&background, map, curve_points, extra)?)?;
     let mut materials = vec![MaterialCurve {
         name: "background".into(),
         params: background.params,

@@ -327,3 +327,79 @@ pub fn scan_layout(img: &PiImage, setpoint: f64) -> Layout {
         variables,
     )
 }
+
+/// The maps of an image's layout ([`layout`], [`scan_layout`]) summarised for its JSON document
+/// (the maps themselves are the dataset's, `image.nc`): `pixels` and `lines`, `x` and `y` (m,
+/// the first and last pixel centre and line position), and under `maps` every variable over
+/// (y, x): a float map's `units`, `min`, `max` and `mean` over its finite values (null where it
+/// has none) and `finite` (their number); a flag or code map's count of pixels per meaning
+/// (`counts`).
+pub fn summary(layout: &Layout) -> serde_json::Value {
+    use serde_json::{json, Map, Value};
+    let num = |v: f64| if v.is_finite() { json!(v) } else { Value::Null };
+    let ends = |name: &str| -> Value {
+        let values = layout.variables.iter().find(|v| v.name == name);
+        match values.map(|v| &v.values) {
+            Some(Values::F64(c)) => json!([
+                num(c.first().copied().unwrap_or(f64::NAN)),
+                num(c.last().copied().unwrap_or(f64::NAN))
+            ]),
+            _ => Value::Null,
+        }
+    };
+    let length = |name: &str| {
+        layout
+            .dims
+            .iter()
+            .find(|(n, _)| n == name)
+            .map_or(0, |(_, l)| *l)
+    };
+    let mut maps = Map::new();
+    for v in layout.variables.iter().filter(|v| v.dims == ["y", "x"]) {
+        let entry = match &v.values {
+            Values::F64(values) => {
+                let finite: Vec<f64> = values.iter().copied().filter(|x| x.is_finite()).collect();
+                let n = finite.len();
+                let min = finite.iter().copied().fold(f64::INFINITY, f64::min);
+                let max = finite.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                let mean = finite.iter().sum::<f64>() / n as f64;
+                json!({"units": v.units, "min": num(min), "max": num(max), "mean": num(mean),
+                       "finite": n})
+            }
+            Values::I32(codes) => {
+                let meanings = v.attrs.iter().find_map(|(k, a)| match (k.as_str(), a) {
+                    ("flag_meanings", Attr::Text(t)) => Some(t.clone()),
+                    _ => None,
+                });
+                let words: Vec<String> = meanings
+                    .unwrap_or_default()
+                    .split_whitespace()
+                    .map(str::to_string)
+                    .collect();
+                let mut counts = Map::new();
+                for &c in codes {
+                    let word = usize::try_from(c)
+                        .ok()
+                        .and_then(|k| words.get(k).cloned())
+                        .unwrap_or_else(|| c.to_string());
+                    let n = counts.entry(word).or_insert(json!(0));
+                    *n = json!(n.as_u64().unwrap_or(0) + 1);
+                }
+                json!({"counts": counts})
+            }
+            Values::Bool(flags) => {
+                let set = flags.iter().filter(|&&b| b).count();
+                json!({"counts": {"true": set, "false": flags.len() - set}})
+            }
+            _ => continue,
+        };
+        maps.insert(v.name.clone(), entry);
+    }
+    json!({
+        "pixels": length("x"),
+        "lines": length("y"),
+        "x": ends("x"),
+        "y": ends("y"),
+        "maps": maps,
+    })
+}

@@ -176,6 +176,102 @@ fn positive(
     }
 }
 
+/// The settings of a PI scan of `req` over `map` under `probe` (the lever's defaults where
+/// `scan` leaves them out), the loop's gains in the model's units and the drive periods of the
+/// whole scan, checked before any work ([`ScanStudy::new`]'s, and the cost of
+/// [`super::image_job::ImageJob`]).
+///
+/// # Errors
+/// As [`ScanStudy::new`]'s settings.
+pub(crate) fn resolve(
+    probe: &Probe,
+    map: &SampleMap,
+    req: &ImageRequest,
+    scan: &PiScan,
+) -> Result<(ScanSettings, FeedbackGains, f64), SimError> {
+    let t_s = probe.scales.time_s;
+    let (q, f0) = (
+        probe.calibration.quality_factor,
+        probe.calibration.resonance_frequency,
+    );
+    let lever = FeedbackGains::for_lever(q, std::f64::consts::TAU * f0 * t_s);
+    let (kp, ki) = match scan.gains {
+        Some((p, i)) => (
+            positive("gains", p, true, "K_P must be a finite number ≥ 0")?,
+            positive("gains", i, false, "K_I must be a finite rate > 0 (1/s)")?,
+        ),
+        None => (lever.proportional, lever.integral / t_s),
+    };
+    let tc = match scan.time_constant {
+        Some(v) => positive("time_constant", v, true, "must be a finite time ≥ 0 (s)")?,
+        None => lever.time_constant * t_s,
+    };
+    let gains = FeedbackGains {
+        proportional: kp,
+        integral: ki * t_s,
+        time_constant: tc / t_s,
+    };
+    let f_drive = probe.drive_frequency;
+    let pixels = req.pixels;
+    let fastest = f_drive / (2.0 * pixels as f64);
+    let scan_rate = match scan.scan_rate {
+        Some(r) => positive(
+            "scan_rate",
+            r,
+            false,
+            "must be a finite rate > 0 (Hz, lines per second)",
+        )?,
+        None => ki / (2.0 * pixels as f64 * PIXEL_LOOP_TIMES),
+    };
+    if scan_rate > fastest && scan.scan_rate.is_none() {
+        // the rate was not given: it follows K_I, which is then what to change
+        return Err(SimError::out_of_range(
+            "gains",
+            format!(
+                "K_I = {ki:e} 1/s (at most {:.6e} here)",
+                fastest * 2.0 * pixels as f64 * PIXEL_LOOP_TIMES
+            ),
+            "sets the default scan rate (a pixel lasts 5 loop times 1/K_I) above the drive \
+                 frequency over 2 × pixels: give a smaller K_I, or scan_rate",
+        ));
+    }
+    if scan_rate > fastest {
+        return Err(SimError::out_of_range(
+            "scan_rate",
+            format!("{scan_rate:e} (the limit here: {fastest:.6e} Hz)"),
+            "must be at most the drive frequency over 2 × pixels: each pixel needs at least \
+                 one drive period",
+        ));
+    }
+    let periods_per_pixel = (f_drive / (2.0 * scan_rate * pixels as f64))
+        .round()
+        .max(1.0);
+    let period = probe.params.period();
+    let engage_periods = (ENGAGE_LOOP_TIMES / (gains.integral * period)).ceil();
+    let lines = req.lines(map) as f64;
+    let total = lines * (engage_periods + 2.0 * pixels as f64 * periods_per_pixel);
+    if total.is_nan() || total > MAX_SCAN_PERIODS as f64 {
+        return Err(SimError::out_of_range(
+            "scan_rate",
+            format!("{scan_rate:e} ({total:.3e} drive periods)"),
+            "must leave at most 1e9 drive periods in all (lines × (engage + 2 × pixels × \
+                 periods per pixel)): scan faster, or with fewer pixels or lines",
+        ));
+    }
+    let settings = ScanSettings {
+        scan_rate,
+        proportional_gain: kp,
+        integral_gain: ki,
+        time_constant: tc,
+        periods_per_pixel: periods_per_pixel as usize,
+        engage_periods: engage_periods as usize,
+        lock_in_samples: LOCK_IN_SAMPLES,
+        pixel_time: periods_per_pixel / f_drive,
+        amplitude_time: 2.0 * q / (std::f64::consts::TAU * f0),
+    };
+    Ok((settings, gains, total))
+}
+
 impl ScanStudy {
     /// The study of `req` and `scan` over `map` under the probe `probe_table` (SI in): the
     /// materials' approach curves, the ideal image, the settings.
@@ -194,75 +290,8 @@ impl ScanStudy {
         req.validate(map)?;
         let probe =
             Probe::from_table(probe_table, "probe").map_err(|e| SimError::Probe(e.to_string()))?;
-        let t_s = probe.scales.time_s;
-        let (q, f0) = (
-            probe.calibration.quality_factor,
-            probe.calibration.resonance_frequency,
-        );
-        let lever = FeedbackGains::for_lever(q, std::f64::consts::TAU * f0 * t_s);
-        let (kp, ki) = match scan.gains {
-            Some((p, i)) => (
-                positive("gains", p, true, "K_P must be a finite number ≥ 0")?,
-                positive("gains", i, false, "K_I must be a finite rate > 0 (1/s)")?,
-            ),
-            None => (lever.proportional, lever.integral / t_s),
-        };
-        let tc = match scan.time_constant {
-            Some(v) => positive("time_constant", v, true, "must be a finite time ≥ 0 (s)")?,
-            None => lever.time_constant * t_s,
-        };
-        let gains = FeedbackGains {
-            proportional: kp,
-            integral: ki * t_s,
-            time_constant: tc / t_s,
-        };
-        let f_drive = probe.drive_frequency;
+        let (settings, gains, total) = resolve(&probe, map, req, scan)?;
         let pixels = req.pixels;
-        let fastest = f_drive / (2.0 * pixels as f64);
-        let scan_rate = match scan.scan_rate {
-            Some(r) => positive(
-                "scan_rate",
-                r,
-                false,
-                "must be a finite rate > 0 (Hz, lines per second)",
-            )?,
-            None => ki / (2.0 * pixels as f64 * PIXEL_LOOP_TIMES),
-        };
-        if scan_rate > fastest && scan.scan_rate.is_none() {
-            // the rate was not given: it follows K_I, which is then what to change
-            return Err(SimError::out_of_range(
-                "gains",
-                format!(
-                    "K_I = {ki:e} 1/s (at most {:.6e} here)",
-                    fastest * 2.0 * pixels as f64 * PIXEL_LOOP_TIMES
-                ),
-                "sets the default scan rate (a pixel lasts 5 loop times 1/K_I) above the drive \
-                 frequency over 2 × pixels: give a smaller K_I, or scan_rate",
-            ));
-        }
-        if scan_rate > fastest {
-            return Err(SimError::out_of_range(
-                "scan_rate",
-                format!("{scan_rate:e} (the limit here: {fastest:.6e} Hz)"),
-                "must be at most the drive frequency over 2 × pixels: each pixel needs at least \
-                 one drive period",
-            ));
-        }
-        let periods_per_pixel = (f_drive / (2.0 * scan_rate * pixels as f64))
-            .round()
-            .max(1.0);
-        let period = probe.params.period();
-        let engage_periods = (ENGAGE_LOOP_TIMES / (gains.integral * period)).ceil();
-        let lines = req.lines(map) as f64;
-        let total = lines * (engage_periods + 2.0 * pixels as f64 * periods_per_pixel);
-        if total.is_nan() || total > MAX_SCAN_PERIODS as f64 {
-            return Err(SimError::out_of_range(
-                "scan_rate",
-                format!("{scan_rate:e} ({total:.3e} drive periods)"),
-                "must leave at most 1e9 drive periods in all (lines × (engage + 2 × pixels × \
-                 periods per pixel)): scan faster, or with fewer pixels or lines",
-            ));
-        }
         // the lines' drive periods (× modes) and the pixels' memory, with the curves' cost
         let extra = crate::request::limits::Cost {
             bytes: req.pixel_bytes(map),
@@ -292,17 +321,6 @@ impl ScanStudy {
                     (lo.min(z), hi.max(z))
                 })
             });
-        let settings = ScanSettings {
-            scan_rate,
-            proportional_gain: kp,
-            integral_gain: ki,
-            time_constant: tc,
-            periods_per_pixel: periods_per_pixel as usize,
-            engage_periods: engage_periods as usize,
-            lock_in_samples: LOCK_IN_SAMPLES,
-            pixel_time: periods_per_pixel / f_drive,
-            amplitude_time: 2.0 * q / (std::f64::consts::TAU * f0),
-        };
         let free_amplitude = probe.free_amplitude / units.length;
         let spec = LineSpec {
             materials: curves.iter().map(|m| m.params).collect(),

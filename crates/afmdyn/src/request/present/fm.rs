@@ -24,7 +24,7 @@ pub fn fm(document: &mut Value, text: TextUnits, files: Files, dir: Option<&Path
         if si {
             text.value(v, si_unit)
         } else {
-            format!("{v:e} {model_unit}")
+            format!("{} {model_unit}", crate::error::number(v))
         }
     };
     let at = |r: Option<&Vec<f64>>, k: usize| r.map_or(f64::NAN, |r| r[k]);

@@ -2,12 +2,13 @@
 //! draws them (height, phase, E_dis; the error image of a PI scan), the first line's profile,
 //! the setpoint study's plots and the text summary, for the ideal feedback and the PI scan.
 
+use crate::error::number;
 use crate::layout::figure::{AfmImage, Figure, Plot, Series, Style};
 use crate::report::{Presentation, TextUnits};
 use crate::request::image::{DomainContrast, Image, OperatingPoint, SetpointStudy};
-use crate::request::image_layout::{layout, scan_layout};
+use crate::request::image_layout::{layout, scan_layout, summary};
 use crate::request::image_scan::PiImage;
-use serde_json::Value;
+use serde_json::{json, Value};
 
 /// A profile's series: its label, style and value at pixel i of the first line.
 type ProfileSeries<'a> = (&'a str, Style, &'a dyn Fn(usize) -> f64);
@@ -132,8 +133,49 @@ pub fn ideal_document(img: &Image, setpoint: f64, study: Option<&SetpointStudy>)
     json
 }
 
+/// The summary document of an ideal-feedback image at `setpoint` (`afmdyn image --json`,
+/// `image.json`; the maps are `image.nc`'s): `image`, its maps summarised
+/// ([`crate::request::image_layout::summary`]: per map `min`, `max`, `mean`; per code map the
+/// pixels of each meaning); `feedback`, `setpoint`, `reference_z_c` (m), `materials` with their
+/// operating points, `warnings`, and the setpoint study (`"setpoint_study"`) when one was
+/// asked for. [`ideal_document`] is the document with every pixel.
+pub fn ideal_summary(img: &Image, setpoint: f64, study: Option<&SetpointStudy>) -> Value {
+    let num = |v: f64| if v.is_finite() { json!(v) } else { Value::Null };
+    let mut json = json!({
+        "image": summary(&layout(img, setpoint)),
+        "feedback": "ideal",
+        "setpoint": setpoint,
+        "reference_z_c": num(img.reference),
+        "materials": img.materials,
+        "warnings": img.warnings,
+    });
+    if let Some(s) = study {
+        json["setpoint_study"] = serde_json::to_value(s).expect("a study serialises");
+    }
+    json
+}
+
+/// The summary document of a PI-scanned image at `setpoint` (`afmdyn image --feedback pi
+/// --json`, `image.json`; the maps are `image.nc`'s): `image`, the maps of trace, retrace and
+/// ideal image summarised ([`crate::request::image_layout::summary`]); `feedback`, `scan` (the
+/// settings), `artefacts` of `trace` and `retrace`, `setpoint`, `reference_z_c` (m),
+/// `materials`, `warnings`. [`PiImage::document`] is the document with every pixel.
+pub fn pi_summary(img: &PiImage, setpoint: f64) -> Value {
+    let num = |v: f64| if v.is_finite() { json!(v) } else { Value::Null };
+    json!({
+        "image": summary(&scan_layout(img, setpoint)),
+        "feedback": "pi",
+        "scan": img.settings,
+        "artefacts": {"trace": img.artefacts[0], "retrace": img.artefacts[1]},
+        "setpoint": setpoint,
+        "reference_z_c": num(img.ideal.reference),
+        "materials": img.ideal.materials,
+        "warnings": img.warnings,
+    })
+}
+
 /// An ideal-feedback image at `setpoint` (and its setpoint study): the study's plots,
-/// `image.json` (`document`, [`ideal_document`]), `image.nc`, the maps `image-height`,
+/// `image.json` (`document`: [`ideal_summary`], or [`ideal_document`]), `image.nc`, the maps `image-height`,
 /// `image-phase`, `image-dissipation`, the profile `image-profile`, and the summary: every
 /// material's operating point where it is first met, the study's table.
 pub fn ideal(
@@ -177,7 +219,7 @@ pub fn ideal(
         "ideal-feedback image, {} × {} pixels, setpoint A/A0 = {}; z_c,ref = {} on the background",
         img.x.len(),
         img.y.len(),
-        setpoint,
+        number(setpoint),
         u.value(img.reference, "m")
     ));
     let names = std::iter::once((None, "background")).chain(
@@ -233,7 +275,8 @@ pub fn ideal(
     s
 }
 
-/// A PI-scanned image at `setpoint`: `image.json` (`document`, [`PiImage::document`]),
+/// A PI-scanned image at `setpoint`: `image.json` (`document`: [`pi_summary`], or
+/// [`PiImage::document`]),
 /// `image.nc`, the trace's maps (recorded height, error image, phase, E_dis), the first line's
 /// profile (trace, retrace, ideal and true height), and the summary: the settings and each
 /// direction's artefacts.
@@ -291,9 +334,9 @@ pub fn pi(img: &PiImage, setpoint: f64, document: &Value, u: TextUnits) -> Prese
          lock-in time constant {}; {} drive periods per pixel ({}), {} to engage each line",
         grid.x.len(),
         grid.y.len(),
-        setpoint,
+        number(setpoint),
         u.value(st.scan_rate, "Hz"),
-        st.proportional_gain,
+        number(st.proportional_gain),
         u.value(st.integral_gain, "1/s"),
         u.value(st.time_constant, "s"),
         st.periods_per_pixel,

@@ -1,0 +1,189 @@
+//! `image` as an [`Analysis`] ([`ImageJob`]): the probe file's table, the sample map, the
+//! request, the feedback (ideal, or a PI scan with its settings) and the setpoint study, held
+//! against the budgets before any work ([`Analysis::cost`]: the materials' approach curves, the
+//! pixels' memory and a scan's drive periods), run ([`super::image::image`],
+//! [`crate::study::scan::pi_image`], [`super::image::setpoint_study`]) and presented
+//! ([`super::present::image`]). A front end that runs the PI scan resumably into a store of
+//! its own takes the study from [`ImageJob::scan_study`] after [`super::run::admit`], and the
+//! document and presentation of the image it assembles from [`Analysis::report`] and
+//! [`Analysis::present`].
+
+use super::image::{
+    background_probe, curves_cost, image, setpoint_study, Image, ImageRequest, SampleMap,
+    SetpointStudy,
+};
+use super::image_scan::{resolve, PiImage, PiScan, ScanStudy};
+use super::limits::{check_threads, Cost};
+use super::present::Files;
+use super::run::{Analysis, Resolved};
+use crate::analysis::progress::Progress;
+use crate::error::SimError;
+use crate::report::{OutputFile, Presentation, TextUnits};
+use serde_json::Value;
+
+/// An image request with its inputs ([module docs](self)).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ImageJob {
+    /// The probe file's table (SI): the lever, tip, drive and the background sample.
+    pub probe: toml::Table,
+    /// The sample map.
+    pub sample: SampleMap,
+    /// The image request.
+    pub request: ImageRequest,
+    /// `None`: the ideal feedback; else a PI scan with these settings.
+    pub feedback: Option<PiScan>,
+    /// The setpoint study's ratios (the ideal feedback only).
+    pub study: Option<Vec<f64>>,
+    /// A PI scan's worker threads (`None`: all cores).
+    pub threads: Option<usize>,
+    /// Which files its presentation holds.
+    pub files: Files,
+}
+
+/// An [`ImageJob`]'s result.
+// one value a run, its bulk on the heap: the variants' sizes do not matter
+#[allow(clippy::large_enum_variant)]
+#[derive(Debug, Clone, PartialEq)]
+pub enum ImageOutput {
+    /// An ideal-feedback image and its setpoint study.
+    Ideal {
+        /// The image.
+        image: Image,
+        /// The setpoint study, when one was asked for.
+        study: Option<SetpointStudy>,
+    },
+    /// A PI-scanned image.
+    Pi(PiImage),
+}
+
+impl ImageJob {
+    /// The model the job runs on: the background probe's parameters, without the SI block
+    /// (the image's documents are in SI already).
+    ///
+    /// # Errors
+    /// As [`background_probe`]: a probe the format refuses, a multifrequency drive.
+    pub fn model(&self) -> Result<Resolved, SimError> {
+        Ok(Resolved::plain(background_probe(&self.probe)?.params))
+    }
+
+    /// The PI scan's study (its materials' approach curves computed), for a front end that
+    /// runs it into a store of its own; `None` for the ideal feedback.
+    ///
+    /// # Errors
+    /// As [`ScanStudy::new`].
+    pub fn scan_study(&self) -> Result<Option<ScanStudy>, SimError> {
+        self.feedback
+            .as_ref()
+            .map(|scan| ScanStudy::new(&self.probe, &self.sample, &self.request, scan))
+            .transpose()
+    }
+}
+
+impl Analysis for ImageJob {
+    type Output = ImageOutput;
+
+    fn validate(&self, _model: &Resolved) -> Result<(), SimError> {
+        self.request.validate(&self.sample)?;
+        check_threads(self.threads)?;
+        let background = background_probe(&self.probe)?;
+        match (&self.feedback, &self.study) {
+            (Some(_), Some(_)) => Err(SimError::out_of_range(
+                "setpoint_study",
+                "a study with the PI feedback",
+                "only with the ideal feedback (a study of exact operating points)",
+            )),
+            (Some(scan), None) => {
+                resolve(&background, &self.sample, &self.request, scan).map(|_| ())
+            }
+            (None, _) => Ok(()),
+        }
+    }
+
+    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<ImageOutput, SimError> {
+        self.validate(model)?;
+        match &self.feedback {
+            Some(scan) => crate::study::scan::pi_image(
+                &self.probe,
+                &self.sample,
+                &self.request,
+                scan,
+                self.threads,
+                progress,
+            )
+            .map(ImageOutput::Pi),
+            None => {
+                let image = image(&self.probe, &self.sample, &self.request)?;
+                let study = match &self.study {
+                    Some(r) => Some(setpoint_study(
+                        &self.probe,
+                        &self.sample,
+                        r,
+                        self.request.curve_points,
+                    )?),
+                    None => None,
+                };
+                Ok(ImageOutput::Ideal { image, study })
+            }
+        }
+    }
+
+    fn report(&self, _model: &Resolved, output: &ImageOutput) -> Result<Value, SimError> {
+        let setpoint = self.request.setpoint;
+        Ok(match output {
+            ImageOutput::Ideal { image, study } => {
+                super::present::image::ideal_summary(image, setpoint, study.as_ref())
+            }
+            ImageOutput::Pi(img) => super::present::image::pi_summary(img, setpoint),
+        })
+    }
+
+    fn name(&self) -> &'static str {
+        "image"
+    }
+
+    fn cost(&self, _model: &Resolved) -> Result<Cost, SimError> {
+        let background = background_probe(&self.probe)?;
+        let (map, req) = (&self.sample, &self.request);
+        let periods = match &self.feedback {
+            Some(scan) => resolve(&background, map, req, scan)?.2,
+            None => 0.0,
+        };
+        let extra = Cost {
+            bytes: req.pixel_bytes(map),
+            work: periods,
+        };
+        let mut cost = curves_cost(&background, map, req.curve_points, extra)?;
+        if self.study.is_some() {
+            // the study computes the materials' curves once more
+            let none = Cost {
+                bytes: 0.0,
+                work: 0.0,
+            };
+            cost.work += curves_cost(&background, map, req.curve_points, none)?.work;
+        }
+        Ok(cost)
+    }
+
+    fn present(
+        &self,
+        _model: &Resolved,
+        output: &ImageOutput,
+        document: &Value,
+        units: TextUnits,
+    ) -> Result<Presentation, SimError> {
+        let setpoint = self.request.setpoint;
+        let mut shown = match output {
+            ImageOutput::Ideal { image, study } => {
+                super::present::image::ideal(image, setpoint, study.as_ref(), document, units)
+            }
+            ImageOutput::Pi(img) => super::present::image::pi(img, setpoint, document, units),
+        };
+        // `--files data`: no figures; `none`: only the summary
+        shown.files.retain(|f| match self.files {
+            Files::All => true,
+            Files::Data => !matches!(f, OutputFile::Figure { .. }),
+            Files::None => false,
+        });
+        Ok(shown)
+    }
+}
