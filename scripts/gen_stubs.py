@@ -44,6 +44,7 @@ RUN = [
     ("basins", "basins"),
     ("fm", "fm"),
     ("reconstruct", "reconstruct"),
+    ("peakforce", "peakforce"),
 ]
 #: the studies run into a store through ``_afmdyn.run_stored`` (the library's
 #: ``study::stored::parse``) and their schema files

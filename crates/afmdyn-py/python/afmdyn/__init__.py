@@ -48,6 +48,7 @@ from ._interrupt import cancel_running
 from ._interrupt import install as _install_sigint
 from ._orbits import lyapunov, orbit
 from ._fm import fm
+from ._peakforce import peakforce
 from ._image import image, setpoint_study
 from ._reconstruct import reconstruct
 from ._results import Lyapunov, Orbit, RegionSpectrum, Spectrum
@@ -93,6 +94,7 @@ __all__ = [
     "image",
     "setpoint_study",
     "fm",
+    "peakforce",
     "resonance",
     "simulate",
     "summary",

@@ -391,6 +391,17 @@ ReconstructRequest = TypedDict(
     total=False,
 )
 
+PeakForceRequest = TypedDict(
+    "PeakForceRequest",
+    {
+        "fit_band": List[float],  # default [0.3, 0.9]
+        "samples": int,  # default 4096
+        "setpoint": Optional[float],  # default null
+        "z_c": Optional[float],  # default null
+    },
+    total=False,
+)
+
 BifurcationRequest = TypedDict(
     "BifurcationRequest",
     {
@@ -571,6 +582,15 @@ def run(
 def run(
     name: Literal["reconstruct"],
     request: Optional[ReconstructRequest] = None,
+    params: Optional[Params] = None,
+    probe: Optional[str] = None,
+    progress: Optional[ProgressCallback] = None,
+) -> Dict[str, Any]: ...
+
+@overload
+def run(
+    name: Literal["peakforce"],
+    request: Optional[PeakForceRequest] = None,
     params: Optional[Params] = None,
     probe: Optional[str] = None,
     progress: Optional[ProgressCallback] = None,

@@ -1,0 +1,65 @@
+"""Off-resonance (PeakForce) tapping (``afmdyn peakforce``): the library's steady tap of the
+modulation period as an ``xarray.Dataset`` built from its layouts (no numerics here)."""
+
+from __future__ import annotations
+
+import json
+from typing import TYPE_CHECKING, List, Optional
+
+import xarray as xr
+
+from ._afmdyn import Params
+from ._common import Model, _door, _params, _request
+from ._layout import dataset
+from ._progress import ProgressArg
+
+if TYPE_CHECKING:  # annotations only (PEP 692)
+    from typing_extensions import Unpack
+
+
+def peakforce(
+    params: Optional[Params] = None,
+    /,
+    *,
+    z_c: Optional[float] = None,
+    setpoint: Optional[float] = None,
+    samples: int = 4096,
+    fit_band: Optional[List[float]] = None,
+    progress: ProgressArg = None,
+    **model: Unpack[Model],
+) -> xr.Dataset:
+    """The steady tap of off-resonance tapping (``afmdyn peakforce``; the probe's ``[drive]
+    mode = "off-resonance"``): the periodic orbit of the modulation period found by shooting,
+    with its Floquet multipliers, the instrument's channels and the PF-QNM DMT fit.
+
+    Args:
+        z_c: the mean rest separation (m with ``probe``, else g₀); excludes ``setpoint``.
+        setpoint: the peak force the ideal feedback holds (N with ``probe``): z_c is found.
+        samples: points of the cycle, 2000..=1000000.
+        fit_band: the DMT fit's band, fractions [lo, hi] of the retract's force range
+            (default [0.3, 0.9]).
+        probe: a probe file (a model keyword, as ``--probe``): SI inputs and outputs.
+
+    Returns:
+        An ``xarray.Dataset`` of one cycle over ``sample`` (time, deflection, distance, force)
+        and the force–distance curve, in SI with a probe; attributes: the channels
+        (``peak_force``, ``adhesion``, ``deformation``, ``dissipation``, ``contact_time``,
+        ``snap_off_time``, ``ringing_amplitude``, ``modulus_dmt``, ``taps_per_cycle``) and
+        ``summary`` (the ``afmdyn peakforce --json`` document). Warnings (period-2 tapping,
+        double taps, an unstable tap) are raised as :class:`afmdyn.AfmdynWarning`.
+
+    Raises:
+        ValueError: naming the option or the model parameter.
+    """
+    request = _request(locals())
+    if fit_band is None:
+        del request["fit_band"]
+    p, probe = _params(params, model)
+    d = _door("peakforce", "peakforce", progress, p, probe, request)
+    doc = json.loads(d["json"])
+    ds = xr.merge(
+        [dataset(layout) for layout in d["datasets"].values()], combine_attrs="drop"
+    )
+    ds.attrs = {k: v for k, v in doc["channels"].items() if v is not None}
+    ds.attrs["summary"] = json.dumps(doc)
+    return ds

@@ -1,0 +1,38 @@
+"""peakforce(): the dataset and its channels equal the command line's ``afmdyn peakforce
+--json`` for the same request (one library request and document); the cycle's force is the
+one the channels summarise; bad options are refused naming them."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+import afmdyn
+from conftest import EXAMPLES
+
+AIR = str(EXAMPLES / "probe-peakforce-air.toml")
+
+
+def test_peakforce_equals_the_command_line(cli_json, tmp_path):
+    doc = cli_json("peakforce", "--probe", AIR, "--z-c", "95nm", "--out", tmp_path / "pf")
+    ds = afmdyn.peakforce(probe=AIR, z_c=95e-9)
+    summary = json.loads(ds.attrs["summary"])
+    assert summary["channels"] == doc["channels"]
+    for name, value in doc["channels"].items():
+        if value is not None:
+            assert ds.attrs[name] == value
+    # the channels are the cycle's exact extremes (located between samples): the 4096
+    # samples reach within 0.5 % of them and not beyond
+    force = ds["force"].values
+    peak, adhesion = doc["channels"]["peak_force"], doc["channels"]["adhesion"]
+    assert peak * (1 - 5e-3) <= force.max() <= peak * (1 + 1e-9)
+    assert adhesion * (1 + 1e-9) <= force.min() <= adhesion * (1 - 5e-3)
+
+
+def test_bad_peakforce_options_name_them():
+    with pytest.raises(ValueError, match="setpoint"):
+        afmdyn.peakforce(probe=AIR, setpoint=-1e-9)
+    with pytest.raises(ValueError, match="samples"):
+        afmdyn.peakforce(probe=AIR, z_c=95e-9, samples=10)
