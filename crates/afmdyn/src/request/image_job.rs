@@ -61,7 +61,7 @@ impl ImageJob {
     /// (the image's documents are in SI already).
     ///
     /// # Errors
-    /// As [`background_probe`]: a probe the format refuses, a multifrequency drive.
+    /// As the background probe's reading: a probe the format refuses, a multifrequency drive.
     pub fn model(&self) -> Result<Resolved, SimError> {
         Ok(Resolved::plain(background_probe(&self.probe)?.params))
     }

@@ -1,7 +1,7 @@
 //! The studies a front end runs by name into the command line's resumable store ([`parse`]:
 //! `bifurcation`, `basins`, `global_continuation`, `approach`, `bimodal`, `resonance`): the request parsed,
 //! its study made on the model ([`Stored::prepare`]: validated, before any side effect) and
-//! run into the store of a locked directory, continued with `resume` ([`Stored::run`]), to the
+//! run into the store of a locked directory, continued with `resume` ([`Prepared::run`]), to the
 //! outcome the one door gives for the same request ([`crate::request::named::outcome`]).
 
 use super::basins::{basin_store, BasinStudy};

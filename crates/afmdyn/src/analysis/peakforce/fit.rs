@@ -41,7 +41,7 @@ pub struct DmtFit {
 /// The DMT fit of the retract curve given as distances `d` and forces `f` in time order from
 /// (at or before) the peak force to (at or after) the pull-off, over the band (lo, hi) of
 /// fractions of the range [F_adh, F_peak] (module docs). `None` where fewer than
-/// [`MIN_FIT_POINTS`] points fall in the band or the range is empty.
+/// `MIN_FIT_POINTS` (5) points fall in the band or the range is empty.
 pub fn fit_dmt(d: &[f64], f: &[f64], (lo, hi): (f64, f64)) -> Option<DmtFit> {
     let n = d.len().min(f.len());
     if n < MIN_FIT_POINTS {
