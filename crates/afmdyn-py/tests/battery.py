@@ -21,7 +21,11 @@ non-finite model values of ``chart``; integrator tolerances NaN, 0, negative, â‰
 integrator budget, exit 2 as in ``attractors``); a missing ``--overlay`` (exit 2); writes to a full
 device (``> /dev/full``: exit 1 naming standard output); the contact law's name in capitals in a
 config file (exit 0); Python numbers beyond a double (``cluster_tol=10**400``: ``ValueError``
-naming it); a quality factor of 1e308 (exit 2 naming ``quality_factor``).
+naming it); a quality factor of 1e308 (exit 2 naming ``quality_factor``); and issue 60's
+classes: an image beyond its memory budget refused before any work (``--pixels 2048``),
+``reconstruct --fm/--am /dev/zero``, an SI amplitude beyond its physical range, ``--modes``
+against an eigenmode probe's own modes, and off-resonance tapping's exclusive ``--z-c`` and
+``--setpoint`` and a modulation frequency beyond 1 MHz (each exit 2 naming the input).
 
 The cases are a pure function of the seed, so a run is reproducible. ``test_battery.py`` runs a
 bounded slice in the test command; ``scripts/battery.sh`` runs the whole battery and rewrites
@@ -44,6 +48,7 @@ from typing import Callable, Dict, List, Optional, Sequence, Tuple
 
 REPO = Path(__file__).resolve().parents[3]
 PROBES = [REPO / "examples" / "probe-point-mass-dmt.toml", REPO / "examples" / "probe-beam-dmt.toml"]
+PEAKFORCE = REPO / "examples" / "probe-peakforce-air.toml"
 
 #: values at and beyond the edges of every range (as a user would type them)
 EXTREMES = [
@@ -125,6 +130,22 @@ FAULTS: List[Tuple[List[str], int, Optional[str], Optional[str], Optional[str]]]
     (["simulate", "--periods", "1e300", "--files", "none"], 2, "periods", None, None),
     (["modes", "--probe", "{probe}"], 2, "quality_factor", None,
      PROBES[0].read_text().replace("quality_factor = 400 ", "quality_factor = 1e308 ")),
+    # issue 60's classes: a request's budget checked before any work (B6), unbounded input
+    # files (B7), an SI amplitude beyond its physical range (A2), one meaning of --modes (A1),
+    # exclusive options and a modulation frequency out of range (off-resonance tapping)
+    (["image", "--probe", str(PROBES[0]), "--sample", str(REPO / "examples" / "sample-blend.toml"),
+      "--setpoint", "0.8", "--pixels", "2048", "--files", "none"], 2, "budget", None, None),
+    (["reconstruct", "--fm", "/dev/zero"], 2, "/dev/zero", None, None),
+    (["reconstruct", "--am", "/dev/zero"], 2, "/dev/zero", None, None),
+    (["fm", "--probe", str(PROBES[0]), "--amplitude", "5e-4", "--files", "none"], 2, "amplitude",
+     None, None),
+    (["modes", "--probe", str(REPO / "examples" / "probe-eigenmodes-dmt.toml"), "--modes", "3"],
+     2, "modes", None, None),
+    (["peakforce", "--probe", str(PEAKFORCE), "--z-c", "95nm", "--setpoint", "2nN"], 2,
+     "setpoint", None, None),
+    (["peakforce", "--probe", "{probe}", "--z-c", "95nm", "--out", "{out}"], 2,
+     "modulation_frequency", None,
+     PEAKFORCE.read_text().replace("modulation_frequency = 2e3 ", "modulation_frequency = 1e9 ")),
 ]
 #: issue 42's Python faults: (call, the keyword its ValueError must name)
 PY_FAULTS = [
