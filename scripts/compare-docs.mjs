@@ -22,6 +22,25 @@ export function worst(a, b, at = "") {
   return [isDeepStrictEqual(a, b) ? 0 : Infinity, at];
 }
 
+/** An image's document with every pixel (the browser's) against the command line's summary
+ * (`afmdyn image --json`: the maps are image.nc's): the shared keys, and each map's count of
+ * finite pixels, min, max and mean computed here from the pixels against the summary's; the
+ * largest difference and where. */
+export function imageAgainstSummary(doc, summary) {
+  const keys = ["feedback", "setpoint", "reference_z_c", "materials", "warnings", "setpoint_study"]
+    .filter((k) => k in doc || k in summary);
+  let best = worst(Object.fromEntries(keys.map((k) => [k, doc[k]])),
+    Object.fromEntries(keys.map((k) => [k, summary[k]])));
+  for (const name of ["height", "z_c", "phase_deg", "true_height"]) {
+    const v = doc.image[name].flat().filter((x) => typeof x === "number" && Number.isFinite(x));
+    const m = summary.image.maps[name];
+    const mine = [v.length, Math.min(...v), Math.max(...v), v.reduce((a, b) => a + b, 0) / v.length];
+    const w = worst(mine, [m.finite, m.min, m.max, m.mean], `.image.maps.${name}`);
+    if (w[0] > best[0]) best = w;
+  }
+  return best;
+}
+
 /** An approach curve's parts: the two sweeps and the setpoint's operating points (compared to
  * 1e-9), and the continued branches, folds and jumps, whose adaptive arclength steps carry
  * last-bit differences into the points they land on (compared to 1e-6). */

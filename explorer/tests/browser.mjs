@@ -11,7 +11,7 @@ import { mkdtempSync, readFileSync, rmSync, writeFileSync } from "node:fs";
 import { tmpdir } from "node:os";
 import path from "node:path";
 import { fileURLToPath } from "node:url";
-import { worst, approachSweeps, approachBranches, branchesScaled, compareBifurcation } from "../../scripts/compare-docs.mjs";
+import { worst, approachSweeps, approachBranches, branchesScaled, compareBifurcation, imageAgainstSummary } from "../../scripts/compare-docs.mjs";
 
 const root = path.resolve(path.dirname(fileURLToPath(import.meta.url)), "../..");
 const arg = (name) => {
@@ -352,15 +352,16 @@ try {
     const image = await afmRun();
     const refImage = native(["image", "--probe", "examples/probe-point-mass-dmt.toml", "--sample", `examples/${sample}`,
       "--setpoint", "0.7", "--pixels", "16", "--out", tmp]);
-    [w, where] = worst(image, refImage);
+    // the command line's document is a summary (its maps are image.nc's)
+    [w, where] = imageAgainstSummary(image, refImage);
     const kind = await page.evaluate(() => document.getElementById("afm-plot-a").data[0].type);
     const listed = await page.$$eval("#afm-warnings li", (li) => li.map((x) => x.textContent));
     check(`… and its ${refImage.warnings.length} warning(s) are listed under the plots`,
       listed.length === refImage.warnings.length && refImage.warnings.every((m, i) => listed[i].includes(typeof m === "string" ? m : m.message ?? "")),
       JSON.stringify(listed));
     check(`the image of ${sample} is \`afmdyn image --setpoint 0.7 --pixels 16 --json\`'s (to 1e-9), drawn as ` +
-      (refImage.image.y.length === 1 ? "a line profile" : "maps"),
-    w <= 1e-9 && kind === (refImage.image.y.length === 1 ? "scatter" : "heatmap"), `${w} at ${where}; ${kind}`);
+      (refImage.image.lines === 1 ? "a line profile" : "maps"),
+    w <= 1e-9 && kind === (refImage.image.lines === 1 ? "scatter" : "heatmap"), `${w} at ${where}; ${kind}`);
   }
   await page.screenshot({ path: path.join(out, "screenshot-image.png"), fullPage: true });
   // a PI-feedback image is the command line's only: the engine's refusal beside the field

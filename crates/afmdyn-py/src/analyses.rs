@@ -184,6 +184,9 @@ pub fn image<'py>(
     let img = py.detach(|| image(&table, &map, &req)).map_err(sim_error)?;
     let out = Out::new(py);
     out.json(&img.document(setpoint))?;
+    // the command line's image.json: the summary the dataset's `summary` attribute holds
+    let summary = afmdyn::request::present::image::ideal_summary(&img, setpoint, None);
+    out.set("summary", summary.to_string())?;
     let layout = afmdyn::request::image_layout::layout(&img, setpoint);
     out.set("layout", crate::convert::layout_dict(py, layout)?)?;
     Ok(out.finish())

@@ -155,8 +155,9 @@ pub(crate) fn image_inputs(
     Ok((table, map))
 }
 
-/// A PI scan's document and layout ([`afmdyn::request::image_layout::scan_layout`]) as Python takes
-/// them: `{"json": text, "layout": …}`.
+/// A PI scan's document, its summary (the command line's `image.json`) and layout
+/// ([`afmdyn::request::image_layout::scan_layout`]) as Python takes them: `{"json": text,
+/// "summary": text, "layout": …}`.
 pub(crate) fn scan_out<'py>(
     py: Python<'py>,
     img: &afmdyn::request::image_scan::PiImage,
@@ -164,6 +165,8 @@ pub(crate) fn scan_out<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let out = Out::new(py);
     out.json(&img.document(setpoint))?;
+    let summary = afmdyn::request::present::image::pi_summary(img, setpoint);
+    out.set("summary", summary.to_string())?;
     let layout = afmdyn::request::image_layout::scan_layout(img, setpoint);
     out.set("layout", crate::convert::layout_dict(py, layout)?)?;
     Ok(out.finish())

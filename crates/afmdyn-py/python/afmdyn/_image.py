@@ -119,11 +119,13 @@ def _gains(gains: Optional[Sequence[float]]) -> Optional[Tuple[float, float]]:
 
 
 def _dataset(out: Dict[str, Any], setpoint: float) -> xr.Dataset:
-    """The Dataset of an image (``{"json", "layout"}``), ideal or PI: its maps and flags as the
-    library lays them out (``image.nc``'s variables, units and long names), its integer codes
-    (regime, material, domain; a PI scan's ``_retrace`` ones) as the document's words."""
+    """The Dataset of an image (``{"json", "summary", "layout"}``), ideal or PI: its maps and
+    flags as the library lays them out (``image.nc``'s variables, units and long names), its
+    integer codes (regime, material, domain; a PI scan's ``_retrace`` ones) as the document's
+    words; the command line's ``image.json`` (the summary) as ``summary``."""
     doc = json.loads(out["json"])
-    _warn(doc)
+    summary = json.loads(out["summary"])
+    _warn(summary)
     img = doc["image"]
     dims = ("y", "x")
     layout = _layout.variables(out["layout"])
@@ -147,7 +149,7 @@ def _dataset(out: Dict[str, Any], setpoint: float) -> xr.Dataset:
             "reference_z_c": doc["reference_z_c"],
             "feedback": doc["feedback"],
             **extra,
-            "summary": json.dumps(doc),
+            "summary": json.dumps(summary),
         },
     )
 

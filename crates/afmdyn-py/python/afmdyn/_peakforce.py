@@ -50,6 +50,9 @@ def peakforce(
 
     Raises:
         ValueError: naming the option or the model parameter.
+
+    ``progress``: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a
+    log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.
     """
     request = _request(locals())
     if fit_band is None:
