@@ -360,11 +360,17 @@ impl DiscreteMap for CircleMap<'_> {
     }
 
     /// The smallest distance to grazing over the segment's periods
-    /// ([`crate::maps::flow::grazing_distance`] of each, without the Jacobian).
+    /// ([`crate::maps::flow::grazing_distance`] of each, without the Jacobian), from the node
+    /// states of the last linearisation when it started at `z`.
     fn grazing_distance(&mut self, z: &DVector<f64>, n: usize) -> Result<f64, SimError> {
         Self::one_iterate(n)?;
         let t = self.period();
-        let xs = self.segment(z)?;
+        // the node states: the last linearisation's when it started at z (a Newton solve
+        // measures grazing at its solution, where it has just linearised), else a new segment
+        let xs = match &self.last {
+            Some(seg) if &seg.states[0] == z => seg.states.clone(),
+            _ => self.segment(z)?,
+        };
         let mut graze = f64::INFINITY;
         for (k, x) in xs.iter().take(self.nodes.len()).enumerate() {
             let (t0, t1) = (k as f64 * t, (k + 1) as f64 * t);
