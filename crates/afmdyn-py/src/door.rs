@@ -25,6 +25,14 @@ pub fn probe_of(probe: Option<String>) -> PyResult<Option<Probe>> {
         .map_err(probe_error)
 }
 
+/// The model of a call: `params` (default: the paper's set) and the probe file's text.
+fn resolved(params: Option<PyRef<'_, PyParams>>, probe: Option<String>) -> PyResult<Resolved> {
+    Ok(Resolved {
+        params: params.map_or_else(Params::default, |p| p.inner),
+        probe: probe_of(probe)?,
+    })
+}
+
 /// Run analysis `name` (`"orbit"`, …: `afmdyn.request.named.NAMES`) with the keywords
 /// `request` on `params` (default: the paper's set) and the probe file's text `probe`:
 /// `{"json": str, "datasets": {name: layout}, "facts": dict}`. `progress(done, total)` is
@@ -40,10 +48,7 @@ pub fn run<'py>(
     progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let named = crate::convert::named(name, request)?;
-    let model = Resolved {
-        params: params.map_or_else(Params::default, |p| p.inner),
-        probe: probe_of(probe)?,
-    };
+    let model = resolved(params, probe)?;
     named.validate(&model).map_err(sim_error)?;
     let stop = if named.checks_cancel() {
         Stop::Cancellable
@@ -77,10 +82,7 @@ pub fn run_stored<'py>(
     resume: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let stored = crate::convert::stored(name, request)?;
-    let model = Resolved {
-        params: params.map_or_else(Params::default, |p| p.inner),
-        probe: probe_of(probe)?,
-    };
+    let model = resolved(params, probe)?;
     let study = stored.prepare(model).map_err(sim_error)?;
     if resume && store.is_none() {
         let msg = "resume=True needs store= (the directory of the interrupted run)";
