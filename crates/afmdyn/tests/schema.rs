@@ -80,6 +80,7 @@ fn schemas() -> Vec<(&'static str, Value)> {
             schema::<afmdyn::request::PeakForceRequest>("peakforce"),
         ),
         ("image", schema::<ImageRequest>("image")),
+        ("fit", schema::<afmdyn::request::FitRequest>("fit")),
     ]
 }
 

@@ -17,6 +17,7 @@ pub mod bifurcation;
 pub mod chart;
 pub mod continuation;
 pub mod converge;
+pub mod fit;
 pub mod fm;
 pub mod fm_loop;
 pub mod global_continuation;

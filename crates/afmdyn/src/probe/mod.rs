@@ -306,6 +306,32 @@ pub struct Probe {
     /// [`Excitation::Sample`] (or, with `modulated = "base"`, the beam's base drive).
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub off_resonance: bool,
+    /// The sample's and tip's SI inputs as the file gives them (resolved defaults included):
+    /// what `fit` starts its parameters from, by their probe keys.
+    #[serde(skip)]
+    pub sample_inputs: SampleInputs,
+}
+
+/// The sample's and tip's SI inputs of a probe file by their keys (`None` where the law takes
+/// none): the start values of `fit`'s parameters ([`crate::analysis::fit`]).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct SampleInputs {
+    /// `[sample] youngs_modulus` (Pa).
+    pub youngs_modulus: Option<f64>,
+    /// `[sample] poisson_ratio`.
+    pub poisson_ratio: Option<f64>,
+    /// `[tip] youngs_modulus` (Pa; silicon's when omitted).
+    pub tip_youngs_modulus: Option<f64>,
+    /// `[tip] poisson_ratio` (silicon's when omitted).
+    pub tip_poisson_ratio: Option<f64>,
+    /// `[tip] radius` (m).
+    pub radius: Option<f64>,
+    /// `[sample] adhesion_energy` (J/m²; JKR's W, from H/(12πa₀²) when the file gives hamaker).
+    pub adhesion_energy: Option<f64>,
+    /// `[sample] hamaker` (J).
+    pub hamaker: Option<f64>,
+    /// `[sample] intermolecular_distance` (m).
+    pub intermolecular_distance: Option<f64>,
 }
 
 /// The indentation, as a fraction of the tip radius, beyond which the paraboloid contact of
@@ -473,6 +499,8 @@ struct Sample {
     /// The SLS sample's Maxwell arm: spring k₂ (N/m) and relaxation time τ_r = η/k₂ (s).
     maxwell: Option<(f64, f64)>,
     z_c: Option<f64>,
+    /// The elastic constants as given: sample E (Pa) and ν, tip E (Pa) and ν.
+    elastic: Option<[f64; 4]>,
 }
 
 /// A probe as a front end receives it: a file (the command line's `--probe FILE`, Python's

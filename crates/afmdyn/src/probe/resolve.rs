@@ -281,6 +281,16 @@ impl Probe {
                 )
             }),
             off_resonance: drive.off_resonance,
+            sample_inputs: SampleInputs {
+                youngs_modulus: sample.elastic.map(|e| e[0]),
+                poisson_ratio: sample.elastic.map(|e| e[1]),
+                tip_youngs_modulus: sample.elastic.map(|e| e[2]),
+                tip_poisson_ratio: sample.elastic.map(|e| e[3]),
+                radius: sample.radius,
+                adhesion_energy: sample.adhesion_energy,
+                hamaker: sample.hamaker,
+                intermolecular_distance: sample.a0,
+            },
         })
     }
 

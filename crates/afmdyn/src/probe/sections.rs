@@ -587,6 +587,7 @@ impl Probe {
             meniscus: None,
             maxwell: None,
             z_c,
+            elastic: None,
         };
         match law.as_str() {
             "linear" => {
@@ -623,6 +624,7 @@ impl Probe {
         if let (Some(et), Some(nt), Some(es), Some(ns)) = (tip_e, tip_nu, e_s, nu_s) {
             // Johnson, Contact Mechanics, eq. 4.22
             out.e_star = Some(1.0 / ((1.0 - nt * nt) / et + (1.0 - ns * ns) / es));
+            out.elastic = Some([es, ns, et, nt]);
         }
         if law == "hertz" {
             out.damping = r.optional(s, S, "damping", "N s/m", NON_NEGATIVE);

@@ -45,6 +45,7 @@ pub use crate::io::dir_lock;
 pub mod fm;
 #[cfg(feature = "files")]
 pub use crate::io::height_map as height_map_file;
+pub mod fit;
 pub mod image;
 pub mod image_job;
 pub mod image_layout;
@@ -79,6 +80,7 @@ pub use checkpoint_file::FileCheckpoint;
 pub use curves::{approach_request, resonance_request, CurveRequest};
 #[cfg(feature = "files")]
 pub use dir_lock::{DirLock, LockError};
+pub use fit::FitRequest;
 pub use fm::FmRequest;
 pub use model::{parameter, ModelSpec, ParamInfo, MODEL_PARAMETERS};
 pub use named::{Datasets, Named, Outcome};

@@ -25,7 +25,7 @@ use serde::de::{Deserialize, Deserializer};
 use serde_json::{Map, Value};
 
 /// The names of the analyses [`parse`] knows.
-pub const NAMES: [&str; 16] = [
+pub const NAMES: [&str; 17] = [
     "modes",
     "simulate",
     "converge",
@@ -42,6 +42,7 @@ pub const NAMES: [&str; 16] = [
     "fm",
     "reconstruct",
     "peakforce",
+    "fit",
 ];
 
 /// What a named analysis returns: its document, its arrays and its scalars.
@@ -206,6 +207,7 @@ pub fn parse<'de, D: Deserializer<'de>>(
         "fm" => door::<FmRequest, D>(d, false),
         "reconstruct" => door::<ReconstructRequest, D>(d, false),
         "peakforce" => door::<super::PeakForceRequest, D>(d, false),
+        "fit" => door::<super::FitRequest, D>(d, true),
         _ => Ok(None),
     }
 }
@@ -235,6 +237,7 @@ pub fn default_request(name: &str) -> Option<Value> {
         "reconstruct" => v::<ReconstructRequest>(),
         "fm" => v::<FmRequest>(),
         "peakforce" => v::<super::PeakForceRequest>(),
+        "fit" => v::<super::FitRequest>(),
         _ => None,
     }
 }

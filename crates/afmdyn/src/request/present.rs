@@ -14,6 +14,7 @@ pub(crate) mod continuation;
 pub mod converge;
 pub(crate) mod curve_figures;
 pub mod curves;
+pub mod fit;
 pub mod fm;
 pub mod image;
 pub mod maps;

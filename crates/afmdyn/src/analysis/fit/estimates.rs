@@ -1,0 +1,289 @@
+//! From a minimum of χ² to estimates with their uncertainties: the covariance
+//! C = (JᵀWJ)⁻¹ s² at the minimum (J = ∂f/∂p, W = diag(1/σᵢ²); s² = χ²/(m − n) when the noise
+//! is estimated from the residuals, 1 when σ is given), standard errors √Cⱼⱼ, Wald intervals
+//! p̂ ± 1.96 SE, the correlation matrix, profile-likelihood intervals ([`super::profile`]) and
+//! the identifiability warnings: |correlation| > 0.99, a flat profile, an estimate at its
+//! bound, a parameter the data do not constrain (JᵀWJ singular in it or, for a quantity with a
+//! physical lower bound, a standard error ≥ |estimate|) (Bates & Watts, *Nonlinear Regression
+//! Analysis and Its Applications*, Wiley 1988, §2.3; Raue et al. 2009 for the profiles).
+
+use super::least_squares::{minimize, CurveModel, Observations, Parameter};
+use super::profile::{profile, Profile, ProfileEnd, DELTA_CHI2_95};
+use nalgebra::DMatrix;
+
+/// The standard normal's 97.5 % quantile: the Wald interval is p̂ ± 1.96 SE.
+pub const Z_95: f64 = 1.959_963_984_540_054;
+
+/// Above this |correlation| two parameters are called not separately identifiable.
+pub const CORRELATION_WARNING: f64 = 0.99;
+
+/// Profiles are computed for at most this many fitted parameters (Wald intervals beyond).
+pub const MAX_PROFILED: usize = 4;
+
+/// Below this ratio of the smallest to the largest eigenvalue of the scaled JᵀWJ the matrix is
+/// called singular (the data do not fix some combination of the parameters).
+pub const SINGULAR_RATIO: f64 = 1e-14;
+
+/// One fitted parameter's estimate.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Estimate {
+    /// Its name.
+    pub name: String,
+    /// The estimate p̂.
+    pub value: f64,
+    /// The standard error √Cⱼⱼ (NaN where JᵀWJ is singular in this parameter).
+    pub standard_error: f64,
+    /// The Wald interval p̂ ± 1.96 SE.
+    pub wald: [f64; 2],
+    /// The 95 % interval: the profile's where computed ([`MAX_PROFILED`]), else the Wald one.
+    pub interval: [f64; 2],
+    /// The profile, when computed.
+    pub profile: Option<Profile>,
+}
+
+/// A fit's outcome: estimates, correlation, χ²/dof, the model beside the data, warnings.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FitOutcome {
+    /// The fitted parameters' estimates, in the fit's order.
+    pub estimates: Vec<Estimate>,
+    /// Every parameter's value at the minimum, fixed ones too.
+    pub values: Vec<f64>,
+    /// The correlation matrix of the fitted parameters (n × n, rows in the estimates' order).
+    pub correlation: Vec<Vec<f64>>,
+    /// χ² at the minimum.
+    pub chi2: f64,
+    /// Degrees of freedom m − n.
+    pub dof: usize,
+    /// χ²/dof (with σ: near 1 for a model that fits; without: the noise variance s²).
+    pub chi2_dof: f64,
+    /// Whether the noise was estimated from the residuals (no σ given).
+    pub noise_estimated: bool,
+    /// The model at the estimates, fᵢ(p̂).
+    pub fitted: Vec<f64>,
+    /// The residuals yᵢ − fᵢ(p̂).
+    pub residuals: Vec<f64>,
+    /// Model evaluations made, the profiles' refits included.
+    pub evaluations: usize,
+    /// The minimiser's termination.
+    pub termination: String,
+    /// Identifiability and convergence warnings, in words.
+    pub warnings: Vec<String>,
+}
+
+/// Fit `model` to `obs` over the parameters `params` whose `fixed` entry is `None` (the others
+/// held at it), from their start values; with profiles for up to [`MAX_PROFILED`] of them.
+///
+/// # Panics
+/// Never for consistent lengths: `params` and `fixed` have the model's n entries and `obs`
+/// its m points (the caller's [`crate::request`] checks the data).
+pub fn fit(
+    model: &dyn CurveModel,
+    obs: &Observations,
+    params: &[Parameter],
+    fixed: &[Option<f64>],
+) -> FitOutcome {
+    let start: Vec<f64> = params.iter().map(|p| p.start).collect();
+    let best = minimize(model, obs, params, &start, fixed);
+    let free: Vec<usize> = (0..params.len()).filter(|&j| fixed[j].is_none()).collect();
+    let (m, n) = (model.points(), free.len());
+    let dof = m.saturating_sub(n);
+    let noise_estimated = obs.sigma.is_none();
+    let chi2_dof = if dof > 0 {
+        best.chi2 / dof as f64
+    } else {
+        f64::NAN
+    };
+    let s2 = if noise_estimated { chi2_dof } else { 1.0 };
+    let mut warnings = Vec::new();
+    if !best.converged {
+        warnings.push(format!(
+            "the minimiser did not report convergence ({}): the estimates may not be at the \
+             minimum",
+            best.termination
+        ));
+    }
+    if noise_estimated {
+        warnings.push(format!(
+            "noise estimated from residuals: no σ column, so σ² = χ²/dof = {:.4e} (the \
+             standard errors and intervals assume the model fits)",
+            chi2_dof
+        ));
+    }
+    let (cov, singular) = covariance(model, obs, &best.values, &free, s2);
+    if singular {
+        warnings.push(
+            "JᵀWJ is singular: the data do not constrain every combination of the fitted \
+             parameters"
+                .into(),
+        );
+    }
+    let se: Vec<f64> = (0..n).map(|k| cov[(k, k)].max(0.0).sqrt()).collect();
+    let correlation: Vec<Vec<f64>> = (0..n)
+        .map(|a| {
+            (0..n)
+                .map(|b| cov[(a, b)] / (se[a] * se[b]))
+                .collect::<Vec<f64>>()
+        })
+        .collect();
+    let mut evaluations = best.evaluations;
+    let mut estimates = Vec::with_capacity(n);
+    for (k, &j) in free.iter().enumerate() {
+        let p = &params[j];
+        let value = best.values[j];
+        let wald = [value - Z_95 * se[k], value + Z_95 * se[k]];
+        let step = if se[k].is_finite() && se[k] > 0.0 {
+            se[k]
+        } else {
+            0.1 * p.scale
+        };
+        let prof = (n <= MAX_PROFILED && dof > 0 && s2 > 0.0)
+            .then(|| profile(model, obs, params, &best, fixed, j, step, s2));
+        let interval = prof
+            .as_ref()
+            .map_or(wald, |pr| [pr.lower.value(), pr.upper.value()]);
+        if let Some(pr) = &prof {
+            evaluations += pr.refits;
+            if matches!(pr.lower, ProfileEnd::Flat(_)) || matches!(pr.upper, ProfileEnd::Flat(_)) {
+                warnings.push(format!(
+                    "{}: flat profile — χ² rises by less than {DELTA_CHI2_95:.2} over the \
+                     range walked on {} side; the data do not bound it there",
+                    p.name,
+                    match (pr.lower, pr.upper) {
+                        (ProfileEnd::Flat(_), ProfileEnd::Flat(_)) => "either",
+                        (ProfileEnd::Flat(_), _) => "the lower",
+                        _ => "the upper",
+                    }
+                ));
+            }
+            if pr.lowest < -1e-6 {
+                warnings.push(format!(
+                    "{}: the profile met a χ² lower than the fit's (by {:.3} in Δχ²): the fit \
+                     stopped short of the minimum",
+                    p.name, -pr.lowest
+                ));
+            }
+        }
+        let width = (p.upper - p.lower).abs().min(p.scale.max(value.abs()));
+        for (bound, which) in [(p.lower, "lower"), (p.upper, "upper")] {
+            if bound.is_finite() && (value - bound).abs() <= 1e-6 * width {
+                warnings.push(format!(
+                    "{}: the estimate {value:.6e} is at its {which} bound {bound:.6e}",
+                    p.name
+                ));
+            }
+        }
+        // (an offset without a natural zero — contact point, baseline — is not held to it)
+        if !se[k].is_finite() || (p.lower.is_finite() && se[k] >= value.abs()) {
+            warnings.push(format!(
+                "{}: not constrained by the data (standard error {:.3e} ≥ |estimate| {:.3e})",
+                p.name,
+                se[k],
+                value.abs()
+            ));
+        }
+        estimates.push(Estimate {
+            name: p.name.clone(),
+            value,
+            standard_error: se[k],
+            wald,
+            interval,
+            profile: prof,
+        });
+    }
+    for a in 0..n {
+        for b in a + 1..n {
+            let r = correlation[a][b];
+            if r.abs() > CORRELATION_WARNING {
+                warnings.push(format!(
+                    "{} and {} are correlated at {r:.4} (|r| > {CORRELATION_WARNING}): the data \
+                     fix a combination of them, not each",
+                    params[free[a]].name, params[free[b]].name
+                ));
+            }
+        }
+    }
+    let mut fitted = vec![0.0; m];
+    model.evaluate(&best.values, &mut fitted, None);
+    let residuals = obs.y.iter().zip(&fitted).map(|(y, f)| y - f).collect();
+    FitOutcome {
+        estimates,
+        values: best.values,
+        correlation,
+        chi2: best.chi2,
+        dof,
+        chi2_dof,
+        noise_estimated,
+        fitted,
+        residuals,
+        evaluations,
+        termination: best.termination,
+        warnings,
+    }
+}
+
+/// The covariance (JᵀWJ)⁻¹ s² of the free parameters at `p`, and whether JᵀWJ is singular
+/// (then its pseudo-inverse on the eigenvalues above [`SINGULAR_RATIO`] of the largest, and NaN
+/// variances for parameters in its null space). JᵀWJ is scaled to unit diagonal before the
+/// eigen-decomposition, so parameters of any units compare.
+fn covariance(
+    model: &dyn CurveModel,
+    obs: &Observations,
+    p: &[f64],
+    free: &[usize],
+    s2: f64,
+) -> (DMatrix<f64>, bool) {
+    let (m, n_all, n) = (model.points(), p.len(), free.len());
+    let mut f = vec![0.0; m];
+    let mut jac = vec![0.0; m * n_all];
+    model.evaluate(p, &mut f, Some(&mut jac));
+    let mut a = DMatrix::<f64>::zeros(n, n);
+    for i in 0..m {
+        let w2 = obs.weight(i).powi(2);
+        let row = &jac[i * n_all..(i + 1) * n_all];
+        for (ka, &ja) in free.iter().enumerate() {
+            for (kb, &jb) in free.iter().enumerate().skip(ka) {
+                a[(ka, kb)] += row[ja] * row[jb] * w2;
+            }
+        }
+    }
+    for ka in 0..n {
+        for kb in 0..ka {
+            a[(ka, kb)] = a[(kb, ka)];
+        }
+    }
+    let d: Vec<f64> = (0..n)
+        .map(|k| {
+            let x = a[(k, k)];
+            if x > 0.0 {
+                1.0 / x.sqrt()
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let b = DMatrix::from_fn(n, n, |i, j| a[(i, j)] * d[i] * d[j]);
+    let eig = b.symmetric_eigen();
+    let largest = eig.eigenvalues.iter().cloned().fold(0.0_f64, f64::max);
+    let mut singular = d.contains(&0.0) || largest <= 0.0;
+    let mut inv = DMatrix::<f64>::zeros(n, n);
+    let mut null = vec![false; n];
+    for (k, &lambda) in eig.eigenvalues.iter().enumerate() {
+        let v = eig.eigenvectors.column(k);
+        if lambda > SINGULAR_RATIO * largest {
+            inv += v * v.transpose() / lambda;
+        } else {
+            singular = true;
+            for i in 0..n {
+                null[i] |= v[i].abs() > 1e-6;
+            }
+        }
+    }
+    let cov = DMatrix::from_fn(n, n, |i, j| {
+        if null[i] || null[j] || d[i] == 0.0 || d[j] == 0.0 {
+            f64::NAN
+        } else {
+            inv[(i, j)] * d[i] * d[j] * s2
+        }
+    });
+    (cov, singular)
+}

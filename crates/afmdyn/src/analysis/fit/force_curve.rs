@@ -1,0 +1,294 @@
+//! The quasi-static force-curve fit: a contact law of the registry (Hertz, DMT, JKR) with its
+//! contact point and force baseline, fitted to a measured force against piezo height.
+//!
+//! # Preprocessing (nanite's steps and names, Müller et al., *BMC Bioinformatics* 20 (2019) 465;
+//! nanite 4.2 `preproc.py`, `poc.py`)
+//! 1. `compute_tip_position`: the tip position x = h + F/k from the piezo height h (m,
+//!    decreasing into the sample), the force F (N, repulsion positive: the lever bends away
+//!    from the sample) and the lever's spring constant k (N/m, the probe's) — as JPK's
+//!    "Vertical Tip Position".
+//! 2. `correct_force_offset`: the contact point's index i_c by `deviation_from_baseline` on
+//!    the approach up to its largest force (the baseline is the first 10 % of that part; i_c is
+//!    the first point whose force exceeds the baseline's mean by twice its largest deviation;
+//!    the middle of that part when none does), and the mean force before i_c subtracted (the
+//!    first force when i_c = 0).
+//! 3. `correct_tip_offset`: the tip position at i_c subtracted, so the contact point starts
+//!    near 0.
+//! 4. The segments: the approach up to the lowest piezo height (inclusive), the retract after
+//!    it.
+//!
+//! # Model
+//! F(x) = baseline + F_c(δ), δ = contact_point − x (the indentation), F_c the law's force of
+//! the registry ([`crate::contact::Law::force`]) evaluated in SI: its Hertz group
+//! k_H = (4/3)E*√R (Hertz 1882; Sneddon, *Int. J. Eng. Sci.* 3 (1965) 47, eq. 6.9: the
+//! paraboloid F = (4/3) E/(1 − ν²) √R δ^{3/2} of a rigid tip), 1/E* = (1 − ν_t²)/E_t +
+//! (1 − ν_s²)/E_s (Johnson, *Contact Mechanics*, 1985, eq. 4.22); DMT's van der Waals group
+//! H R/6 and a₀, in contact the Hertz force minus the adhesion HR/(6a₀²) ([`crate::contact::dmt`]);
+//! JKR's adhesion πWR ([`crate::contact::jkr`]; the contact forms at δ = 0 on the approach and
+//! holds down to the break on the retract). Each law's groups are homogeneous in their units,
+//! so the law's dimensionless force is the SI force with g₀ = 1 m and F̃ = 1 N.
+//!
+//! # Sensitivities
+//! ∂F/∂contact_point is the law's exact ∂F_c/∂δ; ∂F/∂baseline = 1; through the groups,
+//! ∂F/∂k_H = F_c/k_H exactly for Hertz, and by central differences of relative step 1e-6 on
+//! DMT's and JKR's groups (error ~1e-12 relative), chained to E_s, R, H and W analytically.
+
+use crate::contact::{DmtLaw, HertzLaw, Jkr, JkrLaw, Law};
+use crate::probe::ranges::si_range;
+
+/// The force-curve laws the fit takes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ForceLaw {
+    /// Hertz's paraboloid.
+    Hertz,
+    /// DMT: Hertz with the van der Waals attraction (constant adhesion in contact).
+    Dmt,
+    /// JKR: the adhesive neck.
+    Jkr,
+}
+
+impl ForceLaw {
+    /// The law of the registry by its name (`hertz`, `dmt`, `jkr`); `None` for another.
+    pub fn from_name(name: &str) -> Option<ForceLaw> {
+        match name {
+            "hertz" => Some(ForceLaw::Hertz),
+            "dmt" => Some(ForceLaw::Dmt),
+            "jkr" => Some(ForceLaw::Jkr),
+            _ => None,
+        }
+    }
+    /// The law's name in the registry.
+    pub fn name(self) -> &'static str {
+        match self {
+            ForceLaw::Hertz => "hertz",
+            ForceLaw::Dmt => "dmt",
+            ForceLaw::Jkr => "jkr",
+        }
+    }
+    /// The names of the model's parameters, in the model's order (every one fittable).
+    pub fn parameter_names(self) -> &'static [&'static str] {
+        match self {
+            ForceLaw::Hertz => &[YOUNGS_MODULUS, RADIUS, CONTACT_POINT, BASELINE],
+            ForceLaw::Dmt => &[YOUNGS_MODULUS, RADIUS, CONTACT_POINT, BASELINE, HAMAKER],
+            ForceLaw::Jkr => &[YOUNGS_MODULUS, RADIUS, CONTACT_POINT, BASELINE, ADHESION],
+        }
+    }
+}
+
+/// `sample.youngs_modulus` (Pa).
+pub const YOUNGS_MODULUS: &str = "sample.youngs_modulus";
+/// `tip.radius` (m).
+pub const RADIUS: &str = "tip.radius";
+/// `contact_point` (m): the tip position where δ = 0, after `correct_tip_offset`.
+pub const CONTACT_POINT: &str = "contact_point";
+/// `baseline` (N): the force far from the sample, after `correct_force_offset`.
+pub const BASELINE: &str = "baseline";
+/// `sample.hamaker` (J), DMT's.
+pub const HAMAKER: &str = "sample.hamaker";
+/// `sample.adhesion_energy` (J/m²), JKR's work of adhesion W.
+pub const ADHESION: &str = "sample.adhesion_energy";
+
+/// Which part of the curve.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Segment {
+    /// Up to the lowest piezo height.
+    Approach,
+    /// After it.
+    Retract,
+}
+
+/// A force curve after the preprocessing of the module docs.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Preprocessed {
+    /// The tip position x (m) of every row, after `correct_tip_offset`.
+    pub tip_position: Vec<f64>,
+    /// The force (N) of every row, after `correct_force_offset`.
+    pub force: Vec<f64>,
+    /// The number of approach rows (the rest is the retract).
+    pub approach_len: usize,
+    /// The contact point's index i_c (`deviation_from_baseline`), `None` where no point
+    /// deviates (then the middle of the approach's rising part is used, as nanite does).
+    pub contact_index: Option<usize>,
+    /// The force subtracted (N).
+    pub force_offset: f64,
+    /// The tip position subtracted (m).
+    pub tip_offset: f64,
+}
+
+impl Preprocessed {
+    /// The rows of `segment` whose tip position lies in `range` (m, inclusive; all without).
+    pub fn rows(&self, segment: Segment, range: Option<[f64; 2]>) -> Vec<usize> {
+        let span = match segment {
+            Segment::Approach => 0..self.approach_len,
+            Segment::Retract => self.approach_len..self.force.len(),
+        };
+        span.filter(|&i| range.is_none_or(|[lo, hi]| (lo..=hi).contains(&self.tip_position[i])))
+            .collect()
+    }
+}
+
+/// nanite's `deviation_from_baseline` on `force` (module docs, step 2): the first index whose
+/// force exceeds the first 10 %'s mean by twice their largest deviation.
+pub fn deviation_from_baseline(force: &[f64]) -> Option<usize> {
+    let n = force.len() / 10;
+    if n == 0 {
+        return None;
+    }
+    let base = &force[..n];
+    let mean = base.iter().sum::<f64>() / n as f64;
+    let range = 2.0 * base.iter().map(|f| (f - mean).abs()).fold(0.0, f64::max);
+    force.iter().position(|f| f - mean > range)
+}
+
+/// The preprocessing of the module docs on a curve of piezo heights `height` (m) and forces
+/// `force` (N) with the lever's spring constant `spring_constant` (N/m).
+pub fn preprocess(height: &[f64], force: &[f64], spring_constant: f64) -> Preprocessed {
+    let mut tip: Vec<f64> = height
+        .iter()
+        .zip(force)
+        .map(|(h, f)| h + f / spring_constant)
+        .collect();
+    // the approach's part up to its largest force (nanite's clip_approach)
+    let peak = force
+        .iter()
+        .enumerate()
+        .fold(0, |best, (i, f)| if *f > force[best] { i } else { best });
+    let clipped = &force[..peak];
+    let found = deviation_from_baseline(clipped);
+    let cp = found.unwrap_or(clipped.len() / 2);
+    let force_offset = if cp > 0 {
+        force[..cp].iter().sum::<f64>() / cp as f64
+    } else {
+        force.first().copied().unwrap_or(0.0)
+    };
+    let force: Vec<f64> = force.iter().map(|f| f - force_offset).collect();
+    let tip_offset = tip.get(cp).copied().unwrap_or(0.0);
+    for x in &mut tip {
+        *x -= tip_offset;
+    }
+    let lowest = height
+        .iter()
+        .enumerate()
+        .fold(0, |best, (i, h)| if *h < height[best] { i } else { best });
+    Preprocessed {
+        tip_position: tip,
+        force,
+        approach_len: (lowest + 1).min(height.len()),
+        contact_index: found,
+        force_offset,
+        tip_offset,
+    }
+}
+
+/// The physical range [lo, hi] of a fitted quantity from the probe's ranges
+/// ([`crate::probe::ranges::SI_RANGES`]; a positive quantity without a lower bound there is
+/// bounded by 0); (−∞, ∞) for the contact point and the baseline.
+pub fn bounds(name: &str) -> (f64, f64) {
+    let (section, key) = match name.split_once('.') {
+        Some(sk) => sk,
+        None => return (f64::NEG_INFINITY, f64::INFINITY),
+    };
+    let range = si_range(section, key);
+    let lo = range.and_then(|r| r.below).map_or(0.0, |b| b.0);
+    let hi = range.and_then(|r| r.above).map_or(f64::INFINITY, |b| b.0);
+    (lo, hi)
+}
+
+/// The force-curve model at the rows' tip positions (module docs). Parameters in
+/// [`ForceLaw::parameter_names`]' order.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ForceCurveModel {
+    /// The law.
+    pub law: ForceLaw,
+    /// The tip positions x (m) of the fitted rows.
+    pub x: Vec<f64>,
+    /// The segment the rows belong to (JKR's contact differs on approach and retract).
+    pub segment: Segment,
+    /// The sample's Poisson ratio ν_s (held).
+    pub poisson_ratio: f64,
+    /// The tip's Young's modulus E_t (Pa) and Poisson ratio ν_t (held).
+    pub tip: (f64, f64),
+    /// DMT's intermolecular distance a₀ (m; held).
+    pub intermolecular_distance: f64,
+}
+
+impl ForceCurveModel {
+    /// k_H = (4/3)E*√R and ∂k_H/∂E_s.
+    fn hertz_group(&self, e_s: f64, r: f64) -> (f64, f64) {
+        let b = 1.0 - self.poisson_ratio * self.poisson_ratio;
+        let a = (1.0 - self.tip.1 * self.tip.1) / self.tip.0;
+        let e_star = 1.0 / (a + b / e_s);
+        let k = 4.0 / 3.0 * e_star * r.sqrt();
+        (k, k * e_star * b / (e_s * e_s))
+    }
+
+    /// The law's force and ∂F/∂δ at indentation δ with Hertz group k and second group g.
+    fn law_force(&self, k: f64, g: f64, delta: f64) -> (f64, f64) {
+        let e = match self.law {
+            ForceLaw::Hertz => HertzLaw.force(k, 0.0, delta >= 0.0, delta, 0.0),
+            ForceLaw::Dmt => DmtLaw {
+                hamaker: g,
+                intermolecular_distance: self.intermolecular_distance,
+            }
+            .force(k, 0.0, delta >= 0.0, delta, 0.0),
+            ForceLaw::Jkr => {
+                let contact = match self.segment {
+                    Segment::Approach => delta >= 0.0,
+                    Segment::Retract => delta > Jkr::new(k, g).release(),
+                };
+                JkrLaw { adhesion: g }.force(k, 0.0, contact, delta, 0.0)
+            }
+        };
+        (e.force, e.d_delta)
+    }
+}
+
+impl super::CurveModel for ForceCurveModel {
+    fn points(&self) -> usize {
+        self.x.len()
+    }
+    fn evaluate(&self, p: &[f64], values: &mut [f64], jacobian: Option<&mut [f64]>) {
+        let (e_s, r, cp, baseline) = (p[0], p[1], p[2], p[3]);
+        let (k, dk_de) = self.hertz_group(e_s, r);
+        // the law's second group and its derivatives by R and by its own parameter
+        let (g, dg_dr, dg_dq) = match self.law {
+            ForceLaw::Hertz => (0.0, 0.0, 0.0),
+            ForceLaw::Dmt => (p[4] * r / 6.0, p[4] / 6.0, r / 6.0),
+            ForceLaw::Jkr => {
+                let pi = std::f64::consts::PI;
+                (pi * p[4] * r, pi * p[4], pi * r)
+            }
+        };
+        let n = p.len();
+        let mut jac = jacobian;
+        for (i, x) in self.x.iter().enumerate() {
+            let delta = cp - x;
+            let (f, d_delta) = self.law_force(k, g, delta);
+            values[i] = baseline + f;
+            let Some(j) = jac.as_deref_mut() else {
+                continue;
+            };
+            let (df_dk, df_dg) = match self.law {
+                ForceLaw::Hertz => (f / k, 0.0),
+                _ => {
+                    let hk = 1e-6 * k;
+                    let hg = 1e-6 * g.abs().max(f64::MIN_POSITIVE);
+                    (
+                        (self.law_force(k + hk, g, delta).0 - self.law_force(k - hk, g, delta).0)
+                            / (2.0 * hk),
+                        (self.law_force(k, g + hg, delta).0 - self.law_force(k, g - hg, delta).0)
+                            / (2.0 * hg),
+                    )
+                }
+            };
+            let row = &mut j[i * n..(i + 1) * n];
+            row[0] = df_dk * dk_de;
+            row[1] = df_dk * k / (2.0 * r) + df_dg * dg_dr;
+            row[2] = d_delta;
+            row[3] = 1.0;
+            if n > 4 {
+                row[4] = df_dg * dg_dq;
+            }
+        }
+    }
+}

@@ -1,0 +1,13 @@
+//! Fitting measured curves (issue 62): weighted least squares by Levenberg–Marquardt with
+//! standard errors, correlations, profile-likelihood intervals and identifiability warnings
+//! ([`least_squares`], [`estimates`], [`profile`]), and the quasi-static force-curve fit of the
+//! registry's contact laws ([`force_curve`]).
+
+pub mod estimates;
+pub mod force_curve;
+pub mod least_squares;
+pub mod profile;
+
+pub use estimates::{fit, Estimate, FitOutcome};
+pub use least_squares::{CurveModel, Minimum, Observations, Parameter};
+pub use profile::{Profile, ProfileEnd};

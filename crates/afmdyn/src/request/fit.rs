@@ -1,0 +1,516 @@
+//! `fit`: a measured quasi-static force curve fitted with a contact law of the registry
+//! ([`crate::analysis::fit::force_curve`]) — the request the command line (`afmdyn fit`) and,
+//! by its name, Python share, and its document: estimates with standard errors and 95 %
+//! intervals, the correlation matrix, χ²/dof, the fitted curve beside the data, the residuals
+//! and the identifiability warnings. Everything is SI (m, N, Pa, J/m²); a probe file is
+//! needed (the lever's spring constant, the start values and the held parameters).
+
+use super::limits::Cost;
+use super::run::{Analysis, Resolved};
+use crate::analysis::fit::force_curve::{
+    bounds, preprocess, ForceCurveModel, ForceLaw, Preprocessed, Segment, BASELINE, CONTACT_POINT,
+    HAMAKER, RADIUS, YOUNGS_MODULUS,
+};
+use crate::analysis::fit::{fit, FitOutcome, Observations, Parameter};
+use crate::analysis::progress::Progress;
+use crate::error::SimError;
+use serde::{Deserialize, Serialize};
+use serde_json::{json, Value};
+
+/// The most rows a force curve may have (a 1 MHz record of one second).
+pub const MAX_FIT_ROWS: usize = 1_000_000;
+
+/// The fewest rows fitted (more than the parameters, for the χ²'s degrees of freedom).
+pub const MIN_FIT_ROWS: usize = 8;
+
+/// The segment of the curve fitted.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[serde(rename_all = "snake_case")]
+pub enum FitSegment {
+    /// The approach, up to the lowest piezo height.
+    #[default]
+    Approach,
+    /// The retract, after it.
+    Retract,
+}
+
+/// `fit`: the force curve (a CSV file `data`, or the columns `height`, `force` and optionally
+/// `sigma`), the parameters fitted (`fit`, probe keys), the segment and the range of tip
+/// positions fitted.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[serde(default, deny_unknown_fields)]
+pub struct FitRequest {
+    /// A CSV file with the columns `height` (m, the piezo height, decreasing into the sample),
+    /// `force` (N, repulsion positive) and optionally `sigma` (N, each force's standard
+    /// deviation), read through the bounded reader; excludes `height` and `force`.
+    pub data: Option<String>,
+    /// The piezo heights (m), when no `data` file is given.
+    pub height: Vec<f64>,
+    /// The forces (N), as many as `height`.
+    pub force: Vec<f64>,
+    /// The forces' standard deviations (N, > 0), as many as `force`; without them the noise is
+    /// estimated from the residuals.
+    pub sigma: Option<Vec<f64>>,
+    /// The parameters fitted, by their probe keys: `sample.youngs_modulus`, `tip.radius`,
+    /// `contact_point`, `baseline`, and `sample.hamaker` (DMT) or `sample.adhesion_energy`
+    /// (JKR); the others are held at the probe's values (contact point and baseline at 0,
+    /// after the preprocessing). Default `sample.youngs_modulus`, `contact_point`.
+    pub fit: Vec<String>,
+    /// The segment fitted (default the approach).
+    pub segment: FitSegment,
+    /// The range of tip positions fitted [lo, hi] (m, after the preprocessing's offset, as
+    /// nanite's `range_x`); default the whole segment.
+    pub range: Option<[f64; 2]>,
+}
+
+impl Default for FitRequest {
+    fn default() -> Self {
+        FitRequest {
+            data: None,
+            height: Vec::new(),
+            force: Vec::new(),
+            sigma: None,
+            fit: vec![YOUNGS_MODULUS.into(), CONTACT_POINT.into()],
+            segment: FitSegment::Approach,
+            range: None,
+        }
+    }
+}
+
+/// The result of a `fit` request.
+#[derive(Debug, Clone)]
+pub struct FitResult {
+    /// The law fitted.
+    pub law: ForceLaw,
+    /// The lever's spring constant (N/m).
+    pub spring_constant: f64,
+    /// The preprocessed curve.
+    pub curve: Preprocessed,
+    /// The rows fitted.
+    pub rows: Vec<usize>,
+    /// Every model parameter's name, in the model's order.
+    pub names: Vec<&'static str>,
+    /// Which were fitted.
+    pub fitted: Vec<bool>,
+    /// The fit.
+    pub outcome: FitOutcome,
+}
+
+/// A force curve's columns: heights, forces and their σ.
+type Columns = (Vec<f64>, Vec<f64>, Option<Vec<f64>>);
+
+fn bad(name: &'static str, value: impl std::fmt::Display, allowed: String) -> SimError {
+    SimError::out_of_range(name, value, allowed)
+}
+
+/// The columns `height`, `force` and optionally `sigma` of the CSV file `path`, read through
+/// the bounded reader ([`crate::io::curve_file::read_curve_file`], a curve CSV's cap).
+///
+/// # Errors
+/// [`SimError::OutOfRange`] naming `data` and the file: refused by the reader, unreadable, a
+/// missing column or a field that is not a number.
+#[cfg(feature = "files")]
+pub fn read_force_curve(path: &std::path::Path) -> Result<Columns, SimError> {
+    use crate::io::curve_file::{read_curve_file, CurveFile};
+    let file = |m: String| bad("data", path.display(), m);
+    match read_curve_file(path).map_err(|e| file(e.to_string()))? {
+        CurveFile::Document(_) => Err(file(
+            "a JSON document; fit reads a CSV with the columns height (m) and force (N)".into(),
+        )),
+        CurveFile::Columns(names, cols) => {
+            let col = |n: &str| names.iter().position(|c| c == n).map(|i| cols[i].clone());
+            let missing = |c: &str| file(format!("no column {c} among {}", names.join(", ")));
+            let height = col("height").ok_or_else(|| missing("height (m)"))?;
+            let force = col("force").ok_or_else(|| missing("force (N)"))?;
+            Ok((height, force, col("sigma")))
+        }
+    }
+}
+
+impl FitRequest {
+    /// The data's columns: the file's or the request's.
+    ///
+    /// # Errors
+    /// As [`read_force_curve`]; [`SimError::OutOfRange`] naming `data` where both or neither
+    /// are given, or a file without the `files` feature.
+    pub fn columns(&self) -> Result<Columns, SimError> {
+        match (&self.data, self.height.is_empty() && self.force.is_empty()) {
+            (Some(_), false) => Err(bad(
+                "data",
+                "given with height/force",
+                "give either a data file or the columns height and force, not both".into(),
+            )),
+            #[cfg(feature = "files")]
+            (Some(path), true) => read_force_curve(std::path::Path::new(path)),
+            #[cfg(not(feature = "files"))]
+            (Some(_), true) => Err(bad(
+                "data",
+                "a file",
+                "this build reads no files: give the columns height and force".into(),
+            )),
+            (None, true) => Err(bad(
+                "data",
+                "missing",
+                "a force curve is needed: a CSV file (columns height, force, optional sigma) \
+                 or the columns height and force"
+                    .into(),
+            )),
+            (None, false) => Ok((self.height.clone(), self.force.clone(), self.sigma.clone())),
+        }
+    }
+
+    /// The law of the probe and every model parameter's name.
+    fn law(model: &Resolved) -> Result<ForceLaw, SimError> {
+        let p = model.probe.as_ref().ok_or_else(|| {
+            bad(
+                "probe",
+                "missing",
+                "fit needs a probe file (the lever's spring constant, the start values and the \
+                 held parameters in SI)"
+                    .into(),
+            )
+        })?;
+        let name = p.params.contact_law.name();
+        ForceLaw::from_name(name).ok_or_else(|| {
+            bad(
+                "law",
+                name,
+                "the force-curve fit takes the probe's [sample].law = hertz, dmt or jkr".into(),
+            )
+        })
+    }
+
+    /// Check the options against the probe's law (the data are checked when read).
+    fn check(&self, model: &Resolved) -> Result<ForceLaw, SimError> {
+        let law = Self::law(model)?;
+        let names = law.parameter_names();
+        if self.fit.is_empty() {
+            return Err(bad(
+                "fit",
+                "none",
+                format!("name one or more of {}", names.join(", ")),
+            ));
+        }
+        for (i, f) in self.fit.iter().enumerate() {
+            if !names.contains(&f.as_str()) {
+                return Err(bad(
+                    "fit",
+                    f,
+                    format!(
+                        "the {} law's parameters are {}",
+                        law.name(),
+                        names.join(", ")
+                    ),
+                ));
+            }
+            if self.fit[..i].contains(f) {
+                return Err(bad("fit", f, "named twice".into()));
+            }
+        }
+        if let Some([lo, hi]) = self.range {
+            if !(lo.is_finite() && hi.is_finite() && lo < hi) {
+                return Err(bad(
+                    "range",
+                    format!("[{lo}, {hi}]"),
+                    "must be two finite tip positions lo < hi (m)".into(),
+                ));
+            }
+        }
+        if self.data.is_none() {
+            check_columns(&self.height, &self.force, self.sigma.as_deref())?;
+        }
+        Ok(law)
+    }
+}
+
+/// The columns' lengths, sizes and values.
+fn check_columns(height: &[f64], force: &[f64], sigma: Option<&[f64]>) -> Result<(), SimError> {
+    if height.len() != force.len() || sigma.is_some_and(|s| s.len() != force.len()) {
+        return Err(bad(
+            "force",
+            force.len(),
+            format!(
+                "height, force (and sigma) must have one value per row ({} heights)",
+                height.len()
+            ),
+        ));
+    }
+    if !(MIN_FIT_ROWS..=MAX_FIT_ROWS).contains(&force.len()) {
+        return Err(bad(
+            "data",
+            format!("{} rows", force.len()),
+            format!("a force curve has {MIN_FIT_ROWS}..={MAX_FIT_ROWS} rows"),
+        ));
+    }
+    if let Some(i) = height.iter().chain(force).position(|x| !x.is_finite()) {
+        return Err(bad(
+            "data",
+            format!("row {}", i % force.len() + 1),
+            "heights and forces must be finite".into(),
+        ));
+    }
+    if let Some(i) = sigma.and_then(|s| s.iter().position(|x| !(x.is_finite() && *x > 0.0))) {
+        return Err(bad(
+            "sigma",
+            format!("row {}", i + 1),
+            "must be finite and > 0 (N)".into(),
+        ));
+    }
+    Ok(())
+}
+
+impl Analysis for FitRequest {
+    type Output = FitResult;
+    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
+        self.check(model).map(|_| ())
+    }
+    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<FitResult, SimError> {
+        let law = self.check(model)?;
+        let (height, force, sigma) = self.columns()?;
+        check_columns(&height, &force, sigma.as_deref())?;
+        let probe = model.probe.as_ref().expect("checked");
+        let k = probe.calibration.spring_constant;
+        let s = probe.sample_inputs;
+        let curve = preprocess(&height, &force, k);
+        let segment = match self.segment {
+            FitSegment::Approach => Segment::Approach,
+            FitSegment::Retract => Segment::Retract,
+        };
+        let rows = curve.rows(segment, self.range);
+        if rows.len() < MIN_FIT_ROWS.max(self.fit.len() + 1) {
+            return Err(bad(
+                "range",
+                format!("{} rows", rows.len()),
+                format!(
+                    "too few rows of the {} in the range to fit {} parameters",
+                    match segment {
+                        Segment::Approach => "approach",
+                        Segment::Retract => "retract",
+                    },
+                    self.fit.len()
+                ),
+            ));
+        }
+        let x: Vec<f64> = rows.iter().map(|&i| curve.tip_position[i]).collect();
+        let y: Vec<f64> = rows.iter().map(|&i| curve.force[i]).collect();
+        let sig: Option<Vec<f64>> = sigma.map(|s| rows.iter().map(|&i| s[i]).collect());
+        let span = x.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        let fmax = y.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        let names = law.parameter_names().to_vec();
+        let need = |v: Option<f64>, key: &str| {
+            v.ok_or_else(|| bad("probe", key, format!("the fit needs the probe's {key}")))
+        };
+        let mut params = Vec::new();
+        for name in &names {
+            let (start, scale) = match *name {
+                YOUNGS_MODULUS => {
+                    let e = need(s.youngs_modulus, YOUNGS_MODULUS)?;
+                    (e, e)
+                }
+                RADIUS => {
+                    let r = need(s.radius, RADIUS)?;
+                    (r, r)
+                }
+                CONTACT_POINT => (0.0, (0.1 * span).max(1e-12)),
+                BASELINE => (0.0, (0.01 * fmax).max(1e-15)),
+                HAMAKER => {
+                    let h = need(s.hamaker, HAMAKER)?;
+                    (h, h.max(1e-21))
+                }
+                _ => {
+                    let w = need(s.adhesion_energy, "sample.adhesion_energy")?;
+                    (w, w.max(1e-3))
+                }
+            };
+            let (lower, upper) = bounds(name);
+            params.push(Parameter {
+                name: (*name).into(),
+                start,
+                lower,
+                upper,
+                scale,
+            });
+        }
+        let fitted: Vec<bool> = names
+            .iter()
+            .map(|n| self.fit.iter().any(|f| f == n))
+            .collect();
+        let fixed: Vec<Option<f64>> = params
+            .iter()
+            .zip(&fitted)
+            .map(|(p, f)| (!f).then_some(p.start))
+            .collect();
+        let m = ForceCurveModel {
+            law,
+            x,
+            segment,
+            poisson_ratio: need(s.poisson_ratio, "sample.poisson_ratio")?,
+            tip: (
+                need(s.tip_youngs_modulus, "tip.youngs_modulus")?,
+                need(s.tip_poisson_ratio, "tip.poisson_ratio")?,
+            ),
+            intermolecular_distance: s.intermolecular_distance.unwrap_or(0.0),
+        };
+        progress.check()?;
+        let obs = Observations {
+            y: &y,
+            sigma: sig.as_deref(),
+        };
+        let outcome = fit(&m, &obs, &params, &fixed);
+        Ok(FitResult {
+            law,
+            spring_constant: k,
+            curve,
+            rows,
+            names,
+            fitted,
+            outcome,
+        })
+    }
+    fn name(&self) -> &'static str {
+        "fit"
+    }
+    fn cost(&self, _: &Resolved) -> Result<Cost, SimError> {
+        // no integration; the columns, the preprocessed curve and the Jacobian (≤ 5 columns)
+        let rows = if self.data.is_some() {
+            MAX_FIT_ROWS
+        } else {
+            self.force.len()
+        } as f64;
+        Ok(Cost {
+            bytes: rows * 8.0 * 16.0,
+            work: 0.0,
+        })
+    }
+    fn report(&self, _: &Resolved, r: &FitResult) -> Result<Value, SimError> {
+        Ok(document(self, r))
+    }
+    fn present(
+        &self,
+        _: &Resolved,
+        _: &FitResult,
+        document: &Value,
+        units: crate::report::TextUnits,
+    ) -> Result<crate::report::Presentation, SimError> {
+        let mut document = document.clone();
+        Ok(super::present::fit::fit(
+            &mut document,
+            units,
+            super::present::Files::All,
+            None,
+        ))
+    }
+}
+
+/// The document of a fit (`afmdyn fit --json`, Python's `summary`): `estimates` (each fitted
+/// parameter's `value`, `standard_error`, 95 % `interval` — the profile likelihood's —,
+/// `wald_interval`), `parameters` (every parameter's value, fitted or held), `correlation`
+/// (`names`, `matrix`), `chi2`, `dof`, `chi2_dof`, `noise`, `curve` (the fitted rows' tip
+/// position, force, fit and residual), `preprocessing`, `law`, `segment`, `range`, `units`,
+/// `method`, `warnings`; SI throughout.
+pub fn document(request: &FitRequest, r: &FitResult) -> Value {
+    let o = &r.outcome;
+    let mut estimates = serde_json::Map::new();
+    for e in &o.estimates {
+        let finite = |x: f64| x.is_finite().then_some(x);
+        estimates.insert(
+            e.name.clone(),
+            json!({
+                "value": e.value,
+                "standard_error": finite(e.standard_error),
+                "interval": e.interval.map(finite),
+                "interval_method": if e.profile.is_some() { "profile likelihood, Δχ² ≤ 3.84" } else { "Wald, ±1.96 SE" },
+                "wald_interval": e.wald.map(finite),
+            }),
+        );
+    }
+    let mut parameters = serde_json::Map::new();
+    for (i, n) in r.names.iter().enumerate() {
+        parameters.insert(
+            (*n).into(),
+            json!({"value": o.values[i], "fitted": r.fitted[i]}),
+        );
+    }
+    let names: Vec<&str> = o.estimates.iter().map(|e| e.name.as_str()).collect();
+    let matrix: Vec<Vec<Option<f64>>> = o
+        .correlation
+        .iter()
+        .map(|row| row.iter().map(|x| x.is_finite().then_some(*x)).collect())
+        .collect();
+    let pick = |v: &[f64]| r.rows.iter().map(|&i| v[i]).collect::<Vec<f64>>();
+    json!({
+        "estimates": estimates,
+        "parameters": parameters,
+        "correlation": {"names": names, "matrix": matrix},
+        "chi2": o.chi2,
+        "dof": o.dof,
+        "chi2_dof": o.chi2_dof,
+        "noise": if o.noise_estimated { "noise estimated from residuals (no sigma column): χ²/dof is the force noise variance σ² (N²)" } else { "the sigma column (χ² in units of σ)" },
+        "curve": {
+            "tip_position": pick(&r.curve.tip_position),
+            "force": pick(&r.curve.force),
+            "fit": o.fitted,
+            "residual": o.residuals,
+        },
+        "preprocessing": {
+            "steps": ["compute_tip_position", "correct_force_offset", "correct_tip_offset", "segments at the lowest height"],
+            "spring_constant": r.spring_constant,
+            "force_offset": r.curve.force_offset,
+            "tip_offset": r.curve.tip_offset,
+            "contact_index": r.curve.contact_index,
+            "approach_rows": r.curve.approach_len,
+            "rows": r.curve.force.len(),
+        },
+        "law": r.law.name(),
+        "segment": request.segment,
+        "range": request.range,
+        "rows_fitted": r.rows.len(),
+        "evaluations": o.evaluations,
+        "termination": o.termination,
+        "units": {"sample.youngs_modulus": "Pa", "tip.radius": "m", "contact_point": "m", "baseline": "N",
+                  "sample.hamaker": "J", "sample.adhesion_energy": "J/m^2", "tip_position": "m", "force": "N",
+                  "fit": "N", "residual": "N", "chi2_dof": if o.noise_estimated { "N^2" } else { "1" }},
+        "method": "weighted least squares by Levenberg–Marquardt (MINPACK lmder, rust-cv levenberg-marquardt) on the preprocessed curve (nanite's steps: tip position x = height + F/k, force offset and tip offset at the deviation_from_baseline contact point); F = baseline + F_law(contact_point − x) with the registry's law in SI (Hertz: (4/3)E*√R δ^{3/2}, Sneddon 1965); standard errors from (JᵀWJ)⁻¹ s²; intervals from the profile likelihood (Δχ² ≤ 3.84) (docs/afm-workflow.md, From data to properties)",
+        "warnings": o.warnings,
+    })
+}
+
+impl super::named::Datasets for FitRequest {
+    /// `curve` (tip position, force, fit and residual over the fitted rows); the estimates
+    /// and their standard errors as facts.
+    fn datasets(&self, _: &Resolved, r: &FitResult) -> Result<super::named::Arrays, SimError> {
+        use crate::layout::{Layout, Variable};
+        let doc = document(self, r);
+        let arr = |k: &str| -> Vec<f64> {
+            doc["curve"][k].as_array().map_or(Vec::new(), |a| {
+                a.iter().map(|v| v.as_f64().unwrap_or(f64::NAN)).collect()
+            })
+        };
+        let n = r.rows.len();
+        let curve = Layout::new(
+            "fit curve",
+            &[("row", n)],
+            [
+                ("tip_position", "m", "tip position"),
+                ("force", "N", "force, measured"),
+                ("fit", "N", "force, fitted"),
+                ("residual", "N", "measured − fitted"),
+            ]
+            .iter()
+            .map(|&(k, u, l)| Variable::f64(k, &["row"], u, l, &arr(k)))
+            .collect(),
+        );
+        let mut facts = serde_json::Map::new();
+        for e in &r.outcome.estimates {
+            facts.insert(e.name.clone(), json!(e.value));
+            facts.insert(
+                format!("{}.standard_error", e.name),
+                json!(e.standard_error),
+            );
+        }
+        facts.insert("chi2_dof".into(), json!(r.outcome.chi2_dof));
+        Ok((vec![("curve".into(), curve)], facts))
+    }
+}

@@ -1,0 +1,96 @@
+//! `fit`: the summary of a force-curve fit (each estimate with its standard error and 95 %
+//! interval, χ²/dof, the warnings), its table `fit-curve.csv` (tip position, force, fit,
+//! residual), its document `fit.json` and the figures of the fit beside the data and of the
+//! residuals.
+
+use super::peakforce::rows;
+use super::{lines, with_document, Files};
+use crate::layout::figure::{Series, Style};
+use crate::report::{OutputsNote, Presentation, TextUnits};
+use serde_json::Value;
+use std::path::Path;
+
+/// The columns of the fitted curve's table (`fit-curve.csv`, Python's Dataset variables).
+pub const CURVE_COLUMNS: [&str; 4] = ["tip_position", "force", "fit", "residual"];
+
+/// The presentation of a fit's `document` ([`crate::request::fit::document`]): the summary,
+/// and with `files` the table, the figures (all files) and the document `fit.json`.
+pub fn fit(
+    document: &mut Value,
+    text: TextUnits,
+    files: Files,
+    dir: Option<&Path>,
+) -> Presentation {
+    let mut p = Presentation {
+        outputs_note: OutputsNote::Tail,
+        ..Presentation::default()
+    };
+    let units = document["units"].clone();
+    if let Some(est) = document["estimates"].as_object() {
+        for (name, e) in est {
+            let unit = units[name.as_str()].as_str().unwrap_or("");
+            let v = |x: &Value| x.as_f64().map_or("—".into(), |x| text.value(x, unit));
+            p.line(format!(
+                "{name} = {} ± {} (95 % interval [{}, {}])",
+                v(&e["value"]),
+                v(&e["standard_error"]),
+                v(&e["interval"][0]),
+                v(&e["interval"][1]),
+            ));
+        }
+    }
+    p.line(format!(
+        "{} law on {} rows of the {}: χ²/dof = {:.4e}; {}",
+        document["law"].as_str().unwrap_or(""),
+        document["rows_fitted"].as_u64().unwrap_or(0),
+        document["segment"].as_str().unwrap_or(""),
+        document["chi2_dof"].as_f64().unwrap_or(f64::NAN),
+        document["noise"].as_str().unwrap_or(""),
+    ));
+    if files == Files::None {
+        return p;
+    }
+    let curve = rows(document, "curve", &CURVE_COLUMNS);
+    #[cfg(feature = "files")]
+    {
+        use crate::layout::files::f;
+        let table = curve
+            .iter()
+            .map(|r| r.iter().map(|v| f(*v)).collect())
+            .collect();
+        p.csv("fit-curve.csv", &CURVE_COLUMNS, table);
+    }
+    if files == Files::All {
+        let series = |label: &str, col: usize, style: Style, color: usize| Series {
+            label: label.into(),
+            points: curve
+                .iter()
+                .map(|r| (r[0], r[col]))
+                .filter(|(x, y)| x.is_finite() && y.is_finite())
+                .collect(),
+            style,
+            color,
+        };
+        p.figure(
+            "fit-curve",
+            lines(
+                "Force curve: the data and the fit",
+                ("tip position (m)".into(), "force (N)".into()),
+                vec![
+                    series("data", 1, Style::Dots, 0),
+                    series("fit", 2, Style::Line, 1),
+                ],
+            ),
+        );
+        p.figure(
+            "fit-residual",
+            lines(
+                "Force curve: residuals (data − fit)",
+                ("tip position (m)".into(), "residual (N)".into()),
+                vec![series("", 3, Style::Line, 0)],
+            ),
+        );
+    }
+    with_document(&mut p, document, ("fit.json", "fit-curve.csv"), dir);
+    p
+}

@@ -1,0 +1,241 @@
+//! The force-curve fit (issue 62 §2) against stated sources: its sensitivities against central
+//! differences, nanite's preprocessing on an exact Hertz curve, the recovery of a synthetic
+//! Hertz curve's E and contact point (Sneddon 1965, eq. 6.9) within their intervals, the
+//! intervals' coverage over seeded noise draws, and the correlation warning where only E√R is
+//! identifiable.
+
+use afmdyn::analysis::fit::force_curve::{
+    preprocess, ForceCurveModel, ForceLaw, Segment, YOUNGS_MODULUS,
+};
+use afmdyn::analysis::fit::CurveModel;
+use afmdyn::analysis::progress::Progress;
+use afmdyn::probe::Probe;
+use afmdyn::request::fit::FitRequest;
+use afmdyn::request::{run, Resolved};
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+/// The lever (N/m), the sample (Pa, ν) and the tip (m) of examples/probe-fit-hertz.toml.
+const K: f64 = 0.05;
+const NU: f64 = 0.5;
+const R: f64 = 5e-6;
+/// The truth: E (Pa) and the contact point's piezo height (m).
+const E_TRUE: f64 = 5e3;
+const CP_TRUE: f64 = 0.0;
+
+fn probe() -> Resolved {
+    let text = include_str!("../../../examples/probe-fit-hertz.toml");
+    let p = Probe::parse(text, "probe-fit-hertz.toml").expect("probe");
+    Resolved {
+        params: p.params,
+        probe: Some(p),
+    }
+}
+
+/// An approach: `rows` piezo heights from +1 µm to −1.5 µm about the contact, the Hertz force
+/// of a rigid paraboloid (E* = E/(1 − ν²), as nanite's model; the probe's silicon tip changes
+/// E* by 4e-8), with `sigma` Gaussian noise (N) of seed `seed`.
+fn synthetic(rows: usize, sigma: f64, seed: u64) -> (Vec<f64>, Vec<f64>) {
+    let e_star = 1.0
+        / ((1.0 - 0.27 * 0.27) / afmdyn::cantilevers::SILICON_YOUNGS_MODULUS
+            + (1.0 - NU * NU) / E_TRUE);
+    let kh = 4.0 / 3.0 * e_star * R.sqrt();
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut height = Vec::with_capacity(rows);
+    let mut force = Vec::with_capacity(rows);
+    for i in 0..rows {
+        // the tip position x, the true force at it, the piezo height h = x − F/k
+        let x = 1e-6 - 2.5e-6 * i as f64 / (rows - 1) as f64;
+        let f = kh * (CP_TRUE - x).max(0.0).powf(1.5);
+        // Box–Muller
+        let (u1, u2): (f64, f64) = (rng.random::<f64>().max(1e-300), rng.random());
+        let noise = sigma * (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos();
+        height.push(x - f / K);
+        force.push(f + noise);
+    }
+    (height, force)
+}
+
+fn request(height: Vec<f64>, force: Vec<f64>, fit: &[&str]) -> FitRequest {
+    FitRequest {
+        height,
+        force,
+        fit: fit.iter().map(|s| s.to_string()).collect(),
+        ..FitRequest::default()
+    }
+}
+
+#[test]
+fn the_sensitivities_match_central_differences() {
+    for (law, p) in [
+        (ForceLaw::Hertz, vec![1e6, 20e-9, 1e-9, 1e-11]),
+        (ForceLaw::Dmt, vec![1e6, 20e-9, 1e-9, 1e-11, 1e-19]),
+        (ForceLaw::Jkr, vec![1e6, 20e-9, 1e-9, 1e-11, 0.05]),
+    ] {
+        let m = ForceCurveModel {
+            law,
+            x: (0..200).map(|i| 20e-9 - i as f64 * 0.25e-9).collect(),
+            segment: Segment::Approach,
+            poisson_ratio: 0.5,
+            tip: (1.69e11, 0.27),
+            intermolecular_distance: 0.3e-9,
+        };
+        let (rows, n) = (m.points(), p.len());
+        let mut v = vec![0.0; rows];
+        let mut jac = vec![0.0; rows * n];
+        m.evaluate(&p, &mut v, Some(&mut jac));
+        for j in 0..n {
+            let h = 1e-5 * p[j].abs();
+            let (mut a, mut b) = (p.clone(), p.clone());
+            a[j] += h;
+            b[j] -= h;
+            let (mut va, mut vb) = (vec![0.0; rows], vec![0.0; rows]);
+            m.evaluate(&a, &mut va, None);
+            m.evaluate(&b, &mut vb, None);
+            let scale = (0..rows).map(|i| jac[i * n + j].abs()).fold(0.0, f64::max);
+            for i in 0..rows {
+                let fd = (va[i] - vb[i]) / (2.0 * h);
+                // the kink at δ = 0 (JKR's jump there) lies between the differences' points
+                let near_kink = (p[2] - m.x[i]).abs() < 2.0 * h.max(1e-5 * p[2]);
+                assert!(
+                    near_kink || (fd - jac[i * n + j]).abs() <= 1e-5 * scale,
+                    "{law:?} ∂F/∂p{j} at row {i}: {fd} against {}",
+                    jac[i * n + j]
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn the_preprocessing_finds_the_contact_and_removes_the_offsets() {
+    let (height, mut force) = synthetic(500, 0.0, 1);
+    for f in &mut force {
+        *f += 2e-10;
+    }
+    let p = preprocess(&height, &force, K);
+    assert_eq!(p.approach_len, 500);
+    assert!((p.force_offset - 2e-10).abs() < 1e-18, "{}", p.force_offset);
+    // the first row past the contact (x < 0): row 200 of 500 on 1 µm … −1.5 µm
+    let i = p.contact_index.expect("a contact");
+    assert!((200..=202).contains(&i), "{i}");
+    assert!(p.tip_offset.abs() < 1.5e-8, "{}", p.tip_offset);
+}
+
+#[test]
+fn a_noisy_hertz_curve_gives_back_its_modulus_within_the_intervals() {
+    let (h, f) = synthetic(1000, 50e-12, 7);
+    let doc = run(
+        &request(h, f, &[YOUNGS_MODULUS, "contact_point", "baseline"]),
+        &probe(),
+        &Progress::default(),
+    )
+    .expect("fit");
+    let e = &doc.json["estimates"][YOUNGS_MODULUS];
+    let value = e["value"].as_f64().unwrap();
+    let [lo, hi] = [
+        e["interval"][0].as_f64().unwrap(),
+        e["interval"][1].as_f64().unwrap(),
+    ];
+    assert!(lo <= E_TRUE && E_TRUE <= hi, "{lo} {value} {hi}");
+    assert!((value / E_TRUE - 1.0).abs() < 0.01, "{value}");
+    let cp = &doc.json["estimates"]["contact_point"];
+    let tip_offset = doc.json["preprocessing"]["tip_offset"].as_f64().unwrap();
+    let [clo, chi] = [
+        cp["interval"][0].as_f64().unwrap(),
+        cp["interval"][1].as_f64().unwrap(),
+    ];
+    assert!(
+        clo + tip_offset <= CP_TRUE && CP_TRUE <= chi + tip_offset,
+        "{clo} {chi} {tip_offset}"
+    );
+    let warnings = doc.json["warnings"].as_array().unwrap();
+    assert!(
+        warnings.iter().any(|w| w
+            .as_str()
+            .unwrap()
+            .starts_with("noise estimated from residuals")),
+        "{warnings:?}"
+    );
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    // χ²/dof is the noise variance: the force's, and its share through the tip position
+    // x = h + F/k (σ/k = 1 nm, times the slope where the curve is steep): 1.3 σ here
+    let s = doc.json["chi2_dof"].as_f64().unwrap().sqrt();
+    assert!((1.0..1.5).contains(&(s / 50e-12)), "{s}");
+    for key in ["correlation", "curve", "preprocessing", "parameters"] {
+        assert!(doc.json.get(key).is_some(), "{key}");
+    }
+}
+
+#[test]
+fn the_intervals_cover_the_truth_in_90_to_99_percent_of_draws() {
+    let model = probe();
+    let draws = 100;
+    let (mut cover_e, mut cover_cp) = (0, 0);
+    for seed in 0..draws {
+        let (h, f) = synthetic(300, 100e-12, 1000 + seed);
+        let doc = run(
+            &request(h, f, &[YOUNGS_MODULUS, "contact_point", "baseline"]),
+            &model,
+            &Progress::default(),
+        )
+        .expect("fit");
+        let est = &doc.json["estimates"];
+        let inside = |name: &str, truth: f64| {
+            let i = &est[name]["interval"];
+            let (lo, hi) = (i[0].as_f64().unwrap(), i[1].as_f64().unwrap());
+            lo <= truth && truth <= hi
+        };
+        let offset = doc.json["preprocessing"]["tip_offset"].as_f64().unwrap();
+        cover_e += inside(YOUNGS_MODULUS, E_TRUE) as usize;
+        cover_cp += inside("contact_point", CP_TRUE - offset) as usize;
+    }
+    for (name, c) in [("E", cover_e), ("contact point", cover_cp)] {
+        assert!((90..=99).contains(&c), "{name}: {c} of {draws}");
+    }
+    eprintln!("coverage of the 95 % intervals: E {cover_e}, contact point {cover_cp} of {draws}");
+}
+
+#[test]
+fn modulus_and_radius_together_are_not_identifiable() {
+    let (h, f) = synthetic(500, 50e-12, 3);
+    let doc = run(
+        &request(h, f, &[YOUNGS_MODULUS, "tip.radius", "contact_point"]),
+        &probe(),
+        &Progress::default(),
+    )
+    .expect("fit");
+    let warnings: Vec<&str> = doc.json["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|w| w.as_str().unwrap())
+        .collect();
+    assert!(
+        warnings.iter().any(
+            |w| w.contains("sample.youngs_modulus and tip.radius are correlated")
+                || w.contains("singular")
+        ),
+        "{warnings:?}"
+    );
+}
+
+#[test]
+fn the_request_refuses_bad_input_in_one_sentence() {
+    let model = probe();
+    let (h, f) = synthetic(100, 0.0, 1);
+    for (r, what) in [
+        (request(h.clone(), f.clone(), &["sample.hamaker"]), "fit"),
+        (
+            request(h.clone(), f[..50].to_vec(), &[YOUNGS_MODULUS]),
+            "force",
+        ),
+        (request(Vec::new(), Vec::new(), &[YOUNGS_MODULUS]), "data"),
+    ] {
+        let e = run(&r, &model, &Progress::default())
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with(what), "{e}");
+        assert!(!e.contains('\n'), "{e}");
+    }
+}
