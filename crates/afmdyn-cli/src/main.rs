@@ -36,6 +36,7 @@ mod cmd_fm;
 mod cmd_image;
 mod cmd_modes;
 mod cmd_orbits;
+mod cmd_fit;
 mod cmd_peakforce;
 mod cmd_reconstruct;
 mod cmd_simulate;
@@ -104,6 +105,8 @@ enum Command {
     Fm(cmd_fm::FmArgs),
     /// Off-resonance (PeakForce) tapping: the steady tap's channels, cycle and force curve
     Peakforce(cmd_peakforce::PeakForceArgs),
+    /// Fit a measured force curve (Hertz, DMT, JKR): estimates, intervals, correlations, warnings
+    Fit(cmd_fit::FitArgs),
     /// Tip–sample force and potential from an FM-AFM frequency-shift curve (Sader–Jarvis)
     Reconstruct(cmd_reconstruct::ReconstructArgs),
     /// AM-AFM image of a heterogeneous sample (ideal or PI feedback): height, phase, E_dis maps
@@ -130,6 +133,7 @@ fn run(cli: Cli) -> Result<(), CliError> {
         Command::Resonance(a) => cmd_approach::resonance(&a),
         Command::Fm(a) => cmd_fm::fm(&a),
         Command::Peakforce(a) => cmd_peakforce::peakforce(&a),
+        Command::Fit(a) => cmd_fit::fit(&a),
         Command::Reconstruct(a) => cmd_reconstruct::reconstruct(&a),
         Command::Image(a) => cmd_image::image_cmd(&a),
     }

@@ -1,0 +1,70 @@
+//! `afmdyn fit`: a measured quasi-static force curve fitted with the probe's contact law
+//! (Hertz, DMT, JKR), with its contact point and baseline — estimates, standard errors, 95 %
+//! profile-likelihood intervals, correlations, χ²/dof, residuals and identifiability
+//! warnings. The request, the preprocessing, the fit and the document are the library's
+//! ([`afmdyn::request::FitRequest`], [`afmdyn::analysis::fit`]), and so are its summary, table,
+//! figures and `fit.json` ([`afmdyn::request::present::fit`]); this front end maps the flags.
+
+use crate::args::ModelArgs;
+use crate::door;
+use crate::error::CliError;
+use afmdyn::request::fit::FitSegment;
+use afmdyn::request::{FitRequest, Resolved};
+use afmdyn::Params;
+use clap::Args;
+use std::path::PathBuf;
+
+/// `afmdyn fit` flags.
+#[derive(Debug, Args)]
+pub struct FitArgs {
+    #[command(flatten)]
+    model: ModelArgs,
+    /// The force curve: a CSV with the columns height (m, the piezo height, decreasing into
+    /// the sample), force (N, repulsion positive) and optionally sigma (N)
+    #[arg(long, value_name = "FILE.csv")]
+    data: PathBuf,
+    /// The parameters fitted, by their probe keys, comma-separated: sample.youngs_modulus,
+    /// tip.radius, contact_point, baseline, sample.hamaker (dmt), sample.adhesion_energy (jkr)
+    #[arg(long, value_delimiter = ',', default_values_t = FitRequest::default().fit)]
+    fit: Vec<String>,
+    /// The segment fitted: approach (up to the lowest height) or retract
+    #[arg(long, default_value = "approach")]
+    segment: String,
+    /// The range of tip positions fitted, LO,HI (m, after the contact-point offset)
+    #[arg(long, value_delimiter = ',', num_args = 2, allow_hyphen_values = true)]
+    range: Option<Vec<f64>>,
+    /// Output directory (locked during the run)
+    #[arg(long, default_value = "afmdyn-out/fit")]
+    out: PathBuf,
+    /// Print one JSON document
+    #[arg(long)]
+    json: bool,
+}
+
+/// Run `afmdyn fit`.
+pub fn fit(a: &FitArgs) -> Result<(), CliError> {
+    let segment = match a.segment.as_str() {
+        "approach" => FitSegment::Approach,
+        "retract" => FitSegment::Retract,
+        s => {
+            return Err(CliError::Input(format!(
+                "--segment {s}: must be approach or retract"
+            )))
+        }
+    };
+    let (params, probe) = a.model.resolve(Params::default())?;
+    let request = FitRequest {
+        data: Some(a.data.display().to_string()),
+        fit: a.fit.clone(),
+        segment,
+        range: a.range.as_ref().map(|r| [r[0], r[1]]),
+        ..FitRequest::default()
+    };
+    let model = Resolved { params, probe };
+    let exit = door::Exit {
+        json: a.json,
+        out: Some(&a.out),
+        unit: "fits",
+    };
+    door::run(&request, &model, exit).map(|_| ())
+}
