@@ -11,7 +11,7 @@ use crate::analysis::fit::force_curve::{
     bounds, preprocess, ForceCurveModel, ForceLaw, Preprocessed, Segment, BASELINE, CONTACT_POINT,
     HAMAKER, RADIUS, YOUNGS_MODULUS,
 };
-use crate::analysis::fit::{fit, FitOutcome, Observations, Parameter};
+use crate::analysis::fit::{fit, FitOutcome, Observations, Parameter, ProfileEnd};
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
 use serde::{Deserialize, Serialize};
@@ -406,11 +406,17 @@ impl Analysis for FitRequest {
 
 /// The document of a fit (`afmdyn fit --json`, Python's `summary`): `estimates` (each fitted
 /// parameter's `value`, `standard_error`, 95 % `interval` — the profile likelihood's —,
-/// `wald_interval`), `parameters` (every parameter's value, fitted or held), `correlation`
+/// `wald_interval`, `interval_ends` — crossing, bound or flat —, `profile` — the points walked,
+/// `value` and `delta_chi2`), `parameters` (every parameter's value, fitted or held), `correlation`
 /// (`names`, `matrix`), `chi2`, `dof`, `chi2_dof`, `noise`, `curve` (the fitted rows' tip
 /// position, force, fit and residual), `preprocessing`, `law`, `segment`, `range`, `units`,
 /// `method`, `warnings`; SI throughout.
 pub fn document(request: &FitRequest, r: &FitResult) -> Value {
+    let end = |e: ProfileEnd| match e {
+        ProfileEnd::Crossing(_) => "crossing",
+        ProfileEnd::Bound(_) => "bound",
+        ProfileEnd::Flat(_) => "flat (the last point walked: open)",
+    };
     let o = &r.outcome;
     let mut estimates = serde_json::Map::new();
     for e in &o.estimates {
@@ -423,6 +429,11 @@ pub fn document(request: &FitRequest, r: &FitResult) -> Value {
                 "interval": e.interval.map(finite),
                 "interval_method": if e.profile.is_some() { "profile likelihood, Δχ² ≤ 3.84" } else { "Wald, ±1.96 SE" },
                 "wald_interval": e.wald.map(finite),
+                "interval_ends": e.profile.as_ref().map(|p| [end(p.lower), end(p.upper)]),
+                "profile": e.profile.as_ref().map(|p| json!({
+                    "value": p.points.iter().map(|q| q.0).collect::<Vec<f64>>(),
+                    "delta_chi2": p.points.iter().map(|q| q.1).collect::<Vec<f64>>(),
+                })),
             }),
         );
     }

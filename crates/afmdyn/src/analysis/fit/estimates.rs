@@ -273,8 +273,8 @@ fn covariance(
             inv += v * v.transpose() / lambda;
         } else {
             singular = true;
-            for i in 0..n {
-                null[i] |= v[i].abs() > 1e-6;
+            for (ni, vi) in null.iter_mut().zip(v.iter()) {
+                *ni |= vi.abs() > 1e-6;
             }
         }
     }

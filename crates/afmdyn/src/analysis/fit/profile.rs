@@ -56,6 +56,7 @@ pub struct Profile {
 /// fraction of its scale where that is not finite), half a step at first and growing by half
 /// after 4 steps' distance, each refit starting from the previous one; `s2` scales χ² (the
 /// noise variance, 1 with σ given).
+#[allow(clippy::too_many_arguments)]
 pub fn profile(
     model: &dyn CurveModel,
     obs: &Observations,
