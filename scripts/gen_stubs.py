@@ -45,6 +45,7 @@ RUN = [
     ("fm", "fm"),
     ("reconstruct", "reconstruct"),
     ("peakforce", "peakforce"),
+    ("fit", "fit"),
 ]
 #: the studies run into a store through ``_afmdyn.run_stored`` (the library's
 #: ``study::stored::parse``) and their schema files

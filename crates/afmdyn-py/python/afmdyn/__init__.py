@@ -49,6 +49,7 @@ from ._interrupt import install as _install_sigint
 from ._orbits import lyapunov, orbit
 from ._fm import fm
 from ._peakforce import peakforce
+from ._fit import fit
 from ._image import image, setpoint_study
 from ._reconstruct import reconstruct
 from ._results import Lyapunov, Orbit, RegionSpectrum, Spectrum
@@ -95,6 +96,7 @@ __all__ = [
     "setpoint_study",
     "fm",
     "peakforce",
+    "fit",
     "resonance",
     "simulate",
     "summary",

@@ -402,6 +402,20 @@ PeakForceRequest = TypedDict(
     total=False,
 )
 
+FitRequest = TypedDict(
+    "FitRequest",
+    {
+        "data": Optional[str],  # default null
+        "fit": List[str],  # default ["sample.youngs_modulus", "contact_point"]
+        "force": List[float],  # default []
+        "height": List[float],  # default []
+        "range": Optional[List[float]],  # default null
+        "segment": Literal["approach", "retract"],  # default "approach"
+        "sigma": Optional[List[float]],  # default null
+    },
+    total=False,
+)
+
 BifurcationRequest = TypedDict(
     "BifurcationRequest",
     {
@@ -591,6 +605,15 @@ def run(
 def run(
     name: Literal["peakforce"],
     request: Optional[PeakForceRequest] = None,
+    params: Optional[Params] = None,
+    probe: Optional[str] = None,
+    progress: Optional[ProgressCallback] = None,
+) -> Dict[str, Any]: ...
+
+@overload
+def run(
+    name: Literal["fit"],
+    request: Optional[FitRequest] = None,
     params: Optional[Params] = None,
     probe: Optional[str] = None,
     progress: Optional[ProgressCallback] = None,
