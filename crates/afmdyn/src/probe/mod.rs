@@ -313,7 +313,7 @@ pub struct Probe {
 }
 
 /// The sample's and tip's SI inputs of a probe file by their keys (`None` where the law takes
-/// none): the start values of `fit`'s parameters ([`crate::analysis::fit`]).
+/// none): the start values of `fit`'s parameters (the request `fit`).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct SampleInputs {
     /// `[sample] youngs_modulus` (Pa).

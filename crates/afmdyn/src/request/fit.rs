@@ -8,12 +8,13 @@
 use super::limits::Cost;
 use super::run::{Analysis, Resolved};
 use crate::analysis::fit::force_curve::{
-    bounds, preprocess, ForceCurveModel, ForceLaw, Preprocessed, Segment, BASELINE, CONTACT_POINT,
-    HAMAKER, RADIUS, YOUNGS_MODULUS,
+    preprocess, ForceCurveModel, ForceLaw, Preprocessed, Segment, BASELINE, CONTACT_POINT, HAMAKER,
+    RADIUS, YOUNGS_MODULUS,
 };
 use crate::analysis::fit::{fit, FitOutcome, Observations, Parameter, ProfileEnd};
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
+use crate::probe::ranges::si_range;
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 
@@ -77,6 +78,20 @@ impl Default for FitRequest {
             range: None,
         }
     }
+}
+
+/// The physical range [lo, hi] of a fitted quantity from the probe's ranges
+/// ([`crate::probe::ranges::SI_RANGES`]; a positive quantity without a lower bound there is
+/// bounded by 0); (−∞, ∞) for the contact point and the baseline.
+pub fn bounds(name: &str) -> (f64, f64) {
+    let (section, key) = match name.split_once('.') {
+        Some(sk) => sk,
+        None => return (f64::NEG_INFINITY, f64::INFINITY),
+    };
+    let range = si_range(section, key);
+    let lo = range.and_then(|r| r.below).map_or(0.0, |b| b.0);
+    let hi = range.and_then(|r| r.above).map_or(f64::INFINITY, |b| b.0);
+    (lo, hi)
 }
 
 /// The result of a `fit` request.

@@ -34,7 +34,6 @@
 //! DMT's and JKR's groups (error ~1e-12 relative), chained to E_s, R, H and W analytically.
 
 use crate::contact::{DmtLaw, HertzLaw, Jkr, JkrLaw, Law};
-use crate::probe::ranges::si_range;
 
 /// The force-curve laws the fit takes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -178,20 +177,6 @@ pub fn preprocess(height: &[f64], force: &[f64], spring_constant: f64) -> Prepro
         force_offset,
         tip_offset,
     }
-}
-
-/// The physical range [lo, hi] of a fitted quantity from the probe's ranges
-/// ([`crate::probe::ranges::SI_RANGES`]; a positive quantity without a lower bound there is
-/// bounded by 0); (−∞, ∞) for the contact point and the baseline.
-pub fn bounds(name: &str) -> (f64, f64) {
-    let (section, key) = match name.split_once('.') {
-        Some(sk) => sk,
-        None => return (f64::NEG_INFINITY, f64::INFINITY),
-    };
-    let range = si_range(section, key);
-    let lo = range.and_then(|r| r.below).map_or(0.0, |b| b.0);
-    let hi = range.and_then(|r| r.above).map_or(f64::INFINITY, |b| b.0);
-    (lo, hi)
 }
 
 /// The force-curve model at the rows' tip positions (module docs). Parameters in
