@@ -451,3 +451,108 @@ fn peakforce_request_by_name_reports_si_channels() {
         .to_string();
     assert!(e.contains("omega"), "{e}");
 }
+
+/// The instrument's low-pass filter (filter_cutoff, Hz with a probe): the curve carries the
+/// measured force k × deflection through a causal second-order Butterworth filter, as long
+/// as the tip–sample force's arrays; a cut-off at 20 kHz (against a 70 kHz lever) lowers and
+/// delays the peak of the measured force; a cut-off above the Nyquist frequency of the
+/// cycle's samples is refused naming `filter_cutoff`.
+#[test]
+fn peakforce_filter_on_the_measured_force() {
+    use afmdyn::request::{named, Resolved};
+    let text = std::fs::read_to_string(AIR)
+        .unwrap()
+        .replace("model = \"beam\"\nmodes = 3", "model = \"point-mass\"");
+    let probe = afmdyn::probe::Probe::parse(&text, "air-pm").unwrap();
+    let model = Resolved {
+        params: probe.params,
+        probe: Some(probe),
+    };
+    let run = |json| {
+        named::parse("peakforce", json)
+            .unwrap()
+            .unwrap()
+            .run(&model, &Default::default())
+    };
+    let plain = run(serde_json::json!({})).unwrap().document;
+    assert!(plain["filter"].is_null());
+    assert!(plain["curve"].get("approach_filtered_force").is_none());
+    let out = run(serde_json::json!({"filter_cutoff": 20e3})).unwrap();
+    let doc = &out.document;
+    assert_eq!(doc["filter"]["cutoff"], 20e3);
+    let curve = &doc["curve"];
+    let arr = |k: &str| -> Vec<f64> {
+        curve[k]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect()
+    };
+    let filtered: Vec<f64> = [
+        arr("approach_filtered_force"),
+        arr("retract_filtered_force"),
+    ]
+    .concat();
+    assert_eq!(
+        filtered.len(),
+        doc["cycle"]["force"].as_array().unwrap().len()
+    );
+    // the measured force k × deflection, unfiltered: the cycle's deflection times k
+    let k = 0.4;
+    let measured: Vec<f64> = doc["cycle"]["deflection"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| k * v.as_f64().unwrap())
+        .collect();
+    let argmax = |v: &[f64]| (0..v.len()).fold(0, |i, j| if v[j] > v[i] { j } else { i });
+    let (im, jf) = (argmax(&measured), argmax(&filtered));
+    eprintln!(
+        "measured peak {:e} at {im}, filtered {:e} at {jf}",
+        measured[im], filtered[jf]
+    );
+    assert!(filtered[jf] < measured[im]);
+    assert!(jf > im);
+    let e = run(serde_json::json!({"filter_cutoff": 1e12}))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("filter_cutoff"), "{e}");
+}
+
+/// A constant passes unchanged (unit DC gain); a sinusoid at the cut-off leaves with the
+/// Butterworth gain 1/√2 and phase −π/2 (the bilinear transform's prewarping keeps the
+/// cut-off exact); one far above it is attenuated as (f_c/f)², and the output is periodic
+/// (no transient).
+#[test]
+fn peakforce_filter_is_a_butterworth_low_pass() {
+    use afmdyn::analysis::peakforce::low_pass_periodic;
+    use std::f64::consts::{PI, SQRT_2, TAU};
+    let n = 4096;
+    let dc = low_pass_periodic(&vec![2.5; n], 0.01).unwrap();
+    assert!(dc.iter().all(|y| (y - 2.5).abs() < 1e-12), "{:?}", &dc[..3]);
+    // 16 cycles per period at the cut-off 16/n cycles per sample
+    let cycles = 16.0;
+    let x: Vec<f64> = (0..n)
+        .map(|k| (TAU * cycles * k as f64 / n as f64).sin())
+        .collect();
+    let y = low_pass_periodic(&x, cycles / n as f64).unwrap();
+    // project on sin and cos: gain and phase
+    let (mut s, mut co) = (0.0, 0.0);
+    for (k, yk) in y.iter().enumerate() {
+        let t = TAU * cycles * k as f64 / n as f64;
+        s += yk * t.sin();
+        co += yk * t.cos();
+    }
+    let (s, co) = (2.0 * s / n as f64, 2.0 * co / n as f64);
+    let gain = s.hypot(co);
+    let phase = co.atan2(s);
+    assert!((gain - 1.0 / SQRT_2).abs() < 1e-9, "gain {gain}");
+    assert!((phase + PI / 2.0).abs() < 1e-9, "phase {phase}");
+    // a tenth of the frequency as cut-off: gain ≈ 1/√(1 + 10⁴)
+    let y = low_pass_periodic(&x, 0.1 * cycles / n as f64).unwrap();
+    let peak = y.iter().fold(0.0, |a: f64, b| a.max(b.abs()));
+    assert!((peak * 100.0 - 1.0).abs() < 2e-2, "{peak}");
+    assert!(low_pass_periodic(&x, 0.5).is_err());
+    assert!(low_pass_periodic(&x, 0.0).is_err());
+}
