@@ -434,6 +434,18 @@ fn peakforce_request_by_name_reports_si_channels() {
     assert_eq!(out.document["units"]["peak_force"], "N");
     assert!(out.document["modulus"]["true"].as_f64().unwrap() > 1e9);
     assert_eq!(out.datasets.len(), 2);
+    // f₀/f_m of the example, 70 kHz over 2 kHz, on the point mass and on the beam (whose
+    // first natural frequency is ≈ 3.516 in its own units, not 1)
+    let ratio = out.document["modulation"]["f0_over_fm"].as_f64().unwrap();
+    assert!((ratio / 35.0 - 1.0).abs() < 1e-9, "{ratio}");
+    let beam = afmdyn::probe::Probe::parse(&text, "air").unwrap();
+    let beam = Resolved {
+        params: beam.params,
+        probe: Some(beam),
+    };
+    let doc = r.run(&beam, &Default::default()).unwrap().document;
+    let ratio = doc["modulation"]["f0_over_fm"].as_f64().unwrap();
+    assert!((ratio / 35.0 - 1.0).abs() < 1e-6, "{ratio}");
     // a force-driven point mass (tapping near resonance) is no modulation
     let tapping = Params {
         excitation: Excitation::Base,

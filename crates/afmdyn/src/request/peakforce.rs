@@ -354,6 +354,11 @@ pub fn document(request: &PeakForceRequest, model: &Resolved, r: &PeakForceResul
     let multipliers: Vec<[f64; 2]> = tap.multipliers.iter().map(|m| [m.re, m.im]).collect();
     let time_unit = if u.si { "s" } else { "τ" };
     let period = std::f64::consts::TAU / p.omega;
+    // f₀/f_m: the lever's first natural frequency as modelled (in its medium; 1 in the lumped
+    // models' units, ≈ 3.516 in the beam's) over Ω
+    let omega1 = CantileverModel::new(&p).map_or(1.0, |m| {
+        crate::eigen::natural_modes(m.galerkin().region(crate::galerkin::Region::Free)).omega[0]
+    });
     let mut curve = json!({
         "approach_distance": col(&t.distance[..half], u.length),
         "approach_force": col(&t.force[..half], u.force),
@@ -396,7 +401,7 @@ pub fn document(request: &PeakForceRequest, model: &Resolved, r: &PeakForceResul
         "feedback_evaluations": r.evaluations,
         "modulation": {
             "period": period * u.time,
-            "f0_over_fm": 1.0 / p.omega,
+            "f0_over_fm": omega1 / p.omega,
             "amplitude": p.alpha2 * u.length,
         },
         "orbit": {
