@@ -7,8 +7,12 @@
 //! this front end maps the flags.
 
 use crate::args::{quantity, Dim, ModelArgs, Quantity};
+use crate::cmd_approach::files;
+use crate::cmd_simulate::Files;
 use crate::door;
 use crate::error::CliError;
+use crate::output::{units_of, OutDir};
+use afmdyn::request::present;
 use afmdyn::request::{PeakForceRequest, Resolved};
 use afmdyn::Params;
 use clap::Args;
@@ -23,12 +27,20 @@ pub struct PeakForceArgs {
     /// excludes --z-c (the mean rest separation, else the probe's [sample] z_c)
     #[arg(long, allow_hyphen_values = true)]
     setpoint: Option<Quantity>,
+    /// The instrument's low-pass filter on the measured force curve: the cut-off (Hz with
+    /// --probe, else cycles per τ; a unit may follow: 50kHz) of a causal second-order
+    /// Butterworth filter on k × deflection; the curve gains the filtered force
+    #[arg(long)]
+    filter_cutoff: Option<Quantity>,
     /// Points of the reported cycle (2000..=1000000)
     #[arg(long, default_value_t = PeakForceRequest::default().samples)]
     samples: usize,
     /// Output directory (locked during the run)
     #[arg(long, default_value = "afmdyn-out/peakforce")]
     out: PathBuf,
+    /// Files written: all (data and plots), data (no plots) or none (only the summary)
+    #[arg(long, value_enum, default_value = "all")]
+    files: Files,
     /// Print one JSON document
     #[arg(long)]
     json: bool,
@@ -48,13 +60,23 @@ pub fn peakforce(a: &PeakForceArgs) -> Result<(), CliError> {
     let request = PeakForceRequest {
         setpoint: quantity(a.setpoint, "setpoint", Dim::Force, si)?,
         samples: a.samples,
+        filter_cutoff: quantity(a.filter_cutoff, "filter-cutoff", Dim::Frequency, si)?,
         ..PeakForceRequest::default()
     };
     let model = Resolved { params, probe };
-    let exit = door::Exit {
-        json: a.json,
-        out: Some(&a.out),
-        unit: "steady taps",
-    };
-    door::run(&request, &model, exit).map(|_| ())
+    // the door's steps (validated and held to the budgets before --out is locked), with the
+    // library's presentation at the --files asked for
+    afmdyn::request::run::admit(&request, &model)?;
+    let out = (a.files != Files::None)
+        .then(|| OutDir::lock(&a.out))
+        .transpose()?;
+    let doc = crate::progress::run(&request, &model, "steady taps")?.json;
+    let dir = out.as_ref().map(OutDir::path);
+    let shown = present::peakforce::peakforce(
+        &mut doc.clone(),
+        units_of(model.probe.as_ref()),
+        files(a.files),
+        dir,
+    );
+    door::emit(out.as_ref(), &shown, &doc, a.json)
 }

@@ -27,13 +27,14 @@ EIG = str(EXAMPLES / "probe-eigenmodes-dmt.toml")
 BIM = str(EXAMPLES / "probe-bimodal.toml")
 STRIPE = str(EXAMPLES / "sample-stripe.toml")
 IMAGE = ["--probe", P1, "--sample", STRIPE, "--setpoint", 0.7, "--pixels", 4]
+PF = str(EXAMPLES / "probe-peakforce-water.toml")
 IMPACT = "--contact-law impact --restitution 0.5 --modes 1 --gap 0.05 --omega 3".split()
 IMPACT_PY = dict(contact_law="impact", restitution=0.5, modes=1, gap=0.05, omega=3.0)
 SHORT = ["--max-periods", 300]
 
 COMMANDS = ["modes", "units", "simulate", "converge", "bifurcation", "attractors", "orbit",
             "continue", "lyapunov", "approach", "resonance", "chart", "basins", "reconstruct",
-            "fm", "bimodal", "image"]
+            "fm", "bimodal", "image", "peakforce"]
 FM = str(EXAMPLES / "fm-vdw.csv")
 FM_ARGS = ["--fm", FM, "--spring-constant", 40, "--resonance-frequency", "300kHz",
            "--amplitude", "10nm"]
@@ -134,13 +135,14 @@ CLI_CASES: List[Tuple[str, List[Any]]] = [
     ("image", IMAGE),
     ("image", [*IMAGE, "--setpoint-study", "0.3:0.9:3"]),
     ("image", [*IMAGE, "--feedback", "pi", "--scan-rate", 20]),
+    ("peakforce", ["--probe", PF]),
     # (a probe refuses the dimensionless omega axis: the drive frequency in Hz, 0.99 f0)
     ("chart", ["--x", "z-c", "--x-from", 6e-9, "--x-to", 8e-9, "--x-steps", 2, "--y",
                "drive-frequency", "--y-from", "297kHz", "--y-to", "297kHz", "--y-steps", 1,
                "--starts", 1, *SHORT, "--probe", P1]),
 ]
 WRITES = {"simulate", "converge", "bifurcation", "attractors", "continue", "chart", "basins",
-          "reconstruct", "fm", "image"}
+          "reconstruct", "fm", "image", "peakforce"}
 
 
 @pytest.fixture(scope="module")
@@ -224,6 +226,7 @@ def _python_docs() -> List[Tuple[str, str, Callable[[], Any]]]:
             afmdyn.image(P1, STRIPE, 0.7, pixels=4)))),
         ("image", "image pi", lambda: _quiet(lambda: afmdyn.summary(afmdyn.image(
             P1, STRIPE, 0.7, pixels=4, feedback="pi", scan_rate=20.0, progress=False)))),
+        ("peakforce", "peakforce probe", lambda: afmdyn.summary(afmdyn.peakforce(probe=PF))),
     ]
 
 

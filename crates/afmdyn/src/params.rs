@@ -34,6 +34,14 @@ pub const ALPHA4_MAX: f64 = 1e8;
 /// Smallest drive frequency Ω: below it one drive period spans more than ~10⁴ oscillations of
 /// the first mode, a grid far beyond [`GRID_BUDGET_BYTES`] for any N > 1.
 pub const OMEGA_MIN: f64 = 1e-3;
+/// Smallest modulation frequency Ω = f_m/f₀ of a moving sample ([`Excitation::Sample`],
+/// off-resonance tapping): f₀/f_m up to 10⁵ is physical (a 300 kHz lever under a 1–8 kHz
+/// PeakForce modulation is 40–300; a 2 MHz lever at 250 Hz is 8 000), and the modulation
+/// does not set the integrators' steps (they follow the lever's modes, the switching search
+/// its contact), so its period costs ~1/Ω lever periods of work, bounded at run time by
+/// [`ADAPTIVE_STEPS_PER_PERIOD`] and up front by [`ADAPTIVE_STEPS_BUDGET`] and
+/// [`GRID_BUDGET_BYTES`]. The resonant drives keep [`OMEGA_MIN`].
+pub const OMEGA_MIN_MODULATED: f64 = 1e-5;
 /// Largest drive frequency Ω: above it the inertial drive α2Ω² is so much larger than the
 /// response that the result is round-off (the per-period energy balance fails, 1e-7 relative at
 /// Ω = 1e8), and Ω is far above the highest Galerkin mode the model resolves (N ≤ 20).
@@ -482,12 +490,18 @@ impl Params {
         if !(self.omega.is_finite() && self.omega > 0.0) {
             return Err(ParamError::Omega(self.omega));
         }
-        if !(OMEGA_MIN..=OMEGA_MAX).contains(&self.omega) {
+        // a moving sample (off-resonance modulation) has its own lower bound
+        let (lowest, range) = if self.excitation == Excitation::Sample {
+            (OMEGA_MIN_MODULATED, "[1e-5, 1e5] (a modulated sample)")
+        } else {
+            (OMEGA_MIN, "[1e-3, 1e5]")
+        };
+        if !(lowest..=OMEGA_MAX).contains(&self.omega) {
             return Err(ParamError::Magnitude {
                 name: "omega (drive frequency Ω)",
                 value: self.omega,
-                range: "[1e-3, 1e5]",
-                reason: if self.omega < OMEGA_MIN {
+                range,
+                reason: if self.omega < lowest {
                     "one drive period would need too many integration steps"
                 } else {
                     "the drive swamps the response in round-off, far above the highest mode"

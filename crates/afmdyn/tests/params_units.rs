@@ -261,7 +261,7 @@ fn magnitudes_beyond_the_numerics_are_rejected_naming_the_field() {
     // wrong. Each limit is accepted exactly and refused just beyond, with a message naming the
     // field and the allowed range.
     let d = Params::default();
-    let cases: [(Params, Params, &str, &str); 8] = [
+    let cases: [(Params, Params, &str, &str); 10] = [
         (
             Params { alpha1: 1e4, ..d },
             Params {
@@ -313,6 +313,28 @@ fn magnitudes_beyond_the_numerics_are_rejected_naming_the_field() {
         (
             Params { omega: 1e5, ..d },
             Params { omega: 1e9, ..d },
+            "omega",
+            "[1e-3, 1e5]",
+        ),
+        // a modulated sample (off-resonance tapping) reaches f₀/f_m = 1e5; the resonant
+        // drives keep 1e-3 (the case above is the default base drive)
+        (
+            Params {
+                omega: 1e-5,
+                excitation: afmdyn::params::Excitation::Sample,
+                ..d
+            },
+            Params {
+                omega: 9e-6,
+                excitation: afmdyn::params::Excitation::Sample,
+                ..d
+            },
+            "omega",
+            "[1e-5, 1e5] (a modulated sample)",
+        ),
+        (
+            Params { omega: 1e-3, ..d },
+            Params { omega: 1e-4, ..d },
             "omega",
             "[1e-3, 1e5]",
         ),

@@ -394,6 +394,7 @@ ReconstructRequest = TypedDict(
 PeakForceRequest = TypedDict(
     "PeakForceRequest",
     {
+        "filter_cutoff": Optional[float],  # default null
         "fit_band": List[float],  # default [0.3, 0.9]
         "samples": int,  # default 4096
         "setpoint": Optional[float],  # default null

@@ -25,6 +25,7 @@ def peakforce(
     setpoint: Optional[float] = None,
     samples: int = 4096,
     fit_band: Optional[List[float]] = None,
+    filter_cutoff: Optional[float] = None,
     progress: ProgressArg = None,
     **model: Unpack[Model],
 ) -> xr.Dataset:
@@ -38,6 +39,9 @@ def peakforce(
         samples: points of the cycle, 2000..=1000000.
         fit_band: the DMT fit's band, fractions [lo, hi] of the retract's force range
             (default [0.3, 0.9]).
+        filter_cutoff: the instrument's low-pass filter (Hz with ``probe``, else cycles per
+            τ): a causal second-order Butterworth filter on the measured force k × deflection;
+            the curve gains ``approach_filtered_force`` and ``retract_filtered_force``.
         probe: a probe file (a model keyword, as ``--probe``): SI inputs and outputs.
 
     Returns:

@@ -30,9 +30,11 @@
 //! same fit on the true force F_c: the channels are the true tip–sample force's, the fit
 //! shows the instrument method's bias.
 
+mod filter;
 mod fit;
 mod setpoint;
 
+pub use filter::low_pass_periodic;
 pub use fit::{fit_dmt, DmtFit, FIT_BAND};
 pub use setpoint::{
     peak_force_setpoint, SetpointOptions, SetpointTap, BRACKET_STEPS, SETPOINT_ITERATIONS,

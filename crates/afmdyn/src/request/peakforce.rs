@@ -9,8 +9,9 @@ use super::costs::{newton_work, state_bytes, steady_periods, MODEL_BYTES};
 use super::limits::Cost;
 use super::run::{Analysis, Resolved};
 use crate::analysis::peakforce::{
-    peak_force_setpoint, steady_tap, PeakForceOptions, SetpointOptions, SteadyTap, BRACKET_STEPS,
-    FIT_BAND, MAX_CYCLE_SAMPLES, MIN_CYCLE_SAMPLES, SETPOINT_ITERATIONS,
+    low_pass_periodic, peak_force_setpoint, static_compliance, steady_tap, PeakForceOptions,
+    SetpointOptions, SteadyTap, BRACKET_STEPS, FIT_BAND, MAX_CYCLE_SAMPLES, MIN_CYCLE_SAMPLES,
+    SETPOINT_ITERATIONS,
 };
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
@@ -42,6 +43,13 @@ pub struct PeakForceRequest {
     /// The DMT fit's band: fractions [lo, hi] of the retract curve's force range from the
     /// adhesion to the peak force (default [0.3, 0.9]).
     pub fit_band: [f64; 2],
+    /// The instrument's low-pass filter on the measured force: the cut-off f_c (Hz with a
+    /// probe, else cycles per τ) of a causal second-order Butterworth filter
+    /// ([`crate::analysis::peakforce::low_pass_periodic`]) applied over the cycle to the force
+    /// the instrument measures, k × deflection; the curve then carries it filtered beside the
+    /// tip–sample force. `None` (default): no filter. f_c must lie below the Nyquist frequency
+    /// of the cycle's samples, `samples`/(2 × the modulation period).
+    pub filter_cutoff: Option<f64>,
 }
 
 impl Default for PeakForceRequest {
@@ -51,6 +59,7 @@ impl Default for PeakForceRequest {
             setpoint: None,
             samples: 4_096,
             fit_band: [FIT_BAND.0, FIT_BAND.1],
+            filter_cutoff: None,
         }
     }
 }
@@ -64,6 +73,9 @@ pub struct PeakForceResult {
     pub tap: SteadyTap,
     /// Steady taps the setpoint's feedback computed (1 at a given z_c).
     pub evaluations: usize,
+    /// The measured force k × deflection (F̃) over the cycle through the instrument's filter
+    /// (with [`PeakForceRequest::filter_cutoff`]).
+    pub filtered: Option<Vec<f64>>,
 }
 
 impl PeakForceRequest {
@@ -120,6 +132,20 @@ impl PeakForceRequest {
             ));
         }
         self.options().validate()?;
+        if let Some(fc) = self.filter_cutoff {
+            // the cycle's sampling interval in the document's time unit (s with a probe)
+            let nyquist = 0.5 / self.sampling_interval(model, &p);
+            if !(fc.is_finite() && fc > 0.0 && fc < nyquist) {
+                return Err(SimError::out_of_range(
+                    "filter_cutoff",
+                    fc,
+                    format!(
+                        "must be a cut-off frequency > 0 below the Nyquist frequency of the \
+                         cycle's samples, {nyquist:.6e} (raise samples to raise it)"
+                    ),
+                ));
+            }
+        }
         let length = Self::units(model).length;
         let mut q = p;
         match (self.z_c, self.setpoint) {
@@ -155,6 +181,30 @@ impl PeakForceRequest {
     }
 }
 
+impl PeakForceRequest {
+    /// The cycle's sampling interval, the modulation period over `samples` (s with a probe,
+    /// else τ).
+    fn sampling_interval(&self, model: &Resolved, p: &Params) -> f64 {
+        std::f64::consts::TAU / p.omega / self.samples as f64 * Self::units(model).time
+    }
+
+    /// The measured force k × deflection (the deflection over the static compliance) of the
+    /// tap's cycle through the filter of [`PeakForceRequest::filter_cutoff`], F̃.
+    fn filtered(
+        &self,
+        model: &Resolved,
+        p: &Params,
+        tap: &SteadyTap,
+    ) -> Result<Option<Vec<f64>>, SimError> {
+        let Some(fc) = self.filter_cutoff else {
+            return Ok(None);
+        };
+        let c = static_compliance(&CantileverModel::new(p)?);
+        let measured: Vec<f64> = tap.cycle.deflection.iter().map(|w| w / c).collect();
+        low_pass_periodic(&measured, fc * self.sampling_interval(model, p)).map(Some)
+    }
+}
+
 impl Analysis for PeakForceRequest {
     type Output = PeakForceResult;
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
@@ -172,15 +222,20 @@ impl Analysis for PeakForceRequest {
                 let s = peak_force_setpoint(&p, f / force, &opts)?;
                 Ok(PeakForceResult {
                     alpha5: s.alpha5,
+                    filtered: self.filtered(model, &p, &s.tap)?,
                     tap: s.tap,
                     evaluations: s.evaluations,
                 })
             }
-            None => Ok(PeakForceResult {
-                alpha5: p.alpha5,
-                tap: steady_tap(&CantileverModel::new(&p)?, &self.options())?,
-                evaluations: 1,
-            }),
+            None => {
+                let tap = steady_tap(&CantileverModel::new(&p)?, &self.options())?;
+                Ok(PeakForceResult {
+                    alpha5: p.alpha5,
+                    filtered: self.filtered(model, &p, &tap)?,
+                    tap,
+                    evaluations: 1,
+                })
+            }
         }
     }
     fn name(&self) -> &'static str {
@@ -233,6 +288,12 @@ impl Analysis for PeakForceRequest {
         Some(r.tap.channels.deformation)
     }
 }
+
+/// The filter's words in the document (`filter.kind`).
+pub const FILTER_KIND: &str = "second-order Butterworth low-pass (Butterworth 1930; bilinear \
+     transform with the cut-off prewarped), causal as the instrument's real-time filter, in \
+     its periodic steady state over the cycle, on the measured force k × deflection: \
+     curve.approach_filtered_force and curve.retract_filtered_force";
 
 /// The sample's true reduced modulus E* (Pa) of a Hertz-type law under a probe: from the
 /// Hertz group α4 = (4/3)E*√R g₀^{3/2}/F_s (module docs of [`crate::probe`]).
@@ -293,6 +354,21 @@ pub fn document(request: &PeakForceRequest, model: &Resolved, r: &PeakForceResul
     let multipliers: Vec<[f64; 2]> = tap.multipliers.iter().map(|m| [m.re, m.im]).collect();
     let time_unit = if u.si { "s" } else { "τ" };
     let period = std::f64::consts::TAU / p.omega;
+    // f₀/f_m: the lever's first natural frequency as modelled (in its medium; 1 in the lumped
+    // models' units, ≈ 3.516 in the beam's) over Ω
+    let omega1 = CantileverModel::new(&p).map_or(1.0, |m| {
+        crate::eigen::natural_modes(m.galerkin().region(crate::galerkin::Region::Free)).omega[0]
+    });
+    let mut curve = json!({
+        "approach_distance": col(&t.distance[..half], u.length),
+        "approach_force": col(&t.force[..half], u.force),
+        "retract_distance": col(&t.distance[half..], u.length),
+        "retract_force": col(&t.force[half..], u.force),
+    });
+    if let Some(fl) = &r.filtered {
+        curve["approach_filtered_force"] = json!(col(&fl[..half], u.force));
+        curve["retract_filtered_force"] = json!(col(&fl[half..], u.force));
+    }
     json!({
         "channels": {
             "peak_force": c.peak_force * u.force,
@@ -325,7 +401,7 @@ pub fn document(request: &PeakForceRequest, model: &Resolved, r: &PeakForceResul
         "feedback_evaluations": r.evaluations,
         "modulation": {
             "period": period * u.time,
-            "f0_over_fm": 1.0 / p.omega,
+            "f0_over_fm": omega1 / p.omega,
             "amplitude": p.alpha2 * u.length,
         },
         "orbit": {
@@ -347,12 +423,11 @@ pub fn document(request: &PeakForceRequest, model: &Resolved, r: &PeakForceResul
             "distance": col(&t.distance, u.length),
             "force": col(&t.force, u.force),
         },
-        "curve": {
-            "approach_distance": col(&t.distance[..half], u.length),
-            "approach_force": col(&t.force[..half], u.force),
-            "retract_distance": col(&t.distance[half..], u.length),
-            "retract_force": col(&t.force[half..], u.force),
-        },
+        "curve": curve,
+        "filter": request.filter_cutoff.map(|fc| json!({
+            "cutoff": fc,
+            "kind": FILTER_KIND,
+        })),
         "units": if u.si {
             json!({"peak_force": "N", "adhesion": "N", "deformation": "m", "dissipation": "J", "contact_time": "s",
                    "snap_off_time": "s (from the largest separation)", "ringing_amplitude": "m", "modulus_dmt": "Pa", "z_c": "m",
@@ -398,39 +473,63 @@ impl super::named::Datasets for PeakForceRequest {
             arr("curve", "approach_distance").len(),
             arr("curve", "retract_distance").len(),
         );
+        let mut variables = vec![
+            Variable::f64(
+                "approach_distance",
+                &["approach"],
+                &unit("distance"),
+                "distance, approach",
+                &arr("curve", "approach_distance"),
+            ),
+            Variable::f64(
+                "approach_force",
+                &["approach"],
+                &unit("force"),
+                "force, approach",
+                &arr("curve", "approach_force"),
+            ),
+            Variable::f64(
+                "retract_distance",
+                &["retract"],
+                &unit("distance"),
+                "distance, retract",
+                &arr("curve", "retract_distance"),
+            ),
+            Variable::f64(
+                "retract_force",
+                &["retract"],
+                &unit("force"),
+                "force, retract",
+                &arr("curve", "retract_force"),
+            ),
+        ];
+        // the measured force through the instrument's filter, with filter_cutoff
+        if r.filtered.is_some() {
+            for (k, dim, what) in [
+                (
+                    "approach_filtered_force",
+                    "approach",
+                    "filtered k × deflection, approach",
+                ),
+                (
+                    "retract_filtered_force",
+                    "retract",
+                    "filtered k × deflection, retract",
+                ),
+            ] {
+                variables.push(Variable::f64(
+                    k,
+                    &[dim],
+                    &unit("force"),
+                    what,
+                    &arr("curve", k),
+                ));
+            }
+        }
         let curve = Layout::new(
             "peakforce force-distance curve",
             &[("approach", a), ("retract", b)],
-            vec![
-                Variable::f64(
-                    "approach_distance",
-                    &["approach"],
-                    &unit("distance"),
-                    "distance, approach",
-                    &arr("curve", "approach_distance"),
-                ),
-                Variable::f64(
-                    "approach_force",
-                    &["approach"],
-                    &unit("force"),
-                    "force, approach",
-                    &arr("curve", "approach_force"),
-                ),
-                Variable::f64(
-                    "retract_distance",
-                    &["retract"],
-                    &unit("distance"),
-                    "distance, retract",
-                    &arr("curve", "retract_distance"),
-                ),
-                Variable::f64(
-                    "retract_force",
-                    &["retract"],
-                    &unit("force"),
-                    "force, retract",
-                    &arr("curve", "retract_force"),
-                ),
-            ],
+            variables,
         );
         let facts = doc["channels"].as_object().cloned().unwrap_or_default();
         Ok((

@@ -20,6 +20,10 @@ pub const CURVE_COLUMNS: [&str; 4] = [
     "retract_force",
 ];
 
+/// The columns the curve's table adds with the instrument's filter (`filter_cutoff`): the
+/// measured force k × deflection through it, approach and retract.
+pub const FILTERED_COLUMNS: [&str; 2] = ["approach_filtered_force", "retract_filtered_force"];
+
 /// A numeric array of the document at `block.name` (empty when absent).
 fn column(doc: &Value, block: &str, name: &str) -> Vec<f64> {
     doc[block][name].as_array().map_or(Vec::new(), |a| {
@@ -107,7 +111,17 @@ pub fn peakforce(
         return p;
     }
     let cycle = rows(document, "cycle", &CYCLE_COLUMNS);
-    let curve = rows(document, "curve", &CURVE_COLUMNS);
+    let filtered = document["curve"].get(FILTERED_COLUMNS[0]).is_some();
+    let curve_columns: Vec<&str> = if filtered {
+        CURVE_COLUMNS
+            .iter()
+            .chain(&FILTERED_COLUMNS)
+            .copied()
+            .collect()
+    } else {
+        CURVE_COLUMNS.to_vec()
+    };
+    let curve = rows(document, "curve", &curve_columns);
     #[cfg(feature = "files")]
     {
         use crate::layout::files::f;
@@ -117,7 +131,7 @@ pub fn peakforce(
                 .collect()
         };
         p.csv("peakforce-cycle.csv", &CYCLE_COLUMNS, table(&cycle));
-        p.csv("peakforce-curve.csv", &CURVE_COLUMNS, table(&curve));
+        p.csv("peakforce-curve.csv", &curve_columns, table(&curve));
     }
     if files == Files::All {
         let (l, f, t) = if si {
@@ -136,15 +150,22 @@ pub fn peakforce(
         };
         let approach = curve.iter().map(|r| (r[0], r[1])).collect();
         let retract = curve.iter().map(|r| (r[2], r[3])).collect();
+        let mut all = vec![
+            series("approach", approach, 0),
+            series("retract", retract, 1),
+        ];
+        if filtered {
+            let approach = curve.iter().map(|r| (r[0], r[4])).collect();
+            let retract = curve.iter().map(|r| (r[2], r[5])).collect();
+            all.push(series("approach, k × deflection filtered", approach, 2));
+            all.push(series("retract, k × deflection filtered", retract, 3));
+        }
         p.figure(
             "peakforce-curve",
             lines(
                 "PeakForce tapping: force against tip–sample distance",
                 (format!("distance{l}"), format!("force{f}")),
-                vec![
-                    series("approach", approach, 0),
-                    series("retract", retract, 1),
-                ],
+                all,
             ),
         );
         let time = cycle.iter().map(|r| (r[0], r[3])).collect();
