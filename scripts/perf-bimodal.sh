@@ -115,7 +115,7 @@ section=$(mktemp)
     echo "The time average does not depend on q but on the decay time and the combination tones'"
     echo "slowest beat (docs/afm-workflow.md §6d): slower than the orbits at small q, faster at large q,"
     echo "and the way for a quasi-periodic (incommensurate) drive. At 627/100 the points are invariant"
-    echo "circles of the stroboscopic map on 26 nodes (docs/afm-workflow.md, curves on invariant circles),"
+    echo "circles of the stroboscopic map on 37 nodes (docs/afm-workflow.md, curves on invariant circles),"
     echo "the exact orbit where a circle is not smooth; circles have no branches (goal, issue 63: ≤ 2×"
     echo "the 25/4 curve with branches)."
     echo "\`bash scripts/perf-bimodal.sh\` on this machine"

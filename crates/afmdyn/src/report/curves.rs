@@ -272,10 +272,14 @@ fn curve_doc(
 /// orbit), and why a point is the exact orbit instead (`not-found`, `not-smooth`, `unstable`,
 /// `jump`; null on the circle).
 fn invariant_circle(names: (&str, &str), c: &SteppedCurve) -> Value {
+    // the circle of a point measured on it
+    fn on(p: &CurvePoint) -> Option<&crate::analysis::stepped::torus::CirclePoint> {
+        p.circle.as_ref().filter(|_| p.fallback.is_none())
+    }
     let sweep = |points: &[CurvePoint]| {
         json!({
-            "nodes": points.iter().map(|p| p.circle.as_ref().map_or(0, |c| c.nodes)).collect::<Vec<_>>(),
-            "contraction": points.iter().map(|p| p.circle.as_ref().map(|c| c.contraction)).collect::<Vec<_>>(),
+            "nodes": points.iter().map(|p| on(p).map_or(0, |c| c.nodes)).collect::<Vec<_>>(),
+            "contraction": points.iter().map(|p| on(p).map(|c| c.contraction)).collect::<Vec<_>>(),
             "fallback": points.iter().map(|p| p.fallback.map(|f| f.name())).collect::<Vec<_>>(),
         })
     };

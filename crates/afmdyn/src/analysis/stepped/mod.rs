@@ -28,6 +28,10 @@
 //! A start already on a computed branch is skipped.
 //!
 //! Every recorded orbit carries its [`Observables`] ([`super::observables`]).
+//!
+//! A two-frequency drive with a long common period can be measured on invariant circles
+//! instead ([`torus`], [`SteppedSpec::torus`]; the exact orbit where a circle is not smooth),
+//! and any multifrequency drive by the time average ([`average`]).
 
 use crate::analysis::bifurcation::SweepSpec;
 use crate::analysis::continuation::{BranchEvent, BranchPoint};
@@ -256,7 +260,8 @@ pub struct CurvePoint {
     /// The convergence estimate of a time-averaged point ([`average`]); `None` for an orbit.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub average: Option<AverageEstimate>,
-    /// The invariant circle of a point measured on it ([`torus`]); `None` for an orbit.
+    /// The invariant circle found at a point of a curve measured on circles ([`torus`]; also
+    /// where it fell back on the exact orbit, when a circle converged); `None` otherwise.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub circle: Option<CirclePoint>,
     /// Why a point of a curve measured on invariant circles ([`SteppedSpec::torus`]) is the

@@ -5,7 +5,7 @@
 //!
 //! At each value the circle is continued from the previous point's: its node state x_0
 //! (the state at τ = 0, [`CurvePoint::state`]) predicted from the previous points of the
-//! branch ([`super::point::prediction_slope`]), Broyden's updates from the previous circle's
+//! branch (the quadratic or secant extrapolation of the orbits' curve), Broyden's updates from the previous circle's
 //! map Jacobian ([`CirclePoint::jacobian`]; [`continue_circle_at`]), else Newton
 //! ([`invariant_circle`]). Each drive component's amplitude, phase, virial and dissipated
 //! energy come from the circle ([`observe_circle`]), its stability from the contraction of
@@ -17,14 +17,13 @@
 //! away from the previous point (a jump), is unstable, or is not smooth (a node within
 //! [`crate::analysis::torus::NEAR_GRAZING`] of grazing: a touch appears at some phases of the
 //! second drive and not at others, and the interpolation converges only algebraically), the
-//! point is the exact orbit ([`super::point::orbit_point`]: continued, halved, or settled by
+//! point is the exact orbit (as without circles: continued, halved, or settled by
 //! the transient), flagged with [`Fallback`]; the curve's warnings count them.
 
 use super::point::{orbit_point, prediction_slope};
 use super::{relative_gap, CurvePoint, Reached, SteppedSpec};
 use crate::analysis::torus::{
     continue_circle_at, invariant_circle, observe_circle, CircleOptions, InvariantCircle,
-    DEFAULT_NODES,
 };
 use crate::error::SimError;
 use crate::maps::circle::MAX_NODES;
@@ -35,24 +34,28 @@ use serde::{Deserialize, Serialize};
 
 /// Common periods (in primary drive periods) beyond which a two-frequency approach curve is
 /// measured on invariant circles by default ([`uses_torus`]): an exact orbit then spans more
-/// than this many periods, a circle [`DEFAULT_NODES`] or a few more (at 6.25 = 25/4 the orbit
-/// spans 4 and is kept; at 94/15, 15; at 6.27 = 627/100, 100 against a circle's 26).
+/// than this many periods, a circle [`CURVE_NODES`] or a few more (at 6.25 = 25/4 the orbit
+/// spans 4 and is kept; at 94/15, 15; at 6.27 = 627/100, 100 against a circle's 37).
 pub const TORUS_PERIODS: u64 = 32;
+
+/// Nodes asked for by a curve measured on invariant circles ([`TorusOptions::default`]): 37 at
+/// 627/100 (the convergent 10/37 of 0.27), whose points agree with the exact orbits' to 1e-7
+/// of each free amplitude on the eigenmode lever in the repulsive regime, where 26 nodes leave
+/// 2.5e-6 (`tests/torus.rs`; the N = 3 beam needs 63, asked by 38).
+pub const CURVE_NODES: usize = 30;
 
 /// The options of a curve measured on invariant circles ([`SteppedSpec::torus`]).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct TorusOptions {
     /// Nodes asked for, in 1..=[`MAX_NODES`]
     /// ([`crate::maps::circle::node_count`] rounds up to a convergent's or semiconvergent's
-    /// denominator of the rotation: 24 gives 26 at 627/100).
+    /// denominator of the rotation: 30 gives 37 at 627/100).
     pub nodes: usize,
 }
 
 impl Default for TorusOptions {
     fn default() -> Self {
-        TorusOptions {
-            nodes: DEFAULT_NODES,
-        }
+        TorusOptions { nodes: CURVE_NODES }
     }
 }
 
@@ -107,8 +110,9 @@ pub(super) fn rotation_of(base: &Params) -> Result<(), SimError> {
     Ok(())
 }
 
-/// The invariant circle of a point measured on it: what its continuation at the next value
-/// needs, and its stability.
+/// The invariant circle found at a point: what its continuation at the next value needs, and
+/// its stability (also at a point that fell back on the exact orbit, [`CurvePoint::fallback`],
+/// when the circle converged there).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CirclePoint {
     /// M, the circle's nodes (its first node's state is the point's state).
@@ -206,9 +210,12 @@ pub(super) fn torus_point(
     };
     let circle = match (circle, why) {
         (Ok(c), None) => c,
-        (_, why) => {
+        (c, why) => {
             let mut p = orbit_point(spec, value, history)?;
             p.fallback = why;
+            // a circle that converged (not smooth, unstable, or away) still carries its map's
+            // Jacobian for the next point's Broyden updates
+            p.circle = c.ok().map(circle_point);
             return Ok(p);
         }
     };
@@ -233,14 +240,19 @@ pub(super) fn torus_point(
         observables,
         tau: 0.0,
         average: None,
-        circle: Some(CirclePoint {
-            nodes: circle.nodes.len(),
-            contraction: circle.contraction,
-            grazing_distance: circle.grazing_distance,
-            jacobian: circle.jacobian,
-        }),
+        circle: Some(circle_point(circle)),
         fallback: None,
     })
+}
+
+/// What a point keeps of its circle.
+fn circle_point(c: InvariantCircle) -> CirclePoint {
+    CirclePoint {
+        nodes: c.nodes.len(),
+        contraction: c.contraction,
+        grazing_distance: c.grazing_distance,
+        jacobian: c.jacobian,
+    }
 }
 
 /// The warning of a curve measured on invariant circles: how many points are the exact orbit
