@@ -278,9 +278,10 @@ fn curve_against_exact(
 }
 
 /// A stepped approach at the lever's true ratio 6.27 = 627/100 on invariant circles (the
-/// default's 37 nodes on the eigenmode lever; 26 leave 2.5e-6 in the repulsive regime) against the same curve on the exact 100-period orbits: every
-/// point but the start on the circle, each component's amplitude within 1e-7 of its free amplitude and its
-/// phase within 1e-7 rad, in the repulsive regime and in the attractive regime without contact.
+/// default's 37 nodes on the eigenmode lever; 26 leave 2.5e-6 in the repulsive regime)
+/// against the same curve on the exact 100-period orbits: every point but the start on the
+/// circle, each component's amplitude within 1e-7 of its free amplitude and its phase within
+/// 1e-7 rad, in the repulsive regime and in the attractive regime without contact.
 #[test]
 fn a_curve_on_circles_matches_the_exact_curve_on_the_eigenmode_lever() {
     for (from, to) in [(0.53, 0.47), (1.15, 1.1)] {

@@ -5,11 +5,12 @@
 //!
 //! At each value the circle is continued from the previous point's: its node state x_0
 //! (the state at τ = 0, [`CurvePoint::state`]) predicted from the previous points of the
-//! branch (the quadratic or secant extrapolation of the orbits' curve), Broyden's updates from the previous circle's
-//! map Jacobian ([`CirclePoint::jacobian`]; [`continue_circle_at`]), else Newton
-//! ([`invariant_circle`]). Each drive component's amplitude, phase, virial and dissipated
-//! energy come from the circle ([`observe_circle`]), its stability from the contraction of
-//! its linearisation ([`crate::analysis::torus::InvariantCircle::contraction`]).
+//! branch (the quadratic or secant extrapolation of the orbits' curve), Broyden's updates
+//! from the previous circle's map Jacobian ([`CirclePoint::jacobian`];
+//! [`continue_circle_at`]), else Newton ([`invariant_circle`]). Each drive component's
+//! amplitude, phase, virial and dissipated energy come from the circle ([`observe_circle`]),
+//! its stability from the contraction of its linearisation
+//! ([`crate::analysis::torus::InvariantCircle::contraction`]).
 //!
 //! On a circle of rational rotation p/q the motion repeats after q periods: the point is the
 //! periodic orbit of the common period, to the circle's interpolation error (period 1 in
