@@ -7,7 +7,9 @@
 # auto integrator, Taylor); then the time-domain way, the library's time average, against the
 # exact orbits (cargo run --release -p afmdyn --example bimodal_timing); and at f2/f1 =
 # 1761/281 (mode 2 at 1.88007 MHz: a common period of 281 drive periods) the orbits against
-# --average over 10 values (one run each: the orbits take minutes). Whole command
+# --average over 10 values (one run each: the orbits take minutes); at the true 6.27 = 627/100
+# (mode 2 and its drive at 1.881 MHz: 100 periods) on invariant circles (the default there,
+# issue 63) and on the exact orbits (--exact). Whole command
 # (outputs and plots included), best of 3. Goal: ≤ 2 s on the eigenmode model.
 # Usage: bash scripts/perf-bimodal.sh
 set -euo pipefail
@@ -19,6 +21,7 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 P=examples/probe-bimodal.toml
 sed 's/1.875e6/1.88e6/g' $P > "$tmp/ratio-94-15.toml"
+sed 's/1.875e6/1.881e6/g' $P > "$tmp/ratio-627-100.toml"
 sed 's/^frequency = .*/frequency = [300e3, 1.88007e6]/' $P > "$tmp/ratio-1761-281.toml"
 sed -e 's/^free_amplitude = .*/free_amplitude = 10e-9/' -e 's/^frequency = .*/frequency = 300e3/' \
     $P > "$tmp/single.toml"
@@ -29,6 +32,8 @@ rows=""
 for case in "eigenmodes, f2/f1 = 25/4, branches|bimodal|$P|" \
             "eigenmodes, f2/f1 = 25/4, --no-branches|bimodal|$P|--no-branches" \
             "eigenmodes, f2/f1 = 94/15, --no-branches|bimodal|$tmp/ratio-94-15.toml|--no-branches" \
+            "eigenmodes, f2/f1 = 627/100 (the true 6.27), branches asked (invariant circles)|bimodal|$tmp/ratio-627-100.toml|" \
+            "eigenmodes, f2/f1 = 627/100, --exact --no-branches (100-period orbits)|bimodal|$tmp/ratio-627-100.toml|--exact --no-branches" \
             "one component (approach, Taylor integrator), --no-branches|approach|$tmp/single.toml|--no-branches"; do
     IFS='|' read -r name cmd probe extra <<< "$case"
     # shellcheck disable=SC2086
@@ -42,6 +47,10 @@ line = f"{len(a['z_c'])} values each way, {len(d['branches'])} branch(es), {len(
 if comp:
     line += (f", A1 {a['amplitude_1'][0] * 1e9:.3f} → {a['amplitude_1'][-1] * 1e9:.3f} nm, "
              f"A2 {a['amplitude_2'][0] * 1e9:.4f} → {a['amplitude_2'][-1] * 1e9:.4f} nm")
+c = d.get("invariant_circle")
+if c:
+    n = [m for s in ("approach", "retract") for m in c[s]["nodes"]]
+    line += f", {sum(1 for m in n if m)} of {len(n)} points on circles of {max(n)} nodes"
 print(line + f", warnings {len(d['warnings'])}")
 PY
 )
@@ -105,7 +114,10 @@ section=$(mktemp)
     echo "Hertz and DMT; it replaced the adaptive DOP853 for such drives, the curves equal to 1e-7)."
     echo "The time average does not depend on q but on the decay time and the combination tones'"
     echo "slowest beat (docs/afm-workflow.md §6d): slower than the orbits at small q, faster at large q,"
-    echo "and the way for a quasi-periodic (incommensurate) drive."
+    echo "and the way for a quasi-periodic (incommensurate) drive. At 627/100 the points are invariant"
+    echo "circles of the stroboscopic map on 37 nodes (docs/afm-workflow.md, curves on invariant circles),"
+    echo "the exact orbit where a circle is not smooth; circles have no branches (goal, issue 63: ≤ 2×"
+    echo "the 25/4 curve with branches)."
     echo "\`bash scripts/perf-bimodal.sh\` on this machine"
     echo "(2 cores; one curve is one chain, so one core)."
     echo "<!-- bimodal:end -->"

@@ -138,6 +138,13 @@ pub struct BimodalArgs {
     /// 1000 drive periods). No branches
     #[arg(long)]
     average: bool,
+    /// Measure every point on the exact periodic orbit of the common period, with branches
+    /// and folds, even where a two-frequency drive repeats only after more than 32 drive
+    /// periods (e.g. f2/f1 = 6.27 = 627/100), whose points are otherwise measured on the
+    /// invariant circle of the stroboscopic map (the exact orbit where the circle is not
+    /// smooth, as the warnings say)
+    #[arg(long, conflicts_with = "average")]
+    exact: bool,
     /// Setpoint A1/A01 in (0, 1] of the first component's amplitude (the one the feedback
     /// holds): the operating points where the curve reaches it, with every component's
     /// amplitude, phase, virial and dissipated energy there ("setpoint" in --json)
@@ -261,6 +268,7 @@ pub fn approach(a: &ApproachArgs) -> Result<(), CliError> {
         curve: a.curve.request(from, to, Dim::Length, si)?,
         setpoint: a.setpoint,
         average: false,
+        exact: false,
     };
     let study = || CurveStudy::approach(&request, &model);
     let out = (a.out.as_path(), "approach");
@@ -278,6 +286,7 @@ pub fn bimodal(a: &BimodalArgs) -> Result<(), CliError> {
         curve: a.curve.request(from, to, Dim::Length, si)?,
         setpoint: a.setpoint,
         average: a.average,
+        exact: a.exact,
     };
     let study = || CurveStudy::approach(&request, &model);
     let out = (a.out.as_path(), "bimodal");

@@ -145,6 +145,7 @@ fn commensurate_orbits_and_time_average_agree() {
         },
         setpoint: None,
         average: true,
+        exact: false,
     };
     let model = Resolved {
         params: p,

@@ -308,6 +308,7 @@ ApproachRequest = TypedDict(
     {
         "average": bool,  # default false
         "branches": bool,  # default true
+        "exact": bool,  # default false
         "from": Optional[float],  # default null
         "points": Optional[int],  # default null
         "setpoint": Optional[float],  # default null

@@ -470,6 +470,7 @@ def bimodal(
     tolerance: float = _DEFAULTS["approach"]["tolerance"],
     traces: Optional[int] = None,
     average: bool = False,
+    exact: bool = False,
     setpoint: Optional[float] = None,
     store: Union[str, "os.PathLike[str]", None] = None,
     resume: bool = False,
@@ -493,6 +494,12 @@ def bimodal(
         average: demodulate a time average (a Hann² window over many primary periods, after
             the transient has settled) instead of the periodic orbit — what an incommensurate
             ratio always gets; branches and traces are then off.
+        exact: the exact periodic orbit of the common period at every point, with branches,
+            also for a two-frequency drive that repeats only after more than 32 primary
+            periods (f2/f1 = 6.27 = 627/100), whose points are otherwise measured on the
+            invariant circle of the stroboscopic map (the exact orbit where the circle is not
+            smooth; per point in ``ds.afmdyn.to_dict()["invariant_circle"]``, counted in the
+            warnings; no branches on circles).
         setpoint: A1/A01 in (0, 1] of the first component, the amplitude the feedback holds:
             ``ds.afmdyn.to_dict()["setpoint"]["points"]`` gives the operating points where the
             curve reaches it, with every component's ``amplitude_i``, ``phase_i_deg``,

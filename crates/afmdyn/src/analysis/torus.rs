@@ -137,13 +137,24 @@ pub fn continue_circle(
     previous: &InvariantCircle,
     opts: &CircleOptions,
 ) -> Result<InvariantCircle, SimError> {
-    solve(
-        model,
-        integ,
-        &previous.states[0],
-        opts,
-        Some(&previous.jacobian),
-    )
+    continue_circle_at(model, integ, &previous.states[0], &previous.jacobian, opts)
+}
+
+/// The circle of `model` continued from a predicted node state `guess` (`[2N]`, at τ = 0) and
+/// an estimate `jacobian` (2N×2N) of its map's Jacobian ∂G, e.g. the previous circle's
+/// [`InvariantCircle::jacobian`]: as [`continue_circle`], the predictor the caller's (a
+/// stepped curve extrapolates the node state from its previous points).
+///
+/// # Errors
+/// As [`continue_circle`].
+pub fn continue_circle_at(
+    model: &CantileverModel,
+    integ: IntegratorOptions,
+    guess: &DVector<f64>,
+    jacobian: &DMatrix<f64>,
+    opts: &CircleOptions,
+) -> Result<InvariantCircle, SimError> {
+    solve(model, integ, guess, opts, Some(jacobian))
 }
 
 fn solve(

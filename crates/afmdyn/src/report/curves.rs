@@ -256,7 +256,37 @@ fn curve_doc(
     if let Some(a) = &c.average {
         doc["time_average"] = time_average(a, names, c, u);
     }
+    if c.first
+        .iter()
+        .chain(&c.second)
+        .any(|p| p.circle.is_some() || p.fallback.is_some())
+    {
+        doc["invariant_circle"] = invariant_circle(names, c);
+    }
     doc
+}
+
+/// The `"invariant_circle"` block of a curve measured on invariant circles
+/// ([`crate::analysis::stepped::torus`]): per sweep and point the circle's nodes (0 for the
+/// exact orbit), the contraction of its linearisation per drive period (null for the exact
+/// orbit), and why a point is the exact orbit instead (`not-found`, `not-smooth`, `unstable`,
+/// `jump`; null on the circle).
+fn invariant_circle(names: (&str, &str), c: &SteppedCurve) -> Value {
+    // the circle of a point measured on it
+    fn on(p: &CurvePoint) -> Option<&crate::analysis::stepped::torus::CirclePoint> {
+        p.circle.as_ref().filter(|_| p.fallback.is_none())
+    }
+    let sweep = |points: &[CurvePoint]| {
+        json!({
+            "nodes": points.iter().map(|p| on(p).map_or(0, |c| c.nodes)).collect::<Vec<_>>(),
+            "contraction": points.iter().map(|p| on(p).map(|c| c.contraction)).collect::<Vec<_>>(),
+            "fallback": points.iter().map(|p| p.fallback.map(|f| f.name())).collect::<Vec<_>>(),
+        })
+    };
+    json!({
+        names.0: sweep(&c.first),
+        names.1: sweep(&c.second),
+    })
 }
 
 /// The `"time_average"` block of a curve measured by the time average

@@ -38,6 +38,7 @@ use crate::analysis::progress::Progress;
 use crate::analysis::shooting::PeriodicOrbit;
 use crate::analysis::shooting::ShootingOptions;
 use crate::analysis::steady::SteadyOptions;
+use crate::analysis::stepped::torus::{uses_torus, TorusOptions};
 use crate::analysis::stepped::SteppedSpec;
 use crate::eigen::{spectrum, RegionSpectrum};
 use crate::error::SimError;
@@ -487,6 +488,14 @@ pub struct ApproachRequest {
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     #[cfg_attr(feature = "schema", schemars(extend("default" = false)))]
     pub average: bool,
+    /// Measure every point on the exact periodic orbit of the drive's common period even where
+    /// a two-frequency drive repeats only after more than
+    /// [`crate::analysis::stepped::torus::TORUS_PERIODS`] drive periods, whose points are
+    /// otherwise measured on invariant circles ([`crate::analysis::stepped::torus`]; with
+    /// branches and folds).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    #[cfg_attr(feature = "schema", schemars(extend("default" = false)))]
+    pub exact: bool,
 }
 
 impl ApproachRequest {
@@ -515,12 +524,16 @@ impl ApproachRequest {
             }
         }
         let average = self.average || model.params.is_quasiperiodic();
-        approach_request(
+        let mut spec = approach_request(
             model.params,
             &self.curve,
             Self::units(model).length,
             average,
-        )
+        )?;
+        if !average && !self.exact && uses_torus(&model.params) {
+            spec.torus = Some(TorusOptions::default());
+        }
+        Ok(spec)
     }
 }
 

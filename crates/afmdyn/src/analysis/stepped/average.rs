@@ -287,5 +287,7 @@ pub(super) fn average_point(
             amplitude_error,
             phase_error,
         }),
+        circle: None,
+        fallback: None,
     })
 }

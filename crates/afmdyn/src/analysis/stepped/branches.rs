@@ -121,6 +121,8 @@ pub(super) fn branch_starts(
             observables,
             tau: 0.0,
             average: None,
+            circle: None,
+            fallback: None,
         });
     }
     starts

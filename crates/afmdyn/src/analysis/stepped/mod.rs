@@ -28,6 +28,10 @@
 //! A start already on a computed branch is skipped.
 //!
 //! Every recorded orbit carries its [`Observables`] ([`super::observables`]).
+//!
+//! A two-frequency drive with a long common period can be measured on invariant circles
+//! instead ([`torus`], [`SteppedSpec::torus`]; the exact orbit where a circle is not smooth),
+//! and any multifrequency drive by the time average ([`average`]).
 
 use crate::analysis::bifurcation::SweepSpec;
 use crate::analysis::continuation::{BranchEvent, BranchPoint};
@@ -51,8 +55,10 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 pub mod average;
 mod branches;
+pub mod torus;
 use average::{average_point, AverageEstimate, AverageOptions};
 use branches::{branch, branch_starts, jumps_of, on_branch, unstable_between_folds};
+use torus::{torus_point, CirclePoint, Fallback, TorusOptions};
 
 mod point;
 pub use point::settle;
@@ -171,6 +177,10 @@ pub struct SteppedSpec {
     /// what a quasi-periodic drive needs ([`Params::is_quasiperiodic`]); no branches, traces
     /// or Floquet multipliers then.
     pub average: Option<AverageOptions>,
+    /// Measure every point on the invariant circle of a two-frequency drive ([`torus`])
+    /// instead of the exact orbit of its common period, which it falls back on where the
+    /// circle is not found or not smooth; no branches then.
+    pub torus: Option<TorusOptions>,
 }
 
 impl SteppedSpec {
@@ -202,6 +212,7 @@ impl SteppedSpec {
             max_branch_points: 2000,
             trace_samples: 0,
             average: None,
+            torus: None,
         }
     }
 }
@@ -249,6 +260,14 @@ pub struct CurvePoint {
     /// The convergence estimate of a time-averaged point ([`average`]); `None` for an orbit.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub average: Option<AverageEstimate>,
+    /// The invariant circle found at a point of a curve measured on circles ([`torus`]; also
+    /// where it fell back on the exact orbit, when a circle converged); `None` otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub circle: Option<CirclePoint>,
+    /// Why a point of a curve measured on invariant circles ([`SteppedSpec::torus`]) is the
+    /// exact orbit instead; `None` otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fallback: Option<Fallback>,
 }
 
 fn is_zero(x: &f64) -> bool {
@@ -489,6 +508,9 @@ pub fn check_values(spec: &SteppedSpec) -> Result<(), SimError> {
                  orbits to continue or to trace)",
             ));
         }
+    } else if let Some(t) = &spec.torus {
+        t.check()?;
+        torus::rotation_of(&spec.base)?;
     } else if spec.base.is_quasiperiodic() {
         return Err(SimError::out_of_range(
             "average",
@@ -574,7 +596,28 @@ pub fn finish_curve(
             crate::params::MAX_COMMON_PERIODS
         ));
     }
-    if q > SLOW_COMMON_PERIODS && spec.average.is_none() {
+    if let Some(t) = &spec.torus {
+        let m = first
+            .iter()
+            .chain(&second)
+            .find_map(|p| p.circle.as_ref().map(|c| c.nodes));
+        warnings.push(format!(
+            "the drive repeats only every {q} drive periods (its frequency ratio {ratios}): the \
+             points are measured on the invariant circle of the stroboscopic map ({} nodes, \
+             asked {}), the exact orbit where the circle is not smooth or not found{}",
+            m.map_or_else(|| "no".to_string(), |m| m.to_string()),
+            t.nodes,
+            if spec.branches {
+                "; the branches and their folds are not continued on circles (exact orbits: \
+                 bimodal --exact)"
+            } else {
+                ""
+            }
+        ));
+        let all: Vec<&CurvePoint> = first.iter().chain(&second).collect();
+        warnings.extend(torus::fallback_warning(&all));
+    }
+    if q > SLOW_COMMON_PERIODS && spec.average.is_none() && spec.torus.is_none() {
         warnings.push(format!(
             "the multifrequency drive repeats only every {q} drive periods (its frequency ratio \
              {ratios}): every orbit spans them all; a ratio p/q with a small q (e.g. f2 = 6.25 \
@@ -583,7 +626,7 @@ pub fn finish_curve(
         ));
     }
     let mut branches: Vec<Vec<BranchSample>> = Vec::new();
-    if spec.branches {
+    if spec.branches && spec.torus.is_none() {
         for start in branch_starts(spec, &first, &second) {
             if branches
                 .iter()

@@ -250,6 +250,20 @@ pub(super) fn step_point(
     if let Some(opts) = &spec.average {
         return average_point(spec, opts, value, prev);
     }
+    if let Some(opts) = &spec.torus {
+        return torus_point(spec, opts, value, history);
+    }
+    orbit_point(spec, value, history)
+}
+
+/// The periodic orbit at `value` continued from the last point of `history` (or found from
+/// rest), settled by the transient where it cannot be followed.
+pub(super) fn orbit_point(
+    spec: &SteppedSpec,
+    value: f64,
+    history: &[CurvePoint],
+) -> Result<CurvePoint, SimError> {
+    let prev = history.last();
     let model = CantileverModel::new(&spec.base.with(spec.param, value))?;
     let last = prev.map_or_else(|| model.rest(), |p| p.state.clone());
     let n = prev.and_then(|p| p.period).unwrap_or(1);
@@ -333,5 +347,7 @@ pub(super) fn step_point(
         observables,
         tau: 0.0,
         average: None,
+        circle: None,
+        fallback: None,
     })
 }
