@@ -456,11 +456,13 @@ impl ScanStudy {
                 .map(|w| format!("the ideal image beside the scan: {w}"))
                 .collect(),
         };
-        // a lock-in time constant outside the typical range: a likely unit slip, named
-        let tc = self.settings.time_constant;
-        if let Some(why) = crate::probe::ranges::warning("feedback", "time_constant", tc) {
-            img.warnings
-                .push(format!("time_constant = {} s is {why}", number(tc)));
+        // a lock-in time constant given outside the typical range: a likely unit slip, named
+        // (the lever's default τ_c/4 is no slip, whatever its value)
+        if let Some(tc) = self.recipe.scan.time_constant {
+            if let Some(why) = crate::probe::ranges::warning("feedback", "time_constant", tc) {
+                img.warnings
+                    .push(format!("time_constant = {} s is {why}", number(tc)));
+            }
         }
         img.artefacts = [0, 1].map(|d| img.artefacts_of(d));
         for (d, a) in ["trace", "retrace"].iter().zip(img.artefacts) {
