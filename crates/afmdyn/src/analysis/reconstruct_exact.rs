@@ -21,10 +21,10 @@
 //! **Inversion (defect correction).** With SJ the Sader–Jarvis operator on the same grid and
 //! G the discrete forward relation,
 //!
-//! F₀ = SJ[Δf],  F_{n+1} = F_n + SJ[Δf − G F_n]
+//! F₀ = SJ\[Δf\],  F_{n+1} = F_n + SJ\[Δf − G F_n\]
 //!
 //! (the residual's last row set to 0: the force at the last distance is the end of the data,
-//! 0, as Sader–Jarvis's is). A fixed point has SJ[Δf − G F] = 0, hence Δf = G F on every row
+//! 0, as Sader–Jarvis's is). A fixed point has SJ\[Δf − G F\] = 0, hence Δf = G F on every row
 //! but the last: the exact solution of the triangular system of the matrix method. SJ is an
 //! approximate inverse of G (within a few per cent on smooth curves), so each step shrinks
 //! the residual by that factor — the classical defect (residual) correction of an approximate
