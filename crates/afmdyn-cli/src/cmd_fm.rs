@@ -30,7 +30,7 @@ pub struct FmArgs {
     #[arg(long, default_value_t = 1)]
     mode: usize,
     /// Rest distance z_c where the approach starts [default: where the frequency shift has
-    /// decayed to 1 % of its value at --to (Giessibl's first-order shift of the law's force);
+    /// decayed to 0.5 % of its value at --to (Giessibl's first-order shift of the law's force);
     /// 2A + a0 for a law without a force before contact]
     #[arg(long, allow_hyphen_values = true)]
     from: Option<Quantity>,

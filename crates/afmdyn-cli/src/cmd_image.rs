@@ -58,7 +58,8 @@ pub struct ImageArgs {
         allow_hyphen_values = true
     )]
     gains: Option<Vec<f64>>,
-    /// PI scan: the lock-in's low-pass time constant, s (default: τ_c/4)
+    /// PI scan: the lock-in's low-pass time constant, s (default: τ_c/4; refused above
+    /// 1000 s, a warning outside 1 µs–0.1 s)
     #[arg(long, value_name = "S")]
     time_constant: Option<f64>,
     /// PI scan: worker threads, one line per task (default: all cores)

@@ -1,5 +1,5 @@
 //! `afmdyn reconstruct`: the tip–sample force and potential behind a frequency-modulation
-//! curve by the Sader–Jarvis inversion. The request, the inversion and the document are the
+//! curve by the Sader–Jarvis inversion or its exact correction (`--inversion exact`). The request, the inversion and the document are the
 //! library's ([`afmdyn::request::ReconstructRequest`], [`afmdyn::analysis::reconstruct`]),
 //! and so are the reading of the curve file ([`afmdyn::io::curve_file`]), the summary,
 //! `reconstruct.csv`, the force figure and the JSON document
@@ -15,6 +15,7 @@ use afmdyn::analysis::reconstruct::Reconstruction;
 use afmdyn::io::curve_file::{read_curve_file, read_document, CurveFile};
 use afmdyn::io::InputFileError;
 use afmdyn::request::present::reconstruct::{reconstruction, Inversion};
+use afmdyn::request::reconstruct::FmInversion;
 use afmdyn::request::{self, ReconstructRequest, Resolved};
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -50,6 +51,16 @@ pub struct ReconstructArgs {
     /// outside 1 fm–1 mm); required with a CSV, replaces the document's
     #[arg(long, conflicts_with = "am", allow_hyphen_values = true)]
     amplitude: Option<Quantity>,
+    /// The inversion of an FM curve: sader-jarvis (Sader & Jarvis's formula, within a few per
+    /// cent; the more robust on noisy data) or exact (its estimate corrected through
+    /// Giessibl's forward relation until the two agree: exact for the first-order relation)
+    #[arg(
+        long,
+        value_enum,
+        default_value = "sader-jarvis",
+        conflicts_with = "am"
+    )]
+    inversion: InversionArg,
     /// Output directory (locked during the run)
     #[arg(long, default_value = "afmdyn-out/reconstruct")]
     out: PathBuf,
@@ -62,6 +73,15 @@ pub struct ReconstructArgs {
 }
 
 /// An input file's refusal as bad input naming the option (`--fm FILE: …`).
+/// `--inversion` ([`afmdyn::request::reconstruct::FmInversion`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum InversionArg {
+    /// Sader–Jarvis.
+    SaderJarvis,
+    /// The exact inversion.
+    Exact,
+}
+
 fn input(option: &'static str) -> impl Fn(InputFileError) -> CliError {
     move |e| CliError::Input(format!("{option} {e}"))
 }
@@ -91,7 +111,10 @@ fn request_of(a: &ReconstructArgs, fm: &Path) -> Result<ReconstructRequest, CliE
     }
     let (names, mut columns) = match read_curve_file(fm).map_err(input("--fm"))? {
         CurveFile::Document(doc) => {
-            return Ok(ReconstructRequest::from_fm_document(&doc, k, f0, amp)?)
+            return Ok(ReconstructRequest {
+                inversion: inversion(a),
+                ..ReconstructRequest::from_fm_document(&doc, k, f0, amp)?
+            })
         }
         CurveFile::Columns(names, columns) => (names, columns),
     };
@@ -114,6 +137,7 @@ fn request_of(a: &ReconstructArgs, fm: &Path) -> Result<ReconstructRequest, CliE
         ))
     })?;
     Ok(ReconstructRequest {
+        inversion: inversion(a),
         law_force: None,
         distance: take("distance"),
         z_c: take("z_c"),
@@ -125,6 +149,14 @@ fn request_of(a: &ReconstructArgs, fm: &Path) -> Result<ReconstructRequest, CliE
 }
 
 /// The reconstruction of an AM document (`--am FILE`) and its JSON document.
+/// The library's inversion of `--inversion`.
+fn inversion(a: &ReconstructArgs) -> FmInversion {
+    match a.inversion {
+        InversionArg::SaderJarvis => FmInversion::SaderJarvis,
+        InversionArg::Exact => FmInversion::Exact,
+    }
+}
+
 fn am_reconstruction(path: &Path) -> Result<(Reconstruction, serde_json::Value), CliError> {
     let doc = read_document(path).map_err(input("--am"))?;
     let d = request::reconstruct::am_reconstruction(
@@ -164,7 +196,11 @@ pub fn reconstruct(a: &ReconstructArgs) -> Result<(), CliError> {
                 &afmdyn::analysis::progress::Progress::new(),
             )?;
             let law = request.law_in_order();
-            (doc.output, doc.json, law, Inversion::SaderJarvis)
+            let how = match request.inversion {
+                FmInversion::SaderJarvis => Inversion::SaderJarvis,
+                FmInversion::Exact => Inversion::Exact,
+            };
+            (doc.output, doc.json, law, how)
         }
         (None, None) => {
             return Err(CliError::Input(

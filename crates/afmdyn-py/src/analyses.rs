@@ -93,9 +93,9 @@ fn json_document(name: &str, text: &str) -> PyResult<serde_json::Value> {
 
 /// The force and potential behind an `fm` document (`afmdyn reconstruct --fm fm.json`): the
 /// request from the document ([`afmdyn::request::ReconstructRequest::from_fm_document`], its
-/// k, f0 and A replaced by those given), and its JSON document.
+/// k, f0 and A replaced by those given, by the `inversion` named), and its JSON document.
 #[pyfunction]
-#[pyo3(signature = (document, spring_constant=None, resonance_frequency=None, amplitude=None, progress=None))]
+#[pyo3(signature = (document, spring_constant=None, resonance_frequency=None, amplitude=None, progress=None, inversion="sader-jarvis"))]
 pub fn reconstruct_fm<'py>(
     py: Python<'py>,
     document: &str,
@@ -103,14 +103,22 @@ pub fn reconstruct_fm<'py>(
     resonance_frequency: Option<f64>,
     amplitude: Option<f64>,
     progress: Option<Bound<'py, PyAny>>,
+    inversion: &str,
 ) -> PyResult<Dict<'py>> {
-    let request = afmdyn::request::ReconstructRequest::from_fm_document(
+    let mut request = afmdyn::request::ReconstructRequest::from_fm_document(
         &json_document("fm", document)?,
         spring_constant,
         resonance_frequency,
         amplitude,
     )
     .map_err(sim_error)?;
+    // the request's own words ("sader-jarvis", "exact"), refused naming the keyword otherwise
+    request.inversion =
+        serde_json::from_value(serde_json::Value::from(inversion)).map_err(|_| {
+            pyo3::exceptions::PyValueError::new_err(format!(
+                "inversion: {inversion:?} is not an inversion (\"sader-jarvis\" or \"exact\")"
+            ))
+        })?;
     reconstruction(py, request, progress)
 }
 

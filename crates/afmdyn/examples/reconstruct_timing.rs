@@ -3,12 +3,15 @@
 //! before the FFT (commit 203d73b, copied: every pair, each integrand value twice), the direct
 //! sum now (`sader_jarvis_direct`, the reference and the method on uneven grids) and
 //! `sader_jarvis` (the FFT), best of 3 (the two O(N²) sums: 1 run at 10⁵); the FFT's largest
-//! difference from the direct sum over the largest |F|. One JSON line.
+//! difference from the direct sum over the largest |F|; the exact inversion
+//! (`reconstruct_exact::exact_inversion`, best of 3), its correction steps and forward
+//! residual. One JSON line.
 //!
 //! Usage: cargo run --release -p afmdyn --example reconstruct_timing
 
 use afmdyn::analysis::progress::Progress;
 use afmdyn::analysis::reconstruct::{sader_jarvis, sader_jarvis_direct, ShiftCurve};
+use afmdyn::analysis::reconstruct_exact::exact_inversion;
 use std::time::Instant;
 
 fn before(curve: &ShiftCurve) -> Vec<f64> {
@@ -91,9 +94,13 @@ fn main() {
             .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()))
             / scale;
         assert_eq!(f_before[..n - 1], direct.force[..n - 1]);
+        let (t_exact, exact) = best(3, || exact_inversion(&curve).expect("exact"));
+        let record = exact.exact.expect("the exact inversion's record");
         rows.push(format!(
             "{{\"points\": {n}, \"before_s\": {t_before:.4}, \"direct_s\": {t_direct:.4}, \
-             \"fft_s\": {t_fft:.5}, \"difference\": {diff:.2e}}}"
+             \"fft_s\": {t_fft:.5}, \"difference\": {diff:.2e}, \"exact_s\": {t_exact:.4}, \
+             \"exact_iterations\": {}, \"exact_residual\": {:.2e}}}",
+            record.iterations, record.forward_residual
         ));
     }
     println!("[{}]", rows.join(", "));

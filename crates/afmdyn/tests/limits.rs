@@ -254,8 +254,14 @@ mod costs {
             resonance_frequency: 300e3,
             amplitude: 1e-9,
             law_force: None,
+            inversion: Default::default(),
         };
         within("reconstruct", curve.cost(&m).unwrap());
+        let exact = ReconstructRequest {
+            inversion: afmdyn::request::reconstruct::FmInversion::Exact,
+            ..curve
+        };
+        within("reconstruct --inversion exact", exact.cost(&m).unwrap());
     }
 
     /// The requests whose options bound their cost one by one stay within the budgets at the

@@ -384,6 +384,7 @@ ReconstructRequest = TypedDict(
         "amplitude": float,  # default 0.0
         "distance": Optional[List[float]],  # default null
         "frequency_shift": List[float],  # default []
+        "inversion": Literal["sader-jarvis", "exact"],  # default "sader-jarvis"
         "law_force": Optional[List[float]],  # default null
         "resonance_frequency": float,  # default 0.0
         "spring_constant": float,  # default 0.0
@@ -718,6 +719,7 @@ def reconstruct_fm(
     resonance_frequency: Optional[float] = None,
     amplitude: Optional[float] = None,
     progress: Optional[ProgressCallback] = None,
+    inversion: str = "sader-jarvis",
 ) -> Dict[str, Any]: ...
 def image(
     probe: str,

@@ -95,7 +95,7 @@ def fm(
             free amplitude A₀).
         mode: the mode K the PLL tracks (1..N).
         from_, to: the z_c range, m with ``probe``, else g₀ (default: from where the frequency
-            shift has decayed to 1 % of its value at ``to`` — Giessibl's first-order shift of
+            shift has decayed to 0.5 % of its value at ``to`` — Giessibl's first-order shift of
             the law's force; 2A + a₀ for a law without a force before contact — down to
             A + a₀, the lower turning point at the contact distance a₀).
         step, points: the grid (a step in the same unit, or the number of values; default 120).

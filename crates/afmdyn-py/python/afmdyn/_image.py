@@ -51,8 +51,9 @@ def image(
     where the material allows it, each line engaged from far. ``feedback="pi"``: each line
     scanned in the time domain, trace and retrace, under a lock-in and a PI z controller
     updating once per drive period (``scan_rate`` in Hz, ``gains`` = (K_P, K_I in 1/s),
-    ``time_constant`` of the lock-in in s; ``None`` for the lever's defaults), its lines on
-    ``threads`` cores with ``progress``; Ctrl-C stops it.
+    ``time_constant`` of the lock-in in s, refused above 1000 s and warned outside
+    1 µs–0.1 s; ``None`` for the lever's defaults), its lines on ``threads`` cores with
+    ``progress``; Ctrl-C stops it.
 
     Args:
         probe: the probe (path, TOML text or dict, as ``afmdyn.probe``): the lever, tip,

@@ -1,5 +1,5 @@
 """The tip–sample force behind a frequency-modulation curve (``afmdyn reconstruct``): the
-library's Sader–Jarvis inversion as an ``xarray.Dataset`` in SI."""
+library's Sader–Jarvis inversion, or its exact correction, as an ``xarray.Dataset`` in SI."""
 
 from __future__ import annotations
 
@@ -28,11 +28,12 @@ def reconstruct(
     z_c: Optional[Sequence[float]] = None,
     fm: Optional[Union[xr.Dataset, Dict[str, Any]]] = None,
     am: Optional[Union[xr.Dataset, Dict[str, Any]]] = None,
+    inversion: str = "sader-jarvis",
     progress: ProgressArg = None,
 ) -> xr.Dataset:
     """The tip–sample force F(d) and potential U(d) behind a frequency-modulation curve, by
     the Sader–Jarvis inversion (J. E. Sader and S. P. Jarvis, Appl. Phys. Lett. 84, 1801
-    (2004); ``afmdyn reconstruct``).
+    (2004); ``afmdyn reconstruct``) or its exact correction (``inversion="exact"``).
 
     Args:
         frequency_shift: Δf = f − f0 (Hz) at each distance.
@@ -47,6 +48,11 @@ def reconstruct(
             document): its attractive run (phase lag above 90°) inverted at each point's
             amplitude by the matrix method (``afmdyn reconstruct --am``); the constants are
             the probe's.
+        inversion: ``"sader-jarvis"`` (the default: within a few per cent, the more robust on
+            noisy data) or ``"exact"`` (the Sader–Jarvis estimate corrected through
+            Giessibl's forward relation until the two agree: exact for the first-order
+            relation; the document's ``exact`` records its steps and forward residual). Not
+            with ``am``.
 
     Returns:
         ``xarray.Dataset`` over ``distance`` (m, increasing): ``force`` (N, attractive < 0),
@@ -79,6 +85,8 @@ def reconstruct(
                                 ("resonance_frequency", resonance_frequency)) if v is not None]
         if given:
             raise ValueError(f"am: the approach curve carries its constants; {given[0]} not taken")
+        if inversion != "sader-jarvis":
+            raise ValueError("inversion: the AM curve is inverted by the matrix method")
         document = am.attrs["summary"] if isinstance(am, xr.Dataset) else json.dumps(am)
         with reporter(progress, "reconstruct") as cb:
             d = _core.reconstruct_am(document, progress=cb)
@@ -94,6 +102,7 @@ def reconstruct(
                 None if resonance_frequency is None else float(resonance_frequency),
                 None if amplitude is None else float(amplitude),
                 progress=cb,
+                inversion=inversion,
             )
         return _dataset(json.loads(d["json"]))
     for name, v in (("frequency_shift", frequency_shift), ("spring_constant", spring_constant),
@@ -107,6 +116,7 @@ def reconstruct(
         spring_constant=float(spring_constant),
         resonance_frequency=float(resonance_frequency),
         amplitude=float(amplitude),
+        inversion=inversion,
     )
     with reporter(progress, "reconstruct") as cb:
         d = _core.run("reconstruct", request, None, None, cb)
@@ -141,6 +151,7 @@ def _dataset(doc: Dict[str, Any]) -> xr.Dataset:
             "resonance_frequency": doc["resonance_frequency"],
             "amplitude": doc["amplitude"],
             "method": doc["method"],
+            "inversion": doc.get("inversion", "matrix"),
             "summary": json.dumps(doc),
         },
     )

@@ -6,7 +6,8 @@
 //! the amplitude spectrum of a time series; frequency-modulation AFM at constant amplitude as
 //! exact periodic orbits ([`fm`]; its time-domain loop for comparison, [`fm_loop`]); force
 //! reconstruction from FM-AFM frequency shifts ([`reconstruct`]: Sader–Jarvis) and from AM
-//! amplitude and phase ([`reconstruct_am`]: the matrix method at each point's amplitude).
+//! amplitude and phase ([`reconstruct_am`]: the matrix method at each point's amplitude); the
+//! exact inversion of the first-order FM relation ([`reconstruct_exact`]).
 
 pub mod am_loop;
 pub mod approach;
@@ -28,6 +29,7 @@ pub mod period;
 pub mod progress;
 pub mod reconstruct;
 pub mod reconstruct_am;
+pub mod reconstruct_exact;
 pub mod resonance;
 pub mod setpoint;
 pub mod settle;

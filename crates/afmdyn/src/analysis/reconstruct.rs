@@ -99,6 +99,24 @@ pub struct Reconstruction {
     pub force: Vec<f64>,
     /// U(d) = ∫_d^{d_max} F dt.
     pub potential: Vec<f64>,
+    /// How the exact inversion went ([`crate::analysis::reconstruct_exact`]); `None` for
+    /// the Sader–Jarvis and AM inversions.
+    pub exact: Option<ExactRecord>,
+}
+
+/// How the exact inversion went ([`crate::analysis::reconstruct_exact`]).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct ExactRecord {
+    /// Correction steps taken (0: the Sader–Jarvis estimate already met the tolerance).
+    pub iterations: usize,
+    /// The forward residual ρ of the Sader–Jarvis estimate: max |Δf − G F| over max |Δf|,
+    /// every row but the last.
+    pub sader_jarvis_residual: f64,
+    /// The forward residual ρ of the result.
+    pub forward_residual: f64,
+    /// ρ ≤ [`crate::analysis::reconstruct_exact::EXACT_TOLERANCE`] (else the iteration
+    /// stalled or reached its cap).
+    pub converged: bool,
 }
 
 impl ShiftCurve {
@@ -327,6 +345,7 @@ pub fn sader_jarvis_direct(
         distance: d.clone(),
         potential: potential_of(d, &force),
         force,
+        exact: None,
     })
 }
 
@@ -425,6 +444,7 @@ fn sader_jarvis_fft(
         distance: d.clone(),
         potential: potential_of(d, &force),
         force,
+        exact: None,
     })
 }
 

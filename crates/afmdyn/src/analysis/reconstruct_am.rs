@@ -186,7 +186,7 @@ fn piece(c: f64, a: f64, lo: f64, hi: f64, alpha: f64, beta: f64) -> f64 {
 
 /// The weight of the hat function of node j (nodes `d`) in the integral of a cycle about `c`
 /// of amplitude `a`; the last node's hat has no falling side (F = 0 beyond).
-fn weight(d: &[f64], j: usize, c: f64, a: f64) -> f64 {
+pub(crate) fn weight(d: &[f64], j: usize, c: f64, a: f64) -> f64 {
     let mut w = 0.0;
     if j > 0 {
         let (x0, x1) = (d[j - 1], d[j]);
@@ -211,7 +211,7 @@ const AM_CHUNK: usize = 64;
 
 /// The nodes of `d` (increasing) whose hats can meet the cycle [c − a, c + a]: those from the
 /// one before the first node above c − a to the one after the last node below c + a.
-fn nodes_within(d: &[f64], c: f64, a: f64) -> std::ops::Range<usize> {
+pub(crate) fn nodes_within(d: &[f64], c: f64, a: f64) -> std::ops::Range<usize> {
     let lo = d.partition_point(|x| *x <= c - a).saturating_sub(1);
     let hi = (d.partition_point(|x| *x < c + a) + 1).min(d.len());
     lo..hi.max(lo)
@@ -305,6 +305,7 @@ pub fn matrix_inversion_with(
         potential: potential_of(&d, &force),
         distance: d,
         force,
+        exact: None,
     })
 }
 

@@ -14,7 +14,17 @@
 //! tensions 0.01–0.6 N/m (CRC Handbook, 97th ed.: the highest liquid at room temperature is
 //! mercury, 0.485 N/m); works of adhesion 1e-3–1 J/m² (polymers 0.03–0.1 J/m², water on silica
 //! 0.14 J/m², clean metals up to ~3 J/m²: Israelachvili 2011, ch. 13 and 17); lever lengths
-//! 5 µm–1 mm.
+//! 5 µm–1 mm; lock-in time constants 1 µs–0.1 s (the PI scan's `time_constant`, section
+//! `feedback`: a quarter of the lever's amplitude time 2Q/ω₀, 8 µs for a Q = 2 lever at 20 kHz
+//! in liquid, 0.1 ms for a tapping lever, 26 ms for Q = 10⁵ in vacuum; SR830 and HF2 lock-ins
+//! offer 1 µs to 30 ks, and no image waits 1 000 s per pixel).
+
+/// Largest |SI distance| (m) of a tip–sample rest distance or an approach range: 100 µm.
+/// Tapping-mode distances are nanometres; a value beyond this is a length meant in nm but
+/// written in m (1e9 too large), refused with that hint before it becomes a gap α5 the user
+/// never wrote (issues 27 and 28). The physical range of `[sample] z_c` ([`SI_RANGES`]) and of
+/// the requests' distances ([`crate::request::limits::si_distance`]).
+pub const MAX_SI_DISTANCE: f64 = 1e-4;
 
 /// A bound of a physical range: the value beyond which a value is refused, and the refusal's
 /// words (`{x}` stands for the value as given).
@@ -102,7 +112,7 @@ pub const SI_RANGES: &[SiRange] = &[
         unit: "m",
         slips: &[],
         below: None,
-        above: Some((1e-6, "longer than 100 µm for a₀ (0.165e-9 m typical); probe files are in metres: {x} nm is {x}e-9")),
+        above: Some((1e-6, "longer than 1 µm for a₀ (0.165e-9 m typical); probe files are in metres: {x} nm is {x}e-9")),
         magnitude: false,
         typical: None,
         zero_typical: false,
@@ -113,7 +123,7 @@ pub const SI_RANGES: &[SiRange] = &[
         unit: "m",
         slips: &[],
         below: None,
-        above: Some((1e-4, "longer than 100 µm for a rest distance; probe files are in metres: {x} nm is {x}e-9")),
+        above: Some((MAX_SI_DISTANCE, "longer than 100 µm for a rest distance; probe files are in metres: {x} nm is {x}e-9")),
         magnitude: true,
         typical: None,
         zero_typical: false,
@@ -218,6 +228,17 @@ pub const SI_RANGES: &[SiRange] = &[
         typical: Some((1e-3, 1.0, "1e-3–1 J/m² of works of adhesion", "they are in J/m² (50 mJ/m² is 50e-3)")),
         zero_typical: false,
     },
+    SiRange {
+        sections: &["feedback"],
+        keys: &["time_constant"],
+        unit: "s",
+        slips: &[("µ", 1e-6), ("m", 1e-3)],
+        below: None,
+        above: Some((1e3, "above 1000 s for a lock-in's time constant (an imaging lock-in's is µs to ms); time constants are in s: {x} µs is {x}e-6")),
+        magnitude: false,
+        typical: Some((1e-6, 0.1, "1 µs–0.1 s of imaging lock-ins", "time constants are in s (100 µs is 100e-6)")),
+        zero_typical: true,
+    },
 ];
 
 /// The ranges of `[section].key`, if it has any beyond its sign.
@@ -310,6 +331,14 @@ mod tests {
         assert!(warning("sample", "surface_tension", 0.9).is_some());
         assert!(warning("sample", "hamaker", 0.0).is_none());
         assert!(refusal("sample", "z_c", -2e-4).is_some());
+        // issue 60 D: the PI scan's lock-in time constant of 1e300 s is refused, 100 (meant
+        // in µs) warned naming µs, 0 (no filter) and 0.1 ms typical
+        assert!(refusal("feedback", "time_constant", 1e300).is_some());
+        assert!(refusal("feedback", "time_constant", 1e3).is_none());
+        let why = warning("feedback", "time_constant", 100.0).unwrap();
+        assert!(why.contains("µs"), "{why}");
+        assert!(warning("feedback", "time_constant", 0.0).is_none());
+        assert!(warning("feedback", "time_constant", 1e-4).is_none());
     }
 
     /// Issue 60: a refusal names the value with at most 6 significant digits (1e300 was

@@ -28,7 +28,7 @@ pub struct FmRequest {
     pub amplitude: Option<f64>,
     /// The mode K (1-based) the PLL tracks; default 1.
     pub mode: usize,
-    /// First z_c of the approach (default: where the frequency shift has decayed to 1 % of
+    /// First z_c of the approach (default: where the frequency shift has decayed to 0.5 % of
     /// its value at `to`, [`default_from`]; 2A + a₀, the lower turning point at A, for the
     /// laws without a force before contact).
     pub from: Option<f64>,
@@ -64,7 +64,12 @@ pub const FM_AMPLITUDE_RANGE: (f64, f64) = (1e-8, 1e4);
 /// The share of the frequency shift at the curve's end (`to`) below which the default FM curve
 /// starts: the range runs from where |Δf| has decayed to it down to contact, which is also the
 /// range a Sader–Jarvis reconstruction needs (its integrals run to where the shift vanishes).
-pub const FM_DEFAULT_DECAY: f64 = 0.01;
+/// Half of `reconstruct`'s truncation threshold ([`super::reconstruct::DECAYED`]): the
+/// default range comes from an estimate of the shift (the cycle mean of [`default_from`]),
+/// and the computed curve's first point sits a little above it (1.0033 % where the two were
+/// equal), so a default `fm` curve handed to `reconstruct` must start with a margin below
+/// the threshold, not on it.
+pub const FM_DEFAULT_DECAY: f64 = super::reconstruct::DECAYED / 2.0;
 
 /// The default first z_c of an FM curve at amplitude `a` ending at `to` (units of g₀): the
 /// largest z_c whose estimated frequency shift is still [`FM_DEFAULT_DECAY`] of its value at

@@ -39,7 +39,7 @@ use crate::analysis::am_loop::{
     LOCK_IN_SAMPLES,
 };
 use crate::analysis::approach::rest_distance;
-use crate::error::SimError;
+use crate::error::{number, SimError};
 use crate::integrate::IntegratorOptions;
 use crate::probe::Probe;
 use crate::report::CurveUnits;
@@ -65,7 +65,9 @@ pub struct PiScan {
     pub scan_rate: Option<f64>,
     /// (K_P, K_I): K_P dimensionless ≥ 0, K_I in 1/s > 0.
     pub gains: Option<(f64, f64)>,
-    /// The lock-in's time constant (s), ≥ 0.
+    /// The lock-in's time constant (s), ≥ 0 and at most 1 000 s (its physical range,
+    /// [`crate::probe::ranges`], section `feedback`); outside 1 µs–0.1 s the image warns of a
+    /// likely unit slip.
     pub time_constant: Option<f64>,
 }
 
@@ -203,7 +205,14 @@ pub(crate) fn resolve(
         None => (lever.proportional, lever.integral / t_s),
     };
     let tc = match scan.time_constant {
-        Some(v) => positive("time_constant", v, true, "must be a finite time ≥ 0 (s)")?,
+        Some(v) => {
+            let v = positive("time_constant", v, true, "must be a finite time ≥ 0 (s)")?;
+            // the lock-in's physical range (probe::ranges, section `feedback`)
+            if let Some(why) = crate::probe::ranges::refusal("feedback", "time_constant", v) {
+                return Err(SimError::out_of_range("time_constant", number(v), why));
+            }
+            v
+        }
         None => lever.time_constant * t_s,
     };
     let gains = FeedbackGains {
@@ -280,7 +289,7 @@ impl ScanStudy {
     /// As [`super::image::image`]; [`SimError::OutOfRange`] naming `scan_rate` (> 0, at most
     /// the drive frequency over 2 × pixels: a pixel needs a drive period; and at most
     /// [`MAX_SCAN_PERIODS`] periods in all), `gains` (K_P ≥ 0, K_I > 0, finite) or
-    /// `time_constant` (≥ 0, finite).
+    /// `time_constant` (≥ 0, finite, at most 1 000 s).
     pub fn new(
         probe_table: &toml::Table,
         map: &SampleMap,
@@ -447,6 +456,14 @@ impl ScanStudy {
                 .map(|w| format!("the ideal image beside the scan: {w}"))
                 .collect(),
         };
+        // a lock-in time constant given outside the typical range: a likely unit slip, named
+        // (the lever's default τ_c/4 is no slip, whatever its value)
+        if let Some(tc) = self.recipe.scan.time_constant {
+            if let Some(why) = crate::probe::ranges::warning("feedback", "time_constant", tc) {
+                img.warnings
+                    .push(format!("time_constant = {} s is {why}", number(tc)));
+            }
+        }
         img.artefacts = [0, 1].map(|d| img.artefacts_of(d));
         for (d, a) in ["trace", "retrace"].iter().zip(img.artefacts) {
             if a.lost_contact_pixels > 0 {

@@ -88,11 +88,8 @@ pub const MAX_OBSERVE_PERIODS: usize = crate::analysis::observables::MAX_PERIODS
 /// [`crate::params::STATE_NORM_MAX`] count as diverged.
 pub const MAX_INITIAL_ENTRY: f64 = crate::params::STATE_NORM_MAX / 10.0;
 
-/// Largest |SI distance| (m) of a tip–sample rest distance or an approach range: 100 µm.
-/// Tapping-mode distances are nanometres; a value beyond this is a length meant in nm but
-/// written in m (1e9 too large), refused with that hint before it becomes a gap α5 the user
-/// never wrote (issues 27 and 28).
-pub const MAX_SI_DISTANCE: f64 = 1e-4;
+// the limit is the physical range of a rest distance, declared with the probe's ranges
+pub use crate::probe::ranges::MAX_SI_DISTANCE;
 
 /// Drive frequencies (Hz) are accepted within [1e-2, 1e4] × the probe's own drive frequency:
 /// wider than the band of any of its 20 modes, narrow enough to catch a value meant in kHz or

@@ -15,6 +15,8 @@ pub enum Inversion {
     SaderJarvis,
     /// An AM curve by the matrix method.
     AmMatrix,
+    /// An FM curve by the exact inversion (Sader–Jarvis corrected through Giessibl's relation).
+    Exact,
 }
 
 /// The presentation of reconstruction `r` and its `document`: the summary (the distances, the
@@ -48,6 +50,20 @@ pub fn reconstruction(
         text.value(f, "N"),
         text.value(r.distance.get(k).copied().unwrap_or(f64::NAN), "m"),
     ));
+    if let Some(e) = &r.exact {
+        p.line(format!(
+            "exact inversion: {} correction step(s), forward residual {} of the largest |Δf| \
+             (Sader–Jarvis's: {}){}",
+            e.iterations,
+            crate::error::number(e.forward_residual),
+            crate::error::number(e.sader_jarvis_residual),
+            if e.converged {
+                ""
+            } else {
+                ", stopped where a step no longer shrank it"
+            },
+        ));
+    }
     if files == Files::None {
         return p;
     }
@@ -80,6 +96,7 @@ pub fn reconstruction(
         let title = match how {
             Inversion::AmMatrix => "Tip–sample force from the AM curve (matrix method)",
             Inversion::SaderJarvis => "Tip–sample force by the Sader–Jarvis inversion",
+            Inversion::Exact => "Tip–sample force by the exact inversion",
         };
         let labels = (
             "distance of closest approach d (m)".into(),
