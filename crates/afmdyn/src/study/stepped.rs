@@ -81,9 +81,15 @@ impl CurveStudy {
     fn new(
         what: &'static str,
         spec: SteppedSpec,
-        fingerprint: Value,
+        mut fingerprint: Value,
     ) -> Result<CurveStudy, SimError> {
         check_values(&spec)?;
+        // points measured on invariant circles are not those of the exact orbits a store
+        // written before them holds (its fingerprint has no such key): such a store is not
+        // resumed by a run on circles, nor the other way round
+        if let (Some(t), Some(fp)) = (&spec.torus, fingerprint.as_object_mut()) {
+            fp.insert("invariant_circles".into(), json!({ "nodes": t.nodes }));
+        }
         // held to the budgets here too: a front end runs the study into its store without
         // `run`
         check_cost(what, stepped_cost(&spec)?)?;
