@@ -307,3 +307,28 @@ fn a_curve_on_circles_matches_the_exact_curve_on_the_beam() {
     assert_eq!(on, all);
     assert!(da < 1e-7 && dp < 1e-7, "amplitudes {da:e}, phases {dp:e}");
 }
+
+/// A curve on invariant circles is a different run from the same curve on exact orbits: the
+/// store's fingerprint names the circles, so neither resumes the other's points; a curve whose
+/// drive repeats quickly (25/4) has the fingerprint it had before circles existed.
+#[test]
+fn a_store_on_circles_is_not_resumed_by_exact_orbits() {
+    use afmdyn::request::run::{ApproachRequest, Resolved};
+    use afmdyn::study::stepped::CurveStudy;
+    let fingerprint = |f2: &str, exact: bool| {
+        let request = ApproachRequest {
+            exact,
+            ..ApproachRequest::default()
+        };
+        let model = Resolved::plain(lever(f2, 1.1));
+        CurveStudy::approach(&request, &model).unwrap().fingerprint
+    };
+    let circles = fingerprint("1.881e6", false);
+    let exact = fingerprint("1.881e6", true);
+    assert!(circles.get("invariant_circles").is_some(), "{circles}");
+    assert!(exact.get("invariant_circles").is_none(), "{exact}");
+    assert_ne!(circles, exact);
+    assert!(fingerprint("1.875e6", false)
+        .get("invariant_circles")
+        .is_none());
+}
