@@ -31,7 +31,12 @@ pub struct FitArgs {
     #[arg(long, default_value = "approach")]
     segment: String,
     /// The range of tip positions fitted, LO,HI (m, after the contact-point offset)
-    #[arg(long, value_delimiter = ',', num_args = 2, allow_hyphen_values = true)]
+    #[arg(
+        long,
+        value_name = "LO,HI",
+        value_delimiter = ',',
+        allow_hyphen_values = true
+    )]
     range: Option<Vec<f64>>,
     /// Output directory (locked during the run)
     #[arg(long, default_value = "afmdyn-out/fit")]
@@ -52,12 +57,22 @@ pub fn fit(a: &FitArgs) -> Result<(), CliError> {
             )))
         }
     };
+    let range = match a.range.as_deref() {
+        None => None,
+        Some(&[lo, hi]) => Some([lo, hi]),
+        Some(r) => {
+            return Err(CliError::Input(format!(
+                "--range: {} value(s) given; must be two, LO,HI (m)",
+                r.len()
+            )))
+        }
+    };
     let (params, probe) = a.model.resolve(Params::default())?;
     let request = FitRequest {
         data: Some(a.data.display().to_string()),
         fit: a.fit.clone(),
         segment,
-        range: a.range.as_ref().map(|r| [r[0], r[1]]),
+        range,
         ..FitRequest::default()
     };
     let model = Resolved { params, probe };

@@ -250,3 +250,25 @@ fn a_finished_store_with_a_line_removed_is_completed_on_resume() {
         String::from_utf8_lossy(&again).replace(cut.to_str().unwrap(), whole.to_str().unwrap())
     );
 }
+
+/// `fit --range` takes LO,HI as its help says: one value, or three, is refused naming the flag
+/// (a range of one value used to take the next flag as its second value).
+#[test]
+fn a_fit_range_of_the_wrong_length_is_refused_by_name() {
+    for range in ["--range=1e-9", "--range=1e-9,2e-9,3e-9"] {
+        refused(
+            &[
+                "fit",
+                "--probe",
+                "examples/probe-fit-hertz.toml",
+                "--data",
+                "examples/force-curve-hertz.csv",
+                range,
+                "--json",
+                "--out",
+                temp_dir("fit-range").join("out").to_str().unwrap(),
+            ],
+            &["--range", "must be two, LO,HI"],
+        );
+    }
+}
