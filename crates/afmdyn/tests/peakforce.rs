@@ -568,3 +568,27 @@ fn peakforce_filter_is_a_butterworth_low_pass() {
     assert!(low_pass_periodic(&x, 0.5).is_err());
     assert!(low_pass_periodic(&x, 0.0).is_err());
 }
+
+/// The off-resonance bound f_m/f₀ ≤ 0.5 holds against the lever's first natural frequency as
+/// modelled: on the beam (first natural frequency ≈ 3.516 in its units) Ω = 1 is f_m/f₀ ≈ 0.28,
+/// accepted, and Ω = 2 (≈ 0.57) refused naming `omega`; on the point mass Ω = 0.6 is refused.
+#[test]
+fn peakforce_modulation_bound_is_relative_to_the_first_resonance() {
+    use afmdyn::request::{PeakForceRequest, Resolved};
+    let text = std::fs::read_to_string(AIR).unwrap();
+    let beam = afmdyn::probe::Probe::parse(&text, "air").unwrap().params;
+    assert_eq!(
+        beam.structure,
+        Structure::Beam,
+        "the air example is the beam"
+    );
+    let check = |p: Params, omega: f64| {
+        PeakForceRequest::default().params(&Resolved::plain(Params { omega, ..p }))
+    };
+    assert!(check(beam, 1.0).is_ok());
+    let e = check(beam, 2.0).unwrap_err().to_string();
+    assert!(e.contains("omega"), "{e}");
+    let pm = point_mass(ContactLaw::Hertz, 100.0, 100.0, 1.0, 0.5);
+    assert!(check(pm, 0.4).is_ok());
+    assert!(check(pm, 0.6).is_err());
+}

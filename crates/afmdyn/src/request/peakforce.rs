@@ -21,9 +21,18 @@ use crate::report::CurveUnits;
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 
-/// Largest modulation frequency relative to the lever's first resonance, Ω = f_m/f₀ (the
-/// model's Ω): above it the drive is not off resonance (use `orbit` or `approach`).
+/// Largest modulation frequency relative to the lever's first resonance, f_m/f₀ (the model's Ω
+/// over the lever's first natural frequency as modelled: Ω itself in the lumped models, Ω/3.516
+/// on the beam): above it the drive is not off resonance (use `orbit` or `approach`).
 pub const MAX_MODULATION_RATIO: f64 = 0.5;
+
+/// The lever's first natural frequency as modelled, in the units of Ω (in its medium; 1 in the
+/// lumped models' units, ≈ 3.516 in the beam's): f₀/f_m = this / Ω.
+fn first_natural_frequency(p: &Params) -> f64 {
+    CantileverModel::new(p).map_or(1.0, |m| {
+        crate::eigen::natural_modes(m.galerkin().region(crate::galerkin::Region::Free)).omega[0]
+    })
+}
 
 /// `peakforce`: one steady off-resonance tap at `z_c` (m with a probe, else g₀) or at the z_c
 /// whose peak force is `setpoint` (N with a probe, else F̃).
@@ -116,7 +125,7 @@ impl PeakForceRequest {
                  with excitation = \"sample\" (or the beam's base drive) and one drive frequency",
             ));
         }
-        if p.omega > MAX_MODULATION_RATIO {
+        if p.omega / first_natural_frequency(&p) > MAX_MODULATION_RATIO {
             return Err(SimError::out_of_range(
                 "omega",
                 p.omega,
@@ -354,11 +363,7 @@ pub fn document(request: &PeakForceRequest, model: &Resolved, r: &PeakForceResul
     let multipliers: Vec<[f64; 2]> = tap.multipliers.iter().map(|m| [m.re, m.im]).collect();
     let time_unit = if u.si { "s" } else { "τ" };
     let period = std::f64::consts::TAU / p.omega;
-    // f₀/f_m: the lever's first natural frequency as modelled (in its medium; 1 in the lumped
-    // models' units, ≈ 3.516 in the beam's) over Ω
-    let omega1 = CantileverModel::new(&p).map_or(1.0, |m| {
-        crate::eigen::natural_modes(m.galerkin().region(crate::galerkin::Region::Free)).omega[0]
-    });
+    let omega1 = first_natural_frequency(&p);
     let mut curve = json!({
         "approach_distance": col(&t.distance[..half], u.length),
         "approach_force": col(&t.force[..half], u.force),
