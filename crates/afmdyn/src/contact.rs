@@ -257,7 +257,7 @@ pub use dmt::{DMT_DEFAULT_A0, DMT_DEFAULT_HAMAKER};
 pub use electrostatic::{ELECTROSTATIC_DEFAULT, ELECTROSTATIC_DEFAULT_RADIUS, VACUUM_PERMITTIVITY};
 pub use impact::IMPACT_DEFAULT_RESTITUTION;
 pub use jkr::{Jkr, JKR_BREAK_CUT, JKR_DEFAULT_ADHESION};
-pub use law::{Law, LawInfo, Param, SampleSi};
+pub use law::{reduced_modulus, Law, LawInfo, Param, SampleSi};
 pub use sls::{Zener, SLS_DEFAULT_MAXWELL};
 
 impl Default for ContactLaw {

@@ -77,6 +77,13 @@ pub struct SampleSi {
     pub maxwell: Option<(f64, f64)>,
 }
 
+/// The reduced (effective) modulus of two elastic bodies in contact,
+/// E* = 1/((1 − ν_t²)/E_t + (1 − ν_s²)/E_s) (Pa; Johnson, *Contact Mechanics*, eq. 4.22), of the
+/// tip (E_t, ν_t) and the sample (E_s, ν_s).
+pub fn reduced_modulus(e_tip: f64, nu_tip: f64, e_sample: f64, nu_sample: f64) -> f64 {
+    1.0 / ((1.0 - nu_tip * nu_tip) / e_tip + (1.0 - nu_sample * nu_sample) / e_sample)
+}
+
 impl SampleSi {
     /// The Hertz group α4 = (4/3) E* √R g₀^{3/2}/F_s (Johnson, *Contact Mechanics*, §4.2).
     pub fn hertz_alpha4(&self) -> f64 {

@@ -622,8 +622,7 @@ impl Probe {
         let e_s = r.required(s, S, "youngs_modulus", "Pa", POSITIVE);
         let nu_s = r.required(s, S, "poisson_ratio", "1", POISSON);
         if let (Some(et), Some(nt), Some(es), Some(ns)) = (tip_e, tip_nu, e_s, nu_s) {
-            // Johnson, Contact Mechanics, eq. 4.22
-            out.e_star = Some(1.0 / ((1.0 - nt * nt) / et + (1.0 - ns * ns) / es));
+            out.e_star = Some(crate::contact::reduced_modulus(et, nt, es, ns));
             out.elastic = Some([es, ns, et, nt]);
         }
         if law == "hertz" {

@@ -33,7 +33,7 @@
 //! ∂F/∂k_H = F_c/k_H exactly for Hertz, and by central differences of relative step 1e-6 on
 //! DMT's and JKR's groups (error ~1e-12 relative), chained to E_s, R, H and W analytically.
 
-use crate::contact::{DmtLaw, HertzLaw, Jkr, JkrLaw, Law};
+use crate::contact::{reduced_modulus, DmtLaw, HertzLaw, Jkr, JkrLaw, Law};
 
 /// The force-curve laws the fit takes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -201,8 +201,8 @@ impl ForceCurveModel {
     /// k_H = (4/3)E*√R and ∂k_H/∂E_s.
     fn hertz_group(&self, e_s: f64, r: f64) -> (f64, f64) {
         let b = 1.0 - self.poisson_ratio * self.poisson_ratio;
-        let a = (1.0 - self.tip.1 * self.tip.1) / self.tip.0;
-        let e_star = 1.0 / (a + b / e_s);
+        let e_star = reduced_modulus(self.tip.0, self.tip.1, e_s, self.poisson_ratio);
+        // ∂E*/∂E_s = E*² (1 − ν_s²)/E_s²
         let k = 4.0 / 3.0 * e_star * r.sqrt();
         (k, k * e_star * b / (e_s * e_s))
     }
