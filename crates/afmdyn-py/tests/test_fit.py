@@ -90,3 +90,35 @@ def test_nanite_hertz_paraboloid_gives_the_same_modulus():
     tip = idnt["tip position"][~segment]
     assert np.allclose(ds["tip_position"].values, tip, rtol=0, atol=1e-15)
     assert np.allclose(ds["force"].values, idnt["force"][~segment], rtol=0, atol=1e-20)
+
+
+def _afmformats_curve(afmformats, h, f, k=K):
+    """The synthetic curve as an afmformats force-distance object (as an instrument file reads)."""
+    n = h.size
+    metadata = {"spring constant": k, "path": str(CURVE), "enum": 0, "duration": 1.0,
+                "sensitivity": 1e-9, "setpoint": 1e-9, "speed approach": 1e-6,
+                "speed retract": 1e-6, "imaging mode": "force-distance", "point count": n}
+    return afmformats.AFMForceDistance(
+        data={"force": f, "height (measured)": h, "segment": np.arange(n) >= n // 2,
+              "time": np.linspace(0.0, 1.0, n)},
+        metadata=metadata)
+
+
+def test_an_instrument_curve_read_by_afmformats_fits_as_its_columns(tmp_path):
+    afmformats = pytest.importorskip("afmformats")
+    h, f = _curve()
+    columns = _fit(data={"height": h, "force": f}, fit=FIT)
+    obj = _afmformats_curve(afmformats, h, f)
+    path = tmp_path / "curve.h5"
+    obj.export_data(str(path), fmt="hdf5")
+    for data in (obj, path, str(path)):
+        ds = _fit(data=data, fit=FIT)
+        # the same rows, so the same estimates to the last digit
+        assert np.array_equal(ds["estimate"].values, columns["estimate"].values)
+    with pytest.raises(ValueError, match="curve"):
+        _fit(data=path, fit=FIT, curve=1)
+    # a file calibrated with another spring constant is named (the probe's is used)
+    other = tmp_path / "other.h5"
+    _afmformats_curve(afmformats, h, f, k=2 * K).export_data(str(other), fmt="hdf5")
+    with pytest.warns(afmdyn.AfmdynWarning, match="spring constant"):
+        afmdyn.fit(probe=PROBE, data=other, fit=FIT)
