@@ -8,6 +8,7 @@ import { Engine, Cancelled } from "./engine.js";
 import { fieldErrors, probeErrors } from "./errors.js";
 import { DYN_PRESETS, DYN_FIELDS, dynModel, dynRequest } from "./dynamics.js";
 import { toCsv, download } from "./export.js";
+import { peakforceView, peakforceRows } from "./peakforce.js";
 
 const $ = (id) => document.getElementById(id);
 const COLOURS = { forward: "#1f5fbf", backward: "#c0392b", selected: "#f39c12" };
@@ -542,10 +543,11 @@ function showAnalysisFields() {
   const a = $("afm-analysis").value;
   $("sample-box").hidden = a !== "image";
   $("setpoint").disabled = !(a === "approach" || a === "image");
-  $("points").disabled = a === "image";
+  // (a PeakForce tap is one steady orbit at the probe's z_c: no curve)
+  $("points").disabled = a === "image" || a === "peakforce";
   // the swept range: z_c (m), or the drive frequency (Hz) of a resonance curve
   for (const end of ["from", "to"]) {
-    $(`curve-${end}`).disabled = a === "image";
+    $(`curve-${end}`).disabled = a === "image" || a === "peakforce";
     $(`curve-${end}-label`).textContent = a === "resonance" ? `frequency ${end} (Hz)` : `z_c ${end} (m)`;
   }
   $("fm-amplitude").disabled = a !== "fm";
@@ -575,7 +577,7 @@ function afmRequest() {
     put("lines", "lines");
     // the engine says why a PI scan is not run here (its message beside the field)
     request.feedback = $("feedback").value;
-  } else {
+  } else if (analysis !== "peakforce") {
     put("points", "points");
     put("from", "curve-from");
     put("to", "curve-to");
@@ -718,6 +720,11 @@ function drawAfm() {
     ]);
   } else if (kind === "image") {
     drawImage(d, y);
+  } else if (kind === "peakforce") {
+    const v = peakforceView(d, COLOURS);
+    react("afm-plot-a", v.a.traces, v.a.layout);
+    react("afm-plot-b", v.b.traces, v.b.layout);
+    summary($("afm-summary"), v.summary);
   } else {
     const c = d.curve;
     const yk = c[y] ? y : "amplitude";
@@ -799,7 +806,8 @@ async function runAfm() {
   const gen = ++generation.afm;
   if (req.analysis === "image") input.sample = $("sample-text").value;
   state.busy.afm = true;
-  status($("afm-status"), `computing the ${req.analysis} curve…`);
+  const what = { image: "image", peakforce: "steady tap" }[req.analysis] ?? `${req.analysis} curve`;
+  status($("afm-status"), `computing the ${what}…`);
   const t0 = performance.now();
   try {
     const { doc, ms } = await engine.run("afm", req.analysis, input);
@@ -817,7 +825,7 @@ async function runAfm() {
     state.timings.afm_ms = performance.now() - t0;
     state.timings.afm_engine_ms = ms;
     drawAfm();
-    status($("afm-status"), `${req.analysis === "image" ? "image" : `${req.analysis} curve`} in ${(state.timings.afm_ms / 1000).toFixed(2)} s` +
+    status($("afm-status"), `${what} in ${(state.timings.afm_ms / 1000).toFixed(2)} s` +
       (doc.warnings?.length ? ` — ${doc.warnings.length} warning(s) below` : ""));
   } catch (e) {
     reportError(e, afmErrorPlaces, $("err-afm"));
@@ -852,6 +860,10 @@ function exportData(format, what) {
         const rows = im.y.flatMap((y, j) => im.x.map((x, i) => ({ line: j, pixel: i, x, y,
           ...Object.fromEntries(maps.map((k) => [k, im[k][j][i]])) })));
         download("image.csv", toCsv(rows), "text/csv");
+        return;
+      }
+      if (a === "peakforce") {
+        download("peakforce-cycle.csv", toCsv(peakforceRows(d)), "text/csv");
         return;
       }
       const sweeps = a === "approach" || a === "bimodal" ? { approach: d.approach, retract: d.retract }
