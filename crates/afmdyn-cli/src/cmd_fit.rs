@@ -40,6 +40,10 @@ pub struct FitArgs {
         allow_hyphen_values = true
     )]
     range: Option<Vec<f64>>,
+    /// The number of rows of the approach (the rest is the retract), as the instrument
+    /// recorded its segments [default: up to the lowest height, inclusive]
+    #[arg(long, value_name = "N")]
+    approach_rows: Option<usize>,
     /// Output directory (locked during the run)
     #[arg(long, default_value = "afmdyn-out/fit")]
     out: PathBuf,
@@ -75,6 +79,7 @@ pub fn fit(a: &FitArgs) -> Result<(), CliError> {
         fit: a.fit.clone(),
         segment,
         range,
+        approach_rows: a.approach_rows,
         ..FitRequest::default()
     };
     let model = Resolved { params, probe };

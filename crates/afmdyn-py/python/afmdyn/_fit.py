@@ -28,6 +28,7 @@ def fit(
     data: Union[str, "os.PathLike[str]", Mapping[str, Sequence[float]], Any, None] = None,
     fit: Optional[List[str]] = None,
     curve: int = 0,
+    approach_rows: Optional[int] = None,
     segment: str = "approach",
     fit_range: Optional[Tuple[float, float]] = None,
     progress: ProgressArg = None,
@@ -48,6 +49,9 @@ def fit(
             ``nanite.Indentation`` too), whose ``height (measured)`` (else ``height
             (piezo)``) and ``force`` columns are taken.
         curve: which curve of an afmformats file with several (a force map), from 0.
+        approach_rows: the number of rows of the approach (the rest is the retract); default
+            the instrument's segments for an afmformats curve (its ``segment`` column), else
+            up to the lowest height, inclusive.
         fit: the parameters fitted, by their probe keys (default ``sample.youngs_modulus``
             and ``contact_point``): also ``tip.radius``, ``baseline``, ``sample.hamaker``
             (dmt), ``sample.adhesion_energy`` (jkr). The others are held at the probe's.
@@ -74,7 +78,11 @@ def fit(
         request["fit"] = list(fit)
     if fit_range is not None:
         request["range"] = [float(fit_range[0]), float(fit_range[1])]
-    data, k_file = _instrument_curve(data, curve)
+    data, k_file, segments = _instrument_curve(data, curve)
+    if approach_rows is None:
+        approach_rows = segments
+    if approach_rows is not None:
+        request["approach_rows"] = int(approach_rows)
     if isinstance(data, (str, os.PathLike)):
         request["data"] = os.fspath(data)
     elif data is not None:
@@ -118,13 +126,14 @@ _AFMFORMATS = (".jpk-force", ".jpk-force-map", ".jpk-qi-data", ".jpk-qi-series",
 _MAX_INSTRUMENT_FILE = 1 << 30
 
 
-def _instrument_curve(data: Any, curve: int) -> Tuple[Any, Optional[float]]:
-    """``data`` as :func:`fit` takes it, and the spring constant (N/m) its file states: an
-    afmformats file or object becomes the mapping of its ``height`` (``height (measured)``,
-    else ``height (piezo)``, m) and ``force`` (N) columns; anything else is returned as it is."""
+def _instrument_curve(data: Any, curve: int) -> Tuple[Any, Optional[float], Optional[int]]:
+    """``data`` as :func:`fit` takes it, the spring constant (N/m) its file states and the rows
+    of its approach: an afmformats file or object becomes the mapping of its ``height``
+    (``height (measured)``, else ``height (piezo)``, m) and ``force`` (N) columns, its approach
+    the leading rows of its ``segment`` column that are 0; anything else is returned as it is."""
     if isinstance(data, (str, os.PathLike)):
         if not os.fspath(data).lower().endswith(_AFMFORMATS):
-            return data, None
+            return data, None, None
         try:
             import afmformats
         except ImportError as e:
@@ -142,12 +151,16 @@ def _instrument_curve(data: Any, curve: int) -> Tuple[Any, Optional[float]]:
     columns = getattr(data, "columns", None)
     if columns is None or isinstance(data, Mapping) or "force" not in columns \
             or "height" in columns:  # (a DataFrame of afmdyn's own columns)
-        return data, None
+        return data, None, None
     heights = [c for c in ("height (measured)", "height (piezo)") if c in columns]
     if not heights:
         raise ValueError("data: the afmformats curve has no 'height (measured)' or "
                          "'height (piezo)' column")
     k_file = getattr(data, "metadata", {}).get("spring constant")
+    approach = None
+    if "segment" in columns:
+        retract = np.flatnonzero(np.asarray(data["segment"]) != 0)
+        approach = int(retract[0]) if retract.size else None
     return {"height": np.asarray(data[heights[0]], dtype=float),
-            "force": np.asarray(data["force"], dtype=float)}, k_file
+            "force": np.asarray(data["force"], dtype=float)}, k_file, approach
 
