@@ -125,6 +125,15 @@ impl Galerkin {
         &self.params
     }
 
+    /// Move the sample to the gap α5 = `alpha5` in place: α5 enters only eq. 18's constant
+    /// forcing (−α4 α5 φ_i(1)), rewritten by the same formula, so the result equals
+    /// [`Galerkin::new`] of the parameters with α5 replaced bit for bit, without allocating.
+    /// The caller validates `alpha5` ([`crate::model::CantileverModel::set_gap`]).
+    pub(crate) fn set_gap(&mut self, alpha5: f64) {
+        self.params.alpha5 = alpha5;
+        contact_constant_into(&self.params, &self.tip, &mut self.contact.forcing.constant);
+    }
+
     /// The clamped–free mode shapes.
     pub fn shapes(&self) -> &ModeShapes {
         &self.shapes
@@ -262,9 +271,20 @@ fn forcing_free(p: &Params, tip: &DVector<f64>, integrals: &DVector<f64>) -> For
 /// base terms with the base amplitude of V_T ([`Params::base_amplitude`], 0 for the point mass).
 fn forcing_contact(p: &Params, tip: &DVector<f64>, free: &Forcing) -> Forcing {
     let b = p.base_amplitude();
+    let mut constant = DVector::zeros(tip.len());
+    contact_constant_into(p, tip, &mut constant);
     Forcing {
-        constant: tip * (-p.alpha4 * p.alpha5),
+        constant,
         sin: &free.sin - tip * (b * p.alpha4),
         cos: &free.cos - tip * (b * p.alpha6 * p.omega),
+    }
+}
+
+/// Eq. 18's constant forcing −α4 α5 φ_i(1) written into `out` (shape `[N]`), elementwise
+/// φ_i(1) · (−α4 α5) as `tip * (−α4 α5)` forms it.
+fn contact_constant_into(p: &Params, tip: &DVector<f64>, out: &mut DVector<f64>) {
+    let c = -p.alpha4 * p.alpha5;
+    for (o, t) in out.iter_mut().zip(tip.iter()) {
+        *o = t * c;
     }
 }

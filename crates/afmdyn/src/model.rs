@@ -98,6 +98,8 @@ pub struct CantileverModel {
     law: TipSample,
     /// M⁻¹φ(1), shape `[N]`.
     mphi: DVector<f64>,
+    /// M⁻¹, N×N: kept for [`CantileverModel::set_gap`].
+    minv: DMatrix<f64>,
     /// m_eff = 1/(φᵀM⁻¹φ).
     m_eff: f64,
     /// φᵀ[−M⁻¹K, −M⁻¹C], shape `[2N]`: the free tip acceleration per unit z.
@@ -191,6 +193,7 @@ impl CantileverModel {
             galerkin,
             regions,
             mphi,
+            minv,
             m_eff,
             tip_acc,
             tip_acc_forcing,
@@ -227,6 +230,30 @@ impl CantileverModel {
         let delta = -self.v_t(tau, z);
         self.law.potential(from == Region::Contact, delta)
             - self.law.potential(to == Region::Contact, delta)
+    }
+
+    /// Move the sample to the gap α5 = `alpha5` in place (a scan's piezo between drive
+    /// periods): afterwards the model equals [`CantileverModel::new`] of its parameters with
+    /// α5 replaced, bit for bit (α5 enters only eq. 18's constant forcing, here rewritten by
+    /// the same operations, and V_T, read from the parameters), without assembling it again.
+    ///
+    /// # Errors
+    /// As [`CantileverModel::new`]: [`Params::validate_fields`] of the changed parameters (the
+    /// drive's common period, [`Params::validate`]'s further check, does not depend on α5);
+    /// the model is unchanged then.
+    pub fn set_gap(&mut self, alpha5: f64) -> Result<(), ParamError> {
+        self.params
+            .with(SweepParam::Alpha5, alpha5)
+            .validate_fields()?;
+        self.params.alpha5 = alpha5;
+        self.galerkin.set_gap(alpha5);
+        let n = self.params.modes;
+        let lower = &self.minv * &self.galerkin.region(Region::Contact).forcing.constant;
+        self.regions[Region::Contact.index()]
+            .b_const
+            .rows_mut(n, n)
+            .copy_from(&lower);
+        Ok(())
     }
 
     /// Parameters.

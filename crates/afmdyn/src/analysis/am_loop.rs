@@ -33,7 +33,7 @@
 
 use super::observables::{observe, wrap_phase, ObservableOptions};
 use crate::error::SimError;
-use crate::integrate::{advance, build, Integrator, IntegratorOptions};
+use crate::integrate::{advance, build, check_start, Integrator, IntegratorOptions};
 use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
 use nalgebra::DVector;
@@ -114,9 +114,58 @@ impl LockIn {
 /// The first harmonic (A, φ) of W(1,τ) over the drive period from the integrator's current τ,
 /// sampled `samples` times (module docs), the integrator advanced to the period's end.
 ///
+/// The samples are read from the integrator's dense output ([`Integrator::dense_state`]) inside
+/// the steps it takes over the period, so that they do not cut its steps: the Taylor
+/// integrator's free-flight step spans up to a quarter period, and stopping it at each of the
+/// 32 samples formed 32 or more series per period. The dense output is the step's solution to
+/// the integrator's tolerance, so (A, φ) differ from [`demodulate_period_stepped`]'s by about
+/// the tolerance times the amplitude (the test `dense_and_stepped_demodulation_agree`). An
+/// integrator with spans ([`Integrator::spans`]: the exact propagator, the split integrator)
+/// is stepped to each sample as [`demodulate_period_stepped`] does.
+///
 /// # Errors
 /// As the integrator.
 pub fn demodulate_period(
+    integ: &mut dyn Integrator,
+    model: &CantileverModel,
+    samples: usize,
+) -> Result<(f64, f64), SimError> {
+    if integ.spans().is_some() {
+        return demodulate_period_stepped(integ, model, samples);
+    }
+    let p = model.params();
+    let (t0, period) = (integ.tau(), model.period());
+    let psi = p.drive_phase();
+    let tau_of = |j: usize| t0 + period * j as f64 / samples as f64;
+    let end = tau_of(samples);
+    let (mut x, mut y) = (0.0, 0.0);
+    let mut j = 1;
+    while j <= samples {
+        integ.step(end)?;
+        let tau1 = integ.tau();
+        while j <= samples && tau_of(j) <= tau1 {
+            let tau = tau_of(j);
+            let w = if tau == tau1 {
+                model.tip_values(tau, integ.state())[0]
+            } else {
+                model.tip_values(tau, &integ.dense_state(tau))[0]
+            };
+            let (s, c) = (p.omega * tau + psi).sin_cos();
+            x += w * s;
+            y -= w * c;
+            j += 1;
+        }
+    }
+    let k = 2.0 / samples as f64;
+    Ok(((k * x).hypot(k * y), wrap_phase((k * y).atan2(k * x))))
+}
+
+/// [`demodulate_period`] with the integrator advanced to each sample (its steps cut there):
+/// the reference of the dense sampling.
+///
+/// # Errors
+/// As the integrator.
+pub fn demodulate_period_stepped(
     integ: &mut dyn Integrator,
     model: &CantileverModel,
     samples: usize,
@@ -269,6 +318,47 @@ fn fit_state(z: &DVector<f64>, dim: usize) -> DVector<f64> {
     DVector::from_fn(dim, |i, _| if i < z.len() { z[i] } else { 0.0 })
 }
 
+/// A material's model and integrator, kept across a scan line.
+type Kept = (CantileverModel, Box<dyn Integrator>);
+
+/// The model of `mat` at the gap `alpha5` and its integrator started at τ = 0 from `z`
+/// ([`fit_state`] to the material's dimension): what [`CantileverModel::new`] and [`build`]
+/// of `mat` with α5 replaced give, bit for bit (their errors included), but the model and the
+/// integrator of `kept` moved to the gap in place ([`CantileverModel::set_gap`],
+/// [`Integrator::set_gap`]) where there are some, instead of assembled every drive period.
+fn at_gap<'a>(
+    kept: &'a mut Option<Kept>,
+    mat: &Params,
+    alpha5: f64,
+    z: &DVector<f64>,
+    opts: &IntegratorOptions,
+) -> Result<(&'a CantileverModel, &'a mut Box<dyn Integrator>), SimError> {
+    let reused = match kept {
+        Some((model, integ)) => {
+            model.set_gap(alpha5)?;
+            integ.set_gap(alpha5)
+        }
+        None => false,
+    };
+    if reused {
+        let (model, integ) = kept.as_mut().expect("kept above");
+        let start = fit_state(z, model.dim());
+        // `build`'s checks that depend on the state (the others do not depend on α5)
+        check_start(&start)?;
+        integ.reset(0.0, &start)?;
+    } else {
+        let model = match kept.take() {
+            Some((model, _)) => model,
+            None => CantileverModel::new(&mat.with(SweepParam::Alpha5, alpha5))?,
+        };
+        let start = fit_state(z, model.dim());
+        let integ = build(&model, opts.clone(), 0.0, &start)?;
+        *kept = Some((model, integ));
+    }
+    let (model, integ) = kept.as_mut().expect("kept above");
+    Ok((model, integ))
+}
+
 /// Accumulates a pixel's means.
 #[derive(Default)]
 struct Sums {
@@ -330,6 +420,9 @@ pub fn scan_line(
         periods: 1,
         harmonics: 1,
     };
+    // each material's model and integrator, kept across the line and moved to each period's
+    // gap in place (`at_gap`)
+    let mut kept: Vec<Option<Kept>> = spec.materials.iter().map(|_| None).collect();
     // one period at position s: returns the observables when `observe_it`
     let mut period_at =
         |s: f64,
@@ -341,20 +434,23 @@ pub fn scan_line(
             let mat = spec.materials.get(m).ok_or_else(|| {
                 SimError::out_of_range("material", m, "must be one of the spec's materials")
             })?;
-            let p = mat.with(SweepParam::Alpha5, mat.alpha5_for_rest_distance(*piezo - h));
-            let model = CantileverModel::new(&p)?;
-            let start = fit_state(&z, model.dim());
-            let mut integ = build(&model, spec.integrator.clone(), 0.0, &start)?;
+            let (model, integ) = at_gap(
+                &mut kept[m],
+                mat,
+                mat.alpha5_for_rest_distance(*piezo - h),
+                &z,
+                &spec.integrator,
+            )?;
             let (raw, o) = if observe_it {
                 let o = observe(integ.as_mut(), &opts)?;
                 ((o.amplitude, o.phase), Some((m, o)))
             } else {
                 (
-                    demodulate_period(integ.as_mut(), &model, spec.samples)?,
+                    demodulate_period(integ.as_mut(), model, spec.samples)?,
                     None,
                 )
             };
-            z = integ.state().clone();
+            z.clone_from(integ.state());
             lock.update(raw.0, raw.1);
             sums.z += *piezo;
             sums.amplitude += lock.amplitude();

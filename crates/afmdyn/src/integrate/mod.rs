@@ -225,6 +225,17 @@ pub trait Integrator: Send {
     fn set_variational(&mut self, on: bool) {
         let _ = on;
     }
+    /// Move the sample to the gap α5 = `alpha5` in place, everything else of the model kept (a
+    /// scan's piezo between drive periods, [`crate::analysis::am_loop::scan_line`]), so that
+    /// after [`Integrator::reset`] the integrator steps as one built by
+    /// [`crate::integrate::build`] for the changed model, bit for bit
+    /// ([`crate::model::CantileverModel::set_gap`]). `false` (the default, and for an α5 the
+    /// model refuses) where it cannot: the caller then builds an integrator of the changed
+    /// model. The Taylor integrator can.
+    fn set_gap(&mut self, alpha5: f64) -> bool {
+        let _ = alpha5;
+        false
+    }
     /// Integrator name.
     fn name(&self) -> &'static str;
     /// Steps of an adaptive method taken since the integrator was built, accepted and rejected

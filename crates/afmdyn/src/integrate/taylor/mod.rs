@@ -293,6 +293,13 @@ impl Integrator for Taylor {
     fn set_variational(&mut self, on: bool) {
         self.variational = on;
     }
+    fn set_gap(&mut self, alpha5: f64) -> bool {
+        if self.model.set_gap(alpha5).is_err() {
+            return false;
+        }
+        self.jet.set_gap(alpha5);
+        true
+    }
 
     fn reset(&mut self, tau: f64, z: &DVector<f64>) -> Result<(), SimError> {
         let (region, z) = self.model.checked_start(tau, z)?;

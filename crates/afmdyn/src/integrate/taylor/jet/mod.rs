@@ -291,6 +291,12 @@ mod contact;
 mod series;
 
 impl Jet {
+    /// Move the sample to the gap α5 = `alpha5` (the only datum of the jet that depends on it:
+    /// the law's piece and the free flight's forcing do not).
+    pub(crate) fn set_gap(&mut self, alpha5: f64) {
+        self.alpha5 = alpha5;
+    }
+
     /// The data of `model`, or `None` for a law the recurrences do not carry (the linear law,
     /// propagated exactly, and the impact law, whose contact is a constraint).
     pub(crate) fn new(model: &CantileverModel) -> Option<Self> {
