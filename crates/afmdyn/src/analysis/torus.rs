@@ -61,8 +61,8 @@ pub struct InvariantCircle {
     pub nodes: CircleNodes,
     /// x_k = u(θ_k) at τ = kT, k = 0..M−1 (M states `[2N]`).
     pub states: Vec<DVector<f64>>,
-    /// ∂G at the solution (2N×2N), G the circle's map ([`CircleMap`]): Broyden's first
-    /// estimate when the circle is continued ([`continue_circle`]).
+    /// ∂G at the solution (2N×2N), G the circle's map ([`CircleMap`]), from its linearisation
+    /// there: Broyden's first estimate when the circle is continued ([`continue_circle`]).
     pub jacobian: DMatrix<f64>,
     /// ‖F‖ after each Newton iteration.
     pub residuals: Vec<f64>,
@@ -107,8 +107,8 @@ pub fn rotation(model: &CantileverModel) -> Result<(u64, u64), SimError> {
 
 /// The invariant circle of `model`'s two-frequency drive near `guess` (the state at τ = 0,
 /// `[2N]`): Newton ([`shoot_map`]) on the circle's map of `opts.nodes` nodes
-/// ([`node_count`]), its stability from the monodromy matrices of the last Newton
-/// linearisation, and its distance to grazing from one more pass.
+/// ([`node_count`]), its stability and its distance to grazing from the last Newton
+/// linearisation (at the solution).
 ///
 /// # Errors
 /// [`SimError::OutOfRange`] for a drive without exactly one further component or nodes
@@ -126,7 +126,8 @@ pub fn invariant_circle(
 /// The circle of `model` continued from `previous` (the circle at a nearby parameter value,
 /// on as many nodes): Broyden's updates ([`shoot_map_broyden`]) from its state and from its
 /// map's Jacobian, by flows without the variational equations, and one linearisation at the
-/// solution — a step of an approach curve at the cost of about one Newton iteration.
+/// solution (its Jacobian, stability and distance to grazing) — a step of an approach curve
+/// at the cost of about one Newton iteration.
 ///
 /// # Errors
 /// As [`invariant_circle`]; [`SimError::OutOfRange`] when `previous` has another number of
@@ -171,7 +172,10 @@ fn solve(
     let nodes = CircleNodes::new(p, q, node_count(p, q, opts.nodes))?;
     let mut it = build(model, integ, 0.0, guess)?;
     let mut map = CircleMap::new(it.as_mut(), nodes.clone());
-    // Newton's solution (whose finish measures the distance to grazing), or Broyden's
+    // Newton's solution (whose last linearisation, at the solution, watched the distance to
+    // grazing), or Broyden's, linearised once at the solution: its exact Jacobian (the next
+    // point's first Broyden Jacobian), its distance to grazing and its monodromy matrices
+    // from one segment
     let (state, jacobian, residuals, graze) = match jacobian {
         None => {
             let o = shoot_map(&mut map, guess, 1, &opts.shooting)?;
@@ -179,8 +183,8 @@ fn solve(
         }
         Some(m0) => {
             let o = shoot_map_broyden(&mut map, guess, 1, &opts.shooting, m0)?;
-            let graze = map.grazing_distance(&o.state, 1)?;
-            (o.state, o.monodromy, o.residuals, graze)
+            let lin = map.linearise(&o.state, 1, true)?;
+            (o.state, lin.jacobian, o.residuals, lin.grazing_distance)
         }
     };
     let mut seg = map.segment_at(&state)?;

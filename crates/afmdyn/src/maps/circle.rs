@@ -331,10 +331,12 @@ impl DiscreteMap for CircleMap<'_> {
         &mut self,
         z: &DVector<f64>,
         n: usize,
-        grazing: bool,
+        _grazing: bool,
     ) -> Result<FlowMap, SimError> {
         Self::one_iterate(n)?;
-        let seg = self.linearised_segment(z, grazing)?;
+        // grazing is watched whether asked or not: a few evaluations of V_T per step against
+        // a pass of its own at the solution ([`DiscreteMap::grazing_distance`] reads it)
+        let seg = self.linearised_segment(z, true)?;
         let (m, d) = (self.nodes.len(), z.len());
         // F = x_M − Σ w_j x_j and ∂F = Φ_M − Σ w_j Φ_j
         let mut f = seg.states[m].clone();
@@ -359,11 +361,17 @@ impl DiscreteMap for CircleMap<'_> {
         Ok(map)
     }
 
-    /// The smallest distance to grazing over the segment's periods
-    /// ([`crate::maps::flow::grazing_distance`] of each, without the Jacobian), from the node
-    /// states of the last linearisation when it started at `z`.
+    /// The smallest distance to grazing over the segment's periods: the one the last
+    /// linearisation watched when it started at `z` (the same steps and searches, so the same
+    /// value), else [`crate::maps::flow::grazing_distance`] of each period, without the
+    /// Jacobian.
     fn grazing_distance(&mut self, z: &DVector<f64>, n: usize) -> Result<f64, SimError> {
         Self::one_iterate(n)?;
+        if let Some(seg) = &self.last {
+            if &seg.states[0] == z && !seg.grazing_distance.is_nan() {
+                return Ok(seg.grazing_distance);
+            }
+        }
         let t = self.period();
         // the node states: the last linearisation's when it started at z (a Newton solve
         // measures grazing at its solution, where it has just linearised), else a new segment

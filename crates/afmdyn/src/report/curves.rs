@@ -270,7 +270,7 @@ fn curve_doc(
 /// ([`crate::analysis::stepped::torus`]): per sweep and point the circle's nodes (0 for the
 /// exact orbit), the contraction of its linearisation per drive period (null for the exact
 /// orbit), and why a point is the exact orbit instead (`not-found`, `not-smooth`, `unstable`,
-/// `jump`; null on the circle).
+/// `jump`, `skipped`; null on the circle).
 fn invariant_circle(names: (&str, &str), c: &SteppedCurve) -> Value {
     // the circle of a point measured on it
     fn on(p: &CurvePoint) -> Option<&crate::analysis::stepped::torus::CirclePoint> {

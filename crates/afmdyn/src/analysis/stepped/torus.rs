@@ -19,7 +19,9 @@
 //! [`crate::analysis::torus::NEAR_GRAZING`] of grazing: a touch appears at some phases of the
 //! second drive and not at others, and the interpolation converges only algebraically), the
 //! point is the exact orbit (as without circles: continued, halved, or settled by
-//! the transient), flagged with [`Fallback`]; the curve's warnings count them.
+//! the transient), flagged with [`Fallback`]; the curve's warnings count them. Inside a stretch
+//! of such points (not smooth or not found) the circle is tried only at every
+//! [`STRETCH_RETRY`]-th point ([`Fallback::Skipped`]).
 
 use super::point::{orbit_point, prediction_slope};
 use super::{relative_gap, CurvePoint, Reached, SteppedSpec};
@@ -139,6 +141,8 @@ pub enum Fallback {
     Unstable,
     /// The circle found is farther than the jump tolerance from the previous point.
     Jump,
+    /// The circle was not tried: the point lies in a grazing stretch ([`STRETCH_RETRY`]).
+    Skipped,
 }
 
 impl Fallback {
@@ -149,8 +153,35 @@ impl Fallback {
             Fallback::NotSmooth => "not-smooth",
             Fallback::Unstable => "unstable",
             Fallback::Jump => "jump",
+            Fallback::Skipped => "skipped",
         }
     }
+}
+
+/// Inside a grazing stretch — the point just before fell back on the exact orbit because its
+/// circle was not smooth or not found, or was skipped — the circle is tried again only at
+/// every `STRETCH_RETRY`-th point: after `STRETCH_RETRY − 1` skipped points in a row; the
+/// others go straight to the exact orbit ([`Fallback::Skipped`]). A circle that crosses
+/// grazing stays non-smooth over a range of z_c (while mode 2's ripple touches the sample at
+/// some phases and not at others), and each try costs a circle's Newton on top of the orbit;
+/// past the stretch's end at most `STRETCH_RETRY − 1` points are exact orbits that a circle
+/// would have measured. At most 4: a point sees the last 3 points of its sweep.
+pub const STRETCH_RETRY: usize = 4;
+
+/// Whether the point after `history` skips its circle ([`STRETCH_RETRY`]).
+fn skips_circle(history: &[CurvePoint]) -> bool {
+    let in_stretch = history.last().is_some_and(|p| {
+        matches!(
+            p.fallback,
+            Some(Fallback::NotSmooth | Fallback::NotFound | Fallback::Skipped)
+        )
+    });
+    let skipped = history
+        .iter()
+        .rev()
+        .take_while(|p| p.fallback == Some(Fallback::Skipped))
+        .count();
+    in_stretch && skipped < STRETCH_RETRY - 1
 }
 
 /// The circle at `value`: continued from the previous point's circle by Broyden's updates
@@ -199,6 +230,11 @@ pub(super) fn torus_point(
         nodes: opts.nodes,
         shooting: spec.newton,
     };
+    if skips_circle(history) {
+        let mut p = orbit_point(spec, value, history)?;
+        p.fallback = Some(Fallback::Skipped);
+        return Ok(p);
+    }
     let circle = find_circle(spec, &model, &copts, value, history);
     let why = match &circle {
         Err(_) => Some(Fallback::NotFound),
@@ -278,7 +314,8 @@ pub(super) fn fallback_warning(points: &[&CurvePoint]) -> Option<String> {
     Some(format!(
         "{total} point(s) of the curve are the exact periodic orbit of the common period instead \
          of the invariant circle ({why}; not-smooth: a node near grazing, where a touch appears \
-         at some phases of the second drive and not at others): the per-point reason is in \
+         at some phases of the second drive and not at others; skipped: not tried inside such \
+         a stretch, tried again every {STRETCH_RETRY}th point): the per-point reason is in \
          invariant_circle.fallback"
     ))
 }
