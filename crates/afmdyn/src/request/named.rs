@@ -206,6 +206,10 @@ pub fn parse<'de, D: Deserializer<'de>>(
         "basins" => door::<BasinsRequest, D>(d, false),
         "fm" => door::<FmRequest, D>(d, false),
         "reconstruct" => door::<ReconstructRequest, D>(d, false),
+        // the reconstruction of an fm or AM document (not in NAMES: no schema of its own)
+        "reconstruct_document" => Ok(Some(Box::new(
+            super::reconstruct_document::FromDocument::deserialize(d)?,
+        ))),
         "peakforce" => door::<super::PeakForceRequest, D>(d, false),
         "fit" => door::<super::FitRequest, D>(d, true),
         _ => Ok(None),
