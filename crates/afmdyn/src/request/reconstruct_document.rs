@@ -2,9 +2,9 @@
 //! ([`ReconstructRequest::from_fm_document`], its k, f0 and A replaced by those given) or an AM
 //! approach document of the point mass ([`am_reconstruction`]), as a front end that knows the
 //! analysis by name gives them (Python's `afmdyn.reconstruct(fm=…)` and `(am=…)`): the named
-//! request `reconstruct_document` ([`super::named::parse`]), whose outcome is the JSON document.
+//! request `reconstruct_document` ([`super::named::parse`]), whose outcome is the JSON document
+//! ([`FromDocument::run`]).
 
-use super::named::{Named, Outcome};
 use super::reconstruct::{am_reconstruction, FmInversion, ReconstructRequest};
 use super::run::{run, Resolved};
 use crate::analysis::progress::Progress;
@@ -38,8 +38,12 @@ fn document(name: &'static str, text: &str) -> Result<Value, SimError> {
     })
 }
 
-impl Named for FromDocument {
-    fn validate(&self, _model: &Resolved) -> Result<(), SimError> {
+impl FromDocument {
+    /// Check that one document is given, not both or neither.
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming `fm`.
+    pub fn validate(&self) -> Result<(), SimError> {
         match (&self.fm, &self.am) {
             (Some(_), None) | (None, Some(_)) => Ok(()),
             _ => Err(SimError::out_of_range(
@@ -50,9 +54,14 @@ impl Named for FromDocument {
         }
     }
 
-    fn run(&self, model: &Resolved, progress: &Progress) -> Result<Outcome, SimError> {
-        self.validate(model)?;
-        let json = match (&self.fm, &self.am) {
+    /// The reconstruction's JSON document, counting in `progress` (cancellable).
+    ///
+    /// # Errors
+    /// As [`FromDocument::validate`]; a text that is not JSON, a document that is not an SI
+    /// `fm` document or an AM approach of the point mass; the inversion's errors.
+    pub fn run(&self, model: &Resolved, progress: &Progress) -> Result<Value, SimError> {
+        self.validate()?;
+        match (&self.fm, &self.am) {
             (Some(fm), _) => {
                 let request = ReconstructRequest {
                     inversion: self.inversion,
@@ -63,14 +72,10 @@ impl Named for FromDocument {
                         self.amplitude,
                     )?
                 };
-                run(&request, model, progress)?.json
+                Ok(run(&request, model, progress)?.json)
             }
-            (None, Some(am)) => am_reconstruction(&document("am", am)?, progress)?.json,
+            (None, Some(am)) => Ok(am_reconstruction(&document("am", am)?, progress)?.json),
             (None, None) => unreachable!("validated"),
-        };
-        Ok(Outcome {
-            document: json,
-            ..Outcome::default()
-        })
+        }
     }
 }
