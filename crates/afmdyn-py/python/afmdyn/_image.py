@@ -15,7 +15,7 @@ from . import _layout
 from ._common import _real_array, _typed, _warn
 from ._progress import ProgressArg, reporter
 
-def _request(probe: Any, sample: Any, setpoint: float, pixels: Optional[int],
+def _keywords(probe: Any, sample: Any, setpoint: float, pixels: Optional[int],
              lines: Optional[int], curve_points: Optional[int], height_map: Any,
              feedback: str, scan_rate: Optional[float], gains: Optional[Sequence[float]],
              time_constant: Optional[float], threads: Optional[int]) -> Tuple[str, Dict[str, Any]]:
@@ -106,8 +106,8 @@ def image(
             "scan_rate, gains, time_constant, threads: only with feedback='pi' "
             "(the ideal feedback has no loop)"
         )
-    text, request = _request(probe, sample, setpoint, pixels, lines, curve_points, height_map,
-                             feedback, scan_rate, gains, time_constant, threads)
+    text, request = _keywords(probe, sample, setpoint, pixels, lines, curve_points, height_map,
+                              feedback, scan_rate, gains, time_constant, threads)
     with reporter(progress if feedback == "pi" else False, "image", unit="line") as cb:
         out = _core.image(text, request, cb)
     return _dataset(out, setpoint)

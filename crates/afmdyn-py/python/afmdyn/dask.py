@@ -33,7 +33,7 @@ from . import _afmdyn as _core
 from ._afmdyn import Params
 from . import _layout
 from ._chart import dataset, study
-from ._common import _DEFAULTS
+from ._common import _DEFAULTS, _request
 from ._progress import ProgressArg, reporter
 
 try:
@@ -260,30 +260,10 @@ def chart(
 
     Returns the same ``xarray.Dataset`` as :func:`afmdyn.chart` with the same arguments.
     """
-    s = study(
-        params,
-        model,
-        x=x,
-        x_from=x_from,
-        x_to=x_to,
-        x_steps=x_steps,
-        y=y,
-        y_from=y_from,
-        y_to=y_to,
-        y_steps=y_steps,
-        starts=starts,
-        seed=seed,
-        tile=tile,
-        cluster_tol=cluster_tol,
-        lyapunov_periods=lyapunov_periods,
-        max_attractors=max_attractors,
-        tol=tol,
-        max_periods=max_periods,
-        max_period=max_period,
-        integrator=integrator,
-        steps_per_period=steps_per_period,
-        tolerance=tolerance,
-    )
+    request = _request(locals())
+    for own in ("client", "checkpoint_seconds"):
+        del request[own]
+    s = study(params, model, **request)
     n = s.tasks()
     if not (checkpoint_seconds >= 0 and np.isfinite(checkpoint_seconds)):
         raise ValueError(f"checkpoint_seconds = {checkpoint_seconds}: must be finite and >= 0")
@@ -412,25 +392,13 @@ def bifurcation(
     ``progress``: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a
     log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.
     """
+    request = _request(locals())
+    del request["client"]
+    if values is not None:
+        request["values"] = np.asarray(values, dtype=np.float64).ravel().tolist()
     from ._api import _params, _sweep_dataset
 
     p, _probe = _params(params, model)
-    request: Dict[str, Any] = dict(
-        param=param,
-        values=None if values is None else np.asarray(values, dtype=np.float64).ravel().tolist(),
-        to=to,
-        steps=steps,
-        starts=starts,
-        seed=seed,
-        continuation=continuation,
-        tol=tol,
-        max_periods=max_periods,
-        max_period=max_period,
-        integrator=integrator,
-        steps_per_period=steps_per_period,
-        tolerance=tolerance,
-    )
-    request["from"] = from_
     plan = _core.Plan.build("bifurcation", request, p)
     with _cluster(client) as client:
         own = None if store is None else plan.store(os.fspath(store))
@@ -499,10 +467,10 @@ def image(
     machine's cores, closed at the end): each line is a task, a pure function of the request
     and its number, so the Dataset equals :func:`afmdyn.image`'s bit for bit.
     """
-    from ._image import _dataset, _request
+    from ._image import _dataset, _keywords
 
-    text, request = _request(probe, sample, setpoint, pixels, lines, curve_points, height_map,
-                             "pi", scan_rate, gains, time_constant, None)
+    text, request = _keywords(probe, sample, setpoint, pixels, lines, curve_points, height_map,
+                              "pi", scan_rate, gains, time_constant, None)
     plan = _core.Plan.build("image", request, None, text)
     with _cluster(client) as client:
         d = _run_plan(client, plan, progress, "image (dask)", unit="line")
