@@ -1,8 +1,7 @@
-//! The analyses, called by the pure-Python layer (`afmdyn/__init__.py`), which turns the dicts
-//! returned here into xarray datasets and result objects. Each function validates its options
-//! as the command line does, runs the library without the GIL (see [`crate::run`]) and returns
-//! NumPy arrays that own the Rust buffers, plus the command line's JSON document where it has
-//! one (`"json"`).
+//! The compiled functions beside the one door ([`crate::door`]): a probe's parameters and SI
+//! block, a height map file's heights, the image (the library's `ImageJob`, whose inputs are a
+//! probe's TOML table and a sample map rather than a model, run as the door runs a request, to
+//! the same outcome dict) and the image's setpoint study.
 
 use crate::errors::{probe_error, sim_error};
 use crate::params::PyParams;
