@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The refusal of oversize inputs, measured (issue 59, Deliver 2): for every file option of the
 # command line (--probe, --config, --overlay, --sample, a sample map's height_map CSV and NPY,
-# reconstruct --fm and --am, and the store files a --resume reads: a sweep's ledger, rows and
+# reconstruct --fm and --am, fit --data, and the store files a --resume reads: a sweep's ledger, rows and
 # partial rows, a study's ledger and records), the wall time and peak RSS
 # (`/usr/bin/time -f '%e %M'`) of the refusal of /dev/zero and of a 2 GiB sparse file. Prints
 # the table and fails if any refusal takes 1 s or more, or 100 MB or more, or is not a refusal
@@ -49,6 +49,7 @@ for make in zero sparse; do
   $make "$f.csv"
   measure "continue --overlay" "$make" $A continue --from 3 --to 2.9 --overlay "$f.csv" --out "$tmp/o"
   measure "reconstruct --fm (CSV)" "$make" $A reconstruct --fm "$f.csv" --out "$tmp/o"
+  measure "fit --data" "$make" $A fit --probe examples/probe-fit-hertz.toml --data "$f.csv" --out "$tmp/o"
   $make "$f.json"
   measure "reconstruct --fm (JSON)" "$make" $A reconstruct --fm "$f.json" --out "$tmp/o"
   measure "reconstruct --am" "$make" $A reconstruct --am "$f.json" --out "$tmp/o"

@@ -135,6 +135,28 @@ message = "";
 try { wasm.reconstruct_fm(orbitText); } catch (e) { message = String(e.message); }
 check("reconstruct_fm refuses a document that is no fm document, naming fm", message.startsWith("fm"), message);
 
+// every analysis of the library's door is reached by its name: a force-curve fit (the curve as
+// the request's columns) and a PeakForce tap against the command line's documents
+const fitProbe = "examples/probe-fit-hertz.toml";
+const fitCsv = readFileSync(path.join(root, "examples/force-curve-hertz.csv"), "utf8").trim().split("\n").slice(1)
+  .map((l) => l.split(",").map(Number));
+const fitWasm = JSON.parse(wasm.run("fit", JSON.stringify({ probe: readFileSync(path.join(root, fitProbe), "utf8"),
+  request: { height: fitCsv.map((r) => r[0]), force: fitCsv.map((r) => r[1]) } })));
+const fitRef = native(["fit", "--probe", fitProbe, "--data", "examples/force-curve-hertz.csv", "--files", "none"]);
+[w, at] = worst(fitWasm.estimates, fitRef.estimates);
+check("fit by name is `afmdyn fit --json`'s (estimates, errors, intervals and profiles to 1e-9)", w <= 1e-9, `${w} at ${at}`);
+const pfProbe = "examples/probe-peakforce-air.toml";
+const pfWasm = JSON.parse(wasm.run("peakforce", JSON.stringify({ probe: readFileSync(path.join(root, pfProbe), "utf8") })));
+const pfRef = native(["peakforce", "--probe", pfProbe, "--files", "none"]);
+// each channel against its own size (the dissipation of this conservative law against the
+// base's work per cycle)
+const pfScale = (k) => (k === "dissipation" ? pfRef.balance.modulation_work : Math.abs(pfRef.channels[k]));
+const pfWorst = Math.max(...Object.keys(pfRef.channels).map((k) => Math.abs(pfWasm.channels[k] - pfRef.channels[k]) / pfScale(k)));
+check("peakforce by name is `afmdyn peakforce --json`'s (channels to 1e-9 of their size)", pfWorst <= 1e-9, String(pfWorst));
+message = "";
+try { wasm.run("no-such-analysis", "{}"); } catch (e) { message = String(e.message); }
+check("an unknown analysis is refused, listing the door's names", message.includes("peakforce") && message.includes("fit"), message);
+
 message = "";
 try { wasm.run("orbit", JSON.stringify({ model: { omega: -1 } })); }
 catch (e) { message = String(e.message); }

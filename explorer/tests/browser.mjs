@@ -343,6 +343,23 @@ try {
     JSON.stringify(a2.axes) === JSON.stringify(["y", "y", "y2", "y2"]) && a2.title.includes("A₂") && a2.range &&
     a2.range[0] <= Math.min(...amp2) && a2.range[1] >= Math.max(...amp2), JSON.stringify(a2));
 
+  // PeakForce: a steady off-resonance tap of the preset probe-peakforce-air.toml against
+  // `afmdyn peakforce --json`, each channel relative to its own size (the dissipation, ~0 for
+  // this conservative DMT law, relative to the base's work per cycle)
+  await page.selectOption("#probe-preset", "probe-peakforce-air.toml");
+  await page.selectOption("#afm-analysis", "peakforce");
+  const tap = await afmRun();
+  const refTap = native(["peakforce", "--probe", "examples/probe-peakforce-air.toml", "--files", "none"]);
+  const tapScale = (k) => (k === "dissipation" ? refTap.balance.modulation_work : Math.abs(refTap.channels[k]));
+  const [wk, wv] = Object.keys(refTap.channels).map((k) => [k, Math.abs(tap.channels[k] - refTap.channels[k]) / tapScale(k)])
+    .reduce((m, r) => (r[1] > m[1] || Number.isNaN(r[1]) ? r : m), ["", 0]);
+  const tapShown = await page.evaluate(() => [document.getElementById("afm-plot-a").data.length,
+    document.getElementById("afm-plot-b").data.length, document.getElementById("afm-summary").textContent]);
+  check("the PeakForce tap of the preset probe-peakforce-air.toml is `afmdyn peakforce --json`'s " +
+    "(channels to 1e-9 of their size); its force–distance curve, its cycle and its channels shown",
+  wv <= 1e-9 && tapShown[0] === 2 && tapShown[1] === 2 && tapShown[2].includes("peak force") &&
+    tapShown[2].includes("modulus_dmt"), `${wv} at ${wk}; ${tapShown[0]}, ${tapShown[1]} traces`);
+
   // an image: the stripe (one line) and the blend (a map) against `afmdyn image --json`
   await page.selectOption("#probe-preset", "probe-point-mass-dmt.toml");
   await page.selectOption("#afm-analysis", "image");

@@ -6,6 +6,8 @@
 //! figures and `fit.json` ([`afmdyn::request::present::fit`]); this front end maps the flags.
 
 use crate::args::ModelArgs;
+use crate::cmd_approach::files;
+use crate::cmd_simulate::Files;
 use crate::door;
 use crate::error::CliError;
 use afmdyn::request::fit::FitSegment;
@@ -28,7 +30,7 @@ pub struct FitArgs {
     #[arg(long, value_delimiter = ',', default_values_t = FitRequest::default().fit)]
     fit: Vec<String>,
     /// The segment fitted: approach (up to the lowest height) or retract
-    #[arg(long, default_value = "approach")]
+    #[arg(long, default_value = "approach", value_parser = ["approach", "retract"])]
     segment: String,
     /// The range of tip positions fitted, LO,HI (m, after the contact-point offset)
     #[arg(
@@ -38,9 +40,16 @@ pub struct FitArgs {
         allow_hyphen_values = true
     )]
     range: Option<Vec<f64>>,
+    /// The number of rows of the approach (the rest is the retract), as the instrument
+    /// recorded its segments [default: up to the lowest height, inclusive]
+    #[arg(long, value_name = "N")]
+    approach_rows: Option<usize>,
     /// Output directory (locked during the run)
     #[arg(long, default_value = "afmdyn-out/fit")]
     out: PathBuf,
+    /// Files written: all (data and plots), data (no plots) or none (only the summary)
+    #[arg(long, value_enum, default_value = "all")]
+    files: Files,
     /// Print one JSON document
     #[arg(long)]
     json: bool,
@@ -48,14 +57,11 @@ pub struct FitArgs {
 
 /// Run `afmdyn fit`.
 pub fn fit(a: &FitArgs) -> Result<(), CliError> {
-    let segment = match a.segment.as_str() {
-        "approach" => FitSegment::Approach,
-        "retract" => FitSegment::Retract,
-        s => {
-            return Err(CliError::Input(format!(
-                "--segment {s}: must be approach or retract"
-            )))
-        }
+    // (clap admits only these two)
+    let segment = if a.segment == "retract" {
+        FitSegment::Retract
+    } else {
+        FitSegment::Approach
     };
     let range = match a.range.as_deref() {
         None => None,
@@ -73,12 +79,14 @@ pub fn fit(a: &FitArgs) -> Result<(), CliError> {
         fit: a.fit.clone(),
         segment,
         range,
+        approach_rows: a.approach_rows,
         ..FitRequest::default()
     };
     let model = Resolved { params, probe };
     let exit = door::Exit {
         json: a.json,
-        out: Some(&a.out),
+        out: (a.files != Files::None).then_some(a.out.as_path()),
+        files: files(a.files),
         unit: "fits",
     };
     door::run(&request, &model, exit).map(|_| ())

@@ -172,6 +172,7 @@ pub fn image_cmd(a: &ImageArgs) -> Result<(), CliError> {
             ));
         }
         let exit = Exit {
+            files: Default::default(),
             json: a.json,
             out,
             unit: if job.feedback.is_some() {

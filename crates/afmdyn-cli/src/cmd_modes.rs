@@ -36,6 +36,7 @@ pub fn modes(a: &ModesArgs) -> Result<(), CliError> {
         return fig3(a, &params);
     }
     let exit = Exit {
+        files: Default::default(),
         json: a.json,
         out: None,
         unit: "modes",

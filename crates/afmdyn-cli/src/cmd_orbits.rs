@@ -55,6 +55,7 @@ pub fn orbit(a: &OrbitArgs) -> Result<(), CliError> {
         start: a.start.request(params.modes)?,
     };
     let exit = Exit {
+        files: Default::default(),
         json: a.json,
         out: None,
         unit: "orbits",
@@ -151,6 +152,7 @@ pub fn continuation(a: &ContinueArgs) -> Result<(), CliError> {
         None => Vec::new(),
     };
     let exit = Exit {
+        files: Default::default(),
         json: a.json,
         out: Some(&a.out),
         unit: "branch points",
@@ -211,6 +213,7 @@ pub fn lyapunov(a: &LyapunovArgs) -> Result<(), CliError> {
         blocks: a.blocks,
     };
     let exit = Exit {
+        files: Default::default(),
         json: a.json,
         out: None,
         unit: "periods",

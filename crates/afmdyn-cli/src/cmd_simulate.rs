@@ -134,7 +134,16 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
     let (json, out, unit) = (a.json, run.dir.as_deref(), "periods");
     // SIGINT/SIGTERM cancel the run at its next chunk; its partial files are removed
     crate::error::stop_on_signal();
-    match door::run(&run, &Resolved { params, probe }, Exit { json, out, unit }) {
+    match door::run(
+        &run,
+        &Resolved { params, probe },
+        Exit {
+            files: Default::default(),
+            json,
+            out,
+            unit,
+        },
+    ) {
         Err(_) if crate::error::interrupted().is_err() => Err(CliError::Interrupted),
         done => done.map(|_| ()),
     }

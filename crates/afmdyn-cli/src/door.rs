@@ -9,6 +9,7 @@ use crate::output::{print_warnings, units_of, write_layout, OutDir};
 use crate::progress;
 use afmdyn::layout::files::{write_bytes, write_csv, NpyStream};
 use afmdyn::report::{OutputFile, OutputsNote, Presentation};
+use afmdyn::request::present::Files;
 use afmdyn::request::{Analysis, Document, Resolved};
 use serde_json::Value;
 use std::path::Path;
@@ -21,6 +22,8 @@ pub struct Exit<'a> {
     pub json: bool,
     /// The output directory.
     pub out: Option<&'a Path>,
+    /// The files written there (`--files`): all, the data without the figures, or none.
+    pub files: Files,
     /// What the progress bar counts ("points", "starts").
     pub unit: &'static str,
 }
@@ -61,6 +64,14 @@ pub fn run_with<A: Analysis>(
         units_of(model.probe.as_ref()),
     )?;
     decorate(&mut shown);
+    // --files: the figures (data) or every file (none) left out
+    match exit.files {
+        Files::All => {}
+        Files::Data => shown
+            .files
+            .retain(|f| !matches!(f, OutputFile::Figure { .. })),
+        Files::None => shown.files.clear(),
+    }
     emit(out.as_ref(), &shown, &doc.json, exit.json)?;
     Ok(doc)
 }

@@ -2,8 +2,8 @@
 //! (`afmdyn::io::input`, a cap per kind): `/dev/zero` (no end, no line end) and a 2 GiB sparse
 //! file (a regular file larger than every cap, refused from its length) are refused with exit
 //! code 2 and one line naming the option, the file and the cap, for `--probe`, `--config`,
-//! `--overlay`, `--sample` and a sample map's `height_map` (CSV and NPY), and `reconstruct
-//! --fm` and `--am`; and a `--resume` whose store's ledger, rows or records are `/dev/zero` or
+//! `--overlay`, `--sample` and a sample map's `height_map` (CSV and NPY), `reconstruct
+//! --fm` and `--am`, and `fit --data`; and a `--resume` whose store's ledger, rows or records are `/dev/zero` or
 //! a 2 GiB sparse file is refused naming the file and the cap, the store left as it was. (How
 //! long a refusal takes is measured by `scripts/bounded-inputs.sh`, not asserted: a loaded
 //! machine would make such an assertion race.)
@@ -205,6 +205,37 @@ fn reconstruct_curves_are_refused_past_their_caps() {
             &[option, b, CSV_CAP, "a curve document"],
         );
     }
+}
+
+#[test]
+fn a_force_curve_to_fit_is_refused_past_its_caps() {
+    let dir = tempfile::tempdir().unwrap();
+    let big = sparse(dir.path(), "big.csv");
+    let b = big.to_str().unwrap();
+    let out = dir.path().join("out");
+    let o = out.to_str().unwrap();
+    let fit = |data: &str| {
+        [
+            "fit",
+            "--probe",
+            "examples/probe-fit-hertz.toml",
+            "--data",
+            data,
+            "--out",
+            o,
+        ]
+        .map(String::from)
+    };
+    let args = fit("/dev/zero");
+    refused(
+        &args.iter().map(String::as_str).collect::<Vec<_>>(),
+        &["data", "/dev/zero", LINE_CAP, "a curve CSV"],
+    );
+    let args = fit(b);
+    refused(
+        &args.iter().map(String::as_str).collect::<Vec<_>>(),
+        &["data", b, CSV_CAP],
+    );
 }
 
 /// Every file of `dir` but its lock (which a run rewrites with its process id): name, and the

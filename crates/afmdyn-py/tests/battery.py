@@ -25,7 +25,9 @@ naming it); a quality factor of 1e308 (exit 2 naming ``quality_factor``); and is
 classes: an image beyond its memory budget refused before any work (``--pixels 2048``),
 ``reconstruct --fm/--am /dev/zero``, an SI amplitude beyond its physical range, ``--modes``
 against an eigenmode probe's own modes, and off-resonance tapping's exclusive ``--z-c`` and
-``--setpoint`` and a modulation frequency beyond 1 MHz (each exit 2 naming the input).
+``--setpoint`` and a modulation frequency beyond 1 MHz (each exit 2 naming the input); and
+issue 62's force-curve fit: ``fit --data /dev/zero``, a parameter the law does not have, a
+reversed ``--range``, and in Python too few rows and an unknown parameter.
 
 The cases are a pure function of the seed, so a run is reproducible. ``test_battery.py`` runs a
 bounded slice in the test command; ``scripts/battery.sh`` runs the whole battery and rewrites
@@ -49,6 +51,8 @@ from typing import Callable, Dict, List, Optional, Sequence, Tuple
 REPO = Path(__file__).resolve().parents[3]
 PROBES = [REPO / "examples" / "probe-point-mass-dmt.toml", REPO / "examples" / "probe-beam-dmt.toml"]
 PEAKFORCE = REPO / "examples" / "probe-peakforce-air.toml"
+FIT_PROBE = REPO / "examples" / "probe-fit-hertz.toml"
+FIT_DATA = REPO / "examples" / "force-curve-hertz.csv"
 
 #: values at and beyond the edges of every range (as a user would type them)
 EXTREMES = [
@@ -146,6 +150,14 @@ FAULTS: List[Tuple[List[str], int, Optional[str], Optional[str], Optional[str]]]
     (["peakforce", "--probe", "{probe}", "--z-c", "95nm", "--out", "{out}"], 2,
      "modulation_frequency", None,
      PEAKFORCE.read_text().replace("modulation_frequency = 2e3 ", "modulation_frequency = 1e9 ")),
+    # issue 62's force-curve fit: an unbounded data file, a parameter the law does not have,
+    # a reversed range (each exit 2 naming the input)
+    (["fit", "--probe", str(FIT_PROBE), "--data", "/dev/zero", "--out", "{out}"], 2, "/dev/zero",
+     None, None),
+    (["fit", "--probe", str(FIT_PROBE), "--data", str(FIT_DATA), "--fit", "sample.hamaker",
+      "--files", "none"], 2, "fit", None, None),
+    (["fit", "--probe", str(FIT_PROBE), "--data", str(FIT_DATA), "--range", "0,-1e-7",
+      "--files", "none"], 2, "range", None, None),
 ]
 #: issue 42's Python faults: (call, the keyword its ValueError must name)
 PY_FAULTS = [
@@ -158,6 +170,9 @@ PY_FAULTS = [
      "contact_stiffness"),
     ("afmdyn.modes(probe='/dev/zero')", "/dev/zero"),
     ("afmdyn.simulate(periods=1, tolerance=float('nan'), progress=False)", "tolerance"),
+    (f"afmdyn.fit(probe={str(FIT_PROBE)!r}, data={{'height': [1, 0, -1], 'force': [0, 1, 2]}})",
+     "data"),
+    (f"afmdyn.fit(probe={str(FIT_PROBE)!r}, data={str(FIT_DATA)!r}, fit=['tip.nonsense'])", "fit"),
 ]
 #: a message that prints a double with all its digits (1e300 as 301 digits, 16 of round-off)
 LONG_NUMBER = re.compile(r"\d{17,}")

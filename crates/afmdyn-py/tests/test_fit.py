@@ -5,9 +5,10 @@ the same preprocessing (compute_tip_position, correct_force_offset, correct_tip_
 same fitted parameters (E, contact point, baseline), the whole approach and no contact-point
 weighting, gives E within 1 % of afmdyn's.
 
-The curve is synthetic (examples/force-curve-hertz.csv, scripts/make-force-curve.py: E = 5 kPa,
-R = 5 µm, k = 0.05 N/m, 20 pN of seeded noise, a 0.1 nN offset), not a measured one: no small
-measured curve with a clear licence was at hand."""
+The synthetic curve: examples/force-curve-hertz.csv (scripts/make-force-curve.py: E = 5 kPa,
+R = 5 µm, k = 0.05 N/m, 20 pN of seeded noise, a 0.1 nN offset). The measured one:
+examples/force-curve-jpk-spot3-0192.jpk-force (afmformats' test data, MIT), read through
+afmformats, against nanite's fit of the same file."""
 
 from __future__ import annotations
 
@@ -90,3 +91,80 @@ def test_nanite_hertz_paraboloid_gives_the_same_modulus():
     tip = idnt["tip position"][~segment]
     assert np.allclose(ds["tip_position"].values, tip, rtol=0, atol=1e-15)
     assert np.allclose(ds["force"].values, idnt["force"][~segment], rtol=0, atol=1e-20)
+
+
+def _afmformats_curve(afmformats, h, f, k=K):
+    """The synthetic curve as an afmformats force-distance object (as an instrument file reads)."""
+    n = h.size
+    metadata = {"spring constant": k, "path": str(CURVE), "enum": 0, "duration": 1.0,
+                "sensitivity": 1e-9, "setpoint": 1e-9, "speed approach": 1e-6,
+                "speed retract": 1e-6, "imaging mode": "force-distance", "point count": n}
+    return afmformats.AFMForceDistance(
+        data={"force": f, "height (measured)": h, "segment": np.arange(n) >= n // 2,
+              "time": np.linspace(0.0, 1.0, n)},
+        metadata=metadata)
+
+
+def test_an_instrument_curve_read_by_afmformats_fits_as_its_columns(tmp_path):
+    afmformats = pytest.importorskip("afmformats")
+    h, f = _curve()
+    columns = _fit(data={"height": h, "force": f}, fit=FIT)
+    obj = _afmformats_curve(afmformats, h, f)
+    path = tmp_path / "curve.h5"
+    obj.export_data(str(path), fmt="hdf5")
+    for data in (obj, path, str(path)):
+        ds = _fit(data=data, fit=FIT)
+        # the same rows, so the same estimates to the last digit
+        assert np.array_equal(ds["estimate"].values, columns["estimate"].values)
+    with pytest.raises(ValueError, match="curve"):
+        _fit(data=path, fit=FIT, curve=1)
+    # a file calibrated with another spring constant is named (the probe's is used)
+    other = tmp_path / "other.h5"
+    _afmformats_curve(afmformats, h, f, k=2 * K).export_data(str(other), fmt="hdf5")
+    with pytest.warns(afmdyn.AfmdynWarning, match="spring constant"):
+        afmdyn.fit(probe=PROBE, data=other, fit=FIT)
+
+
+JPK = EXAMPLES / "force-curve-jpk-spot3-0192.jpk-force"
+JPK_PROBE = str(EXAMPLES / "probe-fit-spot3.toml")
+
+
+def test_a_measured_jpk_curve_fits_as_nanite_fits_it():
+    """A measured curve (afmformats' test file, which nanite's tests fit): read through
+    afmformats with the instrument's segments, afmdyn's Hertz fit (E, contact point, baseline;
+    nanite's three preprocessing steps) and nanite's of the same file agree; nanite's
+    one-step fit reproduces the contact point its own test asserts (1.802931023582261e-05 m,
+    tests/test_fit_base.py), so the file and the peer are the ones of that test."""
+    nanite = pytest.importorskip("nanite")
+    pytest.importorskip("afmformats")
+
+    def nanite_fit(steps, cp=None):
+        idnt = nanite.IndentationGroup(JPK)[0]
+        idnt.apply_preprocessing(steps)
+        params = nanite.model.model_hertz_paraboloidal.get_parameter_defaults()
+        params["baseline"].vary = True
+        if cp is not None:
+            params["contact_point"].set(cp)
+        idnt.fit_model(model_key="hertz_para", params_initial=params, range_x=(0, 0),
+                       range_type="absolute", x_axis="tip position", y_axis="force",
+                       segment="approach", weight_cp=False)
+        return idnt, idnt.fit_properties["params_fitted"]
+
+    _, one = nanite_fit(["compute_tip_position"], cp=1.8321e-5)
+    assert abs(one["contact_point"].value - 1.802931023582261e-05) < 2e-10
+    idnt, ref = nanite_fit(["compute_tip_position", "correct_force_offset", "correct_tip_offset"])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", afmdyn.AfmdynWarning)
+        ds = afmdyn.fit(probe=JPK_PROBE, data=JPK, fit=FIT)
+    est = ds["estimate"]
+    e = est.sel(parameter="sample.youngs_modulus").item()
+    assert abs(e / ref["E"].value - 1) < 1e-4, (e, ref["E"].value)
+    assert abs(est.sel(parameter="contact_point").item() - ref["contact_point"].value) < 1e-11
+    # the rows fitted are nanite's approach segment, preprocessed alike
+    approach = np.asarray(idnt["segment"]) == 0
+    assert ds.sizes["row"] == approach.sum() == 2000
+    assert np.allclose(ds["tip_position"].values, idnt["tip position"][approach], rtol=0, atol=1e-15)
+    # and E lies in its 95 % interval, the curve being real: its noise estimated
+    lo = ds["interval_low"].sel(parameter="sample.youngs_modulus").item()
+    hi = ds["interval_high"].sel(parameter="sample.youngs_modulus").item()
+    assert lo < ref["E"].value < hi

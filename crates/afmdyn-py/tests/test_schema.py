@@ -28,13 +28,15 @@ BIM = str(EXAMPLES / "probe-bimodal.toml")
 STRIPE = str(EXAMPLES / "sample-stripe.toml")
 IMAGE = ["--probe", P1, "--sample", STRIPE, "--setpoint", 0.7, "--pixels", 4]
 PF = str(EXAMPLES / "probe-peakforce-water.toml")
+FIT_PROBE = str(EXAMPLES / "probe-fit-hertz.toml")
+FIT_DATA = str(EXAMPLES / "force-curve-hertz.csv")
 IMPACT = "--contact-law impact --restitution 0.5 --modes 1 --gap 0.05 --omega 3".split()
 IMPACT_PY = dict(contact_law="impact", restitution=0.5, modes=1, gap=0.05, omega=3.0)
 SHORT = ["--max-periods", 300]
 
 COMMANDS = ["modes", "units", "simulate", "converge", "bifurcation", "attractors", "orbit",
             "continue", "lyapunov", "approach", "resonance", "chart", "basins", "reconstruct",
-            "fm", "bimodal", "image", "peakforce"]
+            "fm", "bimodal", "image", "peakforce", "fit"]
 FM = str(EXAMPLES / "fm-vdw.csv")
 FM_ARGS = ["--fm", FM, "--spring-constant", 40, "--resonance-frequency", "300kHz",
            "--amplitude", "10nm"]
@@ -136,13 +138,17 @@ CLI_CASES: List[Tuple[str, List[Any]]] = [
     ("image", [*IMAGE, "--setpoint-study", "0.3:0.9:3"]),
     ("image", [*IMAGE, "--feedback", "pi", "--scan-rate", 20]),
     ("peakforce", ["--probe", PF]),
+    ("fit", ["--probe", FIT_PROBE, "--data", FIT_DATA, "--fit", "sample.youngs_modulus,contact_point",
+             "--files", "data"]),
+    ("fit", ["--probe", FIT_PROBE, "--data", FIT_DATA, "--fit", "sample.youngs_modulus",
+             "--range", "-2e-7,0", "--files", "none"]),
     # (a probe refuses the dimensionless omega axis: the drive frequency in Hz, 0.99 f0)
     ("chart", ["--x", "z-c", "--x-from", 6e-9, "--x-to", 8e-9, "--x-steps", 2, "--y",
                "drive-frequency", "--y-from", "297kHz", "--y-to", "297kHz", "--y-steps", 1,
                "--starts", 1, *SHORT, "--probe", P1]),
 ]
 WRITES = {"simulate", "converge", "bifurcation", "attractors", "continue", "chart", "basins",
-          "reconstruct", "fm", "image", "peakforce"}
+          "reconstruct", "fm", "image", "peakforce", "fit"}
 
 
 @pytest.fixture(scope="module")
@@ -227,6 +233,8 @@ def _python_docs() -> List[Tuple[str, str, Callable[[], Any]]]:
         ("image", "image pi", lambda: _quiet(lambda: afmdyn.summary(afmdyn.image(
             P1, STRIPE, 0.7, pixels=4, feedback="pi", scan_rate=20.0, progress=False)))),
         ("peakforce", "peakforce probe", lambda: afmdyn.summary(afmdyn.peakforce(probe=PF))),
+        ("fit", "fit probe", lambda: _quiet(lambda: afmdyn.summary(afmdyn.fit(
+            probe=FIT_PROBE, data=FIT_DATA, fit=["sample.youngs_modulus", "contact_point"])))),
     ]
 
 

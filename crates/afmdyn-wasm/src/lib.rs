@@ -12,10 +12,13 @@
 //! line's one-line messages (the library's, naming the field and its range), so a page shows
 //! the same text beside the field.
 //!
-//! The analyses ([`ANALYSES`]) and what each returns:
+//! The analyses ([`analyses()`]: every name of the library's door, [`request::named::NAMES`],
+//! so an analysis added there is reachable here without an edit) and what each returns:
 //!
-//! * `modes`, `orbit`, `observe`, `lyapunov`, `continuation`, `attractors`, `converge`,
-//!   `approach`, `resonance`, `fm`: the document of `afmdyn <analysis> --json`;
+//! * `modes`, `orbit`, `observe`, `lyapunov`, `continuation`, `attractors`,
+//!   `global_continuation`, `converge`, `approach`, `resonance`, `basins`, `fm`,
+//!   `reconstruct`, `peakforce`, `fit`: the document of `afmdyn <analysis> --json` (in one
+//!   thread; `reconstruct` and `fit` take their curves as the request's columns);
 //! * `bimodal`: the multifrequency approach curve of `afmdyn bimodal --json` (the request
 //!   `approach`'s keys; the probe's `[drive]` must have two or more components);
 //! * `simulate`: `{"summary": <afmdyn simulate --files none --json>, "series": {name: {"dims",
@@ -45,22 +48,11 @@ use serde::Deserialize;
 use serde_json::Value;
 use wasm_bindgen::prelude::*;
 
-/// The analyses [`run_json`] runs, by the command line's names.
-pub const ANALYSES: [&str; 13] = [
-    "modes",
-    "orbit",
-    "observe",
-    "lyapunov",
-    "continuation",
-    "attractors",
-    "converge",
-    "approach",
-    "resonance",
-    "fm",
-    "bimodal",
-    "simulate",
-    "image",
-];
+/// The analyses [`run_json`] runs, by the command line's names: every analysis of the
+/// library's one door ([`request::named::NAMES`]), and `image`.
+pub fn analyses() -> impl Iterator<Item = &'static str> {
+    request::named::NAMES.iter().copied().chain(["image"])
+}
 
 /// What a page sends.
 #[derive(Debug, Default, Deserialize)]
@@ -117,7 +109,7 @@ pub(crate) fn request<R: DeserializeOwned + Default>(request: Option<Value>) -> 
     }
 }
 
-/// Run the analysis `analysis` (one of [`ANALYSES`]) on `input` (module docs): the document as
+/// Run the analysis `analysis` (one of [`analyses()`]) on `input` (module docs): the document as
 /// JSON text, or the error's one-line message.
 ///
 /// # Errors
@@ -125,10 +117,10 @@ pub(crate) fn request<R: DeserializeOwned + Default>(request: Option<Value>) -> 
 /// the probe format refuses; the model's and the request's validation errors (naming the field
 /// and its range) and the analysis's.
 pub fn run_json(analysis: &str, input: &str) -> Result<String, String> {
-    if !ANALYSES.contains(&analysis) {
+    if !analyses().any(|a| a == analysis) {
         return Err(format!(
             "analysis = {analysis}: must be one of {}",
-            ANALYSES.join(", ")
+            analyses().collect::<Vec<_>>().join(", ")
         ));
     }
     match analysis {

@@ -408,6 +408,7 @@ PeakForceRequest = TypedDict(
 FitRequest = TypedDict(
     "FitRequest",
     {
+        "approach_rows": Optional[int],  # default null
         "data": Optional[str],  # default null
         "fit": List[str],  # default ["sample.youngs_modulus", "contact_point"]
         "force": List[float],  # default []

@@ -64,6 +64,10 @@ pub struct FitRequest {
     /// The range of tip positions fitted [lo, hi] (m, after the preprocessing's offset, as
     /// nanite's `range_x`); default the whole segment.
     pub range: Option<[f64; 2]>,
+    /// The number of rows of the approach (the rest is the retract), as an instrument records
+    /// its segments (afmformats' `segment` column, which Python reads from an instrument
+    /// file); default up to the lowest piezo height, inclusive. 1 to the number of rows.
+    pub approach_rows: Option<usize>,
 }
 
 impl Default for FitRequest {
@@ -76,6 +80,7 @@ impl Default for FitRequest {
             fit: vec![YOUNGS_MODULUS.into(), CONTACT_POINT.into()],
             segment: FitSegment::Approach,
             range: None,
+            approach_rows: None,
         }
     }
 }
@@ -288,7 +293,17 @@ impl Analysis for FitRequest {
         let probe = model.probe.as_ref().expect("checked");
         let k = probe.calibration.spring_constant;
         let s = probe.sample_inputs;
-        let curve = preprocess(&height, &force, k);
+        let mut curve = preprocess(&height, &force, k);
+        if let Some(n) = self.approach_rows {
+            if !(1..=force.len()).contains(&n) {
+                return Err(bad(
+                    "approach_rows",
+                    n,
+                    format!("must be 1..={} (the curve's rows)", force.len()),
+                ));
+            }
+            curve.approach_len = n;
+        }
         let segment = match self.segment {
             FitSegment::Approach => Segment::Approach,
             FitSegment::Retract => Segment::Retract,
