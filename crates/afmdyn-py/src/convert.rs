@@ -12,30 +12,6 @@ pub fn json_to_py<'py>(py: Python<'py>, text: &str) -> PyResult<Bound<'py, PyAny
     py.import("json")?.getattr("loads")?.call1((text,))
 }
 
-/// Builder of the dict a compiled function returns to the Python layer.
-pub struct Out<'py> {
-    pub dict: Bound<'py, PyDict>,
-}
-
-impl<'py> Out<'py> {
-    pub fn new(py: Python<'py>) -> Self {
-        Out {
-            dict: PyDict::new(py),
-        }
-    }
-    /// Any value.
-    pub fn set<V: IntoPyObject<'py>>(&self, key: &str, v: V) -> PyResult<()> {
-        self.dict.set_item(key, v)
-    }
-    /// A JSON document, as text (the Python layer keeps it for `to_dict()`).
-    pub fn json(&self, doc: &serde_json::Value) -> PyResult<()> {
-        self.dict.set_item("json", doc.to_string())
-    }
-    pub fn finish(self) -> Bound<'py, PyDict> {
-        self.dict
-    }
-}
-
 /// A result's [`afmdyn::layout::Layout`] for the Python layer (`afmdyn._layout.dataset`):
 /// `{"title": str, "dims": [(name, length)], "variables": [(name, dims, units, long_name,
 /// values, attrs)]}`, values as flat NumPy arrays (float64, or int64 for integer variables)

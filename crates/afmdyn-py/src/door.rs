@@ -11,9 +11,10 @@ use crate::errors::{lock_store, study_error};
 use crate::errors::{probe_error, sim_error, value_error};
 use crate::params::PyParams;
 use crate::run::{run as run_job, Job, Stop};
+use afmdyn::analysis::progress::Progress;
 use afmdyn::probe::Probe;
 use afmdyn::request::{Outcome, Resolved};
-use afmdyn::Params;
+use afmdyn::{Params, SimError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -50,7 +51,19 @@ pub fn run<'py>(
     let named = crate::convert::named(name, request)?;
     let model = resolved(params, probe)?;
     named.validate(&model).map_err(sim_error)?;
-    let stop = if named.checks_cancel() {
+    let cancellable = named.checks_cancel();
+    run_outcome(py, progress, cancellable, move |p| named.run(&model, p))
+}
+
+/// Run `work` without the GIL ([`crate::run`]; `cancellable`: it checks its progress' cancel
+/// flag, else it is abandoned on an interrupt) to the dict of its outcome ([`outcome_dict`]).
+pub fn run_outcome<'py>(
+    py: Python<'py>,
+    progress: Option<Bound<'py, PyAny>>,
+    cancellable: bool,
+    work: impl FnOnce(&Progress) -> Result<Outcome, SimError> + Send + 'static,
+) -> PyResult<Bound<'py, PyDict>> {
+    let stop = if cancellable {
         Stop::Cancellable
     } else {
         Stop::Abandon
@@ -58,7 +71,7 @@ pub fn run<'py>(
     let job = Job::default();
     let worker = job.clone();
     let outcome = run_job(py, &job, None, progress.as_ref(), stop, move || {
-        named.run(&model, &worker.progress)
+        work(&worker.progress)
     })?
     .map_err(sim_error)?;
     outcome_dict(py, outcome)

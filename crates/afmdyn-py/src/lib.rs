@@ -6,19 +6,17 @@
 //! document, the result's layouts (dicts of NumPy arrays owning the Rust buffers) and its
 //! scalars come back for the Python layer to turn into xarray datasets and result objects.
 //! The studies run into a store (`store=`, `resume=`: bifurcation, basins, global
-//! continuation, the stepped curves) go through `door::run_stored`; the Dask tasks (chart,
-//! basin map, PI scan) keep classes of their own.
+//! continuation, the stepped curves) go through `door::run_stored`; the Dask tasks go through
+//! one class, `plan::Plan` (the library's plans: sweep, basin map, PI scan), and the chart's.
 
 mod analyses;
-mod basin_tasks;
 mod chart;
 mod convert;
 mod door;
 mod errors;
-mod image_tasks;
 mod params;
+mod plan;
 mod run;
-mod sweep;
 
 use pyo3::prelude::*;
 
@@ -42,11 +40,9 @@ fn request_defaults<'py>(py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyA
 fn _afmdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<params::PyParams>()?;
     m.add_class::<chart::ChartStudy>()?;
-    m.add_class::<basin_tasks::BasinMapStudy>()?;
-    m.add_class::<image_tasks::ScanStudy>()?;
     m.add_class::<chart::StoreLock>()?;
-    m.add_class::<sweep::SweepStudy>()?;
-    m.add_class::<sweep::SweepStore>()?;
+    m.add_class::<plan::Plan>()?;
+    m.add_class::<plan::PlanStore>()?;
     m.add(
         "SimulationError",
         m.py().get_type::<errors::SimulationError>(),
@@ -56,10 +52,7 @@ fn _afmdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(door::run_stored, m)?)?;
     m.add_function(wrap_pyfunction!(cantilevers, m)?)?;
     m.add_function(wrap_pyfunction!(request_defaults, m)?)?;
-    m.add_function(wrap_pyfunction!(analyses::reconstruct_fm, m)?)?;
-    m.add_function(wrap_pyfunction!(analyses::reconstruct_am, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::image, m)?)?;
-    m.add_function(wrap_pyfunction!(analyses::pi_image, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::read_height_map, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::setpoint_study, m)?)?;
     m.add_function(wrap_pyfunction!(analyses::probe, m)?)?;

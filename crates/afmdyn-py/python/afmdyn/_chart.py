@@ -15,7 +15,7 @@ import xarray as xr
 from . import _afmdyn as _core
 from . import _layout
 from ._afmdyn import Params
-from ._common import _DEFAULTS, Model, _probe_text, _typed, _warn
+from ._common import _DEFAULTS, Model, _probe_text, _request, _typed, _warn
 from ._progress import ProgressArg, reporter
 
 if TYPE_CHECKING:
@@ -114,31 +114,7 @@ def chart(
     ``progress``: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a
     log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.
     """
-    s = study(
-        params,
-        model,
-        x=x,
-        x_from=x_from,
-        x_to=x_to,
-        x_steps=x_steps,
-        y=y,
-        y_from=y_from,
-        y_to=y_to,
-        y_steps=y_steps,
-        starts=starts,
-        seed=seed,
-        tile=tile,
-        cluster_tol=cluster_tol,
-        lyapunov_periods=lyapunov_periods,
-        max_attractors=max_attractors,
-        threads=threads,
-        tol=tol,
-        max_periods=max_periods,
-        max_period=max_period,
-        integrator=integrator,
-        steps_per_period=steps_per_period,
-        tolerance=tolerance,
-    )
+    s = study(params, model, **_request(locals()))
     with reporter(progress, "chart") as cb:
         d, doc = s.run(
             threads=threads,

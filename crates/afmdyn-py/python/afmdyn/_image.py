@@ -15,17 +15,25 @@ from . import _layout
 from ._common import _real_array, _typed, _warn
 from ._progress import ProgressArg, reporter
 
-def _inputs(probe: Any, sample: Any, height_map: Any) -> Tuple[str, str, Any]:
-    """The probe's TOML text, the sample map's text or path, the height map's rows (or None)."""
-    text = _core.probe_source(probe)
-    source = os.fspath(sample) if isinstance(sample, os.PathLike) else sample
+def _keywords(probe: Any, sample: Any, setpoint: float, pixels: Optional[int],
+             lines: Optional[int], curve_points: Optional[int], height_map: Any,
+             feedback: str, scan_rate: Optional[float], gains: Optional[Sequence[float]],
+             time_constant: Optional[float], threads: Optional[int]) -> Tuple[str, Dict[str, Any]]:
+    """The probe's TOML text and the library's ``ImageKeywords`` of an image's arguments."""
     rows = None
     if isinstance(height_map, (str, os.PathLike)):
         # a .csv or .npy file, read and checked by the library as the TOML key's file is
         rows = _core.read_height_map(os.fspath(height_map))
     elif height_map is not None:
         rows = _real_array("height_map", height_map, 2).tolist()
-    return text, source, rows
+    if gains is not None and len(gains) != 2:
+        raise ValueError("gains: must be two numbers (K_P, K_I in 1/s)")
+    pi = dict(scan_rate=scan_rate, time_constant=time_constant,
+              gains=None if gains is None else [float(g) for g in gains])
+    request = dict(sample=os.fspath(sample) if isinstance(sample, os.PathLike) else sample,
+                   setpoint=setpoint, pixels=pixels, lines=lines, curve_points=curve_points,
+                   height_map=rows, feedback=pi if feedback == "pi" else None, threads=threads)
+    return _core.probe_source(probe), request
 
 
 @_typed
@@ -98,38 +106,25 @@ def image(
             "scan_rate, gains, time_constant, threads: only with feedback='pi' "
             "(the ideal feedback has no loop)"
         )
-    text, source, rows = _inputs(probe, sample, height_map)
-    if feedback == "pi":
-        with reporter(progress, "image", unit="line") as cb:
-            out = _core.pi_image(
-                text, source, setpoint, pixels, lines, curve_points, rows,
-                scan_rate, _gains(gains), time_constant, threads, cb,
-            )
-    else:
-        out = _core.image(text, source, setpoint, pixels, lines, curve_points, rows)
+    text, request = _keywords(probe, sample, setpoint, pixels, lines, curve_points, height_map,
+                              feedback, scan_rate, gains, time_constant, threads)
+    with reporter(progress if feedback == "pi" else False, "image", unit="line") as cb:
+        out = _core.image(text, request, cb)
     return _dataset(out, setpoint)
 
 
-def _gains(gains: Optional[Sequence[float]]) -> Optional[Tuple[float, float]]:
-    """``gains`` as the pair (K_P, K_I) the core takes."""
-    if gains is None:
-        return None
-    if len(gains) != 2:
-        raise ValueError("gains: must be two numbers (K_P, K_I in 1/s)")
-    return (float(gains[0]), float(gains[1]))
-
-
 def _dataset(out: Dict[str, Any], setpoint: float) -> xr.Dataset:
-    """The Dataset of an image (``{"json", "summary", "layout"}``), ideal or PI: its maps and
+    """The Dataset of an image (as ``_afmdyn.run`` returns it: the per-pixel document, the
+    layout ``image``, the fact ``summary``), ideal or PI: its maps and
     flags as the library lays them out (``image.nc``'s variables, units and long names), its
     integer codes (regime, material, domain; a PI scan's ``_retrace`` ones) as the document's
     words; the command line's ``image.json`` (the summary) as ``summary``."""
     doc = json.loads(out["json"])
-    summary = json.loads(out["summary"])
+    summary = out["facts"]["summary"]
     _warn(summary)
     img = doc["image"]
     dims = ("y", "x")
-    layout = _layout.variables(out["layout"])
+    layout = _layout.variables(out["datasets"]["image"])
     data: Dict[str, Any] = {}
     for name, (vdims, values, attrs) in layout.items():
         if vdims != dims:

@@ -87,40 +87,38 @@ def reconstruct(
             raise ValueError(f"am: the approach curve carries its constants; {given[0]} not taken")
         if inversion != "sader-jarvis":
             raise ValueError("inversion: the AM curve is inverted by the matrix method")
-        document = am.attrs["summary"] if isinstance(am, xr.Dataset) else json.dumps(am)
-        with reporter(progress, "reconstruct") as cb:
-            d = _core.reconstruct_am(document, progress=cb)
-        return _dataset(json.loads(d["json"]))
-    if fm is not None:
+        request: Dict[str, Any] = dict(am=_document(am))
+    elif fm is not None:
         if frequency_shift is not None or distance is not None or z_c is not None:
             raise ValueError("fm: give the fm curve or frequency_shift with distance/z_c, not both")
-        document = fm.attrs["summary"] if isinstance(fm, xr.Dataset) else json.dumps(fm)
-        with reporter(progress, "reconstruct") as cb:
-            d = _core.reconstruct_fm(
-                document,
-                None if spring_constant is None else float(spring_constant),
-                None if resonance_frequency is None else float(resonance_frequency),
-                None if amplitude is None else float(amplitude),
-                progress=cb,
-                inversion=inversion,
-            )
-        return _dataset(json.loads(d["json"]))
-    for name, v in (("frequency_shift", frequency_shift), ("spring_constant", spring_constant),
-                    ("resonance_frequency", resonance_frequency), ("amplitude", amplitude)):
-        if v is None:
-            raise ValueError(f"{name}: missing (give the curve and k, f0, A, or fm=)")
-    request = dict(
-        frequency_shift=_values("frequency_shift", frequency_shift),
-        distance=_values("distance", distance),
-        z_c=_values("z_c", z_c),
-        spring_constant=float(spring_constant),
-        resonance_frequency=float(resonance_frequency),
-        amplitude=float(amplitude),
-        inversion=inversion,
-    )
+        consts = (("spring_constant", spring_constant), ("amplitude", amplitude),
+                  ("resonance_frequency", resonance_frequency))
+        request = dict(fm=_document(fm), inversion=inversion,
+                       **{k: None if v is None else float(v) for k, v in consts})
+    else:
+        for name, v in (("frequency_shift", frequency_shift),
+                        ("spring_constant", spring_constant),
+                        ("resonance_frequency", resonance_frequency), ("amplitude", amplitude)):
+            if v is None:
+                raise ValueError(f"{name}: missing (give the curve and k, f0, A, or fm=)")
+        request = dict(
+            frequency_shift=_values("frequency_shift", frequency_shift),
+            distance=_values("distance", distance),
+            z_c=_values("z_c", z_c),
+            spring_constant=float(spring_constant),
+            resonance_frequency=float(resonance_frequency),
+            amplitude=float(amplitude),
+            inversion=inversion,
+        )
+    name = "reconstruct" if "frequency_shift" in request else "reconstruct_document"
     with reporter(progress, "reconstruct") as cb:
-        d = _core.run("reconstruct", request, None, None, cb)
+        d = _core.run(name, request, None, None, cb)
     return _dataset(json.loads(d["json"]))
+
+
+def _document(d: Union[xr.Dataset, Dict[str, Any]]) -> str:
+    """The JSON text of a document given as its dataset or as a dict."""
+    return d.attrs["summary"] if isinstance(d, xr.Dataset) else json.dumps(d)
 
 
 def _dataset(doc: Dict[str, Any]) -> xr.Dataset:

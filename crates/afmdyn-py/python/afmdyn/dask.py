@@ -33,7 +33,7 @@ from . import _afmdyn as _core
 from ._afmdyn import Params
 from . import _layout
 from ._chart import dataset, study
-from ._common import _DEFAULTS
+from ._common import _DEFAULTS, _request
 from ._progress import ProgressArg, reporter
 
 try:
@@ -260,30 +260,10 @@ def chart(
 
     Returns the same ``xarray.Dataset`` as :func:`afmdyn.chart` with the same arguments.
     """
-    s = study(
-        params,
-        model,
-        x=x,
-        x_from=x_from,
-        x_to=x_to,
-        x_steps=x_steps,
-        y=y,
-        y_from=y_from,
-        y_to=y_to,
-        y_steps=y_steps,
-        starts=starts,
-        seed=seed,
-        tile=tile,
-        cluster_tol=cluster_tol,
-        lyapunov_periods=lyapunov_periods,
-        max_attractors=max_attractors,
-        tol=tol,
-        max_periods=max_periods,
-        max_period=max_period,
-        integrator=integrator,
-        steps_per_period=steps_per_period,
-        tolerance=tolerance,
-    )
+    request = _request(locals())
+    for own in ("client", "checkpoint_seconds"):
+        del request[own]
+    s = study(params, model, **request)
     n = s.tasks()
     if not (checkpoint_seconds >= 0 and np.isfinite(checkpoint_seconds)):
         raise ValueError(f"checkpoint_seconds = {checkpoint_seconds}: must be finite and >= 0")
@@ -319,22 +299,57 @@ def chart(
 
 
 @functools.lru_cache(maxsize=8)
-def _sweep_of(recipe: str) -> "_core.SweepStudy":
-    return _core.SweepStudy(recipe)
+def _plan_of(recipe: str) -> "_core.Plan":
+    return _core.Plan(recipe)
 
 
-def run_coarse_task(recipe: str, k: int) -> str:
-    """Stage-0 task ``k`` of the sweep of ``recipe`` (0 forward, 1 backward): the coarse
-    pass's seeds, JSON text."""
-    return _sweep_of(recipe).coarse(k)
+def run_plan_task(recipe: str, start: str, task: int) -> str:
+    """Task ``task`` of the stage beginning at ``start`` of the study of ``recipe`` (what a
+    worker runs; the library's ``study::plan``): its result, as text. The study is built once
+    per worker process and recipe."""
+    return _plan_of(recipe).run(start, task)
 
 
-def run_sweep_task(
-    recipe: str, k: int, forward: Optional[str] = None, backward: Optional[str] = None
-) -> List[str]:
-    """Stage-1 task ``k`` of the sweep of ``recipe`` from the coarse passes' seeds: its rows
-    of ``bifurcation.csv``."""
-    return _sweep_of(recipe).run_task(k, forward, backward)
+def _run_plan(
+    client: "distributed.Client",
+    plan: "_core.Plan",
+    progress: ProgressArg,
+    desc: str,
+    unit: str = "task",
+    store: Any = None,
+    resume: bool = True,
+) -> Dict[str, Any]:
+    """Map the tasks of ``plan``'s stages over ``client``, each stage's start sent to the
+    workers once, and return its outcome (as ``_afmdyn.run`` returns it). With ``store`` (the
+    plan's store, ``Plan.store``) the last stage runs only the tasks it does not hold, each
+    result appended as it arrives."""
+    todo = store.open(resume) if store is not None else None
+    if store is not None and todo is None:
+        return store.outcome()
+    results: List[str] = []
+    stages = plan.stages() if todo != [] else 0
+    last, done = stages - 1, 0
+    with reporter(progress, desc, unit=unit) as cb:
+        for k in range(stages):
+            start, tasks = plan.stage(k, results)
+            if k == last and todo is not None:
+                tasks = [t for t in tasks if t in set(todo)]
+            shared = client.scatter(start, broadcast=True)
+            futures = client.map(run_plan_task, [plan.recipe] * len(tasks),
+                                 [shared] * len(tasks), tasks, pure=False, retries=3)
+            for fut in distributed.as_completed(futures):
+                if k == last and store is not None:
+                    store.append(fut.result())
+                else:
+                    results.append(fut.result())
+                # a chain's passes (a sweep's coarse stage) are not counted; a map's are
+                if cb is not None and (k == last or stages > 2):
+                    done += 1
+                    cb(done, len(tasks) if stages <= 2 else None)
+    if store is None:
+        return plan.outcome(results)
+    store.finish()
+    return store.outcome()
 
 
 def bifurcation(
@@ -377,69 +392,22 @@ def bifurcation(
     ``progress``: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a
     log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.
     """
+    request = _request(locals())
+    del request["client"]
+    if values is not None:
+        request["values"] = np.asarray(values, dtype=np.float64).ravel().tolist()
     from ._api import _params, _sweep_dataset
 
     p, _probe = _params(params, model)
-    request: Dict[str, Any] = dict(
-        param=param,
-        values=None if values is None else np.asarray(values, dtype=np.float64).ravel().tolist(),
-        to=to,
-        steps=steps,
-        starts=starts,
-        seed=seed,
-        continuation=continuation,
-        tol=tol,
-        max_periods=max_periods,
-        max_period=max_period,
-        integrator=integrator,
-        steps_per_period=steps_per_period,
-        tolerance=tolerance,
-    )
-    request["from"] = from_
-    s = _core.SweepStudy.build(request, p)
+    plan = _core.Plan.build("bifurcation", request, p)
     with _cluster(client) as client:
-        sweep_store = None
+        own = None if store is None else plan.store(os.fspath(store))
         try:
-            if store is not None:
-                sweep_store = _core.SweepStore(os.fspath(store))
-            todo: Optional[List[int]] = list(range(s.tasks(1)))
-            if sweep_store is not None:
-                todo = sweep_store.open(s, resume)
-            rows: List[str] = []
-            if todo:
-                with reporter(progress, "bifurcation (dask)") as cb:
-                    recipe = s.recipe
-                    coarse = client.map(run_coarse_task, [recipe] * s.tasks(0),
-                                        range(s.tasks(0)), pure=False, retries=3)
-                    fwd, bwd = (coarse[0], coarse[1]) if coarse else (None, None)
-                    futures = [
-                        client.submit(run_sweep_task, recipe, k, fwd, bwd, pure=False, retries=3)
-                        for k in todo
-                    ]
-                    for i, fut in enumerate(distributed.as_completed(futures)):
-                        task_rows = fut.result()
-                        if sweep_store is not None:
-                            sweep_store.append(task_rows)
-                        else:
-                            rows.extend(task_rows)
-                        if cb is not None:
-                            cb(i + 1, len(todo))
-            if sweep_store is not None:
-                if todo is not None:
-                    sweep_store.finish(s)
-                d = sweep_store.records(s)
-            else:
-                d = s.records(rows)
+            d = _run_plan(client, plan, progress, "bifurcation (dask)", store=own, resume=resume)
         finally:
-            if sweep_store is not None:
-                sweep_store.release()
+            if own is not None:
+                own.release()
     return _sweep_dataset(p, d, starts, seed)
-
-
-def run_basin_row(recipe: str, start: str, iy: int) -> str:
-    """Row ``iy`` of the pass of the basin map of ``recipe`` that begins at ``start`` (the
-    attractors and coarse grid of the passes before it): the finished row, as text."""
-    return _core.BasinMapStudy(recipe).run_row(start, iy)
 
 
 def basins(
@@ -473,34 +441,10 @@ def basins(
         "params", "model", "store", "resume", "threads", "progress"}
     model = {k: keywords.pop(k) for k in list(keywords) if k not in own_keywords}
     p, probe = _params(params, model)
-    s = _core.BasinMapStudy.build(p, keywords, probe)
+    plan = _core.Plan.build("basins", keywords, p, probe)
     with _cluster(client) as client:
-        rows: List[str] = []
-        with reporter(progress, "basins (dask)", unit="row") as cb:
-            for k in range(s.passes()):
-                start = s.start(k, rows)
-                iys = s.rows(start)
-                shared = client.scatter(start, broadcast=True)
-                futures = client.map(run_basin_row, [s.recipe] * len(iys), [shared] * len(iys),
-                                     iys, pure=False, retries=3)
-                for fut in distributed.as_completed(futures):
-                    rows.append(fut.result())
-                    if cb is not None:
-                        cb(len(rows), None)
-        layout, doc = s.result(rows)
-    return _dataset(layout, json.loads(doc), p)
-
-
-def run_image_line(recipe: str, line: int) -> str:
-    """Line ``line`` of the PI scan of ``recipe`` (what a worker runs): its trace and retrace,
-    as text. The scan (its materials' approach curves) is built once per worker process and
-    recipe."""
-    return _scan_of(recipe).run_line(line)
-
-
-@functools.lru_cache(maxsize=8)
-def _scan_of(recipe: str) -> "_core.ScanStudy":
-    return _core.ScanStudy(recipe)
+        d = _run_plan(client, plan, progress, "basins (dask)", unit="row")
+    return _dataset(d["datasets"]["basins"], json.loads(d["json"]), p)
 
 
 def image(
@@ -523,23 +467,14 @@ def image(
     machine's cores, closed at the end): each line is a task, a pure function of the request
     and its number, so the Dataset equals :func:`afmdyn.image`'s bit for bit.
     """
-    from ._image import _dataset, _gains, _inputs
+    from ._image import _dataset, _keywords
 
-    text, source, rows = _inputs(probe, sample, height_map)
-    s = _core.ScanStudy.build(text, source, setpoint, pixels, lines, curve_points, rows,
-                              scan_rate, _gains(gains), time_constant)
-    n = s.lines()
+    text, request = _keywords(probe, sample, setpoint, pixels, lines, curve_points, height_map,
+                              "pi", scan_rate, gains, time_constant, None)
+    plan = _core.Plan.build("image", request, None, text)
     with _cluster(client) as client:
-        texts: List[str] = []
-        with reporter(progress, "image (dask)", unit="line") as cb:
-            futures = client.map(run_image_line, [s.recipe] * n, list(range(n)), pure=False,
-                                 retries=3)
-            for fut in distributed.as_completed(futures):
-                texts.append(fut.result())
-                if cb is not None:
-                    cb(len(texts), n)
-        out = s.document(texts)
-    return _dataset(out, setpoint)
+        d = _run_plan(client, plan, progress, "image (dask)", unit="line")
+    return _dataset(d, setpoint)
 
 
 __all__ = [
@@ -549,9 +484,6 @@ __all__ = [
     "chart",
     "image",
     "ledger_dir",
-    "run_basin_row",
     "run_chart_task",
-    "run_coarse_task",
-    "run_image_line",
-    "run_sweep_task",
+    "run_plan_task",
 ]

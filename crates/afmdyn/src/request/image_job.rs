@@ -12,13 +12,15 @@ use super::image::{
     background_probe, curves_cost, image, setpoint_study, Image, ImageRequest, SampleMap,
     SetpointStudy,
 };
-use super::image_scan::{resolve, PiImage, PiScan, ScanStudy};
+use super::image_scan::{resolve, PiImage, PiScan, ScanRecipe, ScanStudy};
 use super::limits::{check_threads, Cost};
+use super::named::Outcome;
 use super::present::Files;
 use super::run::{Analysis, Resolved};
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
 use crate::report::{OutputFile, Presentation, TextUnits};
+use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
 /// An image request with its inputs ([module docs](self)).
@@ -76,6 +78,111 @@ impl ImageJob {
             .as_ref()
             .map(|scan| ScanStudy::new(&self.probe, &self.sample, &self.request, scan))
             .transpose()
+    }
+}
+
+/// An image as a front end that knows it by name gives it (Python's `afmdyn.image`, and
+/// the lines of its PI scan on a cluster): the sample map and the options beside the request's
+/// keywords; the probe file's text comes apart ([`ImageKeywords::job`]).
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ImageKeywords {
+    /// The sample map: its TOML text or path ([`SampleMap::read`]).
+    pub sample: String,
+    /// Setpoint ratio A_sp/A₀ in (0, 1).
+    pub setpoint: f64,
+    /// Pixels per line (`None`: [`ImageRequest::at`]'s).
+    pub pixels: Option<usize>,
+    /// Lines (`None`: [`ImageRequest::lines`]).
+    pub lines: Option<usize>,
+    /// Points of each material's approach curve (`None`: [`ImageRequest::at`]'s).
+    pub curve_points: Option<usize>,
+    /// Heights (m), `[row][column]`, replacing the map's height map.
+    pub height_map: Option<Vec<Vec<f64>>>,
+    /// `None`: the ideal feedback; else a PI scan with these settings.
+    pub feedback: Option<PiScan>,
+    /// A PI scan's worker threads (`None`: all cores).
+    pub threads: Option<usize>,
+}
+
+impl ImageKeywords {
+    /// The probe's table (from its TOML text) and the sample map, its height map replaced by
+    /// [`ImageKeywords::height_map`] when given.
+    ///
+    /// # Errors
+    /// [`SimError::Probe`] for a probe text that is not TOML; the sample map's errors.
+    pub fn inputs(&self, probe: &str) -> Result<(toml::Table, SampleMap), SimError> {
+        let table = crate::probe::Probe::table(probe, "probe")
+            .map_err(|e| SimError::Probe(format!("probe {e}")))?;
+        let mut map = SampleMap::read(&self.sample)?;
+        if let Some(rows) = &self.height_map {
+            map = map.with_height_map(rows.clone())?;
+        }
+        Ok((table, map))
+    }
+
+    fn request(&self) -> ImageRequest {
+        ImageRequest::with(self.setpoint, self.pixels, self.lines, self.curve_points)
+    }
+
+    /// The job of the probe file's text `probe` (the ideal image, or the PI scan).
+    ///
+    /// # Errors
+    /// As [`ImageKeywords::inputs`].
+    pub fn job(self, probe: &str) -> Result<ImageJob, SimError> {
+        let (probe, sample) = self.inputs(probe)?;
+        Ok(ImageJob {
+            probe,
+            sample,
+            request: self.request(),
+            feedback: self.feedback,
+            study: None,
+            threads: self.threads,
+            files: Files::All,
+        })
+    }
+
+    /// The recipe of the PI scan (the default settings without [`ImageKeywords::feedback`]).
+    ///
+    /// # Errors
+    /// As [`ImageKeywords::inputs`].
+    pub fn scan(self, probe: &str) -> Result<ScanRecipe, SimError> {
+        let (probe, map) = self.inputs(probe)?;
+        Ok(ScanRecipe {
+            probe,
+            map,
+            request: self.request(),
+            scan: self.feedback.unwrap_or_default(),
+        })
+    }
+}
+
+impl ImageOutput {
+    /// The outcome the one door gives: the per-pixel document, the image's layout (`image`:
+    /// `image.nc`'s variables, [`super::image_layout`]) and, as the fact `summary`, the
+    /// command line's `image.json` ([`super::present::image`]).
+    pub fn outcome(&self, setpoint: f64) -> Outcome {
+        use super::image_layout::{layout, scan_layout};
+        use super::present::image::{ideal_summary, pi_summary};
+        let (document, layout, summary) = match self {
+            ImageOutput::Ideal { image, study } => (
+                image.document(setpoint),
+                layout(image, setpoint),
+                ideal_summary(image, setpoint, study.as_ref()),
+            ),
+            ImageOutput::Pi(img) => (
+                img.document(setpoint),
+                scan_layout(img, setpoint),
+                pi_summary(img, setpoint),
+            ),
+        };
+        let mut facts = serde_json::Map::new();
+        facts.insert("summary".into(), summary);
+        Outcome {
+            document,
+            datasets: vec![("image".into(), layout)],
+            facts,
+        }
     }
 }
 

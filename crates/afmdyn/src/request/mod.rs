@@ -59,6 +59,7 @@ pub mod peakforce;
 pub mod pool;
 pub mod present;
 pub mod reconstruct;
+pub mod reconstruct_document;
 pub mod run;
 pub mod simulate;
 #[cfg(feature = "files")]

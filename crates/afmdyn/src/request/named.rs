@@ -10,6 +10,7 @@
 //! (its own budgets, [`SimulateRequest::validate_in_memory`]) and `bimodal` is the approach
 //! curve of a multifrequency drive ([`super::curves::check_bimodal`]).
 
+use super::reconstruct_document::FromDocument;
 use super::run::{document, run, Analysis, Resolved};
 use super::{
     ApproachRequest, AttractorsRequest, BasinsRequest, ContinuationRequest, ConvergeRequest,
@@ -174,7 +175,21 @@ impl Named for Simulate {
     }
 }
 
-/// The request of analysis `name` ([`NAMES`]) from `d`; `None` for another name.
+/// `reconstruct_document`: a reconstruction from an `fm` or AM document.
+impl Named for FromDocument {
+    fn validate(&self, _model: &Resolved) -> Result<(), SimError> {
+        FromDocument::validate(self)
+    }
+    fn run(&self, model: &Resolved, progress: &Progress) -> Result<Outcome, SimError> {
+        Ok(Outcome {
+            document: FromDocument::run(self, model, progress)?,
+            ..Outcome::default()
+        })
+    }
+}
+
+/// The request of analysis `name` ([`NAMES`], and `reconstruct_document`) from `d`; `None`
+/// for another name.
 ///
 /// # Errors
 /// The deserialiser's: an unknown keyword (`deny_unknown_fields`), a value of the wrong type.
@@ -206,6 +221,8 @@ pub fn parse<'de, D: Deserializer<'de>>(
         "basins" => door::<BasinsRequest, D>(d, false),
         "fm" => door::<FmRequest, D>(d, false),
         "reconstruct" => door::<ReconstructRequest, D>(d, false),
+        // the reconstruction of an fm or AM document (not in NAMES: no schema of its own)
+        "reconstruct_document" => Ok(Some(Box::new(FromDocument::deserialize(d)?))),
         "peakforce" => door::<super::PeakForceRequest, D>(d, false),
         "fit" => door::<super::FitRequest, D>(d, true),
         _ => Ok(None),

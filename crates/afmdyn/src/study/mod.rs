@@ -16,6 +16,8 @@
 //!   builds the worker pool (the request's thread count, checked once by
 //!   [`crate::request::limits::check_threads`]), runs the study, appends each finished task
 //!   under one lock, reports progress to an [`Observer`], and finishes the store.
+//! - [`plan`] (feature `files`): the studies as stages of tasks for an executor outside the
+//!   library (Dask), each rebuilt from its recipe, with its ledger.
 //! - the studies: [`chart`] (a behaviour chart's tiles, its store [`chart_store`]), [`sweep`]
 //!   (a bifurcation sweep's points, stored by the request layer's checkpoints), [`basins`]
 //!   (a basin map's rows, pass by pass, its store `basins::basin_store`),
@@ -39,6 +41,8 @@ pub mod chart;
 pub mod chart_store;
 pub mod global_continuation;
 mod memory;
+#[cfg(feature = "files")]
+pub mod plan;
 pub mod scan;
 #[cfg(feature = "files")]
 pub mod scan_store;

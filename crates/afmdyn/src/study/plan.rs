@@ -1,0 +1,473 @@
+//! Studies as stages of numbered tasks for an executor outside the library (Dask:
+//! `afmdyn.dask`), which ships each task to a worker as text and hands the results back:
+//! [`Plan`]. A plan is rebuilt in any process from its recipe ([`Recipe`], JSON text), so it
+//! travels to workers as a few hundred bytes; a task's start and result travel as CBOR text
+//! ([`to_cbor_text`]: every float bit for bit), so a study run on a cluster equals the one run
+//! here ([`super::execute`]) bit for bit.
+//!
+//! - a bifurcation sweep: stage 0 the two coarse continuation passes, stage 1 the chain
+//!   segments and random starts seeded by them ([`SweepPlan`]); with a store, the command
+//!   line's resumable one ([`Plan::store`], [`PlanStore`]);
+//! - a basin map: one stage per pass, whose start is the attractors and coarse grid of the
+//!   passes before it ([`pass_start`]), one task per row;
+//! - a PI-scanned image: one stage, one task per line ([`ScanStudy`]).
+//!
+//! The ledger — which tasks a store holds, how the results merge into the outcome — is the
+//! plan's: the executor only maps tasks and hands results back.
+
+use super::basins::BasinStudy;
+use super::stored::sweep_outcome;
+use super::task_store::{from_cbor_text, to_cbor_text};
+use super::StudyError;
+use crate::analysis::am_loop::ScanLine;
+use crate::analysis::basins::{pass_start, passes, run_pass_row, BasinRow, PassStart};
+use crate::analysis::bifurcation::{Branch, Seeds, SweepPlan, SweepPoint, SweepSpec, SweepTask};
+use crate::error::SimError;
+use crate::request::checkpoint::{self, Checkpoint};
+use crate::request::image_scan::{ScanRecipe, ScanStudy};
+use crate::request::named::{outcome, Outcome};
+use crate::request::sweep::{every_point_failed, fingerprint, order_key, records, SweepRecord};
+use crate::request::{BasinsRequest, BifurcationRequest, DirLock, FileCheckpoint, Resolved};
+use crate::Params;
+use nalgebra::DVector;
+use serde::{Deserialize, Serialize};
+use std::collections::HashSet;
+use std::sync::atomic::AtomicBool;
+use std::sync::Mutex;
+
+/// What rebuilds a plan in any process: the study's name (`"plan"`), its request and model.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(tag = "plan", rename_all = "snake_case", deny_unknown_fields)]
+pub enum Recipe {
+    /// A bifurcation sweep of `request` over `params`.
+    Bifurcation {
+        /// The request.
+        request: BifurcationRequest,
+        /// The model.
+        params: Params,
+    },
+    /// A basin map of `request` over `params`; `probe` the probe file's text (the document's
+    /// SI block).
+    Basins {
+        /// The request.
+        request: BasinsRequest,
+        /// The model.
+        params: Params,
+        /// The probe file's text.
+        probe: Option<String>,
+    },
+    /// A PI-scanned image.
+    Image {
+        /// The scan.
+        scan: ScanRecipe,
+    },
+}
+
+/// The tasks of one stage: the start every task of it takes (text), and their numbers.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Stage {
+    /// The stage's start, sent once to every worker.
+    pub start: String,
+    /// The stage's tasks.
+    pub tasks: Vec<usize>,
+}
+
+/// A study cut into stages of tasks ([module docs](self)).
+pub trait Plan: Send + Sync {
+    /// The recipe (JSON text) that rebuilds the plan ([`rebuild`]).
+    fn recipe(&self) -> &str;
+    /// The number of stages.
+    fn stages(&self) -> usize;
+    /// Stage `stage` from the results of the stages before it (any order).
+    ///
+    /// # Errors
+    /// A result that is not one of this plan's; `stage` not below [`Plan::stages`].
+    fn stage(&self, stage: usize, results: &[String]) -> Result<Stage, SimError>;
+    /// Run task `task` of the stage beginning at `start`: its result (text).
+    ///
+    /// # Errors
+    /// A start that is not one of this plan's, a task not in it, the task's own errors.
+    fn run(&self, start: &str, task: usize, cancel: &AtomicBool) -> Result<String, SimError>;
+    /// The outcome of every result (of every stage, any order): what the one door returns
+    /// for the same request.
+    ///
+    /// # Errors
+    /// A result that is not one of this plan's; the study's (every point failed).
+    fn outcome(&self, results: &[String]) -> Result<Outcome, SimError>;
+    /// The command line's resumable store of the plan in the locked directory `lock`; `None`
+    /// for a plan without one.
+    fn store(&self, _lock: DirLock) -> Option<Box<dyn PlanStore>> {
+        None
+    }
+}
+
+/// A plan's store, written by an executor that runs the tasks elsewhere (see [`Plan::store`]).
+pub trait PlanStore: Send {
+    /// Where the plan stands in the store (a new run begins without `resume`): `None` when it
+    /// finished, else the tasks of the last stage still to run (the stages before it run whole).
+    ///
+    /// # Errors
+    /// [`StudyError::Store`]: another request's store, unreadable files.
+    fn open(&mut self, resume: bool) -> Result<Option<Vec<usize>>, StudyError>;
+    /// Keep the result of a task of the last stage (what it holds that is not stored yet).
+    ///
+    /// # Errors
+    /// [`StudyError`]: a result not of this plan, the store cannot be written.
+    fn append(&mut self, result: &str) -> Result<(), StudyError>;
+    /// Put the stored results in the one order and mark the plan finished.
+    ///
+    /// # Errors
+    /// [`StudyError::Store`].
+    fn finish(&mut self) -> Result<(), StudyError>;
+    /// The outcome of the finished store.
+    ///
+    /// # Errors
+    /// [`StudyError`]: the store's, reading it; the study's (every point failed).
+    fn outcome(&mut self) -> Result<Outcome, StudyError>;
+}
+
+/// The plan of `recipe`.
+///
+/// # Errors
+/// The request's validation errors on its model.
+pub fn plan(recipe: Recipe) -> Result<Box<dyn Plan>, SimError> {
+    let text = serde_json::to_string(&recipe).map_err(|e| bad("recipe", e))?;
+    Ok(match recipe {
+        Recipe::Bifurcation { request, params } => Box::new(Sweep {
+            spec: request.spec(&params)?,
+            request,
+            text,
+        }),
+        Recipe::Basins {
+            request,
+            params,
+            probe,
+        } => Box::new(Basins {
+            study: BasinStudy::new(&request, &params)?,
+            model: Resolved {
+                params,
+                probe: probe
+                    .as_deref()
+                    .map(|t| crate::probe::Probe::parse(t, "probe"))
+                    .transpose()
+                    .map_err(|e| SimError::Probe(format!("probe {e}")))?,
+            },
+            request,
+            text,
+        }),
+        Recipe::Image { scan } => Box::new(Image {
+            study: ScanStudy::from_recipe(&scan)?,
+            text,
+        }),
+    })
+}
+
+/// The plan of a recipe's text ([`Plan::recipe`]).
+///
+/// # Errors
+/// Text that is not a recipe; as [`plan`].
+pub fn rebuild(text: &str) -> Result<Box<dyn Plan>, SimError> {
+    plan(serde_json::from_str(text).map_err(|e| bad("recipe", e))?)
+}
+
+fn bad(what: &'static str, e: impl std::fmt::Display) -> SimError {
+    SimError::out_of_range(what, "the text given", format!("not a study's {what}: {e}"))
+}
+
+fn decode<T: serde::de::DeserializeOwned>(what: &'static str, text: &str) -> Result<T, SimError> {
+    from_cbor_text(text).map_err(|e| bad(what, e))
+}
+
+fn encode<T: Serialize>(value: &T) -> Result<String, SimError> {
+    to_cbor_text(value).map_err(|e| bad("result", e))
+}
+
+fn no_stage(stage: usize, stages: usize) -> SimError {
+    SimError::out_of_range("stage", stage, format!("in 0..{stages}"))
+}
+
+/// A bifurcation sweep's plan.
+struct Sweep {
+    spec: SweepSpec,
+    request: BifurcationRequest,
+    text: String,
+}
+
+/// A sweep task's result: a coarse pass's seeds (forward 0, backward 1), or the rows of
+/// `bifurcation.csv` of a segment or random start (numbers in shortest round-trip form).
+#[derive(Serialize, Deserialize)]
+enum SweepResult {
+    Coarse(usize, Vec<Vec<f64>>),
+    Rows(Vec<String>),
+}
+
+fn sweep_rows(results: &[String]) -> Result<Vec<SweepRecord>, SimError> {
+    let mut recs = Vec::new();
+    for r in results {
+        if let SweepResult::Rows(rows) = decode("result", r)? {
+            for l in rows {
+                recs.push(SweepRecord::parse_csv(&l).map_err(|e| bad("result", e))?);
+            }
+        }
+    }
+    Ok(recs)
+}
+
+impl Plan for Sweep {
+    fn recipe(&self) -> &str {
+        &self.text
+    }
+    fn stages(&self) -> usize {
+        2
+    }
+    fn stage(&self, stage: usize, results: &[String]) -> Result<Stage, SimError> {
+        let plan = SweepPlan::new(&self.spec);
+        let n = plan.chunks();
+        let tasks = (0..plan.tasks(stage).len()).collect();
+        match stage {
+            0 => Ok(Stage {
+                start: String::new(),
+                tasks,
+            }),
+            1 => {
+                let zeros = || vec![vec![0.0; self.spec.base.state_dim()]; n];
+                let mut seeds = [zeros(), zeros()];
+                for r in results {
+                    if let SweepResult::Coarse(k, s) = decode("result", r)? {
+                        if let Some(slot) = seeds.get_mut(k) {
+                            *slot = s;
+                        }
+                    }
+                }
+                Ok(Stage {
+                    start: encode(&seeds)?,
+                    tasks,
+                })
+            }
+            _ => Err(no_stage(stage, 2)),
+        }
+    }
+    fn run(&self, start: &str, task: usize, cancel: &AtomicBool) -> Result<String, SimError> {
+        let plan = SweepPlan::new(&self.spec);
+        if start.is_empty() {
+            let branch = match task {
+                0 => Branch::Forward,
+                1 => Branch::Backward,
+                _ => return Err(SimError::out_of_range("task", task, "0 or 1")),
+            };
+            let seeds = plan.coarse(branch, cancel);
+            let seeds = seeds.iter().map(|z| z.iter().copied().collect()).collect();
+            return encode(&SweepResult::Coarse(task, seeds));
+        }
+        let tasks = plan.tasks(1);
+        let t: SweepTask = *tasks.get(task).ok_or_else(|| {
+            SimError::out_of_range("task", task, format!("in 0..{}", tasks.len()))
+        })?;
+        let [forward, backward]: [Vec<Vec<f64>>; 2] = decode("start", start)?;
+        let vectors = |v: Vec<Vec<f64>>| v.into_iter().map(DVector::from_vec).collect();
+        let seeds = Seeds::new(vectors(forward), vectors(backward));
+        let param = self.spec.param;
+        let out = Mutex::new(Vec::new());
+        plan.run_task(
+            t,
+            &seeds,
+            &Default::default(),
+            &|p: SweepPoint| {
+                let rows = records(param, &p);
+                out.lock()
+                    .unwrap_or_else(|e| e.into_inner())
+                    .extend(rows.iter().map(SweepRecord::csv_line));
+            },
+            cancel,
+        );
+        encode(&SweepResult::Rows(
+            out.into_inner().unwrap_or_else(|e| e.into_inner()),
+        ))
+    }
+    fn outcome(&self, results: &[String]) -> Result<Outcome, SimError> {
+        let mut recs = sweep_rows(results)?;
+        recs.sort_by_key(order_key);
+        if let Some(e) = every_point_failed(&recs) {
+            return Err(e);
+        }
+        Ok(sweep_outcome(&self.spec, &recs))
+    }
+    fn store(&self, lock: DirLock) -> Option<Box<dyn PlanStore>> {
+        Some(Box::new(SweepStore {
+            lock,
+            fingerprint: fingerprint(&self.request, &self.spec),
+            spec: self.spec.clone(),
+            done: HashSet::new(),
+        }))
+    }
+}
+
+/// The command line's store of a sweep (`afmdyn bifurcation --out DIR`): it stores the points
+/// of each finished task that are not stored yet, so a task computed again after an
+/// interruption (a chain segment runs whole from its seed, deterministically) adds nothing
+/// twice.
+struct SweepStore {
+    lock: DirLock,
+    fingerprint: serde_json::Value,
+    spec: SweepSpec,
+    done: HashSet<(usize, Branch)>,
+}
+
+impl PlanStore for SweepStore {
+    fn open(&mut self, resume: bool) -> Result<Option<Vec<usize>>, StudyError> {
+        let mut s = FileCheckpoint::new(&self.lock);
+        let Some(left) = checkpoint::open(&mut s, &self.fingerprint, resume)? else {
+            return Ok(None);
+        };
+        let plan = SweepPlan::new(&self.spec);
+        let todo = plan
+            .tasks(1)
+            .iter()
+            .enumerate()
+            .filter(|(_, t)| match **t {
+                SweepTask::Segment(b, k) => plan
+                    .chunk_indices(b, k)
+                    .iter()
+                    .any(|&i| !left.done.contains(&(i, b))),
+                SweepTask::Start(i, s) => !left.done.contains(&(i, Branch::Start(s))),
+                SweepTask::Coarse(_) => false,
+            })
+            .map(|(k, _)| k)
+            .collect();
+        self.done = left.done;
+        Ok(Some(todo))
+    }
+    fn append(&mut self, result: &str) -> Result<(), StudyError> {
+        let recs = sweep_rows(&[result.to_string()])?;
+        let mut s = FileCheckpoint::new(&self.lock);
+        for point in recs.chunk_by(|a, b| (a.index, a.branch) == (b.index, b.branch)) {
+            if self.done.insert((point[0].index, point[0].branch)) {
+                s.append(point)?;
+            }
+        }
+        Ok(())
+    }
+    fn finish(&mut self) -> Result<(), StudyError> {
+        Ok(FileCheckpoint::new(&self.lock).finish(&self.fingerprint)?)
+    }
+    fn outcome(&mut self) -> Result<Outcome, StudyError> {
+        let recs = FileCheckpoint::new(&self.lock).records()?;
+        if let Some(e) = every_point_failed(&recs) {
+            return Err(e.into());
+        }
+        Ok(sweep_outcome(&self.spec, &recs))
+    }
+}
+
+/// A basin map's plan.
+struct Basins {
+    study: BasinStudy,
+    request: BasinsRequest,
+    model: Resolved,
+    text: String,
+}
+
+fn basin_rows(results: &[String]) -> Result<Vec<BasinRow>, SimError> {
+    results.iter().map(|t| decode("result", t)).collect()
+}
+
+impl Plan for Basins {
+    fn recipe(&self) -> &str {
+        &self.text
+    }
+    fn stages(&self) -> usize {
+        passes(&self.study.spec)
+    }
+    fn stage(&self, stage: usize, results: &[String]) -> Result<Stage, SimError> {
+        if stage >= self.stages() {
+            return Err(no_stage(stage, self.stages()));
+        }
+        let start = pass_start(&self.study.spec, &basin_rows(results)?, stage);
+        Ok(Stage {
+            tasks: start.rows.iter().map(|(iy, _)| *iy).collect(),
+            start: encode(&start)?,
+        })
+    }
+    fn run(&self, start: &str, iy: usize, cancel: &AtomicBool) -> Result<String, SimError> {
+        let start: PassStart = decode("start", start)?;
+        let Some((_, columns)) = start.rows.iter().find(|(i, _)| *i == iy) else {
+            let pass = format!("a row of pass {}", start.pass);
+            return Err(SimError::out_of_range("iy", iy, pass));
+        };
+        let s = &self.study;
+        encode(&run_pass_row(
+            &s.spec, &s.model, &start, iy, columns, cancel,
+        )?)
+    }
+    fn outcome(&self, results: &[String]) -> Result<Outcome, SimError> {
+        let map = self.study.map(basin_rows(results)?)?;
+        outcome(&self.request, &self.model, &map)
+    }
+}
+
+/// A PI scan's plan.
+struct Image {
+    study: ScanStudy,
+    text: String,
+}
+
+impl Plan for Image {
+    fn recipe(&self) -> &str {
+        &self.text
+    }
+    fn stages(&self) -> usize {
+        1
+    }
+    fn stage(&self, stage: usize, _results: &[String]) -> Result<Stage, SimError> {
+        match stage {
+            0 => Ok(Stage {
+                start: String::new(),
+                tasks: (0..self.study.lines()).collect(),
+            }),
+            _ => Err(no_stage(stage, 1)),
+        }
+    }
+    fn run(&self, _start: &str, t: usize, cancel: &AtomicBool) -> Result<String, SimError> {
+        encode(&(t, self.study.line(t, cancel)?))
+    }
+    fn outcome(&self, results: &[String]) -> Result<Outcome, SimError> {
+        let lines = results
+            .iter()
+            .map(|t| decode::<(usize, ScanLine)>("result", t))
+            .collect::<Result<Vec<_>, _>>()?;
+        let img = self.study.assemble(lines)?;
+        Ok(crate::request::image_job::ImageOutput::Pi(img)
+            .outcome(self.study.recipe().request.setpoint))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_sweep_from_its_tasks_is_the_sweep_bit_for_bit() {
+        let request = BifurcationRequest {
+            steps: 3,
+            starts: 1,
+            ..BifurcationRequest::default()
+        };
+        let recipe = Recipe::Bifurcation {
+            request,
+            params: Params::default(),
+        };
+        let p = rebuild(&serde_json::to_string(&recipe).unwrap()).expect("plan");
+        let cancel = AtomicBool::new(false);
+        let mut results = Vec::new();
+        for stage in 0..p.stages() {
+            let st = p.stage(stage, &results).expect("stage");
+            for t in st.tasks {
+                results.push(p.run(&st.start, t, &cancel).expect("task"));
+            }
+        }
+        let out = p.outcome(&results).expect("outcome");
+        assert_eq!(out.datasets.len(), 1);
+        assert!(p.stage(2, &results).is_err());
+        assert!(rebuild("{\"plan\": \"nope\"}").is_err());
+    }
+}
