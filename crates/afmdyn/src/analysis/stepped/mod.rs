@@ -42,7 +42,7 @@ use crate::analysis::settle::{newton_from_transient, SettleOptions, NEWTON_CHUNK
 use crate::analysis::shooting::{
     broyden_pays, shoot_broyden, shoot_undamped, shoot_with, ShootingOptions, ShotOrbit,
 };
-use crate::analysis::steady::{decay_periods, steady_state, SteadyOptions};
+use crate::analysis::steady::{decay_periods, SteadyOptions};
 use crate::error::SimError;
 use crate::integrate::{build, Integrator, IntegratorOptions};
 use crate::maps::StroboscopicMap;
@@ -61,8 +61,8 @@ use branches::{branch, branch_starts, jumps_of, on_branch, unstable_between_fold
 use torus::{torus_point, CirclePoint, Fallback, TorusOptions};
 
 mod point;
-pub use point::settle;
 use point::{integrator_at, step_point};
+pub use point::{settle, Settled, AVERAGE_AGREEMENTS, AVERAGE_MIN_WINDOW, AVERAGE_TOL};
 
 /// Largest number of values of a stepped sweep (each is a steady-state computation, twice).
 pub const MAX_CURVE_POINTS: usize = 100_000;
@@ -227,6 +227,18 @@ pub enum Reached {
     Continued,
     /// The transient from the previous end state was integrated until it settled.
     Settled,
+    /// Averaged (no short period found): the transient from the previous end state was
+    /// integrated until its windowed time averages agreed ([`AVERAGE_TOL`]); the
+    /// observables are those of the last window ([`settle`]).
+    Averaged,
+}
+
+impl Reached {
+    /// Whether the point was reached by integrating the transient ([`Reached::Settled`],
+    /// [`Reached::Averaged`]): not on the branch of the point before.
+    pub fn by_transient(self) -> bool {
+        matches!(self, Reached::Settled | Reached::Averaged)
+    }
 }
 
 /// One point of a stepped sweep (serialized for its study's store: the next point starts from
@@ -565,6 +577,20 @@ pub fn finish_curve(
 ) -> Result<SteppedCurve, SimError> {
     let mut warnings = Vec::new();
     let q = spec.base.common_periods();
+    let averaged = first
+        .iter()
+        .chain(&second)
+        .filter(|p| p.reached == Reached::Averaged)
+        .count();
+    if averaged > 0 {
+        warnings.push(format!(
+            "{averaged} point(s) averaged (no short period found): their motion did not repeat \
+             with a period of at most {} drive periods, and was measured by its time average \
+             once {AVERAGE_AGREEMENTS} successive windows agreed to {AVERAGE_TOL:e} of the \
+             amplitude (reached = \"averaged\"; no Floquet multipliers)",
+            spec.steady.max_period
+        ));
+    }
     let unsettled = first
         .iter()
         .chain(&second)
