@@ -59,11 +59,14 @@ fn average_window(system: &dyn TipSampleSystem) -> usize {
 /// stable orbit ([`newton_from_transient`]); otherwise, over the periods of the point's
 /// [`transient_cap`] not yet spent, in windows (half the slowest free decay time, at least
 /// [`AVERAGE_MIN_WINDOW`] periods) of the stroboscopic
-/// returns' period test (`spec.steady`: a period-m orbit, polished by Newton) alternating with
+/// returns' period test (`spec.steady`: a period-m orbit, polished by Newton; each run of
+/// returns at least 4 `max_period` + 2 periods, to confirm any period) alternating with
 /// windows of the motion's time average ([`observe_tapered`], the Hann² window), whichever
 /// decides first: the motion is settled by its time average once [`AVERAGE_AGREEMENTS`]
 /// successive windows' phasors A e^{iφ} and mean deflections agree to [`AVERAGE_TOL`] of A (as
-/// the time average of a multifrequency drive settles, [`super::average`]). A tapping orbit
+/// the time average of a multifrequency drive settles, [`super::average`]), and not before
+/// the slowest free mode has decayed by the period test's tolerance ([`decay_periods`]: an
+/// orbit whose transient decays as fast has shown its period by then). A tapping orbit
 /// whose returns spiral in too slowly for a short period to show (JKR's neck: its period test
 /// ran to the cap of 20 000 periods) is so settled in a few hundred. A motion that neither
 /// repeats nor averages out within the cap is left nonperiodic.
@@ -98,6 +101,11 @@ pub fn settle(
     integ.set_variational(false);
     let period = integ.system().period();
     let w = average_window(integ.system());
+    // each run of returns long enough to confirm any period ≤ max_period (detected over 2n
+    // returns, confirmed over 2n more), and no average before the free decay to the period
+    // test's tolerance: an orbit whose transient decays as fast shows its period as before
+    let run = w.max(4 * spec.steady.max_period + 2);
+    let least = decay_periods(integ.system(), spec.steady.tol).map_or(0.0, f64::ceil) as usize;
     let window = ObservableOptions {
         periods: w,
         harmonics: spec.observables.harmonics,
@@ -109,7 +117,7 @@ pub fn settle(
     while spent < cap {
         integ.reset(0.0, &z)?;
         let mut returns = ReturnHistory::new(&spec.steady, &z);
-        for k in 1..=w.min(cap - spent) {
+        for k in 1..=run.min(cap - spent) {
             advance(integ, k as f64 * period)?;
             let Some(m) = returns.push(integ.state(), &spec.steady) else {
                 continue;
@@ -134,7 +142,7 @@ pub fn settle(
             integ.reset(tau, &here)?;
             returns = ReturnHistory::new(&spec.steady, &here);
         }
-        spent += w;
+        spent += run;
         if spent >= cap {
             z = integ.state().clone();
             break;
@@ -147,7 +155,7 @@ pub fn settle(
         if let Some((p, d)) = last {
             let close = (now.0 - p).norm().max((now.1 - d).abs()) <= AVERAGE_TOL * o.amplitude;
             agreed = if close { agreed + 1 } else { 0 };
-            if agreed >= AVERAGE_AGREEMENTS {
+            if agreed >= AVERAGE_AGREEMENTS && spent >= least {
                 return Ok(Settled {
                     found: nonperiodic(z),
                     averaged: Some(o),
