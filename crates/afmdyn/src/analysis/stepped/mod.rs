@@ -16,9 +16,10 @@
 //! the distance does not shrink with the step: the attractor vanished at a fold, a jump — the
 //! motion is integrated from the previous end state in chunks of drive periods, Newton being
 //! retried from the transient until the trajectory is seen to approach a stable orbit
-//! ([`settle`]); a motion that never settles on a period-n orbit is classified by
-//! [`super::steady::steady_state`], the whole transient of the point within its
-//! [`transient_cap`].
+//! ([`settle`]); a motion that never settles on a period-n orbit is watched by the returns'
+//! period test and by its windowed time average, within the point's [`transient_cap`]: a
+//! period found is polished by Newton, and a motion whose windows agree first is reported
+//! `averaged` (no short period found, [`Reached::Averaged`], with a warning).
 //!
 //! **Branches.** The periodic-orbit branches through both ends of the range — the two sweeps'
 //! first orbits, and at each end the orbit Newton finds from the other end's (the other regime,
@@ -411,8 +412,8 @@ pub const POINT_MIN_PERIODS: usize = 5_000;
 /// Decay times of the slowest free mode in a point's transient cap ([`transient_cap`]).
 pub const POINT_DECAY_TIMES: f64 = 9.0;
 
-/// The drive periods of transient a point of a stepped sweep may take, [`settle`] and the
-/// classification by [`steady_state`] together: [`POINT_DECAY_TIMES`] times the periods
+/// The drive periods of transient a point of a stepped sweep may take, [`settle`]'s Newton
+/// attempts, period test and time average together: [`POINT_DECAY_TIMES`] times the periods
 /// the slowest free mode of the cantilever (damped eigenvalue λ with the smallest |Re λ|,
 /// eqs. 20–21) takes to decay by the period search's tolerance, ln(1/tol)/(|Re λ| T), within
 /// [[`POINT_MIN_PERIODS`], `spec.steady.max_periods`]; `spec.steady.max_periods` for a
