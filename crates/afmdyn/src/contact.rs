@@ -250,6 +250,7 @@ laws! {
 }
 
 mod law;
+mod prepared;
 pub use capillary::{
     Meniscus, CAPILLARY_DEFAULT_FORCE, CAPILLARY_DEFAULT_MENISCUS, CAPILLARY_DEFAULT_RUPTURE,
 };
@@ -258,6 +259,7 @@ pub use electrostatic::{ELECTROSTATIC_DEFAULT, ELECTROSTATIC_DEFAULT_RADIUS, VAC
 pub use impact::IMPACT_DEFAULT_RESTITUTION;
 pub use jkr::{Jkr, JKR_BREAK_CUT, JKR_DEFAULT_ADHESION};
 pub use law::{reduced_modulus, Law, LawInfo, Param, SampleSi};
+pub use prepared::PreparedLaw;
 pub use sls::{Zener, SLS_DEFAULT_MAXWELL};
 
 impl Default for ContactLaw {

@@ -21,7 +21,7 @@
 //! A chattering sequence (impact velocities decaying as rᵏ) ends in sticking once the next bounce
 //! would rise less than [`STICK_HEIGHT_TOLERANCES`] guard tolerances while λ > 0.
 
-use crate::contact::{ContactLaw, TipSample, TipSampleLaw, Zener};
+use crate::contact::{ContactLaw, PreparedLaw, TipSample, TipSampleLaw, Zener};
 use crate::error::{ParamError, SimError};
 use crate::galerkin::Galerkin;
 use crate::params::{Params, SweepParam};
@@ -95,7 +95,8 @@ pub struct CantileverModel {
     /// eq. 10 with the linear law (regions I and II); region I is also the free flight of
     /// every law apart from its tip force.
     regions: [RegionDynamics; 2],
-    law: TipSample,
+    /// The law with α4, α6 and its derived constants (computed once).
+    law: PreparedLaw,
     /// M⁻¹φ(1), shape `[N]`.
     mphi: DVector<f64>,
     /// M⁻¹, N×N: kept for [`CantileverModel::set_gap`].
@@ -185,11 +186,11 @@ impl CantileverModel {
         ];
         Ok(CantileverModel {
             params: *params,
-            law: TipSample {
+            law: PreparedLaw::new(TipSample {
                 law: params.contact_law,
                 stiffness: params.alpha4,
                 damping: params.alpha6,
-            },
+            }),
             galerkin,
             regions,
             mphi,
@@ -331,7 +332,7 @@ impl CantileverModel {
     pub fn rhs_slice(&self, r: Region, tau: f64, z: &[f64], dz: &mut [f64]) {
         let n = self.modes();
         let (s, c) = (self.params.omega * tau).sin_cos();
-        let linear = self.law.law.is_affine();
+        let linear = self.law.law().is_affine();
         let d = &self.regions[if linear { r.index() } else { 0 }];
         let (zb, dzb) = (&z[..2 * n], &mut dz[..2 * n]);
         for (i, o) in dzb.iter_mut().enumerate() {
@@ -422,7 +423,7 @@ impl CantileverModel {
                 Some((zn, u)) if contact => zn.force(true, -v_t().0, u),
                 _ => 0.0,
             }
-        } else if self.law.law.restitution().is_some() {
+        } else if self.law.law().restitution().is_some() {
             if contact {
                 self.sticking_force_value(tau, z)
             } else {
@@ -452,11 +453,11 @@ impl CantileverModel {
 
     /// [`Self::kelvin_voigt_weight`] given (sin Ωτ, cos Ωτ) = `sc` ([`Self::base_trig`]).
     fn kelvin_voigt_weight_at(&self, r: Region, sc: (f64, f64), z: &[f64]) -> f64 {
-        if r != Region::Contact || !self.law.law.kelvin_voigt() {
+        if r != Region::Contact || !self.law.law().kelvin_voigt() {
             return 0.0;
         }
         let [v, _, _] = self.v_t_at(sc, [self.w_tip_slice(z, 0), 0.0, 0.0]);
-        self.law.damping * (-v).max(0.0).sqrt()
+        self.law.damping() * (-v).max(0.0).sqrt()
     }
 
     /// [`CantileverModel::jacobian_into`], without the singular Kelvin–Voigt term when
@@ -471,7 +472,7 @@ impl CantileverModel {
         singular: bool,
     ) {
         let n = self.modes();
-        let linear = self.law.law.is_affine();
+        let linear = self.law.law().is_affine();
         let a = &self.regions[if linear { r.index() } else { 0 }].a;
         if jac.nrows() == a.nrows() {
             jac.copy_from(a);
@@ -505,7 +506,7 @@ impl CantileverModel {
                 jac[(2 * n, 2 * n)] = rate * (zn.surface_gain() - 1.0);
                 return;
             }
-        } else if self.law.law.restitution().is_some() {
+        } else if self.law.law().restitution().is_some() {
             if r != Region::Contact {
                 return;
             }
@@ -521,7 +522,7 @@ impl CantileverModel {
                 f.d_delta
             } else {
                 // remove α6 δ̇/(2√δ) = α6² δ̇/(2w)
-                f.d_delta - 0.5 * self.law.damping * self.law.damping * (-vd) / w
+                f.d_delta - 0.5 * self.law.damping() * self.law.damping() * (-vd) / w
             };
             for (j, t) in self.tip().iter().enumerate() {
                 row[j] = -d_delta * t;
@@ -692,7 +693,7 @@ impl CantileverModel {
         tau: f64,
         z: &DVector<f64>,
     ) -> Option<(DVector<f64>, DMatrix<f64>)> {
-        self.law.law.restitution()?;
+        self.law.law().restitution()?;
         let (v, vd) = self.v_t_pair(tau, z.as_slice());
         if v >= 0.0 {
             return None;

@@ -75,7 +75,7 @@
 //! differs from E_dis by the work of F_c on the moving base, ∮F_c α2Ω cos Ωτ (beam only).
 
 use super::shooting::PeriodicOrbit;
-use crate::contact::{TipSample, TipSampleLaw};
+use crate::contact::{PreparedLaw, TipSample, TipSampleLaw};
 use crate::eigen::damped_eigenvalues;
 use crate::error::SimError;
 use crate::galerkin::{Region, RegionMatrices};

@@ -342,8 +342,9 @@ fn point(integ: &dyn Integrator) -> PoincarePoint {
 }
 
 /// The period search of [`steady_state`] on the stroboscopic returns, fed one return at a
-/// time (shared by the one-trajectory and the batched search).
-struct ReturnHistory {
+/// time (shared by the one-trajectory and the batched search, and the stepped sweeps' settling,
+/// [`super::stepped::settle`]).
+pub(crate) struct ReturnHistory {
     history: VecDeque<DVector<f64>>,
     confirm: Vec<usize>,
     /// Returns pushed (periods of transient so far).
@@ -351,7 +352,7 @@ struct ReturnHistory {
 }
 
 impl ReturnHistory {
-    fn new(opts: &SteadyOptions, first: &DVector<f64>) -> Self {
+    pub(crate) fn new(opts: &SteadyOptions, first: &DVector<f64>) -> Self {
         let mut history = VecDeque::with_capacity(3 * opts.max_period + 2);
         history.push_back(first.clone());
         ReturnHistory {
@@ -362,7 +363,7 @@ impl ReturnHistory {
     }
 
     /// Account for the next return; `Some(n)` once a period n is confirmed.
-    fn push(&mut self, z: &DVector<f64>, opts: &SteadyOptions) -> Option<usize> {
+    pub(crate) fn push(&mut self, z: &DVector<f64>, opts: &SteadyOptions) -> Option<usize> {
         self.k += 1;
         if self.history.len() == 3 * opts.max_period + 1 {
             self.history.pop_front();

@@ -91,34 +91,16 @@ impl Law for JkrLaw {
         if !contact {
             return ForceEval::default();
         }
-        let jkr = Jkr::new(k, self.adhesion);
-        let q = jkr.radius_variable(delta);
-        let (f, df_dq) = jkr.elastic(q);
-        let q2 = q * q;
-        // dq/dδ = 1/(4q³ − c), large but finite at the break q_b ([`JKR_BREAK_CUT`]);
-        // beyond it, where an integrator's stage may look across the guard, q stays at
-        // q_b and the force at its break value
-        let dq = if delta > jkr.release() {
-            1.0 / (4.0 * q2 * q - jkr.c)
-        } else {
-            0.0
-        };
-        ForceEval {
-            force: f + c * q2 * rate,
-            d_delta: (df_dq + 2.0 * c * q * rate) * dq,
-            d_rate: c * q2,
-        }
+        Jkr::new(k, self.adhesion).contact_force(c, delta, rate)
     }
     fn potential(&self, k: f64, contact: bool, delta: f64) -> f64 {
         if !contact {
             return 0.0;
         }
-        let jkr = Jkr::new(k, self.adhesion);
-        jkr.potential(jkr.radius_variable(delta))
+        Jkr::new(k, self.adhesion).contact_potential(delta)
     }
     fn dissipative(&self, k: f64, c: f64, delta: f64, rate: f64) -> f64 {
-        let q = Jkr::new(k, self.adhesion).radius_variable(delta);
-        c * q * q * rate
+        Jkr::new(k, self.adhesion).dissipative(c, delta, rate)
     }
     fn hysteresis(&self, alpha4: f64) -> Option<Hysteresis> {
         let jkr = Jkr::new(alpha4, self.adhesion);
@@ -171,6 +153,40 @@ impl Jkr {
             q_end,
             q_break: (1.0 + JKR_BREAK_CUT) * q_end,
         }
+    }
+
+    /// F_c(δ, δ̇) in contact with its partials, α6 = `c` the Kelvin–Voigt group (module docs):
+    /// F_c = α4 q⁶ − b q³ + α6 q² δ̇ at q = q(δ) ([`Jkr::radius_variable`]). The force of
+    /// [`JkrLaw`]'s [`Law::force`] in contact, from constants computed once
+    /// ([`super::PreparedLaw`]).
+    pub fn contact_force(&self, c: f64, delta: f64, rate: f64) -> ForceEval {
+        let q = self.radius_variable(delta);
+        let (f, df_dq) = self.elastic(q);
+        let q2 = q * q;
+        // dq/dδ = 1/(4q³ − c), large but finite at the break q_b ([`JKR_BREAK_CUT`]);
+        // beyond it, where an integrator's stage may look across the guard, q stays at
+        // q_b and the force at its break value
+        let dq = if delta > self.release() {
+            1.0 / (4.0 * q2 * q - self.c)
+        } else {
+            0.0
+        };
+        ForceEval {
+            force: f + c * q2 * rate,
+            d_delta: (df_dq + 2.0 * c * q * rate) * dq,
+            d_rate: c * q2,
+        }
+    }
+
+    /// The potential U(δ) in contact: [`Jkr::potential`] at q(δ).
+    pub fn contact_potential(&self, delta: f64) -> f64 {
+        self.potential(self.radius_variable(delta))
+    }
+
+    /// The dissipative part α6 q² δ̇ of the force at δ, α6 = `c`.
+    pub fn dissipative(&self, c: f64, delta: f64, rate: f64) -> f64 {
+        let q = self.radius_variable(delta);
+        c * q * q * rate
     }
 
     /// δ(q) = q⁴ − c q.

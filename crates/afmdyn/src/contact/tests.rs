@@ -156,3 +156,83 @@ fn the_registry_is_consistent() {
         "linear, hertz, dmt, electrostatic, jkr, capillary, sls or impact"
     );
 }
+
+/// The prepared law ([`PreparedLaw`]: JKR's constants computed once) evaluates every law's
+/// force, partials, potential and dissipative part bit for bit as the law evaluated from its
+/// groups at each call, over δ from beyond JKR's break to deep indentation (the break itself,
+/// δ = 0 and NaN included), both regions and three rates; and JKR's force is, bit for bit, the
+/// expression of the law before the constants were kept (q(δ), F(q), dq/dδ from [`Jkr::new`]
+/// at each call).
+#[test]
+fn the_prepared_law_is_the_law_bit_for_bit() {
+    let mut cases = laws();
+    for (stiffness, adhesion) in [(0.5, 1e-3), (20.0, 2.0), (3000.0, 0.05)] {
+        cases.push(TipSample {
+            law: ContactLaw::Jkr { adhesion },
+            stiffness,
+            damping: 0.3,
+        });
+    }
+    let bits = |e: ForceEval| [e.force, e.d_delta, e.d_rate].map(f64::to_bits);
+    let mut checked = 0;
+    for ts in cases {
+        let prepared = PreparedLaw::new(ts);
+        assert_eq!(prepared.tip_sample(), &ts);
+        let jkr = match ts.law {
+            ContactLaw::Jkr { adhesion } => Some(Jkr::new(ts.stiffness, adhesion)),
+            _ => None,
+        };
+        let mut deltas: Vec<f64> = (-400..=400).map(|i| f64::from(i) * 2.5e-4).collect();
+        deltas.extend([0.0, -0.0, f64::NAN, 0.3, 1.7]);
+        if let Some(j) = &jkr {
+            deltas.extend([
+                j.release(),
+                j.release() * (1.0 + 1e-9),
+                j.indentation(j.q_end),
+            ]);
+        }
+        for &delta in &deltas {
+            for rate in [-0.8, 0.0, 0.45] {
+                for contact in [false, true] {
+                    let at = format!("{} δ = {delta}, δ̇ = {rate}, {contact}", ts.law);
+                    let want = ts.force(contact, delta, rate);
+                    assert_eq!(
+                        bits(prepared.force(contact, delta, rate)),
+                        bits(want),
+                        "{at}"
+                    );
+                    let (u, v) = (
+                        prepared.potential(contact, delta),
+                        ts.potential(contact, delta),
+                    );
+                    assert_eq!(u.to_bits(), v.to_bits(), "{at}");
+                    let (u, v) = (
+                        prepared.dissipative(contact, delta, rate),
+                        ts.dissipative(contact, delta, rate),
+                    );
+                    assert_eq!(u.to_bits(), v.to_bits(), "{at}");
+                    if let (Some(_), true) = (&jkr, contact) {
+                        // the law's expression as it was, with the constants of every call
+                        let j = Jkr::new(ts.stiffness, ts.law.groups().adhesion.unwrap());
+                        let q = j.radius_variable(delta);
+                        let (f, df_dq) = j.elastic(q);
+                        let q2 = q * q;
+                        let dq = if delta > j.release() {
+                            1.0 / (4.0 * q2 * q - j.c)
+                        } else {
+                            0.0
+                        };
+                        let old = ForceEval {
+                            force: f + ts.damping * q2 * rate,
+                            d_delta: (df_dq + 2.0 * ts.damping * q * rate) * dq,
+                            d_rate: ts.damping * q2,
+                        };
+                        assert_eq!(bits(prepared.force(true, delta, rate)), bits(old), "{at}");
+                        checked += 1;
+                    }
+                }
+            }
+        }
+    }
+    assert!(checked > 4 * 800, "{checked} JKR evaluations compared");
+}

@@ -22,7 +22,7 @@ impl HybridSystem for CantileverModel {
             v += zn.surface(u);
             vd += zn.surface_gain() * zn.rate(false, -v, u);
         }
-        if self.law.law.restitution().is_some() {
+        if self.law.law().restitution().is_some() {
             if v <= 0.0 && vd == 0.0 && self.sticking_force_value(tau, z) > 0.0 {
                 Region::Contact
             } else {
@@ -49,7 +49,7 @@ impl HybridSystem for CantileverModel {
     /// neck); sticking (impact law): g = λ; over the SLS sample σ(V_T + s(u)) (the contact's
     /// being F_c/(α4 + κ): the tip leaves where the sample's force falls to 0).
     fn guard(&self, mode: Region, tau: f64, z: &[f64]) -> Guard {
-        if mode == Region::Contact && self.law.law.restitution().is_some() {
+        if mode == Region::Contact && self.law.law().restitution().is_some() {
             return self.sticking_force(tau, z);
         }
         let n = self.modes();
@@ -68,7 +68,7 @@ impl HybridSystem for CantileverModel {
     }
 
     fn guard_value(&self, mode: Region, tau: f64, z: &[f64]) -> f64 {
-        if mode == Region::Contact && self.law.law.restitution().is_some() {
+        if mode == Region::Contact && self.law.law().restitution().is_some() {
             return self.sticking_force_value(tau, z);
         }
         mode.guard_sign() * self.switching(self.v_t_pair(tau, z).0, z) + self.guard_offset(mode)
@@ -79,7 +79,7 @@ impl HybridSystem for CantileverModel {
     /// [`STICK_HEIGHT_TOLERANCES`] guard tolerances against λ > 0; sticking ends in a release
     /// (identity).
     fn jump(&self, from: Region, tau: f64, z: &[f64]) -> Jump {
-        let Some(r) = self.law.law.restitution() else {
+        let Some(r) = self.law.law().restitution() else {
             return Jump::switching(from.other(), z);
         };
         if from == Region::Contact {
@@ -137,13 +137,13 @@ impl HybridSystem for CantileverModel {
     }
 
     fn is_affine(&self) -> bool {
-        self.law.law.is_affine()
+        self.law.law().is_affine()
     }
 
     /// σ dV_T/dτ = σ(φ·ȧ + α2 Ω cos Ωτ) for the V_T guards (ȧ = f's top half), without
     /// allocating; the sticking guard through [`HybridSystem::guard`].
     fn guard_rate(&self, mode: Region, tau: f64, z: &[f64], f: &[f64]) -> f64 {
-        if mode == Region::Contact && self.law.law.restitution().is_some() {
+        if mode == Region::Contact && self.law.law().restitution().is_some() {
             let g = self.sticking_force(tau, z);
             return g.grad.iter().zip(f).map(|(a, b)| a * b).sum::<f64>() + g.d_tau;
         }
@@ -166,7 +166,7 @@ impl HybridSystem for CantileverModel {
     /// m_eff (1 + α2 Ω²).
     fn guard_tolerance(&self, mode: Region, _tau: f64, _z: &[f64]) -> f64 {
         let p = &self.params;
-        if mode == Region::Contact && self.law.law.restitution().is_some() {
+        if mode == Region::Contact && self.law.law().restitution().is_some() {
             1e-12 * self.m_eff * (1.0 + p.base_amplitude() * p.omega * p.omega)
         } else {
             1e-12 * (1.0 + p.base_amplitude() + p.alpha5.abs())

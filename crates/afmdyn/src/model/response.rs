@@ -135,7 +135,7 @@ impl CantileverModel {
     /// `None` for laws with restitution, whose guards and jump maps depend on the parameters
     /// in other ways (sticking force, impact).
     pub fn guard_param_derivative(&self, mode: Region, param: SweepParam, tau: f64) -> Option<f64> {
-        if self.law.law.restitution().is_some() {
+        if self.law.law().restitution().is_some() {
             return None;
         }
         let p = &self.params;

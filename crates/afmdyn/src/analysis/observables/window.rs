@@ -26,7 +26,7 @@ pub(super) struct Node {
 /// What [`observe`] needs of the model, computed once.
 pub(super) struct Ctx {
     model: CantileverModel,
-    law: TipSample,
+    law: PreparedLaw,
     free: RegionMatrices,
     tip: DVector<f64>,
     /// Row k: (φᵀx_k) x_kᵀM, the tip deflection carried by eigenmode k of the free region
@@ -95,11 +95,11 @@ impl Ctx {
         });
         Ctx {
             model: model.clone(),
-            law: TipSample {
+            law: PreparedLaw::new(TipSample {
                 law: p.contact_law,
                 stiffness: p.alpha4,
                 damping: p.alpha6,
-            },
+            }),
             free: model.galerkin().region(Region::Free).clone(),
             tip: model.tip().clone(),
             participation: {
@@ -209,7 +209,7 @@ impl Ctx {
                 0.0
             };
         }
-        if r != Region::Contact || self.law.law.restitution().is_none() {
+        if r != Region::Contact || self.law.law().restitution().is_none() {
             return force_rate(&self.law, r, nd);
         }
         let h = 1e-5 * (hi - lo);
@@ -729,7 +729,7 @@ pub(super) fn component(
 
 /// dF_c/dτ at a node: ∂F/∂δ δ̇ + ∂F/∂δ̇ δ̈ for the smooth laws (δ = −V_T, partials of
 /// [`TipSampleLaw::force`]); 0 where no force acts.
-pub(super) fn force_rate(law: &TipSample, r: Region, nd: &Node) -> f64 {
+pub(super) fn force_rate(law: &PreparedLaw, r: Region, nd: &Node) -> f64 {
     let contact = r == Region::Contact;
     if !contact && !law.acts_outside() {
         return 0.0;

@@ -188,7 +188,7 @@ pub(super) fn jumps_of(
     for i in 1..points.len() {
         let (a, b) = (&points[i - 1], &points[i]);
         let gap = gaps[i - 1];
-        if b.reached != Reached::Settled || gap <= jump_tol {
+        if !b.reached.by_transient() || gap <= jump_tol {
             continue;
         }
         // every time-averaged point is reached by settling: a jump is a step that stands out

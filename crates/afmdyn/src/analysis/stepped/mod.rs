@@ -16,9 +16,10 @@
 //! the distance does not shrink with the step: the attractor vanished at a fold, a jump — the
 //! motion is integrated from the previous end state in chunks of drive periods, Newton being
 //! retried from the transient until the trajectory is seen to approach a stable orbit
-//! ([`settle`]); a motion that never settles on a period-n orbit is classified by
-//! [`super::steady::steady_state`], the whole transient of the point within its
-//! [`transient_cap`].
+//! ([`settle`]); a motion that never settles on a period-n orbit is watched by the returns'
+//! period test and by its windowed time average, within the point's [`transient_cap`]: a
+//! period found is polished by Newton, and a motion whose windows agree first is reported
+//! `averaged` (no short period found, [`Reached::Averaged`], with a warning).
 //!
 //! **Branches.** The periodic-orbit branches through both ends of the range — the two sweeps'
 //! first orbits, and at each end the orbit Newton finds from the other end's (the other regime,
@@ -42,7 +43,7 @@ use crate::analysis::settle::{newton_from_transient, SettleOptions, NEWTON_CHUNK
 use crate::analysis::shooting::{
     broyden_pays, shoot_broyden, shoot_undamped, shoot_with, ShootingOptions, ShotOrbit,
 };
-use crate::analysis::steady::{decay_periods, steady_state, SteadyOptions};
+use crate::analysis::steady::{decay_periods, SteadyOptions};
 use crate::error::SimError;
 use crate::integrate::{build, Integrator, IntegratorOptions};
 use crate::maps::StroboscopicMap;
@@ -61,8 +62,8 @@ use branches::{branch, branch_starts, jumps_of, on_branch, unstable_between_fold
 use torus::{torus_point, CirclePoint, Fallback, TorusOptions};
 
 mod point;
-pub use point::settle;
 use point::{integrator_at, step_point};
+pub use point::{settle, Settled, AVERAGE_AGREEMENTS, AVERAGE_MIN_WINDOW, AVERAGE_TOL};
 
 /// Largest number of values of a stepped sweep (each is a steady-state computation, twice).
 pub const MAX_CURVE_POINTS: usize = 100_000;
@@ -227,6 +228,18 @@ pub enum Reached {
     Continued,
     /// The transient from the previous end state was integrated until it settled.
     Settled,
+    /// Averaged (no short period found): the transient from the previous end state was
+    /// integrated until its windowed time averages agreed ([`AVERAGE_TOL`]); the
+    /// observables are those of the last window ([`settle`]).
+    Averaged,
+}
+
+impl Reached {
+    /// Whether the point was reached by integrating the transient ([`Reached::Settled`],
+    /// [`Reached::Averaged`]): not on the branch of the point before.
+    pub fn by_transient(self) -> bool {
+        matches!(self, Reached::Settled | Reached::Averaged)
+    }
 }
 
 /// One point of a stepped sweep (serialized for its study's store: the next point starts from
@@ -399,8 +412,8 @@ pub const POINT_MIN_PERIODS: usize = 5_000;
 /// Decay times of the slowest free mode in a point's transient cap ([`transient_cap`]).
 pub const POINT_DECAY_TIMES: f64 = 9.0;
 
-/// The drive periods of transient a point of a stepped sweep may take, [`settle`] and the
-/// classification by [`steady_state`] together: [`POINT_DECAY_TIMES`] times the periods
+/// The drive periods of transient a point of a stepped sweep may take, [`settle`]'s Newton
+/// attempts, period test and time average together: [`POINT_DECAY_TIMES`] times the periods
 /// the slowest free mode of the cantilever (damped eigenvalue λ with the smallest |Re λ|,
 /// eqs. 20–21) takes to decay by the period search's tolerance, ln(1/tol)/(|Re λ| T), within
 /// [[`POINT_MIN_PERIODS`], `spec.steady.max_periods`]; `spec.steady.max_periods` for a
@@ -565,6 +578,20 @@ pub fn finish_curve(
 ) -> Result<SteppedCurve, SimError> {
     let mut warnings = Vec::new();
     let q = spec.base.common_periods();
+    let averaged = first
+        .iter()
+        .chain(&second)
+        .filter(|p| p.reached == Reached::Averaged)
+        .count();
+    if averaged > 0 {
+        warnings.push(format!(
+            "{averaged} point(s) averaged (no short period found): their motion did not repeat \
+             with a period of at most {} drive periods, and was measured by its time average \
+             once {AVERAGE_AGREEMENTS} successive windows agreed to {AVERAGE_TOL:e} of the \
+             amplitude (reached = \"averaged\"; no Floquet multipliers)",
+            spec.steady.max_period
+        ));
+    }
     let unsettled = first
         .iter()
         .chain(&second)
