@@ -86,7 +86,10 @@ pub fn peakforce(a: &PeakForceArgs) -> Result<(), CliError> {
             };
             let v = |q: Quantity, flag: &str| q.value(flag, dim, si);
             let values = PeakForceSweep::grid(v(from, "from")?, v(to, "to")?, v(step, "step")?)?;
-            Some(PeakForceSweep { param, values })
+            Some(PeakForceSweep {
+                quantity: param,
+                values,
+            })
         }
         _ => None,
     };

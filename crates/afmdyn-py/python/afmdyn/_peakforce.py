@@ -72,9 +72,9 @@ def peakforce(
     del request["modulation_frequency"]
     if modulation_frequency is not None:
         values = [float(v) for v in modulation_frequency]
-        request["sweep"] = {"param": "modulation_frequency", "values": values}
+        request["sweep"] = {"quantity": "modulation_frequency", "values": values}
     elif z_c is not None and not isinstance(z_c, (int, float)):
-        request["sweep"] = {"param": "z_c", "values": [float(v) for v in z_c]}
+        request["sweep"] = {"quantity": "z_c", "values": [float(v) for v in z_c]}
         request["z_c"] = None
     p, probe = _params(params, model)
     d = _door("peakforce", "peakforce", progress, p, probe, request)

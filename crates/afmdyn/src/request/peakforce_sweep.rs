@@ -68,8 +68,9 @@ impl FromStr for PeakForceSweepParam {
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(deny_unknown_fields)]
 pub struct PeakForceSweep {
-    /// The swept quantity.
-    pub param: PeakForceSweepParam,
+    /// The swept quantity (not `param`: that keyword names a model parameter,
+    /// [`crate::SweepParam`]).
+    pub quantity: PeakForceSweepParam,
     /// Its values, in the order the chain visits them (1..=10000 of them).
     pub values: Vec<f64>,
 }
@@ -127,14 +128,14 @@ impl PeakForceSweep {
         }
         let units = PeakForceRequest::units(model);
         let bad = |v: f64, why: &str| {
-            SimError::out_of_range("sweep", v, format!("{}: {why}", self.param.name()))
+            SimError::out_of_range("sweep", v, format!("{}: {why}", self.quantity.name()))
         };
         let mut points = Vec::with_capacity(n);
         for &v in &self.values {
             if !v.is_finite() {
                 return Err(bad(v, "every value must be finite"));
             }
-            let q = match self.param {
+            let q = match self.quantity {
                 PeakForceSweepParam::ZC => {
                     if request.setpoint.is_some() || request.z_c.is_some() {
                         return Err(SimError::out_of_range(
@@ -276,8 +277,8 @@ pub fn sweep_document(
     channels.insert("modulus_dmt".into(), json!(modulus));
     units.insert("modulus_dmt".into(), json!(unit("modulus", u.si)));
     json!({
-        "param": sweep.param.name(),
-        "unit": sweep.param.unit(u.si),
+        "quantity": sweep.quantity.name(),
+        "unit": sweep.quantity.unit(u.si),
         "values": sweep.values,
         "channels": channels,
         "units": units,
@@ -293,7 +294,7 @@ pub fn sweep_document(
 /// dimension named after the swept quantity, every channel over it (NaN where a point
 /// failed), and `period` (0 where a point failed).
 pub fn sweep_layout(block: &Value) -> Layout {
-    let dim = block["param"].as_str().unwrap_or("value").to_string();
+    let dim = block["quantity"].as_str().unwrap_or("value").to_string();
     let nums = |v: &Value| -> Vec<f64> {
         v.as_array().map_or(Vec::new(), |a| {
             a.iter().map(|x| x.as_f64().unwrap_or(f64::NAN)).collect()

@@ -65,7 +65,7 @@ pub const SWEEP_COLUMNS: [&str; 10] = [
 /// column names); `None` without a sweep.
 fn sweep_table(doc: &Value) -> Option<(String, Vec<Vec<f64>>, Vec<&'static str>)> {
     let block = doc.get("sweep").filter(|b| !b.is_null())?;
-    let param = block["param"].as_str().unwrap_or("value").to_string();
+    let param = block["quantity"].as_str().unwrap_or("value").to_string();
     let values = column(doc, "sweep", "values");
     // the swept value first (a swept z_c is not repeated)
     let mut columns: Vec<&'static str> = vec![if param == "z_c" {
