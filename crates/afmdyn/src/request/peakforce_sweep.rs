@@ -307,7 +307,7 @@ pub fn sweep_layout(block: &Value) -> Layout {
         &dim,
         &d,
         block["unit"].as_str().unwrap_or(""),
-        &format!("swept {dim}"),
+        format!("swept {dim}"),
         &values,
     )];
     let units = &block["units"];

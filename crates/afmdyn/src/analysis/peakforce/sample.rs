@@ -9,6 +9,9 @@ use crate::error::SimError;
 use crate::integrate::{advance, form_state, step_span, Integrator};
 use nalgebra::DVector;
 
+/// What [`sample_times`] hands each sample: its index k, τ_k and the state there.
+pub type EachSample<'a> = dyn FnMut(usize, f64, &DVector<f64>) -> Result<(), SimError> + 'a;
+
 /// Call `each(k, τ_k, z(τ_k))` for k = 0, 1, …, `n` − 1 in order, τ_k = `time(k)` increasing
 /// (the first at or after the integrator's time), advancing `integ` to τ_{n−1}. The first
 /// sample is the state there (the integrator advanced to it exactly); a sample inside a step
@@ -21,7 +24,7 @@ pub fn sample_times(
     integ: &mut dyn Integrator,
     n: usize,
     time: &dyn Fn(usize) -> f64,
-    each: &mut dyn FnMut(usize, f64, &DVector<f64>) -> Result<(), SimError>,
+    each: &mut EachSample<'_>,
 ) -> Result<(), SimError> {
     if n == 0 {
         return Ok(());

@@ -60,10 +60,13 @@ pub const SWEEP_COLUMNS: [&str; 10] = [
     "z_c",
 ];
 
+/// A sweep's table: the swept quantity's name, the rows, the column names.
+type SweepTable = (String, Vec<Vec<f64>>, Vec<&'static str>);
+
 /// A sweep's table from the document's `sweep` block: (the swept quantity's name, the rows —
 /// the value, then the [`SWEEP_COLUMNS`] but the swept one, NaN where a point failed —, the
 /// column names); `None` without a sweep.
-fn sweep_table(doc: &Value) -> Option<(String, Vec<Vec<f64>>, Vec<&'static str>)> {
+fn sweep_table(doc: &Value) -> Option<SweepTable> {
     let block = doc.get("sweep").filter(|b| !b.is_null())?;
     let param = block["quantity"].as_str().unwrap_or("value").to_string();
     let values = column(doc, "sweep", "values");
