@@ -2,7 +2,8 @@
 //! task is one value of the swept quantity (the mean rest separation z_c, or the modulation
 //! frequency), numbered by its place in the values; its record the steady tap there, or why it
 //! failed. The tasks form one chain: each tap's transient starts from the previous tap's orbit
-//! (its state at τ = 0), which settles in fewer modulation periods than a start from rest. A
+//! (its state at τ = 0), which near a smooth branch settles in no more modulation periods
+//! than a start from rest (across a change of the tapping it may take more). A
 //! point that fails is recorded with its message and the chain goes on from the last orbit
 //! found. With a setpoint (a sweep in the modulation frequency under ideal peak-force
 //! feedback) each value runs the feedback's own search
