@@ -22,7 +22,7 @@ use crate::study::peakforce::{PeakForceStudy, SweepTap};
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 
-pub use super::peakforce_sweep::{PeakForceSweep, PeakForceSweepParam};
+pub use super::peakforce_sweep::{PeakForceSweep, PeakForceSweepParam, MAX_SWEEP_POINTS};
 
 /// Largest modulation frequency relative to the lever's first resonance, f_m/f₀ (the model's Ω
 /// over the lever's first natural frequency as modelled: Ω itself in the lumped models, Ω/3.516
@@ -200,7 +200,7 @@ impl PeakForceRequest {
         }
         q.validate()?;
         if let Some(sweep) = &self.sweep {
-            sweep.points(self, model, &q)?;
+            self.sweep_points(sweep, model, &q)?;
         }
         Ok(q)
     }
@@ -211,6 +211,74 @@ impl PeakForceRequest {
     /// else τ).
     fn sampling_interval(&self, model: &Resolved, p: &Params) -> f64 {
         std::f64::consts::TAU / p.omega / self.samples as f64 * Self::units(model).time
+    }
+
+    /// The model of every value of `sweep` (`p` the request's model with its checks done).
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming `sweep` (no values, too many, a value that is not
+    /// finite, out of the probe's range of distances, or a frequency not off resonance), or
+    /// `setpoint` with a sweep in z_c (the feedback sets z_c).
+    pub fn sweep_points(
+        &self,
+        sweep: &PeakForceSweep,
+        model: &Resolved,
+        p: &Params,
+    ) -> Result<Vec<Params>, SimError> {
+        let request = self;
+        let n = sweep.values.len();
+        if n == 0 || n > MAX_SWEEP_POINTS {
+            return Err(SimError::out_of_range(
+                "sweep",
+                n,
+                format!("must have 1..={MAX_SWEEP_POINTS} values"),
+            ));
+        }
+        let units = Self::units(model);
+        let bad = |v: f64, why: &str| {
+            SimError::out_of_range("sweep", v, format!("{}: {why}", sweep.quantity.name()))
+        };
+        let mut points = Vec::with_capacity(n);
+        for &v in &sweep.values {
+            if !v.is_finite() {
+                return Err(bad(v, "every value must be finite"));
+            }
+            let q = match sweep.quantity {
+                PeakForceSweepParam::ZC => {
+                    if request.setpoint.is_some() || request.z_c.is_some() {
+                        return Err(SimError::out_of_range(
+                            "sweep",
+                            "z_c with z_c or setpoint",
+                            "a sweep in z_c excludes z_c and setpoint (the feedback sets z_c: \
+                             sweep modulation_frequency with a setpoint)",
+                        ));
+                    }
+                    if model.probe.is_some() {
+                        super::limits::si_distance("sweep", v)?;
+                    }
+                    p.with(
+                        SweepParam::Alpha5,
+                        p.alpha5_for_rest_distance(v / units.length),
+                    )
+                }
+                PeakForceSweepParam::ModulationFrequency => {
+                    let omega = v / units.hz_per_omega.unwrap_or(1.0);
+                    let q = p.with(SweepParam::Omega, omega);
+                    if !(omega > 0.0 && omega / first_natural_frequency(&q) <= MAX_MODULATION_RATIO)
+                    {
+                        return Err(bad(
+                            v,
+                            "every modulation frequency must be > 0 and below half the \
+                             lever's first resonance (f_m/f₀ ≤ 0.5)",
+                        ));
+                    }
+                    q
+                }
+            };
+            q.validate()?;
+            points.push(q);
+        }
+        Ok(points)
     }
 
     /// The sweep's chain of taps ([`PeakForceStudy`], in memory), the first value computed
@@ -224,7 +292,7 @@ impl PeakForceRequest {
     ) -> Result<PeakForceResult, SimError> {
         let force = Self::units(model).force;
         let study = PeakForceStudy {
-            points: sweep.points(self, model, p)?,
+            points: self.sweep_points(sweep, model, p)?,
             setpoint: self.setpoint.map(|f| f / force),
             options: self.options(),
             fingerprint: json!({"afmdyn": env!("CARGO_PKG_VERSION"), "peakforce": self, "params": p}),
@@ -322,8 +390,8 @@ impl Analysis for PeakForceRequest {
                 * lever_periods)
         };
         let tap = match &self.sweep {
-            Some(s) => s
-                .points(self, model, &p)?
+            Some(s) => self
+                .sweep_points(s, model, &p)?
                 .iter()
                 .map(tap_work)
                 .sum::<Result<f64, SimError>>()?,

@@ -3,11 +3,8 @@
 //! ([`crate::study::peakforce::PeakForceStudy`], each tap continued from the previous tap's
 //! orbit), and its block of the document ([`sweep_document`]) and layout ([`sweep_layout`]).
 
-use super::peakforce::{PeakForceRequest, MAX_MODULATION_RATIO};
-use super::run::Resolved;
 use crate::error::SimError;
 use crate::layout::{Layout, Values, Variable};
-use crate::params::{Params, SweepParam};
 use crate::report::CurveUnits;
 use crate::study::peakforce::SweepTap;
 use serde::{Deserialize, Serialize};
@@ -104,75 +101,6 @@ impl PeakForceSweep {
         }
         let dir = if to >= from { step } else { -step };
         Ok((0..=n as usize).map(|k| from + dir * k as f64).collect())
-    }
-
-    /// The model of every value (`p` the request's model with its checks done).
-    ///
-    /// # Errors
-    /// [`SimError::OutOfRange`] naming `sweep` (no values, too many, a value that is not
-    /// finite, out of the probe's range of distances, or a frequency not off resonance), or
-    /// `setpoint` with a sweep in z_c (the feedback sets z_c).
-    pub fn points(
-        &self,
-        request: &PeakForceRequest,
-        model: &Resolved,
-        p: &Params,
-    ) -> Result<Vec<Params>, SimError> {
-        let n = self.values.len();
-        if n == 0 || n > MAX_SWEEP_POINTS {
-            return Err(SimError::out_of_range(
-                "sweep",
-                n,
-                format!("must have 1..={MAX_SWEEP_POINTS} values"),
-            ));
-        }
-        let units = PeakForceRequest::units(model);
-        let bad = |v: f64, why: &str| {
-            SimError::out_of_range("sweep", v, format!("{}: {why}", self.quantity.name()))
-        };
-        let mut points = Vec::with_capacity(n);
-        for &v in &self.values {
-            if !v.is_finite() {
-                return Err(bad(v, "every value must be finite"));
-            }
-            let q = match self.quantity {
-                PeakForceSweepParam::ZC => {
-                    if request.setpoint.is_some() || request.z_c.is_some() {
-                        return Err(SimError::out_of_range(
-                            "sweep",
-                            "z_c with z_c or setpoint",
-                            "a sweep in z_c excludes z_c and setpoint (the feedback sets z_c: \
-                             sweep modulation_frequency with a setpoint)",
-                        ));
-                    }
-                    if model.probe.is_some() {
-                        super::limits::si_distance("sweep", v)?;
-                    }
-                    p.with(
-                        SweepParam::Alpha5,
-                        p.alpha5_for_rest_distance(v / units.length),
-                    )
-                }
-                PeakForceSweepParam::ModulationFrequency => {
-                    let omega = v / units.hz_per_omega.unwrap_or(1.0);
-                    let q = p.with(SweepParam::Omega, omega);
-                    if !(omega > 0.0
-                        && omega / super::peakforce::first_natural_frequency(&q)
-                            <= MAX_MODULATION_RATIO)
-                    {
-                        return Err(bad(
-                            v,
-                            "every modulation frequency must be > 0 and below half the \
-                             lever's first resonance (f_m/f₀ ≤ 0.5)",
-                        ));
-                    }
-                    q
-                }
-            };
-            q.validate()?;
-            points.push(q);
-        }
-        Ok(points)
     }
 }
 
