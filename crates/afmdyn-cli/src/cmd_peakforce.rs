@@ -13,7 +13,7 @@ use crate::door;
 use crate::error::CliError;
 use crate::output::{units_of, OutDir};
 use afmdyn::request::present;
-use afmdyn::request::{PeakForceRequest, Resolved};
+use afmdyn::request::{PeakForceRequest, PeakForceSweep, PeakForceSweepParam, Resolved};
 use afmdyn::Params;
 use clap::Args;
 use std::path::PathBuf;
@@ -32,6 +32,21 @@ pub struct PeakForceArgs {
     /// Butterworth filter on k × deflection; the curve gains the filtered force
     #[arg(long)]
     filter_cutoff: Option<Quantity>,
+    /// Sweep the steady tap over this quantity from --from to --to in steps of --step: z_c
+    /// (m with --probe, else g0; a unit may follow: 5nm) or modulation_frequency (Hz with
+    /// --probe, else Ω; 2kHz); the channels become curves (peakforce-sweep.csv, "sweep" in
+    /// --json), each tap continued from the previous tap's orbit
+    #[arg(long, requires_all = ["from", "to", "step"])]
+    sweep: Option<PeakForceSweepParam>,
+    /// First value of the sweep (z_c without --sweep)
+    #[arg(long, allow_hyphen_values = true, requires_all = ["to", "step"])]
+    from: Option<Quantity>,
+    /// Last value of the sweep
+    #[arg(long, allow_hyphen_values = true, requires = "from")]
+    to: Option<Quantity>,
+    /// Step of the sweep (in the units of --from/--to)
+    #[arg(long, requires = "from")]
+    step: Option<Quantity>,
     /// Points of the reported cycle (2000..=1000000)
     #[arg(long, default_value_t = PeakForceRequest::default().samples)]
     samples: usize,
@@ -57,7 +72,29 @@ pub fn peakforce(a: &PeakForceArgs) -> Result<(), CliError> {
         ));
     }
     let (params, probe) = a.model.resolve(Params::default())?;
+    let sweep = match (a.from, a.to, a.step) {
+        (Some(from), Some(to), Some(step)) => {
+            let param = a.sweep.unwrap_or(PeakForceSweepParam::ZC);
+            if param == PeakForceSweepParam::ZC && a.model.z_c.is_some() {
+                return Err(CliError::Input(
+                    "a sweep in z_c (--from/--to/--step) excludes --z-c".into(),
+                ));
+            }
+            let dim = match param {
+                PeakForceSweepParam::ZC => Dim::Length,
+                PeakForceSweepParam::ModulationFrequency => Dim::Frequency,
+            };
+            let v = |q: Quantity, flag: &str| q.value(flag, dim, si);
+            let values = PeakForceSweep::grid(v(from, "from")?, v(to, "to")?, v(step, "step")?)?;
+            Some(PeakForceSweep {
+                quantity: param,
+                values,
+            })
+        }
+        _ => None,
+    };
     let request = PeakForceRequest {
+        sweep,
         setpoint: quantity(a.setpoint, "setpoint", Dim::Force, si)?,
         samples: a.samples,
         filter_cutoff: quantity(a.filter_cutoff, "filter-cutoff", Dim::Frequency, si)?,

@@ -36,3 +36,29 @@ def test_bad_peakforce_options_name_them():
         afmdyn.peakforce(probe=AIR, setpoint=-1e-9)
     with pytest.raises(ValueError, match="samples"):
         afmdyn.peakforce(probe=AIR, z_c=95e-9, samples=10)
+
+
+def test_peakforce_sweep_in_z_c_equals_the_command_line(cli_json, tmp_path):
+    doc = cli_json(
+        "peakforce",
+        "--probe",
+        AIR,
+        "--from",
+        "97nm",
+        "--to",
+        "95nm",
+        "--step",
+        "1nm",
+        "--files",
+        "none",
+    )
+    ds = afmdyn.peakforce(probe=AIR, z_c=[97e-9, 96e-9, 95e-9])
+    assert ds.sizes["z_c"] == 3
+    np.testing.assert_allclose(ds["z_c"].values, doc["sweep"]["values"], rtol=1e-12)
+    # the command line's grid 97 nm − k × 1 nm differs from 96e-9, 95e-9 in the last bits
+    for name in ("peak_force", "adhesion", "deformation"):
+        np.testing.assert_allclose(
+            ds[name].values, doc["sweep"]["channels"][name], rtol=1e-9
+        )
+    # the peak force grows as the sample reaches farther past the tip
+    assert np.all(np.diff(ds["peak_force"].values) > 0)

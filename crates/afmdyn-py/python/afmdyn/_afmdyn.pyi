@@ -191,6 +191,15 @@ SteadyRequest = TypedDict(
     total=False,
 )
 
+PeakForceSweep = TypedDict(
+    "PeakForceSweep",
+    {
+        "quantity": Literal["z_c", "modulation_frequency"],  # default null
+        "values": List[float],  # default null
+    },
+    total=False,
+)
+
 SimulateRequest = TypedDict(
     "SimulateRequest",
     {
@@ -400,6 +409,7 @@ PeakForceRequest = TypedDict(
         "fit_band": List[float],  # default [0.3, 0.9]
         "samples": int,  # default 4096
         "setpoint": Optional[float],  # default null
+        "sweep": Optional[PeakForceSweep],  # default null
         "z_c": Optional[float],  # default null
     },
     total=False,

@@ -32,6 +32,7 @@
 
 mod filter;
 mod fit;
+mod sample;
 mod setpoint;
 
 pub use filter::low_pass_periodic;
@@ -46,7 +47,7 @@ use super::shooting::{shoot_with, ShootingOptions};
 use super::steady::{steady_state, Motion, SteadyOptions};
 use crate::error::SimError;
 use crate::galerkin::Region;
-use crate::integrate::{advance, build, Integrator, IntegratorOptions};
+use crate::integrate::{build, Integrator, IntegratorOptions};
 use crate::model::CantileverModel;
 use nalgebra::{Complex, DVector};
 use serde::Serialize;
@@ -322,15 +323,15 @@ fn sample_cycle(
         distance: Vec::with_capacity(samples),
         force: Vec::with_capacity(samples),
     };
-    for k in 0..samples {
-        let dt = t * k as f64 / samples as f64;
-        advance(integ, t0 + dt)?;
-        let (w, d, f) = tip_sample(model, integ.tau(), integ.state());
-        c.time.push(dt);
+    let dt = |k: usize| t * k as f64 / samples as f64;
+    sample::sample_times(integ, samples, &|k| t0 + dt(k), &mut |k, tau, z| {
+        let (w, d, f) = tip_sample(model, tau, z);
+        c.time.push(dt(k));
         c.deflection.push(w);
         c.distance.push(d);
         c.force.push(f);
-    }
+        Ok(())
+    })?;
     Ok(c)
 }
 
@@ -406,17 +407,16 @@ fn retract_fit(
     let (t0, t1) = (c.time[a], c.time[b]);
     let origin = time_origin(model);
     integ.reset(0.0, z0)?;
-    advance(integ, origin + t0)?;
     let compliance = static_compliance(model);
     let mut d = Vec::with_capacity(FIT_SAMPLES + 1);
     let (mut measured, mut f) = (d.clone(), d.clone());
-    for k in 0..=FIT_SAMPLES {
-        let t = t0 + (t1 - t0) * k as f64 / FIT_SAMPLES as f64;
-        advance(integ, origin + t)?;
-        let (w, dk, fk) = tip_sample(model, integ.tau(), integ.state());
+    let time = |k: usize| origin + (t0 + (t1 - t0) * k as f64 / FIT_SAMPLES as f64);
+    sample::sample_times(integ, FIT_SAMPLES + 1, &time, &mut |_, tau, z| {
+        let (w, dk, fk) = tip_sample(model, tau, z);
         d.push(dk);
         measured.push(w / compliance);
         f.push(fk);
-    }
+        Ok(())
+    })?;
     Ok(Some((fit_dmt(&d, &measured, band), fit_dmt(&d, &f, band))))
 }

@@ -56,6 +56,7 @@ pub mod model;
 mod model_of;
 pub mod named;
 pub mod peakforce;
+pub mod peakforce_sweep;
 pub mod pool;
 pub mod present;
 pub mod reconstruct;
@@ -85,7 +86,7 @@ pub use fit::FitRequest;
 pub use fm::FmRequest;
 pub use model::{parameter, ModelSpec, ParamInfo, MODEL_PARAMETERS};
 pub use named::{Datasets, Named, Outcome};
-pub use peakforce::PeakForceRequest;
+pub use peakforce::{PeakForceRequest, PeakForceSweep, PeakForceSweepParam};
 pub use pool::in_pool;
 #[cfg(feature = "parallel")]
 pub use pool::thread_pool;

@@ -18,8 +18,11 @@ use crate::error::SimError;
 use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
 use crate::report::CurveUnits;
+use crate::study::peakforce::{PeakForceStudy, SweepTap};
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
+
+pub use super::peakforce_sweep::{PeakForceSweep, PeakForceSweepParam, MAX_SWEEP_POINTS};
 
 /// Largest modulation frequency relative to the lever's first resonance, f_m/f₀ (the model's Ω
 /// over the lever's first natural frequency as modelled: Ω itself in the lumped models, Ω/3.516
@@ -28,7 +31,7 @@ pub const MAX_MODULATION_RATIO: f64 = 0.5;
 
 /// The lever's first natural frequency as modelled, in the units of Ω (in its medium; 1 in the
 /// lumped models' units, ≈ 3.516 in the beam's): f₀/f_m = this / Ω.
-fn first_natural_frequency(p: &Params) -> f64 {
+pub(crate) fn first_natural_frequency(p: &Params) -> f64 {
     CantileverModel::new(p).map_or(1.0, |m| {
         crate::eigen::natural_modes(m.galerkin().region(crate::galerkin::Region::Free)).omega[0]
     })
@@ -59,6 +62,13 @@ pub struct PeakForceRequest {
     /// tip–sample force. `None` (default): no filter. f_c must lie below the Nyquist frequency
     /// of the cycle's samples, `samples`/(2 × the modulation period).
     pub filter_cutoff: Option<f64>,
+    /// A sweep in z_c or in the modulation frequency ([`PeakForceSweep`]): the channels as
+    /// curves over its values (the document's `sweep` block), each tap continued from the
+    /// previous tap's orbit; the single tap's blocks (`channels`, `cycle`, `curve`, …) are
+    /// those of the first value computed. A sweep in z_c excludes `z_c` and `setpoint`; with
+    /// `setpoint` a sweep in the modulation frequency holds the peak force at every value.
+    /// `None` (default): one tap.
+    pub sweep: Option<PeakForceSweep>,
 }
 
 impl Default for PeakForceRequest {
@@ -69,6 +79,7 @@ impl Default for PeakForceRequest {
             samples: 4_096,
             fit_band: [FIT_BAND.0, FIT_BAND.1],
             filter_cutoff: None,
+            sweep: None,
         }
     }
 }
@@ -85,6 +96,8 @@ pub struct PeakForceResult {
     /// The measured force k × deflection (F̃) over the cycle through the instrument's filter
     /// (with [`PeakForceRequest::filter_cutoff`]).
     pub filtered: Option<Vec<f64>>,
+    /// Every value's tap of [`PeakForceRequest::sweep`], in its order.
+    pub sweep: Option<Vec<SweepTap>>,
 }
 
 impl PeakForceRequest {
@@ -186,6 +199,9 @@ impl PeakForceRequest {
             (None, None) => {}
         }
         q.validate()?;
+        if let Some(sweep) = &self.sweep {
+            self.sweep_points(sweep, model, &q)?;
+        }
         Ok(q)
     }
 }
@@ -195,6 +211,112 @@ impl PeakForceRequest {
     /// else τ).
     fn sampling_interval(&self, model: &Resolved, p: &Params) -> f64 {
         std::f64::consts::TAU / p.omega / self.samples as f64 * Self::units(model).time
+    }
+
+    /// The model of every value of `sweep` (`p` the request's model with its checks done).
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming `sweep` (no values, too many, a value that is not
+    /// finite, out of the probe's range of distances, or a frequency not off resonance), or
+    /// `setpoint` with a sweep in z_c (the feedback sets z_c).
+    pub fn sweep_points(
+        &self,
+        sweep: &PeakForceSweep,
+        model: &Resolved,
+        p: &Params,
+    ) -> Result<Vec<Params>, SimError> {
+        let request = self;
+        let n = sweep.values.len();
+        if n == 0 || n > MAX_SWEEP_POINTS {
+            return Err(SimError::out_of_range(
+                "sweep",
+                n,
+                format!("must have 1..={MAX_SWEEP_POINTS} values"),
+            ));
+        }
+        let units = Self::units(model);
+        let bad = |v: f64, why: &str| {
+            SimError::out_of_range("sweep", v, format!("{}: {why}", sweep.quantity.name()))
+        };
+        let mut points = Vec::with_capacity(n);
+        for &v in &sweep.values {
+            if !v.is_finite() {
+                return Err(bad(v, "every value must be finite"));
+            }
+            let q = match sweep.quantity {
+                PeakForceSweepParam::ZC => {
+                    if request.setpoint.is_some() || request.z_c.is_some() {
+                        return Err(SimError::out_of_range(
+                            "sweep",
+                            "z_c with z_c or setpoint",
+                            "a sweep in z_c excludes z_c and setpoint (the feedback sets z_c: \
+                             sweep modulation_frequency with a setpoint)",
+                        ));
+                    }
+                    if model.probe.is_some() {
+                        super::limits::si_distance("sweep", v)?;
+                    }
+                    p.with(
+                        SweepParam::Alpha5,
+                        p.alpha5_for_rest_distance(v / units.length),
+                    )
+                }
+                PeakForceSweepParam::ModulationFrequency => {
+                    let omega = v / units.hz_per_omega.unwrap_or(1.0);
+                    let q = p.with(SweepParam::Omega, omega);
+                    if !(omega > 0.0 && omega / first_natural_frequency(&q) <= MAX_MODULATION_RATIO)
+                    {
+                        return Err(bad(
+                            v,
+                            "every modulation frequency must be > 0 and below half the \
+                             lever's first resonance (f_m/f₀ ≤ 0.5)",
+                        ));
+                    }
+                    q
+                }
+            };
+            q.validate()?;
+            points.push(q);
+        }
+        Ok(points)
+    }
+
+    /// The sweep's chain of taps ([`PeakForceStudy`], in memory), the first value computed
+    /// giving the single tap's blocks.
+    fn execute_sweep(
+        &self,
+        sweep: &PeakForceSweep,
+        model: &Resolved,
+        p: &Params,
+        progress: &Progress,
+    ) -> Result<PeakForceResult, SimError> {
+        let force = Self::units(model).force;
+        let study = PeakForceStudy {
+            points: self.sweep_points(sweep, model, p)?,
+            setpoint: self.setpoint.map(|f| f / force),
+            options: self.options(),
+            fingerprint: json!({"afmdyn": env!("CARGO_PKG_VERSION"), "peakforce": self, "params": p}),
+        };
+        let taps = study.taps(crate::study::execute_in_memory(&study, None, progress)?)?;
+        let failed = taps.iter().filter(|t| t.tap.is_none()).count();
+        let Some(first) = taps.iter().find(|t| t.tap.is_some()) else {
+            return Err(SimError::EveryRunFailed {
+                what: "peakforce sweep points",
+                runs: failed,
+                first: taps
+                    .first()
+                    .and_then(|t| t.message.clone())
+                    .unwrap_or_default(),
+            });
+        };
+        let tap = first.tap.clone().ok_or(SimError::Cancelled)?;
+        Ok(PeakForceResult {
+            alpha5: first.params.alpha5,
+            filtered: self.filtered(model, &first.params, &tap)?,
+            evaluations: taps.iter().map(|t| t.evaluations).sum(),
+            tap,
+            sweep: Some(taps),
+        })
     }
 
     /// The measured force k × deflection (the deflection over the static compliance) of the
@@ -219,8 +341,11 @@ impl Analysis for PeakForceRequest {
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
         self.params(model).map(|_| ())
     }
-    fn execute(&self, model: &Resolved, _: &Progress) -> Result<PeakForceResult, SimError> {
+    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<PeakForceResult, SimError> {
         let p = self.params(model)?;
+        if let Some(sweep) = &self.sweep {
+            return self.execute_sweep(sweep, model, &p, progress);
+        }
         match self.setpoint {
             Some(f) => {
                 let force = Self::units(model).force;
@@ -234,6 +359,7 @@ impl Analysis for PeakForceRequest {
                     filtered: self.filtered(model, &p, &s.tap)?,
                     tap: s.tap,
                     evaluations: s.evaluations,
+                    sweep: None,
                 })
             }
             None => {
@@ -243,6 +369,7 @@ impl Analysis for PeakForceRequest {
                     filtered: self.filtered(model, &p, &tap)?,
                     tap,
                     evaluations: 1,
+                    sweep: None,
                 })
             }
         }
@@ -256,15 +383,26 @@ impl Analysis for PeakForceRequest {
         // and the fit's resampling kept
         let p = self.params(model)?;
         let opts = self.options();
-        let lever_periods = (1.0 / p.omega).max(1.0);
-        let tap = (steady_periods(&opts.steady, &p)? * p.modes as f64
-            + newton_work(&p, 1, &opts.shooting))
-            * lever_periods;
-        let taps = if self.setpoint.is_some() {
+        let tap_work = |q: &Params| -> Result<f64, SimError> {
+            let lever_periods = (1.0 / q.omega).max(1.0);
+            Ok((steady_periods(&opts.steady, q)? * q.modes as f64
+                + newton_work(q, 1, &opts.shooting))
+                * lever_periods)
+        };
+        let tap = match &self.sweep {
+            Some(s) => self
+                .sweep_points(s, model, &p)?
+                .iter()
+                .map(tap_work)
+                .sum::<Result<f64, SimError>>()?,
+            None => tap_work(&p)?,
+        };
+        let per_value = if self.setpoint.is_some() {
             (2 * BRACKET_STEPS + SETPOINT_ITERATIONS) as f64
         } else {
             1.0
         };
+        let taps = per_value;
         let samples = (self.samples + crate::analysis::peakforce::FIT_SAMPLES) as f64;
         Ok(Cost {
             bytes: MODEL_BYTES + 2.0 * samples * 4.0 * 8.0 + 64.0 * state_bytes(&p),
@@ -294,7 +432,12 @@ impl Analysis for PeakForceRequest {
         ))
     }
     fn largest_indentation(&self, r: &PeakForceResult) -> Option<f64> {
-        Some(r.tap.channels.deformation)
+        // a sweep's largest over its taps
+        let taps = r.sweep.iter().flatten().filter_map(|t| t.tap.as_ref());
+        Some(
+            taps.map(|t| t.channels.deformation)
+                .fold(r.tap.channels.deformation, f64::max),
+        )
     }
 }
 
@@ -322,7 +465,14 @@ pub fn document(request: &PeakForceRequest, model: &Resolved, r: &PeakForceResul
     let u = PeakForceRequest::units(model);
     let tap = &r.tap;
     let c = &tap.channels;
-    let p = model.params.with(SweepParam::Alpha5, r.alpha5);
+    // a sweep's single-tap blocks are its first computed value's (its Ω in a sweep of f_m)
+    let p = r
+        .sweep
+        .iter()
+        .flatten()
+        .find(|t| t.tap.is_some())
+        .map_or(model.params, |t| t.params)
+        .with(SweepParam::Alpha5, r.alpha5);
     let has_radius = matches!(
         p.contact_law.name(),
         "hertz" | "dmt" | "electrostatic" | "jkr" | "capillary"
@@ -374,7 +524,29 @@ pub fn document(request: &PeakForceRequest, model: &Resolved, r: &PeakForceResul
         curve["approach_filtered_force"] = json!(col(&fl[..half], u.force));
         curve["retract_filtered_force"] = json!(col(&fl[half..], u.force));
     }
+    let sweep = request
+        .sweep
+        .as_ref()
+        .zip(r.sweep.as_ref())
+        .map(|(s, taps)| {
+            let scale = true_modulus(model, 1.0)
+                .filter(|_| has_radius)
+                .unwrap_or(1.0);
+            super::peakforce_sweep::sweep_document(s, &u, Some(scale), taps)
+        });
+    if let Some(block) = &sweep {
+        let failed = block["message"]
+            .as_array()
+            .map_or(0, |m| m.iter().filter(|x| !x.is_null()).count());
+        if failed > 0 {
+            warnings.push(format!(
+                "{failed} of the sweep's values failed (null in sweep.channels; their \
+                 messages in sweep.message)"
+            ));
+        }
+    }
     json!({
+        "sweep": sweep,
         "channels": {
             "peak_force": c.peak_force * u.force,
             "adhesion": c.adhesion * u.force,
@@ -537,9 +709,13 @@ impl super::named::Datasets for PeakForceRequest {
             variables,
         );
         let facts = doc["channels"].as_object().cloned().unwrap_or_default();
-        Ok((
-            vec![("cycle".into(), cycle), ("curve".into(), curve)],
-            facts,
-        ))
+        let mut layouts = vec![("cycle".into(), cycle), ("curve".into(), curve)];
+        if !doc["sweep"].is_null() {
+            layouts.push((
+                "sweep".into(),
+                super::peakforce_sweep::sweep_layout(&doc["sweep"]),
+            ));
+        }
+        Ok((layouts, facts))
     }
 }

@@ -22,9 +22,9 @@
 //!   (a bifurcation sweep's points, stored by the request layer's checkpoints), [`basins`]
 //!   (a basin map's rows, pass by pass, its store `basins::basin_store`),
 //!   [`global_continuation`] (a global continuation's values, one chain, its store
-//!   `global_continuation::continuation_store`) and [`stepped`] (an approach or resonance
-//!   curve's points, one chain through both sweeps, its store `stepped::curve_store`). A
-//!   chain's resume reads its stored records back (its next task starts from them: `Done` is
+//!   `global_continuation::continuation_store`), [`stepped`] (an approach or resonance
+//!   curve's points, one chain through both sweeps, its store `stepped::curve_store`) and
+//!   [`peakforce`] (a PeakForce sweep's taps, one chain, run in memory). A chain's resume reads its stored records back (its next task starts from them: `Done` is
 //!   the records); a study of independent tasks reads only their numbers.
 //!
 //! The results' variables are declared once in [`crate::layout`], from which the NetCDF file,
@@ -41,6 +41,7 @@ pub mod chart;
 pub mod chart_store;
 pub mod global_continuation;
 mod memory;
+pub mod peakforce;
 #[cfg(feature = "files")]
 pub mod plan;
 pub mod scan;

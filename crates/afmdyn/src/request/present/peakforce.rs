@@ -45,6 +45,51 @@ pub fn rows(doc: &Value, block: &str, columns: &[&str]) -> Vec<Vec<f64>> {
         .collect()
 }
 
+/// The channels of a sweep's table (`peakforce-sweep.csv`), after the swept value (`z_c` or
+/// `modulation_frequency`; a swept z_c is not repeated).
+pub const SWEEP_COLUMNS: [&str; 10] = [
+    "peak_force",
+    "adhesion",
+    "deformation",
+    "dissipation",
+    "contact_time",
+    "snap_off_time",
+    "ringing_amplitude",
+    "modulus_dmt",
+    "taps_per_cycle",
+    "z_c",
+];
+
+/// A sweep's table: the swept quantity's name, the rows, the column names.
+type SweepTable = (String, Vec<Vec<f64>>, Vec<&'static str>);
+
+/// A sweep's table from the document's `sweep` block: (the swept quantity's name, the rows —
+/// the value, then the [`SWEEP_COLUMNS`] but the swept one, NaN where a point failed —, the
+/// column names); `None` without a sweep.
+fn sweep_table(doc: &Value) -> Option<SweepTable> {
+    let block = doc.get("sweep").filter(|b| !b.is_null())?;
+    let param = block["quantity"].as_str().unwrap_or("value").to_string();
+    let values = column(doc, "sweep", "values");
+    // the swept value first (a swept z_c is not repeated)
+    let mut columns: Vec<&'static str> = vec![if param == "z_c" {
+        "z_c"
+    } else {
+        "modulation_frequency"
+    }];
+    columns.extend(SWEEP_COLUMNS.iter().filter(|c| **c != param));
+    let channels = rows(block, "channels", &columns[1..]);
+    let table = values
+        .iter()
+        .enumerate()
+        .map(|(i, v)| {
+            let mut r = vec![*v];
+            r.extend(channels.get(i).cloned().unwrap_or_default());
+            r
+        })
+        .collect();
+    Some((param, table, columns))
+}
+
 /// The presentation of a steady tap's `document` ([`crate::request::peakforce::document`]):
 /// the summary, and with `files` the two tables, the figures (all files) and the document
 /// `peakforce.json`.
@@ -107,6 +152,21 @@ pub fn peakforce(
             .map(|m| num(&m[0]).hypot(num(&m[1])))
             .unwrap_or(f64::NAN),
     ));
+    let sweep = sweep_table(document);
+    if let Some((param, table, _)) = &sweep {
+        let failed = document["sweep"]["message"]
+            .as_array()
+            .map_or(0, |m| m.iter().filter(|x| !x.is_null()).count());
+        p.line(format!(
+            "sweep of {} values of {param}{}; the tap above is the first value computed",
+            table.len(),
+            if failed > 0 {
+                format!(" ({failed} failed)")
+            } else {
+                String::new()
+            }
+        ));
+    }
     if files == Files::None {
         return p;
     }
@@ -132,6 +192,9 @@ pub fn peakforce(
         };
         p.csv("peakforce-cycle.csv", &CYCLE_COLUMNS, table(&cycle));
         p.csv("peakforce-curve.csv", &curve_columns, table(&curve));
+        if let Some((_, rows, columns)) = &sweep {
+            p.csv("peakforce-sweep.csv", columns, table(rows));
+        }
     }
     if files == Files::All {
         let (l, f, t) = if si {
@@ -168,6 +231,23 @@ pub fn peakforce(
                 all,
             ),
         );
+        if let Some((param, rows, _)) = &sweep {
+            let unit = document["sweep"]["unit"].as_str().unwrap_or("");
+            // columns: the value, then SWEEP_COLUMNS (peak_force, adhesion first)
+            let peak = rows.iter().map(|r| (r[0], r[1])).collect();
+            let adhesion = rows.iter().map(|r| (r[0], r[2])).collect();
+            p.figure(
+                "peakforce-sweep",
+                lines(
+                    "PeakForce tapping: peak force and adhesion over the sweep",
+                    (format!("{param} ({unit})"), format!("force{f}")),
+                    vec![
+                        series("peak force", peak, 0),
+                        series("adhesion", adhesion, 1),
+                    ],
+                ),
+            );
+        }
         let time = cycle.iter().map(|r| (r[0], r[3])).collect();
         p.figure(
             "peakforce-force-time",

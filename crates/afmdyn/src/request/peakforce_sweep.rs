@@ -1,0 +1,272 @@
+//! `peakforce` with a sweep: the steady tap's channels as curves over the mean rest separation
+//! z_c or over the modulation frequency f_m ([`PeakForceSweep`]), run as a chain of tasks
+//! ([`crate::study::peakforce::PeakForceStudy`], each tap continued from the previous tap's
+//! orbit), and its block of the document ([`sweep_document`]) and layout ([`sweep_layout`]).
+
+use crate::error::SimError;
+use crate::layout::{Layout, Values, Variable};
+use crate::report::CurveUnits;
+use crate::study::peakforce::SweepTap;
+use serde::{Deserialize, Serialize};
+use serde_json::{json, Value};
+use std::str::FromStr;
+
+/// Most values of a sweep.
+pub const MAX_SWEEP_POINTS: usize = 10_000;
+
+/// The quantity a PeakForce sweep steps.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[serde(rename_all = "snake_case")]
+pub enum PeakForceSweepParam {
+    /// The mean rest separation z_c (m with a probe, else g₀).
+    ZC,
+    /// The modulation frequency f_m (Hz with a probe, else Ω, the model's drive frequency).
+    ModulationFrequency,
+}
+
+impl PeakForceSweepParam {
+    /// Its name in the document and on the command line (`z_c`, `modulation_frequency`).
+    pub fn name(self) -> &'static str {
+        match self {
+            PeakForceSweepParam::ZC => "z_c",
+            PeakForceSweepParam::ModulationFrequency => "modulation_frequency",
+        }
+    }
+
+    /// Its unit: m or Hz with a probe, g0 or Ω without.
+    pub fn unit(self, si: bool) -> &'static str {
+        match (self, si) {
+            (PeakForceSweepParam::ZC, true) => "m",
+            (PeakForceSweepParam::ZC, false) => "g0",
+            (PeakForceSweepParam::ModulationFrequency, true) => "Hz",
+            (PeakForceSweepParam::ModulationFrequency, false) => "Ω",
+        }
+    }
+}
+
+impl FromStr for PeakForceSweepParam {
+    type Err = String;
+    /// `z_c` (or `z-c`) and `modulation_frequency` (or `modulation-frequency`, `f_m`).
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s.trim().to_ascii_lowercase().replace('-', "_").as_str() {
+            "z_c" | "zc" => Ok(PeakForceSweepParam::ZC),
+            "modulation_frequency" | "f_m" | "fm" => Ok(PeakForceSweepParam::ModulationFrequency),
+            other => Err(format!(
+                "unknown peakforce sweep `{other}`: z_c or modulation_frequency"
+            )),
+        }
+    }
+}
+
+/// A sweep of the steady tap: the quantity and its values, in the request's units (m or Hz
+/// with a probe; g₀ or Ω without).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[serde(deny_unknown_fields)]
+pub struct PeakForceSweep {
+    /// The swept quantity (not `param`: that keyword names a model parameter,
+    /// [`crate::SweepParam`]).
+    pub quantity: PeakForceSweepParam,
+    /// Its values, in the order the chain visits them (1..=10000 of them).
+    pub values: Vec<f64>,
+}
+
+impl PeakForceSweep {
+    /// The values from `from` to `to` (both included when the step divides the range) in steps
+    /// of |`step`|, towards `to`.
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming `step` when it is not finite and > 0 or gives more than
+    /// [`MAX_SWEEP_POINTS`] values; [`SimError::NotFinite`] for an end that is not finite.
+    pub fn grid(from: f64, to: f64, step: f64) -> Result<Vec<f64>, SimError> {
+        crate::error::finite("from", from)?;
+        crate::error::finite("to", to)?;
+        let step = step.abs();
+        if !(step.is_finite() && step > 0.0) {
+            return Err(SimError::out_of_range(
+                "step",
+                step,
+                "must be finite and ≠ 0",
+            ));
+        }
+        // one part in 1e9 of a step forgiven: 0.1 steps of 1.0 give 11 values
+        let n = ((to - from).abs() / step * (1.0 + 1e-9)).floor();
+        if n + 1.0 > MAX_SWEEP_POINTS as f64 {
+            return Err(SimError::out_of_range(
+                "step",
+                step,
+                format!("gives more than {MAX_SWEEP_POINTS} values from `from` to `to`"),
+            ));
+        }
+        let dir = if to >= from { step } else { -step };
+        Ok((0..=n as usize).map(|k| from + dir * k as f64).collect())
+    }
+}
+
+/// A channel of a sweep's tap as reported (`None`: the point failed).
+type Channel = fn(&SweepTap, &CurveUnits) -> Option<f64>;
+
+/// The channels of the sweep's document and layout: (name, unit kind, long name, value).
+const CHANNELS: [(&str, &str, &str, Channel); 9] = [
+    ("peak_force", "force", "peak force", |t, u| {
+        t.tap.as_ref().map(|t| t.channels.peak_force * u.force)
+    }),
+    (
+        "adhesion",
+        "force",
+        "adhesion (most negative force)",
+        |t, u| t.tap.as_ref().map(|t| t.channels.adhesion * u.force),
+    ),
+    ("deformation", "length", "largest indentation", |t, u| {
+        t.tap.as_ref().map(|t| t.channels.deformation * u.length)
+    }),
+    (
+        "dissipation",
+        "energy",
+        "tip-sample work per cycle",
+        |t, u| t.tap.as_ref().map(|t| t.channels.dissipation * u.energy),
+    ),
+    (
+        "contact_time",
+        "time",
+        "time in contact per cycle",
+        |t, u| t.tap.as_ref().map(|t| t.channels.contact_time * u.time),
+    ),
+    (
+        "snap_off_time",
+        "time",
+        "snap-off from the largest separation",
+        |t, u| t.tap.as_ref().map(|t| t.channels.snap_off_time * u.time),
+    ),
+    (
+        "ringing_amplitude",
+        "length",
+        "ringing after snap-off",
+        |t, u| {
+            t.tap
+                .as_ref()
+                .map(|t| t.channels.ringing_amplitude * u.length)
+        },
+    ),
+    (
+        "taps_per_cycle",
+        "1",
+        "contacts per modulation period",
+        |t, _| t.tap.as_ref().map(|t| t.channels.taps_per_cycle),
+    ),
+    ("z_c", "length", "mean rest separation", |t, u| {
+        Some(t.params.rest_distance() * u.length)
+    }),
+];
+
+/// The unit of a kind under `u`.
+fn unit(kind: &str, si: bool) -> &'static str {
+    match (kind, si) {
+        ("force", true) => "N",
+        ("force", false) => "F",
+        ("length", true) => "m",
+        ("length", false) => "g0",
+        ("energy", true) => "J",
+        ("energy", false) => "F·g0",
+        ("time", true) => "s",
+        ("time", false) => "τ",
+        ("modulus", true) => "Pa",
+        ("modulus", false) => "α4 (Hertz group)",
+        _ => "1",
+    }
+}
+
+/// The `sweep` block of the document: the swept quantity and its values, each channel (and
+/// `z_c`, the feedback's with a setpoint) over them (`null` where a point failed), the fitted
+/// modulus `modulus_dmt` (`modulus_scale` × the fitted Hertz group: the reduced modulus in Pa
+/// with a probe), the orbit's period and stability, and each point's message (`null` when
+/// computed).
+pub fn sweep_document(
+    sweep: &PeakForceSweep,
+    u: &CurveUnits,
+    modulus_scale: Option<f64>,
+    taps: &[SweepTap],
+) -> Value {
+    let mut channels = serde_json::Map::new();
+    let mut units = serde_json::Map::new();
+    for (name, kind, _, f) in CHANNELS {
+        let v: Vec<Option<f64>> = taps.iter().map(|t| f(t, u)).collect();
+        channels.insert(name.into(), json!(v));
+        units.insert(name.into(), json!(unit(kind, u.si)));
+    }
+    let modulus: Vec<Option<f64>> = taps
+        .iter()
+        .map(|t| {
+            let k = t.tap.as_ref()?.fit?.hertz_group;
+            modulus_scale.map(|s| k * s)
+        })
+        .collect();
+    channels.insert("modulus_dmt".into(), json!(modulus));
+    units.insert("modulus_dmt".into(), json!(unit("modulus", u.si)));
+    json!({
+        "quantity": sweep.quantity.name(),
+        "unit": sweep.quantity.unit(u.si),
+        "values": sweep.values,
+        "channels": channels,
+        "units": units,
+        "period": taps.iter().map(|t| t.tap.as_ref().map(|t| t.period)).collect::<Vec<_>>(),
+        "stable": taps.iter().map(|t| t.tap.as_ref().map(|t| t.stable)).collect::<Vec<_>>(),
+        "transient_periods": taps.iter().map(|t| t.tap.as_ref().map(|t| t.transient_periods)).collect::<Vec<_>>(),
+        "evaluations": taps.iter().map(|t| t.evaluations).collect::<Vec<_>>(),
+        "message": taps.iter().map(|t| t.message.clone()).collect::<Vec<_>>(),
+    })
+}
+
+/// The sweep's layout from the document's `sweep` block: the values as the coordinate of the
+/// dimension named after the swept quantity, every channel over it (NaN where a point
+/// failed), and `period` (0 where a point failed).
+pub fn sweep_layout(block: &Value) -> Layout {
+    let dim = block["quantity"].as_str().unwrap_or("value").to_string();
+    let nums = |v: &Value| -> Vec<f64> {
+        v.as_array().map_or(Vec::new(), |a| {
+            a.iter().map(|x| x.as_f64().unwrap_or(f64::NAN)).collect()
+        })
+    };
+    let values = nums(&block["values"]);
+    let n = values.len();
+    let d = [dim.as_str()];
+    let mut variables = vec![Variable::f64(
+        &dim,
+        &d,
+        block["unit"].as_str().unwrap_or(""),
+        format!("swept {dim}"),
+        &values,
+    )];
+    let units = &block["units"];
+    let mut names: Vec<&str> = CHANNELS.iter().map(|c| c.0).collect();
+    names.push("modulus_dmt");
+    for name in names {
+        // the swept z_c is the coordinate itself
+        if name == dim {
+            continue;
+        }
+        let long = CHANNELS
+            .iter()
+            .find(|c| c.0 == name)
+            .map_or("fitted DMT modulus of the retract (PF-QNM)", |c| c.2);
+        variables.push(Variable::f64(
+            name,
+            &d,
+            units[name].as_str().unwrap_or(""),
+            long,
+            &nums(&block["channels"][name]),
+        ));
+    }
+    let period: Vec<f64> = block["period"].as_array().map_or(Vec::new(), |a| {
+        a.iter().map(|x| x.as_f64().unwrap_or(0.0)).collect()
+    });
+    variables.push(Variable::new(
+        "period",
+        &d,
+        "modulation periods",
+        "period of the orbit (0: the point failed)",
+        Values::F64(period),
+    ));
+    Layout::new("peakforce sweep", &[(dim.as_str(), n)], variables)
+}
