@@ -12,7 +12,9 @@ use super::image::{
     background_probe, curves_cost, image, setpoint_study, Image, ImageRequest, SampleMap,
     SetpointStudy,
 };
-use super::image_scan::{resolve, PiImage, PiScan, ScanRecipe, ScanStudy};
+#[cfg(feature = "files")]
+use super::image_scan::ScanRecipe;
+use super::image_scan::{resolve, PiImage, PiScan, ScanStudy};
 use super::limits::{check_threads, Cost};
 use super::named::Outcome;
 use super::present::Files;
@@ -111,6 +113,7 @@ impl ImageKeywords {
     ///
     /// # Errors
     /// [`SimError::Probe`] for a probe text that is not TOML; the sample map's errors.
+    #[cfg(feature = "files")] // (a sample map may name a file)
     pub fn inputs(&self, probe: &str) -> Result<(toml::Table, SampleMap), SimError> {
         let table = crate::probe::Probe::table(probe, "probe")
             .map_err(|e| SimError::Probe(format!("probe {e}")))?;
@@ -121,6 +124,7 @@ impl ImageKeywords {
         Ok((table, map))
     }
 
+    #[cfg(feature = "files")] // (a sample map may name a file)
     fn request(&self) -> ImageRequest {
         ImageRequest::with(self.setpoint, self.pixels, self.lines, self.curve_points)
     }
@@ -129,6 +133,7 @@ impl ImageKeywords {
     ///
     /// # Errors
     /// As [`ImageKeywords::inputs`].
+    #[cfg(feature = "files")] // (a sample map may name a file)
     pub fn job(self, probe: &str) -> Result<ImageJob, SimError> {
         let (probe, sample) = self.inputs(probe)?;
         Ok(ImageJob {
@@ -146,6 +151,7 @@ impl ImageKeywords {
     ///
     /// # Errors
     /// As [`ImageKeywords::inputs`].
+    #[cfg(feature = "files")] // (a sample map may name a file)
     pub fn scan(self, probe: &str) -> Result<ScanRecipe, SimError> {
         let (probe, map) = self.inputs(probe)?;
         Ok(ScanRecipe {
