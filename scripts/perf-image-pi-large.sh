@@ -89,8 +89,9 @@ print("cores, or on Dask workers) and the image is the same bit for bit at any t
 print("on Dask (tests: `the_scan_does_not_depend_on_the_thread_count`,")
 print("`test_the_dask_scan_equals_the_local_scan`). The floor is the cost of a period of the same lever tapping at a fixed z_c"
       " of the same lever;")
-print("the scan's period costs more by the tip–sample contact each period, the lock-in's samples and"
-      " a new model and integrator at each period's piezo height.")
+print("the scan's period differs from it by the lock-in's samples (read from the integrator's dense"
+      " output) and the gap moved in place at each period's piezo height (one model and integrator"
+      " per material and line).")
 load = open(sys.argv[6]).read().split()
 print(f"`bash scripts/perf-image-pi-large.sh` on this machine (2 cores; load average {load[0]} at the "
       f"start, {load[-1]} at the end: above ~0.5 other work shared the cores and the figures are upper bounds).")
