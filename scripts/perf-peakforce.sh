@@ -26,19 +26,27 @@ farm-bench -n 7 --timeout 600 \
     --vs "$B peakforce --probe $tmp/pm.toml --json --out $tmp/out-pm" \
     -- "$B" peakforce --probe "$tmp/beam.toml" --json --out "$tmp/out-beam" > "$bench"
 cat "$bench"
+# the taps alone: no tables or figures written
+bare="$tmp/bare.txt"
+farm-bench -n 7 --timeout 600 \
+    --vs "$B peakforce --probe $tmp/pm.toml --json --files none" \
+    -- "$B" peakforce --probe "$tmp/beam.toml" --json --files none > "$bare"
+cat "$bare"
 # the documents, for the taps' facts
 "$B" peakforce --probe "$tmp/pm.toml" --json --out "$tmp/out-pm" > "$tmp/pm.json"
 "$B" peakforce --probe "$tmp/beam.toml" --json --out "$tmp/out-beam" > "$tmp/beam.json"
 
 section=$(mktemp)
-python3 - "$bench" "$tmp/pm.json" "$tmp/beam.json" > "$section" <<'PY'
+python3 - "$bench" "$tmp/pm.json" "$tmp/beam.json" "$bare" > "$section" <<'PY'
 import json, sys
-lines = open(sys.argv[1]).read().splitlines()
-med = {}
-for l in lines:
-    parts = l.split()
-    if len(parts) >= 5 and parts[0] in ("A", "B", "A/B") and parts[1] in ("cpu", "wall"):
-        med[(parts[0], parts[1])] = float(parts[-2])
+def medians(path):
+    med = {}
+    for l in open(path).read().splitlines():
+        parts = l.split()
+        if len(parts) >= 5 and parts[0] in ("A", "B", "A/B") and parts[1] in ("cpu", "wall"):
+            med[(parts[0], parts[1])] = float(parts[-2])
+    return med
+med, bare = medians(sys.argv[1]), medians(sys.argv[4])
 pm, beam = (json.load(open(p)) for p in sys.argv[2:4])
 def facts(d):
     c, o = d["channels"], d["orbit"]
@@ -51,10 +59,14 @@ print("|---|---|---|---|")
 print(f"| point mass | {med[('B', 'wall')] * 1e3:.0f} ms | {med[('B', 'cpu')] * 1e3:.0f} ms | {facts(pm)} |")
 print(f"| beam, N = 3 | {med[('A', 'wall')] * 1e3:.0f} ms | {med[('A', 'cpu')] * 1e3:.0f} ms | {facts(beam)} |")
 print(f"| beam / point mass (pair by pair) | **{med[('A/B', 'wall')]:.2f}×** | {med[('A/B', 'cpu')]:.2f}× | |")
+print(f"| point mass, the tap alone (`--files none`) | {bare[('B', 'wall')] * 1e3:.0f} ms | **{bare[('B', 'cpu')] * 1e3:.0f} ms** | |")
+print(f"| beam, N = 3, the tap alone (`--files none`) | {bare[('A', 'wall')] * 1e3:.0f} ms | {bare[('A', 'cpu')] * 1e3:.0f} ms | |")
+print(f"| beam / point mass, the taps alone | {bare[('A/B', 'wall')]:.2f}× | **{bare[('A/B', 'cpu')]:.2f}×** | |")
 print()
 print("Goals (issue 61): ≤ 50 ms for one steady tap at f0/f_m = 100 on the point mass; the N = 3")
 print("beam ≤ 5× the point mass. The ScanAsyst-Air-like lever of examples/probe-peakforce-air.toml at")
-print("f_m = 700 Hz; whole command (start-up and the JSON document included), farm-bench, 7 runs")
+print("f_m = 700 Hz; whole command (start-up and the JSON document included; the first rows writing")
+print("the tables and rendering the figures, `--files all`), farm-bench, 7 runs")
 print("each in turn, medians; `bash scripts/perf-peakforce.sh` on this machine (2 cores, shared).")
 print("<!-- peakforce:end -->")
 PY
