@@ -118,6 +118,8 @@ def test_an_instrument_curve_read_by_afmformats_fits_as_its_columns(tmp_path):
         assert np.array_equal(ds["estimate"].values, columns["estimate"].values)
     with pytest.raises(ValueError, match="curve"):
         _fit(data=path, fit=FIT, curve=1)
+    with pytest.raises(ValueError, match="missing.jpk-force"):
+        _fit(data=tmp_path / "missing.jpk-force", fit=FIT)
     # a file calibrated with another spring constant is named (the probe's is used)
     other = tmp_path / "other.h5"
     _afmformats_curve(afmformats, h, f, k=2 * K).export_data(str(other), fmt="hdf5")

@@ -139,7 +139,10 @@ def _instrument_curve(data: Any, curve: int) -> Tuple[Any, Optional[float], Opti
         except ImportError as e:
             raise ValueError(f"data: reading {os.fspath(data)!r} needs the afmformats package "
                              "(pip install afmformats)") from e
-        size = os.stat(data).st_size
+        try:
+            size = os.stat(data).st_size
+        except OSError as e:
+            raise ValueError(f"data: {os.fspath(data)!r}: {e.strerror}") from e
         if size > _MAX_INSTRUMENT_FILE:
             raise ValueError(f"data: {os.fspath(data)!r} is {size} bytes, over the "
                              f"{_MAX_INSTRUMENT_FILE >> 20} MiB read for one instrument file")
@@ -160,7 +163,8 @@ def _instrument_curve(data: Any, curve: int) -> Tuple[Any, Optional[float], Opti
     approach = None
     if "segment" in columns:
         retract = np.flatnonzero(np.asarray(data["segment"]) != 0)
-        approach = int(retract[0]) if retract.size else None
+        # (no retract, or a curve that starts retracting: the library's default)
+        approach = int(retract[0]) if retract.size and retract[0] > 0 else None
     return {"height": np.asarray(data[heights[0]], dtype=float),
             "force": np.asarray(data["force"], dtype=float)}, k_file, approach
 
