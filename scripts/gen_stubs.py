@@ -7,7 +7,8 @@ JSON Schemas (``docs/schema/requests/*.json``, written by
 type and default. This script writes, between the markers in
 ``crates/afmdyn-py/python/afmdyn/_afmdyn.pyi``, a ``TypedDict`` per request (its keys, types
 and defaults), the overloads of the one door ``run`` and of ``run_stored`` (the studies run into
-a store; one per analysis' name).
+a store; one per analysis' name); and, through ``scripts/gen_wrappers.py``, the modules
+``afmdyn/_wrappers.py`` and ``afmdyn/_dask_wrappers.py`` of the analyses' public functions.
 
     python3 scripts/gen_stubs.py          # rewrite the generated block
     python3 scripts/gen_stubs.py --check  # exit 1 when it is stale (the Python tests run this)
@@ -19,6 +20,9 @@ import json
 import re
 import sys
 from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import gen_wrappers  # noqa: E402  (the analyses' public functions, afmdyn/_wrappers.py)
 
 ROOT = Path(__file__).resolve().parent.parent
 SCHEMAS = ROOT / "docs" / "schema" / "requests"
@@ -129,8 +133,9 @@ def generate() -> str:
     return "\n\n".join(out) + "\n"
 
 
-#: the Python files whose ``contact_law`` annotations list the laws
-LAW_LISTS = [STUB, ROOT / "crates" / "afmdyn-py" / "python" / "afmdyn" / "_common.py"]
+#: the Python files whose ``contact_law`` annotations list the laws (``afmdyn.Model``'s is
+#: generated from the model schema, ``scripts/gen_wrappers.py``)
+LAW_LISTS = [STUB]
 
 
 def law_literal() -> str:
@@ -154,10 +159,13 @@ def main() -> int:
         return 2
     _, sep, tail = rest.partition(END + "\n")
     new = {STUB: with_laws(head + generate() + tail)}
+    for f in gen_wrappers.FILES:
+        new[gen_wrappers.PACKAGE / f] = gen_wrappers.generate(f)
+    new[gen_wrappers.PACKAGE / "_model.py"] = gen_wrappers.generate_model()
     for path in LAW_LISTS[1:]:
         new[path] = with_laws(path.read_text())
     if "--check" in sys.argv[1:]:
-        stale = [p for p, t in new.items() if t != p.read_text()]
+        stale = [p for p, t in new.items() if not p.exists() or t != p.read_text()]
         for p in stale:
             print(f"{p.relative_to(ROOT)} is stale: run python3 scripts/gen_stubs.py",
                   file=sys.stderr)

@@ -26,32 +26,34 @@ model keywords.
 """
 
 from ._afmdyn import Params, SimulationError
-from ._api import (
-    approach,
-    bimodal,
-    bifurcation,
-    continuation,
-    converge,
-    modes,
-    observe,
-    probe,
-    resonance,
-    simulate,
-)
-from ._attractors import Attractor, Attractors, attractors
-from ._basins import basins
+from ._api import probe
+from ._attractors import Attractor, Attractors
 from ._cantilevers import cantilevers
-from ._chart import chart
-from ._global_continuation import global_continuation
 from ._common import AfmdynWarning, Model, summary
 from ._interrupt import cancel_running
 from ._interrupt import install as _install_sigint
-from ._orbits import lyapunov, orbit
-from ._fm import fm
-from ._peakforce import peakforce
 from ._fit import fit
 from ._image import image, setpoint_study
 from ._reconstruct import reconstruct
+from ._wrappers import (
+    approach,
+    attractors,
+    basins,
+    bifurcation,
+    bimodal,
+    chart,
+    continuation,
+    converge,
+    fm,
+    global_continuation,
+    lyapunov,
+    modes,
+    observe,
+    orbit,
+    peakforce,
+    resonance,
+    simulate,
+)
 from ._results import Lyapunov, Orbit, RegionSpectrum, Spectrum
 
 try:

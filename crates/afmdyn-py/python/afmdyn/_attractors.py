@@ -12,16 +12,12 @@ import numpy as np
 
 from ._afmdyn import Params
 from . import _layout
-from ._api import simulate
-from ._common import _DEFAULTS, Model, _door, _params, _request, _typed
-from ._orbits import orbit
-from ._progress import ProgressArg
+from ._common import _door, _params, _request
 from ._results import Orbit, _Document
 
 if TYPE_CHECKING:
     import pandas as pd
     import xarray as xr
-    from typing_extensions import Unpack
 
 
 @dataclass(frozen=True, repr=False)
@@ -77,6 +73,8 @@ class Attractor:
     def orbit(self, **options: Any) -> "Orbit":
         """Newton shooting from this attractor (its period, starting on it): Floquet
         multipliers and stability. Options as :func:`afmdyn.orbit`."""
+        from ._wrappers import orbit  # the public function (generated; imports this)
+
         return orbit(self.params, initial=self, **options)
 
     def simulate(self, periods: Optional[float] = None, **options: Any) -> "xr.Dataset":
@@ -85,6 +83,8 @@ class Attractor:
         Options as :func:`afmdyn.simulate`."""
         if periods is None:
             periods = max(self.period or 8, 2)
+        from ._wrappers import simulate
+
         return simulate(self.params, periods=periods, initial=self.state, **options)
 
     def __repr__(self) -> str:
@@ -164,36 +164,10 @@ class Attractors(_Document, Sequence[Attractor]):
         )
 
 
-@_typed
-def attractors(
-    params: Optional[Params] = None,
-    /,
-    *,
-    samples: int = _DEFAULTS["attractors"]["samples"],
-    seed: int = _DEFAULTS["attractors"]["seed"],
-    cluster_tol: float = _DEFAULTS["attractors"]["cluster_tol"],
-    tol: float = _DEFAULTS["attractors"]["tol"],
-    max_periods: Optional[int] = None,
-    max_period: int = _DEFAULTS["attractors"]["max_period"],
-    integrator: Optional[str] = None,
-    steps_per_period: Optional[int] = None,
-    tolerance: float = _DEFAULTS["attractors"]["tolerance"],
-    progress: ProgressArg = None,
-    **model: Unpack[Model],
-) -> Attractors:
-    """Coexisting attractors and basin fractions (paper Figs. 6–17, ``afmdyn attractors``)
-    from ``samples`` seeded random initial states, in parallel.
-
-    Returns:
-        :class:`Attractors`, a sequence of :class:`Attractor` (most frequent first);
-        ``to_dict()`` is ``afmdyn attractors --json``, ``to_dataframe()`` a summary table.
-
-    ``progress``: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a
-    log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.
-    """
-    req = _request(locals())
-    p, probe = _params(params, model)
-    d = _door("attractors", "attractors", progress, p, probe, req)
+def _finish_attractors(a: Dict[str, Any]) -> Attractors:
+    req = _request(a)
+    p, probe = _params(a["params"], a["model"])
+    d = _door("attractors", "attractors", a["progress"], p, probe, req)
     doc = json.loads(d["json"])
     # each attractor's layout (attractor-1, …): its arrays, and its scalars as Python's
     found_arrays = [
@@ -204,4 +178,4 @@ def attractors(
         Attractor(params=p, period=entry["period"], _doc=entry, **a)
         for a, entry in zip(found_arrays, doc["attractors"])
     ]
-    return Attractors(p, samples, found, list(d["facts"]["failures"]), d["json"])
+    return Attractors(p, a["samples"], found, list(d["facts"]["failures"]), d["json"])

@@ -1,6 +1,6 @@
 """What every analysis shares: the model keywords (:class:`Model`), the parameter set and probe
 of a call, the type check of the keywords, the request of the library an analysis' keywords
-become (its defaults, :data:`_DEFAULTS`, are the requests'), the call of the compiled function
+become, the call of the compiled function
 with a progress reporter, and the warnings of its document. It imports no analysis and no
 result type, so that every module of the package can import it."""
 
@@ -12,26 +12,14 @@ import json
 import numbers
 import os
 import warnings
-from typing import (
-    Literal,
-    Any,
-    Callable,
-    Dict,
-    Optional,
-    Protocol,
-    Sequence,
-    Tuple,
-    TypedDict,
-    TypeVar,
-    Union,
-    cast,
-)
+from typing import Any, Callable, Dict, Optional, Protocol, Sequence, Tuple, TypeVar, Union, cast
 
 import numpy as np
 import xarray as xr
 
 from . import _afmdyn as _core
 from ._afmdyn import Params
+from ._model import Model  # noqa: F401 (afmdyn.Model: generated from the model schema)
 from ._progress import ProgressArg, reporter
 
 
@@ -45,52 +33,6 @@ class HasState(Protocol):
 
 #: An initial state: 2N values, or an :class:`Attractor` / :class:`Orbit` (its ``state``).
 StateLike = Union[None, Sequence[float], np.ndarray, HasState]
-
-
-class Model(TypedDict, total=False):
-    """The model keywords every analysis takes (see :class:`Params` for their ranges; the one
-    table of them is ``afmdyn._afmdyn.MODEL_PARAMETERS``). ``probe`` is a probe in SI (the
-    command line's ``--probe``): a file's path, its TOML text (a ``str`` with a line break or
-    ``=``) or a dict of its sections (``{"cantilever": {...}, "sample": {...}, ...}``); it sets
-    every parameter in SI, ``z_c`` (m) and ``drive_frequency`` (Hz) set α5 and Ω through its
-    scales, ``modes`` and ``restitution`` are taken, and the dimensionless keywords of the
-    values it sets (``gap``, ``omega``, the α's, ``hamaker``, ``intermolecular_distance``,
-    ``contact_law``) raise ``ValueError`` naming the probe key or SI keyword to use; the
-    result's ``to_dict()`` then carries the command line's ``"si"`` block. ``cantilever`` names
-    a cantilever of the library (:func:`afmdyn.cantilevers`) for the probe, as
-    ``--cantilever`` does: it fills the keys the probe leaves out and wins over a name in it."""
-
-    modes: int
-    tip_mass_ratio: float
-    alpha1: float
-    drive_amplitude: float
-    alpha2: float
-    beam_damping: float
-    alpha3: float
-    contact_stiffness: float
-    alpha4: float
-    gap: float
-    alpha5: float
-    contact_damping: float
-    alpha6: float
-    omega: float
-    contact_law: Literal["linear", "hertz", "dmt", "electrostatic", "jkr", "capillary", "sls", "impact"]
-    excitation: Literal["base", "tip"]
-    restitution: float
-    hamaker: float
-    intermolecular_distance: float
-    electrostatic: float
-    tip_radius: float
-    adhesion: float
-    capillary: float
-    meniscus: float
-    rupture: float
-    maxwell_stiffness: float
-    z_c: float
-    drive_frequency: float
-    probe: Union[str, "os.PathLike[str]", Dict[str, Any]]
-    cantilever: str
-    medium: str
 
 
 #: Global attributes of every dataset: the scales of the dimensionless units.
@@ -300,16 +242,6 @@ def _door(
             d = _core.run_stored(name, request, p, si, cb, where, resume)
     _warn(d["json"])
     return d
-
-
-#: The defaults of every analysis' keywords: the library's requests' (``Default``).
-_DEFAULTS = {
-    name: _core.request_defaults(name)
-    for name in (
-        "simulate converge bifurcation attractors global_continuation orbit continuation "
-        "lyapunov observe approach resonance basins chart fm"
-    ).split()
-}
 
 
 def summary(ds: xr.Dataset) -> Dict[str, Any]:

@@ -5,17 +5,12 @@ JSON document (no numerics here)."""
 from __future__ import annotations
 
 import json
-from typing import TYPE_CHECKING, Any, Dict, Optional
+from typing import Any, Dict
 
 import numpy as np
 import xarray as xr
 
-from ._afmdyn import Params
-from ._common import _DEFAULTS, Model, _door, _params, _request, _typed
-from ._progress import ProgressArg
-
-if TYPE_CHECKING:  # annotations only (PEP 692)
-    from typing_extensions import Unpack
+from ._common import _door, _params, _request
 
 #: The long names of the curve's variables (the document's ``curve`` arrays).
 _LONG = {
@@ -69,57 +64,8 @@ def fm_dataset(doc: Dict[str, Any]) -> xr.Dataset:
     )
 
 
-@_typed
-def fm(
-    params: Optional[Params] = None,
-    /,
-    *,
-    amplitude: Optional[float] = None,
-    mode: int = _DEFAULTS["fm"]["mode"],
-    from_: Optional[float] = None,
-    to: Optional[float] = None,
-    step: Optional[float] = None,
-    points: Optional[int] = None,
-    tolerance: float = _DEFAULTS["fm"]["tolerance"],
-    progress: ProgressArg = None,
-    **model: Unpack[Model],
-) -> xr.Dataset:
-    """The frequency-modulation (FM-AFM) curve at constant amplitude over the rest distance
-    z_c (``afmdyn fm``): at each z_c the exact periodic orbit of the cantilever driven at the
-    frequency where its first harmonic lags the drive by the free lever's phase at resonance
-    (an ideal PLL), with the excitation that holds the first-harmonic amplitude at ``amplitude``
-    (an ideal amplitude controller), continued from the previous z_c.
-
-    Args:
-        amplitude: the oscillation amplitude A (m with ``probe``, else g₀; default the probe's
-            free amplitude A₀).
-        mode: the mode K the PLL tracks (1..N).
-        from_, to: the z_c range, m with ``probe``, else g₀ (default: from where the frequency
-            shift has decayed to 0.5 % of its value at ``to`` — Giessibl's first-order shift of
-            the law's force; 2A + a₀ for a law without a force before contact — down to
-            A + a₀, the lower turning point at the contact distance a₀).
-        step, points: the grid (a step in the same unit, or the number of values; default 120).
-        tolerance: of the loop conditions, |A₁/A − 1| and the phase error (rad).
-        probe: a probe file (a model keyword, as ``--probe``): SI inputs and outputs.
-
-    Returns:
-        An ``xarray.Dataset`` over ``z_c``: ``frequency_shift`` (Hz with a probe),
-        ``frequency``, ``excitation`` (relative to the free lever's), ``amplitude``,
-        ``phase_deg``, ``energy_dissipated``, ``virial``, ``mean_deflection``,
-        ``min_distance``, ``peak_force``, ``mean_force``, ``indentation``,
-        ``max_multiplier``, ``stable``, ``loop_residual``, ``iterations``; attributes
-        ``spring_constant``, ``resonance_frequency``, ``amplitude``, ``mode``, ``folds_z_c``
-        and ``summary`` (the ``afmdyn fm --json`` document). A z_c not reached ends the curve
-        with an :class:`afmdyn.AfmdynWarning`. ``afmdyn.reconstruct(fm=ds)`` inverts it.
-
-    Raises:
-        ValueError: naming the option (``amplitude``, ``mode``, ``tolerance``, ``from``, ``to``,
-            ``step``, ``points``) or the model parameter.
-
-    ``progress``: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a
-    log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.
-    """
-    request = _request(locals())
-    p, probe = _params(params, model)
-    d = _door("fm", "fm", progress, p, probe, request)
+def _finish_fm(a: Dict[str, Any]) -> xr.Dataset:
+    request = _request(a)
+    p, probe = _params(a["params"], a["model"])
+    d = _door("fm", "fm", a["progress"], p, probe, request)
     return fm_dataset(json.loads(d["json"]))

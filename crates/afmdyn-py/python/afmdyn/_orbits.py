@@ -1,69 +1,25 @@
-"""Periodic orbits and the Lyapunov spectrum: :func:`orbit` (Newton shooting, Floquet
-multipliers) and :func:`lyapunov`."""
+"""The finishers of :func:`afmdyn.orbit` (Newton shooting, Floquet multipliers) and
+:func:`afmdyn.lyapunov` (their public functions are generated, :mod:`._wrappers`)."""
 
 from __future__ import annotations
 
 import json
-from typing import TYPE_CHECKING, Optional
+from typing import Any, Dict
 
 import numpy as np
 
 from . import _layout
-from ._afmdyn import Params
-from ._common import (
-    _DEFAULTS,
-    Model,
-    StateLike,
-    _door,
-    _params,
-    _request,
-    _start,
-    _start_period,
-    _state,
-    _typed,
-)
-from ._progress import ProgressArg
+from ._common import _door, _params, _request, _start, _start_period, _state
 from ._results import Lyapunov, Orbit
 
-if TYPE_CHECKING:
-    from typing_extensions import Unpack
 
-
-@_typed
-def orbit(
-    params: Optional[Params] = None,
-    /,
-    *,
-    period: Optional[int] = None,
-    initial: StateLike = None,
-    tol: float = _DEFAULTS["orbit"]["steady"]["tol"],
-    max_periods: Optional[int] = None,
-    max_period: int = _DEFAULTS["orbit"]["steady"]["max_period"],
-    progress: ProgressArg = None,
-    **model: Unpack[Model],
-) -> Orbit:
-    """A period-n orbit by Newton shooting, with Floquet multipliers (``afmdyn orbit``).
-
-    Args:
-        period: n (1..=64); default: the period of the steady state reached from rest (or
-            the attractor's period when ``initial`` is an :class:`Attractor`), else 1.
-        initial: start of Newton's iteration (``[2N]``, an :class:`Attractor` or an
-            :class:`Orbit`); default: the steady state reached from rest.
-        tol, max_periods, max_period: steady-state detection for the default start.
-
-    Returns:
-        :class:`Orbit`; ``to_dict()`` is ``afmdyn orbit --json``. Raises
-        :class:`SimulationError` when Newton's method does not converge.
-
-    ``progress``: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a
-    log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.
-    """
-    names = dict(locals())
-    p, probe = _params(params, model)
-    if period is None:
-        period = _start_period(initial)
-    req = _start(_request(names, period=period, initial=_state(initial)))
-    d = _door("orbit", "orbit", progress, p, probe, req)
+def _finish_orbit(a: Dict[str, Any]) -> Orbit:
+    p, probe = _params(a["params"], a["model"])
+    period = a["period"]
+    if period is None:  # an Attractor's own period
+        period = _start_period(a["initial"])
+    req = _start(_request(a, period=period, initial=_state(a["initial"])))
+    d = _door("orbit", "orbit", a["progress"], p, probe, req)
     doc = json.loads(d["json"])
     v = {k: x[1] for k, x in _layout.variables(d["datasets"]["orbit"]).items()}
     return Orbit(
@@ -85,31 +41,10 @@ def orbit(
     )
 
 
-@_typed
-def lyapunov(
-    params: Optional[Params] = None,
-    /,
-    *,
-    initial: StateLike = None,
-    transient: Optional[int] = None,
-    periods: int = _DEFAULTS["lyapunov"]["periods"],
-    blocks: int = _DEFAULTS["lyapunov"]["blocks"],
-    progress: ProgressArg = None,
-    **model: Unpack[Model],
-) -> Lyapunov:
-    """Lyapunov spectrum (tangent dynamics with saltation matrices) and the 0–1 test for chaos
-    (``afmdyn lyapunov``), from ``initial`` (default rest) after ``transient`` drive periods,
-    averaged over ``periods`` in ``blocks`` blocks (periods ≥ blocks ≥ 2).
-
-    Returns:
-        :class:`Lyapunov`; ``to_dict()`` is ``afmdyn lyapunov --json``.
-
-    ``progress``: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a
-    log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.
-    """
-    req = _request(locals(), initial=_state(initial))
-    p, probe = _params(params, model)
-    d = _door("lyapunov", "lyapunov", progress, p, probe, req)
+def _finish_lyapunov(a: Dict[str, Any]) -> Lyapunov:
+    req = _request(a, initial=_state(a["initial"]))
+    p, probe = _params(a["params"], a["model"])
+    d = _door("lyapunov", "lyapunov", a["progress"], p, probe, req)
     doc = json.loads(d["json"])
     v = _layout.variables(d["datasets"]["lyapunov"])
     return Lyapunov(

@@ -23,8 +23,7 @@ import functools
 import json
 import os
 import time
-from typing import (TYPE_CHECKING, Any, Dict, Iterable, Iterator, List, Optional, Sequence,
-                    Set, Union)
+from typing import Any, Dict, Iterable, Iterator, List, Optional, Sequence, Set
 
 import numpy as np
 import xarray as xr
@@ -33,7 +32,7 @@ from . import _afmdyn as _core
 from ._afmdyn import Params
 from . import _layout
 from ._chart import dataset, study
-from ._common import _DEFAULTS, _request
+from ._common import _request
 from ._progress import ProgressArg, reporter
 
 try:
@@ -42,11 +41,6 @@ except ImportError as e:  # pragma: no cover - depends on the installation
     raise ImportError(
         'afmdyn.dask needs dask.distributed and zarr: pip install "afmdyn[dask]"'
     ) from e
-
-if TYPE_CHECKING:
-    from typing_extensions import Unpack
-
-    from ._api import Model
 
 #: The file of finished tasks, in the store's ledger directory ``STORE.afmdyn``.
 DONE = "done"
@@ -219,48 +213,11 @@ def _map(
             cb(finished, total)
 
 
-def chart(
-    params: Optional[Params] = None,
-    /,
-    *,
-    client: Optional["distributed.Client"] = None,
-    store: Union[str, "os.PathLike[str]", None] = None,
-    resume: bool = True,
-    checkpoint_seconds: float = 2.0,
-    x: str = _DEFAULTS["chart"]["x"],
-    x_from: float = _DEFAULTS["chart"]["x_from"],
-    x_to: float = _DEFAULTS["chart"]["x_to"],
-    x_steps: int = _DEFAULTS["chart"]["x_steps"],
-    y: str = _DEFAULTS["chart"]["y"],
-    y_from: float = _DEFAULTS["chart"]["y_from"],
-    y_to: float = _DEFAULTS["chart"]["y_to"],
-    y_steps: int = _DEFAULTS["chart"]["y_steps"],
-    starts: int = _DEFAULTS["chart"]["starts"],
-    seed: int = _DEFAULTS["chart"]["seed"],
-    tile: int = _DEFAULTS["chart"]["tile"],
-    cluster_tol: float = _DEFAULTS["chart"]["cluster_tol"],
-    lyapunov_periods: int = _DEFAULTS["chart"]["lyapunov_periods"],
-    max_attractors: int = _DEFAULTS["chart"]["max_attractors"],
-    tol: float = _DEFAULTS["chart"]["tol"],
-    max_periods: Optional[int] = None,
-    max_period: int = _DEFAULTS["chart"]["max_period"],
-    integrator: Optional[str] = None,
-    steps_per_period: Optional[int] = None,
-    tolerance: float = _DEFAULTS["chart"]["tolerance"],
-    progress: ProgressArg = None,
-    **model: "Unpack[Model]",
-) -> xr.Dataset:
-    """:func:`afmdyn.chart` with its tasks mapped over a Dask cluster: ``client`` (default: a
-    ``LocalCluster`` of this machine's cores, closed at the end). With ``store`` (a Zarr
-    directory, locked during the run) each finished task is written there at once and a
-    rerun resumes (``resume=False`` starts the store over); another request on the same store
-    is refused, naming the first option that differs. Finished tasks reach the store in
-    batches, at least every ``checkpoint_seconds`` (0: each task as it arrives) and at the
-    end: a killed driver loses at most that much work.
-
-    Returns the same ``xarray.Dataset`` as :func:`afmdyn.chart` with the same arguments.
-    """
-    request = _request(locals())
+def _finish_chart(a: Dict[str, Any]) -> xr.Dataset:
+    """Run the chart of :func:`afmdyn.dask.chart`'s keywords ``a`` (its ``locals()``)."""
+    params, model, client, progress = a["params"], a["model"], a["client"], a["progress"]
+    store, resume, checkpoint_seconds = a["store"], a["resume"], a["checkpoint_seconds"]
+    request = _request(a)
     for own in ("client", "checkpoint_seconds"):
         del request[own]
     s = study(params, model, **request)
@@ -352,47 +309,12 @@ def _run_plan(
     return store.outcome()
 
 
-def bifurcation(
-    params: Optional[Params] = None,
-    /,
-    *,
-    client: Optional["distributed.Client"] = None,
-    store: Union[str, "os.PathLike[str]", None] = None,
-    resume: bool = True,
-    param: str = _DEFAULTS["bifurcation"]["param"],
-    from_: float = _DEFAULTS["bifurcation"]["from"],
-    to: float = _DEFAULTS["bifurcation"]["to"],
-    steps: int = _DEFAULTS["bifurcation"]["steps"],
-    values: Optional[Sequence[float]] = None,
-    starts: int = _DEFAULTS["bifurcation"]["starts"],
-    seed: int = _DEFAULTS["bifurcation"]["seed"],
-    continuation: bool = _DEFAULTS["bifurcation"]["continuation"],
-    tol: float = _DEFAULTS["bifurcation"]["tol"],
-    max_periods: Optional[int] = None,
-    max_period: int = _DEFAULTS["bifurcation"]["max_period"],
-    integrator: Optional[str] = None,
-    steps_per_period: Optional[int] = None,
-    tolerance: float = _DEFAULTS["bifurcation"]["tolerance"],
-    progress: ProgressArg = None,
-    **model: "Unpack[Model]",
-) -> xr.Dataset:
-    """:func:`afmdyn.bifurcation` with its tasks mapped over a Dask cluster (``client``;
-    default a ``LocalCluster`` of this machine's cores, closed at the end): the two coarse
-    continuation passes first, then every chain segment and random start, seeded by them.
-
-    With ``store`` (a directory, locked during the run) the sweep is kept in the command
-    line's layout (``afmdyn bifurcation --out DIR``): each finished task's points are
-    appended as they arrive, and a rerun with the same request resumes — from a run of this
-    function, of ``afmdyn.bifurcation(store=...)`` or of the command line — computing only the
-    tasks with points not stored (``resume=False`` starts over; another request is refused).
-
-    Returns the same ``xarray.Dataset`` as :func:`afmdyn.bifurcation` with the same
-    arguments, bit for bit.
-
-    ``progress``: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a
-    log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.
-    """
-    request = _request(locals())
+def _finish_bifurcation(a: Dict[str, Any]) -> xr.Dataset:
+    """Run the sweep of :func:`afmdyn.dask.bifurcation`'s keywords ``a`` (its ``locals()``)."""
+    params, model, client, progress = a["params"], a["model"], a["client"], a["progress"]
+    store, resume, values = a["store"], a["resume"], a["values"]
+    starts, seed = a["starts"], a["seed"]
+    request = _request(a)
     del request["client"]
     if values is not None:
         request["values"] = np.asarray(values, dtype=np.float64).ravel().tolist()
@@ -433,7 +355,7 @@ def basins(
     import inspect
 
     from ._basins import _dataset
-    from ._basins import basins as local
+    from ._wrappers import basins as local
     from ._common import _params
 
     # the map's keywords are those of afmdyn.basins; the others are the model's (as there)
@@ -487,3 +409,7 @@ __all__ = [
     "run_chart_task",
     "run_plan_task",
 ]
+
+
+# the public chart and bifurcation: generated from the requests (they call the finishers above)
+from ._dask_wrappers import bifurcation, chart  # noqa: E402

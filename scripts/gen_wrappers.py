@@ -1,0 +1,290 @@
+"""Generate ``afmdyn/_wrappers.py``: the public analysis functions of the Python package.
+
+Each function's keyword-only signature (names, types, defaults) and the "Args:" of its
+docstring come from its request's JSON Schema (``docs/schema/requests/*.json``, the library's
+request types: field types, ``Default``, doc comments); its summary, "Returns" and "Raises"
+come from :data:`DOCS` below. The body hands ``locals()`` to a hand-written finisher
+(``_finish_<name>`` in the module named by :data:`ANALYSES`) that runs the request through
+the one door (``_afmdyn.run``) and builds the result. ``scripts/gen_stubs.py`` calls
+:func:`generate` and writes (or, with ``--check``, compares) the file.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import sys
+import textwrap
+from pathlib import Path
+from typing import Dict, List, Tuple
+
+ROOT = Path(__file__).resolve().parent.parent
+SCHEMAS = ROOT / "docs" / "schema" / "requests"
+PACKAGE = ROOT / "crates" / "afmdyn-py" / "python" / "afmdyn"
+
+STORE = 'Union[str, "os.PathLike[str]", None]'
+#: Python's own keywords (annotation, default), after the request's
+STORE_KW = [("store", STORE, "None"), ("resume", "bool", "False")]
+PROGRESS = [("progress", "ProgressArg", "None")]
+#: the keywords of the Dask versions (``afmdyn.dask``), before the request's
+DASK_KW = [("client", 'Optional["distributed.Client"]', "None"), ("store", STORE, "None"),
+           ("resume", "bool", "True")]
+
+#: the generated modules: file -> the analyses it holds, each name -> (schema stem or None,
+#: finisher, return annotation, options). Options: ``own`` (keywords of Python's own,
+#: (name, annotation, default), documented in :data:`COMMON_ARGS` or ``DOCS[name]["args"]``),
+#: ``first`` (such keywords before the request's), ``omit`` (request fields Python does not
+#: take), ``override`` (a field's annotation and default in Python, wider than the
+#: request's: the finisher converts it), ``typed`` (False: no ``@_typed`` check of the keywords)
+FILES: Dict[str, Dict[str, Tuple[object, str, str, Dict[str, object]]]] = {
+    "_wrappers.py": {
+        "modes": (None, "_api", "Spectrum", {"own": []}),
+        "simulate": ("simulate", "_api", "xr.Dataset", {}),
+        "converge": ("converge", "_api", "xr.Dataset", {}),
+        "bifurcation": ("bifurcation", "_api", "xr.Dataset", {"own": PROGRESS + STORE_KW}),
+        "continuation": ("continuation", "_api", "xr.Dataset", {}),
+        "observe": ("observe", "_api", "xr.Dataset", {}),
+        "approach": ("approach", "_api", "xr.Dataset",
+                     {"own": STORE_KW + PROGRESS, "omit": ("average", "exact")}),
+        "bimodal": ("approach", "_api", "xr.Dataset", {"own": STORE_KW + PROGRESS}),
+        "resonance": ("resonance", "_api", "xr.Dataset", {"own": STORE_KW + PROGRESS}),
+        "orbit": ("orbit", "_orbits", "Orbit", {}),
+        "lyapunov": ("lyapunov", "_orbits", "Lyapunov", {}),
+        "attractors": ("attractors", "_attractors", "Attractors", {}),
+        "basins": ("basins", "_basins", "xr.Dataset", {"own": STORE_KW + PROGRESS}),
+        "global_continuation": ("global_continuation", "_global_continuation", "xr.Dataset",
+                                {"own": STORE_KW + PROGRESS}),
+        "fm": ("fm", "_fm", "xr.Dataset", {}),
+        "chart": ("chart", "_chart", "xr.Dataset", {"own": PROGRESS + STORE_KW}),
+        "peakforce": ("peakforce", "_peakforce", "xr.Dataset", {
+            "omit": ("sweep",), "typed": False,
+            "override": {"z_c": ("Union[float, Sequence[float], None]", "None"),
+                         "fit_band": ("Optional[Sequence[float]]", "None")},
+            "own": [("modulation_frequency", "Optional[Sequence[float]]", "None")] + PROGRESS}),
+    },
+    "_dask_wrappers.py": {
+        "chart": ("chart", "_dask", "xr.Dataset",
+                  {"first": DASK_KW + [("checkpoint_seconds", "float", "2.0")],
+                   "omit": ("threads",), "typed": False}),
+        "bifurcation": ("bifurcation", "_dask", "xr.Dataset",
+                        {"first": DASK_KW, "omit": ("threads",), "typed": False}),
+    },
+}
+
+#: the Python annotation of a keyword whose request type Python widens (the value is
+#: converted by the finisher, or ``None`` stands for the request's default)
+OVERRIDES = {
+    "initial": ("StateLike", "None"),
+    "integrator": ("Optional[str]", "None"),
+}
+
+#: the "Args:" lines of the keywords a request does not describe (Python's own)
+COMMON_ARGS = {
+    "initial": "+An :class:`Attractor` or :class:`Orbit` is also taken (its state at drive "
+               "phase 0).",
+    "store": "a directory for the command line's resumable store (``afmdyn {name} --out DIR``; "
+             "created if needed, started over without ``resume``).",
+    "resume": "continue the study stored in ``store`` from its last stored point (refused, "
+              "naming the first field that differs, for another request's store).",
+    "progress": "``None`` (a bar for runs over a second in a terminal or Jupyter, none in a "
+                "log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.",
+    "model": "the model keywords (:class:`Model`), ``probe=`` a probe in SI.",
+}
+
+#: per analysis: the summary, then the "Returns:"/"Raises:" sections (as they are printed)
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from wrapper_docs import DOCS, MODEL_DOC  # noqa: E402
+
+
+def _clean(text: str) -> str:
+    """A request's doc comment as reStructuredText: rustdoc links become literals."""
+    text = re.sub(r"\[`(?:crate::)?([^`\]]+)`\]", r"``\1``", text)
+    text = re.sub(r"(?<!`)`([^`]+)`(?!`)", r"``\1``", text)
+    return " ".join(text.split())
+
+
+def _literal(value: object) -> str:
+    return json.dumps(value) if isinstance(value, str) else repr(value)
+
+
+def _annotation(prop: dict, defs: dict) -> str:
+    """The Python annotation of a request field."""
+    ref = prop.get("$ref", "")
+    if ref:
+        return "str"  # an enum of names: checked by the library, which lists them
+    t = prop.get("type")
+    types = t if isinstance(t, list) else [t]
+    base = [x for x in types if x != "null"][0]
+    if base == "array":
+        items = prop["items"].get("type")
+        ann = "Sequence[float]" if items == "number" else "Sequence[str]"
+    else:
+        ann = {"integer": "int", "number": "float", "boolean": "bool", "string": "str"}[base]
+    return f"Optional[{ann}]" if "null" in types else ann
+
+
+def _fields(stem: str, omit: Tuple[str, ...], override: Dict[str, Tuple[str, str]]
+            ) -> List[Tuple[str, str, str, str]]:
+    """(keyword, annotation, default, description) of a request's fields, a nested request
+    (``steady``) flattened into its own fields."""
+    schema = json.loads((SCHEMAS / f"{stem}.json").read_text())
+    defs = schema.get("$defs", {})
+    out = []
+    for key, prop in schema.get("properties", {}).items():
+        if key in omit:
+            continue
+        ref = prop.get("$ref", "").rsplit("/", 1)[-1]
+        if ref and defs[ref].get("type") == "object":
+            for k, p in defs[ref]["properties"].items():
+                default = prop.get("default", {}).get(k, p.get("default"))
+                out.append((k, _annotation(p, defs), _literal(default), p.get("description", "")))
+            continue
+        ann, default = {**OVERRIDES, **override}.get(
+            key, (_annotation(prop, defs), _literal(prop.get("default"))))
+        out.append((key, ann, default, prop.get("description", "")))
+    return out
+
+
+def _arg_lines(name: str, text: str) -> List[str]:
+    return textwrap.wrap(f"{name}: {text}", 92, initial_indent=" " * 8,
+                         subsequent_indent=" " * 12)
+
+
+def _function(file: str, name: str) -> str:
+    stem, module, returns, opts = FILES[file][name]
+    omit, override = tuple(opts.get("omit", ())), dict(opts.get("override", {}))  # type: ignore
+    fields = _fields(str(stem), omit, override) if stem else []
+    first = [(*k, "") for k in opts.get("first", [])]  # type: ignore
+    own = [(*k, "") for k in opts.get("own", PROGRESS)]  # type: ignore
+    doc = DOCS[file][name]
+    sig = ["    params: Optional[Params] = None,", "    /,"]
+    sig += ["    *,"] if fields or own or first else []
+    args = []
+    for key, ann, default, desc in first + fields + own:
+        kw = "from_" if key == "from" else key
+        sig.append(f"    {kw}: {ann} = {default},")
+        own_doc = doc.get("args", {}).get(key, COMMON_ARGS.get(key, ""))
+        if desc and not own_doc.startswith("+"):
+            own_doc = ""
+        desc = (_clean(desc) + " " + own_doc.lstrip("+")).strip() if desc else own_doc
+        args += _arg_lines(kw, desc.replace("{name}", name))
+    sig.append("    **model: Unpack[Model],")
+    args += _arg_lines("**model", COMMON_ARGS["model"])
+    body = [doc["summary"].rstrip(), "", "Args:", *[a[4:] for a in args]]
+    for section in ("returns", "raises"):
+        if section in doc:
+            body += ["", doc[section].rstrip()]
+    text = textwrap.indent("\n".join(body), "    ").replace("\n    \n", "\n\n")
+    lines = (["@_typed"] if opts.get("typed", True) else []) + [
+        f"def {name}(", *sig, f") -> {returns}:", f'    """{text.strip()}', '    """',
+        f"    return {module}._finish_{name}(locals())"]
+    return "\n".join(line.rstrip() for line in lines)
+
+
+HEADER = """\
+# generated by scripts/gen_stubs.py (scripts/gen_wrappers.py) from docs/schema/requests and
+# scripts/wrapper_docs.py: do not edit (CI runs `python3 scripts/gen_stubs.py --check`)
+\"\"\"{doc}
+
+The signature of each function is its library request's (the keywords, their types and
+defaults, their descriptions in "Args:"), its body a call of its hand-written finisher
+(``_finish_NAME``), which runs the request and builds the result.\"\"\"
+
+from __future__ import annotations
+
+import os
+from typing import TYPE_CHECKING, Optional, Sequence, Union
+
+import xarray as xr
+
+{imports}
+
+if TYPE_CHECKING:  # annotations only (PEP 692): editors complete and check the keywords
+    from typing_extensions import Unpack
+{checking}
+__all__ = [
+{names}
+]
+"""
+
+#: per generated file: its docstring's first line, its imports, its imports for annotations
+HEADS = {
+    "_wrappers.py": (
+        "The analyses' public functions (``afmdyn.simulate``, …; their finishers are in\n"
+        ":mod:`._api`, :mod:`._orbits`, :mod:`._attractors`, :mod:`._basins`, :mod:`._fm`,\n"
+        ":mod:`._global_continuation` and :mod:`._chart`). Each checks its keywords' types first\n"
+        "(``TypeError`` naming the keyword); the library checks their values (``ValueError``\n"
+        "naming the field and its range).",
+        "from . import _api, _attractors, _basins, _chart, _fm, _global_continuation, _orbits, _peakforce\n"
+        "from ._afmdyn import Params\n"
+        "from ._attractors import Attractors\n"
+        "from ._common import Model, StateLike, _typed\n"
+        "from ._progress import ProgressArg\n"
+        "from ._results import Lyapunov, Orbit, Spectrum",
+        "",
+    ),
+    "_dask_wrappers.py": (
+        "The public functions of :mod:`afmdyn.dask` (their finishers are in :mod:`afmdyn.dask`).",
+        "from . import dask as _dask\n"
+        "from ._afmdyn import Params\n"
+        "from ._progress import ProgressArg",
+        "    import distributed\n\n    from ._common import Model\n",
+    ),
+}
+
+
+def generate(file: str = "_wrappers.py") -> str:
+    """The text of the generated module ``file``."""
+    doc, imports, checking = HEADS[file]
+    names = "\n".join(f'    "{n}",' for n in FILES[file])
+    head = (HEADER.replace("{doc}", doc).replace("{imports}", imports)
+            .replace("{checking}", checking).replace("{names}", names))
+    parts = [head.rstrip()] + [_function(file, n) for n in FILES[file]]
+    return "\n\n\n".join(parts) + "\n"
+
+
+MODEL_HEAD = '''\
+# generated by scripts/gen_stubs.py (scripts/gen_wrappers.py) from docs/schema/requests/model.json
+# and scripts/wrapper_docs.py: do not edit (CI runs `python3 scripts/gen_stubs.py --check`)
+"""The model keywords every analysis takes (:class:`Model`): the library's model request's
+fields (``ModelSpec``; the paper's ``alpha1`` … ``alpha6`` beside the names they alias) and
+the probe's keywords."""
+
+from __future__ import annotations
+
+import os
+from typing import Any, Dict, Literal, TypedDict, Union
+
+
+class Model(TypedDict, total=False):
+    """{doc}"""
+
+'''
+
+#: the model keywords of Python's own (the command line's ``--probe``, ``--cantilever``,
+#: ``--medium``)
+PROBE_KEYS = [("probe", 'Union[str, "os.PathLike[str]", Dict[str, Any]]'), ("cantilever", "str"),
+              ("medium", "str")]
+
+
+def generate_model() -> str:
+    """The text of ``_model.py``: the ``Model`` TypedDict of ``model.json``'s fields (each
+    ``αk`` field followed by its alias ``alphak``) and the probe's keywords."""
+    schema = json.loads((SCHEMAS / "model.json").read_text())
+    defs = schema.get("$defs", {})
+    keys = []
+    for key, prop in schema["properties"].items():
+        ref = next((p["$ref"] for p in prop.get("anyOf", []) if "$ref" in p), "")
+        if ref:
+            d = defs[ref.rsplit("/", 1)[-1]]
+            consts = [v["const"] for v in d.get("oneOf", []) if "const" in v]
+            ann = "Literal[" + ", ".join(json.dumps(c) for c in consts) + "]"
+        else:
+            ann = _annotation(prop, defs)[len("Optional["):-1]
+        keys.append((key, ann))
+        alias = re.fullmatch(r"α(\d)\.", prop.get("description", ""))
+        if alias:
+            keys.append((f"alpha{alias.group(1)}", ann))
+    doc = textwrap.indent(MODEL_DOC.strip(), "    ").strip()
+    body = "".join(f"    {k}: {ann}\n" for k, ann in keys + PROBE_KEYS)
+    return MODEL_HEAD.replace("{doc}", doc) + body

@@ -1,0 +1,399 @@
+"""The docstrings' own parts of the generated analysis functions (``afmdyn/_wrappers.py``,
+written by ``scripts/gen_wrappers.py``): per analysis its summary and its "Returns:" and
+"Raises:" sections. The "Args:" come from the request schemas' field descriptions; ``args`` gives those of the
+keywords a request does not describe (or describes otherwise for Python)."""
+
+WRAPPERS = {
+    "modes": {
+        "summary": """\
+Natural frequencies and damped eigenvalues of the free and contact systems
+(paper eqs. 19–23).""",
+        "returns": """\
+Returns:
+    A :class:`Spectrum` (``.free``, ``.contact``: ω float64 ``[N]``, eigenvalues
+    complex128, ζ); ``to_dict()`` is ``afmdyn modes --json``.""",
+    },
+    "simulate": {
+        "summary": """\
+Integrate one trajectory (``afmdyn simulate``); ``periods`` defaults to 50 when
+``tau_end`` is not given either.""",
+        "returns": """\
+Returns:
+    ``xarray.Dataset`` with dims ``tau`` (S samples), ``mode`` (N), ``event`` (E
+    switchings), ``section`` (P section points τ = 2πk/Ω), ``component`` (2N) and ``cycle``
+    (C complete drive periods): ``v_t``, ``v_t_dot``, ``w_tip``, ``w_tip_dot``,
+    ``in_contact``, ``contact_force`` ``[S]``; ``a``, ``a_dot`` ``[S, N]``;
+    ``event_tau``, ``event_to_contact``, ``event_v_t_dot`` ``[E]``; ``section_tau``,
+    ``section_v_t``, ``section_w_tip``, ``section_w_tip_dot`` ``[P]``, ``section_state``
+    ``[P, 2N]``; the energy balance per period ``[C]``; ``spectrum`` ``[F]`` over dim
+    ``frequency`` (the amplitude spectrum of W(1,τ) over the last ≤ 2²⁰ samples, the
+    command line's ``spectrum.csv``). ``attrs["summary"]`` holds
+    ``afmdyn simulate --json`` (see :func:`summary`). Units: the model's (τ in t0,
+    lengths in g0, forces E I g0/L³, or k g0 for the point mass); with ``probe`` every
+    array is in SI, as the command line's files — times (the coordinate ``t``, named
+    ``tau`` without a probe; events, sections) in s, lengths in m, velocities in m/s,
+    forces in N, energies in J, the spectrum's frequencies in Hz — each variable's unit in
+    its attrs.""",
+    },
+    "converge": {
+        "summary": """\
+Mode-number convergence (paper Fig. 4, ``afmdyn converge``): the steady tip motion
+for N = 1..max_modes. Without ``params`` the model defaults to Ω = 4.1 (eq. 24 with the
+damping of eq. 26), as on the command line.""",
+        "returns": """\
+Returns:
+    ``xarray.Dataset`` with dims ``n_modes`` (max_modes) and ``sample`` (K):
+    ``w_tip``, ``v_t``, ``tau`` ``[n_modes, K]`` over ``periods`` drive periods from a
+    section point; ``period`` ``[n_modes]`` (−1: nonperiodic); ``rms_change``
+    ``[n_modes]`` (RMS of W_tip(N) − W_tip(N−1), NaN for N = 1); coordinate
+    ``tau_from_section`` ``[K]``.""",
+    },
+    "bifurcation": {
+        "summary": """\
+Bifurcation diagram (paper Fig. 5, ``afmdyn bifurcation``): the steady state at each
+value of ``param`` (``"omega"`` or ``"alpha1"``…``"alpha6"``, or the descriptive names) by
+forward and backward continuation and ``starts`` random starts, in parallel (``threads``
+workers, default all cores). Ctrl-C stops it within one point. ``from_`` is ``from`` (a
+Python keyword).
+
+With ``store``, each finished point is also written to that directory (the layout of
+``afmdyn bifurcation --out DIR``: ``bifurcation.csv`` when finished, the ledger
+``.bifurcation.run.json`` and the partial rows of an unfinished sweep), and ``resume=True``
+continues the sweep stored there, computing only the points not yet written (``--resume``):
+an interrupted sweep, from Python or the command line, resumes; a finished one is read back
+without computing anything.""",
+        "raises": """\
+Raises:
+    ValueError: ``resume=True`` on a store made by another request (the message names the
+        first field that differs and both values, e.g. ``steps = 60 in the interrupted
+        run, 30 now``), on a store holding rows without a ledger, or without ``store``.
+    OSError: the store cannot be read or written.""",
+        "returns": """\
+Returns:
+    ``xarray.Dataset`` in long format, dim ``point`` (one row per section point, in the
+    order of the command line's ``bifurcation.csv``: by value index, then ``forward``,
+    ``backward``, ``start-0``, ``start-1``, …, then ``k``): coordinates
+    ``value``, ``index``, ``branch`` (``"forward"``, ``"backward"``, ``"start-k"``);
+    ``status`` (``"periodic"``, ``"nonperiodic"``, ``"error"``), ``period`` (−1
+    nonperiodic, −2 error), ``k`` (position in the cycle), ``n_points``, ``tau``,
+    ``v_t``, ``w_tip``, ``x_max``, ``v_t_min``, ``contact_fraction``,
+    ``contacts_per_period``, ``transient_periods``, ``message``, ``a_1``…``a_N``,
+    ``a_dot_1``…``a_dot_N``. ``.to_dataframe()`` gives the tidy table.""",
+    },
+    "continuation": {
+        "summary": """\
+Pseudo-arclength continuation of a period-n branch from ``from_`` towards ``to``, with
+located folds, period doublings, Neimark–Sacker and grazing points (``afmdyn continue``).
+The default start is the steady state reached from rest at ``from_``.""",
+        "returns": """\
+Returns:
+    ``xarray.Dataset`` with dim ``point`` (all branches in order): ``branch`` (0 the
+    main branch, 1… switched ones), ``period``, ``s`` (arclength), ``value``, ``stable``,
+    ``max_multiplier``, ``critical``, ``switchings``, ``grazing_distance``, ``event``
+    (``""`` or ``"fold"``, ``"period-doubling"``, ``"neimark-sacker"``, ``"grazing"``);
+    ``w_tip_section`` ``[point, k]`` (W(1,τ) at the section points, NaN-padded),
+    ``multipliers`` ``[point, 2N]`` complex128, ``state`` ``[point, 2N]``.
+    ``attrs["summary"]`` is ``afmdyn continue --json``.""",
+    },
+    "observe": {
+        "summary": """\
+Observables of the steady state reached from ``initial`` (default: rest): first-harmonic
+amplitude and phase lag of the tip deflection, harmonics and THD, mean deflection, peak and
+minimum force, indentation, contact fraction and time, minimum distance, impacts, the energy
+dissipated in the sample, the virial, the per-mode energy balance and the closed forms
+(Cleveland/Anczykowski E_dis, San Paulo & García virial) beside the direct integrals.
+
+The steady state is found as by :func:`orbit` and, when periodic, polished by Newton
+shooting; ``periods`` orbit periods are integrated on the dense output (no sampling).""",
+        "returns": """\
+Returns:
+    An ``xarray.Dataset`` in SI with a probe (m, N, J, s; the model's units g₀, F̃, F̃·g₀,
+    τ otherwise; ``units`` in each variable's attrs), phases in degrees: scalars
+    ``amplitude``, ``amplitude_ratio``, ``phase_deg``, ``mean_deflection``,
+    ``peak_force``, ``min_force``, ``indentation``, ``contact_fraction``,
+    ``min_distance``, ``energy_dissipated``, ``virial``, ``harmonic_distortion``,
+    ``higher_mode_fraction``, ``contact_time``, ``mean_force``, ``impacts_per_period``,
+    ``impact_loss``, ``period`` (NaN when not periodic);
+    ``harmonic_amplitude``/``harmonic_phase_deg`` over ``harmonic``; the energy balance
+    ``mode_drive``, ``mode_sample``, … over ``mode``; ``state`` ``[2N]`` (a, ȧ).
+    ``ds.afmdyn.to_dict()`` is the library's document (dimensionless, phases in radians,
+    the closed forms; its ``reported`` block holds the dataset's values).""",
+    },
+    "approach": {
+        "summary": """\
+The amplitude-modulation approach–retract curve over the rest distance z_c
+(``afmdyn approach``): the steady state stepped from ``from_`` down to ``to`` and back, each
+value continued from the previous orbit, plus the periodic-orbit branches continued in z_c
+with Floquet stability, the folds, the bistable ranges and the jumps. The default range is
+1.2 A₀ to 0.1 A₀ above contact (m with ``probe``, else g₀); with ``traces`` the document's
+``traces`` hold ``z_c``, ``time_periods`` and per z_c ``deflection``, ``distance`` V_T and
+``force`` (the force–distance loop's area is E_dis).""",
+        "returns": """\
+Returns:
+    An ``xarray.Dataset`` (SI with a probe: m, N, J, degrees; ``units`` in each variable's
+    attrs) over ``z_c`` (the approach's grid) and ``sweep`` = ``approach``/``retract``:
+    ``amplitude``, ``amplitude_ratio``, ``phase_deg``, ``mean_deflection``,
+    ``peak_force``, ``min_force``, ``indentation``, ``contact_fraction``,
+    ``min_distance``, ``energy_dissipated``, ``virial``, ``harmonic_distortion``,
+    ``higher_mode_fraction``, ``stable``, ``period``, ``reached``; the branches along
+    ``branch_point`` (``branch``, ``branch_z_c``, ``branch_amplitude``, …,
+    ``branch_event``); with ``traces``, ``trace_deflection``/``trace_distance``/
+    ``trace_force`` over (``trace``, ``trace_time``). ``ds.afmdyn.to_dict()`` is the
+    ``afmdyn approach --json`` document (``folds``, ``bistable``, ``jumps``, ``setpoint``
+    (per stable branch crossing its ``source``, ``z_c``, ``regime``, phase, peak force,
+    indentation, E_dis…), ``warnings``; ``docs/outputs.md``).""",
+    },
+    "bimodal": {
+        "summary": """\
+The bimodal (multifrequency) AM approach–retract curve (``afmdyn bimodal``): the
+approach curve of a drive with two or more components — a probe whose ``[drive]`` gives
+``free_amplitude = [A01, A02]`` and ``frequency = [f1, f2]`` (or each component at its
+mode's resonance), on the eigenmode model (``model = "eigenmodes"``), the beam or the point
+mass. The frequency ratio is taken as a fraction p/q (within 1e-6), the steady state is the
+periodic orbit of the common period q/f1, and each component's amplitude, phase, virial
+and dissipated energy come from demodulation over it (Lozano & García, Phys. Rev. Lett.
+100, 076102 (2008); García & Proksch, Eur. Polym. J. 49, 1897 (2013)). A ratio whose
+common period exceeds 1000 primary periods (incommensurate) is averaged in time instead.
+The keywords are :func:`approach`'s (the default range from 1.2 to 0.1 times the sum of
+the free amplitudes); ``setpoint`` is A1/A01 of the first component, and
+``ds.afmdyn.to_dict()["setpoint"]["points"]`` gives every component's ``amplitude_i``,
+``phase_i_deg``, ``virial_i`` and ``energy_dissipated_i`` there. With ``exact``, points
+otherwise measured on invariant circles are per point in
+``ds.afmdyn.to_dict()["invariant_circle"]``.""",
+        "raises": """\
+Raises:
+    ValueError: for a single-frequency drive (naming ``[drive].free_amplitude``), and as
+        :func:`approach`.""",
+        "returns": """\
+Returns:
+    The dataset of :func:`approach` plus, over (``sweep``, ``z_c``), ``amplitude_i``,
+    ``phase_i_deg``, ``virial_i`` and ``energy_dissipated_i`` (per cycle of component i)
+    for each component i = 1, 2, … (1 the primary; SI with a probe); the branches' as
+    ``branch_amplitude_2`` …; the frequencies, ratios and free amplitudes in
+    ``ds.afmdyn.to_dict()["drive_components"]``; for a time average, each point's periods,
+    whether it settled, and its amplitude and phase error estimates per component in
+    ``ds.afmdyn.to_dict()["time_average"]`` (an unsettled point also in the warnings).""",
+    },
+    "resonance": {
+        "summary": """\
+Amplitude and phase against the drive frequency near mode ``mode``
+(``afmdyn resonance``): up- and down-sweep, each value continued from the previous orbit,
+plus the branches continued in Ω with their folds (the bent, multivalued resonance curves of
+tapping mode). The default band is ω_k (1 ∓ max(6/Q_k, 0.02)), in Hz with ``probe``, else
+Ω; the other keywords are as :func:`approach`'s (traces per frequency of the up-sweep).""",
+        "returns": """\
+Returns:
+    An ``xarray.Dataset`` as :func:`approach`'s over ``frequency_hz`` (with a probe) or
+    ``omega`` and ``sweep`` = ``up``/``down``; ``ds.afmdyn.to_dict()`` is the
+    ``afmdyn resonance --json`` document.""",
+    },
+    "orbit": {
+        "summary": """\
+A period-n orbit by Newton shooting, with Floquet multipliers (``afmdyn orbit``). The
+default period is the attractor's when ``initial`` is an :class:`Attractor`.""",
+        "returns": """\
+Returns:
+    :class:`Orbit`; ``to_dict()`` is ``afmdyn orbit --json``. Raises
+    :class:`SimulationError` when Newton's method does not converge.""",
+    },
+    "lyapunov": {
+        "summary": """\
+Lyapunov spectrum (tangent dynamics with saltation matrices) and the 0–1 test for chaos
+(``afmdyn lyapunov``), from ``initial`` (default rest) after ``transient`` drive periods,
+averaged over ``periods`` in ``blocks`` blocks (periods ≥ blocks ≥ 2).""",
+        "returns": """\
+Returns:
+    :class:`Lyapunov`; ``to_dict()`` is ``afmdyn lyapunov --json``.""",
+    },
+    "attractors": {
+        "summary": """\
+Coexisting attractors and basin fractions (paper Figs. 6–17, ``afmdyn attractors``)
+from ``samples`` seeded random initial states, in parallel.""",
+        "returns": """\
+Returns:
+    :class:`Attractors`, a sequence of :class:`Attractor` (most frequent first);
+    ``to_dict()`` is ``afmdyn attractors --json``, ``to_dataframe()`` a summary table.""",
+    },
+    "basins": {
+        "summary": """\
+Basins of attraction (``afmdyn basins``) over two coordinates of the initial state at
+τ = 0 (``"a1"``…``"aN"``, ``"adot1"``…``"adotN"``, ``"w"``, ``"wdot"``; the others from
+``base``, 2N values a1…aN, ȧ1…ȧN, default at rest): each start stops as soon as it is near
+a known periodic attractor (3 returns within ``near_tol``) or its returns recur in
+state-space cells of one basin (``basin_hits`` returns in cells of side ``cell``), else the
+steady-state search decides. Where the plane is the whole section (N = 1, a position and a
+velocity) the map is made in passes from a coarse grid (``stride``; 0 automatic, 1 one
+pass): a later start stops when a return lands inside a coarse cell of one basin.""",
+        "returns": """\
+Returns:
+    ``xarray.Dataset`` with dims ``(y, x)``: ``label`` (attractor id, −2 failed),
+    ``decided`` (``"near"``, ``"recurrence"``, ``"grid"``, ``"steady"``, ``"failed"``),
+    ``periods``; dim ``attractor``: ``period`` (−1 nonperiodic), ``x_max``, ``v_t_min``
+    (g0), ``basin_fraction``, ``stable`` (1/0 from the Floquet multipliers of the orbit
+    polished by shooting; NaN nonperiodic), ``lyapunov`` (λ₁ of a nonperiodic attractor);
+    attributes ``basin_entropy``, ``boundary_basin_entropy`` (Daza et al. 2016; NaN when
+    undefined), ``uncertainty_exponent`` (Grebogi et al. 1983) and ``summary`` (the
+    command line's JSON document).""",
+    },
+    "global_continuation": {
+        "summary": """\
+Attractors continued over ``param`` (``afmdyn attractors --sweep``; Datseris, Rossi &
+Wagemakers, Chaos 33, 073151 (2023)): at every value (``from_`` … ``to`` in ``steps``, or
+``values`` in the order given) a census of ``samples`` random starts plus one start from
+each attractor of the previous value; the attractors are matched to the previous value's
+by the distance between their Poincaré point sets (``match_tol``, relative), so an id is
+one attractor followed over the parameter. The basin fractions count the random starts
+only (an attractor found only from the previous value has fraction 0).""",
+        "args": {
+            "store": "a directory for the command line's resumable store of values (``afmdyn "
+                     "attractors --sweep --out DIR``; created if needed, started over without "
+                     "``resume``).",
+        },
+        "returns": """\
+Returns:
+    ``xarray.Dataset`` with dims ``(value, id)``: ``basin_fraction`` (0 where the id has no
+    attractor), ``period`` (−1 nonperiodic, 0 absent), ``x_max`` and ``v_t_min`` (g0, NaN
+    absent), ``stable`` (1/0 from the Floquet multipliers of the orbit polished by shooting,
+    NaN otherwise); dim ``value``: ``failures`` (runs that failed). Attribute ``summary``:
+    the command line's JSON document (Poincaré points, multipliers of every attractor).""",
+    },
+    "fm": {
+        "summary": """\
+The frequency-modulation (FM-AFM) curve at constant amplitude over the rest distance
+z_c (``afmdyn fm``): at each z_c the exact periodic orbit of the cantilever driven at the
+frequency where its first harmonic lags the drive by the free lever's phase at resonance
+(an ideal PLL), with the excitation that holds the first-harmonic amplitude at ``amplitude``
+(an ideal amplitude controller; m with ``probe``, else g₀; default the probe's free
+amplitude A₀), continued from the previous z_c. The default range runs from where the
+frequency shift has decayed to 0.5 % of its value at ``to`` (Giessibl's first-order shift
+of the law's force; 2A + a₀ for a law without a force before contact) down to A + a₀.""",
+        "returns": """\
+Returns:
+    An ``xarray.Dataset`` over ``z_c``: ``frequency_shift`` (Hz with a probe),
+    ``frequency``, ``excitation`` (relative to the free lever's), ``amplitude``,
+    ``phase_deg``, ``energy_dissipated``, ``virial``, ``mean_deflection``,
+    ``min_distance``, ``peak_force``, ``mean_force``, ``indentation``,
+    ``max_multiplier``, ``stable``, ``loop_residual``, ``iterations``; attributes
+    ``spring_constant``, ``resonance_frequency``, ``amplitude``, ``mode``, ``folds_z_c``
+    and ``summary`` (the ``afmdyn fm --json`` document). A z_c not reached ends the curve
+    with an :class:`afmdyn.AfmdynWarning`. ``afmdyn.reconstruct(fm=ds)`` inverts it.""",
+        "raises": """\
+Raises:
+    ValueError: naming the option (``amplitude``, ``mode``, ``tolerance``, ``from``, ``to``,
+        ``step``, ``points``) or the model parameter.""",
+    },
+}
+
+WRAPPERS["chart"] = {
+    "summary": """\
+Behaviour chart over two parameters (``afmdyn chart``): every attractor that each cell's
+``starts`` random starts and the continuation from its neighbours along x reach, on all
+cores (``threads``). Ctrl-C stops it within one task.
+
+An axis is any real model parameter by name or alias (``"omega"``, ``"alpha2"`` /
+``"drive_amplitude"``, ``"gap"``, ``"restitution"``, ``"hamaker"``, …) and, with
+``probe=``, ``"z_c"`` (m), ``"drive_frequency"`` (Hz) and the probe file's own values
+``"free_amplitude"`` (m), ``"sample_modulus"`` (Pa), ``"quality_factor"``,
+``"spring_constant"`` (N/m), ``"tip_radius"`` (m).""",
+    "raises": """\
+Raises:
+    ValueError: an axis that is not a real model parameter, a value out of its range, an
+        option out of its limits (each named), or ``resume`` on another request's store.
+    SimulationError: no cell found any attractor.""",
+    "returns": """\
+Returns:
+    ``xarray.Dataset`` with dims ``(y, x, attractor)``: per cell ``attractors``,
+    ``failures``, ``dominant_period``; per attractor slot (most random starts first;
+    ``max_attractors`` slots, empty ones with period 0 and NaN) ``period`` (−1
+    nonperiodic), ``motion`` (1 periodic, 2 chaotic: λ₁ > 2 × its error, 3 quasi-periodic:
+    |λ₁| ≤ 2 × its error, 4 unsettled: λ₁ < −2 × its error, 5 nonperiodic without λ₁),
+    ``lyapunov`` (λ₁ per unit τ of a nonperiodic attractor), ``lyapunov_error``, ``x_max``,
+    ``v_t_min`` (g0), ``contacts_per_period``, ``contact_fraction``, ``fraction``
+    (basin fraction among the random starts). The same values as ``chart.nc``.""",
+}
+
+#: the Dask versions (:mod:`afmdyn.dask`)
+DASK = {
+    "chart": {
+        "summary": """\
+:func:`afmdyn.chart` with its tasks mapped over a Dask cluster: ``client`` (default: a
+``LocalCluster`` of this machine's cores, closed at the end). With ``store`` (a Zarr
+directory, locked during the run) each finished task is written there at once and a
+rerun resumes (``resume=False`` starts the store over); another request on the same store
+is refused, naming the first option that differs. Finished tasks reach the store in
+batches, at least every ``checkpoint_seconds`` (0: each task as it arrives) and at the
+end: a killed driver loses at most that much work.""",
+        "returns": """\
+Returns:
+    The same ``xarray.Dataset`` as :func:`afmdyn.chart` with the same arguments.""",
+        "args": {
+            "client": "a ``dask.distributed.Client`` (default: a ``LocalCluster``).",
+            "store": "a Zarr directory keeping the finished tasks (locked during the run).",
+            "resume": "resume the store (``False``: start it over).",
+            "checkpoint_seconds": "the longest time finished tasks wait to be written (>= 0).",
+        },
+    },
+    "bifurcation": {
+        "summary": """\
+:func:`afmdyn.bifurcation` with its tasks mapped over a Dask cluster (``client``;
+default a ``LocalCluster`` of this machine's cores, closed at the end): the two coarse
+continuation passes first, then every chain segment and random start, seeded by them.
+
+With ``store`` (a directory, locked during the run) the sweep is kept in the command
+line's layout (``afmdyn bifurcation --out DIR``): each finished task's points are
+appended as they arrive, and a rerun with the same request resumes — from a run of this
+function, of ``afmdyn.bifurcation(store=...)`` or of the command line — computing only the
+tasks with points not stored (``resume=False`` starts over; another request is refused).""",
+        "returns": """\
+Returns:
+    The same ``xarray.Dataset`` as :func:`afmdyn.bifurcation` with the same arguments, bit
+    for bit.""",
+        "args": {
+            "client": "a ``dask.distributed.Client`` (default: a ``LocalCluster``).",
+            "store": "a directory keeping the sweep in the command line's layout.",
+            "resume": "resume the stored sweep (``False``: start it over).",
+        },
+    },
+}
+
+WRAPPERS["peakforce"] = {
+    "summary": """\
+The steady tap of off-resonance tapping (``afmdyn peakforce``; the probe's ``[drive]
+mode = "off-resonance"``): the periodic orbit of the modulation period found by shooting,
+with its Floquet multipliers, the instrument's channels and the PF-QNM DMT fit.""",
+    "args": {
+        "z_c": "+A sequence sweeps it: the channels over a ``z_c`` dimension.",
+        "modulation_frequency": "values of f_m to sweep (Hz with ``probe``, else Ω): the "
+        "channels over a ``modulation_frequency`` dimension (with ``setpoint``, the feedback "
+        "holds the peak force at each).",
+    },
+    "returns": """\
+Returns:
+    An ``xarray.Dataset`` of one cycle over ``sample`` (time, deflection, distance, force)
+    and the force–distance curve, in SI with a probe; attributes: the channels
+    (``peak_force``, ``adhesion``, ``deformation``, ``dissipation``, ``contact_time``,
+    ``snap_off_time``, ``ringing_amplitude``, ``modulus_dmt``, ``taps_per_cycle``) and
+    ``summary`` (the ``afmdyn peakforce --json`` document). With a sweep the channels
+    (and ``modulus_dmt``, ``z_c``, ``period``) are variables over its dimension, NaN where
+    a value failed; the cycle and curve are the first computed value's. Warnings (period-2
+    tapping, double taps, an unstable tap) are raised as :class:`afmdyn.AfmdynWarning`.""",
+    "raises": """\
+Raises:
+    ValueError: naming the option or the model parameter.""",
+}
+
+DOCS = {"_wrappers.py": WRAPPERS, "_dask_wrappers.py": DASK}
+
+#: the docstring of ``afmdyn.Model`` (the model keywords)
+MODEL_DOC = """\
+The model keywords every analysis takes (see :class:`Params` for their ranges; the one
+table of them is ``afmdyn._afmdyn.MODEL_PARAMETERS``). ``probe`` is a probe in SI (the
+command line's ``--probe``): a file's path, its TOML text (a ``str`` with a line break or
+``=``) or a dict of its sections (``{"cantilever": {...}, "sample": {...}, ...}``); it sets
+every parameter in SI, ``z_c`` (m) and ``drive_frequency`` (Hz) set α5 and Ω through its
+scales, ``modes`` and ``restitution`` are taken, and the dimensionless keywords of the
+values it sets (``gap``, ``omega``, the α's, ``hamaker``, ``intermolecular_distance``,
+``contact_law``) raise ``ValueError`` naming the probe key or SI keyword to use; the
+result's ``to_dict()`` then carries the command line's ``"si"`` block. ``cantilever`` names
+a cantilever of the library (:func:`afmdyn.cantilevers`) for the probe, as
+``--cantilever`` does: it fills the keys the probe leaves out and wins over a name in it."""
