@@ -35,7 +35,7 @@ DASK_KW = [("client", 'Optional["distributed.Client"]', "None"), ("store", STORE
 #: (name, annotation, default), documented in :data:`COMMON_ARGS` or ``DOCS[name]["args"]``),
 #: ``first`` (such keywords before the request's), ``omit`` (request fields Python does not
 #: take), ``override`` (a field's annotation and default in Python, wider than the
-#: request's: the finisher converts it), ``typed`` (False: no ``@_typed`` check of the keywords)
+#: request's: the finisher converts it), ``rename`` (a field's keyword in Python), ``typed`` (False: no ``@_typed`` check of the keywords)
 FILES: Dict[str, Dict[str, Tuple[object, str, str, Dict[str, object]]]] = {
     "_wrappers.py": {
         "modes": (None, "_api", "Spectrum", {"own": []}),
@@ -61,6 +61,14 @@ FILES: Dict[str, Dict[str, Tuple[object, str, str, Dict[str, object]]]] = {
             "override": {"z_c": ("Union[float, Sequence[float], None]", "None"),
                          "fit_band": ("Optional[Sequence[float]]", "None")},
             "own": [("modulation_frequency", "Optional[Sequence[float]]", "None")] + PROGRESS}),
+        "fit": ("fit", "_fit", "xr.Dataset", {
+            "omit": ("force", "height", "sigma"), "typed": False, "rename": {"range": "fit_range"},
+            "override": {
+                "data": ('Union[str, "os.PathLike[str]", Mapping[str, Sequence[float]], Any, None]',
+                         "None"),
+                "fit": ("Optional[Sequence[str]]", "None"),
+                "range": ("Optional[Tuple[float, float]]", "None")},
+            "own": [("curve", "int", "0")] + PROGRESS}),
     },
     "_dask_wrappers.py": {
         "chart": ("chart", "_dask", "xr.Dataset",
@@ -153,6 +161,7 @@ def _arg_lines(name: str, text: str) -> List[str]:
 def _function(file: str, name: str) -> str:
     stem, module, returns, opts = FILES[file][name]
     omit, override = tuple(opts.get("omit", ())), dict(opts.get("override", {}))  # type: ignore
+    rename = dict(opts.get("rename", {}))  # type: ignore
     fields = _fields(str(stem), omit, override) if stem else []
     first = [(*k, "") for k in opts.get("first", [])]  # type: ignore
     own = [(*k, "") for k in opts.get("own", PROGRESS)]  # type: ignore
@@ -161,12 +170,14 @@ def _function(file: str, name: str) -> str:
     sig += ["    *,"] if fields or own or first else []
     args = []
     for key, ann, default, desc in first + fields + own:
-        kw = "from_" if key == "from" else key
+        kw = {"from": "from_", **rename}.get(key, key)
         sig.append(f"    {kw}: {ann} = {default},")
-        own_doc = doc.get("args", {}).get(key, COMMON_ARGS.get(key, ""))
-        if desc and not own_doc.startswith("+"):
-            own_doc = ""
-        desc = (_clean(desc) + " " + own_doc.lstrip("+")).strip() if desc else own_doc
+        # the request's description, with Python's addition ("+…"), or Python's own text
+        extra = doc.get("args", {}).get(key, COMMON_ARGS.get(key, ""))
+        if desc and (not extra or extra.startswith("+")):
+            desc = (_clean(desc) + " " + extra[1:]).strip()
+        else:
+            desc = extra
         args += _arg_lines(kw, desc.replace("{name}", name))
     sig.append("    **model: Unpack[Model],")
     args += _arg_lines("**model", COMMON_ARGS["model"])
@@ -193,7 +204,7 @@ defaults, their descriptions in "Args:"), its body a call of its hand-written fi
 from __future__ import annotations
 
 import os
-from typing import TYPE_CHECKING, Optional, Sequence, Union
+from typing import TYPE_CHECKING, Any, Mapping, Optional, Sequence, Tuple, Union
 
 import xarray as xr
 
@@ -212,10 +223,11 @@ HEADS = {
     "_wrappers.py": (
         "The analyses' public functions (``afmdyn.simulate``, …; their finishers are in\n"
         ":mod:`._api`, :mod:`._orbits`, :mod:`._attractors`, :mod:`._basins`, :mod:`._fm`,\n"
-        ":mod:`._global_continuation` and :mod:`._chart`). Each checks its keywords' types first\n"
-        "(``TypeError`` naming the keyword); the library checks their values (``ValueError``\n"
-        "naming the field and its range).",
-        "from . import _api, _attractors, _basins, _chart, _fm, _global_continuation, _orbits, _peakforce\n"
+        ":mod:`._global_continuation`, :mod:`._chart`, :mod:`._peakforce` and :mod:`._fit`).\n"
+        "Those marked ``@_typed`` check their keywords' types first (``TypeError`` naming the\n"
+        "keyword); the library checks the values (``ValueError`` naming the field and its range).",
+        "from . import _api, _attractors, _basins, _chart, _fit, _fm, _global_continuation, _orbits\n"
+        "from . import _peakforce\n"
         "from ._afmdyn import Params\n"
         "from ._attractors import Attractors\n"
         "from ._common import Model, StateLike, _typed\n"

@@ -382,6 +382,39 @@ Raises:
     ValueError: naming the option or the model parameter.""",
 }
 
+WRAPPERS["fit"] = {
+    "summary": """\
+Fit a quasi-static force curve with the probe's contact law (``afmdyn fit``; hertz,
+dmt or jkr), its contact point and baseline: nanite's preprocessing (tip position
+height + F/k, force and tip offsets at the contact point), Levenberg–Marquardt, standard
+errors, 95 % profile-likelihood intervals, correlations and identifiability warnings.
+``probe`` (a model keyword, as ``--probe``) is required.""",
+    "args": {
+        "data": "the force curve: a CSV file with the columns ``height`` (m, the piezo "
+        "height, decreasing into the sample), ``force`` (N, repulsion positive) and optionally "
+        "``sigma`` (N); or a mapping (a ``pandas.DataFrame``, a dict) with those columns; or an "
+        "instrument's curve read by afmformats (Müller et al.; JPK ``.jpk-force``, "
+        "``.jpk-force-map``, ``.jpk-qi-data``, Asylum ``.ibw``, afmformats ``.h5``/``.tab``): a "
+        "file of those kinds, or an ``afmformats`` force-distance object (a "
+        "``nanite.Indentation`` too), whose ``height (measured)`` (else ``height (piezo)``) and "
+        "``force`` columns are taken.",
+        "curve": "which curve of an afmformats file with several (a force map), from 0.",
+        "approach_rows": "+For an afmformats curve the default is the instrument's segments.",
+    },
+    "returns": """\
+Returns:
+    An ``xarray.Dataset``: over ``row`` the fitted rows' ``tip_position``, ``force``,
+    ``fit`` and ``residual``; over ``parameter`` the ``estimate``, ``standard_error``,
+    ``interval_low`` and ``interval_high`` (95 %), and ``correlation`` over
+    (``parameter``, ``parameter_2``); attributes ``chi2_dof``, ``noise`` and ``summary``
+    (the ``afmdyn fit --json`` document). Warnings (a correlation above 0.99, a flat
+    profile, an estimate at its bound, the noise estimated from the residuals) are raised
+    as :class:`afmdyn.AfmdynWarning`.""",
+    "raises": """\
+Raises:
+    ValueError: naming the option, the data or the probe key.""",
+}
+
 DOCS = {"_wrappers.py": WRAPPERS, "_dask_wrappers.py": DASK}
 
 #: the docstring of ``afmdyn.Model`` (the model keywords)

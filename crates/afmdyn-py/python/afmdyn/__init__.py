@@ -32,7 +32,6 @@ from ._cantilevers import cantilevers
 from ._common import AfmdynWarning, Model, summary
 from ._interrupt import cancel_running
 from ._interrupt import install as _install_sigint
-from ._fit import fit
 from ._image import image, setpoint_study
 from ._reconstruct import reconstruct
 from ._wrappers import (
@@ -44,6 +43,7 @@ from ._wrappers import (
     chart,
     continuation,
     converge,
+    fit,
     fm,
     global_continuation,
     lyapunov,

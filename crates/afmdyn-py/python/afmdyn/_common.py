@@ -11,6 +11,7 @@ import inspect
 import json
 import numbers
 import os
+import sys
 import warnings
 from typing import Any, Callable, Dict, Optional, Protocol, Sequence, Tuple, TypeVar, Union, cast
 
@@ -196,7 +197,19 @@ def _warn(doc: Any) -> None:
             return
     if isinstance(doc, dict):
         for w in doc.get("warnings") or []:
-            warnings.warn(str(w), AfmdynWarning, stacklevel=5)
+            warnings.warn(str(w), AfmdynWarning, stacklevel=_user_level())
+
+
+def _user_level() -> int:
+    """The ``stacklevel`` (for a ``warnings.warn`` in the caller) of the first frame outside
+    this package: a warning points at the user's line, however deep the package's calls."""
+    f, level = sys._getframe(1), 1
+    while f.f_back is not None and os.path.dirname(f.f_code.co_filename) == _HERE:
+        f, level = f.f_back, level + 1
+    return level
+
+
+_HERE = os.path.dirname(os.path.abspath(__file__))
 
 
 _NOT_REQUEST = frozenset(("params", "progress", "model", "store", "resume"))

@@ -1,84 +1,34 @@
 """Fitting a measured force curve (``afmdyn fit``): the library's preprocessing, least
 squares, intervals and warnings, returned as an ``xarray.Dataset`` built from its document
-and layouts (no numerics here)."""
+and layouts (no numerics here; the public function is generated, :mod:`._wrappers`)."""
 
 from __future__ import annotations
 
 import json
 import os
 import warnings
-from typing import TYPE_CHECKING, Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
+from typing import Any, Dict, List, Mapping, Optional, Tuple
 
 import numpy as np
 import xarray as xr
 
-from ._afmdyn import Params
-from ._common import AfmdynWarning, Model, _door, _params
+from ._common import AfmdynWarning, _door, _params, _request, _user_level
 from ._layout import dataset
-from ._progress import ProgressArg
-
-if TYPE_CHECKING:  # annotations only (PEP 692)
-    from typing_extensions import Unpack
 
 
-def fit(
-    params: Optional[Params] = None,
-    /,
-    *,
-    data: Union[str, "os.PathLike[str]", Mapping[str, Sequence[float]], Any, None] = None,
-    fit: Optional[List[str]] = None,
-    curve: int = 0,
-    approach_rows: Optional[int] = None,
-    segment: str = "approach",
-    fit_range: Optional[Tuple[float, float]] = None,
-    progress: ProgressArg = None,
-    **model: Unpack[Model],
-) -> xr.Dataset:
-    """Fit a quasi-static force curve with the probe's contact law (``afmdyn fit``; hertz,
-    dmt or jkr), its contact point and baseline: nanite's preprocessing (tip position
-    height + F/k, force and tip offsets at the contact point), Levenberg–Marquardt, standard
-    errors, 95 % profile-likelihood intervals, correlations and identifiability warnings.
+#: the keywords of :func:`afmdyn.fit` that are not the request's as they are
+_OWN = ("data", "curve", "fit", "fit_range", "approach_rows")
 
-    Args:
-        data: the force curve: a CSV file with the columns ``height`` (m, the piezo height,
-            decreasing into the sample), ``force`` (N, repulsion positive) and optionally
-            ``sigma`` (N); or a mapping (a ``pandas.DataFrame``, a dict) with those columns;
-            or an instrument's curve read by afmformats (Müller et al.; JPK ``.jpk-force``,
-            ``.jpk-force-map``, ``.jpk-qi-data``, Asylum ``.ibw``, afmformats ``.h5``/``.tab``):
-            a file of those kinds, or an ``afmformats`` force-distance object (a
-            ``nanite.Indentation`` too), whose ``height (measured)`` (else ``height
-            (piezo)``) and ``force`` columns are taken.
-        curve: which curve of an afmformats file with several (a force map), from 0.
-        approach_rows: the number of rows of the approach (the rest is the retract); default
-            the instrument's segments for an afmformats curve (its ``segment`` column), else
-            up to the lowest height, inclusive.
-        fit: the parameters fitted, by their probe keys (default ``sample.youngs_modulus``
-            and ``contact_point``): also ``tip.radius``, ``baseline``, ``sample.hamaker``
-            (dmt), ``sample.adhesion_energy`` (jkr). The others are held at the probe's.
-        segment: ``"approach"`` (up to the lowest height) or ``"retract"``.
-        fit_range: the tip positions fitted (lo, hi) in m, after the contact-point offset.
-        probe: a probe file (a model keyword, as ``--probe``): required.
 
-    Returns:
-        An ``xarray.Dataset``: over ``row`` the fitted rows' ``tip_position``, ``force``,
-        ``fit`` and ``residual``; over ``parameter`` the ``estimate``, ``standard_error``,
-        ``interval_low`` and ``interval_high`` (95 %), and ``correlation`` over
-        (``parameter``, ``parameter_2``); attributes ``chi2_dof``, ``noise`` and ``summary``
-        (the ``afmdyn fit --json`` document). Warnings (a correlation above 0.99, a flat
-        profile, an estimate at its bound, the noise estimated from the residuals) are raised
-        as :class:`afmdyn.AfmdynWarning`.
-
-    Raises:
-        ValueError: naming the option, the data or the probe key.
-
-    ``progress``: ``None``, ``True``, ``False`` or ``callable(done, total)``.
-    """
-    request: Dict[str, Any] = {"segment": segment}
+def _finish_fit(a: Dict[str, Any]) -> xr.Dataset:
+    """Fit the curve of :func:`afmdyn.fit`'s keywords ``a`` (its ``locals()``)."""
+    request = {k: v for k, v in _request(a).items() if v is not None and k not in _OWN}
+    fit, fit_range, approach_rows = a["fit"], a["fit_range"], a["approach_rows"]
     if fit is not None:
         request["fit"] = list(fit)
     if fit_range is not None:
         request["range"] = [float(fit_range[0]), float(fit_range[1])]
-    data, k_file, segments = _instrument_curve(data, curve)
+    data, k_file, segments = _instrument_curve(a["data"], a["curve"])
     if approach_rows is None:
         approach_rows = segments
     if approach_rows is not None:
@@ -89,14 +39,14 @@ def fit(
         for key in ("height", "force", "sigma"):
             if key in data:
                 request[key] = [float(v) for v in np.asarray(data[key], dtype=float)]
-    p, probe = _params(params, model)
-    d = _door("fit", "fit", progress, p, probe, request)
+    p, probe = _params(a["params"], a["model"])
+    d = _door("fit", "fit", a["progress"], p, probe, request)
     doc = json.loads(d["json"])
     k = doc["preprocessing"]["spring_constant"]
     if k_file and abs(k_file / k - 1) > 0.01:
         warnings.warn(f"the file's spring constant {k_file:g} N/m differs from the probe's "
                       f"{k:g} N/m: the probe's is used (set [cantilever] spring_constant to "
-                      "the file's to use it)", AfmdynWarning, stacklevel=2)
+                      "the file's to use it)", AfmdynWarning, stacklevel=_user_level())
     ds = xr.merge([dataset(layout) for layout in d["datasets"].values()], combine_attrs="drop")
     names = list(doc["estimates"])
     est = [doc["estimates"][n] for n in names]

@@ -2,9 +2,9 @@
 # scripts/wrapper_docs.py: do not edit (CI runs `python3 scripts/gen_stubs.py --check`)
 """The analyses' public functions (``afmdyn.simulate``, …; their finishers are in
 :mod:`._api`, :mod:`._orbits`, :mod:`._attractors`, :mod:`._basins`, :mod:`._fm`,
-:mod:`._global_continuation` and :mod:`._chart`). Each checks its keywords' types first
-(``TypeError`` naming the keyword); the library checks their values (``ValueError``
-naming the field and its range).
+:mod:`._global_continuation`, :mod:`._chart`, :mod:`._peakforce` and :mod:`._fit`).
+Those marked ``@_typed`` check their keywords' types first (``TypeError`` naming the
+keyword); the library checks the values (``ValueError`` naming the field and its range).
 
 The signature of each function is its library request's (the keywords, their types and
 defaults, their descriptions in "Args:"), its body a call of its hand-written finisher
@@ -13,11 +13,12 @@ defaults, their descriptions in "Args:"), its body a call of its hand-written fi
 from __future__ import annotations
 
 import os
-from typing import TYPE_CHECKING, Optional, Sequence, Union
+from typing import TYPE_CHECKING, Any, Mapping, Optional, Sequence, Tuple, Union
 
 import xarray as xr
 
-from . import _api, _attractors, _basins, _chart, _fm, _global_continuation, _orbits, _peakforce
+from . import _api, _attractors, _basins, _chart, _fit, _fm, _global_continuation, _orbits
+from . import _peakforce
 from ._afmdyn import Params
 from ._attractors import Attractors
 from ._common import Model, StateLike, _typed
@@ -45,6 +46,7 @@ __all__ = [
     "fm",
     "chart",
     "peakforce",
+    "fit",
 ]
 
 
@@ -1090,3 +1092,64 @@ def peakforce(
         ValueError: naming the option or the model parameter.
     """
     return _peakforce._finish_peakforce(locals())
+
+
+def fit(
+    params: Optional[Params] = None,
+    /,
+    *,
+    approach_rows: Optional[int] = None,
+    data: Union[str, "os.PathLike[str]", Mapping[str, Sequence[float]], Any, None] = None,
+    fit: Optional[Sequence[str]] = None,
+    fit_range: Optional[Tuple[float, float]] = None,
+    segment: str = "approach",
+    curve: int = 0,
+    progress: ProgressArg = None,
+    **model: Unpack[Model],
+) -> xr.Dataset:
+    """Fit a quasi-static force curve with the probe's contact law (``afmdyn fit``; hertz,
+    dmt or jkr), its contact point and baseline: nanite's preprocessing (tip position
+    height + F/k, force and tip offsets at the contact point), Levenberg–Marquardt, standard
+    errors, 95 % profile-likelihood intervals, correlations and identifiability warnings.
+    ``probe`` (a model keyword, as ``--probe``) is required.
+
+    Args:
+        approach_rows: The number of rows of the approach (the rest is the retract), as an
+            instrument records its segments (afmformats' ``segment`` column, which Python
+            reads from an instrument file); default up to the lowest piezo height,
+            inclusive. 1 to the number of rows. For an afmformats curve the default is the
+            instrument's segments.
+        data: the force curve: a CSV file with the columns ``height`` (m, the piezo height,
+            decreasing into the sample), ``force`` (N, repulsion positive) and optionally
+            ``sigma`` (N); or a mapping (a ``pandas.DataFrame``, a dict) with those columns;
+            or an instrument's curve read by afmformats (Müller et al.; JPK ``.jpk-force``,
+            ``.jpk-force-map``, ``.jpk-qi-data``, Asylum ``.ibw``, afmformats
+            ``.h5``/``.tab``): a file of those kinds, or an ``afmformats`` force-distance
+            object (a ``nanite.Indentation`` too), whose ``height (measured)`` (else
+            ``height (piezo)``) and ``force`` columns are taken.
+        fit: The parameters fitted, by their probe keys: ``sample.youngs_modulus``,
+            ``tip.radius``, ``contact_point``, ``baseline``, and ``sample.hamaker`` (DMT) or
+            ``sample.adhesion_energy`` (JKR); the others are held at the probe's values
+            (contact point and baseline at 0, after the preprocessing). Default
+            ``sample.youngs_modulus``, ``contact_point``.
+        fit_range: The range of tip positions fitted [lo, hi] (m, after the preprocessing's
+            offset, as nanite's ``range_x``); default the whole segment.
+        segment: The segment fitted (default the approach).
+        curve: which curve of an afmformats file with several (a force map), from 0.
+        progress: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a
+            log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.
+        **model: the model keywords (:class:`Model`), ``probe=`` a probe in SI.
+
+    Returns:
+        An ``xarray.Dataset``: over ``row`` the fitted rows' ``tip_position``, ``force``,
+        ``fit`` and ``residual``; over ``parameter`` the ``estimate``, ``standard_error``,
+        ``interval_low`` and ``interval_high`` (95 %), and ``correlation`` over
+        (``parameter``, ``parameter_2``); attributes ``chi2_dof``, ``noise`` and ``summary``
+        (the ``afmdyn fit --json`` document). Warnings (a correlation above 0.99, a flat
+        profile, an estimate at its bound, the noise estimated from the residuals) are raised
+        as :class:`afmdyn.AfmdynWarning`.
+
+    Raises:
+        ValueError: naming the option, the data or the probe key.
+    """
+    return _fit._finish_fit(locals())
