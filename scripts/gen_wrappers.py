@@ -1,12 +1,15 @@
-"""Generate ``afmdyn/_wrappers.py``: the public analysis functions of the Python package.
+"""Generate the analyses' public functions of the Python package: ``afmdyn/_wrappers.py``
+(``afmdyn.simulate``, …), ``afmdyn/_dask_wrappers.py`` (``afmdyn.dask.chart``,
+``afmdyn.dask.bifurcation``) and ``afmdyn/_model.py`` (the ``Model`` keywords).
 
 Each function's keyword-only signature (names, types, defaults) and the "Args:" of its
 docstring come from its request's JSON Schema (``docs/schema/requests/*.json``, the library's
-request types: field types, ``Default``, doc comments); its summary, "Returns" and "Raises"
-come from :data:`DOCS` below. The body hands ``locals()`` to a hand-written finisher
-(``_finish_<name>`` in the module named by :data:`ANALYSES`) that runs the request through
-the one door (``_afmdyn.run``) and builds the result. ``scripts/gen_stubs.py`` calls
-:func:`generate` and writes (or, with ``--check``, compares) the file.
+request types: field types, ``Default``, doc comments), with the few Python keywords of its
+own and the widened types listed in :data:`FILES`; its summary, "Returns" and "Raises" come
+from ``scripts/wrapper_docs.py``. The body hands ``locals()`` to a hand-written finisher
+(``_finish_<name>`` in the module :data:`FILES` names) that runs the request through the one
+door (``_afmdyn.run``) and builds the result. ``scripts/gen_stubs.py`` calls :func:`generate`
+and :func:`generate_model` and writes (or, with ``--check``, compares) the files.
 """
 
 from __future__ import annotations
@@ -35,7 +38,8 @@ DASK_KW = [("client", 'Optional["distributed.Client"]', "None"), ("store", STORE
 #: (name, annotation, default), documented in :data:`COMMON_ARGS` or ``DOCS[name]["args"]``),
 #: ``first`` (such keywords before the request's), ``omit`` (request fields Python does not
 #: take), ``override`` (a field's annotation and default in Python, wider than the
-#: request's: the finisher converts it), ``rename`` (a field's keyword in Python), ``typed`` (False: no ``@_typed`` check of the keywords)
+#: request's: the finisher converts it), ``rename`` (a field's keyword in Python), ``typed``
+#: (False: no ``@_typed`` check of the keywords)
 FILES: Dict[str, Dict[str, Tuple[object, str, str, Dict[str, object]]]] = {
     "_wrappers.py": {
         "modes": (None, "_api", "Spectrum", {"own": []}),
@@ -43,19 +47,21 @@ FILES: Dict[str, Dict[str, Tuple[object, str, str, Dict[str, object]]]] = {
         "converge": ("converge", "_api", "xr.Dataset", {}),
         "bifurcation": ("bifurcation", "_api", "xr.Dataset", {"own": PROGRESS + STORE_KW}),
         "continuation": ("continuation", "_api", "xr.Dataset", {}),
-        "observe": ("observe", "_api", "xr.Dataset", {}),
-        "approach": ("approach", "_api", "xr.Dataset",
-                     {"own": STORE_KW + PROGRESS, "omit": ("average", "exact")}),
-        "bimodal": ("approach", "_api", "xr.Dataset", {"own": STORE_KW + PROGRESS}),
-        "resonance": ("resonance", "_api", "xr.Dataset", {"own": STORE_KW + PROGRESS}),
         "orbit": ("orbit", "_orbits", "Orbit", {}),
         "lyapunov": ("lyapunov", "_orbits", "Lyapunov", {}),
         "attractors": ("attractors", "_attractors", "Attractors", {}),
         "basins": ("basins", "_basins", "xr.Dataset", {"own": STORE_KW + PROGRESS}),
         "global_continuation": ("global_continuation", "_global_continuation", "xr.Dataset",
                                 {"own": STORE_KW + PROGRESS}),
-        "fm": ("fm", "_fm", "xr.Dataset", {}),
         "chart": ("chart", "_chart", "xr.Dataset", {"own": PROGRESS + STORE_KW}),
+    },
+    "_wrappers_afm.py": {
+        "observe": ("observe", "_api", "xr.Dataset", {}),
+        "approach": ("approach", "_api", "xr.Dataset",
+                     {"own": STORE_KW + PROGRESS, "omit": ("average", "exact")}),
+        "bimodal": ("approach", "_api", "xr.Dataset", {"own": STORE_KW + PROGRESS}),
+        "resonance": ("resonance", "_api", "xr.Dataset", {"own": STORE_KW + PROGRESS}),
+        "fm": ("fm", "_fm", "xr.Dataset", {}),
         "peakforce": ("peakforce", "_peakforce", "xr.Dataset", {
             "omit": ("sweep",), "typed": False,
             "override": {"z_c": ("Union[float, Sequence[float], None]", "None"),
@@ -99,7 +105,7 @@ COMMON_ARGS = {
     "model": "the model keywords (:class:`Model`), ``probe=`` a probe in SI.",
 }
 
-#: per analysis: the summary, then the "Returns:"/"Raises:" sections (as they are printed)
+# per generated file and analysis: the summary, "Returns:", "Raises:" and Python's own "Args:"
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from wrapper_docs import DOCS, MODEL_DOC  # noqa: E402
 
@@ -204,7 +210,7 @@ defaults, their descriptions in "Args:"), its body a call of its hand-written fi
 from __future__ import annotations
 
 import os
-from typing import TYPE_CHECKING, Any, Mapping, Optional, Sequence, Tuple, Union
+from typing import {typing}
 
 import xarray as xr
 
@@ -221,18 +227,29 @@ __all__ = [
 #: per generated file: its docstring's first line, its imports, its imports for annotations
 HEADS = {
     "_wrappers.py": (
-        "The analyses' public functions (``afmdyn.simulate``, …; their finishers are in\n"
-        ":mod:`._api`, :mod:`._orbits`, :mod:`._attractors`, :mod:`._basins`, :mod:`._fm`,\n"
-        ":mod:`._global_continuation`, :mod:`._chart`, :mod:`._peakforce` and :mod:`._fit`).\n"
-        "Those marked ``@_typed`` check their keywords' types first (``TypeError`` naming the\n"
+        "The public functions of the dynamics' analyses (``afmdyn.simulate``, …, their\n"
+        "finishers in :mod:`._api`, :mod:`._orbits`, :mod:`._attractors`, :mod:`._basins`,\n"
+        ":mod:`._global_continuation` and :mod:`._chart`; the AFM measurements' are in\n"
+        ":mod:`._wrappers_afm`). Each checks its keywords' types first (``TypeError`` naming the\n"
         "keyword); the library checks the values (``ValueError`` naming the field and its range).",
-        "from . import _api, _attractors, _basins, _chart, _fit, _fm, _global_continuation, _orbits\n"
-        "from . import _peakforce\n"
+        "from . import _api, _attractors, _basins, _chart, _global_continuation, _orbits\n"
         "from ._afmdyn import Params\n"
         "from ._attractors import Attractors\n"
         "from ._common import Model, StateLike, _typed\n"
         "from ._progress import ProgressArg\n"
         "from ._results import Lyapunov, Orbit, Spectrum",
+        "",
+    ),
+    "_wrappers_afm.py": (
+        "The public functions of the AFM measurements (``afmdyn.observe``, ``approach``,\n"
+        "``bimodal``, ``resonance``, ``fm``, ``peakforce``, ``fit``; their finishers in\n"
+        ":mod:`._api`, :mod:`._fm`, :mod:`._peakforce` and :mod:`._fit`). Those marked\n"
+        "``@_typed`` check their keywords' types first (``TypeError`` naming the keyword); the\n"
+        "library checks the values (``ValueError`` naming the field and its range).",
+        "from . import _api, _fit, _fm, _peakforce\n"
+        "from ._afmdyn import Params\n"
+        "from ._common import Model, StateLike, _typed\n"
+        "from ._progress import ProgressArg",
         "",
     ),
     "_dask_wrappers.py": (
@@ -251,7 +268,11 @@ def generate(file: str = "_wrappers.py") -> str:
     names = "\n".join(f'    "{n}",' for n in FILES[file])
     head = (HEADER.replace("{doc}", doc).replace("{imports}", imports)
             .replace("{checking}", checking).replace("{names}", names))
-    parts = [head.rstrip()] + [_function(file, n) for n in FILES[file]]
+    functions = [_function(file, n) for n in FILES[file]]
+    used = [n for n in ("Any", "Mapping", "Optional", "Sequence", "Tuple", "Union")
+            if re.search(rf"\b{n}\[|\b{n}\b,|\b{n}\]", "\n".join(functions))]
+    head = head.replace("{typing}", ", ".join(["TYPE_CHECKING"] + used))
+    parts = [head.rstrip()] + functions
     return "\n\n\n".join(parts) + "\n"
 
 

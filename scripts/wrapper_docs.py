@@ -1,7 +1,8 @@
 """The docstrings' own parts of the generated analysis functions (``afmdyn/_wrappers.py``,
 written by ``scripts/gen_wrappers.py``): per analysis its summary and its "Returns:" and
-"Raises:" sections. The "Args:" come from the request schemas' field descriptions; ``args`` gives those of the
-keywords a request does not describe (or describes otherwise for Python)."""
+"Raises:" sections. The "Args:" come from the request schemas' field descriptions; ``args``
+gives those of the keywords a request does not describe (or describes otherwise for Python;
+a text starting with "+" is added to the request's)."""
 
 WRAPPERS = {
     "modes": {
@@ -415,7 +416,9 @@ Raises:
     ValueError: naming the option, the data or the probe key.""",
 }
 
-DOCS = {"_wrappers.py": WRAPPERS, "_dask_wrappers.py": DASK}
+AFM = ("observe", "approach", "bimodal", "resonance", "fm", "peakforce", "fit")
+DOCS = {"_wrappers.py": {k: v for k, v in WRAPPERS.items() if k not in AFM},
+        "_wrappers_afm.py": {k: WRAPPERS[k] for k in AFM}, "_dask_wrappers.py": DASK}
 
 #: the docstring of ``afmdyn.Model`` (the model keywords)
 MODEL_DOC = """\

@@ -35,25 +35,19 @@ from ._interrupt import install as _install_sigint
 from ._image import image, setpoint_study
 from ._reconstruct import reconstruct
 from ._wrappers import (
-    approach,
     attractors,
     basins,
     bifurcation,
-    bimodal,
     chart,
     continuation,
     converge,
-    fit,
-    fm,
     global_continuation,
     lyapunov,
     modes,
-    observe,
     orbit,
-    peakforce,
-    resonance,
     simulate,
 )
+from ._wrappers_afm import approach, bimodal, fit, fm, observe, peakforce, resonance
 from ._results import Lyapunov, Orbit, RegionSpectrum, Spectrum
 
 try:

@@ -1,5 +1,6 @@
-"""The finishers of the analyses whose public functions (:mod:`._wrappers`, generated from the
-library's request schemas) return datasets or spectra, and :func:`probe`. A finisher takes the
+"""The finishers of the analyses whose public functions (:mod:`._wrappers`,
+:mod:`._wrappers_afm`, generated from the library's request schemas) return datasets or
+spectra, and :func:`probe`. A finisher takes the
 public function's ``locals()`` (its keywords, ``params``, ``model``, ``progress``), runs the
 request through the one door (:func:`._common._door`) and builds the result from the library's
 layouts (:mod:`._layout`); the other finishers are in :mod:`._orbits`, :mod:`._attractors`,

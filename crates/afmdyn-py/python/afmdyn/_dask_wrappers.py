@@ -9,7 +9,7 @@ defaults, their descriptions in "Args:"), its body a call of its hand-written fi
 from __future__ import annotations
 
 import os
-from typing import TYPE_CHECKING, Any, Mapping, Optional, Sequence, Tuple, Union
+from typing import TYPE_CHECKING, Optional, Sequence, Union
 
 import xarray as xr
 

@@ -1,6 +1,6 @@
 """Fitting a measured force curve (``afmdyn fit``): the library's preprocessing, least
 squares, intervals and warnings, returned as an ``xarray.Dataset`` built from its document
-and layouts (no numerics here; the public function is generated, :mod:`._wrappers`)."""
+and layouts (no numerics here; the public function is generated, :mod:`._wrappers_afm`)."""
 
 from __future__ import annotations
 

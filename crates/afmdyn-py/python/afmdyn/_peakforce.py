@@ -1,6 +1,6 @@
 """Off-resonance (PeakForce) tapping (``afmdyn peakforce``): the library's steady tap of the
 modulation period as an ``xarray.Dataset`` built from its layouts (no numerics here; the
-public function is generated, :mod:`._wrappers`)."""
+public function is generated, :mod:`._wrappers_afm`)."""
 
 from __future__ import annotations
 
