@@ -173,3 +173,42 @@ fn sweep_grids_and_refusals() {
         .to_string()
         .contains("sweep"));
 }
+
+/// Every value of a sweep is checked for what makes its channels misleading, not only the first
+/// (issue 61, "a result that may be unsettled says so"): the sample held off the tip at
+/// z_c = 1.5 and 1.2 g₀ (its lowest point z_c − A_m above the resting tip: no force at all),
+/// in contact at 0.96; each value's warnings in `sweep.warnings`, one document warning
+/// counting them with the values where they hold.
+#[test]
+fn every_value_of_a_sweep_is_checked_for_its_warnings() {
+    let p = point_mass(100.0, 0.95);
+    let request = PeakForceRequest {
+        sweep: Some(PeakForceSweep {
+            quantity: PeakForceSweepParam::ZC,
+            values: vec![1.5, 1.2, 0.96],
+        }),
+        ..PeakForceRequest::default()
+    };
+    let d = run(&request, p);
+    let per_value: Vec<Vec<String>> =
+        serde_json::from_value(d.json["sweep"]["warnings"].clone()).unwrap();
+    assert_eq!(per_value.len(), 3);
+    for w in &per_value[..2] {
+        assert!(
+            w.iter().any(|m| m.contains("no repulsive contact")),
+            "{per_value:?}"
+        );
+    }
+    assert!(per_value[2].is_empty(), "{per_value:?}");
+    let warnings: Vec<String> = serde_json::from_value(d.json["warnings"].clone()).unwrap();
+    let counted: Vec<&String> = warnings
+        .iter()
+        .filter(|w| w.contains("no repulsive contact"))
+        .collect();
+    assert_eq!(counted.len(), 1, "{warnings:?}");
+    assert!(
+        counted[0].starts_with("at 2 of the sweep's 3 values (z_c = 1.5, 1.2 g0)"),
+        "{}",
+        counted[0]
+    );
+}

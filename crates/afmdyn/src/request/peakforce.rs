@@ -456,6 +456,50 @@ fn true_modulus(model: &Resolved, alpha4: f64) -> Option<f64> {
     Some(alpha4 * s.force_n / (4.0 / 3.0 * r.sqrt() * s.length_m.powf(1.5)))
 }
 
+/// What may make a steady tap's channels misleading, each with its kind (`period`, `double-tap`,
+/// `unstable`, `no-contact`) and its message: a period-n orbit (the cycle shows the first
+/// period), more than one contact per modulation period (`modulus_dmt` is then not meaningful),
+/// an unstable orbit, no repulsive contact. Every tap of a sweep is checked alike
+/// ([`super::peakforce_sweep::sweep_warnings`]).
+pub fn tap_warnings(tap: &SteadyTap) -> Vec<(&'static str, String)> {
+    let c = &tap.channels;
+    let mut warnings = Vec::new();
+    if tap.period > 1 {
+        warnings.push((
+            "period",
+            format!(
+                "period-{} tapping: the orbit repeats after {} modulation periods; the cycle \
+                 shows the first",
+                tap.period, tap.period
+            ),
+        ));
+    }
+    if c.taps_per_cycle > 1.0 + 1e-9 {
+        warnings.push((
+            "double-tap",
+            format!(
+                "{} contacts per modulation period: double taps (the lever's ringing reaches the \
+                 sample again); modulus_dmt, fitted as PF-QNM does on the retract of one tap, is \
+                 not meaningful for such a cycle",
+                c.taps_per_cycle
+            ),
+        ));
+    }
+    if !tap.stable {
+        warnings.push((
+            "unstable",
+            "the steady tap is unstable (a Floquet multiplier outside the unit circle)".into(),
+        ));
+    }
+    if c.peak_force <= 0.0 {
+        warnings.push((
+            "no-contact",
+            "no repulsive contact: the sample never reaches the tip at this z_c".into(),
+        ));
+    }
+    warnings
+}
+
 /// The document of a steady tap (`afmdyn peakforce --json`, Python's `to_dict()`): `channels`
 /// (the instrument's, SI with a probe), `modulus` (the DMT fit beside the true modulus),
 /// `orbit` (period, Floquet multipliers, stability), `balance` (energy per cycle), `cycle`
@@ -483,30 +527,12 @@ pub fn document(request: &PeakForceRequest, model: &Resolved, r: &PeakForceResul
         Some(scale) if has_radius => (fitted.map(|k| k * scale), Some(p.alpha4 * scale)),
         _ => (fitted, has_radius.then_some(p.alpha4)),
     };
-    let mut warnings: Vec<String> = Vec::new();
-    if tap.period > 1 {
-        warnings.push(format!(
-            "period-{} tapping: the orbit repeats after {} modulation periods; the cycle shows \
-             the first",
-            tap.period, tap.period
-        ));
-    }
-    if c.taps_per_cycle > 1.0 + 1e-9 {
-        warnings.push(format!(
-            "{} contacts per modulation period: double taps (the lever's ringing reaches the \
-             sample again); modulus_dmt, fitted as PF-QNM does on the retract of one tap, is not \
-             meaningful for such a cycle",
-            c.taps_per_cycle
-        ));
-    }
-    if !tap.stable {
-        warnings.push(
-            "the steady tap is unstable (a Floquet multiplier outside the unit circle)".into(),
-        );
-    }
-    if c.peak_force <= 0.0 {
-        warnings.push("no repulsive contact: the sample never reaches the tip at this z_c".into());
-    }
+    // a sweep's taps are each checked (the sweep's warnings, below); a single tap here
+    let mut warnings: Vec<String> = if r.sweep.is_some() {
+        Vec::new()
+    } else {
+        tap_warnings(tap).into_iter().map(|(_, w)| w).collect()
+    };
     let t = &tap.cycle;
     let half = t.time.len() / 2;
     let col = |v: &[f64], s: f64| v.iter().map(|x| x * s).collect::<Vec<f64>>();
@@ -534,7 +560,8 @@ pub fn document(request: &PeakForceRequest, model: &Resolved, r: &PeakForceResul
                 .unwrap_or(1.0);
             super::peakforce_sweep::sweep_document(s, &u, Some(scale), taps)
         });
-    if let Some(block) = &sweep {
+    if let (Some(block), Some(taps)) = (&sweep, &r.sweep) {
+        warnings.extend(super::peakforce_sweep::sweep_warnings(block, taps));
         let failed = block["message"]
             .as_array()
             .map_or(0, |m| m.iter().filter(|x| !x.is_null()).count());

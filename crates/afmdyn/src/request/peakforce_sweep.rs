@@ -215,7 +215,65 @@ pub fn sweep_document(
         "transient_periods": taps.iter().map(|t| t.tap.as_ref().map(|t| t.transient_periods)).collect::<Vec<_>>(),
         "evaluations": taps.iter().map(|t| t.evaluations).collect::<Vec<_>>(),
         "message": taps.iter().map(|t| t.message.clone()).collect::<Vec<_>>(),
+        "warnings": taps
+            .iter()
+            .map(|t| {
+                t.tap.as_ref().map_or(Vec::new(), |tap| {
+                    super::peakforce::tap_warnings(tap)
+                        .into_iter()
+                        .map(|(_, w)| w)
+                        .collect()
+                })
+            })
+            .collect::<Vec<Vec<String>>>(),
     })
+}
+
+/// The sweep's warnings for the document: each kind of [`super::peakforce::tap_warnings`]
+/// once, with the number of values it holds at and the swept values where it does (the
+/// first three and the last, in `block`'s units), its message the first such tap's; the
+/// per-value messages are in `sweep.warnings`.
+pub fn sweep_warnings(block: &Value, taps: &[SweepTap]) -> Vec<String> {
+    let quantity = block["quantity"].as_str().unwrap_or("value");
+    let unit = block["unit"].as_str().unwrap_or("");
+    let values: Vec<f64> = block["values"].as_array().map_or(Vec::new(), |a| {
+        a.iter().map(|v| v.as_f64().unwrap_or(f64::NAN)).collect()
+    });
+    // (kind, first message, indices), in the order the kinds first appear
+    let mut kinds: Vec<(&'static str, String, Vec<usize>)> = Vec::new();
+    for (i, t) in taps.iter().enumerate() {
+        let Some(tap) = &t.tap else { continue };
+        for (kind, message) in super::peakforce::tap_warnings(tap) {
+            match kinds.iter_mut().find(|k| k.0 == kind) {
+                Some(k) => k.2.push(i),
+                None => kinds.push((kind, message, vec![i])),
+            }
+        }
+    }
+    kinds
+        .into_iter()
+        .map(|(_, message, at)| {
+            let show = |&i: &usize| {
+                values
+                    .get(i)
+                    .map_or_else(|| format!("#{i}"), |&v| crate::error::number(v))
+            };
+            let mut list: Vec<String> = at.iter().take(3).map(show).collect();
+            if at.len() > 4 {
+                list.push("…".into());
+            }
+            if at.len() > 3 {
+                list.push(show(at.last().expect("non-empty")));
+            }
+            format!(
+                "at {} of the sweep's {} values ({quantity} = {} {unit}): {message} (each \
+                 value's in sweep.warnings)",
+                at.len(),
+                taps.len(),
+                list.join(", ")
+            )
+        })
+        .collect()
 }
 
 /// The sweep's layout from the document's `sweep` block: the values as the coordinate of the
