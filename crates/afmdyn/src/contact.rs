@@ -143,6 +143,10 @@ macro_rules! laws {
             }
         }
 
+        prepared_contact! {
+            [$( [$(#[cfg($cfg)])?] $Variant $Law [$($($field)*)?] )*]
+        }
+
         law_methods! {
             [$( [$(#[cfg($cfg)])?] $Variant $Law [$($($field)*)?] )*]
             /// The groups of the law (those it has).
@@ -196,6 +200,58 @@ macro_rules! laws {
             /// Why the law does not apply in a liquid medium, if it does not
             /// ([`Law::not_in_liquid`]: the capillary meniscus, the electrostatic force).
             fn not_in_liquid() -> Option<&'static str>;
+        }
+    };
+}
+
+/// [`PreparedContact`] (one variant per law, holding its [`Law::Prepared`]),
+/// [`ContactLaw::prepare`] and the static dispatch of its evaluations.
+macro_rules! prepared_contact {
+    ([$( [$(#[cfg($cfg:meta)])?] $Variant:ident $Law:ident [$($field:ident)*] )*]) => {
+        /// A law with its constants prepared once from its groups and α4, α6
+        /// ([`ContactLaw::prepare`]): each variant holds its law's [`Law::Prepared`].
+        #[derive(Debug, Clone, Copy, PartialEq)]
+        pub enum PreparedContact {
+            $(
+                $(#[cfg($cfg)])?
+                #[doc = concat!("[`", stringify!($Law), "`]'s prepared constants.")]
+                $Variant(<$Law as Law>::Prepared),
+            )*
+        }
+
+        impl ContactLaw {
+            /// The law's prepare step ([`Law::prepare`]) with α4 = `alpha4` and α6 = `alpha6`:
+            /// its constants, computed once per model.
+            pub fn prepare(&self, alpha4: f64, alpha6: f64) -> PreparedContact {
+                match *self {
+                    $(
+                        $(#[cfg($cfg)])?
+                        ContactLaw::$Variant { $($field),* } => PreparedContact::$Variant(
+                            Law::prepare(&$Law { $($field),* }, alpha4, alpha6),
+                        ),
+                    )*
+                }
+            }
+        }
+
+        impl PreparedForce for PreparedContact {
+            fn force(&self, contact: bool, delta: f64, rate: f64) -> ForceEval {
+                match self {
+                    $( $(#[cfg($cfg)])? PreparedContact::$Variant(p) => p.force(contact, delta, rate), )*
+                }
+            }
+
+            fn potential(&self, contact: bool, delta: f64) -> f64 {
+                match self {
+                    $( $(#[cfg($cfg)])? PreparedContact::$Variant(p) => p.potential(contact, delta), )*
+                }
+            }
+
+            fn dissipative(&self, delta: f64, rate: f64) -> f64 {
+                match self {
+                    $( $(#[cfg($cfg)])? PreparedContact::$Variant(p) => p.dissipative(delta, rate), )*
+                }
+            }
         }
     };
 }
@@ -254,12 +310,13 @@ mod prepared;
 pub use capillary::{
     Meniscus, CAPILLARY_DEFAULT_FORCE, CAPILLARY_DEFAULT_MENISCUS, CAPILLARY_DEFAULT_RUPTURE,
 };
+pub use dmt::PreparedDmt;
 pub use dmt::{DMT_DEFAULT_A0, DMT_DEFAULT_HAMAKER};
 pub use electrostatic::{ELECTROSTATIC_DEFAULT, ELECTROSTATIC_DEFAULT_RADIUS, VACUUM_PERMITTIVITY};
 pub use impact::IMPACT_DEFAULT_RESTITUTION;
-pub use jkr::{Jkr, JKR_BREAK_CUT, JKR_DEFAULT_ADHESION};
+pub use jkr::{Jkr, PreparedJkr, JKR_BREAK_CUT, JKR_DEFAULT_ADHESION};
 pub use law::{reduced_modulus, Law, LawInfo, Param, SampleSi};
-pub use prepared::PreparedLaw;
+pub use prepared::{AsGiven, PreparedForce, PreparedLaw};
 pub use sls::{Zener, SLS_DEFAULT_MAXWELL};
 
 impl Default for ContactLaw {

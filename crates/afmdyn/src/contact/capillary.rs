@@ -80,6 +80,7 @@ impl Law for CapillaryLaw {
         },
     ];
 
+    super::prepared::as_given!();
     fn with_groups(g: &LawGroups) -> Self {
         CapillaryLaw {
             capillary: g.capillary.unwrap_or(CAPILLARY_DEFAULT_FORCE),

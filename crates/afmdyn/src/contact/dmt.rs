@@ -7,7 +7,7 @@
 //! (1999) 4961 and Garcia, *Amplitude Modulation AFM*, Wiley 2010, ch. 3). The force is
 //! continuous at δ = 0, so the free flight is nonlinear but the switching has no force jump.
 
-use super::{ForceEval, JetLaw, Law, LawGroups, Param, SampleSi};
+use super::{ForceEval, JetLaw, Law, LawGroups, Param, PreparedForce, SampleSi};
 use crate::error::ParamError;
 
 /// Default DMT groups: H̃ = 1e-5, ã₀ = 0.01, an adhesion force H̃/ã₀² = 0.1, about 5 % of the
@@ -53,69 +53,95 @@ pub(crate) fn van_der_waals(h: f64, d: f64) -> [f64; 3] {
     [-h / (d * d), 2.0 * h / (d * d * d), -h / d]
 }
 
-/// DMT's (and the electrostatic law's) force: the long-range attraction `long` at distance d
-/// outside contact; at d = a₀ plus Hertz and Kelvin–Voigt in contact.
-pub(crate) fn dmt_force(
-    long: impl Fn(f64) -> [f64; 3],
-    a0: f64,
-    (k, c): (f64, f64),
-    contact: bool,
-    delta: f64,
-    rate: f64,
-) -> ForceEval {
-    if contact {
-        let d = delta.max(0.0);
-        let s = d.sqrt();
-        // ∂(√δ δ̇)/∂δ = δ̇/(2√δ): integrable singularity at δ = 0, 0 there
-        let visc_d = if s > 0.0 { 0.5 * c * rate / s } else { 0.0 };
-        ForceEval {
-            force: long(a0)[0] + k * d * s + c * s * rate,
-            d_delta: 1.5 * k * s + visc_d,
-            d_rate: c * s,
-        }
-    } else {
-        // d = a₀ + V_T = a₀ − δ > a₀; ∂/∂δ = −∂/∂d
-        let [force, d_d, _] = long(a0 - delta);
-        ForceEval {
-            force,
-            d_delta: -d_d,
-            d_rate: 0.0,
+/// DMT's (and the electrostatic law's) prepare step ([`Law::prepare`]): the law with α4, α6,
+/// ã₀ and its long-range force at contact, [F, dF/dd, U] at d = ã₀ (DMT's adhesion
+/// F = −H̃/ã₀²), computed once. Outside contact the long-range attraction at d = ã₀ − δ > ã₀;
+/// in contact the adhesion at d = ã₀ plus Hertz and Kelvin–Voigt (module docs).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PreparedDmt<L> {
+    /// The law's groups (its long-range force).
+    pub law: L,
+    /// α4.
+    pub k: f64,
+    /// α6.
+    pub c: f64,
+    /// ã₀.
+    pub a0: f64,
+    /// The long-range [F, dF/dd, U] at d = ã₀.
+    pub at_contact: [f64; 3],
+}
+
+impl<L: Law> PreparedDmt<L> {
+    /// `law` (with ã₀ its [`Law::distance_offset`]) with α4 = `k`, α6 = `c`.
+    pub fn new(law: L, k: f64, c: f64) -> Self {
+        let a0 = law.distance_offset();
+        PreparedDmt {
+            law,
+            k,
+            c,
+            a0,
+            at_contact: law.long_range(a0),
         }
     }
 }
 
-/// DMT's potential: the long-range one outside contact, continued by the adhesion and Hertz
-/// inside.
-pub(crate) fn dmt_potential(
-    long: impl Fn(f64) -> [f64; 3],
-    a0: f64,
-    k: f64,
-    contact: bool,
-    delta: f64,
-) -> f64 {
-    if contact {
-        let [f0, _, u0] = long(a0);
-        u0 + f0 * delta + 0.4 * k * delta.max(0.0).powf(2.5)
-    } else {
-        long(a0 - delta)[2]
+impl<L: Law> PreparedForce for PreparedDmt<L> {
+    fn force(&self, contact: bool, delta: f64, rate: f64) -> ForceEval {
+        let (k, c) = (self.k, self.c);
+        if contact {
+            let d = delta.max(0.0);
+            let s = d.sqrt();
+            // ∂(√δ δ̇)/∂δ = δ̇/(2√δ): integrable singularity at δ = 0, 0 there
+            let visc_d = if s > 0.0 { 0.5 * c * rate / s } else { 0.0 };
+            ForceEval {
+                force: self.at_contact[0] + k * d * s + c * s * rate,
+                d_delta: 1.5 * k * s + visc_d,
+                d_rate: c * s,
+            }
+        } else {
+            // d = a₀ + V_T = a₀ − δ > a₀; ∂/∂δ = −∂/∂d
+            let [force, d_d, _] = self.law.long_range(self.a0 - delta);
+            ForceEval {
+                force,
+                d_delta: -d_d,
+                d_rate: 0.0,
+            }
+        }
+    }
+
+    /// The long-range potential outside contact, continued by the adhesion and Hertz inside.
+    fn potential(&self, contact: bool, delta: f64) -> f64 {
+        if contact {
+            let [f0, _, u0] = self.at_contact;
+            u0 + f0 * delta + 0.4 * self.k * delta.max(0.0).powf(2.5)
+        } else {
+            self.law.long_range(self.a0 - delta)[2]
+        }
+    }
+
+    /// The Kelvin–Voigt part α6 √δ δ̇.
+    fn dissipative(&self, delta: f64, rate: f64) -> f64 {
+        self.c * delta.max(0.0).sqrt() * rate
     }
 }
 
-/// The methods DMT and the electrostatic law share (their long-range force aside): the force
-/// and potential of [`dmt_force`], [`dmt_potential`], the Kelvin–Voigt dissipation α6 √δ δ̇,
-/// the force outside contact and the offset ã₀.
+/// The methods DMT and the electrostatic law share (their long-range force aside): the prepare
+/// step [`PreparedDmt`], whose force, potential and dissipation (the Kelvin–Voigt α6 √δ δ̇) are
+/// the law's, the force outside contact and the offset ã₀.
 macro_rules! dmt_family {
     () => {
+        type Prepared = PreparedDmt<Self>;
+        fn prepare(&self, k: f64, c: f64) -> PreparedDmt<Self> {
+            PreparedDmt::new(*self, k, c)
+        }
         fn force(&self, k: f64, c: f64, contact: bool, delta: f64, rate: f64) -> ForceEval {
-            let long = |d| self.long_range(d);
-            dmt_force(long, self.intermolecular_distance, (k, c), contact, delta, rate)
+            self.prepare(k, c).force(contact, delta, rate)
         }
         fn potential(&self, k: f64, contact: bool, delta: f64) -> f64 {
-            let long = |d| self.long_range(d);
-            dmt_potential(long, self.intermolecular_distance, k, contact, delta)
+            self.prepare(k, 0.0).potential(contact, delta)
         }
-        fn dissipative(&self, _k: f64, c: f64, delta: f64, rate: f64) -> f64 {
-            c * delta.max(0.0).sqrt() * rate
+        fn dissipative(&self, k: f64, c: f64, delta: f64, rate: f64) -> f64 {
+            self.prepare(k, c).dissipative(delta, rate)
         }
         fn acts_outside(&self) -> bool {
             true

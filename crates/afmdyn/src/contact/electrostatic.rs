@@ -6,8 +6,9 @@
 //! Hertz and Kelvin–Voigt in contact, as DMT (continuous at δ = 0).
 
 use super::dmt::{
-    dmt_family,dmt_force, dmt_potential, van_der_waals, DmtLaw, DMT_DEFAULT_A0, DMT_DEFAULT_HAMAKER};
-use super::{ForceEval, Law, LawGroups, Param, SampleSi};
+    dmt_family, van_der_waals, DmtLaw, PreparedDmt, DMT_DEFAULT_A0, DMT_DEFAULT_HAMAKER,
+};
+use super::{ForceEval, Law, LawGroups, Param, PreparedForce, SampleSi};
 use crate::error::ParamError;
 
 /// ε₀, the vacuum permittivity (F/m; CODATA 2018).

@@ -12,6 +12,7 @@ impl Law for HertzLaw {
         "Hertz sphere–flat repulsion with a viscous damper: F_c = α4 δ^{3/2} + α6 δ̇";
     const SAMPLE_KEYS: &'static [&'static str] = &["law", "youngs_modulus", "poisson_ratio", "damping", "z_c"];
 
+    super::prepared::as_given!();
     fn with_groups(_: &LawGroups) -> Self {
         HertzLaw
     }

@@ -31,6 +31,7 @@ impl Law for ImpactLaw {
         si_keys: &["restitution"],
     }];
 
+    super::prepared::as_given!();
     fn with_groups(g: &LawGroups) -> Self {
         ImpactLaw {
             restitution: g.restitution.unwrap_or(IMPACT_DEFAULT_RESTITUTION),

@@ -14,7 +14,7 @@
 //! = (3/5 + 4^{−1/3}/10) 2^{2/3} π^{5/3} (W⁵R⁴/E*²)^{1/3} ≈ 7.09 (W⁵R⁴/E*²)^{1/3} (from
 //! the potential below). The region is hysteretic: contact persists while δ > δ_f.
 
-use super::{ForceEval, Hysteresis, Law, LawGroups, Param, SampleSi};
+use super::{ForceEval, Hysteresis, Law, LawGroups, Param, PreparedForce, SampleSi};
 use crate::error::ParamError;
 
 /// Default JKR adhesion group P̃ = πWR = 0.05: the work of adhesion of DMT's defaults (whose
@@ -42,6 +42,8 @@ impl Law for JkrLaw {
         doc: "adhesion group P̃ = πWR/F (W the work of adhesion): pull-off (3/2)P̃",
         si_keys: &["adhesion_energy", "radius"],
     }];
+
+    type Prepared = PreparedJkr;
 
     fn with_groups(g: &LawGroups) -> Self {
         JkrLaw {
@@ -87,20 +89,20 @@ impl Law for JkrLaw {
         };
         Ok((law, si.hertz_alpha4(), si.kelvin_voigt_alpha6()))
     }
-    fn force(&self, k: f64, c: f64, contact: bool, delta: f64, rate: f64) -> ForceEval {
-        if !contact {
-            return ForceEval::default();
+    fn prepare(&self, k: f64, c: f64) -> PreparedJkr {
+        PreparedJkr {
+            jkr: Jkr::new(k, self.adhesion),
+            damping: c,
         }
-        Jkr::new(k, self.adhesion).contact_force(c, delta, rate)
+    }
+    fn force(&self, k: f64, c: f64, contact: bool, delta: f64, rate: f64) -> ForceEval {
+        self.prepare(k, c).force(contact, delta, rate)
     }
     fn potential(&self, k: f64, contact: bool, delta: f64) -> f64 {
-        if !contact {
-            return 0.0;
-        }
-        Jkr::new(k, self.adhesion).contact_potential(delta)
+        self.prepare(k, 0.0).potential(contact, delta)
     }
     fn dissipative(&self, k: f64, c: f64, delta: f64, rate: f64) -> f64 {
-        Jkr::new(k, self.adhesion).dissipative(c, delta, rate)
+        self.prepare(k, c).dissipative(delta, rate)
     }
     fn hysteresis(&self, alpha4: f64) -> Option<Hysteresis> {
         let jkr = Jkr::new(alpha4, self.adhesion);
@@ -110,6 +112,35 @@ impl Law for JkrLaw {
             pull_off_force: 1.5 * self.adhesion,
             energy_per_tap: jkr.hysteresis(),
         })
+    }
+}
+
+/// JKR's prepare step ([`Law::prepare`]): the contact's constants ([`Jkr::new`]: two square
+/// roots and a cube root of α4 and P̃) with the Kelvin–Voigt group α6. No force outside
+/// contact.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PreparedJkr {
+    /// The contact's constants.
+    pub jkr: Jkr,
+    /// α6.
+    pub damping: f64,
+}
+
+impl PreparedForce for PreparedJkr {
+    fn force(&self, contact: bool, delta: f64, rate: f64) -> ForceEval {
+        if !contact {
+            return ForceEval::default();
+        }
+        self.jkr.contact_force(self.damping, delta, rate)
+    }
+    fn potential(&self, contact: bool, delta: f64) -> f64 {
+        if !contact {
+            return 0.0;
+        }
+        self.jkr.contact_potential(delta)
+    }
+    fn dissipative(&self, delta: f64, rate: f64) -> f64 {
+        self.jkr.dissipative(self.damping, delta, rate)
     }
 }
 
@@ -158,7 +189,7 @@ impl Jkr {
     /// F_c(δ, δ̇) in contact with its partials, α6 = `c` the Kelvin–Voigt group (module docs):
     /// F_c = α4 q⁶ − b q³ + α6 q² δ̇ at q = q(δ) ([`Jkr::radius_variable`]). The force of
     /// [`JkrLaw`]'s [`Law::force`] in contact, from constants computed once
-    /// ([`super::PreparedLaw`]).
+    /// ([`PreparedJkr`]).
     pub fn contact_force(&self, c: f64, delta: f64, rate: f64) -> ForceEval {
         let q = self.radius_variable(delta);
         let (f, df_dq) = self.elastic(q);

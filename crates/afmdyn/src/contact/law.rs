@@ -2,7 +2,7 @@
 //! [`Param`]) the registry ([`super::LAWS`]) hands to the front ends (schema, CLI help, Python,
 //! docs, conformance suite).
 
-use super::{ForceEval, Hysteresis, LawGroups, Zener};
+use super::{ForceEval, Hysteresis, LawGroups, PreparedForce, Zener};
 use crate::error::ParamError;
 
 /// One dimensionless group of a law: what a front end needs to name, document and check it.
@@ -118,8 +118,17 @@ pub trait Law: Copy + Sized {
     /// The keys a probe file's `[sample]` table may hold for the law ([`crate::probe`]).
     const SAMPLE_KEYS: &'static [&'static str] = &["law", "z_c"];
 
+    /// The law's constants, derived once from its groups and α4, α6 ([`Law::prepare`]);
+    /// [`super::AsGiven`] for a law that derives nothing worth keeping.
+    type Prepared: PreparedForce + Copy + std::fmt::Debug + PartialEq;
+
     /// The law from the groups a front end gives, the missing ones at their defaults.
     fn with_groups(groups: &LawGroups) -> Self;
+    /// The prepare step: the law's groups with α4 = `k` and α6 = `c` turned into the constants
+    /// its force needs, once per model ([`super::PreparedLaw`]). Evaluating the result is
+    /// [`Law::force`], [`Law::potential`] and [`Law::dissipative`] bit for bit (the same
+    /// operations in the same order).
+    fn prepare(&self, k: f64, c: f64) -> Self::Prepared;
     /// The law's groups (those it has).
     fn groups(&self) -> LawGroups {
         LawGroups::default()

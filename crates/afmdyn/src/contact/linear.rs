@@ -11,6 +11,7 @@ impl Law for LinearLaw {
     const DOC: &'static str = "the paper's spring–damper F_c = α4 δ + α6 δ̇ in contact (eqs. 16–18)";
     const SAMPLE_KEYS: &'static [&'static str] = &["law", "stiffness", "damping", "z_c"];
 
+    super::prepared::as_given!();
     fn with_groups(_: &LawGroups) -> Self {
         LinearLaw
     }

@@ -46,6 +46,7 @@ impl Law for SlsLaw {
         si_keys: &["maxwell_stiffness", "relaxation_time"],
     }];
 
+    super::prepared::as_given!();
     fn with_groups(g: &LawGroups) -> Self {
         SlsLaw {
             maxwell_stiffness: g.maxwell_stiffness.unwrap_or(SLS_DEFAULT_MAXWELL),

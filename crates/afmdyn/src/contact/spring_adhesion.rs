@@ -29,6 +29,7 @@ impl Law for SpringAdhesionLaw {
         si_keys: &[],
     }];
 
+    super::prepared::as_given!();
     fn with_groups(g: &LawGroups) -> Self {
         SpringAdhesionLaw {
             adhesion: g.adhesion.unwrap_or(0.1),

@@ -157,12 +157,14 @@ fn the_registry_is_consistent() {
     );
 }
 
-/// The prepared law ([`PreparedLaw`]: JKR's constants computed once) evaluates every law's
+/// The prepared law ([`PreparedLaw`]: each law's prepare step, JKR's constants and DMT's
+/// adhesion computed once) evaluates every law's
 /// force, partials, potential and dissipative part bit for bit as the law evaluated from its
 /// groups at each call, over δ from beyond JKR's break to deep indentation (the break itself,
 /// δ = 0 and NaN included), both regions and three rates; and JKR's force is, bit for bit, the
 /// expression of the law before the constants were kept (q(δ), F(q), dq/dδ from [`Jkr::new`]
-/// at each call).
+/// at each call), DMT's force and potential the expressions with −H̃/ã₀² and −H̃/ã₀ formed at
+/// each call.
 #[test]
 fn the_prepared_law_is_the_law_bit_for_bit() {
     let mut cases = laws();
@@ -175,6 +177,7 @@ fn the_prepared_law_is_the_law_bit_for_bit() {
     }
     let bits = |e: ForceEval| [e.force, e.d_delta, e.d_rate].map(f64::to_bits);
     let mut checked = 0;
+    let mut dmt_checked = 0;
     for ts in cases {
         let prepared = PreparedLaw::new(ts);
         assert_eq!(prepared.tip_sample(), &ts);
@@ -230,9 +233,49 @@ fn the_prepared_law_is_the_law_bit_for_bit() {
                         assert_eq!(bits(prepared.force(true, delta, rate)), bits(old), "{at}");
                         checked += 1;
                     }
+                    if let ContactLaw::Dmt {
+                        hamaker: h,
+                        intermolecular_distance: a0,
+                    } = ts.law
+                    {
+                        // DMT's expression before the adhesion −H̃/ã₀² was prepared
+                        let (k, c) = (ts.stiffness, ts.damping);
+                        let (old, u) = if contact {
+                            let d = delta.max(0.0);
+                            let s = d.sqrt();
+                            let visc_d = if s > 0.0 { 0.5 * c * rate / s } else { 0.0 };
+                            let [f0, _, u0] = dmt::van_der_waals(h, a0);
+                            let old = ForceEval {
+                                force: f0 + k * d * s + c * s * rate,
+                                d_delta: 1.5 * k * s + visc_d,
+                                d_rate: c * s,
+                            };
+                            (old, u0 + f0 * delta + 0.4 * k * d.powf(2.5))
+                        } else {
+                            let [force, d_d, u] = dmt::van_der_waals(h, a0 - delta);
+                            let old = ForceEval {
+                                force,
+                                d_delta: -d_d,
+                                d_rate: 0.0,
+                            };
+                            (old, u)
+                        };
+                        assert_eq!(
+                            bits(prepared.force(contact, delta, rate)),
+                            bits(old),
+                            "{at}"
+                        );
+                        let got = prepared.potential(contact, delta);
+                        assert_eq!(got.to_bits(), u.to_bits(), "{at}");
+                        dmt_checked += 1;
+                    }
                 }
             }
         }
     }
     assert!(checked > 4 * 800, "{checked} JKR evaluations compared");
+    assert!(
+        dmt_checked > 6 * 800,
+        "{dmt_checked} DMT evaluations compared"
+    );
 }
