@@ -33,6 +33,7 @@
 
 use super::observables::{observe, wrap_phase, ObservableOptions};
 use crate::error::SimError;
+use crate::integrate::dense::sample_dense;
 use crate::integrate::{advance, build, check_start, Integrator, IntegratorOptions};
 use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
@@ -114,14 +115,12 @@ impl LockIn {
 /// The first harmonic (A, φ) of W(1,τ) over the drive period from the integrator's current τ,
 /// sampled `samples` times (module docs), the integrator advanced to the period's end.
 ///
-/// The samples are read from the integrator's dense output ([`Integrator::dense_state`]) inside
-/// the steps it takes over the period, so that they do not cut its steps: the Taylor
-/// integrator's free-flight step spans up to a quarter period, and stopping it at each of the
-/// 32 samples formed 32 or more series per period. The dense output is the step's solution to
-/// the integrator's tolerance, so (A, φ) differ from [`demodulate_period_stepped`]'s by about
-/// the tolerance times the amplitude (the test `dense_and_stepped_demodulation_agree`). An
-/// integrator with spans ([`Integrator::spans`]: the exact propagator, the split integrator)
-/// is stepped to each sample as [`demodulate_period_stepped`] does.
+/// The samples are read from the integrator's dense output inside the steps it takes over the
+/// period ([`sample_dense`]), so that they do not cut its steps: (A, φ) differ from
+/// [`demodulate_period_stepped`]'s by about the tolerance times the amplitude (the test
+/// `dense_and_stepped_demodulation_agree`). An integrator with spans ([`Integrator::spans`]:
+/// the exact propagator, the split integrator) is stepped to each sample as
+/// [`demodulate_period_stepped`] does.
 ///
 /// # Errors
 /// As the integrator.
@@ -130,32 +129,17 @@ pub fn demodulate_period(
     model: &CantileverModel,
     samples: usize,
 ) -> Result<(f64, f64), SimError> {
-    if integ.spans().is_some() {
-        return demodulate_period_stepped(integ, model, samples);
-    }
     let p = model.params();
     let (t0, period) = (integ.tau(), model.period());
     let psi = p.drive_phase();
     let tau_of = |j: usize| t0 + period * j as f64 / samples as f64;
-    let end = tau_of(samples);
     let (mut x, mut y) = (0.0, 0.0);
-    let mut j = 1;
-    while j <= samples {
-        integ.step(end)?;
-        let tau1 = integ.tau();
-        while j <= samples && tau_of(j) <= tau1 {
-            let tau = tau_of(j);
-            let w = if tau == tau1 {
-                model.tip_values(tau, integ.state())[0]
-            } else {
-                model.tip_values(tau, &integ.dense_state(tau))[0]
-            };
-            let (s, c) = (p.omega * tau + psi).sin_cos();
-            x += w * s;
-            y -= w * c;
-            j += 1;
-        }
-    }
+    sample_dense(integ, samples, &tau_of, &mut |_, tau, z| {
+        let w = model.w_tip_slice(z, 0);
+        let (s, c) = (p.omega * tau + psi).sin_cos();
+        x += w * s;
+        y -= w * c;
+    })?;
     let k = 2.0 / samples as f64;
     Ok(((k * x).hypot(k * y), wrap_phase((k * y).atan2(k * x))))
 }
