@@ -538,7 +538,8 @@ impl CantileverModel {
         }
     }
 
-    fn w_tip_slice(&self, z: &[f64], offset: usize) -> f64 {
+    /// φ(1)ᵀ of the N values of `z` from `offset`: W(1,τ) at offset 0, ∂W(1,τ)/∂τ at N.
+    pub(crate) fn w_tip_slice(&self, z: &[f64], offset: usize) -> f64 {
         let n = self.modes();
         self.tip()
             .as_slice()

@@ -470,3 +470,36 @@ fn dense_and_stepped_demodulation_agree() {
     }
     assert!(tapped >= 20, "the periods tap: {tapped}");
 }
+
+/// A distributed scan's worker rebuilds the plan from its recipe without the study (no
+/// approach curves) and scans its lines from the stage's start (the study's line job): the
+/// same lines, bit for bit (the results' text equal), as the planning process's own study.
+#[test]
+fn a_worker_scans_the_lines_of_the_start_bit_for_bit() {
+    use afmdyn::request::image_scan::ScanRecipe;
+    use afmdyn::study::plan::{plan, rebuild, Recipe};
+    let map2d = MAP.replace("size = [1.0e-6, 0.0]", "size = [1.0e-6, 0.2e-6]");
+    let scan = ScanRecipe {
+        probe: probe(100.0),
+        map: SampleMap::parse(&map2d, "<test>").unwrap(),
+        request: ImageRequest {
+            pixels: 6,
+            lines: Some(2),
+            ..ImageRequest::at(0.7)
+        },
+        scan: PiScan {
+            scan_rate: Some(40.0),
+            ..PiScan::default()
+        },
+    };
+    let here = plan(Recipe::Image { scan }).unwrap();
+    let stage = here.stage(0, &[]).unwrap();
+    assert_eq!(stage.tasks, vec![0, 1]);
+    let worker = rebuild(here.recipe()).unwrap();
+    let cancel = std::sync::atomic::AtomicBool::new(false);
+    for t in stage.tasks {
+        let remote = worker.run(&stage.start, t, &cancel).unwrap();
+        assert_eq!(remote, here.run("", t, &cancel).unwrap(), "line {t}");
+    }
+    assert!(worker.run("not a start", 0, &cancel).is_err());
+}

@@ -13,6 +13,9 @@
 //! X_k = (2/M) Σ_j W_j sin θ_j = A cos φ, Y_k = −(2/M) Σ_j W_j cos θ_j = A sin φ for
 //! W = ⟨W⟩ + A sin(θ − φ): exact for a periodic motion but for the harmonics M ± 1, 2M ± 1, …
 //! that alias onto the first (a digital lock-in sampling at M times the drive frequency). The
+//! sines and cosines come from one of each per period: θ₀ = Ωτ₀ + ψ rotated by ΩT/M at each
+//! sample (M rotations of a few ulp each: within 1e-14 of sin θ_j, while Ωτ itself carries
+//! the rounding of τ, about 1e-10 after 10⁵ periods). The
 //! output low-pass is first order with time constant τ_L, sampled exactly for an input held
 //! over the period T: X̄_k = X̄_{k−1} + β (X_k − X̄_{k−1}), β = 1 − e^{−T/τ_L} (β = 1 for
 //! τ_L = 0: the period's own boxcar average); A = |(X̄, Ȳ)|, φ = arg(X̄ + iȲ).
@@ -33,6 +36,7 @@
 
 use super::observables::{observe, wrap_phase, ObservableOptions};
 use crate::error::SimError;
+use crate::integrate::dense::sample_dense;
 use crate::integrate::{advance, build, check_start, Integrator, IntegratorOptions};
 use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
@@ -114,14 +118,12 @@ impl LockIn {
 /// The first harmonic (A, φ) of W(1,τ) over the drive period from the integrator's current τ,
 /// sampled `samples` times (module docs), the integrator advanced to the period's end.
 ///
-/// The samples are read from the integrator's dense output ([`Integrator::dense_state`]) inside
-/// the steps it takes over the period, so that they do not cut its steps: the Taylor
-/// integrator's free-flight step spans up to a quarter period, and stopping it at each of the
-/// 32 samples formed 32 or more series per period. The dense output is the step's solution to
-/// the integrator's tolerance, so (A, φ) differ from [`demodulate_period_stepped`]'s by about
-/// the tolerance times the amplitude (the test `dense_and_stepped_demodulation_agree`). An
-/// integrator with spans ([`Integrator::spans`]: the exact propagator, the split integrator)
-/// is stepped to each sample as [`demodulate_period_stepped`] does.
+/// The samples are read from the integrator's dense output inside the steps it takes over the
+/// period ([`sample_dense`]), so that they do not cut its steps: (A, φ) differ from
+/// [`demodulate_period_stepped`]'s by about the tolerance times the amplitude (the test
+/// `dense_and_stepped_demodulation_agree`). An integrator with spans ([`Integrator::spans`]:
+/// the exact propagator, the split integrator) is stepped to each sample as
+/// [`demodulate_period_stepped`] does.
 ///
 /// # Errors
 /// As the integrator.
@@ -130,32 +132,20 @@ pub fn demodulate_period(
     model: &CantileverModel,
     samples: usize,
 ) -> Result<(f64, f64), SimError> {
-    if integ.spans().is_some() {
-        return demodulate_period_stepped(integ, model, samples);
-    }
     let p = model.params();
     let (t0, period) = (integ.tau(), model.period());
     let psi = p.drive_phase();
     let tau_of = |j: usize| t0 + period * j as f64 / samples as f64;
-    let end = tau_of(samples);
+    // sin θ_j, cos θ_j by rotating θ₀ = Ωτ₀ + ψ by ΩT/M per sample (module docs)
+    let (mut s, mut c) = (p.omega * t0 + psi).sin_cos();
+    let (sd, cd) = (p.omega * (period / samples as f64)).sin_cos();
     let (mut x, mut y) = (0.0, 0.0);
-    let mut j = 1;
-    while j <= samples {
-        integ.step(end)?;
-        let tau1 = integ.tau();
-        while j <= samples && tau_of(j) <= tau1 {
-            let tau = tau_of(j);
-            let w = if tau == tau1 {
-                model.tip_values(tau, integ.state())[0]
-            } else {
-                model.tip_values(tau, &integ.dense_state(tau))[0]
-            };
-            let (s, c) = (p.omega * tau + psi).sin_cos();
-            x += w * s;
-            y -= w * c;
-            j += 1;
-        }
-    }
+    sample_dense(integ, samples, &tau_of, &mut |_, _, z| {
+        (s, c) = (s * cd + c * sd, c * cd - s * sd);
+        let w = model.w_tip_slice(z, 0);
+        x += w * s;
+        y -= w * c;
+    })?;
     let k = 2.0 / samples as f64;
     Ok(((k * x).hypot(k * y), wrap_phase((k * y).atan2(k * x))))
 }
@@ -260,7 +250,7 @@ pub struct ScanPixel {
 }
 
 /// What a scan line needs (model units).
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct LineSpec {
     /// The materials under the tip: the same lever and drive, only the sample differs (their
     /// α5 is set per period).
@@ -282,12 +272,13 @@ pub struct LineSpec {
     pub engage_periods: usize,
     /// The rest-distance range of the controller above the local surface (lowest, highest).
     pub range: (f64, f64),
-    /// The integrator.
+    /// The integrator (not serialised: a scan's is the default, [`IntegratorOptions::default`]).
+    #[serde(skip)]
     pub integrator: IntegratorOptions,
 }
 
 /// Where a line engages: far above its first pixel's material, on the steady state there.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Engage {
     /// The steady state at the start (τ = 0 of a period), shape `[dim]` of its material.
     pub state: DVector<f64>,

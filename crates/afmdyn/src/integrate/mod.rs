@@ -33,6 +33,7 @@
 //! [`SwitchEvent`].
 
 pub mod adaptive;
+pub mod dense;
 mod dop853;
 pub mod exact;
 mod factory;
@@ -177,6 +178,12 @@ pub trait Integrator: Send {
     fn dense_tip(&mut self, tau: f64) -> [f64; 3];
     /// Full state at `tau` inside the last step, shape `[2N]`.
     fn dense_state(&mut self, tau: f64) -> DVector<f64>;
+    /// [`Integrator::dense_state`] written into `out` (shape `[2N]`, the state's length), bit
+    /// for bit: the default copies it; the Taylor integrator allocates nothing (the lock-in's
+    /// 32 samples per drive period, [`dense::sample_dense`]).
+    fn dense_state_into(&mut self, tau: f64, out: &mut [f64]) {
+        out.copy_from_slice(self.dense_state(tau).as_slice());
+    }
     /// The states at the sample times τ_i = t0 + i·dt, i = `first`, `first` + 1, …, all inside
     /// the last step, into `out` (one row of 2N values per sample, `out.len()` a multiple of
     /// 2N): [`Integrator::dense_state`] at each (the default). The exact propagator advances its

@@ -151,13 +151,63 @@ pub struct ScanStudy {
     pub(crate) fingerprint: Value,
     recipe: ScanRecipe,
     ideal: Image,
-    of_domain: Vec<usize>,
+    /// What a line needs (the start of a distributed scan's stage, [`ScanStudy::line_job`]).
+    job: LineJob,
+    units: CurveUnits,
+    settings: ScanSettings,
+}
+
+/// What scanning one line of a PI image needs ([`ScanStudy::line_job`]): the line's
+/// settings, each material's engage, the sample map and the lines' y positions (model units
+/// as [`LineSpec`]; `length` is g₀ in m). Its lines are those of the study it came from, bit
+/// for bit, wherever it is sent (serde: every number as its bits).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LineJob {
     spec: LineSpec,
     /// Per material: where a line starting on it engages.
     engage: Vec<Engage>,
-    units: CurveUnits,
-    settings: ScanSettings,
+    map: SampleMap,
+    /// The material of each of the map's domains.
+    of_domain: Vec<usize>,
+    /// The lines' y positions (m), shape `[lines]`.
+    y: Vec<f64>,
+    /// g₀ (m).
+    length: f64,
     pixels: usize,
+}
+
+impl LineJob {
+    /// The number of lines.
+    pub fn lines(&self) -> usize {
+        self.y.len()
+    }
+
+    /// Scan line `t` (trace and retrace).
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming `line` beyond the image; as
+    /// [`crate::analysis::am_loop::scan_line`].
+    pub fn line(&self, t: usize, cancel: &AtomicBool) -> Result<ScanLine, SimError> {
+        if t >= self.lines() {
+            return Err(SimError::out_of_range(
+                "line",
+                format!("{t} (of {} lines)", self.lines()),
+                "must be a line of the image",
+            ));
+        }
+        let y = self.y[t];
+        let map = &self.map;
+        let (lx, g0) = (map.size.0, self.length);
+        let dx = lx / self.pixels as f64;
+        let under_tip = |s: f64| {
+            // a position on an edge belongs to the pixel it begins
+            let x = (s * dx).clamp(0.0, lx);
+            let m = map.domain_at(x, y).map_or(0, |k| self.of_domain[k]);
+            (m, map.height_at(x, y) / g0)
+        };
+        let first = under_tip(engage_position(&self.spec)).0;
+        scan_line(&self.spec, &self.engage[first], &under_tip, cancel)
+    }
 }
 
 /// A positive finite SI setting, or an error naming it.
@@ -352,6 +402,15 @@ impl ScanStudy {
             "request": req,
             "scan": settings,
         });
+        let job = LineJob {
+            spec,
+            engage,
+            map: map.clone(),
+            of_domain,
+            y: ideal.y.clone(),
+            length: units.length,
+            pixels,
+        };
         Ok(ScanStudy {
             fingerprint,
             recipe: ScanRecipe {
@@ -361,12 +420,9 @@ impl ScanStudy {
                 scan: *scan,
             },
             ideal,
-            of_domain,
-            spec,
-            engage,
+            job,
             units,
             settings,
-            pixels,
         })
     }
 
@@ -393,31 +449,19 @@ impl ScanStudy {
         &self.settings
     }
 
-    /// Scan line `t` (trace and retrace).
+    /// Scan line `t` (trace and retrace): [`LineJob::line`] of [`ScanStudy::line_job`].
     ///
     /// # Errors
-    /// [`SimError::OutOfRange`] naming `line` beyond the image; as
-    /// [`crate::analysis::am_loop::scan_line`].
+    /// As [`LineJob::line`].
     pub fn line(&self, t: usize, cancel: &AtomicBool) -> Result<ScanLine, SimError> {
-        if t >= self.lines() {
-            return Err(SimError::out_of_range(
-                "line",
-                format!("{t} (of {} lines)", self.lines()),
-                "must be a line of the image",
-            ));
-        }
-        let y = self.ideal.y[t];
-        let map = &self.recipe.map;
-        let (lx, g0) = (map.size.0, self.units.length);
-        let dx = lx / self.pixels as f64;
-        let under_tip = |s: f64| {
-            // a position on an edge belongs to the pixel it begins
-            let x = (s * dx).clamp(0.0, lx);
-            let m = map.domain_at(x, y).map_or(0, |k| self.of_domain[k]);
-            (m, map.height_at(x, y) / g0)
-        };
-        let first = under_tip(engage_position(&self.spec)).0;
-        scan_line(&self.spec, &self.engage[first], &under_tip, cancel)
+        self.job.line(t, cancel)
+    }
+
+    /// What scanning a line needs, without the materials' approach curves that
+    /// [`ScanStudy::new`] computes: a distributed scan sends it to its workers once (the
+    /// stage's start, [`crate::study::plan`]), so that a worker does not build the study.
+    pub fn line_job(&self) -> &LineJob {
+        &self.job
     }
 
     /// The image of the finished lines `records` (in any order, every line once).

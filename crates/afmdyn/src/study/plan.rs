@@ -10,7 +10,9 @@
 //!   line's resumable one ([`Plan::store`], [`PlanStore`]);
 //! - a basin map: one stage per pass, whose start is the attractors and coarse grid of the
 //!   passes before it ([`pass_start`]), one task per row;
-//! - a PI-scanned image: one stage, one task per line ([`ScanStudy`]).
+//! - a PI-scanned image: one stage, one task per line ([`ScanStudy`]), whose start is what a
+//!   line needs ([`LineJob`]): a worker scans lines without building the study (the
+//!   materials' approach curves, each several lines' time).
 //!
 //! The ledger — which tasks a store holds, how the results merge into the outcome — is the
 //! plan's: the executor only maps tasks and hands results back.
@@ -24,7 +26,7 @@ use crate::analysis::basins::{pass_start, passes, run_pass_row, BasinRow, PassSt
 use crate::analysis::bifurcation::{Branch, Seeds, SweepPlan, SweepPoint, SweepSpec, SweepTask};
 use crate::error::SimError;
 use crate::request::checkpoint::{self, Checkpoint};
-use crate::request::image_scan::{ScanRecipe, ScanStudy};
+use crate::request::image_scan::{LineJob, ScanRecipe, ScanStudy};
 use crate::request::named::{outcome, Outcome};
 use crate::request::sweep::{every_point_failed, fingerprint, order_key, records, SweepRecord};
 use crate::request::{BasinsRequest, BifurcationRequest, DirLock, FileCheckpoint, Resolved};
@@ -131,6 +133,12 @@ pub trait PlanStore: Send {
 /// # Errors
 /// The request's validation errors on its model.
 pub fn plan(recipe: Recipe) -> Result<Box<dyn Plan>, SimError> {
+    plan_of(recipe, true)
+}
+
+/// [`plan`]; a PI image's study built at once when `eager`, else on first use (a worker that
+/// runs lines from the stage's start never builds it).
+fn plan_of(recipe: Recipe, eager: bool) -> Result<Box<dyn Plan>, SimError> {
     let text = serde_json::to_string(&recipe).map_err(|e| bad("recipe", e))?;
     Ok(match recipe {
         Recipe::Bifurcation { request, params } => Box::new(Sweep {
@@ -155,19 +163,27 @@ pub fn plan(recipe: Recipe) -> Result<Box<dyn Plan>, SimError> {
             request,
             text,
         }),
-        Recipe::Image { scan } => Box::new(Image {
-            study: ScanStudy::from_recipe(&scan)?,
-            text,
-        }),
+        Recipe::Image { scan } => {
+            let study = std::sync::OnceLock::new();
+            if eager {
+                let _ = study.set(ScanStudy::from_recipe(&scan)?);
+            }
+            Box::new(Image { study, scan, text })
+        }
     })
 }
 
-/// The plan of a recipe's text ([`Plan::recipe`]).
+/// The plan of a recipe's text ([`Plan::recipe`]), as a worker rebuilds it: a PI image's
+/// study is built on first use, which a worker given the stage's start never makes (its lines
+/// run from the start, [`crate::request::image_scan::LineJob`]).
 ///
 /// # Errors
-/// Text that is not a recipe; as [`plan`].
+/// Text that is not a recipe; as [`plan`] (a PI image's study's errors when first used).
 pub fn rebuild(text: &str) -> Result<Box<dyn Plan>, SimError> {
-    plan(serde_json::from_str(text).map_err(|e| bad("recipe", e))?)
+    plan_of(
+        serde_json::from_str(text).map_err(|e| bad("recipe", e))?,
+        false,
+    )
 }
 
 fn bad(what: &'static str, e: impl std::fmt::Display) -> SimError {
@@ -405,10 +421,24 @@ impl Plan for Basins {
     }
 }
 
-/// A PI scan's plan.
+/// A PI scan's plan: its one stage's start is the study's [`LineJob`] (what a line needs,
+/// without the materials' approach curves), so that a worker scans lines without building
+/// the study.
 struct Image {
-    study: ScanStudy,
+    /// Built on first use ([`rebuild`]) or at once ([`plan`]).
+    study: std::sync::OnceLock<ScanStudy>,
+    scan: ScanRecipe,
     text: String,
+}
+
+impl Image {
+    fn study(&self) -> Result<&ScanStudy, SimError> {
+        if let Some(s) = self.study.get() {
+            return Ok(s);
+        }
+        let s = ScanStudy::from_recipe(&self.scan)?;
+        Ok(self.study.get_or_init(|| s))
+    }
 }
 
 impl Plan for Image {
@@ -420,24 +450,31 @@ impl Plan for Image {
     }
     fn stage(&self, stage: usize, _results: &[String]) -> Result<Stage, SimError> {
         match stage {
-            0 => Ok(Stage {
-                start: String::new(),
-                tasks: (0..self.study.lines()).collect(),
-            }),
+            0 => {
+                let study = self.study()?;
+                Ok(Stage {
+                    start: encode(study.line_job())?,
+                    tasks: (0..study.lines()).collect(),
+                })
+            }
             _ => Err(no_stage(stage, 1)),
         }
     }
-    fn run(&self, _start: &str, t: usize, cancel: &AtomicBool) -> Result<String, SimError> {
-        encode(&(t, self.study.line(t, cancel)?))
+    fn run(&self, start: &str, t: usize, cancel: &AtomicBool) -> Result<String, SimError> {
+        let line = if start.is_empty() {
+            self.study()?.line(t, cancel)?
+        } else {
+            decode::<LineJob>("start", start)?.line(t, cancel)?
+        };
+        encode(&(t, line))
     }
     fn outcome(&self, results: &[String]) -> Result<Outcome, SimError> {
         let lines = results
             .iter()
             .map(|t| decode::<(usize, ScanLine)>("result", t))
             .collect::<Result<Vec<_>, _>>()?;
-        let img = self.study.assemble(lines)?;
-        Ok(crate::request::image_job::ImageOutput::Pi(img)
-            .outcome(self.study.recipe().request.setpoint))
+        let img = self.study()?.assemble(lines)?;
+        Ok(crate::request::image_job::ImageOutput::Pi(img).outcome(self.scan.request.setpoint))
     }
 }
 

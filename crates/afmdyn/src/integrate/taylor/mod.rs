@@ -430,13 +430,18 @@ impl Integrator for Taylor {
     }
 
     fn dense_state(&mut self, tau: f64) -> DVector<f64> {
+        let mut z = DVector::zeros(self.z.len());
+        self.dense_state_into(tau, z.as_mut_slice());
+        z
+    }
+
+    fn dense_state_into(&mut self, tau: f64, out: &mut [f64]) {
         if !self.last.valid {
-            return self.z.clone();
+            out.copy_from_slice(self.z.as_slice());
+            return;
         }
         let s = self.local(tau);
-        let mut z = DVector::zeros(self.z.len());
-        self.last.series.state_at(s, z.as_mut_slice());
-        z
+        self.last.series.state_at(s, out);
     }
 
     fn dense_tip(&mut self, tau: f64) -> [f64; 3] {
