@@ -216,3 +216,29 @@ fn the_door_gives_the_image_and_refuses_an_am_probe() {
         .unwrap();
     assert!(err.to_string().contains("off-resonance"), "{err}");
 }
+
+#[test]
+fn the_plan_of_engages_and_lines_is_the_image_bit_for_bit() {
+    use afmdyn::study::plan::{plan, rebuild, Recipe};
+    use std::sync::atomic::AtomicBool;
+    let recipe = Recipe::PeakForceImage {
+        probe: probe(),
+        map: map(),
+        request: request(6, 4),
+    };
+    let p = plan(recipe).unwrap();
+    // as Dask does: every task in a plan rebuilt from its recipe's text
+    let worker = rebuild(p.recipe()).unwrap();
+    let cancel = AtomicBool::new(false);
+    let mut results = Vec::new();
+    for stage in 0..p.stages() {
+        let st = p.stage(stage, &results).unwrap();
+        for t in st.tasks.into_iter().rev() {
+            results.push(worker.run(&st.start, t, &cancel).unwrap());
+        }
+    }
+    let out = p.outcome(&results).unwrap();
+    let img = image(6, 4, 2);
+    let direct = afmdyn::request::image_job::ImageOutput::PeakForce(img).outcome(SETPOINT);
+    assert_eq!(out.document, direct.document);
+}

@@ -406,6 +406,9 @@ pub(crate) fn material_curves(
     Ok((materials, of_domain, units))
 }
 
+/// The materials' (name, model) of a sample map and the material of each of its domains.
+pub(crate) type MaterialModels = (Vec<(String, Params)>, Vec<usize>);
+
 /// The models of `map`'s materials under the probe table `probe_table` (its background
 /// `background`): the background, then one per domain with its own sample (name, model: the
 /// same lever, drive and units, only the sample differs); the material of each domain.
@@ -416,7 +419,7 @@ pub(crate) fn material_models(
     probe_table: &toml::Table,
     map: &SampleMap,
     background: &Probe,
-) -> Result<(Vec<(String, Params)>, Vec<usize>), SimError> {
+) -> Result<MaterialModels, SimError> {
     let mut models = vec![("background".to_string(), background.params)];
     let mut of_domain = Vec::with_capacity(map.domains.len());
     for d in &map.domains {

@@ -145,8 +145,9 @@ impl ImageKeywords {
         Ok((table, map))
     }
 
-    #[cfg(feature = "files")] // (a sample map may name a file)
-    fn request(&self) -> ImageRequest {
+    /// The image request of the keywords (its setpoint as given: A_sp/A₀, or N with
+    /// [`ImageMode::Peakforce`]).
+    pub fn request(&self) -> ImageRequest {
         ImageRequest::with(self.setpoint, self.pixels, self.lines, self.curve_points)
     }
 

@@ -99,6 +99,8 @@ pub struct PfMaterial {
     pub params: Params,
     /// The sample's true reduced modulus E* (Pa; NaN without a tip radius).
     pub true_modulus: f64,
+    /// The factor from the Hertz group (model units) to E* (Pa); `None` without a tip radius.
+    pub modulus_scale: Option<f64>,
     /// The engage from far: α5, the orbit's state at τ = 0 and the operating point; or why
     /// the setpoint is not reached.
     pub engaged: Result<(f64, DVector<f64>, PeakForceTap), String>,
@@ -189,14 +191,37 @@ pub fn peakforce_cost(
     })
 }
 
+/// A material's engage from far, as a task computes it: the steady taps of the feedback's
+/// search, and α5, the orbit's state at τ = 0 and the operating point, or why the setpoint is
+/// not reached.
+pub type Engage = (usize, Result<(f64, Vec<f64>, PeakForceTap), String>);
+
 impl PeakForceImageStudy {
     /// The study of `map` under the probe `probe_table` at the peak force `req.setpoint` (N):
     /// the materials' models and their engages from far (module docs).
     ///
     /// # Errors
-    /// As [`ImageRequest::validate_grid`] and [`peakforce_probe`]; [`SimError::Probe`] for a
-    /// domain's sample the probe format refuses; [`SimError::Cancelled`].
+    /// As [`PeakForceImageStudy::unengaged`]; [`SimError::Cancelled`].
     pub fn new(
+        probe_table: &toml::Table,
+        map: &SampleMap,
+        req: &ImageRequest,
+    ) -> Result<PeakForceImageStudy, SimError> {
+        let study = Self::unengaged(probe_table, map, req)?;
+        let engages = (0..study.materials.len())
+            .map(|m| study.engage(m))
+            .collect::<Result<Vec<_>, SimError>>()?;
+        Ok(study.with_engages(engages))
+    }
+
+    /// The study before its materials' engages ([`PeakForceImageStudy::engage`], then
+    /// [`PeakForceImageStudy::with_engages`]): an executor elsewhere (Dask) runs the engages
+    /// as tasks of their own.
+    ///
+    /// # Errors
+    /// As [`ImageRequest::validate_grid`] and [`peakforce_probe`]; [`SimError::Probe`] for a
+    /// domain's sample the probe format refuses.
+    pub fn unengaged(
         probe_table: &toml::Table,
         map: &SampleMap,
         req: &ImageRequest,
@@ -205,8 +230,6 @@ impl PeakForceImageStudy {
         let background = peakforce_probe(probe_table, req.setpoint)?;
         let units = CurveUnits::from_scales(&background.scales, true);
         let (models, of_domain) = material_models(probe_table, map, &background)?;
-        let options = PeakForceOptions::default();
-        let setpoint = req.setpoint / units.force;
         let resolved = |p: Params| Resolved {
             params: p,
             probe: Some(background.clone()),
@@ -215,27 +238,16 @@ impl PeakForceImageStudy {
             .into_iter()
             .map(|(name, params)| {
                 let scale = modulus_scale(&resolved(params), &params);
-                let opts = SetpointOptions {
-                    tap: options.clone(),
-                    ..SetpointOptions::default()
-                };
-                let (engaged, evaluations) = match peak_force_setpoint(&params, setpoint, &opts) {
-                    Ok(s) => {
-                        let tap = si_tap(&params, &units, scale, s.alpha5, &s.tap);
-                        (Ok((s.alpha5, s.tap.state, tap)), s.evaluations)
-                    }
-                    Err(SimError::Cancelled) => return Err(SimError::Cancelled),
-                    Err(e) => (Err(e.to_string()), 0),
-                };
-                Ok(PfMaterial {
+                PfMaterial {
                     name,
                     true_modulus: scale.map_or(f64::NAN, |s| s * params.alpha4),
+                    modulus_scale: scale,
                     params,
-                    engaged,
-                    evaluations,
-                })
+                    engaged: Err("not engaged".into()),
+                    evaluations: 0,
+                }
             })
-            .collect::<Result<Vec<_>, SimError>>()?;
+            .collect();
         let fingerprint = serde_json::json!({
             "afmdyn": env!("CARGO_PKG_VERSION"),
             "image": "peakforce",
@@ -248,11 +260,45 @@ impl PeakForceImageStudy {
             request: *req,
             materials,
             of_domain,
+            setpoint: req.setpoint / units.force,
             units,
-            setpoint,
-            options,
+            options: PeakForceOptions::default(),
             fingerprint,
         })
+    }
+
+    /// The engage of material `m` from far: the feedback's search from rest
+    /// ([`peak_force_setpoint`]).
+    ///
+    /// # Errors
+    /// [`SimError::Cancelled`]; a setpoint the material does not reach is the engage's
+    /// message, not an error.
+    pub fn engage(&self, m: usize) -> Result<Engage, SimError> {
+        let params = self.materials[m].params;
+        let opts = SetpointOptions {
+            tap: self.options.clone(),
+            ..SetpointOptions::default()
+        };
+        Ok(match peak_force_setpoint(&params, self.setpoint, &opts) {
+            Ok(s) => {
+                let tap = si_tap(&params, &self.units, self.scale(m), s.alpha5, &s.tap);
+                (
+                    s.evaluations,
+                    Ok((s.alpha5, s.tap.state.iter().copied().collect(), tap)),
+                )
+            }
+            Err(SimError::Cancelled) => return Err(SimError::Cancelled),
+            Err(e) => (0, Err(e.to_string())),
+        })
+    }
+
+    /// The study with the materials' engages (in the order of the materials).
+    pub fn with_engages(mut self, engages: Vec<Engage>) -> PeakForceImageStudy {
+        for (m, (evaluations, e)) in self.materials.iter_mut().zip(engages) {
+            m.evaluations = evaluations;
+            m.engaged = e.map(|(a5, z, tap)| (a5, DVector::from_vec(z), tap));
+        }
+        self
     }
 
     /// The number of lines.
@@ -335,9 +381,7 @@ impl PeakForceImageStudy {
 
     /// The factor from the Hertz group to E* (Pa) of material `m`.
     fn scale(&self, m: usize) -> Option<f64> {
-        let p = &self.materials[m].params;
-        (p.alpha4 > 0.0 && self.materials[m].true_modulus.is_finite())
-            .then(|| self.materials[m].true_modulus / p.alpha4)
+        self.materials[m].modulus_scale
     }
 
     /// The tap of `params` at the setpoint continued from α5 `a0` and the orbit state `z0` by
@@ -346,13 +390,12 @@ impl PeakForceImageStudy {
     ///
     /// # Errors
     /// [`SimError`] other than a tap's non-convergence (a model that cannot be built).
-    #[allow(clippy::type_complexity)]
     fn continue_to(
         &self,
         params: &Params,
         a0: f64,
         z0: &DVector<f64>,
-    ) -> Result<(Option<(f64, SteadyTap)>, usize), SimError> {
+    ) -> Result<Continued, SimError> {
         let f_set = self.setpoint;
         let tol = SETPOINT_TOL * f_set;
         let mut start = z0.clone();
@@ -398,6 +441,10 @@ impl PeakForceImageStudy {
         Ok((None, evaluations))
     }
 }
+
+/// A continuation's outcome: α5 and the tap at the setpoint (`None`: it did not converge), and
+/// the steady taps it computed.
+type Continued = (Option<(f64, SteadyTap)>, usize);
 
 /// The SI operating point of the tap `tap` of `p` at α5 `a5` (`scale`: the Hertz group to E*).
 fn si_tap(
