@@ -475,11 +475,12 @@ enum PfResult {
     Line(usize, Vec<LinePixel>),
 }
 
+/// A PeakForce image's results: the materials' engages (in their order) and the lines.
+type PfResults = (Vec<Engage>, Vec<(usize, Vec<LinePixel>)>);
+
 impl PfImage {
-    fn results(
-        &self,
-        results: &[String],
-    ) -> Result<(Vec<Engage>, Vec<(usize, Vec<LinePixel>)>), SimError> {
+    /// The engages and lines of `results` (any order; every material's engage required).
+    fn results(&self, results: &[String]) -> Result<PfResults, SimError> {
         let mut engages = Vec::new();
         let mut lines = Vec::new();
         for r in results {

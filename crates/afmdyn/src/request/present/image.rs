@@ -400,7 +400,7 @@ pub fn peakforce(img: &PeakForceImage, document: &Value, u: TextUnits) -> Presen
         (
             "image-modulus",
             "modulus_dmt",
-            "DMT modulus (PF-QNM fit)",
+            "Modulus (DMT fit, PF-QNM)",
             "Pa",
         ),
         ("image-adhesion", "adhesion", "Adhesion", "N"),
