@@ -132,7 +132,8 @@ pub struct PeakForceImageStudy {
 /// The background probe of a PeakForce image, checked to be off resonance.
 ///
 /// # Errors
-/// As [`background_probe`]; [`SimError::OutOfRange`] naming `excitation` for a probe without
+/// As the background probe of an AM image (a probe the format refuses, a multifrequency
+/// drive); [`SimError::OutOfRange`] naming `excitation` for a probe without
 /// an off-resonance drive, `setpoint` for a setpoint that is not a finite force > 0.
 pub fn peakforce_probe(probe_table: &toml::Table, setpoint: f64) -> Result<Probe, SimError> {
     let background = background_probe(probe_table)?;
