@@ -7,13 +7,14 @@
 //! ([`afmdyn::request::run::admit`]). It writes `image.json` (a summary), `image.nc` (the maps),
 //! the maps' figures and the line profile, as `--files` asks.
 
+use crate::args::{Dim, Quantity};
 use crate::cmd_approach::files;
 use crate::cmd_simulate::Files;
 use crate::door::{self, Exit};
 use crate::error::CliError;
 use crate::output::{units_of, OutDir};
 use afmdyn::request::image::{study_ratios, ImageRequest, SampleMap};
-use afmdyn::request::image_job::ImageJob;
+use afmdyn::request::image_job::{ImageJob, ImageMode};
 use afmdyn::request::image_scan::PiScan;
 use afmdyn::request::Analysis;
 use clap::Args;
@@ -38,9 +39,15 @@ pub struct ImageArgs {
     /// [domain.sample])
     #[arg(long, value_name = "S.toml")]
     sample: PathBuf,
-    /// Amplitude setpoint A_sp/A0 in (0, 1)
+    /// Setpoint: the amplitude ratio A_sp/A0 in (0, 1) (--mode am), or the peak force the
+    /// feedback holds (--mode peakforce; N, or with a unit: 2nN)
     #[arg(long)]
-    setpoint: f64,
+    setpoint: Quantity,
+    /// Imaging mode: am (amplitude-modulation tapping) or peakforce (off-resonance tapping with
+    /// an ideal peak-force feedback; a probe with [drive] mode = "off-resonance"): maps of
+    /// height, modulus_dmt, adhesion, deformation and dissipation
+    #[arg(long, default_value = "am")]
+    mode: String,
     /// Feedback: ideal (an operating point of the local material at every pixel) or pi (a
     /// time-domain scan, trace and retrace, under a lock-in and a PI z controller)
     #[arg(long, default_value = "ideal")]
@@ -62,7 +69,7 @@ pub struct ImageArgs {
     /// 1000 s, a warning outside 1 µs–0.1 s)
     #[arg(long, value_name = "S")]
     time_constant: Option<f64>,
-    /// PI scan: worker threads, one line per task (default: all cores)
+    /// PI scan or PeakForce image: worker threads, one line per task (default: all cores)
     #[arg(long)]
     threads: Option<usize>,
     /// PI scan: continue an interrupted scan; refused unless the other arguments are those of
@@ -99,13 +106,46 @@ pub struct ImageArgs {
 
 /// Run `afmdyn image`.
 pub fn image_cmd(a: &ImageArgs) -> Result<(), CliError> {
+    let mode = match a.mode.as_str() {
+        "am" => ImageMode::Am,
+        "peakforce" => ImageMode::Peakforce,
+        other => {
+            return Err(CliError::Input(format!(
+                "--mode {other}: must be am or peakforce"
+            )))
+        }
+    };
+    let setpoint = match mode {
+        ImageMode::Am if a.setpoint.dim.is_some() => {
+            return Err(CliError::Input(
+                "--setpoint: a ratio A_sp/A0 in (0, 1) without a unit (a force with --mode \
+                 peakforce)"
+                    .into(),
+            ))
+        }
+        ImageMode::Am => a.setpoint.value,
+        ImageMode::Peakforce => a.setpoint.value("setpoint", Dim::Force, true)?,
+    };
+    if mode == ImageMode::Peakforce {
+        for (set, flag) in [
+            (a.feedback != "ideal", "--feedback"),
+            (a.setpoint_study.is_some(), "--setpoint-study"),
+            (a.curve_points.is_some(), "--curve-points"),
+        ] {
+            if set {
+                return Err(CliError::Input(format!(
+                    "{flag}: not with --mode peakforce (the ideal peak-force feedback only)"
+                )));
+            }
+        }
+    }
     let pi = match a.feedback.as_str() {
         "ideal" => {
             for (set, flag) in [
                 (a.scan_rate.is_some(), "--scan-rate"),
                 (a.gains.is_some(), "--gains"),
                 (a.time_constant.is_some(), "--time-constant"),
-                (a.threads.is_some(), "--threads"),
+                (a.threads.is_some() && mode == ImageMode::Am, "--threads"),
                 (a.resume, "--resume"),
             ] {
                 if set {
@@ -151,10 +191,14 @@ pub fn image_cmd(a: &ImageArgs) -> Result<(), CliError> {
         afmdyn::SimError::Probe(m) => CliError::Input(format!("--sample {m}")),
         e => e.into(),
     })?;
-    let request = ImageRequest::with(a.setpoint, a.pixels, a.lines, a.curve_points);
-    request.validate(&map)?;
+    let request = ImageRequest::with(setpoint, a.pixels, a.lines, a.curve_points);
+    match mode {
+        ImageMode::Am => request.validate(&map)?,
+        ImageMode::Peakforce => request.validate_grid(&map)?,
+    }
     let study = a.setpoint_study.as_deref().map(study_ratios).transpose()?;
     let job = ImageJob {
+        mode,
         probe: table,
         sample: map,
         request,
@@ -175,7 +219,7 @@ pub fn image_cmd(a: &ImageArgs) -> Result<(), CliError> {
             files: Default::default(),
             json: a.json,
             out,
-            unit: if job.feedback.is_some() {
+            unit: if job.feedback.is_some() || mode == ImageMode::Peakforce {
                 "lines"
             } else {
                 "points"

@@ -245,6 +245,16 @@ impl ImageRequest {
                 "must be a ratio A_sp/A0 in (0, 1)",
             ));
         }
+        self.validate_grid(map)
+    }
+
+    /// Check the request's grid against the map (every check of [`ImageRequest::validate`]
+    /// but the setpoint's, which a PeakForce image reads as a force).
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming `pixels`, `lines` (1..=4096; 1 for a line map) or
+    /// `curve_points` (8..=2000); [`SimError::Budget`] for an image over [`MAX_IMAGE_BYTES`].
+    pub fn validate_grid(&self, map: &SampleMap) -> Result<(), SimError> {
         if !(1..=MAX_PIXELS).contains(&self.pixels) {
             return Err(SimError::out_of_range(
                 "pixels",
@@ -382,11 +392,35 @@ pub(crate) fn material_curves(
     let background = background_probe(probe_table)?;
     let units = CurveUnits::from_scales(&background.scales, false);
     check_cost("image", curves_cost(&background, map, curve_points, extra)?)?;
-    let mut materials = vec![MaterialCurve {
-        name: "background".into(),
-        params: background.params,
-        curve: approach_curve(background.params, &units, curve_points)?,
-    }];
+    let (models, of_domain) = material_models(probe_table, map, &background)?;
+    let materials = models
+        .into_iter()
+        .map(|(name, params)| {
+            Ok(MaterialCurve {
+                name,
+                params,
+                curve: approach_curve(params, &units, curve_points)?,
+            })
+        })
+        .collect::<Result<Vec<_>, SimError>>()?;
+    Ok((materials, of_domain, units))
+}
+
+/// The materials' (name, model) of a sample map and the material of each of its domains.
+pub(crate) type MaterialModels = (Vec<(String, Params)>, Vec<usize>);
+
+/// The models of `map`'s materials under the probe table `probe_table` (its background
+/// `background`): the background, then one per domain with its own sample (name, model: the
+/// same lever, drive and units, only the sample differs); the material of each domain.
+///
+/// # Errors
+/// [`SimError::Probe`] for a domain's sample the probe format refuses (named by the domain).
+pub(crate) fn material_models(
+    probe_table: &toml::Table,
+    map: &SampleMap,
+    background: &Probe,
+) -> Result<MaterialModels, SimError> {
+    let mut models = vec![("background".to_string(), background.params)];
     let mut of_domain = Vec::with_capacity(map.domains.len());
     for d in &map.domains {
         let Some(sample) = &d.sample else {
@@ -398,15 +432,10 @@ pub(crate) fn material_curves(
         let origin = format!("domain '{}'", d.name);
         let probe =
             Probe::from_table(&root, &origin).map_err(|e| SimError::Probe(e.to_string()))?;
-        // the same lever, drive and units: only the sample differs
-        of_domain.push(materials.len());
-        materials.push(MaterialCurve {
-            name: d.name.clone(),
-            params: probe.params,
-            curve: approach_curve(probe.params, &units, curve_points)?,
-        });
+        of_domain.push(models.len());
+        models.push((d.name.clone(), probe.params));
     }
-    Ok((materials, of_domain, units))
+    Ok((models, of_domain))
 }
 
 /// The warnings of the materials' approach curves, each named by its material.
@@ -499,6 +528,20 @@ pub fn image(
     Ok(image_of(&curves, &of_domain, &units, map, req))
 }
 
+/// The pixel centres x (m, `[pixels]`) and line positions y (m, `[lines]`) of `req` over `map`:
+/// the centres of equal cells of the map's size.
+pub(crate) fn pixel_grid(map: &SampleMap, req: &ImageRequest) -> (Vec<f64>, Vec<f64>) {
+    let (lx, ly) = map.size;
+    let x: Vec<f64> = (0..req.pixels)
+        .map(|i| (i as f64 + 0.5) * lx / req.pixels as f64)
+        .collect();
+    let n_lines = req.lines(map);
+    let y: Vec<f64> = (0..n_lines)
+        .map(|j| (j as f64 + 0.5) * ly / n_lines as f64)
+        .collect();
+    (x, y)
+}
+
 /// [`image`] from the materials' curves ([`material_curves`]).
 pub(crate) fn image_of(
     curves: &[MaterialCurve],
@@ -515,14 +558,7 @@ pub(crate) fn image_of(
             warnings: m.curve.warnings.clone(),
         })
         .collect();
-    let (lx, ly) = map.size;
-    let x: Vec<f64> = (0..req.pixels)
-        .map(|i| (i as f64 + 0.5) * lx / req.pixels as f64)
-        .collect();
-    let n_lines = req.lines(map);
-    let y: Vec<f64> = (0..n_lines)
-        .map(|j| (j as f64 + 0.5) * ly / n_lines as f64)
-        .collect();
+    let (x, y) = pixel_grid(map, req);
     // the approach curves' own warnings (an unsettled point, a failed one), named by material
     let mut warnings = curve_warnings(curves);
     for m in &materials {
@@ -537,7 +573,7 @@ pub(crate) fn image_of(
     let reference = engage(&materials[0].points)
         .map(|i| materials[0].points[i].z_c)
         .unwrap_or(f64::NAN);
-    let mut pixels = Vec::with_capacity(n_lines);
+    let mut pixels = Vec::with_capacity(y.len());
     let mut switches = 0usize;
     for &yj in &y {
         let mut line = Vec::with_capacity(req.pixels);

@@ -12,6 +12,7 @@ use super::image::{
     background_probe, curves_cost, image, setpoint_study, Image, ImageRequest, SampleMap,
     SetpointStudy,
 };
+use super::image_peakforce::{peakforce_cost, peakforce_probe, PeakForceImage};
 #[cfg(feature = "files")]
 use super::image_scan::ScanRecipe;
 use super::image_scan::{resolve, PiImage, PiScan, ScanStudy};
@@ -25,9 +26,25 @@ use crate::report::{OutputFile, Presentation, TextUnits};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
+/// The imaging mode: amplitude-modulation (AM) tapping or off-resonance (PeakForce) tapping.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ImageMode {
+    /// AM-AFM: the amplitude feedback at the setpoint ratio A_sp/A₀ ([`super::image`],
+    /// [`super::image_scan`]).
+    #[default]
+    Am,
+    /// PeakForce: the ideal peak-force feedback at the setpoint force (N) with an off-resonance
+    /// probe ([`super::image_peakforce`]).
+    Peakforce,
+}
+
 /// An image request with its inputs ([module docs](self)).
 #[derive(Debug, Clone, PartialEq)]
 pub struct ImageJob {
+    /// The imaging mode (AM: the request's setpoint is A_sp/A₀; PeakForce: the peak force in
+    /// N).
+    pub mode: ImageMode,
     /// The probe file's table (SI): the lever, tip, drive and the background sample.
     pub probe: toml::Table,
     /// The sample map.
@@ -58,6 +75,8 @@ pub enum ImageOutput {
     },
     /// A PI-scanned image.
     Pi(PiImage),
+    /// A PeakForce image (ideal peak-force feedback).
+    PeakForce(PeakForceImage),
 }
 
 impl ImageJob {
@@ -91,8 +110,10 @@ impl ImageJob {
 pub struct ImageKeywords {
     /// The sample map: its TOML text or path ([`SampleMap::read`]).
     pub sample: String,
-    /// Setpoint ratio A_sp/A₀ in (0, 1).
+    /// Setpoint: the ratio A_sp/A₀ in (0, 1) (AM), the peak force in N (PeakForce).
     pub setpoint: f64,
+    /// The imaging mode (`None`: AM).
+    pub mode: Option<ImageMode>,
     /// Pixels per line (`None`: [`ImageRequest::at`]'s).
     pub pixels: Option<usize>,
     /// Lines (`None`: [`ImageRequest::lines`]).
@@ -124,8 +145,9 @@ impl ImageKeywords {
         Ok((table, map))
     }
 
-    #[cfg(feature = "files")] // (a sample map may name a file)
-    fn request(&self) -> ImageRequest {
+    /// The image request of the keywords (its setpoint as given: A_sp/A₀, or N with
+    /// [`ImageMode::Peakforce`]).
+    pub fn request(&self) -> ImageRequest {
         ImageRequest::with(self.setpoint, self.pixels, self.lines, self.curve_points)
     }
 
@@ -137,6 +159,7 @@ impl ImageKeywords {
     pub fn job(self, probe: &str) -> Result<ImageJob, SimError> {
         let (probe, sample) = self.inputs(probe)?;
         Ok(ImageJob {
+            mode: self.mode.unwrap_or_default(),
             probe,
             sample,
             request: self.request(),
@@ -163,13 +186,30 @@ impl ImageKeywords {
     }
 }
 
+impl ImageJob {
+    /// [`Analysis::validate`] of a PeakForce image: the grid, an off-resonance probe, a
+    /// setpoint force > 0, no PI feedback and no setpoint study.
+    fn validate_peakforce(&self) -> Result<(), SimError> {
+        if self.feedback.is_some() || self.study.is_some() {
+            return Err(SimError::out_of_range(
+                "mode",
+                "peakforce",
+                "a PeakForce image has the ideal peak-force feedback only (no PI scan, no \
+                 setpoint study)",
+            ));
+        }
+        self.request.validate_grid(&self.sample)?;
+        peakforce_probe(&self.probe, self.request.setpoint).map(|_| ())
+    }
+}
+
 impl ImageOutput {
     /// The outcome the one door gives: the per-pixel document, the image's layout (`image`:
     /// `image.nc`'s variables, [`super::image_layout`]) and, as the fact `summary`, the
     /// command line's `image.json` ([`super::present::image`]).
     pub fn outcome(&self, setpoint: f64) -> Outcome {
-        use super::image_layout::{layout, scan_layout};
-        use super::present::image::{ideal_summary, pi_summary};
+        use super::image_layout::{layout, peakforce_layout, scan_layout};
+        use super::present::image::{ideal_summary, peakforce_summary, pi_summary};
         let (document, layout, summary) = match self {
             ImageOutput::Ideal { image, study } => (
                 image.document(setpoint),
@@ -180,6 +220,11 @@ impl ImageOutput {
                 img.document(setpoint),
                 scan_layout(img, setpoint),
                 pi_summary(img, setpoint),
+            ),
+            ImageOutput::PeakForce(img) => (
+                img.document(),
+                peakforce_layout(img),
+                peakforce_summary(img),
             ),
         };
         let mut facts = serde_json::Map::new();
@@ -198,6 +243,9 @@ impl Analysis for ImageJob {
     fn validate(&self, _model: &Resolved) -> Result<(), SimError> {
         self.request.validate(&self.sample)?;
         check_threads(self.threads)?;
+        if self.mode == ImageMode::Peakforce {
+            return self.validate_peakforce();
+        }
         let background = background_probe(&self.probe)?;
         match (&self.feedback, &self.study) {
             (Some(_), Some(_)) => Err(SimError::out_of_range(
@@ -214,6 +262,16 @@ impl Analysis for ImageJob {
 
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<ImageOutput, SimError> {
         self.validate(model)?;
+        if self.mode == ImageMode::Peakforce {
+            return crate::study::peakforce_image::peakforce_image(
+                &self.probe,
+                &self.sample,
+                &self.request,
+                self.threads,
+                progress,
+            )
+            .map(ImageOutput::PeakForce);
+        }
         match &self.feedback {
             Some(scan) => crate::study::scan::pi_image(
                 &self.probe,
@@ -247,6 +305,7 @@ impl Analysis for ImageJob {
                 super::present::image::ideal_summary(image, setpoint, study.as_ref())
             }
             ImageOutput::Pi(img) => super::present::image::pi_summary(img, setpoint),
+            ImageOutput::PeakForce(img) => super::present::image::peakforce_summary(img),
         })
     }
 
@@ -255,6 +314,9 @@ impl Analysis for ImageJob {
     }
 
     fn cost(&self, _model: &Resolved) -> Result<Cost, SimError> {
+        if self.mode == ImageMode::Peakforce {
+            return peakforce_cost(&self.probe, &self.sample, &self.request);
+        }
         let background = background_probe(&self.probe)?;
         let (map, req) = (&self.sample, &self.request);
         let periods = match &self.feedback {
@@ -290,6 +352,7 @@ impl Analysis for ImageJob {
                 super::present::image::ideal(image, setpoint, study.as_ref(), document, units)
             }
             ImageOutput::Pi(img) => super::present::image::pi(img, setpoint, document, units),
+            ImageOutput::PeakForce(img) => super::present::image::peakforce(img, document, units),
         };
         // `--files data`: no figures; `none`: only the summary
         shown.files.retain(|f| match self.files {

@@ -5,6 +5,7 @@
 //! ([`crate::request::image_scan::PiImage`], [`scan_layout`]).
 
 use super::image::{Image, OperatingPoint, Regime};
+use super::image_peakforce::{PeakForceImage, PF_FIELDS};
 use super::image_scan::PiImage;
 use crate::layout::{Attr, Layout, Values, Variable};
 
@@ -76,16 +77,21 @@ fn domain_variable(img: &Image) -> Variable {
         .flat_map(|j| (0..nx).map(move |i| (j, i)))
         .map(|(j, i)| img.pixels[j][i].domain.map_or(0, |k| k as i32 + 1))
         .collect();
+    domain_codes(&domain, &img.domain_names)
+}
+
+/// The domain codes `domain` over (y, x) with the map's domain names `names` as their meanings.
+fn domain_codes(domain: &[i32], names: &[String]) -> Variable {
     flags(
         Variable::i32(
             "domain",
             &["y", "x"],
             "1",
             "domain of the sample map on top at the pixel",
-            &domain,
+            domain,
         ),
         std::iter::once("background".to_string())
-            .chain(img.domain_names.iter().map(|n| word(n)))
+            .chain(names.iter().map(|n| word(n)))
             .collect(),
     )
 }
@@ -323,6 +329,67 @@ pub fn scan_layout(img: &PiImage, setpoint: f64) -> Layout {
     }
     Layout::new(
         format!("afmdyn PI-feedback AM-AFM scan at the setpoint A/A0 = {setpoint}"),
+        &[("y", ny), ("x", nx)],
+        variables,
+    )
+}
+
+/// A PeakForce image's layout (`image.nc` of `afmdyn image --mode peakforce`): coordinates
+/// `x`, `y` (m); over (y, x) the [`PF_FIELDS`] as 64-bit floats in SI (NaN where the setpoint
+/// is not reached), `evaluations` (steady taps computed per pixel), `material` and `domain`
+/// (32-bit codes with their CF `flag_values` and `flag_meanings`, as in [`layout`]); the scalars
+/// `setpoint` (N) and `reference_z_c` (m).
+pub fn peakforce_layout(img: &PeakForceImage) -> Layout {
+    let (nx, ny) = (img.x.len(), img.y.len());
+    let cells = || (0..ny).flat_map(move |j| (0..nx).map(move |i| (j, i)));
+    let grid: &[&str] = &["y", "x"];
+    let mut variables = vec![
+        Variable::f64("x", &["x"], "m", "pixel centre x", &img.x),
+        Variable::f64("y", &["y"], "m", "line position y", &img.y),
+    ];
+    for (name, units, long_name) in PF_FIELDS {
+        let values: Vec<f64> = cells().map(|(j, i)| img.value(name, j, i)).collect();
+        variables.push(Variable::f64(name, grid, units, long_name, &values));
+    }
+    let evaluations: Vec<i32> = cells()
+        .map(|(j, i)| img.pixels[j][i].evaluations as i32)
+        .collect();
+    variables.push(Variable::i32(
+        "evaluations",
+        grid,
+        "1",
+        "steady taps computed for the pixel (0: the previous pixel's orbit or the engage kept)",
+        &evaluations,
+    ));
+    let material: Vec<i32> = cells().map(|(j, i)| img.material[j][i] as i32).collect();
+    variables.push(flags(
+        Variable::i32("material", grid, "1", "material of the pixel", &material),
+        img.materials.iter().map(|m| word(&m.name)).collect(),
+    ));
+    let domain: Vec<i32> = cells()
+        .map(|(j, i)| img.domain[j][i].map_or(0, |k| k as i32 + 1))
+        .collect();
+    variables.push(domain_codes(&domain, &img.domain_names));
+    variables.push(Variable::f64(
+        "setpoint",
+        &[],
+        "N",
+        "peak-force setpoint",
+        &[img.setpoint],
+    ));
+    variables.push(Variable::f64(
+        "reference_z_c",
+        &[],
+        "m",
+        "mean rest separation z_c,ref engaged on the background (the zero of the apparent \
+         height)",
+        &[img.reference],
+    ));
+    Layout::new(
+        format!(
+            "afmdyn ideal-feedback PeakForce image at the peak force {} N",
+            img.setpoint
+        ),
         &[("y", ny), ("x", nx)],
         variables,
     )

@@ -49,6 +49,7 @@ pub mod fit;
 pub mod image;
 pub mod image_job;
 pub mod image_layout;
+pub mod image_peakforce;
 pub mod image_scan;
 pub mod keywords;
 pub mod limits;

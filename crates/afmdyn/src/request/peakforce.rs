@@ -500,6 +500,17 @@ pub fn tap_warnings(tap: &SteadyTap) -> Vec<(&'static str, String)> {
     warnings
 }
 
+/// The factor from the fitted Hertz group (model units) to the reduced modulus E* (Pa) of the
+/// model `p` under the probe of `model`; `None` for a law without a tip radius (no modulus)
+/// or without a probe (the Hertz group itself is reported).
+pub(crate) fn modulus_scale(model: &Resolved, p: &Params) -> Option<f64> {
+    let has_radius = matches!(
+        p.contact_law.name(),
+        "hertz" | "dmt" | "electrostatic" | "jkr" | "capillary"
+    );
+    true_modulus(model, 1.0).filter(|_| has_radius)
+}
+
 /// The document of a steady tap (`afmdyn peakforce --json`, Python's `to_dict()`): `channels`
 /// (the instrument's, SI with a probe), `modulus` (the DMT fit beside the true modulus),
 /// `orbit` (period, Floquet multipliers, stability), `balance` (energy per cycle), `cycle`

@@ -42,6 +42,7 @@ pub mod chart_store;
 pub mod global_continuation;
 mod memory;
 pub mod peakforce;
+pub mod peakforce_image;
 #[cfg(feature = "files")]
 pub mod plan;
 pub mod scan;

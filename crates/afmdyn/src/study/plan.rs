@@ -12,7 +12,9 @@
 //!   passes before it ([`pass_start`]), one task per row;
 //! - a PI-scanned image: one stage, one task per line ([`ScanStudy`]), whose start is what a
 //!   line needs ([`LineJob`]): a worker scans lines without building the study (the
-//!   materials' approach curves, each several lines' time).
+//!   materials' approach curves, each several lines' time);
+//! - a PeakForce image: stage 0 the materials' engages from far, one task each; stage 1 the
+//!   lines, one task each, whose start is the engages ([`PeakForceImageStudy`]).
 //!
 //! The ledger — which tasks a store holds, how the results merge into the outcome — is the
 //! plan's: the executor only maps tasks and hands results back.
@@ -26,6 +28,8 @@ use crate::analysis::basins::{pass_start, passes, run_pass_row, BasinRow, PassSt
 use crate::analysis::bifurcation::{Branch, Seeds, SweepPlan, SweepPoint, SweepSpec, SweepTask};
 use crate::error::SimError;
 use crate::request::checkpoint::{self, Checkpoint};
+use crate::request::image::{ImageRequest, SampleMap};
+use crate::request::image_peakforce::{Engage, LinePixel, PeakForceImageStudy};
 use crate::request::image_scan::{LineJob, ScanRecipe, ScanStudy};
 use crate::request::named::{outcome, Outcome};
 use crate::request::sweep::{every_point_failed, fingerprint, order_key, records, SweepRecord};
@@ -62,6 +66,15 @@ pub enum Recipe {
     Image {
         /// The scan.
         scan: ScanRecipe,
+    },
+    /// A PeakForce image (ideal peak-force feedback, [`PeakForceImageStudy`]).
+    PeakForceImage {
+        /// The probe file's table (SI).
+        probe: toml::Table,
+        /// The sample map.
+        map: SampleMap,
+        /// The request (its setpoint the peak force in N).
+        request: ImageRequest,
     },
 }
 
@@ -170,6 +183,14 @@ fn plan_of(recipe: Recipe, eager: bool) -> Result<Box<dyn Plan>, SimError> {
             }
             Box::new(Image { study, scan, text })
         }
+        Recipe::PeakForceImage {
+            probe,
+            map,
+            request,
+        } => Box::new(PfImage {
+            study: PeakForceImageStudy::unengaged(&probe, &map, &request)?,
+            text,
+        }),
     })
 }
 
@@ -475,6 +496,80 @@ impl Plan for Image {
             .collect::<Result<Vec<_>, _>>()?;
         let img = self.study()?.assemble(lines)?;
         Ok(crate::request::image_job::ImageOutput::Pi(img).outcome(self.scan.request.setpoint))
+    }
+}
+
+/// A PeakForce image's plan.
+struct PfImage {
+    study: PeakForceImageStudy,
+    text: String,
+}
+
+/// A PeakForce image task's result: a material's engage, or a line.
+#[derive(Serialize, Deserialize)]
+enum PfResult {
+    Engage(usize, Engage),
+    Line(usize, Vec<LinePixel>),
+}
+
+/// A PeakForce image's results: the materials' engages (in their order) and the lines.
+type PfResults = (Vec<Engage>, Vec<(usize, Vec<LinePixel>)>);
+
+impl PfImage {
+    /// The engages and lines of `results` (any order; every material's engage required).
+    fn results(&self, results: &[String]) -> Result<PfResults, SimError> {
+        let mut engages = Vec::new();
+        let mut lines = Vec::new();
+        for r in results {
+            match decode::<PfResult>("result", r)? {
+                PfResult::Engage(m, e) => engages.push((m, e)),
+                PfResult::Line(t, l) => lines.push((t, l)),
+            }
+        }
+        engages.sort_by_key(|e| e.0);
+        let n = self.study.materials.len();
+        if engages.len() != n || engages.iter().enumerate().any(|(i, e)| e.0 != i) {
+            return Err(bad("result", "not every material's engage"));
+        }
+        Ok((engages.into_iter().map(|e| e.1).collect(), lines))
+    }
+}
+
+impl Plan for PfImage {
+    fn recipe(&self) -> &str {
+        &self.text
+    }
+    fn stages(&self) -> usize {
+        2
+    }
+    fn stage(&self, stage: usize, results: &[String]) -> Result<Stage, SimError> {
+        match stage {
+            0 => Ok(Stage {
+                start: encode(&None::<Vec<Engage>>)?,
+                tasks: (0..self.study.materials.len()).collect(),
+            }),
+            1 => Ok(Stage {
+                start: encode(&Some(self.results(results)?.0))?,
+                tasks: (0..self.study.lines()).collect(),
+            }),
+            _ => Err(no_stage(stage, 2)),
+        }
+    }
+    fn run(&self, start: &str, t: usize, _cancel: &AtomicBool) -> Result<String, SimError> {
+        match decode::<Option<Vec<Engage>>>("start", start)? {
+            None => encode(&PfResult::Engage(t, self.study.engage(t)?)),
+            Some(engages) => {
+                let study = self.study.clone().with_engages(engages);
+                encode(&PfResult::Line(t, study.line(t)?))
+            }
+        }
+    }
+    fn outcome(&self, results: &[String]) -> Result<Outcome, SimError> {
+        let (engages, lines) = self.results(results)?;
+        let study = self.study.clone().with_engages(engages);
+        let img = study.assemble(lines)?;
+        Ok(crate::request::image_job::ImageOutput::PeakForce(img)
+            .outcome(self.study.request.setpoint))
     }
 }
 

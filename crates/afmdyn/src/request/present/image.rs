@@ -6,7 +6,8 @@ use crate::error::number;
 use crate::layout::figure::{AfmImage, Figure, Plot, Series, Style};
 use crate::report::{Presentation, TextUnits};
 use crate::request::image::{DomainContrast, Image, OperatingPoint, SetpointStudy};
-use crate::request::image_layout::{layout, scan_layout, summary};
+use crate::request::image_layout::{layout, peakforce_layout, scan_layout, summary};
+use crate::request::image_peakforce::PeakForceImage;
 use crate::request::image_scan::PiImage;
 use serde_json::{json, Value};
 
@@ -26,7 +27,19 @@ fn map_of(
     unit: &str,
     value: &dyn Fn(usize, usize) -> f64,
 ) {
-    let (nx, ny) = (img.x.len(), img.y.len());
+    map_on(s, (&img.x, &img.y), stem, title, unit, value);
+}
+
+/// The map `stem` of one field over the pixel centres x and line positions y ([`map_of`]).
+fn map_on(
+    s: &mut Presentation,
+    (x, y): (&[f64], &[f64]),
+    stem: &str,
+    title: &str,
+    unit: &str,
+    value: &dyn Fn(usize, usize) -> f64,
+) {
+    let (nx, ny) = (x.len(), y.len());
     let values: Vec<f64> = (0..ny)
         .flat_map(|j| (0..nx).map(move |i| (j, i)))
         .map(|(j, i)| value(j, i))
@@ -42,8 +55,8 @@ fn map_of(
         stem,
         Plot::Image(AfmImage {
             title: title.to_string(),
-            x: img.x.clone(),
-            y: img.y.clone(),
+            x: x.to_vec(),
+            y: y.to_vec(),
             values,
             label: format!("{quantity} ({unit})"),
         }),
@@ -354,6 +367,82 @@ pub fn pi(img: &PiImage, setpoint: f64, document: &Value, u: TextUnits) -> Prese
             art.lost_contact_pixels,
             art.saturated_periods
         ));
+    }
+    s
+}
+
+/// The summary document of a PeakForce image (`afmdyn image --mode peakforce --json`,
+/// `image.json`; the maps are `image.nc`'s): `image`, its maps summarised
+/// ([`crate::request::image_layout::summary`]); `mode`, `feedback`, `setpoint` (N),
+/// `reference_z_c` (m), `materials` (each with its true modulus and engaged operating point),
+/// `taps`, `warnings`. [`PeakForceImage::document`] is the document with every pixel.
+pub fn peakforce_summary(img: &PeakForceImage) -> Value {
+    let mut doc = img.document();
+    doc["image"] = summary(&peakforce_layout(img));
+    doc
+}
+
+/// A PeakForce image: `image.json` (`document`: [`peakforce_summary`], or
+/// [`PeakForceImage::document`]), `image.nc`, the maps `image-height`, `image-modulus`,
+/// `image-adhesion`, `image-deformation`, `image-dissipation`, and the summary: every
+/// material's engaged operating point beside its true modulus.
+pub fn peakforce(img: &PeakForceImage, document: &Value, u: TextUnits) -> Presentation {
+    let mut s = Presentation::default();
+    s.json("image.json", document.clone());
+    s.dataset("image.nc", peakforce_layout(img));
+    for (stem, field, title, unit) in [
+        (
+            "image-height",
+            "height",
+            "Apparent height (ideal peak-force feedback)",
+            "m",
+        ),
+        (
+            "image-modulus",
+            "modulus_dmt",
+            "Modulus (DMT fit, PF-QNM)",
+            "Pa",
+        ),
+        ("image-adhesion", "adhesion", "Adhesion", "N"),
+        ("image-deformation", "deformation", "Deformation", "m"),
+        (
+            "image-dissipation",
+            "dissipation",
+            "Dissipation per cycle",
+            "J",
+        ),
+    ] {
+        let value = |j: usize, i: usize| img.value(field, j, i);
+        map_on(&mut s, (&img.x, &img.y), stem, title, unit, &value);
+    }
+    s.line(format!(
+        "PeakForce image (ideal feedback), {} × {} pixels, peak-force setpoint {}; z_c,ref = {} \
+         on the background; {} steady taps",
+        img.x.len(),
+        img.y.len(),
+        u.value(img.setpoint, "N"),
+        u.value(img.reference, "m"),
+        img.taps()
+    ));
+    for m in &img.materials {
+        match &m.engaged {
+            Some(t) => s.line(format!(
+                "  {}: z_c {}, modulus_dmt {} (true E* {}), adhesion {}, deformation {}, \
+                 dissipation {}",
+                m.name,
+                u.value(t.z_c, "m"),
+                u.value(t.modulus_dmt, "Pa"),
+                u.value(m.true_modulus, "Pa"),
+                u.value(t.adhesion, "N"),
+                u.value(t.deformation, "m"),
+                u.value(t.dissipation, "J")
+            )),
+            None => s.line(format!(
+                "  {}: not imaged ({})",
+                m.name,
+                m.message.as_deref().unwrap_or("no operating point")
+            )),
+        }
     }
     s
 }

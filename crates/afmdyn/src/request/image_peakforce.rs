@@ -1,0 +1,728 @@
+//! PeakForce images (issue 61 §3): `afmdyn image --mode peakforce --setpoint 2nN` — the maps
+//! an ideal peak-force feedback records over a sample map ([`super::image::SampleMap`]) with an
+//! off-resonance probe ([`crate::analysis::peakforce`]).
+//!
+//! **Ideal feedback.** At every pixel the feedback holds the steady tap's peak force at the
+//! setpoint: the pixel's operating point is the periodic tap orbit of its material at the mean
+//! rest separation z_c where F_peak(z_c) = F_set (to [`SETPOINT_TOL`] relative), and the z
+//! piezo records the true height plus that z_c: the apparent height is h + z_c − z_c,ref,
+//! z_c,ref the background's (as AM images do, [`super::image`]).
+//!
+//! **History.** Each line is engaged from far on its first pixel's material: the feedback's own
+//! search from rest ([`peak_force_setpoint`]), computed once per material before the lines
+//! ([`PeakForceImageStudy::new`]). Along the line each pixel continues from the previous
+//! pixel's orbit, as an instrument's feedback does and as the z_c sweeps do
+//! ([`crate::study::peakforce`]):
+//! - a pixel of the same material (the same model) as the previous one has its operating
+//!   point: the previous orbit at the previous z_c is the fixed point the continuation starts
+//!   from (the feedback has nothing to correct), so it is taken, not computed again;
+//! - at a change of material the tap is continued from the previous orbit and z_c is found by
+//!   the secant method on F_peak(z_c) − F_set from the previous z_c, its first step from the
+//!   lever's static compliance c (the quasi-static slope |dF_peak/dα5| ≤ 1/c: the first step
+//!   falls short of the root, never across a fold), at most [`CONTINUE_ITERATIONS`] taps;
+//! - where the continuation does not converge (a tap that does not settle, a fold of the
+//!   steady taps) the pixel is re-engaged from far on its material (counted and reported);
+//! - a material whose engage from far does not reach the setpoint leaves its pixels empty
+//!   (NaN, reported) and the next pixel engages again.
+//!
+//! A uniform domain thus costs no tap per pixel and a change of material a few taps, so the
+//! image costs the materials' engages plus its material changes. **A line is a task**
+//! ([`PeakForceImageStudy::line`]): it depends only on the request and its number, so the image
+//! does not depend on the thread count or the executor.
+
+use super::costs::{newton_work, steady_periods, MODEL_BYTES};
+use super::image::{background_probe, material_models, pixel_grid, ImageRequest, SampleMap};
+use super::limits::Cost;
+use super::peakforce::modulus_scale;
+use super::run::Resolved;
+use crate::analysis::peakforce::{
+    peak_force_setpoint, static_compliance, steady_tap_from, PeakForceOptions, SetpointOptions,
+    SteadyTap, BRACKET_STEPS, SETPOINT_ITERATIONS, SETPOINT_TOL,
+};
+use crate::error::SimError;
+use crate::model::CantileverModel;
+use crate::params::{Params, SweepParam};
+use crate::probe::Probe;
+use crate::report::CurveUnits;
+use nalgebra::DVector;
+use serde::{Deserialize, Serialize};
+use serde_json::Value;
+
+/// Most taps of the secant continuation at a change of material before the pixel is
+/// re-engaged from far.
+pub const CONTINUE_ITERATIONS: usize = 30;
+
+/// Taps a change of material is expected to cost (the request's cost estimate).
+pub const TAPS_PER_CHANGE: f64 = 6.0;
+
+/// A pixel's operating point in SI: the steady tap at the setpoint and its channels.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct PeakForceTap {
+    /// Mean rest separation z_c the feedback holds (m).
+    pub z_c: f64,
+    /// Peak force (N): the setpoint to the feedback's tolerance.
+    pub peak_force: f64,
+    /// Adhesion, the most negative force (N, ≤ 0).
+    pub adhesion: f64,
+    /// Deformation, the largest indentation (m).
+    pub deformation: f64,
+    /// Tip–sample dissipation per modulation period (J).
+    pub dissipation: f64,
+    /// The DMT fit's reduced modulus E* (Pa; NaN where no fit or no tip radius).
+    pub modulus_dmt: f64,
+    /// Contacts per modulation period (1: a single tap; more: double taps).
+    pub taps_per_cycle: f64,
+    /// Modulation periods after which the orbit repeats (2: period-2 tapping).
+    pub period: usize,
+    /// Whether the orbit is stable (every Floquet multiplier inside the unit circle).
+    pub stable: bool,
+}
+
+/// One pixel of a line as its task computes it.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct LinePixel {
+    /// The operating point (`None`: the setpoint is not reached on the pixel's material).
+    pub tap: Option<PeakForceTap>,
+    /// Steady taps computed for this pixel (0 where the previous pixel's orbit is kept or the
+    /// material's engage is taken).
+    pub evaluations: usize,
+    /// Whether the continuation failed here and the pixel was re-engaged from far.
+    pub reengaged: bool,
+}
+
+/// A material of a PeakForce image and its engage.
+#[derive(Debug, Clone)]
+pub struct PfMaterial {
+    /// `background` or the domain's name.
+    pub name: String,
+    /// Its model (the probe's lever and drive, its sample).
+    pub params: Params,
+    /// The sample's true reduced modulus E* (Pa; NaN without a tip radius).
+    pub true_modulus: f64,
+    /// The factor from the Hertz group (model units) to E* (Pa); `None` without a tip radius.
+    pub modulus_scale: Option<f64>,
+    /// The engage from far: α5, the orbit's state at τ = 0 and the operating point; or why
+    /// the setpoint is not reached.
+    pub engaged: Result<(f64, DVector<f64>, PeakForceTap), String>,
+    /// Steady taps of the engage's search.
+    pub evaluations: usize,
+}
+
+/// A PeakForce image as a study of lines ([module docs](self)).
+#[derive(Debug, Clone)]
+pub struct PeakForceImageStudy {
+    /// The sample map.
+    pub map: SampleMap,
+    /// The request (its setpoint the peak force in N).
+    pub request: ImageRequest,
+    /// The materials: 0 the background, then one per domain with its own sample.
+    pub materials: Vec<PfMaterial>,
+    /// The material of each domain.
+    pub of_domain: Vec<usize>,
+    /// SI units of the model.
+    pub units: CurveUnits,
+    /// The setpoint in model units F̃.
+    pub setpoint: f64,
+    /// The steady taps' options.
+    pub options: PeakForceOptions,
+    /// What a resumed run must match.
+    pub fingerprint: Value,
+}
+
+/// The background probe of a PeakForce image, checked to be off resonance.
+///
+/// # Errors
+/// As the background probe of an AM image (a probe the format refuses, a multifrequency
+/// drive); [`SimError::OutOfRange`] naming `excitation` for a probe without
+/// an off-resonance drive, `setpoint` for a setpoint that is not a finite force > 0.
+pub fn peakforce_probe(probe_table: &toml::Table, setpoint: f64) -> Result<Probe, SimError> {
+    let background = background_probe(probe_table)?;
+    if !background.off_resonance {
+        return Err(SimError::out_of_range(
+            "excitation",
+            background.params.excitation.name(),
+            "a PeakForce image needs a probe with [drive] mode = \"off-resonance\" \
+             (modulation_frequency, modulation_amplitude)",
+        ));
+    }
+    if !(setpoint.is_finite() && setpoint > 0.0) {
+        return Err(SimError::out_of_range(
+            "setpoint",
+            setpoint,
+            "must be the peak force (N) the feedback holds, finite and > 0 (2 nN is 2e-9, or \
+             2nN on the command line)",
+        ));
+    }
+    Ok(background)
+}
+
+/// What a PeakForce image of `map` costs: the materials' engages (the feedback's bracket and
+/// iterations each), [`TAPS_PER_CHANGE`] taps at every change of material along the lines, and
+/// the pixels' memory.
+///
+/// # Errors
+/// As [`peakforce_probe`], the probe's models and the taps' transient estimate.
+pub fn peakforce_cost(
+    probe_table: &toml::Table,
+    map: &SampleMap,
+    req: &ImageRequest,
+) -> Result<Cost, SimError> {
+    let background = peakforce_probe(probe_table, req.setpoint)?;
+    let (models, of_domain) = material_models(probe_table, map, &background)?;
+    let opts = PeakForceOptions::default();
+    let p = background.params;
+    let lever_periods = (1.0 / p.omega).max(1.0);
+    let tap = (steady_periods(&opts.steady, &p)? * p.modes as f64
+        + newton_work(&p, 1, &opts.shooting))
+        * lever_periods;
+    let (x, y) = pixel_grid(map, req);
+    let material = |xi: f64, yj: f64| map.domain_at(xi, yj).map_or(0, |k| of_domain[k]);
+    let changes: usize = y
+        .iter()
+        .map(|&yj| {
+            x.windows(2)
+                .filter(|w| material(w[0], yj) != material(w[1], yj))
+                .count()
+        })
+        .sum();
+    let engages = models.len() as f64 * (2 * BRACKET_STEPS + SETPOINT_ITERATIONS) as f64;
+    Ok(Cost {
+        bytes: MODEL_BYTES + req.pixel_bytes(map),
+        work: (engages + changes as f64 * TAPS_PER_CHANGE) * tap,
+    })
+}
+
+/// A material's engage from far, as a task computes it: the steady taps of the feedback's
+/// search, and α5, the orbit's state at τ = 0 and the operating point, or why the setpoint is
+/// not reached.
+pub type Engage = (usize, Result<(f64, Vec<f64>, PeakForceTap), String>);
+
+impl PeakForceImageStudy {
+    /// The study of `map` under the probe `probe_table` at the peak force `req.setpoint` (N):
+    /// the materials' models and their engages from far (module docs).
+    ///
+    /// # Errors
+    /// As [`PeakForceImageStudy::unengaged`]; [`SimError::Cancelled`].
+    pub fn new(
+        probe_table: &toml::Table,
+        map: &SampleMap,
+        req: &ImageRequest,
+    ) -> Result<PeakForceImageStudy, SimError> {
+        let study = Self::unengaged(probe_table, map, req)?;
+        let engages = (0..study.materials.len())
+            .map(|m| study.engage(m))
+            .collect::<Result<Vec<_>, SimError>>()?;
+        Ok(study.with_engages(engages))
+    }
+
+    /// The study before its materials' engages ([`PeakForceImageStudy::engage`], then
+    /// [`PeakForceImageStudy::with_engages`]): an executor elsewhere (Dask) runs the engages
+    /// as tasks of their own.
+    ///
+    /// # Errors
+    /// As [`ImageRequest::validate_grid`] and [`peakforce_probe`]; [`SimError::Probe`] for a
+    /// domain's sample the probe format refuses.
+    pub fn unengaged(
+        probe_table: &toml::Table,
+        map: &SampleMap,
+        req: &ImageRequest,
+    ) -> Result<PeakForceImageStudy, SimError> {
+        req.validate_grid(map)?;
+        let background = peakforce_probe(probe_table, req.setpoint)?;
+        let units = CurveUnits::from_scales(&background.scales, true);
+        let (models, of_domain) = material_models(probe_table, map, &background)?;
+        let resolved = |p: Params| Resolved {
+            params: p,
+            probe: Some(background.clone()),
+        };
+        let materials = models
+            .into_iter()
+            .map(|(name, params)| {
+                let scale = modulus_scale(&resolved(params), &params);
+                PfMaterial {
+                    name,
+                    true_modulus: scale.map_or(f64::NAN, |s| s * params.alpha4),
+                    modulus_scale: scale,
+                    params,
+                    engaged: Err("not engaged".into()),
+                    evaluations: 0,
+                }
+            })
+            .collect();
+        let fingerprint = serde_json::json!({
+            "afmdyn": env!("CARGO_PKG_VERSION"),
+            "image": "peakforce",
+            "probe": probe_table,
+            "map": map,
+            "request": req,
+        });
+        Ok(PeakForceImageStudy {
+            map: map.clone(),
+            request: *req,
+            materials,
+            of_domain,
+            setpoint: req.setpoint / units.force,
+            units,
+            options: PeakForceOptions::default(),
+            fingerprint,
+        })
+    }
+
+    /// The engage of material `m` from far: the feedback's search from rest
+    /// ([`peak_force_setpoint`]).
+    ///
+    /// # Errors
+    /// [`SimError::Cancelled`]; a setpoint the material does not reach is the engage's
+    /// message, not an error.
+    pub fn engage(&self, m: usize) -> Result<Engage, SimError> {
+        let params = self.materials[m].params;
+        let opts = SetpointOptions {
+            tap: self.options.clone(),
+            ..SetpointOptions::default()
+        };
+        Ok(match peak_force_setpoint(&params, self.setpoint, &opts) {
+            Ok(s) => {
+                let tap = si_tap(&params, &self.units, self.scale(m), s.alpha5, &s.tap);
+                (
+                    s.evaluations,
+                    Ok((s.alpha5, s.tap.state.iter().copied().collect(), tap)),
+                )
+            }
+            Err(SimError::Cancelled) => return Err(SimError::Cancelled),
+            Err(e) => (0, Err(e.to_string())),
+        })
+    }
+
+    /// The study with the materials' engages (in the order of the materials).
+    pub fn with_engages(mut self, engages: Vec<Engage>) -> PeakForceImageStudy {
+        for (m, (evaluations, e)) in self.materials.iter_mut().zip(engages) {
+            m.evaluations = evaluations;
+            m.engaged = e.map(|(a5, z, tap)| (a5, DVector::from_vec(z), tap));
+        }
+        self
+    }
+
+    /// The number of lines.
+    pub fn lines(&self) -> usize {
+        self.request.lines(&self.map)
+    }
+
+    /// The material of the pixel at (x, y).
+    pub fn material_at(&self, x: f64, y: f64) -> usize {
+        self.map.domain_at(x, y).map_or(0, |k| self.of_domain[k])
+    }
+
+    /// Line `t` (module docs): each pixel engaged, kept or continued from the previous.
+    ///
+    /// # Errors
+    /// [`SimError`] from a model the map's material refuses (checked when the study was
+    /// built); a tap that does not converge re-engages the pixel instead.
+    pub fn line(&self, t: usize) -> Result<Vec<LinePixel>, SimError> {
+        let (x, y) = pixel_grid(&self.map, &self.request);
+        let yj = y[t];
+        let mut out = Vec::with_capacity(x.len());
+        // the previous pixel: its material, α5, orbit state and operating point
+        let mut prev: Option<(usize, f64, DVector<f64>, PeakForceTap)> = None;
+        for &xi in &x {
+            let m = self.material_at(xi, yj);
+            let mat = &self.materials[m];
+            let engage = |reengaged: bool| match &mat.engaged {
+                Ok((a5, z, tap)) => (
+                    Some((m, *a5, z.clone(), *tap)),
+                    LinePixel {
+                        tap: Some(*tap),
+                        evaluations: 0,
+                        reengaged,
+                    },
+                ),
+                Err(_) => (
+                    None,
+                    LinePixel {
+                        tap: None,
+                        evaluations: 0,
+                        reengaged,
+                    },
+                ),
+            };
+            let (next, pixel) = match prev.take() {
+                // a material that does not reach the setpoint from far: its pixels are empty
+                // and the next pixel engages again
+                None => engage(false),
+                Some(_) if mat.engaged.is_err() => engage(false),
+                Some((pm, a5, z, tap)) if self.materials[pm].params == mat.params => {
+                    let pixel = LinePixel {
+                        tap: Some(tap),
+                        evaluations: 0,
+                        reengaged: false,
+                    };
+                    (Some((m, a5, z, tap)), pixel)
+                }
+                Some((_, a5, z, _)) => match self.continue_to(&mat.params, a5, &z)? {
+                    (Some((b5, tap)), evaluations) => {
+                        let si = si_tap(&mat.params, &self.units, self.scale(m), b5, &tap);
+                        let pixel = LinePixel {
+                            tap: Some(si),
+                            evaluations,
+                            reengaged: false,
+                        };
+                        (Some((m, b5, tap.state, si)), pixel)
+                    }
+                    (None, evaluations) => {
+                        let (n, mut pixel) = engage(true);
+                        pixel.evaluations = evaluations;
+                        (n, pixel)
+                    }
+                },
+            };
+            prev = next;
+            out.push(pixel);
+        }
+        Ok(out)
+    }
+
+    /// The factor from the Hertz group to E* (Pa) of material `m`.
+    fn scale(&self, m: usize) -> Option<f64> {
+        self.materials[m].modulus_scale
+    }
+
+    /// The tap of `params` at the setpoint continued from α5 `a0` and the orbit state `z0` by
+    /// the secant method (module docs): (α5 and the tap, or `None` where it does not
+    /// converge; the taps computed).
+    ///
+    /// # Errors
+    /// [`SimError`] other than a tap's non-convergence (a model that cannot be built).
+    fn continue_to(
+        &self,
+        params: &Params,
+        a0: f64,
+        z0: &DVector<f64>,
+    ) -> Result<Continued, SimError> {
+        let f_set = self.setpoint;
+        let tol = SETPOINT_TOL * f_set;
+        let mut start = z0.clone();
+        let mut evaluations = 0;
+        let mut eval =
+            |a5: f64, start: &mut DVector<f64>| -> Result<Option<(f64, SteadyTap)>, SimError> {
+                let model = CantileverModel::new(&params.with(SweepParam::Alpha5, a5))?;
+                evaluations += 1;
+                match steady_tap_from(&model, &self.options, start) {
+                    Ok(tap) => {
+                        start.copy_from(&tap.state);
+                        Ok(Some((tap.channels.peak_force - f_set, tap)))
+                    }
+                    Err(SimError::NoConvergence { .. }) => Ok(None),
+                    Err(e) => Err(e),
+                }
+            };
+        let Some((mut g0, tap)) = eval(a0, &mut start)? else {
+            return Ok((None, evaluations));
+        };
+        let mut x0 = a0;
+        if g0.abs() <= tol {
+            return Ok((Some((a0, tap)), evaluations));
+        }
+        // the first step from the quasi-static slope bound 1/c: short of the root
+        let c = static_compliance(&CantileverModel::new(params)?);
+        let mut x1 = a0 + g0 * c;
+        for _ in 1..CONTINUE_ITERATIONS {
+            let Some((g1, tap)) = eval(x1, &mut start)? else {
+                return Ok((None, evaluations));
+            };
+            if g1.abs() <= tol {
+                return Ok((Some((x1, tap)), evaluations));
+            }
+            // the peak force falls as α5 grows: a slope ≥ 0 is a fold (or round-off)
+            let slope = (g1 - g0) / (x1 - x0);
+            if !(slope < 0.0 && slope.is_finite()) {
+                return Ok((None, evaluations));
+            }
+            (x0, g0) = (x1, g1);
+            x1 -= g1 / slope;
+        }
+        Ok((None, evaluations))
+    }
+}
+
+/// A continuation's outcome: α5 and the tap at the setpoint (`None`: it did not converge), and
+/// the steady taps it computed.
+type Continued = (Option<(f64, SteadyTap)>, usize);
+
+/// The SI operating point of the tap `tap` of `p` at α5 `a5` (`scale`: the Hertz group to E*).
+fn si_tap(
+    p: &Params,
+    u: &CurveUnits,
+    scale: Option<f64>,
+    a5: f64,
+    tap: &SteadyTap,
+) -> PeakForceTap {
+    let c = &tap.channels;
+    let q = p.with(SweepParam::Alpha5, a5);
+    PeakForceTap {
+        z_c: q.rest_distance() * u.length,
+        peak_force: c.peak_force * u.force,
+        adhesion: c.adhesion * u.force,
+        deformation: c.deformation * u.length,
+        dissipation: c.dissipation * u.energy,
+        modulus_dmt: match (tap.fit, scale) {
+            (Some(f), Some(s)) => f.hertz_group * s,
+            _ => f64::NAN,
+        },
+        taps_per_cycle: c.taps_per_cycle,
+        period: tap.period,
+        stable: tap.stable,
+    }
+}
+
+/// A material of a [`PeakForceImage`] as its document reports it (SI).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PfMaterialReport {
+    /// `background` or the domain's name.
+    pub name: String,
+    /// The sample's true reduced modulus E* (Pa; NaN without a tip radius).
+    pub true_modulus: f64,
+    /// The operating point a line engages on from far (`None`: the setpoint is not reached).
+    pub engaged: Option<PeakForceTap>,
+    /// Why the setpoint is not reached (`None` when it is).
+    pub message: Option<String>,
+    /// Steady taps of its engage's search.
+    pub evaluations: usize,
+}
+
+/// A PeakForce image ([module docs](self)).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PeakForceImage {
+    /// Pixel centres x (m).
+    pub x: Vec<f64>,
+    /// Line positions y (m).
+    pub y: Vec<f64>,
+    /// The setpoint: the peak force the feedback holds (N).
+    pub setpoint: f64,
+    /// The materials: 0 the background, then one per domain with its own sample.
+    pub materials: Vec<PfMaterialReport>,
+    /// The pixels' material (index into `materials`), `[line][pixel]`.
+    pub material: Vec<Vec<usize>>,
+    /// The pixels' domain (`None` the background), `[line][pixel]`.
+    pub domain: Vec<Vec<Option<usize>>>,
+    /// The true height (m), `[line][pixel]`.
+    pub true_height: Vec<Vec<f64>>,
+    /// The pixels, `[line][pixel]`.
+    pub pixels: Vec<Vec<LinePixel>>,
+    /// z_c,ref (m): the background's engaged z_c, the zero of the apparent height (NaN where
+    /// the background does not reach the setpoint).
+    pub reference: f64,
+    /// The map's domain names, in its order.
+    pub domain_names: Vec<String>,
+    /// What the image cannot show as asked.
+    pub warnings: Vec<String>,
+}
+
+impl PeakForceImageStudy {
+    /// The image of the lines' records (any order).
+    ///
+    /// # Errors
+    /// [`SimError::Cancelled`] when a line is missing (a run cut short).
+    pub fn assemble(
+        &self,
+        mut records: Vec<(usize, Vec<LinePixel>)>,
+    ) -> Result<PeakForceImage, SimError> {
+        records.sort_by_key(|r| r.0);
+        let n = self.lines();
+        if records.len() != n || records.iter().enumerate().any(|(i, r)| r.0 != i) {
+            return Err(SimError::Cancelled);
+        }
+        let (x, y) = pixel_grid(&self.map, &self.request);
+        let grid = |f: &dyn Fn(f64, f64) -> f64| -> Vec<Vec<f64>> {
+            y.iter()
+                .map(|&yj| x.iter().map(|&xi| f(xi, yj)).collect())
+                .collect()
+        };
+        let materials: Vec<PfMaterialReport> = self
+            .materials
+            .iter()
+            .map(|m| PfMaterialReport {
+                name: m.name.clone(),
+                true_modulus: m.true_modulus,
+                engaged: m.engaged.as_ref().ok().map(|e| e.2),
+                message: m.engaged.as_ref().err().cloned(),
+                evaluations: m.evaluations,
+            })
+            .collect();
+        let mut warnings: Vec<String> = materials
+            .iter()
+            .filter_map(|m| {
+                m.message.as_ref().map(|e| {
+                    format!(
+                        "{}: the setpoint is not reached ({e}): its pixels are empty (NaN)",
+                        m.name
+                    )
+                })
+            })
+            .collect();
+        let pixels: Vec<Vec<LinePixel>> = records.into_iter().map(|r| r.1).collect();
+        let all = || pixels.iter().flatten();
+        let reengaged = all().filter(|p| p.reengaged).count();
+        if reengaged > 0 {
+            warnings.push(format!(
+                "{reengaged} pixel(s) re-engaged from far: the feedback's continuation from the \
+                 previous pixel did not converge there (a fold of the steady taps, or a tap that \
+                 does not settle)"
+            ));
+        }
+        let taps = || all().filter_map(|p| p.tap);
+        if taps().any(|t| t.taps_per_cycle > 1.0 + 1e-9) {
+            warnings.push(
+                "double taps on some pixels (more than one contact per modulation period): \
+                 modulus_dmt is not meaningful there (taps_per_cycle)"
+                    .into(),
+            );
+        }
+        if taps().any(|t| t.period > 1) {
+            warnings.push("period-2 (or longer) tapping on some pixels (period)".into());
+        }
+        if taps().any(|t| !t.stable) {
+            warnings.push("unstable steady taps on some pixels (stable = false)".into());
+        }
+        Ok(PeakForceImage {
+            setpoint: self.request.setpoint,
+            reference: materials[0].engaged.map_or(f64::NAN, |t| t.z_c),
+            material: y
+                .iter()
+                .map(|&yj| x.iter().map(|&xi| self.material_at(xi, yj)).collect())
+                .collect(),
+            domain: y
+                .iter()
+                .map(|&yj| x.iter().map(|&xi| self.map.domain_at(xi, yj)).collect())
+                .collect(),
+            true_height: grid(&|xi, yj| self.map.height_at(xi, yj)),
+            materials,
+            pixels,
+            domain_names: self.map.domains.iter().map(|d| d.name.clone()).collect(),
+            warnings,
+            x,
+            y,
+        })
+    }
+}
+
+/// The numeric maps of a PeakForce image over (y, x): name, units, long name, as its document's
+/// `image` block and `image.nc` name them.
+pub const PF_FIELDS: [(&str, &str, &str); 9] = [
+    (
+        "height",
+        "m",
+        "apparent height h + z_c − z_c,ref (ideal peak-force feedback)",
+    ),
+    ("true_height", "m", "true height of the sample map"),
+    ("z_c", "m", "mean rest separation z_c the feedback holds"),
+    ("peak_force", "N", "peak force (the setpoint where reached)"),
+    (
+        "modulus_dmt",
+        "Pa",
+        "reduced modulus E* of the DMT fit of the retract curve (PF-QNM)",
+    ),
+    (
+        "adhesion",
+        "N",
+        "adhesion: the most negative tip–sample force",
+    ),
+    ("deformation", "m", "deformation: the largest indentation"),
+    (
+        "dissipation",
+        "J",
+        "tip–sample dissipation per modulation period",
+    ),
+    ("taps_per_cycle", "1", "contacts per modulation period"),
+];
+
+impl PeakForceImage {
+    /// The operating point of pixel (line, pixel), `None` where the setpoint is not reached.
+    pub fn tap(&self, line: usize, pixel: usize) -> Option<&PeakForceTap> {
+        self.pixels[line][pixel].tap.as_ref()
+    }
+
+    /// The value of the map `name` ([`PF_FIELDS`]) at (line, pixel) (NaN where not reached or
+    /// an unknown name).
+    pub fn value(&self, name: &str, line: usize, pixel: usize) -> f64 {
+        if name == "true_height" {
+            return self.true_height[line][pixel];
+        }
+        let Some(t) = self.tap(line, pixel) else {
+            return f64::NAN;
+        };
+        match name {
+            "height" => self.true_height[line][pixel] + t.z_c - self.reference,
+            "z_c" => t.z_c,
+            "peak_force" => t.peak_force,
+            "modulus_dmt" => t.modulus_dmt,
+            "adhesion" => t.adhesion,
+            "deformation" => t.deformation,
+            "dissipation" => t.dissipation,
+            "taps_per_cycle" => t.taps_per_cycle,
+            _ => f64::NAN,
+        }
+    }
+
+    /// The image document (`afmdyn image --mode peakforce --json`): `image` with `x`, `y` (m)
+    /// and per `[line][pixel]` the [`PF_FIELDS`] (SI; null where not reached), `evaluations`,
+    /// `material` and `domain` (names); `mode` `"peakforce"`, `feedback` `"ideal"`, `setpoint`
+    /// (N), `reference_z_c` (m), `materials` (each with its true modulus and engaged operating
+    /// point), `taps` (steady taps computed), `warnings`.
+    pub fn document(&self) -> Value {
+        use serde_json::json;
+        let num = |v: f64| if v.is_finite() { json!(v) } else { Value::Null };
+        let grid = |f: &dyn Fn(usize, usize) -> Value| -> Value {
+            Value::Array(
+                (0..self.y.len())
+                    .map(|j| Value::Array((0..self.x.len()).map(|i| f(j, i)).collect()))
+                    .collect(),
+            )
+        };
+        let mut image = serde_json::Map::new();
+        image.insert("x".into(), json!(self.x));
+        image.insert("y".into(), json!(self.y));
+        for (name, _, _) in PF_FIELDS {
+            image.insert(name.into(), grid(&|j, i| num(self.value(name, j, i))));
+        }
+        image.insert(
+            "evaluations".into(),
+            grid(&|j, i| json!(self.pixels[j][i].evaluations)),
+        );
+        image.insert(
+            "material".into(),
+            grid(&|j, i| json!(self.materials[self.material[j][i]].name)),
+        );
+        image.insert(
+            "domain".into(),
+            grid(&|j, i| {
+                json!(self.domain[j][i].map_or("background", |k| self.domain_names[k].as_str()))
+            }),
+        );
+        json!({
+            "image": image,
+            "mode": "peakforce",
+            "feedback": "ideal",
+            "setpoint": self.setpoint,
+            "reference_z_c": num(self.reference),
+            "materials": self.materials.iter().map(|m| json!({
+                "name": m.name,
+                "true_modulus": num(m.true_modulus),
+                "engaged": m.engaged,
+                "message": m.message,
+                "evaluations": m.evaluations,
+            })).collect::<Vec<_>>(),
+            "taps": self.taps(),
+            "warnings": self.warnings,
+        })
+    }
+
+    /// Steady taps computed for the image: the materials' engages and the lines' continuations.
+    pub fn taps(&self) -> usize {
+        self.materials.iter().map(|m| m.evaluations).sum::<usize>()
+            + self
+                .pixels
+                .iter()
+                .flatten()
+                .map(|p| p.evaluations)
+                .sum::<usize>()
+    }
+}

@@ -1,0 +1,244 @@
+//! PeakForce images (issue 61 §3, [`afmdyn::request::image_peakforce`]): every pixel's peak
+//! force is the setpoint to the feedback's tolerance; a pixel is the standalone `peakforce
+//! --setpoint` tap of its material (exactly where the line engages on it, to a stated
+//! tolerance where the feedback continues into it from another material); a two-material
+//! sample gives the two materials' channels; the image does not depend on the thread count;
+//! the door gives it (`afmdyn image --mode peakforce`) and refuses an AM probe by name.
+
+use afmdyn::analysis::peakforce::SETPOINT_TOL;
+use afmdyn::analysis::progress::Progress;
+use afmdyn::probe::Probe;
+use afmdyn::request::image::{ImageRequest, SampleMap};
+use afmdyn::request::image_job::{ImageJob, ImageMode, ImageOutput};
+use afmdyn::request::image_peakforce::PeakForceImage;
+use afmdyn::request::present::Files;
+use afmdyn::request::{PeakForceRequest, Resolved};
+use afmdyn::study::peakforce_image::peakforce_image;
+
+/// The setpoint (N).
+const SETPOINT: f64 = 2e-9;
+
+fn repo(path: &str) -> String {
+    std::fs::read_to_string(format!("{}/../../{path}", env!("CARGO_MANIFEST_DIR"))).unwrap()
+}
+
+/// The point-mass probe of Amo & Garcia 2016 (E* = 1 GPa) at f₀/f_m = 100 (f_m = 1.5 kHz).
+fn probe() -> toml::Table {
+    let mut p: toml::Table = repo("examples/probe-peakforce-amo-garcia.toml")
+        .parse()
+        .unwrap();
+    p["drive"]["modulation_frequency"] = toml::Value::Float(1.5e3);
+    p
+}
+
+/// The two-material map: background, a stiffer less adhesive domain, a 5 nm terrace.
+fn map() -> SampleMap {
+    SampleMap::parse(&repo("examples/sample-peakforce-blend.toml"), "map").unwrap()
+}
+
+fn request(pixels: usize, lines: usize) -> ImageRequest {
+    ImageRequest::with(SETPOINT, Some(pixels), Some(lines), None)
+}
+
+fn image(pixels: usize, lines: usize, threads: usize) -> PeakForceImage {
+    peakforce_image(
+        &probe(),
+        &map(),
+        &request(pixels, lines),
+        Some(threads),
+        &Progress::new(),
+    )
+    .unwrap()
+}
+
+/// The standalone `peakforce --setpoint` tap of the probe with `sample` as its `[sample]`
+/// (`None`: the probe's own): its document.
+fn standalone(sample: Option<&toml::Table>) -> serde_json::Value {
+    let mut table = probe();
+    if let Some(s) = sample {
+        table.insert("sample".into(), toml::Value::Table(s.clone()));
+    }
+    let pr = Probe::from_table(&table, "probe").unwrap();
+    let model = Resolved {
+        params: pr.params,
+        probe: Some(pr),
+    };
+    let request = PeakForceRequest {
+        setpoint: Some(SETPOINT),
+        ..PeakForceRequest::default()
+    };
+    afmdyn::request::run::run(&request, &model, &Progress::new())
+        .unwrap()
+        .json
+}
+
+fn close(a: f64, b: f64, rel: f64) -> bool {
+    (a - b).abs() <= rel * a.abs().max(b.abs())
+}
+
+#[test]
+fn every_pixel_holds_the_setpoint_and_a_two_material_sample_gives_both_materials() {
+    let img = image(8, 6, 2);
+    assert_eq!(img.materials.len(), 2, "background and the stiff domain");
+    assert!(img.warnings.is_empty(), "{:?}", img.warnings);
+    let mut seen = [0usize; 2];
+    for j in 0..img.y.len() {
+        for i in 0..img.x.len() {
+            let t = img.tap(j, i).expect("every pixel reaches the setpoint");
+            // the feedback's tolerance
+            assert!(
+                (t.peak_force - SETPOINT).abs() <= SETPOINT_TOL * SETPOINT,
+                "pixel ({j}, {i}): peak force {} against {SETPOINT}",
+                t.peak_force
+            );
+            let m = img.material[j][i];
+            seen[m] += 1;
+            // each material's channels: its engaged operating point, to the continuation's
+            // tolerance where the line enters it from the other material
+            let e = img.materials[m].engaged.unwrap();
+            for (a, b, what) in [
+                (t.z_c, e.z_c, "z_c"),
+                (t.modulus_dmt, e.modulus_dmt, "modulus_dmt"),
+                (t.adhesion, e.adhesion, "adhesion"),
+                (t.deformation, e.deformation, "deformation"),
+            ] {
+                assert!(
+                    close(a, b, 1e-4),
+                    "pixel ({j}, {i}) {what}: {a} against {b}"
+                );
+            }
+        }
+    }
+    assert!(seen[0] > 0 && seen[1] > 0, "{seen:?}");
+    let (bg, stiff) = (
+        img.materials[0].engaged.unwrap(),
+        img.materials[1].engaged.unwrap(),
+    );
+    // the stiffer, less adhesive domain: a larger modulus, less adhesion (H R/(6 a0²): 1.25
+    // against 1.67 nN), less deformation
+    assert!(stiff.modulus_dmt > 2.0 * bg.modulus_dmt, "{stiff:?} {bg:?}");
+    assert!(close(stiff.adhesion, -1.25e-9, 1e-6), "{stiff:?}");
+    assert!(close(bg.adhesion, -5e-9 / 3.0, 1e-6), "{bg:?}");
+    assert!(stiff.deformation < bg.deformation, "{stiff:?} {bg:?}");
+    // the true moduli of the two materials (E* = 1 GPa and 3 GPa; the tip of 1e15 Pa)
+    assert!(close(img.materials[0].true_modulus, 1e9, 1e-5));
+    assert!(close(img.materials[1].true_modulus, 3e9, 1e-5));
+    // the apparent height: 0 on the background, its z_c's difference on the domain, the 5 nm
+    // terrace at its true height
+    for j in 0..img.y.len() {
+        for i in 0..img.x.len() {
+            let h = img.value("height", j, i);
+            let expected = img.true_height[j][i] + img.tap(j, i).unwrap().z_c - img.reference;
+            assert!((h - expected).abs() < 1e-18);
+        }
+    }
+    let terrace = img.y.iter().position(|&y| y > 0.7e-6).unwrap();
+    assert!((img.value("height", terrace, 0) - 5e-9).abs() < 1e-15);
+}
+
+#[test]
+fn a_pixel_is_the_standalone_setpoint_tap_of_its_material() {
+    let img = image(8, 6, 2);
+    let doc = map();
+    let stiff = doc.domains[0].sample.as_ref().unwrap();
+    for (m, sample) in [(0usize, None), (1, Some(stiff))] {
+        let d = standalone(sample);
+        let ch = &d["channels"];
+        let e = img.materials[m].engaged.unwrap();
+        // the engage is the standalone search itself: equal bit for bit
+        assert_eq!(e.z_c, d["z_c"].as_f64().unwrap(), "material {m}");
+        assert_eq!(e.peak_force, ch["peak_force"].as_f64().unwrap());
+        assert_eq!(e.modulus_dmt, ch["modulus_dmt"].as_f64().unwrap());
+        assert_eq!(e.adhesion, ch["adhesion"].as_f64().unwrap());
+        assert_eq!(e.deformation, ch["deformation"].as_f64().unwrap());
+        assert_eq!(e.dissipation, ch["dissipation"].as_f64().unwrap());
+        // a pixel the feedback continued into from the other material: the same periodic orbit
+        // at the same setpoint, to the feedback's tolerance (peak force 1e-6 relative: z_c
+        // and the fitted channels to 1e-4)
+        let continued = (0..img.y.len())
+            .flat_map(|j| (0..img.x.len()).map(move |i| (j, i)))
+            .find(|&(j, i)| img.material[j][i] == m && img.pixels[j][i].evaluations > 0);
+        if let Some((j, i)) = continued {
+            let t = img.tap(j, i).unwrap();
+            assert!(close(t.z_c, e.z_c, 1e-4), "{} {}", t.z_c, e.z_c);
+            assert!(close(t.modulus_dmt, e.modulus_dmt, 1e-4));
+            assert!(close(t.adhesion, e.adhesion, 1e-4));
+            assert!(close(t.deformation, e.deformation, 1e-4));
+        }
+    }
+    // the stiff domain is entered from the background along its lines
+    assert!(img.pixels.iter().flatten().any(|p| p.evaluations > 0));
+}
+
+#[test]
+fn the_image_does_not_depend_on_the_thread_count() {
+    let one = image(6, 6, 1);
+    let two = image(6, 6, 2);
+    assert_eq!(one, two, "bit for bit");
+}
+
+#[test]
+fn the_door_gives_the_image_and_refuses_an_am_probe() {
+    let job = |probe: toml::Table| ImageJob {
+        mode: ImageMode::Peakforce,
+        probe,
+        sample: map(),
+        request: request(4, 2),
+        feedback: None,
+        study: None,
+        threads: Some(1),
+        files: Files::None,
+    };
+    let j = job(probe());
+    let model = j.model().unwrap();
+    let d = afmdyn::request::run::run(&j, &model, &Progress::new()).unwrap();
+    let ImageOutput::PeakForce(img) = &d.output else {
+        panic!("a PeakForce image")
+    };
+    assert_eq!(img.x.len(), 4);
+    let outcome = d.output.outcome(SETPOINT);
+    let doc = &outcome.document;
+    assert_eq!(doc["mode"], "peakforce");
+    for k in [
+        "height",
+        "modulus_dmt",
+        "adhesion",
+        "deformation",
+        "dissipation",
+    ] {
+        assert_eq!(doc["image"][k].as_array().unwrap().len(), 2, "{k}");
+    }
+    assert_eq!(outcome.datasets[0].0, "image");
+    let am: toml::Table = repo("examples/probe-point-mass-dmt.toml").parse().unwrap();
+    let bad = job(am);
+    let err = afmdyn::request::run::run(&bad, &bad.model().unwrap(), &Progress::new())
+        .err()
+        .unwrap();
+    assert!(err.to_string().contains("off-resonance"), "{err}");
+}
+
+#[test]
+fn the_plan_of_engages_and_lines_is_the_image_bit_for_bit() {
+    use afmdyn::study::plan::{plan, rebuild, Recipe};
+    use std::sync::atomic::AtomicBool;
+    let recipe = Recipe::PeakForceImage {
+        probe: probe(),
+        map: map(),
+        request: request(6, 4),
+    };
+    let p = plan(recipe).unwrap();
+    // as Dask does: every task in a plan rebuilt from its recipe's text
+    let worker = rebuild(p.recipe()).unwrap();
+    let cancel = AtomicBool::new(false);
+    let mut results = Vec::new();
+    for stage in 0..p.stages() {
+        let st = p.stage(stage, &results).unwrap();
+        for t in st.tasks.into_iter().rev() {
+            results.push(worker.run(&st.start, t, &cancel).unwrap());
+        }
+    }
+    let out = p.outcome(&results).unwrap();
+    let img = image(6, 4, 2);
+    let direct = afmdyn::request::image_job::ImageOutput::PeakForce(img).outcome(SETPOINT);
+    assert_eq!(out.document, direct.document);
+}
