@@ -1,5 +1,5 @@
-"""AM-AFM images of a heterogeneous sample (``afmdyn image``): the library's ideal-feedback
-image as an ``xarray.Dataset`` in SI."""
+"""Images of a heterogeneous sample (``afmdyn image``): the library's AM image (ideal or PI
+feedback) or PeakForce image (ideal peak-force feedback) as an ``xarray.Dataset`` in SI."""
 
 from __future__ import annotations
 
@@ -18,7 +18,8 @@ from ._progress import ProgressArg, reporter
 def _keywords(probe: Any, sample: Any, setpoint: float, pixels: Optional[int],
              lines: Optional[int], curve_points: Optional[int], height_map: Any,
              feedback: str, scan_rate: Optional[float], gains: Optional[Sequence[float]],
-             time_constant: Optional[float], threads: Optional[int]) -> Tuple[str, Dict[str, Any]]:
+             time_constant: Optional[float], threads: Optional[int],
+             mode: str = "am") -> Tuple[str, Dict[str, Any]]:
     """The probe's TOML text and the library's ``ImageKeywords`` of an image's arguments."""
     rows = None
     if isinstance(height_map, (str, os.PathLike)):
@@ -32,7 +33,8 @@ def _keywords(probe: Any, sample: Any, setpoint: float, pixels: Optional[int],
               gains=None if gains is None else [float(g) for g in gains])
     request = dict(sample=os.fspath(sample) if isinstance(sample, os.PathLike) else sample,
                    setpoint=setpoint, pixels=pixels, lines=lines, curve_points=curve_points,
-                   height_map=rows, feedback=pi if feedback == "pi" else None, threads=threads)
+                   height_map=rows, feedback=pi if feedback == "pi" else None, threads=threads,
+                   mode=None if mode == "am" else mode)
     return _core.probe_source(probe), request
 
 
@@ -51,6 +53,7 @@ def image(
     gains: Optional[Tuple[float, float]] = None,
     time_constant: Optional[float] = None,
     threads: Optional[int] = None,
+    mode: str = "am",
     progress: ProgressArg = None,
 ) -> xr.Dataset:
     """The image an amplitude feedback records over a heterogeneous sample
@@ -61,7 +64,9 @@ def image(
     updating once per drive period (``scan_rate`` in Hz, ``gains`` = (K_P, K_I in 1/s),
     ``time_constant`` of the lock-in in s, refused above 1000 s and warned outside
     1 µs–0.1 s; ``None`` for the lever's defaults), its lines on ``threads`` cores with
-    ``progress``; Ctrl-C stops it.
+    ``progress``; Ctrl-C stops it. ``mode="peakforce"`` (an off-resonance probe): the image
+    an ideal peak-force feedback records, ``setpoint`` the peak force (N), each pixel's steady
+    tap exact (issue 61 §3), its lines on ``threads`` cores.
 
     Args:
         probe: the probe (path, TOML text or dict, as ``afmdyn.probe``): the lever, tip,
@@ -70,7 +75,7 @@ def image(
             entries with ``name``, ``x``, ``y``, ``height`` (m) and ``[domain.sample]``; its
             ``height_map`` the rows inline or a ``.csv`` / ``.npy`` file (a relative path from
             the sample file's directory, or from the current one for TOML text).
-        setpoint: A_sp/A0 in (0, 1).
+        setpoint: A_sp/A0 in (0, 1); with ``mode="peakforce"`` the peak force (N).
         pixels: pixels per line (default 64). lines: lines (default: as many as pixels, 1 for
             a line map). curve_points: points of each material's approach curve (default 120).
         height_map: a 2D array of heights (m), rows from y = 0 to Ly and columns from x = 0 to
@@ -92,23 +97,35 @@ def image(
         direction the height error against the ideal image, the overshoot, the error image's
         RMS, the pixels that lost contact).
 
+        With ``mode="peakforce"``: ``height``, ``true_height``, ``z_c``, ``peak_force``,
+        ``modulus_dmt``, ``adhesion``, ``deformation``, ``dissipation``, ``taps_per_cycle``,
+        ``evaluations`` (steady taps computed at the pixel), ``material`` and ``domain``, as
+        ``image.nc`` of ``afmdyn image --mode peakforce``.
+
     Raises:
         ValueError: naming the field — a setpoint outside (0, 1), pixels or lines outside
             1..=4096 (lines = 1 for a line map), a sample map's key, a scan setting
             (scan_rate, gains, time_constant).
     """
+    if mode not in ("am", "peakforce"):
+        raise ValueError(f"mode = {mode!r}: must be 'am' or 'peakforce'")
+    if mode == "peakforce" and (feedback != "ideal" or curve_points is not None):
+        raise ValueError("feedback, curve_points: not with mode='peakforce' (its ideal "
+                         "peak-force feedback engages each material by its own setpoint search)")
     if feedback not in ("ideal", "pi"):
         raise ValueError(f"feedback = {feedback!r}: must be 'ideal' or 'pi'")
     if feedback == "ideal" and any(
-        v is not None for v in (scan_rate, gains, time_constant, threads)
+        v is not None for v in (scan_rate, gains, time_constant)
+        + ((threads,) if mode == "am" else ())
     ):
         raise ValueError(
             "scan_rate, gains, time_constant, threads: only with feedback='pi' "
             "(the ideal feedback has no loop)"
         )
     text, request = _keywords(probe, sample, setpoint, pixels, lines, curve_points, height_map,
-                              feedback, scan_rate, gains, time_constant, threads)
-    with reporter(progress if feedback == "pi" else False, "image", unit="line") as cb:
+                              feedback, scan_rate, gains, time_constant, threads, mode)
+    lines_progress = feedback == "pi" or mode == "peakforce"
+    with reporter(progress if lines_progress else False, "image", unit="line") as cb:
         out = _core.image(text, request, cb)
     return _dataset(out, setpoint)
 

@@ -383,16 +383,22 @@ def image(
     scan_rate: Optional[float] = None,
     gains: Optional[Sequence[float]] = None,
     time_constant: Optional[float] = None,
+    mode: str = "am",
 ) -> xr.Dataset:
     """:func:`afmdyn.image` with ``feedback="pi"`` (the same keywords but ``threads``) with
     its lines mapped over a Dask cluster (``client``; default a ``LocalCluster`` of this
     machine's cores, closed at the end): each line is a task, a pure function of the request
-    and its number, so the Dataset equals :func:`afmdyn.image`'s bit for bit.
+    and its number, so the Dataset equals :func:`afmdyn.image`'s bit for bit. With
+    ``mode="peakforce"`` the PeakForce image (``setpoint`` the peak force, N): the materials'
+    engages are the first stage's tasks, the lines the second's.
     """
     from ._image import _dataset, _keywords
 
+    if mode not in ("am", "peakforce"):
+        raise ValueError(f"mode = {mode!r}: must be 'am' or 'peakforce'")
+    feedback = "pi" if mode == "am" else "ideal"
     text, request = _keywords(probe, sample, setpoint, pixels, lines, curve_points, height_map,
-                              "pi", scan_rate, gains, time_constant, None)
+                              feedback, scan_rate, gains, time_constant, None, mode)
     plan = _core.Plan.build("image", request, None, text)
     with _cluster(client) as client:
         d = _run_plan(client, plan, progress, "image (dask)", unit="line")
