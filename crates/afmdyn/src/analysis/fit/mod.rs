@@ -7,6 +7,7 @@ pub mod estimates;
 pub mod force_curve;
 pub mod least_squares;
 pub mod profile;
+pub mod sensitivity;
 
 pub use estimates::{fit, Estimate, FitOutcome};
 pub use least_squares::{CurveModel, Minimum, Observations, Parameter};
