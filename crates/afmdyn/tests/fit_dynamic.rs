@@ -70,15 +70,15 @@ fn orbit(params: &Params, guess: &DVector<f64>) -> OrbitSensitivity {
     orbit_sensitivity(&model, TOL, guess, &[], &newton()).expect("orbit")
 }
 
-/// Check the exact sensitivities at the orbit near `guess` against central differences.
-fn check_point(base: &Params, guess: &DVector<f64>, params: &[OrbitParam], what: &str) {
+/// Check the exact sensitivities at the orbit near `guess` against central differences;
+/// `false` (nothing checked) where the orbit is near a fold or grazing.
+fn check_point(base: &Params, guess: &DVector<f64>, params: &[OrbitParam], what: &str) -> bool {
     let model = CantileverModel::new(base).expect("model");
     let exact = orbit_sensitivity(&model, TOL, guess, params, &newton()).expect("sensitivity");
-    assert!(
-        exact.warnings.is_empty(),
-        "{what}: {:?} (pick another point)",
-        exact.warnings
-    );
+    if !exact.warnings.is_empty() {
+        eprintln!("{what}: skipped, {:?}", exact.warnings);
+        return false;
+    }
     // the amplitude of the Fourier integrals is the library's observable
     let shot = shoot(&model, &exact.state, 1, &newton()).expect("orbit");
     let opts = IntegratorOptions {
@@ -102,15 +102,32 @@ fn check_point(base: &Params, guess: &DVector<f64>, params: &[OrbitParam], what:
     for (j, &p) in params.iter().enumerate() {
         let v = value_of(base, p);
         let h = STEP * v.abs();
-        let plus = orbit(&with(base, p, v + h), &exact.state);
-        let minus = orbit(&with(base, p, v - h), &exact.state);
-        let fd_a = (plus.amplitude - minus.amplitude) / (2.0 * h);
-        let fd_phi = (plus.phase - minus.phase) / (2.0 * h);
-        let fd_z = (&plus.state - &minus.state) / (2.0 * h);
-        let rel = |e: f64, f: f64| (e - f).abs() / e.abs().max(f64::MIN_POSITIVE);
+        // the fourth-order central difference (its truncation error O(h⁴) far below the
+        // integration error's ~TOL/h)
+        let at = |k: f64| orbit(&with(base, p, v + k * h), &exact.state);
+        let (p1, m1, p2, m2) = (at(1.0), at(-1.0), at(2.0), at(-2.0));
+        let diff = |f: &dyn Fn(&OrbitSensitivity) -> f64| {
+            (8.0 * (f(&p1) - f(&m1)) - (f(&p2) - f(&m2))) / (12.0 * h)
+        };
+        let fd_a = diff(&|o| o.amplitude);
+        let fd_phi = diff(&|o| o.phase);
+        let fd_z = ((&p1.state - &m1.state) * 8.0 - (&p2.state - &m2.state)) / (12.0 * h);
+        // relative to the derivative; a parameter the orbit does not feel (α4 or H̃ of an
+        // orbit out of contact) has both exactly 0
+        let rel = |e: f64, f: f64| {
+            if e == 0.0 && f == 0.0 {
+                0.0
+            } else {
+                (e - f).abs() / e.abs().max(f64::MIN_POSITIVE)
+            }
+        };
         let (ea, ep) = (exact.d_amplitude[j], exact.d_phase[j]);
         let ez = exact.d_state.column(j).into_owned();
-        let rz = (&ez - &fd_z).norm() / ez.norm();
+        let rz = if ez.norm() == 0.0 && fd_z.norm() == 0.0 {
+            0.0
+        } else {
+            (&ez - &fd_z).norm() / ez.norm()
+        };
         eprintln!(
             "{what} {p:?}: dA/dp {ea:.9e} (fd {fd_a:.9e}, rel {:.1e}), dφ/dp {ep:.9e} (fd \
              {fd_phi:.9e}, rel {:.1e}), dz*/dp rel {rz:.1e}",
@@ -121,6 +138,17 @@ fn check_point(base: &Params, guess: &DVector<f64>, params: &[OrbitParam], what:
         assert!(rel(ep, fd_phi) <= AGREE, "{what} {p:?}: dφ/dp");
         assert!(rz <= AGREE, "{what} {p:?}: dz*/dp");
     }
+    true
+}
+
+/// Check the first of `points` (approach points of `base`) that is neither near a fold nor
+/// grazing.
+fn check_first(base: &Params, points: &[&CurvePoint], params: &[OrbitParam], what: &str) {
+    let checked = points.iter().any(|p| {
+        let b = with(base, OrbitParam::Gap, p.value);
+        check_point(&b, &p.state, params, what)
+    });
+    assert!(checked, "{what}: no point away from folds and grazing");
 }
 
 /// An approach from z_c = 1.2 A₀ to 0.2 A₀ in `points` points.
@@ -129,18 +157,21 @@ fn approach(base: Params, points: usize) -> Vec<CurvePoint> {
     approach_retract(&spec).expect("approach").first
 }
 
-/// An attractive (φ > 90°, A < 0.95 A_far) and a repulsive (φ < 90°, A near 0.6 of the first
-/// point's) stable period-1 point of the approach.
-fn regimes(curve: &[CurvePoint]) -> (Option<&CurvePoint>, Option<&CurvePoint>) {
+/// The attractive (φ > 90°, A < 0.98 A_far) and the repulsive (φ < 90°, A < 0.7 A_far)
+/// stable period-1 points of the approach.
+fn regimes(curve: &[CurvePoint]) -> (Vec<&CurvePoint>, Vec<&CurvePoint>) {
     let a_far = curve[0].observables.amplitude;
     let ok = |p: &&CurvePoint| p.period == Some(1) && p.stable;
     let attractive = curve
         .iter()
         .filter(ok)
-        .find(|p| p.observables.phase > FRAC_PI_2 && p.observables.amplitude < 0.95 * a_far);
-    let repulsive = curve.iter().filter(ok).find(|p| {
-        p.observables.phase < FRAC_PI_2 && p.observables.amplitude < 0.7 * a_far
-    });
+        .filter(|p| p.observables.phase > FRAC_PI_2 && p.observables.amplitude < 0.98 * a_far)
+        .collect();
+    let repulsive = curve
+        .iter()
+        .filter(ok)
+        .filter(|p| p.observables.phase < FRAC_PI_2 && p.observables.amplitude < 0.7 * a_far)
+        .collect();
     (attractive, repulsive)
 }
 
@@ -155,9 +186,7 @@ fn point_mass_dmt_sensitivities_are_the_finite_differences() {
         OrbitParam::Hamaker,
     ];
     for (p, what) in [(att, "attractive"), (rep, "repulsive")] {
-        let p = p.unwrap_or_else(|| panic!("no {what} point"));
-        let b = with(&base, OrbitParam::Gap, p.value);
-        check_point(&b, &p.state, &ps, &format!("point mass DMT, {what}"));
+        check_first(&base, &p, &ps, &format!("point mass DMT, {what}"));
     }
 }
 
@@ -169,17 +198,16 @@ fn point_mass_hertz_sensitivities_are_the_finite_differences() {
     };
     let curve = approach(base, 41);
     let (_, rep) = regimes(&curve);
-    let p = rep.expect("a repulsive point");
     let ps = [OrbitParam::Gap, OrbitParam::ContactStiffness];
-    let b = with(&base, OrbitParam::Gap, p.value);
-    check_point(&b, &p.state, &ps, "point mass Hertz, repulsive");
-    // a lighter touch: the first point in contact
-    let light = curve
+    check_first(&base, &rep, &ps, "point mass Hertz, repulsive");
+    // a lighter touch: the stable points of A_far > A > 0.7 A_far
+    let a_far = curve[0].observables.amplitude;
+    let light: Vec<&CurvePoint> = curve
         .iter()
-        .find(|q| q.period == Some(1) && q.stable && q.observables.amplitude < 0.98 * curve[0].observables.amplitude)
-        .expect("a touching point");
-    let b = with(&base, OrbitParam::Gap, light.value);
-    check_point(&b, &light.state, &ps, "point mass Hertz, light touch");
+        .filter(|p| p.period == Some(1) && p.stable)
+        .filter(|p| (0.7 * a_far..0.99 * a_far).contains(&p.observables.amplitude))
+        .collect();
+    check_first(&base, &light, &ps, "point mass Hertz, light touch");
 }
 
 #[test]
@@ -193,8 +221,6 @@ fn beam_dmt_sensitivities_are_the_finite_differences() {
         OrbitParam::Hamaker,
     ];
     for (p, what) in [(att, "attractive"), (rep, "repulsive")] {
-        let p = p.unwrap_or_else(|| panic!("no {what} point"));
-        let b = with(&base, OrbitParam::Gap, p.value);
-        check_point(&b, &p.state, &ps, &format!("N = 3 beam DMT, {what}"));
+        check_first(&base, &p, &ps, &format!("N = 3 beam DMT, {what}"));
     }
 }

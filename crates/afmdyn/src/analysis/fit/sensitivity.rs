@@ -376,14 +376,11 @@ pub fn orbit_sensitivity(
         .iter()
         .copied()
         .fold(f64::INFINITY, f64::min);
-    let d_state = i_m
-        .lu()
-        .solve(&d_map)
-        .ok_or(SimError::NoConvergence {
-            what: "orbit sensitivity: I − M is singular (a fold)",
-            iterations: 0,
-            residual: sigma_min,
-        })?;
+    let d_state = i_m.lu().solve(&d_map).ok_or(SimError::NoConvergence {
+        what: "orbit sensitivity: I − M is singular (a fold)",
+        iterations: 0,
+        residual: sigma_min,
+    })?;
     let dq = &dq_dz * &d_state + dq_dp;
     let scale = 2.0 / period;
     let (cs, cc) = (scale * flow.state[d], scale * flow.state[d + 1]);
