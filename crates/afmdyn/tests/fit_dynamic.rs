@@ -21,7 +21,7 @@ use std::path::Path;
 /// The adaptive integrator's tolerance of the sensitivities and of the finite differences.
 const TOL: f64 = 1e-12;
 /// The relative step of the central differences.
-const STEP: f64 = 1e-4;
+const STEP: f64 = 1e-3;
 /// The agreement asked for (issue 62: ≤ 1e-6 relative).
 const AGREE: f64 = 1e-6;
 
