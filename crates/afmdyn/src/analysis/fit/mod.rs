@@ -3,6 +3,7 @@
 //! ([`least_squares`], [`estimates`], [`profile`]), and the quasi-static force-curve fit of the
 //! registry's contact laws ([`force_curve`]).
 
+pub mod am_curve;
 pub mod estimates;
 pub mod force_curve;
 pub mod least_squares;

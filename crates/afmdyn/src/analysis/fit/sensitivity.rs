@@ -313,7 +313,8 @@ impl TipSampleSystem for Extended {
 }
 
 /// The period-1 orbit of `model` near `guess` (polished by Newton, `newton`, on the adaptive
-/// integrator of tolerance `tol`), its first harmonic and their exact sensitivities to
+/// integrator of tolerance `tol`; `None`: `guess` is taken as the orbit, as a stepped sweep
+/// converged it with its own integrator), its first harmonic and their exact sensitivities to
 /// `params` (module docs).
 ///
 /// # Errors
@@ -325,7 +326,7 @@ pub fn orbit_sensitivity(
     tol: f64,
     guess: &DVector<f64>,
     params: &[OrbitParam],
-    newton: &ShootingOptions,
+    newton: Option<&ShootingOptions>,
 ) -> Result<OrbitSensitivity, SimError> {
     let p = model.params();
     let unsupported = |hint: &'static str| SimError::Unsupported {
@@ -352,15 +353,21 @@ pub fn orbit_sensitivity(
             ))
         }
     }
-    let mut plain = Adaptive::new(model, tol);
-    let orbit = shoot_with(&mut plain, guess, 1, newton)?;
+    let (state, shot_grazing) = match newton {
+        Some(newton) => {
+            let mut plain = Adaptive::new(model, tol);
+            let orbit = shoot_with(&mut plain, guess, 1, newton)?;
+            (orbit.state, orbit.grazing_distance)
+        }
+        None => (guess.clone(), f64::INFINITY),
+    };
     let ext = Extended {
         model: model.clone(),
         params: params.to_vec(),
     };
     let (d, k) = (model.dim(), params.len());
     let mut y0 = DVector::zeros(ext.dim());
-    y0.rows_mut(0, d).copy_from(&orbit.state);
+    y0.rows_mut(0, d).copy_from(&state);
     let mut integ = Adaptive::new(&ext, tol);
     let period = HybridSystem::period(model);
     let flow = flow_with_jacobian(&mut integ, 0.0, &y0, period)?;
@@ -400,14 +407,14 @@ pub fn orbit_sensitivity(
     if sigma_min < FOLD_TOL {
         warnings.push(SensitivityWarning::NearFold { sigma_min });
     }
-    let grazing_distance = flow.grazing_distance.min(orbit.grazing_distance);
+    let grazing_distance = flow.grazing_distance.min(shot_grazing);
     if grazing_distance < GRAZING_TOL {
         warnings.push(SensitivityWarning::Grazing {
             distance: grazing_distance,
         });
     }
     Ok(OrbitSensitivity {
-        state: orbit.state,
+        state,
         amplitude,
         phase,
         d_state,
