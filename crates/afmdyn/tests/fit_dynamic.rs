@@ -229,7 +229,7 @@ fn beam_dmt_sensitivities_are_the_finite_differences() {
 // ---- the dynamic fit (`analysis::fit::am_curve`) ----
 
 use afmdyn::analysis::fit::am_curve::{AmCurveModel, AmParam, AmProbe};
-use afmdyn::analysis::fit::{fit, CurveModel, FitOutcome, Observations, Parameter};
+use afmdyn::analysis::fit::{fit_with, CurveModel, FitOutcome, Observations, Parameter};
 
 /// The example probe as the dynamic fit's probe.
 pub fn am_probe(name: &str) -> AmProbe {
@@ -344,7 +344,7 @@ fn run_fit(model: &AmCurveModel, y: &[f64], sigma: &[f64]) -> FitOutcome {
         sigma: Some(sigma),
     };
     let fixed = vec![None; params.len()];
-    fit(model, &obs, &params, &fixed)
+    fit_with(model, &obs, &params, &fixed, false)
 }
 
 #[test]
@@ -424,4 +424,57 @@ fn e_and_r_from_the_attractive_amplitude_alone_are_not_identifiable() {
         "{:?}",
         out.warnings
     );
+}
+
+#[test]
+fn an_am_csv_goes_through_the_fit_door() {
+    use afmdyn::analysis::progress::Progress;
+    use afmdyn::request::fit::FitRequest;
+    use afmdyn::request::{run, Resolved};
+    let (model, y, sigma, _) = synthetic(
+        "probe-point-mass-dmt.toml",
+        20,
+        (1.1, 0.5),
+        vec![AmParam::ZOffset],
+        (true, false),
+        3,
+    );
+    let dir = std::env::temp_dir().join(format!("afmdyn-fit-dynamic-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let path = dir.join("am.csv");
+    let mut text = String::from("z,amplitude,sigma_amplitude\n");
+    for ((z, a), s) in model.z.iter().zip(&y).zip(&sigma) {
+        text += &format!("{z:?},{a:?},{s:?}\n");
+    }
+    std::fs::write(&path, text).expect("csv");
+    let path_str = path.display().to_string();
+    let p = Probe::load(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/probe-point-mass-dmt.toml"),
+    )
+    .expect("probe");
+    let resolved = Resolved {
+        params: p.params,
+        probe: Some(p),
+    };
+    let request = FitRequest {
+        data: Some(path_str),
+        fit: vec!["z_offset".into()],
+        ..FitRequest::default()
+    };
+    let doc = run(&request, &resolved, &Progress::default())
+        .expect("fit")
+        .json;
+    std::fs::remove_dir_all(&dir).ok();
+    assert_eq!(doc["kind"], "am");
+    let e = &doc["estimates"]["z_offset"];
+    let [lo, hi] = [
+        e["interval"][0].as_f64().unwrap(),
+        e["interval"][1].as_f64().unwrap(),
+    ];
+    assert!(lo <= 1e-9 && 1e-9 <= hi, "z_offset interval [{lo}, {hi}]");
+    assert_eq!(
+        doc["curve"]["amplitude_fit"].as_array().map(Vec::len),
+        Some(20)
+    );
+    assert!(doc["curve"]["phase"].is_null());
 }

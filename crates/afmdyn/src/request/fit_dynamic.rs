@@ -10,7 +10,7 @@
 use super::fit::{bounds, FitRequest, FitResult, MIN_FIT_ROWS};
 use super::run::Resolved;
 use crate::analysis::fit::am_curve::{AmCurveModel, AmParam, AmProbe, Z_OFFSET};
-use crate::analysis::fit::{fit, Observations, Parameter};
+use crate::analysis::fit::{fit_with, Observations, Parameter};
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
 use serde_json::{json, Value};
@@ -262,7 +262,8 @@ pub fn execute(
         sigma: sigma.as_deref(),
     };
     let fixed = vec![None; params.len()];
-    let mut outcome = fit(&curve, &obs, &params, &fixed);
+    // Wald intervals: a profile's refits would cost a hundred stepped approaches each
+    let mut outcome = fit_with(&curve, &obs, &params, &fixed, false);
     let model_warnings = curve.warnings();
     outcome.warnings.extend(model_warnings.iter().cloned());
     let names: Vec<&'static str> = params
@@ -335,7 +336,7 @@ pub fn document(r: &FitResult, d: &DynamicFit, estimates: Value, correlation: Va
         "termination": o.termination,
         "units": {"sample.youngs_modulus": "Pa", "tip.radius": "m", "sample.hamaker": "J", "z_offset": "m",
                   "z": "m", "amplitude": "m", "phase": "deg"},
-        "method": "weighted least squares by Levenberg–Marquardt (MINPACK lmder, rust-cv levenberg-marquardt) of the stepped approach the instrument did (each row's periodic orbit continued from the previous one, z_c = z + z_offset), with the exact sensitivities of the orbits: the variational equations extended by the parameter columns, saltation at the switchings, ∂x*/∂p = (I − M)⁻¹ ∂P/∂p (docs/afm-workflow.md, From data to properties)",
+        "method": "Wald intervals (±1.96 standard errors; no profiles: each refit is a stepped approach); weighted least squares by Levenberg–Marquardt (MINPACK lmder, rust-cv levenberg-marquardt) of the stepped approach the instrument did (each row's periodic orbit continued from the previous one, z_c = z + z_offset), with the exact sensitivities of the orbits: the variational equations extended by the parameter columns, saltation at the switchings, ∂x*/∂p = (I − M)⁻¹ ∂P/∂p (docs/afm-workflow.md, From data to properties)",
         "warnings": o.warnings,
     })
 }

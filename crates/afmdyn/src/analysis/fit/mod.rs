@@ -10,6 +10,6 @@ pub mod least_squares;
 pub mod profile;
 pub mod sensitivity;
 
-pub use estimates::{fit, Estimate, FitOutcome};
+pub use estimates::{fit, fit_with, Estimate, FitOutcome};
 pub use least_squares::{CurveModel, Minimum, Observations, Parameter};
 pub use profile::{Profile, ProfileEnd};
