@@ -1,6 +1,6 @@
 """The coverage of the dynamic fit's 95 % intervals (issue 62 §1, check "Coverage"): a synthetic
-100-row AM approach (amplitude and phase against the piezo position z; z_c = 11 → 3 nm through
-the bistable range's jump) of examples/probe-point-mass-dmt.toml made once by `afmdyn approach`,
+100-row AM approach (amplitude and phase against the piezo position z; z_c = 7.5 → 3 nm, the
+repulsive branch below the approach's fold) of examples/probe-point-mass-dmt.toml made once by `afmdyn approach`,
 then DRAWS draws of seeded Gaussian noise (σ = 0.02 nm and 0.1°), each fitted by `afmdyn fit`
 for sample.youngs_modulus, sample.hamaker and z_offset (truth: the probe's E = 4 GPa and
 H = 6.6e-20 J, z_offset = 1 nm). Prints, for each parameter, the fraction of draws whose 95 %
@@ -24,7 +24,7 @@ truth = {"sample.youngs_modulus": 4e9, "sample.hamaker": 6.6e-20, "z_offset": 1e
 sa, sp = 2e-11, 0.1
 
 with tempfile.TemporaryDirectory() as tmp:
-    appr = subprocess.run([binary, "approach", "--probe", probe, "--from", "11e-9", "--to", "3e-9",
+    appr = subprocess.run([binary, "approach", "--probe", probe, "--from", "7.5e-9", "--to", "3e-9",
                            "--points", "100", "--json", "--files", "none"],
                           check=True, capture_output=True, text=True)
     a = json.loads(appr.stdout)["approach"]

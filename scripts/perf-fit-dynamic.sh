@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Regenerate the "Dynamic AM fit (issue 62)" section of docs/performance.md: `afmdyn fit` of
 # sample.youngs_modulus, sample.hamaker and z_offset to a synthetic 100-row AM approach
-# (amplitude and phase against the piezo position z, z_c = 11 → 3 nm through the jump of the
-# bistable range; σ = 0.02 nm and 0.1°, seeded Gaussian noise; truth: the probe's E and H and
+# (amplitude and phase against the piezo position z, z_c = 7.5 → 3 nm, the repulsive branch below
+# the approach's fold; σ = 0.02 nm and 0.1°, seeded Gaussian noise; truth: the probe's E and H and
 # z_offset = 1 nm) made by `afmdyn approach` on the point mass (examples/probe-point-mass-dmt.toml)
 # and the N = 3 beam (examples/probe-beam-dmt.toml). The whole command (the stepped approaches,
 # the exact orbit sensitivities, the fit, the profiles; --json, no files). farm-bench, RUNS runs
@@ -19,7 +19,7 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 
 make_curve() { # PROBE OUT.csv
-    "$B" approach --probe "$1" --from 11e-9 --to 3e-9 --points 100 --json --files none > "$tmp/appr.json"
+    "$B" approach --probe "$1" --from 7.5e-9 --to 3e-9 --points 100 --json --files none > "$tmp/appr.json"
     python3 - "$tmp/appr.json" "$2" <<'PY'
 import json, random, sys
 d = json.load(open(sys.argv[1]))
