@@ -319,12 +319,17 @@ pub fn parameters(probe: &AmProbe, params: &[AmParam]) -> Vec<Parameter> {
         .iter()
         .map(|p| {
             let (start, lower, upper, scale) = match p {
-                AmParam::YoungsModulus => {
-                    (0.6 * probe.youngs_modulus, 1e5, 1e12, probe.youngs_modulus)
-                }
-                AmParam::Hamaker => (1.5 * probe.hamaker, 1e-23, 1e-17, probe.hamaker),
+                // one-sided bounds: MINUIT's sine map of a two-sided range squashes a value
+                // near its lower end (E = 4 GPa in [0.1 MPa, 1 TPa])
+                AmParam::YoungsModulus => (
+                    0.6 * probe.youngs_modulus,
+                    1e5,
+                    f64::INFINITY,
+                    probe.youngs_modulus,
+                ),
+                AmParam::Hamaker => (1.5 * probe.hamaker, 0.0, f64::INFINITY, probe.hamaker),
                 AmParam::ZOffset => (0.0, -5e-9, 5e-9, 1e-9),
-                AmParam::TipRadius => (1.3 * probe.radius, 1e-10, 1e-6, probe.radius),
+                AmParam::TipRadius => (1.3 * probe.radius, 1e-10, f64::INFINITY, probe.radius),
             };
             Parameter {
                 name: p.name().into(),
@@ -379,10 +384,11 @@ fn a_noisy_point_mass_am_curve_gives_back_e_h_and_the_offset() {
     let t0 = std::time::Instant::now();
     let out = run_fit(&model, &y, &sigma);
     eprintln!(
-        "fit of E, H, z_offset to 100 rows (amplitude and phase): {:.2} s, {} evaluations, \
-         χ²/dof {:.3}, {:?}",
+        "fit of E, H, z_offset to 100 rows (amplitude and phase): {:.2} s, {} evaluations \
+         ({}), χ²/dof {:.3}, {:?}",
         t0.elapsed().as_secs_f64(),
         out.evaluations,
+        out.termination,
         out.chi2_dof,
         out.warnings
     );
@@ -499,7 +505,7 @@ fn the_am_models_jacobian_is_its_finite_differences() {
     let mut jac = vec![0.0; m * n];
     model.evaluate(&truth, &mut v, Some(&mut jac));
     for k in 0..n {
-        let h = 1e-4 * truth[k].abs().max(1e-10);
+        let h = 1e-4 * truth[k].abs();
         let (mut up, mut down) = (truth.clone(), truth.clone());
         up[k] += h;
         down[k] -= h;

@@ -227,9 +227,12 @@ pub fn execute(
             AmParam::TipRadius => (am_probe.radius, am_probe.radius),
             AmParam::ZOffset => (0.0, 0.1 * am_probe.length_m),
         };
+        // the physical range's lower end only: MINUIT's sine map of a two-sided range squashes
+        // a value near its lower end (a modulus of GPa in a range to TPa), where the
+        // one-sided map keeps its scale
         let (lower, upper) = match p {
             AmParam::ZOffset => (-am_probe.length_m * 10.0, am_probe.length_m * 10.0),
-            _ => bounds(n),
+            _ => (bounds(n).0, f64::INFINITY),
         };
         am.push(p);
         params.push(Parameter {
