@@ -116,6 +116,9 @@ pub struct FitResult {
     pub fitted: Vec<bool>,
     /// The fit.
     pub outcome: FitOutcome,
+    /// The dynamic fit's data and channels, when the data are an AM curve
+    /// ([`super::fit_dynamic`]; then `curve` and `rows` are empty).
+    pub dynamic: Option<super::fit_dynamic::DynamicFit>,
 }
 
 /// A force curve's columns: heights, forces and their σ.
@@ -284,9 +287,16 @@ fn check_columns(height: &[f64], force: &[f64], sigma: Option<&[f64]>) -> Result
 impl Analysis for FitRequest {
     type Output = FitResult;
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
+        if super::fit_dynamic::read_am_data(self)?.is_some() {
+            // an AM curve: its names and columns are checked when it runs
+            return Ok(());
+        }
         self.check(model).map(|_| ())
     }
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<FitResult, SimError> {
+        if let Some(data) = super::fit_dynamic::read_am_data(self)? {
+            return super::fit_dynamic::execute(self, model, data, progress);
+        }
         let law = self.check(model)?;
         let (height, force, sigma) = self.columns()?;
         check_columns(&height, &force, sigma.as_deref())?;
@@ -397,6 +407,7 @@ impl Analysis for FitRequest {
             names,
             fitted,
             outcome,
+            dynamic: None,
         })
     }
     fn name(&self) -> &'static str {
@@ -480,6 +491,14 @@ pub fn document(request: &FitRequest, r: &FitResult) -> Value {
         .iter()
         .map(|row| row.iter().map(|x| x.is_finite().then_some(*x)).collect())
         .collect();
+    if let Some(d) = &r.dynamic {
+        return super::fit_dynamic::document(
+            r,
+            d,
+            Value::Object(estimates),
+            json!({"names": names, "matrix": matrix}),
+        );
+    }
     let pick = |v: &[f64]| r.rows.iter().map(|&i| v[i]).collect::<Vec<f64>>();
     json!({
         "estimates": estimates,
@@ -530,18 +549,25 @@ impl super::named::Datasets for FitRequest {
             })
         };
         let n = r.rows.len();
-        let curve = Layout::new(
-            "fit curve",
-            &[("row", n)],
-            [
+        let columns: &[(&str, &str, &str)] = if r.dynamic.is_some() {
+            &super::fit_dynamic::CURVE_VARIABLES
+        } else {
+            &[
                 ("tip_position", "m", "tip position"),
                 ("force", "N", "force, measured"),
                 ("fit", "N", "force, fitted"),
                 ("residual", "N", "measured − fitted"),
             ]
-            .iter()
-            .map(|&(k, u, l)| Variable::f64(k, &["row"], u, l, &arr(k)))
-            .collect(),
+        };
+        let n = r.dynamic.as_ref().map_or(n, |d| d.data.z.len());
+        let curve = Layout::new(
+            "fit curve",
+            &[("row", n)],
+            columns
+                .iter()
+                .filter(|(k, _, _)| doc["curve"][k].is_array())
+                .map(|&(k, u, l)| Variable::f64(k, &["row"], u, l, &arr(k)))
+                .collect(),
         );
         let mut facts = serde_json::Map::new();
         for e in &r.outcome.estimates {

@@ -46,6 +46,7 @@ pub mod fm;
 #[cfg(feature = "files")]
 pub use crate::io::height_map as height_map_file;
 pub mod fit;
+pub mod fit_dynamic;
 pub mod image;
 pub mod image_job;
 pub mod image_layout;

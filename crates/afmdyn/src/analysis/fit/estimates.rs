@@ -82,6 +82,19 @@ pub fn fit(
     params: &[Parameter],
     fixed: &[Option<f64>],
 ) -> FitOutcome {
+    fit_with(model, obs, params, fixed, true)
+}
+
+/// [`fit`], with the profile-likelihood intervals when `profiles` (else the Wald intervals,
+/// ±1.96 standard errors: a model whose every evaluation is costly — the dynamic fit's stepped
+/// approach — skips the profiles' refits).
+pub fn fit_with(
+    model: &dyn CurveModel,
+    obs: &Observations,
+    params: &[Parameter],
+    fixed: &[Option<f64>],
+    profiles: bool,
+) -> FitOutcome {
     let start: Vec<f64> = params.iter().map(|p| p.start).collect();
     let best = minimize(model, obs, params, &start, fixed);
     let free: Vec<usize> = (0..params.len()).filter(|&j| fixed[j].is_none()).collect();
@@ -136,7 +149,7 @@ pub fn fit(
         } else {
             0.1 * p.scale
         };
-        let prof = (n <= MAX_PROFILED && dof > 0 && s2 > 0.0)
+        let prof = (profiles && n <= MAX_PROFILED && dof > 0 && s2 > 0.0)
             .then(|| profile(model, obs, params, &best, fixed, j, step, s2));
         let interval = prof
             .as_ref()

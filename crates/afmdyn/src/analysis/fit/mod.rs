@@ -3,11 +3,13 @@
 //! ([`least_squares`], [`estimates`], [`profile`]), and the quasi-static force-curve fit of the
 //! registry's contact laws ([`force_curve`]).
 
+pub mod am_curve;
 pub mod estimates;
 pub mod force_curve;
 pub mod least_squares;
 pub mod profile;
+pub mod sensitivity;
 
-pub use estimates::{fit, Estimate, FitOutcome};
+pub use estimates::{fit, fit_with, Estimate, FitOutcome};
 pub use least_squares::{CurveModel, Minimum, Observations, Parameter};
 pub use profile::{Profile, ProfileEnd};

@@ -50,6 +50,11 @@ pub fn fit(
     if files == Files::None {
         return p;
     }
+    if document["kind"] == "am" {
+        am_files(&mut p, document, files);
+        with_document(&mut p, document, ("fit.json", "fit-curve.csv"), dir);
+        return p;
+    }
     let curve = rows(document, "curve", &CURVE_COLUMNS);
     #[cfg(feature = "files")]
     {
@@ -93,4 +98,66 @@ pub fn fit(
     }
     with_document(&mut p, document, ("fit.json", "fit-curve.csv"), dir);
     p
+}
+
+/// The table and figures of a dynamic (AM) fit ([`crate::request::fit_dynamic`]): the columns
+/// of the channels fitted, each channel's data and fit against z, and its residuals.
+fn am_files(p: &mut Presentation, document: &Value, files: Files) {
+    let columns: Vec<&str> = crate::request::fit_dynamic::CURVE_VARIABLES
+        .iter()
+        .map(|v| v.0)
+        .filter(|k| document["curve"][k].is_array())
+        .collect();
+    let curve = rows(document, "curve", &columns);
+    #[cfg(feature = "files")]
+    {
+        use crate::layout::files::f;
+        let table = curve
+            .iter()
+            .map(|r| r.iter().map(|v| f(*v)).collect())
+            .collect();
+        p.csv("fit-curve.csv", &columns, table);
+    }
+    if files != Files::All {
+        return;
+    }
+    let col = |k: &str| columns.iter().position(|c| *c == k);
+    let series = |label: &str, c: usize, style: Style, color: usize| Series {
+        label: label.into(),
+        points: curve
+            .iter()
+            .map(|r| (r[0], r[c]))
+            .filter(|(x, y)| x.is_finite() && y.is_finite())
+            .collect(),
+        style,
+        color,
+    };
+    for (channel, unit) in [("amplitude", "m"), ("phase", "deg")] {
+        let (Some(d), Some(f), Some(r)) = (
+            col(channel),
+            col(&format!("{channel}_fit")),
+            col(&format!("{channel}_residual")),
+        ) else {
+            continue;
+        };
+        p.figure(
+            &format!("fit-{channel}"),
+            lines(
+                &format!("AM curve: the {channel}, data and fit"),
+                ("z (m)".into(), format!("{channel} ({unit})")),
+                vec![
+                    series("data", d, Style::Dots, 0),
+                    series("fit", f, Style::Line, 1),
+                ],
+            ),
+        );
+        p.figure(
+            &format!("fit-{channel}-residual"),
+            lines(
+                &format!("AM curve: {channel} residuals (data − fit)"),
+                ("z (m)".into(), format!("residual ({unit})")),
+                vec![series("", r, Style::Line, 0)],
+            ),
+        );
+    }
 }

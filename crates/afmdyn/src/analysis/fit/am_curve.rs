@@ -1,0 +1,324 @@
+//! The dynamic fit's model (issue 62 §1): a measured amplitude-modulation curve — the first
+//! harmonic's amplitude A (m) and phase φ (deg) against the piezo position z (m) — as the
+//! stepped approach the instrument did ([`crate::analysis::stepped`]: each point's periodic
+//! orbit continued from the previous one, following its branch through a bistable range and
+//! jumping where it ends), with the exact sensitivities of each point's orbit
+//! ([`super::sensitivity`]) as the Jacobian.
+//!
+//! # Parameters (SI, probe names)
+//! * `sample.youngs_modulus` E_s (Pa): the Hertz group α4 ∝ E*, 1/E* = (1 − ν_t²)/E_t +
+//!   (1 − ν_s²)/E_s (Johnson, *Contact Mechanics*, 1985, eq. 4.22), so
+//!   ∂α4/∂E_s = α4 E* (1 − ν_s²)/E_s²;
+//! * `sample.hamaker` H (J), DMT's: H̃ ∝ H, ∂H̃/∂H = H̃/H;
+//! * `tip.radius` R (m): α4 ∝ √R (Hertz's paraboloid) and H̃ ∝ R (the sphere's van der Waals
+//!   force, −HR/(6d²)), so ∂α4/∂R = α4/(2R), ∂H̃/∂R = H̃/R;
+//! * `z_offset` (m): the rest distance of row i is z_c = z_i + z_offset (the piezo's zero is not
+//!   the sample's), α5 = z_c/g₀ − ã_offset ([`crate::params::Params::alpha5_for_rest_distance`]),
+//!   ∂α5/∂z_offset = 1/g₀.
+//!
+//! The model's values are the amplitudes A g₀ (m) of the rows, then their phases φ (deg), for
+//! the channels fitted; a row whose point is not a stable period-1 orbit keeps the stepped
+//! sweep's observables with a zero Jacobian row, and says so in [`AmCurveModel::warnings`], as
+//! a fold or a grazing orbit does (where the sensitivities are not to be trusted).
+
+use super::sensitivity::{orbit_sensitivity, OrbitParam};
+use super::CurveModel;
+use crate::analysis::stepped::{check_values, sweep_points, CurvePoint, SteppedSpec};
+use crate::contact::{reduced_modulus, ContactLaw};
+use crate::error::SimError;
+use crate::model::CantileverModel;
+use crate::params::{Params, SweepParam};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Mutex;
+
+/// `z_offset` (m).
+pub const Z_OFFSET: &str = "z_offset";
+/// `sample.youngs_modulus` (Pa).
+pub const YOUNGS_MODULUS: &str = "sample.youngs_modulus";
+/// `sample.hamaker` (J).
+pub const HAMAKER: &str = "sample.hamaker";
+/// `tip.radius` (m).
+pub const RADIUS: &str = "tip.radius";
+
+/// The adaptive integrator's tolerance of the fit's Jacobian: the sensitivities to ~1e-7
+/// relative, far inside what Levenberg–Marquardt and the covariance need (the values are the
+/// stepped sweep's, at its own tolerance).
+pub const SENSITIVITY_TOLERANCE: f64 = 1e-9;
+
+/// A parameter of the dynamic fit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum AmParam {
+    /// `sample.youngs_modulus`.
+    YoungsModulus,
+    /// `sample.hamaker` (DMT).
+    Hamaker,
+    /// `z_offset`.
+    ZOffset,
+    /// `tip.radius`.
+    TipRadius,
+}
+
+impl AmParam {
+    /// The parameter of a probe name; `None` for another.
+    pub fn from_name(name: &str) -> Option<AmParam> {
+        match name {
+            YOUNGS_MODULUS => Some(AmParam::YoungsModulus),
+            HAMAKER => Some(AmParam::Hamaker),
+            Z_OFFSET => Some(AmParam::ZOffset),
+            RADIUS => Some(AmParam::TipRadius),
+            _ => None,
+        }
+    }
+    /// Its probe name.
+    pub fn name(self) -> &'static str {
+        match self {
+            AmParam::YoungsModulus => YOUNGS_MODULUS,
+            AmParam::Hamaker => HAMAKER,
+            AmParam::ZOffset => Z_OFFSET,
+            AmParam::TipRadius => RADIUS,
+        }
+    }
+}
+
+/// The probe's SI values the model scales from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AmProbe {
+    /// The probe's dimensionless parameters (α4 at `youngs_modulus`, H̃ at `hamaker`).
+    pub params: Params,
+    /// g₀ (m per unit length).
+    pub length_m: f64,
+    /// The probe's E_s (Pa).
+    pub youngs_modulus: f64,
+    /// ν_s.
+    pub poisson_ratio: f64,
+    /// E_t (Pa), ν_t.
+    pub tip: (f64, f64),
+    /// The probe's H (J; 0 for Hertz).
+    pub hamaker: f64,
+    /// The probe's R (m).
+    pub radius: f64,
+}
+
+/// The model of a measured AM curve (module docs).
+#[derive(Debug)]
+pub struct AmCurveModel {
+    /// The probe.
+    pub probe: AmProbe,
+    /// The piezo positions z (m) of the rows, in the order the instrument stepped.
+    pub z: Vec<f64>,
+    /// Whether the amplitude and the phase are fitted (values: the amplitudes, then the phases).
+    pub channels: (bool, bool),
+    /// The model's parameters, in the fit's order.
+    pub params: Vec<AmParam>,
+    /// The stepped sweep's settings (its values are overwritten by the rows').
+    pub spec: SteppedSpec,
+    /// The adaptive integrator's tolerance of the sensitivities (default
+    /// [`SENSITIVITY_TOLERANCE`]).
+    pub tolerance: f64,
+    /// The last evaluation's warnings.
+    warnings: Mutex<Vec<String>>,
+}
+
+impl AmCurveModel {
+    /// A model of the rows `z` (m) under `probe`, with parameters `params` and the channels
+    /// (amplitude, phase).
+    pub fn new(probe: AmProbe, z: Vec<f64>, channels: (bool, bool), params: Vec<AmParam>) -> Self {
+        let mut spec = SteppedSpec::new(probe.params, SweepParam::Alpha5, Vec::new());
+        spec.branches = false;
+        let tolerance = SENSITIVITY_TOLERANCE;
+        AmCurveModel {
+            probe,
+            z,
+            channels,
+            params,
+            spec,
+            tolerance,
+            warnings: Mutex::new(Vec::new()),
+        }
+    }
+
+    /// The last evaluation's warnings (folds, grazing, rows off a period-1 orbit).
+    pub fn warnings(&self) -> Vec<String> {
+        self.warnings.lock().map(|w| w.clone()).unwrap_or_default()
+    }
+
+    /// The parameters at `p` (SI, the model's order), z_offset, and ∂α4/∂E_s, ∂H̃/∂H,
+    /// ∂α5/∂z_offset, ∂α4/∂R, ∂H̃/∂R.
+    fn scaled(&self, p: &[f64]) -> (Params, f64, [f64; 5]) {
+        let pr = &self.probe;
+        let get = |a: AmParam, default: f64| {
+            self.params
+                .iter()
+                .position(|q| *q == a)
+                .map_or(default, |j| p[j])
+        };
+        let e = get(AmParam::YoungsModulus, pr.youngs_modulus);
+        let h = get(AmParam::Hamaker, pr.hamaker);
+        let z_offset = get(AmParam::ZOffset, 0.0);
+        let r = get(AmParam::TipRadius, pr.radius);
+        let e_star = |e| reduced_modulus(pr.tip.0, pr.tip.1, e, pr.poisson_ratio);
+        let mut q = pr.params;
+        let ratio = e_star(e) / e_star(pr.youngs_modulus) * (r / pr.radius).sqrt();
+        q.alpha4 = pr.params.alpha4 * ratio;
+        let de = q.alpha4 * e_star(e) * (1.0 - pr.poisson_ratio * pr.poisson_ratio) / (e * e);
+        let dr4 = q.alpha4 / (2.0 * r);
+        let (mut dh, mut drh) = (0.0, 0.0);
+        if let ContactLaw::Dmt { hamaker, .. } = &mut q.contact_law {
+            if pr.hamaker > 0.0 {
+                // H̃ ∝ H R
+                dh = *hamaker * (r / pr.radius) / pr.hamaker;
+                *hamaker *= h / pr.hamaker * (r / pr.radius);
+                drh = *hamaker / r;
+            }
+        }
+        (q, z_offset, [de, dh, 1.0 / pr.length_m, dr4, drh])
+    }
+
+    fn evaluate_checked(
+        &self,
+        p: &[f64],
+        values: &mut [f64],
+        mut jacobian: Option<&mut [f64]>,
+    ) -> Result<Vec<String>, SimError> {
+        let (q, z_offset, chain) = self.scaled(p);
+        let g0 = self.probe.length_m;
+        let alpha5: Vec<f64> = self
+            .z
+            .iter()
+            .map(|z| q.alpha5_for_rest_distance((z + z_offset) / g0))
+            .collect();
+        let mut spec = self.spec.clone();
+        spec.base = q;
+        spec.values = alpha5.clone();
+        let first = first_sweep(&spec)?;
+        let dmt = matches!(q.contact_law, ContactLaw::Dmt { .. });
+        let mut orbit_params = vec![OrbitParam::Gap, OrbitParam::ContactStiffness];
+        if dmt {
+            orbit_params.push(OrbitParam::Hamaker);
+        }
+        let m = self.z.len();
+        let n = self.params.len();
+        let (amp, ph) = self.channels;
+        let phase_row = if amp { m } else { 0 };
+        let deg = 180.0 / std::f64::consts::PI;
+        let mut warnings = Vec::new();
+        let mut off = 0;
+        for (i, point) in first.iter().enumerate() {
+            let mut a = point.observables.amplitude;
+            let mut phi = point.observables.phase;
+            let mut da = [0.0; 4];
+            let mut dphi = [0.0; 4];
+            // the values alone (the residuals) are the sweep's observables; with the Jacobian,
+            // those of the sensitivities' Fourier integrals (the same to the integration error)
+            if jacobian.is_some() && point.period == Some(1) && point.stable {
+                let model = CantileverModel::new(&q.with(SweepParam::Alpha5, alpha5[i]))?;
+                let s =
+                    orbit_sensitivity(&model, self.tolerance, &point.state, &orbit_params, None)?;
+                a = s.amplitude;
+                phi = s.phase;
+                for w in &s.warnings {
+                    warnings.push(format!("row {} (z = {:.4e} m): {w}", i + 1, self.z[i]));
+                }
+                // (gap, α4, H̃) → (E_s, H, z_offset, R)
+                let dh = |d: &[f64]| if dmt { d[2] } else { 0.0 };
+                let map = |d: &[f64]| {
+                    [
+                        d[1] * chain[0],
+                        dh(d) * chain[1],
+                        d[0] * chain[2],
+                        d[1] * chain[3] + dh(d) * chain[4],
+                    ]
+                };
+                da = map(&s.d_amplitude);
+                dphi = map(&s.d_phase);
+            } else if point.period != Some(1) || !point.stable {
+                off += 1;
+            }
+            if amp {
+                values[i] = a * g0;
+            }
+            if ph {
+                values[phase_row + i] = phi * deg;
+            }
+            if let Some(j) = jacobian.as_deref_mut() {
+                for (k, param) in self.params.iter().enumerate() {
+                    let c = match param {
+                        AmParam::YoungsModulus => 0,
+                        AmParam::Hamaker => 1,
+                        AmParam::ZOffset => 2,
+                        AmParam::TipRadius => 3,
+                    };
+                    if amp {
+                        j[i * n + k] = da[c] * g0;
+                    }
+                    if ph {
+                        j[(phase_row + i) * n + k] = dphi[c] * deg;
+                    }
+                }
+            }
+        }
+        if off > 0 {
+            warnings.push(format!(
+                "{off} row(s) not on a stable period-1 orbit: their model values are the stepped \
+                 sweep's, without sensitivities"
+            ));
+        }
+        Ok(warnings)
+    }
+}
+
+/// The first sweep of `spec` alone ([`sweep_points`], stopped once its last point is done: the
+/// instrument's path through the rows; the sweep back is not run).
+///
+/// # Errors
+/// As [`sweep_points`].
+pub fn first_sweep(spec: &SteppedSpec) -> Result<Vec<CurvePoint>, SimError> {
+    check_values(spec)?;
+    let n = spec.values.len();
+    let cancel = AtomicBool::new(false);
+    let points = Mutex::new(Vec::with_capacity(n));
+    let sink = |k: usize, p: &CurvePoint| {
+        if k < n {
+            if let Ok(mut v) = points.lock() {
+                v.push(p.clone());
+            }
+        }
+        if k + 1 >= n {
+            cancel.store(true, Ordering::Relaxed);
+        }
+    };
+    match sweep_points(spec, &[], &cancel, &sink) {
+        Ok(_) | Err(SimError::Cancelled) => {}
+        Err(e) => return Err(e),
+    }
+    let points = points.into_inner().unwrap_or_default();
+    if points.len() == n {
+        Ok(points)
+    } else {
+        Err(SimError::Cancelled)
+    }
+}
+
+impl CurveModel for AmCurveModel {
+    fn points(&self) -> usize {
+        self.z.len() * (usize::from(self.channels.0) + usize::from(self.channels.1))
+    }
+    fn evaluate(&self, p: &[f64], values: &mut [f64], jacobian: Option<&mut [f64]>) {
+        let has_jacobian = jacobian.is_some();
+        match self.evaluate_checked(p, values, jacobian) {
+            Ok(w) => {
+                if has_jacobian {
+                    if let Ok(mut l) = self.warnings.lock() {
+                        *l = w;
+                    }
+                }
+            }
+            Err(e) => {
+                values.fill(f64::NAN);
+                if let Ok(mut l) = self.warnings.lock() {
+                    *l = vec![format!("the model failed at {p:?}: {e}")];
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,429 @@
+//! Exact parametric sensitivities of a periodic orbit and of its first harmonic (issue 62 §1):
+//! ∂z*/∂p, ∂A/∂p and ∂φ/∂p for the gap α5 (the rest distance, so `z_offset`), the Hertz group
+//! α4 (∝ E*) and DMT's van der Waals group H̃ (∝ H), for the Hertz and DMT laws.
+//!
+//! # Method
+//! The model's state z (2N) is extended by the two Fourier integrals of the tip deflection
+//! W(1,τ) = φᵀa against the drive, q_s' = W sin θ, q_c' = W cos θ (θ = Ωτ + ψ, ψ the drive's
+//! phase, [`crate::params::Params::drive_phase`]), and by the parameters p with p' = 0. The
+//! extended system's Jacobian has the parameter columns ∂f/∂p = (0, M⁻¹φ ∂F_c/∂p), with ∂F_c/∂p
+//! in closed form from the law (F_c the law's force at δ = −V_T, δ̇ = −V̇_T, [`d_force`]):
+//! * α5 enters through the gap, V_T = W(1,τ) + α2 sin Ωτ + α5 (eq. 8), so ∂F_c/∂α5 =
+//!   −∂F_c/∂δ;
+//! * both laws are linear in α4 (Hertz 1882; Johnson, *Contact Mechanics*, 1985, eq. 4.23: the
+//!   repulsion α4 δ^{3/2} in contact), so ∂F_c/∂α4 = δ^{3/2} in contact, 0 outside;
+//! * DMT is linear in H̃ (Derjaguin, Muller & Toporov, *J. Colloid Interface Sci.* 53 (1975)
+//!   314: −H̃/(ã₀ + V_T)² outside contact, −H̃/ã₀² in it), so ∂F_c/∂H̃ is that force at H̃ = 1.
+//!
+//! The adaptive integrator's variational equations of the extended system
+//! ([`crate::integrate::adaptive`]; Hairer, Nørsett & Wanner, *Solving ODEs I*, §I.14: with
+//! p as a state, the parameter columns of Φ obey d/dτ(∂x/∂p) = J ∂x/∂p + ∂f/∂p from 0) and the
+//! saltation matrix of each switching of the extended system ([`crate::system::saltation`];
+//! Leine & Nijmeijer 2004, §7.1: the guard σV_T moves with α5, ∂g/∂α5 = σ, so the parameter
+//! column gains w ∂g/∂α5) give over one period the monodromy matrix of the extended map,
+//! [[M, ∂P/∂p], [∂q/∂z, ∂q/∂p], [0, I]]. Hertz and DMT have a continuous force at V_T = 0
+//! (Hertz's is 0 at δ = 0; DMT's is −H̃/ã₀² on both sides), so f⁺ = f⁻ there, the shift w is
+//! zero and the saltation matrix is the identity, for the state's and the parameters' columns
+//! alike; it is applied all the same, as the monodromy matrix of [`crate::maps::flow`] applies
+//! it.
+//!
+//! By the implicit function theorem on the shooting equations P(z*, p) = z*,
+//! ∂z*/∂p = (I − M)⁻¹ ∂P/∂p, and the Fourier integrals' total derivatives are
+//! dq/dp = ∂q/∂z · ∂z*/∂p + ∂q/∂p. With c_s = (2/T) q_s = A cos φ and c_c = (2/T) q_c =
+//! −A sin φ (the harmonic A sin(θ − φ) of [`crate::analysis::observables`]),
+//! dA = (c_s dc_s + c_c dc_c)/A and dφ = (c_c dc_s − c_s dc_c)/A².
+//!
+//! # Where it breaks
+//! At a fold, I − M is singular (a multiplier at +1) and ∂z*/∂p is unbounded; at grazing, the
+//! map is not differentiable. Both are reported as [`SensitivityWarning`]s, with their
+//! measures: the smallest singular value of I − M against [`FOLD_TOL`], and the grazing distance
+//! of the flow ([`crate::maps::flow::FlowMap::grazing_distance`]) against
+//! [`crate::analysis::shooting::GRAZING_TOL`].
+//!
+//! Units are the model's (lengths in g₀, τ, forces F̃). Only period-1 orbits; only the laws
+//! `hertz` and `dmt` (without Kelvin–Voigt damping, α6 = 0, whose δ̇/√δ Jacobian singularity
+//! at contact onset the plain variational equations do not resolve).
+
+use crate::analysis::shooting::{shoot_with, ShootingOptions, GRAZING_TOL};
+use crate::contact::{ContactLaw, DmtLaw, HertzLaw, Law, TipSample, TipSampleLaw};
+use crate::error::SimError;
+use crate::integrate::adaptive::Adaptive;
+use crate::maps::flow::flow_with_jacobian;
+use crate::model::CantileverModel;
+use crate::params::SweepParam;
+use crate::system::{Guard, HybridSystem, Jump, Region};
+use crate::tip_sample::TipSampleSystem;
+use nalgebra::{DMatrix, DVector};
+use serde::Serialize;
+use std::f64::consts::{PI, TAU};
+
+/// The smallest singular value of I − M below which an orbit counts as near a fold: there
+/// (I − M)⁻¹ amplifies by more than 10³ and the sensitivities lose three digits.
+pub const FOLD_TOL: f64 = 1e-3;
+
+/// A model parameter whose sensitivity is taken (dimensionless, the model's).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum OrbitParam {
+    /// α5, the gap: V_T = W + α2 sin Ωτ + α5 (eq. 8); a rest distance z_c moves it one to one.
+    Gap,
+    /// α4, the Hertz group of the Hertz and DMT laws (∝ E* √R).
+    ContactStiffness,
+    /// H̃, DMT's van der Waals group (∝ H R).
+    Hamaker,
+}
+
+/// Why a sensitivity is not to be trusted.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum SensitivityWarning {
+    /// I − M is near singular (a multiplier near +1: a fold of the branch).
+    NearFold {
+        /// The smallest singular value of I − M.
+        sigma_min: f64,
+    },
+    /// The orbit (nearly) grazes the sample: the map is not differentiable there.
+    Grazing {
+        /// The flow's distance to grazing (units of g₀).
+        distance: f64,
+    },
+}
+
+impl std::fmt::Display for SensitivityWarning {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            SensitivityWarning::NearFold { sigma_min } => write!(
+                f,
+                "near a fold: the smallest singular value of I − M is {sigma_min:.3e} \
+                 (< {FOLD_TOL:e}); the sensitivities (I − M)⁻¹ ∂P/∂p are unreliable there"
+            ),
+            SensitivityWarning::Grazing { distance } => write!(
+                f,
+                "a grazing orbit (distance {distance:.3e} < {GRAZING_TOL:e} g₀): the \
+                 stroboscopic map is not differentiable there"
+            ),
+        }
+    }
+}
+
+/// A period-1 orbit with its first harmonic and their exact parameter sensitivities.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OrbitSensitivity {
+    /// z* at τ = 0, shape `[2N]`.
+    pub state: DVector<f64>,
+    /// A₁ of the tip deflection (g₀), from the Fourier integrals of the extended flow.
+    pub amplitude: f64,
+    /// φ₁, the lag behind the drive (rad, in (−π/2, 3π/2]).
+    pub phase: f64,
+    /// ∂z*/∂p, 2N × k (k the parameters asked for, in their order).
+    pub d_state: DMatrix<f64>,
+    /// ∂A/∂p, shape `[k]`.
+    pub d_amplitude: Vec<f64>,
+    /// ∂φ/∂p (rad per unit p), shape `[k]`.
+    pub d_phase: Vec<f64>,
+    /// The monodromy matrix M, 2N×2N.
+    pub monodromy: DMatrix<f64>,
+    /// ∂P/∂p at fixed z, 2N × k.
+    pub d_map: DMatrix<f64>,
+    /// The smallest singular value of I − M.
+    pub sigma_min: f64,
+    /// The flow's distance to grazing (g₀).
+    pub grazing_distance: f64,
+    /// Near a fold or grazing.
+    pub warnings: Vec<SensitivityWarning>,
+}
+
+/// ∂F_c/∂p of the law of `law` (groups α4 = `stiffness`, α6 = `damping`) at indentation δ =
+/// `delta`, rate δ̇ = `rate`, in or out of contact (module docs). `None` for a law other than
+/// Hertz and DMT, and for H̃ of Hertz.
+pub fn d_force(
+    law: &ContactLaw,
+    stiffness: f64,
+    damping: f64,
+    param: OrbitParam,
+    contact: bool,
+    delta: f64,
+    rate: f64,
+) -> Option<f64> {
+    let a0 = match *law {
+        ContactLaw::Hertz => None,
+        ContactLaw::Dmt {
+            intermolecular_distance,
+            ..
+        } => Some(intermolecular_distance),
+        _ => return None,
+    };
+    Some(match param {
+        OrbitParam::Gap => {
+            let law = TipSample {
+                law: *law,
+                stiffness,
+                damping,
+            };
+            -law.force(contact, delta, rate).d_delta
+        }
+        OrbitParam::ContactStiffness => HertzLaw.force(1.0, 0.0, contact, delta, 0.0).force,
+        OrbitParam::Hamaker => {
+            let a0 = a0?;
+            DmtLaw {
+                hamaker: 1.0,
+                intermolecular_distance: a0,
+            }
+            .force(0.0, 0.0, contact, delta, 0.0)
+            .force
+        }
+    })
+}
+
+/// The model extended by the Fourier integrals and the parameters (module docs): state
+/// (z, q_s, q_c, p), dimension 2N + 2 + k.
+#[derive(Debug, Clone)]
+struct Extended {
+    model: CantileverModel,
+    params: Vec<OrbitParam>,
+}
+
+impl Extended {
+    fn base(&self) -> usize {
+        self.model.dim()
+    }
+    fn theta(&self, tau: f64) -> (f64, f64) {
+        (self.model.omega() * tau + self.model.params().drive_phase()).sin_cos()
+    }
+    fn plain(&self, z: &DVector<f64>) -> DVector<f64> {
+        z.rows(0, self.base()).into_owned()
+    }
+    /// W(1,τ) = φᵀa and W' = φᵀȧ of the model's state `z`.
+    fn tip_pair(&self, z: &[f64]) -> (f64, f64) {
+        let n = self.model.modes();
+        let tip = self.model.tip();
+        let dot = |x: &[f64]| tip.iter().zip(x).map(|(a, b)| a * b).sum::<f64>();
+        (dot(&z[..n]), dot(&z[n..2 * n]))
+    }
+    /// ∂F_c/∂p_k at (τ, z) in `mode`.
+    fn d_force(&self, mode: Region, tau: f64, z: &[f64], k: usize) -> f64 {
+        let m = &self.model;
+        let p = m.params();
+        let (w, wd) = self.tip_pair(z);
+        let [v, vd, _] = m.v_t_from_tip(tau, [w, wd, 0.0]);
+        d_force(
+            &p.contact_law,
+            p.alpha4,
+            p.alpha6,
+            self.params[k],
+            mode == Region::Contact,
+            -v,
+            -vd,
+        )
+        .unwrap_or(0.0)
+    }
+}
+
+impl HybridSystem for Extended {
+    fn dim(&self) -> usize {
+        self.base() + 2 + self.params.len()
+    }
+    fn period(&self) -> f64 {
+        HybridSystem::period(&self.model)
+    }
+    fn mode_at(&self, tau: f64, z: &[f64]) -> Region {
+        self.model.mode_at(tau, &z[..self.base()])
+    }
+    fn rhs(&self, mode: Region, tau: f64, z: &[f64], dz: &mut [f64]) {
+        let d = self.base();
+        self.model.rhs_slice(mode, tau, &z[..d], &mut dz[..d]);
+        let (w, _) = self.tip_pair(z);
+        let (s, c) = self.theta(tau);
+        dz[d] = w * s;
+        dz[d + 1] = w * c;
+        dz[d + 2..].fill(0.0);
+    }
+    fn jacobian(&self, mode: Region, tau: f64, z: &[f64], jac: &mut DMatrix<f64>) {
+        let d = self.base();
+        let n = self.model.modes();
+        // the model's own (2N×2N) block, written by the model into the top-left corner of the
+        // larger matrix after zeroing it (its jacobian of a larger matrix)
+        self.model.jacobian(mode, tau, &z[..d], jac);
+        let (s, c) = self.theta(tau);
+        for (j, t) in self.model.tip().iter().enumerate() {
+            jac[(d, j)] = t * s;
+            jac[(d + 1, j)] = t * c;
+        }
+        for k in 0..self.params.len() {
+            let df = self.d_force(mode, tau, &z[..d], k);
+            for (i, m) in self.model.tip_mobility().iter().enumerate() {
+                jac[(n + i, d + 2 + k)] = m * df;
+            }
+        }
+    }
+    fn guard(&self, mode: Region, tau: f64, z: &[f64]) -> Guard {
+        let d = self.base();
+        let g = self.model.guard(mode, tau, &z[..d]);
+        let mut grad = DVector::zeros(self.dim());
+        grad.rows_mut(0, d).copy_from(&g.grad);
+        for (k, p) in self.params.iter().enumerate() {
+            if *p == OrbitParam::Gap {
+                grad[d + 2 + k] = self
+                    .model
+                    .guard_param_derivative(mode, SweepParam::Alpha5, tau)
+                    .unwrap_or(0.0);
+            }
+        }
+        Guard {
+            value: g.value,
+            grad,
+            d_tau: g.d_tau,
+        }
+    }
+    fn guard_value(&self, mode: Region, tau: f64, z: &[f64]) -> f64 {
+        self.model.guard_value(mode, tau, &z[..self.base()])
+    }
+    fn guard_tolerance(&self, mode: Region, tau: f64, z: &[f64]) -> f64 {
+        self.model.guard_tolerance(mode, tau, &z[..self.base()])
+    }
+    fn jump(&self, from: Region, tau: f64, z: &[f64]) -> Jump {
+        // Hertz and DMT switch without a jump of the state (R = I): the model's region after
+        let to = self.model.jump(from, tau, &z[..self.base()]).to;
+        Jump::switching(to, z)
+    }
+    fn is_affine(&self) -> bool {
+        false
+    }
+}
+
+impl TipSampleSystem for Extended {
+    fn modes(&self) -> usize {
+        self.model.modes()
+    }
+    fn omega(&self) -> f64 {
+        self.model.omega()
+    }
+    fn tip(&self) -> &DVector<f64> {
+        self.model.tip()
+    }
+    fn v_t_from_tip(&self, tau: f64, w: [f64; 3]) -> [f64; 3] {
+        self.model.v_t_from_tip(tau, w)
+    }
+    fn tip_values(&self, tau: f64, z: &DVector<f64>) -> [f64; 4] {
+        self.model.tip_values(tau, &self.plain(z))
+    }
+    fn law_name(&self) -> &'static str {
+        self.model.law().name()
+    }
+}
+
+/// The period-1 orbit of `model` near `guess` (polished by Newton, `newton`, on the adaptive
+/// integrator of tolerance `tol`; `None`: `guess` is taken as the orbit, as a stepped sweep
+/// converged it with its own integrator), its first harmonic and their exact sensitivities to
+/// `params` (module docs).
+///
+/// # Errors
+/// [`SimError::Unsupported`] for a law other than Hertz and DMT, for H̃ under Hertz, and for
+/// DMT with α6 > 0; [`SimError::NoConvergence`] from the Newton solve; [`SimError`] from the
+/// integrator.
+pub fn orbit_sensitivity(
+    model: &CantileverModel,
+    tol: f64,
+    guess: &DVector<f64>,
+    params: &[OrbitParam],
+    newton: Option<&ShootingOptions>,
+) -> Result<OrbitSensitivity, SimError> {
+    let p = model.params();
+    let unsupported = |hint: &'static str| SimError::Unsupported {
+        integrator: "adaptive",
+        law: model.law().name(),
+        hint,
+    };
+    match p.contact_law {
+        ContactLaw::Hertz => {
+            if params.contains(&OrbitParam::Hamaker) {
+                return Err(unsupported("the Hertz law has no Hamaker group"));
+            }
+        }
+        ContactLaw::Dmt { .. } => {
+            if p.alpha6 != 0.0 {
+                return Err(unsupported(
+                    "exact sensitivities of DMT need α6 = 0 (no Kelvin–Voigt damping)",
+                ));
+            }
+        }
+        _ => {
+            return Err(unsupported(
+                "exact orbit sensitivities are implemented for the hertz and dmt laws",
+            ))
+        }
+    }
+    let (state, shot_grazing) = match newton {
+        Some(newton) => {
+            let mut plain = Adaptive::new(model, tol);
+            let orbit = shoot_with(&mut plain, guess, 1, newton)?;
+            (orbit.state, orbit.grazing_distance)
+        }
+        None => (guess.clone(), f64::INFINITY),
+    };
+    let ext = Extended {
+        model: model.clone(),
+        params: params.to_vec(),
+    };
+    let (d, k) = (model.dim(), params.len());
+    let mut y0 = DVector::zeros(ext.dim());
+    y0.rows_mut(0, d).copy_from(&state);
+    let mut integ = Adaptive::new(&ext, tol);
+    let period = HybridSystem::period(model);
+    let flow = flow_with_jacobian(&mut integ, 0.0, &y0, period)?;
+    let big = &flow.jacobian;
+    let m = big.view((0, 0), (d, d)).into_owned();
+    let d_map = big.view((0, d + 2), (d, k)).into_owned();
+    let dq_dz = big.view((d, 0), (2, d)).into_owned();
+    let dq_dp = big.view((d, d + 2), (2, k)).into_owned();
+    let i_m = DMatrix::identity(d, d) - &m;
+    let sigma_min = i_m
+        .clone()
+        .singular_values()
+        .iter()
+        .copied()
+        .fold(f64::INFINITY, f64::min);
+    let d_state = i_m.lu().solve(&d_map).ok_or(SimError::NoConvergence {
+        what: "orbit sensitivity: I − M is singular (a fold)",
+        iterations: 0,
+        residual: sigma_min,
+    })?;
+    let dq = &dq_dz * &d_state + dq_dp;
+    let scale = 2.0 / period;
+    let (cs, cc) = (scale * flow.state[d], scale * flow.state[d + 1]);
+    let amplitude = cs.hypot(cc);
+    let mut phase = (-cc).atan2(cs);
+    if phase <= -0.5 * PI {
+        phase += TAU;
+    }
+    let a2 = amplitude * amplitude;
+    let (mut d_amplitude, mut d_phase) = (Vec::with_capacity(k), Vec::with_capacity(k));
+    for j in 0..k {
+        let (dcs, dcc) = (scale * dq[(0, j)], scale * dq[(1, j)]);
+        d_amplitude.push((cs * dcs + cc * dcc) / amplitude);
+        d_phase.push((cc * dcs - cs * dcc) / a2);
+    }
+    let mut warnings = Vec::new();
+    if sigma_min < FOLD_TOL {
+        warnings.push(SensitivityWarning::NearFold { sigma_min });
+    }
+    let grazing_distance = flow.grazing_distance.min(shot_grazing);
+    if grazing_distance < GRAZING_TOL {
+        warnings.push(SensitivityWarning::Grazing {
+            distance: grazing_distance,
+        });
+    }
+    Ok(OrbitSensitivity {
+        state,
+        amplitude,
+        phase,
+        d_state,
+        d_amplitude,
+        d_phase,
+        monodromy: m,
+        d_map,
+        sigma_min,
+        grazing_distance,
+        warnings,
+    })
+}

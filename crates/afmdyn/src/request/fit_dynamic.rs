@@ -1,0 +1,345 @@
+//! `fit` of a measured amplitude-modulation curve (issue 62 §1): a CSV `data` file with the
+//! column `z` (m, the piezo position, in the order the instrument stepped) and any of
+//! `amplitude` (m) and `phase` (deg), with optional `sigma_amplitude` (m) and `sigma_phase`
+//! (deg), fitted with the stepped approach of the probe's model and the exact sensitivities of
+//! its orbits ([`crate::analysis::fit::am_curve`]). The request is [`super::FitRequest`] (the
+//! data's columns choose the kind: `z` makes it dynamic); its document has the force-curve
+//! fit's shape (estimates with value, standard error and interval, correlation, χ²/dof, the
+//! curve beside the data with its residuals, warnings).
+
+use super::fit::{bounds, FitRequest, FitResult, MIN_FIT_ROWS};
+use super::run::Resolved;
+use crate::analysis::fit::am_curve::{AmCurveModel, AmParam, AmProbe, Z_OFFSET};
+use crate::analysis::fit::{fit_with, Observations, Parameter};
+use crate::analysis::progress::Progress;
+use crate::error::SimError;
+use serde_json::{json, Value};
+
+/// The variables of a dynamic fit's curve (name, unit, label): the columns of its table and
+/// Dataset, those of the channels fitted.
+pub const CURVE_VARIABLES: [(&str, &str, &str); 7] = [
+    ("z", "m", "piezo position"),
+    ("amplitude", "m", "amplitude, measured"),
+    ("amplitude_fit", "m", "amplitude, fitted"),
+    ("amplitude_residual", "m", "measured − fitted amplitude"),
+    ("phase", "deg", "phase, measured"),
+    ("phase_fit", "deg", "phase, fitted"),
+    ("phase_residual", "deg", "measured − fitted phase"),
+];
+
+/// A measured AM curve's columns.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct AmData {
+    /// The piezo positions z (m).
+    pub z: Vec<f64>,
+    /// The amplitudes (m).
+    pub amplitude: Option<Vec<f64>>,
+    /// The phases (deg).
+    pub phase: Option<Vec<f64>>,
+    /// The amplitudes' standard deviations (m).
+    pub sigma_amplitude: Option<Vec<f64>>,
+    /// The phases' standard deviations (deg).
+    pub sigma_phase: Option<Vec<f64>>,
+}
+
+/// The dynamic fit's part of a [`FitResult`].
+#[derive(Debug, Clone)]
+pub struct DynamicFit {
+    /// The data.
+    pub data: AmData,
+    /// The model's values at the estimates (amplitudes, then phases, as fitted).
+    pub channels: (bool, bool),
+    /// The last evaluation's warnings of the model (folds, grazing).
+    pub model_warnings: Vec<String>,
+}
+
+fn bad(name: &'static str, value: impl std::fmt::Display, allowed: String) -> SimError {
+    SimError::out_of_range(name, value, allowed)
+}
+
+/// The AM columns of a CSV file's `names` and `cols`, `None` without a `z` column.
+pub fn am_columns(names: &[String], cols: &[Vec<f64>]) -> Option<AmData> {
+    let col = |n: &str| names.iter().position(|c| c == n).map(|i| cols[i].clone());
+    Some(AmData {
+        z: col("z")?,
+        amplitude: col("amplitude"),
+        phase: col("phase"),
+        sigma_amplitude: col("sigma_amplitude"),
+        sigma_phase: col("sigma_phase"),
+    })
+}
+
+/// The AM data of the request's `data` file, `None` when it is not one (no `z` column, or no
+/// file).
+///
+/// # Errors
+/// [`SimError::OutOfRange`] naming `data` where the file cannot be read.
+pub fn read_am_data(request: &FitRequest) -> Result<Option<AmData>, SimError> {
+    #[cfg(feature = "files")]
+    {
+        if let Some(path) = &request.data {
+            use crate::io::curve_file::{read_curve_file, CurveFile};
+            let path = std::path::Path::new(path);
+            let file =
+                read_curve_file(path).map_err(|e| bad("data", path.display(), e.to_string()))?;
+            return Ok(match file {
+                CurveFile::Columns(names, cols) => am_columns(&names, &cols),
+                CurveFile::Document(_) => None,
+            });
+        }
+    }
+    let _ = request;
+    Ok(None)
+}
+
+fn check_data(d: &AmData) -> Result<(), SimError> {
+    let m = d.z.len();
+    if d.amplitude.is_none() && d.phase.is_none() {
+        return Err(bad(
+            "data",
+            "no amplitude or phase column",
+            "an AM curve has the column z (m) and amplitude (m) and/or phase (deg)".into(),
+        ));
+    }
+    if !(MIN_FIT_ROWS..=crate::analysis::stepped::MAX_CURVE_POINTS).contains(&m) {
+        return Err(bad(
+            "data",
+            format!("{m} rows"),
+            format!("an AM curve has {MIN_FIT_ROWS}..=100000 rows"),
+        ));
+    }
+    let all = [
+        &Some(d.z.clone()),
+        &d.amplitude,
+        &d.phase,
+        &d.sigma_amplitude,
+        &d.sigma_phase,
+    ];
+    for c in all.into_iter().flatten() {
+        if c.len() != m || c.iter().any(|x| !x.is_finite()) {
+            return Err(bad(
+                "data",
+                "a column",
+                "every column must have one finite value per row".into(),
+            ));
+        }
+    }
+    for s in [&d.sigma_amplitude, &d.sigma_phase].into_iter().flatten() {
+        if s.iter().any(|x| *x <= 0.0) {
+            return Err(bad("sigma", "≤ 0", "σ must be > 0".into()));
+        }
+    }
+    if d.amplitude.is_some()
+        && d.phase.is_some()
+        && (d.sigma_amplitude.is_none() || d.sigma_phase.is_none())
+    {
+        return Err(bad(
+            "sigma",
+            "missing",
+            "fitting amplitude (m) and phase (deg) together needs their σ columns \
+             sigma_amplitude and sigma_phase (the two channels' units differ)"
+                .into(),
+        ));
+    }
+    Ok(())
+}
+
+/// Run the dynamic fit of `request` on `data` under `model`'s probe.
+///
+/// # Errors
+/// [`SimError::OutOfRange`] for bad data, parameter names, a probe without a Hertz or DMT
+/// sample; [`SimError::Cancelled`].
+pub fn execute(
+    request: &FitRequest,
+    model: &Resolved,
+    data: AmData,
+    progress: &Progress,
+) -> Result<FitResult, SimError> {
+    check_data(&data)?;
+    let probe = model.probe.as_ref().ok_or_else(|| {
+        bad(
+            "probe",
+            "missing",
+            "fit needs a probe file (start values and held parameters in SI)".into(),
+        )
+    })?;
+    let law_name = probe.params.contact_law.name();
+    let law = crate::analysis::fit::force_curve::ForceLaw::from_name(law_name)
+        .filter(|l| l.name() != "jkr")
+        .ok_or_else(|| {
+            bad(
+                "law",
+                law_name,
+                "the dynamic fit takes the probe's [sample].law = hertz or dmt".into(),
+            )
+        })?;
+    let s = probe.sample_inputs;
+    let need = |v: Option<f64>, key: &str| {
+        v.ok_or_else(|| bad("probe", key, format!("the fit needs the probe's {key}")))
+    };
+    let am_probe = AmProbe {
+        params: probe.params,
+        length_m: probe.scales.length_m,
+        youngs_modulus: need(s.youngs_modulus, "sample.youngs_modulus")?,
+        poisson_ratio: need(s.poisson_ratio, "sample.poisson_ratio")?,
+        tip: (
+            need(s.tip_youngs_modulus, "tip.youngs_modulus")?,
+            need(s.tip_poisson_ratio, "tip.poisson_ratio")?,
+        ),
+        hamaker: s.hamaker.unwrap_or(0.0),
+        radius: need(s.radius, "tip.radius")?,
+    };
+    // the default (the force curve's) is E and z_offset, with H on DMT; z_offset is always
+    // fitted
+    let mut names: Vec<String> = if request.fit == FitRequest::default().fit {
+        let mut v = vec!["sample.youngs_modulus".to_string()];
+        if law_name == "dmt" {
+            v.push("sample.hamaker".into());
+        }
+        v
+    } else {
+        request.fit.clone()
+    };
+    if !names.iter().any(|n| n == Z_OFFSET) {
+        names.push(Z_OFFSET.into());
+    }
+    let mut params = Vec::new();
+    let mut am = Vec::new();
+    for n in &names {
+        let p = AmParam::from_name(n).ok_or_else(|| {
+            bad(
+                "fit",
+                n,
+                "the dynamic fit's parameters are sample.youngs_modulus, sample.hamaker (dmt), \
+                 tip.radius and z_offset"
+                    .into(),
+            )
+        })?;
+        if p == AmParam::Hamaker && law_name != "dmt" {
+            return Err(bad("fit", n, "sample.hamaker is DMT's".into()));
+        }
+        if am.contains(&p) {
+            return Err(bad("fit", n, "named twice".into()));
+        }
+        let (start, scale) = match p {
+            AmParam::YoungsModulus => (am_probe.youngs_modulus, am_probe.youngs_modulus),
+            AmParam::Hamaker => (am_probe.hamaker, am_probe.hamaker.max(1e-21)),
+            AmParam::TipRadius => (am_probe.radius, am_probe.radius),
+            AmParam::ZOffset => (0.0, 0.1 * am_probe.length_m),
+        };
+        // the physical range's lower end only: MINUIT's sine map of a two-sided range squashes
+        // a value near its lower end (a modulus of GPa in a range to TPa), where the
+        // one-sided map keeps its scale
+        let (lower, upper) = match p {
+            AmParam::ZOffset => (-am_probe.length_m * 10.0, am_probe.length_m * 10.0),
+            _ => (bounds(n).0, f64::INFINITY),
+        };
+        am.push(p);
+        params.push(Parameter {
+            name: n.clone(),
+            start,
+            lower,
+            upper,
+            scale,
+        });
+    }
+    let channels = (data.amplitude.is_some(), data.phase.is_some());
+    let curve = AmCurveModel::new(am_probe, data.z.clone(), channels, am);
+    let mut y = Vec::new();
+    let mut sigma = Vec::new();
+    for (c, sg) in [
+        (&data.amplitude, &data.sigma_amplitude),
+        (&data.phase, &data.sigma_phase),
+    ] {
+        if let Some(c) = c {
+            y.extend_from_slice(c);
+            if let Some(sg) = sg {
+                sigma.extend_from_slice(sg);
+            }
+        }
+    }
+    let sigma = (sigma.len() == y.len()).then_some(sigma);
+    progress.check()?;
+    let obs = Observations {
+        y: &y,
+        sigma: sigma.as_deref(),
+    };
+    let fixed = vec![None; params.len()];
+    // Wald intervals: a profile's refits would cost a hundred stepped approaches each
+    let mut outcome = fit_with(&curve, &obs, &params, &fixed, false);
+    let model_warnings = curve.warnings();
+    outcome.warnings.extend(model_warnings.iter().cloned());
+    let names: Vec<&'static str> = params
+        .iter()
+        .map(|p| AmParam::from_name(&p.name).map_or("", AmParam::name))
+        .collect();
+    Ok(FitResult {
+        law,
+        spring_constant: probe.calibration.spring_constant,
+        curve: crate::analysis::fit::force_curve::preprocess(&[], &[], 1.0),
+        rows: Vec::new(),
+        fitted: vec![true; names.len()],
+        names,
+        outcome,
+        dynamic: Some(DynamicFit {
+            data,
+            channels,
+            model_warnings,
+        }),
+    })
+}
+
+/// The document of a dynamic fit (the force-curve fit's shape, [`super::fit::document`]):
+/// `estimates`, `parameters`, `correlation`, `chi2`, `dof`, `chi2_dof`, `noise`, `curve` (z and,
+/// per channel, the data, the fit and the residual: `amplitude`, `amplitude_fit`,
+/// `amplitude_residual`, `phase`, …), `preprocessing` (none; the lever's `spring_constant`),
+/// `kind` = `"am"`, `law`, `units`, `method`, `warnings`.
+pub fn document(r: &FitResult, d: &DynamicFit, estimates: Value, correlation: Value) -> Value {
+    let o = &r.outcome;
+    let m = d.data.z.len();
+    let mut curve = serde_json::Map::new();
+    curve.insert("z".into(), json!(d.data.z));
+    let mut off = 0;
+    for (name, col, on) in [
+        ("amplitude", &d.data.amplitude, d.channels.0),
+        ("phase", &d.data.phase, d.channels.1),
+    ] {
+        if !on {
+            continue;
+        }
+        curve.insert(name.into(), json!(col));
+        curve.insert(format!("{name}_fit"), json!(&o.fitted[off..off + m]));
+        curve.insert(
+            format!("{name}_residual"),
+            json!(&o.residuals[off..off + m]),
+        );
+        off += m;
+    }
+    let mut parameters = serde_json::Map::new();
+    for (i, n) in r.names.iter().enumerate() {
+        parameters.insert((*n).into(), json!({"value": o.values[i], "fitted": true}));
+    }
+    json!({
+        "kind": "am",
+        "estimates": estimates,
+        "parameters": parameters,
+        "correlation": correlation,
+        "chi2": o.chi2,
+        "dof": o.dof,
+        "chi2_dof": o.chi2_dof,
+        "noise": if o.noise_estimated { "noise estimated from residuals (no sigma column)" } else { "the sigma columns (χ² in units of σ)" },
+        "curve": curve,
+        "preprocessing": {
+            "steps": ["none: z, amplitude and phase as measured; z_c = z + z_offset"],
+            "spring_constant": r.spring_constant,
+        },
+        "law": r.law.name(),
+        "rows_fitted": m,
+        "evaluations": o.evaluations,
+        "termination": o.termination,
+        "units": {"sample.youngs_modulus": "Pa", "tip.radius": "m", "sample.hamaker": "J", "z_offset": "m",
+                  "z": "m", "amplitude": "m", "phase": "deg"},
+        "method": "Wald intervals (±1.96 standard errors; no profiles: each refit is a stepped approach); weighted least squares by Levenberg–Marquardt (MINPACK lmder, rust-cv levenberg-marquardt) of the stepped approach the instrument did (each row's periodic orbit continued from the previous one, z_c = z + z_offset), with the exact sensitivities of the orbits: the variational equations extended by the parameter columns, saltation at the switchings, ∂x*/∂p = (I − M)⁻¹ ∂P/∂p (docs/afm-workflow.md, From data to properties)",
+        "warnings": o.warnings,
+    })
+}
