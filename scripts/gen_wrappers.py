@@ -254,7 +254,7 @@ HEADS = {
     ),
     "_dask_wrappers.py": (
         "The public functions of :mod:`afmdyn.dask` (their finishers are in :mod:`afmdyn.dask`).",
-        "from . import dask as _dask\n"
+        "from . import _dask\n"
         "from ._afmdyn import Params\n"
         "from ._progress import ProgressArg",
         "    import distributed\n\n    from ._common import Model\n",
@@ -273,7 +273,12 @@ def generate(file: str = "_wrappers.py") -> str:
             if re.search(rf"\b{n}\[|\b{n}\b,|\b{n}\]", "\n".join(functions))]
     head = head.replace("{typing}", ", ".join(["TYPE_CHECKING"] + used))
     parts = [head.rstrip()] + functions
-    return "\n\n\n".join(parts) + "\n"
+    text = "\n\n\n".join(parts) + "\n"
+    if file == "_wrappers.py":
+        # an attractor continues into the public orbit and simulate: handed to its module here
+        # (which this one imports), so that it need not import this one back
+        text += ("\n\n_attractors.PUBLIC.update(orbit=orbit, simulate=simulate)\n")
+    return text
 
 
 MODEL_HEAD = '''\

@@ -1,13 +1,13 @@
 //! The tasks `afmdyn.dask` maps over a cluster: [`Plan`], a study the library plans as stages
 //! of numbered tasks ([`afmdyn::study::plan`]: a bifurcation sweep, a basin map, a PI-scanned
-//! or PeakForce image), which any process rebuilds from its recipe (JSON text), so that it pickles to Dask
-//! workers as a few hundred bytes. Starts and results travel as text; the ledger (which tasks
+//! or PeakForce image), which any process rebuilds from its recipe (JSON text), so that it
+//! pickles to Dask workers as a few hundred bytes. Starts and results travel as text; the ledger (which tasks
 //! a store holds, how results merge) is the library's ([`PlanStore`]).
 
 use crate::door::outcome_dict;
 use crate::errors::{lock_store, sim_error, study_error, value_error};
 use crate::params::PyParams;
-use afmdyn::request::image_job::{ImageKeywords, ImageMode};
+use afmdyn::request::image_job::ImageKeywords;
 use afmdyn::study::plan::{self, Recipe};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
@@ -56,19 +56,7 @@ impl Plan {
             "image" => {
                 let keywords: ImageKeywords = req(name, request)?;
                 let text = probe.ok_or_else(|| value_error("image: the probe is needed"))?;
-                if keywords.mode == Some(ImageMode::Peakforce) {
-                    // the materials' engages, then the lines, as tasks
-                    let (probe, map) = keywords.inputs(&text).map_err(sim_error)?;
-                    Recipe::PeakForceImage {
-                        probe,
-                        map,
-                        request: keywords.request(),
-                    }
-                } else {
-                    Recipe::Image {
-                        scan: keywords.scan(&text).map_err(sim_error)?,
-                    }
-                }
+                Recipe::image(keywords, &text).map_err(sim_error)?
             }
             _ => return Err(pyo3::exceptions::PyKeyError::new_err(name.to_string())),
         };

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import json
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, Dict, Iterator, List, Optional, Sequence, overload
+from typing import TYPE_CHECKING, Any, Callable, Dict, Iterator, List, Optional, Sequence, overload
 
 import numpy as np
 
@@ -14,6 +14,10 @@ from ._afmdyn import Params
 from . import _layout
 from ._common import _door, _params, _request
 from ._results import Orbit, _Document
+
+#: The public :func:`afmdyn.orbit` and :func:`afmdyn.simulate` an attractor continues into,
+#: handed over by the generated :mod:`._wrappers` (which imports this module) when it loads.
+PUBLIC: Dict[str, Callable[..., Any]] = {}
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -73,9 +77,7 @@ class Attractor:
     def orbit(self, **options: Any) -> "Orbit":
         """Newton shooting from this attractor (its period, starting on it): Floquet
         multipliers and stability. Options as :func:`afmdyn.orbit`."""
-        from ._wrappers import orbit  # the public function (generated; imports this)
-
-        return orbit(self.params, initial=self, **options)
+        return PUBLIC["orbit"](self.params, initial=self, **options)
 
     def simulate(self, periods: Optional[float] = None, **options: Any) -> "xr.Dataset":
         """Time series on the attractor from τ = 0 (drive phase 0), ``periods`` drive periods
@@ -83,9 +85,7 @@ class Attractor:
         Options as :func:`afmdyn.simulate`."""
         if periods is None:
             periods = max(self.period or 8, 2)
-        from ._wrappers import simulate
-
-        return simulate(self.params, periods=periods, initial=self.state, **options)
+        return PUBLIC["simulate"](self.params, periods=periods, initial=self.state, **options)
 
     def __repr__(self) -> str:
         kind = f"period-{self.period}" if self.period else "nonperiodic"

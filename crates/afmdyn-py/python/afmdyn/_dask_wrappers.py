@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Optional, Sequence, Union
 
 import xarray as xr
 
-from . import dask as _dask
+from . import _dask
 from ._afmdyn import Params
 from ._progress import ProgressArg
 

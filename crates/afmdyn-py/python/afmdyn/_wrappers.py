@@ -720,3 +720,6 @@ def chart(
         SimulationError: no cell found any attractor.
     """
     return _chart._finish_chart(locals())
+
+
+_attractors.PUBLIC.update(orbit=orbit, simulate=simulate)

@@ -456,50 +456,6 @@ fn true_modulus(model: &Resolved, alpha4: f64) -> Option<f64> {
     Some(alpha4 * s.force_n / (4.0 / 3.0 * r.sqrt() * s.length_m.powf(1.5)))
 }
 
-/// What may make a steady tap's channels misleading, each with its kind (`period`, `double-tap`,
-/// `unstable`, `no-contact`) and its message: a period-n orbit (the cycle shows the first
-/// period), more than one contact per modulation period (`modulus_dmt` is then not meaningful),
-/// an unstable orbit, no repulsive contact. Every tap of a sweep is checked alike
-/// ([`super::peakforce_sweep::sweep_warnings`]).
-pub fn tap_warnings(tap: &SteadyTap) -> Vec<(&'static str, String)> {
-    let c = &tap.channels;
-    let mut warnings = Vec::new();
-    if tap.period > 1 {
-        warnings.push((
-            "period",
-            format!(
-                "period-{} tapping: the orbit repeats after {} modulation periods; the cycle \
-                 shows the first",
-                tap.period, tap.period
-            ),
-        ));
-    }
-    if c.taps_per_cycle > 1.0 + 1e-9 {
-        warnings.push((
-            "double-tap",
-            format!(
-                "{} contacts per modulation period: double taps (the lever's ringing reaches the \
-                 sample again); modulus_dmt, fitted as PF-QNM does on the retract of one tap, is \
-                 not meaningful for such a cycle",
-                c.taps_per_cycle
-            ),
-        ));
-    }
-    if !tap.stable {
-        warnings.push((
-            "unstable",
-            "the steady tap is unstable (a Floquet multiplier outside the unit circle)".into(),
-        ));
-    }
-    if c.peak_force <= 0.0 {
-        warnings.push((
-            "no-contact",
-            "no repulsive contact: the sample never reaches the tip at this z_c".into(),
-        ));
-    }
-    warnings
-}
-
 /// The factor from the fitted Hertz group (model units) to the reduced modulus E* (Pa) of the
 /// model `p` under the probe of `model`; `None` for a law without a tip radius (no modulus)
 /// or without a probe (the Hertz group itself is reported).
@@ -542,7 +498,10 @@ pub fn document(request: &PeakForceRequest, model: &Resolved, r: &PeakForceResul
     let mut warnings: Vec<String> = if r.sweep.is_some() {
         Vec::new()
     } else {
-        tap_warnings(tap).into_iter().map(|(_, w)| w).collect()
+        super::peakforce_sweep::tap_warnings(tap)
+            .into_iter()
+            .map(|(_, w)| w)
+            .collect()
     };
     let t = &tap.cycle;
     let half = t.time.len() / 2;

@@ -3,6 +3,7 @@
 //! ([`crate::study::peakforce::PeakForceStudy`], each tap continued from the previous tap's
 //! orbit), and its block of the document ([`sweep_document`]) and layout ([`sweep_layout`]).
 
+use crate::analysis::peakforce::SteadyTap;
 use crate::error::SimError;
 use crate::layout::{Layout, Values, Variable};
 use crate::report::CurveUnits;
@@ -219,7 +220,7 @@ pub fn sweep_document(
             .iter()
             .map(|t| {
                 t.tap.as_ref().map_or(Vec::new(), |tap| {
-                    super::peakforce::tap_warnings(tap)
+                    tap_warnings(tap)
                         .into_iter()
                         .map(|(_, w)| w)
                         .collect()
@@ -229,7 +230,51 @@ pub fn sweep_document(
     })
 }
 
-/// The sweep's warnings for the document: each kind of [`super::peakforce::tap_warnings`]
+/// What may make a steady tap's channels misleading, each with its kind (`period`, `double-tap`,
+/// `unstable`, `no-contact`) and its message: a period-n orbit (the cycle shows the first
+/// period), more than one contact per modulation period (`modulus_dmt` is then not meaningful),
+/// an unstable orbit, no repulsive contact. Every tap of a sweep is checked alike
+/// ([`sweep_warnings`]), and a single tap's document has them ([`super::peakforce::document`]).
+pub fn tap_warnings(tap: &SteadyTap) -> Vec<(&'static str, String)> {
+    let c = &tap.channels;
+    let mut warnings = Vec::new();
+    if tap.period > 1 {
+        warnings.push((
+            "period",
+            format!(
+                "period-{} tapping: the orbit repeats after {} modulation periods; the cycle \
+                 shows the first",
+                tap.period, tap.period
+            ),
+        ));
+    }
+    if c.taps_per_cycle > 1.0 + 1e-9 {
+        warnings.push((
+            "double-tap",
+            format!(
+                "{} contacts per modulation period: double taps (the lever's ringing reaches the \
+                 sample again); modulus_dmt, fitted as PF-QNM does on the retract of one tap, is \
+                 not meaningful for such a cycle",
+                c.taps_per_cycle
+            ),
+        ));
+    }
+    if !tap.stable {
+        warnings.push((
+            "unstable",
+            "the steady tap is unstable (a Floquet multiplier outside the unit circle)".into(),
+        ));
+    }
+    if c.peak_force <= 0.0 {
+        warnings.push((
+            "no-contact",
+            "no repulsive contact: the sample never reaches the tip at this z_c".into(),
+        ));
+    }
+    warnings
+}
+
+/// The sweep's warnings for the document: each kind of [`tap_warnings`]
 /// once, with the number of values it holds at and the swept values where it does (the
 /// first three and the last, in `block`'s units), its message the first such tap's; the
 /// per-value messages are in `sweep.warnings`.
@@ -243,7 +288,7 @@ pub fn sweep_warnings(block: &Value, taps: &[SweepTap]) -> Vec<String> {
     let mut kinds: Vec<(&'static str, String, Vec<usize>)> = Vec::new();
     for (i, t) in taps.iter().enumerate() {
         let Some(tap) = &t.tap else { continue };
-        for (kind, message) in super::peakforce::tap_warnings(tap) {
+        for (kind, message) in tap_warnings(tap) {
             match kinds.iter_mut().find(|k| k.0 == kind) {
                 Some(k) => k.2.push(i),
                 None => kinds.push((kind, message, vec![i])),

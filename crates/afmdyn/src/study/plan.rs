@@ -29,6 +29,8 @@ use crate::analysis::bifurcation::{Branch, Seeds, SweepPlan, SweepPoint, SweepSp
 use crate::error::SimError;
 use crate::request::checkpoint::{self, Checkpoint};
 use crate::request::image::{ImageRequest, SampleMap};
+#[cfg(feature = "files")]
+use crate::request::image_job::ImageKeywords;
 use crate::request::image_peakforce::{Engage, LinePixel, PeakForceImageStudy};
 use crate::request::image_scan::{LineJob, ScanRecipe, ScanStudy};
 use crate::request::named::{outcome, Outcome};
@@ -76,6 +78,31 @@ pub enum Recipe {
         /// The request (its setpoint the peak force in N).
         request: ImageRequest,
     },
+}
+
+impl Recipe {
+    /// The recipe of an image's keywords on the probe text `probe`: a PeakForce image
+    /// ([`crate::request::image_job::ImageMode::Peakforce`]: the materials' engages, then the
+    /// lines) or a PI scan (the lines).
+    ///
+    /// # Errors
+    /// As [`ImageKeywords::inputs`] and [`ImageKeywords::scan`].
+    #[cfg(feature = "files")] // (a sample map may name a file)
+    pub fn image(keywords: ImageKeywords, probe: &str) -> Result<Recipe, SimError> {
+        use crate::request::image_job::ImageMode;
+        Ok(if keywords.mode == Some(ImageMode::Peakforce) {
+            let (probe, map) = keywords.inputs(probe)?;
+            Recipe::PeakForceImage {
+                probe,
+                map,
+                request: keywords.request(),
+            }
+        } else {
+            Recipe::Image {
+                scan: keywords.scan(probe)?,
+            }
+        })
+    }
 }
 
 /// The tasks of one stage: the start every task of it takes (text), and their numbers.

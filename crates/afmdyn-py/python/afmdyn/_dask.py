@@ -1,0 +1,391 @@
+"""The machinery of :mod:`afmdyn.dask` (its public names are re-exported there): the
+clusters, the chart's Zarr ledger, the plans' task runners and the finishers of the generated
+``afmdyn.dask.chart`` and ``afmdyn.dask.bifurcation`` (:mod:`._dask_wrappers`)."""
+
+from __future__ import annotations
+
+import contextlib
+import functools
+import json
+import os
+import time
+from typing import Any, Dict, Iterable, Iterator, List, Optional, Sequence, Set
+
+import numpy as np
+import xarray as xr
+
+from . import _afmdyn as _core
+from ._afmdyn import Params
+from . import _layout
+from ._chart import dataset, study
+from ._common import _request
+from ._progress import ProgressArg, reporter
+
+try:
+    import distributed
+except ImportError as e:  # pragma: no cover - depends on the installation
+    raise ImportError(
+        'afmdyn.dask needs dask.distributed and zarr: pip install "afmdyn[dask]"'
+    ) from e
+
+#: The file of finished tasks, in the store's ledger directory ``STORE.afmdyn``.
+DONE = "done"
+
+
+@contextlib.contextmanager
+def _cluster(client: Optional["distributed.Client"]) -> Iterator["distributed.Client"]:
+    """``client``, or a ``LocalCluster`` of this machine's cores (one thread per worker)
+    started for the study and closed at its end."""
+    if client is not None:
+        yield client
+        return
+    cluster = distributed.LocalCluster(threads_per_worker=1, dashboard_address=None)
+    own = distributed.Client(cluster)
+    try:
+        yield own
+    finally:
+        own.close()
+        cluster.close()
+
+
+def ledger_dir(store: str) -> str:
+    """The directory beside a store that is locked during a run and lists its finished tasks."""
+    return os.path.normpath(store) + ".afmdyn"
+
+
+@functools.lru_cache(maxsize=8)
+def _chart_of(recipe: str) -> "_core.ChartStudy":
+    return _core.ChartStudy(recipe)
+
+
+def run_chart_task(recipe: str, task: int) -> str:
+    """Task ``task`` of the chart of ``recipe`` (what a worker runs): its cells, JSON text.
+    The chart is built once per worker process and recipe."""
+    return _chart_of(recipe).run_task(task)
+
+
+def _template(s: "_core.ChartStudy") -> xr.Dataset:
+    """The store's dataset before any task: every cell empty (as a cell with no attractor)."""
+    d = s.arrays([])
+    return dataset(s, d)
+
+
+#: Largest ledger of finished tasks read back, in bytes: 16 MiB, a line of at most 16 bytes for
+#: each of the 10^6 tasks of the largest chart (one cell a task).
+MAX_DONE_BYTES = 16 * 1024 * 1024
+
+
+def _done(store: str) -> Set[int]:
+    """The finished tasks: every complete line of the ledger (a cut last line is dropped)."""
+    path = os.path.join(ledger_dir(store), DONE)
+    try:
+        with open(path, "rb") as f:
+            # bounded: one short line per task of the largest chart (1e6 cells), never /dev/zero
+            # read on or a sparse file held whole
+            text = f.read(MAX_DONE_BYTES + 1)
+    except FileNotFoundError:
+        return set()
+    if len(text) > MAX_DONE_BYTES or b"\0" in text:
+        raise ValueError(
+            f"resume: {path} is not this store's ledger (text of at most {MAX_DONE_BYTES} "
+            "bytes); call with resume=False to start over"
+        )
+    lines = text.split(b"\n")
+    return {int(x) for x in lines[:-1] if x.strip()}
+
+
+def _open_store(s: "_core.ChartStudy", store: str, resume: bool) -> Set[int]:
+    """The tasks already in ``store`` (none for a new one, which is written empty first)."""
+    import zarr
+
+    try:
+        group = zarr.open_group(store, mode="r")
+    except Exception:  # no store there yet (zarr raises its own not-found errors)
+        group = None
+    if group is None and os.path.exists(store) and (
+        not os.path.isdir(store) or os.listdir(store)
+    ):
+        # never overwrite what is not a store (mode "w" would delete the directory's files)
+        raise ValueError(f"store: {store} exists and is not a Zarr store; choose another store=")
+    if resume and group is not None:
+        then = group.attrs.get("fingerprint")
+        if then is None:
+            raise ValueError(
+                f"resume: {store} has no record of the request that made it; "
+                "call with resume=False to start over"
+            )
+        diff = s.compare(then)
+        if diff is not None:
+            field, a, b = diff
+            raise ValueError(
+                f"resume: {field} = {a} in the interrupted run, {b} now; call with the same "
+                "arguments, or with resume=False to start over"
+            )
+        return _done(store)
+    done = os.path.join(ledger_dir(store), DONE)
+    if os.path.exists(done):
+        os.remove(done)
+    # Zarr format 2: what every xarray and zarr version reads, with consolidated metadata
+    _template(s).to_zarr(store, mode="w", consolidated=False, zarr_format=2)
+    return set()
+
+
+class _Writer:
+    """Writes finished tasks' regions into the store, in batches (every ``batch`` tasks or
+    ``seconds``, and at the end), then records them as done (flushed to disk): a killed
+    driver loses at most the unwritten batch, which a rerun computes again. A batch rewrites
+    the rows it touches whole; zarr writes each chunk file atomically (a temporary file
+    renamed into place), so the tasks already done in those rows keep their values whatever
+    chunk a kill interrupts."""
+
+    def __init__(self, store: str, s: "_core.ChartStudy", batch: int = 32, seconds: float = 2.0):
+        import zarr
+
+        self.store, self.s = store, s
+        self.group = zarr.open_group(store, mode="r+")
+        # the per-cell variables of the chart's layout: over (y, x) and (y, x, attractor)
+        self.names = _layout.over(s.arrays([]), ("y", "x"))
+        self.arrays = {k: self.group[k] for k in self.names}
+        self.batch, self.seconds = batch, seconds
+        self.pending: list = []
+        self.last = time.monotonic()
+
+    def add(self, task: int, cells: str) -> None:
+        self.pending.append((task, cells))
+        if len(self.pending) >= self.batch or time.monotonic() - self.last >= self.seconds:
+            self.flush()
+
+    def flush(self) -> None:
+        if not self.pending:
+            return
+        # one read and one write per variable: the slab of rows the batch touches
+        tiles = [(self.s.tile(t), cells) for t, cells in self.pending]
+        y0 = min(iy for (iy, _, _), _ in tiles)
+        y1 = max(iy for (iy, _, _), _ in tiles) + 1
+        slabs = {k: a[y0:y1] for k, a in self.arrays.items()}
+        for (iy, lo, hi), cells in tiles:
+            region = _layout.variables(self.s.arrays([cells], origin=(lo, iy), size=(hi - lo, 1)))
+            for k in self.names:
+                slabs[k][iy - y0, lo:hi] = region[k][1][0]
+        for k, a in self.arrays.items():
+            a[y0:y1] = slabs[k]
+        with open(os.path.join(ledger_dir(self.store), DONE), "a", encoding="utf-8") as f:
+            f.write("".join(f"{t}\n" for t, _ in self.pending))
+            f.flush()
+            os.fsync(f.fileno())
+        self.pending.clear()
+        self.last = time.monotonic()
+
+
+def _map(
+    client: "distributed.Client",
+    s: "_core.ChartStudy",
+    todo: Iterable[int],
+    each: Any,
+    cb: Any,
+    total: int,
+    done0: int,
+) -> None:
+    todo = list(todo)
+    futures = client.map(
+        run_chart_task, [s.recipe] * len(todo), todo, pure=False, retries=3
+    )
+    task_of = {f.key: t for f, t in zip(futures, todo)}
+    finished = done0
+    for fut in distributed.as_completed(futures):
+        each(task_of[fut.key], fut.result())
+        finished += 1
+        if cb is not None:
+            cb(finished, total)
+
+
+def _finish_chart(a: Dict[str, Any]) -> xr.Dataset:
+    """Run the chart of :func:`afmdyn.dask.chart`'s keywords ``a`` (its ``locals()``)."""
+    params, model, client, progress = a["params"], a["model"], a["client"], a["progress"]
+    store, resume, checkpoint_seconds = a["store"], a["resume"], a["checkpoint_seconds"]
+    request = _request(a)
+    for own in ("client", "checkpoint_seconds"):
+        del request[own]
+    s = study(params, model, **request)
+    n = s.tasks()
+    if not (checkpoint_seconds >= 0 and np.isfinite(checkpoint_seconds)):
+        raise ValueError(f"checkpoint_seconds = {checkpoint_seconds}: must be finite and >= 0")
+    with _cluster(client) as client:
+        lock = None
+        try:
+            with reporter(progress, "chart (dask)") as cb:
+                if store is None:
+                    results: Dict[int, str] = {}
+                    _map(client, s, range(n), results.__setitem__, cb, n, 0)
+                    ds = dataset(s, s.arrays([results[t] for t in range(n)]))
+                else:
+                    import zarr
+
+                    path = os.fspath(store)
+                    lock = _core.StoreLock(ledger_dir(path))
+                    done = _open_store(s, path, resume)
+                    todo = [t for t in range(n) if t not in done]
+                    writer = _Writer(path, s, seconds=checkpoint_seconds)
+                    _map(client, s, todo, writer.add, cb, n, n - len(todo))
+                    writer.flush()
+                    zarr.consolidate_metadata(path)
+                    ds = xr.open_zarr(path).load()
+                    ds.attrs = {
+                        **_template(s).attrs,
+                        "failed_runs": int(ds["failures"].values.sum()),
+                    }
+        finally:
+            if lock is not None:
+                lock.release()
+    s.check(ds["attractors"].values.ravel().tolist())
+    return ds
+
+
+@functools.lru_cache(maxsize=8)
+def _plan_of(recipe: str) -> "_core.Plan":
+    return _core.Plan(recipe)
+
+
+def run_plan_task(recipe: str, start: str, task: int) -> str:
+    """Task ``task`` of the stage beginning at ``start`` of the study of ``recipe`` (what a
+    worker runs; the library's ``study::plan``): its result, as text. The study is built once
+    per worker process and recipe."""
+    return _plan_of(recipe).run(start, task)
+
+
+def _run_plan(
+    client: "distributed.Client",
+    plan: "_core.Plan",
+    progress: ProgressArg,
+    desc: str,
+    unit: str = "task",
+    store: Any = None,
+    resume: bool = True,
+) -> Dict[str, Any]:
+    """Map the tasks of ``plan``'s stages over ``client``, each stage's start sent to the
+    workers once, and return its outcome (as ``_afmdyn.run`` returns it). With ``store`` (the
+    plan's store, ``Plan.store``) the last stage runs only the tasks it does not hold, each
+    result appended as it arrives."""
+    todo = store.open(resume) if store is not None else None
+    if store is not None and todo is None:
+        return store.outcome()
+    results: List[str] = []
+    stages = plan.stages() if todo != [] else 0
+    last, done = stages - 1, 0
+    with reporter(progress, desc, unit=unit) as cb:
+        for k in range(stages):
+            start, tasks = plan.stage(k, results)
+            if k == last and todo is not None:
+                tasks = [t for t in tasks if t in set(todo)]
+            shared = client.scatter(start, broadcast=True)
+            futures = client.map(run_plan_task, [plan.recipe] * len(tasks),
+                                 [shared] * len(tasks), tasks, pure=False, retries=3)
+            for fut in distributed.as_completed(futures):
+                if k == last and store is not None:
+                    store.append(fut.result())
+                else:
+                    results.append(fut.result())
+                # a chain's passes (a sweep's coarse stage) are not counted; a map's are
+                if cb is not None and (k == last or stages > 2):
+                    done += 1
+                    cb(done, len(tasks) if stages <= 2 else None)
+    if store is None:
+        return plan.outcome(results)
+    store.finish()
+    return store.outcome()
+
+
+def _finish_bifurcation(a: Dict[str, Any]) -> xr.Dataset:
+    """Run the sweep of :func:`afmdyn.dask.bifurcation`'s keywords ``a`` (its ``locals()``)."""
+    params, model, client, progress = a["params"], a["model"], a["client"], a["progress"]
+    store, resume, values = a["store"], a["resume"], a["values"]
+    starts, seed = a["starts"], a["seed"]
+    request = _request(a)
+    del request["client"]
+    if values is not None:
+        request["values"] = np.asarray(values, dtype=np.float64).ravel().tolist()
+    from ._api import _params, _sweep_dataset
+
+    p, _probe = _params(params, model)
+    plan = _core.Plan.build("bifurcation", request, p)
+    with _cluster(client) as client:
+        own = None if store is None else plan.store(os.fspath(store))
+        try:
+            d = _run_plan(client, plan, progress, "bifurcation (dask)", store=own, resume=resume)
+        finally:
+            if own is not None:
+                own.release()
+    return _sweep_dataset(p, d, starts, seed)
+
+
+def basins(
+    params: Optional[Params] = None,
+    /,
+    *,
+    client: Optional["distributed.Client"] = None,
+    progress: ProgressArg = None,
+    **keywords: Any,
+) -> xr.Dataset:
+    """:func:`afmdyn.basins` (the same keywords but ``store``, ``resume`` and ``threads``)
+    with the rows of each pass mapped over a Dask cluster (``client``; default a
+    ``LocalCluster`` of this machine's cores, closed at the end). The passes run in turn: the
+    start of a pass — the attractors and the coarse grid of the passes before it, made by the
+    library from their finished rows — is sent to the workers once, and each row is a task.
+
+    Returns the same ``xarray.Dataset`` as :func:`afmdyn.basins` with the same arguments, bit
+    for bit (a row is a pure function of its pass's start).
+
+    ``progress``: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a
+    log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.
+    """
+    import inspect
+
+    from ._basins import _dataset
+    from ._wrappers import basins as local
+    from ._common import _params
+
+    # the map's keywords are those of afmdyn.basins; the others are the model's (as there)
+    own_keywords = set(inspect.signature(local).parameters) - {
+        "params", "model", "store", "resume", "threads", "progress"}
+    model = {k: keywords.pop(k) for k in list(keywords) if k not in own_keywords}
+    p, probe = _params(params, model)
+    plan = _core.Plan.build("basins", keywords, p, probe)
+    with _cluster(client) as client:
+        d = _run_plan(client, plan, progress, "basins (dask)", unit="row")
+    return _dataset(d["datasets"]["basins"], json.loads(d["json"]), p)
+
+
+def image(
+    probe: Any,
+    sample: Any,
+    setpoint: float,
+    *,
+    client: Optional["distributed.Client"] = None,
+    progress: ProgressArg = None,
+    pixels: Optional[int] = None,
+    lines: Optional[int] = None,
+    curve_points: Optional[int] = None,
+    height_map: Any = None,
+    scan_rate: Optional[float] = None,
+    gains: Optional[Sequence[float]] = None,
+    time_constant: Optional[float] = None,
+    mode: str = "am",
+) -> xr.Dataset:
+    """:func:`afmdyn.image` with ``feedback="pi"`` (the same keywords but ``threads``) with
+    its lines mapped over a Dask cluster (``client``; default a ``LocalCluster`` of this
+    machine's cores, closed at the end): each line is a task, a pure function of the request
+    and its number, so the Dataset equals :func:`afmdyn.image`'s bit for bit. With
+    ``mode="peakforce"`` the PeakForce image (``setpoint`` the peak force, N): the materials'
+    engages are the first stage's tasks, the lines the second's.
+    """
+    from ._image import _dataset, _keywords
+
+    if mode not in ("am", "peakforce"):
+        raise ValueError(f"mode = {mode!r}: must be 'am' or 'peakforce'")
+    feedback = "pi" if mode == "am" else "ideal"
+    text, request = _keywords(probe, sample, setpoint, pixels, lines, curve_points, height_map,
+                              feedback, scan_rate, gains, time_constant, None, mode)
+    plan = _core.Plan.build("image", request, None, text)
+    with _cluster(client) as client:
+        d = _run_plan(client, plan, progress, "image (dask)", unit="line")
+    return _dataset(d, setpoint)
