@@ -5,24 +5,21 @@
 //! and the identifiability warnings. Everything is SI (m, N, Pa, J/m²); a probe file is
 //! needed (the lever's spring constant, the start values and the held parameters).
 
+pub use super::fit_result::{bounds, FitResult, MIN_FIT_ROWS};
 use super::limits::Cost;
 use super::run::{Analysis, Resolved};
 use crate::analysis::fit::force_curve::{
-    preprocess, ForceCurveModel, ForceLaw, Preprocessed, Segment, BASELINE, CONTACT_POINT, HAMAKER,
-    RADIUS, YOUNGS_MODULUS,
+    preprocess, ForceCurveModel, ForceLaw, Segment, BASELINE, CONTACT_POINT, HAMAKER, RADIUS,
+    YOUNGS_MODULUS,
 };
-use crate::analysis::fit::{fit, FitOutcome, Observations, Parameter, ProfileEnd};
+use crate::analysis::fit::{fit, Observations, Parameter, ProfileEnd};
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
-use crate::probe::ranges::si_range;
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 
 /// The most rows a force curve may have (a 1 MHz record of one second).
 pub const MAX_FIT_ROWS: usize = 1_000_000;
-
-/// The fewest rows fitted (more than the parameters, for the χ²'s degrees of freedom).
-pub const MIN_FIT_ROWS: usize = 8;
 
 /// The segment of the curve fitted.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -83,42 +80,6 @@ impl Default for FitRequest {
             approach_rows: None,
         }
     }
-}
-
-/// The physical range [lo, hi] of a fitted quantity from the probe's ranges
-/// ([`crate::probe::ranges::SI_RANGES`]; a positive quantity without a lower bound there is
-/// bounded by 0); (−∞, ∞) for the contact point and the baseline.
-pub fn bounds(name: &str) -> (f64, f64) {
-    let (section, key) = match name.split_once('.') {
-        Some(sk) => sk,
-        None => return (f64::NEG_INFINITY, f64::INFINITY),
-    };
-    let range = si_range(section, key);
-    let lo = range.and_then(|r| r.below).map_or(0.0, |b| b.0);
-    let hi = range.and_then(|r| r.above).map_or(f64::INFINITY, |b| b.0);
-    (lo, hi)
-}
-
-/// The result of a `fit` request.
-#[derive(Debug, Clone)]
-pub struct FitResult {
-    /// The law fitted.
-    pub law: ForceLaw,
-    /// The lever's spring constant (N/m).
-    pub spring_constant: f64,
-    /// The preprocessed curve.
-    pub curve: Preprocessed,
-    /// The rows fitted.
-    pub rows: Vec<usize>,
-    /// Every model parameter's name, in the model's order.
-    pub names: Vec<&'static str>,
-    /// Which were fitted.
-    pub fitted: Vec<bool>,
-    /// The fit.
-    pub outcome: FitOutcome,
-    /// The dynamic fit's data and channels, when the data are an AM curve
-    /// ([`super::fit_dynamic`]; then `curve` and `rows` are empty).
-    pub dynamic: Option<super::fit_dynamic::DynamicFit>,
 }
 
 /// A force curve's columns: heights, forces and their σ.
@@ -287,15 +248,21 @@ fn check_columns(height: &[f64], force: &[f64], sigma: Option<&[f64]>) -> Result
 impl Analysis for FitRequest {
     type Output = FitResult;
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
-        if super::fit_dynamic::read_am_data(self)?.is_some() {
+        if super::fit_dynamic::read_am_data(self.data.as_deref())?.is_some() {
             // an AM curve: its names and columns are checked when it runs
             return Ok(());
         }
         self.check(model).map(|_| ())
     }
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<FitResult, SimError> {
-        if let Some(data) = super::fit_dynamic::read_am_data(self)? {
-            return super::fit_dynamic::execute(self, model, data, progress);
+        if let Some(data) = super::fit_dynamic::read_am_data(self.data.as_deref())? {
+            return super::fit_dynamic::execute(
+                &self.fit,
+                self.fit == FitRequest::default().fit,
+                model,
+                data,
+                progress,
+            );
         }
         let law = self.check(model)?;
         let (height, force, sigma) = self.columns()?;

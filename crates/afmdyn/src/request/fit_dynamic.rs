@@ -7,13 +7,21 @@
 //! fit's shape (estimates with value, standard error and interval, correlation, χ²/dof, the
 //! curve beside the data with its residuals, warnings).
 
-use super::fit::{bounds, FitRequest, FitResult, MIN_FIT_ROWS};
+use super::fit_result::{bounds, FitResult, MIN_FIT_ROWS};
+pub use super::fit_result::{AmData, DynamicFit};
 use super::run::Resolved;
 use crate::analysis::fit::am_curve::{AmCurveModel, AmParam, AmProbe, Z_OFFSET};
+use crate::analysis::fit::least_squares::chi2;
 use crate::analysis::fit::{fit_with, Observations, Parameter};
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
 use serde_json::{json, Value};
+
+/// Half the number of steps of z_offset's start grid: the starts −6 … 6 steps.
+const Z_OFFSET_GRID: i32 = 6;
+/// The step of z_offset's start grid, in g₀ = A₀ (the grid spans ±0.3 A₀, within which the
+/// free amplitude's far rows and the curve's onset place the contact point).
+const Z_OFFSET_STEP: f64 = 0.05;
 
 /// The variables of a dynamic fit's curve (name, unit, label): the columns of its table and
 /// Dataset, those of the channels fitted.
@@ -26,32 +34,6 @@ pub const CURVE_VARIABLES: [(&str, &str, &str); 7] = [
     ("phase_fit", "deg", "phase, fitted"),
     ("phase_residual", "deg", "measured − fitted phase"),
 ];
-
-/// A measured AM curve's columns.
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct AmData {
-    /// The piezo positions z (m).
-    pub z: Vec<f64>,
-    /// The amplitudes (m).
-    pub amplitude: Option<Vec<f64>>,
-    /// The phases (deg).
-    pub phase: Option<Vec<f64>>,
-    /// The amplitudes' standard deviations (m).
-    pub sigma_amplitude: Option<Vec<f64>>,
-    /// The phases' standard deviations (deg).
-    pub sigma_phase: Option<Vec<f64>>,
-}
-
-/// The dynamic fit's part of a [`FitResult`].
-#[derive(Debug, Clone)]
-pub struct DynamicFit {
-    /// The data.
-    pub data: AmData,
-    /// The model's values at the estimates (amplitudes, then phases, as fitted).
-    pub channels: (bool, bool),
-    /// The last evaluation's warnings of the model (folds, grazing).
-    pub model_warnings: Vec<String>,
-}
 
 fn bad(name: &'static str, value: impl std::fmt::Display, allowed: String) -> SimError {
     SimError::out_of_range(name, value, allowed)
@@ -74,10 +56,10 @@ pub fn am_columns(names: &[String], cols: &[Vec<f64>]) -> Option<AmData> {
 ///
 /// # Errors
 /// [`SimError::OutOfRange`] naming `data` where the file cannot be read.
-pub fn read_am_data(request: &FitRequest) -> Result<Option<AmData>, SimError> {
+pub fn read_am_data(data: Option<&str>) -> Result<Option<AmData>, SimError> {
     #[cfg(feature = "files")]
     {
-        if let Some(path) = &request.data {
+        if let Some(path) = data {
             use crate::io::curve_file::{read_curve_file, CurveFile};
             let path = std::path::Path::new(path);
             let file =
@@ -88,7 +70,7 @@ pub fn read_am_data(request: &FitRequest) -> Result<Option<AmData>, SimError> {
             });
         }
     }
-    let _ = request;
+    let _ = data;
     Ok(None)
 }
 
@@ -144,13 +126,15 @@ fn check_data(d: &AmData) -> Result<(), SimError> {
     Ok(())
 }
 
-/// Run the dynamic fit of `request` on `data` under `model`'s probe.
+/// Run the dynamic fit of the parameters `fit` (the force-curve fit's default when
+/// `default_fit`: E, with H on DMT; z_offset always) on `data` under `model`'s probe.
 ///
 /// # Errors
 /// [`SimError::OutOfRange`] for bad data, parameter names, a probe without a Hertz or DMT
 /// sample; [`SimError::Cancelled`].
 pub fn execute(
-    request: &FitRequest,
+    fit: &[String],
+    default_fit: bool,
     model: &Resolved,
     data: AmData,
     progress: &Progress,
@@ -191,14 +175,14 @@ pub fn execute(
     };
     // the default (the force curve's) is E and z_offset, with H on DMT; z_offset is always
     // fitted
-    let mut names: Vec<String> = if request.fit == FitRequest::default().fit {
+    let mut names: Vec<String> = if default_fit {
         let mut v = vec!["sample.youngs_modulus".to_string()];
         if law_name == "dmt" {
             v.push("sample.hamaker".into());
         }
         v
     } else {
-        request.fit.clone()
+        fit.to_vec()
     };
     if !names.iter().any(|n| n == Z_OFFSET) {
         names.push(Z_OFFSET.into());
@@ -244,6 +228,10 @@ pub fn execute(
         });
     }
     let channels = (data.amplitude.is_some(), data.phase.is_some());
+    let (z_index, g0) = (
+        am.iter().position(|&p| p == AmParam::ZOffset),
+        am_probe.length_m,
+    );
     let curve = AmCurveModel::new(am_probe, data.z.clone(), channels, am);
     let mut y = Vec::new();
     let mut sigma = Vec::new();
@@ -265,6 +253,21 @@ pub fn execute(
         sigma: sigma.as_deref(),
     };
     let fixed = vec![None; params.len()];
+    // z_offset's start: the best χ² on a grid (the model's first rows otherwise follow another
+    // branch than the data's, and Levenberg–Marquardt stops in that local minimum)
+    if let Some(k) = z_index {
+        let mut trial: Vec<f64> = params.iter().map(|p| p.start).collect();
+        let mut best = (f64::INFINITY, params[k].start);
+        for i in -Z_OFFSET_GRID..=Z_OFFSET_GRID {
+            progress.check()?;
+            trial[k] = i as f64 * Z_OFFSET_STEP * g0;
+            let c = chi2(&curve, &obs, &trial);
+            if c < best.0 {
+                best = (c, trial[k]);
+            }
+        }
+        params[k].start = best.1;
+    }
     // Wald intervals: a profile's refits would cost a hundred stepped approaches each
     let mut outcome = fit_with(&curve, &obs, &params, &fixed, false);
     let model_warnings = curve.warnings();

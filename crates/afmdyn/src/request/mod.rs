@@ -47,6 +47,7 @@ pub mod fm;
 pub use crate::io::height_map as height_map_file;
 pub mod fit;
 pub mod fit_dynamic;
+pub mod fit_result;
 pub mod image;
 pub mod image_job;
 pub mod image_layout;

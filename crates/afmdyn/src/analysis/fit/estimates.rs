@@ -41,6 +41,11 @@ pub struct Estimate {
     pub profile: Option<Profile>,
 }
 
+/// Standard deviations of χ²/dof above 1 beyond which a fit with σ given warns that the model
+/// does not describe the data (χ² of m − n degrees of freedom has mean m − n and variance
+/// 2(m − n); at 4 of them a fit that does describe its data warns about once in 30 000).
+pub const CHI2_SIGMAS: f64 = 4.0;
+
 /// A fit's outcome: estimates, correlation, χ²/dof, the model beside the data, warnings.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FitOutcome {
@@ -120,6 +125,18 @@ pub fn fit_with(
             "noise estimated from residuals: no σ column, so σ² = χ²/dof = {:.4e} (the \
              standard errors and intervals assume the model fits)",
             chi2_dof
+        ));
+    }
+    // with σ given, χ² of a model that fits is χ²(dof): mean dof, standard deviation √(2 dof)
+    let bound = 1.0 + CHI2_SIGMAS * (2.0 / dof.max(1) as f64).sqrt();
+    if !noise_estimated && dof > 0 && chi2_dof > bound {
+        warnings.push(format!(
+            "χ²/dof = {} with the σ given, above {} ({CHI2_SIGMAS} standard deviations of χ²/dof \
+             for {dof} degrees of freedom): the model does not describe the data within σ — a \
+             local minimum (another start), another law or model, or σ too small; the standard \
+             errors assume it does",
+            crate::error::number(chi2_dof),
+            crate::error::number(bound)
         ));
     }
     let (cov, singular) = covariance(model, obs, &best.values, &free, s2);

@@ -1,0 +1,72 @@
+//! What the force-curve fit ([`super::fit`]) and the dynamic fit ([`super::fit_dynamic`])
+//! share: the result of a `fit` request, the data of an AM curve, the fewest rows and the
+//! fitted quantities' physical ranges.
+
+use crate::analysis::fit::force_curve::{ForceLaw, Preprocessed};
+use crate::analysis::fit::FitOutcome;
+use crate::probe::ranges::si_range;
+
+/// The fewest rows fitted (more than the parameters, for the χ²'s degrees of freedom).
+pub const MIN_FIT_ROWS: usize = 8;
+
+/// The physical range [lo, hi] of a fitted quantity from the probe's ranges
+/// ([`crate::probe::ranges::SI_RANGES`]; a positive quantity without a lower bound there is
+/// bounded by 0); (−∞, ∞) for the contact point and the baseline.
+pub fn bounds(name: &str) -> (f64, f64) {
+    let (section, key) = match name.split_once('.') {
+        Some(sk) => sk,
+        None => return (f64::NEG_INFINITY, f64::INFINITY),
+    };
+    let range = si_range(section, key);
+    let lo = range.and_then(|r| r.below).map_or(0.0, |b| b.0);
+    let hi = range.and_then(|r| r.above).map_or(f64::INFINITY, |b| b.0);
+    (lo, hi)
+}
+
+/// The result of a `fit` request.
+#[derive(Debug, Clone)]
+pub struct FitResult {
+    /// The law fitted.
+    pub law: ForceLaw,
+    /// The lever's spring constant (N/m).
+    pub spring_constant: f64,
+    /// The preprocessed curve.
+    pub curve: Preprocessed,
+    /// The rows fitted.
+    pub rows: Vec<usize>,
+    /// Every model parameter's name, in the model's order.
+    pub names: Vec<&'static str>,
+    /// Which were fitted.
+    pub fitted: Vec<bool>,
+    /// The fit.
+    pub outcome: FitOutcome,
+    /// The dynamic fit's data and channels, when the data are an AM curve
+    /// ([`super::fit_dynamic`]; then `curve` and `rows` are empty).
+    pub dynamic: Option<DynamicFit>,
+}
+
+/// A measured AM curve's columns.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct AmData {
+    /// The piezo positions z (m).
+    pub z: Vec<f64>,
+    /// The amplitudes (m).
+    pub amplitude: Option<Vec<f64>>,
+    /// The phases (deg).
+    pub phase: Option<Vec<f64>>,
+    /// The amplitudes' standard deviations (m).
+    pub sigma_amplitude: Option<Vec<f64>>,
+    /// The phases' standard deviations (deg).
+    pub sigma_phase: Option<Vec<f64>>,
+}
+
+/// The dynamic fit's part of a [`FitResult`].
+#[derive(Debug, Clone)]
+pub struct DynamicFit {
+    /// The data.
+    pub data: AmData,
+    /// The model's values at the estimates (amplitudes, then phases, as fitted).
+    pub channels: (bool, bool),
+    /// The last evaluation's warnings of the model (folds, grazing).
+    pub model_warnings: Vec<String>,
+}
