@@ -218,6 +218,7 @@ fn the_door_gives_the_image_and_refuses_an_am_probe() {
 }
 
 #[test]
+#[cfg(feature = "files")] // (the plans are the files feature's: stores and ledgers)
 fn the_plan_of_engages_and_lines_is_the_image_bit_for_bit() {
     use afmdyn::study::plan::{plan, rebuild, Recipe};
     use std::sync::atomic::AtomicBool;

@@ -475,6 +475,7 @@ fn dense_and_stepped_demodulation_agree() {
 /// approach curves) and scans its lines from the stage's start (the study's line job): the
 /// same lines, bit for bit (the results' text equal), as the planning process's own study.
 #[test]
+#[cfg(feature = "files")] // (the plans are the files feature's: stores and ledgers)
 fn a_worker_scans_the_lines_of_the_start_bit_for_bit() {
     use afmdyn::request::image_scan::ScanRecipe;
     use afmdyn::study::plan::{plan, rebuild, Recipe};
