@@ -30,8 +30,21 @@ STORE = 'Union[str, "os.PathLike[str]", None]'
 STORE_KW = [("store", STORE, "None"), ("resume", "bool", "False")]
 PROGRESS = [("progress", "ProgressArg", "None")]
 #: the keywords of the Dask versions (``afmdyn.dask``), before the request's
-DASK_KW = [("client", 'Optional["distributed.Client"]', "None"), ("store", STORE, "None"),
-           ("resume", "bool", "True")]
+CLIENT = [("client", 'Optional["distributed.Client"]', "None")]
+DASK_KW = CLIENT + [("store", STORE, "None"), ("resume", "bool", "True")]
+#: an image's probe and sample map (``afmdyn.image``, ``afmdyn.setpoint_study``)
+IMAGE_INPUTS = [("probe", 'Union[str, "os.PathLike[str]", Dict[str, Any]]'),
+                ("sample", 'Union[str, "os.PathLike[str]"]')]
+#: an image's positional parameters and options (``afmdyn.image``, ``afmdyn.dask.image``)
+IMAGE = {"positional": IMAGE_INPUTS + [("setpoint", "float")], "model": False,
+         "override": {k: ("Optional[int]", "None") for k in ("pixels", "curve_points")}}
+#: an image's keywords of Python's own (``afmdyn.dask.image`` takes no feedback nor threads)
+IMAGE_KW = [("height_map", "Optional[Any]", "None"), ("feedback", "str", '"ideal"'),
+            ("scan_rate", "Optional[float]", "None"),
+            ("gains", "Optional[Tuple[float, float]]", "None"),
+            ("time_constant", "Optional[float]", "None"), ("threads", "Optional[int]", "None"),
+            ("mode", "str", '"am"')]
+OPTIONAL_FLOAT = ("Optional[float]", "None")
 
 #: the generated modules: file -> the analyses it holds, each name -> (schema stem or None,
 #: finisher, return annotation, options). Options: ``own`` (keywords of Python's own,
@@ -39,7 +52,9 @@ DASK_KW = [("client", 'Optional["distributed.Client"]', "None"), ("store", STORE
 #: ``first`` (such keywords before the request's), ``omit`` (request fields Python does not
 #: take), ``override`` (a field's annotation and default in Python, wider than the
 #: request's: the finisher converts it), ``rename`` (a field's keyword in Python), ``typed``
-#: (False: no ``@_typed`` check of the keywords)
+#: (False: no ``@_typed`` check of the keywords), ``positional`` ((name, annotation) of the
+#: parameters before the keywords, a request's field or Python's own, instead of ``params``)
+#: and ``model`` (False: no model keywords)
 FILES: Dict[str, Dict[str, Tuple[object, str, str, Dict[str, object]]]] = {
     "_wrappers.py": {
         "modes": (None, "_api", "Spectrum", {"own": []}),
@@ -51,7 +66,7 @@ FILES: Dict[str, Dict[str, Tuple[object, str, str, Dict[str, object]]]] = {
         "lyapunov": ("lyapunov", "_orbits", "Lyapunov", {}),
         "attractors": ("attractors", "_attractors", "Attractors", {}),
         "basins": ("basins", "_basins", "xr.Dataset", {"own": STORE_KW + PROGRESS}),
-        "global_continuation": ("global_continuation", "_global_continuation", "xr.Dataset",
+        "global_continuation": ("global_continuation", "_basins", "xr.Dataset",
                                 {"own": STORE_KW + PROGRESS}),
         "chart": ("chart", "_chart", "xr.Dataset", {"own": PROGRESS + STORE_KW}),
     },
@@ -75,6 +90,18 @@ FILES: Dict[str, Dict[str, Tuple[object, str, str, Dict[str, object]]]] = {
                 "fit": ("Optional[Sequence[str]]", "None"),
                 "range": ("Optional[Tuple[float, float]]", "None")},
             "own": [("curve", "int", "0")] + PROGRESS}),
+        "image": ("image", "_image", "xr.Dataset", {**IMAGE, "own": IMAGE_KW + PROGRESS}),
+        "setpoint_study": ("image", "_image", "xr.Dataset", {
+            "positional": IMAGE_INPUTS + [("ratios", "Sequence[float]")], "model": False,
+            "omit": ("setpoint", "pixels", "lines"), "own": [],
+            "override": {"curve_points": ("Optional[int]", "None")}}),
+        "reconstruct": ("reconstruct", "_reconstruct", "xr.Dataset", {
+            "positional": [], "model": False, "typed": False, "omit": ("law_force",),
+            "override": {"frequency_shift": ("Optional[Sequence[float]]", "None"),
+                         **{k: OPTIONAL_FLOAT for k in ("spring_constant",
+                                                        "resonance_frequency", "amplitude")}},
+            "own": [(k, "Optional[Union[xr.Dataset, Dict[str, Any]]]", "None")
+                    for k in ("fm", "am")] + PROGRESS}),
     },
     "_dask_wrappers.py": {
         "chart": ("chart", "_dask", "xr.Dataset",
@@ -82,6 +109,12 @@ FILES: Dict[str, Dict[str, Tuple[object, str, str, Dict[str, object]]]] = {
                    "omit": ("threads",), "typed": False}),
         "bifurcation": ("bifurcation", "_dask", "xr.Dataset",
                         {"first": DASK_KW, "omit": ("threads",), "typed": False}),
+        "basins": ("basins", "_dask", "xr.Dataset",
+                   {"first": CLIENT + PROGRESS, "omit": ("threads",), "own": [],
+                    "typed": False}),
+        "image": ("image", "_dask", "xr.Dataset", {
+            **IMAGE, "first": CLIENT + PROGRESS, "typed": False,
+            "own": [k for k in IMAGE_KW if k[0] not in ("feedback", "threads")]}),
     },
 }
 
@@ -171,13 +204,21 @@ def _function(file: str, name: str) -> str:
     fields = _fields(str(stem), omit, override) if stem else []
     first = [(*k, "") for k in opts.get("first", [])]  # type: ignore
     own = [(*k, "") for k in opts.get("own", PROGRESS)]  # type: ignore
+    # the positional parameters (default: the parameter set), a request's field taken there
+    given = opts.get("positional")
+    positional = [(k, ann, "") for k, ann in given or []]  # type: ignore
+    described = {f[0]: f[3] for f in fields}
+    fields = [f for f in fields if f[0] not in {k for k, _, _ in positional}]
     doc = DOCS[file][name]
-    sig = ["    params: Optional[Params] = None,", "    /,"]
+    sig = [f"    {k}: {ann}," for k, ann, _ in positional] if given is not None else [
+        "    params: Optional[Params] = None,", "    /,"]
     sig += ["    *,"] if fields or own or first else []
     args = []
-    for key, ann, default, desc in first + fields + own:
+    for key, ann, default, desc in [(k, a, None, described.get(k, "")) for k, a, _ in positional
+                                    ] + first + fields + own:
         kw = {"from": "from_", **rename}.get(key, key)
-        sig.append(f"    {kw}: {ann} = {default},")
+        if default is not None:
+            sig.append(f"    {kw}: {ann} = {default},")
         # the request's description, with Python's addition ("+…"), or Python's own text
         extra = doc.get("args", {}).get(key, COMMON_ARGS.get(key, ""))
         if desc and (not extra or extra.startswith("+")):
@@ -185,10 +226,11 @@ def _function(file: str, name: str) -> str:
         else:
             desc = extra
         args += _arg_lines(kw, desc.replace("{name}", name))
-    sig.append("    **model: Unpack[Model],")
-    args += _arg_lines("**model", COMMON_ARGS["model"])
+    if opts.get("model", True):
+        sig.append("    **model: Unpack[Model],")
+        args += _arg_lines("**model", COMMON_ARGS["model"])
     body = [doc["summary"].rstrip(), "", "Args:", *[a[4:] for a in args]]
-    for section in ("returns", "raises"):
+    for section in ("returns", "warns", "raises"):
         if section in doc:
             body += ["", doc[section].rstrip()]
     text = textwrap.indent("\n".join(body), "    ").replace("\n    \n", "\n\n")
@@ -228,11 +270,11 @@ __all__ = [
 HEADS = {
     "_wrappers.py": (
         "The public functions of the dynamics' analyses (``afmdyn.simulate``, …, their\n"
-        "finishers in :mod:`._api`, :mod:`._orbits`, :mod:`._attractors`, :mod:`._basins`,\n"
-        ":mod:`._global_continuation` and :mod:`._chart`; the AFM measurements' are in\n"
+        "finishers in :mod:`._api`, :mod:`._orbits`, :mod:`._attractors`, :mod:`._basins` and\n"
+        ":mod:`._chart`; the AFM measurements' are in\n"
         ":mod:`._wrappers_afm`). Each checks its keywords' types first (``TypeError`` naming the\n"
         "keyword); the library checks the values (``ValueError`` naming the field and its range).",
-        "from . import _api, _attractors, _basins, _chart, _global_continuation, _orbits\n"
+        "from . import _api, _attractors, _basins, _chart, _orbits\n"
         "from ._afmdyn import Params\n"
         "from ._attractors import Attractors\n"
         "from ._common import Model, StateLike, _typed\n"
@@ -242,11 +284,12 @@ HEADS = {
     ),
     "_wrappers_afm.py": (
         "The public functions of the AFM measurements (``afmdyn.observe``, ``approach``,\n"
-        "``bimodal``, ``resonance``, ``fm``, ``peakforce``, ``fit``; their finishers in\n"
-        ":mod:`._api`, :mod:`._fm`, :mod:`._peakforce` and :mod:`._fit`). Those marked\n"
+        "``bimodal``, ``resonance``, ``fm``, ``peakforce``, ``fit``, ``image``,\n"
+        "``setpoint_study``, ``reconstruct``; their finishers in :mod:`._api`, :mod:`._fm`,\n"
+        ":mod:`._peakforce`, :mod:`._fit`, :mod:`._image` and :mod:`._reconstruct`). Those marked\n"
         "``@_typed`` check their keywords' types first (``TypeError`` naming the keyword); the\n"
         "library checks the values (``ValueError`` naming the field and its range).",
-        "from . import _api, _fit, _fm, _peakforce\n"
+        "from . import _api, _fit, _fm, _image, _peakforce, _reconstruct\n"
         "from ._afmdyn import Params\n"
         "from ._common import Model, StateLike, _typed\n"
         "from ._progress import ProgressArg",
@@ -269,7 +312,7 @@ def generate(file: str = "_wrappers.py") -> str:
     head = (HEADER.replace("{doc}", doc).replace("{imports}", imports)
             .replace("{checking}", checking).replace("{names}", names))
     functions = [_function(file, n) for n in FILES[file]]
-    used = [n for n in ("Any", "Mapping", "Optional", "Sequence", "Tuple", "Union")
+    used = [n for n in ("Any", "Dict", "Mapping", "Optional", "Sequence", "Tuple", "Union")
             if re.search(rf"\b{n}\[|\b{n}\b,|\b{n}\]", "\n".join(functions))]
     head = head.replace("{typing}", ", ".join(["TYPE_CHECKING"] + used))
     parts = [head.rstrip()] + functions

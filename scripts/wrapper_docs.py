@@ -416,7 +416,154 @@ Raises:
     ValueError: naming the option, the data or the probe key.""",
 }
 
-AFM = ("observe", "approach", "bimodal", "resonance", "fm", "peakforce", "fit")
+#: an image's probe and sample map (``image``, ``setpoint_study`` and ``afmdyn.dask.image``)
+IMAGE_ARGS = {
+    "probe": "the probe (path, TOML text or dict, as ``afmdyn.probe``): the lever, tip, drive "
+    "and the background sample.",
+    "sample": "the sample map (path or TOML text): ``size = [Lx, Ly]`` (m) and ``[[domain]]`` "
+    "entries with ``name``, ``x``, ``y``, ``height`` (m) and ``[domain.sample]``; its "
+    "``height_map`` the rows inline or a ``.csv`` / ``.npy`` file (a relative path from the "
+    "sample file's directory, or from the current one for TOML text).",
+    "setpoint": "+With ``mode=\"peakforce\"`` the peak force (N).",
+    "height_map": "a 2D array of heights (m), rows from y = 0 to Ly and columns from x = 0 to "
+    "Lx, interpolated bilinearly and added to the map's topography (replaces the map's own "
+    "``height_map``); or the path of a ``.csv`` or ``.npy`` file holding them.",
+    "feedback": "``\"ideal\"`` or ``\"pi\"`` (a scan in the time domain).",
+    "scan_rate": "the PI scan's line rate (Hz; ``None``: the lever's default).",
+    "gains": "the PI controller's (K_P, K_I in 1/s; ``None``: the lever's defaults).",
+    "time_constant": "the PI scan's lock-in time constant (s), refused above 1000 s and "
+    "warned outside 1 µs–0.1 s (``None``: the lever's default).",
+    "threads": "the cores a PI scan's or PeakForce image's lines run on (default all).",
+    "mode": "``\"am\"`` or ``\"peakforce\"`` (an off-resonance probe).",
+}
+
+WRAPPERS["image"] = {
+    "summary": """\
+The image an amplitude feedback records over a heterogeneous sample
+(``afmdyn image``). ``feedback="ideal"``: at every pixel the operating point of the local
+material where the amplitude equals the setpoint, the regime kept from the previous pixel
+where the material allows it, each line engaged from far. ``feedback="pi"``: each line
+scanned in the time domain, trace and retrace, under a lock-in and a PI z controller
+updating once per drive period, its lines on ``threads`` cores with ``progress``; Ctrl-C
+stops it. ``mode="peakforce"`` (an off-resonance probe): the image an ideal peak-force
+feedback records, ``setpoint`` the peak force (N), each pixel's steady tap exact (issue 61
+§3), its lines on ``threads`` cores.""",
+    "args": IMAGE_ARGS,
+    "returns": """\
+Returns:
+    ``xarray.Dataset`` over ``y`` and ``x`` (m): ``height``, ``true_height``, ``z_c``,
+    ``amplitude``, ``phase_deg``, ``energy_dissipated``, ``virial``, ``peak_force``,
+    ``indentation`` (NaN where the setpoint is not reached; units and long names as the
+    library lays them out, the variables of ``afmdyn image``'s ``image.nc``), ``regime``,
+    ``material`` and ``domain`` (strings); attributes ``setpoint``, ``reference_z_c`` (m) and
+    ``summary`` (the command line's JSON document, with each material's operating points).
+
+    With ``feedback="pi"``: the recorded trace ``height``, ``amplitude``, ``phase_deg``,
+    ``tracking_error``, ``energy_dissipated``, ``virial``, ``peak_force``, ``indentation``
+    and ``lost_contact``, the same with ``_retrace``, ``ideal_height`` and
+    ``true_height`` (m); attributes ``scan`` (the settings) and ``artefacts`` (JSON: per
+    direction the height error against the ideal image, the overshoot, the error image's
+    RMS, the pixels that lost contact).
+
+    With ``mode="peakforce"``: ``height``, ``true_height``, ``z_c``, ``peak_force``,
+    ``modulus_dmt``, ``adhesion``, ``deformation``, ``dissipation``, ``taps_per_cycle``,
+    ``evaluations`` (steady taps computed at the pixel), ``material`` and ``domain``, as
+    ``image.nc`` of ``afmdyn image --mode peakforce``.""",
+    "raises": """\
+Raises:
+    ValueError: naming the field — a setpoint outside (0, 1), pixels or lines outside
+        1..=4096 (lines = 1 for a line map), a sample map's key, a scan setting
+        (scan_rate, gains, time_constant).""",
+}
+
+WRAPPERS["setpoint_study"] = {
+    "summary": """\
+Every domain's apparent height, phase lag and dissipated energy against the setpoint
+under an ideal feedback (``afmdyn image --setpoint-study``): at each ratio a line engaged
+on the background crosses onto each domain — the contrast inversion of AM-AFM (García &
+San Paulo, Phys. Rev. B 61, R13381 (2000)). Arguments as :func:`image`'s.""",
+    "args": {**IMAGE_ARGS, "ratios": "the setpoints A_sp/A0 in (0, 1)."},
+    "returns": """\
+Returns:
+    ``xarray.Dataset`` over ``domain`` (``background`` first) and ``setpoint``:
+    ``apparent_height`` (m), ``phase_deg``, ``energy_dissipated`` (J) (NaN where a
+    material has no operating point) and ``regime``; attribute ``summary`` (the JSON).""",
+}
+
+WRAPPERS["reconstruct"] = {
+    "summary": """\
+The tip–sample force F(d) and potential U(d) behind a frequency-modulation curve, by
+the Sader–Jarvis inversion (J. E. Sader and S. P. Jarvis, Appl. Phys. Lett. 84, 1801
+(2004); ``afmdyn reconstruct``) or its exact correction (``inversion="exact"``).""",
+    "args": {
+        "fm": "instead of the curve, the dataset of :func:`afmdyn.fm` with a probe (or its "
+        "document, ``afmdyn.summary(ds)``): its distances of closest approach "
+        "(``min_distance``), shifts, k, f0 and A; ``spring_constant``, "
+        "``resonance_frequency``, ``amplitude`` given replace the document's.",
+        "am": "instead, the dataset of :func:`afmdyn.approach` with a point-mass probe (or its "
+        "document): its attractive run (phase lag above 90°) inverted at each point's "
+        "amplitude by the matrix method (``afmdyn reconstruct --am``); the constants are the "
+        "probe's.",
+        "inversion": "+``\"sader-jarvis\"`` is within a few per cent and the more robust on "
+        "noisy data; ``\"exact\"`` corrects it through Giessibl's forward relation until the "
+        "two agree (the document's ``exact`` records its steps and forward residual). Not "
+        "with ``am``.",
+    },
+    "returns": """\
+Returns:
+    ``xarray.Dataset`` over ``distance`` (m, increasing): ``force`` (N, attractive < 0),
+    ``potential`` (J, ∫_d^{d_max} F), and from ``fm=`` ``law`` (N, the model's force at
+    d); attributes ``spring_constant``, ``resonance_frequency``, ``amplitude`` and
+    ``summary`` (the command line's JSON document). The force near the largest distance is
+    not reconstructed (the inversion integrates the shift beyond each distance): take data
+    out to where Δf has decayed. On an evenly spaced grid (every distance within 1e-9 of a
+    spacing of d0 + i h) the inversion takes O(N log N) by FFT, up to 2 000 000 points; on
+    another grid O(N²), up to 20 000 points. Ctrl-C stops it.""",
+    "warns": """\
+Warns:
+    AfmdynWarning: a constant outside its typical range (A 10 pm–1 µm, f0 1 kHz–10 MHz,
+        k 0.01–1e6 N/m: a likely unit slip, named); data that end while |Δf| is still
+        above 1 % of its extreme.""",
+    "raises": """\
+Raises:
+    ValueError: naming the field — fewer than 3 points, distances not monotonic, lengths
+        that differ, constants missing or outside their physical range (A 1e-15–1e-3 m,
+        f0 1–1e10 Hz, k 1e-6–1e9 N/m), neither or both of ``distance`` and ``z_c``, more
+        points than the limits above; ``fm`` not an SI ``fm`` document.
+    KeyboardInterrupt: on Ctrl-C.""",
+}
+
+DASK["basins"] = {
+    "summary": """\
+:func:`afmdyn.basins` (the same keywords but ``store``, ``resume`` and ``threads``)
+with the rows of each pass mapped over a Dask cluster (``client``; default a
+``LocalCluster`` of this machine's cores, closed at the end). The passes run in turn: the
+start of a pass — the attractors and the coarse grid of the passes before it, made by the
+library from their finished rows — is sent to the workers once, and each row is a task.""",
+    "returns": """\
+Returns:
+    The same ``xarray.Dataset`` as :func:`afmdyn.basins` with the same arguments, bit
+    for bit (a row is a pure function of its pass's start).""",
+    "args": {"client": "a ``dask.distributed.Client`` (default: a ``LocalCluster``)."},
+}
+
+DASK["image"] = {
+    "summary": """\
+:func:`afmdyn.image` with ``feedback="pi"`` (the same keywords but ``threads``) with
+its lines mapped over a Dask cluster (``client``; default a ``LocalCluster`` of this
+machine's cores, closed at the end): each line is a task, a pure function of the request
+and its number, so the Dataset equals :func:`afmdyn.image`'s bit for bit. With
+``mode="peakforce"`` the PeakForce image (``setpoint`` the peak force, N): the materials'
+engages are the first stage's tasks, the lines the second's.""",
+    "returns": """\
+Returns:
+    The same ``xarray.Dataset`` as :func:`afmdyn.image` with the same arguments.""",
+    "args": {**IMAGE_ARGS, "client": "a ``dask.distributed.Client`` (default: a "
+             "``LocalCluster``)."},
+}
+
+AFM = ("observe", "approach", "bimodal", "resonance", "fm", "peakforce", "fit", "image",
+       "setpoint_study", "reconstruct")
 DOCS = {"_wrappers.py": {k: v for k, v in WRAPPERS.items() if k not in AFM},
         "_wrappers_afm.py": {k: WRAPPERS[k] for k in AFM}, "_dask_wrappers.py": DASK}
 

@@ -25,30 +25,19 @@ electrostatic), ``electrostatic`` and ``tip_radius`` (electrostatic), ``adhesion
 model keywords.
 """
 
+from . import _wrappers, _wrappers_afm
 from ._afmdyn import Params, SimulationError
-from ._api import probe
+from ._api import cantilevers, probe
 from ._attractors import Attractor, Attractors
-from ._cantilevers import cantilevers
 from ._common import AfmdynWarning, Model, summary
 from ._interrupt import cancel_running
 from ._interrupt import install as _install_sigint
-from ._image import image, setpoint_study
-from ._reconstruct import reconstruct
-from ._wrappers import (
-    attractors,
-    basins,
-    bifurcation,
-    chart,
-    continuation,
-    converge,
-    global_continuation,
-    lyapunov,
-    modes,
-    orbit,
-    simulate,
-)
-from ._wrappers_afm import approach, bimodal, fit, fm, observe, peakforce, resonance
 from ._results import Lyapunov, Orbit, RegionSpectrum, Spectrum
+
+# the analyses (simulate, orbit, …, approach, image, …): generated, each module's names in its
+# __all__
+from ._wrappers import *  # noqa: F401,F403
+from ._wrappers_afm import *  # noqa: F401,F403
 
 try:
     from importlib.metadata import version as _version
@@ -71,29 +60,10 @@ __all__ = [
     "RegionSpectrum",
     "SimulationError",
     "Spectrum",
-    "approach",
-    "bimodal",
-    "attractors",
-    "basins",
-    "bifurcation",
     "cancel_running",
     "cantilevers",
-    "chart",
-    "continuation",
-    "converge",
-    "global_continuation",
-    "lyapunov",
-    "modes",
-    "observe",
-    "orbit",
     "probe",
-    "reconstruct",
-    "image",
-    "setpoint_study",
-    "fm",
-    "peakforce",
-    "fit",
-    "resonance",
-    "simulate",
     "summary",
 ]
+__all__ += _wrappers.__all__
+__all__ += _wrappers_afm.__all__

@@ -1,10 +1,11 @@
 """The finishers of the analyses whose public functions (:mod:`._wrappers`,
 :mod:`._wrappers_afm`, generated from the library's request schemas) return datasets or
-spectra, and :func:`probe`. A finisher takes the
+spectra, :func:`probe` and :func:`cantilevers` (the cantilever library, as a
+``pandas.DataFrame``). A finisher takes the
 public function's ``locals()`` (its keywords, ``params``, ``model``, ``progress``), runs the
 request through the one door (:func:`._common._door`) and builds the result from the library's
 layouts (:mod:`._layout`); the other finishers are in :mod:`._orbits`, :mod:`._attractors`,
-:mod:`._basins`, :mod:`._fm` and :mod:`._global_continuation`.
+:mod:`._basins` (and global continuation) and :mod:`._fm`.
 
 Units (paper eq. 5): time τ in t0 = √(mL⁴/EI), displacements in the beam gap g0, forces in
 EI g0/L³, energies in EI g0²/L³ (SI with a probe).
@@ -12,9 +13,10 @@ EI g0/L³, energies in EI g0²/L³ (SI with a probe).
 
 from __future__ import annotations
 
+import functools
 import json
 import os
-from typing import Any, Dict, Optional, Union
+from typing import TYPE_CHECKING, Any, Dict, Optional, Union
 
 import numpy as np
 import xarray as xr
@@ -25,6 +27,9 @@ from ._common import Model  # noqa: F401 (afmdyn._api.Model, as before)
 from ._common import _attrs, _door, _params, _probe_text, _request, _start, _state
 from . import _layout
 from ._results import RegionSpectrum, Spectrum
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 Args = Dict[str, Any]
 
@@ -45,16 +50,9 @@ def _finish_simulate(a: Args) -> xr.Dataset:
     p, probe = _params(a["params"], a["model"])
     d = _door("simulate", "simulate", a["progress"], p, probe, req)
     f = d["facts"]
-    attrs = _attrs(
-        p,
-        summary=d["json"],
-        tau_end=f["tau_end"],
-        switchings=f["switchings"],
-        body_contact=int(f["body_contact"]),
-        integrator=f["integrator"],
-        transient_tau=f["transient_tau"],
-        samples_per_period=a["samples_per_period"],
-    )
+    facts = {k: f[k] for k in ("tau_end", "switchings", "integrator", "transient_tau")}
+    attrs = _attrs(p, summary=d["json"], **facts, body_contact=int(f["body_contact"]),
+                   samples_per_period=a["samples_per_period"])
     # with a probe the library laid every array out in SI (report::simulate_layout)
     return _layout.dataset(d["datasets"]["simulate"], attrs)
 
@@ -67,10 +65,17 @@ def _finish_converge(a: Args) -> xr.Dataset:
     return _layout.dataset(d["datasets"]["converge"], attrs, coords=("tau_from_section",))
 
 
-def _finish_bifurcation(a: Args) -> xr.Dataset:
+def _sweep_request(a: Args) -> Args:
+    """The request of a sweep's keywords ``a`` (``bifurcation``'s, and
+    ``afmdyn.dask.bifurcation``'s): its ``values`` as a flat list."""
     req = _request(a)
     if a["values"] is not None:
         req["values"] = np.asarray(a["values"], dtype=np.float64).ravel().tolist()
+    return req
+
+
+def _finish_bifurcation(a: Args) -> xr.Dataset:
+    req = _sweep_request(a)
     p, _ = _params(a["params"], a["model"])
     # the sweep's records carry no JSON document, so no "si" block: the probe only resolved p
     d = _door("bifurcation", "bifurcation", a["progress"], p, None, req, a["store"],
@@ -120,6 +125,19 @@ def probe(
     return {"params": p, "si": json.loads(si)}
 
 
+def cantilevers() -> "pd.DataFrame":
+    """The cantilever library (``afmdyn cantilevers``): nominal datasheet values of common
+    tapping-mode, soft-tapping and biological-imaging cantilevers, one row per cantilever,
+    indexed by name: ``maker``, ``spring_constant`` (N/m), ``resonance_frequency`` (Hz),
+    ``quality_factor`` (in air; ``q_typical`` True where it is the lever class's typical value,
+    not the datasheet's), ``radius`` (tip radius, m), ``source``. A probe file names one with
+    ``[cantilever] name = "RTESPA-300"``; its own keys override the library's."""
+    import pandas as pd
+
+    doc = json.loads(_core.cantilevers())
+    return pd.DataFrame(doc["cantilevers"]).set_index("name")
+
+
 def _finish_observe(a: Args) -> xr.Dataset:
     req = _start(_request(a, initial=_state(a["initial"])))
     p, probe = _params(a["params"], a["model"])
@@ -148,13 +166,6 @@ def _curve(desc: str, a: Args) -> xr.Dataset:
     return _layout.dataset(d["datasets"]["curve"], attrs, coords=traces)
 
 
-def _finish_approach(a: Args) -> xr.Dataset:
-    return _curve("approach", a)
-
-
-def _finish_bimodal(a: Args) -> xr.Dataset:
-    return _curve("bimodal", a)
-
-
-def _finish_resonance(a: Args) -> xr.Dataset:
-    return _curve("resonance", a)
+_finish_approach = functools.partial(_curve, "approach")
+_finish_bimodal = functools.partial(_curve, "bimodal")
+_finish_resonance = functools.partial(_curve, "resonance")

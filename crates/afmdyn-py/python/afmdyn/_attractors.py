@@ -95,6 +95,12 @@ class Attractor:
         )
 
 
+#: The columns of :meth:`Attractors.to_dataframe`: each attractor's scalars.
+_COLUMNS = ("period", "basin_fraction", "count", "x_max", "x_min", "v_t_min", "contact_fraction",
+            "contacts_per_period", "body_contact", "transient_periods")
+
+
+@dataclass(repr=False, eq=False)
 class Attractors(_Document, Sequence[Attractor]):
     """Coexisting attractors, most frequent first (a sequence of :class:`Attractor`);
     ``to_dict()`` is ``afmdyn attractors --json``.
@@ -104,19 +110,11 @@ class Attractors(_Document, Sequence[Attractor]):
         starts that failed.
     """
 
-    def __init__(
-        self,
-        params: Params,
-        samples: int,
-        attractors: List[Attractor],
-        failures: List[str],
-        doc: str,
-    ) -> None:
-        self.params = params
-        self.samples = samples
-        self.attractors = attractors
-        self.failures = failures
-        self._json = doc
+    params: Params
+    samples: int
+    attractors: List[Attractor]
+    failures: List[str]
+    _json: str
 
     def __len__(self) -> int:
         return len(self.attractors)
@@ -138,21 +136,7 @@ class Attractors(_Document, Sequence[Attractor]):
         import pandas as pd
 
         return pd.DataFrame(
-            [
-                {
-                    "period": a.period,
-                    "basin_fraction": a.basin_fraction,
-                    "count": a.count,
-                    "x_max": a.x_max,
-                    "x_min": a.x_min,
-                    "v_t_min": a.v_t_min,
-                    "contact_fraction": a.contact_fraction,
-                    "contacts_per_period": a.contacts_per_period,
-                    "body_contact": a.body_contact,
-                    "transient_periods": a.transient_periods,
-                }
-                for a in self.attractors
-            ],
+            [{k: getattr(a, k) for k in _COLUMNS} for a in self.attractors],
             index=pd.RangeIndex(1, len(self.attractors) + 1, name="attractor"),
         )
 

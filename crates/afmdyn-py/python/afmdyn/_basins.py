@@ -1,5 +1,7 @@
-"""Basins of attraction over a plane of initial conditions (``afmdyn basins``): the library's
-map and measures, as an ``xarray.Dataset``."""
+"""The studies of random starts as ``xarray.Dataset`` objects: basins of attraction over a plane
+of initial conditions (``afmdyn basins``: the library's map and measures), and attractors with
+their basin fractions continued over a parameter (``afmdyn attractors --sweep``: the library's
+global continuation; its finisher :func:`_finish_global_continuation`)."""
 
 from __future__ import annotations
 
@@ -11,7 +13,7 @@ import xarray as xr
 
 from . import _layout
 from ._afmdyn import Params
-from ._common import _door, _params, _request
+from ._common import _door, _param_attrs, _params, _request
 
 
 def _finish_basins(a: Dict[str, Any]) -> xr.Dataset:
@@ -35,7 +37,7 @@ def _dataset(layout: Any, doc: Any, p: Params) -> xr.Dataset:
             "boundary_basin_entropy": num(doc["boundary_basin_entropy"]),
             "uncertainty_exponent": num(doc["uncertainty_exponent"]),
             "summary": json.dumps(doc),
-            **{k: v for k, v in p.to_dict().items() if isinstance(v, (int, float, str))},
+            **_param_attrs(p),
         },
     )
     decided = ds["decided"]
@@ -44,3 +46,18 @@ def _dataset(layout: Any, doc: Any, p: Params) -> xr.Dataset:
     attrs = {k: v for k, v in decided.attrs.items() if not k.startswith("flag_")}
     ds["decided"] = (decided.dims, names.reshape(decided.shape), attrs)
     return ds.assign_coords(attractor=("attractor", np.arange(ds.sizes["attractor"])))
+
+
+def _finish_global_continuation(a: Dict[str, Any]) -> xr.Dataset:
+    req = _request(a)
+    p, probe = _params(a["params"], a["model"])
+    d = _door("global_continuation", "starts", a["progress"], p, probe, req, a["store"],
+              a["resume"])
+    layout = d["datasets"]["global_continuation"]
+    doc = json.loads(d["json"])
+    # the library's layout (the command line's attractors-sweep.nc)
+    return _layout.dataset(
+        layout,
+        {"param": doc["param"], "samples": a["samples"], "match_tol": a["match_tol"],
+         "summary": json.dumps(doc)},
+    )

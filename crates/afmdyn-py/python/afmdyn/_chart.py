@@ -16,7 +16,7 @@ import xarray as xr
 from . import _afmdyn as _core
 from . import _layout
 from ._afmdyn import Params
-from ._common import _probe_text, _request, _warn
+from ._common import _inputs, _request, _warn
 from ._progress import reporter
 
 
@@ -27,11 +27,7 @@ def study(
 ) -> "_core.ChartStudy":
     """The validated chart of the options ``request`` (the library's ``ChartRequest``) over
     ``params`` with the ``model`` keywords (``probe`` a probe file's path)."""
-    if params is not None and not isinstance(params, Params):
-        raise TypeError(f"params: expected afmdyn.Params or None, got {type(params).__name__}")
-    model = dict(model)
-    text = _probe_text(model)
-    return _core.ChartStudy.build(request, params, text, model)
+    return _core.ChartStudy.build(request, *_inputs(params, model))
 
 
 def dataset(s: "_core.ChartStudy", d: Dict[str, Any]) -> xr.Dataset:

@@ -65,11 +65,16 @@ def _params(
     library as the command line resolves ``--probe``/``--config`` and the model flags:
     ``params`` (or the probe's set, or ``default``, or the paper's set) with the ``model``
     keywords applied."""
+    params, probe, model = _inputs(params, model)
+    return _core.resolve(params, default, probe, model), probe
+
+
+def _inputs(params: Optional[Params], model: Any) -> Tuple[Optional[Params], Optional[str], Any]:
+    """``params`` checked, the probe's text and the other ``model`` keywords (a new dict)."""
     if params is not None and not isinstance(params, Params):
         raise TypeError(f"params: expected afmdyn.Params or None, got {type(params).__name__}")
     model = dict(model)
-    probe = _probe_text(model)
-    return _core.resolve(params, default, probe, model), probe
+    return params, _probe_text(model), model
 
 
 def _probe_text(model: Dict[str, Any]) -> Optional[str]:

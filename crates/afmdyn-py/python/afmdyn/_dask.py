@@ -1,6 +1,6 @@
 """The machinery of :mod:`afmdyn.dask` (its public names are re-exported there): the
 clusters, the chart's Zarr ledger, the plans' task runners and the finishers of the generated
-``afmdyn.dask.chart`` and ``afmdyn.dask.bifurcation`` (:mod:`._dask_wrappers`)."""
+``afmdyn.dask.chart``, ``bifurcation``, ``basins`` and ``image`` (:mod:`._dask_wrappers`)."""
 
 from __future__ import annotations
 
@@ -9,13 +9,12 @@ import functools
 import json
 import os
 import time
-from typing import Any, Dict, Iterable, Iterator, List, Optional, Sequence, Set
+from typing import Any, Dict, Iterable, Iterator, List, Optional, Set
 
 import numpy as np
 import xarray as xr
 
 from . import _afmdyn as _core
-from ._afmdyn import Params
 from . import _layout
 from ._chart import dataset, study
 from ._common import _request
@@ -66,8 +65,7 @@ def run_chart_task(recipe: str, task: int) -> str:
 
 def _template(s: "_core.ChartStudy") -> xr.Dataset:
     """The store's dataset before any task: every cell empty (as a cell with no attractor)."""
-    d = s.arrays([])
-    return dataset(s, d)
+    return dataset(s, s.arrays([]))
 
 
 #: Largest ledger of finished tasks read back, in bytes: 16 MiB, a line of at most 16 bytes for
@@ -298,13 +296,11 @@ def _run_plan(
 def _finish_bifurcation(a: Dict[str, Any]) -> xr.Dataset:
     """Run the sweep of :func:`afmdyn.dask.bifurcation`'s keywords ``a`` (its ``locals()``)."""
     params, model, client, progress = a["params"], a["model"], a["client"], a["progress"]
-    store, resume, values = a["store"], a["resume"], a["values"]
-    starts, seed = a["starts"], a["seed"]
-    request = _request(a)
+    store, resume = a["store"], a["resume"]
+    from ._api import _params, _sweep_dataset, _sweep_request
+
+    request = _sweep_request(a)
     del request["client"]
-    if values is not None:
-        request["values"] = np.asarray(values, dtype=np.float64).ravel().tolist()
-    from ._api import _params, _sweep_dataset
 
     p, _probe = _params(params, model)
     plan = _core.Plan.build("bifurcation", request, p)
@@ -315,77 +311,32 @@ def _finish_bifurcation(a: Dict[str, Any]) -> xr.Dataset:
         finally:
             if own is not None:
                 own.release()
-    return _sweep_dataset(p, d, starts, seed)
+    return _sweep_dataset(p, d, a["starts"], a["seed"])
 
 
-def basins(
-    params: Optional[Params] = None,
-    /,
-    *,
-    client: Optional["distributed.Client"] = None,
-    progress: ProgressArg = None,
-    **keywords: Any,
-) -> xr.Dataset:
-    """:func:`afmdyn.basins` (the same keywords but ``store``, ``resume`` and ``threads``)
-    with the rows of each pass mapped over a Dask cluster (``client``; default a
-    ``LocalCluster`` of this machine's cores, closed at the end). The passes run in turn: the
-    start of a pass — the attractors and the coarse grid of the passes before it, made by the
-    library from their finished rows — is sent to the workers once, and each row is a task.
-
-    Returns the same ``xarray.Dataset`` as :func:`afmdyn.basins` with the same arguments, bit
-    for bit (a row is a pure function of its pass's start).
-
-    ``progress``: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a
-    log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.
-    """
-    import inspect
-
+def _finish_basins(a: Dict[str, Any]) -> xr.Dataset:
+    """Run the basins of :func:`afmdyn.dask.basins`'s keywords ``a`` (its ``locals()``)."""
     from ._basins import _dataset
-    from ._wrappers import basins as local
     from ._common import _params
 
-    # the map's keywords are those of afmdyn.basins; the others are the model's (as there)
-    own_keywords = set(inspect.signature(local).parameters) - {
-        "params", "model", "store", "resume", "threads", "progress"}
-    model = {k: keywords.pop(k) for k in list(keywords) if k not in own_keywords}
-    p, probe = _params(params, model)
-    plan = _core.Plan.build("basins", keywords, p, probe)
-    with _cluster(client) as client:
-        d = _run_plan(client, plan, progress, "basins (dask)", unit="row")
+    request = _request(a)
+    del request["client"]
+    p, probe = _params(a["params"], a["model"])
+    plan = _core.Plan.build("basins", request, p, probe)
+    with _cluster(a["client"]) as client:
+        d = _run_plan(client, plan, a["progress"], "basins (dask)", unit="row")
     return _dataset(d["datasets"]["basins"], json.loads(d["json"]), p)
 
 
-def image(
-    probe: Any,
-    sample: Any,
-    setpoint: float,
-    *,
-    client: Optional["distributed.Client"] = None,
-    progress: ProgressArg = None,
-    pixels: Optional[int] = None,
-    lines: Optional[int] = None,
-    curve_points: Optional[int] = None,
-    height_map: Any = None,
-    scan_rate: Optional[float] = None,
-    gains: Optional[Sequence[float]] = None,
-    time_constant: Optional[float] = None,
-    mode: str = "am",
-) -> xr.Dataset:
-    """:func:`afmdyn.image` with ``feedback="pi"`` (the same keywords but ``threads``) with
-    its lines mapped over a Dask cluster (``client``; default a ``LocalCluster`` of this
-    machine's cores, closed at the end): each line is a task, a pure function of the request
-    and its number, so the Dataset equals :func:`afmdyn.image`'s bit for bit. With
-    ``mode="peakforce"`` the PeakForce image (``setpoint`` the peak force, N): the materials'
-    engages are the first stage's tasks, the lines the second's.
-    """
+def _finish_image(a: Dict[str, Any]) -> xr.Dataset:
+    """Run the image of :func:`afmdyn.dask.image`'s keywords ``a`` (its ``locals()``)."""
     from ._image import _dataset, _keywords
 
+    mode = a["mode"]
     if mode not in ("am", "peakforce"):
         raise ValueError(f"mode = {mode!r}: must be 'am' or 'peakforce'")
-    feedback = "pi" if mode == "am" else "ideal"
-    text, request = _keywords(probe, sample, setpoint, pixels, lines, curve_points, height_map,
-                              feedback, scan_rate, gains, time_constant, None, mode)
+    text, request = _keywords(a, "pi" if mode == "am" else "ideal")
     plan = _core.Plan.build("image", request, None, text)
-    with _cluster(client) as client:
-        d = _run_plan(client, plan, progress, "image (dask)", unit="line")
-    return _dataset(d, setpoint)
+    with _cluster(a["client"]) as client:
+        d = _run_plan(client, plan, a["progress"], "image (dask)", unit="line")
+    return _dataset(d, a["setpoint"])

@@ -9,7 +9,7 @@ defaults, their descriptions in "Args:"), its body a call of its hand-written fi
 from __future__ import annotations
 
 import os
-from typing import TYPE_CHECKING, Optional, Sequence, Union
+from typing import TYPE_CHECKING, Any, Dict, Optional, Sequence, Tuple, Union
 
 import xarray as xr
 
@@ -26,6 +26,8 @@ if TYPE_CHECKING:  # annotations only (PEP 692): editors complete and check the 
 __all__ = [
     "chart",
     "bifurcation",
+    "basins",
+    "image",
 ]
 
 
@@ -190,3 +192,144 @@ def bifurcation(
         for bit.
     """
     return _dask._finish_bifurcation(locals())
+
+
+def basins(
+    params: Optional[Params] = None,
+    /,
+    *,
+    client: Optional["distributed.Client"] = None,
+    progress: ProgressArg = None,
+    base: Optional[Sequence[float]] = None,
+    basin_hits: int = 16,
+    cell: float = 0.01,
+    cluster_tol: float = 1e-05,
+    discover_after: int = 200,
+    integrator: Optional[str] = None,
+    max_period: int = 64,
+    max_periods: Optional[int] = None,
+    near_tol: float = 0.02,
+    steps_per_period: Optional[int] = None,
+    stride: int = 0,
+    tol: float = 1e-08,
+    tolerance: float = 1e-12,
+    x: str = "a1",
+    x_from: float = -0.6,
+    x_steps: int = 40,
+    x_to: float = 0.6,
+    y: str = "adot1",
+    y_from: float = -1.2,
+    y_steps: int = 40,
+    y_to: float = 1.2,
+    **model: Unpack[Model],
+) -> xr.Dataset:
+    """:func:`afmdyn.basins` (the same keywords but ``store``, ``resume`` and ``threads``)
+    with the rows of each pass mapped over a Dask cluster (``client``; default a
+    ``LocalCluster`` of this machine's cores, closed at the end). The passes run in turn: the
+    start of a pass — the attractors and the coarse grid of the passes before it, made by the
+    library from their finished rows — is sent to the workers once, and each row is a task.
+
+    Args:
+        client: a ``dask.distributed.Client`` (default: a ``LocalCluster``).
+        progress: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a
+            log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.
+        base: The other coordinates of every start, 2N values (a1…aN, ȧ1…ȧN); ``None``: the
+            rest state.
+        basin_hits: Consecutive returns in cells of one basin that decide a start (0: no
+            recurrence test).
+        cell: Side of the state-space cells of the recurrence test (g0; ×Ω for velocities),
+            > 0.
+        cluster_tol: Relative tolerance for two steady states to be one attractor, > 0.
+        discover_after: Returns tested before the steady-state search takes over.
+        integrator: ``auto`` (the exact propagator for the linear law, the split integrator
+            for Hertz and the impact law with r > 0, adaptive DOP853 for the plastic impact
+            law r = 0, the Taylor integrator for DMT; split falls back to adaptive where its
+            exact free flight cannot be built), ``exact``, ``rk4``, ``rk4-naive``,
+            ``adaptive``, ``split`` or ``taylor``.
+        max_period: Largest period searched, 1..=64 (``MAX_PERIOD``).
+        max_periods: Cap on the transient, in drive periods, 1..=``MAX_STEADY_PERIODS``;
+            ``None`` (default): derived from the model's slowest free decay, six times the
+            periods it takes to decay by ``tol`` and at least 1 500 (≈ 1.9 Q ln(1/tol) for a
+            lever of quality factor Q: ``analysis::steady::default_transient_cap``).
+        near_tol: Relative distance to a periodic attractor's section point that counts as
+            near, (0, 1].
+        steps_per_period: Fixed steps per drive period of ``rk4`` / ``rk4-naive`` (default
+            2000).
+        stride: Stride of the first pass's coarse grid (0: automatic, 1: one pass).
+        tol: Relative tolerance for two returns of the stroboscopic map to coincide, in
+            [1e-14, 1e-3].
+        tolerance: Relative and absolute tolerance of the adaptive integrator.
+        x: x coordinate: ``a1``…``aN``, ``adot1``…``adotN``, ``w`` or ``wdot`` (the tip, set
+            through mode 1).
+        x_from: First x value (g0, or g0 per unit τ for a velocity).
+        x_steps: Number of x values (columns).
+        x_to: Last x value.
+        y: y coordinate, as ``x``.
+        y_from: First y value.
+        y_steps: Number of y values (rows).
+        y_to: Last y value.
+        **model: the model keywords (:class:`Model`), ``probe=`` a probe in SI.
+
+    Returns:
+        The same ``xarray.Dataset`` as :func:`afmdyn.basins` with the same arguments, bit
+        for bit (a row is a pure function of its pass's start).
+    """
+    return _dask._finish_basins(locals())
+
+
+def image(
+    probe: Union[str, "os.PathLike[str]", Dict[str, Any]],
+    sample: Union[str, "os.PathLike[str]"],
+    setpoint: float,
+    *,
+    client: Optional["distributed.Client"] = None,
+    progress: ProgressArg = None,
+    curve_points: Optional[int] = None,
+    lines: Optional[int] = None,
+    pixels: Optional[int] = None,
+    height_map: Optional[Any] = None,
+    scan_rate: Optional[float] = None,
+    gains: Optional[Tuple[float, float]] = None,
+    time_constant: Optional[float] = None,
+    mode: str = "am",
+) -> xr.Dataset:
+    """:func:`afmdyn.image` with ``feedback="pi"`` (the same keywords but ``threads``) with
+    its lines mapped over a Dask cluster (``client``; default a ``LocalCluster`` of this
+    machine's cores, closed at the end): each line is a task, a pure function of the request
+    and its number, so the Dataset equals :func:`afmdyn.image`'s bit for bit. With
+    ``mode="peakforce"`` the PeakForce image (``setpoint`` the peak force, N): the materials'
+    engages are the first stage's tasks, the lines the second's.
+
+    Args:
+        probe: the probe (path, TOML text or dict, as ``afmdyn.probe``): the lever, tip,
+            drive and the background sample.
+        sample: the sample map (path or TOML text): ``size = [Lx, Ly]`` (m) and
+            ``[[domain]]`` entries with ``name``, ``x``, ``y``, ``height`` (m) and
+            ``[domain.sample]``; its ``height_map`` the rows inline or a ``.csv`` / ``.npy``
+            file (a relative path from the sample file's directory, or from the current one
+            for TOML text).
+        setpoint: Setpoint ratio A_sp/A₀ in (0, 1). With ``mode="peakforce"`` the peak force
+            (N).
+        client: a ``dask.distributed.Client`` (default: a ``LocalCluster``).
+        progress: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a
+            log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.
+        curve_points: Points of each material's approach curve (its z_c grid, the probe's
+            default range; default 120, the approach's
+            ``analysis::stepped::DEFAULT_CURVE_POINTS``).
+        lines: Lines; ``None``: as many as pixels, 1 for a line map (Ly = 0)
+            (``ImageRequest::lines``).
+        pixels: Pixels per line (default 64).
+        height_map: a 2D array of heights (m), rows from y = 0 to Ly and columns from x = 0
+            to Lx, interpolated bilinearly and added to the map's topography (replaces the
+            map's own ``height_map``); or the path of a ``.csv`` or ``.npy`` file holding
+            them.
+        scan_rate: the PI scan's line rate (Hz; ``None``: the lever's default).
+        gains: the PI controller's (K_P, K_I in 1/s; ``None``: the lever's defaults).
+        time_constant: the PI scan's lock-in time constant (s), refused above 1000 s and
+            warned outside 1 µs–0.1 s (``None``: the lever's default).
+        mode: ``"am"`` or ``"peakforce"`` (an off-resonance probe).
+
+    Returns:
+        The same ``xarray.Dataset`` as :func:`afmdyn.image` with the same arguments.
+    """
+    return _dask._finish_image(locals())

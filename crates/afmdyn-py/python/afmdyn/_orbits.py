@@ -13,6 +13,11 @@ from ._common import _door, _params, _request, _start, _start_period, _state
 from ._results import Lyapunov, Orbit
 
 
+#: The fields of an :class:`Orbit` from its layout (arrays) and from its document.
+_ORBIT_ARRAYS = ("state", "section", "monodromy", "multipliers", "newton_residuals")
+_ORBIT_FACTS = ("period", "stable", "critical", "grazing", "grazing_distance", "switchings")
+
+
 def _finish_orbit(a: Dict[str, Any]) -> Orbit:
     p, probe = _params(a["params"], a["model"])
     period = a["period"]
@@ -22,23 +27,10 @@ def _finish_orbit(a: Dict[str, Any]) -> Orbit:
     d = _door("orbit", "orbit", a["progress"], p, probe, req)
     doc = json.loads(d["json"])
     v = {k: x[1] for k, x in _layout.variables(d["datasets"]["orbit"]).items()}
-    return Orbit(
-        params=p,
-        period=doc["period"],
-        state=v["state"],
-        section=v["section"],
-        poincare_v_t=np.asarray(doc["poincare"]["v_t"], dtype=np.float64),
-        poincare_w_tip=np.asarray(doc["poincare"]["w_tip"], dtype=np.float64),
-        monodromy=v["monodromy"],
-        multipliers=v["multipliers"],
-        stable=doc["stable"],
-        critical=doc["critical"],
-        grazing=doc["grazing"],
-        grazing_distance=doc["grazing_distance"],
-        switchings=doc["switchings"],
-        newton_residuals=v["newton_residuals"],
-        _json=d["json"],
-    )
+    poincare = {f"poincare_{k}": np.asarray(doc["poincare"][k], dtype=np.float64)
+                for k in ("v_t", "w_tip")}
+    return Orbit(params=p, **{k: v[k] for k in _ORBIT_ARRAYS}, **poincare,
+                 **{k: doc[k] for k in _ORBIT_FACTS}, _json=d["json"])
 
 
 def _finish_lyapunov(a: Dict[str, Any]) -> Lyapunov:
@@ -47,13 +39,7 @@ def _finish_lyapunov(a: Dict[str, Any]) -> Lyapunov:
     d = _door("lyapunov", "lyapunov", a["progress"], p, probe, req)
     doc = json.loads(d["json"])
     v = _layout.variables(d["datasets"]["lyapunov"])
-    return Lyapunov(
-        params=p,
-        exponents=v["exponents"][1],
-        uncertainty=v["uncertainty"][1],
-        volume_rate=doc["volume_rate"],
-        zero_one=float("nan") if doc["zero_one"] is None else doc["zero_one"],
-        periods=doc["periods"],
-        verdict=doc["verdict"],
-        _json=d["json"],
-    )
+    zero_one = float("nan") if doc["zero_one"] is None else doc["zero_one"]
+    return Lyapunov(params=p, **{k: v[k][1] for k in ("exponents", "uncertainty")},
+                    **{k: doc[k] for k in ("volume_rate", "periods", "verdict")},
+                    zero_one=zero_one, _json=d["json"])

@@ -61,19 +61,10 @@ class _Bar:
 
     def __call__(self, done: int, total: Optional[int]) -> None:
         if self.bar is None:
-            tqdm = _tqdm_class()
-            if total is None:
-                self.bar = tqdm(
-                    total=None,
-                    desc=self.desc,
-                    delay=self.delay,
-                    bar_format="{desc}: running {elapsed}",
-                    leave=False,
-                )
-            else:
-                self.bar = tqdm(
-                    total=total, desc=self.desc, unit=self.unit, delay=self.delay, leave=True
-                )
+            # work that cannot be counted: the time it has run, the bar gone at its end
+            kind = (dict(bar_format="{desc}: running {elapsed}", leave=False) if total is None
+                    else dict(unit=self.unit, leave=True))
+            self.bar = _tqdm_class()(total=total, desc=self.desc, delay=self.delay, **kind)
         self.bar.update(done - self.bar.n)
 
     def close(self) -> None:

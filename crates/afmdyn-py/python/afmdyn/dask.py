@@ -18,16 +18,9 @@ the task's region is written: a killed driver loses at most the task it was writ
 
 from __future__ import annotations
 
-from ._dask import DONE, basins, image, ledger_dir, run_chart_task, run_plan_task
-from ._dask_wrappers import bifurcation, chart
+from . import _dask_wrappers
+from ._dask import DONE, ledger_dir, run_chart_task, run_plan_task
+from ._dask_wrappers import *  # noqa: F401,F403 (chart, bifurcation, basins, image: generated)
 
-__all__ = [
-    "DONE",
-    "basins",
-    "bifurcation",
-    "chart",
-    "image",
-    "ledger_dir",
-    "run_chart_task",
-    "run_plan_task",
-]
+__all__ = ["DONE", "ledger_dir", "run_chart_task", "run_plan_task"]
+__all__ += _dask_wrappers.__all__
