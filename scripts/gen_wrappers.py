@@ -1,6 +1,8 @@
 """Generate the analyses' public functions of the Python package: ``afmdyn/_wrappers.py``
-(``afmdyn.simulate``, …), ``afmdyn/_dask_wrappers.py`` (``afmdyn.dask.chart``,
-``afmdyn.dask.bifurcation``) and ``afmdyn/_model.py`` (the ``Model`` keywords).
+(``afmdyn.simulate``, …), ``afmdyn/_wrappers_starts.py`` (``afmdyn.attractors``, …),
+``afmdyn/_wrappers_afm.py`` (``afmdyn.approach``, …, ``afmdyn.image``),
+``afmdyn/_dask_wrappers.py`` (``afmdyn.dask.chart``, …) and ``afmdyn/_model.py`` (the
+``Model`` keywords).
 
 Each function's keyword-only signature (names, types, defaults) and the "Args:" of its
 docstring come from its request's JSON Schema (``docs/schema/requests/*.json``, the library's
@@ -64,11 +66,13 @@ FILES: Dict[str, Dict[str, Tuple[object, str, str, Dict[str, object]]]] = {
         "continuation": ("continuation", "_api", "xr.Dataset", {}),
         "orbit": ("orbit", "_orbits", "Orbit", {}),
         "lyapunov": ("lyapunov", "_orbits", "Lyapunov", {}),
+        "chart": ("chart", "_chart", "xr.Dataset", {"own": PROGRESS + STORE_KW}),
+    },
+    "_wrappers_starts.py": {
         "attractors": ("attractors", "_attractors", "Attractors", {}),
         "basins": ("basins", "_basins", "xr.Dataset", {"own": STORE_KW + PROGRESS}),
         "global_continuation": ("global_continuation", "_basins", "xr.Dataset",
                                 {"own": STORE_KW + PROGRESS}),
-        "chart": ("chart", "_chart", "xr.Dataset", {"own": PROGRESS + STORE_KW}),
     },
     "_wrappers_afm.py": {
         "observe": ("observe", "_api", "xr.Dataset", {}),
@@ -270,16 +274,29 @@ __all__ = [
 HEADS = {
     "_wrappers.py": (
         "The public functions of the dynamics' analyses (``afmdyn.simulate``, …, their\n"
-        "finishers in :mod:`._api`, :mod:`._orbits`, :mod:`._attractors`, :mod:`._basins` and\n"
-        ":mod:`._chart`; the AFM measurements' are in\n"
+        "finishers in :mod:`._api`, :mod:`._orbits` and :mod:`._chart`; the studies of random\n"
+        "starts' are in :mod:`._wrappers_starts`, the AFM measurements' in\n"
         ":mod:`._wrappers_afm`). Each checks its keywords' types first (``TypeError`` naming the\n"
         "keyword); the library checks the values (``ValueError`` naming the field and its range).",
-        "from . import _api, _attractors, _basins, _chart, _orbits\n"
+        "from . import _api, _chart, _orbits\n"
         "from ._afmdyn import Params\n"
-        "from ._attractors import Attractors\n"
         "from ._common import Model, StateLike, _typed\n"
         "from ._progress import ProgressArg\n"
         "from ._results import Lyapunov, Orbit, Spectrum",
+        "",
+    ),
+    "_wrappers_starts.py": (
+        "The public functions of the studies of random starts (``afmdyn.attractors``,\n"
+        "``basins``, ``global_continuation``; their finishers in :mod:`._attractors` and\n"
+        ":mod:`._basins`), apart from :mod:`._wrappers` so that an :class:`Attractor` continues\n"
+        "into its ``orbit`` and ``simulate`` without an import circle. Each checks its keywords'\n"
+        "types first (``TypeError`` naming the keyword); the library checks the values\n"
+        "(``ValueError`` naming the field and its range).",
+        "from . import _attractors, _basins\n"
+        "from ._afmdyn import Params\n"
+        "from ._attractors import Attractors\n"
+        "from ._common import Model, _typed\n"
+        "from ._progress import ProgressArg",
         "",
     ),
     "_wrappers_afm.py": (
@@ -316,12 +333,7 @@ def generate(file: str = "_wrappers.py") -> str:
             if re.search(rf"\b{n}\[|\b{n}\b,|\b{n}\]", "\n".join(functions))]
     head = head.replace("{typing}", ", ".join(["TYPE_CHECKING"] + used))
     parts = [head.rstrip()] + functions
-    text = "\n\n\n".join(parts) + "\n"
-    if file == "_wrappers.py":
-        # an attractor continues into the public orbit and simulate: handed to its module here
-        # (which this one imports), so that it need not import this one back
-        text += ("\n\n_attractors.PUBLIC.update(orbit=orbit, simulate=simulate)\n")
-    return text
+    return "\n\n\n".join(parts) + "\n"
 
 
 MODEL_HEAD = '''\

@@ -564,7 +564,9 @@ Returns:
 
 AFM = ("observe", "approach", "bimodal", "resonance", "fm", "peakforce", "fit", "image",
        "setpoint_study", "reconstruct")
-DOCS = {"_wrappers.py": {k: v for k, v in WRAPPERS.items() if k not in AFM},
+STARTS = ("attractors", "basins", "global_continuation")
+DOCS = {"_wrappers.py": {k: v for k, v in WRAPPERS.items() if k not in AFM + STARTS},
+        "_wrappers_starts.py": {k: WRAPPERS[k] for k in STARTS},
         "_wrappers_afm.py": {k: WRAPPERS[k] for k in AFM}, "_dask_wrappers.py": DASK}
 
 #: the docstring of ``afmdyn.Model`` (the model keywords)

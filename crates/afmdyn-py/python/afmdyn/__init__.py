@@ -25,7 +25,7 @@ electrostatic), ``electrostatic`` and ``tip_radius`` (electrostatic), ``adhesion
 model keywords.
 """
 
-from . import _wrappers, _wrappers_afm
+from . import _wrappers, _wrappers_afm, _wrappers_starts
 from ._afmdyn import Params, SimulationError
 from ._api import cantilevers, probe
 from ._attractors import Attractor, Attractors
@@ -38,6 +38,7 @@ from ._results import Lyapunov, Orbit, RegionSpectrum, Spectrum
 # __all__
 from ._wrappers import *  # noqa: F401,F403
 from ._wrappers_afm import *  # noqa: F401,F403
+from ._wrappers_starts import *  # noqa: F401,F403
 
 try:
     from importlib.metadata import version as _version
@@ -67,3 +68,4 @@ __all__ = [
 ]
 __all__ += _wrappers.__all__
 __all__ += _wrappers_afm.__all__
+__all__ += _wrappers_starts.__all__

@@ -6,18 +6,17 @@ from __future__ import annotations
 
 import json
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, Callable, Dict, Iterator, List, Optional, Sequence, overload
+from typing import TYPE_CHECKING, Any, Dict, Iterator, List, Optional, Sequence, overload
 
 import numpy as np
 
 from ._afmdyn import Params
 from . import _layout
 from ._common import _door, _params, _request
+# (attractors() is generated apart, in ._wrappers_starts: ._wrappers does not import this module)
+from ._wrappers import orbit as _orbit, simulate as _simulate
 from ._results import Orbit, _Document
 
-#: The public :func:`afmdyn.orbit` and :func:`afmdyn.simulate` an attractor continues into,
-#: handed over by the generated :mod:`._wrappers` (which imports this module) when it loads.
-PUBLIC: Dict[str, Callable[..., Any]] = {}
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -77,7 +76,7 @@ class Attractor:
     def orbit(self, **options: Any) -> "Orbit":
         """Newton shooting from this attractor (its period, starting on it): Floquet
         multipliers and stability. Options as :func:`afmdyn.orbit`."""
-        return PUBLIC["orbit"](self.params, initial=self, **options)
+        return _orbit(self.params, initial=self, **options)
 
     def simulate(self, periods: Optional[float] = None, **options: Any) -> "xr.Dataset":
         """Time series on the attractor from τ = 0 (drive phase 0), ``periods`` drive periods
@@ -85,7 +84,7 @@ class Attractor:
         Options as :func:`afmdyn.simulate`."""
         if periods is None:
             periods = max(self.period or 8, 2)
-        return PUBLIC["simulate"](self.params, periods=periods, initial=self.state, **options)
+        return _simulate(self.params, periods=periods, initial=self.state, **options)
 
     def __repr__(self) -> str:
         kind = f"period-{self.period}" if self.period else "nonperiodic"
