@@ -217,12 +217,15 @@ def _user_level() -> int:
 _HERE = os.path.dirname(os.path.abspath(__file__))
 
 
-_NOT_REQUEST = frozenset(("params", "progress", "model", "store", "resume"))
+#: Python's own keywords (a Dask version's ``client`` and ``checkpoint_seconds`` too)
+_NOT_REQUEST = frozenset(("params", "progress", "model", "store", "resume", "client",
+                          "checkpoint_seconds"))
 
 
 def _request(names: Dict[str, Any], **given: Any) -> Dict[str, Any]:
     """The request of an analysis: its keywords (``names``, the function's ``locals()``), but
-    the model's, ``params``, ``progress`` and a store's, with ``given`` ones replaced."""
+    the model's, ``params``, ``progress``, a store's and a cluster's, with ``given`` ones
+    replaced."""
     r = {k: v for k, v in names.items() if k not in _NOT_REQUEST}
     r.update(given)
     return r

@@ -201,10 +201,7 @@ def _finish_chart(a: Dict[str, Any]) -> xr.Dataset:
     """Run the chart of :func:`afmdyn.dask.chart`'s keywords ``a`` (its ``locals()``)."""
     params, model, client, progress = a["params"], a["model"], a["client"], a["progress"]
     store, resume, checkpoint_seconds = a["store"], a["resume"], a["checkpoint_seconds"]
-    request = _request(a)
-    for own in ("client", "checkpoint_seconds"):
-        del request[own]
-    s = study(params, model, **request)
+    s = study(params, model, **_request(a))
     n = s.tasks()
     if not (checkpoint_seconds >= 0 and np.isfinite(checkpoint_seconds)):
         raise ValueError(f"checkpoint_seconds = {checkpoint_seconds}: must be finite and >= 0")
@@ -300,7 +297,6 @@ def _finish_bifurcation(a: Dict[str, Any]) -> xr.Dataset:
     from ._api import _params, _sweep_dataset, _sweep_request
 
     request = _sweep_request(a)
-    del request["client"]
 
     p, _probe = _params(params, model)
     plan = _core.Plan.build("bifurcation", request, p)
@@ -319,10 +315,8 @@ def _finish_basins(a: Dict[str, Any]) -> xr.Dataset:
     from ._basins import _dataset
     from ._common import _params
 
-    request = _request(a)
-    del request["client"]
     p, probe = _params(a["params"], a["model"])
-    plan = _core.Plan.build("basins", request, p, probe)
+    plan = _core.Plan.build("basins", _request(a), p, probe)
     with _cluster(a["client"]) as client:
         d = _run_plan(client, plan, a["progress"], "basins (dask)", unit="row")
     return _dataset(d["datasets"]["basins"], json.loads(d["json"]), p)
