@@ -36,7 +36,7 @@
 
 use super::observables::{observe, wrap_phase, ObservableOptions};
 use crate::error::SimError;
-use crate::integrate::dense::sample_dense;
+use crate::integrate::dense::{sample_dense, SpanSampling};
 use crate::integrate::{advance, build, check_start, Integrator, IntegratorOptions};
 use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
@@ -140,12 +140,19 @@ pub fn demodulate_period(
     let (mut s, mut c) = (p.omega * t0 + psi).sin_cos();
     let (sd, cd) = (p.omega * (period / samples as f64)).sin_cos();
     let (mut x, mut y) = (0.0, 0.0);
-    sample_dense(integ, samples, &tau_of, &mut |_, _, z| {
-        (s, c) = (s * cd + c * sd, c * cd - s * sd);
-        let w = model.w_tip_slice(z, 0);
-        x += w * s;
-        y -= w * c;
-    })?;
+    sample_dense(
+        integ,
+        samples,
+        &tau_of,
+        SpanSampling::Cut,
+        &mut |_, _, z| {
+            (s, c) = (s * cd + c * sd, c * cd - s * sd);
+            let w = model.w_tip_slice(z, 0);
+            x += w * s;
+            y -= w * c;
+            Ok(())
+        },
+    )?;
     let k = 2.0 / samples as f64;
     Ok(((k * x).hypot(k * y), wrap_phase((k * y).atan2(k * x))))
 }

@@ -15,7 +15,7 @@ mod map;
 
 pub use map::{
     map_section_points, reduce_map_period, shoot_map, shoot_map_broyden, shoot_map_from_section,
-    shoot_map_globalised, shoot_map_undamped,
+    shoot_map_globalised, shoot_map_undamped, shoot_map_unwatched,
 };
 
 use super::period::{close, MERGE_FACTOR};
@@ -105,7 +105,8 @@ pub struct PeriodicOrbit {
     pub stable: bool,
     /// Type of the critical multiplier.
     pub critical: Instability,
-    /// Distance to grazing (see [`crate::maps::flow::FlowMap::grazing_distance`]).
+    /// Distance to grazing (see [`crate::maps::flow::FlowMap::grazing_distance`]); NaN from
+    /// [`shoot_map_unwatched`], which does not measure it.
     pub grazing_distance: f64,
     /// The orbit is (near) grazing: `grazing_distance` < [`GRAZING_TOL`].
     pub grazing: bool,

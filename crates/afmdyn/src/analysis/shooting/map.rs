@@ -23,8 +23,45 @@ pub fn shoot_map(
     n: usize,
     opts: &ShootingOptions,
 ) -> Result<PeriodicOrbit, SimError> {
+    shoot_damped(dmap, guess, n, opts, Watch::Grazing)
+}
+
+/// [`shoot_map`] without the distance to grazing: the same iterates, orbit, section points and
+/// multipliers, but no flow to measure [`PeriodicOrbit::grazing_distance`] (NaN, and
+/// [`PeriodicOrbit::grazing`] `false`), for a caller that does not report it — the steady tap
+/// of [`crate::analysis::peakforce`], where that flow (with the variational equations, as
+/// [`DiscreteMap::grazing_distance`] takes it) was a fifth of the N = 3 beam's tap.
+///
+/// # Errors
+/// As [`shoot_map`].
+pub fn shoot_map_unwatched(
+    dmap: &mut dyn DiscreteMap,
+    guess: &DVector<f64>,
+    n: usize,
+    opts: &ShootingOptions,
+) -> Result<PeriodicOrbit, SimError> {
+    shoot_damped(dmap, guess, n, opts, Watch::None)
+}
+
+/// [`newton`] with halved steps, then [`finish`]: [`shoot_map`] and [`shoot_map_unwatched`].
+fn shoot_damped(
+    dmap: &mut dyn DiscreteMap,
+    guess: &DVector<f64>,
+    n: usize,
+    opts: &ShootingOptions,
+    watch: Watch,
+) -> Result<PeriodicOrbit, SimError> {
     let (z, map, residuals) = newton(dmap, guess, n, opts, Damping::Halve)?;
-    finish(dmap, z, n, map, residuals, opts)
+    finish(dmap, z, n, map, residuals, opts, watch)
+}
+
+/// Whether [`finish`] measures the converged orbit's distance to grazing.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Watch {
+    /// [`DiscreteMap::grazing_distance`] at the orbit (one more flow).
+    Grazing,
+    /// No: NaN.
+    None,
 }
 
 /// [`shoot_map`] globalised: each Newton step is backtracked by a line search on ½‖F‖²
@@ -45,7 +82,7 @@ pub fn shoot_map_globalised(
     opts: &ShootingOptions,
 ) -> Result<PeriodicOrbit, SimError> {
     let (z, map, residuals) = newton(dmap, guess, n, opts, Damping::LineSearch)?;
-    finish(dmap, z, n, map, residuals, opts)
+    finish(dmap, z, n, map, residuals, opts, Watch::Grazing)
 }
 
 /// A period-n orbit near a recorded stretch of an attractor's stroboscopic section
@@ -454,7 +491,7 @@ pub fn reduce_map_period(
         return Ok(None);
     }
     let section = map_section_points(dmap, z, n)?;
-    minimal(dmap, &section, opts)
+    minimal(dmap, &section, opts, Watch::Grazing)
 }
 
 /// [`reduce_map_period`] on the orbit's section points.
@@ -462,18 +499,22 @@ fn minimal(
     dmap: &mut dyn DiscreteMap,
     section: &[DVector<f64>],
     opts: &ShootingOptions,
+    watch: Watch,
 ) -> Result<Option<PeriodicOrbit>, SimError> {
     let Some(d) = proper_period(section, opts.tol) else {
         return Ok(None);
     };
     match newton(dmap, &section[0], d, opts, Damping::Stop) {
-        Ok((z, map, residuals)) => finish(dmap, z, d, map, residuals, opts).map(Some),
+        Ok((z, map, residuals)) => finish(dmap, z, d, map, residuals, opts, watch).map(Some),
         Err(SimError::Cancelled) => Err(SimError::Cancelled),
         // not an orbit of period d after all: n stands
         Err(_) => Ok(None),
     }
 }
 
+/// The converged orbit of a Newton solve: refused where it does not close in its region,
+/// reduced to its minimal period, with its section points, multipliers and (with
+/// [`Watch::Grazing`]) its distance to grazing.
 fn finish(
     dmap: &mut dyn DiscreteMap,
     z: DVector<f64>,
@@ -481,14 +522,18 @@ fn finish(
     map: FlowMap,
     residuals: Vec<f64>,
     opts: &ShootingOptions,
+    watch: Watch,
 ) -> Result<PeriodicOrbit, SimError> {
     closes_in_its_region(dmap, &z, n, &residuals)?;
     let section = map_section_points(dmap, &z, n)?;
     // the minimal period: an orbit found as period n may repeat after a divisor of n
-    if let Some(o) = minimal(dmap, &section, opts)? {
+    if let Some(o) = minimal(dmap, &section, opts, watch)? {
         return Ok(o);
     }
-    let grazing_distance = dmap.grazing_distance(&z, n)?;
+    let grazing_distance = match watch {
+        Watch::Grazing => dmap.grazing_distance(&z, n)?,
+        Watch::None => f64::NAN,
+    };
     let (multipliers, stable, critical) = floquet_stability(&map.jacobian);
     Ok(PeriodicOrbit {
         period: n,
