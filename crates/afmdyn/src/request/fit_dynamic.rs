@@ -11,17 +11,11 @@ use super::fit_result::{bounds, FitResult, MIN_FIT_ROWS};
 pub use super::fit_result::{AmData, DynamicFit};
 use super::run::Resolved;
 use crate::analysis::fit::am_curve::{AmCurveModel, AmParam, AmProbe, Z_OFFSET};
-use crate::analysis::fit::least_squares::chi2;
+use crate::analysis::fit::start::{grid_start, z_offset_grid};
 use crate::analysis::fit::{fit_with, Observations, Parameter};
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
 use serde_json::{json, Value};
-
-/// Half the number of steps of z_offset's start grid: the starts −6 … 6 steps.
-const Z_OFFSET_GRID: i32 = 6;
-/// The step of z_offset's start grid, in g₀ = A₀ (the grid spans ±0.3 A₀, within which the
-/// free amplitude's far rows and the curve's onset place the contact point).
-const Z_OFFSET_STEP: f64 = 0.05;
 
 /// The variables of a dynamic fit's curve (name, unit, label): the columns of its table and
 /// Dataset, those of the channels fitted.
@@ -256,17 +250,7 @@ pub fn execute(
     // z_offset's start: the best χ² on a grid (the model's first rows otherwise follow another
     // branch than the data's, and Levenberg–Marquardt stops in that local minimum)
     if let Some(k) = z_index {
-        let mut trial: Vec<f64> = params.iter().map(|p| p.start).collect();
-        let mut best = (f64::INFINITY, params[k].start);
-        for i in -Z_OFFSET_GRID..=Z_OFFSET_GRID {
-            progress.check()?;
-            trial[k] = i as f64 * Z_OFFSET_STEP * g0;
-            let c = chi2(&curve, &obs, &trial);
-            if c < best.0 {
-                best = (c, trial[k]);
-            }
-        }
-        params[k].start = best.1;
+        params[k].start = grid_start(&curve, &obs, &params, k, z_offset_grid(g0), progress)?;
     }
     // Wald intervals: a profile's refits would cost a hundred stepped approaches each
     let mut outcome = fit_with(&curve, &obs, &params, &fixed, false);

@@ -1,7 +1,7 @@
 //! Fitting measured curves (issue 62): weighted least squares by Levenberg–Marquardt with
 //! standard errors, correlations, profile-likelihood intervals and identifiability warnings
 //! ([`least_squares`], [`estimates`], [`profile`]), and the quasi-static force-curve fit of the
-//! registry's contact laws ([`force_curve`]).
+//! registry's contact laws ([`force_curve`]); start values from a grid ([`start`]).
 
 pub mod am_curve;
 pub mod estimates;
@@ -9,6 +9,7 @@ pub mod force_curve;
 pub mod least_squares;
 pub mod profile;
 pub mod sensitivity;
+pub mod start;
 
 pub use estimates::{fit, fit_with, Estimate, FitOutcome};
 pub use least_squares::{CurveModel, Minimum, Observations, Parameter};
