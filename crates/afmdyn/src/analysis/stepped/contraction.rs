@@ -24,7 +24,9 @@
 //! first run), keeps the wait: it ends at the free decay as before. On the issue 60 image line
 //! (RTESPA-300, Q = 500, over E_s = 100 MPa, W = 0.05 J/m²) the transient reaches the floor
 //! of ~1e-4 within the Newton attempts' 1 000 periods, and the wait ends with the windows'
-//! agreement instead of at the free decay's 2 930 periods.
+//! agreement instead of at the free decay's 2 930 periods: the line's averaged points take
+//! about half the periods (3 080 before) and the line 2.6 s of CPU instead of 5.8 s, 1.8× the
+//! line with a DMT stripe (docs/contact-laws.md).
 
 use nalgebra::DVector;
 use std::collections::VecDeque;
