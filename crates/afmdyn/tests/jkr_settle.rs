@@ -270,7 +270,9 @@ fn orbit_says_no_period_was_found_on_a_grazing_jkr_motion() {
     use afmdyn::request::analyses::OrbitRequest;
     use afmdyn::SimError;
     let p = params_at("7e-9");
-    let err = OrbitRequest::default().run(&p).expect_err("no period-1 orbit");
+    let err = OrbitRequest::default()
+        .run(&p)
+        .expect_err("no period-1 orbit");
     let SimError::NoPeriod {
         max_period,
         periods,

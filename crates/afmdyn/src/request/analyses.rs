@@ -76,7 +76,7 @@ impl OrbitRequest {
     /// As [`Self::validate`], [`StartRequest::guess`] and [`shoot`]; the
     /// [`SimError::NoConvergence`] of the last search tried when none converges, or
     /// [`SimError::NoPeriod`] when the period was not given and the steady-state search from
-    /// the start found none ([`explain_start`]).
+    /// the start found none.
     pub fn run(&self, params: &Params) -> Result<PeriodicOrbit, SimError> {
         self.validate()?;
         let model = CantileverModel::new(params)?;

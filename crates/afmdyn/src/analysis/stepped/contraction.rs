@@ -31,7 +31,7 @@
 use nalgebra::DVector;
 use std::collections::VecDeque;
 
-/// Successive runs of returns whose contraction must end the wait ([`wait_over`]) before a
+/// Successive runs of returns whose contraction must end the wait (module docs) before a
 /// motion is settled by its time average early: two, so that one run whose spreads happen to
 /// stall while the taps lock into a period does not (on the issue 60 line, a period-7 orbit
 /// found 27 periods after one stalled run).
