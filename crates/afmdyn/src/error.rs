@@ -246,6 +246,27 @@ pub enum SimError {
         /// Final residual.
         residual: f64,
     },
+    /// An orbit search without a given period found none: the steady-state search from the
+    /// start saw no period of at most `max_period` drive periods within its transient cap of
+    /// `periods`, and Newton from the motion's states found no period-1 orbit either — the
+    /// motion is not periodic within `max_period` (a chaotic one, or the taps and missed taps
+    /// of a grazing JKR contact, docs/contact-laws.md).
+    #[error(
+        "no periodic orbit found: the motion from this start did not repeat with a period of at \
+         most {max_period} drive periods within {periods} periods, and Newton from its states \
+         found no period-1 orbit (residual {}): it is not periodic within max_period — \
+         `simulate` gives the motion itself, and an approach curve its time average \
+         (reached = \"averaged\"); or give the period, another start or more max_periods",
+        number(*residual)
+    )]
+    NoPeriod {
+        /// The longest period the search tested (drive periods).
+        max_period: usize,
+        /// The transient the search integrated (drive periods, its cap).
+        periods: usize,
+        /// The residual ‖Pⁿ(z) − z‖ of the last Newton search tried.
+        residual: f64,
+    },
     /// The chosen integrator cannot integrate the chosen contact law.
     #[error("integrator '{integrator}' cannot integrate the '{law}' contact law: {hint}")]
     Unsupported {

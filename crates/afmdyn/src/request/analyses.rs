@@ -74,7 +74,9 @@ impl OrbitRequest {
     ///
     /// # Errors
     /// As [`Self::validate`], [`StartRequest::guess`] and [`shoot`]; the
-    /// [`SimError::NoConvergence`] of the last search tried when none converges.
+    /// [`SimError::NoConvergence`] of the last search tried when none converges, or
+    /// [`SimError::NoPeriod`] when the period was not given and the steady-state search from
+    /// the start found none.
     pub fn run(&self, params: &Params) -> Result<PeriodicOrbit, SimError> {
         self.validate()?;
         let model = CantileverModel::new(params)?;
@@ -94,32 +96,33 @@ impl OrbitRequest {
             }
             r => r,
         };
-        explain_start(r, self.period, found)
+        explain_start(r, self.period, found, self.start.searched(&model)?)
     }
 }
 
 /// `r` with a Newton failure explained when the period was guessed: the user gave none and
-/// the steady state from the start showed none, so Newton started from the last state of a
-/// nonperiodic motion (issue 28: every early end says why). The one place orbit searches and
-/// continuations say so.
+/// the steady-state search from the start (`searched`: its `max_period` and transient cap,
+/// `None` for a given initial state, which is not searched) showed none, so Newton started
+/// from the last state of a motion not periodic within `max_period`: [`SimError::NoPeriod`]
+/// (issue 28: every early end says why; issue 60 item 10: the grazing JKR orbit). The one
+/// place orbit searches and continuations say so.
 fn explain_start<T>(
     r: Result<T, SimError>,
     period: Option<usize>,
     found: Option<usize>,
+    searched: Option<(usize, usize)>,
 ) -> Result<T, SimError> {
-    match r {
-        Err(SimError::NoConvergence {
-            iterations,
-            residual,
-            ..
-        }) if period.is_none() && found.is_none() => Err(SimError::NoConvergence {
-            what: "shooting for a period-1 orbit from the states of a motion that showed \
-                   no period up to max_period (nonperiodic from this start: give the period, \
-                   another start or more max_periods)",
-            iterations,
-            residual,
-        }),
-        r => r,
+    match (r, searched) {
+        (Err(SimError::NoConvergence { residual, .. }), Some((max_period, periods)))
+            if period.is_none() && found.is_none() =>
+        {
+            Err(SimError::NoPeriod {
+                max_period,
+                periods,
+                residual,
+            })
+        }
+        (r, _) => r,
     }
 }
 
@@ -186,7 +189,7 @@ impl ContinuationRequest {
         } else {
             continue_branch_with(&spec, &guess, progress).map(|b| vec![b])
         };
-        explain_start(r, self.period, found)
+        explain_start(r, self.period, found, self.start.searched(&model)?)
     }
 }
 

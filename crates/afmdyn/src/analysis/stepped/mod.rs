@@ -56,6 +56,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 pub mod average;
 mod branches;
+pub mod contraction;
+pub use contraction::{SettleWait, STALLED_RUNS};
 pub mod torus;
 use average::{average_point, AverageEstimate, AverageOptions};
 use branches::{branch, branch_starts, jumps_of, on_branch, unstable_between_folds};
@@ -182,6 +184,8 @@ pub struct SteppedSpec {
     /// instead of the exact orbit of its common period, which it falls back on where the
     /// circle is not found or not smooth; no branches then.
     pub torus: Option<TorusOptions>,
+    /// How long [`settle`] waits before a motion is settled by its time average.
+    pub settle_wait: SettleWait,
 }
 
 impl SteppedSpec {
@@ -214,6 +218,7 @@ impl SteppedSpec {
             trace_samples: 0,
             average: None,
             torus: None,
+            settle_wait: SettleWait::default(),
         }
     }
 }

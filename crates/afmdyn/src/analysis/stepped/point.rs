@@ -2,6 +2,7 @@
 //! ([`settle`]), the orbit continued by a predicted Newton solve with substeps where it fails,
 //! and the trend of the branch the predictor follows (module docs of [`super`]).
 
+use super::contraction::{wait_over, Spread, STALLED_RUNS};
 use super::*;
 use crate::analysis::observables::observe_tapered;
 use crate::analysis::settle::minimal_period;
@@ -66,7 +67,12 @@ fn average_window(system: &dyn TipSampleSystem) -> usize {
 /// successive windows' phasors A e^{iφ} and mean deflections agree to [`AVERAGE_TOL`] of A (as
 /// the time average of a multifrequency drive settles, [`super::average`]), and not before
 /// the slowest free mode has decayed by the period test's tolerance ([`decay_periods`]: an
-/// orbit whose transient decays as fast has shown its period by then). A tapping orbit
+/// orbit whose transient decays as fast has shown its period by then) — unless the returns'
+/// measured contraction ends that wait earlier (`spec.settle_wait`, [`SettleWait`]): in
+/// [`STALLED_RUNS`] successive runs no lag m ≤ `max_period` of the returns' differences
+/// contracted fast enough to reach the period test's tolerance before the free decay's wait
+/// ends (a geometric projection from the ratio between runs, [`super::contraction`]). A
+/// tapping orbit
 /// whose returns spiral in too slowly for a short period to show (JKR's neck: its period test
 /// ran to the cap of 20 000 periods) is so settled in a few hundred. A motion that neither
 /// repeats nor averages out within the cap is left nonperiodic.
@@ -114,11 +120,16 @@ pub fn settle(
     let mut spent = s.periods;
     let mut last: Option<(Complex<f64>, f64)> = None;
     let mut agreed = 0;
+    // the previous run's spreads, and the runs in a row whose contraction ended the wait
+    let mut before: Option<Vec<f64>> = None;
+    let mut stalled = 0;
     while spent < cap {
         integ.reset(0.0, &z)?;
         let mut returns = ReturnHistory::new(&spec.steady, &z);
+        let mut spread = Spread::new(spec.steady.max_period, &z);
         for k in 1..=run.min(cap - spent) {
             advance(integ, k as f64 * period)?;
+            spread.push(integ.state());
             let Some(m) = returns.push(integ.state(), &spec.steady) else {
                 continue;
             };
@@ -147,6 +158,14 @@ pub fn settle(
             z = integ.state().clone();
             break;
         }
+        let now = spread.spreads().to_vec();
+        if let (SettleWait::Contraction, Some(b)) = (spec.settle_wait, &before) {
+            // D: from the last run's start to this one's
+            let left = least.saturating_sub(spent) as f64;
+            let over = wait_over(b, &now, (run + w) as f64, spec.steady.tol, left);
+            stalled = if over { stalled + 1 } else { 0 };
+        }
+        before = Some(now);
         let o = observe_tapered(integ, &window)?;
         spent += w;
         // the drive is periodic: the window's end is the state at τ ≡ 0
@@ -155,7 +174,7 @@ pub fn settle(
         if let Some((p, d)) = last {
             let close = (now.0 - p).norm().max((now.1 - d).abs()) <= AVERAGE_TOL * o.amplitude;
             agreed = if close { agreed + 1 } else { 0 };
-            if agreed >= AVERAGE_AGREEMENTS && spent >= least {
+            if agreed >= AVERAGE_AGREEMENTS && (spent >= least || stalled >= STALLED_RUNS) {
                 return Ok(Settled {
                     found: nonperiodic(z),
                     averaged: Some(o),

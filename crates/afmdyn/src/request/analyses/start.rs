@@ -187,6 +187,20 @@ impl StartRequest {
         Ok((z, found))
     }
 
+    /// The longest period and the transient cap (drive periods) of the steady-state search
+    /// [`Self::guess`] runs from this start on `model`; `None` for a given `initial` state
+    /// (not searched).
+    ///
+    /// # Errors
+    /// As [`SteadyRequest::options`].
+    pub fn searched(&self, model: &CantileverModel) -> Result<Option<(usize, usize)>, SimError> {
+        let steady = self.steady.options()?;
+        Ok(self
+            .initial
+            .is_none()
+            .then(|| (steady.max_period, steady.cap(model))))
+    }
+
     /// [`Self::guess`] with the section points the steady-state search recorded (z(kT) of
     /// consecutive drive periods, the last one the guess; empty for a given `initial`): the
     /// starts of [`shoot_from_section`] when Newton from the guess fails.
