@@ -210,6 +210,22 @@ fn the_door_gives_the_image_and_refuses_an_am_probe() {
         assert_eq!(doc["image"][k].as_array().unwrap().len(), 2, "{k}");
     }
     assert_eq!(outcome.datasets[0].0, "image");
+    // the command line's document: a summary, per material its pixels' statistics
+    let summary = &outcome.facts["summary"];
+    assert_eq!(summary["image"]["pixels"], 4);
+    let materials = summary["materials"].as_array().unwrap();
+    let pixels: u64 = materials
+        .iter()
+        .map(|m| m["pixels"].as_u64().unwrap())
+        .sum();
+    assert_eq!(pixels, 8);
+    for m in materials.iter().filter(|m| m["pixels"].as_u64() > Some(0)) {
+        let pf = &m["maps"]["peak_force"];
+        assert_eq!(pf["units"], "N");
+        assert_eq!(pf["finite"], m["pixels"]);
+        assert!((pf["mean"].as_f64().unwrap() - SETPOINT).abs() <= SETPOINT_TOL * SETPOINT);
+    }
+    assert_eq!(summary["taps"], doc["taps"]);
     let am: toml::Table = repo("examples/probe-point-mass-dmt.toml").parse().unwrap();
     let bad = job(am);
     let err = afmdyn::request::run::run(&bad, &bad.model().unwrap(), &Progress::new())

@@ -706,8 +706,18 @@ impl PeakForceImage {
                 json!(self.domain[j][i].map_or("background", |k| self.domain_names[k].as_str()))
             }),
         );
+        let mut doc = self.document_head();
+        doc["image"] = Value::Object(image);
+        doc
+    }
+
+    /// The document's keys other than `image` ([`PeakForceImage::document`]): `mode`,
+    /// `feedback`, `setpoint` (N), `reference_z_c` (m), `materials` (name, true modulus, the
+    /// engaged operating point or why not, the engage's taps `evaluations`), `taps`, `warnings`.
+    pub fn document_head(&self) -> Value {
+        use serde_json::json;
+        let num = |v: f64| if v.is_finite() { json!(v) } else { Value::Null };
         json!({
-            "image": image,
             "mode": "peakforce",
             "feedback": "ideal",
             "setpoint": self.setpoint,
