@@ -113,3 +113,49 @@ export function compareBifurcation(engineRows, csvText) {
   }
   return { bad, far, farAt, rows: rows.length, periodic: groups.size };
 }
+
+/** A PeakForce image's document with every pixel (the browser's) against the command line's
+ * summary (`afmdyn image --mode peakforce --json`): mode, feedback, setpoint, taps and
+ * warnings equal; the materials' engaged operating points and z_c,ref, and each map's count
+ * of finite pixels, min, max and mean computed here from the pixels against the summary's,
+ * relative to the native value (the maps are in SI: forces of nN) — the dissipation relative
+ * to the peak force's work (setpoint × the largest deformation): a conservative law's is
+ * round-off (1e-30 J), whose last bits wasm's libm changes; the largest relative difference
+ * and where. */
+export function peakforceAgainstSummary(doc, summary) {
+  for (const k of ["mode", "feedback", "setpoint", "taps", "warnings"]) {
+    if (!isDeepStrictEqual(doc[k], summary[k])) return [Infinity, `.${k}`];
+  }
+  const rel = (a, b, at) => {
+    if (a === null && b === null) return [0, at];
+    if (typeof a !== "number" || typeof b !== "number") return [Infinity, at];
+    return [a === b ? 0 : Math.abs(a - b) / Math.max(Math.abs(b), 1e-300), at];
+  };
+  const work = summary.setpoint * summary.image.maps.deformation.max;
+  let best = rel(doc.reference_z_c, summary.reference_z_c, ".reference_z_c");
+  const more = (w) => { if (w[0] > best[0]) best = w; };
+  if (doc.materials.length !== summary.materials.length) return [Infinity, ".materials"];
+  doc.materials.forEach((m, k) => {
+    const s = summary.materials[k];
+    if (m.name !== s.name || m.evaluations !== s.evaluations) more([Infinity, `.materials[${k}]`]);
+    for (const [key, v] of Object.entries(s.engaged ?? {})) {
+      const at = `.materials[${k}].engaged.${key}`;
+      more(key === "dissipation" ? [Math.abs(m.engaged[key] - v) / work, at]
+        : typeof v === "number" ? rel(m.engaged[key], v, at)
+        : [isDeepStrictEqual(m.engaged[key], v) ? 0 : Infinity, at]);
+    }
+  });
+  for (const name of ["height", "modulus_dmt", "adhesion", "deformation", "dissipation", "peak_force"]) {
+    const v = doc.image[name].flat().filter((x) => typeof x === "number" && Number.isFinite(x));
+    const m = summary.image.maps[name];
+    if (v.length !== m.finite) more([Infinity, `.image.maps.${name}.finite`]);
+    const mine = [Math.min(...v), Math.max(...v), v.reduce((a, b) => a + b, 0) / v.length];
+    [m.min, m.max, m.mean].forEach((x, i) => {
+      // (a map whose values cancel, the apparent height's 0 on the background: absolute to
+      // its largest value)
+      const scale = name === "dissipation" ? work : Math.max(Math.abs(m.min), Math.abs(m.max));
+      more([Math.abs(mine[i] - x) / scale, `.image.maps.${name}[${["min", "max", "mean"][i]}]`]);
+    });
+  }
+  return best;
+}

@@ -9,7 +9,8 @@ import { execFileSync } from "node:child_process";
 import { readFileSync, writeFileSync } from "node:fs";
 import { isDeepStrictEqual } from "node:util";
 import path from "node:path";
-import { worst, approachSweeps, approachBranches, compareBifurcation, imageAgainstSummary } from "./compare-docs.mjs";
+import { worst, approachSweeps, approachBranches, compareBifurcation, imageAgainstSummary,
+  peakforceAgainstSummary } from "./compare-docs.mjs";
 
 const require = createRequire(import.meta.url);
 const [pkg, bin] = process.argv.slice(2);
@@ -107,6 +108,28 @@ const img = JSON.parse(wasm.run("image", JSON.stringify({ probe: text, sample: s
 check("image of the stripe sample is `afmdyn image --setpoint 0.7 --pixels 16 --json`'s " +
   "(its summary: numbers to 1e-9)", w <= 1e-9, `${w} at ${at}`);
 console.log(`     largest difference ${w.toExponential(1)} at ${at}`);
+
+// the PeakForce image of the blend (ideal peak-force feedback), as `afmdyn image --mode
+// peakforce … --json`: its document with every pixel against the command line's summary
+const pfImgProbe = "examples/probe-peakforce-amo-garcia.toml";
+const pfImgSample = "examples/sample-peakforce-blend.toml";
+const pfImg = JSON.parse(wasm.run("image", JSON.stringify({
+  probe: readFileSync(path.join(root, pfImgProbe), "utf8"),
+  sample: readFileSync(path.join(root, pfImgSample), "utf8"),
+  request: { mode: "peakforce", setpoint: 2e-9, pixels: 6, lines: 4 } })));
+[w, at] = peakforceAgainstSummary(pfImg, native(["image", "--mode", "peakforce", "--probe", pfImgProbe,
+  "--sample", pfImgSample, "--setpoint", "2e-9", "--pixels", "6", "--lines", "4", "--files", "none"]));
+check("PeakForce image of the blend is `afmdyn image --mode peakforce --setpoint 2e-9 --pixels 6 " +
+  "--lines 4 --json`'s (its summary: numbers to 1e-6 relative)", w <= 1e-6 &&
+  pfImg.image.modulus_dmt.length === 4 && pfImg.image.modulus_dmt[0].length === 6, `${w} at ${at}`);
+console.log(`     largest difference ${w.toExponential(1)} at ${at}`);
+message = "";
+try {
+  wasm.run("image", JSON.stringify({ probe: text, sample: sampleText,
+    request: { mode: "peakforce", setpoint: 2e-9, pixels: 4 } }));
+} catch (e) { message = String(e.message); }
+check("a PeakForce image of an AM probe is refused, naming the off-resonance drive",
+  message.includes("off-resonance"), message);
 
 // wasm has no files: a height map file is refused with the library's message
 message = "";

@@ -34,8 +34,8 @@ function branchTraces(branches, xKey, yKey) {
   }));
 }
 
-const AXIS_UNITS = { amplitude: "m", z_c: "m", peak_force: "N", indentation: "m", energy_dissipated: "J", virial: "J", phase_deg: "°", frequency_hz: "Hz", frequency_shift: "Hz" };
-const AXIS_NAMES = { amplitude: "amplitude A", z_c: "z_c (rest tip–sample distance)", peak_force: "peak force", indentation: "indentation", energy_dissipated: "E_dis (dissipated energy per period)", virial: "virial", phase_deg: "phase", frequency_hz: "drive frequency", frequency_shift: "frequency shift Δf" };
+const AXIS_UNITS = { modulus_dmt: "Pa", adhesion: "N", deformation: "m", dissipation: "J", amplitude: "m", z_c: "m", peak_force: "N", indentation: "m", energy_dissipated: "J", virial: "J", phase_deg: "°", frequency_hz: "Hz", frequency_shift: "Hz" };
+const AXIS_NAMES = { modulus_dmt: "modulus (DMT fit, PF-QNM)", adhesion: "adhesion", deformation: "deformation", dissipation: "dissipation per cycle", amplitude: "amplitude A", z_c: "z_c (rest tip–sample distance)", peak_force: "peak force", indentation: "indentation", energy_dissipated: "E_dis (dissipated energy per period)", virial: "virial", phase_deg: "phase", frequency_hz: "drive frequency", frequency_shift: "frequency shift Δf" };
 const axis = (k) => ({ title: { text: `${AXIS_NAMES[k] ?? k} (${AXIS_UNITS[k] ?? ""})` }, exponentformat: "SI" });
 
 /** The share of its magnitude below which a plotted quantity's spread is round-off, not
@@ -181,14 +181,18 @@ export function drawAfmDocument(afm, y) {
 /** An image: maps over (y, x) as heatmaps, or a line's profiles when the map is one line. */
 function drawImage(d, channel) {
   const im = d.image;
-  const key = im[channel] ? channel : "phase_deg";
+  // a PeakForce image (ideal peak-force feedback): its maps of modulus, adhesion, deformation
+  // and dissipation; the setpoint a peak force (N)
+  const pf = d.mode === "peakforce";
+  const key = im[channel] ? channel : pf ? "modulus_dmt" : "phase_deg";
+  const at = pf ? `peak force ${d.setpoint.toExponential(3)} N` : `A/A₀ = ${d.setpoint}`;
   const margin = { l: 75, r: 10, t: 30, b: 50 };
   const xTitle = { title: { text: "x (m)" }, exponentformat: "SI" };
   if (im.y.length === 1) {
     react("afm-plot-a", [
       lines(im.x, im.height[0], "apparent height", COLOURS.forward),
       lines(im.x, im.true_height[0], "true height", "#7f8c8d", { line: { dash: "dot", color: "#7f8c8d" } }),
-    ], { margin, title: { text: `Line profile at A/A₀ = ${d.setpoint}`, font: { size: 13 } }, xaxis: xTitle,
+    ], { margin, title: { text: `Line profile at ${at}`, font: { size: 13 } }, xaxis: xTitle,
       yaxis: { title: { text: "height (m)" }, exponentformat: "SI" }, legend: { orientation: "h", y: -0.25 } });
     react("afm-plot-b", [lines(im.x, im[key][0], AXIS_NAMES[key], COLOURS.backward)],
       { margin, title: { text: AXIS_NAMES[key], font: { size: 13 } }, xaxis: xTitle,
@@ -197,15 +201,20 @@ function drawImage(d, channel) {
     const heat = (div, z, name, unit) => Plotly.react(div, [{
       type: "heatmap", x: im.x, y: im.y, z, colorscale: "Viridis",
       colorbar: { title: { text: `${name} (${unit})` }, exponentformat: "SI" },
-    }], { margin: { ...margin, r: 20 }, title: { text: `${name} at A/A₀ = ${d.setpoint}`, font: { size: 13 } },
+    }], { margin: { ...margin, r: 20 }, title: { text: `${name} at ${at}`, font: { size: 13 } },
       xaxis: xTitle, yaxis: { title: { text: "y (m)" }, exponentformat: "SI", scaleanchor: "x" } }, PLOT_CONFIG);
     heat("afm-plot-a", im.height, "apparent height", "m");
     heat("afm-plot-b", im[key], AXIS_NAMES[key], AXIS_UNITS[key]);
   }
+  const g = (v, unit) => (typeof v === "number" ? `${v.toExponential(4)} ${unit}` : "—");
   summary($("afm-summary"), [
-    ["feedback", d.feedback],
-    ["setpoint", `A/A₀ = ${d.setpoint}`],
+    ["feedback", pf ? "ideal peak-force feedback" : d.feedback],
+    ["setpoint", at],
     ["pixels", `${im.x.length} × ${im.y.length}`],
-    ["reference z_c", `${d.reference_z_c.toExponential(4)} m`],
+    ["reference z_c", g(d.reference_z_c, "m")],
+    // each material's engaged operating point beside its true modulus, and the steady taps
+    ...(pf ? [...d.materials.map((m) => [m.name, m.engaged
+      ? `modulus_dmt ${g(m.engaged.modulus_dmt, "Pa")} (true E* ${g(m.true_modulus, "Pa")}), adhesion ${g(m.engaged.adhesion, "N")}, deformation ${g(m.engaged.deformation, "m")}, dissipation ${g(m.engaged.dissipation, "J")}`
+      : `not imaged (${m.message})`]), ["steady taps", String(d.taps)]] : []),
   ]);
 }

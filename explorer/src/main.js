@@ -38,7 +38,7 @@ function readHash() {
 }
 
 /** The AFM workspace's fields the URL keeps (by element id). */
-const AFM_KEPT = ["afm-analysis", "points", "setpoint", "afm-y", "pixels", "lines", "feedback", "curve-from", "curve-to", "fm-amplitude"];
+const AFM_KEPT = ["afm-analysis", "points", "setpoint", "afm-y", "pixels", "lines", "feedback", "image-mode", "curve-from", "curve-to", "fm-amplitude"];
 
 function writeHash() {
   const p = new URLSearchParams();
@@ -530,6 +530,10 @@ function showAnalysisFields() {
   const a = $("afm-analysis").value;
   $("sample-box").hidden = a !== "image";
   $("setpoint").disabled = !(a === "approach" || a === "image");
+  // a PeakForce image holds the peak force (N), an AM image and curve the amplitude ratio
+  const pf = a === "image" && $("image-mode").value === "peakforce";
+  $("setpoint-label").textContent = pf ? "setpoint: peak force (N)" : "setpoint A/A₀";
+  $("feedback").disabled = pf;
   // (a PeakForce tap is one steady orbit at the probe's z_c: no curve)
   $("points").disabled = a === "image" || a === "peakforce";
   // the swept range: z_c (m), or the drive frequency (Hz) of a resonance curve
@@ -562,8 +566,13 @@ function afmRequest() {
     put("setpoint", "setpoint");
     put("pixels", "pixels");
     put("lines", "lines");
-    // the engine says why a PI scan is not run here (its message beside the field)
-    request.feedback = $("feedback").value;
+    if ($("image-mode").value === "peakforce") {
+      // the ideal peak-force feedback (its only one): the setpoint is the peak force in N
+      request.mode = "peakforce";
+    } else {
+      // the engine says why a PI scan is not run here (its message beside the field)
+      request.feedback = $("feedback").value;
+    }
   } else if (analysis !== "peakforce") {
     put("points", "points");
     put("from", "curve-from");
@@ -727,6 +736,7 @@ async function main() {
     showAnalysisFields();
   });
   $("sample-preset").addEventListener("change", chooseSample);
+  $("image-mode").addEventListener("change", showAnalysisFields);
   $("afm-y").addEventListener("change", () => { if (state.afm) drawAfmDocument(state.afm, $("afm-y").value); writeHash(); });
 
   for (const b of document.querySelectorAll("[data-export]")) {

@@ -11,7 +11,8 @@ import { mkdtempSync, readFileSync, rmSync, writeFileSync } from "node:fs";
 import { tmpdir } from "node:os";
 import path from "node:path";
 import { fileURLToPath } from "node:url";
-import { worst, approachSweeps, approachBranches, branchesScaled, compareBifurcation, imageAgainstSummary } from "../../scripts/compare-docs.mjs";
+import { worst, approachSweeps, approachBranches, branchesScaled, compareBifurcation, imageAgainstSummary,
+  peakforceAgainstSummary } from "../../scripts/compare-docs.mjs";
 
 const root = path.resolve(path.dirname(fileURLToPath(import.meta.url)), "../..");
 const arg = (name) => {
@@ -389,7 +390,31 @@ try {
   check("a PI-feedback image is refused beside its field: not in the browser, the command line's --feedback pi",
     piMsg.startsWith("feedback = pi: not in the browser") && piMsg.includes("afmdyn image --feedback pi"), piMsg);
   await page.selectOption("#feedback", "ideal");
-  await page.selectOption("#afm-analysis", "approach");
+  // a PeakForce image (ideal peak-force feedback) of the preset blend with the Amo & Garcia
+  // probe against `afmdyn image --mode peakforce --json`'s summary, drawn as maps
+  // (selects and fields of the form, set in order)
+  const setForm = async (values) => {
+    for (const [id, v] of values) {
+      if ((await page.evaluate((i) => document.getElementById(i).tagName, id)) === "SELECT") await page.selectOption(`#${id}`, v);
+      else await page.fill(`#${id}`, v);
+    }
+  };
+  await setForm([["probe-preset", "probe-peakforce-amo-garcia.toml"], ["sample-preset", "sample-peakforce-blend.toml"],
+    ["image-mode", "peakforce"], ["setpoint", "2e-9"], ["pixels", "6"], ["lines", "4"], ["afm-y", "modulus_dmt"]]);
+  const pfImage = await afmRun();
+  const refPf = native(["image", "--mode", "peakforce", "--probe", "examples/probe-peakforce-amo-garcia.toml",
+    "--sample", "examples/sample-peakforce-blend.toml", "--setpoint", "2e-9", "--pixels", "6", "--lines", "4",
+    "--files", "none"]);
+  [w, where] = peakforceAgainstSummary(pfImage, refPf);
+  const pfShown = await page.evaluate(() => [document.getElementById("afm-plot-a").data[0].type,
+    document.getElementById("afm-plot-b").layout.title.text, document.getElementById("afm-summary").textContent,
+    document.getElementById("setpoint-label").textContent]);
+  check("the PeakForce image of the preset blend is `afmdyn image --mode peakforce --setpoint 2e-9 --pixels 6 " +
+    "--lines 4 --json`'s (its summary, to 1e-6 relative), drawn as maps of height and modulus_dmt with each " +
+    "material's operating point", w <= 1e-6 && pfShown[0] === "heatmap" && pfShown[1].startsWith("modulus") &&
+    pfShown[2].includes("true E*") && pfShown[3].includes("peak force"), `${w} at ${where}; ${JSON.stringify(pfShown)}`);
+  await setForm([["image-mode", "am"], ["setpoint", "0.7"], ["lines", ""], ["afm-y", "phase_deg"],
+    ["probe-preset", "probe-point-mass-dmt.toml"], ["afm-analysis", "approach"]]);
 
   // a bad probe value: beside its field, the command line's message for that key
   await page.fill("#p-spring_constant", "-40");

@@ -28,6 +28,9 @@ BIM = str(EXAMPLES / "probe-bimodal.toml")
 STRIPE = str(EXAMPLES / "sample-stripe.toml")
 IMAGE = ["--probe", P1, "--sample", STRIPE, "--setpoint", 0.7, "--pixels", 4]
 PF = str(EXAMPLES / "probe-peakforce-water.toml")
+PF_IMAGE = ["--mode", "peakforce", "--probe", str(EXAMPLES / "probe-peakforce-amo-garcia.toml"),
+            "--sample", str(EXAMPLES / "sample-peakforce-blend.toml"), "--setpoint", "2nN",
+            "--pixels", 4]
 FIT_PROBE = str(EXAMPLES / "probe-fit-hertz.toml")
 FIT_DATA = str(EXAMPLES / "force-curve-hertz.csv")
 IMPACT = "--contact-law impact --restitution 0.5 --modes 1 --gap 0.05 --omega 3".split()
@@ -137,6 +140,7 @@ CLI_CASES: List[Tuple[str, List[Any]]] = [
     ("image", IMAGE),
     ("image", [*IMAGE, "--setpoint-study", "0.3:0.9:3"]),
     ("image", [*IMAGE, "--feedback", "pi", "--scan-rate", 20]),
+    ("image", PF_IMAGE),
     ("peakforce", ["--probe", PF]),
     ("fit", ["--probe", FIT_PROBE, "--data", FIT_DATA, "--fit", "sample.youngs_modulus,contact_point",
              "--files", "data"]),

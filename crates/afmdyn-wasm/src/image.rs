@@ -12,10 +12,20 @@
 //! `setpoint_study` (`"FROM:TO:N"`: the document gains `"setpoint_study"`, as with
 //! `--setpoint-study`) and `feedback` (`"ideal"`; the PI scan, `"pi"`, is refused: its lines
 //! take seconds each and run on worker threads).
+//!
+//! `mode = "peakforce"` (an off-resonance probe, `[drive] mode = "off-resonance"`): the
+//! PeakForce image under an ideal peak-force feedback
+//! ([`afmdyn::request::image_peakforce`], `afmdyn image --mode peakforce`), `setpoint` the
+//! peak force (N); its document with every pixel
+//! ([`afmdyn::request::image_peakforce::PeakForceImage::document`]: maps of height,
+//! modulus_dmt, adhesion, deformation, dissipation, …), its lines computed one after the
+//! other (no threads in wasm32; the image does not depend on the thread count). No
+//! `curve_points`, `setpoint_study` or PI feedback with it.
 
 use afmdyn::probe::Probe;
 use afmdyn::request::image::{image as ideal_image, setpoint_study, study_ratios};
 use afmdyn::request::image::{ImageRequest, SampleMap};
+use afmdyn::request::image_peakforce::PeakForceImageStudy;
 use afmdyn::request::ModelSpec;
 use serde::Deserialize;
 
@@ -34,6 +44,7 @@ struct ImageKeys {
     curve_points: Option<usize>,
     setpoint_study: Option<String>,
     feedback: Option<String>,
+    mode: Option<String>,
 }
 
 /// The image of `input` (module docs): its document as JSON text.
@@ -69,13 +80,37 @@ pub fn image(input: &str) -> Result<String, String> {
         }
         Some(other) => return Err(format!("feedback = {other}: must be ideal or pi")),
     }
-    let setpoint = keys
-        .setpoint
-        .ok_or("setpoint: missing; must be a ratio A_sp/A0 in (0, 1)")?;
+    let peakforce = match keys.mode.as_deref() {
+        None | Some("am") => false,
+        Some("peakforce") => true,
+        Some(other) => return Err(format!("mode = {other}: must be am or peakforce")),
+    };
+    if peakforce {
+        if keys.curve_points.is_some() || keys.setpoint_study.is_some() {
+            return Err(
+                "mode = peakforce: no curve_points or setpoint_study (its ideal \
+                        peak-force feedback engages each material by its own setpoint search)"
+                    .into(),
+            );
+        }
+        if keys.feedback.as_deref() == Some("pi") {
+            return Err("feedback = pi: a PeakForce image has the ideal feedback only".into());
+        }
+    }
+    let setpoint = keys.setpoint.ok_or(if peakforce {
+        "setpoint: missing; must be the peak force (N) the feedback holds, > 0"
+    } else {
+        "setpoint: missing; must be a ratio A_sp/A0 in (0, 1)"
+    })?;
     let table = Probe::table(&probe, "probe").map_err(|e| e.to_string())?;
     let map = SampleMap::parse(&sample, "sample").map_err(|e| e.to_string())?;
     let req = ImageRequest::with(setpoint, keys.pixels, keys.lines, keys.curve_points);
-    req.validate(&map).map_err(|e| e.to_string())?;
+    if peakforce {
+        req.validate_grid(&map)
+    } else {
+        req.validate(&map)
+    }
+    .map_err(|e| e.to_string())?;
     let lines = req.lines(&map);
     if req.pixels * lines > MAX_IMAGE_PIXELS {
         return Err(format!(
@@ -84,6 +119,16 @@ pub fn image(input: &str) -> Result<String, String> {
             req.pixels,
             req.pixels * lines
         ));
+    }
+    if peakforce {
+        // its engages, then its lines one after the other (the document with every pixel)
+        let study = PeakForceImageStudy::new(&table, &map, &req).map_err(|e| e.to_string())?;
+        let records = (0..study.lines())
+            .map(|t| study.line(t).map(|l| (t, l)))
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(|e| e.to_string())?;
+        let img = study.assemble(records).map_err(|e| e.to_string())?;
+        return Ok(img.document().to_string());
     }
     let ratios = keys
         .setpoint_study

@@ -3,7 +3,8 @@
 //! --setpoint` tap of its material (exactly where the line engages on it, to a stated
 //! tolerance where the feedback continues into it from another material); a two-material
 //! sample gives the two materials' channels; the image does not depend on the thread count;
-//! the door gives it (`afmdyn image --mode peakforce`) and refuses an AM probe by name.
+//! the door gives it (`afmdyn image --mode peakforce`) and refuses an AM probe by name; a
+//! change of material at every pixel costs one tap each.
 
 use afmdyn::analysis::peakforce::SETPOINT_TOL;
 use afmdyn::analysis::progress::Progress;
@@ -209,6 +210,22 @@ fn the_door_gives_the_image_and_refuses_an_am_probe() {
         assert_eq!(doc["image"][k].as_array().unwrap().len(), 2, "{k}");
     }
     assert_eq!(outcome.datasets[0].0, "image");
+    // the command line's document: a summary, per material its pixels' statistics
+    let summary = &outcome.facts["summary"];
+    assert_eq!(summary["image"]["pixels"], 4);
+    let materials = summary["materials"].as_array().unwrap();
+    let pixels: u64 = materials
+        .iter()
+        .map(|m| m["pixels"].as_u64().unwrap())
+        .sum();
+    assert_eq!(pixels, 8);
+    for m in materials.iter().filter(|m| m["pixels"].as_u64() > Some(0)) {
+        let pf = &m["maps"]["peak_force"];
+        assert_eq!(pf["units"], "N");
+        assert_eq!(pf["finite"], m["pixels"]);
+        assert!((pf["mean"].as_f64().unwrap() - SETPOINT).abs() <= SETPOINT_TOL * SETPOINT);
+    }
+    assert_eq!(summary["taps"], doc["taps"]);
     let am: toml::Table = repo("examples/probe-point-mass-dmt.toml").parse().unwrap();
     let bad = job(am);
     let err = afmdyn::request::run::run(&bad, &bad.model().unwrap(), &Progress::new())
@@ -242,4 +259,58 @@ fn the_plan_of_engages_and_lines_is_the_image_bit_for_bit() {
     let img = image(6, 4, 2);
     let direct = afmdyn::request::image_job::ImageOutput::PeakForce(img).outcome(SETPOINT);
     assert_eq!(out.document, direct.document);
+}
+
+/// Stripes one pixel wide at 8 pixels a line: the material changes at every pixel.
+fn stripes() -> SampleMap {
+    let mut text = String::from("size = [1.0e-6, 1.0e-6]\n");
+    for k in (1..8).step_by(2) {
+        let (a, b) = (
+            k as f64 / 8.0 * 1e-6 + 1e-12,
+            (k + 1) as f64 / 8.0 * 1e-6 - 1e-12,
+        );
+        text += &format!(
+            "[[domain]]\nname = \"s{k}\"\nx = [{a:e}, {b:e}]\n[domain.sample]\nlaw = \"dmt\"\n\
+             youngs_modulus = 3e9\npoisson_ratio = 0\nhamaker = 6e-20\n\
+             intermolecular_distance = 0.2e-9\n"
+        );
+    }
+    SampleMap::parse(&text, "map").unwrap()
+}
+
+#[test]
+fn a_change_of_material_at_every_pixel_costs_one_tap_and_holds_the_setpoint() {
+    let img = |threads| {
+        peakforce_image(
+            &probe(),
+            &stripes(),
+            &request(8, 2),
+            Some(threads),
+            &Progress::new(),
+        )
+        .unwrap()
+    };
+    let one = img(1);
+    assert_eq!(one, img(2), "bit for bit on 1 and 2 threads");
+    assert!(one.warnings.is_empty(), "{:?}", one.warnings);
+    for j in 0..2 {
+        for i in 0..8 {
+            let m = one.material[j][i];
+            assert_eq!(m != 0, i % 2 == 1, "the stripes: ({j}, {i})");
+            let t = one.tap(j, i).unwrap();
+            assert!(
+                (t.peak_force - SETPOINT).abs() <= SETPOINT_TOL * SETPOINT,
+                "pixel ({j}, {i}): peak force {}",
+                t.peak_force
+            );
+            // the secant starts from the material's engaged z_c and orbit: one tap, at the
+            // engaged operating point
+            let p = &one.pixels[j][i];
+            assert_eq!(p.evaluations, usize::from(i > 0), "({j}, {i})");
+            assert!(!p.reengaged);
+            let e = one.materials[m].engaged.unwrap();
+            assert!(close(t.z_c, e.z_c, 1e-9), "{} {}", t.z_c, e.z_c);
+            assert!(close(t.modulus_dmt, e.modulus_dmt, 1e-6));
+        }
+    }
 }

@@ -395,6 +395,19 @@ pub fn peakforce_layout(img: &PeakForceImage) -> Layout {
     )
 }
 
+/// A number map's summary in an image's JSON document: `units`, the `min`, `max` and `mean`
+/// of the finite ones of `values` (null where there is none) and `finite` (their number).
+pub fn number_summary(units: &str, values: impl Iterator<Item = f64>) -> serde_json::Value {
+    use serde_json::{json, Value};
+    let num = |v: f64| if v.is_finite() { json!(v) } else { Value::Null };
+    let finite: Vec<f64> = values.filter(|x| x.is_finite()).collect();
+    let n = finite.len();
+    let min = finite.iter().copied().fold(f64::INFINITY, f64::min);
+    let max = finite.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let mean = finite.iter().sum::<f64>() / n as f64;
+    json!({"units": units, "min": num(min), "max": num(max), "mean": num(mean), "finite": n})
+}
+
 /// The maps of an image's layout ([`layout`], [`scan_layout`]) summarised for its JSON document
 /// (the maps themselves are the dataset's, `image.nc`): `pixels` and `lines`, `x` and `y` (m,
 /// the first and last pixel centre and line position), and under `maps` every variable over
@@ -424,15 +437,7 @@ pub fn summary(layout: &Layout) -> serde_json::Value {
     let mut maps = Map::new();
     for v in layout.variables.iter().filter(|v| v.dims == ["y", "x"]) {
         let entry = match &v.values {
-            Values::F64(values) => {
-                let finite: Vec<f64> = values.iter().copied().filter(|x| x.is_finite()).collect();
-                let n = finite.len();
-                let min = finite.iter().copied().fold(f64::INFINITY, f64::min);
-                let max = finite.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-                let mean = finite.iter().sum::<f64>() / n as f64;
-                json!({"units": v.units, "min": num(min), "max": num(max), "mean": num(mean),
-                       "finite": n})
-            }
+            Values::F64(values) => number_summary(&v.units, values.iter().copied()),
             Values::I32(codes) => {
                 let meanings = v.attrs.iter().find_map(|(k, a)| match (k.as_str(), a) {
                     ("flag_meanings", Attr::Text(t)) => Some(t.clone()),

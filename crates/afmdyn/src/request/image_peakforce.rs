@@ -10,22 +10,25 @@
 //!
 //! **History.** Each line is engaged from far on its first pixel's material: the feedback's own
 //! search from rest ([`peak_force_setpoint`]), computed once per material before the lines
-//! ([`PeakForceImageStudy::new`]). Along the line each pixel continues from the previous
-//! pixel's orbit, as an instrument's feedback does and as the z_c sweeps do
-//! ([`crate::study::peakforce`]):
+//! ([`PeakForceImageStudy::new`]). Along the line:
 //! - a pixel of the same material (the same model) as the previous one has its operating
 //!   point: the previous orbit at the previous z_c is the fixed point the continuation starts
 //!   from (the feedback has nothing to correct), so it is taken, not computed again;
-//! - at a change of material the tap is continued from the previous orbit and z_c is found by
-//!   the secant method on F_peak(z_c) − F_set from the previous z_c, its first step from the
-//!   lever's static compliance c (the quasi-static slope |dF_peak/dα5| ≤ 1/c: the first step
-//!   falls short of the root, never across a fold), at most [`CONTINUE_ITERATIONS`] taps;
+//! - at a change of material z_c is found by the secant method on F_peak(z_c) − F_set
+//!   started from the new material's engaged z_c and orbit — its operating point at the
+//!   setpoint. z_c is the rest separation from the local surface, so the topography does not
+//!   shift it (the height enters the apparent height only), and the first tap, from the
+//!   orbit's own fixed point, is at the setpoint to the feedback's tolerance: a change of
+//!   material costs one tap. Were it off, the secant's first step is from the lever's static
+//!   compliance c (the quasi-static slope |dF_peak/dα5| ≤ 1/c: the first step falls short of
+//!   the root, never across a fold), at most [`CONTINUE_ITERATIONS`] taps. (Continuing from
+//!   the previous material's orbit and z_c instead cost 6.4 taps per change, issue 61.)
 //! - where the continuation does not converge (a tap that does not settle, a fold of the
 //!   steady taps) the pixel is re-engaged from far on its material (counted and reported);
 //! - a material whose engage from far does not reach the setpoint leaves its pixels empty
 //!   (NaN, reported) and the next pixel engages again.
 //!
-//! A uniform domain thus costs no tap per pixel and a change of material a few taps, so the
+//! A uniform domain thus costs no tap per pixel and a change of material one tap, so the
 //! image costs the materials' engages plus its material changes. **A line is a task**
 //! ([`PeakForceImageStudy::line`]): it depends only on the request and its number, so the image
 //! does not depend on the thread count or the executor.
@@ -52,8 +55,9 @@ use serde_json::Value;
 /// re-engaged from far.
 pub const CONTINUE_ITERATIONS: usize = 30;
 
-/// Taps a change of material is expected to cost (the request's cost estimate).
-pub const TAPS_PER_CHANGE: f64 = 6.0;
+/// Taps a change of material is expected to cost (the request's cost estimate): one, from the
+/// material's engaged orbit (module docs).
+pub const TAPS_PER_CHANGE: f64 = 1.0;
 
 /// A pixel's operating point in SI: the steady tap at the setpoint and its channels.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -357,7 +361,9 @@ impl PeakForceImageStudy {
                     };
                     (Some((m, a5, z, tap)), pixel)
                 }
-                Some((_, a5, z, _)) => match self.continue_to(&mat.params, a5, &z)? {
+                // a change of material: the secant starts from the material's engaged z_c
+                // and orbit (its operating point at the setpoint, module docs)
+                Some(_) => match self.continue_to(&mat.params, &mat.engaged)? {
                     (Some((b5, tap)), evaluations) => {
                         let si = si_tap(&mat.params, &self.units, self.scale(m), b5, &tap);
                         let pixel = LinePixel {
@@ -385,18 +391,21 @@ impl PeakForceImageStudy {
         self.materials[m].modulus_scale
     }
 
-    /// The tap of `params` at the setpoint continued from α5 `a0` and the orbit state `z0` by
-    /// the secant method (module docs): (α5 and the tap, or `None` where it does not
-    /// converge; the taps computed).
+    /// The tap of `params` at the setpoint by the secant method from its engage `engaged`:
+    /// α5 `a0` and the orbit state `z0` (module docs): (α5 and the tap, or `None` where it
+    /// does not converge or there is no engage; the taps computed).
     ///
     /// # Errors
     /// [`SimError`] other than a tap's non-convergence (a model that cannot be built).
     fn continue_to(
         &self,
         params: &Params,
-        a0: f64,
-        z0: &DVector<f64>,
+        engaged: &Result<(f64, DVector<f64>, PeakForceTap), String>,
     ) -> Result<Continued, SimError> {
+        let Ok((a0, z0, _)) = engaged else {
+            return Ok((None, 0));
+        };
+        let a0 = *a0;
         let f_set = self.setpoint;
         let tol = SETPOINT_TOL * f_set;
         let mut start = z0.clone();
@@ -697,8 +706,18 @@ impl PeakForceImage {
                 json!(self.domain[j][i].map_or("background", |k| self.domain_names[k].as_str()))
             }),
         );
+        let mut doc = self.document_head();
+        doc["image"] = Value::Object(image);
+        doc
+    }
+
+    /// The document's keys other than `image` ([`PeakForceImage::document`]): `mode`,
+    /// `feedback`, `setpoint` (N), `reference_z_c` (m), `materials` (name, true modulus, the
+    /// engaged operating point or why not, the engage's taps `evaluations`), `taps`, `warnings`.
+    pub fn document_head(&self) -> Value {
+        use serde_json::json;
+        let num = |v: f64| if v.is_finite() { json!(v) } else { Value::Null };
         json!({
-            "image": image,
             "mode": "peakforce",
             "feedback": "ideal",
             "setpoint": self.setpoint,

@@ -6,8 +6,9 @@ use crate::error::number;
 use crate::layout::figure::{AfmImage, Figure, Plot, Series, Style};
 use crate::report::{Presentation, TextUnits};
 use crate::request::image::{DomainContrast, Image, OperatingPoint, SetpointStudy};
+use crate::request::image_layout::number_summary;
 use crate::request::image_layout::{layout, peakforce_layout, scan_layout, summary};
-use crate::request::image_peakforce::PeakForceImage;
+use crate::request::image_peakforce::{PeakForceImage, PF_FIELDS};
 use crate::request::image_scan::PiImage;
 use serde_json::{json, Value};
 
@@ -374,11 +375,39 @@ pub fn pi(img: &PiImage, setpoint: f64, document: &Value, u: TextUnits) -> Prese
 /// The summary document of a PeakForce image (`afmdyn image --mode peakforce --json`,
 /// `image.json`; the maps are `image.nc`'s): `image`, its maps summarised
 /// ([`crate::request::image_layout::summary`]); `mode`, `feedback`, `setpoint` (N),
-/// `reference_z_c` (m), `materials` (each with its true modulus and engaged operating point),
-/// `taps`, `warnings`. [`PeakForceImage::document`] is the document with every pixel.
+/// `reference_z_c` (m), `materials` (each with its true modulus and engaged operating point,
+/// as [`PeakForceImage::document_head`], and its pixels: `pixels`, `taps` the steady taps of
+/// the continuations into them, `reengaged`, and `maps`, each of [`PF_FIELDS`] summarised
+/// over them as [`number_summary`]), `taps`, `warnings`. [`PeakForceImage::document`] is the
+/// document with every pixel.
 pub fn peakforce_summary(img: &PeakForceImage) -> Value {
-    let mut doc = img.document();
+    let mut doc = img.document_head();
     doc["image"] = summary(&peakforce_layout(img));
+    let cells: Vec<(usize, usize)> = (0..img.y.len())
+        .flat_map(|j| (0..img.x.len()).map(move |i| (j, i)))
+        .collect();
+    for (m, entry) in doc["materials"]
+        .as_array_mut()
+        .expect("the materials' list")
+        .iter_mut()
+        .enumerate()
+    {
+        let mine: Vec<(usize, usize)> = cells
+            .iter()
+            .copied()
+            .filter(|&(j, i)| img.material[j][i] == m)
+            .collect();
+        let pixels = || mine.iter().map(|&(j, i)| &img.pixels[j][i]);
+        let mut maps = serde_json::Map::new();
+        for (name, units, _) in PF_FIELDS {
+            let values = mine.iter().map(|&(j, i)| img.value(name, j, i));
+            maps.insert(name.into(), number_summary(units, values));
+        }
+        entry["pixels"] = json!(mine.len());
+        entry["taps"] = json!(pixels().map(|p| p.evaluations).sum::<usize>());
+        entry["reengaged"] = json!(pixels().filter(|p| p.reengaged).count());
+        entry["maps"] = Value::Object(maps);
+    }
     doc
 }
 
