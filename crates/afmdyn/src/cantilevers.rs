@@ -4,7 +4,8 @@
 //! entry fills the keys the file leaves out ([`fill`]): `spring_constant`,
 //! `resonance_frequency`, `quality_factor`, `[tip].radius`, the tip's elastic constants
 //! (silicon, [`SILICON_YOUNGS_MODULUS`], [`SILICON_POISSON_RATIO`]) and `model =
-//! "point-mass"`. The file's own keys always win.
+//! "point-mass"`. The file's own keys always win; a spring constant or resonance frequency
+//! beyond the maker's spread of the named lever's warns ([`calibration_warnings`]).
 
 use std::sync::OnceLock;
 
@@ -169,6 +170,72 @@ pub fn fill(root: &toml::Table) -> Result<toml::Table, String> {
     }
     out.insert("tip".into(), toml::Value::Table(tip));
     Ok(out)
+}
+
+/// How far a probe file's own spring constant may lie from its named lever's nominal one
+/// before it warns: a factor of 3 either way. Makers state k within about a factor of 2–3 of
+/// nominal (Olympus AC160TS-R3: 26 N/m nominal, 8.4–57 N/m), so a calibration outside it more
+/// likely belongs to another lever.
+pub const SPRING_CONSTANT_SPREAD: f64 = 3.0;
+/// The same for the resonance frequency: a factor of 1.5 either way (AC160TS-R3: 300 kHz
+/// nominal, 200–400 kHz).
+pub const RESONANCE_FREQUENCY_SPREAD: f64 = 1.5;
+
+/// Warnings for a probe file that names a library lever (`[cantilever].name`, or the command
+/// line's `--cantilever`) and gives its own `spring_constant` or `resonance_frequency` beyond
+/// the maker's spread of the nominal value ([`SPRING_CONSTANT_SPREAD`],
+/// [`RESONANCE_FREQUENCY_SPREAD`]): the file's value is used (a calibration wins over the
+/// datasheet, [`fill`]), which is right for a calibrated lever and a silent wrong lever when
+/// the file was written for another one. No warning without a name, for a name not in the
+/// library ([`fill`] refuses it) or for values that are not numbers (the probe reader refuses
+/// them).
+pub fn calibration_warnings(root: &toml::Table) -> Vec<String> {
+    let Some(cant) = root.get("cantilever").and_then(|c| c.as_table()) else {
+        return Vec::new();
+    };
+    let Some(Ok(c)) = cant.get("name").and_then(|n| n.as_str()).map(find) else {
+        return Vec::new();
+    };
+    let mut out = Vec::new();
+    for (key, nominal, spread, unit) in [
+        (
+            "spring_constant",
+            c.spring_constant,
+            SPRING_CONSTANT_SPREAD,
+            "N/m",
+        ),
+        (
+            "resonance_frequency",
+            c.resonance_frequency,
+            RESONANCE_FREQUENCY_SPREAD,
+            "Hz",
+        ),
+    ] {
+        let Some(v) = cant
+            .get(key)
+            .and_then(|v| v.as_float().or(v.as_integer().map(|i| i as f64)))
+        else {
+            continue;
+        };
+        if !(v > 0.0 && v.is_finite()) {
+            continue;
+        }
+        let ratio = v / nominal;
+        if ratio > spread || ratio < 1.0 / spread {
+            let (factor, side) = if ratio > 1.0 {
+                (ratio, "above")
+            } else {
+                (1.0 / ratio, "below")
+            };
+            out.push(format!(
+                "[cantilever].{key} = {v} {unit} is {factor:.1}× {side} {}'s nominal \
+                 {nominal} {unit} (the maker's spread is a factor of {spread}): the probe's \
+                 value is used, as a calibration is; check that the probe file is for this lever",
+                c.name
+            ));
+        }
+    }
+    out
 }
 
 /// The library as a JSON document (`afmdyn cantilevers --json`, Python's

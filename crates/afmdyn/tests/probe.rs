@@ -577,3 +577,56 @@ free_amplitude = 20e-9
     // the 4-mode Galerkin beam's first mode is the exact one: k̃₁ = β₁⁴/4 to round-off
     assert!(rel(got, want) < 1e-9, "static k = {got}, 3EI/L³ = {want}");
 }
+
+/// A probe that names a library lever but gives its own k or f0 far from the maker's nominal
+/// values (assets/cantilevers.toml: AC160TS-R3, 26 N/m and 300 kHz; a factor of 3 in k and 1.5
+/// in f0, the makers' spreads) keeps its own values and warns, naming the key and the lever;
+/// within the spread it is a calibration and does not warn; without a name nothing is compared.
+#[test]
+fn a_named_lever_with_another_levers_calibration_warns() {
+    let probe = |cantilever: &str| {
+        let text = format!(
+            "model = \"point-mass\"\n[cantilever]\n{cantilever}\n[tip]\nradius = 7e-9\n[sample]\nlaw = \"dmt\"\nyoungs_modulus = 1e9\n\
+             hamaker = 6.4e-20\npoisson_ratio = 0.3\n[drive]\nfree_amplitude = 10e-9\n"
+        );
+        Probe::parse(&text, "test").unwrap()
+    };
+    // a ScanAsyst-like calibration (0.4 N/m, 70 kHz) under the name of a 26 N/m lever
+    let p = probe(
+        "name = \"AC160TS-R3\"\nspring_constant = 0.4\nresonance_frequency = 70e3\nquality_factor = 80",
+    );
+    assert!(
+        rel(p.calibration.spring_constant, 0.4) < 1e-12,
+        "the file's k is used"
+    );
+    let w = p.warnings().join("\n");
+    assert!(
+        w.contains("[cantilever].spring_constant") && w.contains("65.0× below AC160TS-R3"),
+        "{w}"
+    );
+    assert!(
+        w.contains("[cantilever].resonance_frequency") && w.contains("4.3× below"),
+        "{w}"
+    );
+    // a calibration within the spread: 30 N/m and 280 kHz
+    let p = probe("name = \"AC160TS-R3\"\nspring_constant = 30.0\nresonance_frequency = 280e3");
+    assert!(
+        !p.warnings().iter().any(|w| w.contains("nominal")),
+        "{:?}",
+        p.warnings()
+    );
+    // the library's own values
+    let p = probe("name = \"AC160TS-R3\"");
+    assert!(
+        !p.warnings().iter().any(|w| w.contains("nominal")),
+        "{:?}",
+        p.warnings()
+    );
+    // no name: nothing to compare with
+    let p = probe("spring_constant = 0.4\nresonance_frequency = 70e3\nquality_factor = 80");
+    assert!(
+        !p.warnings().iter().any(|w| w.contains("nominal")),
+        "{:?}",
+        p.warnings()
+    );
+}

@@ -645,6 +645,7 @@ impl Probe {
     /// As [`Probe::parse`], but for the syntax.
     pub fn from_table(root: &toml::Table, origin: &str) -> Result<Probe, ProbeError> {
         // a cantilever of the library fills the keys the file leaves out
+        let original = root;
         let root = crate::cantilevers::fill(root).map_err(|e| ProbeError::Invalid {
             path: origin.to_string(),
             problems: vec![e],
@@ -652,7 +653,11 @@ impl Probe {
         let mut problems = Vec::new();
         let probe = Self::read(&root, &mut problems);
         match probe {
-            Some(p) if problems.is_empty() => Ok(p),
+            Some(mut p) if problems.is_empty() => {
+                p.input_warnings
+                    .extend(crate::cantilevers::calibration_warnings(original));
+                Ok(p)
+            }
             _ => {
                 if problems.is_empty() {
                     problems.push("invalid probe".into());
