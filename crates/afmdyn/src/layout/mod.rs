@@ -14,6 +14,8 @@ pub mod files;
 #[cfg(feature = "files")]
 pub mod netcdf;
 
+use serde::Serialize;
+
 /// The values of a variable, row-major over its dimensions.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Values {
@@ -46,10 +48,24 @@ impl Values {
     pub fn is_empty(&self) -> bool {
         self.len() == 0
     }
+
+    /// The kind of the values, as [`Layout::description`] names it: `"float"`, `"int"`,
+    /// `"bool"`, `"text"` or `"complex"`.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Values::F64(_) => "float",
+            Values::I32(_) => "int",
+            Values::Bool(_) => "bool",
+            Values::Text(_) => "text",
+            Values::C64(_) => "complex",
+        }
+    }
 }
 
-/// A further attribute of a variable (e.g. CF `flag_values` and `flag_meanings`).
-#[derive(Debug, Clone, PartialEq)]
+/// A further attribute of a variable (e.g. CF `flag_values` and `flag_meanings`); serialised
+/// as its value (a list of integers or a string).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(untagged)]
 pub enum Attr {
     /// A list of integers.
     I32(Vec<i32>),
@@ -186,6 +202,56 @@ impl Layout {
     pub fn variable(&self, name: &str) -> Option<&Variable> {
         self.variables.iter().find(|v| v.name == name)
     }
+
+    /// The layout without its values or lengths: what every writer and front end takes from
+    /// it (names, dimensions, units, long names, kinds and attributes), as data
+    /// (`docs/schema/layouts/*.json`, the Python docstrings' "Returns").
+    pub fn description(&self) -> LayoutDescription {
+        LayoutDescription {
+            title: self.title.clone(),
+            dims: self.dims.iter().map(|(n, _)| n.clone()).collect(),
+            variables: self
+                .variables
+                .iter()
+                .map(|v| VariableDescription {
+                    name: v.name.clone(),
+                    dims: v.dims.clone(),
+                    units: v.units.clone(),
+                    long_name: v.long_name.clone(),
+                    kind: v.values.kind(),
+                    attrs: v.attrs.clone(),
+                })
+                .collect(),
+        }
+    }
+}
+
+/// A [`Layout`] without its values ([`Layout::description`]).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LayoutDescription {
+    /// [`Layout::title`].
+    pub title: String,
+    /// The names of [`Layout::dims`], in order.
+    pub dims: Vec<String>,
+    /// Each variable's description, in order.
+    pub variables: Vec<VariableDescription>,
+}
+
+/// A [`Variable`] without its values.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct VariableDescription {
+    /// [`Variable::name`].
+    pub name: String,
+    /// [`Variable::dims`].
+    pub dims: Vec<String>,
+    /// [`Variable::units`].
+    pub units: String,
+    /// [`Variable::long_name`].
+    pub long_name: String,
+    /// [`Values::kind`] of its values.
+    pub kind: &'static str,
+    /// [`Variable::attrs`], as (key, value) pairs.
+    pub attrs: Vec<(String, Attr)>,
 }
 
 #[cfg(test)]
