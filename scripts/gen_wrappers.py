@@ -7,8 +7,11 @@
 Each function's keyword-only signature (names, types, defaults) and the "Args:" of its
 docstring come from its request's JSON Schema (``docs/schema/requests/*.json``, the library's
 request types: field types, ``Default``, doc comments), with the few Python keywords of its
-own and the widened types listed in :data:`FILES`; its summary, "Returns" and "Raises" come
-from ``scripts/wrapper_docs.py``. The body hands ``locals()`` to a hand-written finisher
+own and the widened types listed in :data:`FILES`; the table of variables in "Returns:" of a
+function returning a dataset from the library's result layouts
+(``docs/schema/layouts/<name>.json``, written by ``cargo test -p afmdyn --test layouts``: each
+variable's name, dims, units and long name, as the binding builds the dataset from them); its
+summary, the prose of "Returns" and "Raises" come from ``scripts/wrapper_docs.py``. The body hands ``locals()`` to a hand-written finisher
 (``_finish_<name>`` in the module :data:`FILES` names) that runs the request through the one
 door (``_afmdyn.run``) and builds the result. ``scripts/gen_stubs.py`` calls :func:`generate`
 and :func:`generate_model` and writes (or, with ``--check``, compares) the files.
@@ -25,6 +28,7 @@ from typing import Dict, List, Tuple
 
 ROOT = Path(__file__).resolve().parent.parent
 SCHEMAS = ROOT / "docs" / "schema" / "requests"
+LAYOUTS = ROOT / "docs" / "schema" / "layouts"
 PACKAGE = ROOT / "crates" / "afmdyn-py" / "python" / "afmdyn"
 
 STORE = 'Union[str, "os.PathLike[str]", None]'
@@ -201,6 +205,36 @@ def _arg_lines(name: str, text: str) -> List[str]:
                          subsequent_indent=" " * 12)
 
 
+def _layout_rows(name: str, omit: Tuple[str, ...]) -> List[Tuple[str, str, str, str]]:
+    """(name, dims, units, long name) of every variable of analysis ``name``'s layouts (the
+    datasets of one result merged, as the finishers merge them: a name once), but ``omit``."""
+    doc = json.loads((LAYOUTS / f"{name}.json").read_text())
+    rows: Dict[str, Tuple[str, str, str, str]] = {}
+    for ds in doc["datasets"]:
+        for v in ds["variables"]:
+            if v["name"] not in omit and v["name"] not in rows:
+                dims = ", ".join(v["dims"]) or "scalar"
+                rows[v["name"]] = (f"``{v['name']}``", dims, v["units"] or "—", v["long_name"])
+    return list(rows.values())
+
+
+def _layout_table(name: str, omit: Tuple[str, ...]) -> List[str]:
+    """The variables of analysis ``name``'s dataset, one entry each (name, dims, units:
+    meaning; a table as a list, its meanings too long for columns), after the sentence that
+    sources them."""
+    probe = json.loads((LAYOUTS / f"{name}.json").read_text())["example"]["probe"]
+    units = (f"under ``{probe}``, in SI" if probe else
+             "in the model's units; SI with a probe, as each variable's ``units`` attribute says")
+    intro = textwrap.wrap(
+        f"Its variables (name (dims) [units]: meaning), as the library lays them out "
+        f"(``docs/schema/layouts/{name}.json``: its example request, {units}):", 88, break_on_hyphens=False)
+    rows = []
+    for var, dims, units, meaning in _layout_rows(name, omit):
+        rows += textwrap.wrap(f"- {var} ({dims}) [{units}]: {meaning}", 88,
+                              subsequent_indent="  ", break_on_hyphens=False)
+    return intro + [""] + rows
+
+
 def _function(file: str, name: str) -> str:
     stem, module, returns, opts = FILES[file][name]
     omit, override = tuple(opts.get("omit", ())), dict(opts.get("override", {}))  # type: ignore
@@ -237,6 +271,12 @@ def _function(file: str, name: str) -> str:
     for section in ("returns", "warns", "raises"):
         if section in doc:
             body += ["", doc[section].rstrip()]
+        # a dataset's variables, from the library's layouts (not for the Dask versions, which
+        # return their local function's dataset)
+        if section == "returns" and returns == "xr.Dataset" and file != "_dask_wrappers.py" \
+                and (LAYOUTS / f"{name}.json").exists():
+            table = _layout_table(name, tuple(doc.get("layout_omit", ())))
+            body += [""] + ["    " + t if t else "" for t in table]
     text = textwrap.indent("\n".join(body), "    ").replace("\n    \n", "\n\n")
     lines = (["@_typed"] if opts.get("typed", True) else []) + [
         f"def {name}(", *sig, f") -> {returns}:", f'    """{text.strip()}', '    """',

@@ -20,21 +20,14 @@ Integrate one trajectory (``afmdyn simulate``); ``periods`` defaults to 50 when
 ``tau_end`` is not given either.""",
         "returns": """\
 Returns:
-    ``xarray.Dataset`` with dims ``tau`` (S samples), ``mode`` (N), ``event`` (E
-    switchings), ``section`` (P section points τ = 2πk/Ω), ``component`` (2N) and ``cycle``
-    (C complete drive periods): ``v_t``, ``v_t_dot``, ``w_tip``, ``w_tip_dot``,
-    ``in_contact``, ``contact_force`` ``[S]``; ``a``, ``a_dot`` ``[S, N]``;
-    ``event_tau``, ``event_to_contact``, ``event_v_t_dot`` ``[E]``; ``section_tau``,
-    ``section_v_t``, ``section_w_tip``, ``section_w_tip_dot`` ``[P]``, ``section_state``
-    ``[P, 2N]``; the energy balance per period ``[C]``; ``spectrum`` ``[F]`` over dim
-    ``frequency`` (the amplitude spectrum of W(1,τ) over the last ≤ 2²⁰ samples, the
-    command line's ``spectrum.csv``). ``attrs["summary"]`` holds
-    ``afmdyn simulate --json`` (see :func:`summary`). Units: the model's (τ in t0,
-    lengths in g0, forces E I g0/L³, or k g0 for the point mass); with ``probe`` every
-    array is in SI, as the command line's files — times (the coordinate ``t``, named
-    ``tau`` without a probe; events, sections) in s, lengths in m, velocities in m/s,
-    forces in N, energies in J, the spectrum's frequencies in Hz — each variable's unit in
-    its attrs.""",
+    ``xarray.Dataset`` of the trajectory: over its samples (the coordinate ``tau``, named
+    ``t`` with a probe), its modes, its switchings (``event``), the section points
+    τ = 2πk/Ω (``section``), the state's components, the complete drive periods (``cycle``:
+    the energy balance) and the amplitude spectrum of W(1,τ) over the last ≤ 2²⁰ samples
+    (``frequency``, the command line's ``spectrum.csv``). ``attrs["summary"]`` holds
+    ``afmdyn simulate --json`` (see :func:`summary`). With ``probe`` every array is in SI,
+    as the command line's files (times in s, lengths in m, velocities in m/s, forces in N,
+    energies in J, frequencies in Hz).""",
     },
     "converge": {
         "summary": """\
@@ -43,11 +36,8 @@ for N = 1..max_modes. Without ``params`` the model defaults to Ω = 4.1 (eq. 24 
 damping of eq. 26), as on the command line.""",
         "returns": """\
 Returns:
-    ``xarray.Dataset`` with dims ``n_modes`` (max_modes) and ``sample`` (K):
-    ``w_tip``, ``v_t``, ``tau`` ``[n_modes, K]`` over ``periods`` drive periods from a
-    section point; ``period`` ``[n_modes]`` (−1: nonperiodic); ``rms_change``
-    ``[n_modes]`` (RMS of W_tip(N) − W_tip(N−1), NaN for N = 1); coordinate
-    ``tau_from_section`` ``[K]``.""",
+    ``xarray.Dataset`` over ``n_modes`` (N = 1..max_modes) and ``sample`` (K samples over
+    ``periods`` drive periods from a section point, ``tau_from_section`` a coordinate).""",
     },
     "bifurcation": {
         "summary": """\
@@ -73,13 +63,10 @@ Raises:
 Returns:
     ``xarray.Dataset`` in long format, dim ``point`` (one row per section point, in the
     order of the command line's ``bifurcation.csv``: by value index, then ``forward``,
-    ``backward``, ``start-0``, ``start-1``, …, then ``k``): coordinates
-    ``value``, ``index``, ``branch`` (``"forward"``, ``"backward"``, ``"start-k"``);
-    ``status`` (``"periodic"``, ``"nonperiodic"``, ``"error"``), ``period`` (−1
-    nonperiodic, −2 error), ``k`` (position in the cycle), ``n_points``, ``tau``,
-    ``v_t``, ``w_tip``, ``x_max``, ``v_t_min``, ``contact_fraction``,
-    ``contacts_per_period``, ``transient_periods``, ``message``, ``a_1``…``a_N``,
-    ``a_dot_1``…``a_dot_N``. ``.to_dataframe()`` gives the tidy table.""",
+    ``backward``, ``start-0``, ``start-1``, …, then ``k``), with the coordinates ``value``,
+    ``index`` and ``branch``, and the state at the section as ``a_1`` … ``a_N``,
+    ``a_dot_1`` … ``a_dot_N`` (N = 3 in the example). ``.to_dataframe()`` gives the tidy
+    table.""",
     },
     "continuation": {
         "summary": """\
@@ -88,13 +75,9 @@ located folds, period doublings, Neimark–Sacker and grazing points (``afmdyn c
 The default start is the steady state reached from rest at ``from_``.""",
         "returns": """\
 Returns:
-    ``xarray.Dataset`` with dim ``point`` (all branches in order): ``branch`` (0 the
-    main branch, 1… switched ones), ``period``, ``s`` (arclength), ``value``, ``stable``,
-    ``max_multiplier``, ``critical``, ``switchings``, ``grazing_distance``, ``event``
-    (``""`` or ``"fold"``, ``"period-doubling"``, ``"neimark-sacker"``, ``"grazing"``);
-    ``w_tip_section`` ``[point, k]`` (W(1,τ) at the section points, NaN-padded),
-    ``multipliers`` ``[point, 2N]`` complex128, ``state`` ``[point, 2N]``.
-    ``attrs["summary"]`` is ``afmdyn continue --json``.""",
+    ``xarray.Dataset`` with dim ``point`` (all branches in order, ``value`` a coordinate;
+    ``w_tip_section`` NaN-padded to the longest period). ``attrs["summary"]`` is
+    ``afmdyn continue --json``.""",
     },
     "observe": {
         "summary": """\
@@ -108,17 +91,11 @@ The steady state is found as by :func:`orbit` and, when periodic, polished by Ne
 shooting; ``periods`` orbit periods are integrated on the dense output (no sampling).""",
         "returns": """\
 Returns:
-    An ``xarray.Dataset`` in SI with a probe (m, N, J, s; the model's units g₀, F̃, F̃·g₀,
-    τ otherwise; ``units`` in each variable's attrs), phases in degrees: scalars
-    ``amplitude``, ``amplitude_ratio``, ``phase_deg``, ``mean_deflection``,
-    ``peak_force``, ``min_force``, ``indentation``, ``contact_fraction``,
-    ``min_distance``, ``energy_dissipated``, ``virial``, ``harmonic_distortion``,
-    ``higher_mode_fraction``, ``contact_time``, ``mean_force``, ``impacts_per_period``,
-    ``impact_loss``, ``period`` (NaN when not periodic);
-    ``harmonic_amplitude``/``harmonic_phase_deg`` over ``harmonic``; the energy balance
-    ``mode_drive``, ``mode_sample``, … over ``mode``; ``state`` ``[2N]`` (a, ȧ).
-    ``ds.afmdyn.to_dict()`` is the library's document (dimensionless, phases in radians,
-    the closed forms; its ``reported`` block holds the dataset's values).""",
+    An ``xarray.Dataset`` of the observables (scalars; ``period`` NaN when not periodic), the
+    harmonics and the per-mode energy balance, in SI with a probe (m, N, J, s; the model's
+    units g₀, F̃, F̃·g₀, τ otherwise), phases in degrees. ``ds.afmdyn.to_dict()`` is the
+    library's document (dimensionless, phases in radians, the closed forms; its ``reported``
+    block holds the dataset's values).""",
     },
     "approach": {
         "summary": """\
@@ -131,18 +108,13 @@ with Floquet stability, the folds, the bistable ranges and the jumps. The defaul
 ``force`` (the force–distance loop's area is E_dis).""",
         "returns": """\
 Returns:
-    An ``xarray.Dataset`` (SI with a probe: m, N, J, degrees; ``units`` in each variable's
-    attrs) over ``z_c`` (the approach's grid) and ``sweep`` = ``approach``/``retract``:
-    ``amplitude``, ``amplitude_ratio``, ``phase_deg``, ``mean_deflection``,
-    ``peak_force``, ``min_force``, ``indentation``, ``contact_fraction``,
-    ``min_distance``, ``energy_dissipated``, ``virial``, ``harmonic_distortion``,
-    ``higher_mode_fraction``, ``stable``, ``period``, ``reached``; the branches along
-    ``branch_point`` (``branch``, ``branch_z_c``, ``branch_amplitude``, …,
-    ``branch_event``); with ``traces``, ``trace_deflection``/``trace_distance``/
-    ``trace_force`` over (``trace``, ``trace_time``). ``ds.afmdyn.to_dict()`` is the
-    ``afmdyn approach --json`` document (``folds``, ``bistable``, ``jumps``, ``setpoint``
-    (per stable branch crossing its ``source``, ``z_c``, ``regime``, phase, peak force,
-    indentation, E_dis…), ``warnings``; ``docs/outputs.md``).""",
+    An ``xarray.Dataset`` (SI with a probe: m, N, J, degrees) over ``z_c`` (the approach's
+    grid) and ``sweep`` = ``approach``/``retract``, the branches concatenated along
+    ``branch_point``, and with ``traces`` the recorded cycles over (``trace``,
+    ``trace_time``). ``ds.afmdyn.to_dict()`` is the ``afmdyn approach --json`` document
+    (``folds``, ``bistable``, ``jumps``, ``setpoint`` (per stable branch crossing its
+    ``source``, ``z_c``, ``regime``, phase, peak force, indentation, E_dis…), ``warnings``;
+    ``docs/outputs.md``).""",
     },
     "bimodal": {
         "summary": """\
@@ -167,13 +139,13 @@ Raises:
         :func:`approach`.""",
         "returns": """\
 Returns:
-    The dataset of :func:`approach` plus, over (``sweep``, ``z_c``), ``amplitude_i``,
-    ``phase_i_deg``, ``virial_i`` and ``energy_dissipated_i`` (per cycle of component i)
-    for each component i = 1, 2, … (1 the primary; SI with a probe); the branches' as
-    ``branch_amplitude_2`` …; the frequencies, ratios and free amplitudes in
-    ``ds.afmdyn.to_dict()["drive_components"]``; for a time average, each point's periods,
-    whether it settled, and its amplitude and phase error estimates per component in
-    ``ds.afmdyn.to_dict()["time_average"]`` (an unsettled point also in the warnings).""",
+    The dataset of :func:`approach` plus, per cycle of each component i = 1, 2, … (1 the
+    primary; SI with a probe), its amplitude, phase, virial and dissipated energy, on the
+    sweeps and the branches (the ``_1``, ``_2`` variables below); the frequencies, ratios
+    and free amplitudes in ``ds.afmdyn.to_dict()["drive_components"]``; for a time average,
+    each point's periods, whether it settled, and its amplitude and phase error estimates
+    per component in ``ds.afmdyn.to_dict()["time_average"]`` (an unsettled point also in the
+    warnings).""",
     },
     "resonance": {
         "summary": """\
@@ -227,14 +199,12 @@ velocity) the map is made in passes from a coarse grid (``stride``; 0 automatic,
 pass): a later start stops when a return lands inside a coarse cell of one basin.""",
         "returns": """\
 Returns:
-    ``xarray.Dataset`` with dims ``(y, x)``: ``label`` (attractor id, −2 failed),
-    ``decided`` (``"near"``, ``"recurrence"``, ``"grid"``, ``"steady"``, ``"failed"``),
-    ``periods``; dim ``attractor``: ``period`` (−1 nonperiodic), ``x_max``, ``v_t_min``
-    (g0), ``basin_fraction``, ``stable`` (1/0 from the Floquet multipliers of the orbit
-    polished by shooting; NaN nonperiodic), ``lyapunov`` (λ₁ of a nonperiodic attractor);
-    attributes ``basin_entropy``, ``boundary_basin_entropy`` (Daza et al. 2016; NaN when
-    undefined), ``uncertainty_exponent`` (Grebogi et al. 1983) and ``summary`` (the
-    command line's JSON document).""",
+    ``xarray.Dataset`` over the plane ``(y, x)`` and the attractors found (``attractor``, a
+    coordinate 0, 1, …); ``decided`` as its words (``"near"``, ``"recurrence"``,
+    ``"grid"``, ``"steady"``, ``"failed"``); attributes ``basin_entropy``,
+    ``boundary_basin_entropy`` (Daza et al. 2016; NaN when undefined),
+    ``uncertainty_exponent`` (Grebogi et al. 1983) and ``summary`` (the command line's JSON
+    document).""",
     },
     "global_continuation": {
         "summary": """\
@@ -252,11 +222,9 @@ only (an attractor found only from the previous value has fraction 0).""",
         },
         "returns": """\
 Returns:
-    ``xarray.Dataset`` with dims ``(value, id)``: ``basin_fraction`` (0 where the id has no
-    attractor), ``period`` (−1 nonperiodic, 0 absent), ``x_max`` and ``v_t_min`` (g0, NaN
-    absent), ``stable`` (1/0 from the Floquet multipliers of the orbit polished by shooting,
-    NaN otherwise); dim ``value``: ``failures`` (runs that failed). Attribute ``summary``:
-    the command line's JSON document (Poincaré points, multipliers of every attractor).""",
+    ``xarray.Dataset`` over ``(value, id)``, an id one attractor followed over the
+    parameter. Attribute ``summary``: the command line's JSON document (Poincaré points,
+    multipliers of every attractor).""",
     },
     "fm": {
         "summary": """\
@@ -303,14 +271,10 @@ Raises:
     SimulationError: no cell found any attractor.""",
     "returns": """\
 Returns:
-    ``xarray.Dataset`` with dims ``(y, x, attractor)``: per cell ``attractors``,
-    ``failures``, ``dominant_period``; per attractor slot (most random starts first;
-    ``max_attractors`` slots, empty ones with period 0 and NaN) ``period`` (−1
-    nonperiodic), ``motion`` (1 periodic, 2 chaotic: λ₁ > 2 × its error, 3 quasi-periodic:
-    |λ₁| ≤ 2 × its error, 4 unsettled: λ₁ < −2 × its error, 5 nonperiodic without λ₁),
-    ``lyapunov`` (λ₁ per unit τ of a nonperiodic attractor), ``lyapunov_error``, ``x_max``,
-    ``v_t_min`` (g0), ``contacts_per_period``, ``contact_fraction``, ``fraction``
-    (basin fraction among the random starts). The same values as ``chart.nc``.""",
+    ``xarray.Dataset`` over ``(y, x, attractor)``: per cell, and per attractor slot (most
+    random starts first; ``max_attractors`` slots, empty ones with period 0 and NaN); a
+    ``motion`` is chaotic where λ₁ > 2 × its error, quasi-periodic where |λ₁| ≤ 2 × its
+    error, unsettled where λ₁ < −2 × its error. The same values as ``chart.nc``.""",
 }
 
 #: the Dask versions (:mod:`afmdyn.dask`)
@@ -370,14 +334,14 @@ with its Floquet multipliers, the instrument's channels and the PF-QNM DMT fit."
     },
     "returns": """\
 Returns:
-    An ``xarray.Dataset`` of one cycle over ``sample`` (time, deflection, distance, force)
-    and the force–distance curve, in SI with a probe; attributes: the channels
-    (``peak_force``, ``adhesion``, ``deformation``, ``dissipation``, ``contact_time``,
-    ``snap_off_time``, ``ringing_amplitude``, ``modulus_dmt``, ``taps_per_cycle``) and
-    ``summary`` (the ``afmdyn peakforce --json`` document). With a sweep the channels
-    (and ``modulus_dmt``, ``z_c``, ``period``) are variables over its dimension, NaN where
-    a value failed; the cycle and curve are the first computed value's. Warnings (period-2
-    tapping, double taps, an unstable tap) are raised as :class:`afmdyn.AfmdynWarning`.""",
+    An ``xarray.Dataset`` of one cycle over ``sample`` and the force–distance curve, in SI
+    with a probe; attributes: the channels (``peak_force``, ``adhesion``, ``deformation``,
+    ``dissipation``, ``contact_time``, ``snap_off_time``, ``ringing_amplitude``,
+    ``modulus_dmt``, ``taps_per_cycle``) and ``summary`` (the ``afmdyn peakforce --json``
+    document). With a sweep the channels (and ``modulus_dmt``, ``z_c``, ``period``) are
+    variables over its dimension, NaN where a value failed; the cycle and curve are the
+    first computed value's. Warnings (period-2 tapping, double taps, an unstable tap) are
+    raised as :class:`afmdyn.AfmdynWarning`.""",
     "raises": """\
 Raises:
     ValueError: naming the option or the model parameter.""",
@@ -404,13 +368,13 @@ errors, 95 % profile-likelihood intervals, correlations and identifiability warn
     },
     "returns": """\
 Returns:
-    An ``xarray.Dataset``: over ``row`` the fitted rows' ``tip_position``, ``force``,
-    ``fit`` and ``residual``; over ``parameter`` the ``estimate``, ``standard_error``,
-    ``interval_low`` and ``interval_high`` (95 %), and ``correlation`` over
-    (``parameter``, ``parameter_2``); attributes ``chi2_dof``, ``noise`` and ``summary``
-    (the ``afmdyn fit --json`` document). Warnings (a correlation above 0.99, a flat
-    profile, an estimate at its bound, the noise estimated from the residuals) are raised
-    as :class:`afmdyn.AfmdynWarning`.""",
+    An ``xarray.Dataset``: the fitted rows (the variables below) and, from the document,
+    over ``parameter`` the ``estimate``, ``standard_error``, ``interval_low`` and
+    ``interval_high`` (95 %), and ``correlation`` over (``parameter``, ``parameter_2``);
+    attributes ``chi2_dof``, ``noise``, ``law`` and ``summary`` (the ``afmdyn fit --json``
+    document). Warnings (a correlation above 0.99, a flat profile, an estimate at its
+    bound, the noise estimated from the residuals) are raised as
+    :class:`afmdyn.AfmdynWarning`.""",
     "raises": """\
 Raises:
     ValueError: naming the option, the data or the probe key.""",
@@ -438,6 +402,8 @@ IMAGE_ARGS = {
 }
 
 WRAPPERS["image"] = {
+    # the layout's scalars are the dataset's attributes (``_image._dataset``)
+    "layout_omit": ("setpoint", "reference_z_c"),
     "summary": """\
 The image an amplitude feedback records over a heterogeneous sample
 (``afmdyn image``). ``feedback="ideal"``: at every pixel the operating point of the local
@@ -451,12 +417,11 @@ feedback records, ``setpoint`` the peak force (N), each pixel's steady tap exact
     "args": IMAGE_ARGS,
     "returns": """\
 Returns:
-    ``xarray.Dataset`` over ``y`` and ``x`` (m): ``height``, ``true_height``, ``z_c``,
-    ``amplitude``, ``phase_deg``, ``energy_dissipated``, ``virial``, ``peak_force``,
-    ``indentation`` (NaN where the setpoint is not reached; units and long names as the
-    library lays them out, the variables of ``afmdyn image``'s ``image.nc``), ``regime``,
-    ``material`` and ``domain`` (strings); attributes ``setpoint``, ``reference_z_c`` (m) and
-    ``summary`` (the command line's JSON document, with each material's operating points).
+    ``xarray.Dataset`` over ``y`` and ``x`` (m), NaN where the setpoint is not reached; the
+    codes ``regime``, ``material`` and ``domain`` as their words; attributes ``setpoint``,
+    ``reference_z_c`` (m) and ``summary`` (the command line's JSON document, with each
+    material's operating points). The variables below are the ideal feedback's
+    (``image.nc``).
 
     With ``feedback="pi"``: the recorded trace ``height``, ``amplitude``, ``phase_deg``,
     ``tracking_error``, ``energy_dissipated``, ``virial``, ``peak_force``, ``indentation``

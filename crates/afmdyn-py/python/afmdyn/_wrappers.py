@@ -97,21 +97,53 @@ def simulate(
         **model: the model keywords (:class:`Model`), ``probe=`` a probe in SI.
 
     Returns:
-        ``xarray.Dataset`` with dims ``tau`` (S samples), ``mode`` (N), ``event`` (E
-        switchings), ``section`` (P section points τ = 2πk/Ω), ``component`` (2N) and ``cycle``
-        (C complete drive periods): ``v_t``, ``v_t_dot``, ``w_tip``, ``w_tip_dot``,
-        ``in_contact``, ``contact_force`` ``[S]``; ``a``, ``a_dot`` ``[S, N]``;
-        ``event_tau``, ``event_to_contact``, ``event_v_t_dot`` ``[E]``; ``section_tau``,
-        ``section_v_t``, ``section_w_tip``, ``section_w_tip_dot`` ``[P]``, ``section_state``
-        ``[P, 2N]``; the energy balance per period ``[C]``; ``spectrum`` ``[F]`` over dim
-        ``frequency`` (the amplitude spectrum of W(1,τ) over the last ≤ 2²⁰ samples, the
-        command line's ``spectrum.csv``). ``attrs["summary"]`` holds
-        ``afmdyn simulate --json`` (see :func:`summary`). Units: the model's (τ in t0,
-        lengths in g0, forces E I g0/L³, or k g0 for the point mass); with ``probe`` every
-        array is in SI, as the command line's files — times (the coordinate ``t``, named
-        ``tau`` without a probe; events, sections) in s, lengths in m, velocities in m/s,
-        forces in N, energies in J, the spectrum's frequencies in Hz — each variable's unit in
-        its attrs.
+        ``xarray.Dataset`` of the trajectory: over its samples (the coordinate ``tau``, named
+        ``t`` with a probe), its modes, its switchings (``event``), the section points
+        τ = 2πk/Ω (``section``), the state's components, the complete drive periods (``cycle``:
+        the energy balance) and the amplitude spectrum of W(1,τ) over the last ≤ 2²⁰ samples
+        (``frequency``, the command line's ``spectrum.csv``). ``attrs["summary"]`` holds
+        ``afmdyn simulate --json`` (see :func:`summary`). With ``probe`` every array is in SI,
+        as the command line's files (times in s, lengths in m, velocities in m/s, forces in N,
+        energies in J, frequencies in Hz).
+
+        Its variables (name (dims) [units]: meaning), as the library lays them out
+        (``docs/schema/layouts/simulate.json``: its example request, in the model's units; SI
+        with a probe, as each variable's ``units`` attribute says):
+
+        - ``tau`` (tau) [τ (eq. 5)]: dimensionless time τ = t √(EI/(mL⁴))
+        - ``v_t`` (tau) [g0]: tip–sample distance V_T = W(1,τ) + α2 sin Ωτ + α5 (eq. 8); contact
+          while V_T ≤ 0
+        - ``v_t_dot`` (tau) [g0 per unit τ]: dV_T/dτ
+        - ``w_tip`` (tau) [g0]: tip deflection W(1,τ) relative to the clamped base
+        - ``w_tip_dot`` (tau) [g0 per unit τ]: tip velocity ∂W(1,τ)/∂τ
+        - ``in_contact`` (tau) [—]: 1 while the tip is in contact (region II)
+        - ``contact_force`` (tau) [EI g0/L³]: tip–sample force F_c(δ, δ̇) on the tip, δ = −V_T
+          the indentation (linear law: α4 δ + α6 δ̇ in contact; 0 in free flight except DMT's
+          van der Waals force): positive when the sample pushes the tip away (repulsion, e.g. at
+          the deepest indentation), negative when it pulls the tip towards it (attraction, e.g.
+          DMT's van der Waals force in free flight)
+        - ``a`` (tau, mode) [g0]: modal displacement a_i
+        - ``a_dot`` (tau, mode) [g0 per unit τ]: modal velocity da_i/dτ
+        - ``event_tau`` (event) [τ (eq. 5)]: switching time
+        - ``event_to_contact`` (event) [—]: switching into contact (else out of it)
+        - ``event_v_t_dot`` (event) [g0 per unit τ]: dV_T/dτ at the switching (impact velocity)
+        - ``section_tau`` (section) [τ (eq. 5)]: section time 2πk/Ω
+        - ``section_v_t`` (section) [g0]: V_T at the section
+        - ``section_w_tip`` (section) [g0]: W(1,τ) at the section
+        - ``section_w_tip_dot`` (section) [g0 per unit τ]: ∂W(1,τ)/∂τ at the section
+        - ``section_state`` (section, component) [—]: state (a, da/dτ) at the section
+        - ``energy_tau0`` (cycle) [τ (eq. 5)]: start of the period
+        - ``energy_start`` (cycle) [EI g0²/L³]: stored energy at the start
+        - ``energy_end`` (cycle) [EI g0²/L³]: stored energy at the end
+        - ``base_work`` (cycle) [EI g0²/L³]: work of the base drive
+        - ``beam_dissipation`` (cycle) [EI g0²/L³]: beam damping loss
+        - ``contact_dissipation`` (cycle) [EI g0²/L³]: dissipation in the sample (contact
+          damping, impacts)
+        - ``energy_residual`` (cycle) [EI g0²/L³]: ΔE − (work − losses)
+        - ``spectrum`` (frequency) [g0]: amplitude spectrum of W(1,τ) (spectrum.csv)
+        - ``frequency`` (frequency) [Ω units (1/t0)]: frequency
+        - ``mode`` (mode) [1]: Galerkin mode i
+        - ``component`` (component) [—]: state component (a_i, then da_i/dτ)
     """
     return _api._finish_simulate(locals())
 
@@ -152,11 +184,20 @@ def converge(
         **model: the model keywords (:class:`Model`), ``probe=`` a probe in SI.
 
     Returns:
-        ``xarray.Dataset`` with dims ``n_modes`` (max_modes) and ``sample`` (K):
-        ``w_tip``, ``v_t``, ``tau`` ``[n_modes, K]`` over ``periods`` drive periods from a
-        section point; ``period`` ``[n_modes]`` (−1: nonperiodic); ``rms_change``
-        ``[n_modes]`` (RMS of W_tip(N) − W_tip(N−1), NaN for N = 1); coordinate
-        ``tau_from_section`` ``[K]``.
+        ``xarray.Dataset`` over ``n_modes`` (N = 1..max_modes) and ``sample`` (K samples over
+        ``periods`` drive periods from a section point, ``tau_from_section`` a coordinate).
+
+        Its variables (name (dims) [units]: meaning), as the library lays them out
+        (``docs/schema/layouts/converge.json``: its example request, in the model's units; SI
+        with a probe, as each variable's ``units`` attribute says):
+
+        - ``w_tip`` (n_modes, sample) [g0]: tip deflection W(1,τ)
+        - ``v_t`` (n_modes, sample) [g0]: V_T
+        - ``tau`` (n_modes, sample) [τ (eq. 5)]: time τ
+        - ``period`` (n_modes) [—]: period of the steady state (−1: nonperiodic)
+        - ``rms_change`` (n_modes) [g0]: RMS of W_tip(N) − W_tip(N−1)
+        - ``n_modes`` (n_modes) [—]: number of Galerkin modes N
+        - ``tau_from_section`` (sample) [τ (eq. 5)]: τ − τ0 from a section point
     """
     return _api._finish_converge(locals())
 
@@ -235,13 +276,38 @@ def bifurcation(
     Returns:
         ``xarray.Dataset`` in long format, dim ``point`` (one row per section point, in the
         order of the command line's ``bifurcation.csv``: by value index, then ``forward``,
-        ``backward``, ``start-0``, ``start-1``, …, then ``k``): coordinates
-        ``value``, ``index``, ``branch`` (``"forward"``, ``"backward"``, ``"start-k"``);
-        ``status`` (``"periodic"``, ``"nonperiodic"``, ``"error"``), ``period`` (−1
-        nonperiodic, −2 error), ``k`` (position in the cycle), ``n_points``, ``tau``,
-        ``v_t``, ``w_tip``, ``x_max``, ``v_t_min``, ``contact_fraction``,
-        ``contacts_per_period``, ``transient_periods``, ``message``, ``a_1``…``a_N``,
-        ``a_dot_1``…``a_dot_N``. ``.to_dataframe()`` gives the tidy table.
+        ``backward``, ``start-0``, ``start-1``, …, then ``k``), with the coordinates ``value``,
+        ``index`` and ``branch``, and the state at the section as ``a_1`` … ``a_N``,
+        ``a_dot_1`` … ``a_dot_N`` (N = 3 in the example). ``.to_dataframe()`` gives the tidy
+        table.
+
+        Its variables (name (dims) [units]: meaning), as the library lays them out
+        (``docs/schema/layouts/bifurcation.json``: its example request, in the model's units; SI
+        with a probe, as each variable's ``units`` attribute says):
+
+        - ``value`` (point) [1]: Ω (omega)
+        - ``index`` (point) [count]: index of the value in the sweep (0-based)
+        - ``branch`` (point) [—]: forward, backward or start-k (random start k)
+        - ``status`` (point) [—]: periodic, nonperiodic or error
+        - ``period`` (point) [drive periods]: period n of a periodic motion; −1 nonperiodic; −2
+          failed point
+        - ``k`` (point) [count]: index of the Poincaré point in the recorded cycle
+        - ``n_points`` (point) [count]: Poincaré points of this sweep point (rows of its group)
+        - ``tau`` (point) [τ]: time of the Poincaré point (a multiple of the drive period 2π/Ω)
+        - ``v_t`` (point) [g0]: V_T at the Poincaré point (eq. 8)
+        - ``w_tip`` (point) [g0]: tip deflection W(1,τ) at the Poincaré point
+        - ``x_max`` (point) [g0]: largest tip deflection W(1,τ) over the recorded steady state
+        - ``v_t_min`` (point) [g0]: smallest V_T over the recorded steady state (≤ 0: contact)
+        - ``contact_fraction`` (point) [1]: fraction of the time in contact
+        - ``contacts_per_period`` (point) [1/period]: contact entries per drive period
+        - ``transient_periods`` (point) [drive periods]: length of the transient discarded
+        - ``message`` (point) [—]: why the point failed (empty otherwise)
+        - ``a_1`` (point) [g0]: a_1 at the section
+        - ``a_2`` (point) [g0]: a_2 at the section
+        - ``a_3`` (point) [g0]: a_3 at the section
+        - ``a_dot_1`` (point) [g0 per unit τ]: da_1/dτ at the section
+        - ``a_dot_2`` (point) [g0 per unit τ]: da_2/dτ at the section
+        - ``a_dot_3`` (point) [g0 per unit τ]: da_3/dτ at the section
 
     Raises:
         ValueError: ``resume=True`` on a store made by another request (the message names the
@@ -295,13 +361,27 @@ def continuation(
         **model: the model keywords (:class:`Model`), ``probe=`` a probe in SI.
 
     Returns:
-        ``xarray.Dataset`` with dim ``point`` (all branches in order): ``branch`` (0 the
-        main branch, 1… switched ones), ``period``, ``s`` (arclength), ``value``, ``stable``,
-        ``max_multiplier``, ``critical``, ``switchings``, ``grazing_distance``, ``event``
-        (``""`` or ``"fold"``, ``"period-doubling"``, ``"neimark-sacker"``, ``"grazing"``);
-        ``w_tip_section`` ``[point, k]`` (W(1,τ) at the section points, NaN-padded),
-        ``multipliers`` ``[point, 2N]`` complex128, ``state`` ``[point, 2N]``.
-        ``attrs["summary"]`` is ``afmdyn continue --json``.
+        ``xarray.Dataset`` with dim ``point`` (all branches in order, ``value`` a coordinate;
+        ``w_tip_section`` NaN-padded to the longest period). ``attrs["summary"]`` is
+        ``afmdyn continue --json``.
+
+        Its variables (name (dims) [units]: meaning), as the library lays them out
+        (``docs/schema/layouts/continuation.json``: its example request, in the model's units;
+        SI with a probe, as each variable's ``units`` attribute says):
+
+        - ``branch`` (point) [1]: branch (0: the continued one)
+        - ``period`` (point) [drive periods]: period n
+        - ``s`` (point) [1]: arclength
+        - ``value`` (point) [1]: Ω (omega)
+        - ``stable`` (point) [1]: stable (every Floquet multiplier inside the unit circle)
+        - ``max_multiplier`` (point) [1]: largest |Floquet multiplier|
+        - ``critical`` (point) [1]: how the orbit is or would become unstable
+        - ``switchings`` (point) [1]: switchings per cycle
+        - ``grazing_distance`` (point) [g0]: distance to grazing
+        - ``event`` (point) [1]: located bifurcation ("": none)
+        - ``w_tip_section`` (point, k) [g0]: W(1,τ) at the section points
+        - ``multipliers`` (point, multiplier) [1]: Floquet multipliers
+        - ``state`` (point, component) [g0, g0 per unit τ]: state at τ = 0 (a, ȧ)
     """
     return _api._finish_continuation(locals())
 
@@ -470,14 +550,35 @@ def chart(
         **model: the model keywords (:class:`Model`), ``probe=`` a probe in SI.
 
     Returns:
-        ``xarray.Dataset`` with dims ``(y, x, attractor)``: per cell ``attractors``,
-        ``failures``, ``dominant_period``; per attractor slot (most random starts first;
-        ``max_attractors`` slots, empty ones with period 0 and NaN) ``period`` (−1
-        nonperiodic), ``motion`` (1 periodic, 2 chaotic: λ₁ > 2 × its error, 3 quasi-periodic:
-        |λ₁| ≤ 2 × its error, 4 unsettled: λ₁ < −2 × its error, 5 nonperiodic without λ₁),
-        ``lyapunov`` (λ₁ per unit τ of a nonperiodic attractor), ``lyapunov_error``, ``x_max``,
-        ``v_t_min`` (g0), ``contacts_per_period``, ``contact_fraction``, ``fraction``
-        (basin fraction among the random starts). The same values as ``chart.nc``.
+        ``xarray.Dataset`` over ``(y, x, attractor)``: per cell, and per attractor slot (most
+        random starts first; ``max_attractors`` slots, empty ones with period 0 and NaN); a
+        ``motion`` is chaotic where λ₁ > 2 × its error, quasi-periodic where |λ₁| ≤ 2 × its
+        error, unsettled where λ₁ < −2 × its error. The same values as ``chart.nc``.
+
+        Its variables (name (dims) [units]: meaning), as the library lays them out
+        (``docs/schema/layouts/chart.json``: its example request, in the model's units; SI with
+        a probe, as each variable's ``units`` attribute says):
+
+        - ``x`` (x) [1]: omega
+        - ``y`` (y) [1]: drive_amplitude
+        - ``attractors`` (y, x) [1]: attractors found in the cell
+        - ``failures`` (y, x) [1]: runs of the cell that failed
+        - ``dominant_period`` (y, x) [drive periods]: period of the attractor most random starts
+          reached; -1 nonperiodic, 0 none
+        - ``period`` (y, x, attractor) [drive periods]: period n; -1 nonperiodic; 0 empty slot
+        - ``motion`` (y, x, attractor) [code]: 1 periodic, 2 chaotic, 3 quasi-periodic, 4
+          unsettled (lyapunov < 0), 5 nonperiodic without lyapunov; 0 empty slot
+        - ``lyapunov`` (y, x, attractor) [1/tau]: largest Lyapunov exponent of a nonperiodic
+          attractor
+        - ``lyapunov_error`` (y, x, attractor) [1/tau]: its error: uncertainty over the blocks
+          plus convergence estimate
+        - ``x_max`` (y, x, attractor) [g0]: largest tip deflection W(1,tau) over the steady
+          state
+        - ``v_t_min`` (y, x, attractor) [g0]: smallest V_T over the steady state
+        - ``contacts_per_period`` (y, x, attractor) [1/period]: contact entries (impacts) per
+          drive period
+        - ``contact_fraction`` (y, x, attractor) [1]: fraction of the time in contact
+        - ``fraction`` (y, x, attractor) [1]: basin fraction among the random starts
 
     Raises:
         ValueError: an axis that is not a real model parameter, a value out of its range, an

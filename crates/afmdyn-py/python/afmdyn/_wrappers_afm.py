@@ -81,17 +81,54 @@ def observe(
         **model: the model keywords (:class:`Model`), ``probe=`` a probe in SI.
 
     Returns:
-        An ``xarray.Dataset`` in SI with a probe (m, N, J, s; the model's units g₀, F̃, F̃·g₀,
-        τ otherwise; ``units`` in each variable's attrs), phases in degrees: scalars
-        ``amplitude``, ``amplitude_ratio``, ``phase_deg``, ``mean_deflection``,
-        ``peak_force``, ``min_force``, ``indentation``, ``contact_fraction``,
-        ``min_distance``, ``energy_dissipated``, ``virial``, ``harmonic_distortion``,
-        ``higher_mode_fraction``, ``contact_time``, ``mean_force``, ``impacts_per_period``,
-        ``impact_loss``, ``period`` (NaN when not periodic);
-        ``harmonic_amplitude``/``harmonic_phase_deg`` over ``harmonic``; the energy balance
-        ``mode_drive``, ``mode_sample``, … over ``mode``; ``state`` ``[2N]`` (a, ȧ).
-        ``ds.afmdyn.to_dict()`` is the library's document (dimensionless, phases in radians,
-        the closed forms; its ``reported`` block holds the dataset's values).
+        An ``xarray.Dataset`` of the observables (scalars; ``period`` NaN when not periodic), the
+        harmonics and the per-mode energy balance, in SI with a probe (m, N, J, s; the model's
+        units g₀, F̃, F̃·g₀, τ otherwise), phases in degrees. ``ds.afmdyn.to_dict()`` is the
+        library's document (dimensionless, phases in radians, the closed forms; its ``reported``
+        block holds the dataset's values).
+
+        Its variables (name (dims) [units]: meaning), as the library lays them out
+        (``docs/schema/layouts/observe.json``: its example request, in the model's units; SI
+        with a probe, as each variable's ``units`` attribute says):
+
+        - ``amplitude`` (scalar) [g0]: first-harmonic amplitude A of the tip deflection
+        - ``amplitude_ratio`` (scalar) [1]: A/A0 (A0 the free amplitude at the same drive)
+        - ``phase_deg`` (scalar) [degree]: phase lag of the deflection behind the drive (90
+          free, > 90 attractive, < 90 repulsive)
+        - ``mean_deflection`` (scalar) [g0]: mean tip deflection <W>
+        - ``peak_force`` (scalar) [F~ (k g0 for the point mass)]: largest tip-sample force F_c:
+          the repulsive maximum (F_c > 0 pushes the tip away)
+        - ``min_force`` (scalar) [F~ (k g0 for the point mass)]: smallest tip-sample force F_c:
+          the adhesion minimum (F_c < 0 pulls the tip)
+        - ``indentation`` (scalar) [g0]: largest indentation max(-V_T, 0)
+        - ``contact_fraction`` (scalar) [1]: fraction of the time in contact (V_T <= 0)
+        - ``min_distance`` (scalar) [g0]: minimum tip-sample distance
+        - ``energy_dissipated`` (scalar) [F~ g0]: energy dissipated in the sample per drive
+          period E_dis
+        - ``virial`` (scalar) [F~ g0]: virial (1/T) integral of F_c W over a period
+        - ``harmonic_distortion`` (scalar) [1]: total harmonic distortion of the deflection
+        - ``higher_mode_fraction`` (scalar) [1]: participation of the higher eigenmodes: RMS
+          amplitude of the tip deflection of modes 2..N relative to mode 1's (0 for one mode)
+        - ``contact_time`` (scalar) [τ]: time in contact per drive period
+        - ``mean_force`` (scalar) [F~ (k g0 for the point mass)]: time-averaged tip-sample force
+        - ``impacts_per_period`` (scalar) [1]: entries into contact (impacts) per drive period
+        - ``impact_loss`` (scalar) [F~ g0]: kinetic energy lost in impacts per drive period
+        - ``harmonic`` (harmonic) [—]: harmonic
+        - ``harmonic_amplitude`` (harmonic) [g0]: amplitude of harmonic n
+        - ``harmonic_phase_deg`` (harmonic) [degree]: phase of harmonic n
+        - ``mode`` (mode) [—]: mode
+        - ``mode_drive`` (mode) [F~ g0]: energy balance of the mode per drive period: drive
+        - ``mode_beam_damping`` (mode) [F~ g0]: energy balance of the mode per drive period:
+          beam_damping
+        - ``mode_sample`` (mode) [F~ g0]: energy balance of the mode per drive period: sample
+        - ``mode_coupling`` (mode) [F~ g0]: energy balance of the mode per drive period:
+          coupling
+        - ``mode_energy_change`` (mode) [F~ g0]: energy balance of the mode per drive period:
+          energy_change
+        - ``mode_residual`` (mode) [F~ g0]: energy balance of the mode per drive period:
+          residual
+        - ``state`` (state_index) [—]: state (a, da/dtau) at tau = 0 the observables start from
+        - ``period`` (scalar) [1]: n of the period-n motion (NaN: not periodic)
     """
     return _api._finish_observe(locals())
 
@@ -143,18 +180,76 @@ def approach(
         **model: the model keywords (:class:`Model`), ``probe=`` a probe in SI.
 
     Returns:
-        An ``xarray.Dataset`` (SI with a probe: m, N, J, degrees; ``units`` in each variable's
-        attrs) over ``z_c`` (the approach's grid) and ``sweep`` = ``approach``/``retract``:
-        ``amplitude``, ``amplitude_ratio``, ``phase_deg``, ``mean_deflection``,
-        ``peak_force``, ``min_force``, ``indentation``, ``contact_fraction``,
-        ``min_distance``, ``energy_dissipated``, ``virial``, ``harmonic_distortion``,
-        ``higher_mode_fraction``, ``stable``, ``period``, ``reached``; the branches along
-        ``branch_point`` (``branch``, ``branch_z_c``, ``branch_amplitude``, …,
-        ``branch_event``); with ``traces``, ``trace_deflection``/``trace_distance``/
-        ``trace_force`` over (``trace``, ``trace_time``). ``ds.afmdyn.to_dict()`` is the
-        ``afmdyn approach --json`` document (``folds``, ``bistable``, ``jumps``, ``setpoint``
-        (per stable branch crossing its ``source``, ``z_c``, ``regime``, phase, peak force,
-        indentation, E_dis…), ``warnings``; ``docs/outputs.md``).
+        An ``xarray.Dataset`` (SI with a probe: m, N, J, degrees) over ``z_c`` (the approach's
+        grid) and ``sweep`` = ``approach``/``retract``, the branches concatenated along
+        ``branch_point``, and with ``traces`` the recorded cycles over (``trace``,
+        ``trace_time``). ``ds.afmdyn.to_dict()`` is the ``afmdyn approach --json`` document
+        (``folds``, ``bistable``, ``jumps``, ``setpoint`` (per stable branch crossing its
+        ``source``, ``z_c``, ``regime``, phase, peak force, indentation, E_dis…), ``warnings``;
+        ``docs/outputs.md``).
+
+        Its variables (name (dims) [units]: meaning), as the library lays them out
+        (``docs/schema/layouts/approach.json``: its example request, in the model's units; SI
+        with a probe, as each variable's ``units`` attribute says):
+
+        - ``z_c`` (z_c) [g0]: rest distance z_c of the tip above the sample
+        - ``sweep`` (sweep) [—]: sweep
+        - ``amplitude`` (sweep, z_c) [g0]: first-harmonic amplitude A of the tip deflection
+        - ``amplitude_ratio`` (sweep, z_c) [1]: A/A0 (A0 the free amplitude at the same drive)
+        - ``phase_deg`` (sweep, z_c) [degree]: phase lag of the deflection behind the drive (90
+          free, > 90 attractive, < 90 repulsive)
+        - ``mean_deflection`` (sweep, z_c) [g0]: mean tip deflection <W>
+        - ``peak_force`` (sweep, z_c) [F~ (k g0 for the point mass)]: largest tip-sample force
+          F_c: the repulsive maximum (F_c > 0 pushes the tip away)
+        - ``min_force`` (sweep, z_c) [F~ (k g0 for the point mass)]: smallest tip-sample force
+          F_c: the adhesion minimum (F_c < 0 pulls the tip)
+        - ``indentation`` (sweep, z_c) [g0]: largest indentation max(-V_T, 0)
+        - ``contact_fraction`` (sweep, z_c) [1]: fraction of the time in contact (V_T <= 0)
+        - ``min_distance`` (sweep, z_c) [g0]: minimum tip-sample distance
+        - ``energy_dissipated`` (sweep, z_c) [F~ g0]: energy dissipated in the sample per drive
+          period E_dis
+        - ``virial`` (sweep, z_c) [F~ g0]: virial (1/T) integral of F_c W over a period
+        - ``harmonic_distortion`` (sweep, z_c) [1]: total harmonic distortion of the deflection
+        - ``higher_mode_fraction`` (sweep, z_c) [1]: participation of the higher eigenmodes: RMS
+          amplitude of the tip deflection of modes 2..N relative to mode 1's (0 for one mode)
+        - ``stable`` (sweep, z_c) [—]: every Floquet multiplier inside the unit circle
+        - ``period`` (sweep, z_c) [1]: n of the period-n motion (NaN: not periodic)
+        - ``reached`` (sweep, z_c) [—]: how the point's steady state was reached
+        - ``branch`` (branch_point) [—]: branch index
+        - ``branch_z_c`` (branch_point) [g0]: rest distance z_c of the tip above the sample
+        - ``branch_amplitude`` (branch_point) [g0]: first-harmonic amplitude A of the tip
+          deflection
+        - ``branch_amplitude_ratio`` (branch_point) [1]: A/A0 (A0 the free amplitude at the same
+          drive)
+        - ``branch_phase_deg`` (branch_point) [degree]: phase lag of the deflection behind the
+          drive (90 free, > 90 attractive, < 90 repulsive)
+        - ``branch_mean_deflection`` (branch_point) [g0]: mean tip deflection <W>
+        - ``branch_peak_force`` (branch_point) [F~ (k g0 for the point mass)]: largest
+          tip-sample force F_c: the repulsive maximum (F_c > 0 pushes the tip away)
+        - ``branch_min_force`` (branch_point) [F~ (k g0 for the point mass)]: smallest
+          tip-sample force F_c: the adhesion minimum (F_c < 0 pulls the tip)
+        - ``branch_indentation`` (branch_point) [g0]: largest indentation max(-V_T, 0)
+        - ``branch_contact_fraction`` (branch_point) [1]: fraction of the time in contact (V_T
+          <= 0)
+        - ``branch_min_distance`` (branch_point) [g0]: minimum tip-sample distance
+        - ``branch_energy_dissipated`` (branch_point) [F~ g0]: energy dissipated in the sample
+          per drive period E_dis
+        - ``branch_virial`` (branch_point) [F~ g0]: virial (1/T) integral of F_c W over a period
+        - ``branch_harmonic_distortion`` (branch_point) [1]: total harmonic distortion of the
+          deflection
+        - ``branch_higher_mode_fraction`` (branch_point) [1]: participation of the higher
+          eigenmodes: RMS amplitude of the tip deflection of modes 2..N relative to mode 1's (0
+          for one mode)
+        - ``branch_stable`` (branch_point) [—]: every Floquet multiplier inside the unit circle
+        - ``branch_period`` (branch_point) [1]: n of the period-n orbit
+        - ``branch_event`` (branch_point) [—]: event at the point (fold, period-doubling,
+          grazing, ...)
+        - ``trace_time`` (trace_time) [drive periods]: time within the recorded cycle
+        - ``trace_z_c`` (trace) [g0]: rest distance z_c of the tip above the sample
+        - ``trace_deflection`` (trace, trace_time) [g0]: tip deflection W(1,tau)
+        - ``trace_distance`` (trace, trace_time) [g0]: tip-sample distance V_T (<= 0 in contact)
+        - ``trace_force`` (trace, trace_time) [F~ (k g0 for the point mass)]: tip-sample force
+          F_c (> 0 repulsive, < 0 attractive)
     """
     return _api._finish_approach(locals())
 
@@ -224,13 +319,102 @@ def bimodal(
         **model: the model keywords (:class:`Model`), ``probe=`` a probe in SI.
 
     Returns:
-        The dataset of :func:`approach` plus, over (``sweep``, ``z_c``), ``amplitude_i``,
-        ``phase_i_deg``, ``virial_i`` and ``energy_dissipated_i`` (per cycle of component i)
-        for each component i = 1, 2, … (1 the primary; SI with a probe); the branches' as
-        ``branch_amplitude_2`` …; the frequencies, ratios and free amplitudes in
-        ``ds.afmdyn.to_dict()["drive_components"]``; for a time average, each point's periods,
-        whether it settled, and its amplitude and phase error estimates per component in
-        ``ds.afmdyn.to_dict()["time_average"]`` (an unsettled point also in the warnings).
+        The dataset of :func:`approach` plus, per cycle of each component i = 1, 2, … (1 the
+        primary; SI with a probe), its amplitude, phase, virial and dissipated energy, on the
+        sweeps and the branches (the ``_1``, ``_2`` variables below); the frequencies, ratios
+        and free amplitudes in ``ds.afmdyn.to_dict()["drive_components"]``; for a time average,
+        each point's periods, whether it settled, and its amplitude and phase error estimates
+        per component in ``ds.afmdyn.to_dict()["time_average"]`` (an unsettled point also in the
+        warnings).
+
+        Its variables (name (dims) [units]: meaning), as the library lays them out
+        (``docs/schema/layouts/bimodal.json``: its example request, under
+        ``examples/probe-bimodal.toml``, in SI):
+
+        - ``z_c`` (z_c) [m]: rest distance z_c of the tip above the sample
+        - ``sweep`` (sweep) [—]: sweep
+        - ``amplitude`` (sweep, z_c) [m]: first-harmonic amplitude A of the tip deflection
+        - ``amplitude_ratio`` (sweep, z_c) [1]: A/A0 (A0 the free amplitude at the same drive)
+        - ``phase_deg`` (sweep, z_c) [degree]: phase lag of the deflection behind the drive (90
+          free, > 90 attractive, < 90 repulsive)
+        - ``mean_deflection`` (sweep, z_c) [m]: mean tip deflection <W>
+        - ``peak_force`` (sweep, z_c) [N]: largest tip-sample force F_c: the repulsive maximum
+          (F_c > 0 pushes the tip away)
+        - ``min_force`` (sweep, z_c) [N]: smallest tip-sample force F_c: the adhesion minimum
+          (F_c < 0 pulls the tip)
+        - ``indentation`` (sweep, z_c) [m]: largest indentation max(-V_T, 0)
+        - ``contact_fraction`` (sweep, z_c) [1]: fraction of the time in contact (V_T <= 0)
+        - ``min_distance`` (sweep, z_c) [m]: minimum tip-sample distance
+        - ``energy_dissipated`` (sweep, z_c) [J]: energy dissipated in the sample per drive
+          period E_dis
+        - ``virial`` (sweep, z_c) [J]: virial (1/T) integral of F_c W over a period
+        - ``harmonic_distortion`` (sweep, z_c) [1]: total harmonic distortion of the deflection
+        - ``higher_mode_fraction`` (sweep, z_c) [1]: participation of the higher eigenmodes: RMS
+          amplitude of the tip deflection of modes 2..N relative to mode 1's (0 for one mode)
+        - ``amplitude_1`` (sweep, z_c) [m]: amplitude of the tip deflection at drive component
+          1's frequency
+        - ``phase_1_deg`` (sweep, z_c) [degree]: phase lag of the deflection behind drive
+          component 1
+        - ``virial_1`` (sweep, z_c) [J]: virial of component 1: <F_ts z_1>, z_1 the motion at
+          its frequency
+        - ``energy_dissipated_1`` (sweep, z_c) [J]: energy dissipated by component 1's motion,
+          per cycle of it
+        - ``amplitude_2`` (sweep, z_c) [m]: amplitude of the tip deflection at drive component
+          2's frequency
+        - ``phase_2_deg`` (sweep, z_c) [degree]: phase lag of the deflection behind drive
+          component 2
+        - ``virial_2`` (sweep, z_c) [J]: virial of component 2: <F_ts z_2>, z_2 the motion at
+          its frequency
+        - ``energy_dissipated_2`` (sweep, z_c) [J]: energy dissipated by component 2's motion,
+          per cycle of it
+        - ``stable`` (sweep, z_c) [—]: every Floquet multiplier inside the unit circle
+        - ``period`` (sweep, z_c) [1]: n of the period-n motion (NaN: not periodic)
+        - ``reached`` (sweep, z_c) [—]: how the point's steady state was reached
+        - ``branch`` (branch_point) [—]: branch index
+        - ``branch_z_c`` (branch_point) [m]: rest distance z_c of the tip above the sample
+        - ``branch_amplitude`` (branch_point) [m]: first-harmonic amplitude A of the tip
+          deflection
+        - ``branch_amplitude_ratio`` (branch_point) [1]: A/A0 (A0 the free amplitude at the same
+          drive)
+        - ``branch_phase_deg`` (branch_point) [degree]: phase lag of the deflection behind the
+          drive (90 free, > 90 attractive, < 90 repulsive)
+        - ``branch_mean_deflection`` (branch_point) [m]: mean tip deflection <W>
+        - ``branch_peak_force`` (branch_point) [N]: largest tip-sample force F_c: the repulsive
+          maximum (F_c > 0 pushes the tip away)
+        - ``branch_min_force`` (branch_point) [N]: smallest tip-sample force F_c: the adhesion
+          minimum (F_c < 0 pulls the tip)
+        - ``branch_indentation`` (branch_point) [m]: largest indentation max(-V_T, 0)
+        - ``branch_contact_fraction`` (branch_point) [1]: fraction of the time in contact (V_T
+          <= 0)
+        - ``branch_min_distance`` (branch_point) [m]: minimum tip-sample distance
+        - ``branch_energy_dissipated`` (branch_point) [J]: energy dissipated in the sample per
+          drive period E_dis
+        - ``branch_virial`` (branch_point) [J]: virial (1/T) integral of F_c W over a period
+        - ``branch_harmonic_distortion`` (branch_point) [1]: total harmonic distortion of the
+          deflection
+        - ``branch_higher_mode_fraction`` (branch_point) [1]: participation of the higher
+          eigenmodes: RMS amplitude of the tip deflection of modes 2..N relative to mode 1's (0
+          for one mode)
+        - ``branch_amplitude_1`` (branch_point) [m]: amplitude of the tip deflection at drive
+          component 1's frequency
+        - ``branch_phase_1_deg`` (branch_point) [degree]: phase lag of the deflection behind
+          drive component 1
+        - ``branch_virial_1`` (branch_point) [J]: virial of component 1: <F_ts z_1>, z_1 the
+          motion at its frequency
+        - ``branch_energy_dissipated_1`` (branch_point) [J]: energy dissipated by component 1's
+          motion, per cycle of it
+        - ``branch_amplitude_2`` (branch_point) [m]: amplitude of the tip deflection at drive
+          component 2's frequency
+        - ``branch_phase_2_deg`` (branch_point) [degree]: phase lag of the deflection behind
+          drive component 2
+        - ``branch_virial_2`` (branch_point) [J]: virial of component 2: <F_ts z_2>, z_2 the
+          motion at its frequency
+        - ``branch_energy_dissipated_2`` (branch_point) [J]: energy dissipated by component 2's
+          motion, per cycle of it
+        - ``branch_stable`` (branch_point) [—]: every Floquet multiplier inside the unit circle
+        - ``branch_period`` (branch_point) [1]: n of the period-n orbit
+        - ``branch_event`` (branch_point) [—]: event at the point (fold, period-doubling,
+          grazing, ...)
 
     Raises:
         ValueError: for a single-frequency drive (naming ``[drive].free_amplitude``), and as
@@ -285,6 +469,65 @@ def resonance(
         An ``xarray.Dataset`` as :func:`approach`'s over ``frequency_hz`` (with a probe) or
         ``omega`` and ``sweep`` = ``up``/``down``; ``ds.afmdyn.to_dict()`` is the
         ``afmdyn resonance --json`` document.
+
+        Its variables (name (dims) [units]: meaning), as the library lays them out
+        (``docs/schema/layouts/resonance.json``: its example request, in the model's units; SI
+        with a probe, as each variable's ``units`` attribute says):
+
+        - ``omega`` (omega) [Ω]: dimensionless drive frequency Ω
+        - ``sweep`` (sweep) [—]: sweep
+        - ``amplitude`` (sweep, omega) [g0]: first-harmonic amplitude A of the tip deflection
+        - ``amplitude_ratio`` (sweep, omega) [1]: A/A0 (A0 the free amplitude at the same drive)
+        - ``phase_deg`` (sweep, omega) [degree]: phase lag of the deflection behind the drive
+          (90 free, > 90 attractive, < 90 repulsive)
+        - ``mean_deflection`` (sweep, omega) [g0]: mean tip deflection <W>
+        - ``peak_force`` (sweep, omega) [F~ (k g0 for the point mass)]: largest tip-sample force
+          F_c: the repulsive maximum (F_c > 0 pushes the tip away)
+        - ``min_force`` (sweep, omega) [F~ (k g0 for the point mass)]: smallest tip-sample force
+          F_c: the adhesion minimum (F_c < 0 pulls the tip)
+        - ``indentation`` (sweep, omega) [g0]: largest indentation max(-V_T, 0)
+        - ``contact_fraction`` (sweep, omega) [1]: fraction of the time in contact (V_T <= 0)
+        - ``min_distance`` (sweep, omega) [g0]: minimum tip-sample distance
+        - ``energy_dissipated`` (sweep, omega) [F~ g0]: energy dissipated in the sample per
+          drive period E_dis
+        - ``virial`` (sweep, omega) [F~ g0]: virial (1/T) integral of F_c W over a period
+        - ``harmonic_distortion`` (sweep, omega) [1]: total harmonic distortion of the
+          deflection
+        - ``higher_mode_fraction`` (sweep, omega) [1]: participation of the higher eigenmodes:
+          RMS amplitude of the tip deflection of modes 2..N relative to mode 1's (0 for one
+          mode)
+        - ``stable`` (sweep, omega) [—]: every Floquet multiplier inside the unit circle
+        - ``period`` (sweep, omega) [1]: n of the period-n motion (NaN: not periodic)
+        - ``reached`` (sweep, omega) [—]: how the point's steady state was reached
+        - ``branch`` (branch_point) [—]: branch index
+        - ``branch_omega`` (branch_point) [Ω]: dimensionless drive frequency Ω
+        - ``branch_amplitude`` (branch_point) [g0]: first-harmonic amplitude A of the tip
+          deflection
+        - ``branch_amplitude_ratio`` (branch_point) [1]: A/A0 (A0 the free amplitude at the same
+          drive)
+        - ``branch_phase_deg`` (branch_point) [degree]: phase lag of the deflection behind the
+          drive (90 free, > 90 attractive, < 90 repulsive)
+        - ``branch_mean_deflection`` (branch_point) [g0]: mean tip deflection <W>
+        - ``branch_peak_force`` (branch_point) [F~ (k g0 for the point mass)]: largest
+          tip-sample force F_c: the repulsive maximum (F_c > 0 pushes the tip away)
+        - ``branch_min_force`` (branch_point) [F~ (k g0 for the point mass)]: smallest
+          tip-sample force F_c: the adhesion minimum (F_c < 0 pulls the tip)
+        - ``branch_indentation`` (branch_point) [g0]: largest indentation max(-V_T, 0)
+        - ``branch_contact_fraction`` (branch_point) [1]: fraction of the time in contact (V_T
+          <= 0)
+        - ``branch_min_distance`` (branch_point) [g0]: minimum tip-sample distance
+        - ``branch_energy_dissipated`` (branch_point) [F~ g0]: energy dissipated in the sample
+          per drive period E_dis
+        - ``branch_virial`` (branch_point) [F~ g0]: virial (1/T) integral of F_c W over a period
+        - ``branch_harmonic_distortion`` (branch_point) [1]: total harmonic distortion of the
+          deflection
+        - ``branch_higher_mode_fraction`` (branch_point) [1]: participation of the higher
+          eigenmodes: RMS amplitude of the tip deflection of modes 2..N relative to mode 1's (0
+          for one mode)
+        - ``branch_stable`` (branch_point) [—]: every Floquet multiplier inside the unit circle
+        - ``branch_period`` (branch_point) [1]: n of the period-n orbit
+        - ``branch_event`` (branch_point) [—]: event at the point (fold, period-doubling,
+          grazing, ...)
     """
     return _api._finish_resonance(locals())
 
@@ -389,14 +632,27 @@ def peakforce(
         **model: the model keywords (:class:`Model`), ``probe=`` a probe in SI.
 
     Returns:
-        An ``xarray.Dataset`` of one cycle over ``sample`` (time, deflection, distance, force)
-        and the force–distance curve, in SI with a probe; attributes: the channels
-        (``peak_force``, ``adhesion``, ``deformation``, ``dissipation``, ``contact_time``,
-        ``snap_off_time``, ``ringing_amplitude``, ``modulus_dmt``, ``taps_per_cycle``) and
-        ``summary`` (the ``afmdyn peakforce --json`` document). With a sweep the channels
-        (and ``modulus_dmt``, ``z_c``, ``period``) are variables over its dimension, NaN where
-        a value failed; the cycle and curve are the first computed value's. Warnings (period-2
-        tapping, double taps, an unstable tap) are raised as :class:`afmdyn.AfmdynWarning`.
+        An ``xarray.Dataset`` of one cycle over ``sample`` and the force–distance curve, in SI
+        with a probe; attributes: the channels (``peak_force``, ``adhesion``, ``deformation``,
+        ``dissipation``, ``contact_time``, ``snap_off_time``, ``ringing_amplitude``,
+        ``modulus_dmt``, ``taps_per_cycle``) and ``summary`` (the ``afmdyn peakforce --json``
+        document). With a sweep the channels (and ``modulus_dmt``, ``z_c``, ``period``) are
+        variables over its dimension, NaN where a value failed; the cycle and curve are the
+        first computed value's. Warnings (period-2 tapping, double taps, an unstable tap) are
+        raised as :class:`afmdyn.AfmdynWarning`.
+
+        Its variables (name (dims) [units]: meaning), as the library lays them out
+        (``docs/schema/layouts/peakforce.json``: its example request, under
+        ``examples/probe-peakforce-air.toml``, in SI):
+
+        - ``time`` (sample) [s]: time
+        - ``deflection`` (sample) [m]: deflection
+        - ``distance`` (sample) [m]: distance
+        - ``force`` (sample) [N]: force
+        - ``approach_distance`` (approach) [m]: distance, approach
+        - ``approach_force`` (approach) [N]: force, approach
+        - ``retract_distance`` (retract) [m]: distance, retract
+        - ``retract_force`` (retract) [N]: force, retract
 
     Raises:
         ValueError: naming the option or the model parameter.
@@ -451,13 +707,22 @@ def fit(
         **model: the model keywords (:class:`Model`), ``probe=`` a probe in SI.
 
     Returns:
-        An ``xarray.Dataset``: over ``row`` the fitted rows' ``tip_position``, ``force``,
-        ``fit`` and ``residual``; over ``parameter`` the ``estimate``, ``standard_error``,
-        ``interval_low`` and ``interval_high`` (95 %), and ``correlation`` over
-        (``parameter``, ``parameter_2``); attributes ``chi2_dof``, ``noise`` and ``summary``
-        (the ``afmdyn fit --json`` document). Warnings (a correlation above 0.99, a flat
-        profile, an estimate at its bound, the noise estimated from the residuals) are raised
-        as :class:`afmdyn.AfmdynWarning`.
+        An ``xarray.Dataset``: the fitted rows (the variables below) and, from the document,
+        over ``parameter`` the ``estimate``, ``standard_error``, ``interval_low`` and
+        ``interval_high`` (95 %), and ``correlation`` over (``parameter``, ``parameter_2``);
+        attributes ``chi2_dof``, ``noise``, ``law`` and ``summary`` (the ``afmdyn fit --json``
+        document). Warnings (a correlation above 0.99, a flat profile, an estimate at its
+        bound, the noise estimated from the residuals) are raised as
+        :class:`afmdyn.AfmdynWarning`.
+
+        Its variables (name (dims) [units]: meaning), as the library lays them out
+        (``docs/schema/layouts/fit.json``: its example request, under
+        ``examples/probe-fit-hertz.toml``, in SI):
+
+        - ``tip_position`` (row) [m]: tip position
+        - ``force`` (row) [N]: force, measured
+        - ``fit`` (row) [N]: force, fitted
+        - ``residual`` (row) [N]: measured − fitted
 
     Raises:
         ValueError: naming the option, the data or the probe key.
@@ -524,12 +789,11 @@ def image(
             log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.
 
     Returns:
-        ``xarray.Dataset`` over ``y`` and ``x`` (m): ``height``, ``true_height``, ``z_c``,
-        ``amplitude``, ``phase_deg``, ``energy_dissipated``, ``virial``, ``peak_force``,
-        ``indentation`` (NaN where the setpoint is not reached; units and long names as the
-        library lays them out, the variables of ``afmdyn image``'s ``image.nc``), ``regime``,
-        ``material`` and ``domain`` (strings); attributes ``setpoint``, ``reference_z_c`` (m) and
-        ``summary`` (the command line's JSON document, with each material's operating points).
+        ``xarray.Dataset`` over ``y`` and ``x`` (m), NaN where the setpoint is not reached; the
+        codes ``regime``, ``material`` and ``domain`` as their words; attributes ``setpoint``,
+        ``reference_z_c`` (m) and ``summary`` (the command line's JSON document, with each
+        material's operating points). The variables below are the ideal feedback's
+        (``image.nc``).
 
         With ``feedback="pi"``: the recorded trace ``height``, ``amplitude``, ``phase_deg``,
         ``tracking_error``, ``energy_dissipated``, ``virial``, ``peak_force``, ``indentation``
@@ -542,6 +806,26 @@ def image(
         ``modulus_dmt``, ``adhesion``, ``deformation``, ``dissipation``, ``taps_per_cycle``,
         ``evaluations`` (steady taps computed at the pixel), ``material`` and ``domain``, as
         ``image.nc`` of ``afmdyn image --mode peakforce``.
+
+        Its variables (name (dims) [units]: meaning), as the library lays them out
+        (``docs/schema/layouts/image.json``: its example request, under
+        ``examples/probe-point-mass-dmt.toml``, in SI):
+
+        - ``x`` (x) [m]: pixel centre x
+        - ``y`` (y) [m]: line position y
+        - ``height`` (y, x) [m]: apparent height h + z_c − z_c,ref (ideal feedback)
+        - ``true_height`` (y, x) [m]: true height of the sample map
+        - ``z_c`` (y, x) [m]: rest distance z_c the feedback holds
+        - ``amplitude`` (y, x) [m]: amplitude (the setpoint where reached)
+        - ``phase_deg`` (y, x) [degree]: phase lag behind the drive
+        - ``energy_dissipated`` (y, x) [J]: energy dissipated per drive period
+        - ``virial`` (y, x) [J]: virial of the tip–sample force
+        - ``peak_force`` (y, x) [N]: largest tip–sample force
+        - ``indentation`` (y, x) [m]: largest indentation
+        - ``regime`` (y, x) [1]: regime of the operating point (mean tip–sample force attractive
+          or repulsive)
+        - ``material`` (y, x) [1]: material of the pixel
+        - ``domain`` (y, x) [1]: domain of the sample map on top at the pixel
 
     Raises:
         ValueError: naming the field — a setpoint outside (0, 1), pixels or lines outside

@@ -173,14 +173,29 @@ def basins(
         **model: the model keywords (:class:`Model`), ``probe=`` a probe in SI.
 
     Returns:
-        ``xarray.Dataset`` with dims ``(y, x)``: ``label`` (attractor id, −2 failed),
-        ``decided`` (``"near"``, ``"recurrence"``, ``"grid"``, ``"steady"``, ``"failed"``),
-        ``periods``; dim ``attractor``: ``period`` (−1 nonperiodic), ``x_max``, ``v_t_min``
-        (g0), ``basin_fraction``, ``stable`` (1/0 from the Floquet multipliers of the orbit
-        polished by shooting; NaN nonperiodic), ``lyapunov`` (λ₁ of a nonperiodic attractor);
-        attributes ``basin_entropy``, ``boundary_basin_entropy`` (Daza et al. 2016; NaN when
-        undefined), ``uncertainty_exponent`` (Grebogi et al. 1983) and ``summary`` (the
-        command line's JSON document).
+        ``xarray.Dataset`` over the plane ``(y, x)`` and the attractors found (``attractor``, a
+        coordinate 0, 1, …); ``decided`` as its words (``"near"``, ``"recurrence"``,
+        ``"grid"``, ``"steady"``, ``"failed"``); attributes ``basin_entropy``,
+        ``boundary_basin_entropy`` (Daza et al. 2016; NaN when undefined),
+        ``uncertainty_exponent`` (Grebogi et al. 1983) and ``summary`` (the command line's JSON
+        document).
+
+        Its variables (name (dims) [units]: meaning), as the library lays them out
+        (``docs/schema/layouts/basins.json``: its example request, in the model's units; SI with
+        a probe, as each variable's ``units`` attribute says):
+
+        - ``x`` (x) [g0]: a1 at tau = 0
+        - ``y`` (y) [g0 per unit tau]: adot1 at tau = 0
+        - ``label`` (y, x) [1]: attractor id; -2 failed
+        - ``decided`` (y, x) [1]: how the cell was decided
+        - ``periods`` (y, x) [drive periods]: drive periods the start ran
+        - ``period`` (attractor) [drive periods]: period n; -1 nonperiodic
+        - ``x_max`` (attractor) [g0]: largest tip deflection W(1,tau)
+        - ``v_t_min`` (attractor) [g0]: smallest V_T
+        - ``basin_fraction`` (attractor) [1]: share of the map's cells
+        - ``stable`` (attractor) [1]: 1 stable periodic orbit (shooting), 0 unstable, NaN
+          unknown
+        - ``lyapunov`` (attractor) [1/tau]: largest Lyapunov exponent of a nonperiodic attractor
     """
     return _basins._finish_basins(locals())
 
@@ -256,10 +271,22 @@ def global_continuation(
         **model: the model keywords (:class:`Model`), ``probe=`` a probe in SI.
 
     Returns:
-        ``xarray.Dataset`` with dims ``(value, id)``: ``basin_fraction`` (0 where the id has no
-        attractor), ``period`` (−1 nonperiodic, 0 absent), ``x_max`` and ``v_t_min`` (g0, NaN
-        absent), ``stable`` (1/0 from the Floquet multipliers of the orbit polished by shooting,
-        NaN otherwise); dim ``value``: ``failures`` (runs that failed). Attribute ``summary``:
-        the command line's JSON document (Poincaré points, multipliers of every attractor).
+        ``xarray.Dataset`` over ``(value, id)``, an id one attractor followed over the
+        parameter. Attribute ``summary``: the command line's JSON document (Poincaré points,
+        multipliers of every attractor).
+
+        Its variables (name (dims) [units]: meaning), as the library lays them out
+        (``docs/schema/layouts/global_continuation.json``: its example request, in the model's
+        units; SI with a probe, as each variable's ``units`` attribute says):
+
+        - ``value`` (value) [1]: omega
+        - ``id`` (id) [1]: attractor id
+        - ``basin_fraction`` (value, id) [1]: share of the random starts (0: none)
+        - ``period`` (value, id) [drive periods]: period n (-1 nonperiodic, 0 absent)
+        - ``x_max`` (value, id) [g0]: X_max
+        - ``v_t_min`` (value, id) [g0]: min V_T
+        - ``stable`` (value, id) [1]: 1 stable periodic orbit (shooting), 0 unstable, NaN
+          otherwise
+        - ``failures`` (value) [1]: runs that failed
     """
     return _basins._finish_global_continuation(locals())
