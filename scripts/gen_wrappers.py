@@ -205,34 +205,51 @@ def _arg_lines(name: str, text: str) -> List[str]:
                          subsequent_indent=" " * 12)
 
 
-def _layout_rows(name: str, omit: Tuple[str, ...]) -> List[Tuple[str, str, str, str]]:
-    """(name, dims, units, long name) of every variable of analysis ``name``'s layouts (the
-    datasets of one result merged, as the finishers merge them: a name once), but ``omit``."""
-    doc = json.loads((LAYOUTS / f"{name}.json").read_text())
+def _layout_rows(stem: str, dims: Tuple[Tuple[str, ...], ...]
+                 ) -> List[Tuple[str, str, str, str]]:
+    """(name, dims, units, long name) of every variable of the layouts of
+    ``docs/schema/layouts/<stem>.json`` (the datasets of one result merged, as the finishers
+    merge them: a name once); with ``dims``, only the variables over one of them."""
+    doc = json.loads((LAYOUTS / f"{stem}.json").read_text())
     rows: Dict[str, Tuple[str, str, str, str]] = {}
     for ds in doc["datasets"]:
         for v in ds["variables"]:
-            if v["name"] not in omit and v["name"] not in rows:
-                dims = ", ".join(v["dims"]) or "scalar"
-                rows[v["name"]] = (f"``{v['name']}``", dims, v["units"] or "—", v["long_name"])
+            if v["name"] in rows or (dims and tuple(v["dims"]) not in dims):
+                continue
+            over = ", ".join(v["dims"]) or "scalar"
+            rows[v["name"]] = (f"``{v['name']}``", over, v["units"] or "—", v["long_name"])
     return list(rows.values())
 
 
-def _layout_table(name: str, omit: Tuple[str, ...]) -> List[str]:
-    """The variables of analysis ``name``'s dataset, one entry each (name, dims, units:
-    meaning; a table as a list, its meanings too long for columns), after the sentence that
-    sources them."""
-    probe = json.loads((LAYOUTS / f"{name}.json").read_text())["example"]["probe"]
+def _layout_table(stem: str, dims: Tuple[Tuple[str, ...], ...], lead: str = "Its"
+                  ) -> List[str]:
+    """The variables of the dataset laid out in ``docs/schema/layouts/<stem>.json``, one entry
+    each (name, dims, units: meaning; a table as a list, its meanings too long for columns),
+    after the sentence that sources them."""
+    probe = json.loads((LAYOUTS / f"{stem}.json").read_text())["example"]["probe"]
     units = (f"under ``{probe}``, in SI" if probe else
              "in the model's units; SI with a probe, as each variable's ``units`` attribute says")
     intro = textwrap.wrap(
-        f"Its variables (name (dims) [units]: meaning), as the library lays them out "
-        f"(``docs/schema/layouts/{name}.json``: its example request, {units}):", 88, break_on_hyphens=False)
+        f"{lead} variables (name (dims) [units]: meaning), as the library lays them out "
+        f"(``docs/schema/layouts/{stem}.json``: its example request, {units}):", 88,
+        break_on_hyphens=False)
     rows = []
-    for var, dims, units, meaning in _layout_rows(name, omit):
-        rows += textwrap.wrap(f"- {var} ({dims}) [{units}]: {meaning}", 88,
+    for var, over, unit, meaning in _layout_rows(stem, dims):
+        rows += textwrap.wrap(f"- {var} ({over}) [{unit}]: {meaning}", 88,
                               subsequent_indent="  ", break_on_hyphens=False)
     return intro + [""] + rows
+
+
+def _layout_tables(name: str, doc: Dict[str, object]) -> List[str]:
+    """The tables of analysis ``name``'s dataset: its layout's, then each variant's
+    (``<name>.<variant>.json``, introduced by ``doc["layout_variants"][variant]``)."""
+    dims = tuple(tuple(d) for d in doc.get("layout_dims", ()))  # type: ignore
+    out = _layout_table(name, dims)
+    for path in sorted(LAYOUTS.glob(f"{name}.*.json")):
+        variant = path.stem.split(".", 1)[1]
+        lead = f"With {doc['layout_variants'][variant]}, its"  # type: ignore
+        out += [""] + _layout_table(path.stem, dims, lead)
+    return out
 
 
 def _function(file: str, name: str) -> str:
@@ -275,8 +292,7 @@ def _function(file: str, name: str) -> str:
         # return their local function's dataset)
         if section == "returns" and returns == "xr.Dataset" and file != "_dask_wrappers.py" \
                 and (LAYOUTS / f"{name}.json").exists():
-            table = _layout_table(name, tuple(doc.get("layout_omit", ())))
-            body += [""] + ["    " + t if t else "" for t in table]
+            body += [""] + ["    " + t if t else "" for t in _layout_tables(name, doc)]
     text = textwrap.indent("\n".join(body), "    ").replace("\n    \n", "\n\n")
     lines = (["@_typed"] if opts.get("typed", True) else []) + [
         f"def {name}(", *sig, f") -> {returns}:", f'    """{text.strip()}', '    """',

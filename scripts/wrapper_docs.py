@@ -402,8 +402,10 @@ IMAGE_ARGS = {
 }
 
 WRAPPERS["image"] = {
-    # the layout's scalars are the dataset's attributes (``_image._dataset``)
-    "layout_omit": ("setpoint", "reference_z_c"),
+    # the dataset keeps the maps over (y, x) and the coordinates; the layout's scalars are its
+    # attributes (``_image._dataset``)
+    "layout_dims": (("y", "x"), ("x",), ("y",)),
+    "layout_variants": {"pi": '``feedback="pi"``', "peakforce": '``mode="peakforce"``'},
     "summary": """\
 The image an amplitude feedback records over a heterogeneous sample
 (``afmdyn image``). ``feedback="ideal"``: at every pixel the operating point of the local
@@ -420,20 +422,11 @@ Returns:
     ``xarray.Dataset`` over ``y`` and ``x`` (m), NaN where the setpoint is not reached; the
     codes ``regime``, ``material`` and ``domain`` as their words; attributes ``setpoint``,
     ``reference_z_c`` (m) and ``summary`` (the command line's JSON document, with each
-    material's operating points). The variables below are the ideal feedback's
-    (``image.nc``).
-
-    With ``feedback="pi"``: the recorded trace ``height``, ``amplitude``, ``phase_deg``,
-    ``tracking_error``, ``energy_dissipated``, ``virial``, ``peak_force``, ``indentation``
-    and ``lost_contact``, the same with ``_retrace``, ``ideal_height`` and
-    ``true_height`` (m); attributes ``scan`` (the settings) and ``artefacts`` (JSON: per
-    direction the height error against the ideal image, the overshoot, the error image's
-    RMS, the pixels that lost contact).
-
-    With ``mode="peakforce"``: ``height``, ``true_height``, ``z_c``, ``peak_force``,
-    ``modulus_dmt``, ``adhesion``, ``deformation``, ``dissipation``, ``taps_per_cycle``,
-    ``evaluations`` (steady taps computed at the pixel), ``material`` and ``domain``, as
-    ``image.nc`` of ``afmdyn image --mode peakforce``.""",
+    material's operating points): the maps of ``afmdyn image``'s ``image.nc``. With
+    ``feedback="pi"`` the recorded trace and retrace (``_retrace``) and the attributes
+    ``scan`` (the settings) and ``artefacts`` (JSON: per direction the height error against
+    the ideal image, the overshoot, the error image's RMS, the pixels that lost contact);
+    with ``mode="peakforce"`` the channels of the ideal peak-force feedback.""",
     "raises": """\
 Raises:
     ValueError: naming the field — a setpoint outside (0, 1), pixels or lines outside

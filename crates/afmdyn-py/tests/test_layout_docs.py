@@ -19,53 +19,60 @@ from conftest import REPO
 
 LAYOUTS = REPO / "docs" / "schema" / "layouts"
 
-#: the analyses whose dataset is its layouts as they are (the others add variables from their
-#: document, ``fit``, or turn a code into words and add a coordinate, ``basins``); ``image``
-#: keeps the maps over (y, x), its scalars becoming attributes (the docstring leaves them out)
-ANALYSES = ["simulate", "converge", "continuation", "observe", "approach", "resonance",
-            "bifurcation", "global_continuation", "chart", "bimodal", "peakforce", "image"]
+#: the layout files of the analyses whose dataset is its layouts as they are (the others add
+#: variables from their document, ``fit``, or turn a code into words and add a coordinate,
+#: ``basins``); ``image`` keeps the maps over (y, x), its scalars becoming attributes (the
+#: docstring leaves them out), and has a variant per feedback and mode (``image.pi``, …)
+STEMS = ["simulate", "converge", "continuation", "observe", "approach", "resonance",
+         "bifurcation", "global_continuation", "chart", "bimodal", "peakforce", "image",
+         "image.pi", "image.peakforce"]
 
 ENTRY = re.compile(r"^\s*- ``([^`]+)`` \(([^)]*)\) \[([^]]*)\]:")
+SOURCE = re.compile(r"``docs/schema/layouts/([^`]+)\.json``")
 
 
-def documented(name: str) -> Dict[str, Tuple[Tuple[str, ...], str]]:
-    """The variables the docstring of ``afmdyn.<name>`` names after "Its variables": name ->
-    (dims, units)."""
-    doc = getattr(afmdyn, name).__doc__ or ""
-    _, found, table = doc.partition("Its variables")
-    assert found, f"afmdyn.{name}: no variables in its docstring"
-    out = {}
-    for line in table.splitlines():
+def documented(stem: str) -> Dict[str, Tuple[Tuple[str, ...], str]]:
+    """The variables the docstring of ``afmdyn.<name>`` names in its table sourced from
+    ``docs/schema/layouts/<stem>.json``: name -> (dims, units)."""
+    doc = getattr(afmdyn, stem.split(".")[0]).__doc__ or ""
+    tables: Dict[str, Dict[str, Tuple[Tuple[str, ...], str]]] = {}
+    table = None
+    for line in doc.splitlines():
         m = ENTRY.match(line)
-        if m:
+        if m and table is not None:
             dims = () if m.group(2) == "scalar" else tuple(m.group(2).split(", "))
-            out[m.group(1)] = (dims, m.group(3))
-    return out
+            table[m.group(1)] = (dims, m.group(3))
+        elif SOURCE.search(line):
+            table = tables.setdefault(SOURCE.search(line).group(1), {})  # type: ignore
+    assert stem in tables, f"afmdyn.{stem}: no table of variables in its docstring"
+    return tables[stem]
 
 
-def example(name: str) -> Tuple[List[Any], Dict[str, Any]]:
-    """The positional arguments and keywords of the layout file's example for ``name``."""
-    ex = json.loads((LAYOUTS / f"{name}.json").read_text())["example"]
+def example(stem: str) -> Tuple[List[Any], Dict[str, Any]]:
+    """The positional arguments and keywords of the layout file's example ``stem``."""
+    ex = json.loads((LAYOUTS / f"{stem}.json").read_text())["example"]
     kw = {("from_" if k == "from" else k): v for k, v in ex["request"].items()}
     probe = None if ex["probe"] is None else str(REPO / ex["probe"])
-    if name == "image":
+    if stem.startswith("image"):
+        if "feedback" in kw:  # a PI scan's settings: Python's keywords
+            kw.update(kw.pop("feedback"), feedback="pi")
         return [probe, str(REPO / kw.pop("sample")), kw.pop("setpoint")], kw
     if probe is not None:
         kw["probe"] = probe
     return [], kw
 
 
-def run(name: str) -> xr.Dataset:
-    """``afmdyn.<name>`` on its layout file's example."""
-    args, kw = example(name)
+def run(stem: str) -> xr.Dataset:
+    """The analysis of ``stem`` on its layout file's example."""
+    args, kw = example(stem)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", afmdyn.AfmdynWarning)
-        ds = getattr(afmdyn, name)(*args, **kw)
+        ds = getattr(afmdyn, stem.split(".")[0])(*args, **kw)
     assert isinstance(ds, xr.Dataset)
     return ds
 
 
-@pytest.mark.parametrize("name", ANALYSES)
+@pytest.mark.parametrize("name", STEMS)
 def test_the_dataset_has_the_variables_its_docstring_names(name: str) -> None:
     ds = run(name)
     doc = documented(name)
@@ -74,14 +81,19 @@ def test_the_dataset_has_the_variables_its_docstring_names(name: str) -> None:
         assert ds[var].dims == dims, (name, var)
 
 
-#: ``afmdyn.peakforce`` merges its layouts' datasets with ``combine_attrs="drop"``
-#: (``_peakforce.py``; ``_fit.py`` too), which drops every variable's units and long name
-DROPS_UNITS = pytest.mark.xfail(strict=True, reason="xr.merge(combine_attrs='drop') drops "
-                                "the variables' attrs (_peakforce.py)")
+#: known losses of units in the finishers: ``afmdyn.peakforce`` merges its layouts' datasets
+#: with ``combine_attrs="drop"`` (``_peakforce.py``; ``_fit.py`` too), which drops every
+#: variable's units and long name; ``_image._dataset`` takes every integer map for a code to
+#: turn into words, and keeps ``evaluations`` (a count) without its units
+LOSES_UNITS = {
+    "peakforce": "xr.merge(combine_attrs='drop') drops the variables' attrs (_peakforce.py)",
+    "image.peakforce": "_image._dataset drops the units of the integer map evaluations",
+}
 
 
-@pytest.mark.parametrize("name", [pytest.param(n, marks=DROPS_UNITS) if n == "peakforce" else n
-                                  for n in ANALYSES])
+@pytest.mark.parametrize("name", [
+    pytest.param(n, marks=pytest.mark.xfail(strict=True, reason=LOSES_UNITS[n]))
+    if n in LOSES_UNITS else n for n in STEMS])
 def test_each_variable_has_the_units_its_docstring_gives(name: str) -> None:
     ds = run(name)
     for var, (_, units) in documented(name).items():
@@ -90,11 +102,12 @@ def test_each_variable_has_the_units_its_docstring_gives(name: str) -> None:
         assert ds[var].attrs.get("units", "—") == units, (name, var)
 
 
-def test_a_layout_omits_nothing_the_docstring_shows() -> None:
-    """Every variable of ``approach``'s layout file is in its docstring (nothing left out
-    but what the function's docs omit, ``image``'s scalars)."""
-    for name in ("approach", "image"):
-        layout = json.loads((LAYOUTS / f"{name}.json").read_text())
+def test_a_table_leaves_out_only_what_the_function_drops() -> None:
+    """Every variable of a layout file is in its docstring's table but those the function
+    does not return: ``image``'s scalars (its attributes)."""
+    for stem in STEMS:
+        layout = json.loads((LAYOUTS / f"{stem}.json").read_text())
         names = {v["name"] for d in layout["datasets"] for v in d["variables"]}
-        left = names - set(documented(name))
-        assert left == (set() if name == "approach" else {"setpoint", "reference_z_c"}), name
+        scalars = {v["name"] for d in layout["datasets"] for v in d["variables"]
+                   if not v["dims"]} if stem.startswith("image") else set()
+        assert names - set(documented(stem)) == scalars, stem

@@ -42,10 +42,13 @@ enum Route {
     Image,
 }
 
-/// One example: the analysis (the Python function's name), its route and request, and the
-/// probe file (a repository path) it runs under (`None`: the paper's parameters).
+/// One example: the analysis (the Python function's name), its variant (another layout of the
+/// same analysis: `image`'s PI scan and PeakForce image, file `<analysis>.<variant>.json`),
+/// its route and request, and the probe file (a repository path) it runs under (`None`: the
+/// paper's parameters).
 struct Example {
     analysis: &'static str,
+    variant: Option<&'static str>,
     route: Route,
     request: Value,
     probe: Option<&'static str>,
@@ -59,6 +62,7 @@ fn ex(
 ) -> Example {
     Example {
         analysis,
+        variant: None,
         route,
         request,
         probe,
@@ -133,7 +137,35 @@ fn examples() -> Vec<Example> {
                    "curve_points": 20}),
             Some("examples/probe-point-mass-dmt.toml"),
         ),
+        Example {
+            variant: Some("pi"),
+            ..ex(
+                "image",
+                Image,
+                json!({"sample": "examples/sample-stripe.toml", "setpoint": 0.7, "pixels": 4,
+                       "curve_points": 20, "feedback": {"scan_rate": 40.0}, "threads": 1}),
+                Some("examples/probe-point-mass-dmt.toml"),
+            )
+        },
+        Example {
+            variant: Some("peakforce"),
+            ..ex(
+                "image",
+                Image,
+                json!({"sample": "examples/sample-peakforce-blend.toml", "setpoint": 2e-9,
+                       "mode": "peakforce", "pixels": 2, "lines": 2, "threads": 1}),
+                Some("examples/probe-peakforce-amo-garcia.toml"),
+            )
+        },
     ]
+}
+
+/// The file stem of `e`: its analysis, and its variant after a dot.
+fn stem(e: &Example) -> String {
+    match e.variant {
+        Some(v) => format!("{}.{v}", e.analysis),
+        None => e.analysis.to_string(),
+    }
 }
 
 fn read(repo_path: &str) -> String {
@@ -220,6 +252,7 @@ fn file(e: &Example) -> Value {
         .collect();
     json!({
         "analysis": e.analysis,
+        "variant": e.variant,
         "example": {"request": e.request, "probe": e.probe},
         "datasets": datasets,
     })
@@ -232,7 +265,7 @@ fn layouts_match_the_committed_files() {
     let mut stale = Vec::new();
     for e in examples() {
         let text = serde_json::to_string_pretty(&file(&e)).unwrap() + "\n";
-        let path = dir.join(format!("{}.json", e.analysis));
+        let path = dir.join(format!("{}.json", stem(&e)));
         if write {
             std::fs::create_dir_all(&dir).unwrap();
             std::fs::write(&path, &text).unwrap();
@@ -252,7 +285,7 @@ fn layouts_match_the_committed_files() {
 fn no_stray_layout_file() {
     let names: Vec<String> = examples()
         .iter()
-        .map(|e| format!("{}.json", e.analysis))
+        .map(|e| format!("{}.json", stem(e)))
         .collect();
     let Ok(entries) = std::fs::read_dir(dir()) else {
         return;

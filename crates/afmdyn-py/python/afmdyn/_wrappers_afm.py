@@ -792,20 +792,11 @@ def image(
         ``xarray.Dataset`` over ``y`` and ``x`` (m), NaN where the setpoint is not reached; the
         codes ``regime``, ``material`` and ``domain`` as their words; attributes ``setpoint``,
         ``reference_z_c`` (m) and ``summary`` (the command line's JSON document, with each
-        material's operating points). The variables below are the ideal feedback's
-        (``image.nc``).
-
-        With ``feedback="pi"``: the recorded trace ``height``, ``amplitude``, ``phase_deg``,
-        ``tracking_error``, ``energy_dissipated``, ``virial``, ``peak_force``, ``indentation``
-        and ``lost_contact``, the same with ``_retrace``, ``ideal_height`` and
-        ``true_height`` (m); attributes ``scan`` (the settings) and ``artefacts`` (JSON: per
-        direction the height error against the ideal image, the overshoot, the error image's
-        RMS, the pixels that lost contact).
-
-        With ``mode="peakforce"``: ``height``, ``true_height``, ``z_c``, ``peak_force``,
-        ``modulus_dmt``, ``adhesion``, ``deformation``, ``dissipation``, ``taps_per_cycle``,
-        ``evaluations`` (steady taps computed at the pixel), ``material`` and ``domain``, as
-        ``image.nc`` of ``afmdyn image --mode peakforce``.
+        material's operating points): the maps of ``afmdyn image``'s ``image.nc``. With
+        ``feedback="pi"`` the recorded trace and retrace (``_retrace``) and the attributes
+        ``scan`` (the settings) and ``artefacts`` (JSON: per direction the height error against
+        the ideal image, the overshoot, the error image's RMS, the pixels that lost contact);
+        with ``mode="peakforce"`` the channels of the ideal peak-force feedback.
 
         Its variables (name (dims) [units]: meaning), as the library lays them out
         (``docs/schema/layouts/image.json``: its example request, under
@@ -825,6 +816,69 @@ def image(
         - ``regime`` (y, x) [1]: regime of the operating point (mean tip–sample force attractive
           or repulsive)
         - ``material`` (y, x) [1]: material of the pixel
+        - ``domain`` (y, x) [1]: domain of the sample map on top at the pixel
+
+        With ``mode="peakforce"``, its variables (name (dims) [units]: meaning), as the library
+        lays them out (``docs/schema/layouts/image.peakforce.json``: its example request, under
+        ``examples/probe-peakforce-amo-garcia.toml``, in SI):
+
+        - ``x`` (x) [m]: pixel centre x
+        - ``y`` (y) [m]: line position y
+        - ``height`` (y, x) [m]: apparent height h + z_c − z_c,ref (ideal peak-force feedback)
+        - ``true_height`` (y, x) [m]: true height of the sample map
+        - ``z_c`` (y, x) [m]: mean rest separation z_c the feedback holds
+        - ``peak_force`` (y, x) [N]: peak force (the setpoint where reached)
+        - ``modulus_dmt`` (y, x) [Pa]: reduced modulus E* of the DMT fit of the retract curve
+          (PF-QNM)
+        - ``adhesion`` (y, x) [N]: adhesion: the most negative tip–sample force
+        - ``deformation`` (y, x) [m]: deformation: the largest indentation
+        - ``dissipation`` (y, x) [J]: tip–sample dissipation per modulation period
+        - ``taps_per_cycle`` (y, x) [1]: contacts per modulation period
+        - ``evaluations`` (y, x) [1]: steady taps computed for the pixel (0: the previous
+          pixel's orbit or the engage kept)
+        - ``material`` (y, x) [1]: material of the pixel
+        - ``domain`` (y, x) [1]: domain of the sample map on top at the pixel
+
+        With ``feedback="pi"``, its variables (name (dims) [units]: meaning), as the library
+        lays them out (``docs/schema/layouts/image.pi.json``: its example request, under
+        ``examples/probe-point-mass-dmt.toml``, in SI):
+
+        - ``x`` (x) [m]: pixel centre x
+        - ``y`` (y) [m]: line position y
+        - ``height`` (y, x) [m]: recorded height: the mean piezo position less the ideal
+          reference z_c,ref
+        - ``amplitude`` (y, x) [m]: mean lock-in amplitude
+        - ``phase_deg`` (y, x) [degree]: mean lock-in phase lag behind the drive
+        - ``tracking_error`` (y, x) [m]: mean amplitude error A_sp − A (the error image)
+        - ``energy_dissipated`` (y, x) [J]: energy dissipated over the pixel's last drive period
+        - ``virial`` (y, x) [J]: virial over the pixel's last drive period
+        - ``peak_force`` (y, x) [N]: largest tip–sample force over the pixel's last drive period
+        - ``indentation`` (y, x) [m]: largest indentation over the pixel's last drive period
+        - ``lost_contact`` (y, x) [1]: the controller lost contact (parachuting) in the pixel's
+          last drive period
+        - ``regime`` (y, x) [1]: regime of the operating point (mean tip–sample force attractive
+          or repulsive)
+        - ``material`` (y, x) [1]: material of the pixel
+        - ``height_retrace`` (y, x) [m]: recorded height: the mean piezo position less the ideal
+          reference z_c,ref
+        - ``amplitude_retrace`` (y, x) [m]: mean lock-in amplitude
+        - ``phase_deg_retrace`` (y, x) [degree]: mean lock-in phase lag behind the drive
+        - ``tracking_error_retrace`` (y, x) [m]: mean amplitude error A_sp − A (the error image)
+        - ``energy_dissipated_retrace`` (y, x) [J]: energy dissipated over the pixel's last
+          drive period
+        - ``virial_retrace`` (y, x) [J]: virial over the pixel's last drive period
+        - ``peak_force_retrace`` (y, x) [N]: largest tip–sample force over the pixel's last
+          drive period
+        - ``indentation_retrace`` (y, x) [m]: largest indentation over the pixel's last drive
+          period
+        - ``lost_contact_retrace`` (y, x) [1]: the controller lost contact (parachuting) in the
+          pixel's last drive period
+        - ``regime_retrace`` (y, x) [1]: regime of the operating point (mean tip–sample force
+          attractive or repulsive)
+        - ``material_retrace`` (y, x) [1]: material of the pixel
+        - ``ideal_height`` (y, x) [m]: apparent height under the ideal feedback h + z_c −
+          z_c,ref
+        - ``true_height`` (y, x) [m]: true height of the sample map
         - ``domain`` (y, x) [1]: domain of the sample map on top at the pixel
 
     Raises:
