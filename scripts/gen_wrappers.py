@@ -221,23 +221,48 @@ def _layout_rows(stem: str, dims: Tuple[Tuple[str, ...], ...]
     return list(rows.values())
 
 
+def _entries(rows: List[Tuple[str, str, str, str]]) -> List[str]:
+    """One entry per variable: ``- ``name`` (dims) [units]: meaning``, wrapped."""
+    out = []
+    for var, over, unit, meaning in rows:
+        out += textwrap.wrap(f"- {var} ({over}) [{unit}]: {meaning}", 88,
+                             subsequent_indent="  ", break_on_hyphens=False)
+    return out
+
+
 def _layout_table(stem: str, dims: Tuple[Tuple[str, ...], ...], lead: str = "Its"
                   ) -> List[str]:
     """The variables of the dataset laid out in ``docs/schema/layouts/<stem>.json``, one entry
     each (name, dims, units: meaning; a table as a list, its meanings too long for columns),
-    after the sentence that sources them."""
+    after the sentence that sources them. With ``<stem>.si.json`` (the same request under a
+    probe) each unit is followed by its SI unit after a bar where they differ, and the
+    variables named otherwise under a probe follow."""
     probe = json.loads((LAYOUTS / f"{stem}.json").read_text())["example"]["probe"]
-    units = (f"under ``{probe}``, in SI" if probe else
-             "in the model's units; SI with a probe, as each variable's ``units`` attribute says")
+    si_path = LAYOUTS / f"{stem}.si.json"
+    units = (f"under ``{probe}``, in SI" if probe else "in the model's units" + (
+        "; after a bar, in SI with a probe" if si_path.exists() else
+        "; SI with a probe, as each variable's ``units`` attribute says"))
     intro = textwrap.wrap(
         f"{lead} variables (name (dims) [units]: meaning), as the library lays them out "
         f"(``docs/schema/layouts/{stem}.json``: its example request, {units}):", 88,
         break_on_hyphens=False)
-    rows = []
-    for var, over, unit, meaning in _layout_rows(stem, dims):
-        rows += textwrap.wrap(f"- {var} ({over}) [{unit}]: {meaning}", 88,
-                              subsequent_indent="  ", break_on_hyphens=False)
-    return intro + [""] + rows
+    rows = _layout_rows(stem, dims)
+    if not si_path.exists():
+        return intro + [""] + _entries(rows)
+    si = {r[0]: r for r in _layout_rows(si_path.stem, dims)}
+    out = intro + [""] + _entries([
+        (v, d, u if v not in si or si[v][2] == u else f"{u} | {si[v][2]}", m)
+        for v, d, u, m in rows])
+    gone = [r[0] for r in rows if r[0] not in si]
+    new = [r for name, r in si.items() if name not in {x[0] for x in rows}]
+    if gone or new:
+        si_probe = json.loads(si_path.read_text())["example"]["probe"]
+        out += [""] + textwrap.wrap(
+            f"With a probe (``docs/schema/layouts/{si_path.stem}.json``: the request under "
+            f"``{si_probe}``), in place of {', '.join(gone) or 'nothing'}:", 88,
+            break_on_hyphens=False)
+        out += [""] + _entries(new)
+    return out
 
 
 def _layout_tables(name: str, doc: Dict[str, object]) -> List[str]:
@@ -247,6 +272,8 @@ def _layout_tables(name: str, doc: Dict[str, object]) -> List[str]:
     out = _layout_table(name, dims)
     for path in sorted(LAYOUTS.glob(f"{name}.*.json")):
         variant = path.stem.split(".", 1)[1]
+        if variant == "si":  # in the table's units (``_layout_table``)
+            continue
         lead = f"With {doc['layout_variants'][variant]}, its"  # type: ignore
         out += [""] + _layout_table(path.stem, dims, lead)
     return out

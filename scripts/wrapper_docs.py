@@ -26,8 +26,7 @@ Returns:
     the energy balance) and the amplitude spectrum of W(1,τ) over the last ≤ 2²⁰ samples
     (``frequency``, the command line's ``spectrum.csv``). ``attrs["summary"]`` holds
     ``afmdyn simulate --json`` (see :func:`summary`). With ``probe`` every array is in SI,
-    as the command line's files (times in s, lengths in m, velocities in m/s, forces in N,
-    energies in J, frequencies in Hz).""",
+    as the command line's files.""",
     },
     "converge": {
         "summary": """\
@@ -92,10 +91,9 @@ shooting; ``periods`` orbit periods are integrated on the dense output (no sampl
         "returns": """\
 Returns:
     An ``xarray.Dataset`` of the observables (scalars; ``period`` NaN when not periodic), the
-    harmonics and the per-mode energy balance, in SI with a probe (m, N, J, s; the model's
-    units g₀, F̃, F̃·g₀, τ otherwise), phases in degrees. ``ds.afmdyn.to_dict()`` is the
-    library's document (dimensionless, phases in radians, the closed forms; its ``reported``
-    block holds the dataset's values).""",
+    harmonics and the per-mode energy balance, in SI with a probe, phases in degrees.
+    ``ds.afmdyn.to_dict()`` is the library's document (dimensionless, phases in radians, the
+    closed forms; its ``reported`` block holds the dataset's values).""",
     },
     "approach": {
         "summary": """\

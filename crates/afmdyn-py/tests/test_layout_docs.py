@@ -25,7 +25,8 @@ LAYOUTS = REPO / "docs" / "schema" / "layouts"
 #: docstring leaves them out), and has a variant per feedback and mode (``image.pi``, …)
 STEMS = ["simulate", "converge", "continuation", "observe", "approach", "resonance",
          "bifurcation", "global_continuation", "chart", "bimodal", "peakforce", "image",
-         "image.pi", "image.peakforce"]
+         "image.pi", "image.peakforce", "simulate.si", "observe.si", "approach.si",
+         "resonance.si"]
 
 ENTRY = re.compile(r"^\s*- ``([^`]+)`` \(([^)]*)\) \[([^]]*)\]:")
 SOURCE = re.compile(r"``docs/schema/layouts/([^`]+)\.json``")
@@ -33,7 +34,9 @@ SOURCE = re.compile(r"``docs/schema/layouts/([^`]+)\.json``")
 
 def documented(stem: str) -> Dict[str, Tuple[Tuple[str, ...], str]]:
     """The variables the docstring of ``afmdyn.<name>`` names in its table sourced from
-    ``docs/schema/layouts/<stem>.json``: name -> (dims, units)."""
+    ``docs/schema/layouts/<stem>.json``: name -> (dims, units); for ``<name>.si`` (the same
+    request under a probe) the main table's with the SI units (after a bar) and the variables
+    named otherwise under a probe in place of those they replace (dims renamed alike)."""
     doc = getattr(afmdyn, stem.split(".")[0]).__doc__ or ""
     tables: Dict[str, Dict[str, Tuple[Tuple[str, ...], str]]] = {}
     table = None
@@ -41,11 +44,21 @@ def documented(stem: str) -> Dict[str, Tuple[Tuple[str, ...], str]]:
         m = ENTRY.match(line)
         if m and table is not None:
             dims = () if m.group(2) == "scalar" else tuple(m.group(2).split(", "))
-            table[m.group(1)] = (dims, m.group(3))
+            table[m.group(1)] = (dims, m.group(3))  # (its SI unit after a bar: below)
         elif SOURCE.search(line):
             table = tables.setdefault(SOURCE.search(line).group(1), {})  # type: ignore
+    if stem.endswith(".si"):  # the main table's SI units, and the variables renamed
+        main = tables[stem[:-3]]
+        gone = re.search(rf"``docs/schema/layouts/{re.escape(stem)}\.json``.*?\), in place "
+                         r"of ([^:]*):", " ".join(doc.split()))
+        replaced = re.findall(r"``([^`]+)``", gone.group(1)) if gone else []
+        new = tables.get(stem, {})
+        rename = dict(zip(replaced, new))
+        out = {name: (tuple(rename.get(d, d) for d in dims), units.split(" | ")[-1])
+               for name, (dims, units) in main.items() if name not in replaced}
+        return {**out, **new}
     assert stem in tables, f"afmdyn.{stem}: no table of variables in its docstring"
-    return tables[stem]
+    return {name: (dims, units.split(" | ")[0]) for name, (dims, units) in tables[stem].items()}
 
 
 def example(stem: str) -> Tuple[List[Any], Dict[str, Any]]:

@@ -43,7 +43,8 @@ enum Route {
 }
 
 /// One example: the analysis (the Python function's name), its variant (another layout of the
-/// same analysis: `image`'s PI scan and PeakForce image, file `<analysis>.<variant>.json`),
+/// same analysis, file `<analysis>.<variant>.json`: `image`'s PI scan and PeakForce image, and
+/// `si`, the same request under a probe),
 /// its route and request, and the probe file (a repository path) it runs under (`None`: the
 /// paper's parameters).
 struct Example {
@@ -69,8 +70,30 @@ fn ex(
     }
 }
 
-/// The examples, one per analysis with arrays: small runs of each route.
+/// The analyses whose layouts are in SI under a probe, and the probe of their `si` variant
+/// (the same request).
+const SI: ([&str; 4], &str) = (
+    ["simulate", "observe", "approach", "resonance"],
+    "examples/probe-point-mass-dmt.toml",
+);
+
+/// The examples, one per analysis with arrays (small runs of each route), and the variants.
 fn examples() -> Vec<Example> {
+    let mut all = plain();
+    let si: Vec<Example> = all
+        .iter()
+        .filter(|e| e.variant.is_none() && SI.0.contains(&e.analysis))
+        .map(|e| Example {
+            variant: Some("si"),
+            ..ex(e.analysis, e.route, e.request.clone(), Some(SI.1))
+        })
+        .collect();
+    all.extend(si);
+    all
+}
+
+/// The examples without the `si` variants.
+fn plain() -> Vec<Example> {
     use Route::*;
     vec![
         ex("modes", Door, json!({}), None),

@@ -103,47 +103,52 @@ def simulate(
         the energy balance) and the amplitude spectrum of W(1,τ) over the last ≤ 2²⁰ samples
         (``frequency``, the command line's ``spectrum.csv``). ``attrs["summary"]`` holds
         ``afmdyn simulate --json`` (see :func:`summary`). With ``probe`` every array is in SI,
-        as the command line's files (times in s, lengths in m, velocities in m/s, forces in N,
-        energies in J, frequencies in Hz).
+        as the command line's files.
 
         Its variables (name (dims) [units]: meaning), as the library lays them out
-        (``docs/schema/layouts/simulate.json``: its example request, in the model's units; SI
-        with a probe, as each variable's ``units`` attribute says):
+        (``docs/schema/layouts/simulate.json``: its example request, in the model's units; after
+        a bar, in SI with a probe):
 
         - ``tau`` (tau) [τ (eq. 5)]: dimensionless time τ = t √(EI/(mL⁴))
-        - ``v_t`` (tau) [g0]: tip–sample distance V_T = W(1,τ) + α2 sin Ωτ + α5 (eq. 8); contact
-          while V_T ≤ 0
-        - ``v_t_dot`` (tau) [g0 per unit τ]: dV_T/dτ
-        - ``w_tip`` (tau) [g0]: tip deflection W(1,τ) relative to the clamped base
-        - ``w_tip_dot`` (tau) [g0 per unit τ]: tip velocity ∂W(1,τ)/∂τ
+        - ``v_t`` (tau) [g0 | m]: tip–sample distance V_T = W(1,τ) + α2 sin Ωτ + α5 (eq. 8);
+          contact while V_T ≤ 0
+        - ``v_t_dot`` (tau) [g0 per unit τ | m/s]: dV_T/dτ
+        - ``w_tip`` (tau) [g0 | m]: tip deflection W(1,τ) relative to the clamped base
+        - ``w_tip_dot`` (tau) [g0 per unit τ | m/s]: tip velocity ∂W(1,τ)/∂τ
         - ``in_contact`` (tau) [—]: 1 while the tip is in contact (region II)
-        - ``contact_force`` (tau) [EI g0/L³]: tip–sample force F_c(δ, δ̇) on the tip, δ = −V_T
-          the indentation (linear law: α4 δ + α6 δ̇ in contact; 0 in free flight except DMT's
-          van der Waals force): positive when the sample pushes the tip away (repulsion, e.g. at
-          the deepest indentation), negative when it pulls the tip towards it (attraction, e.g.
-          DMT's van der Waals force in free flight)
-        - ``a`` (tau, mode) [g0]: modal displacement a_i
-        - ``a_dot`` (tau, mode) [g0 per unit τ]: modal velocity da_i/dτ
-        - ``event_tau`` (event) [τ (eq. 5)]: switching time
+        - ``contact_force`` (tau) [EI g0/L³ | N]: tip–sample force F_c(δ, δ̇) on the tip, δ =
+          −V_T the indentation (linear law: α4 δ + α6 δ̇ in contact; 0 in free flight except
+          DMT's van der Waals force): positive when the sample pushes the tip away (repulsion,
+          e.g. at the deepest indentation), negative when it pulls the tip towards it
+          (attraction, e.g. DMT's van der Waals force in free flight)
+        - ``a`` (tau, mode) [g0 | m]: modal displacement a_i
+        - ``a_dot`` (tau, mode) [g0 per unit τ | m/s]: modal velocity da_i/dτ
+        - ``event_tau`` (event) [τ (eq. 5) | s]: switching time
         - ``event_to_contact`` (event) [—]: switching into contact (else out of it)
-        - ``event_v_t_dot`` (event) [g0 per unit τ]: dV_T/dτ at the switching (impact velocity)
-        - ``section_tau`` (section) [τ (eq. 5)]: section time 2πk/Ω
-        - ``section_v_t`` (section) [g0]: V_T at the section
-        - ``section_w_tip`` (section) [g0]: W(1,τ) at the section
-        - ``section_w_tip_dot`` (section) [g0 per unit τ]: ∂W(1,τ)/∂τ at the section
+        - ``event_v_t_dot`` (event) [g0 per unit τ | m/s]: dV_T/dτ at the switching (impact
+          velocity)
+        - ``section_tau`` (section) [τ (eq. 5) | s]: section time 2πk/Ω
+        - ``section_v_t`` (section) [g0 | m]: V_T at the section
+        - ``section_w_tip`` (section) [g0 | m]: W(1,τ) at the section
+        - ``section_w_tip_dot`` (section) [g0 per unit τ | m/s]: ∂W(1,τ)/∂τ at the section
         - ``section_state`` (section, component) [—]: state (a, da/dτ) at the section
-        - ``energy_tau0`` (cycle) [τ (eq. 5)]: start of the period
-        - ``energy_start`` (cycle) [EI g0²/L³]: stored energy at the start
-        - ``energy_end`` (cycle) [EI g0²/L³]: stored energy at the end
-        - ``base_work`` (cycle) [EI g0²/L³]: work of the base drive
-        - ``beam_dissipation`` (cycle) [EI g0²/L³]: beam damping loss
-        - ``contact_dissipation`` (cycle) [EI g0²/L³]: dissipation in the sample (contact
+        - ``energy_tau0`` (cycle) [τ (eq. 5) | s]: start of the period
+        - ``energy_start`` (cycle) [EI g0²/L³ | J]: stored energy at the start
+        - ``energy_end`` (cycle) [EI g0²/L³ | J]: stored energy at the end
+        - ``base_work`` (cycle) [EI g0²/L³ | J]: work of the base drive
+        - ``beam_dissipation`` (cycle) [EI g0²/L³ | J]: beam damping loss
+        - ``contact_dissipation`` (cycle) [EI g0²/L³ | J]: dissipation in the sample (contact
           damping, impacts)
-        - ``energy_residual`` (cycle) [EI g0²/L³]: ΔE − (work − losses)
-        - ``spectrum`` (frequency) [g0]: amplitude spectrum of W(1,τ) (spectrum.csv)
-        - ``frequency`` (frequency) [Ω units (1/t0)]: frequency
+        - ``energy_residual`` (cycle) [EI g0²/L³ | J]: ΔE − (work − losses)
+        - ``spectrum`` (frequency) [g0 | m]: amplitude spectrum of W(1,τ) (spectrum.csv)
+        - ``frequency`` (frequency) [Ω units (1/t0) | Hz]: frequency
         - ``mode`` (mode) [1]: Galerkin mode i
         - ``component`` (component) [—]: state component (a_i, then da_i/dτ)
+
+        With a probe (``docs/schema/layouts/simulate.si.json``: the request under
+        ``examples/probe-point-mass-dmt.toml``), in place of ``tau``:
+
+        - ``t`` (t) [s]: time t = τ t_s (t_s: seconds per unit τ, the probe's scales)
     """
     return _api._finish_simulate(locals())
 

@@ -82,50 +82,51 @@ def observe(
 
     Returns:
         An ``xarray.Dataset`` of the observables (scalars; ``period`` NaN when not periodic), the
-        harmonics and the per-mode energy balance, in SI with a probe (m, N, J, s; the model's
-        units g₀, F̃, F̃·g₀, τ otherwise), phases in degrees. ``ds.afmdyn.to_dict()`` is the
-        library's document (dimensionless, phases in radians, the closed forms; its ``reported``
-        block holds the dataset's values).
+        harmonics and the per-mode energy balance, in SI with a probe, phases in degrees.
+        ``ds.afmdyn.to_dict()`` is the library's document (dimensionless, phases in radians, the
+        closed forms; its ``reported`` block holds the dataset's values).
 
         Its variables (name (dims) [units]: meaning), as the library lays them out
-        (``docs/schema/layouts/observe.json``: its example request, in the model's units; SI
-        with a probe, as each variable's ``units`` attribute says):
+        (``docs/schema/layouts/observe.json``: its example request, in the model's units; after
+        a bar, in SI with a probe):
 
-        - ``amplitude`` (scalar) [g0]: first-harmonic amplitude A of the tip deflection
+        - ``amplitude`` (scalar) [g0 | m]: first-harmonic amplitude A of the tip deflection
         - ``amplitude_ratio`` (scalar) [1]: A/A0 (A0 the free amplitude at the same drive)
         - ``phase_deg`` (scalar) [degree]: phase lag of the deflection behind the drive (90
           free, > 90 attractive, < 90 repulsive)
-        - ``mean_deflection`` (scalar) [g0]: mean tip deflection <W>
-        - ``peak_force`` (scalar) [F~ (k g0 for the point mass)]: largest tip-sample force F_c:
-          the repulsive maximum (F_c > 0 pushes the tip away)
-        - ``min_force`` (scalar) [F~ (k g0 for the point mass)]: smallest tip-sample force F_c:
-          the adhesion minimum (F_c < 0 pulls the tip)
-        - ``indentation`` (scalar) [g0]: largest indentation max(-V_T, 0)
+        - ``mean_deflection`` (scalar) [g0 | m]: mean tip deflection <W>
+        - ``peak_force`` (scalar) [F~ (k g0 for the point mass) | N]: largest tip-sample force
+          F_c: the repulsive maximum (F_c > 0 pushes the tip away)
+        - ``min_force`` (scalar) [F~ (k g0 for the point mass) | N]: smallest tip-sample force
+          F_c: the adhesion minimum (F_c < 0 pulls the tip)
+        - ``indentation`` (scalar) [g0 | m]: largest indentation max(-V_T, 0)
         - ``contact_fraction`` (scalar) [1]: fraction of the time in contact (V_T <= 0)
-        - ``min_distance`` (scalar) [g0]: minimum tip-sample distance
-        - ``energy_dissipated`` (scalar) [F~ g0]: energy dissipated in the sample per drive
+        - ``min_distance`` (scalar) [g0 | m]: minimum tip-sample distance
+        - ``energy_dissipated`` (scalar) [F~ g0 | J]: energy dissipated in the sample per drive
           period E_dis
-        - ``virial`` (scalar) [F~ g0]: virial (1/T) integral of F_c W over a period
+        - ``virial`` (scalar) [F~ g0 | J]: virial (1/T) integral of F_c W over a period
         - ``harmonic_distortion`` (scalar) [1]: total harmonic distortion of the deflection
         - ``higher_mode_fraction`` (scalar) [1]: participation of the higher eigenmodes: RMS
           amplitude of the tip deflection of modes 2..N relative to mode 1's (0 for one mode)
-        - ``contact_time`` (scalar) [τ]: time in contact per drive period
-        - ``mean_force`` (scalar) [F~ (k g0 for the point mass)]: time-averaged tip-sample force
+        - ``contact_time`` (scalar) [τ | s]: time in contact per drive period
+        - ``mean_force`` (scalar) [F~ (k g0 for the point mass) | N]: time-averaged tip-sample
+          force
         - ``impacts_per_period`` (scalar) [1]: entries into contact (impacts) per drive period
-        - ``impact_loss`` (scalar) [F~ g0]: kinetic energy lost in impacts per drive period
+        - ``impact_loss`` (scalar) [F~ g0 | J]: kinetic energy lost in impacts per drive period
         - ``harmonic`` (harmonic) [—]: harmonic
-        - ``harmonic_amplitude`` (harmonic) [g0]: amplitude of harmonic n
+        - ``harmonic_amplitude`` (harmonic) [g0 | m]: amplitude of harmonic n
         - ``harmonic_phase_deg`` (harmonic) [degree]: phase of harmonic n
         - ``mode`` (mode) [—]: mode
-        - ``mode_drive`` (mode) [F~ g0]: energy balance of the mode per drive period: drive
-        - ``mode_beam_damping`` (mode) [F~ g0]: energy balance of the mode per drive period:
+        - ``mode_drive`` (mode) [F~ g0 | J]: energy balance of the mode per drive period: drive
+        - ``mode_beam_damping`` (mode) [F~ g0 | J]: energy balance of the mode per drive period:
           beam_damping
-        - ``mode_sample`` (mode) [F~ g0]: energy balance of the mode per drive period: sample
-        - ``mode_coupling`` (mode) [F~ g0]: energy balance of the mode per drive period:
+        - ``mode_sample`` (mode) [F~ g0 | J]: energy balance of the mode per drive period:
+          sample
+        - ``mode_coupling`` (mode) [F~ g0 | J]: energy balance of the mode per drive period:
           coupling
-        - ``mode_energy_change`` (mode) [F~ g0]: energy balance of the mode per drive period:
-          energy_change
-        - ``mode_residual`` (mode) [F~ g0]: energy balance of the mode per drive period:
+        - ``mode_energy_change`` (mode) [F~ g0 | J]: energy balance of the mode per drive
+          period: energy_change
+        - ``mode_residual`` (mode) [F~ g0 | J]: energy balance of the mode per drive period:
           residual
         - ``state`` (state_index) [—]: state (a, da/dtau) at tau = 0 the observables start from
         - ``period`` (scalar) [1]: n of the period-n motion (NaN: not periodic)
@@ -189,26 +190,26 @@ def approach(
         ``docs/outputs.md``).
 
         Its variables (name (dims) [units]: meaning), as the library lays them out
-        (``docs/schema/layouts/approach.json``: its example request, in the model's units; SI
-        with a probe, as each variable's ``units`` attribute says):
+        (``docs/schema/layouts/approach.json``: its example request, in the model's units; after
+        a bar, in SI with a probe):
 
-        - ``z_c`` (z_c) [g0]: rest distance z_c of the tip above the sample
+        - ``z_c`` (z_c) [g0 | m]: rest distance z_c of the tip above the sample
         - ``sweep`` (sweep) [—]: sweep
-        - ``amplitude`` (sweep, z_c) [g0]: first-harmonic amplitude A of the tip deflection
+        - ``amplitude`` (sweep, z_c) [g0 | m]: first-harmonic amplitude A of the tip deflection
         - ``amplitude_ratio`` (sweep, z_c) [1]: A/A0 (A0 the free amplitude at the same drive)
         - ``phase_deg`` (sweep, z_c) [degree]: phase lag of the deflection behind the drive (90
           free, > 90 attractive, < 90 repulsive)
-        - ``mean_deflection`` (sweep, z_c) [g0]: mean tip deflection <W>
-        - ``peak_force`` (sweep, z_c) [F~ (k g0 for the point mass)]: largest tip-sample force
-          F_c: the repulsive maximum (F_c > 0 pushes the tip away)
-        - ``min_force`` (sweep, z_c) [F~ (k g0 for the point mass)]: smallest tip-sample force
-          F_c: the adhesion minimum (F_c < 0 pulls the tip)
-        - ``indentation`` (sweep, z_c) [g0]: largest indentation max(-V_T, 0)
+        - ``mean_deflection`` (sweep, z_c) [g0 | m]: mean tip deflection <W>
+        - ``peak_force`` (sweep, z_c) [F~ (k g0 for the point mass) | N]: largest tip-sample
+          force F_c: the repulsive maximum (F_c > 0 pushes the tip away)
+        - ``min_force`` (sweep, z_c) [F~ (k g0 for the point mass) | N]: smallest tip-sample
+          force F_c: the adhesion minimum (F_c < 0 pulls the tip)
+        - ``indentation`` (sweep, z_c) [g0 | m]: largest indentation max(-V_T, 0)
         - ``contact_fraction`` (sweep, z_c) [1]: fraction of the time in contact (V_T <= 0)
-        - ``min_distance`` (sweep, z_c) [g0]: minimum tip-sample distance
-        - ``energy_dissipated`` (sweep, z_c) [F~ g0]: energy dissipated in the sample per drive
-          period E_dis
-        - ``virial`` (sweep, z_c) [F~ g0]: virial (1/T) integral of F_c W over a period
+        - ``min_distance`` (sweep, z_c) [g0 | m]: minimum tip-sample distance
+        - ``energy_dissipated`` (sweep, z_c) [F~ g0 | J]: energy dissipated in the sample per
+          drive period E_dis
+        - ``virial`` (sweep, z_c) [F~ g0 | J]: virial (1/T) integral of F_c W over a period
         - ``harmonic_distortion`` (sweep, z_c) [1]: total harmonic distortion of the deflection
         - ``higher_mode_fraction`` (sweep, z_c) [1]: participation of the higher eigenmodes: RMS
           amplitude of the tip deflection of modes 2..N relative to mode 1's (0 for one mode)
@@ -216,25 +217,26 @@ def approach(
         - ``period`` (sweep, z_c) [1]: n of the period-n motion (NaN: not periodic)
         - ``reached`` (sweep, z_c) [—]: how the point's steady state was reached
         - ``branch`` (branch_point) [—]: branch index
-        - ``branch_z_c`` (branch_point) [g0]: rest distance z_c of the tip above the sample
-        - ``branch_amplitude`` (branch_point) [g0]: first-harmonic amplitude A of the tip
+        - ``branch_z_c`` (branch_point) [g0 | m]: rest distance z_c of the tip above the sample
+        - ``branch_amplitude`` (branch_point) [g0 | m]: first-harmonic amplitude A of the tip
           deflection
         - ``branch_amplitude_ratio`` (branch_point) [1]: A/A0 (A0 the free amplitude at the same
           drive)
         - ``branch_phase_deg`` (branch_point) [degree]: phase lag of the deflection behind the
           drive (90 free, > 90 attractive, < 90 repulsive)
-        - ``branch_mean_deflection`` (branch_point) [g0]: mean tip deflection <W>
-        - ``branch_peak_force`` (branch_point) [F~ (k g0 for the point mass)]: largest
+        - ``branch_mean_deflection`` (branch_point) [g0 | m]: mean tip deflection <W>
+        - ``branch_peak_force`` (branch_point) [F~ (k g0 for the point mass) | N]: largest
           tip-sample force F_c: the repulsive maximum (F_c > 0 pushes the tip away)
-        - ``branch_min_force`` (branch_point) [F~ (k g0 for the point mass)]: smallest
+        - ``branch_min_force`` (branch_point) [F~ (k g0 for the point mass) | N]: smallest
           tip-sample force F_c: the adhesion minimum (F_c < 0 pulls the tip)
-        - ``branch_indentation`` (branch_point) [g0]: largest indentation max(-V_T, 0)
+        - ``branch_indentation`` (branch_point) [g0 | m]: largest indentation max(-V_T, 0)
         - ``branch_contact_fraction`` (branch_point) [1]: fraction of the time in contact (V_T
           <= 0)
-        - ``branch_min_distance`` (branch_point) [g0]: minimum tip-sample distance
-        - ``branch_energy_dissipated`` (branch_point) [F~ g0]: energy dissipated in the sample
-          per drive period E_dis
-        - ``branch_virial`` (branch_point) [F~ g0]: virial (1/T) integral of F_c W over a period
+        - ``branch_min_distance`` (branch_point) [g0 | m]: minimum tip-sample distance
+        - ``branch_energy_dissipated`` (branch_point) [F~ g0 | J]: energy dissipated in the
+          sample per drive period E_dis
+        - ``branch_virial`` (branch_point) [F~ g0 | J]: virial (1/T) integral of F_c W over a
+          period
         - ``branch_harmonic_distortion`` (branch_point) [1]: total harmonic distortion of the
           deflection
         - ``branch_higher_mode_fraction`` (branch_point) [1]: participation of the higher
@@ -245,11 +247,12 @@ def approach(
         - ``branch_event`` (branch_point) [—]: event at the point (fold, period-doubling,
           grazing, ...)
         - ``trace_time`` (trace_time) [drive periods]: time within the recorded cycle
-        - ``trace_z_c`` (trace) [g0]: rest distance z_c of the tip above the sample
-        - ``trace_deflection`` (trace, trace_time) [g0]: tip deflection W(1,tau)
-        - ``trace_distance`` (trace, trace_time) [g0]: tip-sample distance V_T (<= 0 in contact)
-        - ``trace_force`` (trace, trace_time) [F~ (k g0 for the point mass)]: tip-sample force
-          F_c (> 0 repulsive, < 0 attractive)
+        - ``trace_z_c`` (trace) [g0 | m]: rest distance z_c of the tip above the sample
+        - ``trace_deflection`` (trace, trace_time) [g0 | m]: tip deflection W(1,tau)
+        - ``trace_distance`` (trace, trace_time) [g0 | m]: tip-sample distance V_T (<= 0 in
+          contact)
+        - ``trace_force`` (trace, trace_time) [F~ (k g0 for the point mass) | N]: tip-sample
+          force F_c (> 0 repulsive, < 0 attractive)
     """
     return _api._finish_approach(locals())
 
@@ -471,26 +474,27 @@ def resonance(
         ``afmdyn resonance --json`` document.
 
         Its variables (name (dims) [units]: meaning), as the library lays them out
-        (``docs/schema/layouts/resonance.json``: its example request, in the model's units; SI
-        with a probe, as each variable's ``units`` attribute says):
+        (``docs/schema/layouts/resonance.json``: its example request, in the model's units;
+        after a bar, in SI with a probe):
 
         - ``omega`` (omega) [Ω]: dimensionless drive frequency Ω
         - ``sweep`` (sweep) [—]: sweep
-        - ``amplitude`` (sweep, omega) [g0]: first-harmonic amplitude A of the tip deflection
+        - ``amplitude`` (sweep, omega) [g0 | m]: first-harmonic amplitude A of the tip
+          deflection
         - ``amplitude_ratio`` (sweep, omega) [1]: A/A0 (A0 the free amplitude at the same drive)
         - ``phase_deg`` (sweep, omega) [degree]: phase lag of the deflection behind the drive
           (90 free, > 90 attractive, < 90 repulsive)
-        - ``mean_deflection`` (sweep, omega) [g0]: mean tip deflection <W>
-        - ``peak_force`` (sweep, omega) [F~ (k g0 for the point mass)]: largest tip-sample force
-          F_c: the repulsive maximum (F_c > 0 pushes the tip away)
-        - ``min_force`` (sweep, omega) [F~ (k g0 for the point mass)]: smallest tip-sample force
-          F_c: the adhesion minimum (F_c < 0 pulls the tip)
-        - ``indentation`` (sweep, omega) [g0]: largest indentation max(-V_T, 0)
+        - ``mean_deflection`` (sweep, omega) [g0 | m]: mean tip deflection <W>
+        - ``peak_force`` (sweep, omega) [F~ (k g0 for the point mass) | N]: largest tip-sample
+          force F_c: the repulsive maximum (F_c > 0 pushes the tip away)
+        - ``min_force`` (sweep, omega) [F~ (k g0 for the point mass) | N]: smallest tip-sample
+          force F_c: the adhesion minimum (F_c < 0 pulls the tip)
+        - ``indentation`` (sweep, omega) [g0 | m]: largest indentation max(-V_T, 0)
         - ``contact_fraction`` (sweep, omega) [1]: fraction of the time in contact (V_T <= 0)
-        - ``min_distance`` (sweep, omega) [g0]: minimum tip-sample distance
-        - ``energy_dissipated`` (sweep, omega) [F~ g0]: energy dissipated in the sample per
+        - ``min_distance`` (sweep, omega) [g0 | m]: minimum tip-sample distance
+        - ``energy_dissipated`` (sweep, omega) [F~ g0 | J]: energy dissipated in the sample per
           drive period E_dis
-        - ``virial`` (sweep, omega) [F~ g0]: virial (1/T) integral of F_c W over a period
+        - ``virial`` (sweep, omega) [F~ g0 | J]: virial (1/T) integral of F_c W over a period
         - ``harmonic_distortion`` (sweep, omega) [1]: total harmonic distortion of the
           deflection
         - ``higher_mode_fraction`` (sweep, omega) [1]: participation of the higher eigenmodes:
@@ -501,24 +505,25 @@ def resonance(
         - ``reached`` (sweep, omega) [—]: how the point's steady state was reached
         - ``branch`` (branch_point) [—]: branch index
         - ``branch_omega`` (branch_point) [Ω]: dimensionless drive frequency Ω
-        - ``branch_amplitude`` (branch_point) [g0]: first-harmonic amplitude A of the tip
+        - ``branch_amplitude`` (branch_point) [g0 | m]: first-harmonic amplitude A of the tip
           deflection
         - ``branch_amplitude_ratio`` (branch_point) [1]: A/A0 (A0 the free amplitude at the same
           drive)
         - ``branch_phase_deg`` (branch_point) [degree]: phase lag of the deflection behind the
           drive (90 free, > 90 attractive, < 90 repulsive)
-        - ``branch_mean_deflection`` (branch_point) [g0]: mean tip deflection <W>
-        - ``branch_peak_force`` (branch_point) [F~ (k g0 for the point mass)]: largest
+        - ``branch_mean_deflection`` (branch_point) [g0 | m]: mean tip deflection <W>
+        - ``branch_peak_force`` (branch_point) [F~ (k g0 for the point mass) | N]: largest
           tip-sample force F_c: the repulsive maximum (F_c > 0 pushes the tip away)
-        - ``branch_min_force`` (branch_point) [F~ (k g0 for the point mass)]: smallest
+        - ``branch_min_force`` (branch_point) [F~ (k g0 for the point mass) | N]: smallest
           tip-sample force F_c: the adhesion minimum (F_c < 0 pulls the tip)
-        - ``branch_indentation`` (branch_point) [g0]: largest indentation max(-V_T, 0)
+        - ``branch_indentation`` (branch_point) [g0 | m]: largest indentation max(-V_T, 0)
         - ``branch_contact_fraction`` (branch_point) [1]: fraction of the time in contact (V_T
           <= 0)
-        - ``branch_min_distance`` (branch_point) [g0]: minimum tip-sample distance
-        - ``branch_energy_dissipated`` (branch_point) [F~ g0]: energy dissipated in the sample
-          per drive period E_dis
-        - ``branch_virial`` (branch_point) [F~ g0]: virial (1/T) integral of F_c W over a period
+        - ``branch_min_distance`` (branch_point) [g0 | m]: minimum tip-sample distance
+        - ``branch_energy_dissipated`` (branch_point) [F~ g0 | J]: energy dissipated in the
+          sample per drive period E_dis
+        - ``branch_virial`` (branch_point) [F~ g0 | J]: virial (1/T) integral of F_c W over a
+          period
         - ``branch_harmonic_distortion`` (branch_point) [1]: total harmonic distortion of the
           deflection
         - ``branch_higher_mode_fraction`` (branch_point) [1]: participation of the higher
@@ -528,6 +533,12 @@ def resonance(
         - ``branch_period`` (branch_point) [1]: n of the period-n orbit
         - ``branch_event`` (branch_point) [—]: event at the point (fold, period-doubling,
           grazing, ...)
+
+        With a probe (``docs/schema/layouts/resonance.si.json``: the request under
+        ``examples/probe-point-mass-dmt.toml``), in place of ``omega``, ``branch_omega``:
+
+        - ``frequency_hz`` (frequency_hz) [Hz]: drive frequency
+        - ``branch_frequency_hz`` (branch_point) [Hz]: drive frequency
     """
     return _api._finish_resonance(locals())
 
