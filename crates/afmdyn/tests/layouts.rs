@@ -44,9 +44,8 @@ enum Route {
 
 /// One example: the analysis (the Python function's name), its variant (another layout of the
 /// same analysis, file `<analysis>.<variant>.json`: `image`'s PI scan and PeakForce image, and
-/// `si`, the same request under a probe),
-/// its route and request, and the probe file (a repository path) it runs under (`None`: the
-/// paper's parameters).
+/// `si`, the same request under a probe), its route and request, and the probe file (a
+/// repository path) it runs under (`None`: the paper's parameters).
 struct Example {
     analysis: &'static str,
     variant: Option<&'static str>,
