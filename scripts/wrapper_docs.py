@@ -320,6 +320,7 @@ Returns:
 }
 
 WRAPPERS["peakforce"] = {
+    "layout_variants": {"sweep": "a sweep (here ``z_c`` a sequence)"},
     "summary": """\
 The steady tap of off-resonance tapping (``afmdyn peakforce``; the probe's ``[drive]
 mode = "off-resonance"``): the periodic orbit of the modulation period found by shooting,
@@ -336,9 +337,8 @@ Returns:
     with a probe; attributes: the channels (``peak_force``, ``adhesion``, ``deformation``,
     ``dissipation``, ``contact_time``, ``snap_off_time``, ``ringing_amplitude``,
     ``modulus_dmt``, ``taps_per_cycle``) and ``summary`` (the ``afmdyn peakforce --json``
-    document). With a sweep the channels (and ``modulus_dmt``, ``z_c``, ``period``) are
-    variables over its dimension, NaN where a value failed; the cycle and curve are the
-    first computed value's. Warnings (period-2 tapping, double taps, an unstable tap) are
+    document). With a sweep the channels are variables over its dimension, NaN where a
+    value failed; the cycle and curve are the first computed value's. Warnings (period-2 tapping, double taps, an unstable tap) are
     raised as :class:`afmdyn.AfmdynWarning`.""",
     "raises": """\
 Raises:

@@ -22,9 +22,11 @@ LAYOUTS = REPO / "docs" / "schema" / "layouts"
 #: the layout files of the analyses whose dataset is its layouts as they are (the others add
 #: variables from their document, ``fit``, or turn a code into words and add a coordinate,
 #: ``basins``); ``image`` keeps the maps over (y, x), its scalars becoming attributes (the
-#: docstring leaves them out), and has a variant per feedback and mode (``image.pi``, …)
+#: docstring leaves them out), and has a variant per feedback and mode (``image.pi``, …);
+#: ``peakforce.sweep`` is a sweep in z_c
 STEMS = ["simulate", "converge", "continuation", "observe", "approach", "resonance",
-         "bifurcation", "global_continuation", "chart", "bimodal", "peakforce", "image",
+         "bifurcation", "global_continuation", "chart", "bimodal", "peakforce", "peakforce.sweep",
+         "image",
          "image.pi", "image.peakforce", "simulate.si", "observe.si", "approach.si",
          "resonance.si"]
 
@@ -70,6 +72,9 @@ def example(stem: str) -> Tuple[List[Any], Dict[str, Any]]:
         if "feedback" in kw:  # a PI scan's settings: Python's keywords
             kw.update(kw.pop("feedback"), feedback="pi")
         return [probe, str(REPO / kw.pop("sample")), kw.pop("setpoint")], kw
+    if "sweep" in kw:  # a PeakForce sweep: its quantity a sequence
+        sweep = kw.pop("sweep")
+        kw[sweep["quantity"]] = sweep["values"]
     if probe is not None:
         kw["probe"] = probe
     return [], kw
@@ -100,6 +105,7 @@ def test_the_dataset_has_the_variables_its_docstring_names(name: str) -> None:
 #: turn into words, and keeps ``evaluations`` (a count) without its units
 LOSES_UNITS = {
     "peakforce": "xr.merge(combine_attrs='drop') drops the variables' attrs (_peakforce.py)",
+    "peakforce.sweep": "as peakforce's",
     "image.peakforce": "_image._dataset drops the units of the integer map evaluations",
 }
 

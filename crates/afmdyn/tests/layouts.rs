@@ -43,8 +43,8 @@ enum Route {
 }
 
 /// One example: the analysis (the Python function's name), its variant (another layout of the
-/// same analysis, file `<analysis>.<variant>.json`: `image`'s PI scan and PeakForce image, and
-/// `si`, the same request under a probe), its route and request, and the probe file (a
+/// same analysis, file `<analysis>.<variant>.json`: `image`'s PI scan and PeakForce image,
+/// `peakforce`'s sweep, and `si`, the same request under a probe), its route and request, and the probe file (a
 /// repository path) it runs under (`None`: the paper's parameters).
 struct Example {
     analysis: &'static str,
@@ -159,6 +159,16 @@ fn plain() -> Vec<Example> {
                    "curve_points": 20}),
             Some("examples/probe-point-mass-dmt.toml"),
         ),
+        Example {
+            variant: Some("sweep"),
+            ..ex(
+                "peakforce",
+                Door,
+                json!({"samples": 2000,
+                       "sweep": {"quantity": "z_c", "values": [95e-9, 90e-9]}}),
+                Some("examples/probe-peakforce-air.toml"),
+            )
+        },
         Example {
             variant: Some("pi"),
             ..ex(

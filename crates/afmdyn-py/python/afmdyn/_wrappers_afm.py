@@ -647,9 +647,8 @@ def peakforce(
         with a probe; attributes: the channels (``peak_force``, ``adhesion``, ``deformation``,
         ``dissipation``, ``contact_time``, ``snap_off_time``, ``ringing_amplitude``,
         ``modulus_dmt``, ``taps_per_cycle``) and ``summary`` (the ``afmdyn peakforce --json``
-        document). With a sweep the channels (and ``modulus_dmt``, ``z_c``, ``period``) are
-        variables over its dimension, NaN where a value failed; the cycle and curve are the
-        first computed value's. Warnings (period-2 tapping, double taps, an unstable tap) are
+        document). With a sweep the channels are variables over its dimension, NaN where a
+        value failed; the cycle and curve are the first computed value's. Warnings (period-2 tapping, double taps, an unstable tap) are
         raised as :class:`afmdyn.AfmdynWarning`.
 
         Its variables (name (dims) [units]: meaning), as the library lays them out
@@ -664,6 +663,30 @@ def peakforce(
         - ``approach_force`` (approach) [N]: force, approach
         - ``retract_distance`` (retract) [m]: distance, retract
         - ``retract_force`` (retract) [N]: force, retract
+
+        With a sweep (here ``z_c`` a sequence), its variables (name (dims) [units]: meaning), as
+        the library lays them out (``docs/schema/layouts/peakforce.sweep.json``: its example
+        request, under ``examples/probe-peakforce-air.toml``, in SI):
+
+        - ``time`` (sample) [s]: time
+        - ``deflection`` (sample) [m]: deflection
+        - ``distance`` (sample) [m]: distance
+        - ``force`` (sample) [N]: force
+        - ``approach_distance`` (approach) [m]: distance, approach
+        - ``approach_force`` (approach) [N]: force, approach
+        - ``retract_distance`` (retract) [m]: distance, retract
+        - ``retract_force`` (retract) [N]: force, retract
+        - ``z_c`` (z_c) [m]: swept z_c
+        - ``peak_force`` (z_c) [N]: peak force
+        - ``adhesion`` (z_c) [N]: adhesion (most negative force)
+        - ``deformation`` (z_c) [m]: largest indentation
+        - ``dissipation`` (z_c) [J]: tip-sample work per cycle
+        - ``contact_time`` (z_c) [s]: time in contact per cycle
+        - ``snap_off_time`` (z_c) [s]: snap-off from the largest separation
+        - ``ringing_amplitude`` (z_c) [m]: ringing after snap-off
+        - ``taps_per_cycle`` (z_c) [1]: contacts per modulation period
+        - ``modulus_dmt`` (z_c) [Pa]: fitted DMT modulus of the retract (PF-QNM)
+        - ``period`` (z_c) [modulation periods]: period of the orbit (0: the point failed)
 
     Raises:
         ValueError: naming the option or the model parameter.
