@@ -283,4 +283,35 @@ mod tests {
             .unwrap_err()
             .contains("z is not declared"));
     }
+
+    #[test]
+    fn a_description_is_the_layout_without_its_values() {
+        let flags = Attr::I32(vec![0, 1]);
+        let layout = Layout::new(
+            "t",
+            &[("y", 2), ("x", 3)],
+            vec![
+                Variable::f64("a", &["y", "x"], "m", "height", &[0.0; 6]),
+                Variable::i32("c", &["y", "x"], "1", "code", &[0; 6]).with("flag_values", flags),
+                Variable::new("w", &["x"], "", "word", Values::Text(vec!["".into(); 3])),
+            ],
+        );
+        let d = layout.description();
+        assert_eq!(
+            (d.title.as_str(), d.dims.clone()),
+            ("t", vec!["y".into(), "x".into()])
+        );
+        for (v, e) in layout.variables.iter().zip(&d.variables) {
+            assert_eq!((&v.name, &v.dims, &v.units), (&e.name, &e.dims, &e.units));
+            assert_eq!((&v.long_name, &v.attrs), (&e.long_name, &e.attrs));
+        }
+        let kinds: Vec<_> = d.variables.iter().map(|v| v.kind).collect();
+        assert_eq!(kinds, ["float", "int", "text"]);
+        let json = serde_json::to_value(&d).unwrap();
+        assert_eq!(
+            json["variables"][1]["attrs"],
+            serde_json::json!([["flag_values", [0, 1]]])
+        );
+        assert!(json["variables"][0].get("values").is_none());
+    }
 }
