@@ -7,6 +7,7 @@ defining identity of building both the dataset and its documentation from one la
 
 from __future__ import annotations
 
+import functools
 import json
 import re
 import warnings
@@ -26,9 +27,8 @@ LAYOUTS = REPO / "docs" / "schema" / "layouts"
 #: ``peakforce.sweep`` is a sweep in z_c
 STEMS = ["simulate", "converge", "continuation", "observe", "approach", "resonance",
          "bifurcation", "global_continuation", "chart", "bimodal", "peakforce", "peakforce.sweep",
-         "image",
-         "image.pi", "image.peakforce", "simulate.si", "observe.si", "approach.si",
-         "resonance.si"]
+         "image", "image.pi", "image.peakforce",
+         "simulate.si", "observe.si", "approach.si", "resonance.si"]
 
 ENTRY = re.compile(r"^\s*- ``([^`]+)`` \(([^)]*)\) \[([^]]*)\]:")
 SOURCE = re.compile(r"``docs/schema/layouts/([^`]+)\.json``")
@@ -46,7 +46,7 @@ def documented(stem: str) -> Dict[str, Tuple[Tuple[str, ...], str]]:
         m = ENTRY.match(line)
         if m and table is not None:
             dims = () if m.group(2) == "scalar" else tuple(m.group(2).split(", "))
-            table[m.group(1)] = (dims, m.group(3))  # (its SI unit after a bar: below)
+            table[m.group(1)] = (dims, m.group(3))  # "unit | SI unit" where they differ
         elif SOURCE.search(line):
             table = tables.setdefault(SOURCE.search(line).group(1), {})  # type: ignore
     if stem.endswith(".si"):  # the main table's SI units, and the variables renamed
@@ -80,8 +80,9 @@ def example(stem: str) -> Tuple[List[Any], Dict[str, Any]]:
     return [], kw
 
 
+@functools.lru_cache(maxsize=None)
 def run(stem: str) -> xr.Dataset:
-    """The analysis of ``stem`` on its layout file's example."""
+    """The analysis of ``stem`` on its layout file's example (run once; not modified)."""
     args, kw = example(stem)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", afmdyn.AfmdynWarning)
