@@ -100,20 +100,7 @@ def test_the_dataset_has_the_variables_its_docstring_names(name: str) -> None:
         assert ds[var].dims == dims, (name, var)
 
 
-#: known losses of units in the finishers: ``afmdyn.peakforce`` merges its layouts' datasets
-#: with ``combine_attrs="drop"`` (``_peakforce.py``; ``_fit.py`` too), which drops every
-#: variable's units and long name; ``_image._dataset`` takes every integer map for a code to
-#: turn into words, and keeps ``evaluations`` (a count) without its units
-LOSES_UNITS = {
-    "peakforce": "xr.merge(combine_attrs='drop') drops the variables' attrs (_peakforce.py)",
-    "peakforce.sweep": "as peakforce's",
-    "image.peakforce": "_image._dataset drops the units of the integer map evaluations",
-}
-
-
-@pytest.mark.parametrize("name", [
-    pytest.param(n, marks=pytest.mark.xfail(strict=True, reason=LOSES_UNITS[n]))
-    if n in LOSES_UNITS else n for n in STEMS])
+@pytest.mark.parametrize("name", STEMS)
 def test_each_variable_has_the_units_its_docstring_gives(name: str) -> None:
     ds = run(name)
     for var, (_, units) in documented(name).items():

@@ -80,8 +80,8 @@ def _dataset(out: Dict[str, Any], setpoint: float) -> xr.Dataset:
     for name, (vdims, values, attrs) in layout.items():
         if vdims != dims:
             continue
-        if values.dtype.kind in "fb":
-            data[name] = (vdims, values, attrs)
+        if values.dtype.kind in "fb" or "flag_values" not in attrs:
+            data[name] = (vdims, values, attrs)  # a measure (a count too): its units kept
         else:
             base, retrace, _ = name.partition("_retrace")
             block = img["retrace"] if retrace else img

@@ -29,7 +29,7 @@ def _finish_peakforce(a: Dict[str, Any]) -> xr.Dataset:
     d = _door("peakforce", "peakforce", a["progress"], p, probe, request)
     doc = json.loads(d["json"])
     ds = xr.merge(
-        [dataset(layout) for layout in d["datasets"].values()], combine_attrs="drop"
+        [dataset(layout) for layout in d["datasets"].values()], combine_attrs="drop_conflicts"
     )
     if doc.get("sweep") is None:
         ds.attrs = {k: v for k, v in doc["channels"].items() if v is not None}
