@@ -88,7 +88,7 @@ def chart(
             1..=``MAX_CHART_SLOTS``: a cell with more keeps its first ones (most random
             starts first) there, and its ``attractors`` count tells how many it has; the CSV
             and JSON list every one.
-        max_period: Largest period searched, 1..=64 (``MAX_PERIOD``).
+        max_period: Largest period searched, 1..=``MAX_PERIOD``.
         max_periods: Cap on the transient, in drive periods, 1..=``MAX_STEADY_PERIODS``;
             ``None`` (default): derived from the model's slowest free decay, six times the
             periods it takes to decay by ``tol`` and at least 1 500 (≈ 1.9 Q ln(1/tol) for a
@@ -167,7 +167,7 @@ def bifurcation(
             law r = 0, the Taylor integrator for DMT; split falls back to adaptive where its
             exact free flight cannot be built), ``exact``, ``rk4``, ``rk4-naive``,
             ``adaptive``, ``split`` or ``taylor``.
-        max_period: Largest period searched, 1..=64 (``MAX_PERIOD``).
+        max_period: Largest period searched, 1..=``MAX_PERIOD``.
         max_periods: Cap on the transient, in drive periods, 1..=``MAX_STEADY_PERIODS``;
             ``None`` (default): derived from the model's slowest free decay, six times the
             periods it takes to decay by ``tol`` and at least 1 500 (≈ 1.9 Q ln(1/tol) for a
@@ -246,7 +246,7 @@ def basins(
             law r = 0, the Taylor integrator for DMT; split falls back to adaptive where its
             exact free flight cannot be built), ``exact``, ``rk4``, ``rk4-naive``,
             ``adaptive``, ``split`` or ``taylor``.
-        max_period: Largest period searched, 1..=64 (``MAX_PERIOD``).
+        max_period: Largest period searched, 1..=``MAX_PERIOD``.
         max_periods: Cap on the transient, in drive periods, 1..=``MAX_STEADY_PERIODS``;
             ``None`` (default): derived from the model's slowest free decay, six times the
             periods it takes to decay by ``tol`` and at least 1 500 (≈ 1.9 Q ln(1/tol) for a

@@ -62,7 +62,7 @@ def attractors(
             law r = 0, the Taylor integrator for DMT; split falls back to adaptive where its
             exact free flight cannot be built), ``exact``, ``rk4``, ``rk4-naive``,
             ``adaptive``, ``split`` or ``taylor``.
-        max_period: Largest period searched, 1..=64 (``MAX_PERIOD``).
+        max_period: Largest period searched, 1..=``MAX_PERIOD``.
         max_periods: Cap on the transient, in drive periods, 1..=``MAX_STEADY_PERIODS``;
             ``None`` (default): derived from the model's slowest free decay, six times the
             periods it takes to decay by ``tol`` and at least 1 500 (≈ 1.9 Q ln(1/tol) for a
@@ -140,7 +140,7 @@ def basins(
             law r = 0, the Taylor integrator for DMT; split falls back to adaptive where its
             exact free flight cannot be built), ``exact``, ``rk4``, ``rk4-naive``,
             ``adaptive``, ``split`` or ``taylor``.
-        max_period: Largest period searched, 1..=64 (``MAX_PERIOD``).
+        max_period: Largest period searched, 1..=``MAX_PERIOD``.
         max_periods: Cap on the transient, in drive periods, 1..=``MAX_STEADY_PERIODS``;
             ``None`` (default): derived from the model's slowest free decay, six times the
             periods it takes to decay by ``tol`` and at least 1 500 (≈ 1.9 Q ln(1/tol) for a
@@ -229,7 +229,7 @@ def global_continuation(
             ``adaptive``, ``split`` or ``taylor``.
         match_tol: Largest relative set distance of two attractors at consecutive values
             that are one, ≥ 0.
-        max_period: Largest period searched, 1..=64 (``MAX_PERIOD``).
+        max_period: Largest period searched, 1..=``MAX_PERIOD``.
         max_periods: Cap on the transient, in drive periods, 1..=``MAX_STEADY_PERIODS``;
             ``None`` (default): derived from the model's slowest free decay, six times the
             periods it takes to decay by ``tol`` and at least 1 500 (≈ 1.9 Q ln(1/tol) for a

@@ -16,8 +16,16 @@ pub struct SteadyRequest {
     /// derived from the model's slowest free decay, six times the periods it takes to decay by
     /// `tol` and at least 1 500 (≈ 1.9 Q ln(1/tol) for a lever of quality factor Q:
     /// [`crate::analysis::steady::default_transient_cap`]).
+    #[cfg_attr(
+        feature = "schema",
+        schemars(extend("x-constants" = { "MAX_STEADY_PERIODS": MAX_STEADY_PERIODS }))
+    )]
     pub max_periods: Option<usize>,
-    /// Largest period searched, 1..=64 ([`MAX_PERIOD`]).
+    /// Largest period searched, 1..=[`MAX_PERIOD`].
+    #[cfg_attr(
+        feature = "schema",
+        schemars(extend("x-constants" = { "MAX_PERIOD": MAX_PERIOD }))
+    )]
     pub max_period: usize,
 }
 
