@@ -192,11 +192,7 @@ def help_text(desc: str, siblings: set, constants: dict) -> str:
     flag (``points`` → ``--points``) and ``None`` "not given"."""
 
     def link(m: re.Match) -> str:
-        target = m.group(1)
-        last = target.rsplit("::", 1)[-1]
-        if last in constants:
-            return number(constants[last])
-        return target.removeprefix("crate::").removeprefix("super::")
+        return m.group(1).removeprefix("crate::").removeprefix("super::")
 
     def constant(m: re.Match) -> str:
         last = m.group(1).rsplit("::", 1)[-1]
@@ -246,8 +242,7 @@ def value_type(prop: dict, defs: dict) -> Tuple[str, bool]:
 class Field:
     """One request field as a flag."""
 
-    def __init__(self, name: str, prop: dict, defs: dict, siblings: set, extra: str,
-                 swept: str):
+    def __init__(self, name: str, prop: dict, defs: dict, siblings: set, extra: str):
         self.name = name
         self.rust, self.nullable = value_type(prop, defs)
         self.default = prop.get("default")
@@ -294,7 +289,7 @@ class Field:
         parts.append(f"help = {rust_str(self.help)}")
         return ", ".join(parts)
 
-    def value(self, swept: str) -> str:
+    def value(self) -> str:
         """The request field's value from the flag."""
         if self.negated:
             return f"!self.{self.ident()}"
@@ -342,7 +337,7 @@ def build(name: str, opts: dict, generated: Dict[str, dict]) -> Tuple[str, dict]
     if only is not None:  # a few fields' flags; the command builds the request
         props = {k: v for k, v in props.items() if k in only}  # type: ignore[operator]
     keys = [k for k in order if k in props] + sorted(k for k in props if k not in order)
-    fields = [Field(k, props[k], defs, siblings, extra.get(k, ""), swept)
+    fields = [Field(k, props[k], defs, siblings, extra.get(k, ""))
               for k in keys if k not in omit and k not in given and k not in flatten]
     uses_si = any(f.dim and not f.axis for f in fields) or any(
         generated[s]["si"] for s in flatten.values())
@@ -381,7 +376,7 @@ def build(name: str, opts: dict, generated: Dict[str, dict]) -> Tuple[str, dict]
             values.append(f"            {k},")
         else:
             f = next(x for x in fields if x.name == k)
-            values.append(f"            {k}: {f.value(swept)},")
+            values.append(f"            {k}: {f.value()},")
     rest = [f"            ..{request}::default()"] if omit else []
     result = f"Result<{request}, CliError>" if fallible else request
     ok, close = ("Ok(", ")") if fallible else ("", "")

@@ -21,7 +21,7 @@ pub struct CurveFlags {
     #[arg(long, allow_hyphen_values = true, conflicts_with = "points", help = "Grid step (front-end unit, that of --from and --to); excludes --points. With --probe a unit may follow (20nm, 300kHz).")]
     pub step: Option<Quantity>,
     /// `--points`: the request's `points`.
-    #[arg(long, help = "Number of grid values, ends included, 2..=100000 (default 120; a resonance curve with a probe takes more where a tenth of the linewidth needs them, linewidth_points).")]
+    #[arg(long, help = "Number of grid values, ends included, 2..=100000 (default 120; a resonance curve with a probe takes more where a tenth of the linewidth needs them).")]
     pub points: Option<usize>,
     /// `--no-branches`: the request's `branches`.
     #[arg(long, help = "Continue the periodic-orbit branches. On by default: this flag turns it off.")]
@@ -137,7 +137,7 @@ impl ResonanceFlags {
 #[derive(Debug, Clone, Args)]
 pub struct IntegratorFlags {
     /// `--integrator`: the request's `integrator`.
-    #[arg(long, default_value = "auto", help = "auto (the exact propagator for the linear law, the split integrator for Hertz and the impact law with r > 0, adaptive DOP853 for the plastic impact law r = 0, the Taylor integrator for DMT; split falls back to adaptive where its exact free flight cannot be built), exact, rk4, rk4-naive, adaptive, split or taylor.")]
+    #[arg(long, default_value = "auto", help = "The time integrator: auto (the exact propagator for the linear law, the split integrator for Hertz and the impact law with r > 0, adaptive DOP853 for the plastic impact law r = 0, the Taylor integrator for DMT; split falls back to adaptive where its exact free flight cannot be built), exact, rk4, rk4-naive, adaptive, split or taylor.")]
     pub integrator: afmdyn::integrate::IntegratorKind,
     /// `--steps-per-period`: the request's `steps_per_period`.
     #[arg(long, value_name = "M", help = "Fixed steps per drive period of rk4 / rk4-naive (default 2000).")]
@@ -231,7 +231,7 @@ pub struct FmFlags {
     #[arg(long, default_value = "1", help = "The mode K (1-based) the PLL tracks; default 1.")]
     pub mode: usize,
     /// `--from`: the request's `from`.
-    #[arg(long, allow_hyphen_values = true, help = "First z_c of the approach (default: where the frequency shift has decayed to 0.5 % of its value at --to, default_from; 2A + a₀, the lower turning point at A, for the laws without a force before contact). With --probe a unit may follow (20nm).")]
+    #[arg(long, allow_hyphen_values = true, help = "First z_c of the approach (default: where the frequency shift has decayed to 0.5 % of its value at --to; 2A + a₀, the lower turning point at A, for the laws without a force before contact). With --probe a unit may follow (20nm).")]
     pub from: Option<Quantity>,
     /// `--to`: the request's `to`.
     #[arg(long, allow_hyphen_values = true, help = "Last z_c (default A + a₀: the lower turning point at the contact distance a₀, 0 for the laws without attraction). With --probe a unit may follow (20nm).")]
@@ -269,7 +269,7 @@ impl FmFlags {
 #[derive(Debug, Clone, Args)]
 pub struct BifurcationFlags {
     /// `--param`: the request's `param`.
-    #[arg(long, default_value = "omega", help = "The swept parameter.")]
+    #[arg(long, default_value = "omega", help = "The swept parameter: omega or alpha1..alpha6 (or their names, tip-mass-ratio, …).")]
     pub param: afmdyn::SweepParam,
     /// `--from`: the request's `from`.
     #[arg(long, default_value = "1.0", allow_negative_numbers = true, help = "First value.")]

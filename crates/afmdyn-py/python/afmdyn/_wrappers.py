@@ -79,11 +79,11 @@ def simulate(
     Args:
         initial: The initial state (2N values); ``None``: rest. An :class:`Attractor` or
             :class:`Orbit` is also taken (its state at drive phase 0).
-        integrator: ``auto`` (the exact propagator for the linear law, the split integrator
-            for Hertz and the impact law with r > 0, adaptive DOP853 for the plastic impact
-            law r = 0, the Taylor integrator for DMT; split falls back to adaptive where its
-            exact free flight cannot be built), ``exact``, ``rk4``, ``rk4-naive``,
-            ``adaptive``, ``split`` or ``taylor``.
+        integrator: The time integrator: ``auto`` (the exact propagator for the linear law,
+            the split integrator for Hertz and the impact law with r > 0, adaptive DOP853
+            for the plastic impact law r = 0, the Taylor integrator for DMT; split falls
+            back to adaptive where its exact free flight cannot be built), ``exact``,
+            ``rk4``, ``rk4-naive``, ``adaptive``, ``split`` or ``taylor``.
         periods: Drive periods recorded after the transient (> 0); default 50 when
             ``tau_end`` is not given either.
         samples_per_period: Samples per drive period, 1..=``MAX_SAMPLES_PER_PERIOD``.
@@ -135,11 +135,11 @@ def converge(
     damping of eq. 26), as on the command line.
 
     Args:
-        integrator: ``auto`` (the exact propagator for the linear law, the split integrator
-            for Hertz and the impact law with r > 0, adaptive DOP853 for the plastic impact
-            law r = 0, the Taylor integrator for DMT; split falls back to adaptive where its
-            exact free flight cannot be built), ``exact``, ``rk4``, ``rk4-naive``,
-            ``adaptive``, ``split`` or ``taylor``.
+        integrator: The time integrator: ``auto`` (the exact propagator for the linear law,
+            the split integrator for Hertz and the impact law with r > 0, adaptive DOP853
+            for the plastic impact law r = 0, the Taylor integrator for DMT; split falls
+            back to adaptive where its exact free flight cannot be built), ``exact``,
+            ``rk4``, ``rk4-naive``, ``adaptive``, ``split`` or ``taylor``.
         max_modes: Largest number of modes, 1..=20.
         periods: Drive periods of steady state compared, 1..=``MAX_CONVERGE_PERIODS``.
         samples_per_period: Samples per drive period, 1..=``MAX_SAMPLES_PER_PERIOD``;
@@ -202,17 +202,18 @@ def bifurcation(
     Args:
         continuation: Forward and backward continuation.
         from_: First value.
-        integrator: ``auto`` (the exact propagator for the linear law, the split integrator
-            for Hertz and the impact law with r > 0, adaptive DOP853 for the plastic impact
-            law r = 0, the Taylor integrator for DMT; split falls back to adaptive where its
-            exact free flight cannot be built), ``exact``, ``rk4``, ``rk4-naive``,
-            ``adaptive``, ``split`` or ``taylor``.
+        integrator: The time integrator: ``auto`` (the exact propagator for the linear law,
+            the split integrator for Hertz and the impact law with r > 0, adaptive DOP853
+            for the plastic impact law r = 0, the Taylor integrator for DMT; split falls
+            back to adaptive where its exact free flight cannot be built), ``exact``,
+            ``rk4``, ``rk4-naive``, ``adaptive``, ``split`` or ``taylor``.
         max_period: Largest period searched, 1..=``MAX_PERIOD``.
         max_periods: Cap on the transient, in drive periods, 1..=``MAX_STEADY_PERIODS``;
             ``None`` (default): derived from the model's slowest free decay, six times the
             periods it takes to decay by ``tol`` and at least 1 500 (≈ 1.9 Q ln(1/tol) for a
             lever of quality factor Q: ``analysis::steady::default_transient_cap``).
-        param: The swept parameter.
+        param: The swept parameter: ``omega`` or ``alpha1``..``alpha6`` (or their names,
+            ``tip-mass-ratio``, …).
         seed: Seed of the random initial states.
         starts: Random initial states per value (besides continuation).
         steps: Number of values.
@@ -425,11 +426,11 @@ def chart(
 
     Args:
         cluster_tol: Clustering tolerance of two steady states, > 0.
-        integrator: ``auto`` (the exact propagator for the linear law, the split integrator
-            for Hertz and the impact law with r > 0, adaptive DOP853 for the plastic impact
-            law r = 0, the Taylor integrator for DMT; split falls back to adaptive where its
-            exact free flight cannot be built), ``exact``, ``rk4``, ``rk4-naive``,
-            ``adaptive``, ``split`` or ``taylor``.
+        integrator: The time integrator: ``auto`` (the exact propagator for the linear law,
+            the split integrator for Hertz and the impact law with r > 0, adaptive DOP853
+            for the plastic impact law r = 0, the Taylor integrator for DMT; split falls
+            back to adaptive where its exact free flight cannot be built), ``exact``,
+            ``rk4``, ``rk4-naive``, ``adaptive``, ``split`` or ``taylor``.
         lyapunov_periods: Drive periods of the λ₁ estimate of each nonperiodic attractor (0:
             none), ≤ ``MAX_CHART_LYAPUNOV_PERIODS``.
         max_attractors: Attractor slots per cell in the arrays of the results

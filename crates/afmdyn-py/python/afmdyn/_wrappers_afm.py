@@ -131,7 +131,7 @@ def approach(
             0.02)).
         points: Number of grid values, ends included, 2..=``MAX_CURVE_POINTS`` (default
             ``DEFAULT_CURVE_POINTS``; a resonance curve with a probe takes more where a
-            tenth of the linewidth needs them, ``linewidth_points``).
+            tenth of the linewidth needs them (``request::curves::linewidth_points``)).
         setpoint: The amplitude setpoint A_sp/A₀ in (0, 1] (under a multifrequency drive
             A₁/A₀₁, of the first component, the one the feedback holds): the document gains
             a ``"setpoint"`` block with the operating points where the curve's amplitude
@@ -220,7 +220,7 @@ def bimodal(
             0.02)).
         points: Number of grid values, ends included, 2..=``MAX_CURVE_POINTS`` (default
             ``DEFAULT_CURVE_POINTS``; a resonance curve with a probe takes more where a
-            tenth of the linewidth needs them, ``linewidth_points``).
+            tenth of the linewidth needs them (``request::curves::linewidth_points``)).
         setpoint: The amplitude setpoint A_sp/A₀ in (0, 1] (under a multifrequency drive
             A₁/A₀₁, of the first component, the one the feedback holds): the document gains
             a ``"setpoint"`` block with the operating points where the curve's amplitude
@@ -289,7 +289,7 @@ def resonance(
         mode: The mode k (1-based) whose resonance is swept.
         points: Number of grid values, ends included, 2..=``MAX_CURVE_POINTS`` (default
             ``DEFAULT_CURVE_POINTS``; a resonance curve with a probe takes more where a
-            tenth of the linewidth needs them, ``linewidth_points``).
+            tenth of the linewidth needs them (``request::curves::linewidth_points``)).
         step: Grid step (front-end unit, that of ``from`` and ``to``); excludes ``points``.
         to: Other end (front-end unit): z_c where the approach ends and the retract starts
             (default 0.1 × A₀), or the end of the resonance band (default ω_k (1 + w)).
@@ -340,8 +340,8 @@ def fm(
         amplitude: The first-harmonic amplitude A the amplitude controller holds (m with a
             probe, else g₀), > 0; default the probe's free amplitude A₀ (1 g₀).
         from_: First z_c of the approach (default: where the frequency shift has decayed to
-            0.5 % of its value at ``to``, ``default_from``; 2A + a₀, the lower turning point
-            at A, for the laws without a force before contact).
+            0.5 % of its value at ``to`` (``request::fm::default_from``); 2A + a₀, the lower
+            turning point at A, for the laws without a force before contact).
         mode: The mode K (1-based) the PLL tracks; default 1.
         points: Number of z_c values, ends included,
             2..=``analysis::stepped::MAX_CURVE_POINTS`` (default

@@ -57,11 +57,11 @@ def attractors(
     Args:
         cluster_tol: Relative tolerance for two Poincaré point sets to be the same
             attractor, > 0.
-        integrator: ``auto`` (the exact propagator for the linear law, the split integrator
-            for Hertz and the impact law with r > 0, adaptive DOP853 for the plastic impact
-            law r = 0, the Taylor integrator for DMT; split falls back to adaptive where its
-            exact free flight cannot be built), ``exact``, ``rk4``, ``rk4-naive``,
-            ``adaptive``, ``split`` or ``taylor``.
+        integrator: The time integrator: ``auto`` (the exact propagator for the linear law,
+            the split integrator for Hertz and the impact law with r > 0, adaptive DOP853
+            for the plastic impact law r = 0, the Taylor integrator for DMT; split falls
+            back to adaptive where its exact free flight cannot be built), ``exact``,
+            ``rk4``, ``rk4-naive``, ``adaptive``, ``split`` or ``taylor``.
         max_period: Largest period searched, 1..=``MAX_PERIOD``.
         max_periods: Cap on the transient, in drive periods, 1..=``MAX_STEADY_PERIODS``;
             ``None`` (default): derived from the model's slowest free decay, six times the
@@ -135,11 +135,11 @@ def basins(
             > 0.
         cluster_tol: Relative tolerance for two steady states to be one attractor, > 0.
         discover_after: Returns tested before the steady-state search takes over.
-        integrator: ``auto`` (the exact propagator for the linear law, the split integrator
-            for Hertz and the impact law with r > 0, adaptive DOP853 for the plastic impact
-            law r = 0, the Taylor integrator for DMT; split falls back to adaptive where its
-            exact free flight cannot be built), ``exact``, ``rk4``, ``rk4-naive``,
-            ``adaptive``, ``split`` or ``taylor``.
+        integrator: The time integrator: ``auto`` (the exact propagator for the linear law,
+            the split integrator for Hertz and the impact law with r > 0, adaptive DOP853
+            for the plastic impact law r = 0, the Taylor integrator for DMT; split falls
+            back to adaptive where its exact free flight cannot be built), ``exact``,
+            ``rk4``, ``rk4-naive``, ``adaptive``, ``split`` or ``taylor``.
         max_period: Largest period searched, 1..=``MAX_PERIOD``.
         max_periods: Cap on the transient, in drive periods, 1..=``MAX_STEADY_PERIODS``;
             ``None`` (default): derived from the model's slowest free decay, six times the
@@ -222,11 +222,11 @@ def global_continuation(
         cluster_tol: Relative tolerance for two Poincaré point sets at one value to be one
             attractor, > 0.
         from_: First value.
-        integrator: ``auto`` (the exact propagator for the linear law, the split integrator
-            for Hertz and the impact law with r > 0, adaptive DOP853 for the plastic impact
-            law r = 0, the Taylor integrator for DMT; split falls back to adaptive where its
-            exact free flight cannot be built), ``exact``, ``rk4``, ``rk4-naive``,
-            ``adaptive``, ``split`` or ``taylor``.
+        integrator: The time integrator: ``auto`` (the exact propagator for the linear law,
+            the split integrator for Hertz and the impact law with r > 0, adaptive DOP853
+            for the plastic impact law r = 0, the Taylor integrator for DMT; split falls
+            back to adaptive where its exact free flight cannot be built), ``exact``,
+            ``rk4``, ``rk4-naive``, ``adaptive``, ``split`` or ``taylor``.
         match_tol: Largest relative set distance of two attractors at consecutive values
             that are one, ≥ 0.
         max_period: Largest period searched, 1..=``MAX_PERIOD``.

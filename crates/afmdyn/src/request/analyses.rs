@@ -647,7 +647,8 @@ pub(super) fn check_samples_per_period(spp: usize) -> Result<(), SimError> {
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(default, deny_unknown_fields)]
 pub struct BifurcationRequest {
-    /// The swept parameter.
+    /// The swept parameter: `omega` or `alpha1`..`alpha6` (or their names,
+    /// `tip-mass-ratio`, …).
     pub param: SweepParam,
     /// Explicit values instead of `from`, `to`, `steps`.
     pub values: Option<Vec<f64>>,

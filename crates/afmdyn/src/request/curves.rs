@@ -39,7 +39,7 @@ pub struct CurveRequest {
     pub step: Option<f64>,
     /// Number of grid values, ends included, 2..=[`MAX_CURVE_POINTS`] (default
     /// [`DEFAULT_CURVE_POINTS`]; a resonance curve with a probe takes more where a tenth of
-    /// the linewidth needs them, [`linewidth_points`]).
+    /// the linewidth needs them ([`crate::request::curves::linewidth_points`])).
     #[cfg_attr(
         feature = "schema",
         schemars(extend("x-constants" = {

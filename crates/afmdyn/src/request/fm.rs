@@ -30,7 +30,7 @@ pub struct FmRequest {
     /// The mode K (1-based) the PLL tracks; default 1.
     pub mode: usize,
     /// First z_c of the approach (default: where the frequency shift has decayed to 0.5 % of
-    /// its value at `to`, [`default_from`]; 2A + a₀, the lower turning point at A, for the
+    /// its value at `to` ([`crate::request::fm::default_from`]); 2A + a₀, the lower turning point at A, for the
     /// laws without a force before contact).
     #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "length")))]
     pub from: Option<f64>,

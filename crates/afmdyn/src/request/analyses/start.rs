@@ -62,10 +62,11 @@ impl SteadyRequest {
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(default, deny_unknown_fields)]
 pub struct IntegratorRequest {
-    /// `auto` (the exact propagator for the linear law, the split integrator for Hertz and the
-    /// impact law with r > 0, adaptive DOP853 for the plastic impact law r = 0, the Taylor
-    /// integrator for DMT; split falls back to adaptive where its exact free flight cannot be
-    /// built), `exact`, `rk4`, `rk4-naive`, `adaptive`, `split` or `taylor`.
+    /// The time integrator: `auto` (the exact propagator for the linear law, the split
+    /// integrator for Hertz and the impact law with r > 0, adaptive DOP853 for the plastic
+    /// impact law r = 0, the Taylor integrator for DMT; split falls back to adaptive where its
+    /// exact free flight cannot be built), `exact`, `rk4`, `rk4-naive`, `adaptive`, `split` or
+    /// `taylor`.
     pub integrator: IntegratorKind,
     /// Fixed steps per drive period of `rk4` / `rk4-naive` (default 2000).
     pub steps_per_period: Option<usize>,
