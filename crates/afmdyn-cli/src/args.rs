@@ -1,10 +1,10 @@
 //! Flags shared by every subcommand: the model parameters (with the paper's α aliases), the
-//! TOML config file, the integrator.
+//! TOML config file, the probe; numbers with SI units ([`Quantity`]). The request flags are
+//! generated ([`crate::flags`]).
 
 use crate::error::CliError;
-use afmdyn::integrate::IntegratorKind;
 use afmdyn::io::InputKind;
-use afmdyn::request::{IntegratorRequest, ModelSpec, SteadyRequest};
+use afmdyn::request::ModelSpec;
 use afmdyn::{LawKind, Params};
 use clap::Args;
 use serde::Deserialize;
@@ -233,41 +233,6 @@ impl ModelArgs {
     }
 }
 
-/// Integrator flags.
-#[derive(Debug, Clone, Args)]
-pub struct IntegratorArgs {
-    /// Time integrator: auto (exact for the linear law, split for Hertz and impact, taylor for
-    /// DMT; default), exact (piecewise-exact), split (exact free flight; Taylor series in a
-    /// Hertz contact, adaptive while sticking), taylor (Taylor series of high order, the
-    /// contact's edges in its regularising time: Hertz and DMT), rk4 (located switchings),
-    /// rk4-naive (region per stage, as in the paper) or adaptive (DOP853 with events and
-    /// variational equations)
-    #[arg(long, default_value = "auto", value_parser = parse_integrator)]
-    pub integrator: IntegratorKind,
-    /// Fixed steps per drive period of rk4 / rk4-naive (default 2000)
-    #[arg(long, value_name = "M")]
-    pub steps_per_period: Option<usize>,
-    /// Relative/absolute tolerance of the adaptive integrator
-    #[arg(long, default_value_t = IntegratorRequest::default().tolerance)]
-    pub tolerance: f64,
-}
-
-fn parse_integrator(s: &str) -> Result<IntegratorKind, String> {
-    s.parse()
-}
-
-impl IntegratorArgs {
-    /// The library's request ([`IntegratorRequest::options`] refines `exact`'s grid from the
-    /// sampling rate; rk4 takes `--steps-per-period`, default 2000).
-    pub fn request(&self) -> IntegratorRequest {
-        IntegratorRequest {
-            integrator: self.integrator,
-            steps_per_period: self.steps_per_period,
-            tolerance: self.tolerance,
-        }
-    }
-}
-
 /// What an SI unit suffix measures.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Dim {
@@ -453,32 +418,5 @@ mod quantity_tests {
         assert_eq!(q("5µm").value, 5e-6);
         assert!("7 parsecs".parse::<Quantity>().is_err());
         assert!("nm".parse::<Quantity>().is_err());
-    }
-}
-
-/// Steady-state flags.
-#[derive(Debug, Clone, Args)]
-pub struct SteadyArgs {
-    /// Relative tolerance for returns of the stroboscopic map to coincide
-    #[arg(long, default_value_t = SteadyRequest::default().tol)]
-    tol: f64,
-    /// Cap on the transient, in drive periods [default: derived from the model's slowest free
-    /// decay: six times the periods it takes to decay by --tol, at least 1500; ≈ 1.9 Q
-    /// ln(1/tol) for a lever of quality factor Q]
-    #[arg(long)]
-    max_periods: Option<usize>,
-    /// Largest period searched (≤ 64)
-    #[arg(long, default_value_t = SteadyRequest::default().max_period)]
-    max_period: usize,
-}
-
-impl SteadyArgs {
-    /// The library's request ([`SteadyRequest::options`] validates it).
-    pub fn request(&self) -> SteadyRequest {
-        SteadyRequest {
-            tol: self.tol,
-            max_periods: self.max_periods,
-            max_period: self.max_period,
-        }
     }
 }

@@ -1,7 +1,8 @@
 //! `afmdyn bifurcation` and `afmdyn attractors`.
 
-use crate::args::{IntegratorArgs, ModelArgs};
+use crate::args::ModelArgs;
 use crate::error::{store_error, study_error, CliError};
+use crate::flags::{AttractorsFlags, AttractorsSweepFlags, BifurcationFlags};
 use crate::output::{io_error, units_of, OutDir};
 use crate::plot::{save_scatter_stream, ChunkSink};
 use afmdyn::request::present::census::failed_starts;
@@ -9,10 +10,8 @@ use afmdyn::request::present::sweeps::{
     branch_legend, diagram_point, SweepRow, SweepTally, BIFURCATION_FIGURES,
 };
 use afmdyn::request::Analysis;
-use afmdyn::request::{
-    AttractorsRequest, BifurcationRequest, FileCheckpoint, GlobalContinuationRequest,
-};
 use afmdyn::request::{Document, Resolved};
+use afmdyn::request::{FileCheckpoint, GlobalContinuationRequest};
 use afmdyn::study::global_continuation::{continuation_store, ContinuationStudy};
 use afmdyn::study::sweep::SweepStudy;
 use afmdyn::{Params, SweepParam};
@@ -20,42 +19,13 @@ use clap::Args;
 use serde_json::json;
 use std::path::{Path, PathBuf};
 
-/// The steady-state flags (shared with `basins`, `chart`, `orbit`, …).
-pub use crate::args::SteadyArgs;
-
 /// `afmdyn bifurcation` flags.
 #[derive(Debug, Args)]
 pub struct BifurcationArgs {
     #[command(flatten)]
     model: ModelArgs,
     #[command(flatten)]
-    integrator: IntegratorArgs,
-    #[command(flatten)]
-    steady: SteadyArgs,
-    /// Swept parameter: omega, alpha1..alpha6 (or tip-mass-ratio, drive-amplitude, …)
-    #[arg(long, default_value = "omega")]
-    param: SweepParam,
-    /// First value
-    #[arg(long, default_value_t = BifurcationRequest::default().from, allow_negative_numbers = true)]
-    from: f64,
-    /// Last value
-    #[arg(long, default_value_t = BifurcationRequest::default().to, allow_negative_numbers = true)]
-    to: f64,
-    /// Number of values
-    #[arg(long, default_value_t = BifurcationRequest::default().steps)]
-    steps: usize,
-    /// Random initial states per value (in addition to continuation)
-    #[arg(long, default_value_t = BifurcationRequest::default().starts)]
-    starts: u32,
-    /// Seed of the random initial states
-    #[arg(long, default_value_t = BifurcationRequest::default().seed)]
-    seed: u64,
-    /// Only random starts, no forward/backward continuation
-    #[arg(long)]
-    no_continuation: bool,
-    /// Worker threads (default: all cores)
-    #[arg(long)]
-    threads: Option<usize>,
+    request: BifurcationFlags,
     /// Continue an interrupted sweep; refused unless the other arguments are those of the
     /// interrupted run (recorded in OUT/.bifurcation.run.json)
     #[arg(long)]
@@ -106,19 +76,7 @@ fn read_rows(
 /// the store in `--out`, the diagrams streamed from the store's CSV.
 pub fn bifurcation(a: &BifurcationArgs) -> Result<(), CliError> {
     let (base, probe) = a.model.resolve(Params::default())?;
-    let request = BifurcationRequest {
-        param: a.param,
-        values: None,
-        from: a.from,
-        to: a.to,
-        steps: a.steps,
-        starts: a.starts,
-        seed: a.seed,
-        continuation: !a.no_continuation,
-        threads: a.threads,
-        steady: a.steady.request(),
-        integrator: a.integrator.request(),
-    };
+    let request = a.request.request();
     let spec = request
         .spec(&base)
         .map_err(|e| CliError::Input(crate::error::spell(&e)))?;
@@ -131,7 +89,7 @@ pub fn bifurcation(a: &BifurcationArgs) -> Result<(), CliError> {
         &study,
         &mut store,
         a.resume,
-        a.threads,
+        request.threads,
         "points",
         a.abort_after,
     )
@@ -142,7 +100,7 @@ pub fn bifurcation(a: &BifurcationArgs) -> Result<(), CliError> {
         tally.add_row(SweepRow::from_csv(r));
         Ok(())
     })?;
-    let npy = store.write_npy(a.param)?;
+    let npy = store.write_npy(request.param)?;
     let branches = branch_legend(spec.continuation, spec.starts);
     for (stem, col, title, ylab, by_branch) in BIFURCATION_FIGURES {
         let feed = |draw: &mut ChunkSink<'_>| -> Result<(), CliError> {
@@ -162,11 +120,11 @@ pub fn bifurcation(a: &BifurcationArgs) -> Result<(), CliError> {
         } else {
             tally.legend()
         };
-        let x_label = format!("{} ({})", a.param.symbol(), a.param.name());
+        let x_label = format!("{} ({})", request.param.symbol(), request.param.name());
         let (bounds, labels) = (tally.bounds(col), (x_label.as_str(), ylab));
         save_scatter_stream(out.path(), stem, title, labels, bounds, &legend, &feed)?;
     }
-    let mut summary = tally.document(&base, a.param, spec.values.len());
+    let mut summary = tally.document(&base, request.param, spec.values.len());
     summary["csv"] = json!(final_csv);
     summary["npy"] = json!(npy);
     summary = afmdyn::report::with_si(summary, probe.as_ref(), &base);
@@ -184,7 +142,7 @@ pub fn bifurcation(a: &BifurcationArgs) -> Result<(), CliError> {
     if a.json {
         outln!("{summary}");
     } else {
-        let line = tally.summary(spec.values.len(), a.param);
+        let line = tally.summary(spec.values.len(), request.param);
         outln!("{line}; outputs in {}", out.path().display());
     }
     Ok(())
@@ -196,18 +154,7 @@ pub struct AttractorsArgs {
     #[command(flatten)]
     model: ModelArgs,
     #[command(flatten)]
-    integrator: IntegratorArgs,
-    #[command(flatten)]
-    steady: SteadyArgs,
-    /// Number of random initial states
-    #[arg(long, default_value_t = AttractorsRequest::default().samples)]
-    samples: usize,
-    /// Seed of the initial states
-    #[arg(long, default_value_t = AttractorsRequest::default().seed)]
-    seed: u64,
-    /// Relative tolerance for two Poincaré point sets to be the same attractor
-    #[arg(long, default_value_t = AttractorsRequest::default().cluster_tol)]
-    cluster_tol: f64,
+    request: AttractorsFlags,
     /// Continue the attractors over this parameter (omega, alpha1..alpha6): a census at every
     /// value, seeded from the previous value's attractors and matched to them (global
     /// continuation); needs --from and --to
@@ -219,13 +166,8 @@ pub struct AttractorsArgs {
     /// Last value of --sweep
     #[arg(long, allow_negative_numbers = true, requires = "sweep")]
     to: Option<f64>,
-    /// Number of values of --sweep
-    #[arg(long, default_value_t = GlobalContinuationRequest::default().steps, requires = "sweep")]
-    steps: usize,
-    /// Largest relative distance between the Poincaré point sets of two attractors at
-    /// consecutive values of --sweep that are one attractor
-    #[arg(long, default_value_t = GlobalContinuationRequest::default().match_tol, requires = "sweep")]
-    match_tol: f64,
+    #[command(flatten)]
+    sweep_flags: AttractorsSweepFlags,
     /// Continue an interrupted --sweep; refused unless the other arguments are those of the
     /// interrupted run (recorded in OUT/.continuation.run.json)
     #[arg(long, requires = "sweep")]
@@ -246,21 +188,15 @@ pub struct AttractorsArgs {
 pub fn attractors(a: &AttractorsArgs) -> Result<(), CliError> {
     let (params, probe) = a.model.resolve(Params::default())?;
     let model = Resolved { params, probe };
-    let request = AttractorsRequest {
-        samples: a.samples,
-        seed: a.seed,
-        cluster_tol: a.cluster_tol,
-        steady: a.steady.request(),
-        integrator: a.integrator.request(),
-    };
+    let request = a.request.request();
     if let Some(param) = a.sweep {
         let sweep = GlobalContinuationRequest {
             param,
             values: None,
             from: a.from.unwrap_or(f64::NAN),
             to: a.to.unwrap_or(f64::NAN),
-            steps: a.steps,
-            match_tol: a.match_tol,
+            steps: a.sweep_flags.steps,
+            match_tol: a.sweep_flags.match_tol,
             samples: request.samples,
             seed: request.seed,
             cluster_tol: request.cluster_tol,
@@ -273,7 +209,7 @@ pub fn attractors(a: &AttractorsArgs) -> Result<(), CliError> {
     let out = OutDir::lock(&a.out)?;
     let Document { output, json } = crate::progress::run(&request, &model, "starts")?;
     let shown = request.present(&model, &output, &json, units_of(model.probe.as_ref()))?;
-    if let Some(w) = failed_starts(&output, a.samples) {
+    if let Some(w) = failed_starts(&output, request.samples) {
         errln!("afmdyn: warning: {w}");
     }
     crate::door::emit(Some(&out), &shown, &json, a.json)

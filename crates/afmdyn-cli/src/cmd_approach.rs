@@ -4,40 +4,25 @@
 //! into the `--out` directory's store ([`CurveStudy`]); their summary, tables, traces and
 //! figures are the library's ([`afmdyn::request::present::curves`]).
 
-use crate::args::{quantity, Dim, ModelArgs, Quantity};
+use crate::args::ModelArgs;
 use crate::cmd_simulate::Files;
 use crate::door;
 use crate::error::CliError;
+use crate::flags::{ApproachFlags, BimodalFlags, ResonanceFlags};
 use crate::output::{units_of, OutDir};
 use afmdyn::analysis::stepped::SteppedCurve;
 use afmdyn::request::present;
 use afmdyn::request::present::curves::{stepped, CurveKind, CurveOptions};
-use afmdyn::request::{Analysis, ApproachRequest, CurveRequest, Resolved, ResonanceRequest};
+use afmdyn::request::{Analysis, CurveRequest, Resolved};
 use afmdyn::study::stepped::{curve_store, CurveStudy};
 use afmdyn::{Params, SimError};
 use clap::Args;
 use std::path::{Path, PathBuf};
 
-/// Grid, solver and output flags shared by `approach` and `resonance`.
+/// The output flags shared by `approach`, `bimodal` and `resonance` (the command line's own;
+/// the request's flags are generated: [`crate::flags`]).
 #[derive(Debug, Args)]
 pub struct CurveArgs {
-    /// Grid step of the swept quantity (in the units of --from/--to); conflicts with --points
-    #[arg(long, conflicts_with = "points", allow_hyphen_values = true)]
-    step: Option<Quantity>,
-    /// Number of grid values, ends included (2..=100000) [default: 120]
-    #[arg(long)]
-    points: Option<usize>,
-    /// Skip the continuation of the periodic-orbit branches (stepped sweeps only)
-    #[arg(long)]
-    no_branches: bool,
-    /// Tolerance of the adaptive integrator (the exact propagator ignores it)
-    #[arg(long, default_value_t = CurveRequest::default().tolerance)]
-    tolerance: f64,
-    /// Record one steady-state cycle per point of the first sweep (tip deflection, distance
-    /// V_T, tip–sample force), N samples per drive period (default 200): STEM-traces.nc, the
-    /// force–distance loops plot and "traces" in --json
-    #[arg(long, value_name = "N", num_args = 0..=1, default_missing_value = "200")]
-    traces: Option<usize>,
     /// Files written: all (data and plots), data (no plots) or none (only the summary)
     #[arg(long, value_enum, default_value = "all")]
     files: Files,
@@ -58,98 +43,31 @@ pub struct CurveArgs {
     abort_after: Option<usize>,
 }
 
-impl CurveArgs {
-    /// The request of these flags with the ends `from`, `to` (the library checks and applies
-    /// it: [`CurveRequest`]); the step in `dim` when `si` (a probe).
-    fn request(
-        &self,
-        from: Option<f64>,
-        to: Option<f64>,
-        dim: Dim,
-        si: bool,
-    ) -> Result<CurveRequest, CliError> {
-        Ok(CurveRequest {
-            from,
-            to,
-            step: quantity(self.step, "step", dim, si)?,
-            points: self.points,
-            branches: !self.no_branches,
-            traces: self.traces,
-            tolerance: self.tolerance,
-        })
-    }
-}
-
-/// The z_c range of `approach` and `bimodal`.
-#[derive(Debug, Args)]
-struct ZcRange {
-    /// Rest distance z_c where the approach starts (m with --probe, else units of g0)
-    /// [default: 1.2 × the free amplitude A0 from the sample, the sum of the components' under
-    /// a multifrequency drive]; with --probe a unit may follow (20nm)
-    #[arg(long, allow_hyphen_values = true)]
-    from: Option<Quantity>,
-    /// Rest distance z_c where the approach ends and the retract starts [default: 0.1 × A0]
-    #[arg(long, allow_hyphen_values = true)]
-    to: Option<Quantity>,
-}
-
-impl ZcRange {
-    /// The ends in the model's or SI lengths (a probe: `si`).
-    fn ends(&self, si: bool) -> Result<(Option<f64>, Option<f64>), CliError> {
-        Ok((
-            quantity(self.from, "from", Dim::Length, si)?,
-            quantity(self.to, "to", Dim::Length, si)?,
-        ))
-    }
-}
-
 /// `afmdyn approach` flags.
 #[derive(Debug, Args)]
 pub struct ApproachArgs {
     #[command(flatten)]
     model: ModelArgs,
     #[command(flatten)]
-    range: ZcRange,
+    request: ApproachFlags,
     #[command(flatten)]
     curve: CurveArgs,
-    /// Amplitude setpoint A_sp/A0 in (0, 1]: the operating points where the curve's amplitude
-    /// equals it on each stable branch (attractive and repulsive in the bistable range), with
-    /// phase, peak force, indentation and dissipated energy there ("setpoint" in --json)
-    #[arg(long, value_name = "RATIO")]
-    setpoint: Option<f64>,
     /// Output directory (locked during the run)
     #[arg(long, default_value = "afmdyn-out/approach")]
     out: PathBuf,
 }
 
-/// `afmdyn bimodal` flags: those of `approach`; the probe's `[drive]` gives two or more
-/// components (`free_amplitude = [A01, A02]`, `frequency = [f1, f2]`).
+/// `afmdyn bimodal` flags: those of `approach` with the averaged and exact measures; the
+/// probe's `[drive]` gives two or more components (`free_amplitude = [A01, A02]`,
+/// `frequency = [f1, f2]`).
 #[derive(Debug, Args)]
 pub struct BimodalArgs {
     #[command(flatten)]
     model: ModelArgs,
     #[command(flatten)]
-    range: ZcRange,
+    request: BimodalFlags,
     #[command(flatten)]
     curve: CurveArgs,
-    /// Measure every point by the time average (Hann-windowed demodulation until successive
-    /// windows agree, with an error estimate per component) instead of the exact periodic
-    /// orbit of the common period; always so for an incommensurate ratio (common period beyond
-    /// 1000 drive periods). No branches
-    #[arg(long)]
-    average: bool,
-    /// Measure every point on the exact periodic orbit of the common period, with branches
-    /// and folds, even where a two-frequency drive repeats only after more than 32 drive
-    /// periods (e.g. f2/f1 = 6.27 = 627/100), whose points are otherwise measured on the
-    /// invariant circle of the stroboscopic map (the exact orbit where the circle is not
-    /// smooth, as the warnings say)
-    #[arg(long, conflicts_with = "average")]
-    exact: bool,
-    /// Setpoint A1/A01 in (0, 1] of the first component's amplitude (the one the feedback
-    /// holds): the operating points where the curve reaches it, with every component's
-    /// amplitude, phase, virial and dissipated energy there ("setpoint" in --json)
-    #[arg(long, value_name = "RATIO")]
-    setpoint: Option<f64>,
     /// Output directory (locked during the run)
     #[arg(long, default_value = "afmdyn-out/bimodal")]
     out: PathBuf,
@@ -160,16 +78,8 @@ pub struct BimodalArgs {
 pub struct ResonanceArgs {
     #[command(flatten)]
     model: ModelArgs,
-    /// Mode k whose natural frequency the default band surrounds (1..=N)
-    #[arg(long, default_value_t = ResonanceRequest::default().mode)]
-    mode: usize,
-    /// Start of the band (Hz with --probe, else Ω) [default: ω_k (1 − w), w = max(6/Q_k, 0.02)];
-    /// with --probe a unit may follow (295kHz)
-    #[arg(long, allow_hyphen_values = true)]
-    from: Option<Quantity>,
-    /// End of the band [default: ω_k (1 + w)]
-    #[arg(long, allow_hyphen_values = true)]
-    to: Option<Quantity>,
+    #[command(flatten)]
+    request: ResonanceFlags,
     #[command(flatten)]
     curve: CurveArgs,
     /// Output directory (locked during the run)
@@ -242,11 +152,11 @@ fn go<A: Analysis<Output = SteppedCurve>>(
     door::emit(out.as_ref(), &shown, &json, args.json)
 }
 
-/// The model of the flags, with `--from`/`--to` checked finite.
-fn setup(model: &ModelArgs, from: Option<f64>, to: Option<f64>) -> Result<Resolved, CliError> {
+/// The model of the flags, with the request's `--from`/`--to` checked finite.
+fn setup(model: &ModelArgs, curve: &CurveRequest) -> Result<Resolved, CliError> {
     let (params, probe) = model.resolve(Params::default())?;
-    check_finite("--from", from)?;
-    check_finite("--to", to)?;
+    check_finite("--from", curve.from)?;
+    check_finite("--to", curve.to)?;
     Ok(Resolved { params, probe })
 }
 
@@ -261,15 +171,8 @@ fn check_finite(name: &str, v: Option<f64>) -> Result<(), CliError> {
 
 /// Run `afmdyn approach`.
 pub fn approach(a: &ApproachArgs) -> Result<(), CliError> {
-    let si = a.model.probe.is_some();
-    let (from, to) = a.range.ends(si)?;
-    let model = setup(&a.model, from, to)?;
-    let request = ApproachRequest {
-        curve: a.curve.request(from, to, Dim::Length, si)?,
-        setpoint: a.setpoint,
-        average: false,
-        exact: false,
-    };
+    let request = a.request.request(a.model.probe.is_some())?;
+    let model = setup(&a.model, &request.curve)?;
     let study = || CurveStudy::approach(&request, &model);
     let out = (a.out.as_path(), "approach");
     go(&a.curve, out, &request, &model, study, CurveKind::Approach)
@@ -278,16 +181,9 @@ pub fn approach(a: &ApproachArgs) -> Result<(), CliError> {
 /// Run `afmdyn bimodal`: the approach curve of a multifrequency drive
 /// ([`afmdyn::request::curves::check_bimodal`]), its files `bimodal.*`.
 pub fn bimodal(a: &BimodalArgs) -> Result<(), CliError> {
-    let si = a.model.probe.is_some();
-    let (from, to) = a.range.ends(si)?;
-    let model = setup(&a.model, from, to)?;
+    let request = a.request.request(a.model.probe.is_some())?;
+    let model = setup(&a.model, &request.curve)?;
     afmdyn::request::curves::check_bimodal(&model.params)?;
-    let request = ApproachRequest {
-        curve: a.curve.request(from, to, Dim::Length, si)?,
-        setpoint: a.setpoint,
-        average: a.average,
-        exact: a.exact,
-    };
     let study = || CurveStudy::approach(&request, &model);
     let out = (a.out.as_path(), "bimodal");
     go(&a.curve, out, &request, &model, study, CurveKind::Approach)
@@ -295,14 +191,8 @@ pub fn bimodal(a: &BimodalArgs) -> Result<(), CliError> {
 
 /// Run `afmdyn resonance`.
 pub fn resonance(a: &ResonanceArgs) -> Result<(), CliError> {
-    let si = a.model.probe.is_some();
-    let from = quantity(a.from, "from", Dim::Frequency, si)?;
-    let to = quantity(a.to, "to", Dim::Frequency, si)?;
-    let model = setup(&a.model, from, to)?;
-    let request = ResonanceRequest {
-        mode: a.mode,
-        curve: a.curve.request(from, to, Dim::Frequency, si)?,
-    };
+    let request = a.request.request(a.model.probe.is_some())?;
+    let model = setup(&a.model, &request.curve)?;
     let study = || CurveStudy::resonance(&request, &model);
     let out = (a.out.as_path(), "resonance");
     go(&a.curve, out, &request, &model, study, CurveKind::Resonance)

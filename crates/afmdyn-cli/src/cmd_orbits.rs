@@ -1,14 +1,15 @@
 //! `afmdyn orbit`, `afmdyn continue` and `afmdyn lyapunov`.
 
 use crate::args::ModelArgs;
-use crate::cmd_analysis::{SteadyArgs, COL_VALUE, COL_W_TIP};
+use crate::cmd_analysis::{COL_VALUE, COL_W_TIP};
 use crate::cmd_simulate::parse_initial;
 use crate::door::{self, Exit};
 use crate::error::CliError;
+use crate::flags::{ContinueFlags, LyapunovFlags, OrbitFlags, SteadyFlags};
 use crate::plot::{Series, Style};
 use afmdyn::request::Resolved;
-use afmdyn::request::{ContinuationRequest, LyapunovRequest, OrbitRequest, StartRequest};
-use afmdyn::{Params, SweepParam};
+use afmdyn::request::StartRequest;
+use afmdyn::Params;
 use clap::Args;
 use std::path::{Path, PathBuf};
 
@@ -19,7 +20,7 @@ pub struct StartArgs {
     #[arg(long, allow_hyphen_values = true)]
     initial_modal: Option<String>,
     #[command(flatten)]
-    steady: SteadyArgs,
+    steady: SteadyFlags,
 }
 
 impl StartArgs {
@@ -39,9 +40,8 @@ pub struct OrbitArgs {
     model: ModelArgs,
     #[command(flatten)]
     start: StartArgs,
-    /// Period n of the orbit (default: the period of the steady state reached, else 1)
-    #[arg(long)]
-    period: Option<usize>,
+    #[command(flatten)]
+    request: OrbitFlags,
     /// Print one JSON document
     #[arg(long)]
     json: bool,
@@ -50,10 +50,7 @@ pub struct OrbitArgs {
 /// Run `afmdyn orbit`.
 pub fn orbit(a: &OrbitArgs) -> Result<(), CliError> {
     let (params, probe) = a.model.resolve(Params::default())?;
-    let request = OrbitRequest {
-        period: a.period,
-        start: a.start.request(params.modes)?,
-    };
+    let request = a.request.request(a.start.request(params.modes)?);
     let exit = Exit {
         files: Default::default(),
         json: a.json,
@@ -70,22 +67,8 @@ pub struct ContinueArgs {
     model: ModelArgs,
     #[command(flatten)]
     start: StartArgs,
-    /// Continued parameter: omega or alpha1..alpha6
-    #[arg(long, default_value = "omega")]
-    param: SweepParam,
-    /// Start value
-    #[arg(long, default_value_t = ContinuationRequest::default().from, allow_negative_numbers = true)]
-    from: f64,
-    /// End of the range
-    #[arg(long, default_value_t = ContinuationRequest::default().to, allow_negative_numbers = true)]
-    to: f64,
-    /// Period n of the branch (default: the period of the steady state at --from)
-    #[arg(long)]
-    period: Option<usize>,
-    /// At each period doubling, switch to the period-2n branch and continue it too, recursively
-    /// up to period 8n (the period-doubling cascade)
-    #[arg(long)]
-    switch: bool,
+    #[command(flatten)]
+    request: ContinueFlags,
     /// Draw the branches over this bifurcation.csv (from `afmdyn bifurcation`)
     #[arg(long, value_name = "CSV")]
     overlay: Option<PathBuf>,
@@ -138,14 +121,7 @@ fn read_overlay(path: &Path) -> Result<Vec<(f64, f64)>, CliError> {
 /// Run `afmdyn continue`.
 pub fn continuation(a: &ContinueArgs) -> Result<(), CliError> {
     let (params, probe) = a.model.resolve(Params::default())?;
-    let request = ContinuationRequest {
-        param: a.param,
-        from: a.from,
-        to: a.to,
-        period: a.period,
-        switch: a.switch,
-        start: a.start.request(params.modes)?,
-    };
+    let request = a.request.request(a.start.request(params.modes)?);
     request.validate(&params)?;
     let underlay = match &a.overlay {
         Some(o) => read_overlay(o)?,
@@ -188,16 +164,8 @@ pub struct LyapunovArgs {
     /// Initial modal state "a1,..,aN;adot1,..,adotN" (default: rest)
     #[arg(long, allow_hyphen_values = true)]
     initial_modal: Option<String>,
-    /// Drive periods discarded first [default: derived from the model's slowest free decay,
-    /// as the steady-state searches' --max-periods: 1500 for the paper's beam]
-    #[arg(long)]
-    transient: Option<usize>,
-    /// Drive periods averaged
-    #[arg(long, default_value_t = LyapunovRequest::default().periods)]
-    periods: usize,
-    /// Blocks for the uncertainty
-    #[arg(long, default_value_t = LyapunovRequest::default().blocks)]
-    blocks: usize,
+    #[command(flatten)]
+    request: LyapunovFlags,
     /// Print one JSON document
     #[arg(long)]
     json: bool,
@@ -206,12 +174,9 @@ pub struct LyapunovArgs {
 /// Run `afmdyn lyapunov`.
 pub fn lyapunov(a: &LyapunovArgs) -> Result<(), CliError> {
     let (params, probe) = a.model.resolve(Params::default())?;
-    let request = LyapunovRequest {
-        initial: parse_initial(&a.initial_modal, params.modes)?,
-        transient: a.transient,
-        periods: a.periods,
-        blocks: a.blocks,
-    };
+    let request = a
+        .request
+        .request(parse_initial(&a.initial_modal, params.modes)?);
     let exit = Exit {
         files: Default::default(),
         json: a.json,

@@ -6,14 +6,15 @@
 //! summary, tables, figures and `peakforce.json` ([`afmdyn::request::present::peakforce`]);
 //! this front end maps the flags.
 
-use crate::args::{quantity, Dim, ModelArgs, Quantity};
+use crate::args::{Dim, ModelArgs, Quantity};
 use crate::cmd_approach::files;
 use crate::cmd_simulate::Files;
 use crate::door;
 use crate::error::CliError;
+use crate::flags::PeakForceFlags;
 use crate::output::{units_of, OutDir};
 use afmdyn::request::present;
-use afmdyn::request::{PeakForceRequest, PeakForceSweep, PeakForceSweepParam, Resolved};
+use afmdyn::request::{PeakForceSweep, PeakForceSweepParam, Resolved};
 use afmdyn::Params;
 use clap::Args;
 use std::path::PathBuf;
@@ -23,15 +24,8 @@ use std::path::PathBuf;
 pub struct PeakForceArgs {
     #[command(flatten)]
     model: ModelArgs,
-    /// Peak force the ideal feedback holds (N with --probe, else F; a unit may follow: 2nN);
-    /// excludes --z-c (the mean rest separation, else the probe's [sample] z_c)
-    #[arg(long, allow_hyphen_values = true)]
-    setpoint: Option<Quantity>,
-    /// The instrument's low-pass filter on the measured force curve: the cut-off (Hz with
-    /// --probe, else cycles per τ; a unit may follow: 50kHz) of a causal second-order
-    /// Butterworth filter on k × deflection; the curve gains the filtered force
-    #[arg(long)]
-    filter_cutoff: Option<Quantity>,
+    #[command(flatten)]
+    request: PeakForceFlags,
     /// Sweep the steady tap over this quantity from --from to --to in steps of --step: z_c
     /// (m with --probe, else g0; a unit may follow: 5nm) or modulation_frequency (Hz with
     /// --probe, else Ω; 2kHz); the channels become curves (peakforce-sweep.csv, "sweep" in
@@ -47,9 +41,6 @@ pub struct PeakForceArgs {
     /// Step of the sweep (in the units of --from/--to)
     #[arg(long, requires = "from")]
     step: Option<Quantity>,
-    /// Points of the reported cycle (2000..=1000000)
-    #[arg(long, default_value_t = PeakForceRequest::default().samples)]
-    samples: usize,
     /// Output directory (locked during the run)
     #[arg(long, default_value = "afmdyn-out/peakforce")]
     out: PathBuf,
@@ -64,7 +55,7 @@ pub struct PeakForceArgs {
 /// Run `afmdyn peakforce`.
 pub fn peakforce(a: &PeakForceArgs) -> Result<(), CliError> {
     let si = a.model.probe.is_some();
-    if a.setpoint.is_some() && a.model.z_c.is_some() {
+    if a.request.setpoint.is_some() && a.model.z_c.is_some() {
         return Err(CliError::Input(
             "give either --z-c (the mean rest separation) or --setpoint (the peak force the \
              feedback holds), not both"
@@ -93,13 +84,7 @@ pub fn peakforce(a: &PeakForceArgs) -> Result<(), CliError> {
         }
         _ => None,
     };
-    let request = PeakForceRequest {
-        sweep,
-        setpoint: quantity(a.setpoint, "setpoint", Dim::Force, si)?,
-        samples: a.samples,
-        filter_cutoff: quantity(a.filter_cutoff, "filter-cutoff", Dim::Frequency, si)?,
-        ..PeakForceRequest::default()
-    };
+    let request = a.request.request(si, sweep)?;
     let model = Resolved { params, probe };
     // the door's steps (validated and held to the budgets before --out is locked), with the
     // library's presentation at the --files asked for

@@ -1,11 +1,12 @@
 //! `afmdyn simulate` and `afmdyn converge`.
 
-use crate::args::{IntegratorArgs, ModelArgs};
+use crate::args::ModelArgs;
 use crate::door::{self, Exit};
 use crate::error::CliError;
+use crate::flags::{ConvergeFlags, SimulateFlags};
 use crate::output::{units_of, OutDir};
 use afmdyn::request::simulate_stream::SimulateStream;
-use afmdyn::request::{Analysis, ConvergeRequest, SimulateRequest};
+use afmdyn::request::Analysis;
 use afmdyn::request::{Document, Resolved};
 use afmdyn::Params;
 use clap::{Args, ValueEnum};
@@ -29,22 +30,10 @@ pub struct SimulateArgs {
     #[command(flatten)]
     model: ModelArgs,
     #[command(flatten)]
-    integrator: IntegratorArgs,
-    /// Drive periods to record after the transient; transient + periods ≤ 1e8 [default: 50]
-    #[arg(long, conflicts_with = "tau_end", allow_negative_numbers = true)]
-    periods: Option<f64>,
-    /// End time τ of the run (instead of --periods)
-    #[arg(long, allow_negative_numbers = true)]
-    tau_end: Option<f64>,
-    /// Drive periods discarded before recording
-    #[arg(long, default_value_t = SimulateRequest::default().transient, allow_negative_numbers = true)]
-    transient: f64,
+    request: SimulateFlags,
     /// Initial modal state "a1,..,aN;adot1,..,adotN" (default: rest); |z| < 1e12
     #[arg(long, allow_hyphen_values = true)]
     initial_modal: Option<String>,
-    /// Samples per drive period in the time series (1..=100000)
-    #[arg(long, default_value_t = SimulateRequest::default().samples_per_period)]
-    samples_per_period: usize,
     /// Files written: all (data and plots), data (no plots) or none (only the summary)
     #[arg(long, value_enum, default_value = "all")]
     files: Files,
@@ -116,14 +105,9 @@ pub(crate) fn parse_modal_state(
 /// and presents it (spectrum, figures, summary).
 pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
     let (params, probe) = a.model.resolve(Params::default())?;
-    let request = SimulateRequest {
-        periods: a.periods,
-        tau_end: a.tau_end,
-        transient: a.transient,
-        initial: parse_initial(&a.initial_modal, params.modes)?,
-        samples_per_period: a.samples_per_period,
-        integrator: a.integrator.request(),
-    };
+    let request = a
+        .request
+        .request(parse_initial(&a.initial_modal, params.modes)?);
     let run = SimulateStream {
         request,
         dir: (a.files != Files::None).then(|| a.out.clone()),
@@ -155,16 +139,7 @@ pub struct ConvergeArgs {
     #[command(flatten)]
     model: ModelArgs,
     #[command(flatten)]
-    integrator: IntegratorArgs,
-    /// Largest number of modes N_max
-    #[arg(long, default_value_t = ConvergeRequest::default().max_modes)]
-    max_modes: usize,
-    /// Drive periods of steady state compared
-    #[arg(long, default_value_t = ConvergeRequest::default().periods)]
-    periods: usize,
-    /// Samples per drive period
-    #[arg(long, default_value_t = ConvergeRequest::default().samples_per_period)]
-    samples_per_period: usize,
+    request: ConvergeFlags,
     /// Output directory
     #[arg(long, default_value = "afmdyn-out/converge")]
     out: PathBuf,
@@ -178,12 +153,7 @@ pub fn converge(a: &ConvergeArgs) -> Result<(), CliError> {
     let (params, probe) = a
         .model
         .resolve(afmdyn::request::analyses::converge_defaults())?;
-    let request = ConvergeRequest {
-        max_modes: a.max_modes,
-        periods: a.periods,
-        samples_per_period: a.samples_per_period,
-        integrator: a.integrator.request(),
-    };
+    let request = a.request.request();
     let model = Resolved { params, probe };
     request.validate()?;
     let out = OutDir::lock(&a.out)?;

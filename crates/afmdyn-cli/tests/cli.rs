@@ -675,7 +675,8 @@ fn help_shows_the_defaults_and_errors_keep_the_hint() {
         ("--gap", format!("[default: {}]", d.alpha5)),
         ("--contact-damping", format!("[default: {}]", d.alpha6)),
         ("--omega", format!("[default: {}", d.omega)),
-        ("--periods", "[default: 50]".to_string()),
+        // the request's description (docs/schema/requests/simulate.json)
+        ("--periods", "default 50".to_string()),
     ] {
         let at = help
             .find(&format!("{flag} <"))

@@ -76,11 +76,11 @@ def chart(
         resume: resume the store (``False``: start it over).
         checkpoint_seconds: the longest time finished tasks wait to be written (>= 0).
         cluster_tol: Clustering tolerance of two steady states, > 0.
-        integrator: ``auto`` (the exact propagator for the linear law, the split integrator
-            for Hertz and the impact law with r > 0, adaptive DOP853 for the plastic impact
-            law r = 0, the Taylor integrator for DMT; split falls back to adaptive where its
-            exact free flight cannot be built), ``exact``, ``rk4``, ``rk4-naive``,
-            ``adaptive``, ``split`` or ``taylor``.
+        integrator: The time integrator: ``auto`` (the exact propagator for the linear law,
+            the split integrator for Hertz and the impact law with r > 0, adaptive DOP853
+            for the plastic impact law r = 0, the Taylor integrator for DMT; split falls
+            back to adaptive where its exact free flight cannot be built), ``exact``,
+            ``rk4``, ``rk4-naive``, ``adaptive``, ``split`` or ``taylor``.
         lyapunov_periods: Drive periods of the λ₁ estimate of each nonperiodic attractor (0:
             none), ≤ ``MAX_CHART_LYAPUNOV_PERIODS``.
         max_attractors: Attractor slots per cell in the arrays of the results
@@ -88,7 +88,7 @@ def chart(
             1..=``MAX_CHART_SLOTS``: a cell with more keeps its first ones (most random
             starts first) there, and its ``attractors`` count tells how many it has; the CSV
             and JSON list every one.
-        max_period: Largest period searched, 1..=64 (``MAX_PERIOD``).
+        max_period: Largest period searched, 1..=``MAX_PERIOD``.
         max_periods: Cap on the transient, in drive periods, 1..=``MAX_STEADY_PERIODS``;
             ``None`` (default): derived from the model's slowest free decay, six times the
             periods it takes to decay by ``tol`` and at least 1 500 (≈ 1.9 Q ln(1/tol) for a
@@ -162,17 +162,18 @@ def bifurcation(
         resume: resume the stored sweep (``False``: start it over).
         continuation: Forward and backward continuation.
         from_: First value.
-        integrator: ``auto`` (the exact propagator for the linear law, the split integrator
-            for Hertz and the impact law with r > 0, adaptive DOP853 for the plastic impact
-            law r = 0, the Taylor integrator for DMT; split falls back to adaptive where its
-            exact free flight cannot be built), ``exact``, ``rk4``, ``rk4-naive``,
-            ``adaptive``, ``split`` or ``taylor``.
-        max_period: Largest period searched, 1..=64 (``MAX_PERIOD``).
+        integrator: The time integrator: ``auto`` (the exact propagator for the linear law,
+            the split integrator for Hertz and the impact law with r > 0, adaptive DOP853
+            for the plastic impact law r = 0, the Taylor integrator for DMT; split falls
+            back to adaptive where its exact free flight cannot be built), ``exact``,
+            ``rk4``, ``rk4-naive``, ``adaptive``, ``split`` or ``taylor``.
+        max_period: Largest period searched, 1..=``MAX_PERIOD``.
         max_periods: Cap on the transient, in drive periods, 1..=``MAX_STEADY_PERIODS``;
             ``None`` (default): derived from the model's slowest free decay, six times the
             periods it takes to decay by ``tol`` and at least 1 500 (≈ 1.9 Q ln(1/tol) for a
             lever of quality factor Q: ``analysis::steady::default_transient_cap``).
-        param: The swept parameter.
+        param: The swept parameter: ``omega`` or ``alpha1``..``alpha6`` (or their names,
+            ``tip-mass-ratio``, …).
         seed: Seed of the random initial states.
         starts: Random initial states per value (besides continuation).
         steps: Number of values.
@@ -241,12 +242,12 @@ def basins(
             > 0.
         cluster_tol: Relative tolerance for two steady states to be one attractor, > 0.
         discover_after: Returns tested before the steady-state search takes over.
-        integrator: ``auto`` (the exact propagator for the linear law, the split integrator
-            for Hertz and the impact law with r > 0, adaptive DOP853 for the plastic impact
-            law r = 0, the Taylor integrator for DMT; split falls back to adaptive where its
-            exact free flight cannot be built), ``exact``, ``rk4``, ``rk4-naive``,
-            ``adaptive``, ``split`` or ``taylor``.
-        max_period: Largest period searched, 1..=64 (``MAX_PERIOD``).
+        integrator: The time integrator: ``auto`` (the exact propagator for the linear law,
+            the split integrator for Hertz and the impact law with r > 0, adaptive DOP853
+            for the plastic impact law r = 0, the Taylor integrator for DMT; split falls
+            back to adaptive where its exact free flight cannot be built), ``exact``,
+            ``rk4``, ``rk4-naive``, ``adaptive``, ``split`` or ``taylor``.
+        max_period: Largest period searched, 1..=``MAX_PERIOD``.
         max_periods: Cap on the transient, in drive periods, 1..=``MAX_STEADY_PERIODS``;
             ``None`` (default): derived from the model's slowest free decay, six times the
             periods it takes to decay by ``tol`` and at least 1 500 (≈ 1.9 Q ln(1/tol) for a

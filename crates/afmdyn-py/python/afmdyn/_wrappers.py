@@ -79,11 +79,11 @@ def simulate(
     Args:
         initial: The initial state (2N values); ``None``: rest. An :class:`Attractor` or
             :class:`Orbit` is also taken (its state at drive phase 0).
-        integrator: ``auto`` (the exact propagator for the linear law, the split integrator
-            for Hertz and the impact law with r > 0, adaptive DOP853 for the plastic impact
-            law r = 0, the Taylor integrator for DMT; split falls back to adaptive where its
-            exact free flight cannot be built), ``exact``, ``rk4``, ``rk4-naive``,
-            ``adaptive``, ``split`` or ``taylor``.
+        integrator: The time integrator: ``auto`` (the exact propagator for the linear law,
+            the split integrator for Hertz and the impact law with r > 0, adaptive DOP853
+            for the plastic impact law r = 0, the Taylor integrator for DMT; split falls
+            back to adaptive where its exact free flight cannot be built), ``exact``,
+            ``rk4``, ``rk4-naive``, ``adaptive``, ``split`` or ``taylor``.
         periods: Drive periods recorded after the transient (> 0); default 50 when
             ``tau_end`` is not given either.
         samples_per_period: Samples per drive period, 1..=``MAX_SAMPLES_PER_PERIOD``.
@@ -172,11 +172,11 @@ def converge(
     damping of eq. 26), as on the command line.
 
     Args:
-        integrator: ``auto`` (the exact propagator for the linear law, the split integrator
-            for Hertz and the impact law with r > 0, adaptive DOP853 for the plastic impact
-            law r = 0, the Taylor integrator for DMT; split falls back to adaptive where its
-            exact free flight cannot be built), ``exact``, ``rk4``, ``rk4-naive``,
-            ``adaptive``, ``split`` or ``taylor``.
+        integrator: The time integrator: ``auto`` (the exact propagator for the linear law,
+            the split integrator for Hertz and the impact law with r > 0, adaptive DOP853
+            for the plastic impact law r = 0, the Taylor integrator for DMT; split falls
+            back to adaptive where its exact free flight cannot be built), ``exact``,
+            ``rk4``, ``rk4-naive``, ``adaptive``, ``split`` or ``taylor``.
         max_modes: Largest number of modes, 1..=20.
         periods: Drive periods of steady state compared, 1..=``MAX_CONVERGE_PERIODS``.
         samples_per_period: Samples per drive period, 1..=``MAX_SAMPLES_PER_PERIOD``;
@@ -248,17 +248,18 @@ def bifurcation(
     Args:
         continuation: Forward and backward continuation.
         from_: First value.
-        integrator: ``auto`` (the exact propagator for the linear law, the split integrator
-            for Hertz and the impact law with r > 0, adaptive DOP853 for the plastic impact
-            law r = 0, the Taylor integrator for DMT; split falls back to adaptive where its
-            exact free flight cannot be built), ``exact``, ``rk4``, ``rk4-naive``,
-            ``adaptive``, ``split`` or ``taylor``.
-        max_period: Largest period searched, 1..=64 (``MAX_PERIOD``).
+        integrator: The time integrator: ``auto`` (the exact propagator for the linear law,
+            the split integrator for Hertz and the impact law with r > 0, adaptive DOP853
+            for the plastic impact law r = 0, the Taylor integrator for DMT; split falls
+            back to adaptive where its exact free flight cannot be built), ``exact``,
+            ``rk4``, ``rk4-naive``, ``adaptive``, ``split`` or ``taylor``.
+        max_period: Largest period searched, 1..=``MAX_PERIOD``.
         max_periods: Cap on the transient, in drive periods, 1..=``MAX_STEADY_PERIODS``;
             ``None`` (default): derived from the model's slowest free decay, six times the
             periods it takes to decay by ``tol`` and at least 1 500 (≈ 1.9 Q ln(1/tol) for a
             lever of quality factor Q: ``analysis::steady::default_transient_cap``).
-        param: The swept parameter.
+        param: The swept parameter: ``omega`` or ``alpha1``..``alpha6`` (or their names,
+            ``tip-mass-ratio``, …).
         seed: Seed of the random initial states.
         starts: Random initial states per value (besides continuation).
         steps: Number of values.
@@ -345,22 +346,24 @@ def continuation(
     The default start is the steady state reached from rest at ``from_``.
 
     Args:
-        from_: First value.
+        from_: The value where the continuation starts.
         initial: The initial state (2N values a1..aN, ȧ1..ȧN) used as the guess as it is;
             ``None``: the end of the steady state reached from rest. An :class:`Attractor`
             or :class:`Orbit` is also taken (its state at drive phase 0).
-        param: The continued parameter.
+        param: The continued parameter: ``omega`` or ``alpha1``..``alpha6`` (or their names,
+            ``tip-mass-ratio``, …).
         period: The period n (1..=64); ``None``: the period of the steady state reached at
             ``from``, else 1.
-        max_period: Largest period searched, 1..=64 (``MAX_PERIOD``).
+        max_period: Largest period searched, 1..=``MAX_PERIOD``.
         max_periods: Cap on the transient, in drive periods, 1..=``MAX_STEADY_PERIODS``;
             ``None`` (default): derived from the model's slowest free decay, six times the
             periods it takes to decay by ``tol`` and at least 1 500 (≈ 1.9 Q ln(1/tol) for a
             lever of quality factor Q: ``analysis::steady::default_transient_cap``).
         tol: Relative tolerance for two returns of the stroboscopic map to coincide, in
             [1e-14, 1e-3].
-        switch: Switch branches at period doublings (periods n, 2n, 4n, 8n).
-        to: Last value.
+        switch: At each period doubling, switch to the period-2n branch and continue it too,
+            recursively up to period 8n (the period-doubling cascade).
+        to: The end of the range.
         progress: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a
             log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.
         **model: the model keywords (:class:`Model`), ``probe=`` a probe in SI.
@@ -413,7 +416,7 @@ def orbit(
             or :class:`Orbit` is also taken (its state at drive phase 0).
         period: The period n (1..=64); ``None``: the period of the steady state reached,
             else 1.
-        max_period: Largest period searched, 1..=64 (``MAX_PERIOD``).
+        max_period: Largest period searched, 1..=``MAX_PERIOD``.
         max_periods: Cap on the transient, in drive periods, 1..=``MAX_STEADY_PERIODS``;
             ``None`` (default): derived from the model's slowest free decay, six times the
             periods it takes to decay by ``tol`` and at least 1 500 (≈ 1.9 Q ln(1/tol) for a
@@ -508,11 +511,11 @@ def chart(
 
     Args:
         cluster_tol: Clustering tolerance of two steady states, > 0.
-        integrator: ``auto`` (the exact propagator for the linear law, the split integrator
-            for Hertz and the impact law with r > 0, adaptive DOP853 for the plastic impact
-            law r = 0, the Taylor integrator for DMT; split falls back to adaptive where its
-            exact free flight cannot be built), ``exact``, ``rk4``, ``rk4-naive``,
-            ``adaptive``, ``split`` or ``taylor``.
+        integrator: The time integrator: ``auto`` (the exact propagator for the linear law,
+            the split integrator for Hertz and the impact law with r > 0, adaptive DOP853
+            for the plastic impact law r = 0, the Taylor integrator for DMT; split falls
+            back to adaptive where its exact free flight cannot be built), ``exact``,
+            ``rk4``, ``rk4-naive``, ``adaptive``, ``split`` or ``taylor``.
         lyapunov_periods: Drive periods of the λ₁ estimate of each nonperiodic attractor (0:
             none), ≤ ``MAX_CHART_LYAPUNOV_PERIODS``.
         max_attractors: Attractor slots per cell in the arrays of the results
@@ -520,7 +523,7 @@ def chart(
             1..=``MAX_CHART_SLOTS``: a cell with more keeps its first ones (most random
             starts first) there, and its ``attractors`` count tells how many it has; the CSV
             and JSON list every one.
-        max_period: Largest period searched, 1..=64 (``MAX_PERIOD``).
+        max_period: Largest period searched, 1..=``MAX_PERIOD``.
         max_periods: Cap on the transient, in drive periods, 1..=``MAX_STEADY_PERIODS``;
             ``None`` (default): derived from the model's slowest free decay, six times the
             periods it takes to decay by ``tol`` and at least 1 500 (≈ 1.9 Q ln(1/tol) for a

@@ -69,7 +69,7 @@ def observe(
             ``None``: the end of the steady state reached from rest. An :class:`Attractor`
             or :class:`Orbit` is also taken (its state at drive phase 0).
         periods: Orbit periods integrated, 1..=``MAX_OBSERVE_PERIODS``.
-        max_period: Largest period searched, 1..=64 (``MAX_PERIOD``).
+        max_period: Largest period searched, 1..=``MAX_PERIOD``.
         max_periods: Cap on the transient, in drive periods, 1..=``MAX_STEADY_PERIODS``;
             ``None`` (default): derived from the model's slowest free decay, six times the
             periods it takes to decay by ``tol`` and at least 1 500 (≈ 1.9 Q ln(1/tol) for a
@@ -162,13 +162,21 @@ def approach(
 
     Args:
         branches: Continue the periodic-orbit branches.
-        from_: First end of the swept quantity (front-end unit).
-        points: Number of grid values, ends included (default ``DEFAULT_CURVE_POINTS``).
-        setpoint: The amplitude setpoint A_sp/A₀ in (0, 1]: the document gains a
-            ``"setpoint"`` block with the operating points where the curve's amplitude
-            equals it (``analysis::setpoint``).
-        step: Grid step (front-end unit); excludes ``points``.
-        to: Other end (front-end unit).
+        from_: First end of the swept quantity (front-end unit): the rest distance z_c where
+            the approach starts (m with a probe, else g₀; default 1.2 × the free amplitude
+            A₀, the sum of the components' under a multifrequency drive), or the start of
+            the resonance band (Hz with a probe, else Ω; default ω_k (1 − w), w = max(6/Q_k,
+            0.02)).
+        points: Number of grid values, ends included, 2..=``MAX_CURVE_POINTS`` (default
+            ``DEFAULT_CURVE_POINTS``; a resonance curve with a probe takes more where a
+            tenth of the linewidth needs them (``request::curves::linewidth_points``)).
+        setpoint: The amplitude setpoint A_sp/A₀ in (0, 1] (under a multifrequency drive
+            A₁/A₀₁, of the first component, the one the feedback holds): the document gains
+            a ``"setpoint"`` block with the operating points where the curve's amplitude
+            equals it on each stable branch (``analysis::setpoint``).
+        step: Grid step (front-end unit, that of ``from`` and ``to``); excludes ``points``.
+        to: Other end (front-end unit): z_c where the approach ends and the retract starts
+            (default 0.1 × A₀), or the end of the resonance band (default ω_k (1 + w)).
         tolerance: Tolerance of the adaptive integrator, in (0, 1e-3).
         traces: Record one steady-state cycle per point of the first sweep with this many
             samples per drive period (2..=10000; ``analysis::traces``); ``None``: no traces.
@@ -303,13 +311,21 @@ def bimodal(
             ``analysis::stepped::torus::TORUS_PERIODS`` drive periods, whose points are
             otherwise measured on invariant circles (``analysis::stepped::torus``; with
             branches and folds).
-        from_: First end of the swept quantity (front-end unit).
-        points: Number of grid values, ends included (default ``DEFAULT_CURVE_POINTS``).
-        setpoint: The amplitude setpoint A_sp/A₀ in (0, 1]: the document gains a
-            ``"setpoint"`` block with the operating points where the curve's amplitude
-            equals it (``analysis::setpoint``).
-        step: Grid step (front-end unit); excludes ``points``.
-        to: Other end (front-end unit).
+        from_: First end of the swept quantity (front-end unit): the rest distance z_c where
+            the approach starts (m with a probe, else g₀; default 1.2 × the free amplitude
+            A₀, the sum of the components' under a multifrequency drive), or the start of
+            the resonance band (Hz with a probe, else Ω; default ω_k (1 − w), w = max(6/Q_k,
+            0.02)).
+        points: Number of grid values, ends included, 2..=``MAX_CURVE_POINTS`` (default
+            ``DEFAULT_CURVE_POINTS``; a resonance curve with a probe takes more where a
+            tenth of the linewidth needs them (``request::curves::linewidth_points``)).
+        setpoint: The amplitude setpoint A_sp/A₀ in (0, 1] (under a multifrequency drive
+            A₁/A₀₁, of the first component, the one the feedback holds): the document gains
+            a ``"setpoint"`` block with the operating points where the curve's amplitude
+            equals it on each stable branch (``analysis::setpoint``).
+        step: Grid step (front-end unit, that of ``from`` and ``to``); excludes ``points``.
+        to: Other end (front-end unit): z_c where the approach ends and the retract starts
+            (default 0.1 × A₀), or the end of the resonance band (default ω_k (1 + w)).
         tolerance: Tolerance of the adaptive integrator, in (0, 1e-3).
         traces: Record one steady-state cycle per point of the first sweep with this many
             samples per drive period (2..=10000; ``analysis::traces``); ``None``: no traces.
@@ -452,11 +468,18 @@ def resonance(
 
     Args:
         branches: Continue the periodic-orbit branches.
-        from_: First end of the swept quantity (front-end unit).
+        from_: First end of the swept quantity (front-end unit): the rest distance z_c where
+            the approach starts (m with a probe, else g₀; default 1.2 × the free amplitude
+            A₀, the sum of the components' under a multifrequency drive), or the start of
+            the resonance band (Hz with a probe, else Ω; default ω_k (1 − w), w = max(6/Q_k,
+            0.02)).
         mode: The mode k (1-based) whose resonance is swept.
-        points: Number of grid values, ends included (default ``DEFAULT_CURVE_POINTS``).
-        step: Grid step (front-end unit); excludes ``points``.
-        to: Other end (front-end unit).
+        points: Number of grid values, ends included, 2..=``MAX_CURVE_POINTS`` (default
+            ``DEFAULT_CURVE_POINTS``; a resonance curve with a probe takes more where a
+            tenth of the linewidth needs them (``request::curves::linewidth_points``)).
+        step: Grid step (front-end unit, that of ``from`` and ``to``); excludes ``points``.
+        to: Other end (front-end unit): z_c where the approach ends and the retract starts
+            (default 0.1 × A₀), or the end of the resonance band (default ω_k (1 + w)).
         tolerance: Tolerance of the adaptive integrator, in (0, 1e-3).
         traces: Record one steady-state cycle per point of the first sweep with this many
             samples per drive period (2..=10000; ``analysis::traces``); ``None``: no traces.
@@ -571,10 +594,12 @@ def fm(
         amplitude: The first-harmonic amplitude A the amplitude controller holds (m with a
             probe, else g₀), > 0; default the probe's free amplitude A₀ (1 g₀).
         from_: First z_c of the approach (default: where the frequency shift has decayed to
-            0.5 % of its value at ``to``, ``default_from``; 2A + a₀, the lower turning point
-            at A, for the laws without a force before contact).
+            0.5 % of its value at ``to`` (``request::fm::default_from``); 2A + a₀, the lower
+            turning point at A, for the laws without a force before contact).
         mode: The mode K (1-based) the PLL tracks; default 1.
-        points: Number of z_c values, ends included (default 120).
+        points: Number of z_c values, ends included,
+            2..=``analysis::stepped::MAX_CURVE_POINTS`` (default
+            ``analysis::stepped::DEFAULT_CURVE_POINTS``).
         step: Step of z_c; excludes ``points``.
         to: Last z_c (default A + a₀: the lower turning point at the contact distance a₀, 0
             for the laws without attraction).

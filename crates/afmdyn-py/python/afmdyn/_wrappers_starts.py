@@ -57,12 +57,12 @@ def attractors(
     Args:
         cluster_tol: Relative tolerance for two Poincaré point sets to be the same
             attractor, > 0.
-        integrator: ``auto`` (the exact propagator for the linear law, the split integrator
-            for Hertz and the impact law with r > 0, adaptive DOP853 for the plastic impact
-            law r = 0, the Taylor integrator for DMT; split falls back to adaptive where its
-            exact free flight cannot be built), ``exact``, ``rk4``, ``rk4-naive``,
-            ``adaptive``, ``split`` or ``taylor``.
-        max_period: Largest period searched, 1..=64 (``MAX_PERIOD``).
+        integrator: The time integrator: ``auto`` (the exact propagator for the linear law,
+            the split integrator for Hertz and the impact law with r > 0, adaptive DOP853
+            for the plastic impact law r = 0, the Taylor integrator for DMT; split falls
+            back to adaptive where its exact free flight cannot be built), ``exact``,
+            ``rk4``, ``rk4-naive``, ``adaptive``, ``split`` or ``taylor``.
+        max_period: Largest period searched, 1..=``MAX_PERIOD``.
         max_periods: Cap on the transient, in drive periods, 1..=``MAX_STEADY_PERIODS``;
             ``None`` (default): derived from the model's slowest free decay, six times the
             periods it takes to decay by ``tol`` and at least 1 500 (≈ 1.9 Q ln(1/tol) for a
@@ -135,12 +135,12 @@ def basins(
             > 0.
         cluster_tol: Relative tolerance for two steady states to be one attractor, > 0.
         discover_after: Returns tested before the steady-state search takes over.
-        integrator: ``auto`` (the exact propagator for the linear law, the split integrator
-            for Hertz and the impact law with r > 0, adaptive DOP853 for the plastic impact
-            law r = 0, the Taylor integrator for DMT; split falls back to adaptive where its
-            exact free flight cannot be built), ``exact``, ``rk4``, ``rk4-naive``,
-            ``adaptive``, ``split`` or ``taylor``.
-        max_period: Largest period searched, 1..=64 (``MAX_PERIOD``).
+        integrator: The time integrator: ``auto`` (the exact propagator for the linear law,
+            the split integrator for Hertz and the impact law with r > 0, adaptive DOP853
+            for the plastic impact law r = 0, the Taylor integrator for DMT; split falls
+            back to adaptive where its exact free flight cannot be built), ``exact``,
+            ``rk4``, ``rk4-naive``, ``adaptive``, ``split`` or ``taylor``.
+        max_period: Largest period searched, 1..=``MAX_PERIOD``.
         max_periods: Cap on the transient, in drive periods, 1..=``MAX_STEADY_PERIODS``;
             ``None`` (default): derived from the model's slowest free decay, six times the
             periods it takes to decay by ``tol`` and at least 1 500 (≈ 1.9 Q ln(1/tol) for a
@@ -237,14 +237,14 @@ def global_continuation(
         cluster_tol: Relative tolerance for two Poincaré point sets at one value to be one
             attractor, > 0.
         from_: First value.
-        integrator: ``auto`` (the exact propagator for the linear law, the split integrator
-            for Hertz and the impact law with r > 0, adaptive DOP853 for the plastic impact
-            law r = 0, the Taylor integrator for DMT; split falls back to adaptive where its
-            exact free flight cannot be built), ``exact``, ``rk4``, ``rk4-naive``,
-            ``adaptive``, ``split`` or ``taylor``.
+        integrator: The time integrator: ``auto`` (the exact propagator for the linear law,
+            the split integrator for Hertz and the impact law with r > 0, adaptive DOP853
+            for the plastic impact law r = 0, the Taylor integrator for DMT; split falls
+            back to adaptive where its exact free flight cannot be built), ``exact``,
+            ``rk4``, ``rk4-naive``, ``adaptive``, ``split`` or ``taylor``.
         match_tol: Largest relative set distance of two attractors at consecutive values
             that are one, ≥ 0.
-        max_period: Largest period searched, 1..=64 (``MAX_PERIOD``).
+        max_period: Largest period searched, 1..=``MAX_PERIOD``.
         max_periods: Cap on the transient, in drive periods, 1..=``MAX_STEADY_PERIODS``;
             ``None`` (default): derived from the model's slowest free decay, six times the
             periods it takes to decay by ``tol`` and at least 1 500 (≈ 1.9 Q ln(1/tol) for a

@@ -132,15 +132,17 @@ fn explain_start<T>(
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(default, deny_unknown_fields)]
 pub struct ContinuationRequest {
-    /// The continued parameter.
+    /// The continued parameter: `omega` or `alpha1`..`alpha6` (or their names,
+    /// `tip-mass-ratio`, …).
     pub param: SweepParam,
-    /// First value.
+    /// The value where the continuation starts.
     pub from: f64,
-    /// Last value.
+    /// The end of the range.
     pub to: f64,
     /// The period n (1..=64); `None`: the period of the steady state reached at `from`, else 1.
     pub period: Option<usize>,
-    /// Switch branches at period doublings (periods n, 2n, 4n, 8n).
+    /// At each period doubling, switch to the period-2n branch and continue it too,
+    /// recursively up to period 8n (the period-doubling cascade).
     pub switch: bool,
     /// The start at `from`.
     #[serde(flatten)]
@@ -205,6 +207,10 @@ pub struct LyapunovRequest {
     /// paper's beam, ≈ 1.9 Q ln(1e8) for a lever of quality factor Q).
     pub transient: Option<usize>,
     /// Drive periods averaged; transient + periods ≤ [`MAX_RUN_PERIODS`].
+    #[cfg_attr(
+        feature = "schema",
+        schemars(extend("x-constants" = { "MAX_RUN_PERIODS": MAX_RUN_PERIODS }))
+    )]
     pub periods: usize,
     /// Blocks for the uncertainty, 2..=periods.
     pub blocks: usize,
@@ -270,6 +276,10 @@ impl LyapunovRequest {
 #[serde(default, deny_unknown_fields)]
 pub struct AttractorsRequest {
     /// Random initial states, 1..=[`MAX_ATTRACTOR_SAMPLES`].
+    #[cfg_attr(
+        feature = "schema",
+        schemars(extend("x-constants" = { "MAX_ATTRACTOR_SAMPLES": crate::analysis::attractors::MAX_ATTRACTOR_SAMPLES }))
+    )]
     pub samples: usize,
     /// Seed of the initial states.
     pub seed: u64,
@@ -351,10 +361,18 @@ pub struct GlobalContinuationRequest {
     /// Last value.
     pub to: f64,
     /// Number of values, 1..=[`MAX_CONTINUATION_VALUES`].
+    #[cfg_attr(
+        feature = "schema",
+        schemars(extend("x-constants" = { "MAX_CONTINUATION_VALUES": MAX_CONTINUATION_VALUES }))
+    )]
     pub steps: usize,
     /// Largest relative set distance of two attractors at consecutive values that are one, ≥ 0.
     pub match_tol: f64,
     /// Random starts per value, 1..=[`MAX_ATTRACTOR_SAMPLES`].
+    #[cfg_attr(
+        feature = "schema",
+        schemars(extend("x-constants" = { "MAX_ATTRACTOR_SAMPLES": crate::analysis::attractors::MAX_ATTRACTOR_SAMPLES }))
+    )]
     pub samples: usize,
     /// Seed of the random starts (keyed by value and start, as a sweep's).
     pub seed: u64,
@@ -522,9 +540,20 @@ pub struct ConvergeRequest {
     /// Largest number of modes, 1..=20.
     pub max_modes: usize,
     /// Drive periods of steady state compared, 1..=[`MAX_CONVERGE_PERIODS`].
+    #[cfg_attr(
+        feature = "schema",
+        schemars(extend("x-constants" = { "MAX_CONVERGE_PERIODS": MAX_CONVERGE_PERIODS }))
+    )]
     pub periods: usize,
     /// Samples per drive period, 1..=[`MAX_SAMPLES_PER_PERIOD`];
     /// periods × samples_per_period ≤ [`MAX_CONVERGE_SAMPLES`].
+    #[cfg_attr(
+        feature = "schema",
+        schemars(extend("x-constants" = {
+            "MAX_SAMPLES_PER_PERIOD": MAX_SAMPLES_PER_PERIOD,
+            "MAX_CONVERGE_SAMPLES": MAX_CONVERGE_SAMPLES
+        }))
+    )]
     pub samples_per_period: usize,
     /// The integrator.
     #[serde(flatten)]
@@ -618,7 +647,8 @@ pub(super) fn check_samples_per_period(spp: usize) -> Result<(), SimError> {
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(default, deny_unknown_fields)]
 pub struct BifurcationRequest {
-    /// The swept parameter.
+    /// The swept parameter: `omega` or `alpha1`..`alpha6` (or their names,
+    /// `tip-mass-ratio`, …).
     pub param: SweepParam,
     /// Explicit values instead of `from`, `to`, `steps`.
     pub values: Option<Vec<f64>>,
@@ -635,6 +665,10 @@ pub struct BifurcationRequest {
     /// Forward and backward continuation.
     pub continuation: bool,
     /// Worker threads, 1..=[`MAX_THREADS`]; `None`: all cores.
+    #[cfg_attr(
+        feature = "schema",
+        schemars(extend("x-constants" = { "MAX_THREADS": super::limits::MAX_THREADS }))
+    )]
     pub threads: Option<usize>,
     /// The steady-state search of every point.
     #[serde(flatten)]

@@ -57,6 +57,10 @@ pub struct BasinsRequest {
     /// Relative tolerance for two steady states to be one attractor, > 0.
     pub cluster_tol: f64,
     /// Worker threads, 1..=[`MAX_THREADS`](super::limits::MAX_THREADS); `None`: all cores.
+    #[cfg_attr(
+        feature = "schema",
+        schemars(extend("x-constants" = { "MAX_THREADS": super::limits::MAX_THREADS }))
+    )]
     pub threads: Option<usize>,
     /// The steady-state search of a start the early tests leave undecided.
     #[serde(flatten)]

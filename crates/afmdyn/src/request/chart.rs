@@ -44,36 +44,60 @@ pub struct ChartRequest {
     pub x: String,
     /// First x value (in the parameter's unit: dimensionless, m for z_c, Hz for
     /// drive_frequency).
+    #[cfg_attr(feature = "schema", schemars(extend("x-dim" = { "axis": "x" })))]
     pub x_from: f64,
     /// Last x value.
+    #[cfg_attr(feature = "schema", schemars(extend("x-dim" = { "axis": "x" })))]
     pub x_to: f64,
     /// Number of x values, ≥ 1.
     pub x_steps: usize,
     /// The y parameter (rows).
     pub y: String,
     /// First y value.
+    #[cfg_attr(feature = "schema", schemars(extend("x-dim" = { "axis": "y" })))]
     pub y_from: f64,
     /// Last y value.
+    #[cfg_attr(feature = "schema", schemars(extend("x-dim" = { "axis": "y" })))]
     pub y_to: f64,
     /// Number of y values, ≥ 1.
     pub y_steps: usize,
     /// Random starts per cell, 1..=[`MAX_CHART_STARTS`].
+    #[cfg_attr(
+        feature = "schema",
+        schemars(extend("x-constants" = { "MAX_CHART_STARTS": MAX_CHART_STARTS }))
+    )]
     pub starts: u32,
     /// Seed of the random starts.
     pub seed: u64,
     /// Cells per task (continuation runs along x within a tile), 1..=[`MAX_CHART_TILE`].
+    #[cfg_attr(
+        feature = "schema",
+        schemars(extend("x-constants" = { "MAX_CHART_TILE": MAX_CHART_TILE }))
+    )]
     pub tile: usize,
     /// Clustering tolerance of two steady states, > 0.
     pub cluster_tol: f64,
     /// Drive periods of the λ₁ estimate of each nonperiodic attractor (0: none),
     /// ≤ [`MAX_CHART_LYAPUNOV_PERIODS`].
+    #[cfg_attr(
+        feature = "schema",
+        schemars(extend("x-constants" = { "MAX_CHART_LYAPUNOV_PERIODS": MAX_CHART_LYAPUNOV_PERIODS }))
+    )]
     pub lyapunov_periods: usize,
     /// Attractor slots per cell in the arrays of the results ([`ChartArrays`]: `chart.nc`,
     /// Python's dataset, the Dask store), 1..=[`MAX_CHART_SLOTS`]: a cell with more keeps its
     /// first ones (most random starts first) there, and its `attractors` count tells how many
     /// it has; the CSV and JSON list every one.
+    #[cfg_attr(
+        feature = "schema",
+        schemars(extend("x-constants" = { "MAX_CHART_SLOTS": MAX_CHART_SLOTS }))
+    )]
     pub max_attractors: usize,
     /// Worker threads, 1..=[`MAX_THREADS`](super::limits::MAX_THREADS); `None`: all cores.
+    #[cfg_attr(
+        feature = "schema",
+        schemars(extend("x-constants" = { "MAX_THREADS": super::limits::MAX_THREADS }))
+    )]
     pub threads: Option<usize>,
     /// The steady-state search of every run.
     #[serde(flatten)]

@@ -24,13 +24,28 @@ use serde::{Deserialize, Serialize};
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(default, deny_unknown_fields)]
 pub struct CurveRequest {
-    /// First end of the swept quantity (front-end unit).
+    /// First end of the swept quantity (front-end unit): the rest distance z_c where the
+    /// approach starts (m with a probe, else g₀; default 1.2 × the free amplitude A₀, the sum of
+    /// the components' under a multifrequency drive), or the start of the resonance band (Hz
+    /// with a probe, else Ω; default ω_k (1 − w), w = max(6/Q_k, 0.02)).
+    #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "swept")))]
     pub from: Option<f64>,
-    /// Other end (front-end unit).
+    /// Other end (front-end unit): z_c where the approach ends and the retract starts (default
+    /// 0.1 × A₀), or the end of the resonance band (default ω_k (1 + w)).
+    #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "swept")))]
     pub to: Option<f64>,
-    /// Grid step (front-end unit); excludes `points`.
+    /// Grid step (front-end unit, that of `from` and `to`); excludes `points`.
+    #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "swept")))]
     pub step: Option<f64>,
-    /// Number of grid values, ends included (default [`DEFAULT_CURVE_POINTS`]).
+    /// Number of grid values, ends included, 2..=[`MAX_CURVE_POINTS`] (default
+    /// [`DEFAULT_CURVE_POINTS`]; a resonance curve with a probe takes more where a tenth of
+    /// the linewidth needs them ([`crate::request::curves::linewidth_points`])).
+    #[cfg_attr(
+        feature = "schema",
+        schemars(extend("x-constants" = {
+            "MAX_CURVE_POINTS": MAX_CURVE_POINTS, "DEFAULT_CURVE_POINTS": DEFAULT_CURVE_POINTS
+        }))
+    )]
     pub points: Option<usize>,
     /// Continue the periodic-orbit branches.
     pub branches: bool,

@@ -46,9 +46,11 @@ pub struct PeakForceRequest {
     /// The mean rest separation z_c (m with a probe, else g₀): the tip–sample distance with the
     /// lever at rest and the sample at the centre of its modulation; default the model's
     /// (the probe's `[sample] z_c`, default A_m). Excludes `setpoint`.
+    #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "length")))]
     pub z_c: Option<f64>,
     /// The peak force the ideal feedback holds (N with a probe, else F̃), > 0: z_c is found so
     /// that the steady tap's peak force equals it. Excludes `z_c`.
+    #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "force")))]
     pub setpoint: Option<f64>,
     /// Points of the reported cycle, in 2000..=1000000 (default 4096).
     pub samples: usize,
@@ -61,6 +63,7 @@ pub struct PeakForceRequest {
     /// the instrument measures, k × deflection; the curve then carries it filtered beside the
     /// tip–sample force. `None` (default): no filter. f_c must lie below the Nyquist frequency
     /// of the cycle's samples, `samples`/(2 × the modulation period).
+    #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "frequency")))]
     pub filter_cutoff: Option<f64>,
     /// A sweep in z_c or in the modulation frequency ([`PeakForceSweep`]): the channels as
     /// curves over its values (the document's `sweep` block), each tap continued from the

@@ -473,13 +473,15 @@ impl Analysis for ConvergeRequest {
 /// ([`crate::analysis::approach`]); `from`/`to`/`step` in metres with a probe, else in g₀.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[cfg_attr(feature = "schema", schemars(extend("x-swept" = "length")))]
 #[serde(default, deny_unknown_fields)]
 pub struct ApproachRequest {
     /// The curve's range and options.
     #[serde(flatten)]
     pub curve: CurveRequest,
-    /// The amplitude setpoint A_sp/A₀ in (0, 1]: the document gains a `"setpoint"` block with
-    /// the operating points where the curve's amplitude equals it
+    /// The amplitude setpoint A_sp/A₀ in (0, 1] (under a multifrequency drive A₁/A₀₁, of the
+    /// first component, the one the feedback holds): the document gains a `"setpoint"` block
+    /// with the operating points where the curve's amplitude equals it on each stable branch
     /// ([`crate::analysis::setpoint`]).
     pub setpoint: Option<f64>,
     /// Measure every point by the time average of a multifrequency drive
@@ -495,6 +497,12 @@ pub struct ApproachRequest {
     /// branches and folds).
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     #[cfg_attr(feature = "schema", schemars(extend("default" = false)))]
+    #[cfg_attr(
+        feature = "schema",
+        schemars(extend("x-constants" = {
+            "TORUS_PERIODS": crate::analysis::stepped::torus::TORUS_PERIODS
+        }))
+    )]
     pub exact: bool,
 }
 
@@ -541,6 +549,7 @@ impl ApproachRequest {
 /// ([`crate::analysis::resonance`]); `from`/`to`/`step` in Hz with a probe, else in Ω.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[cfg_attr(feature = "schema", schemars(extend("x-swept" = "frequency")))]
 #[serde(default, deny_unknown_fields)]
 pub struct ResonanceRequest {
     /// The mode k (1-based) whose resonance is swept.

@@ -36,6 +36,10 @@ pub struct SimulateRequest {
     /// The initial state (2N values); `None`: rest.
     pub initial: Option<Vec<f64>>,
     /// Samples per drive period, 1..=[`MAX_SAMPLES_PER_PERIOD`].
+    #[cfg_attr(
+        feature = "schema",
+        schemars(extend("x-constants" = { "MAX_SAMPLES_PER_PERIOD": MAX_SAMPLES_PER_PERIOD }))
+    )]
     pub samples_per_period: usize,
     /// The integrator.
     #[serde(flatten)]

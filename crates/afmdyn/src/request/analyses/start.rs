@@ -16,8 +16,16 @@ pub struct SteadyRequest {
     /// derived from the model's slowest free decay, six times the periods it takes to decay by
     /// `tol` and at least 1 500 (≈ 1.9 Q ln(1/tol) for a lever of quality factor Q:
     /// [`crate::analysis::steady::default_transient_cap`]).
+    #[cfg_attr(
+        feature = "schema",
+        schemars(extend("x-constants" = { "MAX_STEADY_PERIODS": MAX_STEADY_PERIODS }))
+    )]
     pub max_periods: Option<usize>,
-    /// Largest period searched, 1..=64 ([`MAX_PERIOD`]).
+    /// Largest period searched, 1..=[`MAX_PERIOD`].
+    #[cfg_attr(
+        feature = "schema",
+        schemars(extend("x-constants" = { "MAX_PERIOD": MAX_PERIOD }))
+    )]
     pub max_period: usize,
 }
 
@@ -54,10 +62,11 @@ impl SteadyRequest {
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(default, deny_unknown_fields)]
 pub struct IntegratorRequest {
-    /// `auto` (the exact propagator for the linear law, the split integrator for Hertz and the
-    /// impact law with r > 0, adaptive DOP853 for the plastic impact law r = 0, the Taylor
-    /// integrator for DMT; split falls back to adaptive where its exact free flight cannot be
-    /// built), `exact`, `rk4`, `rk4-naive`, `adaptive`, `split` or `taylor`.
+    /// The time integrator: `auto` (the exact propagator for the linear law, the split
+    /// integrator for Hertz and the impact law with r > 0, adaptive DOP853 for the plastic
+    /// impact law r = 0, the Taylor integrator for DMT; split falls back to adaptive where its
+    /// exact free flight cannot be built), `exact`, `rk4`, `rk4-naive`, `adaptive`, `split` or
+    /// `taylor`.
     pub integrator: IntegratorKind,
     /// Fixed steps per drive period of `rk4` / `rk4-naive` (default 2000).
     pub steps_per_period: Option<usize>,

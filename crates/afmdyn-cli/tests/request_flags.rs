@@ -1,0 +1,128 @@
+//! The request flags (written by `scripts/gen_cli.py` from the request schemas) held against
+//! the library's requests themselves: for every command, each field of its request's
+//! `Default` (serialised by serde, not read from the schema) has its flag — kebab-case of the
+//! field, `--no-<field>` for a boolean on by default — and the default `--help` shows for it
+//! is the request's, value for value.
+
+mod common;
+
+use afmdyn::request::{
+    ApproachRequest, AttractorsRequest, BasinsRequest, BifurcationRequest, ChartRequest,
+    ContinuationRequest, ConvergeRequest, FmRequest, LyapunovRequest, OrbitRequest,
+    PeakForceRequest, ResonanceRequest, SimulateRequest,
+};
+use serde::Serialize;
+use serde_json::Value;
+
+/// Each flag of `afmdyn CMD --help` with its text (the flag's line and its help lines, joined).
+fn flags(cmd: &str) -> Vec<(String, String)> {
+    let help = common::text(&[cmd, "--help"]);
+    let mut out: Vec<(String, String)> = Vec::new();
+    for line in help.lines() {
+        let indent = line.len() - line.trim_start().len();
+        let t = line.trim();
+        // an option's line starts with its flag, indented at most 6 (`  -s, --x` or `      --x`)
+        let flag = (indent <= 6 && t.starts_with('-'))
+            .then(|| t.split([' ', ',']).find(|w| w.starts_with("--")))
+            .flatten();
+        match flag {
+            Some(f) => out.push((f.to_string(), t.to_string())),
+            None => {
+                if let Some(last) = out.last_mut() {
+                    last.1.push(' ');
+                    last.1.push_str(t);
+                }
+            }
+        }
+    }
+    out
+}
+
+/// The `[default: …]` of a flag's help text.
+fn shown_default(text: &str) -> Option<&str> {
+    let at = text.rfind("[default: ")? + "[default: ".len();
+    text[at..].split(']').next()
+}
+
+/// Every field of `request` (nested requests' fields too, by their own names) has its flag in
+/// `afmdyn cmd --help`, showing the request's default; `skip`: fields the command takes in
+/// another form (`initial` as `--initial-modal`) or not at all.
+fn defaults_shown(cmd: &str, request: impl Serialize, skip: &[&str]) {
+    let flags = flags(cmd);
+    let find = |flag: &str| {
+        flags
+            .iter()
+            .find(|(f, _)| f == flag)
+            .map(|(_, t)| t.as_str())
+            .unwrap_or_else(|| panic!("{cmd}: no {flag} in --help"))
+    };
+    let mut fields: Vec<(String, Value)> = Vec::new();
+    let Value::Object(top) = serde_json::to_value(request).unwrap() else {
+        panic!("{cmd}: a request serialises to an object")
+    };
+    for (key, value) in top {
+        match value {
+            Value::Object(nested) => fields.extend(nested),
+            v => fields.push((key, v)),
+        }
+    }
+    let mut checked = 0;
+    for (key, value) in fields {
+        if skip.contains(&key.as_str()) {
+            continue;
+        }
+        let flag = format!("--{}", key.replace('_', "-"));
+        match &value {
+            Value::Bool(true) => drop(find(&format!("--no-{}", &flag[2..]))),
+            Value::Bool(false) | Value::Null => drop(find(&flag)),
+            Value::Number(n) => {
+                let text = find(&flag);
+                let shown = shown_default(text).unwrap_or_else(|| panic!("{cmd} {flag}: {text}"));
+                let v: f64 = shown
+                    .parse()
+                    .unwrap_or_else(|_| panic!("{cmd} {flag}: default {shown}"));
+                assert_eq!(Some(v), n.as_f64(), "{cmd} {flag}: {text}");
+            }
+            Value::String(s) => {
+                let text = find(&flag);
+                assert_eq!(
+                    shown_default(text),
+                    Some(s.as_str()),
+                    "{cmd} {flag}: {text}"
+                );
+            }
+            Value::Array(_) | Value::Object(_) => panic!("{cmd}: {key} has no flag: skip it"),
+        }
+        checked += 1;
+    }
+    assert!(checked > 0, "{cmd}: no field checked");
+}
+
+#[test]
+fn every_request_field_has_its_flag_and_the_request_default() {
+    defaults_shown("approach", ApproachRequest::default(), &[]);
+    defaults_shown("bimodal", ApproachRequest::default(), &[]);
+    defaults_shown("resonance", ResonanceRequest::default(), &[]);
+    defaults_shown("fm", FmRequest::default(), &[]);
+    defaults_shown("simulate", SimulateRequest::default(), &["initial"]);
+    defaults_shown("converge", ConvergeRequest::default(), &[]);
+    defaults_shown("bifurcation", BifurcationRequest::default(), &["values"]);
+    defaults_shown("attractors", AttractorsRequest::default(), &[]);
+    defaults_shown("basins", BasinsRequest::default(), &[]);
+    defaults_shown("chart", ChartRequest::default(), &[]);
+    defaults_shown("orbit", OrbitRequest::default(), &["initial"]);
+    defaults_shown("continue", ContinuationRequest::default(), &["initial"]);
+    defaults_shown("lyapunov", LyapunovRequest::default(), &["initial"]);
+    defaults_shown("peakforce", PeakForceRequest::default(), &["fit_band"]);
+}
+
+#[test]
+fn a_boolean_on_by_default_is_turned_off_by_its_no_flag() {
+    // `--no-branches` is the request's `branches: false`: the default curve of the paper's
+    // beam has branches, the same curve with the flag none
+    let args = ["approach", "--points", "6", "--files", "none", "--json"];
+    let branches = |doc: &serde_json::Value| doc["branches"].as_array().map_or(0, Vec::len);
+    assert!(branches(&common::json(&args)) > 0);
+    let off = common::json(&[&args[..], &["--no-branches"]].concat());
+    assert_eq!(branches(&off), 0, "{}", off["branches"]);
+}
