@@ -149,6 +149,7 @@ COMMON_ARGS = {
 # per generated file and analysis: the summary, "Returns:", "Raises:" and Python's own "Args:"
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from wrapper_docs import DOCS, MODEL_DOC  # noqa: E402
+from gen_cli import number  # noqa: E402  (one format of a constant for the help and the docs)
 
 
 def _clean(text: str) -> str:
@@ -192,12 +193,24 @@ def _fields(stem: str, omit: Tuple[str, ...], override: Dict[str, Tuple[str, str
         if ref and defs[ref].get("type") == "object":
             for k, p in defs[ref]["properties"].items():
                 default = prop.get("default", {}).get(k, p.get("default"))
-                out.append((k, _annotation(p, defs), _literal(default), p.get("description", "")))
+                out.append((k, _annotation(p, defs), _literal(default), _described(p)))
             continue
         ann, default = {**OVERRIDES, **override}.get(
             key, (_annotation(prop, defs), _literal(prop.get("default"))))
-        out.append((key, ann, default, prop.get("description", "")))
+        out.append((key, ann, default, _described(prop)))
     return out
+
+
+def _described(prop: dict) -> str:
+    """A field's description with each constant its ``"x-constants"`` gives as its value
+    (``[`MAX_PERIOD`]`` → ``64``, written as the command line's help writes it)."""
+    constants = prop.get("x-constants", {})
+
+    def constant(m: re.Match) -> str:
+        last = m.group(1).rsplit("::", 1)[-1]
+        return number(constants[last]) if last in constants else m.group(0)
+
+    return re.sub(r"\[`([^`\]]+)`\](?:\([^)]*\))?", constant, prop.get("description", ""))
 
 
 def _arg_lines(name: str, text: str) -> List[str]:

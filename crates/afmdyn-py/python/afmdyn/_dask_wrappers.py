@@ -82,23 +82,21 @@ def chart(
             back to adaptive where its exact free flight cannot be built), ``exact``,
             ``rk4``, ``rk4-naive``, ``adaptive``, ``split`` or ``taylor``.
         lyapunov_periods: Drive periods of the λ₁ estimate of each nonperiodic attractor (0:
-            none), ≤ ``MAX_CHART_LYAPUNOV_PERIODS``.
+            none), ≤ 1000000.
         max_attractors: Attractor slots per cell in the arrays of the results
-            (``ChartArrays``: ``chart.nc``, Python's dataset, the Dask store),
-            1..=``MAX_CHART_SLOTS``: a cell with more keeps its first ones (most random
-            starts first) there, and its ``attractors`` count tells how many it has; the CSV
-            and JSON list every one.
-        max_period: Largest period searched, 1..=``MAX_PERIOD``.
-        max_periods: Cap on the transient, in drive periods, 1..=``MAX_STEADY_PERIODS``;
-            ``None`` (default): derived from the model's slowest free decay, six times the
-            periods it takes to decay by ``tol`` and at least 1 500 (≈ 1.9 Q ln(1/tol) for a
-            lever of quality factor Q: ``analysis::steady::default_transient_cap``).
+            (``ChartArrays``: ``chart.nc``, Python's dataset, the Dask store), 1..=64: a
+            cell with more keeps its first ones (most random starts first) there, and its
+            ``attractors`` count tells how many it has; the CSV and JSON list every one.
+        max_period: Largest period searched, 1..=64.
+        max_periods: Cap on the transient, in drive periods, 1..=10000000; ``None``
+            (default): derived from the model's slowest free decay, six times the periods it
+            takes to decay by ``tol`` and at least 1 500 (≈ 1.9 Q ln(1/tol) for a lever of
+            quality factor Q: ``analysis::steady::default_transient_cap``).
         seed: Seed of the random starts.
-        starts: Random starts per cell, 1..=``MAX_CHART_STARTS``.
+        starts: Random starts per cell, 1..=1000.
         steps_per_period: Fixed steps per drive period of ``rk4`` / ``rk4-naive`` (default
             2000).
-        tile: Cells per task (continuation runs along x within a tile),
-            1..=``MAX_CHART_TILE``.
+        tile: Cells per task (continuation runs along x within a tile), 1..=10000.
         tol: Relative tolerance for two returns of the stroboscopic map to coincide, in
             [1e-14, 1e-3].
         tolerance: Relative and absolute tolerance of the adaptive integrator.
@@ -167,11 +165,11 @@ def bifurcation(
             for the plastic impact law r = 0, the Taylor integrator for DMT; split falls
             back to adaptive where its exact free flight cannot be built), ``exact``,
             ``rk4``, ``rk4-naive``, ``adaptive``, ``split`` or ``taylor``.
-        max_period: Largest period searched, 1..=``MAX_PERIOD``.
-        max_periods: Cap on the transient, in drive periods, 1..=``MAX_STEADY_PERIODS``;
-            ``None`` (default): derived from the model's slowest free decay, six times the
-            periods it takes to decay by ``tol`` and at least 1 500 (≈ 1.9 Q ln(1/tol) for a
-            lever of quality factor Q: ``analysis::steady::default_transient_cap``).
+        max_period: Largest period searched, 1..=64.
+        max_periods: Cap on the transient, in drive periods, 1..=10000000; ``None``
+            (default): derived from the model's slowest free decay, six times the periods it
+            takes to decay by ``tol`` and at least 1 500 (≈ 1.9 Q ln(1/tol) for a lever of
+            quality factor Q: ``analysis::steady::default_transient_cap``).
         param: The swept parameter: ``omega`` or ``alpha1``..``alpha6`` (or their names,
             ``tip-mass-ratio``, …).
         seed: Seed of the random initial states.
@@ -247,11 +245,11 @@ def basins(
             for the plastic impact law r = 0, the Taylor integrator for DMT; split falls
             back to adaptive where its exact free flight cannot be built), ``exact``,
             ``rk4``, ``rk4-naive``, ``adaptive``, ``split`` or ``taylor``.
-        max_period: Largest period searched, 1..=``MAX_PERIOD``.
-        max_periods: Cap on the transient, in drive periods, 1..=``MAX_STEADY_PERIODS``;
-            ``None`` (default): derived from the model's slowest free decay, six times the
-            periods it takes to decay by ``tol`` and at least 1 500 (≈ 1.9 Q ln(1/tol) for a
-            lever of quality factor Q: ``analysis::steady::default_transient_cap``).
+        max_period: Largest period searched, 1..=64.
+        max_periods: Cap on the transient, in drive periods, 1..=10000000; ``None``
+            (default): derived from the model's slowest free decay, six times the periods it
+            takes to decay by ``tol`` and at least 1 500 (≈ 1.9 Q ln(1/tol) for a lever of
+            quality factor Q: ``analysis::steady::default_transient_cap``).
         near_tol: Relative distance to a periodic attractor's section point that counts as
             near, (0, 1].
         steps_per_period: Fixed steps per drive period of ``rk4`` / ``rk4-naive`` (default

@@ -86,7 +86,7 @@ def simulate(
             ``rk4``, ``rk4-naive``, ``adaptive``, ``split`` or ``taylor``.
         periods: Drive periods recorded after the transient (> 0); default 50 when
             ``tau_end`` is not given either.
-        samples_per_period: Samples per drive period, 1..=``MAX_SAMPLES_PER_PERIOD``.
+        samples_per_period: Samples per drive period, 1..=100000.
         steps_per_period: Fixed steps per drive period of ``rk4`` / ``rk4-naive`` (default
             2000).
         tau_end: End time τ of the run, instead of ``periods``.
@@ -178,9 +178,9 @@ def converge(
             back to adaptive where its exact free flight cannot be built), ``exact``,
             ``rk4``, ``rk4-naive``, ``adaptive``, ``split`` or ``taylor``.
         max_modes: Largest number of modes, 1..=20.
-        periods: Drive periods of steady state compared, 1..=``MAX_CONVERGE_PERIODS``.
-        samples_per_period: Samples per drive period, 1..=``MAX_SAMPLES_PER_PERIOD``;
-            periods × samples_per_period ≤ ``MAX_CONVERGE_SAMPLES``.
+        periods: Drive periods of steady state compared, 1..=10000.
+        samples_per_period: Samples per drive period, 1..=100000; periods ×
+            samples_per_period ≤ 10000000.
         steps_per_period: Fixed steps per drive period of ``rk4`` / ``rk4-naive`` (default
             2000).
         tolerance: Relative and absolute tolerance of the adaptive integrator.
@@ -253,11 +253,11 @@ def bifurcation(
             for the plastic impact law r = 0, the Taylor integrator for DMT; split falls
             back to adaptive where its exact free flight cannot be built), ``exact``,
             ``rk4``, ``rk4-naive``, ``adaptive``, ``split`` or ``taylor``.
-        max_period: Largest period searched, 1..=``MAX_PERIOD``.
-        max_periods: Cap on the transient, in drive periods, 1..=``MAX_STEADY_PERIODS``;
-            ``None`` (default): derived from the model's slowest free decay, six times the
-            periods it takes to decay by ``tol`` and at least 1 500 (≈ 1.9 Q ln(1/tol) for a
-            lever of quality factor Q: ``analysis::steady::default_transient_cap``).
+        max_period: Largest period searched, 1..=64.
+        max_periods: Cap on the transient, in drive periods, 1..=10000000; ``None``
+            (default): derived from the model's slowest free decay, six times the periods it
+            takes to decay by ``tol`` and at least 1 500 (≈ 1.9 Q ln(1/tol) for a lever of
+            quality factor Q: ``analysis::steady::default_transient_cap``).
         param: The swept parameter: ``omega`` or ``alpha1``..``alpha6`` (or their names,
             ``tip-mass-ratio``, …).
         seed: Seed of the random initial states.
@@ -265,7 +265,7 @@ def bifurcation(
         steps: Number of values.
         steps_per_period: Fixed steps per drive period of ``rk4`` / ``rk4-naive`` (default
             2000).
-        threads: Worker threads, 1..=``MAX_THREADS``; ``None``: all cores.
+        threads: Worker threads, 1..=1024; ``None``: all cores.
         to: Last value.
         tol: Relative tolerance for two returns of the stroboscopic map to coincide, in
             [1e-14, 1e-3].
@@ -354,11 +354,11 @@ def continuation(
             ``tip-mass-ratio``, …).
         period: The period n (1..=64); ``None``: the period of the steady state reached at
             ``from``, else 1.
-        max_period: Largest period searched, 1..=``MAX_PERIOD``.
-        max_periods: Cap on the transient, in drive periods, 1..=``MAX_STEADY_PERIODS``;
-            ``None`` (default): derived from the model's slowest free decay, six times the
-            periods it takes to decay by ``tol`` and at least 1 500 (≈ 1.9 Q ln(1/tol) for a
-            lever of quality factor Q: ``analysis::steady::default_transient_cap``).
+        max_period: Largest period searched, 1..=64.
+        max_periods: Cap on the transient, in drive periods, 1..=10000000; ``None``
+            (default): derived from the model's slowest free decay, six times the periods it
+            takes to decay by ``tol`` and at least 1 500 (≈ 1.9 Q ln(1/tol) for a lever of
+            quality factor Q: ``analysis::steady::default_transient_cap``).
         tol: Relative tolerance for two returns of the stroboscopic map to coincide, in
             [1e-14, 1e-3].
         switch: At each period doubling, switch to the period-2n branch and continue it too,
@@ -416,11 +416,11 @@ def orbit(
             or :class:`Orbit` is also taken (its state at drive phase 0).
         period: The period n (1..=64); ``None``: the period of the steady state reached,
             else 1.
-        max_period: Largest period searched, 1..=``MAX_PERIOD``.
-        max_periods: Cap on the transient, in drive periods, 1..=``MAX_STEADY_PERIODS``;
-            ``None`` (default): derived from the model's slowest free decay, six times the
-            periods it takes to decay by ``tol`` and at least 1 500 (≈ 1.9 Q ln(1/tol) for a
-            lever of quality factor Q: ``analysis::steady::default_transient_cap``).
+        max_period: Largest period searched, 1..=64.
+        max_periods: Cap on the transient, in drive periods, 1..=10000000; ``None``
+            (default): derived from the model's slowest free decay, six times the periods it
+            takes to decay by ``tol`` and at least 1 500 (≈ 1.9 Q ln(1/tol) for a lever of
+            quality factor Q: ``analysis::steady::default_transient_cap``).
         tol: Relative tolerance for two returns of the stroboscopic map to coincide, in
             [1e-14, 1e-3].
         progress: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a
@@ -454,7 +454,7 @@ def lyapunov(
         blocks: Blocks for the uncertainty, 2..=periods.
         initial: The initial state (2N values); ``None``: rest. An :class:`Attractor` or
             :class:`Orbit` is also taken (its state at drive phase 0).
-        periods: Drive periods averaged; transient + periods ≤ ``MAX_RUN_PERIODS``.
+        periods: Drive periods averaged; transient + periods ≤ 1e8.
         transient: Drive periods discarded first; ``None`` (default): the model's derived
             transient cap (``analysis::steady::default_transient_cap`` at tol = 1e-8: 1 500
             for the paper's beam, ≈ 1.9 Q ln(1e8) for a lever of quality factor Q).
@@ -517,25 +517,22 @@ def chart(
             back to adaptive where its exact free flight cannot be built), ``exact``,
             ``rk4``, ``rk4-naive``, ``adaptive``, ``split`` or ``taylor``.
         lyapunov_periods: Drive periods of the λ₁ estimate of each nonperiodic attractor (0:
-            none), ≤ ``MAX_CHART_LYAPUNOV_PERIODS``.
+            none), ≤ 1000000.
         max_attractors: Attractor slots per cell in the arrays of the results
-            (``ChartArrays``: ``chart.nc``, Python's dataset, the Dask store),
-            1..=``MAX_CHART_SLOTS``: a cell with more keeps its first ones (most random
-            starts first) there, and its ``attractors`` count tells how many it has; the CSV
-            and JSON list every one.
-        max_period: Largest period searched, 1..=``MAX_PERIOD``.
-        max_periods: Cap on the transient, in drive periods, 1..=``MAX_STEADY_PERIODS``;
-            ``None`` (default): derived from the model's slowest free decay, six times the
-            periods it takes to decay by ``tol`` and at least 1 500 (≈ 1.9 Q ln(1/tol) for a
-            lever of quality factor Q: ``analysis::steady::default_transient_cap``).
+            (``ChartArrays``: ``chart.nc``, Python's dataset, the Dask store), 1..=64: a
+            cell with more keeps its first ones (most random starts first) there, and its
+            ``attractors`` count tells how many it has; the CSV and JSON list every one.
+        max_period: Largest period searched, 1..=64.
+        max_periods: Cap on the transient, in drive periods, 1..=10000000; ``None``
+            (default): derived from the model's slowest free decay, six times the periods it
+            takes to decay by ``tol`` and at least 1 500 (≈ 1.9 Q ln(1/tol) for a lever of
+            quality factor Q: ``analysis::steady::default_transient_cap``).
         seed: Seed of the random starts.
-        starts: Random starts per cell, 1..=``MAX_CHART_STARTS``.
+        starts: Random starts per cell, 1..=1000.
         steps_per_period: Fixed steps per drive period of ``rk4`` / ``rk4-naive`` (default
             2000).
-        threads: Worker threads, 1..=``MAX_THREADS``(super::limits::MAX_THREADS); ``None``:
-            all cores.
-        tile: Cells per task (continuation runs along x within a tile),
-            1..=``MAX_CHART_TILE``.
+        threads: Worker threads, 1..=1024; ``None``: all cores.
+        tile: Cells per task (continuation runs along x within a tile), 1..=10000.
         tol: Relative tolerance for two returns of the stroboscopic map to coincide, in
             [1e-14, 1e-3].
         tolerance: Relative and absolute tolerance of the adaptive integrator.

@@ -68,12 +68,12 @@ def observe(
         initial: The initial state (2N values a1..aN, ȧ1..ȧN) used as the guess as it is;
             ``None``: the end of the steady state reached from rest. An :class:`Attractor`
             or :class:`Orbit` is also taken (its state at drive phase 0).
-        periods: Orbit periods integrated, 1..=``MAX_OBSERVE_PERIODS``.
-        max_period: Largest period searched, 1..=``MAX_PERIOD``.
-        max_periods: Cap on the transient, in drive periods, 1..=``MAX_STEADY_PERIODS``;
-            ``None`` (default): derived from the model's slowest free decay, six times the
-            periods it takes to decay by ``tol`` and at least 1 500 (≈ 1.9 Q ln(1/tol) for a
-            lever of quality factor Q: ``analysis::steady::default_transient_cap``).
+        periods: Orbit periods integrated, 1..=1000000.
+        max_period: Largest period searched, 1..=64.
+        max_periods: Cap on the transient, in drive periods, 1..=10000000; ``None``
+            (default): derived from the model's slowest free decay, six times the periods it
+            takes to decay by ``tol`` and at least 1 500 (≈ 1.9 Q ln(1/tol) for a lever of
+            quality factor Q: ``analysis::steady::default_transient_cap``).
         tol: Relative tolerance for two returns of the stroboscopic map to coincide, in
             [1e-14, 1e-3].
         progress: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a
@@ -167,9 +167,9 @@ def approach(
             A₀, the sum of the components' under a multifrequency drive), or the start of
             the resonance band (Hz with a probe, else Ω; default ω_k (1 − w), w = max(6/Q_k,
             0.02)).
-        points: Number of grid values, ends included, 2..=``MAX_CURVE_POINTS`` (default
-            ``DEFAULT_CURVE_POINTS``; a resonance curve with a probe takes more where a
-            tenth of the linewidth needs them (``request::curves::linewidth_points``)).
+        points: Number of grid values, ends included, 2..=100000 (default 120; a resonance
+            curve with a probe takes more where a tenth of the linewidth needs them
+            (``request::curves::linewidth_points``)).
         setpoint: The amplitude setpoint A_sp/A₀ in (0, 1] (under a multifrequency drive
             A₁/A₀₁, of the first component, the one the feedback holds): the document gains
             a ``"setpoint"`` block with the operating points where the curve's amplitude
@@ -307,18 +307,17 @@ def bimodal(
             quasi-periodic drive (``Params::is_quasiperiodic``). No branches then.
         branches: Continue the periodic-orbit branches.
         exact: Measure every point on the exact periodic orbit of the drive's common period
-            even where a two-frequency drive repeats only after more than
-            ``analysis::stepped::torus::TORUS_PERIODS`` drive periods, whose points are
-            otherwise measured on invariant circles (``analysis::stepped::torus``; with
-            branches and folds).
+            even where a two-frequency drive repeats only after more than 32 drive periods,
+            whose points are otherwise measured on invariant circles
+            (``analysis::stepped::torus``; with branches and folds).
         from_: First end of the swept quantity (front-end unit): the rest distance z_c where
             the approach starts (m with a probe, else g₀; default 1.2 × the free amplitude
             A₀, the sum of the components' under a multifrequency drive), or the start of
             the resonance band (Hz with a probe, else Ω; default ω_k (1 − w), w = max(6/Q_k,
             0.02)).
-        points: Number of grid values, ends included, 2..=``MAX_CURVE_POINTS`` (default
-            ``DEFAULT_CURVE_POINTS``; a resonance curve with a probe takes more where a
-            tenth of the linewidth needs them (``request::curves::linewidth_points``)).
+        points: Number of grid values, ends included, 2..=100000 (default 120; a resonance
+            curve with a probe takes more where a tenth of the linewidth needs them
+            (``request::curves::linewidth_points``)).
         setpoint: The amplitude setpoint A_sp/A₀ in (0, 1] (under a multifrequency drive
             A₁/A₀₁, of the first component, the one the feedback holds): the document gains
             a ``"setpoint"`` block with the operating points where the curve's amplitude
@@ -474,9 +473,9 @@ def resonance(
             the resonance band (Hz with a probe, else Ω; default ω_k (1 − w), w = max(6/Q_k,
             0.02)).
         mode: The mode k (1-based) whose resonance is swept.
-        points: Number of grid values, ends included, 2..=``MAX_CURVE_POINTS`` (default
-            ``DEFAULT_CURVE_POINTS``; a resonance curve with a probe takes more where a
-            tenth of the linewidth needs them (``request::curves::linewidth_points``)).
+        points: Number of grid values, ends included, 2..=100000 (default 120; a resonance
+            curve with a probe takes more where a tenth of the linewidth needs them
+            (``request::curves::linewidth_points``)).
         step: Grid step (front-end unit, that of ``from`` and ``to``); excludes ``points``.
         to: Other end (front-end unit): z_c where the approach ends and the retract starts
             (default 0.1 × A₀), or the end of the resonance band (default ω_k (1 + w)).
@@ -597,9 +596,7 @@ def fm(
             0.5 % of its value at ``to`` (``request::fm::default_from``); 2A + a₀, the lower
             turning point at A, for the laws without a force before contact).
         mode: The mode K (1-based) the PLL tracks; default 1.
-        points: Number of z_c values, ends included,
-            2..=``analysis::stepped::MAX_CURVE_POINTS`` (default
-            ``analysis::stepped::DEFAULT_CURVE_POINTS``).
+        points: Number of z_c values, ends included, 2..=100000 (default 120).
         step: Step of z_c; excludes ``points``.
         to: Last z_c (default A + a₀: the lower turning point at the contact distance a₀, 0
             for the laws without attraction).

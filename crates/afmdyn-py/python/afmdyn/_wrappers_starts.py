@@ -62,12 +62,12 @@ def attractors(
             for the plastic impact law r = 0, the Taylor integrator for DMT; split falls
             back to adaptive where its exact free flight cannot be built), ``exact``,
             ``rk4``, ``rk4-naive``, ``adaptive``, ``split`` or ``taylor``.
-        max_period: Largest period searched, 1..=``MAX_PERIOD``.
-        max_periods: Cap on the transient, in drive periods, 1..=``MAX_STEADY_PERIODS``;
-            ``None`` (default): derived from the model's slowest free decay, six times the
-            periods it takes to decay by ``tol`` and at least 1 500 (≈ 1.9 Q ln(1/tol) for a
-            lever of quality factor Q: ``analysis::steady::default_transient_cap``).
-        samples: Random initial states, 1..=``MAX_ATTRACTOR_SAMPLES``.
+        max_period: Largest period searched, 1..=64.
+        max_periods: Cap on the transient, in drive periods, 1..=10000000; ``None``
+            (default): derived from the model's slowest free decay, six times the periods it
+            takes to decay by ``tol`` and at least 1 500 (≈ 1.9 Q ln(1/tol) for a lever of
+            quality factor Q: ``analysis::steady::default_transient_cap``).
+        samples: Random initial states, 1..=100000.
         seed: Seed of the initial states.
         steps_per_period: Fixed steps per drive period of ``rk4`` / ``rk4-naive`` (default
             2000).
@@ -140,18 +140,17 @@ def basins(
             for the plastic impact law r = 0, the Taylor integrator for DMT; split falls
             back to adaptive where its exact free flight cannot be built), ``exact``,
             ``rk4``, ``rk4-naive``, ``adaptive``, ``split`` or ``taylor``.
-        max_period: Largest period searched, 1..=``MAX_PERIOD``.
-        max_periods: Cap on the transient, in drive periods, 1..=``MAX_STEADY_PERIODS``;
-            ``None`` (default): derived from the model's slowest free decay, six times the
-            periods it takes to decay by ``tol`` and at least 1 500 (≈ 1.9 Q ln(1/tol) for a
-            lever of quality factor Q: ``analysis::steady::default_transient_cap``).
+        max_period: Largest period searched, 1..=64.
+        max_periods: Cap on the transient, in drive periods, 1..=10000000; ``None``
+            (default): derived from the model's slowest free decay, six times the periods it
+            takes to decay by ``tol`` and at least 1 500 (≈ 1.9 Q ln(1/tol) for a lever of
+            quality factor Q: ``analysis::steady::default_transient_cap``).
         near_tol: Relative distance to a periodic attractor's section point that counts as
             near, (0, 1].
         steps_per_period: Fixed steps per drive period of ``rk4`` / ``rk4-naive`` (default
             2000).
         stride: Stride of the first pass's coarse grid (0: automatic, 1: one pass).
-        threads: Worker threads, 1..=``MAX_THREADS``(super::limits::MAX_THREADS); ``None``:
-            all cores.
+        threads: Worker threads, 1..=1024; ``None``: all cores.
         tol: Relative tolerance for two returns of the stroboscopic map to coincide, in
             [1e-14, 1e-3].
         tolerance: Relative and absolute tolerance of the adaptive integrator.
@@ -244,15 +243,15 @@ def global_continuation(
             ``rk4``, ``rk4-naive``, ``adaptive``, ``split`` or ``taylor``.
         match_tol: Largest relative set distance of two attractors at consecutive values
             that are one, ≥ 0.
-        max_period: Largest period searched, 1..=``MAX_PERIOD``.
-        max_periods: Cap on the transient, in drive periods, 1..=``MAX_STEADY_PERIODS``;
-            ``None`` (default): derived from the model's slowest free decay, six times the
-            periods it takes to decay by ``tol`` and at least 1 500 (≈ 1.9 Q ln(1/tol) for a
-            lever of quality factor Q: ``analysis::steady::default_transient_cap``).
+        max_period: Largest period searched, 1..=64.
+        max_periods: Cap on the transient, in drive periods, 1..=10000000; ``None``
+            (default): derived from the model's slowest free decay, six times the periods it
+            takes to decay by ``tol`` and at least 1 500 (≈ 1.9 Q ln(1/tol) for a lever of
+            quality factor Q: ``analysis::steady::default_transient_cap``).
         param: The continued parameter.
-        samples: Random starts per value, 1..=``MAX_ATTRACTOR_SAMPLES``.
+        samples: Random starts per value, 1..=100000.
         seed: Seed of the random starts (keyed by value and start, as a sweep's).
-        steps: Number of values, 1..=``MAX_CONTINUATION_VALUES``.
+        steps: Number of values, 1..=10000.
         steps_per_period: Fixed steps per drive period of ``rk4`` / ``rk4-naive`` (default
             2000).
         to: Last value.

@@ -449,6 +449,10 @@ impl GlobalContinuationRequest {
 #[serde(default, deny_unknown_fields)]
 pub struct ObserveRequest {
     /// Orbit periods integrated, 1..=[`MAX_OBSERVE_PERIODS`].
+    #[cfg_attr(
+        feature = "schema",
+        schemars(extend("x-constants" = { "MAX_OBSERVE_PERIODS": MAX_OBSERVE_PERIODS }))
+    )]
     pub periods: usize,
     /// Highest harmonic reported.
     pub harmonics: usize,
