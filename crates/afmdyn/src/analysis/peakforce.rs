@@ -48,8 +48,8 @@ use super::shooting::{broyden_pays, shoot_unwatched, ShootingOptions, ShootingSt
 use super::steady::{steady_state, Motion, SteadyOptions};
 use crate::error::SimError;
 use crate::galerkin::Region;
-use crate::integrate::dense::{sample_dense, SpanSampling};
-use crate::integrate::{advance, build, form_state, Integrator, IntegratorOptions};
+use crate::integrate::dense::{sample_dense, SpanSampling, StartSample};
+use crate::integrate::{build, Integrator, IntegratorOptions};
 use crate::model::CantileverModel;
 use nalgebra::{Complex, DVector};
 use serde::Serialize;
@@ -319,7 +319,12 @@ fn tip_sample(model: &CantileverModel, tau: f64, z: &DVector<f64>) -> (f64, f64,
 }
 
 /// Sample one period from t = 0 (τ = T/4) at `samples` uniform points; `integ` starts at the
-/// orbit's state at τ = 0.
+/// orbit's state at τ = 0. The samples after the first are read from the integrator's dense
+/// output ([`sample_dense`] with its start, [`StartSample::Included`]), the integrator taking
+/// its own steps (spans where it has them, [`SpanSampling::Dense`]) instead of ending one at
+/// every sample: the cycle's 4 096 samples and the fit's 20 000 ([`retract_fit`]) would
+/// otherwise cut the lever's natural steps (a few per lever period) into hundreds of short
+/// ones.
 fn sample_cycle(
     model: &CantileverModel,
     integ: &mut dyn Integrator,
@@ -333,44 +338,25 @@ fn sample_cycle(
         force: Vec::with_capacity(samples),
     };
     let dt = |k: usize| t * k as f64 / samples as f64;
-    sample_times(integ, samples, &|k| t0 + dt(k), &mut |k, tau, z| {
-        let (w, d, f) = tip_sample(model, tau, z);
-        c.time.push(dt(k));
-        c.deflection.push(w);
-        c.distance.push(d);
-        c.force.push(f);
-    })?;
-    Ok(c)
-}
-
-/// Call `each(k, τ_k, z(τ_k))` for k = 0, 1, …, `n` − 1 in order, τ_k = `time(k)` increasing
-/// (the first at or after the integrator's time), advancing `integ` to τ_{n−1}: the first
-/// sample is the state there (the integrator advanced to it exactly), the others are
-/// [`sample_dense`]'s, the integrator taking its own steps (spans where it has them,
-/// [`SpanSampling::Dense`]) instead of ending one at every sample — the cycle's 4 096 samples
-/// and the fit's 20 000 would otherwise cut the lever's natural steps (a few per lever period)
-/// into hundreds of short ones.
-///
-/// # Errors
-/// [`SimError`] from the integrator.
-fn sample_times(
-    integ: &mut dyn Integrator,
-    n: usize,
-    time: &dyn Fn(usize) -> f64,
-    each: &mut dyn FnMut(usize, f64, &DVector<f64>),
-) -> Result<(), SimError> {
-    if n == 0 {
-        return Ok(());
-    }
-    advance(integ, time(0))?;
-    form_state(integ);
-    each(0, integ.tau(), integ.state());
     let mut z = DVector::zeros(integ.state().len());
-    sample_dense(integ, n - 1, time, SpanSampling::Dense, &mut |k, tau, s| {
-        z.copy_from_slice(s);
-        each(k, tau, &z);
-        Ok(())
-    })
+    let (spans, start) = (SpanSampling::Dense, StartSample::Included);
+    sample_dense(
+        integ,
+        samples - 1,
+        &|k| t0 + dt(k),
+        spans,
+        start,
+        &mut |k, tau, s| {
+            z.copy_from_slice(s);
+            let (w, d, f) = tip_sample(model, tau, &z);
+            c.time.push(dt(k));
+            c.deflection.push(w);
+            c.distance.push(d);
+            c.force.push(f);
+            Ok(())
+        },
+    )?;
+    Ok(c)
 }
 
 /// The lever's static compliance at the tip, c = φ(1)ᵀK⁻¹φ(1) (free region, eq. 13): the
@@ -449,11 +435,15 @@ fn retract_fit(
     let mut d = Vec::with_capacity(FIT_SAMPLES + 1);
     let (mut measured, mut f) = (d.clone(), d.clone());
     let time = |k: usize| origin + (t0 + (t1 - t0) * k as f64 / FIT_SAMPLES as f64);
-    sample_times(integ, FIT_SAMPLES + 1, &time, &mut |_, tau, z| {
-        let (w, dk, fk) = tip_sample(model, tau, z);
+    let mut z = DVector::zeros(z0.len());
+    let (spans, start) = (SpanSampling::Dense, StartSample::Included);
+    sample_dense(integ, FIT_SAMPLES, &time, spans, start, &mut |_, tau, s| {
+        z.copy_from_slice(s);
+        let (w, dk, fk) = tip_sample(model, tau, &z);
         d.push(dk);
         measured.push(w / compliance);
         f.push(fk);
+        Ok(())
     })?;
     Ok(Some((fit_dmt(&d, &measured, band), fit_dmt(&d, &f, band))))
 }
