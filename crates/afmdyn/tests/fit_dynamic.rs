@@ -158,84 +158,117 @@ fn approach(base: Params, points: usize) -> Vec<CurvePoint> {
     approach_retract(&spec).expect("approach").first
 }
 
-/// The attractive (φ > 90°, A < 0.98 A_far) and the repulsive (φ < 90°, A < 0.7 A_far)
-/// stable period-1 points of the approach.
-fn regimes(curve: &[CurvePoint]) -> (Vec<&CurvePoint>, Vec<&CurvePoint>) {
-    let a_far = curve[0].observables.amplitude;
-    let ok = |p: &&CurvePoint| p.period == Some(1) && p.stable;
-    let attractive = curve
-        .iter()
-        .filter(ok)
-        .filter(|p| p.observables.phase > FRAC_PI_2 && p.observables.amplitude < 0.98 * a_far)
-        .collect();
-    let repulsive = curve
-        .iter()
-        .filter(ok)
-        .filter(|p| p.observables.phase < FRAC_PI_2 && p.observables.amplitude < 0.7 * a_far)
-        .collect();
-    (attractive, repulsive)
+/// Which stable period-1 points of an approach a case checks (the first of them away from
+/// folds and grazing, [`check_first`]).
+#[derive(Debug, Clone, Copy)]
+enum Regime {
+    /// φ > 90°, A < 0.98 A_far.
+    Attractive,
+    /// φ < 90°, A < 0.7 A_far.
+    Repulsive,
+    /// A lighter touch: 0.7 A_far ≤ A < 0.99 A_far.
+    LightTouch,
 }
 
-#[test]
-fn point_mass_dmt_sensitivities_are_the_finite_differences() {
-    let base = probe("probe-point-mass-dmt.toml");
-    let curve = approach(base, 41);
-    let (att, rep) = regimes(&curve);
-    let ps = [
-        OrbitParam::Gap,
-        OrbitParam::ContactStiffness,
-        OrbitParam::Hamaker,
-    ];
-    for (p, what) in [(att, "attractive"), (rep, "repulsive")] {
-        check_first(&base, &p, &ps, &format!("point mass DMT, {what}"));
+impl Regime {
+    fn name(self) -> &'static str {
+        match self {
+            Regime::Attractive => "attractive",
+            Regime::Repulsive => "repulsive",
+            Regime::LightTouch => "light touch",
+        }
+    }
+
+    /// The stable period-1 points of `curve` in this regime, in the curve's order.
+    fn points(self, curve: &[CurvePoint]) -> Vec<&CurvePoint> {
+        let a_far = curve[0].observables.amplitude;
+        curve
+            .iter()
+            .filter(|p| p.period == Some(1) && p.stable)
+            .filter(|p| {
+                let (a, phi) = (p.observables.amplitude, p.observables.phase);
+                match self {
+                    Regime::Attractive => phi > FRAC_PI_2 && a < 0.98 * a_far,
+                    Regime::Repulsive => phi < FRAC_PI_2 && a < 0.7 * a_far,
+                    Regime::LightTouch => (0.7 * a_far..0.99 * a_far).contains(&a),
+                }
+            })
+            .collect()
     }
 }
 
-#[test]
-fn point_mass_hertz_sensitivities_are_the_finite_differences() {
-    let base = Params {
-        contact_law: ContactLaw::Hertz,
-        ..probe("probe-point-mass-dmt.toml")
-    };
-    let curve = approach(base, 41);
-    let (_, rep) = regimes(&curve);
-    let ps = [OrbitParam::Gap, OrbitParam::ContactStiffness];
-    check_first(&base, &rep, &ps, "point mass Hertz, repulsive");
-    // a lighter touch: the stable points of A_far > A > 0.7 A_far
-    let a_far = curve[0].observables.amplitude;
-    let light: Vec<&CurvePoint> = curve
-        .iter()
-        .filter(|p| p.period == Some(1) && p.stable)
-        .filter(|p| (0.7 * a_far..0.99 * a_far).contains(&p.observables.amplitude))
-        .collect();
-    check_first(&base, &light, &ps, "point mass Hertz, light touch");
+/// One case of the sensitivity check: a probe (its law, or Hertz over it), the points of its
+/// approach, the parameters differentiated and the regimes checked.
+struct Case {
+    /// Named in every failure message, with the regime.
+    name: &'static str,
+    probe: &'static str,
+    hertz: bool,
+    points: usize,
+    params: &'static [OrbitParam],
+    regimes: &'static [Regime],
 }
 
+const DMT_PARAMS: &[OrbitParam] = &[
+    OrbitParam::Gap,
+    OrbitParam::ContactStiffness,
+    OrbitParam::Hamaker,
+];
+const HERTZ_PARAMS: &[OrbitParam] = &[OrbitParam::Gap, OrbitParam::ContactStiffness];
+
+/// The point mass and the N = 3 beam, DMT (attractive and repulsive) and Hertz (repulsive, and
+/// the point mass's light touch).
+const CASES: [Case; 4] = [
+    Case {
+        name: "point mass DMT",
+        probe: "probe-point-mass-dmt.toml",
+        hertz: false,
+        points: 41,
+        params: DMT_PARAMS,
+        regimes: &[Regime::Attractive, Regime::Repulsive],
+    },
+    Case {
+        name: "point mass Hertz",
+        probe: "probe-point-mass-dmt.toml",
+        hertz: true,
+        points: 41,
+        params: HERTZ_PARAMS,
+        regimes: &[Regime::Repulsive, Regime::LightTouch],
+    },
+    Case {
+        name: "N = 3 beam DMT",
+        probe: "probe-beam-dmt.toml",
+        hertz: false,
+        points: 21,
+        params: DMT_PARAMS,
+        regimes: &[Regime::Attractive, Regime::Repulsive],
+    },
+    Case {
+        name: "N = 3 beam Hertz",
+        probe: "probe-beam-dmt.toml",
+        hertz: true,
+        points: 21,
+        params: HERTZ_PARAMS,
+        regimes: &[Regime::Repulsive],
+    },
+];
+
+/// The exact sensitivities of every case ([`CASES`]) against the fourth-order central
+/// differences ([`check_point`], [`AGREE`]) at the first point of each regime away from folds
+/// and grazing.
 #[test]
-fn beam_dmt_sensitivities_are_the_finite_differences() {
-    let base = probe("probe-beam-dmt.toml");
-    let curve = approach(base, 21);
-    let (att, rep) = regimes(&curve);
-    let ps = [
-        OrbitParam::Gap,
-        OrbitParam::ContactStiffness,
-        OrbitParam::Hamaker,
-    ];
-    for (p, what) in [(att, "attractive"), (rep, "repulsive")] {
-        check_first(&base, &p, &ps, &format!("N = 3 beam DMT, {what}"));
+fn sensitivities_are_the_finite_differences() {
+    for case in &CASES {
+        let mut base = probe(case.probe);
+        if case.hertz {
+            base.contact_law = ContactLaw::Hertz;
+        }
+        let curve = approach(base, case.points);
+        for &r in case.regimes {
+            let what = format!("{}, {}", case.name, r.name());
+            check_first(&base, &r.points(&curve), case.params, &what);
+        }
     }
-}
-
-#[test]
-fn beam_hertz_sensitivities_are_the_finite_differences() {
-    let base = Params {
-        contact_law: ContactLaw::Hertz,
-        ..probe("probe-beam-dmt.toml")
-    };
-    let curve = approach(base, 21);
-    let (_, rep) = regimes(&curve);
-    let ps = [OrbitParam::Gap, OrbitParam::ContactStiffness];
-    check_first(&base, &rep, &ps, "N = 3 beam Hertz, repulsive");
 }
 
 // ---- the dynamic fit (`analysis::fit::am_curve`) ----

@@ -15,7 +15,7 @@
 use afmdyn::analysis::settle::minimal_period;
 use afmdyn::analysis::shooting::{
     map_section_points, shoot_map, shoot_map_broyden, shoot_map_globalised, shoot_map_undamped,
-    shoot_with, ShootingOptions,
+    shoot_map_unwatched, shoot_map_unwatched_by, shoot_with, ShootingOptions, ShootingStrategy,
 };
 use afmdyn::galerkin::Region;
 use afmdyn::integrate::{build, IntegratorOptions};
@@ -160,6 +160,56 @@ fn shooting_finds_the_fixed_point_and_multipliers_of_an_affine_map() {
             assert!((z - &want).amax() < 1e-9 * (1.0 + want.amax()), "r = {r}");
         }
         assert_multipliers(&u.multipliers, &mu, 1e-12);
+    }
+}
+
+/// The strategy of Broyden's updates from M ≈ 0 on the affine map: where A contracts (spectral
+/// radius 0.5) the updates reach the closed-form fixed point within Gay's bound of 2d steps
+/// (d = 3; Gay, SIAM J. Numer. Anal. 16 (1979) 623) and one variational map gives the
+/// multipliers, the eigenvalues of A; where A expands (a real eigenvalue 1.7, a complex pair of
+/// modulus 1.2) the first step — the map's own iterate — raises the residual and the solve is
+/// Newton's from the guess, bit for bit; at period 2, and with the Newton strategy, it is
+/// Newton's too.
+#[test]
+fn broyden_from_zero_reaches_the_affine_fixed_point_or_falls_back_on_newton() {
+    let opts = ShootingOptions::default();
+    let guess = DVector::from_vec(vec![3.0, -2.0, 5.0]);
+    let mut m = affine(0.5, -0.3);
+    let want = m.fixed_point();
+    let mu = m.eigenvalues();
+    let b = shoot_map_unwatched_by(&mut m, &guess, 1, &opts, ShootingStrategy::BroydenFromZero)
+        .unwrap();
+    let newton = shoot_map_unwatched(&mut m, &guess, 1, &opts).unwrap();
+    assert!((&b.state - &want).amax() < 1e-10 * (1.0 + want.amax()));
+    assert_multipliers(&b.multipliers, &mu, 1e-12);
+    assert!(b.stable);
+    assert_eq!((b.period, b.section.clone()), (1, vec![b.state.clone()]));
+    assert!(b.grazing_distance.is_nan() && !b.grazing);
+    // Broyden's iterates (up to 2d + 1 residuals and the variational map's), not Newton's two
+    assert_eq!(newton.residuals.len(), 2);
+    assert!(
+        (3..=2 * 3 + 2).contains(&b.residuals.len()),
+        "{:?}",
+        b.residuals
+    );
+    for (r, real) in [(0.9, 1.7), (1.2, 0.2)] {
+        let mut m = affine(r, real);
+        let b = shoot_map_unwatched_by(&mut m, &guess, 1, &opts, ShootingStrategy::BroydenFromZero)
+            .unwrap();
+        let newton = shoot_map_unwatched(&mut m, &guess, 1, &opts).unwrap();
+        assert!(!b.stable);
+        assert_eq!(b.state, newton.state, "r = {r}, {real}");
+        assert_eq!(b.residuals, newton.residuals, "r = {r}, {real}");
+    }
+    for (n, strategy) in [
+        (2, ShootingStrategy::BroydenFromZero),
+        (1, ShootingStrategy::Newton),
+    ] {
+        let mut m = affine(0.5, -0.3);
+        let o = shoot_map_unwatched_by(&mut m, &guess, n, &opts, strategy).unwrap();
+        let newton = shoot_map_unwatched(&mut m, &guess, n, &opts).unwrap();
+        assert_eq!(o.state, newton.state, "n = {n}, {strategy:?}");
+        assert_eq!(o.residuals, newton.residuals, "n = {n}, {strategy:?}");
     }
 }
 

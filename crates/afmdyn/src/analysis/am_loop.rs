@@ -36,7 +36,7 @@
 
 use super::observables::{observe, wrap_phase, ObservableOptions};
 use crate::error::SimError;
-use crate::integrate::dense::{sample_dense, SpanSampling};
+use crate::integrate::dense::{sample_dense, SpanSampling, StartSample};
 use crate::integrate::{advance, build, check_start, Integrator, IntegratorOptions};
 use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
@@ -145,6 +145,7 @@ pub fn demodulate_period(
         samples,
         &tau_of,
         SpanSampling::Cut,
+        StartSample::Excluded,
         &mut |_, _, z| {
             (s, c) = (s * cd + c * sd, c * cd - s * sd);
             let w = model.w_tip_slice(z, 0);

@@ -12,8 +12,9 @@
 //! **Steady state.** The periodic orbit of the modulation period T = 2π/Ω (20–1 000 lever
 //! periods), found as every steady state of afmdyn is: the transient settled by
 //! [`steady_state`] (with Newton from the transient on slowly decaying levers), then shooting
-//! on the period-n stroboscopic map for the orbit and its Floquet multipliers (Broyden's
-//! updates from M ≈ 0 where they pay, else Newton: `shoot_tap`). A period-2 tapping is
+//! on the period-n stroboscopic map for the orbit and its Floquet multipliers
+//! ([`ShootingStrategy::BroydenFromZero`] where Broyden's updates pay, [`broyden_pays`], else
+//! Newton; the shooting module's [`shoot_unwatched`]). A period-2 tapping is
 //! reported as period 2 ([`SteadyTap::period`]); double taps show as
 //! [`TapChannels::taps_per_cycle`] > 1. The integrators' steps and switching search follow
 //! the fastest mode of the lever, not the modulation period (their grids and tolerances are
@@ -43,15 +44,14 @@ pub use setpoint::{
 };
 
 use super::observables::{observe, ObservableOptions};
-use super::shooting::{broyden_pays, shoot_broyden, shoot_map_unwatched, ShootingOptions};
+use super::shooting::{broyden_pays, shoot_unwatched, ShootingOptions, ShootingStrategy};
 use super::steady::{steady_state, Motion, SteadyOptions};
 use crate::error::SimError;
 use crate::galerkin::Region;
-use crate::integrate::dense::{sample_dense, SpanSampling};
-use crate::integrate::{advance, build, form_state, Integrator, IntegratorOptions};
-use crate::maps::StroboscopicMap;
+use crate::integrate::dense::{sample_dense, SpanSampling, StartSample};
+use crate::integrate::{build, Integrator, IntegratorOptions};
 use crate::model::CantileverModel;
-use nalgebra::{Complex, DMatrix, DVector};
+use nalgebra::{Complex, DVector};
 use serde::Serialize;
 
 /// Fewest samples of the reported cycle (the issue's ≥ 2 000 points per period).
@@ -237,7 +237,14 @@ pub fn steady_tap_from(
         }
     };
     let guess = steady.poincare[0].state.clone();
-    let orbit = shoot_tap(model, integ.as_mut(), &guess, n, opts)?;
+    // Broyden's updates from M ≈ 0 where the monodromy matrix costs variational equations
+    // step by step: the tap's ringing decays over the cycle, its multipliers are small
+    let strategy = if broyden_pays(opts.integrator.clone(), model) {
+        ShootingStrategy::BroydenFromZero
+    } else {
+        ShootingStrategy::Newton
+    };
+    let orbit = shoot_unwatched(integ.as_mut(), &guess, n, &opts.shooting, strategy)?;
     integ.set_variational(false);
     let n = orbit.period;
     integ.reset(0.0, &orbit.state)?;
@@ -297,74 +304,6 @@ pub fn steady_tap_from(
     })
 }
 
-/// The steady tap's orbit: its period n, its state at τ = 0, its Floquet multipliers (by
-/// decreasing modulus) and whether all lie inside the unit circle.
-struct TapOrbit {
-    period: usize,
-    state: DVector<f64>,
-    multipliers: Vec<Complex<f64>>,
-    stable: bool,
-}
-
-/// The periodic orbit of the tap from the transient's `guess` (period `n`).
-///
-/// Where the monodromy matrix costs variational equations step by step
-/// ([`broyden_pays`]: the Taylor integrator of DMT and the split integrator's contact, at N = 3
-/// 42 components a step instead of 6), a period-1 tap of a law without hysteresis is solved
-/// first by [`shoot_broyden`] from the estimate M ≈ 0: at f₀/f_m ≫ 1 the ringing after each tap
-/// decays over the cycle's lever periods, so the multipliers are small (2–3e-2 on the
-/// ScanAsyst-Air-like probe at f₀/f_m = 100) and M − I ≈ −I makes the first step the map's own
-/// iterate — the transient continued — after which Broyden's updates learn M − I from the
-/// flows without variational equations; one variational flow at the converged orbit gives the
-/// monodromy matrix. The orbit agrees with Newton's to its tolerance
-/// ([`ShootingOptions::tol`]; the flows of the two solves differ in their steps only). Where
-/// Broyden does not converge within 2 d + 2 iterates (d the state's dimension: Broyden's
-/// bound for an affine map, Gay, *SIAM J. Numer. Anal.* 16 (1979) 623) or a step does not lower
-/// the residual, Newton ([`shoot_map_unwatched`]) solves from the guess as before; so it does
-/// for a hysteretic law (JKR, capillary: whose orbits at Newton's tolerance are sensitive to
-/// the flows' steps) and for a period n > 1 (whose minimal period Newton's solve checks).
-/// No distance to grazing is measured: the tap does not report it.
-fn shoot_tap(
-    model: &CantileverModel,
-    integ: &mut dyn Integrator,
-    guess: &DVector<f64>,
-    n: usize,
-    opts: &PeakForceOptions,
-) -> Result<TapOrbit, SimError> {
-    if n == 1 && broyden_pays(opts.integrator.clone(), model) && !integ.system().is_hysteretic() {
-        let dim = guess.len();
-        let first = ShootingOptions {
-            max_iter: (2 * dim + 2).min(opts.shooting.max_iter),
-            ..opts.shooting
-        };
-        match shoot_broyden(integ, guess, n, &first, &DMatrix::zeros(dim, dim)) {
-            Ok(o) => {
-                return Ok(TapOrbit {
-                    period: n,
-                    state: o.state,
-                    multipliers: o.multipliers,
-                    stable: o.stable,
-                })
-            }
-            Err(SimError::Cancelled) => return Err(SimError::Cancelled),
-            // Newton from the guess
-            Err(_) => {}
-        }
-    }
-    let o = shoot_map_unwatched(
-        &mut StroboscopicMap::new(integ, 1),
-        guess,
-        n,
-        &opts.shooting,
-    )?;
-    Ok(TapOrbit {
-        period: o.period,
-        state: o.state,
-        multipliers: o.multipliers,
-        stable: o.stable,
-    })
-}
-
 /// τ of the largest separation, T/4 (Ωτ = π/2: the sinusoid α2 sin Ωτ at its top).
 pub fn time_origin(model: &CantileverModel) -> f64 {
     0.25 * model.period()
@@ -380,7 +319,12 @@ fn tip_sample(model: &CantileverModel, tau: f64, z: &DVector<f64>) -> (f64, f64,
 }
 
 /// Sample one period from t = 0 (τ = T/4) at `samples` uniform points; `integ` starts at the
-/// orbit's state at τ = 0.
+/// orbit's state at τ = 0. The samples after the first are read from the integrator's dense
+/// output ([`sample_dense`] with its start, [`StartSample::Included`]), the integrator taking
+/// its own steps (spans where it has them, [`SpanSampling::Dense`]) instead of ending one at
+/// every sample: the cycle's 4 096 samples and the fit's 20 000 ([`retract_fit`]) would
+/// otherwise cut the lever's natural steps (a few per lever period) into hundreds of short
+/// ones.
 fn sample_cycle(
     model: &CantileverModel,
     integ: &mut dyn Integrator,
@@ -394,44 +338,25 @@ fn sample_cycle(
         force: Vec::with_capacity(samples),
     };
     let dt = |k: usize| t * k as f64 / samples as f64;
-    sample_times(integ, samples, &|k| t0 + dt(k), &mut |k, tau, z| {
-        let (w, d, f) = tip_sample(model, tau, z);
-        c.time.push(dt(k));
-        c.deflection.push(w);
-        c.distance.push(d);
-        c.force.push(f);
-    })?;
-    Ok(c)
-}
-
-/// Call `each(k, τ_k, z(τ_k))` for k = 0, 1, …, `n` − 1 in order, τ_k = `time(k)` increasing
-/// (the first at or after the integrator's time), advancing `integ` to τ_{n−1}: the first
-/// sample is the state there (the integrator advanced to it exactly), the others are
-/// [`sample_dense`]'s, the integrator taking its own steps (spans where it has them,
-/// [`SpanSampling::Dense`]) instead of ending one at every sample — the cycle's 4 096 samples
-/// and the fit's 20 000 would otherwise cut the lever's natural steps (a few per lever period)
-/// into hundreds of short ones.
-///
-/// # Errors
-/// [`SimError`] from the integrator.
-fn sample_times(
-    integ: &mut dyn Integrator,
-    n: usize,
-    time: &dyn Fn(usize) -> f64,
-    each: &mut dyn FnMut(usize, f64, &DVector<f64>),
-) -> Result<(), SimError> {
-    if n == 0 {
-        return Ok(());
-    }
-    advance(integ, time(0))?;
-    form_state(integ);
-    each(0, integ.tau(), integ.state());
     let mut z = DVector::zeros(integ.state().len());
-    sample_dense(integ, n - 1, time, SpanSampling::Dense, &mut |k, tau, s| {
-        z.copy_from_slice(s);
-        each(k, tau, &z);
-        Ok(())
-    })
+    let (spans, start) = (SpanSampling::Dense, StartSample::Included);
+    sample_dense(
+        integ,
+        samples - 1,
+        &|k| t0 + dt(k),
+        spans,
+        start,
+        &mut |k, tau, s| {
+            z.copy_from_slice(s);
+            let (w, d, f) = tip_sample(model, tau, &z);
+            c.time.push(dt(k));
+            c.deflection.push(w);
+            c.distance.push(d);
+            c.force.push(f);
+            Ok(())
+        },
+    )?;
+    Ok(c)
 }
 
 /// The lever's static compliance at the tip, c = φ(1)ᵀK⁻¹φ(1) (free region, eq. 13): the
@@ -510,11 +435,15 @@ fn retract_fit(
     let mut d = Vec::with_capacity(FIT_SAMPLES + 1);
     let (mut measured, mut f) = (d.clone(), d.clone());
     let time = |k: usize| origin + (t0 + (t1 - t0) * k as f64 / FIT_SAMPLES as f64);
-    sample_times(integ, FIT_SAMPLES + 1, &time, &mut |_, tau, z| {
-        let (w, dk, fk) = tip_sample(model, tau, z);
+    let mut z = DVector::zeros(z0.len());
+    let (spans, start) = (SpanSampling::Dense, StartSample::Included);
+    sample_dense(integ, FIT_SAMPLES, &time, spans, start, &mut |_, tau, s| {
+        z.copy_from_slice(s);
+        let (w, dk, fk) = tip_sample(model, tau, &z);
         d.push(dk);
         measured.push(w / compliance);
         f.push(fk);
+        Ok(())
     })?;
     Ok(Some((fit_dmt(&d, &measured, band), fit_dmt(&d, &f, band))))
 }

@@ -15,7 +15,7 @@ mod map;
 
 pub use map::{
     map_section_points, reduce_map_period, shoot_map, shoot_map_broyden, shoot_map_from_section,
-    shoot_map_globalised, shoot_map_undamped, shoot_map_unwatched,
+    shoot_map_globalised, shoot_map_undamped, shoot_map_unwatched, shoot_map_unwatched_by,
 };
 
 use super::period::{close, MERGE_FACTOR};
@@ -42,6 +42,32 @@ impl Default for ShootingOptions {
             max_iter: 40,
         }
     }
+}
+
+/// How [`shoot_map_unwatched_by`] (and [`shoot_unwatched`] on an integrator) solves for an
+/// orbit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ShootingStrategy {
+    /// Damped Newton from the guess ([`shoot_map_unwatched`]): a flow with the variational
+    /// equations (the monodromy matrix) per iterate.
+    #[default]
+    Newton,
+    /// For a period-1 orbit, Broyden's updates from the estimate M ≈ 0 first
+    /// ([`shoot_map_broyden`]; Broyden, *Math. Comp.* 19 (1965) 577), Newton from the guess
+    /// where they fail. It pays for a strongly contracting map whose monodromy matrix costs
+    /// variational equations step by step ([`broyden_pays`]): there the multipliers are small
+    /// (2–3e-2 on the steady PeakForce tap of a ScanAsyst-Air-like probe at f₀/f_m = 100, whose
+    /// ringing after each tap decays over the cycle's lever periods), so M − I ≈ −I makes the
+    /// first step the map's own iterate — the transient continued — after which the secant
+    /// updates learn M − I from flows without the variational equations (at N = 3, 6
+    /// components a step instead of 42), and one variational flow at the converged orbit
+    /// gives its monodromy matrix. The orbit agrees with Newton's to the tolerance
+    /// ([`ShootingOptions::tol`]; the two solves' flows differ in their steps only). Capped at
+    /// 2d + 2 iterates (d the state's dimension: Gay's bound for an affine map,
+    /// [`shoot_map_unwatched_by`]); not for a period n > 1 (Newton's solve checks the minimal
+    /// period) nor, on an integrator ([`shoot_unwatched`]), for a hysteretic law (JKR,
+    /// capillary: whose orbits at Newton's tolerance are sensitive to the flows' steps).
+    BroydenFromZero,
 }
 
 /// Distance to grazing below which an orbit is flagged as grazing: a local extremum of V_T
@@ -271,6 +297,34 @@ pub fn shoot_broyden(
     m0: &DMatrix<f64>,
 ) -> Result<ShotOrbit, SimError> {
     shoot_map_broyden(&mut StroboscopicMap::new(integ, 1), guess, n, opts, m0)
+}
+
+/// [`shoot_map_unwatched_by`] on the period-1 stroboscopic map of `integ`: the orbit without
+/// its distance to grazing, solved by `strategy`, which falls back on
+/// [`ShootingStrategy::Newton`] for a hysteretic system
+/// ([`crate::tip_sample::TipSampleSystem::is_hysteretic`]).
+///
+/// # Errors
+/// As [`shoot_map_unwatched_by`].
+pub fn shoot_unwatched(
+    integ: &mut dyn Integrator,
+    guess: &DVector<f64>,
+    n: usize,
+    opts: &ShootingOptions,
+    strategy: ShootingStrategy,
+) -> Result<PeriodicOrbit, SimError> {
+    let strategy = if integ.system().is_hysteretic() {
+        ShootingStrategy::Newton
+    } else {
+        strategy
+    };
+    shoot_map_unwatched_by(
+        &mut StroboscopicMap::new(integ, 1),
+        guess,
+        n,
+        opts,
+        strategy,
+    )
 }
 
 /// The n section states z, P(z), …, Pⁿ⁻¹(z) of a period-n orbit of the stroboscopic map of

@@ -27,8 +27,22 @@ pub enum SpanSampling {
     Dense,
 }
 
-/// Advance `integ` from its time τ₀ to τ_n = `time(n)`, calling `each(j, τ_j, z(τ_j))` for
-/// j = 1, …, `n` in order, τ_j = `time(j)` increasing with τ₁ > τ₀ (nothing for n = 0).
+/// Whether [`sample_dense`] samples its start τ₀ too.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StartSample {
+    /// No: τ₀ is the integrator's time, the samples are j = 1, …, n (the lock-in's
+    /// demodulation, [`crate::analysis::am_loop`]).
+    Excluded,
+    /// Yes: τ₀ = `time(0)`, at or after the integrator's time; the integrator is first advanced
+    /// to it ([`advance`], a step ended there) and j = 0 is its state there (the PeakForce cycle
+    /// and the retract branch of its fit, [`crate::analysis::peakforce`]).
+    Included,
+}
+
+/// Advance `integ` from τ₀ to τ_n = `time(n)`, calling `each(j, τ_j, z(τ_j))` for
+/// j = 1, …, `n` in order, τ_j = `time(j)` increasing with τ₁ > τ₀ (nothing for n = 0); τ₀ is
+/// the integrator's time, or with [`StartSample::Included`] `time(0)`, which the integrator is
+/// first advanced to and sampled at (j = 0, before the others; then n = 0 samples it alone).
 ///
 /// The integrator steps towards τ_n; a sample inside a step is read from its dense output
 /// ([`Integrator::dense_state_into`], no allocation per sample for states of at most
@@ -45,8 +59,14 @@ pub fn sample_dense(
     n: usize,
     time: &dyn Fn(usize) -> f64,
     spans: SpanSampling,
+    start: StartSample,
     each: &mut EachSample<'_>,
 ) -> Result<(), SimError> {
+    if start == StartSample::Included {
+        advance(integ, time(0))?;
+        form_state(integ);
+        each(0, integ.tau(), integ.state().as_slice())?;
+    }
     if n == 0 {
         return Ok(());
     }
@@ -93,4 +113,70 @@ pub fn sample_dense(
         form_state(integ);
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::integrate::{build, IntegratorKind, IntegratorOptions};
+    use crate::model::CantileverModel;
+    use crate::params::Params;
+
+    /// The samples of `sample_dense` from `time(0)` on: (j, τ_j, z(τ_j)).
+    type Samples = Vec<(usize, f64, Vec<f64>)>;
+
+    /// Sampling with the start included is, bit for bit, the integrator advanced to
+    /// τ₀ = `time(0)` ([`advance`]), its state there the sample j = 0, then sampled without its
+    /// start: the defining identity of [`StartSample::Included`], for an integrator with spans
+    /// (the exact propagator) and one without (the adaptive one), both span samplings.
+    #[test]
+    fn the_start_sample_is_the_state_advanced_to_it() {
+        let p = Params::default();
+        let model = CantileverModel::new(&p).unwrap();
+        let t = p.period();
+        let time = |j: usize| 0.3 * t + t * j as f64 / 50.0;
+        for kind in [IntegratorKind::Adaptive, IntegratorKind::Exact] {
+            for spans in [SpanSampling::Cut, SpanSampling::Dense] {
+                let opts = IntegratorOptions {
+                    kind,
+                    ..IntegratorOptions::default()
+                };
+                let mut a = build(&model, opts.clone(), 0.0, &model.rest()).unwrap();
+                let mut got: Samples = Vec::new();
+                sample_dense(
+                    a.as_mut(),
+                    50,
+                    &time,
+                    spans,
+                    StartSample::Included,
+                    &mut |j, tau, z| {
+                        got.push((j, tau, z.to_vec()));
+                        Ok(())
+                    },
+                )
+                .unwrap();
+                let mut b = build(&model, opts, 0.0, &model.rest()).unwrap();
+                advance(b.as_mut(), time(0)).unwrap();
+                form_state(b.as_mut());
+                let mut want: Samples = vec![(0, b.tau(), b.state().as_slice().to_vec())];
+                sample_dense(
+                    b.as_mut(),
+                    50,
+                    &time,
+                    spans,
+                    StartSample::Excluded,
+                    &mut |j, tau, z| {
+                        want.push((j, tau, z.to_vec()));
+                        Ok(())
+                    },
+                )
+                .unwrap();
+                assert_eq!(got.len(), 51, "{kind:?}, {spans:?}");
+                assert_eq!(got, want, "{kind:?}, {spans:?}");
+                assert_eq!((a.tau(), a.state()), (b.tau(), b.state()));
+                // the start is where the samples begin: τ₀ = time(0) to the step's rounding
+                assert!((got[0].1 - time(0)).abs() <= 1e-12 * t, "{kind:?}");
+            }
+        }
+    }
 }

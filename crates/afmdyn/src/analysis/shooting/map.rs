@@ -4,8 +4,8 @@
 //! closed-form fixed point, and the stroboscopic map of the paper's linear model).
 
 use super::{
-    floquet_stability, proper_period, PeriodicOrbit, ShootingOptions, ShotOrbit, GRAZING_TOL,
-    LINE_SEARCH_MIN_STEP, SECTION_STARTS, VARIATIONAL_SLACK,
+    floquet_stability, proper_period, PeriodicOrbit, ShootingOptions, ShootingStrategy, ShotOrbit,
+    GRAZING_TOL, LINE_SEARCH_MIN_STEP, SECTION_STARTS, VARIATIONAL_SLACK,
 };
 use crate::error::SimError;
 use crate::maps::flow::FlowMap;
@@ -41,6 +41,59 @@ pub fn shoot_map_unwatched(
     opts: &ShootingOptions,
 ) -> Result<PeriodicOrbit, SimError> {
     shoot_damped(dmap, guess, n, opts, Watch::None)
+}
+
+/// [`shoot_map_unwatched`] by `strategy` ([`ShootingStrategy`]). With
+/// [`ShootingStrategy::BroydenFromZero`] a period-1 orbit (n = 1) is first sought by Broyden's
+/// updates from the monodromy estimate M ≈ 0 ([`shoot_map_broyden`] with `m0` = 0) within
+/// 2d + 2 iterates (d the state's dimension; at most `opts.max_iter`): Broyden's method
+/// reaches the zero of an affine F in at most 2d steps (Gay, *SIAM J. Numer. Anal.* 16 (1979)
+/// 623), and the residual of the last is checked in one more. Where those updates fail (no
+/// convergence within the cap, a step that does not lower the residual, a singular M − I or
+/// a fixed point that does not close in its region), [`shoot_map_unwatched`] solves from
+/// `guess` as with [`ShootingStrategy::Newton`]; so it does for n > 1, whose minimal period
+/// only Newton's solve checks. The orbit of the Broyden solve has no distance to grazing (NaN),
+/// as [`shoot_map_unwatched`]'s.
+///
+/// # Errors
+/// As [`shoot_map_unwatched`]; [`SimError::Cancelled`] from the Broyden solve.
+pub fn shoot_map_unwatched_by(
+    dmap: &mut dyn DiscreteMap,
+    guess: &DVector<f64>,
+    n: usize,
+    opts: &ShootingOptions,
+    strategy: ShootingStrategy,
+) -> Result<PeriodicOrbit, SimError> {
+    if n == 1 && strategy == ShootingStrategy::BroydenFromZero {
+        let dim = guess.len();
+        let first = ShootingOptions {
+            max_iter: (2 * dim + 2).min(opts.max_iter),
+            ..*opts
+        };
+        match broyden(dmap, guess, n, &first, &DMatrix::zeros(dim, dim)) {
+            Ok((z, map, residuals)) => {
+                // a period-1 orbit: its section is its state, its minimal period 1
+                let (multipliers, stable, critical) = floquet_stability(&map.jacobian);
+                return Ok(PeriodicOrbit {
+                    period: 1,
+                    section: vec![z.clone()],
+                    state: z,
+                    monodromy: map.jacobian,
+                    multipliers,
+                    stable,
+                    critical,
+                    grazing_distance: f64::NAN,
+                    grazing: false,
+                    switchings: map.switchings,
+                    residuals,
+                });
+            }
+            Err(SimError::Cancelled) => return Err(SimError::Cancelled),
+            // Newton from the guess
+            Err(_) => {}
+        }
+    }
+    shoot_map_unwatched(dmap, guess, n, opts)
 }
 
 /// [`newton`] with halved steps, then [`finish`]: [`shoot_map`] and [`shoot_map_unwatched`].
@@ -228,6 +281,19 @@ pub fn shoot_map_broyden(
     opts: &ShootingOptions,
     m0: &DMatrix<f64>,
 ) -> Result<ShotOrbit, SimError> {
+    let (state, map, residuals) = broyden(dmap, guess, n, opts, m0)?;
+    Ok(ShotOrbit::new(state, map.jacobian, residuals))
+}
+
+/// The iteration of [`shoot_map_broyden`]: the converged z (closed in its region), its map
+/// (the variational flow's) and the residuals.
+fn broyden(
+    dmap: &mut dyn DiscreteMap,
+    guess: &DVector<f64>,
+    n: usize,
+    opts: &ShootingOptions,
+    m0: &DMatrix<f64>,
+) -> Result<(DVector<f64>, FlowMap, Vec<f64>), SimError> {
     if n == 0 {
         return Err(SimError::out_of_range("period", n, "must be >= 1"));
     }
@@ -293,12 +359,12 @@ pub fn shoot_map_broyden(
     if res_var <= VARIATIONAL_SLACK * opts.tol * (1.0 + z.norm()) {
         residuals.push(res_var);
         closes_in_its_region(dmap, &z, n, &residuals)?;
-        return Ok(ShotOrbit::new(z, map.jacobian, residuals));
+        return Ok((z, map, residuals));
     }
     let (state, map, more) = newton(dmap, &z, n, opts, Damping::Stop)?;
     residuals.extend(more);
     closes_in_its_region(dmap, &state, n, &residuals)?;
-    Ok(ShotOrbit::new(state, map.jacobian, residuals))
+    Ok((state, map, residuals))
 }
 
 /// What [`newton`] does with a full step that does not lower ‖F‖.

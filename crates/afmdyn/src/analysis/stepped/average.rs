@@ -289,5 +289,6 @@ pub(super) fn average_point(
         }),
         circle: None,
         fallback: None,
+        free_decay_wait: false,
     })
 }

@@ -123,6 +123,7 @@ pub(super) fn branch_starts(
             average: None,
             circle: None,
             fallback: None,
+            free_decay_wait: false,
         });
     }
     starts

@@ -286,6 +286,10 @@ pub struct CurvePoint {
     /// exact orbit instead; `None` otherwise.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub fallback: Option<Fallback>,
+    /// Settled by its time average only after the free decay's wait, which its returns'
+    /// unmeasurable contraction kept ([`Settled::free_decay_wait`]; the curve warns).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub free_decay_wait: bool,
 }
 
 fn is_zero(x: &f64) -> bool {
@@ -597,6 +601,7 @@ pub fn finish_curve(
             spec.steady.max_period
         ));
     }
+    warnings.extend(contraction::free_decay_warning(first.iter().chain(&second)));
     let unsettled = first
         .iter()
         .chain(&second)

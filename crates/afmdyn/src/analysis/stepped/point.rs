@@ -2,7 +2,7 @@
 //! ([`settle`]), the orbit continued by a predicted Newton solve with substeps where it fails,
 //! and the trend of the branch the predictor follows (module docs of [`super`]).
 
-use super::contraction::{wait_over, Spread, STALLED_RUNS};
+use super::contraction::{ContractionWait, Spread};
 use super::*;
 use crate::analysis::observables::observe_tapered;
 use crate::analysis::settle::minimal_period;
@@ -37,6 +37,10 @@ pub struct Settled {
     /// period found, its windows' averages agreeing to [`AVERAGE_TOL`]); `None` for an orbit
     /// or a motion that did not settle within the cap.
     pub averaged: Option<Observables>,
+    /// The motion was settled by its time average only at the end of the free decay's wait,
+    /// which runs of returns whose contraction could not be measured kept where its windows
+    /// had agreed earlier ([`super::contraction`]): right, only slower.
+    pub free_decay_wait: bool,
 }
 
 /// Periods per window of [`settle`]'s time average on `system`: half the slowest free mode's
@@ -101,6 +105,7 @@ pub fn settle(
         return Ok(Settled {
             found,
             averaged: None,
+            free_decay_wait: false,
         });
     }
     // no settling on a period-n orbit: the returns' test and the time average
@@ -120,9 +125,8 @@ pub fn settle(
     let mut spent = s.periods;
     let mut last: Option<(Complex<f64>, f64)> = None;
     let mut agreed = 0;
-    // the previous run's spreads, and the runs in a row whose contraction ended the wait
-    let mut before: Option<Vec<f64>> = None;
-    let mut stalled = 0;
+    // the runs' measured contraction (module docs of `contraction`)
+    let mut wait = ContractionWait::default();
     while spent < cap {
         integ.reset(0.0, &z)?;
         let mut returns = ReturnHistory::new(&spec.steady, &z);
@@ -145,6 +149,7 @@ pub fn settle(
                             stable: true,
                         },
                         averaged: None,
+                        free_decay_wait: false,
                     });
                 }
             }
@@ -158,14 +163,11 @@ pub fn settle(
             z = integ.state().clone();
             break;
         }
-        let now = spread.spreads().to_vec();
-        if let (SettleWait::Contraction, Some(b)) = (spec.settle_wait, &before) {
-            // D: from the last run's start to this one's
-            let left = least.saturating_sub(spent) as f64;
-            let over = wait_over(b, &now, (run + w) as f64, spec.steady.tol, left);
-            stalled = if over { stalled + 1 } else { 0 };
-        }
-        before = Some(now);
+        let measure = spec.settle_wait == SettleWait::Contraction;
+        let left = least.saturating_sub(spent) as f64;
+        // D: from the last run's start to this one's
+        let d = (run + w) as f64;
+        wait.run(spread.spreads().to_vec(), measure, d, spec.steady.tol, left);
         let o = observe_tapered(integ, &window)?;
         spent += w;
         // the drive is periodic: the window's end is the state at τ ≡ 0
@@ -174,11 +176,15 @@ pub fn settle(
         if let Some((p, d)) = last {
             let close = (now.0 - p).norm().max((now.1 - d).abs()) <= AVERAGE_TOL * o.amplitude;
             agreed = if close { agreed + 1 } else { 0 };
-            if agreed >= AVERAGE_AGREEMENTS && (spent >= least || stalled >= STALLED_RUNS) {
-                return Ok(Settled {
-                    found: nonperiodic(z),
-                    averaged: Some(o),
-                });
+            if agreed >= AVERAGE_AGREEMENTS {
+                if spent >= least || wait.over() {
+                    return Ok(Settled {
+                        found: nonperiodic(z),
+                        averaged: Some(o),
+                        free_decay_wait: wait.held(),
+                    });
+                }
+                wait.agreed();
             }
         }
         last = Some(now);
@@ -186,6 +192,7 @@ pub fn settle(
     Ok(Settled {
         found: nonperiodic(z),
         averaged: None,
+        free_decay_wait: false,
     })
 }
 
@@ -455,7 +462,7 @@ pub(super) fn orbit_point(
     } else {
         Reached::Start
     };
-    let mut averaged = None;
+    let (mut averaged, mut free_decay_wait) = (None, false);
     let (found, reached) = match continued {
         Some((state, multipliers, monodromy)) => (
             Found {
@@ -469,7 +476,7 @@ pub(super) fn orbit_point(
         ),
         None => {
             let s = settle(integ.as_mut(), &last, n, spec)?;
-            averaged = s.averaged;
+            (averaged, free_decay_wait) = (s.averaged, s.free_decay_wait);
             let reached = match (prev, &averaged) {
                 (_, Some(_)) => Reached::Averaged,
                 (Some(_), None) => Reached::Settled,
@@ -518,6 +525,7 @@ pub(super) fn orbit_point(
         average: None,
         circle: None,
         fallback: None,
+        free_decay_wait,
     })
 }
 

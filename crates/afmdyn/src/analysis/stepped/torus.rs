@@ -279,6 +279,7 @@ pub(super) fn torus_point(
         average: None,
         circle: Some(circle_point(circle)),
         fallback: None,
+        free_decay_wait: false,
     })
 }
 
