@@ -57,6 +57,13 @@ run fm-model fm --contact-law dmt --hamaker 1e-5 --intermolecular-distance 0.01 
 run bimodal bimodal --probe "$EX/probe-bimodal.toml" --points 10 --setpoint 0.7 --out o --json
 run reconstruct reconstruct --fm "$EX/fm-vdw.csv" --spring-constant 40 --resonance-frequency 300kHz --amplitude 10nm --out o --json
 run image image --probe "$P" --sample "$EX/sample-stripe.toml" --setpoint 0.8 --pixels 8 --curve-points 30 --out o --json
+# PeakForce (steady taps, sweep, point mass, water) and stepped sweeps of hysteretic laws
+run pf-air peakforce --probe "$EX/probe-peakforce-air.toml" --z-c 97nm --json --out o
+run pf-sweep peakforce --probe "$EX/probe-peakforce-air.toml" --from 98nm --to 94nm --step 1nm --json --out o
+run pf-pm peakforce --probe "$EX/probe-peakforce-air.toml" --modes 1 --json --out o
+run pf-water peakforce --probe "$EX/probe-peakforce-water.toml" --json --out o
+run approach-jkr approach --probe "$EX/probe-jkr-polymer.toml" --out o --json
+run approach-cap approach --probe "$EX/probe-capillary-humid.toml" --out o --json
 # the Python datasets: every variable's dims, attrs and bytes
 if [ "$PY" != none ] && [ -x "$PY" ]; then
     mkdir -p "$OUT/python"
