@@ -49,6 +49,8 @@ fn with(base: &Params, p: OrbitParam, value: f64) -> Params {
             ContactLaw::Dmt { hamaker, .. } => *hamaker = value,
             _ => panic!("H̃ of a law without it"),
         },
+        OrbitParam::DriveAmplitude => q.alpha2 = value,
+        OrbitParam::DriveFrequency => q.omega = value,
     }
     q
 }
@@ -61,6 +63,8 @@ fn value_of(base: &Params, p: OrbitParam) -> f64 {
             ContactLaw::Dmt { hamaker, .. } => hamaker,
             _ => panic!("H̃ of a law without it"),
         },
+        OrbitParam::DriveAmplitude => base.alpha2,
+        OrbitParam::DriveFrequency => base.omega,
     }
 }
 
@@ -102,7 +106,13 @@ fn check_point(base: &Params, guess: &DVector<f64>, params: &[OrbitParam], what:
     );
     for (j, &p) in params.iter().enumerate() {
         let v = value_of(base, p);
-        let h = STEP * v.abs();
+        // Ω within a small share of the resonance's half linewidth Ω/(2Q) (Q = 400 here),
+        // across which the phase turns by a radian
+        let h = if p == OrbitParam::DriveFrequency {
+            1e-6 * v.abs()
+        } else {
+            STEP * v.abs()
+        };
         // the fourth-order central difference (its truncation error O(h⁴) far below the
         // integration error's ~TOL/h)
         let at = |k: f64| orbit(&with(base, p, v + k * h), &exact.state);
@@ -236,6 +246,37 @@ fn beam_hertz_sensitivities_are_the_finite_differences() {
     let (_, rep) = regimes(&curve);
     let ps = [OrbitParam::Gap, OrbitParam::ContactStiffness];
     check_first(&base, &rep, &ps, "N = 3 beam Hertz, repulsive");
+}
+
+/// The drive's α2 and Ω (the FM loop's unknowns): their columns, Ω's by the rescaling of time
+/// to a fixed phase, against the central differences, on the point mass and the N = 3 beam
+/// (whose base drive also moves V_T), Hertz and DMT, attractive and repulsive points.
+#[test]
+fn drive_sensitivities_are_the_finite_differences() {
+    let ps = [OrbitParam::DriveAmplitude, OrbitParam::DriveFrequency];
+    for (name, points) in [
+        ("probe-point-mass-dmt.toml", 41),
+        ("probe-beam-dmt.toml", 21),
+    ] {
+        let dmt = probe(name);
+        let hertz = Params {
+            contact_law: ContactLaw::Hertz,
+            ..dmt
+        };
+        for (base, law) in [(dmt, "DMT"), (hertz, "Hertz")] {
+            let curve = approach(base, points);
+            let (att, rep) = regimes(&curve);
+            if law == "DMT" {
+                check_first(
+                    &base,
+                    &att,
+                    &ps,
+                    &format!("{name} {law}, attractive, drive"),
+                );
+            }
+            check_first(&base, &rep, &ps, &format!("{name} {law}, repulsive, drive"));
+        }
+    }
 }
 
 // ---- the dynamic fit (`analysis::fit::am_curve`) ----
