@@ -139,3 +139,102 @@ fn point_mass_fm_sensitivities_are_the_finite_differences() {
 fn beam_fm_sensitivities_are_the_finite_differences() {
     check_probe("probe-beam-dmt.toml", "N = 3 beam");
 }
+
+/// Standard normal draws (splitmix64 and Box–Muller: deterministic, no dependency).
+struct Normal(u64);
+
+impl Normal {
+    fn uniform(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    }
+    fn draw(&mut self) -> f64 {
+        let (u, v) = (self.uniform().max(1e-300), self.uniform());
+        (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
+    }
+}
+
+/// A Δf curve of the library's `fm` analysis (`analysis::fm::fm_curve`, the probe's A₀ the
+/// setpoint) at the truth (the probe's E and H, z_offset = 1 nm) with Gaussian noise of 0.2 Hz,
+/// fitted from E × 0.7, H × 1.3 and z_offset 0.6 nm: the 95 % intervals hold the truth.
+#[test]
+fn a_noisy_point_mass_fm_curve_gives_back_e_h_and_the_offset() {
+    use afmdyn::analysis::fit::{fit_with, Observations, Parameter};
+    use afmdyn::analysis::fm::{fm_curve, FmSpec};
+    use afmdyn::analysis::progress::Progress;
+    let (probe, hz) = fm_probe("probe-point-mass-dmt.toml", false);
+    let g0 = probe.length_m;
+    let z_offset = 1e-9;
+    let z = rows(g0, 1.4, 0.95, 30, z_offset);
+    // the truth's Δf by the FM analysis itself
+    let values = z
+        .iter()
+        .map(|z| probe.params.alpha5_for_rest_distance((z + z_offset) / g0))
+        .collect();
+    let curve = fm_curve(&FmSpec::new(probe.params, values, 1.0), &Progress::new()).expect("fm");
+    assert_eq!(curve.points.len(), z.len(), "{:?}", curve.unreached);
+    let sigma = vec![0.2; z.len()];
+    let mut normal = Normal(62);
+    let y: Vec<f64> = curve
+        .points
+        .iter()
+        .zip(&sigma)
+        .map(|(p, s)| (p.omega - curve.reference.omega) * hz + s * normal.draw())
+        .collect();
+    let params = vec![AmParam::YoungsModulus, AmParam::Hamaker, AmParam::ZOffset];
+    let truth = truth(&probe, &params, z_offset);
+    let model = FmCurveModel::new(probe, z, params, hz);
+    let start = [
+        Parameter {
+            name: "sample.youngs_modulus".into(),
+            start: 0.7 * probe.youngs_modulus,
+            lower: 1e5,
+            upper: f64::INFINITY,
+            scale: probe.youngs_modulus,
+        },
+        Parameter {
+            name: "sample.hamaker".into(),
+            start: 1.3 * probe.hamaker,
+            lower: 0.0,
+            upper: f64::INFINITY,
+            scale: probe.hamaker,
+        },
+        Parameter {
+            name: "z_offset".into(),
+            start: 0.6e-9,
+            lower: -5e-9,
+            upper: 5e-9,
+            scale: 1e-9,
+        },
+    ];
+    let obs = Observations {
+        y: &y,
+        sigma: Some(&sigma),
+    };
+    let out = fit_with(&model, &obs, &start, &[None, None, None], false);
+    eprintln!(
+        "Δf fit: {} evaluations ({}), χ²/dof {:.3}, {:?}",
+        out.evaluations, out.termination, out.chi2_dof, out.warnings
+    );
+    for (e, t) in out.estimates.iter().zip(&truth) {
+        eprintln!(
+            "{}: {:.6e} ± {:.3e} [{:.6e}, {:.6e}] (truth {t:.6e})",
+            e.name, e.value, e.standard_error, e.interval[0], e.interval[1]
+        );
+        assert!(
+            (e.interval[0]..=e.interval[1]).contains(t),
+            "{}: the interval misses the truth",
+            e.name
+        );
+        // the data constrain each: the interval is narrower than the truth's magnitude
+        assert!(e.interval[1] - e.interval[0] < t.abs(), "{}", e.name);
+    }
+    assert!(
+        (0.4..2.0).contains(&out.chi2_dof),
+        "χ²/dof {}",
+        out.chi2_dof
+    );
+}
