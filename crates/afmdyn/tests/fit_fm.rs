@@ -157,18 +157,17 @@ impl Normal {
     }
 }
 
-/// A Δf curve of the library's `fm` analysis (`analysis::fm::fm_curve`, the probe's A₀ the
-/// setpoint) at the truth (the probe's E and H, z_offset = 1 nm) with Gaussian noise of 0.2 Hz,
-/// fitted from E × 0.7, H × 1.3 and z_offset 0.6 nm: the 95 % intervals hold the truth.
-#[test]
-fn a_noisy_point_mass_fm_curve_gives_back_e_h_and_the_offset() {
-    use afmdyn::analysis::fit::{fit_with, Observations, Parameter};
+/// A Δf curve (Hz) of `count` rows z (m) of the library's `fm` analysis
+/// (`analysis::fm::fm_curve`, the probe's A₀ the setpoint) on the example point mass at the
+/// truth (the probe's E and H, z_offset = 1 nm), z_c from 1.4 A₀ (attractive) to 0.95 A₀
+/// (repulsive), with Gaussian noise σ = 0.2 Hz: the probe, Hz per Ω, z, Δf and σ.
+fn synthetic(count: usize, seed: u64) -> (AmProbe, f64, Vec<f64>, Vec<f64>, Vec<f64>) {
     use afmdyn::analysis::fm::{fm_curve, FmSpec};
     use afmdyn::analysis::progress::Progress;
     let (probe, hz) = fm_probe("probe-point-mass-dmt.toml", false);
     let g0 = probe.length_m;
     let z_offset = 1e-9;
-    let z = rows(g0, 1.4, 0.95, 30, z_offset);
+    let z = rows(g0, 1.4, 0.95, count, z_offset);
     // the truth's Δf by the FM analysis itself
     let values = z
         .iter()
@@ -177,13 +176,23 @@ fn a_noisy_point_mass_fm_curve_gives_back_e_h_and_the_offset() {
     let curve = fm_curve(&FmSpec::new(probe.params, values, 1.0), &Progress::new()).expect("fm");
     assert_eq!(curve.points.len(), z.len(), "{:?}", curve.unreached);
     let sigma = vec![0.2; z.len()];
-    let mut normal = Normal(62);
+    let mut normal = Normal(seed);
     let y: Vec<f64> = curve
         .points
         .iter()
         .zip(&sigma)
         .map(|(p, s)| (p.omega - curve.reference.omega) * hz + s * normal.draw())
         .collect();
+    (probe, hz, z, y, sigma)
+}
+
+/// The synthetic Δf curve fitted from E × 0.7, H × 1.3 and z_offset 0.6 nm: the 95 %
+/// intervals hold the truth, χ²/dof near 1.
+#[test]
+fn a_noisy_point_mass_fm_curve_gives_back_e_h_and_the_offset() {
+    use afmdyn::analysis::fit::{fit_with, Observations, Parameter};
+    let (probe, hz, z, y, sigma) = synthetic(30, 62);
+    let z_offset = 1e-9;
     let params = vec![AmParam::YoungsModulus, AmParam::Hamaker, AmParam::ZOffset];
     let truth = truth(&probe, &params, z_offset);
     let model = FmCurveModel::new(probe, z, params, hz);
@@ -237,4 +246,76 @@ fn a_noisy_point_mass_fm_curve_gives_back_e_h_and_the_offset() {
         "χ²/dof {}",
         out.chi2_dof
     );
+}
+
+/// The synthetic Δf curve as the door's CSV (`z`, `frequency_shift`, `sigma_frequency_shift`,
+/// and an `amplitude` column, which an FM curve does not fit), fitted through `afmdyn fit`'s
+/// request from the probe's starts (z_offset's on its grid): an FM document whose curve holds
+/// the data, the fit and the residuals (Hz), whose estimates' intervals hold the truth, and
+/// whose Dataset and figures carry the frequency shift.
+#[test]
+fn a_frequency_shift_csv_goes_through_the_fit_door() {
+    use afmdyn::analysis::progress::Progress;
+    use afmdyn::request::fit::FitRequest;
+    use afmdyn::request::{run, Resolved};
+    let (_, _, z, y, sigma) = synthetic(16, 7);
+    let dir = std::env::temp_dir().join(format!("afmdyn-fit-fm-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let path = dir.join("fm.csv");
+    let mut text = String::from("z,frequency_shift,sigma_frequency_shift,amplitude\n");
+    for i in 0..z.len() {
+        text += &format!("{:?},{:?},{:?},1e-8\n", z[i], y[i], sigma[i]);
+    }
+    std::fs::write(&path, text).expect("csv");
+    let p = Probe::load(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/probe-point-mass-dmt.toml"),
+    )
+    .expect("probe");
+    let resolved = Resolved {
+        params: p.params,
+        probe: Some(p.clone()),
+    };
+    let request = FitRequest {
+        data: Some(path.display().to_string()),
+        fit: vec!["sample.hamaker".into(), "z_offset".into()],
+        ..FitRequest::default()
+    };
+    let doc = run(&request, &resolved, &Progress::default())
+        .expect("fit")
+        .json;
+    std::fs::remove_dir_all(&dir).ok();
+    assert_eq!(doc["kind"], "fm", "{doc}");
+    for (name, t) in [
+        ("sample.hamaker", p.sample_inputs.hamaker.unwrap()),
+        ("z_offset", 1e-9),
+    ] {
+        let e = &doc["estimates"][name];
+        let (lo, hi) = (
+            e["interval"][0].as_f64().unwrap(),
+            e["interval"][1].as_f64().unwrap(),
+        );
+        assert!(lo <= t && t <= hi, "{name}: truth {t} outside [{lo}, {hi}]");
+    }
+    let curve = &doc["curve"];
+    let col = |k: &str| -> Vec<f64> {
+        curve[k]
+            .as_array()
+            .unwrap_or_else(|| panic!("{k}"))
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect()
+    };
+    let (data, fit, residual) = (
+        col("frequency_shift"),
+        col("frequency_shift_fit"),
+        col("frequency_shift_residual"),
+    );
+    assert_eq!(data, y);
+    for i in 0..y.len() {
+        assert!((data[i] - fit[i] - residual[i]).abs() <= 1e-9 * data[i].abs().max(1.0));
+    }
+    assert!(curve["amplitude"].is_null() && curve["amplitude_fit"].is_null());
+    assert_eq!(doc["units"]["frequency_shift"], "Hz");
+    let warnings = doc["warnings"].to_string();
+    assert!(warnings.contains("not fitted"), "{warnings}");
 }

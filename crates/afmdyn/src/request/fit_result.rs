@@ -1,5 +1,5 @@
 //! What the force-curve fit ([`super::fit`]) and the dynamic fit ([`super::fit_dynamic`])
-//! share: the result of a `fit` request, the data of an AM curve, the fewest rows and the
+//! share: the result of a `fit` request, the data of an AM or FM curve, the fewest rows and the
 //! fitted quantities' physical ranges.
 
 use crate::analysis::fit::force_curve::{ForceLaw, Preprocessed};
@@ -40,12 +40,13 @@ pub struct FitResult {
     pub fitted: Vec<bool>,
     /// The fit.
     pub outcome: FitOutcome,
-    /// The dynamic fit's data and channels, when the data are an AM curve
+    /// The dynamic fit's data and channels, when the data are an AM or FM curve
     /// ([`super::fit_dynamic`]; then `curve` and `rows` are empty).
     pub dynamic: Option<DynamicFit>,
 }
 
-/// A measured AM curve's columns.
+/// A measured dynamic curve's columns: an AM curve (amplitude and/or phase) or an FM curve
+/// (frequency shift).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct AmData {
     /// The piezo positions z (m).
@@ -58,6 +59,11 @@ pub struct AmData {
     pub sigma_amplitude: Option<Vec<f64>>,
     /// The phases' standard deviations (deg).
     pub sigma_phase: Option<Vec<f64>>,
+    /// The frequency shifts Δf (Hz) of an FM curve (then the curve is fitted as one, by
+    /// [`crate::analysis::fit::fm_curve`]).
+    pub frequency_shift: Option<Vec<f64>>,
+    /// The frequency shifts' standard deviations (Hz).
+    pub sigma_frequency_shift: Option<Vec<f64>>,
 }
 
 /// The dynamic fit's part of a [`FitResult`].
@@ -65,8 +71,11 @@ pub struct AmData {
 pub struct DynamicFit {
     /// The data.
     pub data: AmData,
-    /// The model's values at the estimates (amplitudes, then phases, as fitted).
+    /// Whether the amplitude and the phase were fitted (an AM curve: the model's values the
+    /// amplitudes, then the phases).
     pub channels: (bool, bool),
+    /// Whether the frequency shift was fitted (an FM curve; then `channels` is (false, false)).
+    pub frequency_shift: bool,
     /// The last evaluation's warnings of the model (folds, grazing).
     pub model_warnings: Vec<String>,
 }
