@@ -183,9 +183,11 @@ def test_a_frequency_shift_curve_fits_against_the_fm_model(tmp_path):
     z = fm.z_c.values - 1e-9
     df = fm.frequency_shift.values + 0.2 * rng.standard_normal(z.size)
     path = tmp_path / "fm.csv"
-    rows = "\n".join(f"{a!r},{b!r},0.2" for a, b in zip(z, df))
+    rows = "\n".join(f"{a:.17g},{b:.17g},0.2" for a, b in zip(z, df))
     path.write_text("z,frequency_shift,sigma_frequency_shift\n" + rows + "\n")
-    ds = _fit(data=str(path), fit=["sample.hamaker", "z_offset"])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", afmdyn.AfmdynWarning)
+        ds = afmdyn.fit(probe=probe, data=str(path), fit=["sample.hamaker", "z_offset"])
     assert json.loads(ds.attrs["summary"])["kind"] == "fm"
     assert ds.frequency_shift.attrs["units"] == "Hz"
     np.testing.assert_array_equal(ds.frequency_shift.values, df)
