@@ -154,6 +154,50 @@ pub struct OrbitSensitivity {
     pub grazing_distance: f64,
     /// Near a fold or grazing.
     pub warnings: Vec<SensitivityWarning>,
+    /// The harmonic of the tip deflection at a further drive component's frequency, when asked
+    /// for ([`orbit_sensitivity_component`]: a bimodal drive's A₂, φ₂).
+    pub component: Option<Harmonic>,
+}
+
+/// A harmonic A sin(ω_c τ + ψ_c − φ) of the tip deflection over the orbit's period, with its
+/// exact parameter sensitivities.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Harmonic {
+    /// A (g₀).
+    pub amplitude: f64,
+    /// φ, the lag behind the component's drive (rad, in (−π/2, 3π/2]).
+    pub phase: f64,
+    /// ∂A/∂p, shape `[k]`.
+    pub d_amplitude: Vec<f64>,
+    /// ∂φ/∂p (rad per unit p), shape `[k]`.
+    pub d_phase: Vec<f64>,
+}
+
+/// The harmonic of the Fourier integrals (q_s, q_c) over the period `period` and of their total
+/// derivatives `dq` (2 × k): c_s = (2/T) q_s = A cos φ, c_c = (2/T) q_c = −A sin φ (module
+/// docs).
+fn harmonic(q: (f64, f64), dq: &DMatrix<f64>, period: f64) -> Harmonic {
+    let scale = 2.0 / period;
+    let (cs, cc) = (scale * q.0, scale * q.1);
+    let amplitude = cs.hypot(cc);
+    let mut phase = (-cc).atan2(cs);
+    if phase <= -0.5 * PI {
+        phase += TAU;
+    }
+    let a2 = amplitude * amplitude;
+    let k = dq.ncols();
+    let (mut d_amplitude, mut d_phase) = (Vec::with_capacity(k), Vec::with_capacity(k));
+    for j in 0..k {
+        let (dcs, dcc) = (scale * dq[(0, j)], scale * dq[(1, j)]);
+        d_amplitude.push((cs * dcs + cc * dcc) / amplitude);
+        d_phase.push((cc * dcs - cs * dcc) / a2);
+    }
+    Harmonic {
+        amplitude,
+        phase,
+        d_amplitude,
+        d_phase,
+    }
 }
 
 /// ∂F_c/∂p of the law of `law` (groups α4 = `stiffness`, α6 = `damping`) at indentation δ =
@@ -209,14 +253,18 @@ struct Extended {
     /// ∂b/∂α2 and ∂b/∂Ω of the free region's forcing (the one Hertz and DMT integrate, their
     /// tip force added), `None` when no drive parameter is asked for.
     forcing: [Option<ForcingDerivative>; 2],
+    /// The harmonics demodulated, (ω, ψ) each, the drive's first: the Fourier rows 2h, 2h + 1
+    /// after the model's state integrate W sin(ωτ + ψ) and W cos(ωτ + ψ).
+    harmonics: Vec<(f64, f64)>,
 }
 
 impl Extended {
     fn base(&self) -> usize {
         self.model.dim()
     }
-    fn theta(&self, tau: f64) -> (f64, f64) {
-        (self.model.omega() * tau + self.model.params().drive_phase()).sin_cos()
+    /// The first parameter's row: after the model's state and the Fourier rows.
+    fn first_param(&self) -> usize {
+        self.base() + 2 * self.harmonics.len()
     }
     fn plain(&self, z: &DVector<f64>) -> DVector<f64> {
         z.rows(0, self.base()).into_owned()
@@ -297,7 +345,7 @@ impl Extended {
 
 impl HybridSystem for Extended {
     fn dim(&self) -> usize {
-        self.base() + 2 + self.params.len()
+        self.first_param() + self.params.len()
     }
     fn period(&self) -> f64 {
         HybridSystem::period(&self.model)
@@ -309,26 +357,31 @@ impl HybridSystem for Extended {
         let d = self.base();
         self.model.rhs_slice(mode, tau, &z[..d], &mut dz[..d]);
         let (w, _) = self.tip_pair(z);
-        let (s, c) = self.theta(tau);
-        dz[d] = w * s;
-        dz[d + 1] = w * c;
-        dz[d + 2..].fill(0.0);
+        for (h, (om, psi)) in self.harmonics.iter().enumerate() {
+            let (s, c) = (om * tau + psi).sin_cos();
+            dz[d + 2 * h] = w * s;
+            dz[d + 2 * h + 1] = w * c;
+        }
+        dz[self.first_param()..].fill(0.0);
     }
     fn jacobian(&self, mode: Region, tau: f64, z: &[f64], jac: &mut DMatrix<f64>) {
         let d = self.base();
         // the model's own (2N×2N) block, written by the model into the top-left corner of the
         // larger matrix after zeroing it (its jacobian of a larger matrix)
         self.model.jacobian(mode, tau, &z[..d], jac);
-        let (s, c) = self.theta(tau);
-        for (j, t) in self.model.tip().iter().enumerate() {
-            jac[(d, j)] = t * s;
-            jac[(d + 1, j)] = t * c;
+        for (h, (om, psi)) in self.harmonics.iter().enumerate() {
+            let (s, c) = (om * tau + psi).sin_cos();
+            for (j, t) in self.model.tip().iter().enumerate() {
+                jac[(d + 2 * h, j)] = t * s;
+                jac[(d + 2 * h + 1, j)] = t * c;
+            }
         }
+        let first = self.first_param();
         let mut col = vec![0.0; d];
         for k in 0..self.params.len() {
             self.param_column(mode, tau, &z[..d], k, &mut col);
             for (i, v) in col.iter().enumerate() {
-                jac[(i, d + 2 + k)] = *v;
+                jac[(i, first + k)] = *v;
             }
         }
     }
@@ -345,7 +398,7 @@ impl HybridSystem for Extended {
                 OrbitParam::DriveAmplitude => SweepParam::Alpha2,
                 _ => continue,
             };
-            grad[d + 2 + k] = self
+            grad[self.first_param() + k] = self
                 .model
                 .guard_param_derivative(mode, sweep, tau)
                 .unwrap_or(0.0);
@@ -409,7 +462,49 @@ pub fn orbit_sensitivity(
     params: &[OrbitParam],
     newton: Option<&ShootingOptions>,
 ) -> Result<OrbitSensitivity, SimError> {
+    orbit_sensitivity_component(model, tol, guess, params, newton, None)
+}
+
+/// As [`orbit_sensitivity`], and with `component` = Some(c) also the harmonic of the tip
+/// deflection at the further drive component c's frequency (1-based among
+/// [`crate::params::Params::components`]: the bimodal drive's second, c = 1), ω_c = (p/q) Ω
+/// with ψ_c = θ_c + π/2 (its force F̃ cos(ω_c τ + θ_c) = F̃ sin(ω_c τ + ψ_c)), demodulated over
+/// the drive's common period (a whole number of the component's periods), as
+/// [`crate::analysis::observables::ComponentObservables`] does: A₂, φ₂ and their sensitivities
+/// from a second pair of Fourier integrals of the same extended flow.
+///
+/// # Errors
+/// As [`orbit_sensitivity`]; [`SimError::OutOfRange`] naming `component` when the drive has
+/// no such component.
+pub fn orbit_sensitivity_component(
+    model: &CantileverModel,
+    tol: f64,
+    guess: &DVector<f64>,
+    params: &[OrbitParam],
+    newton: Option<&ShootingOptions>,
+    component: Option<usize>,
+) -> Result<OrbitSensitivity, SimError> {
     let p = model.params();
+    let mut harmonics = vec![(p.omega, p.drive_phase())];
+    if let Some(c) = component {
+        let comp = c
+            .checked_sub(1)
+            .and_then(|i| p.components().nth(i))
+            .ok_or_else(|| {
+                SimError::out_of_range(
+                    "component",
+                    c,
+                    format!(
+                        "1..={}, the further components of the drive",
+                        p.components().count()
+                    ),
+                )
+            })?;
+        harmonics.push((
+            comp.ratio() * p.omega,
+            comp.phase + std::f64::consts::FRAC_PI_2,
+        ));
+    }
     let unsupported = |hint: &'static str| SimError::Unsupported {
         integrator: "adaptive",
         law: model.law().name(),
@@ -460,7 +555,9 @@ pub fn orbit_sensitivity(
         model: model.clone(),
         params: params.to_vec(),
         forcing,
+        harmonics,
     };
+    let first = ext.first_param();
     let (d, k) = (model.dim(), params.len());
     let mut y0 = DVector::zeros(ext.dim());
     y0.rows_mut(0, d).copy_from(&state);
@@ -469,9 +566,14 @@ pub fn orbit_sensitivity(
     let flow = flow_with_jacobian(&mut integ, 0.0, &y0, period)?;
     let big = &flow.jacobian;
     let m = big.view((0, 0), (d, d)).into_owned();
-    let d_map = big.view((0, d + 2), (d, k)).into_owned();
-    let dq_dz = big.view((d, 0), (2, d)).into_owned();
-    let dq_dp = big.view((d, d + 2), (2, k)).into_owned();
+    let d_map = big.view((0, first), (d, k)).into_owned();
+    // the Fourier integrals' total derivatives dq/dp = ∂q/∂z ∂z*/∂p + ∂q/∂p, pair h at rows
+    // d + 2h
+    let dq_of = |h: usize, d_state: &DMatrix<f64>| {
+        let dq_dz = big.view((d + 2 * h, 0), (2, d)).into_owned();
+        let dq_dp = big.view((d + 2 * h, first), (2, k)).into_owned();
+        dq_dz * d_state + dq_dp
+    };
     let i_m = DMatrix::identity(d, d) - &m;
     let sigma_min = i_m
         .clone()
@@ -484,21 +586,14 @@ pub fn orbit_sensitivity(
         iterations: 0,
         residual: sigma_min,
     })?;
-    let dq = &dq_dz * &d_state + dq_dp;
-    let scale = 2.0 / period;
-    let (cs, cc) = (scale * flow.state[d], scale * flow.state[d + 1]);
-    let amplitude = cs.hypot(cc);
-    let mut phase = (-cc).atan2(cs);
-    if phase <= -0.5 * PI {
-        phase += TAU;
-    }
-    let a2 = amplitude * amplitude;
-    let (mut d_amplitude, mut d_phase) = (Vec::with_capacity(k), Vec::with_capacity(k));
-    for j in 0..k {
-        let (dcs, dcc) = (scale * dq[(0, j)], scale * dq[(1, j)]);
-        d_amplitude.push((cs * dcs + cc * dcc) / amplitude);
-        d_phase.push((cc * dcs - cs * dcc) / a2);
-    }
+    let pair = |h: usize| (flow.state[d + 2 * h], flow.state[d + 2 * h + 1]);
+    let Harmonic {
+        amplitude,
+        phase,
+        d_amplitude,
+        d_phase,
+    } = harmonic(pair(0), &dq_of(0, &d_state), period);
+    let component = (component.is_some()).then(|| harmonic(pair(1), &dq_of(1, &d_state), period));
     let mut warnings = Vec::new();
     if sigma_min < FOLD_TOL {
         warnings.push(SensitivityWarning::NearFold { sigma_min });
@@ -521,5 +616,6 @@ pub fn orbit_sensitivity(
         sigma_min,
         grazing_distance,
         warnings,
+        component,
     })
 }
