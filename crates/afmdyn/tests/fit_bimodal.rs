@@ -186,3 +186,83 @@ fn bimodal_beam_sensitivities_are_the_finite_differences() {
     });
     laws(base, 13, "N = 3 beam, bimodal");
 }
+
+// ---- the bimodal curve model (`analysis::fit::bimodal_curve`) ----
+
+use afmdyn::analysis::fit::am_curve::{AmParam, AmProbe};
+use afmdyn::analysis::fit::bimodal_curve::BimodalCurveModel;
+use afmdyn::analysis::fit::CurveModel;
+
+/// The bimodal example probe as the fit's probe.
+fn bimodal_probe() -> AmProbe {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/probe-bimodal.toml");
+    let p = Probe::load(&path).expect("example probe");
+    let s = p.sample_inputs;
+    AmProbe {
+        params: p.params,
+        length_m: p.scales.length_m,
+        youngs_modulus: s.youngs_modulus.expect("E"),
+        poisson_ratio: s.poisson_ratio.expect("ν"),
+        tip: (
+            s.tip_youngs_modulus.expect("E_t"),
+            s.tip_poisson_ratio.expect("ν_t"),
+        ),
+        hamaker: s.hamaker.unwrap_or(0.0),
+        radius: s.radius.expect("R"),
+    }
+}
+
+/// The bimodal model's Jacobian (the exact sensitivities of A₁, φ₁, A₂, φ₂, chained to E, H
+/// and z_offset, in m and deg) against central differences of its values (the stepped
+/// sweep's observables, whose own integration error bounds the agreement: 1e-3, as the AM
+/// model's test takes it), over 10 rows of an approach through contact (z_c = 0.9 → 0.45 A₀).
+#[test]
+fn the_bimodal_models_jacobian_is_its_finite_differences() {
+    let probe = bimodal_probe();
+    let g0 = probe.length_m;
+    let z_offset = 1e-9;
+    let z: Vec<f64> = (0..10)
+        .map(|i| g0 * (0.9 - 0.05 * i as f64) - z_offset)
+        .collect();
+    let params = vec![AmParam::YoungsModulus, AmParam::Hamaker, AmParam::ZOffset];
+    let truth = vec![probe.youngs_modulus, probe.hamaker, z_offset];
+    let model = BimodalCurveModel::new(probe, z, [true, true, true, true], params);
+    let (m, n) = (model.points(), truth.len());
+    assert_eq!(m, 40);
+    let mut v = vec![0.0; m];
+    let mut jac = vec![0.0; m * n];
+    model.evaluate(&truth, &mut v, Some(&mut jac));
+    eprintln!("warnings {:?}", model.warnings());
+    assert!(v.iter().all(|x| x.is_finite()), "{v:?}");
+    for k in 0..n {
+        let h = if k == 2 {
+            1e-4 * g0
+        } else {
+            1e-4 * truth[k].abs()
+        };
+        let (mut up, mut down) = (truth.clone(), truth.clone());
+        up[k] += h;
+        down[k] -= h;
+        let (mut vu, mut vd) = (vec![0.0; m], vec![0.0; m]);
+        model.evaluate(&up, &mut vu, None);
+        model.evaluate(&down, &mut vd, None);
+        // relative to the entry, or to 1e-3 of its channel's largest (a row out of contact
+        // feels E not at all)
+        let mut worst: f64 = 0.0;
+        for c in 0..4 {
+            let rows = c * 10..(c + 1) * 10;
+            let largest = rows
+                .clone()
+                .map(|i| jac[i * n + k].abs())
+                .fold(0.0, f64::max);
+            for i in rows {
+                let fd = (vu[i] - vd[i]) / (2.0 * h);
+                let e = jac[i * n + k];
+                let scale = e.abs().max(fd.abs()).max(1e-3 * largest).max(1e-300);
+                worst = worst.max((e - fd).abs() / scale);
+            }
+        }
+        eprintln!("{}: worst relative gap {worst:.2e}", model.params[k].name());
+        assert!(worst < 1e-3, "{}", model.params[k].name());
+    }
+}

@@ -3,9 +3,11 @@
 //! ([`least_squares`], [`estimates`], [`profile`]), and the quasi-static force-curve fit of the
 //! registry's contact laws ([`force_curve`]); start values from a grid ([`start`]). The
 //! dynamic fits' models: the stepped AM approach ([`am_curve`]) and the FM loop's Δf curve
-//! ([`fm_curve`]), with the exact orbit sensitivities of [`sensitivity`].
+//! ([`fm_curve`]) and the bimodal channels ([`bimodal_curve`]), with the exact orbit
+//! sensitivities of [`sensitivity`].
 
 pub mod am_curve;
+pub mod bimodal_curve;
 pub mod estimates;
 pub mod fm_curve;
 pub mod force_curve;
