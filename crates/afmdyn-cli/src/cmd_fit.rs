@@ -26,7 +26,8 @@ pub struct FitArgs {
     /// columns z (m, the piezo position, in the order stepped), amplitude (m) and/or phase
     /// (deg), optionally sigma_amplitude (m) and sigma_phase (deg); or an FM curve: the columns
     /// z (m) and frequency_shift (Hz), optionally sigma_frequency_shift (Hz), at the probe's
-    /// free amplitude
+    /// free amplitude; or a bimodal curve (a probe with a second drive component): amplitude_2
+    /// (m) and/or phase_2 (deg), with or without amplitude and phase, and their sigma_ columns
     #[arg(long, value_name = "FILE.csv")]
     data: PathBuf,
     /// The parameters fitted, by their probe keys, comma-separated: sample.youngs_modulus,

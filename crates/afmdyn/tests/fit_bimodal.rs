@@ -266,3 +266,79 @@ fn the_bimodal_models_jacobian_is_its_finite_differences() {
         assert!(worst < 1e-3, "{}", model.params[k].name());
     }
 }
+
+/// A bimodal curve's second channels alone (A₂ in m, φ₂ in deg, σ 2 pm and 0.1°, seeded
+/// noise) of the model at the truth (the probe's E and H, z_offset = 1 nm), written as the
+/// door's CSV and fitted through `afmdyn fit`'s request for H and z_offset from the probe's
+/// starts (z_offset's on its grid): the curve holds the data, fit and residuals of A₂ and φ₂,
+/// and the intervals hold the truth.
+#[test]
+fn a_bimodal_csv_goes_through_the_fit_door() {
+    use afmdyn::analysis::progress::Progress;
+    use afmdyn::request::fit::FitRequest;
+    use afmdyn::request::{run, Resolved};
+    let probe = bimodal_probe();
+    let g0 = probe.length_m;
+    let z_offset = 1e-9;
+    let rows = 12;
+    let z: Vec<f64> = (0..rows)
+        .map(|i| g0 * (0.9 - 0.04 * i as f64) - z_offset)
+        .collect();
+    let params = vec![AmParam::Hamaker, AmParam::ZOffset];
+    let model = BimodalCurveModel::new(probe, z.clone(), [false, false, true, true], params);
+    let mut y = vec![0.0; model.points()];
+    model.evaluate(&[probe.hamaker, z_offset], &mut y, None);
+    let sigma: Vec<f64> = (0..2 * rows)
+        .map(|i| if i < rows { 2e-12 } else { 0.1 })
+        .collect();
+    // deterministic noise: a fixed sequence of N(0, 1)-like draws (a sine's values)
+    for (i, (v, s)) in y.iter_mut().zip(&sigma).enumerate() {
+        *v += s * (1.3 * (i as f64 * 2.1).sin());
+    }
+    let dir = std::env::temp_dir().join(format!("afmdyn-fit-bimodal-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let path = dir.join("bimodal.csv");
+    let mut text = String::from("z,amplitude_2,phase_2,sigma_amplitude_2,sigma_phase_2\n");
+    for i in 0..rows {
+        text += &format!(
+            "{:?},{:?},{:?},{:?},{:?}\n",
+            z[i],
+            y[i],
+            y[rows + i],
+            sigma[i],
+            sigma[rows + i]
+        );
+    }
+    std::fs::write(&path, text).expect("csv");
+    let p = Probe::load(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/probe-bimodal.toml"),
+    )
+    .expect("probe");
+    let resolved = Resolved {
+        params: p.params,
+        probe: Some(p),
+    };
+    let request = FitRequest {
+        data: Some(path.display().to_string()),
+        fit: vec!["sample.hamaker".into(), "z_offset".into()],
+        ..FitRequest::default()
+    };
+    let doc = run(&request, &resolved, &Progress::default())
+        .expect("fit")
+        .json;
+    std::fs::remove_dir_all(&dir).ok();
+    eprintln!("{}", doc["estimates"]);
+    assert_eq!(doc["kind"], "am");
+    for (name, t) in [("sample.hamaker", probe.hamaker), ("z_offset", z_offset)] {
+        let e = &doc["estimates"][name];
+        let (lo, hi) = (
+            e["interval"][0].as_f64().unwrap(),
+            e["interval"][1].as_f64().unwrap(),
+        );
+        assert!(lo <= t && t <= hi, "{name}: truth {t} outside [{lo}, {hi}]");
+    }
+    for k in ["amplitude_2", "amplitude_2_fit", "phase_2_residual"] {
+        assert_eq!(doc["curve"][k].as_array().map(Vec::len), Some(rows), "{k}");
+    }
+    assert!(doc["curve"]["amplitude"].is_null());
+}

@@ -6,7 +6,10 @@
 //! columns `z` and `frequency_shift` (Hz), optional `sigma_frequency_shift` (Hz), fitted with
 //! the FM loop's steady states at the probe's free amplitude
 //! ([`crate::analysis::fit::fm_curve`]; the amplitude and phase columns of such a file are
-//! not fitted). The request is [`super::FitRequest`] (the
+//! not fitted); or of a bimodal curve: the columns `amplitude_2` (m) and/or `phase_2` (deg) of
+//! the drive's second component (optional `sigma_amplitude_2`, `sigma_phase_2`), with or
+//! without `amplitude` and `phase`, under a probe whose drive has a second component
+//! ([`crate::analysis::fit::bimodal_curve`]). The request is [`super::FitRequest`] (the
 //! data's columns choose the kind: `z` makes it dynamic); its document has the force-curve
 //! fit's shape (estimates with value, standard error and interval, correlation, χ²/dof, the
 //! curve beside the data with its residuals, warnings).
@@ -15,6 +18,7 @@ use super::fit_result::{bounds, FitResult, MIN_FIT_ROWS};
 pub use super::fit_result::{AmData, DynamicFit};
 use super::run::Resolved;
 use crate::analysis::fit::am_curve::{AmCurveModel, AmParam, AmProbe, Z_OFFSET};
+use crate::analysis::fit::bimodal_curve::BimodalCurveModel;
 use crate::analysis::fit::fm_curve::FmCurveModel;
 use crate::analysis::fit::start::{grid_start, z_offset_grid};
 use crate::analysis::fit::{fit_with, CurveModel, Observations, Parameter};
@@ -24,7 +28,7 @@ use serde_json::{json, Value};
 
 /// The variables of a dynamic fit's curve (name, unit, label): the columns of its table and
 /// Dataset, those of the channels fitted.
-pub const CURVE_VARIABLES: [(&str, &str, &str); 10] = [
+pub const CURVE_VARIABLES: [(&str, &str, &str); 16] = [
     ("z", "m", "piezo position"),
     ("amplitude", "m", "amplitude, measured"),
     ("amplitude_fit", "m", "amplitude, fitted"),
@@ -32,6 +36,20 @@ pub const CURVE_VARIABLES: [(&str, &str, &str); 10] = [
     ("phase", "deg", "phase, measured"),
     ("phase_fit", "deg", "phase, fitted"),
     ("phase_residual", "deg", "measured − fitted phase"),
+    ("amplitude_2", "m", "second component's amplitude, measured"),
+    (
+        "amplitude_2_fit",
+        "m",
+        "second component's amplitude, fitted",
+    ),
+    (
+        "amplitude_2_residual",
+        "m",
+        "measured − fitted second amplitude",
+    ),
+    ("phase_2", "deg", "second component's phase, measured"),
+    ("phase_2_fit", "deg", "second component's phase, fitted"),
+    ("phase_2_residual", "deg", "measured − fitted second phase"),
     ("frequency_shift", "Hz", "frequency shift, measured"),
     ("frequency_shift_fit", "Hz", "frequency shift, fitted"),
     (
@@ -56,6 +74,10 @@ pub fn am_columns(names: &[String], cols: &[Vec<f64>]) -> Option<AmData> {
         sigma_phase: col("sigma_phase"),
         frequency_shift: col("frequency_shift"),
         sigma_frequency_shift: col("sigma_frequency_shift"),
+        amplitude_2: col("amplitude_2"),
+        phase_2: col("phase_2"),
+        sigma_amplitude_2: col("sigma_amplitude_2"),
+        sigma_phase_2: col("sigma_phase_2"),
     })
 }
 
@@ -84,7 +106,8 @@ pub fn read_am_data(data: Option<&str>) -> Result<Option<AmData>, SimError> {
 
 fn check_data(d: &AmData) -> Result<(), SimError> {
     let m = d.z.len();
-    if d.amplitude.is_none() && d.phase.is_none() && d.frequency_shift.is_none() {
+    let bimodal = d.amplitude_2.is_some() || d.phase_2.is_some();
+    if d.amplitude.is_none() && d.phase.is_none() && d.frequency_shift.is_none() && !bimodal {
         return Err(bad(
             "data",
             "no amplitude, phase or frequency_shift column",
@@ -108,6 +131,10 @@ fn check_data(d: &AmData) -> Result<(), SimError> {
         &d.sigma_phase,
         &d.frequency_shift,
         &d.sigma_frequency_shift,
+        &d.amplitude_2,
+        &d.phase_2,
+        &d.sigma_amplitude_2,
+        &d.sigma_phase_2,
     ];
     for c in all.into_iter().flatten() {
         if c.len() != m || c.iter().any(|x| !x.is_finite()) {
@@ -118,11 +145,43 @@ fn check_data(d: &AmData) -> Result<(), SimError> {
             ));
         }
     }
-    let sigmas = [&d.sigma_amplitude, &d.sigma_phase, &d.sigma_frequency_shift];
+    let sigmas = [
+        &d.sigma_amplitude,
+        &d.sigma_phase,
+        &d.sigma_frequency_shift,
+        &d.sigma_amplitude_2,
+        &d.sigma_phase_2,
+    ];
     for s in sigmas.into_iter().flatten() {
         if s.iter().any(|x| *x <= 0.0) {
             return Err(bad("sigma", "≤ 0", "σ must be > 0".into()));
         }
+    }
+    if bimodal && d.frequency_shift.is_some() {
+        return Err(bad(
+            "data",
+            "frequency_shift with amplitude_2 or phase_2",
+            "a curve is an FM curve (frequency_shift) or an AM one (amplitude, phase and the \
+             bimodal amplitude_2, phase_2), not both"
+                .into(),
+        ));
+    }
+    let channels = [
+        (&d.amplitude, &d.sigma_amplitude),
+        (&d.phase, &d.sigma_phase),
+        (&d.amplitude_2, &d.sigma_amplitude_2),
+        (&d.phase_2, &d.sigma_phase_2),
+    ];
+    let fitted = channels.iter().filter(|(c, _)| c.is_some()).count();
+    if bimodal && fitted > 1 && channels.iter().any(|(c, s)| c.is_some() && s.is_none()) {
+        return Err(bad(
+            "sigma",
+            "missing",
+            "fitting several bimodal channels together needs the σ column of each \
+             (sigma_amplitude, sigma_phase, sigma_amplitude_2, sigma_phase_2: their units \
+             differ)"
+                .into(),
+        ));
     }
     if d.frequency_shift.is_none()
         && d.amplitude.is_some()
@@ -248,16 +307,32 @@ pub fn execute(
     } else {
         (data.amplitude.is_some(), data.phase.is_some())
     };
+    let second = (data.amplitude_2.is_some(), data.phase_2.is_some());
+    let bimodal = second.0 || second.1;
+    if bimodal && !probe.params.is_multifrequency() {
+        return Err(bad(
+            "probe",
+            "a single-frequency drive",
+            "the bimodal channels amplitude_2 and phase_2 need a probe whose drive has a second \
+             component ([drive] frequency = [f1, f2], free_amplitude = [A1, A2])"
+                .into(),
+        ));
+    }
     let (z_index, g0) = (
         am.iter().position(|&p| p == AmParam::ZOffset),
         am_probe.length_m,
     );
     let hz = probe.scales.frequency_hz(1.0);
     let fm_model = fm.then(|| FmCurveModel::new(am_probe, data.z.clone(), am.clone(), hz));
+    let bimodal_model = bimodal.then(|| {
+        let on = [channels.0, channels.1, second.0, second.1];
+        BimodalCurveModel::new(am_probe, data.z.clone(), on, am.clone())
+    });
     let am_model = AmCurveModel::new(am_probe, data.z.clone(), channels, am);
-    let curve: &dyn CurveModel = match &fm_model {
-        Some(m) => m,
-        None => &am_model,
+    let curve: &dyn CurveModel = match (&fm_model, &bimodal_model) {
+        (Some(m), _) => m,
+        (None, Some(m)) => m,
+        _ => &am_model,
     };
     let mut y = Vec::new();
     let mut sigma = Vec::new();
@@ -265,6 +340,8 @@ pub fn execute(
     let am_columns = [
         (&data.amplitude, &data.sigma_amplitude),
         (&data.phase, &data.sigma_phase),
+        (&data.amplitude_2, &data.sigma_amplitude_2),
+        (&data.phase_2, &data.sigma_phase_2),
     ];
     for (c, sg) in if fm { &fm_columns[..] } else { &am_columns[..] } {
         if let Some(c) = c {
@@ -289,9 +366,10 @@ pub fn execute(
     // Wald intervals: a profile's refits would cost a hundred stepped approaches (FM curves)
     // each
     let mut outcome = fit_with(curve, &obs, &params, &fixed, false);
-    let model_warnings = match &fm_model {
-        Some(m) => m.warnings(),
-        None => am_model.warnings(),
+    let model_warnings = match (&fm_model, &bimodal_model) {
+        (Some(m), _) => m.warnings(),
+        (None, Some(m)) => m.warnings(),
+        _ => am_model.warnings(),
     };
     outcome.warnings.extend(model_warnings.iter().cloned());
     if fm && (data.amplitude.is_some() || data.phase.is_some()) {
@@ -317,6 +395,7 @@ pub fn execute(
             data,
             channels,
             frequency_shift: fm,
+            second,
             model_warnings,
         }),
     })
@@ -337,6 +416,8 @@ pub fn document(r: &FitResult, d: &DynamicFit, estimates: Value, correlation: Va
     for (name, col, on) in [
         ("amplitude", &d.data.amplitude, d.channels.0),
         ("phase", &d.data.phase, d.channels.1),
+        ("amplitude_2", &d.data.amplitude_2, d.second.0),
+        ("phase_2", &d.data.phase_2, d.second.1),
         (
             "frequency_shift",
             &d.data.frequency_shift,
@@ -391,7 +472,8 @@ pub fn document(r: &FitResult, d: &DynamicFit, estimates: Value, correlation: Va
         "evaluations": o.evaluations,
         "termination": o.termination,
         "units": {"sample.youngs_modulus": "Pa", "tip.radius": "m", "sample.hamaker": "J", "z_offset": "m",
-                  "z": "m", "amplitude": "m", "phase": "deg", "frequency_shift": "Hz"},
+                  "z": "m", "amplitude": "m", "phase": "deg", "frequency_shift": "Hz",
+                  "amplitude_2": "m", "phase_2": "deg"},
         "method": method,
         "warnings": o.warnings,
     })

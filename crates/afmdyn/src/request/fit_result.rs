@@ -64,6 +64,15 @@ pub struct AmData {
     pub frequency_shift: Option<Vec<f64>>,
     /// The frequency shifts' standard deviations (Hz).
     pub sigma_frequency_shift: Option<Vec<f64>>,
+    /// The second drive component's amplitudes A₂ (m) of a bimodal curve (then it is fitted
+    /// by [`crate::analysis::fit::bimodal_curve`]).
+    pub amplitude_2: Option<Vec<f64>>,
+    /// The second component's phases φ₂ (deg).
+    pub phase_2: Option<Vec<f64>>,
+    /// A₂'s standard deviations (m).
+    pub sigma_amplitude_2: Option<Vec<f64>>,
+    /// φ₂'s standard deviations (deg).
+    pub sigma_phase_2: Option<Vec<f64>>,
 }
 
 /// The dynamic fit's part of a [`FitResult`].
@@ -76,6 +85,9 @@ pub struct DynamicFit {
     pub channels: (bool, bool),
     /// Whether the frequency shift was fitted (an FM curve; then `channels` is (false, false)).
     pub frequency_shift: bool,
+    /// Whether the second drive component's amplitude and phase were fitted (a bimodal curve:
+    /// the model's values A₁, φ₁, A₂, φ₂ of the channels fitted, in that order).
+    pub second: (bool, bool),
     /// The last evaluation's warnings of the model (folds, grazing).
     pub model_warnings: Vec<String>,
 }

@@ -136,6 +136,8 @@ fn am_files(p: &mut Presentation, document: &Value, files: Files) {
     for (channel, unit) in [
         ("amplitude", "m"),
         ("phase", "deg"),
+        ("amplitude_2", "m"),
+        ("phase_2", "deg"),
         ("frequency_shift", "Hz"),
     ] {
         let (Some(d), Some(f), Some(r)) = (
