@@ -24,13 +24,16 @@ pub struct FitArgs {
     /// The force curve: a CSV with the columns height (m, the piezo height, decreasing into
     /// the sample), force (N, repulsion positive) and optionally sigma (N); or an AM curve: the
     /// columns z (m, the piezo position, in the order stepped), amplitude (m) and/or phase
-    /// (deg), optionally sigma_amplitude (m) and sigma_phase (deg)
+    /// (deg), optionally sigma_amplitude (m) and sigma_phase (deg); or an FM curve: the columns
+    /// z (m) and frequency_shift (Hz), optionally sigma_frequency_shift (Hz), at the probe's
+    /// free amplitude; or a bimodal curve (a probe with a second drive component): amplitude_2
+    /// (m) and/or phase_2 (deg), with or without amplitude and phase, and their sigma_ columns
     #[arg(long, value_name = "FILE.csv")]
     data: PathBuf,
     /// The parameters fitted, by their probe keys, comma-separated: sample.youngs_modulus,
     /// tip.radius, contact_point, baseline, sample.hamaker (dmt), sample.adhesion_energy (jkr);
-    /// of an AM curve sample.youngs_modulus, sample.hamaker (dmt), tip.radius and z_offset
-    /// (always fitted) [AM default: E, H (dmt), z_offset]
+    /// of an AM or FM curve sample.youngs_modulus, sample.hamaker (dmt), tip.radius and
+    /// z_offset (always fitted) [AM/FM default: E, H (dmt), z_offset]
     #[arg(long, value_delimiter = ',', default_values_t = FitRequest::default().fit)]
     fit: Vec<String>,
     /// The segment fitted: approach (up to the lowest height) or retract

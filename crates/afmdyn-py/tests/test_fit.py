@@ -12,6 +12,7 @@ afmformats, against nanite's fit of the same file."""
 
 from __future__ import annotations
 
+import json
 import warnings
 
 import numpy as np
@@ -170,3 +171,29 @@ def test_a_measured_jpk_curve_fits_as_nanite_fits_it():
     lo = ds["interval_low"].sel(parameter="sample.youngs_modulus").item()
     hi = ds["interval_high"].sel(parameter="sample.youngs_modulus").item()
     assert lo < ref["E"].value < hi
+
+
+def test_a_frequency_shift_curve_fits_against_the_fm_model(tmp_path):
+    """A Δf curve made by ``afmdyn.fm`` (the probe's E and H, z = z_c − 1 nm, 0.2 Hz of seeded
+    noise) is fitted as an FM curve: the Dataset carries the frequency shift's data, fit and
+    residual (Hz) over ``row``, and H and z_offset's 95 % intervals hold the truth."""
+    probe = str(EXAMPLES / "probe-point-mass-dmt.toml")
+    fm = afmdyn.fm(probe=probe, from_=14e-9, to=9.5e-9, points=16)
+    rng = np.random.default_rng(62)
+    z = fm.z_c.values - 1e-9
+    df = fm.frequency_shift.values + 0.2 * rng.standard_normal(z.size)
+    path = tmp_path / "fm.csv"
+    rows = "\n".join(f"{a:.17g},{b:.17g},0.2" for a, b in zip(z, df))
+    path.write_text("z,frequency_shift,sigma_frequency_shift\n" + rows + "\n")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", afmdyn.AfmdynWarning)
+        ds = afmdyn.fit(probe=probe, data=str(path), fit=["sample.hamaker", "z_offset"])
+    assert json.loads(ds.attrs["summary"])["kind"] == "fm"
+    assert ds.frequency_shift.attrs["units"] == "Hz"
+    np.testing.assert_array_equal(ds.frequency_shift.values, df)
+    np.testing.assert_allclose(ds.frequency_shift_residual.values,
+                               df - ds.frequency_shift_fit.values, atol=1e-9)
+    for name, truth in (("sample.hamaker", 6.6e-20), ("z_offset", 1e-9)):
+        lo = ds["interval_low"].sel(parameter=name).item()
+        hi = ds["interval_high"].sel(parameter=name).item()
+        assert lo <= truth <= hi, (name, lo, hi)

@@ -49,6 +49,8 @@ fn with(base: &Params, p: OrbitParam, value: f64) -> Params {
             ContactLaw::Dmt { hamaker, .. } => *hamaker = value,
             _ => panic!("H̃ of a law without it"),
         },
+        OrbitParam::DriveAmplitude => q.alpha2 = value,
+        OrbitParam::DriveFrequency => q.omega = value,
     }
     q
 }
@@ -61,6 +63,8 @@ fn value_of(base: &Params, p: OrbitParam) -> f64 {
             ContactLaw::Dmt { hamaker, .. } => hamaker,
             _ => panic!("H̃ of a law without it"),
         },
+        OrbitParam::DriveAmplitude => base.alpha2,
+        OrbitParam::DriveFrequency => base.omega,
     }
 }
 
@@ -102,7 +106,13 @@ fn check_point(base: &Params, guess: &DVector<f64>, params: &[OrbitParam], what:
     );
     for (j, &p) in params.iter().enumerate() {
         let v = value_of(base, p);
-        let h = STEP * v.abs();
+        // Ω within a small share of the resonance's half linewidth Ω/(2Q) (Q = 400 here),
+        // across which the phase turns by a radian
+        let h = if p == OrbitParam::DriveFrequency {
+            1e-6 * v.abs()
+        } else {
+            STEP * v.abs()
+        };
         // the fourth-order central difference (its truncation error O(h⁴) far below the
         // integration error's ~TOL/h)
         let at = |k: f64| orbit(&with(base, p, v + k * h), &exact.state);
@@ -215,10 +225,13 @@ const DMT_PARAMS: &[OrbitParam] = &[
     OrbitParam::Hamaker,
 ];
 const HERTZ_PARAMS: &[OrbitParam] = &[OrbitParam::Gap, OrbitParam::ContactStiffness];
+/// The drive's α2 and Ω (the FM loop's unknowns): their columns, Ω's by the rescaling of time
+/// to a fixed phase; the N = 3 beam's base drive also moves V_T.
+const DRIVE_PARAMS: &[OrbitParam] = &[OrbitParam::DriveAmplitude, OrbitParam::DriveFrequency];
 
 /// The point mass and the N = 3 beam, DMT (attractive and repulsive) and Hertz (repulsive, and
-/// the point mass's light touch).
-const CASES: [Case; 4] = [
+/// the point mass's light touch); then the drive's parameters on the same four.
+const CASES: [Case; 8] = [
     Case {
         name: "point mass DMT",
         probe: "probe-point-mass-dmt.toml",
@@ -249,6 +262,37 @@ const CASES: [Case; 4] = [
         hertz: true,
         points: 21,
         params: HERTZ_PARAMS,
+        regimes: &[Regime::Repulsive],
+    },    Case {
+        name: "point mass DMT, drive",
+        probe: "probe-point-mass-dmt.toml",
+        hertz: false,
+        points: 41,
+        params: DRIVE_PARAMS,
+        regimes: &[Regime::Attractive, Regime::Repulsive],
+    },
+    Case {
+        name: "point mass Hertz, drive",
+        probe: "probe-point-mass-dmt.toml",
+        hertz: true,
+        points: 41,
+        params: DRIVE_PARAMS,
+        regimes: &[Regime::Repulsive],
+    },
+    Case {
+        name: "N = 3 beam DMT, drive",
+        probe: "probe-beam-dmt.toml",
+        hertz: false,
+        points: 21,
+        params: DRIVE_PARAMS,
+        regimes: &[Regime::Attractive, Regime::Repulsive],
+    },
+    Case {
+        name: "N = 3 beam Hertz, drive",
+        probe: "probe-beam-dmt.toml",
+        hertz: true,
+        points: 21,
+        params: DRIVE_PARAMS,
         regimes: &[Regime::Repulsive],
     },
 ];

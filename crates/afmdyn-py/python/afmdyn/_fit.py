@@ -47,7 +47,9 @@ def _finish_fit(a: Dict[str, Any]) -> xr.Dataset:
         warnings.warn(f"the file's spring constant {k_file:g} N/m differs from the probe's "
                       f"{k:g} N/m: the probe's is used (set [cantilever] spring_constant to "
                       "the file's to use it)", AfmdynWarning, stacklevel=_user_level())
-    ds = xr.merge([dataset(layout) for layout in d["datasets"].values()], combine_attrs="drop_conflicts")
+    # (the variables keep their units and labels; the Dataset's attributes are set below)
+    ds = xr.merge([dataset(layout) for layout in d["datasets"].values()],
+                  combine_attrs="drop_conflicts")
     names = list(doc["estimates"])
     est = [doc["estimates"][n] for n in names]
 

@@ -2,7 +2,14 @@
 //! column `z` (m, the piezo position, in the order the instrument stepped) and any of
 //! `amplitude` (m) and `phase` (deg), with optional `sigma_amplitude` (m) and `sigma_phase`
 //! (deg), fitted with the stepped approach of the probe's model and the exact sensitivities of
-//! its orbits ([`crate::analysis::fit::am_curve`]). The request is [`super::FitRequest`] (the
+//! its orbits ([`crate::analysis::fit::am_curve`]); or of a frequency-modulation curve: the
+//! columns `z` and `frequency_shift` (Hz), optional `sigma_frequency_shift` (Hz), fitted with
+//! the FM loop's steady states at the probe's free amplitude
+//! ([`crate::analysis::fit::fm_curve`]; the amplitude and phase columns of such a file are
+//! not fitted); or of a bimodal curve: the columns `amplitude_2` (m) and/or `phase_2` (deg) of
+//! the drive's second component (optional `sigma_amplitude_2`, `sigma_phase_2`), with or
+//! without `amplitude` and `phase`, under a probe whose drive has a second component
+//! ([`crate::analysis::fit::bimodal_curve`]). The request is [`super::FitRequest`] (the
 //! data's columns choose the kind: `z` makes it dynamic); its document has the force-curve
 //! fit's shape (estimates with value, standard error and interval, correlation, χ²/dof, the
 //! curve beside the data with its residuals, warnings).
@@ -11,15 +18,17 @@ use super::fit_result::{bounds, FitResult, MIN_FIT_ROWS};
 pub use super::fit_result::{AmData, DynamicFit};
 use super::run::Resolved;
 use crate::analysis::fit::am_curve::{AmCurveModel, AmParam, AmProbe, Z_OFFSET};
+use crate::analysis::fit::bimodal_curve::BimodalCurveModel;
+use crate::analysis::fit::fm_curve::FmCurveModel;
 use crate::analysis::fit::start::{grid_start, z_offset_grid};
-use crate::analysis::fit::{fit_with, Observations, Parameter};
+use crate::analysis::fit::{fit_with, CurveModel, Observations, Parameter};
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
 use serde_json::{json, Value};
 
 /// The variables of a dynamic fit's curve (name, unit, label): the columns of its table and
 /// Dataset, those of the channels fitted.
-pub const CURVE_VARIABLES: [(&str, &str, &str); 7] = [
+pub const CURVE_VARIABLES: [(&str, &str, &str); 16] = [
     ("z", "m", "piezo position"),
     ("amplitude", "m", "amplitude, measured"),
     ("amplitude_fit", "m", "amplitude, fitted"),
@@ -27,13 +36,34 @@ pub const CURVE_VARIABLES: [(&str, &str, &str); 7] = [
     ("phase", "deg", "phase, measured"),
     ("phase_fit", "deg", "phase, fitted"),
     ("phase_residual", "deg", "measured − fitted phase"),
+    ("amplitude_2", "m", "second component's amplitude, measured"),
+    (
+        "amplitude_2_fit",
+        "m",
+        "second component's amplitude, fitted",
+    ),
+    (
+        "amplitude_2_residual",
+        "m",
+        "measured − fitted second amplitude",
+    ),
+    ("phase_2", "deg", "second component's phase, measured"),
+    ("phase_2_fit", "deg", "second component's phase, fitted"),
+    ("phase_2_residual", "deg", "measured − fitted second phase"),
+    ("frequency_shift", "Hz", "frequency shift, measured"),
+    ("frequency_shift_fit", "Hz", "frequency shift, fitted"),
+    (
+        "frequency_shift_residual",
+        "Hz",
+        "measured − fitted frequency shift",
+    ),
 ];
 
 fn bad(name: &'static str, value: impl std::fmt::Display, allowed: String) -> SimError {
     SimError::out_of_range(name, value, allowed)
 }
 
-/// The AM columns of a CSV file's `names` and `cols`, `None` without a `z` column.
+/// The AM and FM columns of a CSV file's `names` and `cols`, `None` without a `z` column.
 pub fn am_columns(names: &[String], cols: &[Vec<f64>]) -> Option<AmData> {
     let col = |n: &str| names.iter().position(|c| c == n).map(|i| cols[i].clone());
     Some(AmData {
@@ -42,6 +72,12 @@ pub fn am_columns(names: &[String], cols: &[Vec<f64>]) -> Option<AmData> {
         phase: col("phase"),
         sigma_amplitude: col("sigma_amplitude"),
         sigma_phase: col("sigma_phase"),
+        frequency_shift: col("frequency_shift"),
+        sigma_frequency_shift: col("sigma_frequency_shift"),
+        amplitude_2: col("amplitude_2"),
+        phase_2: col("phase_2"),
+        sigma_amplitude_2: col("sigma_amplitude_2"),
+        sigma_phase_2: col("sigma_phase_2"),
     })
 }
 
@@ -70,18 +106,21 @@ pub fn read_am_data(data: Option<&str>) -> Result<Option<AmData>, SimError> {
 
 fn check_data(d: &AmData) -> Result<(), SimError> {
     let m = d.z.len();
-    if d.amplitude.is_none() && d.phase.is_none() {
+    let bimodal = d.amplitude_2.is_some() || d.phase_2.is_some();
+    if d.amplitude.is_none() && d.phase.is_none() && d.frequency_shift.is_none() && !bimodal {
         return Err(bad(
             "data",
-            "no amplitude or phase column",
-            "an AM curve has the column z (m) and amplitude (m) and/or phase (deg)".into(),
+            "no amplitude, phase or frequency_shift column",
+            "an AM curve has the column z (m) and amplitude (m) and/or phase (deg); an FM \
+             curve z (m) and frequency_shift (Hz)"
+                .into(),
         ));
     }
     if !(MIN_FIT_ROWS..=crate::analysis::stepped::MAX_CURVE_POINTS).contains(&m) {
         return Err(bad(
             "data",
             format!("{m} rows"),
-            format!("an AM curve has {MIN_FIT_ROWS}..=100000 rows"),
+            format!("a dynamic curve has {MIN_FIT_ROWS}..=100000 rows"),
         ));
     }
     let all = [
@@ -90,6 +129,12 @@ fn check_data(d: &AmData) -> Result<(), SimError> {
         &d.phase,
         &d.sigma_amplitude,
         &d.sigma_phase,
+        &d.frequency_shift,
+        &d.sigma_frequency_shift,
+        &d.amplitude_2,
+        &d.phase_2,
+        &d.sigma_amplitude_2,
+        &d.sigma_phase_2,
     ];
     for c in all.into_iter().flatten() {
         if c.len() != m || c.iter().any(|x| !x.is_finite()) {
@@ -100,12 +145,46 @@ fn check_data(d: &AmData) -> Result<(), SimError> {
             ));
         }
     }
-    for s in [&d.sigma_amplitude, &d.sigma_phase].into_iter().flatten() {
+    let sigmas = [
+        &d.sigma_amplitude,
+        &d.sigma_phase,
+        &d.sigma_frequency_shift,
+        &d.sigma_amplitude_2,
+        &d.sigma_phase_2,
+    ];
+    for s in sigmas.into_iter().flatten() {
         if s.iter().any(|x| *x <= 0.0) {
             return Err(bad("sigma", "≤ 0", "σ must be > 0".into()));
         }
     }
-    if d.amplitude.is_some()
+    if bimodal && d.frequency_shift.is_some() {
+        return Err(bad(
+            "data",
+            "frequency_shift with amplitude_2 or phase_2",
+            "a curve is an FM curve (frequency_shift) or an AM one (amplitude, phase and the \
+             bimodal amplitude_2, phase_2), not both"
+                .into(),
+        ));
+    }
+    let channels = [
+        (&d.amplitude, &d.sigma_amplitude),
+        (&d.phase, &d.sigma_phase),
+        (&d.amplitude_2, &d.sigma_amplitude_2),
+        (&d.phase_2, &d.sigma_phase_2),
+    ];
+    let fitted = channels.iter().filter(|(c, _)| c.is_some()).count();
+    if bimodal && fitted > 1 && channels.iter().any(|(c, s)| c.is_some() && s.is_none()) {
+        return Err(bad(
+            "sigma",
+            "missing",
+            "fitting several bimodal channels together needs the σ column of each \
+             (sigma_amplitude, sigma_phase, sigma_amplitude_2, sigma_phase_2: their units \
+             differ)"
+                .into(),
+        ));
+    }
+    if d.frequency_shift.is_none()
+        && d.amplitude.is_some()
         && d.phase.is_some()
         && (d.sigma_amplitude.is_none() || d.sigma_phase.is_none())
     {
@@ -221,18 +300,50 @@ pub fn execute(
             scale,
         });
     }
-    let channels = (data.amplitude.is_some(), data.phase.is_some());
+    // z and frequency_shift make an FM curve (its amplitude and phase columns not fitted)
+    let fm = data.frequency_shift.is_some();
+    let channels = if fm {
+        (false, false)
+    } else {
+        (data.amplitude.is_some(), data.phase.is_some())
+    };
+    let second = (data.amplitude_2.is_some(), data.phase_2.is_some());
+    let bimodal = second.0 || second.1;
+    if bimodal && !probe.params.is_multifrequency() {
+        return Err(bad(
+            "probe",
+            "a single-frequency drive",
+            "the bimodal channels amplitude_2 and phase_2 need a probe whose drive has a second \
+             component ([drive] frequency = [f1, f2], free_amplitude = [A1, A2])"
+                .into(),
+        ));
+    }
     let (z_index, g0) = (
         am.iter().position(|&p| p == AmParam::ZOffset),
         am_probe.length_m,
     );
-    let curve = AmCurveModel::new(am_probe, data.z.clone(), channels, am);
+    let hz = probe.scales.frequency_hz(1.0);
+    let fm_model = fm.then(|| FmCurveModel::new(am_probe, data.z.clone(), am.clone(), hz));
+    let bimodal_model = bimodal.then(|| {
+        let on = [channels.0, channels.1, second.0, second.1];
+        BimodalCurveModel::new(am_probe, data.z.clone(), on, am.clone())
+    });
+    let am_model = AmCurveModel::new(am_probe, data.z.clone(), channels, am);
+    let curve: &dyn CurveModel = match (&fm_model, &bimodal_model) {
+        (Some(m), _) => m,
+        (None, Some(m)) => m,
+        _ => &am_model,
+    };
     let mut y = Vec::new();
     let mut sigma = Vec::new();
-    for (c, sg) in [
+    let fm_columns = [(&data.frequency_shift, &data.sigma_frequency_shift)];
+    let am_columns = [
         (&data.amplitude, &data.sigma_amplitude),
         (&data.phase, &data.sigma_phase),
-    ] {
+        (&data.amplitude_2, &data.sigma_amplitude_2),
+        (&data.phase_2, &data.sigma_phase_2),
+    ];
+    for (c, sg) in if fm { &fm_columns[..] } else { &am_columns[..] } {
         if let Some(c) = c {
             y.extend_from_slice(c);
             if let Some(sg) = sg {
@@ -250,12 +361,24 @@ pub fn execute(
     // z_offset's start: the best χ² on a grid (the model's first rows otherwise follow another
     // branch than the data's, and Levenberg–Marquardt stops in that local minimum)
     if let Some(k) = z_index {
-        params[k].start = grid_start(&curve, &obs, &params, k, z_offset_grid(g0), progress)?;
+        params[k].start = grid_start(curve, &obs, &params, k, z_offset_grid(g0), progress)?;
     }
-    // Wald intervals: a profile's refits would cost a hundred stepped approaches each
-    let mut outcome = fit_with(&curve, &obs, &params, &fixed, false);
-    let model_warnings = curve.warnings();
+    // Wald intervals: a profile's refits would cost a hundred stepped approaches (FM curves)
+    // each
+    let mut outcome = fit_with(curve, &obs, &params, &fixed, false);
+    let model_warnings = match (&fm_model, &bimodal_model) {
+        (Some(m), _) => m.warnings(),
+        (None, Some(m)) => m.warnings(),
+        _ => am_model.warnings(),
+    };
     outcome.warnings.extend(model_warnings.iter().cloned());
+    if fm && (data.amplitude.is_some() || data.phase.is_some()) {
+        outcome.warnings.push(
+            "the data have a frequency_shift column: fitted as an FM curve (the loop holds the \
+             probe's free amplitude); their amplitude and phase columns are not fitted"
+                .into(),
+        );
+    }
     let names: Vec<&'static str> = params
         .iter()
         .map(|p| AmParam::from_name(&p.name).map_or("", AmParam::name))
@@ -271,6 +394,8 @@ pub fn execute(
         dynamic: Some(DynamicFit {
             data,
             channels,
+            frequency_shift: fm,
+            second,
             model_warnings,
         }),
     })
@@ -279,8 +404,9 @@ pub fn execute(
 /// The document of a dynamic fit (the force-curve fit's shape, [`super::fit::document`]):
 /// `estimates`, `parameters`, `correlation`, `chi2`, `dof`, `chi2_dof`, `noise`, `curve` (z and,
 /// per channel, the data, the fit and the residual: `amplitude`, `amplitude_fit`,
-/// `amplitude_residual`, `phase`, …), `preprocessing` (none; the lever's `spring_constant`),
-/// `kind` = `"am"`, `law`, `units`, `method`, `warnings`.
+/// `amplitude_residual`, `phase`, …, or `frequency_shift`, `frequency_shift_fit`,
+/// `frequency_shift_residual` (Hz)), `preprocessing` (none; the lever's `spring_constant`),
+/// `kind` = `"am"` or `"fm"`, `law`, `units`, `method`, `warnings`.
 pub fn document(r: &FitResult, d: &DynamicFit, estimates: Value, correlation: Value) -> Value {
     let o = &r.outcome;
     let m = d.data.z.len();
@@ -290,6 +416,13 @@ pub fn document(r: &FitResult, d: &DynamicFit, estimates: Value, correlation: Va
     for (name, col, on) in [
         ("amplitude", &d.data.amplitude, d.channels.0),
         ("phase", &d.data.phase, d.channels.1),
+        ("amplitude_2", &d.data.amplitude_2, d.second.0),
+        ("phase_2", &d.data.phase_2, d.second.1),
+        (
+            "frequency_shift",
+            &d.data.frequency_shift,
+            d.frequency_shift,
+        ),
     ] {
         if !on {
             continue;
@@ -306,8 +439,22 @@ pub fn document(r: &FitResult, d: &DynamicFit, estimates: Value, correlation: Va
     for (i, n) in r.names.iter().enumerate() {
         parameters.insert((*n).into(), json!({"value": o.values[i], "fitted": true}));
     }
+    let fm = d.frequency_shift;
+    let (kind, steps, method) = if fm {
+        (
+            "fm",
+            "none: z and the frequency shift as measured; z_c = z + z_offset; the amplitude setpoint the probe's free amplitude",
+            "Wald intervals (±1.96 standard errors; no profiles: each refit is an FM curve); weighted least squares by Levenberg–Marquardt (MINPACK lmder, rust-cv levenberg-marquardt) of the FM curve the instrument recorded (an ideal PLL and amplitude controller: each row's orbit at the drive frequency and excitation that hold the first harmonic at the probe's free amplitude and the free lever's phase at resonance, followed from row to row as afmdyn fm does, z_c = z + z_offset; Δf = Ω − ω₁), with exact sensitivities: the implicit function theorem on the loop conditions, d(Ω, α2)/dp = −[∂g/∂(Ω, α2)]⁻¹ ∂g/∂p, from the orbits' sensitivities (variational equations extended by the parameters and the drive's α2 and Ω, time rescaled to a fixed phase; ∂x*/∂p = (I − M)⁻¹ ∂P/∂p) (docs/afm-workflow.md, From data to properties)",
+        )
+    } else {
+        (
+            "am",
+            "none: z, amplitude and phase as measured; z_c = z + z_offset",
+            "Wald intervals (±1.96 standard errors; no profiles: each refit is a stepped approach); weighted least squares by Levenberg–Marquardt (MINPACK lmder, rust-cv levenberg-marquardt) of the stepped approach the instrument did (each row's periodic orbit continued from the previous one, z_c = z + z_offset), with the exact sensitivities of the orbits: the variational equations extended by the parameter columns, saltation at the switchings, ∂x*/∂p = (I − M)⁻¹ ∂P/∂p (docs/afm-workflow.md, From data to properties)",
+        )
+    };
     json!({
-        "kind": "am",
+        "kind": kind,
         "estimates": estimates,
         "parameters": parameters,
         "correlation": correlation,
@@ -317,7 +464,7 @@ pub fn document(r: &FitResult, d: &DynamicFit, estimates: Value, correlation: Va
         "noise": if o.noise_estimated { "noise estimated from residuals (no sigma column)" } else { "the sigma columns (χ² in units of σ)" },
         "curve": curve,
         "preprocessing": {
-            "steps": ["none: z, amplitude and phase as measured; z_c = z + z_offset"],
+            "steps": [steps],
             "spring_constant": r.spring_constant,
         },
         "law": r.law.name(),
@@ -325,8 +472,9 @@ pub fn document(r: &FitResult, d: &DynamicFit, estimates: Value, correlation: Va
         "evaluations": o.evaluations,
         "termination": o.termination,
         "units": {"sample.youngs_modulus": "Pa", "tip.radius": "m", "sample.hamaker": "J", "z_offset": "m",
-                  "z": "m", "amplitude": "m", "phase": "deg"},
-        "method": "Wald intervals (±1.96 standard errors; no profiles: each refit is a stepped approach); weighted least squares by Levenberg–Marquardt (MINPACK lmder, rust-cv levenberg-marquardt) of the stepped approach the instrument did (each row's periodic orbit continued from the previous one, z_c = z + z_offset), with the exact sensitivities of the orbits: the variational equations extended by the parameter columns, saltation at the switchings, ∂x*/∂p = (I − M)⁻¹ ∂P/∂p (docs/afm-workflow.md, From data to properties)",
+                  "z": "m", "amplitude": "m", "phase": "deg", "frequency_shift": "Hz",
+                  "amplitude_2": "m", "phase_2": "deg"},
+        "method": method,
         "warnings": o.warnings,
     })
 }

@@ -1,5 +1,5 @@
 //! What the force-curve fit ([`super::fit`]) and the dynamic fit ([`super::fit_dynamic`])
-//! share: the result of a `fit` request, the data of an AM curve, the fewest rows and the
+//! share: the result of a `fit` request, the data of an AM or FM curve, the fewest rows and the
 //! fitted quantities' physical ranges.
 
 use crate::analysis::fit::force_curve::{ForceLaw, Preprocessed};
@@ -40,12 +40,13 @@ pub struct FitResult {
     pub fitted: Vec<bool>,
     /// The fit.
     pub outcome: FitOutcome,
-    /// The dynamic fit's data and channels, when the data are an AM curve
+    /// The dynamic fit's data and channels, when the data are an AM or FM curve
     /// ([`super::fit_dynamic`]; then `curve` and `rows` are empty).
     pub dynamic: Option<DynamicFit>,
 }
 
-/// A measured AM curve's columns.
+/// A measured dynamic curve's columns: an AM curve (amplitude and/or phase) or an FM curve
+/// (frequency shift).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct AmData {
     /// The piezo positions z (m).
@@ -58,6 +59,20 @@ pub struct AmData {
     pub sigma_amplitude: Option<Vec<f64>>,
     /// The phases' standard deviations (deg).
     pub sigma_phase: Option<Vec<f64>>,
+    /// The frequency shifts Δf (Hz) of an FM curve (then the curve is fitted as one, by
+    /// [`crate::analysis::fit::fm_curve`]).
+    pub frequency_shift: Option<Vec<f64>>,
+    /// The frequency shifts' standard deviations (Hz).
+    pub sigma_frequency_shift: Option<Vec<f64>>,
+    /// The second drive component's amplitudes A₂ (m) of a bimodal curve (then it is fitted
+    /// by [`crate::analysis::fit::bimodal_curve`]).
+    pub amplitude_2: Option<Vec<f64>>,
+    /// The second component's phases φ₂ (deg).
+    pub phase_2: Option<Vec<f64>>,
+    /// A₂'s standard deviations (m).
+    pub sigma_amplitude_2: Option<Vec<f64>>,
+    /// φ₂'s standard deviations (deg).
+    pub sigma_phase_2: Option<Vec<f64>>,
 }
 
 /// The dynamic fit's part of a [`FitResult`].
@@ -65,8 +80,14 @@ pub struct AmData {
 pub struct DynamicFit {
     /// The data.
     pub data: AmData,
-    /// The model's values at the estimates (amplitudes, then phases, as fitted).
+    /// Whether the amplitude and the phase were fitted (an AM curve: the model's values the
+    /// amplitudes, then the phases).
     pub channels: (bool, bool),
+    /// Whether the frequency shift was fitted (an FM curve; then `channels` is (false, false)).
+    pub frequency_shift: bool,
+    /// Whether the second drive component's amplitude and phase were fitted (a bimodal curve:
+    /// the model's values A₁, φ₁, A₂, φ₂ of the channels fitted, in that order).
+    pub second: (bool, bool),
     /// The last evaluation's warnings of the model (folds, grazing).
     pub model_warnings: Vec<String>,
 }

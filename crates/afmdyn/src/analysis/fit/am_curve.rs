@@ -145,9 +145,18 @@ impl AmCurveModel {
     /// The parameters at `p` (SI, the model's order), z_offset, and ∂α4/∂E_s, ∂H̃/∂H,
     /// ∂α5/∂z_offset, ∂α4/∂R, ∂H̃/∂R.
     fn scaled(&self, p: &[f64]) -> (Params, f64, [f64; 5]) {
-        let pr = &self.probe;
+        scaled(&self.probe, &self.params, p)
+    }
+}
+
+/// The model's parameters of `probe` with `params` at `p` (SI, in the order of `params`; the
+/// others at the probe's values), z_offset (m), and the chain factors ∂α4/∂E_s, ∂H̃/∂H,
+/// ∂α5/∂z_offset, ∂α4/∂R, ∂H̃/∂R (module docs).
+pub fn scaled(probe: &AmProbe, params: &[AmParam], p: &[f64]) -> (Params, f64, [f64; 5]) {
+    {
+        let pr = probe;
         let get = |a: AmParam, default: f64| {
-            self.params
+            params
                 .iter()
                 .position(|q| *q == a)
                 .map_or(default, |j| p[j])
@@ -173,7 +182,9 @@ impl AmCurveModel {
         }
         (q, z_offset, [de, dh, 1.0 / pr.length_m, dr4, drh])
     }
+}
 
+impl AmCurveModel {
     fn evaluate_checked(
         &self,
         p: &[f64],

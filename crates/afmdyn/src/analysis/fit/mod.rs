@@ -1,10 +1,15 @@
 //! Fitting measured curves (issue 62): weighted least squares by Levenberg–Marquardt with
 //! standard errors, correlations, profile-likelihood intervals and identifiability warnings
 //! ([`least_squares`], [`estimates`], [`profile`]), and the quasi-static force-curve fit of the
-//! registry's contact laws ([`force_curve`]); start values from a grid ([`start`]).
+//! registry's contact laws ([`force_curve`]); start values from a grid ([`start`]). The
+//! dynamic fits' models: the stepped AM approach ([`am_curve`]) and the FM loop's Δf curve
+//! ([`fm_curve`]) and the bimodal channels ([`bimodal_curve`]), with the exact orbit
+//! sensitivities of [`sensitivity`].
 
 pub mod am_curve;
+pub mod bimodal_curve;
 pub mod estimates;
+pub mod fm_curve;
 pub mod force_curve;
 pub mod least_squares;
 pub mod profile;

@@ -15,6 +15,23 @@
 //! * DMT is linear in H̃ (Derjaguin, Muller & Toporov, *J. Colloid Interface Sci.* 53 (1975)
 //!   314: −H̃/(ã₀ + V_T)² outside contact, −H̃/ã₀² in it), so ∂F_c/∂H̃ is that force at H̃ = 1.
 //!
+//! # The drive
+//! The FM loop's unknowns ([`super::fm_curve`]) are the drive's α2 and Ω:
+//! * α2 enters the forcing b(τ) = b₀ + b_s sin Ωτ + b_c cos Ωτ linearly
+//!   ([`CantileverModel::forcing_derivative`]) and, on the base-driven beam, the tip force
+//!   through V_T = W + α2 sin Ωτ + α5 and V̇_T = W' + α2 Ω cos Ωτ (eq. 8), so its column is
+//!   ∂b/∂α2 + M⁻¹φ (−∂F_c/∂δ sin Ωτ − ∂F_c/∂δ̇ Ω cos Ωτ) there (the point mass's V_T has no
+//!   drive term); the guard σV_T moves by σ sin Ωτ.
+//! * Ω moves the period T = 2π/Ω. Rescaling time to the phase s = Ωτ fixes the period at 2π
+//!   (the normalisation of a periodic orbit of unknown period: Seydel, *Practical Bifurcation
+//!   and Stability Analysis*, Springer 2010, ch. 7): dz/ds = f(s/Ω, z; Ω)/Ω, with f depending
+//!   on τ through Ωτ alone. Differentiating at fixed s and returning to τ, y = ∂z/∂Ω|_s obeys
+//!   y' = J y − f/Ω + ∂f/∂Ω|_{Ωτ} over τ ∈ [0, T]: the column is −f/Ω plus the forcing
+//!   coefficients' ∂b/∂Ω and the tip force's through V̇_T's α2 Ω cos Ωτ (−∂F_c/∂δ̇ α2 cos Ωτ);
+//!   the guard does not move with Ω at fixed s. The Fourier coefficients c_s =
+//!   (1/π)∫₀^{2π} W sin(s + ψ) ds then change by (2/T)∫₀^T (∂W/∂Ω|_s) sin θ dτ: the Fourier
+//!   rows take no column of their own for Ω, and dc = (2/T) dq holds for every parameter.
+//!
 //! The adaptive integrator's variational equations of the extended system
 //! ([`crate::integrate::adaptive`]; Hairer, Nørsett & Wanner, *Solving ODEs I*, §I.14: with
 //! p as a state, the parameter columns of Φ obey d/dτ(∂x/∂p) = J ∂x/∂p + ∂f/∂p from 0) and the
@@ -49,7 +66,7 @@ use crate::contact::{ContactLaw, DmtLaw, HertzLaw, Law, TipSample, TipSampleLaw}
 use crate::error::SimError;
 use crate::integrate::adaptive::Adaptive;
 use crate::maps::flow::flow_with_jacobian;
-use crate::model::CantileverModel;
+use crate::model::{CantileverModel, ForcingDerivative};
 use crate::params::SweepParam;
 use crate::system::{Guard, HybridSystem, Jump, Region};
 use crate::tip_sample::TipSampleSystem;
@@ -71,6 +88,12 @@ pub enum OrbitParam {
     ContactStiffness,
     /// H̃, DMT's van der Waals group (∝ H R).
     Hamaker,
+    /// α2, the drive's amplitude (the base's, or the tip force's of the point mass): it enters
+    /// the forcing linearly and, on the base-driven beam, the gap V_T (eq. 8).
+    DriveAmplitude,
+    /// Ω, the drive's frequency, with the period T = 2π/Ω moving with it (the orbit's
+    /// sensitivity at a fixed phase Ωτ; module docs, *The drive*).
+    DriveFrequency,
 }
 
 /// Why a sensitivity is not to be trusted.
@@ -131,11 +154,56 @@ pub struct OrbitSensitivity {
     pub grazing_distance: f64,
     /// Near a fold or grazing.
     pub warnings: Vec<SensitivityWarning>,
+    /// The harmonic of the tip deflection at a further drive component's frequency, when asked
+    /// for ([`orbit_sensitivity_component`]: a bimodal drive's A₂, φ₂).
+    pub component: Option<Harmonic>,
+}
+
+/// A harmonic A sin(ω_c τ + ψ_c − φ) of the tip deflection over the orbit's period, with its
+/// exact parameter sensitivities.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Harmonic {
+    /// A (g₀).
+    pub amplitude: f64,
+    /// φ, the lag behind the component's drive (rad, in (−π/2, 3π/2]).
+    pub phase: f64,
+    /// ∂A/∂p, shape `[k]`.
+    pub d_amplitude: Vec<f64>,
+    /// ∂φ/∂p (rad per unit p), shape `[k]`.
+    pub d_phase: Vec<f64>,
+}
+
+/// The harmonic of the Fourier integrals (q_s, q_c) over the period `period` and of their total
+/// derivatives `dq` (2 × k): c_s = (2/T) q_s = A cos φ, c_c = (2/T) q_c = −A sin φ (module
+/// docs).
+fn harmonic(q: (f64, f64), dq: &DMatrix<f64>, period: f64) -> Harmonic {
+    let scale = 2.0 / period;
+    let (cs, cc) = (scale * q.0, scale * q.1);
+    let amplitude = cs.hypot(cc);
+    let mut phase = (-cc).atan2(cs);
+    if phase <= -0.5 * PI {
+        phase += TAU;
+    }
+    let a2 = amplitude * amplitude;
+    let k = dq.ncols();
+    let (mut d_amplitude, mut d_phase) = (Vec::with_capacity(k), Vec::with_capacity(k));
+    for j in 0..k {
+        let (dcs, dcc) = (scale * dq[(0, j)], scale * dq[(1, j)]);
+        d_amplitude.push((cs * dcs + cc * dcc) / amplitude);
+        d_phase.push((cc * dcs - cs * dcc) / a2);
+    }
+    Harmonic {
+        amplitude,
+        phase,
+        d_amplitude,
+        d_phase,
+    }
 }
 
 /// ∂F_c/∂p of the law of `law` (groups α4 = `stiffness`, α6 = `damping`) at indentation δ =
 /// `delta`, rate δ̇ = `rate`, in or out of contact (module docs). `None` for a law other than
-/// Hertz and DMT, and for H̃ of Hertz.
+/// Hertz and DMT, for H̃ of Hertz, and for the drive's α2 and Ω (which move δ and δ̇ with the
+/// drive's phase: the extended system forms their columns).
 pub fn d_force(
     law: &ContactLaw,
     stiffness: f64,
@@ -172,6 +240,7 @@ pub fn d_force(
             .force(0.0, 0.0, contact, delta, 0.0)
             .force
         }
+        OrbitParam::DriveAmplitude | OrbitParam::DriveFrequency => return None,
     })
 }
 
@@ -181,14 +250,21 @@ pub fn d_force(
 struct Extended {
     model: CantileverModel,
     params: Vec<OrbitParam>,
+    /// ∂b/∂α2 and ∂b/∂Ω of the free region's forcing (the one Hertz and DMT integrate, their
+    /// tip force added), `None` when no drive parameter is asked for.
+    forcing: [Option<ForcingDerivative>; 2],
+    /// The harmonics demodulated, (ω, ψ) each, the drive's first: the Fourier rows 2h, 2h + 1
+    /// after the model's state integrate W sin(ωτ + ψ) and W cos(ωτ + ψ).
+    harmonics: Vec<(f64, f64)>,
 }
 
 impl Extended {
     fn base(&self) -> usize {
         self.model.dim()
     }
-    fn theta(&self, tau: f64) -> (f64, f64) {
-        (self.model.omega() * tau + self.model.params().drive_phase()).sin_cos()
+    /// The first parameter's row: after the model's state and the Fourier rows.
+    fn first_param(&self) -> usize {
+        self.base() + 2 * self.harmonics.len()
     }
     fn plain(&self, z: &DVector<f64>) -> DVector<f64> {
         z.rows(0, self.base()).into_owned()
@@ -200,6 +276,54 @@ impl Extended {
         let dot = |x: &[f64]| tip.iter().zip(x).map(|(a, b)| a * b).sum::<f64>();
         (dot(&z[..n]), dot(&z[n..2 * n]))
     }
+    /// The column ∂f/∂p_k of the model's rows (2N) at (τ, z) in `mode`: M⁻¹φ ∂F_c/∂p for the
+    /// law's parameters; for the drive's, the forcing's derivative plus the tip force's through
+    /// V_T and V̇_T, and for Ω at a fixed phase also −f/Ω (module docs, *The drive*).
+    fn param_column(&self, mode: Region, tau: f64, z: &[f64], k: usize, out: &mut [f64]) {
+        let m = &self.model;
+        let n = m.modes();
+        out.fill(0.0);
+        let param = self.params[k];
+        let df = match param {
+            OrbitParam::DriveAmplitude | OrbitParam::DriveFrequency => {
+                let p = m.params();
+                let om = m.omega();
+                let (s, c) = (om * tau).sin_cos();
+                let fd = &self.forcing[usize::from(param == OrbitParam::DriveFrequency)];
+                if let Some(fd) = fd {
+                    for (i, o) in out.iter_mut().enumerate() {
+                        *o = fd.b_const[i] + s * fd.b_sin[i] + c * fd.b_cos[i];
+                    }
+                }
+                let (w, wd) = self.tip_pair(z);
+                let [v, vd, _] = m.v_t_from_tip(tau, [w, wd, 0.0]);
+                let law = TipSample {
+                    law: p.contact_law,
+                    stiffness: p.alpha4,
+                    damping: p.alpha6,
+                };
+                let f = law.force(mode == Region::Contact, -v, -vd);
+                // δ = −V_T, δ̇ = −V̇_T with V_T = W + b sin Ωτ + α5 and V̇_T = W' + b Ω cos Ωτ
+                // (b = α2 on the base-driven beam, 0 under a tip force)
+                let unit = p.with(SweepParam::Alpha2, 1.0).base_amplitude();
+                if param == OrbitParam::DriveAmplitude {
+                    -f.d_delta * unit * s - f.d_rate * unit * om * c
+                } else {
+                    let mut rhs = vec![0.0; m.dim()];
+                    m.rhs_slice(mode, tau, z, &mut rhs);
+                    for (o, r) in out.iter_mut().zip(&rhs) {
+                        *o -= r / om;
+                    }
+                    -f.d_rate * p.base_amplitude() * c
+                }
+            }
+            _ => self.d_force(mode, tau, z, k),
+        };
+        for (o, mob) in out[n..].iter_mut().zip(m.tip_mobility().iter()) {
+            *o += mob * df;
+        }
+    }
+
     /// ∂F_c/∂p_k at (τ, z) in `mode`.
     fn d_force(&self, mode: Region, tau: f64, z: &[f64], k: usize) -> f64 {
         let m = &self.model;
@@ -221,7 +345,7 @@ impl Extended {
 
 impl HybridSystem for Extended {
     fn dim(&self) -> usize {
-        self.base() + 2 + self.params.len()
+        self.first_param() + self.params.len()
     }
     fn period(&self) -> f64 {
         HybridSystem::period(&self.model)
@@ -233,26 +357,31 @@ impl HybridSystem for Extended {
         let d = self.base();
         self.model.rhs_slice(mode, tau, &z[..d], &mut dz[..d]);
         let (w, _) = self.tip_pair(z);
-        let (s, c) = self.theta(tau);
-        dz[d] = w * s;
-        dz[d + 1] = w * c;
-        dz[d + 2..].fill(0.0);
+        for (h, (om, psi)) in self.harmonics.iter().enumerate() {
+            let (s, c) = (om * tau + psi).sin_cos();
+            dz[d + 2 * h] = w * s;
+            dz[d + 2 * h + 1] = w * c;
+        }
+        dz[self.first_param()..].fill(0.0);
     }
     fn jacobian(&self, mode: Region, tau: f64, z: &[f64], jac: &mut DMatrix<f64>) {
         let d = self.base();
-        let n = self.model.modes();
         // the model's own (2N×2N) block, written by the model into the top-left corner of the
         // larger matrix after zeroing it (its jacobian of a larger matrix)
         self.model.jacobian(mode, tau, &z[..d], jac);
-        let (s, c) = self.theta(tau);
-        for (j, t) in self.model.tip().iter().enumerate() {
-            jac[(d, j)] = t * s;
-            jac[(d + 1, j)] = t * c;
+        for (h, (om, psi)) in self.harmonics.iter().enumerate() {
+            let (s, c) = (om * tau + psi).sin_cos();
+            for (j, t) in self.model.tip().iter().enumerate() {
+                jac[(d + 2 * h, j)] = t * s;
+                jac[(d + 2 * h + 1, j)] = t * c;
+            }
         }
+        let first = self.first_param();
+        let mut col = vec![0.0; d];
         for k in 0..self.params.len() {
-            let df = self.d_force(mode, tau, &z[..d], k);
-            for (i, m) in self.model.tip_mobility().iter().enumerate() {
-                jac[(n + i, d + 2 + k)] = m * df;
+            self.param_column(mode, tau, &z[..d], k, &mut col);
+            for (i, v) in col.iter().enumerate() {
+                jac[(i, first + k)] = *v;
             }
         }
     }
@@ -262,12 +391,17 @@ impl HybridSystem for Extended {
         let mut grad = DVector::zeros(self.dim());
         grad.rows_mut(0, d).copy_from(&g.grad);
         for (k, p) in self.params.iter().enumerate() {
-            if *p == OrbitParam::Gap {
-                grad[d + 2 + k] = self
-                    .model
-                    .guard_param_derivative(mode, SweepParam::Alpha5, tau)
-                    .unwrap_or(0.0);
-            }
+            // the guard σV_T moves with α5 and, on the base-driven beam, with α2; at a fixed
+            // phase Ωτ it does not move with Ω
+            let sweep = match p {
+                OrbitParam::Gap => SweepParam::Alpha5,
+                OrbitParam::DriveAmplitude => SweepParam::Alpha2,
+                _ => continue,
+            };
+            grad[self.first_param() + k] = self
+                .model
+                .guard_param_derivative(mode, sweep, tau)
+                .unwrap_or(0.0);
         }
         Guard {
             value: g.value,
@@ -328,7 +462,49 @@ pub fn orbit_sensitivity(
     params: &[OrbitParam],
     newton: Option<&ShootingOptions>,
 ) -> Result<OrbitSensitivity, SimError> {
+    orbit_sensitivity_component(model, tol, guess, params, newton, None)
+}
+
+/// As [`orbit_sensitivity`], and with `component` = Some(c) also the harmonic of the tip
+/// deflection at the further drive component c's frequency (1-based among
+/// [`crate::params::Params::components`]: the bimodal drive's second, c = 1), ω_c = (p/q) Ω
+/// with ψ_c = θ_c + π/2 (its force F̃ cos(ω_c τ + θ_c) = F̃ sin(ω_c τ + ψ_c)), demodulated over
+/// the drive's common period (a whole number of the component's periods), as
+/// [`crate::analysis::observables::ComponentObservables`] does: A₂, φ₂ and their sensitivities
+/// from a second pair of Fourier integrals of the same extended flow.
+///
+/// # Errors
+/// As [`orbit_sensitivity`]; [`SimError::OutOfRange`] naming `component` when the drive has
+/// no such component.
+pub fn orbit_sensitivity_component(
+    model: &CantileverModel,
+    tol: f64,
+    guess: &DVector<f64>,
+    params: &[OrbitParam],
+    newton: Option<&ShootingOptions>,
+    component: Option<usize>,
+) -> Result<OrbitSensitivity, SimError> {
     let p = model.params();
+    let mut harmonics = vec![(p.omega, p.drive_phase())];
+    if let Some(c) = component {
+        let comp = c
+            .checked_sub(1)
+            .and_then(|i| p.components().nth(i))
+            .ok_or_else(|| {
+                SimError::out_of_range(
+                    "component",
+                    c,
+                    format!(
+                        "1..={}, the further components of the drive",
+                        p.components().count()
+                    ),
+                )
+            })?;
+        harmonics.push((
+            comp.ratio() * p.omega,
+            comp.phase + std::f64::consts::FRAC_PI_2,
+        ));
+    }
     let unsupported = |hint: &'static str| SimError::Unsupported {
         integrator: "adaptive",
         law: model.law().name(),
@@ -361,10 +537,27 @@ pub fn orbit_sensitivity(
         }
         None => (guess.clone(), f64::INFINITY),
     };
+    let drive = [OrbitParam::DriveAmplitude, OrbitParam::DriveFrequency];
+    if p.is_multifrequency() && params.iter().any(|q| drive.contains(q)) {
+        return Err(unsupported(
+            "the drive's sensitivities are taken for a single-frequency drive",
+        ));
+    }
+    // the free region's forcing derivatives (Hertz and DMT integrate region I's dynamics)
+    let forcing = [SweepParam::Alpha2, SweepParam::Omega].map(|q| {
+        let asked = params.contains(&drive[usize::from(q == SweepParam::Omega)]);
+        asked
+            .then(|| model.forcing_derivative(q))
+            .flatten()
+            .map(|[free, _]| free)
+    });
     let ext = Extended {
         model: model.clone(),
         params: params.to_vec(),
+        forcing,
+        harmonics,
     };
+    let first = ext.first_param();
     let (d, k) = (model.dim(), params.len());
     let mut y0 = DVector::zeros(ext.dim());
     y0.rows_mut(0, d).copy_from(&state);
@@ -373,9 +566,14 @@ pub fn orbit_sensitivity(
     let flow = flow_with_jacobian(&mut integ, 0.0, &y0, period)?;
     let big = &flow.jacobian;
     let m = big.view((0, 0), (d, d)).into_owned();
-    let d_map = big.view((0, d + 2), (d, k)).into_owned();
-    let dq_dz = big.view((d, 0), (2, d)).into_owned();
-    let dq_dp = big.view((d, d + 2), (2, k)).into_owned();
+    let d_map = big.view((0, first), (d, k)).into_owned();
+    // the Fourier integrals' total derivatives dq/dp = ∂q/∂z ∂z*/∂p + ∂q/∂p, pair h at rows
+    // d + 2h
+    let dq_of = |h: usize, d_state: &DMatrix<f64>| {
+        let dq_dz = big.view((d + 2 * h, 0), (2, d)).into_owned();
+        let dq_dp = big.view((d + 2 * h, first), (2, k)).into_owned();
+        dq_dz * d_state + dq_dp
+    };
     let i_m = DMatrix::identity(d, d) - &m;
     let sigma_min = i_m
         .clone()
@@ -388,21 +586,14 @@ pub fn orbit_sensitivity(
         iterations: 0,
         residual: sigma_min,
     })?;
-    let dq = &dq_dz * &d_state + dq_dp;
-    let scale = 2.0 / period;
-    let (cs, cc) = (scale * flow.state[d], scale * flow.state[d + 1]);
-    let amplitude = cs.hypot(cc);
-    let mut phase = (-cc).atan2(cs);
-    if phase <= -0.5 * PI {
-        phase += TAU;
-    }
-    let a2 = amplitude * amplitude;
-    let (mut d_amplitude, mut d_phase) = (Vec::with_capacity(k), Vec::with_capacity(k));
-    for j in 0..k {
-        let (dcs, dcc) = (scale * dq[(0, j)], scale * dq[(1, j)]);
-        d_amplitude.push((cs * dcs + cc * dcc) / amplitude);
-        d_phase.push((cc * dcs - cs * dcc) / a2);
-    }
+    let pair = |h: usize| (flow.state[d + 2 * h], flow.state[d + 2 * h + 1]);
+    let Harmonic {
+        amplitude,
+        phase,
+        d_amplitude,
+        d_phase,
+    } = harmonic(pair(0), &dq_of(0, &d_state), period);
+    let component = (component.is_some()).then(|| harmonic(pair(1), &dq_of(1, &d_state), period));
     let mut warnings = Vec::new();
     if sigma_min < FOLD_TOL {
         warnings.push(SensitivityWarning::NearFold { sigma_min });
@@ -425,5 +616,6 @@ pub fn orbit_sensitivity(
         sigma_min,
         grazing_distance,
         warnings,
+        component,
     })
 }

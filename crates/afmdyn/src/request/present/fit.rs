@@ -100,7 +100,7 @@ pub fn fit(
     p
 }
 
-/// The table and figures of a dynamic (AM) fit ([`crate::request::fit_dynamic`]): the columns
+/// The table and figures of a dynamic (AM or FM) fit ([`crate::request::fit_dynamic`]): the columns
 /// of the channels fitted, each channel's data and fit against z, and its residuals.
 fn am_files(p: &mut Presentation, document: &Value, files: Files) {
     let columns: Vec<&str> = crate::request::fit_dynamic::CURVE_VARIABLES
@@ -132,7 +132,14 @@ fn am_files(p: &mut Presentation, document: &Value, files: Files) {
         style,
         color,
     };
-    for (channel, unit) in [("amplitude", "m"), ("phase", "deg")] {
+    let kind = if document["kind"] == "fm" { "FM" } else { "AM" };
+    for (channel, unit) in [
+        ("amplitude", "m"),
+        ("phase", "deg"),
+        ("amplitude_2", "m"),
+        ("phase_2", "deg"),
+        ("frequency_shift", "Hz"),
+    ] {
         let (Some(d), Some(f), Some(r)) = (
             col(channel),
             col(&format!("{channel}_fit")),
@@ -143,7 +150,10 @@ fn am_files(p: &mut Presentation, document: &Value, files: Files) {
         p.figure(
             &format!("fit-{channel}"),
             lines(
-                &format!("AM curve: the {channel}, data and fit"),
+                &format!(
+                    "{kind} curve: the {}, data and fit",
+                    channel.replace('_', " ")
+                ),
                 ("z (m)".into(), format!("{channel} ({unit})")),
                 vec![
                     series("data", d, Style::Dots, 0),
@@ -154,7 +164,10 @@ fn am_files(p: &mut Presentation, document: &Value, files: Files) {
         p.figure(
             &format!("fit-{channel}-residual"),
             lines(
-                &format!("AM curve: {channel} residuals (data − fit)"),
+                &format!(
+                    "{kind} curve: {} residuals (data − fit)",
+                    channel.replace('_', " ")
+                ),
                 ("z (m)".into(), format!("residual ({unit})")),
                 vec![series("", r, Style::Line, 0)],
             ),

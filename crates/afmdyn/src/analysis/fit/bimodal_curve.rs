@@ -1,0 +1,212 @@
+//! The dynamic fit's model of a measured bimodal AM curve (issue 62 §1, "the bimodal
+//! channels"): under a probe whose drive has a second component at a commensurate ratio
+//! ([`crate::params::Params::drive_components`]), the first harmonic's A₁, φ₁ and the second
+//! component's A₂ (m), φ₂ (deg) against the piezo position z (m), as the stepped approach the
+//! instrument did (as [`super::am_curve`]: each row's orbit continued from the previous one).
+//! A₂ and φ₂ are the harmonic of the tip deflection at the component's frequency over the
+//! drive's common period, with their exact sensitivities from a second pair of Fourier
+//! integrals of the extended flow ([`super::sensitivity::orbit_sensitivity_component`]); the
+//! parameters map onto the model's as in [`super::am_curve`].
+//!
+//! The model's values are, for the channels fitted, the rows' A₁ g₀, then φ₁, A₂ g₀, φ₂ (m and
+//! deg); rows off a stable period-1 orbit (of the common period) keep the stepped sweep's
+//! observables without a Jacobian row, and the warnings say so, as at folds and grazing.
+
+use super::am_curve::{first_sweep, scaled, AmParam, AmProbe, SENSITIVITY_TOLERANCE};
+use super::sensitivity::{orbit_sensitivity_component, OrbitParam};
+use super::CurveModel;
+use crate::analysis::stepped::SteppedSpec;
+use crate::contact::ContactLaw;
+use crate::error::SimError;
+use crate::model::CantileverModel;
+use crate::params::SweepParam;
+use std::sync::Mutex;
+
+/// The model of a measured bimodal curve (module docs).
+#[derive(Debug)]
+pub struct BimodalCurveModel {
+    /// The probe (its drive with a second component).
+    pub probe: AmProbe,
+    /// The piezo positions z (m) of the rows, in the order the instrument stepped.
+    pub z: Vec<f64>,
+    /// Which of (A₁, φ₁, A₂, φ₂) are fitted, in that order of the values.
+    pub channels: [bool; 4],
+    /// The model's parameters, in the fit's order.
+    pub params: Vec<AmParam>,
+    /// The stepped sweep's settings (its values are overwritten by the rows').
+    pub spec: SteppedSpec,
+    /// The adaptive integrator's tolerance of the sensitivities.
+    pub tolerance: f64,
+    warnings: Mutex<Vec<String>>,
+}
+
+impl BimodalCurveModel {
+    /// A model of the rows `z` (m) under `probe`, with parameters `params` and the channels
+    /// (A₁, φ₁, A₂, φ₂).
+    pub fn new(probe: AmProbe, z: Vec<f64>, channels: [bool; 4], params: Vec<AmParam>) -> Self {
+        let mut spec = SteppedSpec::new(probe.params, SweepParam::Alpha5, Vec::new());
+        spec.branches = false;
+        BimodalCurveModel {
+            probe,
+            z,
+            channels,
+            params,
+            spec,
+            tolerance: SENSITIVITY_TOLERANCE,
+            warnings: Mutex::new(Vec::new()),
+        }
+    }
+
+    /// The last evaluation's warnings (folds, grazing, rows off a period-1 orbit).
+    pub fn warnings(&self) -> Vec<String> {
+        self.warnings.lock().map(|w| w.clone()).unwrap_or_default()
+    }
+
+    fn evaluate_checked(
+        &self,
+        p: &[f64],
+        values: &mut [f64],
+        mut jacobian: Option<&mut [f64]>,
+    ) -> Result<Vec<String>, SimError> {
+        if !self.probe.params.is_multifrequency() {
+            return Err(SimError::out_of_range(
+                "drive",
+                "one frequency",
+                "the bimodal channels need a probe whose drive has a second component",
+            ));
+        }
+        let (q, z_offset, chain) = scaled(&self.probe, &self.params, p);
+        let g0 = self.probe.length_m;
+        let alpha5: Vec<f64> = self
+            .z
+            .iter()
+            .map(|z| q.alpha5_for_rest_distance((z + z_offset) / g0))
+            .collect();
+        let mut spec = self.spec.clone();
+        spec.base = q;
+        spec.values = alpha5.clone();
+        let first = first_sweep(&spec)?;
+        let dmt = matches!(q.contact_law, ContactLaw::Dmt { .. });
+        let mut orbit_params = vec![OrbitParam::Gap, OrbitParam::ContactStiffness];
+        if dmt {
+            orbit_params.push(OrbitParam::Hamaker);
+        }
+        let m = self.z.len();
+        let n = self.params.len();
+        // each fitted channel's first value
+        let mut offset = [0usize; 4];
+        let mut next = 0;
+        for (c, on) in self.channels.iter().enumerate() {
+            offset[c] = next;
+            if *on {
+                next += m;
+            }
+        }
+        let deg = 180.0 / std::f64::consts::PI;
+        let scale = [g0, deg, g0, deg];
+        let mut warnings = Vec::new();
+        let mut off = 0;
+        if let Some(j) = jacobian.as_deref_mut() {
+            j.fill(0.0);
+        }
+        for (i, point) in first.iter().enumerate() {
+            let o = &point.observables;
+            let second = o.components.get(1);
+            let mut v = [
+                o.amplitude,
+                o.phase,
+                second.map_or(f64::NAN, |c| c.amplitude),
+                second.map_or(f64::NAN, |c| c.phase),
+            ];
+            let mut d = [[0.0; 4]; 4];
+            let on_orbit = point.period == Some(1) && point.stable;
+            if jacobian.is_some() && on_orbit {
+                let model = CantileverModel::new(&q.with(SweepParam::Alpha5, alpha5[i]))?;
+                let s = orbit_sensitivity_component(
+                    &model,
+                    self.tolerance,
+                    &point.state,
+                    &orbit_params,
+                    None,
+                    Some(1),
+                )?;
+                for w in &s.warnings {
+                    warnings.push(format!("row {} (z = {:.4e} m): {w}", i + 1, self.z[i]));
+                }
+                let two = s.component.as_ref().ok_or(SimError::NoConvergence {
+                    what: "the second component's harmonic",
+                    iterations: 0,
+                    residual: f64::NAN,
+                })?;
+                v = [s.amplitude, s.phase, two.amplitude, two.phase];
+                // (gap, α4, H̃) → (E_s, H, z_offset, R), as the AM model maps them
+                let map = |dd: &[f64]| {
+                    let dh = if dmt { dd[2] } else { 0.0 };
+                    [
+                        dd[1] * chain[0],
+                        dh * chain[1],
+                        dd[0] * chain[2],
+                        dd[1] * chain[3] + dh * chain[4],
+                    ]
+                };
+                d = [
+                    map(&s.d_amplitude),
+                    map(&s.d_phase),
+                    map(&two.d_amplitude),
+                    map(&two.d_phase),
+                ];
+            } else if !on_orbit {
+                off += 1;
+            }
+            for c in 0..4 {
+                if !self.channels[c] {
+                    continue;
+                }
+                let row = offset[c] + i;
+                values[row] = v[c] * scale[c];
+                if let Some(j) = jacobian.as_deref_mut() {
+                    for (k, param) in self.params.iter().enumerate() {
+                        let idx = match param {
+                            AmParam::YoungsModulus => 0,
+                            AmParam::Hamaker => 1,
+                            AmParam::ZOffset => 2,
+                            AmParam::TipRadius => 3,
+                        };
+                        j[row * n + k] = d[c][idx] * scale[c];
+                    }
+                }
+            }
+        }
+        if off > 0 {
+            warnings.push(format!(
+                "{off} row(s) not on a stable period-1 orbit: their model values are the stepped \
+                 sweep's, without sensitivities"
+            ));
+        }
+        Ok(warnings)
+    }
+}
+
+impl CurveModel for BimodalCurveModel {
+    fn points(&self) -> usize {
+        self.z.len() * self.channels.iter().filter(|c| **c).count()
+    }
+    fn evaluate(&self, p: &[f64], values: &mut [f64], jacobian: Option<&mut [f64]>) {
+        let has_jacobian = jacobian.is_some();
+        match self.evaluate_checked(p, values, jacobian) {
+            Ok(w) => {
+                if has_jacobian {
+                    if let Ok(mut l) = self.warnings.lock() {
+                        *l = w;
+                    }
+                }
+            }
+            Err(e) => {
+                values.fill(f64::NAN);
+                if let Ok(mut l) = self.warnings.lock() {
+                    *l = vec![format!("the model failed at {p:?}: {e}")];
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,219 @@
+//! The dynamic fit's model of a measured frequency-modulation curve (issue 62 §1, §3: where
+//! the first-order relation breaks, Δf against the full dynamic model): the frequency shift Δf
+//! (Hz) against the piezo position z (m), as the FM loop's steady state at each row
+//! ([`crate::analysis::fm`]: an ideal PLL and amplitude controller; the orbit's drive Ω and
+//! excitation α2 fixed by the loop conditions g(Ω, α2) = (A₁/A − 1, φ₁ − φ_set) = 0), followed
+//! along the rows as `afmdyn fm` follows its curve, at the amplitude setpoint A = the probe's
+//! free amplitude A₀ (1 g₀, `afmdyn fm`'s default), tracking mode 1. Δf = (Ω − ω₁)·f_scale,
+//! ω₁ the free lever's resonance, as `afmdyn fm` reports it.
+//!
+//! # Sensitivities
+//! By the implicit function theorem on the loop conditions at fixed model parameters p,
+//! d(Ω, α2)/dp = −[∂g/∂(Ω, α2)]⁻¹ ∂g/∂p, with ∂g/∂p = (∂A₁/∂p / A, ∂φ₁/∂p) the orbit's
+//! sensitivities at a fixed drive ([`super::sensitivity`]: the gap α5, α4, H̃) and
+//! ∂g/∂(Ω, α2) from the same extended flow ([`OrbitParam::DriveFrequency`]: time rescaled to
+//! a fixed phase; [`OrbitParam::DriveAmplitude`]: a column of the forcing), so that
+//! dΔf/dp = f_scale dΩ/dp. The reference ω₁, the setpoint A and the lag φ_set are those of the
+//! free lever, which E, H, R and z_offset do not move. The SI parameters map onto (α5, α4, H̃)
+//! as in [`super::am_curve`].
+//!
+//! # Where it breaks
+//! A fold of the FM curve (det ∂g/∂(Ω, α2) = 0, [`crate::analysis::fm::FmCurve::folds`]), a
+//! fold or grazing of the orbit ([`super::sensitivity::SensitivityWarning`]) and rows the loop
+//! does not reach (the curve ends; those rows keep the last Δf reached, without a Jacobian row)
+//! are reported in [`FmCurveModel::warnings`].
+
+use super::am_curve::{scaled, AmParam, AmProbe, SENSITIVITY_TOLERANCE};
+use super::sensitivity::{orbit_sensitivity, OrbitParam, SensitivityWarning};
+use super::CurveModel;
+use crate::analysis::fm::{fm_curve, FmSpec, DEFAULT_LOOP_TOLERANCE};
+use crate::analysis::progress::Progress;
+use crate::contact::ContactLaw;
+use crate::error::SimError;
+use crate::model::CantileverModel;
+use crate::params::SweepParam;
+use nalgebra::{Matrix2, Vector2};
+use std::sync::Mutex;
+
+/// The model of a measured Δf curve (module docs).
+#[derive(Debug)]
+pub struct FmCurveModel {
+    /// The probe (its free amplitude A₀ = 1 g₀ the amplitude setpoint).
+    pub probe: AmProbe,
+    /// The piezo positions z (m) of the rows, in the order the instrument stepped.
+    pub z: Vec<f64>,
+    /// The model's parameters, in the fit's order.
+    pub params: Vec<AmParam>,
+    /// Hz per unit Ω of the probe's scales.
+    pub hz_per_omega: f64,
+    /// The amplitude setpoint A (units of g₀; 1, the probe's A₀).
+    pub amplitude: f64,
+    /// The loop conditions' tolerance ([`FmSpec::tolerance`]).
+    pub loop_tolerance: f64,
+    /// The adaptive integrator's tolerance of the sensitivities.
+    pub tolerance: f64,
+    /// The last evaluation's warnings.
+    warnings: Mutex<Vec<String>>,
+}
+
+impl FmCurveModel {
+    /// A model of the rows `z` (m) under `probe` (whose scales give `hz_per_omega`), with
+    /// parameters `params`; setpoint A₀, the loop to [`DEFAULT_LOOP_TOLERANCE`], the
+    /// sensitivities to [`SENSITIVITY_TOLERANCE`].
+    pub fn new(probe: AmProbe, z: Vec<f64>, params: Vec<AmParam>, hz_per_omega: f64) -> Self {
+        FmCurveModel {
+            probe,
+            z,
+            params,
+            hz_per_omega,
+            amplitude: 1.0,
+            loop_tolerance: DEFAULT_LOOP_TOLERANCE,
+            tolerance: SENSITIVITY_TOLERANCE,
+            warnings: Mutex::new(Vec::new()),
+        }
+    }
+
+    /// The last evaluation's warnings (folds, grazing, rows not reached).
+    pub fn warnings(&self) -> Vec<String> {
+        self.warnings.lock().map(|w| w.clone()).unwrap_or_default()
+    }
+
+    fn evaluate_checked(
+        &self,
+        p: &[f64],
+        values: &mut [f64],
+        mut jacobian: Option<&mut [f64]>,
+    ) -> Result<Vec<String>, SimError> {
+        let (q, z_offset, chain) = scaled(&self.probe, &self.params, p);
+        let g0 = self.probe.length_m;
+        let alpha5: Vec<f64> = self
+            .z
+            .iter()
+            .map(|z| q.alpha5_for_rest_distance((z + z_offset) / g0))
+            .collect();
+        let mut spec = FmSpec::new(q, alpha5, self.amplitude);
+        spec.tolerance = self.loop_tolerance;
+        let curve = fm_curve(&spec, &Progress::new())?;
+        let hz = self.hz_per_omega;
+        let dmt = matches!(q.contact_law, ContactLaw::Dmt { .. });
+        let mut orbit_params = vec![OrbitParam::Gap, OrbitParam::ContactStiffness];
+        if dmt {
+            orbit_params.push(OrbitParam::Hamaker);
+        }
+        let k = orbit_params.len();
+        orbit_params.extend([OrbitParam::DriveFrequency, OrbitParam::DriveAmplitude]);
+        let n = self.params.len();
+        let mut warnings = Vec::new();
+        let row = |i: usize| format!("row {} (z = {:.4e} m)", i + 1, self.z[i]);
+        for f in &curve.folds {
+            warnings.push(format!(
+                "{}: a fold of the FM curve (det ∂(A₁, φ₁)/∂(Ω, α2) changes sign before the \
+                 next row); the sensitivities are unreliable there",
+                row(f.index)
+            ));
+        }
+        let reached = curve.points.len();
+        if let Some(u) = &curve.unreached {
+            warnings.push(format!(
+                "{}: the FM steady state was not found ({}); the {} row(s) from there keep the \
+                 last frequency shift reached, without sensitivities",
+                row(reached),
+                u.reason,
+                self.z.len() - reached
+            ));
+        }
+        let omega_ref = curve.reference.omega;
+        if let Some(j) = jacobian.as_deref_mut() {
+            j.fill(0.0);
+        }
+        let mut last = 0.0;
+        for i in 0..self.z.len() {
+            let Some(point) = curve.points.get(i) else {
+                values[i] = last;
+                continue;
+            };
+            last = (point.omega - omega_ref) * hz;
+            values[i] = last;
+            let Some(j) = jacobian.as_deref_mut() else {
+                continue;
+            };
+            let at = q
+                .with(SweepParam::Alpha5, point.alpha5)
+                .with(SweepParam::Omega, point.omega)
+                .with(SweepParam::Alpha2, point.alpha2);
+            let model = CantileverModel::new(&at)?;
+            let s = orbit_sensitivity(&model, self.tolerance, &point.state, &orbit_params, None)?;
+            // the orbit's own near-fold measure is not the FM curve's: locked at the lever's
+            // resonance, I − M has multipliers within ~π/Q of 1 by construction (the
+            // oscillation's amplitude and phase), the very directions the loop conditions fix;
+            // the curve's folds are those of ∂g/∂(Ω, α2) (above and below)
+            for w in &s.warnings {
+                if matches!(w, SensitivityWarning::Grazing { .. }) {
+                    warnings.push(format!("{}: {w}", row(i)));
+                }
+            }
+            // ∂g/∂(Ω, α2) and ∂g/∂p_m for g = (A₁/A − 1, φ₁ − φ_set)
+            let a = self.amplitude;
+            let g_x = Matrix2::new(
+                s.d_amplitude[k] / a,
+                s.d_amplitude[k + 1] / a,
+                s.d_phase[k],
+                s.d_phase[k + 1],
+            );
+            let Some(inv) = g_x.try_inverse() else {
+                warnings.push(format!(
+                    "{}: ∂(A₁, φ₁)/∂(Ω, α2) is singular (a fold of the FM curve): no \
+                     sensitivities",
+                    row(i)
+                ));
+                continue;
+            };
+            // dΩ/dp_m = first row of −G⁻¹ ∂g/∂p_m, for (gap, α4, H̃)
+            let d_omega: Vec<f64> = (0..k)
+                .map(|m| -(inv * Vector2::new(s.d_amplitude[m] / a, s.d_phase[m]))[0])
+                .collect();
+            let dh = if dmt { d_omega[2] } else { 0.0 };
+            // (gap, α4, H̃) → (E_s, H, z_offset, R), as the AM model maps them
+            let d = [
+                d_omega[1] * chain[0],
+                dh * chain[1],
+                d_omega[0] * chain[2],
+                d_omega[1] * chain[3] + dh * chain[4],
+            ];
+            for (c, param) in self.params.iter().enumerate() {
+                let idx = match param {
+                    AmParam::YoungsModulus => 0,
+                    AmParam::Hamaker => 1,
+                    AmParam::ZOffset => 2,
+                    AmParam::TipRadius => 3,
+                };
+                j[i * n + c] = d[idx] * hz;
+            }
+        }
+        Ok(warnings)
+    }
+}
+
+impl CurveModel for FmCurveModel {
+    fn points(&self) -> usize {
+        self.z.len()
+    }
+    fn evaluate(&self, p: &[f64], values: &mut [f64], jacobian: Option<&mut [f64]>) {
+        let has_jacobian = jacobian.is_some();
+        match self.evaluate_checked(p, values, jacobian) {
+            Ok(w) => {
+                if has_jacobian {
+                    if let Ok(mut l) = self.warnings.lock() {
+                        *l = w;
+                    }
+                }
+            }
+            Err(e) => {
+                values.fill(f64::NAN);
+                if let Ok(mut l) = self.warnings.lock() {
+                    *l = vec![format!("the model failed at {p:?}: {e}")];
+                }
+            }
+        }
+    }
+}

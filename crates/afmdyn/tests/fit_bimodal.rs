@@ -1,0 +1,344 @@
+//! The bimodal channels' sensitivities (issue 62 §1: "or the bimodal channels"): the harmonic
+//! A₂, φ₂ of the tip deflection at the second drive component's frequency, from a second pair
+//! of Fourier integrals over the drive's common period
+//! (`analysis::fit::sensitivity::orbit_sensitivity_component`), against the library's
+//! observables (its component demodulation) and its exact sensitivities against fourth-order
+//! central differences of the shooting solution, on the two-mode eigenmode model of
+//! `examples/probe-bimodal.toml` (f₂ = 6.25 f₁) and the N = 3 beam of
+//! `examples/probe-beam-dmt.toml` with a second tip force (F̃ = 0.1) at 25/4 Ω, Hertz and DMT.
+
+use afmdyn::analysis::approach::{approach_retract, approach_spec};
+use afmdyn::analysis::fit::sensitivity::{
+    orbit_sensitivity_component, OrbitParam, OrbitSensitivity,
+};
+use afmdyn::analysis::observables::observe_orbit;
+use afmdyn::analysis::shooting::{shoot, ShootingOptions};
+use afmdyn::analysis::stepped::Spacing;
+use afmdyn::contact::ContactLaw;
+use afmdyn::integrate::{IntegratorKind, IntegratorOptions};
+use afmdyn::model::CantileverModel;
+use afmdyn::params::DriveComponent;
+use afmdyn::probe::Probe;
+use afmdyn::Params;
+use nalgebra::DVector;
+use std::path::Path;
+
+/// The adaptive integrator's tolerance of the sensitivities and of the finite differences.
+const TOL: f64 = 1e-12;
+/// The relative step of the central differences in the gap; α4 and H̃, in which the laws are
+/// linear, take ten times it (the second harmonic feels them little: its derivatives are small
+/// against the integration error over a smaller step).
+const STEP: f64 = 1e-3;
+/// The agreement asked for (issue 62: ≤ 1e-6 relative).
+const AGREE: f64 = 1e-6;
+
+fn probe(name: &str) -> Params {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../examples")
+        .join(name);
+    Probe::load(&path).expect("example probe").params
+}
+
+fn newton() -> ShootingOptions {
+    ShootingOptions {
+        tol: 1e-12,
+        max_iter: 40,
+    }
+}
+
+fn with(base: &Params, p: OrbitParam, value: f64) -> Params {
+    let mut q = *base;
+    match p {
+        OrbitParam::Gap => q.alpha5 = value,
+        OrbitParam::ContactStiffness => q.alpha4 = value,
+        OrbitParam::Hamaker => match &mut q.contact_law {
+            ContactLaw::Dmt { hamaker, .. } => *hamaker = value,
+            _ => panic!("H̃ of a law without it"),
+        },
+        _ => panic!("not a law parameter"),
+    }
+    q
+}
+
+fn value_of(base: &Params, p: OrbitParam) -> f64 {
+    match p {
+        OrbitParam::Gap => base.alpha5,
+        OrbitParam::ContactStiffness => base.alpha4,
+        OrbitParam::Hamaker => match base.contact_law {
+            ContactLaw::Dmt { hamaker, .. } => hamaker,
+            _ => panic!("H̃ of a law without it"),
+        },
+        _ => panic!("not a law parameter"),
+    }
+}
+
+fn sensitivity(params: &Params, guess: &DVector<f64>, ps: &[OrbitParam]) -> OrbitSensitivity {
+    let model = CantileverModel::new(params).expect("model");
+    orbit_sensitivity_component(&model, TOL, guess, ps, Some(&newton()), Some(1))
+        .expect("sensitivity")
+}
+
+/// The component's A₂, φ₂ at the orbit near `guess` against the observables, and their exact
+/// sensitivities against central differences; `false` (nothing checked) near a fold or grazing
+/// or where the orbit does not feel the sample.
+fn check_point(base: &Params, guess: &DVector<f64>, ps: &[OrbitParam], what: &str) -> bool {
+    let exact = sensitivity(base, guess, ps);
+    if !exact.warnings.is_empty() {
+        eprintln!("{what}: skipped, {:?}", exact.warnings);
+        return false;
+    }
+    let two = exact.component.clone().expect("the component's harmonic");
+    let model = CantileverModel::new(base).expect("model");
+    let shot = shoot(&model, &exact.state, 1, &newton()).expect("orbit");
+    let opts = IntegratorOptions {
+        kind: IntegratorKind::Adaptive,
+        tolerance: TOL,
+        ..IntegratorOptions::default()
+    };
+    let obs = observe_orbit(&model, opts, &shot, 1).expect("observables");
+    let c = &obs.components[1];
+    eprintln!(
+        "{what}: A₂ = {:.9e} (observables {:.9e}), φ₂ = {:.9e} ({:.9e})",
+        two.amplitude, c.amplitude, two.phase, c.phase
+    );
+    assert!(
+        (c.amplitude - two.amplitude).abs() <= 1e-8 * c.amplitude,
+        "{what}: A₂"
+    );
+    assert!((c.phase - two.phase).abs() <= 1e-7, "{what}: φ₂");
+    for (j, &p) in ps.iter().enumerate() {
+        let v = value_of(base, p);
+        let h = if p == OrbitParam::Gap {
+            STEP
+        } else {
+            10.0 * STEP
+        } * v.abs();
+        let at = |k: f64| sensitivity(&with(base, p, v + k * h), &exact.state, &[]);
+        let (p1, m1, p2, m2) = (at(1.0), at(-1.0), at(2.0), at(-2.0));
+        let diff = |f: &dyn Fn(&OrbitSensitivity) -> f64| {
+            (8.0 * (f(&p1) - f(&m1)) - (f(&p2) - f(&m2))) / (12.0 * h)
+        };
+        let amp = |o: &OrbitSensitivity| o.component.as_ref().map_or(f64::NAN, |c| c.amplitude);
+        let phase = |o: &OrbitSensitivity| o.component.as_ref().map_or(f64::NAN, |c| c.phase);
+        let (fd_a, fd_phi) = (diff(&amp), diff(&phase));
+        let rel = |e: f64, f: f64| {
+            if e == 0.0 && f == 0.0 {
+                0.0
+            } else {
+                (e - f).abs() / e.abs().max(f.abs())
+            }
+        };
+        let (ea, ep) = (two.d_amplitude[j], two.d_phase[j]);
+        eprintln!(
+            "{what} {p:?}: dA₂/dp {ea:.9e} (fd {fd_a:.9e}, rel {:.1e}), dφ₂/dp {ep:.9e} (fd \
+             {fd_phi:.9e}, rel {:.1e})",
+            rel(ea, fd_a),
+            rel(ep, fd_phi)
+        );
+        assert!(rel(ea, fd_a) <= AGREE, "{what} {p:?}: dA₂/dp");
+        assert!(rel(ep, fd_phi) <= AGREE, "{what} {p:?}: dφ₂/dp");
+    }
+    true
+}
+
+/// The stable period-1 points of an approach from z_c = 1.2 A₀ to 0.3 A₀ whose amplitude is
+/// reduced (the tip feels the sample), checked until one passes away from folds and grazing.
+fn check_law(base: Params, points: usize, ps: &[OrbitParam], what: &str) {
+    let spec = approach_spec(base, 1.2, 0.3, Spacing::Points(points)).expect("spec");
+    let curve = approach_retract(&spec).expect("approach").first;
+    let a_far = curve[0].observables.amplitude;
+    let checked = curve
+        .iter()
+        .filter(|p| p.period == Some(1) && p.stable)
+        .filter(|p| p.observables.amplitude < 0.95 * a_far)
+        .take(3)
+        .any(|p| check_point(&with(&base, OrbitParam::Gap, p.value), &p.state, ps, what));
+    assert!(checked, "{what}: no point away from folds and grazing");
+}
+
+fn laws(base: Params, points: usize, what: &str) {
+    let dmt = [
+        OrbitParam::Gap,
+        OrbitParam::ContactStiffness,
+        OrbitParam::Hamaker,
+    ];
+    check_law(base, points, &dmt, &format!("{what} DMT"));
+    let hertz = Params {
+        contact_law: ContactLaw::Hertz,
+        ..base
+    };
+    let ps = [OrbitParam::Gap, OrbitParam::ContactStiffness];
+    check_law(hertz, points, &ps, &format!("{what} Hertz"));
+}
+
+#[test]
+fn bimodal_eigenmode_sensitivities_are_the_finite_differences() {
+    laws(probe("probe-bimodal.toml"), 19, "two-mode bimodal");
+}
+
+#[test]
+fn bimodal_beam_sensitivities_are_the_finite_differences() {
+    let mut base = probe("probe-beam-dmt.toml");
+    base.drive_components[0] = Some(DriveComponent {
+        force: 0.1,
+        ratio: [25, 4],
+        phase: 0.0,
+    });
+    laws(base, 13, "N = 3 beam, bimodal");
+}
+
+// ---- the bimodal curve model (`analysis::fit::bimodal_curve`) ----
+
+use afmdyn::analysis::fit::am_curve::{AmParam, AmProbe};
+use afmdyn::analysis::fit::bimodal_curve::BimodalCurveModel;
+use afmdyn::analysis::fit::CurveModel;
+
+/// The bimodal example probe as the fit's probe.
+fn bimodal_probe() -> AmProbe {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/probe-bimodal.toml");
+    let p = Probe::load(&path).expect("example probe");
+    let s = p.sample_inputs;
+    AmProbe {
+        params: p.params,
+        length_m: p.scales.length_m,
+        youngs_modulus: s.youngs_modulus.expect("E"),
+        poisson_ratio: s.poisson_ratio.expect("ν"),
+        tip: (
+            s.tip_youngs_modulus.expect("E_t"),
+            s.tip_poisson_ratio.expect("ν_t"),
+        ),
+        hamaker: s.hamaker.unwrap_or(0.0),
+        radius: s.radius.expect("R"),
+    }
+}
+
+/// The bimodal model's Jacobian (the exact sensitivities of A₁, φ₁, A₂, φ₂, chained to E, H
+/// and z_offset, in m and deg) against central differences of its values (the stepped
+/// sweep's observables, whose own integration error bounds the agreement: 1e-3, as the AM
+/// model's test takes it), over 10 rows of an approach through contact (z_c = 0.9 → 0.45 A₀).
+#[test]
+fn the_bimodal_models_jacobian_is_its_finite_differences() {
+    let probe = bimodal_probe();
+    let g0 = probe.length_m;
+    let z_offset = 1e-9;
+    let z: Vec<f64> = (0..10)
+        .map(|i| g0 * (0.9 - 0.05 * i as f64) - z_offset)
+        .collect();
+    let params = vec![AmParam::YoungsModulus, AmParam::Hamaker, AmParam::ZOffset];
+    let truth = vec![probe.youngs_modulus, probe.hamaker, z_offset];
+    let model = BimodalCurveModel::new(probe, z, [true, true, true, true], params);
+    let (m, n) = (model.points(), truth.len());
+    assert_eq!(m, 40);
+    let mut v = vec![0.0; m];
+    let mut jac = vec![0.0; m * n];
+    model.evaluate(&truth, &mut v, Some(&mut jac));
+    eprintln!("warnings {:?}", model.warnings());
+    assert!(v.iter().all(|x| x.is_finite()), "{v:?}");
+    for k in 0..n {
+        let h = if k == 2 {
+            1e-4 * g0
+        } else {
+            1e-4 * truth[k].abs()
+        };
+        let (mut up, mut down) = (truth.clone(), truth.clone());
+        up[k] += h;
+        down[k] -= h;
+        let (mut vu, mut vd) = (vec![0.0; m], vec![0.0; m]);
+        model.evaluate(&up, &mut vu, None);
+        model.evaluate(&down, &mut vd, None);
+        // relative to the entry, or to 1e-3 of its channel's largest (a row out of contact
+        // feels E not at all)
+        let mut worst: f64 = 0.0;
+        for c in 0..4 {
+            let rows = c * 10..(c + 1) * 10;
+            let largest = rows
+                .clone()
+                .map(|i| jac[i * n + k].abs())
+                .fold(0.0, f64::max);
+            for i in rows {
+                let fd = (vu[i] - vd[i]) / (2.0 * h);
+                let e = jac[i * n + k];
+                let scale = e.abs().max(fd.abs()).max(1e-3 * largest).max(1e-300);
+                worst = worst.max((e - fd).abs() / scale);
+            }
+        }
+        eprintln!("{}: worst relative gap {worst:.2e}", model.params[k].name());
+        assert!(worst < 1e-3, "{}", model.params[k].name());
+    }
+}
+
+/// A bimodal curve's second channels alone (A₂ in m, φ₂ in deg, σ 2 pm and 0.1°, seeded
+/// noise) of the model at the truth (the probe's E and H, z_offset = 1 nm), written as the
+/// door's CSV and fitted through `afmdyn fit`'s request for H and z_offset from the probe's
+/// starts (z_offset's on its grid): the curve holds the data, fit and residuals of A₂ and φ₂,
+/// and the intervals hold the truth.
+#[test]
+fn a_bimodal_csv_goes_through_the_fit_door() {
+    use afmdyn::analysis::progress::Progress;
+    use afmdyn::request::fit::FitRequest;
+    use afmdyn::request::{run, Resolved};
+    let probe = bimodal_probe();
+    let g0 = probe.length_m;
+    let z_offset = 1e-9;
+    let rows = 12;
+    let z: Vec<f64> = (0..rows)
+        .map(|i| g0 * (0.9 - 0.04 * i as f64) - z_offset)
+        .collect();
+    let params = vec![AmParam::Hamaker, AmParam::ZOffset];
+    let model = BimodalCurveModel::new(probe, z.clone(), [false, false, true, true], params);
+    let mut y = vec![0.0; model.points()];
+    model.evaluate(&[probe.hamaker, z_offset], &mut y, None);
+    let sigma: Vec<f64> = (0..2 * rows)
+        .map(|i| if i < rows { 2e-12 } else { 0.1 })
+        .collect();
+    // deterministic noise: a fixed sequence of N(0, 1)-like draws (a sine's values)
+    for (i, (v, s)) in y.iter_mut().zip(&sigma).enumerate() {
+        *v += s * (1.3 * (i as f64 * 2.1).sin());
+    }
+    let dir = std::env::temp_dir().join(format!("afmdyn-fit-bimodal-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let path = dir.join("bimodal.csv");
+    let mut text = String::from("z,amplitude_2,phase_2,sigma_amplitude_2,sigma_phase_2\n");
+    for i in 0..rows {
+        text += &format!(
+            "{:?},{:?},{:?},{:?},{:?}\n",
+            z[i],
+            y[i],
+            y[rows + i],
+            sigma[i],
+            sigma[rows + i]
+        );
+    }
+    std::fs::write(&path, text).expect("csv");
+    let p = Probe::load(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/probe-bimodal.toml"),
+    )
+    .expect("probe");
+    let resolved = Resolved {
+        params: p.params,
+        probe: Some(p),
+    };
+    let request = FitRequest {
+        data: Some(path.display().to_string()),
+        fit: vec!["sample.hamaker".into(), "z_offset".into()],
+        ..FitRequest::default()
+    };
+    let doc = run(&request, &resolved, &Progress::default())
+        .expect("fit")
+        .json;
+    std::fs::remove_dir_all(&dir).ok();
+    eprintln!("{}", doc["estimates"]);
+    assert_eq!(doc["kind"], "am");
+    for (name, t) in [("sample.hamaker", probe.hamaker), ("z_offset", z_offset)] {
+        let e = &doc["estimates"][name];
+        let (lo, hi) = (
+            e["interval"][0].as_f64().unwrap(),
+            e["interval"][1].as_f64().unwrap(),
+        );
+        assert!(lo <= t && t <= hi, "{name}: truth {t} outside [{lo}, {hi}]");
+    }
+    for k in ["amplitude_2", "amplitude_2_fit", "phase_2_residual"] {
+        assert_eq!(doc["curve"][k].as_array().map(Vec::len), Some(rows), "{k}");
+    }
+    assert!(doc["curve"]["amplitude"].is_null());
+}

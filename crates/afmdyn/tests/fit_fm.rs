@@ -1,0 +1,321 @@
+//! Fitting Δf (FM-AFM) curves against the full dynamic model (issue 62 §1, §3;
+//! `analysis::fit::fm_curve`): the model's exact sensitivities of Δf (the implicit function
+//! theorem on the FM loop's conditions, with the orbit's sensitivities to the drive) against
+//! central finite differences of the library's FM curve on the point mass and the N = 3 beam,
+//! Hertz and DMT; a synthetic noisy Δf curve from the library's `fm` analysis fitted back to its
+//! truth (the example probes `examples/probe-point-mass-dmt.toml`, `probe-beam-dmt.toml`).
+
+use afmdyn::analysis::fit::am_curve::{AmParam, AmProbe};
+use afmdyn::analysis::fit::fm_curve::FmCurveModel;
+use afmdyn::analysis::fit::CurveModel;
+use afmdyn::contact::ContactLaw;
+use afmdyn::probe::Probe;
+use std::path::Path;
+
+/// The agreement asked for (issue 62: ≤ 1e-6 relative).
+const AGREE: f64 = 1e-6;
+
+/// The example probe as the fit's probe, and Hz per unit Ω.
+fn fm_probe(name: &str, hertz: bool) -> (AmProbe, f64) {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../examples")
+        .join(name);
+    let p = Probe::load(&path).expect("example probe");
+    let s = p.sample_inputs;
+    let mut params = p.params;
+    if hertz {
+        params.contact_law = ContactLaw::Hertz;
+    }
+    let probe = AmProbe {
+        params,
+        length_m: p.scales.length_m,
+        youngs_modulus: s.youngs_modulus.expect("E"),
+        poisson_ratio: s.poisson_ratio.expect("ν"),
+        tip: (
+            s.tip_youngs_modulus.expect("E_t"),
+            s.tip_poisson_ratio.expect("ν_t"),
+        ),
+        hamaker: if hertz { 0.0 } else { s.hamaker.unwrap_or(0.0) },
+        radius: s.radius.expect("R"),
+    };
+    (probe, p.scales.frequency_hz(1.0))
+}
+
+/// Rows z (m) with z_c = z + `offset` from `from` to `to` (units of A₀ = g₀).
+fn rows(g0: f64, from: f64, to: f64, count: usize, offset: f64) -> Vec<f64> {
+    (0..count)
+        .map(|i| g0 * (from + (to - from) * i as f64 / (count - 1) as f64) - offset)
+        .collect()
+}
+
+fn truth(probe: &AmProbe, params: &[AmParam], z_offset: f64) -> Vec<f64> {
+    params
+        .iter()
+        .map(|p| match p {
+            AmParam::YoungsModulus => probe.youngs_modulus,
+            AmParam::Hamaker => probe.hamaker,
+            AmParam::ZOffset => z_offset,
+            AmParam::TipRadius => probe.radius,
+        })
+        .collect()
+}
+
+/// The model's Jacobian at `p` against the fourth-order central differences of its values
+/// (each value the library's FM curve), row by row where the Jacobian is not flagged.
+fn check_jacobian(model: &FmCurveModel, p: &[f64], what: &str) {
+    let (m, n) = (model.points(), p.len());
+    let mut v = vec![0.0; m];
+    let mut jac = vec![0.0; m * n];
+    model.evaluate(p, &mut v, Some(&mut jac));
+    let warnings = model.warnings();
+    assert!(warnings.is_empty(), "{what}: {warnings:?}");
+    assert!(v.iter().all(|x| x.is_finite()), "{what}: {v:?}");
+    eprintln!("{what}: Δf = {v:?} Hz");
+    for j in 0..n {
+        // a hundredth of E, R, H (Δf is smooth in them: the truncation O(h⁴) ~1e-9); z_offset
+        // 5e-4 A₀, under half a percent of the closest distance (the attraction's steep power
+        // law leaves 2e-5 at 1e-2 A₀, 1e-6 at 2e-3 A₀), the loop to 1e-12 so that its error
+        // over h (~1e-9 Hz over 5 pm) stays below 1e-7 of the derivative
+        let h = match model.params[j] {
+            AmParam::ZOffset => 5e-4 * model.probe.length_m,
+            _ => 1e-2 * p[j].abs(),
+        };
+        let at = |k: f64| {
+            let mut q = p.to_vec();
+            q[j] += k * h;
+            let mut out = vec![0.0; m];
+            model.evaluate(&q, &mut out, None);
+            out
+        };
+        let (p1, m1, p2, m2) = (at(1.0), at(-1.0), at(2.0), at(-2.0));
+        // relative to the entry, or to 1e-3 of the column's largest where the entry is
+        // smaller (a row out of contact feels E and R not at all: exactly 0 against the
+        // loop's round-off)
+        let largest = (0..m).map(|i| jac[i * n + j].abs()).fold(0.0, f64::max);
+        for i in 0..m {
+            let fd = (8.0 * (p1[i] - m1[i]) - (p2[i] - m2[i])) / (12.0 * h);
+            let e = jac[i * n + j];
+            let scale = e.abs().max(fd.abs()).max(1e-3 * largest);
+            let rel = if scale == 0.0 {
+                0.0
+            } else {
+                (e - fd).abs() / scale
+            };
+            eprintln!(
+                "{what} {:?} row {i}: dΔf/dp {e:.9e} (fd {fd:.9e}, rel {rel:.1e})",
+                model.params[j]
+            );
+            assert!(rel <= AGREE, "{what} {:?} row {i}", model.params[j]);
+        }
+    }
+}
+
+/// The Δf model's Jacobian of 4 rows of `name` against its central differences, DMT
+/// (attractive to repulsive) and Hertz (free flight, then contact).
+fn check_probe(name: &str, what: &str) {
+    for hertz in [false, true] {
+        let (probe, hz) = fm_probe(name, hertz);
+        let mut params = vec![AmParam::YoungsModulus, AmParam::ZOffset, AmParam::TipRadius];
+        if !hertz {
+            params.push(AmParam::Hamaker);
+        }
+        // DMT: attractive to repulsive; Hertz: free flight, then light to firmer contact
+        let (from, to) = if hertz { (1.1, 0.85) } else { (1.4, 0.95) };
+        let z = rows(probe.length_m, from, to, 4, 1e-9);
+        let mut model = FmCurveModel::new(probe, z, params.clone(), hz);
+        model.loop_tolerance = 1e-12;
+        let p = truth(&probe, &params, 1e-9);
+        let law = if hertz { "Hertz" } else { "DMT" };
+        check_jacobian(&model, &p, &format!("{what} {law}"));
+    }
+}
+
+#[test]
+fn point_mass_fm_sensitivities_are_the_finite_differences() {
+    check_probe("probe-point-mass-dmt.toml", "point mass");
+}
+
+#[test]
+fn beam_fm_sensitivities_are_the_finite_differences() {
+    check_probe("probe-beam-dmt.toml", "N = 3 beam");
+}
+
+/// Standard normal draws (splitmix64 and Box–Muller: deterministic, no dependency).
+struct Normal(u64);
+
+impl Normal {
+    fn uniform(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    }
+    fn draw(&mut self) -> f64 {
+        let (u, v) = (self.uniform().max(1e-300), self.uniform());
+        (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
+    }
+}
+
+/// A Δf curve (Hz) of `count` rows z (m) of the library's `fm` analysis
+/// (`analysis::fm::fm_curve`, the probe's A₀ the setpoint) on the example point mass at the
+/// truth (the probe's E and H, z_offset = 1 nm), z_c from 1.4 A₀ (attractive) to 0.95 A₀
+/// (repulsive), with Gaussian noise σ = 0.2 Hz: the probe, Hz per Ω, z, Δf and σ.
+fn synthetic(count: usize, seed: u64) -> (AmProbe, f64, Vec<f64>, Vec<f64>, Vec<f64>) {
+    use afmdyn::analysis::fm::{fm_curve, FmSpec};
+    use afmdyn::analysis::progress::Progress;
+    let (probe, hz) = fm_probe("probe-point-mass-dmt.toml", false);
+    let g0 = probe.length_m;
+    let z_offset = 1e-9;
+    let z = rows(g0, 1.4, 0.95, count, z_offset);
+    // the truth's Δf by the FM analysis itself
+    let values = z
+        .iter()
+        .map(|z| probe.params.alpha5_for_rest_distance((z + z_offset) / g0))
+        .collect();
+    let curve = fm_curve(&FmSpec::new(probe.params, values, 1.0), &Progress::new()).expect("fm");
+    assert_eq!(curve.points.len(), z.len(), "{:?}", curve.unreached);
+    let sigma = vec![0.2; z.len()];
+    let mut normal = Normal(seed);
+    let y: Vec<f64> = curve
+        .points
+        .iter()
+        .zip(&sigma)
+        .map(|(p, s)| (p.omega - curve.reference.omega) * hz + s * normal.draw())
+        .collect();
+    (probe, hz, z, y, sigma)
+}
+
+/// The synthetic Δf curve fitted from E × 0.7, H × 1.3 and z_offset 0.6 nm: the 95 %
+/// intervals hold the truth, χ²/dof near 1.
+#[test]
+fn a_noisy_point_mass_fm_curve_gives_back_e_h_and_the_offset() {
+    use afmdyn::analysis::fit::{fit_with, Observations, Parameter};
+    let (probe, hz, z, y, sigma) = synthetic(30, 62);
+    let z_offset = 1e-9;
+    let params = vec![AmParam::YoungsModulus, AmParam::Hamaker, AmParam::ZOffset];
+    let truth = truth(&probe, &params, z_offset);
+    let model = FmCurveModel::new(probe, z, params, hz);
+    let start = [
+        Parameter {
+            name: "sample.youngs_modulus".into(),
+            start: 0.7 * probe.youngs_modulus,
+            lower: 1e5,
+            upper: f64::INFINITY,
+            scale: probe.youngs_modulus,
+        },
+        Parameter {
+            name: "sample.hamaker".into(),
+            start: 1.3 * probe.hamaker,
+            lower: 0.0,
+            upper: f64::INFINITY,
+            scale: probe.hamaker,
+        },
+        Parameter {
+            name: "z_offset".into(),
+            start: 0.6e-9,
+            lower: -5e-9,
+            upper: 5e-9,
+            scale: 1e-9,
+        },
+    ];
+    let obs = Observations {
+        y: &y,
+        sigma: Some(&sigma),
+    };
+    let out = fit_with(&model, &obs, &start, &[None, None, None], false);
+    eprintln!(
+        "Δf fit: {} evaluations ({}), χ²/dof {:.3}, {:?}",
+        out.evaluations, out.termination, out.chi2_dof, out.warnings
+    );
+    for (e, t) in out.estimates.iter().zip(&truth) {
+        eprintln!(
+            "{}: {:.6e} ± {:.3e} [{:.6e}, {:.6e}] (truth {t:.6e})",
+            e.name, e.value, e.standard_error, e.interval[0], e.interval[1]
+        );
+        assert!(
+            (e.interval[0]..=e.interval[1]).contains(t),
+            "{}: the interval misses the truth",
+            e.name
+        );
+        // the data constrain each: the interval is narrower than the truth's magnitude
+        assert!(e.interval[1] - e.interval[0] < t.abs(), "{}", e.name);
+    }
+    assert!(
+        (0.4..2.0).contains(&out.chi2_dof),
+        "χ²/dof {}",
+        out.chi2_dof
+    );
+}
+
+/// The synthetic Δf curve as the door's CSV (`z`, `frequency_shift`, `sigma_frequency_shift`,
+/// and an `amplitude` column, which an FM curve does not fit), fitted through `afmdyn fit`'s
+/// request from the probe's starts (z_offset's on its grid): an FM document whose curve holds
+/// the data, the fit and the residuals (Hz), whose estimates' intervals hold the truth, and
+/// whose Dataset and figures carry the frequency shift.
+#[test]
+fn a_frequency_shift_csv_goes_through_the_fit_door() {
+    use afmdyn::analysis::progress::Progress;
+    use afmdyn::request::fit::FitRequest;
+    use afmdyn::request::{run, Resolved};
+    let (_, _, z, y, sigma) = synthetic(16, 7);
+    let dir = std::env::temp_dir().join(format!("afmdyn-fit-fm-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let path = dir.join("fm.csv");
+    let mut text = String::from("z,frequency_shift,sigma_frequency_shift,amplitude\n");
+    for i in 0..z.len() {
+        text += &format!("{:?},{:?},{:?},1e-8\n", z[i], y[i], sigma[i]);
+    }
+    std::fs::write(&path, text).expect("csv");
+    let p = Probe::load(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/probe-point-mass-dmt.toml"),
+    )
+    .expect("probe");
+    let resolved = Resolved {
+        params: p.params,
+        probe: Some(p.clone()),
+    };
+    let request = FitRequest {
+        data: Some(path.display().to_string()),
+        fit: vec!["sample.hamaker".into(), "z_offset".into()],
+        ..FitRequest::default()
+    };
+    let doc = run(&request, &resolved, &Progress::default())
+        .expect("fit")
+        .json;
+    std::fs::remove_dir_all(&dir).ok();
+    assert_eq!(doc["kind"], "fm", "{doc}");
+    for (name, t) in [
+        ("sample.hamaker", p.sample_inputs.hamaker.unwrap()),
+        ("z_offset", 1e-9),
+    ] {
+        let e = &doc["estimates"][name];
+        let (lo, hi) = (
+            e["interval"][0].as_f64().unwrap(),
+            e["interval"][1].as_f64().unwrap(),
+        );
+        assert!(lo <= t && t <= hi, "{name}: truth {t} outside [{lo}, {hi}]");
+    }
+    let curve = &doc["curve"];
+    let col = |k: &str| -> Vec<f64> {
+        curve[k]
+            .as_array()
+            .unwrap_or_else(|| panic!("{k}"))
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect()
+    };
+    let (data, fit, residual) = (
+        col("frequency_shift"),
+        col("frequency_shift_fit"),
+        col("frequency_shift_residual"),
+    );
+    assert_eq!(data, y);
+    for i in 0..y.len() {
+        assert!((data[i] - fit[i] - residual[i]).abs() <= 1e-9 * data[i].abs().max(1.0));
+    }
+    assert!(curve["amplitude"].is_null() && curve["amplitude_fit"].is_null());
+    assert_eq!(doc["units"]["frequency_shift"], "Hz");
+    let warnings = doc["warnings"].to_string();
+    assert!(warnings.contains("not fitted"), "{warnings}");
+}
