@@ -11,8 +11,9 @@ use super::fit_result::{bounds, FitResult, MIN_FIT_ROWS};
 pub use super::fit_result::{AmData, DynamicFit};
 use super::run::Resolved;
 use crate::analysis::fit::am_curve::{AmCurveModel, AmParam, AmProbe, Z_OFFSET};
+use crate::analysis::fit::profile::{ProfileWalk, MAX_SECANT_STEPS};
 use crate::analysis::fit::start::{grid_start, z_offset_grid};
-use crate::analysis::fit::{fit_with, Observations, Parameter};
+use crate::analysis::fit::{fit_cancellable, Observations, Parameter};
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
 use serde_json::{json, Value};
@@ -121,7 +122,11 @@ fn check_data(d: &AmData) -> Result<(), SimError> {
 }
 
 /// Run the dynamic fit of the parameters `fit` (the force-curve fit's default when
-/// `default_fit`: E, with H on DMT; z_offset always) on `data` under `model`'s probe.
+/// `default_fit`: E, with H on DMT; z_offset always) on `data` under `model`'s probe, with the
+/// profile-likelihood intervals when `profiles` (the secant walk,
+/// [`ProfileWalk::Secant`] with [`MAX_SECANT_STEPS`] refits a side; else the Wald intervals).
+/// Every model evaluation is counted in `progress` and checks its cancel flag, between the
+/// rows of its stepped approach too.
 ///
 /// # Errors
 /// [`SimError::OutOfRange`] for bad data, parameter names, a probe without a Hertz or DMT
@@ -129,6 +134,7 @@ fn check_data(d: &AmData) -> Result<(), SimError> {
 pub fn execute(
     fit: &[String],
     default_fit: bool,
+    profiles: bool,
     model: &Resolved,
     data: AmData,
     progress: &Progress,
@@ -167,20 +173,7 @@ pub fn execute(
         hamaker: s.hamaker.unwrap_or(0.0),
         radius: need(s.radius, "tip.radius")?,
     };
-    // the default (the force curve's) is E and z_offset, with H on DMT; z_offset is always
-    // fitted
-    let mut names: Vec<String> = if default_fit {
-        let mut v = vec!["sample.youngs_modulus".to_string()];
-        if law_name == "dmt" {
-            v.push("sample.hamaker".into());
-        }
-        v
-    } else {
-        fit.to_vec()
-    };
-    if !names.iter().any(|n| n == Z_OFFSET) {
-        names.push(Z_OFFSET.into());
-    }
+    let names = fitted_names(fit, default_fit, law_name);
     let mut params = Vec::new();
     let mut am = Vec::new();
     for n in &names {
@@ -252,8 +245,11 @@ pub fn execute(
     if let Some(k) = z_index {
         params[k].start = grid_start(&curve, &obs, &params, k, z_offset_grid(g0), progress)?;
     }
-    // Wald intervals: a profile's refits would cost a hundred stepped approaches each
-    let mut outcome = fit_with(&curve, &obs, &params, &fixed, false);
+    // each profile point a refit of stepped approaches: the secant walk, when asked for
+    let walk = profiles.then_some(ProfileWalk::Secant {
+        max_steps: MAX_SECANT_STEPS,
+    });
+    let mut outcome = fit_cancellable(&curve, &obs, &params, &fixed, walk, progress)?;
     let model_warnings = curve.warnings();
     outcome.warnings.extend(model_warnings.iter().cloned());
     let names: Vec<&'static str> = params
@@ -273,6 +269,62 @@ pub fn execute(
             channels,
             model_warnings,
         }),
+    })
+}
+
+/// The names of the parameters fitted: `fit`, or the default (the force curve's, when
+/// `default_fit`) E, with H on DMT (`law_name` "dmt"); z_offset always, last unless named.
+pub fn fitted_names(fit: &[String], default_fit: bool, law_name: &str) -> Vec<String> {
+    let mut names: Vec<String> = if default_fit {
+        let mut v = vec!["sample.youngs_modulus".to_string()];
+        if law_name == "dmt" {
+            v.push("sample.hamaker".into());
+        }
+        v
+    } else {
+        fit.to_vec()
+    };
+    if !names.iter().any(|n| n == Z_OFFSET) {
+        names.push(Z_OFFSET.into());
+    }
+    names
+}
+
+/// The declared cost of a dynamic fit of `rows` rows fitting `fitted` parameters on
+/// `params` (the probe's model), with profiles when `profiles`: the worst case of its
+/// evaluations, each one stepped approach of the rows ([`super::costs::stepped_cost`], one
+/// way), z_offset's start grid, the minimiser's most evaluations
+/// ([`crate::analysis::fit::least_squares::max_evaluations`]) and, with profiles (up to
+/// [`crate::analysis::fit::estimates::MAX_PROFILED`] parameters), 2 × [`MAX_SECANT_STEPS`]
+/// refits per parameter of the other parameters. (The sensitivities of a Jacobian add one
+/// period of 2N + 4 columns per row, small beside a row's steady-state cap.)
+///
+/// # Errors
+/// [`SimError::Params`] when the model cannot be built.
+pub fn cost(
+    rows: usize,
+    fitted: usize,
+    profiles: bool,
+    params: &crate::params::Params,
+) -> Result<super::limits::Cost, SimError> {
+    use crate::analysis::fit::estimates::MAX_PROFILED;
+    use crate::analysis::fit::least_squares::max_evaluations;
+    use crate::analysis::fit::start::Z_OFFSET_GRID;
+    let mut spec =
+        crate::analysis::stepped::SteppedSpec::new(*params, crate::params::SweepParam::Alpha5, {
+            vec![params.alpha5; rows.max(2)]
+        });
+    spec.branches = false;
+    let approach = super::costs::stepped_cost(&spec)?;
+    let grid = (2 * Z_OFFSET_GRID + 1) as f64;
+    let mut evaluations = grid + max_evaluations(fitted) as f64 + 2.0;
+    if profiles && fitted <= MAX_PROFILED {
+        let refits = (fitted * 2 * MAX_SECANT_STEPS) as f64;
+        evaluations += refits * max_evaluations(fitted.saturating_sub(1)) as f64;
+    }
+    Ok(super::limits::Cost {
+        bytes: approach.bytes + rows as f64 * 8.0 * 64.0,
+        work: evaluations * approach.work,
     })
 }
 
@@ -306,6 +358,21 @@ pub fn document(r: &FitResult, d: &DynamicFit, estimates: Value, correlation: Va
     for (i, n) in r.names.iter().enumerate() {
         parameters.insert((*n).into(), json!({"value": o.values[i], "fitted": true}));
     }
+    let walk = if o.estimates.iter().any(|e| e.profile.is_some()) {
+        " (walked by secants on √Δχ² from 1 SE, at most 6 refits a side, each started from its \
+         neighbour)"
+    } else {
+        ""
+    };
+    let method = format!(
+        "{}{walk}; weighted least squares by Levenberg–Marquardt (MINPACK lmder, rust-cv \
+         levenberg-marquardt) of the stepped approach the instrument did (each row's periodic \
+         orbit continued from the previous one, z_c = z + z_offset), with the exact \
+         sensitivities of the orbits: the variational equations extended by the parameter \
+         columns, saltation at the switchings, ∂x*/∂p = (I − M)⁻¹ ∂P/∂p (docs/afm-workflow.md, \
+         From data to properties)",
+        super::fit::intervals_method(o)
+    );
     json!({
         "kind": "am",
         "estimates": estimates,
@@ -326,7 +393,7 @@ pub fn document(r: &FitResult, d: &DynamicFit, estimates: Value, correlation: Va
         "termination": o.termination,
         "units": {"sample.youngs_modulus": "Pa", "tip.radius": "m", "sample.hamaker": "J", "z_offset": "m",
                   "z": "m", "amplitude": "m", "phase": "deg"},
-        "method": "Wald intervals (±1.96 standard errors; no profiles: each refit is a stepped approach); weighted least squares by Levenberg–Marquardt (MINPACK lmder, rust-cv levenberg-marquardt) of the stepped approach the instrument did (each row's periodic orbit continued from the previous one, z_c = z + z_offset), with the exact sensitivities of the orbits: the variational equations extended by the parameter columns, saltation at the switchings, ∂x*/∂p = (I − M)⁻¹ ∂P/∂p (docs/afm-workflow.md, From data to properties)",
+        "method": method,
         "warnings": o.warnings,
     })
 }
