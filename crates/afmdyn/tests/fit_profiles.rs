@@ -424,3 +424,61 @@ fn a_cancelled_dynamic_fit_stops_within_one_evaluation() {
     c.model.evaluate(&c.truth, &mut v, None);
     assert!(v.iter().all(|x| x.is_finite()), "{v:?}");
 }
+
+/// The declared cost of a dynamic fit (held against the budget before it runs) counts the
+/// profiles' refits: with `profiles` the work grows by 2 × [`MAX_SECANT_STEPS`] refits of the
+/// other parameters per fitted parameter, each at most the refits' limit of evaluations
+/// (`least_squares::max_evaluations` at `REFIT_PATIENCE`), over the fit's own z_offset grid (13), minimiser and 2
+/// evaluations; every evaluation the same stepped approach of the rows. The 100-row point-mass
+/// fit with profiles is admitted.
+#[test]
+fn the_declared_cost_counts_the_profiles_refits() {
+    use afmdyn::analysis::fit::least_squares::{max_evaluations, PATIENCE};
+    use afmdyn::analysis::fit::profile::REFIT_PATIENCE;
+    use afmdyn::request::fit::FitRequest;
+    use afmdyn::request::{admit, Analysis, Resolved};
+    let dir = std::env::temp_dir().join(format!("afmdyn-fit-cost-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let path = dir.join("am.csv");
+    let mut text = String::from("z,amplitude\n");
+    for i in 0..100 {
+        text += &format!("{:e},{:e}\n", 7.5e-9 - 4.5e-11 * i as f64, 8e-9);
+    }
+    std::fs::write(&path, text).expect("csv");
+    let p = Probe::load(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/probe-point-mass-dmt.toml"),
+    )
+    .expect("probe");
+    let resolved = Resolved {
+        params: p.params,
+        probe: Some(p),
+    };
+    let request = |profiles: Option<bool>| FitRequest {
+        data: Some(path.display().to_string()),
+        fit: vec![
+            "sample.youngs_modulus".into(),
+            "sample.hamaker".into(),
+            "z_offset".into(),
+        ],
+        profiles,
+        ..FitRequest::default()
+    };
+    let without = request(None).cost(&resolved).expect("cost");
+    let with = request(Some(true)).cost(&resolved).expect("cost");
+    assert_eq!(request(Some(false)).cost(&resolved).expect("cost"), without);
+    admit(&request(Some(true)), &resolved).expect("admitted");
+    std::fs::remove_dir_all(&dir).ok();
+    let fit = (13 + max_evaluations(3, PATIENCE) + 2) as f64;
+    let refits = (3 * 2 * MAX_SECANT_STEPS) as f64 * max_evaluations(2, REFIT_PATIENCE) as f64;
+    eprintln!(
+        "declared work: {:.3e} mode-periods, {:.3e} with profiles",
+        without.work, with.work
+    );
+    assert!(without.work > 0.0);
+    let ratio = with.work / without.work;
+    assert!(
+        (ratio - (fit + refits) / fit).abs() <= 1e-12 * ratio,
+        "{ratio} against {}",
+        (fit + refits) / fit
+    );
+}

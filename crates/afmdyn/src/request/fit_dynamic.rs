@@ -296,7 +296,8 @@ pub fn fitted_names(fit: &[String], default_fit: bool, law_name: &str) -> Vec<St
 /// way), z_offset's start grid, the minimiser's most evaluations
 /// ([`crate::analysis::fit::least_squares::max_evaluations`]) and, with profiles (up to
 /// [`crate::analysis::fit::estimates::MAX_PROFILED`] parameters), 2 × [`MAX_SECANT_STEPS`]
-/// refits per parameter of the other parameters. (The sensitivities of a Jacobian add one
+/// refits per parameter of the other parameters, each at most
+/// [`crate::analysis::fit::profile::REFIT_PATIENCE`]'s evaluations. (The sensitivities of a Jacobian add one
 /// period of 2N + 4 columns per row, small beside a row's steady-state cap.)
 ///
 /// # Errors
@@ -308,7 +309,8 @@ pub fn cost(
     params: &crate::params::Params,
 ) -> Result<super::limits::Cost, SimError> {
     use crate::analysis::fit::estimates::MAX_PROFILED;
-    use crate::analysis::fit::least_squares::max_evaluations;
+    use crate::analysis::fit::least_squares::{max_evaluations, PATIENCE};
+    use crate::analysis::fit::profile::REFIT_PATIENCE;
     use crate::analysis::fit::start::Z_OFFSET_GRID;
     let mut spec =
         crate::analysis::stepped::SteppedSpec::new(*params, crate::params::SweepParam::Alpha5, {
@@ -317,10 +319,10 @@ pub fn cost(
     spec.branches = false;
     let approach = super::costs::stepped_cost(&spec)?;
     let grid = (2 * Z_OFFSET_GRID + 1) as f64;
-    let mut evaluations = grid + max_evaluations(fitted) as f64 + 2.0;
+    let mut evaluations = grid + max_evaluations(fitted, PATIENCE) as f64 + 2.0;
     if profiles && fitted <= MAX_PROFILED {
         let refits = (fitted * 2 * MAX_SECANT_STEPS) as f64;
-        evaluations += refits * max_evaluations(fitted.saturating_sub(1)) as f64;
+        evaluations += refits * max_evaluations(fitted.saturating_sub(1), REFIT_PATIENCE) as f64;
     }
     Ok(super::limits::Cost {
         bytes: approach.bytes + rows as f64 * 8.0 * 64.0,

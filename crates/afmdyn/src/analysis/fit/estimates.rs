@@ -8,7 +8,7 @@
 //! Analysis and Its Applications*, Wiley 1988, §2.3; Raue et al. 2009 for the profiles).
 
 use super::least_squares::{
-    evaluate_in, minimize_cancellable, CurveModel, Observations, Parameter,
+    evaluate_in, minimize_cancellable, CurveModel, Observations, Parameter, PATIENCE, TOLERANCE,
 };
 use super::profile::{profile, Profile, ProfileEnd, ProfileWalk, DELTA_CHI2_95};
 use crate::analysis::progress::Progress;
@@ -128,7 +128,15 @@ pub fn fit_cancellable(
     progress: &Progress,
 ) -> Result<FitOutcome, SimError> {
     let start: Vec<f64> = params.iter().map(|p| p.start).collect();
-    let best = minimize_cancellable(model, obs, params, &start, fixed, progress)?;
+    let best = minimize_cancellable(
+        model,
+        obs,
+        params,
+        &start,
+        fixed,
+        (TOLERANCE, PATIENCE),
+        progress,
+    )?;
     let free: Vec<usize> = (0..params.len()).filter(|&j| fixed[j].is_none()).collect();
     let (m, n) = (model.points(), free.len());
     let dof = m.saturating_sub(n);
@@ -174,7 +182,19 @@ pub fn fit_cancellable(
                 .into(),
         );
     }
-    let se: Vec<f64> = (0..n).map(|k| cov[(k, k)].max(0.0).sqrt()).collect();
+    // a variance that is not positive (a parameter whose Jacobian column is zero or at the
+    // rounding level: the pseudo-inverse's diagonal then comes out 0 or negative) is NaN:
+    // the parameter is not constrained, not known exactly
+    let se: Vec<f64> = (0..n)
+        .map(|k| {
+            let v = cov[(k, k)];
+            if v > 0.0 {
+                v.sqrt()
+            } else {
+                f64::NAN
+            }
+        })
+        .collect();
     let correlation: Vec<Vec<f64>> = (0..n)
         .map(|a| {
             (0..n)
@@ -225,6 +245,13 @@ pub fn fit_cancellable(
                      range walked on {side}{walked}; the data do not bound it there (the \
                      interval's end there is the last point walked: open)",
                     p.name,
+                ));
+            }
+            if pr.unconverged > 0 {
+                warnings.push(format!(
+                    "{}: {} of the profile's {} refits stopped at the minimiser's limit of \
+                     evaluations before converging (their Δχ² may be high, the interval narrow)",
+                    p.name, pr.unconverged, pr.refits
                 ));
             }
             if let Some(side) = sides(|e| matches!(e, ProfileEnd::Failed(_))) {

@@ -31,14 +31,14 @@ pub const TOLERANCE: f64 = 1e-10;
 /// (n free parameters; MINPACK's `maxfev`, the crate's `with_patience`).
 pub const PATIENCE: usize = 200;
 
-/// The most model evaluations of one [`minimize`] over `n` free parameters: the minimiser's
-/// [`PATIENCE`] × (n + 1) residual evaluations, at most as many Jacobians (one per outer
-/// iteration, each of which evaluates the residuals at least once) and the final χ²; 1 with
-/// nothing free.
-pub fn max_evaluations(n: usize) -> usize {
+/// The most model evaluations of one minimisation over `n` free parameters with `patience`
+/// ([`PATIENCE`] for a fit): the minimiser's `patience` × (n + 1) residual evaluations, at
+/// most as many Jacobians (one per outer iteration, each of which evaluates the residuals at
+/// least once) and the final χ²; 1 with nothing free.
+pub fn max_evaluations(n: usize, patience: usize) -> usize {
     match n {
         0 => 1,
-        n => 2 * PATIENCE * (n + 1) + 1,
+        n => 2 * patience * (n + 1) + 1,
     }
 }
 
@@ -289,11 +289,21 @@ pub fn minimize(
 ) -> Minimum {
     // a run of its own, never cancelled
     let progress = Progress::new();
-    run(model, obs, params, start, fixed, &progress).0
+    run(
+        model,
+        obs,
+        params,
+        start,
+        fixed,
+        (TOLERANCE, PATIENCE),
+        &progress,
+    )
+    .0
 }
 
-/// [`minimize`] in a run: every evaluation counted in `progress` and checking its cancel flag
-/// (the module docs).
+/// [`minimize`] in a run, to the relative `tolerance` (MINPACK's ftol, xtol and gtol;
+/// [`TOLERANCE`] for a fit) with `patience` ([`PATIENCE`] for a fit): every evaluation counted
+/// in `progress` and checking its cancel flag (the module docs).
 ///
 /// # Errors
 /// [`SimError::Cancelled`] when `progress` is cancelled before the minimum is found.
@@ -303,9 +313,18 @@ pub fn minimize_cancellable(
     params: &[Parameter],
     start: &[f64],
     fixed: &[Option<f64>],
+    (tolerance, patience): (f64, usize),
     progress: &Progress,
 ) -> Result<Minimum, SimError> {
-    match run(model, obs, params, start, fixed, progress) {
+    match run(
+        model,
+        obs,
+        params,
+        start,
+        fixed,
+        (tolerance, patience),
+        progress,
+    ) {
         (_, true) => Err(SimError::Cancelled),
         (m, false) => Ok(m),
     }
@@ -318,6 +337,7 @@ fn run(
     params: &[Parameter],
     start: &[f64],
     fixed: &[Option<f64>],
+    (tolerance, patience): (f64, usize),
     progress: &Progress,
 ) -> (Minimum, bool) {
     let full: Vec<f64> = start
@@ -368,10 +388,10 @@ fn run(
         };
     }
     let (problem, report) = LevenbergMarquardt::new()
-        .with_ftol(TOLERANCE)
-        .with_xtol(TOLERANCE)
-        .with_gtol(TOLERANCE)
-        .with_patience(PATIENCE)
+        .with_ftol(tolerance)
+        .with_xtol(tolerance)
+        .with_gtol(tolerance)
+        .with_patience(patience)
         .minimize(problem);
     let evaluations = problem.evaluations.get() + 1;
     let values = problem.full;

@@ -39,6 +39,18 @@ pub const MAX_SECANT_STEPS: usize = 6;
 /// parabolic profile; the coverage of χ²₁ at 3.791 … 3.891 is 94.84 … 95.14 %.
 pub const SECANT_TOLERANCE: f64 = 0.05;
 
+/// The relative tolerance of a profile's refits (MINPACK's ftol, xtol, gtol): χ² to 1e-7
+/// relative is Δχ² to 1e-4 at χ² = 1000 (m = 1000 points), far inside
+/// [`SECANT_TOLERANCE`]; the fit's own minimum keeps [`super::least_squares::TOLERANCE`].
+pub const REFIT_TOLERANCE: f64 = 1e-7;
+
+/// The patience of a profile's refits (the minimiser stops after `REFIT_PATIENCE` × (n + 1)
+/// residual evaluations, [`super::least_squares::PATIENCE`]): a refit starts from its
+/// neighbour's minimum and converges in a few iterations (~12 evaluations on the dynamic fit of
+/// scripts/perf-fit-dynamic.sh); the cap bounds the profiles' declared cost. A refit that meets
+/// it is counted ([`Profile::unconverged`]) and warned of.
+pub const REFIT_PATIENCE: usize = 50;
+
 /// How a profile is walked (the module docs).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ProfileWalk {
@@ -48,7 +60,7 @@ pub enum ProfileWalk {
     Grid,
     /// The secant walk on √Δχ²: the first refit at one standard error, then the secant through
     /// the last two points (regula falsi once the crossing is bracketed, kept within the
-    /// bracket's middle 80 %), each step at most doubling the distance from the estimate (where
+    /// bracket's middle 96 %), each step at most doubling the distance from the estimate (where
     /// Δχ² rises slowly); it ends at a refit within [`SECANT_TOLERANCE`] of the threshold, or
     /// after `max_steps` refits a side (a flat profile, or the crossing interpolated in its
     /// bracket).
@@ -99,6 +111,8 @@ pub struct Profile {
     pub refits: usize,
     /// Model evaluations the refits made.
     pub evaluations: usize,
+    /// Refits that stopped at [`REFIT_PATIENCE`] before converging.
+    pub unconverged: usize,
 }
 
 /// The profile of parameter `j` about `best`, the parameters `fixed` in the fit held there
@@ -135,6 +149,7 @@ pub fn profile(
         points: vec![(centre, 0.0)],
         refits: 0,
         evaluations: 0,
+        unconverged: 0,
         lowest: 0.0,
     };
     let mut ends = [ProfileEnd::Flat(centre); 2];
@@ -148,6 +163,7 @@ pub fn profile(
         mut points,
         refits,
         evaluations,
+        unconverged,
         lowest,
         ..
     } = walker;
@@ -159,6 +175,7 @@ pub fn profile(
         lowest,
         refits,
         evaluations,
+        unconverged,
     })
 }
 
@@ -175,6 +192,7 @@ struct Walker<'a> {
     points: Vec<(f64, f64)>,
     refits: usize,
     evaluations: usize,
+    unconverged: usize,
     lowest: f64,
 }
 
@@ -190,9 +208,11 @@ impl Walker<'_> {
             self.params,
             from,
             &held,
+            (REFIT_TOLERANCE, REFIT_PATIENCE),
             self.progress,
         )?;
         self.refits += 1;
+        self.unconverged += usize::from(!m.converged);
         self.evaluations += m.evaluations;
         let d = (m.chi2 - self.best.chi2) / self.s2;
         if d.is_finite() {
@@ -304,16 +324,24 @@ impl Walker<'_> {
                 // regula falsi on r inside the bracket, kept off its ends
                 Some((dh, rh, _)) => {
                     let (dl, rl) = (below.0, below.1);
-                    let t = ((target - rl) / (rh - rl)).clamp(0.1, 0.9);
+                    let t = ((target - rl) / (rh - rl)).clamp(0.02, 0.98);
                     dl + t * (dh - dl)
                 }
-                // the secant through the last two points below, at most doubling δ
+                // the secant through the last two points below, at most doubling δ; from the
+                // estimate and the first point aimed at the threshold (exact for a parabola),
+                // later at the tolerance band's upper half (r of a profile that bends over
+                // rises slower than its secant: aimed at the threshold it stops short of it)
                 None => {
                     let (da, ra) = before;
                     let (db, rb) = (below.0, below.1);
                     let most = 2.0 * db;
+                    let aim = if da == 0.0 {
+                        target
+                    } else {
+                        (DELTA_CHI2_95 + 0.5 * SECANT_TOLERANCE).sqrt()
+                    };
                     if rb > ra {
-                        (db + (target - rb) * (db - da) / (rb - ra)).clamp(1.05 * db, most)
+                        (db + (aim - rb) * (db - da) / (rb - ra)).clamp(1.05 * db, most)
                     } else {
                         most
                     }
