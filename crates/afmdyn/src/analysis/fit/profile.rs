@@ -445,7 +445,7 @@ mod tests {
         let walk = ProfileWalk::Secant {
             max_steps: MAX_SECANT_STEPS,
         };
-        for j in 0..2 {
+        for (j, se) in se.into_iter().enumerate() {
             let pr = profile(
                 &model,
                 &obs,
@@ -453,17 +453,17 @@ mod tests {
                 &best,
                 &[None, None],
                 j,
-                se[j],
+                se,
                 1.0,
                 walk,
                 &progress,
             )
             .unwrap();
             let c = best.values[j];
-            for (end, wald) in [(pr.lower, c - Z_95 * se[j]), (pr.upper, c + Z_95 * se[j])] {
+            for (end, wald) in [(pr.lower, c - Z_95 * se), (pr.upper, c + Z_95 * se)] {
                 assert!(matches!(end, ProfileEnd::Crossing(_)), "{end:?}");
                 assert!(
-                    (end.value() - wald).abs() <= 1e-9 * se[j],
+                    (end.value() - wald).abs() <= 1e-9 * se,
                     "{j}: {end:?} against {wald}"
                 );
             }
