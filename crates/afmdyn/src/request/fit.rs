@@ -435,8 +435,8 @@ impl Analysis for FitRequest {
 
 /// The document of a fit (`afmdyn fit --json`, Python's `summary`): `estimates` (each fitted
 /// parameter's `value`, `standard_error`, 95 % `interval` — the profile likelihood's —,
-/// `wald_interval`, `interval_ends` — crossing, bound or flat —, `profile` — the points walked,
-/// `value` and `delta_chi2`), `parameters` (every parameter's value, fitted or held), `correlation`
+/// `wald_interval`, `interval_ends` — crossing, bound, flat or failed —, `profile` — the
+/// points walked, `value` and `delta_chi2`), `parameters` (every parameter's value, fitted or held), `correlation`
 /// (`names`, `matrix`), `chi2`, `dof`, `chi2_dof`, `noise`, `curve` (the fitted rows' tip
 /// position, force, fit and residual), `preprocessing`, `law`, `segment`, `range`, `units`,
 /// `method`, `warnings`; SI throughout.
