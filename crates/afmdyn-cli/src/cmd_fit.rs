@@ -105,7 +105,7 @@ pub fn fit(a: &FitArgs) -> Result<(), CliError> {
         json: a.json,
         out: (a.files != Files::None).then_some(a.out.as_path()),
         files: files(a.files),
-        unit: "fits",
+        unit: "model evaluations",
     };
     door::run(&request, &model, exit).map(|_| ())
 }
