@@ -1,7 +1,8 @@
 //! `afmdyn fit`: a measured quasi-static force curve fitted with the probe's contact law
 //! (Hertz, DMT, JKR), with its contact point and baseline — estimates, standard errors, 95 %
 //! profile-likelihood intervals, correlations, χ²/dof, residuals and identifiability
-//! warnings. The request, the preprocessing, the fit and the document are the library's
+//! warnings (with `--profiles`, an AM curve's intervals are the profile likelihood's too).
+//! The request, the preprocessing, the fit and the document are the library's
 //! ([`afmdyn::request::FitRequest`], [`afmdyn::analysis::fit`]), and so are its summary, table,
 //! figures and `fit.json` ([`afmdyn::request::present::fit`]); this front end maps the flags.
 
@@ -51,6 +52,14 @@ pub struct FitArgs {
     /// recorded its segments [default: up to the lowest height, inclusive]
     #[arg(long, value_name = "N")]
     approach_rows: Option<usize>,
+    /// Profile-likelihood intervals (Δχ² ≤ 3.84, up to 4 fitted parameters) for an AM curve
+    /// too, where each profile point refits stepped approaches (at most 6 refits a side); a
+    /// force curve has them by default [default: Wald intervals ±1.96 SE for an AM curve]
+    #[arg(long, conflicts_with = "no_profiles")]
+    profiles: bool,
+    /// Wald intervals (±1.96 SE) for a force curve too, no profiles
+    #[arg(long)]
+    no_profiles: bool,
     /// Output directory (locked during the run)
     #[arg(long, default_value = "afmdyn-out/fit")]
     out: PathBuf,
@@ -87,6 +96,11 @@ pub fn fit(a: &FitArgs) -> Result<(), CliError> {
         segment,
         range,
         approach_rows: a.approach_rows,
+        profiles: match (a.profiles, a.no_profiles) {
+            (true, _) => Some(true),
+            (_, true) => Some(false),
+            _ => None,
+        },
         ..FitRequest::default()
     };
     let model = Resolved { params, probe };
@@ -94,7 +108,7 @@ pub fn fit(a: &FitArgs) -> Result<(), CliError> {
         json: a.json,
         out: (a.files != Files::None).then_some(a.out.as_path()),
         files: files(a.files),
-        unit: "fits",
+        unit: "model evaluations",
     };
     door::run(&request, &model, exit).map(|_| ())
 }

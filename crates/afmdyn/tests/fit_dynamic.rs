@@ -263,7 +263,8 @@ const CASES: [Case; 8] = [
         points: 21,
         params: HERTZ_PARAMS,
         regimes: &[Regime::Repulsive],
-    },    Case {
+    },
+    Case {
         name: "point mass DMT, drive",
         probe: "probe-point-mass-dmt.toml",
         hertz: false,

@@ -423,6 +423,7 @@ FitRequest = TypedDict(
         "fit": List[str],  # default ["sample.youngs_modulus", "contact_point"]
         "force": List[float],  # default []
         "height": List[float],  # default []
+        "profiles": Optional[bool],  # default null
         "range": Optional[List[float]],  # default null
         "segment": Literal["approach", "retract"],  # default "approach"
         "sigma": Optional[List[float]],  # default null

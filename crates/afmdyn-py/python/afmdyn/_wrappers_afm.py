@@ -723,6 +723,7 @@ def fit(
     approach_rows: Optional[int] = None,
     data: Union[str, "os.PathLike[str]", Mapping[str, Sequence[float]], Any, None] = None,
     fit: Optional[Sequence[str]] = None,
+    profiles: Optional[bool] = None,
     fit_range: Optional[Tuple[float, float]] = None,
     segment: str = "approach",
     curve: int = 0,
@@ -754,6 +755,12 @@ def fit(
             ``sample.adhesion_energy`` (JKR); the others are held at the probe's values
             (contact point and baseline at 0, after the preprocessing). Default
             ``sample.youngs_modulus``, ``contact_point``.
+        profiles: Profile-likelihood intervals (Δχ² ≤ 3.84) for the fitted parameters, up to
+            4 of them (beyond, and when off, the Wald intervals ±1.96 SE). Default on for a
+            force curve; off for an AM curve, where every profile point is a refit of
+            stepped approaches (on, each side is walked by secants on √Δχ² in units of the
+            standard error, at most 6 refits, each started from its neighbour; a side that
+            has not risen by then is reported flat).
         fit_range: The range of tip positions fitted [lo, hi] (m, after the preprocessing's
             offset, as nanite's ``range_x``); default the whole segment.
         segment: The segment fitted (default the approach).

@@ -12,7 +12,8 @@ use crate::analysis::fit::force_curve::{
     preprocess, ForceCurveModel, ForceLaw, Segment, BASELINE, CONTACT_POINT, HAMAKER, RADIUS,
     YOUNGS_MODULUS,
 };
-use crate::analysis::fit::{fit, Observations, Parameter, ProfileEnd};
+use crate::analysis::fit::profile::ProfileWalk;
+use crate::analysis::fit::{fit_cancellable, FitOutcome, Observations, Parameter, ProfileEnd};
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
 use serde::{Deserialize, Serialize};
@@ -65,6 +66,12 @@ pub struct FitRequest {
     /// its segments (afmformats' `segment` column, which Python reads from an instrument
     /// file); default up to the lowest piezo height, inclusive. 1 to the number of rows.
     pub approach_rows: Option<usize>,
+    /// Profile-likelihood intervals (Δχ² ≤ 3.84) for the fitted parameters, up to 4 of them
+    /// (beyond, and when off, the Wald intervals ±1.96 SE). Default on for a force curve; off
+    /// for an AM curve, where every profile point is a refit of stepped approaches (on, each
+    /// side is walked by secants on √Δχ² in units of the standard error, at most 6 refits, each
+    /// started from its neighbour; a side that has not risen by then is reported flat).
+    pub profiles: Option<bool>,
 }
 
 impl Default for FitRequest {
@@ -78,6 +85,7 @@ impl Default for FitRequest {
             segment: FitSegment::Approach,
             range: None,
             approach_rows: None,
+            profiles: None,
         }
     }
 }
@@ -259,6 +267,7 @@ impl Analysis for FitRequest {
             return super::fit_dynamic::execute(
                 &self.fit,
                 self.fit == FitRequest::default().fit,
+                self.profiles.unwrap_or(false),
                 model,
                 data,
                 progress,
@@ -365,7 +374,8 @@ impl Analysis for FitRequest {
             y: &y,
             sigma: sig.as_deref(),
         };
-        let outcome = fit(&m, &obs, &params, &fixed);
+        let walk = self.profiles.unwrap_or(true).then_some(ProfileWalk::Grid);
+        let outcome = fit_cancellable(&m, &obs, &params, &fixed, walk, progress)?;
         Ok(FitResult {
             law,
             spring_constant: k,
@@ -380,7 +390,18 @@ impl Analysis for FitRequest {
     fn name(&self) -> &'static str {
         "fit"
     }
-    fn cost(&self, _: &Resolved) -> Result<Cost, SimError> {
+    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
+        // an AM curve: its stepped approaches, the profiles' refits included
+        if let Some(d) = super::fit_dynamic::read_am_data(self.data.as_deref())? {
+            let law = model
+                .probe
+                .as_ref()
+                .map_or("", |p| p.params.contact_law.name());
+            let default_fit = self.fit == FitRequest::default().fit;
+            let n = super::fit_dynamic::fitted_names(&self.fit, default_fit, law).len();
+            let profiles = self.profiles.unwrap_or(false);
+            return super::fit_dynamic::cost(d.z.len(), n, profiles, &model.params);
+        }
         // no integration; the columns, the preprocessed curve and the Jacobian (≤ 5 columns)
         let rows = if self.data.is_some() {
             MAX_FIT_ROWS
@@ -414,8 +435,8 @@ impl Analysis for FitRequest {
 
 /// The document of a fit (`afmdyn fit --json`, Python's `summary`): `estimates` (each fitted
 /// parameter's `value`, `standard_error`, 95 % `interval` — the profile likelihood's —,
-/// `wald_interval`, `interval_ends` — crossing, bound or flat —, `profile` — the points walked,
-/// `value` and `delta_chi2`), `parameters` (every parameter's value, fitted or held), `correlation`
+/// `wald_interval`, `interval_ends` — crossing, bound, flat or failed —, `profile` — the
+/// points walked, `value` and `delta_chi2`), `parameters` (every parameter's value, fitted or held), `correlation`
 /// (`names`, `matrix`), `chi2`, `dof`, `chi2_dof`, `noise`, `curve` (the fitted rows' tip
 /// position, force, fit and residual), `preprocessing`, `law`, `segment`, `range`, `units`,
 /// `method`, `warnings`; SI throughout.
@@ -424,6 +445,7 @@ pub fn document(request: &FitRequest, r: &FitResult) -> Value {
         ProfileEnd::Crossing(_) => "crossing",
         ProfileEnd::Bound(_) => "bound",
         ProfileEnd::Flat(_) => "flat (the last point walked: open)",
+        ProfileEnd::Failed(_) => "failed (a refit failed: the Wald end)",
     };
     let o = &r.outcome;
     let mut estimates = serde_json::Map::new();
@@ -499,9 +521,19 @@ pub fn document(request: &FitRequest, r: &FitResult) -> Value {
         "units": {"sample.youngs_modulus": "Pa", "tip.radius": "m", "contact_point": "m", "baseline": "N",
                   "sample.hamaker": "J", "sample.adhesion_energy": "J/m^2", "tip_position": "m", "force": "N",
                   "fit": "N", "residual": "N", "chi2_dof": if o.noise_estimated { "N^2" } else { "1" }},
-        "method": "weighted least squares by Levenberg–Marquardt (MINPACK lmder, rust-cv levenberg-marquardt) on the preprocessed curve (nanite's steps: tip position x = height + F/k, force offset and tip offset at the deviation_from_baseline contact point); F = baseline + F_law(contact_point − x) with the registry's law in SI (Hertz: (4/3)E*√R δ^{3/2}, Sneddon 1965); standard errors from (JᵀWJ)⁻¹ s²; intervals from the profile likelihood (Δχ² ≤ 3.84) (docs/afm-workflow.md, From data to properties)",
+        "method": "weighted least squares by Levenberg–Marquardt (MINPACK lmder, rust-cv levenberg-marquardt) on the preprocessed curve (nanite's steps: tip position x = height + F/k, force offset and tip offset at the deviation_from_baseline contact point); F = baseline + F_law(contact_point − x) with the registry's law in SI (Hertz: (4/3)E*√R δ^{3/2}, Sneddon 1965); standard errors from (JᵀWJ)⁻¹ s²; ".to_string() + intervals_method(o) + " (docs/afm-workflow.md, From data to properties)",
         "warnings": o.warnings,
     })
+}
+
+/// How a fit's intervals were found, for its document's `method`: the profile likelihood's
+/// where any parameter was profiled, else the Wald intervals.
+pub fn intervals_method(o: &FitOutcome) -> &'static str {
+    if o.estimates.iter().any(|e| e.profile.is_some()) {
+        "intervals from the profile likelihood (Δχ² ≤ 3.84; up to 4 fitted parameters, Wald ±1.96 SE beyond)"
+    } else {
+        "Wald intervals (±1.96 standard errors; no profiles)"
+    }
 }
 
 impl super::named::Datasets for FitRequest {

@@ -20,8 +20,9 @@ use super::run::Resolved;
 use crate::analysis::fit::am_curve::{AmCurveModel, AmParam, AmProbe, Z_OFFSET};
 use crate::analysis::fit::bimodal_curve::BimodalCurveModel;
 use crate::analysis::fit::fm_curve::FmCurveModel;
+use crate::analysis::fit::profile::{ProfileWalk, MAX_SECANT_STEPS};
 use crate::analysis::fit::start::{grid_start, z_offset_grid};
-use crate::analysis::fit::{fit_with, CurveModel, Observations, Parameter};
+use crate::analysis::fit::{fit_cancellable, CurveModel, Observations, Parameter};
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
 use serde_json::{json, Value};
@@ -200,7 +201,11 @@ fn check_data(d: &AmData) -> Result<(), SimError> {
 }
 
 /// Run the dynamic fit of the parameters `fit` (the force-curve fit's default when
-/// `default_fit`: E, with H on DMT; z_offset always) on `data` under `model`'s probe.
+/// `default_fit`: E, with H on DMT; z_offset always) on `data` under `model`'s probe, with the
+/// profile-likelihood intervals when `profiles` (the secant walk,
+/// [`ProfileWalk::Secant`] with [`MAX_SECANT_STEPS`] refits a side; else the Wald intervals).
+/// Every model evaluation is counted in `progress` and checks its cancel flag, between the
+/// rows of its stepped approach too.
 ///
 /// # Errors
 /// [`SimError::OutOfRange`] for bad data, parameter names, a probe without a Hertz or DMT
@@ -208,6 +213,7 @@ fn check_data(d: &AmData) -> Result<(), SimError> {
 pub fn execute(
     fit: &[String],
     default_fit: bool,
+    profiles: bool,
     model: &Resolved,
     data: AmData,
     progress: &Progress,
@@ -246,20 +252,7 @@ pub fn execute(
         hamaker: s.hamaker.unwrap_or(0.0),
         radius: need(s.radius, "tip.radius")?,
     };
-    // the default (the force curve's) is E and z_offset, with H on DMT; z_offset is always
-    // fitted
-    let mut names: Vec<String> = if default_fit {
-        let mut v = vec!["sample.youngs_modulus".to_string()];
-        if law_name == "dmt" {
-            v.push("sample.hamaker".into());
-        }
-        v
-    } else {
-        fit.to_vec()
-    };
-    if !names.iter().any(|n| n == Z_OFFSET) {
-        names.push(Z_OFFSET.into());
-    }
+    let names = fitted_names(fit, default_fit, law_name);
     let mut params = Vec::new();
     let mut am = Vec::new();
     for n in &names {
@@ -363,9 +356,12 @@ pub fn execute(
     if let Some(k) = z_index {
         params[k].start = grid_start(curve, &obs, &params, k, z_offset_grid(g0), progress)?;
     }
-    // Wald intervals: a profile's refits would cost a hundred stepped approaches (FM curves)
-    // each
-    let mut outcome = fit_with(curve, &obs, &params, &fixed, false);
+    // each profile point a refit of stepped approaches (FM curves): the secant walk, when
+    // asked for
+    let walk = profiles.then_some(ProfileWalk::Secant {
+        max_steps: MAX_SECANT_STEPS,
+    });
+    let mut outcome = fit_cancellable(curve, &obs, &params, &fixed, walk, progress)?;
     let model_warnings = match (&fm_model, &bimodal_model) {
         (Some(m), _) => m.warnings(),
         (None, Some(m)) => m.warnings(),
@@ -398,6 +394,64 @@ pub fn execute(
             second,
             model_warnings,
         }),
+    })
+}
+
+/// The names of the parameters fitted: `fit`, or the default (the force curve's, when
+/// `default_fit`) E, with H on DMT (`law_name` "dmt"); z_offset always, last unless named.
+pub fn fitted_names(fit: &[String], default_fit: bool, law_name: &str) -> Vec<String> {
+    let mut names: Vec<String> = if default_fit {
+        let mut v = vec!["sample.youngs_modulus".to_string()];
+        if law_name == "dmt" {
+            v.push("sample.hamaker".into());
+        }
+        v
+    } else {
+        fit.to_vec()
+    };
+    if !names.iter().any(|n| n == Z_OFFSET) {
+        names.push(Z_OFFSET.into());
+    }
+    names
+}
+
+/// The declared cost of a dynamic fit of `rows` rows fitting `fitted` parameters on
+/// `params` (the probe's model), with profiles when `profiles`: the worst case of its
+/// evaluations, each one stepped approach of the rows ([`super::costs::stepped_cost`], one
+/// way), z_offset's start grid, the minimiser's most evaluations
+/// ([`crate::analysis::fit::least_squares::max_evaluations`]) and, with profiles (up to
+/// [`crate::analysis::fit::estimates::MAX_PROFILED`] parameters), 2 × [`MAX_SECANT_STEPS`]
+/// refits per parameter of the other parameters, each at most
+/// [`crate::analysis::fit::profile::REFIT_PATIENCE`]'s evaluations. (The sensitivities of a Jacobian add one
+/// period of 2N + 4 columns per row, small beside a row's steady-state cap.)
+///
+/// # Errors
+/// [`SimError::Params`] when the model cannot be built.
+pub fn cost(
+    rows: usize,
+    fitted: usize,
+    profiles: bool,
+    params: &crate::params::Params,
+) -> Result<super::limits::Cost, SimError> {
+    use crate::analysis::fit::estimates::MAX_PROFILED;
+    use crate::analysis::fit::least_squares::{max_evaluations, PATIENCE};
+    use crate::analysis::fit::profile::REFIT_PATIENCE;
+    use crate::analysis::fit::start::Z_OFFSET_GRID;
+    let mut spec =
+        crate::analysis::stepped::SteppedSpec::new(*params, crate::params::SweepParam::Alpha5, {
+            vec![params.alpha5; rows.max(2)]
+        });
+    spec.branches = false;
+    let approach = super::costs::stepped_cost(&spec)?;
+    let grid = (2 * Z_OFFSET_GRID + 1) as f64;
+    let mut evaluations = grid + max_evaluations(fitted, PATIENCE) as f64 + 2.0;
+    if profiles && fitted <= MAX_PROFILED {
+        let refits = (fitted * 2 * MAX_SECANT_STEPS) as f64;
+        evaluations += refits * max_evaluations(fitted.saturating_sub(1), REFIT_PATIENCE) as f64;
+    }
+    Ok(super::limits::Cost {
+        bytes: approach.bytes + rows as f64 * 8.0 * 64.0,
+        work: evaluations * approach.work,
     })
 }
 
@@ -439,20 +493,27 @@ pub fn document(r: &FitResult, d: &DynamicFit, estimates: Value, correlation: Va
     for (i, n) in r.names.iter().enumerate() {
         parameters.insert((*n).into(), json!({"value": o.values[i], "fitted": true}));
     }
+    let walk = if o.estimates.iter().any(|e| e.profile.is_some()) {
+        " (walked by secants on √Δχ² from 1 SE, at most 6 refits a side, each started from its \
+         neighbour)"
+    } else {
+        ""
+    };
     let fm = d.frequency_shift;
-    let (kind, steps, method) = if fm {
+    let (kind, steps, least_squares) = if fm {
         (
             "fm",
             "none: z and the frequency shift as measured; z_c = z + z_offset; the amplitude setpoint the probe's free amplitude",
-            "Wald intervals (±1.96 standard errors; no profiles: each refit is an FM curve); weighted least squares by Levenberg–Marquardt (MINPACK lmder, rust-cv levenberg-marquardt) of the FM curve the instrument recorded (an ideal PLL and amplitude controller: each row's orbit at the drive frequency and excitation that hold the first harmonic at the probe's free amplitude and the free lever's phase at resonance, followed from row to row as afmdyn fm does, z_c = z + z_offset; Δf = Ω − ω₁), with exact sensitivities: the implicit function theorem on the loop conditions, d(Ω, α2)/dp = −[∂g/∂(Ω, α2)]⁻¹ ∂g/∂p, from the orbits' sensitivities (variational equations extended by the parameters and the drive's α2 and Ω, time rescaled to a fixed phase; ∂x*/∂p = (I − M)⁻¹ ∂P/∂p) (docs/afm-workflow.md, From data to properties)",
+            "weighted least squares by Levenberg–Marquardt (MINPACK lmder, rust-cv levenberg-marquardt) of the FM curve the instrument recorded (an ideal PLL and amplitude controller: each row's orbit at the drive frequency and excitation that hold the first harmonic at the probe's free amplitude and the free lever's phase at resonance, followed from row to row as afmdyn fm does, z_c = z + z_offset; Δf = Ω − ω₁), with exact sensitivities: the implicit function theorem on the loop conditions, d(Ω, α2)/dp = −[∂g/∂(Ω, α2)]⁻¹ ∂g/∂p, from the orbits' sensitivities (variational equations extended by the parameters and the drive's α2 and Ω, time rescaled to a fixed phase; ∂x*/∂p = (I − M)⁻¹ ∂P/∂p) (docs/afm-workflow.md, From data to properties)",
         )
     } else {
         (
             "am",
             "none: z, amplitude and phase as measured; z_c = z + z_offset",
-            "Wald intervals (±1.96 standard errors; no profiles: each refit is a stepped approach); weighted least squares by Levenberg–Marquardt (MINPACK lmder, rust-cv levenberg-marquardt) of the stepped approach the instrument did (each row's periodic orbit continued from the previous one, z_c = z + z_offset), with the exact sensitivities of the orbits: the variational equations extended by the parameter columns, saltation at the switchings, ∂x*/∂p = (I − M)⁻¹ ∂P/∂p (docs/afm-workflow.md, From data to properties)",
+            "weighted least squares by Levenberg–Marquardt (MINPACK lmder, rust-cv levenberg-marquardt) of the stepped approach the instrument did (each row's periodic orbit continued from the previous one, z_c = z + z_offset), with the exact sensitivities of the orbits: the variational equations extended by the parameter columns, saltation at the switchings, ∂x*/∂p = (I − M)⁻¹ ∂P/∂p (docs/afm-workflow.md, From data to properties)",
         )
     };
+    let method = format!("{}{walk}; {least_squares}", super::fit::intervals_method(o));
     json!({
         "kind": kind,
         "estimates": estimates,

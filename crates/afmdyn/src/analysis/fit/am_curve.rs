@@ -20,6 +20,10 @@
 //! the channels fitted; a row whose point is not a stable period-1 orbit keeps the stepped
 //! sweep's observables with a zero Jacobian row, and says so in [`AmCurveModel::warnings`], as
 //! a fold or a grazing orbit does (where the sensitivities are not to be trusted).
+//!
+//! An evaluation is a stepped approach of every row (and, with the Jacobian, an orbit's
+//! sensitivities per row): [`CurveModel::evaluate_cancellable`] checks the run's cancel flag
+//! between the rows and stops there, its values NaN.
 
 use super::sensitivity::{orbit_sensitivity, OrbitParam};
 use super::CurveModel;
@@ -190,6 +194,7 @@ impl AmCurveModel {
         p: &[f64],
         values: &mut [f64],
         mut jacobian: Option<&mut [f64]>,
+        cancel: &AtomicBool,
     ) -> Result<Vec<String>, SimError> {
         let (q, z_offset, chain) = self.scaled(p);
         let g0 = self.probe.length_m;
@@ -201,7 +206,7 @@ impl AmCurveModel {
         let mut spec = self.spec.clone();
         spec.base = q;
         spec.values = alpha5.clone();
-        let first = first_sweep(&spec)?;
+        let first = first_sweep_cancellable(&spec, cancel)?;
         let dmt = matches!(q.contact_law, ContactLaw::Dmt { .. });
         let mut orbit_params = vec![OrbitParam::Gap, OrbitParam::ContactStiffness];
         if dmt {
@@ -215,6 +220,9 @@ impl AmCurveModel {
         let mut warnings = Vec::new();
         let mut off = 0;
         for (i, point) in first.iter().enumerate() {
+            if cancel.load(Ordering::Relaxed) {
+                return Err(SimError::Cancelled);
+            }
             let mut a = point.observables.amplitude;
             let mut phi = point.observables.phase;
             let mut da = [0.0; 4];
@@ -284,9 +292,20 @@ impl AmCurveModel {
 /// # Errors
 /// As [`sweep_points`].
 pub fn first_sweep(spec: &SteppedSpec) -> Result<Vec<CurvePoint>, SimError> {
+    first_sweep_cancellable(spec, &AtomicBool::new(false))
+}
+
+/// [`first_sweep`], stopped after the point under way once `stop` is set.
+///
+/// # Errors
+/// As [`sweep_points`]; [`SimError::Cancelled`] when `stop` was set before the last point.
+pub fn first_sweep_cancellable(
+    spec: &SteppedSpec,
+    stop: &AtomicBool,
+) -> Result<Vec<CurvePoint>, SimError> {
     check_values(spec)?;
     let n = spec.values.len();
-    let cancel = AtomicBool::new(false);
+    let cancel = AtomicBool::new(stop.load(Ordering::Relaxed));
     let points = Mutex::new(Vec::with_capacity(n));
     let sink = |k: usize, p: &CurvePoint| {
         if k < n {
@@ -294,7 +313,7 @@ pub fn first_sweep(spec: &SteppedSpec) -> Result<Vec<CurvePoint>, SimError> {
                 v.push(p.clone());
             }
         }
-        if k + 1 >= n {
+        if k + 1 >= n || stop.load(Ordering::Relaxed) {
             cancel.store(true, Ordering::Relaxed);
         }
     };
@@ -303,7 +322,7 @@ pub fn first_sweep(spec: &SteppedSpec) -> Result<Vec<CurvePoint>, SimError> {
         Err(e) => return Err(e),
     }
     let points = points.into_inner().unwrap_or_default();
-    if points.len() == n {
+    if points.len() == n && !stop.load(Ordering::Relaxed) {
         Ok(points)
     } else {
         Err(SimError::Cancelled)
@@ -315,8 +334,17 @@ impl CurveModel for AmCurveModel {
         self.z.len() * (usize::from(self.channels.0) + usize::from(self.channels.1))
     }
     fn evaluate(&self, p: &[f64], values: &mut [f64], jacobian: Option<&mut [f64]>) {
+        self.evaluate_cancellable(p, values, jacobian, &AtomicBool::new(false));
+    }
+    fn evaluate_cancellable(
+        &self,
+        p: &[f64],
+        values: &mut [f64],
+        jacobian: Option<&mut [f64]>,
+        cancel: &AtomicBool,
+    ) {
         let has_jacobian = jacobian.is_some();
-        match self.evaluate_checked(p, values, jacobian) {
+        match self.evaluate_checked(p, values, jacobian, cancel) {
             Ok(w) => {
                 if has_jacobian {
                     if let Ok(mut l) = self.warnings.lock() {
@@ -324,6 +352,8 @@ impl CurveModel for AmCurveModel {
                     }
                 }
             }
+            // (the run ends: the warnings stay the last finished evaluation's)
+            Err(SimError::Cancelled) => values.fill(f64::NAN),
             Err(e) => {
                 values.fill(f64::NAN);
                 if let Ok(mut l) = self.warnings.lock() {

@@ -7,8 +7,12 @@
 //! physical lower bound, a standard error ≥ |estimate|) (Bates & Watts, *Nonlinear Regression
 //! Analysis and Its Applications*, Wiley 1988, §2.3; Raue et al. 2009 for the profiles).
 
-use super::least_squares::{minimize, CurveModel, Observations, Parameter};
-use super::profile::{profile, Profile, ProfileEnd, DELTA_CHI2_95};
+use super::least_squares::{
+    evaluate_in, minimize_cancellable, CurveModel, Observations, Parameter, PATIENCE, TOLERANCE,
+};
+use super::profile::{profile, Profile, ProfileEnd, ProfileWalk, DELTA_CHI2_95};
+use crate::analysis::progress::Progress;
+use crate::error::SimError;
 use nalgebra::DMatrix;
 
 /// The standard normal's 97.5 % quantile: the Wald interval is p̂ ± 1.96 SE.
@@ -90,9 +94,8 @@ pub fn fit(
     fit_with(model, obs, params, fixed, true)
 }
 
-/// [`fit`], with the profile-likelihood intervals when `profiles` (else the Wald intervals,
-/// ±1.96 standard errors: a model whose every evaluation is costly — the dynamic fit's stepped
-/// approach — skips the profiles' refits).
+/// [`fit`], with the profile-likelihood intervals when `profiles` (walked on the grid,
+/// [`ProfileWalk::Grid`]; else the Wald intervals, ±1.96 standard errors).
 pub fn fit_with(
     model: &dyn CurveModel,
     obs: &Observations,
@@ -100,8 +103,40 @@ pub fn fit_with(
     fixed: &[Option<f64>],
     profiles: bool,
 ) -> FitOutcome {
+    let walk = profiles.then_some(ProfileWalk::Grid);
+    // a run of its own, never cancelled: the one error is the cancellation
+    let progress = Progress::new();
+    match fit_cancellable(model, obs, params, fixed, walk, &progress) {
+        Ok(o) => o,
+        Err(e) => unreachable!("a fit nobody can cancel was cancelled: {e}"),
+    }
+}
+
+/// [`fit`] in a run: the profiles walked as `profiles` says (none: the Wald intervals), every
+/// model evaluation — the minimiser's, the covariance's, the profiles' refits — counted in
+/// `progress` and checking its cancel flag first.
+///
+/// # Errors
+/// [`SimError::Cancelled`] when `progress` is cancelled before the fit ends (at the latest
+/// after the evaluation under way).
+pub fn fit_cancellable(
+    model: &dyn CurveModel,
+    obs: &Observations,
+    params: &[Parameter],
+    fixed: &[Option<f64>],
+    profiles: Option<ProfileWalk>,
+    progress: &Progress,
+) -> Result<FitOutcome, SimError> {
     let start: Vec<f64> = params.iter().map(|p| p.start).collect();
-    let best = minimize(model, obs, params, &start, fixed);
+    let best = minimize_cancellable(
+        model,
+        obs,
+        params,
+        &start,
+        fixed,
+        (TOLERANCE, PATIENCE),
+        progress,
+    )?;
     let free: Vec<usize> = (0..params.len()).filter(|&j| fixed[j].is_none()).collect();
     let (m, n) = (model.points(), free.len());
     let dof = m.saturating_sub(n);
@@ -139,7 +174,7 @@ pub fn fit_with(
             crate::error::number(bound)
         ));
     }
-    let (cov, singular) = covariance(model, obs, &best.values, &free, s2);
+    let (cov, singular) = covariance(model, obs, &best.values, &free, s2, progress)?;
     if singular {
         warnings.push(
             "JᵀWJ is singular: the data do not constrain every combination of the fitted \
@@ -147,7 +182,19 @@ pub fn fit_with(
                 .into(),
         );
     }
-    let se: Vec<f64> = (0..n).map(|k| cov[(k, k)].max(0.0).sqrt()).collect();
+    // a variance that is not positive (a parameter whose Jacobian column is zero or at the
+    // rounding level: the pseudo-inverse's diagonal then comes out 0 or negative) is NaN:
+    // the parameter is not constrained, not known exactly
+    let se: Vec<f64> = (0..n)
+        .map(|k| {
+            let v = cov[(k, k)];
+            if v > 0.0 {
+                v.sqrt()
+            } else {
+                f64::NAN
+            }
+        })
+        .collect();
     let correlation: Vec<Vec<f64>> = (0..n)
         .map(|a| {
             (0..n)
@@ -155,7 +202,7 @@ pub fn fit_with(
                 .collect::<Vec<f64>>()
         })
         .collect();
-    let mut evaluations = best.evaluations;
+    let mut evaluations = best.evaluations + 1;
     let mut estimates = Vec::with_capacity(n);
     for (k, &j) in free.iter().enumerate() {
         let p = &params[j];
@@ -166,23 +213,52 @@ pub fn fit_with(
         } else {
             0.1 * p.scale
         };
-        let prof = (profiles && n <= MAX_PROFILED && dof > 0 && s2 > 0.0)
-            .then(|| profile(model, obs, params, &best, fixed, j, step, s2));
+        let prof = match profiles {
+            Some(walk) if n <= MAX_PROFILED && dof > 0 && s2 > 0.0 => Some(profile(
+                model, obs, params, &best, fixed, j, step, s2, walk, progress,
+            )?),
+            _ => None,
+        };
         let interval = prof
             .as_ref()
             .map_or(wald, |pr| [pr.lower.value(), pr.upper.value()]);
         if let Some(pr) = &prof {
-            evaluations += pr.refits;
-            if matches!(pr.lower, ProfileEnd::Flat(_)) || matches!(pr.upper, ProfileEnd::Flat(_)) {
+            evaluations += pr.evaluations;
+            let sides = |f: fn(&ProfileEnd) -> bool| match (f(&pr.lower), f(&pr.upper)) {
+                (true, true) => Some("either side"),
+                (true, false) => Some("the lower side"),
+                (false, true) => Some("the upper side"),
+                (false, false) => None,
+            };
+            if let Some(side) = sides(|e| matches!(e, ProfileEnd::Flat(_))) {
+                let walked = match profiles {
+                    Some(ProfileWalk::Secant { max_steps }) => format!(
+                        " ({max_steps} refits a side, to {:.3e} from the estimate)",
+                        (pr.lower.value() - value)
+                            .abs()
+                            .max((pr.upper.value() - value).abs())
+                    ),
+                    _ => String::new(),
+                };
                 warnings.push(format!(
                     "{}: flat profile — χ² rises by less than {DELTA_CHI2_95:.2} over the \
-                     range walked on {} side; the data do not bound it there",
+                     range walked on {side}{walked}; the data do not bound it there (the \
+                     interval's end there is the last point walked: open)",
                     p.name,
-                    match (pr.lower, pr.upper) {
-                        (ProfileEnd::Flat(_), ProfileEnd::Flat(_)) => "either",
-                        (ProfileEnd::Flat(_), _) => "the lower",
-                        _ => "the upper",
-                    }
+                ));
+            }
+            if pr.unconverged > 0 {
+                warnings.push(format!(
+                    "{}: {} of the profile's {} refits stopped at the minimiser's limit of \
+                     evaluations before converging (their Δχ² may be high, the interval narrow)",
+                    p.name, pr.unconverged, pr.refits
+                ));
+            }
+            if let Some(side) = sides(|e| matches!(e, ProfileEnd::Failed(_))) {
+                warnings.push(format!(
+                    "{}: a profile refit failed on {side} (the model could not be evaluated \
+                     there): the Wald end p̂ ± 1.96 SE stands in",
+                    p.name,
                 ));
             }
             if pr.lowest < -1e-6 {
@@ -233,9 +309,10 @@ pub fn fit_with(
         }
     }
     let mut fitted = vec![0.0; m];
-    model.evaluate(&best.values, &mut fitted, None);
+    evaluate_in(model, &best.values, &mut fitted, None, progress)?;
+    evaluations += 1;
     let residuals = obs.y.iter().zip(&fitted).map(|(y, f)| y - f).collect();
-    FitOutcome {
+    Ok(FitOutcome {
         estimates,
         values: best.values,
         correlation,
@@ -248,24 +325,25 @@ pub fn fit_with(
         evaluations,
         termination: best.termination,
         warnings,
-    }
+    })
 }
 
 /// The covariance (JᵀWJ)⁻¹ s² of the free parameters at `p`, and whether JᵀWJ is singular
 /// (then its pseudo-inverse on the eigenvalues above [`SINGULAR_RATIO`] of the largest, and NaN
 /// variances for parameters in its null space). JᵀWJ is scaled to unit diagonal before the
-/// eigen-decomposition, so parameters of any units compare.
+/// eigen-decomposition, so parameters of any units compare. One evaluation of the run.
 fn covariance(
     model: &dyn CurveModel,
     obs: &Observations,
     p: &[f64],
     free: &[usize],
     s2: f64,
-) -> (DMatrix<f64>, bool) {
+    progress: &Progress,
+) -> Result<(DMatrix<f64>, bool), SimError> {
     let (m, n_all, n) = (model.points(), p.len(), free.len());
     let mut f = vec![0.0; m];
     let mut jac = vec![0.0; m * n_all];
-    model.evaluate(p, &mut f, Some(&mut jac));
+    evaluate_in(model, p, &mut f, Some(&mut jac), progress)?;
     let mut a = DMatrix::<f64>::zeros(n, n);
     for i in 0..m {
         let w2 = obs.weight(i).powi(2);
@@ -315,5 +393,5 @@ fn covariance(
             inv[(i, j)] * d[i] * d[j] * s2
         }
     });
-    (cov, singular)
+    Ok((cov, singular))
 }

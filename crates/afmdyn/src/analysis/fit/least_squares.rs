@@ -9,14 +9,38 @@
 //! p = lo + s(√(u² + 1) − 1) above a lower one (below an upper one alike), p = s u without;
 //! s is the parameter's scale, so every u is of order one. The model's Jacobian ∂f/∂p is
 //! chained with dp/du; the covariance is formed in p ([`super::estimates`]).
+//!
+//! Every evaluation is counted in the run's [`Progress`] and checks its cancel flag first
+//! ([`minimize_cancellable`]): a cancelled run stops the minimiser at its next evaluation (the
+//! model's residuals refused, the crate's `User` termination) and returns
+//! [`SimError::Cancelled`]; a model whose evaluation is long also stops inside it
+//! ([`CurveModel::evaluate_cancellable`]).
 
+use crate::analysis::progress::Progress;
+use crate::error::SimError;
 use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
 use nalgebra_lm::{storage::Owned, DMatrix, DVector, Dyn};
+use std::sync::atomic::AtomicBool;
 
 /// The minimiser's relative tolerances (MINPACK's ftol, xtol, gtol): χ² to 1e-10 relative is
 /// Δχ² to 1e-6 at 10⁴ points, far inside the profiles' 3.84, and the estimates to ~1e-10 of
 /// their standard errors' scale.
 pub const TOLERANCE: f64 = 1e-10;
+
+/// The minimiser's patience: it stops after `PATIENCE × (n + 1)` evaluations of the residuals
+/// (n free parameters; MINPACK's `maxfev`, the crate's `with_patience`).
+pub const PATIENCE: usize = 200;
+
+/// The most model evaluations of one minimisation over `n` free parameters with `patience`
+/// ([`PATIENCE`] for a fit): the minimiser's `patience` × (n + 1) residual evaluations, at
+/// most as many Jacobians (one per outer iteration, each of which evaluates the residuals at
+/// least once) and the final χ²; 1 with nothing free.
+pub fn max_evaluations(n: usize, patience: usize) -> usize {
+    match n {
+        0 => 1,
+        n => 2 * patience * (n + 1) + 1,
+    }
+}
 
 /// A model of a measured curve: values fᵢ(p) at the data's points and their derivatives.
 pub trait CurveModel {
@@ -26,6 +50,38 @@ pub trait CurveModel {
     /// ∂fᵢ/∂p_j into `jacobian`, row-major m × n (n = `p.len()`, every parameter of the model,
     /// fixed or not, in the order of the fit's [`Parameter`]s).
     fn evaluate(&self, p: &[f64], values: &mut [f64], jacobian: Option<&mut [f64]>);
+    /// [`CurveModel::evaluate`], which may stop early once `cancel` is set: then `values` are
+    /// unspecified (NaN for the library's models) and the caller, which checks the flag after
+    /// the evaluation, discards them. The default ignores the flag (a model whose evaluation is
+    /// short); the dynamic fit's stepped approach checks it between its rows.
+    fn evaluate_cancellable(
+        &self,
+        p: &[f64],
+        values: &mut [f64],
+        jacobian: Option<&mut [f64]>,
+        cancel: &AtomicBool,
+    ) {
+        let _ = cancel;
+        self.evaluate(p, values, jacobian);
+    }
+}
+
+/// One evaluation of `model` at `p` in a run: the cancel flag of `progress` checked before and
+/// after it ([`CurveModel::evaluate_cancellable`] in between), one unit counted.
+///
+/// # Errors
+/// [`SimError::Cancelled`] when `progress` is cancelled before the evaluation ends.
+pub fn evaluate_in(
+    model: &dyn CurveModel,
+    p: &[f64],
+    values: &mut [f64],
+    jacobian: Option<&mut [f64]>,
+    progress: &Progress,
+) -> Result<(), SimError> {
+    progress.check()?;
+    model.evaluate_cancellable(p, values, jacobian, progress.cancel_flag());
+    progress.tick();
+    progress.check()
 }
 
 /// A parameter of a fit: its name (a probe key, `sample.youngs_modulus`), start value, bounds
@@ -123,6 +179,10 @@ struct Problem<'a> {
     free: Vec<usize>,
     u: DVector<f64>,
     evaluations: std::cell::Cell<usize>,
+    /// The run's progress: every evaluation counted, its cancel flag checked.
+    progress: &'a Progress,
+    /// Set when an evaluation met the cancel flag (the minimiser then stops).
+    cancelled: std::cell::Cell<bool>,
 }
 
 impl Problem<'_> {
@@ -148,8 +208,11 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
     fn residuals(&self) -> Option<DVector<f64>> {
         let m = self.model.points();
         let mut f = vec![0.0; m];
-        self.model.evaluate(&self.full, &mut f, None);
         self.evaluations.set(self.evaluations.get() + 1);
+        if evaluate_in(self.model, &self.full, &mut f, None, self.progress).is_err() {
+            self.cancelled.set(true);
+            return None;
+        }
         let r = DVector::from_fn(m, |i, _| (f[i] - self.obs.y[i]) * self.obs.weight(i));
         r.iter().all(|x| x.is_finite()).then_some(r)
     }
@@ -157,8 +220,19 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
         let (m, n) = (self.model.points(), self.params.len());
         let mut f = vec![0.0; m];
         let mut jac = vec![0.0; m * n];
-        self.model.evaluate(&self.full, &mut f, Some(&mut jac));
         self.evaluations.set(self.evaluations.get() + 1);
+        if evaluate_in(
+            self.model,
+            &self.full,
+            &mut f,
+            Some(&mut jac),
+            self.progress,
+        )
+        .is_err()
+        {
+            self.cancelled.set(true);
+            return None;
+        }
         let chain: Vec<f64> = self
             .free
             .iter()
@@ -176,6 +250,26 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
 pub fn chi2(model: &dyn CurveModel, obs: &Observations, p: &[f64]) -> f64 {
     let mut f = vec![0.0; model.points()];
     model.evaluate(p, &mut f, None);
+    sum_squares(obs, &f)
+}
+
+/// [`chi2`] as one evaluation of a run ([`evaluate_in`]).
+///
+/// # Errors
+/// [`SimError::Cancelled`] when `progress` is cancelled.
+pub fn chi2_in(
+    model: &dyn CurveModel,
+    obs: &Observations,
+    p: &[f64],
+    progress: &Progress,
+) -> Result<f64, SimError> {
+    let mut f = vec![0.0; model.points()];
+    evaluate_in(model, p, &mut f, None, progress)?;
+    Ok(sum_squares(obs, &f))
+}
+
+/// Σ((yᵢ − fᵢ)/σᵢ)² of the model values `f`.
+fn sum_squares(obs: &Observations, f: &[f64]) -> f64 {
     f.iter()
         .enumerate()
         .map(|(i, fi)| ((fi - obs.y[i]) * obs.weight(i)).powi(2))
@@ -193,6 +287,59 @@ pub fn minimize(
     start: &[f64],
     fixed: &[Option<f64>],
 ) -> Minimum {
+    // a run of its own, never cancelled
+    let progress = Progress::new();
+    run(
+        model,
+        obs,
+        params,
+        start,
+        fixed,
+        (TOLERANCE, PATIENCE),
+        &progress,
+    )
+    .0
+}
+
+/// [`minimize`] in a run, to the relative `tolerance` (MINPACK's ftol, xtol and gtol;
+/// [`TOLERANCE`] for a fit) with `patience` ([`PATIENCE`] for a fit): every evaluation counted
+/// in `progress` and checking its cancel flag (the module docs).
+///
+/// # Errors
+/// [`SimError::Cancelled`] when `progress` is cancelled before the minimum is found.
+pub fn minimize_cancellable(
+    model: &dyn CurveModel,
+    obs: &Observations,
+    params: &[Parameter],
+    start: &[f64],
+    fixed: &[Option<f64>],
+    (tolerance, patience): (f64, usize),
+    progress: &Progress,
+) -> Result<Minimum, SimError> {
+    match run(
+        model,
+        obs,
+        params,
+        start,
+        fixed,
+        (tolerance, patience),
+        progress,
+    ) {
+        (_, true) => Err(SimError::Cancelled),
+        (m, false) => Ok(m),
+    }
+}
+
+/// The minimiser's run, and whether it was cancelled (then the minimum is where it stopped).
+fn run(
+    model: &dyn CurveModel,
+    obs: &Observations,
+    params: &[Parameter],
+    start: &[f64],
+    fixed: &[Option<f64>],
+    (tolerance, patience): (f64, usize),
+    progress: &Progress,
+) -> (Minimum, bool) {
     let full: Vec<f64> = start
         .iter()
         .zip(fixed)
@@ -211,32 +358,58 @@ pub fn minimize(
         free,
         u: u.clone(),
         evaluations: std::cell::Cell::new(0),
+        progress,
+        cancelled: std::cell::Cell::new(false),
     };
     problem.set(&u);
+    let cancelled = |full: Vec<f64>, evaluations: usize| {
+        let m = Minimum {
+            values: full,
+            chi2: f64::NAN,
+            evaluations,
+            converged: false,
+            termination: "cancelled".into(),
+        };
+        (m, true)
+    };
     if problem.free.is_empty() {
-        let chi2 = chi2(model, obs, &problem.full);
-        return Minimum {
-            values: problem.full,
-            chi2,
-            evaluations: 1,
-            converged: true,
-            termination: "nothing to fit".into(),
+        return match chi2_in(model, obs, &problem.full, progress) {
+            Ok(chi2) => (
+                Minimum {
+                    values: problem.full,
+                    chi2,
+                    evaluations: 1,
+                    converged: true,
+                    termination: "nothing to fit".into(),
+                },
+                false,
+            ),
+            Err(_) => cancelled(problem.full, 1),
         };
     }
     let (problem, report) = LevenbergMarquardt::new()
-        .with_ftol(TOLERANCE)
-        .with_xtol(TOLERANCE)
-        .with_gtol(TOLERANCE)
-        .with_patience(200)
+        .with_ftol(tolerance)
+        .with_xtol(tolerance)
+        .with_gtol(tolerance)
+        .with_patience(patience)
         .minimize(problem);
     let evaluations = problem.evaluations.get() + 1;
     let values = problem.full;
-    Minimum {
-        chi2: chi2(model, obs, &values),
-        values,
-        evaluations,
-        converged: report.termination.was_successful(),
-        termination: format!("{:?}", report.termination),
+    if problem.cancelled.get() {
+        return cancelled(values, evaluations - 1);
+    }
+    match chi2_in(model, obs, &values, progress) {
+        Ok(chi2) => (
+            Minimum {
+                chi2,
+                values,
+                evaluations,
+                converged: report.termination.was_successful(),
+                termination: format!("{:?}", report.termination),
+            },
+            false,
+        ),
+        Err(_) => cancelled(values, evaluations),
     }
 }
 

@@ -16,6 +16,6 @@ pub mod profile;
 pub mod sensitivity;
 pub mod start;
 
-pub use estimates::{fit, fit_with, Estimate, FitOutcome};
+pub use estimates::{fit, fit_cancellable, fit_with, Estimate, FitOutcome};
 pub use least_squares::{CurveModel, Minimum, Observations, Parameter};
-pub use profile::{Profile, ProfileEnd};
+pub use profile::{Profile, ProfileEnd, ProfileWalk};

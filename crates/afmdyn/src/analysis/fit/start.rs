@@ -4,7 +4,7 @@
 //! follow another branch than the data's when the contact point is off), a coarse scan of the
 //! parameter that moves between them picks the basin first.
 
-use super::least_squares::{chi2, CurveModel, Observations, Parameter};
+use super::least_squares::{chi2_in, CurveModel, Observations, Parameter};
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
 
@@ -26,7 +26,8 @@ pub fn z_offset_grid(g0: f64) -> impl Iterator<Item = f64> {
 /// no grid value gives a χ² below +∞ (each a model evaluation without the Jacobian).
 ///
 /// # Errors
-/// [`SimError::Cancelled`] when `progress` is cancelled (checked before each evaluation).
+/// [`SimError::Cancelled`] when `progress` is cancelled (each evaluation counted in it and
+/// checking it, [`super::least_squares::evaluate_in`]).
 ///
 /// # Panics
 /// When `k` is not an index of `params`.
@@ -41,9 +42,8 @@ pub fn grid_start(
     let mut trial: Vec<f64> = params.iter().map(|p| p.start).collect();
     let mut best = (f64::INFINITY, params[k].start);
     for x in grid {
-        progress.check()?;
         trial[k] = x;
-        let c = chi2(model, obs, &trial);
+        let c = chi2_in(model, obs, &trial, progress)?;
         if c < best.0 {
             best = (c, trial[k]);
         }
