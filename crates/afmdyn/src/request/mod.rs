@@ -33,6 +33,7 @@
 pub mod analyses;
 pub mod basins;
 pub mod chart;
+pub mod chart_layout;
 pub mod checkpoint;
 #[cfg(feature = "files")]
 pub mod checkpoint_file;
