@@ -41,9 +41,13 @@ pub enum FitSegment {
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(default, deny_unknown_fields)]
 pub struct FitRequest {
-    /// A CSV file with the columns `height` (m, the piezo height, decreasing into the sample),
-    /// `force` (N, repulsion positive) and optionally `sigma` (N, each force's standard
-    /// deviation), read through the bounded reader; excludes `height` and `force`.
+    /// A CSV file, read through the bounded reader; excludes `height` and `force`. A force
+    /// curve: the columns `height` (m, the piezo height, decreasing into the sample), `force`
+    /// (N, repulsion positive) and optionally `sigma` (N, each force's standard deviation). A
+    /// dynamic curve: `z` (m, the piezo position, in the order stepped) with `amplitude` (m)
+    /// and/or `phase` (deg) (AM), or `frequency_shift` (Hz) (FM, at the probe's free
+    /// amplitude), or `amplitude_2` (m) and/or `phase_2` (deg) (bimodal, a probe with a second
+    /// drive component), each with an optional `sigma_<column>`.
     pub data: Option<String>,
     /// The piezo heights (m), when no `data` file is given.
     pub height: Vec<f64>,
