@@ -31,8 +31,9 @@ pub const CSV_HEADER: [&str; 18] = [
 
 /// The rows of a cell as CSV lines of [`CSV_HEADER`] (numbers in Rust's shortest round-trip
 /// form; messages with commas and newlines replaced by spaces). The lengths `x_max` and
-/// `v_t_min` are in g₀, or in m with a probe (× [`ChartModel::length_m`] of the cell: the
-/// length unit changes from cell to cell along a `free_amplitude` axis).
+/// `v_t_min` are in g₀, or in m with a probe (×
+/// [`ChartModel::length_m`](super::chart::ChartModel::length_m) of the cell: the length unit
+/// changes from cell to cell along a `free_amplitude` axis).
 pub fn csv_lines(chart: &Chart, cell: &ChartCell) -> Vec<String> {
     let length = chart.model.length_m(cell.x, cell.y).unwrap_or(1.0);
     let message = cell
@@ -72,8 +73,9 @@ pub fn csv_lines(chart: &Chart, cell: &ChartCell) -> Vec<String> {
 }
 
 /// A chart's results as arrays: per cell (y, x) and per attractor slot (y, x, attractor), the
-/// attractor slots of a cell in its order ([`ChartRequest::max_attractors`] of them, empty
-/// ones padded: period 0, NaN). Row-major, y slowest. The one layout of `chart.nc`, of
+/// attractor slots of a cell in its order
+/// ([`ChartRequest::max_attractors`](super::chart::ChartRequest::max_attractors) of them,
+/// empty ones padded: period 0, NaN). Row-major, y slowest. The one layout of `chart.nc`, of
 /// Python's `xarray.Dataset` and of the Dask store's regions.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ChartArrays {
@@ -89,8 +91,9 @@ pub struct ChartArrays {
     pub failures: Vec<i32>,
     /// (y, x, attractor): period n; −1 nonperiodic; 0 empty slot.
     pub period: Vec<i32>,
-    /// (y, x, attractor): the kind of motion ([`crate::analysis::chart::MotionKind::code`]: 1 periodic, 2 chaotic, 3
-    /// quasi-periodic, 4 unsettled, 5 nonperiodic without λ₁; 0 empty slot).
+    /// (y, x, attractor): the kind of motion ([`crate::analysis::chart::MotionKind::code`]:
+    /// 1 periodic, 2 chaotic, 3 quasi-periodic, 4 unsettled, 5 nonperiodic without λ₁; 0 empty
+    /// slot).
     pub motion: Vec<i32>,
     /// (y, x, attractor): λ₁ (NaN: periodic, not estimated, or empty).
     pub lyapunov: Vec<f64>,
