@@ -280,11 +280,50 @@ fn a_frequency_shift_csv_goes_through_the_fit_door() {
         fit: vec!["sample.hamaker".into(), "z_offset".into()],
         ..FitRequest::default()
     };
-    let doc = run(&request, &resolved, &Progress::default())
-        .expect("fit")
-        .json;
+    let done = run(&request, &resolved, &Progress::default()).expect("fit");
+    let doc = done.json.clone();
     std::fs::remove_dir_all(&dir).ok();
     assert_eq!(doc["kind"], "fm", "{doc}");
+    // its files are the FM curve's: the table of z and the frequency shift's data, fit and
+    // residual, and the two frequency-shift figures (not the force curve's)
+    {
+        use afmdyn::report::{OutputFile, TextUnits};
+        use afmdyn::request::Analysis;
+        let shown = request
+            .present(
+                &resolved,
+                &done.output,
+                &doc,
+                TextUnits {
+                    scales: Some(p.scales),
+                    plain: false,
+                },
+            )
+            .expect("present");
+        let mut names = Vec::new();
+        for f in &shown.files {
+            match f {
+                OutputFile::Csv { name, header, .. } => {
+                    assert_eq!(name, "fit-curve.csv");
+                    assert_eq!(header[..3], ["z", "frequency_shift", "frequency_shift_fit"]);
+                    names.push(name.clone());
+                }
+                OutputFile::Figure { stem, .. } => names.push(stem.clone()),
+                _ => {}
+            }
+        }
+        for want in [
+            "fit-curve.csv",
+            "fit-frequency_shift",
+            "fit-frequency_shift-residual",
+        ] {
+            assert!(names.iter().any(|n| n == want), "{want} not in {names:?}");
+        }
+        assert!(shown
+            .summary
+            .iter()
+            .any(|l| l.contains("rows of the FM curve")));
+    }
     for (name, t) in [
         ("sample.hamaker", p.sample_inputs.hamaker.unwrap()),
         ("z_offset", 1e-9),

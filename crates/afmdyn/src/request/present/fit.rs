@@ -39,18 +39,27 @@ pub fn fit(
             ));
         }
     }
+    // a force curve names its segment; a dynamic curve its kind (AM, with the bimodal
+    // channels, or FM)
+    let dynamic = document["kind"]
+        .as_str()
+        .filter(|k| matches!(*k, "am" | "fm"));
+    let segment = match (document["segment"].as_str(), dynamic) {
+        (Some(s), _) => s.to_string(),
+        (None, Some(k)) => format!("{} curve", k.to_uppercase()),
+        (None, None) => "curve".into(),
+    };
     p.line(format!(
-        "{} law on {} rows of the {}: χ²/dof = {:.4e}; {}",
+        "{} law on {} rows of the {segment}: χ²/dof = {:.4e}; {}",
         document["law"].as_str().unwrap_or(""),
         document["rows_fitted"].as_u64().unwrap_or(0),
-        document["segment"].as_str().unwrap_or(""),
         document["chi2_dof"].as_f64().unwrap_or(f64::NAN),
         document["noise"].as_str().unwrap_or(""),
     ));
     if files == Files::None {
         return p;
     }
-    if document["kind"] == "am" {
+    if dynamic.is_some() {
         am_files(&mut p, document, files);
         with_document(&mut p, document, ("fit.json", "fit-curve.csv"), dir);
         return p;
