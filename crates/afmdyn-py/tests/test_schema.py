@@ -33,6 +33,7 @@ PF_IMAGE = ["--mode", "peakforce", "--probe", str(EXAMPLES / "probe-peakforce-am
             "--pixels", 4]
 FIT_PROBE = str(EXAMPLES / "probe-fit-hertz.toml")
 FIT_DATA = str(EXAMPLES / "force-curve-hertz.csv")
+FM_DATA = str(EXAMPLES / "fm-curve-point-mass.csv")
 IMPACT = "--contact-law impact --restitution 0.5 --modes 1 --gap 0.05 --omega 3".split()
 IMPACT_PY = dict(contact_law="impact", restitution=0.5, modes=1, gap=0.05, omega=3.0)
 SHORT = ["--max-periods", 300]
@@ -146,6 +147,9 @@ CLI_CASES: List[Tuple[str, List[Any]]] = [
              "--files", "data"]),
     ("fit", ["--probe", FIT_PROBE, "--data", FIT_DATA, "--fit", "sample.youngs_modulus",
              "--range", "-2e-7,0", "--files", "none"]),
+    # a dynamic curve's form: the frequency shift of the FM loop against z
+    ("fit", ["--probe", P1, "--data", FM_DATA, "--fit", "sample.hamaker,z_offset",
+             "--files", "none"]),
     # (a probe refuses the dimensionless omega axis: the drive frequency in Hz, 0.99 f0)
     ("chart", ["--x", "z-c", "--x-from", 6e-9, "--x-to", 8e-9, "--x-steps", 2, "--y",
                "drive-frequency", "--y-from", "297kHz", "--y-to", "297kHz", "--y-steps", 1,
