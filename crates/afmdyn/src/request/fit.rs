@@ -5,7 +5,7 @@
 //! and the identifiability warnings. Everything is SI (m, N, Pa, J/m²); a probe file is
 //! needed (the lever's spring constant, the start values and the held parameters).
 
-pub use super::fit_result::{bounds, FitResult, MIN_FIT_ROWS};
+pub use super::fit_result::{bounds, intervals_method, FitResult, MIN_FIT_ROWS};
 use super::limits::Cost;
 use super::run::{Analysis, Resolved};
 use crate::analysis::fit::force_curve::{
@@ -13,7 +13,7 @@ use crate::analysis::fit::force_curve::{
     YOUNGS_MODULUS,
 };
 use crate::analysis::fit::profile::ProfileWalk;
-use crate::analysis::fit::{fit_cancellable, FitOutcome, Observations, Parameter, ProfileEnd};
+use crate::analysis::fit::{fit_cancellable, Observations, Parameter, ProfileEnd};
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
 use serde::{Deserialize, Serialize};
@@ -530,16 +530,6 @@ pub fn document(request: &FitRequest, r: &FitResult) -> Value {
     })
 }
 
-/// How a fit's intervals were found, for its document's `method`: the profile likelihood's
-/// where any parameter was profiled, else the Wald intervals.
-pub fn intervals_method(o: &FitOutcome) -> &'static str {
-    if o.estimates.iter().any(|e| e.profile.is_some()) {
-        "intervals from the profile likelihood (Δχ² ≤ 3.84; up to 4 fitted parameters, Wald ±1.96 SE beyond)"
-    } else {
-        "Wald intervals (±1.96 standard errors; no profiles)"
-    }
-}
-
 impl super::named::Datasets for FitRequest {
     /// `curve` (tip position, force, fit and residual over the fitted rows); the estimates
     /// and their standard errors as facts.
@@ -553,7 +543,7 @@ impl super::named::Datasets for FitRequest {
         };
         let n = r.rows.len();
         let columns: &[(&str, &str, &str)] = if r.dynamic.is_some() {
-            &super::fit_dynamic::CURVE_VARIABLES
+            &super::fit_result::CURVE_VARIABLES
         } else {
             &[
                 ("tip_position", "m", "tip position"),

@@ -15,7 +15,7 @@
 //! curve beside the data with its residuals, warnings).
 
 use super::fit_result::{bounds, FitResult, MIN_FIT_ROWS};
-pub use super::fit_result::{AmData, DynamicFit};
+pub use super::fit_result::{AmData, DynamicFit, CURVE_VARIABLES};
 use super::run::Resolved;
 use crate::analysis::fit::am_curve::{AmCurveModel, AmParam, AmProbe, Z_OFFSET};
 use crate::analysis::fit::bimodal_curve::BimodalCurveModel;
@@ -26,39 +26,6 @@ use crate::analysis::fit::{fit_cancellable, CurveModel, Observations, Parameter}
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
 use serde_json::{json, Value};
-
-/// The variables of a dynamic fit's curve (name, unit, label): the columns of its table and
-/// Dataset, those of the channels fitted.
-pub const CURVE_VARIABLES: [(&str, &str, &str); 16] = [
-    ("z", "m", "piezo position"),
-    ("amplitude", "m", "amplitude, measured"),
-    ("amplitude_fit", "m", "amplitude, fitted"),
-    ("amplitude_residual", "m", "measured − fitted amplitude"),
-    ("phase", "deg", "phase, measured"),
-    ("phase_fit", "deg", "phase, fitted"),
-    ("phase_residual", "deg", "measured − fitted phase"),
-    ("amplitude_2", "m", "second component's amplitude, measured"),
-    (
-        "amplitude_2_fit",
-        "m",
-        "second component's amplitude, fitted",
-    ),
-    (
-        "amplitude_2_residual",
-        "m",
-        "measured − fitted second amplitude",
-    ),
-    ("phase_2", "deg", "second component's phase, measured"),
-    ("phase_2_fit", "deg", "second component's phase, fitted"),
-    ("phase_2_residual", "deg", "measured − fitted second phase"),
-    ("frequency_shift", "Hz", "frequency shift, measured"),
-    ("frequency_shift_fit", "Hz", "frequency shift, fitted"),
-    (
-        "frequency_shift_residual",
-        "Hz",
-        "measured − fitted frequency shift",
-    ),
-];
 
 fn bad(name: &'static str, value: impl std::fmt::Display, allowed: String) -> SimError {
     SimError::out_of_range(name, value, allowed)
@@ -513,7 +480,10 @@ pub fn document(r: &FitResult, d: &DynamicFit, estimates: Value, correlation: Va
             "weighted least squares by Levenberg–Marquardt (MINPACK lmder, rust-cv levenberg-marquardt) of the stepped approach the instrument did (each row's periodic orbit continued from the previous one, z_c = z + z_offset), with the exact sensitivities of the orbits: the variational equations extended by the parameter columns, saltation at the switchings, ∂x*/∂p = (I − M)⁻¹ ∂P/∂p (docs/afm-workflow.md, From data to properties)",
         )
     };
-    let method = format!("{}{walk}; {least_squares}", super::fit::intervals_method(o));
+    let method = format!(
+        "{}{walk}; {least_squares}",
+        super::fit_result::intervals_method(o)
+    );
     json!({
         "kind": kind,
         "estimates": estimates,

@@ -6,6 +6,49 @@ use crate::analysis::fit::force_curve::{ForceLaw, Preprocessed};
 use crate::analysis::fit::FitOutcome;
 use crate::probe::ranges::si_range;
 
+/// The variables of a dynamic fit's curve (name, unit, label): the columns of its table and
+/// Dataset, those of the channels fitted.
+pub const CURVE_VARIABLES: [(&str, &str, &str); 16] = [
+    ("z", "m", "piezo position"),
+    ("amplitude", "m", "amplitude, measured"),
+    ("amplitude_fit", "m", "amplitude, fitted"),
+    ("amplitude_residual", "m", "measured − fitted amplitude"),
+    ("phase", "deg", "phase, measured"),
+    ("phase_fit", "deg", "phase, fitted"),
+    ("phase_residual", "deg", "measured − fitted phase"),
+    ("amplitude_2", "m", "second component's amplitude, measured"),
+    (
+        "amplitude_2_fit",
+        "m",
+        "second component's amplitude, fitted",
+    ),
+    (
+        "amplitude_2_residual",
+        "m",
+        "measured − fitted second amplitude",
+    ),
+    ("phase_2", "deg", "second component's phase, measured"),
+    ("phase_2_fit", "deg", "second component's phase, fitted"),
+    ("phase_2_residual", "deg", "measured − fitted second phase"),
+    ("frequency_shift", "Hz", "frequency shift, measured"),
+    ("frequency_shift_fit", "Hz", "frequency shift, fitted"),
+    (
+        "frequency_shift_residual",
+        "Hz",
+        "measured − fitted frequency shift",
+    ),
+];
+
+/// How a fit's intervals were found, for its document's `method`: the profile likelihood's
+/// where any parameter was profiled, else the Wald intervals.
+pub fn intervals_method(o: &FitOutcome) -> &'static str {
+    if o.estimates.iter().any(|e| e.profile.is_some()) {
+        "intervals from the profile likelihood (Δχ² ≤ 3.84; up to 4 fitted parameters, Wald ±1.96 SE beyond)"
+    } else {
+        "Wald intervals (±1.96 standard errors; no profiles)"
+    }
+}
+
 /// The fewest rows fitted (more than the parameters, for the χ²'s degrees of freedom).
 pub const MIN_FIT_ROWS: usize = 8;
 

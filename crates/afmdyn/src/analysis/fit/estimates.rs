@@ -15,8 +15,7 @@ use crate::analysis::progress::Progress;
 use crate::error::SimError;
 use nalgebra::DMatrix;
 
-/// The standard normal's 97.5 % quantile: the Wald interval is p̂ ± 1.96 SE.
-pub const Z_95: f64 = 1.959_963_984_540_054;
+pub use super::profile::Z_95;
 
 /// Above this |correlation| two parameters are called not separately identifiable.
 pub const CORRELATION_WARNING: f64 = 0.99;

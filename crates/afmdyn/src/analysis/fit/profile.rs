@@ -15,10 +15,12 @@
 //! points of r lands on the crossing; for a nonlinear model r is nearly linear near p̂ and a
 //! few secant (regula falsi, inside a bracket) steps reach it.
 
-use super::estimates::Z_95;
 use super::least_squares::{minimize_cancellable, CurveModel, Minimum, Observations, Parameter};
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
+
+/// The standard normal's 97.5 % quantile: the Wald interval is p̂ ± 1.96 SE.
+pub const Z_95: f64 = 1.959_963_984_540_054;
 
 /// The 95 % quantile of χ² with one degree of freedom, 3.841 (the profile's threshold).
 pub const DELTA_CHI2_95: f64 = 3.841_458_820_694_124;

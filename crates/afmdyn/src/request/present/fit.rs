@@ -112,7 +112,7 @@ pub fn fit(
 /// The table and figures of a dynamic (AM or FM) fit ([`crate::request::fit_dynamic`]): the columns
 /// of the channels fitted, each channel's data and fit against z, and its residuals.
 fn am_files(p: &mut Presentation, document: &Value, files: Files) {
-    let columns: Vec<&str> = crate::request::fit_dynamic::CURVE_VARIABLES
+    let columns: Vec<&str> = crate::request::fit_result::CURVE_VARIABLES
         .iter()
         .map(|v| v.0)
         .filter(|k| document["curve"][k].is_array())
