@@ -344,22 +344,36 @@ impl CurveModel for AmCurveModel {
         cancel: &AtomicBool,
     ) {
         let has_jacobian = jacobian.is_some();
-        match self.evaluate_checked(p, values, jacobian, cancel) {
-            Ok(w) => {
-                if has_jacobian {
-                    if let Ok(mut l) = self.warnings.lock() {
-                        *l = w;
-                    }
-                }
-            }
-            // (the run ends: the warnings stay the last finished evaluation's)
-            Err(SimError::Cancelled) => values.fill(f64::NAN),
-            Err(e) => {
-                values.fill(f64::NAN);
-                if let Ok(mut l) = self.warnings.lock() {
-                    *l = vec![format!("the model failed at {p:?}: {e}")];
-                }
-            }
+        let outcome = self.evaluate_checked(p, values, jacobian, cancel);
+        record(&self.warnings, outcome, has_jacobian, values, p);
+    }
+}
+
+/// One evaluation's outcome, as every dynamic model keeps it (AM, bimodal, FM): a Jacobian
+/// evaluation's warnings replace the last ones (a value-only evaluation, a trial step of the
+/// minimiser, leaves them); a failed one fills `values` with NaN (the minimiser's refusal) and
+/// says where it failed at `p`; a cancelled one fills them with NaN and leaves the warnings as
+/// the last finished evaluation's (the run ends).
+pub(super) fn record(
+    warnings: &Mutex<Vec<String>>,
+    outcome: Result<Vec<String>, SimError>,
+    has_jacobian: bool,
+    values: &mut [f64],
+    p: &[f64],
+) {
+    let keep = match outcome {
+        Ok(w) if has_jacobian => w,
+        Ok(_) => return,
+        Err(SimError::Cancelled) => {
+            values.fill(f64::NAN);
+            return;
         }
+        Err(e) => {
+            values.fill(f64::NAN);
+            vec![format!("the model failed at {p:?}: {e}")]
+        }
+    };
+    if let Ok(mut l) = warnings.lock() {
+        *l = keep;
     }
 }

@@ -200,20 +200,7 @@ impl CurveModel for FmCurveModel {
     }
     fn evaluate(&self, p: &[f64], values: &mut [f64], jacobian: Option<&mut [f64]>) {
         let has_jacobian = jacobian.is_some();
-        match self.evaluate_checked(p, values, jacobian) {
-            Ok(w) => {
-                if has_jacobian {
-                    if let Ok(mut l) = self.warnings.lock() {
-                        *l = w;
-                    }
-                }
-            }
-            Err(e) => {
-                values.fill(f64::NAN);
-                if let Ok(mut l) = self.warnings.lock() {
-                    *l = vec![format!("the model failed at {p:?}: {e}")];
-                }
-            }
-        }
+        let outcome = self.evaluate_checked(p, values, jacobian);
+        super::am_curve::record(&self.warnings, outcome, has_jacobian, values, p);
     }
 }
