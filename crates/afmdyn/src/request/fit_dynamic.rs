@@ -203,6 +203,17 @@ pub fn execute(
                 "the dynamic fit takes the probe's [sample].law = hertz or dmt".into(),
             )
         })?;
+    // the exact sensitivities of DMT are those of its elastic force (analysis::fit::sensitivity):
+    // refused here, before a fit whose every Jacobian would fail
+    if law_name == "dmt" && probe.params.alpha6 != 0.0 {
+        return Err(bad(
+            "sample.viscosity",
+            format!("α6 = {:.4e}", probe.params.alpha6),
+            "the dynamic fit of a DMT sample needs it without Kelvin–Voigt damping: \
+             sample.viscosity = 0 (or the hertz law)"
+                .into(),
+        ));
+    }
     let s = probe.sample_inputs;
     let need = |v: Option<f64>, key: &str| {
         v.ok_or_else(|| bad("probe", key, format!("the fit needs the probe's {key}")))
