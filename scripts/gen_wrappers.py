@@ -91,7 +91,7 @@ FILES: Dict[str, Dict[str, Tuple[object, str, str, Dict[str, object]]]] = {
                          "fit_band": ("Optional[Sequence[float]]", "None")},
             "own": [("modulation_frequency", "Optional[Sequence[float]]", "None")] + PROGRESS}),
         "fit": ("fit", "_fit", "xr.Dataset", {
-            "omit": ("force", "height", "sigma"), "typed": False, "rename": {"range": "fit_range"},
+            "omit": ("force", "height", "sigma", "time"), "typed": False, "rename": {"range": "fit_range"},
             "override": {
                 "data": ('Union[str, "os.PathLike[str]", Mapping[str, Sequence[float]], Any, None]',
                          "None"),
@@ -168,6 +168,8 @@ def _annotation(prop: dict, defs: dict) -> str:
     ref = prop.get("$ref", "")
     if ref:
         return "str"  # an enum of names: checked by the library, which lists them
+    if any("$ref" in a for a in prop.get("anyOf", ())):
+        return "Optional[str]"  # an optional enum of names
     t = prop.get("type")
     types = t if isinstance(t, list) else [t]
     base = [x for x in types if x != "null"][0]

@@ -348,19 +348,21 @@ Raises:
 WRAPPERS["fit"] = {
     "summary": """\
 Fit a quasi-static force curve with the probe's contact law (``afmdyn fit``; hertz,
-dmt or jkr), its contact point and baseline: nanite's preprocessing (tip position
+dmt, jkr, or sls on a curve with times and a dwell), its contact point and baseline
+(and an AM, FM or bimodal curve against the dynamic model): nanite's preprocessing (tip position
 height + F/k, force and tip offsets at the contact point), Levenberg–Marquardt, standard
 errors, 95 % profile-likelihood intervals, correlations and identifiability warnings.
 ``probe`` (a model keyword, as ``--probe``) is required.""",
     "args": {
         "data": "the force curve: a CSV file with the columns ``height`` (m, the piezo "
         "height, decreasing into the sample), ``force`` (N, repulsion positive) and optionally "
-        "``sigma`` (N); or a mapping (a ``pandas.DataFrame``, a dict) with those columns; or an "
+        "``sigma`` (N) and ``time`` (s, which the ``sls`` law needs); or a mapping (a "
+        "``pandas.DataFrame``, a dict) with those columns; or an "
         "instrument's curve read by afmformats (Müller et al.; JPK ``.jpk-force``, "
         "``.jpk-force-map``, ``.jpk-qi-data``, Asylum ``.ibw``, afmformats ``.h5``/``.tab``): a "
         "file of those kinds, or an ``afmformats`` force-distance object (a "
-        "``nanite.Indentation`` too), whose ``height (measured)`` (else ``height (piezo)``) and "
-        "``force`` columns are taken.",
+        "``nanite.Indentation`` too), whose ``height (measured)`` (else ``height (piezo)``), "
+        "``force`` and ``time`` columns are taken.",
         "curve": "which curve of an afmformats file with several (a force map), from 0.",
         "approach_rows": "+For an afmformats curve the default is the instrument's segments.",
     },

@@ -1,5 +1,6 @@
 //! `afmdyn fit`: a measured quasi-static force curve fitted with the probe's contact law
-//! (Hertz, DMT, JKR), with its contact point and baseline — estimates, standard errors, 95 %
+//! (Hertz, DMT, JKR, or the SLS on a curve with times and a dwell), with its contact point and
+//! baseline — estimates, standard errors, 95 %
 //! profile-likelihood intervals, correlations, χ²/dof, residuals and identifiability
 //! warnings (with `--profiles`, an AM curve's intervals are the profile likelihood's too).
 //! The request, the preprocessing, the fit and the document are the library's
@@ -23,7 +24,8 @@ pub struct FitArgs {
     #[command(flatten)]
     model: ModelArgs,
     /// The force curve: a CSV with the columns height (m, the piezo height, decreasing into
-    /// the sample), force (N, repulsion positive) and optionally sigma (N); or an AM curve: the
+    /// the sample), force (N, repulsion positive) and optionally sigma (N) and time (s, which
+    /// the sls law needs: its relaxation on a dwell); or an AM curve: the
     /// columns z (m, the piezo position, in the order stepped), amplitude (m) and/or phase
     /// (deg), optionally sigma_amplitude (m) and sigma_phase (deg); or an FM curve: the columns
     /// z (m) and frequency_shift (Hz), optionally sigma_frequency_shift (Hz), at the probe's
@@ -33,13 +35,16 @@ pub struct FitArgs {
     data: PathBuf,
     /// The parameters fitted, by their probe keys, comma-separated: sample.youngs_modulus,
     /// tip.radius, contact_point, baseline, sample.hamaker (dmt), sample.adhesion_energy (jkr);
+    /// sample.stiffness, sample.maxwell_stiffness, sample.relaxation_time (sls, whose default
+    /// frees these three, contact_point and baseline);
     /// of an AM or FM curve sample.youngs_modulus, sample.hamaker (dmt), tip.radius and
     /// z_offset (always fitted) [AM/FM default: E, H (dmt), z_offset]
     #[arg(long, value_delimiter = ',', default_values_t = FitRequest::default().fit)]
     fit: Vec<String>,
-    /// The segment fitted: approach (up to the lowest height) or retract
-    #[arg(long, default_value = "approach", value_parser = ["approach", "retract"])]
-    segment: String,
+    /// The segment fitted: approach (up to the lowest height), retract or whole (approach,
+    /// dwell and retract) [default: approach; whole for the sls law]
+    #[arg(long, value_parser = ["approach", "retract", "whole"])]
+    segment: Option<String>,
     /// The range of tip positions fitted, LO,HI (m, after the contact-point offset)
     #[arg(
         long,
@@ -73,12 +78,12 @@ pub struct FitArgs {
 
 /// Run `afmdyn fit`.
 pub fn fit(a: &FitArgs) -> Result<(), CliError> {
-    // (clap admits only these two)
-    let segment = if a.segment == "retract" {
-        FitSegment::Retract
-    } else {
-        FitSegment::Approach
-    };
+    // (clap admits only these three)
+    let segment = a.segment.as_deref().map(|s| match s {
+        "retract" => FitSegment::Retract,
+        "whole" => FitSegment::Whole,
+        _ => FitSegment::Approach,
+    });
     let range = match a.range.as_deref() {
         None => None,
         Some(&[lo, hi]) => Some([lo, hi]),

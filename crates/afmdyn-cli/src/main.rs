@@ -107,7 +107,7 @@ enum Command {
     Fm(cmd_fm::FmArgs),
     /// Off-resonance (PeakForce) tapping: the steady tap's channels, cycle and force curve
     Peakforce(cmd_peakforce::PeakForceArgs),
-    /// Fit a measured force curve (Hertz, DMT, JKR): estimates, intervals, correlations, warnings
+    /// Fit a measured force curve (Hertz, DMT, JKR, SLS on a dwell) or an AM/FM curve: estimates, intervals, warnings
     Fit(cmd_fit::FitArgs),
     /// Tip–sample force and potential from an FM-AFM frequency-shift curve (Sader–Jarvis)
     Reconstruct(cmd_reconstruct::ReconstructArgs),

@@ -197,3 +197,29 @@ def test_a_frequency_shift_curve_fits_against_the_fm_model(tmp_path):
         lo = ds["interval_low"].sel(parameter=name).item()
         hi = ds["interval_high"].sel(parameter=name).item()
         assert lo <= truth <= hi, (name, lo, hi)
+
+
+def test_a_viscoelastic_curve_with_a_dwell_fits_in_time(tmp_path):
+    """The SLS on examples/force-curve-sls-dwell.csv (scripts/make-sls-curve.py, independent of
+    afmdyn: k1 = 10 mN/m, k2 = 20 mN/m, τ = 0.1 s, 50 pN of noise): from the file and from its
+    columns as a mapping, the same estimates; each truth inside its 95 % interval; the Dataset
+    carries the rows' times in s."""
+    probe = str(EXAMPLES / "probe-fit-sls.toml")
+    path = EXAMPLES / "force-curve-sls-dwell.csv"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", afmdyn.AfmdynWarning)
+        ds = afmdyn.fit(probe=probe, data=str(path))
+        t, h, f = np.loadtxt(path, delimiter=",", skiprows=1).T
+        cols = afmdyn.fit(probe=probe, data={"height": h, "force": f, "time": t})
+    assert list(ds["parameter"].values) == list(cols["parameter"].values)
+    np.testing.assert_allclose(ds["estimate"], cols["estimate"], rtol=1e-9)
+    truth = {"sample.stiffness": 0.01, "sample.maxwell_stiffness": 0.02,
+             "sample.relaxation_time": 0.1}
+    for name, value in truth.items():
+        e = ds.sel(parameter=name)
+        assert float(e["interval_low"]) <= value <= float(e["interval_high"]), name
+    assert ds["time"].attrs["units"] == "s" and ds["time"].size == 3001
+    assert json.loads(ds.attrs["summary"])["segment"] == "whole"
+    # without the times the law cannot run: the error names the column
+    with pytest.raises(ValueError, match="time"):
+        afmdyn.fit(probe=probe, data={"height": h, "force": f})

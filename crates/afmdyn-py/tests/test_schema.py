@@ -147,6 +147,9 @@ CLI_CASES: List[Tuple[str, List[Any]]] = [
              "--files", "data"]),
     ("fit", ["--probe", FIT_PROBE, "--data", FIT_DATA, "--fit", "sample.youngs_modulus",
              "--range", "-2e-7,0", "--files", "none"]),
+    # the SLS in time: an approach, a dwell and a retract with the rows' times
+    ("fit", ["--probe", str(EXAMPLES / "probe-fit-sls.toml"), "--data",
+             str(EXAMPLES / "force-curve-sls-dwell.csv"), "--files", "data"]),
     # a dynamic curve's form: the frequency shift of the FM loop against z
     ("fit", ["--probe", P1, "--data", FM_DATA, "--fit", "sample.hamaker,z_offset",
              "--files", "none"]),

@@ -425,8 +425,9 @@ FitRequest = TypedDict(
         "height": List[float],  # default []
         "profiles": Optional[bool],  # default null
         "range": Optional[List[float]],  # default null
-        "segment": Literal["approach", "retract"],  # default "approach"
+        "segment": Optional[Literal["approach", "retract", "whole"]],  # default null
         "sigma": Optional[List[float]],  # default null
+        "time": List[float],  # default []
     },
     total=False,
 )

@@ -36,7 +36,7 @@ def _finish_fit(a: Dict[str, Any]) -> xr.Dataset:
     if isinstance(data, (str, os.PathLike)):
         request["data"] = os.fspath(data)
     elif data is not None:
-        for key in ("height", "force", "sigma"):
+        for key in ("height", "force", "sigma", "time"):
             if key in data:
                 request[key] = [float(v) for v in np.asarray(data[key], dtype=float)]
     p, probe = _params(a["params"], a["model"])
@@ -81,7 +81,8 @@ _MAX_INSTRUMENT_FILE = 1 << 30
 def _instrument_curve(data: Any, curve: int) -> Tuple[Any, Optional[float], Optional[int]]:
     """``data`` as :func:`fit` takes it, the spring constant (N/m) its file states and the rows
     of its approach: an afmformats file or object becomes the mapping of its ``height``
-    (``height (measured)``, else ``height (piezo)``, m) and ``force`` (N) columns, its approach
+    (``height (measured)``, else ``height (piezo)``, m), ``force`` (N) and, where it has
+    one, ``time`` (s; the ``sls`` law needs it) columns, its approach
     the leading rows of its ``segment`` column that are 0; anything else is returned as it is."""
     if isinstance(data, (str, os.PathLike)):
         if not os.fspath(data).lower().endswith(_AFMFORMATS):
@@ -117,6 +118,9 @@ def _instrument_curve(data: Any, curve: int) -> Tuple[Any, Optional[float], Opti
         retract = np.flatnonzero(np.asarray(data["segment"]) != 0)
         # (no retract, or a curve that starts retracting: the library's default)
         approach = int(retract[0]) if retract.size and retract[0] > 0 else None
-    return {"height": np.asarray(data[heights[0]], dtype=float),
-            "force": np.asarray(data["force"], dtype=float)}, k_file, approach
+    out = {"height": np.asarray(data[heights[0]], dtype=float),
+           "force": np.asarray(data["force"], dtype=float)}
+    if "time" in columns:
+        out["time"] = np.asarray(data["time"], dtype=float)
+    return out, k_file, approach
 

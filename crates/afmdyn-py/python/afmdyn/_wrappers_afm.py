@@ -725,13 +725,14 @@ def fit(
     fit: Optional[Sequence[str]] = None,
     profiles: Optional[bool] = None,
     fit_range: Optional[Tuple[float, float]] = None,
-    segment: str = "approach",
+    segment: Optional[str] = None,
     curve: int = 0,
     progress: ProgressArg = None,
     **model: Unpack[Model],
 ) -> xr.Dataset:
     """Fit a quasi-static force curve with the probe's contact law (``afmdyn fit``; hertz,
-    dmt or jkr), its contact point and baseline: nanite's preprocessing (tip position
+    dmt, jkr, or sls on a curve with times and a dwell), its contact point and baseline
+    (and an AM, FM or bimodal curve against the dynamic model): nanite's preprocessing (tip position
     height + F/k, force and tip offsets at the contact point), Levenberg–Marquardt, standard
     errors, 95 % profile-likelihood intervals, correlations and identifiability warnings.
     ``probe`` (a model keyword, as ``--probe``) is required.
@@ -744,17 +745,21 @@ def fit(
             instrument's segments.
         data: the force curve: a CSV file with the columns ``height`` (m, the piezo height,
             decreasing into the sample), ``force`` (N, repulsion positive) and optionally
-            ``sigma`` (N); or a mapping (a ``pandas.DataFrame``, a dict) with those columns;
-            or an instrument's curve read by afmformats (Müller et al.; JPK ``.jpk-force``,
-            ``.jpk-force-map``, ``.jpk-qi-data``, Asylum ``.ibw``, afmformats
-            ``.h5``/``.tab``): a file of those kinds, or an ``afmformats`` force-distance
-            object (a ``nanite.Indentation`` too), whose ``height (measured)`` (else
-            ``height (piezo)``) and ``force`` columns are taken.
+            ``sigma`` (N) and ``time`` (s, which the ``sls`` law needs); or a mapping (a
+            ``pandas.DataFrame``, a dict) with those columns; or an instrument's curve read
+            by afmformats (Müller et al.; JPK ``.jpk-force``, ``.jpk-force-map``, ``.jpk-qi-
+            data``, Asylum ``.ibw``, afmformats ``.h5``/``.tab``): a file of those kinds, or
+            an ``afmformats`` force-distance object (a ``nanite.Indentation`` too), whose
+            ``height (measured)`` (else ``height (piezo)``), ``force`` and ``time`` columns
+            are taken.
         fit: The parameters fitted, by their probe keys: ``sample.youngs_modulus``,
             ``tip.radius``, ``contact_point``, ``baseline``, and ``sample.hamaker`` (DMT) or
-            ``sample.adhesion_energy`` (JKR); the others are held at the probe's values
+            ``sample.adhesion_energy`` (JKR); of the ``sls`` law ``sample.stiffness``,
+            ``sample.maxwell_stiffness``, ``sample.relaxation_time`` (N/m, N/m, s),
+            ``contact_point`` and ``baseline``. The others are held at the probe's values
             (contact point and baseline at 0, after the preprocessing). Default
-            ``sample.youngs_modulus``, ``contact_point``.
+            ``sample.youngs_modulus``, ``contact_point`` (for ``sls``: its three,
+            ``contact_point`` and ``baseline``).
         profiles: Profile-likelihood intervals (Δχ² ≤ 3.84) for the fitted parameters, up to
             4 of them (beyond, and when off, the Wald intervals ±1.96 SE). Default on for a
             force curve; off for an AM curve, where every profile point is a refit of
@@ -763,7 +768,8 @@ def fit(
             has not risen by then is reported flat).
         fit_range: The range of tip positions fitted [lo, hi] (m, after the preprocessing's
             offset, as nanite's ``range_x``); default the whole segment.
-        segment: The segment fitted (default the approach).
+        segment: The segment fitted: ``approach``, ``retract`` or ``whole``; default the
+            approach, the whole curve for the ``sls`` law.
         curve: which curve of an afmformats file with several (a force map), from 0.
         progress: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a
             log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.

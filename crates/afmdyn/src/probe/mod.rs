@@ -332,6 +332,13 @@ pub struct SampleInputs {
     pub hamaker: Option<f64>,
     /// `[sample] intermolecular_distance` (m).
     pub intermolecular_distance: Option<f64>,
+    /// `[sample] stiffness` (N/m): the linear, Kelvin–Voigt and SLS laws' spring (SLS: the
+    /// relaxed spring k₁).
+    pub stiffness: Option<f64>,
+    /// `[sample] maxwell_stiffness` (N/m, the SLS Maxwell arm's k₂).
+    pub maxwell_stiffness: Option<f64>,
+    /// `[sample] relaxation_time` (s, the SLS Maxwell arm's τ_r = η/k₂).
+    pub relaxation_time: Option<f64>,
 }
 
 /// The indentation, as a fraction of the tip radius, beyond which the paraboloid contact of

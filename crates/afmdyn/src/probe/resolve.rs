@@ -290,6 +290,9 @@ impl Probe {
                 adhesion_energy: sample.adhesion_energy,
                 hamaker: sample.hamaker,
                 intermolecular_distance: sample.a0,
+                stiffness: sample.stiffness,
+                maxwell_stiffness: sample.maxwell.map(|m| m.0),
+                relaxation_time: sample.maxwell.map(|m| m.1),
             },
         })
     }

@@ -13,7 +13,10 @@ use crate::analysis::fit::force_curve::{
     YOUNGS_MODULUS,
 };
 use crate::analysis::fit::profile::ProfileWalk;
-use crate::analysis::fit::{fit_cancellable, Observations, Parameter, ProfileEnd};
+use crate::analysis::fit::sls_curve::{
+    self, SlsCurveModel, MAXWELL_STIFFNESS, RELAXATION_TIME, STIFFNESS,
+};
+use crate::analysis::fit::{fit_cancellable, CurveModel, Observations, Parameter, ProfileEnd};
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
 use serde::{Deserialize, Serialize};
@@ -32,10 +35,13 @@ pub enum FitSegment {
     Approach,
     /// The retract, after it.
     Retract,
+    /// Every row: approach, dwell and retract (the default of the `sls` law, whose dwell
+    /// shows its relaxation or creep).
+    Whole,
 }
 
 /// `fit`: the force curve (a CSV file `data`, or the columns `height`, `force` and optionally
-/// `sigma`), the parameters fitted (`fit`, probe keys), the segment and the range of tip
+/// `sigma` and `time`), the parameters fitted (`fit`, probe keys), the segment and the range of tip
 /// positions fitted.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
@@ -43,7 +49,8 @@ pub enum FitSegment {
 pub struct FitRequest {
     /// A CSV file, read through the bounded reader; excludes `height` and `force`. A force
     /// curve: the columns `height` (m, the piezo height, decreasing into the sample), `force`
-    /// (N, repulsion positive) and optionally `sigma` (N, each force's standard deviation). A
+    /// (N, repulsion positive) and optionally `sigma` (N, each force's standard deviation) and
+    /// `time` (s, strictly increasing; needed by the `sls` law). A
     /// dynamic curve: `z` (m, the piezo position, in the order stepped) with `amplitude` (m)
     /// and/or `phase` (deg) (AM), or `frequency_shift` (Hz) (FM, at the probe's free
     /// amplitude), or `amplitude_2` (m) and/or `phase_2` (deg) (bimodal, a probe with a second
@@ -56,13 +63,20 @@ pub struct FitRequest {
     /// The forces' standard deviations (N, > 0), as many as `force`; without them the noise is
     /// estimated from the residuals.
     pub sigma: Option<Vec<f64>>,
+    /// The rows' times (s, strictly increasing), as many as `force`, when no `data` file is
+    /// given; needed by the `sls` law (its relaxation and creep), ignored by the others.
+    pub time: Vec<f64>,
     /// The parameters fitted, by their probe keys: `sample.youngs_modulus`, `tip.radius`,
     /// `contact_point`, `baseline`, and `sample.hamaker` (DMT) or `sample.adhesion_energy`
-    /// (JKR); the others are held at the probe's values (contact point and baseline at 0,
-    /// after the preprocessing). Default `sample.youngs_modulus`, `contact_point`.
+    /// (JKR); of the `sls` law `sample.stiffness`, `sample.maxwell_stiffness`,
+    /// `sample.relaxation_time` (N/m, N/m, s), `contact_point` and `baseline`. The others are
+    /// held at the probe's values (contact point and baseline at 0, after the preprocessing).
+    /// Default `sample.youngs_modulus`, `contact_point` (for `sls`: its three, `contact_point`
+    /// and `baseline`).
     pub fit: Vec<String>,
-    /// The segment fitted (default the approach).
-    pub segment: FitSegment,
+    /// The segment fitted: `approach`, `retract` or `whole`; default the approach, the whole
+    /// curve for the `sls` law.
+    pub segment: Option<FitSegment>,
     /// The range of tip positions fitted [lo, hi] (m, after the preprocessing's offset, as
     /// nanite's `range_x`); default the whole segment.
     pub range: Option<[f64; 2]>,
@@ -85,8 +99,9 @@ impl Default for FitRequest {
             height: Vec::new(),
             force: Vec::new(),
             sigma: None,
+            time: Vec::new(),
             fit: vec![YOUNGS_MODULUS.into(), CONTACT_POINT.into()],
-            segment: FitSegment::Approach,
+            segment: None,
             range: None,
             approach_rows: None,
             profiles: None,
@@ -94,14 +109,14 @@ impl Default for FitRequest {
     }
 }
 
-/// A force curve's columns: heights, forces and their σ.
-type Columns = (Vec<f64>, Vec<f64>, Option<Vec<f64>>);
+/// A force curve's columns: heights, forces, their σ and the rows' times.
+type Columns = (Vec<f64>, Vec<f64>, Option<Vec<f64>>, Option<Vec<f64>>);
 
 fn bad(name: &'static str, value: impl std::fmt::Display, allowed: String) -> SimError {
     SimError::out_of_range(name, value, allowed)
 }
 
-/// The columns `height`, `force` and optionally `sigma` of the CSV file `path`, read through
+/// The columns `height`, `force` and optionally `sigma` and `time` of the CSV file `path`, read through
 /// the bounded reader ([`crate::io::curve_file::read_curve_file`], a curve CSV's cap).
 ///
 /// # Errors
@@ -120,7 +135,7 @@ pub fn read_force_curve(path: &std::path::Path) -> Result<Columns, SimError> {
             let missing = |c: &str| file(format!("no column {c} among {}", names.join(", ")));
             let height = col("height").ok_or_else(|| missing("height (m)"))?;
             let force = col("force").ok_or_else(|| missing("force (N)"))?;
-            Ok((height, force, col("sigma")))
+            Ok((height, force, col("sigma"), col("time")))
         }
     }
 }
@@ -153,7 +168,12 @@ impl FitRequest {
                  or the columns height and force"
                     .into(),
             )),
-            (None, false) => Ok((self.height.clone(), self.force.clone(), self.sigma.clone())),
+            (None, false) => Ok((
+                self.height.clone(),
+                self.force.clone(),
+                self.sigma.clone(),
+                (!self.time.is_empty()).then(|| self.time.clone()),
+            )),
         }
     }
 
@@ -173,23 +193,55 @@ impl FitRequest {
             bad(
                 "law",
                 name,
-                "the force-curve fit takes the probe's [sample].law = hertz, dmt or jkr".into(),
+                "the force-curve fit takes the probe's [sample].law = hertz, dmt, jkr or sls"
+                    .into(),
             )
         })
+    }
+
+    /// The parameters fitted: `fit`, or the `sls` law's default when `fit` is the request's.
+    pub fn fitted(&self, law: ForceLaw) -> Vec<String> {
+        if law == ForceLaw::Sls && self.fit == FitRequest::default().fit {
+            return sls_curve::DEFAULT_FIT
+                .iter()
+                .map(|s| s.to_string())
+                .collect();
+        }
+        self.fit.clone()
+    }
+
+    /// The segment fitted: `segment`, or the law's default (the whole curve for `sls`).
+    pub fn segment_of(&self, law: ForceLaw) -> Segment {
+        match self.segment {
+            Some(FitSegment::Approach) => Segment::Approach,
+            Some(FitSegment::Retract) => Segment::Retract,
+            Some(FitSegment::Whole) => Segment::Whole,
+            None if law == ForceLaw::Sls => Segment::Whole,
+            None => Segment::Approach,
+        }
     }
 
     /// Check the options against the probe's law (the data are checked when read).
     fn check(&self, model: &Resolved) -> Result<ForceLaw, SimError> {
         let law = Self::law(model)?;
         let names = law.parameter_names();
-        if self.fit.is_empty() {
+        if law == ForceLaw::Jkr && self.segment == Some(FitSegment::Whole) {
+            return Err(bad(
+                "segment",
+                "whole",
+                "the jkr law's contact differs on the approach and the retract: fit one of them"
+                    .into(),
+            ));
+        }
+        let fit = self.fitted(law);
+        if fit.is_empty() {
             return Err(bad(
                 "fit",
                 "none",
                 format!("name one or more of {}", names.join(", ")),
             ));
         }
-        for (i, f) in self.fit.iter().enumerate() {
+        for (i, f) in fit.iter().enumerate() {
             if !names.contains(&f.as_str()) {
                 return Err(bad(
                     "fit",
@@ -201,7 +253,7 @@ impl FitRequest {
                     ),
                 ));
             }
-            if self.fit[..i].contains(f) {
+            if fit[..i].contains(f) {
                 return Err(bad("fit", f, "named twice".into()));
             }
         }
@@ -215,20 +267,30 @@ impl FitRequest {
             }
         }
         if self.data.is_none() {
-            check_columns(&self.height, &self.force, self.sigma.as_deref())?;
+            let time = (!self.time.is_empty()).then_some(self.time.as_slice());
+            check_columns(&self.height, &self.force, self.sigma.as_deref(), time)?;
         }
         Ok(law)
     }
 }
 
 /// The columns' lengths, sizes and values.
-fn check_columns(height: &[f64], force: &[f64], sigma: Option<&[f64]>) -> Result<(), SimError> {
-    if height.len() != force.len() || sigma.is_some_and(|s| s.len() != force.len()) {
+fn check_columns(
+    height: &[f64],
+    force: &[f64],
+    sigma: Option<&[f64]>,
+    time: Option<&[f64]>,
+) -> Result<(), SimError> {
+    let rows = force.len();
+    if height.len() != rows
+        || sigma.is_some_and(|s| s.len() != rows)
+        || time.is_some_and(|t| t.len() != rows)
+    {
         return Err(bad(
             "force",
             force.len(),
             format!(
-                "height, force (and sigma) must have one value per row ({} heights)",
+                "height, force (and sigma, time) must have one value per row ({} heights)",
                 height.len()
             ),
         ));
@@ -252,6 +314,15 @@ fn check_columns(height: &[f64], force: &[f64], sigma: Option<&[f64]>) -> Result
             "sigma",
             format!("row {}", i + 1),
             "must be finite and > 0 (N)".into(),
+        ));
+    }
+    if let Some(i) = time
+        .and_then(|t| (0..t.len()).position(|i| !(t[i].is_finite() && (i == 0 || t[i] > t[i - 1]))))
+    {
+        return Err(bad(
+            "time",
+            format!("row {}", i + 1),
+            "must be finite and strictly increasing (s)".into(),
         ));
     }
     Ok(())
@@ -278,8 +349,8 @@ impl Analysis for FitRequest {
             );
         }
         let law = self.check(model)?;
-        let (height, force, sigma) = self.columns()?;
-        check_columns(&height, &force, sigma.as_deref())?;
+        let (height, force, sigma, time) = self.columns()?;
+        check_columns(&height, &force, sigma.as_deref(), time.as_deref())?;
         let probe = model.probe.as_ref().expect("checked");
         let k = probe.calibration.spring_constant;
         let s = probe.sample_inputs;
@@ -294,12 +365,20 @@ impl Analysis for FitRequest {
             }
             curve.approach_len = n;
         }
-        let segment = match self.segment {
-            FitSegment::Approach => Segment::Approach,
-            FitSegment::Retract => Segment::Retract,
-        };
+        if law == ForceLaw::Sls && time.is_none() {
+            return Err(bad(
+                "time",
+                "missing",
+                "the sls law's force depends on the indentation's history: give the rows' \
+                 times (s), a time column"
+                    .into(),
+            ));
+        }
+        curve.time = time;
+        let segment = self.segment_of(law);
+        let fit = self.fitted(law);
         let rows = curve.rows(segment, self.range);
-        if rows.len() < MIN_FIT_ROWS.max(self.fit.len() + 1) {
+        if rows.len() < MIN_FIT_ROWS.max(fit.len() + 1) {
             return Err(bad(
                 "range",
                 format!("{} rows", rows.len()),
@@ -308,8 +387,9 @@ impl Analysis for FitRequest {
                     match segment {
                         Segment::Approach => "approach",
                         Segment::Retract => "retract",
+                        Segment::Whole => "curve",
                     },
-                    self.fit.len()
+                    fit.len()
                 ),
             ));
         }
@@ -339,6 +419,15 @@ impl Analysis for FitRequest {
                     let h = need(s.hamaker, HAMAKER)?;
                     (h, h.max(1e-21))
                 }
+                STIFFNESS | MAXWELL_STIFFNESS | RELAXATION_TIME => {
+                    let v = match *name {
+                        STIFFNESS => s.stiffness,
+                        MAXWELL_STIFFNESS => s.maxwell_stiffness,
+                        _ => s.relaxation_time,
+                    };
+                    let v = need(v, name)?;
+                    (v, v)
+                }
                 _ => {
                     let w = need(s.adhesion_energy, "sample.adhesion_energy")?;
                     (w, w.max(1e-3))
@@ -353,25 +442,34 @@ impl Analysis for FitRequest {
                 scale,
             });
         }
-        let fitted: Vec<bool> = names
-            .iter()
-            .map(|n| self.fit.iter().any(|f| f == n))
-            .collect();
+        let fitted: Vec<bool> = names.iter().map(|n| fit.iter().any(|f| f == n)).collect();
         let fixed: Vec<Option<f64>> = params
             .iter()
             .zip(&fitted)
             .map(|(p, f)| (!f).then_some(p.start))
             .collect();
-        let m = ForceCurveModel {
-            law,
-            x,
-            segment,
-            poisson_ratio: need(s.poisson_ratio, "sample.poisson_ratio")?,
-            tip: (
-                need(s.tip_youngs_modulus, "tip.youngs_modulus")?,
-                need(s.tip_poisson_ratio, "tip.poisson_ratio")?,
-            ),
-            intermolecular_distance: s.intermolecular_distance.unwrap_or(0.0),
+        // the SLS's force depends on every row before (its history from the first row)
+        let m: Box<dyn CurveModel> = match (law, &curve.time) {
+            (ForceLaw::Sls, Some(t)) => Box::new(SlsCurveModel {
+                // the piezo's height in the preprocessed frame, free of the force's noise
+                height: (curve.tip_position.iter().zip(&curve.force))
+                    .map(|(x, f)| x - f / k)
+                    .collect(),
+                t: t.clone(),
+                spring_constant: k,
+                rows: rows.clone(),
+            }),
+            _ => Box::new(ForceCurveModel {
+                law,
+                x,
+                segment,
+                poisson_ratio: need(s.poisson_ratio, "sample.poisson_ratio")?,
+                tip: (
+                    need(s.tip_youngs_modulus, "tip.youngs_modulus")?,
+                    need(s.tip_poisson_ratio, "tip.poisson_ratio")?,
+                ),
+                intermolecular_distance: s.intermolecular_distance.unwrap_or(0.0),
+            }),
         };
         progress.check()?;
         let obs = Observations {
@@ -379,7 +477,7 @@ impl Analysis for FitRequest {
             sigma: sig.as_deref(),
         };
         let walk = self.profiles.unwrap_or(true).then_some(ProfileWalk::Grid);
-        let outcome = fit_cancellable(&m, &obs, &params, &fixed, walk, progress)?;
+        let outcome = fit_cancellable(m.as_ref(), &obs, &params, &fixed, walk, progress)?;
         Ok(FitResult {
             law,
             spring_constant: k,
@@ -493,7 +591,22 @@ pub fn document(request: &FitRequest, r: &FitResult) -> Value {
         );
     }
     let pick = |v: &[f64]| r.rows.iter().map(|&i| v[i]).collect::<Vec<f64>>();
-    json!({
+    let segment = match request.segment_of(r.law) {
+        Segment::Approach => "approach",
+        Segment::Retract => "retract",
+        Segment::Whole => "whole",
+    };
+    let model = if r.law == ForceLaw::Sls {
+        "F = baseline + F_c: the standard linear solid (Zener) with surface memory in time \
+         (k1 relaxed spring, Maxwell arm k2 with relaxation time τ; F_c = k1 δ + k2 (δ − u), \
+         u' = (δ − u)/τ in contact, the free surface recovering with τ (k1 + k2)/k1; López-Guerra \
+         & Solares 2014), driven through the lever in series from the piezo height (x − F/k, free \
+         of the force noise; linear between rows), from rest at the first row"
+    } else {
+        "F = baseline + F_law(contact_point − x) with the registry's law in SI (Hertz: (4/3)E*√R \
+         δ^{3/2}, Sneddon 1965)"
+    };
+    let mut doc = json!({
         "estimates": estimates,
         "parameters": parameters,
         "correlation": {"names": names, "matrix": matrix},
@@ -517,17 +630,23 @@ pub fn document(request: &FitRequest, r: &FitResult) -> Value {
             "rows": r.curve.force.len(),
         },
         "law": r.law.name(),
-        "segment": request.segment,
+        "segment": segment,
         "range": request.range,
         "rows_fitted": r.rows.len(),
         "evaluations": o.evaluations,
         "termination": o.termination,
         "units": {"sample.youngs_modulus": "Pa", "tip.radius": "m", "contact_point": "m", "baseline": "N",
-                  "sample.hamaker": "J", "sample.adhesion_energy": "J/m^2", "tip_position": "m", "force": "N",
+                  "sample.hamaker": "J", "sample.adhesion_energy": "J/m^2", "sample.stiffness": "N/m",
+                  "sample.maxwell_stiffness": "N/m", "sample.relaxation_time": "s", "time": "s",
+                  "tip_position": "m", "force": "N",
                   "fit": "N", "residual": "N", "chi2_dof": if o.noise_estimated { "N^2" } else { "1" }},
-        "method": "weighted least squares by Levenberg–Marquardt (MINPACK lmder, rust-cv levenberg-marquardt) on the preprocessed curve (nanite's steps: tip position x = height + F/k, force offset and tip offset at the deviation_from_baseline contact point); F = baseline + F_law(contact_point − x) with the registry's law in SI (Hertz: (4/3)E*√R δ^{3/2}, Sneddon 1965); standard errors from (JᵀWJ)⁻¹ s²; ".to_string() + intervals_method(o) + " (docs/afm-workflow.md, From data to properties)",
+        "method": "weighted least squares by Levenberg–Marquardt (MINPACK lmder, rust-cv levenberg-marquardt) on the preprocessed curve (nanite's steps: tip position x = height + F/k, force offset and tip offset at the deviation_from_baseline contact point); ".to_string() + model + "; standard errors from (JᵀWJ)⁻¹ s²; " + intervals_method(o) + " (docs/afm-workflow.md, From data to properties)",
         "warnings": o.warnings,
-    })
+    });
+    if let Some(t) = &r.curve.time {
+        doc["curve"]["time"] = json!(pick(t));
+    }
+    doc
 }
 
 impl super::named::Datasets for FitRequest {
@@ -550,6 +669,7 @@ impl super::named::Datasets for FitRequest {
                 ("force", "N", "force, measured"),
                 ("fit", "N", "force, fitted"),
                 ("residual", "N", "measured − fitted"),
+                ("time", "s", "time (the sls law's curve)"),
             ]
         };
         let n = r.dynamic.as_ref().map_or(n, |d| d.data.z.len());

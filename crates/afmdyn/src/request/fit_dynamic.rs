@@ -195,7 +195,7 @@ pub fn execute(
     })?;
     let law_name = probe.params.contact_law.name();
     let law = crate::analysis::fit::force_curve::ForceLaw::from_name(law_name)
-        .filter(|l| l.name() != "jkr")
+        .filter(|l| matches!(l.name(), "hertz" | "dmt"))
         .ok_or_else(|| {
             bad(
                 "law",

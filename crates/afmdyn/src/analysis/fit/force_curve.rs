@@ -33,6 +33,7 @@
 //! ∂F/∂k_H = F_c/k_H exactly for Hertz, and by central differences of relative step 1e-6 on
 //! DMT's and JKR's groups (error ~1e-12 relative), chained to E_s, R, H and W analytically.
 
+use super::sls_curve::{MAXWELL_STIFFNESS, RELAXATION_TIME, STIFFNESS};
 use crate::contact::{reduced_modulus, DmtLaw, HertzLaw, Jkr, JkrLaw, Law};
 
 /// The force-curve laws the fit takes.
@@ -44,6 +45,9 @@ pub enum ForceLaw {
     Dmt,
     /// JKR: the adhesive neck.
     Jkr,
+    /// The standard linear solid (Zener) with surface memory, in time: its model is
+    /// [`super::sls_curve::SlsCurveModel`], not [`ForceCurveModel`].
+    Sls,
 }
 
 impl ForceLaw {
@@ -53,6 +57,7 @@ impl ForceLaw {
             "hertz" => Some(ForceLaw::Hertz),
             "dmt" => Some(ForceLaw::Dmt),
             "jkr" => Some(ForceLaw::Jkr),
+            "sls" => Some(ForceLaw::Sls),
             _ => None,
         }
     }
@@ -62,6 +67,7 @@ impl ForceLaw {
             ForceLaw::Hertz => "hertz",
             ForceLaw::Dmt => "dmt",
             ForceLaw::Jkr => "jkr",
+            ForceLaw::Sls => "sls",
         }
     }
     /// The names of the model's parameters, in the model's order (every one fittable).
@@ -70,6 +76,13 @@ impl ForceLaw {
             ForceLaw::Hertz => &[YOUNGS_MODULUS, RADIUS, CONTACT_POINT, BASELINE],
             ForceLaw::Dmt => &[YOUNGS_MODULUS, RADIUS, CONTACT_POINT, BASELINE, HAMAKER],
             ForceLaw::Jkr => &[YOUNGS_MODULUS, RADIUS, CONTACT_POINT, BASELINE, ADHESION],
+            ForceLaw::Sls => &[
+                STIFFNESS,
+                MAXWELL_STIFFNESS,
+                RELAXATION_TIME,
+                CONTACT_POINT,
+                BASELINE,
+            ],
         }
     }
 }
@@ -94,6 +107,9 @@ pub enum Segment {
     Approach,
     /// After it.
     Retract,
+    /// Every row: approach, dwell and retract (a time-dependent law's history; JKR's
+    /// [`ForceCurveModel`] takes these rows as an approach's).
+    Whole,
 }
 
 /// A force curve after the preprocessing of the module docs.
@@ -112,6 +128,8 @@ pub struct Preprocessed {
     pub force_offset: f64,
     /// The tip position subtracted (m).
     pub tip_offset: f64,
+    /// The rows' times (s), when the data give them (a time-dependent law needs them).
+    pub time: Option<Vec<f64>>,
 }
 
 impl Preprocessed {
@@ -120,6 +138,7 @@ impl Preprocessed {
         let span = match segment {
             Segment::Approach => 0..self.approach_len,
             Segment::Retract => self.approach_len..self.force.len(),
+            Segment::Whole => 0..self.force.len(),
         };
         span.filter(|&i| range.is_none_or(|[lo, hi]| (lo..=hi).contains(&self.tip_position[i])))
             .collect()
@@ -176,6 +195,7 @@ pub fn preprocess(height: &[f64], force: &[f64], spring_constant: f64) -> Prepro
         contact_index: found,
         force_offset,
         tip_offset,
+        time: None,
     }
 }
 
@@ -218,11 +238,17 @@ impl ForceCurveModel {
             .force(k, 0.0, delta >= 0.0, delta, 0.0),
             ForceLaw::Jkr => {
                 let contact = match self.segment {
-                    Segment::Approach => delta >= 0.0,
+                    Segment::Approach | Segment::Whole => delta >= 0.0,
                     Segment::Retract => delta > Jkr::new(k, g).release(),
                 };
                 JkrLaw { adhesion: g }.force(k, 0.0, contact, delta, 0.0)
             }
+            // not this model's law (its history needs the rows' times): no value
+            ForceLaw::Sls => crate::contact::ForceEval {
+                force: f64::NAN,
+                d_delta: f64::NAN,
+                d_rate: f64::NAN,
+            },
         };
         (e.force, e.d_delta)
     }
@@ -237,7 +263,7 @@ impl super::CurveModel for ForceCurveModel {
         let (k, dk_de) = self.hertz_group(e_s, r);
         // the law's second group and its derivatives by R and by its own parameter
         let (g, dg_dr, dg_dq) = match self.law {
-            ForceLaw::Hertz => (0.0, 0.0, 0.0),
+            ForceLaw::Hertz | ForceLaw::Sls => (0.0, 0.0, 0.0),
             ForceLaw::Dmt => (p[4] * r / 6.0, p[4] / 6.0, r / 6.0),
             ForceLaw::Jkr => {
                 let pi = std::f64::consts::PI;

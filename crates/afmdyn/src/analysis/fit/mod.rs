@@ -1,7 +1,8 @@
 //! Fitting measured curves (issue 62): weighted least squares by Levenberg–Marquardt with
 //! standard errors, correlations, profile-likelihood intervals and identifiability warnings
 //! ([`least_squares`], [`estimates`], [`profile`]), and the quasi-static force-curve fit of the
-//! registry's contact laws ([`force_curve`]); start values from a grid ([`start`]). The
+//! registry's contact laws ([`force_curve`]; the standard linear solid's in time,
+//! [`sls_curve`]); start values from a grid ([`start`]). The
 //! dynamic fits' models: the stepped AM approach ([`am_curve`]) and the FM loop's Δf curve
 //! ([`fm_curve`]) and the bimodal channels ([`bimodal_curve`]), with the exact orbit
 //! sensitivities of [`sensitivity`].
@@ -14,6 +15,7 @@ pub mod force_curve;
 pub mod least_squares;
 pub mod profile;
 pub mod sensitivity;
+pub mod sls_curve;
 pub mod start;
 
 pub use estimates::{fit, fit_cancellable, fit_with, Estimate, FitOutcome};

@@ -1,7 +1,7 @@
 //! `fit`: the summary of a force-curve fit (each estimate with its standard error and 95 %
 //! interval, χ²/dof, the warnings), its table `fit-curve.csv` (tip position, force, fit,
-//! residual), its document `fit.json` and the figures of the fit beside the data and of the
-//! residuals.
+//! residual, and time for the `sls` law), its document `fit.json` and the figures of the fit
+//! beside the data (against time too, for `sls`) and of the residuals.
 
 use super::peakforce::rows;
 use super::{lines, with_document, Files};
@@ -45,6 +45,7 @@ pub fn fit(
         .as_str()
         .filter(|k| matches!(*k, "am" | "fm"));
     let segment = match (document["segment"].as_str(), dynamic) {
+        (Some("whole"), _) => "whole curve".into(),
         (Some(s), _) => s.to_string(),
         (None, Some(k)) => format!("{} curve", k.to_uppercase()),
         (None, None) => "curve".into(),
@@ -64,7 +65,13 @@ pub fn fit(
         with_document(&mut p, document, ("fit.json", "fit-curve.csv"), dir);
         return p;
     }
-    let curve = rows(document, "curve", &CURVE_COLUMNS);
+    // a time-dependent law's curve (sls) carries the rows' times: a column and a figure more
+    let timed = document["curve"]["time"].is_array();
+    let mut columns = CURVE_COLUMNS.to_vec();
+    if timed {
+        columns.push("time");
+    }
+    let curve = rows(document, "curve", &columns);
     #[cfg(feature = "files")]
     {
         use crate::layout::files::f;
@@ -72,18 +79,21 @@ pub fn fit(
             .iter()
             .map(|r| r.iter().map(|v| f(*v)).collect())
             .collect();
-        p.csv("fit-curve.csv", &CURVE_COLUMNS, table);
+        p.csv("fit-curve.csv", &columns, table);
     }
     if files == Files::All {
-        let series = |label: &str, col: usize, style: Style, color: usize| Series {
+        let against = |x: usize, label: &str, col: usize, style: Style, color: usize| Series {
             label: label.into(),
             points: curve
                 .iter()
-                .map(|r| (r[0], r[col]))
+                .map(|r| (r[x], r[col]))
                 .filter(|(x, y)| x.is_finite() && y.is_finite())
                 .collect(),
             style,
             color,
+        };
+        let series = |label: &str, col: usize, style: Style, color: usize| {
+            against(0, label, col, style, color)
         };
         p.figure(
             "fit-curve",
@@ -104,6 +114,19 @@ pub fn fit(
                 vec![series("", 3, Style::Line, 0)],
             ),
         );
+        if timed {
+            p.figure(
+                "fit-force-time",
+                lines(
+                    "Force against time: the data and the fit (approach, dwell, retract)",
+                    ("time (s)".into(), "force (N)".into()),
+                    vec![
+                        against(4, "data", 1, Style::Dots, 0),
+                        against(4, "fit", 2, Style::Line, 1),
+                    ],
+                ),
+            );
+        }
     }
     with_document(&mut p, document, ("fit.json", "fit-curve.csv"), dir);
     p
