@@ -342,3 +342,21 @@ fn a_bimodal_csv_goes_through_the_fit_door() {
     }
     assert!(doc["curve"]["amplitude"].is_null());
 }
+
+/// An evaluation asked to stop (the cancel flag already set) stops at the stepped sweep's
+/// first row: every value NaN, where a finished evaluation of the same rows is finite.
+#[test]
+fn a_cancelled_bimodal_evaluation_stops_at_the_first_row() {
+    use std::sync::atomic::AtomicBool;
+    let probe = bimodal_probe();
+    let g0 = probe.length_m;
+    let z: Vec<f64> = (0..4).map(|i| g0 * (0.9 - 0.05 * i as f64)).collect();
+    let params = vec![AmParam::Hamaker, AmParam::ZOffset];
+    let p = vec![probe.hamaker, 0.0];
+    let model = BimodalCurveModel::new(probe, z, [false, false, true, true], params);
+    let mut v = vec![0.0; model.points()];
+    model.evaluate(&p, &mut v, None);
+    assert!(v.iter().all(|x| x.is_finite()), "{v:?}");
+    model.evaluate_cancellable(&p, &mut v, None, &AtomicBool::new(true));
+    assert!(v.iter().all(|x| x.is_nan()), "{v:?}");
+}

@@ -394,3 +394,21 @@ fn a_damped_dmt_sample_is_refused_before_the_fit() {
     std::fs::remove_dir_all(&dir).ok();
     assert!(err.to_string().contains("sample.viscosity"), "{err}");
 }
+
+/// An evaluation asked to stop (the run's cancel flag already set, as a Ctrl-C leaves it) stops
+/// at the FM curve's first row: every value NaN, no sensitivities, where a finished evaluation
+/// of the same rows is finite.
+#[test]
+fn a_cancelled_evaluation_stops_at_the_first_row() {
+    use std::sync::atomic::AtomicBool;
+    let (probe, hz, z, _, _) = synthetic(6, 62);
+    let params = vec![AmParam::Hamaker, AmParam::ZOffset];
+    let p = truth(&probe, &params, 1e-9);
+    let model = FmCurveModel::new(probe, z, params, hz);
+    let mut v = vec![0.0; model.points()];
+    model.evaluate(&p, &mut v, None);
+    assert!(v.iter().all(|x| x.is_finite()), "{v:?}");
+    let mut jac = vec![0.0; model.points() * p.len()];
+    model.evaluate_cancellable(&p, &mut v, Some(&mut jac), &AtomicBool::new(true));
+    assert!(v.iter().all(|x| x.is_nan()), "{v:?}");
+}

@@ -56,6 +56,7 @@ use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
 use nalgebra::{Complex, DVector, Matrix2, Vector2};
 use serde::{Deserialize, Serialize};
+use std::sync::atomic::{AtomicBool, Ordering};
 
 mod solver;
 use solver::{predict, Locked, Solver};
@@ -275,10 +276,37 @@ pub struct Unreached {
 /// sample) cannot be locked; [`SimError::Cancelled`]. A later value that cannot be reached ends
 /// the curve with a warning.
 pub fn fm_curve(spec: &FmSpec, progress: &Progress) -> Result<FmCurve, SimError> {
+    followed(spec, progress.cancel_flag(), Some(progress))
+}
+
+/// [`fm_curve`] stopped at the next value once `cancel` is set (the dynamic fit's evaluation
+/// of a Δf curve, [`crate::analysis::fit::fm_curve`], which counts its own units).
+///
+/// # Errors
+/// As [`fm_curve`].
+pub fn fm_curve_cancellable(spec: &FmSpec, cancel: &AtomicBool) -> Result<FmCurve, SimError> {
+    followed(spec, cancel, None)
+}
+
+/// [`fm_curve`] checking `cancel` before every value and counting them in `progress`.
+fn followed(
+    spec: &FmSpec,
+    cancel: &AtomicBool,
+    progress: Option<&Progress>,
+) -> Result<FmCurve, SimError> {
+    let check = || {
+        if cancel.load(Ordering::Relaxed) {
+            Err(SimError::Cancelled)
+        } else {
+            Ok(())
+        }
+    };
     spec.check()?;
     let reference = fm_reference(&spec.base, spec.mode, spec.amplitude)?;
     let solver = Solver { spec, reference };
-    progress.add_total(spec.values.len());
+    if let Some(p) = progress {
+        p.add_total(spec.values.len());
+    }
     let mut points: Vec<FmPoint> = Vec::with_capacity(spec.values.len());
     let mut unreached = None;
     let mut jac: Option<Matrix2<f64>> = None;
@@ -287,7 +315,7 @@ pub fn fm_curve(spec: &FmSpec, progress: &Progress) -> Result<FmCurve, SimError>
     let mut last: Option<(f64, Vector2<f64>, DVector<f64>)> = None;
     let mut before: Option<(f64, Vector2<f64>, DVector<f64>)> = None;
     for &target in &spec.values {
-        progress.check()?;
+        check()?;
         // the step from the last value reached towards the target: halved after a failure
         // (at most MAX_HALVINGS times for this target), doubled back after a success; the
         // first value has no earlier point to step from
@@ -331,7 +359,7 @@ pub fn fm_curve(spec: &FmSpec, progress: &Progress) -> Result<FmCurve, SimError>
                     fraction *= 0.5;
                 }
             }
-            progress.check()?;
+            check()?;
         }
         if reached.is_some() {
             (jac, before, last) = (trial_jac, prev, from);
@@ -371,7 +399,9 @@ pub fn fm_curve(spec: &FmSpec, progress: &Progress) -> Result<FmCurve, SimError>
             law_force: law_force(&p, observables.min_distance),
             observables,
         });
-        progress.tick();
+        if let Some(p) = progress {
+            p.tick();
+        }
     }
     // a sign change of the secant estimates is confirmed by forward differences at both ends
     let mut folds = Vec::new();

@@ -188,7 +188,13 @@ pub fn scaled(probe: &AmProbe, params: &[AmParam], p: &[f64]) -> (Params, f64, [
     }
 }
 
-impl AmCurveModel {
+impl CheckedModel for AmCurveModel {
+    fn rows(&self) -> usize {
+        self.z.len() * (usize::from(self.channels.0) + usize::from(self.channels.1))
+    }
+    fn kept(&self) -> &Mutex<Vec<String>> {
+        &self.warnings
+    }
     fn evaluate_checked(
         &self,
         p: &[f64],
@@ -329,9 +335,32 @@ pub fn first_sweep_cancellable(
     }
 }
 
-impl CurveModel for AmCurveModel {
+/// A dynamic model (the AM curve, the bimodal channels, the FM curve): an evaluation row by row
+/// that may fail or be cancelled, and the warnings of the last one it finished. Every such
+/// model is a [`CurveModel`] through one implementation, which keeps the outcome as
+/// [`record`] says.
+pub trait CheckedModel {
+    /// The number of data points m (rows × channels).
+    fn rows(&self) -> usize;
+    /// Where the last evaluation's warnings are kept.
+    fn kept(&self) -> &Mutex<Vec<String>>;
+    /// The values (and the Jacobian, row-major m × n) at `p`, stopping at the next row once
+    /// `cancel` is set; the evaluation's warnings.
+    ///
+    /// # Errors
+    /// The model's failure; [`SimError::Cancelled`] once `cancel` is set.
+    fn evaluate_checked(
+        &self,
+        p: &[f64],
+        values: &mut [f64],
+        jacobian: Option<&mut [f64]>,
+        cancel: &AtomicBool,
+    ) -> Result<Vec<String>, SimError>;
+}
+
+impl<T: CheckedModel> CurveModel for T {
     fn points(&self) -> usize {
-        self.z.len() * (usize::from(self.channels.0) + usize::from(self.channels.1))
+        self.rows()
     }
     fn evaluate(&self, p: &[f64], values: &mut [f64], jacobian: Option<&mut [f64]>) {
         self.evaluate_cancellable(p, values, jacobian, &AtomicBool::new(false));
@@ -345,7 +374,7 @@ impl CurveModel for AmCurveModel {
     ) {
         let has_jacobian = jacobian.is_some();
         let outcome = self.evaluate_checked(p, values, jacobian, cancel);
-        record(&self.warnings, outcome, has_jacobian, values, p);
+        record(self.kept(), outcome, has_jacobian, values, p);
     }
 }
 
@@ -354,7 +383,7 @@ impl CurveModel for AmCurveModel {
 /// minimiser, leaves them); a failed one fills `values` with NaN (the minimiser's refusal) and
 /// says where it failed at `p`; a cancelled one fills them with NaN and leaves the warnings as
 /// the last finished evaluation's (the run ends).
-pub(super) fn record(
+fn record(
     warnings: &Mutex<Vec<String>>,
     outcome: Result<Vec<String>, SimError>,
     has_jacobian: bool,

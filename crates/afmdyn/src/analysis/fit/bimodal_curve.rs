@@ -12,14 +12,15 @@
 //! deg); rows off a stable period-1 orbit (of the common period) keep the stepped sweep's
 //! observables without a Jacobian row, and the warnings say so, as at folds and grazing.
 
-use super::am_curve::{first_sweep, scaled, AmParam, AmProbe, SENSITIVITY_TOLERANCE};
+use super::am_curve::CheckedModel;
+use super::am_curve::{first_sweep_cancellable, scaled, AmParam, AmProbe, SENSITIVITY_TOLERANCE};
 use super::sensitivity::{orbit_sensitivity_component, OrbitParam};
-use super::CurveModel;
 use crate::analysis::stepped::SteppedSpec;
 use crate::contact::ContactLaw;
 use crate::error::SimError;
 use crate::model::CantileverModel;
 use crate::params::SweepParam;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Mutex;
 
 /// The model of a measured bimodal curve (module docs).
@@ -61,12 +62,22 @@ impl BimodalCurveModel {
     pub fn warnings(&self) -> Vec<String> {
         self.warnings.lock().map(|w| w.clone()).unwrap_or_default()
     }
+}
 
+impl CheckedModel for BimodalCurveModel {
+    fn rows(&self) -> usize {
+        self.z.len() * self.channels.iter().filter(|c| **c).count()
+    }
+    fn kept(&self) -> &Mutex<Vec<String>> {
+        &self.warnings
+    }
+    /// Stops at the next row of the curve, or of its sensitivities, once `cancel` is set.
     fn evaluate_checked(
         &self,
         p: &[f64],
         values: &mut [f64],
         mut jacobian: Option<&mut [f64]>,
+        cancel: &AtomicBool,
     ) -> Result<Vec<String>, SimError> {
         if !self.probe.params.is_multifrequency() {
             return Err(SimError::out_of_range(
@@ -85,7 +96,7 @@ impl BimodalCurveModel {
         let mut spec = self.spec.clone();
         spec.base = q;
         spec.values = alpha5.clone();
-        let first = first_sweep(&spec)?;
+        let first = first_sweep_cancellable(&spec, cancel)?;
         let dmt = matches!(q.contact_law, ContactLaw::Dmt { .. });
         let mut orbit_params = vec![OrbitParam::Gap, OrbitParam::ContactStiffness];
         if dmt {
@@ -121,6 +132,9 @@ impl BimodalCurveModel {
             let mut d = [[0.0; 4]; 4];
             let on_orbit = point.period == Some(1) && point.stable;
             if jacobian.is_some() && on_orbit {
+                if cancel.load(Ordering::Relaxed) {
+                    return Err(SimError::Cancelled);
+                }
                 let model = CantileverModel::new(&q.with(SweepParam::Alpha5, alpha5[i]))?;
                 let s = orbit_sensitivity_component(
                     &model,
@@ -184,16 +198,5 @@ impl BimodalCurveModel {
             ));
         }
         Ok(warnings)
-    }
-}
-
-impl CurveModel for BimodalCurveModel {
-    fn points(&self) -> usize {
-        self.z.len() * self.channels.iter().filter(|c| **c).count()
-    }
-    fn evaluate(&self, p: &[f64], values: &mut [f64], jacobian: Option<&mut [f64]>) {
-        let has_jacobian = jacobian.is_some();
-        let outcome = self.evaluate_checked(p, values, jacobian);
-        super::am_curve::record(&self.warnings, outcome, has_jacobian, values, p);
     }
 }

@@ -23,16 +23,16 @@
 //! does not reach (the curve ends; those rows keep the last Δf reached, without a Jacobian row)
 //! are reported in [`FmCurveModel::warnings`].
 
+use super::am_curve::CheckedModel;
 use super::am_curve::{scaled, AmParam, AmProbe, SENSITIVITY_TOLERANCE};
 use super::sensitivity::{orbit_sensitivity, OrbitParam, SensitivityWarning};
-use super::CurveModel;
-use crate::analysis::fm::{fm_curve, FmSpec, DEFAULT_LOOP_TOLERANCE};
-use crate::analysis::progress::Progress;
+use crate::analysis::fm::{fm_curve_cancellable, FmSpec, DEFAULT_LOOP_TOLERANCE};
 use crate::contact::ContactLaw;
 use crate::error::SimError;
 use crate::model::CantileverModel;
 use crate::params::SweepParam;
 use nalgebra::{Matrix2, Vector2};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Mutex;
 
 /// The model of a measured Δf curve (module docs).
@@ -77,12 +77,22 @@ impl FmCurveModel {
     pub fn warnings(&self) -> Vec<String> {
         self.warnings.lock().map(|w| w.clone()).unwrap_or_default()
     }
+}
 
+impl CheckedModel for FmCurveModel {
+    fn rows(&self) -> usize {
+        self.z.len()
+    }
+    fn kept(&self) -> &Mutex<Vec<String>> {
+        &self.warnings
+    }
+    /// Stops at the next row of the curve, or of its sensitivities, once `cancel` is set.
     fn evaluate_checked(
         &self,
         p: &[f64],
         values: &mut [f64],
         mut jacobian: Option<&mut [f64]>,
+        cancel: &AtomicBool,
     ) -> Result<Vec<String>, SimError> {
         let (q, z_offset, chain) = scaled(&self.probe, &self.params, p);
         let g0 = self.probe.length_m;
@@ -93,7 +103,7 @@ impl FmCurveModel {
             .collect();
         let mut spec = FmSpec::new(q, alpha5, self.amplitude);
         spec.tolerance = self.loop_tolerance;
-        let curve = fm_curve(&spec, &Progress::new())?;
+        let curve = fm_curve_cancellable(&spec, cancel)?;
         let hz = self.hz_per_omega;
         let dmt = matches!(q.contact_law, ContactLaw::Dmt { .. });
         let mut orbit_params = vec![OrbitParam::Gap, OrbitParam::ContactStiffness];
@@ -137,6 +147,9 @@ impl FmCurveModel {
             let Some(j) = jacobian.as_deref_mut() else {
                 continue;
             };
+            if cancel.load(Ordering::Relaxed) {
+                return Err(SimError::Cancelled);
+            }
             let at = q
                 .with(SweepParam::Alpha5, point.alpha5)
                 .with(SweepParam::Omega, point.omega)
@@ -191,16 +204,5 @@ impl FmCurveModel {
             }
         }
         Ok(warnings)
-    }
-}
-
-impl CurveModel for FmCurveModel {
-    fn points(&self) -> usize {
-        self.z.len()
-    }
-    fn evaluate(&self, p: &[f64], values: &mut [f64], jacobian: Option<&mut [f64]>) {
-        let has_jacobian = jacobian.is_some();
-        let outcome = self.evaluate_checked(p, values, jacobian);
-        super::am_curve::record(&self.warnings, outcome, has_jacobian, values, p);
     }
 }
