@@ -1,14 +1,14 @@
 //! The arrays of each analysis' result as [`Layout`]s ([`Datasets`]): what a front end shows
 //! beside the document — Python's datasets and result objects, built from them generically.
-//! A result whose front ends build their tables from its document (`fm`, `reconstruct`) has
-//! none; the stepped curves' layout is laid out from their document.
+//! The stepped curves' layout is laid out from their document; `fm`'s, `reconstruct`'s and
+//! `fit`'s are declared beside their requests.
 
 use super::named::Datasets;
 use super::run::{ApproachRequest, ModesRequest, Resolved, ResonanceRequest};
 use super::BasinArrays;
 use super::{
-    AttractorsRequest, BasinsRequest, ContinuationRequest, ConvergeRequest, FmRequest,
-    GlobalContinuationRequest, LyapunovRequest, ObserveRequest, OrbitRequest, ReconstructRequest,
+    AttractorsRequest, BasinsRequest, ContinuationRequest, ConvergeRequest,
+    GlobalContinuationRequest, LyapunovRequest, ObserveRequest, OrbitRequest,
 };
 use crate::analysis::steady::SteadyState;
 use crate::eigen::RegionSpectrum;
@@ -331,5 +331,3 @@ impl Datasets for ResonanceRequest {
         one("curve", super::curve_layout::curve_layout(&doc))
     }
 }
-impl Datasets for FmRequest {}
-impl Datasets for ReconstructRequest {}
