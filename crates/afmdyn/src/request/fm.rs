@@ -506,15 +506,3 @@ pub fn layout(doc: &Value) -> crate::layout::Layout {
     }
     Layout::new("fm", &[("z_c", z_c.len())], variables)
 }
-
-impl super::named::Datasets for FmRequest {
-    /// The curve's layout `fm` ([`layout`]) from its document.
-    fn datasets(
-        &self,
-        model: &Resolved,
-        curve: &FmCurve,
-    ) -> Result<super::named::Arrays, SimError> {
-        let doc = document(self, model, curve);
-        Ok((vec![("fm".into(), layout(&doc))], serde_json::Map::new()))
-    }
-}

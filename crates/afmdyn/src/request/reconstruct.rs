@@ -574,11 +574,3 @@ pub fn layout(r: &Reconstruction, law: Option<Vec<f64>>) -> crate::layout::Layou
     }
     Layout::new("reconstruct", &[("distance", r.distance.len())], variables)
 }
-
-impl super::named::Datasets for ReconstructRequest {
-    /// The reconstruction's layout `reconstruct` ([`layout`], with the request's `law_force`).
-    fn datasets(&self, _: &Resolved, r: &Reconstruction) -> Result<super::named::Arrays, SimError> {
-        let layouts = vec![("reconstruct".into(), layout(r, self.law_in_order()))];
-        Ok((layouts, serde_json::Map::new()))
-    }
-}
