@@ -245,18 +245,20 @@ def _entries(rows: List[Tuple[str, str, str, str]]) -> List[str]:
     return out
 
 
-def _layout_table(stem: str, dims: Tuple[Tuple[str, ...], ...], lead: str = "Its"
-                  ) -> List[str]:
+def _layout_table(stem: str, dims: Tuple[Tuple[str, ...], ...], lead: str = "Its",
+                  si: bool = False) -> List[str]:
     """The variables of the dataset laid out in ``docs/schema/layouts/<stem>.json``, one entry
     each (name, dims, units: meaning; a table as a list, its meanings too long for columns),
-    after the sentence that sources them. With ``<stem>.si.json`` (the same request under a
-    probe) each unit is followed by its SI unit after a bar where they differ, and the
-    variables named otherwise under a probe follow."""
+    after the sentence that sources them (``si``: an analysis in SI without a probe too).
+    With ``<stem>.si.json`` (the same request under a probe) each unit is followed by its SI
+    unit after a bar where they differ, and the variables named otherwise under a probe
+    follow."""
     probe = json.loads((LAYOUTS / f"{stem}.json").read_text())["example"]["probe"]
     si_path = LAYOUTS / f"{stem}.si.json"
-    units = (f"under ``{probe}``, in SI" if probe else "in the model's units" + (
-        "; after a bar, in SI with a probe" if si_path.exists() else
-        "; SI with a probe, as each variable's ``units`` attribute says"))
+    units = (f"under ``{probe}``, in SI" if probe else "in SI" if si else
+             "in the model's units" + (
+                 "; after a bar, in SI with a probe" if si_path.exists() else
+                 "; SI with a probe, as each variable's ``units`` attribute says"))
     intro = textwrap.wrap(
         f"{lead} variables (name (dims) [units]: meaning), as the library lays them out "
         f"(``docs/schema/layouts/{stem}.json``: its example request, {units}):", 88,
@@ -284,13 +286,14 @@ def _layout_tables(name: str, doc: Dict[str, object]) -> List[str]:
     """The tables of analysis ``name``'s dataset: its layout's, then each variant's
     (``<name>.<variant>.json``, introduced by ``doc["layout_variants"][variant]``)."""
     dims = tuple(tuple(d) for d in doc.get("layout_dims", ()))  # type: ignore
-    out = _layout_table(name, dims)
+    si = doc.get("layout_units") == "in SI"
+    out = _layout_table(name, dims, si=si)
     for path in sorted(LAYOUTS.glob(f"{name}.*.json")):
         variant = path.stem.split(".", 1)[1]
         if variant == "si":  # in the table's units (``_layout_table``)
             continue
         lead = f"With {doc['layout_variants'][variant]}, its"  # type: ignore
-        out += [""] + _layout_table(path.stem, dims, lead)
+        out += [""] + _layout_table(path.stem, dims, lead, si)
     return out
 
 

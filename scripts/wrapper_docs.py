@@ -236,14 +236,11 @@ frequency shift has decayed to 0.5 % of its value at ``to`` (Giessibl's first-or
 of the law's force; 2A + a₀ for a law without a force before contact) down to A + a₀.""",
         "returns": """\
 Returns:
-    An ``xarray.Dataset`` over ``z_c``: ``frequency_shift`` (Hz with a probe),
-    ``frequency``, ``excitation`` (relative to the free lever's), ``amplitude``,
-    ``phase_deg``, ``energy_dissipated``, ``virial``, ``mean_deflection``,
-    ``min_distance``, ``peak_force``, ``mean_force``, ``indentation``,
-    ``max_multiplier``, ``stable``, ``loop_residual``, ``iterations``; attributes
-    ``spring_constant``, ``resonance_frequency``, ``amplitude``, ``mode``, ``folds_z_c``
-    and ``summary`` (the ``afmdyn fm --json`` document). A z_c not reached ends the curve
-    with an :class:`afmdyn.AfmdynWarning`. ``afmdyn.reconstruct(fm=ds)`` inverts it.""",
+    An ``xarray.Dataset`` over ``z_c``, one entry per z_c reached (the variables below);
+    attributes ``spring_constant``, ``resonance_frequency``, ``amplitude``, ``mode``,
+    ``folds_z_c``, ``method`` and ``summary`` (the ``afmdyn fm --json`` document). A z_c
+    not reached ends the curve with an :class:`afmdyn.AfmdynWarning`.
+    ``afmdyn.reconstruct(fm=ds)`` inverts it.""",
         "raises": """\
 Raises:
     ValueError: naming the option (``amplitude``, ``mode``, ``tolerance``, ``from``, ``to``,
@@ -443,12 +440,15 @@ San Paulo, Phys. Rev. B 61, R13381 (2000)). Arguments as :func:`image`'s.""",
     "args": {**IMAGE_ARGS, "ratios": "the setpoints A_sp/A0 in (0, 1)."},
     "returns": """\
 Returns:
-    ``xarray.Dataset`` over ``domain`` (``background`` first) and ``setpoint``:
-    ``apparent_height`` (m), ``phase_deg``, ``energy_dissipated`` (J) (NaN where a
-    material has no operating point) and ``regime``; attribute ``summary`` (the JSON).""",
+    ``xarray.Dataset`` over ``domain`` (``background`` first) and ``setpoint`` (the
+    variables below; NaN, and an empty ``regime``, where a material has no operating
+    point); attribute ``summary`` (the JSON).""",
 }
 
 WRAPPERS["reconstruct"] = {
+    # its layouts are in SI without a probe too (the curve's units)
+    "layout_units": "in SI",
+    "layout_variants": {"fm": "``fm=`` (a curve of :func:`afmdyn.fm`: the model's force too)"},
     "summary": """\
 The tip–sample force F(d) and potential U(d) behind a frequency-modulation curve, by
 the Sader–Jarvis inversion (J. E. Sader and S. P. Jarvis, Appl. Phys. Lett. 84, 1801
@@ -469,12 +469,11 @@ the Sader–Jarvis inversion (J. E. Sader and S. P. Jarvis, Appl. Phys. Lett. 84
     },
     "returns": """\
 Returns:
-    ``xarray.Dataset`` over ``distance`` (m, increasing): ``force`` (N, attractive < 0),
-    ``potential`` (J, ∫_d^{d_max} F), and from ``fm=`` ``law`` (N, the model's force at
-    d); attributes ``spring_constant``, ``resonance_frequency``, ``amplitude`` and
-    ``summary`` (the command line's JSON document). The force near the largest distance is
-    not reconstructed (the inversion integrates the shift beyond each distance): take data
-    out to where Δf has decayed. On an evenly spaced grid (every distance within 1e-9 of a
+    ``xarray.Dataset`` over ``distance`` (m, increasing; the variables below, the force
+    attractive < 0); attributes ``spring_constant``, ``resonance_frequency``,
+    ``amplitude``, ``method``, ``inversion`` and ``summary`` (the command line's JSON
+    document). The force near the largest distance is not reconstructed (the inversion
+    integrates the shift beyond each distance): take data out to where Δf has decayed. On an evenly spaced grid (every distance within 1e-9 of a
     spacing of d0 + i h) the inversion takes O(N log N) by FFT, up to 2 000 000 points; on
     another grid O(N²), up to 20 000 points. Ctrl-C stops it.""",
     "warns": """\

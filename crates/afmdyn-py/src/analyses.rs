@@ -59,17 +59,17 @@ pub fn image<'py>(
 }
 
 /// The setpoint study of a sample map under a probe (`afmdyn image --setpoint-study`:
-/// [`afmdyn::request::image::setpoint_study`]): its JSON (`ratio`, `domains`). Arguments as
-/// [`image`]'s.
+/// [`afmdyn::request::image::setpoint_study`]): its outcome as [`crate::door::run`]'s, the
+/// JSON (`ratio`, `domains`) and the layout `setpoint_study`. Arguments as [`image`]'s.
 #[pyfunction]
 #[pyo3(signature = (probe, sample, ratios, curve_points=None))]
-pub fn setpoint_study(
-    py: Python<'_>,
+pub fn setpoint_study<'py>(
+    py: Python<'py>,
     probe: &str,
     sample: &str,
     ratios: Vec<f64>,
     curve_points: Option<usize>,
-) -> PyResult<String> {
+) -> PyResult<Dict<'py>> {
     use afmdyn::request::image::{setpoint_study, ImageRequest};
     use afmdyn::request::image_job::ImageKeywords;
     let keywords = ImageKeywords {
@@ -81,5 +81,5 @@ pub fn setpoint_study(
     let study = py
         .detach(|| setpoint_study(&table, &map, &ratios, points))
         .map_err(sim_error)?;
-    Ok(serde_json::to_string(&study).expect("a study serialises"))
+    crate::door::outcome_dict(py, study.outcome())
 }

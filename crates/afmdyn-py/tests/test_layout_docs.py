@@ -24,14 +24,29 @@ LAYOUTS = REPO / "docs" / "schema" / "layouts"
 #: variables from their document, ``fit``, or turn a code into words and add a coordinate,
 #: ``basins``); ``image`` keeps the maps over (y, x), its scalars becoming attributes (the
 #: docstring leaves them out), and has a variant per feedback and mode (``image.pi``, …);
-#: ``peakforce.sweep`` is a sweep in z_c
+#: ``peakforce.sweep`` is a sweep in z_c; ``reconstruct.fm`` inverts an ``fm`` curve
 STEMS = ["simulate", "converge", "continuation", "observe", "approach", "resonance",
          "bifurcation", "global_continuation", "chart", "bimodal", "peakforce", "peakforce.sweep",
-         "image", "image.pi", "image.peakforce",
-         "simulate.si", "observe.si", "approach.si", "resonance.si"]
+         "image", "image.pi", "image.peakforce", "fm", "reconstruct", "reconstruct.fm",
+         "setpoint_study",
+         "simulate.si", "observe.si", "approach.si", "resonance.si", "fm.si"]
 
 ENTRY = re.compile(r"^\s*- ``([^`]+)`` \(([^)]*)\) \[([^]]*)\]:")
 SOURCE = re.compile(r"``docs/schema/layouts/([^`]+)\.json``")
+
+
+def entries(doc: str) -> List[str]:
+    """The lines of ``doc``, each table entry's wrapped lines joined into one (a unit may be
+    wrapped: ``1 (relative to the free lever's at its resonance)``)."""
+    out: List[str] = []
+    indent = lambda line: len(line) - len(line.lstrip())  # noqa: E731
+    for line in doc.splitlines():
+        if out and out[-1].lstrip().startswith("- ``") and line.strip() \
+                and indent(line) > indent(out[-1]):
+            out[-1] += " " + line.strip()
+        else:
+            out.append(line)
+    return out
 
 
 def documented(stem: str) -> Dict[str, Tuple[Tuple[str, ...], str]]:
@@ -42,7 +57,7 @@ def documented(stem: str) -> Dict[str, Tuple[Tuple[str, ...], str]]:
     doc = getattr(afmdyn, stem.split(".")[0]).__doc__ or ""
     tables: Dict[str, Dict[str, Tuple[Tuple[str, ...], str]]] = {}
     table = None
-    for line in doc.splitlines():
+    for line in entries(doc):
         m = ENTRY.match(line)
         if m and table is not None:
             dims = () if m.group(2) == "scalar" else tuple(m.group(2).split(", "))
@@ -72,6 +87,13 @@ def example(stem: str) -> Tuple[List[Any], Dict[str, Any]]:
         if "feedback" in kw:  # a PI scan's settings: Python's keywords
             kw.update(kw.pop("feedback"), feedback="pi")
         return [probe, str(REPO / kw.pop("sample")), kw.pop("setpoint")], kw
+    if stem == "setpoint_study":
+        return [probe, str(REPO / kw.pop("sample")), kw.pop("ratios")], kw
+    if stem == "reconstruct.fm":  # the dataset of the fm curve of this request, inverted
+        fm = {("from_" if k == "from" else k): v for k, v in kw.pop("fm").items()}
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", afmdyn.AfmdynWarning)
+            return [], {"fm": afmdyn.fm(**fm, probe=probe)}
     if "sweep" in kw:  # a PeakForce sweep: its quantity a sequence
         sweep = kw.pop("sweep")
         kw[sweep["quantity"]] = sweep["values"]

@@ -12,6 +12,7 @@
 use afmdyn::analysis::chart::ChartPlan;
 use afmdyn::analysis::progress::Progress;
 use afmdyn::probe::Probe;
+use afmdyn::request::image::setpoint_study;
 use afmdyn::request::image_job::ImageKeywords;
 use afmdyn::request::{named, ChartArrays, ChartRequest, ModelSpec, Outcome, Resolved};
 use afmdyn::study::stored;
@@ -40,12 +41,19 @@ enum Route {
     /// The image's job ([`ImageKeywords::job`]): `request` holds the keywords, `sample` the
     /// repository path of the sample map.
     Image,
+    /// The image's setpoint study ([`setpoint_study`]): `request` holds `sample` (a repository
+    /// path), `ratios` and `curve_points`.
+    Study,
+    /// A reconstruction from an `fm` curve's document (the one door's `reconstruct_document`):
+    /// `request` holds `fm`, the request of the `fm` curve run first by the door.
+    FmDocument,
 }
 
 /// One example: the analysis (the Python function's name), its variant (another layout of the
 /// same analysis, file `<analysis>.<variant>.json`: `image`'s PI scan and PeakForce image,
-/// `peakforce`'s sweep, and `si`, the same request under a probe), its route and request, and the probe file (a
-/// repository path) it runs under (`None`: the paper's parameters).
+/// `peakforce`'s sweep, `reconstruct`'s of an `fm` curve, and `si`, the same request under a
+/// probe), its route and request, and the probe file (a repository path) it runs under
+/// (`None`: the paper's parameters).
 struct Example {
     analysis: &'static str,
     variant: Option<&'static str>,
@@ -71,8 +79,8 @@ fn ex(
 
 /// The analyses whose layouts are in SI under a probe, and the probe of their `si` variant
 /// (the same request).
-const SI: ([&str; 4], &str) = (
-    ["simulate", "observe", "approach", "resonance"],
+const SI: ([&str; 5], &str) = (
+    ["simulate", "observe", "approach", "resonance", "fm"],
     "examples/probe-point-mass-dmt.toml",
 );
 
@@ -159,6 +167,31 @@ fn plain() -> Vec<Example> {
                    "curve_points": 20}),
             Some("examples/probe-point-mass-dmt.toml"),
         ),
+        ex(
+            "setpoint_study",
+            Study,
+            json!({"sample": "examples/sample-stripe.toml", "ratios": [0.4, 0.8],
+                   "curve_points": 20}),
+            Some("examples/probe-point-mass-dmt.toml"),
+        ),
+        ex("fm", Door, json!({"points": 4}), None),
+        ex(
+            "reconstruct",
+            Door,
+            json!({"distance": [1e-9, 2e-9, 3e-9, 4e-9, 5e-9],
+                   "frequency_shift": [-4.0, -1.0, -0.45, -0.25, -0.16],
+                   "spring_constant": 40.0, "resonance_frequency": 3e5, "amplitude": 1e-8}),
+            None,
+        ),
+        Example {
+            variant: Some("fm"),
+            ..ex(
+                "reconstruct",
+                FmDocument,
+                json!({"fm": {"points": 4}}),
+                Some("examples/probe-point-mass-dmt.toml"),
+            )
+        },
         Example {
             variant: Some("sweep"),
             ..ex(
@@ -252,6 +285,24 @@ fn run(e: &Example) -> Outcome {
                 datasets: vec![("chart".into(), layout)],
                 ..Outcome::default()
             }
+        }
+        Route::Study => {
+            let keywords = ImageKeywords {
+                sample: request["sample"].as_str().unwrap().into(),
+                ..ImageKeywords::default()
+            };
+            let (table, map) = keywords.inputs(text.as_deref().unwrap()).unwrap();
+            let ratios: Vec<f64> = serde_json::from_value(request["ratios"].clone()).unwrap();
+            let points = request["curve_points"].as_u64().unwrap() as usize;
+            setpoint_study(&table, &map, &ratios, points)
+                .unwrap()
+                .outcome()
+        }
+        Route::FmDocument => {
+            let fm = named::parse("fm", request["fm"].clone()).unwrap().unwrap();
+            let doc = fm.run(&model, &progress).unwrap().document;
+            let r = named::parse("reconstruct_document", json!({"fm": doc.to_string()}));
+            r.unwrap().unwrap().run(&model, &progress).unwrap()
         }
         Route::Image => {
             let keywords: ImageKeywords = serde_json::from_value(request).unwrap();

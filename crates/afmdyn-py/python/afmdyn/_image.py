@@ -102,29 +102,13 @@ def _dataset(out: Dict[str, Any], setpoint: float) -> xr.Dataset:
 
 
 def _finish_setpoint_study(a: Args) -> xr.Dataset:
-    """The setpoint study of :func:`afmdyn.setpoint_study`'s keywords ``a`` (its ``locals()``)."""
+    """The setpoint study of :func:`afmdyn.setpoint_study`'s keywords ``a`` (its ``locals()``):
+    its layout ``setpoint_study`` (the library's), the study's JSON as ``summary``."""
     sample = a["sample"]
     text = _core.probe_source(a["probe"])
     source = os.fspath(sample) if isinstance(sample, os.PathLike) else sample
     values = _real_array("ratios", a["ratios"], 1).tolist()
-    doc = json.loads(_core.setpoint_study(text, source, values, a["curve_points"]))
+    out = _core.setpoint_study(text, source, values, a["curve_points"])
+    doc = json.loads(out["json"])
     _warn(doc)
-    dims = ("domain", "setpoint")
-    num = lambda key: np.array(  # noqa: E731
-        [[np.nan if v is None else v for v in d[key]] for d in doc["domains"]], dtype=np.float64
-    )
-    units = {"apparent_height": "m", "phase_deg": "degree", "energy_dissipated": "J"}
-    return xr.Dataset(
-        {
-            **{k: (dims, num(k), {"units": u}) for k, u in units.items()},
-            "regime": (
-                dims,
-                np.array([["" if v is None else v for v in d["regime"]] for d in doc["domains"]]),
-            ),
-        },
-        coords={
-            "domain": [d["name"] for d in doc["domains"]],
-            "setpoint": np.asarray(doc["ratio"], dtype=np.float64),
-        },
-        attrs={"summary": json.dumps(doc)},
-    )
+    return _layout.dataset(out["datasets"]["setpoint_study"], {"summary": json.dumps(doc)})

@@ -7,11 +7,11 @@ from __future__ import annotations
 import json
 from typing import Any, Dict, Optional, Union
 
-import numpy as np
 import xarray as xr
 
 from . import _afmdyn as _core
 from ._common import _real_array, _warn
+from ._layout import dataset
 from ._progress import reporter
 
 
@@ -45,7 +45,7 @@ def _finish_reconstruct(a: Dict[str, Any]) -> xr.Dataset:
     name = "reconstruct" if "frequency_shift" in request else "reconstruct_document"
     with reporter(a["progress"], "reconstruct") as cb:
         d = _core.run(name, request, None, None, cb)
-    return _dataset(json.loads(d["json"]))
+    return _dataset(d)
 
 
 def _document(d: Union[xr.Dataset, Dict[str, Any]]) -> str:
@@ -53,36 +53,12 @@ def _document(d: Union[xr.Dataset, Dict[str, Any]]) -> str:
     return d.attrs["summary"] if isinstance(d, xr.Dataset) else json.dumps(d)
 
 
-#: The variables of a reconstruction: the document's ``force`` arrays, their units (the key of
-#: the document's ``units``) and long names (``law`` only from an ``fm`` curve).
-_VARIABLES = {
-    "law": ("force", "the model's force at d (a curve from afmdyn.fm)"),
-    "force": ("force", "tip–sample force F(d)"),
-    "potential": ("potential", "potential U(d), integral of F from d to the last distance"),
-}
-
-
-def _dataset(doc: Dict[str, Any]) -> xr.Dataset:
-    """The dataset of a reconstruction document, its warnings issued as
+def _dataset(d: Dict[str, Any]) -> xr.Dataset:
+    """The dataset of a reconstruction's outcome ``d`` (``_afmdyn.run``'s): its layout
+    ``reconstruct``, the document's constants as attributes; its warnings issued as
     :class:`afmdyn.AfmdynWarning`."""
+    doc = json.loads(d["json"])
     _warn(doc)
-    f = doc["force"]
-    units = doc["units"]
-    return xr.Dataset(
-        {
-            name: ("distance", np.asarray(f[name]), {"units": units[unit], "long_name": long})
-            for name, (unit, long) in _VARIABLES.items()
-            if name in f
-        },
-        coords={"distance": ("distance", np.asarray(f["distance"]),
-                             {"units": units["distance"],
-                              "long_name": "distance of closest approach d"})},
-        attrs={
-            "spring_constant": doc["spring_constant"],
-            "resonance_frequency": doc["resonance_frequency"],
-            "amplitude": doc["amplitude"],
-            "method": doc["method"],
-            "inversion": doc.get("inversion", "matrix"),
-            "summary": json.dumps(doc),
-        },
-    )
+    attrs = {k: doc[k] for k in ("spring_constant", "resonance_frequency", "amplitude", "method")}
+    attrs.update(inversion=doc.get("inversion", "matrix"), summary=json.dumps(doc))
+    return dataset(d["datasets"]["reconstruct"], attrs)

@@ -607,14 +607,37 @@ def fm(
         **model: the model keywords (:class:`Model`), ``probe=`` a probe in SI.
 
     Returns:
-        An ``xarray.Dataset`` over ``z_c``: ``frequency_shift`` (Hz with a probe),
-        ``frequency``, ``excitation`` (relative to the free lever's), ``amplitude``,
-        ``phase_deg``, ``energy_dissipated``, ``virial``, ``mean_deflection``,
-        ``min_distance``, ``peak_force``, ``mean_force``, ``indentation``,
-        ``max_multiplier``, ``stable``, ``loop_residual``, ``iterations``; attributes
-        ``spring_constant``, ``resonance_frequency``, ``amplitude``, ``mode``, ``folds_z_c``
-        and ``summary`` (the ``afmdyn fm --json`` document). A z_c not reached ends the curve
-        with an :class:`afmdyn.AfmdynWarning`. ``afmdyn.reconstruct(fm=ds)`` inverts it.
+        An ``xarray.Dataset`` over ``z_c``, one entry per z_c reached (the variables below);
+        attributes ``spring_constant``, ``resonance_frequency``, ``amplitude``, ``mode``,
+        ``folds_z_c``, ``method`` and ``summary`` (the ``afmdyn fm --json`` document). A z_c
+        not reached ends the curve with an :class:`afmdyn.AfmdynWarning`.
+        ``afmdyn.reconstruct(fm=ds)`` inverts it.
+
+        Its variables (name (dims) [units]: meaning), as the library lays them out
+        (``docs/schema/layouts/fm.json``: its example request, in the model's units; after a
+        bar, in SI with a probe):
+
+        - ``z_c`` (z_c) [g0 | m]: rest distance z_c
+        - ``frequency_shift`` (z_c) [Ω (units of the τ scale) | Hz]: frequency shift Δf = f −
+          f_K
+        - ``frequency`` (z_c) [Ω | Hz]: drive frequency the PLL locks at
+        - ``excitation`` (z_c) [1 (relative) | 1 (relative to the free lever's at its
+          resonance)]: excitation relative to the free lever's at its resonance
+        - ``amplitude`` (z_c) [g0 | m]: first-harmonic amplitude A1
+        - ``phase_deg`` (z_c) [deg]: lag of the first harmonic behind the drive
+        - ``energy_dissipated`` (z_c) [F·g0 | J]: energy dissipated in the sample per cycle
+        - ``virial`` (z_c) [F·g0 | J]: virial ⟨F_c W⟩
+        - ``mean_deflection`` (z_c) [g0 | m]: mean deflection
+        - ``min_distance`` (z_c) [g0 | m]: tip–sample distance at the lower turning point
+        - ``peak_force`` (z_c) [F | N]: largest tip–sample force
+        - ``mean_force`` (z_c) [F | N]: mean tip–sample force
+        - ``law_force`` (z_c) [F | N]: the law's conservative force at the lower turning point
+        - ``indentation`` (z_c) [g0 | m]: largest indentation
+        - ``max_multiplier`` (z_c) [1]: largest Floquet multiplier modulus under the locked
+          drive
+        - ``stable`` (z_c) [—]: Floquet-stable under the locked drive
+        - ``loop_residual`` (z_c) [1]: loop residual max(|A1/A − 1|, |φ1 − φ_set|)
+        - ``iterations`` (z_c) [1]: Newton iterations on (Ω, α2)
 
     Raises:
         ValueError: naming the option (``amplitude``, ``mode``, ``tolerance``, ``from``, ``to``,
@@ -985,9 +1008,24 @@ def setpoint_study(
             ``analysis::stepped::DEFAULT_CURVE_POINTS``).
 
     Returns:
-        ``xarray.Dataset`` over ``domain`` (``background`` first) and ``setpoint``:
-        ``apparent_height`` (m), ``phase_deg``, ``energy_dissipated`` (J) (NaN where a
-        material has no operating point) and ``regime``; attribute ``summary`` (the JSON).
+        ``xarray.Dataset`` over ``domain`` (``background`` first) and ``setpoint`` (the
+        variables below; NaN, and an empty ``regime``, where a material has no operating
+        point); attribute ``summary`` (the JSON).
+
+        Its variables (name (dims) [units]: meaning), as the library lays them out
+        (``docs/schema/layouts/setpoint_study.json``: its example request, under
+        ``examples/probe-point-mass-dmt.toml``, in SI):
+
+        - ``domain`` (domain) [—]: domain of the sample map (the background first)
+        - ``setpoint`` (setpoint) [1]: setpoint ratio A_sp/A0
+        - ``apparent_height`` (domain, setpoint) [m]: apparent height h + z_c − z_c,ref of the
+          domain (NaN: no operating point)
+        - ``phase_deg`` (domain, setpoint) [degree]: phase lag of the first harmonic behind the
+          drive
+        - ``energy_dissipated`` (domain, setpoint) [J]: energy dissipated in the sample per
+          drive period
+        - ``regime`` (domain, setpoint) [—]: regime of the operating point (mean tip–sample
+          force attractive or repulsive; empty: none)
     """
     return _image._finish_setpoint_study(locals())
 
@@ -1035,14 +1073,32 @@ def reconstruct(
             log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.
 
     Returns:
-        ``xarray.Dataset`` over ``distance`` (m, increasing): ``force`` (N, attractive < 0),
-        ``potential`` (J, ∫_d^{d_max} F), and from ``fm=`` ``law`` (N, the model's force at
-        d); attributes ``spring_constant``, ``resonance_frequency``, ``amplitude`` and
-        ``summary`` (the command line's JSON document). The force near the largest distance is
-        not reconstructed (the inversion integrates the shift beyond each distance): take data
-        out to where Δf has decayed. On an evenly spaced grid (every distance within 1e-9 of a
+        ``xarray.Dataset`` over ``distance`` (m, increasing; the variables below, the force
+        attractive < 0); attributes ``spring_constant``, ``resonance_frequency``,
+        ``amplitude``, ``method``, ``inversion`` and ``summary`` (the command line's JSON
+        document). The force near the largest distance is not reconstructed (the inversion
+        integrates the shift beyond each distance): take data out to where Δf has decayed. On an evenly spaced grid (every distance within 1e-9 of a
         spacing of d0 + i h) the inversion takes O(N log N) by FFT, up to 2 000 000 points; on
         another grid O(N²), up to 20 000 points. Ctrl-C stops it.
+
+        Its variables (name (dims) [units]: meaning), as the library lays them out
+        (``docs/schema/layouts/reconstruct.json``: its example request, in SI):
+
+        - ``distance`` (distance) [m]: distance of closest approach d
+        - ``force`` (distance) [N]: tip–sample force F(d)
+        - ``potential`` (distance) [J]: potential U(d), integral of F from d to the last
+          distance
+
+        With ``fm=`` (a curve of :func:`afmdyn.fm`: the model's force too), its variables (name
+        (dims) [units]: meaning), as the library lays them out
+        (``docs/schema/layouts/reconstruct.fm.json``: its example request, under
+        ``examples/probe-point-mass-dmt.toml``, in SI):
+
+        - ``distance`` (distance) [m]: distance of closest approach d
+        - ``law`` (distance) [N]: the model's force at d (a curve from afmdyn.fm)
+        - ``force`` (distance) [N]: tip–sample force F(d)
+        - ``potential`` (distance) [J]: potential U(d), integral of F from d to the last
+          distance
 
     Warns:
         AfmdynWarning: a constant outside its typical range (A 10 pm–1 µm, f0 1 kHz–10 MHz,

@@ -1,7 +1,7 @@
 //! The arrays of each analysis' result as [`Layout`]s ([`Datasets`]): what a front end shows
 //! beside the document — Python's datasets and result objects, built from them generically.
-//! A result whose front ends build their tables from its document (`fm`, `reconstruct`) has
-//! none; the stepped curves' layout is laid out from their document.
+//! The stepped curves' layouts are laid out from their documents, and so is `fm`'s
+//! ([`super::fm::layout`]); `reconstruct`'s is [`super::reconstruct::layout`].
 
 use super::named::Datasets;
 use super::run::{ApproachRequest, ModesRequest, Resolved, ResonanceRequest};
@@ -331,5 +331,20 @@ impl Datasets for ResonanceRequest {
         one("curve", super::curve_layout::curve_layout(&doc))
     }
 }
-impl Datasets for FmRequest {}
-impl Datasets for ReconstructRequest {}
+
+impl Datasets for FmRequest {
+    /// The curve's layout `fm` from its document ([`super::fm::layout`]).
+    fn datasets(&self, model: &Resolved, curve: &Self::Output) -> Arrays {
+        let doc = super::fm::document(self, model, curve);
+        one("fm", super::fm::layout(&doc))
+    }
+}
+
+impl Datasets for ReconstructRequest {
+    /// The reconstruction's layout `reconstruct` ([`super::reconstruct::layout`], with the
+    /// request's `law_force`).
+    fn datasets(&self, _: &Resolved, r: &Self::Output) -> Arrays {
+        let layout = super::reconstruct::layout(r, self.law_in_order());
+        one("reconstruct", layout)
+    }
+}

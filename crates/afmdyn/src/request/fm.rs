@@ -376,3 +376,133 @@ pub fn document(request: &FmRequest, model: &Resolved, curve: &FmCurve) -> Value
         "warnings": warnings,
     })
 }
+
+/// Where a variable of the FM layout takes its unit: the document's `units` under a key, or
+/// a unit of its own.
+#[derive(Debug, Clone, Copy)]
+enum Unit {
+    /// `units[key]` of the document ([`document`]): its length, frequency, force, energy.
+    Of(&'static str),
+    /// A unit the document does not name (`1` a pure number, `""` a flag).
+    Is(&'static str),
+}
+
+/// The variables of an FM curve's layout ([`layout`]) after `z_c`, in the table's order
+/// (`fm.csv`, [`super::present::fm::COLUMNS`]): name, unit, long name.
+const FM_VARIABLES: [(&str, Unit, &str); 17] = [
+    (
+        "frequency_shift",
+        Unit::Of("frequency_shift"),
+        "frequency shift Δf = f − f_K",
+    ),
+    (
+        "frequency",
+        Unit::Of("frequency"),
+        "drive frequency the PLL locks at",
+    ),
+    (
+        "excitation",
+        Unit::Of("excitation"),
+        "excitation relative to the free lever's at its resonance",
+    ),
+    (
+        "amplitude",
+        Unit::Of("amplitude"),
+        "first-harmonic amplitude A1",
+    ),
+    (
+        "phase_deg",
+        Unit::Is("deg"),
+        "lag of the first harmonic behind the drive",
+    ),
+    (
+        "energy_dissipated",
+        Unit::Of("energy_dissipated"),
+        "energy dissipated in the sample per cycle",
+    ),
+    ("virial", Unit::Of("virial"), "virial ⟨F_c W⟩"),
+    ("mean_deflection", Unit::Of("z_c"), "mean deflection"),
+    (
+        "min_distance",
+        Unit::Of("min_distance"),
+        "tip–sample distance at the lower turning point",
+    ),
+    (
+        "peak_force",
+        Unit::Of("peak_force"),
+        "largest tip–sample force",
+    ),
+    (
+        "mean_force",
+        Unit::Of("peak_force"),
+        "mean tip–sample force",
+    ),
+    (
+        "law_force",
+        Unit::Of("peak_force"),
+        "the law's conservative force at the lower turning point",
+    ),
+    ("indentation", Unit::Of("z_c"), "largest indentation"),
+    (
+        "max_multiplier",
+        Unit::Is("1"),
+        "largest Floquet multiplier modulus under the locked drive",
+    ),
+    (
+        "stable",
+        Unit::Is(""),
+        "Floquet-stable under the locked drive",
+    ),
+    (
+        "loop_residual",
+        Unit::Is("1"),
+        "loop residual max(|A1/A − 1|, |φ1 − φ_set|)",
+    ),
+    ("iterations", Unit::Is("1"), "Newton iterations on (Ω, α2)"),
+];
+
+/// The layout of an FM curve's document `doc` ([`document`]): over `z_c` (the rest distance,
+/// its coordinate) every array of its `curve`, in the document's units (SI with a probe, the
+/// model's without: `units`; `deg` for the phase, `1` for the pure numbers, the length's and
+/// force's units for the mean deflection and indentation, and for the mean and law forces);
+/// `stable` flags, `iterations` integers, `null` as NaN. What Python's `afmdyn.fm` returns.
+pub fn layout(doc: &Value) -> crate::layout::Layout {
+    use crate::layout::{Layout, Values, Variable};
+    let curve = &doc["curve"];
+    let list = |name: &str| curve[name].as_array().cloned().unwrap_or_default();
+    let numbers = |name: &str| -> Vec<f64> {
+        let v = list(name);
+        v.iter().map(|x| x.as_f64().unwrap_or(f64::NAN)).collect()
+    };
+    let unit = |u: Unit| match u {
+        Unit::Of(key) => doc["units"][key].as_str().unwrap_or_default().to_string(),
+        Unit::Is(u) => u.to_string(),
+    };
+    let z_c = numbers("z_c");
+    let mut variables = vec![Variable::f64(
+        "z_c",
+        &["z_c"],
+        &unit(Unit::Of("z_c")),
+        "rest distance z_c",
+        &z_c,
+    )];
+    for (name, u, long_name) in FM_VARIABLES {
+        let values = match name {
+            "stable" => Values::Bool(
+                list(name)
+                    .iter()
+                    .map(|x| x.as_bool() == Some(true))
+                    .collect(),
+            ),
+            "iterations" => Values::I32(
+                list(name)
+                    .iter()
+                    .map(|x| x.as_i64().map_or(-1, |i| i as i32))
+                    .collect(),
+            ),
+            _ => Values::F64(numbers(name)),
+        };
+        variables.push(Variable::new(name, &["z_c"], &unit(u), long_name, values));
+    }
+    Layout::new("fm", &[("z_c", z_c.len())], variables)
+}

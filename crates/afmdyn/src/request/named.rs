@@ -181,8 +181,10 @@ impl Named for FromDocument {
         FromDocument::validate(self)
     }
     fn run(&self, model: &Resolved, progress: &Progress) -> Result<Outcome, SimError> {
+        let (document, layout) = FromDocument::run(self, model, progress)?;
         Ok(Outcome {
-            document: FromDocument::run(self, model, progress)?,
+            document,
+            datasets: vec![("reconstruct".into(), layout)],
             ..Outcome::default()
         })
     }

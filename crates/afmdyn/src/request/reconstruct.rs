@@ -528,3 +528,49 @@ pub fn am_reconstruction(
         output: r,
     })
 }
+
+/// The variables of a reconstruction's layout ([`layout`]) after `distance`: name, unit (SI,
+/// as the documents' `units` name them: [`document`], [`am_document`]) and long name; `law`
+/// only for a curve that carries the model's force (an `fm` document's).
+const RECONSTRUCT_VARIABLES: [(&str, &str, &str); 3] = [
+    (
+        "law",
+        "N",
+        "the model's force at d (a curve from afmdyn.fm)",
+    ),
+    ("force", "N", "tip–sample force F(d)"),
+    (
+        "potential",
+        "J",
+        "potential U(d), integral of F from d to the last distance",
+    ),
+];
+
+/// The layout of a reconstruction `r` (what Python's `afmdyn.reconstruct` returns): over
+/// `distance` (the distance of closest approach d in m, increasing; its coordinate) `law`
+/// (N; with `law`, the model's force at each distance in that order:
+/// [`ReconstructRequest::law_in_order`]), `force` (N) and `potential` (J), SI as the
+/// documents.
+pub fn layout(r: &Reconstruction, law: Option<Vec<f64>>) -> crate::layout::Layout {
+    use crate::layout::{Layout, Variable};
+    let d = ["distance"];
+    let mut variables = vec![Variable::f64(
+        "distance",
+        &d,
+        "m",
+        "distance of closest approach d",
+        &r.distance,
+    )];
+    for (name, unit, long_name) in RECONSTRUCT_VARIABLES {
+        let values = match name {
+            "law" => match &law {
+                Some(l) => l.as_slice(),
+                None => continue,
+            },
+            "force" => r.force.as_slice(),
+            _ => r.potential.as_slice(),
+        };
+        variables.push(Variable::f64(name, &d, unit, long_name, values));
+    }
+    Layout::new("reconstruct", &[("distance", r.distance.len())], variables)
+}

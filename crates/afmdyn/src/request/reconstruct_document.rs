@@ -3,12 +3,13 @@
 //! approach document of the point mass ([`am_reconstruction`]), as a front end that knows the
 //! analysis by name gives them (Python's `afmdyn.reconstruct(fm=…)` and `(am=…)`): the named
 //! request `reconstruct_document` ([`super::named::parse`]), whose outcome is the JSON document
-//! ([`FromDocument::run`]).
+//! and the reconstruction's layout ([`FromDocument::run`]).
 
-use super::reconstruct::{am_reconstruction, FmInversion, ReconstructRequest};
+use super::reconstruct::{am_reconstruction, layout, FmInversion, ReconstructRequest};
 use super::run::{run, Resolved};
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
+use crate::layout::Layout;
 use serde::Deserialize;
 use serde_json::Value;
 
@@ -54,12 +55,13 @@ impl FromDocument {
         }
     }
 
-    /// The reconstruction's JSON document, counting in `progress` (cancellable).
+    /// The reconstruction's JSON document and its layout ([`super::reconstruct::layout`]:
+    /// with the `fm` document's `law_force`), counting in `progress` (cancellable).
     ///
     /// # Errors
     /// As [`FromDocument::validate`]; a text that is not JSON, a document that is not an SI
     /// `fm` document or an AM approach of the point mass; the inversion's errors.
-    pub fn run(&self, model: &Resolved, progress: &Progress) -> Result<Value, SimError> {
+    pub fn run(&self, model: &Resolved, progress: &Progress) -> Result<(Value, Layout), SimError> {
         self.validate()?;
         match (&self.fm, &self.am) {
             (Some(fm), _) => {
@@ -72,9 +74,13 @@ impl FromDocument {
                         self.amplitude,
                     )?
                 };
-                Ok(run(&request, model, progress)?.json)
+                let done = run(&request, model, progress)?;
+                Ok((done.json, layout(&done.output, request.law_in_order())))
             }
-            (None, Some(am)) => Ok(am_reconstruction(&document("am", am)?, progress)?.json),
+            (None, Some(am)) => {
+                let done = am_reconstruction(&document("am", am)?, progress)?;
+                Ok((done.json, layout(&done.output, None)))
+            }
             (None, None) => unreachable!("validated"),
         }
     }

@@ -2,6 +2,8 @@
 //! height, phase and dissipation over a range of amplitude ratios.
 
 use super::*;
+use crate::layout::{Layout, Values, Variable};
+use crate::request::named::Outcome;
 
 /// The most setpoints of a setpoint study, on every front end: each is a line engaged on
 /// the background that crosses every domain.
@@ -36,6 +38,94 @@ pub struct DomainContrast {
     pub energy_dissipated: Vec<f64>,
     /// Regime.
     pub regime: Vec<Option<Regime>>,
+}
+
+/// The variables of a setpoint study's layout over (`domain`, `setpoint`)
+/// ([`SetpointStudy::layout`]): name, unit (SI) and long name.
+const STUDY_VARIABLES: [(&str, &str, &str); 3] = [
+    (
+        "apparent_height",
+        "m",
+        "apparent height h + z_c − z_c,ref of the domain (NaN: no operating point)",
+    ),
+    (
+        "phase_deg",
+        "degree",
+        "phase lag of the first harmonic behind the drive",
+    ),
+    (
+        "energy_dissipated",
+        "J",
+        "energy dissipated in the sample per drive period",
+    ),
+];
+
+impl SetpointStudy {
+    /// The study's layout (what Python's `afmdyn.setpoint_study` returns): over `domain` (its
+    /// name, the background first; a coordinate of words) and `setpoint` (the ratio
+    /// A_sp/A₀; its coordinate) the `apparent_height` (m), `phase_deg` (degree) and
+    /// `energy_dissipated` (J), NaN where a material has no operating point, and `regime`
+    /// (`attractive`, `repulsive`, or empty there).
+    pub fn layout(&self) -> Layout {
+        let (dd, rr) = (self.domains.len(), self.ratio.len());
+        let both = ["domain", "setpoint"];
+        let names = self.domains.iter().map(|d| d.name.clone()).collect();
+        let mut variables = vec![
+            Variable::new(
+                "domain",
+                &["domain"],
+                "",
+                "domain of the sample map (the background first)",
+                Values::Text(names),
+            ),
+            Variable::f64(
+                "setpoint",
+                &["setpoint"],
+                "1",
+                "setpoint ratio A_sp/A0",
+                &self.ratio,
+            ),
+        ];
+        for (name, unit, long_name) in STUDY_VARIABLES {
+            let series = |d: &DomainContrast| match name {
+                "apparent_height" => d.apparent_height.clone(),
+                "phase_deg" => d.phase_deg.clone(),
+                _ => d.energy_dissipated.clone(),
+            };
+            let values: Vec<f64> = self.domains.iter().flat_map(series).collect();
+            variables.push(Variable::f64(name, &both, unit, long_name, &values));
+        }
+        let word = |r: &Option<Regime>| match r {
+            Some(Regime::Attractive) => "attractive".to_string(),
+            Some(Regime::Repulsive) => "repulsive".to_string(),
+            None => String::new(),
+        };
+        let regimes = self.domains.iter().flat_map(|d| d.regime.iter().map(word));
+        variables.push(Variable::new(
+            "regime",
+            &both,
+            "",
+            "regime of the operating point (mean tip–sample force attractive or repulsive; \
+             empty: none)",
+            Values::Text(regimes.collect()),
+        ));
+        Layout::new(
+            "setpoint study",
+            &[("domain", dd), ("setpoint", rr)],
+            variables,
+        )
+    }
+
+    /// The outcome a front end shows: the study's JSON (`ratio`, `domains`, `warnings`: the
+    /// command line's `setpoint_study` of `image.json`) and its layout `setpoint_study`
+    /// ([`SetpointStudy::layout`]).
+    pub fn outcome(&self) -> Outcome {
+        Outcome {
+            document: serde_json::to_value(self).unwrap_or_default(),
+            datasets: vec![("setpoint_study".into(), self.layout())],
+            facts: serde_json::Map::new(),
+        }
+    }
 }
 
 /// Parse a setpoint study's ratios `FROM:TO:N` (N evenly spaced ratios in (0, 1), ends
