@@ -343,6 +343,7 @@ Raises:
 }
 
 WRAPPERS["fit"] = {
+    "layout_variants": {"sls": "the ``sls`` law (a curve with times)"},
     "summary": """\
 Fit a quasi-static force curve with the probe's contact law (``afmdyn fit``; hertz,
 dmt, jkr, or sls on a curve with times and a dwell), its contact point and baseline

@@ -51,9 +51,9 @@ enum Route {
 
 /// One example: the analysis (the Python function's name), its variant (another layout of the
 /// same analysis, file `<analysis>.<variant>.json`: `image`'s PI scan and PeakForce image,
-/// `peakforce`'s sweep, `reconstruct`'s of an `fm` curve, and `si`, the same request under a
-/// probe), its route and request, and the probe file (a repository path) it runs under
-/// (`None`: the paper's parameters).
+/// `peakforce`'s sweep, `reconstruct`'s of an `fm` curve, `fit`'s of the `sls` law (with the
+/// rows' times), and `si`, the same request under a probe), its route and request, and the
+/// probe file (a repository path) it runs under (`None`: the paper's parameters).
 struct Example {
     analysis: &'static str,
     variant: Option<&'static str>,
@@ -160,6 +160,15 @@ fn plain() -> Vec<Example> {
             json!({"data": "examples/force-curve-hertz.csv"}),
             Some("examples/probe-fit-hertz.toml"),
         ),
+        Example {
+            variant: Some("sls"),
+            ..ex(
+                "fit",
+                Door,
+                json!({"data": "examples/force-curve-sls-dwell.csv"}),
+                Some("examples/probe-fit-sls.toml"),
+            )
+        },
         ex(
             "image",
             Image,

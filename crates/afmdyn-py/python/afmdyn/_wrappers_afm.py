@@ -816,6 +816,16 @@ def fit(
         - ``fit`` (row) [N]: force, fitted
         - ``residual`` (row) [N]: measured − fitted
 
+        With the ``sls`` law (a curve with times), its variables (name (dims) [units]: meaning),
+        as the library lays them out (``docs/schema/layouts/fit.sls.json``: its example request,
+        under ``examples/probe-fit-sls.toml``, in SI):
+
+        - ``tip_position`` (row) [m]: tip position
+        - ``force`` (row) [N]: force, measured
+        - ``fit`` (row) [N]: force, fitted
+        - ``residual`` (row) [N]: measured − fitted
+        - ``time`` (row) [s]: time (the sls law's curve)
+
     Raises:
         ValueError: naming the option, the data or the probe key.
     """
