@@ -430,7 +430,7 @@ fn a_cancelled_dynamic_fit_stops_within_one_evaluation() {
 /// other parameters per fitted parameter, each at most the refits' limit of evaluations
 /// (`least_squares::max_evaluations` at `REFIT_PATIENCE`), over the fit's own z_offset grid (13), minimiser and 2
 /// evaluations; every evaluation the same stepped approach of the rows. The 100-row point-mass
-/// fit with profiles is admitted.
+/// fit with profiles is admitted; a 2000-row one is refused, advising fewer rows or no profiles.
 #[test]
 fn the_declared_cost_counts_the_profiles_refits() {
     use afmdyn::analysis::fit::least_squares::{max_evaluations, PATIENCE};
@@ -467,6 +467,15 @@ fn the_declared_cost_counts_the_profiles_refits() {
     let with = request(Some(true)).cost(&resolved).expect("cost");
     assert_eq!(request(Some(false)).cost(&resolved).expect("cost"), without);
     admit(&request(Some(true)), &resolved).expect("admitted");
+    // 2000 rows with profiles are beyond the budget: refused before running, the advice
+    // naming the rows and the profiles (not points or periods)
+    let mut text = String::from("z,amplitude\n");
+    for i in 0..2000 {
+        text += &format!("{:e},{:e}\n", 7.5e-9 - 2.25e-12 * i as f64, 8e-9);
+    }
+    std::fs::write(&path, text).expect("csv");
+    let e = request(Some(true)).cost(&resolved).unwrap_err().to_string();
+    assert!(e.contains("rows") && e.contains("without profiles"), "{e}");
     std::fs::remove_dir_all(&dir).ok();
     let fit = (13 + max_evaluations(3, PATIENCE) + 2) as f64;
     let refits = (3 * 2 * MAX_SECANT_STEPS) as f64 * max_evaluations(2, REFIT_PATIENCE) as f64;

@@ -67,6 +67,26 @@ pub fn newton_work(params: &Params, period: usize, newton: &ShootingOptions) -> 
 /// # Errors
 /// [`SimError::Budget`] naming the request, its cost and the budget.
 pub fn check_cost(what: &'static str, cost: Cost) -> Result<(), SimError> {
+    check_cost_advising(
+        what,
+        cost,
+        "ask for fewer points, samples, cells or periods",
+        "ask for fewer points, samples, cells or periods, or a shorter transient \
+         (max_periods)",
+    )
+}
+
+/// [`check_cost`] with the request's own advice, for memory and for work (a fit names its rows
+/// and its profiles, not points or periods).
+///
+/// # Errors
+/// [`SimError::Budget`] naming the request, its cost, the budget and the advice.
+pub fn check_cost_advising(
+    what: &'static str,
+    cost: Cost,
+    memory_hint: &'static str,
+    work_hint: &'static str,
+) -> Result<(), SimError> {
     const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
     // NaN (an estimate that overflowed) is refused too
     if cost.bytes.is_nan() || cost.bytes > MAX_REQUEST_BYTES {
@@ -74,7 +94,7 @@ pub fn check_cost(what: &'static str, cost: Cost) -> Result<(), SimError> {
             what,
             needed: format!("a peak memory of {:.2} GiB", cost.bytes / GIB),
             budget: format!("{:.1} GiB", MAX_REQUEST_BYTES / GIB),
-            hint: "ask for fewer points, samples, cells or periods",
+            hint: memory_hint,
         });
     }
     if cost.work.is_nan() || cost.work > MAX_REQUEST_WORK {
@@ -85,8 +105,7 @@ pub fn check_cost(what: &'static str, cost: Cost) -> Result<(), SimError> {
                 cost.work
             ),
             budget: format!("{MAX_REQUEST_WORK:.0e} mode-periods"),
-            hint: "ask for fewer points, samples, cells or periods, or a shorter transient \
-                   (max_periods)",
+            hint: work_hint,
         });
     }
     Ok(())

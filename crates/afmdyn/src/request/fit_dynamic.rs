@@ -404,7 +404,8 @@ pub fn fitted_names(fit: &[String], default_fit: bool, law_name: &str) -> Vec<St
 /// period of 2N + 4 columns per row, small beside a row's steady-state cap.)
 ///
 /// # Errors
-/// [`SimError::Params`] when the model cannot be built.
+/// [`SimError::Params`] when the model cannot be built; [`SimError::Budget`] beyond the request
+/// budget, advising fewer rows or parameters, or no profiles.
 pub fn cost(
     rows: usize,
     fitted: usize,
@@ -427,10 +428,18 @@ pub fn cost(
         let refits = (fitted * 2 * MAX_SECANT_STEPS) as f64;
         evaluations += refits * max_evaluations(fitted.saturating_sub(1), REFIT_PATIENCE) as f64;
     }
-    Ok(super::limits::Cost {
+    let cost = super::limits::Cost {
         bytes: approach.bytes + rows as f64 * 8.0 * 64.0,
         work: evaluations * approach.work,
-    })
+    };
+    // every model evaluation steps the approach through every row: the advice names them
+    let advice = if profiles {
+        "fit fewer rows or parameters, or without profiles (each profile point refits the curve)"
+    } else {
+        "fit fewer rows or parameters (each model evaluation steps the approach through every row)"
+    };
+    super::costs::check_cost_advising("fit", cost, advice, advice)?;
+    Ok(cost)
 }
 
 /// The document of a dynamic fit (the force-curve fit's shape, [`super::fit::document`]):
