@@ -10,19 +10,21 @@ with δ = −x, so δ = (−k h + k2 u)/(k + k1 + k2); the tip touches where δ 
 (the force would pull otherwise); u' = (δ − u)/τ in contact, −k1 u/(τ (k1 + k2)) free.
 The piezo moves from +1 µm to −1 µm in 1 s (the surface at 0), holds 1 s, returns in 1 s;
 u is integrated by classical Runge–Kutta with 50 steps per row, rows at 1 kHz, and Gaussian
-noise of 50 pN (seed 62) is added to the force.
+noise of 50 pN (Python's ``random``, seed 62) is added to the force. The arguments set the
+output file and the number of rows (the curve's 3 s sampled evenly).
 
 Truth: k1 = 0.01 N/m, k2 = 0.02 N/m, τ = 0.1 s.
 
-    python3 scripts/make-sls-curve.py   # rewrites examples/force-curve-sls-dwell.csv
+    python3 scripts/make-sls-curve.py              # rewrites examples/force-curve-sls-dwell.csv
+    python3 scripts/make-sls-curve.py OUT.csv ROWS # another file (scripts/perf-fit.sh)
 """
 
+import random
+import sys
 from pathlib import Path
 
-import numpy as np
-
 K, K1, K2, TAU = 0.05, 0.01, 0.02, 0.1
-SIGMA, SEED, DT, SUB = 50e-12, 62, 1e-3, 50
+SIGMA, SEED, SUB = 50e-12, 62, 50
 
 
 def piezo(t: float) -> float:
@@ -44,15 +46,19 @@ def rate(t: float, u: float) -> float:
 
 
 def main() -> None:
-    rng = np.random.default_rng(SEED)
+    root = Path(__file__).resolve().parent.parent
+    out = Path(sys.argv[1]) if len(sys.argv) > 1 else root / "examples" / "force-curve-sls-dwell.csv"
+    n = int(sys.argv[2]) if len(sys.argv) > 2 else 3001
+    dt = 3.0 / (n - 1)
+    rng = random.Random(SEED)
     rows = ["time,height,force"]
     u = 0.0
-    for i in range(int(round(3.0 / DT)) + 1):
-        t = i * DT
+    for i in range(n):
+        t = i * dt
         if i > 0:
-            h = DT / SUB
+            h = dt / SUB
             for j in range(SUB):
-                s = t - DT + j * h
+                s = t - dt + j * h
                 a = rate(s, u)
                 b = rate(s + h / 2, u + h / 2 * a)
                 c = rate(s + h / 2, u + h / 2 * b)
@@ -60,8 +66,7 @@ def main() -> None:
                 u += h / 6 * (a + 2 * b + 2 * c + e)
         d = indentation(piezo(t), u)
         f = 0.0 if d is None else (K1 + K2) * d - K2 * u
-        rows.append(f"{t:.6g},{piezo(t):.9e},{f + SIGMA * rng.standard_normal():.6e}")
-    out = Path(__file__).resolve().parent.parent / "examples" / "force-curve-sls-dwell.csv"
+        rows.append(f"{t:.9g},{piezo(t):.9e},{f + rng.gauss(0.0, SIGMA):.6e}")
     out.write_text("\n".join(rows) + "\n")
 
 

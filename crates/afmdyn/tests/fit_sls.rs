@@ -304,6 +304,14 @@ fn a_noisy_curve_with_a_dwell_gives_back_its_sample_within_the_intervals() {
     for name in DEFAULT_FIT {
         assert!(j["estimates"][name].is_object(), "{name} fitted");
     }
+    // four profiles at most: the sample's keys and the contact point, not the baseline
+    for (name, method) in [
+        (STIFFNESS, "profile likelihood, Δχ² ≤ 3.84"),
+        ("contact_point", "profile likelihood, Δχ² ≤ 3.84"),
+        ("baseline", "Wald, ±1.96 SE"),
+    ] {
+        assert_eq!(j["estimates"][name]["interval_method"], method, "{name}");
+    }
     for (name, truth) in [
         (STIFFNESS, K1),
         (MAXWELL_STIFFNESS, K2),
@@ -392,6 +400,7 @@ fn the_intervals_cover_the_truth_over_noise_draws() {
             }
         }
     }
+    eprintln!("covered (k1, k2, τ): {covered:?} of {draws}");
     for (c, name) in covered
         .iter()
         .zip([STIFFNESS, MAXWELL_STIFFNESS, RELAXATION_TIME])

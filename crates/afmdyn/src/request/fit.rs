@@ -84,8 +84,9 @@ pub struct FitRequest {
     /// its segments (afmformats' `segment` column, which Python reads from an instrument
     /// file); default up to the lowest piezo height, inclusive. 1 to the number of rows.
     pub approach_rows: Option<usize>,
-    /// Profile-likelihood intervals (Δχ² ≤ 3.84) for the fitted parameters, up to 4 of them
-    /// (beyond, and when off, the Wald intervals ±1.96 SE). Default on for a force curve; off
+    /// Profile-likelihood intervals (Δχ² ≤ 3.84) for the fitted parameters, up to 4 of them,
+    /// the probe keys (sample, tip) before the contact point, baseline and z_offset (beyond,
+    /// and when off, the Wald intervals ±1.96 SE). Default on for a force curve; off
     /// for an AM curve, where every profile point is a refit of stepped approaches (on, each
     /// side is walked by secants on √Δχ² in units of the standard error, at most 6 refits, each
     /// started from its neighbour; a side that has not risen by then is reported flat).

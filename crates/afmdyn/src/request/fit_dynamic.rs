@@ -424,8 +424,8 @@ pub fn cost(
     let approach = super::costs::stepped_cost(&spec)?;
     let grid = (2 * Z_OFFSET_GRID + 1) as f64;
     let mut evaluations = grid + max_evaluations(fitted, PATIENCE) as f64 + 2.0;
-    if profiles && fitted <= MAX_PROFILED {
-        let refits = (fitted * 2 * MAX_SECANT_STEPS) as f64;
+    if profiles {
+        let refits = (fitted.min(MAX_PROFILED) * 2 * MAX_SECANT_STEPS) as f64;
         evaluations += refits * max_evaluations(fitted.saturating_sub(1), REFIT_PATIENCE) as f64;
     }
     let cost = super::limits::Cost {

@@ -43,7 +43,7 @@ pub const CURVE_VARIABLES: [(&str, &str, &str); 16] = [
 /// where any parameter was profiled, else the Wald intervals.
 pub fn intervals_method(o: &FitOutcome) -> &'static str {
     if o.estimates.iter().any(|e| e.profile.is_some()) {
-        "intervals from the profile likelihood (Δχ² ≤ 3.84; up to 4 fitted parameters, Wald ±1.96 SE beyond)"
+        "intervals from the profile likelihood (Δχ² ≤ 3.84; up to 4 fitted parameters, the probe keys first, Wald ±1.96 SE beyond)"
     } else {
         "Wald intervals (±1.96 standard errors; no profiles)"
     }

@@ -20,8 +20,24 @@ pub use super::profile::Z_95;
 /// Above this |correlation| two parameters are called not separately identifiable.
 pub const CORRELATION_WARNING: f64 = 0.99;
 
-/// Profiles are computed for at most this many fitted parameters (Wald intervals beyond).
+/// Profiles are computed for at most this many fitted parameters (Wald intervals beyond):
+/// [`profiled`] chooses them.
 pub const MAX_PROFILED: usize = 4;
+
+/// Which of the fitted parameters `names` get profiles: all of them up to [`MAX_PROFILED`];
+/// beyond, the sample's, tip's and lever's (a probe key, `section.key`) first and then the
+/// curve's own (contact point, baseline, z_offset), in order, [`MAX_PROFILED`] in all — the
+/// properties sought before the nuisance parameters.
+pub fn profiled<S: AsRef<str>>(names: &[S]) -> Vec<bool> {
+    let mut on = vec![false; names.len()];
+    let order = (0..names.len())
+        .filter(|&k| names[k].as_ref().contains('.'))
+        .chain((0..names.len()).filter(|&k| !names[k].as_ref().contains('.')));
+    for k in order.take(MAX_PROFILED) {
+        on[k] = true;
+    }
+    on
+}
 
 /// Below this ratio of the smallest to the largest eigenvalue of the scaled JᵀWJ the matrix is
 /// called singular (the data do not fix some combination of the parameters).
@@ -203,6 +219,7 @@ pub fn fit_cancellable(
         .collect();
     let mut evaluations = best.evaluations + 1;
     let mut estimates = Vec::with_capacity(n);
+    let chosen = profiled(&free.iter().map(|&j| &params[j].name).collect::<Vec<_>>());
     for (k, &j) in free.iter().enumerate() {
         let p = &params[j];
         let value = best.values[j];
@@ -213,7 +230,7 @@ pub fn fit_cancellable(
             0.1 * p.scale
         };
         let prof = match profiles {
-            Some(walk) if n <= MAX_PROFILED && dof > 0 && s2 > 0.0 => Some(profile(
+            Some(walk) if chosen[k] && dof > 0 && s2 > 0.0 => Some(profile(
                 model, obs, params, &best, fixed, j, step, s2, walk, progress,
             )?),
             _ => None,
