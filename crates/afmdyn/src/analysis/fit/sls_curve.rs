@@ -170,20 +170,31 @@ impl SlsCurveModel {
         let free_rate = k1 / (tau * sum);
         let mut u = Dual::default();
         let mut contact = false;
+        // e^{−Δt·rate} of the contact and of the free surface, kept while Δt repeats (an
+        // evenly sampled curve computes each once)
+        let mut decay: Option<(f64, Dual, Dual)> = None;
         for i in 0..self.height.len() {
             // cp − h: the indentation of a rigid lever
             let d = cp - Dual(self.height[i], [0.0; 4]);
             if i > 0 {
                 let dt = self.t[i] - self.t[i - 1];
+                let (e_contact, e_free) = match decay {
+                    Some((h, c, f)) if h == dt => (c, f),
+                    _ => {
+                        let c = (-dt * rate_e).exp();
+                        let f = (-dt * free_rate).exp();
+                        decay = Some((dt, c, f));
+                        (c, f)
+                    }
+                };
                 if contact {
                     let d0 = cp - Dual(self.height[i - 1], [0.0; 4]);
                     let (g0, g1) = (g_of * d0, g_of * d);
                     // ġ τ_e = (g₁ − g₀)/(Δt · rate_e)
                     let slope = (g1 - g0) / (dt * rate_e);
-                    let e = (-dt * rate_e).exp();
-                    u = g1 - slope + (u - g0 + slope) * e;
+                    u = g1 - slope + (u - g0 + slope) * e_contact;
                 } else {
-                    u = u * (-dt * free_rate).exp();
+                    u = u * e_free;
                 }
             }
             contact = d.0 >= (gain * u).0;
