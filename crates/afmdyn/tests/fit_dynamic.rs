@@ -7,7 +7,7 @@
 use afmdyn::analysis::approach::{approach_retract, approach_spec};
 use afmdyn::analysis::fit::sensitivity::{orbit_sensitivity, OrbitParam, OrbitSensitivity};
 use afmdyn::analysis::observables::observe_orbit;
-use afmdyn::analysis::shooting::{shoot, ShootingOptions};
+use afmdyn::analysis::shooting::shoot;
 use afmdyn::analysis::stepped::{CurvePoint, Spacing};
 use afmdyn::contact::ContactLaw;
 use afmdyn::integrate::{IntegratorKind, IntegratorOptions};
@@ -18,55 +18,15 @@ use nalgebra::DVector;
 use std::f64::consts::FRAC_PI_2;
 use std::path::Path;
 
+mod common;
+use common::orbit_params::{newton, probe, value_of, with};
+
 /// The adaptive integrator's tolerance of the sensitivities and of the finite differences.
 const TOL: f64 = 1e-12;
 /// The relative step of the central differences.
 const STEP: f64 = 1e-3;
 /// The agreement asked for (issue 62: ≤ 1e-6 relative).
 const AGREE: f64 = 1e-6;
-
-fn probe(name: &str) -> Params {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../examples")
-        .join(name);
-    Probe::load(&path).expect("example probe").params
-}
-
-fn newton() -> ShootingOptions {
-    ShootingOptions {
-        tol: 1e-12,
-        max_iter: 40,
-    }
-}
-
-/// The model's parameters with p moved to `value`.
-fn with(base: &Params, p: OrbitParam, value: f64) -> Params {
-    let mut q = *base;
-    match p {
-        OrbitParam::Gap => q.alpha5 = value,
-        OrbitParam::ContactStiffness => q.alpha4 = value,
-        OrbitParam::Hamaker => match &mut q.contact_law {
-            ContactLaw::Dmt { hamaker, .. } => *hamaker = value,
-            _ => panic!("H̃ of a law without it"),
-        },
-        OrbitParam::DriveAmplitude => q.alpha2 = value,
-        OrbitParam::DriveFrequency => q.omega = value,
-    }
-    q
-}
-
-fn value_of(base: &Params, p: OrbitParam) -> f64 {
-    match p {
-        OrbitParam::Gap => base.alpha5,
-        OrbitParam::ContactStiffness => base.alpha4,
-        OrbitParam::Hamaker => match base.contact_law {
-            ContactLaw::Dmt { hamaker, .. } => hamaker,
-            _ => panic!("H̃ of a law without it"),
-        },
-        OrbitParam::DriveAmplitude => base.alpha2,
-        OrbitParam::DriveFrequency => base.omega,
-    }
-}
 
 /// The orbit at `params` near `guess`, without sensitivities.
 fn orbit(params: &Params, guess: &DVector<f64>) -> OrbitSensitivity {

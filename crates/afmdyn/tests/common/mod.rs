@@ -3,6 +3,8 @@
 // each test file uses some of them
 #![allow(dead_code)]
 
+pub mod orbit_params;
+
 use afmdyn::galerkin::Region;
 use afmdyn::integrate::{
     advance_dyn, build, Integrator, IntegratorKind, IntegratorOptions, SwitchEvent,
