@@ -3,6 +3,7 @@
 // each test file uses some of them
 #![allow(dead_code)]
 
+#[cfg(feature = "files")]
 pub mod orbit_params;
 
 use afmdyn::galerkin::Region;

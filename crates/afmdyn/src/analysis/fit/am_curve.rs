@@ -337,8 +337,9 @@ pub fn first_sweep_cancellable(
 
 /// A dynamic model (the AM curve, the bimodal channels, the FM curve): an evaluation row by row
 /// that may fail or be cancelled, and the warnings of the last one it finished. Every such
-/// model is a [`CurveModel`] through one implementation, which keeps the outcome as
-/// [`record`] says.
+/// model is a [`CurveModel`] through one implementation, which keeps the outcome: a Jacobian
+/// evaluation's warnings replace the last ones, a failed evaluation's values are NaN with a
+/// warning naming where it failed, a cancelled one's values NaN.
 pub trait CheckedModel {
     /// The number of data points m (rows × channels).
     fn rows(&self) -> usize;
