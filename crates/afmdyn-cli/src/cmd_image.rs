@@ -7,13 +7,14 @@
 //! ([`afmdyn::request::run::admit`]). It writes `image.json` (a summary), `image.nc` (the maps),
 //! the maps' figures and the line profile, as `--files` asks.
 
-use crate::args::{Dim, Quantity};
+use crate::args::Dim;
 use crate::cmd_approach::files;
 use crate::cmd_simulate::Files;
 use crate::door::{self, Exit};
 use crate::error::CliError;
+use crate::flags::ImageFlags;
 use crate::output::{units_of, OutDir};
-use afmdyn::request::image::{study_ratios, ImageRequest, SampleMap};
+use afmdyn::request::image::{study_ratios, SampleMap};
 use afmdyn::request::image_job::{ImageJob, ImageMode};
 use afmdyn::request::image_scan::PiScan;
 use afmdyn::request::Analysis;
@@ -39,10 +40,9 @@ pub struct ImageArgs {
     /// [domain.sample])
     #[arg(long, value_name = "S.toml")]
     sample: PathBuf,
-    /// Setpoint: the amplitude ratio A_sp/A0 in (0, 1) (--mode am), or the peak force the
-    /// feedback holds (--mode peakforce; N, or with a unit: 2nN)
-    #[arg(long)]
-    setpoint: Quantity,
+    /// The image request's flags: --setpoint, --pixels, --lines, --curve-points
+    #[command(flatten)]
+    request: ImageFlags,
     /// Imaging mode: am (amplitude-modulation tapping) or peakforce (off-resonance tapping with
     /// an ideal peak-force feedback; a probe with [drive] mode = "off-resonance"): maps of
     /// height, modulus_dmt, adhesion, deformation and dissipation
@@ -79,15 +79,6 @@ pub struct ImageArgs {
     /// Testing: abort the process, as if killed, after this many lines are stored
     #[arg(long, hide = true)]
     abort_after: Option<usize>,
-    /// Pixels per line [default: 64]
-    #[arg(long)]
-    pixels: Option<usize>,
-    /// Lines (default: as many as pixels, 1 for a line map with Ly = 0)
-    #[arg(long)]
-    lines: Option<usize>,
-    /// Points of each material's approach curve (the probe's default z_c range) [default: 120]
-    #[arg(long)]
-    curve_points: Option<usize>,
     /// Also the setpoint study FROM:TO:N (e.g. 0.2:0.95:16): every domain's apparent height,
     /// phase and E_dis at N setpoints, as a line engaged on the background meets it (the
     /// contrast inversion); "setpoint_study" in the document and two plots
@@ -115,22 +106,17 @@ pub fn image_cmd(a: &ImageArgs) -> Result<(), CliError> {
             )))
         }
     };
-    let setpoint = match mode {
-        ImageMode::Am if a.setpoint.dim.is_some() => {
-            return Err(CliError::Input(
-                "--setpoint: a ratio A_sp/A0 in (0, 1) without a unit (a force with --mode \
-                 peakforce)"
-                    .into(),
-            ))
-        }
-        ImageMode::Am => a.setpoint.value,
-        ImageMode::Peakforce => a.setpoint.value("setpoint", Dim::Force, true)?,
+    // the setpoint: a ratio A_sp/A0 (AM) or a peak force (PeakForce); the probe file is SI
+    let setpoint_dim = match mode {
+        ImageMode::Am => None,
+        ImageMode::Peakforce => Some(Dim::Force),
     };
+    let request = a.request.request(true, setpoint_dim)?;
     if mode == ImageMode::Peakforce {
         for (set, flag) in [
             (a.feedback != "ideal", "--feedback"),
             (a.setpoint_study.is_some(), "--setpoint-study"),
-            (a.curve_points.is_some(), "--curve-points"),
+            (a.request.curve_points.is_some(), "--curve-points"),
         ] {
             if set {
                 return Err(CliError::Input(format!(
@@ -191,7 +177,6 @@ pub fn image_cmd(a: &ImageArgs) -> Result<(), CliError> {
         afmdyn::SimError::Probe(m) => CliError::Input(format!("--sample {m}")),
         e => e.into(),
     })?;
-    let request = ImageRequest::with(setpoint, a.pixels, a.lines, a.curve_points);
     match mode {
         ImageMode::Am => request.validate(&map)?,
         ImageMode::Peakforce => request.validate_grid(&map)?,

@@ -832,7 +832,7 @@ def image(
         setpoint: Setpoint ratio A_sp/A₀ in (0, 1). With ``mode="peakforce"`` the peak force
             (N).
         curve_points: Points of each material's approach curve (its z_c grid, the probe's
-            default range; default 120, the approach's
+            default range; default 120, the approach's default:
             ``analysis::stepped::DEFAULT_CURVE_POINTS``).
         lines: Lines; ``None``: as many as pixels, 1 for a line map (Ly = 0)
             (``ImageRequest::lines``).
@@ -975,7 +975,7 @@ def setpoint_study(
             for TOML text).
         ratios: the setpoints A_sp/A0 in (0, 1).
         curve_points: Points of each material's approach curve (its z_c grid, the probe's
-            default range; default 120, the approach's
+            default range; default 120, the approach's default:
             ``analysis::stepped::DEFAULT_CURVE_POINTS``).
 
     Returns:

@@ -65,6 +65,7 @@ pub struct FitRequest {
     pub segment: FitSegment,
     /// The range of tip positions fitted [lo, hi] (m, after the preprocessing's offset, as
     /// nanite's `range_x`); default the whole segment.
+    #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "length")))]
     pub range: Option<[f64; 2]>,
     /// The number of rows of the approach (the rest is the retract), as an instrument records
     /// its segments (afmformats' `segment` column, which Python reads from an instrument
