@@ -163,6 +163,15 @@ STRUCTS: Dict[str, Dict[str, object]] = {
         "notes": {"setpoint": "With --mode peakforce the peak force the feedback holds "
                               "instead, in N or with a unit (2nN)."},
     },
+    # `image --feedback pi`: the PI scan's settings (each refused without it, when given)
+    "PiScanFlags": {
+        "schema": "image_scan",
+        "module": "image_scan",
+        "order": ["scan_rate", "gains", "time_constant"],
+        "notes": {k: "Only with --feedback pi." for k in ["scan_rate", "gains", "time_constant"]},
+        "args": {"scan_rate": 'value_name = "HZ"', "gains": 'value_name = "P,I"',
+                 "time_constant": 'value_name = "S"'},
+    },
     # `reconstruct`: k, f0 and A come from an fm document unless given; the curve's columns
     # from the file (`--fm`); the command builds the request
     "ReconstructFlags": {
@@ -219,10 +228,13 @@ def kebab(name: str) -> str:
 
 
 def number(x: object) -> str:
-    """A constant as the help shows it: ``1e8`` for a large whole float, else as JSON."""
+    """A constant as the help shows it: ``1e8`` for a large whole float, ``5`` for a small
+    one, else as JSON."""
     if isinstance(x, float) and x.is_integer() and abs(x) >= 1e5:
         mantissa, exp = f"{x:e}".split("e")
         return f"{mantissa.rstrip('0').rstrip('.')}e{int(exp)}"
+    if isinstance(x, float) and x.is_integer():
+        return str(int(x))
     return json.dumps(x)
 
 
@@ -378,9 +390,9 @@ class Field:
             parts.append("value_delimiter = ','")
         if self.consts:
             parts.append(f"value_parser = [{', '.join(rust_str(c) for c in self.consts)}]")
-        if self.dim:
+        if self.dim or self.rust == "Vec<f64>":  # (a list: `-1,10` is no negative number)
             parts.append("allow_hyphen_values = true")
-        elif self.rust in ("f64", "isize", "i8", "i16", "i32", "i64", "Vec<f64>"):
+        elif self.rust in ("f64", "isize", "i8", "i16", "i32", "i64"):
             parts.append("allow_negative_numbers = true")
         if self.tri:
             parts.append(f'conflicts_with = "no_{self.name}"')

@@ -12,11 +12,10 @@ use crate::cmd_approach::files;
 use crate::cmd_simulate::Files;
 use crate::door::{self, Exit};
 use crate::error::CliError;
-use crate::flags::ImageFlags;
+use crate::flags::{ImageFlags, PiScanFlags};
 use crate::output::{units_of, OutDir};
 use afmdyn::request::image::{study_ratios, SampleMap};
 use afmdyn::request::image_job::{ImageJob, ImageMode};
-use afmdyn::request::image_scan::PiScan;
 use afmdyn::request::Analysis;
 use clap::Args;
 use std::path::PathBuf;
@@ -52,23 +51,9 @@ pub struct ImageArgs {
     /// time-domain scan, trace and retrace, under a lock-in and a PI z controller)
     #[arg(long, default_value = "ideal")]
     feedback: String,
-    /// PI scan: lines (trace and retrace) per second, Hz (default: a pixel lasts 5 loop time
-    /// constants 1/K_I)
-    #[arg(long, value_name = "HZ")]
-    scan_rate: Option<f64>,
-    /// PI scan: the gains K_P (m/m) and K_I (1/s) (default: K_P = 0, K_I = 1/(4(τ_c + τ_L)),
-    /// τ_c = 2Q/ω0)
-    #[arg(
-        long,
-        value_name = "P,I",
-        value_delimiter = ',',
-        allow_hyphen_values = true
-    )]
-    gains: Option<Vec<f64>>,
-    /// PI scan: the lock-in's low-pass time constant, s (default: τ_c/4; refused above
-    /// 1000 s, a warning outside 1 µs–0.1 s)
-    #[arg(long, value_name = "S")]
-    time_constant: Option<f64>,
+    /// The PI scan's flags: --scan-rate, --gains, --time-constant
+    #[command(flatten)]
+    scan: PiScanFlags,
     /// PI scan or PeakForce image: worker threads, one line per task (default: all cores)
     #[arg(long)]
     threads: Option<usize>,
@@ -128,9 +113,9 @@ pub fn image_cmd(a: &ImageArgs) -> Result<(), CliError> {
     let pi = match a.feedback.as_str() {
         "ideal" => {
             for (set, flag) in [
-                (a.scan_rate.is_some(), "--scan-rate"),
-                (a.gains.is_some(), "--gains"),
-                (a.time_constant.is_some(), "--time-constant"),
+                (a.scan.scan_rate.is_some(), "--scan-rate"),
+                (a.scan.gains.is_some(), "--gains"),
+                (a.scan.time_constant.is_some(), "--time-constant"),
                 (a.threads.is_some() && mode == ImageMode::Am, "--threads"),
                 (a.resume, "--resume"),
             ] {
@@ -150,19 +135,7 @@ pub fn image_cmd(a: &ImageArgs) -> Result<(), CliError> {
                         .into(),
                 ));
             }
-            Some(PiScan {
-                scan_rate: a.scan_rate,
-                gains: match a.gains.as_deref() {
-                    None => None,
-                    Some([p, i]) => Some((*p, *i)),
-                    Some(g) => {
-                        return Err(CliError::Input(format!(
-                            "--gains {g:?}: must be two numbers P,I (K_P in m/m, K_I in 1/s)"
-                        )))
-                    }
-                },
-                time_constant: a.time_constant,
-            })
+            Some(a.scan.request(true)?)
         }
         other => {
             return Err(CliError::Input(format!(

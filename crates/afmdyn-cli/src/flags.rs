@@ -3,9 +3,9 @@
 //! and types of the request schemas (`docs/schema/requests`): written by
 //! `scripts/gen_cli.py` (run by `scripts/gen_stubs.py`, whose `--check` CI runs).
 
-use crate::args::{either, named, quantity, values, Dim, Quantity};
+use crate::args::{either, named, numbers, quantity, values, Dim, Quantity};
 use crate::error::CliError;
-use afmdyn::request::{ApproachRequest, AttractorsRequest, BasinsRequest, BifurcationRequest, ChartRequest, ContinuationRequest, ConvergeRequest, CurveRequest, FitRequest, FmRequest, IntegratorRequest, LyapunovRequest, OrbitRequest, PeakForceRequest, ResonanceRequest, SimulateRequest, StartRequest, SteadyRequest, image::ImageRequest};
+use afmdyn::request::{ApproachRequest, AttractorsRequest, BasinsRequest, BifurcationRequest, ChartRequest, ContinuationRequest, ConvergeRequest, CurveRequest, FitRequest, FmRequest, IntegratorRequest, LyapunovRequest, OrbitRequest, PeakForceRequest, ResonanceRequest, SimulateRequest, StartRequest, SteadyRequest, image::ImageRequest, image_scan::PiScan};
 use clap::Args;
 
 /// The flags of [`CurveRequest`]'s fields (generated from its schema).
@@ -664,6 +664,34 @@ impl ImageFlags {
             lines: self.lines,
             pixels: self.pixels,
             setpoint: self.setpoint.value_in("setpoint", mode_dim, si)?,
+        })
+    }
+}
+
+/// The flags of [`PiScan`]'s fields (generated from its schema).
+#[derive(Debug, Clone, Args)]
+pub struct PiScanFlags {
+    /// `--scan-rate`: the request's `scan_rate`.
+    #[arg(long, allow_hyphen_values = true, value_name = "HZ", help = "Scan rate (Hz): lines (trace and retrace) per second; not given: a pixel lasts 5 loop time constants 1/K_I. Only with --feedback pi. With --probe a unit may follow (300kHz).")]
+    pub scan_rate: Option<Quantity>,
+    /// `--gains`: the request's `gains`.
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true, value_name = "P,I", help = "The gains (K_P, K_I): K_P ≥ 0 (m/m), K_I > 0 (1/s); not given: K_P = 0, K_I = 1/(4(τ_c + τ_L)), τ_c = 2Q/ω₀ the lever's amplitude time constant and τ_L the lock-in's. Only with --feedback pi.")]
+    pub gains: Option<Vec<f64>>,
+    /// `--time-constant`: the request's `time_constant`.
+    #[arg(long, allow_negative_numbers = true, value_name = "S", help = "The lock-in's low-pass time constant (s), ≥ 0 and at most 1 000 s (its physical range, section feedback); outside 1 µs–0.1 s the image warns of a likely unit slip. Not given: τ_c/4. Only with --feedback pi.")]
+    pub time_constant: Option<f64>,
+}
+
+impl PiScanFlags {
+    /// The [`PiScan`] of these flags (the library validates it); SI values when `si` (a probe).
+    ///
+    /// # Errors
+    /// [`CliError::Input`] for a number whose unit is of another dimension than its field's, or a unit without a probe (`si`), or a list of another length than its field's.
+    pub fn request(&self, si: bool) -> Result<PiScan, CliError> {
+        Ok(PiScan {
+            gains: numbers(self.gains.as_deref(), "gains", "P,I")?.map(|[v0, v1]| (v0, v1)),
+            scan_rate: quantity(self.scan_rate, "scan-rate", Dim::Frequency, si)?,
+            time_constant: self.time_constant,
         })
     }
 }

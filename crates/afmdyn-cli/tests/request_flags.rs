@@ -143,6 +143,7 @@ fn every_request_field_has_its_flag_and_the_request_default() {
     // the setpoint is required (the default request's 0.5 only exemplifies it)
     defaults_shown("image", ImageRequest::default(), &["setpoint"]);
     without_default("image", &["--setpoint"]);
+    defaults_shown("image", afmdyn::request::image_scan::PiScan::default(), &[]);
     // the curve's columns come from --fm FILE; k, f0 and A from it too unless given
     let constants = ["spring_constant", "resonance_frequency", "amplitude"];
     let columns = ["distance", "z_c", "frequency_shift"];
