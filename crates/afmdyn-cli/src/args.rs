@@ -245,6 +245,15 @@ pub enum Dim {
 }
 
 impl Dim {
+    /// Its SI unit.
+    fn unit(self) -> &'static str {
+        match self {
+            Dim::Length => "m",
+            Dim::Frequency => "Hz",
+            Dim::Force => "N",
+        }
+    }
+
     fn name(self) -> &'static str {
         match self {
             Dim::Length => "a length (m)",
@@ -398,7 +407,8 @@ pub fn values<const N: usize>(
 ) -> Result<Option<[f64; N]>, CliError> {
     let Some(q) = q else { return Ok(None) };
     if q.len() != N {
-        return Err(count_error(flag, q.len(), N, names));
+        let names = format!("{names} ({})", want.unit());
+        return Err(count_error(flag, q.len(), N, &names));
     }
     let mut out = [0.0; N];
     for (o, v) in out.iter_mut().zip(q) {

@@ -209,3 +209,64 @@ fn an_optional_boolean_takes_on_off_or_the_default() {
     let both = common::run(&[&args[..], &["--profiles", "--no-profiles"]].concat());
     assert!(!both.status.success(), "--profiles with --no-profiles");
 }
+
+#[test]
+fn enum_names_unit_lists_and_a_mode_setpoint_read_as_the_library_does() {
+    // `reconstruct --inversion exact`: the library's exact inversion, whose document records
+    // its iterations under "exact"; the default (Sader–Jarvis) has none
+    let fm = [
+        "reconstruct",
+        "--fm",
+        "examples/fm-vdw.csv",
+        "--spring-constant",
+        "40",
+        "--resonance-frequency",
+        "300kHz",
+        "--amplitude",
+        "10nm",
+        "--files",
+        "none",
+        "--json",
+    ];
+    assert!(common::json(&fm).get("exact").is_none());
+    let exact = common::json(&[&fm[..], &["--inversion", "exact"]].concat());
+    assert!(exact["exact"]["iterations"].as_u64().is_some(), "{exact}");
+    common::refused(
+        &[&fm[..], &["--inversion", "newton"]].concat(),
+        &["--inversion"],
+    );
+    // `fit --range LO,HI` (x-dim length): 20 nm and 2e-8 are the same range
+    let fit = |range: &str| {
+        let args = [
+            "fit",
+            "--probe",
+            "examples/probe-fit-hertz.toml",
+            "--data",
+            "examples/force-curve-hertz.csv",
+            "--files",
+            "none",
+            "--json",
+            range,
+        ];
+        common::json(&args)
+    };
+    let (si, units) = (fit("--range=-2e-8,2e-7"), fit("--range=-20nm,200nm"));
+    assert_eq!(si["range"], serde_json::json!([-2e-8, 2e-7]));
+    assert_eq!(si["range"], units["range"]);
+    assert_eq!(si["rows_fitted"], units["rows_fitted"]);
+    // `image --setpoint` (x-dim mode): a plain ratio in AM, a unit refused by name
+    common::refused(
+        &[
+            "image",
+            "--probe",
+            "examples/probe-point-mass-dmt.toml",
+            "--sample",
+            "examples/sample-stripe.toml",
+            "--setpoint",
+            "2nN",
+            "--files",
+            "none",
+        ],
+        &["--setpoint", "plain number"],
+    );
+}
