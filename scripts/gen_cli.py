@@ -7,8 +7,10 @@ JSON Schemas (``docs/schema/requests/*.json``, written by
 type, default and description. This script writes ``crates/afmdyn-cli/src/flags.rs``: per
 entry of :data:`STRUCTS` a clap ``Args`` struct with one flag per request field (the field's
 name in kebab-case; its help the field's description; its default the schema's, shown by
-``--help``; a boolean whose default is true becomes ``--no-<name>``; a field whose schema
-carries ``"x-dim"`` takes the CLI's ``Quantity``, a number with an optional SI unit) and a
+``--help``; a boolean whose default is true becomes ``--no-<name>``, an optional one the pair
+``--<name>``/``--no-<name>``; a field whose schema carries ``"x-dim"`` takes the CLI's
+``Quantity``, a number with an optional SI unit; an enum of names takes one of them; a list
+is comma-separated, a fixed-length one checked for its length) and a
 ``request`` method that builds the request from the flags. The commands (``cmd_*.rs``)
 flatten these structs beside their own CLI-only flags (``--out``, ``--json``, ``--files``,
 ``--resume``, testing flags) and only map names.
@@ -152,8 +154,8 @@ STRUCTS: Dict[str, Dict[str, object]] = {
         "given": {"start": ("StartRequest", "start")},
         "order": ["param", "from", "to", "period", "switch"],
     },
-    # `image`: the request's fields; the mode, feedback, PI settings, study and files are the
-    # command's (ImageJob, PiScan: no request schema). `--curve-points` is refused with
+    # `image`: the request's fields; the mode, feedback, threads, study and files are the
+    # command's (ImageJob has no request schema). `--curve-points` is refused with
     # `--mode peakforce` only when given.
     "ImageFlags": {
         "schema": "image",
@@ -436,9 +438,9 @@ class Field:
                 value += f".map(|[{parts}]| ({parts}))"
             return value
         if self.dim:
-            dim = {"swept": "swept", "mode": None}.get(self.dim, DIMS.get(self.dim, ("",))[0])
-            if dim is None:
+            if self.dim == "mode":
                 return f'self.{self.name}.value_in("{flag}", mode_dim, si)?'
+            dim = "swept" if self.dim == "swept" else DIMS[self.dim][0]
             if self.ty().startswith("Option"):
                 value = f'quantity(self.{self.name}, "{flag}", {dim}, si)?'
             else:
