@@ -245,6 +245,15 @@ pub enum Dim {
 }
 
 impl Dim {
+    /// Its SI unit.
+    fn unit(self) -> &'static str {
+        match self {
+            Dim::Length => "m",
+            Dim::Frequency => "Hz",
+            Dim::Force => "N",
+        }
+    }
+
     fn name(self) -> &'static str {
         match self {
             Dim::Length => "a length (m)",
@@ -361,6 +370,96 @@ pub fn quantity(
     si: bool,
 ) -> Result<Option<f64>, CliError> {
     q.map(|q| q.value(flag, want, si)).transpose()
+}
+
+impl Quantity {
+    /// The value of flag `--flag` whose dimension the command's mode gives: `want` as in
+    /// [`Quantity::value`], or `None` for a plain number (a ratio), which takes no unit.
+    ///
+    /// # Errors
+    /// [`CliError::Input`] as [`Quantity::value`], or for a unit where the mode takes a plain
+    /// number.
+    pub fn value_in(self, flag: &str, want: Option<Dim>, si: bool) -> Result<f64, CliError> {
+        match (want, self.dim) {
+            (Some(want), _) => self.value(flag, want, si),
+            (None, Some(d)) => Err(CliError::Input(format!(
+                "--{flag}: the unit makes it {}, but here --{flag} is a plain number \
+                 (a ratio, without a unit)",
+                d.name()
+            ))),
+            (None, None) => Ok(self.value),
+        }
+    }
+}
+
+/// The values of a comma-separated flag `--flag` of exactly `N` quantities of dimension
+/// `want` ([`Quantity::value`]), e.g. `--range LO,HI` (`names`: its value name, `LO,HI`).
+///
+/// # Errors
+/// [`CliError::Input`] naming the flag for another number of values, or as
+/// [`Quantity::value`].
+pub fn values<const N: usize>(
+    q: Option<&[Quantity]>,
+    flag: &str,
+    names: &str,
+    want: Dim,
+    si: bool,
+) -> Result<Option<[f64; N]>, CliError> {
+    let Some(q) = q else { return Ok(None) };
+    if q.len() != N {
+        let names = format!("{names} ({})", want.unit());
+        return Err(count_error(flag, q.len(), N, &names));
+    }
+    let mut out = [0.0; N];
+    for (o, v) in out.iter_mut().zip(q) {
+        *o = v.value(flag, want, si)?;
+    }
+    Ok(Some(out))
+}
+
+/// The numbers of a comma-separated flag `--flag` of exactly `N` plain numbers (`names`: its
+/// value name, e.g. `P,I`).
+///
+/// # Errors
+/// [`CliError::Input`] naming the flag for another number of values.
+pub fn numbers<const N: usize>(
+    q: Option<&[f64]>,
+    flag: &str,
+    names: &str,
+) -> Result<Option<[f64; N]>, CliError> {
+    let Some(q) = q else { return Ok(None) };
+    <[f64; N]>::try_from(q)
+        .map(Some)
+        .map_err(|_| count_error(flag, q.len(), N, names))
+}
+
+/// `--flag: 1 value(s) given; must be two, LO,HI`.
+fn count_error(flag: &str, given: usize, n: usize, names: &str) -> CliError {
+    let words = ["none", "one", "two", "three", "four"];
+    CliError::Input(format!(
+        "--{flag}: {given} value(s) given; must be {}, {names}",
+        words.get(n).map_or(n.to_string(), |w| w.to_string())
+    ))
+}
+
+/// A name of the library's enum (a request field's `oneOf` of names in its schema) as serde
+/// reads it; clap admits only the schema's names, so this fails only if they drift apart.
+///
+/// # Errors
+/// [`CliError::Input`] naming the flag for a name the type does not take.
+pub fn named<T: serde::de::DeserializeOwned>(name: &str, flag: &str) -> Result<T, CliError> {
+    serde_json::from_value(serde_json::Value::String(name.to_string()))
+        .map_err(|e| CliError::Input(format!("--{flag} {name}: {e}")))
+}
+
+/// An optional boolean of two flags, `--x` (`on`) and `--no-x` (`off`; clap refuses both):
+/// `Some(true)`, `Some(false)`, or `None` (the request's default) when neither is given.
+pub fn either(on: bool, off: bool) -> Option<bool> {
+    match (on, off) {
+        (true, _) => Some(true),
+        (_, true) => Some(false),
+        _ => None,
+    }
 }
 
 /// The text of the probe file `path` (read through the bounded reader, its refusals naming

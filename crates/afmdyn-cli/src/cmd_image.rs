@@ -7,15 +7,15 @@
 //! ([`afmdyn::request::run::admit`]). It writes `image.json` (a summary), `image.nc` (the maps),
 //! the maps' figures and the line profile, as `--files` asks.
 
-use crate::args::{Dim, Quantity};
+use crate::args::Dim;
 use crate::cmd_approach::files;
 use crate::cmd_simulate::Files;
 use crate::door::{self, Exit};
 use crate::error::CliError;
+use crate::flags::{ImageFlags, PiScanFlags};
 use crate::output::{units_of, OutDir};
-use afmdyn::request::image::{study_ratios, ImageRequest, SampleMap};
+use afmdyn::request::image::{study_ratios, SampleMap};
 use afmdyn::request::image_job::{ImageJob, ImageMode};
-use afmdyn::request::image_scan::PiScan;
 use afmdyn::request::Analysis;
 use clap::Args;
 use std::path::PathBuf;
@@ -39,10 +39,9 @@ pub struct ImageArgs {
     /// [domain.sample])
     #[arg(long, value_name = "S.toml")]
     sample: PathBuf,
-    /// Setpoint: the amplitude ratio A_sp/A0 in (0, 1) (--mode am), or the peak force the
-    /// feedback holds (--mode peakforce; N, or with a unit: 2nN)
-    #[arg(long)]
-    setpoint: Quantity,
+    /// The image request's flags: --setpoint, --pixels, --lines, --curve-points
+    #[command(flatten)]
+    request: ImageFlags,
     /// Imaging mode: am (amplitude-modulation tapping) or peakforce (off-resonance tapping with
     /// an ideal peak-force feedback; a probe with [drive] mode = "off-resonance"): maps of
     /// height, modulus_dmt, adhesion, deformation and dissipation
@@ -52,23 +51,9 @@ pub struct ImageArgs {
     /// time-domain scan, trace and retrace, under a lock-in and a PI z controller)
     #[arg(long, default_value = "ideal")]
     feedback: String,
-    /// PI scan: lines (trace and retrace) per second, Hz (default: a pixel lasts 5 loop time
-    /// constants 1/K_I)
-    #[arg(long, value_name = "HZ")]
-    scan_rate: Option<f64>,
-    /// PI scan: the gains K_P (m/m) and K_I (1/s) (default: K_P = 0, K_I = 1/(4(τ_c + τ_L)),
-    /// τ_c = 2Q/ω0)
-    #[arg(
-        long,
-        value_name = "P,I",
-        value_delimiter = ',',
-        allow_hyphen_values = true
-    )]
-    gains: Option<Vec<f64>>,
-    /// PI scan: the lock-in's low-pass time constant, s (default: τ_c/4; refused above
-    /// 1000 s, a warning outside 1 µs–0.1 s)
-    #[arg(long, value_name = "S")]
-    time_constant: Option<f64>,
+    /// The PI scan's flags: --scan-rate, --gains, --time-constant
+    #[command(flatten)]
+    scan: PiScanFlags,
     /// PI scan or PeakForce image: worker threads, one line per task (default: all cores)
     #[arg(long)]
     threads: Option<usize>,
@@ -79,15 +64,6 @@ pub struct ImageArgs {
     /// Testing: abort the process, as if killed, after this many lines are stored
     #[arg(long, hide = true)]
     abort_after: Option<usize>,
-    /// Pixels per line [default: 64]
-    #[arg(long)]
-    pixels: Option<usize>,
-    /// Lines (default: as many as pixels, 1 for a line map with Ly = 0)
-    #[arg(long)]
-    lines: Option<usize>,
-    /// Points of each material's approach curve (the probe's default z_c range) [default: 120]
-    #[arg(long)]
-    curve_points: Option<usize>,
     /// Also the setpoint study FROM:TO:N (e.g. 0.2:0.95:16): every domain's apparent height,
     /// phase and E_dis at N setpoints, as a line engaged on the background meets it (the
     /// contrast inversion); "setpoint_study" in the document and two plots
@@ -115,22 +91,17 @@ pub fn image_cmd(a: &ImageArgs) -> Result<(), CliError> {
             )))
         }
     };
-    let setpoint = match mode {
-        ImageMode::Am if a.setpoint.dim.is_some() => {
-            return Err(CliError::Input(
-                "--setpoint: a ratio A_sp/A0 in (0, 1) without a unit (a force with --mode \
-                 peakforce)"
-                    .into(),
-            ))
-        }
-        ImageMode::Am => a.setpoint.value,
-        ImageMode::Peakforce => a.setpoint.value("setpoint", Dim::Force, true)?,
+    // the setpoint: a ratio A_sp/A0 (AM) or a peak force (PeakForce); the probe file is SI
+    let setpoint_dim = match mode {
+        ImageMode::Am => None,
+        ImageMode::Peakforce => Some(Dim::Force),
     };
+    let request = a.request.request(true, setpoint_dim)?;
     if mode == ImageMode::Peakforce {
         for (set, flag) in [
             (a.feedback != "ideal", "--feedback"),
             (a.setpoint_study.is_some(), "--setpoint-study"),
-            (a.curve_points.is_some(), "--curve-points"),
+            (a.request.curve_points.is_some(), "--curve-points"),
         ] {
             if set {
                 return Err(CliError::Input(format!(
@@ -142,9 +113,9 @@ pub fn image_cmd(a: &ImageArgs) -> Result<(), CliError> {
     let pi = match a.feedback.as_str() {
         "ideal" => {
             for (set, flag) in [
-                (a.scan_rate.is_some(), "--scan-rate"),
-                (a.gains.is_some(), "--gains"),
-                (a.time_constant.is_some(), "--time-constant"),
+                (a.scan.scan_rate.is_some(), "--scan-rate"),
+                (a.scan.gains.is_some(), "--gains"),
+                (a.scan.time_constant.is_some(), "--time-constant"),
                 (a.threads.is_some() && mode == ImageMode::Am, "--threads"),
                 (a.resume, "--resume"),
             ] {
@@ -164,19 +135,7 @@ pub fn image_cmd(a: &ImageArgs) -> Result<(), CliError> {
                         .into(),
                 ));
             }
-            Some(PiScan {
-                scan_rate: a.scan_rate,
-                gains: match a.gains.as_deref() {
-                    None => None,
-                    Some([p, i]) => Some((*p, *i)),
-                    Some(g) => {
-                        return Err(CliError::Input(format!(
-                            "--gains {g:?}: must be two numbers P,I (K_P in m/m, K_I in 1/s)"
-                        )))
-                    }
-                },
-                time_constant: a.time_constant,
-            })
+            Some(a.scan.request(true)?)
         }
         other => {
             return Err(CliError::Input(format!(
@@ -191,7 +150,6 @@ pub fn image_cmd(a: &ImageArgs) -> Result<(), CliError> {
         afmdyn::SimError::Probe(m) => CliError::Input(format!("--sample {m}")),
         e => e.into(),
     })?;
-    let request = ImageRequest::with(setpoint, a.pixels, a.lines, a.curve_points);
     match mode {
         ImageMode::Am => request.validate(&map)?,
         ImageMode::Peakforce => request.validate_grid(&map)?,

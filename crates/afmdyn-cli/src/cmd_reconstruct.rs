@@ -5,11 +5,12 @@
 //! `reconstruct.csv`, the force figure and the JSON document
 //! ([`afmdyn::request::present::reconstruct`]); this front end maps the flags.
 
-use crate::args::{quantity, Dim, Quantity};
+use crate::args::{named, quantity, Dim};
 use crate::cmd_approach::files;
 use crate::cmd_simulate::Files;
 use crate::door;
 use crate::error::CliError;
+use crate::flags::ReconstructFlags;
 use crate::output::{units_of, OutDir};
 use afmdyn::analysis::reconstruct::Reconstruction;
 use afmdyn::io::curve_file::{read_curve_file, read_document, CurveFile};
@@ -39,28 +40,9 @@ pub struct ReconstructArgs {
     /// inverted at each point's amplitude (the matrix method)
     #[arg(long, value_name = "FILE")]
     am: Option<PathBuf>,
-    /// Spring constant k (N/m; typical 0.01–1e6, refused outside 1e-6–1e9); required with a
-    /// CSV, replaces the document's
-    #[arg(long, conflicts_with = "am", allow_hyphen_values = true)]
-    spring_constant: Option<f64>,
-    /// Free resonance frequency f0 (Hz; a unit may follow: 300kHz; typical 1 kHz–10 MHz,
-    /// refused outside 1 Hz–10 GHz); required with a CSV, replaces the document's
-    #[arg(long, conflicts_with = "am", allow_hyphen_values = true)]
-    resonance_frequency: Option<Quantity>,
-    /// Oscillation amplitude A (m; a unit may follow: 10nm; typical 10 pm–1 µm, refused
-    /// outside 1 fm–1 mm); required with a CSV, replaces the document's
-    #[arg(long, conflicts_with = "am", allow_hyphen_values = true)]
-    amplitude: Option<Quantity>,
-    /// The inversion of an FM curve: sader-jarvis (Sader & Jarvis's formula, within a few per
-    /// cent; the more robust on noisy data) or exact (its estimate corrected through
-    /// Giessibl's forward relation until the two agree: exact for the first-order relation)
-    #[arg(
-        long,
-        value_enum,
-        default_value = "sader-jarvis",
-        conflicts_with = "am"
-    )]
-    inversion: InversionArg,
+    /// The request's flags: --spring-constant, --resonance-frequency, --amplitude, --inversion
+    #[command(flatten)]
+    request: ReconstructFlags,
     /// Output directory (locked during the run)
     #[arg(long, default_value = "afmdyn-out/reconstruct")]
     out: PathBuf,
@@ -73,29 +55,22 @@ pub struct ReconstructArgs {
 }
 
 /// An input file's refusal as bad input naming the option (`--fm FILE: …`).
-/// `--inversion` ([`afmdyn::request::reconstruct::FmInversion`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum InversionArg {
-    /// Sader–Jarvis.
-    SaderJarvis,
-    /// The exact inversion.
-    Exact,
-}
-
 fn input(option: &'static str) -> impl Fn(InputFileError) -> CliError {
     move |e| CliError::Input(format!("{option} {e}"))
 }
 
 /// The request of the flags: from an `fm` JSON document, or from a CSV with k, f0 and A.
 fn request_of(a: &ReconstructArgs, fm: &Path) -> Result<ReconstructRequest, CliError> {
-    let k = a.spring_constant;
+    let flags = &a.request;
+    let k = flags.spring_constant;
     let f0 = quantity(
-        a.resonance_frequency,
+        flags.resonance_frequency,
         "resonance-frequency",
         Dim::Frequency,
         true,
     )?;
-    let amp = quantity(a.amplitude, "amplitude", Dim::Length, true)?;
+    let amp = quantity(flags.amplitude, "amplitude", Dim::Length, true)?;
+    let inversion = named::<FmInversion>(&flags.inversion, "inversion")?;
     // a constant ≤ 0 is refused here naming its flag (the library's ranges name the field)
     for (flag, v) in [
         ("spring-constant", k),
@@ -112,7 +87,7 @@ fn request_of(a: &ReconstructArgs, fm: &Path) -> Result<ReconstructRequest, CliE
     let (names, mut columns) = match read_curve_file(fm).map_err(input("--fm"))? {
         CurveFile::Document(doc) => {
             return Ok(ReconstructRequest {
-                inversion: inversion(a),
+                inversion,
                 ..ReconstructRequest::from_fm_document(&doc, k, f0, amp)?
             })
         }
@@ -137,7 +112,7 @@ fn request_of(a: &ReconstructArgs, fm: &Path) -> Result<ReconstructRequest, CliE
         ))
     })?;
     Ok(ReconstructRequest {
-        inversion: inversion(a),
+        inversion,
         law_force: None,
         distance: take("distance"),
         z_c: take("z_c"),
@@ -149,14 +124,6 @@ fn request_of(a: &ReconstructArgs, fm: &Path) -> Result<ReconstructRequest, CliE
 }
 
 /// The reconstruction of an AM document (`--am FILE`) and its JSON document.
-/// The library's inversion of `--inversion`.
-fn inversion(a: &ReconstructArgs) -> FmInversion {
-    match a.inversion {
-        InversionArg::SaderJarvis => FmInversion::SaderJarvis,
-        InversionArg::Exact => FmInversion::Exact,
-    }
-}
-
 fn am_reconstruction(path: &Path) -> Result<(Reconstruction, serde_json::Value), CliError> {
     let doc = read_document(path).map_err(input("--am"))?;
     let d = request::reconstruct::am_reconstruction(

@@ -3,9 +3,9 @@
 //! and types of the request schemas (`docs/schema/requests`): written by
 //! `scripts/gen_cli.py` (run by `scripts/gen_stubs.py`, whose `--check` CI runs).
 
-use crate::args::{quantity, Dim, Quantity};
+use crate::args::{either, named, numbers, quantity, values, Dim, Quantity};
 use crate::error::CliError;
-use afmdyn::request::{ApproachRequest, AttractorsRequest, BasinsRequest, BifurcationRequest, ChartRequest, ContinuationRequest, ConvergeRequest, CurveRequest, FmRequest, IntegratorRequest, LyapunovRequest, OrbitRequest, PeakForceRequest, ResonanceRequest, SimulateRequest, StartRequest, SteadyRequest};
+use afmdyn::request::{ApproachRequest, AttractorsRequest, BasinsRequest, BifurcationRequest, ChartRequest, ContinuationRequest, ConvergeRequest, CurveRequest, FitRequest, FmRequest, IntegratorRequest, LyapunovRequest, OrbitRequest, PeakForceRequest, ResonanceRequest, SimulateRequest, StartRequest, SteadyRequest, image::ImageRequest, image_scan::PiScan};
 use clap::Args;
 
 /// The flags of [`CurveRequest`]'s fields (generated from its schema).
@@ -633,6 +633,127 @@ impl ContinueFlags {
             switch: self.switch,
             to: self.to,
         }
+    }
+}
+
+/// The flags of [`ImageRequest`]'s fields (generated from its schema).
+#[derive(Debug, Clone, Args)]
+pub struct ImageFlags {
+    /// `--setpoint`: the request's `setpoint`.
+    #[arg(long, allow_hyphen_values = true, help = "Setpoint ratio A_sp/A₀ in (0, 1). With --mode peakforce the peak force the feedback holds instead, in N or with a unit (2nN).")]
+    pub setpoint: Quantity,
+    /// `--pixels`: the request's `pixels`.
+    #[arg(long, default_value = "64", help = "Pixels per line (default 64).")]
+    pub pixels: usize,
+    /// `--lines`: the request's `lines`.
+    #[arg(long, help = "Lines; not given: as many as pixels, 1 for a line map (Ly = 0).")]
+    pub lines: Option<usize>,
+    /// `--curve-points`: the request's `curve_points`.
+    #[arg(long, help = "Points of each material's approach curve (its z_c grid, the probe's default range; default 120, the approach's default). [default: 120]")]
+    pub curve_points: Option<usize>,
+}
+
+impl ImageFlags {
+    /// The [`ImageRequest`] of these flags (the library validates it); SI values when `si` (a probe).
+    ///
+    /// # Errors
+    /// [`CliError::Input`] for a number whose unit is of another dimension than its field's, or a unit without a probe (`si`).
+    pub fn request(&self, si: bool, mode_dim: Option<Dim>) -> Result<ImageRequest, CliError> {
+        Ok(ImageRequest {
+            curve_points: self.curve_points.unwrap_or(120),
+            lines: self.lines,
+            pixels: self.pixels,
+            setpoint: self.setpoint.value_in("setpoint", mode_dim, si)?,
+        })
+    }
+}
+
+/// The flags of [`PiScan`]'s fields (generated from its schema).
+#[derive(Debug, Clone, Args)]
+pub struct PiScanFlags {
+    /// `--scan-rate`: the request's `scan_rate`.
+    #[arg(long, allow_hyphen_values = true, value_name = "HZ", help = "Scan rate (Hz): lines (trace and retrace) per second; not given: a pixel lasts 5 loop time constants 1/K_I. Only with --feedback pi. With --probe a unit may follow (300kHz).")]
+    pub scan_rate: Option<Quantity>,
+    /// `--gains`: the request's `gains`.
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true, value_name = "P,I", help = "The gains (K_P, K_I): K_P ≥ 0 (m/m), K_I > 0 (1/s); not given: K_P = 0, K_I = 1/(4(τ_c + τ_L)), τ_c = 2Q/ω₀ the lever's amplitude time constant and τ_L the lock-in's. Only with --feedback pi.")]
+    pub gains: Option<Vec<f64>>,
+    /// `--time-constant`: the request's `time_constant`.
+    #[arg(long, allow_negative_numbers = true, value_name = "S", help = "The lock-in's low-pass time constant (s), ≥ 0 and at most 1 000 s (its physical range, section feedback); outside 1 µs–0.1 s the image warns of a likely unit slip. Not given: τ_c/4. Only with --feedback pi.")]
+    pub time_constant: Option<f64>,
+}
+
+impl PiScanFlags {
+    /// The [`PiScan`] of these flags (the library validates it); SI values when `si` (a probe).
+    ///
+    /// # Errors
+    /// [`CliError::Input`] for a number whose unit is of another dimension than its field's, or a unit without a probe (`si`), or a list of another length than its field's.
+    pub fn request(&self, si: bool) -> Result<PiScan, CliError> {
+        Ok(PiScan {
+            gains: numbers(self.gains.as_deref(), "gains", "P,I")?.map(|[v0, v1]| (v0, v1)),
+            scan_rate: quantity(self.scan_rate, "scan-rate", Dim::Frequency, si)?,
+            time_constant: self.time_constant,
+        })
+    }
+}
+
+/// The flags of some of `afmdyn::request::ReconstructRequest`'s fields (from its schema).
+#[derive(Debug, Clone, Args)]
+pub struct ReconstructFlags {
+    /// `--spring-constant`: the request's `spring_constant`.
+    #[arg(long, allow_negative_numbers = true, conflicts_with = "am", help = "Spring constant k (N/m), > 0. Required with a CSV; replaces the document's.")]
+    pub spring_constant: Option<f64>,
+    /// `--resonance-frequency`: the request's `resonance_frequency`.
+    #[arg(long, allow_hyphen_values = true, conflicts_with = "am", help = "Free resonance frequency f0 (Hz), > 0. Required with a CSV; replaces the document's. A unit may follow (300kHz).")]
+    pub resonance_frequency: Option<Quantity>,
+    /// `--amplitude`: the request's `amplitude`.
+    #[arg(long, allow_hyphen_values = true, conflicts_with = "am", help = "Oscillation amplitude A (m), > 0. Required with a CSV; replaces the document's. A unit may follow (20nm).")]
+    pub amplitude: Option<Quantity>,
+    /// `--inversion`: the request's `inversion`.
+    #[arg(long, default_value = "sader-jarvis", value_parser = ["sader-jarvis", "exact"], conflicts_with = "am", help = "The inversion: \"sader-jarvis\" (the default) or \"exact\".")]
+    pub inversion: String,
+}
+
+/// The flags of [`FitRequest`]'s fields (generated from its schema).
+#[derive(Debug, Clone, Args)]
+pub struct FitFlags {
+    /// `--data`: the request's `data`.
+    #[arg(long, required = true, value_name = "FILE.csv", help = "A CSV file, read through the bounded reader (instead of the columns height and force). A force curve: the columns height (m, the piezo height, decreasing into the sample), force (N, repulsion positive) and optionally sigma (N, each force's standard deviation) and time (s, strictly increasing; needed by the sls law). A dynamic curve: z (m, the piezo position, in the order stepped) with amplitude (m) and/or phase (deg) (AM), or frequency_shift (Hz) (FM, at the probe's free amplitude), or amplitude_2 (m) and/or phase_2 (deg) (bimodal, a probe with a second drive component), each with an optional sigma_<column>.")]
+    pub data: Option<String>,
+    /// `--fit`: the request's `fit`.
+    #[arg(long, default_values = ["sample.youngs_modulus", "contact_point"], value_delimiter = ',', help = "The parameters fitted, by their probe keys: sample.youngs_modulus, tip.radius, contact_point, baseline, and sample.hamaker (DMT) or sample.adhesion_energy (JKR); of the sls law sample.stiffness, sample.maxwell_stiffness, sample.relaxation_time (N/m, N/m, s), contact_point and baseline. The others are held at the probe's values (contact point and baseline at 0, after the preprocessing). Default sample.youngs_modulus, contact_point (for sls: its three, contact_point and baseline). Of an AM, FM or bimodal curve: sample.youngs_modulus, sample.hamaker (DMT), tip.radius and z_offset (always fitted); default sample.youngs_modulus, sample.hamaker (DMT) and z_offset.")]
+    pub fit: Vec<String>,
+    /// `--segment`: the request's `segment`.
+    #[arg(long, value_parser = ["approach", "retract", "whole"], help = "The segment fitted: approach, retract or whole; default the approach, the whole curve for the sls law.")]
+    pub segment: Option<String>,
+    /// `--range`: the request's `range`.
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true, value_name = "LO,HI", help = "The range of tip positions fitted [lo, hi] (m, after the preprocessing's offset, as nanite's range_x); default the whole segment. With --probe a unit may follow (20nm).")]
+    pub range: Option<Vec<Quantity>>,
+    /// `--approach-rows`: the request's `approach_rows`.
+    #[arg(long, value_name = "N", help = "The number of rows of the approach (the rest is the retract), as an instrument records its segments (afmformats' segment column, which Python reads from an instrument file); default up to the lowest piezo height, inclusive. 1 to the number of rows.")]
+    pub approach_rows: Option<usize>,
+    /// `--profiles`: the request's `profiles`.
+    #[arg(long, conflicts_with = "no_profiles", help = "Profile-likelihood intervals (Δχ² ≤ 3.84) for the fitted parameters, up to 4 of them, the probe keys (sample, tip) before the contact point, baseline and z_offset (beyond, and when off, the Wald intervals ±1.96 SE). Default on for a force curve; off for an AM curve, where every profile point is a refit of stepped approaches (on, each side is walked by secants on √Δχ² in units of the standard error, at most 6 refits, each started from its neighbour; a side that has not risen by then is reported flat).")]
+    pub profiles: bool,
+    /// `--no-profiles`: the request's `profiles` false.
+    #[arg(long, help = "Turns --profiles off (not given: the default).")]
+    pub no_profiles: bool,
+}
+
+impl FitFlags {
+    /// The [`FitRequest`] of these flags (the library validates it); SI values when `si` (a probe).
+    ///
+    /// # Errors
+    /// [`CliError::Input`] for a number whose unit is of another dimension than its field's, or a unit without a probe (`si`), or a list of another length than its field's.
+    pub fn request(&self, si: bool) -> Result<FitRequest, CliError> {
+        Ok(FitRequest {
+            approach_rows: self.approach_rows,
+            data: self.data.clone(),
+            fit: self.fit.clone(),
+            profiles: either(self.profiles, self.no_profiles),
+            range: values(self.range.as_deref(), "range", "LO,HI", Dim::Length, si)?,
+            segment: self.segment.as_deref().map(|s| named(s, "segment")).transpose()?,
+            ..FitRequest::default()
+        })
     }
 }
 

@@ -6,10 +6,11 @@
 
 mod common;
 
+use afmdyn::request::image::ImageRequest;
 use afmdyn::request::{
     ApproachRequest, AttractorsRequest, BasinsRequest, BifurcationRequest, ChartRequest,
-    ContinuationRequest, ConvergeRequest, FmRequest, LyapunovRequest, OrbitRequest,
-    PeakForceRequest, ResonanceRequest, SimulateRequest,
+    ContinuationRequest, ConvergeRequest, FitRequest, FmRequest, LyapunovRequest, OrbitRequest,
+    PeakForceRequest, ReconstructRequest, ResonanceRequest, SimulateRequest,
 };
 use serde::Serialize;
 use serde_json::Value;
@@ -91,11 +92,36 @@ fn defaults_shown(cmd: &str, request: impl Serialize, skip: &[&str]) {
                     "{cmd} {flag}: {text}"
                 );
             }
+            // a list of names (`fit`'s parameters): clap shows the defaults space-separated
+            Value::Array(items) if items.iter().all(Value::is_string) => {
+                let text = find(&flag);
+                let shown = shown_default(text).unwrap_or_else(|| panic!("{cmd} {flag}: {text}"));
+                let want: Vec<&str> = items.iter().filter_map(Value::as_str).collect();
+                assert_eq!(
+                    shown.split(' ').collect::<Vec<_>>(),
+                    want,
+                    "{cmd} {flag}: {text}"
+                );
+            }
             Value::Array(_) | Value::Object(_) => panic!("{cmd}: {key} has no flag: skip it"),
         }
         checked += 1;
     }
     assert!(checked > 0, "{cmd}: no field checked");
+}
+
+/// `afmdyn cmd --help` has each of `flags` without a default: a value the command requires
+/// (`image --setpoint`) or takes from elsewhere when not given (`reconstruct`'s constants,
+/// from an fm document), whose request default (0) is no default of the command line's.
+fn without_default(cmd: &str, wanted: &[&str]) {
+    let flags = flags(cmd);
+    for flag in wanted {
+        let (_, text) = flags
+            .iter()
+            .find(|(f, _)| f == flag)
+            .unwrap_or_else(|| panic!("{cmd}: no {flag} in --help"));
+        assert_eq!(shown_default(text), None, "{cmd} {flag}: {text}");
+    }
 }
 
 #[test]
@@ -114,6 +140,29 @@ fn every_request_field_has_its_flag_and_the_request_default() {
     defaults_shown("continue", ContinuationRequest::default(), &["initial"]);
     defaults_shown("lyapunov", LyapunovRequest::default(), &["initial"]);
     defaults_shown("peakforce", PeakForceRequest::default(), &["fit_band"]);
+    // the setpoint is required (the default request's 0.5 only exemplifies it)
+    defaults_shown("image", ImageRequest::default(), &["setpoint"]);
+    without_default("image", &["--setpoint"]);
+    defaults_shown("image", afmdyn::request::image_scan::PiScan::default(), &[]);
+    // the curve's columns come from --fm FILE; k, f0 and A from it too unless given
+    let constants = ["spring_constant", "resonance_frequency", "amplitude"];
+    let columns = ["distance", "z_c", "frequency_shift"];
+    defaults_shown(
+        "reconstruct",
+        ReconstructRequest::default(),
+        &[&columns[..], &constants[..]].concat(),
+    );
+    without_default(
+        "reconstruct",
+        &["--spring-constant", "--resonance-frequency", "--amplitude"],
+    );
+    // the curve's columns come from --data FILE.csv
+    defaults_shown(
+        "fit",
+        FitRequest::default(),
+        &["height", "force", "sigma", "time"],
+    );
+    without_default("fit", &["--no-profiles"]);
 }
 
 #[test]
@@ -125,4 +174,99 @@ fn a_boolean_on_by_default_is_turned_off_by_its_no_flag() {
     assert!(branches(&common::json(&args)) > 0);
     let off = common::json(&[&args[..], &["--no-branches"]].concat());
     assert_eq!(branches(&off), 0, "{}", off["branches"]);
+}
+
+#[test]
+fn an_optional_boolean_takes_on_off_or_the_default() {
+    // `fit`'s `profiles: Option<bool>`: a force curve has profile-likelihood intervals by
+    // default (`None`), Wald intervals with `--no-profiles` (`Some(false)`); the two flags
+    // together are refused
+    let args = [
+        "fit",
+        "--probe",
+        "examples/probe-fit-hertz.toml",
+        "--data",
+        "examples/force-curve-hertz.csv",
+        "--files",
+        "none",
+        "--json",
+    ];
+    let method = |extra: &[&str]| {
+        let doc = common::json(&[&args[..], extra].concat());
+        doc["method"].as_str().unwrap().to_string()
+    };
+    assert!(
+        method(&[]).contains("profile likelihood"),
+        "{}",
+        method(&[])
+    );
+    assert!(method(&["--profiles"]).contains("profile likelihood"));
+    let off = method(&["--no-profiles"]);
+    assert!(
+        off.contains("Wald") && !off.contains("profile likelihood"),
+        "{off}"
+    );
+    let both = common::run(&[&args[..], &["--profiles", "--no-profiles"]].concat());
+    assert!(!both.status.success(), "--profiles with --no-profiles");
+}
+
+#[test]
+fn enum_names_unit_lists_and_a_mode_setpoint_read_as_the_library_does() {
+    // `reconstruct --inversion exact`: the library's exact inversion, whose document records
+    // its iterations under "exact"; the default (Sader–Jarvis) has none
+    let fm = [
+        "reconstruct",
+        "--fm",
+        "examples/fm-vdw.csv",
+        "--spring-constant",
+        "40",
+        "--resonance-frequency",
+        "300kHz",
+        "--amplitude",
+        "10nm",
+        "--files",
+        "none",
+        "--json",
+    ];
+    assert!(common::json(&fm).get("exact").is_none());
+    let exact = common::json(&[&fm[..], &["--inversion", "exact"]].concat());
+    assert!(exact["exact"]["iterations"].as_u64().is_some(), "{exact}");
+    common::refused(
+        &[&fm[..], &["--inversion", "newton"]].concat(),
+        &["--inversion"],
+    );
+    // `fit --range LO,HI` (x-dim length): 20 nm and 2e-8 are the same range
+    let fit = |range: &str| {
+        let args = [
+            "fit",
+            "--probe",
+            "examples/probe-fit-hertz.toml",
+            "--data",
+            "examples/force-curve-hertz.csv",
+            "--files",
+            "none",
+            "--json",
+            range,
+        ];
+        common::json(&args)
+    };
+    let (si, units) = (fit("--range=-2e-8,2e-7"), fit("--range=-20nm,200nm"));
+    assert_eq!(si["range"], serde_json::json!([-2e-8, 2e-7]));
+    assert_eq!(si["range"], units["range"]);
+    assert_eq!(si["rows_fitted"], units["rows_fitted"]);
+    // `image --setpoint` (x-dim mode): a plain ratio in AM, a unit refused by name
+    common::refused(
+        &[
+            "image",
+            "--probe",
+            "examples/probe-point-mass-dmt.toml",
+            "--sample",
+            "examples/sample-stripe.toml",
+            "--setpoint",
+            "2nN",
+            "--files",
+            "none",
+        ],
+        &["--setpoint", "plain number"],
+    );
 }

@@ -80,6 +80,10 @@ fn schemas() -> Vec<(&'static str, Value)> {
             schema::<afmdyn::request::PeakForceRequest>("peakforce"),
         ),
         ("image", schema::<ImageRequest>("image")),
+        (
+            "image_scan",
+            schema::<afmdyn::request::image_scan::PiScan>("image_scan"),
+        ),
         ("fit", schema::<afmdyn::request::FitRequest>("fit")),
     ]
 }

@@ -313,7 +313,7 @@ def image(
         progress: ``None`` (a bar for runs over a second in a terminal or Jupyter, none in a
             log), ``True`` (a bar at once), ``False`` or ``callable(done, total)``.
         curve_points: Points of each material's approach curve (its z_c grid, the probe's
-            default range; default 120, the approach's
+            default range; default 120, the approach's default:
             ``analysis::stepped::DEFAULT_CURVE_POINTS``).
         lines: Lines; ``None``: as many as pixels, 1 for a line map (Ly = 0)
             (``ImageRequest::lines``).

@@ -782,7 +782,10 @@ def fit(
             ``contact_point`` and ``baseline``. The others are held at the probe's values
             (contact point and baseline at 0, after the preprocessing). Default
             ``sample.youngs_modulus``, ``contact_point`` (for ``sls``: its three,
-            ``contact_point`` and ``baseline``).
+            ``contact_point`` and ``baseline``). Of an AM, FM or bimodal curve:
+            ``sample.youngs_modulus``, ``sample.hamaker`` (DMT), ``tip.radius`` and
+            ``z_offset`` (always fitted); default ``sample.youngs_modulus``,
+            ``sample.hamaker`` (DMT) and ``z_offset``.
         profiles: Profile-likelihood intervals (Δχ² ≤ 3.84) for the fitted parameters, up to
             4 of them, the probe keys (sample, tip) before the contact point, baseline and
             z_offset (beyond, and when off, the Wald intervals ±1.96 SE). Default on for a
@@ -872,7 +875,7 @@ def image(
         setpoint: Setpoint ratio A_sp/A₀ in (0, 1). With ``mode="peakforce"`` the peak force
             (N).
         curve_points: Points of each material's approach curve (its z_c grid, the probe's
-            default range; default 120, the approach's
+            default range; default 120, the approach's default:
             ``analysis::stepped::DEFAULT_CURVE_POINTS``).
         lines: Lines; ``None``: as many as pixels, 1 for a line map (Ly = 0)
             (``ImageRequest::lines``).
@@ -1015,7 +1018,7 @@ def setpoint_study(
             for TOML text).
         ratios: the setpoints A_sp/A0 in (0, 1).
         curve_points: Points of each material's approach curve (its z_c grid, the probe's
-            default range; default 120, the approach's
+            default range; default 120, the approach's default:
             ``analysis::stepped::DEFAULT_CURVE_POINTS``).
 
     Returns:

@@ -47,7 +47,8 @@ pub enum FitSegment {
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(default, deny_unknown_fields)]
 pub struct FitRequest {
-    /// A CSV file, read through the bounded reader; excludes `height` and `force`. A force
+    /// A CSV file, read through the bounded reader (instead of the columns `height` and
+    /// `force`). A force
     /// curve: the columns `height` (m, the piezo height, decreasing into the sample), `force`
     /// (N, repulsion positive) and optionally `sigma` (N, each force's standard deviation) and
     /// `time` (s, strictly increasing; needed by the `sls` law). A
@@ -72,13 +73,16 @@ pub struct FitRequest {
     /// `sample.relaxation_time` (N/m, N/m, s), `contact_point` and `baseline`. The others are
     /// held at the probe's values (contact point and baseline at 0, after the preprocessing).
     /// Default `sample.youngs_modulus`, `contact_point` (for `sls`: its three, `contact_point`
-    /// and `baseline`).
+    /// and `baseline`). Of an AM, FM or bimodal curve: `sample.youngs_modulus`,
+    /// `sample.hamaker` (DMT), `tip.radius` and `z_offset` (always fitted); default
+    /// `sample.youngs_modulus`, `sample.hamaker` (DMT) and `z_offset`.
     pub fit: Vec<String>,
     /// The segment fitted: `approach`, `retract` or `whole`; default the approach, the whole
     /// curve for the `sls` law.
     pub segment: Option<FitSegment>,
     /// The range of tip positions fitted [lo, hi] (m, after the preprocessing's offset, as
     /// nanite's `range_x`); default the whole segment.
+    #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "length")))]
     pub range: Option<[f64; 2]>,
     /// The number of rows of the approach (the rest is the retract), as an instrument records
     /// its segments (afmformats' `segment` column, which Python reads from an instrument

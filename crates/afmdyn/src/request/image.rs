@@ -90,14 +90,28 @@ pub struct SampleMap {
 #[serde(deny_unknown_fields)]
 pub struct ImageRequest {
     /// Setpoint ratio A_sp/A₀ in (0, 1).
+    #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "mode")))]
     pub setpoint: f64,
     /// Pixels per line (default 64).
+    #[serde(default = "default_pixels")]
     pub pixels: usize,
     /// Lines; `None`: as many as pixels, 1 for a line map (Ly = 0) ([`ImageRequest::lines`]).
     pub lines: Option<usize>,
     /// Points of each material's approach curve (its z_c grid, the probe's default range;
-    /// default 120, the approach's [`crate::analysis::stepped::DEFAULT_CURVE_POINTS`]).
+    /// default 120, the approach's default: [`crate::analysis::stepped::DEFAULT_CURVE_POINTS`]).
+    #[serde(default = "default_curve_points")]
     pub curve_points: usize,
+}
+
+/// [`ImageRequest::pixels`]' default: 64.
+fn default_pixels() -> usize {
+    64
+}
+
+/// [`ImageRequest::curve_points`]' default: the approach's
+/// ([`crate::analysis::stepped::DEFAULT_CURVE_POINTS`]).
+fn default_curve_points() -> usize {
+    crate::analysis::stepped::DEFAULT_CURVE_POINTS
 }
 
 impl Default for ImageRequest {
@@ -112,9 +126,9 @@ impl ImageRequest {
     pub fn at(setpoint: f64) -> ImageRequest {
         ImageRequest {
             setpoint,
-            pixels: 64,
+            pixels: default_pixels(),
             lines: None,
-            curve_points: crate::analysis::stepped::DEFAULT_CURVE_POINTS,
+            curve_points: default_curve_points(),
         }
     }
 

@@ -55,8 +55,10 @@ pub struct ReconstructRequest {
     /// Spring constant k (N/m), > 0.
     pub spring_constant: f64,
     /// Free resonance frequency f0 (Hz), > 0.
+    #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "frequency")))]
     pub resonance_frequency: f64,
     /// Oscillation amplitude A (m), > 0.
+    #[cfg_attr(feature = "schema", schemars(extend("x-dim" = "length")))]
     pub amplitude: f64,
     /// The model's force at each distance (N), when the curve came from a model (an `fm`
     /// document's `curve.law_force`): reported beside the reconstruction for comparison.
