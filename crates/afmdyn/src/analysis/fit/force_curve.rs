@@ -33,7 +33,6 @@
 //! ∂F/∂k_H = F_c/k_H exactly for Hertz, and by central differences of relative step 1e-6 on
 //! DMT's and JKR's groups (error ~1e-12 relative), chained to E_s, R, H and W analytically.
 
-use super::sls_curve::{MAXWELL_STIFFNESS, RELAXATION_TIME, STIFFNESS};
 use crate::contact::{reduced_modulus, DmtLaw, HertzLaw, Jkr, JkrLaw, Law};
 
 /// The force-curve laws the fit takes.
@@ -99,6 +98,12 @@ pub const BASELINE: &str = "baseline";
 pub const HAMAKER: &str = "sample.hamaker";
 /// `sample.adhesion_energy` (J/m²), JKR's work of adhesion W.
 pub const ADHESION: &str = "sample.adhesion_energy";
+/// `sample.stiffness` (N/m): the SLS's relaxed spring k₁ ([`super::sls_curve`]).
+pub const STIFFNESS: &str = "sample.stiffness";
+/// `sample.maxwell_stiffness` (N/m): the SLS Maxwell arm's spring k₂.
+pub const MAXWELL_STIFFNESS: &str = "sample.maxwell_stiffness";
+/// `sample.relaxation_time` (s): the SLS Maxwell arm's τ = η/k₂.
+pub const RELAXATION_TIME: &str = "sample.relaxation_time";
 
 /// Which part of the curve.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -47,12 +47,7 @@
 
 use super::CurveModel;
 
-/// `sample.stiffness` (N/m): the relaxed spring k₁.
-pub const STIFFNESS: &str = "sample.stiffness";
-/// `sample.maxwell_stiffness` (N/m): the Maxwell arm's spring k₂.
-pub const MAXWELL_STIFFNESS: &str = "sample.maxwell_stiffness";
-/// `sample.relaxation_time` (s): the Maxwell arm's τ = η/k₂.
-pub const RELAXATION_TIME: &str = "sample.relaxation_time";
+pub use super::force_curve::{MAXWELL_STIFFNESS, RELAXATION_TIME, STIFFNESS};
 
 /// The parameters the SLS fit frees by default: its three, the contact point and the baseline.
 /// The baseline is freed because the preprocessing's force offset (the mean force before the
