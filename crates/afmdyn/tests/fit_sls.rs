@@ -408,3 +408,33 @@ fn the_intervals_cover_the_truth_over_noise_draws() {
         assert!((90..=99).contains(c), "{name}: {c} of {draws} covered");
     }
 }
+
+#[test]
+fn a_curve_that_starts_in_contact_is_said_to() {
+    // the recorded curve from its 600th row (the piezo already 0.2 µm into the sample): the
+    // sample is not at rest at the first row; the fit puts the tip on it there, and says so
+    let (height, force, time) = recorded(50e-12, 5);
+    let request = FitRequest {
+        height: height[600..].to_vec(),
+        force: force[600..].to_vec(),
+        time: time[600..].to_vec(),
+        ..FitRequest::default()
+    };
+    let doc = run(&request, &probe(), &Progress::default()).expect("fit");
+    let warned = doc.json["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .any(|w| w.as_str().unwrap().contains("in contact at its first row"));
+    assert!(warned, "{}", doc.json["warnings"]);
+    // and the whole curve does not warn so
+    let (height, force, time) = recorded(50e-12, 5);
+    let request = FitRequest {
+        height,
+        force,
+        time,
+        ..FitRequest::default()
+    };
+    let doc = run(&request, &probe(), &Progress::default()).expect("fit");
+    assert!(!doc.json["warnings"].to_string().contains("first row"));
+}

@@ -454,8 +454,8 @@ impl Analysis for FitRequest {
             .map(|(p, f)| (!f).then_some(p.start))
             .collect();
         // the SLS's force depends on every row before (its history from the first row)
-        let m: Box<dyn CurveModel> = match (law, &curve.time) {
-            (ForceLaw::Sls, Some(t)) => Box::new(SlsCurveModel {
+        let sls = match (law, &curve.time) {
+            (ForceLaw::Sls, Some(t)) => Some(SlsCurveModel {
                 // the piezo's height in the preprocessed frame, free of the force's noise
                 height: (curve.tip_position.iter().zip(&curve.force))
                     .map(|(x, f)| x - f / k)
@@ -464,6 +464,10 @@ impl Analysis for FitRequest {
                 spring_constant: k,
                 rows: rows.clone(),
             }),
+            _ => None,
+        };
+        let m: Box<dyn CurveModel> = match &sls {
+            Some(model) => Box::new(model.clone()),
             _ => Box::new(ForceCurveModel {
                 law,
                 x,
@@ -482,7 +486,21 @@ impl Analysis for FitRequest {
             sigma: sig.as_deref(),
         };
         let walk = self.profiles.unwrap_or(true).then_some(ProfileWalk::Grid);
-        let outcome = fit_cancellable(m.as_ref(), &obs, &params, &fixed, walk, progress)?;
+        let mut outcome = fit_cancellable(m.as_ref(), &obs, &params, &fixed, walk, progress)?;
+        // the SLS starts from rest at the first row: a fit that puts the tip on the sample
+        // there broke that assumption
+        if let Some(model) = &sls {
+            let mut f = vec![0.0; model.height.len()];
+            model.forces(&outcome.values, &mut f, None);
+            if f.first().is_some_and(|f| *f > 0.0) {
+                outcome.warnings.push(format!(
+                    "the fitted curve is in contact at its first row ({:.3e} N): the sls model \
+                     starts the sample at rest there, so a curve that starts on the surface is \
+                     misfitted; record the approach from off the surface",
+                    f[0]
+                ));
+            }
+        }
         Ok(FitResult {
             law,
             spring_constant: k,
