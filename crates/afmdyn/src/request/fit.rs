@@ -272,7 +272,9 @@ impl FitRequest {
             }
         }
         if self.data.is_none() {
-            let time = (!self.time.is_empty()).then_some(self.time.as_slice());
+            // (the times matter, and are checked, for the sls law only)
+            let time = (law == ForceLaw::Sls && !self.time.is_empty())
+                .then_some(self.time.as_slice());
             check_columns(&self.height, &self.force, self.sigma.as_deref(), time)?;
         }
         Ok(law)
@@ -355,6 +357,8 @@ impl Analysis for FitRequest {
         }
         let law = self.check(model)?;
         let (height, force, sigma, time) = self.columns()?;
+        // (the times matter, and are checked, for the sls law only)
+        let time = time.filter(|_| law == ForceLaw::Sls);
         check_columns(&height, &force, sigma.as_deref(), time.as_deref())?;
         let probe = model.probe.as_ref().expect("checked");
         let k = probe.calibration.spring_constant;
