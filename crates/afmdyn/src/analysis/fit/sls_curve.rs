@@ -1,8 +1,7 @@
 //! The standard linear solid's force curve: the registry's `sls` law
-//! ([`crate::contact::sls`]) driven by a measured indentation history — approach, dwell and
-//! retract — in time, for the quasi-static force-curve fit ([`super::force_curve`]'s
-//! preprocessing gives the tip position x and the force of every row; the rows' times come
-//! from the data).
+//! ([`crate::contact::sls`]) under a recorded approach, dwell and retract, in time, for the
+//! quasi-static force-curve fit ([`super::force_curve`]'s preprocessing gives the tip position
+//! x and the force of every row, hence the piezo height; the rows' times come from the data).
 //!
 //! # Model
 //! The sample is the law's Zener solid in SI (López-Guerra & Solares, *Beilstein J.
