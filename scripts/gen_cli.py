@@ -174,6 +174,14 @@ STRUCTS: Dict[str, Dict[str, object]] = {
         "args": {"scan_rate": 'value_name = "HZ"', "gains": 'value_name = "P,I"',
                  "time_constant": 'value_name = "S"'},
     },
+    # `image`'s options (mode, feedback, threads, setpoint study), checked together by the
+    # library (`ImageOptions::check`)
+    "ImageOptionsFlags": {
+        "schema": "image_options",
+        "module": "image_options",
+        "order": ["mode", "feedback", "threads", "setpoint_study"],
+        "args": {"setpoint_study": 'value_name = "FROM:TO:N"'},
+    },
     # `reconstruct`: k, f0 and A come from an fm document unless given; the curve's columns
     # from the file (`--fm`); the command builds the request
     "ReconstructFlags": {

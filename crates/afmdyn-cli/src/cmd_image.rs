@@ -12,10 +12,11 @@ use crate::cmd_approach::files;
 use crate::cmd_simulate::Files;
 use crate::door::{self, Exit};
 use crate::error::CliError;
-use crate::flags::{ImageFlags, PiScanFlags};
+use crate::flags::{ImageFlags, ImageOptionsFlags, PiScanFlags};
 use crate::output::{units_of, OutDir};
-use afmdyn::request::image::{study_ratios, SampleMap};
+use afmdyn::request::image::SampleMap;
 use afmdyn::request::image_job::{ImageJob, ImageMode};
+use afmdyn::request::image_options::ImageFeedback;
 use afmdyn::request::Analysis;
 use clap::Args;
 use std::path::PathBuf;
@@ -42,21 +43,12 @@ pub struct ImageArgs {
     /// The image request's flags: --setpoint, --pixels, --lines, --curve-points
     #[command(flatten)]
     request: ImageFlags,
-    /// Imaging mode: am (amplitude-modulation tapping) or peakforce (off-resonance tapping with
-    /// an ideal peak-force feedback; a probe with [drive] mode = "off-resonance"): maps of
-    /// height, modulus_dmt, adhesion, deformation and dissipation
-    #[arg(long, default_value = "am")]
-    mode: String,
-    /// Feedback: ideal (an operating point of the local material at every pixel) or pi (a
-    /// time-domain scan, trace and retrace, under a lock-in and a PI z controller)
-    #[arg(long, default_value = "ideal")]
-    feedback: String,
+    /// The image's options: --mode, --feedback, --threads, --setpoint-study
+    #[command(flatten)]
+    options: ImageOptionsFlags,
     /// The PI scan's flags: --scan-rate, --gains, --time-constant
     #[command(flatten)]
     scan: PiScanFlags,
-    /// PI scan or PeakForce image: worker threads, one line per task (default: all cores)
-    #[arg(long)]
-    threads: Option<usize>,
     /// PI scan: continue an interrupted scan; refused unless the other arguments are those of
     /// the interrupted run (recorded in OUT/.image.run.json)
     #[arg(long)]
@@ -64,11 +56,6 @@ pub struct ImageArgs {
     /// Testing: abort the process, as if killed, after this many lines are stored
     #[arg(long, hide = true)]
     abort_after: Option<usize>,
-    /// Also the setpoint study FROM:TO:N (e.g. 0.2:0.95:16): every domain's apparent height,
-    /// phase and E_dis at N setpoints, as a line engaged on the background meets it (the
-    /// contrast inversion); "setpoint_study" in the document and two plots
-    #[arg(long, value_name = "FROM:TO:N")]
-    setpoint_study: Option<String>,
     /// Output directory (locked during the run)
     #[arg(long, default_value = "afmdyn-out/image")]
     out: PathBuf,
@@ -82,66 +69,44 @@ pub struct ImageArgs {
 
 /// Run `afmdyn image`.
 pub fn image_cmd(a: &ImageArgs) -> Result<(), CliError> {
-    let mode = match a.mode.as_str() {
-        "am" => ImageMode::Am,
-        "peakforce" => ImageMode::Peakforce,
-        other => {
-            return Err(CliError::Input(format!(
-                "--mode {other}: must be am or peakforce"
-            )))
-        }
-    };
+    let options = a.options.request()?;
+    // what else was given, for the library's one check of how the options combine
+    let given: Vec<(&'static str, String)> = [
+        (
+            "scan_rate",
+            a.scan.scan_rate.as_ref().map(|q| q.to_string()),
+        ),
+        (
+            "gains",
+            a.scan
+                .gains
+                .as_ref()
+                .map(|g| format!("{},{}", g[0], g.get(1).unwrap_or(&f64::NAN))),
+        ),
+        (
+            "time_constant",
+            a.scan.time_constant.as_ref().map(|q| q.to_string()),
+        ),
+        (
+            "curve_points",
+            a.request.curve_points.map(|n| n.to_string()),
+        ),
+        ("resume", a.resume.then(|| "true".to_string())),
+    ]
+    .into_iter()
+    .filter_map(|(k, v)| v.map(|v| (k, v)))
+    .collect();
+    options.check(&given)?;
+    let mode = options.mode;
     // the setpoint: a ratio A_sp/A0 (AM) or a peak force (PeakForce); the probe file is SI
     let setpoint_dim = match mode {
         ImageMode::Am => None,
         ImageMode::Peakforce => Some(Dim::Force),
     };
     let request = a.request.request(true, setpoint_dim)?;
-    if mode == ImageMode::Peakforce {
-        for (set, flag) in [
-            (a.feedback != "ideal", "--feedback"),
-            (a.setpoint_study.is_some(), "--setpoint-study"),
-            (a.request.curve_points.is_some(), "--curve-points"),
-        ] {
-            if set {
-                return Err(CliError::Input(format!(
-                    "{flag}: not with --mode peakforce (the ideal peak-force feedback only)"
-                )));
-            }
-        }
-    }
-    let pi = match a.feedback.as_str() {
-        "ideal" => {
-            for (set, flag) in [
-                (a.scan.scan_rate.is_some(), "--scan-rate"),
-                (a.scan.gains.is_some(), "--gains"),
-                (a.scan.time_constant.is_some(), "--time-constant"),
-                (a.threads.is_some() && mode == ImageMode::Am, "--threads"),
-                (a.resume, "--resume"),
-            ] {
-                if set {
-                    return Err(CliError::Input(format!(
-                        "{flag}: only with --feedback pi (the ideal feedback has no loop)"
-                    )));
-                }
-            }
-            None
-        }
-        "pi" => {
-            if a.setpoint_study.is_some() {
-                return Err(CliError::Input(
-                    "--setpoint-study: only with --feedback ideal (a study of exact operating \
-                     points)"
-                        .into(),
-                ));
-            }
-            Some(a.scan.request(true)?)
-        }
-        other => {
-            return Err(CliError::Input(format!(
-                "feedback = {other}: must be ideal or pi"
-            )))
-        }
+    let pi = match options.feedback {
+        ImageFeedback::Ideal => None,
+        ImageFeedback::Pi => Some(a.scan.request(true)?),
     };
     let text = crate::args::probe_text(&a.probe, a.cantilever.as_deref(), a.medium.as_deref())?;
     let table = afmdyn::probe::Probe::table(&text, &a.probe.display().to_string())?;
@@ -154,7 +119,7 @@ pub fn image_cmd(a: &ImageArgs) -> Result<(), CliError> {
         ImageMode::Am => request.validate(&map)?,
         ImageMode::Peakforce => request.validate_grid(&map)?,
     }
-    let study = a.setpoint_study.as_deref().map(study_ratios).transpose()?;
+    let study = options.study()?;
     let job = ImageJob {
         mode,
         probe: table,
@@ -162,7 +127,7 @@ pub fn image_cmd(a: &ImageArgs) -> Result<(), CliError> {
         request,
         feedback: pi,
         study,
-        threads: a.threads,
+        threads: options.threads,
         files: files(a.files),
     };
     let model = job.model()?;
@@ -203,7 +168,7 @@ fn pi_cmd(
         &study,
         &mut store,
         a.resume,
-        a.threads,
+        job.threads,
         "lines",
         a.abort_after,
     )

@@ -5,7 +5,7 @@
 
 use crate::args::{either, named, numbers, quantity, values, Dim, Quantity};
 use crate::error::CliError;
-use afmdyn::request::{ApproachRequest, AttractorsRequest, BasinsRequest, BifurcationRequest, ChartRequest, ContinuationRequest, ConvergeRequest, CurveRequest, FitRequest, FmRequest, IntegratorRequest, LyapunovRequest, OrbitRequest, PeakForceRequest, ResonanceRequest, SimulateRequest, StartRequest, SteadyRequest, image::ImageRequest, image_scan::PiScan};
+use afmdyn::request::{ApproachRequest, AttractorsRequest, BasinsRequest, BifurcationRequest, ChartRequest, ContinuationRequest, ConvergeRequest, CurveRequest, FitRequest, FmRequest, IntegratorRequest, LyapunovRequest, OrbitRequest, PeakForceRequest, ResonanceRequest, SimulateRequest, StartRequest, SteadyRequest, image::ImageRequest, image_options::ImageOptions, image_scan::PiScan};
 use clap::Args;
 
 /// The flags of [`CurveRequest`]'s fields (generated from its schema).
@@ -692,6 +692,38 @@ impl PiScanFlags {
             gains: numbers(self.gains.as_deref(), "gains", "P,I")?.map(|[v0, v1]| (v0, v1)),
             scan_rate: quantity(self.scan_rate, "scan-rate", Dim::Frequency, si)?,
             time_constant: self.time_constant,
+        })
+    }
+}
+
+/// The flags of [`ImageOptions`]'s fields (generated from its schema).
+#[derive(Debug, Clone, Args)]
+pub struct ImageOptionsFlags {
+    /// `--mode`: the request's `mode`.
+    #[arg(long, default_value = "am", value_parser = ["am", "peakforce"], help = "Imaging mode: am (amplitude-modulation tapping) or peakforce (off-resonance tapping with an ideal peak-force feedback; a probe with [drive] mode = \"off-resonance\"): maps of height, modulus_dmt, adhesion, deformation and dissipation.")]
+    pub mode: String,
+    /// `--feedback`: the request's `feedback`.
+    #[arg(long, default_value = "ideal", value_parser = ["ideal", "pi"], help = "Feedback: ideal (an operating point of the local material at every pixel) or pi (a time-domain scan, trace and retrace, under a lock-in and a PI z controller).")]
+    pub feedback: String,
+    /// `--threads`: the request's `threads`.
+    #[arg(long, help = "PI scan or PeakForce image: worker threads, one line per task (default: all cores).")]
+    pub threads: Option<usize>,
+    /// `--setpoint-study`: the request's `setpoint_study`.
+    #[arg(long, value_name = "FROM:TO:N", help = "Also the setpoint study FROM:TO:N (e.g. 0.2:0.95:16): every domain's apparent height, phase and E_dis at N setpoints, as a line engaged on the background meets it (the contrast inversion); \"setpoint_study\" in the document and two plots.")]
+    pub setpoint_study: Option<String>,
+}
+
+impl ImageOptionsFlags {
+    /// The [`ImageOptions`] of these flags (the library validates it).
+    ///
+    /// # Errors
+    /// [`CliError::Input`] for a number whose unit is of another dimension than its field's, or a unit without a probe (`si`).
+    pub fn request(&self) -> Result<ImageOptions, CliError> {
+        Ok(ImageOptions {
+            feedback: named(&self.feedback, "feedback")?,
+            mode: named(&self.mode, "mode")?,
+            setpoint_study: self.setpoint_study.clone(),
+            threads: self.threads,
         })
     }
 }

@@ -83,7 +83,37 @@ fn bad_input_exits_2_naming_the_field() {
     for (extra, want) in [
         (vec!["--setpoint", "1.5"], "setpoint"),
         (vec!["--setpoint", "0.7", "--feedback", "pid"], "feedback"),
-        (vec!["--setpoint", "0.7", "--scan-rate", "2"], "--scan-rate"),
+        // the library's one check of the image's options (ImageOptions::check)
+        (
+            vec!["--setpoint", "0.7", "--scan-rate", "2"],
+            "scan-rate = 2: only with feedback = pi",
+        ),
+        (
+            vec![
+                "--setpoint",
+                "0.7",
+                "--mode",
+                "peakforce",
+                "--feedback",
+                "pi",
+            ],
+            "feedback = pi: not with mode = peakforce",
+        ),
+        (
+            vec![
+                "--setpoint",
+                "0.7",
+                "--feedback",
+                "pi",
+                "--setpoint-study",
+                "0.3:0.9:3",
+            ],
+            "setpoint-study = 0.3:0.9:3: only with feedback = ideal",
+        ),
+        (
+            vec!["--setpoint", "0.7", "--threads", "2"],
+            "threads = 2: only with feedback = pi",
+        ),
         (
             vec!["--setpoint", "0.7", "--feedback", "pi", "--gains", "-1,10"],
             "gains",

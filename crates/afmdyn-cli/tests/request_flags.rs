@@ -144,6 +144,11 @@ fn every_request_field_has_its_flag_and_the_request_default() {
     defaults_shown("image", ImageRequest::default(), &["setpoint"]);
     without_default("image", &["--setpoint"]);
     defaults_shown("image", afmdyn::request::image_scan::PiScan::default(), &[]);
+    defaults_shown(
+        "image",
+        afmdyn::request::image_options::ImageOptions::default(),
+        &[],
+    );
     // the curve's columns come from --fm FILE; k, f0 and A from it too unless given
     let constants = ["spring_constant", "resonance_frequency", "amplitude"];
     let columns = ["distance", "z_c", "frequency_shift"];

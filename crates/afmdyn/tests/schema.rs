@@ -84,6 +84,10 @@ fn schemas() -> Vec<(&'static str, Value)> {
             "image_scan",
             schema::<afmdyn::request::image_scan::PiScan>("image_scan"),
         ),
+        (
+            "image_options",
+            schema::<afmdyn::request::image_options::ImageOptions>("image_options"),
+        ),
         ("fit", schema::<afmdyn::request::FitRequest>("fit")),
     ]
 }

@@ -273,8 +273,8 @@ impl FitRequest {
         }
         if self.data.is_none() {
             // (the times matter, and are checked, for the sls law only)
-            let time = (law == ForceLaw::Sls && !self.time.is_empty())
-                .then_some(self.time.as_slice());
+            let time =
+                (law == ForceLaw::Sls && !self.time.is_empty()).then_some(self.time.as_slice());
             check_columns(&self.height, &self.force, self.sigma.as_deref(), time)?;
         }
         Ok(law)

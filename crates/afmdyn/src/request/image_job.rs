@@ -28,6 +28,7 @@ use serde_json::Value;
 
 /// The imaging mode: amplitude-modulation (AM) tapping or off-resonance (PeakForce) tapping.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[serde(rename_all = "lowercase")]
 pub enum ImageMode {
     /// AM-AFM: the amplitude feedback at the setpoint ratio A_sp/A₀ ([`super::image`],

@@ -52,6 +52,7 @@ pub mod fit_result;
 pub mod image;
 pub mod image_job;
 pub mod image_layout;
+pub mod image_options;
 pub mod image_peakforce;
 pub mod image_scan;
 pub mod keywords;
