@@ -172,6 +172,7 @@ fn bimodal_probe() -> AmProbe {
         ),
         hamaker: s.hamaker.unwrap_or(0.0),
         radius: s.radius.expect("R"),
+        damping_unit: p.scales.length_m / (p.scales.time_s * p.scales.force_n),
     }
 }
 

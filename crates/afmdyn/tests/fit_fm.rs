@@ -37,6 +37,7 @@ fn fm_probe(name: &str, hertz: bool) -> (AmProbe, f64) {
         ),
         hamaker: if hertz { 0.0 } else { s.hamaker.unwrap_or(0.0) },
         radius: s.radius.expect("R"),
+        damping_unit: p.scales.length_m / (p.scales.time_s * p.scales.force_n),
     };
     (probe, p.scales.frequency_hz(1.0))
 }
@@ -56,6 +57,7 @@ fn truth(probe: &AmProbe, params: &[AmParam], z_offset: f64) -> Vec<f64> {
             AmParam::Hamaker => probe.hamaker,
             AmParam::ZOffset => z_offset,
             AmParam::TipRadius => probe.radius,
+            AmParam::Damping => probe.params.alpha6 / probe.damping_unit,
         })
         .collect()
 }
