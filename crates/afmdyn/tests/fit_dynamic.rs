@@ -637,6 +637,22 @@ fn fit_through_the_door(
     fit: &[&str],
     tag: &str,
 ) -> serde_json::Value {
+    let p = Probe::load(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/probe-point-mass-dmt.toml"),
+    )
+    .expect("probe");
+    door(p, model, y, sigma, fit, tag).expect("fit")
+}
+
+/// [`fit_through_the_door`] under the probe `p`: the document, or the request's error.
+fn door(
+    p: Probe,
+    model: &AmCurveModel,
+    y: &[f64],
+    sigma: &[f64],
+    fit: &[&str],
+    tag: &str,
+) -> Result<serde_json::Value, afmdyn::SimError> {
     use afmdyn::analysis::progress::Progress;
     use afmdyn::request::fit::FitRequest;
     use afmdyn::request::{run, Resolved};
@@ -668,10 +684,6 @@ fn fit_through_the_door(
         text.push('\n');
     }
     std::fs::write(&path, text).expect("csv");
-    let p = Probe::load(
-        &Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/probe-point-mass-dmt.toml"),
-    )
-    .expect("probe");
     let resolved = Resolved {
         params: p.params,
         probe: Some(p),
@@ -681,9 +693,7 @@ fn fit_through_the_door(
         fit: fit.iter().map(|n| n.to_string()).collect(),
         ..FitRequest::default()
     };
-    let doc = run(&request, &resolved, &Progress::default())
-        .expect("fit")
-        .json;
+    let doc = run(&request, &resolved, &Progress::default()).map(|o| o.json);
     std::fs::remove_dir_all(&dir).ok();
     doc
 }
@@ -889,4 +899,81 @@ fn a_noisy_damped_hertz_am_curve_gives_back_the_damping() {
         "χ²/dof {}",
         out.chi2_dof
     );
+}
+
+/// The point-mass example's text as a Hertz sample with `[sample] damping` = `damping`
+/// (N s/m; `None`: no damping key), through `Probe::parse`.
+fn hertz_probe_text(damping: Option<f64>) -> Probe {
+    let path =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/probe-point-mass-dmt.toml");
+    let text = std::fs::read_to_string(&path).expect("example probe");
+    let mut out = String::new();
+    for line in text.lines() {
+        let key = line.split('=').next().unwrap_or("").trim();
+        match key {
+            "hamaker" | "intermolecular_distance" | "viscosity" => continue,
+            "law" => out += "law = \"hertz\"\n",
+            _ => out += &format!("{line}\n"),
+        }
+    }
+    if let Some(c) = damping {
+        out = out.replace(
+            "law = \"hertz\"\n",
+            &format!("law = \"hertz\"\ndamping = {c:?}\n"),
+        );
+    }
+    Probe::parse(&out, "hertz-damped").expect("hertz probe")
+}
+
+/// Through the door: `sample.damping` of a Hertz probe, from the probe's c (the truth) and from
+/// an undamped probe's c = 0 (scaled by the c whose α6 is 1 % of α4), comes back inside its
+/// 95 % interval with E and z_offset (z_offset from its start grid); the document gives its
+/// unit. `sample.viscosity` (DMT's η) and the damper of a DMT probe are refused, naming
+/// `sample.damping`.
+#[test]
+fn the_door_fits_the_hertz_damping() {
+    let ps = vec![AmParam::Damping, AmParam::YoungsModulus, AmParam::ZOffset];
+    let (model, y, sigma, truth) =
+        synthetic_of(damped_hertz_probe(), 100, (1.0, 0.5), ps, (true, true), 6);
+    let names = ["sample.damping", "sample.youngs_modulus", "z_offset"];
+    let c = truth[0];
+    let damped = hertz_probe_text(Some(c));
+    assert!(
+        (damped.params.alpha6 - HERTZ_ALPHA6).abs() <= 1e-12 * HERTZ_ALPHA6,
+        "the probe's α6 {} (c = {c:e} N s/m)",
+        damped.params.alpha6
+    );
+    for (what, probe) in [("from c", damped), ("from 0", hertz_probe_text(None))] {
+        let doc = door(probe, &model, &y, &sigma, &names, "fit-damping").expect("fit");
+        let chi2_dof = doc["chi2_dof"].as_f64().unwrap();
+        eprintln!(
+            "{what}: χ²/dof {chi2_dof:.3}, {}",
+            doc["estimates"]["sample.damping"]
+        );
+        assert!(
+            chi2_dof < 1.5,
+            "{what}: χ²/dof = {chi2_dof}: {}",
+            doc["warnings"]
+        );
+        for (name, t) in names.iter().zip(&truth) {
+            let [lo, hi] = interval(&doc, name);
+            assert!(
+                lo <= *t && *t <= hi,
+                "{what} {name}: {t} outside [{lo}, {hi}]"
+            );
+        }
+        assert_eq!(doc["units"]["sample.damping"], "N s/m");
+    }
+    let refused = |p: Probe, fit: &str| {
+        let e = door(p, &model, &y, &sigma, &[fit], "fit-damping-refused")
+            .expect_err("refused")
+            .to_string();
+        assert!(e.contains("sample.damping"), "{fit}: {e}");
+    };
+    refused(hertz_probe_text(Some(c)), "sample.viscosity");
+    let dmt = Probe::load(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/probe-point-mass-dmt.toml"),
+    )
+    .expect("probe");
+    refused(dmt, "sample.damping");
 }
