@@ -172,6 +172,7 @@ fn bimodal_probe() -> AmProbe {
         ),
         hamaker: s.hamaker.unwrap_or(0.0),
         radius: s.radius.expect("R"),
+        damping_unit: p.scales.length_m / (p.scales.time_s * p.scales.force_n),
     }
 }
 
@@ -182,13 +183,33 @@ fn bimodal_probe() -> AmProbe {
 #[test]
 fn the_bimodal_models_jacobian_is_its_finite_differences() {
     let probe = bimodal_probe();
+    let params = vec![AmParam::YoungsModulus, AmParam::Hamaker, AmParam::ZOffset];
+    let truth = vec![probe.youngs_modulus, probe.hamaker, 1e-9];
+    check_jacobian(probe, params, truth);
+}
+
+/// As [`the_bimodal_models_jacobian_is_its_finite_differences`], of the Hertz damper
+/// `sample.damping` (with E and z_offset) on the bimodal probe as a damped Hertz sample
+/// (α6 = 0.05, c = α6/(g₀/(t_s F_s))): A₂ and φ₂ feel the contact's dissipation too.
+#[test]
+fn the_bimodal_models_damping_column_is_its_finite_differences() {
+    let mut probe = bimodal_probe();
+    probe.params.contact_law = afmdyn::contact::ContactLaw::Hertz;
+    probe.params.alpha6 = 0.05;
+    probe.hamaker = 0.0;
+    let params = vec![AmParam::Damping, AmParam::YoungsModulus, AmParam::ZOffset];
+    let c = probe.params.alpha6 / probe.damping_unit;
+    let truth = vec![c, probe.youngs_modulus, 1e-9];
+    check_jacobian(probe, params, truth);
+}
+
+/// The bimodal model's Jacobian at `truth` (z_offset last) against its central differences.
+fn check_jacobian(probe: AmProbe, params: Vec<AmParam>, truth: Vec<f64>) {
     let g0 = probe.length_m;
-    let z_offset = 1e-9;
+    let z_offset = truth[truth.len() - 1];
     let z: Vec<f64> = (0..10)
         .map(|i| g0 * (0.9 - 0.05 * i as f64) - z_offset)
         .collect();
-    let params = vec![AmParam::YoungsModulus, AmParam::Hamaker, AmParam::ZOffset];
-    let truth = vec![probe.youngs_modulus, probe.hamaker, z_offset];
     let model = BimodalCurveModel::new(probe, z, [true, true, true, true], params);
     let (m, n) = (model.points(), truth.len());
     assert_eq!(m, 40);
@@ -198,7 +219,7 @@ fn the_bimodal_models_jacobian_is_its_finite_differences() {
     eprintln!("warnings {:?}", model.warnings());
     assert!(v.iter().all(|x| x.is_finite()), "{v:?}");
     for k in 0..n {
-        let h = if k == 2 {
+        let h = if model.params[k] == AmParam::ZOffset {
             1e-4 * g0
         } else {
             1e-4 * truth[k].abs()

@@ -37,6 +37,7 @@ fn fm_probe(name: &str, hertz: bool) -> (AmProbe, f64) {
         ),
         hamaker: if hertz { 0.0 } else { s.hamaker.unwrap_or(0.0) },
         radius: s.radius.expect("R"),
+        damping_unit: p.scales.length_m / (p.scales.time_s * p.scales.force_n),
     };
     (probe, p.scales.frequency_hz(1.0))
 }
@@ -56,6 +57,7 @@ fn truth(probe: &AmProbe, params: &[AmParam], z_offset: f64) -> Vec<f64> {
             AmParam::Hamaker => probe.hamaker,
             AmParam::ZOffset => z_offset,
             AmParam::TipRadius => probe.radius,
+            AmParam::Damping => probe.params.alpha6 / probe.damping_unit,
         })
         .collect()
 }
@@ -78,6 +80,9 @@ fn check_jacobian(model: &FmCurveModel, p: &[f64], what: &str) {
         // over h (~1e-9 Hz over 5 pm) stays below 1e-7 of the derivative
         let h = match model.params[j] {
             AmParam::ZOffset => 5e-4 * model.probe.length_m,
+            // the damper moves Δf weakly (the amplitude loop takes up the dissipation: 0.05 Hz
+            // over 1e-2 c), so the loop's error over h reaches 1e-6 there; 2e-2 c halves it
+            AmParam::Damping => 2e-2 * p[j].abs(),
             _ => 1e-2 * p[j].abs(),
         };
         let at = |k: f64| {
@@ -128,6 +133,26 @@ fn check_probe(name: &str, what: &str) {
         let law = if hertz { "Hertz" } else { "DMT" };
         check_jacobian(&model, &p, &format!("{what} {law}"));
     }
+}
+
+/// The Δf model's Jacobian column of the Hertz damper `sample.damping` (with E and z_offset)
+/// against its central differences, on 4 rows of the point mass as a damped Hertz sample
+/// (α6 = 0.05): the loop's excitation α2 answers the contact's dissipation, Δf moves with it
+/// through ∂g/∂(Ω, α2).
+#[test]
+fn point_mass_fm_damping_column_is_the_finite_differences() {
+    let (mut probe, hz) = fm_probe("probe-point-mass-dmt.toml", true);
+    probe.params.alpha6 = 0.05;
+    let params = vec![AmParam::Damping, AmParam::YoungsModulus, AmParam::ZOffset];
+    let z = rows(probe.length_m, 1.1, 0.85, 4, 1e-9);
+    let mut model = FmCurveModel::new(probe, z, params.clone(), hz);
+    model.loop_tolerance = 1e-12;
+    // the sensitivities' integration to 1e-11: at the default 1e-9 the light-contact row's
+    // ∂Δf/∂c is off by 1.7e-6 relative (the damped force jumps by α6 δ̇ at each contact, where
+    // the adaptive steps shorten), at 1e-11 it agrees with the differences to 1e-8
+    model.tolerance = 1e-11;
+    let p = truth(&probe, &params, 1e-9);
+    check_jacobian(&model, &p, "point mass Hertz, damped");
 }
 
 #[test]

@@ -56,6 +56,7 @@ fn am_probe() -> AmProbe {
         ),
         hamaker: s.hamaker.unwrap_or(0.0),
         radius: s.radius.expect("R"),
+        damping_unit: p.scales.length_m / (p.scales.time_s * p.scales.force_n),
     }
 }
 
@@ -108,6 +109,7 @@ fn synthetic(
             AmParam::Hamaker => probe.hamaker,
             AmParam::ZOffset => z_offset,
             AmParam::TipRadius => probe.radius,
+            AmParam::Damping => probe.params.alpha6 / probe.damping_unit,
         })
         .collect();
     let mut y = vec![0.0; model.points()];
@@ -145,6 +147,7 @@ fn parameters(c: &Curve) -> Vec<Parameter> {
                 AmParam::Hamaker => (0.0, f64::INFINITY, probe.hamaker),
                 AmParam::ZOffset => (-5e-9, 5e-9, 1e-9),
                 AmParam::TipRadius => (1e-10, f64::INFINITY, probe.radius),
+                AmParam::Damping => (0.0, f64::INFINITY, probe.params.alpha6 / probe.damping_unit),
             };
             Parameter {
                 name: p.name().into(),

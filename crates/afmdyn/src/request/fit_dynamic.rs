@@ -229,22 +229,43 @@ pub fn execute(
         ),
         hamaker: s.hamaker.unwrap_or(0.0),
         radius: need(s.radius, "tip.radius")?,
+        damping_unit: probe.scales.length_m / (probe.scales.time_s * probe.scales.force_n),
     };
     let names = fitted_names(fit, default_fit, law_name);
     let mut params = Vec::new();
     let mut am = Vec::new();
     for n in &names {
+        if n == "sample.viscosity" {
+            // η (Pa s) is DMT's Kelvin–Voigt term, refused above when not 0; the hertz law's
+            // dashpot is its damping c (N s/m)
+            return Err(bad(
+                "fit",
+                n,
+                "the dynamic fit of a DMT sample needs it without Kelvin–Voigt damping \
+                 (sample.viscosity = 0, not fitted); the hertz law's damper is sample.damping \
+                 (N s/m)"
+                    .into(),
+            ));
+        }
         let p = AmParam::from_name(n).ok_or_else(|| {
             bad(
                 "fit",
                 n,
                 "the dynamic fit's parameters are sample.youngs_modulus, sample.hamaker (dmt), \
-                 tip.radius and z_offset"
+                 sample.damping (hertz), tip.radius and z_offset"
                     .into(),
             )
         })?;
         if p == AmParam::Hamaker && law_name != "dmt" {
             return Err(bad("fit", n, "sample.hamaker is DMT's".into()));
+        }
+        if p == AmParam::Damping && law_name != "hertz" {
+            return Err(bad(
+                "fit",
+                n,
+                "sample.damping is the hertz law's damper (DMT's Kelvin–Voigt term is refused)"
+                    .into(),
+            ));
         }
         if am.contains(&p) {
             return Err(bad("fit", n, "named twice".into()));
@@ -254,6 +275,14 @@ pub fn execute(
             AmParam::Hamaker => (am_probe.hamaker, am_probe.hamaker.max(1e-21)),
             AmParam::TipRadius => (am_probe.radius, am_probe.radius),
             AmParam::ZOffset => (0.0, 0.1 * am_probe.length_m),
+            // the probe's c; its scale c itself, or (c = 0, an undamped start) the c whose
+            // α6 is 1 % of α4 (a dashpot force α6 δ̇ at the rate g₀/t_s of 1 % of the Hertz
+            // force at δ = g₀)
+            AmParam::Damping => {
+                let c = am_probe.params.alpha6 / am_probe.damping_unit;
+                let typical = 0.01 * am_probe.params.alpha4 / am_probe.damping_unit;
+                (c, if c > 0.0 { c } else { typical })
+            }
         };
         // the physical range's lower end only: MINUIT's sine map of a two-sided range squashes
         // a value near its lower end (a modulus of GPa in a range to TPa), where the
@@ -522,7 +551,7 @@ pub fn document(r: &FitResult, d: &DynamicFit, estimates: Value, correlation: Va
         "rows_fitted": m,
         "evaluations": o.evaluations,
         "termination": o.termination,
-        "units": {"sample.youngs_modulus": "Pa", "tip.radius": "m", "sample.hamaker": "J", "z_offset": "m",
+        "units": {"sample.youngs_modulus": "Pa", "tip.radius": "m", "sample.hamaker": "J", "z_offset": "m", "sample.damping": "N s/m",
                   "z": "m", "amplitude": "m", "phase": "deg", "frequency_shift": "Hz",
                   "amplitude_2": "m", "phase_2": "deg"},
         "method": method,

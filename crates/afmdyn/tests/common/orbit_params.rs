@@ -31,6 +31,7 @@ pub fn with(base: &Params, p: OrbitParam, value: f64) -> Params {
     match p {
         OrbitParam::Gap => q.alpha5 = value,
         OrbitParam::ContactStiffness => q.alpha4 = value,
+        OrbitParam::Damping => q.alpha6 = value,
         OrbitParam::Hamaker => match &mut q.contact_law {
             ContactLaw::Dmt { hamaker, .. } => *hamaker = value,
             _ => panic!("H̃ of a law without it"),
@@ -46,6 +47,7 @@ pub fn value_of(base: &Params, p: OrbitParam) -> f64 {
     match p {
         OrbitParam::Gap => base.alpha5,
         OrbitParam::ContactStiffness => base.alpha4,
+        OrbitParam::Damping => base.alpha6,
         OrbitParam::Hamaker => match base.contact_law {
             ContactLaw::Dmt { hamaker, .. } => hamaker,
             _ => panic!("H̃ of a law without it"),

@@ -12,6 +12,10 @@
 //! * `sample.hamaker` H (J), DMT's: H̃ ∝ H, ∂H̃/∂H = H̃/H;
 //! * `tip.radius` R (m): α4 ∝ √R (Hertz's paraboloid) and H̃ ∝ R (the sphere's van der Waals
 //!   force, −HR/(6d²)), so ∂α4/∂R = α4/(2R), ∂H̃/∂R = H̃/R;
+//! * `sample.damping` c (N s/m), the Hertz law's damper (F_c = α4 δ^{3/2} + α6 δ̇,
+//!   [`crate::contact::HertzLaw`]): α6 = c g₀/(t_s F_s)
+//!   ([`crate::contact::SampleSi::damper_alpha6`]), ∂α6/∂c = g₀/(t_s F_s) ([`AmProbe::damping_unit`]), independent of R (a dashpot, not
+//!   a contact-area law);
 //! * `z_offset` (m): the rest distance of row i is z_c = z_i + z_offset (the piezo's zero is not
 //!   the sample's), α5 = z_c/g₀ − ã_offset ([`crate::params::Params::alpha5_for_rest_distance`]),
 //!   ∂α5/∂z_offset = 1/g₀.
@@ -43,6 +47,8 @@ pub const YOUNGS_MODULUS: &str = "sample.youngs_modulus";
 pub const HAMAKER: &str = "sample.hamaker";
 /// `tip.radius` (m).
 pub const RADIUS: &str = "tip.radius";
+/// `sample.damping` (N s/m), the Hertz law's damper.
+pub const DAMPING: &str = "sample.damping";
 
 /// The adaptive integrator's tolerance of the fit's Jacobian: the sensitivities to ~1e-7
 /// relative, far inside what Levenberg–Marquardt and the covariance need (the values are the
@@ -60,6 +66,8 @@ pub enum AmParam {
     ZOffset,
     /// `tip.radius`.
     TipRadius,
+    /// `sample.damping` (Hertz).
+    Damping,
 }
 
 impl AmParam {
@@ -70,6 +78,7 @@ impl AmParam {
             HAMAKER => Some(AmParam::Hamaker),
             Z_OFFSET => Some(AmParam::ZOffset),
             RADIUS => Some(AmParam::TipRadius),
+            DAMPING => Some(AmParam::Damping),
             _ => None,
         }
     }
@@ -80,7 +89,38 @@ impl AmParam {
             AmParam::Hamaker => HAMAKER,
             AmParam::ZOffset => Z_OFFSET,
             AmParam::TipRadius => RADIUS,
+            AmParam::Damping => DAMPING,
         }
+    }
+}
+
+/// The orbit parameters a model of `params` under `law` differentiates: the gap and α4
+/// always, H̃ on DMT, α6 when the damper is fitted.
+pub fn orbit_params(law: &ContactLaw, params: &[AmParam]) -> Vec<OrbitParam> {
+    let mut v = vec![OrbitParam::Gap, OrbitParam::ContactStiffness];
+    if matches!(law, ContactLaw::Dmt { .. }) {
+        v.push(OrbitParam::Hamaker);
+    }
+    if params.contains(&AmParam::Damping) {
+        v.push(OrbitParam::Damping);
+    }
+    v
+}
+
+/// The chain rule from the orbit's sensitivities `d` (one per `orbit`, in its order) to the
+/// SI parameter `param`, with the chain factors `chain` of [`scaled`] (module docs): E_s and
+/// R through α4 (and R through H̃), H through H̃, z_offset through α5, c through α6. An orbit
+/// parameter not in `orbit` counts 0.
+pub fn to_si(chain: &[f64; 6], orbit: &[OrbitParam], d: &[f64], param: AmParam) -> f64 {
+    let at = |o: OrbitParam| orbit.iter().position(|x| *x == o).map_or(0.0, |i| d[i]);
+    match param {
+        AmParam::YoungsModulus => at(OrbitParam::ContactStiffness) * chain[0],
+        AmParam::Hamaker => at(OrbitParam::Hamaker) * chain[1],
+        AmParam::ZOffset => at(OrbitParam::Gap) * chain[2],
+        AmParam::TipRadius => {
+            at(OrbitParam::ContactStiffness) * chain[3] + at(OrbitParam::Hamaker) * chain[4]
+        }
+        AmParam::Damping => at(OrbitParam::Damping) * chain[5],
     }
 }
 
@@ -101,6 +141,9 @@ pub struct AmProbe {
     pub hamaker: f64,
     /// The probe's R (m).
     pub radius: f64,
+    /// α6 per N s/m of the Hertz damper, g₀/(t_s F_s) (the probe's scales; the probe's
+    /// `[sample] damping` is `params.alpha6 / damping_unit`).
+    pub damping_unit: f64,
 }
 
 /// The model of a measured AM curve (module docs).
@@ -147,16 +190,16 @@ impl AmCurveModel {
     }
 
     /// The parameters at `p` (SI, the model's order), z_offset, and ∂α4/∂E_s, ∂H̃/∂H,
-    /// ∂α5/∂z_offset, ∂α4/∂R, ∂H̃/∂R.
-    fn scaled(&self, p: &[f64]) -> (Params, f64, [f64; 5]) {
+    /// ∂α5/∂z_offset, ∂α4/∂R, ∂H̃/∂R, ∂α6/∂c.
+    fn scaled(&self, p: &[f64]) -> (Params, f64, [f64; 6]) {
         scaled(&self.probe, &self.params, p)
     }
 }
 
 /// The model's parameters of `probe` with `params` at `p` (SI, in the order of `params`; the
 /// others at the probe's values), z_offset (m), and the chain factors ∂α4/∂E_s, ∂H̃/∂H,
-/// ∂α5/∂z_offset, ∂α4/∂R, ∂H̃/∂R (module docs).
-pub fn scaled(probe: &AmProbe, params: &[AmParam], p: &[f64]) -> (Params, f64, [f64; 5]) {
+/// ∂α5/∂z_offset, ∂α4/∂R, ∂H̃/∂R, ∂α6/∂c (module docs).
+pub fn scaled(probe: &AmProbe, params: &[AmParam], p: &[f64]) -> (Params, f64, [f64; 6]) {
     {
         let pr = probe;
         let get = |a: AmParam, default: f64| {
@@ -184,7 +227,12 @@ pub fn scaled(probe: &AmProbe, params: &[AmParam], p: &[f64]) -> (Params, f64, [
                 drh = *hamaker / r;
             }
         }
-        (q, z_offset, [de, dh, 1.0 / pr.length_m, dr4, drh])
+        // α6 = c g₀/(t_s F_s), linear in c (a dashpot: R does not enter it)
+        if params.contains(&AmParam::Damping) {
+            q.alpha6 = get(AmParam::Damping, 0.0) * pr.damping_unit;
+        }
+        let chain = [de, dh, 1.0 / pr.length_m, dr4, drh, pr.damping_unit];
+        (q, z_offset, chain)
     }
 }
 
@@ -213,11 +261,7 @@ impl CheckedModel for AmCurveModel {
         spec.base = q;
         spec.values = alpha5.clone();
         let first = first_sweep_cancellable(&spec, cancel)?;
-        let dmt = matches!(q.contact_law, ContactLaw::Dmt { .. });
-        let mut orbit_params = vec![OrbitParam::Gap, OrbitParam::ContactStiffness];
-        if dmt {
-            orbit_params.push(OrbitParam::Hamaker);
-        }
+        let orbit_params = orbit_params(&q.contact_law, &self.params);
         let m = self.z.len();
         let n = self.params.len();
         let (amp, ph) = self.channels;
@@ -231,8 +275,8 @@ impl CheckedModel for AmCurveModel {
             }
             let mut a = point.observables.amplitude;
             let mut phi = point.observables.phase;
-            let mut da = [0.0; 4];
-            let mut dphi = [0.0; 4];
+            let mut da = vec![0.0; n];
+            let mut dphi = vec![0.0; n];
             // the values alone (the residuals) are the sweep's observables; with the Jacobian,
             // those of the sensitivities' Fourier integrals (the same to the integration error)
             if jacobian.is_some() && point.period == Some(1) && point.stable {
@@ -244,15 +288,10 @@ impl CheckedModel for AmCurveModel {
                 for w in &s.warnings {
                     warnings.push(format!("row {} (z = {:.4e} m): {w}", i + 1, self.z[i]));
                 }
-                // (gap, α4, H̃) → (E_s, H, z_offset, R)
-                let dh = |d: &[f64]| if dmt { d[2] } else { 0.0 };
-                let map = |d: &[f64]| {
-                    [
-                        d[1] * chain[0],
-                        dh(d) * chain[1],
-                        d[0] * chain[2],
-                        d[1] * chain[3] + dh(d) * chain[4],
-                    ]
+                // (gap, α4, H̃, α6) → (E_s, H, z_offset, R, c)
+                let map = |d: &[f64]| -> Vec<f64> {
+                    let si = |a: &AmParam| to_si(&chain, &orbit_params, d, *a);
+                    self.params.iter().map(si).collect()
                 };
                 da = map(&s.d_amplitude);
                 dphi = map(&s.d_phase);
@@ -266,18 +305,12 @@ impl CheckedModel for AmCurveModel {
                 values[phase_row + i] = phi * deg;
             }
             if let Some(j) = jacobian.as_deref_mut() {
-                for (k, param) in self.params.iter().enumerate() {
-                    let c = match param {
-                        AmParam::YoungsModulus => 0,
-                        AmParam::Hamaker => 1,
-                        AmParam::ZOffset => 2,
-                        AmParam::TipRadius => 3,
-                    };
+                for k in 0..n {
                     if amp {
-                        j[i * n + k] = da[c] * g0;
+                        j[i * n + k] = da[k] * g0;
                     }
                     if ph {
-                        j[(phase_row + i) * n + k] = dphi[c] * deg;
+                        j[(phase_row + i) * n + k] = dphi[k] * deg;
                     }
                 }
             }

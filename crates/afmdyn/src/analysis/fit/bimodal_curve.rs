@@ -13,10 +13,11 @@
 //! observables without a Jacobian row, and the warnings say so, as at folds and grazing.
 
 use super::am_curve::CheckedModel;
-use super::am_curve::{first_sweep_cancellable, scaled, AmParam, AmProbe, SENSITIVITY_TOLERANCE};
-use super::sensitivity::{orbit_sensitivity_component, OrbitParam};
+use super::am_curve::{
+    first_sweep_cancellable, orbit_params, scaled, to_si, AmParam, AmProbe, SENSITIVITY_TOLERANCE,
+};
+use super::sensitivity::orbit_sensitivity_component;
 use crate::analysis::stepped::SteppedSpec;
-use crate::contact::ContactLaw;
 use crate::error::SimError;
 use crate::model::CantileverModel;
 use crate::params::SweepParam;
@@ -97,11 +98,7 @@ impl CheckedModel for BimodalCurveModel {
         spec.base = q;
         spec.values = alpha5.clone();
         let first = first_sweep_cancellable(&spec, cancel)?;
-        let dmt = matches!(q.contact_law, ContactLaw::Dmt { .. });
-        let mut orbit_params = vec![OrbitParam::Gap, OrbitParam::ContactStiffness];
-        if dmt {
-            orbit_params.push(OrbitParam::Hamaker);
-        }
+        let orbit_params = orbit_params(&q.contact_law, &self.params);
         let m = self.z.len();
         let n = self.params.len();
         // each fitted channel's first value
@@ -129,7 +126,7 @@ impl CheckedModel for BimodalCurveModel {
                 second.map_or(f64::NAN, |c| c.amplitude),
                 second.map_or(f64::NAN, |c| c.phase),
             ];
-            let mut d = [[0.0; 4]; 4];
+            let mut d = vec![vec![0.0; n]; 4];
             let on_orbit = point.period == Some(1) && point.stable;
             if jacobian.is_some() && on_orbit {
                 if cancel.load(Ordering::Relaxed) {
@@ -153,17 +150,12 @@ impl CheckedModel for BimodalCurveModel {
                     residual: f64::NAN,
                 })?;
                 v = [s.amplitude, s.phase, two.amplitude, two.phase];
-                // (gap, α4, H̃) → (E_s, H, z_offset, R), as the AM model maps them
-                let map = |dd: &[f64]| {
-                    let dh = if dmt { dd[2] } else { 0.0 };
-                    [
-                        dd[1] * chain[0],
-                        dh * chain[1],
-                        dd[0] * chain[2],
-                        dd[1] * chain[3] + dh * chain[4],
-                    ]
+                // (gap, α4, H̃, α6) → (E_s, H, z_offset, R, c), as the AM model maps them
+                let map = |dd: &[f64]| -> Vec<f64> {
+                    let si = |a: &AmParam| to_si(&chain, &orbit_params, dd, *a);
+                    self.params.iter().map(si).collect()
                 };
-                d = [
+                d = vec![
                     map(&s.d_amplitude),
                     map(&s.d_phase),
                     map(&two.d_amplitude),
@@ -179,14 +171,8 @@ impl CheckedModel for BimodalCurveModel {
                 let row = offset[c] + i;
                 values[row] = v[c] * scale[c];
                 if let Some(j) = jacobian.as_deref_mut() {
-                    for (k, param) in self.params.iter().enumerate() {
-                        let idx = match param {
-                            AmParam::YoungsModulus => 0,
-                            AmParam::Hamaker => 1,
-                            AmParam::ZOffset => 2,
-                            AmParam::TipRadius => 3,
-                        };
-                        j[row * n + k] = d[c][idx] * scale[c];
+                    for k in 0..n {
+                        j[row * n + k] = d[c][k] * scale[c];
                     }
                 }
             }

@@ -14,8 +14,8 @@
 //! ∂g/∂(Ω, α2) from the same extended flow ([`OrbitParam::DriveFrequency`]: time rescaled to
 //! a fixed phase; [`OrbitParam::DriveAmplitude`]: a column of the forcing), so that
 //! dΔf/dp = f_scale dΩ/dp. The reference ω₁, the setpoint A and the lag φ_set are those of the
-//! free lever, which E, H, R and z_offset do not move. The SI parameters map onto (α5, α4, H̃)
-//! as in [`super::am_curve`].
+//! free lever, which E, H, R, c and z_offset do not move. The SI parameters map onto
+//! (α5, α4, H̃, α6) as in [`super::am_curve`].
 //!
 //! # Where it breaks
 //! A fold of the FM curve (det ∂g/∂(Ω, α2) = 0, [`crate::analysis::fm::FmCurve::folds`]), a
@@ -24,10 +24,9 @@
 //! are reported in [`FmCurveModel::warnings`].
 
 use super::am_curve::CheckedModel;
-use super::am_curve::{scaled, AmParam, AmProbe, SENSITIVITY_TOLERANCE};
+use super::am_curve::{orbit_params, scaled, to_si, AmParam, AmProbe, SENSITIVITY_TOLERANCE};
 use super::sensitivity::{orbit_sensitivity, OrbitParam, SensitivityWarning};
 use crate::analysis::fm::{fm_curve_cancellable, FmSpec, DEFAULT_LOOP_TOLERANCE};
-use crate::contact::ContactLaw;
 use crate::error::SimError;
 use crate::model::CantileverModel;
 use crate::params::SweepParam;
@@ -105,11 +104,7 @@ impl CheckedModel for FmCurveModel {
         spec.tolerance = self.loop_tolerance;
         let curve = fm_curve_cancellable(&spec, cancel)?;
         let hz = self.hz_per_omega;
-        let dmt = matches!(q.contact_law, ContactLaw::Dmt { .. });
-        let mut orbit_params = vec![OrbitParam::Gap, OrbitParam::ContactStiffness];
-        if dmt {
-            orbit_params.push(OrbitParam::Hamaker);
-        }
+        let mut orbit_params = orbit_params(&q.contact_law, &self.params);
         let k = orbit_params.len();
         orbit_params.extend([OrbitParam::DriveFrequency, OrbitParam::DriveAmplitude]);
         let n = self.params.len();
@@ -181,26 +176,13 @@ impl CheckedModel for FmCurveModel {
                 ));
                 continue;
             };
-            // dΩ/dp_m = first row of −G⁻¹ ∂g/∂p_m, for (gap, α4, H̃)
+            // dΩ/dp_m = first row of −G⁻¹ ∂g/∂p_m, for (gap, α4, H̃, α6)
             let d_omega: Vec<f64> = (0..k)
                 .map(|m| -(inv * Vector2::new(s.d_amplitude[m] / a, s.d_phase[m]))[0])
                 .collect();
-            let dh = if dmt { d_omega[2] } else { 0.0 };
-            // (gap, α4, H̃) → (E_s, H, z_offset, R), as the AM model maps them
-            let d = [
-                d_omega[1] * chain[0],
-                dh * chain[1],
-                d_omega[0] * chain[2],
-                d_omega[1] * chain[3] + dh * chain[4],
-            ];
+            // (gap, α4, H̃, α6) → (E_s, H, z_offset, R, c), as the AM model maps them
             for (c, param) in self.params.iter().enumerate() {
-                let idx = match param {
-                    AmParam::YoungsModulus => 0,
-                    AmParam::Hamaker => 1,
-                    AmParam::ZOffset => 2,
-                    AmParam::TipRadius => 3,
-                };
-                j[i * n + c] = d[idx] * hz;
+                j[i * n + c] = to_si(&chain, &orbit_params[..k], &d_omega, *param) * hz;
             }
         }
         Ok(warnings)

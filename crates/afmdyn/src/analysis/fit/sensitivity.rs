@@ -1,6 +1,7 @@
 //! Exact parametric sensitivities of a periodic orbit and of its first harmonic (issue 62 §1):
 //! ∂z*/∂p, ∂A/∂p and ∂φ/∂p for the gap α5 (the rest distance, so `z_offset`), the Hertz group
-//! α4 (∝ E*) and DMT's van der Waals group H̃ (∝ H), for the Hertz and DMT laws.
+//! α4 (∝ E*), DMT's van der Waals group H̃ (∝ H) and the Hertz law's damper α6, for the Hertz
+//! and DMT laws.
 //!
 //! # Method
 //! The model's state z (2N) is extended by the two Fourier integrals of the tip deflection
@@ -13,7 +14,10 @@
 //! * both laws are linear in α4 (Hertz 1882; Johnson, *Contact Mechanics*, 1985, eq. 4.23: the
 //!   repulsion α4 δ^{3/2} in contact), so ∂F_c/∂α4 = δ^{3/2} in contact, 0 outside;
 //! * DMT is linear in H̃ (Derjaguin, Muller & Toporov, *J. Colloid Interface Sci.* 53 (1975)
-//!   314: −H̃/(ã₀ + V_T)² outside contact, −H̃/ã₀² in it), so ∂F_c/∂H̃ is that force at H̃ = 1.
+//!   314: −H̃/(ã₀ + V_T)² outside contact, −H̃/ã₀² in it), so ∂F_c/∂H̃ is that force at H̃ = 1;
+//! * the Hertz law's damper is linear in α6 (F_c = α4 δ^{3/2} + α6 δ̇ in contact,
+//!   [`crate::contact::HertzLaw`]: a Kelvin–Voigt dashpot beside the Hertz spring), so
+//!   ∂F_c/∂α6 = δ̇ in contact, 0 outside.
 //!
 //! # The drive
 //! The FM loop's unknowns ([`super::fm_curve`]) are the drive's α2 and Ω:
@@ -38,11 +42,16 @@
 //! saltation matrix of each switching of the extended system ([`crate::system::saltation`];
 //! Leine & Nijmeijer 2004, §7.1: the guard σV_T moves with α5, ∂g/∂α5 = σ, so the parameter
 //! column gains w ∂g/∂α5) give over one period the monodromy matrix of the extended map,
-//! [[M, ∂P/∂p], [∂q/∂z, ∂q/∂p], [0, I]]. Hertz and DMT have a continuous force at V_T = 0
-//! (Hertz's is 0 at δ = 0; DMT's is −H̃/ã₀² on both sides), so f⁺ = f⁻ there, the shift w is
-//! zero and the saltation matrix is the identity, for the state's and the parameters' columns
-//! alike; it is applied all the same, as the monodromy matrix of [`crate::maps::flow`] applies
-//! it.
+//! [[M, ∂P/∂p], [∂q/∂z, ∂q/∂p], [0, I]]. Hertz and DMT switch without a jump of the state
+//! (R = I). Without damping their force is continuous at V_T = 0 (Hertz's is 0 at δ = 0;
+//! DMT's is −H̃/ã₀² on both sides), so f⁺ = f⁻ there, the shift w is zero and the saltation
+//! matrix is the identity. The Hertz damper's α6 δ̇ is not 0 at δ = 0: with α6 > 0 the vector
+//! field jumps by M⁻¹φ α6 δ̇ at the switching, w ≠ 0 and S = I + w ∇gᵀ moves every column
+//! (the state's, α5's and α2's through ∂g/∂p, the others through S alone). The guard σV_T does
+//! not move with α6, α4 or H̃ (∂g/∂α6 = 0), so their columns take no w ∂g/∂p term of their
+//! own. The saltation is applied at every switching, as the monodromy matrix of
+//! [`crate::maps::flow`] applies it ([`crate::system::saltation_parts`], with f⁺ and f⁻ of
+//! the extended system), so nothing more is needed for α6.
 //!
 //! By the implicit function theorem on the shooting equations P(z*, p) = z*,
 //! ∂z*/∂p = (I − M)⁻¹ ∂P/∂p, and the Fourier integrals' total derivatives are
@@ -58,8 +67,9 @@
 //! [`crate::analysis::shooting::GRAZING_TOL`].
 //!
 //! Units are the model's (lengths in g₀, τ, forces F̃). Only period-1 orbits; only the laws
-//! `hertz` and `dmt` (without Kelvin–Voigt damping, α6 = 0, whose δ̇/√δ Jacobian singularity
-//! at contact onset the plain variational equations do not resolve).
+//! `hertz` (with or without its damper α6 δ̇, smooth in δ) and `dmt` (without Kelvin–Voigt
+//! damping, α6 = 0, whose δ̇/√δ Jacobian singularity at contact onset the plain variational
+//! equations do not resolve).
 
 use crate::analysis::shooting::{shoot_with, ShootingOptions, GRAZING_TOL};
 use crate::contact::{ContactLaw, DmtLaw, HertzLaw, Law, TipSample, TipSampleLaw};
@@ -86,6 +96,9 @@ pub enum OrbitParam {
     Gap,
     /// α4, the Hertz group of the Hertz and DMT laws (∝ E* √R).
     ContactStiffness,
+    /// α6, the Hertz law's damper (F_c = α4 δ^{3/2} + α6 δ̇ in contact; ∝ the probe's
+    /// `[sample] damping`, N s/m).
+    Damping,
     /// H̃, DMT's van der Waals group (∝ H R).
     Hamaker,
     /// α2, the drive's amplitude (the base's, or the tip force's of the point mass): it enters
@@ -202,7 +215,8 @@ fn harmonic(q: (f64, f64), dq: &DMatrix<f64>, period: f64) -> Harmonic {
 
 /// ∂F_c/∂p of the law of `law` (groups α4 = `stiffness`, α6 = `damping`) at indentation δ =
 /// `delta`, rate δ̇ = `rate`, in or out of contact (module docs). `None` for a law other than
-/// Hertz and DMT, for H̃ of Hertz, and for the drive's α2 and Ω (which move δ and δ̇ with the
+/// Hertz and DMT, for H̃ of Hertz, for α6 of DMT (its Kelvin–Voigt term is refused), and for
+/// the drive's α2 and Ω (which move δ and δ̇ with the
 /// drive's phase: the extended system forms their columns).
 pub fn d_force(
     law: &ContactLaw,
@@ -239,6 +253,13 @@ pub fn d_force(
             }
             .force(0.0, 0.0, contact, delta, 0.0)
             .force
+        }
+        OrbitParam::Damping => {
+            if a0.is_some() {
+                return None;
+            }
+            // Hertz's α6 δ̇ at α6 = 1 (and α4 = 0): δ̇ in contact, 0 outside
+            HertzLaw.force(0.0, 1.0, contact, delta, rate).force
         }
         OrbitParam::DriveAmplitude | OrbitParam::DriveFrequency => return None,
     })
@@ -452,9 +473,9 @@ impl TipSampleSystem for Extended {
 /// `params` (module docs).
 ///
 /// # Errors
-/// [`SimError::Unsupported`] for a law other than Hertz and DMT, for H̃ under Hertz, and for
-/// DMT with α6 > 0; [`SimError::NoConvergence`] from the Newton solve; [`SimError`] from the
-/// integrator.
+/// [`SimError::Unsupported`] for a law other than Hertz and DMT, for H̃ under Hertz, for
+/// DMT with α6 > 0 and for α6 ([`OrbitParam::Damping`]) under DMT;
+/// [`SimError::NoConvergence`] from the Newton solve; [`SimError`] from the integrator.
 pub fn orbit_sensitivity(
     model: &CantileverModel,
     tol: f64,
@@ -520,6 +541,12 @@ pub fn orbit_sensitivity_component(
             if p.alpha6 != 0.0 {
                 return Err(unsupported(
                     "exact sensitivities of DMT need α6 = 0 (no Kelvin–Voigt damping)",
+                ));
+            }
+            if params.contains(&OrbitParam::Damping) {
+                return Err(unsupported(
+                    "the damper's sensitivity α6 is the hertz law's (DMT's Kelvin–Voigt term \
+                     is refused)",
                 ));
             }
         }
