@@ -10,7 +10,7 @@ and defaults), the overloads of the one door ``run`` and of ``run_stored`` (the 
 a store; one per analysis' name); and, through ``scripts/gen_wrappers.py``, the modules
 ``afmdyn/_wrappers.py`` and ``afmdyn/_dask_wrappers.py`` of the analyses' public functions;
 and, through ``scripts/gen_cli.py``, the command line's request flags
-(``crates/afmdyn-cli/src/flags.rs``).
+(``crates/afmdyn-cli/src/flags.rs`` and ``flags_afm.rs``).
 
     python3 scripts/gen_stubs.py          # rewrite the generated block
     python3 scripts/gen_stubs.py --check  # exit 1 when it is stale (the Python tests run this)
@@ -25,7 +25,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import gen_wrappers  # noqa: E402  (the analyses' public functions, afmdyn/_wrappers.py)
-import gen_cli  # noqa: E402  (the command line's request flags, crates/afmdyn-cli/src/flags.rs)
+import gen_cli  # noqa: E402  (the command line's request flags, crates/afmdyn-cli/src/flags*.rs)
 
 ROOT = Path(__file__).resolve().parent.parent
 SCHEMAS = ROOT / "docs" / "schema" / "requests"
@@ -165,7 +165,7 @@ def main() -> int:
     for f in gen_wrappers.FILES:
         new[gen_wrappers.PACKAGE / f] = gen_wrappers.generate(f)
     new[gen_wrappers.PACKAGE / "_model.py"] = gen_wrappers.generate_model()
-    new[gen_cli.OUT] = gen_cli.generate()
+    new.update(gen_cli.generate_files())
     for path in LAW_LISTS[1:]:
         new[path] = with_laws(path.read_text())
     if "--check" in sys.argv[1:]:

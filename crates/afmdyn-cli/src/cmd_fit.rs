@@ -12,7 +12,7 @@ use crate::cmd_approach::files;
 use crate::cmd_simulate::Files;
 use crate::door;
 use crate::error::CliError;
-use crate::flags::FitFlags;
+use crate::flags_afm::FitFlags;
 use afmdyn::request::Resolved;
 use afmdyn::Params;
 use clap::Args;

@@ -12,7 +12,7 @@ use crate::cmd_approach::files;
 use crate::cmd_simulate::Files;
 use crate::door::{self, Exit};
 use crate::error::CliError;
-use crate::flags::{ImageFlags, ImageOptionsFlags, PiScanFlags};
+use crate::flags_afm::{ImageFlags, ImageOptionsFlags, PiScanFlags};
 use crate::output::{units_of, OutDir};
 use afmdyn::request::image::SampleMap;
 use afmdyn::request::image_job::{ImageJob, ImageMode};

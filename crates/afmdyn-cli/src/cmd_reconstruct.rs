@@ -10,7 +10,7 @@ use crate::cmd_approach::files;
 use crate::cmd_simulate::Files;
 use crate::door;
 use crate::error::CliError;
-use crate::flags::ReconstructFlags;
+use crate::flags_afm::ReconstructFlags;
 use crate::output::{units_of, OutDir};
 use afmdyn::analysis::reconstruct::Reconstruction;
 use afmdyn::io::curve_file::{read_curve_file, read_document, CurveFile};
