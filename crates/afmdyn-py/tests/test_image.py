@@ -204,8 +204,11 @@ def test_pi_settings_are_refused_by_name(tmp_path):
         afmdyn.image(probe, STRIPE, 0.5, pixels=8, feedback="pi", time_constant=-1.0)
     with pytest.raises(ValueError, match="feedback"):
         afmdyn.image(probe, STRIPE, 0.5, feedback="pid")
-    with pytest.raises(ValueError, match="only with feedback='pi'"):
+    # the library's one check of the options (ImageOptions::check, the command line's too)
+    with pytest.raises(ValueError, match="scan_rate = 2: only with feedback = pi"):
         afmdyn.image(probe, STRIPE, 0.5, scan_rate=2.0)
+    with pytest.raises(ValueError, match="threads = 2: only with feedback = pi"):
+        afmdyn.image(probe, STRIPE, 0.5, threads=2)
 
 
 def test_the_dask_scan_equals_the_local_scan(tmp_path):

@@ -45,8 +45,10 @@ def test_the_peakforce_image_is_image_nc(cli, tmp_path):
 def test_peakforce_image_refusals_name_their_field():
     with pytest.raises(ValueError, match="mode"):
         afmdyn.image(PROBE, BLEND, 2e-9, mode="force-volume")
-    with pytest.raises(ValueError, match="feedback, curve_points"):
+    with pytest.raises(ValueError, match="feedback = pi: not with mode = peakforce"):
         afmdyn.image(PROBE, BLEND, 2e-9, mode="peakforce", feedback="pi")
+    with pytest.raises(ValueError, match="curve_points = 20: not with mode = peakforce"):
+        afmdyn.image(PROBE, BLEND, 2e-9, mode="peakforce", curve_points=20)
     # an AM probe has no modulation to tap with
     with pytest.raises(ValueError, match="excitation"):
         afmdyn.image(EXAMPLES / "probe-point-mass-dmt.toml", BLEND, 2e-9, mode="peakforce",

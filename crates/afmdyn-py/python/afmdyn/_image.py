@@ -33,11 +33,17 @@ def _keywords(a: Args, feedback: str) -> Tuple[str, Args]:
         raise ValueError("gains: must be two numbers (K_P, K_I in 1/s)")
     pi = dict(scan_rate=a["scan_rate"], time_constant=a["time_constant"],
               gains=None if gains is None else [float(g) for g in gains])
+    # the options and what else was given, checked together by the library
+    # (ImageOptions::check, as the command line's flags are)
+    given = [[k, repr(a[k])] for k in ("scan_rate", "gains", "time_constant", "curve_points")
+             if a.get(k) is not None]
+    options = dict(mode=mode, feedback=feedback, threads=a.get("threads"))
     request = dict(sample=os.fspath(sample) if isinstance(sample, os.PathLike) else sample,
                    setpoint=a["setpoint"], pixels=a["pixels"], lines=a["lines"],
                    curve_points=a["curve_points"], height_map=rows,
                    feedback=pi if feedback == "pi" else None, threads=a.get("threads"),
-                   mode=None if mode == "am" else mode)
+                   mode=None if mode == "am" else mode,
+                   options=dict(options=options, given=given))
     return _core.probe_source(a["probe"]), request
 
 
@@ -46,17 +52,8 @@ def _finish_image(a: Args) -> xr.Dataset:
     mode, feedback = a["mode"], a["feedback"]
     if mode not in ("am", "peakforce"):
         raise ValueError(f"mode = {mode!r}: must be 'am' or 'peakforce'")
-    if mode == "peakforce" and (feedback != "ideal" or a["curve_points"] is not None):
-        raise ValueError("feedback, curve_points: not with mode='peakforce' (its ideal "
-                         "peak-force feedback engages each material by its own setpoint search)")
     if feedback not in ("ideal", "pi"):
         raise ValueError(f"feedback = {feedback!r}: must be 'ideal' or 'pi'")
-    loop = ("scan_rate", "gains", "time_constant") + (("threads",) if mode == "am" else ())
-    if feedback == "ideal" and any(a[k] is not None for k in loop):
-        raise ValueError(
-            "scan_rate, gains, time_constant, threads: only with feedback='pi' "
-            "(the ideal feedback has no loop)"
-        )
     text, request = _keywords(a, feedback)
     lines_progress = feedback == "pi" or mode == "peakforce"
     with reporter(a["progress"] if lines_progress else False, "image", unit="line") as cb:

@@ -12,6 +12,7 @@ use super::image::{
     background_probe, curves_cost, image, setpoint_study, Image, ImageRequest, SampleMap,
     SetpointStudy,
 };
+use super::image_options::GivenOptions;
 use super::image_peakforce::{peakforce_cost, peakforce_probe, PeakForceImage};
 #[cfg(feature = "files")]
 use super::image_scan::ScanRecipe;
@@ -127,6 +128,10 @@ pub struct ImageKeywords {
     pub feedback: Option<PiScan>,
     /// A PI scan's worker threads (`None`: all cores).
     pub threads: Option<usize>,
+    /// The options as the front end was given them, with what else it was given, checked
+    /// together ([`GivenOptions::check`]) before the job or the scan is built (`None`: the
+    /// front end checked them itself, as the command line does with its flags).
+    pub options: Option<GivenOptions>,
 }
 
 impl ImageKeywords {
@@ -146,6 +151,14 @@ impl ImageKeywords {
         Ok((table, map))
     }
 
+    /// The options' check ([`ImageKeywords::options`]), when given.
+    ///
+    /// # Errors
+    /// As [`GivenOptions::check`].
+    pub fn check(&self) -> Result<(), SimError> {
+        self.options.as_ref().map_or(Ok(()), GivenOptions::check)
+    }
+
     /// The image request of the keywords (its setpoint as given: A_sp/A₀, or N with
     /// [`ImageMode::Peakforce`]).
     pub fn request(&self) -> ImageRequest {
@@ -155,9 +168,10 @@ impl ImageKeywords {
     /// The job of the probe file's text `probe` (the ideal image, or the PI scan).
     ///
     /// # Errors
-    /// As [`ImageKeywords::inputs`].
+    /// As [`ImageKeywords::check`] and [`ImageKeywords::inputs`].
     #[cfg(feature = "files")] // (a sample map may name a file)
     pub fn job(self, probe: &str) -> Result<ImageJob, SimError> {
+        self.check()?;
         let (probe, sample) = self.inputs(probe)?;
         Ok(ImageJob {
             mode: self.mode.unwrap_or_default(),
@@ -174,9 +188,10 @@ impl ImageKeywords {
     /// The recipe of the PI scan (the default settings without [`ImageKeywords::feedback`]).
     ///
     /// # Errors
-    /// As [`ImageKeywords::inputs`].
+    /// As [`ImageKeywords::check`] and [`ImageKeywords::inputs`].
     #[cfg(feature = "files")] // (a sample map may name a file)
     pub fn scan(self, probe: &str) -> Result<ScanRecipe, SimError> {
+        self.check()?;
         let (probe, map) = self.inputs(probe)?;
         Ok(ScanRecipe {
             probe,

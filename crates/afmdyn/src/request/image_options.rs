@@ -104,3 +104,47 @@ impl ImageOptions {
         self.setpoint_study.as_deref().map(study_ratios).transpose()
     }
 }
+
+/// The names [`ImageOptions::check`] knows of the other settings a front end was given.
+const GIVEN: [&str; 5] = [
+    "scan_rate",
+    "gains",
+    "time_constant",
+    "curve_points",
+    "resume",
+];
+
+/// [`ImageOptions`] with what else a front end was given, by name and value as text, for a
+/// front end that passes them with an image's keywords (Python's `afmdyn.image`,
+/// [`super::image_job::ImageKeywords::options`]).
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct GivenOptions {
+    /// The options.
+    pub options: ImageOptions,
+    /// The other settings given: `[name, value]` pairs, names among `scan_rate`, `gains`,
+    /// `time_constant`, `curve_points` and `resume`.
+    pub given: Vec<(String, String)>,
+}
+
+impl GivenOptions {
+    /// [`ImageOptions::check`] of the options with the settings given.
+    ///
+    /// # Errors
+    /// As [`ImageOptions::check`]; [`SimError::OutOfRange`] naming `given` for a name it does
+    /// not know.
+    pub fn check(&self) -> Result<(), SimError> {
+        let mut given = Vec::with_capacity(self.given.len());
+        for (name, value) in &self.given {
+            let known = GIVEN.iter().find(|k| **k == name.as_str()).ok_or_else(|| {
+                SimError::out_of_range(
+                    "given",
+                    name.clone(),
+                    format!("names one of {}", GIVEN.join(", ")),
+                )
+            })?;
+            given.push((*known, value.clone()));
+        }
+        self.options.check(&given)
+    }
+}
