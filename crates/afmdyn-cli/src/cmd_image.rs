@@ -81,7 +81,7 @@ pub fn image_cmd(a: &ImageArgs) -> Result<(), CliError> {
             a.scan
                 .gains
                 .as_ref()
-                .map(|g| format!("{},{}", g[0], g.get(1).unwrap_or(&f64::NAN))),
+                .map(|g| g.iter().map(f64::to_string).collect::<Vec<_>>().join(",")),
         ),
         (
             "time_constant",

@@ -471,19 +471,23 @@ impl Analysis for FitRequest {
             }),
             _ => None,
         };
-        let m: Box<dyn CurveModel> = match &sls {
-            Some(model) => Box::new(model.clone()),
-            _ => Box::new(ForceCurveModel {
-                law,
-                x,
-                segment,
-                poisson_ratio: need(s.poisson_ratio, "sample.poisson_ratio")?,
-                tip: (
-                    need(s.tip_youngs_modulus, "tip.youngs_modulus")?,
-                    need(s.tip_poisson_ratio, "tip.poisson_ratio")?,
-                ),
-                intermolecular_distance: s.intermolecular_distance.unwrap_or(0.0),
-            }),
+        let elastic;
+        let m: &dyn CurveModel = match &sls {
+            Some(model) => model,
+            None => {
+                elastic = ForceCurveModel {
+                    law,
+                    x,
+                    segment,
+                    poisson_ratio: need(s.poisson_ratio, "sample.poisson_ratio")?,
+                    tip: (
+                        need(s.tip_youngs_modulus, "tip.youngs_modulus")?,
+                        need(s.tip_poisson_ratio, "tip.poisson_ratio")?,
+                    ),
+                    intermolecular_distance: s.intermolecular_distance.unwrap_or(0.0),
+                };
+                &elastic
+            }
         };
         progress.check()?;
         let obs = Observations {
@@ -491,7 +495,7 @@ impl Analysis for FitRequest {
             sigma: sig.as_deref(),
         };
         let walk = self.profiles.unwrap_or(true).then_some(ProfileWalk::Grid);
-        let mut outcome = fit_cancellable(m.as_ref(), &obs, &params, &fixed, walk, progress)?;
+        let mut outcome = fit_cancellable(m, &obs, &params, &fixed, walk, progress)?;
         // the SLS starts from rest at the first row: a fit that puts the tip on the sample
         // there broke that assumption
         if let Some(model) = &sls {

@@ -196,6 +196,15 @@ impl AmCurveModel {
     }
 }
 
+/// The gaps α5 of the rows at the piezo positions `z` (m), shifted by `z_offset` (m), under the
+/// parameters `q` of `probe` (module docs: α5 from the rest distance (z + z_offset)/g₀).
+pub fn gaps(probe: &AmProbe, q: &Params, z: &[f64], z_offset: f64) -> Vec<f64> {
+    let g0 = probe.length_m;
+    z.iter()
+        .map(|z| q.alpha5_for_rest_distance((z + z_offset) / g0))
+        .collect()
+}
+
 /// The model's parameters of `probe` with `params` at `p` (SI, in the order of `params`; the
 /// others at the probe's values), z_offset (m), and the chain factors ∂α4/∂E_s, ∂H̃/∂H,
 /// ∂α5/∂z_offset, ∂α4/∂R, ∂H̃/∂R, ∂α6/∂c (module docs).
@@ -252,11 +261,7 @@ impl CheckedModel for AmCurveModel {
     ) -> Result<Vec<String>, SimError> {
         let (q, z_offset, chain) = self.scaled(p);
         let g0 = self.probe.length_m;
-        let alpha5: Vec<f64> = self
-            .z
-            .iter()
-            .map(|z| q.alpha5_for_rest_distance((z + z_offset) / g0))
-            .collect();
+        let alpha5 = gaps(&self.probe, &q, &self.z, z_offset);
         let mut spec = self.spec.clone();
         spec.base = q;
         spec.values = alpha5.clone();

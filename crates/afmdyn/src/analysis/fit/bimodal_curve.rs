@@ -14,7 +14,8 @@
 
 use super::am_curve::CheckedModel;
 use super::am_curve::{
-    first_sweep_cancellable, orbit_params, scaled, to_si, AmParam, AmProbe, SENSITIVITY_TOLERANCE,
+    first_sweep_cancellable, gaps, orbit_params, scaled, to_si, AmParam, AmProbe,
+    SENSITIVITY_TOLERANCE,
 };
 use super::sensitivity::orbit_sensitivity_component;
 use crate::analysis::stepped::SteppedSpec;
@@ -89,11 +90,7 @@ impl CheckedModel for BimodalCurveModel {
         }
         let (q, z_offset, chain) = scaled(&self.probe, &self.params, p);
         let g0 = self.probe.length_m;
-        let alpha5: Vec<f64> = self
-            .z
-            .iter()
-            .map(|z| q.alpha5_for_rest_distance((z + z_offset) / g0))
-            .collect();
+        let alpha5 = gaps(&self.probe, &q, &self.z, z_offset);
         let mut spec = self.spec.clone();
         spec.base = q;
         spec.values = alpha5.clone();

@@ -24,7 +24,7 @@
 //! are reported in [`FmCurveModel::warnings`].
 
 use super::am_curve::CheckedModel;
-use super::am_curve::{orbit_params, scaled, to_si, AmParam, AmProbe, SENSITIVITY_TOLERANCE};
+use super::am_curve::{gaps, orbit_params, scaled, to_si, AmParam, AmProbe, SENSITIVITY_TOLERANCE};
 use super::sensitivity::{orbit_sensitivity, OrbitParam, SensitivityWarning};
 use crate::analysis::fm::{fm_curve_cancellable, FmSpec, DEFAULT_LOOP_TOLERANCE};
 use crate::error::SimError;
@@ -94,12 +94,7 @@ impl CheckedModel for FmCurveModel {
         cancel: &AtomicBool,
     ) -> Result<Vec<String>, SimError> {
         let (q, z_offset, chain) = scaled(&self.probe, &self.params, p);
-        let g0 = self.probe.length_m;
-        let alpha5: Vec<f64> = self
-            .z
-            .iter()
-            .map(|z| q.alpha5_for_rest_distance((z + z_offset) / g0))
-            .collect();
+        let alpha5 = gaps(&self.probe, &q, &self.z, z_offset);
         let mut spec = FmSpec::new(q, alpha5, self.amplitude);
         spec.tolerance = self.loop_tolerance;
         let curve = fm_curve_cancellable(&spec, cancel)?;
