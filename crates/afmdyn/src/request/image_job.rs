@@ -27,19 +27,7 @@ use crate::report::{OutputFile, Presentation, TextUnits};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
-/// The imaging mode: amplitude-modulation (AM) tapping or off-resonance (PeakForce) tapping.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
-#[serde(rename_all = "lowercase")]
-pub enum ImageMode {
-    /// AM-AFM: the amplitude feedback at the setpoint ratio A_sp/A₀ ([`super::image`],
-    /// [`super::image_scan`]).
-    #[default]
-    Am,
-    /// PeakForce: the ideal peak-force feedback at the setpoint force (N) with an off-resonance
-    /// probe ([`super::image_peakforce`]).
-    Peakforce,
-}
+pub use super::image_options::ImageMode;
 
 /// An image request with its inputs ([module docs](self)).
 #[derive(Debug, Clone, PartialEq)]
