@@ -94,33 +94,40 @@ impl AmParam {
     }
 }
 
-/// The orbit parameters a model of `params` under `law` differentiates: the gap and α4
-/// always, H̃ on DMT, α6 when the damper is fitted.
-pub fn orbit_params(law: &ContactLaw, params: &[AmParam]) -> Vec<OrbitParam> {
-    let mut v = vec![OrbitParam::Gap, OrbitParam::ContactStiffness];
-    if matches!(law, ContactLaw::Dmt { .. }) {
-        v.push(OrbitParam::Hamaker);
-    }
-    if params.contains(&AmParam::Damping) {
-        v.push(OrbitParam::Damping);
-    }
-    v
+/// The chain rule from the model's groups to the SI parameters (module docs): the terms
+/// ∂o/∂p of each fitted SI parameter p through each orbit parameter o it moves, so that
+/// ∂y/∂p = Σ_o ∂y/∂o · ∂o/∂p. A parameter adds its terms in [`scaled`]; the orbit parameters
+/// a model differentiates are those the terms name ([`Chain::orbit_params`]).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Chain {
+    /// (p, o, ∂o/∂p), in the order added.
+    pub terms: Vec<(AmParam, OrbitParam, f64)>,
 }
 
-/// The chain rule from the orbit's sensitivities `d` (one per `orbit`, in its order) to the
-/// SI parameter `param`, with the chain factors `chain` of [`scaled`] (module docs): E_s and
-/// R through α4 (and R through H̃), H through H̃, z_offset through α5, c through α6. An orbit
-/// parameter not in `orbit` counts 0.
-pub fn to_si(chain: &[f64; 6], orbit: &[OrbitParam], d: &[f64], param: AmParam) -> f64 {
-    let at = |o: OrbitParam| orbit.iter().position(|x| *x == o).map_or(0.0, |i| d[i]);
-    match param {
-        AmParam::YoungsModulus => at(OrbitParam::ContactStiffness) * chain[0],
-        AmParam::Hamaker => at(OrbitParam::Hamaker) * chain[1],
-        AmParam::ZOffset => at(OrbitParam::Gap) * chain[2],
-        AmParam::TipRadius => {
-            at(OrbitParam::ContactStiffness) * chain[3] + at(OrbitParam::Hamaker) * chain[4]
+impl Chain {
+    /// Add the term ∂o/∂p = `factor`.
+    pub fn push(&mut self, param: AmParam, orbit: OrbitParam, factor: f64) {
+        self.terms.push((param, orbit, factor));
+    }
+    /// The orbit parameters the terms name, each once, in the order first named.
+    pub fn orbit_params(&self) -> Vec<OrbitParam> {
+        let mut v: Vec<OrbitParam> = Vec::new();
+        for (_, o, _) in &self.terms {
+            if !v.contains(o) {
+                v.push(*o);
+            }
         }
-        AmParam::Damping => at(OrbitParam::Damping) * chain[5],
+        v
+    }
+    /// ∂y/∂`param` from the orbit's sensitivities `d` (one per `orbit`, in its order): the sum
+    /// of the terms of `param`; an orbit parameter not in `orbit` counts 0.
+    pub fn to_si(&self, orbit: &[OrbitParam], d: &[f64], param: AmParam) -> f64 {
+        let at = |o: OrbitParam| orbit.iter().position(|x| *x == o).map_or(0.0, |i| d[i]);
+        self.terms
+            .iter()
+            .filter(|(p, _, _)| *p == param)
+            .map(|(_, o, f)| at(*o) * f)
+            .sum()
     }
 }
 
@@ -189,9 +196,8 @@ impl AmCurveModel {
         self.warnings.lock().map(|w| w.clone()).unwrap_or_default()
     }
 
-    /// The parameters at `p` (SI, the model's order), z_offset, and ∂α4/∂E_s, ∂H̃/∂H,
-    /// ∂α5/∂z_offset, ∂α4/∂R, ∂H̃/∂R, ∂α6/∂c.
-    fn scaled(&self, p: &[f64]) -> (Params, f64, [f64; 6]) {
+    /// The parameters at `p` (SI, the model's order), z_offset, and the chain rule.
+    fn scaled(&self, p: &[f64]) -> (Params, f64, Chain) {
         scaled(&self.probe, &self.params, p)
     }
 }
@@ -206,43 +212,59 @@ pub fn gaps(probe: &AmProbe, q: &Params, z: &[f64], z_offset: f64) -> Vec<f64> {
 }
 
 /// The model's parameters of `probe` with `params` at `p` (SI, in the order of `params`; the
-/// others at the probe's values), z_offset (m), and the chain factors ∂α4/∂E_s, ∂H̃/∂H,
-/// ∂α5/∂z_offset, ∂α4/∂R, ∂H̃/∂R, ∂α6/∂c (module docs).
-pub fn scaled(probe: &AmProbe, params: &[AmParam], p: &[f64]) -> (Params, f64, [f64; 6]) {
-    {
-        let pr = probe;
-        let get = |a: AmParam, default: f64| {
-            params
-                .iter()
-                .position(|q| *q == a)
-                .map_or(default, |j| p[j])
-        };
-        let e = get(AmParam::YoungsModulus, pr.youngs_modulus);
-        let h = get(AmParam::Hamaker, pr.hamaker);
-        let z_offset = get(AmParam::ZOffset, 0.0);
-        let r = get(AmParam::TipRadius, pr.radius);
-        let e_star = |e| reduced_modulus(pr.tip.0, pr.tip.1, e, pr.poisson_ratio);
-        let mut q = pr.params;
-        let ratio = e_star(e) / e_star(pr.youngs_modulus) * (r / pr.radius).sqrt();
-        q.alpha4 = pr.params.alpha4 * ratio;
+/// others at the probe's values), z_offset (m), and the chain rule from the model's groups to
+/// the fitted parameters (module docs).
+pub fn scaled(probe: &AmProbe, params: &[AmParam], p: &[f64]) -> (Params, f64, Chain) {
+    let pr = probe;
+    let get = |a: AmParam, default: f64| {
+        params
+            .iter()
+            .position(|q| *q == a)
+            .map_or(default, |j| p[j])
+    };
+    let fitted = |a: AmParam| params.contains(&a);
+    let e = get(AmParam::YoungsModulus, pr.youngs_modulus);
+    let h = get(AmParam::Hamaker, pr.hamaker);
+    let z_offset = get(AmParam::ZOffset, 0.0);
+    let r = get(AmParam::TipRadius, pr.radius);
+    let e_star = |e| reduced_modulus(pr.tip.0, pr.tip.1, e, pr.poisson_ratio);
+    let mut q = pr.params;
+    let mut chain = Chain::default();
+    let ratio = e_star(e) / e_star(pr.youngs_modulus) * (r / pr.radius).sqrt();
+    q.alpha4 = pr.params.alpha4 * ratio;
+    if fitted(AmParam::YoungsModulus) {
         let de = q.alpha4 * e_star(e) * (1.0 - pr.poisson_ratio * pr.poisson_ratio) / (e * e);
-        let dr4 = q.alpha4 / (2.0 * r);
-        let (mut dh, mut drh) = (0.0, 0.0);
-        if let ContactLaw::Dmt { hamaker, .. } = &mut q.contact_law {
-            if pr.hamaker > 0.0 {
-                // H̃ ∝ H R
-                dh = *hamaker * (r / pr.radius) / pr.hamaker;
-                *hamaker *= h / pr.hamaker * (r / pr.radius);
-                drh = *hamaker / r;
+        chain.push(AmParam::YoungsModulus, OrbitParam::ContactStiffness, de);
+    }
+    if fitted(AmParam::TipRadius) {
+        chain.push(
+            AmParam::TipRadius,
+            OrbitParam::ContactStiffness,
+            q.alpha4 / (2.0 * r),
+        );
+    }
+    if let ContactLaw::Dmt { hamaker, .. } = &mut q.contact_law {
+        if pr.hamaker > 0.0 {
+            // H̃ ∝ H R
+            let dh = *hamaker * (r / pr.radius) / pr.hamaker;
+            *hamaker *= h / pr.hamaker * (r / pr.radius);
+            if fitted(AmParam::Hamaker) {
+                chain.push(AmParam::Hamaker, OrbitParam::Hamaker, dh);
+            }
+            if fitted(AmParam::TipRadius) {
+                chain.push(AmParam::TipRadius, OrbitParam::Hamaker, *hamaker / r);
             }
         }
-        // α6 = c g₀/(t_s F_s), linear in c (a dashpot: R does not enter it)
-        if params.contains(&AmParam::Damping) {
-            q.alpha6 = get(AmParam::Damping, 0.0) * pr.damping_unit;
-        }
-        let chain = [de, dh, 1.0 / pr.length_m, dr4, drh, pr.damping_unit];
-        (q, z_offset, chain)
     }
+    if fitted(AmParam::ZOffset) {
+        chain.push(AmParam::ZOffset, OrbitParam::Gap, 1.0 / pr.length_m);
+    }
+    // α6 = c g₀/(t_s F_s), linear in c (a dashpot: R does not enter it)
+    if fitted(AmParam::Damping) {
+        q.alpha6 = get(AmParam::Damping, 0.0) * pr.damping_unit;
+        chain.push(AmParam::Damping, OrbitParam::Damping, pr.damping_unit);
+    }
+    (q, z_offset, chain)
 }
 
 impl CheckedModel for AmCurveModel {
@@ -266,7 +288,7 @@ impl CheckedModel for AmCurveModel {
         spec.base = q;
         spec.values = alpha5.clone();
         let first = first_sweep_cancellable(&spec, cancel)?;
-        let orbit_params = orbit_params(&q.contact_law, &self.params);
+        let orbit_params = chain.orbit_params();
         let m = self.z.len();
         let n = self.params.len();
         let (amp, ph) = self.channels;
@@ -295,7 +317,7 @@ impl CheckedModel for AmCurveModel {
                 }
                 // (gap, α4, H̃, α6) → (E_s, H, z_offset, R, c)
                 let map = |d: &[f64]| -> Vec<f64> {
-                    let si = |a: &AmParam| to_si(&chain, &orbit_params, d, *a);
+                    let si = |a: &AmParam| chain.to_si(&orbit_params, d, *a);
                     self.params.iter().map(si).collect()
                 };
                 da = map(&s.d_amplitude);

@@ -14,8 +14,7 @@
 
 use super::am_curve::CheckedModel;
 use super::am_curve::{
-    first_sweep_cancellable, gaps, orbit_params, scaled, to_si, AmParam, AmProbe,
-    SENSITIVITY_TOLERANCE,
+    first_sweep_cancellable, gaps, scaled, AmParam, AmProbe, SENSITIVITY_TOLERANCE,
 };
 use super::sensitivity::orbit_sensitivity_component;
 use crate::analysis::stepped::SteppedSpec;
@@ -95,7 +94,7 @@ impl CheckedModel for BimodalCurveModel {
         spec.base = q;
         spec.values = alpha5.clone();
         let first = first_sweep_cancellable(&spec, cancel)?;
-        let orbit_params = orbit_params(&q.contact_law, &self.params);
+        let orbit_params = chain.orbit_params();
         let m = self.z.len();
         let n = self.params.len();
         // each fitted channel's first value
@@ -149,7 +148,7 @@ impl CheckedModel for BimodalCurveModel {
                 v = [s.amplitude, s.phase, two.amplitude, two.phase];
                 // (gap, α4, H̃, α6) → (E_s, H, z_offset, R, c), as the AM model maps them
                 let map = |dd: &[f64]| -> Vec<f64> {
-                    let si = |a: &AmParam| to_si(&chain, &orbit_params, dd, *a);
+                    let si = |a: &AmParam| chain.to_si(&orbit_params, dd, *a);
                     self.params.iter().map(si).collect()
                 };
                 d = vec![

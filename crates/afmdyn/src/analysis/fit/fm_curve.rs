@@ -24,7 +24,7 @@
 //! are reported in [`FmCurveModel::warnings`].
 
 use super::am_curve::CheckedModel;
-use super::am_curve::{gaps, orbit_params, scaled, to_si, AmParam, AmProbe, SENSITIVITY_TOLERANCE};
+use super::am_curve::{gaps, scaled, AmParam, AmProbe, SENSITIVITY_TOLERANCE};
 use super::sensitivity::{orbit_sensitivity, OrbitParam, SensitivityWarning};
 use crate::analysis::fm::{fm_curve_cancellable, FmSpec, DEFAULT_LOOP_TOLERANCE};
 use crate::error::SimError;
@@ -99,7 +99,7 @@ impl CheckedModel for FmCurveModel {
         spec.tolerance = self.loop_tolerance;
         let curve = fm_curve_cancellable(&spec, cancel)?;
         let hz = self.hz_per_omega;
-        let mut orbit_params = orbit_params(&q.contact_law, &self.params);
+        let mut orbit_params = chain.orbit_params();
         let k = orbit_params.len();
         orbit_params.extend([OrbitParam::DriveFrequency, OrbitParam::DriveAmplitude]);
         let n = self.params.len();
@@ -177,7 +177,7 @@ impl CheckedModel for FmCurveModel {
                 .collect();
             // (gap, α4, H̃, α6) → (E_s, H, z_offset, R, c), as the AM model maps them
             for (c, param) in self.params.iter().enumerate() {
-                j[i * n + c] = to_si(&chain, &orbit_params[..k], &d_omega, *param) * hz;
+                j[i * n + c] = chain.to_si(&orbit_params[..k], &d_omega, *param) * hz;
             }
         }
         Ok(warnings)
