@@ -176,6 +176,24 @@ impl Galerkin {
                 return None
             }
         };
+        Some(self.forcing_difference(param, value))
+    }
+
+    /// The lever's damping α3's derivatives (eq. 12, eq. 14, eq. 16, eq. 18): ∂C_s/∂α3 =
+    /// diag(s_1 … s_N) in both regions (shape `[N]`, the damping profile; the fluid's and the
+    /// sample's damping do not move with α3), and ∂F_s/∂α3 of the free and the contact region
+    /// (the base velocity's −α2 α3 s_i ∫φ_i cos Ωτ of eq. 14; 0 under a force drive), linear in
+    /// α3, so the central difference of [`Galerkin::forcing_derivative`] is exact.
+    pub fn damping_derivative(&self) -> (DVector<f64>, [Forcing; 2]) {
+        let p = &self.params;
+        let s = DVector::from_fn(p.modes, |j, _| profile(p, j));
+        (s, self.forcing_difference(SweepParam::Alpha3, p.alpha3))
+    }
+
+    /// (F(p + δ) − F(p − δ)) / 2δ of both regions' forcing in `param` at `value`, δ = 1 + |p|:
+    /// the derivative, exactly up to round-off, for a forcing polynomial of degree ≤ 2 in p.
+    fn forcing_difference(&self, param: SweepParam, value: f64) -> [Forcing; 2] {
+        let p0 = self.params;
         let delta = 1.0 + value.abs();
         let at = |v: f64| {
             let p = p0.with(param, v);
@@ -190,7 +208,7 @@ impl Galerkin {
             sin: diff(&plus[i].sin, &minus[i].sin),
             cos: diff(&plus[i].cos, &minus[i].cos),
         };
-        Some([region(0), region(1)])
+        [region(0), region(1)]
     }
 }
 

@@ -74,6 +74,16 @@ pub struct ForcingDerivative {
     pub d_omega: f64,
 }
 
+/// The free region's derivative in the lever's damping α3
+/// ([`CantileverModel::damping_derivative`]): ∂f/∂α3 = b′(τ) + (0, V ȧ).
+#[derive(Debug, Clone, PartialEq)]
+pub struct DampingDerivative {
+    /// ∂b/∂α3 of the forcing (the base velocity's term of eq. 14), lifted to the state.
+    pub forcing: ForcingDerivative,
+    /// V = −M⁻¹ diag(s), shape N×N: the rate's derivative per unit of ȧ.
+    pub velocity: DMatrix<f64>,
+}
+
 /// Rates of the energy balance dE/dτ = P_base − D_beam − D_contact (see [`CantileverModel::power`]).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct PowerTerms {

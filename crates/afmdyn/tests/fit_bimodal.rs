@@ -155,25 +155,13 @@ fn bimodal_beam_sensitivities_are_the_finite_differences() {
 use afmdyn::analysis::fit::am_curve::{AmParam, AmProbe};
 use afmdyn::analysis::fit::bimodal_curve::BimodalCurveModel;
 use afmdyn::analysis::fit::CurveModel;
+use afmdyn::request::fit_dynamic::am_probe as am_probe_of;
 
 /// The bimodal example probe as the fit's probe.
 fn bimodal_probe() -> AmProbe {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/probe-bimodal.toml");
     let p = Probe::load(&path).expect("example probe");
-    let s = p.sample_inputs;
-    AmProbe {
-        params: p.params,
-        length_m: p.scales.length_m,
-        youngs_modulus: s.youngs_modulus.expect("E"),
-        poisson_ratio: s.poisson_ratio.expect("ν"),
-        tip: (
-            s.tip_youngs_modulus.expect("E_t"),
-            s.tip_poisson_ratio.expect("ν_t"),
-        ),
-        hamaker: s.hamaker.unwrap_or(0.0),
-        radius: s.radius.expect("R"),
-        damping_unit: p.scales.length_m / (p.scales.time_s * p.scales.force_n),
-    }
+    am_probe_of(&p).expect("the fit's probe")
 }
 
 /// The bimodal model's Jacobian (the exact sensitivities of A₁, φ₁, A₂, φ₂, chained to E, H

@@ -10,7 +10,11 @@ use afmdyn::analysis::fit::fm_curve::FmCurveModel;
 use afmdyn::analysis::fit::CurveModel;
 use afmdyn::contact::ContactLaw;
 use afmdyn::probe::Probe;
+use afmdyn::request::fit_dynamic::am_probe as am_probe_of;
 use std::path::Path;
+
+mod common;
+use common::am_synthetic::{truth, Normal};
 
 /// The agreement asked for (issue 62: ≤ 1e-6 relative).
 const AGREE: f64 = 1e-6;
@@ -21,23 +25,15 @@ fn fm_probe(name: &str, hertz: bool) -> (AmProbe, f64) {
         .join("../../examples")
         .join(name);
     let p = Probe::load(&path).expect("example probe");
-    let s = p.sample_inputs;
+    let base = am_probe_of(&p).expect("the fit's probe");
     let mut params = p.params;
     if hertz {
         params.contact_law = ContactLaw::Hertz;
     }
     let probe = AmProbe {
         params,
-        length_m: p.scales.length_m,
-        youngs_modulus: s.youngs_modulus.expect("E"),
-        poisson_ratio: s.poisson_ratio.expect("ν"),
-        tip: (
-            s.tip_youngs_modulus.expect("E_t"),
-            s.tip_poisson_ratio.expect("ν_t"),
-        ),
-        hamaker: if hertz { 0.0 } else { s.hamaker.unwrap_or(0.0) },
-        radius: s.radius.expect("R"),
-        damping_unit: p.scales.length_m / (p.scales.time_s * p.scales.force_n),
+        hamaker: if hertz { 0.0 } else { base.hamaker },
+        ..base
     };
     (probe, p.scales.frequency_hz(1.0))
 }
@@ -46,19 +42,6 @@ fn fm_probe(name: &str, hertz: bool) -> (AmProbe, f64) {
 fn rows(g0: f64, from: f64, to: f64, count: usize, offset: f64) -> Vec<f64> {
     (0..count)
         .map(|i| g0 * (from + (to - from) * i as f64 / (count - 1) as f64) - offset)
-        .collect()
-}
-
-fn truth(probe: &AmProbe, params: &[AmParam], z_offset: f64) -> Vec<f64> {
-    params
-        .iter()
-        .map(|p| match p {
-            AmParam::YoungsModulus => probe.youngs_modulus,
-            AmParam::Hamaker => probe.hamaker,
-            AmParam::ZOffset => z_offset,
-            AmParam::TipRadius => probe.radius,
-            AmParam::Damping => probe.params.alpha6 / probe.damping_unit,
-        })
         .collect()
 }
 
@@ -163,23 +146,6 @@ fn point_mass_fm_sensitivities_are_the_finite_differences() {
 #[test]
 fn beam_fm_sensitivities_are_the_finite_differences() {
     check_probe("probe-beam-dmt.toml", "N = 3 beam");
-}
-
-/// Standard normal draws (splitmix64 and Box–Muller: deterministic, no dependency).
-struct Normal(u64);
-
-impl Normal {
-    fn uniform(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn draw(&mut self) -> f64 {
-        let (u, v) = (self.uniform().max(1e-300), self.uniform());
-        (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
-    }
 }
 
 /// A Δf curve (Hz) of `count` rows z (m) of the library's `fm` analysis

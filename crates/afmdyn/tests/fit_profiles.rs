@@ -21,9 +21,13 @@ use afmdyn::analysis::fit::{
 };
 use afmdyn::analysis::progress::Progress;
 use afmdyn::probe::Probe;
+use afmdyn::request::fit_dynamic::am_probe as am_probe_of;
 use afmdyn::SimError;
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+
+mod common;
+use common::am_synthetic::{truth, Normal};
 
 /// The 95 % quantile of χ²₁ (the profile's threshold), written out here: 1.959964² = 3.841459.
 const THRESHOLD: f64 = 3.841_458_820_694_124;
@@ -44,37 +48,7 @@ fn am_probe() -> AmProbe {
     let path =
         Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/probe-point-mass-dmt.toml");
     let p = Probe::load(&path).expect("example probe");
-    let s = p.sample_inputs;
-    AmProbe {
-        params: p.params,
-        length_m: p.scales.length_m,
-        youngs_modulus: s.youngs_modulus.expect("E"),
-        poisson_ratio: s.poisson_ratio.expect("ν"),
-        tip: (
-            s.tip_youngs_modulus.expect("E_t"),
-            s.tip_poisson_ratio.expect("ν_t"),
-        ),
-        hamaker: s.hamaker.unwrap_or(0.0),
-        radius: s.radius.expect("R"),
-        damping_unit: p.scales.length_m / (p.scales.time_s * p.scales.force_n),
-    }
-}
-
-/// Standard normal draws (splitmix64 and Box–Muller: deterministic, no dependency).
-struct Normal(u64);
-
-impl Normal {
-    fn uniform(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn draw(&mut self) -> f64 {
-        let (u, v) = (self.uniform().max(1e-300), self.uniform());
-        (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
-    }
+    am_probe_of(&p).expect("the fit's probe")
 }
 
 /// A synthetic curve: the model of `rows` rows from z_c = `from` to `to` (A₀) with the truth
@@ -102,16 +76,7 @@ fn synthetic(
         .map(|i| g0 * (from + (to - from) * i as f64 / (rows - 1) as f64) - z_offset)
         .collect();
     let model = AmCurveModel::new(probe, z, channels, params.clone());
-    let truth: Vec<f64> = params
-        .iter()
-        .map(|p| match p {
-            AmParam::YoungsModulus => probe.youngs_modulus,
-            AmParam::Hamaker => probe.hamaker,
-            AmParam::ZOffset => z_offset,
-            AmParam::TipRadius => probe.radius,
-            AmParam::Damping => probe.params.alpha6 / probe.damping_unit,
-        })
-        .collect();
+    let truth = truth(&probe, &params, z_offset);
     let mut y = vec![0.0; model.points()];
     model.evaluate(&truth, &mut y, None);
     let mut sigma = Vec::new();
@@ -148,6 +113,8 @@ fn parameters(c: &Curve) -> Vec<Parameter> {
                 AmParam::ZOffset => (-5e-9, 5e-9, 1e-9),
                 AmParam::TipRadius => (1e-10, f64::INFINITY, probe.radius),
                 AmParam::Damping => (0.0, f64::INFINITY, probe.params.alpha6 / probe.damping_unit),
+                AmParam::QualityFactor => (0.0, f64::INFINITY, probe.quality_factor),
+                AmParam::FreeAmplitude => (1e-12, f64::INFINITY, probe.length_m),
             };
             Parameter {
                 name: p.name().into(),

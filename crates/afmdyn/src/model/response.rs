@@ -84,6 +84,47 @@ impl CantileverModel {
     /// # Errors
     /// [`SimError::OutOfRange`] when Ω is at an undamped natural frequency (no steady state).
     pub fn free_tip_response(&self) -> Result<nalgebra::Complex<f64>, SimError> {
+        Ok(self.free_tip_response_solved()?.0)
+    }
+
+    /// [`CantileverModel::free_tip_response`] H and its derivative dH/dα3 in the lever's
+    /// damping α3 ([`crate::galerkin::Galerkin::damping_derivative`]): differentiating
+    /// D X = F with D = K − Ω²M + iΩC, dX/dα3 = D⁻¹(dF/dα3 − iΩ diag(s) X), and
+    /// dH = φ(1)ᵀ dX e^{−iψ}. The free amplitude set by an instrument fixes |H| α2; with α3
+    /// moving, α2 follows as 1/|H| (d|H|/dα3 = Re(H̄ dH/dα3)/|H|).
+    ///
+    /// # Errors
+    /// As [`CantileverModel::free_tip_response`].
+    pub fn free_tip_response_damping_derivative(
+        &self,
+    ) -> Result<(nalgebra::Complex<f64>, nalgebra::Complex<f64>), SimError> {
+        use nalgebra::Complex;
+        let (h, lu, x) = self.free_tip_response_solved()?;
+        let om = self.params.omega;
+        let (s, df) = self.galerkin.damping_derivative();
+        let rhs = DVector::from_fn(self.modes(), |i, _| {
+            Complex::new(df[0].sin[i], df[0].cos[i]) - Complex::new(0.0, om * s[i]) * x[i]
+        });
+        let dx = lu.solve(&rhs).ok_or_else(|| {
+            SimError::out_of_range("omega", om, "the free system has no steady state")
+        })?;
+        let dh: Complex<f64> = self.tip().iter().zip(dx.iter()).map(|(p, d)| d * *p).sum();
+        Ok((h, dh * Complex::from_polar(1.0, -self.params.drive_phase())))
+    }
+
+    /// H, the LU factors of D = K − Ω²M + iΩC and X (module docs of
+    /// [`CantileverModel::free_tip_response`]).
+    #[allow(clippy::type_complexity)]
+    fn free_tip_response_solved(
+        &self,
+    ) -> Result<
+        (
+            nalgebra::Complex<f64>,
+            nalgebra::LU<nalgebra::Complex<f64>, nalgebra::Dyn, nalgebra::Dyn>,
+            DVector<nalgebra::Complex<f64>>,
+        ),
+        SimError,
+    > {
         use nalgebra::Complex;
         let g = self.galerkin.region(Region::Free);
         let om = self.params.omega;
@@ -96,7 +137,8 @@ impl CantileverModel {
         let f = DVector::from_fn(self.modes(), |i, _| {
             Complex::new(g.forcing.sin[i], g.forcing.cos[i])
         });
-        let x = dyn_stiff.lu().solve(&f).ok_or_else(|| {
+        let lu = dyn_stiff.lu();
+        let x = lu.solve(&f).ok_or_else(|| {
             SimError::out_of_range(
                 "omega",
                 om,
@@ -104,7 +146,33 @@ impl CantileverModel {
             )
         })?;
         let tip: Complex<f64> = self.tip().iter().zip(x.iter()).map(|(p, xi)| xi * *p).sum();
-        Ok(tip * Complex::from_polar(1.0, -self.params.drive_phase()))
+        Ok((
+            tip * Complex::from_polar(1.0, -self.params.drive_phase()),
+            lu,
+            x,
+        ))
+    }
+
+    /// The free region's ∂f/∂α3 in the lever's damping α3 (eq. 12, eq. 14): the state's rate
+    /// (ȧ, M⁻¹(F(τ) − C ȧ − K a)) moves by (0, M⁻¹(∂F/∂α3(τ) − diag(s) ȧ)). `None` when M
+    /// is not positive definite.
+    pub fn damping_derivative(&self) -> Option<DampingDerivative> {
+        let (s, df) = self.galerkin.damping_derivative();
+        let n = self.modes();
+        let chol = self.galerkin.region(Region::Free).mass.clone().cholesky()?;
+        let lift = |f: &DVector<f64>| {
+            let mut v = DVector::zeros(self.dim());
+            v.rows_mut(n, n).copy_from(&chol.solve(f));
+            v
+        };
+        let forcing = ForcingDerivative {
+            b_const: lift(&df[0].constant),
+            b_sin: lift(&df[0].sin),
+            b_cos: lift(&df[0].cos),
+            d_omega: 0.0,
+        };
+        let velocity = -chol.solve(&DMatrix::from_diagonal(&s));
+        Some(DampingDerivative { forcing, velocity })
     }
 
     /// ∂b/∂p of the free and the contact region (in that order) for a parameter p that enters

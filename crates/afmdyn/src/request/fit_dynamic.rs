@@ -214,23 +214,7 @@ pub fn execute(
                 .into(),
         ));
     }
-    let s = probe.sample_inputs;
-    let need = |v: Option<f64>, key: &str| {
-        v.ok_or_else(|| bad("probe", key, format!("the fit needs the probe's {key}")))
-    };
-    let am_probe = AmProbe {
-        params: probe.params,
-        length_m: probe.scales.length_m,
-        youngs_modulus: need(s.youngs_modulus, "sample.youngs_modulus")?,
-        poisson_ratio: need(s.poisson_ratio, "sample.poisson_ratio")?,
-        tip: (
-            need(s.tip_youngs_modulus, "tip.youngs_modulus")?,
-            need(s.tip_poisson_ratio, "tip.poisson_ratio")?,
-        ),
-        hamaker: s.hamaker.unwrap_or(0.0),
-        radius: need(s.radius, "tip.radius")?,
-        damping_unit: probe.scales.length_m / (probe.scales.time_s * probe.scales.force_n),
-    };
+    let am_probe = am_probe(probe)?;
     let names = fitted_names(fit, default_fit, law_name);
     let mut params = Vec::new();
     let mut am = Vec::new();
@@ -252,7 +236,8 @@ pub fn execute(
                 "fit",
                 n,
                 "the dynamic fit's parameters are sample.youngs_modulus, sample.hamaker (dmt), \
-                 sample.damping (hertz), tip.radius and z_offset"
+                 sample.damping (hertz), tip.radius, cantilever.quality_factor, \
+                 drive.free_amplitude and z_offset"
                     .into(),
             )
         })?;
@@ -270,11 +255,14 @@ pub fn execute(
         if am.contains(&p) {
             return Err(bad("fit", n, "named twice".into()));
         }
+        lever_refusal(p, probe, &data).map_or(Ok(()), |why| Err(bad("fit", n, why.into())))?;
         let (start, scale) = match p {
             AmParam::YoungsModulus => (am_probe.youngs_modulus, am_probe.youngs_modulus),
             AmParam::Hamaker => (am_probe.hamaker, am_probe.hamaker.max(1e-21)),
             AmParam::TipRadius => (am_probe.radius, am_probe.radius),
             AmParam::ZOffset => (0.0, 0.1 * am_probe.length_m),
+            AmParam::QualityFactor => (am_probe.quality_factor, am_probe.quality_factor),
+            AmParam::FreeAmplitude => (am_probe.length_m, am_probe.length_m),
             // the probe's c; its scale c itself, or (c = 0, an undamped start) the c whose
             // α6 is 1 % of α4 (a dashpot force α6 δ̇ at the rate g₀/t_s of 1 % of the Hertz
             // force at δ = g₀)
@@ -402,6 +390,62 @@ pub fn execute(
             model_warnings,
         }),
     })
+}
+
+/// The SI values of `probe` the dynamic fit's models scale from ([`AmProbe`]).
+///
+/// # Errors
+/// [`SimError::OutOfRange`] naming the first of E_s, ν_s, E_t, ν_t and R the probe lacks.
+pub fn am_probe(probe: &crate::probe::Probe) -> Result<AmProbe, SimError> {
+    let s = probe.sample_inputs;
+    let need = |v: Option<f64>, key: &str| {
+        v.ok_or_else(|| bad("probe", key, format!("the fit needs the probe's {key}")))
+    };
+    Ok(AmProbe {
+        params: probe.params,
+        length_m: probe.scales.length_m,
+        youngs_modulus: need(s.youngs_modulus, "sample.youngs_modulus")?,
+        poisson_ratio: need(s.poisson_ratio, "sample.poisson_ratio")?,
+        tip: (
+            need(s.tip_youngs_modulus, "tip.youngs_modulus")?,
+            need(s.tip_poisson_ratio, "tip.poisson_ratio")?,
+        ),
+        hamaker: s.hamaker.unwrap_or(0.0),
+        radius: need(s.radius, "tip.radius")?,
+        damping_unit: probe.scales.length_m / (probe.scales.time_s * probe.scales.force_n),
+        quality_factor: probe.calibration.quality_factor,
+    })
+}
+
+/// Why the lever's Q₁ or the free amplitude A₀ (`p`) cannot be fitted on `data` under `probe`,
+/// if so (analysis::fit::am_curve, `lever_and_drive`): Q₁ moves the lever's damping α3 with
+/// the drive α2 holding A₀, which holds for the AM curve of a single-frequency drive in air
+/// or vacuum. An FM curve's Δf does not constrain Q₁ (the loop locks the phase at resonance;
+/// Q₁ shows in the drive it needs, which the fit does not take); a bimodal drive's further
+/// components' forces would follow Q₁ too; in a `[medium]`, Q₁ is the fluid's, made of the
+/// medium's hydrodynamic damping and the lever's. Off resonance, the drive is the sample's
+/// modulation, not a free amplitude.
+fn lever_refusal(p: AmParam, probe: &crate::probe::Probe, data: &AmData) -> Option<&'static str> {
+    let fm = data.frequency_shift.is_some();
+    match p {
+        AmParam::QualityFactor if fm => Some(
+            "an FM curve's frequency shift does not constrain Q (the loop holds the phase at \
+             resonance; Q shows in the drive it needs, which the fit does not take)",
+        ),
+        AmParam::QualityFactor if probe.params.is_multifrequency() => Some(
+            "Q is fitted on the AM curve of a single-frequency drive (the further \
+             components' forces would follow it)",
+        ),
+        AmParam::QualityFactor if probe.medium.is_some() => Some(
+            "in a [medium], Q is the fluid's, made of the medium's damping and the lever's: \
+             fit it on a probe without [medium] whose quality_factor is the measured one",
+        ),
+        AmParam::QualityFactor | AmParam::FreeAmplitude if probe.off_resonance => Some(
+            "an off-resonance (PeakForce) drive is the sample's modulation, with no free \
+             amplitude or resonance to fit",
+        ),
+        _ => None,
+    }
 }
 
 /// The names of the parameters fitted: `fit`, or the default (the force curve's, when
@@ -551,7 +595,7 @@ pub fn document(r: &FitResult, d: &DynamicFit, estimates: Value, correlation: Va
         "rows_fitted": m,
         "evaluations": o.evaluations,
         "termination": o.termination,
-        "units": {"sample.youngs_modulus": "Pa", "tip.radius": "m", "sample.hamaker": "J", "z_offset": "m", "sample.damping": "N s/m",
+        "units": {"sample.youngs_modulus": "Pa", "tip.radius": "m", "sample.hamaker": "J", "z_offset": "m", "sample.damping": "N s/m", "cantilever.quality_factor": "1", "drive.free_amplitude": "m",
                   "z": "m", "amplitude": "m", "phase": "deg", "frequency_shift": "Hz",
                   "amplitude_2": "m", "phase_2": "deg"},
         "method": method,

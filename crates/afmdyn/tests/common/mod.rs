@@ -4,6 +4,10 @@
 #![allow(dead_code)]
 
 #[cfg(feature = "files")]
+pub mod am_synthetic;
+#[cfg(feature = "files")]
+pub mod orbit_check;
+#[cfg(feature = "files")]
 pub mod orbit_params;
 
 use afmdyn::galerkin::Region;

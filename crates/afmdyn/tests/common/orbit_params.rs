@@ -38,6 +38,7 @@ pub fn with(base: &Params, p: OrbitParam, value: f64) -> Params {
         },
         OrbitParam::DriveAmplitude => q.alpha2 = value,
         OrbitParam::DriveFrequency => q.omega = value,
+        OrbitParam::LeverDamping => q.alpha3 = value,
     }
     q
 }
@@ -54,5 +55,6 @@ pub fn value_of(base: &Params, p: OrbitParam) -> f64 {
         },
         OrbitParam::DriveAmplitude => base.alpha2,
         OrbitParam::DriveFrequency => base.omega,
+        OrbitParam::LeverDamping => base.alpha3,
     }
 }

@@ -16,6 +16,10 @@
 //!   [`crate::contact::HertzLaw`]): α6 = c g₀/(t_s F_s)
 //!   ([`crate::contact::SampleSi::damper_alpha6`]), ∂α6/∂c = g₀/(t_s F_s) ([`AmProbe::damping_unit`]), independent of R (a dashpot, not
 //!   a contact-area law);
+//! * `cantilever.quality_factor` Q₁ and `drive.free_amplitude` A₀ (m): through the lever's
+//!   damping α3 ∝ 1/Q₁ and the drive α2, which holds the free amplitude A₀ the instrument set
+//!   (`lever_and_drive`; the orbit's columns [`OrbitParam::LeverDamping`] and
+//!   [`OrbitParam::DriveAmplitude`]); g₀ stays the probe's A₀;
 //! * `z_offset` (m): the rest distance of row i is z_c = z_i + z_offset (the piezo's zero is not
 //!   the sample's), α5 = z_c/g₀ − ã_offset ([`crate::params::Params::alpha5_for_rest_distance`]),
 //!   ∂α5/∂z_offset = 1/g₀.
@@ -49,6 +53,10 @@ pub const HAMAKER: &str = "sample.hamaker";
 pub const RADIUS: &str = "tip.radius";
 /// `sample.damping` (N s/m), the Hertz law's damper.
 pub const DAMPING: &str = "sample.damping";
+/// `cantilever.quality_factor` (1), the lever's Q₁.
+pub const QUALITY_FACTOR: &str = "cantilever.quality_factor";
+/// `drive.free_amplitude` (m), the free amplitude A₀ the instrument set.
+pub const FREE_AMPLITUDE: &str = "drive.free_amplitude";
 
 /// The adaptive integrator's tolerance of the fit's Jacobian: the sensitivities to ~1e-7
 /// relative, far inside what Levenberg–Marquardt and the covariance need (the values are the
@@ -68,6 +76,10 @@ pub enum AmParam {
     TipRadius,
     /// `sample.damping` (Hertz).
     Damping,
+    /// `cantilever.quality_factor` (AM curves of a single-frequency drive).
+    QualityFactor,
+    /// `drive.free_amplitude`.
+    FreeAmplitude,
 }
 
 impl AmParam {
@@ -79,6 +91,8 @@ impl AmParam {
             Z_OFFSET => Some(AmParam::ZOffset),
             RADIUS => Some(AmParam::TipRadius),
             DAMPING => Some(AmParam::Damping),
+            QUALITY_FACTOR => Some(AmParam::QualityFactor),
+            FREE_AMPLITUDE => Some(AmParam::FreeAmplitude),
             _ => None,
         }
     }
@@ -90,6 +104,8 @@ impl AmParam {
             AmParam::ZOffset => Z_OFFSET,
             AmParam::TipRadius => RADIUS,
             AmParam::Damping => DAMPING,
+            AmParam::QualityFactor => QUALITY_FACTOR,
+            AmParam::FreeAmplitude => FREE_AMPLITUDE,
         }
     }
 }
@@ -151,6 +167,8 @@ pub struct AmProbe {
     /// α6 per N s/m of the Hertz damper, g₀/(t_s F_s) (the probe's scales; the probe's
     /// `[sample] damping` is `params.alpha6 / damping_unit`).
     pub damping_unit: f64,
+    /// The lever's Q₁ that gave `params.alpha3` (the probe's `[cantilever] quality_factor`).
+    pub quality_factor: f64,
 }
 
 /// The model of a measured AM curve (module docs).
@@ -264,7 +282,59 @@ pub fn scaled(probe: &AmProbe, params: &[AmParam], p: &[f64]) -> (Params, f64, C
         q.alpha6 = get(AmParam::Damping, 0.0) * pr.damping_unit;
         chain.push(AmParam::Damping, OrbitParam::Damping, pr.damping_unit);
     }
+    lever_and_drive(pr, params, p, &mut q, &mut chain);
     (q, z_offset, chain)
+}
+
+/// The lever's Q₁ and the free amplitude A₀ (module docs): α3 = α3₀ Q₀/Q₁ (α3 ∝ 1/Q₁ at a
+/// fixed damping profile, [`crate::eigen::beam_damping_for_q`]), and α2 = (A₀/g₀)/|H₁(α3)|
+/// with H₁ the free tip response per unit α2 ([`CantileverModel::free_tip_response`]): the
+/// instrument sets A₀ far from the sample, so the drive follows Q₁. Hence ∂α3/∂Q₁ = −α3/Q₁,
+/// ∂α2/∂Q₁ = −α2 (d|H₁|/dα3)/|H₁| · ∂α3/∂Q₁
+/// ([`CantileverModel::free_tip_response_damping_derivative`]), ∂α2/∂A₀ = α2/A₀. g₀ stays
+/// the probe's (its A₀), so the other groups do not move. With neither fitted, q is left as
+/// the probe made it; a model that cannot be built leaves α2 NaN (its evaluation then fails).
+fn lever_and_drive(pr: &AmProbe, params: &[AmParam], p: &[f64], q: &mut Params, chain: &mut Chain) {
+    let at = |a: AmParam| params.iter().position(|x| *x == a).map(|j| p[j]);
+    let (q1, a0) = (at(AmParam::QualityFactor), at(AmParam::FreeAmplitude));
+    if q1.is_none() && a0.is_none() {
+        return;
+    }
+    let g0 = pr.length_m;
+    let a0 = a0.unwrap_or(g0);
+    let (mut d_alpha3, mut d_alpha2_d_alpha3) = (0.0, 0.0);
+    if let Some(q1) = q1 {
+        q.alpha3 = pr.params.alpha3 * pr.quality_factor / q1;
+        d_alpha3 = -q.alpha3 / q1;
+        let response = CantileverModel::new(&q.with(SweepParam::Alpha2, 1.0))
+            .map_err(SimError::from)
+            .and_then(|m| m.free_tip_response_damping_derivative());
+        match response {
+            Ok((h, dh)) => {
+                let mag = h.norm();
+                q.alpha2 = a0 / g0 / mag;
+                d_alpha2_d_alpha3 = -q.alpha2 * (h.conj() * dh).re / (mag * mag);
+            }
+            Err(_) => q.alpha2 = f64::NAN,
+        }
+    } else {
+        q.alpha2 = pr.params.alpha2 * a0 / g0;
+    }
+    if at(AmParam::QualityFactor).is_some() {
+        chain.push(AmParam::QualityFactor, OrbitParam::LeverDamping, d_alpha3);
+        chain.push(
+            AmParam::QualityFactor,
+            OrbitParam::DriveAmplitude,
+            d_alpha2_d_alpha3 * d_alpha3,
+        );
+    }
+    if at(AmParam::FreeAmplitude).is_some() {
+        chain.push(
+            AmParam::FreeAmplitude,
+            OrbitParam::DriveAmplitude,
+            q.alpha2 / a0,
+        );
+    }
 }
 
 impl CheckedModel for AmCurveModel {

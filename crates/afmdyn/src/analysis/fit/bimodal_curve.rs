@@ -87,6 +87,15 @@ impl CheckedModel for BimodalCurveModel {
                 "the bimodal channels need a probe whose drive has a second component",
             ));
         }
+        if self.params.contains(&AmParam::QualityFactor) {
+            // the further components' forces F̃ᵢ = A₀ᵢ/|Hᵢ| would follow Q₁ too
+            return Err(SimError::out_of_range(
+                "fit",
+                AmParam::QualityFactor.name(),
+                "not on bimodal channels: Q is fitted on the AM curve of a single-frequency \
+                 drive",
+            ));
+        }
         let (q, z_offset, chain) = scaled(&self.probe, &self.params, p);
         let g0 = self.probe.length_m;
         let alpha5 = gaps(&self.probe, &q, &self.z, z_offset);

@@ -15,7 +15,10 @@
 //! a fixed phase; [`OrbitParam::DriveAmplitude`]: a column of the forcing), so that
 //! dΔf/dp = f_scale dΩ/dp. The reference ω₁, the setpoint A and the lag φ_set are those of the
 //! free lever, which E, H, R, c and z_offset do not move. The SI parameters map onto
-//! (α5, α4, H̃, α6) as in [`super::am_curve`].
+//! (α5, α4, H̃, α6) as in [`super::am_curve`]. The free amplitude A₀ (`drive.free_amplitude`)
+//! is the loop's amplitude setpoint A = A₀/g₀, so ∂g/∂A₀ = (−A₁/A² · 1/g₀, 0) at fixed
+//! (Ω, α2); the lever's Q₁ is refused (the loop holds the phase at resonance: Δf alone does
+//! not constrain Q₁, which shows in the drive the loop needs).
 //!
 //! # Where it breaks
 //! A fold of the FM curve (det ∂g/∂(Ω, α2) = 0, [`crate::analysis::fm::FmCurve::folds`]), a
@@ -93,13 +96,35 @@ impl CheckedModel for FmCurveModel {
         mut jacobian: Option<&mut [f64]>,
         cancel: &AtomicBool,
     ) -> Result<Vec<String>, SimError> {
+        if self.params.contains(&AmParam::QualityFactor) {
+            return Err(SimError::out_of_range(
+                "fit",
+                AmParam::QualityFactor.name(),
+                "not on an FM curve: the frequency shift does not constrain Q (the loop holds \
+                 the phase at resonance)",
+            ));
+        }
         let (q, z_offset, chain) = scaled(&self.probe, &self.params, p);
         let alpha5 = gaps(&self.probe, &q, &self.z, z_offset);
-        let mut spec = FmSpec::new(q, alpha5, self.amplitude);
+        // the amplitude setpoint: the free amplitude A₀ (the probe's, or the one fitted)
+        let g0 = self.probe.length_m;
+        let a0_at = self
+            .params
+            .iter()
+            .position(|x| *x == AmParam::FreeAmplitude);
+        let setpoint_per_a0 = self.amplitude / g0;
+        let a = a0_at.map_or(self.amplitude, |j| setpoint_per_a0 * p[j]);
+        let mut spec = FmSpec::new(q, alpha5, a);
         spec.tolerance = self.loop_tolerance;
         let curve = fm_curve_cancellable(&spec, cancel)?;
         let hz = self.hz_per_omega;
-        let mut orbit_params = chain.orbit_params();
+        // the loop solves for α2 and Ω: the chain's own drive terms (A₀'s through α2) are the
+        // setpoint's here
+        let mut orbit_params: Vec<OrbitParam> = chain
+            .orbit_params()
+            .into_iter()
+            .filter(|o| !matches!(o, OrbitParam::DriveAmplitude | OrbitParam::DriveFrequency))
+            .collect();
         let k = orbit_params.len();
         orbit_params.extend([OrbitParam::DriveFrequency, OrbitParam::DriveAmplitude]);
         let n = self.params.len();
@@ -156,7 +181,6 @@ impl CheckedModel for FmCurveModel {
                 }
             }
             // ∂g/∂(Ω, α2) and ∂g/∂p_m for g = (A₁/A − 1, φ₁ − φ_set)
-            let a = self.amplitude;
             let g_x = Matrix2::new(
                 s.d_amplitude[k] / a,
                 s.d_amplitude[k + 1] / a,
@@ -178,6 +202,11 @@ impl CheckedModel for FmCurveModel {
             // (gap, α4, H̃, α6) → (E_s, H, z_offset, R, c), as the AM model maps them
             for (c, param) in self.params.iter().enumerate() {
                 j[i * n + c] = chain.to_si(&orbit_params[..k], &d_omega, *param) * hz;
+            }
+            // A₀ moves the setpoint A = A₀/g₀: ∂g/∂A₀ = (−A₁/A² · ∂A/∂A₀, 0)
+            if let Some(c) = a0_at {
+                let dg = -s.amplitude / (a * a) * setpoint_per_a0;
+                j[i * n + c] = -(inv * Vector2::new(dg, 0.0))[0] * hz;
             }
         }
         Ok(warnings)

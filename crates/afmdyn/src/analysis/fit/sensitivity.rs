@@ -36,6 +36,13 @@
 //!   (1/π)∫₀^{2π} W sin(s + ψ) ds then change by (2/T)∫₀^T (∂W/∂Ω|_s) sin θ dτ: the Fourier
 //!   rows take no column of their own for Ω, and dc = (2/T) dq holds for every parameter.
 //!
+//! # The lever's damping
+//! α3 sets the lever's damping matrix C^I = α3 diag(s) (eq. 12; s the damping profile, 1 in
+//! the paper) and, on the base-driven beam, the forcing's base-velocity term −α2 α3 s_i ∫φ_i
+//! cos Ωτ (eq. 14). The state's rate (ȧ, M⁻¹(F − C ȧ − K a + φ F_c)) is affine in α3, so its
+//! column is (0, M⁻¹(∂F/∂α3(τ) − diag(s) ȧ)) ([`CantileverModel::damping_derivative`]); the
+//! law's force, the guard σV_T and the saltation's jump do not move with α3.
+//!
 //! The adaptive integrator's variational equations of the extended system
 //! ([`crate::integrate::adaptive`]; Hairer, Nørsett & Wanner, *Solving ODEs I*, §I.14: with
 //! p as a state, the parameter columns of Φ obey d/dτ(∂x/∂p) = J ∂x/∂p + ∂f/∂p from 0) and the
@@ -76,7 +83,7 @@ use crate::contact::{ContactLaw, DmtLaw, HertzLaw, Law, TipSample, TipSampleLaw}
 use crate::error::SimError;
 use crate::integrate::adaptive::Adaptive;
 use crate::maps::flow::flow_with_jacobian;
-use crate::model::{CantileverModel, ForcingDerivative};
+use crate::model::{CantileverModel, DampingDerivative, ForcingDerivative};
 use crate::params::SweepParam;
 use crate::system::{Guard, HybridSystem, Jump, Region};
 use crate::tip_sample::TipSampleSystem;
@@ -107,6 +114,10 @@ pub enum OrbitParam {
     /// Ω, the drive's frequency, with the period T = 2π/Ω moving with it (the orbit's
     /// sensitivity at a fixed phase Ωτ; module docs, *The drive*).
     DriveFrequency,
+    /// α3, the lever's damping (C^I = α3 diag(s), eq. 12; α3 ∝ 1/Q₁): it enters the rate
+    /// through −M⁻¹ diag(s) ȧ and, on the base-driven beam, the forcing's base-velocity term
+    /// (eq. 14) (module docs, *The lever's damping*).
+    LeverDamping,
 }
 
 /// Why a sensitivity is not to be trusted.
@@ -261,7 +272,9 @@ pub fn d_force(
             // Hertz's α6 δ̇ at α6 = 1 (and α4 = 0): δ̇ in contact, 0 outside
             HertzLaw.force(0.0, 1.0, contact, delta, rate).force
         }
-        OrbitParam::DriveAmplitude | OrbitParam::DriveFrequency => return None,
+        OrbitParam::DriveAmplitude | OrbitParam::DriveFrequency | OrbitParam::LeverDamping => {
+            return None
+        }
     })
 }
 
@@ -274,6 +287,8 @@ struct Extended {
     /// ∂b/∂α2 and ∂b/∂Ω of the free region's forcing (the one Hertz and DMT integrate, their
     /// tip force added), `None` when no drive parameter is asked for.
     forcing: [Option<ForcingDerivative>; 2],
+    /// ∂f/∂α3 of the free region, when α3 is asked for.
+    lever: Option<DampingDerivative>,
     /// The harmonics demodulated, (ω, ψ) each, the drive's first: the Fourier rows 2h, 2h + 1
     /// after the model's state integrate W sin(ωτ + ψ) and W cos(ωτ + ψ).
     harmonics: Vec<(f64, f64)>,
@@ -337,6 +352,20 @@ impl Extended {
                     }
                     -f.d_rate * p.base_amplitude() * c
                 }
+            }
+            OrbitParam::LeverDamping => {
+                if let Some(ld) = &self.lever {
+                    let (s, c) = (m.omega() * tau).sin_cos();
+                    let fd = &ld.forcing;
+                    for (i, o) in out.iter_mut().enumerate() {
+                        *o = fd.b_const[i] + s * fd.b_sin[i] + c * fd.b_cos[i];
+                    }
+                    let rate = &z[n..2 * n];
+                    for i in 0..n {
+                        out[n + i] += (0..n).map(|j| ld.velocity[(i, j)] * rate[j]).sum::<f64>();
+                    }
+                }
+                0.0
             }
             _ => self.d_force(mode, tau, z, k),
         };
@@ -565,9 +594,11 @@ pub fn orbit_sensitivity_component(
         None => (guess.clone(), f64::INFINITY),
     };
     let drive = [OrbitParam::DriveAmplitude, OrbitParam::DriveFrequency];
-    if p.is_multifrequency() && params.iter().any(|q| drive.contains(q)) {
+    // the further components' forces do not move with α2 (the primary's), but their phases
+    // move with Ω
+    if p.is_multifrequency() && params.contains(&OrbitParam::DriveFrequency) {
         return Err(unsupported(
-            "the drive's sensitivities are taken for a single-frequency drive",
+            "the drive frequency's sensitivity is taken for a single-frequency drive",
         ));
     }
     // the free region's forcing derivatives (Hertz and DMT integrate region I's dynamics)
@@ -578,10 +609,20 @@ pub fn orbit_sensitivity_component(
             .flatten()
             .map(|[free, _]| free)
     });
+    let lever = if params.contains(&OrbitParam::LeverDamping) {
+        Some(model.damping_derivative().ok_or(SimError::NoConvergence {
+            what: "orbit sensitivity: the mass matrix is not positive definite",
+            iterations: 0,
+            residual: f64::NAN,
+        })?)
+    } else {
+        None
+    };
     let ext = Extended {
         model: model.clone(),
         params: params.to_vec(),
         forcing,
+        lever,
         harmonics,
     };
     let first = ext.first_param();
