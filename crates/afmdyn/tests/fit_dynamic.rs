@@ -182,7 +182,9 @@ fn the_damper_of_dmt_is_refused() {
 
 use afmdyn::analysis::fit::am_curve::{AmCurveModel, AmParam, AmProbe};
 use afmdyn::analysis::fit::{fit_with, CurveModel, FitOutcome, Observations};
-use common::am_synthetic::{am_probe, parameters, run_fit, synthetic, synthetic_of};
+use common::am_synthetic::{
+    am_probe, door, interval, jacobian_gaps, parameters, run_fit, synthetic, synthetic_of,
+};
 
 #[test]
 fn a_noisy_point_mass_am_curve_gives_back_e_h_and_the_offset() {
@@ -353,69 +355,6 @@ fn fit_through_the_door(
     door(p, model, y, sigma, fit, tag).expect("fit")
 }
 
-/// [`fit_through_the_door`] under the probe `p`: the document, or the request's error.
-fn door(
-    p: Probe,
-    model: &AmCurveModel,
-    y: &[f64],
-    sigma: &[f64],
-    fit: &[&str],
-    tag: &str,
-) -> Result<serde_json::Value, afmdyn::SimError> {
-    use afmdyn::analysis::progress::Progress;
-    use afmdyn::request::fit::FitRequest;
-    use afmdyn::request::{run, Resolved};
-    let dir = std::env::temp_dir().join(format!("afmdyn-{tag}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    let path = dir.join("am.csv");
-    let m = model.z.len();
-    // the channels' columns: values and σ of channel c at y[c m + i], sigma[c m + i]
-    let names: Vec<&str> = [("amplitude", model.channels.0), ("phase", model.channels.1)]
-        .into_iter()
-        .filter_map(|(n, on)| on.then_some(n))
-        .collect();
-    let mut text = String::from("z");
-    for n in &names {
-        text += &format!(",{n}");
-    }
-    for n in &names {
-        text += &format!(",sigma_{n}");
-    }
-    text.push('\n');
-    for (i, z) in model.z.iter().enumerate() {
-        text += &format!("{z:?}");
-        for c in 0..names.len() {
-            text += &format!(",{:?}", y[c * m + i]);
-        }
-        for c in 0..names.len() {
-            text += &format!(",{:?}", sigma[c * m + i]);
-        }
-        text.push('\n');
-    }
-    std::fs::write(&path, text).expect("csv");
-    let resolved = Resolved {
-        params: p.params,
-        probe: Some(p),
-    };
-    let request = FitRequest {
-        data: Some(path.display().to_string()),
-        fit: fit.iter().map(|n| n.to_string()).collect(),
-        ..FitRequest::default()
-    };
-    let doc = run(&request, &resolved, &Progress::default()).map(|o| o.json);
-    std::fs::remove_dir_all(&dir).ok();
-    doc
-}
-
-/// A document's 95 % interval of `name`.
-fn interval(doc: &serde_json::Value, name: &str) -> [f64; 2] {
-    let e = &doc["estimates"][name];
-    [
-        e["interval"][0].as_f64().unwrap(),
-        e["interval"][1].as_f64().unwrap(),
-    ]
-}
-
 /// Through the door from the probe's own starts (E and H the truth's, z_offset 0, 1 nm off —
 /// where the model's first rows follow another branch than the data's and Levenberg–Marquardt
 /// alone stopped at χ²/dof ≈ 100 with E = 2.3 GPa): z_offset's start grid puts the fit in
@@ -477,36 +416,8 @@ fn the_am_models_jacobian_is_its_finite_differences() {
         (true, true),
         1,
     );
-    let m = model.points();
-    let n = truth.len();
-    let mut v = vec![0.0; m];
-    let mut jac = vec![0.0; m * n];
-    model.evaluate(&truth, &mut v, Some(&mut jac));
-    for k in 0..n {
-        let h = 1e-4 * truth[k].abs();
-        let (mut up, mut down) = (truth.clone(), truth.clone());
-        up[k] += h;
-        down[k] -= h;
-        let (mut vu, mut vd) = (vec![0.0; m], vec![0.0; m]);
-        model.evaluate(&up, &mut vu, None);
-        model.evaluate(&down, &mut vd, None);
-        if vu[0].is_nan() || vd[0].is_nan() {
-            eprintln!("{:?}", model.warnings());
-        }
-        let worst = (0..m)
-            .map(|i| {
-                let fd = (vu[i] - vd[i]) / (2.0 * h);
-                let e = jac[i * n + k];
-                (e - fd).abs() / e.abs().max(fd.abs()).max(1e-300)
-            })
-            .fold(0.0, f64::max);
-        eprintln!(
-            "{}: worst relative gap {worst:.2e} (jac row 0 {:.4e}, fd {:.4e})",
-            model.params[k].name(),
-            jac[k],
-            (vu[0] - vd[0]) / (2.0 * h)
-        );
-        assert!(worst < 1e-3, "{}", model.params[k].name());
+    for (name, worst, _) in jacobian_gaps(&model, &truth) {
+        assert!(worst < 1e-3, "{name}: worst relative gap {worst:.2e}");
     }
 }
 
@@ -536,39 +447,10 @@ fn the_damped_am_models_jacobian_is_its_finite_differences() {
     ];
     let (model, _, _, truth) =
         synthetic_of(damped_hertz_probe(), 12, (0.75, 0.3), ps, (true, true), 1);
-    let m = model.points();
-    let n = truth.len();
-    let mut v = vec![0.0; m];
-    let mut jac = vec![0.0; m * n];
-    model.evaluate(&truth, &mut v, Some(&mut jac));
-    assert!(model.warnings().is_empty(), "{:?}", model.warnings());
-    for k in 0..n {
-        let h = 1e-4 * truth[k].abs();
-        let (mut up, mut down) = (truth.clone(), truth.clone());
-        up[k] += h;
-        down[k] -= h;
-        let (mut vu, mut vd) = (vec![0.0; m], vec![0.0; m]);
-        model.evaluate(&up, &mut vu, None);
-        model.evaluate(&down, &mut vd, None);
-        let fd = |i: usize| (vu[i] - vd[i]) / (2.0 * h);
-        let worst = (0..m)
-            .map(|i| {
-                let e = jac[i * n + k];
-                (e - fd(i)).abs() / e.abs().max(fd(i).abs()).max(1e-300)
-            })
-            .fold(0.0, f64::max);
+    for (name, worst, phase_max) in jacobian_gaps(&model, &truth) {
         // the phase rows feel the damper: a column of zeros would pass the relative test
-        let phase_max = (m / 2..m).map(|i| jac[i * n + k].abs()).fold(0.0, f64::max);
-        eprintln!(
-            "{}: worst relative gap {worst:.2e} (largest |∂φ/∂p| {phase_max:.3e} deg per unit)",
-            model.params[k].name(),
-        );
-        assert!(
-            phase_max > 0.0,
-            "{}: no phase sensitivity",
-            model.params[k].name()
-        );
-        assert!(worst < 1e-3, "{}", model.params[k].name());
+        assert!(phase_max > 0.0, "{name}: no phase sensitivity");
+        assert!(worst < 1e-3, "{name}: worst relative gap {worst:.2e}");
     }
 }
 

@@ -62,7 +62,8 @@ fn check_jacobian(model: &FmCurveModel, p: &[f64], what: &str) {
         // law leaves 2e-5 at 1e-2 A₀, 1e-6 at 2e-3 A₀), the loop to 1e-12 so that its error
         // over h (~1e-9 Hz over 5 pm) stays below 1e-7 of the derivative
         let h = match model.params[j] {
-            AmParam::ZOffset => 5e-4 * model.probe.length_m,
+            // A₀ moves the closest distance z_c − A as z_offset does
+            AmParam::ZOffset | AmParam::FreeAmplitude => 5e-4 * model.probe.length_m,
             // the damper moves Δf weakly (the amplitude loop takes up the dissipation: 0.05 Hz
             // over 1e-2 c), so the loop's error over h reaches 1e-6 there; 2e-2 c halves it
             AmParam::Damping => 2e-2 * p[j].abs(),
@@ -136,6 +137,32 @@ fn point_mass_fm_damping_column_is_the_finite_differences() {
     model.tolerance = 1e-11;
     let p = truth(&probe, &params, 1e-9);
     check_jacobian(&model, &p, "point mass Hertz, damped");
+}
+
+/// The Δf model's Jacobian column of the free amplitude A₀ (`drive.free_amplitude`: the
+/// loop's amplitude setpoint A = A₀/g₀, so ∂g/∂A₀ = (−A₁/A² · 1/g₀, 0) at a fixed drive),
+/// with E and z_offset, against its central differences on 4 rows of the point mass, DMT
+/// (attractive to repulsive) and Hertz (free flight, then contact).
+#[test]
+fn point_mass_fm_free_amplitude_column_is_the_finite_differences() {
+    for hertz in [false, true] {
+        let (probe, hz) = fm_probe("probe-point-mass-dmt.toml", hertz);
+        let params = vec![
+            AmParam::FreeAmplitude,
+            AmParam::YoungsModulus,
+            AmParam::ZOffset,
+        ];
+        let (from, to) = if hertz { (1.1, 0.85) } else { (1.4, 0.95) };
+        let z = rows(probe.length_m, from, to, 4, 1e-9);
+        let mut model = FmCurveModel::new(probe, z, params.clone(), hz);
+        model.loop_tolerance = 1e-12;
+        // the sensitivities' integration to 1e-11: at the default 1e-9 the repulsive row's
+        // ∂Δf/∂A₀ is off by 1.2e-6 relative, at 1e-11 by 1e-8
+        model.tolerance = 1e-11;
+        let p = truth(&probe, &params, 1e-9);
+        let law = if hertz { "Hertz" } else { "DMT" };
+        check_jacobian(&model, &p, &format!("point mass {law}, A₀"));
+    }
 }
 
 #[test]

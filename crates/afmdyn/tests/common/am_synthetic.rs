@@ -150,3 +150,114 @@ pub fn run_fit(model: &AmCurveModel, y: &[f64], sigma: &[f64]) -> FitOutcome {
     let fixed = vec![None; params.len()];
     fit_with(model, &obs, &params, &fixed, false)
 }
+
+/// The AM model's Jacobian at `truth` against central differences of its values (steps 1e-4
+/// of each value), column by column: the parameter's name, the worst relative gap over the
+/// rows, and the largest |∂φ/∂p| of the phase rows (0 without them), after asserting that the
+/// Jacobian's evaluation has no warnings.
+pub fn jacobian_gaps(model: &AmCurveModel, truth: &[f64]) -> Vec<(&'static str, f64, f64)> {
+    let m = model.points();
+    let n = truth.len();
+    let mut v = vec![0.0; m];
+    let mut jac = vec![0.0; m * n];
+    model.evaluate(truth, &mut v, Some(&mut jac));
+    assert!(model.warnings().is_empty(), "{:?}", model.warnings());
+    let phase_rows = if model.channels.1 {
+        m - model.z.len()..m
+    } else {
+        m..m
+    };
+    (0..n)
+        .map(|k| {
+            let h = 1e-4 * truth[k].abs();
+            let (mut up, mut down) = (truth.to_vec(), truth.to_vec());
+            up[k] += h;
+            down[k] -= h;
+            let (mut vu, mut vd) = (vec![0.0; m], vec![0.0; m]);
+            model.evaluate(&up, &mut vu, None);
+            model.evaluate(&down, &mut vd, None);
+            let fd = |i: usize| (vu[i] - vd[i]) / (2.0 * h);
+            let worst = (0..m)
+                .map(|i| {
+                    let e = jac[i * n + k];
+                    (e - fd(i)).abs() / e.abs().max(fd(i).abs()).max(1e-300)
+                })
+                .fold(0.0, f64::max);
+            let phase_max = phase_rows
+                .clone()
+                .map(|i| jac[i * n + k].abs())
+                .fold(0.0, f64::max);
+            let name = model.params[k].name();
+            eprintln!(
+                "{name}: worst relative gap {worst:.2e} (row 0: jac {:.4e}, fd {:.4e}; largest \
+                 |∂φ/∂p| {phase_max:.3e})",
+                jac[k],
+                fd(0)
+            );
+            (name, worst, phase_max)
+        })
+        .collect()
+}
+
+/// [`fit_through_the_door`] under the probe `p`: the document, or the request's error.
+pub fn door(
+    p: Probe,
+    model: &AmCurveModel,
+    y: &[f64],
+    sigma: &[f64],
+    fit: &[&str],
+    tag: &str,
+) -> Result<serde_json::Value, afmdyn::SimError> {
+    use afmdyn::analysis::progress::Progress;
+    use afmdyn::request::fit::FitRequest;
+    use afmdyn::request::{run, Resolved};
+    let dir = std::env::temp_dir().join(format!("afmdyn-{tag}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let path = dir.join("am.csv");
+    let m = model.z.len();
+    // the channels' columns: values and σ of channel c at y[c m + i], sigma[c m + i]
+    let names: Vec<&str> = [("amplitude", model.channels.0), ("phase", model.channels.1)]
+        .into_iter()
+        .filter_map(|(n, on)| on.then_some(n))
+        .collect();
+    let mut text = String::from("z");
+    for n in &names {
+        text += &format!(",{n}");
+    }
+    for n in &names {
+        text += &format!(",sigma_{n}");
+    }
+    text.push('\n');
+    for (i, z) in model.z.iter().enumerate() {
+        text += &format!("{z:?}");
+        for c in 0..names.len() {
+            text += &format!(",{:?}", y[c * m + i]);
+        }
+        for c in 0..names.len() {
+            text += &format!(",{:?}", sigma[c * m + i]);
+        }
+        text.push('\n');
+    }
+    std::fs::write(&path, text).expect("csv");
+    let resolved = Resolved {
+        params: p.params,
+        probe: Some(p),
+    };
+    let request = FitRequest {
+        data: Some(path.display().to_string()),
+        fit: fit.iter().map(|n| n.to_string()).collect(),
+        ..FitRequest::default()
+    };
+    let doc = run(&request, &resolved, &Progress::default()).map(|o| o.json);
+    std::fs::remove_dir_all(&dir).ok();
+    doc
+}
+
+/// A document's 95 % interval of `name`.
+pub fn interval(doc: &serde_json::Value, name: &str) -> [f64; 2] {
+    let e = &doc["estimates"][name];
+    [
+        e["interval"][0].as_f64().unwrap(),
+        e["interval"][1].as_f64().unwrap(),
+    ]
+}
