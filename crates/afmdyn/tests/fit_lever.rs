@@ -36,7 +36,15 @@ const LEVER: &[OrbitParam] = &[
 /// base drive carrying α3 in the forcing's base-velocity term, eq. 14).
 #[test]
 fn lever_damping_sensitivities_are_the_finite_differences() {
-    let cases: [(&str, &str, Option<f64>, usize, &[Regime]); 3] = [
+    // (name, probe, the Hertz damper α6 if any, approach points, regimes)
+    type Case = (
+        &'static str,
+        &'static str,
+        Option<f64>,
+        usize,
+        &'static [Regime],
+    );
+    let cases: [Case; 3] = [
         (
             "point mass DMT",
             "probe-point-mass-dmt.toml",
