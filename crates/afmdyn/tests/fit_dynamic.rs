@@ -412,6 +412,7 @@ fn synthetic_of(
             AmParam::ZOffset => z_offset,
             AmParam::TipRadius => probe.radius,
             AmParam::Damping => probe.params.alpha6 / probe.damping_unit,
+            AmParam::AdhesionEnergy => probe.adhesion_energy(),
         })
         .collect();
     let mut y = vec![0.0; model.points()];
@@ -452,6 +453,10 @@ pub fn parameters(probe: &AmProbe, params: &[AmParam]) -> Vec<Parameter> {
                 AmParam::Damping => {
                     let c = probe.params.alpha6 / probe.damping_unit;
                     (0.7 * c, 0.0, f64::INFINITY, c)
+                }
+                AmParam::AdhesionEnergy => {
+                    let w = probe.adhesion_energy();
+                    (1.3 * w, 0.0, f64::INFINITY, w)
                 }
             };
             Parameter {

@@ -58,6 +58,7 @@ fn truth(probe: &AmProbe, params: &[AmParam], z_offset: f64) -> Vec<f64> {
             AmParam::ZOffset => z_offset,
             AmParam::TipRadius => probe.radius,
             AmParam::Damping => probe.params.alpha6 / probe.damping_unit,
+            AmParam::AdhesionEnergy => probe.adhesion_energy(),
         })
         .collect()
 }

@@ -110,6 +110,7 @@ fn synthetic(
             AmParam::ZOffset => z_offset,
             AmParam::TipRadius => probe.radius,
             AmParam::Damping => probe.params.alpha6 / probe.damping_unit,
+            AmParam::AdhesionEnergy => probe.adhesion_energy(),
         })
         .collect();
     let mut y = vec![0.0; model.points()];
@@ -148,6 +149,7 @@ fn parameters(c: &Curve) -> Vec<Parameter> {
                 AmParam::ZOffset => (-5e-9, 5e-9, 1e-9),
                 AmParam::TipRadius => (1e-10, f64::INFINITY, probe.radius),
                 AmParam::Damping => (0.0, f64::INFINITY, probe.params.alpha6 / probe.damping_unit),
+                AmParam::AdhesionEnergy => (0.0, f64::INFINITY, probe.adhesion_energy()),
             };
             Parameter {
                 name: p.name().into(),
