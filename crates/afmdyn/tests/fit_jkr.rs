@@ -119,7 +119,13 @@ fn check_point(base: &Params, guess: &DVector<f64>, params: &[OrbitParam], what:
     );
     for (j, &p) in params.iter().enumerate() {
         let v = value_of(base, p);
-        let h = STEP * v.abs();
+        // Ω within a small share of the resonance's half linewidth Ω/(2Q) (Q = 400 here), as
+        // fit_dynamic.rs's drive cases
+        let h = if p == OrbitParam::DriveFrequency {
+            1e-6 * v.abs()
+        } else {
+            STEP * v.abs()
+        };
         let at = |k: f64| orbit(&with(base, p, v + k * h), &exact.state);
         let (p1, m1, p2, m2) = (at(1.0), at(-1.0), at(2.0), at(-2.0));
         let diff = |f: &dyn Fn(&OrbitSensitivity) -> f64| {
@@ -155,10 +161,10 @@ fn approach(base: Params, points: usize) -> Vec<CurvePoint> {
     approach_retract(&spec).expect("approach").first
 }
 
-/// Check the first stable period-1 point of the approach of `base` whose amplitude is below
-/// 0.98 of the far one and whose phase is above (`attractive`) or below 90°, that taps and is
-/// away from folds and grazing.
-fn check_first(base: &Params, points: usize, attractive: bool, what: &str) {
+/// Check the sensitivities to `params` at the first stable period-1 point of the approach of
+/// `base` whose amplitude is below 0.98 of the far one and whose phase is above
+/// (`attractive`) or below 90°, that taps and is away from folds and grazing.
+fn check_first(base: &Params, points: usize, attractive: bool, params: &[OrbitParam], what: &str) {
     let curve = approach(*base, points);
     let a_far = curve[0].observables.amplitude;
     let checked = curve
@@ -168,7 +174,7 @@ fn check_first(base: &Params, points: usize, attractive: bool, what: &str) {
         .filter(|p| (p.observables.phase > FRAC_PI_2) == attractive)
         .any(|p| {
             let b = with(base, OrbitParam::Gap, p.value);
-            check_point(&b, &p.state, JKR_PARAMS, what)
+            check_point(&b, &p.state, params, what)
         });
     assert!(
         checked,
@@ -183,9 +189,26 @@ fn check_first(base: &Params, points: usize, attractive: bool, what: &str) {
 fn jkr_sensitivities_are_the_finite_differences() {
     let point_mass = jkr_probe("probe-point-mass-dmt.toml").params;
     assert!(matches!(point_mass.contact_law, ContactLaw::Jkr { .. }));
-    check_first(&point_mass, 41, false, "point mass JKR, repulsive");
+    check_first(
+        &point_mass,
+        41,
+        false,
+        JKR_PARAMS,
+        "point mass JKR, repulsive",
+    );
     let beam = jkr_probe("probe-beam-dmt.toml").params;
-    check_first(&beam, 21, false, "N = 3 beam JKR, repulsive");
+    check_first(&beam, 21, false, JKR_PARAMS, "N = 3 beam JKR, repulsive");
+}
+
+/// The drive's α2 and Ω (the FM loop's unknowns; the N = 3 beam's base drive also moves V_T and
+/// so the guards) under JKR, at the same points, against the same differences.
+#[test]
+fn jkr_drive_sensitivities_are_the_finite_differences() {
+    const DRIVE: &[OrbitParam] = &[OrbitParam::DriveAmplitude, OrbitParam::DriveFrequency];
+    let point_mass = jkr_probe("probe-point-mass-dmt.toml").params;
+    check_first(&point_mass, 41, false, DRIVE, "point mass JKR, drive");
+    let beam = jkr_probe("probe-beam-dmt.toml").params;
+    check_first(&beam, 21, false, DRIVE, "N = 3 beam JKR, drive");
 }
 
 /// The refusals: JKR with a Kelvin–Voigt damper (α6 > 0), H̃ of JKR, and P̃ of another law.
