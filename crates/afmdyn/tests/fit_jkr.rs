@@ -599,3 +599,59 @@ fn the_door_refuses_what_jkr_does_not_take() {
         "{e}"
     );
 }
+
+// ---- the FM model under JKR (`analysis::fit::fm_curve`) ----
+
+/// The Δf model's Jacobian columns of E, W and z_offset under JKR (the point mass), 4 rows
+/// with z_c from 0.95 to 0.75 A₀ (the loop holding A₀: tapping), against fourth-order central
+/// differences of its values (each the library's FM loop, to 1e-12): the FM model maps the
+/// orbit's sensitivities to P̃ through the same chain ([`scaled`]).
+#[test]
+fn the_jkr_fm_models_jacobian_is_its_finite_differences() {
+    use afmdyn::analysis::fit::fm_curve::FmCurveModel;
+    let p = jkr_probe("probe-point-mass-dmt.toml");
+    let hz = p.scales.frequency_hz(1.0);
+    let probe = am_probe_of(&p);
+    let params = vec![
+        AmParam::YoungsModulus,
+        AmParam::AdhesionEnergy,
+        AmParam::ZOffset,
+    ];
+    let g0 = probe.length_m;
+    let z: Vec<f64> = (0..4)
+        .map(|i| g0 * (0.95 - 0.2 * i as f64 / 3.0) - 1e-9)
+        .collect();
+    let mut model = FmCurveModel::new(probe, z, params.clone(), hz);
+    model.loop_tolerance = 1e-12;
+    let truth: Vec<f64> = params.iter().map(|a| truth_of(&probe, *a)).collect();
+    let (m, n) = (model.points(), truth.len());
+    let mut v = vec![0.0; m];
+    let mut jac = vec![0.0; m * n];
+    model.evaluate(&truth, &mut v, Some(&mut jac));
+    assert!(model.warnings().is_empty(), "{:?}", model.warnings());
+    eprintln!("Δf = {v:?} Hz");
+    for j in 0..n {
+        let h = match params[j] {
+            AmParam::ZOffset => 5e-4 * g0,
+            _ => 1e-2 * truth[j].abs(),
+        };
+        let at = |k: f64| {
+            let mut q = truth.clone();
+            q[j] += k * h;
+            let mut out = vec![0.0; m];
+            model.evaluate(&q, &mut out, None);
+            out
+        };
+        let (p1, m1, p2, m2) = (at(1.0), at(-1.0), at(2.0), at(-2.0));
+        for i in 0..m {
+            let fd = (8.0 * (p1[i] - m1[i]) - (p2[i] - m2[i])) / (12.0 * h);
+            let e = jac[i * n + j];
+            let rel = rel(e, fd);
+            eprintln!(
+                "{:?} row {i}: dΔf/dp {e:.9e} (fd {fd:.9e}, rel {rel:.1e})",
+                params[j]
+            );
+            assert!(e != 0.0 && rel <= AGREE, "{:?} row {i}", params[j]);
+        }
+    }
+}
