@@ -115,6 +115,7 @@ fn parameters(c: &Curve) -> Vec<Parameter> {
                 AmParam::Damping => (0.0, f64::INFINITY, probe.params.alpha6 / probe.damping_unit),
                 AmParam::QualityFactor => (0.0, f64::INFINITY, probe.quality_factor),
                 AmParam::FreeAmplitude => (1e-12, f64::INFINITY, probe.length_m),
+                AmParam::AdhesionEnergy => (0.0, f64::INFINITY, probe.adhesion_energy()),
             };
             Parameter {
                 name: p.name().into(),

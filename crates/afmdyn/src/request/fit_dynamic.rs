@@ -167,16 +167,16 @@ fn check_data(d: &AmData) -> Result<(), SimError> {
     Ok(())
 }
 
-/// Run the dynamic fit of the parameters `fit` (the force-curve fit's default when
-/// `default_fit`: E, with H on DMT; z_offset always) on `data` under `model`'s probe, with the
+/// Run the dynamic fit of the parameters `fit` (the default when `default_fit`, [`fitted_names`]:
+/// E, with H on DMT and W on JKR; z_offset always) on `data` under `model`'s probe, with the
 /// profile-likelihood intervals when `profiles` (the secant walk,
 /// [`ProfileWalk::Secant`] with [`MAX_SECANT_STEPS`] refits a side; else the Wald intervals).
 /// Every model evaluation is counted in `progress` and checks its cancel flag, between the
 /// rows of its stepped approach too.
 ///
 /// # Errors
-/// [`SimError::OutOfRange`] for bad data, parameter names, a probe without a Hertz or DMT
-/// sample; [`SimError::Cancelled`].
+/// [`SimError::OutOfRange`] for bad data, parameter names, a probe without a Hertz, DMT or JKR
+/// sample, a DMT or JKR sample with Kelvin–Voigt damping; [`SimError::Cancelled`].
 pub fn execute(
     fit: &[String],
     default_fit: bool,
@@ -195,12 +195,12 @@ pub fn execute(
     })?;
     let law_name = probe.params.contact_law.name();
     let law = crate::analysis::fit::force_curve::ForceLaw::from_name(law_name)
-        .filter(|l| matches!(l.name(), "hertz" | "dmt"))
+        .filter(|l| matches!(l.name(), "hertz" | "dmt" | "jkr"))
         .ok_or_else(|| {
             bad(
                 "law",
                 law_name,
-                "the dynamic fit takes the probe's [sample].law = hertz or dmt".into(),
+                "the dynamic fit takes the probe's [sample].law = hertz, dmt or jkr".into(),
             )
         })?;
     // the exact sensitivities of DMT are those of its elastic force (analysis::fit::sensitivity):
@@ -211,6 +211,17 @@ pub fn execute(
             format!("α6 = {:.4e}", probe.params.alpha6),
             "the dynamic fit of a DMT sample needs it without Kelvin–Voigt damping: \
              sample.viscosity = 0 (or the hertz law)"
+                .into(),
+        ));
+    }
+    // JKR's exact sensitivities likewise without its Kelvin–Voigt term
+    // (analysis::fit::sensitivity_jkr)
+    if law_name == "jkr" && probe.params.alpha6 != 0.0 {
+        return Err(bad(
+            "sample.viscosity",
+            format!("α6 = {:.4e}", probe.params.alpha6),
+            "the dynamic fit of a JKR sample needs it without Kelvin–Voigt damping: \
+             sample.viscosity = 0"
                 .into(),
         ));
     }
@@ -236,8 +247,8 @@ pub fn execute(
                 "fit",
                 n,
                 "the dynamic fit's parameters are sample.youngs_modulus, sample.hamaker (dmt), \
-                 sample.damping (hertz), tip.radius, cantilever.quality_factor, \
-                 drive.free_amplitude and z_offset"
+                 sample.damping (hertz), sample.adhesion_energy (jkr), tip.radius, \
+                 cantilever.quality_factor, drive.free_amplitude and z_offset"
                     .into(),
             )
         })?;
@@ -249,6 +260,15 @@ pub fn execute(
                 "fit",
                 n,
                 "sample.damping is the hertz law's damper (DMT's Kelvin–Voigt term is refused)"
+                    .into(),
+            ));
+        }
+        if p == AmParam::AdhesionEnergy && law_name != "jkr" {
+            return Err(bad(
+                "fit",
+                n,
+                "sample.adhesion_energy is the jkr law's work of adhesion (DMT's adhesion is \
+                 its sample.hamaker)"
                     .into(),
             ));
         }
@@ -270,6 +290,11 @@ pub fn execute(
                 let c = am_probe.params.alpha6 / am_probe.damping_unit;
                 let typical = 0.01 * am_probe.params.alpha4 / am_probe.damping_unit;
                 (c, if c > 0.0 { c } else { typical })
+            }
+            // the probe's W (J/m²), its own scale (JKR's P̃ > 0, so W > 0)
+            AmParam::AdhesionEnergy => {
+                let w = am_probe.adhesion_energy();
+                (w, w)
             }
         };
         // the physical range's lower end only: MINUIT's sine map of a two-sided range squashes
@@ -450,11 +475,17 @@ fn lever_refusal(p: AmParam, probe: &crate::probe::Probe, data: &AmData) -> Opti
 
 /// The names of the parameters fitted: `fit`, or the default (the force curve's, when
 /// `default_fit`) E, with H on DMT (`law_name` "dmt"); z_offset always, last unless named.
+/// The names of the parameters fitted: `fit`, or the default (when `default_fit`) E, with H on
+/// DMT (`law_name` "dmt") and the work of adhesion W (`sample.adhesion_energy`) on JKR
+/// (`law_name` "jkr"); z_offset always, last unless named.
 pub fn fitted_names(fit: &[String], default_fit: bool, law_name: &str) -> Vec<String> {
     let mut names: Vec<String> = if default_fit {
         let mut v = vec!["sample.youngs_modulus".to_string()];
         if law_name == "dmt" {
             v.push("sample.hamaker".into());
+        }
+        if law_name == "jkr" {
+            v.push("sample.adhesion_energy".into());
         }
         v
     } else {
@@ -596,6 +627,7 @@ pub fn document(r: &FitResult, d: &DynamicFit, estimates: Value, correlation: Va
         "evaluations": o.evaluations,
         "termination": o.termination,
         "units": {"sample.youngs_modulus": "Pa", "tip.radius": "m", "sample.hamaker": "J", "z_offset": "m", "sample.damping": "N s/m", "cantilever.quality_factor": "1", "drive.free_amplitude": "m",
+                  "sample.adhesion_energy": "J/m^2",
                   "z": "m", "amplitude": "m", "phase": "deg", "frequency_shift": "Hz",
                   "amplitude_2": "m", "phase_2": "deg"},
         "method": method,

@@ -29,6 +29,7 @@ pub fn truth(probe: &AmProbe, params: &[AmParam], z_offset: f64) -> Vec<f64> {
             AmParam::Damping => probe.params.alpha6 / probe.damping_unit,
             AmParam::QualityFactor => probe.quality_factor,
             AmParam::FreeAmplitude => probe.length_m,
+            AmParam::AdhesionEnergy => probe.adhesion_energy(),
         })
         .collect()
 }
@@ -127,6 +128,10 @@ pub fn parameters(probe: &AmProbe, params: &[AmParam]) -> Vec<Parameter> {
                 AmParam::FreeAmplitude => {
                     let a0 = probe.length_m;
                     (0.95 * a0, 1e-12, f64::INFINITY, a0)
+                }
+                AmParam::AdhesionEnergy => {
+                    let w = probe.adhesion_energy();
+                    (1.3 * w, 0.0, f64::INFINITY, w)
                 }
             };
             Parameter {

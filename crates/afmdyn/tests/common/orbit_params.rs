@@ -1,4 +1,4 @@
-//! The exact-sensitivity tests' helpers (`fit_dynamic.rs`, `fit_bimodal.rs`): an example
+//! The exact-sensitivity tests' helpers (`fit_dynamic.rs`, `fit_bimodal.rs`, `fit_jkr.rs`): an example
 //! probe's model parameters, a tight Newton, and a model parameter moved or read by its
 //! [`OrbitParam`].
 
@@ -39,6 +39,10 @@ pub fn with(base: &Params, p: OrbitParam, value: f64) -> Params {
         OrbitParam::DriveAmplitude => q.alpha2 = value,
         OrbitParam::DriveFrequency => q.omega = value,
         OrbitParam::LeverDamping => q.alpha3 = value,
+        OrbitParam::Adhesion => match &mut q.contact_law {
+            ContactLaw::Jkr { adhesion } => *adhesion = value,
+            _ => panic!("P̃ of a law without it"),
+        },
     }
     q
 }
@@ -56,5 +60,9 @@ pub fn value_of(base: &Params, p: OrbitParam) -> f64 {
         OrbitParam::DriveAmplitude => base.alpha2,
         OrbitParam::DriveFrequency => base.omega,
         OrbitParam::LeverDamping => base.alpha3,
+        OrbitParam::Adhesion => match base.contact_law {
+            ContactLaw::Jkr { adhesion } => adhesion,
+            _ => panic!("P̃ of a law without it"),
+        },
     }
 }

@@ -23,6 +23,10 @@
 //! * `z_offset` (m): the rest distance of row i is z_c = z_i + z_offset (the piezo's zero is not
 //!   the sample's), α5 = z_c/g₀ − ã_offset ([`crate::params::Params::alpha5_for_rest_distance`]),
 //!   ∂α5/∂z_offset = 1/g₀.
+//! * `sample.adhesion_energy` W (J/m²), JKR's work of adhesion: the adhesion group
+//!   P̃ = πWR/F_s (Johnson, Kendall & Roberts 1971; [`crate::contact::Jkr`]) is linear in W and
+//!   in R, so ∂P̃/∂W = P̃/W, and R's chain gains ∂P̃/∂R = P̃/R beside α4's (E moves α4 alone).
+//!   The probe's W is [`AmProbe::adhesion_energy`].
 //!
 //! The model's values are the amplitudes A g₀ (m) of the rows, then their phases φ (deg), for
 //! the channels fitted; a row whose point is not a stable period-1 orbit keeps the stepped
@@ -57,6 +61,8 @@ pub const DAMPING: &str = "sample.damping";
 pub const QUALITY_FACTOR: &str = "cantilever.quality_factor";
 /// `drive.free_amplitude` (m), the free amplitude A₀ the instrument set.
 pub const FREE_AMPLITUDE: &str = "drive.free_amplitude";
+/// `sample.adhesion_energy` (J/m²), JKR's work of adhesion.
+pub const ADHESION_ENERGY: &str = "sample.adhesion_energy";
 
 /// The adaptive integrator's tolerance of the fit's Jacobian: the sensitivities to ~1e-7
 /// relative, far inside what Levenberg–Marquardt and the covariance need (the values are the
@@ -80,6 +86,8 @@ pub enum AmParam {
     QualityFactor,
     /// `drive.free_amplitude`.
     FreeAmplitude,
+    /// `sample.adhesion_energy` (JKR).
+    AdhesionEnergy,
 }
 
 impl AmParam {
@@ -93,6 +101,7 @@ impl AmParam {
             DAMPING => Some(AmParam::Damping),
             QUALITY_FACTOR => Some(AmParam::QualityFactor),
             FREE_AMPLITUDE => Some(AmParam::FreeAmplitude),
+            ADHESION_ENERGY => Some(AmParam::AdhesionEnergy),
             _ => None,
         }
     }
@@ -106,6 +115,7 @@ impl AmParam {
             AmParam::Damping => DAMPING,
             AmParam::QualityFactor => QUALITY_FACTOR,
             AmParam::FreeAmplitude => FREE_AMPLITUDE,
+            AmParam::AdhesionEnergy => ADHESION_ENERGY,
         }
     }
 }
@@ -169,6 +179,30 @@ pub struct AmProbe {
     pub damping_unit: f64,
     /// The lever's Q₁ that gave `params.alpha3` (the probe's `[cantilever] quality_factor`).
     pub quality_factor: f64,
+}
+
+impl AmProbe {
+    /// The probe's work of adhesion W (J/m²) under JKR, from its groups: P̃ = πWR/F_s with
+    /// the force scale of its Hertz group, F_s = (4/3)E*√R g₀^{3/2}/α4
+    /// ([`crate::contact::SampleSi::hertz_alpha4`]), so W = P̃ (4/3) E* g₀^{3/2}/(π α4 √R)
+    /// (the probe's E*, R, g₀). 0 under another law (or α4 = 0).
+    pub fn adhesion_energy(&self) -> f64 {
+        let ContactLaw::Jkr { adhesion } = self.params.contact_law else {
+            return 0.0;
+        };
+        let alpha4 = self.params.alpha4;
+        if !(alpha4 > 0.0 && self.radius > 0.0) {
+            return 0.0;
+        }
+        let e_star = reduced_modulus(
+            self.tip.0,
+            self.tip.1,
+            self.youngs_modulus,
+            self.poisson_ratio,
+        );
+        adhesion * 4.0 / 3.0 * e_star * self.length_m.powf(1.5)
+            / (std::f64::consts::PI * alpha4 * self.radius.sqrt())
+    }
 }
 
 /// The model of a measured AM curve (module docs).
@@ -283,6 +317,20 @@ pub fn scaled(probe: &AmProbe, params: &[AmParam], p: &[f64]) -> (Params, f64, C
         chain.push(AmParam::Damping, OrbitParam::Damping, pr.damping_unit);
     }
     lever_and_drive(pr, params, p, &mut q, &mut chain);
+    // JKR's P̃ = πWR/F_s ∝ W R (module docs)
+    if let ContactLaw::Jkr { adhesion } = &mut q.contact_law {
+        let w0 = pr.adhesion_energy();
+        if w0 > 0.0 {
+            let w = get(AmParam::AdhesionEnergy, w0);
+            *adhesion *= w / w0 * (r / pr.radius);
+            if fitted(AmParam::AdhesionEnergy) {
+                chain.push(AmParam::AdhesionEnergy, OrbitParam::Adhesion, *adhesion / w);
+            }
+            if fitted(AmParam::TipRadius) {
+                chain.push(AmParam::TipRadius, OrbitParam::Adhesion, *adhesion / r);
+            }
+        }
+    }
     (q, z_offset, chain)
 }
 
@@ -385,7 +433,7 @@ impl CheckedModel for AmCurveModel {
                 for w in &s.warnings {
                     warnings.push(format!("row {} (z = {:.4e} m): {w}", i + 1, self.z[i]));
                 }
-                // (gap, α4, H̃, α6) → (E_s, H, z_offset, R, c)
+                // (gap, α4, H̃, α6, P̃) → (E_s, H, z_offset, R, c, W)
                 let map = |d: &[f64]| -> Vec<f64> {
                     let si = |a: &AmParam| chain.to_si(&orbit_params, d, *a);
                     self.params.iter().map(si).collect()

@@ -15,6 +15,7 @@ pub mod force_curve;
 pub mod least_squares;
 pub mod profile;
 pub mod sensitivity;
+pub mod sensitivity_jkr;
 pub mod sls_curve;
 pub mod start;
 

@@ -77,6 +77,12 @@
 //! `hertz` (with or without its damper α6 δ̇, smooth in δ) and `dmt` (without Kelvin–Voigt
 //! damping, α6 = 0, whose δ̇/√δ Jacobian singularity at contact onset the plain variational
 //! equations do not resolve).
+//!
+//! # JKR
+//! The law `jkr` (α6 = 0) takes α5, α4 and its adhesion group P̃ ([`OrbitParam::Adhesion`]):
+//! its force at fixed δ moves through the root q(δ) of the contact radius, its contact guard
+//! |δ_b| − V_T moves with α4 and P̃, and its force jumps where the contact forms and breaks, so
+//! the saltation is not the identity there ([`super::sensitivity_jkr`] for the derivatives).
 
 use crate::analysis::shooting::{shoot_with, ShootingOptions, GRAZING_TOL};
 use crate::contact::{ContactLaw, DmtLaw, HertzLaw, Law, TipSample, TipSampleLaw};
@@ -118,6 +124,8 @@ pub enum OrbitParam {
     /// through −M⁻¹ diag(s) ȧ and, on the base-driven beam, the forcing's base-velocity term
     /// (eq. 14) (module docs, *The lever's damping*).
     LeverDamping,
+    /// P̃, the JKR law's adhesion group (πWR/F̃-unit, ∝ W R; [`crate::contact::Jkr`]).
+    Adhesion,
 }
 
 /// Why a sensitivity is not to be trusted.
@@ -238,6 +246,10 @@ pub fn d_force(
     delta: f64,
     rate: f64,
 ) -> Option<f64> {
+    if let ContactLaw::Jkr { adhesion } = *law {
+        // JKR's at fixed δ through the root q(δ) (without its damper, refused)
+        return super::sensitivity_jkr::d_force(stiffness, adhesion, param, contact, delta);
+    }
     let a0 = match *law {
         ContactLaw::Hertz => None,
         ContactLaw::Dmt {
@@ -275,6 +287,7 @@ pub fn d_force(
         OrbitParam::DriveAmplitude | OrbitParam::DriveFrequency | OrbitParam::LeverDamping => {
             return None
         }
+        OrbitParam::Adhesion => return None,
     })
 }
 
@@ -453,6 +466,15 @@ impl HybridSystem for Extended {
                 .guard_param_derivative(mode, sweep, tau)
                 .unwrap_or(0.0);
         }
+        if let ContactLaw::Jkr { adhesion } = self.model.params().contact_law {
+            // JKR's contact guard |δ_b| − V_T moves with α4 and P̃ (sensitivity_jkr)
+            let alpha4 = self.model.params().alpha4;
+            for (k, &p) in self.params.iter().enumerate() {
+                if let Some(dg) = super::sensitivity_jkr::d_guard(alpha4, adhesion, mode, p) {
+                    grad[self.first_param() + k] = dg;
+                }
+            }
+        }
         Guard {
             value: g.value,
             grad,
@@ -503,7 +525,8 @@ impl TipSampleSystem for Extended {
 ///
 /// # Errors
 /// [`SimError::Unsupported`] for a law other than Hertz and DMT, for H̃ under Hertz, for
-/// DMT with α6 > 0 and for α6 ([`OrbitParam::Damping`]) under DMT;
+/// DMT with α6 > 0 and for α6 ([`OrbitParam::Damping`]) under DMT; likewise for JKR with
+/// α6 > 0 or asked for H̃ or α6, and for P̃ ([`OrbitParam::Adhesion`]) under another law;
 /// [`SimError::NoConvergence`] from the Newton solve; [`SimError`] from the integrator.
 pub fn orbit_sensitivity(
     model: &CantileverModel,
@@ -579,11 +602,27 @@ pub fn orbit_sensitivity_component(
                 ));
             }
         }
+        ContactLaw::Jkr { .. } => {
+            if p.alpha6 != 0.0 {
+                return Err(unsupported(
+                    "exact sensitivities of JKR need α6 = 0 (no Kelvin–Voigt damping)",
+                ));
+            }
+            let other = [OrbitParam::Hamaker, OrbitParam::Damping];
+            if params.iter().any(|q| other.contains(q)) {
+                return Err(unsupported(
+                    "the JKR law has no Hamaker group and its Kelvin–Voigt damper is refused",
+                ));
+            }
+        }
         _ => {
             return Err(unsupported(
-                "exact orbit sensitivities are implemented for the hertz and dmt laws",
+                "exact orbit sensitivities are implemented for the hertz, dmt and jkr laws",
             ))
         }
+    }
+    if !matches!(p.contact_law, ContactLaw::Jkr { .. }) && params.contains(&OrbitParam::Adhesion) {
+        return Err(unsupported("the adhesion group P̃ is the jkr law's"));
     }
     let (state, shot_grazing) = match newton {
         Some(newton) => {
