@@ -6,29 +6,22 @@
 //! a JKR sample); the contact forms and breaks every period there, so the force jumps at both
 //! switchings and the contact guard |δ_b| − V_T moves with α4 and P̃.
 
-use afmdyn::analysis::approach::{approach_retract, approach_spec};
-use afmdyn::analysis::fit::sensitivity::{orbit_sensitivity, OrbitParam, OrbitSensitivity};
-use afmdyn::analysis::observables::observe_orbit;
-use afmdyn::analysis::shooting::shoot;
-use afmdyn::analysis::stepped::{CurvePoint, Spacing};
+use afmdyn::analysis::fit::am_curve::{scaled, AmCurveModel, AmParam, AmProbe};
+use afmdyn::analysis::fit::sensitivity::{orbit_sensitivity, OrbitParam};
+use afmdyn::analysis::fit::CurveModel;
 use afmdyn::contact::ContactLaw;
-use afmdyn::integrate::{IntegratorKind, IntegratorOptions};
 use afmdyn::model::CantileverModel;
 use afmdyn::probe::Probe;
+use afmdyn::request::fit_dynamic::am_probe;
 use afmdyn::Params;
 use nalgebra::DVector;
-use std::f64::consts::FRAC_PI_2;
 use std::path::Path;
 
 mod common;
-use common::orbit_params::{newton, probe, value_of, with};
+use common::am_synthetic::{door, interval, jacobian_gaps, run_fit, synthetic_of, truth};
+use common::orbit_check::{approach, check_first, Regime, AGREE, TOL};
+use common::orbit_params::probe;
 
-/// The adaptive integrator's tolerance of the sensitivities and of the finite differences.
-const TOL: f64 = 1e-12;
-/// The relative step of the central differences.
-const STEP: f64 = 1e-3;
-/// The agreement asked for (issue 62: ≤ 1e-6 relative).
-const AGREE: f64 = 1e-6;
 /// The JKR parameters differentiated.
 const JKR_PARAMS: &[OrbitParam] = &[
     OrbitParam::Gap,
@@ -66,120 +59,11 @@ fn jkr_probe_with(name: &str, w: f64) -> Probe {
     Probe::parse(&text, name).expect("jkr probe")
 }
 
-/// The orbit at `params` near `guess`, without sensitivities.
-fn orbit(params: &Params, guess: &DVector<f64>) -> OrbitSensitivity {
-    let model = CantileverModel::new(params).expect("model");
-    orbit_sensitivity(&model, TOL, guess, &[], Some(&newton())).expect("orbit")
-}
-
-/// Relative difference of an exact derivative `e` and its finite difference `f` (0 when both
-/// are exactly 0).
-fn rel(e: f64, f: f64) -> f64 {
-    if e == 0.0 && f == 0.0 {
-        0.0
-    } else {
-        (e - f).abs() / e.abs().max(f64::MIN_POSITIVE)
-    }
-}
-
-/// Check the exact sensitivities at the orbit near `guess` against fourth-order central
-/// differences; `false` (nothing checked) where the orbit is near a fold, grazing, or does not
-/// tap (contact for a share of the period strictly between 0 and 1).
-fn check_point(base: &Params, guess: &DVector<f64>, params: &[OrbitParam], what: &str) -> bool {
-    let model = CantileverModel::new(base).expect("model");
-    let exact =
-        orbit_sensitivity(&model, TOL, guess, params, Some(&newton())).expect("sensitivity");
-    if !exact.warnings.is_empty() {
-        eprintln!("{what}: skipped, {:?}", exact.warnings);
-        return false;
-    }
-    let shot = shoot(&model, &exact.state, 1, &newton()).expect("orbit");
-    let opts = IntegratorOptions {
-        kind: IntegratorKind::Adaptive,
-        tolerance: TOL,
-        ..IntegratorOptions::default()
-    };
-    let obs = observe_orbit(&model, opts, &shot, 1).expect("observables");
-    if !(obs.contact_fraction > 0.0 && obs.contact_fraction < 1.0) {
-        eprintln!("{what}: skipped, contact fraction {}", obs.contact_fraction);
-        return false;
-    }
-    // the Fourier integrals' harmonic is the library's observable
-    assert!(
-        (obs.amplitude - exact.amplitude).abs() <= 1e-8 * obs.amplitude,
-        "{what}: A = {} against the observables' {}",
-        exact.amplitude,
-        obs.amplitude
-    );
-    assert!(
-        (obs.phase - exact.phase).abs() <= 1e-8,
-        "{what}: φ = {} against the observables' {}",
-        exact.phase,
-        obs.phase
-    );
-    for (j, &p) in params.iter().enumerate() {
-        let v = value_of(base, p);
-        // Ω within a small share of the resonance's half linewidth Ω/(2Q) (Q = 400 here), as
-        // fit_dynamic.rs's drive cases
-        let h = if p == OrbitParam::DriveFrequency {
-            1e-6 * v.abs()
-        } else {
-            STEP * v.abs()
-        };
-        let at = |k: f64| orbit(&with(base, p, v + k * h), &exact.state);
-        let (p1, m1, p2, m2) = (at(1.0), at(-1.0), at(2.0), at(-2.0));
-        let diff = |f: &dyn Fn(&OrbitSensitivity) -> f64| {
-            (8.0 * (f(&p1) - f(&m1)) - (f(&p2) - f(&m2))) / (12.0 * h)
-        };
-        let fd_a = diff(&|o| o.amplitude);
-        let fd_phi = diff(&|o| o.phase);
-        let fd_z = ((&p1.state - &m1.state) * 8.0 - (&p2.state - &m2.state)) / (12.0 * h);
-        let (ea, ep) = (exact.d_amplitude[j], exact.d_phase[j]);
-        let ez = exact.d_state.column(j).into_owned();
-        let rz = (&ez - &fd_z).norm() / ez.norm();
-        eprintln!(
-            "{what} {p:?} (contact fraction {:.3}): dA/dp {ea:.9e} (fd {fd_a:.9e}, rel {:.1e}), \
-             dφ/dp {ep:.9e} (fd {fd_phi:.9e}, rel {:.1e}), dz*/dp rel {rz:.1e}",
-            obs.contact_fraction,
-            rel(ea, fd_a),
-            rel(ep, fd_phi)
-        );
-        assert!(
-            ea != 0.0 && ep != 0.0,
-            "{what} {p:?}: a tapping orbit feels p"
-        );
-        assert!(rel(ea, fd_a) <= AGREE, "{what} {p:?}: dA/dp");
-        assert!(rel(ep, fd_phi) <= AGREE, "{what} {p:?}: dφ/dp");
-        assert!(rz <= AGREE, "{what} {p:?}: dz*/dp");
-    }
-    true
-}
-
-/// An approach from z_c = 1.2 A₀ to 0.2 A₀ in `points` points.
-fn approach(base: Params, points: usize) -> Vec<CurvePoint> {
-    let spec = approach_spec(base, 1.2, 0.2, Spacing::Points(points)).expect("spec");
-    approach_retract(&spec).expect("approach").first
-}
-
-/// Check the sensitivities to `params` at the first stable period-1 point of the approach of
-/// `base` whose amplitude is below 0.98 of the far one and whose phase is above
-/// (`attractive`) or below 90°, that taps and is away from folds and grazing.
-fn check_first(base: &Params, points: usize, attractive: bool, params: &[OrbitParam], what: &str) {
+/// Check the sensitivities to `params` at the first tapping point ([`Regime::Tapping`]) of
+/// the approach of `base` in `points` points away from folds and grazing.
+fn check_tapping(base: &Params, points: usize, params: &[OrbitParam], what: &str) {
     let curve = approach(*base, points);
-    let a_far = curve[0].observables.amplitude;
-    let checked = curve
-        .iter()
-        .filter(|p| p.period == Some(1) && p.stable)
-        .filter(|p| p.observables.amplitude < 0.98 * a_far)
-        .filter(|p| (p.observables.phase > FRAC_PI_2) == attractive)
-        .any(|p| {
-            let b = with(base, OrbitParam::Gap, p.value);
-            check_point(&b, &p.state, params, what)
-        });
-    assert!(
-        checked,
-        "{what}: no tapping point away from folds and grazing"
-    );
+    check_first(base, &Regime::Tapping.points(&curve), params, what);
 }
 
 /// ∂(A, φ, z*)/∂(α5, α4, P̃) under JKR against the fourth-order central differences
@@ -189,15 +73,9 @@ fn check_first(base: &Params, points: usize, attractive: bool, params: &[OrbitPa
 fn jkr_sensitivities_are_the_finite_differences() {
     let point_mass = jkr_probe("probe-point-mass-dmt.toml").params;
     assert!(matches!(point_mass.contact_law, ContactLaw::Jkr { .. }));
-    check_first(
-        &point_mass,
-        41,
-        false,
-        JKR_PARAMS,
-        "point mass JKR, repulsive",
-    );
+    check_tapping(&point_mass, 41, JKR_PARAMS, "point mass JKR, tapping");
     let beam = jkr_probe("probe-beam-dmt.toml").params;
-    check_first(&beam, 21, false, JKR_PARAMS, "N = 3 beam JKR, repulsive");
+    check_tapping(&beam, 21, JKR_PARAMS, "N = 3 beam JKR, tapping");
 }
 
 /// The drive's α2 and Ω (the FM loop's unknowns; the N = 3 beam's base drive also moves V_T and
@@ -206,9 +84,9 @@ fn jkr_sensitivities_are_the_finite_differences() {
 fn jkr_drive_sensitivities_are_the_finite_differences() {
     const DRIVE: &[OrbitParam] = &[OrbitParam::DriveAmplitude, OrbitParam::DriveFrequency];
     let point_mass = jkr_probe("probe-point-mass-dmt.toml").params;
-    check_first(&point_mass, 41, false, DRIVE, "point mass JKR, drive");
+    check_tapping(&point_mass, 41, DRIVE, "point mass JKR, drive");
     let beam = jkr_probe("probe-beam-dmt.toml").params;
-    check_first(&beam, 21, false, DRIVE, "N = 3 beam JKR, drive");
+    check_tapping(&beam, 21, DRIVE, "N = 3 beam JKR, drive");
 }
 
 /// The refusals: JKR with a Kelvin–Voigt damper (α6 > 0), H̃ of JKR, and P̃ of another law.
@@ -231,10 +109,6 @@ fn jkr_refusals_name_the_reason() {
 }
 
 // ---- the dynamic fit of E, W and z_offset under JKR (`analysis::fit::am_curve`) ----
-
-use afmdyn::analysis::fit::am_curve::{scaled, AmCurveModel, AmParam, AmProbe};
-use afmdyn::analysis::fit::{fit_with, CurveModel, FitOutcome, Observations, Parameter};
-use afmdyn::request::fit_dynamic::am_probe;
 
 /// A probe as the dynamic fit's probe.
 fn am_probe_of(p: &Probe) -> AmProbe {
@@ -294,60 +168,17 @@ fn the_probes_work_of_adhesion_and_its_scaling() {
     }
 }
 
-/// Standard normal draws (splitmix64 and Box–Muller: deterministic, no dependency).
-struct Normal(u64);
-
-impl Normal {
-    fn uniform(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn draw(&mut self) -> f64 {
-        let (u, v) = (self.uniform().max(1e-300), self.uniform());
-        (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
-    }
-}
-
-/// The truth of `p` under `probe` (z_offset = 1 nm).
-fn truth_of(probe: &AmProbe, p: AmParam) -> f64 {
-    match p {
-        AmParam::YoungsModulus => probe.youngs_modulus,
-        AmParam::AdhesionEnergy => probe.adhesion_energy(),
-        AmParam::ZOffset => 1e-9,
-        AmParam::TipRadius => probe.radius,
-        _ => panic!("not a JKR parameter"),
-    }
-}
-
-/// A synthetic AM approach (the library's stepped approach, [`AmCurveModel`]) of `rows` rows
-/// from z_c = `from` to `to` (units of A₀) under the point-mass JKR probe with the truth
-/// (E, W = 0.05 J/m², z_offset = 1 nm): the model, the noisy data, σ (amplitude 0.02 nm,
-/// phase 0.1°) and the truth.
+/// A synthetic AM approach ([`synthetic_of`]: the library's stepped approach, amplitude σ
+/// 0.02 nm and phase σ 0.1°) of `rows` rows from z_c = `from` to `to` (units of A₀) under the
+/// point-mass JKR probe with the truth (E, W = 0.05 J/m², z_offset = 1 nm).
 fn synthetic(
     rows: usize,
-    (from, to): (f64, f64),
+    range: (f64, f64),
     params: Vec<AmParam>,
     seed: u64,
 ) -> (AmCurveModel, Vec<f64>, Vec<f64>, Vec<f64>) {
     let probe = am_probe_of(&jkr_probe("probe-point-mass-dmt.toml"));
-    let g0 = probe.length_m;
-    let z: Vec<f64> = (0..rows)
-        .map(|i| g0 * (from + (to - from) * i as f64 / (rows - 1) as f64) - 1e-9)
-        .collect();
-    let model = AmCurveModel::new(probe, z, (true, true), params.clone());
-    let truth: Vec<f64> = params.iter().map(|p| truth_of(&probe, *p)).collect();
-    let mut y = vec![0.0; model.points()];
-    model.evaluate(&truth, &mut y, None);
-    let mut sigma: Vec<f64> = std::iter::repeat_n(2e-11, rows).collect();
-    sigma.extend(std::iter::repeat_n(0.1, rows));
-    let mut normal = Normal(seed);
-    for (v, s) in y.iter_mut().zip(&sigma) {
-        *v += s * normal.draw();
-    }
-    (model, y, sigma, truth)
+    synthetic_of(probe, rows, range, params, (true, true), seed)
 }
 
 /// The AM model's Jacobian columns of E, W, z_offset and R (R's chain moves α4 ∝ √R and
@@ -369,59 +200,10 @@ fn the_jkr_am_models_jacobian_is_its_finite_differences() {
     model.spec.integrator.tolerance = 1e-12;
     model.spec.newton.tol = 1e-12;
     model.tolerance = 1e-12;
-    let m = model.points();
-    let n = truth.len();
-    let mut v = vec![0.0; m];
-    let mut jac = vec![0.0; m * n];
-    model.evaluate(&truth, &mut v, Some(&mut jac));
-    assert!(model.warnings().is_empty(), "{:?}", model.warnings());
-    for k in 0..n {
-        let h = 1e-4 * truth[k].abs();
-        let (mut up, mut down) = (truth.clone(), truth.clone());
-        up[k] += h;
-        down[k] -= h;
-        let (mut vu, mut vd) = (vec![0.0; m], vec![0.0; m]);
-        model.evaluate(&up, &mut vu, None);
-        model.evaluate(&down, &mut vd, None);
-        let worst = (0..m)
-            .map(|i| {
-                let fd = (vu[i] - vd[i]) / (2.0 * h);
-                let e = jac[i * n + k];
-                (e - fd).abs() / e.abs().max(fd.abs()).max(1e-300)
-            })
-            .fold(0.0, f64::max);
-        eprintln!(
-            "{}: worst relative gap {worst:.2e} (jac row 0 {:.4e}, fd {:.4e})",
-            model.params[k].name(),
-            jac[k],
-            (vu[0] - vd[0]) / (2.0 * h)
-        );
-        assert!(jac[k] != 0.0, "{}: a zero column", model.params[k].name());
-        assert!(worst < 1e-4, "{}", model.params[k].name());
+    for (name, worst, phase_max) in jacobian_gaps(&model, &truth) {
+        assert!(phase_max > 0.0, "{name}: a zero column");
+        assert!(worst < 1e-4, "{name}: worst relative gap {worst:.2e}");
     }
-}
-
-/// The fit's parameters, started off the truth (E × 0.8, W × 1.3, z_offset 0.8 nm).
-fn parameters(probe: &AmProbe, params: &[AmParam]) -> Vec<Parameter> {
-    params
-        .iter()
-        .map(|p| {
-            let t = truth_of(probe, *p);
-            let (start, lower, upper, scale) = match p {
-                AmParam::YoungsModulus => (0.8 * t, 1e5, f64::INFINITY, t),
-                AmParam::AdhesionEnergy => (1.3 * t, 0.0, f64::INFINITY, t),
-                AmParam::ZOffset => (0.8e-9, -5e-9, 5e-9, 1e-9),
-                _ => panic!("not fitted here"),
-            };
-            Parameter {
-                name: p.name().into(),
-                start,
-                lower,
-                upper,
-                scale,
-            }
-        })
-        .collect()
 }
 
 /// E, W and z_offset from a noisy synthetic JKR AM curve (100 rows of amplitude and phase on
@@ -435,12 +217,8 @@ fn a_noisy_jkr_am_curve_gives_back_e_w_and_the_offset() {
         AmParam::ZOffset,
     ];
     let (model, y, sigma, truth) = synthetic(100, (0.75, 0.3), ps, 62);
-    let params = parameters(&model.probe, &model.params);
-    let obs = Observations {
-        y: &y,
-        sigma: Some(&sigma),
-    };
-    let out: FitOutcome = fit_with(&model, &obs, &params, &[None; 3], false);
+    // from E × 0.6, W × 1.3, z_offset 0.8 nm ([`parameters`])
+    let out = run_fit(&model, &y, &sigma);
     eprintln!(
         "fit of E, W, z_offset to 100 rows: {} evaluations ({}), χ²/dof {:.3}, {:?}",
         out.evaluations, out.termination, out.chi2_dof, out.warnings
@@ -464,60 +242,6 @@ fn a_noisy_jkr_am_curve_gives_back_e_w_and_the_offset() {
 }
 
 // ---- through the door (`afmdyn fit`'s request) ----
-
-/// The synthetic data of `model` (`y`, `sigma`: amplitude then phase) written as an AM CSV to a
-/// fresh temporary directory named by `tag`, and fitted through the door for the parameters
-/// `fit` (the default when empty) under the probe `p`: the document, or the request's error.
-fn door(
-    p: Probe,
-    model: &AmCurveModel,
-    y: &[f64],
-    sigma: &[f64],
-    fit: &[&str],
-    tag: &str,
-) -> Result<serde_json::Value, afmdyn::SimError> {
-    use afmdyn::analysis::progress::Progress;
-    use afmdyn::request::fit::FitRequest;
-    use afmdyn::request::{run, Resolved};
-    let dir = std::env::temp_dir().join(format!("afmdyn-{tag}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    let path = dir.join("am.csv");
-    let m = model.z.len();
-    let mut text = String::from("z,amplitude,phase,sigma_amplitude,sigma_phase\n");
-    for (i, z) in model.z.iter().enumerate() {
-        text += &format!(
-            "{z:?},{:?},{:?},{:?},{:?}\n",
-            y[i],
-            y[m + i],
-            sigma[i],
-            sigma[m + i]
-        );
-    }
-    std::fs::write(&path, text).expect("csv");
-    let resolved = Resolved {
-        params: p.params,
-        probe: Some(p),
-    };
-    let mut request = FitRequest {
-        data: Some(path.display().to_string()),
-        ..FitRequest::default()
-    };
-    if !fit.is_empty() {
-        request.fit = fit.iter().map(|n| n.to_string()).collect();
-    }
-    let doc = run(&request, &resolved, &Progress::default()).map(|o| o.json);
-    std::fs::remove_dir_all(&dir).ok();
-    doc
-}
-
-/// A document's 95 % interval of `name`.
-fn interval(doc: &serde_json::Value, name: &str) -> [f64; 2] {
-    let e = &doc["estimates"][name];
-    [
-        e["interval"][0].as_f64().unwrap(),
-        e["interval"][1].as_f64().unwrap(),
-    ]
-}
 
 /// Through the door with the default parameters of a JKR probe (E, W and z_offset,
 /// `fitted_names`), started from the probe's values (z_offset from its grid): each truth of the
@@ -611,7 +335,7 @@ fn the_jkr_fm_models_jacobian_is_its_finite_differences() {
         .collect();
     let mut model = FmCurveModel::new(probe, z, params.clone(), hz);
     model.loop_tolerance = 1e-12;
-    let truth: Vec<f64> = params.iter().map(|a| truth_of(&probe, *a)).collect();
+    let truth = truth(&probe, &params, 1e-9);
     let (m, n) = (model.points(), truth.len());
     let mut v = vec![0.0; m];
     let mut jac = vec![0.0; m * n];
@@ -634,7 +358,7 @@ fn the_jkr_fm_models_jacobian_is_its_finite_differences() {
         for i in 0..m {
             let fd = (8.0 * (p1[i] - m1[i]) - (p2[i] - m2[i])) / (12.0 * h);
             let e = jac[i * n + j];
-            let rel = rel(e, fd);
+            let rel = (e - fd).abs() / e.abs().max(f64::MIN_POSITIVE);
             eprintln!(
                 "{:?} row {i}: dΔf/dp {e:.9e} (fd {fd:.9e}, rel {rel:.1e})",
                 params[j]

@@ -204,7 +204,10 @@ pub fn jacobian_gaps(model: &AmCurveModel, truth: &[f64]) -> Vec<(&'static str, 
         .collect()
 }
 
-/// [`fit_through_the_door`] under the probe `p`: the document, or the request's error.
+/// The synthetic curve `y` (σ `sigma`, the model's rows and channels) written as an AM CSV to a
+/// fresh temporary directory named by `tag` and fitted through the door (`afmdyn fit`'s
+/// request) for the parameters `fit` (the request's default when empty) under the probe `p`:
+/// the document, or the request's error.
 pub fn door(
     p: Probe,
     model: &AmCurveModel,
@@ -248,11 +251,14 @@ pub fn door(
         params: p.params,
         probe: Some(p),
     };
-    let request = FitRequest {
+    let mut request = FitRequest {
         data: Some(path.display().to_string()),
-        fit: fit.iter().map(|n| n.to_string()).collect(),
         ..FitRequest::default()
     };
+    // none named: the request's default parameters
+    if !fit.is_empty() {
+        request.fit = fit.iter().map(|n| n.to_string()).collect();
+    }
     let doc = run(&request, &resolved, &Progress::default()).map(|o| o.json);
     std::fs::remove_dir_all(&dir).ok();
     doc

@@ -132,6 +132,9 @@ pub enum Regime {
     Repulsive,
     /// A lighter touch: 0.7 A_far ≤ A < 0.99 A_far.
     LightTouch,
+    /// φ < 90°, A < 0.98 A_far, in contact for a share of the period strictly between 0 and 1
+    /// (a tapping orbit: it forms and breaks contact each period).
+    Tapping,
 }
 
 impl Regime {
@@ -140,6 +143,7 @@ impl Regime {
             Regime::Attractive => "attractive",
             Regime::Repulsive => "repulsive",
             Regime::LightTouch => "light touch",
+            Regime::Tapping => "tapping",
         }
     }
 
@@ -155,6 +159,10 @@ impl Regime {
                     Regime::Attractive => phi > FRAC_PI_2 && a < 0.98 * a_far,
                     Regime::Repulsive => phi < FRAC_PI_2 && a < 0.7 * a_far,
                     Regime::LightTouch => (0.7 * a_far..0.99 * a_far).contains(&a),
+                    Regime::Tapping => {
+                        let c = p.observables.contact_fraction;
+                        phi < FRAC_PI_2 && a < 0.98 * a_far && c > 0.0 && c < 1.0
+                    }
                 }
             })
             .collect()
