@@ -5,15 +5,13 @@
 //! `examples/probe-point-mass-dmt.toml` and `examples/probe-beam-dmt.toml`), and the Hertz
 //! damper α6 (`sample.damping`) of a damped Hertz sample.
 
-use afmdyn::analysis::fit::sensitivity::{orbit_sensitivity, OrbitParam};
+use afmdyn::analysis::fit::sensitivity::OrbitParam;
 use afmdyn::contact::ContactLaw;
-use afmdyn::model::CantileverModel;
 use afmdyn::probe::Probe;
-use nalgebra::DVector;
 use std::path::Path;
 
 mod common;
-use common::orbit_check::{approach, check_first, Regime, TOL};
+use common::orbit_check::{approach, check_first, Regime};
 use common::orbit_params::probe;
 
 /// One case of the sensitivity check: a probe (its law, or Hertz over it), the points of its
@@ -165,17 +163,6 @@ fn damped_hertz_sensitivities_are_the_finite_differences() {
             check_first(&base, &r.points(&curve), DAMPED, &what);
         }
     }
-}
-
-/// α6 of DMT is refused (its Kelvin–Voigt term has the δ̇/√δ singularity), with the reason.
-#[test]
-fn the_damper_of_dmt_is_refused() {
-    let base = probe("probe-point-mass-dmt.toml");
-    let model = CantileverModel::new(&base).expect("model");
-    let guess = DVector::zeros(2);
-    let e =
-        orbit_sensitivity(&model, TOL, &guess, &[OrbitParam::Damping], None).expect_err("DMT's α6");
-    assert!(e.to_string().contains("hertz law"), "{e}");
 }
 
 // ---- the dynamic fit (`analysis::fit::am_curve`) ----

@@ -377,42 +377,6 @@ fn a_frequency_shift_csv_goes_through_the_fit_door() {
     assert!(warnings.contains("not fitted"), "{warnings}");
 }
 
-/// A DMT sample with Kelvin–Voigt damping (the library's RTESPA-300 over polystyrene,
-/// viscosity 10 Pa s) is refused before the fit, naming `sample.viscosity`: the exact
-/// sensitivities of DMT are those of its elastic force, so every Jacobian would fail and the
-/// estimates would stay at their starts.
-#[test]
-fn a_damped_dmt_sample_is_refused_before_the_fit() {
-    use afmdyn::analysis::progress::Progress;
-    use afmdyn::request::fit::FitRequest;
-    use afmdyn::request::{run, Resolved};
-    let dir = std::env::temp_dir().join(format!("afmdyn-fit-damped-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    let path = dir.join("fm.csv");
-    let mut text = String::from("z,frequency_shift\n");
-    for i in 0..10 {
-        text += &format!("{:?},{:?}\n", 20e-9 - 0.5e-9 * i as f64, -0.1 * i as f64);
-    }
-    std::fs::write(&path, text).expect("csv");
-    let p = Probe::load(
-        &Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../../examples/probe-rtespa300-polystyrene.toml"),
-    )
-    .expect("probe");
-    assert!(p.params.alpha6 > 0.0, "the example's sample is damped");
-    let resolved = Resolved {
-        params: p.params,
-        probe: Some(p),
-    };
-    let request = FitRequest {
-        data: Some(path.display().to_string()),
-        ..FitRequest::default()
-    };
-    let err = run(&request, &resolved, &Progress::default()).expect_err("refused");
-    std::fs::remove_dir_all(&dir).ok();
-    assert!(err.to_string().contains("sample.viscosity"), "{err}");
-}
-
 /// An evaluation asked to stop (the run's cancel flag already set, as a Ctrl-C leaves it) stops
 /// at the FM curve's first row: every value NaN, no sensitivities, where a finished evaluation
 /// of the same rows is finite.

@@ -116,6 +116,7 @@ fn parameters(c: &Curve) -> Vec<Parameter> {
                 AmParam::QualityFactor => (0.0, f64::INFINITY, probe.quality_factor),
                 AmParam::FreeAmplitude => (1e-12, f64::INFINITY, probe.length_m),
                 AmParam::AdhesionEnergy => (0.0, f64::INFINITY, probe.adhesion_energy()),
+                AmParam::Viscosity => (0.0, f64::INFINITY, probe.viscosity()),
             };
             Parameter {
                 name: p.name().into(),

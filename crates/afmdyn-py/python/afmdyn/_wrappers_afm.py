@@ -783,13 +783,13 @@ def fit(
             (contact point and baseline at 0, after the preprocessing). Default
             ``sample.youngs_modulus``, ``contact_point`` (for ``sls``: its three,
             ``contact_point`` and ``baseline``). Of an AM, FM or bimodal curve:
-            ``sample.youngs_modulus``, ``sample.hamaker`` (DMT), ``sample.damping`` (Hertz's
-            damper, N s/m), ``sample.adhesion_energy`` (JKR, J/m²), ``tip.radius``,
-            ``drive.free_amplitude`` (m), ``cantilever.quality_factor`` (AM curves of a
-            single-frequency drive without ``[medium]``; at resonance Q trades against the
-            sample's E: fit it with E held) and ``z_offset`` (always fitted); default
-            ``sample.youngs_modulus``, ``sample.hamaker`` (DMT) or
-            ``sample.adhesion_energy`` (JKR) and ``z_offset``.
+            ``sample.youngs_modulus``, ``sample.hamaker`` and ``sample.viscosity`` (DMT;
+            Kelvin–Voigt η, Pa s), ``sample.damping`` (Hertz's damper, N s/m),
+            ``sample.adhesion_energy`` (JKR, J/m²), ``tip.radius``, ``drive.free_amplitude``
+            (m), ``cantilever.quality_factor`` (AM curves of a single-frequency drive
+            without ``[medium]``; at resonance Q trades against the sample's E: fit it with
+            E held) and ``z_offset`` (always fitted); default ``sample.youngs_modulus``,
+            ``sample.hamaker`` (DMT) or ``sample.adhesion_energy`` (JKR) and ``z_offset``.
         profiles: Profile-likelihood intervals (Δχ² ≤ 3.84) for the fitted parameters, up to
             4 of them, the probe keys (sample, tip) before the contact point, baseline and
             z_offset (beyond, and when off, the Wald intervals ±1.96 SE). Default on for a

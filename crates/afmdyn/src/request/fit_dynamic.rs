@@ -176,7 +176,7 @@ fn check_data(d: &AmData) -> Result<(), SimError> {
 ///
 /// # Errors
 /// [`SimError::OutOfRange`] for bad data, parameter names, a probe without a Hertz, DMT or JKR
-/// sample, a DMT or JKR sample with Kelvin–Voigt damping; [`SimError::Cancelled`].
+/// sample, a JKR sample with Kelvin–Voigt damping; [`SimError::Cancelled`].
 pub fn execute(
     fit: &[String],
     default_fit: bool,
@@ -203,17 +203,6 @@ pub fn execute(
                 "the dynamic fit takes the probe's [sample].law = hertz, dmt or jkr".into(),
             )
         })?;
-    // the exact sensitivities of DMT are those of its elastic force (analysis::fit::sensitivity):
-    // refused here, before a fit whose every Jacobian would fail
-    if law_name == "dmt" && probe.params.alpha6 != 0.0 {
-        return Err(bad(
-            "sample.viscosity",
-            format!("α6 = {:.4e}", probe.params.alpha6),
-            "the dynamic fit of a DMT sample needs it without Kelvin–Voigt damping: \
-             sample.viscosity = 0 (or the hertz law)"
-                .into(),
-        ));
-    }
     // JKR's exact sensitivities likewise without its Kelvin–Voigt term
     // (analysis::fit::sensitivity_jkr)
     if law_name == "jkr" && probe.params.alpha6 != 0.0 {
@@ -230,24 +219,13 @@ pub fn execute(
     let mut params = Vec::new();
     let mut am = Vec::new();
     for n in &names {
-        if n == "sample.viscosity" {
-            // η (Pa s) is DMT's Kelvin–Voigt term, refused above when not 0; the hertz law's
-            // dashpot is its damping c (N s/m)
-            return Err(bad(
-                "fit",
-                n,
-                "the dynamic fit of a DMT sample needs it without Kelvin–Voigt damping \
-                 (sample.viscosity = 0, not fitted); the hertz law's damper is sample.damping \
-                 (N s/m)"
-                    .into(),
-            ));
-        }
         let p = AmParam::from_name(n).ok_or_else(|| {
             bad(
                 "fit",
                 n,
                 "the dynamic fit's parameters are sample.youngs_modulus, sample.hamaker (dmt), \
-                 sample.damping (hertz), sample.adhesion_energy (jkr), tip.radius, \
+                 sample.viscosity (dmt), sample.damping (hertz), sample.adhesion_energy (jkr), \
+                 tip.radius, \
                  cantilever.quality_factor, drive.free_amplitude and z_offset"
                     .into(),
             )
@@ -259,7 +237,19 @@ pub fn execute(
             return Err(bad(
                 "fit",
                 n,
-                "sample.damping is the hertz law's damper (DMT's Kelvin–Voigt term is refused)"
+                "sample.damping is the hertz law's damper (DMT's Kelvin–Voigt term is \
+                 sample.viscosity, Pa s)"
+                    .into(),
+            ));
+        }
+        if p == AmParam::Viscosity && law_name != "dmt" {
+            // η (Pa s) is DMT's Kelvin–Voigt term; the hertz law's dashpot is its damping c
+            // (N s/m); JKR's Kelvin–Voigt term is not differentiated (refused above)
+            return Err(bad(
+                "fit",
+                n,
+                "sample.viscosity is DMT's Kelvin–Voigt term in the dynamic fit; the hertz \
+                 law's damper is sample.damping (N s/m)"
                     .into(),
             ));
         }
@@ -290,6 +280,14 @@ pub fn execute(
                 let c = am_probe.params.alpha6 / am_probe.damping_unit;
                 let typical = 0.01 * am_probe.params.alpha4 / am_probe.damping_unit;
                 (c, if c > 0.0 { c } else { typical })
+            }
+            // the probe's η; its scale η itself, or (η = 0) the η whose α6 is 1 % of α4, as
+            // the hertz damper's
+            AmParam::Viscosity => {
+                let eta = am_probe.viscosity();
+                let unit = am_probe.viscosity_unit(am_probe.radius);
+                let typical = 0.01 * am_probe.params.alpha4 / unit;
+                (eta, if eta > 0.0 { eta } else { typical })
             }
             // the probe's W (J/m²), its own scale (JKR's P̃ > 0, so W > 0)
             AmParam::AdhesionEnergy => {
@@ -627,7 +625,7 @@ pub fn document(r: &FitResult, d: &DynamicFit, estimates: Value, correlation: Va
         "evaluations": o.evaluations,
         "termination": o.termination,
         "units": {"sample.youngs_modulus": "Pa", "tip.radius": "m", "sample.hamaker": "J", "z_offset": "m", "sample.damping": "N s/m", "cantilever.quality_factor": "1", "drive.free_amplitude": "m",
-                  "sample.adhesion_energy": "J/m^2",
+                  "sample.adhesion_energy": "J/m^2", "sample.viscosity": "Pa s",
                   "z": "m", "amplitude": "m", "phase": "deg", "frequency_shift": "Hz",
                   "amplitude_2": "m", "phase_2": "deg"},
         "method": method,

@@ -30,6 +30,7 @@ pub fn truth(probe: &AmProbe, params: &[AmParam], z_offset: f64) -> Vec<f64> {
             AmParam::QualityFactor => probe.quality_factor,
             AmParam::FreeAmplitude => probe.length_m,
             AmParam::AdhesionEnergy => probe.adhesion_energy(),
+            AmParam::Viscosity => probe.viscosity(),
         })
         .collect()
 }
@@ -128,6 +129,10 @@ pub fn parameters(probe: &AmProbe, params: &[AmParam]) -> Vec<Parameter> {
                 AmParam::FreeAmplitude => {
                     let a0 = probe.length_m;
                     (0.95 * a0, 1e-12, f64::INFINITY, a0)
+                }
+                AmParam::Viscosity => {
+                    let eta = probe.viscosity();
+                    (0.7 * eta, 0.0, f64::INFINITY, eta)
                 }
                 AmParam::AdhesionEnergy => {
                     let w = probe.adhesion_energy();

@@ -22,18 +22,29 @@ pub const STEP: f64 = 1e-3;
 /// The agreement asked for (issue 62: ≤ 1e-6 relative).
 pub const AGREE: f64 = 1e-6;
 
-/// The orbit at `params` near `guess`, without sensitivities.
-pub fn orbit(params: &Params, guess: &DVector<f64>) -> OrbitSensitivity {
+/// The orbit at `params` near `guess`, without sensitivities, integrated to `tol`.
+pub fn orbit(params: &Params, guess: &DVector<f64>, tol: f64) -> OrbitSensitivity {
     let model = CantileverModel::new(params).expect("model");
-    orbit_sensitivity(&model, TOL, guess, &[], Some(&newton())).expect("orbit")
+    orbit_sensitivity(&model, tol, guess, &[], Some(&newton())).expect("orbit")
 }
 
 /// Check the exact sensitivities at the orbit near `guess` against central differences;
 /// `false` (nothing checked) where the orbit is near a fold or grazing.
 pub fn check_point(base: &Params, guess: &DVector<f64>, params: &[OrbitParam], what: &str) -> bool {
+    check_point_at(base, guess, params, what, TOL)
+}
+
+/// [`check_point`] with the orbits and their sensitivities integrated to `tol`.
+pub fn check_point_at(
+    base: &Params,
+    guess: &DVector<f64>,
+    params: &[OrbitParam],
+    what: &str,
+    tol: f64,
+) -> bool {
     let model = CantileverModel::new(base).expect("model");
     let exact =
-        orbit_sensitivity(&model, TOL, guess, params, Some(&newton())).expect("sensitivity");
+        orbit_sensitivity(&model, tol, guess, params, Some(&newton())).expect("sensitivity");
     if !exact.warnings.is_empty() {
         eprintln!("{what}: skipped, {:?}", exact.warnings);
         return false;
@@ -42,7 +53,7 @@ pub fn check_point(base: &Params, guess: &DVector<f64>, params: &[OrbitParam], w
     let shot = shoot(&model, &exact.state, 1, &newton()).expect("orbit");
     let opts = IntegratorOptions {
         kind: IntegratorKind::Adaptive,
-        tolerance: TOL,
+        tolerance: tol,
         ..IntegratorOptions::default()
     };
     let obs = observe_orbit(&model, opts, &shot, 1).expect("observables");
@@ -69,7 +80,7 @@ pub fn check_point(base: &Params, guess: &DVector<f64>, params: &[OrbitParam], w
         };
         // the fourth-order central difference (its truncation error O(h⁴) far below the
         // integration error's ~TOL/h)
-        let at = |k: f64| orbit(&with(base, p, v + k * h), &exact.state);
+        let at = |k: f64| orbit(&with(base, p, v + k * h), &exact.state, tol);
         let (p1, m1, p2, m2) = (at(1.0), at(-1.0), at(2.0), at(-2.0));
         let diff = |f: &dyn Fn(&OrbitSensitivity) -> f64| {
             (8.0 * (f(&p1) - f(&m1)) - (f(&p2) - f(&m2))) / (12.0 * h)
@@ -109,9 +120,20 @@ pub fn check_point(base: &Params, guess: &DVector<f64>, params: &[OrbitParam], w
 /// Check the first of `points` (approach points of `base`) that is neither near a fold nor
 /// grazing.
 pub fn check_first(base: &Params, points: &[&CurvePoint], params: &[OrbitParam], what: &str) {
+    check_first_at(base, points, params, what, TOL);
+}
+
+/// [`check_first`] with the orbits and their sensitivities integrated to `tol`.
+pub fn check_first_at(
+    base: &Params,
+    points: &[&CurvePoint],
+    params: &[OrbitParam],
+    what: &str,
+    tol: f64,
+) {
     let checked = points.iter().any(|p| {
         let b = with(base, OrbitParam::Gap, p.value);
-        check_point(&b, &p.state, params, what)
+        check_point_at(&b, &p.state, params, what, tol)
     });
     assert!(checked, "{what}: no point away from folds and grazing");
 }

@@ -16,6 +16,8 @@
 //!   [`crate::contact::HertzLaw`]): α6 = c g₀/(t_s F_s)
 //!   ([`crate::contact::SampleSi::damper_alpha6`]), ∂α6/∂c = g₀/(t_s F_s) ([`AmProbe::damping_unit`]), independent of R (a dashpot, not
 //!   a contact-area law);
+//! * `sample.viscosity` η (Pa s), DMT's Kelvin–Voigt term α6 √δ δ̇: α6 = η √(R g₀) g₀/(t_s F_s)
+//!   ([`AmProbe::viscosity_unit`]), so ∂α6/∂η = α6/η and R's chain gains ∂α6/∂R = α6/(2R);
 //! * `cantilever.quality_factor` Q₁ and `drive.free_amplitude` A₀ (m): through the lever's
 //!   damping α3 ∝ 1/Q₁ and the drive α2, which holds the free amplitude A₀ the instrument set
 //!   (`lever_and_drive`; the orbit's columns [`OrbitParam::LeverDamping`] and
@@ -57,6 +59,8 @@ pub const HAMAKER: &str = "sample.hamaker";
 pub const RADIUS: &str = "tip.radius";
 /// `sample.damping` (N s/m), the Hertz law's damper.
 pub const DAMPING: &str = "sample.damping";
+/// `sample.viscosity` (Pa s), DMT's Kelvin–Voigt η.
+pub const VISCOSITY: &str = "sample.viscosity";
 /// `cantilever.quality_factor` (1), the lever's Q₁.
 pub const QUALITY_FACTOR: &str = "cantilever.quality_factor";
 /// `drive.free_amplitude` (m), the free amplitude A₀ the instrument set.
@@ -88,6 +92,8 @@ pub enum AmParam {
     FreeAmplitude,
     /// `sample.adhesion_energy` (JKR).
     AdhesionEnergy,
+    /// `sample.viscosity` (DMT's Kelvin–Voigt η).
+    Viscosity,
 }
 
 impl AmParam {
@@ -102,6 +108,7 @@ impl AmParam {
             QUALITY_FACTOR => Some(AmParam::QualityFactor),
             FREE_AMPLITUDE => Some(AmParam::FreeAmplitude),
             ADHESION_ENERGY => Some(AmParam::AdhesionEnergy),
+            VISCOSITY => Some(AmParam::Viscosity),
             _ => None,
         }
     }
@@ -116,6 +123,7 @@ impl AmParam {
             AmParam::QualityFactor => QUALITY_FACTOR,
             AmParam::FreeAmplitude => FREE_AMPLITUDE,
             AmParam::AdhesionEnergy => ADHESION_ENERGY,
+            AmParam::Viscosity => VISCOSITY,
         }
     }
 }
@@ -182,6 +190,24 @@ pub struct AmProbe {
 }
 
 impl AmProbe {
+    /// α6 per Pa s of DMT's Kelvin–Voigt term at the tip radius `radius` (m):
+    /// √(R g₀) g₀/(t_s F_s) ([`crate::contact::SampleSi::kelvin_voigt_alpha6`]: the damper
+    /// η a δ̇ with the contact radius a = √(Rδ)).
+    pub fn viscosity_unit(&self, radius: f64) -> f64 {
+        self.damping_unit * (radius * self.length_m).sqrt()
+    }
+
+    /// The probe's viscosity η (Pa s) of DMT's Kelvin–Voigt term, α6 over
+    /// [`AmProbe::viscosity_unit`]; 0 under another law.
+    pub fn viscosity(&self) -> f64 {
+        match self.params.contact_law {
+            ContactLaw::Dmt { .. } if self.radius > 0.0 => {
+                self.params.alpha6 / self.viscosity_unit(self.radius)
+            }
+            _ => 0.0,
+        }
+    }
+
     /// The probe's work of adhesion W (J/m²) under JKR, from its groups: P̃ = πWR/F_s with
     /// the force scale of its Hertz group, F_s = (4/3)E*√R g₀^{3/2}/α4
     /// ([`crate::contact::SampleSi::hertz_alpha4`]), so W = P̃ (4/3) E* g₀^{3/2}/(π α4 √R)
@@ -315,6 +341,22 @@ pub fn scaled(probe: &AmProbe, params: &[AmParam], p: &[f64]) -> (Params, f64, C
     if fitted(AmParam::Damping) {
         q.alpha6 = get(AmParam::Damping, 0.0) * pr.damping_unit;
         chain.push(AmParam::Damping, OrbitParam::Damping, pr.damping_unit);
+    }
+    // DMT's Kelvin–Voigt α6 = η √(R g₀) g₀/(t_s F_s) ∝ η √R
+    let dmt = matches!(q.contact_law, ContactLaw::Dmt { .. });
+    if dmt && (fitted(AmParam::Viscosity) || fitted(AmParam::TipRadius)) {
+        let unit = pr.viscosity_unit(r);
+        q.alpha6 = get(AmParam::Viscosity, pr.viscosity()) * unit;
+        if fitted(AmParam::Viscosity) {
+            chain.push(AmParam::Viscosity, OrbitParam::Damping, unit);
+        }
+        if fitted(AmParam::TipRadius) && q.alpha6 != 0.0 {
+            chain.push(
+                AmParam::TipRadius,
+                OrbitParam::Damping,
+                q.alpha6 / (2.0 * r),
+            );
+        }
     }
     lever_and_drive(pr, params, p, &mut q, &mut chain);
     // JKR's P̃ = πWR/F_s ∝ W R (module docs)
