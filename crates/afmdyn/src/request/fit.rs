@@ -74,8 +74,9 @@ pub struct FitRequest {
     /// held at the probe's values (contact point and baseline at 0, after the preprocessing).
     /// Default `sample.youngs_modulus`, `contact_point` (for `sls`: its three, `contact_point`
     /// and `baseline`). Of an AM, FM or bimodal curve: `sample.youngs_modulus`,
-    /// `sample.hamaker` and `sample.viscosity` (DMT; Kelvin–Voigt η, Pa s), `sample.damping`
-    /// (Hertz's damper, N s/m), `sample.adhesion_energy` (JKR, J/m²), `tip.radius`, `drive.free_amplitude` (m),
+    /// `sample.hamaker` (DMT), `sample.viscosity` (DMT and JKR; Kelvin–Voigt η, Pa s),
+    /// `sample.damping` (Hertz's damper, N s/m), `sample.adhesion_energy` (JKR, J/m²),
+    /// `tip.radius`, `drive.free_amplitude` (m),
     /// `cantilever.quality_factor` (AM curves of a single-frequency drive without `[medium]`;
     /// at resonance Q trades against the sample's E: fit it with E held) and `z_offset` (always
     /// fitted); default `sample.youngs_modulus`, `sample.hamaker` (DMT) or

@@ -176,7 +176,7 @@ fn check_data(d: &AmData) -> Result<(), SimError> {
 ///
 /// # Errors
 /// [`SimError::OutOfRange`] for bad data, parameter names, a probe without a Hertz, DMT or JKR
-/// sample, a JKR sample with Kelvin–Voigt damping; [`SimError::Cancelled`].
+/// sample; [`SimError::Cancelled`].
 pub fn execute(
     fit: &[String],
     default_fit: bool,
@@ -203,17 +203,6 @@ pub fn execute(
                 "the dynamic fit takes the probe's [sample].law = hertz, dmt or jkr".into(),
             )
         })?;
-    // JKR's exact sensitivities likewise without its Kelvin–Voigt term
-    // (analysis::fit::sensitivity_jkr)
-    if law_name == "jkr" && probe.params.alpha6 != 0.0 {
-        return Err(bad(
-            "sample.viscosity",
-            format!("α6 = {:.4e}", probe.params.alpha6),
-            "the dynamic fit of a JKR sample needs it without Kelvin–Voigt damping: \
-             sample.viscosity = 0"
-                .into(),
-        ));
-    }
     let am_probe = am_probe(probe)?;
     let names = fitted_names(fit, default_fit, law_name);
     let mut params = Vec::new();
@@ -224,7 +213,7 @@ pub fn execute(
                 "fit",
                 n,
                 "the dynamic fit's parameters are sample.youngs_modulus, sample.hamaker (dmt), \
-                 sample.viscosity (dmt), sample.damping (hertz), sample.adhesion_energy (jkr), \
+                 sample.viscosity (dmt, jkr), sample.damping (hertz), sample.adhesion_energy (jkr), \
                  tip.radius, \
                  cantilever.quality_factor, drive.free_amplitude and z_offset"
                     .into(),
@@ -237,19 +226,19 @@ pub fn execute(
             return Err(bad(
                 "fit",
                 n,
-                "sample.damping is the hertz law's damper (DMT's Kelvin–Voigt term is \
-                 sample.viscosity, Pa s)"
+                "sample.damping is the hertz law's damper (the Kelvin–Voigt term of dmt and \
+                 jkr is sample.viscosity, Pa s)"
                     .into(),
             ));
         }
-        if p == AmParam::Viscosity && law_name != "dmt" {
-            // η (Pa s) is DMT's Kelvin–Voigt term; the hertz law's dashpot is its damping c
-            // (N s/m); JKR's Kelvin–Voigt term is not differentiated (refused above)
+        if p == AmParam::Viscosity && law_name == "hertz" {
+            // η (Pa s) is DMT's and JKR's Kelvin–Voigt term; the hertz law's dashpot is its
+            // damping c (N s/m)
             return Err(bad(
                 "fit",
                 n,
-                "sample.viscosity is DMT's Kelvin–Voigt term in the dynamic fit; the hertz \
-                 law's damper is sample.damping (N s/m)"
+                "sample.viscosity is the Kelvin–Voigt term of dmt and jkr; the hertz law's \
+                 damper is sample.damping (N s/m)"
                     .into(),
             ));
         }

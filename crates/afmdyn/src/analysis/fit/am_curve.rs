@@ -16,7 +16,8 @@
 //!   [`crate::contact::HertzLaw`]): α6 = c g₀/(t_s F_s)
 //!   ([`crate::contact::SampleSi::damper_alpha6`]), ∂α6/∂c = g₀/(t_s F_s) ([`AmProbe::damping_unit`]), independent of R (a dashpot, not
 //!   a contact-area law);
-//! * `sample.viscosity` η (Pa s), DMT's Kelvin–Voigt term α6 √δ δ̇: α6 = η √(R g₀) g₀/(t_s F_s)
+//! * `sample.viscosity` η (Pa s), DMT's Kelvin–Voigt term α6 √δ δ̇ (JKR's α6 q² δ̇):
+//!   α6 = η √(R g₀) g₀/(t_s F_s)
 //!   ([`AmProbe::viscosity_unit`]), so ∂α6/∂η = α6/η and R's chain gains ∂α6/∂R = α6/(2R);
 //! * `cantilever.quality_factor` Q₁ and `drive.free_amplitude` A₀ (m): through the lever's
 //!   damping α3 ∝ 1/Q₁ and the drive α2, which holds the free amplitude A₀ the instrument set
@@ -92,7 +93,7 @@ pub enum AmParam {
     FreeAmplitude,
     /// `sample.adhesion_energy` (JKR).
     AdhesionEnergy,
-    /// `sample.viscosity` (DMT's Kelvin–Voigt η).
+    /// `sample.viscosity` (DMT's and JKR's Kelvin–Voigt η).
     Viscosity,
 }
 
@@ -190,18 +191,18 @@ pub struct AmProbe {
 }
 
 impl AmProbe {
-    /// α6 per Pa s of DMT's Kelvin–Voigt term at the tip radius `radius` (m):
+    /// α6 per Pa s of DMT's (and JKR's) Kelvin–Voigt term at the tip radius `radius` (m):
     /// √(R g₀) g₀/(t_s F_s) ([`crate::contact::SampleSi::kelvin_voigt_alpha6`]: the damper
     /// η a δ̇ with the contact radius a = √(Rδ)).
     pub fn viscosity_unit(&self, radius: f64) -> f64 {
         self.damping_unit * (radius * self.length_m).sqrt()
     }
 
-    /// The probe's viscosity η (Pa s) of DMT's Kelvin–Voigt term, α6 over
+    /// The probe's viscosity η (Pa s) of DMT's or JKR's Kelvin–Voigt term, α6 over
     /// [`AmProbe::viscosity_unit`]; 0 under another law.
     pub fn viscosity(&self) -> f64 {
         match self.params.contact_law {
-            ContactLaw::Dmt { .. } if self.radius > 0.0 => {
+            ContactLaw::Dmt { .. } | ContactLaw::Jkr { .. } if self.radius > 0.0 => {
                 self.params.alpha6 / self.viscosity_unit(self.radius)
             }
             _ => 0.0,
@@ -342,9 +343,12 @@ pub fn scaled(probe: &AmProbe, params: &[AmParam], p: &[f64]) -> (Params, f64, C
         q.alpha6 = get(AmParam::Damping, 0.0) * pr.damping_unit;
         chain.push(AmParam::Damping, OrbitParam::Damping, pr.damping_unit);
     }
-    // DMT's Kelvin–Voigt α6 = η √(R g₀) g₀/(t_s F_s) ∝ η √R
-    let dmt = matches!(q.contact_law, ContactLaw::Dmt { .. });
-    if dmt && (fitted(AmParam::Viscosity) || fitted(AmParam::TipRadius)) {
+    // DMT's and JKR's Kelvin–Voigt α6 = η √(R g₀) g₀/(t_s F_s) ∝ η √R
+    let kelvin_voigt = matches!(
+        q.contact_law,
+        ContactLaw::Dmt { .. } | ContactLaw::Jkr { .. }
+    );
+    if kelvin_voigt && (fitted(AmParam::Viscosity) || fitted(AmParam::TipRadius)) {
         let unit = pr.viscosity_unit(r);
         q.alpha6 = get(AmParam::Viscosity, pr.viscosity()) * unit;
         if fitted(AmParam::Viscosity) {

@@ -88,7 +88,8 @@
 //! α6 √δ δ̇) and `jkr` (below).
 //!
 //! # JKR
-//! The law `jkr` (α6 = 0) takes α5, α4 and its adhesion group P̃ ([`OrbitParam::Adhesion`]):
+//! The law `jkr` takes α5, α4, its adhesion group P̃ ([`OrbitParam::Adhesion`]) and its
+//! Kelvin–Voigt group α6 (the damper α6 q² δ̇):
 //! its force at fixed δ moves through the root q(δ) of the contact radius, its contact guard
 //! |δ_b| − V_T moves with α4 and P̃, and its force jumps where the contact forms and breaks, so
 //! the saltation is not the identity there ([`super::sensitivity_jkr`] for the derivatives).
@@ -282,8 +283,10 @@ pub fn d_force(
     rate: f64,
 ) -> Option<f64> {
     if let ContactLaw::Jkr { adhesion } = *law {
-        // JKR's at fixed δ through the root q(δ) (without its damper, refused)
-        return super::sensitivity_jkr::d_force(stiffness, adhesion, param, contact, delta);
+        // JKR's at fixed (δ, δ̇) through the root q(δ)
+        return super::sensitivity_jkr::d_force(
+            stiffness, adhesion, damping, param, contact, delta, rate,
+        );
     }
     let a0 = match *law {
         ContactLaw::Hertz => None,
@@ -565,8 +568,8 @@ impl TipSampleSystem for Extended {
 /// `params` (module docs).
 ///
 /// # Errors
-/// [`SimError::Unsupported`] for a law other than Hertz, DMT and JKR, for H̃ under Hertz; for
-/// JKR with α6 > 0 or asked for H̃ or α6, and for P̃ ([`OrbitParam::Adhesion`]) under another
+/// [`SimError::Unsupported`] for a law other than Hertz, DMT and JKR, for H̃ under Hertz or
+/// JKR, and for P̃ ([`OrbitParam::Adhesion`]) under another
 /// law;
 /// [`SimError::NoConvergence`] from the Newton solve; [`SimError`] from the integrator.
 pub fn orbit_sensitivity(
@@ -632,16 +635,8 @@ pub fn orbit_sensitivity_component(
         }
         ContactLaw::Dmt { .. } => {}
         ContactLaw::Jkr { .. } => {
-            if p.alpha6 != 0.0 {
-                return Err(unsupported(
-                    "exact sensitivities of JKR need α6 = 0 (no Kelvin–Voigt damping)",
-                ));
-            }
-            let other = [OrbitParam::Hamaker, OrbitParam::Damping];
-            if params.iter().any(|q| other.contains(q)) {
-                return Err(unsupported(
-                    "the JKR law has no Hamaker group and its Kelvin–Voigt damper is refused",
-                ));
+            if params.contains(&OrbitParam::Hamaker) {
+                return Err(unsupported("the JKR law has no Hamaker group"));
             }
         }
         _ => {

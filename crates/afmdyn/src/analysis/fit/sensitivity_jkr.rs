@@ -1,19 +1,24 @@
 //! The JKR law's parameter derivatives for the exact orbit sensitivities
 //! ([`super::sensitivity`]): ∂F_c/∂p at fixed (δ, δ̇) and the contact guard's ∂g/∂p, for the
-//! gap α5, the Hertz group α4 and the adhesion group P̃ (Kelvin–Voigt α6 = 0 only).
+//! gap α5, the Hertz group α4, the adhesion group P̃ and the Kelvin–Voigt group α6.
 //!
 //! # The force at fixed indentation
 //! Johnson, Kendall & Roberts, *Proc. R. Soc. Lond. A* 324 (1971) 301, in the variable
 //! q = (a²/R)^{1/4} of [`crate::contact::Jkr`] (module docs of `contact/jkr.rs`): in contact
-//! F_c = α4 q⁶ − b q³ with δ = q⁴ − c q, c = √(8P̃/(3α4)), b = √(6P̃α4); no force out of
-//! contact. The indentation δ is the state's (δ = −V_T), so a parameter moves F_c at fixed δ
-//! both directly and through the root q(δ; c):
-//! ∂F_c/∂p|_δ = ∂F/∂p|_q + F_q ∂q/∂p|_δ, F_q = 6α4 q⁵ − 3b q², and, differentiating
+//! F_c = α4 q⁶ − b q³ + α6 q² δ̇ with δ = q⁴ − c q, c = √(8P̃/(3α4)), b = √(6P̃α4) (the
+//! Kelvin–Voigt damper α6 q² δ̇ ∝ the contact radius a = √R q², as DMT's); no force out of
+//! contact. The indentation δ and its rate δ̇ are the state's (δ = −V_T), so a parameter moves
+//! F_c at fixed (δ, δ̇) both directly and through the root q(δ; c):
+//! ∂F_c/∂p|_δ = ∂F/∂p|_q + F_q ∂q/∂p|_δ, F_q = 6α4 q⁵ − 3b q² + 2α6 q δ̇, and, differentiating
 //! q⁴ − c q = δ at fixed δ, ∂q/∂p|_δ = q (∂c/∂p)/(4q³ − c). With ∂b/∂α4 = b/(2α4),
 //! ∂b/∂P̃ = b/(2P̃), ∂c/∂α4 = −c/(2α4), ∂c/∂P̃ = c/(2P̃):
 //! * ∂F_c/∂α4|_δ = q⁶ − (b/(2α4)) q³ − F_q q c/(2α4 (4q³ − c));
 //! * ∂F_c/∂P̃|_δ = −(b/(2P̃)) q³ + F_q q c/(2P̃ (4q³ − c));
+//! * ∂F_c/∂α6 = q² δ̇ (q does not move with α6);
 //! * ∂F_c/∂α5 = −∂F_c/∂δ = −F_q/(4q³ − c) (V_T = W + α2 sin Ωτ + α5, eq. 8).
+//!
+//! Unlike DMT's √δ δ̇, JKR's damper has no singular derivative where the contact forms: there
+//! q = c^{1/3} > 0 and dq/dδ = 1/(3c).
 //!
 //! Beyond the break (δ ≤ δ_b, where an integrator's stage may look across the guard) the law
 //! holds q at q_b ([`crate::contact::Jkr::radius_variable`]); there q_b moves with c as the
@@ -34,16 +39,18 @@ use super::sensitivity::OrbitParam;
 use crate::contact::Jkr;
 use crate::system::Region;
 
-/// ∂F_c/∂p of the JKR law (Hertz group α4 = `alpha4`, adhesion P̃ = `adhesion`, no damper) at
-/// indentation δ = `delta` in or out of contact (module docs), for p = α5, α4 and P̃; `None`
-/// for the other parameters (α6 and H̃ are not JKR's; the drive's columns are formed by the
-/// extended system from the law's partials).
+/// ∂F_c/∂p of the JKR law (Hertz group α4 = `alpha4`, adhesion P̃ = `adhesion`, Kelvin–Voigt
+/// group α6 = `damping`) at indentation δ = `delta` and rate δ̇ = `rate`, in or out of contact
+/// (module docs), for p = α5, α4, P̃ and α6; `None` for the other parameters (H̃ is not JKR's;
+/// the drive's columns are formed by the extended system from the law's partials).
 pub fn d_force(
     alpha4: f64,
     adhesion: f64,
+    damping: f64,
     param: OrbitParam,
     contact: bool,
     delta: f64,
+    rate: f64,
 ) -> Option<f64> {
     let dc_of = |c: f64| match param {
         OrbitParam::ContactStiffness => Some(-c / (2.0 * alpha4)),
@@ -52,7 +59,7 @@ pub fn d_force(
     };
     if !matches!(
         param,
-        OrbitParam::Gap | OrbitParam::ContactStiffness | OrbitParam::Adhesion
+        OrbitParam::Gap | OrbitParam::ContactStiffness | OrbitParam::Adhesion | OrbitParam::Damping
     ) {
         return None;
     }
@@ -61,7 +68,12 @@ pub fn d_force(
     }
     let j = Jkr::new(alpha4, adhesion);
     let q = j.radius_variable(delta);
-    let (_, f_q) = j.elastic(q);
+    if param == OrbitParam::Damping {
+        return Some(q * q * rate);
+    }
+    let (_, f_el) = j.elastic(q);
+    // ∂F/∂q at fixed δ̇, the damper's 2α6 q δ̇ with the elastic–adhesive part's
+    let f_q = f_el + 2.0 * damping * q * rate;
     let q3 = q * q * q;
     let beyond = delta <= j.release();
     if param == OrbitParam::Gap {
