@@ -668,33 +668,6 @@ impl CantileverModel {
             - p.component_force(tau)
     }
 
-    /// Complex amplitude H of the free tip deflection's response to a unit force cos(ωτ) at the
-    /// tip: W(1,τ) = Re(H e^{iωτ}), so F̃|H| is a force component's free amplitude and −arg H
-    /// its phase lag ([`Params::drive_components`]); H = φ(1)ᵀ(K − ω²M + iωC)⁻¹φ(1), the
-    /// harmonic balance of the free system as in [`CantileverModel::free_tip_response`].
-    ///
-    /// # Errors
-    /// [`SimError::OutOfRange`] when ω is at an undamped natural frequency.
-    pub fn free_force_response(&self, omega: f64) -> Result<nalgebra::Complex<f64>, SimError> {
-        use nalgebra::Complex;
-        let g = self.galerkin.region(Region::Free);
-        let dyn_stiff = DMatrix::from_fn(self.modes(), self.modes(), |i, j| {
-            Complex::new(
-                g.stiffness[(i, j)] - omega * omega * g.mass[(i, j)],
-                omega * g.damping[(i, j)],
-            )
-        });
-        let f = self.tip().map(|v| Complex::new(v, 0.0));
-        let x = dyn_stiff.lu().solve(&f).ok_or_else(|| {
-            SimError::out_of_range(
-                "drive frequency",
-                omega,
-                "the free system has no steady state at an undamped natural frequency",
-            )
-        })?;
-        Ok(self.tip().iter().zip(x.iter()).map(|(p, xi)| xi * *p).sum())
-    }
-
     /// Impact law, start inside the sample (V_T < 0): the plastic contact that places it on the
     /// surface, a ← a − V_T m_eff M⁻¹φ and, when V̇_T < 0, ȧ ← ȧ − V̇_T m_eff M⁻¹φ (the smallest
     /// change in the kinetic metric with V_T = 0, V̇_T ≥ 0), with its Jacobian (2N×2N). `None`

@@ -191,6 +191,47 @@ fn the_bimodal_models_damping_column_is_its_finite_differences() {
     check_jacobian(probe, params, truth);
 }
 
+/// The bimodal model's Jacobian column of the lever's Q₁ (with E and z_offset): the drive α2
+/// and the second component's force F̃₁ follow Q₁ so that both free amplitudes stay the
+/// probe's (`analysis::fit::am_curve`), so the column gathers α3's, α2's and F̃₁'s.
+#[test]
+fn the_bimodal_models_quality_factor_column_is_its_finite_differences() {
+    let probe = bimodal_probe();
+    let params = vec![
+        AmParam::QualityFactor,
+        AmParam::YoungsModulus,
+        AmParam::ZOffset,
+    ];
+    let truth = vec![probe.quality_factor, probe.youngs_modulus, 1e-9];
+    check_jacobian(probe, params, truth);
+}
+
+/// Far from the sample (z_c = 3 → 2.5 A₁₀, no contact) both free amplitudes stay the probe's
+/// A₁₀ = 10 nm and A₂₀ = 1 nm whatever Q₁ (× 1.3, × 0.7): the drive and the second force follow
+/// Q₁ (to 1e-6, the integration's).
+#[test]
+fn both_free_amplitudes_are_held_whatever_the_quality_factor() {
+    let probe = bimodal_probe();
+    let g0 = probe.length_m;
+    let z: Vec<f64> = (0..3).map(|i| g0 * (3.0 - 0.25 * i as f64)).collect();
+    let model = BimodalCurveModel::new(
+        probe,
+        z,
+        [true, false, true, false],
+        vec![AmParam::QualityFactor],
+    );
+    for q in [1.3, 0.7].map(|f| f * probe.quality_factor) {
+        let mut v = vec![0.0; model.points()];
+        model.evaluate(&[q], &mut v, None);
+        for a in &v[..3] {
+            assert!((a / 10e-9 - 1.0).abs() < 1e-6, "Q = {q}: A₁ = {a:e}");
+        }
+        for a in &v[3..] {
+            assert!((a / 1e-9 - 1.0).abs() < 1e-6, "Q = {q}: A₂ = {a:e}");
+        }
+    }
+}
+
 /// The bimodal model's Jacobian at `truth` (z_offset last) against its central differences.
 fn check_jacobian(probe: AmProbe, params: Vec<AmParam>, truth: Vec<f64>) {
     let g0 = probe.length_m;

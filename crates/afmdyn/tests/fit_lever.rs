@@ -81,17 +81,23 @@ fn lever_damping_sensitivities_are_the_finite_differences() {
     }
 }
 
-/// The primary drive's α2 on a bimodal drive (its further component's force does not move
-/// with α2): ∂(A₁, φ₁)/∂α2 against the differences, which A₀'s chain uses on bimodal curves.
+/// On a bimodal drive: the primary drive's α2 (its further component's force does not move
+/// with α2), the further component's force F̃₁ (its column M⁻¹φ cos(ω₁τ + θ₁)) and α3:
+/// ∂(A₁, φ₁)/∂p against the differences, which Q₁'s and A₀'s chains use on bimodal curves.
 #[test]
-fn the_bimodal_drives_amplitude_sensitivity_is_the_finite_difference() {
+fn the_bimodal_drives_sensitivities_are_the_finite_differences() {
     let base = probe("probe-bimodal.toml");
     let curve = approach(base, 21);
     let points = Regime::Repulsive.points(&curve);
     check_first(
         &base,
         &points,
-        &[OrbitParam::DriveAmplitude, OrbitParam::Gap],
+        &[
+            OrbitParam::DriveAmplitude,
+            OrbitParam::ComponentForce,
+            OrbitParam::LeverDamping,
+            OrbitParam::Gap,
+        ],
         "bimodal DMT, repulsive",
     );
 }
@@ -297,8 +303,8 @@ fn a_noisy_am_curve_gives_back_the_free_amplitude() {
 
 /// Through the door (`afmdyn fit`'s request): `cantilever.quality_factor` and
 /// `drive.free_amplitude` by their probe names come back inside their intervals from the
-/// probe's starts, with their units in the document; Q₁ is refused on a probe in a medium and
-/// on a bimodal probe, naming why.
+/// probe's starts, with their units in the document; Q₁ is refused on a probe in a medium,
+/// naming why.
 #[test]
 fn the_door_fits_q_and_a0_and_refuses_q_where_it_does_not_hold() {
     let ps = vec![AmParam::QualityFactor, AmParam::ZOffset];
@@ -334,10 +340,7 @@ fn the_door_fits_q_and_a0_and_refuses_q_where_it_does_not_hold() {
     }
     assert_eq!(doc["units"]["cantilever.quality_factor"], "1");
     assert_eq!(doc["units"]["drive.free_amplitude"], "m");
-    for (file, words) in [
-        ("probe-water-beam.toml", "[medium]"),
-        ("probe-bimodal.toml", "single-frequency"),
-    ] {
+    for (file, words) in [("probe-water-beam.toml", "[medium]")] {
         // the water probe without its Kelvin–Voigt term (DMT's, refused on its own)
         let text = std::fs::read_to_string(
             Path::new(env!("CARGO_MANIFEST_DIR"))

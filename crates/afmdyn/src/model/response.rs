@@ -128,16 +128,10 @@ impl CantileverModel {
         use nalgebra::Complex;
         let g = self.galerkin.region(Region::Free);
         let om = self.params.omega;
-        let dyn_stiff = DMatrix::from_fn(self.modes(), self.modes(), |i, j| {
-            Complex::new(
-                g.stiffness[(i, j)] - om * om * g.mass[(i, j)],
-                om * g.damping[(i, j)],
-            )
-        });
         let f = DVector::from_fn(self.modes(), |i, _| {
             Complex::new(g.forcing.sin[i], g.forcing.cos[i])
         });
-        let lu = dyn_stiff.lu();
+        let lu = self.free_dynamic_stiffness(om).lu();
         let x = lu.solve(&f).ok_or_else(|| {
             SimError::out_of_range(
                 "omega",
@@ -151,6 +145,61 @@ impl CantileverModel {
             lu,
             x,
         ))
+    }
+
+    /// D(ω) = K − ω²M + iωC of the free region (N×N): the harmonic balance of the free
+    /// linear system at the frequency ω.
+    fn free_dynamic_stiffness(&self, omega: f64) -> DMatrix<nalgebra::Complex<f64>> {
+        let g = self.galerkin.region(Region::Free);
+        DMatrix::from_fn(self.modes(), self.modes(), |i, j| {
+            nalgebra::Complex::new(
+                g.stiffness[(i, j)] - omega * omega * g.mass[(i, j)],
+                omega * g.damping[(i, j)],
+            )
+        })
+    }
+
+    /// Complex amplitude H of the free tip deflection's response to a unit force cos(ωτ) at the
+    /// tip: W(1,τ) = Re(H e^{iωτ}), so F̃|H| is a force component's free amplitude and −arg H
+    /// its phase lag ([`Params::drive_components`]); H = φ(1)ᵀ(K − ω²M + iωC)⁻¹φ(1), the
+    /// harmonic balance of the free system as in [`CantileverModel::free_tip_response`].
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] when ω is at an undamped natural frequency.
+    pub fn free_force_response(&self, omega: f64) -> Result<nalgebra::Complex<f64>, SimError> {
+        Ok(self.free_force_response_damping_derivative(omega)?.0)
+    }
+
+    /// [`CantileverModel::free_force_response`] H at ω and its derivative dH/dα3 in the
+    /// lever's damping: the force at the tip does not move with α3, so
+    /// dX/dα3 = −D⁻¹(iω diag(s) X) and dH = φ(1)ᵀ dX (module docs of
+    /// [`CantileverModel::free_tip_response_damping_derivative`]). A further drive component
+    /// set to a free amplitude A₀ᵢ has F̃ᵢ = A₀ᵢ/|Hᵢ|, which follows α3 as 1/|Hᵢ|.
+    ///
+    /// # Errors
+    /// As [`CantileverModel::free_force_response`].
+    pub fn free_force_response_damping_derivative(
+        &self,
+        omega: f64,
+    ) -> Result<(nalgebra::Complex<f64>, nalgebra::Complex<f64>), SimError> {
+        use nalgebra::Complex;
+        let lu = self.free_dynamic_stiffness(omega).lu();
+        let no_steady_state = || {
+            SimError::out_of_range(
+                "drive frequency",
+                omega,
+                "the free system has no steady state at an undamped natural frequency",
+            )
+        };
+        let f = self.tip().map(|v| Complex::new(v, 0.0));
+        let x = lu.solve(&f).ok_or_else(no_steady_state)?;
+        let (s, _) = self.galerkin.damping_derivative();
+        let rhs = DVector::from_fn(self.modes(), |i, _| -Complex::new(0.0, omega * s[i]) * x[i]);
+        let dx = lu.solve(&rhs).ok_or_else(no_steady_state)?;
+        let at_tip = |v: &DVector<Complex<f64>>| -> Complex<f64> {
+            self.tip().iter().zip(v.iter()).map(|(p, xi)| xi * *p).sum()
+        };
+        Ok((at_tip(&x), at_tip(&dx)))
     }
 
     /// The free region's ∂f/∂α3 in the lever's damping α3 (eq. 12, eq. 14): the state's rate

@@ -77,7 +77,7 @@ pub struct FitRequest {
     /// `sample.hamaker` (DMT), `sample.viscosity` (DMT and JKR; Kelvin–Voigt η, Pa s),
     /// `sample.damping` (Hertz's damper, N s/m), `sample.adhesion_energy` (JKR, J/m²),
     /// `tip.radius`, `drive.free_amplitude` (m),
-    /// `cantilever.quality_factor` (AM curves of a single-frequency drive without `[medium]`;
+    /// `cantilever.quality_factor` (AM and bimodal curves without `[medium]`;
     /// at resonance Q trades against the sample's E: fit it with E held) and `z_offset` (always
     /// fitted); default `sample.youngs_modulus`, `sample.hamaker` (DMT) or
     /// `sample.adhesion_energy` (JKR) and `z_offset`.

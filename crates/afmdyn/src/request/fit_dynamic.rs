@@ -431,10 +431,10 @@ pub fn am_probe(probe: &crate::probe::Probe) -> Result<AmProbe, SimError> {
 
 /// Why the lever's Q₁ or the free amplitude A₀ (`p`) cannot be fitted on `data` under `probe`,
 /// if so (analysis::fit::am_curve, `lever_and_drive`): Q₁ moves the lever's damping α3 with
-/// the drive α2 holding A₀, which holds for the AM curve of a single-frequency drive in air
-/// or vacuum. An FM curve's Δf does not constrain Q₁ (the loop locks the phase at resonance;
-/// Q₁ shows in the drive it needs, which the fit does not take); a bimodal drive's further
-/// components' forces would follow Q₁ too; in a `[medium]`, Q₁ is the fluid's, made of the
+/// the drive α2 holding A₀ (and a bimodal drive's second force holding A₀₁), which holds for
+/// the AM and bimodal curves of a drive of at most two components in air or vacuum. An FM
+/// curve's Δf does not constrain Q₁ (the loop locks the phase at resonance; Q₁ shows in the
+/// drive it needs, which the fit does not take); in a `[medium]`, Q₁ is the fluid's, made of the
 /// medium's hydrodynamic damping and the lever's. Off resonance, the drive is the sample's
 /// modulation, not a free amplitude.
 fn lever_refusal(p: AmParam, probe: &crate::probe::Probe, data: &AmData) -> Option<&'static str> {
@@ -444,9 +444,9 @@ fn lever_refusal(p: AmParam, probe: &crate::probe::Probe, data: &AmData) -> Opti
             "an FM curve's frequency shift does not constrain Q (the loop holds the phase at \
              resonance; Q shows in the drive it needs, which the fit does not take)",
         ),
-        AmParam::QualityFactor if probe.params.is_multifrequency() => Some(
-            "Q is fitted on the AM curve of a single-frequency drive (the further \
-             components' forces would follow it)",
+        AmParam::QualityFactor if probe.params.components().count() > 1 => Some(
+            "Q is fitted under a drive of at most two components (the further component's \
+             force follows Q to hold its free amplitude)",
         ),
         AmParam::QualityFactor if probe.medium.is_some() => Some(
             "in a [medium], Q is the fluid's, made of the medium's damping and the lever's: \

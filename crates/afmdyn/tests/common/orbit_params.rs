@@ -39,6 +39,11 @@ pub fn with(base: &Params, p: OrbitParam, value: f64) -> Params {
         OrbitParam::DriveAmplitude => q.alpha2 = value,
         OrbitParam::DriveFrequency => q.omega = value,
         OrbitParam::LeverDamping => q.alpha3 = value,
+        OrbitParam::ComponentForce => {
+            if let Some(c) = q.drive_components.iter_mut().flatten().next() {
+                c.force = value;
+            }
+        }
         OrbitParam::Adhesion => match &mut q.contact_law {
             ContactLaw::Jkr { adhesion } => *adhesion = value,
             _ => panic!("P̃ of a law without it"),
@@ -60,6 +65,7 @@ pub fn value_of(base: &Params, p: OrbitParam) -> f64 {
         OrbitParam::DriveAmplitude => base.alpha2,
         OrbitParam::DriveFrequency => base.omega,
         OrbitParam::LeverDamping => base.alpha3,
+        OrbitParam::ComponentForce => base.components().next().map_or(f64::NAN, |c| c.force),
         OrbitParam::Adhesion => match base.contact_law {
             ContactLaw::Jkr { adhesion } => adhesion,
             _ => panic!("P̃ of a law without it"),

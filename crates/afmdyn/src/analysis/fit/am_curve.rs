@@ -396,7 +396,7 @@ fn lever_and_drive(pr: &AmProbe, params: &[AmParam], p: &[f64], q: &mut Params, 
     }
     let g0 = pr.length_m;
     let a0 = a0.unwrap_or(g0);
-    let (mut d_alpha3, mut d_alpha2_d_alpha3) = (0.0, 0.0);
+    let (mut d_alpha3, mut d_alpha2_d_alpha3, mut d_force_d_alpha3) = (0.0, 0.0, 0.0);
     if let Some(q1) = q1 {
         q.alpha3 = pr.params.alpha3 * pr.quality_factor / q1;
         d_alpha3 = -q.alpha3 / q1;
@@ -411,6 +411,11 @@ fn lever_and_drive(pr: &AmProbe, params: &[AmParam], p: &[f64], q: &mut Params, 
             }
             Err(_) => q.alpha2 = f64::NAN,
         }
+        // a bimodal drive's further component holds its free amplitude A₀₁ = F̃₁|H₁| g₀ too:
+        // F̃₁ = F̃₁⁰ |H₁(α3⁰)|/|H₁(α3)|, ∂F̃₁/∂α3 = −F̃₁ (d|H₁|/dα3)/|H₁| (one component)
+        if let Some(d) = component_following(pr, q) {
+            d_force_d_alpha3 = d;
+        }
     } else {
         q.alpha2 = pr.params.alpha2 * a0 / g0;
     }
@@ -421,6 +426,13 @@ fn lever_and_drive(pr: &AmProbe, params: &[AmParam], p: &[f64], q: &mut Params, 
             OrbitParam::DriveAmplitude,
             d_alpha2_d_alpha3 * d_alpha3,
         );
+        if q.is_multifrequency() {
+            chain.push(
+                AmParam::QualityFactor,
+                OrbitParam::ComponentForce,
+                d_force_d_alpha3 * d_alpha3,
+            );
+        }
     }
     if at(AmParam::FreeAmplitude).is_some() {
         chain.push(
@@ -429,6 +441,32 @@ fn lever_and_drive(pr: &AmProbe, params: &[AmParam], p: &[f64], q: &mut Params, 
             q.alpha2 / a0,
         );
     }
+}
+
+/// The first further drive component's force F̃₁ of `q` (its α3 moved from the probe's) set so
+/// that its free amplitude stays the probe's, and ∂F̃₁/∂α3 ([`lever_and_drive`]); `None` without
+/// a further component. A response that cannot be formed leaves F̃₁ NaN (the evaluation then
+/// fails).
+fn component_following(pr: &AmProbe, q: &mut Params) -> Option<f64> {
+    let c = q.drive_components.iter().flatten().next().copied()?;
+    let omega = c.ratio() * q.omega;
+    let at = |p: &Params| {
+        CantileverModel::new(p)
+            .map_err(SimError::from)
+            .and_then(|m| m.free_force_response_damping_derivative(omega))
+    };
+    let (force, derivative) = match (at(&pr.params), at(q)) {
+        (Ok((h0, _)), Ok((h, dh))) => {
+            let mag = h.norm();
+            let force = c.force * h0.norm() / mag;
+            (force, Some(-force * (h.conj() * dh).re / (mag * mag)))
+        }
+        _ => (f64::NAN, None),
+    };
+    if let Some(slot) = q.drive_components.iter_mut().flatten().next() {
+        slot.force = force;
+    }
+    derivative
 }
 
 impl CheckedModel for AmCurveModel {

@@ -87,13 +87,14 @@ impl CheckedModel for BimodalCurveModel {
                 "the bimodal channels need a probe whose drive has a second component",
             ));
         }
-        if self.params.contains(&AmParam::QualityFactor) {
-            // the further components' forces F̃ᵢ = A₀ᵢ/|Hᵢ| would follow Q₁ too
+        if self.params.contains(&AmParam::QualityFactor)
+            && self.probe.params.components().count() > 1
+        {
+            // the chain follows one further component's force (F̃₁ = A₀₁/(g₀|H₁|))
             return Err(SimError::out_of_range(
                 "fit",
                 AmParam::QualityFactor.name(),
-                "not on bimodal channels: Q is fitted on the AM curve of a single-frequency \
-                 drive",
+                "Q is fitted under a drive of at most two components",
             ));
         }
         let (q, z_offset, chain) = scaled(&self.probe, &self.params, p);

@@ -155,6 +155,10 @@ pub enum OrbitParam {
     /// through −M⁻¹ diag(s) ȧ and, on the base-driven beam, the forcing's base-velocity term
     /// (eq. 14) (module docs, *The lever's damping*).
     LeverDamping,
+    /// F̃₁, the force of the drive's first further component (a bimodal drive's second, a tip
+    /// force F̃₁ cos(ω₁τ + θ₁), [`crate::params::Params::drive_components`]): its column is
+    /// M⁻¹φ cos(ω₁τ + θ₁).
+    ComponentForce,
     /// P̃, the JKR law's adhesion group (πWR/F̃-unit, ∝ W R; [`crate::contact::Jkr`]).
     Adhesion,
 }
@@ -328,9 +332,10 @@ pub fn d_force(
             // Hertz's α6 δ̇ at α6 = 1 (and α4 = 0): δ̇ in contact, 0 outside
             None => HertzLaw.force(0.0, 1.0, contact, delta, rate).force,
         },
-        OrbitParam::DriveAmplitude | OrbitParam::DriveFrequency | OrbitParam::LeverDamping => {
-            return None
-        }
+        OrbitParam::DriveAmplitude
+        | OrbitParam::DriveFrequency
+        | OrbitParam::LeverDamping
+        | OrbitParam::ComponentForce => return None,
         OrbitParam::Adhesion => return None,
     })
 }
@@ -410,6 +415,12 @@ impl Extended {
                     -f.d_rate * p.base_amplitude() * c
                 }
             }
+            // the first further component's tip force F̃₁ cos(ω₁τ + θ₁) (Params::component_force)
+            OrbitParam::ComponentForce => m
+                .params()
+                .components()
+                .next()
+                .map_or(0.0, |c| (c.ratio() * m.omega() * tau + c.phase).cos()),
             OrbitParam::LeverDamping => {
                 if let Some(ld) = &self.lever {
                     let (s, c) = (m.omega() * tau).sin_cos();
@@ -656,6 +667,11 @@ pub fn orbit_sensitivity_component(
         }
         None => (guess.clone(), f64::INFINITY),
     };
+    if params.contains(&OrbitParam::ComponentForce) && p.components().next().is_none() {
+        return Err(unsupported(
+            "the component force's sensitivity needs a drive with a further component",
+        ));
+    }
     let drive = [OrbitParam::DriveAmplitude, OrbitParam::DriveFrequency];
     // the further components' forces do not move with α2 (the primary's), but their phases
     // move with Ω
