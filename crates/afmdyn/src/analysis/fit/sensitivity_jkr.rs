@@ -35,7 +35,7 @@
 //! both switchings, and the saltation of the extended system (S = I + w ∇gᵀ with these
 //! parameter entries of ∇g; Leine & Nijmeijer 2004, §7.1) carries the columns across them.
 
-use super::sensitivity::OrbitParam;
+use super::orbit_param::OrbitParam;
 use crate::contact::Jkr;
 use crate::system::Region;
 
