@@ -170,7 +170,8 @@ fn damped_hertz_sensitivities_are_the_finite_differences() {
 use afmdyn::analysis::fit::am_curve::{AmCurveModel, AmParam, AmProbe};
 use afmdyn::analysis::fit::{fit_with, CurveModel, FitOutcome, Observations};
 use common::am_synthetic::{
-    am_probe, door, interval, jacobian_gaps, parameters, run_fit, synthetic, synthetic_of,
+    am_probe, assert_recovered, door, interval, jacobian_gaps, parameters, run_fit, synthetic,
+    synthetic_of,
 };
 
 #[test]
@@ -204,31 +205,8 @@ fn a_noisy_point_mass_am_curve_gives_back_e_h_and_the_offset() {
     );
     let t0 = std::time::Instant::now();
     let out = run_fit(&model, &y, &sigma);
-    eprintln!(
-        "fit of E, H, z_offset to 100 rows (amplitude and phase): {:.2} s, {} evaluations \
-         ({}), χ²/dof {:.3}, {:?}",
-        t0.elapsed().as_secs_f64(),
-        out.evaluations,
-        out.termination,
-        out.chi2_dof,
-        out.warnings
-    );
-    for (e, t) in out.estimates.iter().zip(&truth) {
-        eprintln!(
-            "{}: {:.6e} ± {:.3e} [{:.6e}, {:.6e}] (truth {t:.6e})",
-            e.name, e.value, e.standard_error, e.interval[0], e.interval[1]
-        );
-        assert!(
-            (e.interval[0]..=e.interval[1]).contains(t),
-            "{}: the interval misses the truth",
-            e.name
-        );
-    }
-    assert!(
-        (0.5..2.0).contains(&out.chi2_dof),
-        "χ²/dof {}",
-        out.chi2_dof
-    );
+    eprintln!("{:.2} s", t0.elapsed().as_secs_f64());
+    assert_recovered(&out, &truth, "E, H, z_offset, 100 rows", None, 0.5..2.0);
     // the χ²/dof warning (estimates::CHI2_SIGMAS): χ² of a model that describes its data is
     // χ²(dof), mean dof and standard deviation √(2 dof); with the true σ it stays within 4 of
     // them, with σ 10× too small χ²/dof is ~100 and warns (the same minimum: every weight
@@ -455,28 +433,7 @@ fn a_noisy_damped_hertz_am_curve_gives_back_the_damping() {
     let (model, y, sigma, truth) =
         synthetic_of(damped_hertz_probe(), 100, (1.0, 0.5), ps, (true, true), 6);
     let out = run_fit(&model, &y, &sigma);
-    eprintln!(
-        "damped Hertz: {} evaluations ({}), χ²/dof {:.3}, {:?}",
-        out.evaluations, out.termination, out.chi2_dof, out.warnings
-    );
-    for (e, t) in out.estimates.iter().zip(&truth) {
-        eprintln!(
-            "{}: {:.6e} ± {:.3e} [{:.6e}, {:.6e}] (truth {t:.6e})",
-            e.name, e.value, e.standard_error, e.interval[0], e.interval[1]
-        );
-        assert!(
-            (e.interval[0]..=e.interval[1]).contains(t),
-            "{}: the interval misses the truth",
-            e.name
-        );
-        // an estimate, not an unconstrained one
-        assert!(e.standard_error < 0.1 * t.abs(), "{}", e.name);
-    }
-    assert!(
-        (0.5..2.0).contains(&out.chi2_dof),
-        "χ²/dof {}",
-        out.chi2_dof
-    );
+    assert_recovered(&out, &truth, "damped Hertz", Some(0.1), 0.5..2.0);
 }
 
 /// The point-mass example's text as a Hertz sample with `[sample] damping` = `damping`

@@ -8,7 +8,6 @@
 
 use afmdyn::analysis::fit::am_curve::{scaled, AmCurveModel, AmParam, AmProbe};
 use afmdyn::analysis::fit::sensitivity::{orbit_sensitivity, OrbitParam};
-use afmdyn::analysis::fit::CurveModel;
 use afmdyn::contact::ContactLaw;
 use afmdyn::model::CantileverModel;
 use afmdyn::probe::Probe;
@@ -18,7 +17,10 @@ use nalgebra::DVector;
 use std::path::Path;
 
 mod common;
-use common::am_synthetic::{door, interval, jacobian_gaps, run_fit, synthetic_of, truth};
+use common::am_synthetic::{
+    assert_recovered, door, interval, jacobian_gaps, run_fit, synthetic_of, truth,
+};
+use common::fm_check::check_fm_jacobian;
 use common::orbit_check::{approach, check_first, Regime, AGREE, TOL};
 use common::orbit_params::probe;
 
@@ -202,52 +204,36 @@ fn synthetic(
 }
 
 /// The AM model's Jacobian columns of E, W, z_offset and R (R's chain moves α4 ∝ √R and
-/// P̃ ∝ R) against central differences of its values (the stepped sweep's observables), on 12
-/// rows of the repulsive branch of the JKR approach, amplitude and phase: 1e-4 relative (the
-/// values' integration error over the step 1e-4, with the values integrated at 1e-12).
+/// P̃ ∝ R), and of the damped sample's η (`sample.viscosity`, α6 ∝ η √R; α6 = 0.01), against
+/// central differences of its values (the stepped sweep's observables), on 12 rows of the
+/// repulsive branch of the JKR approach, amplitude and phase: 1e-4 relative (the values'
+/// integration error over the step 1e-4, with the values integrated at 1e-12).
 #[test]
 fn the_jkr_am_models_jacobian_is_its_finite_differences() {
-    let ps = vec![
-        AmParam::YoungsModulus,
-        AmParam::AdhesionEnergy,
-        AmParam::ZOffset,
-        AmParam::TipRadius,
-    ];
-    let (mut model, _, _, truth) = synthetic(12, (0.75, 0.3), ps, 1);
-    // the values' own integration and Newton tolerances tightened to the sensitivities': at
-    // the sweep's defaults the phase rows' central differences scatter by ~1e-3 relative
-    // (JKR's force jumps at both switchings, located to the integrator's tolerance)
-    model.spec.integrator.tolerance = 1e-12;
-    model.spec.newton.tol = 1e-12;
-    model.tolerance = 1e-12;
-    for (name, worst, phase_max) in jacobian_gaps(&model, &truth) {
-        assert!(phase_max > 0.0, "{name}: a zero column");
-        assert!(worst < 1e-4, "{name}: worst relative gap {worst:.2e}");
-    }
-}
-
-/// The damped JKR sample's AM model (α6 = 0.01, η = α6 over its unit): the Jacobian columns
-/// of η (`sample.viscosity`, α6 ∝ η √R), E, W, z_offset and R against central differences of
-/// its values, 12 repulsive rows, at the tolerances above: 1e-4 relative.
-#[test]
-fn the_damped_jkr_am_models_jacobian_is_its_finite_differences() {
-    let ps = vec![
-        AmParam::Viscosity,
-        AmParam::YoungsModulus,
-        AmParam::AdhesionEnergy,
-        AmParam::ZOffset,
-        AmParam::TipRadius,
-    ];
-    let mut probe = am_probe_of(&jkr_probe("probe-point-mass-dmt.toml"));
-    probe.params.alpha6 = 0.01;
-    assert!(probe.viscosity() > 0.0);
-    let (mut model, _, _, truth) = synthetic_of(probe, 12, (0.75, 0.3), ps, (true, true), 1);
-    model.spec.integrator.tolerance = 1e-12;
-    model.spec.newton.tol = 1e-12;
-    model.tolerance = 1e-12;
-    for (name, worst, phase_max) in jacobian_gaps(&model, &truth) {
-        assert!(phase_max > 0.0, "{name}: a zero column");
-        assert!(worst < 1e-4, "{name}: worst relative gap {worst:.2e}");
+    for alpha6 in [0.0, 0.01] {
+        let mut ps = vec![
+            AmParam::YoungsModulus,
+            AmParam::AdhesionEnergy,
+            AmParam::ZOffset,
+            AmParam::TipRadius,
+        ];
+        let mut probe = am_probe_of(&jkr_probe("probe-point-mass-dmt.toml"));
+        if alpha6 > 0.0 {
+            probe.params.alpha6 = alpha6;
+            ps.push(AmParam::Viscosity);
+        }
+        let (mut model, _, _, truth) = synthetic_of(probe, 12, (0.75, 0.3), ps, (true, true), 1);
+        // the values' own integration and Newton tolerances tightened to the sensitivities':
+        // at the sweep's defaults the phase rows' central differences scatter by ~1e-3
+        // relative (JKR's force jumps at both switchings, located to the integrator's
+        // tolerance)
+        model.spec.integrator.tolerance = 1e-12;
+        model.spec.newton.tol = 1e-12;
+        model.tolerance = 1e-12;
+        for (name, worst, phase_max) in jacobian_gaps(&model, &truth) {
+            assert!(phase_max > 0.0, "α6 = {alpha6}, {name}: a zero column");
+            assert!(worst < 1e-4, "α6 = {alpha6}, {name}: worst gap {worst:.2e}");
+        }
     }
 }
 
@@ -264,25 +250,12 @@ fn a_noisy_jkr_am_curve_gives_back_e_w_and_the_offset() {
     let (model, y, sigma, truth) = synthetic(100, (0.75, 0.3), ps, 62);
     // from E × 0.6, W × 1.3, z_offset 0.8 nm ([`parameters`])
     let out = run_fit(&model, &y, &sigma);
-    eprintln!(
-        "fit of E, W, z_offset to 100 rows: {} evaluations ({}), χ²/dof {:.3}, {:?}",
-        out.evaluations, out.termination, out.chi2_dof, out.warnings
-    );
-    for (e, t) in out.estimates.iter().zip(&truth) {
-        eprintln!(
-            "{}: {:.6e} ± {:.3e} [{:.6e}, {:.6e}] (truth {t:.6e})",
-            e.name, e.value, e.standard_error, e.interval[0], e.interval[1]
-        );
-        assert!(
-            (e.interval[0]..=e.interval[1]).contains(t),
-            "{}: the interval misses the truth",
-            e.name
-        );
-    }
-    assert!(
-        (0.5..2.0).contains(&out.chi2_dof),
-        "χ²/dof {}",
-        out.chi2_dof
+    assert_recovered(
+        &out,
+        &truth,
+        "fit of E, W, z_offset to 100 rows",
+        None,
+        0.5..2.0,
     );
 }
 
@@ -373,34 +346,5 @@ fn the_jkr_fm_models_jacobian_is_its_finite_differences() {
     let mut model = FmCurveModel::new(probe, z, params.clone(), hz);
     model.loop_tolerance = 1e-12;
     let truth = truth(&probe, &params, 1e-9);
-    let (m, n) = (model.points(), truth.len());
-    let mut v = vec![0.0; m];
-    let mut jac = vec![0.0; m * n];
-    model.evaluate(&truth, &mut v, Some(&mut jac));
-    assert!(model.warnings().is_empty(), "{:?}", model.warnings());
-    eprintln!("Δf = {v:?} Hz");
-    for j in 0..n {
-        let h = match params[j] {
-            AmParam::ZOffset => 5e-4 * g0,
-            _ => 1e-2 * truth[j].abs(),
-        };
-        let at = |k: f64| {
-            let mut q = truth.clone();
-            q[j] += k * h;
-            let mut out = vec![0.0; m];
-            model.evaluate(&q, &mut out, None);
-            out
-        };
-        let (p1, m1, p2, m2) = (at(1.0), at(-1.0), at(2.0), at(-2.0));
-        for i in 0..m {
-            let fd = (8.0 * (p1[i] - m1[i]) - (p2[i] - m2[i])) / (12.0 * h);
-            let e = jac[i * n + j];
-            let rel = (e - fd).abs() / e.abs().max(f64::MIN_POSITIVE);
-            eprintln!(
-                "{:?} row {i}: dΔf/dp {e:.9e} (fd {fd:.9e}, rel {rel:.1e})",
-                params[j]
-            );
-            assert!(e != 0.0 && rel <= AGREE, "{:?} row {i}", params[j]);
-        }
-    }
+    check_fm_jacobian(&model, &truth, "point mass JKR", AGREE, &[]);
 }

@@ -17,7 +17,7 @@ use std::path::Path;
 
 mod common;
 use common::am_synthetic::{
-    am_probe, door, interval, jacobian_gaps, run_fit, synthetic, synthetic_of,
+    am_probe, assert_recovered, door, interval, jacobian_gaps, run_fit, synthetic, synthetic_of,
 };
 use common::orbit_check::{approach, check_first, Regime};
 use common::orbit_params::probe;
@@ -249,27 +249,7 @@ fn a_noisy_am_curve_on_a_known_sample_gives_back_the_quality_factor() {
     let (model, y, sigma, truth) =
         synthetic_of(hertz_probe(), 100, (1.1, 0.5), ps, (true, true), 11);
     let out = run_fit(&model, &y, &sigma);
-    eprintln!(
-        "Q: {} evaluations ({}), χ²/dof {:.3}, {:?}",
-        out.evaluations, out.termination, out.chi2_dof, out.warnings
-    );
-    for (e, t) in out.estimates.iter().zip(&truth) {
-        eprintln!(
-            "{}: {:.6e} ± {:.3e} [{:.6e}, {:.6e}] (truth {t:.6e})",
-            e.name, e.value, e.standard_error, e.interval[0], e.interval[1]
-        );
-        assert!(
-            (e.interval[0]..=e.interval[1]).contains(t),
-            "{}: the interval misses the truth",
-            e.name
-        );
-        assert!(e.standard_error < 0.1 * t.abs(), "{}", e.name);
-    }
-    assert!(
-        (0.5..2.0).contains(&out.chi2_dof),
-        "χ²/dof {}",
-        out.chi2_dof
-    );
+    assert_recovered(&out, &truth, "Q", Some(0.1), 0.5..2.0);
 }
 
 /// A noisy synthetic AM curve of a Hertz sample fitted for A₀, E and z_offset from A₀ × 0.95: the free rows pin

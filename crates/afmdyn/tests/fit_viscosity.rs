@@ -9,13 +9,15 @@
 use afmdyn::analysis::fit::am_curve::{AmParam, AmProbe};
 use afmdyn::analysis::fit::fm_curve::FmCurveModel;
 use afmdyn::analysis::fit::sensitivity::OrbitParam;
-use afmdyn::analysis::fit::CurveModel;
 use afmdyn::probe::Probe;
 use afmdyn::request::fit_dynamic::am_probe;
 use std::path::Path;
 
 mod common;
-use common::am_synthetic::{door, interval, jacobian_gaps, run_fit, synthetic_of, truth};
+use common::am_synthetic::{
+    assert_recovered, door, interval, jacobian_gaps, run_fit, synthetic_of, truth,
+};
+use common::fm_check::check_fm_jacobian;
 use common::orbit_check::{approach, check_first_at, Regime};
 use common::orbit_params::probe;
 
@@ -114,42 +116,14 @@ fn the_fm_models_viscosity_column_is_its_finite_differences() {
     model.loop_tolerance = 1e-12;
     model.tolerance = KV_TOL;
     let t = truth(&probe, &params, 1e-9);
-    let (m, n) = (model.points(), t.len());
-    let mut v = vec![0.0; m];
-    let mut jac = vec![0.0; m * n];
-    model.evaluate(&t, &mut v, Some(&mut jac));
-    assert!(model.warnings().is_empty(), "{:?}", model.warnings());
-    eprintln!("Δf = {v:?} Hz");
-    for j in 0..n {
-        // z_offset 5e-4 A₀ (fit_fm.rs's step); η 1e-2 of itself (the loop's noise over a
-        // smaller step reaches 1e-4 of the derivative); E 2e-3 (at E ± 2 % the deepest row's
-        // loop does not converge)
-        let h = match params[j] {
-            AmParam::ZOffset => 5e-4 * g0,
-            AmParam::Viscosity => 1e-2 * t[j].abs(),
-            _ => 2e-3 * t[j].abs(),
-        };
-        let at = |k: f64| {
-            let mut q = t.clone();
-            q[j] += k * h;
-            let mut out = vec![0.0; m];
-            model.evaluate(&q, &mut out, None);
-            out
-        };
-        let (p1, m1, p2, m2) = (at(1.0), at(-1.0), at(2.0), at(-2.0));
-        let largest = (0..m).map(|i| jac[i * n + j].abs()).fold(0.0, f64::max);
-        assert!(largest > 0.0, "{:?}: a zero column", params[j]);
-        for i in 0..m {
-            let fd = (8.0 * (p1[i] - m1[i]) - (p2[i] - m2[i])) / (12.0 * h);
-            let e = jac[i * n + j];
-            let rel = (e - fd).abs() / e.abs().max(fd.abs()).max(1e-3 * largest);
-            eprintln!(
-                "{:?} row {i}: dΔf/dp {e:.9e} (fd {fd:.9e}, rel {rel:.1e})",
-                params[j]
-            );
-            assert!(rel <= 1e-4, "{:?} row {i}: rel {rel:e}", params[j]);
-        }
-    }
+    // E's step 2e-3 (at E ± 2 % the deepest row's loop does not converge)
+    check_fm_jacobian(
+        &model,
+        &t,
+        "point mass DMT, η > 0",
+        1e-4,
+        &[(AmParam::YoungsModulus, 2e-3)],
+    );
 }
 
 /// A noisy synthetic AM curve of the RTESPA-300 over polystyrene (100 rows z_c = 0.75 → 0.3 A₀,
@@ -162,26 +136,7 @@ fn a_noisy_am_curve_gives_back_the_viscosity() {
     let (probe, _) = rtespa();
     let (model, y, sigma, truth) = synthetic_of(probe, 100, (0.75, 0.3), ps, (true, true), 7);
     let out = run_fit(&model, &y, &sigma);
-    eprintln!(
-        "η: {} evaluations ({}), χ²/dof {:.3}, {:?}",
-        out.evaluations, out.termination, out.chi2_dof, out.warnings
-    );
-    for (e, t) in out.estimates.iter().zip(&truth) {
-        eprintln!(
-            "{}: {:.6e} ± {:.3e} [{:.6e}, {:.6e}] (truth {t:.6e})",
-            e.name, e.value, e.standard_error, e.interval[0], e.interval[1]
-        );
-        assert!(
-            (e.interval[0]..=e.interval[1]).contains(t),
-            "{}: the interval misses the truth",
-            e.name
-        );
-    }
-    assert!(
-        (0.5..2.0).contains(&out.chi2_dof),
-        "χ²/dof {}",
-        out.chi2_dof
-    );
+    assert_recovered(&out, &truth, "η", None, 0.5..2.0);
 }
 
 /// Through the door (`afmdyn fit`'s request) on the RTESPA-300 over polystyrene: η, E and

@@ -288,3 +288,39 @@ pub fn interval(doc: &serde_json::Value, name: &str) -> [f64; 2] {
         e["interval"][1].as_f64().unwrap(),
     ]
 }
+
+/// Print the fit's outcome under `what` and assert that each estimate's 95 % interval holds
+/// its truth (`truth`, in the fit's order), that each standard error is below `se_share` of
+/// the truth's magnitude when given (an estimate, not an unconstrained one), and that χ²/dof
+/// lies in `chi2` (noise drawn from the σ given: near 1).
+pub fn assert_recovered(
+    out: &FitOutcome,
+    truth: &[f64],
+    what: &str,
+    se_share: Option<f64>,
+    chi2: std::ops::Range<f64>,
+) {
+    eprintln!(
+        "{what}: {} evaluations ({}), χ²/dof {:.3}, {:?}",
+        out.evaluations, out.termination, out.chi2_dof, out.warnings
+    );
+    for (e, t) in out.estimates.iter().zip(truth) {
+        eprintln!(
+            "{}: {:.6e} ± {:.3e} [{:.6e}, {:.6e}] (truth {t:.6e})",
+            e.name, e.value, e.standard_error, e.interval[0], e.interval[1]
+        );
+        assert!(
+            (e.interval[0]..=e.interval[1]).contains(t),
+            "{what} {}: the interval misses the truth",
+            e.name
+        );
+        if let Some(share) = se_share {
+            assert!(e.standard_error < share * t.abs(), "{what} {}", e.name);
+        }
+    }
+    assert!(
+        chi2.contains(&out.chi2_dof),
+        "{what}: χ²/dof {}",
+        out.chi2_dof
+    );
+}

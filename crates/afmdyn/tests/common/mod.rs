@@ -6,6 +6,8 @@
 #[cfg(feature = "files")]
 pub mod am_synthetic;
 #[cfg(feature = "files")]
+pub mod fm_check;
+#[cfg(feature = "files")]
 pub mod orbit_check;
 #[cfg(feature = "files")]
 pub mod orbit_params;
