@@ -60,7 +60,7 @@ pub const HAMAKER: &str = "sample.hamaker";
 pub const RADIUS: &str = "tip.radius";
 /// `sample.damping` (N s/m), the Hertz law's damper.
 pub const DAMPING: &str = "sample.damping";
-/// `sample.viscosity` (Pa s), DMT's Kelvin–Voigt η.
+/// `sample.viscosity` (Pa s), the Kelvin–Voigt η of DMT and JKR.
 pub const VISCOSITY: &str = "sample.viscosity";
 /// `cantilever.quality_factor` (1), the lever's Q₁.
 pub const QUALITY_FACTOR: &str = "cantilever.quality_factor";
@@ -87,7 +87,7 @@ pub enum AmParam {
     TipRadius,
     /// `sample.damping` (Hertz).
     Damping,
-    /// `cantilever.quality_factor` (AM curves of a single-frequency drive).
+    /// `cantilever.quality_factor` (AM and bimodal curves; not FM).
     QualityFactor,
     /// `drive.free_amplitude`.
     FreeAmplitude,

@@ -244,9 +244,9 @@ fn harmonic(q: (f64, f64), dq: &DMatrix<f64>, period: f64) -> Harmonic {
 
 /// ∂F_c/∂p of the law of `law` (groups α4 = `stiffness`, α6 = `damping`) at indentation δ =
 /// `delta`, rate δ̇ = `rate`, in or out of contact (module docs). `None` for a law other than
-/// Hertz, DMT and JKR, for H̃ of Hertz, and for
-/// the drive's α2 and Ω (which move δ and δ̇ with the
-/// drive's phase: the extended system forms their columns).
+/// Hertz, DMT and JKR, for H̃ of Hertz and JKR, and for the parameters that do not enter the
+/// law: the drive's α2 and Ω (which move δ and δ̇ with the drive's phase), the lever's α3 and
+/// the component force F̃₁ (the extended system forms their columns).
 pub fn d_force(
     law: &ContactLaw,
     stiffness: f64,
