@@ -223,3 +223,38 @@ def test_a_viscoelastic_curve_with_a_dwell_fits_in_time(tmp_path):
     # without the times the law cannot run: the error names the column
     with pytest.raises(ValueError, match="time"):
         afmdyn.fit(probe=probe, data={"height": h, "force": f})
+
+
+def test_the_lever_and_the_samples_viscosity_fit_from_an_am_curve(tmp_path):
+    """Issue 62's probe keys on the library's RTESPA-300 over polystyrene (DMT, η = 10 Pa s):
+    an AM approach made by ``afmdyn.approach`` (30 rows, z_c = 11 → 5 nm, z = z_c − 1 nm,
+    20 pm and 0.1° of seeded noise) fitted for ``sample.viscosity`` (Pa s) and z_offset, and
+    for ``cantilever.quality_factor`` and z_offset, by their probe names: the truth (10 Pa s,
+    Q = 500, 1 nm) inside each 95 % interval; Q on a Δf curve is refused with the reason, as
+    the command line refuses it."""
+    probe = str(EXAMPLES / "probe-rtespa300-polystyrene.toml")
+    ds = afmdyn.approach(afmdyn.Params.from_probe(probe), probe=probe, from_=11e-9, to=5e-9,
+                         points=30, branches=False)
+    rng = np.random.default_rng(62)
+    zc = ds.z_c.values
+    amp = ds.amplitude.sel(sweep="approach").values + 2e-11 * rng.standard_normal(zc.size)
+    phase = ds.phase_deg.sel(sweep="approach").values + 0.1 * rng.standard_normal(zc.size)
+    path = tmp_path / "am.csv"
+    rows = "\n".join(f"{z - 1e-9:.17g},{a:.17g},{p:.17g},2e-11,0.1"
+                     for z, a, p in zip(zc, amp, phase))
+    path.write_text("z,amplitude,phase,sigma_amplitude,sigma_phase\n" + rows + "\n")
+    for name, truth in (("sample.viscosity", 10.0), ("cantilever.quality_factor", 500.0)):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", afmdyn.AfmdynWarning)
+            fit = afmdyn.fit(probe=probe, data=str(path), fit=[name, "z_offset"])
+        doc = json.loads(fit.attrs["summary"])
+        assert doc["kind"] == "am"
+        for key, t in ((name, truth), ("z_offset", 1e-9)):
+            lo = fit["interval_low"].sel(parameter=key).item()
+            hi = fit["interval_high"].sel(parameter=key).item()
+            assert lo <= t <= hi, (key, lo, hi)
+    fm = tmp_path / "fm.csv"
+    fm.write_text("z,frequency_shift\n" + "\n".join(f"{10e-9 - 0.5e-9 * i:.17g},{-i:.17g}"
+                                                     for i in range(10)) + "\n")
+    with pytest.raises(ValueError, match="does not constrain Q"):
+        afmdyn.fit(probe=probe, data=str(fm), fit=["cantilever.quality_factor"])
