@@ -167,7 +167,8 @@ impl CantileverModel {
     /// # Errors
     /// [`SimError::OutOfRange`] when ω is at an undamped natural frequency.
     pub fn free_force_response(&self, omega: f64) -> Result<nalgebra::Complex<f64>, SimError> {
-        Ok(self.free_force_response_damping_derivative(omega)?.0)
+        let (_, x) = self.free_force_solved(omega)?;
+        Ok(self.at_tip(&x))
     }
 
     /// [`CantileverModel::free_force_response`] H at ω and its derivative dH/dα3 in the
@@ -183,23 +184,34 @@ impl CantileverModel {
         omega: f64,
     ) -> Result<(nalgebra::Complex<f64>, nalgebra::Complex<f64>), SimError> {
         use nalgebra::Complex;
-        let lu = self.free_dynamic_stiffness(omega).lu();
-        let no_steady_state = || {
-            SimError::out_of_range(
-                "drive frequency",
-                omega,
-                "the free system has no steady state at an undamped natural frequency",
-            )
-        };
-        let f = self.tip().map(|v| Complex::new(v, 0.0));
-        let x = lu.solve(&f).ok_or_else(no_steady_state)?;
+        let (lu, x) = self.free_force_solved(omega)?;
         let (s, _) = self.galerkin.damping_derivative();
         let rhs = DVector::from_fn(self.modes(), |i, _| -Complex::new(0.0, omega * s[i]) * x[i]);
-        let dx = lu.solve(&rhs).ok_or_else(no_steady_state)?;
-        let at_tip = |v: &DVector<Complex<f64>>| -> Complex<f64> {
-            self.tip().iter().zip(v.iter()).map(|(p, xi)| xi * *p).sum()
-        };
-        Ok((at_tip(&x), at_tip(&dx)))
+        let dx = lu.solve(&rhs).ok_or_else(|| no_free_steady_state(omega))?;
+        Ok((self.at_tip(&x), self.at_tip(&dx)))
+    }
+
+    /// The LU factors of D(ω) and X = D⁻¹φ(1) of a unit tip force at ω.
+    #[allow(clippy::type_complexity)]
+    fn free_force_solved(
+        &self,
+        omega: f64,
+    ) -> Result<
+        (
+            nalgebra::LU<nalgebra::Complex<f64>, nalgebra::Dyn, nalgebra::Dyn>,
+            DVector<nalgebra::Complex<f64>>,
+        ),
+        SimError,
+    > {
+        let lu = self.free_dynamic_stiffness(omega).lu();
+        let f = self.tip().map(|v| nalgebra::Complex::new(v, 0.0));
+        let x = lu.solve(&f).ok_or_else(|| no_free_steady_state(omega))?;
+        Ok((lu, x))
+    }
+
+    /// φ(1)ᵀ v: the tip's value of the modal amplitudes `v`.
+    fn at_tip(&self, v: &DVector<nalgebra::Complex<f64>>) -> nalgebra::Complex<f64> {
+        self.tip().iter().zip(v.iter()).map(|(p, xi)| xi * *p).sum()
     }
 
     /// The free region's ∂f/∂α3 in the lever's damping α3 (eq. 12, eq. 14): the state's rate
@@ -276,4 +288,13 @@ impl CantileverModel {
     pub fn saltation(&self, from: Region, tau: f64, z: &DVector<f64>) -> DMatrix<f64> {
         crate::system::saltation(self, from, tau, z.as_slice()).0
     }
+}
+
+/// The free system has no steady state at ω (an undamped natural frequency).
+fn no_free_steady_state(omega: f64) -> SimError {
+    SimError::out_of_range(
+        "drive frequency",
+        omega,
+        "the free system has no steady state at an undamped natural frequency",
+    )
 }
