@@ -186,8 +186,16 @@ impl Galerkin {
     /// α3, so the central difference of [`Galerkin::forcing_derivative`] is exact.
     pub fn damping_derivative(&self) -> (DVector<f64>, [Forcing; 2]) {
         let p = &self.params;
-        let s = DVector::from_fn(p.modes, |j, _| profile(p, j));
-        (s, self.forcing_difference(SweepParam::Alpha3, p.alpha3))
+        (
+            self.damping_profile(),
+            self.forcing_difference(SweepParam::Alpha3, p.alpha3),
+        )
+    }
+
+    /// ∂C_s/∂α3 = diag(s_1 … s_N), the damping profile (shape `[N]`; 1 in the paper, eq. 12).
+    pub fn damping_profile(&self) -> DVector<f64> {
+        let p = &self.params;
+        DVector::from_fn(p.modes, |j, _| profile(p, j))
     }
 
     /// (F(p + δ) − F(p − δ)) / 2δ of both regions' forcing in `param` at `value`, δ = 1 + |p|:

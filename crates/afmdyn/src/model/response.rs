@@ -185,7 +185,7 @@ impl CantileverModel {
     ) -> Result<(nalgebra::Complex<f64>, nalgebra::Complex<f64>), SimError> {
         use nalgebra::Complex;
         let (lu, x) = self.free_force_solved(omega)?;
-        let (s, _) = self.galerkin.damping_derivative();
+        let s = self.galerkin.damping_profile();
         let rhs = DVector::from_fn(self.modes(), |i, _| -Complex::new(0.0, omega * s[i]) * x[i]);
         let dx = lu.solve(&rhs).ok_or_else(|| no_free_steady_state(omega))?;
         Ok((self.at_tip(&x), self.at_tip(&dx)))
