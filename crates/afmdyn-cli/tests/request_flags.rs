@@ -181,21 +181,24 @@ fn a_boolean_on_by_default_is_turned_off_by_its_no_flag() {
     assert_eq!(branches(&off), 0, "{}", off["branches"]);
 }
 
+/// `fit` of the example Hertz force curve, its document on stdout.
+const FIT_HERTZ: [&str; 8] = [
+    "fit",
+    "--probe",
+    "examples/probe-fit-hertz.toml",
+    "--data",
+    "examples/force-curve-hertz.csv",
+    "--files",
+    "none",
+    "--json",
+];
+
 #[test]
 fn an_optional_boolean_takes_on_off_or_the_default() {
     // `fit`'s `profiles: Option<bool>`: a force curve has profile-likelihood intervals by
     // default (`None`), Wald intervals with `--no-profiles` (`Some(false)`); the two flags
     // together are refused
-    let args = [
-        "fit",
-        "--probe",
-        "examples/probe-fit-hertz.toml",
-        "--data",
-        "examples/force-curve-hertz.csv",
-        "--files",
-        "none",
-        "--json",
-    ];
+    let args = FIT_HERTZ;
     let method = |extra: &[&str]| {
         let doc = common::json(&[&args[..], extra].concat());
         doc["method"].as_str().unwrap().to_string()
@@ -241,20 +244,7 @@ fn enum_names_unit_lists_and_a_mode_setpoint_read_as_the_library_does() {
         &["--inversion"],
     );
     // `fit --range LO,HI` (x-dim length): 20 nm and 2e-8 are the same range
-    let fit = |range: &str| {
-        let args = [
-            "fit",
-            "--probe",
-            "examples/probe-fit-hertz.toml",
-            "--data",
-            "examples/force-curve-hertz.csv",
-            "--files",
-            "none",
-            "--json",
-            range,
-        ];
-        common::json(&args)
-    };
+    let fit = |range: &str| common::json(&[&FIT_HERTZ[..], &[range]].concat());
     let (si, units) = (fit("--range=-2e-8,2e-7"), fit("--range=-20nm,200nm"));
     assert_eq!(si["range"], serde_json::json!([-2e-8, 2e-7]));
     assert_eq!(si["range"], units["range"]);

@@ -27,7 +27,7 @@ use std::path::Path;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 mod common;
-use common::am_synthetic::{truth, Normal};
+use common::am_synthetic::synthetic_with_noise;
 
 /// The 95 % quantile of χ²₁ (the profile's threshold), written out here: 1.959964² = 3.841459.
 const THRESHOLD: f64 = 3.841_458_820_694_124;
@@ -63,33 +63,14 @@ struct Curve {
 
 fn synthetic(
     rows: usize,
-    (from, to): (f64, f64),
+    range: (f64, f64),
     params: Vec<AmParam>,
     channels: (bool, bool),
-    (sa, sp): (f64, f64),
+    noise: (f64, f64),
     seed: u64,
 ) -> Curve {
-    let probe = am_probe();
-    let g0 = probe.length_m;
-    let z_offset = 1e-9;
-    let z: Vec<f64> = (0..rows)
-        .map(|i| g0 * (from + (to - from) * i as f64 / (rows - 1) as f64) - z_offset)
-        .collect();
-    let model = AmCurveModel::new(probe, z, channels, params.clone());
-    let truth = truth(&probe, &params, z_offset);
-    let mut y = vec![0.0; model.points()];
-    model.evaluate(&truth, &mut y, None);
-    let mut sigma = Vec::new();
-    if channels.0 {
-        sigma.extend(std::iter::repeat_n(sa, rows));
-    }
-    if channels.1 {
-        sigma.extend(std::iter::repeat_n(sp, rows));
-    }
-    let mut normal = Normal(seed);
-    for (v, s) in y.iter_mut().zip(&sigma) {
-        *v += s * normal.draw();
-    }
+    let (model, y, sigma, truth) =
+        synthetic_with_noise(am_probe(), rows, range, params, channels, noise, seed);
     Curve {
         model,
         y,

@@ -286,15 +286,21 @@ fn recorded(sigma: f64, seed: u64) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
     (height, force, time)
 }
 
+/// The request fitting the law's defaults to [`recorded`]'s curve (noise `sigma`, `seed`) from
+/// its row `from` on.
+fn recorded_request(sigma: f64, seed: u64, from: usize) -> FitRequest {
+    let (height, force, time) = recorded(sigma, seed);
+    FitRequest {
+        height: height[from..].to_vec(),
+        force: force[from..].to_vec(),
+        time: time[from..].to_vec(),
+        ..FitRequest::default()
+    }
+}
+
 #[test]
 fn a_noisy_curve_with_a_dwell_gives_back_its_sample_within_the_intervals() {
-    let (height, force, time) = recorded(50e-12, 3);
-    let request = FitRequest {
-        height,
-        force,
-        time,
-        ..FitRequest::default()
-    };
+    let request = recorded_request(50e-12, 3, 0);
     let doc = run(&request, &probe(), &Progress::default()).expect("fit");
     let j = &doc.json;
     // the law's defaults: its three parameters and the contact point, on the whole curve
@@ -381,13 +387,7 @@ fn the_intervals_cover_the_truth_over_noise_draws() {
     let mut covered = [0usize; 3];
     let draws = 100;
     for seed in 0..draws {
-        let (height, force, time) = recorded(200e-12, 1000 + seed);
-        let request = FitRequest {
-            height,
-            force,
-            time,
-            ..FitRequest::default()
-        };
+        let request = recorded_request(200e-12, 1000 + seed, 0);
         let doc = run(&request, &probe(), &Progress::default()).expect("fit");
         for (c, (name, truth)) in covered.iter_mut().zip([
             (STIFFNESS, K1),
@@ -413,13 +413,7 @@ fn the_intervals_cover_the_truth_over_noise_draws() {
 fn a_curve_that_starts_in_contact_is_said_to() {
     // the recorded curve from its 600th row (the piezo already 0.2 µm into the sample): the
     // sample is not at rest at the first row; the fit puts the tip on it there, and says so
-    let (height, force, time) = recorded(50e-12, 5);
-    let request = FitRequest {
-        height: height[600..].to_vec(),
-        force: force[600..].to_vec(),
-        time: time[600..].to_vec(),
-        ..FitRequest::default()
-    };
+    let request = recorded_request(50e-12, 5, 600);
     let doc = run(&request, &probe(), &Progress::default()).expect("fit");
     let warned = doc.json["warnings"]
         .as_array()
@@ -428,13 +422,7 @@ fn a_curve_that_starts_in_contact_is_said_to() {
         .any(|w| w.as_str().unwrap().contains("in contact at its first row"));
     assert!(warned, "{}", doc.json["warnings"]);
     // and the whole curve does not warn so
-    let (height, force, time) = recorded(50e-12, 5);
-    let request = FitRequest {
-        height,
-        force,
-        time,
-        ..FitRequest::default()
-    };
+    let request = recorded_request(50e-12, 5, 0);
     let doc = run(&request, &probe(), &Progress::default()).expect("fit");
     assert!(!doc.json["warnings"].to_string().contains("first row"));
 }

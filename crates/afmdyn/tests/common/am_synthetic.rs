@@ -71,9 +71,22 @@ pub fn synthetic(
 pub fn synthetic_of(
     probe: AmProbe,
     rows: usize,
+    range: (f64, f64),
+    params: Vec<AmParam>,
+    channels: (bool, bool),
+    seed: u64,
+) -> (AmCurveModel, Vec<f64>, Vec<f64>, Vec<f64>) {
+    synthetic_with_noise(probe, rows, range, params, channels, (2e-11, 0.1), seed)
+}
+
+/// [`synthetic_of`] with the noise σ = (amplitude m, phase deg).
+pub fn synthetic_with_noise(
+    probe: AmProbe,
+    rows: usize,
     (from, to): (f64, f64),
     params: Vec<AmParam>,
     channels: (bool, bool),
+    (sa, sp): (f64, f64),
     seed: u64,
 ) -> (AmCurveModel, Vec<f64>, Vec<f64>, Vec<f64>) {
     let g0 = probe.length_m;
@@ -87,10 +100,10 @@ pub fn synthetic_of(
     model.evaluate(&truth, &mut y, None);
     let mut sigma = Vec::new();
     if channels.0 {
-        sigma.extend(std::iter::repeat_n(2e-11, rows));
+        sigma.extend(std::iter::repeat_n(sa, rows));
     }
     if channels.1 {
-        sigma.extend(std::iter::repeat_n(0.1, rows));
+        sigma.extend(std::iter::repeat_n(sp, rows));
     }
     let mut normal = Normal(seed);
     for (v, s) in y.iter_mut().zip(&sigma) {
