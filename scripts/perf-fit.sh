@@ -49,13 +49,8 @@ cat "$sls_bench"
 section=$(mktemp)
 python3 - "$bench" "$tmp/doc.json" "$n" "$(cut -d' ' -f1 /proc/loadavg)" "$sls_bench" "$tmp/sls.json" > "$section" <<'PY'
 import json, sys
-def medians(path):
-    med = {}
-    for l in open(path).read().splitlines():
-        parts = l.split()
-        if len(parts) >= 5 and parts[0] in ("A", "B", "A/B") and parts[1] in ("cpu", "wall"):
-            med[(parts[0], parts[1])] = float(parts[-2])
-    return med
+sys.path.insert(0, "scripts")
+from bench_medians import medians
 med, sls_med = medians(sys.argv[1]), medians(sys.argv[5])
 doc, n, load = json.load(open(sys.argv[2])), sys.argv[3], sys.argv[4]
 sls = json.load(open(sys.argv[6]))

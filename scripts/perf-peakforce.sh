@@ -39,13 +39,8 @@ cat "$bare"
 section=$(mktemp)
 python3 - "$bench" "$tmp/pm.json" "$tmp/beam.json" "$bare" > "$section" <<'PY'
 import json, sys
-def medians(path):
-    med = {}
-    for l in open(path).read().splitlines():
-        parts = l.split()
-        if len(parts) >= 5 and parts[0] in ("A", "B", "A/B") and parts[1] in ("cpu", "wall"):
-            med[(parts[0], parts[1])] = float(parts[-2])
-    return med
+sys.path.insert(0, "scripts")
+from bench_medians import medians
 med, bare = medians(sys.argv[1]), medians(sys.argv[4])
 pm, beam = (json.load(open(p)) for p in sys.argv[2:4])
 def facts(d):
