@@ -224,7 +224,7 @@ STRUCTS: Dict[str, Dict[str, object]] = {
 #: their ``FromStr``)
 RUST_TYPES = {
     "SweepParam": "afmdyn::SweepParam",
-    "IntegratorKind": "afmdyn::integrate::IntegratorKind",
+    "IntegratorKind": "afmdyn::request::IntegratorKind",
 }
 
 #: the ``Dim`` of an ``"x-dim"`` value, and the unit a user may write after a number of it

@@ -3,14 +3,10 @@
 use crate::args::{read_toml, ModelArgs};
 use crate::door::{self, Exit};
 use crate::error::CliError;
-use crate::output::OutDir;
-use afmdyn::eigen::fig3_sweep;
-use afmdyn::request::present::modes;
-use afmdyn::request::{ModesRequest, Resolved};
+use afmdyn::request::{CantileversRequest, Fig3Request, ModesRequest, Resolved, UnitsRequest};
 use afmdyn::units::PhysicalFile;
 use afmdyn::Params;
 use clap::Args;
-use serde_json::json;
 use std::path::PathBuf;
 
 /// `afmdyn modes` flags.
@@ -44,16 +40,18 @@ pub fn modes(a: &ModesArgs) -> Result<(), CliError> {
     door::run(&ModesRequest {}, &Resolved { params, probe }, exit).map(drop)
 }
 
+/// `--sweep fig3`, on the model's parameters alone (the maps are dimensionless: no SI block).
 fn fig3(a: &ModesArgs, p: &Params) -> Result<(), CliError> {
-    let out = OutDir::lock(&a.out)?;
-    let pts = fig3_sweep(p.modes, &modes::fig3_alpha1(), &modes::fig3_alpha4())?;
-    door::write_files(&out, &modes::fig3(p.modes, &pts))?;
-    if a.json {
-        outln!("{}", json!({ "params": p, "points": pts, "out": a.out }));
-    } else {
-        outln!("wrote {} points to {}", pts.len(), out.path().display());
-    }
-    Ok(())
+    let request = Fig3Request {
+        out: a.out.display().to_string(),
+    };
+    let exit = Exit {
+        files: Default::default(),
+        json: a.json,
+        out: Some(&a.out),
+        unit: "points",
+    };
+    door::run(&request, &Resolved::plain(*p), exit).map(drop)
 }
 
 /// `afmdyn units` flags.
@@ -86,35 +84,42 @@ pub struct UnitsArgs {
     json: bool,
 }
 
-/// Run `afmdyn units`.
+/// Run `afmdyn units`: the probe file's model (its SI block) or the physical model's
+/// dimensionless set, through the door.
 pub fn units(a: &UnitsArgs) -> Result<(), CliError> {
-    if let Some(path) = &a.probe {
-        let (_, pr) = afmdyn::probe::Probe::source_text(
-            afmdyn::probe::ProbeSource::Path(path),
-            a.cantilever.as_deref(),
-            a.medium.as_deref(),
-        )?;
-        let p = pr.params;
-        let doc = json!({ "params": p, "si": afmdyn::report::si(&pr, &p, &json!({})) });
-        if a.json {
-            outln!("{doc}");
-        } else {
-            outln!("{}", serde_json::to_string_pretty(&doc).expect("json"));
+    let (request, model) = match (&a.probe, &a.config) {
+        (Some(path), _) => {
+            let (_, probe) = afmdyn::probe::Probe::source_text(
+                afmdyn::probe::ProbeSource::Path(path),
+                a.cantilever.as_deref(),
+                a.medium.as_deref(),
+            )?;
+            let model = Resolved {
+                params: probe.params,
+                probe: Some(probe),
+            };
+            (UnitsRequest::default(), model)
         }
-        return Ok(());
-    }
-    let Some(config) = &a.config else {
-        return Err(CliError::Input("give --config or --probe".into()));
+        (None, Some(config)) => {
+            let pf: PhysicalFile = read_toml(config)?;
+            let request = UnitsRequest {
+                physical: Some(pf.resolve()?),
+            };
+            (request, Resolved::plain(Params::default()))
+        }
+        (None, None) => return Err(CliError::Input("give --config or --probe".into())),
     };
-    let pf: PhysicalFile = read_toml(config)?;
-    let model = pf.resolve()?;
-    let p = model.to_params()?;
-    let s = model.scales();
-    if a.json {
-        outln!("{}", json!({ "params": p, "scales": s, "physical": model }));
-        return Ok(());
+    door::run(&request, &model, quiet(a.json)).map(drop)
+}
+
+/// A command that writes no file and shows no progress: its document (`--json`) or summary.
+fn quiet(json: bool) -> Exit<'static> {
+    Exit {
+        files: Default::default(),
+        json,
+        out: None,
+        unit: "",
     }
-    door::emit(None, &modes::units(&model, &p, &s), &json!({}), false)
 }
 
 /// `afmdyn cantilevers` flags.
@@ -125,12 +130,13 @@ pub struct CantileversArgs {
     json: bool,
 }
 
-/// Run `afmdyn cantilevers`: the cantilever library, one line per cantilever.
+/// Run `afmdyn cantilevers`: the cantilever library, one line per cantilever (every entry
+/// with its source in the JSON document).
 pub fn cantilevers(a: &CantileversArgs) -> Result<(), CliError> {
-    if a.json {
-        let doc = afmdyn::cantilevers::document();
-        outln!("{doc}");
-        return Ok(());
-    }
-    door::emit(None, &modes::cantilevers(), &json!({}), false)
+    door::run(
+        &CantileversRequest {},
+        &Resolved::plain(Params::default()),
+        quiet(a.json),
+    )
+    .map(drop)
 }

@@ -12,11 +12,11 @@ use crate::door;
 use crate::error::CliError;
 use crate::flags_afm::ReconstructFlags;
 use crate::output::{units_of, OutDir};
-use afmdyn::analysis::reconstruct::Reconstruction;
 use afmdyn::io::curve_file::{read_curve_file, read_document, CurveFile};
 use afmdyn::io::InputFileError;
 use afmdyn::request::present::reconstruct::{reconstruction, Inversion};
 use afmdyn::request::reconstruct::FmInversion;
+use afmdyn::request::Reconstruction;
 use afmdyn::request::{self, ReconstructRequest, Resolved};
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -126,10 +126,7 @@ fn request_of(a: &ReconstructArgs, fm: &Path) -> Result<ReconstructRequest, CliE
 /// The reconstruction of an AM document (`--am FILE`) and its JSON document.
 fn am_reconstruction(path: &Path) -> Result<(Reconstruction, serde_json::Value), CliError> {
     let doc = read_document(path).map_err(input("--am"))?;
-    let d = request::reconstruct::am_reconstruction(
-        &doc,
-        &afmdyn::analysis::progress::Progress::new(),
-    )?;
+    let d = request::reconstruct::am_reconstruction(&doc, &request::Progress::new())?;
     Ok((d.output, d.json))
 }
 
@@ -157,11 +154,7 @@ pub fn reconstruct(a: &ReconstructArgs) -> Result<(), CliError> {
             let request = request_of(a, fm)?;
             let model = Resolved::plain(afmdyn::Params::default());
             request::Analysis::validate(&request, &model).map_err(flagged)?;
-            let doc = request::run(
-                &request,
-                &model,
-                &afmdyn::analysis::progress::Progress::new(),
-            )?;
+            let doc = request::run(&request, &model, &request::Progress::new())?;
             let law = request.law_in_order();
             let how = match request.inversion {
                 FmInversion::SaderJarvis => Inversion::SaderJarvis,

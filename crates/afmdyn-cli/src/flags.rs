@@ -138,7 +138,7 @@ impl ResonanceFlags {
 pub struct IntegratorFlags {
     /// `--integrator`: the request's `integrator`.
     #[arg(long, default_value = "auto", help = "The time integrator: auto (the exact propagator for the linear law, the split integrator for Hertz and the impact law with r > 0, adaptive DOP853 for the plastic impact law r = 0, the Taylor integrator for DMT; split falls back to adaptive where its exact free flight cannot be built), exact, rk4, rk4-naive, adaptive, split or taylor.")]
-    pub integrator: afmdyn::integrate::IntegratorKind,
+    pub integrator: afmdyn::request::IntegratorKind,
     /// `--steps-per-period`: the request's `steps_per_period`.
     #[arg(long, value_name = "M", help = "Fixed steps per drive period of rk4 / rk4-naive (default 2000).")]
     pub steps_per_period: Option<usize>,

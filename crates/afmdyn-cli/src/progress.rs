@@ -2,7 +2,7 @@
 //! 100 ms by a thread that draws an indicatif bar on stderr (only on a terminal, and only once
 //! the run has taken a second), cleared when the run ends.
 
-use afmdyn::analysis::progress::Progress;
+use afmdyn::request::Progress;
 use afmdyn::request::{self, Analysis, Document, Resolved};
 use afmdyn::SimError;
 use indicatif::{ProgressBar, ProgressStyle};

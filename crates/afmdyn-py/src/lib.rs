@@ -47,7 +47,7 @@ fn _afmdyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
         "SimulationError",
         m.py().get_type::<errors::SimulationError>(),
     )?;
-    m.add("FORCE_SIGN", afmdyn::contact::FORCE_SIGN)?;
+    m.add("FORCE_SIGN", afmdyn::request::FORCE_SIGN)?;
     m.add_function(wrap_pyfunction!(door::run, m)?)?;
     m.add_function(wrap_pyfunction!(door::run_stored, m)?)?;
     m.add_function(wrap_pyfunction!(cantilevers, m)?)?;

@@ -11,7 +11,7 @@
 //! past the value it started with at its next poll: it is cancelled (or abandoned) and its
 //! caller gets `KeyboardInterrupt`, whatever thread it runs in.
 
-use afmdyn::analysis::progress::Progress;
+use afmdyn::request::Progress;
 use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError};
 use pyo3::prelude::*;
 use std::panic::{catch_unwind, AssertUnwindSafe};

@@ -39,8 +39,8 @@ pub mod image;
 pub mod series;
 pub mod simulate;
 
-use afmdyn::analysis::progress::Progress;
 use afmdyn::probe::Probe;
+use afmdyn::request::Progress;
 use afmdyn::request::{self, ModelSpec, Resolved};
 use afmdyn::Params;
 use serde::de::DeserializeOwned;
@@ -174,32 +174,18 @@ pub fn reconstruct_fm(fm: &str) -> Result<String, JsError> {
     reconstruct_fm_json(fm).map_err(|e| JsError::new(&e))
 }
 
-/// Most drive periods [`advance_periods`] integrates.
-pub const MAX_PERIODS: usize = 1_000_000;
-
-/// Integrate the model of `input` (its `model` and `probe`; no `request`) from rest over
-/// `periods` drive periods with the default (`auto`) integrator: the final state `z` (shape
-/// `[2N]`, (a, ȧ)) as JSON — the engine's cost per forcing period, timed by the caller (the
-/// browser against the native build, `scripts/perf-wasm.sh`).
+/// The model of `input` (its `model` and `probe`; no `request`) integrated from rest over
+/// `periods` drive periods ([`afmdyn::request::analyses::advance_from_rest`]): the final state
+/// `z` (shape `[2N]`, (a, ȧ)) as JSON, the engine's cost per forcing period timed by the
+/// caller.
 ///
 /// # Errors
-/// `periods` outside 1..=[`MAX_PERIODS`]; as [`run_json`]'s model; the integrator's.
+/// `periods` outside 1..=1000000; as [`run_json`]'s model; the integrator's.
 pub fn advance_periods(input: &str, periods: usize) -> Result<String, String> {
-    if !(1..=MAX_PERIODS).contains(&periods) {
-        return Err(format!("periods = {periods}: must be in 1..=1000000"));
-    }
     let (model, _) = resolve(input, "periods")?;
-    let m = afmdyn::CantileverModel::new(&model.params).map_err(|e| e.to_string())?;
-    let mut integ = afmdyn::integrate::build(
-        &m,
-        afmdyn::integrate::IntegratorOptions::default(),
-        0.0,
-        &m.rest(),
-    )
-    .map_err(|e| e.to_string())?;
-    afmdyn::integrate::advance(integ.as_mut(), periods as f64 * m.period())
+    let z = afmdyn::request::analyses::advance_from_rest(&model.params, periods)
         .map_err(|e| e.to_string())?;
-    Ok(serde_json::to_string(integ.state().as_slice()).expect("numbers serialise"))
+    Ok(serde_json::to_string(&z).expect("numbers serialise"))
 }
 
 /// [`advance_periods`] for JavaScript.
@@ -228,12 +214,12 @@ pub fn cantilevers() -> String {
     afmdyn::cantilevers::document().to_string()
 }
 
-/// The registered contact laws ([`afmdyn::contact::LAWS`]), in registry order: JSON text of
+/// The registered contact laws ([`afmdyn::request::LAWS`]), in registry order: JSON text of
 /// `[{"name", "aliases", "doc", "params", "sample_keys"}, …]`; the explorer's law lists are
 /// filled from it, so a law added to the registry appears there without an edit.
 #[wasm_bindgen]
 pub fn laws() -> String {
-    serde_json::to_string(afmdyn::contact::LAWS).expect("the law descriptors serialise")
+    serde_json::to_string(afmdyn::request::LAWS).expect("the law descriptors serialise")
 }
 
 /// The columns of `bifurcation.csv`, in its order ([`bifurcation::columns`]): JSON text of

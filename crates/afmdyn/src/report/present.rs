@@ -33,6 +33,8 @@ pub enum OutputsNote {
     After(usize),
     /// At the end of the last summary line: `; outputs in DIR`, or `; no files written`.
     Tail,
+    /// The directory itself ends the last summary line (`wrote 1111 points to DIR`).
+    Named,
 }
 
 /// One output file of a result (its name relative to the output directory).
@@ -169,6 +171,11 @@ impl Presentation {
                 match lines.last_mut() {
                     Some(last) => *last = format!("{last}; {tail}"),
                     None => lines.push(tail),
+                }
+            }
+            (OutputsNote::Named, _) => {
+                if let (Some(last), Some(d)) = (lines.last_mut(), dir) {
+                    *last = format!("{last} {}", d.display());
                 }
             }
             (OutputsNote::End, Some(named)) => lines.push(named),

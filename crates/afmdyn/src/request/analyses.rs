@@ -739,3 +739,27 @@ pub use super::simulate::{SeriesStore, SimulateRequest, SimulateSpan};
 #[cfg(test)]
 #[path = "analyses_tests.rs"]
 mod tests;
+
+/// Most drive periods [`advance_from_rest`] integrates.
+pub const MAX_ADVANCE_PERIODS: usize = 1_000_000;
+
+/// The state `z` (shape `[2N]`, (a, ȧ)) after `periods` drive periods from rest, with the
+/// default (`auto`) integrator: the engine's cost per forcing period, which a front end times
+/// (the browser against the native build, `scripts/perf-wasm.sh`).
+///
+/// # Errors
+/// [`SimError::OutOfRange`] for `periods` outside 1..=[`MAX_ADVANCE_PERIODS`]; the model's
+/// and the integrator's errors.
+pub fn advance_from_rest(params: &Params, periods: usize) -> Result<Vec<f64>, SimError> {
+    if !(1..=MAX_ADVANCE_PERIODS).contains(&periods) {
+        return Err(SimError::out_of_range(
+            "periods",
+            periods,
+            "must be in 1..=1000000",
+        ));
+    }
+    let m = CantileverModel::new(params)?;
+    let mut integ = build(&m, IntegratorOptions::default(), 0.0, &m.rest())?;
+    crate::integrate::advance(integ.as_mut(), periods as f64 * m.period())?;
+    Ok(integ.state().as_slice().to_vec())
+}

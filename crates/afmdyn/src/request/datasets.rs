@@ -3,8 +3,9 @@
 //! The stepped curves' layouts are laid out from their documents, and so is `fm`'s
 //! ([`super::fm::layout`]); `reconstruct`'s is [`super::reconstruct::layout`].
 
+use super::modes::ModesRequest;
 use super::named::Datasets;
-use super::run::{ApproachRequest, ModesRequest, Resolved, ResonanceRequest};
+use super::run::{ApproachRequest, Resolved, ResonanceRequest};
 use super::BasinArrays;
 use super::{
     AttractorsRequest, BasinsRequest, ContinuationRequest, ConvergeRequest, FmRequest,

@@ -1,31 +1,21 @@
-//! `image` as an [`Analysis`] ([`ImageJob`]): the probe file's table, the sample map, the
-//! request, the feedback (ideal, or a PI scan with its settings) and the setpoint study, held
-//! against the budgets before any work ([`Analysis::cost`]: the materials' approach curves, the
-//! pixels' memory and a scan's drive periods), run ([`super::image::image`],
-//! [`crate::study::scan::pi_image`], [`super::image::setpoint_study`]) and presented
-//! ([`super::present::image`]). A front end that runs the PI scan resumably into a store of
-//! its own takes the study from [`ImageJob::scan_study`] after [`super::run::admit`], and the
-//! document and presentation of the image it assembles from [`Analysis::report`] and
-//! [`Analysis::present`].
+//! `image` as data ([`ImageJob`]): the probe file's table, the sample map, the request, the
+//! feedback (ideal, or a PI scan with its settings) and the setpoint study; its run as an
+//! [`super::run::Analysis`] (cost, execution, document and presentation) is the study layer's
+//! (`crate::study::image`). A front end that runs the PI scan resumably into a store of its own
+//! takes the study from [`ImageJob::scan_study`] after [`super::run::admit`], and the document
+//! and presentation of the image it assembles from the analysis' `report` and `present`.
 
-use super::image::{
-    background_probe, curves_cost, image, setpoint_study, Image, ImageRequest, SampleMap,
-    SetpointStudy,
-};
+use super::image::{background_probe, Image, ImageRequest, SampleMap, SetpointStudy};
 use super::image_options::GivenOptions;
-use super::image_peakforce::{peakforce_cost, peakforce_probe, PeakForceImage};
+use super::image_peakforce::PeakForceImage;
 #[cfg(feature = "files")]
 use super::image_scan::ScanRecipe;
-use super::image_scan::{resolve, PiImage, PiScan, ScanStudy};
-use super::limits::{check_threads, Cost};
+use super::image_scan::{PiImage, PiScan, ScanStudy};
 use super::named::Outcome;
 use super::present::Files;
-use super::run::{Analysis, Resolved};
-use crate::analysis::progress::Progress;
+use super::run::Resolved;
 use crate::error::SimError;
-use crate::report::{OutputFile, Presentation, TextUnits};
 use serde::{Deserialize, Serialize};
-use serde_json::Value;
 
 pub use super::image_options::ImageMode;
 
@@ -190,23 +180,6 @@ impl ImageKeywords {
     }
 }
 
-impl ImageJob {
-    /// [`Analysis::validate`] of a PeakForce image: the grid, an off-resonance probe, a
-    /// setpoint force > 0, no PI feedback and no setpoint study.
-    fn validate_peakforce(&self) -> Result<(), SimError> {
-        if self.feedback.is_some() || self.study.is_some() {
-            return Err(SimError::out_of_range(
-                "mode",
-                "peakforce",
-                "a PeakForce image has the ideal peak-force feedback only (no PI scan, no \
-                 setpoint study)",
-            ));
-        }
-        self.request.validate_grid(&self.sample)?;
-        peakforce_probe(&self.probe, self.request.setpoint).map(|_| ())
-    }
-}
-
 impl ImageOutput {
     /// The outcome the one door gives: the per-pixel document, the image's layout (`image`:
     /// `image.nc`'s variables, [`super::image_layout`]) and, as the fact `summary`, the
@@ -238,132 +211,5 @@ impl ImageOutput {
             datasets: vec![("image".into(), layout)],
             facts,
         }
-    }
-}
-
-impl Analysis for ImageJob {
-    type Output = ImageOutput;
-
-    fn validate(&self, _model: &Resolved) -> Result<(), SimError> {
-        self.request.validate(&self.sample)?;
-        check_threads(self.threads)?;
-        if self.mode == ImageMode::Peakforce {
-            return self.validate_peakforce();
-        }
-        let background = background_probe(&self.probe)?;
-        match (&self.feedback, &self.study) {
-            (Some(_), Some(_)) => Err(SimError::out_of_range(
-                "setpoint_study",
-                "a study with the PI feedback",
-                "only with the ideal feedback (a study of exact operating points)",
-            )),
-            (Some(scan), None) => {
-                resolve(&background, &self.sample, &self.request, scan).map(|_| ())
-            }
-            (None, _) => Ok(()),
-        }
-    }
-
-    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<ImageOutput, SimError> {
-        self.validate(model)?;
-        if self.mode == ImageMode::Peakforce {
-            return crate::study::peakforce_image::peakforce_image(
-                &self.probe,
-                &self.sample,
-                &self.request,
-                self.threads,
-                progress,
-            )
-            .map(ImageOutput::PeakForce);
-        }
-        match &self.feedback {
-            Some(scan) => crate::study::scan::pi_image(
-                &self.probe,
-                &self.sample,
-                &self.request,
-                scan,
-                self.threads,
-                progress,
-            )
-            .map(ImageOutput::Pi),
-            None => {
-                let image = image(&self.probe, &self.sample, &self.request)?;
-                let study = match &self.study {
-                    Some(r) => Some(setpoint_study(
-                        &self.probe,
-                        &self.sample,
-                        r,
-                        self.request.curve_points,
-                    )?),
-                    None => None,
-                };
-                Ok(ImageOutput::Ideal { image, study })
-            }
-        }
-    }
-
-    fn report(&self, _model: &Resolved, output: &ImageOutput) -> Result<Value, SimError> {
-        let setpoint = self.request.setpoint;
-        Ok(match output {
-            ImageOutput::Ideal { image, study } => {
-                super::present::image::ideal_summary(image, setpoint, study.as_ref())
-            }
-            ImageOutput::Pi(img) => super::present::image::pi_summary(img, setpoint),
-            ImageOutput::PeakForce(img) => super::present::image::peakforce_summary(img),
-        })
-    }
-
-    fn name(&self) -> &'static str {
-        "image"
-    }
-
-    fn cost(&self, _model: &Resolved) -> Result<Cost, SimError> {
-        if self.mode == ImageMode::Peakforce {
-            return peakforce_cost(&self.probe, &self.sample, &self.request);
-        }
-        let background = background_probe(&self.probe)?;
-        let (map, req) = (&self.sample, &self.request);
-        let periods = match &self.feedback {
-            Some(scan) => resolve(&background, map, req, scan)?.2,
-            None => 0.0,
-        };
-        let extra = Cost {
-            bytes: req.pixel_bytes(map),
-            work: periods,
-        };
-        let mut cost = curves_cost(&background, map, req.curve_points, extra)?;
-        if self.study.is_some() {
-            // the study computes the materials' curves once more
-            let none = Cost {
-                bytes: 0.0,
-                work: 0.0,
-            };
-            cost.work += curves_cost(&background, map, req.curve_points, none)?.work;
-        }
-        Ok(cost)
-    }
-
-    fn present(
-        &self,
-        _model: &Resolved,
-        output: &ImageOutput,
-        document: &Value,
-        units: TextUnits,
-    ) -> Result<Presentation, SimError> {
-        let setpoint = self.request.setpoint;
-        let mut shown = match output {
-            ImageOutput::Ideal { image, study } => {
-                super::present::image::ideal(image, setpoint, study.as_ref(), document, units)
-            }
-            ImageOutput::Pi(img) => super::present::image::pi(img, setpoint, document, units),
-            ImageOutput::PeakForce(img) => super::present::image::peakforce(img, document, units),
-        };
-        // `--files data`: no figures; `none`: only the summary
-        shown.files.retain(|f| match self.files {
-            Files::All => true,
-            Files::Data => !matches!(f, OutputFile::Figure { .. }),
-            Files::None => false,
-        });
-        Ok(shown)
     }
 }

@@ -59,6 +59,7 @@ pub mod keywords;
 pub mod limits;
 pub mod model;
 mod model_of;
+pub mod modes;
 pub mod named;
 pub mod peakforce;
 pub mod peakforce_sweep;
@@ -90,16 +91,24 @@ pub use dir_lock::{DirLock, LockError};
 pub use fit::FitRequest;
 pub use fm::FmRequest;
 pub use model::{parameter, ModelSpec, ParamInfo, MODEL_PARAMETERS};
+pub use modes::{CantileversRequest, Fig3Request, ModesRequest, UnitsRequest};
 pub use named::{Datasets, Named, Outcome};
 pub use peakforce::{PeakForceRequest, PeakForceSweep, PeakForceSweepParam};
 pub use pool::in_pool;
 #[cfg(feature = "parallel")]
 pub use pool::thread_pool;
 pub use reconstruct::ReconstructRequest;
-pub use run::{
-    admit, run, Analysis, ApproachRequest, Document, ModesRequest, Resolved, ResonanceRequest,
-};
+pub use run::{admit, run, Analysis, ApproachRequest, Document, Resolved, ResonanceRequest};
 pub use sweep::{fingerprint, SweepRecord};
+
+// the door's vocabulary, for the front ends that go through it: the progress and cancel flag a
+// run counts in, the results the curve and reconstruction requests return, the integrators a
+// request names, and the contact laws' registry with the force's sign convention
+pub use crate::analysis::progress::Progress;
+pub use crate::analysis::reconstruct::Reconstruction;
+pub use crate::analysis::stepped::SteppedCurve;
+pub use crate::contact::{FORCE_SIGN, LAWS};
+pub use crate::integrate::IntegratorKind;
 
 /// The default relative distance within which two Poincaré point sets are one attractor
 /// (`cluster_tol` of the census, its global continuation, the basin map and the chart).

@@ -5,20 +5,16 @@
 //! share, and its document. With a probe everything is SI (m, N, J, s, Pa); without one the
 //! model's units (g₀, F̃, F̃·g₀, τ).
 
-use super::costs::{newton_work, state_bytes, steady_periods, MODEL_BYTES};
-use super::limits::Cost;
-use super::run::{Analysis, Resolved};
+use super::peakforce_sweep::SweepTap;
+use super::run::Resolved;
 use crate::analysis::peakforce::{
-    low_pass_periodic, peak_force_setpoint, static_compliance, steady_tap, PeakForceOptions,
-    SetpointOptions, SteadyTap, BRACKET_STEPS, FIT_BAND, MAX_CYCLE_SAMPLES, MIN_CYCLE_SAMPLES,
-    SETPOINT_ITERATIONS,
+    low_pass_periodic, static_compliance, PeakForceOptions, SteadyTap, FIT_BAND, MAX_CYCLE_SAMPLES,
+    MIN_CYCLE_SAMPLES,
 };
-use crate::analysis::progress::Progress;
 use crate::error::SimError;
 use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
 use crate::report::CurveUnits;
-use crate::study::peakforce::{PeakForceStudy, SweepTap};
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 
@@ -284,47 +280,9 @@ impl PeakForceRequest {
         Ok(points)
     }
 
-    /// The sweep's chain of taps ([`PeakForceStudy`], in memory), the first value computed
-    /// giving the single tap's blocks.
-    fn execute_sweep(
-        &self,
-        sweep: &PeakForceSweep,
-        model: &Resolved,
-        p: &Params,
-        progress: &Progress,
-    ) -> Result<PeakForceResult, SimError> {
-        let force = Self::units(model).force;
-        let study = PeakForceStudy {
-            points: self.sweep_points(sweep, model, p)?,
-            setpoint: self.setpoint.map(|f| f / force),
-            options: self.options(),
-            fingerprint: json!({"afmdyn": env!("CARGO_PKG_VERSION"), "peakforce": self, "params": p}),
-        };
-        let taps = study.taps(crate::study::execute_in_memory(&study, None, progress)?)?;
-        let failed = taps.iter().filter(|t| t.tap.is_none()).count();
-        let Some(first) = taps.iter().find(|t| t.tap.is_some()) else {
-            return Err(SimError::EveryRunFailed {
-                what: "peakforce sweep points",
-                runs: failed,
-                first: taps
-                    .first()
-                    .and_then(|t| t.message.clone())
-                    .unwrap_or_default(),
-            });
-        };
-        let tap = first.tap.clone().ok_or(SimError::Cancelled)?;
-        Ok(PeakForceResult {
-            alpha5: first.params.alpha5,
-            filtered: self.filtered(model, &first.params, &tap)?,
-            evaluations: taps.iter().map(|t| t.evaluations).sum(),
-            tap,
-            sweep: Some(taps),
-        })
-    }
-
     /// The measured force k × deflection (the deflection over the static compliance) of the
     /// tap's cycle through the filter of [`PeakForceRequest::filter_cutoff`], F̃.
-    fn filtered(
+    pub(crate) fn filtered(
         &self,
         model: &Resolved,
         p: &Params,
@@ -336,111 +294,6 @@ impl PeakForceRequest {
         let c = static_compliance(&CantileverModel::new(p)?);
         let measured: Vec<f64> = tap.cycle.deflection.iter().map(|w| w / c).collect();
         low_pass_periodic(&measured, fc * self.sampling_interval(model, p)).map(Some)
-    }
-}
-
-impl Analysis for PeakForceRequest {
-    type Output = PeakForceResult;
-    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
-        self.params(model).map(|_| ())
-    }
-    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<PeakForceResult, SimError> {
-        let p = self.params(model)?;
-        if let Some(sweep) = &self.sweep {
-            return self.execute_sweep(sweep, model, &p, progress);
-        }
-        match self.setpoint {
-            Some(f) => {
-                let force = Self::units(model).force;
-                let opts = SetpointOptions {
-                    tap: self.options(),
-                    ..SetpointOptions::default()
-                };
-                let s = peak_force_setpoint(&p, f / force, &opts)?;
-                Ok(PeakForceResult {
-                    alpha5: s.alpha5,
-                    filtered: self.filtered(model, &p, &s.tap)?,
-                    tap: s.tap,
-                    evaluations: s.evaluations,
-                    sweep: None,
-                })
-            }
-            None => {
-                let tap = steady_tap(&CantileverModel::new(&p)?, &self.options())?;
-                Ok(PeakForceResult {
-                    alpha5: p.alpha5,
-                    filtered: self.filtered(model, &p, &tap)?,
-                    tap,
-                    evaluations: 1,
-                    sweep: None,
-                })
-            }
-        }
-    }
-    fn name(&self) -> &'static str {
-        "peakforce"
-    }
-    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
-        // every tap: the transient (at most its cap) and Newton's variational flows, each drive
-        // period spanning 1/Ω lever periods; the setpoint's bracket and iterations; the cycle
-        // and the fit's resampling kept
-        let p = self.params(model)?;
-        let opts = self.options();
-        let tap_work = |q: &Params| -> Result<f64, SimError> {
-            let lever_periods = (1.0 / q.omega).max(1.0);
-            Ok((steady_periods(&opts.steady, q)? * q.modes as f64
-                + newton_work(q, 1, &opts.shooting))
-                * lever_periods)
-        };
-        let tap = match &self.sweep {
-            Some(s) => self
-                .sweep_points(s, model, &p)?
-                .iter()
-                .map(tap_work)
-                .sum::<Result<f64, SimError>>()?,
-            None => tap_work(&p)?,
-        };
-        let per_value = if self.setpoint.is_some() {
-            (2 * BRACKET_STEPS + SETPOINT_ITERATIONS) as f64
-        } else {
-            1.0
-        };
-        let taps = per_value;
-        let samples = (self.samples + crate::analysis::peakforce::FIT_SAMPLES) as f64;
-        Ok(Cost {
-            bytes: MODEL_BYTES + 2.0 * samples * 4.0 * 8.0 + 64.0 * state_bytes(&p),
-            work: taps * tap,
-        })
-    }
-    fn computed_at(&self, model: &Resolved) -> Result<Params, SimError> {
-        self.params(model)
-    }
-    fn report(&self, model: &Resolved, r: &PeakForceResult) -> Result<Value, SimError> {
-        Ok(document(self, model, r))
-    }
-    fn present(
-        &self,
-        _: &Resolved,
-        _: &PeakForceResult,
-        document: &Value,
-        units: crate::report::TextUnits,
-    ) -> Result<crate::report::Presentation, SimError> {
-        let mut document = document.clone();
-        let files = super::present::Files::All;
-        Ok(super::present::peakforce::peakforce(
-            &mut document,
-            units,
-            files,
-            None,
-        ))
-    }
-    fn largest_indentation(&self, r: &PeakForceResult) -> Option<f64> {
-        // a sweep's largest over its taps
-        let taps = r.sweep.iter().flatten().filter_map(|t| t.tap.as_ref());
-        Some(
-            taps.map(|t| t.channels.deformation)
-                .fold(r.tap.channels.deformation, f64::max),
-        )
     }
 }
 

@@ -1,13 +1,13 @@
 //! `peakforce` with a sweep: the steady tap's channels as curves over the mean rest separation
 //! z_c or over the modulation frequency f_m ([`PeakForceSweep`]), run as a chain of tasks
-//! ([`crate::study::peakforce::PeakForceStudy`], each tap continued from the previous tap's
+//! (`study::peakforce`, each tap continued from the previous tap's
 //! orbit), and its block of the document ([`sweep_document`]) and layout ([`sweep_layout`]).
 
 use crate::analysis::peakforce::SteadyTap;
 use crate::error::SimError;
 use crate::layout::{Layout, Values, Variable};
+use crate::params::Params;
 use crate::report::CurveUnits;
-use crate::study::peakforce::SweepTap;
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 use std::str::FromStr;
@@ -372,4 +372,20 @@ pub fn sweep_layout(block: &Value) -> Layout {
         Values::F64(period),
     ));
     Layout::new("peakforce sweep", &[(dim.as_str(), n)], variables)
+}
+
+/// One value of a PeakForce sweep: its place, the model it was computed on (α5 is the tap's:
+/// the feedback's with a setpoint), and the steady tap or why it failed.
+#[derive(Debug, Clone)]
+pub struct SweepTap {
+    /// Place of the value in the sweep (0-based).
+    pub index: usize,
+    /// The model's parameters of this tap (α5 found by the feedback with a setpoint).
+    pub params: Params,
+    /// The steady tap (`None` when the point failed).
+    pub tap: Option<SteadyTap>,
+    /// Steady taps computed for this value (1 without a setpoint).
+    pub evaluations: usize,
+    /// Why the point failed (`None` when it was computed).
+    pub message: Option<String>,
 }

@@ -40,7 +40,6 @@ use crate::analysis::shooting::ShootingOptions;
 use crate::analysis::steady::SteadyOptions;
 use crate::analysis::stepped::torus::{uses_torus, TorusOptions};
 use crate::analysis::stepped::SteppedSpec;
-use crate::eigen::{spectrum, RegionSpectrum};
 use crate::error::SimError;
 use crate::model::CantileverModel;
 use crate::params::Params;
@@ -197,50 +196,6 @@ pub fn document<A: Analysis + ?Sized>(
         }
     }
     Ok(doc)
-}
-
-/// `modes`: natural frequencies and damped eigenvalues of the free and contact systems
-/// (eqs. 19–23). No options.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
-#[serde(deny_unknown_fields)]
-pub struct ModesRequest {}
-
-impl Analysis for ModesRequest {
-    type Output = (RegionSpectrum, RegionSpectrum);
-    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
-        Ok(model.params.validate_fields()?)
-    }
-    fn execute(&self, model: &Resolved, _: &Progress) -> Result<Self::Output, SimError> {
-        Ok(spectrum(&model.params)?)
-    }
-    fn name(&self) -> &'static str {
-        "modes"
-    }
-    fn cost(&self, _: &Resolved) -> Result<Cost, SimError> {
-        // two eigenproblems of 2N × 2N: no integration
-        Ok(Cost {
-            bytes: MODEL_BYTES,
-            work: 0.0,
-        })
-    }
-    fn report(&self, model: &Resolved, (free, contact): &Self::Output) -> Result<Value, SimError> {
-        Ok(report::modes(&model.params, free, contact))
-    }
-    fn present(
-        &self,
-        model: &Resolved,
-        (free, contact): &Self::Output,
-        _: &Value,
-        units: report::TextUnits,
-    ) -> Result<report::Presentation, SimError> {
-        Ok(super::present::modes::modes(
-            &model.params,
-            free,
-            contact,
-            units,
-        ))
-    }
 }
 
 impl Analysis for OrbitRequest {

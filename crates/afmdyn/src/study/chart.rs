@@ -3,7 +3,8 @@
 //! with the task's number, what a resume skips the stored tasks ([`super::chart_store`]).
 
 use super::{execute_in_memory, Study};
-use crate::analysis::chart::{run_chart, ChartCell, ChartPlan};
+use crate::analysis::chart::run_chart;
+pub use crate::analysis::chart::{ChartCell, ChartPlan};
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
 use crate::request::chart::chart_cost;

@@ -40,6 +40,7 @@ pub mod chart;
 #[cfg(feature = "files")]
 pub mod chart_store;
 pub mod global_continuation;
+pub mod image;
 mod memory;
 pub mod peakforce;
 pub mod peakforce_image;

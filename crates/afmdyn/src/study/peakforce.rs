@@ -9,34 +9,26 @@
 //! feedback) each value runs the feedback's own search
 //! ([`crate::analysis::peakforce::peak_force_setpoint`], from rest).
 //!
-//! Run in memory ([`super::execute_in_memory`]) by the `peakforce` request with a sweep.
+//! Run in memory ([`super::execute_in_memory`]) by the `peakforce` request with a sweep, whose
+//! [`Analysis`] (running a request: a study's layer, above the request's data) is here.
 
 use super::{Prefix, Study};
 use crate::analysis::peakforce::{
-    peak_force_setpoint, steady_tap_from, PeakForceOptions, SetpointOptions, SteadyTap,
+    peak_force_setpoint, steady_tap, steady_tap_from, PeakForceOptions, SetpointOptions, SteadyTap,
+    BRACKET_STEPS, SETPOINT_ITERATIONS,
 };
+use crate::analysis::progress::Progress;
 use crate::error::SimError;
 use crate::model::CantileverModel;
 use crate::params::Params;
+use crate::request::costs::{newton_work, state_bytes, steady_periods, MODEL_BYTES};
+use crate::request::limits::Cost;
+use crate::request::peakforce::{document, PeakForceResult};
+use crate::request::peakforce_sweep::SweepTap;
+use crate::request::{Analysis, PeakForceRequest, PeakForceSweep, Resolved};
 use nalgebra::DVector;
-use serde_json::Value;
+use serde_json::{json, Value};
 use std::sync::atomic::{AtomicBool, Ordering};
-
-/// One value of a PeakForce sweep: its place, the model it was computed on (α5 is the tap's:
-/// the feedback's with a setpoint), and the steady tap or why it failed.
-#[derive(Debug, Clone)]
-pub struct SweepTap {
-    /// Place of the value in the sweep (0-based).
-    pub index: usize,
-    /// The model's parameters of this tap (α5 found by the feedback with a setpoint).
-    pub params: Params,
-    /// The steady tap (`None` when the point failed).
-    pub tap: Option<SteadyTap>,
-    /// Steady taps computed for this value (1 without a setpoint).
-    pub evaluations: usize,
-    /// Why the point failed (`None` when it was computed).
-    pub message: Option<String>,
-}
 
 /// A PeakForce sweep as a [`Study`] (see the module doc).
 #[derive(Debug, Clone)]
@@ -152,4 +144,147 @@ impl Study for PeakForceStudy {
         }
         Ok(())
     }
+}
+
+impl Analysis for PeakForceRequest {
+    type Output = PeakForceResult;
+    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
+        self.params(model).map(|_| ())
+    }
+    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<PeakForceResult, SimError> {
+        let p = self.params(model)?;
+        if let Some(sweep) = &self.sweep {
+            return execute_sweep(self, sweep, model, &p, progress);
+        }
+        match self.setpoint {
+            Some(f) => {
+                let force = Self::units(model).force;
+                let opts = SetpointOptions {
+                    tap: self.options(),
+                    ..SetpointOptions::default()
+                };
+                let s = peak_force_setpoint(&p, f / force, &opts)?;
+                Ok(PeakForceResult {
+                    alpha5: s.alpha5,
+                    filtered: self.filtered(model, &p, &s.tap)?,
+                    tap: s.tap,
+                    evaluations: s.evaluations,
+                    sweep: None,
+                })
+            }
+            None => {
+                let tap = steady_tap(&CantileverModel::new(&p)?, &self.options())?;
+                Ok(PeakForceResult {
+                    alpha5: p.alpha5,
+                    filtered: self.filtered(model, &p, &tap)?,
+                    tap,
+                    evaluations: 1,
+                    sweep: None,
+                })
+            }
+        }
+    }
+    fn name(&self) -> &'static str {
+        "peakforce"
+    }
+    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
+        // every tap: the transient (at most its cap) and Newton's variational flows, each drive
+        // period spanning 1/Ω lever periods; the setpoint's bracket and iterations; the cycle
+        // and the fit's resampling kept
+        let p = self.params(model)?;
+        let opts = self.options();
+        let tap_work = |q: &Params| -> Result<f64, SimError> {
+            let lever_periods = (1.0 / q.omega).max(1.0);
+            Ok((steady_periods(&opts.steady, q)? * q.modes as f64
+                + newton_work(q, 1, &opts.shooting))
+                * lever_periods)
+        };
+        let tap = match &self.sweep {
+            Some(s) => self
+                .sweep_points(s, model, &p)?
+                .iter()
+                .map(tap_work)
+                .sum::<Result<f64, SimError>>()?,
+            None => tap_work(&p)?,
+        };
+        let per_value = if self.setpoint.is_some() {
+            (2 * BRACKET_STEPS + SETPOINT_ITERATIONS) as f64
+        } else {
+            1.0
+        };
+        let taps = per_value;
+        let samples = (self.samples + crate::analysis::peakforce::FIT_SAMPLES) as f64;
+        Ok(Cost {
+            bytes: MODEL_BYTES + 2.0 * samples * 4.0 * 8.0 + 64.0 * state_bytes(&p),
+            work: taps * tap,
+        })
+    }
+    fn computed_at(&self, model: &Resolved) -> Result<Params, SimError> {
+        self.params(model)
+    }
+    fn report(&self, model: &Resolved, r: &PeakForceResult) -> Result<Value, SimError> {
+        Ok(document(self, model, r))
+    }
+    fn present(
+        &self,
+        _: &Resolved,
+        _: &PeakForceResult,
+        document: &Value,
+        units: crate::report::TextUnits,
+    ) -> Result<crate::report::Presentation, SimError> {
+        let mut document = document.clone();
+        let files = crate::request::present::Files::All;
+        Ok(crate::request::present::peakforce::peakforce(
+            &mut document,
+            units,
+            files,
+            None,
+        ))
+    }
+    fn largest_indentation(&self, r: &PeakForceResult) -> Option<f64> {
+        // a sweep's largest over its taps
+        let taps = r.sweep.iter().flatten().filter_map(|t| t.tap.as_ref());
+        Some(
+            taps.map(|t| t.channels.deformation)
+                .fold(r.tap.channels.deformation, f64::max),
+        )
+    }
+}
+
+/// The sweep's chain of taps ([`PeakForceStudy`], in memory), the first value computed
+/// giving the single tap's blocks.
+fn execute_sweep(
+    request: &PeakForceRequest,
+    sweep: &PeakForceSweep,
+    model: &Resolved,
+    p: &Params,
+    progress: &Progress,
+) -> Result<PeakForceResult, SimError> {
+    let force = PeakForceRequest::units(model).force;
+    let study = PeakForceStudy {
+        points: request.sweep_points(sweep, model, p)?,
+        setpoint: request.setpoint.map(|f| f / force),
+        options: request.options(),
+        fingerprint: json!({"afmdyn": env!("CARGO_PKG_VERSION"), "peakforce": request, "params": p}),
+    };
+    let taps = study.taps(super::execute_in_memory(&study, None, progress)?)?;
+    let failed = taps.iter().filter(|t| t.tap.is_none()).count();
+    let Some(first) = taps.iter().find(|t| t.tap.is_some()) else {
+        return Err(SimError::EveryRunFailed {
+            what: "peakforce sweep points",
+            runs: failed,
+            first: taps
+                .first()
+                .and_then(|t| t.message.clone())
+                .unwrap_or_default(),
+        });
+    };
+    let tap = first.tap.clone().ok_or(SimError::Cancelled)?;
+    Ok(PeakForceResult {
+        alpha5: first.params.alpha5,
+        filtered: request.filtered(model, &first.params, &tap)?,
+        evaluations: taps.iter().map(|t| t.evaluations).sum(),
+        tap,
+        sweep: Some(taps),
+    })
 }
