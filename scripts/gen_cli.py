@@ -223,7 +223,7 @@ STRUCTS: Dict[str, Dict[str, object]] = {
 #: the Rust path of the library types a schema names by ``$ref`` (enums of names, parsed by
 #: their ``FromStr``)
 RUST_TYPES = {
-    "SweepParam": "afmdyn::SweepParam",
+    "SweepParam": "afmdyn::request::SweepParam",
     "IntegratorKind": "afmdyn::request::IntegratorKind",
 }
 

@@ -5,7 +5,7 @@
 use crate::error::CliError;
 use afmdyn::io::InputKind;
 use afmdyn::request::ModelSpec;
-use afmdyn::{LawKind, Params};
+use afmdyn::request::{LawKind, Params};
 use clap::Args;
 use serde::Deserialize;
 use std::path::PathBuf;
@@ -100,7 +100,7 @@ pub struct ModelArgs {
     #[arg(long, value_name = "LAW", value_parser = parse_law)]
     pub contact_law: Option<LawKind>,
     #[arg(long, value_name = "WHERE", value_parser = parse_excitation)]
-    pub excitation: Option<afmdyn::Excitation>,
+    pub excitation: Option<afmdyn::request::Excitation>,
     #[arg(long, value_name = "r", allow_negative_numbers = true)]
     pub restitution: Option<f64>,
     #[arg(long, value_name = "H̃", allow_negative_numbers = true)]
@@ -127,7 +127,7 @@ fn parse_law(s: &str) -> Result<LawKind, String> {
     s.parse()
 }
 
-fn parse_excitation(s: &str) -> Result<afmdyn::Excitation, String> {
+fn parse_excitation(s: &str) -> Result<afmdyn::request::Excitation, String> {
     s.parse()
 }
 

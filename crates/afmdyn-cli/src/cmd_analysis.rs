@@ -12,9 +12,9 @@ use afmdyn::request::present::sweeps::{
 use afmdyn::request::Analysis;
 use afmdyn::request::{Document, Resolved};
 use afmdyn::request::{FileCheckpoint, GlobalContinuationRequest};
+use afmdyn::request::{Params, SweepParam};
 use afmdyn::study::global_continuation::{continuation_store, ContinuationStudy};
 use afmdyn::study::sweep::SweepStudy;
-use afmdyn::{Params, SweepParam};
 use clap::Args;
 use serde_json::json;
 use std::path::{Path, PathBuf};

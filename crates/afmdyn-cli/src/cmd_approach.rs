@@ -10,12 +10,13 @@ use crate::door;
 use crate::error::CliError;
 use crate::flags::{ApproachFlags, BimodalFlags, ResonanceFlags};
 use crate::output::{units_of, OutDir};
+use afmdyn::error::SimError;
 use afmdyn::request::present;
 use afmdyn::request::present::curves::{stepped, CurveKind, CurveOptions};
+use afmdyn::request::Params;
 use afmdyn::request::SteppedCurve;
 use afmdyn::request::{Analysis, CurveRequest, Resolved};
 use afmdyn::study::stepped::{curve_store, CurveStudy};
-use afmdyn::{Params, SimError};
 use clap::Args;
 use std::path::{Path, PathBuf};
 

@@ -8,9 +8,9 @@ use crate::cmd_simulate::parse_modal_state;
 use crate::error::CliError;
 use crate::flags::BasinsFlags;
 use crate::output::OutDir;
+use afmdyn::request::Params;
 use afmdyn::request::{Analysis, Resolved};
 use afmdyn::study::basins::{basin_store, BasinStudy};
-use afmdyn::Params;
 use clap::Args;
 use std::path::PathBuf;
 

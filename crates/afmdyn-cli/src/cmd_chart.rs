@@ -11,9 +11,9 @@ use crate::flags::ChartFlags;
 use crate::output::OutDir;
 use afmdyn::request::chart::{axis_name, axis_unit, document};
 use afmdyn::request::present;
+use afmdyn::request::Params;
 use afmdyn::study::chart::every_cell_failed;
 use afmdyn::study::chart_store::{cells, chart_store};
-use afmdyn::Params;
 use clap::Args;
 use std::path::PathBuf;
 

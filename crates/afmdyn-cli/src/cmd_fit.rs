@@ -13,8 +13,8 @@ use crate::cmd_simulate::Files;
 use crate::door;
 use crate::error::CliError;
 use crate::flags_afm::FitFlags;
+use afmdyn::request::Params;
 use afmdyn::request::Resolved;
-use afmdyn::Params;
 use clap::Args;
 use std::path::PathBuf;
 

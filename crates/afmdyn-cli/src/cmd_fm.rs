@@ -13,8 +13,8 @@ use crate::error::CliError;
 use crate::flags::FmFlags;
 use crate::output::{units_of, OutDir};
 use afmdyn::request::present;
+use afmdyn::request::Params;
 use afmdyn::request::{self, Resolved};
-use afmdyn::Params;
 use clap::Args;
 use std::path::PathBuf;
 

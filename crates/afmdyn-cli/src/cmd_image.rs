@@ -112,7 +112,7 @@ pub fn image_cmd(a: &ImageArgs) -> Result<(), CliError> {
     let table = afmdyn::probe::Probe::table(&text, &a.probe.display().to_string())?;
     // a sample map's refusals (its file, its height map's) name the option
     let map = SampleMap::load(&a.sample).map_err(|e| match e {
-        afmdyn::SimError::Probe(m) => CliError::Input(format!("--sample {m}")),
+        afmdyn::error::SimError::Probe(m) => CliError::Input(format!("--sample {m}")),
         e => e.into(),
     })?;
     match mode {

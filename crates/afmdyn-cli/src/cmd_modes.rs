@@ -3,9 +3,9 @@
 use crate::args::{read_toml, ModelArgs};
 use crate::door::{self, Exit};
 use crate::error::CliError;
+use afmdyn::request::Params;
 use afmdyn::request::{CantileversRequest, Fig3Request, ModesRequest, Resolved, UnitsRequest};
 use afmdyn::units::PhysicalFile;
-use afmdyn::Params;
 use clap::Args;
 use std::path::PathBuf;
 

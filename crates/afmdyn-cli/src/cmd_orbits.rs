@@ -7,9 +7,9 @@ use crate::door::{self, Exit};
 use crate::error::CliError;
 use crate::flags::{ContinueFlags, LyapunovFlags, OrbitFlags, SteadyFlags};
 use crate::plot::{Series, Style};
+use afmdyn::request::Params;
 use afmdyn::request::Resolved;
 use afmdyn::request::StartRequest;
-use afmdyn::Params;
 use clap::Args;
 use std::path::{Path, PathBuf};
 

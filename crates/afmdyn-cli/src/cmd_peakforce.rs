@@ -14,8 +14,8 @@ use crate::error::CliError;
 use crate::flags::PeakForceFlags;
 use crate::output::{units_of, OutDir};
 use afmdyn::request::present;
+use afmdyn::request::Params;
 use afmdyn::request::{PeakForceSweep, PeakForceSweepParam, Resolved};
-use afmdyn::Params;
 use clap::Args;
 use std::path::PathBuf;
 

@@ -132,9 +132,9 @@ fn am_reconstruction(path: &Path) -> Result<(Reconstruction, serde_json::Value),
 
 /// A library error with the cantilever's constants spelled as their flags
 /// (`--amplitude = 10: must be …`).
-fn flagged(e: afmdyn::SimError) -> CliError {
+fn flagged(e: afmdyn::error::SimError) -> CliError {
     match &e {
-        afmdyn::SimError::OutOfRange { name, .. }
+        afmdyn::error::SimError::OutOfRange { name, .. }
             if ["amplitude", "resonance_frequency", "spring_constant"].contains(name) =>
         {
             CliError::Input(format!("--{}", crate::error::spell(&e)))
@@ -152,7 +152,7 @@ pub fn reconstruct(a: &ReconstructArgs) -> Result<(), CliError> {
         }
         (None, Some(fm)) => {
             let request = request_of(a, fm)?;
-            let model = Resolved::plain(afmdyn::Params::default());
+            let model = Resolved::plain(afmdyn::request::Params::default());
             request::Analysis::validate(&request, &model).map_err(flagged)?;
             let doc = request::run(&request, &model, &request::Progress::new())?;
             let law = request.law_in_order();

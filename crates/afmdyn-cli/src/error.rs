@@ -12,7 +12,7 @@ pub enum CliError {
     /// A computation failed, or the library refused an option (the message names the flag,
     /// see [`spell`]).
     #[error("{}", spell(.0))]
-    Sim(#[from] afmdyn::SimError),
+    Sim(#[from] afmdyn::error::SimError),
     /// Reading or writing a file failed; the message names the file (see
     /// [`crate::output::io_error`]). There is deliberately no conversion from `std::io::Error`,
     /// which would lose the path.
@@ -49,7 +49,7 @@ pub fn interrupted() -> Result<(), CliError> {
 /// The library's message with a request parameter spelled as its flag: `samples_per_period`
 /// → `samples-per-period`, `initial` → `--initial-modal`; the hints of a budget name the
 /// flags that lower it, those of an unsupported integrator the `--integrator` flag.
-pub fn spell(e: &afmdyn::SimError) -> String {
+pub fn spell(e: &afmdyn::error::SimError) -> String {
     let msg = e.spelled(|name| match name {
         "initial" => "--initial-modal".to_string(),
         // a probe file's key ([section].key) keeps its TOML spelling
@@ -57,12 +57,12 @@ pub fn spell(e: &afmdyn::SimError) -> String {
         _ => name.replace('_', "-"),
     });
     match e {
-        afmdyn::SimError::Budget { .. } => msg
+        afmdyn::error::SimError::Budget { .. } => msg
             .replace("lower periods", "lower --periods")
             .replace("samples_per_period", "--samples-per-period")
             .replace("keep no time series", "use --files none"),
         // `use integrator = "adaptive" (or "auto")` → `use --integrator adaptive (or auto)`
-        afmdyn::SimError::Unsupported { .. } => msg
+        afmdyn::error::SimError::Unsupported { .. } => msg
             .replace("integrator = ", "--integrator ")
             .replace('"', ""),
         _ => msg,
@@ -108,8 +108,8 @@ pub(crate) fn study_error(e: afmdyn::study::StudyError, what: &str) -> CliError 
     }
 }
 
-impl From<afmdyn::ParamError> for CliError {
-    fn from(e: afmdyn::ParamError) -> Self {
+impl From<afmdyn::error::ParamError> for CliError {
+    fn from(e: afmdyn::error::ParamError) -> Self {
         CliError::Input(e.to_string())
     }
 }
@@ -120,8 +120,8 @@ impl From<afmdyn::probe::ProbeError> for CliError {
     }
 }
 
-impl From<afmdyn::UnitsError> for CliError {
-    fn from(e: afmdyn::UnitsError) -> Self {
+impl From<afmdyn::error::UnitsError> for CliError {
+    fn from(e: afmdyn::error::UnitsError) -> Self {
         CliError::Input(e.to_string())
     }
 }

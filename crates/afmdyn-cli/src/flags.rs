@@ -270,7 +270,7 @@ impl FmFlags {
 pub struct BifurcationFlags {
     /// `--param`: the request's `param`.
     #[arg(long, default_value = "omega", help = "The swept parameter: omega or alpha1..alpha6 (or their names, tip-mass-ratio, …).")]
-    pub param: afmdyn::SweepParam,
+    pub param: afmdyn::request::SweepParam,
     /// `--from`: the request's `from`.
     #[arg(long, default_value = "1.0", allow_negative_numbers = true, help = "First value.")]
     pub from: f64,
@@ -607,7 +607,7 @@ impl OrbitFlags {
 pub struct ContinueFlags {
     /// `--param`: the request's `param`.
     #[arg(long, default_value = "omega", help = "The continued parameter: omega or alpha1..alpha6 (or their names, tip-mass-ratio, …).")]
-    pub param: afmdyn::SweepParam,
+    pub param: afmdyn::request::SweepParam,
     /// `--from`: the request's `from`.
     #[arg(long, default_value = "5.0", allow_negative_numbers = true, help = "The value where the continuation starts.")]
     pub from: f64,

@@ -2,9 +2,9 @@
 //! 100 ms by a thread that draws an indicatif bar on stderr (only on a terminal, and only once
 //! the run has taken a second), cleared when the run ends.
 
+use afmdyn::error::SimError;
 use afmdyn::request::Progress;
 use afmdyn::request::{self, Analysis, Document, Resolved};
-use afmdyn::SimError;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};

@@ -11,10 +11,11 @@ use crate::errors::{lock_store, study_error};
 use crate::errors::{probe_error, sim_error, value_error};
 use crate::params::PyParams;
 use crate::run::{run as run_job, Job, Stop};
+use afmdyn::error::SimError;
 use afmdyn::probe::Probe;
+use afmdyn::request::Params;
 use afmdyn::request::Progress;
 use afmdyn::request::{Outcome, Resolved};
-use afmdyn::{Params, SimError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 

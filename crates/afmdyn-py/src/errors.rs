@@ -1,10 +1,10 @@
 //! The library's typed errors as Python exceptions: bad input is a `ValueError` (the command
 //! line's exit code 2), a failed computation an `afmdyn.SimulationError` (a `RuntimeError`).
 
+use afmdyn::error::{ParamError, SimError};
 use afmdyn::request::checkpoint::CheckpointError;
 use afmdyn::request::{DirLock, LockError};
 use afmdyn::study::StudyError;
-use afmdyn::{ParamError, SimError};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 

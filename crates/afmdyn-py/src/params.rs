@@ -1,9 +1,9 @@
 //! `afmdyn.Params` and the one place where Python keyword arguments become an
-//! [`afmdyn::Params`]: [`params_from_kwargs`].
+//! [`afmdyn::request::Params`]: [`params_from_kwargs`].
 
 use crate::errors::param_error;
 use afmdyn::request::ModelSpec;
-use afmdyn::Params;
+use afmdyn::request::Params;
 use pyo3::exceptions::{PyAttributeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -182,7 +182,7 @@ impl PyParams {
 
     fn __repr__(&self) -> String {
         // every serialised field, the known ones in the paper's order first, so a field added
-        // to `afmdyn::Params` shows up here without a change
+        // to `afmdyn::request::Params` shows up here without a change
         let value = serde_json::to_value(self.inner).expect("params");
         let map = value.as_object().expect("a struct");
         let order = [

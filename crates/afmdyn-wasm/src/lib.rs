@@ -40,9 +40,9 @@ pub mod series;
 pub mod simulate;
 
 use afmdyn::probe::Probe;
+use afmdyn::request::Params;
 use afmdyn::request::Progress;
 use afmdyn::request::{self, ModelSpec, Resolved};
-use afmdyn::Params;
 use serde::de::DeserializeOwned;
 use serde::Deserialize;
 use serde_json::Value;

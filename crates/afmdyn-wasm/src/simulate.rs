@@ -41,9 +41,7 @@
 //! fits in a JavaScript string ([`MAX_VALUES`]: 1,538,461 samples for N = 3).
 
 use crate::series::LayoutJson;
-use afmdyn::report::{self, SeriesUnits};
-use afmdyn::request::SimulateRequest;
-use afmdyn::CantileverModel;
+use afmdyn::request::{self, Progress, SimulateRequest};
 use serde::Serialize;
 use serde_json::{json, Value};
 
@@ -77,7 +75,8 @@ struct Output<'a> {
 /// more than [`MAX_SAMPLES`] samples; the initial state's and the integrator's.
 pub fn simulate(input: &str) -> Result<String, String> {
     let (model, r) = crate::resolve(input, "simulate")?;
-    let request: SimulateRequest = crate::request(r)?;
+    let r = r.unwrap_or_else(|| Value::Object(Default::default()));
+    let request: SimulateRequest = crate::request(Some(r.clone()))?;
     let p = &model.params;
     let span = request.validate_in_memory(p).map_err(|e| e.to_string())?;
     let limit = max_samples(p.modes);
@@ -92,16 +91,18 @@ pub fn simulate(input: &str) -> Result<String, String> {
             p.modes
         ));
     }
-    let m = CantileverModel::new(p).map_err(|e| e.to_string())?;
-    let (tr, _) = request.record_whole(&m, &span).map_err(|e| e.to_string())?;
-    let su = SeriesUnits::new(p, model.probe.as_ref());
-    let layout = report::simulate_layout(&m, &tr, &su, request.samples_per_period);
-    let mut summary = report::with_si(report::simulate(&m, &tr), model.probe.as_ref(), p);
-    summary["files"] = json!("none");
-    drop(tr);
+    // the one door, as Python's `afmdyn.simulate`: the run recorded whole, its layout
+    let named = request::named::parse("simulate", r)
+        .map_err(|e| format!("request: {e}"))?
+        .ok_or("analysis = simulate: not a named analysis")?;
+    let mut outcome = named
+        .run(&model, &Progress::new())
+        .map_err(|e| e.to_string())?;
+    outcome.document["files"] = json!("none");
+    let (_, layout) = outcome.datasets.first().ok_or("simulate: no series")?;
     serde_json::to_string(&Output {
-        summary: &summary,
-        series: LayoutJson(&layout),
+        summary: &outcome.document,
+        series: LayoutJson(layout),
     })
     .map_err(|e| format!("simulate: {e}"))
 }

@@ -107,8 +107,9 @@ pub use sweep::{fingerprint, SweepRecord};
 pub use crate::analysis::progress::Progress;
 pub use crate::analysis::reconstruct::Reconstruction;
 pub use crate::analysis::stepped::SteppedCurve;
-pub use crate::contact::{FORCE_SIGN, LAWS};
+pub use crate::contact::{LawKind, FORCE_SIGN, LAWS};
 pub use crate::integrate::IntegratorKind;
+pub use crate::params::{Excitation, Params, SweepParam};
 
 /// The default relative distance within which two Poincaré point sets are one attractor
 /// (`cluster_tol` of the census, its global continuation, the basin map and the chart).
