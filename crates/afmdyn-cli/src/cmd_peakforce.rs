@@ -92,7 +92,7 @@ pub fn peakforce(a: &PeakForceArgs) -> Result<(), CliError> {
     let out = (a.files != Files::None)
         .then(|| OutDir::lock(&a.out))
         .transpose()?;
-    let doc = crate::progress::run(&request, &model, "steady taps")?.json;
+    let doc = crate::progress::run_admitted(&request, &model, "steady taps")?.json;
     let dir = out.as_ref().map(OutDir::path);
     let shown = present::peakforce::peakforce(
         &mut doc.clone(),

@@ -56,7 +56,7 @@ pub fn run_with<A: Analysis>(
     // validated and held to the budgets before the output directory is created or locked
     afmdyn::request::run::admit(request, model)?;
     let out = exit.out.map(OutDir::lock).transpose()?;
-    let doc = progress::run(request, model, exit.unit)?;
+    let doc = progress::run_admitted(request, model, exit.unit)?;
     let mut shown = request.present(
         model,
         &doc.output,

@@ -83,6 +83,20 @@ pub fn run<A: Analysis + ?Sized>(
     with_bar(unit, |progress| request::run(analysis, model, progress))
 }
 
+/// [`request::run_admitted`] with a bar counting `unit`s: a request the caller admitted.
+///
+/// # Errors
+/// As [`request::run_admitted`].
+pub fn run_admitted<A: Analysis + ?Sized>(
+    analysis: &A,
+    model: &Resolved,
+    unit: &'static str,
+) -> Result<Document<A::Output>, SimError> {
+    with_bar(unit, |progress| {
+        request::run_admitted(analysis, model, progress)
+    })
+}
+
 /// What the command line observes of a study: the bar's counter, and the testing hook
 /// `--abort-after K` (abort the process, as if killed, once K tasks are stored).
 struct Watch<'a> {

@@ -98,7 +98,9 @@ pub use pool::in_pool;
 #[cfg(feature = "parallel")]
 pub use pool::thread_pool;
 pub use reconstruct::ReconstructRequest;
-pub use run::{admit, run, Analysis, ApproachRequest, Document, Resolved, ResonanceRequest};
+pub use run::{
+    admit, run, run_admitted, Analysis, ApproachRequest, Document, Resolved, ResonanceRequest,
+};
 pub use sweep::{fingerprint, SweepRecord};
 
 // the door's vocabulary, for the front ends that go through it: the progress and cancel flag a

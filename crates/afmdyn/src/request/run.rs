@@ -156,6 +156,21 @@ pub fn run<A: Analysis + ?Sized>(
 ) -> Result<Document<A::Output>, SimError> {
     progress.check()?;
     admit(analysis, model)?;
+    run_admitted(analysis, model, progress)
+}
+
+/// [`run`] after [`admit`]: [`Analysis::execute`] and the document, for a front end that
+/// admitted the request itself before its side effects (locking its output directory), so
+/// that a request is admitted once per run.
+///
+/// # Errors
+/// As [`run`], less the admission's.
+pub fn run_admitted<A: Analysis + ?Sized>(
+    analysis: &A,
+    model: &Resolved,
+    progress: &Progress,
+) -> Result<Document<A::Output>, SimError> {
+    progress.check()?;
     let output = analysis.execute(model, progress)?;
     Ok(Document {
         json: document(analysis, model, &output)?,
