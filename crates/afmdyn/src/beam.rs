@@ -137,7 +137,7 @@ impl ModeShapes {
     }
 
     /// β_i⁴ = ∫₀¹ φ_i φ_i'''' dξ (with ∫φ_i² = 1): shape `[N]`.
-    pub fn beta4(&self) -> Vec<f64> {
+    pub(crate) fn beta4(&self) -> Vec<f64> {
         self.modes.iter().map(|m| m.beta.powi(4)).collect()
     }
 }

@@ -62,7 +62,12 @@ pub fn first_mode_at_tip(m: &RegionMatrices, tip: &DVector<f64>) -> (f64, DVecto
 /// x₁ (x₁ᵀMx₁ = 1) of frequency ω̃₁ (modal damping of a lightly damped mode, Q = 1/(2ζ);
 /// Meirovitch, *Fundamentals of Vibrations*, 2001, §7.15). The one place α3 is derived from Q;
 /// `profile` is s (None: uniform).
-pub fn beam_damping_for_q(omega1: f64, x1: &DVector<f64>, q1: f64, profile: Option<&[f64]>) -> f64 {
+pub(crate) fn beam_damping_for_q(
+    omega1: f64,
+    x1: &DVector<f64>,
+    q1: f64,
+    profile: Option<&[f64]>,
+) -> f64 {
     let s_x1: f64 = x1
         .iter()
         .enumerate()
@@ -87,7 +92,7 @@ pub fn mode_at_tip(m: &RegionMatrices, tip: &DVector<f64>, k: usize) -> (f64, DV
 
 /// The first-order state matrix of eqs. 20–21: with Q = (Ẋ, X), M* Q̇ + K* Q = 0 where
 /// M* = [[M, 0], [0, −K]] and K* = [[C, K], [K, 0]], so Q̇ = −M*⁻¹ K* Q. Shape 2N×2N.
-pub fn state_matrix_eq21(m: &RegionMatrices) -> DMatrix<f64> {
+pub(crate) fn state_matrix_eq21(m: &RegionMatrices) -> DMatrix<f64> {
     let n = m.mass.nrows();
     let mut mstar = DMatrix::zeros(2 * n, 2 * n);
     mstar.view_mut((0, 0), (n, n)).copy_from(&m.mass);

@@ -193,7 +193,7 @@ impl Galerkin {
     }
 
     /// ∂C_s/∂α3 = diag(s_1 … s_N), the damping profile (shape `[N]`; 1 in the paper, eq. 12).
-    pub fn damping_profile(&self) -> DVector<f64> {
+    pub(crate) fn damping_profile(&self) -> DVector<f64> {
         let p = &self.params;
         DVector::from_fn(p.modes, |j, _| profile(p, j))
     }

@@ -51,7 +51,7 @@ pub struct Medium {
 }
 
 /// The density (kg/m³) from which a medium counts as a liquid ([`Medium::is_liquid`]).
-pub const LIQUID_DENSITY: f64 = 100.0;
+pub(crate) const LIQUID_DENSITY: f64 = 100.0;
 
 impl Medium {
     /// Water at 25 °C: ρ = 997.05 kg/m³, η = 0.890 mPa s (CRC Handbook of Chemistry and
@@ -70,7 +70,7 @@ impl Medium {
 
     /// Whether the medium is a liquid: a density of [`LIQUID_DENSITY`] or more (gases at
     /// ambient conditions are below 10 kg/m³, liquids above 500).
-    pub fn is_liquid(&self) -> bool {
+    pub(crate) fn is_liquid(&self) -> bool {
         self.density >= LIQUID_DENSITY
     }
 
@@ -164,7 +164,7 @@ pub fn gamma_circular(re: f64) -> Result<Complex<f64>, SimError> {
 ///
 /// # Errors
 /// [`SimError::OutOfRange`] for Re outside [[`MIN_REYNOLDS`], [`MAX_REYNOLDS`]].
-pub fn rectangular_correction(re: f64) -> Result<Complex<f64>, SimError> {
+pub(crate) fn rectangular_correction(re: f64) -> Result<Complex<f64>, SimError> {
     let tau = check_reynolds(re)?.log10();
     // Horner's rule on coefficients in ascending powers of τ
     let poly = |c: &[f64]| c.iter().rev().fold(0.0, |acc, &a| acc * tau + a);
@@ -242,7 +242,7 @@ impl Section {
     }
 
     /// T = πρb²/(4μ) in `medium`.
-    pub fn mass_ratio(&self, medium: &Medium) -> f64 {
+    pub(crate) fn mass_ratio(&self, medium: &Medium) -> f64 {
         PI * medium.density * self.width * self.width / (4.0 * self.mass_per_length)
     }
 

@@ -44,7 +44,7 @@ pub use rate_form::RateForm;
 pub const STICK_HEIGHT_TOLERANCES: f64 = 1e3;
 
 /// Baumgarte rate of the sticking constraint, in units of Ω (see the sticking force λ).
-pub const BAUMGARTE_RATE: f64 = 10.0;
+pub(crate) const BAUMGARTE_RATE: f64 = 10.0;
 
 /// First-order dynamics of one region: ż = A z + b_const + b_sin sin Ωτ + b_cos cos Ωτ.
 #[derive(Debug, Clone, PartialEq)]
@@ -234,7 +234,13 @@ impl CantileverModel {
     /// is continuous: the drop of the tip–sample potential U_from − U_to (F̃·g₀). 0 for the laws
     /// whose potential is continuous across the switching; for JKR E_hys where the contact
     /// forms (the adhesive neck snaps in) and 0 where it breaks (U = 0 at δ_f).
-    pub fn switching_loss(&self, from: Region, to: Region, tau: f64, z: &DVector<f64>) -> f64 {
+    pub(crate) fn switching_loss(
+        &self,
+        from: Region,
+        to: Region,
+        tau: f64,
+        z: &DVector<f64>,
+    ) -> f64 {
         if self.release == 0.0 || from == to {
             return 0.0;
         }
@@ -339,7 +345,7 @@ impl CantileverModel {
     }
 
     /// As [`CantileverModel::rhs`] on slices of length 2N.
-    pub fn rhs_slice(&self, r: Region, tau: f64, z: &[f64], dz: &mut [f64]) {
+    pub(crate) fn rhs_slice(&self, r: Region, tau: f64, z: &[f64], dz: &mut [f64]) {
         let n = self.modes();
         let (s, c) = (self.params.omega * tau).sin_cos();
         let linear = self.law.law().is_affine();
@@ -450,7 +456,7 @@ impl CantileverModel {
     /// ∂ż/∂z at (τ, z) in region r into `jac` (2N×2N): A_I plus the rank-one tip-force term
     /// M⁻¹φ (∂F_c/∂z)ᵀ with ∂F_c/∂a = −(∂F_c/∂δ) φ, ∂F_c/∂ȧ = −(∂F_c/∂δ̇) φ; for sticking
     /// ∂λ/∂z of the sticking force. The linear law gives A_s of eqs. 15–18.
-    pub fn jacobian_into(&self, r: Region, tau: f64, z: &[f64], jac: &mut DMatrix<f64>) {
+    pub(crate) fn jacobian_into(&self, r: Region, tau: f64, z: &[f64], jac: &mut DMatrix<f64>) {
         self.jacobian_parts(r, tau, self.base_trig(tau), z, jac, true);
     }
 

@@ -41,7 +41,7 @@ pub const OMEGA_MIN: f64 = 1e-3;
 /// its contact), so its period costs ~1/Ω lever periods of work, bounded at run time by
 /// [`ADAPTIVE_STEPS_PER_PERIOD`] and up front by [`ADAPTIVE_STEPS_BUDGET`] and
 /// [`GRID_BUDGET_BYTES`]. The resonant drives keep [`OMEGA_MIN`].
-pub const OMEGA_MIN_MODULATED: f64 = 1e-5;
+pub(crate) const OMEGA_MIN_MODULATED: f64 = 1e-5;
 /// Largest drive frequency Ω: above it the inertial drive α2Ω² is so much larger than the
 /// response that the result is round-off (the per-period energy balance fails, 1e-7 relative at
 /// Ω = 1e8), and Ω is far above the highest Galerkin mode the model resolves (N ≤ 20).
@@ -170,7 +170,7 @@ pub enum Excitation {
 
 impl Excitation {
     /// Whether this is the base drive (the default).
-    pub fn is_base(&self) -> bool {
+    pub(crate) fn is_base(&self) -> bool {
         *self == Excitation::Base
     }
     /// `base` or `tip`.
@@ -241,7 +241,7 @@ fn bounded(
 }
 
 /// Most further drive components beside the primary one ([`Params::drive_components`]).
-pub const MAX_DRIVE_COMPONENTS: usize = 3;
+pub(crate) const MAX_DRIVE_COMPONENTS: usize = 3;
 /// Largest common period of a multifrequency drive, in periods 2π/Ω of the primary drive:
 /// the orbit, the stroboscopic map and the observables' window span this many periods.
 pub const MAX_COMMON_PERIODS: u64 = 1000;
@@ -657,7 +657,7 @@ impl Params {
 
     /// Whether the sample moves and the lever's frame is at rest ([`Excitation::Sample`]): V_T
     /// carries α2 sin Ωτ, the modal forcing is zero.
-    pub fn is_sample_modulated(&self) -> bool {
+    pub(crate) fn is_sample_modulated(&self) -> bool {
         self.excitation == Excitation::Sample
     }
 
@@ -686,7 +686,7 @@ impl Params {
 
     /// The state dimension 2N + m of the model of these parameters: N modes and the law's m
     /// internal states ([`crate::ContactLaw::internal_states`]).
-    pub fn state_dim(&self) -> usize {
+    pub(crate) fn state_dim(&self) -> usize {
         2 * self.modes + self.contact_law.internal_states()
     }
 
@@ -703,7 +703,7 @@ impl Params {
     }
 
     /// Whether the drive has further components ([`Params::drive_components`]).
-    pub fn is_multifrequency(&self) -> bool {
+    pub(crate) fn is_multifrequency(&self) -> bool {
         self.components().next().is_some()
     }
 
@@ -724,7 +724,7 @@ impl Params {
     }
 
     /// d/dτ of [`Params::component_force`].
-    pub fn component_force_rate(&self, tau: f64) -> f64 {
+    pub(crate) fn component_force_rate(&self, tau: f64) -> f64 {
         self.components()
             .map(|c| {
                 let w = c.ratio() * self.omega;

@@ -58,7 +58,7 @@ impl Region {
     }
 
     /// Region of a tip displacement V_T: contact when V_T ≤ 0 (eq. 10).
-    pub fn of_v_t(v_t: f64) -> Region {
+    pub(crate) fn of_v_t(v_t: f64) -> Region {
         if v_t <= 0.0 {
             Region::Contact
         } else {
@@ -213,7 +213,7 @@ pub fn check_state(name: &'static str, dim: usize, z: &DVector<f64>) -> Result<(
 }
 
 /// dΨ = J Ψ for d×d column-major `psi` and `dpsi` (the variational equations' product).
-pub fn jacobian_product(jac: &DMatrix<f64>, psi: &[f64], dpsi: &mut [f64]) {
+pub(crate) fn jacobian_product(jac: &DMatrix<f64>, psi: &[f64], dpsi: &mut [f64]) {
     jacobian_rows_product(jac, 0, psi, dpsi);
 }
 
@@ -223,7 +223,12 @@ pub fn jacobian_product(jac: &DMatrix<f64>, psi: &[f64], dpsi: &mut [f64]) {
 /// second-order system in z = (a, ȧ) has `J = [[0, I], [L]]`: its top rows are a copy of Ψ's
 /// lower rows, and only the lower rows (`row0` = d/2) need this product.
 #[inline]
-pub fn jacobian_rows_product(jac: &DMatrix<f64>, row0: usize, psi: &[f64], dpsi: &mut [f64]) {
+pub(crate) fn jacobian_rows_product(
+    jac: &DMatrix<f64>,
+    row0: usize,
+    psi: &[f64],
+    dpsi: &mut [f64],
+) {
     let d = jac.nrows();
     let j = jac.as_slice();
     for (out, col) in dpsi.chunks_exact_mut(d).zip(psi.chunks_exact(d)) {

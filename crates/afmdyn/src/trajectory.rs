@@ -145,7 +145,7 @@ pub struct SampleRows {
 
 impl SampleRows {
     /// The values of a row before the state.
-    pub const LEADING: usize = 6;
+    pub(crate) const LEADING: usize = 6;
 
     /// Empty rows for states of `dim` = 2N values.
     pub fn new(dim: usize) -> Self {
@@ -201,7 +201,7 @@ impl SampleRows {
 
 impl Sample {
     /// The sample of a row of [`SampleRows`].
-    pub fn from_row(row: &[f64]) -> Self {
+    pub(crate) fn from_row(row: &[f64]) -> Self {
         Sample {
             tau: row[0],
             v_t: row[1],

@@ -26,7 +26,7 @@ pub const SILICON_TIP: Material = Material {
 };
 
 /// Named sample materials: (name, material). Sources per entry.
-pub const SAMPLE_MATERIALS: &[(&str, Material)] = &[
+pub(crate) const SAMPLE_MATERIALS: &[(&str, Material)] = &[
     // E: the paper §4 ("polystyrene (E2 = 4 GPa)", from its ref. [44]).
     // ν: 0.34, J.E. Mark (ed.), Physical Properties of Polymers Handbook, 2nd ed., Springer 2007.
     (
@@ -143,11 +143,11 @@ impl Cantilever {
         self.width * self.thickness.powi(3) / 12.0
     }
     /// Bending stiffness EI (N m²).
-    pub fn bending_stiffness(&self) -> f64 {
+    pub(crate) fn bending_stiffness(&self) -> f64 {
         self.youngs_modulus * self.inertia()
     }
     /// Mass per unit length m = ρ b h (kg/m).
-    pub fn mass_per_length(&self) -> f64 {
+    pub(crate) fn mass_per_length(&self) -> f64 {
         self.density * self.width * self.thickness
     }
     /// Static spring constant K_c = 3EI/L³ (N/m), paper §4.
@@ -155,7 +155,7 @@ impl Cantilever {
         3.0 * self.bending_stiffness() / self.length.powi(3)
     }
     /// Seconds per unit of dimensionless time: t = τ √(mL⁴/EI) (eq. 5).
-    pub fn time_scale(&self) -> f64 {
+    pub(crate) fn time_scale(&self) -> f64 {
         (self.mass_per_length() * self.length.powi(4) / self.bending_stiffness()).sqrt()
     }
     /// First natural frequency of the bare cantilever f₁ = β₁² √(EI/(mL⁴)) / 2π (Hz).

@@ -373,7 +373,7 @@ struct Sums {
 
 /// Where a line engages, in pixels along it: the trace's first drive period,
 /// 0.5/`periods_per_pixel` (its material is the one [`Engage`] must be of).
-pub fn engage_position(spec: &LineSpec) -> f64 {
+pub(crate) fn engage_position(spec: &LineSpec) -> f64 {
     0.5 / spec.periods_per_pixel as f64
 }
 
@@ -527,7 +527,7 @@ pub fn scan_line(
 ///
 /// # Errors
 /// The error of the lowest-numbered line that failed (the others finished are sent).
-pub fn scan_lines(
+pub(crate) fn scan_lines(
     lines: usize,
     done: &std::collections::HashSet<usize>,
     line: &(dyn Fn(usize) -> Result<ScanLine, SimError> + Sync),

@@ -69,7 +69,7 @@ pub const DEFAULT_BASIN_HITS: usize = 16;
 pub const DEFAULT_DISCOVER_AFTER: usize = 200;
 /// Consecutive returns in coarse cells whose four corners share one label that decide a start
 /// of a later pass (one return decides when the 3 × 3 coarse cells around it share the label).
-pub const GRID_HITS: usize = 2;
+pub(crate) const GRID_HITS: usize = 2;
 /// Default stride of the first pass's coarse grid: 0, automatic ([`BasinSpec::first_stride`]).
 pub const DEFAULT_STRIDE: usize = 0;
 /// Fewest nodes per axis of the first pass's coarse grid chosen automatically. (On the impact
@@ -190,7 +190,7 @@ pub struct BasinSpec {
 }
 
 /// Largest number of cells of a basin map.
-pub const MAX_BASIN_CELLS: usize = 4_000_000;
+pub(crate) const MAX_BASIN_CELLS: usize = 4_000_000;
 
 impl BasinSpec {
     /// Check the options (the one place of their limits).
@@ -471,7 +471,7 @@ pub fn pass_start(spec: &BasinSpec, rows: &[BasinRow], pass: usize) -> PassStart
 ///
 /// # Errors
 /// [`SimError::Cancelled`] once `cancel` is set.
-pub fn run_pass_row(
+pub(crate) fn run_pass_row(
     spec: &BasinSpec,
     model: &CantileverModel,
     start: &PassStart,
@@ -543,7 +543,7 @@ pub fn basins(spec: &BasinSpec) -> Result<BasinMap, SimError> {
 ///
 /// # Errors
 /// As [`basins`]; [`SimError::Cancelled`] once `progress` is cancelled.
-pub fn basins_with(spec: &BasinSpec, progress: &Progress) -> Result<BasinMap, SimError> {
+pub(crate) fn basins_with(spec: &BasinSpec, progress: &Progress) -> Result<BasinMap, SimError> {
     spec.validate()?;
     let model = CantileverModel::new(&spec.params)?;
     progress.add_total(spec.xs.len() * spec.ys.len());

@@ -21,7 +21,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Scale A of random initial states: a_j ~ U(−A, A)·β₁²/β_j², ȧ_j ~ U(−A, A)·β₁² (every mode
 /// gets a comparable share of energy; A = 0.6 gap units covers the paper's amplitudes 0.1–1.5).
-pub const RANDOM_AMPLITUDE: f64 = 0.6;
+pub(crate) const RANDOM_AMPLITUDE: f64 = 0.6;
 
 /// Largest number of sweep points, values × (2 for continuation + random starts): each point is
 /// a steady-state computation, and the bookkeeping of a run (resume set, output index) grows

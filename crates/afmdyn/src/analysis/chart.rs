@@ -192,7 +192,7 @@ pub fn cell_start(model: &CantileverModel, seed: u64, x: f64, y: f64, k: u32) ->
 
 /// Relative distance within which a run that ends nonperiodic counts as converging to a known
 /// periodic attractor.
-pub const CONVERGING_TOL: f64 = 1e-3;
+pub(crate) const CONVERGING_TOL: f64 = 1e-3;
 
 /// Whether `s`, a run that hit the transient cap without a period, is still converging to the
 /// periodic attractor `a`: every recorded Poincaré point of `s` lies within [`CONVERGING_TOL`]

@@ -54,7 +54,7 @@ pub fn mode_convergence(
 ///
 /// # Errors
 /// As [`mode_convergence`]; [`SimError::Cancelled`] once `progress` is cancelled.
-pub fn mode_convergence_with(
+pub(crate) fn mode_convergence_with(
     params: &Params,
     max_modes: usize,
     periods: usize,

@@ -68,7 +68,7 @@ pub const DEFAULT_ORBIT_TOLERANCE: f64 = 1e-13;
 /// The loop conditions are met to the tolerance, or, where the orbit's own error bounds them
 /// (module docs, [`FmSpec::new`]), to this many times Q_K × the integrator's tolerance once
 /// Newton stops gaining.
-pub const NOISE_FLOOR_FACTOR: f64 = 1e3;
+pub(crate) const NOISE_FLOOR_FACTOR: f64 = 1e3;
 /// A shooting that stops above its tolerance at a residual r ≤ [`ROUND_OFF_LIMIT`] (the map's
 /// round-off floor) is taken again to this many times r.
 pub const ROUND_OFF_RETRY: f64 = 4.0;
@@ -76,14 +76,14 @@ pub const ROUND_OFF_RETRY: f64 = 4.0;
 pub const ROUND_OFF_LIMIT: f64 = 1e-7;
 /// … plus this many times Q_K × the orbit's fixed-point residual (an orbit error δz moves
 /// the first harmonic by up to Q δz/π).
-pub const ORBIT_FLOOR_FACTOR: f64 = 10.0;
+pub(crate) const ORBIT_FLOOR_FACTOR: f64 = 10.0;
 /// The largest loop residual accepted at the orbit's round-off floor (1e-6 rad of phase: at
 /// Q = 10⁴ and f0 = 300 kHz, 2e-5 Hz of frequency shift).
-pub const MAX_LOOP_RESIDUAL: f64 = 1e-6;
+pub(crate) const MAX_LOOP_RESIDUAL: f64 = 1e-6;
 /// Most Newton iterations on (Ω, α2) per value.
-pub const MAX_LOOP_ITERATIONS: usize = 30;
+pub(crate) const MAX_LOOP_ITERATIONS: usize = 30;
 /// Most failures (each halving the step in z_c) on the way to one value.
-pub const MAX_HALVINGS: usize = 6;
+pub(crate) const MAX_HALVINGS: usize = 6;
 /// Step of the forward differences of the loop Jacobian: relative in α2; in Ω relative to the
 /// half linewidth ω_K/(2Q_K) (across which the phase turns by about 1 rad), so that the phase
 /// moves by about this many rad, well above its round-off and well inside its linear range.
@@ -284,7 +284,10 @@ pub fn fm_curve(spec: &FmSpec, progress: &Progress) -> Result<FmCurve, SimError>
 ///
 /// # Errors
 /// As [`fm_curve`].
-pub fn fm_curve_cancellable(spec: &FmSpec, cancel: &AtomicBool) -> Result<FmCurve, SimError> {
+pub(crate) fn fm_curve_cancellable(
+    spec: &FmSpec,
+    cancel: &AtomicBool,
+) -> Result<FmCurve, SimError> {
     followed(spec, cancel, None)
 }
 

@@ -108,7 +108,7 @@ pub struct LyapunovSpectrum {
 /// error (uncertainty plus convergence estimate, as [`LyapunovSpectrum`] reports them);
 /// `None` when the run fails or is shorter than 2 periods. What a chart's or a basin map's
 /// nonperiodic attractor records.
-pub fn largest_exponent(
+pub(crate) fn largest_exponent(
     model: &CantileverModel,
     z0: &DVector<f64>,
     periods: usize,
@@ -243,7 +243,7 @@ pub fn lyapunov_spectrum_with(
 }
 
 /// Fewest periods averaged for exponents whose signs are reliable (the default is 4000).
-pub const MIN_PERIODS: usize = 200;
+pub(crate) const MIN_PERIODS: usize = 200;
 
 /// The warnings of [`LyapunovSpectrum::warnings`].
 fn run_warnings(

@@ -61,7 +61,7 @@ pub const MAX_CYCLE_SAMPLES: usize = 1_000_000;
 /// Samples of the retract branch resampled for the DMT fit, between the peak force and the
 /// pull-off: the contact point d₀ is the distance at the force minimum, and a coarse grid
 /// would misplace it by a sample's travel (the fit's δ^{3/2} is sensitive to d₀).
-pub const FIT_SAMPLES: usize = 20_000;
+pub(crate) const FIT_SAMPLES: usize = 20_000;
 
 /// Options of [`steady_tap`].
 #[derive(Debug, Clone)]
@@ -218,7 +218,7 @@ pub fn steady_tap(model: &CantileverModel, opts: &PeakForceOptions) -> Result<St
 ///
 /// # Errors
 /// As [`steady_tap`].
-pub fn steady_tap_from(
+pub(crate) fn steady_tap_from(
     model: &CantileverModel,
     opts: &PeakForceOptions,
     z0: &DVector<f64>,
@@ -305,7 +305,7 @@ pub fn steady_tap_from(
 }
 
 /// τ of the largest separation, T/4 (Ωτ = π/2: the sinusoid α2 sin Ωτ at its top).
-pub fn time_origin(model: &CantileverModel) -> f64 {
+pub(crate) fn time_origin(model: &CantileverModel) -> f64 {
     0.25 * model.period()
 }
 
@@ -361,7 +361,7 @@ fn sample_cycle(
 
 /// The lever's static compliance at the tip, c = φ(1)ᵀK⁻¹φ(1) (free region, eq. 13): the
 /// quasi-static deflection is c F_c.
-pub fn static_compliance(model: &CantileverModel) -> f64 {
+pub(crate) fn static_compliance(model: &CantileverModel) -> f64 {
     let k = &model.galerkin().region(Region::Free).stiffness;
     let tip = model.tip();
     k.clone().lu().solve(tip).map_or(f64::NAN, |x| x.dot(tip))

@@ -24,7 +24,7 @@ impl Progress {
         Self::default()
     }
     /// Add `n` units to the expected total (a run that learns its size as it goes adds more).
-    pub fn add_total(&self, n: usize) {
+    pub(crate) fn add_total(&self, n: usize) {
         self.total.fetch_add(n, Ordering::Relaxed);
     }
     /// Units expected, when known.
@@ -51,7 +51,7 @@ impl Progress {
         self.cancel.store(true, Ordering::Relaxed);
     }
     /// Whether the run was asked to stop.
-    pub fn is_cancelled(&self) -> bool {
+    pub(crate) fn is_cancelled(&self) -> bool {
         self.cancel.load(Ordering::Relaxed)
     }
     /// The cancel flag itself, for the analyses that take one

@@ -450,7 +450,7 @@ fn sader_jarvis_fft(
 
 /// U(d_j) = ∫_{d_j}^{d_max} F dt by the trapezoidal rule on the increasing distances `d`
 /// (U(d_max) = 0): the potential of every reconstruction.
-pub fn potential_of(d: &[f64], force: &[f64]) -> Vec<f64> {
+pub(crate) fn potential_of(d: &[f64], force: &[f64]) -> Vec<f64> {
     let n = d.len();
     let mut potential = vec![0.0; n];
     for j in (0..n.saturating_sub(1)).rev() {
@@ -463,7 +463,7 @@ pub fn potential_of(d: &[f64], force: &[f64]) -> Vec<f64> {
 ///
 /// # Errors
 /// [`SimError::OutOfRange`] naming the first that is not.
-pub fn positive_constants(constants: &[(&'static str, f64)]) -> Result<(), SimError> {
+pub(crate) fn positive_constants(constants: &[(&'static str, f64)]) -> Result<(), SimError> {
     for &(name, v) in constants {
         if !(v.is_finite() && v > 0.0) {
             return Err(SimError::out_of_range(

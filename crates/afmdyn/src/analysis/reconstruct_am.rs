@@ -139,7 +139,7 @@ impl AmCurve {
     }
 
     /// The lower turning points c − A.
-    pub fn turning_points(&self) -> Vec<f64> {
+    pub(crate) fn turning_points(&self) -> Vec<f64> {
         self.centres()
             .iter()
             .zip(&self.amplitude)
@@ -148,7 +148,7 @@ impl AmCurve {
     }
 
     /// I = k A (1 − ω²/ω₀²) − F₀ cos φ at every point (module docs).
-    pub fn force_integrals(&self) -> Vec<f64> {
+    pub(crate) fn force_integrals(&self) -> Vec<f64> {
         let k = self.spring_constant;
         let r = self.drive_frequency / self.resonance_frequency;
         let f0 = k

@@ -99,7 +99,7 @@ impl Instability {
 }
 
 /// The critical multiplier: the one of largest modulus, and its type.
-pub fn critical_multiplier(mu: &[Complex<f64>]) -> (Complex<f64>, Instability) {
+pub(crate) fn critical_multiplier(mu: &[Complex<f64>]) -> (Complex<f64>, Instability) {
     let m = *mu
         .iter()
         .max_by(|a, b| a.norm().total_cmp(&b.norm()))
@@ -209,7 +209,7 @@ pub const LINE_SEARCH_MIN_STEP: f64 = 1e-8;
 
 /// Floquet multipliers of a monodromy matrix (decreasing modulus), whether all lie inside the
 /// unit circle, and the type of the critical one.
-pub fn floquet_stability(m: &DMatrix<f64>) -> (Vec<Complex<f64>>, bool, Instability) {
+pub(crate) fn floquet_stability(m: &DMatrix<f64>) -> (Vec<Complex<f64>>, bool, Instability) {
     let multipliers = floquet_multipliers(m);
     let (crit, critical) = critical_multiplier(&multipliers);
     (multipliers, crit.norm() < 1.0, critical)
@@ -332,7 +332,7 @@ pub fn shoot_unwatched(
 ///
 /// # Errors
 /// [`SimError`] from the propagator.
-pub fn section_points(
+pub(crate) fn section_points(
     integ: &mut dyn Integrator,
     z: &DVector<f64>,
     n: usize,
@@ -345,7 +345,7 @@ pub fn section_points(
 ///
 /// # Errors
 /// [`SimError`] from the propagator.
-pub fn reduce_period(
+pub(crate) fn reduce_period(
     integ: &mut dyn Integrator,
     z: &DVector<f64>,
     n: usize,

@@ -12,7 +12,11 @@ pub const SPECTRUM_SAMPLES: usize = 1 << 20;
 /// pairs (frequency in the units of Ω, amplitude in the units of x), `[L/2 + 1]` for
 /// L = `x.len() − 1` (the last sample, which closes the last period, is left out so that L
 /// samples span whole periods). Empty for fewer than 5 samples.
-pub fn amplitude_spectrum(x: &[f64], samples_per_period: usize, omega: f64) -> Vec<(f64, f64)> {
+pub(crate) fn amplitude_spectrum(
+    x: &[f64],
+    samples_per_period: usize,
+    omega: f64,
+) -> Vec<(f64, f64)> {
     use rustfft::{num_complex::Complex, FftPlanner};
     let len = x.len().saturating_sub(1);
     if len < 4 || samples_per_period == 0 {

@@ -556,7 +556,7 @@ pub fn steady_state(
 
 /// Drive periods between the Newton attempts of [`steady_state`] on a slowly decaying model
 /// (the stepped sweeps' chunk).
-pub const SETTLE_CHUNK: usize = 25;
+pub(crate) const SETTLE_CHUNK: usize = 25;
 
 #[cfg(test)]
 mod tests {

@@ -17,7 +17,7 @@ use std::sync::Mutex;
 ///
 /// # Errors
 /// The error of the lowest-numbered task that failed (the others that finished are sent).
-pub fn run_independent<R, E: Send>(
+pub(crate) fn run_independent<R, E: Send>(
     tasks: usize,
     done: &HashSet<usize>,
     task: &(dyn Fn(usize) -> Result<Option<R>, E> + Sync),

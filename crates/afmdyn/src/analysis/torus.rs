@@ -33,7 +33,7 @@ pub const NEAR_GRAZING: f64 = 1e-2;
 
 /// Default number of nodes asked for: the circle takes the smallest convergent denominator of
 /// the rotation at or above it ([`node_count`]).
-pub const DEFAULT_NODES: usize = 24;
+pub(crate) const DEFAULT_NODES: usize = 24;
 
 /// Options of [`invariant_circle`].
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -19,7 +19,7 @@ use nalgebra::DVector;
 
 /// A point of a sweep to trace: the swept parameter's value, the state at τ = 0 (shape `[2N]`)
 /// and the period n (`None`: not period-n, traced over one period).
-pub type TracePoint<'a> = (f64, &'a DVector<f64>, Option<usize>);
+pub(crate) type TracePoint<'a> = (f64, &'a DVector<f64>, Option<usize>);
 
 /// Most drive periods of a trace (a period-n orbit with n larger is recorded over this many).
 pub const MAX_TRACE_PERIODS: usize = 16;

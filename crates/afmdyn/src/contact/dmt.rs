@@ -18,7 +18,7 @@ pub const DMT_DEFAULT_HAMAKER: f64 = 1e-5;
 pub const DMT_DEFAULT_A0: f64 = 0.01;
 
 /// The DMT groups' descriptors (shared with the electrostatic law).
-pub const PARAMS: [Param; 2] = [
+pub(crate) const PARAMS: [Param; 2] = [
     Param {
         name: "hamaker",
         symbol: "H̃",

@@ -234,7 +234,7 @@ impl Jkr {
     }
 
     /// q = c^{1/3} where the contact forms on approach (δ = 0).
-    pub fn q_contact(&self) -> f64 {
+    pub(crate) fn q_contact(&self) -> f64 {
         self.c.cbrt()
     }
 

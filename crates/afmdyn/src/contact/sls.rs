@@ -162,7 +162,7 @@ impl Zener {
         }
     }
     /// κ/(α4 + κ): the free surface's depression per unit u (0 for κ = 0, 1 for α4 = 0).
-    pub fn surface_gain(&self) -> f64 {
+    pub(crate) fn surface_gain(&self) -> f64 {
         let k = self.relaxed + self.maxwell;
         if k > 0.0 {
             self.maxwell / k
@@ -176,7 +176,7 @@ impl Zener {
         self.surface_gain() * u
     }
     /// The surface's depression δ_s: the indentation δ in contact, s(u) free.
-    pub fn depression(&self, contact: bool, delta: f64, u: f64) -> f64 {
+    pub(crate) fn depression(&self, contact: bool, delta: f64, u: f64) -> f64 {
         if contact {
             delta
         } else {
@@ -184,7 +184,7 @@ impl Zener {
         }
     }
     /// κ/α6: the Maxwell arm's relaxation rate 1/τ_r (0 for κ = 0).
-    pub fn relaxation_rate(&self) -> f64 {
+    pub(crate) fn relaxation_rate(&self) -> f64 {
         if self.maxwell == 0.0 {
             0.0
         } else {

@@ -12,7 +12,7 @@ use crate::params::MAX_STATE;
 
 /// What [`sample_dense`] hands each sample: its number j, τ_j and the state z(τ_j) (shape
 /// `[dim]`, the integrator's state); an error it returns ends the sampling.
-pub type EachSample<'a> = dyn FnMut(usize, f64, &[f64]) -> Result<(), SimError> + 'a;
+pub(crate) type EachSample<'a> = dyn FnMut(usize, f64, &[f64]) -> Result<(), SimError> + 'a;
 
 /// How [`sample_dense`] advances an integrator with spans ([`Integrator::spans`]: the exact
 /// propagator, the split integrator).

@@ -4,7 +4,7 @@
 
 /// m sub-steps per drive period T.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct PeriodGrid {
+pub(crate) struct PeriodGrid {
     /// Drive period T.
     pub period: f64,
     /// Sub-steps per period m (≥ 1).
@@ -31,7 +31,7 @@ impl PeriodGrid {
     }
 
     /// Index of the first grid point strictly after τ.
-    pub fn next_index(&self, tau: f64) -> i64 {
+    pub(crate) fn next_index(&self, tau: f64) -> i64 {
         let p = (tau / self.period).floor();
         let rem = tau - p * self.period;
         let mut j = p as i64 * self.m as i64 + (rem / self.h).floor() as i64 + 1;
@@ -47,7 +47,7 @@ impl PeriodGrid {
     /// The column of a one-period table over the grid points k = 0..=m (sin/cos Ωτ_k, z_p at
     /// τ_k) for grid point k of some period reached by a step: m at a period end (k = 0), so
     /// that the values are those at the end of the period the step ran in.
-    pub fn table_column(&self, k: usize) -> usize {
+    pub(crate) fn table_column(&self, k: usize) -> usize {
         if k == 0 {
             self.m
         } else {

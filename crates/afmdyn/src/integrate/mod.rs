@@ -109,7 +109,7 @@ impl Step {
 
     /// A step of `model` in region `from` that ends at an event of `kind` at (τ_s, z⁻) into
     /// region `to`.
-    pub fn with_event<S: TipSampleSystem + ?Sized>(
+    pub(crate) fn with_event<S: TipSampleSystem + ?Sized>(
         model: &S,
         tau0: f64,
         from: Region,
@@ -148,7 +148,7 @@ pub struct Step {
 }
 
 /// Callback after every step: `(integrator, step, state before the step)`.
-pub type StepObserver<'a> =
+pub(crate) type StepObserver<'a> =
     dyn FnMut(&mut dyn Integrator, &Step, &DVector<f64>) -> Result<(), SimError> + 'a;
 
 /// A time integrator of a [`TipSampleSystem`] (the cantilever model of the paper, or another).
@@ -394,7 +394,7 @@ pub trait SmoothTime {
 
 /// The last step's smooth time over a piece [a, b] of it ([`SmoothTime::tau_of`]), τ itself,
 /// a + u(b − a), where the integrator has no other ([`Integrator::smooth_time`]).
-pub fn smooth_time(integ: &mut dyn Integrator, a: f64, b: f64, u: f64) -> (f64, f64) {
+pub(crate) fn smooth_time(integ: &mut dyn Integrator, a: f64, b: f64, u: f64) -> (f64, f64) {
     match integ.smooth_time() {
         Some(s) => s.tau_of(a, b, u),
         None => (a + u * (b - a), b - a),
@@ -535,7 +535,7 @@ impl BodyContactCheck {
     /// against the lowest base 1 − |α2| ≤ α2 sin Ωτ + 1 (less 4 ulp for its rounding), which
     /// needs no sine and spares most steps away from the sample (about 19 of 20 on the
     /// default attractor at N = 10), then against the base at τ.
-    pub fn touches_observed(&self, it: &mut Observed<'_>) -> bool {
+    pub(crate) fn touches_observed(&self, it: &mut Observed<'_>) -> bool {
         let lowest = self.lowest_base() - 4.0 * f64::EPSILON;
         let bound = it.displacement_bound(&self.reach, lowest / (1.0 + 1e-9));
         if Self::spared(bound, lowest) {

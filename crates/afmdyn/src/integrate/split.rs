@@ -143,7 +143,7 @@ impl Split {
 
     /// Whether `model`'s law exerts no force in free flight (linear, Hertz, impact; not DMT or
     /// the electrostatic law).
-    pub fn applies(model: &CantileverModel) -> bool {
+    pub(crate) fn applies(model: &CantileverModel) -> bool {
         model.law().internal_states() == 0 && !model.law().acts_outside()
     }
 

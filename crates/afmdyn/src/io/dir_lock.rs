@@ -19,7 +19,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// Name of the lock file in a locked directory.
-pub const LOCK_FILE: &str = ".afmdyn.lock";
+pub(crate) const LOCK_FILE: &str = ".afmdyn.lock";
 
 /// The temporary sibling `path` is written as before it is renamed into place:
 /// `DIR/NAME.EXT` → `DIR/.NAME.partial.EXT` (`DIR/.NAME.partial` without an extension; the
@@ -144,7 +144,7 @@ impl DirLock {
 ///
 /// # Errors
 /// [`LockError::Io`] naming a file that exists but cannot be removed.
-pub fn remove_partials_in(dir: &Path, outputs: &[&str]) -> Result<Vec<PathBuf>, LockError> {
+pub(crate) fn remove_partials_in(dir: &Path, outputs: &[&str]) -> Result<Vec<PathBuf>, LockError> {
     let mut removed = Vec::new();
     for name in outputs {
         let tmp = partial_path(&dir.join(name));

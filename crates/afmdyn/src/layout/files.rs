@@ -40,7 +40,7 @@ fn without_errno(text: &str) -> &str {
 
 /// Temporary sibling of `path` keeping its extension (plotters picks the format from it):
 /// [`crate::io::dir_lock::partial_path`].
-pub fn temp_path(path: &Path) -> PathBuf {
+pub(crate) fn temp_path(path: &Path) -> PathBuf {
     crate::io::dir_lock::partial_path(path)
 }
 
@@ -129,7 +129,7 @@ impl<W> Drop for Stream<W> {
 }
 
 /// A streamed CSV table.
-pub type CsvStream = Stream<csv::Writer<BufWriter<File>>>;
+pub(crate) type CsvStream = Stream<csv::Writer<BufWriter<File>>>;
 
 /// Start a streamed CSV table with its header row.
 pub fn csv_stream(path: &Path, header: &[&str]) -> Result<CsvStream, FileError> {
@@ -151,7 +151,7 @@ where
 }
 
 /// Finish a streamed CSV table.
-pub fn csv_finish(s: CsvStream) -> Result<(), FileError> {
+pub(crate) fn csv_finish(s: CsvStream) -> Result<(), FileError> {
     s.finish(|mut w| {
         w.flush().map_err(|e| e.to_string())?;
         let f = w.into_inner().map_err(|e| e.error().to_string())?;
@@ -218,7 +218,7 @@ impl Column {
 
 /// The header file `X.npy.json` of `X.npy`: shape, dtype and the meaning and unit of each
 /// column, so that the array is self-describing (`docs/outputs.md` has the same tables).
-pub fn write_npy_header(npy: &Path, rows: u64, columns: &[Column]) -> Result<(), FileError> {
+pub(crate) fn write_npy_header(npy: &Path, rows: u64, columns: &[Column]) -> Result<(), FileError> {
     let name = npy
         .file_name()
         .and_then(|s| s.to_str())
@@ -327,7 +327,7 @@ impl NpyStream {
     }
 
     /// Append whole rows, one after the other in `values` (a multiple of the columns).
-    pub fn push_rows(&mut self, values: &[f64]) -> Result<(), FileError> {
+    pub(crate) fn push_rows(&mut self, values: &[f64]) -> Result<(), FileError> {
         if !values.len().is_multiple_of(self.cols.max(1)) {
             return Err(self.stream.err(format!(
                 "{} values are not whole rows of {}",
@@ -396,7 +396,7 @@ fn std_format(v: f64) -> String {
 }
 
 /// [`f`] appended to `out` (no allocation but where the standard formatting is used).
-pub fn f_into(out: &mut Vec<u8>, v: f64) {
+pub(crate) fn f_into(out: &mut Vec<u8>, v: f64) {
     let a = v.abs();
     if !v.is_finite() || a == 0.0 {
         out.extend(std_format(v).as_bytes());

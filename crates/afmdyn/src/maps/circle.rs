@@ -278,7 +278,7 @@ impl<'a> CircleMap<'a> {
     ///
     /// # Errors
     /// [`SimError`] from the integrator.
-    pub fn segment_at(&mut self, x0: &DVector<f64>) -> Result<Segment, SimError> {
+    pub(crate) fn segment_at(&mut self, x0: &DVector<f64>) -> Result<Segment, SimError> {
         match self.last.take() {
             Some(seg) if &seg.states[0] == x0 => Ok(seg),
             _ => self.linearised_segment(x0, false),

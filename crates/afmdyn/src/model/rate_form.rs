@@ -39,14 +39,14 @@ impl RateForm {
     }
 
     /// The linear coefficient l(τ) = l₀ + l_s s + l_c c into `out` (shape `[2N]`).
-    pub fn linear_at(&self, (s, c): (f64, f64), out: &mut [f64]) {
+    pub(crate) fn linear_at(&self, (s, c): (f64, f64), out: &mut [f64]) {
         for (i, o) in out.iter_mut().enumerate() {
             *o = self.l[0][i] + s * self.l[1][i] + c * self.l[2][i];
         }
     }
 
     /// The state-independent part k(τ).
-    pub fn constant_at(&self, (s, c): (f64, f64)) -> f64 {
+    pub(crate) fn constant_at(&self, (s, c): (f64, f64)) -> f64 {
         let k = &self.k;
         k[0] + k[1] * s + k[2] * c + k[3] * s * s + k[4] * s * c + k[5] * c * c
     }
@@ -65,7 +65,7 @@ impl RateForm {
 impl CantileverModel {
     /// The rates [base power, beam dissipation, sample dissipation] of region `r` as quadratic
     /// forms (module docs), or `None` for a law that is not affine (only the linear law is).
-    pub fn rate_forms(&self, r: Region) -> Option<[RateForm; 3]> {
+    pub(crate) fn rate_forms(&self, r: Region) -> Option<[RateForm; 3]> {
         // the forms hold one harmonic drive (a multifrequency drive's power is not in them)
         if !self.law().is_affine() || self.params().is_multifrequency() {
             return None;

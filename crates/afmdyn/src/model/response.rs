@@ -179,7 +179,7 @@ impl CantileverModel {
     ///
     /// # Errors
     /// As [`CantileverModel::free_force_response`].
-    pub fn free_force_response_damping_derivative(
+    pub(crate) fn free_force_response_damping_derivative(
         &self,
         omega: f64,
     ) -> Result<(nalgebra::Complex<f64>, nalgebra::Complex<f64>), SimError> {
@@ -263,7 +263,12 @@ impl CantileverModel {
     /// point mass, ∂V_T/∂α5 = 1, and 0 for the parameters that enter only the dynamics).
     /// `None` for laws with restitution, whose guards and jump maps depend on the parameters
     /// in other ways (sticking force, impact).
-    pub fn guard_param_derivative(&self, mode: Region, param: SweepParam, tau: f64) -> Option<f64> {
+    pub(crate) fn guard_param_derivative(
+        &self,
+        mode: Region,
+        param: SweepParam,
+        tau: f64,
+    ) -> Option<f64> {
         if self.law.law().restitution().is_some() {
             return None;
         }

@@ -431,7 +431,7 @@ impl MediumReport {
     /// # Errors
     /// A message naming `[medium]` when a mode's Reynolds number leaves Sader's range or the
     /// set is invalid.
-    pub fn reload(&self, params: &mut Params, time_s: f64) -> Result<(), String> {
+    pub(crate) fn reload(&self, params: &mut Params, time_s: f64) -> Result<(), String> {
         let medium = Medium {
             density: self.density,
             viscosity: self.viscosity,

@@ -179,7 +179,7 @@ pub enum ProbeError {
 /// The largest quality factor a probe may give: 1e7, beyond the Q of cantilevers and quartz
 /// sensors in vacuum (1e4–1e6); a larger one leaves the beam's damping α3 and the drive
 /// amplitude α2 = A₀/Q-scaled below the double's resolution (Q = 1e308 made α2 NaN).
-pub const MAX_QUALITY_FACTOR: f64 = 1e7;
+pub(crate) const MAX_QUALITY_FACTOR: f64 = 1e7;
 
 /// A refusal of a dimensionless group derived from the probe's keys, with the keys it was
 /// derived from: the user wrote those, not the group (a tiny `free_amplitude` was refused as
@@ -230,7 +230,7 @@ impl Scales {
         self.force_n * self.length_m
     }
     /// Watts per unit power.
-    pub fn power_w(&self) -> f64 {
+    pub(crate) fn power_w(&self) -> f64 {
         self.energy_j() / self.time_s
     }
     /// Frequency in Hz of a dimensionless angular frequency Ω.

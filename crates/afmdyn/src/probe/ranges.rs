@@ -242,7 +242,7 @@ pub const SI_RANGES: &[SiRange] = &[
 ];
 
 /// The ranges of `[section].key`, if it has any beyond its sign.
-pub fn si_range(section: &str, key: &str) -> Option<&'static SiRange> {
+pub(crate) fn si_range(section: &str, key: &str) -> Option<&'static SiRange> {
     SI_RANGES
         .iter()
         .find(|r| r.sections.contains(&section) && r.keys.contains(&key))

@@ -16,7 +16,7 @@ use crate::params::Params;
 
 /// The abscissa of a curve's table and the names of its two sweeps.
 #[derive(Debug, Clone)]
-pub struct CurveAxis {
+pub(crate) struct CurveAxis {
     /// The abscissa's name in the JSON document (`z_c`, `frequency_hz`, `omega`).
     pub name: &'static str,
     /// Its meaning, with the unit (the axis label of the plots).
@@ -28,7 +28,7 @@ pub struct CurveAxis {
 /// The rows and columns of the table of `c`: abscissa values `x(value)` in `u`'s unit, the
 /// observables in `u`'s units, at the drive of `base`; with `dforce` the columns of dForce
 /// 2.0's `zcdom` table first and in its order, else named and ordered as the JSON document.
-pub fn curve_table(
+pub(crate) fn curve_table(
     c: &SteppedCurve,
     x: &dyn Fn(f64) -> f64,
     u: &CurveUnits,

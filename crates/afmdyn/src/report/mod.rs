@@ -23,7 +23,7 @@ use nalgebra::DVector;
 use serde_json::{json, Value};
 
 /// One region of `afmdyn modes --json`: `{"omega": [ω_i], "eigenvalues": [[re, im], …]}`.
-pub fn region_spectrum(r: &RegionSpectrum) -> Value {
+pub(crate) fn region_spectrum(r: &RegionSpectrum) -> Value {
     json!({
         "omega": r.omega,
         "eigenvalues": r.eigenvalues.iter().map(|e| [e.re, e.im]).collect::<Vec<_>>(),
@@ -374,7 +374,7 @@ pub fn continuation(base: &Params, param: SweepParam, branches: &[Branch]) -> Va
 
 /// One line for every branch that ended before covering what was asked
 /// ([`crate::analysis::continuation::BranchEnd::warning`]).
-pub fn continuation_warnings(param: SweepParam, branches: &[Branch]) -> Vec<String> {
+pub(crate) fn continuation_warnings(param: SweepParam, branches: &[Branch]) -> Vec<String> {
     branches
         .iter()
         .filter_map(|b| b.end.warning(param, b.first().map_or(1, |p| p.period)))
@@ -390,7 +390,7 @@ mod series;
 mod units;
 pub use branches::*;
 #[cfg(feature = "files")]
-pub use curve_table::*;
+pub(crate) use curve_table::*;
 pub use curves::*;
 pub use present::*;
 pub use series::*;

@@ -359,7 +359,7 @@ pub const CURVE_COLUMNS: [CurveColumn; 13] = [
 ];
 
 /// The column of [`CURVE_COLUMNS`] named `name`.
-pub fn curve_column_index(name: &str) -> Option<usize> {
+pub(crate) fn curve_column_index(name: &str) -> Option<usize> {
     CURVE_COLUMNS.iter().position(|c| c.name == name)
 }
 

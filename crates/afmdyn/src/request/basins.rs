@@ -221,7 +221,7 @@ pub fn document(spec: &BasinSpec, map: &BasinMap) -> Value {
 
 /// `basins.csv`: a header and one line per cell, row by row (`ix,iy,x,y,label,decided,periods`;
 /// `decided` as [`Decided::name`]).
-pub fn csv_text(spec: &BasinSpec, map: &BasinMap) -> String {
+pub(crate) fn csv_text(spec: &BasinSpec, map: &BasinMap) -> String {
     let nx = spec.xs.len();
     let mut text = String::from("ix,iy,x,y,label,decided,periods\n");
     for (k, c) in map.cells.iter().enumerate() {

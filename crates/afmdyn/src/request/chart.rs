@@ -23,11 +23,11 @@ use serde_json::{json, Value};
 pub use super::chart_layout::{csv_lines, ChartArrays, CSV_HEADER};
 
 /// Largest number of cells of a chart (x_steps × y_steps).
-pub const MAX_CHART_CELLS: usize = 1_000_000;
+pub(crate) const MAX_CHART_CELLS: usize = 1_000_000;
 /// Largest number of random starts per cell.
 pub const MAX_CHART_STARTS: u32 = 1000;
 /// Largest number of steady-state runs from random starts in a chart (cells × starts).
-pub const MAX_CHART_RUNS: usize = 10_000_000;
+pub(crate) const MAX_CHART_RUNS: usize = 10_000_000;
 /// Largest tile (cells per task).
 pub const MAX_CHART_TILE: usize = 10_000;
 /// Largest number of attractor slots per cell in the result arrays.
@@ -547,6 +547,6 @@ pub fn document(chart: &Chart, cells: &[ChartCell]) -> Value {
 }
 
 /// The cost of a chart ([`super::costs::chart_cost`] of its spec, slots and cells; its errors).
-pub fn chart_cost(chart: &Chart) -> Result<super::limits::Cost, SimError> {
+pub(crate) fn chart_cost(chart: &Chart) -> Result<super::limits::Cost, SimError> {
     super::costs::chart_cost(&chart.spec, chart.slots, &|x, y| chart.model.params(x, y))
 }

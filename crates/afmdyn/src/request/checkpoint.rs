@@ -134,7 +134,7 @@ pub trait Checkpoint: Send {
 
 /// What is done from the stored points: their keys, and the end state of every stored
 /// continuation point that did not fail (where its chain segment goes on).
-pub fn resume_of(done: Vec<DonePoint>) -> Resume {
+pub(crate) fn resume_of(done: Vec<DonePoint>) -> Resume {
     let mut resume = Resume::default();
     for d in done {
         resume.done.insert((d.index, d.branch));

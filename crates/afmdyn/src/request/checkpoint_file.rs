@@ -31,20 +31,20 @@ use std::io::{BufRead, BufReader, BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 /// The finished rows.
-pub const FINAL_CSV: &str = "bifurcation.csv";
+pub(crate) const FINAL_CSV: &str = "bifurcation.csv";
 /// The rows of an unfinished sweep.
-pub const PARTIAL_CSV: &str = ".bifurcation.partial.csv";
+pub(crate) const PARTIAL_CSV: &str = ".bifurcation.partial.csv";
 /// The ledger.
-pub const LEDGER: &str = ".bifurcation.run.json";
+pub(crate) const LEDGER: &str = ".bifurcation.run.json";
 /// The finished rows while they are being sorted.
 const SORTED_CSV: &str = ".bifurcation.sorted.csv";
 /// The last column of the checkpoint's rows: the CRC-32 of the row's text before it.
-pub const CRC_COLUMN: &str = "crc32";
+pub(crate) const CRC_COLUMN: &str = "crc32";
 /// What a damaged store's message tells the user to do.
 pub(crate) const START_OVER: &str = "rerun without --resume to start over";
 
 /// The checkpoint's header: [`HEADER`] and [`CRC_COLUMN`].
-pub fn partial_header() -> String {
+pub(crate) fn partial_header() -> String {
     format!("{},{CRC_COLUMN}", HEADER.join(","))
 }
 
@@ -54,12 +54,12 @@ pub(crate) fn crc_hex(text: &str) -> String {
 }
 
 /// A row as the checkpoint stores it: the row and, in the last column, its checksum.
-pub fn sealed(row: &str) -> String {
+pub(crate) fn sealed(row: &str) -> String {
     format!("{row},{}", crc_hex(row))
 }
 
 /// The row of a stored line whose checksum matches (`None`: no checksum, or another one).
-pub fn unsealed(line: &str) -> Option<&str> {
+pub(crate) fn unsealed(line: &str) -> Option<&str> {
     let (row, crc) = line.rsplit_once(',')?;
     (crc_hex(row) == crc).then_some(row)
 }

@@ -24,10 +24,10 @@ use crate::params::Params;
 
 /// Memory of a model and its propagators, held by every request, in bytes: 1 MiB (N ≤ 20:
 /// a few dozen 2N × 2N matrices per contact region).
-pub const MODEL_BYTES: f64 = 1024.0 * 1024.0;
+pub(crate) const MODEL_BYTES: f64 = 1024.0 * 1024.0;
 
 /// Memory of a state (2N values and the law's internal ones), in bytes.
-pub fn state_bytes(params: &Params) -> f64 {
+pub(crate) fn state_bytes(params: &Params) -> f64 {
     params.state_dim() as f64 * 8.0
 }
 
@@ -36,7 +36,7 @@ pub fn state_bytes(params: &Params) -> f64 {
 ///
 /// # Errors
 /// [`SimError::Params`] when the model cannot be built.
-pub fn steady_periods(steady: &SteadyOptions, params: &Params) -> Result<f64, SimError> {
+pub(crate) fn steady_periods(steady: &SteadyOptions, params: &Params) -> Result<f64, SimError> {
     Ok(steady.cap(&CantileverModel::new(params)?) as f64)
 }
 
@@ -45,7 +45,10 @@ pub fn steady_periods(steady: &SteadyOptions, params: &Params) -> Result<f64, Si
 ///
 /// # Errors
 /// As [`super::SteadyRequest::options`]; [`SimError::Params`] when the model cannot be built.
-pub fn start_work(start: &StartRequest, params: &Params) -> Result<(f64, SteadyOptions), SimError> {
+pub(crate) fn start_work(
+    start: &StartRequest,
+    params: &Params,
+) -> Result<(f64, SteadyOptions), SimError> {
     let steady = start.steady.options()?;
     let search = match start.initial {
         Some(_) => 0.0,
@@ -56,7 +59,7 @@ pub fn start_work(start: &StartRequest, params: &Params) -> Result<(f64, SteadyO
 
 /// The mode-periods of a Newton solve of an orbit of `period` drive periods on `params`
 /// (`max_iter` iterations of the state and its variational system: see the module).
-pub fn newton_work(params: &Params, period: usize, newton: &ShootingOptions) -> f64 {
+pub(crate) fn newton_work(params: &Params, period: usize, newton: &ShootingOptions) -> f64 {
     let columns = 2.0 * params.modes as f64 + 1.0;
     newton.max_iter as f64 * period as f64 * columns * params.modes as f64
 }
@@ -81,7 +84,7 @@ pub fn check_cost(what: &'static str, cost: Cost) -> Result<(), SimError> {
 ///
 /// # Errors
 /// [`SimError::Budget`] naming the request, its cost, the budget and the advice.
-pub fn check_cost_advising(
+pub(crate) fn check_cost_advising(
     what: &'static str,
     cost: Cost,
     memory_hint: &'static str,
@@ -117,7 +120,7 @@ pub fn check_cost_advising(
 ///
 /// # Errors
 /// [`SimError::Params`] when the model cannot be built.
-pub fn census_cost(spec: &AttractorSpec, values: usize) -> Result<Cost, SimError> {
+pub(crate) fn census_cost(spec: &AttractorSpec, values: usize) -> Result<Cost, SimError> {
     let p = &spec.params;
     let starts = values as f64 * spec.samples as f64;
     let per_start = (spec.steady.max_period as f64 + 2.0) * state_bytes(p) + 128.0;
@@ -130,7 +133,7 @@ pub fn census_cost(spec: &AttractorSpec, values: usize) -> Result<Cost, SimError
 /// The memory of a trajectory's sample as [`crate::trajectory::record`] holds it, for a state
 /// of `params`, in bytes: the sample and its state's heap block, twice (a growing vector's old
 /// and new blocks are both live while it is copied).
-pub fn recorded_sample_bytes(params: &Params) -> f64 {
+pub(crate) fn recorded_sample_bytes(params: &Params) -> f64 {
     2.0 * (std::mem::size_of::<crate::trajectory::Sample>() as f64 + state_bytes(params))
 }
 
@@ -141,7 +144,7 @@ pub fn recorded_sample_bytes(params: &Params) -> f64 {
 ///
 /// # Errors
 /// [`SimError::Params`] when the model cannot be built.
-pub fn converge_cost(req: &ConvergeRequest, params: &Params) -> Result<Cost, SimError> {
+pub(crate) fn converge_cost(req: &ConvergeRequest, params: &Params) -> Result<Cost, SimError> {
     let top = Params {
         modes: req.max_modes,
         ..*params
@@ -205,7 +208,7 @@ pub fn stepped_cost(spec: &SteppedSpec) -> Result<Cost, SimError> {
 ///
 /// # Errors
 /// [`SimError::Params`] when the model cannot be built.
-pub fn basins_cost(spec: &BasinSpec) -> Result<Cost, SimError> {
+pub(crate) fn basins_cost(spec: &BasinSpec) -> Result<Cost, SimError> {
     let p = &spec.params;
     let cells = spec.xs.len() as f64 * spec.ys.len() as f64;
     Ok(Cost {
@@ -216,7 +219,7 @@ pub fn basins_cost(spec: &BasinSpec) -> Result<Cost, SimError> {
 
 /// Runs of a chart's cell in the worst case its options allow: its K random starts and, by
 /// continuation, the attractors of its two neighbours (about K each).
-pub const CHART_RUNS_PER_START: f64 = 3.0;
+pub(crate) const CHART_RUNS_PER_START: f64 = 3.0;
 
 /// The cost of a behaviour chart of `spec` (its cells' parameters by `params(x, y)`, up to
 /// `slots` attractors a cell): cells × starts (and the
@@ -228,7 +231,7 @@ pub const CHART_RUNS_PER_START: f64 = 3.0;
 ///
 /// # Errors
 /// [`SimError`] when a corner's parameters do not build a model.
-pub fn chart_cost(
+pub(crate) fn chart_cost(
     spec: &crate::analysis::chart::ChartSpec,
     slots: usize,
     params: &dyn Fn(f64, f64) -> Result<crate::params::Params, SimError>,
@@ -260,7 +263,7 @@ pub fn chart_cost(
 ///
 /// # Errors
 /// As the approach curve's request.
-pub fn image_curves_cost(
+pub(crate) fn image_curves_cost(
     params: Params,
     length: f64,
     curve_points: usize,

@@ -236,7 +236,7 @@ pub fn check_bimodal(base: &Params) -> Result<(), SimError> {
 ///
 /// # Errors
 /// [`SimError::OutOfRange`] naming the probe's `[drive].frequency`.
-pub fn check_single_frequency(base: &Params, what: &'static str) -> Result<(), SimError> {
+pub(crate) fn check_single_frequency(base: &Params, what: &'static str) -> Result<(), SimError> {
     if base.is_multifrequency() {
         Err(SimError::out_of_range(
             "[drive].frequency",

@@ -23,7 +23,7 @@ use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 
 /// The most rows a force curve may have (a 1 MHz record of one second).
-pub const MAX_FIT_ROWS: usize = 1_000_000;
+pub(crate) const MAX_FIT_ROWS: usize = 1_000_000;
 
 /// The segment of the curve fitted.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -221,7 +221,7 @@ impl FitRequest {
     }
 
     /// The segment fitted: `segment`, or the law's default (the whole curve for `sls`).
-    pub fn segment_of(&self, law: ForceLaw) -> Segment {
+    pub(crate) fn segment_of(&self, law: ForceLaw) -> Segment {
         match self.segment {
             Some(FitSegment::Approach) => Segment::Approach,
             Some(FitSegment::Retract) => Segment::Retract,

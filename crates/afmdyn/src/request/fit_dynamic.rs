@@ -54,7 +54,7 @@ pub fn am_columns(names: &[String], cols: &[Vec<f64>]) -> Option<AmData> {
 ///
 /// # Errors
 /// [`SimError::OutOfRange`] naming `data` where the file cannot be read.
-pub fn read_am_data(data: Option<&str>) -> Result<Option<AmData>, SimError> {
+pub(crate) fn read_am_data(data: Option<&str>) -> Result<Option<AmData>, SimError> {
     #[cfg(feature = "files")]
     {
         if let Some(path) = data {

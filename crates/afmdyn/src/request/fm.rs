@@ -71,7 +71,7 @@ impl Default for FmRequest {
 
 /// The FM amplitude's range in the model's length unit (g₀ = A₀ of a probe): outside it the
 /// request is refused, naming `amplitude`.
-pub const FM_AMPLITUDE_RANGE: (f64, f64) = (1e-8, 1e4);
+pub(crate) const FM_AMPLITUDE_RANGE: (f64, f64) = (1e-8, 1e4);
 
 /// The share of the frequency shift at the curve's end (`to`) below which the default FM curve
 /// starts: the range runs from where |Δf| has decayed to it down to contact, which is also the

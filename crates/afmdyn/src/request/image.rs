@@ -151,7 +151,7 @@ impl ImageRequest {
 
     /// The memory of the image over `map` while it is held and written:
     /// [`IMAGE_BYTES_PER_PIXEL`] a pixel.
-    pub fn pixel_bytes(&self, map: &SampleMap) -> f64 {
+    pub(crate) fn pixel_bytes(&self, map: &SampleMap) -> f64 {
         (self.pixels * self.lines(map)) as f64 * IMAGE_BYTES_PER_PIXEL
     }
 
@@ -320,7 +320,7 @@ impl ImageRequest {
 
 /// Memory of one pixel of an image while it is held and written (its maps, operating point
 /// and its share of the JSON document): 920 B measured at 512 × 512 (RSS 241 MB), rounded up.
-pub const IMAGE_BYTES_PER_PIXEL: f64 = 1000.0;
+pub(crate) const IMAGE_BYTES_PER_PIXEL: f64 = 1000.0;
 
 /// The largest memory an image may take, estimated before the run: 1.1 GiB, about the traces'
 /// budget of a curve ([`super::limits::MAX_TRACE_BYTES`]), so that 1024 × 1024 pixels fit and

@@ -339,7 +339,7 @@ pub fn scan_layout(img: &PiImage, setpoint: f64) -> Layout {
 /// is not reached), `evaluations` (steady taps computed per pixel), `material` and `domain`
 /// (32-bit codes with their CF `flag_values` and `flag_meanings`, as in [`layout`]); the scalars
 /// `setpoint` (N) and `reference_z_c` (m).
-pub fn peakforce_layout(img: &PeakForceImage) -> Layout {
+pub(crate) fn peakforce_layout(img: &PeakForceImage) -> Layout {
     let (nx, ny) = (img.x.len(), img.y.len());
     let cells = || (0..ny).flat_map(move |j| (0..nx).map(move |i| (j, i)));
     let grid: &[&str] = &["y", "x"];

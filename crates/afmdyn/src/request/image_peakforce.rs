@@ -57,7 +57,7 @@ pub const CONTINUE_ITERATIONS: usize = 30;
 
 /// Taps a change of material is expected to cost (the request's cost estimate): one, from the
 /// material's engaged orbit (module docs).
-pub const TAPS_PER_CHANGE: f64 = 1.0;
+pub(crate) const TAPS_PER_CHANGE: f64 = 1.0;
 
 /// A pixel's operating point in SI: the steady tap at the setpoint and its channels.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -166,7 +166,7 @@ pub fn peakforce_probe(probe_table: &toml::Table, setpoint: f64) -> Result<Probe
 ///
 /// # Errors
 /// As [`peakforce_probe`], the probe's models and the taps' transient estimate.
-pub fn peakforce_cost(
+pub(crate) fn peakforce_cost(
     probe_table: &toml::Table,
     map: &SampleMap,
     req: &ImageRequest,
@@ -199,7 +199,7 @@ pub fn peakforce_cost(
 /// A material's engage from far, as a task computes it: the steady taps of the feedback's
 /// search, and α5, the orbit's state at τ = 0 and the operating point, or why the setpoint is
 /// not reached.
-pub type Engage = (usize, Result<(f64, Vec<f64>, PeakForceTap), String>);
+pub(crate) type Engage = (usize, Result<(f64, Vec<f64>, PeakForceTap), String>);
 
 impl PeakForceImageStudy {
     /// The study of `map` under the probe `probe_table` at the peak force `req.setpoint` (N):
@@ -312,7 +312,7 @@ impl PeakForceImageStudy {
     }
 
     /// The material of the pixel at (x, y).
-    pub fn material_at(&self, x: f64, y: f64) -> usize {
+    pub(crate) fn material_at(&self, x: f64, y: f64) -> usize {
         self.map.domain_at(x, y).map_or(0, |k| self.of_domain[k])
     }
 

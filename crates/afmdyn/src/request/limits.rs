@@ -94,7 +94,7 @@ pub use crate::probe::ranges::MAX_SI_DISTANCE;
 /// Drive frequencies (Hz) are accepted within [1e-2, 1e4] × the probe's own drive frequency:
 /// wider than the band of any of its 20 modes, narrow enough to catch a value meant in kHz or
 /// MHz but written in Hz (1e3 or 1e6 too small).
-pub const SI_FREQUENCY_RATIO: (f64, f64) = (1e-2, 1e4);
+pub(crate) const SI_FREQUENCY_RATIO: (f64, f64) = (1e-2, 1e4);
 
 pub use crate::analysis::tolerance;
 

@@ -48,7 +48,7 @@ pub mod fm;
 pub use crate::io::height_map as height_map_file;
 pub mod fit;
 pub mod fit_dynamic;
-pub mod fit_result;
+pub(crate) mod fit_result;
 pub mod image;
 pub mod image_job;
 pub mod image_layout;
@@ -62,7 +62,7 @@ mod model_of;
 pub mod modes;
 pub mod named;
 pub mod peakforce;
-pub mod peakforce_sweep;
+pub(crate) mod peakforce_sweep;
 pub mod pool;
 pub mod present;
 pub mod reconstruct;
@@ -115,7 +115,7 @@ pub use crate::params::{Excitation, Params, SweepParam};
 
 /// The default relative distance within which two Poincaré point sets are one attractor
 /// (`cluster_tol` of the census, its global continuation, the basin map and the chart).
-pub const DEFAULT_CLUSTER_TOL: f64 = 1e-5;
+pub(crate) const DEFAULT_CLUSTER_TOL: f64 = 1e-5;
 /// The default seed of the random initial states (`seed` of the sweep, the census, its global
 /// continuation and the chart).
-pub const DEFAULT_SEED: u64 = 1;
+pub(crate) const DEFAULT_SEED: u64 = 1;

@@ -316,7 +316,7 @@ pub fn parameter(key: &str) -> Option<&'static ParamInfo> {
 
 /// The model parameter name (or alias) closest to a misspelt `key` — Jaro–Winkler similarity
 /// ≥ 0.85 (`omgea` → `omega`, `beam_dampnig` → `beam_damping`) — for a "did you mean" hint.
-pub fn closest_parameter(key: &str) -> Option<&'static str> {
+pub(crate) fn closest_parameter(key: &str) -> Option<&'static str> {
     MODEL_PARAMETERS
         .iter()
         .flat_map(|p| std::iter::once(p.name).chain(p.alias))

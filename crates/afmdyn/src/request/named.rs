@@ -60,7 +60,7 @@ pub struct Outcome {
 }
 
 /// A result's layouts, each named, and its scalars ([`Outcome::facts`]).
-pub type Arrays = (Vec<(String, Layout)>, Map<String, Value>);
+pub(crate) type Arrays = (Vec<(String, Layout)>, Map<String, Value>);
 
 /// The arrays of an analysis' result, beside its document: empty by default.
 pub trait Datasets: Analysis {

@@ -23,7 +23,7 @@ pub use super::peakforce_sweep::{PeakForceSweep, PeakForceSweepParam, MAX_SWEEP_
 /// Largest modulation frequency relative to the lever's first resonance, f_m/f₀ (the model's Ω
 /// over the lever's first natural frequency as modelled: Ω itself in the lumped models, Ω/3.516
 /// on the beam): above it the drive is not off resonance (use `orbit` or `approach`).
-pub const MAX_MODULATION_RATIO: f64 = 0.5;
+pub(crate) const MAX_MODULATION_RATIO: f64 = 0.5;
 
 /// The lever's first natural frequency as modelled, in the units of Ω (in its medium; 1 in the
 /// lumped models' units, ≈ 3.516 in the beam's): f₀/f_m = this / Ω.
@@ -298,7 +298,8 @@ impl PeakForceRequest {
 }
 
 /// The filter's words in the document (`filter.kind`).
-pub const FILTER_KIND: &str = "second-order Butterworth low-pass (Butterworth 1930; bilinear \
+pub(crate) const FILTER_KIND: &str =
+    "second-order Butterworth low-pass (Butterworth 1930; bilinear \
      transform with the cut-off prewarped), causal as the instrument's real-time filter, in \
      its periodic steady state over the cycle, on the measured force k × deflection: \
      curve.approach_filtered_force and curve.retract_filtered_force";

@@ -183,7 +183,7 @@ fn unit(kind: &str, si: bool) -> &'static str {
 /// modulus `modulus_dmt` (`modulus_scale` × the fitted Hertz group: the reduced modulus in Pa
 /// with a probe), the orbit's period and stability, and each point's message (`null` when
 /// computed).
-pub fn sweep_document(
+pub(crate) fn sweep_document(
     sweep: &PeakForceSweep,
     u: &CurveUnits,
     modulus_scale: Option<f64>,
@@ -235,7 +235,7 @@ pub fn sweep_document(
 /// period), more than one contact per modulation period (`modulus_dmt` is then not meaningful),
 /// an unstable orbit, no repulsive contact. Every tap of a sweep is checked alike
 /// ([`sweep_warnings`]), and a single tap's document has them ([`super::peakforce::document`]).
-pub fn tap_warnings(tap: &SteadyTap) -> Vec<(&'static str, String)> {
+pub(crate) fn tap_warnings(tap: &SteadyTap) -> Vec<(&'static str, String)> {
     let c = &tap.channels;
     let mut warnings = Vec::new();
     if tap.period > 1 {
@@ -278,7 +278,7 @@ pub fn tap_warnings(tap: &SteadyTap) -> Vec<(&'static str, String)> {
 /// once, with the number of values it holds at and the swept values where it does (the
 /// first three and the last, in `block`'s units), its message the first such tap's; the
 /// per-value messages are in `sweep.warnings`.
-pub fn sweep_warnings(block: &Value, taps: &[SweepTap]) -> Vec<String> {
+pub(crate) fn sweep_warnings(block: &Value, taps: &[SweepTap]) -> Vec<String> {
     let quantity = block["quantity"].as_str().unwrap_or("value");
     let unit = block["unit"].as_str().unwrap_or("");
     let values: Vec<f64> = block["values"].as_array().map_or(Vec::new(), |a| {
@@ -324,7 +324,7 @@ pub fn sweep_warnings(block: &Value, taps: &[SweepTap]) -> Vec<String> {
 /// The sweep's layout from the document's `sweep` block: the values as the coordinate of the
 /// dimension named after the swept quantity, every channel over it (NaN where a point
 /// failed), and `period` (0 where a point failed).
-pub fn sweep_layout(block: &Value) -> Layout {
+pub(crate) fn sweep_layout(block: &Value) -> Layout {
     let dim = block["quantity"].as_str().unwrap_or("value").to_string();
     let nums = |v: &Value| -> Vec<f64> {
         v.as_array().map_or(Vec::new(), |a| {

@@ -80,7 +80,7 @@ impl SimulateRequest {
     ///
     /// # Errors
     /// As [`super::analyses::IntegratorRequest::options`].
-    pub fn integrator_options(&self) -> Result<IntegratorOptions, SimError> {
+    pub(crate) fn integrator_options(&self) -> Result<IntegratorOptions, SimError> {
         self.integrator.options(1)
     }
 

@@ -23,7 +23,7 @@ use std::path::Path;
 
 /// The names of the files [`SeriesFiles`] writes (a run removes their stale temporary
 /// siblings first).
-pub const SERIES_FILES: [&str; 6] = [
+pub(crate) const SERIES_FILES: [&str; 6] = [
     "timeseries.npy",
     "timeseries.npy.json",
     "timeseries.csv",
@@ -46,7 +46,7 @@ pub struct SeriesFiles {
 }
 
 /// The columns of `timeseries.npy` (and `.csv`) of an N-mode run in `su`'s units.
-pub fn series_columns(n: usize, su: &SeriesUnits) -> Vec<Column> {
+pub(crate) fn series_columns(n: usize, su: &SeriesUnits) -> Vec<Column> {
     su.columns(n)
         .into_iter()
         .map(|c| Column::new(c.name, c.unit, c.long_name))

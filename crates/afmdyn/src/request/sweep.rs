@@ -174,7 +174,7 @@ pub fn every_point_failed(records: &[SweepRecord]) -> Option<crate::SimError> {
 /// Position of `value` in [`COLUMNS`].
 pub const COL_VALUE: usize = 1;
 /// Position of `index`.
-pub const COL_INDEX: usize = 2;
+pub(crate) const COL_INDEX: usize = 2;
 /// Position of `branch`.
 pub const COL_BRANCH: usize = 3;
 /// Position of `status`.
@@ -182,15 +182,15 @@ pub const COL_STATUS: usize = 4;
 /// Position of `period`.
 pub const COL_PERIOD: usize = 5;
 /// Position of `point`.
-pub const COL_POINT: usize = 6;
+pub(crate) const COL_POINT: usize = 6;
 /// Position of `points`.
 pub const COL_POINTS: usize = 7;
 /// Position of `tau`.
-pub const COL_TAU: usize = 8;
+pub(crate) const COL_TAU: usize = 8;
 /// Position of `w_tip`.
 pub const COL_W_TIP: usize = 10;
 /// Position of `x_max`.
-pub const COL_X_MAX: usize = 11;
+pub(crate) const COL_X_MAX: usize = 11;
 /// Position of `message`.
 pub const COL_MESSAGE: usize = 16;
 /// Position of `state`.
@@ -568,7 +568,7 @@ pub fn fingerprint(request: &BifurcationRequest, spec: &SweepSpec) -> Value {
 
 /// The plan of a sweep's tasks in its fingerprint: chains cut into ⌈√n⌉ chunks seeded by a
 /// coarse pass, random starts keyed by (seed, value, start).
-pub const PLAN: &str = "chunks-sqrt, starts keyed by value";
+pub(crate) const PLAN: &str = "chunks-sqrt, starts keyed by value";
 
 /// The order in which [`first_difference`] compares a fingerprint's fields.
 const FIELD_ORDER: [&str; 17] = [

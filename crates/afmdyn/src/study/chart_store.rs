@@ -9,7 +9,7 @@ use crate::io::dir_lock::DirLock;
 use crate::request::checkpoint::CheckpointError;
 
 /// The chart's files.
-pub const CHART_FILES: TaskFiles = TaskFiles {
+pub(crate) const CHART_FILES: TaskFiles = TaskFiles {
     ledger: ".chart.run.json",
     records: ".chart.tiles.jsonl",
     key: "cells",
@@ -18,7 +18,7 @@ pub const CHART_FILES: TaskFiles = TaskFiles {
 };
 
 /// A chart's store: its tiles' cells by task.
-pub type ChartStore<'a> = TaskStore<'a, Vec<ChartCell>>;
+pub(crate) type ChartStore<'a> = TaskStore<'a, Vec<ChartCell>>;
 
 /// The chart store of the directory `lock` holds.
 pub fn chart_store(lock: &DirLock) -> ChartStore<'_> {

@@ -10,7 +10,7 @@ use crate::analysis::am_loop::ScanLine;
 use crate::io::dir_lock::DirLock;
 
 /// The scan's files.
-pub const SCAN_FILES: TaskFiles = TaskFiles {
+pub(crate) const SCAN_FILES: TaskFiles = TaskFiles {
     ledger: ".image.run.json",
     records: ".image.lines.jsonl",
     key: "line",
@@ -19,7 +19,7 @@ pub const SCAN_FILES: TaskFiles = TaskFiles {
 };
 
 /// A PI scan's store: its lines by number.
-pub type ScanStore<'a> = TaskStore<'a, ScanLine>;
+pub(crate) type ScanStore<'a> = TaskStore<'a, ScanLine>;
 
 /// The scan store of the directory `lock` holds.
 pub fn scan_store(lock: &DirLock) -> ScanStore<'_> {

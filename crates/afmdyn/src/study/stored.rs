@@ -247,7 +247,7 @@ impl Prepared for Sweep {
 /// A sweep's records (in their order) as an outcome: no document but the swept parameter and
 /// its values (also the facts), the records' layout ([`crate::request::sweep::layout`]) as
 /// `bifurcation`.
-pub fn sweep_outcome(spec: &SweepSpec, records: &[SweepRecord]) -> Outcome {
+pub(crate) fn sweep_outcome(spec: &SweepSpec, records: &[SweepRecord]) -> Outcome {
     let facts = serde_json::json!({ "param": spec.param.name(), "values": spec.values });
     let layout = crate::request::sweep::layout(spec, records);
     Outcome {

@@ -40,7 +40,7 @@ use std::path::{Path, PathBuf};
 use super::{Opened, Store, Study};
 
 /// The store's layout (the ledger's `format`): 2 since the lines carry checksums.
-pub const FORMAT: u64 = 2;
+pub(crate) const FORMAT: u64 = 2;
 /// What ends a record's line before its checksum.
 const CRC_KEY: &str = ",\"crc32\":\"";
 
@@ -392,7 +392,7 @@ pub fn to_cbor_text<T: Serialize + ?Sized>(value: &T) -> Result<String, String> 
 ///
 /// # Errors
 /// The decoder's message (not base64, not CBOR, not a `T`).
-pub fn from_cbor_text<T: DeserializeOwned>(text: &str) -> Result<T, String> {
+pub(crate) fn from_cbor_text<T: DeserializeOwned>(text: &str) -> Result<T, String> {
     let bytes = BASE64.decode(text).map_err(|e| e.to_string())?;
     ciborium::from_reader(bytes.as_slice()).map_err(|e| e.to_string())
 }

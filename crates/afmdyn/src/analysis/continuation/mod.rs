@@ -103,7 +103,7 @@ impl ContinuationSpec {
 /// three-mode branches from Ω = 5 to 1 take 1.4·10⁷ (Hertz, 1340 points) and 3.0·10⁷ (DMT,
 /// 2295 points); the budget ends a branch that winds on without end (an undamped beam, say)
 /// after a bounded, reproducible amount of work, with a warning naming where it stopped.
-pub const WORK_BUDGET: u64 = 100_000_000;
+pub(crate) const WORK_BUDGET: u64 = 100_000_000;
 
 /// Why a branch ended.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]

@@ -51,23 +51,23 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Mutex;
 
 /// `z_offset` (m).
-pub const Z_OFFSET: &str = "z_offset";
+pub(crate) const Z_OFFSET: &str = "z_offset";
 /// `sample.youngs_modulus` (Pa).
 pub const YOUNGS_MODULUS: &str = "sample.youngs_modulus";
 /// `sample.hamaker` (J).
-pub const HAMAKER: &str = "sample.hamaker";
+pub(crate) const HAMAKER: &str = "sample.hamaker";
 /// `tip.radius` (m).
 pub const RADIUS: &str = "tip.radius";
 /// `sample.damping` (N s/m), the Hertz law's damper.
-pub const DAMPING: &str = "sample.damping";
+pub(crate) const DAMPING: &str = "sample.damping";
 /// `sample.viscosity` (Pa s), the Kelvin–Voigt η of DMT and JKR.
-pub const VISCOSITY: &str = "sample.viscosity";
+pub(crate) const VISCOSITY: &str = "sample.viscosity";
 /// `cantilever.quality_factor` (1), the lever's Q₁.
-pub const QUALITY_FACTOR: &str = "cantilever.quality_factor";
+pub(crate) const QUALITY_FACTOR: &str = "cantilever.quality_factor";
 /// `drive.free_amplitude` (m), the free amplitude A₀ the instrument set.
-pub const FREE_AMPLITUDE: &str = "drive.free_amplitude";
+pub(crate) const FREE_AMPLITUDE: &str = "drive.free_amplitude";
 /// `sample.adhesion_energy` (J/m²), JKR's work of adhesion.
-pub const ADHESION_ENERGY: &str = "sample.adhesion_energy";
+pub(crate) const ADHESION_ENERGY: &str = "sample.adhesion_energy";
 
 /// The adaptive integrator's tolerance of the fit's Jacobian: the sensitivities to ~1e-7
 /// relative, far inside what Levenberg–Marquardt and the covariance need (the values are the
@@ -99,7 +99,7 @@ pub enum AmParam {
 
 impl AmParam {
     /// The parameter of a probe name; `None` for another.
-    pub fn from_name(name: &str) -> Option<AmParam> {
+    pub(crate) fn from_name(name: &str) -> Option<AmParam> {
         match name {
             YOUNGS_MODULUS => Some(AmParam::YoungsModulus),
             HAMAKER => Some(AmParam::Hamaker),
@@ -156,7 +156,7 @@ impl Chain {
     }
     /// ∂y/∂`param` from the orbit's sensitivities `d` (one per `orbit`, in its order): the sum
     /// of the terms of `param`; an orbit parameter not in `orbit` counts 0.
-    pub fn to_si(&self, orbit: &[OrbitParam], d: &[f64], param: AmParam) -> f64 {
+    pub(crate) fn to_si(&self, orbit: &[OrbitParam], d: &[f64], param: AmParam) -> f64 {
         let at = |o: OrbitParam| orbit.iter().position(|x| *x == o).map_or(0.0, |i| d[i]);
         self.terms
             .iter()
@@ -567,7 +567,7 @@ pub fn first_sweep(spec: &SteppedSpec) -> Result<Vec<CurvePoint>, SimError> {
 ///
 /// # Errors
 /// As [`sweep_points`]; [`SimError::Cancelled`] when `stop` was set before the last point.
-pub fn first_sweep_cancellable(
+pub(crate) fn first_sweep_cancellable(
     spec: &SteppedSpec,
     stop: &AtomicBool,
 ) -> Result<Vec<CurvePoint>, SimError> {
@@ -602,7 +602,7 @@ pub fn first_sweep_cancellable(
 /// model is a [`CurveModel`] through one implementation, which keeps the outcome: a Jacobian
 /// evaluation's warnings replace the last ones, a failed evaluation's values are NaN with a
 /// warning naming where it failed, a cancelled one's values NaN.
-pub trait CheckedModel {
+pub(crate) trait CheckedModel {
     /// The number of data points m (rows × channels).
     fn rows(&self) -> usize;
     /// Where the last evaluation's warnings are kept.

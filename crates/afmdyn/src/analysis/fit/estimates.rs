@@ -18,7 +18,7 @@ use nalgebra::DMatrix;
 pub use super::profile::Z_95;
 
 /// Above this |correlation| two parameters are called not separately identifiable.
-pub const CORRELATION_WARNING: f64 = 0.99;
+pub(crate) const CORRELATION_WARNING: f64 = 0.99;
 
 /// Profiles are computed for at most this many fitted parameters (Wald intervals beyond):
 /// [`profiled`] chooses them.
@@ -41,7 +41,7 @@ pub fn profiled<S: AsRef<str>>(names: &[S]) -> Vec<bool> {
 
 /// Below this ratio of the smallest to the largest eigenvalue of the scaled JᵀWJ the matrix is
 /// called singular (the data do not fix some combination of the parameters).
-pub const SINGULAR_RATIO: f64 = 1e-14;
+pub(crate) const SINGULAR_RATIO: f64 = 1e-14;
 
 /// One fitted parameter's estimate.
 #[derive(Debug, Clone, PartialEq)]

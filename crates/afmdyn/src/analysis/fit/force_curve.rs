@@ -51,7 +51,7 @@ pub enum ForceLaw {
 
 impl ForceLaw {
     /// The law of the registry by its name (`hertz`, `dmt`, `jkr`); `None` for another.
-    pub fn from_name(name: &str) -> Option<ForceLaw> {
+    pub(crate) fn from_name(name: &str) -> Option<ForceLaw> {
         match name {
             "hertz" => Some(ForceLaw::Hertz),
             "dmt" => Some(ForceLaw::Dmt),
@@ -91,13 +91,13 @@ pub const YOUNGS_MODULUS: &str = "sample.youngs_modulus";
 /// `tip.radius` (m).
 pub const RADIUS: &str = "tip.radius";
 /// `contact_point` (m): the tip position where δ = 0, after `correct_tip_offset`.
-pub const CONTACT_POINT: &str = "contact_point";
+pub(crate) const CONTACT_POINT: &str = "contact_point";
 /// `baseline` (N): the force far from the sample, after `correct_force_offset`.
-pub const BASELINE: &str = "baseline";
+pub(crate) const BASELINE: &str = "baseline";
 /// `sample.hamaker` (J), DMT's.
-pub const HAMAKER: &str = "sample.hamaker";
+pub(crate) const HAMAKER: &str = "sample.hamaker";
 /// `sample.adhesion_energy` (J/m²), JKR's work of adhesion W.
-pub const ADHESION: &str = "sample.adhesion_energy";
+pub(crate) const ADHESION: &str = "sample.adhesion_energy";
 /// `sample.stiffness` (N/m): the SLS's relaxed spring k₁ ([`super::sls_curve`]).
 pub const STIFFNESS: &str = "sample.stiffness";
 /// `sample.maxwell_stiffness` (N/m): the SLS Maxwell arm's spring k₂.
@@ -152,7 +152,7 @@ impl Preprocessed {
 
 /// nanite's `deviation_from_baseline` on `force` (module docs, step 2): the first index whose
 /// force exceeds the first 10 %'s mean by twice their largest deviation.
-pub fn deviation_from_baseline(force: &[f64]) -> Option<usize> {
+pub(crate) fn deviation_from_baseline(force: &[f64]) -> Option<usize> {
     let n = force.len() / 10;
     if n == 0 {
         return None;

@@ -71,7 +71,7 @@ pub trait CurveModel {
 ///
 /// # Errors
 /// [`SimError::Cancelled`] when `progress` is cancelled before the evaluation ends.
-pub fn evaluate_in(
+pub(crate) fn evaluate_in(
     model: &dyn CurveModel,
     p: &[f64],
     values: &mut [f64],
@@ -257,7 +257,7 @@ pub fn chi2(model: &dyn CurveModel, obs: &Observations, p: &[f64]) -> f64 {
 ///
 /// # Errors
 /// [`SimError::Cancelled`] when `progress` is cancelled.
-pub fn chi2_in(
+pub(crate) fn chi2_in(
     model: &dyn CurveModel,
     obs: &Observations,
     p: &[f64],

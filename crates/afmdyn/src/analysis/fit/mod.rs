@@ -13,7 +13,7 @@ pub mod estimates;
 pub mod fm_curve;
 pub mod force_curve;
 pub mod least_squares;
-pub mod orbit_param;
+pub(crate) mod orbit_param;
 pub mod profile;
 pub mod sensitivity;
 pub mod sensitivity_jkr;

@@ -44,7 +44,7 @@ pub const SECANT_TOLERANCE: f64 = 0.05;
 /// The relative tolerance of a profile's refits (MINPACK's ftol, xtol, gtol): χ² to 1e-7
 /// relative is Δχ² to 1e-4 at χ² = 1000 (m = 1000 points), far inside
 /// [`SECANT_TOLERANCE`]; the fit's own minimum keeps [`super::least_squares::TOLERANCE`].
-pub const REFIT_TOLERANCE: f64 = 1e-7;
+pub(crate) const REFIT_TOLERANCE: f64 = 1e-7;
 
 /// The patience of a profile's refits (the minimiser stops after `REFIT_PATIENCE` × (n + 1)
 /// residual evaluations, [`super::least_squares::PATIENCE`]): a refit starts from its

@@ -98,7 +98,7 @@ pub fn d_force(
 /// ∂g/∂p of the guard of `mode` (module docs, *The guards*) for p = α4 and P̃ under JKR
 /// (Hertz group α4 = `alpha4`, adhesion P̃ = `adhesion`): 0 in free flight,
 /// (2/3)δ_b/α4 and −(2/3)δ_b/P̃ in contact; `None` for the other parameters.
-pub fn d_guard(alpha4: f64, adhesion: f64, mode: Region, param: OrbitParam) -> Option<f64> {
+pub(crate) fn d_guard(alpha4: f64, adhesion: f64, mode: Region, param: OrbitParam) -> Option<f64> {
     let scale = match param {
         OrbitParam::ContactStiffness => 1.0 / alpha4,
         OrbitParam::Adhesion => -1.0 / adhesion,

@@ -9,15 +9,15 @@ use crate::analysis::progress::Progress;
 use crate::error::SimError;
 
 /// Half the number of steps of z_offset's start grid: the starts −6 … 6 steps.
-pub const Z_OFFSET_GRID: i32 = 6;
+pub(crate) const Z_OFFSET_GRID: i32 = 6;
 
 /// The step of z_offset's start grid, in g₀ = A₀ (the grid spans ±0.3 A₀, within which the
 /// free amplitude's far rows and the curve's onset place the contact point).
-pub const Z_OFFSET_STEP: f64 = 0.05;
+pub(crate) const Z_OFFSET_STEP: f64 = 0.05;
 
 /// z_offset's start grid (m): −[`Z_OFFSET_GRID`] … [`Z_OFFSET_GRID`] steps of
 /// [`Z_OFFSET_STEP`] `g0` (`g0` = A₀ in m), 13 values from −0.3 A₀ to 0.3 A₀, ascending.
-pub fn z_offset_grid(g0: f64) -> impl Iterator<Item = f64> {
+pub(crate) fn z_offset_grid(g0: f64) -> impl Iterator<Item = f64> {
     (-Z_OFFSET_GRID..=Z_OFFSET_GRID).map(move |i| i as f64 * Z_OFFSET_STEP * g0)
 }
 
@@ -31,7 +31,7 @@ pub fn z_offset_grid(g0: f64) -> impl Iterator<Item = f64> {
 ///
 /// # Panics
 /// When `k` is not an index of `params`.
-pub fn grid_start(
+pub(crate) fn grid_start(
     model: &dyn CurveModel,
     obs: &Observations,
     params: &[Parameter],

@@ -20,7 +20,7 @@ use serde::Serialize;
 pub const FIT_BAND: (f64, f64) = (0.3, 0.9);
 
 /// Fewest retract points in the band for a fit.
-pub const MIN_FIT_POINTS: usize = 5;
+pub(crate) const MIN_FIT_POINTS: usize = 5;
 
 /// A DMT fit of a retract curve (model units: g₀, F̃).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]

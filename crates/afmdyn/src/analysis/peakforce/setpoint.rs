@@ -20,7 +20,7 @@ pub const SETPOINT_TOL: f64 = 1e-6;
 pub const BRACKET_STEPS: usize = 12;
 /// Points passed over at the bracket's far end whose tap does not settle (each 0.05 α2
 /// farther out).
-pub const UNSETTLED_SKIPS: usize = 4;
+pub(crate) const UNSETTLED_SKIPS: usize = 4;
 /// Iterations of false position.
 pub const SETPOINT_ITERATIONS: usize = 80;
 

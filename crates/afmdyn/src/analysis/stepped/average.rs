@@ -44,7 +44,7 @@ pub const RESOLVED_HARMONIC: u32 = 10;
 pub const BEAT_DENOMINATOR: u32 = 32;
 /// Beats of [`slowest_beat`] per settling window: 3 or more put the beat's sidebands on the
 /// zeros of the Hann² window's transform (it vanishes at every whole bin from the third on).
-pub const BEATS_PER_WINDOW: f64 = 4.0;
+pub(crate) const BEATS_PER_WINDOW: f64 = 4.0;
 /// Longest settling window the defaults choose ([`AverageOptions::for_model`]): a slower beat
 /// leaves the point unsettled, and the warning says why.
 pub const MAX_DEFAULT_WINDOW: usize = 4096;

@@ -88,7 +88,7 @@ pub enum Spacing {
 
 /// A multifrequency drive whose common period spans more drive periods than this gets a
 /// warning on its curves: each orbit costs that many periods (the example's 25/4 takes 4).
-pub const SLOW_COMMON_PERIODS: u64 = 32;
+pub(crate) const SLOW_COMMON_PERIODS: u64 = 32;
 
 /// Grid points of a curve request that gives neither a step nor a count.
 pub const DEFAULT_CURVE_POINTS: usize = 120;
@@ -242,7 +242,7 @@ pub enum Reached {
 impl Reached {
     /// Whether the point was reached by integrating the transient ([`Reached::Settled`],
     /// [`Reached::Averaged`]): not on the branch of the point before.
-    pub fn by_transient(self) -> bool {
+    pub(crate) fn by_transient(self) -> bool {
         matches!(self, Reached::Settled | Reached::Averaged)
     }
 }
@@ -561,7 +561,7 @@ pub fn stepped_sweep(spec: &SteppedSpec) -> Result<SteppedCurve, SimError> {
 ///
 /// # Errors
 /// As [`stepped_sweep`]; [`SimError::Cancelled`] once `progress` is cancelled.
-pub fn stepped_sweep_with(
+pub(crate) fn stepped_sweep_with(
     spec: &SteppedSpec,
     progress: &Progress,
 ) -> Result<SteppedCurve, SimError> {

@@ -93,7 +93,7 @@ use spectral::Spectral;
 use std::sync::Arc;
 
 /// Bound on ‖Ã‖₂ h for the grid step (radians of the fastest mode per step).
-pub const THETA: f64 = 4.0;
+pub(crate) const THETA: f64 = 4.0;
 /// Number of Taylor terms kept in partial steps and tip polynomials (‖Ãt‖ ≤ θ = 4:
 /// θ^40/40! ≈ 1.5e-24, below round-off even after the largest term, θ⁴/4! ≈ 11).
 const K: usize = 39;

@@ -65,7 +65,7 @@ impl ExactPropagator {
 
     /// Jacobian ∂z(τ1)/∂z(τ0) of the flow over the last step [τ0, τ1] inside its region
     /// (without the saltation at a switching that ends it), 2N×2N: Φ_s or e^{A_s t}.
-    pub fn step_transition(&self) -> DMatrix<f64> {
+    pub(crate) fn step_transition(&self) -> DMatrix<f64> {
         let dim = self.z.len();
         let mut out = DMatrix::zeros(dim, dim);
         self.step_transition_into(&mut out);

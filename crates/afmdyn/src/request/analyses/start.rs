@@ -169,7 +169,7 @@ pub fn initial_state(
 
 /// [`StartRequest::guess_with_section`]: the guess, the period found, the recorded section
 /// points (each of shape `[2N]`).
-pub type GuessWithSection = (DVector<f64>, Option<usize>, Vec<DVector<f64>>);
+pub(crate) type GuessWithSection = (DVector<f64>, Option<usize>, Vec<DVector<f64>>);
 
 /// Where an orbit analysis starts: a given state, or the steady state reached from rest.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
@@ -216,7 +216,7 @@ impl StartRequest {
     ///
     /// # Errors
     /// As [`Self::guess`].
-    pub fn guess_with_section(
+    pub(crate) fn guess_with_section(
         &self,
         model: &CantileverModel,
     ) -> Result<GuessWithSection, SimError> {

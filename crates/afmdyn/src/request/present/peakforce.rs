@@ -10,7 +10,7 @@ use serde_json::Value;
 use std::path::Path;
 
 /// The columns of the cycle's table (`peakforce-cycle.csv`, Python's Dataset variables).
-pub const CYCLE_COLUMNS: [&str; 4] = ["time", "deflection", "distance", "force"];
+pub(crate) const CYCLE_COLUMNS: [&str; 4] = ["time", "deflection", "distance", "force"];
 /// The columns of the force–distance curve's table (`peakforce-curve.csv`): approach and
 /// retract side by side (the retract has as many points as the approach, or one more).
 pub const CURVE_COLUMNS: [&str; 4] = [
@@ -22,7 +22,8 @@ pub const CURVE_COLUMNS: [&str; 4] = [
 
 /// The columns the curve's table adds with the instrument's filter (`filter_cutoff`): the
 /// measured force k × deflection through it, approach and retract.
-pub const FILTERED_COLUMNS: [&str; 2] = ["approach_filtered_force", "retract_filtered_force"];
+pub(crate) const FILTERED_COLUMNS: [&str; 2] =
+    ["approach_filtered_force", "retract_filtered_force"];
 
 /// A numeric array of the document at `block.name` (empty when absent).
 fn column(doc: &Value, block: &str, name: &str) -> Vec<f64> {

@@ -10,7 +10,7 @@ use serde_json::{json, Value};
 use std::collections::HashSet;
 
 /// The palette index of a period class: 1, 2, 3, 4, 5–8, 9–64, nonperiodic (and failed).
-pub fn period_color(period: f64) -> usize {
+pub(crate) fn period_color(period: f64) -> usize {
     match period as i64 {
         1 => 0,
         2 => 1,
@@ -141,7 +141,7 @@ pub const BIFURCATION_FIGURES: [(&str, usize, &str, &str, bool); 3] = [
 ];
 
 /// A legend entry: label, palette index, drawn as a marker.
-pub type Legend = (String, usize, bool);
+pub(crate) type Legend = (String, usize, bool);
 
 impl SweepTally {
     /// Count a row.

@@ -59,12 +59,12 @@ impl Series {
     }
 
     /// The state at s (τ − τ₀ in free flight, σ in contact) into `out` (d), by Horner's scheme.
-    pub fn state_at(&self, s: f64, out: &mut [f64]) {
+    pub(crate) fn state_at(&self, s: f64, out: &mut [f64]) {
         with_width!(self.d / 2, w => horner_fixed(w, &self.z, self.p, s, out))
     }
 
     /// Φ at s into `out` (d², column-major).
-    pub fn jacobian_at(&self, s: f64, out: &mut [f64]) {
+    pub(crate) fn jacobian_at(&self, s: f64, out: &mut [f64]) {
         let dd = self.d * self.d;
         horner_vec(&self.phi, dd, self.p, s, out);
     }
@@ -72,7 +72,7 @@ impl Series {
     /// ∞-norms of the coefficients of order k of everything the step carries (state, Φ, the
     /// drive's sin Ωτ and cos Ωτ — the energy balance integrates products with them —, and in
     /// contact τ − τ₀ and w): the input of the step-size rule.
-    pub fn order_norm(&self, k: usize) -> f64 {
+    pub(crate) fn order_norm(&self, k: usize) -> f64 {
         let d = self.d;
         let mut m = self.z[k * d..(k + 1) * d]
             .iter()
@@ -93,7 +93,7 @@ impl Series {
     }
 
     /// The indentation δ = −V_T (contact).
-    pub fn depth(&self) -> &[f64] {
+    pub(crate) fn depth(&self) -> &[f64] {
         &self.del[..=self.p]
     }
 
