@@ -24,3 +24,20 @@ mod reconstruct;
 mod request_flags;
 mod silent_answers;
 mod wasm_api;
+
+/// Every tests/*.rs file is a module above: with `autotests = false` cargo no longer builds a
+/// new file by itself, which would then run nothing.
+#[test]
+fn every_test_file_is_built() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let main = include_str!("main.rs");
+    for entry in std::fs::read_dir(root.join("tests")).unwrap() {
+        let name = entry.unwrap().file_name().into_string().unwrap();
+        if let Some(stem) = name.strip_suffix(".rs").filter(|s| *s != "main") {
+            assert!(
+                main.contains(&format!("\nmod {stem};\n")),
+                "tests/{name} is in no test binary: add `mod {stem};` to tests/main.rs"
+            );
+        }
+    }
+}

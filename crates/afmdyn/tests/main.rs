@@ -77,3 +77,22 @@ mod taylor;
 mod time_average;
 mod tip_sample;
 mod torus;
+
+/// Every tests/*.rs file is a module above or a binary of its own in Cargo.toml: with
+/// `autotests = false` cargo no longer builds a new file by itself, which would then run nothing.
+#[test]
+fn every_test_file_is_built() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let main = include_str!("main.rs");
+    let manifest = std::fs::read_to_string(root.join("Cargo.toml")).unwrap();
+    for entry in std::fs::read_dir(root.join("tests")).unwrap() {
+        let name = entry.unwrap().file_name().into_string().unwrap();
+        if let Some(stem) = name.strip_suffix(".rs").filter(|s| *s != "main") {
+            assert!(
+                main.contains(&format!("\nmod {stem};\n"))
+                    || manifest.contains(&format!("path = \"tests/{name}\"")),
+                "tests/{name} is in no test binary: add `mod {stem};` to tests/main.rs"
+            );
+        }
+    }
+}
