@@ -2,8 +2,8 @@
 """Generate the request part of the Python stubs from the library's request schemas.
 
 The requests (``crates/afmdyn/src/request``) are the one signature of every analysis: their
-JSON Schemas (``docs/schema/requests/*.json``, written by
-``AFMDYN_WRITE_SCHEMA=1 cargo test --release -p afmdyn --test schema``) give each keyword's
+JSON Schemas (``docs/schema/requests/*.json``, written by ``AFMDYN_WRITE_SCHEMA=1 cargo
+test --release -p afmdyn --test main schema::``) give each keyword's
 type and default. This script writes, between the markers in
 ``crates/afmdyn-py/python/afmdyn/_afmdyn.pyi``, a ``TypedDict`` per request (its keys, types
 and defaults), the overloads of the one door ``run`` and of ``run_stored`` (the studies run into

@@ -7,7 +7,7 @@
 //! `--average` measures the same points by the time average, within its error estimates of
 //! the orbits; an incommensurate ratio is averaged without being asked, and says so.
 
-mod common;
+use crate::common;
 use common::{column, run as afmdyn};
 
 const PROBE: &str = concat!(

@@ -4,7 +4,7 @@
 //! (d from 3a₀ to A/2, where the inversion's own error is below 1 % on this grid); the files;
 //! bad input exits 2 with one line naming the flag.
 
-mod common;
+use crate::common;
 use common::{column, run as afmdyn};
 use std::process::Output;
 

@@ -1,7 +1,7 @@
 //! Issue 60, part D: a refusal names what the user gave and can change, and a damaged store is
 //! recovered, not reported as a cancellation.
 
-mod common;
+use crate::common;
 use common::{refused, run};
 
 /// `image --feedback pi --gains 0,1e12` without `--scan-rate` blamed "scan-rate = 1.25e10",

@@ -1,7 +1,7 @@
 //! `afmdyn peakforce` end to end: the example probe's steady tap as one JSON document with the
 //! instrument's channels in SI; bad input exits 2 naming the flag.
 
-mod common;
+use crate::common;
 use common::run as afmdyn;
 
 const AIR: &str = concat!(

@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-mod common;
+use crate::common;
 use common::{column, json, repo, run};
 
 /// The probe's parameters reach the model: `modes` reports the first free frequency f₀ of the

@@ -1,7 +1,7 @@
 //! What the command line prints under a probe: text summaries in SI with the prefixes of
 //! `--units`, and the chart's CSV lengths in metres (issue 42).
 
-mod common;
+use crate::common;
 use common::{json, text};
 
 /// The text summaries of `orbit`, `modes`, `lyapunov` and `continue` speak SI under a probe,

@@ -4,7 +4,7 @@
 //! field, `--no-<field>` for a boolean on by default — and the default `--help` shows for it
 //! is the request's, value for value.
 
-mod common;
+use crate::common;
 
 use afmdyn::request::image::ImageRequest;
 use afmdyn::request::{

@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-mod common;
+use crate::common;
 use common::{json, refused, run};
 
 /// A probe file written into a fresh temporary directory.

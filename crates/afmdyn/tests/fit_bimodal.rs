@@ -23,7 +23,7 @@ use afmdyn::Params;
 use nalgebra::DVector;
 use std::path::Path;
 
-mod common;
+use crate::common;
 use common::orbit_params::{newton, probe, value_of, with};
 
 /// The adaptive integrator's tolerance of the sensitivities and of the finite differences.

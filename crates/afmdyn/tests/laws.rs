@@ -18,7 +18,7 @@ use afmdyn::{CantileverModel, ContactLaw, EventKind, Params, SweepParam};
 use nalgebra::{Complex, DMatrix, DVector};
 use proptest::prelude::*;
 
-mod common;
+use crate::common;
 use common::laws::{CAP, DMT, ES, JKR, SLS};
 use common::{events_until, impact_model, opts};
 
@@ -402,7 +402,11 @@ fn fd_flow_jacobian(m: &CantileverModel, z0: &DVector<f64>, t1: f64, eps: f64) -
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 6, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig {
+        cases: 6,
+        failure_persistence: crate::common::regressions_beside_the_source(),
+        ..ProptestConfig::default()
+    })]
     /// The Jacobian of the flow over one period (variational equations × saltation matrices)
     /// equals central differences of the flow, for Hertz, DMT (Kelvin–Voigt tangent coordinates),
     /// the electrostatic law, JKR (the force jumps where the neck forms and breaks), the

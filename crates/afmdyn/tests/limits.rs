@@ -106,7 +106,11 @@ fn magnitude(max: f64) -> impl Strategy<Value = f64> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 32, .. ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig {
+        cases: 32,
+        failure_persistence: crate::common::regressions_beside_the_source(),
+        ..ProptestConfig::default()
+    })]
 
     /// Anywhere in the allowed box (and with states up to 1e6): building either fails with a
     /// typed error or yields an integrator whose steps finish quickly with a finite state or a

@@ -18,7 +18,7 @@ use afmdyn::{CantileverModel, ContactLaw, Params, SimError};
 use nalgebra::DVector;
 use std::f64::consts::PI;
 
-mod common;
+use crate::common;
 use common::events_until;
 
 fn sls(kappa: f64) -> ContactLaw {

@@ -15,7 +15,7 @@ use afmdyn::{CantileverModel, ContactLaw, Params, SweepParam};
 use nalgebra::{Complex, DMatrix, DVector};
 use proptest::prelude::*;
 
-mod common;
+use crate::common;
 use common::{events_until, harmonic_response};
 
 fn model(p: Params) -> CantileverModel {
@@ -36,7 +36,11 @@ fn attractor(m: &CantileverModel) -> (DVector<f64>, Option<usize>) {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 24, .. ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig {
+        cases: 24,
+        failure_persistence: crate::common::regressions_beside_the_source(),
+        ..ProptestConfig::default()
+    })]
 
     /// The analytic monodromy (step propagators × saltation matrices) equals a central
     /// finite-difference Jacobian of the one-period map.

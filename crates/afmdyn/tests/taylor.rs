@@ -11,7 +11,7 @@ use afmdyn::integrate::{build, IntegratorKind, IntegratorOptions};
 use afmdyn::request::analyses::OrbitRequest;
 use afmdyn::{CantileverModel, ContactLaw, Params};
 
-mod common;
+use crate::common;
 use common::{against_adaptive_oracle, events_until, harmonic_response};
 
 const DMT: ContactLaw = ContactLaw::Dmt {

@@ -17,7 +17,7 @@ use afmdyn::probe::Probe;
 use afmdyn::{CantileverModel, Params};
 use nalgebra::DVector;
 
-mod common;
+use crate::common;
 use common::opts;
 
 /// The eigenmode lever of `common::bimodal_lever` (k = [40, 1571] N/m, f₁ = 300 kHz, Q =

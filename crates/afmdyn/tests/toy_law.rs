@@ -8,7 +8,7 @@
 //! From those alone it runs through the registry (parser, serde form, descriptors, the groups'
 //! owners), the request schema and a request, the force law's identities, an orbit (shooting)
 //! and an approach (stepped curve); the conformance suite takes every registered law, so
-//! `cargo test -p afmdyn --features toy-law --test conformance` runs its cases on it too.
+//! `cargo test -p afmdyn --features toy-law --test main conformance::` runs its cases on it too.
 #![cfg(feature = "toy-law")]
 
 use afmdyn::analysis::approach::{approach_retract, approach_spec};

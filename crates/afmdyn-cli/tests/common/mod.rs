@@ -1,5 +1,4 @@
 //! Helpers of the command line's test files: the binary run in the repository's root.
-#![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

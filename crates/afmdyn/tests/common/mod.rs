@@ -1,7 +1,5 @@
 //! Test helpers shared by the integration tests: the closed-form forced response of a region
 //! and the events of a run.
-// each test file uses some of them
-#![allow(dead_code)]
 
 #[cfg(feature = "files")]
 pub mod am_synthetic;
@@ -19,6 +17,18 @@ use afmdyn::integrate::{
 use afmdyn::request::analyses::OrbitRequest;
 use afmdyn::{CantileverModel, ContactLaw, HybridSystem, SimError};
 use nalgebra::{Complex, DMatrix, DVector};
+use proptest::test_runner::{FailurePersistence, FileFailurePersistence};
+
+/// Where a `proptest!` block keeps its failing cases: next to its source file, with the
+/// extension `proptest-regressions` (`laws.rs` → `laws.proptest-regressions`). Proptest's
+/// default would put them in `../proptest-regressions/laws.txt` now that `tests/` has a
+/// `main.rs` (the default looks for a `lib.rs` or `main.rs` above the file, and fell back to
+/// this place while the tests were binaries of their own).
+pub fn regressions_beside_the_source() -> Option<Box<dyn FailurePersistence>> {
+    Some(Box::new(FileFailurePersistence::WithSource(
+        "proptest-regressions",
+    )))
+}
 
 /// The complex amplitude â of region `r`'s linear response a = Re(â e^{iΩτ}) to its harmonic
 /// forcing: (K − Ω²M + iΩC) â = F_cos − i F_sin (eq. 10, shape `[N]`).
@@ -68,7 +78,7 @@ pub fn events_until(integ: &mut dyn Integrator, tau_end: f64) -> Vec<SwitchEvent
 
 /// An integrator against the adaptive DOP853 integrator at 1e-14 (the oracle), and DOP853 at
 /// the integrator's own tolerance: see [`against_adaptive_oracle`].
-#[allow(dead_code)]
+#[allow(dead_code)] // `work` is read by no test at present
 pub struct OracleComparison {
     /// Events of the run.
     pub events: usize,
@@ -86,7 +96,6 @@ pub struct OracleComparison {
 /// `tol`, against the adaptive DOP853 integrator at 1e-14: the events matched one to one in
 /// kind and regions (asserted; each on its guard to 1e-10), the largest differences of event
 /// times and of the final state.
-#[allow(dead_code)]
 pub fn against_adaptive_oracle(
     m: &CantileverModel,
     kind: IntegratorKind,
@@ -128,7 +137,6 @@ pub fn against_adaptive_oracle(
 
 /// Whether `built` is [`SimError::Unsupported`] naming `integrator` (and `law`, when given): an
 /// integrator refusing a law it does not integrate.
-#[allow(dead_code)]
 pub fn is_refusal<T>(built: &Result<T, SimError>, integrator: &str, law: Option<&str>) -> bool {
     matches!(built, Err(SimError::Unsupported { integrator: i, law: l, .. })
         if *i == integrator && law.is_none_or(|w| *l == w))
@@ -136,7 +144,6 @@ pub fn is_refusal<T>(built: &Result<T, SimError>, integrator: &str, law: Option<
 
 /// `law` without its long-range attraction (DMT with H̃ = 0; the other laws as they are): a
 /// sample out of reach then exerts no force.
-#[allow(dead_code)]
 pub fn without_attraction(law: ContactLaw) -> ContactLaw {
     match law {
         ContactLaw::Dmt {

@@ -30,6 +30,7 @@ pub fn orbit(params: &Params, guess: &DVector<f64>, tol: f64) -> OrbitSensitivit
 
 /// Check the exact sensitivities at the orbit near `guess` against central differences;
 /// `false` (nothing checked) where the orbit is near a fold or grazing.
+#[allow(dead_code)] // no test calls it at present (fit_bimodal.rs has its own)
 pub fn check_point(base: &Params, guess: &DVector<f64>, params: &[OrbitParam], what: &str) -> bool {
     check_point_at(base, guess, params, what, TOL)
 }
