@@ -859,6 +859,8 @@ fn every_example_probe_loads_and_the_hysteretic_ones_approach() {
             "--points",
             "16",
             "--no-branches",
+            "--files",
+            "none",
             "--json",
         ]);
         assert_eq!(doc["params"]["contact_law"]["law"], law);
@@ -924,6 +926,8 @@ fn a_viscoelastic_sample_in_water_approaches_from_its_probe_file() {
         "--points",
         "24",
         "--no-branches",
+        "--files",
+        "none",
         "--json",
     ]);
     assert_eq!(doc["params"]["contact_law"]["law"], "sls");

@@ -63,6 +63,9 @@ fn an_approach_curve_from_a_probe_is_the_command_lines() {
     let path = "examples/probe-point-mass-dmt.toml";
     let text =
         std::fs::read_to_string(format!("{}/../../{path}", env!("CARGO_MANIFEST_DIR"))).unwrap();
+    // its own output directory: the command line locks it, and other tests run beside this one
+    let out = tempfile::tempdir().unwrap();
+    let out = out.path().to_str().unwrap();
     assert_eq!(
         wasm(
             "approach",
@@ -76,6 +79,8 @@ fn an_approach_curve_from_a_probe_is_the_command_lines() {
             "40",
             "--setpoint",
             "0.7",
+            "--out",
+            out,
             "--json"
         ])
     );
