@@ -66,6 +66,20 @@ pub fn bounds(name: &str) -> (f64, f64) {
     (lo, hi)
 }
 
+/// The probe's value `v` of `key`, which the fit needs.
+///
+/// # Errors
+/// [`SimError::OutOfRange`] naming `probe` and `key` when the probe lacks it.
+pub fn probe_value(v: Option<f64>, key: &str) -> Result<f64, crate::error::SimError> {
+    v.ok_or_else(|| {
+        crate::error::SimError::out_of_range(
+            "probe",
+            key,
+            format!("the fit needs the probe's {key}"),
+        )
+    })
+}
+
 /// The result of a `fit` request.
 #[derive(Debug, Clone)]
 pub struct FitResult {
