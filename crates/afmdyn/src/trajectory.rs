@@ -410,25 +410,19 @@ fn round_off(tau: f64) -> f64 {
     1e-12 * (1.0 + tau.abs())
 }
 
-/// The transient and the recorded length of `spec`: finite and ≥ 0.
+/// The transient and the recorded length of `spec`: both finite, then both ≥ 0.
 fn check_lengths(spec: &RecordSpec) -> Result<(), SimError> {
-    finite("transient_periods", spec.transient_periods)?;
-    finite("record_tau", spec.record_tau)?;
-    if spec.transient_periods < 0.0 {
-        return Err(SimError::out_of_range(
-            "transient_periods",
-            spec.transient_periods,
-            "must be >= 0",
-        ));
+    let lengths = [
+        ("transient_periods", spec.transient_periods),
+        ("record_tau", spec.record_tau),
+    ];
+    for (name, v) in lengths {
+        finite(name, v)?;
     }
-    if spec.record_tau < 0.0 {
-        return Err(SimError::out_of_range(
-            "record_tau",
-            spec.record_tau,
-            "must be >= 0",
-        ));
+    match lengths.into_iter().find(|&(_, v)| v < 0.0) {
+        Some((name, v)) => Err(SimError::out_of_range(name, v, "must be >= 0")),
+        None => Ok(()),
     }
-    Ok(())
 }
 
 /// The samples τ_i = start + i·dt of a recording that ends at `end`: the next one's index and

@@ -271,10 +271,13 @@ fn section_variables(model: &CantileverModel, tr: &Trajectory, su: &SeriesUnits)
     ]
 }
 
+/// A term of the energy balance: its name, long name and value.
+type EnergyTerm = (&'static str, &'static str, fn(&EnergyBalance) -> f64);
+
 /// The energy balance per period `[cycle]`: the period's start, then each term.
 fn energy_variables(tr: &Trajectory, su: &SeriesUnits) -> Vec<Variable> {
     let names = su.names();
-    let terms: [(&str, &str, fn(&EnergyBalance) -> f64); 6] = [
+    let terms: [EnergyTerm; 6] = [
         ("energy_start", "stored energy at the start", |e| e.e_start),
         ("energy_end", "stored energy at the end", |e| e.e_end),
         ("base_work", "work of the base drive", |e| e.base_work),

@@ -4,6 +4,7 @@
 
 use crate::analysis::fit::force_curve::{ForceLaw, Preprocessed};
 use crate::analysis::fit::FitOutcome;
+use crate::error::SimError;
 use crate::probe::ranges::si_range;
 
 /// The variables of a dynamic fit's curve (name, unit, label): the columns of its table and
@@ -70,13 +71,9 @@ pub fn bounds(name: &str) -> (f64, f64) {
 ///
 /// # Errors
 /// [`SimError::OutOfRange`] naming `probe` and `key` when the probe lacks it.
-pub fn probe_value(v: Option<f64>, key: &str) -> Result<f64, crate::error::SimError> {
+pub fn probe_value(v: Option<f64>, key: &str) -> Result<f64, SimError> {
     v.ok_or_else(|| {
-        crate::error::SimError::out_of_range(
-            "probe",
-            key,
-            format!("the fit needs the probe's {key}"),
-        )
+        SimError::out_of_range("probe", key, format!("the fit needs the probe's {key}"))
     })
 }
 

@@ -200,7 +200,8 @@ impl ExactPropagator {
     }
 
     /// The time after τ0 of the leftmost switching in the step of `len` that ends at (V_T, its
-    /// rate) = `vt_b`, `None` where the ends' certified test rules one out or the search finds none.
+    /// rate) = `vt_b`; `None` where the ends' certified test rules one out or the search finds
+    /// none.
     #[inline(always)]
     fn first_switching(&mut self, tau0: f64, len: f64, vt_b: (f64, f64)) -> Option<f64> {
         let ri = self.region.index();
