@@ -71,7 +71,7 @@ pub fn bounds(name: &str) -> (f64, f64) {
 ///
 /// # Errors
 /// [`SimError::OutOfRange`] naming `probe` and `key` when the probe lacks it.
-pub fn probe_value(v: Option<f64>, key: &str) -> Result<f64, SimError> {
+pub(crate) fn probe_value(v: Option<f64>, key: &str) -> Result<f64, SimError> {
     v.ok_or_else(|| {
         SimError::out_of_range("probe", key, format!("the fit needs the probe's {key}"))
     })
