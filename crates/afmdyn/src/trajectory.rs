@@ -6,7 +6,7 @@ pub mod chunked;
 
 use crate::error::{finite, SimError};
 use crate::galerkin::Region;
-use crate::integrate::{advance, Integrator, Observed, SwitchEvent};
+use crate::integrate::{advance, Integrator, Observed, Step, SwitchEvent};
 use crate::model::{weighted_displacement, BodyContactCheck, CantileverModel};
 use crate::system::EventKind;
 use gauss_quad::legendre::GaussLegendre;
@@ -65,6 +65,18 @@ pub struct EnergyBalance {
 }
 
 impl EnergyBalance {
+    /// The balance of a period that starts at `tau0` with the stored energy `e_start`.
+    fn open(tau0: f64, e_start: f64) -> Self {
+        EnergyBalance {
+            tau0,
+            e_start,
+            e_end: 0.0,
+            base_work: 0.0,
+            beam_dissipation: 0.0,
+            contact_dissipation: 0.0,
+        }
+    }
+
     /// (e_end − e_start) − (base_work − beam_dissipation − contact_dissipation).
     pub fn residual(&self) -> f64 {
         (self.e_end - self.e_start)
@@ -310,22 +322,7 @@ pub fn record_rows(
     spec: &RecordSpec,
     rows: &mut SampleRows,
 ) -> Result<Trajectory, SimError> {
-    finite("transient_periods", spec.transient_periods)?;
-    finite("record_tau", spec.record_tau)?;
-    if spec.transient_periods < 0.0 {
-        return Err(SimError::out_of_range(
-            "transient_periods",
-            spec.transient_periods,
-            "must be >= 0",
-        ));
-    }
-    if spec.record_tau < 0.0 {
-        return Err(SimError::out_of_range(
-            "record_tau",
-            spec.record_tau,
-            "must be >= 0",
-        ));
-    }
+    check_lengths(spec)?;
     let model =
         crate::tip_sample::require_cantilever(integ.system(), "the recorded trajectory")?.clone();
     let period = model.period();
@@ -337,24 +334,26 @@ pub fn record_rows(
     rows.clear();
     let mut out = Trajectory::default();
     let body = spec.body_contact.then(|| BodyContactCheck::new(&model, 64));
-    let gl = GaussLegendre::new(NonZeroUsize::new(12).expect("nonzero"));
     let spp = spec.samples_per_period;
     let dt = if spp > 0 {
         period / spp as f64
     } else {
         f64::INFINITY
     };
-    let tol = |t: f64| 1e-12 * (1.0 + t.abs());
-    let mut phase = SamplePhase::new(model.omega(), dt);
-    let mut states = vec![0.0; SAMPLE_BATCH * dim];
-    // the next sample's index
-    let mut i_next = 0u64;
+    let mut sampler = Sampler {
+        start,
+        dt,
+        end,
+        next: 0,
+        phase: SamplePhase::new(model.omega(), dt),
+        states: vec![0.0; SAMPLE_BATCH * dim],
+    };
     let mut k_period = (start / period).ceil() as i64;
     if spp > 0 {
-        let sc = phase.at(0, integ.tau());
+        let sc = sampler.phase.at(0, integ.tau());
         let (tau, r) = (integ.tau(), integ.region());
         rows.push(&model, r, tau, sc, integ.state().as_slice());
-        i_next = 1;
+        sampler.next = 1;
     }
     let record_section = |tau: f64, z: &DVector<f64>, out: &mut Trajectory, k_period: &mut i64| {
         out.poincare.push((tau, z.clone()));
@@ -362,137 +361,36 @@ pub fn record_rows(
     };
     let at_section = |tau: f64, k_period: i64| {
         let t_sec = k_period as f64 * period;
-        tau == t_sec || (tau - t_sec).abs() <= tol(tau)
+        tau == t_sec || (tau - t_sec).abs() <= round_off(tau)
     };
     if at_section(integ.tau(), k_period) {
         let tau = integ.tau();
         record_section(tau, integ.state(), &mut out, &mut k_period);
     }
-    let mut acc = EnergyBalance {
-        tau0: integ.tau(),
-        e_start: model.energy(integ.region(), integ.tau(), integ.state()),
-        e_end: 0.0,
-        base_work: 0.0,
-        beam_dissipation: 0.0,
-        contact_dissipation: 0.0,
-    };
-    let mut next_energy_cut = (k_period as f64) * period;
-    if next_energy_cut <= integ.tau() {
-        next_energy_cut += period;
-    }
+    let mut balance = Balance::new(&model, integ, (k_period as f64) * period);
     while integ.tau() < end {
         let next_section = k_period as f64 * period;
         // a span proven free of body contact is checked at its end only
         let step = crate::integrate::step_span(integ, end.min(next_section), body.as_ref())?;
-        let closed = if spec.energy && step.tau1 > step.tau0 {
-            integ.last_step_rate_integrals()
-        } else {
-            None
-        };
-        if let Some([pb, db, dc]) = closed {
-            acc.base_work += pb;
-            acc.beam_dissipation += db;
-            acc.contact_dissipation += dc;
-        } else if spec.energy && step.tau1 > step.tau0 {
-            let r = step.region;
-            let (mut pb, mut db, mut dc) = (0.0, 0.0, 0.0);
-            for (x, w) in gl.iter() {
-                let tau = 0.5 * (step.tau1 - step.tau0) * (x + 1.0) + step.tau0;
-                let z = integ.dense_state(tau);
-                let p = model.power(r, tau, &z);
-                pb += w * p.base;
-                db += w * p.beam_dissipation;
-                dc += w * p.contact_dissipation;
-            }
-            let half = 0.5 * (step.tau1 - step.tau0);
-            acc.base_work += half * pb;
-            acc.beam_dissipation += half * db;
-            acc.contact_dissipation += half * dc;
+        if spec.energy && step.tau1 > step.tau0 {
+            balance.add_step(&model, integ, &step);
         }
-        // the samples inside the step, from its dense output; at its end after an event, and
-        // beyond the end of the recording by round-off, the state there
         if spp > 0 {
-            let tau1 = step.tau1;
-            let limit = if tau1 >= end { tau1 + tol(tau1) } else { tau1 };
-            loop {
-                let mut count = 0usize;
-                while count < SAMPLE_BATCH {
-                    let t = start + (i_next + count as u64) as f64 * dt;
-                    let dense = t < tau1 || (t == tau1 && step.event.is_none());
-                    if !dense {
-                        break;
-                    }
-                    count += 1;
-                }
-                if count > 0 {
-                    let buf = &mut states[..count * dim];
-                    integ.dense_states_into(start, dt, i_next, buf);
-                    for (j, z) in buf.chunks_exact(dim).enumerate() {
-                        let i = i_next + j as u64;
-                        let t = start + i as f64 * dt;
-                        let sc = phase.at(i, t);
-                        rows.push(&model, step.region, t, sc, z);
-                        if let Some(b) = &body {
-                            out.body_contact |= sample_touches(b, t, z);
-                        }
-                    }
-                    i_next += count as u64;
-                }
-                if count < SAMPLE_BATCH {
-                    break;
-                }
-            }
-            let t = start + i_next as f64 * dt;
-            if t <= limit {
-                // at the step's end (after an event), or beyond the end by round-off: the
-                // state there
-                crate::integrate::form_state(integ);
-                let sc = (model.omega() * tau1).sin_cos();
-                rows.push(&model, integ.region(), tau1, sc, integ.state().as_slice());
-                i_next += 1;
-            }
+            out.body_contact |= sampler.samples_in(&model, integ, &step, rows, body.as_ref());
         }
         let tau = integ.tau();
         if let Some(b) = &body {
             out.body_contact |= step_touches(b, integ);
         }
         if let Some(e) = step.event {
-            // an impact's impulse: energy lost in the sample and work done on the clamped frame
-            let r = match e.kind {
-                EventKind::Impact => model.law().restitution(),
-                EventKind::Stick => Some(0.0),
-                _ => None,
-            };
-            if let (true, Some(r)) = (spec.energy, r) {
-                let (loss, base) = model.impact_energy(e.tau, e.v_t_dot, r);
-                acc.contact_dissipation += loss;
-                acc.base_work += base;
-            }
-            // a hysteretic law's potential drops where the contact forms (JKR's neck)
-            if spec.energy && e.kind == EventKind::Switching {
-                acc.contact_dissipation += model.switching_loss(e.from, e.to, e.tau, &e.state);
+            if spec.energy {
+                balance.add_event(&model, &e);
             }
             out.events.push(e);
         }
-        if spec.energy && (tau >= next_energy_cut || (tau - next_energy_cut).abs() <= tol(tau)) {
-            crate::integrate::form_state(integ);
-            let z = integ.state();
-            acc.e_end = model.energy(step.region, tau, z);
-            out.energy.push(acc);
-            acc = EnergyBalance {
-                tau0: tau,
-                // the same state and region: the same energy
-                e_start: if integ.region() == step.region {
-                    acc.e_end
-                } else {
-                    model.energy(integ.region(), tau, z)
-                },
-                e_end: 0.0,
-                base_work: 0.0,
-                beam_dissipation: 0.0,
-                contact_dissipation: 0.0,
-            };
-            next_energy_cut += period;
+        let cut = balance.next_cut;
+        if spec.energy && (tau >= cut || (tau - cut).abs() <= round_off(tau)) {
+            balance.cut(&model, integ, step.region, period, &mut out.energy);
         }
         if at_section(tau, k_period) {
             crate::integrate::form_state(integ);
@@ -504,4 +402,198 @@ pub fn record_rows(
     out.final_state = integ.state().clone();
     out.final_region = integ.region();
     Ok(out)
+}
+
+/// The round-off tolerance 1e-12 (1 + |τ|) of a time τ of the recording.
+#[inline]
+fn round_off(tau: f64) -> f64 {
+    1e-12 * (1.0 + tau.abs())
+}
+
+/// The transient and the recorded length of `spec`: both finite, then both ≥ 0.
+fn check_lengths(spec: &RecordSpec) -> Result<(), SimError> {
+    let lengths = [
+        ("transient_periods", spec.transient_periods),
+        ("record_tau", spec.record_tau),
+    ];
+    for (name, v) in lengths {
+        finite(name, v)?;
+    }
+    match lengths.into_iter().find(|&(_, v)| v < 0.0) {
+        Some((name, v)) => Err(SimError::out_of_range(name, v, "must be >= 0")),
+        None => Ok(()),
+    }
+}
+
+/// The samples τ_i = start + i·dt of a recording that ends at `end`: the next one's index and
+/// what forms them.
+struct Sampler {
+    start: f64,
+    dt: f64,
+    end: f64,
+    /// The next sample's index.
+    next: u64,
+    phase: SamplePhase,
+    /// A batch of states (of the state's dimension) formed from a step's dense output.
+    states: Vec<f64>,
+}
+
+impl Sampler {
+    /// The samples inside `step`, just taken by `integ`, into `rows`, from its dense output; at
+    /// its end after an event, and beyond the end of the recording by round-off, the state
+    /// there. Whether a sample's beam body touches the substrate (`body`).
+    #[inline]
+    fn samples_in(
+        &mut self,
+        model: &CantileverModel,
+        integ: &mut dyn Integrator,
+        step: &Step,
+        rows: &mut SampleRows,
+        body: Option<&BodyContactCheck>,
+    ) -> bool {
+        let (start, dt, dim) = (self.start, self.dt, self.states.len() / SAMPLE_BATCH);
+        let tau1 = step.tau1;
+        let limit = if tau1 >= self.end {
+            tau1 + round_off(tau1)
+        } else {
+            tau1
+        };
+        let mut touches = false;
+        loop {
+            let mut count = 0usize;
+            while count < SAMPLE_BATCH {
+                let t = start + (self.next + count as u64) as f64 * dt;
+                let dense = t < tau1 || (t == tau1 && step.event.is_none());
+                if !dense {
+                    break;
+                }
+                count += 1;
+            }
+            if count > 0 {
+                let buf = &mut self.states[..count * dim];
+                integ.dense_states_into(start, dt, self.next, buf);
+                for (j, z) in buf.chunks_exact(dim).enumerate() {
+                    let i = self.next + j as u64;
+                    let t = start + i as f64 * dt;
+                    let sc = self.phase.at(i, t);
+                    rows.push(model, step.region, t, sc, z);
+                    if let Some(b) = body {
+                        touches |= sample_touches(b, t, z);
+                    }
+                }
+                self.next += count as u64;
+            }
+            if count < SAMPLE_BATCH {
+                break;
+            }
+        }
+        let t = start + self.next as f64 * dt;
+        if t <= limit {
+            // at the step's end (after an event), or beyond the end by round-off: the
+            // state there
+            crate::integrate::form_state(integ);
+            let sc = (model.omega() * tau1).sin_cos();
+            rows.push(model, integ.region(), tau1, sc, integ.state().as_slice());
+            self.next += 1;
+        }
+        touches
+    }
+}
+
+/// The energy balance of the drive period under way: its terms so far, where it ends, and the
+/// quadrature of a step without closed forms.
+struct Balance {
+    acc: EnergyBalance,
+    next_cut: f64,
+    gl: GaussLegendre,
+}
+
+impl Balance {
+    /// The balance of the period from `integ`'s state, cut first at the section `section` (or
+    /// a period on, when the state is there already).
+    fn new(model: &CantileverModel, integ: &dyn Integrator, section: f64) -> Self {
+        let tau = integ.tau();
+        let e_start = model.energy(integ.region(), tau, integ.state());
+        let period = model.period();
+        Balance {
+            acc: EnergyBalance::open(tau, e_start),
+            next_cut: if section <= tau {
+                section + period
+            } else {
+                section
+            },
+            gl: GaussLegendre::new(NonZeroUsize::new(12).expect("nonzero")),
+        }
+    }
+
+    /// The base work and the losses over `step`, just taken by `integ`: the integrator's closed
+    /// forms ([`Integrator::last_step_rate_integrals`]), else Gauss–Legendre on its dense
+    /// output.
+    #[inline]
+    fn add_step(&mut self, model: &CantileverModel, integ: &mut dyn Integrator, step: &Step) {
+        let acc = &mut self.acc;
+        if let Some([pb, db, dc]) = integ.last_step_rate_integrals() {
+            acc.base_work += pb;
+            acc.beam_dissipation += db;
+            acc.contact_dissipation += dc;
+            return;
+        }
+        let r = step.region;
+        let (mut pb, mut db, mut dc) = (0.0, 0.0, 0.0);
+        for (x, w) in self.gl.iter() {
+            let tau = 0.5 * (step.tau1 - step.tau0) * (x + 1.0) + step.tau0;
+            let z = integ.dense_state(tau);
+            let p = model.power(r, tau, &z);
+            pb += w * p.base;
+            db += w * p.beam_dissipation;
+            dc += w * p.contact_dissipation;
+        }
+        let half = 0.5 * (step.tau1 - step.tau0);
+        acc.base_work += half * pb;
+        acc.beam_dissipation += half * db;
+        acc.contact_dissipation += half * dc;
+    }
+
+    /// The energy of the switching `e`: an impact's impulse (the loss in the sample and the
+    /// work done on the clamped frame), a hysteretic law's drop of potential where the contact
+    /// forms (JKR's neck).
+    fn add_event(&mut self, model: &CantileverModel, e: &SwitchEvent) {
+        let r = match e.kind {
+            EventKind::Impact => model.law().restitution(),
+            EventKind::Stick => Some(0.0),
+            _ => None,
+        };
+        if let Some(r) = r {
+            let (loss, base) = model.impact_energy(e.tau, e.v_t_dot, r);
+            self.acc.contact_dissipation += loss;
+            self.acc.base_work += base;
+        }
+        if e.kind == EventKind::Switching {
+            self.acc.contact_dissipation += model.switching_loss(e.from, e.to, e.tau, &e.state);
+        }
+    }
+
+    /// The period's balance closed at `integ`'s time (the step's end, in `region` until then)
+    /// into `energy`, and the next period's opened.
+    fn cut(
+        &mut self,
+        model: &CantileverModel,
+        integ: &mut dyn Integrator,
+        region: Region,
+        period: f64,
+        energy: &mut Vec<EnergyBalance>,
+    ) {
+        crate::integrate::form_state(integ);
+        let (tau, z) = (integ.tau(), integ.state());
+        self.acc.e_end = model.energy(region, tau, z);
+        energy.push(self.acc);
+        // the same state and region: the same energy
+        let e_start = if integ.region() == region {
+            self.acc.e_end
+        } else {
+            model.energy(integ.region(), tau, z)
+        };
+        self.acc = EnergyBalance::open(tau, e_start);
+        self.next_cut += period;
+    }
 }

@@ -34,7 +34,7 @@
 //! (s²(τ_c + τ_L) + s + K_I = 0 has a double root). The lock-in's default time constant is
 //! τ_c/4, K_P = 0.
 
-use super::observables::{observe, wrap_phase, ObservableOptions};
+use super::observables::{observe, wrap_phase, ObservableOptions, Observables};
 use crate::error::SimError;
 use crate::integrate::dense::{sample_dense, SpanSampling, StartSample};
 use crate::integrate::{advance, build, check_start, Integrator, IntegratorOptions};
@@ -371,6 +371,34 @@ struct Sums {
     last: f64,
 }
 
+impl Sums {
+    /// The pixel of these means, on `material` with the observables `o` of its last period.
+    fn pixel(&self, spec: &LineSpec, material: usize, o: &Observables) -> ScanPixel {
+        let n = self.n as f64;
+        ScanPixel {
+            z: self.z / n,
+            amplitude: self.amplitude / n,
+            phase: self.phase / n,
+            tracking_error: self.error / n,
+            material,
+            energy_dissipated: o.energy_dissipated,
+            virial: o.virial,
+            peak_force: o.peak_force,
+            indentation: o.indentation,
+            mean_deflection: o.mean_deflection,
+            lost_contact: o.contact_fraction == 0.0
+                && o.impacts_per_period == 0.0
+                && 2.0 * self.last > spec.setpoint + spec.free_amplitude,
+            saturated: self.saturated,
+            energy_residual: o
+                .mode_balance
+                .iter()
+                .map(|b| b.residual.abs() / b.drive.abs().max(f64::MIN_POSITIVE))
+                .fold(0.0, f64::max),
+        }
+    }
+}
+
 /// Where a line engages, in pixels along it: the trace's first drive period,
 /// 0.5/`periods_per_pixel` (its material is the one [`Engage`] must be of).
 pub(crate) fn engage_position(spec: &LineSpec) -> f64 {
@@ -423,46 +451,45 @@ pub fn scan_line(
     // gap in place (`at_gap`)
     let mut kept: Vec<Option<Kept>> = spec.materials.iter().map(|_| None).collect();
     // one period at position s: returns the observables when `observe_it`
-    let mut period_at =
-        |s: f64,
-         observe_it: bool,
-         piezo: &mut f64,
-         sums: &mut Sums|
-         -> Result<Option<(usize, crate::analysis::observables::Observables)>, SimError> {
-            let (m, h) = under_tip(s);
-            let mat = spec.materials.get(m).ok_or_else(|| {
-                SimError::out_of_range("material", m, "must be one of the spec's materials")
-            })?;
-            let (model, integ) = at_gap(
-                &mut kept[m],
-                mat,
-                mat.alpha5_for_rest_distance(*piezo - h),
-                &z,
-                &spec.integrator,
-            )?;
-            let (raw, o) = if observe_it {
-                let o = observe(integ.as_mut(), &opts)?;
-                ((o.amplitude, o.phase), Some((m, o)))
-            } else {
-                (
-                    demodulate_period(integ.as_mut(), model, spec.samples)?,
-                    None,
-                )
-            };
-            z.clone_from(integ.state());
-            lock.update(raw.0, raw.1);
-            sums.z += *piezo;
-            sums.amplitude += lock.amplitude();
-            sums.last = lock.amplitude();
-            sums.phase += lock.phase();
-            let e = spec.setpoint - lock.amplitude();
-            sums.error += e;
-            let (next, sat) = pi.output(e, (h + spec.range.0, h + spec.range.1));
-            sums.saturated += usize::from(sat);
-            sums.n += 1;
-            *piezo = next;
-            Ok(o)
+    let mut period_at = |s: f64,
+                         observe_it: bool,
+                         piezo: &mut f64,
+                         sums: &mut Sums|
+     -> Result<Option<(usize, Observables)>, SimError> {
+        let (m, h) = under_tip(s);
+        let mat = spec.materials.get(m).ok_or_else(|| {
+            SimError::out_of_range("material", m, "must be one of the spec's materials")
+        })?;
+        let (model, integ) = at_gap(
+            &mut kept[m],
+            mat,
+            mat.alpha5_for_rest_distance(*piezo - h),
+            &z,
+            &spec.integrator,
+        )?;
+        let (raw, o) = if observe_it {
+            let o = observe(integ.as_mut(), &opts)?;
+            ((o.amplitude, o.phase), Some((m, o)))
+        } else {
+            (
+                demodulate_period(integ.as_mut(), model, spec.samples)?,
+                None,
+            )
         };
+        z.clone_from(integ.state());
+        lock.update(raw.0, raw.1);
+        sums.z += *piezo;
+        sums.amplitude += lock.amplitude();
+        sums.last = lock.amplitude();
+        sums.phase += lock.phase();
+        let e = spec.setpoint - lock.amplitude();
+        sums.error += e;
+        let (next, sat) = pi.output(e, (h + spec.range.0, h + spec.range.1));
+        sums.saturated += usize::from(sat);
+        sums.n += 1;
+        *piezo = next;
+        Ok(o)
+    };
     let mut scratch = Sums::default();
     for _ in 0..spec.engage_periods {
         if cancel.load(Ordering::Relaxed) {
@@ -491,28 +518,7 @@ pub fn scan_line(
                 }
             }
             let (material, o) = last.expect("a pixel has at least one period");
-            let n = sums.n as f64;
-            out.push(ScanPixel {
-                z: sums.z / n,
-                amplitude: sums.amplitude / n,
-                phase: sums.phase / n,
-                tracking_error: sums.error / n,
-                material,
-                energy_dissipated: o.energy_dissipated,
-                virial: o.virial,
-                peak_force: o.peak_force,
-                indentation: o.indentation,
-                mean_deflection: o.mean_deflection,
-                lost_contact: o.contact_fraction == 0.0
-                    && o.impacts_per_period == 0.0
-                    && 2.0 * sums.last > spec.setpoint + spec.free_amplitude,
-                saturated: sums.saturated,
-                energy_residual: o
-                    .mode_balance
-                    .iter()
-                    .map(|b| b.residual.abs() / b.drive.abs().max(f64::MIN_POSITIVE))
-                    .fold(0.0, f64::max),
-            });
+            out.push(sums.pixel(spec, material, &o));
         }
     }
     let [trace, mut retrace] = lines;

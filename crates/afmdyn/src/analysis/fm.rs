@@ -312,75 +312,21 @@ fn followed(
     }
     let mut points: Vec<FmPoint> = Vec::with_capacity(spec.values.len());
     let mut unreached = None;
-    let mut jac: Option<Matrix2<f64>> = None;
     // the free orbit at the reference from rest (Newton on the free flight's affine map)
     let start = CantileverModel::new(&spec.base.with(SweepParam::Alpha5, spec.values[0]))?.rest();
-    let mut last: Option<(f64, Vector2<f64>, DVector<f64>)> = None;
-    let mut before: Option<(f64, Vector2<f64>, DVector<f64>)> = None;
+    let mut walk = Walk::default();
     for &target in &spec.values {
         check()?;
-        // the step from the last value reached towards the target: halved after a failure
-        // (at most MAX_HALVINGS times for this target), doubled back after a success; the
-        // first value has no earlier point to step from
-        let mut reached: Option<(Locked, usize)> = None;
-        let mut failure: Option<SimError> = None;
-        let (mut from, mut prev, mut trial_jac) = (last.clone(), before.clone(), jac);
-        let (mut fraction, mut failures) = (1.0f64, 0);
-        loop {
-            let value = match &from {
-                Some((a, ..)) if fraction < 1.0 => a + (target - a) * fraction,
-                _ => target,
-            };
-            let (x0, guess) = predict(&from, &prev, value, &reference, &start);
-            let locked = match solver.lock(value, x0, &guess, &mut trial_jac) {
-                Err(SimError::Cancelled) => Err(SimError::Cancelled),
-                Err(_) => {
-                    trial_jac = None;
-                    solver
-                        .lock_augmented(value, x0, &guess)
-                        .or_else(|_| solver.lock_bracketed(value, x0, &guess))
-                }
-                ok => ok,
-            };
-            match locked {
-                Ok((locked, it)) => {
-                    prev = from;
-                    from = Some((value, locked.x, locked.orbit.state.clone()));
-                    if value == target {
-                        reached = Some((locked, it));
-                        break;
-                    }
-                    fraction = (2.0 * fraction).min(1.0);
-                }
-                Err(SimError::Cancelled) => return Err(SimError::Cancelled),
-                Err(e) => {
-                    failure = Some(e);
-                    failures += 1;
-                    if from.is_none() || failures > MAX_HALVINGS {
-                        break;
-                    }
-                    fraction *= 0.5;
-                }
+        let (locked, iterations) = match walk.reach(&solver, target, &start, &check)? {
+            Ok(reached) => reached,
+            Err(e) if points.is_empty() => return Err(e),
+            Err(e) => {
+                unreached = Some(Unreached {
+                    alpha5: target,
+                    reason: e.to_string(),
+                });
+                break;
             }
-            check()?;
-        }
-        if reached.is_some() {
-            (jac, before, last) = (trial_jac, prev, from);
-        }
-        let Some((locked, iterations)) = reached else {
-            let e = failure.unwrap_or(SimError::NoConvergence {
-                what: "the FM loop",
-                iterations: 0,
-                residual: f64::NAN,
-            });
-            if points.is_empty() {
-                return Err(e);
-            }
-            unreached = Some(Unreached {
-                alpha5: target,
-                reason: e.to_string(),
-            });
-            break;
         };
         let p = spec
             .base
@@ -396,7 +342,7 @@ fn followed(
             state: locked.orbit.state.clone(),
             multipliers: locked.orbit.multipliers.clone(),
             stable: locked.orbit.stable,
-            loop_determinant: jac.map_or(f64::NAN, |j| j.determinant()),
+            loop_determinant: walk.jac.map_or(f64::NAN, |j| j.determinant()),
             iterations,
             loop_residual: locked.residual.amax(),
             law_force: law_force(&p, observables.min_distance),
@@ -406,7 +352,91 @@ fn followed(
             p.tick();
         }
     }
-    // a sign change of the secant estimates is confirmed by forward differences at both ends
+    Ok(FmCurve {
+        reference,
+        amplitude: spec.amplitude,
+        folds: folds(&solver, &points)?,
+        points,
+        unreached,
+    })
+}
+
+/// A value reached by the loops: (α5, (Ω, α2), the orbit's state at τ = 0).
+type Anchor = (f64, Vector2<f64>, DVector<f64>);
+
+/// Where an FM curve stands: the last value reached, the one before it, and the loop
+/// Jacobian's secant estimate at the last.
+#[derive(Default)]
+struct Walk {
+    last: Option<Anchor>,
+    before: Option<Anchor>,
+    jac: Option<Matrix2<f64>>,
+}
+
+impl Walk {
+    /// The loops locked at `target`, stepping from the last value reached: the step halved
+    /// after a failure (at most [`MAX_HALVINGS`] times for this target), doubled back after a
+    /// success; the first value has no earlier point to step from (it starts from the free
+    /// orbit `start`). Reaching `target` moves the walk there. `Ok(Err)`: the last failure.
+    ///
+    /// # Errors
+    /// [`SimError::Cancelled`] once `check` says so.
+    fn reach(
+        &mut self,
+        solver: &Solver,
+        target: f64,
+        start: &DVector<f64>,
+        check: &dyn Fn() -> Result<(), SimError>,
+    ) -> Result<Result<(Locked, usize), SimError>, SimError> {
+        let (mut from, mut prev, mut trial_jac) =
+            (self.last.clone(), self.before.clone(), self.jac);
+        let (mut fraction, mut failures) = (1.0f64, 0);
+        loop {
+            let value = match &from {
+                Some((a, ..)) if fraction < 1.0 => a + (target - a) * fraction,
+                _ => target,
+            };
+            let (x0, guess) = predict(&from, &prev, value, &solver.reference, start);
+            let locked = match solver.lock(value, x0, &guess, &mut trial_jac) {
+                Err(SimError::Cancelled) => Err(SimError::Cancelled),
+                Err(_) => {
+                    trial_jac = None;
+                    solver
+                        .lock_augmented(value, x0, &guess)
+                        .or_else(|_| solver.lock_bracketed(value, x0, &guess))
+                }
+                ok => ok,
+            };
+            match locked {
+                Ok((locked, it)) => {
+                    prev = from;
+                    from = Some((value, locked.x, locked.orbit.state.clone()));
+                    if value == target {
+                        (self.jac, self.before, self.last) = (trial_jac, prev, from);
+                        return Ok(Ok((locked, it)));
+                    }
+                    fraction = (2.0 * fraction).min(1.0);
+                }
+                Err(SimError::Cancelled) => return Err(SimError::Cancelled),
+                Err(e) => {
+                    failures += 1;
+                    if from.is_none() || failures > MAX_HALVINGS {
+                        return Ok(Err(e));
+                    }
+                    fraction *= 0.5;
+                }
+            }
+            check()?;
+        }
+    }
+}
+
+/// The folds of the FM curve `points`: a sign change of the secant estimates of the loop
+/// Jacobian's determinant, confirmed by forward differences at both ends.
+///
+/// # Errors
+/// As [`Solver::orbit`] and [`Solver::jacobian`].
+fn folds(solver: &Solver, points: &[FmPoint]) -> Result<Vec<FmFold>, SimError> {
     let mut folds = Vec::new();
     for index in 0..points.len().saturating_sub(1) {
         let (a, b) = (&points[index], &points[index + 1]);
@@ -423,13 +453,7 @@ fn followed(
             }
         }
     }
-    Ok(FmCurve {
-        reference,
-        amplitude: spec.amplitude,
-        points,
-        folds,
-        unreached,
-    })
+    Ok(folds)
 }
 
 /// The lag error φ₁ − φ_set wrapped into (−π, π] (the lags are reported in (−π/2, 3π/2]: a

@@ -439,6 +439,91 @@ impl<S: TipSampleSystem + Clone> Adaptive<S> {
         best
     }
 
+    /// A step to `tau_max` of a remainder far below the step size: the first-order update
+    /// (error O(rem²) below round-off), its Hermite record and its Jacobian I + J rem.
+    fn remainder_step(&mut self, tau_max: f64) {
+        let (tau0, region, d) = (self.tau, self.region, self.dim());
+        let rem = tau_max - tau0;
+        let mut f = vec![0.0; d];
+        self.model.rhs(region, tau0, self.z.as_slice(), &mut f);
+        let z0 = self.z.clone();
+        for (zi, fi) in self.z.iter_mut().zip(&f) {
+            *zi += rem * fi;
+        }
+        self.tau = tau_max;
+        self.last.tau0 = tau0;
+        self.last.tau1 = tau_max;
+        self.last.region = region;
+        self.last
+            .hermite
+            .record(&self.model, region, tau0, &z0, tau_max, &self.z);
+        self.last.jacobian = self.variational.then(|| {
+            let mut j = DMatrix::zeros(d, d);
+            self.model.jacobian(region, tau0, z0.as_slice(), &mut j);
+            DMatrix::identity(d, d) + j * rem
+        });
+        self.stint_open = false;
+    }
+
+    /// The last step's record: its span (τ0, τ1) in `region`, with the variational equations
+    /// its Jacobian from the augmented state `y` at τ1 (the stepper's end when `None`), and
+    /// `stepper`, its dense output.
+    #[inline(always)]
+    fn record_last(
+        &mut self,
+        region: Region,
+        (tau0, tau1): (f64, f64),
+        y: Option<&[f64]>,
+        stepper: Box<Stepper>,
+    ) {
+        self.last.tau0 = tau0;
+        self.last.tau1 = tau1;
+        self.last.region = region;
+        if self.variational {
+            let mut jac = self.last.jacobian.take();
+            self.step_jacobian_into(region, tau1, y.unwrap_or(stepper.y()), &mut jac);
+            self.last.jacobian = jac;
+        } else {
+            self.last.jacobian = None;
+        }
+        let old = self.last.dense.replace(stepper);
+        self.recycle(old);
+    }
+
+    /// The switching near `t_guess` in the step (τ0, τ1] of `region` polished: Newton on g(τ),
+    /// each iterate integrated afresh from the step's start `y0`. Returns the time and the
+    /// augmented state there.
+    ///
+    /// # Errors
+    /// As [`Adaptive::integrate_to`].
+    fn polish(
+        &self,
+        region: Region,
+        (tau0, t1): (f64, f64),
+        y0: &[f64],
+        t_guess: f64,
+    ) -> Result<(f64, Vec<f64>), SimError> {
+        let (d, var) = (self.dim(), self.variational);
+        let mut ts = t_guess;
+        let mut ys = self.integrate_to(region, tau0, y0, ts, var)?;
+        for _ in 0..6 {
+            let g = self.model.guard(region, ts, &ys[..d]);
+            let mut f = vec![0.0; d];
+            self.model.rhs(region, ts, &ys[..d], &mut f);
+            let rate = g.grad.iter().zip(&f).map(|(a, b)| a * b).sum::<f64>() + g.d_tau;
+            if rate == 0.0 || g.value == 0.0 {
+                break;
+            }
+            let next = (ts - g.value / rate).clamp(tau0, t1);
+            if (next - ts).abs() <= 4.0 * f64::EPSILON * (1.0 + ts.abs()) || next <= tau0 {
+                break;
+            }
+            ts = next;
+            ys = self.integrate_to(region, tau0, y0, ts, var)?;
+        }
+        Ok((ts, ys))
+    }
+
     /// Leftmost guard zero in (t0, t1] on the dense output, or None (module docs).
     /// `(t0, z0)` and `(t1, z1)` are the step's ends (formed once by the caller).
     fn find_zero(
@@ -555,30 +640,10 @@ impl<S: TipSampleSystem + Clone + 'static> Integrator for Adaptive<S> {
                 self.new_stepper(region, tau0, &y0, var, self.h)?
             }
         };
-        let h_now = stepper.h();
         // a remainder far below the step size: first-order update (error O(rem²) < round-off)
-        if tau_max - tau0 <= 1e-9 * h_now.abs() {
-            let rem = tau_max - tau0;
-            let mut f = vec![0.0; d];
-            self.model.rhs(region, tau0, self.z.as_slice(), &mut f);
-            let z0 = self.z.clone();
-            for (zi, fi) in self.z.iter_mut().zip(&f) {
-                *zi += rem * fi;
-            }
-            self.tau = tau_max;
-            self.last.tau0 = tau0;
-            self.last.tau1 = tau_max;
-            self.last.region = region;
+        if tau_max - tau0 <= 1e-9 * stepper.h().abs() {
             self.recycle(Some(stepper));
-            self.last
-                .hermite
-                .record(&self.model, region, tau0, &z0, tau_max, &self.z);
-            self.last.jacobian = var.then(|| {
-                let mut j = DMatrix::zeros(d, d);
-                self.model.jacobian(region, tau0, z0.as_slice(), &mut j);
-                DMatrix::identity(d, d) + j * rem
-            });
-            self.stint_open = false;
+            self.remainder_step(tau_max);
             self.start = y0;
             return Ok(Step::plain(tau0, tau_max, region));
         }
@@ -597,54 +662,15 @@ impl<S: TipSampleSystem + Clone + 'static> Integrator for Adaptive<S> {
             if norm.is_nan() || norm >= 1e12 {
                 return Err(SimError::Diverged { tau: t1, norm });
             }
-            self.last.tau0 = tau0;
-            self.last.tau1 = t1;
-            self.last.region = region;
-            if var {
-                let mut jac = self.last.jacobian.take();
-                self.step_jacobian_into(region, t1, stepper.y(), &mut jac);
-                self.last.jacobian = jac;
-            } else {
-                self.last.jacobian = None;
-            }
-            let old = self.last.dense.replace(stepper);
-            self.recycle(old);
+            self.record_last(region, (tau0, t1), None, stepper);
             self.stint_open = !var;
             self.start = y0;
             return Ok(Step::plain(tau0, t1, region));
         };
-        // polish: Newton on g(τ), each iterate integrated afresh from the step's start
-        let mut ts = t_guess;
-        let mut ys = self.integrate_to(region, tau0, &y0, ts, var)?;
-        for _ in 0..6 {
-            let g = self.model.guard(region, ts, &ys[..d]);
-            let mut f = vec![0.0; d];
-            self.model.rhs(region, ts, &ys[..d], &mut f);
-            let rate = g.grad.iter().zip(&f).map(|(a, b)| a * b).sum::<f64>() + g.d_tau;
-            if rate == 0.0 || g.value == 0.0 {
-                break;
-            }
-            let next = (ts - g.value / rate).clamp(tau0, t1);
-            if (next - ts).abs() <= 4.0 * f64::EPSILON * (1.0 + ts.abs()) || next <= tau0 {
-                break;
-            }
-            ts = next;
-            ys = self.integrate_to(region, tau0, &y0, ts, var)?;
-        }
+        let (ts, ys) = self.polish(region, (tau0, t1), &y0, t_guess)?;
         let z_minus = DVector::from_column_slice(&ys[..d]);
         let jump = self.model.jump(region, ts, z_minus.as_slice());
-        self.last.tau0 = tau0;
-        self.last.tau1 = ts;
-        self.last.region = region;
-        if var {
-            let mut jac = self.last.jacobian.take();
-            self.step_jacobian_into(region, ts, &ys, &mut jac);
-            self.last.jacobian = jac;
-        } else {
-            self.last.jacobian = None;
-        }
-        let old = self.last.dense.replace(stepper);
-        self.recycle(old);
+        self.record_last(region, (tau0, ts), Some(&ys), stepper);
         self.z.copy_from(&jump.state);
         self.tau = ts;
         self.region = jump.to;

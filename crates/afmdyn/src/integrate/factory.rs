@@ -213,6 +213,57 @@ pub fn build(
     // that would need more steps than the budget, are refused before any work is done
     check_start(z)?;
     let kind = opts.kind.resolve(model);
+    check_supported(model, kind)?;
+    let mut integ: Box<dyn Integrator> = match kind {
+        IntegratorKind::Auto | IntegratorKind::Exact => Box::new(exact::ExactPropagator::try_with(
+            model,
+            exact::ExactOptions {
+                min_steps_per_period: opts.steps_per_period,
+                cache: Some(opts.cache.clone()),
+                ..exact::ExactOptions::default()
+            },
+        )?),
+        IntegratorKind::Rk4 => Box::new(rk4::Rk4::new(model, opts.steps_per_period, true)),
+        IntegratorKind::Rk4Naive => Box::new(rk4::Rk4::new(model, opts.steps_per_period, false)),
+        IntegratorKind::Taylor => Box::new(taylor::Taylor::new(model, opts.tolerance)?),
+        IntegratorKind::Adaptive | IntegratorKind::Split => {
+            if !(opts.tolerance.is_finite() && opts.tolerance > 0.0 && opts.tolerance < 1.0) {
+                return Err(SimError::out_of_range(
+                    "tolerance",
+                    opts.tolerance,
+                    "must be in (0, 1)",
+                ));
+            }
+            let adaptive = || Box::new(adaptive::Adaptive::new(model, opts.tolerance));
+            if kind == IntegratorKind::Adaptive {
+                adaptive()
+            } else {
+                let cache = Some(opts.cache.clone());
+                match split::Split::try_new(model, opts.steps_per_period, opts.tolerance, cache) {
+                    Ok(s) => Box::new(s),
+                    Err(SimError::OutOfRange { .. } | SimError::Budget { .. })
+                        if opts.kind == IntegratorKind::Auto =>
+                    {
+                        adaptive()
+                    }
+                    Err(e) => return Err(e),
+                }
+            }
+        }
+    };
+    integ.reset(tau, z)?;
+    Ok(integ)
+}
+
+/// Whether an integrator of `kind` can integrate `model`: an adaptive stepper's steps per drive
+/// period within [`crate::params::ADAPTIVE_STEPS_BUDGET`], one harmonic drive for the exact and
+/// split integrators, no internal states of the law but for the adaptive one, and neither a
+/// contact's neck nor impacts for RK4.
+///
+/// # Errors
+/// [`SimError::Budget`], [`SimError::OutOfRange`] naming `integrator`, or
+/// [`SimError::Unsupported`].
+fn check_supported(model: &CantileverModel, kind: IntegratorKind) -> Result<(), SimError> {
     if matches!(
         kind,
         IntegratorKind::Adaptive | IntegratorKind::Split | IntegratorKind::Taylor
@@ -283,45 +334,7 @@ pub fn build(
             hint: "impacts need located events with jumps: use integrator = \"adaptive\" (or \"auto\")",
         });
     }
-    let mut integ: Box<dyn Integrator> = match kind {
-        IntegratorKind::Auto | IntegratorKind::Exact => Box::new(exact::ExactPropagator::try_with(
-            model,
-            exact::ExactOptions {
-                min_steps_per_period: opts.steps_per_period,
-                cache: Some(opts.cache.clone()),
-                ..exact::ExactOptions::default()
-            },
-        )?),
-        IntegratorKind::Rk4 => Box::new(rk4::Rk4::new(model, opts.steps_per_period, true)),
-        IntegratorKind::Rk4Naive => Box::new(rk4::Rk4::new(model, opts.steps_per_period, false)),
-        IntegratorKind::Taylor => Box::new(taylor::Taylor::new(model, opts.tolerance)?),
-        IntegratorKind::Adaptive | IntegratorKind::Split => {
-            if !(opts.tolerance.is_finite() && opts.tolerance > 0.0 && opts.tolerance < 1.0) {
-                return Err(SimError::out_of_range(
-                    "tolerance",
-                    opts.tolerance,
-                    "must be in (0, 1)",
-                ));
-            }
-            let adaptive = || Box::new(adaptive::Adaptive::new(model, opts.tolerance));
-            if kind == IntegratorKind::Adaptive {
-                adaptive()
-            } else {
-                let cache = Some(opts.cache.clone());
-                match split::Split::try_new(model, opts.steps_per_period, opts.tolerance, cache) {
-                    Ok(s) => Box::new(s),
-                    Err(SimError::OutOfRange { .. } | SimError::Budget { .. })
-                        if opts.kind == IntegratorKind::Auto =>
-                    {
-                        adaptive()
-                    }
-                    Err(e) => return Err(e),
-                }
-            }
-        }
-    };
-    integ.reset(tau, z)?;
-    Ok(integ)
+    Ok(())
 }
 
 /// Refuse a start at or beyond the divergence threshold of the integrators (|z| ≥ 1e12,

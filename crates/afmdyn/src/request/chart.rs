@@ -285,18 +285,7 @@ impl ChartRequest {
         base.check_finite()?;
         let x = axis_name("x", &self.x)?;
         let y = axis_name("y", &self.y)?;
-        let table: Option<toml::Table> = match probe {
-            Some(text) => Some(text.parse().map_err(|e: toml::de::Error| {
-                SimError::Probe(format!("probe: {}", e.to_string().replace('\n', " ")))
-            })?),
-            None => None,
-        };
-        let probe = match &table {
-            Some(t) => {
-                Some(Probe::from_table(t, "probe").map_err(|e| SimError::Probe(e.to_string()))?)
-            }
-            None => None,
-        };
+        let (table, probe) = read_probe(probe)?;
         for (field, name) in [("x", x), ("y", y)] {
             if probe.is_none() && probe_axis(name).is_some() {
                 return Err(SimError::out_of_range(
@@ -314,6 +303,68 @@ impl ChartRequest {
                 "must differ from the x parameter",
             ));
         }
+        self.check_options()?;
+        let xs = SweepSpec::linspace(self.x_from, self.x_to, self.x_steps)?;
+        let ys = SweepSpec::linspace(self.y_from, self.y_to, self.y_steps)?;
+        let model = ChartModel {
+            base,
+            defaults,
+            probe,
+            probe_table: table.filter(|_| uses_table),
+            x,
+            y,
+        };
+        for &xv in &xs {
+            model.params(xv, ys[0])?;
+        }
+        for &yv in &ys {
+            model.params(xs[0], yv)?;
+        }
+        model.params(xs[xs.len() - 1], ys[ys.len() - 1])?;
+        let spec = ChartSpec {
+            x: xs,
+            y: ys,
+            starts: self.starts,
+            seed: self.seed,
+            tile: self.tile,
+            cluster_tol: self.cluster_tol,
+            lyapunov_periods: self.lyapunov_periods,
+            steady: self.steady.options()?,
+            integrator: self.integrator.options(1)?,
+        };
+        // the integrator's up-front budgets (steps per period, support of the law) at the
+        // corners, as the attractor census checks them: an input error before any cell runs,
+        // not every cell failing alike
+        let (xs, ys) = (&spec.x, &spec.y);
+        for (xv, yv) in [
+            (xs[0], ys[0]),
+            (xs[xs.len() - 1], ys[0]),
+            (xs[0], ys[ys.len() - 1]),
+            (xs[xs.len() - 1], ys[ys.len() - 1]),
+        ] {
+            crate::integrate::check_buildable(&model.params(xv, yv)?, spec.integrator.clone())?;
+        }
+        let fingerprint = fingerprint(self, &model);
+        let chart = Chart {
+            spec,
+            slots: self.max_attractors,
+            model,
+            fingerprint,
+            threads: self.threads,
+        };
+        // held to the budgets of a request here, where every front end builds its chart
+        super::costs::check_cost("chart", chart_cost(&chart)?)?;
+        Ok(chart)
+    }
+
+    /// The chart's sizes and options: the threads, the steps of each axis, the cells, starts
+    /// and runs in all, the tile, the clustering tolerance, the λ₁ periods, the attractors
+    /// told apart, and the axes' finite ends.
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] or [`SimError::NotFinite`] naming the first option that is
+    /// not.
+    fn check_options(&self) -> Result<(), SimError> {
         super::limits::check_threads(self.threads)?;
         let steps = |name: &'static str, n: usize| {
             if (1..=MAX_CHART_CELLS).contains(&n) {
@@ -380,58 +431,26 @@ impl ChartRequest {
         crate::error::finite("x_to", self.x_to)?;
         crate::error::finite("y_from", self.y_from)?;
         crate::error::finite("y_to", self.y_to)?;
-        let xs = SweepSpec::linspace(self.x_from, self.x_to, self.x_steps)?;
-        let ys = SweepSpec::linspace(self.y_from, self.y_to, self.y_steps)?;
-        let model = ChartModel {
-            base,
-            defaults,
-            probe,
-            probe_table: table.filter(|_| uses_table),
-            x,
-            y,
-        };
-        for &xv in &xs {
-            model.params(xv, ys[0])?;
-        }
-        for &yv in &ys {
-            model.params(xs[0], yv)?;
-        }
-        model.params(xs[xs.len() - 1], ys[ys.len() - 1])?;
-        let spec = ChartSpec {
-            x: xs,
-            y: ys,
-            starts: self.starts,
-            seed: self.seed,
-            tile: self.tile,
-            cluster_tol: self.cluster_tol,
-            lyapunov_periods: self.lyapunov_periods,
-            steady: self.steady.options()?,
-            integrator: self.integrator.options(1)?,
-        };
-        // the integrator's up-front budgets (steps per period, support of the law) at the
-        // corners, as the attractor census checks them: an input error before any cell runs,
-        // not every cell failing alike
-        let (xs, ys) = (&spec.x, &spec.y);
-        for (xv, yv) in [
-            (xs[0], ys[0]),
-            (xs[xs.len() - 1], ys[0]),
-            (xs[0], ys[ys.len() - 1]),
-            (xs[xs.len() - 1], ys[ys.len() - 1]),
-        ] {
-            crate::integrate::check_buildable(&model.params(xv, yv)?, spec.integrator.clone())?;
-        }
-        let fingerprint = fingerprint(self, &model);
-        let chart = Chart {
-            spec,
-            slots: self.max_attractors,
-            model,
-            fingerprint,
-            threads: self.threads,
-        };
-        // held to the budgets of a request here, where every front end builds its chart
-        super::costs::check_cost("chart", chart_cost(&chart)?)?;
-        Ok(chart)
+        Ok(())
     }
+}
+
+/// The probe file's text `probe` parsed: its table and the probe.
+///
+/// # Errors
+/// [`SimError::Probe`] for a text that is not TOML or not a probe.
+fn read_probe(probe: Option<&str>) -> Result<(Option<toml::Table>, Option<Probe>), SimError> {
+    let table: Option<toml::Table> = match probe {
+        Some(text) => Some(text.parse().map_err(|e: toml::de::Error| {
+            SimError::Probe(format!("probe: {}", e.to_string().replace('\n', " ")))
+        })?),
+        None => None,
+    };
+    let probe = match &table {
+        Some(t) => Some(Probe::from_table(t, "probe").map_err(|e| SimError::Probe(e.to_string()))?),
+        None => None,
+    };
+    Ok((table, probe))
 }
 
 /// The fingerprint of a chart: everything that determines its cells (the library's version,

@@ -67,6 +67,25 @@ fn text(v: &Value) -> String {
     v.as_str().unwrap_or_default().to_string()
 }
 
+/// The unit of a `kind` of quantity in a document's `units` (the kind itself where they do not
+/// name it), `1` for a pure number (`None`).
+fn unit(units: &Value, kind: Option<&str>) -> String {
+    match kind {
+        None => "1".to_string(),
+        Some(k) => units
+            .get(k)
+            .and_then(Value::as_str)
+            .unwrap_or(k)
+            .to_string(),
+    }
+}
+
+/// A curve's column: (key, kind of unit or none, long name).
+type Column = (String, Option<String>, String);
+
+/// A curve's abscissa: (key, unit, long name).
+type Abscissa<'a> = (&'a str, &'a str, &'a str);
+
 /// The layout of a stepped curve's document `doc`.
 ///
 /// Dimensions: the abscissa (`z_c`, `frequency_hz` or `omega`: the values of the first sweep,
@@ -78,14 +97,6 @@ fn text(v: &Value) -> String {
 /// document's (`units`), `1` for a pure number.
 pub fn curve_layout(doc: &Value) -> Layout {
     let units = &doc["units"];
-    let unit = |kind: Option<&str>| match kind {
-        None => "1".to_string(),
-        Some(k) => units
-            .get(k)
-            .and_then(Value::as_str)
-            .unwrap_or(k)
-            .to_string(),
-    };
     let sweeps = if doc.get("approach").is_some() {
         ["approach", "retract"]
     } else {
@@ -96,8 +107,51 @@ pub fn curve_layout(doc: &Value) -> Layout {
         .into_iter()
         .find(|(k, ..)| first.get(*k).is_some())
         .unwrap_or(ABSCISSAE[0]);
-    let x_unit = unit(Some(x_kind));
+    let x_unit = unit(units, Some(x_kind));
+    let abscissa = (x, x_unit.as_str(), x_name);
     let grid = numbers(&first[x]);
+    // the curve's columns; under a multifrequency drive each component's (amplitude_i,
+    // phase_i_deg, …) too
+    let mut columns: Vec<Column> = CURVE_COLUMNS
+        .iter()
+        .map(|c| {
+            let kind = c.kind.key().map(Into::into);
+            (c.name.into(), kind, c.long_name.into())
+        })
+        .collect();
+    for c in list(&doc["drive_components"]["columns"]) {
+        let kind = c[1].as_str().map(Into::into);
+        columns.push((text(&c[0]), kind, text(&c[2])));
+    }
+    let sweep = Values::Text(sweeps.map(Into::into).into());
+    let mut vars = vec![
+        Variable::new(x, &[x], &x_unit, x_name, Values::F64(grid.clone())),
+        Variable::new("sweep", &["sweep"], "", "sweep", sweep),
+    ];
+    vars.extend(sweep_variables(doc, sweeps, x, &grid, &columns));
+    let branches = branch_variables(doc, abscissa, &columns);
+    let mut dims = vec![(x, grid.len()), ("sweep", 2), ("branch_point", branches.1)];
+    vars.extend(branches.0);
+    let traces = &doc["traces"];
+    if traces.is_object() {
+        let (trace_vars, trace_dims) = trace_variables(traces, units, abscissa);
+        dims.extend(trace_dims);
+        vars.extend(trace_vars);
+    }
+    Layout::new("stepped curve", &dims, vars)
+}
+
+/// The two `sweeps` of `doc` on the `grid` of the abscissa `x` (the first sweep's values):
+/// the `columns`, `stable`, `period` and `reached` over (sweep, abscissa), NaN (false, "")
+/// where a sweep has no point.
+fn sweep_variables(
+    doc: &Value,
+    sweeps: [&str; 2],
+    x: &str,
+    grid: &[f64],
+    columns: &[Column],
+) -> Vec<Variable> {
+    let units = &doc["units"];
     let index: HashMap<u64, usize> = grid.iter().enumerate().map(|(i, v)| (key(*v), i)).collect();
     let on_grid = |col: &str, put: &mut dyn FnMut(usize, &Value)| {
         for (s, name) in sweeps.iter().enumerate() {
@@ -116,70 +170,37 @@ pub fn curve_layout(doc: &Value) -> Layout {
         Values::F64(out)
     };
     let xdims = ["sweep", x];
-    let mut columns: Vec<(String, Option<String>, String)> = CURVE_COLUMNS
+    let mut vars: Vec<Variable> = columns
         .iter()
-        .map(|c| {
-            (
-                c.name.into(),
-                c.kind.key().map(Into::into),
-                c.long_name.into(),
-            )
+        .map(|(col, kind, long)| {
+            let unit = unit(units, kind.as_deref());
+            Variable::new(col, &xdims, &unit, long.as_str(), grid_f64(col))
         })
         .collect();
-    // under a multifrequency drive each component's (amplitude_i, phase_i_deg, …)
-    for c in list(&doc["drive_components"]["columns"]) {
-        let kind = c[1].as_str().map(Into::into);
-        columns.push((text(&c[0]), kind, text(&c[2])));
-    }
-    let mut vars = vec![
-        Variable::new(x, &[x], &x_unit, x_name, Values::F64(grid.clone())),
-        Variable::new(
-            "sweep",
-            &["sweep"],
-            "",
-            "sweep",
-            Values::Text(sweeps.map(Into::into).into()),
-        ),
-    ];
-    for (col, kind, long) in &columns {
-        vars.push(Variable::new(
-            col,
-            &xdims,
-            &unit(kind.as_deref()),
-            long.as_str(),
-            grid_f64(col),
-        ));
-    }
     let mut stable = vec![false; size];
     on_grid("stable", &mut |i, v| {
         stable[i] = v.as_bool().unwrap_or(false)
     });
-    vars.push(Variable::new(
-        "stable",
-        &xdims,
-        "",
-        STABLE,
-        Values::Bool(stable),
-    ));
-    let period = "n of the period-n motion (NaN: not periodic)";
-    vars.push(Variable::new(
-        "period",
-        &xdims,
-        "1",
-        period,
-        grid_f64("period"),
-    ));
     let mut reached = vec![String::new(); size];
     on_grid("reached", &mut |i, v| reached[i] = text(v));
+    let period = "n of the period-n motion (NaN: not periodic)";
     let how = "how the point's steady state was reached";
-    vars.push(Variable::new(
-        "reached",
-        &xdims,
-        "",
-        how,
-        Values::Text(reached),
-    ));
-    // the branches, concatenated
+    vars.extend([
+        Variable::new("stable", &xdims, "", STABLE, Values::Bool(stable)),
+        Variable::new("period", &xdims, "1", period, grid_f64("period")),
+        Variable::new("reached", &xdims, "", how, Values::Text(reached)),
+    ]);
+    vars
+}
+
+/// The branches of `doc` concatenated along `branch_point`: the branch index, the abscissa,
+/// the `columns`, `stable`, `period` and `event`; and the number of points.
+fn branch_variables(
+    doc: &Value,
+    (x, x_unit, x_name): Abscissa,
+    columns: &[Column],
+) -> (Vec<Variable>, usize) {
+    let units = &doc["units"];
     let branches = list(&doc["branches"]);
     let along =
         |col: &str| -> Vec<&Value> { branches.iter().flat_map(|b| list(&b[col])).collect() };
@@ -190,85 +211,75 @@ pub fn curve_layout(doc: &Value) -> Layout {
         .collect();
     let points = ids.len();
     let bp = ["branch_point"];
-    vars.push(Variable::new(
-        "branch",
-        &bp,
-        "",
-        "branch index",
-        Values::I32(ids),
-    ));
-    vars.push(Variable::new(
-        &format!("branch_{x}"),
-        &bp,
-        &x_unit,
-        x_name,
-        floats(x),
-    ));
-    for (col, kind, long) in &columns {
+    let mut vars = vec![
+        Variable::new("branch", &bp, "", "branch index", Values::I32(ids)),
+        Variable::new(&format!("branch_{x}"), &bp, x_unit, x_name, floats(x)),
+    ];
+    for (col, kind, long) in columns {
+        let unit = unit(units, kind.as_deref());
         let name = format!("branch_{col}");
-        vars.push(Variable::new(
-            &name,
-            &bp,
-            &unit(kind.as_deref()),
-            long.as_str(),
-            floats(col),
-        ));
+        vars.push(Variable::new(&name, &bp, &unit, long.as_str(), floats(col)));
     }
     let flags = along("stable")
         .into_iter()
         .map(|v| v.as_bool().unwrap_or(false));
-    vars.push(Variable::new(
-        "branch_stable",
-        &bp,
-        "",
-        STABLE,
-        Values::Bool(flags.collect()),
-    ));
     let orbit = "n of the period-n orbit";
-    vars.push(Variable::new(
-        "branch_period",
-        &bp,
-        "1",
-        orbit,
-        floats("period"),
-    ));
     let events = Values::Text(along("event").into_iter().map(text).collect());
     let event = "event at the point (fold, period-doubling, grazing, ...)";
-    vars.push(Variable::new("branch_event", &bp, "", event, events));
-    let mut dims = vec![(x, grid.len()), ("sweep", 2), ("branch_point", points)];
-    let traces = &doc["traces"];
-    if traces.is_object() {
-        let time = numbers(&traces["time_periods"]);
-        let at = numbers(&traces[x]);
-        dims.extend([("trace", at.len()), ("trace_time", time.len())]);
-        let within = "time within the recorded cycle";
-        vars.push(Variable::new(
+    vars.extend([
+        Variable::new(
+            "branch_stable",
+            &bp,
+            "",
+            STABLE,
+            Values::Bool(flags.collect()),
+        ),
+        Variable::new("branch_period", &bp, "1", orbit, floats("period")),
+        Variable::new("branch_event", &bp, "", event, events),
+    ]);
+    (vars, points)
+}
+
+/// The recorded cycles `traces` (their units in `units`): `trace_time` in drive periods, the
+/// abscissa of each trace and the traces over (`trace`, `trace_time`); and those two dimensions.
+fn trace_variables(
+    traces: &Value,
+    units: &Value,
+    (x, x_unit, x_name): Abscissa,
+) -> (Vec<Variable>, [(&'static str, usize); 2]) {
+    let time = numbers(&traces["time_periods"]);
+    let at = numbers(&traces[x]);
+    let dims = [("trace", at.len()), ("trace_time", time.len())];
+    let within = "time within the recorded cycle";
+    let mut vars = vec![
+        Variable::new(
             "trace_time",
             &["trace_time"],
             "drive periods",
             within,
             Values::F64(time),
-        ));
-        vars.push(Variable::new(
+        ),
+        Variable::new(
             &format!("trace_{x}"),
             &["trace"],
-            &x_unit,
+            x_unit,
             x_name,
             Values::F64(at),
+        ),
+    ];
+    for (var, kind, long) in TRACES {
+        let values = Values::F64(numbers(&traces[var]));
+        let name = format!("trace_{var}");
+        let unit = unit(units, Some(kind));
+        vars.push(Variable::new(
+            &name,
+            &["trace", "trace_time"],
+            &unit,
+            long,
+            values,
         ));
-        for (var, kind, long) in TRACES {
-            let values = Values::F64(numbers(&traces[var]));
-            let name = format!("trace_{var}");
-            vars.push(Variable::new(
-                &name,
-                &["trace", "trace_time"],
-                &unit(Some(kind)),
-                long,
-                values,
-            ));
-        }
     }
-    Layout::new("stepped curve", &dims, vars)
+    (vars, dims)
 }
 
 /// The per-component observables of a multifrequency drive: (key, kind of unit, long name).
@@ -348,22 +359,9 @@ const OBSERVED: [(&str, Option<&str>, &str); 4] = [
 pub fn observe_layout(doc: &Value, state: &[f64], period: Option<usize>) -> Layout {
     let r = &doc["reported"];
     let units = &r["units"];
-    let unit = |kind: Option<&str>| match kind {
-        None => "1".to_string(),
-        Some(k) => units
-            .get(k)
-            .and_then(Value::as_str)
-            .unwrap_or(k)
-            .to_string(),
-    };
     let scalar = |key: &str, kind: Option<&str>, long: &str| {
-        Variable::new(
-            key,
-            &[],
-            &unit(kind),
-            long,
-            Values::F64(vec![number(&r[key])]),
-        )
+        let value = Values::F64(vec![number(&r[key])]);
+        Variable::new(key, &[], &unit(units, kind), long, value)
     };
     let mut vars: Vec<Variable> = CURVE_COLUMNS
         .iter()
@@ -374,71 +372,13 @@ pub fn observe_layout(doc: &Value, state: &[f64], period: Option<usize>) -> Layo
             .iter()
             .map(|(k, kind, long)| scalar(k, *kind, long)),
     );
-    let h = &r["harmonics"];
-    let integers = |v: &Value| -> Vec<i32> {
-        list(v)
-            .iter()
-            .map(|x| x.as_i64().unwrap_or(0) as i32)
-            .collect()
-    };
-    let n = integers(&h["n"]);
-    let hd = ["harmonic"];
-    vars.push(Variable::new(
-        "harmonic",
-        &hd,
-        "",
-        "harmonic",
-        Values::I32(n.clone()),
-    ));
-    let amp = "amplitude of harmonic n";
-    let amplitude = Values::F64(numbers(&h["amplitude"]));
-    vars.push(Variable::new(
-        "harmonic_amplitude",
-        &hd,
-        &unit(Some("length")),
-        amp,
-        amplitude,
-    ));
-    let phase = Values::F64(numbers(&h["phase_deg"]));
-    let ph = "phase of harmonic n";
-    vars.push(Variable::new(
-        "harmonic_phase_deg",
-        &hd,
-        &unit(Some("phase")),
-        ph,
-        phase,
-    ));
-    let b = &r["mode_balance"];
-    let modes = integers(&b["mode"]);
-    vars.push(Variable::new(
-        "mode",
-        &["mode"],
-        "",
-        "mode",
-        Values::I32(modes.clone()),
-    ));
-    for term in [
-        "drive",
-        "beam_damping",
-        "sample",
-        "coupling",
-        "energy_change",
-        "residual",
-    ] {
-        let long = format!("energy balance of the mode per drive period: {term}");
-        let values = Values::F64(numbers(&b[term]));
-        let name = format!("mode_{term}");
-        vars.push(Variable::new(
-            &name,
-            &["mode"],
-            &unit(Some("energy")),
-            long,
-            values,
-        ));
-    }
+    let (harmonics, n) = harmonic_variables(&r["harmonics"], units);
+    vars.extend(harmonics);
+    let (balance, modes) = mode_balance_variables(&r["mode_balance"], units);
+    vars.extend(balance);
     let mut dims = vec![
-        ("harmonic", n.len()),
-        ("mode", modes.len()),
+        ("harmonic", n),
+        ("mode", modes),
         ("state_index", state.len()),
     ];
     let comp = &r["components"];
@@ -457,7 +397,13 @@ pub fn observe_layout(doc: &Value, state: &[f64], period: Option<usize>) -> Layo
         for (key, kind, long) in COMPONENTS {
             let values = Values::F64(numbers(&comp[key]));
             let name = format!("component_{key}");
-            vars.push(Variable::new(&name, &cd, &unit(Some(kind)), long, values));
+            vars.push(Variable::new(
+                &name,
+                &cd,
+                &unit(units, Some(kind)),
+                long,
+                values,
+            ));
         }
         let over = "frequency over the first's";
         vars.push(Variable::new(
@@ -475,4 +421,61 @@ pub fn observe_layout(doc: &Value, state: &[f64], period: Option<usize>) -> Layo
     let p = Values::F64(vec![period.map_or(f64::NAN, |n| n as f64)]);
     vars.push(Variable::new("period", &[], "1", n_of, p));
     Layout::new("observe", &dims, vars)
+}
+
+/// Integers (`null` and others as 0).
+fn integers(v: &Value) -> Vec<i32> {
+    list(v)
+        .iter()
+        .map(|x| x.as_i64().unwrap_or(0) as i32)
+        .collect()
+}
+
+/// The harmonics `h` of an `observe` document: their orders n, amplitudes and phases over
+/// `harmonic`; and how many.
+fn harmonic_variables(h: &Value, units: &Value) -> (Vec<Variable>, usize) {
+    let n = integers(&h["n"]);
+    let count = n.len();
+    let hd = ["harmonic"];
+    let amp = "amplitude of harmonic n";
+    let amplitude = Values::F64(numbers(&h["amplitude"]));
+    let length = unit(units, Some("length"));
+    let phase = Values::F64(numbers(&h["phase_deg"]));
+    let ph = "phase of harmonic n";
+    let deg = unit(units, Some("phase"));
+    let vars = vec![
+        Variable::new("harmonic", &hd, "", "harmonic", Values::I32(n)),
+        Variable::new("harmonic_amplitude", &hd, &length, amp, amplitude),
+        Variable::new("harmonic_phase_deg", &hd, &deg, ph, phase),
+    ];
+    (vars, count)
+}
+
+/// The per-mode energy balance `b` of an `observe` document over `mode`: the modes and each
+/// term; and how many modes.
+fn mode_balance_variables(b: &Value, units: &Value) -> (Vec<Variable>, usize) {
+    let modes = integers(&b["mode"]);
+    let count = modes.len();
+    let mut vars = vec![Variable::new(
+        "mode",
+        &["mode"],
+        "",
+        "mode",
+        Values::I32(modes),
+    )];
+    let energy = unit(units, Some("energy"));
+    for term in [
+        "drive",
+        "beam_damping",
+        "sample",
+        "coupling",
+        "energy_change",
+        "residual",
+    ] {
+        let long = format!("energy balance of the mode per drive period: {term}");
+        let values = Values::F64(numbers(&b[term]));
+        let name = format!("mode_{term}");
+        vars.push(Variable::new(&name, &["mode"], &energy, long, values));
+    }
+    (vars, count)
 }

@@ -5,12 +5,13 @@
 //! and the identifiability warnings. Everything is SI (m, N, Pa, J/m²); a probe file is
 //! needed (the lever's spring constant, the start values and the held parameters).
 
+use super::fit_result::probe_value;
 pub use super::fit_result::{bounds, intervals_method, FitResult, MIN_FIT_ROWS};
 use super::limits::Cost;
 use super::run::{Analysis, Resolved};
 use crate::analysis::fit::force_curve::{
-    preprocess, ForceCurveModel, ForceLaw, Segment, BASELINE, CONTACT_POINT, HAMAKER, RADIUS,
-    YOUNGS_MODULUS,
+    preprocess, ForceCurveModel, ForceLaw, Preprocessed, Segment, BASELINE, CONTACT_POINT, HAMAKER,
+    RADIUS, YOUNGS_MODULUS,
 };
 use crate::analysis::fit::profile::ProfileWalk;
 use crate::analysis::fit::sls_curve::{
@@ -19,6 +20,7 @@ use crate::analysis::fit::sls_curve::{
 use crate::analysis::fit::{fit_cancellable, CurveModel, Observations, Parameter, ProfileEnd};
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
+use crate::probe::SampleInputs;
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 
@@ -340,6 +342,140 @@ fn check_columns(
     Ok(())
 }
 
+impl FitRequest {
+    /// The curve of `height` and `force` (and the sls law's `time`) preprocessed with the
+    /// lever's spring constant `k`, its approach `approach_rows` long when given.
+    ///
+    /// # Errors
+    /// [`SimError::OutOfRange`] naming `approach_rows` beyond the curve's rows, or `time` for
+    /// the sls law without it.
+    fn preprocessed(
+        &self,
+        law: ForceLaw,
+        height: &[f64],
+        force: &[f64],
+        time: Option<Vec<f64>>,
+        k: f64,
+    ) -> Result<Preprocessed, SimError> {
+        let mut curve = preprocess(height, force, k);
+        if let Some(n) = self.approach_rows {
+            if !(1..=force.len()).contains(&n) {
+                return Err(bad(
+                    "approach_rows",
+                    n,
+                    format!("must be 1..={} (the curve's rows)", force.len()),
+                ));
+            }
+            curve.approach_len = n;
+        }
+        if law == ForceLaw::Sls && time.is_none() {
+            return Err(bad(
+                "time",
+                "missing",
+                "the sls law's force depends on the indentation's history: give the rows' \
+                 times (s), a time column"
+                    .into(),
+            ));
+        }
+        curve.time = time;
+        Ok(curve)
+    }
+}
+
+/// The rows of `curve`'s `segment` in `range`, enough of them to fit `fitted` parameters.
+///
+/// # Errors
+/// [`SimError::OutOfRange`] naming `range` when there are too few.
+fn fit_rows(
+    curve: &Preprocessed,
+    segment: Segment,
+    range: Option<[f64; 2]>,
+    fitted: usize,
+) -> Result<Vec<usize>, SimError> {
+    let rows = curve.rows(segment, range);
+    if rows.len() < MIN_FIT_ROWS.max(fitted + 1) {
+        return Err(bad(
+            "range",
+            format!("{} rows", rows.len()),
+            format!(
+                "too few rows of the {} in the range to fit {fitted} parameters",
+                match segment {
+                    Segment::Approach => "approach",
+                    Segment::Retract => "retract",
+                    Segment::Whole => "curve",
+                },
+            ),
+        ));
+    }
+    Ok(rows)
+}
+
+/// Every parameter of the law (`names`) with its start (the probe's sample `s`; the contact
+/// point and baseline at 0), scale (the tip positions `x` and forces `y` fitted for those
+/// two) and range.
+///
+/// # Errors
+/// [`SimError::OutOfRange`] naming `probe` and the first value the probe lacks.
+fn start_values(
+    names: &[&'static str],
+    s: &SampleInputs,
+    x: &[f64],
+    y: &[f64],
+) -> Result<Vec<Parameter>, SimError> {
+    let span = x.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    let fmax = y.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    let mut params = Vec::new();
+    for &name in names {
+        let (start, scale) = match name {
+            CONTACT_POINT => (0.0, (0.1 * span).max(1e-12)),
+            BASELINE => (0.0, (0.01 * fmax).max(1e-15)),
+            HAMAKER => {
+                let h = probe_value(s.hamaker, HAMAKER)?;
+                (h, h.max(1e-21))
+            }
+            YOUNGS_MODULUS | RADIUS | STIFFNESS | MAXWELL_STIFFNESS | RELAXATION_TIME => {
+                let v = match name {
+                    YOUNGS_MODULUS => s.youngs_modulus,
+                    RADIUS => s.radius,
+                    STIFFNESS => s.stiffness,
+                    MAXWELL_STIFFNESS => s.maxwell_stiffness,
+                    _ => s.relaxation_time,
+                };
+                let v = probe_value(v, name)?;
+                (v, v)
+            }
+            _ => {
+                let w = probe_value(s.adhesion_energy, "sample.adhesion_energy")?;
+                (w, w.max(1e-3))
+            }
+        };
+        let (lower, upper) = bounds(name);
+        params.push(Parameter {
+            name: name.into(),
+            start,
+            lower,
+            upper,
+            scale,
+        });
+    }
+    Ok(params)
+}
+
+/// The warning of an sls fit (its values `p`) whose curve is in contact at its first row: the
+/// model starts the sample at rest there.
+fn sls_start_warning(model: &SlsCurveModel, p: &[f64]) -> Option<String> {
+    let mut f = vec![0.0; model.height.len()];
+    model.forces(p, &mut f, None);
+    f.first().is_some_and(|f| *f > 0.0).then(|| {
+        format!(
+            "the fitted curve is in contact at its first row ({:.3e} N): the sls model \
+             starts the sample at rest there, so a curve that starts on the surface is \
+             misfitted; record the approach from off the surface",
+            f[0]
+        )
+    })
+}
+
 impl Analysis for FitRequest {
     type Output = FitResult;
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
@@ -368,94 +504,15 @@ impl Analysis for FitRequest {
         let probe = model.probe.as_ref().expect("checked");
         let k = probe.calibration.spring_constant;
         let s = probe.sample_inputs;
-        let mut curve = preprocess(&height, &force, k);
-        if let Some(n) = self.approach_rows {
-            if !(1..=force.len()).contains(&n) {
-                return Err(bad(
-                    "approach_rows",
-                    n,
-                    format!("must be 1..={} (the curve's rows)", force.len()),
-                ));
-            }
-            curve.approach_len = n;
-        }
-        if law == ForceLaw::Sls && time.is_none() {
-            return Err(bad(
-                "time",
-                "missing",
-                "the sls law's force depends on the indentation's history: give the rows' \
-                 times (s), a time column"
-                    .into(),
-            ));
-        }
-        curve.time = time;
+        let curve = self.preprocessed(law, &height, &force, time, k)?;
         let segment = self.segment_of(law);
         let fit = self.fitted(law);
-        let rows = curve.rows(segment, self.range);
-        if rows.len() < MIN_FIT_ROWS.max(fit.len() + 1) {
-            return Err(bad(
-                "range",
-                format!("{} rows", rows.len()),
-                format!(
-                    "too few rows of the {} in the range to fit {} parameters",
-                    match segment {
-                        Segment::Approach => "approach",
-                        Segment::Retract => "retract",
-                        Segment::Whole => "curve",
-                    },
-                    fit.len()
-                ),
-            ));
-        }
+        let rows = fit_rows(&curve, segment, self.range, fit.len())?;
         let x: Vec<f64> = rows.iter().map(|&i| curve.tip_position[i]).collect();
         let y: Vec<f64> = rows.iter().map(|&i| curve.force[i]).collect();
         let sig: Option<Vec<f64>> = sigma.map(|s| rows.iter().map(|&i| s[i]).collect());
-        let span = x.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
-        let fmax = y.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
         let names = law.parameter_names().to_vec();
-        let need = |v: Option<f64>, key: &str| {
-            v.ok_or_else(|| bad("probe", key, format!("the fit needs the probe's {key}")))
-        };
-        let mut params = Vec::new();
-        for name in &names {
-            let (start, scale) = match *name {
-                YOUNGS_MODULUS => {
-                    let e = need(s.youngs_modulus, YOUNGS_MODULUS)?;
-                    (e, e)
-                }
-                RADIUS => {
-                    let r = need(s.radius, RADIUS)?;
-                    (r, r)
-                }
-                CONTACT_POINT => (0.0, (0.1 * span).max(1e-12)),
-                BASELINE => (0.0, (0.01 * fmax).max(1e-15)),
-                HAMAKER => {
-                    let h = need(s.hamaker, HAMAKER)?;
-                    (h, h.max(1e-21))
-                }
-                STIFFNESS | MAXWELL_STIFFNESS | RELAXATION_TIME => {
-                    let v = match *name {
-                        STIFFNESS => s.stiffness,
-                        MAXWELL_STIFFNESS => s.maxwell_stiffness,
-                        _ => s.relaxation_time,
-                    };
-                    let v = need(v, name)?;
-                    (v, v)
-                }
-                _ => {
-                    let w = need(s.adhesion_energy, "sample.adhesion_energy")?;
-                    (w, w.max(1e-3))
-                }
-            };
-            let (lower, upper) = bounds(name);
-            params.push(Parameter {
-                name: (*name).into(),
-                start,
-                lower,
-                upper,
-                scale,
-            });
-        }
+        let params = start_values(&names, &s, &x, &y)?;
         let fitted: Vec<bool> = names.iter().map(|n| fit.iter().any(|f| f == n)).collect();
         let fixed: Vec<Option<f64>> = params
             .iter()
@@ -483,10 +540,10 @@ impl Analysis for FitRequest {
                     law,
                     x,
                     segment,
-                    poisson_ratio: need(s.poisson_ratio, "sample.poisson_ratio")?,
+                    poisson_ratio: probe_value(s.poisson_ratio, "sample.poisson_ratio")?,
                     tip: (
-                        need(s.tip_youngs_modulus, "tip.youngs_modulus")?,
-                        need(s.tip_poisson_ratio, "tip.poisson_ratio")?,
+                        probe_value(s.tip_youngs_modulus, "tip.youngs_modulus")?,
+                        probe_value(s.tip_poisson_ratio, "tip.poisson_ratio")?,
                     ),
                     intermolecular_distance: s.intermolecular_distance.unwrap_or(0.0),
                 };
@@ -500,19 +557,10 @@ impl Analysis for FitRequest {
         };
         let walk = self.profiles.unwrap_or(true).then_some(ProfileWalk::Grid);
         let mut outcome = fit_cancellable(m, &obs, &params, &fixed, walk, progress)?;
-        // the SLS starts from rest at the first row: a fit that puts the tip on the sample
-        // there broke that assumption
         if let Some(model) = &sls {
-            let mut f = vec![0.0; model.height.len()];
-            model.forces(&outcome.values, &mut f, None);
-            if f.first().is_some_and(|f| *f > 0.0) {
-                outcome.warnings.push(format!(
-                    "the fitted curve is in contact at its first row ({:.3e} N): the sls model \
-                     starts the sample at rest there, so a curve that starts on the surface is \
-                     misfitted; record the approach from off the surface",
-                    f[0]
-                ));
-            }
+            outcome
+                .warnings
+                .extend(sls_start_warning(model, &outcome.values));
         }
         Ok(FitResult {
             law,

@@ -14,7 +14,7 @@
 //! fit's shape (estimates with value, standard error and interval, correlation, χ²/dof, the
 //! curve beside the data with its residuals, warnings).
 
-use super::fit_result::{bounds, FitResult, MIN_FIT_ROWS};
+use super::fit_result::{bounds, probe_value, FitResult, MIN_FIT_ROWS};
 pub use super::fit_result::{AmData, DynamicFit, CURVE_VARIABLES};
 use super::run::Resolved;
 use crate::analysis::fit::am_curve::{AmCurveModel, AmParam, AmProbe, Z_OFFSET};
@@ -205,101 +205,7 @@ pub fn execute(
         })?;
     let am_probe = am_probe(probe)?;
     let names = fitted_names(fit, default_fit, law_name);
-    let mut params = Vec::new();
-    let mut am = Vec::new();
-    for n in &names {
-        let p = AmParam::from_name(n).ok_or_else(|| {
-            bad(
-                "fit",
-                n,
-                "the dynamic fit's parameters are sample.youngs_modulus, sample.hamaker (dmt), \
-                 sample.viscosity (dmt, jkr), sample.damping (hertz), sample.adhesion_energy (jkr), \
-                 tip.radius, \
-                 cantilever.quality_factor, drive.free_amplitude and z_offset"
-                    .into(),
-            )
-        })?;
-        if p == AmParam::Hamaker && law_name != "dmt" {
-            return Err(bad("fit", n, "sample.hamaker is DMT's".into()));
-        }
-        if p == AmParam::Damping && law_name != "hertz" {
-            return Err(bad(
-                "fit",
-                n,
-                "sample.damping is the hertz law's damper (the Kelvin–Voigt term of dmt and \
-                 jkr is sample.viscosity, Pa s)"
-                    .into(),
-            ));
-        }
-        if p == AmParam::Viscosity && law_name == "hertz" {
-            // η (Pa s) is DMT's and JKR's Kelvin–Voigt term; the hertz law's dashpot is its
-            // damping c (N s/m)
-            return Err(bad(
-                "fit",
-                n,
-                "sample.viscosity is the Kelvin–Voigt term of dmt and jkr; the hertz law's \
-                 damper is sample.damping (N s/m)"
-                    .into(),
-            ));
-        }
-        if p == AmParam::AdhesionEnergy && law_name != "jkr" {
-            return Err(bad(
-                "fit",
-                n,
-                "sample.adhesion_energy is the jkr law's work of adhesion (DMT's adhesion is \
-                 its sample.hamaker)"
-                    .into(),
-            ));
-        }
-        if am.contains(&p) {
-            return Err(bad("fit", n, "named twice".into()));
-        }
-        lever_refusal(p, probe, &data).map_or(Ok(()), |why| Err(bad("fit", n, why.into())))?;
-        let (start, scale) = match p {
-            AmParam::YoungsModulus => (am_probe.youngs_modulus, am_probe.youngs_modulus),
-            AmParam::Hamaker => (am_probe.hamaker, am_probe.hamaker.max(1e-21)),
-            AmParam::TipRadius => (am_probe.radius, am_probe.radius),
-            AmParam::ZOffset => (0.0, 0.1 * am_probe.length_m),
-            AmParam::QualityFactor => (am_probe.quality_factor, am_probe.quality_factor),
-            AmParam::FreeAmplitude => (am_probe.length_m, am_probe.length_m),
-            // the probe's c; its scale c itself, or (c = 0, an undamped start) the c whose
-            // α6 is 1 % of α4 (a dashpot force α6 δ̇ at the rate g₀/t_s of 1 % of the Hertz
-            // force at δ = g₀)
-            AmParam::Damping => {
-                let c = am_probe.params.alpha6 / am_probe.damping_unit;
-                let typical = 0.01 * am_probe.params.alpha4 / am_probe.damping_unit;
-                (c, if c > 0.0 { c } else { typical })
-            }
-            // the probe's η; its scale η itself, or (η = 0) the η whose α6 is 1 % of α4, as
-            // the hertz damper's
-            AmParam::Viscosity => {
-                let eta = am_probe.viscosity();
-                let unit = am_probe.viscosity_unit(am_probe.radius);
-                let typical = 0.01 * am_probe.params.alpha4 / unit;
-                (eta, if eta > 0.0 { eta } else { typical })
-            }
-            // the probe's W (J/m²), its own scale (JKR's P̃ > 0, so W > 0)
-            AmParam::AdhesionEnergy => {
-                let w = am_probe.adhesion_energy();
-                (w, w)
-            }
-        };
-        // the physical range's lower end only: MINUIT's sine map of a two-sided range squashes
-        // a value near its lower end (a modulus of GPa in a range to TPa), where the
-        // one-sided map keeps its scale
-        let (lower, upper) = match p {
-            AmParam::ZOffset => (-am_probe.length_m * 10.0, am_probe.length_m * 10.0),
-            _ => (bounds(n).0, f64::INFINITY),
-        };
-        am.push(p);
-        params.push(Parameter {
-            name: n.clone(),
-            start,
-            lower,
-            upper,
-            scale,
-        });
-    }
+    let (am, mut params) = parameters(&names, probe, &am_probe, &data)?;
     // z and frequency_shift make an FM curve (its amplitude and phase columns not fitted)
     let fm = data.frequency_shift.is_some();
     let channels = if fm {
@@ -308,8 +214,7 @@ pub fn execute(
         (data.amplitude.is_some(), data.phase.is_some())
     };
     let second = (data.amplitude_2.is_some(), data.phase_2.is_some());
-    let bimodal = second.0 || second.1;
-    if bimodal && !probe.params.is_multifrequency() {
+    if (second.0 || second.1) && !probe.params.is_multifrequency() {
         return Err(bad(
             "probe",
             "a single-frequency drive",
@@ -318,40 +223,10 @@ pub fn execute(
                 .into(),
         ));
     }
-    let (z_index, g0) = (
-        am.iter().position(|&p| p == AmParam::ZOffset),
-        am_probe.length_m,
-    );
+    let z_index = am.iter().position(|&p| p == AmParam::ZOffset);
     let hz = probe.scales.frequency_hz(1.0);
-    let fm_model = fm.then(|| FmCurveModel::new(am_probe, data.z.clone(), am.clone(), hz));
-    let bimodal_model = bimodal.then(|| {
-        let on = [channels.0, channels.1, second.0, second.1];
-        BimodalCurveModel::new(am_probe, data.z.clone(), on, am.clone())
-    });
-    let am_model = AmCurveModel::new(am_probe, data.z.clone(), channels, am);
-    let curve: &dyn CurveModel = match (&fm_model, &bimodal_model) {
-        (Some(m), _) => m,
-        (None, Some(m)) => m,
-        _ => &am_model,
-    };
-    let mut y = Vec::new();
-    let mut sigma = Vec::new();
-    let fm_columns = [(&data.frequency_shift, &data.sigma_frequency_shift)];
-    let am_columns = [
-        (&data.amplitude, &data.sigma_amplitude),
-        (&data.phase, &data.sigma_phase),
-        (&data.amplitude_2, &data.sigma_amplitude_2),
-        (&data.phase_2, &data.sigma_phase_2),
-    ];
-    for (c, sg) in if fm { &fm_columns[..] } else { &am_columns[..] } {
-        if let Some(c) = c {
-            y.extend_from_slice(c);
-            if let Some(sg) = sg {
-                sigma.extend_from_slice(sg);
-            }
-        }
-    }
-    let sigma = (sigma.len() == y.len()).then_some(sigma);
+    let curve = DynamicModel::new(am_probe, &data, channels, second, am, hz);
+    let (y, sigma) = observations(&data);
     progress.check()?;
     let obs = Observations {
         y: &y,
@@ -361,19 +236,16 @@ pub fn execute(
     // z_offset's start: the best χ² on a grid (the model's first rows otherwise follow another
     // branch than the data's, and Levenberg–Marquardt stops in that local minimum)
     if let Some(k) = z_index {
-        params[k].start = grid_start(curve, &obs, &params, k, z_offset_grid(g0), progress)?;
+        let grid = z_offset_grid(am_probe.length_m);
+        params[k].start = grid_start(curve.curve(), &obs, &params, k, grid, progress)?;
     }
     // each profile point a refit of stepped approaches (FM curves): the secant walk, when
     // asked for
     let walk = profiles.then_some(ProfileWalk::Secant {
         max_steps: MAX_SECANT_STEPS,
     });
-    let mut outcome = fit_cancellable(curve, &obs, &params, &fixed, walk, progress)?;
-    let model_warnings = match (&fm_model, &bimodal_model) {
-        (Some(m), _) => m.warnings(),
-        (None, Some(m)) => m.warnings(),
-        _ => am_model.warnings(),
-    };
+    let mut outcome = fit_cancellable(curve.curve(), &obs, &params, &fixed, walk, progress)?;
+    let model_warnings = curve.warnings();
     outcome.warnings.extend(model_warnings.iter().cloned());
     if fm && (data.amplitude.is_some() || data.phase.is_some()) {
         outcome.warnings.push(
@@ -404,26 +276,203 @@ pub fn execute(
     })
 }
 
+/// The parameters `names` of the dynamic fit on `data` under `probe` (its SI values
+/// `am_probe`): each one's [`AmParam`] and its start, scale and range.
+///
+/// # Errors
+/// [`SimError::OutOfRange`] naming `fit` for an unknown parameter, one of another law, one
+/// named twice or one the lever or drive cannot fit ([`lever_refusal`]).
+fn parameters(
+    names: &[String],
+    probe: &crate::probe::Probe,
+    am_probe: &AmProbe,
+    data: &AmData,
+) -> Result<(Vec<AmParam>, Vec<Parameter>), SimError> {
+    let law_name = probe.params.contact_law.name();
+    let mut params = Vec::new();
+    let mut am = Vec::new();
+    for n in names {
+        let p = AmParam::from_name(n).ok_or_else(|| {
+            bad(
+                "fit",
+                n,
+                "the dynamic fit's parameters are sample.youngs_modulus, sample.hamaker (dmt), \
+                 sample.viscosity (dmt, jkr), sample.damping (hertz), sample.adhesion_energy (jkr), \
+                 tip.radius, \
+                 cantilever.quality_factor, drive.free_amplitude and z_offset"
+                    .into(),
+            )
+        })?;
+        law_refusal(p, law_name).map_or(Ok(()), |why| Err(bad("fit", n, why.into())))?;
+        if am.contains(&p) {
+            return Err(bad("fit", n, "named twice".into()));
+        }
+        lever_refusal(p, probe, data).map_or(Ok(()), |why| Err(bad("fit", n, why.into())))?;
+        let (start, scale) = start_and_scale(p, am_probe);
+        // the physical range's lower end only: MINUIT's sine map of a two-sided range squashes
+        // a value near its lower end (a modulus of GPa in a range to TPa), where the
+        // one-sided map keeps its scale
+        let (lower, upper) = match p {
+            AmParam::ZOffset => (-am_probe.length_m * 10.0, am_probe.length_m * 10.0),
+            _ => (bounds(n).0, f64::INFINITY),
+        };
+        am.push(p);
+        params.push(Parameter {
+            name: n.clone(),
+            start,
+            lower,
+            upper,
+            scale,
+        });
+    }
+    Ok((am, params))
+}
+
+/// Why `p` is not a parameter of the contact law `law_name`, if so.
+fn law_refusal(p: AmParam, law_name: &str) -> Option<&'static str> {
+    match p {
+        AmParam::Hamaker if law_name != "dmt" => Some("sample.hamaker is DMT's"),
+        AmParam::Damping if law_name != "hertz" => Some(
+            "sample.damping is the hertz law's damper (the Kelvin–Voigt term of dmt and \
+             jkr is sample.viscosity, Pa s)",
+        ),
+        // η (Pa s) is DMT's and JKR's Kelvin–Voigt term; the hertz law's dashpot is its
+        // damping c (N s/m)
+        AmParam::Viscosity if law_name == "hertz" => Some(
+            "sample.viscosity is the Kelvin–Voigt term of dmt and jkr; the hertz law's \
+             damper is sample.damping (N s/m)",
+        ),
+        AmParam::AdhesionEnergy if law_name != "jkr" => Some(
+            "sample.adhesion_energy is the jkr law's work of adhesion (DMT's adhesion is \
+             its sample.hamaker)",
+        ),
+        _ => None,
+    }
+}
+
+/// The start value of `p` (the probe's, z_offset 0) and its scale.
+fn start_and_scale(p: AmParam, am_probe: &AmProbe) -> (f64, f64) {
+    match p {
+        AmParam::YoungsModulus => (am_probe.youngs_modulus, am_probe.youngs_modulus),
+        AmParam::Hamaker => (am_probe.hamaker, am_probe.hamaker.max(1e-21)),
+        AmParam::TipRadius => (am_probe.radius, am_probe.radius),
+        AmParam::ZOffset => (0.0, 0.1 * am_probe.length_m),
+        AmParam::QualityFactor => (am_probe.quality_factor, am_probe.quality_factor),
+        AmParam::FreeAmplitude => (am_probe.length_m, am_probe.length_m),
+        // the probe's c; its scale c itself, or (c = 0, an undamped start) the c whose
+        // α6 is 1 % of α4 (a dashpot force α6 δ̇ at the rate g₀/t_s of 1 % of the Hertz
+        // force at δ = g₀)
+        AmParam::Damping => {
+            let c = am_probe.params.alpha6 / am_probe.damping_unit;
+            let typical = 0.01 * am_probe.params.alpha4 / am_probe.damping_unit;
+            (c, if c > 0.0 { c } else { typical })
+        }
+        // the probe's η; its scale η itself, or (η = 0) the η whose α6 is 1 % of α4, as
+        // the hertz damper's
+        AmParam::Viscosity => {
+            let eta = am_probe.viscosity();
+            let unit = am_probe.viscosity_unit(am_probe.radius);
+            let typical = 0.01 * am_probe.params.alpha4 / unit;
+            (eta, if eta > 0.0 { eta } else { typical })
+        }
+        // the probe's W (J/m²), its own scale (JKR's P̃ > 0, so W > 0)
+        AmParam::AdhesionEnergy => {
+            let w = am_probe.adhesion_energy();
+            (w, w)
+        }
+    }
+}
+
+/// The values fitted and their σ (when every channel has its σ column): the frequency shift of
+/// an FM curve, else the amplitude, phase, A₂ and φ₂ columns given, in that order.
+fn observations(data: &AmData) -> (Vec<f64>, Option<Vec<f64>>) {
+    let mut y = Vec::new();
+    let mut sigma = Vec::new();
+    let fm_columns = [(&data.frequency_shift, &data.sigma_frequency_shift)];
+    let am_columns = [
+        (&data.amplitude, &data.sigma_amplitude),
+        (&data.phase, &data.sigma_phase),
+        (&data.amplitude_2, &data.sigma_amplitude_2),
+        (&data.phase_2, &data.sigma_phase_2),
+    ];
+    let fm = data.frequency_shift.is_some();
+    for (c, sg) in if fm { &fm_columns[..] } else { &am_columns[..] } {
+        if let Some(c) = c {
+            y.extend_from_slice(c);
+            if let Some(sg) = sg {
+                sigma.extend_from_slice(sg);
+            }
+        }
+    }
+    let sigma = (sigma.len() == y.len()).then_some(sigma);
+    (y, sigma)
+}
+
+/// The model of a dynamic curve: an FM curve's, a bimodal one's or an AM one's.
+enum DynamicModel {
+    Fm(FmCurveModel),
+    Bimodal(BimodalCurveModel),
+    Am(AmCurveModel),
+}
+
+impl DynamicModel {
+    /// The model of `data` (an FM curve when it has a frequency shift, else bimodal when a
+    /// `second` channel is fitted, else AM with its `channels`) in the parameters `am`.
+    fn new(
+        am_probe: AmProbe,
+        data: &AmData,
+        channels: (bool, bool),
+        second: (bool, bool),
+        am: Vec<AmParam>,
+        hz: f64,
+    ) -> Self {
+        let z = data.z.clone();
+        if data.frequency_shift.is_some() {
+            DynamicModel::Fm(FmCurveModel::new(am_probe, z, am, hz))
+        } else if second.0 || second.1 {
+            let on = [channels.0, channels.1, second.0, second.1];
+            DynamicModel::Bimodal(BimodalCurveModel::new(am_probe, z, on, am))
+        } else {
+            DynamicModel::Am(AmCurveModel::new(am_probe, z, channels, am))
+        }
+    }
+
+    /// The model fitted.
+    fn curve(&self) -> &dyn CurveModel {
+        match self {
+            DynamicModel::Fm(m) => m,
+            DynamicModel::Bimodal(m) => m,
+            DynamicModel::Am(m) => m,
+        }
+    }
+
+    /// Its last evaluation's warnings.
+    fn warnings(&self) -> Vec<String> {
+        match self {
+            DynamicModel::Fm(m) => m.warnings(),
+            DynamicModel::Bimodal(m) => m.warnings(),
+            DynamicModel::Am(m) => m.warnings(),
+        }
+    }
+}
+
 /// The SI values of `probe` the dynamic fit's models scale from ([`AmProbe`]).
 ///
 /// # Errors
 /// [`SimError::OutOfRange`] naming the first of E_s, ν_s, E_t, ν_t and R the probe lacks.
 pub fn am_probe(probe: &crate::probe::Probe) -> Result<AmProbe, SimError> {
     let s = probe.sample_inputs;
-    let need = |v: Option<f64>, key: &str| {
-        v.ok_or_else(|| bad("probe", key, format!("the fit needs the probe's {key}")))
-    };
     Ok(AmProbe {
         params: probe.params,
         length_m: probe.scales.length_m,
-        youngs_modulus: need(s.youngs_modulus, "sample.youngs_modulus")?,
-        poisson_ratio: need(s.poisson_ratio, "sample.poisson_ratio")?,
+        youngs_modulus: probe_value(s.youngs_modulus, "sample.youngs_modulus")?,
+        poisson_ratio: probe_value(s.poisson_ratio, "sample.poisson_ratio")?,
         tip: (
-            need(s.tip_youngs_modulus, "tip.youngs_modulus")?,
-            need(s.tip_poisson_ratio, "tip.poisson_ratio")?,
+            probe_value(s.tip_youngs_modulus, "tip.youngs_modulus")?,
+            probe_value(s.tip_poisson_ratio, "tip.poisson_ratio")?,
         ),
         hamaker: s.hamaker.unwrap_or(0.0),
-        radius: need(s.radius, "tip.radius")?,
+        radius: probe_value(s.radius, "tip.radius")?,
         damping_unit: probe.scales.length_m / (probe.scales.time_s * probe.scales.force_n),
         quality_factor: probe.calibration.quality_factor,
     })

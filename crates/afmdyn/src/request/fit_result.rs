@@ -4,6 +4,7 @@
 
 use crate::analysis::fit::force_curve::{ForceLaw, Preprocessed};
 use crate::analysis::fit::FitOutcome;
+use crate::error::SimError;
 use crate::probe::ranges::si_range;
 
 /// The variables of a dynamic fit's curve (name, unit, label): the columns of its table and
@@ -64,6 +65,16 @@ pub fn bounds(name: &str) -> (f64, f64) {
     let lo = range.and_then(|r| r.below).map_or(0.0, |b| b.0);
     let hi = range.and_then(|r| r.above).map_or(f64::INFINITY, |b| b.0);
     (lo, hi)
+}
+
+/// The probe's value `v` of `key`, which the fit needs.
+///
+/// # Errors
+/// [`SimError::OutOfRange`] naming `probe` and `key` when the probe lacks it.
+pub(crate) fn probe_value(v: Option<f64>, key: &str) -> Result<f64, SimError> {
+    v.ok_or_else(|| {
+        SimError::out_of_range("probe", key, format!("the fit needs the probe's {key}"))
+    })
 }
 
 /// The result of a `fit` request.

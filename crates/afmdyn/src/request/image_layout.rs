@@ -211,67 +211,12 @@ pub fn scan_layout(img: &PiImage, setpoint: f64) -> Layout {
     let (nx, ny) = (g.x.len(), g.y.len());
     let cells = || (0..ny).flat_map(move |j| (0..nx).map(move |i| (j, i)));
     let grid: &[&str] = &["y", "x"];
-    let (m, e, f) = (img.length(), img.energy(), img.force());
     let mut variables = vec![
         Variable::f64("x", &["x"], "m", "pixel centre x", &g.x),
         Variable::f64("y", &["y"], "m", "line position y", &g.y),
     ];
     for (d, suffix) in [(0, ""), (1, "_retrace")] {
-        let pixel = |j: usize, i: usize| {
-            if d == 0 {
-                &img.lines[j].trace[i]
-            } else {
-                &img.lines[j].retrace[i]
-            }
-        };
-        for (name, units, long_name) in SCAN_FIELDS {
-            let values: Vec<f64> = cells()
-                .map(|(j, i)| {
-                    let p = pixel(j, i);
-                    match name {
-                        "height" => img.height(d, j, i),
-                        "amplitude" => p.amplitude * m,
-                        "phase_deg" => p.phase.to_degrees(),
-                        "tracking_error" => p.tracking_error * m,
-                        "energy_dissipated" => p.energy_dissipated * e,
-                        "virial" => p.virial * e,
-                        "peak_force" => p.peak_force * f,
-                        _ => p.indentation * m,
-                    }
-                })
-                .collect();
-            variables.push(Variable::f64(
-                &format!("{name}{suffix}"),
-                grid,
-                units,
-                long_name,
-                &values,
-            ));
-        }
-        let lost: Vec<bool> = cells().map(|(j, i)| pixel(j, i).lost_contact).collect();
-        variables.push(Variable::new(
-            &format!("lost_contact{suffix}"),
-            grid,
-            "1",
-            "the controller lost contact (parachuting) in the pixel's last drive period",
-            Values::Bool(lost),
-        ));
-        let regime: Vec<i32> = cells()
-            .map(|(j, i)| {
-                if crate::report::regime(pixel(j, i).mean_deflection) == "attractive" {
-                    REGIME_FLAGS[1].0
-                } else {
-                    REGIME_FLAGS[2].0
-                }
-            })
-            .collect();
-        variables.push(regime_variable(&format!("regime{suffix}"), &regime));
-        let material: Vec<i32> = cells().map(|(j, i)| pixel(j, i).material as i32).collect();
-        variables.push(material_variable(
-            g,
-            &format!("material{suffix}"),
-            &material,
-        ));
+        variables.extend(direction_variables(img, d, suffix));
     }
     let ideal: Vec<f64> = cells().map(|(j, i)| g.apparent_height(j, i)).collect();
     variables.push(Variable::f64(
@@ -332,6 +277,73 @@ pub fn scan_layout(img: &PiImage, setpoint: f64) -> Layout {
         &[("y", ny), ("x", nx)],
         variables,
     )
+}
+
+/// The maps of the PI scan's direction `d` (0 the trace, 1 the retrace, its names suffixed
+/// `suffix`) over (y, x): the [`SCAN_FIELDS`], `lost_contact`, `regime` and `material`.
+fn direction_variables(img: &PiImage, d: usize, suffix: &str) -> Vec<Variable> {
+    let g = &img.ideal;
+    let (nx, ny) = (g.x.len(), g.y.len());
+    let cells = || (0..ny).flat_map(move |j| (0..nx).map(move |i| (j, i)));
+    let grid: &[&str] = &["y", "x"];
+    let (m, e, f) = (img.length(), img.energy(), img.force());
+    let mut variables = Vec::new();
+    let pixel = |j: usize, i: usize| {
+        if d == 0 {
+            &img.lines[j].trace[i]
+        } else {
+            &img.lines[j].retrace[i]
+        }
+    };
+    for (name, units, long_name) in SCAN_FIELDS {
+        let values: Vec<f64> = cells()
+            .map(|(j, i)| {
+                let p = pixel(j, i);
+                match name {
+                    "height" => img.height(d, j, i),
+                    "amplitude" => p.amplitude * m,
+                    "phase_deg" => p.phase.to_degrees(),
+                    "tracking_error" => p.tracking_error * m,
+                    "energy_dissipated" => p.energy_dissipated * e,
+                    "virial" => p.virial * e,
+                    "peak_force" => p.peak_force * f,
+                    _ => p.indentation * m,
+                }
+            })
+            .collect();
+        variables.push(Variable::f64(
+            &format!("{name}{suffix}"),
+            grid,
+            units,
+            long_name,
+            &values,
+        ));
+    }
+    let lost: Vec<bool> = cells().map(|(j, i)| pixel(j, i).lost_contact).collect();
+    variables.push(Variable::new(
+        &format!("lost_contact{suffix}"),
+        grid,
+        "1",
+        "the controller lost contact (parachuting) in the pixel's last drive period",
+        Values::Bool(lost),
+    ));
+    let regime: Vec<i32> = cells()
+        .map(|(j, i)| {
+            if crate::report::regime(pixel(j, i).mean_deflection) == "attractive" {
+                REGIME_FLAGS[1].0
+            } else {
+                REGIME_FLAGS[2].0
+            }
+        })
+        .collect();
+    variables.push(regime_variable(&format!("regime{suffix}"), &regime));
+    let material: Vec<i32> = cells().map(|(j, i)| pixel(j, i).material as i32).collect();
+    variables.push(material_variable(
+        g,
+        &format!("material{suffix}"),
+        &material,
+    ));
+    variables
 }
 
 /// A PeakForce image's layout (`image.nc` of `afmdyn image --mode peakforce`): coordinates

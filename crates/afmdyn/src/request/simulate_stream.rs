@@ -462,25 +462,7 @@ fn figures(
     let shade_all: Vec<(f64, f64)> = (pd.shade.intervals.iter())
         .map(|iv| (su.t(iv.0), su.t(iv.1)))
         .collect();
-    let (t_label, y_label, phase_x, phase_y, spec_x, spec_y) = if su.u.si {
-        (
-            "time t (s)",
-            "W(1,t), V_T (m)",
-            "V_T (m)",
-            "dV_T/dt (m/s)",
-            "frequency (Hz)",
-            "log₁₀(amplitude / m)",
-        )
-    } else {
-        (
-            "τ",
-            "W(1,τ), V_T",
-            "V_T",
-            "dV_T/dτ",
-            "frequency (dimensionless, Ω = drive)",
-            "log₁₀(amplitude / g0)",
-        )
-    };
+    let [t_label, y_label, phase_x, phase_y, spec_x, spec_y] = axis_labels(su.u.si);
     let recorded = (pd.t1 - pd.t0) / period;
     let last = |n: usize, what: &str| {
         let periods = n as f64 / spp as f64;
@@ -511,21 +493,6 @@ fn figures(
     };
     if recorded > TIP_WINDOW_PERIODS as f64 + 1e-9 {
         // the last periods, readable; every recorded period in tip-all
-        let mut shade: Vec<(f64, f64)> = Vec::new();
-        let mut open: Option<f64> = None;
-        for &(t, _, _, contact) in &recent {
-            match (contact, open) {
-                (true, None) => open = Some(t),
-                (false, Some(t0)) => {
-                    shade.push((t0, t));
-                    open = None;
-                }
-                _ => {}
-            }
-        }
-        if let (Some(t0), Some(&(t1, ..))) = (open, recent.last()) {
-            shade.push((t0, t1));
-        }
         s.figure(
             "tip",
             tip_figure(
@@ -535,7 +502,7 @@ fn figures(
                 ),
                 recent.iter().map(|&(t, w, ..)| (t, w)).collect(),
                 recent.iter().map(|&(t, _, v, _)| (t, v)).collect(),
-                shade,
+                contact_shade(&recent),
             ),
         );
         s.figure(
@@ -574,6 +541,51 @@ fn figures(
     let title = last(window, "Amplitude spectrum of W(1,τ)");
     let points = log_spectrum(spec, f_max);
     s.figure("spectrum", one(title, spec_x, spec_y, points));
+}
+
+/// The axis labels of a run's figures, in SI (`si`) or the model's units: time, tip motion,
+/// the phase portrait's V_T and its rate, the spectrum's frequency and log amplitude.
+fn axis_labels(si: bool) -> [&'static str; 6] {
+    if si {
+        [
+            "time t (s)",
+            "W(1,t), V_T (m)",
+            "V_T (m)",
+            "dV_T/dt (m/s)",
+            "frequency (Hz)",
+            "log₁₀(amplitude / m)",
+        ]
+    } else {
+        [
+            "τ",
+            "W(1,τ), V_T",
+            "V_T",
+            "dV_T/dτ",
+            "frequency (dimensionless, Ω = drive)",
+            "log₁₀(amplitude / g0)",
+        ]
+    }
+}
+
+/// The contact intervals of the `recent` samples (t, W, V_T, in contact), the last one closed
+/// at the last sample.
+fn contact_shade(recent: &[(f64, f64, f64, bool)]) -> Vec<(f64, f64)> {
+    let mut shade: Vec<(f64, f64)> = Vec::new();
+    let mut open: Option<f64> = None;
+    for &(t, _, _, contact) in recent {
+        match (contact, open) {
+            (true, None) => open = Some(t),
+            (false, Some(t0)) => {
+                shade.push((t0, t));
+                open = None;
+            }
+            _ => {}
+        }
+    }
+    if let (Some(t0), Some(&(t1, ..))) = (open, recent.last()) {
+        shade.push((t0, t1));
+    }
+    shade
 }
 
 /// How far below the spectrum's peak its log-scale plot reaches: 1e-10 of the peak, where the

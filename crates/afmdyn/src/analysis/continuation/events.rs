@@ -34,12 +34,15 @@ pub(super) fn multiplier_shift(a: &[Complex<f64>], b: &[Complex<f64>]) -> f64 {
 }
 
 /// Test functions of a point: (dp/ds, det(M + I), complex multipliers outside the circle, switchings).
+pub(super) type Tests = (f64, f64, usize, usize);
+
+/// The [`Tests`] of a point.
 pub(super) fn tests(
     t: &DVector<f64>,
     m: &DMatrix<f64>,
     mu: &[Complex<f64>],
     switchings: usize,
-) -> (f64, f64, usize, usize) {
+) -> Tests {
     let dim = m.nrows();
     let pd = (m + DMatrix::identity(dim, dim)).determinant();
     let ns = mu
@@ -49,10 +52,7 @@ pub(super) fn tests(
     (t[dim], pd, ns, switchings)
 }
 
-pub(super) fn changed(
-    a: &(f64, f64, usize, usize),
-    b: &(f64, f64, usize, usize),
-) -> Option<BranchEvent> {
+pub(super) fn changed(a: &Tests, b: &Tests) -> Option<BranchEvent> {
     if a.3 != b.3 {
         Some(BranchEvent::Grazing)
     } else if a.0.signum() != b.0.signum() {
@@ -68,11 +68,7 @@ pub(super) fn changed(
 
 /// The test function of event `e` at `t`, signed so that it keeps the sign it has at the
 /// reference point `a` until the event (integer counts: +1 while equal to a's count, else −1).
-pub(super) fn which(
-    e: BranchEvent,
-    t: &(f64, f64, usize, usize),
-    a: &(f64, f64, usize, usize),
-) -> f64 {
+pub(super) fn which(e: BranchEvent, t: &Tests, a: &Tests) -> f64 {
     let same = |x: usize, y: usize| if x == y { 1.0 } else { -1.0 };
     match e {
         BranchEvent::Fold => t.0 * a.0.signum(),
@@ -158,6 +154,48 @@ impl Bracket {
         }
         at_a
     }
+}
+
+/// The event `ev` located on the step of `ds` from the point `y` (arclength `s`, tangent `t`,
+/// test functions `tf`) to one whose test functions are `tf_end`: the bracket of arclength
+/// shrunk to 1e-7 (1 + |s|), by bisection for the counts and, for the smooth test functions,
+/// by the secant through the bracket's ends (Illinois). The last point found past the event,
+/// labelled with it; `None` where the corrector fails before one is.
+///
+/// # Errors
+/// As [`Solver::tangent`] and [`point`].
+pub(super) fn locate(
+    solver: &mut Solver,
+    ev: BranchEvent,
+    (s, ds): (f64, f64),
+    (y, t): (&DVector<f64>, &DVector<f64>),
+    tf: &Tests,
+    tf_end: &Tests,
+) -> Result<Option<BranchPoint>, SimError> {
+    let f0 = which(ev, tf, tf);
+    let mut bracket = Bracket::new(ds, f0, which(ev, tf_end, tf), smooth(ev));
+    let mut best: Option<BranchPoint> = None;
+    for _ in 0..30 {
+        let mid = bracket.next();
+        let Ok((ym, mm, _, fpm)) = solver.correct(&(y + t * mid), t) else {
+            break;
+        };
+        let tm = Solver::tangent(&mm.jacobian, &fpm, t)?;
+        let mut pm = point(solver, s + mid, &ym, &mm)?;
+        let fm = which(
+            ev,
+            &tests(&tm, &mm.jacobian, &pm.multipliers, mm.switchings),
+            tf,
+        );
+        if !bracket.update(mid, fm) {
+            pm.event = Some(ev);
+            best = Some(pm);
+        }
+        if bracket.width() <= 1e-7 * (1.0 + s.abs()) {
+            break;
+        }
+    }
+    Ok(best)
 }
 
 pub(super) fn point(

@@ -35,7 +35,7 @@ pub use switching::{
 mod events;
 mod solver;
 pub use events::MAX_MULTIPLIER_STEP;
-use events::{changed, chord_passes, multiplier_shift, point, smooth, tests, which, Bracket};
+use events::{changed, chord_passes, locate, multiplier_shift, point, tests};
 use solver::Solver;
 
 /// A continuation run.
@@ -297,19 +297,8 @@ pub fn continue_branch_with(
     spec.base.with(spec.param, spec.to).validate()?;
     let mut solver = Solver::new(spec)?;
     let orbit = shoot_with(solver.at(spec.from)?, guess, spec.period, &spec.newton)?;
+    let (mut y, mut t, map) = start(&mut solver, &orbit.state)?;
     let dim = orbit.state.len();
-    let mut y = DVector::zeros(dim + 1);
-    y.rows_mut(0, dim).copy_from(&orbit.state);
-    y[dim] = spec.from;
-    let dir = if spec.to >= spec.from { 1.0 } else { -1.0 };
-    let mut t0 = DVector::zeros(dim + 1);
-    t0[dim] = dir;
-    let map = solver.map(&orbit.state, spec.from, true)?;
-    let fp0 = solver.dp_of(&map, &orbit.state, spec.from)?;
-    let mut t = Solver::tangent(&map.jacobian, &fp0, &t0)?;
-    if t[dim] * dir < 0.0 {
-        t = -t;
-    }
     let (lo, hi) = spec
         .range
         .unwrap_or((spec.from.min(spec.to), spec.from.max(spec.to)));
@@ -346,51 +335,22 @@ pub fn continue_branch_with(
         };
         let t_new = Solver::tangent(&map_new.jacobian, &fp_new, &t)?;
         let mut pt = point(&mut solver, s + ds, &y_new, &map_new)?;
-        let tf_new = tests(
-            &t_new,
-            &map_new.jacobian,
-            &pt.multipliers,
-            map_new.switchings,
-        );
+        let mu = &pt.multipliers;
+        let tf_new = tests(&t_new, &map_new.jacobian, mu, map_new.switchings);
         // step control on the multipliers: a step may not move any multiplier by more than
         // MAX_MULTIPLIER_STEP, nor change the number of unstable multipliers without a located
         // event — else two crossings (of −1, say) could cancel in the test functions
         let event = changed(&tf, &tf_new);
         let unstable = |mu: &[Complex<f64>]| mu.iter().filter(|m| m.norm() > 1.0).count();
-        if (multiplier_shift(&mu_prev, &pt.multipliers) > MAX_MULTIPLIER_STEP
-            || (event.is_none() && unstable(&mu_prev) != unstable(&pt.multipliers)))
+        if (multiplier_shift(&mu_prev, mu) > MAX_MULTIPLIER_STEP
+            || (event.is_none() && unstable(&mu_prev) != unstable(mu)))
             && ds > 16.0 * spec.ds_min
         {
             ds *= 0.5;
             continue;
         }
         if let Some(ev) = event {
-            // locate on the step from the previous point: the bracket [a, b] of arclength
-            // shrunk to 1e-7 (1 + |s|), by bisection for the counts and, for the smooth test
-            // functions, by the secant through the bracket's ends (Illinois)
-            let f0 = which(ev, &tf, &tf);
-            let mut bracket = Bracket::new(ds, f0, which(ev, &tf_new, &tf), smooth(ev));
-            let mut best: Option<BranchPoint> = None;
-            for _ in 0..30 {
-                let mid = bracket.next();
-                let Ok((ym, mm, _, fpm)) = solver.correct(&(&y + &t * mid), &t) else {
-                    break;
-                };
-                let tm = Solver::tangent(&mm.jacobian, &fpm, &t)?;
-                let mut pm = point(&mut solver, s + mid, &ym, &mm)?;
-                let fm = which(
-                    ev,
-                    &tests(&tm, &mm.jacobian, &pm.multipliers, mm.switchings),
-                    &tf,
-                );
-                if !bracket.update(mid, fm) {
-                    pm.event = Some(ev);
-                    best = Some(pm);
-                }
-                if bracket.width() <= 1e-7 * (1.0 + s.abs()) {
-                    break;
-                }
-            }
+            let best = locate(&mut solver, ev, (s, ds), (&y, &t), &tf, &tf_new)?;
             // a genuine fold has a multiplier +1; a sign change of dp/ds without one is the
             // tangent flipping across a non-smooth (grazing) point: retry with a smaller step
             let spurious_fold = ev == BranchEvent::Fold
@@ -401,21 +361,9 @@ pub fn continue_branch_with(
                 ds *= 0.25;
                 continue;
             }
-            if let Some(bp) = best {
-                // the same event located again within the resolution of the location (next to
-                // a junction the test function can change sign twice within 1e-4): keep one
-                let again = out
-                    .iter()
-                    .rev()
-                    .find(|b| b.event.is_some())
-                    .is_some_and(|b| {
-                        b.event == bp.event
-                            && (b.value - bp.value).abs() < 1e-4 * (1.0 + b.value.abs())
-                    });
-                if !again {
-                    out.push(bp);
-                    progress.tick();
-                }
+            if let Some(bp) = best.filter(|bp| !located_again(&out, bp)) {
+                out.push(bp);
+                progress.tick();
             }
         }
         if !(lo..=hi).contains(&y_new[dim]) {
@@ -425,38 +373,7 @@ pub fn continue_branch_with(
         // period-2n branch has merged into a period-n orbit (its half-cycle repeats): beyond that
         // it would trace the period-n branch again
         let closed = out.len() > 10 && chord_passes(&y, &y_new, &first);
-        let half = spec.period / 2;
-        let half_gap = |b: &BranchPoint| {
-            (&b.section[half] - &b.section[0]).norm() / (1.0 + b.section[0].norm())
-        };
-        // a fold at a parent's period doubling where the half-cycle nearly repeats is the tip of
-        // the pitchfork at which the period-2n branch meets its parent (the gap closes like
-        // √|Δp|): beyond it the branch is its own phase-shifted copy
-        widest = widest.max(half_gap(&pt));
-        let at_parent = out.last().is_some_and(|b| {
-            b.event == Some(BranchEvent::Fold)
-                && half_gap(b) < 0.05 * widest
-                && spec
-                    .junctions
-                    .iter()
-                    .any(|j| (j - b.value).abs() <= 1e-4 * (1.0 + j.abs()))
-        });
-        let merged =
-            spec.period.is_multiple_of(2) && out.len() > 3 && (half_gap(&pt) < 1e-6 || at_parent);
-        if merged && at_parent {
-            // the junction is the parent's period doubling, seen from the period-2n branch; a
-            // period doubling located within 1e-4 before it is the same point
-            let k = out.len() - 1;
-            let at = out[k].value;
-            out[k].event = Some(BranchEvent::PeriodDoubling);
-            for b in out[..k].iter_mut().rev().take(4) {
-                if b.event == Some(BranchEvent::PeriodDoubling)
-                    && (b.value - at).abs() < 1e-4 * (1.0 + at.abs())
-                {
-                    b.event = None;
-                }
-            }
-        }
+        let merged = merges(spec, &mut out, &pt, &mut widest);
         s += ds;
         pt.s = s;
         out.push(pt);
@@ -482,9 +399,91 @@ pub fn continue_branch_with(
     Ok(Branch { points: out, end })
 }
 
+/// The start of a branch at the orbit `state` at `spec.from`: y = (z, p), the unit tangent
+/// towards `spec.to`, and the map there.
+///
+/// # Errors
+/// As [`Solver::map`], [`Solver::dp_of`] and [`Solver::tangent`].
+fn start(
+    solver: &mut Solver,
+    state: &DVector<f64>,
+) -> Result<(DVector<f64>, DVector<f64>, FlowMap), SimError> {
+    let (from, to) = (solver.spec.from, solver.spec.to);
+    let dim = state.len();
+    let mut y = DVector::zeros(dim + 1);
+    y.rows_mut(0, dim).copy_from(state);
+    y[dim] = from;
+    let dir = if to >= from { 1.0 } else { -1.0 };
+    let mut t0 = DVector::zeros(dim + 1);
+    t0[dim] = dir;
+    let map = solver.map(state, from, true)?;
+    let fp0 = solver.dp_of(&map, state, from)?;
+    let mut t = Solver::tangent(&map.jacobian, &fp0, &t0)?;
+    if t[dim] * dir < 0.0 {
+        t = -t;
+    }
+    Ok((y, t, map))
+}
+
+/// Whether the event point `bp` is the last event of `out` located again, within the
+/// resolution of the location (next to a junction the test function can change sign twice
+/// within 1e-4).
+fn located_again(out: &[BranchPoint], bp: &BranchPoint) -> bool {
+    out.iter()
+        .rev()
+        .find(|b| b.event.is_some())
+        .is_some_and(|b| {
+            b.event == bp.event && (b.value - bp.value).abs() < 1e-4 * (1.0 + b.value.abs())
+        })
+}
+
+/// Whether a period-2n branch has merged into its period-n parent at the new point `pt`
+/// after the points `out`: its half-cycle repeats, or the last point is the pitchfork junction
+/// with the parent (then labelled its period doubling). `widest` is the widest half-cycle gap
+/// met so far.
+fn merges(
+    spec: &ContinuationSpec,
+    out: &mut [BranchPoint],
+    pt: &BranchPoint,
+    widest: &mut f64,
+) -> bool {
+    let half = spec.period / 2;
+    let half_gap =
+        |b: &BranchPoint| (&b.section[half] - &b.section[0]).norm() / (1.0 + b.section[0].norm());
+    // a fold at a parent's period doubling where the half-cycle nearly repeats is the tip of
+    // the pitchfork at which the period-2n branch meets its parent (the gap closes like
+    // √|Δp|): beyond it the branch is its own phase-shifted copy
+    *widest = widest.max(half_gap(pt));
+    let at_parent = out.last().is_some_and(|b| {
+        b.event == Some(BranchEvent::Fold)
+            && half_gap(b) < 0.05 * *widest
+            && spec
+                .junctions
+                .iter()
+                .any(|j| (j - b.value).abs() <= 1e-4 * (1.0 + j.abs()))
+    });
+    let merged =
+        spec.period.is_multiple_of(2) && out.len() > 3 && (half_gap(pt) < 1e-6 || at_parent);
+    if merged && at_parent {
+        // the junction is the parent's period doubling, seen from the period-2n branch; a
+        // period doubling located within 1e-4 before it is the same point
+        let k = out.len() - 1;
+        let at = out[k].value;
+        out[k].event = Some(BranchEvent::PeriodDoubling);
+        for b in out[..k].iter_mut().rev().take(4) {
+            if b.event == Some(BranchEvent::PeriodDoubling)
+                && (b.value - at).abs() < 1e-4 * (1.0 + at.abs())
+            {
+                b.event = None;
+            }
+        }
+    }
+    merged
+}
+
 #[cfg(test)]
 mod tests {
-    use super::{chord_passes, Bracket};
+    use super::events::{chord_passes, Bracket};
     use nalgebra::DVector;
 
     /// Shrink a bracket of [0, w] on f to `tol` as the continuation does; the evaluations and

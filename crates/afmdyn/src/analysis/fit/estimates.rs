@@ -8,7 +8,8 @@
 //! Analysis and Its Applications*, Wiley 1988, §2.3; Raue et al. 2009 for the profiles).
 
 use super::least_squares::{
-    evaluate_in, minimize_cancellable, CurveModel, Observations, Parameter, PATIENCE, TOLERANCE,
+    evaluate_in, minimize_cancellable, CurveModel, Minimum, Observations, Parameter, PATIENCE,
+    TOLERANCE,
 };
 use super::profile::{profile, Profile, ProfileEnd, ProfileWalk, DELTA_CHI2_95};
 use crate::analysis::progress::Progress;
@@ -162,33 +163,7 @@ pub fn fit_cancellable(
         f64::NAN
     };
     let s2 = if noise_estimated { chi2_dof } else { 1.0 };
-    let mut warnings = Vec::new();
-    if !best.converged {
-        warnings.push(format!(
-            "the minimiser did not report convergence ({}): the estimates may not be at the \
-             minimum",
-            best.termination
-        ));
-    }
-    if noise_estimated {
-        warnings.push(format!(
-            "noise estimated from residuals: no σ column, so σ² = χ²/dof = {:.4e} (the \
-             standard errors and intervals assume the model fits)",
-            chi2_dof
-        ));
-    }
-    // with σ given, χ² of a model that fits is χ²(dof): mean dof, standard deviation √(2 dof)
-    let bound = 1.0 + CHI2_SIGMAS * (2.0 / dof.max(1) as f64).sqrt();
-    if !noise_estimated && dof > 0 && chi2_dof > bound {
-        warnings.push(format!(
-            "χ²/dof = {} with the σ given, above {} ({CHI2_SIGMAS} standard deviations of χ²/dof \
-             for {dof} degrees of freedom): the model does not describe the data within σ — a \
-             local minimum (another start), another law or model, or σ too small; the standard \
-             errors assume it does",
-            crate::error::number(chi2_dof),
-            crate::error::number(bound)
-        ));
-    }
+    let mut warnings = goodness_warnings(&best, noise_estimated, dof, chi2_dof);
     let (cov, singular) = covariance(model, obs, &best.values, &free, s2, progress)?;
     if singular {
         warnings.push(
@@ -197,26 +172,7 @@ pub fn fit_cancellable(
                 .into(),
         );
     }
-    // a variance that is not positive (a parameter whose Jacobian column is zero or at the
-    // rounding level: the pseudo-inverse's diagonal then comes out 0 or negative) is NaN:
-    // the parameter is not constrained, not known exactly
-    let se: Vec<f64> = (0..n)
-        .map(|k| {
-            let v = cov[(k, k)];
-            if v > 0.0 {
-                v.sqrt()
-            } else {
-                f64::NAN
-            }
-        })
-        .collect();
-    let correlation: Vec<Vec<f64>> = (0..n)
-        .map(|a| {
-            (0..n)
-                .map(|b| cov[(a, b)] / (se[a] * se[b]))
-                .collect::<Vec<f64>>()
-        })
-        .collect();
+    let (se, correlation) = standard_errors(&cov);
     let mut evaluations = best.evaluations + 1;
     let mut estimates = Vec::with_capacity(n);
     let chosen = profiled(&free.iter().map(|&j| &params[j].name).collect::<Vec<_>>());
@@ -240,69 +196,9 @@ pub fn fit_cancellable(
             .map_or(wald, |pr| [pr.lower.value(), pr.upper.value()]);
         if let Some(pr) = &prof {
             evaluations += pr.evaluations;
-            let sides = |f: fn(&ProfileEnd) -> bool| match (f(&pr.lower), f(&pr.upper)) {
-                (true, true) => Some("either side"),
-                (true, false) => Some("the lower side"),
-                (false, true) => Some("the upper side"),
-                (false, false) => None,
-            };
-            if let Some(side) = sides(|e| matches!(e, ProfileEnd::Flat(_))) {
-                let walked = match profiles {
-                    Some(ProfileWalk::Secant { max_steps }) => format!(
-                        " ({max_steps} refits a side, to {:.3e} from the estimate)",
-                        (pr.lower.value() - value)
-                            .abs()
-                            .max((pr.upper.value() - value).abs())
-                    ),
-                    _ => String::new(),
-                };
-                warnings.push(format!(
-                    "{}: flat profile — χ² rises by less than {DELTA_CHI2_95:.2} over the \
-                     range walked on {side}{walked}; the data do not bound it there (the \
-                     interval's end there is the last point walked: open)",
-                    p.name,
-                ));
-            }
-            if pr.unconverged > 0 {
-                warnings.push(format!(
-                    "{}: {} of the profile's {} refits stopped at the minimiser's limit of \
-                     evaluations before converging (their Δχ² may be high, the interval narrow)",
-                    p.name, pr.unconverged, pr.refits
-                ));
-            }
-            if let Some(side) = sides(|e| matches!(e, ProfileEnd::Failed(_))) {
-                warnings.push(format!(
-                    "{}: a profile refit failed on {side} (the model could not be evaluated \
-                     there): the Wald end p̂ ± 1.96 SE stands in",
-                    p.name,
-                ));
-            }
-            if pr.lowest < -1e-6 {
-                warnings.push(format!(
-                    "{}: the profile met a χ² lower than the fit's (by {:.3} in Δχ²): the fit \
-                     stopped short of the minimum",
-                    p.name, -pr.lowest
-                ));
-            }
+            profile_warnings(&p.name, value, pr, profiles, &mut warnings);
         }
-        let width = (p.upper - p.lower).abs().min(p.scale.max(value.abs()));
-        for (bound, which) in [(p.lower, "lower"), (p.upper, "upper")] {
-            if bound.is_finite() && (value - bound).abs() <= 1e-6 * width {
-                warnings.push(format!(
-                    "{}: the estimate {value:.6e} is at its {which} bound {bound:.6e}",
-                    p.name
-                ));
-            }
-        }
-        // (an offset without a natural zero — contact point, baseline — is not held to it)
-        if !se[k].is_finite() || (p.lower.is_finite() && se[k] >= value.abs()) {
-            warnings.push(format!(
-                "{}: not constrained by the data (standard error {:.3e} ≥ |estimate| {:.3e})",
-                p.name,
-                se[k],
-                value.abs()
-            ));
-        }
+        estimate_warnings(p, value, se[k], &mut warnings);
         estimates.push(Estimate {
             name: p.name.clone(),
             value,
@@ -342,6 +238,148 @@ pub fn fit_cancellable(
         termination: best.termination,
         warnings,
     })
+}
+
+/// The warnings on the minimum `best` as a whole: no convergence reported, the noise estimated
+/// from the residuals, or (σ given) a χ²/dof above [`CHI2_SIGMAS`] standard deviations of its
+/// distribution for `dof` degrees of freedom.
+fn goodness_warnings(
+    best: &Minimum,
+    noise_estimated: bool,
+    dof: usize,
+    chi2_dof: f64,
+) -> Vec<String> {
+    let mut warnings = Vec::new();
+    if !best.converged {
+        warnings.push(format!(
+            "the minimiser did not report convergence ({}): the estimates may not be at the \
+             minimum",
+            best.termination
+        ));
+    }
+    if noise_estimated {
+        warnings.push(format!(
+            "noise estimated from residuals: no σ column, so σ² = χ²/dof = {:.4e} (the \
+             standard errors and intervals assume the model fits)",
+            chi2_dof
+        ));
+    }
+    // with σ given, χ² of a model that fits is χ²(dof): mean dof, standard deviation √(2 dof)
+    let bound = 1.0 + CHI2_SIGMAS * (2.0 / dof.max(1) as f64).sqrt();
+    if !noise_estimated && dof > 0 && chi2_dof > bound {
+        warnings.push(format!(
+            "χ²/dof = {} with the σ given, above {} ({CHI2_SIGMAS} standard deviations of χ²/dof \
+             for {dof} degrees of freedom): the model does not describe the data within σ — a \
+             local minimum (another start), another law or model, or σ too small; the standard \
+             errors assume it does",
+            crate::error::number(chi2_dof),
+            crate::error::number(bound)
+        ));
+    }
+    warnings
+}
+
+/// The standard errors √Cₖₖ of the covariance `cov` and its correlation matrix. A variance that
+/// is not positive (a parameter whose Jacobian column is zero or at the rounding level: the
+/// pseudo-inverse's diagonal then comes out 0 or negative) gives NaN: the parameter is not
+/// constrained, not known exactly.
+fn standard_errors(cov: &DMatrix<f64>) -> (Vec<f64>, Vec<Vec<f64>>) {
+    let n = cov.nrows();
+    let se: Vec<f64> = (0..n)
+        .map(|k| {
+            let v = cov[(k, k)];
+            if v > 0.0 {
+                v.sqrt()
+            } else {
+                f64::NAN
+            }
+        })
+        .collect();
+    let correlation: Vec<Vec<f64>> = (0..n)
+        .map(|a| {
+            (0..n)
+                .map(|b| cov[(a, b)] / (se[a] * se[b]))
+                .collect::<Vec<f64>>()
+        })
+        .collect();
+    (se, correlation)
+}
+
+/// Into `warnings`, those of the profile `pr` of the parameter `name` (estimate `value`) walked
+/// as `walk` says: a flat side, refits stopped before converging, a failed refit, a χ² lower
+/// than the fit's.
+fn profile_warnings(
+    name: &str,
+    value: f64,
+    pr: &Profile,
+    walk: Option<ProfileWalk>,
+    warnings: &mut Vec<String>,
+) {
+    let sides = |f: fn(&ProfileEnd) -> bool| match (f(&pr.lower), f(&pr.upper)) {
+        (true, true) => Some("either side"),
+        (true, false) => Some("the lower side"),
+        (false, true) => Some("the upper side"),
+        (false, false) => None,
+    };
+    if let Some(side) = sides(|e| matches!(e, ProfileEnd::Flat(_))) {
+        let walked = match walk {
+            Some(ProfileWalk::Secant { max_steps }) => format!(
+                " ({max_steps} refits a side, to {:.3e} from the estimate)",
+                (pr.lower.value() - value)
+                    .abs()
+                    .max((pr.upper.value() - value).abs())
+            ),
+            _ => String::new(),
+        };
+        warnings.push(format!(
+            "{name}: flat profile — χ² rises by less than {DELTA_CHI2_95:.2} over the \
+             range walked on {side}{walked}; the data do not bound it there (the \
+             interval's end there is the last point walked: open)",
+        ));
+    }
+    if pr.unconverged > 0 {
+        warnings.push(format!(
+            "{name}: {} of the profile's {} refits stopped at the minimiser's limit of \
+             evaluations before converging (their Δχ² may be high, the interval narrow)",
+            pr.unconverged, pr.refits
+        ));
+    }
+    if let Some(side) = sides(|e| matches!(e, ProfileEnd::Failed(_))) {
+        warnings.push(format!(
+            "{name}: a profile refit failed on {side} (the model could not be evaluated \
+             there): the Wald end p̂ ± 1.96 SE stands in",
+        ));
+    }
+    if pr.lowest < -1e-6 {
+        warnings.push(format!(
+            "{name}: the profile met a χ² lower than the fit's (by {:.3} in Δχ²): the fit \
+             stopped short of the minimum",
+            -pr.lowest
+        ));
+    }
+}
+
+/// Into `warnings`, those of the estimate `value` of `p` with the standard error `se`: at a
+/// bound, or not constrained by the data.
+fn estimate_warnings(p: &Parameter, value: f64, se: f64, warnings: &mut Vec<String>) {
+    let width = (p.upper - p.lower).abs().min(p.scale.max(value.abs()));
+    for (bound, which) in [(p.lower, "lower"), (p.upper, "upper")] {
+        if bound.is_finite() && (value - bound).abs() <= 1e-6 * width {
+            warnings.push(format!(
+                "{}: the estimate {value:.6e} is at its {which} bound {bound:.6e}",
+                p.name
+            ));
+        }
+    }
+    // (an offset without a natural zero — contact point, baseline — is not held to it)
+    if !se.is_finite() || (p.lower.is_finite() && se >= value.abs()) {
+        warnings.push(format!(
+            "{}: not constrained by the data (standard error {:.3e} ≥ |estimate| {:.3e})",
+            p.name,
+            se,
+            value.abs()
+        ));
+    }
 }
 
 /// The covariance (JᵀWJ)⁻¹ s² of the free parameters at `p`, and whether JᵀWJ is singular

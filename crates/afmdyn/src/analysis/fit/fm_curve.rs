@@ -29,7 +29,7 @@
 use super::am_curve::CheckedModel;
 use super::am_curve::{gaps, scaled, AmParam, AmProbe, SENSITIVITY_TOLERANCE};
 use super::sensitivity::{orbit_sensitivity, OrbitParam, SensitivityWarning};
-use crate::analysis::fm::{fm_curve_cancellable, FmSpec, DEFAULT_LOOP_TOLERANCE};
+use crate::analysis::fm::{fm_curve_cancellable, FmCurve, FmSpec, DEFAULT_LOOP_TOLERANCE};
 use crate::error::SimError;
 use crate::model::CantileverModel;
 use crate::params::SweepParam;
@@ -78,6 +78,35 @@ impl FmCurveModel {
     /// The last evaluation's warnings (folds, grazing, rows not reached).
     pub fn warnings(&self) -> Vec<String> {
         self.warnings.lock().map(|w| w.clone()).unwrap_or_default()
+    }
+
+    /// Row i (0-based) as the warnings name it, with its piezo position.
+    fn row(&self, i: usize) -> String {
+        format!("row {} (z = {:.4e} m)", i + 1, self.z[i])
+    }
+
+    /// The warnings of the FM curve `curve` of the rows: its folds, and the rows from the first
+    /// one it did not reach.
+    fn curve_warnings(&self, curve: &FmCurve) -> Vec<String> {
+        let mut warnings = Vec::new();
+        for f in &curve.folds {
+            warnings.push(format!(
+                "{}: a fold of the FM curve (det ∂(A₁, φ₁)/∂(Ω, α2) changes sign before the \
+                 next row); the sensitivities are unreliable there",
+                self.row(f.index)
+            ));
+        }
+        let reached = curve.points.len();
+        if let Some(u) = &curve.unreached {
+            warnings.push(format!(
+                "{}: the FM steady state was not found ({}); the {} row(s) from there keep the \
+                 last frequency shift reached, without sensitivities",
+                self.row(reached),
+                u.reason,
+                self.z.len() - reached
+            ));
+        }
+        warnings
     }
 }
 
@@ -128,25 +157,8 @@ impl CheckedModel for FmCurveModel {
         let k = orbit_params.len();
         orbit_params.extend([OrbitParam::DriveFrequency, OrbitParam::DriveAmplitude]);
         let n = self.params.len();
-        let mut warnings = Vec::new();
-        let row = |i: usize| format!("row {} (z = {:.4e} m)", i + 1, self.z[i]);
-        for f in &curve.folds {
-            warnings.push(format!(
-                "{}: a fold of the FM curve (det ∂(A₁, φ₁)/∂(Ω, α2) changes sign before the \
-                 next row); the sensitivities are unreliable there",
-                row(f.index)
-            ));
-        }
-        let reached = curve.points.len();
-        if let Some(u) = &curve.unreached {
-            warnings.push(format!(
-                "{}: the FM steady state was not found ({}); the {} row(s) from there keep the \
-                 last frequency shift reached, without sensitivities",
-                row(reached),
-                u.reason,
-                self.z.len() - reached
-            ));
-        }
+        let mut warnings = self.curve_warnings(&curve);
+        let row = |i: usize| self.row(i);
         let omega_ref = curve.reference.omega;
         if let Some(j) = jacobian.as_deref_mut() {
             j.fill(0.0);

@@ -100,7 +100,7 @@ use crate::error::SimError;
 use crate::integrate::adaptive::Adaptive;
 use crate::maps::flow::flow_with_jacobian;
 use crate::model::{CantileverModel, DampingDerivative, ForcingDerivative};
-use crate::params::SweepParam;
+use crate::params::{Params, SweepParam};
 use crate::system::{Guard, HybridSystem, Jump, Region};
 use crate::tip_sample::TipSampleSystem;
 use nalgebra::{DMatrix, DVector};
@@ -582,53 +582,8 @@ pub fn orbit_sensitivity_component(
     newton: Option<&ShootingOptions>,
     component: Option<usize>,
 ) -> Result<OrbitSensitivity, SimError> {
-    let p = model.params();
-    let mut harmonics = vec![(p.omega, p.drive_phase())];
-    if let Some(c) = component {
-        let comp = c
-            .checked_sub(1)
-            .and_then(|i| p.components().nth(i))
-            .ok_or_else(|| {
-                SimError::out_of_range(
-                    "component",
-                    c,
-                    format!(
-                        "1..={}, the further components of the drive",
-                        p.components().count()
-                    ),
-                )
-            })?;
-        harmonics.push((
-            comp.ratio() * p.omega,
-            comp.phase + std::f64::consts::FRAC_PI_2,
-        ));
-    }
-    let unsupported = |hint: &'static str| SimError::Unsupported {
-        integrator: "adaptive",
-        law: model.law().name(),
-        hint,
-    };
-    match p.contact_law {
-        ContactLaw::Hertz => {
-            if params.contains(&OrbitParam::Hamaker) {
-                return Err(unsupported("the Hertz law has no Hamaker group"));
-            }
-        }
-        ContactLaw::Dmt { .. } => {}
-        ContactLaw::Jkr { .. } => {
-            if params.contains(&OrbitParam::Hamaker) {
-                return Err(unsupported("the JKR law has no Hamaker group"));
-            }
-        }
-        _ => {
-            return Err(unsupported(
-                "exact orbit sensitivities are implemented for the hertz, dmt and jkr laws",
-            ))
-        }
-    }
-    if !matches!(p.contact_law, ContactLaw::Jkr { .. }) && params.contains(&OrbitParam::Adhesion) {
-        return Err(unsupported("the adhesion group P̃ is the jkr law's"));
-    }
+    let harmonics = demodulated(model.params(), component)?;
+    check_law(model, params)?;
     let (state, shot_grazing) = match newton {
         Some(newton) => {
             let mut plain = Adaptive::new(model, tol);
@@ -637,43 +592,7 @@ pub fn orbit_sensitivity_component(
         }
         None => (guess.clone(), f64::INFINITY),
     };
-    if params.contains(&OrbitParam::ComponentForce) && p.components().next().is_none() {
-        return Err(unsupported(
-            "the component force's sensitivity needs a drive with a further component",
-        ));
-    }
-    let drive = [OrbitParam::DriveAmplitude, OrbitParam::DriveFrequency];
-    // the further components' forces do not move with α2 (the primary's), but their phases
-    // move with Ω
-    if p.is_multifrequency() && params.contains(&OrbitParam::DriveFrequency) {
-        return Err(unsupported(
-            "the drive frequency's sensitivity is taken for a single-frequency drive",
-        ));
-    }
-    // the free region's forcing derivatives (Hertz and DMT integrate region I's dynamics)
-    let forcing = [SweepParam::Alpha2, SweepParam::Omega].map(|q| {
-        let asked = params.contains(&drive[usize::from(q == SweepParam::Omega)]);
-        asked
-            .then(|| model.forcing_derivative(q))
-            .flatten()
-            .map(|[free, _]| free)
-    });
-    let lever = if params.contains(&OrbitParam::LeverDamping) {
-        Some(model.damping_derivative().ok_or(SimError::NoConvergence {
-            what: "orbit sensitivity: the mass matrix is not positive definite",
-            iterations: 0,
-            residual: f64::NAN,
-        })?)
-    } else {
-        None
-    };
-    let ext = Extended {
-        model: model.clone(),
-        params: params.to_vec(),
-        forcing,
-        lever,
-        harmonics,
-    };
+    let ext = extended(model, params, harmonics)?;
     let first = ext.first_param();
     let (d, k) = (model.dim(), params.len());
     let mut y0 = DVector::zeros(ext.dim());
@@ -738,5 +657,129 @@ pub fn orbit_sensitivity_component(
         grazing_distance,
         warnings,
         component,
+    })
+}
+
+/// The harmonics demodulated, (ω, ψ): the drive's, and with `component` = Some(c) the further
+/// component c's (1-based) at ω_c = (p/q) Ω with ψ_c = θ_c + π/2.
+///
+/// # Errors
+/// [`SimError::OutOfRange`] naming `component` when the drive has no such component.
+fn demodulated(p: &Params, component: Option<usize>) -> Result<Vec<(f64, f64)>, SimError> {
+    let mut harmonics = vec![(p.omega, p.drive_phase())];
+    if let Some(c) = component {
+        let comp = c
+            .checked_sub(1)
+            .and_then(|i| p.components().nth(i))
+            .ok_or_else(|| {
+                SimError::out_of_range(
+                    "component",
+                    c,
+                    format!(
+                        "1..={}, the further components of the drive",
+                        p.components().count()
+                    ),
+                )
+            })?;
+        harmonics.push((
+            comp.ratio() * p.omega,
+            comp.phase + std::f64::consts::FRAC_PI_2,
+        ));
+    }
+    Ok(harmonics)
+}
+
+/// The sensitivities to `params` are not taken under `model`'s law: `hint` says why.
+fn unsupported(model: &CantileverModel, hint: &'static str) -> SimError {
+    SimError::Unsupported {
+        integrator: "adaptive",
+        law: model.law().name(),
+        hint,
+    }
+}
+
+/// `model`'s law has sensitivities to `params`: Hertz, DMT or JKR, H̃ DMT's and P̃ JKR's.
+///
+/// # Errors
+/// [`SimError::Unsupported`] saying which is not.
+fn check_law(model: &CantileverModel, params: &[OrbitParam]) -> Result<(), SimError> {
+    let law = model.params().contact_law;
+    match law {
+        ContactLaw::Hertz => {
+            if params.contains(&OrbitParam::Hamaker) {
+                return Err(unsupported(model, "the Hertz law has no Hamaker group"));
+            }
+        }
+        ContactLaw::Dmt { .. } => {}
+        ContactLaw::Jkr { .. } => {
+            if params.contains(&OrbitParam::Hamaker) {
+                return Err(unsupported(model, "the JKR law has no Hamaker group"));
+            }
+        }
+        _ => {
+            return Err(unsupported(
+                model,
+                "exact orbit sensitivities are implemented for the hertz, dmt and jkr laws",
+            ))
+        }
+    }
+    if !matches!(law, ContactLaw::Jkr { .. }) && params.contains(&OrbitParam::Adhesion) {
+        return Err(unsupported(model, "the adhesion group P̃ is the jkr law's"));
+    }
+    Ok(())
+}
+
+/// The flow of `model` extended by the sensitivities to `params` and the Fourier integrals of
+/// the `harmonics`, with the derivatives of the free region's forcing by α2 and Ω and of the
+/// lever's damping that `params` ask for.
+///
+/// # Errors
+/// [`SimError::Unsupported`] for the component force without a further drive component or
+/// the drive frequency under a multifrequency drive; [`SimError::NoConvergence`] where the
+/// mass matrix is not positive definite (the damping's derivative).
+fn extended(
+    model: &CantileverModel,
+    params: &[OrbitParam],
+    harmonics: Vec<(f64, f64)>,
+) -> Result<Extended, SimError> {
+    let p = model.params();
+    if params.contains(&OrbitParam::ComponentForce) && p.components().next().is_none() {
+        return Err(unsupported(
+            model,
+            "the component force's sensitivity needs a drive with a further component",
+        ));
+    }
+    let drive = [OrbitParam::DriveAmplitude, OrbitParam::DriveFrequency];
+    // the further components' forces do not move with α2 (the primary's), but their phases
+    // move with Ω
+    if p.is_multifrequency() && params.contains(&OrbitParam::DriveFrequency) {
+        return Err(unsupported(
+            model,
+            "the drive frequency's sensitivity is taken for a single-frequency drive",
+        ));
+    }
+    // the free region's forcing derivatives (Hertz and DMT integrate region I's dynamics)
+    let forcing = [SweepParam::Alpha2, SweepParam::Omega].map(|q| {
+        let asked = params.contains(&drive[usize::from(q == SweepParam::Omega)]);
+        asked
+            .then(|| model.forcing_derivative(q))
+            .flatten()
+            .map(|[free, _]| free)
+    });
+    let lever = if params.contains(&OrbitParam::LeverDamping) {
+        Some(model.damping_derivative().ok_or(SimError::NoConvergence {
+            what: "orbit sensitivity: the mass matrix is not positive definite",
+            iterations: 0,
+            residual: f64::NAN,
+        })?)
+    } else {
+        None
+    };
+    Ok(Extended {
+        model: model.clone(),
+        params: params.to_vec(),
+        forcing,
+        lever,
+        harmonics,
     })
 }

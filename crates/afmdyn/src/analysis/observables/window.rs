@@ -534,80 +534,14 @@ pub(super) fn observe_window(
         }
         ctx.steps = Some((tau_start, TAU / om, w));
     }
-    let (model, free) = (&ctx.model, &ctx.free);
-    let end = tau_start + window;
     let z_start = integ.state().clone();
     let mut acc = Acc::new(n, nh);
     acc.comp = vec![[0.0; 4]; ctx.components.len()];
-    let mut scratch = Scratch {
-        fi: DVector::zeros(n),
-        scan: Vec::with_capacity(GL_NODES + 2),
-        start: None,
-    };
-    let mode_energy = |z: &DVector<f64>, j: usize| {
-        0.5 * free.mass[(j, j)] * z[n + j] * z[n + j] + 0.5 * free.stiffness[(j, j)] * z[j] * z[j]
-    };
-    // a step-weighted window: steps end at each period's end, where the weighted energy
-    // change Σ_k W_k (E_j(end of k) − E_j(start of k)) takes each mode's energy
-    let mut boundary = 1;
-    let mut step_energy = vec![0.0; n];
-    if let Some((_, _, w)) = &ctx.steps {
-        for (j, e) in step_energy.iter_mut().enumerate() {
-            *e -= w[0] * mode_energy(&z_start, j);
-        }
-    }
-    while integ.tau() < end {
-        let target = match &ctx.steps {
-            Some((_, t, w)) if boundary < w.len() => tau_start + boundary as f64 * t,
-            _ => end,
-        };
-        let step = integ.step(target)?;
-        if let Some((_, _, w)) = &ctx.steps {
-            if integ.tau() >= target && boundary <= w.len() {
-                let z = integ.state();
-                for (j, e) in step_energy.iter_mut().enumerate() {
-                    let ej = mode_energy(z, j);
-                    *e += w[boundary - 1] * ej - w.get(boundary).map_or(0.0, |wb| wb * ej);
-                }
-                boundary += 1;
-            }
-        }
-        let (r, t0, t1) = (step.region, step.tau0, step.tau1);
-        if t1 > t0 {
-            if r == Region::Contact {
-                acc.contact_time += ctx.weighted_length(t0, t1);
-            }
-            let pieces = ((t1 - t0) / ctx.h_max[r.index()]).ceil().max(1.0) as usize;
-            let hp = (t1 - t0) / pieces as f64;
-            // pieces of one step share their end nodes; a step starts afresh
-            scratch.start = None;
-            for k in 0..pieces {
-                let a = t0 + k as f64 * hp;
-                let b = if k + 1 == pieces {
-                    t1
-                } else {
-                    t0 + (k + 1) as f64 * hp
-                };
-                acc.piece(&ctx, integ, r, (a, b), &mut scratch);
-            }
-        }
-        if let Some(e) = &step.event {
-            acc.event(&ctx, e, integ.state());
-        }
-    }
+    let step_energy = ctx.integrate(integ, &mut acc, tau_start + window)?;
+    let model = &ctx.model;
     let z_end = integ.state().clone();
     let t_tot = integ.tau() - tau_start;
-    let harmonics: Vec<Harmonic> = (0..nh)
-        .map(|h| {
-            let s = 2.0 * acc.sin[h] / t_tot;
-            let c = 2.0 * acc.cos[h] / t_tot;
-            Harmonic {
-                n: h + 1,
-                amplitude: s.hypot(c),
-                phase: wrap_phase((-c).atan2(s)),
-            }
-        })
-        .collect();
+    let harmonics = acc.harmonics(t_tot);
     let mean = acc.mean / t_tot;
     let a1 = harmonics[0].amplitude;
     let higher_sq = 2.0 * (acc.w2 / t_tot - mean * mean) - a1 * a1;
@@ -619,18 +553,9 @@ pub(super) fn observe_window(
             } else if taper {
                 -acc.energy_rate[j]
             } else {
-                mode_energy(&z_end, j) - mode_energy(&z_start, j)
+                ctx.mode_energy(&z_end, j) - ctx.mode_energy(&z_start, j)
             };
-            let (d, b, s, c) = (acc.drive[j], acc.damp[j], acc.sample[j], acc.coupling[j]);
-            ModeBalance {
-                mode: j,
-                drive: d / per,
-                beam_damping: b / per,
-                sample: s / per,
-                coupling: c / per,
-                energy_change: de / per,
-                residual: (de - (d - b - s - c)) / per,
-            }
+            acc.mode_balance(j, de, per)
         })
         .collect();
     let mode_amplitudes = (0..n)
@@ -673,6 +598,115 @@ pub(super) fn observe_window(
         closed_form,
         components,
     })
+}
+
+impl Ctx {
+    /// The energy of mode j in the state `z`: ½ M_jj ȧ_j² + ½ K_jj a_j².
+    fn mode_energy(&self, z: &DVector<f64>, j: usize) -> f64 {
+        let (n, free) = (self.model.modes(), &self.free);
+        0.5 * free.mass[(j, j)] * z[n + j] * z[n + j] + 0.5 * free.stiffness[(j, j)] * z[j] * z[j]
+    }
+
+    /// The window's integrals into `acc`, `integ` stepped to `end`: each step's smooth pieces
+    /// and events. Returns, for a step-weighted window (steps ending at each period's end),
+    /// each mode's weighted energy change Σ_k W_k (E_j(end of k) − E_j(start of k)).
+    fn integrate(
+        &self,
+        integ: &mut dyn Integrator,
+        acc: &mut Acc,
+        end: f64,
+    ) -> Result<Vec<f64>, SimError> {
+        let tau_start = integ.tau();
+        let mut scratch = Scratch {
+            fi: DVector::zeros(self.model.modes()),
+            scan: Vec::with_capacity(GL_NODES + 2),
+            start: None,
+        };
+        let mut boundary = 1;
+        let mut step_energy = vec![0.0; self.model.modes()];
+        if let Some((_, _, w)) = &self.steps {
+            for (j, e) in step_energy.iter_mut().enumerate() {
+                *e -= w[0] * self.mode_energy(integ.state(), j);
+            }
+        }
+        while integ.tau() < end {
+            let target = match &self.steps {
+                Some((_, t, w)) if boundary < w.len() => tau_start + boundary as f64 * t,
+                _ => end,
+            };
+            let step = integ.step(target)?;
+            if let Some((_, _, w)) = &self.steps {
+                if integ.tau() >= target && boundary <= w.len() {
+                    let z = integ.state();
+                    for (j, e) in step_energy.iter_mut().enumerate() {
+                        let ej = self.mode_energy(z, j);
+                        *e += w[boundary - 1] * ej - w.get(boundary).map_or(0.0, |wb| wb * ej);
+                    }
+                    boundary += 1;
+                }
+            }
+            let (r, t0, t1) = (step.region, step.tau0, step.tau1);
+            if t1 > t0 {
+                if r == Region::Contact {
+                    acc.contact_time += self.weighted_length(t0, t1);
+                }
+                let pieces = ((t1 - t0) / self.h_max[r.index()]).ceil().max(1.0) as usize;
+                let hp = (t1 - t0) / pieces as f64;
+                // pieces of one step share their end nodes; a step starts afresh
+                scratch.start = None;
+                for k in 0..pieces {
+                    let a = t0 + k as f64 * hp;
+                    let b = if k + 1 == pieces {
+                        t1
+                    } else {
+                        t0 + (k + 1) as f64 * hp
+                    };
+                    acc.piece(self, integ, r, (a, b), &mut scratch);
+                }
+            }
+            if let Some(e) = &step.event {
+                acc.event(self, e, integ.state());
+            }
+        }
+        Ok(step_energy)
+    }
+}
+
+impl Acc {
+    /// The harmonics of W(1,τ) over the window's length `t_tot`.
+    fn harmonics(&self, t_tot: f64) -> Vec<Harmonic> {
+        (0..self.sin.len())
+            .map(|h| {
+                let s = 2.0 * self.sin[h] / t_tot;
+                let c = 2.0 * self.cos[h] / t_tot;
+                Harmonic {
+                    n: h + 1,
+                    amplitude: s.hypot(c),
+                    phase: wrap_phase((-c).atan2(s)),
+                }
+            })
+            .collect()
+    }
+
+    /// Mode j's energy balance per drive period (`per` periods in the window) with its
+    /// energy change `de` over the window.
+    fn mode_balance(&self, j: usize, de: f64, per: f64) -> ModeBalance {
+        let (d, b, s, c) = (
+            self.drive[j],
+            self.damp[j],
+            self.sample[j],
+            self.coupling[j],
+        );
+        ModeBalance {
+            mode: j,
+            drive: d / per,
+            beam_damping: b / per,
+            sample: s / per,
+            coupling: c / per,
+            energy_change: de / per,
+            residual: (de - (d - b - s - c)) / per,
+        }
+    }
 }
 
 /// [`ComponentObservables`] of component `i` (0: the primary) at ω_c = `om` from its window

@@ -585,116 +585,12 @@ pub fn finish_curve(
     second: Vec<CurvePoint>,
     progress: &Progress,
 ) -> Result<SteppedCurve, SimError> {
-    let mut warnings = Vec::new();
-    let q = spec.base.common_periods();
-    let averaged = first
-        .iter()
-        .chain(&second)
-        .filter(|p| p.reached == Reached::Averaged)
-        .count();
-    if averaged > 0 {
-        warnings.push(format!(
-            "{averaged} point(s) averaged (no short period found): their motion did not repeat \
-             with a period of at most {} drive periods, and was measured by its time average \
-             once {AVERAGE_AGREEMENTS} successive windows agreed to {AVERAGE_TOL:e} of the \
-             amplitude (reached = \"averaged\"; no Floquet multipliers)",
-            spec.steady.max_period
-        ));
-    }
-    warnings.extend(contraction::free_decay_warning(first.iter().chain(&second)));
-    let unsettled = first
-        .iter()
-        .chain(&second)
-        .filter(|p| p.average.as_ref().is_some_and(|a| !a.settled))
-        .count();
-    if unsettled > 0 {
-        warnings.push(format!(
-            "{unsettled} time-averaged point(s) did not settle within their transient cap (their \
-             components' windows still differed by more than the tolerance): their values and \
-             error estimates are those of the last windows{}",
-            spec.average
-                .as_ref()
-                .map(|a| slow_beat(&spec.base, a.window_periods))
-                .unwrap_or_default()
-        ));
-    }
-    // the components' ratios p/q, for the warnings
-    let ratios = spec
-        .base
-        .components()
-        .map(|c| format!("{}/{}", c.ratio[0], c.ratio[1]))
-        .collect::<Vec<_>>()
-        .join(", ");
-    if spec.average.is_some() && spec.base.is_quasiperiodic() {
-        warnings.push(format!(
-            "the drive's frequency ratio ({ratios}) repeats only after more than {} drive \
-             periods (quasi-periodic): every point is a time average, with its error estimate \
-             in time_average",
-            crate::params::MAX_COMMON_PERIODS
-        ));
-    }
-    if let Some(t) = &spec.torus {
-        let m = first
-            .iter()
-            .chain(&second)
-            .find_map(|p| p.circle.as_ref().map(|c| c.nodes));
-        warnings.push(format!(
-            "the drive repeats only every {q} drive periods (its frequency ratio {ratios}): the \
-             points are measured on the invariant circle of the stroboscopic map ({} nodes, \
-             asked {}), the exact orbit where the circle is not smooth or not found{}",
-            m.map_or_else(|| "no".to_string(), |m| m.to_string()),
-            t.nodes,
-            if spec.branches {
-                "; the branches and their folds are not continued on circles (exact orbits: \
-                 bimodal --exact)"
-            } else {
-                ""
-            }
-        ));
-        let all: Vec<&CurvePoint> = first.iter().chain(&second).collect();
-        warnings.extend(torus::fallback_warning(&all));
-    }
-    if q > SLOW_COMMON_PERIODS && spec.average.is_none() && spec.torus.is_none() {
-        warnings.push(format!(
-            "the multifrequency drive repeats only every {q} drive periods (its frequency ratio \
-             {ratios}): every orbit spans them all; a ratio p/q with a small q (e.g. f2 = 6.25 \
-             f1) is as many times faster, and the time average (bimodal --average) does not \
-             depend on q"
-        ));
-    }
-    let mut branches: Vec<Vec<BranchSample>> = Vec::new();
-    if spec.branches && spec.torus.is_none() {
-        for start in branch_starts(spec, &first, &second) {
-            if branches
-                .iter()
-                .any(|b| on_branch(b, start.value, &start.state))
-            {
-                continue;
-            }
-            let (lo, hi) = (spec.values[0], spec.values[spec.values.len() - 1]);
-            let to = if start.value == lo { hi } else { lo };
-            match branch(spec, &start, to, progress) {
-                Ok((br, end)) => {
-                    if let Some(why) = end.cause() {
-                        // the curve's parameter is reported in the user's units by the front
-                        // end: the warning names the cause, not the internal value
-                        warnings.push(format!(
-                            "a period-{} branch ended before the end of the range ({why}); \
-                             folds beyond it are not located",
-                            start.period.unwrap_or(1)
-                        ));
-                    }
-                    branches.push(br);
-                }
-                Err(SimError::Cancelled) => return Err(SimError::Cancelled),
-                Err(e) => warnings.push(format!(
-                    "branch from {} = {}: {e}",
-                    spec.param.name(),
-                    start.value
-                )),
-            }
-        }
-    }
+    let mut warnings = curve_warnings(spec, &first, &second);
+    let branches = if spec.branches && spec.torus.is_none() {
+        continued_branches(spec, (&first, &second), progress, &mut warnings)?
+    } else {
+        Vec::new()
+    };
     let mut folds: Vec<f64> = Vec::new();
     let mut bistable = Vec::new();
     for br in &branches {
@@ -737,6 +633,135 @@ pub fn finish_curve(
         traces,
         average: spec.average,
     })
+}
+
+/// The warnings on the two sweeps' points (averaged or unsettled ones, a free decay) and on
+/// the drive (quasi-periodic, on invariant circles, a slow common period).
+fn curve_warnings(spec: &SteppedSpec, first: &[CurvePoint], second: &[CurvePoint]) -> Vec<String> {
+    let mut warnings = Vec::new();
+    let q = spec.base.common_periods();
+    let averaged = first
+        .iter()
+        .chain(second)
+        .filter(|p| p.reached == Reached::Averaged)
+        .count();
+    if averaged > 0 {
+        warnings.push(format!(
+            "{averaged} point(s) averaged (no short period found): their motion did not repeat \
+             with a period of at most {} drive periods, and was measured by its time average \
+             once {AVERAGE_AGREEMENTS} successive windows agreed to {AVERAGE_TOL:e} of the \
+             amplitude (reached = \"averaged\"; no Floquet multipliers)",
+            spec.steady.max_period
+        ));
+    }
+    warnings.extend(contraction::free_decay_warning(first.iter().chain(second)));
+    let unsettled = first
+        .iter()
+        .chain(second)
+        .filter(|p| p.average.as_ref().is_some_and(|a| !a.settled))
+        .count();
+    if unsettled > 0 {
+        warnings.push(format!(
+            "{unsettled} time-averaged point(s) did not settle within their transient cap (their \
+             components' windows still differed by more than the tolerance): their values and \
+             error estimates are those of the last windows{}",
+            spec.average
+                .as_ref()
+                .map(|a| slow_beat(&spec.base, a.window_periods))
+                .unwrap_or_default()
+        ));
+    }
+    // the components' ratios p/q, for the warnings
+    let ratios = spec
+        .base
+        .components()
+        .map(|c| format!("{}/{}", c.ratio[0], c.ratio[1]))
+        .collect::<Vec<_>>()
+        .join(", ");
+    if spec.average.is_some() && spec.base.is_quasiperiodic() {
+        warnings.push(format!(
+            "the drive's frequency ratio ({ratios}) repeats only after more than {} drive \
+             periods (quasi-periodic): every point is a time average, with its error estimate \
+             in time_average",
+            crate::params::MAX_COMMON_PERIODS
+        ));
+    }
+    if let Some(t) = &spec.torus {
+        let m = first
+            .iter()
+            .chain(second)
+            .find_map(|p| p.circle.as_ref().map(|c| c.nodes));
+        warnings.push(format!(
+            "the drive repeats only every {q} drive periods (its frequency ratio {ratios}): the \
+             points are measured on the invariant circle of the stroboscopic map ({} nodes, \
+             asked {}), the exact orbit where the circle is not smooth or not found{}",
+            m.map_or_else(|| "no".to_string(), |m| m.to_string()),
+            t.nodes,
+            if spec.branches {
+                "; the branches and their folds are not continued on circles (exact orbits: \
+                 bimodal --exact)"
+            } else {
+                ""
+            }
+        ));
+        let all: Vec<&CurvePoint> = first.iter().chain(second).collect();
+        warnings.extend(torus::fallback_warning(&all));
+    }
+    if q > SLOW_COMMON_PERIODS && spec.average.is_none() && spec.torus.is_none() {
+        warnings.push(format!(
+            "the multifrequency drive repeats only every {q} drive periods (its frequency ratio \
+             {ratios}): every orbit spans them all; a ratio p/q with a small q (e.g. f2 = 6.25 \
+             f1) is as many times faster, and the time average (bimodal --average) does not \
+             depend on q"
+        ));
+    }
+    warnings
+}
+
+/// The periodic-orbit branches through the sweeps' (`first`, `second`) first points, each
+/// continued once (their points counted in `progress`); a branch that ends early or cannot be
+/// continued is a warning into `warnings`.
+///
+/// # Errors
+/// [`SimError::Cancelled`] once `progress` is cancelled.
+fn continued_branches(
+    spec: &SteppedSpec,
+    (first, second): (&[CurvePoint], &[CurvePoint]),
+    progress: &Progress,
+    warnings: &mut Vec<String>,
+) -> Result<Vec<Vec<BranchSample>>, SimError> {
+    let mut branches: Vec<Vec<BranchSample>> = Vec::new();
+    for start in branch_starts(spec, first, second) {
+        if branches
+            .iter()
+            .any(|b| on_branch(b, start.value, &start.state))
+        {
+            continue;
+        }
+        let (lo, hi) = (spec.values[0], spec.values[spec.values.len() - 1]);
+        let to = if start.value == lo { hi } else { lo };
+        match branch(spec, &start, to, progress) {
+            Ok((br, end)) => {
+                if let Some(why) = end.cause() {
+                    // the curve's parameter is reported in the user's units by the front
+                    // end: the warning names the cause, not the internal value
+                    warnings.push(format!(
+                        "a period-{} branch ended before the end of the range ({why}); \
+                         folds beyond it are not located",
+                        start.period.unwrap_or(1)
+                    ));
+                }
+                branches.push(br);
+            }
+            Err(SimError::Cancelled) => return Err(SimError::Cancelled),
+            Err(e) => warnings.push(format!(
+                "branch from {} = {}: {e}",
+                spec.param.name(),
+                start.value
+            )),
+        }
+    }
+    Ok(branches)
 }
 
 /// Whether `z` is a fixed point of the period-n stroboscopic map at `value` to `tol`

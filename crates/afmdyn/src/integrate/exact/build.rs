@@ -3,10 +3,11 @@
 
 use super::bound::BoundCols;
 use super::cache::{cached, PropagatorCache};
-use super::forcing::{forced, forcing_key, FORCING_KEEP_BYTES};
+use super::forcing::{forced, forcing_key, Forcing, FORCING_KEEP_BYTES};
 use super::modal::Modes;
 use super::search::TipPoly;
 use super::series::LastStep;
+use super::spectral::Spectral;
 use super::tip::base_amp;
 use super::{spectral, ExactPropagator, CHATTER_COUNT, CHATTER_WINDOW, THETA};
 use crate::error::SimError;
@@ -100,9 +101,7 @@ impl ExactPropagator {
                     "only the linear law is piecewise affine: use integrator = \"adaptive\" (or \"auto\")",
             });
         }
-        let n = model.modes();
-        let dim = 2 * n;
-        let omega = model.omega();
+        let dim = 2 * model.modes();
         let period = model.period();
         let key = spectral::matrix_key(model);
         let cache = opts.cache.as_ref();
@@ -112,25 +111,7 @@ impl ExactPropagator {
         })?;
         let rho = spec[0].rho.max(spec[1].rho);
         let base = opts.min_steps_per_period.max(1);
-        // budget: the grid of one period, (2N + 2)(m + 1) values, must fit in
-        // params::GRID_BUDGET_BYTES; checked in floating point before any allocation
-        let need_f = (period * rho / THETA).ceil().max(8.0);
-        let m_f = base as f64 * (need_f / base as f64).ceil();
-        let bytes = (dim as f64 + 2.0) * (m_f + 1.0) * 8.0;
-        if bytes.is_nan() || bytes > crate::params::GRID_BUDGET_BYTES {
-            return Err(SimError::Budget {
-                what: "exact integrator grid",
-                needed: format!(
-                    "{m_f:.3e} steps per drive period ({:.0} MiB)",
-                    bytes / (1024.0 * 1024.0)
-                ),
-                budget: "128 MiB".into(),
-                hint: "the system is too stiff for its drive period: raise Ω, lower α3, α4, α6 \
-                       or N, or lower the samples per period",
-            });
-        }
-        let need = need_f as usize;
-        let m = base * need.div_ceil(base);
+        let m = grid_steps(period, rho, base, dim)?;
         let h = period / m as f64;
         let mut grid_key = key.clone();
         grid_key.push(h.to_bits());
@@ -143,19 +124,7 @@ impl ExactPropagator {
         let (forcing, forcing_reused) = cached(
             tables.filter(|_| keep).map(|t| &t.forcing),
             &forcing_key(model, &key, h),
-            || {
-                let trig: Vec<(f64, f64)> = (0..=m)
-                    .map(|k| (omega * (k as f64 * h)).sin_cos())
-                    .collect();
-                let trig_mid: Vec<(f64, f64)> = (0..m)
-                    .map(|k| (omega * ((2 * k + 1) as f64 * (0.5 * h))).sin_cos())
-                    .collect();
-                let forced = Arc::new([
-                    forced(model, Region::Free, &spec[0], &trig, h)?,
-                    forced(model, Region::Contact, &spec[1], &trig, h)?,
-                ]);
-                Ok((forced, trig.into(), trig_mid.into()))
-            },
+            || forcing(model, &spec, m, h),
         )?;
         let (forced, trig, trig_mid) = (forcing.0.clone(), forcing.1.clone(), forcing.2.clone());
         let modal = std::array::from_fn(|i| {
@@ -240,4 +209,56 @@ impl ExactPropagator {
     pub fn modal_regions(&self) -> [bool; 2] {
         self.modal
     }
+}
+
+/// The grid's sub-steps per drive period m: the fewest (at least 8) with ‖Ã_s‖₂ h ≤ θ in both
+/// regions (`rho` the larger norm), rounded up to a multiple of `base`.
+///
+/// # Errors
+/// [`SimError::Budget`] when the grid of one period, (2N + 2)(m + 1) values (`dim` = 2N),
+/// would exceed [`crate::params::GRID_BUDGET_BYTES`]: checked in floating point before any
+/// allocation.
+fn grid_steps(period: f64, rho: f64, base: usize, dim: usize) -> Result<usize, SimError> {
+    let need_f = (period * rho / THETA).ceil().max(8.0);
+    let m_f = base as f64 * (need_f / base as f64).ceil();
+    let bytes = (dim as f64 + 2.0) * (m_f + 1.0) * 8.0;
+    if bytes.is_nan() || bytes > crate::params::GRID_BUDGET_BYTES {
+        return Err(SimError::Budget {
+            what: "exact integrator grid",
+            needed: format!(
+                "{m_f:.3e} steps per drive period ({:.0} MiB)",
+                bytes / (1024.0 * 1024.0)
+            ),
+            budget: "128 MiB".into(),
+            hint: "the system is too stiff for its drive period: raise Ω, lower α3, α4, α6 \
+                   or N, or lower the samples per period",
+        });
+    }
+    let need = need_f as usize;
+    Ok(base * need.div_ceil(base))
+}
+
+/// The forcing data of `model` on the grid of `m` steps of `h`: both regions' particular
+/// solutions (their spectral data `spec`), and sin, cos Ωτ on the grid and at its middles.
+///
+/// # Errors
+/// As [`forced`].
+fn forcing(
+    model: &CantileverModel,
+    spec: &[Spectral; 2],
+    m: usize,
+    h: f64,
+) -> Result<Forcing, SimError> {
+    let omega = model.omega();
+    let trig: Vec<(f64, f64)> = (0..=m)
+        .map(|k| (omega * (k as f64 * h)).sin_cos())
+        .collect();
+    let trig_mid: Vec<(f64, f64)> = (0..m)
+        .map(|k| (omega * ((2 * k + 1) as f64 * (0.5 * h))).sin_cos())
+        .collect();
+    let forced = Arc::new([
+        forced(model, Region::Free, &spec[0], &trig, h)?,
+        forced(model, Region::Contact, &spec[1], &trig, h)?,
+    ]);
+    Ok((forced, trig.into(), trig_mid.into()))
 }

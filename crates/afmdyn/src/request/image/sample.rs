@@ -99,6 +99,115 @@ pub(super) fn height_map_file(
     ))
 }
 
+/// The map's `size` [Lx, Ly] (m) in its `root` table: Lx > 0, Ly ≥ 0 (0 for a line).
+fn map_size(root: &toml::Table) -> Result<(f64, f64), SimError> {
+    let size = root.get("size").ok_or_else(|| {
+        bad(
+            "size".into(),
+            "missing",
+            "[Lx, Ly] in m (Ly = 0 for a line)",
+        )
+    })?;
+    let s = size.as_array().filter(|a| a.len() == 2).ok_or_else(|| {
+        bad(
+            "size".into(),
+            size,
+            "must be [Lx, Ly] in m (Ly = 0 for a line)",
+        )
+    })?;
+    let (lx, ly) = (length(&s[0], "size")?, length(&s[1], "size")?);
+    if !(lx > 0.0 && ly >= 0.0) {
+        return Err(bad(
+            "size".into(),
+            format!("[{lx:e}, {ly:e}]"),
+            "must be [Lx, Ly] with Lx > 0 and Ly ≥ 0 (m)",
+        ));
+    }
+    Ok((lx, ly))
+}
+
+/// The `i`-th `[[domain]]` entry `e` of a map of size (`lx`, `ly`): its name, x and y ranges
+/// (overlapping the map), height (within ±10 µm), width (≥ 0) and `[domain.sample]` (without
+/// z_c, which the feedback sets).
+fn domain(i: usize, e: &toml::Value, (lx, ly): (f64, f64)) -> Result<Domain, SimError> {
+    let t = e
+        .as_table()
+        .ok_or_else(|| bad(format!("domain {}", i + 1), e, "must be a table"))?;
+    let name = match t.get("name") {
+        Some(n) => n
+            .as_str()
+            .ok_or_else(|| bad(format!("domain {} name", i + 1), n, "must be a string"))?
+            .to_string(),
+        None => format!("domain {}", i + 1),
+    };
+    let key = |k: &str| format!("domain '{name}' {k}");
+    for k in t.keys() {
+        if !matches!(
+            k.as_str(),
+            "name" | "x" | "y" | "height" | "width" | "sample"
+        ) {
+            return Err(bad(
+                key(k),
+                "given",
+                "unknown: expected name, x, y, height, width and [domain.sample]",
+            ));
+        }
+    }
+    let x = pair(
+        t.get("x")
+            .ok_or_else(|| bad(key("x"), "missing", "[x0, x1] in m"))?,
+        &key("x"),
+    )?;
+    let y = t.get("y").map(|v| pair(v, &key("y"))).transpose()?;
+    if x.1 <= 0.0 || x.0 >= lx || y.is_some_and(|y| y.1 <= 0.0 || y.0 >= ly.max(0.0)) {
+        return Err(bad(
+            key("x, y"),
+            "outside the map",
+            "must overlap the map [0, Lx] × [0, Ly]",
+        ));
+    }
+    let optional_length = |k: &str| -> Result<f64, SimError> {
+        let v = t.get(k).map(|v| length(v, &key(k))).transpose()?;
+        Ok(v.unwrap_or(0.0))
+    };
+    let height = optional_length("height")?;
+    if height.abs() > MAX_HEIGHT {
+        return Err(bad(
+            key("height"),
+            height,
+            "must be within ±10 µm (a topography the z piezo follows)",
+        ));
+    }
+    let width = optional_length("width")?;
+    if width < 0.0 {
+        return Err(bad(key("width"), width, "must be ≥ 0 (m)"));
+    }
+    let sample = match t.get("sample") {
+        None => None,
+        Some(v) => {
+            let s = v
+                .as_table()
+                .ok_or_else(|| bad(key("sample"), v, "must be a table ([domain.sample])"))?;
+            if s.contains_key("z_c") {
+                return Err(bad(
+                    key("sample.z_c"),
+                    "given",
+                    "is set by the feedback, not by the sample",
+                ));
+            }
+            Some(s.clone())
+        }
+    };
+    Ok(Domain {
+        name,
+        x,
+        y,
+        height,
+        width,
+        sample,
+    })
+}
+
 impl SampleMap {
     /// Parse a sample map from TOML text; `origin` names it in errors. A height map file
     /// (`height_map = "h.csv"`) is read from the current directory when its path is relative.
@@ -124,6 +233,7 @@ impl SampleMap {
             .map_err(|e| SimError::Probe(format!("sample map {origin}: {e}")))
     }
 
+    /// [`SampleMap::parse_in`] without the file's name in its errors.
     pub(super) fn parse_text(
         text: &str,
         dir: Option<&std::path::Path>,
@@ -143,28 +253,7 @@ impl SampleMap {
                 ));
             }
         }
-        let size = root.get("size").ok_or_else(|| {
-            bad(
-                "size".into(),
-                "missing",
-                "[Lx, Ly] in m (Ly = 0 for a line)",
-            )
-        })?;
-        let s = size.as_array().filter(|a| a.len() == 2).ok_or_else(|| {
-            bad(
-                "size".into(),
-                size,
-                "must be [Lx, Ly] in m (Ly = 0 for a line)",
-            )
-        })?;
-        let (lx, ly) = (length(&s[0], "size")?, length(&s[1], "size")?);
-        if !(lx > 0.0 && ly >= 0.0) {
-            return Err(bad(
-                "size".into(),
-                format!("[{lx:e}, {ly:e}]"),
-                "must be [Lx, Ly] with Lx > 0 and Ly ≥ 0 (m)",
-            ));
-        }
+        let size = map_size(&root)?;
         let entries = match root.get("domain") {
             None => Vec::new(),
             Some(v) => v
@@ -175,96 +264,16 @@ impl SampleMap {
         if entries.len() > MAX_DOMAINS {
             return Err(bad("domain".into(), entries.len(), "at most 1000 domains"));
         }
-        let mut domains = Vec::with_capacity(entries.len());
-        for (i, e) in entries.iter().enumerate() {
-            let t = e
-                .as_table()
-                .ok_or_else(|| bad(format!("domain {}", i + 1), e, "must be a table"))?;
-            let name = match t.get("name") {
-                Some(n) => n
-                    .as_str()
-                    .ok_or_else(|| bad(format!("domain {} name", i + 1), n, "must be a string"))?
-                    .to_string(),
-                None => format!("domain {}", i + 1),
-            };
-            let key = |k: &str| format!("domain '{name}' {k}");
-            for k in t.keys() {
-                if !matches!(
-                    k.as_str(),
-                    "name" | "x" | "y" | "height" | "width" | "sample"
-                ) {
-                    return Err(bad(
-                        key(k),
-                        "given",
-                        "unknown: expected name, x, y, height, width and [domain.sample]",
-                    ));
-                }
-            }
-            let x = pair(
-                t.get("x")
-                    .ok_or_else(|| bad(key("x"), "missing", "[x0, x1] in m"))?,
-                &key("x"),
-            )?;
-            let y = t.get("y").map(|v| pair(v, &key("y"))).transpose()?;
-            if x.1 <= 0.0 || x.0 >= lx || y.is_some_and(|y| y.1 <= 0.0 || y.0 >= ly.max(0.0)) {
-                return Err(bad(
-                    key("x, y"),
-                    "outside the map",
-                    "must overlap the map [0, Lx] × [0, Ly]",
-                ));
-            }
-            let height = t
-                .get("height")
-                .map(|v| length(v, &key("height")))
-                .transpose()?
-                .unwrap_or(0.0);
-            if height.abs() > MAX_HEIGHT {
-                return Err(bad(
-                    key("height"),
-                    height,
-                    "must be within ±10 µm (a topography the z piezo follows)",
-                ));
-            }
-            let width = t
-                .get("width")
-                .map(|v| length(v, &key("width")))
-                .transpose()?
-                .unwrap_or(0.0);
-            if width < 0.0 {
-                return Err(bad(key("width"), width, "must be ≥ 0 (m)"));
-            }
-            let sample = match t.get("sample") {
-                None => None,
-                Some(v) => {
-                    let s = v.as_table().ok_or_else(|| {
-                        bad(key("sample"), v, "must be a table ([domain.sample])")
-                    })?;
-                    if s.contains_key("z_c") {
-                        return Err(bad(
-                            key("sample.z_c"),
-                            "given",
-                            "is set by the feedback, not by the sample",
-                        ));
-                    }
-                    Some(s.clone())
-                }
-            };
-            domains.push(Domain {
-                name,
-                x,
-                y,
-                height,
-                width,
-                sample,
-            });
-        }
+        let domains = (entries.iter().enumerate())
+            .map(|(i, e)| domain(i, e, size))
+            .collect::<Result<Vec<_>, _>>()?;
         let height_map = match root.get("height_map") {
             None => Vec::new(),
             Some(toml::Value::String(file)) => height_map_file(file, dir)?,
             Some(v) => height_map(v)?,
         };
         Ok(SampleMap {
-            size: (lx, ly),
+            size,
             domains,
             height_map,
         })

@@ -1,6 +1,6 @@
 //! `attractors` and `attractors --sweep`: their summaries, tables, datasets and figures.
 
-use crate::analysis::attractors::AttractorReport;
+use crate::analysis::attractors::{Attractor, AttractorReport};
 use crate::analysis::global_continuation::ContinuationStep;
 use crate::error::SimError;
 use crate::integrate::build;
@@ -12,7 +12,7 @@ use crate::report::{self, OutputFile, Presentation, TextUnits};
 use crate::request::analyses::{AttractorsRequest, GlobalContinuationRequest};
 use crate::request::limits::ATTRACTOR_SAMPLES_PER_PERIOD;
 use crate::system::Region;
-use crate::trajectory::{record, RecordSpec};
+use crate::trajectory::{record, RecordSpec, Trajectory};
 use serde_json::Value;
 
 /// A period as the summaries name it: `period-n` or `nonperiodic`.
@@ -57,70 +57,96 @@ pub fn attractors(
                 body_contact: false,
             },
         )?;
-        let stem = format!("attractor-{}", k + 1);
-        s.csv(
-            &format!("{stem}.csv"),
-            &["tau", "v_t", "w_tip", "w_tip_dot", "in_contact"],
-            (tr.samples.iter())
-                .map(|s| {
-                    vec![
-                        f(s.tau),
-                        f(s.v_t),
-                        f(s.w_tip),
-                        f(s.w_tip_dot),
-                        u8::from(s.region == Region::Contact).to_string(),
-                    ]
-                })
-                .collect(),
-        );
-        let label = period_name(att.steady.period());
-        let line = |points| Series {
-            label: String::new(),
-            points,
-            style: Style::Line,
-            color: k,
-        };
-        s.figure(
-            &format!("{stem}-time"),
-            Plot::Lines(Figure {
-                y_min_span: 0.0,
-                title: format!(
-                    "Attractor {} ({label}, basin {:.1} %), Ω = {}",
-                    k + 1,
-                    100.0 * att.basin_fraction,
-                    p.omega
-                ),
-                x_label: "τ".into(),
-                y_label: "W(1,τ)".into(),
-                series: vec![line(tr.samples.iter().map(|s| (s.tau, s.w_tip)).collect())],
-                shade: vec![],
-            }),
-        );
-        let sections = Series {
-            label: "Poincaré points".into(),
-            points: (att.steady.poincare.iter())
-                .map(|q| (q.w_tip, model.w_tip_dot(&q.state)))
-                .collect(),
-            style: Style::Points,
-            color: if k % 10 == 3 { 4 } else { 3 },
-        };
-        let phase = tr.samples.iter().map(|s| (s.w_tip, s.w_tip_dot)).collect();
-        s.figure(
-            &format!("{stem}-phase"),
-            Plot::Lines(Figure {
-                y_min_span: 0.0,
-                title: format!("Attractor {} ({label}): phase plane", k + 1),
-                x_label: "W(1,τ)".into(),
-                y_label: "∂W(1,τ)/∂τ".into(),
-                series: vec![line(phase), sections],
-                shade: vec![],
-            }),
-        );
+        attractor_files(&mut s, &model, k, att, &tr);
     }
     s.files.push(OutputFile::Json {
         name: "attractors.json".into(),
         value: document.clone(),
     });
+    summary(&mut s, request, p, report, u);
+    Ok(s)
+}
+
+/// The files of attractor `k` (`att`, recorded over its cycle as `tr` under `model`) into `s`:
+/// `attractor-k.csv`, its time series and its phase plane with the Poincaré points.
+fn attractor_files(
+    s: &mut Presentation,
+    model: &CantileverModel,
+    k: usize,
+    att: &Attractor,
+    tr: &Trajectory,
+) {
+    let stem = format!("attractor-{}", k + 1);
+    s.csv(
+        &format!("{stem}.csv"),
+        &["tau", "v_t", "w_tip", "w_tip_dot", "in_contact"],
+        (tr.samples.iter())
+            .map(|s| {
+                vec![
+                    f(s.tau),
+                    f(s.v_t),
+                    f(s.w_tip),
+                    f(s.w_tip_dot),
+                    u8::from(s.region == Region::Contact).to_string(),
+                ]
+            })
+            .collect(),
+    );
+    let label = period_name(att.steady.period());
+    let line = |points| Series {
+        label: String::new(),
+        points,
+        style: Style::Line,
+        color: k,
+    };
+    s.figure(
+        &format!("{stem}-time"),
+        Plot::Lines(Figure {
+            y_min_span: 0.0,
+            title: format!(
+                "Attractor {} ({label}, basin {:.1} %), Ω = {}",
+                k + 1,
+                100.0 * att.basin_fraction,
+                model.omega()
+            ),
+            x_label: "τ".into(),
+            y_label: "W(1,τ)".into(),
+            series: vec![line(tr.samples.iter().map(|s| (s.tau, s.w_tip)).collect())],
+            shade: vec![],
+        }),
+    );
+    let sections = Series {
+        label: "Poincaré points".into(),
+        points: (att.steady.poincare.iter())
+            .map(|q| (q.w_tip, model.w_tip_dot(&q.state)))
+            .collect(),
+        style: Style::Points,
+        color: if k % 10 == 3 { 4 } else { 3 },
+    };
+    let phase = tr.samples.iter().map(|s| (s.w_tip, s.w_tip_dot)).collect();
+    s.figure(
+        &format!("{stem}-phase"),
+        Plot::Lines(Figure {
+            y_min_span: 0.0,
+            title: format!("Attractor {} ({label}): phase plane", k + 1),
+            x_label: "W(1,τ)".into(),
+            y_label: "∂W(1,τ)/∂τ".into(),
+            series: vec![line(phase), sections],
+            shade: vec![],
+        }),
+    );
+}
+
+/// The census's summary into `s`: the attractors found from the request's starts at `p`,
+/// each with its period, basin, largest excursion, closest approach and contact fraction, and
+/// the starts still unsettled; lengths in `u` (g₀, or m with a probe).
+fn summary(
+    s: &mut Presentation,
+    request: &AttractorsRequest,
+    p: &Params,
+    report: &AttractorReport,
+    u: TextUnits,
+) {
     s.line(format!(
         "{} attractors from {} starts ({} failed) at {}{}:",
         report.attractors.len(),
@@ -165,7 +191,6 @@ pub fn attractors(
             x.lyapunov.map_or(f64::NAN, |l| l.0)
         ));
     }
-    Ok(s)
 }
 
 /// The warning of failed random starts of a census of `samples`, if any.

@@ -3,8 +3,8 @@
 
 use crate::analysis::continuation::BranchEvent;
 use crate::analysis::observables::Observables;
-use crate::analysis::stepped::SteppedCurve;
 use crate::analysis::stepped::Sweep;
+use crate::analysis::stepped::{BranchSample, SteppedCurve};
 use crate::layout::figure::{Figure, Plot, Series, Style};
 use crate::report::TextUnits;
 use crate::report::{component_columns, component_row, curve_column_index, curve_row, CurveUnits};
@@ -61,6 +61,10 @@ fn col(o: &Observables, u: &CurveUnits, k: Key) -> f64 {
     }
 }
 
+/// A panel of a curve's figures: (where its values come from, the column's name, the y axis
+/// label, the file stem's suffix).
+type Panel = (Key, String, String, String);
+
 /// The figures of a curve against its swept quantity, each with its stem: amplitude, phase,
 /// dissipation, virial, peak force, each drive component's amplitude and phase, the higher
 /// modes' share; the sweeps, the continued branches (unstable dotted), jumps and folds, the
@@ -68,6 +72,41 @@ fn col(o: &Observables, u: &CurveUnits, k: Key) -> f64 {
 pub(crate) fn panels(s: &Shown<'_>) -> Vec<(String, Plot)> {
     let (c, x, u, l) = (s.c, s.x, s.u, s.l);
     let mut figures = Vec::new();
+    for (k, name, y_label, suffix) in panel_list(s) {
+        let name = name.as_str();
+        figures.push((
+            format!("{}-{suffix}", l.stem),
+            Plot::Lines(Figure {
+                // energies and forces below 1e-6 of the model's units are round-off (a
+                // conservative law's E_dis): drawn as zero on an axis of that extent
+                y_min_span: match name {
+                    "energy_dissipated" | "virial" => 1e-6 * u.energy,
+                    "peak_force" => 1e-6 * u.force,
+                    _ => 0.0,
+                },
+                title: format!("{} curve: {}", l.stem, name.replace('_', " ")),
+                x_label: l.x_label.clone(),
+                y_label,
+                series: panel_series(s, k),
+                shade: c
+                    .bistable
+                    .iter()
+                    .map(|&(a, b)| {
+                        let (p, q) = (x(a), x(b));
+                        (p.min(q), p.max(q))
+                    })
+                    .collect(),
+            }),
+        ));
+    }
+    figures
+}
+
+/// The panels of a curve: amplitude (its ratio to the free one against z_c), phase,
+/// dissipation, virial, peak force; under a multifrequency drive each component's amplitude
+/// and phase; with more than one mode the higher modes' share.
+fn panel_list(s: &Shown<'_>) -> Vec<Panel> {
+    let (c, u, l) = (s.c, s.u, s.l);
     let unit = |base: &str| {
         if u.si {
             base.to_string()
@@ -109,21 +148,12 @@ pub(crate) fn panels(s: &Shown<'_>) -> Vec<(String, Plot)> {
         .map_or(0, |p| p.observables.components.len());
     for (k, (name, _, _)) in component_columns(count).into_iter().enumerate() {
         let i = k / 4 + 1;
-        match k % 4 {
-            0 => panels.push((
-                Key::Component(k),
-                name,
-                format!("amplitude A{i} {}", unit("(m)")),
-                format!("amplitude-{i}"),
-            )),
-            1 => panels.push((
-                Key::Component(k),
-                name,
-                format!("phase lag φ{i} (deg)"),
-                format!("phase-{i}"),
-            )),
-            _ => {}
-        }
+        let (y, suffix) = match k % 4 {
+            0 => (format!("amplitude A{i} {}", unit("(m)")), "amplitude"),
+            1 => (format!("phase lag φ{i} (deg)"), "phase"),
+            _ => continue,
+        };
+        panels.push((Key::Component(k), name, y, format!("{suffix}-{i}")));
     }
     // more than one mode: the higher modes' share of the motion (in liquid, every tap rings them)
     let modes = c
@@ -138,123 +168,92 @@ pub(crate) fn panels(s: &Shown<'_>) -> Vec<(String, Plot)> {
             "higher-modes".to_string(),
         ));
     }
-    for (k, name, y_label, suffix) in panels {
-        let name = name.as_str();
-        let mut series = Vec::new();
-        // branches first (underneath): each unstable stretch a dotted line, stable points as
-        // small dots
-        for b in &c.branches {
-            let stable: Vec<(f64, f64)> = b
-                .iter()
-                .filter(|s| s.point.stable)
-                .map(|s| (x(s.point.value), col(&s.observables, u, k)))
-                .collect();
-            for run in b.chunk_by(|p, q| p.point.stable == q.point.stable) {
-                if !run[0].point.stable {
-                    series.push(Series {
-                        label: String::new(),
-                        points: run
-                            .iter()
-                            .map(|s| (x(s.point.value), col(&s.observables, u, k)))
-                            .collect(),
-                        style: Style::Dotted,
-                        color: 3,
-                    });
-                }
-            }
-            if !stable.is_empty() {
+    panels
+}
+
+/// The series of the values `k` of a curve: the continued branches first (underneath: each
+/// unstable stretch a dotted line, stable points as small dots), the two sweeps, the jumps
+/// and the folds.
+fn panel_series(s: &Shown<'_>, k: Key) -> Vec<Series> {
+    let (c, x, u, l) = (s.c, s.x, s.u, s.l);
+    let mut series = Vec::new();
+    let points = |label: &str, points: Vec<(f64, f64)>, color| Series {
+        label: label.into(),
+        points,
+        style: Style::Points,
+        color,
+    };
+    for b in &c.branches {
+        let at = |s: &BranchSample| (x(s.point.value), col(&s.observables, u, k));
+        let stable: Vec<(f64, f64)> = b.iter().filter(|s| s.point.stable).map(at).collect();
+        for run in b.chunk_by(|p, q| p.point.stable == q.point.stable) {
+            if !run[0].point.stable {
                 series.push(Series {
                     label: String::new(),
-                    points: stable,
-                    style: Style::Dots,
-                    color: 7,
+                    points: run.iter().map(at).collect(),
+                    style: Style::Dotted,
+                    color: 3,
                 });
             }
         }
-        if let Some(s) = series.iter_mut().find(|s| s.color == 3) {
-            s.label = "unstable branch (dotted)".into();
-        }
-        if let Some(s) = series.iter_mut().find(|s| s.color == 7) {
-            s.label = "stable branch (continuation)".into();
-        }
-        for (sweep, style, color, label) in [
-            (&c.first, Style::Line, 0, format!("{} (solid)", l.sweeps.0)),
-            (
-                &c.second,
-                Style::Dashed,
-                1,
-                format!("{} (dashed)", l.sweeps.1),
-            ),
-        ] {
+        if !stable.is_empty() {
             series.push(Series {
-                label,
-                points: sweep
-                    .iter()
-                    .map(|p| (x(p.value), col(&p.observables, u, k)))
-                    .collect(),
-                style,
-                color,
+                label: String::new(),
+                points: stable,
+                style: Style::Dots,
+                color: 7,
             });
         }
-        let mut marks = Vec::new();
-        for j in &c.jumps {
-            let sw = match j.sweep {
-                Sweep::First => &c.first,
-                Sweep::Second => &c.second,
-            };
-            for p in &sw[j.index - 1..=j.index] {
-                marks.push((x(p.value), col(&p.observables, u, k)));
-            }
-        }
-        if !marks.is_empty() {
-            series.push(Series {
-                label: "jumps".into(),
-                points: marks,
-                style: Style::Points,
-                color: 2,
-            });
-        }
-        let folds: Vec<(f64, f64)> = c
-            .branches
-            .iter()
-            .flatten()
-            .filter(|s| s.point.event == Some(BranchEvent::Fold))
-            .map(|s| (x(s.point.value), col(&s.observables, u, k)))
-            .collect();
-        if !folds.is_empty() {
-            series.push(Series {
-                label: "folds (saddle-node)".into(),
-                points: folds,
-                style: Style::Points,
-                color: 4,
-            });
-        }
-        figures.push((
-            format!("{}-{suffix}", l.stem),
-            Plot::Lines(Figure {
-                // energies and forces below 1e-6 of the model's units are round-off (a
-                // conservative law's E_dis): drawn as zero on an axis of that extent
-                y_min_span: match name {
-                    "energy_dissipated" | "virial" => 1e-6 * u.energy,
-                    "peak_force" => 1e-6 * u.force,
-                    _ => 0.0,
-                },
-                title: format!("{} curve: {}", l.stem, name.replace('_', " ")),
-                x_label: l.x_label.clone(),
-                y_label,
-                series,
-                shade: c
-                    .bistable
-                    .iter()
-                    .map(|&(a, b)| {
-                        let (p, q) = (x(a), x(b));
-                        (p.min(q), p.max(q))
-                    })
-                    .collect(),
-            }),
-        ));
     }
-    figures
+    if let Some(s) = series.iter_mut().find(|s| s.color == 3) {
+        s.label = "unstable branch (dotted)".into();
+    }
+    if let Some(s) = series.iter_mut().find(|s| s.color == 7) {
+        s.label = "stable branch (continuation)".into();
+    }
+    for (sweep, style, color, label) in [
+        (&c.first, Style::Line, 0, format!("{} (solid)", l.sweeps.0)),
+        (
+            &c.second,
+            Style::Dashed,
+            1,
+            format!("{} (dashed)", l.sweeps.1),
+        ),
+    ] {
+        series.push(Series {
+            label,
+            points: sweep
+                .iter()
+                .map(|p| (x(p.value), col(&p.observables, u, k)))
+                .collect(),
+            style,
+            color,
+        });
+    }
+    let mut marks = Vec::new();
+    for j in &c.jumps {
+        let sw = match j.sweep {
+            Sweep::First => &c.first,
+            Sweep::Second => &c.second,
+        };
+        for p in &sw[j.index - 1..=j.index] {
+            marks.push((x(p.value), col(&p.observables, u, k)));
+        }
+    }
+    if !marks.is_empty() {
+        series.push(points("jumps", marks, 2));
+    }
+    let folds: Vec<(f64, f64)> = c
+        .branches
+        .iter()
+        .flatten()
+        .filter(|s| s.point.event == Some(BranchEvent::Fold))
+        .map(|s| (x(s.point.value), col(&s.observables, u, k)))
+        .collect();
+    if !folds.is_empty() {
+        series.push(points("folds (saddle-node)", folds, 4));
+    }
+    series
 }
 
 /// The force–distance loops of up to 8 of the traces' `xs` spread over the sweep (`distance`

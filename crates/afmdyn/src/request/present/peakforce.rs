@@ -104,6 +104,58 @@ pub fn peakforce(
         outputs_note: OutputsNote::Tail,
         ..Presentation::default()
     };
+    let sweep = sweep_table(document);
+    summary(&mut p, document, text, sweep.as_ref());
+    if files == Files::None {
+        return p;
+    }
+    let cycle = rows(document, "cycle", &CYCLE_COLUMNS);
+    let filtered = document["curve"].get(FILTERED_COLUMNS[0]).is_some();
+    let curve_columns: Vec<&str> = if filtered {
+        CURVE_COLUMNS
+            .iter()
+            .chain(&FILTERED_COLUMNS)
+            .copied()
+            .collect()
+    } else {
+        CURVE_COLUMNS.to_vec()
+    };
+    let curve = rows(document, "curve", &curve_columns);
+    #[cfg(feature = "files")]
+    {
+        use crate::layout::files::f;
+        let table = |t: &[Vec<f64>]| {
+            t.iter()
+                .map(|r| r.iter().map(|v| f(*v)).collect())
+                .collect()
+        };
+        p.csv("peakforce-cycle.csv", &CYCLE_COLUMNS, table(&cycle));
+        p.csv("peakforce-curve.csv", &curve_columns, table(&curve));
+        if let Some((_, rows, columns)) = &sweep {
+            p.csv("peakforce-sweep.csv", columns, table(rows));
+        }
+    }
+    if files == Files::All {
+        figures(
+            &mut p,
+            document,
+            text.si(),
+            (&cycle, &curve, filtered),
+            sweep.as_ref(),
+        );
+    }
+    with_document(
+        &mut p,
+        document,
+        ("peakforce.json", "peakforce-cycle.csv"),
+        dir,
+    );
+    p
+}
+
+/// The summary of a steady tap's `document` into `p`: its channels, the DMT fit beside the
+/// true modulus, the orbit's stability and, with a `sweep`, its length.
+fn summary(p: &mut Presentation, document: &Value, text: TextUnits, sweep: Option<&SweepTable>) {
     let si = text.si();
     let ch = &document["channels"];
     let num = |v: &Value| v.as_f64().unwrap_or(f64::NAN);
@@ -153,8 +205,7 @@ pub fn peakforce(
             .map(|m| num(&m[0]).hypot(num(&m[1])))
             .unwrap_or(f64::NAN),
     ));
-    let sweep = sweep_table(document);
-    if let Some((param, table, _)) = &sweep {
+    if let Some((param, table, _)) = sweep {
         let failed = document["sweep"]["message"]
             .as_array()
             .map_or(0, |m| m.iter().filter(|x| !x.is_null()).count());
@@ -168,105 +219,79 @@ pub fn peakforce(
             }
         ));
     }
-    if files == Files::None {
-        return p;
-    }
-    let cycle = rows(document, "cycle", &CYCLE_COLUMNS);
-    let filtered = document["curve"].get(FILTERED_COLUMNS[0]).is_some();
-    let curve_columns: Vec<&str> = if filtered {
-        CURVE_COLUMNS
-            .iter()
-            .chain(&FILTERED_COLUMNS)
-            .copied()
-            .collect()
+}
+
+/// The figures of a steady tap into `p` (in SI when `si`): force against distance (the
+/// `curve`'s rows; the force through the instrument's filter too when `filtered`), the
+/// `sweep`'s peak force and adhesion, and force against time (the `cycle`'s rows).
+fn figures(
+    p: &mut Presentation,
+    document: &Value,
+    si: bool,
+    (cycle, curve, filtered): (&[Vec<f64>], &[Vec<f64>], bool),
+    sweep: Option<&SweepTable>,
+) {
+    let (l, f, t) = if si {
+        (" (m)", " (N)", " (s)")
     } else {
-        CURVE_COLUMNS.to_vec()
+        (" (g0)", " (F)", " (τ)")
     };
-    let curve = rows(document, "curve", &curve_columns);
-    #[cfg(feature = "files")]
-    {
-        use crate::layout::files::f;
-        let table = |t: &[Vec<f64>]| {
-            t.iter()
-                .map(|r| r.iter().map(|v| f(*v)).collect())
-                .collect()
-        };
-        p.csv("peakforce-cycle.csv", &CYCLE_COLUMNS, table(&cycle));
-        p.csv("peakforce-curve.csv", &curve_columns, table(&curve));
-        if let Some((_, rows, columns)) = &sweep {
-            p.csv("peakforce-sweep.csv", columns, table(rows));
-        }
+    let series = |label: &str, pts: Vec<(f64, f64)>, color: usize| Series {
+        label: label.into(),
+        points: pts
+            .into_iter()
+            .filter(|(x, y)| x.is_finite() && y.is_finite())
+            .collect(),
+        style: Style::Line,
+        color,
+    };
+    let approach = curve.iter().map(|r| (r[0], r[1])).collect();
+    let retract = curve.iter().map(|r| (r[2], r[3])).collect();
+    let mut all = vec![
+        series("approach", approach, 0),
+        series("retract", retract, 1),
+    ];
+    if filtered {
+        let approach = curve.iter().map(|r| (r[0], r[4])).collect();
+        let retract = curve.iter().map(|r| (r[2], r[5])).collect();
+        all.push(series("approach, k × deflection filtered", approach, 2));
+        all.push(series("retract, k × deflection filtered", retract, 3));
     }
-    if files == Files::All {
-        let (l, f, t) = if si {
-            (" (m)", " (N)", " (s)")
-        } else {
-            (" (g0)", " (F)", " (τ)")
-        };
-        let series = |label: &str, pts: Vec<(f64, f64)>, color: usize| Series {
-            label: label.into(),
-            points: pts
-                .into_iter()
-                .filter(|(x, y)| x.is_finite() && y.is_finite())
-                .collect(),
-            style: Style::Line,
-            color,
-        };
-        let approach = curve.iter().map(|r| (r[0], r[1])).collect();
-        let retract = curve.iter().map(|r| (r[2], r[3])).collect();
-        let mut all = vec![
-            series("approach", approach, 0),
-            series("retract", retract, 1),
-        ];
-        if filtered {
-            let approach = curve.iter().map(|r| (r[0], r[4])).collect();
-            let retract = curve.iter().map(|r| (r[2], r[5])).collect();
-            all.push(series("approach, k × deflection filtered", approach, 2));
-            all.push(series("retract, k × deflection filtered", retract, 3));
-        }
-        p.figure(
-            "peakforce-curve",
-            lines(
-                "PeakForce tapping: force against tip–sample distance",
-                (format!("distance{l}"), format!("force{f}")),
-                all,
-            ),
-        );
-        if let Some((param, rows, _)) = &sweep {
-            let unit = document["sweep"]["unit"].as_str().unwrap_or("");
-            // columns: the value, then SWEEP_COLUMNS (peak_force, adhesion first)
-            let peak = rows.iter().map(|r| (r[0], r[1])).collect();
-            let adhesion = rows.iter().map(|r| (r[0], r[2])).collect();
-            p.figure(
-                "peakforce-sweep",
-                lines(
-                    "PeakForce tapping: peak force and adhesion over the sweep",
-                    (format!("{param} ({unit})"), format!("force{f}")),
-                    vec![
-                        series("peak force", peak, 0),
-                        series("adhesion", adhesion, 1),
-                    ],
-                ),
-            );
-        }
-        let time = cycle.iter().map(|r| (r[0], r[3])).collect();
-        p.figure(
-            "peakforce-force-time",
-            lines(
-                "PeakForce tapping: force over one modulation period",
-                (
-                    format!("time from the largest separation{t}"),
-                    format!("force{f}"),
-                ),
-                vec![series("", time, 0)],
-            ),
-        );
-    }
-    with_document(
-        &mut p,
-        document,
-        ("peakforce.json", "peakforce-cycle.csv"),
-        dir,
+    p.figure(
+        "peakforce-curve",
+        lines(
+            "PeakForce tapping: force against tip–sample distance",
+            (format!("distance{l}"), format!("force{f}")),
+            all,
+        ),
     );
-    p
+    if let Some((param, rows, _)) = sweep {
+        let unit = document["sweep"]["unit"].as_str().unwrap_or("");
+        // columns: the value, then SWEEP_COLUMNS (peak_force, adhesion first)
+        let peak = rows.iter().map(|r| (r[0], r[1])).collect();
+        let adhesion = rows.iter().map(|r| (r[0], r[2])).collect();
+        p.figure(
+            "peakforce-sweep",
+            lines(
+                "PeakForce tapping: peak force and adhesion over the sweep",
+                (format!("{param} ({unit})"), format!("force{f}")),
+                vec![
+                    series("peak force", peak, 0),
+                    series("adhesion", adhesion, 1),
+                ],
+            ),
+        );
+    }
+    let time = cycle.iter().map(|r| (r[0], r[3])).collect();
+    p.figure(
+        "peakforce-force-time",
+        lines(
+            "PeakForce tapping: force over one modulation period",
+            (
+                format!("time from the largest separation{t}"),
+                format!("force{f}"),
+            ),
+            vec![series("", time, 0)],
+        ),
+    );
 }
