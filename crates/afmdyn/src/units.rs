@@ -154,13 +154,53 @@ impl Cantilever {
     pub fn spring_constant(&self) -> f64 {
         3.0 * self.bending_stiffness() / self.length.powi(3)
     }
-    /// Seconds per unit of dimensionless time: t = τ √(mL⁴/EI) (eq. 5).
+    /// Seconds per unit of dimensionless time (the time scale of the beam without a tip mass).
     pub fn time_scale(&self) -> f64 {
-        (self.mass_per_length() * self.length.powi(4) / self.bending_stiffness()).sqrt()
+        self.with_tip(0.0).time_scale()
+    }
+    /// The beam of eq. 3 this cantilever makes with a tip mass M (kg).
+    pub(crate) fn with_tip(&self, tip_mass: f64) -> BeamSi {
+        BeamSi {
+            length: self.length,
+            bending_stiffness: self.bending_stiffness(),
+            mass_per_length: self.mass_per_length(),
+            tip_mass,
+        }
     }
     /// First natural frequency of the bare cantilever f₁ = β₁² √(EI/(mL⁴)) / 2π (Hz).
     pub fn first_frequency_hz(&self) -> f64 {
         crate::beam::beta_root(1).powi(2) / self.time_scale() / std::f64::consts::TAU
+    }
+}
+
+/// The beam of eq. 3 in SI — length L, bending stiffness EI, mass per unit length m, tip mass M —
+/// and what the model's groups take from it: the one route from a cantilever's SI values to the
+/// tip-mass ratio, the time scale and the stiffness unit, for `units`
+/// ([`PhysicalModel::to_params`]) and for a probe file given by its geometry (`crate::probe`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct BeamSi {
+    /// Length L (m).
+    pub length: f64,
+    /// Bending stiffness EI (N m²).
+    pub bending_stiffness: f64,
+    /// Mass per unit length m (kg/m).
+    pub mass_per_length: f64,
+    /// Tip mass M (kg).
+    pub tip_mass: f64,
+}
+
+impl BeamSi {
+    /// The tip-mass ratio α1 = M/(mL) (eq. 7).
+    pub fn tip_mass_ratio(&self) -> f64 {
+        self.tip_mass / (self.mass_per_length * self.length)
+    }
+    /// Seconds per unit of dimensionless time: t = τ √(mL⁴/EI) (eq. 5).
+    pub fn time_scale(&self) -> f64 {
+        (self.mass_per_length * self.length.powi(4) / self.bending_stiffness).sqrt()
+    }
+    /// The stiffness unit EI/L³ (N/m), in which α4 measures the contact stiffness K₁.
+    pub fn stiffness_unit(&self) -> f64 {
+        self.bending_stiffness / self.length.powi(3)
     }
 }
 
@@ -241,19 +281,19 @@ impl PhysicalModel {
     /// [`UnitsError`] for invalid physical input.
     pub fn to_params(&self) -> Result<Params, UnitsError> {
         self.validate()?;
-        let c = &self.cantilever;
-        let (l, m, ei) = (c.length, c.mass_per_length(), c.bending_stiffness());
+        let beam = self.cantilever.with_tip(self.tip_mass);
+        let (l, m, ei) = (beam.length, beam.mass_per_length, beam.bending_stiffness);
         let root = (ei * m).sqrt();
         let p = Params {
             contact_law: Default::default(),
             modes: self.modes,
-            alpha1: self.tip_mass / (m * l),
+            alpha1: beam.tip_mass_ratio(),
             alpha2: self.drive_amplitude / self.beam_gap,
             alpha3: self.beam_damping * l * l / root,
             alpha4: self.contact_stiffness * l.powi(3) / ei,
             alpha5: self.tip_gap / self.beam_gap,
             alpha6: self.contact_damping * l / root,
-            omega: std::f64::consts::TAU * self.drive_frequency_hz * c.time_scale(),
+            omega: std::f64::consts::TAU * self.drive_frequency_hz * beam.time_scale(),
             ..Params::default()
         };
         p.validate()?;

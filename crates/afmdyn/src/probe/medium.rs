@@ -228,14 +228,10 @@ pub(super) fn to_vacuum(
     let e = |x: crate::error::SimError| format!("[medium]: {x}");
     // the section, and f₀ in vacuum
     let (section, f_vac) = match *beam {
-        Beam::Geometry {
-            width,
-            mass_per_length,
-            ..
-        } => (
+        Beam::Geometry { width, si } => (
             Section {
                 width,
-                mass_per_length,
+                mass_per_length: si.mass_per_length,
             },
             f0,
         ),

@@ -465,12 +465,10 @@ enum Beam {
         /// Length and width (m) when given (what `[medium]` needs).
         plan: Option<(f64, f64)>,
     },
+    /// The beam's width b (m, what `[medium]` needs) and the beam in SI.
     Geometry {
-        length: f64,
         width: f64,
-        ei: f64,
-        mass_per_length: f64,
-        tip_mass: f64,
+        si: crate::units::BeamSi,
     },
 }
 

@@ -19,19 +19,13 @@ impl Probe {
         let (a0, freq) = (drive.free_amplitude, drive.frequency);
         let q1_file = q1;
         let g0 = a0;
-        // tip-mass ratio α1 of the beam, and for the geometry the time scale t = τ √(mL⁴/EI)
-        // (eq. 5), the force unit EI/L³ and the static stiffness 3EI/L³
+        // tip-mass ratio α1 of the beam, and for the geometry the time scale and the stiffness
+        // unit EI/L³ (with the static stiffness 3EI/L³)
         let (beam_alpha1, geometry) = match beam {
             Beam::Calibrated { alpha1, k, f0, .. } => (alpha1, Err((k, f0))),
-            Beam::Geometry {
-                length: l,
-                ei,
-                mass_per_length: m,
-                tip_mass,
-                ..
-            } => (
-                tip_mass / (m * l),
-                Ok(((m * l.powi(4) / ei).sqrt(), ei / l.powi(3))),
+            Beam::Geometry { si, .. } => (
+                si.tip_mass_ratio(),
+                Ok((si.time_scale(), si.stiffness_unit())),
             ),
         };
         let alpha1 = match structure {

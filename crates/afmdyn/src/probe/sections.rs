@@ -464,11 +464,13 @@ impl Probe {
                 let tip_mass = r.optional(c, S, "tip_mass", "kg", NON_NEGATIVE);
                 match (length, width, thickness, e, rho) {
                     (Some(l), Some(b), Some(h), Some(e), Some(rho)) => Some(Beam::Geometry {
-                        length: l,
                         width: b,
-                        ei: e * b * h.powi(3) / 12.0,
-                        mass_per_length: rho * b * h,
-                        tip_mass: tip_mass.unwrap_or(0.0),
+                        si: crate::units::BeamSi {
+                            length: l,
+                            bending_stiffness: e * b * h.powi(3) / 12.0,
+                            mass_per_length: rho * b * h,
+                            tip_mass: tip_mass.unwrap_or(0.0),
+                        },
                     }),
                     _ => None,
                 }
