@@ -98,11 +98,17 @@ pub(crate) fn preset<T: Copy>(
         })
 }
 
-/// Hertz contact stiffness K₁ = 2E*√(RΔ), 1/E* = (1 − ν₁²)/E₁ + (1 − ν₂²)/E₂ (paper §4). N/m.
+/// Hertz contact stiffness K₁ = 2E*√(RΔ) (paper §4), E* of tip and sample
+/// ([`crate::contact::reduced_modulus`]). N/m.
 pub fn hertz_stiffness(tip: Material, sample: Material, radius: f64, indentation: f64) -> f64 {
-    let inv = (1.0 - tip.poisson_ratio.powi(2)) / tip.youngs_modulus
-        + (1.0 - sample.poisson_ratio.powi(2)) / sample.youngs_modulus;
-    2.0 / inv * (radius * indentation).sqrt()
+    let (t, s) = (tip, sample);
+    let e_star = crate::contact::reduced_modulus(
+        t.youngs_modulus,
+        t.poisson_ratio,
+        s.youngs_modulus,
+        s.poisson_ratio,
+    );
+    2.0 * e_star * (radius * indentation).sqrt()
 }
 
 /// A rectangular cantilever: geometry and material (SI).
@@ -191,15 +197,15 @@ pub(crate) struct BeamSi {
 
 impl BeamSi {
     /// The tip-mass ratio α1 = M/(mL) (eq. 7).
-    pub fn tip_mass_ratio(&self) -> f64 {
+    pub(crate) fn tip_mass_ratio(&self) -> f64 {
         self.tip_mass / (self.mass_per_length * self.length)
     }
     /// Seconds per unit of dimensionless time: t = τ √(mL⁴/EI) (eq. 5).
-    pub fn time_scale(&self) -> f64 {
+    pub(crate) fn time_scale(&self) -> f64 {
         (self.mass_per_length * self.length.powi(4) / self.bending_stiffness).sqrt()
     }
     /// The stiffness unit EI/L³ (N/m), in which α4 measures the contact stiffness K₁.
-    pub fn stiffness_unit(&self) -> f64 {
+    pub(crate) fn stiffness_unit(&self) -> f64 {
         self.bending_stiffness / self.length.powi(3)
     }
 }
@@ -312,11 +318,8 @@ impl PhysicalModel {
         cantilever.validate()?;
         positive("beam_gap", beam_gap, "m")?;
         p.validate()?;
-        let (l, m, ei) = (
-            cantilever.length,
-            cantilever.mass_per_length(),
-            cantilever.bending_stiffness(),
-        );
+        let beam = cantilever.with_tip(0.0);
+        let (l, m, ei) = (beam.length, beam.mass_per_length, beam.bending_stiffness);
         let root = (ei * m).sqrt();
         Ok(PhysicalModel {
             cantilever,
@@ -414,23 +417,14 @@ pub fn contact_stiffness(k: ContactStiffness) -> Result<f64, UnitsError> {
         } => {
             positive("tip_radius", radius, "m")?;
             non_negative("indentation", indentation, "m")?;
-            for (name, m) in [("tip", tip), ("sample", sample)] {
-                positive(
-                    if name == "tip" {
-                        "tip_youngs_modulus"
-                    } else {
-                        "sample_youngs_modulus"
-                    },
-                    m.youngs_modulus,
-                    "Pa",
-                )?;
+            for (m, modulus, poisson) in [
+                (tip, "tip_youngs_modulus", "tip_poisson_ratio"),
+                (sample, "sample_youngs_modulus", "sample_poisson_ratio"),
+            ] {
+                positive(modulus, m.youngs_modulus, "Pa")?;
                 if !(m.poisson_ratio > -1.0 && m.poisson_ratio <= 0.5) {
                     return Err(UnitsError::Poisson {
-                        name: if name == "tip" {
-                            "tip_poisson_ratio"
-                        } else {
-                            "sample_poisson_ratio"
-                        },
+                        name: poisson,
                         value: m.poisson_ratio,
                     });
                 }
