@@ -247,14 +247,9 @@ pub(super) fn to_vacuum(
         Beam::Geometry { .. } => (air_mode(f0)?.frequency_hz, f0),
         Beam::Calibrated { .. } => (f0, f_vac),
     };
-    let eigen_frequencies = match eigen_f {
-        Some(f) => Some(
-            f.iter()
-                .map(|&x| vacuum(x).map(|m| m.1))
-                .collect::<Result<Vec<_>, _>>()?,
-        ),
-        None => None,
-    };
+    let eigen_frequencies = eigen_f
+        .map(|f| f.iter().map(|&x| vacuum(x).map(|m| m.1)).collect())
+        .transpose()?;
     // mode j's frequency in air: the eigenmode model's as given; the beam's from its vacuum
     // frequency (f₀ times the Galerkin ratio)
     let air_frequency = |j: usize| -> Result<f64, String> {
@@ -271,27 +266,24 @@ pub(super) fn to_vacuum(
         "quality_factor",
         &mut warnings,
     );
-    let qs = match qs {
-        Some(q) => Some(
+    // the eigenmode model's array is quality_factor, the beam's quality_factors
+    let key = if eigen_f.is_some() {
+        "quality_factor"
+    } else {
+        "quality_factors"
+    };
+    let mut intrinsic_j = |j: usize, qj: f64| -> Result<f64, String> {
+        let mode = vacuum(air_frequency(j)?)?.0;
+        Ok(intrinsic(qj, &mode, &format!("{key}[{j}]"), &mut warnings))
+    };
+    let qs = qs
+        .map(|q| {
             q.iter()
                 .enumerate()
-                .map(|(j, &qj)| {
-                    // the eigenmode model's array is quality_factor, the beam's quality_factors
-                    let key = match eigen_f {
-                        Some(_) => format!("quality_factor[{j}]"),
-                        None => format!("quality_factors[{j}]"),
-                    };
-                    Ok::<f64, String>(intrinsic(
-                        qj,
-                        &vacuum(air_frequency(j)?)?.0,
-                        &key,
-                        &mut warnings,
-                    ))
-                })
-                .collect::<Result<Vec<_>, _>>()?,
-        ),
-        None => None,
-    };
+                .map(|(j, &qj)| intrinsic_j(j, qj))
+                .collect()
+        })
+        .transpose()?;
     Ok(Vacuum {
         f0: f_vac1,
         q1: q1_int,
@@ -361,7 +353,7 @@ fn section(
 
 impl Vacuum {
     /// The eigenmode model's modes `e` with the frequency ratios in vacuum.
-    pub fn ratios(&self, mut e: Eigenmodes) -> Eigenmodes {
+    pub(super) fn ratios(&self, mut e: Eigenmodes) -> Eigenmodes {
         if let Some(fv) = &self.eigen_frequencies {
             for (j, f) in fv.iter().enumerate() {
                 e.frequency[j] = f / fv[0];

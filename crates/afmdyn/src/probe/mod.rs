@@ -566,32 +566,23 @@ impl Probe {
         medium: Option<&str>,
     ) -> Result<(String, Probe), ProbeError> {
         let origin = source.origin();
+        let syntax = |message| ProbeError::Syntax {
+            path: origin.clone(),
+            message,
+        };
         let text = match source {
             #[cfg(feature = "files")]
             ProbeSource::Path(path) => Self::read_file(path)?,
             ProbeSource::Text(t) => t.to_string(),
-            ProbeSource::Table(t) => toml::to_string(t).map_err(|e| ProbeError::Syntax {
-                path: origin.clone(),
-                message: e.to_string(),
-            })?,
+            ProbeSource::Table(t) => toml::to_string(t).map_err(|e| syntax(e.to_string()))?,
         };
         let text = match cantilever {
             None => text,
-            Some(name) => crate::cantilevers::with_name(&text, name).map_err(|message| {
-                ProbeError::Syntax {
-                    path: origin.clone(),
-                    message,
-                }
-            })?,
+            Some(name) => crate::cantilevers::with_name(&text, name).map_err(syntax)?,
         };
         let text = match medium {
             None => text,
-            Some(name) => {
-                crate::hydro::with_medium(&text, name).map_err(|message| ProbeError::Syntax {
-                    path: origin.clone(),
-                    message,
-                })?
-            }
+            Some(name) => crate::hydro::with_medium(&text, name).map_err(syntax)?,
         };
         let probe = Self::parse(&text, &origin)?;
         Ok((text, probe))

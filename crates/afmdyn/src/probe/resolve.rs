@@ -216,13 +216,10 @@ impl Cantilever {
             alpha5: 1.0,
             alpha6: 0.0,
             omega: 1.0,
-            contact_law: ContactLaw::Linear,
             structure,
-            damping_profile: None,
             eigenmodes,
-            drive_components: [None; MAX_DRIVE_COMPONENTS],
             excitation,
-            hydrodynamic: None,
+            ..Params::default()
         }
     }
 
