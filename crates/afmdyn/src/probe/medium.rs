@@ -309,46 +309,36 @@ fn section(
     f0: f64,
     w1_k1: f64,
 ) -> Result<(Section, f64), String> {
-    let (length, width) = match *beam {
-        Beam::Geometry { width, si } => {
-            let mass_per_length = si.mass_per_length;
-            return Ok((
-                Section {
-                    width,
-                    mass_per_length,
-                },
-                f0,
-            ));
-        }
+    let (width, mass_per_length, f_vac) = match *beam {
+        Beam::Geometry { width, si } => (width, si.mass_per_length, f0),
         Beam::Calibrated {
-            plan: Some(plan), ..
-        } => plan,
+            plan: Some((length, width)),
+            ..
+        } => {
+            let mu = |f: f64| k * w1_k1 / ((TAU * f).powi(2) * length);
+            let mut f = f0;
+            if spec.calibrated_in == CalibratedIn::Air {
+                for _ in 0..8 {
+                    let s = Section {
+                        width,
+                        mass_per_length: mu(f),
+                    };
+                    f = s.mode_at(f0, &Medium::AIR).map_err(in_medium)?.1;
+                }
+            }
+            (width, mu(f), f)
+        }
         Beam::Calibrated { plan: None, .. } => {
             return Err(
-                "[medium] needs the lever's plan: give [cantilever] length and \
-                        width (m)"
-                    .into(),
+                "[medium] needs the lever's plan: give [cantilever] length and width (m)".into(),
             )
         }
     };
-    let mu = |f: f64| k * w1_k1 / ((TAU * f).powi(2) * length);
-    let mut f = f0;
-    if spec.calibrated_in == CalibratedIn::Air {
-        for _ in 0..8 {
-            let s = Section {
-                width,
-                mass_per_length: mu(f),
-            };
-            f = s.mode_at(f0, &Medium::AIR).map_err(in_medium)?.1;
-        }
-    }
-    Ok((
-        Section {
-            width,
-            mass_per_length: mu(f),
-        },
-        f,
-    ))
+    let section = Section {
+        width,
+        mass_per_length,
+    };
+    Ok((section, f_vac))
 }
 
 impl Vacuum {

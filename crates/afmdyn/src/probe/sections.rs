@@ -72,7 +72,25 @@ impl Probe {
             .table(root, "medium", false)
             .and_then(|t| medium::read(&mut r, t));
         let medium_given = root.contains_key("medium");
-        Self::check_quality_factors(&mut r, cant, structure, modes, qs.is_some());
+        // [cantilever] quality_factors against the model: the point mass has one mode, the
+        // others one value per mode (counted as written: an entry refused is still one value)
+        if let (Some(Structure::PointMass), Some(_)) = (structure, &qs) {
+            r.problems.push(
+                "[cantilever].quality_factors: the point-mass model has one mode (use quality_factor)"
+                    .into(),
+            );
+        }
+        let written = match cant.and_then(|c| c.get("quality_factors")) {
+            Some(toml::Value::Array(a)) => Some(a.len()),
+            _ => None,
+        };
+        if let (Some(n), Some(len)) = (modes, written) {
+            if len != n {
+                r.problems.push(format!(
+                    "[cantilever].quality_factors has {len} values: give one per mode (modes = {n})"
+                ));
+            }
+        }
         if !r.problems.is_empty() || (medium_given && medium.is_none()) {
             return None;
         }
@@ -259,34 +277,6 @@ impl Probe {
             excitation,
             off_resonance,
         })
-    }
-
-    /// `[cantilever] quality_factors` against the model: the point mass has one mode, the
-    /// others one value per mode (counted as written: an entry refused is still one value).
-    fn check_quality_factors(
-        r: &mut Reader<'_>,
-        cant: Option<&toml::Table>,
-        structure: Option<Structure>,
-        modes: Option<usize>,
-        given: bool,
-    ) {
-        if structure == Some(Structure::PointMass) && given {
-            r.problems.push(
-                "[cantilever].quality_factors: the point-mass model has one mode (use quality_factor)"
-                    .into(),
-            );
-        }
-        let written = match cant.and_then(|c| c.get("quality_factors")) {
-            Some(toml::Value::Array(a)) => Some(a.len()),
-            _ => None,
-        };
-        if let (Some(n), Some(len)) = (modes, written) {
-            if len != n {
-                r.problems.push(format!(
-                    "[cantilever].quality_factors has {len} values: give one per mode (modes = {n})"
-                ));
-            }
-        }
     }
 
     /// `[drive]`'s components: `free_amplitude` (m) and `frequency` (Hz) as numbers (one component), or as
