@@ -219,6 +219,13 @@ pub struct Hydrodynamic {
 }
 
 /// Check a coefficient that must be finite, ≥ 0 and ≤ `max` (`range` as written, `reason` why).
+/// Why a tip mass (or a mode's added mass) is bounded.
+const TIP_MASS: &str = "the mass matrix becomes ill-conditioned";
+/// Why displacements (α2, α5, a component's force) are bounded.
+const DISPLACEMENT: &str = "displacements scale with it and overflow the switching search";
+/// Why damping (α3, α6, a mode's damping) is bounded.
+const DAMPING: &str = "the system becomes too stiff for the integration grid";
+
 fn bounded(
     name: &'static str,
     value: f64,
@@ -359,36 +366,6 @@ impl Default for Params {
 }
 
 impl Params {
-    /// Build and validate a parameter set.
-    ///
-    /// # Errors
-    /// [`ParamError`] naming the first field out of range.
-    #[allow(clippy::too_many_arguments)]
-    pub fn new(
-        modes: usize,
-        alpha1: f64,
-        alpha2: f64,
-        alpha3: f64,
-        alpha4: f64,
-        alpha5: f64,
-        alpha6: f64,
-        omega: f64,
-    ) -> Result<Self, ParamError> {
-        let p = Params {
-            modes,
-            alpha1,
-            alpha2,
-            alpha3,
-            alpha4,
-            alpha5,
-            alpha6,
-            omega,
-            ..Params::default()
-        };
-        p.validate()?;
-        Ok(p)
-    }
-
     /// The paper's eq. 24 set (α1 = α2 = 0.1, α3 = α5 = α6 = 0, α4 = 20) at Ω = 4.1 (Fig. 4).
     pub fn paper_eq24() -> Self {
         Params {
@@ -431,12 +408,80 @@ impl Params {
     /// # Errors
     /// [`ParamError`] naming the first field out of range.
     pub fn validate_fields(&self) -> Result<(), ParamError> {
+        self.validate_groups()?;
+        self.contact_law.validate()?;
+        // the law's groups against the shared α4, α6 (JKR's neck scale P̃/α4, the SLS
+        // relaxation rate κ/α6)
+        self.contact_law.validate_shared(self.alpha4, self.alpha6)?;
+        if let Some(profile) = &self.damping_profile {
+            for &s in &profile[..self.modes] {
+                if !(s.is_finite() && s >= 0.0) {
+                    return Err(ParamError::NonNegative {
+                        name: "damping_profile (per-mode damping s_j)",
+                        value: s,
+                    });
+                }
+                if s * self.alpha3 > DAMPING_MAX {
+                    return Err(ParamError::Magnitude {
+                        name: "damping_profile (per-mode damping α3 s_j)",
+                        value: s * self.alpha3,
+                        range: "[0, 1e4]",
+                        reason: DAMPING,
+                    });
+                }
+            }
+        }
+        self.validate_eigenmodes()?;
+        self.validate_components()?;
+        if let Some(h) = &self.hydrodynamic {
+            for j in 0..self.modes {
+                bounded(
+                    "hydrodynamic.added_mass (mode's added mass)",
+                    h.added_mass[j],
+                    ALPHA1_MAX,
+                    "[0, 1e4]",
+                    TIP_MASS,
+                )?;
+                bounded(
+                    "hydrodynamic.damping (mode's hydrodynamic damping)",
+                    h.damping[j],
+                    DAMPING_MAX,
+                    "[0, 1e4]",
+                    DAMPING,
+                )?;
+            }
+        }
+        if self.structure == Structure::PointMass {
+            for (name, bad, value) in [
+                (
+                    "modes (point-mass model: exactly 1)",
+                    self.modes != 1,
+                    self.modes as f64,
+                ),
+                (
+                    "alpha1 (point-mass model: no tip mass, 0)",
+                    self.alpha1 != 0.0,
+                    self.alpha1,
+                ),
+                (
+                    "damping_profile (point-mass model: one mode, use alpha3 = 1/Q)",
+                    self.damping_profile.is_some(),
+                    f64::NAN,
+                ),
+            ] {
+                if bad {
+                    return Err(ParamError::Structure { name, value });
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// N, the groups α1 … α6 and Ω against their ranges.
+    fn validate_groups(&self) -> Result<(), ParamError> {
         if !(1..=MAX_MODES).contains(&self.modes) {
             return Err(ParamError::Modes(self.modes));
         }
-        const TIP_MASS: &str = "the mass matrix becomes ill-conditioned";
-        const DISPLACEMENT: &str = "displacements scale with it and overflow the switching search";
-        const DAMPING: &str = "the system becomes too stiff for the integration grid";
         for (name, value, max, range, reason) in [
             (
                 "alpha1 (tip-mass ratio α1)",
@@ -508,35 +553,17 @@ impl Params {
                 },
             });
         }
-        self.contact_law.validate()?;
-        // the law's groups against the shared α4, α6 (JKR's neck scale P̃/α4, the SLS
-        // relaxation rate κ/α6)
-        self.contact_law.validate_shared(self.alpha4, self.alpha6)?;
-        if let Some(profile) = &self.damping_profile {
-            for &s in &profile[..self.modes] {
-                if !(s.is_finite() && s >= 0.0) {
-                    return Err(ParamError::NonNegative {
-                        name: "damping_profile (per-mode damping s_j)",
-                        value: s,
-                    });
-                }
-                if s * self.alpha3 > DAMPING_MAX {
-                    return Err(ParamError::Magnitude {
-                        name: "damping_profile (per-mode damping α3 s_j)",
-                        value: s * self.alpha3,
-                        range: "[0, 1e4]",
-                        reason: DAMPING,
-                    });
-                }
-            }
-        }
+        Ok(())
+    }
+
+    /// The eigenmode model's modes, given for it and only for it: no tip mass, mode 1's
+    /// stiffness and frequency 1, the others' ratios in range.
+    fn validate_eigenmodes(&self) -> Result<(), ParamError> {
         match (self.structure, &self.eigenmodes) {
-            (Structure::Eigenmodes, None) => {
-                return Err(ParamError::Structure {
-                    name: "eigenmodes (eigenmode model: the modes' stiffnesses and frequencies)",
-                    value: f64::NAN,
-                })
-            }
+            (Structure::Eigenmodes, None) => Err(ParamError::Structure {
+                name: "eigenmodes (eigenmode model: the modes' stiffnesses and frequencies)",
+                value: f64::NAN,
+            }),
             (Structure::Eigenmodes, Some(e)) => {
                 if self.alpha1 != 0.0 {
                     return Err(ParamError::Structure {
@@ -560,15 +587,18 @@ impl Params {
                         });
                     }
                 }
+                Ok(())
             }
-            (_, Some(_)) => {
-                return Err(ParamError::Structure {
-                    name: "eigenmodes (only for the eigenmode model)",
-                    value: f64::NAN,
-                })
-            }
-            _ => {}
+            (_, Some(_)) => Err(ParamError::Structure {
+                name: "eigenmodes (only for the eigenmode model)",
+                value: f64::NAN,
+            }),
+            _ => Ok(()),
         }
+    }
+
+    /// The further drive components' forces, ratios and phases.
+    fn validate_components(&self) -> Result<(), ParamError> {
         for c in self.components() {
             if !(c.force.is_finite() && (0.0..=DISPLACEMENT_MAX).contains(&c.force)) {
                 return Err(ParamError::Structure {
@@ -588,48 +618,6 @@ impl Params {
                 return Err(ParamError::Structure {
                     name: "drive_components.phase (rad, finite)",
                     value: c.phase,
-                });
-            }
-        }
-        if let Some(h) = &self.hydrodynamic {
-            for j in 0..self.modes {
-                bounded(
-                    "hydrodynamic.added_mass (mode's added mass)",
-                    h.added_mass[j],
-                    ALPHA1_MAX,
-                    "[0, 1e4]",
-                    TIP_MASS,
-                )?;
-                bounded(
-                    "hydrodynamic.damping (mode's hydrodynamic damping)",
-                    h.damping[j],
-                    DAMPING_MAX,
-                    "[0, 1e4]",
-                    DAMPING,
-                )?;
-            }
-        }
-        if self.structure == Structure::PointMass {
-            for (name, bad, value) in [
-                (
-                    "modes (point-mass model: exactly 1)",
-                    self.modes != 1,
-                    self.modes as f64,
-                ),
-                (
-                    "alpha1 (point-mass model: no tip mass, 0)",
-                    self.alpha1 != 0.0,
-                    self.alpha1,
-                ),
-            ] {
-                if bad {
-                    return Err(ParamError::Structure { name, value });
-                }
-            }
-            if self.damping_profile.is_some() {
-                return Err(ParamError::Structure {
-                    name: "damping_profile (point-mass model: one mode, use alpha3 = 1/Q)",
-                    value: f64::NAN,
                 });
             }
         }

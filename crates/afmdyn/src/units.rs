@@ -98,11 +98,17 @@ pub(crate) fn preset<T: Copy>(
         })
 }
 
-/// Hertz contact stiffness K₁ = 2E*√(RΔ), 1/E* = (1 − ν₁²)/E₁ + (1 − ν₂²)/E₂ (paper §4). N/m.
+/// Hertz contact stiffness K₁ = 2E*√(RΔ) (paper §4), E* of tip and sample
+/// ([`crate::contact::reduced_modulus`]). N/m.
 pub fn hertz_stiffness(tip: Material, sample: Material, radius: f64, indentation: f64) -> f64 {
-    let inv = (1.0 - tip.poisson_ratio.powi(2)) / tip.youngs_modulus
-        + (1.0 - sample.poisson_ratio.powi(2)) / sample.youngs_modulus;
-    2.0 / inv * (radius * indentation).sqrt()
+    let (t, s) = (tip, sample);
+    let e_star = crate::contact::reduced_modulus(
+        t.youngs_modulus,
+        t.poisson_ratio,
+        s.youngs_modulus,
+        s.poisson_ratio,
+    );
+    2.0 * e_star * (radius * indentation).sqrt()
 }
 
 /// A rectangular cantilever: geometry and material (SI).
@@ -154,13 +160,53 @@ impl Cantilever {
     pub fn spring_constant(&self) -> f64 {
         3.0 * self.bending_stiffness() / self.length.powi(3)
     }
-    /// Seconds per unit of dimensionless time: t = τ √(mL⁴/EI) (eq. 5).
+    /// Seconds per unit of dimensionless time (the time scale of the beam without a tip mass).
     pub(crate) fn time_scale(&self) -> f64 {
-        (self.mass_per_length() * self.length.powi(4) / self.bending_stiffness()).sqrt()
+        self.with_tip(0.0).time_scale()
+    }
+    /// The beam of eq. 3 this cantilever makes with a tip mass M (kg).
+    pub(crate) fn with_tip(&self, tip_mass: f64) -> BeamSi {
+        BeamSi {
+            length: self.length,
+            bending_stiffness: self.bending_stiffness(),
+            mass_per_length: self.mass_per_length(),
+            tip_mass,
+        }
     }
     /// First natural frequency of the bare cantilever f₁ = β₁² √(EI/(mL⁴)) / 2π (Hz).
     pub fn first_frequency_hz(&self) -> f64 {
         crate::beam::beta_root(1).powi(2) / self.time_scale() / std::f64::consts::TAU
+    }
+}
+
+/// The beam of eq. 3 in SI — length L, bending stiffness EI, mass per unit length m, tip mass M —
+/// and what the model's groups take from it: the one route from a cantilever's SI values to the
+/// tip-mass ratio, the time scale and the stiffness unit, for `units`
+/// ([`PhysicalModel::to_params`]) and for a probe file given by its geometry (`crate::probe`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct BeamSi {
+    /// Length L (m).
+    pub length: f64,
+    /// Bending stiffness EI (N m²).
+    pub bending_stiffness: f64,
+    /// Mass per unit length m (kg/m).
+    pub mass_per_length: f64,
+    /// Tip mass M (kg).
+    pub tip_mass: f64,
+}
+
+impl BeamSi {
+    /// The tip-mass ratio α1 = M/(mL) (eq. 7).
+    pub(crate) fn tip_mass_ratio(&self) -> f64 {
+        self.tip_mass / (self.mass_per_length * self.length)
+    }
+    /// Seconds per unit of dimensionless time: t = τ √(mL⁴/EI) (eq. 5).
+    pub(crate) fn time_scale(&self) -> f64 {
+        (self.mass_per_length * self.length.powi(4) / self.bending_stiffness).sqrt()
+    }
+    /// The stiffness unit EI/L³ (N/m), in which α4 measures the contact stiffness K₁.
+    pub(crate) fn stiffness_unit(&self) -> f64 {
+        self.bending_stiffness / self.length.powi(3)
     }
 }
 
@@ -241,19 +287,19 @@ impl PhysicalModel {
     /// [`UnitsError`] for invalid physical input.
     pub fn to_params(&self) -> Result<Params, UnitsError> {
         self.validate()?;
-        let c = &self.cantilever;
-        let (l, m, ei) = (c.length, c.mass_per_length(), c.bending_stiffness());
+        let beam = self.cantilever.with_tip(self.tip_mass);
+        let (l, m, ei) = (beam.length, beam.mass_per_length, beam.bending_stiffness);
         let root = (ei * m).sqrt();
         let p = Params {
             contact_law: Default::default(),
             modes: self.modes,
-            alpha1: self.tip_mass / (m * l),
+            alpha1: beam.tip_mass_ratio(),
             alpha2: self.drive_amplitude / self.beam_gap,
             alpha3: self.beam_damping * l * l / root,
             alpha4: self.contact_stiffness * l.powi(3) / ei,
             alpha5: self.tip_gap / self.beam_gap,
             alpha6: self.contact_damping * l / root,
-            omega: std::f64::consts::TAU * self.drive_frequency_hz * c.time_scale(),
+            omega: std::f64::consts::TAU * self.drive_frequency_hz * beam.time_scale(),
             ..Params::default()
         };
         p.validate()?;
@@ -272,11 +318,8 @@ impl PhysicalModel {
         cantilever.validate()?;
         positive("beam_gap", beam_gap, "m")?;
         p.validate()?;
-        let (l, m, ei) = (
-            cantilever.length,
-            cantilever.mass_per_length(),
-            cantilever.bending_stiffness(),
-        );
+        let beam = cantilever.with_tip(0.0);
+        let (l, m, ei) = (beam.length, beam.mass_per_length, beam.bending_stiffness);
         let root = (ei * m).sqrt();
         Ok(PhysicalModel {
             cantilever,
@@ -374,23 +417,14 @@ pub fn contact_stiffness(k: ContactStiffness) -> Result<f64, UnitsError> {
         } => {
             positive("tip_radius", radius, "m")?;
             non_negative("indentation", indentation, "m")?;
-            for (name, m) in [("tip", tip), ("sample", sample)] {
-                positive(
-                    if name == "tip" {
-                        "tip_youngs_modulus"
-                    } else {
-                        "sample_youngs_modulus"
-                    },
-                    m.youngs_modulus,
-                    "Pa",
-                )?;
+            for (m, modulus, poisson) in [
+                (tip, "tip_youngs_modulus", "tip_poisson_ratio"),
+                (sample, "sample_youngs_modulus", "sample_poisson_ratio"),
+            ] {
+                positive(modulus, m.youngs_modulus, "Pa")?;
                 if !(m.poisson_ratio > -1.0 && m.poisson_ratio <= 0.5) {
                     return Err(UnitsError::Poisson {
-                        name: if name == "tip" {
-                            "tip_poisson_ratio"
-                        } else {
-                            "sample_poisson_ratio"
-                        },
+                        name: poisson,
                         value: m.poisson_ratio,
                     });
                 }

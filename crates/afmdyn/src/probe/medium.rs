@@ -29,11 +29,11 @@
 //! mass for the eigenmode model.
 
 use super::reader::Reader;
-use super::Beam;
+use super::{Beam, Calibration};
 use crate::eigen::natural_modes;
 use crate::galerkin::{Galerkin, Region};
 use crate::hydro::{wet_mode_of, Medium, Section};
-use crate::params::{Hydrodynamic, Params, Structure};
+use crate::params::{Eigenmodes, Hydrodynamic, Params, Structure};
 use serde::Serialize;
 use std::f64::consts::TAU;
 
@@ -209,66 +209,27 @@ fn intrinsic(q: f64, mode: &crate::hydro::WetMode, key: &str, warnings: &mut Vec
     1.0 / (inv * (1.0 + mode.added_mass_ratio).sqrt())
 }
 
-/// The lever's values in vacuum (module docs). `w1_k1` is ω̃₁²/k̃₁ of the structure's bare
-/// first mode (4 for the lumped models: the uniform beam's); `beam_frequencies` the vacuum
+/// The lever's values in vacuum (module docs): the `calibration` brought to vacuum. `w1_k1` is
+/// ω̃₁²/k̃₁ of the structure's bare first mode (4 for the lumped models: the uniform beam's);
+/// `eigen_f` the eigenmode model's frequencies as given; `beam_frequencies` the vacuum
 /// frequencies of the beam's modes per unit f₀ (for per-mode Q of the beam).
-#[allow(clippy::too_many_arguments)]
 pub(super) fn to_vacuum(
     spec: &MediumSpec,
     beam: &Beam,
-    k: f64,
-    f0: f64,
-    q1: f64,
-    qs: Option<&[f64]>,
+    calibration: &Calibration,
     eigen_f: Option<&[f64]>,
     w1_k1: f64,
     beam_frequencies: &[f64],
 ) -> Result<Vacuum, String> {
+    let (f0, q1, qs) = (
+        calibration.resonance_frequency,
+        calibration.quality_factor,
+        calibration.quality_factors.as_deref(),
+    );
     let air = Medium::AIR;
-    let e = |x: crate::error::SimError| format!("[medium]: {x}");
-    // the section, and f₀ in vacuum
-    let (section, f_vac) = match *beam {
-        Beam::Geometry {
-            width,
-            mass_per_length,
-            ..
-        } => (
-            Section {
-                width,
-                mass_per_length,
-            },
-            f0,
-        ),
-        Beam::Calibrated { plan, .. } => {
-            let Some((length, width)) = plan else {
-                return Err(
-                    "[medium] needs the lever's plan: give [cantilever] length and \
-                            width (m)"
-                        .into(),
-                );
-            };
-            let mu = |f: f64| k * w1_k1 / ((TAU * f).powi(2) * length);
-            let mut f = f0;
-            if spec.calibrated_in == CalibratedIn::Air {
-                for _ in 0..8 {
-                    let s = Section {
-                        width,
-                        mass_per_length: mu(f),
-                    };
-                    f = s.mode_at(f0, &air).map_err(e)?.1;
-                }
-            }
-            (
-                Section {
-                    width,
-                    mass_per_length: mu(f),
-                },
-                f,
-            )
-        }
-    };
+    let (section, f_vac) = section(spec, beam, calibration.spring_constant, f0, w1_k1)?;
     let vacuum = |f_air: f64| -> Result<(crate::hydro::WetMode, f64), String> {
-        section.mode_at(f_air, &air).map_err(e)
+        section.mode_at(f_air, &air).map_err(in_medium)
     };
     if spec.calibrated_in == CalibratedIn::Vacuum {
         return Ok(Vacuum {
@@ -281,19 +242,14 @@ pub(super) fn to_vacuum(
         });
     }
     // the geometry's f₀ is a vacuum frequency: its mode in air from the wet-mode equation
-    let air_mode = |f_vacuum: f64| wet_mode_of(f_vacuum, &section, &air).map_err(e);
+    let air_mode = |f_vacuum: f64| wet_mode_of(f_vacuum, &section, &air).map_err(in_medium);
     let (f_air1, f_vac1) = match beam {
         Beam::Geometry { .. } => (air_mode(f0)?.frequency_hz, f0),
         Beam::Calibrated { .. } => (f0, f_vac),
     };
-    let eigen_frequencies = match eigen_f {
-        Some(f) => Some(
-            f.iter()
-                .map(|&x| vacuum(x).map(|m| m.1))
-                .collect::<Result<Vec<_>, _>>()?,
-        ),
-        None => None,
-    };
+    let eigen_frequencies = eigen_f
+        .map(|f| f.iter().map(|&x| vacuum(x).map(|m| m.1)).collect())
+        .transpose()?;
     // mode j's frequency in air: the eigenmode model's as given; the beam's from its vacuum
     // frequency (f₀ times the Galerkin ratio)
     let air_frequency = |j: usize| -> Result<f64, String> {
@@ -310,27 +266,24 @@ pub(super) fn to_vacuum(
         "quality_factor",
         &mut warnings,
     );
-    let qs = match qs {
-        Some(q) => Some(
+    // the eigenmode model's array is quality_factor, the beam's quality_factors
+    let key = if eigen_f.is_some() {
+        "quality_factor"
+    } else {
+        "quality_factors"
+    };
+    let mut intrinsic_j = |j: usize, qj: f64| -> Result<f64, String> {
+        let mode = vacuum(air_frequency(j)?)?.0;
+        Ok(intrinsic(qj, &mode, &format!("{key}[{j}]"), &mut warnings))
+    };
+    let qs = qs
+        .map(|q| {
             q.iter()
                 .enumerate()
-                .map(|(j, &qj)| {
-                    // the eigenmode model's array is quality_factor, the beam's quality_factors
-                    let key = match eigen_f {
-                        Some(_) => format!("quality_factor[{j}]"),
-                        None => format!("quality_factors[{j}]"),
-                    };
-                    Ok::<f64, String>(intrinsic(
-                        qj,
-                        &vacuum(air_frequency(j)?)?.0,
-                        &key,
-                        &mut warnings,
-                    ))
-                })
-                .collect::<Result<Vec<_>, _>>()?,
-        ),
-        None => None,
-    };
+                .map(|(j, &qj)| intrinsic_j(j, qj))
+                .collect()
+        })
+        .transpose()?;
     Ok(Vacuum {
         f0: f_vac1,
         q1: q1_int,
@@ -341,6 +294,65 @@ pub(super) fn to_vacuum(
     })
 }
 
+/// An error of the fluid's loading as a problem of `[medium]`.
+fn in_medium(x: impl std::fmt::Display) -> String {
+    format!("[medium]: {x}")
+}
+
+/// The lever's section in the fluid, and its f₀ in vacuum (module docs): the geometry's own
+/// (its f₀ is a vacuum frequency); a calibrated lever's from its plan, with μ from the spring
+/// constant `k` and, calibrated in air, f₀ in vacuum and μ iterated to a fixed point.
+fn section(
+    spec: &MediumSpec,
+    beam: &Beam,
+    k: f64,
+    f0: f64,
+    w1_k1: f64,
+) -> Result<(Section, f64), String> {
+    let (width, mass_per_length, f_vac) = match *beam {
+        Beam::Geometry { width, si } => (width, si.mass_per_length, f0),
+        Beam::Calibrated {
+            plan: Some((length, width)),
+            ..
+        } => {
+            let mu = |f: f64| k * w1_k1 / ((TAU * f).powi(2) * length);
+            let mut f = f0;
+            if spec.calibrated_in == CalibratedIn::Air {
+                for _ in 0..8 {
+                    let s = Section {
+                        width,
+                        mass_per_length: mu(f),
+                    };
+                    f = s.mode_at(f0, &Medium::AIR).map_err(in_medium)?.1;
+                }
+            }
+            (width, mu(f), f)
+        }
+        Beam::Calibrated { plan: None, .. } => {
+            return Err(
+                "[medium] needs the lever's plan: give [cantilever] length and width (m)".into(),
+            )
+        }
+    };
+    let section = Section {
+        width,
+        mass_per_length,
+    };
+    Ok((section, f_vac))
+}
+
+impl Vacuum {
+    /// The eigenmode model's modes `e` with the frequency ratios in vacuum.
+    pub(super) fn ratios(&self, mut e: Eigenmodes) -> Eigenmodes {
+        if let Some(fv) = &self.eigen_frequencies {
+            for (j, f) in fv.iter().enumerate() {
+                e.frequency[j] = f / fv[0];
+            }
+        }
+        e
+    }
+}
+
 /// Load every mode of `params` (vacuum values, time scale `time_s`) with the fluid: sets
 /// [`Params::hydrodynamic`] and returns the report.
 pub(super) fn load(
@@ -349,10 +361,9 @@ pub(super) fn load(
     params: &mut Params,
     time_s: f64,
 ) -> Result<MediumReport, String> {
-    let derived = |x: crate::error::ParamError| format!("[medium]: {x}");
     let modes = loading(&spec.medium, &vacuum.section, params, time_s)?;
     let t = vacuum.section.mass_ratio(&spec.medium);
-    let loaded = Galerkin::new(params).map_err(derived)?;
+    let loaded = Galerkin::new(params).map_err(in_medium)?;
     let region = loaded.region(Region::Free);
     let w1 = natural_modes(region).omega[0];
     Ok(MediumReport {
@@ -380,12 +391,11 @@ fn loading(
     params: &mut Params,
     time_s: f64,
 ) -> Result<Vec<FluidMode>, String> {
-    let derived = |x: crate::error::ParamError| format!("[medium]: {x}");
     let bare = Galerkin::new(&Params {
         hydrodynamic: None,
         ..*params
     })
-    .map_err(derived)?;
+    .map_err(in_medium)?;
     let natural = natural_modes(bare.region(Region::Free));
     let n = params.modes;
     let mut h = Hydrodynamic {

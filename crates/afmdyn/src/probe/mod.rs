@@ -455,7 +455,7 @@ pub fn convergent(r: f64) -> Option<(u32, u32)> {
     convergent_within(r, MAX_RATIO_DENOMINATOR)
 }
 
-/// The cantilever section, before the model is known.
+/// The lever of the cantilever section, before the model is known.
 #[derive(Debug, Clone, Copy)]
 enum Beam {
     Calibrated {
@@ -465,13 +465,30 @@ enum Beam {
         /// Length and width (m) when given (what `[medium]` needs).
         plan: Option<(f64, f64)>,
     },
+    /// The beam's width b (m, what `[medium]` needs) and the beam in SI.
     Geometry {
-        length: f64,
         width: f64,
-        ei: f64,
-        mass_per_length: f64,
-        tip_mass: f64,
+        si: crate::units::BeamSi,
     },
+}
+
+impl Beam {
+    /// The beam's tip-mass ratio α1: given, or from the geometry.
+    fn tip_mass_ratio(&self) -> f64 {
+        match self {
+            Beam::Calibrated { alpha1, .. } => *alpha1,
+            Beam::Geometry { si, .. } => si.tip_mass_ratio(),
+        }
+    }
+}
+
+/// The cantilever section in SI: the lever, Q₁ as given, the per-mode Q_j when given, and the
+/// eigenmode model's per-mode k_j (N/m) and f_j (Hz).
+struct Cantilever {
+    beam: Beam,
+    q1: f64,
+    qs: Option<Vec<f64>>,
+    eigen: Option<(Vec<f64>, Vec<f64>)>,
 }
 
 /// The drive section in SI: the first component's A₀ (m) and f (Hz, `None`: f₀), and the
@@ -486,27 +503,13 @@ struct Drive {
     off_resonance: bool,
 }
 
-/// The sample section in SI.
+/// The sample section in SI: the law's name, the values its [`crate::contact::Law::from_si`]
+/// reads (the scales g₀, F_s and t_s are the probe's, set when it is resolved), z_c, and the
+/// elastic constants as given: sample E (Pa) and ν, tip E (Pa) and ν.
 struct Sample {
     law: String,
-    e_star: Option<f64>,
-    radius: Option<f64>,
-    hamaker: Option<f64>,
-    a0: Option<f64>,
-    viscosity: Option<f64>,
-    stiffness: Option<f64>,
-    damping: Option<f64>,
-    restitution: Option<f64>,
-    /// The electrostatic law's voltage across the gap, bias − contact potential (V).
-    voltage: Option<f64>,
-    /// JKR's work of adhesion W (J/m²).
-    adhesion_energy: Option<f64>,
-    /// The capillary meniscus: volume V (m³), surface tension γ (N/m), contact angle θ (rad).
-    meniscus: Option<(f64, f64, f64)>,
-    /// The SLS sample's Maxwell arm: spring k₂ (N/m) and relaxation time τ_r = η/k₂ (s).
-    maxwell: Option<(f64, f64)>,
+    si: crate::contact::SampleSi,
     z_c: Option<f64>,
-    /// The elastic constants as given: sample E (Pa) and ν, tip E (Pa) and ν.
     elastic: Option<[f64; 4]>,
 }
 
@@ -563,32 +566,23 @@ impl Probe {
         medium: Option<&str>,
     ) -> Result<(String, Probe), ProbeError> {
         let origin = source.origin();
+        let syntax = |message| ProbeError::Syntax {
+            path: origin.clone(),
+            message,
+        };
         let text = match source {
             #[cfg(feature = "files")]
             ProbeSource::Path(path) => Self::read_file(path)?,
             ProbeSource::Text(t) => t.to_string(),
-            ProbeSource::Table(t) => toml::to_string(t).map_err(|e| ProbeError::Syntax {
-                path: origin.clone(),
-                message: e.to_string(),
-            })?,
+            ProbeSource::Table(t) => toml::to_string(t).map_err(|e| syntax(e.to_string()))?,
         };
         let text = match cantilever {
             None => text,
-            Some(name) => crate::cantilevers::with_name(&text, name).map_err(|message| {
-                ProbeError::Syntax {
-                    path: origin.clone(),
-                    message,
-                }
-            })?,
+            Some(name) => crate::cantilevers::with_name(&text, name).map_err(syntax)?,
         };
         let text = match medium {
             None => text,
-            Some(name) => {
-                crate::hydro::with_medium(&text, name).map_err(|message| ProbeError::Syntax {
-                    path: origin.clone(),
-                    message,
-                })?
-            }
+            Some(name) => crate::hydro::with_medium(&text, name).map_err(syntax)?,
         };
         let probe = Self::parse(&text, &origin)?;
         Ok((text, probe))

@@ -3,6 +3,8 @@
 use super::*;
 
 impl Probe {
+    /// The probe of a file's table: every section read, every problem collected in `problems`
+    /// (in the file's order), then resolved ([`Probe::resolve`]).
     pub(super) fn read(root: &toml::Table, problems: &mut Vec<String>) -> Option<Probe> {
         let mut r = Reader {
             problems,
@@ -21,7 +23,99 @@ impl Probe {
                 "medium",
             ],
         );
-        let structure = match r.string(root, "", "model") {
+        let structure = Self::read_structure(&mut r, root);
+        let modes = Self::read_modes(&mut r, root, structure);
+        // [cantilever]
+        let cant = r.table(root, "cantilever", true);
+        let mut eigen = None;
+        let (beam, q1, qs) = match (cant, structure) {
+            (Some(c), Some(Structure::Eigenmodes)) => match Self::read_eigenmodes(&mut r, c) {
+                Some((k, f, q)) => {
+                    let beam = Beam::Calibrated {
+                        k: k[0],
+                        f0: f[0],
+                        alpha1: 0.0,
+                        plan: Self::read_plan(&mut r, c),
+                    };
+                    let q1 = q[0];
+                    eigen = Some((k, f));
+                    (Some(beam), Some(q1), Some(q))
+                }
+                None => (None, None, None),
+            },
+            (Some(c), _) => Self::read_cantilever(&mut r, c),
+            (None, _) => (None, None, None),
+        };
+        // [tip]: a silicon tip where the section omits its elastic constants (the one
+        // materials table, crate::units::SILICON_TIP)
+        let tip = r.table(root, "tip", false);
+        let (mut tip_e, mut tip_nu, mut radius) = (None, None, None);
+        if let Some(t) = tip {
+            r.unknown(t, "tip", &["radius", "youngs_modulus", "poisson_ratio"]);
+            radius = r.optional(t, "tip", "radius", "m", POSITIVE);
+            tip_e = r.optional(t, "tip", "youngs_modulus", "Pa", POSITIVE);
+            tip_nu = r.optional(t, "tip", "poisson_ratio", "1", POISSON);
+            if !t.contains_key("youngs_modulus") {
+                tip_e = Some(crate::cantilevers::SILICON_YOUNGS_MODULUS);
+            }
+            if !t.contains_key("poisson_ratio") {
+                tip_nu = Some(crate::cantilevers::SILICON_POISSON_RATIO);
+            }
+        }
+        // [sample]
+        let sample = r
+            .table(root, "sample", true)
+            .and_then(|s| Self::read_sample(&mut r, s, tip, radius, tip_e, tip_nu));
+        let drive = Self::read_drive(&mut r, root, structure);
+        // [medium]
+        let medium = r
+            .table(root, "medium", false)
+            .and_then(|t| medium::read(&mut r, t));
+        let medium_given = root.contains_key("medium");
+        // [cantilever] quality_factors against the model: the point mass has one mode, the
+        // others one value per mode (counted as written: an entry refused is still one value)
+        if let (Some(Structure::PointMass), Some(_)) = (structure, &qs) {
+            r.problems.push(
+                "[cantilever].quality_factors: the point-mass model has one mode (use quality_factor)"
+                    .into(),
+            );
+        }
+        let written = match cant.and_then(|c| c.get("quality_factors")) {
+            Some(toml::Value::Array(a)) => Some(a.len()),
+            _ => None,
+        };
+        if let (Some(n), Some(len)) = (modes, written) {
+            if len != n {
+                r.problems.push(format!(
+                    "[cantilever].quality_factors has {len} values: give one per mode (modes = {n})"
+                ));
+            }
+        }
+        if !r.problems.is_empty() || (medium_given && medium.is_none()) {
+            return None;
+        }
+        let cantilever = Cantilever {
+            beam: beam?,
+            q1: q1?,
+            qs,
+            eigen,
+        };
+        match Self::resolve(structure?, modes?, cantilever, sample?, drive?, medium) {
+            Ok(p) => Some(Probe {
+                input_warnings: [std::mem::take(&mut r.warnings), p.input_warnings.clone()]
+                    .concat(),
+                ..p
+            }),
+            Err(e) => {
+                r.problems.push(e);
+                None
+            }
+        }
+    }
+
+    /// The root's `model`: the structure.
+    fn read_structure(r: &mut Reader<'_>, root: &toml::Table) -> Option<Structure> {
+        match r.string(root, "", "model") {
             None if !root.contains_key("model") => {
                 r.problems
                     .push("missing key model (\"beam\", \"point-mass\" or \"eigenmodes\")".into());
@@ -35,7 +129,16 @@ impl Probe {
                     None
                 }
             },
-        };
+        }
+    }
+
+    /// The root's `modes`, N: the beam's as given, the point mass's 1, the eigenmode model's one
+    /// per entry of the cantilever's arrays.
+    fn read_modes(
+        r: &mut Reader<'_>,
+        root: &toml::Table,
+        structure: Option<Structure>,
+    ) -> Option<usize> {
         let modes = match root.get("modes") {
             None => None,
             Some(toml::Value::Integer(i)) if (1..=MAX_MODES as i64).contains(i) => {
@@ -47,7 +150,7 @@ impl Probe {
                 None
             }
         };
-        let modes = match (structure, modes) {
+        match (structure, modes) {
             (Some(Structure::PointMass), Some(n)) if n != 1 => {
                 r.problems.push(format!(
                     "modes = {n}: the point-mass model has one mode (omit modes)"
@@ -55,7 +158,6 @@ impl Probe {
                 None
             }
             (Some(Structure::PointMass), _) => Some(1),
-            // the eigenmode model: one mode per entry of the cantilever's arrays
             (Some(Structure::Eigenmodes), n) => {
                 let len = root
                     .get("cantilever")
@@ -87,60 +189,23 @@ impl Probe {
                 None
             }
             (_, n) => n,
-        };
-
-        // [cantilever]
-        let cant = r.table(root, "cantilever", true);
-        let mut eigen = None;
-        let (beam, q1, qs) = match (cant, structure) {
-            (Some(c), Some(Structure::Eigenmodes)) => match Self::read_eigenmodes(&mut r, c) {
-                Some((k, f, q)) => {
-                    let beam = Beam::Calibrated {
-                        k: k[0],
-                        f0: f[0],
-                        alpha1: 0.0,
-                        plan: Self::read_plan(&mut r, c),
-                    };
-                    let q1 = q[0];
-                    eigen = Some((k, f));
-                    (Some(beam), Some(q1), Some(q))
-                }
-                None => (None, None, None),
-            },
-            (Some(c), _) => Self::read_cantilever(&mut r, c),
-            (None, _) => (None, None, None),
-        };
-        // [tip]
-        let tip = r.table(root, "tip", false);
-        let mut tip_e = None;
-        let mut tip_nu = None;
-        let mut radius = None;
-        if let Some(t) = tip {
-            r.unknown(t, "tip", &["radius", "youngs_modulus", "poisson_ratio"]);
-            radius = r.optional(t, "tip", "radius", "m", POSITIVE);
-            tip_e = r.optional(t, "tip", "youngs_modulus", "Pa", POSITIVE);
-            tip_nu = r.optional(t, "tip", "poisson_ratio", "1", POISSON);
-            // a silicon tip where the section omits its elastic constants (the one materials
-            // table, crate::units::SILICON_TIP)
-            if !t.contains_key("youngs_modulus") {
-                tip_e = Some(crate::cantilevers::SILICON_YOUNGS_MODULUS);
-            }
-            if !t.contains_key("poisson_ratio") {
-                tip_nu = Some(crate::cantilevers::SILICON_POISSON_RATIO);
-            }
         }
-        // [sample]
-        let sample = r
-            .table(root, "sample", true)
-            .and_then(|s| Self::read_sample(&mut r, s, tip, radius, tip_e, tip_nu));
-        // [drive]
+    }
+
+    /// `[drive]`: tapping near resonance (free amplitude and frequency, the excitation), or
+    /// off-resonance modulation; `None` when a required value is missing or refused.
+    fn read_drive(
+        r: &mut Reader<'_>,
+        root: &toml::Table,
+        structure: Option<Structure>,
+    ) -> Option<Drive> {
         let drive = r.table(root, "drive", true);
         let mut excitation = Excitation::Base;
         let off_resonance = drive
             .and_then(|d| d.get("mode"))
             .and_then(toml::Value::as_str)
             .is_some_and(|m| m == "off-resonance");
-        let (a0, freq, extra) = match drive {
+        let (a0, frequency, components) = match drive {
             Some(d) if off_resonance => {
                 r.unknown(
                     d,
@@ -194,7 +259,7 @@ impl Probe {
                         Err(m) => r.problems.push(format!("[drive].{m}")),
                     }
                 }
-                Self::read_drive(&mut r, d)
+                Self::read_components(r, d)
             }
             None => (None, None, Vec::new()),
         };
@@ -205,61 +270,22 @@ impl Probe {
                     .into(),
             );
         }
-        // [medium]
-        let medium = r
-            .table(root, "medium", false)
-            .and_then(|t| medium::read(&mut r, t));
-        let medium_given = root.contains_key("medium");
-        if let (Some(Structure::PointMass), Some(_)) = (structure, &qs) {
-            r.problems.push(
-                "[cantilever].quality_factors: the point-mass model has one mode (use quality_factor)"
-                    .into(),
-            );
-        }
-        // the count as written (an entry refused above is still one value)
-        let written = match cant.and_then(|c| c.get("quality_factors")) {
-            Some(toml::Value::Array(a)) => Some(a.len()),
-            _ => None,
-        };
-        if let (Some(n), Some(len)) = (modes, written) {
-            if len != n {
-                r.problems.push(format!(
-                    "[cantilever].quality_factors has {len} values: give one per mode (modes = {n})"
-                ));
-            }
-        }
-        if !r.problems.is_empty() || (medium_given && medium.is_none()) {
-            return None;
-        }
-        let (structure, modes, beam, q1, sample, a0) =
-            (structure?, modes?, beam?, q1?, sample?, a0?);
-        let drive = Drive {
-            free_amplitude: a0,
-            frequency: freq,
-            components: extra,
+        Some(Drive {
+            free_amplitude: a0?,
+            frequency,
+            components,
             excitation,
             off_resonance,
-        };
-        match Self::resolve(structure, modes, beam, q1, qs, eigen, sample, drive, medium) {
-            Ok(p) => Some(Probe {
-                input_warnings: [std::mem::take(&mut r.warnings), p.input_warnings.clone()]
-                    .concat(),
-                ..p
-            }),
-            Err(e) => {
-                r.problems.push(e);
-                None
-            }
-        }
+        })
     }
 
-    /// `[drive]`: `free_amplitude` (m) and `frequency` (Hz) as numbers (one component), or as
+    /// `[drive]`'s components: `free_amplitude` (m) and `frequency` (Hz) as numbers (one component), or as
     /// arrays of equal length (a multifrequency drive, at most 1 + [`MAX_DRIVE_COMPONENTS`]
     /// components; `frequency` may be omitted, each component then at its mode's free
     /// resonance). Returns A₀ and f of the first component and (A₀ᵢ, fᵢ) of the others (fᵢ NaN
     /// where omitted).
     #[allow(clippy::type_complexity)]
-    pub(super) fn read_drive(
+    fn read_components(
         r: &mut Reader<'_>,
         d: &toml::Table,
     ) -> (Option<f64>, Option<f64>, Vec<(f64, f64)>) {
@@ -464,11 +490,13 @@ impl Probe {
                 let tip_mass = r.optional(c, S, "tip_mass", "kg", NON_NEGATIVE);
                 match (length, width, thickness, e, rho) {
                     (Some(l), Some(b), Some(h), Some(e), Some(rho)) => Some(Beam::Geometry {
-                        length: l,
                         width: b,
-                        ei: e * b * h.powi(3) / 12.0,
-                        mass_per_length: rho * b * h,
-                        tip_mass: tip_mass.unwrap_or(0.0),
+                        si: crate::units::BeamSi {
+                            length: l,
+                            bending_stiffness: e * b * h.powi(3) / 12.0,
+                            mass_per_length: rho * b * h,
+                            tip_mass: tip_mass.unwrap_or(0.0),
+                        },
                     }),
                     _ => None,
                 }
@@ -533,6 +561,8 @@ impl Probe {
         (beam, q1, qs)
     }
 
+    /// `[sample]`: the law and the keys it takes ([`crate::contact::Law::SAMPLE_KEYS`]), with
+    /// the `[tip]`'s radius and elastic constants as read.
     pub(super) fn read_sample(
         r: &mut Reader<'_>,
         s: &toml::Table,
@@ -542,12 +572,50 @@ impl Probe {
         tip_nu: Option<f64>,
     ) -> Option<Sample> {
         const S: &str = "sample";
-        // the law's name in any case ("DMT" as the literature writes it)
-        let law = match r
-            .string(s, S, "law")
+        let law = Self::read_law(r, s)?;
+        let keys = law
+            .parse::<crate::contact::LawKind>()
+            .map_or(&[][..], |kind| kind.info().sample_keys);
+        r.unknown(s, S, keys);
+        let z_c = r.optional(s, S, "z_c", "m", ANY);
+        let mut out = Sample {
+            law,
+            si: crate::contact::SampleSi {
+                radius,
+                ..Default::default()
+            },
+            z_c,
+            elastic: None,
+        };
+        let si = &mut out.si;
+        match out.law.as_str() {
+            "linear" => {
+                si.stiffness = r.required(s, S, "stiffness", "N/m", NON_NEGATIVE);
+                si.damping = r.optional(s, S, "damping", "N s/m", NON_NEGATIVE);
+                si.stiffness.map(|_| out)
+            }
+            "sls" => {
+                si.stiffness = r.required(s, S, "stiffness", "N/m", POSITIVE);
+                let k2 = r.required(s, S, "maxwell_stiffness", "N/m", POSITIVE);
+                let tau = r.required(s, S, "relaxation_time", "s", POSITIVE);
+                si.maxwell = k2.zip(tau);
+                si.stiffness.and(si.maxwell).map(|_| out)
+            }
+            "impact" => {
+                si.restitution = r.required(s, S, "restitution", "1", UNIT_INTERVAL);
+                si.restitution.map(|_| out)
+            }
+            _ => Self::read_contact(r, s, out, tip, tip_e, tip_nu),
+        }
+    }
+
+    /// `[sample] law`: a registered law's name ([`crate::contact::LAWS`]) in any case ("DMT" as
+    /// the literature writes it).
+    fn read_law(r: &mut Reader<'_>, s: &toml::Table) -> Option<String> {
+        match r
+            .string(s, "sample", "law")
             .map(|l| (l, l.trim().to_ascii_lowercase()))
         {
-            // a registered law's name ([`crate::contact::LAWS`])
             Some((_, l)) if crate::contact::LAWS.iter().any(|law| law.name == l) => Some(l),
             Some((l, _)) => {
                 r.problems.push(format!(
@@ -565,56 +633,28 @@ impl Probe {
                 }
                 None
             }
-        }?;
-        // the keys the law takes ([`crate::contact::Law::SAMPLE_KEYS`])
-        let keys = law
-            .parse::<crate::contact::LawKind>()
-            .map_or(&[][..], |kind| kind.info().sample_keys);
-        r.unknown(s, S, keys);
-        let z_c = r.optional(s, S, "z_c", "m", ANY);
-        let mut out = Sample {
-            law: law.clone(),
-            e_star: None,
-            radius,
-            hamaker: None,
-            a0: None,
-            viscosity: None,
-            stiffness: None,
-            damping: None,
-            restitution: None,
-            voltage: None,
-            adhesion_energy: None,
-            meniscus: None,
-            maxwell: None,
-            z_c,
-            elastic: None,
-        };
-        match law.as_str() {
-            "linear" => {
-                out.stiffness = r.required(s, S, "stiffness", "N/m", NON_NEGATIVE);
-                out.damping = r.optional(s, S, "damping", "N s/m", NON_NEGATIVE);
-                return out.stiffness.map(|_| out);
-            }
-            "sls" => {
-                out.stiffness = r.required(s, S, "stiffness", "N/m", POSITIVE);
-                let k2 = r.required(s, S, "maxwell_stiffness", "N/m", POSITIVE);
-                let tau = r.required(s, S, "relaxation_time", "s", POSITIVE);
-                out.maxwell = k2.zip(tau);
-                return out.stiffness.and(out.maxwell).map(|_| out);
-            }
-            "impact" => {
-                out.restitution = r.required(s, S, "restitution", "1", UNIT_INTERVAL);
-                return out.restitution.map(|_| out);
-            }
-            _ => {}
         }
-        // hertz and dmt need the tip (its radius; E and ν default to silicon's)
+    }
+
+    /// The `[sample]` of a law of Hertz's contact (hertz, dmt, electrostatic, jkr, capillary):
+    /// the tip's radius, E* of tip and sample, and the law's own keys.
+    fn read_contact(
+        r: &mut Reader<'_>,
+        s: &toml::Table,
+        mut out: Sample,
+        tip: Option<&toml::Table>,
+        tip_e: Option<f64>,
+        tip_nu: Option<f64>,
+    ) -> Option<Sample> {
+        const S: &str = "sample";
+        let (law, si) = (out.law.as_str(), &mut out.si);
+        // the tip (its radius; E and ν default to silicon's)
         if tip.is_none() {
             r.problems.push(format!(
                 "missing table [tip] (the {law} law needs the tip radius; youngs_modulus and \
                  poisson_ratio default to silicon's)"
             ));
-        } else if radius.is_none() && !tip.is_some_and(|t| t.contains_key("radius")) {
+        } else if si.radius.is_none() && !tip.is_some_and(|t| t.contains_key("radius")) {
             r.problems.push(format!(
                 "missing key [tip].radius (m, needed by the {law} law)"
             ));
@@ -622,11 +662,11 @@ impl Probe {
         let e_s = r.required(s, S, "youngs_modulus", "Pa", POSITIVE);
         let nu_s = r.required(s, S, "poisson_ratio", "1", POISSON);
         if let (Some(et), Some(nt), Some(es), Some(ns)) = (tip_e, tip_nu, e_s, nu_s) {
-            out.e_star = Some(crate::contact::reduced_modulus(et, nt, es, ns));
+            si.e_star = Some(crate::contact::reduced_modulus(et, nt, es, ns));
             out.elastic = Some([es, ns, et, nt]);
         }
         if law == "hertz" {
-            out.damping = r.optional(s, S, "damping", "N s/m", NON_NEGATIVE);
+            si.damping = r.optional(s, S, "damping", "N s/m", NON_NEGATIVE);
         } else if law == "capillary" {
             let volume = r.required(s, S, "meniscus_volume", "m^3", POSITIVE);
             let gamma = r
@@ -635,15 +675,15 @@ impl Probe {
             let theta = r
                 .optional(s, S, "contact_angle", "degree", WETTING_ANGLE)
                 .or(Some(0.0));
-            out.viscosity = r.optional(s, S, "viscosity", "Pa s", NON_NEGATIVE);
+            si.viscosity = r.optional(s, S, "viscosity", "Pa s", NON_NEGATIVE);
             if let (Some(v), Some(g), Some(t)) = (volume, gamma, theta) {
-                out.meniscus = Some((v, g, t.to_radians()));
+                si.meniscus = Some((v, g, t.to_radians()));
             }
-            out.meniscus?;
+            si.meniscus?;
         } else {
             // JKR: the work of adhesion W, or H/(12πa₀²) from the Hamaker constant
-            out.hamaker = if law == "jkr" {
-                out.adhesion_energy = r.optional(s, S, "adhesion_energy", "J/m^2", POSITIVE);
+            si.hamaker = if law == "jkr" {
+                si.adhesion_energy = r.optional(s, S, "adhesion_energy", "J/m^2", POSITIVE);
                 // (a given but invalid adhesion_energy is reported by its own check, not
                 // as missing)
                 match (s.contains_key("adhesion_energy"), s.contains_key("hamaker")) {
@@ -664,12 +704,12 @@ impl Probe {
             // a₀ = 0.165 nm when omitted (Israelachvili, Intermolecular and Surface Forces,
             // 3rd ed., Academic Press 2011, §13.6: the contact separation D₀ that gives
             // surface energies from Hamaker constants; García & San Paulo 1999 use it)
-            out.a0 = if s.contains_key("intermolecular_distance") {
+            si.a0 = if s.contains_key("intermolecular_distance") {
                 r.optional(s, S, "intermolecular_distance", "m", POSITIVE)
             } else {
                 Some(DEFAULT_INTERMOLECULAR_DISTANCE)
             };
-            out.viscosity = r.optional(s, S, "viscosity", "Pa s", NON_NEGATIVE);
+            si.viscosity = r.optional(s, S, "viscosity", "Pa s", NON_NEGATIVE);
         }
         if law == "electrostatic" {
             // the voltage across the gap: the bias less the contact potential difference
@@ -677,11 +717,11 @@ impl Probe {
             let cpd = r
                 .optional(s, S, "contact_potential", "V", ANY)
                 .unwrap_or(0.0);
-            out.voltage = bias.map(|b| b - cpd);
-            out.voltage?;
+            si.voltage = bias.map(|b| b - cpd);
+            si.voltage?;
         }
         if law == "jkr" {
-            if out.adhesion_energy.is_some() && out.hamaker.is_some() {
+            if si.adhesion_energy.is_some() && si.hamaker.is_some() {
                 r.problems.push(
                     "[sample] gives both adhesion_energy and hamaker: the jkr law takes one work \
                      of adhesion (W, or H/(12πa₀²))"
@@ -689,11 +729,11 @@ impl Probe {
                 );
                 return None;
             }
-            if let (None, Some(h), Some(a0)) = (out.adhesion_energy, out.hamaker, out.a0) {
-                out.adhesion_energy = Some(work_of_adhesion(h, a0));
+            if let (None, Some(h), Some(a0)) = (si.adhesion_energy, si.hamaker, si.a0) {
+                si.adhesion_energy = Some(work_of_adhesion(h, a0));
             }
-            out.adhesion_energy?;
+            si.adhesion_energy?;
         }
-        out.e_star.and(out.radius).map(|_| out)
+        si.e_star.and(si.radius).map(|_| out)
     }
 }

@@ -50,261 +50,241 @@ pub struct ParamInfo {
     pub kind: ValueKind,
 }
 
-#[allow(clippy::too_many_arguments)] // one row of the table, every column named at the call
-const fn info(
-    name: &'static str,
-    alias: Option<&'static str>,
-    symbol: &'static str,
-    unit: &'static str,
-    range: &'static str,
-    default: &'static str,
-    help: &'static str,
-    kind: ValueKind,
-) -> ParamInfo {
-    ParamInfo {
-        name,
-        alias,
-        symbol,
-        unit,
-        range,
-        default,
-        help,
-        kind,
-    }
-}
-
 /// Every model parameter a request takes, in the order the front ends list them. The ranges
 /// are those [`Params::validate`] and [`ContactLaw::validate`] enforce; `z_c` and
 /// `drive_frequency` are SI values that need a probe file.
 pub const MODEL_PARAMETERS: [ParamInfo; 22] = [
-    info(
-        "modes",
-        None,
-        "N",
-        "1",
-        "1..=20",
-        "3",
-        "number of Galerkin modes N (eq. 9)",
-        ValueKind::Integer,
-    ),
-    info(
-        "tip_mass_ratio",
-        Some("alpha1"),
-        "α1",
-        "1",
-        "0..=1e4",
-        "0.1",
-        "tip-mass ratio α1 = M/(mL)",
-        ValueKind::Real,
-    ),
-    info(
-        "drive_amplitude",
-        Some("alpha2"),
-        "α2",
-        "1",
-        "0..=1e6",
-        "0.1",
-        "base-drive amplitude α2 = f/g0",
-        ValueKind::Real,
-    ),
-    info(
-        "beam_damping",
-        Some("alpha3"),
-        "α3",
-        "1",
-        "0..=1e4",
-        "0.1",
-        "beam damping α3",
-        ValueKind::Real,
-    ),
-    info(
-        "contact_stiffness",
-        Some("alpha4"),
-        "α4",
-        "1",
-        "0..=1e8",
-        "20",
-        "contact stiffness α4 = K1 L³/(EI)",
-        ValueKind::Real,
-    ),
-    info(
-        "gap",
-        Some("alpha5"),
-        "α5",
-        "1",
-        "-1e6..=1e6",
-        "0",
-        "tip–sample gap α5 = g1/g0 (may be negative)",
-        ValueKind::Real,
-    ),
-    info(
-        "contact_damping",
-        Some("alpha6"),
-        "α6",
-        "1",
-        "0..=1e4",
-        "0.2",
-        "contact damping α6",
-        ValueKind::Real,
-    ),
-    info(
-        "omega",
-        None,
-        "Ω",
-        "1",
-        "1e-3..=1e5",
-        "2.6",
-        "dimensionless drive frequency Ω",
-        ValueKind::Real,
-    ),
-    info(
-        "contact_law",
-        None,
-        "F_c",
-        "1",
-        crate::contact::LawKind::EXPECTED,
-        "linear",
-        "tip–sample law: linear (α4 δ + α6 δ̇), hertz (α4 δ^1.5 + α6 δ̇), dmt (van der Waals + \
+    ParamInfo {
+        name: "modes",
+        alias: None,
+        symbol: "N",
+        unit: "1",
+        range: "1..=20",
+        default: "3",
+        help: "number of Galerkin modes N (eq. 9)",
+        kind: ValueKind::Integer,
+    },
+    ParamInfo {
+        name: "tip_mass_ratio",
+        alias: Some("alpha1"),
+        symbol: "α1",
+        unit: "1",
+        range: "0..=1e4",
+        default: "0.1",
+        help: "tip-mass ratio α1 = M/(mL)",
+        kind: ValueKind::Real,
+    },
+    ParamInfo {
+        name: "drive_amplitude",
+        alias: Some("alpha2"),
+        symbol: "α2",
+        unit: "1",
+        range: "0..=1e6",
+        default: "0.1",
+        help: "base-drive amplitude α2 = f/g0",
+        kind: ValueKind::Real,
+    },
+    ParamInfo {
+        name: "beam_damping",
+        alias: Some("alpha3"),
+        symbol: "α3",
+        unit: "1",
+        range: "0..=1e4",
+        default: "0.1",
+        help: "beam damping α3",
+        kind: ValueKind::Real,
+    },
+    ParamInfo {
+        name: "contact_stiffness",
+        alias: Some("alpha4"),
+        symbol: "α4",
+        unit: "1",
+        range: "0..=1e8",
+        default: "20",
+        help: "contact stiffness α4 = K1 L³/(EI)",
+        kind: ValueKind::Real,
+    },
+    ParamInfo {
+        name: "gap",
+        alias: Some("alpha5"),
+        symbol: "α5",
+        unit: "1",
+        range: "-1e6..=1e6",
+        default: "0",
+        help: "tip–sample gap α5 = g1/g0 (may be negative)",
+        kind: ValueKind::Real,
+    },
+    ParamInfo {
+        name: "contact_damping",
+        alias: Some("alpha6"),
+        symbol: "α6",
+        unit: "1",
+        range: "0..=1e4",
+        default: "0.2",
+        help: "contact damping α6",
+        kind: ValueKind::Real,
+    },
+    ParamInfo {
+        name: "omega",
+        alias: None,
+        symbol: "Ω",
+        unit: "1",
+        range: "1e-3..=1e5",
+        default: "2.6",
+        help: "dimensionless drive frequency Ω",
+        kind: ValueKind::Real,
+    },
+    ParamInfo {
+        name: "contact_law",
+        alias: None,
+        symbol: "F_c",
+        unit: "1",
+        range: crate::contact::LawKind::EXPECTED,
+        default: "linear",
+        help:
+            "tip–sample law: linear (α4 δ + α6 δ̇), hertz (α4 δ^1.5 + α6 δ̇), dmt (van der Waals + \
          adhesion + Hertz + α6 √δ δ̇), electrostatic (dmt + a biased tip), jkr (adhesive Hertz \
          contact with a neck, formed at δ = 0, broken at δ_f < 0), capillary (a meniscus formed \
          at contact, ruptured at V_T = D_r, over a Hertz sample), sls (standard linear solid: \
          α4 in parallel with a Maxwell arm κ, α6, whose surface recovers after the tip leaves) \
          or impact (rigid sample, restitution r)",
-        ValueKind::Law,
-    ),
-    info(
-        "excitation",
-        None,
-        "—",
-        "1",
-        "base or tip",
-        "base",
-        "where the drive acts on the beam: base (α2 sin Ωτ, the paper; acoustic) or tip (a \
+        kind: ValueKind::Law,
+    },
+    ParamInfo {
+        name: "excitation",
+        alias: None,
+        symbol: "—",
+        unit: "1",
+        range: "base or tip",
+        default: "base",
+        help: "where the drive acts on the beam: base (α2 sin Ωτ, the paper; acoustic) or tip (a \
          force α2 cos Ωτ at the tip: magnetic, photothermal)",
-        ValueKind::Excitation,
-    ),
-    info(
-        "restitution",
-        None,
-        "r",
-        "1",
-        "0..=1",
-        "0.8",
-        "impact law: coefficient of restitution r",
-        ValueKind::Real,
-    ),
-    info(
-        "hamaker",
-        None,
-        "H̃",
-        "1",
-        ">= 0",
-        "1e-5",
-        "DMT: van der Waals group H̃ = H R L³/(6 EI g0³)",
-        ValueKind::Real,
-    ),
-    info(
-        "intermolecular_distance",
-        None,
-        "ã0",
-        "1",
-        "> 0",
-        "0.01",
-        "DMT: intermolecular distance ã0 = a0/g0, the contact threshold",
-        ValueKind::Real,
-    ),
-    info(
-        "electrostatic",
-        None,
-        "Ẽ",
-        "1",
-        ">= 0",
-        "1e-3",
-        "electrostatic law: group Ẽ = πε0 V²/F of the biased tip, F_es = -Ẽ R̃²/(d(d + R̃))",
-        ValueKind::Real,
-    ),
-    info(
-        "tip_radius",
-        None,
-        "R̃",
-        "1",
-        "> 0",
-        "1",
-        "electrostatic law: tip radius R̃ = R/g0",
-        ValueKind::Real,
-    ),
-    info(
-        "adhesion",
-        None,
-        "P̃",
-        "1",
-        "> 0",
-        "0.05",
-        "jkr law: adhesion group P̃ = πWR/F (W the work of adhesion): pull-off (3/2)P̃",
-        ValueKind::Real,
-    ),
-    info(
-        "capillary",
-        None,
-        "F̃_cap",
-        "1",
-        "> 0",
-        "0.1",
-        "capillary law: the meniscus's force at contact F̃_cap = 4πRγcosθ/F",
-        ValueKind::Real,
-    ),
-    info(
-        "meniscus",
-        None,
-        "h̃",
-        "1",
-        "1e-9..=1e6",
-        "0.01",
-        "capillary law: the meniscus's immersion at contact h̃ = √(V/(πR))/g0 (V its volume)",
-        ValueKind::Real,
-    ),
-    info(
-        "rupture",
-        None,
-        "D̃_r",
-        "1",
-        "1e-9..=1e6",
-        "0.05",
-        "capillary law: the rupture distance D̃_r = (1 + θ/2)V^(1/3)/g0 (Lian et al. 1993)",
-        ValueKind::Real,
-    ),
-    info(
-        "maxwell_stiffness",
-        None,
-        "κ",
-        "1",
-        "(0, 1e12]",
-        "20",
-        "sls law: the Maxwell arm's spring κ (in series with the dashpot α6; relaxation time \
+        kind: ValueKind::Excitation,
+    },
+    ParamInfo {
+        name: "restitution",
+        alias: None,
+        symbol: "r",
+        unit: "1",
+        range: "0..=1",
+        default: "0.8",
+        help: "impact law: coefficient of restitution r",
+        kind: ValueKind::Real,
+    },
+    ParamInfo {
+        name: "hamaker",
+        alias: None,
+        symbol: "H̃",
+        unit: "1",
+        range: ">= 0",
+        default: "1e-5",
+        help: "DMT: van der Waals group H̃ = H R L³/(6 EI g0³)",
+        kind: ValueKind::Real,
+    },
+    ParamInfo {
+        name: "intermolecular_distance",
+        alias: None,
+        symbol: "ã0",
+        unit: "1",
+        range: "> 0",
+        default: "0.01",
+        help: "DMT: intermolecular distance ã0 = a0/g0, the contact threshold",
+        kind: ValueKind::Real,
+    },
+    ParamInfo {
+        name: "electrostatic",
+        alias: None,
+        symbol: "Ẽ",
+        unit: "1",
+        range: ">= 0",
+        default: "1e-3",
+        help: "electrostatic law: group Ẽ = πε0 V²/F of the biased tip, F_es = -Ẽ R̃²/(d(d + R̃))",
+        kind: ValueKind::Real,
+    },
+    ParamInfo {
+        name: "tip_radius",
+        alias: None,
+        symbol: "R̃",
+        unit: "1",
+        range: "> 0",
+        default: "1",
+        help: "electrostatic law: tip radius R̃ = R/g0",
+        kind: ValueKind::Real,
+    },
+    ParamInfo {
+        name: "adhesion",
+        alias: None,
+        symbol: "P̃",
+        unit: "1",
+        range: "> 0",
+        default: "0.05",
+        help: "jkr law: adhesion group P̃ = πWR/F (W the work of adhesion): pull-off (3/2)P̃",
+        kind: ValueKind::Real,
+    },
+    ParamInfo {
+        name: "capillary",
+        alias: None,
+        symbol: "F̃_cap",
+        unit: "1",
+        range: "> 0",
+        default: "0.1",
+        help: "capillary law: the meniscus's force at contact F̃_cap = 4πRγcosθ/F",
+        kind: ValueKind::Real,
+    },
+    ParamInfo {
+        name: "meniscus",
+        alias: None,
+        symbol: "h̃",
+        unit: "1",
+        range: "1e-9..=1e6",
+        default: "0.01",
+        help: "capillary law: the meniscus's immersion at contact h̃ = √(V/(πR))/g0 (V its volume)",
+        kind: ValueKind::Real,
+    },
+    ParamInfo {
+        name: "rupture",
+        alias: None,
+        symbol: "D̃_r",
+        unit: "1",
+        range: "1e-9..=1e6",
+        default: "0.05",
+        help: "capillary law: the rupture distance D̃_r = (1 + θ/2)V^(1/3)/g0 (Lian et al. 1993)",
+        kind: ValueKind::Real,
+    },
+    ParamInfo {
+        name: "maxwell_stiffness",
+        alias: None,
+        symbol: "κ",
+        unit: "1",
+        range: "(0, 1e12]",
+        default: "20",
+        help:
+            "sls law: the Maxwell arm's spring κ (in series with the dashpot α6; relaxation time \
          α6/κ, instantaneous stiffness α4 + κ)",
-        ValueKind::Real,
-    ),
-    info(
-        "z_c",
-        None,
-        "z_c",
-        "m",
-        "finite",
-        "the probe's",
-        "with a probe: the rest tip–sample distance z_c in metres (sets α5)",
-        ValueKind::Real,
-    ),
-    info(
-        "drive_frequency",
-        None,
-        "f",
-        "Hz",
-        "> 0",
-        "the probe's",
-        "with a probe: the drive frequency in Hz (sets Ω; the drive force or base amplitude is \
+        kind: ValueKind::Real,
+    },
+    ParamInfo {
+        name: "z_c",
+        alias: None,
+        symbol: "z_c",
+        unit: "m",
+        range: "finite",
+        default: "the probe's",
+        help: "with a probe: the rest tip–sample distance z_c in metres (sets α5)",
+        kind: ValueKind::Real,
+    },
+    ParamInfo {
+        name: "drive_frequency",
+        alias: None,
+        symbol: "f",
+        unit: "Hz",
+        range: "> 0",
+        default: "the probe's",
+        help:
+            "with a probe: the drive frequency in Hz (sets Ω; the drive force or base amplitude is \
          kept)",
-        ValueKind::Real,
-    ),
+        kind: ValueKind::Real,
+    },
 ];
 
 /// The entry of [`MODEL_PARAMETERS`] named `key` (its name or its alias).
@@ -441,7 +421,17 @@ impl ModelSpec {
     /// [`SimError::NotFinite`] naming the first value that is not finite by its request name
     /// (`contact_stiffness`, `z_c`, …).
     pub fn check_finite(&self) -> Result<(), SimError> {
-        let values = [
+        for (name, v) in self.reals() {
+            if let Some(x) = v {
+                crate::error::finite(name, x)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// The real values by their names, in the order of [`MODEL_PARAMETERS`].
+    fn reals(&self) -> [(&'static str, Option<f64>); 19] {
+        [
             ("tip_mass_ratio", self.tip_mass_ratio),
             ("drive_amplitude", self.drive_amplitude),
             ("beam_damping", self.beam_damping),
@@ -461,13 +451,7 @@ impl ModelSpec {
             ("maxwell_stiffness", self.maxwell_stiffness),
             ("z_c", self.z_c),
             ("drive_frequency", self.drive_frequency),
-        ];
-        for (name, v) in values {
-            if let Some(x) = v {
-                crate::error::finite(name, x)?;
-            }
-        }
-        Ok(())
+        ]
     }
 
     /// The parameter set: `defaults`, or the probe's set when a probe is given, with this
@@ -482,24 +466,7 @@ impl ModelSpec {
     pub fn resolve(&self, defaults: Params, probe: Option<&Probe>) -> Result<Params, SimError> {
         if let Some(pr) = probe {
             self.refuse_dimensionless_under_probe()?;
-            // one meaning of N everywhere: a lumped model's modes are the probe's (the point
-            // mass has one, the eigenmode model one per entry of [cantilever].spring_constant),
-            // as the probe file's own `modes` key is checked; a larger N would repeat mode 1
-            if let (Some(n), true) = (self.modes, pr.params.structure.is_lumped()) {
-                if n != pr.params.modes {
-                    return Err(SimError::out_of_range(
-                        "modes",
-                        format!(
-                            "{n} (this probe's {} model has {} mode(s))",
-                            pr.params.structure.name(),
-                            pr.params.modes
-                        ),
-                        "must equal the probe's number of modes: the point-mass model has \
-                         one mode and the eigenmode model one per entry of [cantilever] \
-                         spring_constant (omit modes, or edit the probe's arrays)",
-                    ));
-                }
-            }
+            self.check_probe_modes(pr)?;
         }
         let base = probe.map_or(defaults, |p| p.params);
         let contact_law = ContactLaw::from_parts(
@@ -539,71 +506,104 @@ impl ModelSpec {
             }
         }
         if let Some(z) = self.z_c {
-            let probe = probe.ok_or_else(|| {
-                SimError::out_of_range("z_c", z, "needs a probe file (z_c is in m, SI)")
-            })?;
-            if !z.is_finite() {
-                return Err(SimError::out_of_range(
-                    "z_c",
-                    z,
-                    "must be a finite distance in m",
-                ));
-            }
-            super::limits::si_distance("z_c", z)?;
-            p.alpha5 = p.alpha5_for_rest_distance(z / probe.scales.length_m);
-            if p.alpha5.is_nan() || p.alpha5.abs() > crate::params::DISPLACEMENT_MAX {
-                // the model's range of α5 in the user's unit: z_c in m for this probe's A0
-                let edge =
-                    |a5: f64| Params { alpha5: a5, ..p }.rest_distance() * probe.scales.length_m;
-                return Err(SimError::out_of_range(
-                    "z_c",
-                    format!(
-                        "{} m (this probe allows [{}, {}] m: ±1e6 × its length unit A0 = {} m)",
-                        crate::error::number(z),
-                        crate::error::number(edge(-crate::params::DISPLACEMENT_MAX)),
-                        crate::error::number(edge(crate::params::DISPLACEMENT_MAX)),
-                        crate::error::number(probe.scales.length_m)
-                    ),
-                    "must lie within the probe's range: the model takes rest distances up to \
-                     1e6 free amplitudes A0 from the sample",
-                ));
-            }
+            p.alpha5 = alpha5_of_rest_distance(z, &p, probe)?;
         }
         if let Some(f) = self.drive_frequency {
-            let probe = probe.ok_or_else(|| {
-                SimError::out_of_range(
-                    "drive_frequency",
-                    f,
-                    "needs a probe file (drive_frequency is in Hz, SI)",
-                )
-            })?;
-            if !(f.is_finite() && f > 0.0) {
-                return Err(SimError::out_of_range(
-                    "drive_frequency",
-                    f,
-                    "must be finite and > 0 (Hz)",
-                ));
-            }
-            let (lo, hi) = super::limits::SI_FREQUENCY_RATIO;
-            let ratio = f / probe.drive_frequency;
-            if !(lo..=hi).contains(&ratio) {
-                return Err(SimError::out_of_range(
-                    "drive_frequency",
-                    format!(
-                        "{} Hz ({} × the probe's {} Hz)",
-                        crate::error::number(f),
-                        crate::error::number(ratio),
-                        crate::error::number(probe.drive_frequency)
-                    ),
-                    "must be within [0.01, 1e4] × the probe's drive frequency: frequencies are \
-                     in Hz (300 kHz is 300e3, or 300kHz on the command line)",
-                ));
-            }
-            p.omega = probe.scales.omega(f);
+            p.omega = omega_of_drive_frequency(f, probe)?;
         }
         p.validate_fields().map_err(SimError::from)?;
         Ok(p)
     }
+
+    /// One meaning of N everywhere: a lumped model's modes are the probe's (the point mass has
+    /// one, the eigenmode model one per entry of [cantilever].spring_constant), as the probe
+    /// file's own `modes` key is checked; a larger N would repeat mode 1.
+    fn check_probe_modes(&self, pr: &Probe) -> Result<(), SimError> {
+        if let (Some(n), true) = (self.modes, pr.params.structure.is_lumped()) {
+            if n != pr.params.modes {
+                return Err(SimError::out_of_range(
+                    "modes",
+                    format!(
+                        "{n} (this probe's {} model has {} mode(s))",
+                        pr.params.structure.name(),
+                        pr.params.modes
+                    ),
+                    "must equal the probe's number of modes: the point-mass model has \
+                     one mode and the eigenmode model one per entry of [cantilever] \
+                     spring_constant (omit modes, or edit the probe's arrays)",
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// α5 of `p` for the rest distance `z` (m, the request's `z_c`): z in units of the probe's
+/// length scale ([`Params::alpha5_for_rest_distance`]), within the model's range.
+fn alpha5_of_rest_distance(z: f64, p: &Params, probe: Option<&Probe>) -> Result<f64, SimError> {
+    let probe = probe
+        .ok_or_else(|| SimError::out_of_range("z_c", z, "needs a probe file (z_c is in m, SI)"))?;
+    if !z.is_finite() {
+        return Err(SimError::out_of_range(
+            "z_c",
+            z,
+            "must be a finite distance in m",
+        ));
+    }
+    super::limits::si_distance("z_c", z)?;
+    let alpha5 = p.alpha5_for_rest_distance(z / probe.scales.length_m);
+    if alpha5.is_nan() || alpha5.abs() > crate::params::DISPLACEMENT_MAX {
+        // the model's range of α5 in the user's unit: z_c in m for this probe's A0
+        let edge = |a5: f64| Params { alpha5: a5, ..*p }.rest_distance() * probe.scales.length_m;
+        return Err(SimError::out_of_range(
+            "z_c",
+            format!(
+                "{} m (this probe allows [{}, {}] m: ±1e6 × its length unit A0 = {} m)",
+                crate::error::number(z),
+                crate::error::number(edge(-crate::params::DISPLACEMENT_MAX)),
+                crate::error::number(edge(crate::params::DISPLACEMENT_MAX)),
+                crate::error::number(probe.scales.length_m)
+            ),
+            "must lie within the probe's range: the model takes rest distances up to \
+             1e6 free amplitudes A0 from the sample",
+        ));
+    }
+    Ok(alpha5)
+}
+
+/// Ω of the drive frequency `f` (Hz, the request's `drive_frequency`) under the probe's time
+/// scale, within [`super::limits::SI_FREQUENCY_RATIO`] of the probe's drive frequency.
+fn omega_of_drive_frequency(f: f64, probe: Option<&Probe>) -> Result<f64, SimError> {
+    let probe = probe.ok_or_else(|| {
+        SimError::out_of_range(
+            "drive_frequency",
+            f,
+            "needs a probe file (drive_frequency is in Hz, SI)",
+        )
+    })?;
+    if !(f.is_finite() && f > 0.0) {
+        return Err(SimError::out_of_range(
+            "drive_frequency",
+            f,
+            "must be finite and > 0 (Hz)",
+        ));
+    }
+    let (lo, hi) = super::limits::SI_FREQUENCY_RATIO;
+    let ratio = f / probe.drive_frequency;
+    if !(lo..=hi).contains(&ratio) {
+        return Err(SimError::out_of_range(
+            "drive_frequency",
+            format!(
+                "{} Hz ({} × the probe's {} Hz)",
+                crate::error::number(f),
+                crate::error::number(ratio),
+                crate::error::number(probe.drive_frequency)
+            ),
+            "must be within [0.01, 1e4] × the probe's drive frequency: frequencies are \
+             in Hz (300 kHz is 300e3, or 300kHz on the command line)",
+        ));
+    }
+    Ok(probe.scales.omega(f))
 }
 
 /// The model values a probe file sets in SI, refused as dimensionless values when a probe is
@@ -707,29 +707,9 @@ pub const PROBE_SETS: [(&str, &str); 18] = [
 impl ModelSpec {
     /// Refuse the values a probe sets in SI ([`PROBE_SETS`]): the first one given, named.
     fn refuse_dimensionless_under_probe(&self) -> Result<(), SimError> {
-        let given = [
-            ("tip_mass_ratio", self.tip_mass_ratio),
-            ("drive_amplitude", self.drive_amplitude),
-            ("beam_damping", self.beam_damping),
-            ("contact_stiffness", self.contact_stiffness),
-            ("gap", self.gap),
-            ("contact_damping", self.contact_damping),
-            ("omega", self.omega),
-            ("contact_law", None),
-            ("hamaker", self.hamaker),
-            ("intermolecular_distance", self.intermolecular_distance),
-            ("electrostatic", self.electrostatic),
-            ("tip_radius", self.tip_radius),
-            ("excitation", None),
-            ("adhesion", self.adhesion),
-            ("capillary", self.capillary),
-            ("meniscus", self.meniscus),
-            ("rupture", self.rupture),
-            ("maxwell_stiffness", self.maxwell_stiffness),
-        ];
-        for ((name, value), (key, allowed)) in given.into_iter().zip(PROBE_SETS) {
-            debug_assert_eq!(name, key);
-            if let Some(v) = value {
+        for (name, value) in self.reals() {
+            let set = PROBE_SETS.iter().find(|(key, _)| *key == name);
+            if let (Some(v), Some(&(key, allowed))) = (value, set) {
                 return Err(SimError::out_of_range(
                     key,
                     crate::error::number(v),
