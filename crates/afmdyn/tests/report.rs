@@ -5,6 +5,7 @@ use afmdyn::analysis::shooting::{shoot, ShootingOptions};
 use afmdyn::analysis::steady::{steady_state, SteadyOptions};
 use afmdyn::eigen::spectrum;
 use afmdyn::integrate::{build, IntegratorOptions};
+use afmdyn::maps::StroboscopicMap;
 use afmdyn::{report, CantileverModel, Params, SweepParam};
 use nalgebra::DVector;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
@@ -74,7 +75,17 @@ fn orbit_document_carries_the_orbit_and_its_parameters() {
     let model = CantileverModel::new(&p).unwrap();
     let mut integ = build(&model, IntegratorOptions::default(), 0.0, &model.rest()).unwrap();
     let s = steady_state(integ.as_mut(), &SteadyOptions::default()).unwrap();
-    let o = shoot(&model, s.end_state(), 2, &ShootingOptions::default()).unwrap();
+    let mut fresh = build(&model, IntegratorOptions::default(), 0.0, &model.rest()).unwrap();
+    let two = ShootingOptions {
+        period: 2,
+        ..ShootingOptions::default()
+    };
+    let o = shoot(
+        &mut StroboscopicMap::new(fresh.as_mut(), 1),
+        s.end_state(),
+        &two,
+    )
+    .unwrap();
     let doc = report::orbit(&model, &o);
     assert_eq!(doc["period"], 2);
     assert_eq!(doc["params"]["omega"], 2.8);

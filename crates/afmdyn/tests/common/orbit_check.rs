@@ -9,7 +9,8 @@ use afmdyn::analysis::fit::sensitivity::{orbit_sensitivity, OrbitParam, OrbitSen
 use afmdyn::analysis::observables::observe_orbit;
 use afmdyn::analysis::shooting::shoot;
 use afmdyn::analysis::stepped::{CurvePoint, Spacing};
-use afmdyn::integrate::{IntegratorKind, IntegratorOptions};
+use afmdyn::integrate::{build, IntegratorKind, IntegratorOptions};
+use afmdyn::maps::StroboscopicMap;
 use afmdyn::model::CantileverModel;
 use afmdyn::Params;
 use nalgebra::DVector;
@@ -50,7 +51,13 @@ pub fn check_point_at(
         return false;
     }
     // the amplitude of the Fourier integrals is the library's observable
-    let shot = shoot(&model, &exact.state, 1, &newton()).expect("orbit");
+    let mut it = build(&model, IntegratorOptions::default(), 0.0, &model.rest()).expect("build");
+    let shot = shoot(
+        &mut StroboscopicMap::new(it.as_mut(), 1),
+        &exact.state,
+        &newton(),
+    )
+    .expect("orbit");
     let opts = IntegratorOptions {
         kind: IntegratorKind::Adaptive,
         tolerance: tol,

@@ -138,7 +138,11 @@ pub fn settle(
                 continue;
             };
             let (tau, here) = (integ.tau(), integ.state().clone());
-            if let Ok(o) = shoot_with(integ, &here, m, &spec.newton) {
+            let newton = ShootingOptions {
+                period: m,
+                ..spec.newton
+            };
+            if let Ok(o) = shoot(&mut StroboscopicMap::new(integ, 1), &here, &newton) {
                 if o.stable {
                     return Ok(Settled {
                         found: Found {
@@ -248,10 +252,11 @@ pub(super) fn integrator_at(
 /// Follow the stable period-n orbit `z0` at `v0` (its monodromy matrix and trend `m0`) to `v1`
 /// by Newton
 /// (from the secant prediction `z0 + slope (v1 − v0)`, then from `z0`; undamped,
-/// [`shoot_undamped`]: a full step that does not lower the residual means the orbit is not
-/// near, and halving the parameter step is the remedy; where the integrator integrates the
-/// variational equations step by step ([`broyden_pays`]), first [`shoot_broyden`] with the
-/// trend's estimate at `v1` as the first Jacobian): accepted when stable and within `jump_tol`
+/// [`ShootingStrategy::Undamped`]: a full step that does not lower the residual means the orbit
+/// is not near, and halving the parameter step is the remedy; where the integrator integrates
+/// the variational equations step by step ([`broyden_pays`]), first
+/// [`ShootingStrategy::Broyden`] with the trend's estimate at `v1` as the first Jacobian):
+/// accepted when stable and within `jump_tol`
 /// of `z0`.
 /// Otherwise the step is halved (up to `depth` times) and each half continued in turn — a
 /// quasi-static sweep — unless three halvings in a row did not shrink the distance to the stable
@@ -270,7 +275,7 @@ pub(super) fn continue_orbit(
     n: usize,
     depth: usize,
     whole: Option<(f64, usize)>,
-) -> Result<Option<ShotOrbit>, SimError> {
+) -> Result<Option<PeriodicOrbit>, SimError> {
     let model = CantileverModel::new(&spec.base.with(spec.param, v1))?;
     let mut integ = build(&model, spec.integrator.clone(), 0.0, z0)?;
     let m1 = m0
@@ -281,12 +286,29 @@ pub(super) fn continue_orbit(
         guesses.push(z0 + s * (v1 - v0));
     }
     guesses.push(z0.clone());
+    let map = &mut StroboscopicMap::new(integ.as_mut(), 1);
+    let undamped = ShootingOptions {
+        period: n,
+        strategy: ShootingStrategy::Undamped,
+        ..spec.newton
+    };
+    let broyden = ShootingOptions {
+        strategy: ShootingStrategy::Broyden,
+        ..undamped
+    };
     let mut gap: Option<f64> = None;
     for g in &guesses {
         let shot = match &m1 {
-            Some(m) => shoot_broyden(integ.as_mut(), g, n, &spec.newton, m)
-                .or_else(|_| shoot_undamped(integ.as_mut(), g, n, &spec.newton)),
-            None => shoot_undamped(integ.as_mut(), g, n, &spec.newton),
+            Some(m) => shoot(
+                map,
+                Guess::Estimated {
+                    state: g,
+                    monodromy: m,
+                },
+                &broyden,
+            )
+            .or_else(|_| shoot(map, g, &undamped)),
+            None => shoot(map, g, &undamped),
         };
         if let Ok(o) = shot {
             if o.stable {
@@ -328,7 +350,8 @@ pub(super) fn continue_orbit(
 }
 
 /// The monodromy matrix M of the orbit followed at v0 and, when the orbit before it is on the
-/// same branch, its rate of change along the sweep: the first Jacobian of [`shoot_broyden`] at
+/// same branch, its rate of change along the sweep: the first Jacobian of
+/// [`ShootingStrategy::Broyden`] at
 /// v is M + (v − v0) dM/dv (linear extrapolation, the monodromy's counterpart of
 /// [`prediction_slope`]).
 #[derive(Debug, Clone)]
@@ -452,10 +475,17 @@ pub(super) fn orbit_point(
             None,
         )?
         .map(|o| (o.state, o.multipliers, o.monodromy)),
-        None => shoot_with(integ.as_mut(), &last, n, &spec.newton)
-            .ok()
-            .filter(|o| o.stable)
-            .map(|o| (o.state, o.multipliers, o.monodromy)),
+        None => shoot(
+            &mut StroboscopicMap::new(integ.as_mut(), 1),
+            &last,
+            &ShootingOptions {
+                period: n,
+                ..spec.newton
+            },
+        )
+        .ok()
+        .filter(|o| o.stable)
+        .map(|o| (o.state, o.multipliers, o.monodromy)),
     };
     let first = if prev.is_some() {
         Reached::Continued
@@ -551,7 +581,8 @@ mod tests {
         let spec = SteppedSpec::new(p, SweepParam::Alpha5, vec![p.alpha5, p.alpha5 + 0.01]);
         let model = CantileverModel::new(&p).unwrap();
         let mut integ = build(&model, spec.integrator.clone(), 0.0, &model.rest()).unwrap();
-        let one = shoot_with(integ.as_mut(), &model.rest(), 1, &spec.newton).unwrap();
+        let mut map = StroboscopicMap::new(integ.as_mut(), 1);
+        let one = shoot(&mut map, &model.rest(), &spec.newton).unwrap();
         assert_eq!(one.period, 1);
         let as_six = Found {
             period: Some(6),
