@@ -125,11 +125,8 @@ fn shooting(modes: usize, reps: usize) -> Result<(), Box<dyn std::error::Error>>
     let opts = IntegratorOptions::default();
     let solve = || {
         let mut it = build(&m, opts.clone(), 0.0, &m.rest())?;
-        shoot(
-            &mut StroboscopicMap::new(it.as_mut(), 1),
-            &guess,
-            &ShootingOptions::default(),
-        )
+        let map = &mut StroboscopicMap::new(it.as_mut(), 1);
+        shoot(map, &guess, &ShootingOptions::default())
     };
     let iters = solve()?.residuals.len();
     let us = best_of(reps, || {

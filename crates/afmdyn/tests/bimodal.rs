@@ -36,8 +36,9 @@ fn far_from_the_sample_each_component_is_free() {
     assert_eq!(p.common_periods(), 15);
     let model = CantileverModel::new(&p).unwrap();
     let mut it = build(&model, IntegratorOptions::default(), 0.0, &model.rest()).unwrap();
+    let map = &mut StroboscopicMap::new(it.as_mut(), 1);
     let orbit = shoot(
-        &mut StroboscopicMap::new(it.as_mut(), 1),
+        map,
         &nalgebra::DVector::zeros(4),
         &ShootingOptions::default(),
     )

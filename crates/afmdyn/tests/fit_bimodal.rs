@@ -54,12 +54,8 @@ fn check_point(base: &Params, guess: &DVector<f64>, ps: &[OrbitParam], what: &st
     let two = exact.component.clone().expect("the component's harmonic");
     let model = CantileverModel::new(base).expect("model");
     let mut it = build(&model, IntegratorOptions::default(), 0.0, &model.rest()).expect("build");
-    let shot = shoot(
-        &mut StroboscopicMap::new(it.as_mut(), 1),
-        &exact.state,
-        &newton(),
-    )
-    .expect("orbit");
+    let map = &mut StroboscopicMap::new(it.as_mut(), 1);
+    let shot = shoot(map, &exact.state, &newton()).expect("orbit");
     let opts = IntegratorOptions {
         kind: IntegratorKind::Adaptive,
         tolerance: TOL,

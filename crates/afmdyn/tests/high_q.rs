@@ -255,12 +255,8 @@ fn a_passage_near_the_saddle_is_not_a_steady_state() {
     let model = CantileverModel::new(&p).unwrap();
     let newton = |z| {
         let mut it = build(&model, IntegratorOptions::default(), 0.0, &model.rest()).unwrap();
-        shoot(
-            &mut StroboscopicMap::new(it.as_mut(), 1),
-            z,
-            &ShootingOptions::default(),
-        )
-        .unwrap()
+        let map = &mut StroboscopicMap::new(it.as_mut(), 1);
+        shoot(map, z, &ShootingOptions::default()).unwrap()
     };
     // the saddle, from a state near it (a basin map's third "attractor")
     let near = nalgebra::DVector::from_vec(vec![-0.2178, 0.9493]);

@@ -196,10 +196,7 @@ fn linear_law_adaptive_reproduces_exact() {
         .unwrap()
         .end_state()
         .clone();
-    let two = ShootingOptions {
-        period: 2,
-        ..ShootingOptions::default()
-    };
+    let two = ShootingOptions::default().with_period(2);
     let o_ex = shoot(&mut StroboscopicMap::new(ex.as_mut(), 1), &guess, &two).unwrap();
     let o_ad = shoot(&mut StroboscopicMap::new(ad.as_mut(), 1), &guess, &two).unwrap();
     assert!((&o_ex.state - &o_ad.state).amax() < 1e-9);
@@ -563,16 +560,9 @@ fn every_analysis_on_every_law() {
             c.law
         );
         let mut it = build(&m, IntegratorOptions::default(), 0.0, &m.rest()).unwrap();
-        let period = ShootingOptions {
-            period: c.period,
-            ..ShootingOptions::default()
-        };
-        let o = shoot(
-            &mut StroboscopicMap::new(it.as_mut(), 1),
-            ss.end_state(),
-            &period,
-        )
-        .unwrap();
+        let period = ShootingOptions::default().with_period(c.period);
+        let map = &mut StroboscopicMap::new(it.as_mut(), 1);
+        let o = shoot(map, ss.end_state(), &period).unwrap();
         assert!(o.stable, "{}", c.law);
         assert!((&o.state - ss.end_state()).amax() < 1e-6, "{}", c.law);
         // multipliers against a central-difference monodromy of the same map

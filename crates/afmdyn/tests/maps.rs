@@ -215,10 +215,7 @@ fn broyden_from_zero_reaches_the_affine_fixed_point_or_falls_back_on_newton() {
         (1, ShootingStrategy::Newton),
     ] {
         let mut m = affine(0.5, -0.3);
-        let period = ShootingOptions {
-            period: n,
-            ..unwatched
-        };
+        let period = unwatched.with_period(n);
         let o = shoot(&mut m, &guess, &ShootingOptions { strategy, ..period }).unwrap();
         let newton = shoot(&mut m, &guess, &period).unwrap();
         assert_eq!(o.state, newton.state, "n = {n}, {strategy:?}");

@@ -379,10 +379,7 @@ fn beam_mode_balance(law: ContactLaw) {
         panic!("expected a periodic orbit, got {:?}", s.motion)
     };
     let guess = s.end_state().clone();
-    let period = ShootingOptions {
-        period: n,
-        ..ShootingOptions::default()
-    };
+    let period = ShootingOptions::default().with_period(n);
     let orbit = shoot(&mut StroboscopicMap::new(it.as_mut(), 1), &guess, &period).unwrap();
     let z0 = orbit.state.clone();
     let o = observe_orbit(&model, integ(), &orbit, 10).unwrap();

@@ -76,16 +76,9 @@ fn orbit_document_carries_the_orbit_and_its_parameters() {
     let mut integ = build(&model, IntegratorOptions::default(), 0.0, &model.rest()).unwrap();
     let s = steady_state(integ.as_mut(), &SteadyOptions::default()).unwrap();
     let mut fresh = build(&model, IntegratorOptions::default(), 0.0, &model.rest()).unwrap();
-    let two = ShootingOptions {
-        period: 2,
-        ..ShootingOptions::default()
-    };
-    let o = shoot(
-        &mut StroboscopicMap::new(fresh.as_mut(), 1),
-        s.end_state(),
-        &two,
-    )
-    .unwrap();
+    let two = ShootingOptions::default().with_period(2);
+    let map = &mut StroboscopicMap::new(fresh.as_mut(), 1);
+    let o = shoot(map, s.end_state(), &two).unwrap();
     let doc = report::orbit(&model, &o);
     assert_eq!(doc["period"], 2);
     assert_eq!(doc["params"]["omega"], 2.8);

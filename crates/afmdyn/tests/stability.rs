@@ -40,10 +40,7 @@ fn attractor(m: &CantileverModel) -> (DVector<f64>, Option<usize>) {
 /// The period-n orbit of `m` by default Newton from `guess`, on a fresh default integrator.
 fn newton(m: &CantileverModel, guess: &DVector<f64>, n: usize) -> PeriodicOrbit {
     let mut it = build(m, IntegratorOptions::default(), 0.0, &m.rest()).unwrap();
-    let opts = ShootingOptions {
-        period: n,
-        ..ShootingOptions::default()
-    };
+    let opts = ShootingOptions::default().with_period(n);
     shoot(&mut StroboscopicMap::new(it.as_mut(), 1), guess, &opts).unwrap()
 }
 

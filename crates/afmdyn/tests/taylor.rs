@@ -89,11 +89,8 @@ fn taylor_orbits_and_monodromy_agree_with_the_adaptive_oracle() {
         let (guess, _) = OrbitRequest::default().start.guess(&m).unwrap();
         let orbit = |kind, tol| {
             let mut it = build(&m, opts(kind, tol), 0.0, &m.rest()).unwrap();
-            shoot(
-                &mut StroboscopicMap::new(it.as_mut(), 1),
-                &guess,
-                &ShootingOptions::default(),
-            )
+            let map = &mut StroboscopicMap::new(it.as_mut(), 1);
+            shoot(map, &guess, &ShootingOptions::default())
         };
         let (Ok(a), Ok(b)) = (
             orbit(IntegratorKind::Taylor, 1e-12),

@@ -35,8 +35,9 @@ fn tapered_window_on_an_orbit_is_the_rectangular_one() {
     assert_eq!(p.common_periods(), 4);
     let model = CantileverModel::new(&p).unwrap();
     let mut it = build(&model, IntegratorOptions::default(), 0.0, &model.rest()).unwrap();
+    let map = &mut StroboscopicMap::new(it.as_mut(), 1);
     let orbit = shoot(
-        &mut StroboscopicMap::new(it.as_mut(), 1),
+        map,
         &nalgebra::DVector::zeros(4),
         &ShootingOptions::default(),
     )
@@ -99,8 +100,9 @@ fn tapered_balance_closes_off_the_period() {
     let probe = Probe::parse(&probe("1.875e6"), "test").unwrap();
     let model = CantileverModel::new(&probe.params).unwrap();
     let mut it = build(&model, IntegratorOptions::default(), 0.0, &model.rest()).unwrap();
+    let map = &mut StroboscopicMap::new(it.as_mut(), 1);
     let orbit = shoot(
-        &mut StroboscopicMap::new(it.as_mut(), 1),
+        map,
         &nalgebra::DVector::zeros(4),
         &ShootingOptions::default(),
     )

@@ -366,11 +366,8 @@ pub(crate) fn polish_steady(
     }
     let guess = steady.end_state().clone();
     let mut integ = build(model, integrator, 0.0, &guess).ok()?;
-    let opts = ShootingOptions {
-        period: n,
-        ..ShootingOptions::default()
-    };
-    let orbit = shoot(&mut StroboscopicMap::new(integ.as_mut(), 1), &guess, &opts).ok()?;
+    let map = &mut StroboscopicMap::new(integ.as_mut(), 1);
+    let orbit = shoot(map, &guess, &ShootingOptions::default().with_period(n)).ok()?;
     // section = [z*, P(z*), …]; z* replaces the last recorded point p_n, P(z*) the first
     let k = steady.poincare.len();
     if k == n {

@@ -254,11 +254,8 @@ pub fn steady_tap_from(
         watch_grazing: false,
         ..opts.shooting
     };
-    let orbit = shoot(
-        &mut StroboscopicMap::new(integ.as_mut(), 1),
-        &guess,
-        &shooting,
-    )?;
+    let map = &mut StroboscopicMap::new(integ.as_mut(), 1);
+    let orbit = shoot(map, &guess, &shooting)?;
     integ.set_variational(false);
     let n = orbit.period;
     integ.reset(0.0, &orbit.state)?;

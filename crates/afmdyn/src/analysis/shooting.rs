@@ -59,6 +59,14 @@ impl Default for ShootingOptions {
     }
 }
 
+impl ShootingOptions {
+    /// These options for a period-`n` orbit.
+    #[must_use]
+    pub fn with_period(self, n: usize) -> Self {
+        ShootingOptions { period: n, ..self }
+    }
+}
+
 /// How [`shoot`] solves for an orbit, and what it forms of the orbit it finds. A *finished*
 /// orbit is refused where it does not close in its region ([`DiscreteMap::closes`]), reduced to
 /// its minimal period (an orbit found as period n may repeat after a divisor of n,

@@ -534,12 +534,8 @@ pub fn steady_state(
             // not the steady state: the transient goes on
             let passage = match found {
                 Some(n) if spent < cap => {
-                    let newton = ShootingOptions {
-                        period: n,
-                        ..settle.newton
-                    };
-                    shoot(&mut StroboscopicMap::new(&mut *integ, 1), &s.state, &newton)
-                        .is_ok_and(|o| !o.stable)
+                    let map = &mut StroboscopicMap::new(&mut *integ, 1);
+                    shoot(map, &s.state, &settle.newton.with_period(n)).is_ok_and(|o| !o.stable)
                 }
                 _ => false,
             };

@@ -176,10 +176,7 @@ fn solve(
     // grazing), or Broyden's, linearised once at the solution: its exact Jacobian (the next
     // point's first Broyden Jacobian), its distance to grazing and its monodromy matrices
     // from one segment
-    let newton = ShootingOptions {
-        period: 1,
-        ..opts.shooting
-    };
+    let newton = opts.shooting.with_period(1);
     let (state, jacobian, residuals, graze) = match jacobian {
         None => {
             let o = shoot(&mut map, guess, &newton)?;

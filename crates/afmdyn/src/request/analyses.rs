@@ -81,10 +81,7 @@ impl OrbitRequest {
         let model = CantileverModel::new(params)?;
         let (guess, found, section) = self.start.guess_with_section(&model)?;
         let n = self.period.or(found).unwrap_or(1);
-        let opts = ShootingOptions {
-            period: n,
-            ..ShootingOptions::default()
-        };
+        let opts = ShootingOptions::default().with_period(n);
         let integ = || build(&model, IntegratorOptions::default(), 0.0, &model.rest());
         let first = integ()
             .and_then(|mut i| shoot(&mut StroboscopicMap::new(i.as_mut(), 1), &guess, &opts));
@@ -521,9 +518,9 @@ impl ObserveRequest {
         let n = found.unwrap_or(1);
         let newton = ShootingOptions {
             tol: 1e-12,
-            period: n,
             ..ShootingOptions::default()
-        };
+        }
+        .with_period(n);
         let orbit = build(&model, IntegratorOptions::default(), 0.0, &model.rest())
             .and_then(|mut i| shoot(&mut StroboscopicMap::new(i.as_mut(), 1), &z, &newton));
         let (state, period) = match orbit {

@@ -52,12 +52,8 @@ pub fn check_point_at(
     }
     // the amplitude of the Fourier integrals is the library's observable
     let mut it = build(&model, IntegratorOptions::default(), 0.0, &model.rest()).expect("build");
-    let shot = shoot(
-        &mut StroboscopicMap::new(it.as_mut(), 1),
-        &exact.state,
-        &newton(),
-    )
-    .expect("orbit");
+    let map = &mut StroboscopicMap::new(it.as_mut(), 1);
+    let shot = shoot(map, &exact.state, &newton()).expect("orbit");
     let opts = IntegratorOptions {
         kind: IntegratorKind::Adaptive,
         tolerance: tol,

@@ -296,15 +296,8 @@ pub fn continue_branch_with(
     spec.base.with(spec.param, spec.from).validate()?;
     spec.base.with(spec.param, spec.to).validate()?;
     let mut solver = Solver::new(spec)?;
-    let opts = ShootingOptions {
-        period: spec.period,
-        ..spec.newton
-    };
-    let orbit = shoot(
-        &mut StroboscopicMap::new(solver.at(spec.from)?, 1),
-        guess,
-        &opts,
-    )?;
+    let map = &mut StroboscopicMap::new(solver.at(spec.from)?, 1);
+    let orbit = shoot(map, guess, &spec.newton.with_period(spec.period))?;
     let dim = orbit.state.len();
     let mut y = DVector::zeros(dim + 1);
     y.rows_mut(0, dim).copy_from(&orbit.state);

@@ -633,11 +633,8 @@ pub fn orbit_sensitivity_component(
     let (state, shot_grazing) = match newton {
         Some(newton) => {
             let mut plain = Adaptive::new(model, tol);
-            let period_1 = ShootingOptions {
-                period: 1,
-                ..*newton
-            };
-            let orbit = shoot(&mut StroboscopicMap::new(&mut plain, 1), guess, &period_1)?;
+            let newton = newton.with_period(1);
+            let orbit = shoot(&mut StroboscopicMap::new(&mut plain, 1), guess, &newton)?;
             (orbit.state, orbit.grazing_distance)
         }
         None => (guess.clone(), f64::INFINITY),

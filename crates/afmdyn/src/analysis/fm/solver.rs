@@ -51,10 +51,7 @@ impl Solver<'_> {
         // square-root singularity) Newton with a line search; at the map's round-off floor a
         // looser tolerance
         let map = &mut StroboscopicMap::new(integ.as_mut(), 1);
-        let newton = ShootingOptions {
-            period: 1,
-            ..self.spec.newton
-        };
+        let newton = self.spec.newton.with_period(1);
         let globalised = ShootingOptions {
             strategy: ShootingStrategy::Globalised,
             ..newton

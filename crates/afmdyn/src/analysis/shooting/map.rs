@@ -11,6 +11,7 @@ use crate::error::SimError;
 use crate::maps::flow::FlowMap;
 use crate::maps::DiscreteMap;
 use nalgebra::{DMatrix, DVector};
+use std::borrow::Cow;
 
 /// A period-n orbit (n = [`ShootingOptions::period`] iterates of the map `dmap`) from `guess`,
 /// a zero of F(z) = Pⁿ(z) − z, solved by [`ShootingOptions::strategy`]. On an integrator, on
@@ -53,15 +54,8 @@ fn solve(
             Ok(orbit(state, None, n, map, residuals, f64::NAN))
         }
         ShootingStrategy::Broyden => {
-            let zero;
-            let m0 = match estimate {
-                Some(m) => m,
-                None => {
-                    zero = DMatrix::zeros(dim, dim);
-                    &zero
-                }
-            };
-            let (state, map, residuals) = broyden(dmap, z, n, opts, m0)?;
+            let m0 = estimate.map_or_else(|| Cow::Owned(DMatrix::zeros(dim, dim)), Cow::Borrowed);
+            let (state, map, residuals) = broyden(dmap, z, n, opts, &m0)?;
             Ok(orbit(state, None, n, map, residuals, f64::NAN))
         }
         ShootingStrategy::BroydenFromZero => {

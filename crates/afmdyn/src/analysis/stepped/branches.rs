@@ -10,7 +10,7 @@ use crate::analysis::continuation::{
     continue_branch_with, Branch, BranchEnd, BranchEvent, ContinuationSpec,
 };
 use crate::analysis::progress::Progress;
-use crate::analysis::shooting::{shoot, ShootingOptions};
+use crate::analysis::shooting::shoot;
 use crate::error::SimError;
 use crate::maps::StroboscopicMap;
 use nalgebra::{Complex, DVector};
@@ -101,15 +101,8 @@ pub(super) fn branch_starts(
         let Ok(mut integ) = integrator_at(spec, at.value, &from.state) else {
             continue;
         };
-        let newton = ShootingOptions {
-            period: n,
-            ..spec.newton
-        };
-        let Ok(o) = shoot(
-            &mut StroboscopicMap::new(integ.as_mut(), 1),
-            &from.state,
-            &newton,
-        ) else {
+        let map = &mut StroboscopicMap::new(integ.as_mut(), 1);
+        let Ok(o) = shoot(map, &from.state, &spec.newton.with_period(n)) else {
             continue;
         };
         if relative_gap(&o.state, &at.state) < 1e-3 {

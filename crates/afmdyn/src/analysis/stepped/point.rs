@@ -138,11 +138,8 @@ pub fn settle(
                 continue;
             };
             let (tau, here) = (integ.tau(), integ.state().clone());
-            let newton = ShootingOptions {
-                period: m,
-                ..spec.newton
-            };
-            if let Ok(o) = shoot(&mut StroboscopicMap::new(integ, 1), &here, &newton) {
+            let map = &mut StroboscopicMap::new(integ, 1);
+            if let Ok(o) = shoot(map, &here, &spec.newton.with_period(m)) {
                 if o.stable {
                     return Ok(Settled {
                         found: Found {
@@ -472,6 +469,7 @@ pub(super) fn orbit_point(
     let n = prev.and_then(|p| p.period).unwrap_or(1);
     let mut integ = build(&model, spec.integrator.clone(), 0.0, &last)?;
     let slope = prediction_slope(history, value);
+    let newton = spec.newton.with_period(n);
     let continued = match prev {
         Some(p) => continue_orbit(
             spec,
@@ -487,17 +485,10 @@ pub(super) fn orbit_point(
             None,
         )?
         .map(|o| (o.state, o.multipliers, o.monodromy)),
-        None => shoot(
-            &mut StroboscopicMap::new(integ.as_mut(), 1),
-            &last,
-            &ShootingOptions {
-                period: n,
-                ..spec.newton
-            },
-        )
-        .ok()
-        .filter(|o| o.stable)
-        .map(|o| (o.state, o.multipliers, o.monodromy)),
+        None => shoot(&mut StroboscopicMap::new(integ.as_mut(), 1), &last, &newton)
+            .ok()
+            .filter(|o| o.stable)
+            .map(|o| (o.state, o.multipliers, o.monodromy)),
     };
     let first = if prev.is_some() {
         Reached::Continued
