@@ -51,7 +51,7 @@ def from_caller(func, caller):
 
 
 orbits = from_caller("analysis::stepped::continue_orbit", "analysis::stepped::sweep")
-orbits += from_caller("analysis::shooting::shoot_with", "analysis::stepped::sweep")
+orbits += from_caller("analysis::shooting::map::shoot", "analysis::stepped::sweep")
 transients = inclusive("analysis::stepped::settle")
 observables = inclusive("analysis::observables::observe")
 branches = inclusive("analysis::continuation::continue_branch_with")

@@ -84,17 +84,15 @@ pub fn run_outcome<'py>(
 /// store: in memory): what `run` returns.
 #[pyfunction]
 #[pyo3(signature = (name, request=None, params=None, probe=None, progress=None, store=None, resume=false))]
-#[allow(clippy::too_many_arguments)]
-pub fn run_stored<'py>(
-    py: Python<'py>,
+pub fn run_stored(
     name: &str,
-    request: Option<&Bound<'py, PyDict>>,
+    request: Option<&Bound<'_, PyDict>>,
     params: Option<PyRef<'_, PyParams>>,
     probe: Option<String>,
-    progress: Option<Bound<'py, PyAny>>,
+    progress: Option<Bound<'_, PyAny>>,
     store: Option<std::path::PathBuf>,
     resume: bool,
-) -> PyResult<Bound<'py, PyDict>> {
+) -> PyResult<Py<PyDict>> {
     let stored = crate::convert::stored(name, request)?;
     let model = resolved(params, probe)?;
     let study = stored.prepare(model).map_err(sim_error)?;
@@ -106,16 +104,20 @@ pub fn run_stored<'py>(
     let lock = store.map(|dir| lock_store(&dir)).transpose()?;
     let job = Job::default();
     let worker = job.clone();
-    let outcome = run_job(
-        py,
-        &job,
-        None,
-        progress.as_ref(),
-        Stop::Cancellable,
-        move || study.run(lock.as_ref(), resume, &worker.progress),
-    )?
-    .map_err(study_error)?;
-    outcome_dict(py, outcome)
+    // the call is attached to the interpreter already: its token from there, not as an
+    // eighth argument
+    Python::attach(|py| {
+        let outcome = run_job(
+            py,
+            &job,
+            None,
+            progress.as_ref(),
+            Stop::Cancellable,
+            move || study.run(lock.as_ref(), resume, &worker.progress),
+        )?
+        .map_err(study_error)?;
+        outcome_dict(py, outcome).map(Bound::unbind)
+    })
 }
 
 /// An [`Outcome`] as `run` returns it.

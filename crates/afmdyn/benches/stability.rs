@@ -5,9 +5,10 @@
 //! Run with `cargo bench -p afmdyn --bench stability`.
 
 use afmdyn::analysis::continuation::{continue_branch, ContinuationSpec};
-use afmdyn::analysis::shooting::{shoot_with, ShootingOptions};
+use afmdyn::analysis::shooting::{shoot, ShootingOptions};
 use afmdyn::analysis::steady::{steady_state, SteadyOptions};
 use afmdyn::integrate::{build, IntegratorOptions};
+use afmdyn::maps::StroboscopicMap;
 use afmdyn::{CantileverModel, Params, SweepParam};
 use criterion::{criterion_group, criterion_main, Criterion};
 use nalgebra::DVector;
@@ -35,7 +36,8 @@ fn shooting(c: &mut Criterion) {
     let opts = IntegratorOptions::default();
     let solve = || {
         let mut it = build(&m, opts.clone(), 0.0, &m.rest()).unwrap();
-        shoot_with(it.as_mut(), &guess, 1, &ShootingOptions::default()).unwrap()
+        let map = &mut StroboscopicMap::new(it.as_mut(), 1);
+        shoot(map, &guess, &ShootingOptions::default()).unwrap()
     };
     let iters = solve().residuals.len();
     println!("shooting: {iters} residual evaluations (Newton iterations + 1)");

@@ -28,12 +28,13 @@
 //! parameters (for `scripts/perf-floor.sh`).
 
 use afmdyn::analysis::continuation::{continue_branch, ContinuationSpec};
-use afmdyn::analysis::shooting::{shoot_with, ShootingOptions};
+use afmdyn::analysis::shooting::{shoot, ShootingOptions};
 use afmdyn::analysis::steady::{steady_state, StatsObserver, SteadyOptions};
 use afmdyn::integrate::exact::{ExactOptions, ExactPropagator, Propagation};
 use afmdyn::integrate::{
     advance, advance_dyn, advance_observed, build, IntegratorOptions, Observed, Observer, Step,
 };
+use afmdyn::maps::StroboscopicMap;
 use afmdyn::{CantileverModel, LawKind, Params, SweepParam};
 use nalgebra::DVector;
 use std::time::Instant;
@@ -124,7 +125,8 @@ fn shooting(modes: usize, reps: usize) -> Result<(), Box<dyn std::error::Error>>
     let opts = IntegratorOptions::default();
     let solve = || {
         let mut it = build(&m, opts.clone(), 0.0, &m.rest())?;
-        shoot_with(it.as_mut(), &guess, 1, &ShootingOptions::default())
+        let map = &mut StroboscopicMap::new(it.as_mut(), 1);
+        shoot(map, &guess, &ShootingOptions::default())
     };
     let iters = solve()?.residuals.len();
     let us = best_of(reps, || {

@@ -14,10 +14,11 @@
 //! repulsive): milliseconds of each solve (the fastest of 3), and the errors.
 
 use afmdyn::analysis::observables::{observe_orbit, Observables};
-use afmdyn::analysis::shooting::{shoot_with, ShootingOptions};
+use afmdyn::analysis::shooting::{shoot, ShootingOptions};
 use afmdyn::analysis::torus::{continue_circle, invariant_circle, observe_circle, CircleOptions};
 use afmdyn::integrate::{build, IntegratorOptions};
 use afmdyn::maps::flow::flow_state;
+use afmdyn::maps::StroboscopicMap;
 use afmdyn::probe::Probe;
 use afmdyn::{CantileverModel, Params};
 use nalgebra::DVector;
@@ -70,13 +71,15 @@ fn main() {
             let before = CantileverModel::new(&params(f2, zc + 0.1)).expect("model");
             let guess = settled(&before, 4000);
             let mut it = build(&before, integ.clone(), 0.0, &guess).expect("build");
-            let start = shoot_with(it.as_mut(), &guess, 1, &ShootingOptions::default())
+            let map = &mut StroboscopicMap::new(it.as_mut(), 1);
+            let start = shoot(map, &guess, &ShootingOptions::default())
                 .expect("orbit before")
                 .state;
             let model = CantileverModel::new(&params(f2, zc)).expect("model");
             let (t_orbit, orbit) = best_of_3(|| {
                 let mut it = build(&model, integ.clone(), 0.0, &start).expect("build");
-                shoot_with(it.as_mut(), &start, 1, &ShootingOptions::default()).expect("orbit")
+                let map = &mut StroboscopicMap::new(it.as_mut(), 1);
+                shoot(map, &start, &ShootingOptions::default()).expect("orbit")
             });
             line.push(format!(
                 "\"orbit_{name}_ms\": {t_orbit:.1}, \"orbit_{name}_periods\": {}",

@@ -254,8 +254,9 @@ fn bad_grids_are_refused_with_the_field_named() {
 fn setpoint_points_are_orbits_with_the_setpoint_amplitude() {
     use afmdyn::analysis::observables::observe_orbit;
     use afmdyn::analysis::setpoint::{setpoint_crossings, Source};
-    use afmdyn::analysis::shooting::{shoot_with, ShootingOptions};
+    use afmdyn::analysis::shooting::{shoot, ShootingOptions};
     use afmdyn::integrate::{build, IntegratorOptions};
+    use afmdyn::maps::StroboscopicMap;
     use afmdyn::{CantileverModel, SweepParam};
     let (spec, c) = curve();
     let ratio = 0.85;
@@ -273,7 +274,8 @@ fn setpoint_points_are_orbits_with_the_setpoint_amplitude() {
         let model = CantileverModel::new(&p).unwrap();
         let integ = IntegratorOptions::default();
         let mut it = build(&model, integ.clone(), 0.0, &z).unwrap();
-        let orbit = shoot_with(it.as_mut(), &z, 1, &ShootingOptions::default()).unwrap();
+        let map = &mut StroboscopicMap::new(it.as_mut(), 1);
+        let orbit = shoot(map, &z, &ShootingOptions::default()).unwrap();
         assert!(orbit.stable);
         let o = observe_orbit(&model, integ, &orbit, 4).unwrap();
         let r = o.amplitude / o.closed_form.free_amplitude;

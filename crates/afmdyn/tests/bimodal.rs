@@ -6,7 +6,8 @@
 
 use afmdyn::analysis::observables::observe_orbit;
 use afmdyn::analysis::shooting::{shoot, ShootingOptions};
-use afmdyn::integrate::{IntegratorKind, IntegratorOptions};
+use afmdyn::integrate::{build, IntegratorKind, IntegratorOptions};
+use afmdyn::maps::StroboscopicMap;
 use afmdyn::probe::Probe;
 use afmdyn::CantileverModel;
 
@@ -34,10 +35,11 @@ fn far_from_the_sample_each_component_is_free() {
     p.alpha5 = p.alpha5_for_rest_distance(1e-6 / probe.scales.length_m);
     assert_eq!(p.common_periods(), 15);
     let model = CantileverModel::new(&p).unwrap();
+    let mut it = build(&model, IntegratorOptions::default(), 0.0, &model.rest()).unwrap();
+    let map = &mut StroboscopicMap::new(it.as_mut(), 1);
     let orbit = shoot(
-        &model,
+        map,
         &nalgebra::DVector::zeros(4),
-        1,
         &ShootingOptions::default(),
     )
     .unwrap();
@@ -96,7 +98,9 @@ frequency = [300e3, 1.875e6]
         )
         .unwrap();
         let start = settled.end_state().clone();
-        let Ok(orbit) = shoot(&model, &start, 1, &ShootingOptions::default()) else {
+        let mut fresh = build(&model, IntegratorOptions::default(), 0.0, &model.rest()).unwrap();
+        let map = &mut StroboscopicMap::new(fresh.as_mut(), 1);
+        let Ok(orbit) = shoot(map, &start, &ShootingOptions::default()) else {
             continue;
         };
         let o = observe_orbit(&model, integ(), &orbit, 3).unwrap();
@@ -324,13 +328,13 @@ fn taylor_agrees_with_dop853_under_a_bimodal_drive() {
         let shoot_with = |kind, tol| {
             let mut it =
                 afmdyn::integrate::build(&model, opts(kind, tol), 0.0, &model.rest()).unwrap();
-            let orbit = afmdyn::analysis::shooting::shoot_with(
-                it.as_mut(),
+            let orbit = shoot(
+                &mut StroboscopicMap::new(it.as_mut(), 1),
                 settled.end_state(),
-                1,
                 &ShootingOptions {
                     tol: 1e-12,
                     max_iter: 20,
+                    ..ShootingOptions::default()
                 },
             )
             .unwrap();

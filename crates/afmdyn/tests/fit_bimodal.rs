@@ -15,7 +15,8 @@ use afmdyn::analysis::observables::observe_orbit;
 use afmdyn::analysis::shooting::shoot;
 use afmdyn::analysis::stepped::Spacing;
 use afmdyn::contact::ContactLaw;
-use afmdyn::integrate::{IntegratorKind, IntegratorOptions};
+use afmdyn::integrate::{build, IntegratorKind, IntegratorOptions};
+use afmdyn::maps::StroboscopicMap;
 use afmdyn::model::CantileverModel;
 use afmdyn::params::DriveComponent;
 use afmdyn::probe::Probe;
@@ -52,7 +53,9 @@ fn check_point(base: &Params, guess: &DVector<f64>, ps: &[OrbitParam], what: &st
     }
     let two = exact.component.clone().expect("the component's harmonic");
     let model = CantileverModel::new(base).expect("model");
-    let shot = shoot(&model, &exact.state, 1, &newton()).expect("orbit");
+    let mut it = build(&model, IntegratorOptions::default(), 0.0, &model.rest()).expect("build");
+    let map = &mut StroboscopicMap::new(it.as_mut(), 1);
+    let shot = shoot(map, &exact.state, &newton()).expect("orbit");
     let opts = IntegratorOptions {
         kind: IntegratorKind::Adaptive,
         tolerance: TOL,

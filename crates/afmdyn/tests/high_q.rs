@@ -250,18 +250,24 @@ fn the_lyapunov_transient_is_derived_by_default() {
 #[test]
 fn a_passage_near_the_saddle_is_not_a_steady_state() {
     use afmdyn::analysis::shooting::{shoot, ShootingOptions};
+    use afmdyn::maps::StroboscopicMap;
     let p = lever(14.3e-9);
     let model = CantileverModel::new(&p).unwrap();
+    let newton = |z| {
+        let mut it = build(&model, IntegratorOptions::default(), 0.0, &model.rest()).unwrap();
+        let map = &mut StroboscopicMap::new(it.as_mut(), 1);
+        shoot(map, z, &ShootingOptions::default()).unwrap()
+    };
     // the saddle, from a state near it (a basin map's third "attractor")
     let near = nalgebra::DVector::from_vec(vec![-0.2178, 0.9493]);
-    let saddle = shoot(&model, &near, 1, &ShootingOptions::default()).unwrap();
+    let saddle = newton(&near);
     assert!(!saddle.stable && saddle.multipliers[0].norm() > 1.0);
     let z0 = &saddle.state + nalgebra::DVector::from_vec(vec![1e-9, 0.0]);
     let mut it = build(&model, IntegratorOptions::default(), 0.0, &z0).unwrap();
     let s = steady_state(it.as_mut(), &SteadyOptions::default()).unwrap();
     assert_eq!(s.period(), Some(1));
     let end = s.end_state().clone();
-    let orbit = shoot(&model, &end, 1, &ShootingOptions::default()).unwrap();
+    let orbit = newton(&end);
     assert!(orbit.stable, "ended on {:?}", orbit.multipliers[0]);
     assert!((&orbit.state - &saddle.state).norm() > 0.05);
 }

@@ -7,7 +7,7 @@
 
 use afmdyn::analysis::continuation::{continue_branch, BranchEnd, ContinuationSpec};
 use afmdyn::analysis::lyapunov::{lyapunov_spectrum, LyapunovOptions};
-use afmdyn::analysis::shooting::{floquet_multipliers, shoot, shoot_with, ShootingOptions};
+use afmdyn::analysis::shooting::{floquet_multipliers, shoot, ShootingOptions};
 use afmdyn::analysis::steady::{steady_state, Motion, SteadyOptions};
 use afmdyn::galerkin::Region;
 use afmdyn::integrate::{advance_dyn, build, IntegratorKind, IntegratorOptions, SwitchEvent};
@@ -92,7 +92,8 @@ fn split_integrator_agrees_with_the_adaptive_oracle() {
                 },
             );
             let mut it = build(&m, o, 0.0, &m.rest()).unwrap();
-            shoot_with(it.as_mut(), &guess, 1, &ShootingOptions::default()).unwrap()
+            let map = &mut StroboscopicMap::new(it.as_mut(), 1);
+            shoot(map, &guess, &ShootingOptions::default()).unwrap()
         };
         let (a, b) = (
             orbit(IntegratorKind::Split),
@@ -195,8 +196,9 @@ fn linear_law_adaptive_reproduces_exact() {
         .unwrap()
         .end_state()
         .clone();
-    let o_ex = shoot_with(ex.as_mut(), &guess, 2, &ShootingOptions::default()).unwrap();
-    let o_ad = shoot_with(ad.as_mut(), &guess, 2, &ShootingOptions::default()).unwrap();
+    let two = ShootingOptions::default().with_period(2);
+    let o_ex = shoot(&mut StroboscopicMap::new(ex.as_mut(), 1), &guess, &two).unwrap();
+    let o_ad = shoot(&mut StroboscopicMap::new(ad.as_mut(), 1), &guess, &two).unwrap();
     assert!((&o_ex.state - &o_ad.state).amax() < 1e-9);
     for (a, b) in o_ex.multipliers.iter().zip(&o_ad.multipliers) {
         assert!((a - b).norm() < 1e-7, "{a} vs {b}");
@@ -334,7 +336,9 @@ fn hertz_and_dmt_orbits_agree_with_an_independent_integrator() {
             ..Params::default()
         };
         let m = CantileverModel::new(&p).unwrap();
-        let o = shoot(&m, &m.rest(), 1, &ShootingOptions::default()).unwrap();
+        let mut it = build(&m, IntegratorOptions::default(), 0.0, &m.rest()).unwrap();
+        let map = &mut StroboscopicMap::new(it.as_mut(), 1);
+        let o = shoot(map, &m.rest(), &ShootingOptions::default()).unwrap();
         let ind = Independent::new(&p);
         let (z, mu) = ind.orbit(&o.state, 1, 40_000);
         let err = (&z - &o.state).amax();
@@ -357,7 +361,8 @@ fn dmt_kelvin_voigt_monodromy_matches_finite_differences() {
         ..Default::default()
     };
     let mut it = build(&m, tight, 0.0, &m.rest()).unwrap();
-    let o = shoot_with(it.as_mut(), &m.rest(), 1, &ShootingOptions::default()).unwrap();
+    let map = &mut StroboscopicMap::new(it.as_mut(), 1);
+    let o = shoot(map, &m.rest(), &ShootingOptions::default()).unwrap();
     let dim = o.state.len();
     let eps = 1e-6;
     let mut fd = DMatrix::zeros(dim, dim);
@@ -558,7 +563,10 @@ fn every_analysis_on_every_law() {
             "{}",
             c.law
         );
-        let o = shoot(&m, ss.end_state(), c.period, &ShootingOptions::default()).unwrap();
+        let mut it = build(&m, IntegratorOptions::default(), 0.0, &m.rest()).unwrap();
+        let period = ShootingOptions::default().with_period(c.period);
+        let map = &mut StroboscopicMap::new(it.as_mut(), 1);
+        let o = shoot(map, ss.end_state(), &period).unwrap();
         assert!(o.stable, "{}", c.law);
         assert!((&o.state - ss.end_state()).amax() < 1e-6, "{}", c.law);
         // multipliers against a central-difference monodromy of the same map
@@ -705,7 +713,9 @@ fn a_branch_ends_when_its_work_budget_is_spent() {
         ..Params::default()
     };
     let m = CantileverModel::new(&p.with(SweepParam::Omega, 5.0)).unwrap();
-    let o = shoot(&m, &m.rest(), 1, &ShootingOptions::default()).unwrap();
+    let mut it = build(&m, IntegratorOptions::default(), 0.0, &m.rest()).unwrap();
+    let map = &mut StroboscopicMap::new(it.as_mut(), 1);
+    let o = shoot(map, &m.rest(), &ShootingOptions::default()).unwrap();
     let mut spec = ContinuationSpec::new(p, SweepParam::Omega, 5.0, 4.9, 1);
     let full = continue_branch(&spec, &o.state).unwrap();
     assert_eq!(full.end, BranchEnd::Range);

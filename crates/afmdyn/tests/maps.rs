@@ -14,8 +14,7 @@
 
 use afmdyn::analysis::settle::minimal_period;
 use afmdyn::analysis::shooting::{
-    map_section_points, shoot_map, shoot_map_broyden, shoot_map_globalised, shoot_map_undamped,
-    shoot_map_unwatched, shoot_map_unwatched_by, shoot_with, ShootingOptions, ShootingStrategy,
+    map_section_points, shoot, Guess, ShootingOptions, ShootingStrategy,
 };
 use afmdyn::galerkin::Region;
 use afmdyn::integrate::{build, IntegratorOptions};
@@ -136,7 +135,7 @@ fn shooting_finds_the_fixed_point_and_multipliers_of_an_affine_map() {
         let want = m.fixed_point();
         let mu = m.eigenvalues();
         let guess = DVector::from_vec(vec![3.0, -2.0, 5.0]);
-        let o = shoot_map(&mut m, &guess, 1, &opts).unwrap();
+        let o = shoot(&mut m, &guess, &opts).unwrap();
         assert!(
             (&o.state - &want).amax() < 1e-12 * (1.0 + want.amax()),
             "r = {r}"
@@ -153,9 +152,14 @@ fn shooting_finds_the_fixed_point_and_multipliers_of_an_affine_map() {
         // as the previous orbit's along a sweep)
         let m0 = &m.a * 1.02;
         let dmap: &mut dyn DiscreteMap = &mut m;
-        let g = shoot_map_globalised(dmap, &guess, 1, &opts).unwrap();
-        let u = shoot_map_undamped(dmap, &guess, 1, &opts).unwrap();
-        let b = shoot_map_broyden(dmap, &guess, 1, &opts, &m0).unwrap();
+        let by = |strategy| ShootingOptions { strategy, ..opts };
+        let g = shoot(dmap, &guess, &by(ShootingStrategy::Globalised)).unwrap();
+        let u = shoot(dmap, &guess, &by(ShootingStrategy::Undamped)).unwrap();
+        let estimated = Guess::Estimated {
+            state: &guess,
+            monodromy: &m0,
+        };
+        let b = shoot(dmap, estimated, &by(ShootingStrategy::Broyden)).unwrap();
         for z in [&g.state, &u.state, &b.state] {
             assert!((z - &want).amax() < 1e-9 * (1.0 + want.amax()), "r = {r}");
         }
@@ -172,14 +176,20 @@ fn shooting_finds_the_fixed_point_and_multipliers_of_an_affine_map() {
 /// Newton's too.
 #[test]
 fn broyden_from_zero_reaches_the_affine_fixed_point_or_falls_back_on_newton() {
-    let opts = ShootingOptions::default();
+    let unwatched = ShootingOptions {
+        watch_grazing: false,
+        ..ShootingOptions::default()
+    };
+    let from_zero = ShootingOptions {
+        strategy: ShootingStrategy::BroydenFromZero,
+        ..unwatched
+    };
     let guess = DVector::from_vec(vec![3.0, -2.0, 5.0]);
     let mut m = affine(0.5, -0.3);
     let want = m.fixed_point();
     let mu = m.eigenvalues();
-    let b = shoot_map_unwatched_by(&mut m, &guess, 1, &opts, ShootingStrategy::BroydenFromZero)
-        .unwrap();
-    let newton = shoot_map_unwatched(&mut m, &guess, 1, &opts).unwrap();
+    let b = shoot(&mut m, &guess, &from_zero).unwrap();
+    let newton = shoot(&mut m, &guess, &unwatched).unwrap();
     assert!((&b.state - &want).amax() < 1e-10 * (1.0 + want.amax()));
     assert_multipliers(&b.multipliers, &mu, 1e-12);
     assert!(b.stable);
@@ -194,9 +204,8 @@ fn broyden_from_zero_reaches_the_affine_fixed_point_or_falls_back_on_newton() {
     );
     for (r, real) in [(0.9, 1.7), (1.2, 0.2)] {
         let mut m = affine(r, real);
-        let b = shoot_map_unwatched_by(&mut m, &guess, 1, &opts, ShootingStrategy::BroydenFromZero)
-            .unwrap();
-        let newton = shoot_map_unwatched(&mut m, &guess, 1, &opts).unwrap();
+        let b = shoot(&mut m, &guess, &from_zero).unwrap();
+        let newton = shoot(&mut m, &guess, &unwatched).unwrap();
         assert!(!b.stable);
         assert_eq!(b.state, newton.state, "r = {r}, {real}");
         assert_eq!(b.residuals, newton.residuals, "r = {r}, {real}");
@@ -206,8 +215,9 @@ fn broyden_from_zero_reaches_the_affine_fixed_point_or_falls_back_on_newton() {
         (1, ShootingStrategy::Newton),
     ] {
         let mut m = affine(0.5, -0.3);
-        let o = shoot_map_unwatched_by(&mut m, &guess, n, &opts, strategy).unwrap();
-        let newton = shoot_map_unwatched(&mut m, &guess, n, &opts).unwrap();
+        let period = unwatched.with_period(n);
+        let o = shoot(&mut m, &guess, &ShootingOptions { strategy, ..period }).unwrap();
+        let newton = shoot(&mut m, &guess, &period).unwrap();
         assert_eq!(o.state, newton.state, "n = {n}, {strategy:?}");
         assert_eq!(o.residuals, newton.residuals, "n = {n}, {strategy:?}");
     }
@@ -221,7 +231,8 @@ fn a_fixed_point_shot_at_period_two_is_reduced_to_period_one() {
     let opts = ShootingOptions::default();
     let mut m = affine(0.5, -0.3);
     let want = m.fixed_point();
-    let o = shoot_map(&mut m, &DVector::zeros(3), 2, &opts).unwrap();
+    let two = ShootingOptions { period: 2, ..opts };
+    let o = shoot(&mut m, &DVector::zeros(3), &two).unwrap();
     assert_eq!(o.period, 1);
     assert!((&o.state - &want).amax() < 1e-12);
     let section = map_section_points(&mut m, &want, 3).unwrap();
@@ -237,7 +248,7 @@ fn a_fixed_point_shot_at_period_two_is_reduced_to_period_one() {
 #[test]
 fn a_guess_of_the_wrong_length_is_refused() {
     let mut m = affine(0.5, -0.3);
-    let e = shoot_map(&mut m, &DVector::zeros(2), 1, &ShootingOptions::default()).unwrap_err();
+    let e = shoot(&mut m, &DVector::zeros(2), &ShootingOptions::default()).unwrap_err();
     assert!(
         matches!(
             e,
@@ -268,13 +279,14 @@ fn stroboscopic_map_of_the_linear_model_has_the_harmonic_orbit() {
     assert_eq!(DiscreteMap::dim(&map), model.dim());
     assert_eq!(DiscreteMap::periods(&map), 1);
     assert_eq!(DiscreteMap::duration(&map), p.period());
-    let o = shoot_map(&mut map, &model.rest(), 1, &ShootingOptions::default()).unwrap();
+    let o = shoot(&mut map, &model.rest(), &ShootingOptions::default()).unwrap();
     assert!((&o.state - &want).amax() < 1e-9 * (1.0 + want.amax()));
     assert_multipliers(&o.multipliers, &mu, 1e-9);
     assert!(o.stable);
     assert_eq!(o.switchings, 0);
-    // the integrator's own entry point is the same solve
-    let again = shoot_with(it.as_mut(), &model.rest(), 1, &ShootingOptions::default()).unwrap();
+    // a second solve on the integrator (a new map over it) is the same, bit for bit
+    let mut map = StroboscopicMap::new(it.as_mut(), 1);
+    let again = shoot(&mut map, &model.rest(), &ShootingOptions::default()).unwrap();
     assert_eq!(again, o);
 }
 

@@ -7,9 +7,10 @@
 use crate::common;
 
 use afmdyn::analysis::observables::{observe_from, observe_orbit, ObservableOptions, Observables};
-use afmdyn::analysis::shooting::{shoot_with, ShootingOptions};
+use afmdyn::analysis::shooting::{shoot, ShootingOptions};
 use afmdyn::analysis::steady::{steady_state, Motion, SteadyOptions};
 use afmdyn::integrate::{advance_dyn, build, IntegratorOptions};
+use afmdyn::maps::StroboscopicMap;
 use afmdyn::report;
 use afmdyn::trajectory::{record, RecordSpec};
 use afmdyn::{CantileverModel, ContactLaw, Params, Region, SimError, Structure};
@@ -54,9 +55,10 @@ fn orbit(model: &CantileverModel, n: usize) -> DVector<f64> {
     let guess = it.state().clone();
     let opts = ShootingOptions {
         tol: 1e-12,
+        period: n,
         ..ShootingOptions::default()
     };
-    let o = shoot_with(it.as_mut(), &guess, n, &opts).unwrap();
+    let o = shoot(&mut StroboscopicMap::new(it.as_mut(), 1), &guess, &opts).unwrap();
     it.reset(0.0, &o.state).unwrap();
     advance_dyn(
         it.as_mut(),
@@ -377,7 +379,8 @@ fn beam_mode_balance(law: ContactLaw) {
         panic!("expected a periodic orbit, got {:?}", s.motion)
     };
     let guess = s.end_state().clone();
-    let orbit = shoot_with(it.as_mut(), &guess, n, &ShootingOptions::default()).unwrap();
+    let period = ShootingOptions::default().with_period(n);
+    let orbit = shoot(&mut StroboscopicMap::new(it.as_mut(), 1), &guess, &period).unwrap();
     let z0 = orbit.state.clone();
     let o = observe_orbit(&model, integ(), &orbit, 10).unwrap();
     assert_eq!(o.periods, n);

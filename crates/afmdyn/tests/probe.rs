@@ -364,8 +364,9 @@ fn examples_resolve() {
 #[test]
 fn beam_n1_matches_point_mass_within_the_base_drive() {
     use afmdyn::analysis::observables::{observe, ObservableOptions};
-    use afmdyn::analysis::shooting::{shoot_with, ShootingOptions};
+    use afmdyn::analysis::shooting::{shoot, ShootingOptions};
     use afmdyn::integrate::{advance_dyn, build, IntegratorKind, IntegratorOptions};
+    use afmdyn::maps::StroboscopicMap;
     let opts = IntegratorOptions {
         kind: IntegratorKind::Adaptive,
         steps_per_period: 1,
@@ -378,10 +379,9 @@ fn beam_n1_matches_point_mass_within_the_base_drive() {
         let mut it = build(&model, opts.clone(), 0.0, &model.rest()).unwrap();
         advance_dyn(it.as_mut(), 3000.0 * model.period(), &mut |_, _, _| Ok(())).unwrap();
         let guess = it.state().clone();
-        let o = shoot_with(
-            it.as_mut(),
+        let o = shoot(
+            &mut StroboscopicMap::new(it.as_mut(), 1),
             &guess,
-            1,
             &ShootingOptions {
                 tol: 1e-11,
                 ..ShootingOptions::default()

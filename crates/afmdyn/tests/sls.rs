@@ -12,6 +12,7 @@ use afmdyn::analysis::shooting::{shoot, ShootingOptions};
 use afmdyn::contact::Zener;
 use afmdyn::galerkin::Region;
 use afmdyn::integrate::{advance, build, IntegratorKind, IntegratorOptions};
+use afmdyn::maps::StroboscopicMap;
 use afmdyn::probe::Probe;
 use afmdyn::trajectory::{record, RecordSpec};
 use afmdyn::{CantileverModel, ContactLaw, Params, SimError};
@@ -149,7 +150,9 @@ fn an_orbit_loses_to_the_dashpot_what_the_tip_loses() {
     let zn = *m.zener().unwrap();
     let mut it = build(&m, IntegratorOptions::default(), 0.0, &m.rest()).unwrap();
     advance(it.as_mut(), 300.0 * m.period()).unwrap();
-    let o = shoot(&m, it.state(), 1, &ShootingOptions::default()).unwrap();
+    let mut fresh = build(&m, IntegratorOptions::default(), 0.0, &m.rest()).unwrap();
+    let map = &mut StroboscopicMap::new(fresh.as_mut(), 1);
+    let o = shoot(map, it.state(), &ShootingOptions::default()).unwrap();
     assert!(o.stable);
     assert_eq!(o.state.len(), 2 * n + 1);
     let mut it = build(&m, IntegratorOptions::default(), 0.0, &o.state).unwrap();

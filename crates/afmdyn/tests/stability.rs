@@ -5,7 +5,9 @@ use afmdyn::analysis::continuation::{
     continue_branch, continue_with_switching, BranchEvent, ContinuationSpec,
 };
 use afmdyn::analysis::lyapunov::{lyapunov_spectrum, zero_one_test, LyapunovOptions, Verdict};
-use afmdyn::analysis::shooting::{shoot, shoot_broyden, Instability, ShootingOptions};
+use afmdyn::analysis::shooting::{
+    shoot, Guess, Instability, PeriodicOrbit, ShootingOptions, ShootingStrategy,
+};
 use afmdyn::analysis::steady::{steady_state, SteadyOptions};
 use afmdyn::galerkin::Region;
 use afmdyn::integrate::exact::ExactPropagator;
@@ -33,6 +35,13 @@ fn attractor(m: &CantileverModel) -> (DVector<f64>, Option<usize>) {
     )
     .unwrap();
     (s.end_state().clone(), s.period())
+}
+
+/// The period-n orbit of `m` by default Newton from `guess`, on a fresh default integrator.
+fn newton(m: &CantileverModel, guess: &DVector<f64>, n: usize) -> PeriodicOrbit {
+    let mut it = build(m, IntegratorOptions::default(), 0.0, &m.rest()).unwrap();
+    let opts = ShootingOptions::default().with_period(n);
+    shoot(&mut StroboscopicMap::new(it.as_mut(), 1), guess, &opts).unwrap()
 }
 
 proptest! {
@@ -109,7 +118,7 @@ fn multipliers_of_a_never_touching_orbit_are_exp_lambda_t() {
         ..Params::default()
     };
     let m = model(p);
-    let o = shoot(&m, &m.rest(), 1, &ShootingOptions::default()).unwrap();
+    let o = newton(&m, &m.rest(), 1);
     assert_eq!(o.switchings, 0);
     let eig = m.dynamics(Region::Free).a.complex_eigenvalues();
     let mut want: Vec<Complex<f64>> = eig.iter().map(|l| (l * p.period()).exp()).collect();
@@ -150,6 +159,8 @@ fn broyden_start(m: &CantileverModel) -> BroydenStart {
         opts: ShootingOptions {
             tol: 1e-11,
             max_iter: 30,
+            strategy: ShootingStrategy::Broyden,
+            ..ShootingOptions::default()
         },
     }
 }
@@ -188,7 +199,11 @@ fn broyden_shooting_from_an_estimated_jacobian_reaches_the_harmonic_orbit() {
             ..IntegratorOptions::default()
         };
         let mut it = build(&m, io, 0.0, &guess).unwrap();
-        let o = shoot_broyden(it.as_mut(), &guess, 1, &opts, &m0).unwrap();
+        let estimated = Guess::Estimated {
+            state: &guess,
+            monodromy: &m0,
+        };
+        let o = shoot(&mut StroboscopicMap::new(it.as_mut(), 1), estimated, &opts).unwrap();
         let err = (&o.state - &want).norm() / (1.0 + want.norm());
         assert!(err < 1e-9, "{kind:?}: orbit off by {err:e}");
         it.reset(0.0, &o.state).unwrap();
@@ -234,13 +249,18 @@ fn broyden_shooting_with_the_taylor_integrator_and_a_refused_estimate() {
         ..IntegratorOptions::default()
     };
     let mut it = build(&m, io, 0.0, &guess).unwrap();
-    let o = shoot_broyden(it.as_mut(), &guess, 1, &opts, &m0).unwrap();
+    let map = &mut StroboscopicMap::new(it.as_mut(), 1);
+    let estimated = |monodromy| Guess::Estimated {
+        state: &guess,
+        monodromy,
+    };
+    let o = shoot(map, estimated(&m0), &opts).unwrap();
     let err = (&o.state - &want).norm() / (1.0 + want.norm());
     assert!(err < 1e-9, "orbit off by {err:e}");
     let dist = (&o.monodromy - &exact).amax() / exact.amax();
     assert!(dist < 1e-9, "monodromy off by {dist:e}");
     let wrong = DMatrix::identity(dim + 2, dim + 2);
-    let e = shoot_broyden(it.as_mut(), &guess, 1, &opts, &wrong).unwrap_err();
+    let e = shoot(map, estimated(&wrong), &opts).unwrap_err();
     assert!(e.to_string().contains("monodromy estimate"), "{e}");
 }
 
@@ -254,7 +274,7 @@ fn shooting_converges_quadratically_to_the_period_two_orbit() {
     assert_eq!(n, Some(2));
     // start away from the orbit so several Newton steps are needed
     let guess = &z + DVector::from_element(6, 2e-3);
-    let o = shoot(&m, &guess, 2, &ShootingOptions::default()).unwrap();
+    let o = newton(&m, &guess, 2);
     let r = &o.residuals;
     assert!(r.len() >= 3, "{r:?}");
     let last = r.last().unwrap();
@@ -284,7 +304,7 @@ fn multipliers_predict_the_decay_of_a_perturbation() {
         ..Params::default()
     });
     let (z, _) = attractor(&m);
-    let o = shoot(&m, &z, 1, &ShootingOptions::default()).unwrap();
+    let o = newton(&m, &z, 1);
     let mu = o.multipliers[0].norm();
     assert!(mu < 1.0);
     // P^k(z* + δ) − z* decays like |μ_max|^k once the faster components have died out
@@ -396,7 +416,7 @@ fn lyapunov_exponent_of_a_periodic_orbit_is_its_floquet_rate() {
     };
     let m = model(p);
     let (z, n) = attractor(&m);
-    let o = shoot(&m, &z, n.unwrap(), &ShootingOptions::default()).unwrap();
+    let o = newton(&m, &z, n.unwrap());
     let want = o.multipliers[0].norm().ln() / (o.period as f64 * p.period());
     let l = lyapunov_spectrum(
         &m,
@@ -440,7 +460,7 @@ fn the_motion_at_omega_2_6_is_chaotic() {
     assert!(l.zero_one > 0.8, "K = {}", l.zero_one);
     assert_eq!(l.verdict, Verdict::Chaotic);
     // and its period-1 orbit exists but is unstable by period doubling
-    let o = shoot(&m, &attractor(&m).0, 1, &ShootingOptions::default()).unwrap();
+    let o = newton(&m, &attractor(&m).0, 1);
     assert!(!o.stable && o.critical == Instability::PeriodDoubling);
 }
 
@@ -474,15 +494,7 @@ fn continuation_locates_the_period_doubling_near_omega_2_91() {
         .find(|b| b.event == Some(BranchEvent::PeriodDoubling))
         .expect("a period doubling");
     // independent check by shooting on either side: stable above, μ < −1 below
-    let side = |omega: f64| {
-        shoot(
-            &model(Params { omega, ..base }),
-            &pd.section[0],
-            1,
-            &ShootingOptions::default(),
-        )
-        .unwrap()
-    };
+    let side = |omega: f64| newton(&model(Params { omega, ..base }), &pd.section[0], 1);
     let above = side(pd.value + 2e-3);
     let below = side(pd.value - 2e-3);
     assert!(above.stable, "stable above {}", pd.value);

@@ -5,9 +5,10 @@
 //! point-mass DMT probe and the beam (N = 3) with the Hertz and DMT laws, DMT with its
 //! Kelvin–Voigt term; the conformance suite of every integrator; its refusals.
 
-use afmdyn::analysis::shooting::{shoot_with, ShootingOptions};
+use afmdyn::analysis::shooting::{shoot, ShootingOptions};
 use afmdyn::galerkin::Region;
 use afmdyn::integrate::{build, IntegratorKind, IntegratorOptions};
+use afmdyn::maps::StroboscopicMap;
 use afmdyn::request::analyses::OrbitRequest;
 use afmdyn::{CantileverModel, ContactLaw, Params};
 
@@ -88,7 +89,8 @@ fn taylor_orbits_and_monodromy_agree_with_the_adaptive_oracle() {
         let (guess, _) = OrbitRequest::default().start.guess(&m).unwrap();
         let orbit = |kind, tol| {
             let mut it = build(&m, opts(kind, tol), 0.0, &m.rest()).unwrap();
-            shoot_with(it.as_mut(), &guess, 1, &ShootingOptions::default())
+            let map = &mut StroboscopicMap::new(it.as_mut(), 1);
+            shoot(map, &guess, &ShootingOptions::default())
         };
         let (Ok(a), Ok(b)) = (
             orbit(IntegratorKind::Taylor, 1e-12),

@@ -8,7 +8,8 @@ use afmdyn::analysis::observables::{observe, observe_tapered, ObservableOptions}
 use afmdyn::analysis::shooting::{shoot, ShootingOptions};
 use afmdyn::analysis::stepped::average::{slowest_beat, AverageOptions};
 use afmdyn::analysis::stepped::{stepped_sweep, Spacing};
-use afmdyn::integrate::{build, IntegratorKind};
+use afmdyn::integrate::{build, IntegratorKind, IntegratorOptions};
+use afmdyn::maps::StroboscopicMap;
 use afmdyn::probe::{rational_ratio, Probe};
 use afmdyn::request::{run, Analysis, ApproachRequest, CurveRequest, Resolved};
 use afmdyn::CantileverModel;
@@ -33,10 +34,11 @@ fn tapered_window_on_an_orbit_is_the_rectangular_one() {
     let p = probe.params;
     assert_eq!(p.common_periods(), 4);
     let model = CantileverModel::new(&p).unwrap();
+    let mut it = build(&model, IntegratorOptions::default(), 0.0, &model.rest()).unwrap();
+    let map = &mut StroboscopicMap::new(it.as_mut(), 1);
     let orbit = shoot(
-        &model,
+        map,
         &nalgebra::DVector::zeros(4),
-        1,
         &ShootingOptions::default(),
     )
     .unwrap();
@@ -97,10 +99,11 @@ fn tapered_window_on_an_orbit_is_the_rectangular_one() {
 fn tapered_balance_closes_off_the_period() {
     let probe = Probe::parse(&probe("1.875e6"), "test").unwrap();
     let model = CantileverModel::new(&probe.params).unwrap();
+    let mut it = build(&model, IntegratorOptions::default(), 0.0, &model.rest()).unwrap();
+    let map = &mut StroboscopicMap::new(it.as_mut(), 1);
     let orbit = shoot(
-        &model,
+        map,
         &nalgebra::DVector::zeros(4),
-        1,
         &ShootingOptions::default(),
     )
     .unwrap();

@@ -13,11 +13,12 @@
 //! has determinant 1), which the Lyapunov exponents obey as λ₁ + λ₂ = −2ζ.
 
 use afmdyn::analysis::lyapunov::{lyapunov_spectrum_with, LyapunovOptions};
-use afmdyn::analysis::shooting::{shoot_with, ShootingOptions};
+use afmdyn::analysis::shooting::{shoot, ShootingOptions};
 use afmdyn::analysis::steady::{steady_state, Motion, SteadyOptions};
 use afmdyn::integrate::adaptive::Adaptive;
 use afmdyn::integrate::rk4::Rk4;
 use afmdyn::integrate::Integrator;
+use afmdyn::maps::StroboscopicMap;
 use afmdyn::system::{Guard, Jump};
 use afmdyn::tip_sample::require_cantilever;
 use afmdyn::{HybridSystem, Region, SimError, TipSampleSystem};
@@ -165,11 +166,13 @@ fn away_from_the_sample_the_steady_state_and_multipliers_are_the_linear_oscillat
         assert!((w - a0).abs() < 1e-7, "{name}: W = {w}");
         if name == "rk4" {
             // RK4 has no step Jacobians: refused, not guessed
-            let err = shoot_with(it.as_mut(), z, 1, &ShootingOptions::default()).unwrap_err();
+            let map = &mut StroboscopicMap::new(it.as_mut(), 1);
+            let err = shoot(map, z, &ShootingOptions::default()).unwrap_err();
             assert!(matches!(err, SimError::Unsupported { .. }), "{err}");
             continue;
         }
-        let orbit = shoot_with(it.as_mut(), z, 1, &ShootingOptions::default()).unwrap();
+        let map = &mut StroboscopicMap::new(it.as_mut(), 1);
+        let orbit = shoot(map, z, &ShootingOptions::default()).unwrap();
         assert!(orbit.stable && orbit.switchings == 0);
         for mu in &orbit.multipliers {
             assert!(
@@ -202,8 +205,8 @@ fn an_orbit_that_touches_the_sample_keeps_liouvilles_volume_law() {
         if name == "rk4" {
             continue;
         }
-        let orbit =
-            shoot_with(it.as_mut(), ss.end_state(), 1, &ShootingOptions::default()).unwrap();
+        let map = &mut StroboscopicMap::new(it.as_mut(), 1);
+        let orbit = shoot(map, ss.end_state(), &ShootingOptions::default()).unwrap();
         assert_eq!(orbit.switchings, 2);
         let det = orbit.monodromy.determinant();
         let want = (-2.0 * sys.zeta * t).exp();

@@ -11,8 +11,9 @@ use afmdyn::analysis::stepped::{stepped_sweep, Spacing};
 use afmdyn::analysis::torus::{
     continue_circle, invariant_circle, observe_circle, CircleOptions, InvariantCircle,
 };
-use afmdyn::integrate::IntegratorKind;
+use afmdyn::integrate::{build, IntegratorKind, IntegratorOptions};
 use afmdyn::maps::flow::flow_state;
+use afmdyn::maps::StroboscopicMap;
 use afmdyn::probe::Probe;
 use afmdyn::{CantileverModel, Params};
 use nalgebra::DVector;
@@ -88,7 +89,9 @@ fn at_a_commensurate_ratio_the_circle_is_the_periodic_orbit() {
     let model = CantileverModel::new(&lever("1.875e6", 0.8)).unwrap();
     assert_eq!(model.params().common_periods(), 4);
     let guess = settled(&model, 400);
-    let orbit = shoot(&model, &guess, 1, &ShootingOptions::default()).unwrap();
+    let mut it = build(&model, IntegratorOptions::default(), 0.0, &model.rest()).unwrap();
+    let map = &mut StroboscopicMap::new(it.as_mut(), 1);
+    let orbit = shoot(map, &guess, &ShootingOptions::default()).unwrap();
     assert!(orbit.stable);
     let circle = invariant_circle(&model, integ(), &guess, &CircleOptions::default()).unwrap();
     assert!(circle.nodes.exact);
@@ -119,7 +122,9 @@ fn at_a_commensurate_ratio_the_circle_is_the_periodic_orbit() {
 fn against_the_orbit(model: &CantileverModel, nodes: usize) -> (f64, f64, InvariantCircle) {
     assert_eq!(model.params().common_periods(), 100);
     let guess = settled(model, 400);
-    let orbit = shoot(model, &guess, 1, &ShootingOptions::default()).unwrap();
+    let mut it = build(model, IntegratorOptions::default(), 0.0, &model.rest()).unwrap();
+    let map = &mut StroboscopicMap::new(it.as_mut(), 1);
+    let orbit = shoot(map, &guess, &ShootingOptions::default()).unwrap();
     assert!(orbit.stable);
     let exact = observe_orbit(model, integ(), &orbit, 2).unwrap();
     let circle = invariant_circle(

@@ -16,6 +16,7 @@ use afmdyn::analysis::shooting::{shoot, ShootingOptions};
 use afmdyn::analysis::stepped::Spacing;
 use afmdyn::contact::{LawGroups, TipSample, TipSampleLaw, LAWS};
 use afmdyn::integrate::{advance, build, IntegratorKind, IntegratorOptions};
+use afmdyn::maps::StroboscopicMap;
 use afmdyn::request::ModelSpec;
 use afmdyn::{CantileverModel, ContactLaw, LawKind, Params};
 use std::path::{Path, PathBuf};
@@ -174,7 +175,9 @@ fn force_partials_and_potential_are_consistent() {
 #[test]
 fn an_orbit_by_shooting() {
     let m = CantileverModel::new(&params()).unwrap();
-    let o = shoot(&m, &m.rest(), 1, &ShootingOptions::default()).unwrap();
+    let mut it = build(&m, IntegratorOptions::default(), 0.0, &m.rest()).unwrap();
+    let map = &mut StroboscopicMap::new(it.as_mut(), 1);
+    let o = shoot(map, &m.rest(), &ShootingOptions::default()).unwrap();
     assert!(o.switchings >= 2, "the orbit touches the sample");
     let opts = IntegratorOptions {
         kind: IntegratorKind::Adaptive,

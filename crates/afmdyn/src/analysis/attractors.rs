@@ -9,11 +9,12 @@ use super::lyapunov::largest_exponent;
 use super::period::close;
 #[cfg(not(feature = "parallel"))]
 use super::sequential::*;
-use super::shooting::{shoot_with, PeriodicOrbit, ShootingOptions};
+use super::shooting::{shoot, PeriodicOrbit, ShootingOptions};
 use super::steady::{steady_state, PoincarePoint, SteadyOptions, SteadyState};
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
 use crate::integrate::{build, IntegratorKind, IntegratorOptions};
+use crate::maps::StroboscopicMap;
 use crate::model::CantileverModel;
 use crate::params::Params;
 use nalgebra::DVector;
@@ -365,7 +366,8 @@ pub(crate) fn polish_steady(
     }
     let guess = steady.end_state().clone();
     let mut integ = build(model, integrator, 0.0, &guess).ok()?;
-    let orbit = shoot_with(integ.as_mut(), &guess, n, &ShootingOptions::default()).ok()?;
+    let map = &mut StroboscopicMap::new(integ.as_mut(), 1);
+    let orbit = shoot(map, &guess, &ShootingOptions::default().with_period(n)).ok()?;
     // section = [z*, P(z*), …]; z* replaces the last recorded point p_n, P(z*) the first
     let k = steady.poincare.len();
     if k == n {

@@ -48,10 +48,11 @@
 use super::observables::{free_response, observe, observe_orbit, ObservableOptions, Observables};
 use super::progress::Progress;
 use super::resonance::mode_resonance;
-use super::shooting::{shoot_globalised, shoot_with, PeriodicOrbit, ShootingOptions};
+use super::shooting::{shoot, PeriodicOrbit, ShootingOptions, ShootingStrategy};
 use crate::contact::{TipSample, TipSampleLaw};
 use crate::error::SimError;
 use crate::integrate::{build, IntegratorOptions};
+use crate::maps::StroboscopicMap;
 use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
 use nalgebra::{Complex, DVector, Matrix2, Vector2};
@@ -106,7 +107,7 @@ pub struct FmSpec {
     pub mode: usize,
     /// Integrator of the orbits and observables.
     pub integrator: IntegratorOptions,
-    /// Newton shooting of the orbit at each (Ω, α2).
+    /// Newton shooting of the (period-1) orbit at each (Ω, α2); globalised where Newton stalls.
     pub newton: ShootingOptions,
     /// Tolerance of the loop conditions (relative amplitude, phase in rad), in (0, 1e-3).
     pub tolerance: f64,
@@ -135,6 +136,7 @@ impl FmSpec {
             newton: ShootingOptions {
                 tol: 1e-12,
                 max_iter: 20,
+                ..ShootingOptions::default()
             },
             tolerance: DEFAULT_LOOP_TOLERANCE,
         }

@@ -13,8 +13,9 @@
 //! periods), found as every steady state of afmdyn is: the transient settled by
 //! [`steady_state`] (with Newton from the transient on slowly decaying levers), then shooting
 //! on the period-n stroboscopic map for the orbit and its Floquet multipliers
-//! ([`ShootingStrategy::BroydenFromZero`] where Broyden's updates pay, [`broyden_pays`], else
-//! Newton; the shooting module's [`shoot_unwatched`]). A period-2 tapping is
+//! ([`ShootingStrategy::BroydenFromZero`] where Broyden's updates pay, [`broyden_pays`], and the
+//! law is not hysteretic, else Newton; unwatched for grazing,
+//! [`ShootingOptions::watch_grazing`]). A period-2 tapping is
 //! reported as period 2 ([`SteadyTap::period`]); double taps show as
 //! [`TapChannels::taps_per_cycle`] > 1. The integrators' steps and switching search follow
 //! the fastest mode of the lever, not the modulation period (their grids and tolerances are
@@ -44,12 +45,13 @@ pub use setpoint::{
 };
 
 use super::observables::{observe, ObservableOptions};
-use super::shooting::{broyden_pays, shoot_unwatched, ShootingOptions, ShootingStrategy};
+use super::shooting::{broyden_pays, shoot, ShootingOptions, ShootingStrategy};
 use super::steady::{steady_state, Motion, SteadyOptions};
 use crate::error::SimError;
 use crate::galerkin::Region;
 use crate::integrate::dense::{sample_dense, SpanSampling, StartSample};
 use crate::integrate::{build, Integrator, IntegratorOptions};
+use crate::maps::StroboscopicMap;
 use crate::model::CantileverModel;
 use nalgebra::{Complex, DVector};
 use serde::Serialize;
@@ -73,7 +75,8 @@ pub struct PeakForceOptions {
     pub fit_band: (f64, f64),
     /// The transient's settling (the default: tolerance 1e-8, cap from the slowest decay).
     pub steady: SteadyOptions,
-    /// Newton's options for the orbit.
+    /// Newton's tolerance and iteration cap for the orbit (its period, strategy and grazing
+    /// watch are the tap's).
     pub shooting: ShootingOptions,
     /// The integrator.
     pub integrator: IntegratorOptions,
@@ -238,13 +241,21 @@ pub(crate) fn steady_tap_from(
     };
     let guess = steady.poincare[0].state.clone();
     // Broyden's updates from M ≈ 0 where the monodromy matrix costs variational equations
-    // step by step: the tap's ringing decays over the cycle, its multipliers are small
-    let strategy = if broyden_pays(opts.integrator.clone(), model) {
-        ShootingStrategy::BroydenFromZero
-    } else {
-        ShootingStrategy::Newton
+    // step by step: the tap's ringing decays over the cycle, its multipliers are small (not
+    // for a hysteretic law, whose orbits are sensitive to the flows' steps)
+    let broyden = broyden_pays(opts.integrator.clone(), model) && !integ.system().is_hysteretic();
+    let shooting = ShootingOptions {
+        period: n,
+        strategy: if broyden {
+            ShootingStrategy::BroydenFromZero
+        } else {
+            ShootingStrategy::Newton
+        },
+        watch_grazing: false,
+        ..opts.shooting
     };
-    let orbit = shoot_unwatched(integ.as_mut(), &guess, n, &opts.shooting, strategy)?;
+    let map = &mut StroboscopicMap::new(integ.as_mut(), 1);
+    let orbit = shoot(map, &guess, &shooting)?;
     integ.set_variational(false);
     let n = orbit.period;
     integ.reset(0.0, &orbit.state)?;

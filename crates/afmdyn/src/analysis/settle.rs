@@ -5,13 +5,13 @@
 //! A lever of quality factor Q takes ~Q ln(1/tol)/π drive periods for its returns to repeat
 //! to the tolerance tol (≈ 2 900 periods at Q = 500, tol = 1e-8). So every
 //! [`SettleOptions::chunk_periods`] periods Newton's method is tried from the current state
-//! (undamped, [`shoot_undamped`]: from a transient far from the orbit the damped iteration's
-//! halvings rarely converge and each costs a flow, and the next attempt starts nearer); a
-//! *stable* orbit it finds is accepted only once the trajectory is seen to go to it — it has
-//! come closer over two further chunks and is within [`SettleOptions::settled`] of it, or has
-//! arrived on it, or (where [`SettleOptions::linear`] allows it) has twice come closer at the
-//! rate |μ₁|^chunk of the orbit's leading Floquet multiplier — so it is the attractor the
-//! motion goes to, not another orbit Newton happened to reach from a state on the way.
+//! (undamped, [`ShootingStrategy::Undamped`]: from a transient far from the orbit the damped
+//! iteration's halvings rarely converge and each costs a flow, and the next attempt starts
+//! nearer); a *stable* orbit it finds is accepted only once the trajectory is seen to go to it
+//! — it has come closer over two further chunks and is within [`SettleOptions::settled`] of it,
+//! or has arrived on it, or (where [`SettleOptions::linear`] allows it) has twice come closer
+//! at the rate |μ₁|^chunk of the orbit's leading Floquet multiplier — so it is the attractor
+//! the motion goes to, not another orbit Newton happened to reach from a state on the way.
 //! (Newton's method for periodic orbits: Seydel, *Practical Bifurcation and Stability
 //! Analysis*, 3rd ed., Springer 2010, §7.3.)
 //!
@@ -23,10 +23,10 @@
 //! stepped sweep, whose transient starts on the previous value's orbit, keeps [`SETTLED`] and
 //! the rate test.
 
-use super::shooting::{shoot_undamped, ShootingOptions};
+use super::shooting::{shoot, ShootingOptions, ShootingStrategy};
 use crate::error::SimError;
 use crate::integrate::{advance, Integrator};
-use crate::maps::DiscreteMap;
+use crate::maps::{DiscreteMap, StroboscopicMap};
 use nalgebra::{Complex, DMatrix, DVector};
 
 /// Chunks of [`SettleOptions::chunk_periods`] during which Newton is retried before the
@@ -49,7 +49,7 @@ pub const CENSUS_SETTLED: f64 = 1e-3;
 /// Options of [`newton_from_transient`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SettleOptions {
-    /// Newton shooting from the transient.
+    /// Newton shooting from the transient (undamped, for each period tried).
     pub newton: ShootingOptions,
     /// Drive periods between Newton attempts (≥ 1).
     pub chunk_periods: usize,
@@ -222,21 +222,25 @@ pub fn newton_from_transient(
             Some(n) => vec![n],
             None => period_guesses(&returns, opts.max_period),
         };
-        candidate =
-            tries
-                .into_iter()
-                .find_map(|n| match shoot_undamped(integ, &x, n, &opts.newton) {
-                    Ok(o) if o.stable => Some(Candidate {
-                        period: n,
-                        distance: (&x - &o.state).norm(),
-                        state: o.state,
-                        multipliers: o.multipliers,
-                        monodromy: o.monodromy,
-                        approaches: 0,
-                        linear: 0,
-                    }),
-                    _ => None,
-                });
+        candidate = tries.into_iter().find_map(|n| {
+            let undamped = ShootingOptions {
+                period: n,
+                strategy: ShootingStrategy::Undamped,
+                ..opts.newton
+            };
+            match shoot(&mut StroboscopicMap::new(integ, 1), &x, &undamped) {
+                Ok(o) if o.stable => Some(Candidate {
+                    period: n,
+                    distance: (&x - &o.state).norm(),
+                    state: o.state,
+                    multipliers: o.multipliers,
+                    monodromy: o.monodromy,
+                    approaches: 0,
+                    linear: 0,
+                }),
+                _ => None,
+            }
+        });
         wait = if candidate.is_some() {
             1.0
         } else {

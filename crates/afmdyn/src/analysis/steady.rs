@@ -2,7 +2,7 @@
 
 use super::period::{detect_period, minimal_divisor, MAX_PERIOD, MERGE_FACTOR};
 use super::settle::{minimal_period, newton_from_transient, SettleOptions, CENSUS_SETTLED};
-use super::shooting::{shoot_with, ShootingOptions};
+use super::shooting::{shoot, ShootingOptions};
 use crate::error::SimError;
 use crate::galerkin::Region;
 use crate::integrate::{advance, advance_observed, Integrator, Observed, Observer, Step};
@@ -500,6 +500,7 @@ pub fn steady_state(
             newton: ShootingOptions {
                 tol: (opts.tol * 1e-2).max(1e-12),
                 max_iter: 6,
+                ..ShootingOptions::default()
             },
             chunk_periods: SETTLE_CHUNK,
             max_period: opts.max_period,
@@ -533,7 +534,8 @@ pub fn steady_state(
             // not the steady state: the transient goes on
             let passage = match found {
                 Some(n) if spent < cap => {
-                    shoot_with(integ, &s.state, n, &settle.newton).is_ok_and(|o| !o.stable)
+                    let map = &mut StroboscopicMap::new(&mut *integ, 1);
+                    shoot(map, &s.state, &settle.newton.with_period(n)).is_ok_and(|o| !o.stable)
                 }
                 _ => false,
             };

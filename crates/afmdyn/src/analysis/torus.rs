@@ -17,7 +17,7 @@
 //! modulus to the power 1/M.
 
 use crate::analysis::observables::{observe_weighted, ObservableOptions, Observables};
-use crate::analysis::shooting::{shoot_map, shoot_map_broyden, ShootingOptions, GRAZING_TOL};
+use crate::analysis::shooting::{shoot, Guess, ShootingOptions, ShootingStrategy, GRAZING_TOL};
 use crate::error::SimError;
 use crate::integrate::{build, IntegratorOptions};
 use crate::maps::circle::{node_count, CircleMap, CircleNodes};
@@ -106,7 +106,7 @@ pub fn rotation(model: &CantileverModel) -> Result<(u64, u64), SimError> {
 }
 
 /// The invariant circle of `model`'s two-frequency drive near `guess` (the state at τ = 0,
-/// `[2N]`): Newton ([`shoot_map`]) on the circle's map of `opts.nodes` nodes
+/// `[2N]`): Newton ([`shoot`]) on the circle's map of `opts.nodes` nodes
 /// ([`node_count`]), its stability and its distance to grazing from the last Newton
 /// linearisation (at the solution).
 ///
@@ -124,7 +124,7 @@ pub fn invariant_circle(
 }
 
 /// The circle of `model` continued from `previous` (the circle at a nearby parameter value,
-/// on as many nodes): Broyden's updates ([`shoot_map_broyden`]) from its state and from its
+/// on as many nodes): Broyden's updates ([`ShootingStrategy::Broyden`]) from its state and from its
 /// map's Jacobian, by flows without the variational equations, and one linearisation at the
 /// solution (its Jacobian, stability and distance to grazing) — a step of an approach curve
 /// at the cost of about one Newton iteration.
@@ -176,13 +176,22 @@ fn solve(
     // grazing), or Broyden's, linearised once at the solution: its exact Jacobian (the next
     // point's first Broyden Jacobian), its distance to grazing and its monodromy matrices
     // from one segment
+    let newton = opts.shooting.with_period(1);
     let (state, jacobian, residuals, graze) = match jacobian {
         None => {
-            let o = shoot_map(&mut map, guess, 1, &opts.shooting)?;
+            let o = shoot(&mut map, guess, &newton)?;
             (o.state, o.monodromy, o.residuals, o.grazing_distance)
         }
         Some(m0) => {
-            let o = shoot_map_broyden(&mut map, guess, 1, &opts.shooting, m0)?;
+            let broyden = ShootingOptions {
+                strategy: ShootingStrategy::Broyden,
+                ..newton
+            };
+            let estimated = Guess::Estimated {
+                state: guess,
+                monodromy: m0,
+            };
+            let o = shoot(&mut map, estimated, &broyden)?;
             let lin = map.linearise(&o.state, 1, true)?;
             (o.state, lin.jacobian, o.residuals, lin.grazing_distance)
         }

@@ -26,7 +26,7 @@
 //! gap theorem), where the interpolation is well conditioned ([`node_count`]).
 //!
 //! [`CircleMap`] is a [`DiscreteMap`] whose fixed points are the circle's x_0: G(x_0) = x_0 +
-//! F(x_0), ∂G = I + ∂F, so the one Newton of [`crate::analysis::shooting::shoot_map`] solves it.
+//! F(x_0), ∂G = I + ∂F, so the one Newton of [`crate::analysis::shooting::shoot`] solves it.
 
 use crate::error::SimError;
 use crate::integrate::Integrator;

@@ -7,7 +7,7 @@
 use crate::error::SimError;
 use crate::galerkin::Region;
 use crate::integrate::exact::matmul_into;
-use crate::integrate::{Integrator, Step};
+use crate::integrate::{Integrator, Step, SwitchEvent};
 use crate::params::SweepParam;
 use crate::roots::extremum;
 use crate::system::{saltation_parts, EventKind};
@@ -82,25 +82,12 @@ pub(crate) fn flow(
     tau0: f64,
     z0: &DVector<f64>,
     tau1: f64,
-    mut param: Option<SweepParam>,
+    param: Option<SweepParam>,
     grazing: bool,
 ) -> Result<FlowMap, SimError> {
     integ.set_variational(true);
     integ.reset(tau0, z0)?;
-    let dim = z0.len();
-    // a start inside a rigid sample is first projected onto it (impact law): its Jacobian
-    let mut jac = match integ.system().start_projection(tau0, z0) {
-        Some((_, p)) => {
-            // the projection's own parameter dependence is not modelled
-            param = None;
-            p
-        }
-        None => DMatrix::identity(dim, dim),
-    };
-    // parameter sensitivity, the step's ∂z/∂p (or ∂z_p/∂p at the open stint's start) and
-    // scratch
-    let mut sens = DVector::zeros(dim);
-    let (mut step_dp, mut tmp) = (DVector::zeros(dim), DVector::zeros(dim));
+    let mut product = Product::start(integ, tau0, z0, param);
     let mut out = FlowMap {
         state: z0.clone(),
         jacobian: DMatrix::zeros(0, 0),
@@ -112,11 +99,6 @@ pub(crate) fn flow(
         param_derivative: None,
     };
     let mut before = z0.clone();
-    // scratch for the step Jacobian and the product (no allocation per step)
-    let mut step_jac = DMatrix::zeros(dim, dim);
-    let mut prod = DMatrix::zeros(dim, dim);
-    // the open stint (region, start time) whose Jacobian is taken at its end
-    let mut stint: Option<(Region, f64)> = None;
     while integ.tau() < tau1 {
         before.copy_from(integ.state());
         let step = integ.step(tau1)?;
@@ -124,48 +106,7 @@ pub(crate) fn flow(
         if len <= 0.0 && step.event.is_none() {
             continue;
         }
-        // a stint in a region with a transition matrix for any duration (affine,
-        // [`crate::integrate::AffineRegions::region_transition_into`]) takes one Jacobian e^{A_r t} at its end
-        // instead of one product per step, and the parameter sensitivity telescopes over it
-        // ([`crate::integrate::AffineRegions::region_particular_param_derivative_into`]: ∂z_p/∂p at its start now)
-        if stint.is_none()
-            && integ
-                .affine()
-                .is_some_and(|a| a.has_region_transition(step.region))
-        {
-            let open = match param {
-                Some(p) => match integ.affine() {
-                    Some(a) => a.region_particular_param_derivative_into(
-                        p,
-                        step.region,
-                        step.tau0,
-                        &mut step_dp,
-                    )?,
-                    None => false,
-                },
-                None => true,
-            };
-            if open {
-                stint = Some((step.region, step.tau0));
-            }
-        }
-        if stint.is_none() {
-            integ.last_step_jacobian_into(&mut step_jac)?;
-            left_mul(&step_jac, &mut jac, &mut prod);
-            if let Some(p) = param {
-                let given = match integ.affine() {
-                    Some(a) => a.last_step_param_derivative_into(p, &mut step_dp)?,
-                    None => false,
-                };
-                if given {
-                    tmp.gemv(1.0, &step_jac, &sens, 0.0);
-                    sens.copy_from(&tmp);
-                    sens += &step_dp;
-                } else {
-                    param = None;
-                }
-            }
-        }
+        product.step(integ, &step)?;
         if step.region == Region::Contact {
             out.contact_time += len;
         }
@@ -173,45 +114,165 @@ pub(crate) fn flow(
             watch_grazing(integ, &step, &before, &mut out.grazing_distance);
         }
         if let Some(e) = &step.event {
-            if let Some((r, t0)) = stint.take() {
-                let t = e.tau - t0;
-                close_stint(integ, r, t, &mut step_jac, &mut jac, &mut prod);
-                if let Some(p) = param {
-                    close_stint_sensitivity(
-                        integ, p, r, e.tau, &step_jac, &mut sens, &step_dp, &mut tmp,
-                    )?;
-                }
-            }
-            // M ← S M and s ← S s + w ∂g/∂p, S = R + w ∇gᵀ applied as a rank-one update
-            let salt = saltation_parts(integ.system(), e.from, e.tau, e.state.as_slice());
-            salt.apply(jac.as_mut_slice());
-            if let Some(p) = param {
-                match integ.system().guard_param_derivative(e.from, p, e.tau) {
-                    Some(dg) => {
-                        salt.apply(sens.as_mut_slice());
-                        sens.axpy(dg, &salt.shift, 1.0);
-                    }
-                    None => param = None,
-                }
-            }
+            product.close_stint(integ, e.tau)?;
+            product.event(integ, e);
             out.switchings += 1;
             if e.to == Region::Contact || e.kind == EventKind::Impact {
                 out.contacts += 1;
             }
         }
     }
-    if let Some((r, t0)) = stint.take() {
-        let tau = integ.tau();
-        close_stint(integ, r, tau - t0, &mut step_jac, &mut jac, &mut prod);
-        if let Some(p) = param {
-            close_stint_sensitivity(integ, p, r, tau, &step_jac, &mut sens, &step_dp, &mut tmp)?;
+    let tau = integ.tau();
+    product.close_stint(integ, tau)?;
+    out.state = integ.state().clone();
+    out.param_derivative = product.param.map(|_| product.sens);
+    out.log_volume = product.jac.clone().lu().determinant().abs().ln();
+    out.jacobian = product.jac;
+    Ok(out)
+}
+
+/// The Jacobian M and the parameter sensitivity s of a flow as [`flow`] multiplies them up step
+/// by step, with their scratch (no allocation per step).
+struct Product {
+    /// M so far.
+    jac: DMatrix<f64>,
+    /// The step Jacobian, or a stint's transition matrix.
+    step_jac: DMatrix<f64>,
+    /// The product's scratch.
+    prod: DMatrix<f64>,
+    /// The parameter of s, `None` once a step or an event does not provide its derivative.
+    param: Option<SweepParam>,
+    /// s so far.
+    sens: DVector<f64>,
+    /// The step's ∂z/∂p, or ∂z_p/∂p at the open stint's start.
+    step_dp: DVector<f64>,
+    /// Scratch of s.
+    tmp: DVector<f64>,
+    /// The open stint (region, start time) whose Jacobian is taken at its end.
+    stint: Option<(Region, f64)>,
+}
+
+impl Product {
+    /// M = I (or the projection's Jacobian of a start inside a rigid sample, whose own
+    /// parameter dependence is not modelled: no s then), s = 0.
+    fn start(
+        integ: &dyn Integrator,
+        tau0: f64,
+        z0: &DVector<f64>,
+        mut param: Option<SweepParam>,
+    ) -> Self {
+        let dim = z0.len();
+        // a start inside a rigid sample is first projected onto it (impact law): its Jacobian
+        let jac = match integ.system().start_projection(tau0, z0) {
+            Some((_, p)) => {
+                // the projection's own parameter dependence is not modelled
+                param = None;
+                p
+            }
+            None => DMatrix::identity(dim, dim),
+        };
+        Product {
+            jac,
+            step_jac: DMatrix::zeros(dim, dim),
+            prod: DMatrix::zeros(dim, dim),
+            param,
+            sens: DVector::zeros(dim),
+            step_dp: DVector::zeros(dim),
+            tmp: DVector::zeros(dim),
+            stint: None,
         }
     }
-    out.state = integ.state().clone();
-    out.param_derivative = param.map(|_| sens);
-    out.log_volume = jac.clone().lu().determinant().abs().ln();
-    out.jacobian = jac;
-    Ok(out)
+
+    /// The step taken: a stint opened in a region with a transition matrix for any duration
+    /// (affine, [`crate::integrate::AffineRegions::region_transition_into`]), which takes one
+    /// Jacobian e^{A_r t} at its end instead of one product per step, and over which the
+    /// parameter sensitivity telescopes
+    /// ([`crate::integrate::AffineRegions::region_particular_param_derivative_into`]: ∂z_p/∂p
+    /// at its start now); else M ← J M and s ← J s + ∂z/∂p of the step.
+    fn step(&mut self, integ: &mut dyn Integrator, step: &Step) -> Result<(), SimError> {
+        if self.stint.is_none()
+            && integ
+                .affine()
+                .is_some_and(|a| a.has_region_transition(step.region))
+        {
+            let open = match self.param {
+                Some(p) => match integ.affine() {
+                    Some(a) => a.region_particular_param_derivative_into(
+                        p,
+                        step.region,
+                        step.tau0,
+                        &mut self.step_dp,
+                    )?,
+                    None => false,
+                },
+                None => true,
+            };
+            if open {
+                self.stint = Some((step.region, step.tau0));
+            }
+        }
+        if self.stint.is_none() {
+            integ.last_step_jacobian_into(&mut self.step_jac)?;
+            left_mul(&self.step_jac, &mut self.jac, &mut self.prod);
+            if let Some(p) = self.param {
+                let given = match integ.affine() {
+                    Some(a) => a.last_step_param_derivative_into(p, &mut self.step_dp)?,
+                    None => false,
+                };
+                if given {
+                    self.tmp.gemv(1.0, &self.step_jac, &self.sens, 0.0);
+                    self.sens.copy_from(&self.tmp);
+                    self.sens += &self.step_dp;
+                } else {
+                    self.param = None;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The open stint, if any, closed at its end `tau`: M ← e^{A_r t} M
+    /// ([`crate::integrate::AffineRegions::region_transition_into`], which
+    /// [`crate::integrate::AffineRegions::has_region_transition`] promised) and
+    /// s ← e^{A_r t}(s − ∂z_p/∂p(τ0)) + ∂z_p/∂p(τ) (see
+    /// [`crate::integrate::AffineRegions::region_particular_param_derivative_into`]).
+    fn close_stint(&mut self, integ: &mut dyn Integrator, tau: f64) -> Result<(), SimError> {
+        let Some((r, t0)) = self.stint.take() else {
+            return Ok(());
+        };
+        let done = integ
+            .affine()
+            .is_some_and(|a| a.region_transition_into(r, tau - t0, &mut self.step_jac));
+        debug_assert!(done, "has_region_transition promised the transition");
+        left_mul(&self.step_jac, &mut self.jac, &mut self.prod);
+        if let Some(p) = self.param {
+            self.sens -= &self.step_dp;
+            self.tmp.gemv(1.0, &self.step_jac, &self.sens, 0.0);
+            let done = match integ.affine() {
+                Some(a) => a.region_particular_param_derivative_into(p, r, tau, &mut self.sens)?,
+                None => false,
+            };
+            debug_assert!(done, "provided at the stint's start");
+            self.sens += &self.tmp;
+        }
+        Ok(())
+    }
+
+    /// M ← S M and s ← S s + w ∂g/∂p at the event `e`, S = R + w ∇gᵀ applied as a rank-one
+    /// update.
+    fn event(&mut self, integ: &dyn Integrator, e: &SwitchEvent) {
+        let salt = saltation_parts(integ.system(), e.from, e.tau, e.state.as_slice());
+        salt.apply(self.jac.as_mut_slice());
+        if let Some(p) = self.param {
+            match integ.system().guard_param_derivative(e.from, p, e.tau) {
+                Some(dg) => {
+                    salt.apply(self.sens.as_mut_slice());
+                    self.sens.axpy(dg, &salt.shift, 1.0);
+                }
+                None => self.param = None,
+            }
+        }
+    }
 }
 
 /// M ← J M: the product rule of the monodromy matrix M = Π S_k Φ_k (Leine & Nijmeijer 2004,
@@ -220,49 +281,6 @@ pub(crate) fn flow(
 fn left_mul(j: &DMatrix<f64>, m: &mut DMatrix<f64>, prod: &mut DMatrix<f64>) {
     matmul_into(j, m, 1.0, prod);
     std::mem::swap(m, prod);
-}
-
-/// M ← e^{A_r t} M for a stint of length t in region r
-/// ([`crate::integrate::AffineRegions::region_transition_into`], which [`crate::integrate::AffineRegions::has_region_transition`]
-/// promised), with `scratch` for the transition matrix.
-fn close_stint(
-    integ: &mut dyn Integrator,
-    r: Region,
-    t: f64,
-    scratch: &mut DMatrix<f64>,
-    m: &mut DMatrix<f64>,
-    prod: &mut DMatrix<f64>,
-) {
-    let done = integ
-        .affine()
-        .is_some_and(|a| a.region_transition_into(r, t, scratch));
-    debug_assert!(done, "has_region_transition promised the transition");
-    left_mul(scratch, m, prod);
-}
-
-/// s ← e^{A_r t}(s − ∂z_p/∂p(τ0)) + ∂z_p/∂p(τ) at the end τ of a stint in region r that
-/// started at τ0 (see [`crate::integrate::AffineRegions::region_particular_param_derivative_into`]): `phi` holds
-/// e^{A_r t} (from [`close_stint`]), `dzp0` ∂z_p/∂p(τ0); `tmp` is scratch.
-#[allow(clippy::too_many_arguments)]
-fn close_stint_sensitivity(
-    integ: &mut dyn Integrator,
-    p: SweepParam,
-    r: Region,
-    tau: f64,
-    phi: &DMatrix<f64>,
-    sens: &mut DVector<f64>,
-    dzp0: &DVector<f64>,
-    tmp: &mut DVector<f64>,
-) -> Result<(), SimError> {
-    *sens -= dzp0;
-    tmp.gemv(1.0, phi, sens, 0.0);
-    let done = match integ.affine() {
-        Some(a) => a.region_particular_param_derivative_into(p, r, tau, sens)?,
-        None => false,
-    };
-    debug_assert!(done, "provided at the stint's start");
-    *sens += &*tmp;
-    Ok(())
 }
 
 /// Lower `nearest` to the distance to grazing within `step` (from `before`, the state at its

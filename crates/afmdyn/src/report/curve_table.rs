@@ -78,18 +78,29 @@ const DFORCE: [&str; 9] = [
     "Power_diss",
 ];
 
-/// One numeric row per sweep point and branch point, in the order of [`columns`].
-#[allow(clippy::too_many_arguments)]
-fn row(
+/// A sweep point or branch point as the table has it: its abscissa `x`, its observables at
+/// the drive frequency `omega`, and its `sweep`, `stable`, `period` and `event` columns.
+struct TablePoint<'a> {
     x: f64,
-    o: &Observables,
+    observables: &'a Observables,
     omega: f64,
-    u: &CurveUnits,
-    code: f64,
+    sweep: f64,
     stable: bool,
     period: Option<usize>,
     event: Option<BranchEvent>,
-) -> Vec<f64> {
+}
+
+/// The numeric row of a point, in the order of [`columns`].
+fn row(point: &TablePoint, u: &CurveUnits) -> Vec<f64> {
+    let TablePoint {
+        x,
+        observables: o,
+        omega,
+        sweep: code,
+        stable,
+        period,
+        event,
+    } = *point;
     let period_s = std::f64::consts::TAU / omega * u.time;
     // the library's values of the observables in u's units (one derivation: curve_row), in
     // the order of this file's columns
@@ -128,31 +139,31 @@ fn rows(c: &SteppedCurve, x: &dyn Fn(f64) -> f64, u: &CurveUnits, base: &Params)
     let mut out = Vec::new();
     for (code, sweep) in [(0.0, &c.first), (1.0, &c.second)] {
         for p in sweep {
-            out.push(row(
-                x(p.value),
-                &p.observables,
-                omega(p.value),
-                u,
-                code,
-                p.stable,
-                p.period,
-                None,
-            ));
+            let point = TablePoint {
+                x: x(p.value),
+                observables: &p.observables,
+                omega: omega(p.value),
+                sweep: code,
+                stable: p.stable,
+                period: p.period,
+                event: None,
+            };
+            out.push(row(&point, u));
         }
     }
     for (k, b) in c.branches.iter().enumerate() {
         for s in b {
             let bp = &s.point;
-            out.push(row(
-                x(bp.value),
-                &s.observables,
-                omega(bp.value),
-                u,
-                2.0 + k as f64,
-                bp.stable,
-                Some(bp.period),
-                bp.event,
-            ));
+            let point = TablePoint {
+                x: x(bp.value),
+                observables: &s.observables,
+                omega: omega(bp.value),
+                sweep: 2.0 + k as f64,
+                stable: bp.stable,
+                period: Some(bp.period),
+                event: bp.event,
+            };
+            out.push(row(&point, u));
         }
     }
     out

@@ -21,12 +21,11 @@ use crate::analysis::lyapunov::{lyapunov_spectrum_with, LyapunovOptions, Lyapuno
 use crate::analysis::observables::{observe_from, ObservableOptions, Observables};
 use crate::analysis::period::MAX_PERIOD;
 use crate::analysis::progress::Progress;
-use crate::analysis::shooting::{
-    shoot, shoot_from_section, shoot_globalised, PeriodicOrbit, ShootingOptions,
-};
+use crate::analysis::shooting::{shoot, Guess, PeriodicOrbit, ShootingOptions, ShootingStrategy};
 use crate::analysis::steady::{default_transient_cap, steady_state, SteadyOptions};
 use crate::error::SimError;
 use crate::integrate::{build, IntegratorKind, IntegratorOptions};
+use crate::maps::StroboscopicMap;
 use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
 use nalgebra::DVector;
@@ -67,10 +66,10 @@ impl OrbitRequest {
     }
 
     /// The orbit of `params`: Newton shooting ([`shoot`]) from the guess; when that fails to
-    /// converge, the globalised Newton ([`shoot_globalised`]: a line search on ½‖F‖²) from the
-    /// guess, then from the closest returns among the section points the steady-state search
-    /// recorded ([`shoot_from_section`]) — so that a chaotic attractor yields an unstable
-    /// periodic orbit embedded in it.
+    /// converge, the globalised Newton ([`ShootingStrategy::Globalised`]: a line search on
+    /// ½‖F‖²) from the guess, then from the closest returns among the section points the
+    /// steady-state search recorded ([`Guess::Section`]) — so that a chaotic attractor yields
+    /// an unstable periodic orbit embedded in it.
     ///
     /// # Errors
     /// As [`Self::validate`], [`StartRequest::guess`] and [`shoot`]; the
@@ -82,14 +81,21 @@ impl OrbitRequest {
         let model = CantileverModel::new(params)?;
         let (guess, found, section) = self.start.guess_with_section(&model)?;
         let n = self.period.or(found).unwrap_or(1);
-        let opts = ShootingOptions::default();
-        let first = shoot(&model, &guess, n, &opts);
+        let opts = ShootingOptions::default().with_period(n);
+        let integ = || build(&model, IntegratorOptions::default(), 0.0, &model.rest());
+        let first = integ()
+            .and_then(|mut i| shoot(&mut StroboscopicMap::new(i.as_mut(), 1), &guess, &opts));
         let r = match first {
             Err(SimError::NoConvergence { .. }) => {
-                let mut integ = build(&model, IntegratorOptions::default(), 0.0, &model.rest())?;
-                match shoot_globalised(integ.as_mut(), &guess, n, &opts) {
+                let mut integ = integ()?;
+                let map = &mut StroboscopicMap::new(integ.as_mut(), 1);
+                let globalised = ShootingOptions {
+                    strategy: ShootingStrategy::Globalised,
+                    ..opts
+                };
+                match shoot(map, &guess, &globalised) {
                     Err(SimError::NoConvergence { .. }) if section.len() > n => {
-                        shoot_from_section(integ.as_mut(), &section, n, &opts)
+                        shoot(map, Guess::Section(&section), &globalised)
                     }
                     r => r,
                 }
@@ -513,8 +519,11 @@ impl ObserveRequest {
         let newton = ShootingOptions {
             tol: 1e-12,
             ..ShootingOptions::default()
-        };
-        let (state, period) = match shoot(&model, &z, n, &newton) {
+        }
+        .with_period(n);
+        let orbit = build(&model, IntegratorOptions::default(), 0.0, &model.rest())
+            .and_then(|mut i| shoot(&mut StroboscopicMap::new(i.as_mut(), 1), &z, &newton));
+        let (state, period) = match orbit {
             Ok(o) => (o.state, Some(n)),
             Err(_) => (z, found),
         };

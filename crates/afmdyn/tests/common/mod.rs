@@ -290,7 +290,9 @@ pub fn hysteretic_tap(m: &CantileverModel, e: f64) -> DVector<f64> {
     };
     let mut it = build(m, IntegratorOptions::default(), 0.0, &m.rest()).unwrap();
     let warm = afmdyn::trajectory::record(it.as_mut(), &spec(300.0, 0.0, false)).unwrap();
-    let o = shoot(m, &warm.final_state, 1, &ShootingOptions::default()).unwrap();
+    let mut fresh = build(m, IntegratorOptions::default(), 0.0, &m.rest()).unwrap();
+    let map = &mut afmdyn::maps::StroboscopicMap::new(fresh.as_mut(), 1);
+    let o = shoot(map, &warm.final_state, &ShootingOptions::default()).unwrap();
     assert!(o.stable);
     let mut it = build(m, IntegratorOptions::default(), 0.0, &o.state).unwrap();
     let obs = observe(it.as_mut(), &ObservableOptions::default()).unwrap();

@@ -9,7 +9,8 @@ use afmdyn::analysis::fit::sensitivity::{orbit_sensitivity, OrbitParam, OrbitSen
 use afmdyn::analysis::observables::observe_orbit;
 use afmdyn::analysis::shooting::shoot;
 use afmdyn::analysis::stepped::{CurvePoint, Spacing};
-use afmdyn::integrate::{IntegratorKind, IntegratorOptions};
+use afmdyn::integrate::{build, IntegratorKind, IntegratorOptions};
+use afmdyn::maps::StroboscopicMap;
 use afmdyn::model::CantileverModel;
 use afmdyn::Params;
 use nalgebra::DVector;
@@ -51,7 +52,9 @@ pub fn check_point_at(
         return false;
     }
     // the amplitude of the Fourier integrals is the library's observable
-    let shot = shoot(&model, &exact.state, 1, &newton()).expect("orbit");
+    let mut it = build(&model, IntegratorOptions::default(), 0.0, &model.rest()).expect("build");
+    let map = &mut StroboscopicMap::new(it.as_mut(), 1);
+    let shot = shoot(map, &exact.state, &newton()).expect("orbit");
     let opts = IntegratorOptions {
         kind: IntegratorKind::Adaptive,
         tolerance: tol,

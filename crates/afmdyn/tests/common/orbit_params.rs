@@ -22,6 +22,7 @@ pub fn newton() -> ShootingOptions {
     ShootingOptions {
         tol: 1e-12,
         max_iter: 40,
+        ..ShootingOptions::default()
     }
 }
 

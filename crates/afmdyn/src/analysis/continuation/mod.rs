@@ -15,7 +15,7 @@
 
 use crate::analysis::progress::Progress;
 use crate::analysis::shooting::{
-    floquet_stability, section_points, shoot_with, Instability, ShootingOptions,
+    floquet_stability, section_points, shoot, Instability, ShootingOptions,
 };
 use crate::error::SimError;
 use crate::integrate::{build, Integrator, IntegratorOptions};
@@ -63,7 +63,7 @@ pub struct ContinuationSpec {
     /// flows (corrector, ∂F/∂p, event location); the exact propagator's steps are not counted.
     /// The branch ends with [`BranchEnd::Budget`] once it is spent.
     pub max_work: u64,
-    /// Newton options (also for the corrector).
+    /// Newton options (also for the corrector); the orbit's period is [`Self::period`].
     pub newton: ShootingOptions,
     /// Integrator of the stroboscopic map (default: auto, exact for the linear law).
     pub integrator: IntegratorOptions,
@@ -296,7 +296,11 @@ pub fn continue_branch_with(
     spec.base.with(spec.param, spec.from).validate()?;
     spec.base.with(spec.param, spec.to).validate()?;
     let mut solver = Solver::new(spec)?;
-    let orbit = shoot_with(solver.at(spec.from)?, guess, spec.period, &spec.newton)?;
+    let orbit = shoot(
+        &mut StroboscopicMap::new(solver.at(spec.from)?, 1),
+        guess,
+        &spec.newton.with_period(spec.period),
+    )?;
     let (mut y, mut t, map) = start(&mut solver, &orbit.state)?;
     let dim = orbit.state.len();
     let (lo, hi) = spec

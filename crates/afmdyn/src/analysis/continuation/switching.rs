@@ -4,7 +4,7 @@
 
 use super::{continue_branch_with, Branch, BranchEvent, BranchPoint, ContinuationSpec};
 use crate::analysis::progress::Progress;
-use crate::analysis::shooting::shoot_with;
+use crate::analysis::shooting::shoot;
 use crate::error::SimError;
 use crate::integrate::build;
 use crate::maps::StroboscopicMap;
@@ -66,7 +66,8 @@ pub fn period_doubling_starts(
             };
             for sign_v in [1.0, -1.0] {
                 let guess = &z + &v * (sign_v * eps);
-                let Ok(o) = shoot_with(integ.as_mut(), &guess, 2 * pd.period, &spec.newton) else {
+                let map = &mut StroboscopicMap::new(integ.as_mut(), 1);
+                let Ok(o) = shoot(map, &guess, &spec.newton.with_period(2 * pd.period)) else {
                     continue;
                 };
                 let Ok(half) = StroboscopicMap::new(integ.as_mut(), pd.period).apply(&o.state)

@@ -11,7 +11,7 @@ use super::least_squares::{
     evaluate_in, minimize_cancellable, CurveModel, Minimum, Observations, Parameter, PATIENCE,
     TOLERANCE,
 };
-use super::profile::{profile, Profile, ProfileEnd, ProfileWalk, DELTA_CHI2_95};
+use super::profile::{profile, Fitted, Profile, ProfileEnd, ProfileWalk, DELTA_CHI2_95};
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
 use nalgebra::DMatrix;
@@ -186,9 +186,17 @@ pub fn fit_cancellable(
             0.1 * p.scale
         };
         let prof = match profiles {
-            Some(walk) if chosen[k] && dof > 0 && s2 > 0.0 => Some(profile(
-                model, obs, params, &best, fixed, j, step, s2, walk, progress,
-            )?),
+            Some(walk) if chosen[k] && dof > 0 && s2 > 0.0 => {
+                let fit = Fitted {
+                    model,
+                    obs,
+                    params,
+                    best: &best,
+                    fixed,
+                    s2,
+                };
+                Some(profile(&fit, j, step, walk, progress)?)
+            }
             _ => None,
         };
         let interval = prof

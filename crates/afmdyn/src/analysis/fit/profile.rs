@@ -117,36 +117,43 @@ pub struct Profile {
     pub unconverged: usize,
 }
 
-/// The profile of parameter `j` about `best`, the parameters `fixed` in the fit held there
-/// too, walked as `walk` says from steps of `step` (its standard error, or a fraction of its
-/// scale where that is not finite), each refit starting from the neighbouring point's values;
-/// `s2` scales χ² (the noise variance, 1 with σ given). Every refit's evaluations are counted
-/// in `progress` and check its cancel flag.
+/// A least-squares fit at its minimum, as a profile walks about it: the model, the
+/// observations and the parameters, the minimum `best`, the parameters `fixed` in the fit, and
+/// `s2`, which scales χ² (the noise variance, 1 with σ given).
+pub struct Fitted<'a> {
+    /// The model fitted.
+    pub model: &'a dyn CurveModel,
+    /// The observations.
+    pub obs: &'a Observations<'a>,
+    /// The parameters, in the fit's order.
+    pub params: &'a [Parameter],
+    /// The minimum.
+    pub best: &'a Minimum,
+    /// The parameters held fixed in the fit (`Some`: their values).
+    pub fixed: &'a [Option<f64>],
+    /// The scale of χ².
+    pub s2: f64,
+}
+
+/// The profile of parameter `j` of `fit` about its minimum, the parameters fixed in the fit
+/// held there too, walked as `walk` says from steps of `step` (its standard error, or a
+/// fraction of its scale where that is not finite), each refit starting from the neighbouring
+/// point's values. Every refit's evaluations are counted in `progress` and check its cancel
+/// flag.
 ///
 /// # Errors
 /// [`SimError::Cancelled`] when `progress` is cancelled.
-#[allow(clippy::too_many_arguments)]
 pub fn profile(
-    model: &dyn CurveModel,
-    obs: &Observations,
-    params: &[Parameter],
-    best: &Minimum,
-    fixed: &[Option<f64>],
+    fit: &Fitted,
     j: usize,
     step: f64,
-    s2: f64,
     walk: ProfileWalk,
     progress: &Progress,
 ) -> Result<Profile, SimError> {
-    let centre = best.values[j];
+    let centre = fit.best.values[j];
     let mut walker = Walker {
-        model,
-        obs,
-        params,
-        best,
-        fixed,
+        fit,
         j,
-        s2,
         progress,
         points: vec![(centre, 0.0)],
         refits: 0,
@@ -183,13 +190,8 @@ pub fn profile(
 
 /// The state of one profile's walk: the fit, the points walked, the refits made.
 struct Walker<'a> {
-    model: &'a dyn CurveModel,
-    obs: &'a Observations<'a>,
-    params: &'a [Parameter],
-    best: &'a Minimum,
-    fixed: &'a [Option<f64>],
+    fit: &'a Fitted<'a>,
     j: usize,
-    s2: f64,
     progress: &'a Progress,
     points: Vec<(f64, f64)>,
     refits: usize,
@@ -202,12 +204,12 @@ impl Walker<'_> {
     /// Δχ² with parameter j held at `x`, the others refitted from `from`, and the refit's
     /// values; the point recorded (a finite Δχ² only).
     fn delta_at(&mut self, x: f64, from: &[f64]) -> Result<(f64, Vec<f64>), SimError> {
-        let mut held = self.fixed.to_vec();
+        let mut held = self.fit.fixed.to_vec();
         held[self.j] = Some(x);
         let m = minimize_cancellable(
-            self.model,
-            self.obs,
-            self.params,
+            self.fit.model,
+            self.fit.obs,
+            self.fit.params,
             from,
             &held,
             (REFIT_TOLERANCE, REFIT_PATIENCE),
@@ -216,7 +218,7 @@ impl Walker<'_> {
         self.refits += 1;
         self.unconverged += usize::from(!m.converged);
         self.evaluations += m.evaluations;
-        let d = (m.chi2 - self.best.chi2) / self.s2;
+        let d = (m.chi2 - self.fit.best.chi2) / self.fit.s2;
         if d.is_finite() {
             self.points.push((x, d));
             self.lowest = self.lowest.min(d);
@@ -226,7 +228,7 @@ impl Walker<'_> {
 
     /// The parameter's bound on the side `sign` (−1 lower, +1 upper).
     fn bound(&self, sign: f64) -> f64 {
-        let p = &self.params[self.j];
+        let p = &self.fit.params[self.j];
         if sign < 0.0 {
             p.lower
         } else {
@@ -236,9 +238,9 @@ impl Walker<'_> {
 
     /// The grid walk of one side ([`ProfileWalk::Grid`]).
     fn grid(&mut self, sign: f64, step: f64) -> Result<ProfileEnd, SimError> {
-        let centre = self.best.values[self.j];
+        let centre = self.fit.best.values[self.j];
         let bound = self.bound(sign);
-        let (mut prev_x, mut prev_d, mut prev_v) = (centre, 0.0, self.best.values.clone());
+        let (mut prev_x, mut prev_d, mut prev_v) = (centre, 0.0, self.fit.best.values.clone());
         let mut distance = 0.0;
         for i in 1..=MAX_PROFILE_STEPS {
             distance = if i <= 8 {
@@ -284,12 +286,12 @@ impl Walker<'_> {
     /// The secant walk of one side ([`ProfileWalk::Secant`]), in the distance δ ≥ 0 from the
     /// estimate and r = √max(Δχ², 0).
     fn secant(&mut self, sign: f64, step: f64, max_steps: usize) -> Result<ProfileEnd, SimError> {
-        let centre = self.best.values[self.j];
+        let centre = self.fit.best.values[self.j];
         let bound = self.bound(sign);
         let target = DELTA_CHI2_95.sqrt();
         // the farthest point below the threshold (δ, r, values), the one before it, and the
         // nearest above
-        let mut below = (0.0, 0.0, self.best.values.clone());
+        let mut below = (0.0, 0.0, self.fit.best.values.clone());
         let mut before = (0.0, 0.0);
         let mut above: Option<(f64, f64, Vec<f64>)> = None;
         let mut delta = step;
@@ -448,19 +450,15 @@ mod tests {
             max_steps: MAX_SECANT_STEPS,
         };
         for (j, se) in se.into_iter().enumerate() {
-            let pr = profile(
-                &model,
-                &obs,
-                &params,
-                &best,
-                &[None, None],
-                j,
-                se,
-                1.0,
-                walk,
-                &progress,
-            )
-            .unwrap();
+            let fit = Fitted {
+                model: &model,
+                obs: &obs,
+                params: &params,
+                best: &best,
+                fixed: &[None, None],
+                s2: 1.0,
+            };
+            let pr = profile(&fit, j, se, walk, &progress).unwrap();
             let c = best.values[j];
             for (end, wald) in [(pr.lower, c - Z_95 * se), (pr.upper, c + Z_95 * se)] {
                 assert!(matches!(end, ProfileEnd::Crossing(_)), "{end:?}");
@@ -515,19 +513,15 @@ mod tests {
             ),
             (ProfileWalk::Grid, 0.01),
         ] {
-            let pr = profile(
-                &model,
-                &obs,
-                &params,
-                &best,
-                &[None],
-                0,
-                se,
-                1.0,
-                walk,
-                &progress,
-            )
-            .unwrap();
+            let fit = Fitted {
+                model: &model,
+                obs: &obs,
+                params: &params,
+                best: &best,
+                fixed: &[None],
+                s2: 1.0,
+            };
+            let pr = profile(&fit, 0, se, walk, &progress).unwrap();
             for (end, c) in [pr.lower, pr.upper].into_iter().zip(closed) {
                 let d = delta(end.value());
                 assert!(
@@ -552,19 +546,16 @@ mod tests {
         // p[1] is not used by f = p₀² x
         let params = [param("p", 1.0), param("q", 0.0)];
         let best = minimize(&model, &obs, &params, &[1.0, 0.0], &[None, None]);
-        let pr = profile(
-            &model,
-            &obs,
-            &params,
-            &best,
-            &[None, None],
-            1,
-            1.0,
-            1.0,
-            ProfileWalk::Secant { max_steps: 6 },
-            &Progress::new(),
-        )
-        .unwrap();
+        let fit = Fitted {
+            model: &model,
+            obs: &obs,
+            params: &params,
+            best: &best,
+            fixed: &[None, None],
+            s2: 1.0,
+        };
+        let walk = ProfileWalk::Secant { max_steps: 6 };
+        let pr = profile(&fit, 1, 1.0, walk, &Progress::new()).unwrap();
         let c = best.values[1];
         assert_eq!(
             (pr.lower, pr.upper),

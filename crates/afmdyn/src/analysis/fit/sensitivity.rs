@@ -94,11 +94,12 @@
 //! |δ_b| − V_T moves with α4 and P̃, and its force jumps where the contact forms and breaks, so
 //! the saltation is not the identity there ([`super::sensitivity_jkr`] for the derivatives).
 
-use crate::analysis::shooting::{shoot_with, ShootingOptions, GRAZING_TOL};
+use crate::analysis::shooting::{shoot, ShootingOptions, GRAZING_TOL};
 use crate::contact::{ContactLaw, DmtLaw, HertzLaw, Law, TipSample, TipSampleLaw};
 use crate::error::SimError;
 use crate::integrate::adaptive::Adaptive;
 use crate::maps::flow::flow_with_jacobian;
+use crate::maps::StroboscopicMap;
 use crate::model::{CantileverModel, DampingDerivative, ForcingDerivative};
 use crate::params::{Params, SweepParam};
 use crate::system::{Guard, HybridSystem, Jump, Region};
@@ -587,7 +588,8 @@ pub fn orbit_sensitivity_component(
     let (state, shot_grazing) = match newton {
         Some(newton) => {
             let mut plain = Adaptive::new(model, tol);
-            let orbit = shoot_with(&mut plain, guess, 1, newton)?;
+            let newton = newton.with_period(1);
+            let orbit = shoot(&mut StroboscopicMap::new(&mut plain, 1), guess, &newton)?;
             (orbit.state, orbit.grazing_distance)
         }
         None => (guess.clone(), f64::INFINITY),

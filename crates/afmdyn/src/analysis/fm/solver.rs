@@ -50,21 +50,23 @@ impl Solver<'_> {
         // Newton's full steps; where they stall (near a grazing orbit, whose map has a
         // square-root singularity) Newton with a line search; at the map's round-off floor a
         // looser tolerance
-        let orbit = match shoot_with(integ.as_mut(), guess, 1, &self.spec.newton) {
-            Err(SimError::NoConvergence { .. }) => {
-                match shoot_globalised(integ.as_mut(), guess, 1, &self.spec.newton) {
-                    Err(SimError::NoConvergence { residual, .. })
-                        if residual <= ROUND_OFF_LIMIT =>
-                    {
-                        let looser = ShootingOptions {
-                            tol: ROUND_OFF_RETRY * residual,
-                            ..self.spec.newton
-                        };
-                        shoot_globalised(integ.as_mut(), guess, 1, &looser)?
-                    }
-                    r => r?,
+        let map = &mut StroboscopicMap::new(integ.as_mut(), 1);
+        let newton = self.spec.newton.with_period(1);
+        let globalised = ShootingOptions {
+            strategy: ShootingStrategy::Globalised,
+            ..newton
+        };
+        let orbit = match shoot(map, guess, &newton) {
+            Err(SimError::NoConvergence { .. }) => match shoot(map, guess, &globalised) {
+                Err(SimError::NoConvergence { residual, .. }) if residual <= ROUND_OFF_LIMIT => {
+                    let looser = ShootingOptions {
+                        tol: ROUND_OFF_RETRY * residual,
+                        ..globalised
+                    };
+                    shoot(map, guess, &looser)?
                 }
-            }
+                r => r?,
+            },
             r => r?,
         };
         let fixed_point = orbit.residuals.last().copied().unwrap_or(0.0);

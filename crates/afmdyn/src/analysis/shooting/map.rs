@@ -1,163 +1,101 @@
-//! Newton shooting on any [`DiscreteMap`]: the period-n orbits (n iterates of the map) that
-//! [`super`]'s functions find on the stroboscopic map of an integrator, written against the
-//! trait so that every map runs through the same code (`tests/maps.rs`: an affine map with a
-//! closed-form fixed point, and the stroboscopic map of the paper's linear model).
+//! Shooting on any [`DiscreteMap`]: the period-n orbits (n iterates of the map) that
+//! [`shoot`] finds, on the stroboscopic map of an integrator as on any other, written against
+//! the trait so that every map runs through the same code (`tests/maps.rs`: an affine map with
+//! a closed-form fixed point, and the stroboscopic map of the paper's linear model).
 
 use super::{
-    floquet_stability, proper_period, PeriodicOrbit, ShootingOptions, ShootingStrategy, ShotOrbit,
+    floquet_stability, proper_period, Guess, PeriodicOrbit, ShootingOptions, ShootingStrategy,
     GRAZING_TOL, LINE_SEARCH_MIN_STEP, SECTION_STARTS, VARIATIONAL_SLACK,
 };
 use crate::error::SimError;
 use crate::maps::flow::FlowMap;
 use crate::maps::DiscreteMap;
 use nalgebra::{DMatrix, DVector};
+use std::borrow::Cow;
 
-/// Newton iteration for F(z) = Pⁿ(z) − z from `guess` on the map `dmap` (n iterates of it: a
-/// period-n orbit of the map), damped by halving a step that does not lower ‖F‖.
+/// A period-n orbit (n = [`ShootingOptions::period`] iterates of the map `dmap`) from `guess`,
+/// a zero of F(z) = Pⁿ(z) − z, solved by [`ShootingOptions::strategy`]. On an integrator, on
+/// its period-1 [`StroboscopicMap`]: `shoot(&mut StroboscopicMap::new(integ, 1), guess, opts)`.
 ///
 /// # Errors
-/// [`SimError::NoConvergence`] when Newton fails; [`SimError`] from the map.
-pub fn shoot_map(
+/// [`SimError::NoConvergence`] when the solve fails (as the strategy says), or after
+/// `opts.max_iter` iterations; [`SimError::OutOfRange`] for n = 0 and as [`Guess`] says;
+/// [`SimError::Cancelled`] and [`SimError`] from the map.
+///
+/// [`StroboscopicMap`]: crate::maps::StroboscopicMap
+pub fn shoot<'a>(
     dmap: &mut dyn DiscreteMap,
-    guess: &DVector<f64>,
-    n: usize,
+    guess: impl Into<Guess<'a>>,
     opts: &ShootingOptions,
 ) -> Result<PeriodicOrbit, SimError> {
-    shoot_damped(dmap, guess, n, opts, Watch::Grazing)
+    match guess.into() {
+        Guess::State(z) => solve(dmap, z, None, opts),
+        Guess::Estimated { state, monodromy } => solve(dmap, state, Some(monodromy), opts),
+        Guess::Section(section) => from_section(dmap, section, opts),
+    }
 }
 
-/// [`shoot_map`] without the distance to grazing: the same iterates, orbit, section points and
-/// multipliers, but no flow to measure [`PeriodicOrbit::grazing_distance`] (NaN, and
-/// [`PeriodicOrbit::grazing`] `false`), for a caller that does not report it — the steady tap
-/// of [`crate::analysis::peakforce`], where that flow (with the variational equations, as
-/// [`DiscreteMap::grazing_distance`] takes it) was a fifth of the N = 3 beam's tap.
-///
-/// # Errors
-/// As [`shoot_map`].
-pub fn shoot_map_unwatched(
+/// [`shoot`] from the state `z`, with `estimate` of the monodromy matrix for Broyden's first
+/// Jacobian.
+fn solve(
     dmap: &mut dyn DiscreteMap,
-    guess: &DVector<f64>,
-    n: usize,
+    z: &DVector<f64>,
+    estimate: Option<&DMatrix<f64>>,
     opts: &ShootingOptions,
 ) -> Result<PeriodicOrbit, SimError> {
-    shoot_damped(dmap, guess, n, opts, Watch::None)
-}
-
-/// [`shoot_map_unwatched`] by `strategy` ([`ShootingStrategy`]). With
-/// [`ShootingStrategy::BroydenFromZero`] a period-1 orbit (n = 1) is first sought by Broyden's
-/// updates from the monodromy estimate M ≈ 0 ([`shoot_map_broyden`] with `m0` = 0) within
-/// 2d + 2 iterates (d the state's dimension; at most `opts.max_iter`): Broyden's method
-/// reaches the zero of an affine F in at most 2d steps (Gay, *SIAM J. Numer. Anal.* 16 (1979)
-/// 623), and the residual of the last is checked in one more. Where those updates fail (no
-/// convergence within the cap, a step that does not lower the residual, a singular M − I or
-/// a fixed point that does not close in its region), [`shoot_map_unwatched`] solves from
-/// `guess` as with [`ShootingStrategy::Newton`]; so it does for n > 1, whose minimal period
-/// only Newton's solve checks. The orbit of the Broyden solve has no distance to grazing (NaN),
-/// as [`shoot_map_unwatched`]'s.
-///
-/// # Errors
-/// As [`shoot_map_unwatched`]; [`SimError::Cancelled`] from the Broyden solve.
-pub fn shoot_map_unwatched_by(
-    dmap: &mut dyn DiscreteMap,
-    guess: &DVector<f64>,
-    n: usize,
-    opts: &ShootingOptions,
-    strategy: ShootingStrategy,
-) -> Result<PeriodicOrbit, SimError> {
-    if n == 1 && strategy == ShootingStrategy::BroydenFromZero {
-        let dim = guess.len();
-        let first = ShootingOptions {
-            max_iter: (2 * dim + 2).min(opts.max_iter),
-            ..*opts
-        };
-        match broyden(dmap, guess, n, &first, &DMatrix::zeros(dim, dim)) {
-            Ok((z, map, residuals)) => {
-                // a period-1 orbit: its section is its state, its minimal period 1
-                let (multipliers, stable, critical) = floquet_stability(&map.jacobian);
-                return Ok(PeriodicOrbit {
-                    period: 1,
-                    section: vec![z.clone()],
-                    state: z,
-                    monodromy: map.jacobian,
-                    multipliers,
-                    stable,
-                    critical,
-                    grazing_distance: f64::NAN,
-                    grazing: false,
-                    switchings: map.switchings,
-                    residuals,
-                });
+    let n = opts.period;
+    let dim = z.len();
+    match opts.strategy {
+        ShootingStrategy::Newton => finished(dmap, z, opts, Damping::Halve),
+        ShootingStrategy::Globalised => finished(dmap, z, opts, Damping::LineSearch),
+        ShootingStrategy::Undamped => {
+            let (state, map, residuals) = newton(dmap, z, n, opts, Damping::Stop)?;
+            closes_in_its_region(dmap, &state, n, &residuals)?;
+            Ok(orbit(state, None, n, map, residuals, f64::NAN))
+        }
+        ShootingStrategy::Broyden => {
+            let m0 = estimate.map_or_else(|| Cow::Owned(DMatrix::zeros(dim, dim)), Cow::Borrowed);
+            let (state, map, residuals) = broyden(dmap, z, n, opts, &m0)?;
+            Ok(orbit(state, None, n, map, residuals, f64::NAN))
+        }
+        ShootingStrategy::BroydenFromZero => {
+            if n == 1 {
+                let first = ShootingOptions {
+                    max_iter: (2 * dim + 2).min(opts.max_iter),
+                    ..*opts
+                };
+                match broyden(dmap, z, n, &first, &DMatrix::zeros(dim, dim)) {
+                    Ok((state, map, residuals)) => {
+                        return Ok(orbit(state, None, 1, map, residuals, f64::NAN));
+                    }
+                    Err(SimError::Cancelled) => return Err(SimError::Cancelled),
+                    // Newton from the guess
+                    Err(_) => {}
+                }
             }
-            Err(SimError::Cancelled) => return Err(SimError::Cancelled),
-            // Newton from the guess
-            Err(_) => {}
+            finished(dmap, z, opts, Damping::Halve)
         }
     }
-    shoot_map_unwatched(dmap, guess, n, opts)
 }
 
-/// [`newton`] with halved steps, then [`finish`]: [`shoot_map`] and [`shoot_map_unwatched`].
-fn shoot_damped(
+/// [`newton`] with `damping`, then [`finish`]: the finished strategies.
+fn finished(
     dmap: &mut dyn DiscreteMap,
     guess: &DVector<f64>,
-    n: usize,
     opts: &ShootingOptions,
-    watch: Watch,
+    damping: Damping,
 ) -> Result<PeriodicOrbit, SimError> {
-    let (z, map, residuals) = newton(dmap, guess, n, opts, Damping::Halve)?;
-    finish(dmap, z, n, map, residuals, opts, watch)
+    let (z, map, residuals) = newton(dmap, guess, opts.period, opts, damping)?;
+    finish(dmap, z, opts.period, map, residuals, opts)
 }
 
-/// Whether [`finish`] measures the converged orbit's distance to grazing.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Watch {
-    /// [`DiscreteMap::grazing_distance`] at the orbit (one more flow).
-    Grazing,
-    /// No: NaN.
-    None,
-}
-
-/// [`shoot_map`] globalised: each Newton step is backtracked by a line search on ½‖F‖²
-/// with Armijo's sufficient-decrease condition ([`LINE_SEARCH_MIN_STEP`]; Dennis & Schnabel,
-/// *Numerical Methods for Unconstrained Optimization and Nonlinear Equations*, SIAM 1996,
-/// §6.3 and Algorithm A6.3.1), so that a guess farther from the orbit than Newton's basin of
-/// quadratic convergence — a point of a chaotic attractor near one of its unstable periodic
-/// orbits — still reaches it where ‖F‖ decreases towards it. Steps that the map accepts whole
-/// are [`shoot_map`]'s.
-///
-/// # Errors
-/// [`SimError::NoConvergence`] when the line search stalls or after `opts.max_iter`
-/// iterations; [`SimError`] from the map.
-pub fn shoot_map_globalised(
-    dmap: &mut dyn DiscreteMap,
-    guess: &DVector<f64>,
-    n: usize,
-    opts: &ShootingOptions,
-) -> Result<PeriodicOrbit, SimError> {
-    let (z, map, residuals) = newton(dmap, guess, n, opts, Damping::LineSearch)?;
-    finish(dmap, z, n, map, residuals, opts, Watch::Grazing)
-}
-
-/// A period-n orbit near a recorded stretch of an attractor's stroboscopic section
-/// (`section[k]` = z(kT) of consecutive drive periods, e.g. the points a nonperiodic
-/// [`crate::analysis::steady::SteadyState`] recorded): the points whose n-period return
-/// ‖z_{k+n} − z_k‖ is smallest (close returns: a chaotic orbit shadows the unstable periodic
-/// orbits embedded in it, and passes close to a period-n one where it nearly repeats after n
-/// periods; Auerbach, Cvitanović, Eckmann, Gunaratne & Procaccia, *Phys. Rev. Lett.* 58 (1987)
-/// 2387; Lathrop & Kostelich, *Phys. Rev. A* 40 (1989) 4028), up to [`SECTION_STARTS`] of them
-/// in increasing order of that return, each start polished by [`shoot_map_globalised`]; the first
-/// orbit reached is returned.
-///
-/// # Errors
-/// [`SimError::OutOfRange`] when `section` has fewer than n + 1 points or n = 0;
-/// [`SimError::NoConvergence`] (the smallest residual reached) when no start converges;
-/// [`SimError::Cancelled`] and the map's errors other than a failed start.
-pub fn shoot_map_from_section(
+/// [`shoot`] from the close returns of an attractor's section points ([`Guess::Section`]).
+fn from_section(
     dmap: &mut dyn DiscreteMap,
     section: &[DVector<f64>],
-    n: usize,
     opts: &ShootingOptions,
 ) -> Result<PeriodicOrbit, SimError> {
+    let n = opts.period;
     if n == 0 || section.len() <= n {
         return Err(SimError::out_of_range(
             "section points",
@@ -172,7 +110,7 @@ pub fn shoot_map_from_section(
     returns.sort_by(|a, b| a.0.total_cmp(&b.0));
     let mut best: Option<SimError> = None;
     for &(_, k) in returns.iter().take(SECTION_STARTS) {
-        match shoot_map_globalised(dmap, &section[k], n, opts) {
+        match solve(dmap, &section[k], None, opts) {
             Ok(orbit) => return Ok(orbit),
             Err(SimError::Cancelled) => return Err(SimError::Cancelled),
             Err(e) => {
@@ -210,28 +148,31 @@ pub fn shoot_map_from_section(
     })
 }
 
-/// Newton for F(z) = Pⁿ(z) − z from a guess close to the orbit (a predictor along a branch),
-/// without damping: a full Newton step that does not lower ‖F‖ ends the solve with
-/// [`SimError::NoConvergence`] at once — from a close guess it means the orbit is not there
-/// (it vanished at a fold between the guess's parameter and this one), and a caller that
-/// halves its parameter step gains nothing from the 10 halvings of a damped step (each a
-/// flow). Only the multipliers of the converged orbit are formed: no section points and no
-/// distance to grazing (the flows of [`shoot_map`]'s `finish`). The iterates and the
-/// converged orbit are those of [`shoot_map`] from the same guess whenever it takes full
-/// steps.
-///
-/// # Errors
-/// [`SimError::NoConvergence`] as above or after `opts.max_iter` iterations; [`SimError`] from
-/// the map.
-pub fn shoot_map_undamped(
-    dmap: &mut dyn DiscreteMap,
-    guess: &DVector<f64>,
+/// The orbit through `state` (period n, its `map`'s monodromy matrix and switchings, the
+/// solve's `residuals`): its multipliers formed, with its `section` points (`None`: an
+/// unfinished orbit, `[state]`) and `grazing_distance`.
+fn orbit(
+    state: DVector<f64>,
+    section: Option<Vec<DVector<f64>>>,
     n: usize,
-    opts: &ShootingOptions,
-) -> Result<ShotOrbit, SimError> {
-    let (state, map, residuals) = newton(dmap, guess, n, opts, Damping::Stop)?;
-    closes_in_its_region(dmap, &state, n, &residuals)?;
-    Ok(ShotOrbit::new(state, map.jacobian, residuals))
+    map: FlowMap,
+    residuals: Vec<f64>,
+    grazing_distance: f64,
+) -> PeriodicOrbit {
+    let (multipliers, stable, critical) = floquet_stability(&map.jacobian);
+    PeriodicOrbit {
+        period: n,
+        section: section.unwrap_or_else(|| vec![state.clone()]),
+        state,
+        monodromy: map.jacobian,
+        multipliers,
+        stable,
+        critical,
+        grazing: grazing_distance < GRAZING_TOL,
+        grazing_distance,
+        switchings: map.switchings,
+        residuals,
+    }
 }
 
 /// The fixed point z = Pⁿ(z) is refused where it is no orbit of the system the map comes from
@@ -261,32 +202,8 @@ fn closes_in_its_region(
     })
 }
 
-/// [`shoot_map_undamped`] with `m0`, an estimate of the monodromy matrix (the previous orbit's
-/// along a sweep), for the first Jacobian: the iterates take flows without the variational
-/// equations ([`DiscreteMap::iterate`]; for the adaptive integrator at N = 3 a seventh of a variational
-/// flow's work), the Jacobian M − I of F updated after each step δ by Broyden's rank-one secant
-/// update J ← J + (ΔF − J δ) δᵀ/(δᵀδ) (Broyden, *Math. Comp.* 19 (1965) 577; Dennis & Schnabel,
-/// *Numerical Methods for Unconstrained Optimization and Nonlinear Equations*, SIAM 1996,
-/// §8.1), and the converged orbit takes one variational flow for its monodromy matrix — whose
-/// residual must be within [`VARIATIONAL_SLACK`] tolerances (the two kinds of flow take different
-/// steps), else Newton steps follow from it as in [`shoot_map_undamped`]. A step that does not lower
-/// ‖F‖ ends the solve, as there.
-///
-/// # Errors
-/// As [`shoot_map_undamped`]; [`SimError::OutOfRange`] for an `m0` that is not d×d.
-pub fn shoot_map_broyden(
-    dmap: &mut dyn DiscreteMap,
-    guess: &DVector<f64>,
-    n: usize,
-    opts: &ShootingOptions,
-    m0: &DMatrix<f64>,
-) -> Result<ShotOrbit, SimError> {
-    let (state, map, residuals) = broyden(dmap, guess, n, opts, m0)?;
-    Ok(ShotOrbit::new(state, map.jacobian, residuals))
-}
-
-/// The iteration of [`shoot_map_broyden`]: the converged z (closed in its region), its map
-/// (the variational flow's) and the residuals.
+/// The iteration of [`ShootingStrategy::Broyden`] from `m0`: the converged z (closed in its
+/// region), its map (the variational flow's) and the residuals.
 fn broyden(
     dmap: &mut dyn DiscreteMap,
     guess: &DVector<f64>,
@@ -428,7 +345,7 @@ fn line_search(
     Ok(None)
 }
 
-/// The Newton iteration of [`shoot_map`] and [`shoot_map_undamped`]: the converged z, its map
+/// The Newton iteration of [`shoot`] (and of [`minimal`]): the converged z, its map
 /// (unwatched: no grazing searches) and the residuals.
 fn newton(
     dmap: &mut dyn DiscreteMap,
@@ -444,8 +361,8 @@ fn newton(
     let dim = guess.len();
     let mut z = guess.clone();
     let mut residuals = Vec::new();
-    // the iterates without the grazing searches (`shoot_map`'s `finish` gives the converged
-    // orbit its distance to grazing)
+    // the iterates without the grazing searches (`finish` gives the converged orbit its
+    // distance to grazing)
     let mut map = dmap.linearise(&z, n, false)?;
     let mut res = (&map.state - &z).norm();
     for _ in 0..opts.max_iter {
@@ -543,7 +460,8 @@ pub fn map_section_points(
 
 /// The period-n orbit through `z` (converged to `opts.tol`) reduced to its minimal period:
 /// the orbit shot again at the [`proper_period`] of its section, which must converge there
-/// (else n stands). `Ok(None)` when n is minimal (costs n − 1 plain flows of one period).
+/// (else n stands), finished with `opts`' grazing watch. `Ok(None)` when n is minimal (costs
+/// n − 1 plain flows of one period).
 ///
 /// # Errors
 /// [`SimError`] from the map.
@@ -557,7 +475,7 @@ pub fn reduce_map_period(
         return Ok(None);
     }
     let section = map_section_points(dmap, z, n)?;
-    minimal(dmap, &section, opts, Watch::Grazing)
+    minimal(dmap, &section, opts)
 }
 
 /// [`reduce_map_period`] on the orbit's section points.
@@ -565,22 +483,21 @@ fn minimal(
     dmap: &mut dyn DiscreteMap,
     section: &[DVector<f64>],
     opts: &ShootingOptions,
-    watch: Watch,
 ) -> Result<Option<PeriodicOrbit>, SimError> {
     let Some(d) = proper_period(section, opts.tol) else {
         return Ok(None);
     };
     match newton(dmap, &section[0], d, opts, Damping::Stop) {
-        Ok((z, map, residuals)) => finish(dmap, z, d, map, residuals, opts, watch).map(Some),
+        Ok((z, map, residuals)) => finish(dmap, z, d, map, residuals, opts).map(Some),
         Err(SimError::Cancelled) => Err(SimError::Cancelled),
         // not an orbit of period d after all: n stands
         Err(_) => Ok(None),
     }
 }
 
-/// The converged orbit of a Newton solve: refused where it does not close in its region,
-/// reduced to its minimal period, with its section points, multipliers and (with
-/// [`Watch::Grazing`]) its distance to grazing.
+/// The converged orbit of a Newton solve, finished ([`ShootingStrategy`]): refused where it
+/// does not close in its region, reduced to its minimal period, with its section points,
+/// multipliers and (watched, [`ShootingOptions::watch_grazing`]) its distance to grazing.
 fn finish(
     dmap: &mut dyn DiscreteMap,
     z: DVector<f64>,
@@ -588,30 +505,17 @@ fn finish(
     map: FlowMap,
     residuals: Vec<f64>,
     opts: &ShootingOptions,
-    watch: Watch,
 ) -> Result<PeriodicOrbit, SimError> {
     closes_in_its_region(dmap, &z, n, &residuals)?;
     let section = map_section_points(dmap, &z, n)?;
     // the minimal period: an orbit found as period n may repeat after a divisor of n
-    if let Some(o) = minimal(dmap, &section, opts, watch)? {
+    if let Some(o) = minimal(dmap, &section, opts)? {
         return Ok(o);
     }
-    let grazing_distance = match watch {
-        Watch::Grazing => dmap.grazing_distance(&z, n)?,
-        Watch::None => f64::NAN,
+    let grazing_distance = if opts.watch_grazing {
+        dmap.grazing_distance(&z, n)?
+    } else {
+        f64::NAN
     };
-    let (multipliers, stable, critical) = floquet_stability(&map.jacobian);
-    Ok(PeriodicOrbit {
-        period: n,
-        state: z,
-        section,
-        monodromy: map.jacobian,
-        stable,
-        critical,
-        multipliers,
-        grazing: grazing_distance < GRAZING_TOL,
-        grazing_distance,
-        switchings: map.switchings,
-        residuals,
-    })
+    Ok(orbit(z, Some(section), n, map, residuals, grazing_distance))
 }

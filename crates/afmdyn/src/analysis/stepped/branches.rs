@@ -10,8 +10,9 @@ use crate::analysis::continuation::{
     continue_branch_with, Branch, BranchEnd, BranchEvent, ContinuationSpec,
 };
 use crate::analysis::progress::Progress;
-use crate::analysis::shooting::shoot_with;
+use crate::analysis::shooting::shoot;
 use crate::error::SimError;
+use crate::maps::StroboscopicMap;
 use nalgebra::{Complex, DVector};
 
 /// Continue the branch through `from` (a stable orbit of a sweep) towards `to`, with
@@ -100,7 +101,8 @@ pub(super) fn branch_starts(
         let Ok(mut integ) = integrator_at(spec, at.value, &from.state) else {
             continue;
         };
-        let Ok(o) = shoot_with(integ.as_mut(), &from.state, n, &spec.newton) else {
+        let map = &mut StroboscopicMap::new(integ.as_mut(), 1);
+        let Ok(o) = shoot(map, &from.state, &spec.newton.with_period(n)) else {
             continue;
         };
         if relative_gap(&o.state, &at.state) < 1e-3 {

@@ -9,7 +9,7 @@
 //! integrating ~Q/π periods of transient per value, the previous orbit is followed by Newton
 //! shooting ([`super::shooting`]) from a secant prediction (where the integrator integrates the
 //! variational equations step by step, Broyden's method from the previous orbits' monodromy
-//! matrix, [`super::shooting::shoot_broyden`]): a stable orbit near the previous
+//! matrix, [`super::shooting::ShootingStrategy::Broyden`]): a stable orbit near the previous
 //! one is its continuation, the state the motion settles on; a step the orbit moves too far in
 //! is halved (quasi-static sub-steps, [`SUBSTEP_DEPTH`]) as long as halving brings the orbits
 //! closer. When the orbit cannot be followed — Newton fails or lands on an unstable orbit, or
@@ -41,7 +41,7 @@ use crate::analysis::progress::Progress;
 pub use crate::analysis::settle::Found;
 use crate::analysis::settle::{newton_from_transient, SettleOptions, NEWTON_CHUNKS, SETTLED};
 use crate::analysis::shooting::{
-    broyden_pays, shoot_broyden, shoot_undamped, shoot_with, ShootingOptions, ShotOrbit,
+    broyden_pays, shoot, Guess, PeriodicOrbit, ShootingOptions, ShootingStrategy,
 };
 use crate::analysis::steady::{decay_periods, SteadyOptions};
 use crate::error::SimError;
@@ -156,7 +156,8 @@ pub struct SteppedSpec {
     pub integrator: IntegratorOptions,
     /// Newton shooting from the previous orbit (default: tolerance 1e-10, at most 6 iterations:
     /// from the secant prediction Newton converges in ~3; one that has not converged by 6 is
-    /// stalled at a non-smooth point or far from the orbit, and a halved step is cheaper).
+    /// stalled at a non-smooth point or far from the orbit, and a halved step is cheaper); the
+    /// period is the orbit's, the strategy undamped or Broyden's where an orbit is followed.
     pub newton: ShootingOptions,
     /// Classification of a motion that does not settle on an orbit; `max_periods` is the most
     /// drive periods of transient a point may take, [`settle`] and classification together
@@ -202,6 +203,7 @@ impl SteppedSpec {
             newton: ShootingOptions {
                 tol: 1e-10,
                 max_iter: 6,
+                ..ShootingOptions::default()
             },
             steady: SteadyOptions {
                 tol: 1e-8,

@@ -138,7 +138,8 @@ pub fn settle(
                 continue;
             };
             let (tau, here) = (integ.tau(), integ.state().clone());
-            if let Ok(o) = shoot_with(integ, &here, m, &spec.newton) {
+            let map = &mut StroboscopicMap::new(integ, 1);
+            if let Ok(o) = shoot(map, &here, &spec.newton.with_period(m)) {
                 if o.stable {
                     return Ok(Settled {
                         found: Found {
@@ -245,48 +246,78 @@ pub(super) fn integrator_at(
     build(&model, spec.integrator.clone(), 0.0, z)
 }
 
-/// Follow the stable period-n orbit `z0` at `v0` (its monodromy matrix and trend `m0`) to `v1`
-/// by Newton
-/// (from the secant prediction `z0 + slope (v1 − v0)`, then from `z0`; undamped,
-/// [`shoot_undamped`]: a full step that does not lower the residual means the orbit is not
-/// near, and halving the parameter step is the remedy; where the integrator integrates the
-/// variational equations step by step ([`broyden_pays`]), first [`shoot_broyden`] with the
-/// trend's estimate at `v1` as the first Jacobian): accepted when stable and within `jump_tol`
-/// of `z0`.
-/// Otherwise the step is halved (up to `depth` times) and each half continued in turn — a
-/// quasi-static sweep — unless three halvings in a row did not shrink the distance to the stable
-/// orbit Newton found below 0.95 of the distance over the longer step (`whole`: that distance
-/// and the halvings so far without shrinking): a jump, not a steep piece of branch (across a
-/// resonance much sharper than the step the distance shrinks slowly, but it shrinks). `None` when the orbit cannot be followed (it vanished or lost
-/// stability).
-#[allow(clippy::type_complexity, clippy::too_many_arguments)]
-pub(super) fn continue_orbit(
+/// The stable orbit a step of the sweep follows: its value v0 and state z0, the secant slope
+/// that predicts it along the branch, its monodromy matrix and trend ([`Trend`]), its period n.
+struct Followed<'a> {
+    value: f64,
+    state: &'a DVector<f64>,
+    slope: Option<&'a DVector<f64>>,
+    trend: Option<&'a Trend>,
+    period: usize,
+}
+
+/// The longer step a halved one is part of: the distance to the stable orbit Newton found over
+/// it, and the halvings in a row so far that did not shrink that distance.
+#[derive(Debug, Clone, Copy)]
+struct LongerStep {
+    gap: f64,
+    unshrunk: usize,
+}
+
+/// Follow the stable orbit `from` (period n, at v0) to `v1` by Newton (from the secant
+/// prediction `z0 + slope (v1 − v0)`, then from `z0`; undamped,
+/// [`ShootingStrategy::Undamped`]: a full step that does not lower the residual means the orbit
+/// is not near, and halving the parameter step is the remedy; where the integrator integrates
+/// the variational equations step by step ([`broyden_pays`]), first
+/// [`ShootingStrategy::Broyden`] with the trend's estimate at `v1` as the first Jacobian):
+/// accepted when stable and within `jump_tol` of `z0`. Otherwise the step is halved (up to
+/// `depth` times) and each half continued in turn — a quasi-static sweep — unless three
+/// halvings in a row did not shrink the distance to the stable orbit Newton found below 0.95
+/// of the distance over the longer step (`whole`): a jump, not a steep piece of branch (across
+/// a resonance much sharper than the step the distance shrinks slowly, but it shrinks). `None`
+/// when the orbit cannot be followed (it vanished or lost stability).
+fn continue_orbit(
     spec: &SteppedSpec,
-    v0: f64,
-    z0: &DVector<f64>,
-    slope: Option<&DVector<f64>>,
+    from: &Followed,
     v1: f64,
-    m0: Option<&Trend>,
-    n: usize,
     depth: usize,
-    whole: Option<(f64, usize)>,
-) -> Result<Option<ShotOrbit>, SimError> {
+    whole: Option<LongerStep>,
+) -> Result<Option<PeriodicOrbit>, SimError> {
+    let (v0, z0) = (from.value, from.state);
     let model = CantileverModel::new(&spec.base.with(spec.param, v1))?;
     let mut integ = build(&model, spec.integrator.clone(), 0.0, z0)?;
-    let m1 = m0
+    let m1 = from
+        .trend
         .filter(|_| broyden_pays(spec.integrator.clone(), &model))
         .map(|t| t.at(v1 - v0));
     let mut guesses = Vec::with_capacity(2);
-    if let Some(s) = slope {
+    if let Some(s) = from.slope {
         guesses.push(z0 + s * (v1 - v0));
     }
     guesses.push(z0.clone());
+    let map = &mut StroboscopicMap::new(integ.as_mut(), 1);
+    let undamped = ShootingOptions {
+        period: from.period,
+        strategy: ShootingStrategy::Undamped,
+        ..spec.newton
+    };
+    let broyden = ShootingOptions {
+        strategy: ShootingStrategy::Broyden,
+        ..undamped
+    };
     let mut gap: Option<f64> = None;
     for g in &guesses {
         let shot = match &m1 {
-            Some(m) => shoot_broyden(integ.as_mut(), g, n, &spec.newton, m)
-                .or_else(|_| shoot_undamped(integ.as_mut(), g, n, &spec.newton)),
-            None => shoot_undamped(integ.as_mut(), g, n, &spec.newton),
+            Some(m) => shoot(
+                map,
+                Guess::Estimated {
+                    state: g,
+                    monodromy: m,
+                },
+                &broyden,
+            )
+            .or_else(|_| shoot(map, g, &undamped)),
+            None => shoot(map, g, &undamped),
         };
         if let Ok(o) = shot {
             if o.stable {
@@ -299,36 +330,35 @@ pub(super) fn continue_orbit(
         }
     }
     // halvings in a row that did not shrink the distance
-    let stuck = match (gap, whole) {
-        (Some(g), Some((w, k))) if g > 0.95 * w => k + 1,
+    let unshrunk = match (gap, whole) {
+        (Some(g), Some(w)) if g > 0.95 * w.gap => w.unshrunk + 1,
         _ => 0,
     };
-    if depth == 0 || stuck >= 3 {
+    if depth == 0 || unshrunk >= 3 {
         return Ok(None);
     }
     let mid = 0.5 * (v0 + v1);
-    let first = gap.map(|g| (g, stuck));
-    let Some(om) = continue_orbit(spec, v0, z0, slope, mid, m0, n, depth - 1, first)? else {
+    let first = gap.map(|gap| LongerStep { gap, unshrunk });
+    let Some(om) = continue_orbit(spec, from, mid, depth - 1, first)? else {
         return Ok(None);
     };
     let half_slope = (&om.state - z0) / (mid - v0);
-    let trend = m0.map(|t| Trend::through(&t.m, &om.monodromy, mid - v0));
-    let mm = trend.as_ref();
-    continue_orbit(
-        spec,
-        mid,
-        &om.state,
-        Some(&half_slope),
-        v1,
-        mm,
-        n,
-        depth - 1,
-        None,
-    )
+    let trend = from
+        .trend
+        .map(|t| Trend::through(&t.m, &om.monodromy, mid - v0));
+    let half = Followed {
+        value: mid,
+        state: &om.state,
+        slope: Some(&half_slope),
+        trend: trend.as_ref(),
+        period: from.period,
+    };
+    continue_orbit(spec, &half, v1, depth - 1, None)
 }
 
 /// The monodromy matrix M of the orbit followed at v0 and, when the orbit before it is on the
-/// same branch, its rate of change along the sweep: the first Jacobian of [`shoot_broyden`] at
+/// same branch, its rate of change along the sweep: the first Jacobian of
+/// [`ShootingStrategy::Broyden`] at
 /// v is M + (v − v0) dM/dv (linear extrapolation, the monodromy's counterpart of
 /// [`prediction_slope`]).
 #[derive(Debug, Clone)]
@@ -439,20 +469,23 @@ pub(super) fn orbit_point(
     let n = prev.and_then(|p| p.period).unwrap_or(1);
     let mut integ = build(&model, spec.integrator.clone(), 0.0, &last)?;
     let slope = prediction_slope(history, value);
+    let newton = spec.newton.with_period(n);
     let continued = match prev {
         Some(p) => continue_orbit(
             spec,
-            p.value,
-            &last,
-            slope.as_ref(),
+            &Followed {
+                value: p.value,
+                state: &last,
+                slope: slope.as_ref(),
+                trend: Trend::of(history).as_ref(),
+                period: n,
+            },
             value,
-            Trend::of(history).as_ref(),
-            n,
             SUBSTEP_DEPTH,
             None,
         )?
         .map(|o| (o.state, o.multipliers, o.monodromy)),
-        None => shoot_with(integ.as_mut(), &last, n, &spec.newton)
+        None => shoot(&mut StroboscopicMap::new(integ.as_mut(), 1), &last, &newton)
             .ok()
             .filter(|o| o.stable)
             .map(|o| (o.state, o.multipliers, o.monodromy)),
@@ -551,7 +584,8 @@ mod tests {
         let spec = SteppedSpec::new(p, SweepParam::Alpha5, vec![p.alpha5, p.alpha5 + 0.01]);
         let model = CantileverModel::new(&p).unwrap();
         let mut integ = build(&model, spec.integrator.clone(), 0.0, &model.rest()).unwrap();
-        let one = shoot_with(integ.as_mut(), &model.rest(), 1, &spec.newton).unwrap();
+        let mut map = StroboscopicMap::new(integ.as_mut(), 1);
+        let one = shoot(&mut map, &model.rest(), &spec.newton).unwrap();
         assert_eq!(one.period, 1);
         let as_six = Found {
             period: Some(6),

@@ -21,6 +21,18 @@ pub(super) enum SeriesStart<'a> {
     Modal(&'a ModalExp, &'a Modes),
 }
 
+/// Where `build_poly` expands a tip series: over the step [τ0, τ0 + `len`], centred at local
+/// time `center` (with `trig` = (sin, cos) Ω(τ0 + center)), from the homogeneous state there
+/// (`start`).
+#[derive(Clone, Copy)]
+pub(super) struct Expansion<'a> {
+    pub(super) tau0: f64,
+    pub(super) center: f64,
+    pub(super) trig: (f64, f64),
+    pub(super) len: f64,
+    pub(super) start: SeriesStart<'a>,
+}
+
 /// The last step, kept for dense output.
 #[derive(Debug, Clone)]
 pub(super) struct LastStep {
@@ -111,26 +123,31 @@ impl ExactPropagator {
         matvec(&sp.tinv, &yt[..dim], out, 1.0, true);
     }
 
-    /// Fill `out` with the tip series of a step [τ0, τ0 + len] in region `r`, centred at local
-    /// time `center` (with sin, cos Ω(τ0 + center)), from the homogeneous state at τ0 + center
-    /// (`start`: energy or modal coordinates). The series reaches |t − center| ≤ max(center,
-    /// len − center), half the step when centred, so its terms fall off twice as fast. The
+    /// Fill `out` with the tip series of a step in region `r` expanded `at` the step
+    /// [τ0, τ0 + len], centred at local time `center`, from the homogeneous state at
+    /// τ0 + center (`start`: energy or modal coordinates). The series reaches |t − center| ≤
+    /// max(center, len − center), half the step when centred, so its terms fall off twice as
+    /// fast. The
     /// moments c̃ᵀÃⁿy (one product with the precomputed rows, or with the modal table of
     /// [`ModalExp::moments`]), then the Taylor coefficients of g and g′ four terms at a time
     /// (the harmonic factors Ωⁿ/n! from [`Forced`]) until the a priori tail bound is below
     /// round-off (1/n! and 1/n from tables: no division until it passes).
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn build_poly(
         sp: &Spectral,
         fr: &Forced,
         p: &Params,
         dead: f64,
         r: Region,
-        (tau0, center, (s0, c0)): (f64, f64, (f64, f64)),
-        start: SeriesStart,
-        len: f64,
+        at: &Expansion,
         out: &mut TipPoly,
     ) {
+        let Expansion {
+            tau0,
+            center,
+            trig: (s0, c0),
+            len,
+            start,
+        } = *at;
         let radius = center.max(len - center);
         // the harmonic part a_s sin(Ωτc + Ωu) + a_c cos(Ωτc + Ωu) + const of V_T (τc = τ0 +
         // center, u = t − center): its n-th u-derivative at 0 is Ωⁿ (S, C, −S, −C)[n mod 4]
@@ -264,37 +281,42 @@ impl ExactPropagator {
         let dim = self.z.len();
         let h = self.grid.h;
         let mut y0 = [0.0; MAXD];
-        let (center, start, len) = match (&self.spec[ri].modal, at) {
+        let expansion = match (&self.spec[ri].modal, at) {
             (Some(me), SeriesAt::Window) => {
                 let mid = &mut self.scratch;
                 me.factors(t, mid);
                 mid.mul_assign(&self.last.q0, me.len());
                 let at = self.last.tau0 + t;
-                let sc = (self.model.omega() * at).sin_cos();
-                (
-                    (at - 0.5 * h, 0.5 * h, sc),
-                    SeriesStart::Modal(me, &self.scratch),
-                    h,
-                )
+                Expansion {
+                    tau0: at - 0.5 * h,
+                    center: 0.5 * h,
+                    trig: (self.model.omega() * at).sin_cos(),
+                    len: h,
+                    start: SeriesStart::Modal(me, &self.scratch),
+                }
             }
             (Some(me), SeriesAt::Centred) if self.last.modal && self.last.full => {
                 let mid = &mut self.scratch;
                 mid.copy_prefix(&self.last.q0, me.len());
                 mid.mul_assign(&self.forced[ri].half_fac, me.len());
-                (
-                    (self.last.tau0, 0.5 * t, self.trig_mid[self.last.k]),
-                    SeriesStart::Modal(me, &self.scratch),
-                    t,
-                )
+                Expansion {
+                    tau0: self.last.tau0,
+                    center: 0.5 * t,
+                    trig: self.trig_mid[self.last.k],
+                    len: t,
+                    start: SeriesStart::Modal(me, &self.scratch),
+                }
             }
             _ => {
                 self.last_y0(&mut y0[..dim]);
                 let tau0 = self.last.tau0;
-                (
-                    (tau0, 0.0, self.trig_at(tau0)),
-                    SeriesStart::Energy(&y0[..dim]),
-                    t,
-                )
+                Expansion {
+                    tau0,
+                    center: 0.0,
+                    trig: self.trig_at(tau0),
+                    len: t,
+                    start: SeriesStart::Energy(&y0[..dim]),
+                }
             }
         };
         Self::build_poly(
@@ -303,9 +325,7 @@ impl ExactPropagator {
             self.model.params(),
             self.dead,
             self.last.region,
-            center,
-            start,
-            len,
+            &expansion,
             &mut self.poly,
         );
         self.poly_built = true;

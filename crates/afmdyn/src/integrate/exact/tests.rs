@@ -3,7 +3,7 @@
 
 use super::modal::{ModalExp, Modes};
 use super::search::TipPoly;
-use super::series::SeriesStart;
+use super::series::{Expansion, SeriesStart};
 use super::tip::base_amp;
 use super::{ExactOptions, ExactPropagator, PropagatorCache};
 use crate::model::CantileverModel;
@@ -107,17 +107,14 @@ fn tip_series_equal_the_closed_form() {
             ];
             for (case, (center, start)) in starts.into_iter().enumerate() {
                 let mut poly = TipPoly::empty();
-                ExactPropagator::build_poly(
-                    sp,
-                    fr,
-                    &p,
-                    prop.dead,
-                    r,
-                    (tau0, center, (om * (tau0 + center)).sin_cos()),
+                let at = Expansion {
+                    tau0,
+                    center,
+                    trig: (om * (tau0 + center)).sin_cos(),
+                    len: h,
                     start,
-                    h,
-                    &mut poly,
-                );
+                };
+                ExactPropagator::build_poly(sp, fr, &p, prop.dead, r, &at, &mut poly);
                 assert_eq!(poly.center, center);
                 for k in 0..=40 {
                     let t = h * k as f64 / 40.0;

@@ -54,7 +54,7 @@ use crate::model::CantileverModel;
 use crate::roots::safeguarded_newton;
 use crate::system::{HybridSystem, Region};
 use crate::tip_sample::TipSampleSystem;
-use jet::{Jet, Series};
+use jet::{Jet, Order, Series};
 use nalgebra::{DMatrix, DVector};
 
 /// Events within this many drive periods' ten-millionth that count as chattering (as the
@@ -315,14 +315,17 @@ impl Integrator for Taylor {
             return Ok(Step::plain(tau0, tau0, region));
         }
         self.budget.count(tau0)?;
-        let (p, var) = (self.order, self.variational);
+        let order = Order {
+            p: self.order,
+            variational: self.variational,
+        };
         let remaining = tau_max - tau0;
         let dead = self.model.guard_tolerance(region, tau0, self.z.as_slice());
         let s = &mut *self.next;
         // (end in the series' variable, end time, whether a guard zero ends the step)
         let (end, tau1, hit) = match region {
             Region::Free => {
-                self.jet.free(s, tau0, self.z.as_slice(), var, p);
+                self.jet.free(s, tau0, self.z.as_slice(), order);
                 let h = rule(s, self.drive_period, self.tol).min(remaining);
                 let hit = poly::leftmost_crossing(s.guard(), h, dead, self.just_switched);
                 match hit {
@@ -343,7 +346,7 @@ impl Integrator for Taylor {
                 if it.open && w0 > 0.0 && tau0 - it.entry >= INTERIOR_DEPTH * it.advance {
                     // the contact's interior in τ (module docs)
                     self.jet
-                        .contact_interior(s, tau0, self.z.as_slice(), w0, var, p);
+                        .contact_interior(s, tau0, self.z.as_slice(), w0, order);
                     let h = rule(s, self.drive_period, self.tol);
                     if h >= it.advance
                         && poly::leftmost_crossing(s.depth(), h.min(remaining), 0.0, false)
@@ -361,11 +364,11 @@ impl Integrator for Taylor {
                         it.open = false;
                     }
                 }
-                self.jet.contact(s, tau0, self.z.as_slice(), w0, var, p);
+                self.jet.contact(s, tau0, self.z.as_slice(), w0, order);
                 let h = rule(s, self.drive_period, self.tol);
                 let hit = poly::leftmost_crossing(s.guard(), h, dead, self.just_switched);
                 let e = hit.unwrap_or(h);
-                let theta = &s.theta[..=p];
+                let theta = &s.theta[..=order.p];
                 if poly::eval(theta, e) >= remaining {
                     (Self::sigma_at(theta, remaining, e), tau_max, false)
                 } else {
@@ -386,7 +389,7 @@ impl Integrator for Taylor {
         if norm.is_nan() || norm >= crate::params::STATE_NORM_MAX {
             return Err(SimError::Diverged { tau: tau1, norm });
         }
-        if var {
+        if order.variational {
             let mut jac = self.last.jacobian.take();
             let m = match &mut jac {
                 Some(m) if m.nrows() == d && m.ncols() == d => m,

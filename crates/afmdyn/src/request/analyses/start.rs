@@ -212,7 +212,7 @@ impl StartRequest {
 
     /// [`Self::guess`] with the section points the steady-state search recorded (z(kT) of
     /// consecutive drive periods, the last one the guess; empty for a given `initial`): the
-    /// starts of [`shoot_from_section`] when Newton from the guess fails.
+    /// starts of [`crate::analysis::shooting::Guess::Section`] when Newton from the guess fails.
     ///
     /// # Errors
     /// As [`Self::guess`].

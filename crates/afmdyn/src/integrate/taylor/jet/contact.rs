@@ -27,8 +27,8 @@ impl Jet {
         }
     }
 
-    /// The series of the contact flow from (τ₀, z₀) in τ − τ₀ to order `p` (with Φ(τ₀) = I
-    /// when `variational`), into `s`: a step inside the contact, δ₀ = `w0`² > 0. The field is
+    /// The series of the contact flow from (τ₀, z₀) in τ − τ₀ to `order` (with Φ(τ₀) = I when
+    /// variational), into `s`: a step inside the contact, δ₀ = `w0`² > 0. The field is
     /// the free flight's linear one plus M⁻¹φ F_c with F_c from w = √δ, whose series follows
     /// from w² = δ (the square root's recurrence, module docs), analytic while δ stays off 0 — the radius the step rule reads is
     /// the distance to the complex time where δ = 0. Per order: two or three products of series
@@ -40,13 +40,11 @@ impl Jet {
         t0: f64,
         z0: &[f64],
         w0: f64,
-        variational: bool,
-        p: usize,
+        order: Order,
     ) {
-        with_width!(self.n, w => self.contact_interior_w(w, s, t0, z0, w0, variational, p))
+        with_width!(self.n, w => self.contact_interior_w(w, s, t0, z0, w0, order))
     }
 
-    #[allow(clippy::too_many_arguments)]
     fn contact_interior_w<W: Width>(
         &self,
         wd: W,
@@ -54,12 +52,12 @@ impl Jet {
         t0: f64,
         z0: &[f64],
         w0: f64,
-        variational: bool,
-        p: usize,
+        order: Order,
     ) {
+        let Order { p, variational } = order;
         let n = wd.get();
         let d = 2 * n;
-        let (sn, cs) = s.start(p, d, variational, Region::Contact, t0, z0, self.omega);
+        let (sn, cs) = s.start(order, d, Region::Contact, t0, z0, self.omega);
         s.sigma = false;
         self.trig_series(s, sn, cs, p);
         s.theta[..=p].fill(0.0);
@@ -118,21 +116,12 @@ impl Jet {
         }
     }
 
-    /// The series of the contact flow from (τ₀, z₀), w(0) = `w0` (= √δ₀), in σ to order `p`
-    /// (with Φ(τ₀) = I when `variational`), into `s`.
-    pub(crate) fn contact(
-        &self,
-        s: &mut Series,
-        t0: f64,
-        z0: &[f64],
-        w0: f64,
-        variational: bool,
-        p: usize,
-    ) {
-        with_width!(self.n, w => self.contact_w(w, s, t0, z0, w0, variational, p))
+    /// The series of the contact flow from (τ₀, z₀), w(0) = `w0` (= √δ₀), in σ to `order`
+    /// (with Φ(τ₀) = I when variational), into `s`.
+    pub(crate) fn contact(&self, s: &mut Series, t0: f64, z0: &[f64], w0: f64, order: Order) {
+        with_width!(self.n, w => self.contact_w(w, s, t0, z0, w0, order))
     }
 
-    #[allow(clippy::too_many_arguments)]
     fn contact_w<W: Width>(
         &self,
         wd: W,
@@ -140,13 +129,13 @@ impl Jet {
         t0: f64,
         z0: &[f64],
         w0: f64,
-        variational: bool,
-        p: usize,
+        order: Order,
     ) {
+        let Order { p, variational } = order;
         let n = wd.get();
         let d = 2 * n;
         let dd = d * d;
-        let (sn, cs) = s.start(p, d, variational, Region::Contact, t0, z0, self.omega);
+        let (sn, cs) = s.start(order, d, Region::Contact, t0, z0, self.omega);
         s.s[0] = sn;
         s.c[0] = cs;
         self.component_sigma_start(s);
@@ -193,7 +182,7 @@ impl Jet {
             {
                 let mut lower = [0.0; crate::params::MAX_MODES];
                 let zs = &s.z[k * d..(k + 1) * d];
-                self.lower_field(wd, zs, k, s.s[k], s.c[k], f + s.fd[k], &mut lower[..n]);
+                self.lower_field(wd, zs, s, k, f, &mut lower[..n]);
                 for i in 0..n {
                     s.g[i * M + k] = zs[n + i];
                     s.g[(n + i) * M + k] = lower[i];

@@ -96,6 +96,14 @@ pub(crate) struct Jet {
     rate_rule: [(f64, f64); RATE_NODES],
 }
 
+/// What the series of a step are formed to ([`Jet::free`], [`Jet::contact`],
+/// [`Jet::contact_interior`]): order `p`, and Φ (from Φ(τ₀) = I) when `variational`.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Order {
+    pub p: usize,
+    pub variational: bool,
+}
+
 /// Nodes of the Gauss–Legendre rule of the energy balance over a step ([`Jet::rate_integrals`]).
 const RATE_NODES: usize = 8;
 
@@ -456,20 +464,21 @@ impl Jet {
         dot(&self.phi[..a.len()], a) + self.base * sk + if k == 0 { self.alpha5 } else { 0.0 }
     }
 
-    /// The lower half of f at one order: −M⁻¹K a_k − M⁻¹C ȧ_k + M⁻¹F^I_k + M⁻¹φ F_k into `out`
-    /// (N), given the forcing's coefficients (const only at order 0) and the force's.
+    /// The lower half of f at order k: −M⁻¹K a_k − M⁻¹C ȧ_k + M⁻¹F^I_k + M⁻¹φ F_k into `out`
+    /// (N), from the state's coefficient `zk`, the tip force's `f` and the series' forcing
+    /// (F^I's const only at order 0, its sin Ωτ and cos Ωτ, and the further drive components'
+    /// `fd` added to the tip force).
     #[inline(always)]
-    #[allow(clippy::too_many_arguments)]
     fn lower_field<W: Width>(
         &self,
         w: W,
         zk: &[f64],
+        series: &Series,
         k: usize,
-        s: f64,
-        c: f64,
         f: f64,
         out: &mut [f64],
     ) {
+        let (s, c, f) = (series.s[k], series.c[k], f + series.fd[k]);
         let n = w.get();
         let (a, ad) = zk.split_at(n);
         for i in 0..n {
@@ -571,7 +580,7 @@ impl Jet {
         let inv = 1.0 / (k + 1) as f64;
         let mut lower = [0.0; crate::params::MAX_MODES];
         let lower = &mut lower[..n];
-        self.lower_field(w, cur, k, s.s[k], s.c[k], f + s.fd[k], lower);
+        self.lower_field(w, cur, s, k, f, lower);
         let mut nxt = [0.0; 2 * crate::params::MAX_MODES];
         let nxt = &mut nxt[..d];
         for i in 0..n {
@@ -616,20 +625,24 @@ impl Jet {
         }
     }
 
-    /// The series of the free flight from (τ₀, z₀) in τ − τ₀ to order `p` (with Φ(τ₀) = I when
-    /// `variational`), into `s`.
-    pub(crate) fn free(&self, s: &mut Series, t0: f64, z0: &[f64], variational: bool, p: usize) {
-        if let (1, false, Law::Dmt { h, a0, .. }) = (self.n, variational, self.law) {
-            return self.free_point_mass_dmt(s, t0, z0, p, h, a0);
+    /// The series of the free flight from (τ₀, z₀) in τ − τ₀ to `order` (with Φ(τ₀) = I when
+    /// variational), into `s`.
+    pub(crate) fn free(&self, s: &mut Series, t0: f64, z0: &[f64], order: Order) {
+        if let (1, false, Law::Dmt { h, a0, .. }) = (self.n, order.variational, self.law) {
+            return self.free_point_mass_dmt(s, t0, z0, order.p, h, a0);
         }
-        with_width!(self.n, w => self.free_w(w, s, t0, z0, variational, p))
+        with_width!(self.n, w => self.free_w(w, s, t0, z0, order))
     }
 
     /// [`Jet::free`] of one mode with the DMT law, without the variational equations (the
     /// point-mass model's free flight, the path of `simulate`): the same recurrences as
     /// [`Jet::free_w`] with the state's two coefficients in registers.
     fn free_point_mass_dmt(&self, s: &mut Series, t0: f64, z0: &[f64], p: usize, h: f64, a0: f64) {
-        let (sn, cs) = s.start(p, 2, false, Region::Free, t0, z0, self.omega);
+        let order = Order {
+            p,
+            variational: false,
+        };
+        let (sn, cs) = s.start(order, 2, Region::Free, t0, z0, self.omega);
         self.trig_series(s, sn, cs, p);
         let (phi, ak, ac, m) = (self.phi[0], self.ak[0], self.ac[0], self.mphi[0]);
         let (b0, bs, bc) = (self.b_const[0], self.b_sin[0], self.b_cos[0]);
@@ -684,18 +697,11 @@ impl Jet {
         }
     }
 
-    fn free_w<W: Width>(
-        &self,
-        w: W,
-        s: &mut Series,
-        t0: f64,
-        z0: &[f64],
-        variational: bool,
-        p: usize,
-    ) {
+    fn free_w<W: Width>(&self, w: W, s: &mut Series, t0: f64, z0: &[f64], order: Order) {
+        let Order { p, variational } = order;
         let n = w.get();
         let d = 2 * n;
-        let (sn, cs) = s.start(p, d, variational, Region::Free, t0, z0, self.omega);
+        let (sn, cs) = s.start(order, d, Region::Free, t0, z0, self.omega);
         self.trig_series(s, sn, cs, p);
         // z_k in registers from one order to the next (not reloaded from the series)
         let mut cur = [0.0; 2 * crate::params::MAX_MODES];

@@ -3,19 +3,18 @@
 use super::*;
 
 impl Series {
-    /// Start the series of a step from (τ₀, z₀) to order `p`: buffers sized, z's order 0,
-    /// Φ(τ₀) = I when `variational`; returns (sin Ωτ₀, cos Ωτ₀).
-    #[allow(clippy::too_many_arguments)]
+    /// Start the series of a step from (τ₀, z₀) to `order`: buffers sized, z's order 0,
+    /// Φ(τ₀) = I when variational; returns (sin Ωτ₀, cos Ωτ₀).
     pub(super) fn start(
         &mut self,
-        p: usize,
+        order: Order,
         d: usize,
-        variational: bool,
         region: Region,
         t0: f64,
         z0: &[f64],
         omega: f64,
     ) -> (f64, f64) {
+        let Order { p, variational } = order;
         self.prepare(p, d, variational, region, t0);
         self.z[..d].copy_from_slice(z0);
         if variational {

@@ -61,8 +61,12 @@ fn interior_tau_series_match_the_sigma_series() {
         assert!((delta0 - 0.1).abs() < 1e-12);
         let p = 22;
         let (mut st, mut ss) = (Series::default(), Series::default());
-        jet.contact_interior(&mut st, 0.0, &z0, delta0.sqrt(), true, p);
-        jet.contact(&mut ss, 0.0, &z0, delta0.sqrt(), true, p);
+        let order = Order {
+            p,
+            variational: true,
+        };
+        jet.contact_interior(&mut st, 0.0, &z0, delta0.sqrt(), order);
+        jet.contact(&mut ss, 0.0, &z0, delta0.sqrt(), order);
         assert!(!st.sigma && ss.sigma && st.region == Region::Contact);
         for k in 0..=p {
             let w2: f64 = (0..=k).map(|j| st.w[j] * st.w[k - j]).sum();
@@ -120,7 +124,11 @@ fn free_flight_series_solve_the_linear_equations() {
     let z0: Vec<f64> = (0..d).map(|i| 0.1 * (i as f64 + 1.0).sin()).collect();
     let (t0, p) = (0.37, 20);
     let mut s = Series::default();
-    jet.free(&mut s, t0, &z0, true, p);
+    let order = Order {
+        p,
+        variational: true,
+    };
+    jet.free(&mut s, t0, &z0, order);
     let dy = m.dynamics(Region::Free);
     let om = m.omega();
     for k in 0..p {
