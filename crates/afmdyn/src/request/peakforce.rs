@@ -8,8 +8,8 @@
 use super::peakforce_sweep::SweepTap;
 use super::run::Resolved;
 use crate::analysis::peakforce::{
-    low_pass_periodic, static_compliance, PeakForceOptions, SteadyTap, FIT_BAND, MAX_CYCLE_SAMPLES,
-    MIN_CYCLE_SAMPLES,
+    low_pass_periodic, static_compliance, Cycle, PeakForceOptions, SteadyTap, FIT_BAND,
+    MAX_CYCLE_SAMPLES, MIN_CYCLE_SAMPLES,
 };
 use crate::error::SimError;
 use crate::model::CantileverModel;
@@ -361,44 +361,10 @@ pub fn document(request: &PeakForceRequest, model: &Resolved, r: &PeakForceResul
             .collect()
     };
     let t = &tap.cycle;
-    let half = t.time.len() / 2;
-    let col = |v: &[f64], s: f64| v.iter().map(|x| x * s).collect::<Vec<f64>>();
     let multipliers: Vec<[f64; 2]> = tap.multipliers.iter().map(|m| [m.re, m.im]).collect();
-    let time_unit = if u.si { "s" } else { "τ" };
     let period = std::f64::consts::TAU / p.omega;
     let omega1 = first_natural_frequency(&p);
-    let mut curve = json!({
-        "approach_distance": col(&t.distance[..half], u.length),
-        "approach_force": col(&t.force[..half], u.force),
-        "retract_distance": col(&t.distance[half..], u.length),
-        "retract_force": col(&t.force[half..], u.force),
-    });
-    if let Some(fl) = &r.filtered {
-        curve["approach_filtered_force"] = json!(col(&fl[..half], u.force));
-        curve["retract_filtered_force"] = json!(col(&fl[half..], u.force));
-    }
-    let sweep = request
-        .sweep
-        .as_ref()
-        .zip(r.sweep.as_ref())
-        .map(|(s, taps)| {
-            let scale = true_modulus(model, 1.0)
-                .filter(|_| has_radius)
-                .unwrap_or(1.0);
-            super::peakforce_sweep::sweep_document(s, &u, Some(scale), taps)
-        });
-    if let (Some(block), Some(taps)) = (&sweep, &r.sweep) {
-        warnings.extend(super::peakforce_sweep::sweep_warnings(block, taps));
-        let failed = block["message"]
-            .as_array()
-            .map_or(0, |m| m.iter().filter(|x| !x.is_null()).count());
-        if failed > 0 {
-            warnings.push(format!(
-                "{failed} of the sweep's values failed (null in sweep.channels; their \
-                 messages in sweep.message)"
-            ));
-        }
-    }
+    let sweep = sweep_block(request, model, r, has_radius, &mut warnings);
     json!({
         "sweep": sweep,
         "channels": {
@@ -449,28 +415,89 @@ pub fn document(request: &PeakForceRequest, model: &Resolved, r: &PeakForceResul
             "residual": tap.balance.residual * u.energy,
         },
         "cycle": {
-            "time": col(&t.time, u.time),
-            "deflection": col(&t.deflection, u.length),
-            "distance": col(&t.distance, u.length),
-            "force": col(&t.force, u.force),
+            "time": scaled(&t.time, u.time),
+            "deflection": scaled(&t.deflection, u.length),
+            "distance": scaled(&t.distance, u.length),
+            "force": scaled(&t.force, u.force),
         },
-        "curve": curve,
+        "curve": curve_block(t, r.filtered.as_deref(), &u),
         "filter": request.filter_cutoff.map(|fc| json!({
             "cutoff": fc,
             "kind": FILTER_KIND,
         })),
-        "units": if u.si {
-            json!({"peak_force": "N", "adhesion": "N", "deformation": "m", "dissipation": "J", "contact_time": "s",
-                   "snap_off_time": "s (from the largest separation)", "ringing_amplitude": "m", "modulus_dmt": "Pa", "z_c": "m",
-                   "time": time_unit, "deflection": "m", "distance": "m", "force": "N"})
-        } else {
-            json!({"peak_force": "F", "adhesion": "F", "deformation": "g0", "dissipation": "F·g0", "contact_time": "τ",
-                   "snap_off_time": "τ (from the largest separation)", "ringing_amplitude": "g0", "modulus_dmt": "α4 (Hertz group)", "z_c": "g0",
-                   "time": time_unit, "deflection": "g0", "distance": "g0", "force": "F"})
-        },
+        "units": units_block(u.si),
         "method": "the sample (or base) modulated as z_c + A_m cos 2πf_m t (t = 0 at the largest separation); the steady tap is the periodic orbit of the modulation period, settled from rest and Newton-shot with its Floquet multipliers; modulus_dmt from the DMT relation F − F_adh = (4/3)E*√R(d₀ − d)^{3/2} fitted on the retract curve between fit_band of its force range, d₀ at the force minimum (PF-QNM, Bruker AN128); adhesion is the most negative force (signed) (docs/afm-workflow.md)",
         "warnings": warnings,
     })
+}
+
+/// A column of the cycle in the document's units.
+fn scaled(v: &[f64], scale: f64) -> Vec<f64> {
+    v.iter().map(|x| x * scale).collect()
+}
+
+/// The document's `curve`: the cycle's force–distance curve, approach (its first half, from the
+/// largest separation) and retract, with the filtered force when there is one.
+fn curve_block(t: &Cycle, filtered: Option<&[f64]>, u: &CurveUnits) -> Value {
+    let half = t.time.len() / 2;
+    let mut curve = json!({
+        "approach_distance": scaled(&t.distance[..half], u.length),
+        "approach_force": scaled(&t.force[..half], u.force),
+        "retract_distance": scaled(&t.distance[half..], u.length),
+        "retract_force": scaled(&t.force[half..], u.force),
+    });
+    if let Some(fl) = filtered {
+        curve["approach_filtered_force"] = json!(scaled(&fl[..half], u.force));
+        curve["retract_filtered_force"] = json!(scaled(&fl[half..], u.force));
+    }
+    curve
+}
+
+/// The document's `sweep` block (`None` without a sweep), its warnings added to `warnings`.
+fn sweep_block(
+    request: &PeakForceRequest,
+    model: &Resolved,
+    r: &PeakForceResult,
+    has_radius: bool,
+    warnings: &mut Vec<String>,
+) -> Option<Value> {
+    let u = PeakForceRequest::units(model);
+    let sweep = request
+        .sweep
+        .as_ref()
+        .zip(r.sweep.as_ref())
+        .map(|(s, taps)| {
+            let scale = true_modulus(model, 1.0)
+                .filter(|_| has_radius)
+                .unwrap_or(1.0);
+            super::peakforce_sweep::sweep_document(s, &u, Some(scale), taps)
+        });
+    if let (Some(block), Some(taps)) = (&sweep, &r.sweep) {
+        warnings.extend(super::peakforce_sweep::sweep_warnings(block, taps));
+        let failed = block["message"]
+            .as_array()
+            .map_or(0, |m| m.iter().filter(|x| !x.is_null()).count());
+        if failed > 0 {
+            warnings.push(format!(
+                "{failed} of the sweep's values failed (null in sweep.channels; their \
+                 messages in sweep.message)"
+            ));
+        }
+    }
+    sweep
+}
+
+/// The document's `units`: SI with a probe, else the model's.
+fn units_block(si: bool) -> Value {
+    if si {
+        json!({"peak_force": "N", "adhesion": "N", "deformation": "m", "dissipation": "J", "contact_time": "s",
+                   "snap_off_time": "s (from the largest separation)", "ringing_amplitude": "m", "modulus_dmt": "Pa", "z_c": "m",
+                   "time": "s", "deflection": "m", "distance": "m", "force": "N"})
+    } else {
+        json!({"peak_force": "F", "adhesion": "F", "deformation": "g0", "dissipation": "F·g0", "contact_time": "τ",
+                   "snap_off_time": "τ (from the largest separation)", "ringing_amplitude": "g0", "modulus_dmt": "α4 (Hertz group)", "z_c": "g0",
+                   "time": "τ", "deflection": "g0", "distance": "g0", "force": "F"})
+    }
 }
 
 impl super::named::Datasets for PeakForceRequest {

@@ -271,6 +271,27 @@ fn rule(s: &Series, period: f64, tol: f64) -> f64 {
     }
 }
 
+/// The step's Jacobian at its end `end` (the series' variable) into `jacobian` (d × d, its
+/// storage reused), or `None` without the variational equations.
+#[inline]
+fn keep_jacobian(
+    jacobian: &mut Option<DMatrix<f64>>,
+    s: &Series,
+    end: f64,
+    d: usize,
+    variational: bool,
+) {
+    if !variational {
+        *jacobian = None;
+        return;
+    }
+    let m = match jacobian {
+        Some(m) if m.nrows() == d && m.ncols() == d => m,
+        _ => jacobian.insert(DMatrix::zeros(d, d)),
+    };
+    s.jacobian_at(end, m.as_mut_slice());
+}
+
 impl Integrator for Taylor {
     fn system(&self) -> &dyn TipSampleSystem {
         &self.model
@@ -389,17 +410,7 @@ impl Integrator for Taylor {
         if norm.is_nan() || norm >= crate::params::STATE_NORM_MAX {
             return Err(SimError::Diverged { tau: tau1, norm });
         }
-        if order.variational {
-            let mut jac = self.last.jacobian.take();
-            let m = match &mut jac {
-                Some(m) if m.nrows() == d && m.ncols() == d => m,
-                _ => jac.insert(DMatrix::zeros(d, d)),
-            };
-            s.jacobian_at(end, m.as_mut_slice());
-            self.last.jacobian = jac;
-        } else {
-            self.last.jacobian = None;
-        }
+        keep_jacobian(&mut self.last.jacobian, s, end, d, order.variational);
         // the step's series becomes the dense output
         std::mem::swap(&mut self.last.series, &mut self.next);
         self.last.tau0 = tau0;
