@@ -94,15 +94,17 @@ pub fn units(a: &UnitsArgs) -> Result<(), CliError> {
                 a.cantilever.as_deref(),
                 a.medium.as_deref(),
             )?;
-            let model = Resolved {
-                params: probe.params,
+            let model = Resolved::plain(probe.params);
+            let request = UnitsRequest {
                 probe: Some(probe),
+                physical: None,
             };
-            (UnitsRequest::default(), model)
+            (request, model)
         }
         (None, Some(config)) => {
             let pf: PhysicalFile = read_toml(config)?;
             let request = UnitsRequest {
+                probe: None,
                 physical: Some(pf.resolve()?),
             };
             (request, Resolved::plain(Params::default()))

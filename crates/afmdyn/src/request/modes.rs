@@ -111,12 +111,15 @@ impl Analysis for Fig3Request {
     }
 }
 
-/// `units`: a model's dimensionless set and its SI scales — of the probe file the model came
-/// from (`{params, si}`), or of a physical model in the paper's terms (`physical`, eqs. 5, 7:
-/// `{params, scales, physical}`).
+/// `units`: a model's dimensionless set and its SI scales — of a probe file (`probe`:
+/// `{params, si}`, the probe's conversion alone, without the warnings a run's document
+/// carries), or of a physical model in the paper's terms (`physical`, eqs. 5, 7:
+/// `{params, scales, physical}`). Run on a plain model ([`Resolved::plain`]).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct UnitsRequest {
-    /// The physical model (SI), instead of the model's probe.
+    /// The probe whose dimensionless set and scales are shown.
+    pub probe: Option<crate::probe::Probe>,
+    /// The physical model (SI), instead of a probe.
     pub physical: Option<PhysicalModel>,
 }
 
@@ -141,7 +144,12 @@ impl Analysis for UnitsRequest {
     fn report(&self, model: &Resolved, output: &Self::Output) -> Result<Value, SimError> {
         Ok(match output {
             Some((p, s)) => json!({ "params": p, "scales": s, "physical": self.physical }),
-            None => json!({ "params": model.params }),
+            None => match &self.probe {
+                Some(pr) => {
+                    json!({ "params": pr.params, "si": report::si(pr, &pr.params, &json!({})) })
+                }
+                None => json!({ "params": model.params }),
+            },
         })
     }
     fn present(
