@@ -369,6 +369,24 @@ mod tests {
     use super::*;
     use crate::analysis::fit::least_squares::minimize;
 
+    /// A fit at `best` with no parameter held and χ² at its scale (σ given).
+    fn unfixed<'a>(
+        model: &'a Model,
+        obs: &'a Observations<'a>,
+        params: &'a [Parameter],
+        best: &'a Minimum,
+        none: &'a [Option<f64>],
+    ) -> Fitted<'a> {
+        Fitted {
+            model,
+            obs,
+            params,
+            best,
+            fixed: none,
+            s2: 1.0,
+        }
+    }
+
     /// f = a + b x (linear in its parameters), or f = p² x (`square`).
     struct Model {
         x: Vec<f64>,
@@ -450,14 +468,7 @@ mod tests {
             max_steps: MAX_SECANT_STEPS,
         };
         for (j, se) in se.into_iter().enumerate() {
-            let fit = Fitted {
-                model: &model,
-                obs: &obs,
-                params: &params,
-                best: &best,
-                fixed: &[None, None],
-                s2: 1.0,
-            };
+            let fit = unfixed(&model, &obs, &params, &best, &[None, None]);
             let pr = profile(&fit, j, se, walk, &progress).unwrap();
             let c = best.values[j];
             for (end, wald) in [(pr.lower, c - Z_95 * se), (pr.upper, c + Z_95 * se)] {
@@ -513,14 +524,7 @@ mod tests {
             ),
             (ProfileWalk::Grid, 0.01),
         ] {
-            let fit = Fitted {
-                model: &model,
-                obs: &obs,
-                params: &params,
-                best: &best,
-                fixed: &[None],
-                s2: 1.0,
-            };
+            let fit = unfixed(&model, &obs, &params, &best, &[None]);
             let pr = profile(&fit, 0, se, walk, &progress).unwrap();
             for (end, c) in [pr.lower, pr.upper].into_iter().zip(closed) {
                 let d = delta(end.value());
@@ -546,14 +550,7 @@ mod tests {
         // p[1] is not used by f = p₀² x
         let params = [param("p", 1.0), param("q", 0.0)];
         let best = minimize(&model, &obs, &params, &[1.0, 0.0], &[None, None]);
-        let fit = Fitted {
-            model: &model,
-            obs: &obs,
-            params: &params,
-            best: &best,
-            fixed: &[None, None],
-            s2: 1.0,
-        };
+        let fit = unfixed(&model, &obs, &params, &best, &[None, None]);
         let walk = ProfileWalk::Secant { max_steps: 6 };
         let pr = profile(&fit, 1, 1.0, walk, &Progress::new()).unwrap();
         let c = best.values[1];
