@@ -272,3 +272,22 @@ fn a_fit_range_of_the_wrong_length_is_refused_by_name() {
         );
     }
 }
+
+/// An instrument's binary file given to `fit --data` is named as such, with where it is read
+/// (issue 77: "CSV parse error: record 0 … invalid utf-8" on a JPK `.jpk-force`).
+#[test]
+fn an_instrument_file_for_fit_says_where_it_is_read() {
+    refused(
+        &[
+            "fit",
+            "--probe",
+            "examples/probe-fit-spot3.toml",
+            "--data",
+            "examples/force-curve-jpk-spot3-0192.jpk-force",
+        ],
+        &[
+            "a binary file",
+            "afmdyn.fit(data=PATH) reads instrument files",
+        ],
+    );
+}

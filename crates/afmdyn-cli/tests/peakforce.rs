@@ -99,3 +99,136 @@ fn peakforce_holds_a_setpoint_past_a_grazing_tap() {
         assert!(err.contains("not meaningful"), "{err}");
     }
 }
+
+/// The SI block of a setpoint's document gives the rest distance the feedback found (issue 77:
+/// it kept the probe's own z_c, 95 nm, beside a `z_c` of 98.09 nm).
+#[test]
+fn peakforce_setpoint_si_block_names_the_z_c_found() {
+    let out = afmdyn(&[
+        "peakforce",
+        "--probe",
+        AIR,
+        "--setpoint",
+        "2nN",
+        "--json",
+        "--files",
+        "none",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let found = doc["z_c"].as_f64().unwrap();
+    let si = doc["si"]["z_c_m"].as_f64().unwrap();
+    assert_eq!(si, found, "si.z_c_m {si} against z_c {found}");
+    assert!((found - 95e-9).abs() > 1e-9, "the probe's own z_c: {found}");
+}
+
+/// A setpoint no z_c reaches is refused in the units it was given (issue 77: the refusal of
+/// 500 pN read "setpoint = 0.0386324", the force in the model's unit F̃).
+#[test]
+fn peakforce_refuses_a_setpoint_in_newtons() {
+    let out = afmdyn(&[
+        "peakforce",
+        "--probe",
+        AIR,
+        "--setpoint",
+        "500pN",
+        "--files",
+        "none",
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("setpoint = 5e-10 N: no z_c gives"), "{err}");
+}
+
+/// The probe's own warnings reach a PeakForce image as they reach `peakforce` (issue 77: the
+/// Tabor warning of a compliant, adhesive DMT sample was missing from `image --mode
+/// peakforce` on the same probe).
+#[test]
+fn a_peakforce_image_carries_the_probes_tabor_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    let probe = std::fs::read_to_string(AIR)
+        .unwrap()
+        .replace("youngs_modulus = 2.7e9", "youngs_modulus = 2e8")
+        .replace("radius = 2e-9", "radius = 20e-9")
+        .replace("hamaker = 6.6e-20", "hamaker = 2e-19");
+    let probe_path = dir.path().join("probe.toml");
+    std::fs::write(&probe_path, probe).unwrap();
+    let sample = dir.path().join("flat.toml");
+    std::fs::write(&sample, "size = [1.0e-6, 1.0e-6]\n").unwrap();
+    let tabor = "the sample's Tabor parameter is 14.9";
+    let single = afmdyn(&[
+        "peakforce",
+        "--probe",
+        probe_path.to_str().unwrap(),
+        "--files",
+        "none",
+    ]);
+    assert!(String::from_utf8_lossy(&single.stderr).contains(tabor));
+    let out = afmdyn(&[
+        "image",
+        "--mode",
+        "peakforce",
+        "--probe",
+        probe_path.to_str().unwrap(),
+        "--sample",
+        sample.to_str().unwrap(),
+        "--pixels",
+        "1",
+        "--setpoint",
+        "30nN",
+        "--json",
+        "--files",
+        "none",
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains(&format!("background: {tabor}")), "{err}");
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let warnings = doc["warnings"].as_array().unwrap();
+    assert!(
+        warnings.iter().any(|w| w.as_str().unwrap().contains(tabor)),
+        "{doc}"
+    );
+}
+
+/// A soft, adhesive sample the tip indents while the force stays attractive: the warning says
+/// so, not that the sample never reaches the tip beside an indentation past R/2 (issue 77).
+#[test]
+fn an_attractive_peak_force_in_contact_is_not_called_no_contact() {
+    let dir = tempfile::tempdir().unwrap();
+    let probe = std::fs::read_to_string(AIR)
+        .unwrap()
+        .replace("youngs_modulus = 2.7e9", "youngs_modulus = 5e6")
+        .replace("radius = 2e-9", "radius = 20e-9")
+        .replace("hamaker = 6.6e-20", "hamaker = 2e-19");
+    let path = dir.path().join("probe.toml");
+    std::fs::write(&path, probe).unwrap();
+    let out = afmdyn(&[
+        "peakforce",
+        "--probe",
+        path.to_str().unwrap(),
+        "--json",
+        "--files",
+        "none",
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(
+        doc["channels"]["peak_force"].as_f64().unwrap() <= 0.0,
+        "{doc}"
+    );
+    assert!(
+        doc["channels"]["deformation"].as_f64().unwrap() > 0.0,
+        "{doc}"
+    );
+    assert!(
+        err.contains("adhesion outweighs the elastic repulsion"),
+        "{err}"
+    );
+    assert!(!err.contains("never reaches the tip"), "{err}");
+}

@@ -260,6 +260,12 @@ free_amplitude = 20e-9
             && err.contains("exceeds half the tip radius R = 8e-9 m"),
         "{err}"
     );
+    // the advice holds for AM's amplitude ratio and for PeakForce's force (issue 77: it said
+    // "a larger setpoint", wrong for a peak-force setpoint)
+    assert!(
+        err.contains("a larger AM setpoint A/A₀, a smaller peak-force setpoint"),
+        "{err}"
+    );
     let stiff = args("examples/probe-point-mass-dmt.toml", "stiff");
     assert!(stiff.status.success());
     let err = String::from_utf8_lossy(&stiff.stderr);

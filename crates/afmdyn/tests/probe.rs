@@ -498,7 +498,7 @@ fn unit_slips_are_refused_with_the_meant_reading() {
         let key = l.split('=').next().unwrap_or("").trim();
         let line = match (section.as_str(), key) {
             ("[tip]", "radius") => "radius = 10".to_string(),
-            ("[sample]", "youngs_modulus") => "youngs_modulus = 4".to_string(),
+            ("[sample]", "youngs_modulus") => "youngs_modulus = 0.5".to_string(),
             ("[sample]", "hamaker") => "hamaker = 6.6".to_string(),
             ("[cantilever]", "resonance_frequency") => "resonance_frequency = 300".to_string(),
             ("[drive]", "free_amplitude") => "free_amplitude = 1e-30".to_string(),
@@ -514,8 +514,8 @@ fn unit_slips_are_refused_with_the_meant_reading() {
     for needle in [
         "[tip].radius = 10 (m): longer than 100 µm for a tip radius; probe files are in metres: \
          10 nm is 10e-9",
-        "[sample].youngs_modulus = 4 (Pa): below 100 Pa",
-        "4 GPa is 4e9",
+        "[sample].youngs_modulus = 0.5 (Pa): below 1 Pa",
+        "0.5 GPa is 0.5e9",
         "[sample].hamaker = 6.6 (J): above 1e-17 J",
         // (it was refused naming alpha5 = 7.8e21, a group the user never wrote)
         "[drive].free_amplitude = 1e-30 (m): below 1 pm",
@@ -526,6 +526,63 @@ fn unit_slips_are_refused_with_the_meant_reading() {
     }
     // the example itself passes every check
     assert!(Probe::parse(&full, "example.toml").is_ok());
+}
+
+/// Soft matter below 100 Pa is a sample, not a unit slip (issue 77: E = 50 Pa was refused as
+/// "softer than any cell", and a fit held two gels nanite reads at 56 and 73 Pa at 100 Pa):
+/// accepted down to 1 Pa, with a warning below the 10 Pa of the softest gels.
+#[test]
+fn soft_gels_are_samples() {
+    let full = std::fs::read_to_string("../../examples/probe-point-mass-dmt.toml").unwrap();
+    let at = |e: &str| {
+        let mut section = "";
+        let text: Vec<String> = full
+            .lines()
+            .map(|l| {
+                if l.starts_with('[') {
+                    section = l.trim();
+                }
+                match (section, l.split('=').next().unwrap_or("").trim()) {
+                    ("[sample]", "youngs_modulus") => format!("youngs_modulus = {e}"),
+                    _ => l.to_string(),
+                }
+            })
+            .collect();
+        Probe::parse(&text.join("\n"), "gel.toml")
+    };
+    let gel = at("50").expect("a 50 Pa gel is a sample");
+    assert!(!gel.warnings().iter().any(|w| w.contains("youngs_modulus")));
+    let slip = at("4").expect("4 Pa: accepted with a warning");
+    let w = slip.warnings().join("\n");
+    assert!(
+        w.contains("youngs_modulus") && w.contains("4 GPa is 4e9"),
+        "{w}"
+    );
+}
+
+/// A tip radius below an atom is refused (issue 77: 1e-308 m was accepted while 2 m was not).
+#[test]
+fn a_tip_radius_below_an_atom_is_refused() {
+    let full = std::fs::read_to_string("../../examples/probe-point-mass-dmt.toml").unwrap();
+    let at = |r: &str| {
+        let text: Vec<String> = full
+            .lines()
+            .map(|l| match l.split('=').next().unwrap_or("").trim() {
+                "radius" => format!("radius = {r}"),
+                _ => l.to_string(),
+            })
+            .collect();
+        Probe::parse(&text.join("\n"), "radius.toml")
+    };
+    let Err(ProbeError::Invalid { problems, .. }) = at("1e-308") else {
+        panic!("must fail")
+    };
+    let all = problems.join("\n");
+    assert!(
+        all.contains("[tip].radius = 1e-308 (m): below 0.1 nm"),
+        "{all}"
+    );
+    assert!(at("2e-10").is_ok(), "0.2 nm is accepted (with a warning)");
 }
 
 /// The units of a recorded trajectory: the probe's scales in SI (a velocity is a length over

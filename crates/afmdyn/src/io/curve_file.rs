@@ -24,13 +24,30 @@ pub enum CurveFile {
 /// [`InputFileError`] naming the file: refused by the bounded reader, unreadable, not JSON,
 /// or a field that is not a number.
 pub fn read_curve_file(path: &Path) -> Result<CurveFile, InputFileError> {
-    let (reader, first) = open_document(path)?;
+    let (mut reader, first) = open_document(path)?;
+    let head = reader.fill_buf().map_err(|e| io_failure(path, &e))?;
+    if is_binary(head) {
+        return Err(invalid(
+            path,
+            "not a text curve (CSV or JSON) but a binary file, as an instrument's (JPK's \
+             .jpk-force is a zip archive): the command line reads CSV or JSON; Python's \
+             afmdyn.fit(data=PATH) reads instrument files through afmformats",
+        ));
+    }
     if first == Some(b'{') {
         return parse_document(path, reader).map(CurveFile::Document);
     }
     drop(reader);
     let (names, columns) = read_columns(path)?;
     Ok(CurveFile::Columns(names, columns))
+}
+
+/// Whether the first bytes `head` of a file are binary: a zip archive's signature, a NUL byte,
+/// or bytes that are no UTF-8 (a character cut at the buffer's end aside).
+fn is_binary(head: &[u8]) -> bool {
+    head.starts_with(b"PK\x03\x04")
+        || head.contains(&0)
+        || std::str::from_utf8(head).is_err_and(|e| e.error_len().is_some())
 }
 
 /// The JSON document in `path`.

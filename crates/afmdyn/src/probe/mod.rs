@@ -384,8 +384,9 @@ impl Probe {
                 "the largest indentation, {} m, exceeds half the tip radius R = {} m: the \
                  {} law's paraboloid contact holds for indentations well below R (contact \
                  radius √(Rδ) ≪ R; Johnson 1985, §4.2), so forces and indentations there are \
-                 outside the law's validity (a stiffer sample, a smaller amplitude or a larger \
-                 setpoint keeps the tip shallower)",
+                 outside the law's validity (a stiffer sample or a lighter touch keeps the tip \
+                 shallower: a smaller amplitude, a larger AM setpoint A/A₀, a smaller peak-force \
+                 setpoint)",
                 crate::error::number(indentation),
                 crate::error::number(r),
                 self.params.contact_law.name()

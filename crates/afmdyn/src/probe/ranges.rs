@@ -62,7 +62,9 @@ pub const SI_RANGES: &[SiRange] = &[
         keys: &["radius"],
         unit: "m",
         slips: &[("n", 1e-9), ("µ", 1e-6)],
-        below: None,
+        // a continuum tip is at least an atom across (issue 77: R = 1e-308 m was accepted and
+        // read a DMT modulus of 1e149 Pa)
+        below: Some((1e-10, "below 0.1 nm, smaller than an atom: no continuum tip; probe files are in metres: 10 nm is 10e-9")),
         above: Some((1e-4, "longer than 100 µm for a tip radius; probe files are in metres: {x} nm is {x}e-9")),
         magnitude: false,
         typical: Some((1e-9, 5e-5, "1 nm–50 µm of tips and colloidal probes", "radii are in m (10 nm is 10e-9)")),
@@ -166,10 +168,12 @@ pub const SI_RANGES: &[SiRange] = &[
         keys: &["youngs_modulus"],
         unit: "Pa",
         slips: &[],
-        below: Some((100.0, "below 100 Pa (softer than any cell); moduli are in Pa: {x} MPa is {x}e6, {x} GPa is {x}e9")),
+        // hydrogels, brain tissue and cells reach 10 Pa and below (issue 77: two gel curves that
+        // nanite fits at 56 and 73 Pa were held at a bound of 100 Pa)
+        below: Some((1.0, "below 1 Pa (softer than the softest gels); moduli are in Pa: {x} MPa is {x}e6, {x} GPa is {x}e9")),
         above: None,
         magnitude: false,
-        typical: None,
+        typical: Some((10.0, 1.2e12, "10 Pa–1.2 TPa of soft gels to diamond", "moduli are in Pa (4 GPa is 4e9)")),
         zero_typical: false,
     },
     SiRange {

@@ -406,7 +406,7 @@ pub(crate) fn material_curves(
     let background = background_probe(probe_table)?;
     let units = CurveUnits::from_scales(&background.scales, false);
     check_cost("image", curves_cost(&background, map, curve_points, extra)?)?;
-    let (models, of_domain) = material_models(probe_table, map, &background)?;
+    let (models, of_domain, _) = material_models(probe_table, map, &background)?;
     let materials = models
         .into_iter()
         .map(|(name, params)| {
@@ -420,8 +420,10 @@ pub(crate) fn material_curves(
     Ok((materials, of_domain, units))
 }
 
-/// The materials' (name, model) of a sample map and the material of each of its domains.
-pub(crate) type MaterialModels = (Vec<(String, Params)>, Vec<usize>);
+/// The materials' (name, model) of a sample map, the material of each of its domains, and the
+/// materials' own probe warnings ([`Probe::warnings`], each named by its material: a domain's
+/// only where the background's does not say it).
+pub(crate) type MaterialModels = (Vec<(String, Params)>, Vec<usize>, Vec<String>);
 
 /// The models of `map`'s materials under the probe table `probe_table` (its background
 /// `background`): the background, then one per domain with its own sample (name, model: the
@@ -436,6 +438,8 @@ pub(crate) fn material_models(
 ) -> Result<MaterialModels, SimError> {
     let mut models = vec![("background".to_string(), background.params)];
     let mut of_domain = Vec::with_capacity(map.domains.len());
+    let own = background.warnings();
+    let mut warnings: Vec<String> = own.iter().map(|w| format!("background: {w}")).collect();
     for d in &map.domains {
         let Some(sample) = &d.sample else {
             of_domain.push(0);
@@ -448,8 +452,10 @@ pub(crate) fn material_models(
             Probe::from_table(&root, &origin).map_err(|e| SimError::Probe(e.to_string()))?;
         of_domain.push(models.len());
         models.push((d.name.clone(), probe.params));
+        let new = probe.warnings().into_iter().filter(|w| !own.contains(w));
+        warnings.extend(new.map(|w| format!("{}: {w}", d.name)));
     }
-    Ok((models, of_domain))
+    Ok((models, of_domain, warnings))
 }
 
 /// The warnings of the materials' approach curves, each named by its material.

@@ -127,6 +127,9 @@ pub struct PeakForceImageStudy {
     pub units: CurveUnits,
     /// The setpoint in model units F̃.
     pub setpoint: f64,
+    /// The materials' own probe warnings (a sample in JKR's regime under the DMT law, a value
+    /// outside its typical range), which the image's warnings begin with.
+    pub probe_warnings: Vec<String>,
     /// The steady taps' options.
     pub options: PeakForceOptions,
     /// What a resumed run must match.
@@ -172,7 +175,7 @@ pub(crate) fn peakforce_cost(
     req: &ImageRequest,
 ) -> Result<Cost, SimError> {
     let background = peakforce_probe(probe_table, req.setpoint)?;
-    let (models, of_domain) = material_models(probe_table, map, &background)?;
+    let (models, of_domain, _) = material_models(probe_table, map, &background)?;
     let opts = PeakForceOptions::default();
     let p = background.params;
     let lever_periods = (1.0 / p.omega).max(1.0);
@@ -234,7 +237,7 @@ impl PeakForceImageStudy {
         req.validate_grid(map)?;
         let background = peakforce_probe(probe_table, req.setpoint)?;
         let units = CurveUnits::from_scales(&background.scales, true);
-        let (models, of_domain) = material_models(probe_table, map, &background)?;
+        let (models, of_domain, probe_warnings) = material_models(probe_table, map, &background)?;
         let resolved = |p: Params| Resolved {
             params: p,
             probe: Some(background.clone()),
@@ -266,6 +269,7 @@ impl PeakForceImageStudy {
             materials,
             of_domain,
             setpoint: req.setpoint / units.force,
+            probe_warnings,
             units,
             options: PeakForceOptions::default(),
             fingerprint,
@@ -293,7 +297,13 @@ impl PeakForceImageStudy {
                 )
             }
             Err(SimError::Cancelled) => return Err(SimError::Cancelled),
-            Err(e) => (0, Err(e.to_string())),
+            Err(e) => {
+                let newtons = self.setpoint * self.units.force;
+                (
+                    0,
+                    Err(super::peakforce::setpoint_in_newtons(e, newtons).to_string()),
+                )
+            }
         })
     }
 
@@ -556,17 +566,15 @@ impl PeakForceImageStudy {
                 evaluations: m.evaluations,
             })
             .collect();
-        let mut warnings: Vec<String> = materials
-            .iter()
-            .filter_map(|m| {
-                m.message.as_ref().map(|e| {
-                    format!(
-                        "{}: the setpoint is not reached ({e}): its pixels are empty (NaN)",
-                        m.name
-                    )
-                })
+        let mut warnings = self.probe_warnings.clone();
+        warnings.extend(materials.iter().filter_map(|m| {
+            m.message.as_ref().map(|e| {
+                format!(
+                    "{}: the setpoint is not reached ({e}): its pixels are empty (NaN)",
+                    m.name
+                )
             })
-            .collect();
+        }));
         let pixels: Vec<Vec<LinePixel>> = records.into_iter().map(|r| r.1).collect();
         let all = || pixels.iter().flatten();
         let reengaged = all().filter(|p| p.reengaged).count();

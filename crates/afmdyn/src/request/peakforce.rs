@@ -600,3 +600,16 @@ impl super::named::Datasets for PeakForceRequest {
         Ok((layouts, facts))
     }
 }
+
+/// A refusal of the setpoint stated in newtons (`newtons`, the request's value): the search
+/// works in F̃, which a user of a probe never wrote (issue 77); other errors unchanged.
+pub(crate) fn setpoint_in_newtons(e: SimError, newtons: f64) -> SimError {
+    match e {
+        SimError::OutOfRange { name, allowed, .. } if name == "setpoint" => SimError::OutOfRange {
+            name,
+            value: format!("{} N", crate::error::number(newtons)),
+            allowed,
+        },
+        e => e,
+    }
+}

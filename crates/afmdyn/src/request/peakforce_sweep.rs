@@ -266,10 +266,15 @@ pub(crate) fn tap_warnings(tap: &SteadyTap) -> Vec<(&'static str, String)> {
         ));
     }
     if c.peak_force <= 0.0 {
-        warnings.push((
-            "no-contact",
-            "no repulsive contact: the sample never reaches the tip at this z_c".into(),
-        ));
+        // the sample may indent the tip and still pull: adhesion outweighs the elastic
+        // repulsion at the deepest indentation (issue 77: this was said as "never reaches")
+        let why = if c.deformation > 0.0 {
+            "the tip indents the sample but adhesion outweighs the elastic repulsion at the \
+             deepest indentation (the peak force is an attraction)"
+        } else {
+            "the sample never reaches the tip at this z_c"
+        };
+        warnings.push(("no-contact", format!("no repulsive contact: {why}")));
     }
     warnings
 }

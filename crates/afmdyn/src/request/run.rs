@@ -117,6 +117,14 @@ pub trait Analysis {
     fn computed_at(&self, model: &Resolved) -> Result<Params, SimError> {
         Ok(model.params)
     }
+    /// The parameters `output` holds, for its SI block ([`document`]): [`Analysis::computed_at`],
+    /// unless the result found one of them (a PeakForce setpoint's rest distance z_c).
+    ///
+    /// # Errors
+    /// As [`Analysis::computed_at`].
+    fn found_at(&self, model: &Resolved, _output: &Self::Output) -> Result<Params, SimError> {
+        self.computed_at(model)
+    }
     /// The largest indentation max(−V_T, 0) of a result that has operating points in contact
     /// (in the model's length unit), which [`document`] holds against the contact law's
     /// validity under a probe ([`crate::probe::Probe::indentation_warnings`]); `None` (the
@@ -202,7 +210,11 @@ pub fn document<A: Analysis + ?Sized>(
     output: &A::Output,
 ) -> Result<Value, SimError> {
     let doc = analysis.report(model, output)?;
-    let mut doc = report::with_si(doc, model.probe.as_ref(), &analysis.computed_at(model)?);
+    let mut doc = report::with_si(
+        doc,
+        model.probe.as_ref(),
+        &analysis.found_at(model, output)?,
+    );
     // the result's validity against the law's assumptions, in every document of a probe
     if let (Some(p), Some(d)) = (&model.probe, analysis.largest_indentation(output)) {
         if let Some(w) = doc.get_mut("warnings").and_then(Value::as_array_mut) {

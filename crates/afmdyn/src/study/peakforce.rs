@@ -20,10 +20,10 @@ use crate::analysis::peakforce::{
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
 use crate::model::CantileverModel;
-use crate::params::Params;
+use crate::params::{Params, SweepParam};
 use crate::request::costs::{newton_work, state_bytes, steady_periods, MODEL_BYTES};
 use crate::request::limits::Cost;
-use crate::request::peakforce::{document, PeakForceResult};
+use crate::request::peakforce::{document, setpoint_in_newtons, PeakForceResult};
 use crate::request::peakforce_sweep::SweepTap;
 use crate::request::{Analysis, PeakForceRequest, PeakForceSweep, Resolved};
 use nalgebra::DVector;
@@ -69,7 +69,7 @@ impl PeakForceStudy {
                     ..SetpointOptions::default()
                 };
                 let s = peak_force_setpoint(&p, f, &opts)?;
-                let q = p.with(crate::params::SweepParam::Alpha5, s.alpha5);
+                let q = p.with(SweepParam::Alpha5, s.alpha5);
                 Ok((q, s.tap, s.evaluations))
             }
             None => {
@@ -163,7 +163,11 @@ impl Analysis for PeakForceRequest {
                     tap: self.options(),
                     ..SetpointOptions::default()
                 };
-                let s = peak_force_setpoint(&p, f / force, &opts)?;
+                let s =
+                    peak_force_setpoint(&p, f / force, &opts).map_err(|e| match model.probe {
+                        Some(_) => setpoint_in_newtons(e, f),
+                        None => e,
+                    })?;
                 Ok(PeakForceResult {
                     alpha5: s.alpha5,
                     filtered: self.filtered(model, &p, &s.tap)?,
@@ -221,6 +225,14 @@ impl Analysis for PeakForceRequest {
     }
     fn computed_at(&self, model: &Resolved) -> Result<Params, SimError> {
         self.params(model)
+    }
+    fn found_at(&self, model: &Resolved, r: &PeakForceResult) -> Result<Params, SimError> {
+        // a setpoint's z_c is the one found; a sweep keeps the probe's (its values are listed)
+        let p = self.params(model)?;
+        Ok(match r.sweep {
+            None => p.with(SweepParam::Alpha5, r.alpha5),
+            Some(_) => p,
+        })
     }
     fn report(&self, model: &Resolved, r: &PeakForceResult) -> Result<Value, SimError> {
         Ok(document(self, model, r))
