@@ -422,3 +422,70 @@ fn setpoint_summary_prints_repulsive_peak_adhesion_and_resolved_zeros() {
     assert!(e.abs() < 1e-6 * unit, "E_dis {e:e}");
     assert!(line.ends_with("E_dis 0 J"), "{line}");
 }
+
+/// Every operating point at a setpoint is an orbit of the curve, listed once (issue 77): on
+/// the RTESPA-300 over a 50 MPa DMT sample (A₀ 15 nm) the branch jumps between two of its
+/// points, and the observables interpolated across that gap made an "attractive" point at
+/// z_c = 5.98 nm with A = 12 nm where the stable orbits have 6.6–7.2 nm and 14.6 nm; a
+/// stretch of the branch traced three times listed its repulsive point three times.
+#[test]
+fn setpoint_operating_points_are_orbits_of_the_curve() {
+    let dir = tempfile::tempdir().unwrap();
+    let probe = std::fs::read_to_string(repo().join("examples/probe-rtespa300-polystyrene.toml"))
+        .unwrap()
+        .replace("youngs_modulus = 2.5e9", "youngs_modulus = 50e6")
+        .replace("viscosity = 10.0", "");
+    let path = dir.path().join("rt50.toml");
+    std::fs::write(&path, probe).unwrap();
+    let doc = json(&[
+        "approach",
+        "--probe",
+        path.to_str().unwrap(),
+        "--setpoint",
+        "0.8",
+        "--json",
+        "--files",
+        "none",
+    ]);
+    let col = |block: &serde_json::Value, k: &str| -> Vec<f64> {
+        block[k]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap_or(f64::NAN))
+            .collect()
+    };
+    let z = col(&doc["approach"], "z_c");
+    let step = (z[0] - z[1]).abs();
+    // every stable (z_c, A) of the sweeps and the branches
+    let mut stable: Vec<(f64, f64)> = Vec::new();
+    let blocks = [&doc["approach"], &doc["retract"]];
+    let branches = doc["branches"].as_array().unwrap();
+    for b in blocks.into_iter().chain(branches) {
+        let (zs, amps) = (col(b, "z_c"), col(b, "amplitude"));
+        let st = b["stable"].as_array().unwrap();
+        for i in 0..zs.len() {
+            if st[i].as_bool() == Some(true) {
+                stable.push((zs[i], amps[i]));
+            }
+        }
+    }
+    let points = doc["setpoint"]["points"].as_array().unwrap();
+    assert!(!points.is_empty());
+    let a_sp = doc["setpoint"]["amplitude"].as_f64().unwrap();
+    for (i, p) in points.iter().enumerate() {
+        let (zc, a) = (p["z_c"].as_f64().unwrap(), p["amplitude"].as_f64().unwrap());
+        assert!((a - a_sp).abs() <= 1e-6 * a_sp, "{p}");
+        let near = stable
+            .iter()
+            .any(|&(zs, amp)| (zs - zc).abs() <= 1.5 * step && (amp - a).abs() <= 0.05 * a);
+        assert!(near, "no stable orbit of the curve near {p}");
+        for q in &points[..i] {
+            let dz = (q["z_c"].as_f64().unwrap() - zc).abs();
+            assert!(
+                dz > 1e-12 || q["regime"] != p["regime"],
+                "listed twice: {p}"
+            );
+        }
+    }
+}

@@ -52,7 +52,8 @@ fn operating_points(probe_text: &str, r: f64, points: usize) -> Vec<(f64, String
     };
     let spec = approach_request(p.params, &req, u.length, false).unwrap();
     let c = approach_retract(&spec).unwrap();
-    let doc = setpoint(&p.params, &c, r, &u);
+    let ops = afmdyn::analysis::setpoint::operating_points(&spec, &c, r).unwrap();
+    let doc = setpoint(&p.params, &c, &ops, r, &u);
     doc["points"]
         .as_array()
         .unwrap()

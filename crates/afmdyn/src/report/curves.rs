@@ -403,17 +403,24 @@ pub fn regime(mean_deflection: f64) -> &'static str {
 }
 
 /// The `"setpoint"` block of `afmdyn approach --setpoint S --json`: the ratio A_sp/A₀, the
-/// amplitude it means (in `u`'s length), and per crossing of the curve
-/// ([`crate::analysis::setpoint::setpoint_crossings`]) its `source` (`"branch k"`,
+/// amplitude it means (in `u`'s length), and per operating point of the curve at the setpoint
+/// (`points`, [`crate::analysis::setpoint::operating_points`]) its `source` (`"branch k"`,
 /// `"approach"`, `"retract"`), `z_c`, `regime` (`"attractive"` where the mean tip–sample force,
 /// k⟨W⟩ for the point mass, is negative, else `"repulsive"`; García & San Paulo 2000) and the
-/// [`CURVE_COLUMNS`] interpolated there.
-pub fn setpoint(params: &Params, c: &SteppedCurve, ratio: f64, u: &CurveUnits) -> Value {
-    use crate::analysis::setpoint::{setpoint_crossings, Source};
+/// [`CURVE_COLUMNS`] of its orbit (interpolated between two time-averaged motions).
+pub fn setpoint(
+    params: &Params,
+    c: &SteppedCurve,
+    points: &[crate::analysis::setpoint::OperatingPoint],
+    ratio: f64,
+    u: &CurveUnits,
+) -> Value {
+    use crate::analysis::setpoint::Source;
     let x = z_c_of(params, u);
-    let points: Vec<Value> = setpoint_crossings(c, ratio)
-        .into_iter()
-        .map(|k| {
+    let points: Vec<Value> = points
+        .iter()
+        .map(|op| {
+            let k = &op.crossing;
             let (name, a, b) = match k.source {
                 Source::Branch(j) => (
                     format!("branch {j}"),
@@ -421,14 +428,9 @@ pub fn setpoint(params: &Params, c: &SteppedCurve, ratio: f64, u: &CurveUnits) -
                     &c.branches[j][k.index + 1].observables,
                 ),
                 Source::Sweep(s) => {
-                    let pts = match s {
-                        Sweep::First => &c.first,
-                        Sweep::Second => &c.second,
-                    };
-                    let name = if s == Sweep::First {
-                        "approach"
-                    } else {
-                        "retract"
+                    let (name, pts) = match s {
+                        Sweep::First => ("approach", &c.first),
+                        Sweep::Second => ("retract", &c.second),
                     };
                     (
                         name.to_string(),
@@ -437,24 +439,31 @@ pub fn setpoint(params: &Params, c: &SteppedCurve, ratio: f64, u: &CurveUnits) -
                     )
                 }
             };
-            let (ra, rb) = (curve_row(a, u), curve_row(b, u));
+            // the orbit's own observables; two averaged motions' interpolated
+            let mix = |p: &[f64], q: &[f64]| -> Vec<f64> {
+                p.iter()
+                    .zip(q)
+                    .map(|(p, q)| (1.0 - k.t) * p + k.t * q)
+                    .collect()
+            };
+            let (row, comps) = match &op.exact {
+                Some(o) => (curve_row(o, u).to_vec(), component_row(o, u)),
+                None => (
+                    mix(&curve_row(a, u), &curve_row(b, u)),
+                    mix(&component_row(a, u), &component_row(b, u)),
+                ),
+            };
             let mut m = serde_json::Map::new();
             m.insert("source".into(), json!(name));
             m.insert("z_c".into(), json!(x(k.value)));
-            let row: Vec<f64> = ra
-                .iter()
-                .zip(rb)
-                .map(|(p, q)| (1.0 - k.t) * p + k.t * q)
-                .collect();
             m.insert("regime".into(), json!(regime(row[3])));
             for (c, v) in CURVE_COLUMNS.iter().zip(row) {
                 m.insert(c.name.into(), json!(v));
             }
             // a multifrequency drive: each component's amplitude, phase, virial and E_dis there
-            let (ca, cb) = (component_row(a, u), component_row(b, u));
-            let names = component_columns(ca.len() / 4);
-            for ((name, _, _), (p, q)) in names.into_iter().zip(ca.iter().zip(&cb)) {
-                m.insert(name, json!((1.0 - k.t) * p + k.t * q));
+            let names = component_columns(comps.len() / 4);
+            for ((name, _, _), v) in names.into_iter().zip(comps) {
+                m.insert(name, json!(v));
             }
             Value::Object(m)
         })

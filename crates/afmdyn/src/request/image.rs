@@ -34,6 +34,8 @@
 //! setpoints.
 
 use crate::analysis::approach::approach_retract;
+use crate::analysis::setpoint::operating_points;
+use crate::analysis::stepped::SteppedSpec;
 use crate::error::SimError;
 use crate::params::Params;
 use crate::probe::Probe;
@@ -333,22 +335,25 @@ pub(crate) struct MaterialCurve {
     pub(crate) name: String,
     pub(crate) params: Params,
     pub(crate) curve: crate::analysis::stepped::SteppedCurve,
+    /// The curve's spec (its operating points are refined with it).
+    pub(crate) spec: SteppedSpec,
 }
 
 /// The approach curve of `params` (`curve_points` z_c values each way over the probe's default
-/// range, no branches).
+/// range, no branches), and its spec.
 fn approach_curve(
     params: Params,
     units: &CurveUnits,
     curve_points: usize,
-) -> Result<crate::analysis::stepped::SteppedCurve, SimError> {
+) -> Result<(SteppedSpec, crate::analysis::stepped::SteppedCurve), SimError> {
     let curve_req = CurveRequest {
         points: Some(curve_points),
         branches: false,
         ..CurveRequest::default()
     };
     let spec = approach_request(params, &curve_req, units.length, false)?;
-    approach_retract(&spec)
+    let curve = approach_retract(&spec)?;
+    Ok((spec, curve))
 }
 
 /// The background probe of an image under the probe file's table `probe_table`.
@@ -410,10 +415,12 @@ pub(crate) fn material_curves(
     let materials = models
         .into_iter()
         .map(|(name, params)| {
+            let (spec, curve) = approach_curve(params, &units, curve_points)?;
             Ok(MaterialCurve {
                 name,
                 params,
-                curve: approach_curve(params, &units, curve_points)?,
+                curve,
+                spec,
             })
         })
         .collect::<Result<Vec<_>, SimError>>()?;
@@ -473,10 +480,15 @@ fn curve_warnings(curves: &[MaterialCurve]) -> Vec<String> {
 
 /// The operating points of a material's curve at the setpoint `ratio`, in SI (`units`;
 /// [`crate::report::setpoint`]).
-fn points_at(m: &MaterialCurve, ratio: f64, units: &CurveUnits) -> Vec<OperatingPoint> {
-    let doc = crate::report::setpoint(&m.params, &m.curve, ratio, units);
+fn points_at(
+    m: &MaterialCurve,
+    ratio: f64,
+    units: &CurveUnits,
+) -> Result<Vec<OperatingPoint>, SimError> {
+    let points = operating_points(&m.spec, &m.curve, ratio)?;
+    let doc = crate::report::setpoint(&m.params, &m.curve, &points, ratio, units);
     let num = |p: &Value, k: &str| p[k].as_f64().unwrap_or(f64::NAN);
-    doc["points"]
+    Ok(doc["points"]
         .as_array()
         .map(|a| {
             a.iter()
@@ -497,7 +509,7 @@ fn points_at(m: &MaterialCurve, ratio: f64, units: &CurveUnits) -> Vec<Operating
                 })
                 .collect()
         })
-        .unwrap_or_default()
+        .unwrap_or_default())
 }
 
 /// The operating point a line engages on: the approach sweep's first (largest z_c), else the
@@ -545,7 +557,7 @@ pub fn image(
         work: 0.0,
     };
     let (curves, of_domain, units) = material_curves(probe_table, map, req.curve_points, extra)?;
-    Ok(image_of(&curves, &of_domain, &units, map, req))
+    image_of(&curves, &of_domain, &units, map, req)
 }
 
 /// The pixel centres x (m, `[pixels]`) and line positions y (m, `[lines]`) of `req` over `map`:
@@ -569,15 +581,17 @@ pub(crate) fn image_of(
     units: &CurveUnits,
     map: &SampleMap,
     req: &ImageRequest,
-) -> Image {
+) -> Result<Image, SimError> {
     let materials: Vec<Material> = curves
         .iter()
-        .map(|m| Material {
-            name: m.name.clone(),
-            points: points_at(m, req.setpoint, units),
-            warnings: m.curve.warnings.clone(),
+        .map(|m| {
+            Ok(Material {
+                name: m.name.clone(),
+                points: points_at(m, req.setpoint, units)?,
+                warnings: m.curve.warnings.clone(),
+            })
         })
-        .collect();
+        .collect::<Result<_, SimError>>()?;
     let (x, y) = pixel_grid(map, req);
     // the approach curves' own warnings (an unsettled point, a failed one), named by material
     let mut warnings = curve_warnings(curves);
@@ -630,7 +644,7 @@ pub(crate) fn image_of(
              operating point in the previous one's: the image's contrast changes there"
         ));
     }
-    Image {
+    Ok(Image {
         x,
         y,
         materials,
@@ -638,7 +652,7 @@ pub(crate) fn image_of(
         reference,
         domain_names: map.domains.iter().map(|d| d.name.clone()).collect(),
         warnings,
-    }
+    })
 }
 
 impl Image {

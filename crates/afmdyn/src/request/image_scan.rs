@@ -367,7 +367,7 @@ impl ScanStudy {
         };
         let (curves, of_domain, units) =
             material_curves(probe_table, map, req.curve_points, extra)?;
-        let ideal = image_of(&curves, &of_domain, &units, map, req);
+        let ideal = image_of(&curves, &of_domain, &units, map, req)?;
         let engage = curves
             .iter()
             .map(|m| {

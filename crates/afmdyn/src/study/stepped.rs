@@ -15,6 +15,7 @@
 
 use super::{execute_in_memory, Prefix, Study};
 use crate::analysis::progress::Progress;
+use crate::analysis::setpoint::operating_points;
 use crate::analysis::stepped::{
     check_values, finish_curve, sweep_points, CurvePoint, SteppedCurve, SteppedSpec,
 };
@@ -195,7 +196,8 @@ impl Analysis for ApproachRequest {
         let u = Self::units(model);
         let mut doc = report::approach(&model.params, c, &u);
         if let Some(s) = self.setpoint {
-            doc["setpoint"] = report::setpoint(&model.params, c, s, &u);
+            let points = operating_points(&self.spec(model)?, c, s)?;
+            doc["setpoint"] = report::setpoint(&model.params, c, &points, s, &u);
         }
         // the default range ends at the soft sample's force bound (default_range): say so when
         // the amplitude has not come down to half the free one by then

@@ -217,8 +217,10 @@ pub fn setpoint_study(
         })
         .collect();
     for &r in ratios {
-        let points: Vec<Vec<OperatingPoint>> =
-            curves.iter().map(|m| points_at(m, r, &units)).collect();
+        let points: Vec<Vec<OperatingPoint>> = curves
+            .iter()
+            .map(|m| points_at(m, r, &units))
+            .collect::<Result<_, SimError>>()?;
         let engaged = engage(&points[0]).map(|i| &points[0][i]);
         for ((_, material, height), series) in names.clone().zip(domains.iter_mut()) {
             let pts = &points[material];
