@@ -6,8 +6,7 @@ use super::{continue_branch_with, Branch, BranchEvent, BranchPoint, Continuation
 use crate::analysis::progress::Progress;
 use crate::analysis::shooting::shoot;
 use crate::error::SimError;
-use crate::integrate::build;
-use crate::maps::StroboscopicMap;
+use crate::maps::{DiscreteMap, StroboscopicMap};
 use crate::model::CantileverModel;
 use nalgebra::{DMatrix, DVector};
 
@@ -33,8 +32,8 @@ pub fn period_doubling_starts(
     let dim = z.len();
     let Some(v) = (|| {
         let model = CantileverModel::new(&spec.base.with(spec.param, pd.value)).ok()?;
-        let mut integ = build(&model, spec.integrator.clone(), 0.0, &model.rest()).ok()?;
-        let m = StroboscopicMap::new(integ.as_mut(), pd.period)
+        let m = StroboscopicMap::build(&model, spec.integrator.clone(), &model.rest(), pd.period)
+            .ok()?
             .apply(&z)
             .ok()?
             .jacobian;
@@ -61,17 +60,18 @@ pub fn period_doubling_starts(
             let Ok(model) = CantileverModel::new(&spec.base.with(spec.param, p)) else {
                 continue;
             };
-            let Ok(mut integ) = build(&model, spec.integrator.clone(), 0.0, &model.rest()) else {
+            let rest = model.rest();
+            let Ok(map) = &mut StroboscopicMap::build(&model, spec.integrator.clone(), &rest, 1)
+            else {
                 continue;
             };
             for sign_v in [1.0, -1.0] {
                 let guess = &z + &v * (sign_v * eps);
-                let map = &mut StroboscopicMap::new(integ.as_mut(), 1);
                 let Ok(o) = shoot(map, &guess, &spec.newton.with_period(2 * pd.period)) else {
                     continue;
                 };
-                let Ok(half) = StroboscopicMap::new(integ.as_mut(), pd.period).apply(&o.state)
-                else {
+                // the map of n periods, as one flow over them
+                let Ok(half) = map.linearise(&o.state, pd.period, true) else {
                     continue;
                 };
                 if (&half.state - &o.state).norm() > 1e-6 * (1.0 + o.state.norm()) {

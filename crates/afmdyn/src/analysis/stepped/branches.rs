@@ -3,7 +3,7 @@
 //! and the jumps of a sweep. Shapes, units and sources as in [`super`].
 
 use super::{
-    integrator_at, measure, relative_gap, BranchSample, CurvePoint, Jump, Reached, SteppedSpec,
+    map_at, measure, relative_gap, BranchSample, CurvePoint, Jump, Reached, SteppedSpec,
     Sweep,
 };
 use crate::analysis::continuation::{
@@ -12,7 +12,6 @@ use crate::analysis::continuation::{
 use crate::analysis::progress::Progress;
 use crate::analysis::shooting::shoot;
 use crate::error::SimError;
-use crate::maps::StroboscopicMap;
 use nalgebra::{Complex, DVector};
 
 /// Continue the branch through `from` (a stable orbit of a sweep) towards `to`, with
@@ -48,8 +47,8 @@ pub(super) fn branch(
     let mut out = Vec::with_capacity(points.len());
     for p in points {
         progress.check()?;
-        let mut integ = integrator_at(spec, p.value, &p.section[0])?;
-        let observables = measure(integ.as_mut(), &p.section[0], p.period, &spec.observables)?;
+        let mut map = map_at(spec, p.value, &p.section[0])?;
+        let observables = measure(map.integrator(), &p.section[0], p.period, &spec.observables)?;
         out.push(BranchSample {
             point: p,
             observables,
@@ -98,10 +97,9 @@ pub(super) fn branch_starts(
         let (Some(n), Some(_)) = (from.period, at.period) else {
             continue;
         };
-        let Ok(mut integ) = integrator_at(spec, at.value, &from.state) else {
+        let Ok(map) = &mut map_at(spec, at.value, &from.state) else {
             continue;
         };
-        let map = &mut StroboscopicMap::new(integ.as_mut(), 1);
         let Ok(o) = shoot(map, &from.state, &spec.newton.with_period(n)) else {
             continue;
         };
@@ -109,7 +107,7 @@ pub(super) fn branch_starts(
             continue;
         }
         let periods = n;
-        let Ok(observables) = measure(integ.as_mut(), &o.state, periods, &spec.observables) else {
+        let Ok(observables) = measure(map.integrator(), &o.state, periods, &spec.observables) else {
             continue;
         };
         starts.push(CurvePoint {

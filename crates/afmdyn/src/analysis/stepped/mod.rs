@@ -46,7 +46,7 @@ use crate::analysis::shooting::{
 use crate::analysis::steady::{decay_periods, SteadyOptions};
 use crate::error::SimError;
 use crate::integrate::{build, Integrator, IntegratorOptions};
-use crate::maps::StroboscopicMap;
+use crate::maps::{DiscreteMap, StroboscopicMap};
 use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
 use crate::tip_sample::TipSampleSystem;
@@ -64,7 +64,7 @@ use branches::{branch, branch_starts, jumps_of, on_branch, unstable_between_fold
 use torus::{torus_point, CirclePoint, Fallback, TorusOptions};
 
 mod point;
-use point::{integrator_at, step_point};
+use point::{map_at, step_point};
 pub use point::{settle, Settled, AVERAGE_AGREEMENTS, AVERAGE_MIN_WINDOW, AVERAGE_TOL};
 
 /// Largest number of values of a stepped sweep (each is a steady-state computation, twice).
@@ -778,8 +778,8 @@ pub fn is_fixed_point(
     n: usize,
     tol: f64,
 ) -> Result<bool, SimError> {
-    let mut integ = integrator_at(spec, value, z)?;
-    let m = StroboscopicMap::new(integ.as_mut(), n).apply(z)?;
+    // the map of n periods, as one flow over them
+    let m = map_at(spec, value, z)?.linearise(z, n, true)?;
     Ok((&m.state - z).norm() <= tol * (1.0 + z.norm()))
 }
 
