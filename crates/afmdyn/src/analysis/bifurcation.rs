@@ -283,11 +283,6 @@ impl<'a> SweepPlan<'a> {
         }
     }
 
-    /// Values per chunk.
-    pub fn chunk_len(&self) -> usize {
-        self.chunk
-    }
-
     /// Chunks per continuation branch (0 without continuation).
     pub fn chunks(&self) -> usize {
         if self.spec.continuation && !self.spec.values.is_empty() {
@@ -313,11 +308,6 @@ impl<'a> SweepPlan<'a> {
             }
             _ => Vec::new(),
         }
-    }
-
-    /// The number of tasks of every stage.
-    pub fn task_count(&self) -> usize {
-        self.tasks(0).len() + self.chunks() * 2 + self.spec.values.len() * self.spec.starts as usize
     }
 
     /// The value indices of `branch` in its order of continuation (increasing forward,

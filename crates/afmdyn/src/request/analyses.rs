@@ -13,7 +13,7 @@ use crate::analysis::bifurcation::SweepSpec;
 use crate::analysis::continuation::{
     continue_branch_with, continue_with_switching_with, Branch, ContinuationSpec,
 };
-use crate::analysis::converge::{mode_convergence_with, ConvergenceRun};
+use crate::analysis::converge::{mode_convergence, ConvergenceRun};
 use crate::analysis::global_continuation::{
     GlobalContinuationSpec, DEFAULT_MATCH_TOL, MAX_CONTINUATION_VALUES,
 };
@@ -631,7 +631,7 @@ impl ConvergeRequest {
         progress: &Progress,
     ) -> Result<Vec<ConvergenceRun>, SimError> {
         self.validate()?;
-        mode_convergence_with(
+        mode_convergence(
             params,
             self.max_modes,
             self.periods,
