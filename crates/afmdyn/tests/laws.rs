@@ -7,6 +7,7 @@
 
 use afmdyn::analysis::continuation::{continue_branch, BranchEnd, ContinuationSpec};
 use afmdyn::analysis::lyapunov::{lyapunov_spectrum, LyapunovOptions};
+use afmdyn::analysis::progress::Progress;
 use afmdyn::analysis::shooting::{floquet_multipliers, shoot, ShootingOptions};
 use afmdyn::analysis::steady::{steady_state, Motion, SteadyOptions};
 use afmdyn::galerkin::Region;
@@ -609,7 +610,7 @@ fn every_analysis_on_every_law() {
         let mut spec =
             ContinuationSpec::new(p, SweepParam::Omega, c.omega, c.omega + 0.03, c.period);
         spec.max_points = 6;
-        let branch = continue_branch(&spec, &o.state).unwrap();
+        let branch = continue_branch(&spec, &o.state, &Progress::new()).unwrap();
         assert!(branch.len() >= 3, "{}: {} points", c.law, branch.len());
         // six points do not reach Ω + 0.03: the branch says it stopped at its cap, where
         let last = branch.last().unwrap().value;
@@ -717,11 +718,11 @@ fn a_branch_ends_when_its_work_budget_is_spent() {
     let map = &mut StroboscopicMap::new(it.as_mut(), 1);
     let o = shoot(map, &m.rest(), &ShootingOptions::default()).unwrap();
     let mut spec = ContinuationSpec::new(p, SweepParam::Omega, 5.0, 4.9, 1);
-    let full = continue_branch(&spec, &o.state).unwrap();
+    let full = continue_branch(&spec, &o.state, &Progress::new()).unwrap();
     assert_eq!(full.end, BranchEnd::Range);
     assert!(full.end.warning(SweepParam::Omega, 1).is_none());
     spec.max_work = 2_000;
-    let cut = continue_branch(&spec, &o.state).unwrap();
+    let cut = continue_branch(&spec, &o.state, &Progress::new()).unwrap();
     let BranchEnd::Budget { value, steps } = cut.end else {
         panic!("ended by {:?}", cut.end);
     };

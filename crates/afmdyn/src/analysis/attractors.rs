@@ -138,19 +138,13 @@ pub fn same_attractor(a: &SteadyState, b: &SteadyState, tol: f64) -> bool {
 
 /// Run the search in parallel over samples.
 ///
-/// # Errors
-/// [`SimError`] for invalid parameters or options (individual failing starts are reported in
-/// [`AttractorReport::failures`]).
-pub fn find_attractors(spec: &AttractorSpec) -> Result<AttractorReport, SimError> {
-    find_attractors_with(spec, &Progress::new())
-}
-
-/// [`find_attractors`] counting the random starts done in `progress` (its total grows by
-/// `samples`) and stopping when it is cancelled.
+/// It counts the random starts done in `progress` (its total grows by `samples`) and stops when
+/// it is cancelled.
 ///
 /// # Errors
-/// As [`find_attractors`]; [`SimError::Cancelled`] once `progress` is cancelled.
-pub fn find_attractors_with(
+/// [`SimError`] for invalid parameters or options (individual failing starts are reported in
+/// [`AttractorReport::failures`]); [`SimError::Cancelled`] once `progress` is cancelled.
+pub fn find_attractors(
     spec: &AttractorSpec,
     progress: &Progress,
 ) -> Result<AttractorReport, SimError> {

@@ -207,7 +207,12 @@ pub struct Resume {
 
 fn solve_point(spec: &SweepSpec, value: f64, z0: &DVector<f64>) -> Result<SteadyState, SimError> {
     let p = spec.base.with(spec.param, value);
-    steady_state_of(&CantileverModel::new(&p)?, spec.integrator.clone(), z0, &spec.steady)
+    steady_state_of(
+        &CantileverModel::new(&p)?,
+        spec.integrator.clone(),
+        z0,
+        &spec.steady,
+    )
 }
 
 /// One task of a planned sweep ([`SweepPlan`]).

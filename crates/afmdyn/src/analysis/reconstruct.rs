@@ -275,21 +275,12 @@ fn first_interval(omega: f64, slope: f64, step: f64, a: f64) -> f64 {
 /// The force and potential of `curve` by the Sader–Jarvis inversion (module doc): by FFT on a
 /// uniform grid, else by the direct sum ([`ShiftCurve::method`]).
 ///
-/// # Errors
-/// As [`ShiftCurve::method`].
-pub fn sader_jarvis(curve: &ShiftCurve) -> Result<Reconstruction, SimError> {
-    sader_jarvis_with(curve, &Progress::new())
-}
-
-/// [`sader_jarvis`] counting the curve's points in `progress` and checking its cancel flag
-/// between chunks of rows.
+/// It counts the curve's points in `progress` and checks its cancel flag between chunks of
+/// rows.
 ///
 /// # Errors
 /// As [`ShiftCurve::method`]; [`SimError::Cancelled`] once `progress` is cancelled.
-pub fn sader_jarvis_with(
-    curve: &ShiftCurve,
-    progress: &Progress,
-) -> Result<Reconstruction, SimError> {
+pub fn sader_jarvis(curve: &ShiftCurve, progress: &Progress) -> Result<Reconstruction, SimError> {
     match curve.method()? {
         Method::Fft { h } => sader_jarvis_fft(curve, h, progress),
         Method::Direct => sader_jarvis_direct(curve, progress),
@@ -539,13 +530,16 @@ mod tests {
                 .iter()
                 .map(|&d| giessibl_shift(&force, d, k, f0, a, GIESSIBL_NODES))
                 .collect();
-            let r = sader_jarvis(&ShiftCurve {
-                distance: distance.clone(),
-                frequency_shift,
-                spring_constant: k,
-                resonance_frequency: f0,
-                amplitude: a,
-            })
+            let r = sader_jarvis(
+                &ShiftCurve {
+                    distance: distance.clone(),
+                    frequency_shift,
+                    spring_constant: k,
+                    resonance_frequency: f0,
+                    amplitude: a,
+                },
+                &Progress::new(),
+            )
             .unwrap();
             for (i, &d) in distance.iter().enumerate().filter(|(_, &d)| d <= 5e-9) {
                 let (want, u) = (force(d), -hr / (6.0 * d) + hr / (6.0 * hi));
@@ -568,7 +562,7 @@ mod tests {
             resonance_frequency: 1.0,
             amplitude: 1.0,
         };
-        assert!(sader_jarvis(&good).is_ok());
+        assert!(sader_jarvis(&good, &Progress::new()).is_ok());
         for (bad, name) in [
             (
                 ShiftCurve {
@@ -599,7 +593,9 @@ mod tests {
                 "distance",
             ),
         ] {
-            let e = sader_jarvis(&bad).unwrap_err().to_string();
+            let e = sader_jarvis(&bad, &Progress::new())
+                .unwrap_err()
+                .to_string();
             assert!(e.starts_with(name), "{e}");
         }
     }

@@ -50,7 +50,10 @@ impl StroboscopicMap<'static> {
         z: &DVector<f64>,
         periods: usize,
     ) -> Result<Self, SimError> {
-        Ok(Self::held(Held::Owned(build(model, opts, 0.0, z)?), periods))
+        Ok(Self::held(
+            Held::Owned(build(model, opts, 0.0, z)?),
+            periods,
+        ))
     }
 }
 

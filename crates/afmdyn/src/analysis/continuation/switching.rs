@@ -2,7 +2,7 @@
 //! the continuation of the whole period-doubling cascade ([`continue_with_switching`]).
 //! Shapes, units and sources as in [`super`].
 
-use super::{continue_branch_with, Branch, BranchEvent, BranchPoint, ContinuationSpec};
+use super::{continue_branch, Branch, BranchEvent, BranchPoint, ContinuationSpec};
 use crate::analysis::progress::Progress;
 use crate::analysis::shooting::shoot;
 use crate::error::SimError;
@@ -90,29 +90,19 @@ pub fn period_doubling_starts(
 /// bifurcations at the same parameter values) is kept once. Returns the branches, the first
 /// being the one of `spec`.
 ///
-/// # Errors
-/// As [`super::continue_branch`] for the first branch; a sub-branch that fails is skipped.
-pub fn continue_with_switching(
-    spec: &ContinuationSpec,
-    guess: &DVector<f64>,
-    max_period: usize,
-) -> Result<Vec<Branch>, SimError> {
-    continue_with_switching_with(spec, guess, max_period, &Progress::new())
-}
-
-/// [`continue_with_switching`] counting every branch point in `progress` and stopping when it
-/// is cancelled.
+/// It counts every branch point in `progress` and stops when it is cancelled.
 ///
 /// # Errors
-/// As [`continue_with_switching`]; [`SimError::Cancelled`] once `progress` is cancelled (also
-/// inside a sub-branch, whose other failures are skipped).
-pub fn continue_with_switching_with(
+/// As [`super::continue_branch`] for the first branch; a sub-branch that fails is skipped;
+/// [`SimError::Cancelled`] once `progress` is cancelled (also inside a sub-branch, whose other
+/// failures are skipped).
+pub fn continue_with_switching(
     spec: &ContinuationSpec,
     guess: &DVector<f64>,
     max_period: usize,
     progress: &Progress,
 ) -> Result<Vec<Branch>, SimError> {
-    let mut branches = vec![continue_branch_with(spec, guess, progress)?];
+    let mut branches = vec![continue_branch(spec, guess, progress)?];
     let mut next = 0;
     while next < branches.len() {
         let pds: Vec<BranchPoint> = branches[next]
@@ -159,7 +149,7 @@ pub fn continue_with_switching_with(
                         .collect(),
                     ..spec.clone()
                 };
-                let b = match continue_branch_with(&sub, &z, progress) {
+                let b = match continue_branch(&sub, &z, progress) {
                     Ok(b) => b,
                     Err(SimError::Cancelled) => return Err(SimError::Cancelled),
                     Err(_) => continue,

@@ -3,11 +3,10 @@
 //! and the jumps of a sweep. Shapes, units and sources as in [`super`].
 
 use super::{
-    map_at, measure, relative_gap, BranchSample, CurvePoint, Jump, Reached, SteppedSpec,
-    Sweep,
+    map_at, measure, relative_gap, BranchSample, CurvePoint, Jump, Reached, SteppedSpec, Sweep,
 };
 use crate::analysis::continuation::{
-    continue_branch_with, Branch, BranchEnd, BranchEvent, ContinuationSpec,
+    continue_branch, Branch, BranchEnd, BranchEvent, ContinuationSpec,
 };
 use crate::analysis::progress::Progress;
 use crate::analysis::shooting::shoot;
@@ -42,7 +41,7 @@ pub(super) fn branch(
     cs.ds = scale / 100.0;
     cs.ds_max = scale / 25.0;
     // the branch's points were counted as they came; its length is known only now
-    let Branch { points, end } = continue_branch_with(&cs, &from.state, progress)?;
+    let Branch { points, end } = continue_branch(&cs, &from.state, progress)?;
     progress.add_total(points.len());
     let mut out = Vec::with_capacity(points.len());
     for p in points {
@@ -107,7 +106,8 @@ pub(super) fn branch_starts(
             continue;
         }
         let periods = n;
-        let Ok(observables) = measure(map.integrator(), &o.state, periods, &spec.observables) else {
+        let Ok(observables) = measure(map.integrator(), &o.state, periods, &spec.observables)
+        else {
             continue;
         };
         starts.push(CurvePoint {

@@ -554,24 +554,11 @@ pub fn check_values(spec: &SteppedSpec) -> Result<(), SimError> {
 /// non-finite ones; [`SimError::Params`] when a value is outside its parameter's range;
 /// [`SimError`] from the integrator. A branch that cannot be continued is a warning.
 pub fn stepped_sweep(spec: &SteppedSpec) -> Result<SteppedCurve, SimError> {
-    stepped_sweep_with(spec, &Progress::new())
-}
-
-/// [`stepped_sweep`] counting in `progress` the points of both sweeps (its total grows by
-/// twice the number of values) and of the branches (whose lengths are not known ahead), and
-/// stopping when it is cancelled.
-///
-/// # Errors
-/// As [`stepped_sweep`]; [`SimError::Cancelled`] once `progress` is cancelled.
-pub(crate) fn stepped_sweep_with(
-    spec: &SteppedSpec,
-    progress: &Progress,
-) -> Result<SteppedCurve, SimError> {
     check_values(spec)?;
-    progress.add_total(2 * spec.values.len());
-    let count = |_: usize, _: &CurvePoint| progress.tick();
-    let (first, second) = sweep_points(spec, &[], progress.cancel_flag(), &count)?;
-    finish_curve(spec, first, second, progress)
+    // a run of its own, never cancelled
+    let progress = Progress::new();
+    let (first, second) = sweep_points(spec, &[], progress.cancel_flag(), &|_, _| ())?;
+    finish_curve(spec, first, second, &progress)
 }
 
 /// The curve of the two sweeps ([`sweep_points`]): with `spec.branches` the periodic-orbit
