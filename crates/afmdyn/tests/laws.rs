@@ -12,7 +12,7 @@ use afmdyn::analysis::shooting::{floquet_multipliers, shoot, ShootingOptions};
 use afmdyn::analysis::steady::{steady_state, Motion, SteadyOptions};
 use afmdyn::galerkin::Region;
 use afmdyn::integrate::{advance_dyn, build, IntegratorKind, IntegratorOptions, SwitchEvent};
-use afmdyn::maps::flow::flow_with_jacobian;
+use afmdyn::maps::flow::flow;
 use afmdyn::maps::StroboscopicMap;
 use afmdyn::request::analyses::OrbitRequest;
 use afmdyn::{CantileverModel, ContactLaw, EventKind, Params, SweepParam};
@@ -448,7 +448,7 @@ proptest! {
             }
             let t1 = m.period();
             let mut it = build(&m, opts(IntegratorKind::Adaptive, 1e-13), 0.0, &z0).unwrap();
-            let map = flow_with_jacobian(it.as_mut(), 0.0, &z0, t1).unwrap();
+            let map = flow(it.as_mut(), 0.0, &z0, t1, None, true).unwrap();
             // near grazing the flow is not differentiable enough for central differences
             if map.grazing_distance <= 1e-2 {
                 continue;

@@ -98,7 +98,7 @@ use crate::analysis::shooting::{shoot, ShootingOptions, GRAZING_TOL};
 use crate::contact::{ContactLaw, DmtLaw, HertzLaw, Law, TipSample, TipSampleLaw};
 use crate::error::SimError;
 use crate::integrate::adaptive::Adaptive;
-use crate::maps::flow::flow_with_jacobian;
+use crate::maps::flow::flow;
 use crate::maps::StroboscopicMap;
 use crate::model::{CantileverModel, DampingDerivative, ForcingDerivative};
 use crate::params::{Params, SweepParam};
@@ -601,7 +601,7 @@ pub fn orbit_sensitivity_component(
     y0.rows_mut(0, d).copy_from(&state);
     let mut integ = Adaptive::new(&ext, tol);
     let period = HybridSystem::period(model);
-    let flow = flow_with_jacobian(&mut integ, 0.0, &y0, period)?;
+    let flow = flow(&mut integ, 0.0, &y0, period, None, true)?;
     let big = &flow.jacobian;
     let m = big.view((0, 0), (d, d)).into_owned();
     let d_map = big.view((0, first), (d, k)).into_owned();
