@@ -332,12 +332,7 @@ pub fn sader_jarvis_direct(
     // the last point has no interval beyond it: its force is the end of the data
     force[n - 1] = 0.0;
     progress.advance(1);
-    Ok(Reconstruction {
-        distance: d.clone(),
-        potential: potential_of(d, &force),
-        force,
-        exact: None,
-    })
+    Ok(Reconstruction::of(d.clone(), force, None))
 }
 
 /// The Sader–Jarvis inversion on a uniform grid of spacing `h` (module doc: the Ω part by a
@@ -431,23 +426,26 @@ fn sader_jarvis_fft(
     }
     force[n - 1] = 0.0;
     progress.advance(1);
-    Ok(Reconstruction {
-        distance: d.clone(),
-        potential: potential_of(d, &force),
-        force,
-        exact: None,
-    })
+    Ok(Reconstruction::of(d.clone(), force, None))
 }
 
-/// U(d_j) = ∫_{d_j}^{d_max} F dt by the trapezoidal rule on the increasing distances `d`
-/// (U(d_max) = 0): the potential of every reconstruction.
-pub(crate) fn potential_of(d: &[f64], force: &[f64]) -> Vec<f64> {
-    let n = d.len();
-    let mut potential = vec![0.0; n];
-    for j in (0..n.saturating_sub(1)).rev() {
-        potential[j] = potential[j + 1] + 0.5 * (force[j] + force[j + 1]) * (d[j + 1] - d[j]);
+impl Reconstruction {
+    /// The reconstruction of `force` at the increasing distances `d`, its potential
+    /// U(d_j) = ∫_{d_j}^{d_max} F dt by the trapezoidal rule (U(d_max) = 0): the end of every
+    /// inversion.
+    pub(crate) fn of(d: Vec<f64>, force: Vec<f64>, exact: Option<ExactRecord>) -> Reconstruction {
+        let n = d.len();
+        let mut potential = vec![0.0; n];
+        for j in (0..n.saturating_sub(1)).rev() {
+            potential[j] = potential[j + 1] + 0.5 * (force[j] + force[j + 1]) * (d[j + 1] - d[j]);
+        }
+        Reconstruction {
+            distance: d,
+            force,
+            potential,
+            exact,
+        }
     }
-    potential
 }
 
 /// Each named constant finite and > 0.

@@ -46,7 +46,7 @@
 //! Units: any consistent set (SI: lengths in m, k in N/m → F in N).
 
 use super::progress::Progress;
-use super::reconstruct::{positive_constants, potential_of, Reconstruction};
+use super::reconstruct::{positive_constants, Reconstruction};
 use crate::error::SimError;
 use std::f64::consts::PI;
 
@@ -291,12 +291,7 @@ pub fn matrix_inversion(curve: &AmCurve, progress: &Progress) -> Result<Reconstr
         force[k] = (y[k] - rest) / diag;
     }
     progress.advance(1);
-    Ok(Reconstruction {
-        potential: potential_of(&d, &force),
-        distance: d,
-        force,
-        exact: None,
-    })
+    Ok(Reconstruction::of(d, force, None))
 }
 
 #[cfg(test)]

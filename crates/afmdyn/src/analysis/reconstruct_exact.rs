@@ -54,7 +54,7 @@
 
 use super::progress::Progress;
 pub use super::reconstruct::ExactRecord;
-use super::reconstruct::{potential_of, sader_jarvis, uniform_spacing, Reconstruction, ShiftCurve};
+use super::reconstruct::{sader_jarvis, uniform_spacing, Reconstruction, ShiftCurve};
 use super::reconstruct_am::{nodes_within, weight};
 use crate::error::SimError;
 use rustfft::{num_complex::Complex, Fft, FftPlanner};
@@ -295,11 +295,9 @@ pub fn exact_inversion(
         forward_residual: rho,
         converged: rho <= EXACT_TOLERANCE,
     };
-    let d = curve.distance.clone();
-    Ok(Reconstruction {
-        potential: potential_of(&d, &force),
-        distance: d,
+    Ok(Reconstruction::of(
+        curve.distance.clone(),
         force,
-        exact: Some(record),
-    })
+        Some(record),
+    ))
 }
