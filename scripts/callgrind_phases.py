@@ -6,7 +6,7 @@ callgrind) by phase, from the inclusive costs of `callgrind_annotate --tree=call
 - transients: `stepped::settle` (integration after a jump or at a nonperiodic point, with its
   Newton attempts and the classification by `steady::steady_state`);
 - observables: `observables::observe` (every sweep and branch point);
-- branches: `continuation::continue_branch_with` (corrector flows, ∂F/∂p, event location);
+- branches: `continuation::continue_branch` (corrector flows, ∂F/∂p, event location);
 - rest: everything else (set-up, branch starts, outputs).
 
 Usage: python3 scripts/callgrind_phases.py CALLGRIND_OUT NAME
@@ -54,7 +54,7 @@ orbits = from_caller("analysis::stepped::continue_orbit", "analysis::stepped::sw
 orbits += from_caller("analysis::shooting::map::shoot", "analysis::stepped::sweep")
 transients = inclusive("analysis::stepped::settle")
 observables = inclusive("analysis::observables::observe")
-branches = inclusive("analysis::continuation::continue_branch_with")
+branches = inclusive("analysis::continuation::continue_branch")
 rest = total - orbits - transients - observables - branches
 g = lambda v: "%.2f" % (v / 1e9)
 print(

@@ -5,6 +5,7 @@
 //! Run with `cargo bench -p afmdyn --bench stability`.
 
 use afmdyn::analysis::continuation::{continue_branch, ContinuationSpec};
+use afmdyn::analysis::progress::Progress;
 use afmdyn::analysis::shooting::{shoot, ShootingOptions};
 use afmdyn::analysis::steady::{steady_state, SteadyOptions};
 use afmdyn::integrate::{build, IntegratorOptions};
@@ -48,14 +49,22 @@ fn continuation(c: &mut Criterion) {
     let base = Params::default();
     let guess = attractor(&Params { omega: 5.0, ..base });
     let spec = ContinuationSpec::new(base, SweepParam::Omega, 5.0, 1.0, 1);
-    let n = continue_branch(&spec, &guess).unwrap().len();
+    let n = continue_branch(&spec, &guess, &Progress::new())
+        .unwrap()
+        .len();
     println!("continuation Ω 5 → 1: {n} points");
     let mut g = c.benchmark_group("continuation");
     g.sample_size(10)
         .warm_up_time(Duration::from_millis(100))
         .measurement_time(Duration::from_secs(20));
     g.bench_function("period-1 branch, Ω 5 → 1", |b| {
-        b.iter(|| black_box(continue_branch(&spec, &guess).unwrap().len()))
+        b.iter(|| {
+            black_box(
+                continue_branch(&spec, &guess, &Progress::new())
+                    .unwrap()
+                    .len(),
+            )
+        })
     });
     g.finish();
 }

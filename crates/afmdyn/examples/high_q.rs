@@ -21,6 +21,7 @@ use afmdyn::analysis::basins::{
     DEFAULT_NEAR_TOL, DEFAULT_STRIDE,
 };
 use afmdyn::analysis::bifurcation::SweepSpec;
+use afmdyn::analysis::progress::Progress;
 use afmdyn::analysis::steady::{steady_state, SteadyOptions};
 use afmdyn::integrate::{build, IntegratorOptions};
 use afmdyn::probe::Probe;
@@ -62,13 +63,16 @@ fn census(samples: usize) -> Result<(), Box<dyn std::error::Error>> {
         integrator: IntegratorOptions::default(),
     };
     let t = Instant::now();
-    let fast = find_attractors(&spec)?;
+    let fast = find_attractors(&spec, &Progress::new())?;
     let t_fast = t.elapsed().as_secs_f64();
     let t = Instant::now();
-    let slow = find_attractors(&AttractorSpec {
-        steady: reference(),
-        ..spec.clone()
-    })?;
+    let slow = find_attractors(
+        &AttractorSpec {
+            steady: reference(),
+            ..spec.clone()
+        },
+        &Progress::new(),
+    )?;
     let t_slow = t.elapsed().as_secs_f64();
     let describe = |r: &afmdyn::analysis::attractors::AttractorReport| {
         r.attractors

@@ -28,6 +28,7 @@
 //! parameters (for `scripts/perf-floor.sh`).
 
 use afmdyn::analysis::continuation::{continue_branch, ContinuationSpec};
+use afmdyn::analysis::progress::Progress;
 use afmdyn::analysis::shooting::{shoot, ShootingOptions};
 use afmdyn::analysis::steady::{steady_state, StatsObserver, SteadyOptions};
 use afmdyn::integrate::exact::{ExactOptions, ExactPropagator, Propagation};
@@ -150,7 +151,7 @@ fn continuation(modes: usize, reps: usize) -> Result<(), Box<dyn std::error::Err
     let spec = ContinuationSpec::new(base, SweepParam::Omega, 5.0, 1.0, 1);
     let mut points = 0;
     let us = best_of(reps, || {
-        points = continue_branch(&spec, &guess).map_or(0, |b| b.len());
+        points = continue_branch(&spec, &guess, &Progress::new()).map_or(0, |b| b.len());
     });
     println!(
         "continuation N = {modes}, Ω 5 → 1: {:.3} s ({points} points)",

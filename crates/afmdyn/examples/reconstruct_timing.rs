@@ -85,7 +85,7 @@ fn main() {
         let (t_direct, direct) = best(runs, || {
             sader_jarvis_direct(&curve, &Progress::new()).expect("direct")
         });
-        let (t_fft, fft) = best(3, || sader_jarvis(&curve).expect("fft"));
+        let (t_fft, fft) = best(3, || sader_jarvis(&curve, &Progress::new()).expect("fft"));
         let scale = direct.force.iter().fold(0.0f64, |m, f| m.max(f.abs()));
         let diff = fft
             .force
@@ -94,7 +94,9 @@ fn main() {
             .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()))
             / scale;
         assert_eq!(f_before[..n - 1], direct.force[..n - 1]);
-        let (t_exact, exact) = best(3, || exact_inversion(&curve).expect("exact"));
+        let (t_exact, exact) = best(3, || {
+            exact_inversion(&curve, &Progress::new()).expect("exact")
+        });
         let record = exact.exact.expect("the exact inversion's record");
         rows.push(format!(
             "{{\"points\": {n}, \"before_s\": {t_before:.4}, \"direct_s\": {t_direct:.4}, \

@@ -101,7 +101,14 @@ fn main() {
                 let previous =
                     invariant_circle(&before, integ.clone(), &start, &opts).expect("circle");
                 let (t_cont, continued) = best_of_3(|| {
-                    continue_circle(&model, integ.clone(), &previous, &opts).expect("continued")
+                    continue_circle(
+                        &model,
+                        integ.clone(),
+                        &previous.states[0],
+                        &previous.jacobian,
+                        &opts,
+                    )
+                    .expect("continued")
                 });
                 let torus = observe_circle(&model, integ.clone(), &circle, 2).expect("observe");
                 let torus_c =

@@ -95,7 +95,7 @@ pub trait TipSampleSystem: HybridSystem {
     /// ∂g/∂p of the guard of `mode` at fixed (τ, z) for a parameter p of the forcing (Ω, α2,
     /// α5), or `None` where the system does not provide it (the default): the parameter
     /// sensitivity of a flow then is not available
-    /// ([`crate::maps::flow::flow_with_param_derivative`]).
+    /// ([`crate::maps::flow::flow`]).
     fn guard_param_derivative(&self, mode: Region, param: SweepParam, tau: f64) -> Option<f64> {
         let _ = (mode, param, tau);
         None

@@ -4,6 +4,7 @@
 use afmdyn::analysis::attractors::{find_attractors, same_attractor, AttractorSpec};
 use afmdyn::analysis::bifurcation::{run_sweep, Branch, Resume, SweepSpec};
 use afmdyn::analysis::period::{detect_period, minimal_divisor, MERGE_FACTOR};
+use afmdyn::analysis::progress::Progress;
 use afmdyn::analysis::steady::{steady_state, Motion, SteadyOptions};
 use afmdyn::integrate::{advance_dyn, build, IntegratorKind, IntegratorOptions};
 use afmdyn::{CantileverModel, Params, SweepParam};
@@ -125,7 +126,7 @@ fn clustering_merges_one_attractor_and_separates_two() {
         integrator: IntegratorOptions::default(),
     };
     // Ω = 2.8: every start reaches the same period-2 orbit, entered at either phase
-    let r = find_attractors(&spec(2.8)).unwrap();
+    let r = find_attractors(&spec(2.8), &Progress::new()).unwrap();
     assert_eq!(
         r.attractors.len(),
         1,
@@ -137,7 +138,7 @@ fn clustering_merges_one_attractor_and_separates_two() {
     );
     assert_eq!(r.attractors[0].count, 24);
     // Ω = 1.8: two coexisting period-2 orbits with different contact fractions
-    let r = find_attractors(&spec(1.8)).unwrap();
+    let r = find_attractors(&spec(1.8), &Progress::new()).unwrap();
     assert_eq!(r.attractors.len(), 2);
     let (a, b) = (&r.attractors[0].steady, &r.attractors[1].steady);
     assert!(!same_attractor(a, b, 1e-5) && !same_attractor(b, a, 1e-5));
@@ -209,7 +210,7 @@ fn attractor_census_reports_polished_orbits_with_multipliers() {
         steady: SteadyOptions::default(),
         integrator: IntegratorOptions::default(),
     };
-    let r = find_attractors(&spec).unwrap();
+    let r = find_attractors(&spec, &Progress::new()).unwrap();
     let m = CantileverModel::new(&p).unwrap();
     let mut it = build(&m, IntegratorOptions::default(), 0.0, &m.rest()).unwrap();
     let mut checked = 0;
@@ -258,7 +259,7 @@ fn the_parallel_census_equals_the_census_one_by_one() {
         steady: SteadyOptions::default(),
         integrator: IntegratorOptions::default(),
     };
-    let report = find_attractors(&spec).unwrap();
+    let report = find_attractors(&spec, &Progress::new()).unwrap();
     let m = CantileverModel::new(&p).unwrap();
     // one by one: (first start, steady state, count) per attractor in order of discovery
     let mut alone: Vec<(

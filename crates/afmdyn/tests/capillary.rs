@@ -20,7 +20,7 @@
 
 use afmdyn::contact::{Meniscus, TipSample, TipSampleLaw};
 use afmdyn::integrate::{advance, build, IntegratorKind, IntegratorOptions};
-use afmdyn::maps::flow::flow_with_jacobian;
+use afmdyn::maps::flow::flow;
 use afmdyn::probe::Probe;
 use afmdyn::{CantileverModel, ContactLaw, HybridSystem, Params, Region};
 use nalgebra::{DMatrix, DVector};
@@ -198,7 +198,7 @@ fn a_tap_dissipates_the_meniscus_energy() {
         ..IntegratorOptions::default()
     };
     let mut it = build(&m, opts, 0.0, &state).unwrap();
-    let map = flow_with_jacobian(it.as_mut(), 0.0, &state, t1).unwrap();
+    let map = flow(it.as_mut(), 0.0, &state, t1, None, true).unwrap();
     let mut flow = |z: &DVector<f64>| {
         it.reset(0.0, z).unwrap();
         advance(it.as_mut(), t1).unwrap();

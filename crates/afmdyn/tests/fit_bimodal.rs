@@ -1,16 +1,14 @@
 //! The bimodal channels' sensitivities (issue 62 §1: "or the bimodal channels"): the harmonic
 //! A₂, φ₂ of the tip deflection at the second drive component's frequency, from a second pair
 //! of Fourier integrals over the drive's common period
-//! (`analysis::fit::sensitivity::orbit_sensitivity_component`), against the library's
+//! (`analysis::fit::sensitivity::orbit_sensitivity`), against the library's
 //! observables (its component demodulation) and its exact sensitivities against fourth-order
 //! central differences of the shooting solution, on the two-mode eigenmode model of
 //! `examples/probe-bimodal.toml` (f₂ = 6.25 f₁) and the N = 3 beam of
 //! `examples/probe-beam-dmt.toml` with a second tip force (F̃ = 0.1) at 25/4 Ω, Hertz and DMT.
 
 use afmdyn::analysis::approach::{approach_retract, approach_spec};
-use afmdyn::analysis::fit::sensitivity::{
-    orbit_sensitivity_component, OrbitParam, OrbitSensitivity,
-};
+use afmdyn::analysis::fit::sensitivity::{orbit_sensitivity, OrbitParam, OrbitSensitivity};
 use afmdyn::analysis::observables::observe_orbit;
 use afmdyn::analysis::shooting::shoot;
 use afmdyn::analysis::stepped::Spacing;
@@ -38,8 +36,7 @@ const AGREE: f64 = 1e-6;
 
 fn sensitivity(params: &Params, guess: &DVector<f64>, ps: &[OrbitParam]) -> OrbitSensitivity {
     let model = CantileverModel::new(params).expect("model");
-    orbit_sensitivity_component(&model, TOL, guess, ps, Some(&newton()), Some(1))
-        .expect("sensitivity")
+    orbit_sensitivity(&model, TOL, guess, ps, Some(&newton()), Some(1)).expect("sensitivity")
 }
 
 /// The component's A₂, φ₂ at the orbit near `guess` against the observables, and their exact

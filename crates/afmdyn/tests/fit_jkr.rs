@@ -122,11 +122,13 @@ fn jkr_refusals_name_the_reason() {
     let base = probe("probe-jkr-polymer.toml");
     let guess = DVector::zeros(2);
     let model = CantileverModel::new(&base).expect("model");
-    let e = orbit_sensitivity(&model, TOL, &guess, &[OrbitParam::Hamaker], None).expect_err("H̃");
+    let e =
+        orbit_sensitivity(&model, TOL, &guess, &[OrbitParam::Hamaker], None, None).expect_err("H̃");
     assert!(e.to_string().contains("Hamaker"), "{e}");
     let dmt = probe("probe-point-mass-dmt.toml");
     let model = CantileverModel::new(&dmt).expect("model");
-    let e = orbit_sensitivity(&model, TOL, &guess, &[OrbitParam::Adhesion], None).expect_err("P̃");
+    let e =
+        orbit_sensitivity(&model, TOL, &guess, &[OrbitParam::Adhesion], None, None).expect_err("P̃");
     assert!(e.to_string().contains("jkr"), "{e}");
 }
 

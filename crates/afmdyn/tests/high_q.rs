@@ -3,6 +3,7 @@
 //! period-1 orbit coexist at z_c = 14.3 nm and a transient takes ~3 000 drive periods.
 
 use afmdyn::analysis::attractors::{find_attractors, same_attractor, AttractorSpec};
+use afmdyn::analysis::progress::Progress;
 use afmdyn::analysis::steady::{
     decay_periods, default_transient_cap, steady_state, SteadyOptions, MIN_TRANSIENT_PERIODS,
     TRANSIENT_DECAY_TIMES,
@@ -80,15 +81,18 @@ fn the_census_of_a_high_q_lever_finds_its_two_orbits_at_defaults() {
         steady: SteadyOptions::default(),
         integrator: IntegratorOptions::default(),
     };
-    let fast = find_attractors(&spec).unwrap();
-    let slow = find_attractors(&AttractorSpec {
-        steady: SteadyOptions {
-            max_periods: Some(20_000),
-            newton: false,
-            ..SteadyOptions::default()
+    let fast = find_attractors(&spec, &Progress::new()).unwrap();
+    let slow = find_attractors(
+        &AttractorSpec {
+            steady: SteadyOptions {
+                max_periods: Some(20_000),
+                newton: false,
+                ..SteadyOptions::default()
+            },
+            ..spec.clone()
         },
-        ..spec.clone()
-    })
+        &Progress::new(),
+    )
     .unwrap();
     for r in [&fast, &slow] {
         let periods: Vec<_> = r.attractors.iter().map(|a| a.steady.period()).collect();
@@ -122,18 +126,21 @@ fn the_census_of_a_high_q_lever_finds_its_two_orbits_at_defaults() {
 /// error) are not attractors, the others carry λ₁ and a warning names them and the cap.
 #[test]
 fn unsettled_ends_are_not_attractors_without_a_warning() {
-    let r = find_attractors(&AttractorSpec {
-        params: lever(14.3e-9),
-        samples: 8,
-        seed: 1,
-        cluster_tol: 1e-5,
-        steady: SteadyOptions {
-            max_periods: Some(300),
-            newton: false,
-            ..SteadyOptions::default()
+    let r = find_attractors(
+        &AttractorSpec {
+            params: lever(14.3e-9),
+            samples: 8,
+            seed: 1,
+            cluster_tol: 1e-5,
+            steady: SteadyOptions {
+                max_periods: Some(300),
+                newton: false,
+                ..SteadyOptions::default()
+            },
+            integrator: IntegratorOptions::default(),
         },
-        integrator: IntegratorOptions::default(),
-    })
+        &Progress::new(),
+    )
     .unwrap();
     let warnings = r.warnings();
     assert!(!warnings.is_empty());

@@ -7,11 +7,12 @@
 
 use afmdyn::analysis::continuation::{continue_branch, BranchEnd, ContinuationSpec};
 use afmdyn::analysis::lyapunov::{lyapunov_spectrum, LyapunovOptions};
+use afmdyn::analysis::progress::Progress;
 use afmdyn::analysis::shooting::{floquet_multipliers, shoot, ShootingOptions};
 use afmdyn::analysis::steady::{steady_state, Motion, SteadyOptions};
 use afmdyn::galerkin::Region;
 use afmdyn::integrate::{advance_dyn, build, IntegratorKind, IntegratorOptions, SwitchEvent};
-use afmdyn::maps::flow::flow_with_jacobian;
+use afmdyn::maps::flow::flow;
 use afmdyn::maps::StroboscopicMap;
 use afmdyn::request::analyses::OrbitRequest;
 use afmdyn::{CantileverModel, ContactLaw, EventKind, Params, SweepParam};
@@ -447,7 +448,7 @@ proptest! {
             }
             let t1 = m.period();
             let mut it = build(&m, opts(IntegratorKind::Adaptive, 1e-13), 0.0, &z0).unwrap();
-            let map = flow_with_jacobian(it.as_mut(), 0.0, &z0, t1).unwrap();
+            let map = flow(it.as_mut(), 0.0, &z0, t1, None, true).unwrap();
             // near grazing the flow is not differentiable enough for central differences
             if map.grazing_distance <= 1e-2 {
                 continue;
@@ -609,7 +610,7 @@ fn every_analysis_on_every_law() {
         let mut spec =
             ContinuationSpec::new(p, SweepParam::Omega, c.omega, c.omega + 0.03, c.period);
         spec.max_points = 6;
-        let branch = continue_branch(&spec, &o.state).unwrap();
+        let branch = continue_branch(&spec, &o.state, &Progress::new()).unwrap();
         assert!(branch.len() >= 3, "{}: {} points", c.law, branch.len());
         // six points do not reach Ω + 0.03: the branch says it stopped at its cap, where
         let last = branch.last().unwrap().value;
@@ -717,11 +718,11 @@ fn a_branch_ends_when_its_work_budget_is_spent() {
     let map = &mut StroboscopicMap::new(it.as_mut(), 1);
     let o = shoot(map, &m.rest(), &ShootingOptions::default()).unwrap();
     let mut spec = ContinuationSpec::new(p, SweepParam::Omega, 5.0, 4.9, 1);
-    let full = continue_branch(&spec, &o.state).unwrap();
+    let full = continue_branch(&spec, &o.state, &Progress::new()).unwrap();
     assert_eq!(full.end, BranchEnd::Range);
     assert!(full.end.warning(SweepParam::Omega, 1).is_none());
     spec.max_work = 2_000;
-    let cut = continue_branch(&spec, &o.state).unwrap();
+    let cut = continue_branch(&spec, &o.state, &Progress::new()).unwrap();
     let BranchEnd::Budget { value, steps } = cut.end else {
         panic!("ended by {:?}", cut.end);
     };

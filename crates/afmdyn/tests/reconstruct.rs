@@ -10,9 +10,8 @@
 
 use afmdyn::analysis::progress::Progress;
 use afmdyn::analysis::reconstruct::{
-    giessibl_shift, sader_jarvis, sader_jarvis_direct, sader_jarvis_with, uniform_spacing, Method,
-    ShiftCurve, GIESSIBL_NODES, MAX_DIRECT_POINTS, MAX_UNIFORM_POINTS, NEAR_FIELD,
-    UNIFORM_TOLERANCE,
+    giessibl_shift, sader_jarvis, sader_jarvis_direct, uniform_spacing, Method, ShiftCurve,
+    GIESSIBL_NODES, MAX_DIRECT_POINTS, MAX_UNIFORM_POINTS, NEAR_FIELD, UNIFORM_TOLERANCE,
 };
 use afmdyn::error::SimError;
 
@@ -114,7 +113,7 @@ fn the_fft_equals_the_direct_sum_on_an_even_grid() {
     for a in [1e-10, 1e-9, 1e-8] {
         let c = curve(d.clone(), a);
         assert_eq!(c.method().unwrap(), Method::Fft { h });
-        let fft = sader_jarvis(&c).unwrap();
+        let fft = sader_jarvis(&c, &Progress::new()).unwrap();
         let direct = sader_jarvis_direct(&c, &Progress::new()).unwrap();
         let (ef, eu) = (
             relative_difference(&fft.force, &direct.force),
@@ -144,7 +143,7 @@ fn the_fft_equals_the_direct_sum_on_a_computed_grid() {
         let d: Vec<f64> = (0..n).map(|i| lo + i as f64 * step).collect();
         let c = curve(d, 1e-9);
         assert!(matches!(c.method().unwrap(), Method::Fft { .. }), "{n}");
-        let fft = sader_jarvis(&c).unwrap();
+        let fft = sader_jarvis(&c, &Progress::new()).unwrap();
         let direct = sader_jarvis_direct(&c, &Progress::new()).unwrap();
         let e = relative_difference(&fft.force, &direct.force);
         eprintln!("computed grid, {n} points: {e:.2e}");
@@ -170,7 +169,7 @@ fn the_uniformity_criterion() {
     let c = curve(moved(0.9 * UNIFORM_TOLERANCE), 1e-9);
     assert!(matches!(c.method().unwrap(), Method::Fft { .. }));
     let e = relative_difference(
-        &sader_jarvis(&c).unwrap().force,
+        &sader_jarvis(&c, &Progress::new()).unwrap().force,
         &sader_jarvis_direct(&c, &Progress::new()).unwrap().force,
     );
     assert!(e < 1e-12, "{e}");
@@ -195,7 +194,7 @@ fn the_size_limits_are_checked_before_the_run() {
         flat(log_grid(MAX_DIRECT_POINTS)).method().unwrap(),
         Method::Direct
     );
-    let e = sader_jarvis(&flat(log_grid(MAX_DIRECT_POINTS + 1)))
+    let e = sader_jarvis(&flat(log_grid(MAX_DIRECT_POINTS + 1)), &Progress::new())
         .unwrap_err()
         .to_string();
     assert!(
@@ -232,14 +231,11 @@ fn a_cancelled_run_stops() {
     for d in [even, log] {
         let c = curve(d, 1e-9);
         let p = Progress::new();
-        sader_jarvis_with(&c, &p).unwrap();
+        sader_jarvis(&c, &p).unwrap();
         assert_eq!((p.done(), p.total()), (n, Some(n)));
         let p = Progress::new();
         p.cancel();
-        assert!(matches!(
-            sader_jarvis_with(&c, &p),
-            Err(SimError::Cancelled)
-        ));
+        assert!(matches!(sader_jarvis(&c, &p), Err(SimError::Cancelled)));
         assert!(matches!(
             sader_jarvis_direct(&c, &p),
             Err(SimError::Cancelled)
@@ -283,8 +279,8 @@ fn worst(c: &ShiftCurve, force: &[f64], (lo, hi): (f64, f64)) -> f64 {
 fn the_exact_inversion_removes_sader_jarvis_error_at_intermediate_amplitudes() {
     for a in [0.5e-9, 1e-9] {
         let c = curve(even(0.3e-9, 300e-9, 100_000), a);
-        let sj = sader_jarvis(&c).unwrap();
-        let exact = exact_inversion(&c).unwrap();
+        let sj = sader_jarvis(&c, &Progress::new()).unwrap();
+        let exact = exact_inversion(&c, &Progress::new()).unwrap();
         let record = exact.exact.unwrap();
         let band = (0.4, 1.0);
         let (e_sj, e_exact) = (worst(&c, &sj.force, band), worst(&c, &exact.force, band));
@@ -359,8 +355,8 @@ fn noisy_data_measured() {
                 .collect(),
             ..clean.clone()
         };
-        let sj = sader_jarvis(&noisy).unwrap();
-        let exact = exact_inversion(&noisy).unwrap();
+        let sj = sader_jarvis(&noisy, &Progress::new()).unwrap();
+        let exact = exact_inversion(&noisy, &Progress::new()).unwrap();
         let record = exact.exact.unwrap();
         for band in [(0.4, 1.0), (0.1, 3.0)] {
             let (e_sj, e_exact) = (

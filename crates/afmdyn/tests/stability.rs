@@ -5,6 +5,7 @@ use afmdyn::analysis::continuation::{
     continue_branch, continue_with_switching, BranchEvent, ContinuationSpec,
 };
 use afmdyn::analysis::lyapunov::{lyapunov_spectrum, zero_one_test, LyapunovOptions, Verdict};
+use afmdyn::analysis::progress::Progress;
 use afmdyn::analysis::shooting::{
     shoot, Guess, Instability, PeriodicOrbit, ShootingOptions, ShootingStrategy,
 };
@@ -488,7 +489,7 @@ fn continuation_locates_the_period_doubling_near_omega_2_91() {
     let (z, n) = attractor(&m);
     assert_eq!(n, Some(1));
     let spec = ContinuationSpec::new(base, SweepParam::Omega, 3.2, 2.7, 1);
-    let br = continue_branch(&spec, &z).unwrap();
+    let br = continue_branch(&spec, &z, &Progress::new()).unwrap();
     let pd = br
         .iter()
         .find(|b| b.event == Some(BranchEvent::PeriodDoubling))
@@ -574,7 +575,7 @@ fn continuation_does_not_step_over_a_period_doubling() {
     let base = Params::default();
     let guess = attractor_at(base.with(SweepParam::Omega, 2.70));
     let spec = ContinuationSpec::new(base, SweepParam::Omega, 2.70, 2.60, 2);
-    let br = continue_branch(&spec, &guess).unwrap();
+    let br = continue_branch(&spec, &guess, &Progress::new()).unwrap();
     let pds: Vec<f64> = br
         .iter()
         .filter(|b| b.event == Some(BranchEvent::PeriodDoubling))
@@ -612,7 +613,7 @@ fn switching_builds_the_period_four_and_eight_branches() {
     let base = Params::default();
     let guess = attractor_at(base.with(SweepParam::Omega, 2.75));
     let spec = ContinuationSpec::new(base, SweepParam::Omega, 2.75, 2.665, 2);
-    let branches = continue_with_switching(&spec, &guess, 8).unwrap();
+    let branches = continue_with_switching(&spec, &guess, 8, &Progress::new()).unwrap();
     let pd_on = |period: usize| -> Vec<f64> {
         branches
             .iter()

@@ -6,6 +6,7 @@
 use afmdyn::analysis::attractors::{find_attractors, same_attractor, AttractorSpec};
 use afmdyn::analysis::bifurcation::{run_sweep, Branch, Resume, SweepPlan, SweepPoint, SweepSpec};
 use afmdyn::analysis::chart::{run_chart, CellParams, ChartCell, ChartPlan};
+use afmdyn::analysis::progress::Progress;
 use afmdyn::analysis::steady::{steady_state, SteadyOptions};
 use afmdyn::integrate::{build, IntegratorOptions};
 use afmdyn::probe::Probe;
@@ -225,14 +226,17 @@ fn chart_attractors_are_real_and_their_fractions_add_up() {
         let converged = f64::from(req.starts - c.failures.min(req.starts)) / f64::from(req.starts);
         assert!((sum - converged).abs() < 1e-12, "{c:?}");
         let p = OmegaDrive.params(c.x, c.y).unwrap();
-        let census = find_attractors(&AttractorSpec {
-            params: p,
-            samples: 64,
-            seed: 9,
-            cluster_tol: 1e-5,
-            steady: SteadyOptions::default(),
-            integrator: IntegratorOptions::default(),
-        })
+        let census = find_attractors(
+            &AttractorSpec {
+                params: p,
+                samples: 64,
+                seed: 9,
+                cluster_tol: 1e-5,
+                steady: SteadyOptions::default(),
+                integrator: IntegratorOptions::default(),
+            },
+            &Progress::new(),
+        )
         .unwrap();
         let m = CantileverModel::new(&p).unwrap();
         for a in &c.attractors {

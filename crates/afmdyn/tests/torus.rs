@@ -228,7 +228,14 @@ fn a_continued_circle_is_the_circle() {
     let previous = invariant_circle(&before, integ(), &guess, &opts).unwrap();
     let model = CantileverModel::new(&lever_a2("1.881e6", 0.5, "0.5e-9")).unwrap();
     let fresh = invariant_circle(&model, integ(), &guess, &opts).unwrap();
-    let continued = continue_circle(&model, integ(), &previous, &opts).unwrap();
+    let continued = continue_circle(
+        &model,
+        integ(),
+        &previous.states[0],
+        &previous.jacobian,
+        &opts,
+    )
+    .unwrap();
     assert_eq!(fresh.nodes, continued.nodes);
     let scale = fresh.states[0].amax();
     for (a, b) in fresh.states.iter().zip(&continued.states) {

@@ -10,10 +10,10 @@ use super::period::close;
 #[cfg(not(feature = "parallel"))]
 use super::sequential::*;
 use super::shooting::{shoot, PeriodicOrbit, ShootingOptions};
-use super::steady::{steady_state, PoincarePoint, SteadyOptions, SteadyState};
+use super::steady::{steady_state_of, PoincarePoint, SteadyOptions, SteadyState};
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
-use crate::integrate::{build, IntegratorKind, IntegratorOptions};
+use crate::integrate::{IntegratorKind, IntegratorOptions};
 use crate::maps::StroboscopicMap;
 use crate::model::CantileverModel;
 use crate::params::Params;
@@ -138,19 +138,13 @@ pub fn same_attractor(a: &SteadyState, b: &SteadyState, tol: f64) -> bool {
 
 /// Run the search in parallel over samples.
 ///
-/// # Errors
-/// [`SimError`] for invalid parameters or options (individual failing starts are reported in
-/// [`AttractorReport::failures`]).
-pub fn find_attractors(spec: &AttractorSpec) -> Result<AttractorReport, SimError> {
-    find_attractors_with(spec, &Progress::new())
-}
-
-/// [`find_attractors`] counting the random starts done in `progress` (its total grows by
-/// `samples`) and stopping when it is cancelled.
+/// It counts the random starts done in `progress` (its total grows by `samples`) and stops when
+/// it is cancelled.
 ///
 /// # Errors
-/// As [`find_attractors`]; [`SimError::Cancelled`] once `progress` is cancelled.
-pub fn find_attractors_with(
+/// [`SimError`] for invalid parameters or options (individual failing starts are reported in
+/// [`AttractorReport::failures`]); [`SimError::Cancelled`] once `progress` is cancelled.
+pub fn find_attractors(
     spec: &AttractorSpec,
     progress: &Progress,
 ) -> Result<AttractorReport, SimError> {
@@ -320,8 +314,7 @@ fn steady_states_of_starts(
             let r = if cancel.load(Ordering::Relaxed) {
                 Err(SimError::Cancelled)
             } else {
-                build(model, spec.integrator.clone(), 0.0, &z0)
-                    .and_then(|mut it| steady_state(it.as_mut(), &spec.steady))
+                steady_state_of(model, spec.integrator.clone(), &z0, &spec.steady)
             };
             tick();
             (z0, r)
@@ -365,8 +358,7 @@ pub(crate) fn polish_steady(
         return None;
     }
     let guess = steady.end_state().clone();
-    let mut integ = build(model, integrator, 0.0, &guess).ok()?;
-    let map = &mut StroboscopicMap::new(integ.as_mut(), 1);
+    let map = &mut StroboscopicMap::build(model, integrator, &guess, 1).ok()?;
     let orbit = shoot(map, &guess, &ShootingOptions::default().with_period(n)).ok()?;
     // section = [z*, P(z*), …]; z* replaces the last recorded point p_n, P(z*) the first
     let k = steady.poincare.len();

@@ -34,7 +34,6 @@
 use super::attractors::{polish_steady, same_attractor, same_orbit};
 use super::bifurcation::mix64;
 use super::lyapunov::largest_exponent;
-use super::progress::Progress;
 #[cfg(not(feature = "parallel"))]
 use super::sequential::*;
 use super::shooting::PeriodicOrbit;
@@ -535,20 +534,10 @@ pub fn run_passes(
 /// # Errors
 /// [`SimError`] for invalid parameters or coordinates outside N modes.
 pub fn basins(spec: &BasinSpec) -> Result<BasinMap, SimError> {
-    basins_with(spec, &Progress::new())
-}
-
-/// [`basins`] counting the cells done in `progress` (its total grows by nx × ny, a row's cells
-/// counted when the row is done) and stopping when it is cancelled.
-///
-/// # Errors
-/// As [`basins`]; [`SimError::Cancelled`] once `progress` is cancelled.
-pub(crate) fn basins_with(spec: &BasinSpec, progress: &Progress) -> Result<BasinMap, SimError> {
     spec.validate()?;
     let model = CantileverModel::new(&spec.params)?;
-    progress.add_total(spec.xs.len() * spec.ys.len());
-    let count = |r: &BasinRow| progress.advance(r.cells.len());
-    let rows = run_passes(spec, &model, &[], &count, progress.cancel_flag())?;
+    let never = AtomicBool::new(false);
+    let rows = run_passes(spec, &model, &[], &|_| (), &never)?;
     basin_map(spec, rows)
 }
 

@@ -4,9 +4,9 @@
 
 #[cfg(not(feature = "parallel"))]
 use super::sequential::*;
-use super::steady::{steady_state, SteadyOptions, SteadyState};
+use super::steady::{steady_state_of, SteadyOptions, SteadyState};
 use crate::error::SimError;
-use crate::integrate::{build, IntegratorOptions};
+use crate::integrate::IntegratorOptions;
 use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
 use nalgebra::DVector;
@@ -207,9 +207,12 @@ pub struct Resume {
 
 fn solve_point(spec: &SweepSpec, value: f64, z0: &DVector<f64>) -> Result<SteadyState, SimError> {
     let p = spec.base.with(spec.param, value);
-    let model = CantileverModel::new(&p)?;
-    let mut integ = build(&model, spec.integrator.clone(), 0.0, z0)?;
-    steady_state(integ.as_mut(), &spec.steady)
+    steady_state_of(
+        &CantileverModel::new(&p)?,
+        spec.integrator.clone(),
+        z0,
+        &spec.steady,
+    )
 }
 
 /// One task of a planned sweep ([`SweepPlan`]).
@@ -285,11 +288,6 @@ impl<'a> SweepPlan<'a> {
         }
     }
 
-    /// Values per chunk.
-    pub fn chunk_len(&self) -> usize {
-        self.chunk
-    }
-
     /// Chunks per continuation branch (0 without continuation).
     pub fn chunks(&self) -> usize {
         if self.spec.continuation && !self.spec.values.is_empty() {
@@ -315,11 +313,6 @@ impl<'a> SweepPlan<'a> {
             }
             _ => Vec::new(),
         }
-    }
-
-    /// The number of tasks of every stage.
-    pub fn task_count(&self) -> usize {
-        self.tasks(0).len() + self.chunks() * 2 + self.spec.values.len() * self.spec.starts as usize
     }
 
     /// The value indices of `branch` in its order of continuation (increasing forward,

@@ -22,9 +22,9 @@
 use super::attractors::same_attractor;
 use super::bifurcation::{mix64, random_state};
 use super::lyapunov::largest_exponent;
-use super::steady::{steady_state, SteadyOptions, SteadyState};
+use super::steady::{steady_state_of, SteadyOptions, SteadyState};
 use crate::error::SimError;
-use crate::integrate::{build, IntegratorOptions};
+use crate::integrate::IntegratorOptions;
 use crate::model::CantileverModel;
 use crate::params::Params;
 use nalgebra::DVector;
@@ -259,8 +259,7 @@ impl<'a> ChartPlan<'a> {
 
     fn run(&self, w: &mut Work, z0: &DVector<f64>, origin: Origin) {
         let Some(model) = &w.model else { return };
-        let r = build(model, self.spec.integrator.clone(), 0.0, z0)
-            .and_then(|mut it| steady_state(it.as_mut(), &self.spec.steady));
+        let r = steady_state_of(model, self.spec.integrator.clone(), z0, &self.spec.steady);
         match r {
             Err(e) => {
                 w.failures += 1;

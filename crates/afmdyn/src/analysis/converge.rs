@@ -26,35 +26,13 @@ pub struct ConvergenceRun {
 }
 
 /// Steady-state tip motion for N = 1..=`max_modes` at `params` (its N is ignored), sampled at
-/// `samples_per_period` over `periods` drive periods from a section point.
+/// `samples_per_period` over `periods` drive periods from a section point, counting the runs
+/// done (N = 1..=`max_modes`) in `progress` and stopping when it is cancelled.
 ///
 /// # Errors
-/// [`SimError`] for invalid parameters or a failing run.
+/// [`SimError`] for invalid parameters or a failing run; [`SimError::Cancelled`] once
+/// `progress` is cancelled.
 pub fn mode_convergence(
-    params: &Params,
-    max_modes: usize,
-    periods: usize,
-    samples_per_period: usize,
-    steady: &SteadyOptions,
-    integrator: IntegratorOptions,
-) -> Result<Vec<ConvergenceRun>, SimError> {
-    mode_convergence_with(
-        params,
-        max_modes,
-        periods,
-        samples_per_period,
-        steady,
-        integrator,
-        &Progress::new(),
-    )
-}
-
-/// [`mode_convergence`] counting the runs done (N = 1..=`max_modes`) in `progress` and
-/// stopping when it is cancelled.
-///
-/// # Errors
-/// As [`mode_convergence`]; [`SimError::Cancelled`] once `progress` is cancelled.
-pub(crate) fn mode_convergence_with(
     params: &Params,
     max_modes: usize,
     periods: usize,

@@ -15,7 +15,7 @@ use crate::analysis::progress::Progress;
 use crate::error::SimError;
 use crate::integrate::Integrator;
 use crate::integrate::{advance, build, IntegratorOptions};
-use crate::maps::flow::flow_with_jacobian;
+use crate::maps::flow::flow;
 use crate::model::CantileverModel;
 use nalgebra::{DMatrix, DVector};
 use rand::{RngExt, SeedableRng};
@@ -178,7 +178,7 @@ pub fn lyapunov_spectrum_with(
         progress.check()?;
         // one period of the flow with its Jacobian (step propagators × saltation matrices)
         let (ta, tb) = (t0 + k as f64 * period, t0 + (k + 1) as f64 * period);
-        let map = flow_with_jacobian(&mut *integ, ta, &z, tb)?;
+        let map = flow(&mut *integ, ta, &z, tb, None, true)?;
         log_volume += map.log_volume;
         q = map.jacobian * q;
         z = map.state;

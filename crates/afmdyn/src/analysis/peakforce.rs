@@ -50,7 +50,7 @@ use super::steady::{steady_state, Motion, SteadyOptions};
 use crate::error::SimError;
 use crate::galerkin::Region;
 use crate::integrate::dense::{sample_dense, SpanSampling, StartSample};
-use crate::integrate::{build, Integrator, IntegratorOptions};
+use crate::integrate::{Integrator, IntegratorOptions};
 use crate::maps::StroboscopicMap;
 use crate::model::CantileverModel;
 use nalgebra::{Complex, DVector};
@@ -227,8 +227,8 @@ pub(crate) fn steady_tap_from(
     z0: &DVector<f64>,
 ) -> Result<SteadyTap, SimError> {
     opts.validate()?;
-    let mut integ = build(model, opts.integrator.clone(), 0.0, z0)?;
-    let steady = steady_state(integ.as_mut(), &opts.steady)?;
+    let mut map = StroboscopicMap::build(model, opts.integrator.clone(), z0, 1)?;
+    let steady = steady_state(map.integrator(), &opts.steady)?;
     let n = match steady.motion {
         Motion::Periodic { period } => period,
         Motion::Nonperiodic => {
@@ -243,7 +243,8 @@ pub(crate) fn steady_tap_from(
     // Broyden's updates from M ≈ 0 where the monodromy matrix costs variational equations
     // step by step: the tap's ringing decays over the cycle, its multipliers are small (not
     // for a hysteretic law, whose orbits are sensitive to the flows' steps)
-    let broyden = broyden_pays(opts.integrator.clone(), model) && !integ.system().is_hysteretic();
+    let broyden =
+        broyden_pays(opts.integrator.clone(), model) && !map.integrator().system().is_hysteretic();
     let shooting = ShootingOptions {
         period: n,
         strategy: if broyden {
@@ -254,13 +255,13 @@ pub(crate) fn steady_tap_from(
         watch_grazing: false,
         ..opts.shooting
     };
-    let map = &mut StroboscopicMap::new(integ.as_mut(), 1);
-    let orbit = shoot(map, &guess, &shooting)?;
+    let orbit = shoot(&mut map, &guess, &shooting)?;
+    let integ = map.integrator();
     integ.set_variational(false);
     let n = orbit.period;
     integ.reset(0.0, &orbit.state)?;
     let obs = observe(
-        integ.as_mut(),
+        integ,
         &ObservableOptions {
             periods: n,
             harmonics: 1,
@@ -287,11 +288,10 @@ pub(crate) fn steady_tap_from(
         }
     };
     integ.reset(0.0, &orbit.state)?;
-    let cycle = sample_cycle(model, integ.as_mut(), opts.samples)?;
+    let cycle = sample_cycle(model, integ, opts.samples)?;
     let (snap_off_time, ringing_amplitude) = after_snap_off(model, &cycle);
     let (fit, fit_tip_sample) =
-        retract_fit(model, integ.as_mut(), &orbit.state, &cycle, opts.fit_band)?
-            .unwrap_or((None, None));
+        retract_fit(model, integ, &orbit.state, &cycle, opts.fit_band)?.unwrap_or((None, None));
     Ok(SteadyTap {
         period: n,
         multipliers: orbit.multipliers,

@@ -275,21 +275,12 @@ fn first_interval(omega: f64, slope: f64, step: f64, a: f64) -> f64 {
 /// The force and potential of `curve` by the Sader–Jarvis inversion (module doc): by FFT on a
 /// uniform grid, else by the direct sum ([`ShiftCurve::method`]).
 ///
-/// # Errors
-/// As [`ShiftCurve::method`].
-pub fn sader_jarvis(curve: &ShiftCurve) -> Result<Reconstruction, SimError> {
-    sader_jarvis_with(curve, &Progress::new())
-}
-
-/// [`sader_jarvis`] counting the curve's points in `progress` and checking its cancel flag
-/// between chunks of rows.
+/// It counts the curve's points in `progress` and checks its cancel flag between chunks of
+/// rows.
 ///
 /// # Errors
 /// As [`ShiftCurve::method`]; [`SimError::Cancelled`] once `progress` is cancelled.
-pub fn sader_jarvis_with(
-    curve: &ShiftCurve,
-    progress: &Progress,
-) -> Result<Reconstruction, SimError> {
+pub fn sader_jarvis(curve: &ShiftCurve, progress: &Progress) -> Result<Reconstruction, SimError> {
     match curve.method()? {
         Method::Fft { h } => sader_jarvis_fft(curve, h, progress),
         Method::Direct => sader_jarvis_direct(curve, progress),
@@ -341,12 +332,7 @@ pub fn sader_jarvis_direct(
     // the last point has no interval beyond it: its force is the end of the data
     force[n - 1] = 0.0;
     progress.advance(1);
-    Ok(Reconstruction {
-        distance: d.clone(),
-        potential: potential_of(d, &force),
-        force,
-        exact: None,
-    })
+    Ok(Reconstruction::of(d.clone(), force, None))
 }
 
 /// The Sader–Jarvis inversion on a uniform grid of spacing `h` (module doc: the Ω part by a
@@ -440,23 +426,26 @@ fn sader_jarvis_fft(
     }
     force[n - 1] = 0.0;
     progress.advance(1);
-    Ok(Reconstruction {
-        distance: d.clone(),
-        potential: potential_of(d, &force),
-        force,
-        exact: None,
-    })
+    Ok(Reconstruction::of(d.clone(), force, None))
 }
 
-/// U(d_j) = ∫_{d_j}^{d_max} F dt by the trapezoidal rule on the increasing distances `d`
-/// (U(d_max) = 0): the potential of every reconstruction.
-pub(crate) fn potential_of(d: &[f64], force: &[f64]) -> Vec<f64> {
-    let n = d.len();
-    let mut potential = vec![0.0; n];
-    for j in (0..n.saturating_sub(1)).rev() {
-        potential[j] = potential[j + 1] + 0.5 * (force[j] + force[j + 1]) * (d[j + 1] - d[j]);
+impl Reconstruction {
+    /// The reconstruction of `force` at the increasing distances `d`, its potential
+    /// U(d_j) = ∫_{d_j}^{d_max} F dt by the trapezoidal rule (U(d_max) = 0): the end of every
+    /// inversion.
+    pub(crate) fn of(d: Vec<f64>, force: Vec<f64>, exact: Option<ExactRecord>) -> Reconstruction {
+        let n = d.len();
+        let mut potential = vec![0.0; n];
+        for j in (0..n.saturating_sub(1)).rev() {
+            potential[j] = potential[j + 1] + 0.5 * (force[j] + force[j + 1]) * (d[j + 1] - d[j]);
+        }
+        Reconstruction {
+            distance: d,
+            force,
+            potential,
+            exact,
+        }
     }
-    potential
 }
 
 /// Each named constant finite and > 0.
@@ -539,13 +528,16 @@ mod tests {
                 .iter()
                 .map(|&d| giessibl_shift(&force, d, k, f0, a, GIESSIBL_NODES))
                 .collect();
-            let r = sader_jarvis(&ShiftCurve {
-                distance: distance.clone(),
-                frequency_shift,
-                spring_constant: k,
-                resonance_frequency: f0,
-                amplitude: a,
-            })
+            let r = sader_jarvis(
+                &ShiftCurve {
+                    distance: distance.clone(),
+                    frequency_shift,
+                    spring_constant: k,
+                    resonance_frequency: f0,
+                    amplitude: a,
+                },
+                &Progress::new(),
+            )
             .unwrap();
             for (i, &d) in distance.iter().enumerate().filter(|(_, &d)| d <= 5e-9) {
                 let (want, u) = (force(d), -hr / (6.0 * d) + hr / (6.0 * hi));
@@ -568,7 +560,7 @@ mod tests {
             resonance_frequency: 1.0,
             amplitude: 1.0,
         };
-        assert!(sader_jarvis(&good).is_ok());
+        assert!(sader_jarvis(&good, &Progress::new()).is_ok());
         for (bad, name) in [
             (
                 ShiftCurve {
@@ -599,7 +591,9 @@ mod tests {
                 "distance",
             ),
         ] {
-            let e = sader_jarvis(&bad).unwrap_err().to_string();
+            let e = sader_jarvis(&bad, &Progress::new())
+                .unwrap_err()
+                .to_string();
             assert!(e.starts_with(name), "{e}");
         }
     }

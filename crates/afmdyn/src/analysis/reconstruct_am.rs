@@ -41,12 +41,12 @@
 //! computes the weights of those (found by bisection), Σ_k (nodes within cycle k) of them —
 //! O(N · 2A/Δd), quadratic only when the cycles span the whole curve. The count is checked
 //! before the run against [`MAX_AM_WEIGHTS`], and the cancel flag between chunks of rows
-//! ([`matrix_inversion_with`]).
+//! ([`matrix_inversion`]).
 //!
 //! Units: any consistent set (SI: lengths in m, k in N/m → F in N).
 
 use super::progress::Progress;
-use super::reconstruct::{positive_constants, potential_of, Reconstruction};
+use super::reconstruct::{positive_constants, Reconstruction};
 use crate::error::SimError;
 use std::f64::consts::PI;
 
@@ -235,24 +235,14 @@ pub fn force_integrals_of(d: &[f64], force: &[f64], centre: &[f64], amplitude: &
 /// of each point (module docs), at the curve's lower turning points in increasing distance;
 /// the force at the largest distance is 0 (the end of the data).
 ///
-/// # Errors
-/// As [`matrix_inversion_with`].
-pub fn matrix_inversion(curve: &AmCurve) -> Result<Reconstruction, SimError> {
-    matrix_inversion_with(curve, &Progress::new())
-}
-
-/// [`matrix_inversion`] counting the rows in `progress` and checking its cancel flag between
-/// chunks of them.
+/// It counts the rows in `progress` and checks its cancel flag between chunks of them.
 ///
 /// # Errors
 /// As [`AmCurve::validate`]; [`SimError::OutOfRange`] naming `z_c` for more than
 /// [`MAX_AM_WEIGHTS`] weights (checked before the run); [`SimError::NoConvergence`] for a
-/// singular diagonal (a cycle that does not reach beyond its own turning point: never for
-/// A > 0); [`SimError::Cancelled`] once `progress` is cancelled.
-pub fn matrix_inversion_with(
-    curve: &AmCurve,
-    progress: &Progress,
-) -> Result<Reconstruction, SimError> {
+/// singular diagonal (a cycle that does not reach beyond its own turning point: never for A >
+/// 0); [`SimError::Cancelled`] once `progress` is cancelled.
+pub fn matrix_inversion(curve: &AmCurve, progress: &Progress) -> Result<Reconstruction, SimError> {
     curve.validate()?;
     let mut order: Vec<usize> = (0..curve.z_c.len()).collect();
     let d_all = curve.turning_points();
@@ -301,12 +291,7 @@ pub fn matrix_inversion_with(
         force[k] = (y[k] - rest) / diag;
     }
     progress.advance(1);
-    Ok(Reconstruction {
-        potential: potential_of(&d, &force),
-        distance: d,
-        force,
-        exact: None,
-    })
+    Ok(Reconstruction::of(d, force, None))
 }
 
 #[cfg(test)]
@@ -368,7 +353,7 @@ mod tests {
             drive_frequency: f0,
             free_amplitude: a0,
         };
-        let r = matrix_inversion(&curve).unwrap();
+        let r = matrix_inversion(&curve, &Progress::new()).unwrap();
         let mut checked = 0;
         for (d, f) in r.distance.iter().zip(&r.force) {
             if *d > 0.5e-9 && *d < 5e-9 {
@@ -433,7 +418,7 @@ mod end_to_end {
             drive_frequency: 300e3,
             free_amplitude: 10e-9,
         };
-        let r = matrix_inversion(&curve).unwrap();
+        let r = matrix_inversion(&curve, &Progress::new()).unwrap();
         let hr6 = 6.6e-20 * 10e-9 / 6.0;
         let mut checked = 0;
         for (d, f) in r.distance.iter().zip(&r.force) {

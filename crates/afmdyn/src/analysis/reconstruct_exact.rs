@@ -54,9 +54,7 @@
 
 use super::progress::Progress;
 pub use super::reconstruct::ExactRecord;
-use super::reconstruct::{
-    potential_of, sader_jarvis_with, uniform_spacing, Reconstruction, ShiftCurve,
-};
+use super::reconstruct::{sader_jarvis, uniform_spacing, Reconstruction, ShiftCurve};
 use super::reconstruct_am::{nodes_within, weight};
 use crate::error::SimError;
 use rustfft::{num_complex::Complex, Fft, FftPlanner};
@@ -241,18 +239,12 @@ fn shifts(forward: &Forward, curve: &ShiftCurve, force: &[f64]) -> Vec<f64> {
 /// The force and potential of `curve` by the exact inversion ([module doc](self)), with its
 /// [`ExactRecord`] (`exact`).
 ///
-/// # Errors
-/// As [`exact_inversion_with`].
-pub fn exact_inversion(curve: &ShiftCurve) -> Result<Reconstruction, SimError> {
-    exact_inversion_with(curve, &Progress::new())
-}
-
-/// [`exact_inversion`] counting the Sader–Jarvis estimate's rows in `progress` and checking
-/// its cancel flag between steps.
+/// It counts the Sader–Jarvis estimate's rows in `progress` and checks its cancel flag between
+/// steps.
 ///
 /// # Errors
 /// As [`check_exact`]; [`SimError::Cancelled`] once `progress` is cancelled.
-pub fn exact_inversion_with(
+pub fn exact_inversion(
     curve: &ShiftCurve,
     progress: &Progress,
 ) -> Result<Reconstruction, SimError> {
@@ -272,13 +264,13 @@ pub fn exact_inversion_with(
         let worst = r.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         (r, if scale > 0.0 { worst / scale } else { 0.0 })
     };
-    let mut force = sader_jarvis_with(curve, progress)?.force;
+    let mut force = sader_jarvis(curve, progress)?.force;
     let (mut r, mut rho) = residual(&force);
     let sader_jarvis_residual = rho;
     let mut iterations = 0;
     while rho > EXACT_TOLERANCE && iterations < EXACT_MAX_ITERATIONS {
         progress.check()?;
-        let correction = sader_jarvis_with(
+        let correction = sader_jarvis(
             &ShiftCurve {
                 frequency_shift: r.clone(),
                 ..curve.clone()
@@ -303,11 +295,9 @@ pub fn exact_inversion_with(
         forward_residual: rho,
         converged: rho <= EXACT_TOLERANCE,
     };
-    let d = curve.distance.clone();
-    Ok(Reconstruction {
-        potential: potential_of(&d, &force),
-        distance: d,
+    Ok(Reconstruction::of(
+        curve.distance.clone(),
         force,
-        exact: Some(record),
-    })
+        Some(record),
+    ))
 }

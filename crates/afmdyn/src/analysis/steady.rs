@@ -5,9 +5,11 @@ use super::settle::{minimal_period, newton_from_transient, SettleOptions, CENSUS
 use super::shooting::{shoot, ShootingOptions};
 use crate::error::SimError;
 use crate::galerkin::Region;
-use crate::integrate::{advance, advance_observed, Integrator, Observed, Observer, Step};
+use crate::integrate::{
+    advance, advance_observed, build, Integrator, IntegratorOptions, Observed, Observer, Step,
+};
 use crate::maps::StroboscopicMap;
-use crate::model::BodyContactCheck;
+use crate::model::{BodyContactCheck, CantileverModel};
 use crate::roots::extremum;
 use crate::system::EventKind;
 use crate::tip_sample::TipSampleSystem;
@@ -554,6 +556,20 @@ pub fn steady_state(
         found = returns.push(integ.state(), opts);
     }
     record(integ, found, before + returns.k, opts)
+}
+
+/// [`steady_state`] from (τ = 0, `z0`) on a new integrator of `model` built with `integrator`
+/// ([`crate::integrate::build`]): the set-up every start of a census or sweep repeats.
+///
+/// # Errors
+/// As [`crate::integrate::build`] and [`steady_state`].
+pub(crate) fn steady_state_of(
+    model: &CantileverModel,
+    integrator: IntegratorOptions,
+    z0: &DVector<f64>,
+    opts: &SteadyOptions,
+) -> Result<SteadyState, SimError> {
+    steady_state(build(model, integrator, 0.0, z0)?.as_mut(), opts)
 }
 
 /// Drive periods between the Newton attempts of [`steady_state`] on a slowly decaying model

@@ -123,32 +123,18 @@ pub fn invariant_circle(
     solve(model, integ, guess, opts, None)
 }
 
-/// The circle of `model` continued from `previous` (the circle at a nearby parameter value,
-/// on as many nodes): Broyden's updates ([`ShootingStrategy::Broyden`]) from its state and from its
-/// map's Jacobian, by flows without the variational equations, and one linearisation at the
-/// solution (its Jacobian, stability and distance to grazing) — a step of an approach curve
-/// at the cost of about one Newton iteration.
+/// The circle of `model` continued from a predicted node state `guess` (`[2N]`, at τ = 0; the
+/// previous circle's first state, or a stepped curve's extrapolation from its previous points)
+/// and an estimate `jacobian` (2N×2N) of its map's Jacobian ∂G (the previous circle's
+/// [`InvariantCircle::jacobian`], at a nearby parameter value, on as many nodes): Broyden's
+/// updates ([`ShootingStrategy::Broyden`]) by flows without the variational equations, and one
+/// linearisation at the solution (its Jacobian, stability and distance to grazing) — a step of
+/// an approach curve at the cost of about one Newton iteration.
 ///
 /// # Errors
-/// As [`invariant_circle`]; [`SimError::OutOfRange`] when `previous` has another number of
-/// nodes than `opts.nodes` gives for `model`.
+/// As [`invariant_circle`]; [`SimError::OutOfRange`] naming the monodromy estimate when
+/// `jacobian` is not 2N×2N.
 pub fn continue_circle(
-    model: &CantileverModel,
-    integ: IntegratorOptions,
-    previous: &InvariantCircle,
-    opts: &CircleOptions,
-) -> Result<InvariantCircle, SimError> {
-    continue_circle_at(model, integ, &previous.states[0], &previous.jacobian, opts)
-}
-
-/// The circle of `model` continued from a predicted node state `guess` (`[2N]`, at τ = 0) and
-/// an estimate `jacobian` (2N×2N) of its map's Jacobian ∂G, e.g. the previous circle's
-/// [`InvariantCircle::jacobian`]: as [`continue_circle`], the predictor the caller's (a
-/// stepped curve extrapolates the node state from its previous points).
-///
-/// # Errors
-/// As [`continue_circle`].
-pub fn continue_circle_at(
     model: &CantileverModel,
     integ: IntegratorOptions,
     guess: &DVector<f64>,

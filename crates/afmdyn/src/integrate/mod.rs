@@ -291,7 +291,7 @@ pub trait AffineRegions {
     /// α5; [`crate::model::CantileverModel::forcing_derivative`]). With the step Jacobians J
     /// and the event shifts of [`crate::system::saltation_with_shift`] it gives the parameter
     /// sensitivity of a flow, s ← J s + this (see
-    /// [`crate::maps::flow::flow_with_param_derivative`]). `Ok(false)`, with `out`
+    /// [`crate::maps::flow::flow`]). `Ok(false)`, with `out`
     /// untouched, where the integrator does not provide it for this step or parameter (the
     /// exact propagator provides it for Ω, α2 and α5).
     ///
@@ -309,7 +309,7 @@ pub trait AffineRegions {
     /// e^{A_r t}(z(τ0) − z_p(τ0)) with A_r independent of p, so over a whole stint the
     /// parameter sensitivity telescopes to s(τ) = e^{A_r t}(s(τ0) − ∂z_p/∂p(τ0)) + ∂z_p/∂p(τ)
     /// — one product per stint instead of one per step
-    /// ([`crate::maps::flow::flow_with_param_derivative`]). `Ok(false)`, with `out`
+    /// ([`crate::maps::flow::flow`]). `Ok(false)`, with `out`
     /// untouched, where the integrator does not provide it (the exact propagator provides it
     /// for Ω, α2 and α5).
     ///

@@ -34,50 +34,27 @@ pub struct FlowMap {
     /// change (for an affine region ln det e^{A t} = t trace A, Liouville), from one determinant
     /// of the product.
     pub log_volume: f64,
-    /// ∂z(τ1)/∂p at fixed τ1, shape `[2N]`, when asked for ([`flow_with_param_derivative`]) and
+    /// ∂z(τ1)/∂p at fixed τ1, shape `[2N]`, when asked for ([`flow`]) and
     /// the integrator provides it ([`crate::integrate::AffineRegions::last_step_param_derivative_into`] per step,
     /// [`crate::integrate::AffineRegions::region_particular_param_derivative_into`] per stint); else `None`.
     pub param_derivative: Option<DVector<f64>>,
 }
 
 /// Integrate (τ0, z0) → τ1 with `integ`, multiplying the step Jacobians and saltation
-/// matrices. Switches the integrator's variational equations on.
+/// matrices, with the distance to grazing when `grazing` (else NaN) and, for `param`, the
+/// parameter sensitivity s = ∂z(τ1)/∂p at fixed τ1 in [`FlowMap::param_derivative`]: s(τ0) =
+/// 0, s ← J s + ∂z(τ_b)/∂p|_{z(τ_a)} over each step (variational equation of the parameter,
+/// Hairer, Nørsett & Wanner, *Solving ODEs I*, §I.14) — over a whole stint at once in an
+/// affine region
+/// ([`crate::integrate::AffineRegions::region_particular_param_derivative_into`]) — and
+/// s⁺ = S s⁻ + w ∂g/∂p at each event ([`crate::system::saltation_with_shift`]); `None` there
+/// when the integrator or the law does not provide it (then ∂z/∂p needs finite differences).
+/// The one loop of every flow with a Jacobian ([`crate::maps::StroboscopicMap::apply`]).
+/// Switches the integrator's variational equations on.
 ///
 /// # Errors
 /// [`SimError`] from the integrator, [`SimError::Unsupported`] for one without step Jacobians.
-pub fn flow_with_jacobian(
-    integ: &mut dyn Integrator,
-    tau0: f64,
-    z0: &DVector<f64>,
-    tau1: f64,
-) -> Result<FlowMap, SimError> {
-    flow(integ, tau0, z0, tau1, None, true)
-}
-
-/// [`flow_with_jacobian`] with the parameter sensitivity s = ∂z(τ1)/∂p at fixed τ1 in
-/// [`FlowMap::param_derivative`]: s(τ0) = 0, s ← J s + ∂z(τ_b)/∂p|_{z(τ_a)} over each step
-/// (variational equation of the parameter, Hairer, Nørsett & Wanner, *Solving ODEs I*, §I.14)
-/// — over a whole stint at once in an affine region
-/// ([`crate::integrate::AffineRegions::region_particular_param_derivative_into`]) — and s⁺ = S s⁻ + w ∂g/∂p at each
-/// event ([`crate::system::saltation_with_shift`]). `None` there when the integrator or the law
-/// does not provide it (then ∂z/∂p needs finite differences).
-///
-/// # Errors
-/// As [`flow_with_jacobian`].
-pub fn flow_with_param_derivative(
-    integ: &mut dyn Integrator,
-    tau0: f64,
-    z0: &DVector<f64>,
-    tau1: f64,
-    param: SweepParam,
-) -> Result<FlowMap, SimError> {
-    flow(integ, tau0, z0, tau1, Some(param), true)
-}
-
-/// The flow from (τ0, z0) to τ1 with its Jacobian, the parameter sensitivity for `param` and
-/// the distance to grazing when `grazing` (else NaN): the one loop of [`flow_with_jacobian`],
-/// [`flow_with_param_derivative`] and [`crate::maps::StroboscopicMap::apply`].
-pub(crate) fn flow(
+pub fn flow(
     integ: &mut dyn Integrator,
     tau0: f64,
     z0: &DVector<f64>,
@@ -328,7 +305,7 @@ fn farther(va: f64, vb: f64, d0: f64, nearest: f64) -> bool {
 }
 
 /// The distance to grazing of the flow from (τ0, z0) to τ1 ([`FlowMap::grazing_distance`]),
-/// without the Jacobian: the same steps as [`flow_with_jacobian`] (variational equations
+/// without the Jacobian: the same steps as [`flow`] (variational equations
 /// switched on as there) and the same searches, so the same value.
 ///
 /// # Errors
@@ -358,7 +335,7 @@ pub fn grazing_distance(
 /// off (an integrator whose step control sees them — the adaptive one — then takes its own
 /// steps, a seventh of the work of a variational step at N = 3): for finite differences of the
 /// map, whose flows must all take steps chosen alike, not for the `state` of
-/// [`flow_with_jacobian`].
+/// [`flow`].
 ///
 /// # Errors
 /// [`SimError`] from the integrator.

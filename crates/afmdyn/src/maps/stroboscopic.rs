@@ -5,9 +5,10 @@
 //! ([`crate::maps::flow`] computes the flows).
 
 use crate::error::SimError;
-use crate::integrate::Integrator;
+use crate::integrate::{build, Integrator, IntegratorOptions};
 use crate::maps::discrete::DiscreteMap;
 use crate::maps::flow::{flow, flow_state, grazing_distance, FlowMap};
+use crate::model::CantileverModel;
 use crate::params::SweepParam;
 use nalgebra::DVector;
 
@@ -21,18 +22,49 @@ use nalgebra::DVector;
 /// * [`StroboscopicMap::image`]: Pⁿ(z) alone, the Jacobian off (variational equations off);
 /// * [`StroboscopicMap::grazing_distance`]: the distance to grazing alone.
 ///
-/// Every call restarts the integrator at τ = 0 from the given state.
+/// Every call restarts the integrator at τ = 0 from the given state. The integrator is the
+/// caller's ([`StroboscopicMap::new`]) or the map's own ([`StroboscopicMap::build`]).
 pub struct StroboscopicMap<'a> {
-    integ: &'a mut dyn Integrator,
+    integ: Held<'a>,
     periods: usize,
     param: Option<SweepParam>,
     grazing: bool,
+}
+
+/// The integrator a map runs on: the caller's, or the map's own.
+enum Held<'a> {
+    Borrowed(&'a mut dyn Integrator),
+    Owned(Box<dyn Integrator>),
+}
+
+impl StroboscopicMap<'static> {
+    /// The period-`periods` map over its own integrator of `model`, built at (τ = 0, `z`) with
+    /// `opts` ([`crate::integrate::build`]): the set-up of an analysis that shoots or iterates
+    /// from `z` on the model ([`StroboscopicMap::integrator`] hands the integrator out).
+    ///
+    /// # Errors
+    /// As [`crate::integrate::build`].
+    pub fn build(
+        model: &CantileverModel,
+        opts: IntegratorOptions,
+        z: &DVector<f64>,
+        periods: usize,
+    ) -> Result<Self, SimError> {
+        Ok(Self::held(
+            Held::Owned(build(model, opts, 0.0, z)?),
+            periods,
+        ))
+    }
 }
 
 impl<'a> StroboscopicMap<'a> {
     /// The period-`periods` map (n ≥ 1 drive periods) over `integ` at its system's parameters:
     /// Jacobian on, distance to grazing watched, no parameter derivative.
     pub fn new(integ: &'a mut dyn Integrator, periods: usize) -> Self {
+        Self::held(Held::Borrowed(integ), periods)
+    }
+
+    fn held(integ: Held<'a>, periods: usize) -> Self {
         StroboscopicMap {
             integ,
             periods,
@@ -74,7 +106,18 @@ impl<'a> StroboscopicMap<'a> {
 
     /// The integrator the map runs on (its state after a call is the last image's).
     pub fn integrator(&mut self) -> &mut dyn Integrator {
-        &mut *self.integ
+        match &mut self.integ {
+            Held::Borrowed(i) => &mut **i,
+            Held::Owned(i) => i.as_mut(),
+        }
+    }
+
+    /// The integrator, read only.
+    fn integ(&self) -> &dyn Integrator {
+        match &self.integ {
+            Held::Borrowed(i) => &**i,
+            Held::Owned(i) => i.as_ref(),
+        }
     }
 
     /// Pⁿ(z) with its monodromy matrix, and ∂Pⁿ/∂p and the distance to grazing as asked for.
@@ -89,7 +132,7 @@ impl<'a> StroboscopicMap<'a> {
 
     /// The duration of `periods` drive periods (dimensionless τ).
     fn duration_of(&self, periods: usize) -> f64 {
-        periods as f64 * self.integ.system().period()
+        periods as f64 * self.integ().system().period()
     }
 
     /// [`Self::apply`] over `periods` drive periods, the distance to grazing when `grazing`.
@@ -99,13 +142,13 @@ impl<'a> StroboscopicMap<'a> {
         periods: usize,
         grazing: bool,
     ) -> Result<FlowMap, SimError> {
-        let t = self.duration_of(periods);
-        let mut map = flow(&mut *self.integ, 0.0, z, t, self.param, grazing)?;
-        if let (Some(d), Some(SweepParam::Omega)) = (&mut map.param_derivative, self.param) {
+        let (t, param) = (self.duration_of(periods), self.param);
+        let mut map = flow(self.integrator(), 0.0, z, t, param, grazing)?;
+        if let (Some(d), Some(SweepParam::Omega)) = (&mut map.param_derivative, param) {
             let mut f = DVector::zeros(z.len());
-            let m = self.integ.system();
+            let m = self.integ().system();
             m.rhs(
-                self.integ.region(),
+                self.integ().region(),
                 t,
                 map.state.as_slice(),
                 f.as_mut_slice(),
@@ -124,7 +167,7 @@ impl<'a> StroboscopicMap<'a> {
     /// [`SimError`] from the integrator.
     pub fn image(&mut self, z: &DVector<f64>) -> Result<DVector<f64>, SimError> {
         let t = self.duration();
-        flow_state(&mut *self.integ, 0.0, z, t)
+        flow_state(self.integrator(), 0.0, z, t)
     }
 
     /// The distance to grazing of Pⁿ(z) ([`FlowMap::grazing_distance`]) without the Jacobian:
@@ -134,7 +177,7 @@ impl<'a> StroboscopicMap<'a> {
     /// [`SimError`] from the integrator.
     pub fn grazing_distance(&mut self, z: &DVector<f64>) -> Result<f64, SimError> {
         let t = self.duration();
-        grazing_distance(&mut *self.integ, 0.0, z, t)
+        grazing_distance(self.integrator(), 0.0, z, t)
     }
 }
 
@@ -144,7 +187,7 @@ impl<'a> StroboscopicMap<'a> {
 /// [`StroboscopicMap::with_param_derivative`].
 impl DiscreteMap for StroboscopicMap<'_> {
     fn dim(&self) -> usize {
-        self.integ.system().dim()
+        self.integ().system().dim()
     }
 
     fn periods(&self) -> usize {
@@ -157,7 +200,7 @@ impl DiscreteMap for StroboscopicMap<'_> {
 
     fn iterate(&mut self, z: &DVector<f64>, n: usize) -> Result<DVector<f64>, SimError> {
         let t = self.duration_of(self.periods * n);
-        flow_state(&mut *self.integ, 0.0, z, t)
+        flow_state(self.integrator(), 0.0, z, t)
     }
 
     fn linearise(
@@ -171,11 +214,11 @@ impl DiscreteMap for StroboscopicMap<'_> {
 
     fn grazing_distance(&mut self, z: &DVector<f64>, n: usize) -> Result<f64, SimError> {
         let t = self.duration_of(self.periods * n);
-        grazing_distance(&mut *self.integ, 0.0, z, t)
+        grazing_distance(self.integrator(), 0.0, z, t)
     }
 
     fn check_state(&self, name: &'static str, z: &DVector<f64>) -> Result<(), SimError> {
-        self.integ.system().check_state(name, z)
+        self.integ().system().check_state(name, z)
     }
 
     /// For a hysteretic system ([`crate::tip_sample::TipSampleSystem::is_hysteretic`]): whether
@@ -183,11 +226,11 @@ impl DiscreteMap for StroboscopicMap<'_> {
     /// ([`crate::system::HybridSystem::mode_at`]'s rule in the neck's band): one extra flow,
     /// for such systems only; `true` for every other system.
     fn closes(&mut self, z: &DVector<f64>, n: usize) -> Result<bool, SimError> {
-        if !self.integ.system().is_hysteretic() {
+        if !self.integ().system().is_hysteretic() {
             return Ok(true);
         }
-        let start = self.integ.system().mode_at(0.0, z.as_slice());
+        let start = self.integ().system().mode_at(0.0, z.as_slice());
         self.iterate(z, n)?;
-        Ok(self.integ.region() == start)
+        Ok(self.integ().region() == start)
     }
 }

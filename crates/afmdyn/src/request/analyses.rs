@@ -8,12 +8,12 @@
 //! [`super::ModelSpec::resolve`], into the [`Params`] every `validate` and `run` takes.
 
 use super::limits::*;
-use crate::analysis::attractors::{find_attractors_with, AttractorReport, AttractorSpec};
+use crate::analysis::attractors::{find_attractors, AttractorReport, AttractorSpec};
 use crate::analysis::bifurcation::SweepSpec;
 use crate::analysis::continuation::{
-    continue_branch_with, continue_with_switching_with, Branch, ContinuationSpec,
+    continue_branch, continue_with_switching, Branch, ContinuationSpec,
 };
-use crate::analysis::converge::{mode_convergence_with, ConvergenceRun};
+use crate::analysis::converge::{mode_convergence, ConvergenceRun};
 use crate::analysis::global_continuation::{
     GlobalContinuationSpec, DEFAULT_MATCH_TOL, MAX_CONTINUATION_VALUES,
 };
@@ -193,9 +193,9 @@ impl ContinuationRequest {
         let n = self.period.or(found).unwrap_or(1);
         let spec = ContinuationSpec::new(*base, self.param, self.from, self.to, n);
         let r = if self.switch {
-            continue_with_switching_with(&spec, &guess, CASCADE_FACTOR * n, progress)
+            continue_with_switching(&spec, &guess, CASCADE_FACTOR * n, progress)
         } else {
-            continue_branch_with(&spec, &guess, progress).map(|b| vec![b])
+            continue_branch(&spec, &guess, progress).map(|b| vec![b])
         };
         explain_start(r, self.period, found, self.start.searched(&model)?)
     }
@@ -334,10 +334,10 @@ impl AttractorsRequest {
     /// the run. Starts that fail are listed in [`AttractorReport::failures`].
     ///
     /// # Errors
-    /// As [`Self::spec`] and [`find_attractors_with`]; [`SimError::EveryRunFailed`] when every
+    /// As [`Self::spec`] and [`find_attractors`]; [`SimError::EveryRunFailed`] when every
     /// start failed (there is no attractor to report).
     pub fn run(&self, params: &Params, progress: &Progress) -> Result<AttractorReport, SimError> {
-        let report = find_attractors_with(&self.spec(params)?, progress)?;
+        let report = find_attractors(&self.spec(params)?, progress)?;
         if report.attractors.is_empty() {
             if let Some(first) = report.failures.first() {
                 return Err(SimError::EveryRunFailed {
@@ -631,7 +631,7 @@ impl ConvergeRequest {
         progress: &Progress,
     ) -> Result<Vec<ConvergenceRun>, SimError> {
         self.validate()?;
-        mode_convergence_with(
+        mode_convergence(
             params,
             self.max_modes,
             self.periods,

@@ -32,9 +32,9 @@ use super::costs::MODEL_BYTES;
 use super::limits::Cost;
 use super::run::{Analysis, Resolved};
 use crate::analysis::progress::Progress;
-use crate::analysis::reconstruct::{sader_jarvis_with, Method, Reconstruction, ShiftCurve};
+use crate::analysis::reconstruct::{sader_jarvis, Method, Reconstruction, ShiftCurve};
 use crate::analysis::reconstruct_am::AmCurve;
-use crate::analysis::reconstruct_exact::{check_exact, exact_inversion_with, exact_weights};
+use crate::analysis::reconstruct_exact::{check_exact, exact_inversion, exact_weights};
 use crate::error::{number, SimError};
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
@@ -302,8 +302,8 @@ impl Analysis for ReconstructRequest {
     }
     fn execute(&self, _: &Resolved, progress: &Progress) -> Result<Reconstruction, SimError> {
         match self.inversion {
-            FmInversion::SaderJarvis => sader_jarvis_with(&self.curve()?, progress),
-            FmInversion::Exact => exact_inversion_with(&self.curve()?, progress),
+            FmInversion::SaderJarvis => sader_jarvis(&self.curve()?, progress),
+            FmInversion::Exact => exact_inversion(&self.curve()?, progress),
         }
     }
     fn name(&self) -> &'static str {
@@ -518,13 +518,13 @@ pub fn am_document(curve: &AmCurve, r: &Reconstruction) -> Value {
 ///
 /// # Errors
 /// As [`am_curve_from_approach`] and the inversion
-/// ([`crate::analysis::reconstruct_am::matrix_inversion_with`]).
+/// ([`crate::analysis::reconstruct_am::matrix_inversion`]).
 pub fn am_reconstruction(
     approach: &Value,
     progress: &Progress,
 ) -> Result<super::run::Document<Reconstruction>, SimError> {
     let curve = am_curve_from_approach(approach)?;
-    let r = crate::analysis::reconstruct_am::matrix_inversion_with(&curve, progress)?;
+    let r = crate::analysis::reconstruct_am::matrix_inversion(&curve, progress)?;
     Ok(super::run::Document {
         json: am_document(&curve, &r),
         output: r,

@@ -26,7 +26,7 @@ pub const AGREE: f64 = 1e-6;
 /// The orbit at `params` near `guess`, without sensitivities, integrated to `tol`.
 pub fn orbit(params: &Params, guess: &DVector<f64>, tol: f64) -> OrbitSensitivity {
     let model = CantileverModel::new(params).expect("model");
-    orbit_sensitivity(&model, tol, guess, &[], Some(&newton())).expect("orbit")
+    orbit_sensitivity(&model, tol, guess, &[], Some(&newton()), None).expect("orbit")
 }
 
 /// Check the exact sensitivities at the orbit near `guess` against central differences;
@@ -46,7 +46,7 @@ pub fn check_point_at(
 ) -> bool {
     let model = CantileverModel::new(base).expect("model");
     let exact =
-        orbit_sensitivity(&model, tol, guess, params, Some(&newton())).expect("sensitivity");
+        orbit_sensitivity(&model, tol, guess, params, Some(&newton()), None).expect("sensitivity");
     if !exact.warnings.is_empty() {
         eprintln!("{what}: skipped, {:?}", exact.warnings);
         return false;

@@ -27,10 +27,7 @@ use nalgebra::{Complex, DMatrix, DVector};
 use serde::Serialize;
 
 mod switching;
-pub use switching::{
-    continue_with_switching, continue_with_switching_with, period_doubling_starts,
-    switch_at_period_doubling,
-};
+pub use switching::{continue_with_switching, period_doubling_starts, switch_at_period_doubling};
 
 mod events;
 mod solver;
@@ -277,18 +274,13 @@ pub struct BranchPoint {
 /// Continue the period-n branch through the orbit found by shooting from `guess` at `from`.
 /// Points are returned in arclength order; located bifurcations carry their label.
 ///
-/// # Errors
-/// [`SimError`] when the first orbit cannot be found or the parameters are invalid.
-pub fn continue_branch(spec: &ContinuationSpec, guess: &DVector<f64>) -> Result<Branch, SimError> {
-    continue_branch_with(spec, guess, &Progress::new())
-}
-
-/// [`continue_branch`] counting every branch point in `progress` (a branch's length is not
-/// known ahead: the total is left as it is) and stopping when it is cancelled.
+/// It counts every branch point in `progress` (a branch's length is not known ahead: the total
+/// is left as it is) and stops when it is cancelled.
 ///
 /// # Errors
-/// As [`continue_branch`]; [`SimError::Cancelled`] once `progress` is cancelled.
-pub fn continue_branch_with(
+/// [`SimError`] when the first orbit cannot be found or the parameters are invalid;
+/// [`SimError::Cancelled`] once `progress` is cancelled.
+pub fn continue_branch(
     spec: &ContinuationSpec,
     guess: &DVector<f64>,
     progress: &Progress,

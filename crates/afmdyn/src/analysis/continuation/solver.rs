@@ -1,4 +1,4 @@
-//! The pseudo-arclength corrector's maps ([`super::continue_branch_with`]): the integrators
+//! The pseudo-arclength corrector's maps ([`super::continue_branch`]): the integrators
 //! per parameter value, Pⁿ with its monodromy matrix and ∂Pⁿ/∂p (exact or by differences),
 //! and the corrector itself (module docs of [`super`]).
 

@@ -2,12 +2,11 @@
 //! the continuation of the whole period-doubling cascade ([`continue_with_switching`]).
 //! Shapes, units and sources as in [`super`].
 
-use super::{continue_branch_with, Branch, BranchEvent, BranchPoint, ContinuationSpec};
+use super::{continue_branch, Branch, BranchEvent, BranchPoint, ContinuationSpec};
 use crate::analysis::progress::Progress;
 use crate::analysis::shooting::shoot;
 use crate::error::SimError;
-use crate::integrate::build;
-use crate::maps::StroboscopicMap;
+use crate::maps::{DiscreteMap, StroboscopicMap};
 use crate::model::CantileverModel;
 use nalgebra::{DMatrix, DVector};
 
@@ -33,8 +32,8 @@ pub fn period_doubling_starts(
     let dim = z.len();
     let Some(v) = (|| {
         let model = CantileverModel::new(&spec.base.with(spec.param, pd.value)).ok()?;
-        let mut integ = build(&model, spec.integrator.clone(), 0.0, &model.rest()).ok()?;
-        let m = StroboscopicMap::new(integ.as_mut(), pd.period)
+        let m = StroboscopicMap::build(&model, spec.integrator.clone(), &model.rest(), pd.period)
+            .ok()?
             .apply(&z)
             .ok()?
             .jacobian;
@@ -61,17 +60,18 @@ pub fn period_doubling_starts(
             let Ok(model) = CantileverModel::new(&spec.base.with(spec.param, p)) else {
                 continue;
             };
-            let Ok(mut integ) = build(&model, spec.integrator.clone(), 0.0, &model.rest()) else {
+            let rest = model.rest();
+            let Ok(map) = &mut StroboscopicMap::build(&model, spec.integrator.clone(), &rest, 1)
+            else {
                 continue;
             };
             for sign_v in [1.0, -1.0] {
                 let guess = &z + &v * (sign_v * eps);
-                let map = &mut StroboscopicMap::new(integ.as_mut(), 1);
                 let Ok(o) = shoot(map, &guess, &spec.newton.with_period(2 * pd.period)) else {
                     continue;
                 };
-                let Ok(half) = StroboscopicMap::new(integ.as_mut(), pd.period).apply(&o.state)
-                else {
+                // the map of n periods, as one flow over them
+                let Ok(half) = map.linearise(&o.state, pd.period, true) else {
                     continue;
                 };
                 if (&half.state - &o.state).norm() > 1e-6 * (1.0 + o.state.norm()) {
@@ -90,29 +90,19 @@ pub fn period_doubling_starts(
 /// bifurcations at the same parameter values) is kept once. Returns the branches, the first
 /// being the one of `spec`.
 ///
-/// # Errors
-/// As [`super::continue_branch`] for the first branch; a sub-branch that fails is skipped.
-pub fn continue_with_switching(
-    spec: &ContinuationSpec,
-    guess: &DVector<f64>,
-    max_period: usize,
-) -> Result<Vec<Branch>, SimError> {
-    continue_with_switching_with(spec, guess, max_period, &Progress::new())
-}
-
-/// [`continue_with_switching`] counting every branch point in `progress` and stopping when it
-/// is cancelled.
+/// It counts every branch point in `progress` and stops when it is cancelled.
 ///
 /// # Errors
-/// As [`continue_with_switching`]; [`SimError::Cancelled`] once `progress` is cancelled (also
-/// inside a sub-branch, whose other failures are skipped).
-pub fn continue_with_switching_with(
+/// As [`super::continue_branch`] for the first branch; a sub-branch that fails is skipped;
+/// [`SimError::Cancelled`] once `progress` is cancelled (also inside a sub-branch, whose other
+/// failures are skipped).
+pub fn continue_with_switching(
     spec: &ContinuationSpec,
     guess: &DVector<f64>,
     max_period: usize,
     progress: &Progress,
 ) -> Result<Vec<Branch>, SimError> {
-    let mut branches = vec![continue_branch_with(spec, guess, progress)?];
+    let mut branches = vec![continue_branch(spec, guess, progress)?];
     let mut next = 0;
     while next < branches.len() {
         let pds: Vec<BranchPoint> = branches[next]
@@ -159,7 +149,7 @@ pub fn continue_with_switching_with(
                         .collect(),
                     ..spec.clone()
                 };
-                let b = match continue_branch_with(&sub, &z, progress) {
+                let b = match continue_branch(&sub, &z, progress) {
                     Ok(b) => b,
                     Err(SimError::Cancelled) => return Err(SimError::Cancelled),
                     Err(_) => continue,

@@ -510,8 +510,14 @@ impl CheckedModel for AmCurveModel {
             // those of the sensitivities' Fourier integrals (the same to the integration error)
             if jacobian.is_some() && point.period == Some(1) && point.stable {
                 let model = CantileverModel::new(&q.with(SweepParam::Alpha5, alpha5[i]))?;
-                let s =
-                    orbit_sensitivity(&model, self.tolerance, &point.state, &orbit_params, None)?;
+                let s = orbit_sensitivity(
+                    &model,
+                    self.tolerance,
+                    &point.state,
+                    &orbit_params,
+                    None,
+                    None,
+                )?;
                 a = s.amplitude;
                 phi = s.phase;
                 for w in &s.warnings {
@@ -555,15 +561,8 @@ impl CheckedModel for AmCurveModel {
 }
 
 /// The first sweep of `spec` alone ([`sweep_points`], stopped once its last point is done: the
-/// instrument's path through the rows; the sweep back is not run).
-///
-/// # Errors
-/// As [`sweep_points`].
-pub fn first_sweep(spec: &SteppedSpec) -> Result<Vec<CurvePoint>, SimError> {
-    first_sweep_cancellable(spec, &AtomicBool::new(false))
-}
-
-/// [`first_sweep`], stopped after the point under way once `stop` is set.
+/// instrument's path through the rows; the sweep back is not run), stopped after the point
+/// under way once `stop` is set.
 ///
 /// # Errors
 /// As [`sweep_points`]; [`SimError::Cancelled`] when `stop` was set before the last point.

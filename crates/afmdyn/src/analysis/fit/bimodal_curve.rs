@@ -5,7 +5,7 @@
 //! instrument did (as [`super::am_curve`]: each row's orbit continued from the previous one).
 //! A₂ and φ₂ are the harmonic of the tip deflection at the component's frequency over the
 //! drive's common period, with their exact sensitivities from a second pair of Fourier
-//! integrals of the extended flow ([`super::sensitivity::orbit_sensitivity_component`]); the
+//! integrals of the extended flow ([`super::sensitivity::orbit_sensitivity`]); the
 //! parameters map onto the model's as in [`super::am_curve`].
 //!
 //! The model's values are, for the channels fitted, the rows' A₁ g₀, then φ₁, A₂ g₀, φ₂ (m and
@@ -16,7 +16,7 @@ use super::am_curve::CheckedModel;
 use super::am_curve::{
     first_sweep_cancellable, gaps, scaled, AmParam, AmProbe, SENSITIVITY_TOLERANCE,
 };
-use super::sensitivity::orbit_sensitivity_component;
+use super::sensitivity::orbit_sensitivity;
 use crate::analysis::stepped::SteppedSpec;
 use crate::error::SimError;
 use crate::model::CantileverModel;
@@ -139,7 +139,7 @@ impl CheckedModel for BimodalCurveModel {
                     return Err(SimError::Cancelled);
                 }
                 let model = CantileverModel::new(&q.with(SweepParam::Alpha5, alpha5[i]))?;
-                let s = orbit_sensitivity_component(
+                let s = orbit_sensitivity(
                     &model,
                     self.tolerance,
                     &point.state,

@@ -96,22 +96,13 @@ pub struct FitOutcome {
 }
 
 /// Fit `model` to `obs` over the parameters `params` whose `fixed` entry is `None` (the others
-/// held at it), from their start values; with profiles for up to [`MAX_PROFILED`] of them.
+/// held at it), from their start values; with the profile-likelihood intervals of up to
+/// [`MAX_PROFILED`] of them when `profiles` (walked on the grid, [`ProfileWalk::Grid`]; else
+/// the Wald intervals, ±1.96 standard errors).
 ///
 /// # Panics
 /// Never for consistent lengths: `params` and `fixed` have the model's n entries and `obs`
 /// its m points (the caller's [`crate::request`] checks the data).
-pub fn fit(
-    model: &dyn CurveModel,
-    obs: &Observations,
-    params: &[Parameter],
-    fixed: &[Option<f64>],
-) -> FitOutcome {
-    fit_with(model, obs, params, fixed, true)
-}
-
-/// [`fit`], with the profile-likelihood intervals when `profiles` (walked on the grid,
-/// [`ProfileWalk::Grid`]; else the Wald intervals, ±1.96 standard errors).
 pub fn fit_with(
     model: &dyn CurveModel,
     obs: &Observations,
@@ -128,7 +119,7 @@ pub fn fit_with(
     }
 }
 
-/// [`fit`] in a run: the profiles walked as `profiles` says (none: the Wald intervals), every
+/// [`fit_with`] in a run: the profiles walked as `profiles` says (none: the Wald intervals), every
 /// model evaluation — the minimiser's, the covariance's, the profiles' refits — counted in
 /// `progress` and checking its cancel flag first.
 ///

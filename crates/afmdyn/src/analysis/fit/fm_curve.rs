@@ -182,7 +182,14 @@ impl CheckedModel for FmCurveModel {
                 .with(SweepParam::Omega, point.omega)
                 .with(SweepParam::Alpha2, point.alpha2);
             let model = CantileverModel::new(&at)?;
-            let s = orbit_sensitivity(&model, self.tolerance, &point.state, &orbit_params, None)?;
+            let s = orbit_sensitivity(
+                &model,
+                self.tolerance,
+                &point.state,
+                &orbit_params,
+                None,
+                None,
+            )?;
             // the orbit's own near-fold measure is not the FM curve's: locked at the lever's
             // resonance, I − M has multipliers within ~π/Q of 1 by construction (the
             // oscillation's amplitude and phase), the very directions the loop conditions fix;

@@ -20,6 +20,6 @@ pub mod sensitivity_jkr;
 pub mod sls_curve;
 pub mod start;
 
-pub use estimates::{fit, fit_cancellable, fit_with, Estimate, FitOutcome};
+pub use estimates::{fit_cancellable, fit_with, Estimate, FitOutcome};
 pub use least_squares::{CurveModel, Minimum, Observations, Parameter};
 pub use profile::{Profile, ProfileEnd, ProfileWalk};

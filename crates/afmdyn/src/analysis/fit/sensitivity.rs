@@ -98,7 +98,7 @@ use crate::analysis::shooting::{shoot, ShootingOptions, GRAZING_TOL};
 use crate::contact::{ContactLaw, DmtLaw, HertzLaw, Law, TipSample, TipSampleLaw};
 use crate::error::SimError;
 use crate::integrate::adaptive::Adaptive;
-use crate::maps::flow::flow_with_jacobian;
+use crate::maps::flow::flow;
 use crate::maps::StroboscopicMap;
 use crate::model::{CantileverModel, DampingDerivative, ForcingDerivative};
 use crate::params::{Params, SweepParam};
@@ -198,7 +198,7 @@ pub struct OrbitSensitivity {
     /// Near a fold or grazing.
     pub warnings: Vec<SensitivityWarning>,
     /// The harmonic of the tip deflection at a further drive component's frequency, when asked
-    /// for ([`orbit_sensitivity_component`]: a bimodal drive's A₂, φ₂).
+    /// for ([`orbit_sensitivity`]: a bimodal drive's A₂, φ₂).
     pub component: Option<Harmonic>,
 }
 
@@ -547,24 +547,7 @@ impl TipSampleSystem for Extended {
 /// The period-1 orbit of `model` near `guess` (polished by Newton, `newton`, on the adaptive
 /// integrator of tolerance `tol`; `None`: `guess` is taken as the orbit, as a stepped sweep
 /// converged it with its own integrator), its first harmonic and their exact sensitivities to
-/// `params` (module docs).
-///
-/// # Errors
-/// [`SimError::Unsupported`] for a law other than Hertz, DMT and JKR, for H̃ under Hertz or
-/// JKR, and for P̃ ([`OrbitParam::Adhesion`]) under another
-/// law;
-/// [`SimError::NoConvergence`] from the Newton solve; [`SimError`] from the integrator.
-pub fn orbit_sensitivity(
-    model: &CantileverModel,
-    tol: f64,
-    guess: &DVector<f64>,
-    params: &[OrbitParam],
-    newton: Option<&ShootingOptions>,
-) -> Result<OrbitSensitivity, SimError> {
-    orbit_sensitivity_component(model, tol, guess, params, newton, None)
-}
-
-/// As [`orbit_sensitivity`], and with `component` = Some(c) also the harmonic of the tip
+/// `params` (module docs); with `component` = Some(c) also the harmonic of the tip
 /// deflection at the further drive component c's frequency (1-based among
 /// [`crate::params::Params::components`]: the bimodal drive's second, c = 1), ω_c = (p/q) Ω
 /// with ψ_c = θ_c + π/2 (its force F̃ cos(ω_c τ + θ_c) = F̃ sin(ω_c τ + ψ_c)), demodulated over
@@ -573,9 +556,11 @@ pub fn orbit_sensitivity(
 /// from a second pair of Fourier integrals of the same extended flow.
 ///
 /// # Errors
-/// As [`orbit_sensitivity`]; [`SimError::OutOfRange`] naming `component` when the drive has
-/// no such component.
-pub fn orbit_sensitivity_component(
+/// [`SimError::Unsupported`] for a law other than Hertz, DMT and JKR, for H̃ under Hertz or
+/// JKR, and for P̃ ([`OrbitParam::Adhesion`]) under another law;
+/// [`SimError::NoConvergence`] from the Newton solve; [`SimError::OutOfRange`] naming
+/// `component` when the drive has no such component; [`SimError`] from the integrator.
+pub fn orbit_sensitivity(
     model: &CantileverModel,
     tol: f64,
     guess: &DVector<f64>,
@@ -601,7 +586,7 @@ pub fn orbit_sensitivity_component(
     y0.rows_mut(0, d).copy_from(&state);
     let mut integ = Adaptive::new(&ext, tol);
     let period = HybridSystem::period(model);
-    let flow = flow_with_jacobian(&mut integ, 0.0, &y0, period)?;
+    let flow = flow(&mut integ, 0.0, &y0, period, None, true)?;
     let big = &flow.jacobian;
     let m = big.view((0, 0), (d, d)).into_owned();
     let d_map = big.view((0, first), (d, k)).into_owned();

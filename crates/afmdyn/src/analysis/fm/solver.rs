@@ -46,11 +46,10 @@ impl Solver<'_> {
             .with(SweepParam::Alpha2, x[1]);
         p.validate()?;
         let model = CantileverModel::new(&p)?;
-        let mut integ = build(&model, self.spec.integrator.clone(), 0.0, guess)?;
         // Newton's full steps; where they stall (near a grazing orbit, whose map has a
         // square-root singularity) Newton with a line search; at the map's round-off floor a
         // looser tolerance
-        let map = &mut StroboscopicMap::new(integ.as_mut(), 1);
+        let map = &mut StroboscopicMap::build(&model, self.spec.integrator.clone(), guess, 1)?;
         let newton = self.spec.newton.with_period(1);
         let globalised = ShootingOptions {
             strategy: ShootingStrategy::Globalised,

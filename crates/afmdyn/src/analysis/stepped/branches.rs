@@ -3,16 +3,14 @@
 //! and the jumps of a sweep. Shapes, units and sources as in [`super`].
 
 use super::{
-    integrator_at, measure, relative_gap, BranchSample, CurvePoint, Jump, Reached, SteppedSpec,
-    Sweep,
+    map_at, measure, relative_gap, BranchSample, CurvePoint, Jump, Reached, SteppedSpec, Sweep,
 };
 use crate::analysis::continuation::{
-    continue_branch_with, Branch, BranchEnd, BranchEvent, ContinuationSpec,
+    continue_branch, Branch, BranchEnd, BranchEvent, ContinuationSpec,
 };
 use crate::analysis::progress::Progress;
 use crate::analysis::shooting::shoot;
 use crate::error::SimError;
-use crate::maps::StroboscopicMap;
 use nalgebra::{Complex, DVector};
 
 /// Continue the branch through `from` (a stable orbit of a sweep) towards `to`, with
@@ -43,13 +41,13 @@ pub(super) fn branch(
     cs.ds = scale / 100.0;
     cs.ds_max = scale / 25.0;
     // the branch's points were counted as they came; its length is known only now
-    let Branch { points, end } = continue_branch_with(&cs, &from.state, progress)?;
+    let Branch { points, end } = continue_branch(&cs, &from.state, progress)?;
     progress.add_total(points.len());
     let mut out = Vec::with_capacity(points.len());
     for p in points {
         progress.check()?;
-        let mut integ = integrator_at(spec, p.value, &p.section[0])?;
-        let observables = measure(integ.as_mut(), &p.section[0], p.period, &spec.observables)?;
+        let mut map = map_at(spec, p.value, &p.section[0])?;
+        let observables = measure(map.integrator(), &p.section[0], p.period, &spec.observables)?;
         out.push(BranchSample {
             point: p,
             observables,
@@ -98,10 +96,9 @@ pub(super) fn branch_starts(
         let (Some(n), Some(_)) = (from.period, at.period) else {
             continue;
         };
-        let Ok(mut integ) = integrator_at(spec, at.value, &from.state) else {
+        let Ok(map) = &mut map_at(spec, at.value, &from.state) else {
             continue;
         };
-        let map = &mut StroboscopicMap::new(integ.as_mut(), 1);
         let Ok(o) = shoot(map, &from.state, &spec.newton.with_period(n)) else {
             continue;
         };
@@ -109,7 +106,8 @@ pub(super) fn branch_starts(
             continue;
         }
         let periods = n;
-        let Ok(observables) = measure(integ.as_mut(), &o.state, periods, &spec.observables) else {
+        let Ok(observables) = measure(map.integrator(), &o.state, periods, &spec.observables)
+        else {
             continue;
         };
         starts.push(CurvePoint {

@@ -46,7 +46,7 @@ use crate::analysis::shooting::{
 use crate::analysis::steady::{decay_periods, SteadyOptions};
 use crate::error::SimError;
 use crate::integrate::{build, Integrator, IntegratorOptions};
-use crate::maps::StroboscopicMap;
+use crate::maps::{DiscreteMap, StroboscopicMap};
 use crate::model::CantileverModel;
 use crate::params::{Params, SweepParam};
 use crate::tip_sample::TipSampleSystem;
@@ -64,7 +64,7 @@ use branches::{branch, branch_starts, jumps_of, on_branch, unstable_between_fold
 use torus::{torus_point, CirclePoint, Fallback, TorusOptions};
 
 mod point;
-use point::{integrator_at, step_point};
+use point::{map_at, step_point};
 pub use point::{settle, Settled, AVERAGE_AGREEMENTS, AVERAGE_MIN_WINDOW, AVERAGE_TOL};
 
 /// Largest number of values of a stepped sweep (each is a steady-state computation, twice).
@@ -554,24 +554,11 @@ pub fn check_values(spec: &SteppedSpec) -> Result<(), SimError> {
 /// non-finite ones; [`SimError::Params`] when a value is outside its parameter's range;
 /// [`SimError`] from the integrator. A branch that cannot be continued is a warning.
 pub fn stepped_sweep(spec: &SteppedSpec) -> Result<SteppedCurve, SimError> {
-    stepped_sweep_with(spec, &Progress::new())
-}
-
-/// [`stepped_sweep`] counting in `progress` the points of both sweeps (its total grows by
-/// twice the number of values) and of the branches (whose lengths are not known ahead), and
-/// stopping when it is cancelled.
-///
-/// # Errors
-/// As [`stepped_sweep`]; [`SimError::Cancelled`] once `progress` is cancelled.
-pub(crate) fn stepped_sweep_with(
-    spec: &SteppedSpec,
-    progress: &Progress,
-) -> Result<SteppedCurve, SimError> {
     check_values(spec)?;
-    progress.add_total(2 * spec.values.len());
-    let count = |_: usize, _: &CurvePoint| progress.tick();
-    let (first, second) = sweep_points(spec, &[], progress.cancel_flag(), &count)?;
-    finish_curve(spec, first, second, progress)
+    // a run of its own, never cancelled
+    let progress = Progress::new();
+    let (first, second) = sweep_points(spec, &[], progress.cancel_flag(), &|_, _| ())?;
+    finish_curve(spec, first, second, &progress)
 }
 
 /// The curve of the two sweeps ([`sweep_points`]): with `spec.branches` the periodic-orbit
@@ -778,8 +765,8 @@ pub fn is_fixed_point(
     n: usize,
     tol: f64,
 ) -> Result<bool, SimError> {
-    let mut integ = integrator_at(spec, value, z)?;
-    let m = StroboscopicMap::new(integ.as_mut(), n).apply(z)?;
+    // the map of n periods, as one flow over them
+    let m = map_at(spec, value, z)?.linearise(z, n, true)?;
     Ok((&m.state - z).norm() <= tol * (1.0 + z.norm()))
 }
 

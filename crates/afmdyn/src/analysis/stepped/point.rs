@@ -236,14 +236,14 @@ fn minimal_orbit(integ: &mut dyn Integrator, found: Found, spec: &SteppedSpec) -
     }
 }
 
-/// The integrator at one parameter value, started at `z` (τ = 0).
-pub(super) fn integrator_at(
+/// The period-1 map at one parameter value over its own integrator, started at `z` (τ = 0).
+pub(super) fn map_at(
     spec: &SteppedSpec,
     value: f64,
     z: &DVector<f64>,
-) -> Result<Box<dyn Integrator>, SimError> {
+) -> Result<StroboscopicMap<'static>, SimError> {
     let model = CantileverModel::new(&spec.base.with(spec.param, value))?;
-    build(&model, spec.integrator.clone(), 0.0, z)
+    StroboscopicMap::build(&model, spec.integrator.clone(), z, 1)
 }
 
 /// The stable orbit a step of the sweep follows: its value v0 and state z0, the secant slope
@@ -285,7 +285,7 @@ fn continue_orbit(
 ) -> Result<Option<PeriodicOrbit>, SimError> {
     let (v0, z0) = (from.value, from.state);
     let model = CantileverModel::new(&spec.base.with(spec.param, v1))?;
-    let mut integ = build(&model, spec.integrator.clone(), 0.0, z0)?;
+    let map = &mut StroboscopicMap::build(&model, spec.integrator.clone(), z0, 1)?;
     let m1 = from
         .trend
         .filter(|_| broyden_pays(spec.integrator.clone(), &model))
@@ -295,7 +295,6 @@ fn continue_orbit(
         guesses.push(z0 + s * (v1 - v0));
     }
     guesses.push(z0.clone());
-    let map = &mut StroboscopicMap::new(integ.as_mut(), 1);
     let undamped = ShootingOptions {
         period: from.period,
         strategy: ShootingStrategy::Undamped,

@@ -7,7 +7,7 @@
 //! (the state at τ = 0, [`CurvePoint::state`]) predicted from the previous points of the
 //! branch (the quadratic or secant extrapolation of the orbits' curve), Broyden's updates
 //! from the previous circle's map Jacobian ([`CirclePoint::jacobian`];
-//! [`continue_circle_at`]), else Newton ([`invariant_circle`]). Each drive component's
+//! [`continue_circle`]), else Newton ([`invariant_circle`]). Each drive component's
 //! amplitude, phase, virial and dissipated energy come from the circle ([`observe_circle`]),
 //! its stability from the contraction of its linearisation
 //! ([`crate::analysis::torus::InvariantCircle::contraction`]).
@@ -26,7 +26,7 @@
 use super::point::{orbit_point, prediction_slope};
 use super::{relative_gap, CurvePoint, Reached, SteppedSpec};
 use crate::analysis::torus::{
-    continue_circle_at, invariant_circle, observe_circle, CircleOptions, InvariantCircle,
+    continue_circle, invariant_circle, observe_circle, CircleOptions, InvariantCircle,
 };
 use crate::error::SimError;
 use crate::maps::circle::MAX_NODES;
@@ -206,7 +206,7 @@ fn find_circle(
         .and_then(|p| p.circle.as_ref())
         .filter(|c| c.jacobian.nrows() == guess.len());
     match previous {
-        Some(c) => continue_circle_at(model, integ.clone(), &guess, &c.jacobian, opts)
+        Some(c) => continue_circle(model, integ.clone(), &guess, &c.jacobian, opts)
             .or_else(|_| invariant_circle(model, integ, &guess, opts)),
         None => invariant_circle(model, integ, &guess, opts),
     }
