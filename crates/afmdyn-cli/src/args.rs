@@ -139,16 +139,19 @@ impl clap::FromArgMatches for GroupArgs {
 
 impl Args for GroupArgs {
     fn augment_args(cmd: clap::Command) -> clap::Command {
-        GROUPS.iter().zip(group_flags()).fold(cmd, |cmd, (g, flag)| {
-            cmd.arg(
-                clap::Arg::new(g.name)
-                    .long(flag.as_str())
-                    .value_name(g.symbol)
-                    .allow_negative_numbers(true)
-                    .value_parser(clap::value_parser!(f64))
-                    .action(clap::ArgAction::Set),
-            )
-        })
+        GROUPS
+            .iter()
+            .zip(group_flags())
+            .fold(cmd, |cmd, (g, flag)| {
+                cmd.arg(
+                    clap::Arg::new(g.name)
+                        .long(flag.as_str())
+                        .value_name(g.symbol)
+                        .allow_negative_numbers(true)
+                        .value_parser(clap::value_parser!(f64))
+                        .action(clap::ArgAction::Set),
+                )
+            })
     }
 
     fn augment_args_for_update(cmd: clap::Command) -> clap::Command {
