@@ -87,6 +87,7 @@ macro_rules! laws {
                 doc: <$Law as Law>::DOC,
                 params: <$Law as Law>::PARAMS,
                 sample_keys: <$Law as Law>::SAMPLE_KEYS,
+                tip_radius: <$Law as Law>::TIP_RADIUS,
             },
         )*];
 

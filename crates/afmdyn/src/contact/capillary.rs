@@ -48,6 +48,7 @@ impl CapillaryLaw {
 }
 
 impl Law for CapillaryLaw {
+    const TIP_RADIUS: bool = true;
     const DOC: &'static str = "capillary meniscus over a Hertz sample: formed at contact, ruptured at V_T = D̃_r (Zitzler, Herminghaus & Mugele 2002)";
     const SAMPLE_KEYS: &'static [&'static str] = &["law", "youngs_modulus", "poisson_ratio", "viscosity", "meniscus_volume", "surface_tension", "contact_angle", "z_c"];
     const PARAMS: &'static [Param] = &[

@@ -156,6 +156,7 @@ macro_rules! dmt_family {
 pub(crate) use dmt_family;
 
 impl Law for DmtLaw {
+    const TIP_RADIUS: bool = true;
     const DOC: &'static str =
         "DMT: van der Waals attraction outside contact, adhesion + Hertz + Kelvin–Voigt inside";
     const PARAMS: &'static [Param] = &PARAMS;

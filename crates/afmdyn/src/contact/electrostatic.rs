@@ -35,6 +35,7 @@ pub struct ElectrostaticLaw {
 }
 
 impl Law for ElectrostaticLaw {
+    const TIP_RADIUS: bool = true;
     const DOC: &'static str =
         "DMT plus the electrostatic force of a biased spherical tip (Hudlet et al. 1998)";
     const SAMPLE_KEYS: &'static [&'static str] = &["law", "youngs_modulus", "poisson_ratio", "hamaker", "intermolecular_distance", "viscosity", "z_c", "bias_voltage", "contact_potential"];

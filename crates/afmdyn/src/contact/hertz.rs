@@ -8,6 +8,7 @@ use super::{ForceEval, JetLaw, Law, SampleSi};
 pub struct HertzLaw;
 
 impl Law for HertzLaw {
+    const TIP_RADIUS: bool = true;
     const DOC: &'static str =
         "Hertz sphere–flat repulsion with a viscous damper: F_c = α4 δ^{3/2} + α6 δ̇";
     const SAMPLE_KEYS: &'static [&'static str] = &["law", "youngs_modulus", "poisson_ratio", "damping", "z_c"];

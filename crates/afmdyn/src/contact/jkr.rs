@@ -31,6 +31,7 @@ pub struct JkrLaw {
 }
 
 impl Law for JkrLaw {
+    const TIP_RADIUS: bool = true;
     const DOC: &'static str = "JKR: adhesive Hertz contact with a neck, formed at δ = 0, broken at δ_f < 0 (Johnson, Kendall & Roberts 1971)";
     const SAMPLE_KEYS: &'static [&'static str] = &["law", "youngs_modulus", "poisson_ratio", "hamaker", "intermolecular_distance", "viscosity", "z_c", "adhesion_energy"];
     const PARAMS: &'static [Param] = &[Param {

@@ -57,6 +57,8 @@ pub struct LawInfo {
     pub params: &'static [Param],
     /// The keys a probe file's `[sample]` table may hold for it ([`Law::SAMPLE_KEYS`]).
     pub sample_keys: &'static [&'static str],
+    /// Whether its contact is Hertz's sphere of the tip's radius ([`Law::TIP_RADIUS`]).
+    pub tip_radius: bool,
 }
 
 /// A probe file's sample in SI (`[sample]` and `[tip]`, read by [`crate::probe`]) and the probe's
@@ -137,6 +139,10 @@ pub trait Law: Copy + Sized {
     const PARAMS: &'static [Param] = &[];
     /// The keys a probe file's `[sample]` table may hold for the law ([`crate::probe`]).
     const SAMPLE_KEYS: &'static [&'static str] = &["law", "z_c"];
+    /// Whether the law's contact is Hertz's sphere of the tip's radius, α4 its Hertz group
+    /// (4/3)E*√R g₀^{3/2}/F_s ([`SampleSi::hertz_alpha4`]): a probe's tip radius and sample
+    /// modulus set it, and a fitted α4 is a modulus.
+    const TIP_RADIUS: bool = false;
 
     /// The law's constants, derived once from its groups and α4, α6 ([`Law::prepare`]);
     /// [`super::AsGiven`] for a law that derives nothing worth keeping.
