@@ -7,7 +7,7 @@
 //! single values of [`ModelSpec`] ← the SI overrides `z_c` (sets α5) and `drive_frequency`
 //! (sets Ω), which need the probe's scales.
 
-use crate::contact::{ContactLaw, LawGroups, LawKind, GROUPS};
+use crate::contact::{ContactLaw, LawGroups, LawKind, GROUPS, LAWS};
 use crate::error::SimError;
 use crate::params::{Excitation, Params};
 use crate::probe::Probe;
@@ -21,7 +21,7 @@ pub enum ValueKind {
     Integer,
     /// A real number.
     Real,
-    /// One of `linear`, `hertz`, `dmt`, `electrostatic`, `impact`.
+    /// A registered law's name ([`LAWS`]).
     Law,
     /// One of `base`, `tip`.
     Excitation,
@@ -139,13 +139,8 @@ const BEFORE_GROUPS: [ParamInfo; 10] = [
         unit: "1",
         range: crate::contact::LawKind::EXPECTED,
         default: "linear",
-        help:
-            "tip–sample law: linear (α4 δ + α6 δ̇), hertz (α4 δ^1.5 + α6 δ̇), dmt (van der Waals + \
-         adhesion + Hertz + α6 √δ δ̇), electrostatic (dmt + a biased tip), jkr (adhesive Hertz \
-         contact with a neck, formed at δ = 0, broken at δ_f < 0), capillary (a meniscus formed \
-         at contact, ruptured at V_T = D_r, over a Hertz sample), sls (standard linear solid: \
-         α4 in parallel with a Maxwell arm κ, α6, whose surface recovers after the tip leaves) \
-         or impact (rigid sample, restitution r)",
+        // the registry's laws and doc lines ([`law_help`])
+        help: "tip–sample law",
         kind: ValueKind::Law,
     },
     ParamInfo {
@@ -202,12 +197,26 @@ pub static MODEL_PARAMETERS: std::sync::LazyLock<Vec<ParamInfo>> = std::sync::La
         help: leak(format!("{}: {}", crate::contact::owners(g.name), g.doc)),
         kind: ValueKind::Real,
     });
-    BEFORE_GROUPS
-        .into_iter()
-        .chain(groups)
+    let laws = BEFORE_GROUPS.into_iter().map(|p| match p.kind {
+        ValueKind::Law => ParamInfo {
+            help: law_help(),
+            ..p
+        },
+        _ => p,
+    });
+    laws.chain(groups)
         .chain(AFTER_GROUPS)
         .collect()
 });
+
+/// The help of `contact_law`: each registered law's name and doc line ([`LAWS`]).
+fn law_help() -> &'static str {
+    let laws: Vec<String> = LAWS
+        .iter()
+        .map(|l| format!("{} ({})", l.name, l.doc))
+        .collect();
+    leak(format!("tip–sample law: {}", laws.join(", ")))
+}
 
 /// A text built once for the table of [`MODEL_PARAMETERS`], kept for the program's life.
 fn leak(text: String) -> &'static str {
