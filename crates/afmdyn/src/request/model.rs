@@ -277,11 +277,13 @@ macro_rules! model_spec {
         fn fields() -> &'static [&'static str] {
             static FIELDS: std::sync::OnceLock<Vec<&'static str>> = std::sync::OnceLock::new();
             FIELDS.get_or_init(|| {
-                let mut out: Vec<&'static str> = Vec::new();
-                $( $( out.push(stringify!($balias)); )? out.push(stringify!($b)); )*
-                out.extend(GROUPS.iter().map(|g| g.name));
-                $( out.push(stringify!($a)); )*
-                out
+                let before = [$( $(stringify!($balias),)? stringify!($b), )*];
+                let after = [$( stringify!($a), )*];
+                before
+                    .into_iter()
+                    .chain(GROUPS.iter().map(|g| g.name))
+                    .chain(after)
+                    .collect()
             })
         }
 
