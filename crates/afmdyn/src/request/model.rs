@@ -194,7 +194,7 @@ pub static MODEL_PARAMETERS: std::sync::LazyLock<Vec<ParamInfo>> = std::sync::La
         unit: g.unit,
         range: g.range,
         default: leak(crate::error::number(g.default)),
-        help: leak(format!("{}: {}", crate::contact::owners(g.name), g.doc)),
+        help: leak(format!("{} law: {}", crate::contact::owners(g.name), g.doc)),
         kind: ValueKind::Real,
     });
     let laws = BEFORE_GROUPS.into_iter().map(|p| match p.kind {
