@@ -218,7 +218,11 @@ fn the_table_the_schema_and_a_request_take_the_toy_law_and_its_group() {
         .find(|p| p.name == "toy_adhesion")
         .expect("a row of the table");
     assert_eq!((row.symbol, row.default), ("F̃_ad", "0.1"));
-    assert!(row.help.starts_with("spring_adhesion law: "), "{}", row.help);
+    assert!(
+        row.help.starts_with("spring_adhesion law: "),
+        "{}",
+        row.help
+    );
     let schema = schemars::schema_for!(ModelSpec).to_value();
     let text = schema.to_string();
     assert!(text.contains(r#""const":"spring_adhesion""#), "{text}");

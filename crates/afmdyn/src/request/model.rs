@@ -204,9 +204,7 @@ pub static MODEL_PARAMETERS: std::sync::LazyLock<Vec<ParamInfo>> = std::sync::La
         },
         _ => p,
     });
-    laws.chain(groups)
-        .chain(AFTER_GROUPS)
-        .collect()
+    laws.chain(groups).chain(AFTER_GROUPS).collect()
 });
 
 /// The help of `contact_law`: each registered law's name and doc line ([`LAWS`]).
