@@ -5,7 +5,7 @@
 use crate::error::CliError;
 use afmdyn::io::InputKind;
 use afmdyn::request::ModelSpec;
-use afmdyn::request::{LawKind, Params};
+use afmdyn::request::{LawGroups, LawKind, Params, GROUPS};
 use clap::Args;
 use serde::Deserialize;
 use std::path::PathBuf;
@@ -101,26 +101,62 @@ pub struct ModelArgs {
     pub contact_law: Option<LawKind>,
     #[arg(long, value_name = "WHERE", value_parser = parse_excitation)]
     pub excitation: Option<afmdyn::request::Excitation>,
-    #[arg(long, value_name = "r", allow_negative_numbers = true)]
-    pub restitution: Option<f64>,
-    #[arg(long, value_name = "H̃", allow_negative_numbers = true)]
-    pub hamaker: Option<f64>,
-    #[arg(long, value_name = "ã0", allow_negative_numbers = true)]
-    pub intermolecular_distance: Option<f64>,
-    #[arg(long, value_name = "Ẽ", allow_negative_numbers = true)]
-    pub electrostatic: Option<f64>,
-    #[arg(long, value_name = "R̃", allow_negative_numbers = true)]
-    pub tip_radius: Option<f64>,
-    #[arg(long, value_name = "P̃", allow_negative_numbers = true)]
-    pub adhesion: Option<f64>,
-    #[arg(long, value_name = "F̃_cap", allow_negative_numbers = true)]
-    pub capillary: Option<f64>,
-    #[arg(long, value_name = "h̃", allow_negative_numbers = true)]
-    pub meniscus: Option<f64>,
-    #[arg(long, value_name = "D̃_r", allow_negative_numbers = true)]
-    pub rupture: Option<f64>,
-    #[arg(long, value_name = "κ", allow_negative_numbers = true)]
-    pub maxwell_stiffness: Option<f64>,
+    /// The law groups' flags ([`GroupArgs`]).
+    #[command(flatten)]
+    pub groups: GroupArgs,
+}
+
+/// The flags of the law groups, one per group of the library's registry
+/// ([`afmdyn::request::GROUPS`]: `--hamaker`, `--maxwell-stiffness`, …), built with clap's
+/// builder API: each takes a number (negative ones too, refused by the law's range), its value
+/// named by the group's symbol; the help comes from the library's table, as every model flag's
+/// (main.rs).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct GroupArgs(pub LawGroups);
+
+/// The groups' flag names (`_` as `-`), in the order of [`GROUPS`].
+fn group_flags() -> &'static [String] {
+    static FLAGS: std::sync::OnceLock<Vec<String>> = std::sync::OnceLock::new();
+    FLAGS.get_or_init(|| GROUPS.iter().map(|g| g.name.replace('_', "-")).collect())
+}
+
+impl clap::FromArgMatches for GroupArgs {
+    fn from_arg_matches(m: &clap::ArgMatches) -> Result<Self, clap::Error> {
+        let mut out = GroupArgs::default();
+        out.update_from_arg_matches(m)?;
+        Ok(out)
+    }
+
+    fn update_from_arg_matches(&mut self, m: &clap::ArgMatches) -> Result<(), clap::Error> {
+        for g in GROUPS.iter() {
+            if let Some(v) = m.get_one::<f64>(g.name) {
+                self.0.set(g.name, Some(*v));
+            }
+        }
+        Ok(())
+    }
+}
+
+impl Args for GroupArgs {
+    fn augment_args(cmd: clap::Command) -> clap::Command {
+        GROUPS
+            .iter()
+            .zip(group_flags())
+            .fold(cmd, |cmd, (g, flag)| {
+                cmd.arg(
+                    clap::Arg::new(g.name)
+                        .long(flag.as_str())
+                        .value_name(g.symbol)
+                        .allow_negative_numbers(true)
+                        .value_parser(clap::value_parser!(f64))
+                        .action(clap::ArgAction::Set),
+                )
+            })
+    }
+
+    fn augment_args_for_update(cmd: clap::Command) -> clap::Command {
+        Self::augment_args(cmd)
+    }
 }
 
 fn parse_law(s: &str) -> Result<LawKind, String> {
@@ -169,16 +205,7 @@ impl ModelArgs {
             omega: self.omega,
             contact_law: self.contact_law,
             excitation: self.excitation,
-            restitution: self.restitution,
-            hamaker: self.hamaker,
-            intermolecular_distance: self.intermolecular_distance,
-            electrostatic: self.electrostatic,
-            tip_radius: self.tip_radius,
-            adhesion: self.adhesion,
-            capillary: self.capillary,
-            meniscus: self.meniscus,
-            rupture: self.rupture,
-            maxwell_stiffness: self.maxwell_stiffness,
+            groups: self.groups.0,
             z_c: quantity(self.z_c, "z-c", Dim::Length, true)?,
             drive_frequency: quantity(
                 self.drive_frequency,

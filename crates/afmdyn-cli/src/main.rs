@@ -177,7 +177,7 @@ fn with_table_help(mut cmd: clap::Command) -> clap::Command {
         .collect();
     for name in names {
         cmd = cmd.mut_subcommand(name, |mut sub| {
-            for p in &afmdyn::request::MODEL_PARAMETERS {
+            for p in afmdyn::request::MODEL_PARAMETERS.iter() {
                 // the flag's id is the paper's name where it has one (alpha1 …), else the name
                 let id = p.alias.unwrap_or(p.name);
                 if sub.get_arguments().any(|a| a.get_id() == id) {

@@ -87,6 +87,7 @@ macro_rules! laws {
                 doc: <$Law as Law>::DOC,
                 params: <$Law as Law>::PARAMS,
                 sample_keys: <$Law as Law>::SAMPLE_KEYS,
+                tip_radius: <$Law as Law>::TIP_RADIUS,
             },
         )*];
 
@@ -119,16 +120,17 @@ macro_rules! laws {
                 }
             }
 
-            /// Build the law, filling groups that are not given with the law's defaults.
+            /// Build the law, filling groups that are not given with the law's defaults
+            /// ([`Param::default`] of its [`Law::PARAMS`]).
             pub fn with_groups(self, groups: LawGroups) -> ContactLaw {
                 match self {
                     $(
                         $(#[cfg($cfg)])?
-                        LawKind::$Variant => {
-                            #[allow(unused_variables)]
-                            let law = <$Law as Law>::with_groups(&groups);
-                            ContactLaw::$Variant $({ $($field: law.$field),* })?
-                        }
+                        LawKind::$Variant => ContactLaw::$Variant $({ $(
+                            $field: groups.get(stringify!($field)).unwrap_or_else(|| {
+                                default_of(<$Law as Law>::PARAMS, stringify!($field))
+                            })
+                        ),* })?,
                     )*
                 }
             }
@@ -141,6 +143,21 @@ macro_rules! laws {
                     $( $(#[cfg($cfg)])? ContactLaw::$Variant { .. } => LawKind::$Variant, )*
                 }
             }
+
+            /// The groups of the law (those it has), by their names.
+            pub fn groups(&self) -> LawGroups {
+                #[allow(unused_mut)]
+                let mut groups = LawGroups::default();
+                match *self {
+                    $(
+                        $(#[cfg($cfg)])?
+                        ContactLaw::$Variant { $($($field),*)? } => {
+                            $($( groups.set(stringify!($field), Some($field)); )*)?
+                        }
+                    )*
+                }
+                groups
+            }
         }
 
         prepared_contact! {
@@ -149,8 +166,6 @@ macro_rules! laws {
 
         law_methods! {
             [$( [$(#[cfg($cfg)])?] $Variant $Law [$($($field)*)?] )*]
-            /// The groups of the law (those it has).
-            fn groups() -> LawGroups;
             /// Check the law's own groups ([`Law::validate`]).
             ///
             /// # Errors
@@ -302,7 +317,7 @@ laws! {
     sls => Sls { maxwell_stiffness } : SlsLaw,
     impact => Impact { restitution } : ImpactLaw,
     #[cfg(feature = "toy-law")]
-    spring_adhesion => SpringAdhesion { adhesion } : SpringAdhesionLaw,
+    spring_adhesion => SpringAdhesion { toy_adhesion } : SpringAdhesionLaw,
 }
 
 mod law;
@@ -467,31 +482,91 @@ impl LawKind {
     }
 }
 
-/// The law groups a front end may give (each `None` when not given): the one argument of
-/// [`LawKind::with_groups`] and [`ContactLaw::from_parts`].
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct LawGroups {
-    /// DMT and electrostatic: H̃.
-    pub hamaker: Option<f64>,
-    /// DMT and electrostatic: ã₀.
-    pub intermolecular_distance: Option<f64>,
-    /// Impact: r.
-    pub restitution: Option<f64>,
-    /// Electrostatic: Ẽ.
-    pub electrostatic: Option<f64>,
-    /// Electrostatic: R̃.
-    pub tip_radius: Option<f64>,
-    /// JKR: P̃.
-    pub adhesion: Option<f64>,
-    /// Capillary: F̃_cap.
-    pub capillary: Option<f64>,
-    /// Capillary: h̃.
-    pub meniscus: Option<f64>,
-    /// Capillary: D̃_r.
-    pub rupture: Option<f64>,
-    /// SLS: κ.
-    pub maxwell_stiffness: Option<f64>,
+/// Whether two names are equal (in a `const` context).
+const fn same(a: &str, b: &str) -> bool {
+    let (a, b) = (a.as_bytes(), b.as_bytes());
+    if a.len() != b.len() {
+        return false;
+    }
+    let mut i = 0;
+    while i < a.len() {
+        if a[i] != b[i] {
+            return false;
+        }
+        i += 1;
+    }
+    true
 }
+
+/// Whether the `j`-th group of the `i`-th law of [`LAWS`] is the first of its name.
+const fn first_of_name(i: usize, j: usize) -> bool {
+    let name = LAWS[i].params[j].name;
+    let mut l = 0;
+    while l <= i {
+        let params = LAWS[l].params;
+        let end = if l == i { j } else { params.len() };
+        let mut k = 0;
+        while k < end {
+            if same(params[k].name, name) {
+                return false;
+            }
+            k += 1;
+        }
+        l += 1;
+    }
+    true
+}
+
+/// The number of distinct group names of the registered laws.
+const fn group_count() -> usize {
+    let mut n = 0;
+    let mut i = 0;
+    while i < LAWS.len() {
+        let mut j = 0;
+        while j < LAWS[i].params.len() {
+            if first_of_name(i, j) {
+                n += 1;
+            }
+            j += 1;
+        }
+        i += 1;
+    }
+    n
+}
+
+/// Every law group, once, in registry order (a group two laws share, as DMT's `hamaker`, is
+/// described by its first law's [`Param`]): the names requests, config files, CLI flags,
+/// Python keywords and the schema take, all derived from the laws' [`Law::PARAMS`].
+pub const GROUPS: [Param; group_count()] = {
+    let mut out = [Param::EMPTY; group_count()];
+    let mut n = 0;
+    let mut i = 0;
+    while i < LAWS.len() {
+        let mut j = 0;
+        while j < LAWS[i].params.len() {
+            if first_of_name(i, j) {
+                out[n] = LAWS[i].params[j];
+                n += 1;
+            }
+            j += 1;
+        }
+        i += 1;
+    }
+    out
+};
+
+/// The default of group `name` in `params` (a law's [`Law::PARAMS`]).
+fn default_of(params: &[Param], name: &str) -> f64 {
+    params
+        .iter()
+        .find(|p| p.name == name)
+        .map_or(f64::NAN, |p| p.default)
+}
+
+/// The law groups a front end may give, by name ([`GROUPS`]; each `None` when not given): the
+/// one argument of [`LawKind::with_groups`] and [`ContactLaw::from_parts`].
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct LawGroups([Option<f64>; GROUPS.len()]);
 
 impl LawGroups {
     /// The groups of `law` (those it has), e.g. to keep them when another group is changed.
@@ -499,38 +574,47 @@ impl LawGroups {
         law.groups()
     }
 
-    /// Each group by its name ([`Param::name`]), given or not, in a fixed order.
-    pub fn entries(&self) -> [(&'static str, Option<f64>); 10] {
-        [
-            ("restitution", self.restitution),
-            ("hamaker", self.hamaker),
-            ("intermolecular_distance", self.intermolecular_distance),
-            ("electrostatic", self.electrostatic),
-            ("tip_radius", self.tip_radius),
-            ("adhesion", self.adhesion),
-            ("capillary", self.capillary),
-            ("meniscus", self.meniscus),
-            ("rupture", self.rupture),
-            ("maxwell_stiffness", self.maxwell_stiffness),
-        ]
+    /// The index of group `name` in [`GROUPS`].
+    fn index(name: &str) -> Option<usize> {
+        GROUPS.iter().position(|p| p.name == name)
+    }
+
+    /// The value of group `name`, if given (`None` as well for a name that is no group).
+    pub fn get(&self, name: &str) -> Option<f64> {
+        Self::index(name).and_then(|i| self.0[i])
+    }
+
+    /// Set (or clear) group `name`; `false`, and nothing set, when no law has a group of
+    /// that name.
+    pub fn set(&mut self, name: &str, value: Option<f64>) -> bool {
+        match Self::index(name) {
+            Some(i) => {
+                self.0[i] = value;
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// `self` with group `name` set to `value` (unchanged when no law has that group).
+    pub fn with(mut self, name: &str, value: f64) -> LawGroups {
+        self.set(name, Some(value));
+        self
+    }
+
+    /// Each group by its name ([`Param::name`]), given or not, in the order of [`GROUPS`].
+    pub fn entries(&self) -> impl Iterator<Item = (&'static str, Option<f64>)> + '_ {
+        GROUPS.iter().zip(self.0).map(|(p, v)| (p.name, v))
+    }
+
+    /// The groups given, by name, in the order of [`GROUPS`].
+    pub fn given(&self) -> impl Iterator<Item = (&'static str, f64)> + '_ {
+        self.entries().filter_map(|(name, v)| Some((name, v?)))
     }
 
     /// Each group of `self`, or `other`'s where `self` has none.
     pub fn or(self, other: LawGroups) -> LawGroups {
-        LawGroups {
-            hamaker: self.hamaker.or(other.hamaker),
-            intermolecular_distance: self
-                .intermolecular_distance
-                .or(other.intermolecular_distance),
-            restitution: self.restitution.or(other.restitution),
-            electrostatic: self.electrostatic.or(other.electrostatic),
-            tip_radius: self.tip_radius.or(other.tip_radius),
-            adhesion: self.adhesion.or(other.adhesion),
-            capillary: self.capillary.or(other.capillary),
-            meniscus: self.meniscus.or(other.meniscus),
-            rupture: self.rupture.or(other.rupture),
-            maxwell_stiffness: self.maxwell_stiffness.or(other.maxwell_stiffness),
-        }
+        LawGroups(std::array::from_fn(|i| self.0[i].or(other.0[i])))
     }
 }
 
@@ -565,7 +649,7 @@ impl ContactLaw {
 }
 
 /// The laws owning `group`, for messages: `dmt or electrostatic` (built once per group).
-fn owners(group: &str) -> &'static str {
+pub(crate) fn owners(group: &str) -> &'static str {
     static OWNERS: std::sync::OnceLock<Vec<(&'static str, &'static str)>> =
         std::sync::OnceLock::new();
     let table = OWNERS.get_or_init(|| {

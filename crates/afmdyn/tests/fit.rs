@@ -4,14 +4,13 @@
 //! intervals' coverage over seeded noise draws, and the correlation warning where only E√R is
 //! identifiable.
 
-use afmdyn::analysis::fit::force_curve::{
-    preprocess, ForceCurveModel, ForceLaw, Segment, YOUNGS_MODULUS,
-};
+use afmdyn::analysis::fit::force_curve::{preprocess, ForceCurveModel, Segment, YOUNGS_MODULUS};
 use afmdyn::analysis::fit::CurveModel;
 use afmdyn::analysis::progress::Progress;
 use afmdyn::probe::Probe;
 use afmdyn::request::fit::FitRequest;
 use afmdyn::request::{run, Resolved};
+use afmdyn::LawKind;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -68,9 +67,9 @@ fn request(height: Vec<f64>, force: Vec<f64>, fit: &[&str]) -> FitRequest {
 #[test]
 fn the_sensitivities_match_central_differences() {
     for (law, p) in [
-        (ForceLaw::Hertz, vec![1e6, 20e-9, 1e-9, 1e-11]),
-        (ForceLaw::Dmt, vec![1e6, 20e-9, 1e-9, 1e-11, 1e-19]),
-        (ForceLaw::Jkr, vec![1e6, 20e-9, 1e-9, 1e-11, 0.05]),
+        (LawKind::Hertz, vec![1e6, 20e-9, 1e-9, 1e-11]),
+        (LawKind::Dmt, vec![1e6, 20e-9, 1e-9, 1e-11, 1e-19]),
+        (LawKind::Jkr, vec![1e6, 20e-9, 1e-9, 1e-11, 0.05]),
     ] {
         let m = ForceCurveModel {
             law,

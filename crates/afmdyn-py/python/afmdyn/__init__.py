@@ -19,10 +19,8 @@ with :func:`afmdyn.dask.chart`), :func:`orbit`, :func:`continuation`, :func:`lya
 folds. Physical units: a probe
 file in SI (:func:`probe`, ``Params.from_probe``) sets every parameter. Tip–sample laws:
 ``contact_law="linear" | "hertz" | "dmt" | "electrostatic" | "jkr" | "capillary" | "sls" | "impact"``
-with ``restitution`` (impact), ``hamaker`` and ``intermolecular_distance`` (DMT,
-electrostatic), ``electrostatic`` and ``tip_radius`` (electrostatic), ``adhesion`` (JKR),
-``capillary``, ``meniscus`` and ``rupture`` (capillary), ``maxwell_stiffness`` (sls) among the
-model keywords.
+with each law's groups, under their own names, among the model keywords (the table
+``afmdyn._afmdyn.MODEL_PARAMETERS`` lists them with their laws and ranges).
 """
 
 from . import _wrappers, _wrappers_afm, _wrappers_starts

@@ -18,7 +18,7 @@
 //! (dF/dD = F̃_cap/h̃ on the meniscus side, 0 on the contact side), inside the region
 //! ([`Meniscus`]).
 
-use super::{ForceEval, Hysteresis, Law, LawGroups, Param, SampleSi};
+use super::{ForceEval, Hysteresis, Law, Param, SampleSi};
 use crate::error::ParamError;
 
 /// Default capillary force at contact F̃_cap = 0.1: DMT's default adhesion (a water meniscus
@@ -48,6 +48,7 @@ impl CapillaryLaw {
 }
 
 impl Law for CapillaryLaw {
+    const TIP_RADIUS: bool = true;
     const DOC: &'static str = "capillary meniscus over a Hertz sample: formed at contact, ruptured at V_T = D̃_r (Zitzler, Herminghaus & Mugele 2002)";
     const SAMPLE_KEYS: &'static [&'static str] = &["law", "youngs_modulus", "poisson_ratio", "viscosity", "meniscus_volume", "surface_tension", "contact_angle", "z_c"];
     const PARAMS: &'static [Param] = &[
@@ -59,6 +60,7 @@ impl Law for CapillaryLaw {
             default: CAPILLARY_DEFAULT_FORCE,
             doc: "the meniscus's force at contact F̃_cap = 4πRγcosθ/F",
             si_keys: &["surface_tension", "contact_angle", "radius"],
+            under_probe: Some("give the probe file's [sample] surface_tension (N/m) and contact_angle (degrees) (law = \"capillary\")"),
         },
         Param {
             name: "meniscus",
@@ -68,6 +70,7 @@ impl Law for CapillaryLaw {
             default: CAPILLARY_DEFAULT_MENISCUS,
             doc: "the meniscus's immersion at contact h̃ = √(V/(πR))/g0 (V its volume)",
             si_keys: &["meniscus_volume", "radius"],
+            under_probe: Some("give the probe file's [sample] meniscus_volume (m³, law = \"capillary\")"),
         },
         Param {
             name: "rupture",
@@ -77,25 +80,11 @@ impl Law for CapillaryLaw {
             default: CAPILLARY_DEFAULT_RUPTURE,
             doc: "the rupture distance D̃_r = (1 + θ/2)V^(1/3)/g0 (Lian et al. 1993)",
             si_keys: &["meniscus_volume", "contact_angle"],
+            under_probe: Some("give the probe file's [sample] meniscus_volume (m³) and contact_angle (degrees) (law = \"capillary\")"),
         },
     ];
 
     super::prepared::as_given!();
-    fn with_groups(g: &LawGroups) -> Self {
-        CapillaryLaw {
-            capillary: g.capillary.unwrap_or(CAPILLARY_DEFAULT_FORCE),
-            meniscus: g.meniscus.unwrap_or(CAPILLARY_DEFAULT_MENISCUS),
-            rupture: g.rupture.unwrap_or(CAPILLARY_DEFAULT_RUPTURE),
-        }
-    }
-    fn groups(&self) -> LawGroups {
-        LawGroups {
-            capillary: Some(self.capillary),
-            meniscus: Some(self.meniscus),
-            rupture: Some(self.rupture),
-            ..LawGroups::default()
-        }
-    }
     fn validate(&self) -> Result<(), ParamError> {
         let bad = |name: &'static str, value: f64, range: &'static str| {
             Err(ParamError::Law { name, value, range })

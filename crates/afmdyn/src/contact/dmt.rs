@@ -7,7 +7,7 @@
 //! (1999) 4961 and Garcia, *Amplitude Modulation AFM*, Wiley 2010, ch. 3). The force is
 //! continuous at δ = 0, so the free flight is nonlinear but the switching has no force jump.
 
-use super::{ForceEval, JetLaw, Law, LawGroups, Param, PreparedForce, SampleSi};
+use super::{ForceEval, JetLaw, Law, Param, PreparedForce, SampleSi};
 use crate::error::ParamError;
 
 /// Default DMT groups: H̃ = 1e-5, ã₀ = 0.01, an adhesion force H̃/ã₀² = 0.1, about 5 % of the
@@ -27,6 +27,7 @@ pub(crate) const PARAMS: [Param; 2] = [
         default: DMT_DEFAULT_HAMAKER,
         doc: "van der Waals group H̃ = H R L³/(6 EI g0³)",
         si_keys: &["hamaker", "radius"],
+        under_probe: Some("give the Hamaker constant in the probe file's [sample] hamaker (J)"),
     },
     Param {
         name: "intermolecular_distance",
@@ -36,6 +37,7 @@ pub(crate) const PARAMS: [Param; 2] = [
         default: DMT_DEFAULT_A0,
         doc: "intermolecular distance ã0 = a0/g0, the contact threshold",
         si_keys: &["intermolecular_distance"],
+        under_probe: Some("give a0 in the probe file's [sample] intermolecular_distance (m)"),
     },
 ];
 
@@ -154,24 +156,12 @@ macro_rules! dmt_family {
 pub(crate) use dmt_family;
 
 impl Law for DmtLaw {
+    const TIP_RADIUS: bool = true;
     const DOC: &'static str =
         "DMT: van der Waals attraction outside contact, adhesion + Hertz + Kelvin–Voigt inside";
     const PARAMS: &'static [Param] = &PARAMS;
     const SAMPLE_KEYS: &'static [&'static str] = &["law", "youngs_modulus", "poisson_ratio", "hamaker", "intermolecular_distance", "viscosity", "z_c"];
 
-    fn with_groups(g: &LawGroups) -> Self {
-        DmtLaw {
-            hamaker: g.hamaker.unwrap_or(DMT_DEFAULT_HAMAKER),
-            intermolecular_distance: g.intermolecular_distance.unwrap_or(DMT_DEFAULT_A0),
-        }
-    }
-    fn groups(&self) -> LawGroups {
-        LawGroups {
-            hamaker: Some(self.hamaker),
-            intermolecular_distance: Some(self.intermolecular_distance),
-            ..LawGroups::default()
-        }
-    }
     fn validate(&self) -> Result<(), ParamError> {
         let (hamaker, intermolecular_distance) = (self.hamaker, self.intermolecular_distance);
         let bad = |name: &'static str, value: f64, range: &'static str| {

@@ -6,9 +6,9 @@
 //! Hertz and Kelvin–Voigt in contact, as DMT (continuous at δ = 0).
 
 use super::dmt::{
-    dmt_family, van_der_waals, DmtLaw, PreparedDmt, DMT_DEFAULT_A0, DMT_DEFAULT_HAMAKER,
+    dmt_family, van_der_waals, DmtLaw, PreparedDmt,
 };
-use super::{ForceEval, Law, LawGroups, Param, PreparedForce, SampleSi};
+use super::{ForceEval, Law, Param, PreparedForce, SampleSi};
 use crate::error::ParamError;
 
 /// ε₀, the vacuum permittivity (F/m; CODATA 2018).
@@ -35,6 +35,7 @@ pub struct ElectrostaticLaw {
 }
 
 impl Law for ElectrostaticLaw {
+    const TIP_RADIUS: bool = true;
     const DOC: &'static str =
         "DMT plus the electrostatic force of a biased spherical tip (Hudlet et al. 1998)";
     const SAMPLE_KEYS: &'static [&'static str] = &["law", "youngs_modulus", "poisson_ratio", "hamaker", "intermolecular_distance", "viscosity", "z_c", "bias_voltage", "contact_potential"];
@@ -49,6 +50,7 @@ impl Law for ElectrostaticLaw {
             default: ELECTROSTATIC_DEFAULT,
             doc: "group Ẽ = πε0 V²/F of the biased tip, F_es = -Ẽ R̃²/(d(d + R̃))",
             si_keys: &["voltage", "contact_potential"],
+            under_probe: Some("give the voltage in the probe file's [sample] bias_voltage (V, law = \"electrostatic\")"),
         },
         Param {
             name: "tip_radius",
@@ -58,26 +60,10 @@ impl Law for ElectrostaticLaw {
             default: ELECTROSTATIC_DEFAULT_RADIUS,
             doc: "tip radius R̃ = R/g0",
             si_keys: &["radius"],
+            under_probe: Some("give the radius in the probe file's [tip] radius (m)"),
         },
     ];
 
-    fn with_groups(g: &LawGroups) -> Self {
-        ElectrostaticLaw {
-            hamaker: g.hamaker.unwrap_or(DMT_DEFAULT_HAMAKER),
-            intermolecular_distance: g.intermolecular_distance.unwrap_or(DMT_DEFAULT_A0),
-            electrostatic: g.electrostatic.unwrap_or(ELECTROSTATIC_DEFAULT),
-            tip_radius: g.tip_radius.unwrap_or(ELECTROSTATIC_DEFAULT_RADIUS),
-        }
-    }
-    fn groups(&self) -> LawGroups {
-        LawGroups {
-            hamaker: Some(self.hamaker),
-            intermolecular_distance: Some(self.intermolecular_distance),
-            electrostatic: Some(self.electrostatic),
-            tip_radius: Some(self.tip_radius),
-            ..LawGroups::default()
-        }
-    }
     fn validate(&self) -> Result<(), ParamError> {
         let bad = |name: &'static str, value: f64, range: &'static str| {
             Err(ParamError::Law { name, value, range })

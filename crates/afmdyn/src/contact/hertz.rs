@@ -1,21 +1,19 @@
 //! `hertz` — F_c = α4 δ^{3/2} + α6 δ̇ while δ ≥ 0 (Hertz 1882; Johnson, *Contact Mechanics*,
 //! CUP 1985, §4.2: F = (4/3) E* √R δ^{3/2}, so α4 = (4/3) E* √(R g₀) L³/(EI)).
 
-use super::{ForceEval, JetLaw, Law, LawGroups, SampleSi};
+use super::{ForceEval, JetLaw, Law, SampleSi};
 
 /// The Hertz law: no groups of its own (α4 is the Hertz group, α6 the damper).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct HertzLaw;
 
 impl Law for HertzLaw {
+    const TIP_RADIUS: bool = true;
     const DOC: &'static str =
         "Hertz sphere–flat repulsion with a viscous damper: F_c = α4 δ^{3/2} + α6 δ̇";
     const SAMPLE_KEYS: &'static [&'static str] = &["law", "youngs_modulus", "poisson_ratio", "damping", "z_c"];
 
     super::prepared::as_given!();
-    fn with_groups(_: &LawGroups) -> Self {
-        HertzLaw
-    }
     fn from_si(si: &SampleSi) -> Result<(Self, f64, f64), String> {
         Ok((HertzLaw, si.hertz_alpha4(), si.damper_alpha6()))
     }

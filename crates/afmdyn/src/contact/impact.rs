@@ -4,7 +4,7 @@
 //! impulse and the sticking phase are handled by the model ([`crate::model`]).
 
 
-use super::{Law, LawGroups, Param, SampleSi};
+use super::{Law, Param, SampleSi};
 use crate::error::ParamError;
 
 /// Default coefficient of restitution of the impact law.
@@ -29,20 +29,10 @@ impl Law for ImpactLaw {
         default: IMPACT_DEFAULT_RESTITUTION,
         doc: "coefficient of restitution r",
         si_keys: &["restitution"],
+        under_probe: None,
     }];
 
     super::prepared::as_given!();
-    fn with_groups(g: &LawGroups) -> Self {
-        ImpactLaw {
-            restitution: g.restitution.unwrap_or(IMPACT_DEFAULT_RESTITUTION),
-        }
-    }
-    fn groups(&self) -> LawGroups {
-        LawGroups {
-            restitution: Some(self.restitution),
-            ..LawGroups::default()
-        }
-    }
     fn validate(&self) -> Result<(), ParamError> {
         let restitution = self.restitution;
         if !(restitution.is_finite() && (0.0..=1.0).contains(&restitution)) {

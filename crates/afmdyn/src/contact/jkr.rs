@@ -14,7 +14,7 @@
 //! = (3/5 + 4^{−1/3}/10) 2^{2/3} π^{5/3} (W⁵R⁴/E*²)^{1/3} ≈ 7.09 (W⁵R⁴/E*²)^{1/3} (from
 //! the potential below). The region is hysteretic: contact persists while δ > δ_f.
 
-use super::{ForceEval, Hysteresis, Law, LawGroups, Param, PreparedForce, SampleSi};
+use super::{ForceEval, Hysteresis, Law, Param, PreparedForce, SampleSi};
 use crate::error::ParamError;
 
 /// Default JKR adhesion group P̃ = πWR = 0.05: the work of adhesion of DMT's defaults (whose
@@ -31,6 +31,7 @@ pub struct JkrLaw {
 }
 
 impl Law for JkrLaw {
+    const TIP_RADIUS: bool = true;
     const DOC: &'static str = "JKR: adhesive Hertz contact with a neck, formed at δ = 0, broken at δ_f < 0 (Johnson, Kendall & Roberts 1971)";
     const SAMPLE_KEYS: &'static [&'static str] = &["law", "youngs_modulus", "poisson_ratio", "hamaker", "intermolecular_distance", "viscosity", "z_c", "adhesion_energy"];
     const PARAMS: &'static [Param] = &[Param {
@@ -41,21 +42,11 @@ impl Law for JkrLaw {
         default: JKR_DEFAULT_ADHESION,
         doc: "adhesion group P̃ = πWR/F (W the work of adhesion): pull-off (3/2)P̃",
         si_keys: &["adhesion_energy", "radius"],
+        under_probe: Some("give the work of adhesion in the probe file's [sample] adhesion_energy (J/m², law = \"jkr\")"),
     }];
 
     type Prepared = PreparedJkr;
 
-    fn with_groups(g: &LawGroups) -> Self {
-        JkrLaw {
-            adhesion: g.adhesion.unwrap_or(JKR_DEFAULT_ADHESION),
-        }
-    }
-    fn groups(&self) -> LawGroups {
-        LawGroups {
-            adhesion: Some(self.adhesion),
-            ..LawGroups::default()
-        }
-    }
     fn validate(&self) -> Result<(), ParamError> {
         let adhesion = self.adhesion;
         // P̃ = 0 is Hertz (use `hertz`); the neck's scale P̃/α4 must stay resolvable

@@ -2,7 +2,7 @@
 //! [`Param`]) the registry ([`super::LAWS`]) hands to the front ends (schema, CLI help, Python,
 //! docs, conformance suite).
 
-use super::{ForceEval, Hysteresis, LawGroups, PreparedForce, Zener};
+use super::{ForceEval, Hysteresis, PreparedForce, Zener};
 use crate::error::ParamError;
 
 /// One dimensionless group of a law: what a front end needs to name, document and check it.
@@ -23,6 +23,25 @@ pub struct Param {
     pub doc: &'static str,
     /// The probe file's SI keys (`[sample]` table) the group is derived from.
     pub si_keys: &'static [&'static str],
+    /// Where a probe file sets the group, for the message refusing it as a dimensionless
+    /// value under a probe (`give the Hamaker constant in the probe file's [sample] hamaker
+    /// (J)`); `None` for a group a request may give with a probe (a pure number, as the
+    /// impact law's `restitution`).
+    pub under_probe: Option<&'static str>,
+}
+
+impl Param {
+    /// A placeholder (no name), to fill tables built at compile time.
+    pub const EMPTY: Param = Param {
+        name: "",
+        symbol: "",
+        unit: "",
+        range: "",
+        default: 0.0,
+        doc: "",
+        si_keys: &[],
+        under_probe: None,
+    };
 }
 
 /// A registered law's descriptor ([`super::LAWS`]).
@@ -38,6 +57,8 @@ pub struct LawInfo {
     pub params: &'static [Param],
     /// The keys a probe file's `[sample]` table may hold for it ([`Law::SAMPLE_KEYS`]).
     pub sample_keys: &'static [&'static str],
+    /// Whether its contact is Hertz's sphere of the tip's radius ([`Law::TIP_RADIUS`]).
+    pub tip_radius: bool,
 }
 
 /// A probe file's sample in SI (`[sample]` and `[tip]`, read by [`crate::probe`]) and the probe's
@@ -102,8 +123,9 @@ impl SampleSi {
     }
 }
 
-/// A tip–sample law: a struct of its dimensionless groups (all `f64`, named as its
-/// [`Law::PARAMS`]), registered by one line in [`super`]'s `laws!` registry.
+/// A tip–sample law: a struct of its dimensionless groups (all `f64`, named and ordered as its
+/// [`Law::PARAMS`], whose defaults fill the groups a front end does not give), registered by
+/// one line in [`super`]'s `laws!` registry.
 ///
 /// Every method has the default of a law with no force, no memory and no special numerics;
 /// `k` is α4 (the shared stiffness or Hertz group), `c` is α6 (the shared damper), δ = −V_T the
@@ -117,22 +139,20 @@ pub trait Law: Copy + Sized {
     const PARAMS: &'static [Param] = &[];
     /// The keys a probe file's `[sample]` table may hold for the law ([`crate::probe`]).
     const SAMPLE_KEYS: &'static [&'static str] = &["law", "z_c"];
+    /// Whether the law's contact is Hertz's sphere of the tip's radius, α4 its Hertz group
+    /// (4/3)E*√R g₀^{3/2}/F_s ([`SampleSi::hertz_alpha4`]): a probe's tip radius and sample
+    /// modulus set it, and a fitted α4 is a modulus.
+    const TIP_RADIUS: bool = false;
 
     /// The law's constants, derived once from its groups and α4, α6 ([`Law::prepare`]);
     /// [`super::AsGiven`] for a law that derives nothing worth keeping.
     type Prepared: PreparedForce + Copy + std::fmt::Debug + PartialEq;
 
-    /// The law from the groups a front end gives, the missing ones at their defaults.
-    fn with_groups(groups: &LawGroups) -> Self;
     /// The prepare step: the law's groups with α4 = `k` and α6 = `c` turned into the constants
     /// its force needs, once per model ([`super::PreparedLaw`]). Evaluating the result is
     /// [`Law::force`], [`Law::potential`] and [`Law::dissipative`] bit for bit (the same
     /// operations in the same order).
     fn prepare(&self, k: f64, c: f64) -> Self::Prepared;
-    /// The law's groups (those it has).
-    fn groups(&self) -> LawGroups {
-        LawGroups::default()
-    }
     /// Check the law's own groups.
     ///
     /// # Errors

@@ -1,7 +1,7 @@
 //! `linear` — the paper's spring–damper: F_c = α4 δ + α6 δ̇ while δ ≥ 0 (eqs. 16–18). Each
 //! region is affine in the state, so the exact propagator applies.
 
-use super::{ForceEval, Law, LawGroups, SampleSi};
+use super::{ForceEval, Law, SampleSi};
 
 /// The linear law: no groups of its own (α4, α6 are [`crate::Params`]').
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -12,9 +12,6 @@ impl Law for LinearLaw {
     const SAMPLE_KEYS: &'static [&'static str] = &["law", "stiffness", "damping", "z_c"];
 
     super::prepared::as_given!();
-    fn with_groups(_: &LawGroups) -> Self {
-        LinearLaw
-    }
     fn from_si(si: &SampleSi) -> Result<(Self, f64, f64), String> {
         let alpha4 = si.stiffness.unwrap_or(0.0) * si.g0 / si.force;
         Ok((LinearLaw, alpha4, si.damper_alpha6()))

@@ -15,7 +15,7 @@
 //! is the linear law without damper; κ → ∞ a Kelvin–Voigt solid α4, α6 whose surface lags
 //! the tip. ([`Zener`]; the model carries u, [`crate::CantileverModel`].)
 
-use super::{ForceEval, Law, LawGroups, Param, SampleSi};
+use super::{ForceEval, Law, Param, SampleSi};
 use crate::error::ParamError;
 
 /// Default Maxwell arm κ = 20 of the SLS law: the sample twice as stiff at the onset of a tap
@@ -44,20 +44,10 @@ impl Law for SlsLaw {
         default: SLS_DEFAULT_MAXWELL,
         doc: "the Maxwell arm's spring κ (in series with the dashpot α6; relaxation time α6/κ, instantaneous stiffness α4 + κ)",
         si_keys: &["maxwell_stiffness", "relaxation_time"],
+        under_probe: Some("give the probe file's [sample] maxwell_stiffness (N/m, law = \"sls\")"),
     }];
 
     super::prepared::as_given!();
-    fn with_groups(g: &LawGroups) -> Self {
-        SlsLaw {
-            maxwell_stiffness: g.maxwell_stiffness.unwrap_or(SLS_DEFAULT_MAXWELL),
-        }
-    }
-    fn groups(&self) -> LawGroups {
-        LawGroups {
-            maxwell_stiffness: Some(self.maxwell_stiffness),
-            ..LawGroups::default()
-        }
-    }
     fn validate(&self) -> Result<(), ParamError> {
         let maxwell_stiffness = self.maxwell_stiffness;
         // κ = 0 leaves u without dynamics (a neutral direction of every monodromy):

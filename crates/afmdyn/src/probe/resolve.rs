@@ -355,14 +355,13 @@ impl Sample {
         })
     }
 
-    /// The tip radius of a law whose contact is Hertz's paraboloid ([`Probe::tip_radius`]).
+    /// The tip radius of a law whose contact is Hertz's sphere ([`crate::contact::Law::TIP_RADIUS`],
+    /// [`Probe::tip_radius`]).
     fn tip_radius(&self) -> Option<f64> {
-        self.si.radius.filter(|_| {
-            matches!(
-                self.law.as_str(),
-                "hertz" | "dmt" | "electrostatic" | "jkr" | "capillary"
-            )
-        })
+        let hertz = self.law.parse::<crate::contact::LawKind>();
+        self.si
+            .radius
+            .filter(|_| hertz.is_ok_and(|k| k.info().tip_radius))
     }
 
     /// The inputs by their probe keys ([`SampleInputs`]).

@@ -10,7 +10,7 @@ pub use super::fit_result::{bounds, intervals_method, FitResult, MIN_FIT_ROWS};
 use super::limits::Cost;
 use super::run::{Analysis, Resolved};
 use crate::analysis::fit::force_curve::{
-    preprocess, ForceCurveModel, ForceLaw, Preprocessed, Segment, BASELINE, CONTACT_POINT, HAMAKER,
+    self, preprocess, ForceCurveModel, Preprocessed, Segment, BASELINE, CONTACT_POINT, HAMAKER,
     RADIUS, YOUNGS_MODULUS,
 };
 use crate::analysis::fit::profile::ProfileWalk;
@@ -19,6 +19,7 @@ use crate::analysis::fit::sls_curve::{
 };
 use crate::analysis::fit::{fit_cancellable, CurveModel, Observations, Parameter, ProfileEnd};
 use crate::analysis::progress::Progress;
+use crate::contact::LawKind;
 use crate::error::SimError;
 use crate::probe::SampleInputs;
 use serde::{Deserialize, Serialize};
@@ -190,7 +191,7 @@ impl FitRequest {
     }
 
     /// The law of the probe and every model parameter's name.
-    fn law(model: &Resolved) -> Result<ForceLaw, SimError> {
+    fn law(model: &Resolved) -> Result<LawKind, SimError> {
         let p = model.probe.as_ref().ok_or_else(|| {
             bad(
                 "probe",
@@ -201,19 +202,22 @@ impl FitRequest {
             )
         })?;
         let name = p.params.contact_law.name();
-        ForceLaw::from_name(name).ok_or_else(|| {
-            bad(
-                "law",
-                name,
-                "the force-curve fit takes the probe's [sample].law = hertz, dmt, jkr or sls"
-                    .into(),
-            )
-        })
+        name.parse::<LawKind>()
+            .ok()
+            .filter(|&k| force_curve::parameter_names(k).is_some())
+            .ok_or_else(|| {
+                bad(
+                    "law",
+                    name,
+                    "the force-curve fit takes the probe's [sample].law = hertz, dmt, jkr or sls"
+                        .into(),
+                )
+            })
     }
 
     /// The parameters fitted: `fit`, or the `sls` law's default when `fit` is the request's.
-    pub fn fitted(&self, law: ForceLaw) -> Vec<String> {
-        if law == ForceLaw::Sls && self.fit == FitRequest::default().fit {
+    pub fn fitted(&self, law: LawKind) -> Vec<String> {
+        if law == LawKind::Sls && self.fit == FitRequest::default().fit {
             return sls_curve::DEFAULT_FIT
                 .iter()
                 .map(|s| s.to_string())
@@ -223,21 +227,21 @@ impl FitRequest {
     }
 
     /// The segment fitted: `segment`, or the law's default (the whole curve for `sls`).
-    pub(crate) fn segment_of(&self, law: ForceLaw) -> Segment {
+    pub(crate) fn segment_of(&self, law: LawKind) -> Segment {
         match self.segment {
             Some(FitSegment::Approach) => Segment::Approach,
             Some(FitSegment::Retract) => Segment::Retract,
             Some(FitSegment::Whole) => Segment::Whole,
-            None if law == ForceLaw::Sls => Segment::Whole,
+            None if law == LawKind::Sls => Segment::Whole,
             None => Segment::Approach,
         }
     }
 
     /// Check the options against the probe's law (the data are checked when read).
-    fn check(&self, model: &Resolved) -> Result<ForceLaw, SimError> {
+    fn check(&self, model: &Resolved) -> Result<LawKind, SimError> {
         let law = Self::law(model)?;
-        let names = law.parameter_names();
-        if law == ForceLaw::Jkr && self.segment == Some(FitSegment::Whole) {
+        let names = force_curve::parameter_names(law).unwrap_or_default();
+        if law == LawKind::Jkr && self.segment == Some(FitSegment::Whole) {
             return Err(bad(
                 "segment",
                 "whole",
@@ -281,7 +285,7 @@ impl FitRequest {
         if self.data.is_none() {
             // (the times matter, and are checked, for the sls law only)
             let time =
-                (law == ForceLaw::Sls && !self.time.is_empty()).then_some(self.time.as_slice());
+                (law == LawKind::Sls && !self.time.is_empty()).then_some(self.time.as_slice());
             check_columns(&self.height, &self.force, self.sigma.as_deref(), time)?;
         }
         Ok(law)
@@ -351,7 +355,7 @@ impl FitRequest {
     /// the sls law without it.
     fn preprocessed(
         &self,
-        law: ForceLaw,
+        law: LawKind,
         height: &[f64],
         force: &[f64],
         time: Option<Vec<f64>>,
@@ -368,7 +372,7 @@ impl FitRequest {
             }
             curve.approach_len = n;
         }
-        if law == ForceLaw::Sls && time.is_none() {
+        if law == LawKind::Sls && time.is_none() {
             return Err(bad(
                 "time",
                 "missing",
@@ -499,7 +503,7 @@ impl Analysis for FitRequest {
         let law = self.check(model)?;
         let (height, force, sigma, time) = self.columns()?;
         // (the times matter, and are checked, for the sls law only)
-        let time = time.filter(|_| law == ForceLaw::Sls);
+        let time = time.filter(|_| law == LawKind::Sls);
         check_columns(&height, &force, sigma.as_deref(), time.as_deref())?;
         let probe = model.probe.as_ref().expect("checked");
         let k = probe.calibration.spring_constant;
@@ -511,7 +515,9 @@ impl Analysis for FitRequest {
         let x: Vec<f64> = rows.iter().map(|&i| curve.tip_position[i]).collect();
         let y: Vec<f64> = rows.iter().map(|&i| curve.force[i]).collect();
         let sig: Option<Vec<f64>> = sigma.map(|s| rows.iter().map(|&i| s[i]).collect());
-        let names = law.parameter_names().to_vec();
+        let names = force_curve::parameter_names(law)
+            .unwrap_or_default()
+            .to_vec();
         let params = start_values(&names, &s, &x, &y)?;
         let fitted: Vec<bool> = names.iter().map(|n| fit.iter().any(|f| f == n)).collect();
         let fixed: Vec<Option<f64>> = params
@@ -521,7 +527,7 @@ impl Analysis for FitRequest {
             .collect();
         // the SLS's force depends on every row before (its history from the first row)
         let sls = match (law, &curve.time) {
-            (ForceLaw::Sls, Some(t)) => Some(SlsCurveModel {
+            (LawKind::Sls, Some(t)) => Some(SlsCurveModel {
                 // the piezo's height in the preprocessed frame, free of the force's noise
                 height: (curve.tip_position.iter().zip(&curve.force))
                     .map(|(x, f)| x - f / k)
@@ -680,7 +686,7 @@ pub fn document(request: &FitRequest, r: &FitResult) -> Value {
         Segment::Retract => "retract",
         Segment::Whole => "whole",
     };
-    let model = if r.law == ForceLaw::Sls {
+    let model = if r.law == LawKind::Sls {
         "F = baseline + F_c: the standard linear solid (Zener) with surface memory in time \
          (k1 relaxed spring, Maxwell arm k2 with relaxation time τ; F_c = k1 δ + k2 (δ − u), \
          u' = (δ − u)/τ in contact, the free surface recovering with τ (k1 + k2)/k1; López-Guerra \

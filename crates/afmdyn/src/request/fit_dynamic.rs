@@ -24,6 +24,7 @@ use crate::analysis::fit::profile::{ProfileWalk, MAX_SECANT_STEPS};
 use crate::analysis::fit::start::{grid_start, z_offset_grid};
 use crate::analysis::fit::{fit_cancellable, CurveModel, Observations, Parameter};
 use crate::analysis::progress::Progress;
+use crate::contact::LawKind;
 use crate::error::SimError;
 use serde_json::{json, Value};
 
@@ -194,8 +195,8 @@ pub fn execute(
         )
     })?;
     let law_name = probe.params.contact_law.name();
-    let law = crate::analysis::fit::force_curve::ForceLaw::from_name(law_name)
-        .filter(|l| matches!(l.name(), "hertz" | "dmt" | "jkr"))
+    let law = Some(probe.params.contact_law.kind())
+        .filter(|l| matches!(l, LawKind::Hertz | LawKind::Dmt | LawKind::Jkr))
         .ok_or_else(|| {
             bad(
                 "law",

@@ -2,8 +2,9 @@
 //! share: the result of a `fit` request, the data of an AM or FM curve, the fewest rows and the
 //! fitted quantities' physical ranges.
 
-use crate::analysis::fit::force_curve::{ForceLaw, Preprocessed};
+use crate::analysis::fit::force_curve::Preprocessed;
 use crate::analysis::fit::FitOutcome;
+use crate::contact::LawKind;
 use crate::error::SimError;
 use crate::probe::ranges::si_range;
 
@@ -81,7 +82,7 @@ pub(crate) fn probe_value(v: Option<f64>, key: &str) -> Result<f64, SimError> {
 #[derive(Debug, Clone)]
 pub struct FitResult {
     /// The law fitted.
-    pub law: ForceLaw,
+    pub law: LawKind,
     /// The lever's spring constant (N/m).
     pub spring_constant: f64,
     /// The preprocessed curve.

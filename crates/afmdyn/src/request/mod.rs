@@ -109,7 +109,7 @@ pub use sweep::{fingerprint, SweepRecord};
 pub use crate::analysis::progress::Progress;
 pub use crate::analysis::reconstruct::Reconstruction;
 pub use crate::analysis::stepped::SteppedCurve;
-pub use crate::contact::{LawKind, FORCE_SIGN, LAWS};
+pub use crate::contact::{LawGroups, LawKind, FORCE_SIGN, GROUPS, LAWS};
 pub use crate::integrate::IntegratorKind;
 pub use crate::params::{Excitation, Params, SweepParam};
 

@@ -7,7 +7,7 @@
 //! single values of [`ModelSpec`] ← the SI overrides `z_c` (sets α5) and `drive_frequency`
 //! (sets Ω), which need the probe's scales.
 
-use crate::contact::{ContactLaw, LawGroups, LawKind};
+use crate::contact::{ContactLaw, LawGroups, LawKind, GROUPS, LAWS};
 use crate::error::SimError;
 use crate::params::{Excitation, Params};
 use crate::probe::Probe;
@@ -21,7 +21,7 @@ pub enum ValueKind {
     Integer,
     /// A real number.
     Real,
-    /// One of `linear`, `hertz`, `dmt`, `electrostatic`, `impact`.
+    /// A registered law's name ([`LAWS`]).
     Law,
     /// One of `base`, `tip`.
     Excitation,
@@ -50,10 +50,8 @@ pub struct ParamInfo {
     pub kind: ValueKind,
 }
 
-/// Every model parameter a request takes, in the order the front ends list them. The ranges
-/// are those [`Params::validate`] and [`ContactLaw::validate`] enforce; `z_c` and
-/// `drive_frequency` are SI values that need a probe file.
-pub const MODEL_PARAMETERS: [ParamInfo; 22] = [
+/// The model parameters before the law's groups, in the order the front ends list them.
+const BEFORE_GROUPS: [ParamInfo; 10] = [
     ParamInfo {
         name: "modes",
         alias: None,
@@ -141,13 +139,8 @@ pub const MODEL_PARAMETERS: [ParamInfo; 22] = [
         unit: "1",
         range: crate::contact::LawKind::EXPECTED,
         default: "linear",
-        help:
-            "tip–sample law: linear (α4 δ + α6 δ̇), hertz (α4 δ^1.5 + α6 δ̇), dmt (van der Waals + \
-         adhesion + Hertz + α6 √δ δ̇), electrostatic (dmt + a biased tip), jkr (adhesive Hertz \
-         contact with a neck, formed at δ = 0, broken at δ_f < 0), capillary (a meniscus formed \
-         at contact, ruptured at V_T = D_r, over a Hertz sample), sls (standard linear solid: \
-         α4 in parallel with a Maxwell arm κ, α6, whose surface recovers after the tip leaves) \
-         or impact (rigid sample, restitution r)",
+        // the registry's laws and doc lines ([`law_help`])
+        help: "tip–sample law",
         kind: ValueKind::Law,
     },
     ParamInfo {
@@ -161,108 +154,10 @@ pub const MODEL_PARAMETERS: [ParamInfo; 22] = [
          force α2 cos Ωτ at the tip: magnetic, photothermal)",
         kind: ValueKind::Excitation,
     },
-    ParamInfo {
-        name: "restitution",
-        alias: None,
-        symbol: "r",
-        unit: "1",
-        range: "0..=1",
-        default: "0.8",
-        help: "impact law: coefficient of restitution r",
-        kind: ValueKind::Real,
-    },
-    ParamInfo {
-        name: "hamaker",
-        alias: None,
-        symbol: "H̃",
-        unit: "1",
-        range: ">= 0",
-        default: "1e-5",
-        help: "DMT: van der Waals group H̃ = H R L³/(6 EI g0³)",
-        kind: ValueKind::Real,
-    },
-    ParamInfo {
-        name: "intermolecular_distance",
-        alias: None,
-        symbol: "ã0",
-        unit: "1",
-        range: "> 0",
-        default: "0.01",
-        help: "DMT: intermolecular distance ã0 = a0/g0, the contact threshold",
-        kind: ValueKind::Real,
-    },
-    ParamInfo {
-        name: "electrostatic",
-        alias: None,
-        symbol: "Ẽ",
-        unit: "1",
-        range: ">= 0",
-        default: "1e-3",
-        help: "electrostatic law: group Ẽ = πε0 V²/F of the biased tip, F_es = -Ẽ R̃²/(d(d + R̃))",
-        kind: ValueKind::Real,
-    },
-    ParamInfo {
-        name: "tip_radius",
-        alias: None,
-        symbol: "R̃",
-        unit: "1",
-        range: "> 0",
-        default: "1",
-        help: "electrostatic law: tip radius R̃ = R/g0",
-        kind: ValueKind::Real,
-    },
-    ParamInfo {
-        name: "adhesion",
-        alias: None,
-        symbol: "P̃",
-        unit: "1",
-        range: "> 0",
-        default: "0.05",
-        help: "jkr law: adhesion group P̃ = πWR/F (W the work of adhesion): pull-off (3/2)P̃",
-        kind: ValueKind::Real,
-    },
-    ParamInfo {
-        name: "capillary",
-        alias: None,
-        symbol: "F̃_cap",
-        unit: "1",
-        range: "> 0",
-        default: "0.1",
-        help: "capillary law: the meniscus's force at contact F̃_cap = 4πRγcosθ/F",
-        kind: ValueKind::Real,
-    },
-    ParamInfo {
-        name: "meniscus",
-        alias: None,
-        symbol: "h̃",
-        unit: "1",
-        range: "1e-9..=1e6",
-        default: "0.01",
-        help: "capillary law: the meniscus's immersion at contact h̃ = √(V/(πR))/g0 (V its volume)",
-        kind: ValueKind::Real,
-    },
-    ParamInfo {
-        name: "rupture",
-        alias: None,
-        symbol: "D̃_r",
-        unit: "1",
-        range: "1e-9..=1e6",
-        default: "0.05",
-        help: "capillary law: the rupture distance D̃_r = (1 + θ/2)V^(1/3)/g0 (Lian et al. 1993)",
-        kind: ValueKind::Real,
-    },
-    ParamInfo {
-        name: "maxwell_stiffness",
-        alias: None,
-        symbol: "κ",
-        unit: "1",
-        range: "(0, 1e12]",
-        default: "20",
-        help:
-            "sls law: the Maxwell arm's spring κ (in series with the dashpot α6; relaxation time \
-         α6/κ, instantaneous stiffness α4 + κ)",
-        kind: ValueKind::Real,
-    },
+];
+
+/// The SI model parameters after the law's groups (they need a probe file).
+const AFTER_GROUPS: [ParamInfo; 2] = [
     ParamInfo {
         name: "z_c",
         alias: None,
@@ -287,6 +182,45 @@ pub const MODEL_PARAMETERS: [ParamInfo; 22] = [
     },
 ];
 
+/// Every model parameter a request takes, in the order the front ends list them: the model's
+/// own, the law groups of the registry ([`crate::contact::GROUPS`], each described by its
+/// law's [`crate::contact::Param`]), then `z_c` and `drive_frequency`, SI values that need a
+/// probe file. The ranges are those [`Params::validate`] and [`ContactLaw::validate`] enforce.
+pub static MODEL_PARAMETERS: std::sync::LazyLock<Vec<ParamInfo>> = std::sync::LazyLock::new(|| {
+    let groups = GROUPS.iter().map(|g| ParamInfo {
+        name: g.name,
+        alias: None,
+        symbol: g.symbol,
+        unit: g.unit,
+        range: g.range,
+        default: leak(crate::error::number(g.default)),
+        help: leak(format!("{} law: {}", crate::contact::owners(g.name), g.doc)),
+        kind: ValueKind::Real,
+    });
+    let laws = BEFORE_GROUPS.into_iter().map(|p| match p.kind {
+        ValueKind::Law => ParamInfo {
+            help: law_help(),
+            ..p
+        },
+        _ => p,
+    });
+    laws.chain(groups).chain(AFTER_GROUPS).collect()
+});
+
+/// The help of `contact_law`: each registered law's name and doc line ([`LAWS`]).
+fn law_help() -> &'static str {
+    let laws: Vec<String> = LAWS
+        .iter()
+        .map(|l| format!("{} ({})", l.name, l.doc))
+        .collect();
+    leak(format!("tip–sample law: {}", laws.join(", ")))
+}
+
+/// A text built once for the table of [`MODEL_PARAMETERS`], kept for the program's life.
+fn leak(text: String) -> &'static str {
+    Box::leak(text.into_boxed_str())
+}
+
 /// The entry of [`MODEL_PARAMETERS`] named `key` (its name or its alias).
 pub fn parameter(key: &str) -> Option<&'static ParamInfo> {
     MODEL_PARAMETERS
@@ -306,113 +240,217 @@ pub(crate) fn closest_parameter(key: &str) -> Option<&'static str> {
         .map(|(_, name)| name)
 }
 
-/// The model values of a request, each optional (a missing one keeps the value below it in the
-/// precedence of this module). Serialised with the names of [`MODEL_PARAMETERS`]; the paper's
-/// `alpha1` … `alpha6` are accepted as aliases; unknown keys are refused (this is also the
-/// schema of a `--config FILE.toml`).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
-#[serde(deny_unknown_fields)]
-pub struct ModelSpec {
-    /// N.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub modes: Option<usize>,
-    /// α1.
-    #[serde(alias = "alpha1", skip_serializing_if = "Option::is_none")]
-    pub tip_mass_ratio: Option<f64>,
-    /// α2.
-    #[serde(alias = "alpha2", skip_serializing_if = "Option::is_none")]
-    pub drive_amplitude: Option<f64>,
-    /// α3.
-    #[serde(alias = "alpha3", skip_serializing_if = "Option::is_none")]
-    pub beam_damping: Option<f64>,
-    /// α4.
-    #[serde(alias = "alpha4", skip_serializing_if = "Option::is_none")]
-    pub contact_stiffness: Option<f64>,
-    /// α5.
-    #[serde(alias = "alpha5", skip_serializing_if = "Option::is_none")]
-    pub gap: Option<f64>,
-    /// α6.
-    #[serde(alias = "alpha6", skip_serializing_if = "Option::is_none")]
-    pub contact_damping: Option<f64>,
-    /// Ω.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub omega: Option<f64>,
-    /// The tip–sample law.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub contact_law: Option<LawKind>,
-    /// Where the drive acts (beam).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub excitation: Option<Excitation>,
-    /// Impact law: r.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub restitution: Option<f64>,
-    /// DMT: H̃.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub hamaker: Option<f64>,
-    /// DMT: ã0.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub intermolecular_distance: Option<f64>,
-    /// Electrostatic law: Ẽ.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub electrostatic: Option<f64>,
-    /// Electrostatic law: R̃.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub tip_radius: Option<f64>,
-    /// JKR law: P̃.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub adhesion: Option<f64>,
-    /// Capillary law: F̃_cap.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub capillary: Option<f64>,
-    /// Capillary law: h̃.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub meniscus: Option<f64>,
-    /// Capillary law: D̃_r.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub rupture: Option<f64>,
-    /// SLS law: κ.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub maxwell_stiffness: Option<f64>,
-    /// With a probe: z_c in m.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub z_c: Option<f64>,
-    /// With a probe: the drive frequency in Hz.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub drive_frequency: Option<f64>,
+/// [`ModelSpec`], its serde form and its schema from one list of its own fields: those before
+/// the law's groups, and the SI values after them (`name | alias: type`, each documented).
+macro_rules! model_spec {
+    (
+        [$( $(#[doc = $bdoc:expr])* $b:ident $(| $balias:ident)? : $bty:ty, )*]
+        [$( $(#[doc = $adoc:expr])* $a:ident : $aty:ty, )*]
+    ) => {
+        /// The model values of a request, each optional (a missing one keeps the value below it in the
+        /// precedence of this module). Serialised with the names of [`MODEL_PARAMETERS`]; the paper's
+        /// `alpha1` … `alpha6` are accepted as aliases; unknown keys are refused (this is also the
+        /// schema of a `--config FILE.toml`).
+        #[derive(Debug, Clone, Copy, Default, PartialEq)]
+        pub struct ModelSpec {
+            $( $(#[doc = $bdoc])* pub $b: Option<$bty>, )*
+            /// The law's groups, each under its own name ([`crate::contact::GROUPS`]:
+            /// `hamaker`, `restitution`, …), as the registry's laws declare them.
+            pub groups: LawGroups,
+            $( $(#[doc = $adoc])* pub $a: Option<$aty>, )*
+        }
+
+        impl ModelSpec {
+            /// `self`'s values, and `lower`'s where `self` has none (flags over a config file).
+            pub fn over(self, lower: ModelSpec) -> ModelSpec {
+                ModelSpec {
+                    $( $b: self.$b.or(lower.$b), )*
+                    groups: self.groups.or(lower.groups),
+                    $( $a: self.$a.or(lower.$a), )*
+                }
+            }
+        }
+
+        /// The keys a model spec takes, aliases before names (as serde's derive lists them).
+        fn fields() -> &'static [&'static str] {
+            static FIELDS: std::sync::OnceLock<Vec<&'static str>> = std::sync::OnceLock::new();
+            FIELDS.get_or_init(|| {
+                let before = [$( $(stringify!($balias),)? stringify!($b), )*];
+                let after = [$( stringify!($a), )*];
+                before
+                    .into_iter()
+                    .chain(GROUPS.iter().map(|g| g.name))
+                    .chain(after)
+                    .collect()
+            })
+        }
+
+        /// The name of key `key` (a name or an alias).
+        fn canonical(key: &str) -> Option<&'static str> {
+            match key {
+                $( $(stringify!($balias) | )? stringify!($b) => Some(stringify!($b)), )*
+                $( stringify!($a) => Some(stringify!($a)), )*
+                _ => GROUPS.iter().find(|g| g.name == key).map(|g| g.name),
+            }
+        }
+
+        impl Serialize for ModelSpec {
+            fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+                use serde::ser::SerializeStruct;
+                let given = [$( self.$b.is_some(), )* $( self.$a.is_some(), )*];
+                let n = given.iter().filter(|g| **g).count() + self.groups.given().count();
+                let mut st = s.serialize_struct("ModelSpec", n)?;
+                $( if let Some(v) = &self.$b { st.serialize_field(stringify!($b), v)?; } )*
+                for (name, v) in self.groups.given() {
+                    st.serialize_field(name, &v)?;
+                }
+                $( if let Some(v) = &self.$a { st.serialize_field(stringify!($a), v)?; } )*
+                st.end()
+            }
+        }
+
+        impl<'de> serde::de::Visitor<'de> for SpecVisitor {
+            type Value = ModelSpec;
+            fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str("struct ModelSpec")
+            }
+            fn visit_map<M: serde::de::MapAccess<'de>>(self, mut map: M) -> Result<ModelSpec, M::Error> {
+                let mut spec = ModelSpec::default();
+                let mut seen: Vec<&'static str> = Vec::new();
+                while let Some(Key(key)) = map.next_key()? {
+                    if seen.contains(&key) {
+                        return Err(serde::de::Error::duplicate_field(key));
+                    }
+                    seen.push(key);
+                    match key {
+                        $( stringify!($b) => spec.$b = map.next_value()?, )*
+                        $( stringify!($a) => spec.$a = map.next_value()?, )*
+                        group => {
+                            spec.groups.set(group, map.next_value()?);
+                        }
+                    }
+                }
+                Ok(spec)
+            }
+        }
+
+        #[cfg(feature = "schema")]
+        impl schemars::JsonSchema for ModelSpec {
+            fn schema_name() -> std::borrow::Cow<'static, str> {
+                "ModelSpec".into()
+            }
+            fn json_schema(generator: &mut schemars::SchemaGenerator) -> schemars::Schema {
+                let mut props = serde_json::Map::new();
+                $( props.insert(
+                    stringify!($b).into(),
+                    described(generator.subschema_for::<Option<$bty>>(), concat!($($bdoc, "\n"),*)),
+                ); )*
+                for g in GROUPS.iter() {
+                    let doc = format!("{} law: {}.", crate::contact::owners(g.name), g.symbol);
+                    props.insert(g.name.into(), described(generator.subschema_for::<Option<f64>>(), &doc));
+                }
+                $( props.insert(
+                    stringify!($a).into(),
+                    described(generator.subschema_for::<Option<$aty>>(), concat!($($adoc, "\n"),*)),
+                ); )*
+                let doc = doc_text(concat!(
+                    " The model values of a request, each optional (a missing one keeps the value below it in the\n",
+                    " precedence of this module). Serialised with the names of [`MODEL_PARAMETERS`]; the paper's\n",
+                    " `alpha1` … `alpha6` are accepted as aliases; unknown keys are refused (this is also the\n",
+                    " schema of a `--config FILE.toml`).",
+                ));
+                schemars::json_schema!({
+                    "title": "ModelSpec",
+                    "description": doc,
+                    "type": "object",
+                    "properties": props,
+                    "additionalProperties": false,
+                })
+            }
+        }
+    };
+}
+
+model_spec! {
+    [
+        /// N.
+        modes: usize,
+        /// α1.
+        tip_mass_ratio | alpha1: f64,
+        /// α2.
+        drive_amplitude | alpha2: f64,
+        /// α3.
+        beam_damping | alpha3: f64,
+        /// α4.
+        contact_stiffness | alpha4: f64,
+        /// α5.
+        gap | alpha5: f64,
+        /// α6.
+        contact_damping | alpha6: f64,
+        /// Ω.
+        omega: f64,
+        /// The tip–sample law.
+        contact_law: LawKind,
+        /// Where the drive acts (beam).
+        excitation: Excitation,
+    ]
+    [
+        /// With a probe: z_c in m.
+        z_c: f64,
+        /// With a probe: the drive frequency in Hz.
+        drive_frequency: f64,
+    ]
+}
+
+/// A key of a model spec, by its name ([`canonical`]); an unknown key is refused as serde's
+/// derive refuses it, listing [`fields`].
+struct Key(&'static str);
+
+impl<'de> Deserialize<'de> for Key {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Key, D::Error> {
+        struct KeyVisitor;
+        impl serde::de::Visitor<'_> for KeyVisitor {
+            type Value = Key;
+            fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str("field identifier")
+            }
+            fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<Key, E> {
+                canonical(v)
+                    .map(Key)
+                    .ok_or_else(|| E::unknown_field(v, fields()))
+            }
+        }
+        d.deserialize_identifier(KeyVisitor)
+    }
+}
+
+/// [`ModelSpec`]'s map visitor.
+struct SpecVisitor;
+
+impl<'de> Deserialize<'de> for ModelSpec {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<ModelSpec, D::Error> {
+        d.deserialize_struct("ModelSpec", fields(), SpecVisitor)
+    }
+}
+
+/// A doc comment's text as a schema's description (each line's leading space dropped).
+#[cfg(feature = "schema")]
+fn doc_text(doc: &str) -> String {
+    let lines: Vec<&str> = doc
+        .lines()
+        .map(|l| l.strip_prefix(' ').unwrap_or(l))
+        .collect();
+    lines.join("\n").trim().to_string()
+}
+
+/// `schema` with the description `doc`, as JSON.
+#[cfg(feature = "schema")]
+fn described(mut schema: schemars::Schema, doc: &str) -> serde_json::Value {
+    schema.insert("description".into(), doc_text(doc).into());
+    schema.to_value()
 }
 
 impl ModelSpec {
-    /// `self`'s values, and `lower`'s where `self` has none (flags over a config file).
-    pub fn over(self, lower: ModelSpec) -> ModelSpec {
-        ModelSpec {
-            modes: self.modes.or(lower.modes),
-            tip_mass_ratio: self.tip_mass_ratio.or(lower.tip_mass_ratio),
-            drive_amplitude: self.drive_amplitude.or(lower.drive_amplitude),
-            beam_damping: self.beam_damping.or(lower.beam_damping),
-            contact_stiffness: self.contact_stiffness.or(lower.contact_stiffness),
-            gap: self.gap.or(lower.gap),
-            contact_damping: self.contact_damping.or(lower.contact_damping),
-            omega: self.omega.or(lower.omega),
-            contact_law: self.contact_law.or(lower.contact_law),
-            excitation: self.excitation.or(lower.excitation),
-            restitution: self.restitution.or(lower.restitution),
-            hamaker: self.hamaker.or(lower.hamaker),
-            intermolecular_distance: self
-                .intermolecular_distance
-                .or(lower.intermolecular_distance),
-            electrostatic: self.electrostatic.or(lower.electrostatic),
-            tip_radius: self.tip_radius.or(lower.tip_radius),
-            adhesion: self.adhesion.or(lower.adhesion),
-            capillary: self.capillary.or(lower.capillary),
-            meniscus: self.meniscus.or(lower.meniscus),
-            rupture: self.rupture.or(lower.rupture),
-            maxwell_stiffness: self.maxwell_stiffness.or(lower.maxwell_stiffness),
-            z_c: self.z_c.or(lower.z_c),
-            drive_frequency: self.drive_frequency.or(lower.drive_frequency),
-        }
-    }
-
     /// Every given value is a finite number. A chart carries its model values through JSON to
     /// set one per cell, where a NaN or an infinity would become `null` and silently the
     /// default; the other analyses refuse them through [`ModelSpec::resolve`] alike.
@@ -430,7 +468,7 @@ impl ModelSpec {
     }
 
     /// The real values by their names, in the order of [`MODEL_PARAMETERS`].
-    fn reals(&self) -> [(&'static str, Option<f64>); 19] {
+    fn reals(&self) -> impl Iterator<Item = (&'static str, Option<f64>)> + '_ {
         [
             ("tip_mass_ratio", self.tip_mass_ratio),
             ("drive_amplitude", self.drive_amplitude),
@@ -439,19 +477,10 @@ impl ModelSpec {
             ("gap", self.gap),
             ("contact_damping", self.contact_damping),
             ("omega", self.omega),
-            ("restitution", self.restitution),
-            ("hamaker", self.hamaker),
-            ("intermolecular_distance", self.intermolecular_distance),
-            ("electrostatic", self.electrostatic),
-            ("tip_radius", self.tip_radius),
-            ("adhesion", self.adhesion),
-            ("capillary", self.capillary),
-            ("meniscus", self.meniscus),
-            ("rupture", self.rupture),
-            ("maxwell_stiffness", self.maxwell_stiffness),
-            ("z_c", self.z_c),
-            ("drive_frequency", self.drive_frequency),
         ]
+        .into_iter()
+        .chain(self.groups.entries())
+        .chain([("z_c", self.z_c), ("drive_frequency", self.drive_frequency)])
     }
 
     /// The parameter set: `defaults`, or the probe's set when a probe is given, with this
@@ -469,22 +498,7 @@ impl ModelSpec {
             self.check_probe_modes(pr)?;
         }
         let base = probe.map_or(defaults, |p| p.params);
-        let contact_law = ContactLaw::from_parts(
-            self.contact_law,
-            LawGroups {
-                hamaker: self.hamaker,
-                intermolecular_distance: self.intermolecular_distance,
-                restitution: self.restitution,
-                electrostatic: self.electrostatic,
-                tip_radius: self.tip_radius,
-                adhesion: self.adhesion,
-                capillary: self.capillary,
-                meniscus: self.meniscus,
-                rupture: self.rupture,
-                maxwell_stiffness: self.maxwell_stiffness,
-            },
-            base.contact_law,
-        )?;
+        let contact_law = ContactLaw::from_parts(self.contact_law, self.groups, base.contact_law)?;
         let mut p = Params {
             contact_law,
             modes: self.modes.unwrap_or(base.modes),
@@ -608,10 +622,11 @@ fn omega_of_drive_frequency(f: f64, probe: Option<&Probe>) -> Result<f64, SimErr
 
 /// The model values a probe file sets in SI, refused as dimensionless values when a probe is
 /// given (its scales would not apply to them: `hamaker = 6.6e-20` taken as H̃ is not the
-/// Hamaker constant in J): the value's name and what to give instead. `modes` and
+/// Hamaker constant in J): the value's name and what to give instead. The law's groups say
+/// it themselves ([`crate::contact::Param::under_probe`], [`probe_sets`]). `modes`,
 /// `restitution` (pure numbers, the same in SI) and the SI values `z_c` and `drive_frequency`
 /// are taken with a probe.
-pub const PROBE_SETS: [(&str, &str); 18] = [
+pub const PROBE_SETS: [(&str, &str); 9] = [
     (
         "tip_mass_ratio",
         "is the dimensionless α1 and a probe sets it: give it in the probe file's [cantilever] \
@@ -653,65 +668,36 @@ pub const PROBE_SETS: [(&str, &str); 18] = [
          change the law there",
     ),
     (
-        "hamaker",
-        "is the dimensionless H̃ and a probe sets it: give the Hamaker constant in the probe \
-         file's [sample] hamaker (J)",
-    ),
-    (
-        "intermolecular_distance",
-        "is the dimensionless ã0 and a probe sets it: give a0 in the probe file's [sample] \
-         intermolecular_distance (m)",
-    ),
-    (
-        "electrostatic",
-        "is the dimensionless Ẽ and a probe sets it: give the voltage in the probe file's \
-         [sample] bias_voltage (V, law = \"electrostatic\")",
-    ),
-    (
-        "tip_radius",
-        "is the dimensionless R̃ and a probe sets it: give the radius in the probe file's \
-         [tip] radius (m)",
-    ),
-    (
         "excitation",
         "is set by the probe file's [drive] excitation (its drive amplitude is calibrated for \
          it): change it there",
     ),
-    (
-        "adhesion",
-        "is the dimensionless P̃ and a probe sets it: give the work of adhesion in the probe \
-         file's [sample] adhesion_energy (J/m², law = \"jkr\")",
-    ),
-    (
-        "capillary",
-        "is the dimensionless F̃_cap and a probe sets it: give the probe file's [sample] \
-         surface_tension (N/m) and contact_angle (degrees) (law = \"capillary\")",
-    ),
-    (
-        "meniscus",
-        "is the dimensionless h̃ and a probe sets it: give the probe file's [sample] \
-         meniscus_volume (m³, law = \"capillary\")",
-    ),
-    (
-        "rupture",
-        "is the dimensionless D̃_r and a probe sets it: give the probe file's [sample] \
-         meniscus_volume (m³) and contact_angle (degrees) (law = \"capillary\")",
-    ),
-    (
-        "maxwell_stiffness",
-        "is the dimensionless κ and a probe sets it: give the probe file's [sample] \
-         maxwell_stiffness (N/m, law = \"sls\")",
-    ),
 ];
 
+/// What to give instead of `name` under a probe ([`PROBE_SETS`], or the law group's
+/// [`crate::contact::Param::under_probe`]), if a probe sets it.
+pub fn probe_sets(name: &str) -> Option<std::borrow::Cow<'static, str>> {
+    if let Some((_, allowed)) = PROBE_SETS.iter().find(|(key, _)| *key == name) {
+        return Some((*allowed).into());
+    }
+    let g = GROUPS.iter().find(|g| g.name == name)?;
+    let hint = g.under_probe?;
+    Some(
+        format!(
+            "is the dimensionless {} and a probe sets it: {hint}",
+            g.symbol
+        )
+        .into(),
+    )
+}
+
 impl ModelSpec {
-    /// Refuse the values a probe sets in SI ([`PROBE_SETS`]): the first one given, named.
+    /// Refuse the values a probe sets in SI ([`probe_sets`]): the first one given, named.
     fn refuse_dimensionless_under_probe(&self) -> Result<(), SimError> {
         for (name, value) in self.reals() {
-            let set = PROBE_SETS.iter().find(|(key, _)| *key == name);
-            if let (Some(v), Some(&(key, allowed))) = (value, set) {
+            if let (Some(v), Some(allowed)) = (value, probe_sets(name)) {
                 return Err(SimError::out_of_range(
-                    key,
+                    name,
                     crate::error::number(v),
                     allowed,
                 ));
@@ -728,7 +714,7 @@ impl ModelSpec {
             return Err(SimError::out_of_range(
                 "excitation",
                 e.name(),
-                PROBE_SETS[12].1,
+                PROBE_SETS[8].1,
             ));
         }
         Ok(())

@@ -10,7 +10,6 @@ impl ModelSpec {
     /// `None`), no SI values (`z_c`, `drive_frequency`: a probe's, not the set's). Resolved
     /// over any set it gives `p` back (for the keywords' part of it).
     pub fn of(p: &Params) -> ModelSpec {
-        let g = p.contact_law.groups();
         ModelSpec {
             modes: Some(p.modes),
             tip_mass_ratio: Some(p.alpha1),
@@ -22,16 +21,7 @@ impl ModelSpec {
             omega: Some(p.omega),
             contact_law: Some(p.contact_law.kind()),
             excitation: Some(p.excitation),
-            restitution: p.contact_law.restitution(),
-            hamaker: g.hamaker,
-            intermolecular_distance: g.intermolecular_distance,
-            electrostatic: g.electrostatic,
-            tip_radius: g.tip_radius,
-            adhesion: g.adhesion,
-            capillary: g.capillary,
-            meniscus: g.meniscus,
-            rupture: g.rupture,
-            maxwell_stiffness: g.maxwell_stiffness,
+            groups: p.contact_law.groups(),
             z_c: None,
             drive_frequency: None,
         }

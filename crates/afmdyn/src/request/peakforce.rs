@@ -317,10 +317,7 @@ fn true_modulus(model: &Resolved, alpha4: f64) -> Option<f64> {
 /// model `p` under the probe of `model`; `None` for a law without a tip radius (no modulus)
 /// or without a probe (the Hertz group itself is reported).
 pub(crate) fn modulus_scale(model: &Resolved, p: &Params) -> Option<f64> {
-    let has_radius = matches!(
-        p.contact_law.name(),
-        "hertz" | "dmt" | "electrostatic" | "jkr" | "capillary"
-    );
+    let has_radius = p.contact_law.info().tip_radius;
     true_modulus(model, 1.0).filter(|_| has_radius)
 }
 
@@ -341,10 +338,7 @@ pub fn document(request: &PeakForceRequest, model: &Resolved, r: &PeakForceResul
         .find(|t| t.tap.is_some())
         .map_or(model.params, |t| t.params)
         .with(SweepParam::Alpha5, r.alpha5);
-    let has_radius = matches!(
-        p.contact_law.name(),
-        "hertz" | "dmt" | "electrostatic" | "jkr" | "capillary"
-    );
+    let has_radius = p.contact_law.info().tip_radius;
     // the fitted Hertz group to a modulus (SI with a probe), beside the true one
     let fitted = tap.fit.map(|f| f.hertz_group);
     let (modulus_fit, modulus_true) = match true_modulus(model, 1.0) {

@@ -33,56 +33,27 @@
 //! ∂F/∂k_H = F_c/k_H exactly for Hertz, and by central differences of relative step 1e-6 on
 //! DMT's and JKR's groups (error ~1e-12 relative), chained to E_s, R, H and W analytically.
 
-use crate::contact::{reduced_modulus, DmtLaw, HertzLaw, Jkr, JkrLaw, Law};
+use crate::contact::{reduced_modulus, DmtLaw, HertzLaw, Jkr, JkrLaw, Law, LawKind};
 
-/// The force-curve laws the fit takes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum ForceLaw {
-    /// Hertz's paraboloid.
-    Hertz,
-    /// DMT: Hertz with the van der Waals attraction (constant adhesion in contact).
-    Dmt,
-    /// JKR: the adhesive neck.
-    Jkr,
-    /// The standard linear solid (Zener) with surface memory, in time: its model is
-    /// [`super::sls_curve::SlsCurveModel`], not [`ForceCurveModel`].
-    Sls,
-}
-
-impl ForceLaw {
-    /// The law of the registry by its name (`hertz`, `dmt`, `jkr`); `None` for another.
-    pub(crate) fn from_name(name: &str) -> Option<ForceLaw> {
-        match name {
-            "hertz" => Some(ForceLaw::Hertz),
-            "dmt" => Some(ForceLaw::Dmt),
-            "jkr" => Some(ForceLaw::Jkr),
-            "sls" => Some(ForceLaw::Sls),
-            _ => None,
-        }
-    }
-    /// The law's name in the registry.
-    pub fn name(self) -> &'static str {
-        match self {
-            ForceLaw::Hertz => "hertz",
-            ForceLaw::Dmt => "dmt",
-            ForceLaw::Jkr => "jkr",
-            ForceLaw::Sls => "sls",
-        }
-    }
-    /// The names of the model's parameters, in the model's order (every one fittable).
-    pub fn parameter_names(self) -> &'static [&'static str] {
-        match self {
-            ForceLaw::Hertz => &[YOUNGS_MODULUS, RADIUS, CONTACT_POINT, BASELINE],
-            ForceLaw::Dmt => &[YOUNGS_MODULUS, RADIUS, CONTACT_POINT, BASELINE, HAMAKER],
-            ForceLaw::Jkr => &[YOUNGS_MODULUS, RADIUS, CONTACT_POINT, BASELINE, ADHESION],
-            ForceLaw::Sls => &[
-                STIFFNESS,
-                MAXWELL_STIFFNESS,
-                RELAXATION_TIME,
-                CONTACT_POINT,
-                BASELINE,
-            ],
-        }
+/// The names of the force-curve model's parameters of the registry's law `law`, in the
+/// model's order (every one fittable): Hertz's paraboloid, DMT (Hertz with the van der Waals
+/// attraction, a constant adhesion in contact), JKR (the adhesive neck) and the standard linear
+/// solid (Zener, with surface memory, in time: its model is
+/// [`super::sls_curve::SlsCurveModel`], not [`ForceCurveModel`]); `None` for a law the fit does
+/// not take.
+pub fn parameter_names(law: LawKind) -> Option<&'static [&'static str]> {
+    match law {
+        LawKind::Hertz => Some(&[YOUNGS_MODULUS, RADIUS, CONTACT_POINT, BASELINE]),
+        LawKind::Dmt => Some(&[YOUNGS_MODULUS, RADIUS, CONTACT_POINT, BASELINE, HAMAKER]),
+        LawKind::Jkr => Some(&[YOUNGS_MODULUS, RADIUS, CONTACT_POINT, BASELINE, ADHESION]),
+        LawKind::Sls => Some(&[
+            STIFFNESS,
+            MAXWELL_STIFFNESS,
+            RELAXATION_TIME,
+            CONTACT_POINT,
+            BASELINE,
+        ]),
+        _ => None,
     }
 }
 
@@ -205,11 +176,11 @@ pub fn preprocess(height: &[f64], force: &[f64], spring_constant: f64) -> Prepro
 }
 
 /// The force-curve model at the rows' tip positions (module docs). Parameters in
-/// [`ForceLaw::parameter_names`]' order.
+/// [`parameter_names`]' order.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ForceCurveModel {
-    /// The law.
-    pub law: ForceLaw,
+    /// The law (one [`parameter_names`] takes).
+    pub law: LawKind,
     /// The tip positions x (m) of the fitted rows.
     pub x: Vec<f64>,
     /// The segment the rows belong to (JKR's contact differs on approach and retract).
@@ -235,21 +206,21 @@ impl ForceCurveModel {
     /// The law's force and ∂F/∂δ at indentation δ with Hertz group k and second group g.
     fn law_force(&self, k: f64, g: f64, delta: f64) -> (f64, f64) {
         let e = match self.law {
-            ForceLaw::Hertz => HertzLaw.force(k, 0.0, delta >= 0.0, delta, 0.0),
-            ForceLaw::Dmt => DmtLaw {
+            LawKind::Hertz => HertzLaw.force(k, 0.0, delta >= 0.0, delta, 0.0),
+            LawKind::Dmt => DmtLaw {
                 hamaker: g,
                 intermolecular_distance: self.intermolecular_distance,
             }
             .force(k, 0.0, delta >= 0.0, delta, 0.0),
-            ForceLaw::Jkr => {
+            LawKind::Jkr => {
                 let contact = match self.segment {
                     Segment::Approach | Segment::Whole => delta >= 0.0,
                     Segment::Retract => delta > Jkr::new(k, g).release(),
                 };
                 JkrLaw { adhesion: g }.force(k, 0.0, contact, delta, 0.0)
             }
-            // not this model's law (its history needs the rows' times): no value
-            ForceLaw::Sls => crate::contact::ForceEval {
+            // not this model's law (SLS's history needs the rows' times): no value
+            _ => crate::contact::ForceEval {
                 force: f64::NAN,
                 d_delta: f64::NAN,
                 d_rate: f64::NAN,
@@ -268,12 +239,12 @@ impl super::CurveModel for ForceCurveModel {
         let (k, dk_de) = self.hertz_group(e_s, r);
         // the law's second group and its derivatives by R and by its own parameter
         let (g, dg_dr, dg_dq) = match self.law {
-            ForceLaw::Hertz | ForceLaw::Sls => (0.0, 0.0, 0.0),
-            ForceLaw::Dmt => (p[4] * r / 6.0, p[4] / 6.0, r / 6.0),
-            ForceLaw::Jkr => {
+            LawKind::Dmt => (p[4] * r / 6.0, p[4] / 6.0, r / 6.0),
+            LawKind::Jkr => {
                 let pi = std::f64::consts::PI;
                 (pi * p[4] * r, pi * p[4], pi * r)
             }
+            _ => (0.0, 0.0, 0.0),
         };
         let n = p.len();
         let mut jac = jacobian;
@@ -285,7 +256,7 @@ impl super::CurveModel for ForceCurveModel {
                 continue;
             };
             let (df_dk, df_dg) = match self.law {
-                ForceLaw::Hertz => (f / k, 0.0),
+                LawKind::Hertz => (f / k, 0.0),
                 _ => {
                     let hk = 1e-6 * k;
                     let hg = 1e-6 * g.abs().max(f64::MIN_POSITIVE);

@@ -15,16 +15,10 @@ fn the_table_names_every_field_of_the_spec() {
         omega: Some(1.0),
         contact_law: Some(LawKind::Linear),
         excitation: Some(Excitation::Tip),
-        restitution: Some(0.5),
-        hamaker: Some(0.0),
-        intermolecular_distance: Some(1.0),
-        electrostatic: Some(0.0),
-        tip_radius: Some(1.0),
-        adhesion: Some(1.0),
-        capillary: Some(1.0),
-        meniscus: Some(1.0),
-        rupture: Some(1.0),
-        maxwell_stiffness: Some(1.0),
+        // every group of the registry
+        groups: GROUPS
+            .iter()
+            .fold(LawGroups::default(), |g, p| g.with(p.name, 1.0)),
         z_c: Some(0.0),
         drive_frequency: Some(1.0),
     };
@@ -36,7 +30,7 @@ fn the_table_names_every_field_of_the_spec() {
     names.sort_unstable();
     assert_eq!(keys_sorted, names);
     // and the aliases are accepted as keys
-    for p in &MODEL_PARAMETERS {
+    for p in MODEL_PARAMETERS.iter() {
         if let Some(alias) = p.alias {
             let spec = ModelSpec::from_toml(&format!("{alias} = 0.5")).unwrap();
             let direct = ModelSpec::from_toml(&format!("{} = 0.5", p.name)).unwrap();
@@ -182,14 +176,14 @@ fn a_probe_refuses_the_values_it_sets() {
         ),
         (
             ModelSpec {
-                hamaker: Some(6.6e-20),
+                groups: LawGroups::default().with("hamaker", 6.6e-20),
                 ..ModelSpec::default()
             },
             "[sample] hamaker (J)",
         ),
         (
             ModelSpec {
-                intermolecular_distance: Some(0.01),
+                groups: LawGroups::default().with("intermolecular_distance", 0.01),
                 ..ModelSpec::default()
             },
             "[sample] intermolecular_distance (m)",
@@ -200,12 +194,12 @@ fn a_probe_refuses_the_values_it_sets() {
         assert!(matches!(e, SimError::OutOfRange { .. }), "{e:?}");
         assert!(e.to_string().contains(hint), "{e}");
         // taken as the dimensionless value without a probe (the law groups need their law)
-        if spec.hamaker.is_none() && spec.intermolecular_distance.is_none() {
+        if spec.groups.given().next().is_none() {
             spec.resolve(Params::default(), None).unwrap();
         }
     }
     let e = ModelSpec {
-        hamaker: Some(6.6e-20),
+        groups: LawGroups::default().with("hamaker", 6.6e-20),
         ..ModelSpec::default()
     }
     .resolve(Params::default(), Some(&probe))
