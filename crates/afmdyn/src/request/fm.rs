@@ -271,6 +271,19 @@ impl Analysis for FmRequest {
         let files = super::present::Files::All;
         Ok(super::present::fm::fm(&mut document, units, files, None))
     }
+    fn present_to(
+        &self,
+        _: &Resolved,
+        _: &FmCurve,
+        document: &Value,
+        units: crate::report::TextUnits,
+        to: super::run::Destination<'_>,
+    ) -> Result<crate::report::Presentation, SimError> {
+        let mut document = document.clone();
+        let mut shown = super::present::fm::fm(&mut document, units, to.files, to.dir);
+        shown.document = Some(document);
+        Ok(shown)
+    }
     fn largest_indentation(&self, curve: &FmCurve) -> Option<f64> {
         let d = curve.points.iter().map(|q| q.observables.indentation);
         Some(d.filter(|d| d.is_finite()).fold(0.0, f64::max))

@@ -139,6 +139,58 @@ pub trait Analysis {
     ) -> Result<report::Presentation, SimError> {
         Ok(report::Presentation::default())
     }
+    /// [`Analysis::present`] as a front end writes it to `to`: only the files `to.files`
+    /// keeps; a result whose files or document name the directory (`"csv"`: its path) adds
+    /// them here, its printed document in [`report::Presentation::document`].
+    ///
+    /// # Errors
+    /// As [`Analysis::present`].
+    fn present_to(
+        &self,
+        model: &Resolved,
+        output: &Self::Output,
+        document: &Value,
+        units: report::TextUnits,
+        to: Destination<'_>,
+    ) -> Result<report::Presentation, SimError> {
+        let mut shown = self.present(model, output, document, units)?;
+        to.keep(&mut shown);
+        Ok(shown)
+    }
+}
+
+/// Where a front end writes a result ([`Analysis::present_to`]): which files, the directory
+/// (none: no files written) and the naming of a stepped curve's columns.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Destination<'a> {
+    /// The files written: all, the data without the figures, or none.
+    pub files: super::present::Files,
+    /// The output directory.
+    pub dir: Option<&'a std::path::Path>,
+    /// A stepped curve's CSV/NPY columns named and ordered as dForce 2.0's zcdom table.
+    pub dforce_columns: bool,
+}
+
+impl Destination<'_> {
+    /// A stepped curve's options at this destination, its files named `stem`.
+    pub fn curve(&self, stem: &'static str) -> super::present::curves::CurveOptions {
+        super::present::curves::CurveOptions {
+            stem,
+            files: self.files,
+            dforce_columns: self.dforce_columns,
+        }
+    }
+    /// `shown` without the files [`Destination::files`] leaves out (the figures, or all).
+    pub fn keep(&self, shown: &mut report::Presentation) {
+        use super::present::Files;
+        match self.files {
+            Files::All => {}
+            Files::Data => shown
+                .files
+                .retain(|f| !matches!(f, report::OutputFile::Figure { .. })),
+            Files::None => shown.files.clear(),
+        }
+    }
 }
 
 /// Run `analysis` on `model`: [`Analysis::validate`], its [`Analysis::cost`] held against the
@@ -369,7 +421,12 @@ impl Analysis for AttractorsRequest {
         document: &Value,
         units: report::TextUnits,
     ) -> Result<report::Presentation, SimError> {
-        super::present::census::attractors(self, &model.params, r, document, units)
+        let mut shown =
+            super::present::census::attractors(self, &model.params, r, document, units)?;
+        shown
+            .warnings
+            .extend(super::present::census::failed_starts(r, self.samples));
+        Ok(shown)
     }
 }
 
@@ -436,6 +493,23 @@ impl Analysis for ConvergeRequest {
         _: report::TextUnits,
     ) -> Result<report::Presentation, SimError> {
         Ok(super::present::converge::converge(&model.params, runs))
+    }
+    fn present_to(
+        &self,
+        model: &Resolved,
+        runs: &Self::Output,
+        document: &Value,
+        units: report::TextUnits,
+        to: Destination<'_>,
+    ) -> Result<report::Presentation, SimError> {
+        let mut shown = self.present(model, runs, document, units)?;
+        if let Some(dir) = to.dir {
+            let mut document = document.clone();
+            document["out"] = serde_json::json!(dir);
+            shown.document = Some(document);
+        }
+        to.keep(&mut shown);
+        Ok(shown)
     }
 }
 

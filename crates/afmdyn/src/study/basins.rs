@@ -154,6 +154,29 @@ impl Analysis for BasinsRequest {
         let spec = self.spec(&model.params)?;
         crate::request::present::maps::basins(&spec, map, document)
     }
+    fn present_to(
+        &self,
+        model: &Resolved,
+        map: &BasinMap,
+        document: &Value,
+        units: crate::report::TextUnits,
+        to: crate::request::Destination<'_>,
+    ) -> Result<crate::report::Presentation, SimError> {
+        // the document (basins.json too) names the files written
+        let Some(dir) = to.dir else {
+            let mut shown = self.present(model, map, document, units)?;
+            to.keep(&mut shown);
+            return Ok(shown);
+        };
+        let mut document = document.clone();
+        document["csv"] = serde_json::json!(dir.join("basins.csv"));
+        document["netcdf"] = serde_json::json!(dir.join("basins.nc"));
+        let mut shown = self.present(model, map, &document, units)?;
+        to.keep(&mut shown);
+        shown.document = Some(document);
+        shown.outputs_note = crate::report::OutputsNote::Tail;
+        Ok(shown)
+    }
 }
 
 /// The resumable store of a basin map (feature `files`): a [`TaskStore`](crate::study::task_store::TaskStore) of rows in the

@@ -86,6 +86,27 @@ impl Analysis for Chart {
     ) -> Result<crate::report::Presentation, SimError> {
         Ok(crate::request::present::maps::chart(self, cells))
     }
+    fn present_to(
+        &self,
+        _: &Resolved,
+        cells: &Vec<ChartCell>,
+        document: &Value,
+        _: crate::report::TextUnits,
+        to: crate::request::Destination<'_>,
+    ) -> Result<crate::report::Presentation, SimError> {
+        let mut shown = crate::request::present::maps::chart(self, cells);
+        to.keep(&mut shown);
+        if let Some(dir) = to.dir {
+            let mut document = document.clone();
+            document["files"] = serde_json::json!({
+                "csv": dir.join("chart.csv"),
+                "netcdf": dir.join("chart.nc"),
+            });
+            shown.document = Some(document);
+            shown.outputs_note = crate::report::OutputsNote::Tail;
+        }
+        Ok(shown)
+    }
 }
 
 /// The cells of the tasks `records` (a [`super::MemoryStore`]'s, in any order), row

@@ -241,6 +241,19 @@ impl Analysis for PeakForceRequest {
             None,
         ))
     }
+    fn present_to(
+        &self,
+        _: &Resolved,
+        _: &PeakForceResult,
+        document: &Value,
+        units: crate::report::TextUnits,
+        to: crate::request::Destination<'_>,
+    ) -> Result<crate::report::Presentation, SimError> {
+        let mut document = document.clone();
+        let (files, dir) = (to.files, to.dir);
+        let p = crate::request::present::peakforce::peakforce;
+        Ok(p(&mut document, units, files, dir))
+    }
     fn largest_indentation(&self, r: &PeakForceResult) -> Option<f64> {
         // a sweep's largest over its taps
         let taps = r.sweep.iter().flatten().filter_map(|t| t.tap.as_ref());
