@@ -126,13 +126,13 @@ pub fn image_cmd(a: &ImageArgs) -> Result<(), CliError> {
         feedback: pi,
         study,
         threads: options.threads,
-        files: files(a.files),
     };
     let model = job.model()?;
     let out = (a.files != Files::None).then_some(a.out.as_path());
     let exit = Exit {
         json: a.json,
         out,
+        files: files(a.files),
         unit: if job.feedback.is_some() || mode == ImageMode::Peakforce {
             "lines"
         } else {

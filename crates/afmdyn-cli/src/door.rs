@@ -132,7 +132,9 @@ fn present<A: Analysis>(
         dforce_columns: exit.dforce_columns,
     };
     let units = units_of(model.probe.as_ref());
-    Ok(request.present_to(model, output, document, units, to)?)
+    let mut shown = request.present(model, output, document, units, to)?;
+    to.keep(&mut shown);
+    Ok(shown)
 }
 
 /// Write a presentation: its warnings and `document`'s on stderr, the files into `out`, then

@@ -266,17 +266,6 @@ impl Analysis for FmRequest {
         _: &FmCurve,
         document: &Value,
         units: crate::report::TextUnits,
-    ) -> Result<crate::report::Presentation, SimError> {
-        let mut document = document.clone();
-        let files = super::present::Files::All;
-        Ok(super::present::fm::fm(&mut document, units, files, None))
-    }
-    fn present_to(
-        &self,
-        _: &Resolved,
-        _: &FmCurve,
-        document: &Value,
-        units: crate::report::TextUnits,
         to: super::run::Destination<'_>,
     ) -> Result<crate::report::Presentation, SimError> {
         let mut document = document.clone();

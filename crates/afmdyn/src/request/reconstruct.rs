@@ -341,22 +341,6 @@ impl Analysis for ReconstructRequest {
         r: &Reconstruction,
         document: &Value,
         units: crate::report::TextUnits,
-    ) -> Result<crate::report::Presentation, SimError> {
-        let files = (super::present::Files::All, None);
-        let law = self.law_in_order();
-        let mut document = document.clone();
-        let how = match self.inversion {
-            FmInversion::SaderJarvis => Inversion::SaderJarvis,
-            FmInversion::Exact => Inversion::Exact,
-        };
-        Ok(reconstruction(r, how, law, &mut document, units, files))
-    }
-    fn present_to(
-        &self,
-        _: &Resolved,
-        r: &Reconstruction,
-        document: &Value,
-        units: crate::report::TextUnits,
         to: super::run::Destination<'_>,
     ) -> Result<crate::report::Presentation, SimError> {
         let how = match self.inversion {
@@ -413,7 +397,7 @@ impl Analysis for AmReconstruction {
     fn report(&self, _: &Resolved, r: &Reconstruction) -> Result<Value, SimError> {
         Ok(am_document(&am_curve_from_approach(&self.0)?, r))
     }
-    fn present_to(
+    fn present(
         &self,
         _: &Resolved,
         r: &Reconstruction,

@@ -126,7 +126,10 @@ pub trait Analysis {
     }
     /// What the result shows besides its document ([`report::Presentation`]): the text
     /// summary in `units`, its tables, datasets and figures as data, for every front end to
-    /// write; `document` is the result's JSON ([`run`]'s). Empty by default.
+    /// write to `to` (a front end keeps only the files `to.files` says: [`Destination::keep`]);
+    /// `document` is the result's JSON ([`run`]'s). A result whose files or document name the
+    /// directory (`"csv"`: its path) adds them here, the document as printed in
+    /// [`report::Presentation::document`]. Empty by default.
     ///
     /// # Errors
     /// [`SimError`] where the presentation needs the model built again (an invalid `params`).
@@ -136,30 +139,13 @@ pub trait Analysis {
         _output: &Self::Output,
         _document: &Value,
         _units: report::TextUnits,
+        _to: Destination<'_>,
     ) -> Result<report::Presentation, SimError> {
         Ok(report::Presentation::default())
     }
-    /// [`Analysis::present`] as a front end writes it to `to`: only the files `to.files`
-    /// keeps; a result whose files or document name the directory (`"csv"`: its path) adds
-    /// them here, its printed document in [`report::Presentation::document`].
-    ///
-    /// # Errors
-    /// As [`Analysis::present`].
-    fn present_to(
-        &self,
-        model: &Resolved,
-        output: &Self::Output,
-        document: &Value,
-        units: report::TextUnits,
-        to: Destination<'_>,
-    ) -> Result<report::Presentation, SimError> {
-        let mut shown = self.present(model, output, document, units)?;
-        to.keep(&mut shown);
-        Ok(shown)
-    }
 }
 
-/// Where a front end writes a result ([`Analysis::present_to`]): which files, the directory
+/// Where a front end writes a result ([`Analysis::present`]): which files, the directory
 /// (none: no files written) and the naming of a stepped curve's columns.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Destination<'a> {
@@ -296,6 +282,7 @@ impl Analysis for OrbitRequest {
         output: &Self::Output,
         _: &Value,
         units: report::TextUnits,
+        _: Destination<'_>,
     ) -> Result<report::Presentation, SimError> {
         super::present::orbits::orbit(&model.params, output, units)
     }
@@ -341,6 +328,7 @@ impl Analysis for ContinuationRequest {
         branches: &Self::Output,
         _: &Value,
         units: report::TextUnits,
+        _: Destination<'_>,
     ) -> Result<report::Presentation, SimError> {
         super::present::continuation::continuation(
             &model.params,
@@ -386,6 +374,7 @@ impl Analysis for LyapunovRequest {
         output: &Self::Output,
         _: &Value,
         units: report::TextUnits,
+        _: Destination<'_>,
     ) -> Result<report::Presentation, SimError> {
         Ok(super::present::orbits::lyapunov(
             &model.params,
@@ -420,6 +409,7 @@ impl Analysis for AttractorsRequest {
         r: &Self::Output,
         document: &Value,
         units: report::TextUnits,
+        _: Destination<'_>,
     ) -> Result<report::Presentation, SimError> {
         let mut shown =
             super::present::census::attractors(self, &model.params, r, document, units)?;
@@ -489,26 +479,17 @@ impl Analysis for ConvergeRequest {
         &self,
         model: &Resolved,
         runs: &Self::Output,
-        _: &Value,
-        _: report::TextUnits,
-    ) -> Result<report::Presentation, SimError> {
-        Ok(super::present::converge::converge(&model.params, runs))
-    }
-    fn present_to(
-        &self,
-        model: &Resolved,
-        runs: &Self::Output,
         document: &Value,
-        units: report::TextUnits,
+        _: report::TextUnits,
         to: Destination<'_>,
     ) -> Result<report::Presentation, SimError> {
-        let mut shown = self.present(model, runs, document, units)?;
+        let mut shown = super::present::converge::converge(&model.params, runs);
+        // the printed document names the output directory
         if let Some(dir) = to.dir {
             let mut document = document.clone();
             document["out"] = serde_json::json!(dir);
             shown.document = Some(document);
         }
-        to.keep(&mut shown);
         Ok(shown)
     }
 }

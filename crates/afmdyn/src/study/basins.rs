@@ -150,29 +150,17 @@ impl Analysis for BasinsRequest {
         map: &BasinMap,
         document: &Value,
         _: crate::report::TextUnits,
-    ) -> Result<crate::report::Presentation, SimError> {
-        let spec = self.spec(&model.params)?;
-        crate::request::present::maps::basins(&spec, map, document)
-    }
-    fn present_to(
-        &self,
-        model: &Resolved,
-        map: &BasinMap,
-        document: &Value,
-        units: crate::report::TextUnits,
         to: crate::request::Destination<'_>,
     ) -> Result<crate::report::Presentation, SimError> {
-        // the document (basins.json too) names the files written
+        let spec = self.spec(&model.params)?;
         let Some(dir) = to.dir else {
-            let mut shown = self.present(model, map, document, units)?;
-            to.keep(&mut shown);
-            return Ok(shown);
+            return crate::request::present::maps::basins(&spec, map, document);
         };
+        // the document (basins.json too) names the files written
         let mut document = document.clone();
         document["csv"] = serde_json::json!(dir.join("basins.csv"));
         document["netcdf"] = serde_json::json!(dir.join("basins.nc"));
-        let mut shown = self.present(model, map, &document, units)?;
-        to.keep(&mut shown);
+        let mut shown = crate::request::present::maps::basins(&spec, map, &document)?;
         shown.document = Some(document);
         shown.outputs_note = crate::report::OutputsNote::Tail;
         Ok(shown)

@@ -81,21 +81,12 @@ impl Analysis for Chart {
         &self,
         _: &Resolved,
         cells: &Vec<ChartCell>,
-        _: &Value,
-        _: crate::report::TextUnits,
-    ) -> Result<crate::report::Presentation, SimError> {
-        Ok(crate::request::present::maps::chart(self, cells))
-    }
-    fn present_to(
-        &self,
-        _: &Resolved,
-        cells: &Vec<ChartCell>,
         document: &Value,
         _: crate::report::TextUnits,
         to: crate::request::Destination<'_>,
     ) -> Result<crate::report::Presentation, SimError> {
         let mut shown = crate::request::present::maps::chart(self, cells);
-        to.keep(&mut shown);
+        // the printed document names the files written
         if let Some(dir) = to.dir {
             let mut document = document.clone();
             document["files"] = serde_json::json!({

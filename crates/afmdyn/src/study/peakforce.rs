@@ -231,22 +231,6 @@ impl Analysis for PeakForceRequest {
         _: &PeakForceResult,
         document: &Value,
         units: crate::report::TextUnits,
-    ) -> Result<crate::report::Presentation, SimError> {
-        let mut document = document.clone();
-        let files = crate::request::present::Files::All;
-        Ok(crate::request::present::peakforce::peakforce(
-            &mut document,
-            units,
-            files,
-            None,
-        ))
-    }
-    fn present_to(
-        &self,
-        _: &Resolved,
-        _: &PeakForceResult,
-        document: &Value,
-        units: crate::report::TextUnits,
         to: crate::request::Destination<'_>,
     ) -> Result<crate::report::Presentation, SimError> {
         let mut document = document.clone();

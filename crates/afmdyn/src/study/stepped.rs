@@ -23,7 +23,7 @@ use crate::params::Params;
 use crate::report;
 use crate::request::costs::{check_cost, stepped_cost};
 use crate::request::limits::Cost;
-use crate::request::present::curves::{stepped, CurveKind, CurveOptions};
+use crate::request::present::curves::{stepped, CurveKind};
 use crate::request::run::{Analysis, ApproachRequest, Destination, Resolved, ResonanceRequest};
 use serde::Serialize;
 use serde_json::{json, Value};
@@ -170,16 +170,6 @@ macro_rules! present_curve {
             c: &Self::Output,
             document: &Value,
             units: report::TextUnits,
-        ) -> Result<report::Presentation, SimError> {
-            let options = CurveOptions::all(self.name());
-            Ok(stepped($kind, model, c, document, units, &options))
-        }
-        fn present_to(
-            &self,
-            model: &Resolved,
-            c: &Self::Output,
-            document: &Value,
-            units: report::TextUnits,
             to: Destination<'_>,
         ) -> Result<report::Presentation, SimError> {
             Ok(stepped(
@@ -229,64 +219,6 @@ impl Analysis for ApproachRequest {
         Some(c.largest_indentation())
     }
     present_curve!(CurveKind::Approach);
-}
-
-/// `bimodal`: the approach curve of a drive with two or more components
-/// ([`crate::request::curves::check_bimodal`]), its files named `bimodal`; its refusals name
-/// the approach curve it is.
-#[derive(Debug, Clone)]
-pub struct Bimodal(pub ApproachRequest);
-
-impl Analysis for Bimodal {
-    type Output = SteppedCurve;
-    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
-        crate::request::curves::check_bimodal(&model.params)?;
-        self.0.validate(model)
-    }
-    fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
-        crate::request::curves::check_bimodal(&model.params)?;
-        self.0.execute(model, progress)
-    }
-    fn name(&self) -> &'static str {
-        self.0.name()
-    }
-    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
-        self.0.cost(model)
-    }
-    fn report(&self, model: &Resolved, c: &Self::Output) -> Result<Value, SimError> {
-        self.0.report(model, c)
-    }
-    fn largest_indentation(&self, c: &Self::Output) -> Option<f64> {
-        self.0.largest_indentation(c)
-    }
-    fn present_to(
-        &self,
-        model: &Resolved,
-        c: &Self::Output,
-        document: &Value,
-        units: report::TextUnits,
-        to: Destination<'_>,
-    ) -> Result<report::Presentation, SimError> {
-        let options = to.curve("bimodal");
-        Ok(stepped(
-            CurveKind::Approach,
-            model,
-            c,
-            document,
-            units,
-            &options,
-        ))
-    }
-}
-
-impl crate::request::Datasets for Bimodal {
-    fn datasets(
-        &self,
-        model: &Resolved,
-        c: &Self::Output,
-    ) -> Result<crate::request::named::Arrays, SimError> {
-        self.0.datasets(model, c)
-    }
 }
 
 impl Analysis for ResonanceRequest {

@@ -12,16 +12,18 @@ use super::chart::cells_of;
 use super::chart_store::chart_store;
 use super::global_continuation::{continuation_store, ContinuationStudy};
 use super::scan_store::scan_store;
-use super::stepped::{curve_store, Bimodal, CurveStudy};
+use super::stepped::{curve_store, CurveStudy};
 use super::sweep::SweepStudy;
 use super::task_store::{StoredTasks, TaskStore};
 use super::{execute, MemoryStore, Observer, Study, StudyError};
 use crate::analysis::bifurcation::SweepSpec;
 use crate::analysis::progress::Progress;
+use crate::analysis::stepped::SteppedCurve;
 use crate::error::SimError;
 use crate::request::chart::Chart;
 use crate::request::checkpoint::CheckpointError;
 use crate::request::checkpoint_file::each_row;
+use crate::request::curves::Bimodal;
 use crate::request::image_job::{ImageJob, ImageOutput};
 use crate::request::image_scan::ScanStudy;
 use crate::request::named::{self, Datasets, Outcome};
@@ -149,7 +151,7 @@ impl<'a> Storage<'a> {
 }
 
 /// A request whose study runs resumably into a store ([`Storage`]) to the request's typed
-/// output, which its [`Analysis::present_to`] presents.
+/// output, which its [`Analysis::present`] presents.
 pub trait Resumable: Analysis {
     /// The study, made on the model before any side effect.
     type Study: Send + Sync;
@@ -185,6 +187,16 @@ pub struct Failure {
     pub with_document: bool,
 }
 
+/// A stepped curve's points run into the curve store, then its branches.
+fn curve(
+    study: &CurveStudy,
+    storage: Storage<'_>,
+    progress: &Progress,
+) -> Result<SteppedCurve, StudyError> {
+    let records = storage.records(study, curve_store, None, progress)?;
+    Ok(study.curve(records, progress)?)
+}
+
 impl Resumable for ApproachRequest {
     type Study = CurveStudy;
     fn study(&self, model: &Resolved) -> Result<CurveStudy, SimError> {
@@ -197,8 +209,7 @@ impl Resumable for ApproachRequest {
         storage: Storage<'_>,
         progress: &Progress,
     ) -> Result<Self::Output, StudyError> {
-        let records = storage.records(study, curve_store, None, progress)?;
-        Ok(study.curve(records, progress)?)
+        curve(study, storage, progress)
     }
 }
 
@@ -211,11 +222,11 @@ impl Resumable for Bimodal {
     fn resume(
         &self,
         study: &CurveStudy,
-        model: &Resolved,
+        _: &Resolved,
         storage: Storage<'_>,
         progress: &Progress,
     ) -> Result<Self::Output, StudyError> {
-        self.0.resume(study, model, storage, progress)
+        curve(study, storage, progress)
     }
 }
 
@@ -231,8 +242,7 @@ impl Resumable for ResonanceRequest {
         storage: Storage<'_>,
         progress: &Progress,
     ) -> Result<Self::Output, StudyError> {
-        let records = storage.records(study, curve_store, None, progress)?;
-        Ok(study.curve(records, progress)?)
+        curve(study, storage, progress)
     }
 }
 
@@ -359,6 +369,7 @@ impl Analysis for SweepInto {
         files: &SweepFiles,
         _: &Value,
         _: crate::report::TextUnits,
+        _: crate::request::Destination<'_>,
     ) -> Result<crate::report::Presentation, SimError> {
         Ok(stored_bifurcation(files, self.0.param))
     }
