@@ -151,7 +151,7 @@ pub struct FileCheckpoint<'a> {
 ///
 /// # Errors
 /// As said.
-pub fn each_row<E: From<CheckpointError>>(
+pub(crate) fn each_row<E: From<CheckpointError>>(
     path: &Path,
     each: &mut dyn FnMut(&csv::StringRecord) -> Result<(), E>,
 ) -> Result<(), E> {
