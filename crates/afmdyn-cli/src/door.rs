@@ -1,8 +1,11 @@
-//! The one door of the command line: a request is validated and held to the budgets, its
-//! `--out` directory locked, it runs with a progress bar ([`progress::run`]), and its presentation
-//! ([`afmdyn::report::Presentation`], built by the library) is written: the document's
-//! warnings on stderr, every file into the directory (CSV, NetCDF, JSON, figures through the
-//! one plotting module), then the JSON document (`--json`) or the text summary on stdout.
+//! The one door of the command line, for every subcommand: a request is validated and held
+//! to the budgets (admitted once), its `--out` directory locked, it runs with a progress bar
+//! ([`run`]; a study resumably into the directory's store, [`run_stored`]: the library's
+//! [`afmdyn::study::stored::Resumable`], `--resume` and `--abort-after` included), and its
+//! presentation ([`afmdyn::report::Presentation`], built by the library for the destination)
+//! is written: its warnings and the document's on stderr, every file into the directory (CSV,
+//! NetCDF, JSON, figures through the one plotting module), then the JSON document (`--json`)
+//! or the text summary on stdout.
 
 use crate::error::study_error;
 use crate::error::CliError;
