@@ -1,23 +1,14 @@
 //! `afmdyn bifurcation` and `afmdyn attractors`.
 
 use crate::args::ModelArgs;
-use crate::error::{store_error, study_error, CliError};
+use crate::door::{self, Exit, Resume};
+use crate::error::CliError;
 use crate::flags::{AttractorsFlags, AttractorsSweepFlags, BifurcationFlags};
-use crate::output::{io_error, units_of, OutDir};
-use crate::plot::{save_scatter_stream, ChunkSink};
-use afmdyn::request::present::census::failed_starts;
-use afmdyn::request::present::sweeps::{
-    branch_legend, diagram_point, SweepRow, SweepTally, BIFURCATION_FIGURES,
-};
-use afmdyn::request::Analysis;
-use afmdyn::request::{Document, Resolved};
-use afmdyn::request::{FileCheckpoint, GlobalContinuationRequest};
-use afmdyn::request::{Params, SweepParam};
-use afmdyn::study::global_continuation::{continuation_store, ContinuationStudy};
-use afmdyn::study::sweep::SweepStudy;
+use afmdyn::request::GlobalContinuationRequest;
+use afmdyn::request::{Params, Resolved, SweepParam};
+use afmdyn::study::stored::SweepInto;
 use clap::Args;
-use serde_json::json;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// `afmdyn bifurcation` flags.
 #[derive(Debug, Args)]
@@ -44,108 +35,24 @@ pub struct BifurcationArgs {
 /// Column positions in the library's sweep records (also read by `afmdyn continue --overlay`).
 pub(crate) use afmdyn::request::sweep::{COL_VALUE, COL_W_TIP};
 
-/// Each row of the store's CSV `path`, read back through the bounded reader as a store file.
-fn read_rows(
-    path: &Path,
-    each: &mut dyn FnMut(&csv::StringRecord) -> Result<(), String>,
-) -> Result<(), CliError> {
-    // a refusal of the bounded reader (past the cap, not a store's CSV) is the input's fault:
-    // exit code 2, the store left as it is
-    let refused = |e: afmdyn::io::InputFileError| match e {
-        afmdyn::io::InputFileError::Io { message, .. } => io_error("read", path, message),
-        e => CliError::Input(format!("{e}; rerun without --resume to start over")),
-    };
-    let rd = |e: csv::Error| {
-        if let csv::ErrorKind::Io(io) = e.kind() {
-            if let Some(r) = afmdyn::io::refusal(io) {
-                return refused(r.clone());
-            }
-        }
-        io_error("read", path, e)
-    };
-    let file = afmdyn::io::open(path, afmdyn::io::InputKind::Store).map_err(refused)?;
-    let mut rd_csv = csv::Reader::from_reader(file);
-    for r in rd_csv.records() {
-        let r = r.map_err(rd)?;
-        each(&r).map_err(CliError::Io)?;
-    }
-    Ok(())
-}
-
-/// Run `afmdyn bifurcation`: its cost checked by the library, the sweep run resumably into
-/// the store in `--out`, the diagrams streamed from the store's CSV.
+/// Run `afmdyn bifurcation` through the door: its cost checked by the library, the sweep run
+/// resumably into the store in `--out`, its diagrams streamed from the store's CSV by the
+/// library's presentation.
 pub fn bifurcation(a: &BifurcationArgs) -> Result<(), CliError> {
-    let (base, probe) = a.model.resolve(Params::default())?;
-    let request = a.request.request();
-    let spec = request
-        .spec(&base)
-        .map_err(|e| CliError::Input(crate::error::spell(&e)))?;
-    afmdyn::request::admit(&request, &Resolved::plain(base))?;
-    let out = OutDir::lock(&a.out)?;
-    let mut store = FileCheckpoint::new(out.dir_lock());
-    let final_csv = store.final_csv();
-    let study = SweepStudy::new(&request, spec.clone());
-    crate::progress::study(
-        &study,
-        &mut store,
-        a.resume,
-        request.threads,
-        "points",
-        a.abort_after,
-    )
-    .map_err(|e| study_error(e, "sweep"))?;
-    // derived files, streamed from the finished CSV
-    let mut tally = SweepTally::default();
-    read_rows(&final_csv, &mut |r| {
-        tally.add_row(SweepRow::from_csv(r));
-        Ok(())
-    })?;
-    let npy = store.write_npy(request.param)?;
-    let branches = branch_legend(spec.continuation, spec.starts);
-    for (stem, col, title, ylab, by_branch) in BIFURCATION_FIGURES {
-        let feed = |draw: &mut ChunkSink<'_>| -> Result<(), CliError> {
-            let mut chunk = Vec::with_capacity(4096);
-            read_rows(&final_csv, &mut |r| {
-                chunk.extend(diagram_point(SweepRow::from_csv(r), col, by_branch));
-                if chunk.len() == chunk.capacity() {
-                    draw(&chunk)?;
-                    chunk.clear();
-                }
-                Ok(())
-            })?;
-            draw(&chunk).map_err(CliError::Io)
-        };
-        let legend = if by_branch {
-            branches.clone()
-        } else {
-            tally.legend()
-        };
-        let x_label = format!("{} ({})", request.param.symbol(), request.param.name());
-        let (bounds, labels) = (tally.bounds(col), (x_label.as_str(), ylab));
-        save_scatter_stream(out.path(), stem, title, labels, bounds, &legend, &feed)?;
-    }
-    let mut summary = tally.document(&base, request.param, spec.values.len());
-    summary["csv"] = json!(final_csv);
-    summary["npy"] = json!(npy);
-    summary = afmdyn::report::with_si(summary, probe.as_ref(), &base);
-    // the exit-code rule (docs/outputs.md): failed points are reported on stderr too, and a
-    // sweep with no point computed has no answer (exit 1)
-    if let Some(e) = tally.failure() {
-        if a.json {
-            outln!("{summary}");
-        }
-        return Err(CliError::Sim(e));
-    }
-    if let Some(w) = tally.warning() {
-        errln!("afmdyn: warning: {w}");
-    }
-    if a.json {
-        outln!("{summary}");
-    } else {
-        let line = tally.summary(spec.values.len(), request.param);
-        outln!("{line}; outputs in {}", out.path().display());
-    }
-    Ok(())
+    let (params, probe) = a.model.resolve(Params::default())?;
+    let exit = Exit {
+        json: a.json,
+        out: Some(&a.out),
+        unit: "points",
+        ..Exit::default()
+    };
+    let how = Resume {
+        resume: a.resume,
+        abort_after: a.abort_after,
+        what: "sweep",
+    };
+    let request = SweepInto(a.request.request());
+    door::run_stored(&request, &Resolved { params, probe }, exit, how)
 }
 
 /// `afmdyn attractors` flags.
@@ -189,50 +96,32 @@ pub fn attractors(a: &AttractorsArgs) -> Result<(), CliError> {
     let (params, probe) = a.model.resolve(Params::default())?;
     let model = Resolved { params, probe };
     let request = a.request.request();
-    if let Some(param) = a.sweep {
-        let sweep = GlobalContinuationRequest {
-            param,
-            values: None,
-            from: a.from.unwrap_or(f64::NAN),
-            to: a.to.unwrap_or(f64::NAN),
-            steps: a.sweep_flags.steps,
-            match_tol: a.sweep_flags.match_tol,
-            samples: request.samples,
-            seed: request.seed,
-            cluster_tol: request.cluster_tol,
-            steady: request.steady,
-            integrator: request.integrator,
-        };
-        return attractors_sweep(a, &sweep, &model);
-    }
-    request.validate(&model)?;
-    let out = OutDir::lock(&a.out)?;
-    let Document { output, json } = crate::progress::run(&request, &model, "starts")?;
-    let shown = request.present(&model, &output, &json, units_of(model.probe.as_ref()))?;
-    if let Some(w) = failed_starts(&output, request.samples) {
-        errln!("afmdyn: warning: {w}");
-    }
-    crate::door::emit(Some(&out), &shown, &json, a.json)
-}
-
-/// `afmdyn attractors --sweep`: the global continuation run resumably into the store in
-/// `--out`, presented by the library.
-fn attractors_sweep(
-    a: &AttractorsArgs,
-    request: &GlobalContinuationRequest,
-    model: &Resolved,
-) -> Result<(), CliError> {
-    let study = ContinuationStudy::new(request, &model.params)?;
-    afmdyn::request::admit(request, model)?;
-    let out = OutDir::lock(&a.out)?;
-    let mut store = continuation_store(out.dir_lock());
-    crate::progress::study(&study, &mut store, a.resume, None, "starts", a.abort_after)
-        .map_err(|e| study_error(e, "attractors --sweep"))?;
-    let records = store
-        .records()
-        .map_err(|e| store_error(e, "attractors --sweep"))?;
-    let steps = study.steps(records)?;
-    let doc = afmdyn::request::run::document(request, model, &steps)?;
-    let shown = request.present(model, &steps, &doc, units_of(model.probe.as_ref()))?;
-    crate::door::emit(Some(&out), &shown, &doc, a.json)
+    let exit = Exit {
+        json: a.json,
+        out: Some(&a.out),
+        unit: "starts",
+        ..Exit::default()
+    };
+    let Some(param) = a.sweep else {
+        return door::run(&request, &model, exit).map(drop);
+    };
+    let sweep = GlobalContinuationRequest {
+        param,
+        values: None,
+        from: a.from.unwrap_or(f64::NAN),
+        to: a.to.unwrap_or(f64::NAN),
+        steps: a.sweep_flags.steps,
+        match_tol: a.sweep_flags.match_tol,
+        samples: request.samples,
+        seed: request.seed,
+        cluster_tol: request.cluster_tol,
+        steady: request.steady,
+        integrator: request.integrator,
+    };
+    let how = Resume {
+        resume: a.resume,
+        abort_after: a.abort_after,
+        what: "attractors --sweep",
+    };
+    door::run_stored(&sweep, &model, exit, how)
 }

@@ -6,17 +6,15 @@
 
 use crate::args::ModelArgs;
 use crate::cmd_simulate::Files;
-use crate::door;
+use crate::door::{self, Exit, Resume};
 use crate::error::CliError;
 use crate::flags::{ApproachFlags, BimodalFlags, ResonanceFlags};
-use crate::output::{units_of, OutDir};
-use afmdyn::error::SimError;
+use afmdyn::request::curves::Bimodal;
 use afmdyn::request::present;
-use afmdyn::request::present::curves::{stepped, CurveKind, CurveOptions};
 use afmdyn::request::Params;
 use afmdyn::request::SteppedCurve;
-use afmdyn::request::{Analysis, CurveRequest, Resolved};
-use afmdyn::study::stepped::{curve_store, CurveStudy};
+use afmdyn::request::{CurveRequest, Resolved};
+use afmdyn::study::stored::Resumable;
 use clap::Args;
 use std::path::{Path, PathBuf};
 
@@ -97,60 +95,35 @@ pub(crate) fn files(f: Files) -> present::Files {
     }
 }
 
-/// Lock the output directory, run the curve (resumable into its store, without files in
-/// memory), then write the library's presentation through the door.
-fn go<A: Analysis<Output = SteppedCurve>>(
+/// Run the curve through the door: resumable into the store of the output directory, or in
+/// memory without files (nothing to resume from).
+fn go<A: Resumable<Output = SteppedCurve>>(
     args: &CurveArgs,
     (out, stem): (&Path, &'static str),
     request: &A,
     model: &Resolved,
-    study: impl FnOnce() -> Result<CurveStudy, SimError>,
-    kind: CurveKind,
 ) -> Result<(), CliError> {
-    request.validate(model)?;
-    let out = (args.files != Files::None)
-        .then(|| OutDir::lock(out))
-        .transpose()?;
-    let (c, json) = match &out {
-        // no files: nothing to resume from
-        None if args.resume => {
-            return Err(CliError::Input(
-                "--resume: --files none keeps no store to resume; use --files data or all".into(),
-            ))
-        }
-        None => {
-            let d = crate::progress::run(request, model, "points")?;
-            (d.output, d.json)
-        }
-        Some(o) => {
-            // the points in the directory's store, resumable; the branches after them
-            let study = study()?;
-            let mut store = curve_store(o.dir_lock());
-            crate::progress::study(
-                &study,
-                &mut store,
-                args.resume,
-                None,
-                "points",
-                args.abort_after,
-            )
-            .map_err(|e| crate::error::study_error(e, stem))?;
-            let records = store
-                .records()
-                .map_err(|e| crate::error::store_error(e, stem))?;
-            let c = crate::progress::with_bar("branch points", |p| study.curve(records, p))?;
-            let json = afmdyn::request::run::document(request, model, &c)?;
-            (c, json)
-        }
-    };
-    let options = CurveOptions {
-        stem,
+    let exit = Exit {
+        json: args.json,
+        out: (args.files != Files::None).then_some(out),
         files: files(args.files),
+        unit: "points",
         dforce_columns: args.dforce_columns,
     };
-    let units = units_of(model.probe.as_ref());
-    let shown = stepped(kind, model, &c, &json, units, &options);
-    door::emit(out.as_ref(), &shown, &json, args.json)
+    if exit.out.is_none() {
+        if args.resume {
+            return Err(CliError::Input(
+                "--resume: --files none keeps no store to resume; use --files data or all".into(),
+            ));
+        }
+        return door::run(request, model, exit).map(drop);
+    }
+    let how = Resume {
+        resume: args.resume,
+        abort_after: args.abort_after,
+        what: stem,
+    };
+    door::run_stored(request, model, exit, how)
 }
 
 /// The model of the flags, with the request's `--from`/`--to` checked finite.
@@ -174,27 +147,20 @@ fn check_finite(name: &str, v: Option<f64>) -> Result<(), CliError> {
 pub fn approach(a: &ApproachArgs) -> Result<(), CliError> {
     let request = a.request.request(a.model.probe.is_some())?;
     let model = setup(&a.model, &request.curve)?;
-    let study = || CurveStudy::approach(&request, &model);
-    let out = (a.out.as_path(), "approach");
-    go(&a.curve, out, &request, &model, study, CurveKind::Approach)
+    go(&a.curve, (&a.out, "approach"), &request, &model)
 }
 
 /// Run `afmdyn bimodal`: the approach curve of a multifrequency drive
 /// ([`afmdyn::request::curves::check_bimodal`]), its files `bimodal.*`.
 pub fn bimodal(a: &BimodalArgs) -> Result<(), CliError> {
-    let request = a.request.request(a.model.probe.is_some())?;
-    let model = setup(&a.model, &request.curve)?;
-    afmdyn::request::curves::check_bimodal(&model.params)?;
-    let study = || CurveStudy::approach(&request, &model);
-    let out = (a.out.as_path(), "bimodal");
-    go(&a.curve, out, &request, &model, study, CurveKind::Approach)
+    let request = Bimodal(a.request.request(a.model.probe.is_some())?);
+    let model = setup(&a.model, &request.0.curve)?;
+    go(&a.curve, (&a.out, "bimodal"), &request, &model)
 }
 
 /// Run `afmdyn resonance`.
 pub fn resonance(a: &ResonanceArgs) -> Result<(), CliError> {
     let request = a.request.request(a.model.probe.is_some())?;
     let model = setup(&a.model, &request.curve)?;
-    let study = || CurveStudy::resonance(&request, &model);
-    let out = (a.out.as_path(), "resonance");
-    go(&a.curve, out, &request, &model, study, CurveKind::Resonance)
+    go(&a.curve, (&a.out, "resonance"), &request, &model)
 }

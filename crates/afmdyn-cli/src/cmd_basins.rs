@@ -5,12 +5,11 @@
 
 use crate::args::ModelArgs;
 use crate::cmd_simulate::parse_modal_state;
+use crate::door::{self, Exit, Resume};
 use crate::error::CliError;
 use crate::flags::BasinsFlags;
-use crate::output::OutDir;
 use afmdyn::request::Params;
-use afmdyn::request::{Analysis, Resolved};
-use afmdyn::study::basins::{basin_store, BasinStudy};
+use afmdyn::request::Resolved;
 use clap::Args;
 use std::path::PathBuf;
 
@@ -41,34 +40,20 @@ pub struct BasinsArgs {
 
 /// Run `afmdyn basins`.
 pub fn basins_cmd(a: &BasinsArgs) -> Result<(), CliError> {
-    let (p, probe) = a.model.resolve(Params::default())?;
+    let (params, probe) = a.model.resolve(Params::default())?;
     let request = a
         .request
-        .request(parse_modal_state("base", &a.base, p.modes)?);
-    let study = BasinStudy::new(&request, &p)?;
-    let out = OutDir::lock(&a.out)?;
-    let mut store = basin_store(out.dir_lock());
-    let failed = |e| crate::error::study_error(e, "basins");
-    crate::progress::study(
-        &study,
-        &mut store,
-        a.resume,
-        request.threads,
-        "starts",
-        a.abort_after,
-    )
-    .map_err(failed)?;
-    let rows = store
-        .records()
-        .map_err(|e| crate::error::store_error(e, "basins"))?;
-    let map = afmdyn::request::in_pool(request.threads, || {
-        study.map(rows.into_iter().map(|(_, r)| r))
-    })?;
-    let resolved = Resolved { params: p, probe };
-    let mut doc = afmdyn::request::run::document(&request, &resolved, &map)?;
-    doc["csv"] = serde_json::json!(out.join("basins.csv"));
-    doc["netcdf"] = serde_json::json!(out.join("basins.nc"));
-    let units = crate::output::units_of(resolved.probe.as_ref());
-    let shown = request.present(&resolved, &map, &doc, units)?;
-    crate::door::emit_as(Some(&out), &shown, &doc, a.json, true)
+        .request(parse_modal_state("base", &a.base, params.modes)?);
+    let exit = Exit {
+        json: a.json,
+        out: Some(&a.out),
+        unit: "starts",
+        ..Exit::default()
+    };
+    let how = Resume {
+        resume: a.resume,
+        abort_after: a.abort_after,
+        what: "basins",
+    };
+    door::run_stored(&request, &Resolved { params, probe }, exit, how)
 }

@@ -6,14 +6,11 @@
 //! maps.
 
 use crate::args::{Dim, ModelArgs, Quantity};
+use crate::door::{self, Exit, Resume};
 use crate::error::CliError;
 use crate::flags::ChartFlags;
-use crate::output::OutDir;
-use afmdyn::request::chart::{axis_name, axis_unit, document};
-use afmdyn::request::present;
-use afmdyn::request::Params;
-use afmdyn::study::chart::every_cell_failed;
-use afmdyn::study::chart_store::{cells, chart_store};
+use afmdyn::request::chart::{axis_name, axis_unit};
+use afmdyn::request::{Params, Resolved};
 use clap::Args;
 use std::path::PathBuf;
 
@@ -62,7 +59,8 @@ fn axis_value(q: Quantity, flag: &str, axis: &str) -> Result<f64, CliError> {
     }
 }
 
-/// Run `afmdyn chart`.
+/// Run `afmdyn chart`: the chart the library builds from the flags (validated, held to the
+/// budgets), run through the door resumably into the store in `--out`.
 pub fn chart(a: &ChartArgs) -> Result<(), CliError> {
     let (spec, probe) = a.model.spec_and_probe()?;
     // the chart reads the probe file's text: an axis may be one of its values
@@ -74,27 +72,18 @@ pub fn chart(a: &ChartArgs) -> Result<(), CliError> {
     let chart = request
         .chart(spec, Params::default(), probe_text.as_deref())
         .map_err(|e| CliError::Input(crate::error::spell(&e)))?;
-    let out = OutDir::lock(&a.out)?;
-    let mut store = chart_store(out.dir_lock());
-    crate::progress::study(
-        &chart,
-        &mut store,
-        a.resume,
-        request.threads,
-        "cells",
-        a.abort_after,
-    )
-    .map_err(|e| crate::error::study_error(e, "chart"))?;
-    let cells = cells(&mut store).map_err(|e| crate::error::store_error(e, "chart"))?;
-    let shown = present::maps::chart(&chart, &cells);
-    if let Some(e) = every_cell_failed(&cells) {
-        crate::door::write_files(&out, &shown)?;
-        return Err(CliError::Sim(e));
-    }
-    let mut doc = document(&chart, &cells);
-    doc["files"] = serde_json::json!({
-        "csv": out.join("chart.csv"),
-        "netcdf": out.join("chart.nc"),
-    });
-    crate::door::emit_as(Some(&out), &shown, &doc, a.json, true)
+    let exit = Exit {
+        json: a.json,
+        out: Some(&a.out),
+        unit: "cells",
+        ..Exit::default()
+    };
+    let how = Resume {
+        resume: a.resume,
+        abort_after: a.abort_after,
+        what: "chart",
+    };
+    // the chart's model is its own: the one given is not read
+    let model = Resolved::plain(Params::default());
+    door::run_stored(&chart, &model, exit, how)
 }

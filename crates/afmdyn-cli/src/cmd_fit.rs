@@ -48,6 +48,7 @@ pub fn fit(a: &FitArgs) -> Result<(), CliError> {
         out: (a.files != Files::None).then_some(a.out.as_path()),
         files: files(a.files),
         unit: "model evaluations",
+        ..door::Exit::default()
     };
     door::run(&request, &model, exit).map(|_| ())
 }

@@ -8,13 +8,10 @@
 use crate::args::ModelArgs;
 use crate::cmd_approach::files;
 use crate::cmd_simulate::Files;
-use crate::door;
+use crate::door::{self, Exit};
 use crate::error::CliError;
 use crate::flags::FmFlags;
-use crate::output::{units_of, OutDir};
-use afmdyn::request::present;
-use afmdyn::request::Params;
-use afmdyn::request::{self, Resolved};
+use afmdyn::request::{Params, Resolved};
 use clap::Args;
 use std::path::PathBuf;
 
@@ -36,18 +33,16 @@ pub struct FmArgs {
     json: bool,
 }
 
-/// Run `afmdyn fm`.
+/// Run `afmdyn fm` through the door.
 pub fn fm(a: &FmArgs) -> Result<(), CliError> {
     let (params, probe) = a.model.resolve(Params::default())?;
     let request = a.request.request(a.model.probe.is_some())?;
-    let model = Resolved { params, probe };
-    request::Analysis::validate(&request, &model)?;
-    let out = (a.files != Files::None)
-        .then(|| OutDir::lock(&a.out))
-        .transpose()?;
-    let mut doc = crate::progress::run(&request, &model, "z_c values")?.json;
-    let units = units_of(model.probe.as_ref());
-    let dir = out.as_ref().map(OutDir::path);
-    let shown = present::fm::fm(&mut doc, units, files(a.files), dir);
-    door::emit(out.as_ref(), &shown, &doc, a.json)
+    let exit = Exit {
+        json: a.json,
+        out: (a.files != Files::None).then_some(a.out.as_path()),
+        files: files(a.files),
+        unit: "z_c values",
+        ..Exit::default()
+    };
+    door::run(&request, &Resolved { params, probe }, exit).map(drop)
 }

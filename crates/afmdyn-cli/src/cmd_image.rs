@@ -10,14 +10,12 @@
 use crate::args::Dim;
 use crate::cmd_approach::files;
 use crate::cmd_simulate::Files;
-use crate::door::{self, Exit};
+use crate::door::{self, Exit, Resume};
 use crate::error::CliError;
 use crate::flags_afm::{ImageFlags, ImageOptionsFlags, PiScanFlags};
-use crate::output::{units_of, OutDir};
 use afmdyn::request::image::SampleMap;
 use afmdyn::request::image_job::{ImageJob, ImageMode};
 use afmdyn::request::image_options::ImageFeedback;
-use afmdyn::request::Analysis;
 use clap::Args;
 use std::path::PathBuf;
 
@@ -128,56 +126,33 @@ pub fn image_cmd(a: &ImageArgs) -> Result<(), CliError> {
         feedback: pi,
         study,
         threads: options.threads,
-        files: files(a.files),
     };
     let model = job.model()?;
     let out = (a.files != Files::None).then_some(a.out.as_path());
+    let exit = Exit {
+        json: a.json,
+        out,
+        files: files(a.files),
+        unit: if job.feedback.is_some() || mode == ImageMode::Peakforce {
+            "lines"
+        } else {
+            "points"
+        },
+        ..Exit::default()
+    };
     if job.feedback.is_none() || out.is_none() {
         if a.resume {
             return Err(CliError::Input(
                 "--resume: --files none keeps no store to resume; use --files data or all".into(),
             ));
         }
-        let exit = Exit {
-            files: Default::default(),
-            json: a.json,
-            out,
-            unit: if job.feedback.is_some() || mode == ImageMode::Peakforce {
-                "lines"
-            } else {
-                "points"
-            },
-        };
         return door::run(&job, &model, exit).map(|_| ());
     }
-    pi_cmd(a, &job, &model)
-}
-
-/// `afmdyn image --feedback pi` with files: the scan's lines as a study on the worker threads
-/// in the output directory's store (resumable), then its presentation.
-fn pi_cmd(
-    a: &ImageArgs,
-    job: &ImageJob,
-    model: &afmdyn::request::Resolved,
-) -> Result<(), CliError> {
-    afmdyn::request::run::admit(job, model)?;
-    let out = OutDir::lock(&a.out)?;
-    let study = job.scan_study()?.expect("a PI scan");
-    let mut store = afmdyn::study::scan_store::scan_store(out.dir_lock());
-    crate::progress::study(
-        &study,
-        &mut store,
-        a.resume,
-        job.threads,
-        "lines",
-        a.abort_after,
-    )
-    .map_err(|e| crate::error::study_error(e, "image"))?;
-    let records = store
-        .records()
-        .map_err(|e| crate::error::store_error(e, "image"))?;
-    let output = afmdyn::request::image_job::ImageOutput::Pi(study.assemble(records)?);
-    let json = afmdyn::request::run::document(job, model, &output)?;
-    let shown = job.present(model, &output, &json, units_of(None))?;
-    door::emit(Some(&out), &shown, &json, a.json)
+    // a PI scan with files: its lines in the output directory's store (resumable)
+    let how = Resume {
+        resume: a.resume,
+        abort_after: a.abort_after,
+        what: "image",
+    };
+    door::run_stored(&job, &model, exit, how)
 }

@@ -32,10 +32,10 @@ pub fn modes(a: &ModesArgs) -> Result<(), CliError> {
         return fig3(a, &params);
     }
     let exit = Exit {
-        files: Default::default(),
         json: a.json,
         out: None,
         unit: "modes",
+        ..Exit::default()
     };
     door::run(&ModesRequest {}, &Resolved { params, probe }, exit).map(drop)
 }
@@ -46,10 +46,10 @@ fn fig3(a: &ModesArgs, p: &Params) -> Result<(), CliError> {
         out: a.out.display().to_string(),
     };
     let exit = Exit {
-        files: Default::default(),
         json: a.json,
         out: Some(&a.out),
         unit: "points",
+        ..Exit::default()
     };
     door::run(&request, &Resolved::plain(*p), exit).map(drop)
 }
@@ -117,10 +117,10 @@ pub fn units(a: &UnitsArgs) -> Result<(), CliError> {
 /// A command that writes no file and shows no progress: its document (`--json`) or summary.
 fn quiet(json: bool) -> Exit<'static> {
     Exit {
-        files: Default::default(),
         json,
         out: None,
         unit: "",
+        ..Exit::default()
     }
 }
 

@@ -52,10 +52,10 @@ pub fn orbit(a: &OrbitArgs) -> Result<(), CliError> {
     let (params, probe) = a.model.resolve(Params::default())?;
     let request = a.request.request(a.start.request(params.modes)?);
     let exit = Exit {
-        files: Default::default(),
         json: a.json,
         out: None,
         unit: "orbits",
+        ..Exit::default()
     };
     door::run(&request, &Resolved { params, probe }, exit).map(drop)
 }
@@ -128,10 +128,10 @@ pub fn continuation(a: &ContinueArgs) -> Result<(), CliError> {
         None => Vec::new(),
     };
     let exit = Exit {
-        files: Default::default(),
         json: a.json,
         out: Some(&a.out),
         unit: "branch points",
+        ..Exit::default()
     };
     // the sweep's points below the branches
     let decorate = |shown: &mut afmdyn::report::Presentation| {
@@ -178,10 +178,10 @@ pub fn lyapunov(a: &LyapunovArgs) -> Result<(), CliError> {
         .request
         .request(parse_initial(&a.initial_modal, params.modes)?);
     let exit = Exit {
-        files: Default::default(),
         json: a.json,
         out: None,
         unit: "periods",
+        ..Exit::default()
     };
     door::run(&request, &Resolved { params, probe }, exit).map(drop)
 }

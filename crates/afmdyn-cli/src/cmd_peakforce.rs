@@ -9,11 +9,9 @@
 use crate::args::{Dim, ModelArgs, Quantity};
 use crate::cmd_approach::files;
 use crate::cmd_simulate::Files;
-use crate::door;
+use crate::door::{self, Exit};
 use crate::error::CliError;
 use crate::flags::PeakForceFlags;
-use crate::output::{units_of, OutDir};
-use afmdyn::request::present;
 use afmdyn::request::Params;
 use afmdyn::request::{PeakForceSweep, PeakForceSweepParam, Resolved};
 use clap::Args;
@@ -85,20 +83,12 @@ pub fn peakforce(a: &PeakForceArgs) -> Result<(), CliError> {
         _ => None,
     };
     let request = a.request.request(si, sweep)?;
-    let model = Resolved { params, probe };
-    // the door's steps (validated and held to the budgets before --out is locked), with the
-    // library's presentation at the --files asked for
-    afmdyn::request::run::admit(&request, &model)?;
-    let out = (a.files != Files::None)
-        .then(|| OutDir::lock(&a.out))
-        .transpose()?;
-    let doc = crate::progress::run_admitted(&request, &model, "steady taps")?.json;
-    let dir = out.as_ref().map(OutDir::path);
-    let shown = present::peakforce::peakforce(
-        &mut doc.clone(),
-        units_of(model.probe.as_ref()),
-        files(a.files),
-        dir,
-    );
-    door::emit(out.as_ref(), &shown, &doc, a.json)
+    let exit = Exit {
+        json: a.json,
+        out: (a.files != Files::None).then_some(a.out.as_path()),
+        files: files(a.files),
+        unit: "steady taps",
+        ..Exit::default()
+    };
+    door::run(&request, &Resolved { params, probe }, exit).map(drop)
 }

@@ -8,15 +8,12 @@
 use crate::args::{named, quantity, Dim};
 use crate::cmd_approach::files;
 use crate::cmd_simulate::Files;
-use crate::door;
+use crate::door::{self, Exit};
 use crate::error::CliError;
 use crate::flags_afm::ReconstructFlags;
-use crate::output::{units_of, OutDir};
 use afmdyn::io::curve_file::{read_curve_file, read_document, CurveFile};
 use afmdyn::io::InputFileError;
-use afmdyn::request::present::reconstruct::{reconstruction, Inversion};
-use afmdyn::request::reconstruct::FmInversion;
-use afmdyn::request::Reconstruction;
+use afmdyn::request::reconstruct::{AmReconstruction, FmInversion};
 use afmdyn::request::{self, ReconstructRequest, Resolved};
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -123,13 +120,6 @@ fn request_of(a: &ReconstructArgs, fm: &Path) -> Result<ReconstructRequest, CliE
     })
 }
 
-/// The reconstruction of an AM document (`--am FILE`) and its JSON document.
-fn am_reconstruction(path: &Path) -> Result<(Reconstruction, serde_json::Value), CliError> {
-    let doc = read_document(path).map_err(input("--am"))?;
-    let d = request::reconstruct::am_reconstruction(&doc, &request::Progress::new())?;
-    Ok((d.output, d.json))
-}
-
 /// A library error with the cantilever's constants spelled as their flags
 /// (`--amplitude = 10: must be …`).
 fn flagged(e: afmdyn::error::SimError) -> CliError {
@@ -143,35 +133,30 @@ fn flagged(e: afmdyn::error::SimError) -> CliError {
     }
 }
 
-/// Run `afmdyn reconstruct`.
+/// Run `afmdyn reconstruct` through the door: the FM curve's request, or the AM document's.
 pub fn reconstruct(a: &ReconstructArgs) -> Result<(), CliError> {
-    let (r, mut json, law, how) = match (&a.am, &a.fm) {
+    // no model: the curve carries the cantilever's constants
+    let model = Resolved::plain(afmdyn::request::Params::default());
+    let exit = Exit {
+        json: a.json,
+        out: (a.files != Files::None).then_some(a.out.as_path()),
+        files: files(a.files),
+        unit: "distances",
+        ..Exit::default()
+    };
+    match (&a.am, &a.fm) {
         (Some(path), _) => {
-            let (r, json) = am_reconstruction(path)?;
-            (r, json, None, Inversion::AmMatrix)
+            let doc = read_document(path).map_err(input("--am"))?;
+            door::run(&AmReconstruction(doc), &model, exit).map(drop)
         }
         (None, Some(fm)) => {
             let request = request_of(a, fm)?;
-            let model = Resolved::plain(afmdyn::request::Params::default());
+            // the cantilever's constants refused naming their flags
             request::Analysis::validate(&request, &model).map_err(flagged)?;
-            let doc = request::run(&request, &model, &request::Progress::new())?;
-            let law = request.law_in_order();
-            let how = match request.inversion {
-                FmInversion::SaderJarvis => Inversion::SaderJarvis,
-                FmInversion::Exact => Inversion::Exact,
-            };
-            (doc.output, doc.json, law, how)
+            door::run(&request, &model, exit).map(drop)
         }
-        (None, None) => {
-            return Err(CliError::Input(
-                "give --fm FILE or --am FILE (the curve to invert)".into(),
-            ))
-        }
-    };
-    let out = (a.files != Files::None)
-        .then(|| OutDir::lock(&a.out))
-        .transpose()?;
-    let files = (files(a.files), out.as_ref().map(OutDir::path));
-    let shown = reconstruction(&r, how, law, &mut json, units_of(None), files);
-    door::emit(out.as_ref(), &shown, &json, a.json)
+        (None, None) => Err(CliError::Input(
+            "give --fm FILE or --am FILE (the curve to invert)".into(),
+        )),
+    }
 }

@@ -4,13 +4,10 @@ use crate::args::ModelArgs;
 use crate::door::{self, Exit};
 use crate::error::CliError;
 use crate::flags::{ConvergeFlags, SimulateFlags};
-use crate::output::{units_of, OutDir};
 use afmdyn::request::simulate_stream::SimulateStream;
-use afmdyn::request::Analysis;
 use afmdyn::request::Params;
-use afmdyn::request::{Document, Resolved};
+use afmdyn::request::Resolved;
 use clap::{Args, ValueEnum};
-use serde_json::json;
 use std::path::PathBuf;
 
 /// Which files a run writes.
@@ -122,10 +119,10 @@ pub fn simulate(a: &SimulateArgs) -> Result<(), CliError> {
         &run,
         &Resolved { params, probe },
         Exit {
-            files: Default::default(),
             json,
             out,
             unit,
+            ..Exit::default()
         },
     ) {
         Err(_) if crate::error::interrupted().is_err() => Err(CliError::Interrupted),
@@ -148,17 +145,16 @@ pub struct ConvergeArgs {
     json: bool,
 }
 
-/// Run `afmdyn converge`.
+/// Run `afmdyn converge` through the door.
 pub fn converge(a: &ConvergeArgs) -> Result<(), CliError> {
     let (params, probe) = a
         .model
         .resolve(afmdyn::request::analyses::converge_defaults())?;
-    let request = a.request.request();
-    let model = Resolved { params, probe };
-    request.validate()?;
-    let out = OutDir::lock(&a.out)?;
-    let Document { output, mut json } = crate::progress::run(&request, &model, "mode counts")?;
-    let shown = request.present(&model, &output, &json, units_of(model.probe.as_ref()))?;
-    json["out"] = json!(a.out);
-    crate::door::emit(Some(&out), &shown, &json, a.json)
+    let exit = Exit {
+        json: a.json,
+        out: Some(&a.out),
+        unit: "mode counts",
+        ..Exit::default()
+    };
+    door::run(&a.request.request(), &Resolved { params, probe }, exit).map(drop)
 }

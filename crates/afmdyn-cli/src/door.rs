@@ -1,22 +1,27 @@
-//! The one door of the command line: a request is validated and held to the budgets, its
-//! `--out` directory locked, it runs with a progress bar ([`progress::run`]), and its presentation
-//! ([`afmdyn::report::Presentation`], built by the library) is written: the document's
-//! warnings on stderr, every file into the directory (CSV, NetCDF, JSON, figures through the
-//! one plotting module), then the JSON document (`--json`) or the text summary on stdout.
+//! The one door of the command line, for every subcommand: a request is validated and held
+//! to the budgets (admitted once), its `--out` directory locked, it runs with a progress bar
+//! ([`run`]; a study resumably into the directory's store, [`run_stored`]: the library's
+//! [`afmdyn::study::stored::Resumable`], `--resume` and `--abort-after` included), and its
+//! presentation ([`afmdyn::report::Presentation`], built by the library for the destination)
+//! is written: its warnings and the document's on stderr, every file into the directory (CSV,
+//! NetCDF, JSON, figures through the one plotting module), then the JSON document (`--json`)
+//! or the text summary on stdout.
 
+use crate::error::study_error;
 use crate::error::CliError;
 use crate::output::{print_warnings, units_of, write_layout, OutDir};
 use crate::progress;
 use afmdyn::layout::files::{write_bytes, write_csv, NpyStream};
-use afmdyn::report::{OutputFile, OutputsNote, Presentation};
+use afmdyn::report::{OutputFile, Presentation};
 use afmdyn::request::present::Files;
-use afmdyn::request::{Analysis, Document, Resolved};
+use afmdyn::request::{Analysis, Destination, Document, Resolved};
+use afmdyn::study::stored::{Resumable, Storage};
 use serde_json::Value;
 use std::path::Path;
 
 /// How a command's results leave: the JSON document on stdout instead of the summary, and the
 /// output directory of its files (none: a command that writes none).
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, Default)]
 pub struct Exit<'a> {
     /// Print the JSON document.
     pub json: bool,
@@ -26,6 +31,20 @@ pub struct Exit<'a> {
     pub files: Files,
     /// What the progress bar counts ("points", "starts").
     pub unit: &'static str,
+    /// A stepped curve's columns named as dForce 2.0's (`--dforce-columns`).
+    pub dforce_columns: bool,
+}
+
+/// How a study runs into the store of `--out`: continued (`--resume`), the testing hook
+/// `--abort-after`, and what the store holds in the refusals of a resume (`sweep`, `chart`).
+#[derive(Debug, Clone, Copy)]
+pub struct Resume {
+    /// Continue the interrupted run.
+    pub resume: bool,
+    /// Testing: abort the process once this many tasks are stored.
+    pub abort_after: Option<usize>,
+    /// The store's results, in its refusals.
+    pub what: &'static str,
 }
 
 /// Run `request` on `model` through the door and write its presentation; the typed result
@@ -57,27 +76,73 @@ pub fn run_with<A: Analysis>(
     afmdyn::request::run::admit(request, model)?;
     let out = exit.out.map(OutDir::lock).transpose()?;
     let doc = progress::run_admitted(request, model, exit.unit)?;
-    let mut shown = request.present(
-        model,
-        &doc.output,
-        &doc.json,
-        units_of(model.probe.as_ref()),
-    )?;
+    let mut shown = present(request, model, &doc.output, &doc.json, out.as_ref(), exit)?;
     decorate(&mut shown);
-    // --files: the figures (data) or every file (none) left out
-    match exit.files {
-        Files::All => {}
-        Files::Data => shown
-            .files
-            .retain(|f| !matches!(f, OutputFile::Figure { .. })),
-        Files::None => shown.files.clear(),
-    }
     emit(out.as_ref(), &shown, &doc.json, exit.json)?;
     Ok(doc)
 }
 
-/// Write a presentation: `document`'s warnings on stderr, the files into `out`, then the
-/// document (`json`) or the summary and where the outputs are on stdout.
+/// Run `request`'s study on `model` resumably into the store of `--out` (the library's
+/// [`Resumable`]: in memory without a directory), then write its presentation as [`run`]
+/// does; a result that is no answer ([`Resumable::failure`]) has its files written (and its
+/// document printed where it says so), then fails.
+///
+/// # Errors
+/// As [`run`]; the store's refusals of a resume naming `how.what`.
+pub fn run_stored<A: Resumable>(
+    request: &A,
+    model: &Resolved,
+    exit: Exit<'_>,
+    how: Resume,
+) -> Result<(), CliError> {
+    afmdyn::request::run::admit(request, model)?;
+    let out = exit.out.map(OutDir::lock).transpose()?;
+    let study = request.study(model)?;
+    let storage = Storage {
+        lock: out.as_ref().map(OutDir::dir_lock),
+        resume: how.resume,
+        abort_after: how.abort_after,
+    };
+    let output = progress::with_bar(exit.unit, |p| request.resume(&study, model, storage, p))
+        .map_err(|e| study_error(e, how.what))?;
+    let json = afmdyn::request::run::document(request, model, &output)?;
+    let shown = present(request, model, &output, &json, out.as_ref(), exit)?;
+    if let Some(failed) = request.failure(&output) {
+        // the files are written, then the run fails (exit 1): the document first, if asked for
+        if let Some(out) = &out {
+            write_files(out, &shown)?;
+        }
+        if failed.with_document && exit.json {
+            outln!("{json}");
+        }
+        return Err(failed.error.into());
+    }
+    emit(out.as_ref(), &shown, &json, exit.json)
+}
+
+/// The library's presentation of `output` at the command's destination.
+fn present<A: Analysis>(
+    request: &A,
+    model: &Resolved,
+    output: &A::Output,
+    document: &Value,
+    out: Option<&OutDir>,
+    exit: Exit<'_>,
+) -> Result<Presentation, CliError> {
+    let to = Destination {
+        files: exit.files,
+        dir: out.map(OutDir::path),
+        dforce_columns: exit.dforce_columns,
+    };
+    let units = units_of(model.probe.as_ref());
+    let mut shown = request.present(model, output, document, units, to)?;
+    to.keep(&mut shown);
+    Ok(shown)
+}
+
+/// Write a presentation: its warnings and `document`'s on stderr, the files into `out`, then
+/// the document (`json`; the presentation's own where it has one) or the summary and where
+/// the outputs are on stdout.
 ///
 /// # Errors
 /// [`CliError::Io`] naming a file or stream that cannot be written.
@@ -87,21 +152,10 @@ pub fn emit(
     document: &Value,
     json: bool,
 ) -> Result<(), CliError> {
-    emit_as(out, shown, document, json, false)
-}
-
-/// [`emit`]; `inline`: the summary's last line ends with `; outputs in DIR` instead of a line
-/// of its own (the one-line summaries of `chart` and `basins`).
-///
-/// # Errors
-/// As [`emit`].
-pub fn emit_as(
-    out: Option<&OutDir>,
-    shown: &Presentation,
-    document: &Value,
-    json: bool,
-    inline: bool,
-) -> Result<(), CliError> {
+    let document = shown.document.as_ref().unwrap_or(document);
+    for w in &shown.warnings {
+        errln!("afmdyn: warning: {w}");
+    }
     print_warnings(document)?;
     if let Some(out) = out {
         write_files(out, shown)?;
@@ -111,18 +165,7 @@ pub fn emit_as(
         return Ok(());
     }
     let dir = out.filter(|_| !shown.files.is_empty()).map(OutDir::path);
-    let lines = if inline && dir.is_some() {
-        // the one-line summaries: `…; outputs in DIR`
-        let tail = Presentation {
-            summary: shown.summary.clone(),
-            outputs_note: OutputsNote::Tail,
-            ..Presentation::default()
-        };
-        tail.summary_with(dir)
-    } else {
-        shown.summary_with(dir)
-    };
-    for line in lines {
+    for line in shown.summary_with(dir) {
         outln!("{line}");
     }
     Ok(())

@@ -14,7 +14,7 @@ pub enum CliError {
     #[error("{}", spell(.0))]
     Sim(#[from] afmdyn::error::SimError),
     /// Reading or writing a file failed; the message names the file (see
-    /// [`crate::output::io_error`]). There is deliberately no conversion from `std::io::Error`,
+    /// [`afmdyn::layout::files::io_error`]). There is deliberately no conversion from `std::io::Error`,
     /// which would lose the path.
     #[error("{0}")]
     Io(String),
@@ -136,6 +136,10 @@ impl From<crate::plot::PlotError> for CliError {
     fn from(e: crate::plot::PlotError) -> Self {
         match e {
             crate::plot::PlotError::File(e) => e.into(),
+            // a store's table not as written, or past its cap: the input's fault (exit code 2)
+            crate::plot::PlotError::Feed(afmdyn::layout::figure::FeedError::Refused(m)) => {
+                CliError::Input(m)
+            }
             e => CliError::Io(e.to_string()),
         }
     }

@@ -4,14 +4,7 @@
 
 use crate::error::CliError;
 use afmdyn::request::{DirLock, LockError};
-use std::fmt::Display;
 use std::path::{Path, PathBuf};
-
-/// An I/O failure on `path`, as one readable line ("cannot write DIR/x.csv: No space left on
-/// device"): the library's [`afmdyn::layout::files::io_error`].
-pub fn io_error(verb: &str, path: &Path, e: impl Display) -> CliError {
-    afmdyn::layout::files::io_error(verb, path, e).into()
-}
 
 /// A failed write to a standard stream: a closed pipe (`afmdyn … | head`) ends the run quietly
 /// with status 141, as SIGPIPE ends other Unix tools; any other failure (`> /dev/full`) is

@@ -71,18 +71,6 @@ fn draw(progress: &Progress, finished: &AtomicBool, unit: &'static str) {
     }
 }
 
-/// [`request::run()`] with a bar counting `unit`s.
-///
-/// # Errors
-/// As [`request::run()`].
-pub fn run<A: Analysis + ?Sized>(
-    analysis: &A,
-    model: &Resolved,
-    unit: &'static str,
-) -> Result<Document<A::Output>, SimError> {
-    with_bar(unit, |progress| request::run(analysis, model, progress))
-}
-
 /// [`request::run_admitted`] with a bar counting `unit`s: a request the caller admitted.
 ///
 /// # Errors
@@ -94,54 +82,5 @@ pub fn run_admitted<A: Analysis + ?Sized>(
 ) -> Result<Document<A::Output>, SimError> {
     with_bar(unit, |progress| {
         request::run_admitted(analysis, model, progress)
-    })
-}
-
-/// What the command line observes of a study: the bar's counter, and the testing hook
-/// `--abort-after K` (abort the process, as if killed, once K tasks are stored).
-struct Watch<'a> {
-    progress: &'a Progress,
-    abort_after: Option<usize>,
-}
-
-impl afmdyn::study::Observer for Watch<'_> {
-    fn start(&self, total: u64, done: u64) {
-        afmdyn::study::Observer::start(self.progress, total, done);
-    }
-
-    fn stored(&self, units: u64, count: usize) {
-        afmdyn::study::Observer::stored(self.progress, units, count);
-        if self.abort_after == Some(count) {
-            std::process::abort();
-        }
-    }
-
-    fn cancel_flag(&self) -> &AtomicBool {
-        self.progress.cancel_flag()
-    }
-}
-
-/// [`afmdyn::study::execute`] with a bar counting `unit`s.
-///
-/// # Errors
-/// As [`afmdyn::study::execute`].
-pub fn study<S, St>(
-    study: &S,
-    store: &mut St,
-    resume: bool,
-    threads: Option<usize>,
-    unit: &'static str,
-    abort_after: Option<usize>,
-) -> Result<afmdyn::study::Outcome, afmdyn::study::StudyError>
-where
-    S: afmdyn::study::Study + ?Sized,
-    St: afmdyn::study::Store<S>,
-{
-    with_bar(unit, |progress| {
-        let watch = Watch {
-            progress,
-            abort_after,
-        };
-        afmdyn::study::execute(study, store, resume, threads, &watch)
     })
 }

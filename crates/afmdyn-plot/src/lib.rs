@@ -38,6 +38,9 @@ pub enum PlotError {
     /// The file could not be written.
     #[error(transparent)]
     File(#[from] FileError),
+    /// A streamed scatter's points could not be read.
+    #[error(transparent)]
+    Feed(#[from] afmdyn::layout::figure::FeedError),
 }
 
 static PLAIN_SI: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
@@ -522,6 +525,11 @@ pub fn save_plot(dir: &Path, stem: &str, plot: &Plot) -> Result<(), PlotError> {
         Plot::Cells(m) => save_map(dir, stem, m),
         Plot::Stacked(s) => save_stacked(dir, stem, s),
         Plot::Image(i) => save_image(dir, stem, i),
+        Plot::Scatter(s) => {
+            let feed = |draw: &mut ChunkSink<'_>| s.points.feed(draw).map_err(PlotError::Feed);
+            let labels = (s.labels.0.as_str(), s.labels.1.as_str());
+            save_scatter_stream(dir, stem, &s.title, labels, s.bounds, &s.legend, &feed)
+        }
     }
 }
 

@@ -3,17 +3,16 @@
 //! the model values, the defaults and the probe file's text), so that it pickles to Dask
 //! workers as a few hundred bytes.
 
-use crate::errors::{checkpoint_error, lock_store, study_error};
+use crate::errors::{lock_store, study_error};
 use crate::errors::{probe_error, sim_error, value_error};
 use crate::params::{model_spec, PyParams};
 use crate::run::{run, Job, Stop};
 use afmdyn::probe::Probe;
 use afmdyn::request::chart::Chart;
 use afmdyn::request::Params;
-use afmdyn::request::{ChartArrays, ChartRequest, DirLock, ModelSpec};
+use afmdyn::request::{ChartArrays, ChartRequest, DirLock, ModelSpec, Resolved};
 use afmdyn::study::chart::{ChartCell, ChartPlan};
-use afmdyn::study::chart_store::{cells, chart_store};
-use afmdyn::study::{execute, MemoryStore};
+use afmdyn::study::stored::{Resumable, Storage};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 use serde::{Deserialize, Serialize};
@@ -225,7 +224,10 @@ impl ChartStudy {
         }
         let lock = store.map(|dir| lock_store(&dir)).transpose()?;
         let this = slf.get();
-        let chart = this.chart.clone();
+        let chart = Chart {
+            threads,
+            ..this.chart.clone()
+        };
         let total = chart.spec.x.len() * chart.spec.y.len();
         let job = Job::default();
         let worker_job = job.clone();
@@ -236,19 +238,18 @@ impl ChartStudy {
             progress.as_ref(),
             Stop::Cancellable,
             move || -> PyResult<Vec<ChartCell>> {
+                // the command line's run into its store (the library's one path)
+                let storage = Storage {
+                    lock: lock.as_ref(),
+                    resume,
+                    abort_after: None,
+                };
+                // a chart's model is its own: the one given is not read
+                let model = Resolved::plain(Params::default());
                 let progress = &*worker_job.progress;
-                match lock.as_ref() {
-                    Some(lock) => {
-                        let mut s = chart_store(lock);
-                        execute(&chart, &mut s, resume, threads, progress).map_err(study_error)?;
-                        cells(&mut s).map_err(checkpoint_error)
-                    }
-                    None => {
-                        let mut s = MemoryStore::default();
-                        execute(&chart, &mut s, false, threads, progress).map_err(study_error)?;
-                        Ok(afmdyn::study::chart::cells_of(s.records))
-                    }
-                }
+                chart
+                    .resume(&(), &model, storage, progress)
+                    .map_err(study_error)
             },
         )??;
         let this = slf.get();

@@ -263,6 +263,7 @@ fn a_frequency_shift_csv_goes_through_the_fit_door() {
                     scales: Some(p.scales),
                     plain: false,
                 },
+                Default::default(),
             )
             .expect("present");
         let mut names = Vec::new();

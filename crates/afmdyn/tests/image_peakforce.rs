@@ -12,7 +12,6 @@ use afmdyn::probe::Probe;
 use afmdyn::request::image::{ImageRequest, SampleMap};
 use afmdyn::request::image_job::{ImageJob, ImageMode, ImageOutput};
 use afmdyn::request::image_peakforce::PeakForceImage;
-use afmdyn::request::present::Files;
 use afmdyn::request::{PeakForceRequest, Resolved};
 use afmdyn::study::peakforce_image::peakforce_image;
 
@@ -188,7 +187,6 @@ fn the_door_gives_the_image_and_refuses_an_am_probe() {
         feedback: None,
         study: None,
         threads: Some(1),
-        files: Files::None,
     };
     let j = job(probe());
     let model = j.model().unwrap();

@@ -147,6 +147,49 @@ pub enum Plot {
     Stacked(StackedFractions),
     /// An AFM image with its colour bar.
     Image(AfmImage),
+    /// Points streamed from their source in chunks.
+    Scatter(StreamedScatter),
+}
+
+/// One chunk of (x, y, palette index) points of a streamed scatter, drawn; a drawing failure
+/// is its message.
+pub type PointSink<'a> = dyn FnMut(&[(f64, f64, usize)]) -> Result<(), String> + 'a;
+
+/// Where a streamed scatter's points come from, chunk by chunk (a store's table, read again
+/// for each figure): the figure holds no points, so memory does not grow with them.
+pub trait PointSource: std::fmt::Debug + Send + Sync {
+    /// Every point, in chunks, into `draw`.
+    ///
+    /// # Errors
+    /// The source's read error; `draw`'s as [`FeedError::Io`].
+    fn feed(&self, draw: &mut PointSink<'_>) -> Result<(), FeedError>;
+}
+
+/// Why a streamed scatter's points could not be fed.
+#[derive(Debug, Clone, thiserror::Error)]
+pub enum FeedError {
+    /// The source is not what was written there, or is past its size cap (bad input).
+    #[error("{0}")]
+    Refused(String),
+    /// Reading the source, or drawing, failed.
+    #[error("{0}")]
+    Io(String),
+}
+
+/// A scatter of many points streamed from their source (a bifurcation diagram over the
+/// store's rows), on fixed bounds with a fixed legend.
+#[derive(Debug, Clone)]
+pub struct StreamedScatter {
+    /// The title.
+    pub title: String,
+    /// The x and y axis labels.
+    pub labels: (String, String),
+    /// The axes' bounds (x0, x1, y0, y1).
+    pub bounds: (f64, f64, f64, f64),
+    /// The legend: label, palette index, drawn as a marker.
+    pub legend: Vec<(String, usize, bool)>,
+    /// The points.
+    pub points: std::sync::Arc<dyn PointSource>,
 }
 
 /// A pixel column of a monotone line: column, (first, lowest, highest, last) point, and the

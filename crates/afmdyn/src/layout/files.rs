@@ -31,7 +31,7 @@ pub fn io_error(verb: &str, path: &Path, e: impl Display) -> FileError {
 }
 
 /// An operating system's message without its ` (os error N)`: `No space left on device`.
-fn without_errno(text: &str) -> &str {
+pub(crate) fn without_errno(text: &str) -> &str {
     match text.rfind(" (os error ") {
         Some(i) if text.ends_with(')') => &text[..i],
         _ => text,

@@ -20,6 +20,11 @@ pub struct Presentation {
     pub files: Vec<OutputFile>,
     /// Where a front end that writes the files into a directory says so in the summary.
     pub outputs_note: OutputsNote,
+    /// Warnings a front end shows beside the document's (on stderr, before them).
+    pub warnings: Vec<String>,
+    /// The document as a front end prints it, when presenting it to a directory added to it
+    /// (the paths of its files); `None`: the result's document as it is.
+    pub document: Option<Value>,
 }
 
 /// Where the summary of a front end that writes files into a directory names it

@@ -145,6 +145,47 @@ pub struct FileCheckpoint<'a> {
     writer: Option<BufWriter<File>>,
 }
 
+/// Each row of the store's CSV `path` (its finished rows), read through the bounded reader: a
+/// read failure as the store's error (the reader's refusal naming the file and its cap, as
+/// [`refused`]), `each`'s as it is.
+///
+/// # Errors
+/// As said.
+pub(crate) fn each_row<E: From<CheckpointError>>(
+    path: &Path,
+    each: &mut dyn FnMut(&csv::StringRecord) -> Result<(), E>,
+) -> Result<(), E> {
+    let file = crate::io::open(path, InputKind::Store).map_err(|e| refused(path, e))?;
+    let mut reader = csv::Reader::from_reader(file);
+    for r in reader.records() {
+        let r = r.map_err(|e| {
+            if let csv::ErrorKind::Io(io) = e.kind() {
+                if let Some(r) = refusal(io) {
+                    return refused(path, r.clone());
+                }
+            }
+            CheckpointError::Io {
+                action: "read",
+                path: path.display().to_string(),
+                message: crate::layout::files::without_errno(&e.to_string()).to_string(),
+            }
+        })?;
+        each(&r)?;
+    }
+    Ok(())
+}
+
+/// A store's error feeding a figure: a store not as written, or past its cap, is refused (bad
+/// input); any other is a read failure.
+impl From<CheckpointError> for crate::layout::figure::FeedError {
+    fn from(e: CheckpointError) -> Self {
+        match e {
+            CheckpointError::Corrupt { .. } => Self::Refused(e.to_string()),
+            e => Self::Io(e.to_string()),
+        }
+    }
+}
+
 fn io<'a>(
     action: &'static str,
     path: &'a Path,

@@ -614,6 +614,7 @@ impl Analysis for FitRequest {
         _: &FitResult,
         document: &Value,
         units: crate::report::TextUnits,
+        _: crate::request::Destination<'_>,
     ) -> Result<crate::report::Presentation, SimError> {
         let mut document = document.clone();
         Ok(super::present::fit::fit(

@@ -266,10 +266,12 @@ impl Analysis for FmRequest {
         _: &FmCurve,
         document: &Value,
         units: crate::report::TextUnits,
+        to: super::run::Destination<'_>,
     ) -> Result<crate::report::Presentation, SimError> {
         let mut document = document.clone();
-        let files = super::present::Files::All;
-        Ok(super::present::fm::fm(&mut document, units, files, None))
+        let mut shown = super::present::fm::fm(&mut document, units, to.files, to.dir);
+        shown.document = Some(document);
+        Ok(shown)
     }
     fn largest_indentation(&self, curve: &FmCurve) -> Option<f64> {
         let d = curve.points.iter().map(|q| q.observables.indentation);

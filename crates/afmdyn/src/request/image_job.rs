@@ -1,9 +1,8 @@
 //! `image` as data ([`ImageJob`]): the probe file's table, the sample map, the request, the
 //! feedback (ideal, or a PI scan with its settings) and the setpoint study; its run as an
 //! [`super::run::Analysis`] (cost, execution, document and presentation) is the study layer's
-//! (`crate::study::image`). A front end that runs the PI scan resumably into a store of its own
-//! takes the study from [`ImageJob::scan_study`] after [`super::run::admit`], and the document
-//! and presentation of the image it assembles from the analysis' `report` and `present`.
+//! (`crate::study::image`), and so is its PI scan's run resumably into a store
+//! (`crate::study::stored::Resumable`, its study [`ImageJob::scan_study`]).
 
 use super::image::{background_probe, Image, ImageRequest, SampleMap, SetpointStudy};
 use super::image_options::GivenOptions;
@@ -12,7 +11,6 @@ use super::image_peakforce::PeakForceImage;
 use super::image_scan::ScanRecipe;
 use super::image_scan::{PiImage, PiScan, ScanStudy};
 use super::named::Outcome;
-use super::present::Files;
 use super::run::Resolved;
 use crate::error::SimError;
 use serde::{Deserialize, Serialize};
@@ -37,8 +35,6 @@ pub struct ImageJob {
     pub study: Option<Vec<f64>>,
     /// A PI scan's worker threads (`None`: all cores).
     pub threads: Option<usize>,
-    /// Which files its presentation holds.
-    pub files: Files,
 }
 
 /// An [`ImageJob`]'s result.
@@ -159,7 +155,6 @@ impl ImageKeywords {
             feedback: self.feedback,
             study: None,
             threads: self.threads,
-            files: Files::All,
         })
     }
 

@@ -99,7 +99,8 @@ pub use pool::in_pool;
 pub use pool::thread_pool;
 pub use reconstruct::ReconstructRequest;
 pub use run::{
-    admit, run, run_admitted, Analysis, ApproachRequest, Document, Resolved, ResonanceRequest,
+    admit, run, run_admitted, Analysis, ApproachRequest, Destination, Document, Resolved,
+    ResonanceRequest,
 };
 pub use sweep::{fingerprint, SweepRecord};
 

@@ -51,6 +51,7 @@ impl Analysis for ModesRequest {
         (free, contact): &Self::Output,
         _: &Value,
         units: report::TextUnits,
+        _: crate::request::Destination<'_>,
     ) -> Result<report::Presentation, SimError> {
         Ok(super::present::modes::modes(
             &model.params,
@@ -99,6 +100,7 @@ impl Analysis for Fig3Request {
         points: &Self::Output,
         _: &Value,
         _: report::TextUnits,
+        _: crate::request::Destination<'_>,
     ) -> Result<report::Presentation, SimError> {
         #[cfg(feature = "files")]
         let mut shown = super::present::modes::fig3(model.params.modes, points);
@@ -158,6 +160,7 @@ impl Analysis for UnitsRequest {
         output: &Self::Output,
         document: &Value,
         _: report::TextUnits,
+        _: crate::request::Destination<'_>,
     ) -> Result<report::Presentation, SimError> {
         Ok(match (&self.physical, output) {
             (Some(m), Some((p, s))) => super::present::modes::units(m, p, s),
@@ -198,6 +201,7 @@ impl Analysis for CantileversRequest {
         _: &(),
         _: &Value,
         _: report::TextUnits,
+        _: crate::request::Destination<'_>,
     ) -> Result<report::Presentation, SimError> {
         Ok(super::present::modes::cantilevers())
     }

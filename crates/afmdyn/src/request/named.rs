@@ -121,24 +121,6 @@ where
     }
 }
 
-/// `bimodal`: the approach curve of a drive with two or more components.
-struct Bimodal(ApproachRequest);
-
-impl Named for Bimodal {
-    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
-        super::curves::check_bimodal(&model.params)?;
-        self.0.validate(model)
-    }
-    fn run(&self, model: &Resolved, progress: &Progress) -> Result<Outcome, SimError> {
-        super::curves::check_bimodal(&model.params)?;
-        Door {
-            request: self.0.clone(),
-            quick: false,
-        }
-        .run(model, progress)
-    }
-}
-
 /// `simulate`: one trajectory recorded whole in memory, laid out by
 /// [`report::simulate_layout`] (in SI with a probe), with its end time, switchings, body
 /// contact, integrator and transient as facts.
@@ -218,7 +200,7 @@ pub fn parse<'de, D: Deserializer<'de>>(
         "lyapunov" => door::<LyapunovRequest, D>(d, false),
         "observe" => door::<ObserveRequest, D>(d, true),
         "approach" => door::<ApproachRequest, D>(d, false),
-        "bimodal" => Ok(Some(Box::new(Bimodal(ApproachRequest::deserialize(d)?)))),
+        "bimodal" => door::<super::curves::Bimodal, D>(d, false),
         "resonance" => door::<ResonanceRequest, D>(d, false),
         "basins" => door::<BasinsRequest, D>(d, false),
         "fm" => door::<FmRequest, D>(d, false),

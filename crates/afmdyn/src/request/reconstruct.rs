@@ -30,6 +30,7 @@
 
 use super::costs::MODEL_BYTES;
 use super::limits::Cost;
+use super::present::reconstruct::{reconstruction, Inversion};
 use super::run::{Analysis, Resolved};
 use crate::analysis::progress::Progress;
 use crate::analysis::reconstruct::{sader_jarvis, Method, Reconstruction, ShiftCurve};
@@ -340,16 +341,71 @@ impl Analysis for ReconstructRequest {
         r: &Reconstruction,
         document: &Value,
         units: crate::report::TextUnits,
+        to: super::run::Destination<'_>,
     ) -> Result<crate::report::Presentation, SimError> {
-        use super::present::reconstruct::{reconstruction, Inversion};
-        let files = (super::present::Files::All, None);
-        let law = self.law_in_order();
-        let mut document = document.clone();
         let how = match self.inversion {
             FmInversion::SaderJarvis => Inversion::SaderJarvis,
             FmInversion::Exact => Inversion::Exact,
         };
-        Ok(reconstruction(r, how, law, &mut document, units, files))
+        present_reconstruction(r, how, self.law_in_order(), document, units, to)
+    }
+}
+
+/// A reconstruction's presentation at `to` ([`super::present::reconstruct::reconstruction`]),
+/// the printed document naming its table.
+fn present_reconstruction(
+    r: &Reconstruction,
+    how: Inversion,
+    law: Option<Vec<f64>>,
+    document: &Value,
+    units: crate::report::TextUnits,
+    to: super::run::Destination<'_>,
+) -> Result<crate::report::Presentation, SimError> {
+    let mut document = document.clone();
+    let files = (to.files, to.dir);
+    let mut shown = reconstruction(r, how, law, &mut document, units, files);
+    shown.document = Some(document);
+    Ok(shown)
+}
+
+/// `reconstruct --am`: the AM matrix inversion of an `afmdyn approach --probe` document of
+/// the point mass ([`am_curve_from_approach`], [`am_reconstruction`]).
+#[derive(Debug, Clone)]
+pub struct AmReconstruction(pub Value);
+
+impl Analysis for AmReconstruction {
+    type Output = Reconstruction;
+    fn validate(&self, _: &Resolved) -> Result<(), SimError> {
+        am_curve_from_approach(&self.0).map(|_| ())
+    }
+    fn execute(&self, _: &Resolved, progress: &Progress) -> Result<Reconstruction, SimError> {
+        let curve = am_curve_from_approach(&self.0)?;
+        crate::analysis::reconstruct_am::matrix_inversion_with(&curve, progress)
+    }
+    fn name(&self) -> &'static str {
+        "reconstruct"
+    }
+    fn cost(&self, _: &Resolved) -> Result<Cost, SimError> {
+        // no integration; the curve's and the inversion's columns (its weights are summed
+        // row by row, at most a documented number of them)
+        let n = am_curve_from_approach(&self.0)?.z_c.len() as f64;
+        Ok(Cost {
+            bytes: MODEL_BYTES + 12.0 * 8.0 * n,
+            work: 0.0,
+        })
+    }
+    fn report(&self, _: &Resolved, r: &Reconstruction) -> Result<Value, SimError> {
+        Ok(am_document(&am_curve_from_approach(&self.0)?, r))
+    }
+    fn present(
+        &self,
+        _: &Resolved,
+        r: &Reconstruction,
+        document: &Value,
+        units: crate::report::TextUnits,
+        to: super::run::Destination<'_>,
+    ) -> Result<crate::report::Presentation, SimError> {
+        present_reconstruction(r, Inversion::AmMatrix, None, document, units, to)
     }
 }
 

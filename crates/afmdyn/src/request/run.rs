@@ -134,7 +134,10 @@ pub trait Analysis {
     }
     /// What the result shows besides its document ([`report::Presentation`]): the text
     /// summary in `units`, its tables, datasets and figures as data, for every front end to
-    /// write; `document` is the result's JSON ([`run`]'s). Empty by default.
+    /// write to `to` (a front end keeps only the files `to.files` says: [`Destination::keep`]);
+    /// `document` is the result's JSON ([`run`]'s). A result whose files or document name the
+    /// directory (`"csv"`: its path) adds them here, the document as printed in
+    /// [`report::Presentation::document`]. Empty by default.
     ///
     /// # Errors
     /// [`SimError`] where the presentation needs the model built again (an invalid `params`).
@@ -144,8 +147,43 @@ pub trait Analysis {
         _output: &Self::Output,
         _document: &Value,
         _units: report::TextUnits,
+        _to: Destination<'_>,
     ) -> Result<report::Presentation, SimError> {
         Ok(report::Presentation::default())
+    }
+}
+
+/// Where a front end writes a result ([`Analysis::present`]): which files, the directory
+/// (none: no files written) and the naming of a stepped curve's columns.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Destination<'a> {
+    /// The files written: all, the data without the figures, or none.
+    pub files: super::present::Files,
+    /// The output directory.
+    pub dir: Option<&'a std::path::Path>,
+    /// A stepped curve's CSV/NPY columns named and ordered as dForce 2.0's zcdom table.
+    pub dforce_columns: bool,
+}
+
+impl Destination<'_> {
+    /// A stepped curve's options at this destination, its files named `stem`.
+    pub fn curve(&self, stem: &'static str) -> super::present::curves::CurveOptions {
+        super::present::curves::CurveOptions {
+            stem,
+            files: self.files,
+            dforce_columns: self.dforce_columns,
+        }
+    }
+    /// `shown` without the files [`Destination::files`] leaves out (the figures, or all).
+    pub fn keep(&self, shown: &mut report::Presentation) {
+        use super::present::Files;
+        match self.files {
+            Files::All => {}
+            Files::Data => shown
+                .files
+                .retain(|f| !matches!(f, report::OutputFile::Figure { .. })),
+            Files::None => shown.files.clear(),
+        }
     }
 }
 
@@ -256,6 +294,7 @@ impl Analysis for OrbitRequest {
         output: &Self::Output,
         _: &Value,
         units: report::TextUnits,
+        _: Destination<'_>,
     ) -> Result<report::Presentation, SimError> {
         super::present::orbits::orbit(&model.params, output, units)
     }
@@ -301,6 +340,7 @@ impl Analysis for ContinuationRequest {
         branches: &Self::Output,
         _: &Value,
         units: report::TextUnits,
+        _: Destination<'_>,
     ) -> Result<report::Presentation, SimError> {
         super::present::continuation::continuation(
             &model.params,
@@ -346,6 +386,7 @@ impl Analysis for LyapunovRequest {
         output: &Self::Output,
         _: &Value,
         units: report::TextUnits,
+        _: Destination<'_>,
     ) -> Result<report::Presentation, SimError> {
         Ok(super::present::orbits::lyapunov(
             &model.params,
@@ -380,8 +421,14 @@ impl Analysis for AttractorsRequest {
         r: &Self::Output,
         document: &Value,
         units: report::TextUnits,
+        _: Destination<'_>,
     ) -> Result<report::Presentation, SimError> {
-        super::present::census::attractors(self, &model.params, r, document, units)
+        let mut shown =
+            super::present::census::attractors(self, &model.params, r, document, units)?;
+        shown
+            .warnings
+            .extend(super::present::census::failed_starts(r, self.samples));
+        Ok(shown)
     }
 }
 
@@ -444,10 +491,18 @@ impl Analysis for ConvergeRequest {
         &self,
         model: &Resolved,
         runs: &Self::Output,
-        _: &Value,
+        document: &Value,
         _: report::TextUnits,
+        to: Destination<'_>,
     ) -> Result<report::Presentation, SimError> {
-        Ok(super::present::converge::converge(&model.params, runs))
+        let mut shown = super::present::converge::converge(&model.params, runs);
+        // the printed document names the output directory
+        if let Some(dir) = to.dir {
+            let mut document = document.clone();
+            document["out"] = serde_json::json!(dir);
+            shown.document = Some(document);
+        }
+        Ok(shown)
     }
 }
 

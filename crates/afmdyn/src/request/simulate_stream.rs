@@ -206,6 +206,7 @@ impl Analysis for SimulateStream {
         r: &Self::Output,
         _: &Value,
         _: report::TextUnits,
+        _: crate::request::Destination<'_>,
     ) -> Result<report::Presentation, SimError> {
         simulate(self, model, r)
     }

@@ -81,10 +81,22 @@ impl Analysis for Chart {
         &self,
         _: &Resolved,
         cells: &Vec<ChartCell>,
-        _: &Value,
+        document: &Value,
         _: crate::report::TextUnits,
+        to: crate::request::Destination<'_>,
     ) -> Result<crate::report::Presentation, SimError> {
-        Ok(crate::request::present::maps::chart(self, cells))
+        let mut shown = crate::request::present::maps::chart(self, cells);
+        // the printed document names the files written
+        if let Some(dir) = to.dir {
+            let mut document = document.clone();
+            document["files"] = serde_json::json!({
+                "csv": dir.join("chart.csv"),
+                "netcdf": dir.join("chart.nc"),
+            });
+            shown.document = Some(document);
+            shown.outputs_note = crate::report::OutputsNote::Tail;
+        }
+        Ok(shown)
     }
 }
 

@@ -6,7 +6,6 @@
 use super::task_store::{Encoding, TaskFiles, TaskStore};
 use crate::analysis::chart::ChartCell;
 use crate::io::dir_lock::DirLock;
-use crate::request::checkpoint::CheckpointError;
 
 /// The chart's files.
 pub(crate) const CHART_FILES: TaskFiles = TaskFiles {
@@ -23,13 +22,4 @@ pub(crate) type ChartStore<'a> = TaskStore<'a, Vec<ChartCell>>;
 /// The chart store of the directory `lock` holds.
 pub fn chart_store(lock: &DirLock) -> ChartStore<'_> {
     TaskStore::new(lock, CHART_FILES)
-}
-
-/// Every stored cell, in the order of the tasks (row by row, x increasing), read back from
-/// the store.
-///
-/// # Errors
-/// As [`TaskStore::records`].
-pub fn cells(store: &mut ChartStore<'_>) -> Result<Vec<ChartCell>, CheckpointError> {
-    Ok(store.records()?.into_iter().flat_map(|(_, c)| c).collect())
 }

@@ -158,6 +158,7 @@ impl Analysis for GlobalContinuationRequest {
         steps: &Self::Output,
         document: &Value,
         _: report::TextUnits,
+        _: crate::request::Destination<'_>,
     ) -> Result<report::Presentation, SimError> {
         Ok(crate::request::present::census::global_continuation(
             self, steps, document,

@@ -6,13 +6,12 @@
 
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
-use crate::report::{OutputFile, Presentation, TextUnits};
+use crate::report::{Presentation, TextUnits};
 use crate::request::image::{background_probe, curves_cost, image, setpoint_study};
 use crate::request::image_job::{ImageJob, ImageMode, ImageOutput};
 use crate::request::image_peakforce::{peakforce_cost, peakforce_probe};
 use crate::request::image_scan::resolve;
 use crate::request::limits::{check_threads, Cost};
-use crate::request::present::Files;
 use crate::request::run::{Analysis, Resolved};
 use serde_json::Value;
 
@@ -141,9 +140,10 @@ impl Analysis for ImageJob {
         output: &ImageOutput,
         document: &Value,
         units: TextUnits,
+        _: crate::request::Destination<'_>,
     ) -> Result<Presentation, SimError> {
         let setpoint = self.request.setpoint;
-        let mut shown = match output {
+        Ok(match output {
             ImageOutput::Ideal { image, study } => crate::request::present::image::ideal(
                 image,
                 setpoint,
@@ -157,13 +157,6 @@ impl Analysis for ImageJob {
             ImageOutput::PeakForce(img) => {
                 crate::request::present::image::peakforce(img, document, units)
             }
-        };
-        // `--files data`: no figures; `none`: only the summary
-        shown.files.retain(|f| match self.files {
-            Files::All => true,
-            Files::Data => !matches!(f, OutputFile::Figure { .. }),
-            Files::None => false,
-        });
-        Ok(shown)
+        })
     }
 }

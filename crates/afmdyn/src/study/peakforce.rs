@@ -243,15 +243,12 @@ impl Analysis for PeakForceRequest {
         _: &PeakForceResult,
         document: &Value,
         units: crate::report::TextUnits,
+        to: crate::request::Destination<'_>,
     ) -> Result<crate::report::Presentation, SimError> {
         let mut document = document.clone();
-        let files = crate::request::present::Files::All;
-        Ok(crate::request::present::peakforce::peakforce(
-            &mut document,
-            units,
-            files,
-            None,
-        ))
+        let (files, dir) = (to.files, to.dir);
+        let p = crate::request::present::peakforce::peakforce;
+        Ok(p(&mut document, units, files, dir))
     }
     fn largest_indentation(&self, r: &PeakForceResult) -> Option<f64> {
         // a sweep's largest over its taps

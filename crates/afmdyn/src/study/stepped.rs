@@ -24,8 +24,8 @@ use crate::params::Params;
 use crate::report;
 use crate::request::costs::{check_cost, stepped_cost};
 use crate::request::limits::Cost;
-use crate::request::present::curves::{stepped, CurveKind, CurveOptions};
-use crate::request::run::{Analysis, ApproachRequest, Resolved, ResonanceRequest};
+use crate::request::present::curves::{stepped, CurveKind};
+use crate::request::run::{Analysis, ApproachRequest, Destination, Resolved, ResonanceRequest};
 use serde::Serialize;
 use serde_json::{json, Value};
 use std::sync::atomic::AtomicBool;
@@ -171,9 +171,16 @@ macro_rules! present_curve {
             c: &Self::Output,
             document: &Value,
             units: report::TextUnits,
+            to: Destination<'_>,
         ) -> Result<report::Presentation, SimError> {
-            let options = CurveOptions::all(self.name());
-            Ok(stepped($kind, model, c, document, units, &options))
+            Ok(stepped(
+                $kind,
+                model,
+                c,
+                document,
+                units,
+                &to.curve(self.name()),
+            ))
         }
     };
 }

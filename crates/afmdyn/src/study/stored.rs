@@ -1,25 +1,417 @@
-//! The studies a front end runs by name into the command line's resumable store ([`parse`]:
-//! `bifurcation`, `basins`, `global_continuation`, `approach`, `bimodal`, `resonance`): the request parsed,
-//! its study made on the model ([`Stored::prepare`]: validated, before any side effect) and
-//! run into the store of a locked directory, continued with `resume` ([`Prepared::run`]), to the
-//! outcome the one door gives for the same request ([`crate::request::named::outcome`]).
+//! A request run resumably into the store of a locked directory ([`Resumable`]: its study made
+//! on the model before any side effect, run into the store — continued with `resume`, watched
+//! by the testing hook `abort_after` — and finished to the request's typed output): the one
+//! path of the command line's door and of Python's `run_stored`. The studies a front end runs
+//! by name ([`parse`]: `bifurcation`, `basins`, `global_continuation`, `approach`, `bimodal`,
+//! `resonance`) are prepared ([`Stored::prepare`]: validated, before any side effect) and run
+//! ([`Prepared::run`]) to the outcome the one door gives for the same request
+//! ([`crate::request::named::outcome`]).
 
 use super::basins::{basin_store, BasinStudy};
+use super::chart::cells_of;
+use super::chart_store::chart_store;
 use super::global_continuation::{continuation_store, ContinuationStudy};
+use super::scan_store::scan_store;
 use super::stepped::{curve_store, CurveStudy};
 use super::sweep::SweepStudy;
 use super::task_store::{StoredTasks, TaskStore};
-use super::{execute, MemoryStore, Study, StudyError};
+use super::{execute, MemoryStore, Observer, Study, StudyError};
 use crate::analysis::bifurcation::SweepSpec;
 use crate::analysis::progress::Progress;
+use crate::analysis::stepped::SteppedCurve;
 use crate::error::SimError;
+use crate::request::chart::Chart;
+use crate::request::checkpoint::CheckpointError;
+use crate::request::checkpoint_file::each_row;
+use crate::request::curves::Bimodal;
+use crate::request::image_job::{ImageJob, ImageOutput};
+use crate::request::image_scan::ScanStudy;
 use crate::request::named::{self, Datasets, Outcome};
+use crate::request::present::sweeps::{stored_bifurcation, SweepFiles, SweepRow, SweepTally};
 use crate::request::sweep::{every_point_failed, SweepRecord};
-use crate::request::{ApproachRequest, BasinsRequest, BifurcationRequest, DirLock};
+use crate::request::{Analysis, ApproachRequest, BasinsRequest, BifurcationRequest, DirLock};
 use crate::request::{FileCheckpoint, GlobalContinuationRequest, MemoryCheckpoint};
 use crate::request::{Resolved, ResonanceRequest};
 use serde::de::{DeserializeOwned, Deserializer};
 use serde::{Deserialize, Serialize};
+use serde_json::Value;
+use std::sync::atomic::AtomicBool;
+
+/// Where a study runs: the store of a locked directory (none: in memory), continued from an
+/// interrupted run of the same request (`resume`), and the testing hook `abort_after` (abort
+/// the process, as if killed, once that many tasks are stored).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Storage<'a> {
+    /// The locked directory of the store; `None`: in memory.
+    pub lock: Option<&'a DirLock>,
+    /// Continue the interrupted run stored there.
+    pub resume: bool,
+    /// Testing: abort the process once this many tasks are stored.
+    pub abort_after: Option<usize>,
+}
+
+/// What a study's run reports to: the progress it counts in, and the testing hook.
+struct Watch<'a> {
+    progress: &'a Progress,
+    abort_after: Option<usize>,
+}
+
+impl Observer for Watch<'_> {
+    fn start(&self, total: u64, done: u64) {
+        Observer::start(self.progress, total, done);
+    }
+
+    fn stored(&self, units: u64, count: usize) {
+        Observer::stored(self.progress, units, count);
+        if self.abort_after == Some(count) {
+            std::process::abort();
+        }
+    }
+
+    fn cancel_flag(&self) -> &AtomicBool {
+        self.progress.cancel_flag()
+    }
+}
+
+impl Storage<'_> {
+    /// Run `study` (on `threads`, counting in `progress`) into the task store `open` makes of
+    /// the directory, or into memory: its records.
+    ///
+    /// # Errors
+    /// The store's and the study's.
+    fn records<S, R>(
+        &self,
+        study: &S,
+        open: fn(&DirLock) -> TaskStore<'_, R>,
+        threads: Option<usize>,
+        progress: &Progress,
+    ) -> Result<Vec<(usize, R)>, StudyError>
+    where
+        S: Study<Record = (usize, R)>,
+        S::Done: StoredTasks<R>,
+        R: Serialize + DeserializeOwned + Clone + Send,
+    {
+        let watch = Watch {
+            progress,
+            abort_after: self.abort_after,
+        };
+        match self.lock {
+            Some(lock) => {
+                let mut store = open(lock);
+                execute(study, &mut store, self.resume, threads, &watch)?;
+                Ok(store.records()?)
+            }
+            None => {
+                let mut store = MemoryStore::default();
+                execute(study, &mut store, false, threads, &watch)?;
+                Ok(store.records)
+            }
+        }
+    }
+}
+
+/// A sweep run: into the directory's checkpoint (its rows in its `bifurcation.csv`), or into
+/// memory.
+pub(crate) enum Swept<'a> {
+    /// The directory's checkpoint, finished.
+    Stored(FileCheckpoint<'a>),
+    /// The records.
+    Memory(Vec<SweepRecord>),
+}
+
+impl<'a> Storage<'a> {
+    /// Run the sweep `study` (on `threads`, counting in `progress`) into the directory's
+    /// checkpoint, or into memory.
+    ///
+    /// # Errors
+    /// The store's and the study's.
+    pub(crate) fn sweep(
+        &self,
+        study: &SweepStudy,
+        threads: Option<usize>,
+        progress: &Progress,
+    ) -> Result<Swept<'a>, StudyError> {
+        let watch = Watch {
+            progress,
+            abort_after: self.abort_after,
+        };
+        match self.lock {
+            Some(lock) => {
+                let mut s = FileCheckpoint::new(lock);
+                execute(study, &mut s, self.resume, threads, &watch)?;
+                Ok(Swept::Stored(s))
+            }
+            None => {
+                let mut s = MemoryCheckpoint::default();
+                execute(study, &mut s, false, threads, &watch)?;
+                Ok(Swept::Memory(s.into_records()))
+            }
+        }
+    }
+}
+
+/// A request whose study runs resumably into a store ([`Storage`]) to the request's typed
+/// output, which its [`Analysis::present`] presents.
+pub trait Resumable: Analysis {
+    /// The study, made on the model before any side effect.
+    type Study: Send + Sync;
+    /// The study of the request on `model`.
+    ///
+    /// # Errors
+    /// The request's validation errors.
+    fn study(&self, model: &Resolved) -> Result<Self::Study, SimError>;
+    /// Run `study` on `model` into `storage`, counting in `progress`: the request's output.
+    ///
+    /// # Errors
+    /// The store's and the study's.
+    fn resume(
+        &self,
+        study: &Self::Study,
+        model: &Resolved,
+        storage: Storage<'_>,
+        progress: &Progress,
+    ) -> Result<Self::Output, StudyError>;
+    /// A result that is no answer (every chart cell, every sweep point failed): its files
+    /// are still written, then it fails. `None` by default.
+    fn failure(&self, _output: &Self::Output) -> Option<Failure> {
+        None
+    }
+}
+
+/// A stored result that is no answer ([`Resumable::failure`]).
+#[derive(Debug)]
+pub struct Failure {
+    /// The error.
+    pub error: SimError,
+    /// Whether a front end prints the document (`--json`) before failing (a sweep's tally).
+    pub with_document: bool,
+}
+
+/// A stepped curve's points run into the curve store, then its branches.
+fn curve(
+    study: &CurveStudy,
+    storage: Storage<'_>,
+    progress: &Progress,
+) -> Result<SteppedCurve, StudyError> {
+    let records = storage.records(study, curve_store, None, progress)?;
+    Ok(study.curve(records, progress)?)
+}
+
+impl Resumable for ApproachRequest {
+    type Study = CurveStudy;
+    fn study(&self, model: &Resolved) -> Result<CurveStudy, SimError> {
+        CurveStudy::approach(self, model)
+    }
+    fn resume(
+        &self,
+        study: &CurveStudy,
+        _: &Resolved,
+        storage: Storage<'_>,
+        progress: &Progress,
+    ) -> Result<Self::Output, StudyError> {
+        curve(study, storage, progress)
+    }
+}
+
+impl Resumable for Bimodal {
+    type Study = CurveStudy;
+    fn study(&self, model: &Resolved) -> Result<CurveStudy, SimError> {
+        crate::request::curves::check_bimodal(&model.params)?;
+        CurveStudy::approach(&self.0, model)
+    }
+    fn resume(
+        &self,
+        study: &CurveStudy,
+        _: &Resolved,
+        storage: Storage<'_>,
+        progress: &Progress,
+    ) -> Result<Self::Output, StudyError> {
+        curve(study, storage, progress)
+    }
+}
+
+impl Resumable for ResonanceRequest {
+    type Study = CurveStudy;
+    fn study(&self, model: &Resolved) -> Result<CurveStudy, SimError> {
+        CurveStudy::resonance(self, model)
+    }
+    fn resume(
+        &self,
+        study: &CurveStudy,
+        _: &Resolved,
+        storage: Storage<'_>,
+        progress: &Progress,
+    ) -> Result<Self::Output, StudyError> {
+        curve(study, storage, progress)
+    }
+}
+
+impl Resumable for BasinsRequest {
+    type Study = BasinStudy;
+    fn study(&self, model: &Resolved) -> Result<BasinStudy, SimError> {
+        BasinStudy::new(self, &model.params)
+    }
+    fn resume(
+        &self,
+        study: &BasinStudy,
+        _: &Resolved,
+        storage: Storage<'_>,
+        progress: &Progress,
+    ) -> Result<Self::Output, StudyError> {
+        let rows = storage.records(study, basin_store, self.threads, progress)?;
+        let map = || study.map(rows.into_iter().map(|(_, r)| r));
+        Ok(crate::request::in_pool(self.threads, map)?)
+    }
+}
+
+impl Resumable for GlobalContinuationRequest {
+    type Study = ContinuationStudy;
+    fn study(&self, model: &Resolved) -> Result<ContinuationStudy, SimError> {
+        ContinuationStudy::new(self, &model.params)
+    }
+    fn resume(
+        &self,
+        study: &ContinuationStudy,
+        _: &Resolved,
+        storage: Storage<'_>,
+        progress: &Progress,
+    ) -> Result<Self::Output, StudyError> {
+        let records = storage.records(study, continuation_store, None, progress)?;
+        Ok(study.steps(records)?)
+    }
+}
+
+/// A chart is its own study (validated and held to the budgets when it was built).
+impl Resumable for Chart {
+    type Study = ();
+    fn study(&self, _: &Resolved) -> Result<(), SimError> {
+        Ok(())
+    }
+    fn resume(
+        &self,
+        _: &(),
+        _: &Resolved,
+        storage: Storage<'_>,
+        progress: &Progress,
+    ) -> Result<Self::Output, StudyError> {
+        Ok(cells_of(storage.records(
+            self,
+            chart_store,
+            self.threads,
+            progress,
+        )?))
+    }
+    fn failure(&self, cells: &Self::Output) -> Option<Failure> {
+        let error = super::chart::every_cell_failed(cells)?;
+        Some(Failure {
+            error,
+            with_document: false,
+        })
+    }
+}
+
+/// An image: a PI scan's lines run into the store (its study computes the materials' curves);
+/// an image of the ideal feedback, or a PeakForce image, in memory.
+impl Resumable for ImageJob {
+    type Study = Option<ScanStudy>;
+    fn study(&self, _: &Resolved) -> Result<Option<ScanStudy>, SimError> {
+        self.scan_study()
+    }
+    fn resume(
+        &self,
+        study: &Option<ScanStudy>,
+        model: &Resolved,
+        storage: Storage<'_>,
+        progress: &Progress,
+    ) -> Result<Self::Output, StudyError> {
+        let Some(study) = study else {
+            return Ok(self.execute(model, progress)?);
+        };
+        let records = storage.records(study, scan_store, self.threads, progress)?;
+        Ok(ImageOutput::Pi(study.assemble(records)?))
+    }
+}
+
+/// `bifurcation` into the files of its store (`afmdyn bifurcation --out DIR`): the sweep run
+/// resumably into the directory's checkpoint, then tallied, its NPY written and its diagrams
+/// streamed from the finished rows' CSV ([`SweepFiles`]), so that memory does not grow with
+/// the sweep. It runs only into a directory.
+#[derive(Debug, Clone)]
+pub struct SweepInto(pub BifurcationRequest);
+
+/// Why a sweep into files cannot run without a directory.
+const NO_DIRECTORY: &str = "a sweep into its store's files needs the store's directory";
+
+impl Analysis for SweepInto {
+    type Output = SweepFiles;
+    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
+        self.0.validate(model)
+    }
+    fn execute(&self, _: &Resolved, _: &Progress) -> Result<SweepFiles, SimError> {
+        Err(SimError::File(NO_DIRECTORY.into()))
+    }
+    fn name(&self) -> &'static str {
+        self.0.name()
+    }
+    fn cost(&self, model: &Resolved) -> Result<crate::request::limits::Cost, SimError> {
+        self.0.cost(model)
+    }
+    fn report(&self, model: &Resolved, files: &SweepFiles) -> Result<Value, SimError> {
+        let values = files.spec.values.len();
+        let mut doc = files.tally.document(&model.params, self.0.param, values);
+        doc["csv"] = serde_json::json!(files.csv);
+        doc["npy"] = serde_json::json!(files.npy);
+        Ok(doc)
+    }
+    fn present(
+        &self,
+        _: &Resolved,
+        files: &SweepFiles,
+        _: &Value,
+        _: crate::report::TextUnits,
+        _: crate::request::Destination<'_>,
+    ) -> Result<crate::report::Presentation, SimError> {
+        Ok(stored_bifurcation(files, self.0.param))
+    }
+}
+
+impl Resumable for SweepInto {
+    type Study = SweepStudy;
+    fn study(&self, model: &Resolved) -> Result<SweepStudy, SimError> {
+        Ok(SweepStudy::new(&self.0, self.0.spec(&model.params)?))
+    }
+    fn resume(
+        &self,
+        study: &SweepStudy,
+        _: &Resolved,
+        storage: Storage<'_>,
+        progress: &Progress,
+    ) -> Result<SweepFiles, StudyError> {
+        let Swept::Stored(store) = storage.sweep(study, self.0.threads, progress)? else {
+            return Err(SimError::File(NO_DIRECTORY.into()).into());
+        };
+        // derived from the finished rows, streamed
+        let csv = store.final_csv();
+        let mut tally = SweepTally::default();
+        each_row(&csv, &mut |r| -> Result<(), CheckpointError> {
+            tally.add_row(SweepRow::from_csv(r));
+            Ok(())
+        })?;
+        let npy = store.write_npy(self.0.param).map_err(SimError::from)?;
+        Ok(SweepFiles {
+            spec: study.spec.clone(),
+            tally,
+            csv,
+            npy,
+        })
+    }
+    fn failure(&self, files: &SweepFiles) -> Option<Failure> {
+        Some(Failure {
+            error: files.tally.failure()?,
+            with_document: true,
+        })
+    }
+}
 
 /// A request of a study run into a store.
 pub trait Stored: Send {
@@ -45,43 +437,26 @@ pub trait Prepared: Send {
     ) -> Result<Outcome, StudyError>;
 }
 
-/// A request with what makes its study (`of`), opens its store (`open`) and finishes its
-/// output from the stored records (`finish`); `ready` once prepared.
-struct Plan<A, S, R, Of, Fin> {
+/// A [`Resumable`] request, with its model and study once prepared.
+struct Held<A: Resumable> {
     request: A,
-    threads: Option<usize>,
-    of: Of,
-    open: fn(&DirLock) -> TaskStore<'_, R>,
-    finish: Fin,
-    ready: Option<(Resolved, S)>,
+    ready: Option<(Resolved, A::Study)>,
 }
 
-impl<A, S, R, Of, Fin> Stored for Plan<A, S, R, Of, Fin>
+impl<A> Stored for Held<A>
 where
-    A: Datasets + Send + 'static,
-    A::Output: Send,
-    S: Study<Record = (usize, R)> + Send + 'static,
-    S::Done: StoredTasks<R>,
-    R: Serialize + DeserializeOwned + Clone + Send + 'static,
-    Of: Fn(&A, &Resolved) -> Result<S, SimError> + Send + 'static,
-    Fin: Fn(&S, Vec<(usize, R)>, &Progress) -> Result<A::Output, SimError> + Send + Sync + 'static,
+    A: Resumable + Datasets + Send + 'static,
 {
     fn prepare(mut self: Box<Self>, model: Resolved) -> Result<Box<dyn Prepared>, SimError> {
-        let study = (self.of)(&self.request, &model)?;
+        let study = self.request.study(&model)?;
         self.ready = Some((model, study));
         Ok(self)
     }
 }
 
-impl<A, S, R, Of, Fin> Prepared for Plan<A, S, R, Of, Fin>
+impl<A> Prepared for Held<A>
 where
-    A: Datasets + Send,
-    A::Output: Send,
-    S: Study<Record = (usize, R)> + Send,
-    S::Done: StoredTasks<R>,
-    R: Serialize + DeserializeOwned + Clone + Send,
-    Of: Send,
-    Fin: Fn(&S, Vec<(usize, R)>, &Progress) -> Result<A::Output, SimError> + Send + Sync,
+    A: Resumable + Datasets + Send,
 {
     fn run(
         &self,
@@ -92,47 +467,20 @@ where
         let Some((model, study)) = &self.ready else {
             return Err(SimError::Cancelled.into()); // unreachable: only `prepare` makes one
         };
-        let records = match lock {
-            Some(lock) => {
-                let mut store = (self.open)(lock);
-                execute(study, &mut store, resume, self.threads, progress)?;
-                store.records()?
-            }
-            None => {
-                let mut store = MemoryStore::default();
-                execute(study, &mut store, false, self.threads, progress)?;
-                store.records
-            }
+        let storage = Storage {
+            lock,
+            resume,
+            abort_after: None,
         };
-        let finish = &self.finish;
-        let finish = || finish(study, records, progress);
-        let output = crate::request::in_pool(self.threads, finish)?;
+        let output = self.request.resume(study, model, storage, progress)?;
         Ok(named::outcome(&self.request, model, &output)?)
     }
 }
 
-fn plan<A, S, R, Of, Fin>(
-    request: A,
-    threads: Option<usize>,
-    of: Of,
-    open: fn(&DirLock) -> TaskStore<'_, R>,
-    finish: Fin,
-) -> Box<dyn Stored>
-where
-    A: Datasets + Send + 'static,
-    A::Output: Send,
-    S: Study<Record = (usize, R)> + Send + 'static,
-    S::Done: StoredTasks<R>,
-    R: Serialize + DeserializeOwned + Clone + Send + 'static,
-    Of: Fn(&A, &Resolved) -> Result<S, SimError> + Send + 'static,
-    Fin: Fn(&S, Vec<(usize, R)>, &Progress) -> Result<A::Output, SimError> + Send + Sync + 'static,
-{
-    Box::new(Plan {
+/// `request` held until prepared.
+fn held<A: Resumable + Datasets + Send + 'static>(request: A) -> Box<dyn Stored> {
+    Box::new(Held {
         request,
-        threads,
-        of,
-        open,
-        finish,
         ready: None,
     })
 }
@@ -147,55 +495,16 @@ pub fn parse<'de, D: Deserializer<'de>>(
     name: &str,
     d: D,
 ) -> Result<Option<Box<dyn Stored>>, D::Error> {
-    let curve = |s: &CurveStudy, records: Vec<_>, progress: &Progress| s.curve(records, progress);
     Ok(Some(match name {
-        "basins" => {
-            let r = BasinsRequest::deserialize(d)?;
-            let threads = r.threads;
-            let of = |r: &BasinsRequest, m: &Resolved| BasinStudy::new(r, &m.params);
-            let map = |s: &BasinStudy, records: Vec<_>, _: &Progress| {
-                s.map(records.into_iter().map(|(_, r)| r))
-            };
-            plan(r, threads, of, basin_store, map)
-        }
-        "global_continuation" => {
-            let r = GlobalContinuationRequest::deserialize(d)?;
-            let of =
-                |r: &GlobalContinuationRequest, m: &Resolved| ContinuationStudy::new(r, &m.params);
-            let steps = |s: &ContinuationStudy, records, _: &Progress| s.steps(records);
-            plan(r, None, of, continuation_store, steps)
-        }
-        "approach" => plan(
-            ApproachRequest::deserialize(d)?,
-            None,
-            CurveStudy::approach,
-            curve_store,
-            curve,
-        ),
-        "bimodal" => {
-            let of = |r: &ApproachRequest, m: &Resolved| {
-                crate::request::curves::check_bimodal(&m.params)?;
-                CurveStudy::approach(r, m)
-            };
-            plan(
-                ApproachRequest::deserialize(d)?,
-                None,
-                of,
-                curve_store,
-                curve,
-            )
-        }
+        "basins" => held(BasinsRequest::deserialize(d)?),
+        "global_continuation" => held(GlobalContinuationRequest::deserialize(d)?),
+        "approach" => held(ApproachRequest::deserialize(d)?),
+        "bimodal" => held(Bimodal(ApproachRequest::deserialize(d)?)),
         "bifurcation" => Box::new(Sweep {
             request: BifurcationRequest::deserialize(d)?,
             spec: None,
         }),
-        "resonance" => plan(
-            ResonanceRequest::deserialize(d)?,
-            None,
-            CurveStudy::resonance,
-            curve_store,
-            curve,
-        ),
+        "resonance" => held(ResonanceRequest::deserialize(d)?),
         _ => return Ok(None),
     }))
 }
@@ -224,18 +533,14 @@ impl Prepared for Sweep {
             return Err(SimError::Cancelled.into()); // unreachable: only `prepare` makes one
         };
         let study = SweepStudy::new(&self.request, spec.clone());
-        let threads = self.request.threads;
-        let records = match lock {
-            Some(lock) => {
-                let mut s = FileCheckpoint::new(lock);
-                execute(&study, &mut s, resume, threads, progress)?;
-                s.records()?
-            }
-            None => {
-                let mut s = MemoryCheckpoint::default();
-                execute(&study, &mut s, false, threads, progress)?;
-                s.into_records()
-            }
+        let storage = Storage {
+            lock,
+            resume,
+            abort_after: None,
+        };
+        let records = match storage.sweep(&study, self.request.threads, progress)? {
+            Swept::Stored(store) => store.records()?,
+            Swept::Memory(records) => records,
         };
         if let Some(e) = every_point_failed(&records) {
             return Err(e.into());

@@ -25,17 +25,6 @@ pub struct CurveOptions {
     pub dforce_columns: bool,
 }
 
-impl CurveOptions {
-    /// Every file, the columns named as the document, the files named `stem`.
-    pub fn all(stem: &'static str) -> Self {
-        CurveOptions {
-            stem,
-            files: Files::All,
-            dforce_columns: false,
-        }
-    }
-}
-
 /// Which stepped curve is shown.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum CurveKind {

@@ -248,6 +248,95 @@ impl SweepTally {
     }
 }
 
+/// A sweep run into its store's files: the tally of its rows, the finished rows' CSV and its
+/// NPY, and the sweep.
+#[cfg(feature = "files")]
+#[derive(Debug, Clone)]
+pub struct SweepFiles {
+    /// The sweep.
+    pub spec: crate::analysis::bifurcation::SweepSpec,
+    /// The tally of its rows.
+    pub tally: SweepTally,
+    /// The finished rows (`bifurcation.csv`).
+    pub csv: std::path::PathBuf,
+    /// Their NPY (`bifurcation.npy`).
+    pub npy: std::path::PathBuf,
+}
+
+/// A diagram's points, streamed from the store's CSV ([`diagram_point`] of each row): the
+/// memory of a large sweep's figures stays bounded.
+#[cfg(feature = "files")]
+#[derive(Debug)]
+struct StoredDiagram {
+    csv: std::path::PathBuf,
+    column: usize,
+    by_branch: bool,
+}
+
+#[cfg(feature = "files")]
+impl crate::layout::figure::PointSource for StoredDiagram {
+    fn feed(
+        &self,
+        draw: &mut crate::layout::figure::PointSink<'_>,
+    ) -> Result<(), crate::layout::figure::FeedError> {
+        use crate::layout::figure::FeedError;
+        let mut chunk = Vec::with_capacity(4096);
+        crate::request::checkpoint_file::each_row(&self.csv, &mut |r| -> Result<(), FeedError> {
+            chunk.extend(diagram_point(
+                SweepRow::from_csv(r),
+                self.column,
+                self.by_branch,
+            ));
+            if chunk.len() == chunk.capacity() {
+                draw(&chunk).map_err(FeedError::Io)?;
+                chunk.clear();
+            }
+            Ok(())
+        })?;
+        draw(&chunk).map_err(FeedError::Io)
+    }
+}
+
+/// The presentation of a sweep run into its store ([`SweepFiles`]): its summary line (the
+/// directory at its end), the warning of failed points, and the diagrams
+/// ([`BIFURCATION_FIGURES`]) streamed from the store's CSV.
+#[cfg(feature = "files")]
+pub fn stored_bifurcation(files: &SweepFiles, param: SweepParam) -> crate::report::Presentation {
+    use crate::layout::figure::{Plot, StreamedScatter};
+    let (spec, tally) = (&files.spec, &files.tally);
+    let mut p = crate::report::Presentation {
+        outputs_note: crate::report::OutputsNote::Tail,
+        ..Default::default()
+    };
+    p.line(tally.summary(spec.values.len(), param));
+    p.warnings.extend(tally.warning());
+    let branches = branch_legend(spec.continuation, spec.starts);
+    for (stem, column, title, y_label, by_branch) in BIFURCATION_FIGURES {
+        let legend = if by_branch {
+            branches.clone()
+        } else {
+            tally.legend()
+        };
+        let points = StoredDiagram {
+            csv: files.csv.clone(),
+            column,
+            by_branch,
+        };
+        let scatter = StreamedScatter {
+            title: title.into(),
+            labels: (
+                format!("{} ({})", param.symbol(), param.name()),
+                y_label.into(),
+            ),
+            bounds: tally.bounds(column),
+            legend,
+            points: std::sync::Arc::new(points),
+        };
+        p.figure(stem, Plot::Scatter(scatter));
+    }
+    p
+}
+
 /// The legend of the diagram coloured by branch: the continuations and the random starts of a
 /// sweep that has them.
 pub fn branch_legend(continuation: bool, starts: u32) -> Vec<Legend> {
