@@ -380,7 +380,7 @@ impl Analysis for AmReconstruction {
     }
     fn execute(&self, _: &Resolved, progress: &Progress) -> Result<Reconstruction, SimError> {
         let curve = am_curve_from_approach(&self.0)?;
-        crate::analysis::reconstruct_am::matrix_inversion_with(&curve, progress)
+        crate::analysis::reconstruct_am::matrix_inversion(&curve, progress)
     }
     fn name(&self) -> &'static str {
         "reconstruct"
