@@ -308,6 +308,9 @@ mod tests {
         let e = find("RTESPA").unwrap_err();
         assert!(e.contains("RTESPA-300") && e.contains("RTESPA-150"), "{e}");
         assert!(find("nope").unwrap_err().contains("TESPA-V2"));
+        // the levers of PeakForce in liquid (issue 77): a 20 nm and a sharpened 2 nm tip
+        assert_eq!(find("scanasyst-fluid").unwrap().radius, 20e-9);
+        assert_eq!(find("ScanAsyst-Fluid+").unwrap().radius, 2e-9);
     }
 
     #[test]
