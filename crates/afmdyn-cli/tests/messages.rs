@@ -287,7 +287,7 @@ fn an_instrument_file_for_fit_says_where_it_is_read() {
         ],
         &[
             "a binary file",
-            "afmdyn.fit(data=PATH) reads instrument files",
+            "through afmformats (afmdyn.fit(data=PATH))",
         ],
     );
 }

@@ -30,8 +30,8 @@ pub fn read_curve_file(path: &Path) -> Result<CurveFile, InputFileError> {
         return Err(invalid(
             path,
             "not a text curve (CSV or JSON) but a binary file, as an instrument's (JPK's \
-             .jpk-force is a zip archive): the command line reads CSV or JSON; Python's \
-             afmdyn.fit(data=PATH) reads instrument files through afmformats",
+             .jpk-force is a zip archive): the command line reads CSV or JSON curves; Python \
+             reads an instrument's force curves through afmformats (afmdyn.fit(data=PATH))",
         ));
     }
     if first == Some(b'{') {
@@ -42,11 +42,11 @@ pub fn read_curve_file(path: &Path) -> Result<CurveFile, InputFileError> {
     Ok(CurveFile::Columns(names, columns))
 }
 
-/// Whether the first bytes `head` of a file are binary: a zip archive's signature, a NUL byte,
-/// or bytes that are no UTF-8 (a character cut at the buffer's end aside).
+/// Whether the first bytes `head` of a file are binary: a zip archive's signature or bytes that
+/// are no UTF-8 (a character cut at the buffer's end aside). A stream of NUL bytes is text to
+/// this test: the bounded reader refuses it at its line cap, naming the cap.
 fn is_binary(head: &[u8]) -> bool {
     head.starts_with(b"PK\x03\x04")
-        || head.contains(&0)
         || std::str::from_utf8(head).is_err_and(|e| e.error_len().is_some())
 }
 
