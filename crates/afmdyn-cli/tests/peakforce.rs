@@ -232,3 +232,53 @@ fn an_attractive_peak_force_in_contact_is_not_called_no_contact() {
     );
     assert!(!err.contains("never reaches the tip"), "{err}");
 }
+
+/// A modulus_dmt far from the sample's own E*, or from a fit that is not the DMT relation's
+/// shape, is said (issue 77: 0.6–2.9 × E* and residuals up to 0.41 were reported silently); a
+/// tap whose fit reads the sample's modulus is not.
+#[test]
+fn a_biased_modulus_dmt_is_said() {
+    let probe = |name: &str| {
+        concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../examples/probe-peakforce-"
+        )
+        .to_string()
+            + name
+            + ".toml"
+    };
+    let warned = afmdyn(&[
+        "peakforce",
+        "--probe",
+        &probe("amo-garcia"),
+        "--json",
+        "--files",
+        "none",
+    ]);
+    assert!(warned.status.success());
+    let doc: serde_json::Value = serde_json::from_slice(&warned.stdout).unwrap();
+    let ratio = doc["modulus"]["ratio"].as_f64().unwrap();
+    assert!((ratio - 1.0).abs() > 0.1, "{ratio}");
+    let w = doc["warnings"].to_string();
+    assert!(
+        w.contains(&format!(
+            "modulus_dmt reads {ratio:.3} × the sample's own E*"
+        )),
+        "{w}"
+    );
+    assert!(w.contains("the DMT fit's relative residual is"), "{w}");
+    let fine = afmdyn(&[
+        "peakforce",
+        "--probe",
+        &probe("water"),
+        "--json",
+        "--files",
+        "none",
+    ]);
+    let doc: serde_json::Value = serde_json::from_slice(&fine.stdout).unwrap();
+    assert!((doc["modulus"]["ratio"].as_f64().unwrap() - 1.0).abs() < 0.1);
+    assert!(
+        !doc["warnings"].to_string().contains("modulus_dmt"),
+        "{doc}"
+    );
+}

@@ -38,6 +38,7 @@ mod fit;
 mod setpoint;
 
 pub use filter::low_pass_periodic;
+pub(crate) use fit::MIN_FIT_POINTS;
 pub use fit::{fit_dmt, DmtFit, FIT_BAND};
 pub use setpoint::{
     peak_force_setpoint, SetpointOptions, SetpointTap, BRACKET_STEPS, SETPOINT_ITERATIONS,

@@ -313,6 +313,59 @@ fn true_modulus(model: &Resolved, alpha4: f64) -> Option<f64> {
     Some(alpha4 * s.force_n / (4.0 / 3.0 * r.sqrt() * s.length_m.powf(1.5)))
 }
 
+/// A DMT fit whose root-mean-square residual passes this fraction of the fitted force range
+/// is said not to be the DMT relation's shape.
+pub const MAX_FIT_RESIDUAL: f64 = 0.1;
+/// A modulus_dmt more than this fraction off the sample's own E* (which a simulation knows) is
+/// said to be biased.
+pub const MAX_MODULUS_BIAS: f64 = 0.1;
+
+/// Why a single tap's `modulus_dmt` is missing, or where it is not the sample's modulus
+/// (issue 77): no fit (too few retract points in the band), a fit residual above
+/// [`MAX_FIT_RESIDUAL`], a reading more than [`MAX_MODULUS_BIAS`] off the sample's own E*
+/// (Hertz group α4 of `p`). A double tap is said by its own warning.
+fn modulus_warnings(tap: &SteadyTap, band: [f64; 2], p: &Params) -> Vec<String> {
+    if tap.channels.taps_per_cycle > 1.0 + 1e-9 {
+        return Vec::new();
+    }
+    let Some(fit) = tap.fit else {
+        return vec![format!(
+            "modulus_dmt is missing: the DMT fit needs at least {} retract points between {} and \
+             {} of the force range from the adhesion to the peak force, and this tap's retract \
+             has fewer there (a contact short against the cycle's samples: raise samples, or \
+             widen fit_band)",
+            crate::analysis::peakforce::MIN_FIT_POINTS,
+            band[0],
+            band[1]
+        )];
+    };
+    let mut w = Vec::new();
+    if fit.relative_residual > MAX_FIT_RESIDUAL {
+        w.push(format!(
+            "modulus_dmt: the DMT fit's relative residual is {:.3} (above {MAX_FIT_RESIDUAL}): \
+             the retract curve in the fit band does not have the DMT relation's shape, so the \
+             modulus is not meaningful",
+            fit.relative_residual
+        ));
+    }
+    let ratio = fit.hertz_group / p.alpha4;
+    if (ratio - 1.0).abs() > MAX_MODULUS_BIAS {
+        let law = p.contact_law.name();
+        let other_law = match law {
+            "hertz" | "dmt" => String::new(),
+            _ => format!("a {law} sample read with the DMT relation, "),
+        };
+        w.push(format!(
+            "modulus_dmt reads {ratio:.3} × the sample's own E* (more than {:.0} % off): the DMT \
+             fit of this tap is biased ({other_law}the lever's inertia and ringing within the \
+             tap, an indentation past the paraboloid's validity): compare it against a \
+             calibration sample, not as the sample's modulus",
+            MAX_MODULUS_BIAS * 100.0
+        ));
+    }
+    w
+}
+
 /// The factor from the fitted Hertz group (model units) to the reduced modulus E* (Pa) of the
 /// model `p` under the probe of `model`; `None` for a law without a tip radius (no modulus)
 /// or without a probe (the Hertz group itself is reported).
@@ -354,6 +407,9 @@ pub fn document(request: &PeakForceRequest, model: &Resolved, r: &PeakForceResul
             .map(|(_, w)| w)
             .collect()
     };
+    if r.sweep.is_none() && has_radius {
+        warnings.extend(modulus_warnings(tap, request.fit_band, &p));
+    }
     let t = &tap.cycle;
     let multipliers: Vec<[f64; 2]> = tap.multipliers.iter().map(|m| [m.re, m.im]).collect();
     let period = std::f64::consts::TAU / p.omega;
