@@ -282,3 +282,28 @@ fn a_biased_modulus_dmt_is_said() {
         "{doc}"
     );
 }
+
+/// A dissipation within the cycle's energy balance residual prints as 0, not as a round-off
+/// value (issue 77: "dissipation -5.3e-12 aJ per cycle" on an elastic sample).
+#[test]
+fn a_round_off_dissipation_prints_as_zero() {
+    let out = afmdyn(&[
+        "peakforce",
+        "--probe",
+        AIR,
+        "--z-c",
+        "95nm",
+        "--files",
+        "none",
+    ]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        text.contains("dissipation 0 (within the energy balance's residual,"),
+        "{text}"
+    );
+}

@@ -235,6 +235,31 @@ pub fn si_value(v: f64, unit: &str, plain: bool) -> String {
     format!("{m:.digits$} {p}{unit}")
 }
 
+/// The format of an estimate `v` with its standard error `se` in `unit` (issue 77: an error
+/// printed with more digits than its value): every number of the estimate (the value, the
+/// error, the interval's ends) with the SI prefix of the larger of |v| and `se` and the error's
+/// two significant digits, `0.07988 aJ ± 0.00043 aJ` (the rounding convention of the GUM, JCGM
+/// 100:2008 §7.2.6). `None` where the error is not finite and positive, or the values need a
+/// power of ten besides the prefix (plain SI): they print one by one ([`si_value`]) then.
+pub fn si_with_error(
+    v: f64,
+    se: f64,
+    unit: &str,
+    plain: bool,
+) -> Option<impl Fn(f64) -> String + '_> {
+    if !(v.is_finite() && se.is_finite() && se > 0.0) {
+        return None;
+    }
+    let big = v.abs().max(se);
+    let (e, p) = si_prefix(big, plain);
+    let scale = 10f64.powi(e);
+    if !(1e-3..1e4).contains(&(big / scale)) {
+        return None;
+    }
+    let digits = (1 - (se / scale).log10().floor() as i32).clamp(0, 15) as usize;
+    Some(move |x: f64| format!("{:.digits$} {p}{unit}", x / scale))
+}
+
 /// The units of a text summary: SI with a probe (lengths, frequencies and rates through its
 /// scales, printed by [`si_value`]), else the model's (g₀, Ω, per unit τ).
 #[derive(Debug, Clone, Copy)]
@@ -293,7 +318,33 @@ impl TextUnits {
 
 #[cfg(test)]
 mod tests {
-    use super::{si_value, OutputsNote, Presentation};
+    use super::{si_value, si_with_error, OutputsNote, Presentation};
+
+    /// An estimate prints its error to two significant digits and every number to the same
+    /// decimal place, with one prefix (issue 77: "0.07988 aJ ± 4.346295e-4 aJ").
+    #[test]
+    fn an_error_sets_the_digits_of_its_estimate() {
+        let f = si_with_error(7.988e-20, 4.346295e-22, "J", false).unwrap();
+        assert_eq!(
+            (f(7.988e-20), f(4.346295e-22)),
+            ("0.07988 aJ".into(), "0.00043 aJ".into())
+        );
+        let f = si_with_error(4998.63, 1.28348, "Pa", false).unwrap();
+        assert_eq!(
+            (f(4998.63), f(1.28348)),
+            ("4.9986 kPa".into(), "0.0013 kPa".into())
+        );
+        let f = si_with_error(31.6318e-9, 208.954e-12, "m", false).unwrap();
+        assert_eq!(f(31.6318e-9), "31.63 nm");
+        // an error larger than its value sets the prefix; no error, no rounding
+        let f = si_with_error(-1.67529e-12, 1.77567e-12, "N", false).unwrap();
+        assert_eq!(
+            (f(-1.67529e-12), f(1.77567e-12)),
+            ("-1.7 pN".into(), "1.8 pN".into())
+        );
+        assert!(si_with_error(1.0, 0.0, "m", false).is_none());
+        assert!(si_with_error(1.0, f64::NAN, "m", false).is_none());
+    }
 
     /// The output directory is named where the presentation says: on its own line at the end
     /// or after a number of lines, or at the end of the last line ("no files written" without

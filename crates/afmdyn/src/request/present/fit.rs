@@ -29,7 +29,15 @@ pub fn fit(
     if let Some(est) = document["estimates"].as_object() {
         for (name, e) in est {
             let unit = units[name.as_str()].as_str().unwrap_or("");
-            let v = |x: &Value| x.as_f64().map_or("—".into(), |x| text.value(x, unit));
+            let num = |x: &Value| x.as_f64().unwrap_or(f64::NAN);
+            let (value, se) = (num(&e["value"]), num(&e["standard_error"]));
+            // the error's two digits set the decimals of every number, where it has them
+            let rounded = crate::report::si_with_error(value, se, unit, text.plain);
+            let v = |x: &Value| match (x.as_f64(), &rounded) {
+                (None, _) => "—".into(),
+                (Some(x), Some(f)) => f(x),
+                (Some(x), None) => text.value(x, unit),
+            };
             p.line(format!(
                 "{name} = {} ± {} (95 % interval [{}, {}])",
                 v(&e["value"]),

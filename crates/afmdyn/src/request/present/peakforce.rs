@@ -166,6 +166,20 @@ fn summary(p: &mut Presentation, document: &Value, text: TextUnits, sweep: Optio
             format!("{v:e} {model_unit}")
         }
     };
+    // a dissipation within the cycle's energy balance residual is round-off, not a value
+    // (issue 77: "dissipation -5.3e-12 aJ per cycle" on an elastic sample)
+    let (dissipation, residual) = (
+        num(&ch["dissipation"]),
+        num(&document["balance"]["residual"]),
+    );
+    let dissipation = if dissipation.abs() <= residual {
+        format!(
+            "0 (within the energy balance's residual, {})",
+            value(residual, "J", "F·g0")
+        )
+    } else {
+        value(dissipation, "J", "F·g0")
+    };
     p.line(format!(
         "steady tap at z_c = {}: peak force {}, adhesion {}, deformation {}, dissipation {} per \
          cycle",
@@ -173,7 +187,7 @@ fn summary(p: &mut Presentation, document: &Value, text: TextUnits, sweep: Optio
         value(num(&ch["peak_force"]), "N", "F"),
         value(num(&ch["adhesion"]), "N", "F"),
         value(num(&ch["deformation"]), "m", "g0"),
-        value(num(&ch["dissipation"]), "J", "F·g0"),
+        dissipation,
     ));
     p.line(format!(
         "contact time {}, snap-off at {}, ringing {}",
