@@ -13,6 +13,31 @@ use std::path::Path;
 /// The columns of the fitted curve's table (`fit-curve.csv`, Python's Dataset variables).
 pub const CURVE_COLUMNS: [&str; 4] = ["tip_position", "force", "fit", "residual"];
 
+/// The summary line of the estimate `e` of `name` in `unit`: value ± standard error and the
+/// 95 % interval, the error's two digits setting the decimals of every number where it has
+/// them ([`crate::report::si_with_error`]).
+fn estimate_line(name: &str, e: &Value, unit: &str, text: TextUnits) -> String {
+    let num = |x: &Value| x.as_f64().unwrap_or(f64::NAN);
+    let rounded = crate::report::si_with_error(
+        num(&e["value"]),
+        num(&e["standard_error"]),
+        unit,
+        text.plain,
+    );
+    let v = |x: &Value| match (x.as_f64(), &rounded) {
+        (None, _) => "—".into(),
+        (Some(x), Some(f)) => f(x),
+        (Some(x), None) => text.value(x, unit),
+    };
+    format!(
+        "{name} = {} ± {} (95 % interval [{}, {}])",
+        v(&e["value"]),
+        v(&e["standard_error"]),
+        v(&e["interval"][0]),
+        v(&e["interval"][1]),
+    )
+}
+
 /// The presentation of a fit's `document` ([`crate::request::fit::document`]): the summary,
 /// and with `files` the table, the figures (all files) and the document `fit.json`.
 pub fn fit(
@@ -29,22 +54,7 @@ pub fn fit(
     if let Some(est) = document["estimates"].as_object() {
         for (name, e) in est {
             let unit = units[name.as_str()].as_str().unwrap_or("");
-            let num = |x: &Value| x.as_f64().unwrap_or(f64::NAN);
-            let (value, se) = (num(&e["value"]), num(&e["standard_error"]));
-            // the error's two digits set the decimals of every number, where it has them
-            let rounded = crate::report::si_with_error(value, se, unit, text.plain);
-            let v = |x: &Value| match (x.as_f64(), &rounded) {
-                (None, _) => "—".into(),
-                (Some(x), Some(f)) => f(x),
-                (Some(x), None) => text.value(x, unit),
-            };
-            p.line(format!(
-                "{name} = {} ± {} (95 % interval [{}, {}])",
-                v(&e["value"]),
-                v(&e["standard_error"]),
-                v(&e["interval"][0]),
-                v(&e["interval"][1]),
-            ));
+            p.line(estimate_line(name, e, unit, text));
         }
     }
     // a force curve names its segment; a dynamic curve its kind (AM, with the bimodal
