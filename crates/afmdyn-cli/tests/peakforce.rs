@@ -144,19 +144,30 @@ fn peakforce_refuses_a_setpoint_in_newtons() {
     assert!(err.contains("setpoint = 5e-10 N: no z_c gives"), "{err}");
 }
 
+/// The air example's probe in `dir` with a 20 nm tip on a compliant, adhesive DMT sample of
+/// Young's modulus `modulus` (Pa; Hamaker constant 2e-19 J): JKR's regime by its Tabor
+/// parameter.
+fn adhesive_air_probe(dir: &std::path::Path, modulus: &str) -> std::path::PathBuf {
+    let probe = std::fs::read_to_string(AIR)
+        .unwrap()
+        .replace(
+            "youngs_modulus = 2.7e9",
+            &format!("youngs_modulus = {modulus}"),
+        )
+        .replace("radius = 2e-9", "radius = 20e-9")
+        .replace("hamaker = 6.6e-20", "hamaker = 2e-19");
+    let path = dir.join("probe.toml");
+    std::fs::write(&path, probe).unwrap();
+    path
+}
+
 /// The probe's own warnings reach a PeakForce image as they reach `peakforce` (issue 77: the
 /// Tabor warning of a compliant, adhesive DMT sample was missing from `image --mode
 /// peakforce` on the same probe).
 #[test]
 fn a_peakforce_image_carries_the_probes_tabor_warning() {
     let dir = tempfile::tempdir().unwrap();
-    let probe = std::fs::read_to_string(AIR)
-        .unwrap()
-        .replace("youngs_modulus = 2.7e9", "youngs_modulus = 2e8")
-        .replace("radius = 2e-9", "radius = 20e-9")
-        .replace("hamaker = 6.6e-20", "hamaker = 2e-19");
-    let probe_path = dir.path().join("probe.toml");
-    std::fs::write(&probe_path, probe).unwrap();
+    let probe_path = adhesive_air_probe(dir.path(), "2e8");
     let sample = dir.path().join("flat.toml");
     std::fs::write(&sample, "size = [1.0e-6, 1.0e-6]\n").unwrap();
     let tabor = "the sample's Tabor parameter is 14.9";
@@ -200,13 +211,7 @@ fn a_peakforce_image_carries_the_probes_tabor_warning() {
 #[test]
 fn an_attractive_peak_force_in_contact_is_not_called_no_contact() {
     let dir = tempfile::tempdir().unwrap();
-    let probe = std::fs::read_to_string(AIR)
-        .unwrap()
-        .replace("youngs_modulus = 2.7e9", "youngs_modulus = 5e6")
-        .replace("radius = 2e-9", "radius = 20e-9")
-        .replace("hamaker = 6.6e-20", "hamaker = 2e-19");
-    let path = dir.path().join("probe.toml");
-    std::fs::write(&path, probe).unwrap();
+    let path = adhesive_air_probe(dir.path(), "5e6");
     let out = afmdyn(&[
         "peakforce",
         "--probe",
