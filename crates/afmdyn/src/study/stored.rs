@@ -197,54 +197,34 @@ fn curve(
     Ok(study.curve(records, progress)?)
 }
 
-impl Resumable for ApproachRequest {
-    type Study = CurveStudy;
-    fn study(&self, model: &Resolved) -> Result<CurveStudy, SimError> {
-        CurveStudy::approach(self, model)
-    }
-    fn resume(
-        &self,
-        study: &CurveStudy,
-        _: &Resolved,
-        storage: Storage<'_>,
-        progress: &Progress,
-    ) -> Result<Self::Output, StudyError> {
-        curve(study, storage, progress)
-    }
+/// `Resumable` for a stepped-curve request whose study `$study(request, model)` makes: its
+/// points run into the curve store, then its branches ([`curve`]).
+macro_rules! curve_resumable {
+    ($request:ty, $study:expr) => {
+        impl Resumable for $request {
+            type Study = CurveStudy;
+            fn study(&self, model: &Resolved) -> Result<CurveStudy, SimError> {
+                $study(self, model)
+            }
+            fn resume(
+                &self,
+                study: &CurveStudy,
+                _: &Resolved,
+                storage: Storage<'_>,
+                progress: &Progress,
+            ) -> Result<Self::Output, StudyError> {
+                curve(study, storage, progress)
+            }
+        }
+    };
 }
 
-impl Resumable for Bimodal {
-    type Study = CurveStudy;
-    fn study(&self, model: &Resolved) -> Result<CurveStudy, SimError> {
-        crate::request::curves::check_bimodal(&model.params)?;
-        CurveStudy::approach(&self.0, model)
-    }
-    fn resume(
-        &self,
-        study: &CurveStudy,
-        _: &Resolved,
-        storage: Storage<'_>,
-        progress: &Progress,
-    ) -> Result<Self::Output, StudyError> {
-        curve(study, storage, progress)
-    }
-}
-
-impl Resumable for ResonanceRequest {
-    type Study = CurveStudy;
-    fn study(&self, model: &Resolved) -> Result<CurveStudy, SimError> {
-        CurveStudy::resonance(self, model)
-    }
-    fn resume(
-        &self,
-        study: &CurveStudy,
-        _: &Resolved,
-        storage: Storage<'_>,
-        progress: &Progress,
-    ) -> Result<Self::Output, StudyError> {
-        curve(study, storage, progress)
-    }
-}
+curve_resumable!(ApproachRequest, CurveStudy::approach);
+curve_resumable!(ResonanceRequest, CurveStudy::resonance);
+curve_resumable!(Bimodal, |r: &Bimodal, model: &Resolved| {
+    crate::request::curves::check_bimodal(&model.params)?;
+    CurveStudy::approach(&r.0, model)
+});
 
 impl Resumable for BasinsRequest {
     type Study = BasinStudy;
