@@ -2,13 +2,12 @@
 //! and tolerance as a front end takes them, in the front end's unit of the swept quantity, and
 //! the [`SteppedSpec`] they give ([`approach_request`], [`resonance_request`]).
 
-use super::run::{Analysis, ApproachRequest, Resolved};
 use crate::analysis::approach::{approach_spec, default_range};
 use crate::analysis::observables::free_response;
 use crate::analysis::resonance::{mode_band, mode_resonance, resonance_spec};
 use crate::analysis::stepped::average::AverageOptions;
 use crate::analysis::stepped::{
-    Spacing, SteppedCurve, SteppedSpec, DEFAULT_CURVE_POINTS, DEFAULT_TOLERANCE, MAX_CURVE_POINTS,
+    Spacing, SteppedSpec, DEFAULT_CURVE_POINTS, DEFAULT_TOLERANCE, MAX_CURVE_POINTS,
 };
 use crate::error::SimError;
 use crate::model::CantileverModel;
@@ -380,69 +379,6 @@ pub(crate) fn in_units(e: SimError, unit: f64) -> SimError {
             },
         },
         e => e,
-    }
-}
-
-/// `bimodal`: the approach curve of a drive with two or more components
-/// ([`check_bimodal`]), its files named `bimodal`; its refusals name
-/// the approach curve it is.
-#[derive(Debug, Clone, Deserialize)]
-#[serde(transparent)]
-pub struct Bimodal(pub ApproachRequest);
-
-impl Analysis for Bimodal {
-    type Output = SteppedCurve;
-    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
-        check_bimodal(&model.params)?;
-        self.0.validate(model)
-    }
-    fn execute(
-        &self,
-        model: &Resolved,
-        progress: &crate::analysis::progress::Progress,
-    ) -> Result<Self::Output, SimError> {
-        check_bimodal(&model.params)?;
-        self.0.execute(model, progress)
-    }
-    fn name(&self) -> &'static str {
-        self.0.name()
-    }
-    fn cost(&self, model: &Resolved) -> Result<super::limits::Cost, SimError> {
-        self.0.cost(model)
-    }
-    fn report(&self, model: &Resolved, c: &Self::Output) -> Result<serde_json::Value, SimError> {
-        self.0.report(model, c)
-    }
-    fn largest_indentation(&self, c: &Self::Output) -> Option<f64> {
-        self.0.largest_indentation(c)
-    }
-    fn present(
-        &self,
-        model: &Resolved,
-        c: &Self::Output,
-        document: &serde_json::Value,
-        units: crate::report::TextUnits,
-        to: super::run::Destination<'_>,
-    ) -> Result<crate::report::Presentation, SimError> {
-        let options = to.curve("bimodal");
-        Ok(super::present::curves::stepped(
-            super::present::curves::CurveKind::Approach,
-            model,
-            c,
-            document,
-            units,
-            &options,
-        ))
-    }
-}
-
-impl super::Datasets for Bimodal {
-    fn datasets(
-        &self,
-        model: &Resolved,
-        c: &SteppedCurve,
-    ) -> Result<super::named::Arrays, SimError> {
-        self.0.datasets(model, c)
     }
 }
 

@@ -5,7 +5,7 @@
 
 use super::modes::ModesRequest;
 use super::named::Datasets;
-use super::run::{ApproachRequest, Resolved, ResonanceRequest};
+use super::run::{ApproachRequest, Bimodal, Resolved, ResonanceRequest};
 use super::BasinArrays;
 use super::{
     AttractorsRequest, BasinsRequest, ContinuationRequest, ConvergeRequest, FmRequest,
@@ -347,5 +347,14 @@ impl Datasets for ReconstructRequest {
     fn datasets(&self, _: &Resolved, r: &Self::Output) -> Arrays {
         let layout = super::reconstruct::layout(r, self.law_in_order());
         one("reconstruct", layout)
+    }
+}
+impl Datasets for Bimodal {
+    fn datasets(
+        &self,
+        model: &Resolved,
+        c: &crate::analysis::stepped::SteppedCurve,
+    ) -> Result<super::named::Arrays, SimError> {
+        self.0.datasets(model, c)
     }
 }

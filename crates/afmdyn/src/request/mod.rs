@@ -99,7 +99,7 @@ pub use pool::in_pool;
 pub use pool::thread_pool;
 pub use reconstruct::ReconstructRequest;
 pub use run::{
-    admit, run, run_admitted, Analysis, ApproachRequest, Destination, Document, Resolved,
+    admit, run, run_admitted, Analysis, ApproachRequest, Bimodal, Destination, Document, Resolved,
     ResonanceRequest,
 };
 pub use sweep::{fingerprint, SweepRecord};

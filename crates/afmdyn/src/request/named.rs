@@ -200,7 +200,7 @@ pub fn parse<'de, D: Deserializer<'de>>(
         "lyapunov" => door::<LyapunovRequest, D>(d, false),
         "observe" => door::<ObserveRequest, D>(d, true),
         "approach" => door::<ApproachRequest, D>(d, false),
-        "bimodal" => door::<super::curves::Bimodal, D>(d, false),
+        "bimodal" => door::<super::run::Bimodal, D>(d, false),
         "resonance" => door::<ResonanceRequest, D>(d, false),
         "basins" => door::<BasinsRequest, D>(d, false),
         "fm" => door::<FmRequest, D>(d, false),

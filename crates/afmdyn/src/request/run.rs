@@ -167,8 +167,8 @@ pub struct Destination<'a> {
 
 impl Destination<'_> {
     /// A stepped curve's options at this destination, its files named `stem`.
-    pub fn curve(&self, stem: &'static str) -> super::present::curves::CurveOptions {
-        super::present::curves::CurveOptions {
+    pub fn curve(&self, stem: &'static str) -> CurveOptions {
+        CurveOptions {
             stem,
             files: self.files,
             dforce_columns: self.dforce_columns,
@@ -624,6 +624,24 @@ impl ResonanceRequest {
         let hz = Self::units(model).hz_per_omega.unwrap_or(1.0);
         resonance_request(self.computed_at(model)?, self.mode, &self.curve, hz)
     }
+}
+
+/// `bimodal`: the approach curve of a drive with two or more components
+/// ([`super::curves::check_bimodal`]), its files named `bimodal`; its refusals name
+/// the approach curve it is.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(transparent)]
+pub struct Bimodal(pub ApproachRequest);
+
+/// How a stepped curve's presentation is made (`--files`, `--dforce-columns`).
+#[derive(Debug, Clone, Copy)]
+pub struct CurveOptions {
+    /// The files' stem (`approach`, `bimodal`, `resonance`).
+    pub stem: &'static str,
+    /// Which files: all (data and figures), the data, none.
+    pub files: super::present::Files,
+    /// Name and order the table's columns as dForce 2.0's `zcdom` table.
+    pub dforce_columns: bool,
 }
 
 #[cfg(test)]

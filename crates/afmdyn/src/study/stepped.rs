@@ -25,7 +25,9 @@ use crate::report;
 use crate::request::costs::{check_cost, stepped_cost};
 use crate::request::limits::Cost;
 use crate::request::present::curves::{stepped, CurveKind};
-use crate::request::run::{Analysis, ApproachRequest, Destination, Resolved, ResonanceRequest};
+use crate::request::run::{
+    Analysis, ApproachRequest, Bimodal, Destination, Resolved, ResonanceRequest,
+};
 use serde::Serialize;
 use serde_json::{json, Value};
 use std::sync::atomic::AtomicBool;
@@ -314,4 +316,49 @@ fn soft_sample_warning(
         crate::error::number(z),
         if u.si { "m" } else { "g0" },
     ))
+}
+impl Analysis for Bimodal {
+    type Output = SteppedCurve;
+    fn validate(&self, model: &Resolved) -> Result<(), SimError> {
+        crate::request::curves::check_bimodal(&model.params)?;
+        self.0.validate(model)
+    }
+    fn execute(
+        &self,
+        model: &Resolved,
+        progress: &crate::analysis::progress::Progress,
+    ) -> Result<Self::Output, SimError> {
+        crate::request::curves::check_bimodal(&model.params)?;
+        self.0.execute(model, progress)
+    }
+    fn name(&self) -> &'static str {
+        self.0.name()
+    }
+    fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
+        self.0.cost(model)
+    }
+    fn report(&self, model: &Resolved, c: &Self::Output) -> Result<serde_json::Value, SimError> {
+        self.0.report(model, c)
+    }
+    fn largest_indentation(&self, c: &Self::Output) -> Option<f64> {
+        self.0.largest_indentation(c)
+    }
+    fn present(
+        &self,
+        model: &Resolved,
+        c: &Self::Output,
+        document: &serde_json::Value,
+        units: crate::report::TextUnits,
+        to: Destination<'_>,
+    ) -> Result<crate::report::Presentation, SimError> {
+        let options = to.curve("bimodal");
+        Ok(stepped(
+            CurveKind::Approach,
+            model,
+            c,
+            document,
+            units,
+            &options,
+        ))
+    }
 }

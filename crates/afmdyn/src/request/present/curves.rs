@@ -11,19 +11,8 @@ use crate::analysis::stepped::{SteppedCurve, Sweep};
 use crate::analysis::traces::Traces;
 use crate::layout::{Layout, Variable};
 use crate::report::{CurveUnits, OutputsNote, Presentation, TextUnits};
-use crate::request::run::{ApproachRequest, Resolved, ResonanceRequest};
+use crate::request::run::{ApproachRequest, CurveOptions, Resolved, ResonanceRequest};
 use serde_json::Value;
-
-/// How a stepped curve's presentation is made (`--files`, `--dforce-columns`).
-#[derive(Debug, Clone, Copy)]
-pub struct CurveOptions {
-    /// The files' stem (`approach`, `bimodal`, `resonance`).
-    pub stem: &'static str,
-    /// Which files: all (data and figures), the data, none.
-    pub files: Files,
-    /// Name and order the table's columns as dForce 2.0's `zcdom` table.
-    pub dforce_columns: bool,
-}
 
 /// Which stepped curve is shown.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
