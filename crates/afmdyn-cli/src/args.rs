@@ -4,6 +4,7 @@
 
 use crate::error::CliError;
 use afmdyn::io::InputKind;
+use afmdyn::probe::ProbeNeeds;
 use afmdyn::request::ModelSpec;
 use afmdyn::request::{LawGroups, LawKind, Params, GROUPS};
 use clap::Args;
@@ -216,12 +217,13 @@ impl ModelArgs {
         })
     }
 
-    /// The probe file, when given (read once per call), with `--cantilever`'s name in it.
-    pub fn probe(&self) -> Result<Option<afmdyn::probe::Probe>, CliError> {
+    /// The probe file, when given (read once per call), with `--cantilever`'s name in it,
+    /// read for a request that uses what `needs` says.
+    pub fn probe(&self, needs: ProbeNeeds) -> Result<Option<afmdyn::probe::Probe>, CliError> {
         let (Some(path), Some(text)) = (&self.probe, self.probe_text()?) else {
             return Ok(None);
         };
-        afmdyn::probe::Probe::parse(&text, &path.display().to_string())
+        afmdyn::probe::Probe::parse_for(&text, &path.display().to_string(), needs)
             .map(Some)
             .map_err(CliError::from)
     }
@@ -238,7 +240,15 @@ impl ModelArgs {
     /// The model values of the flags over the config file, and the probe (unresolved: a
     /// chart resolves them once per cell).
     pub fn spec_and_probe(&self) -> Result<(ModelSpec, Option<afmdyn::probe::Probe>), CliError> {
-        let probe = self.probe()?;
+        self.spec_and_probe_for(ProbeNeeds::Oscillation)
+    }
+
+    /// As [`ModelArgs::spec_and_probe`], the probe read for what `needs` says.
+    fn spec_and_probe_for(
+        &self,
+        needs: ProbeNeeds,
+    ) -> Result<(ModelSpec, Option<afmdyn::probe::Probe>), CliError> {
+        let probe = self.probe(needs)?;
         let file: ModelSpec = match &self.config {
             Some(p) => read_toml(p)?,
             None => ModelSpec::default(),
@@ -252,7 +262,17 @@ impl ModelArgs {
         &self,
         defaults: Params,
     ) -> Result<(Params, Option<afmdyn::probe::Probe>), CliError> {
-        let (spec, probe) = self.spec_and_probe()?;
+        self.resolve_for(defaults, ProbeNeeds::Oscillation)
+    }
+
+    /// As [`ModelArgs::resolve`], the probe read for a request that uses what `needs` says
+    /// (a force-curve fit: the spring constant, tip and sample).
+    pub fn resolve_for(
+        &self,
+        defaults: Params,
+        needs: ProbeNeeds,
+    ) -> Result<(Params, Option<afmdyn::probe::Probe>), CliError> {
+        let (spec, probe) = self.spec_and_probe_for(needs)?;
         let p = spec
             .resolve(defaults, probe.as_ref())
             .map_err(|e| CliError::Input(crate::error::spell(&e)))?;

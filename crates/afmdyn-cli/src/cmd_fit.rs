@@ -13,6 +13,7 @@ use crate::cmd_simulate::Files;
 use crate::door;
 use crate::error::CliError;
 use crate::flags_afm::FitFlags;
+use afmdyn::request::run::Analysis;
 use afmdyn::request::Params;
 use afmdyn::request::Resolved;
 use clap::Args;
@@ -39,9 +40,11 @@ pub struct FitArgs {
 
 /// Run `afmdyn fit`.
 pub fn fit(a: &FitArgs) -> Result<(), CliError> {
-    let (params, probe) = a.model.resolve(Params::default())?;
     // a range may carry a unit with a probe (SI)
-    let request = a.request.request(probe.is_some())?;
+    let request = a.request.request(a.model.probe.is_some())?;
+    let (params, probe) = a
+        .model
+        .resolve_for(Params::default(), request.probe_needs())?;
     let model = Resolved { params, probe };
     let exit = door::Exit {
         json: a.json,

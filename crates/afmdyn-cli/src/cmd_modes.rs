@@ -91,8 +91,8 @@ pub fn units(a: &UnitsArgs) -> Result<(), CliError> {
         (Some(path), _) => {
             let (_, probe) = afmdyn::probe::Probe::source_text(
                 afmdyn::probe::ProbeSource::Path(path),
-                a.cantilever.as_deref(),
-                a.medium.as_deref(),
+                (a.cantilever.as_deref(), a.medium.as_deref()),
+                afmdyn::probe::ProbeNeeds::Oscillation,
             )?;
             let model = Resolved::plain(probe.params);
             let request = UnitsRequest {

@@ -2,7 +2,7 @@
 //! recovered, not reported as a cancellation.
 
 use crate::common;
-use common::{refused, run};
+use common::{json, refused, run};
 
 /// `image --feedback pi --gains 0,1e12` without `--scan-rate` blamed "scan-rate = 1.25e10",
 /// a flag never given: the default scan rate follows K_I (a pixel lasts 5/K_I), so K_I is what
@@ -288,6 +288,44 @@ fn an_instrument_file_for_fit_says_where_it_is_read() {
         &[
             "a binary file",
             "through afmformats (afmdyn.fit(data=PATH))",
+        ],
+    );
+}
+
+/// `fit` of a force curve asks only for what it uses (issue 77 §10): a probe of the spring
+/// constant, the tip and the sample gives the full example probe's estimates, naming the
+/// stand-ins in its SI block; `approach` on the same file still names what it misses.
+#[test]
+fn a_force_curve_fit_takes_a_probe_of_k_tip_and_sample() {
+    let dir = temp_dir("fit-k-tip-sample");
+    let probe = dir.join("probe.toml");
+    std::fs::write(
+        &probe,
+        "[cantilever]\nspring_constant = 0.05\n[tip]\nradius = 5e-6\n[sample]\n\
+         law = \"hertz\"\nyoungs_modulus = 10e3\npoisson_ratio = 0.5\n",
+    )
+    .unwrap();
+    let fit = |p: &str| {
+        json(&[
+            "fit",
+            "--probe",
+            p,
+            "--data",
+            "examples/force-curve-hertz.csv",
+            "--json",
+            "--files",
+            "none",
+        ])
+    };
+    let ours = fit(probe.to_str().unwrap());
+    let full = fit("examples/probe-fit-hertz.toml");
+    assert_eq!(ours["estimates"], full["estimates"]);
+    assert_eq!(ours["si"]["assumed"][0], "model");
+    refused(
+        &["approach", "--probe", probe.to_str().unwrap(), "--json"],
+        &[
+            "missing key [cantilever].resonance_frequency",
+            "missing table [drive]",
         ],
     );
 }

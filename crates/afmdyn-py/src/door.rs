@@ -12,26 +12,26 @@ use crate::errors::{probe_error, sim_error, value_error};
 use crate::params::PyParams;
 use crate::run::{run as run_job, Job, Stop};
 use afmdyn::error::SimError;
-use afmdyn::probe::Probe;
+use afmdyn::probe::{Probe, ProbeNeeds};
 use afmdyn::request::Params;
 use afmdyn::request::Progress;
 use afmdyn::request::{Outcome, Resolved};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-/// A probe file's text parsed (the command line's `--probe`).
-pub fn probe_of(probe: Option<String>) -> PyResult<Option<Probe>> {
-    probe
-        .map(|text| Probe::parse(&text, "probe"))
-        .transpose()
-        .map_err(probe_error)
-}
-
-/// The model of a call: `params` (default: the paper's set) and the probe file's text.
-fn resolved(params: Option<PyRef<'_, PyParams>>, probe: Option<String>) -> PyResult<Resolved> {
+/// The model of a call: `params` (default: the paper's set) and the probe file's text, read
+/// for what the request uses of it (the command line's `--probe`).
+fn resolved(
+    params: Option<PyRef<'_, PyParams>>,
+    probe: Option<String>,
+    needs: ProbeNeeds,
+) -> PyResult<Resolved> {
     Ok(Resolved {
         params: params.map_or_else(Params::default, |p| p.inner),
-        probe: probe_of(probe)?,
+        probe: probe
+            .map(|text| Probe::parse_for(&text, "probe", needs))
+            .transpose()
+            .map_err(probe_error)?,
     })
 }
 
@@ -50,7 +50,7 @@ pub fn run<'py>(
     progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let named = crate::convert::named(name, request)?;
-    let model = resolved(params, probe)?;
+    let model = resolved(params, probe, named.probe_needs())?;
     named.validate(&model).map_err(sim_error)?;
     let cancellable = named.checks_cancel();
     run_outcome(py, progress, cancellable, move |p| named.run(&model, p))
@@ -94,7 +94,7 @@ pub fn run_stored(
     resume: bool,
 ) -> PyResult<Py<PyDict>> {
     let stored = crate::convert::stored(name, request)?;
-    let model = resolved(params, probe)?;
+    let model = resolved(params, probe, ProbeNeeds::Oscillation)?;
     let study = stored.prepare(model).map_err(sim_error)?;
     if resume && store.is_none() {
         let msg = "resume=True needs store= (the directory of the interrupted run)";

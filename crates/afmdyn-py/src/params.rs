@@ -30,17 +30,20 @@ pub fn params_from_kwargs(base: Params, kwargs: Option<&Bound<'_, PyDict>>) -> P
 /// keywords and `modes`/`restitution` override it, the dimensionless ones it sets are refused
 /// ([`afmdyn::request::model::PROBE_SETS`]).
 #[pyfunction]
-#[pyo3(signature = (params=None, default=None, probe=None, model=None))]
+#[pyo3(signature = (params=None, default=None, probe=None, model=None, quasi_static=false))]
 pub fn resolve(
     params: Option<PyRef<'_, PyParams>>,
     default: Option<PyRef<'_, PyParams>>,
     probe: Option<String>,
     model: Option<&Bound<'_, PyDict>>,
+    quasi_static: bool,
 ) -> PyResult<PyParams> {
     let spec = model_spec(model)?;
+    let needs = probe_needs(quasi_static);
     let probe = probe
-        .map(|t| afmdyn::probe::Probe::parse(&t, "probe").map_err(crate::errors::probe_error))
-        .transpose()?;
+        .map(|t| afmdyn::probe::Probe::parse_for(&t, "probe", needs))
+        .transpose()
+        .map_err(crate::errors::probe_error)?;
     let base = match (&params, &probe) {
         (Some(given), Some(pr)) if given.inner != pr.params => {
             return Err(PyValueError::new_err(
@@ -144,7 +147,7 @@ impl PyParams {
     #[staticmethod]
     #[pyo3(signature = (path, **model))]
     fn from_probe(path: &Bound<'_, PyAny>, model: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
-        let text = probe_source(path, None, None)?;
+        let text = probe_source(path, None, None, false)?;
         let pr = afmdyn::probe::Probe::parse(&text, "probe").map_err(crate::errors::probe_error)?;
         Ok(PyParams {
             inner: model_spec(model)?
@@ -223,23 +226,25 @@ impl PyParams {
 /// # Errors
 /// `ValueError` naming the source and every problem; `TypeError` for another type.
 #[pyfunction]
-#[pyo3(signature = (probe, cantilever=None, medium=None))]
+#[pyo3(signature = (probe, cantilever=None, medium=None, quasi_static=false))]
 pub fn probe_source(
     probe: &Bound<'_, PyAny>,
     cantilever: Option<String>,
     medium: Option<String>,
+    quasi_static: bool,
 ) -> PyResult<String> {
     use crate::errors::probe_error;
     use afmdyn::probe::{Probe, ProbeSource};
     use std::path::PathBuf;
-    let (name, medium) = (cantilever.as_deref(), medium.as_deref());
+    let names = (cantilever.as_deref(), medium.as_deref());
+    let needs = probe_needs(quasi_static);
     let r = if let Ok(d) = probe.cast::<pyo3::types::PyDict>() {
         let table = crate::convert::toml_table(d)?;
-        Probe::source_text(ProbeSource::Table(&table), name, medium)
+        Probe::source_text(ProbeSource::Table(&table), names, needs)
     } else if let Ok(s) = probe.extract::<String>() {
-        Probe::source_text(ProbeSource::of_str(&s), name, medium)
+        Probe::source_text(ProbeSource::of_str(&s), names, needs)
     } else if let Ok(p) = probe.extract::<PathBuf>() {
-        Probe::source_text(ProbeSource::Path(&p), name, medium)
+        Probe::source_text(ProbeSource::Path(&p), names, needs)
     } else {
         return Err(pyo3::exceptions::PyTypeError::new_err(format!(
             "probe: expected a path, TOML text or a dict, got {}",
@@ -247,4 +252,14 @@ pub fn probe_source(
         )));
     };
     r.map(|(text, _)| text).map_err(probe_error)
+}
+
+/// What a call uses of its probe: a quasi-static force curve's spring constant, tip and
+/// sample (`quasi_static`), or the oscillating lever.
+fn probe_needs(quasi_static: bool) -> afmdyn::probe::ProbeNeeds {
+    if quasi_static {
+        afmdyn::probe::ProbeNeeds::Static
+    } else {
+        afmdyn::probe::ProbeNeeds::Oscillation
+    }
 }

@@ -61,6 +61,22 @@ def test_fit_takes_columns_and_warns_that_the_noise_is_estimated():
         afmdyn.fit(probe=PROBE, data={"height": h, "force": f}, fit=["sample.hamaker"])
 
 
+def test_a_force_curve_fit_takes_a_probe_of_k_tip_and_sample():
+    """Issue 77 §10: the fit uses the lever's k, the tip and the sample, and asks for no more
+    (the stand-ins of the resonance, Q and drive are named in ``si.assumed``); the estimates
+    are the full probe's. An analysis of the oscillating lever still refuses the file."""
+    minimal = {"cantilever": {"spring_constant": K}, "tip": {"radius": R},
+               "sample": {"law": "hertz", "youngs_modulus": 10e3, "poisson_ratio": NU}}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", afmdyn.AfmdynWarning)
+        ours = afmdyn.fit(probe=minimal, data=str(CURVE), fit=FIT)
+    full = _fit(data=str(CURVE), fit=FIT)
+    assert np.array_equal(ours["estimate"].values, full["estimate"].values)
+    assert json.loads(ours.attrs["summary"])["si"]["assumed"][0] == "model"
+    with pytest.raises(ValueError, match=r"missing table \[drive\]"):
+        afmdyn.approach(probe=minimal)
+
+
 def test_nanite_hertz_paraboloid_gives_the_same_modulus():
     nanite = pytest.importorskip("nanite")
     h, f = _curve()

@@ -238,3 +238,74 @@ fn the_request_refuses_bad_input_in_one_sentence() {
         assert!(!e.contains('\n'), "{e}");
     }
 }
+
+/// A force curve needs what a force curve uses (issue 77 §10): a probe of the spring constant,
+/// the tip and the sample only is read for the fit with stand-ins in place of the resonance,
+/// Q, model and drive, which it names, and the fit on it is the full probe's to the bit
+/// (nothing quasi-static reads the stand-ins); an analysis of the oscillating lever still
+/// refuses the same file, naming the missing keys, and so does an AM curve's fit.
+#[test]
+fn a_force_curve_fit_needs_only_the_spring_constant_tip_and_sample() {
+    use afmdyn::probe::ProbeNeeds;
+    let text = "[cantilever]\nspring_constant = 0.05\n[tip]\nradius = 5e-6\n\
+                [sample]\nlaw = \"hertz\"\nyoungs_modulus = 10e3\npoisson_ratio = 0.5\n";
+    let e = Probe::parse(text, "k-tip-sample").unwrap_err().to_string();
+    for missing in [
+        "missing key model",
+        "missing key [cantilever].resonance_frequency",
+        "missing table [drive]",
+    ] {
+        assert!(e.contains(missing), "{e}");
+    }
+    let p = Probe::parse_for(text, "k-tip-sample", ProbeNeeds::Static).expect("static read");
+    assert_eq!(
+        p.assumed,
+        [
+            "model",
+            "[cantilever].resonance_frequency",
+            "[cantilever].quality_factor",
+            "[drive].free_amplitude"
+        ]
+    );
+    let (h, f) = synthetic(400, 50e-12, 3);
+    let req = request(h, f, &[YOUNGS_MODULUS, "contact_point"]);
+    assert_eq!(
+        afmdyn::request::run::Analysis::probe_needs(&req),
+        ProbeNeeds::Static
+    );
+    let minimal = Resolved {
+        params: p.params,
+        probe: Some(p),
+    };
+    let ours = run(&req, &minimal, &Progress::default()).expect("fit");
+    let full = run(&req, &probe(), &Progress::default()).expect("fit");
+    assert_eq!(ours.json["estimates"], full.json["estimates"]);
+    assert_eq!(ours.json["warnings"], full.json["warnings"]);
+    assert_eq!(ours.json["si"]["assumed"].as_array().map(Vec::len), Some(4));
+    assert!(full.json["si"].get("assumed").is_none());
+    // the full probe is read alike for the fit (nothing stood in for)
+    let text_full = include_str!("../../../examples/probe-fit-hertz.toml");
+    let same = Probe::parse_for(text_full, "full", ProbeNeeds::Static).expect("full");
+    assert!(same.assumed.is_empty());
+    // an AM curve's fit on the stand-ins: refused before any work, naming them
+    let dir = std::env::temp_dir().join(format!("afmdyn-static-am-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let csv = dir.join("am.csv");
+    let rows: String = (0..20)
+        .map(|i| format!("{},{}\n", 20e-9 - i as f64 * 1e-9, 8e-9))
+        .collect();
+    std::fs::write(&csv, format!("z,amplitude\n{rows}")).unwrap();
+    let am = FitRequest {
+        data: Some(csv.display().to_string()),
+        ..FitRequest::default()
+    };
+    let e = run(&am, &minimal, &Progress::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with("probe = without model, [cantilever].resonance_frequency")
+            && e.contains("give the model, the cantilever's resonance_frequency and quality_factor, and [drive]"),
+        "{e}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -103,9 +103,12 @@ fn input_files_are_bounded() {
         let e = afmdyn::probe::Probe::load(zero).unwrap_err();
         assert!(e.to_string().contains("/dev/zero: larger than"), "{e}");
         // the reader of Python's probe= in every form (read the whole of /dev/zero before)
-        let e =
-            afmdyn::probe::Probe::source_text(afmdyn::probe::ProbeSource::Path(zero), None, None)
-                .unwrap_err();
+        let e = afmdyn::probe::Probe::source_text(
+            afmdyn::probe::ProbeSource::Path(zero),
+            (None, None),
+            afmdyn::probe::ProbeNeeds::Oscillation,
+        )
+        .unwrap_err();
         assert!(e.to_string().contains("/dev/zero: larger than"), "{e}");
         assert!(start.elapsed().as_secs_f64() < 5.0);
     }

@@ -745,12 +745,14 @@ def probe_source(
     probe: Union[str, "os.PathLike[str]", Dict[str, Any]],
     cantilever: Optional[str] = None,
     medium: Optional[str] = None,
+    quasi_static: bool = False,
 ) -> str: ...
 def resolve(
     params: Optional[Params] = None,
     default: Optional[Params] = None,
     probe: Optional[str] = None,
     model: Optional[Dict[str, Any]] = None,
+    quasi_static: bool = False,
 ) -> Params: ...
 
 class ChartStudy:

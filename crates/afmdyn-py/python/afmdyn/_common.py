@@ -59,28 +59,35 @@ def _real_array(name: str, v: Any, ndim: int) -> np.ndarray:
 
 
 def _params(
-    params: Optional[Params], model: Any, default: Optional[Params] = None
+    params: Optional[Params],
+    model: Any,
+    default: Optional[Params] = None,
+    quasi_static: bool = False,
 ) -> Tuple[Params, Optional[str]]:
     """The parameter set of an analysis call and its probe file (or ``None``), resolved by the
     library as the command line resolves ``--probe``/``--config`` and the model flags:
     ``params`` (or the probe's set, or ``default``, or the paper's set) with the ``model``
-    keywords applied."""
-    params, probe, model = _inputs(params, model)
-    return _core.resolve(params, default, probe, model), probe
+    keywords applied; ``quasi_static`` for a call that uses only the probe's spring constant,
+    tip and sample (a force curve's fit: the library's ``ProbeNeeds::Static``)."""
+    params, probe, model = _inputs(params, model, quasi_static)
+    return _core.resolve(params, default, probe, model, quasi_static), probe
 
 
-def _inputs(params: Optional[Params], model: Any) -> Tuple[Optional[Params], Optional[str], Any]:
+def _inputs(
+    params: Optional[Params], model: Any, quasi_static: bool = False
+) -> Tuple[Optional[Params], Optional[str], Any]:
     """``params`` checked, the probe's text and the other ``model`` keywords (a new dict)."""
     if params is not None and not isinstance(params, Params):
         raise TypeError(f"params: expected afmdyn.Params or None, got {type(params).__name__}")
     model = dict(model)
-    return params, _probe_text(model), model
+    return params, _probe_text(model, quasi_static), model
 
 
-def _probe_text(model: Dict[str, Any]) -> Optional[str]:
+def _probe_text(model: Dict[str, Any], quasi_static: bool = False) -> Optional[str]:
     """Pop ``probe``, ``cantilever`` and ``medium`` from the model keywords: the probe's TOML
     text with the cantilever's name and the fluid (``"water"``, ``"air"`` or ``"none"``) set
-    (the library's ``Probe::source_text``), checked, or ``None``."""
+    (the library's ``Probe::source_text``), checked (for a quasi-static call with
+    ``quasi_static``), or ``None``."""
     probe = model.pop("probe", None)
     cantilever = model.pop("cantilever", None)
     medium = model.pop("medium", None)
@@ -94,7 +101,7 @@ def _probe_text(model: Dict[str, Any]) -> Optional[str]:
         return None
     if not isinstance(probe, (str, dict)):
         probe = os.fspath(probe)
-    return _core.probe_source(probe, cantilever, medium)
+    return _core.probe_source(probe, cantilever, medium, quasi_static)
 
 
 def _state(initial: StateLike) -> Optional[list]:

@@ -39,7 +39,9 @@ def _finish_fit(a: Dict[str, Any]) -> xr.Dataset:
         for key in ("height", "force", "sigma", "time"):
             if key in data:
                 request[key] = [float(v) for v in np.asarray(data[key], dtype=float)]
-    p, probe = _params(a["params"], a["model"])
+    # a force curve uses the probe's spring constant, tip and sample (the library refuses
+    # an AM, FM or bimodal curve's fit on a probe read so)
+    p, probe = _params(a["params"], a["model"], quasi_static=True)
     d = _door("fit", "fit", a["progress"], p, probe, request)
     doc = json.loads(d["json"])
     k = doc["preprocessing"]["spring_constant"]

@@ -310,7 +310,35 @@ pub struct Probe {
     /// what `fit` starts its parameters from, by their probe keys.
     #[serde(skip)]
     pub sample_inputs: SampleInputs,
+    /// The keys a quasi-static read ([`ProbeNeeds::Static`]) stood in for because the file
+    /// omits them (`[cantilever].quality_factor`, `[drive]`, …): values no quasi-static
+    /// analysis reads, which an analysis of the oscillating lever refuses. Empty otherwise.
+    #[serde(skip)]
+    pub assumed: Vec<String>,
 }
+
+/// What a request uses of a probe ([`crate::request::run::Analysis::probe_needs`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ProbeNeeds {
+    /// The oscillating lever: `model`, the cantilever's resonance and Q, and `[drive]`, as
+    /// every dynamic analysis does.
+    #[default]
+    Oscillation,
+    /// A quasi-static force curve: the spring constant, the tip and the sample only. The
+    /// resonance, Q, `model` and `[drive]` a file omits are stood in for by
+    /// [`STATIC_STAND_INS`] and named in [`Probe::assumed`].
+    Static,
+}
+
+/// The values a quasi-static read ([`ProbeNeeds::Static`]) puts where the file omits them:
+/// key (`section.key`, `model` at the root) and TOML value. Nothing quasi-static reads them;
+/// they are typical values (a 50 kHz point-mass lever of Q 100 at 10 nm) only so that the
+/// probe resolves.
+pub const STATIC_STAND_INS: [(&str, f64); 3] = [
+    ("cantilever.resonance_frequency", 50e3),
+    ("cantilever.quality_factor", 100.0),
+    ("drive.free_amplitude", 10e-9),
+];
 
 /// The sample's and tip's SI inputs of a probe file by their keys (`None` where the law takes
 /// none): the start values of `fit`'s parameters (the request `fit`).
@@ -555,7 +583,8 @@ impl Probe {
     /// given (the command line's `--cantilever NAME`, Python's `cantilever=`, which win over a
     /// name in the probe: [`crate::cantilevers::with_name`]) and its fluid set to `medium`
     /// (`--medium NAME`, `medium=`: [`crate::hydro::with_medium`]), checked by resolving it,
-    /// so that every later [`Probe::parse`] of the text succeeds; with the resolved probe.
+    /// so that every later [`Probe::parse_for`] of the text for `needs` succeeds; with the
+    /// resolved probe.
     ///
     /// # Errors
     /// [`ProbeError::Io`] for a file that cannot be read; as [`Probe::parse`], naming the
@@ -563,8 +592,8 @@ impl Probe {
     /// not in the library or a `cantilever` key that is not a table.
     pub fn source_text(
         source: ProbeSource<'_>,
-        cantilever: Option<&str>,
-        medium: Option<&str>,
+        (cantilever, medium): (Option<&str>, Option<&str>),
+        needs: ProbeNeeds,
     ) -> Result<(String, Probe), ProbeError> {
         let origin = source.origin();
         let syntax = |message| ProbeError::Syntax {
@@ -585,7 +614,7 @@ impl Probe {
             None => text,
             Some(name) => crate::hydro::with_medium(&text, name).map_err(syntax)?,
         };
-        let probe = Self::parse(&text, &origin)?;
+        let probe = Self::parse_for(&text, &origin, needs)?;
         Ok((text, probe))
     }
 }
@@ -624,7 +653,16 @@ impl Probe {
     /// [`ProbeError::Syntax`] for invalid TOML, [`ProbeError::Invalid`] listing every unknown,
     /// missing or out-of-range key.
     pub fn parse(text: &str, origin: &str) -> Result<Probe, ProbeError> {
-        Self::from_table(&Self::table(text, origin)?, origin)
+        Self::parse_for(text, origin, ProbeNeeds::Oscillation)
+    }
+
+    /// As [`Probe::parse`], for a request that uses what `needs` says
+    /// ([`Probe::from_table_for`]).
+    ///
+    /// # Errors
+    /// As [`Probe::parse`].
+    pub fn parse_for(text: &str, origin: &str, needs: ProbeNeeds) -> Result<Probe, ProbeError> {
+        Self::from_table_for(&Self::table(text, origin)?, origin, needs)
     }
 
     /// A probe file's TOML text as its table, unresolved (an image reads each domain's sample
@@ -646,18 +684,37 @@ impl Probe {
     /// # Errors
     /// As [`Probe::parse`], but for the syntax.
     pub fn from_table(root: &toml::Table, origin: &str) -> Result<Probe, ProbeError> {
+        Self::from_table_for(root, origin, ProbeNeeds::Oscillation)
+    }
+
+    /// As [`Probe::from_table`], for a request that uses what `needs` says: with
+    /// [`ProbeNeeds::Static`], the keys of [`STATIC_STAND_INS`] (and `model = "point-mass"`) a
+    /// file omits are stood in for and named in [`Probe::assumed`].
+    ///
+    /// # Errors
+    /// As [`Probe::from_table`].
+    pub fn from_table_for(
+        root: &toml::Table,
+        origin: &str,
+        needs: ProbeNeeds,
+    ) -> Result<Probe, ProbeError> {
         // a cantilever of the library fills the keys the file leaves out
         let original = root;
-        let root = crate::cantilevers::fill(root).map_err(|e| ProbeError::Invalid {
+        let mut root = crate::cantilevers::fill(root).map_err(|e| ProbeError::Invalid {
             path: origin.to_string(),
             problems: vec![e],
         })?;
+        let assumed = match needs {
+            ProbeNeeds::Static => stand_in(&mut root),
+            ProbeNeeds::Oscillation => Vec::new(),
+        };
         let mut problems = Vec::new();
         let probe = Self::read(&root, &mut problems);
         match probe {
             Some(mut p) if problems.is_empty() => {
                 p.input_warnings
                     .extend(crate::cantilevers::calibration_warnings(original));
+                p.assumed = assumed;
                 Ok(p)
             }
             _ => {
@@ -676,6 +733,46 @@ impl Probe {
     pub fn z_c_of(&self, params: &Params) -> f64 {
         params.rest_distance() * self.scales.length_m
     }
+}
+
+/// Stand in for the keys of [`STATIC_STAND_INS`] and the root's `model` that `root` omits,
+/// for a calibrated lever (a `[cantilever]` with its `spring_constant`; a geometry, eigenmodes
+/// or a missing section are left to the reader's messages): the keys stood in for.
+fn stand_in(root: &mut toml::Table) -> Vec<String> {
+    let calibrated = root
+        .get("cantilever")
+        .and_then(toml::Value::as_table)
+        .is_some_and(|c| c.contains_key("spring_constant") && !c.contains_key("length"));
+    if !calibrated
+        || root
+            .get("model")
+            .is_some_and(|m| m.as_str() == Some("eigenmodes"))
+    {
+        return Vec::new();
+    }
+    let mut assumed = Vec::new();
+    if !root.contains_key("model") {
+        root.insert("model".into(), "point-mass".into());
+        assumed.push("model".to_string());
+    }
+    let has_q = |c: &toml::Table| c.contains_key("quality_factors");
+    for (key, value) in STATIC_STAND_INS {
+        let (section, name) = key.split_once('.').expect("section.key");
+        let table = root
+            .entry(section)
+            .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+        let Some(t) = table.as_table_mut() else {
+            continue;
+        };
+        let given = t.contains_key(name)
+            || (name == "quality_factor" && has_q(t))
+            || (section == "drive" && !t.is_empty());
+        if !given {
+            t.insert(name.into(), value.into());
+            assumed.push(format!("[{section}].{name}"));
+        }
+    }
+    assumed
 }
 
 type DVectorF = nalgebra::DVector<f64>;

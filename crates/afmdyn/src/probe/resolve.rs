@@ -98,6 +98,7 @@ impl Probe {
             tip_radius: sample.tip_radius(),
             off_resonance: drive.off_resonance,
             sample_inputs: sample.inputs(),
+            assumed: Vec::new(),
         })
     }
 

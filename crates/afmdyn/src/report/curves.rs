@@ -360,6 +360,10 @@ fn drive_components(params: &Params, c: &SteppedCurve, u: &CurveUnits) -> Option
 pub fn with_si(mut doc: Value, probe: Option<&crate::probe::Probe>, params: &Params) -> Value {
     if let Some(p) = probe {
         doc["si"] = si(p, params, &doc);
+        if !p.assumed.is_empty() {
+            // a quasi-static read's stand-ins: in the SI block, but not the file's
+            doc["si"]["assumed"] = Value::from(p.assumed.clone());
+        }
         // the probe's own warnings (a sample outside its law's regime, a value outside its
         // typical range) in every document: joined to its warnings, or as its warnings
         let own = p.warnings();

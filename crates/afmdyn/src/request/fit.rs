@@ -484,7 +484,11 @@ impl Analysis for FitRequest {
     type Output = FitResult;
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
         if super::fit_dynamic::read_am_data(self.data.as_deref())?.is_some() {
-            // an AM curve: its names and columns are checked when it runs
+            // an AM curve: its names and columns are checked when it runs; a probe read
+            // for a force curve (its stand-ins) is refused now
+            if let Some(p) = model.probe.as_ref().filter(|p| !p.assumed.is_empty()) {
+                super::fit_dynamic::am_probe(p)?;
+            }
             return Ok(());
         }
         self.check(model).map(|_| ())
@@ -581,6 +585,12 @@ impl Analysis for FitRequest {
     }
     fn name(&self) -> &'static str {
         "fit"
+    }
+    /// A force curve uses the probe's spring constant, tip and sample only; an AM, FM or
+    /// bimodal curve refuses the values a quasi-static read stood in for
+    /// ([`super::fit_dynamic::am_probe`]).
+    fn probe_needs(&self) -> crate::probe::ProbeNeeds {
+        crate::probe::ProbeNeeds::Static
     }
     fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
         // an AM curve: its stepped approaches, the profiles' refits included

@@ -460,8 +460,18 @@ impl DynamicModel {
 /// The SI values of `probe` the dynamic fit's models scale from ([`AmProbe`]).
 ///
 /// # Errors
-/// [`SimError::OutOfRange`] naming the first of E_s, ν_s, E_t, ν_t and R the probe lacks.
+/// [`SimError::OutOfRange`] naming `probe` and the keys a quasi-static read stood in for
+/// ([`crate::probe::Probe::assumed`]: a dynamic curve needs the lever's resonance, Q and
+/// drive), or the first of E_s, ν_s, E_t, ν_t and R the probe lacks.
 pub fn am_probe(probe: &crate::probe::Probe) -> Result<AmProbe, SimError> {
+    if !probe.assumed.is_empty() {
+        return Err(SimError::out_of_range(
+            "probe",
+            format!("without {}", probe.assumed.join(", ")),
+            "an AM, FM or bimodal curve is fitted with the oscillating lever's model: give \
+             the model, the cantilever's resonance_frequency and quality_factor, and [drive]",
+        ));
+    }
     let s = probe.sample_inputs;
     Ok(AmProbe {
         params: probe.params,

@@ -91,6 +91,10 @@ pub trait Named: Send {
     fn checks_cancel(&self) -> bool {
         true
     }
+    /// What the request uses of a probe ([`Analysis::probe_needs`]).
+    fn probe_needs(&self) -> crate::probe::ProbeNeeds {
+        crate::probe::ProbeNeeds::Oscillation
+    }
 }
 
 /// An [`Analysis`] with its [`Datasets`] as a [`Named`] one; `quick` for one that neither
@@ -118,6 +122,9 @@ where
     }
     fn checks_cancel(&self) -> bool {
         !self.quick
+    }
+    fn probe_needs(&self) -> crate::probe::ProbeNeeds {
+        self.request.probe_needs()
     }
 }
 

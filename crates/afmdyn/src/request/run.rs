@@ -100,6 +100,11 @@ pub trait Analysis {
     fn report(&self, model: &Resolved, output: &Self::Output) -> Result<Value, SimError>;
     /// The request's name in its refusals (`"attractors"`).
     fn name(&self) -> &'static str;
+    /// What the request uses of a probe, which a front end reads it for
+    /// ([`crate::probe::Probe::parse_for`]): the oscillating lever by default.
+    fn probe_needs(&self) -> crate::probe::ProbeNeeds {
+        crate::probe::ProbeNeeds::Oscillation
+    }
     /// What the request costs on `model` — peak memory and work in mode-periods
     /// ([`super::costs`]) — estimated for the worst case its options allow, before any work;
     /// [`run`] refuses it beyond [`super::limits::MAX_REQUEST_BYTES`] or

@@ -57,6 +57,21 @@ pub fn fit(
             p.line(estimate_line(name, e, unit, text));
         }
     }
+    // the parameters held, at their values, so that no held one passes for fitted
+    if let Some(params) = document["parameters"].as_object() {
+        let held: Vec<String> = params
+            .iter()
+            .filter(|(_, q)| q["fitted"] == Value::Bool(false))
+            .map(|(name, q)| {
+                let unit = units[name.as_str()].as_str().unwrap_or("");
+                let value = q["value"].as_f64().unwrap_or(f64::NAN);
+                format!("{name} = {}", text.value(value, unit))
+            })
+            .collect();
+        if !held.is_empty() {
+            p.line(format!("held: {}", held.join(", ")));
+        }
+    }
     // a force curve names its segment; a dynamic curve its kind (AM, with the bimodal
     // channels, or FM)
     let dynamic = document["kind"]
