@@ -53,7 +53,7 @@ fn operating_points(probe_text: &str, r: f64, points: usize) -> Vec<(f64, String
     let spec = approach_request(p.params, &req, u.length, false).unwrap();
     let c = approach_retract(&spec).unwrap();
     let ops = afmdyn::analysis::setpoint::operating_points(&spec, &c, r).unwrap();
-    let doc = setpoint(&p.params, &c, &ops, r, &u);
+    let doc = setpoint(&p.params, &c, (&ops.0, &ops.1), r, &u);
     doc["points"]
         .as_array()
         .unwrap()
@@ -588,5 +588,62 @@ fn without_files_a_height_map_file_is_refused() {
     assert!(
         msg.contains("height_map = \"h.csv\"") && msg.contains("`files` feature"),
         "{msg}"
+    );
+}
+
+/// A setpoint inside the jump of the approach sweep (issue 77: a crossing dropped without a
+/// word): on `examples/probe-point-mass-dmt.toml` without branches, the approach's largest
+/// step in A/A₀ between two stable period-1 points is its jump at the fold; the setpoint at
+/// the jump's middle crosses it, no stable orbit runs from one side to the other, and the
+/// crossing is left out — said in the setpoint's warnings, naming the two z_c of the jump.
+#[test]
+fn a_setpoint_in_a_jump_of_the_curve_is_said_not_left_out() {
+    let p = Probe::parse(&repo("examples/probe-point-mass-dmt.toml"), "<test>").unwrap();
+    let u = CurveUnits::from_scales(&p.scales, false);
+    let req = CurveRequest {
+        points: Some(60),
+        branches: false,
+        ..CurveRequest::default()
+    };
+    let spec = approach_request(p.params, &req, u.length, false).unwrap();
+    let c = approach_retract(&spec).unwrap();
+    let ratio = |i: usize| {
+        let o = &c.first[i].observables;
+        o.amplitude / o.closed_form.free_amplitude
+    };
+    let jump = (0..c.first.len() - 1)
+        .filter(|&i| c.first[i].stable && c.first[i + 1].stable)
+        .max_by(|&i, &j| {
+            (ratio(i) - ratio(i + 1))
+                .abs()
+                .total_cmp(&(ratio(j) - ratio(j + 1)).abs())
+        })
+        .unwrap();
+    let (r0, r1) = (ratio(jump), ratio(jump + 1));
+    assert!((r0 - r1).abs() > 0.02, "no jump: {r0} {r1}");
+    let r = 0.5 * (r0 + r1);
+    let (points, dropped) = afmdyn::analysis::setpoint::operating_points(&spec, &c, r).unwrap();
+    assert!(
+        dropped.iter().any(|k| k.index == jump),
+        "{dropped:?} {points:?}"
+    );
+    let doc = setpoint(&p.params, &c, (&points, &dropped), r, &u);
+    let warnings = doc["warnings"].as_array().expect("warnings");
+    let z = |i: usize| {
+        afmdyn::error::number(
+            p.params.with(spec.param, c.first[i].value).rest_distance() * u.length,
+        )
+    };
+    assert!(
+        warnings.iter().any(|w| {
+            let w = w.as_str().unwrap();
+            w.contains("no operating point is listed")
+                && w.contains(&format!(
+                    "between z_c = {} m and {} m on the approach",
+                    z(jump),
+                    z(jump + 1)
+                ))
+        }),
+        "{warnings:?}"
     );
 }

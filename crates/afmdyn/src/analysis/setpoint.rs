@@ -121,7 +121,8 @@ type Bracketed = (f64, DVector<f64>, f64);
 /// The operating points of `curve` (computed with `spec`) at A/A₀ = `ratio` (module docs):
 /// every crossing of [`setpoint_crossings`] between two periodic orbits of one period refined
 /// to the exact orbit at the setpoint; a crossing with no continuous orbit across its bracket
-/// dropped; a crossing between time-averaged motions interpolated.
+/// dropped (returned apart, for the result to say so); a crossing between time-averaged
+/// motions interpolated.
 ///
 /// # Errors
 /// [`SimError`] from the model of a swept value (the curve's own values are valid).
@@ -129,32 +130,34 @@ pub fn operating_points(
     spec: &SteppedSpec,
     curve: &SteppedCurve,
     ratio: f64,
-) -> Result<Vec<OperatingPoint>, SimError> {
-    let mut out = Vec::new();
+) -> Result<(Vec<OperatingPoint>, Vec<Crossing>), SimError> {
+    let (mut out, mut dropped) = (Vec::new(), Vec::new());
     for k in setpoint_crossings(curve, ratio) {
         let (a, b) = ends(curve, &k);
         match (a.period.zip(a.state), b.period.zip(b.state)) {
             (Some((na, za)), Some((nb, zb))) if na == nb => {
                 let lo = (a.value, za.clone(), a.ratio - ratio);
                 let hi = (b.value, zb.clone(), b.ratio - ratio);
-                if let Some((value, o)) = refine(spec, na, ratio, lo, hi)? {
-                    // a branch that passes the same orbit again (its stretches traced twice)
-                    // gives it once
-                    let seen = out.iter().any(|p: &OperatingPoint| {
-                        p.crossing.source == k.source
-                            && (p.crossing.value - value).abs() <= SAME_ORBIT * (1.0 + value.abs())
-                            && p.exact.as_ref().is_some_and(|e| {
-                                (e.phase - o.phase).abs() <= SAME_ORBIT
-                                    && (e.amplitude - o.amplitude).abs()
-                                        <= SAME_ORBIT * o.amplitude.abs()
-                            })
+                let Some((value, o)) = refine(spec, na, ratio, lo, hi)? else {
+                    dropped.push(k);
+                    continue;
+                };
+                // a branch that passes the same orbit again (its stretches traced twice) gives
+                // it once
+                let seen = out.iter().any(|p: &OperatingPoint| {
+                    p.crossing.source == k.source
+                        && (p.crossing.value - value).abs() <= SAME_ORBIT * (1.0 + value.abs())
+                        && p.exact.as_ref().is_some_and(|e| {
+                            (e.phase - o.phase).abs() <= SAME_ORBIT
+                                && (e.amplitude - o.amplitude).abs()
+                                    <= SAME_ORBIT * o.amplitude.abs()
+                        })
+                });
+                if !seen {
+                    out.push(OperatingPoint {
+                        crossing: Crossing { value, ..k },
+                        exact: Some(o),
                     });
-                    if !seen {
-                        out.push(OperatingPoint {
-                            crossing: Crossing { value, ..k },
-                            exact: Some(o),
-                        });
-                    }
                 }
             }
             _ => out.push(OperatingPoint {
@@ -163,7 +166,7 @@ pub fn operating_points(
             }),
         }
     }
-    Ok(out)
+    Ok((out, dropped))
 }
 
 /// A curve point around a crossing.

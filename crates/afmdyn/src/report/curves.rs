@@ -415,34 +415,19 @@ pub fn regime(mean_deflection: f64) -> &'static str {
 pub fn setpoint(
     params: &Params,
     c: &SteppedCurve,
-    points: &[crate::analysis::setpoint::OperatingPoint],
+    (points, dropped): (
+        &[crate::analysis::setpoint::OperatingPoint],
+        &[crate::analysis::setpoint::Crossing],
+    ),
     ratio: f64,
     u: &CurveUnits,
 ) -> Value {
-    use crate::analysis::setpoint::Source;
     let x = z_c_of(params, u);
     let points: Vec<Value> = points
         .iter()
         .map(|op| {
             let k = &op.crossing;
-            let (name, a, b) = match k.source {
-                Source::Branch(j) => (
-                    format!("branch {j}"),
-                    &c.branches[j][k.index].observables,
-                    &c.branches[j][k.index + 1].observables,
-                ),
-                Source::Sweep(s) => {
-                    let (name, pts) = match s {
-                        Sweep::First => ("approach", &c.first),
-                        Sweep::Second => ("retract", &c.second),
-                    };
-                    (
-                        name.to_string(),
-                        &pts[k.index].observables,
-                        &pts[k.index + 1].observables,
-                    )
-                }
-            };
+            let (name, [(_, a), (_, b)]) = around(c, k);
             // the orbit's own observables; two averaged motions' interpolated
             let mix = |p: &[f64], q: &[f64]| -> Vec<f64> {
                 p.iter()
@@ -476,11 +461,66 @@ pub fn setpoint(
         .first
         .first()
         .map(|p| p.observables.closed_form.free_amplitude * u.length);
-    json!({
+    let mut doc = json!({
         "ratio": ratio,
         "amplitude": a0.map(|a| a * ratio),
         "points": points,
-    })
+    });
+    if !dropped.is_empty() {
+        doc["warnings"] = json!(setpoint_gaps(params, c, dropped, ratio, u));
+    }
+    doc
+}
+
+/// The warnings of the setpoint's crossings that hold no operating point
+/// ([`crate::analysis::setpoint::operating_points`]: no continuous stable orbit across the
+/// bracket, where the curve jumps), so that a crossing left out is said.
+fn setpoint_gaps(
+    params: &Params,
+    c: &SteppedCurve,
+    dropped: &[crate::analysis::setpoint::Crossing],
+    ratio: f64,
+    u: &CurveUnits,
+) -> Vec<String> {
+    let x = z_c_of(params, u);
+    let unit = if u.si { "m" } else { "g0" };
+    dropped
+        .iter()
+        .map(|k| {
+            let (name, [(v0, _), (v1, _)]) = around(c, k);
+            format!(
+                "the setpoint A/A0 = {ratio} falls between z_c = {} {unit} and {} {unit} on the \
+                 {name}, where no stable orbit runs continuously from one to the other (the \
+                 curve jumps there): no operating point is listed for that crossing",
+                crate::error::number(x(v0)),
+                crate::error::number(x(v1)),
+            )
+        })
+        .collect()
+}
+
+/// The curve of crossing `k` (`approach`, `retract` or `branch j`) and its two points around
+/// the crossing: (swept value, observables).
+fn around<'a>(
+    c: &'a SteppedCurve,
+    k: &crate::analysis::setpoint::Crossing,
+) -> (String, [(f64, &'a Observables); 2]) {
+    use crate::analysis::setpoint::Source;
+    let [i, j] = [k.index, k.index + 1];
+    match k.source {
+        Source::Branch(b) => {
+            let at = |i: usize| (c.branches[b][i].point.value, &c.branches[b][i].observables);
+            (format!("branch {b}"), [at(i), at(j)])
+        }
+        Source::Sweep(s) => {
+            let (name, pts) = match s {
+                Sweep::First => ("approach", &c.first),
+                Sweep::Second => ("retract", &c.second),
+            };
+            let at = |i: usize| (pts[i].value, &pts[i].observables);
+            (name.into(), [at(i), at(j)])
+        }
+    }
 }
 
 /// `afmdyn resonance --json`: as [`approach`] with the abscissa `omega` (dimensionless Ω) or

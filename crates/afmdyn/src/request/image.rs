@@ -485,8 +485,8 @@ fn points_at(
     ratio: f64,
     units: &CurveUnits,
 ) -> Result<Vec<OperatingPoint>, SimError> {
-    let points = operating_points(&m.spec, &m.curve, ratio)?;
-    let doc = crate::report::setpoint(&m.params, &m.curve, &points, ratio, units);
+    let (points, dropped) = operating_points(&m.spec, &m.curve, ratio)?;
+    let doc = crate::report::setpoint(&m.params, &m.curve, (&points, &dropped), ratio, units);
     let num = |p: &Value, k: &str| p[k].as_f64().unwrap_or(f64::NAN);
     Ok(doc["points"]
         .as_array()

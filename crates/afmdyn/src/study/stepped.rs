@@ -205,8 +205,13 @@ impl Analysis for ApproachRequest {
         let u = Self::units(model);
         let mut doc = report::approach(&model.params, c, &u);
         if let Some(s) = self.setpoint {
-            let points = operating_points(&self.spec(model)?, c, s)?;
-            doc["setpoint"] = report::setpoint(&model.params, c, &points, s, &u);
+            let (points, dropped) = operating_points(&self.spec(model)?, c, s)?;
+            doc["setpoint"] = report::setpoint(&model.params, c, (&points, &dropped), s, &u);
+            // a crossing left out, in the document's warnings too (every front end shows them)
+            let gaps = doc["setpoint"]["warnings"].as_array().cloned();
+            if let (Some(gaps), Some(ws)) = (gaps, doc["warnings"].as_array_mut()) {
+                ws.extend(gaps);
+            }
         }
         // the default range ends at the soft sample's force bound (default_range): say so when
         // the amplitude has not come down to half the free one by then
