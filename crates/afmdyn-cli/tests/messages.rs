@@ -329,3 +329,38 @@ fn a_force_curve_fit_takes_a_probe_of_k_tip_and_sample() {
         ],
     );
 }
+
+/// A tapping request on a PeakForce (off-resonance) probe is refused naming `drive.mode` and
+/// what to use instead (issue 77 §9: "to = 2e-10: must differ from the start of the sweep" for
+/// `image --mode am`, "alpha2 = inf" for `fm`).
+#[test]
+fn a_tapping_request_on_an_off_resonance_probe_names_the_drive_mode() {
+    let probe = "examples/probe-peakforce-air.toml";
+    for args in [
+        &["approach", "--probe", probe][..],
+        &["fm", "--probe", probe],
+        &["bimodal", "--probe", probe],
+        &[
+            "image",
+            "--probe",
+            probe,
+            "--sample",
+            "examples/sample-stripe.toml",
+            "--setpoint",
+            "0.7",
+            "--mode",
+            "am",
+        ],
+    ] {
+        let mut args = args.to_vec();
+        args.extend(["--files", "none"]);
+        refused(
+            &args,
+            &[
+                "drive.mode = off-resonance",
+                "taps near a resonance",
+                "afmdyn peakforce or image --mode peakforce",
+            ],
+        );
+    }
+}

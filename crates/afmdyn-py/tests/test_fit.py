@@ -274,3 +274,4 @@ def test_the_lever_and_the_samples_viscosity_fit_from_an_am_curve(tmp_path):
                                                      for i in range(10)) + "\n")
     with pytest.raises(ValueError, match="does not constrain Q"):
         afmdyn.fit(probe=probe, data=str(fm), fit=["cantilever.quality_factor"])
+

@@ -228,3 +228,12 @@ def test_probe_as_text_or_dict_and_a_library_cantilever(cli_json, tmp_path):
         afmdyn.approach(probe=bare, cantilever="NO-SUCH-LEVER", points=8)
     with pytest.raises(ValueError, match="needs probe"):
         afmdyn.orbit(cantilever="RTESPA-300")
+
+
+def test_a_tapping_call_on_an_off_resonance_probe_names_the_drive_mode():
+    """Issue 77 §9: an approach curve or FM on a PeakForce probe is refused naming
+    ``drive.mode`` (the library's door, ``Probe::serves``), not an inner sweep's bound."""
+    probe = str(ROOT / "examples" / "probe-peakforce-air.toml")
+    for call in (afmdyn.approach, afmdyn.fm):
+        with pytest.raises(ValueError, match="drive.mode = off-resonance: .* taps near a resonance"):
+            call(probe=probe)

@@ -324,6 +324,10 @@ pub enum ProbeNeeds {
     /// every dynamic analysis does.
     #[default]
     Oscillation,
+    /// Tapping: the lever driven near a resonance at its free amplitude A₀ (an approach
+    /// curve, FM, bimodal, an AM image), which a probe of `[drive] mode = "off-resonance"`
+    /// (PeakForce tapping) does not have ([`Probe::serves`]).
+    Tapping,
     /// A quasi-static force curve: the spring constant, the tip and the sample only. The
     /// resonance, Q, `model` and `[drive]` a file omits are stood in for by
     /// [`STATIC_STAND_INS`] and named in [`Probe::assumed`].
@@ -706,7 +710,7 @@ impl Probe {
         })?;
         let assumed = match needs {
             ProbeNeeds::Static => stand_in(&mut root),
-            ProbeNeeds::Oscillation => Vec::new(),
+            ProbeNeeds::Oscillation | ProbeNeeds::Tapping => Vec::new(),
         };
         let mut problems = Vec::new();
         let probe = Self::read(&root, &mut problems);
@@ -727,6 +731,28 @@ impl Probe {
                 })
             }
         }
+    }
+
+    /// Whether this probe serves request `name`, which uses what `needs` says: a tapping
+    /// request refuses an off-resonance (PeakForce) drive, naming `drive.mode` and what to
+    /// do instead.
+    ///
+    /// # Errors
+    /// [`crate::error::SimError::OutOfRange`] naming `drive.mode`.
+    pub fn serves(&self, name: &str, needs: ProbeNeeds) -> Result<(), crate::error::SimError> {
+        if needs == ProbeNeeds::Tapping && self.off_resonance {
+            return Err(crate::error::SimError::out_of_range(
+                "drive.mode",
+                "off-resonance",
+                format!(
+                    "{name} taps near a resonance at the free amplitude A0, which a PeakForce \
+                     (off-resonance) drive does not have: give the probe a tapping drive \
+                     ([drive] free_amplitude and frequency), or use afmdyn peakforce or \
+                     image --mode peakforce"
+                ),
+            ));
+        }
+        Ok(())
     }
 
     /// The rest distance z_c (m) of a parameter set under these scales.

@@ -245,6 +245,9 @@ impl Analysis for FmRequest {
     fn name(&self) -> &'static str {
         "fm"
     }
+    fn probe_needs(&self) -> crate::probe::ProbeNeeds {
+        crate::probe::ProbeNeeds::Tapping
+    }
     fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
         // every z_c: up to MAX_LOOP_ITERATIONS × MAX_HALVINGS steps of the phase loop, each a
         // Newton solve of the period-1 orbit; a point's orbit and observables kept

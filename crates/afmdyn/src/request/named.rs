@@ -109,7 +109,7 @@ where
     A: Datasets + Send,
 {
     fn validate(&self, model: &Resolved) -> Result<(), SimError> {
-        self.request.validate(model)
+        super::run::validate(&self.request, model)
     }
     fn run(&self, model: &Resolved, progress: &Progress) -> Result<Outcome, SimError> {
         let doc = run(&self.request, model, progress)?;

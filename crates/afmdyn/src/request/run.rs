@@ -234,11 +234,27 @@ pub fn run_admitted<A: Analysis + ?Sized>(
 /// front end's for a request it runs itself (a study into its store, a run streamed to files).
 ///
 /// # Errors
-/// The request's validation errors; [`SimError::Budget`] naming the request, its cost and the
-/// budget.
+/// A probe that does not serve the request ([`crate::probe::Probe::serves`]); the request's
+/// validation errors; [`SimError::Budget`] naming the request, its cost and the budget.
 pub fn admit<A: Analysis + ?Sized>(analysis: &A, model: &Resolved) -> Result<(), SimError> {
-    analysis.validate(model)?;
+    validate(analysis, model)?;
     check_cost(analysis.name(), analysis.cost(model)?)
+}
+
+/// [`admit`] without the cost: the probe held against what the request uses of it
+/// ([`crate::probe::Probe::serves`]), then [`Analysis::validate`] — what a front end checks
+/// before its side effects.
+///
+/// # Errors
+/// As [`admit`], less the budget's.
+pub(crate) fn validate<A: Analysis + ?Sized>(
+    analysis: &A,
+    model: &Resolved,
+) -> Result<(), SimError> {
+    if let Some(p) = &model.probe {
+        p.serves(analysis.name(), analysis.probe_needs())?;
+    }
+    analysis.validate(model)
 }
 
 /// The document of `analysis`'s `output` on `model`: [`Analysis::report`] with the SI block of

@@ -42,6 +42,7 @@ impl Analysis for ImageJob {
             return self.validate_peakforce();
         }
         let background = background_probe(&self.probe)?;
+        background.serves("image --mode am", crate::probe::ProbeNeeds::Tapping)?;
         match (&self.feedback, &self.study) {
             (Some(_), Some(_)) => Err(SimError::out_of_range(
                 "setpoint_study",

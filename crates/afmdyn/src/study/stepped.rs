@@ -198,6 +198,9 @@ impl Analysis for ApproachRequest {
     fn name(&self) -> &'static str {
         "approach"
     }
+    fn probe_needs(&self) -> crate::probe::ProbeNeeds {
+        crate::probe::ProbeNeeds::Tapping
+    }
     fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
         stepped_cost(&self.spec(model)?)
     }
@@ -338,6 +341,9 @@ impl Analysis for Bimodal {
     }
     fn name(&self) -> &'static str {
         self.0.name()
+    }
+    fn probe_needs(&self) -> crate::probe::ProbeNeeds {
+        crate::probe::ProbeNeeds::Tapping
     }
     fn cost(&self, model: &Resolved) -> Result<Cost, SimError> {
         self.0.cost(model)
