@@ -41,6 +41,7 @@ pub mod chart;
 pub mod chart_store;
 pub mod global_continuation;
 pub mod image;
+mod kinds;
 mod memory;
 pub mod peakforce;
 pub mod peakforce_image;
@@ -56,6 +57,7 @@ pub mod sweep;
 #[cfg(feature = "files")]
 pub mod task_store;
 
+pub use kinds::{Chain, Tasks};
 pub use memory::MemoryStore;
 
 use crate::analysis::progress::Progress;
