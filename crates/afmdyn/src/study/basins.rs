@@ -1,4 +1,4 @@
-//! A basin map ([`crate::analysis::basins`]) as a [`Chain`] ([`BasinStudy::chain`]): a task is one
+//! A basin map ([`crate::analysis::basins`]) as a `Chain` (`BasinStudy::chain`): a task is one
 //! row of one pass, numbered `pass × ny + iy`; its record the finished row ([`BasinRow`]: its
 //! cells and the attractors found there); what a resume skips the stored rows themselves, since
 //! each pass begins with the attractors and the coarse grid of the passes before it
@@ -24,7 +24,7 @@ use crate::request::BasinsRequest;
 use serde_json::{json, Value};
 use std::sync::atomic::AtomicBool;
 
-/// A basin map, its study a [`Chain`] (see the module doc): its validated spec, its model and its
+/// A basin map, its study a `Chain` (see the module doc): its validated spec, its model and its
 /// fingerprint.
 #[derive(Debug, Clone)]
 pub struct BasinStudy {
@@ -82,9 +82,9 @@ impl BasinStudy {
         basin_map(&self.spec, records.into_iter().collect())
     }
 
-    /// The map as a [`Chain`]: its rows pass by pass (their cells the units), each pass after
+    /// The map as a `Chain`: its rows pass by pass (their cells the units), each pass after
     /// every stored row ([`run_passes`]).
-    pub fn chain(&self) -> Chain<'_, BasinRow, Vec<BasinRow>> {
+    pub(crate) fn chain(&self) -> Chain<'_, BasinRow, Vec<BasinRow>> {
         let units = (self.spec.xs.len() * self.spec.ys.len()) as u64;
         let run =
             |done: &[BasinRow], sink: &(dyn Fn(usize, BasinRow) + Sync), cancel: &AtomicBool| {

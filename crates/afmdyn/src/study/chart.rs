@@ -1,5 +1,5 @@
 //! A behaviour chart ([`crate::request::chart::Chart`]) as a study of independent tasks
-//! ([`Chart::tasks`]): its tasks are the tiles of [`ChartPlan`] (cells of one row, continued
+//! (`Chart::tasks`): its tasks are the tiles of [`ChartPlan`] (cells of one row, continued
 //! along x), its record a tile's cells with the task's number, what a resume skips the stored
 //! tasks ([`super::chart_store`]).
 
@@ -14,9 +14,9 @@ use crate::request::run::{Analysis, Resolved};
 use serde_json::Value;
 
 impl Chart {
-    /// The chart as a [`Tasks`] study: its tasks the tiles of [`ChartPlan`], each counting its
+    /// The chart as a `Tasks` study: its tasks the tiles of [`ChartPlan`], each counting its
     /// cells (a cell that fails is a cell without attractors, with its message: no task fails).
-    pub fn tasks(&self) -> Tasks<'_, Vec<ChartCell>> {
+    pub(crate) fn tasks(&self) -> Tasks<'_, Vec<ChartCell>> {
         let plan = ChartPlan::new(&self.spec, &self.model);
         let cells: Vec<u64> = (0..plan.tasks())
             .map(|t| plan.tile(t).1.len() as u64)

@@ -1,5 +1,5 @@
-//! A global continuation ([`crate::analysis::global_continuation`]) as a [`Chain`]
-//! ([`ContinuationStudy::chain`]): a task is one value of the parameter, numbered by its place in the
+//! A global continuation ([`crate::analysis::global_continuation`]) as a `Chain`
+//! (`ContinuationStudy::chain`): a task is one value of the parameter, numbered by its place in the
 //! values; its record the value's step (its attractors with their ids); the tasks form one
 //! chain — each value's census is seeded from the previous value's attractors and its ids
 //! matched to them — so what a resume skips is the stored steps themselves, and the chain goes
@@ -26,7 +26,7 @@ use crate::request::GlobalContinuationRequest;
 use serde_json::{json, Value};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
-/// A global continuation, its study a [`Chain`] (see the module doc): its validated spec and its
+/// A global continuation, its study a `Chain` (see the module doc): its validated spec and its
 /// fingerprint.
 #[derive(Debug, Clone)]
 pub struct ContinuationStudy {
@@ -87,10 +87,10 @@ impl ContinuationStudy {
         Ok(records.into_iter().map(|(_, s)| s).collect())
     }
 
-    /// The continuation as a [`Chain`]: its values (their random starts the units), continued
+    /// The continuation as a `Chain`: its values (their random starts the units), continued
     /// after every stored step ([`continue_values`]; a store holds its first values: a step is
     /// stored once the one before it is).
-    pub fn chain(&self) -> Chain<'_, ContinuationStep, Vec<ContinuationStep>> {
+    pub(crate) fn chain(&self) -> Chain<'_, ContinuationStep, Vec<ContinuationStep>> {
         let samples = self.spec.census.samples as u64;
         let units = self.spec.values.len() as u64 * samples;
         let run = |done: &[ContinuationStep],

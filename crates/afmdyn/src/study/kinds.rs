@@ -26,7 +26,7 @@ use std::sync::atomic::AtomicBool;
 type Task<'a, R> = Box<dyn Fn(usize, &AtomicBool) -> Result<Option<R>, SimError> + Sync + 'a>;
 
 /// A study of independent tasks `0..n` (see the module doc).
-pub struct Tasks<'a, R> {
+pub(crate) struct Tasks<'a, R> {
     fingerprint: &'a Value,
     count: usize,
     units: Box<dyn Fn(usize) -> u64 + Sync + 'a>,
@@ -36,7 +36,7 @@ pub struct Tasks<'a, R> {
 impl<'a, R> Tasks<'a, R> {
     /// The study of `count` tasks, `task(t, cancel)` computing task `t` (one progress unit
     /// each), fingerprinted `fingerprint`.
-    pub fn new(
+    pub(crate) fn new(
         fingerprint: &'a Value,
         count: usize,
         task: impl Fn(usize, &AtomicBool) -> Result<Option<R>, SimError> + Sync + 'a,
@@ -50,7 +50,7 @@ impl<'a, R> Tasks<'a, R> {
     }
 
     /// The study with `units(t)` progress units in task `t` (a chart tile's cells).
-    pub fn weighted(self, units: impl Fn(usize) -> u64 + Sync + 'a) -> Tasks<'a, R> {
+    pub(crate) fn weighted(self, units: impl Fn(usize) -> u64 + Sync + 'a) -> Tasks<'a, R> {
         Tasks {
             units: Box::new(units),
             ..self
@@ -103,7 +103,7 @@ type Run<'a, R> =
 
 /// A study whose tasks start from the records before them (see the module doc); `D` is what
 /// a resume reads back: [`Prefix`] (the first unbroken records) or `Vec<R>` (every one).
-pub struct Chain<'a, R, D = Prefix<R>> {
+pub(crate) struct Chain<'a, R, D = Prefix<R>> {
     fingerprint: &'a Value,
     units: u64,
     unit: Box<dyn Fn(&R) -> u64 + Sync + 'a>,
@@ -114,11 +114,10 @@ pub struct Chain<'a, R, D = Prefix<R>> {
 impl<'a, R, D> Chain<'a, R, D> {
     /// The chain of `tasks` tasks (one progress unit each), fingerprinted `fingerprint`, that
     /// `run(stored, sink, cancel)` computes after the `stored` records.
-    pub fn new(
-        fingerprint: &'a Value,
-        tasks: usize,
-        run: impl Fn(&[R], &(dyn Fn(usize, R) + Sync), &AtomicBool) -> Result<(), SimError> + Sync + 'a,
-    ) -> Chain<'a, R, D> {
+    pub(crate) fn new<F>(fingerprint: &'a Value, tasks: usize, run: F) -> Chain<'a, R, D>
+    where
+        F: Fn(&[R], &(dyn Fn(usize, R) + Sync), &AtomicBool) -> Result<(), SimError> + Sync + 'a,
+    {
         Chain {
             fingerprint,
             units: tasks as u64,
@@ -130,7 +129,11 @@ impl<'a, R, D> Chain<'a, R, D> {
 
     /// The chain counted in `units` progress units, `unit(record)` in each record (a basin
     /// row's cells, a continuation value's random starts).
-    pub fn weighted(self, units: u64, unit: impl Fn(&R) -> u64 + Sync + 'a) -> Chain<'a, R, D> {
+    pub(crate) fn weighted(
+        self,
+        units: u64,
+        unit: impl Fn(&R) -> u64 + Sync + 'a,
+    ) -> Chain<'a, R, D> {
         Chain {
             units,
             unit: Box::new(unit),

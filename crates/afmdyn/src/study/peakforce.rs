@@ -1,6 +1,5 @@
-//! A PeakForce sweep ([`crate::analysis::peakforce`]) as a [`Chain`]
-//! ([`PeakForceStudy::chain`]): a
-//! task is one value of the swept quantity (the mean rest separation z_c, or the modulation
+//! A PeakForce sweep ([`crate::analysis::peakforce`]) as a `Chain` (`PeakForceStudy::chain`):
+//! a task is one value of the swept quantity (the mean rest separation z_c, or the modulation
 //! frequency), numbered by its place in the values; its record the steady tap there, or why it
 //! failed. The tasks form one chain: each tap's transient starts from the previous tap's orbit
 //! (its state at τ = 0), which near a smooth branch settles in no more modulation periods
@@ -31,7 +30,7 @@ use nalgebra::DVector;
 use serde_json::{json, Value};
 use std::sync::atomic::{AtomicBool, Ordering};
 
-/// A PeakForce sweep, its study a [`Chain`] (see the module doc).
+/// A PeakForce sweep, its study a `Chain` (see the module doc).
 #[derive(Debug, Clone)]
 pub struct PeakForceStudy {
     /// The model of every value, in the order of the sweep.
@@ -80,9 +79,9 @@ impl PeakForceStudy {
         }
     }
 
-    /// The sweep as a [`Chain`]: its values' taps, each from the orbit of the last tap found
+    /// The sweep as a `Chain`: its values' taps, each from the orbit of the last tap found
     /// (from rest without one), after the stored taps up to the first one missing.
-    pub fn chain(&self) -> Chain<'_, SweepTap> {
+    pub(crate) fn chain(&self) -> Chain<'_, SweepTap> {
         Chain::new(
             &self.fingerprint,
             self.points.len(),
@@ -90,7 +89,7 @@ impl PeakForceStudy {
         )
     }
 
-    /// The taps after `done`, each handed to `sink` (see [`PeakForceStudy::chain`]).
+    /// The taps after `done`, each handed to `sink` (see `PeakForceStudy::chain`).
     fn taps_after(
         &self,
         done: &[SweepTap],

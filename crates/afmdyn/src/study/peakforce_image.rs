@@ -1,4 +1,4 @@
-//! A PeakForce image as a study ([`PeakForceImageStudy::tasks`]: one task per line) and its local run
+//! A PeakForce image as a study (`PeakForceImageStudy::tasks`: one task per line) and its local run
 //! ([`peakforce_image`]); the image itself is [`crate::request::image_peakforce`].
 
 use super::Tasks;
@@ -7,8 +7,8 @@ use crate::request::image::{ImageRequest, SampleMap};
 use crate::request::image_peakforce::{LinePixel, PeakForceImage, PeakForceImageStudy};
 
 impl PeakForceImageStudy {
-    /// The image as a [`Tasks`] study: one task per line (its pixels).
-    pub fn tasks(&self) -> Tasks<'_, Vec<LinePixel>> {
+    /// The image as a `Tasks` study: one task per line (its pixels).
+    pub(crate) fn tasks(&self) -> Tasks<'_, Vec<LinePixel>> {
         Tasks::new(&self.fingerprint, self.lines(), |t, _| {
             self.line(t).map(Some)
         })

@@ -1,4 +1,4 @@
-//! The PI scan of an image as a study ([`ScanStudy::tasks`]: one task per line) and its local run
+//! The PI scan of an image as a study (`ScanStudy::tasks`: one task per line) and its local run
 //! ([`pi_image`]); the scan itself is [`crate::request::image_scan`].
 
 use super::Tasks;
@@ -8,8 +8,8 @@ use crate::request::image::{ImageRequest, SampleMap};
 use crate::request::image_scan::{PiImage, PiScan, ScanStudy};
 
 impl ScanStudy {
-    /// The scan as a [`Tasks`] study: one task per line (its trace and retrace).
-    pub fn tasks(&self) -> Tasks<'_, ScanLine> {
+    /// The scan as a `Tasks` study: one task per line (its trace and retrace).
+    pub(crate) fn tasks(&self) -> Tasks<'_, ScanLine> {
         Tasks::new(&self.fingerprint, self.lines(), |t, cancel| {
             self.line(t, cancel).map(Some)
         })

@@ -1,5 +1,5 @@
 //! A stepped approach–retract or resonance curve ([`crate::analysis::stepped`]) as a
-//! [`Chain`] ([`CurveStudy::chain`]): a task is one point of the two sweeps, numbered 0..n along the
+//! `Chain` (`CurveStudy::chain`): a task is one point of the two sweeps, numbered 0..n along the
 //! first sweep (approach, up-sweep) and n..2n along the sweep back; the points form one chain
 //! — each is stepped from the orbit before it (its state, the secant or quadratic predictor
 //! through the points before, the monodromy trend) — so what a resume skips is the stored
@@ -31,7 +31,7 @@ use crate::request::run::{
 use serde::Serialize;
 use serde_json::{json, Value};
 
-/// A stepped curve, its study a [`Chain`] (see the module doc): its validated spec and its
+/// A stepped curve, its study a `Chain` (see the module doc): its validated spec and its
 /// fingerprint.
 #[derive(Debug, Clone)]
 pub struct CurveStudy {
@@ -121,9 +121,10 @@ impl CurveStudy {
         finish_curve(&self.spec, points, second, progress)
     }
 
-    /// The curve as a [`Chain`]: its points (one unit each) of both sweeps, `0..2n`, stepped
-    /// after the stored points up to the first one missing ([`Prefix`](super::Prefix), [`sweep_points`]).
-    pub fn chain(&self) -> Chain<'_, CurvePoint> {
+    /// The curve as a `Chain`: its points (one unit each) of both sweeps, `0..2n`, stepped
+    /// after the stored points up to the first one missing ([`Prefix`](super::Prefix),
+    /// [`sweep_points`]).
+    pub(crate) fn chain(&self) -> Chain<'_, CurvePoint> {
         let n = 2 * self.spec.values.len();
         Chain::new(&self.fingerprint, n, |done, sink, cancel| {
             let store = |k: usize, p: &CurvePoint| sink(k, p.clone());
