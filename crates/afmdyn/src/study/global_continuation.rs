@@ -77,14 +77,7 @@ impl ContinuationStudy {
         &self,
         records: impl IntoIterator<Item = (usize, ContinuationStep)>,
     ) -> Result<Vec<ContinuationStep>, SimError> {
-        let mut records: Vec<(usize, ContinuationStep)> = records.into_iter().collect();
-        records.sort_by_key(|(t, _)| *t);
-        if records.len() != self.spec.values.len()
-            || records.iter().enumerate().any(|(i, (t, _))| *t != i)
-        {
-            return Err(SimError::Cancelled);
-        }
-        Ok(records.into_iter().map(|(_, s)| s).collect())
+        super::in_order(records.into_iter().collect(), self.spec.values.len())
     }
 
     /// The continuation as a `Chain`: its values (their random starts the units), continued

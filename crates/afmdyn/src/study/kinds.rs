@@ -174,6 +174,18 @@ impl<R: Send, D: AsRef<[R]> + Default + Send + Sync> Study for Chain<'_, R, D> {
     }
 }
 
+/// The records of a finished study of `tasks` tasks (in any order), in the order of the tasks.
+///
+/// # Errors
+/// [`SimError::Cancelled`] when a task is missing (a run cut short).
+pub(crate) fn in_order<R>(mut records: Vec<(usize, R)>, tasks: usize) -> Result<Vec<R>, SimError> {
+    records.sort_by_key(|(t, _)| *t);
+    if records.len() != tasks || records.iter().enumerate().any(|(i, (t, _))| *t != i) {
+        return Err(SimError::Cancelled);
+    }
+    Ok(records.into_iter().map(|(_, r)| r).collect())
+}
+
 impl<R> AsRef<[R]> for Prefix<R> {
     fn as_ref(&self) -> &[R] {
         &self.0

@@ -61,7 +61,7 @@ pub mod sweep;
 #[cfg(feature = "files")]
 pub mod task_store;
 
-pub(crate) use kinds::{Chain, Tasks};
+pub(crate) use kinds::{in_order, Chain, Tasks};
 pub use memory::MemoryStore;
 
 use crate::analysis::progress::Progress;

@@ -45,20 +45,6 @@ pub struct PeakForceStudy {
 }
 
 impl PeakForceStudy {
-    /// The records of a finished study (in any order), in the order of the values.
-    ///
-    /// # Errors
-    /// [`SimError::Cancelled`] when a value is missing (a run cut short).
-    pub fn taps(&self, mut records: Vec<SweepTap>) -> Result<Vec<SweepTap>, SimError> {
-        records.sort_by_key(|r| r.index);
-        if records.len() != self.points.len()
-            || records.iter().enumerate().any(|(i, r)| r.index != i)
-        {
-            return Err(SimError::Cancelled);
-        }
-        Ok(records)
-    }
-
     /// The tap at value `i` from the state `start` at τ = 0.
     fn tap(&self, i: usize, start: &DVector<f64>) -> Result<(Params, SteadyTap, usize), SimError> {
         let p = self.points[i];
@@ -264,7 +250,7 @@ fn execute_sweep(
         fingerprint: json!({"afmdyn": env!("CARGO_PKG_VERSION"), "peakforce": request, "params": p}),
     };
     let records = super::execute_in_memory(&study.chain(), None, progress)?;
-    let taps = study.taps(records.into_iter().map(|(_, t)| t).collect())?;
+    let taps = super::in_order(records, study.points.len())?;
     let failed = taps.iter().filter(|t| t.tap.is_none()).count();
     let Some(first) = taps.iter().find(|t| t.tap.is_some()) else {
         return Err(SimError::EveryRunFailed {

@@ -111,12 +111,7 @@ impl CurveStudy {
         progress: &Progress,
     ) -> Result<SteppedCurve, SimError> {
         let n = self.spec.values.len();
-        let mut records: Vec<(usize, CurvePoint)> = records.into_iter().collect();
-        records.sort_by_key(|(k, _)| *k);
-        if records.len() != 2 * n || records.iter().enumerate().any(|(i, (k, _))| *k != i) {
-            return Err(SimError::Cancelled);
-        }
-        let mut points: Vec<CurvePoint> = records.into_iter().map(|(_, p)| p).collect();
+        let mut points = super::in_order(records.into_iter().collect(), 2 * n)?;
         let second = points.split_off(n);
         finish_curve(&self.spec, points, second, progress)
     }
