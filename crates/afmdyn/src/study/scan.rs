@@ -30,14 +30,6 @@ pub fn pi_image(
     observer: &dyn super::Observer,
 ) -> Result<PiImage, SimError> {
     let study = ScanStudy::new(probe_table, map, req, scan)?;
-    let mut store = super::MemoryStore::default();
-    match super::execute(&study.tasks(), &mut store, false, threads, observer) {
-        Ok(super::Outcome::Cancelled) => return Err(SimError::Cancelled),
-        Ok(_) => {}
-        Err(super::StudyError::Sim(e)) => return Err(e),
-        Err(super::StudyError::Store(e)) => {
-            return Err(SimError::Probe(format!("the scan's store: {e}")))
-        }
-    }
-    study.assemble(store.records)
+    let records = super::execute_in_memory(&study.tasks(), threads, observer)?;
+    study.assemble(records)
 }
