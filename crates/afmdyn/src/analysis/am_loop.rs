@@ -525,20 +525,3 @@ pub fn scan_line(
     retrace.reverse();
     Ok(ScanLine { trace, retrace })
 }
-
-/// Scan the lines `0..lines` not in `done` (on the current rayon pool with the `parallel`
-/// feature, one line per task), handing each finished one to `sink`; start no line once
-/// `cancel` is set. Each line depends only on its number, so the result does not depend on
-/// the thread count.
-///
-/// # Errors
-/// The error of the lowest-numbered line that failed (the others finished are sent).
-pub(crate) fn scan_lines(
-    lines: usize,
-    done: &std::collections::HashSet<usize>,
-    line: &(dyn Fn(usize) -> Result<ScanLine, SimError> + Sync),
-    sink: &(dyn Fn(usize, ScanLine) + Sync),
-    cancel: &AtomicBool,
-) -> Result<(), SimError> {
-    super::tasks::run_independent(lines, done, &|t| line(t).map(Some), sink, cancel)
-}

@@ -169,13 +169,7 @@ pub fn open<C: Checkpoint + ?Sized>(
             }
             None => {}
             Some(ledger) => {
-                // the stored fingerprint went through JSON text: so does this one, so that
-                // numbers compare as they read back
-                let now: Value = serde_json::from_str(&fingerprint.to_string())
-                    .unwrap_or_else(|_| fingerprint.clone());
-                if let Some((field, then, now)) = first_difference(&ledger.fingerprint, &now) {
-                    return Err(CheckpointError::Mismatch { field, then, now });
-                }
+                same_request(&ledger.fingerprint, fingerprint, "")?;
                 if status.partial {
                     return Ok(Some(resume_of(store.done()?)));
                 }
@@ -187,6 +181,28 @@ pub fn open<C: Checkpoint + ?Sized>(
     }
     store.begin(fingerprint)?;
     Ok(Some(Resume::default()))
+}
+
+/// Refuse a resume of the store whose ledger holds `stored` by the request of `fingerprint`
+/// when they differ: [`CheckpointError::Mismatch`] naming the first field that differs
+/// (without `prefix`, the study's own key, `"chart."`).
+pub(crate) fn same_request(
+    stored: &Value,
+    fingerprint: &Value,
+    prefix: &str,
+) -> Result<(), CheckpointError> {
+    // the stored fingerprint went through JSON text: so does this one, so that numbers
+    // compare as they read back
+    let now: Value =
+        serde_json::from_str(&fingerprint.to_string()).unwrap_or_else(|_| fingerprint.clone());
+    match first_difference(stored, &now) {
+        Some((field, then, now)) => Err(CheckpointError::Mismatch {
+            field: field.strip_prefix(prefix).unwrap_or(&field).to_string(),
+            then,
+            now,
+        }),
+        None => Ok(()),
+    }
 }
 
 /// The number of points of a sweep: values × (2 with continuation + random starts).

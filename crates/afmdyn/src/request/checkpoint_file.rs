@@ -186,7 +186,8 @@ impl From<CheckpointError> for crate::layout::figure::FeedError {
     }
 }
 
-fn io<'a>(
+/// An I/O error of the store file `path` while doing `action`, as the store's error.
+pub(crate) fn io<'a>(
     action: &'static str,
     path: &'a Path,
 ) -> impl FnOnce(std::io::Error) -> CheckpointError + 'a {

@@ -1,4 +1,4 @@
-//! A basin map ([`crate::analysis::basins`]) as a [`Study`] ([`BasinStudy`]): a task is one
+//! A basin map ([`crate::analysis::basins`]) as a `Chain` (`BasinStudy::chain`): a task is one
 //! row of one pass, numbered `pass × ny + iy`; its record the finished row ([`BasinRow`]: its
 //! cells and the attractors found there); what a resume skips the stored rows themselves, since
 //! each pass begins with the attractors and the coarse grid of the passes before it
@@ -10,7 +10,7 @@
 //! The request's [`Analysis`] (`request::run`, Python's `afmdyn.basins`) runs this study in
 //! memory.
 
-use super::{execute_in_memory, Study};
+use super::{execute_in_memory, Chain};
 use crate::analysis::basins::{basin_map, run_passes, BasinMap, BasinRow, BasinSpec};
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
@@ -24,7 +24,7 @@ use crate::request::BasinsRequest;
 use serde_json::{json, Value};
 use std::sync::atomic::AtomicBool;
 
-/// A basin map as a [`Study`] (see the module doc): its validated spec, its model and its
+/// A basin map, its study a `Chain` (see the module doc): its validated spec, its model and its
 /// fingerprint.
 #[derive(Debug, Clone)]
 pub struct BasinStudy {
@@ -81,44 +81,17 @@ impl BasinStudy {
     pub fn map(&self, records: impl IntoIterator<Item = BasinRow>) -> Result<BasinMap, SimError> {
         basin_map(&self.spec, records.into_iter().collect())
     }
-}
 
-impl Study for BasinStudy {
-    /// The task's number and its row.
-    type Record = (usize, BasinRow);
-    /// The stored rows.
-    type Done = Vec<BasinRow>;
-
-    fn fingerprint(&self) -> &Value {
-        &self.fingerprint
-    }
-
-    fn units(&self) -> u64 {
-        (self.spec.xs.len() * self.spec.ys.len()) as u64
-    }
-
-    fn done_units(&self, done: &Vec<BasinRow>) -> u64 {
-        done.iter().map(|r| r.cells.len() as u64).sum()
-    }
-
-    fn record_units(&self, record: &(usize, BasinRow)) -> u64 {
-        record.1.cells.len() as u64
-    }
-
-    fn run(
-        &self,
-        done: &Vec<BasinRow>,
-        sink: &(dyn Fn((usize, BasinRow)) + Sync),
-        cancel: &AtomicBool,
-    ) -> Result<(), SimError> {
-        run_passes(
-            &self.spec,
-            &self.model,
-            done,
-            &|row| sink((self.task(row), row.clone())),
-            cancel,
-        )
-        .map(|_| ())
+    /// The map as a `Chain`: its rows pass by pass (their cells the units), each pass after
+    /// every stored row ([`run_passes`]).
+    pub(crate) fn chain(&self) -> Chain<'_, BasinRow, Vec<BasinRow>> {
+        let units = (self.spec.xs.len() * self.spec.ys.len()) as u64;
+        let run =
+            |done: &[BasinRow], sink: &(dyn Fn(usize, BasinRow) + Sync), cancel: &AtomicBool| {
+                let store = |row: &BasinRow| sink(self.task(row), row.clone());
+                run_passes(&self.spec, &self.model, done, &store, cancel).map(|_| ())
+            };
+        Chain::new(&self.fingerprint, 0, run).weighted(units, |row| row.cells.len() as u64)
     }
 }
 
@@ -129,7 +102,7 @@ impl Analysis for BasinsRequest {
     }
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<BasinMap, SimError> {
         let study = BasinStudy::new(self, &model.params)?;
-        let records = execute_in_memory(&study, self.threads, progress)?;
+        let records = execute_in_memory(&study.chain(), self.threads, progress)?;
         crate::request::in_pool(self.threads, || {
             study.map(records.into_iter().map(|(_, r)| r))
         })

@@ -1,9 +1,9 @@
-//! A behaviour chart ([`crate::request::chart::Chart`]) as a [`Study`]: its tasks are the
-//! tiles of [`ChartPlan`] (cells of one row, continued along x), its record a tile's cells
-//! with the task's number, what a resume skips the stored tasks ([`super::chart_store`]).
+//! A behaviour chart ([`crate::request::chart::Chart`]) as a study of independent tasks
+//! (`Chart::tasks`): its tasks are the tiles of [`ChartPlan`] (cells of one row, continued
+//! along x), its record a tile's cells with the task's number, what a resume skips the stored
+//! tasks ([`super::chart_store`]).
 
-use super::{execute_in_memory, Study};
-use crate::analysis::chart::run_chart;
+use super::{execute_in_memory, Tasks};
 pub use crate::analysis::chart::{ChartCell, ChartPlan};
 use crate::analysis::progress::Progress;
 use crate::error::SimError;
@@ -12,42 +12,19 @@ use crate::request::chart::{document, Chart};
 use crate::request::limits::Cost;
 use crate::request::run::{Analysis, Resolved};
 use serde_json::Value;
-use std::collections::HashSet;
-use std::sync::atomic::AtomicBool;
 
-impl Study for Chart {
-    /// A task's number and its cells.
-    type Record = (usize, Vec<ChartCell>);
-    /// The tasks stored.
-    type Done = HashSet<usize>;
-
-    fn fingerprint(&self) -> &Value {
-        &self.fingerprint
-    }
-
-    fn units(&self) -> u64 {
-        (self.spec.x.len() * self.spec.y.len()) as u64
-    }
-
-    fn done_units(&self, done: &HashSet<usize>) -> u64 {
+impl Chart {
+    /// The chart as a `Tasks` study: its tasks the tiles of [`ChartPlan`], each counting its
+    /// cells (a cell that fails is a cell without attractors, with its message: no task fails).
+    pub(crate) fn tasks(&self) -> Tasks<'_, Vec<ChartCell>> {
         let plan = ChartPlan::new(&self.spec, &self.model);
-        done.iter().map(|&t| plan.tile(t).1.len() as u64).sum()
-    }
-
-    fn record_units(&self, record: &(usize, Vec<ChartCell>)) -> u64 {
-        record.1.len() as u64
-    }
-
-    fn run(
-        &self,
-        done: &HashSet<usize>,
-        sink: &(dyn Fn((usize, Vec<ChartCell>)) + Sync),
-        cancel: &AtomicBool,
-    ) -> Result<(), SimError> {
-        // a cell that fails is a cell without attractors, with its message: no task fails
-        let plan = ChartPlan::new(&self.spec, &self.model);
-        run_chart(&plan, done, &|t, cells| sink((t, cells)), cancel);
-        Ok(())
+        let cells: Vec<u64> = (0..plan.tasks())
+            .map(|t| plan.tile(t).1.len() as u64)
+            .collect();
+        Tasks::new(&self.fingerprint, plan.tasks(), move |t, cancel| {
+            Ok(plan.run_task(t, cancel))
+        })
+        .weighted(move |t| cells[t])
     }
 }
 
@@ -62,7 +39,7 @@ impl Analysis for Chart {
         Ok(())
     }
     fn execute(&self, _: &Resolved, progress: &Progress) -> Result<Vec<ChartCell>, SimError> {
-        let cells = cells_of(execute_in_memory(self, self.threads, progress)?);
+        let cells = cells_of(execute_in_memory(&self.tasks(), self.threads, progress)?);
         match every_cell_failed(&cells) {
             Some(e) => Err(e),
             None => Ok(cells),

@@ -1,5 +1,5 @@
-//! A global continuation ([`crate::analysis::global_continuation`]) as a [`Study`]
-//! ([`ContinuationStudy`]): a task is one value of the parameter, numbered by its place in the
+//! A global continuation ([`crate::analysis::global_continuation`]) as a `Chain`
+//! (`ContinuationStudy::chain`): a task is one value of the parameter, numbered by its place in the
 //! values; its record the value's step (its attractors with their ids); the tasks form one
 //! chain — each value's census is seeded from the previous value's attractors and its ids
 //! matched to them — so what a resume skips is the stored steps themselves, and the chain goes
@@ -11,7 +11,7 @@
 //! The request's [`Analysis`] (`request::run`, Python's `afmdyn.global_continuation`) runs
 //! this study in memory.
 
-use super::{execute_in_memory, Study};
+use super::{execute_in_memory, Chain};
 use crate::analysis::global_continuation::{
     continue_values, ContinuationStep, GlobalContinuationSpec,
 };
@@ -26,7 +26,7 @@ use crate::request::GlobalContinuationRequest;
 use serde_json::{json, Value};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
-/// A global continuation as a [`Study`] (see the module doc): its validated spec and its
+/// A global continuation, its study a `Chain` (see the module doc): its validated spec and its
 /// fingerprint.
 #[derive(Debug, Clone)]
 pub struct ContinuationStudy {
@@ -77,52 +77,24 @@ impl ContinuationStudy {
         &self,
         records: impl IntoIterator<Item = (usize, ContinuationStep)>,
     ) -> Result<Vec<ContinuationStep>, SimError> {
-        let mut records: Vec<(usize, ContinuationStep)> = records.into_iter().collect();
-        records.sort_by_key(|(t, _)| *t);
-        if records.len() != self.spec.values.len()
-            || records.iter().enumerate().any(|(i, (t, _))| *t != i)
-        {
-            return Err(SimError::Cancelled);
-        }
-        Ok(records.into_iter().map(|(_, s)| s).collect())
-    }
-}
-
-impl Study for ContinuationStudy {
-    /// The value's place and its step.
-    type Record = (usize, ContinuationStep);
-    /// The stored steps, in the order of the values.
-    type Done = Vec<ContinuationStep>;
-
-    fn fingerprint(&self) -> &Value {
-        &self.fingerprint
+        super::in_order(records.into_iter().collect(), self.spec.values.len())
     }
 
-    /// The random starts of every value.
-    fn units(&self) -> u64 {
-        (self.spec.values.len() * self.spec.census.samples) as u64
-    }
-
-    fn done_units(&self, done: &Vec<ContinuationStep>) -> u64 {
-        (done.len() * self.spec.census.samples) as u64
-    }
-
-    fn record_units(&self, _: &(usize, ContinuationStep)) -> u64 {
-        self.spec.census.samples as u64
-    }
-
-    fn run(
-        &self,
-        done: &Vec<ContinuationStep>,
-        sink: &(dyn Fn((usize, ContinuationStep)) + Sync),
-        cancel: &AtomicBool,
-    ) -> Result<(), SimError> {
-        // the chain of values: a store holds its first values (a stored step after a missing
-        // one cannot be: each is stored once the one before it is)
-        let first = done.len();
-        let index = AtomicUsize::new(first);
-        let store = |s: &ContinuationStep| sink((index.fetch_add(1, Ordering::SeqCst), s.clone()));
-        continue_values(&self.spec, done, cancel, &store).map(|_| ())
+    /// The continuation as a `Chain`: its values (their random starts the units), continued
+    /// after every stored step ([`continue_values`]; a store holds its first values: a step is
+    /// stored once the one before it is).
+    pub(crate) fn chain(&self) -> Chain<'_, ContinuationStep, Vec<ContinuationStep>> {
+        let samples = self.spec.census.samples as u64;
+        let units = self.spec.values.len() as u64 * samples;
+        let run = |done: &[ContinuationStep],
+                   sink: &(dyn Fn(usize, ContinuationStep) + Sync),
+                   cancel: &AtomicBool| {
+            let index = AtomicUsize::new(done.len());
+            let store =
+                |s: &ContinuationStep| sink(index.fetch_add(1, Ordering::SeqCst), s.clone());
+            continue_values(&self.spec, done, cancel, &store).map(|_| ())
+        };
+        Chain::new(&self.fingerprint, self.spec.values.len(), run).weighted(units, move |_| samples)
     }
 }
 
@@ -133,7 +105,8 @@ impl Analysis for GlobalContinuationRequest {
     }
     fn execute(&self, model: &Resolved, progress: &Progress) -> Result<Self::Output, SimError> {
         let study = ContinuationStudy::new(self, &model.params)?;
-        study.steps(execute_in_memory(&study, None, progress)?)
+        let records = execute_in_memory(&study.chain(), None, progress)?;
+        study.steps(records)
     }
     fn name(&self) -> &'static str {
         "attractors --sweep"

@@ -18,14 +18,18 @@
 //!   under one lock, reports progress to an [`Observer`], and finishes the store.
 //! - [`plan`] (feature `files`): the studies as stages of tasks for an executor outside the
 //!   library (Dask), each rebuilt from its recipe, with its ledger.
-//! - the studies: [`chart`] (a behaviour chart's tiles, its store [`chart_store`]), [`sweep`]
-//!   (a bifurcation sweep's points, stored by the request layer's checkpoints), [`basins`]
-//!   (a basin map's rows, pass by pass, its store `basins::basin_store`),
-//!   [`global_continuation`] (a global continuation's values, one chain, its store
-//!   `global_continuation::continuation_store`), [`stepped`] (an approach or resonance
-//!   curve's points, one chain through both sweeps, its store `stepped::curve_store`) and
-//!   [`peakforce`] (a PeakForce sweep's taps, one chain, run in memory). A chain's resume reads its stored records back (its next task starts from them: `Done` is
-//!   the records); a study of independent tasks reads only their numbers.
+//! - the studies: three kinds ([`Study`] implementations). `Tasks`: independent tasks
+//!   `0..n` run in parallel — [`chart`] (a behaviour chart's tiles, its store [`chart_store`]),
+//!   [`scan`] (a PI-scanned image's lines, its store `scan_store`) and [`peakforce_image`]
+//!   (a PeakForce image's lines). `Chain`: tasks that start from the records before them —
+//!   [`basins`] (a basin map's rows, pass by pass, its store `basins::basin_store`),
+//!   [`global_continuation`] (a global continuation's values, its store
+//!   `global_continuation::continuation_store`), [`stepped`] (an approach or resonance curve's
+//!   points, one chain through both sweeps, its store `stepped::curve_store`) and
+//!   [`peakforce`] (a PeakForce sweep's taps, run in memory). And [`sweep`] (a bifurcation
+//!   sweep's points, its branches continued across them, stored by the request layer's
+//!   checkpoints). A chain's resume reads its stored records back (its next task starts from
+//!   them: `Done` is the records); a study of independent tasks reads only their numbers.
 //!
 //! The results' variables are declared once in [`crate::layout`], from which the NetCDF file,
 //! the Python `xarray.Dataset` and the Dask Zarr store are written.
@@ -41,6 +45,7 @@ pub mod chart;
 pub mod chart_store;
 pub mod global_continuation;
 pub mod image;
+mod kinds;
 mod memory;
 pub mod peakforce;
 pub mod peakforce_image;
@@ -56,6 +61,7 @@ pub mod sweep;
 #[cfg(feature = "files")]
 pub mod task_store;
 
+pub(crate) use kinds::{in_order, Chain, Tasks};
 pub use memory::MemoryStore;
 
 use crate::analysis::progress::Progress;

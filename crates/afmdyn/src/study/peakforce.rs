@@ -1,5 +1,5 @@
-//! A PeakForce sweep ([`crate::analysis::peakforce`]) as a [`Study`] ([`PeakForceStudy`]): a
-//! task is one value of the swept quantity (the mean rest separation z_c, or the modulation
+//! A PeakForce sweep ([`crate::analysis::peakforce`]) as a `Chain` (`PeakForceStudy::chain`):
+//! a task is one value of the swept quantity (the mean rest separation z_c, or the modulation
 //! frequency), numbered by its place in the values; its record the steady tap there, or why it
 //! failed. The tasks form one chain: each tap's transient starts from the previous tap's orbit
 //! (its state at τ = 0), which near a smooth branch settles in no more modulation periods
@@ -12,7 +12,7 @@
 //! Run in memory ([`super::execute_in_memory`]) by the `peakforce` request with a sweep, whose
 //! [`Analysis`] (running a request: a study's layer, above the request's data) is here.
 
-use super::{Prefix, Study};
+use super::Chain;
 use crate::analysis::peakforce::{
     peak_force_setpoint, steady_tap, steady_tap_from, PeakForceOptions, SetpointOptions, SteadyTap,
     BRACKET_STEPS, SETPOINT_ITERATIONS,
@@ -30,7 +30,7 @@ use nalgebra::DVector;
 use serde_json::{json, Value};
 use std::sync::atomic::{AtomicBool, Ordering};
 
-/// A PeakForce sweep as a [`Study`] (see the module doc).
+/// A PeakForce sweep, its study a `Chain` (see the module doc).
 #[derive(Debug, Clone)]
 pub struct PeakForceStudy {
     /// The model of every value, in the order of the sweep.
@@ -45,20 +45,6 @@ pub struct PeakForceStudy {
 }
 
 impl PeakForceStudy {
-    /// The records of a finished study (in any order), in the order of the values.
-    ///
-    /// # Errors
-    /// [`SimError::Cancelled`] when a value is missing (a run cut short).
-    pub fn taps(&self, mut records: Vec<SweepTap>) -> Result<Vec<SweepTap>, SimError> {
-        records.sort_by_key(|r| r.index);
-        if records.len() != self.points.len()
-            || records.iter().enumerate().any(|(i, r)| r.index != i)
-        {
-            return Err(SimError::Cancelled);
-        }
-        Ok(records)
-    }
-
     /// The tap at value `i` from the state `start` at τ = 0.
     fn tap(&self, i: usize, start: &DVector<f64>) -> Result<(Params, SteadyTap, usize), SimError> {
         let p = self.points[i];
@@ -78,45 +64,32 @@ impl PeakForceStudy {
             }
         }
     }
-}
 
-impl Study for PeakForceStudy {
-    /// The value's tap.
-    type Record = SweepTap;
-    /// The stored taps of the first values (the chain goes on from the last orbit).
-    type Done = Prefix<SweepTap>;
-
-    fn fingerprint(&self) -> &Value {
-        &self.fingerprint
+    /// The sweep as a `Chain`: its values' taps, each from the orbit of the last tap found
+    /// (from rest without one), after the stored taps up to the first one missing.
+    pub(crate) fn chain(&self) -> Chain<'_, SweepTap> {
+        Chain::new(
+            &self.fingerprint,
+            self.points.len(),
+            |done, sink, cancel| self.taps_after(done, sink, cancel),
+        )
     }
 
-    fn units(&self) -> u64 {
-        self.points.len() as u64
-    }
-
-    fn done_units(&self, done: &Prefix<SweepTap>) -> u64 {
-        done.0.len() as u64
-    }
-
-    fn record_units(&self, _: &SweepTap) -> u64 {
-        1
-    }
-
-    fn run(
+    /// The taps after `done`, each handed to `sink` (see `PeakForceStudy::chain`).
+    fn taps_after(
         &self,
-        done: &Prefix<SweepTap>,
-        sink: &(dyn Fn(SweepTap) + Sync),
+        done: &[SweepTap],
+        sink: &(dyn Fn(usize, SweepTap) + Sync),
         cancel: &AtomicBool,
     ) -> Result<(), SimError> {
         let dim = self.points.first().map_or(0, Params::state_dim);
         // the chain starts from the last orbit stored (from rest without one)
         let mut start = done
-            .0
             .iter()
             .rev()
             .find_map(|r| r.tap.as_ref().map(|t| t.state.clone()))
             .unwrap_or_else(|| DVector::zeros(dim));
-        for i in done.0.len()..self.points.len() {
+        for i in done.len()..self.points.len() {
             if cancel.load(Ordering::Relaxed) {
                 return Err(SimError::Cancelled);
             }
@@ -140,7 +113,7 @@ impl Study for PeakForceStudy {
                     message: Some(e.to_string()),
                 },
             };
-            sink(record);
+            sink(i, record);
         }
         Ok(())
     }
@@ -276,7 +249,8 @@ fn execute_sweep(
         options: request.options(),
         fingerprint: json!({"afmdyn": env!("CARGO_PKG_VERSION"), "peakforce": request, "params": p}),
     };
-    let taps = study.taps(super::execute_in_memory(&study, None, progress)?)?;
+    let records = super::execute_in_memory(&study.chain(), None, progress)?;
+    let taps = super::in_order(records, study.points.len())?;
     let failed = taps.iter().filter(|t| t.tap.is_none()).count();
     let Some(first) = taps.iter().find(|t| t.tap.is_some()) else {
         return Err(SimError::EveryRunFailed {

@@ -1,50 +1,18 @@
-//! The PI scan of an image as a study ([`ScanStudy`]: one task per line) and its local run
+//! The PI scan of an image as a study (`ScanStudy::tasks`: one task per line) and its local run
 //! ([`pi_image`]); the scan itself is [`crate::request::image_scan`].
 
-use super::Study;
-use crate::analysis::am_loop::{scan_lines, ScanLine};
+use super::Tasks;
+use crate::analysis::am_loop::ScanLine;
 use crate::error::SimError;
 use crate::request::image::{ImageRequest, SampleMap};
 use crate::request::image_scan::{PiImage, PiScan, ScanStudy};
-use serde_json::Value;
-use std::collections::HashSet;
-use std::sync::atomic::AtomicBool;
 
-impl Study for ScanStudy {
-    /// A line's number and its trace and retrace.
-    type Record = (usize, ScanLine);
-    /// The lines stored.
-    type Done = HashSet<usize>;
-
-    fn fingerprint(&self) -> &Value {
-        &self.fingerprint
-    }
-
-    fn units(&self) -> u64 {
-        self.lines() as u64
-    }
-
-    fn done_units(&self, done: &HashSet<usize>) -> u64 {
-        done.len() as u64
-    }
-
-    fn record_units(&self, _: &(usize, ScanLine)) -> u64 {
-        1
-    }
-
-    fn run(
-        &self,
-        done: &HashSet<usize>,
-        sink: &(dyn Fn((usize, ScanLine)) + Sync),
-        cancel: &AtomicBool,
-    ) -> Result<(), SimError> {
-        scan_lines(
-            self.lines(),
-            done,
-            &|t| self.line(t, cancel),
-            &|t, l| sink((t, l)),
-            cancel,
-        )
+impl ScanStudy {
+    /// The scan as a `Tasks` study: one task per line (its trace and retrace).
+    pub(crate) fn tasks(&self) -> Tasks<'_, ScanLine> {
+        Tasks::new(&self.fingerprint, self.lines(), |t, cancel| {
+            self.line(t, cancel).map(Some)
+        })
     }
 }
 
@@ -62,14 +30,6 @@ pub fn pi_image(
     observer: &dyn super::Observer,
 ) -> Result<PiImage, SimError> {
     let study = ScanStudy::new(probe_table, map, req, scan)?;
-    let mut store = super::MemoryStore::default();
-    match super::execute(&study, &mut store, false, threads, observer) {
-        Ok(super::Outcome::Cancelled) => return Err(SimError::Cancelled),
-        Ok(_) => {}
-        Err(super::StudyError::Sim(e)) => return Err(e),
-        Err(super::StudyError::Store(e)) => {
-            return Err(SimError::Probe(format!("the scan's store: {e}")))
-        }
-    }
-    study.assemble(store.records)
+    let records = super::execute_in_memory(&study.tasks(), threads, observer)?;
+    study.assemble(records)
 }

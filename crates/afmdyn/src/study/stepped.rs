@@ -1,5 +1,5 @@
 //! A stepped approach–retract or resonance curve ([`crate::analysis::stepped`]) as a
-//! [`Study`] ([`CurveStudy`]): a task is one point of the two sweeps, numbered 0..n along the
+//! `Chain` (`CurveStudy::chain`): a task is one point of the two sweeps, numbered 0..n along the
 //! first sweep (approach, up-sweep) and n..2n along the sweep back; the points form one chain
 //! — each is stepped from the orbit before it (its state, the secant or quadratic predictor
 //! through the points before, the monodromy trend) — so what a resume skips is the stored
@@ -13,7 +13,7 @@
 //! The requests' [`Analysis`] (`request::run`, Python's `afmdyn.approach` and
 //! `afmdyn.resonance`) run this study in memory.
 
-use super::{execute_in_memory, Prefix, Study};
+use super::{execute_in_memory, Chain};
 use crate::analysis::progress::Progress;
 use crate::analysis::setpoint::operating_points;
 use crate::analysis::stepped::{
@@ -30,9 +30,8 @@ use crate::request::run::{
 };
 use serde::Serialize;
 use serde_json::{json, Value};
-use std::sync::atomic::AtomicBool;
 
-/// A stepped curve as a [`Study`] (see the module doc): its validated spec and its
+/// A stepped curve, its study a `Chain` (see the module doc): its validated spec and its
 /// fingerprint.
 #[derive(Debug, Clone)]
 pub struct CurveStudy {
@@ -112,54 +111,26 @@ impl CurveStudy {
         progress: &Progress,
     ) -> Result<SteppedCurve, SimError> {
         let n = self.spec.values.len();
-        let mut records: Vec<(usize, CurvePoint)> = records.into_iter().collect();
-        records.sort_by_key(|(k, _)| *k);
-        if records.len() != 2 * n || records.iter().enumerate().any(|(i, (k, _))| *k != i) {
-            return Err(SimError::Cancelled);
-        }
-        let mut points: Vec<CurvePoint> = records.into_iter().map(|(_, p)| p).collect();
+        let mut points = super::in_order(records.into_iter().collect(), 2 * n)?;
         let second = points.split_off(n);
         finish_curve(&self.spec, points, second, progress)
     }
 
+    /// The curve as a `Chain`: its points (one unit each) of both sweeps, `0..2n`, stepped
+    /// after the stored points up to the first one missing ([`Prefix`](super::Prefix),
+    /// [`sweep_points`]).
+    pub(crate) fn chain(&self) -> Chain<'_, CurvePoint> {
+        let n = 2 * self.spec.values.len();
+        Chain::new(&self.fingerprint, n, |done, sink, cancel| {
+            let store = |k: usize, p: &CurvePoint| sink(k, p.clone());
+            sweep_points(&self.spec, done, cancel, &store).map(|_| ())
+        })
+    }
+
     /// Run the study in memory and assemble its curve.
     fn run_in_memory(&self, progress: &Progress) -> Result<SteppedCurve, SimError> {
-        let records = execute_in_memory(self, None, progress)?;
+        let records = execute_in_memory(&self.chain(), None, progress)?;
         self.curve(records, progress)
-    }
-}
-
-impl Study for CurveStudy {
-    /// The point's place (0..2n) and the point.
-    type Record = (usize, CurvePoint);
-    /// The stored points up to the first one missing, in order ([`Prefix`]).
-    type Done = Prefix<CurvePoint>;
-
-    fn fingerprint(&self) -> &Value {
-        &self.fingerprint
-    }
-
-    /// The points of both sweeps.
-    fn units(&self) -> u64 {
-        2 * self.spec.values.len() as u64
-    }
-
-    fn done_units(&self, done: &Prefix<CurvePoint>) -> u64 {
-        done.0.len() as u64
-    }
-
-    fn record_units(&self, _: &(usize, CurvePoint)) -> u64 {
-        1
-    }
-
-    fn run(
-        &self,
-        done: &Prefix<CurvePoint>,
-        sink: &(dyn Fn((usize, CurvePoint)) + Sync),
-        cancel: &AtomicBool,
-    ) -> Result<(), SimError> {
-        let store = |k: usize, p: &CurvePoint| sink((k, p.clone()));
-        sweep_points(&self.spec, &done.0, cancel, &store).map(|_| ())
     }
 }
 

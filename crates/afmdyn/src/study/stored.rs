@@ -193,7 +193,7 @@ fn curve(
     storage: Storage<'_>,
     progress: &Progress,
 ) -> Result<SteppedCurve, StudyError> {
-    let records = storage.records(study, curve_store, None, progress)?;
+    let records = storage.records(&study.chain(), curve_store, None, progress)?;
     Ok(study.curve(records, progress)?)
 }
 
@@ -238,7 +238,7 @@ impl Resumable for BasinsRequest {
         storage: Storage<'_>,
         progress: &Progress,
     ) -> Result<Self::Output, StudyError> {
-        let rows = storage.records(study, basin_store, self.threads, progress)?;
+        let rows = storage.records(&study.chain(), basin_store, self.threads, progress)?;
         let map = || study.map(rows.into_iter().map(|(_, r)| r));
         Ok(crate::request::in_pool(self.threads, map)?)
     }
@@ -256,7 +256,7 @@ impl Resumable for GlobalContinuationRequest {
         storage: Storage<'_>,
         progress: &Progress,
     ) -> Result<Self::Output, StudyError> {
-        let records = storage.records(study, continuation_store, None, progress)?;
+        let records = storage.records(&study.chain(), continuation_store, None, progress)?;
         Ok(study.steps(records)?)
     }
 }
@@ -275,7 +275,7 @@ impl Resumable for Chart {
         progress: &Progress,
     ) -> Result<Self::Output, StudyError> {
         Ok(cells_of(storage.records(
-            self,
+            &self.tasks(),
             chart_store,
             self.threads,
             progress,
@@ -307,7 +307,7 @@ impl Resumable for ImageJob {
         let Some(study) = study else {
             return Ok(self.execute(model, progress)?);
         };
-        let records = storage.records(study, scan_store, self.threads, progress)?;
+        let records = storage.records(&study.tasks(), scan_store, self.threads, progress)?;
         Ok(ImageOutput::Pi(study.assemble(records)?))
     }
 }

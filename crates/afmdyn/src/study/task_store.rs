@@ -22,10 +22,9 @@
 
 use crate::io::dir_lock::DirLock;
 use crate::io::input::InputKind;
-use crate::request::checkpoint::{CheckpointError, Ledger};
-use crate::request::checkpoint_file::{crc_hex, open_store, read_failed, read_ledger};
+use crate::request::checkpoint::{same_request, CheckpointError, Ledger};
+use crate::request::checkpoint_file::{crc_hex, io, open_store, read_failed, read_ledger};
 use crate::request::checkpoint_file::{write_atomic, START_OVER};
-use crate::request::sweep::first_difference;
 use base64::engine::general_purpose::STANDARD as BASE64;
 use base64::Engine;
 use serde::de::DeserializeOwned;
@@ -35,7 +34,7 @@ use std::collections::{BTreeMap, BTreeSet, HashSet};
 use std::fs::{self, File, OpenOptions};
 use std::io::{BufRead, BufReader, BufWriter, Write};
 use std::marker::PhantomData;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use super::{Opened, Store, Study};
 
@@ -69,17 +68,6 @@ pub enum Encoding {
     /// every f64 bit for bit, NaN and ±∞ included (a periodic orbit's grazing distance is +∞
     /// when it never comes near the sample).
     Cbor,
-}
-
-fn io<'p>(
-    action: &'static str,
-    path: &'p Path,
-) -> impl FnOnce(std::io::Error) -> CheckpointError + 'p {
-    move |e| CheckpointError::Io {
-        action,
-        path: path.display().to_string(),
-        message: e.to_string(),
-    }
 }
 
 /// A study's store of records `R` in the directory its lock holds.
@@ -174,15 +162,7 @@ impl<'a, R: Serialize + DeserializeOwned + Clone> TaskStore<'a, R> {
                 }
                 None => {}
                 Some(ledger) => {
-                    let now: Value = serde_json::from_str(&fingerprint.to_string())
-                        .unwrap_or_else(|_| fingerprint.clone());
-                    if let Some((field, then, now)) = first_difference(&ledger.fingerprint, &now) {
-                        let field = field
-                            .strip_prefix(self.files.prefix)
-                            .unwrap_or(&field)
-                            .to_string();
-                        return Err(CheckpointError::Mismatch { field, then, now });
-                    }
+                    same_request(&ledger.fingerprint, fingerprint, self.files.prefix)?;
                     self.tasks = self.read_records(|_, _| {})?;
                     if let Some(k) = self.kept.as_mut() {
                         *k = (BTreeMap::new(), false);
