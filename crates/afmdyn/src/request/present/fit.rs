@@ -38,6 +38,22 @@ fn estimate_line(name: &str, e: &Value, unit: &str, text: TextUnits) -> String {
     )
 }
 
+/// The parameters a fit held, at their values (`held: baseline = 0 N, …`), so that no held
+/// one passes for fitted; `None` when every parameter was fitted.
+fn held_line(document: &Value, text: TextUnits) -> Option<String> {
+    let held: Vec<String> = document["parameters"]
+        .as_object()?
+        .iter()
+        .filter(|(_, q)| q["fitted"] == Value::Bool(false))
+        .map(|(name, q)| {
+            let unit = document["units"][name.as_str()].as_str().unwrap_or("");
+            let value = q["value"].as_f64().unwrap_or(f64::NAN);
+            format!("{name} = {}", text.value(value, unit))
+        })
+        .collect();
+    (!held.is_empty()).then(|| format!("held: {}", held.join(", ")))
+}
+
 /// The presentation of a fit's `document` ([`crate::request::fit::document`]): the summary,
 /// and with `files` the table, the figures (all files) and the document `fit.json`.
 pub fn fit(
@@ -57,20 +73,8 @@ pub fn fit(
             p.line(estimate_line(name, e, unit, text));
         }
     }
-    // the parameters held, at their values, so that no held one passes for fitted
-    if let Some(params) = document["parameters"].as_object() {
-        let held: Vec<String> = params
-            .iter()
-            .filter(|(_, q)| q["fitted"] == Value::Bool(false))
-            .map(|(name, q)| {
-                let unit = units[name.as_str()].as_str().unwrap_or("");
-                let value = q["value"].as_f64().unwrap_or(f64::NAN);
-                format!("{name} = {}", text.value(value, unit))
-            })
-            .collect();
-        if !held.is_empty() {
-            p.line(format!("held: {}", held.join(", ")));
-        }
+    if let Some(line) = held_line(document, text) {
+        p.line(line);
     }
     // a force curve names its segment; a dynamic curve its kind (AM, with the bimodal
     // channels, or FM)
