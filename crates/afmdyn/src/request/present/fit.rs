@@ -138,8 +138,9 @@ pub fn fit(
                 "Force curve: the data and the fit",
                 ("tip position (m)".into(), "force (N)".into()),
                 vec![
-                    series("data", 1, Style::Dots, 0),
+                    // the data drawn over the fit line, not hidden behind it
                     series("fit", 2, Style::Line, 1),
+                    series("data", 1, Style::Dots, 0),
                 ],
             ),
         );
@@ -158,8 +159,8 @@ pub fn fit(
                     "Force against time: the data and the fit (approach, dwell, retract)",
                     ("time (s)".into(), "force (N)".into()),
                     vec![
-                        against(4, "data", 1, Style::Dots, 0),
                         against(4, "fit", 2, Style::Line, 1),
+                        against(4, "data", 1, Style::Dots, 0),
                     ],
                 ),
             );
@@ -225,8 +226,9 @@ fn am_files(p: &mut Presentation, document: &Value, files: Files) {
                 ),
                 ("z (m)".into(), format!("{channel} ({unit})")),
                 vec![
-                    series("data", d, Style::Dots, 0),
+                    // the data drawn over the fit line (issue 77: hidden behind it)
                     series("fit", f, Style::Line, 1),
+                    series("data", d, Style::Dots, 0),
                 ],
             ),
         );
