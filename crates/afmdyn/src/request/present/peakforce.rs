@@ -235,6 +235,30 @@ fn summary(p: &mut Presentation, document: &Value, text: TextUnits, sweep: Optio
     }
 }
 
+/// The distances about the contact of a tap's force curve (rows: approach distance and force,
+/// retract distance and force): where |F| is at least 2 % of its largest, widened by a quarter
+/// of that span below and one span above (the force's onset and the adhesion's tail); `None`
+/// when that covers most of the modulation anyway (nothing to zoom on).
+fn contact_window(curve: &[Vec<f64>]) -> Option<(f64, f64)> {
+    let points = || {
+        curve
+            .iter()
+            .flat_map(|r| [(r[0], r[1]), (r[2], r[3])])
+            .filter(|(d, f)| d.is_finite() && f.is_finite())
+    };
+    let peak = points().map(|(_, f)| f.abs()).fold(0.0, f64::max);
+    let (mut a, mut b) = (f64::INFINITY, f64::NEG_INFINITY);
+    for (d, _) in points().filter(|(_, f)| f.abs() >= 0.02 * peak) {
+        (a, b) = (a.min(d), b.max(d));
+    }
+    let (lo, hi) = points().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), (d, _)| {
+        (lo.min(d), hi.max(d))
+    });
+    let w = (b - a).max(1e-3 * (hi - lo));
+    let window = (a - 0.25 * w, b + w);
+    (peak > 0.0 && window.1 - window.0 < 0.5 * (hi - lo)).then_some(window)
+}
+
 /// The figures of a steady tap into `p` (in SI when `si`): force against distance (the
 /// `curve`'s rows; the force through the instrument's filter too when `filtered`), the
 /// `sweep`'s peak force and adhesion, and force against time (the `cycle`'s rows).
@@ -259,25 +283,29 @@ fn figures(
         style: Style::Line,
         color,
     };
-    let approach = curve.iter().map(|r| (r[0], r[1])).collect();
-    let retract = curve.iter().map(|r| (r[2], r[3])).collect();
+    // the distances shown: the contact's, as instruments show a force curve (the whole
+    // modulation in the table)
+    let (lo, hi) = contact_window(curve).unwrap_or((f64::NEG_INFINITY, f64::INFINITY));
+    let shown = |x: usize, y: usize| -> Vec<(f64, f64)> {
+        let rows = curve.iter().map(|r| (r[x], r[y]));
+        rows.filter(|(d, _)| (lo..=hi).contains(d)).collect()
+    };
     let mut all = vec![
-        series("approach", approach, 0),
-        series("retract", retract, 1),
+        series("approach", shown(0, 1), 0),
+        series("retract", shown(2, 3), 1),
     ];
     if filtered {
-        let approach = curve.iter().map(|r| (r[0], r[4])).collect();
-        let retract = curve.iter().map(|r| (r[2], r[5])).collect();
-        all.push(series("approach, k × deflection filtered", approach, 2));
-        all.push(series("retract, k × deflection filtered", retract, 3));
+        all.push(series("approach, k × deflection filtered", shown(0, 4), 2));
+        all.push(series("retract, k × deflection filtered", shown(2, 5), 3));
     }
+    let title = if hi.is_finite() {
+        "PeakForce tapping: force against tip–sample distance, about the contact"
+    } else {
+        "PeakForce tapping: force against tip–sample distance"
+    };
     p.figure(
         "peakforce-curve",
-        lines(
-            "PeakForce tapping: force against tip–sample distance",
-            (format!("distance{l}"), format!("force{f}")),
-            all,
-        ),
+        lines(title, (format!("distance{l}"), format!("force{f}")), all),
     );
     if let Some((param, rows, _)) = sweep {
         let unit = document["sweep"]["unit"].as_str().unwrap_or("");
@@ -308,4 +336,31 @@ fn figures(
             vec![series("", time, 0)],
         ),
     );
+}
+
+#[cfg(test)]
+mod tests {
+    /// The force curve is shown about the contact (issue 77 §12: a 300 nm modulation made the
+    /// few-nm contact a vertical line): a Hertz contact F ∝ max(−d, 0)^{3/2} below d = 0 with
+    /// a 1 nm adhesive well, over distances from −3 nm to 297 nm, is shown from below its
+    /// deepest point to a few nm above the contact; a force over the whole range is not zoomed.
+    #[test]
+    fn the_force_curve_is_shown_about_the_contact() {
+        let row = |d: f64| {
+            let f = if d < 0.0 {
+                (-d).powf(1.5)
+            } else {
+                -0.3 * (-d).exp()
+            };
+            vec![d, f, d, f]
+        };
+        let curve: Vec<Vec<f64>> = (0..=3000).map(|i| row(-3.0 + 0.1 * i as f64)).collect();
+        let (lo, hi) = super::contact_window(&curve).expect("zoomed");
+        assert!((-4.5..-3.0).contains(&lo), "{lo}");
+        assert!(hi > 3.0 && hi < 15.0, "{hi}");
+        let linear: Vec<Vec<f64>> = (0..=300)
+            .map(|i| vec![i as f64, i as f64, i as f64, i as f64])
+            .collect();
+        assert_eq!(super::contact_window(&linear), None);
+    }
 }
