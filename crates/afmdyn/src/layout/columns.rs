@@ -1,0 +1,223 @@
+//! A result table declared once: its columns, each with its name, where its unit comes from,
+//! its long name and how its value is taken from a result's row. From that one declaration
+//! come a JSON document's arrays ([`arrays`]) and its `units` object ([`units`]), the
+//! [`Layout`](super::Layout)'s variables ([`variables`]: Python's Dataset, NetCDF) and a
+//! table's columns and rows ([`names`], [`rows`]: the CSV file).
+//!
+//! A row is read through a frame `C` (the factors that turn the model's values into the
+//! reported units, a reference point), so a column's value is a plain function of the two.
+
+use super::{Values, Variable};
+use serde_json::{Map, Value};
+
+/// The names of the units of a result's kinds of quantity in one system of units (SI with a
+/// probe, the model's without).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct UnitNames {
+    /// Whether these are SI names ([`Unit::Own`] takes its first name then).
+    pub si: bool,
+    /// Lengths.
+    pub length: &'static str,
+    /// Forces.
+    pub force: &'static str,
+    /// Energies.
+    pub energy: &'static str,
+    /// Frequencies.
+    pub frequency: &'static str,
+}
+
+/// Where a column's unit comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Unit {
+    /// The result's length unit.
+    Length,
+    /// The result's force unit.
+    Force,
+    /// The result's energy unit.
+    Energy,
+    /// The result's frequency unit.
+    Frequency,
+    /// A unit of its own, the same in both systems (`"1"` a pure number, `""` a flag).
+    Fixed(&'static str),
+    /// A unit of its own in each system: (SI, the model's).
+    Own(&'static str, &'static str),
+}
+
+impl Unit {
+    /// The unit's name among `names`.
+    pub fn name(self, names: &UnitNames) -> &'static str {
+        match self {
+            Unit::Length => names.length,
+            Unit::Force => names.force,
+            Unit::Energy => names.energy,
+            Unit::Frequency => names.frequency,
+            Unit::Fixed(u) => u,
+            Unit::Own(si, model) => {
+                if names.si {
+                    si
+                } else {
+                    model
+                }
+            }
+        }
+    }
+}
+
+/// How a column's value is taken from a row `R` read through a frame `C`; the variant is the
+/// kind of the values.
+pub enum Get<C, R> {
+    /// A number.
+    F64(fn(&C, &R) -> f64),
+    /// A flag (a table's 1/0).
+    Bool(fn(&R) -> bool),
+    /// A count (a layout's 32-bit integer).
+    Count(fn(&R) -> usize),
+}
+
+/// One column of a result table.
+pub struct Column<C, R> {
+    /// Its name: the document's key, the variable's and the table column's.
+    pub name: &'static str,
+    /// Where its unit comes from.
+    pub unit: Unit,
+    /// Whether the document's `units` object names it ([`units`]).
+    pub listed: bool,
+    /// What it is, in words (the variable's long name).
+    pub long_name: &'static str,
+    /// How its value is taken from a row.
+    pub get: Get<C, R>,
+}
+
+/// The values of `column` over `rows` as a JSON array (NaN as `null`).
+fn array<C, R>(column: &Column<C, R>, frame: &C, rows: &[R]) -> Value {
+    match column.get {
+        Get::F64(f) => rows.iter().map(|r| f(frame, r)).collect::<Vec<_>>().into(),
+        Get::Bool(f) => rows.iter().map(f).collect::<Vec<_>>().into(),
+        Get::Count(f) => rows.iter().map(f).collect::<Vec<_>>().into(),
+    }
+}
+
+/// The document's arrays: one per column, keyed by its name, one entry per row.
+pub fn arrays<C, R>(columns: &[Column<C, R>], frame: &C, rows: &[R]) -> Map<String, Value> {
+    let named = columns
+        .iter()
+        .map(|c| (c.name.into(), array(c, frame, rows)));
+    named.collect()
+}
+
+/// The document's `units` object: the unit of each column it names ([`Column::listed`]).
+pub fn units<C, R>(columns: &[Column<C, R>], names: &UnitNames) -> Map<String, Value> {
+    let listed = columns.iter().filter(|c| c.listed);
+    listed
+        .map(|c| (c.name.into(), c.unit.name(names).into()))
+        .collect()
+}
+
+/// The layout's variables: one per column over `dims`, in the columns' order, with its unit
+/// and long name.
+pub fn variables<C, R>(
+    columns: &[Column<C, R>],
+    frame: &C,
+    rows: &[R],
+    dims: &[&str],
+    names: &UnitNames,
+) -> Vec<Variable> {
+    let values = |get: &Get<C, R>| match *get {
+        Get::F64(f) => Values::F64(rows.iter().map(|r| f(frame, r)).collect()),
+        Get::Bool(f) => Values::Bool(rows.iter().map(f).collect()),
+        Get::Count(f) => Values::I32(rows.iter().map(|r| f(r) as i32).collect()),
+    };
+    let variable = |c: &Column<C, R>| {
+        let unit = c.unit.name(names);
+        Variable::new(c.name, dims, unit, c.long_name, values(&c.get))
+    };
+    columns.iter().map(variable).collect()
+}
+
+/// The table's column names, in order.
+pub fn names<C, R>(columns: &[Column<C, R>]) -> Vec<&'static str> {
+    columns.iter().map(|c| c.name).collect()
+}
+
+/// The table's rows, one per row, in the columns' order (flags as 1/0).
+pub fn rows<C, R>(columns: &[Column<C, R>], frame: &C, rows: &[R]) -> Vec<Vec<f64>> {
+    let cell = |c: &Column<C, R>, r: &R| match c.get {
+        Get::F64(f) => f(frame, r),
+        Get::Bool(f) => f64::from(u8::from(f(r))),
+        Get::Count(f) => f(r) as f64,
+    };
+    let row = |r: &R| columns.iter().map(|c| cell(c, r)).collect();
+    rows.iter().map(row).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    struct Point {
+        x: f64,
+        on: bool,
+        n: usize,
+    }
+
+    const NAMES: UnitNames = UnitNames {
+        si: true,
+        length: "m",
+        force: "N",
+        energy: "J",
+        frequency: "Hz",
+    };
+
+    const COLUMNS: [Column<f64, Point>; 3] = [
+        Column {
+            name: "x",
+            unit: Unit::Length,
+            listed: true,
+            long_name: "position",
+            get: Get::F64(|scale, p| p.x * scale),
+        },
+        Column {
+            name: "on",
+            unit: Unit::Fixed(""),
+            listed: false,
+            long_name: "flag",
+            get: Get::Bool(|p| p.on),
+        },
+        Column {
+            name: "n",
+            unit: Unit::Own("1 (SI)", "1"),
+            listed: true,
+            long_name: "count",
+            get: Get::Count(|p| p.n),
+        },
+    ];
+
+    fn points() -> [Point; 2] {
+        let p = |x, on, n| Point { x, on, n };
+        [p(1.0, true, 3), p(f64::NAN, false, 4)]
+    }
+
+    #[test]
+    fn one_declaration_gives_every_form_of_the_table() {
+        let p = points();
+        let doc = Value::Object(arrays(&COLUMNS, &2.0, &p));
+        let expected = serde_json::json!({"x": [2.0, null], "on": [true, false], "n": [3, 4]});
+        assert_eq!(doc, expected);
+        let u = Value::Object(units(&COLUMNS, &NAMES));
+        assert_eq!(u, serde_json::json!({"x": "m", "n": "1 (SI)"}));
+        let model = UnitNames { si: false, ..NAMES };
+        assert_eq!(Unit::Own("a", "b").name(&model), "b");
+        let vars = variables(&COLUMNS, &2.0, &p, &["i"], &model);
+        let described: Vec<_> = vars
+            .iter()
+            .map(|v| (v.name.as_str(), v.units.as_str()))
+            .collect();
+        assert_eq!(described, [("x", "m"), ("on", ""), ("n", "1")]);
+        assert_eq!(vars[1].values, Values::Bool(vec![true, false]));
+        assert_eq!(vars[2].values, Values::I32(vec![3, 4]));
+        assert_eq!(names(&COLUMNS), ["x", "on", "n"]);
+        let table = rows(&COLUMNS, &2.0, &p);
+        assert_eq!(table[0], [2.0, 1.0, 3.0]);
+        assert!(table[1][0].is_nan() && table[1][1..] == [0.0, 4.0]);
+    }
+}
